@@ -1,0 +1,69 @@
+# phgmg — build, test, demo, bench.
+#   make test      build and run every test (plain, then ASan+UBSan), compile checks
+#   make demo      reproduce Section 5 of the paper into results/
+#   make bench     timings into bench/results.csv
+#   make examples  build the examples
+#   make embedded  cross-compile the controller example for Cortex-M4F
+#   make fuzz      short fuzzing run of every reader of outside data
+CC      ?= cc
+CXX     ?= c++
+WARN     = -Wall -Wextra -Werror -pedantic -Wshadow
+CFLAGS_T = -std=c99 $(WARN) -O2 -g $(DEVFLAGS)
+# TEMPORARY while fragments are being written in parallel; removed when all are defined.
+DEVFLAGS = -Wno-unused-function
+SANFLAGS = -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=all
+OPTFLAGS = -std=c99 $(WARN) -O2 -march=native
+LDLIBS   = -lm
+
+FRAGS   := $(wildcard dev/h*.h dev/i*.c dev/z*.h)
+TESTSRC := $(wildcard tests/test_*.c)
+BUILD    = build
+
+.PHONY: all test test-plain test-asan compile-checks demo bench examples embedded fuzz clean
+
+all: phgmg.h examples
+
+phgmg.h: $(FRAGS) dev/amalgamate.sh
+	sh dev/amalgamate.sh
+
+tests/suites.inc: $(TESTSRC)
+	grep -h '^SUITE(' $(TESTSRC) | sed 's/^SUITE(\([a-z0-9_]*\)).*/SUITE_DECL(\1)/' > $@
+
+$(BUILD)/test_run: phgmg.h tests/run.c tests/harness.h tests/suites.inc $(TESTSRC)
+	@mkdir -p $(BUILD)
+	$(CC) $(CFLAGS_T) -o $@ tests/run.c $(TESTSRC) $(LDLIBS)
+
+$(BUILD)/test_run_asan: phgmg.h tests/run.c tests/harness.h tests/suites.inc $(TESTSRC)
+	@mkdir -p $(BUILD)
+	$(CC) $(CFLAGS_T) -O1 $(SANFLAGS) -o $@ tests/run.c $(TESTSRC) $(LDLIBS)
+
+test: test-plain test-asan compile-checks
+
+test-plain: $(BUILD)/test_run
+	./$(BUILD)/test_run
+
+test-asan: $(BUILD)/test_run_asan
+	ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1 ./$(BUILD)/test_run_asan
+
+# The header as users build it: C99, C11, C++, float online scalar, PHGMG_STATIC
+# in two translation units, declarations only, offline half compiled out.
+compile-checks: phgmg.h
+	@mkdir -p $(BUILD)/cc
+	@printf '#define PHGMG_IMPLEMENTATION\n#include "../../phgmg.h"\nint main(void){return 0;}\n' > $(BUILD)/cc/impl.c
+	@cp $(BUILD)/cc/impl.c $(BUILD)/cc/impl.cpp
+	@printf '#include "../../phgmg.h"\nint decl_only(void){return (int)PHGMG_OK;}\n' > $(BUILD)/cc/decl.c
+	@printf '#define PHGMG_STATIC\n#define PHGMG_IMPLEMENTATION\n#include "../../phgmg.h"\nint tu2(void){return (int)PHGMG_OK;}\n' > $(BUILD)/cc/s2.c
+	@printf '#define PHGMG_STATIC\n#define PHGMG_IMPLEMENTATION\n#include "../../phgmg.h"\nint tu2(void);\nint main(void){return tu2();}\n' > $(BUILD)/cc/s1.c
+	$(CC) -std=c99 $(WARN) -Wdouble-promotion -c $(BUILD)/cc/impl.c -o $(BUILD)/cc/a.o
+	$(CC) -std=c11 $(WARN) -Wdouble-promotion -c $(BUILD)/cc/impl.c -o $(BUILD)/cc/a.o
+	$(CC) -std=c99 $(WARN) -Wdouble-promotion -DPHGMG_REAL_FLOAT -c $(BUILD)/cc/impl.c -o $(BUILD)/cc/a.o
+	$(CC) -std=c99 $(WARN) -Wdouble-promotion -DPHGMG_REAL_FLOAT -DPHGMG_NO_OFFLINE -c $(BUILD)/cc/impl.c -o $(BUILD)/cc/a.o
+	$(CC) -std=c99 $(WARN) -DPHGMG_NO_OFFLINE -c $(BUILD)/cc/impl.c -o $(BUILD)/cc/a.o
+	$(CXX) -std=c++11 -Wall -Wextra -Werror -c $(BUILD)/cc/impl.cpp -o $(BUILD)/cc/a.o
+	$(CXX) -std=c++11 -Wall -Wextra -Werror -DPHGMG_REAL_FLOAT -c $(BUILD)/cc/impl.cpp -o $(BUILD)/cc/a.o
+	$(CC) -std=c99 $(WARN) -c $(BUILD)/cc/decl.c -o $(BUILD)/cc/a.o
+	$(CC) -std=c99 $(WARN) $(BUILD)/cc/s1.c $(BUILD)/cc/s2.c -o $(BUILD)/cc/static2 $(LDLIBS)
+	@echo "compile checks passed"
+
+clean:
+	rm -rf $(BUILD) results tests/suites.inc bench/results.csv

@@ -1,0 +1,128 @@
+
+/* >>ph ==================================================================== */
+/* Full-order port-Hamiltonian systems (offline half, double):
+       x' = (J - R) grad H(x) + B u(t),   y = B^T grad H(x),
+       H(x) = 1/2 x^T Q x + H_nl(x).
+   J, R, Q are given dense (N x N, column-major, ld = N) or banded (all three
+   with the same half-bandwidth kb, stored as (2kb+1) x N, element (i,j) with
+   |i-j| <= kb at band[(kb + i - j) + j*(2kb+1)]). B is always dense N x m. */
+#ifndef PHGMG_NO_OFFLINE
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef enum phgmg_storage { PHGMG_DENSE = 0, PHGMG_BANDED = 1 } phgmg_storage;
+
+typedef enum phgmg_nl_kind {
+  PHGMG_NL_NONE = 0,      /* quadratic Hamiltonian only                          */
+  PHGMG_NL_SEPARABLE = 1, /* H_nl(x) = sum_k w_k phi_k(x[idx_k])  (DEIM needs this) */
+  PHGMG_NL_GENERAL = 2    /* H_nl, grad and Hessian by callbacks                 */
+} phgmg_nl_kind;
+
+/* Scalar callbacks of a separable nonlinear part: for term k (0-based, over the
+   nsep terms) return phi_k(s), phi_k'(s), phi_k''(s). */
+typedef double (*phgmg_phi_fn)(int k, double s, void *user);
+
+typedef struct phgmg_ph_system {
+  int N, m;
+  phgmg_storage storage;   /* DENSE (default) or BANDED                      */
+  int kb;                  /* half-bandwidth for BANDED                      */
+  const double *J, *R, *Q; /* dense N x N or banded (2kb+1) x N              */
+  const double *B;         /* N x m, ld = N                                   */
+  /* nonlinear part of H */
+  phgmg_nl_kind nl;
+  int nsep;                /* SEPARABLE: number of terms                     */
+  const int *sep_idx;      /* SEPARABLE: coordinate of term k (0-based)      */
+  const double *sep_w;     /* SEPARABLE: weights (NULL = all 1)              */
+  phgmg_phi_fn phi, dphi, ddphi;
+  /* SEPARABLE, optional: if poly_deg > 0, phi_k(s) = sum_j poly[j] s^j for every
+     k (the callbacks may then be NULL). Reduced models can be exported only
+     when the nonlinearity is given this way. */
+  int poly_deg;
+  const double *poly;      /* poly_deg+1 coefficients, constant term first   */
+  /* GENERAL */
+  double (*H_nl)(const double *x, void *user);
+  void (*grad_nl)(const double *x, double *g, void *user);
+  /* Hessian of H_nl: dense N x N (ld N) or banded like Q. */
+  void (*hess_nl)(const double *x, double *Hs, void *user);
+  void *user;
+} phgmg_ph_system;
+
+/* Validation of a system. tol (<= 0: 1e-12) is relative to the matrix norms:
+   ||J + J^T|| <= tol ||J||, ||R - R^T|| <= tol ||R||, lambda_min(R) >= -tol ||R||,
+   B full column rank, 1/cond_1(J - R) > tol (rcond_out, may be NULL, receives
+   the estimate), no NaN/Inf, sizes consistent.
+   Returns PHGMG_ERR_SIZE / _NANINF / _NOT_SKEW / _NOT_SYMMETRIC / _NOT_PSD /
+   _RANK / _SINGULAR / _NOMEM. */
+PHGMG_DEF phgmg_result phgmg_ph_validate(const phgmg_ph_system *sys, double tol,
+                                         double *rcond_out, const phgmg_allocator *alloc);
+
+/* Hamiltonian, its gradient and the output at a state. */
+PHGMG_DEF double phgmg_ph_hamiltonian(const phgmg_ph_system *sys, const double *x);
+PHGMG_DEF void phgmg_ph_gradient(const phgmg_ph_system *sys, const double *x, double *g);
+/* f = (J - R) grad H(x) + B u  (u may be NULL = 0). */
+PHGMG_DEF void phgmg_ph_rhs(const phgmg_ph_system *sys, const double *x, const double *u, double *f);
+/* y (m) = B^T grad H(x). */
+PHGMG_DEF void phgmg_ph_output(const phgmg_ph_system *sys, const double *x, double *y);
+
+/* >>gl3 =================================================================== */
+/* 3-stage Gauss-Legendre (order 6), simplified Newton on the transformed stage
+   system (one real and one complex N x N solve per iteration), factorization
+   reuse, extrapolated starting guess. For linear systems (nl == NONE) with a
+   fixed step a precomputed step map is used unless opts.no_step_map. */
+
+/* u(t) into u[m]. */
+typedef void (*phgmg_input_fn)(double t, double *u, void *user);
+
+typedef struct phgmg_gl3_opts {
+  double tol;          /* Newton tolerance on the stage residual, inf-norm (0: 1e-10) */
+  int max_iter;        /* Newton iteration cap per step (0: 10)                      */
+  int no_step_map;     /* 1: never use the precomputed linear step map               */
+  double contraction;  /* refactor when the contraction rate exceeds this (0: 0.5)    */
+} phgmg_gl3_opts;
+
+typedef struct phgmg_gl3_stats {
+  long steps, newton_iters, factorizations, rhs_evals, failures;
+  double max_residual;  /* largest final stage residual over the steps */
+} phgmg_gl3_stats;
+
+/* Energy bookkeeping of one run, per grid point n = 0..nsteps:
+   H[n] = H(x_n), S[n] = supplied energy up to t_n (h sum b_i y_i^T u_i),
+   D[n] = dissipated energy up to t_n (h sum b_i gradH(Y_i)^T R gradH(Y_i)),
+   so e_energy(t_n) = |H[n] - H[0] - S[n] + D[n]| (paper eq.
+   def_energy_conserve_error, stage quadrature). */
+typedef struct phgmg_energy {
+  double *H, *S, *D;   /* each nsteps+1, caller-provided */
+} phgmg_energy;
+
+/* A stepper object for one system and one step size (allocates once). */
+typedef struct phgmg_gl3 phgmg_gl3;
+PHGMG_DEF phgmg_result phgmg_gl3_create(phgmg_gl3 **out, const phgmg_ph_system *sys, double dt,
+                                        const phgmg_gl3_opts *opts, const phgmg_allocator *alloc);
+PHGMG_DEF void phgmg_gl3_destroy(phgmg_gl3 *s);
+/* One step from (t, x) to t + dt; x updated in place on success, untouched on
+   failure (PHGMG_ERR_NOT_CONVERGED, PHGMG_ERR_NANINF, PHGMG_ERR_SINGULAR).
+   uf may be NULL (u = 0). energy_inc (may be NULL) receives
+   {supplied, dissipated} over the step. */
+PHGMG_DEF phgmg_result phgmg_gl3_step(phgmg_gl3 *s, double t, double *x, phgmg_input_fn uf,
+                                      void *uuser, double energy_inc[2]);
+PHGMG_DEF const phgmg_gl3_stats *phgmg_gl3_get_stats(const phgmg_gl3 *s);
+
+/* Simulate nsteps steps from x0 at t0. Outputs (each may be NULL):
+   X: N x (nsteps+1) trajectory (ld N), Y: m x (nsteps+1) outputs (ld m),
+   energy: bookkeeping as above; stats: totals. On a step failure the
+   buffers hold the steps done so far and the failing code is returned;
+   *steps_done (may be NULL) says how many steps succeeded. */
+PHGMG_DEF phgmg_result phgmg_simulate(const phgmg_ph_system *sys, const double *x0, double t0,
+                                      double dt, int nsteps, phgmg_input_fn uf, void *uuser,
+                                      const phgmg_gl3_opts *opts, double *X, double *Y,
+                                      const phgmg_energy *energy, phgmg_gl3_stats *stats,
+                                      int *steps_done, const phgmg_allocator *alloc);
+
+/* Gauss-Legendre coefficients (closed forms): c[3], b[3], A[9] row-major A[i*3+j]. */
+PHGMG_DEF void phgmg_gl3_coefficients(double c[3], double b[3], double A[9]);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* PHGMG_NO_OFFLINE */

@@ -1,0 +1,42 @@
+/* Minimal test harness for phgmg (no external framework).
+   A test is `TEST(name) { ... CHECK(cond); ... }`, registered in a suite:
+       SUITE(linalg) { RUN(test_lu_random); RUN(test_qr); }
+   Suites are collected by the Makefile into tests/suites.inc. The runner ends
+   with the line "N passed, N failed". Each test file defines PHGMG_STATIC and
+   PHGMG_IMPLEMENTATION itself, so it can reach private helpers. */
+#ifndef PHGMG_TEST_HARNESS_H
+#define PHGMG_TEST_HARNESS_H
+#include <stdio.h>
+#include <math.h>
+#include <string.h>
+
+extern int th_cur_failed;    /* checks failed in the current test */
+extern const char *th_filter;
+void th_run(const char *suite, const char *name, void (*fn)(void));
+void th_fail_msg(const char *file, int line, const char *expr);
+
+#define TEST(name) static void name(void)
+#define RUN(name) th_run(th_suite_name_, #name, name)
+#define SUITE(s) \
+  void suite_##s(void); \
+  static const char *th_suite_name_ = #s; \
+  void suite_##s(void)
+#define CHECK(cond) do { if (!(cond)) th_fail_msg(__FILE__, __LINE__, #cond); } while (0)
+/* a <= b with both printed on failure */
+#define CHECK_LE(a, b) do { double th_a_ = (double)(a), th_b_ = (double)(b); \
+    if (!(th_a_ <= th_b_)) { char th_m_[256]; \
+      snprintf(th_m_, sizeof th_m_, "%s <= %s  (%.3e vs %.3e)", #a, #b, th_a_, th_b_); \
+      th_fail_msg(__FILE__, __LINE__, th_m_); } } while (0)
+#define CHECK_RC(rc, expect) do { int th_r_ = (int)(rc), th_e_ = (int)(expect); \
+    if (th_r_ != th_e_) { char th_m_[256]; \
+      snprintf(th_m_, sizeof th_m_, "%s == %s  (got %d: %s)", #rc, #expect, th_r_, \
+               phgmg_result_string((phgmg_result)th_r_)); \
+      th_fail_msg(__FILE__, __LINE__, th_m_); } } while (0)
+
+/* Deterministic random numbers for tests (xorshift64*), uniform in [-1, 1). */
+static inline double th_rand(void) {
+  static unsigned long long s = 0x9E3779B97F4A7C15ULL;
+  s ^= s >> 12; s ^= s << 25; s ^= s >> 27;
+  return (double)((s * 2685821657736338717ULL) >> 11) / 4503599627370496.0 - 1.0;
+}
+#endif
