@@ -221,6 +221,20 @@ typedef struct phgmg_ph_system {
   /* Hessian of H_nl: dense N x N (ld N) or banded like Q. */
   void (*hess_nl)(const double *x, double *Hs, void *user);
   void *user;
+  /* Optional caller-supplied solver for the shifted Newton matrices of the GL3
+     stepper, K(sigma) = sigma I - (J - R) Hess H(x_lin), sigma = sr + i si, so a
+     model can bring its own O(N) solve. Both NULL (default): the library's
+     dense or banded LU. Both set: at every (re)factorization the stepper calls
+     shifted_factor twice, with the real shift (gamma/h, 0) and the complex one
+     (alpha/h, -beta/h), and the linearization state x_lin (N); the callee must
+     keep both systems ready. shifted_solve(sr, si, rhs, user) then overwrites
+     rhs with K(sigma)^{-1} rhs, where rhs is a real N-vector if si == 0 and an
+     interleaved complex N-vector (2N doubles, re/im pairs) otherwise. A
+     non-PHGMG_OK return of shifted_factor (e.g. PHGMG_ERR_SINGULAR) is passed
+     on by phgmg_gl3_step. Not used by the linear step map (see >>gl3). */
+  phgmg_result (*shifted_factor)(double sr, double si, const double *x_lin, void *user);
+  void (*shifted_solve)(double sr, double si, double *rhs, void *user);
+  void *shifted_user;      /* `user` argument of the two callbacks above      */
 } phgmg_ph_system;
 
 /* Validation of a system. tol (<= 0: 1e-12) is relative to the matrix norms:
@@ -239,6 +253,20 @@ PHGMG_DEF void phgmg_ph_gradient(const phgmg_ph_system *sys, const double *x, do
 PHGMG_DEF void phgmg_ph_rhs(const phgmg_ph_system *sys, const double *x, const double *u, double *f);
 /* y (m) = B^T grad H(x). */
 PHGMG_DEF void phgmg_ph_output(const phgmg_ph_system *sys, const double *x, double *y);
+
+/* Y = M X for M in {'J','R','Q'} ('Q': the quadratic part of H only), dense or
+   banded storage; X is N x nrhs (ldx), Y is N x nrhs (ldy). */
+PHGMG_DEF void phgmg_ph_apply(const phgmg_ph_system *sys, char which, int nrhs,
+                              const double *X, int ldx, double *Y, int ldy);
+
+/* A factorization of J - R (dense LU or banded LU, by the system's storage),
+   for applying G = (J - R)^{-1} without forming it. */
+typedef struct phgmg_jr_factor phgmg_jr_factor;
+PHGMG_DEF phgmg_result phgmg_jr_factor_create(phgmg_jr_factor **out, const phgmg_ph_system *sys,
+                                              double *rcond_out, const phgmg_allocator *alloc);
+/* X <- (J - R)^{-1} X (trans 'N') or (J - R)^{-T} X (trans 'T'); X is N x nrhs. */
+PHGMG_DEF void phgmg_jr_solve(const phgmg_jr_factor *f, char trans, int nrhs, double *X, int ldx);
+PHGMG_DEF void phgmg_jr_factor_destroy(phgmg_jr_factor *f);
 
 /* >>gl3 =================================================================== */
 /* 3-stage Gauss-Legendre (order 6), simplified Newton on the transformed stage
@@ -296,6 +324,320 @@ PHGMG_DEF phgmg_result phgmg_simulate(const phgmg_ph_system *sys, const double *
 
 /* Gauss-Legendre coefficients (closed forms): c[3], b[3], A[9] row-major A[i*3+j]. */
 PHGMG_DEF void phgmg_gl3_coefficients(double c[3], double b[3], double A[9]);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* PHGMG_NO_OFFLINE */
+
+/* >>online ================================================================ */
+/* Reduced models online: allocation-free, no globals, no stdio, no VLAs, in
+   the build's scalar phgmg_real (double, or float with PHGMG_REAL_FLOAT).
+   A phgmg_rom is a set of non-owning const views (so an exported model can
+   sit in flash as static const arrays). The reduced model is the pH system
+       x' = K(x) grad H(x) + Bh u,   y = Bh^T grad H(x),
+       K(x) = J(x) - R(x)  (J skew, R symmetric positive semidefinite),
+   with, for a LINEAR map phi(x) = V0 x:   K constant,
+       H(x) = 1/2 x^T Qh x + sum_j w_j poly(P0_j x),
+   and for the QUADRATIC map phi(x) = V0 x + V2 q(x2), q = M (x2 kron x2),
+   x = (x1, x2), x1 in R^m, x2 in R^p, p = r - m:
+       K(x) = (Dphi^T G Dphi)^{-1},  G = (J - R)^{-1},  Dphi = V0 + V2 [0, L(x2)],
+       L(:,k) = sum_j Ms(:, k*p + j) x2_j,   q = L x2 / 2,
+       H(x) = 1/2 phi^T Q phi + sum_j w_j poly(P0_j x + P1_j q),
+   where every product with N-dimensional data was precomputed offline
+   (G00 = V0^T G V0, ... see the fields). The online cost is independent of N. */
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef enum phgmg_rom_kind { PHGMG_ROM_LINEAR = 1, PHGMG_ROM_QUADRATIC = 2 } phgmg_rom_kind;
+typedef enum phgmg_method {
+  PHGMG_METHOD_GMG_POD = 1, /* phi = [B, Vbar] x, GMG reduction (paper 4.2.1)         */
+  PHGMG_METHOD_GMG_QM = 2,  /* quadratic manifold, GMG reduction (paper 4.2.2)        */
+  PHGMG_METHOD_SP1 = 3,     /* SP1-POD: phi = V_POD x, W = QV(V^TQV)^-1 (eq. 5.3)     */
+  PHGMG_METHOD_SP2 = 4      /* SP2-POD: W = V_gradH (V_POD^T V_gradH)^-1 (NUMERICS 6.3) */
+} phgmg_method;
+
+#define PHGMG_ROM_MAGIC 0x50484731u /* "PHG1" */
+
+typedef struct phgmg_rom {
+  int kind;      /* phgmg_rom_kind                                   */
+  int method;    /* phgmg_method (informative)                       */
+  int r, m;      /* reduced order, ports                             */
+  int rn;        /* QUADRATIC: lifting dimension r_n, else 0         */
+  int nd;        /* separable nonlinear terms kept online (DEIM points), 0 = quadratic H */
+  int poly_deg;  /* degree of the shared polynomial phi (nd > 0)     */
+  const phgmg_real *Bh;   /* r x m   reduced port matrix (W^T B; [I;0] for GMG)   */
+  const phgmg_real *Qh;   /* r x r   V0^T Q V0                                     */
+  const phgmg_real *K;    /* r x r   LINEAR: J - R reduced (constant)              */
+  /* QUADRATIC only */
+  const phgmg_real *G00;  /* r x r   V0^T G V0 */
+  const phgmg_real *G01;  /* r x rn  V0^T G V2 */
+  const phgmg_real *G10;  /* rn x r  V2^T G V0 */
+  const phgmg_real *G11;  /* rn x rn V2^T G V2 */
+  const phgmg_real *Q01;  /* r x rn  V0^T Q V2 */
+  const phgmg_real *Q11;  /* rn x rn V2^T Q V2 */
+  const phgmg_real *Ms;   /* rn x p*p symmetrised M: Ms(:,k*p+j) = M(:,k*p+j) + M(:,j*p+k) */
+  /* separable nonlinear part (nd > 0) */
+  const phgmg_real *P0;   /* nd x r   rows of V0 at the kept coordinates */
+  const phgmg_real *P1;   /* nd x rn  rows of V2 (QUADRATIC)             */
+  const phgmg_real *w;    /* nd       weights (structure-preserving DEIM) */
+  const phgmg_real *poly; /* poly_deg+1 coefficients of phi, constant first */
+  /* precomputed GL3 step map (LINEAR, nd == 0; NULL if absent) for step dt:
+     x+ = Phi x + Gam u3, stage values Y = SX x + SU u3 (for the energy). */
+  phgmg_real dt;
+  const phgmg_real *Phi;  /* r x r    */
+  const phgmg_real *Gam;  /* r x 3m   (u3 = [u(t+c1 h); u(t+c2 h); u(t+c3 h)]) */
+  const phgmg_real *SX;   /* 3r x r   */
+  const phgmg_real *SU;   /* 3r x 3m  */
+} phgmg_rom;
+
+/* Checks a model's sizes and pointers for consistency (not its values). */
+PHGMG_DEF phgmg_result phgmg_rom_check(const phgmg_rom *rom);
+
+/* Evaluation (allocation-free; `work` must hold phgmg_rom_eval_work_size(rom) reals). */
+PHGMG_DEF size_t phgmg_rom_eval_work_size(const phgmg_rom *rom);
+PHGMG_DEF phgmg_real phgmg_rom_hamiltonian(const phgmg_rom *rom, const phgmg_real *x, phgmg_real *work);
+PHGMG_DEF void phgmg_rom_gradient(const phgmg_rom *rom, const phgmg_real *x, phgmg_real *g, phgmg_real *work);
+/* f = K(x) grad H(x) + Bh u (u may be NULL). PHGMG_ERR_SINGULAR if D^T G D is singular at x. */
+PHGMG_DEF phgmg_result phgmg_rom_rhs(const phgmg_rom *rom, const phgmg_real *x, const phgmg_real *u,
+                                     phgmg_real *f, phgmg_real *work);
+/* y = Bh^T grad H(x). */
+PHGMG_DEF void phgmg_rom_output(const phgmg_rom *rom, const phgmg_real *x, phgmg_real *y, phgmg_real *work);
+/* The reduced structure matrices at x: Jr = (K - K^T)/2 (skew), Rr = -(K + K^T)/2 (sym PSD), r x r. */
+PHGMG_DEF phgmg_result phgmg_rom_structure(const phgmg_rom *rom, const phgmg_real *x, phgmg_real *Jr,
+                                           phgmg_real *Rr, phgmg_real *work);
+/* Newton Jacobian of the right-hand side, d f / d x (r x r): analytic for LINEAR
+   models; for QUADRATIC ones a central finite difference of phgmg_rom_rhs. */
+PHGMG_DEF phgmg_result phgmg_rom_jacobian(const phgmg_rom *rom, const phgmg_real *x, phgmg_real *Jf,
+                                          phgmg_real *work);
+
+/* --- the online stepper (GL3, simplified Newton on the 3r stage system) --- */
+typedef struct phgmg_rom_stats {
+  long steps, newton_iters, factorizations, failures;
+} phgmg_rom_stats;
+
+typedef struct phgmg_rom_stepper {
+  const phgmg_rom *rom;
+  phgmg_real dt, tol;     /* step and Newton tolerance (inf-norm of the stage residual) */
+  int max_iter;           /* Newton cap per step                                        */
+  int use_map;            /* 1 if the precomputed step map is used                      */
+  int have_lu, have_prev; /* internal: factors valid / extrapolation data valid        */
+  phgmg_real *ws;         /* caller memory, carved by init                              */
+  size_t ws_count;
+  phgmg_rom_stats stats;
+} phgmg_rom_stepper;
+
+/* Bytes of caller memory phgmg_rom_stepper_init needs for this model. */
+PHGMG_DEF size_t phgmg_rom_stepper_memsize(const phgmg_rom *rom);
+/* Compile-time upper bound in bytes for static buffers (r, m, rn, nd as above). */
+#define PHGMG_ROM_STEPPER_MEMSIZE_MAX(r, m, rn, nd) \
+  (sizeof(phgmg_real) * (size_t)(9 * (r) * (r) + 30 * (r) + 3 * (m) + 4 * (rn) * (r) + 2 * (rn) * (rn) + 6 * (rn) + 3 * (nd) + 64) \
+   + sizeof(int) * (size_t)(4 * (r) + 8) + 64)
+/* Set up a stepper in caller memory (mem must be aligned for phgmg_real and
+   int; anything from malloc or a static phgmg_real array is). tol <= 0 gives
+   1e-10 (double) / 1e-5 (float); max_iter <= 0 gives 10. PHGMG_ERR_WORKSPACE
+   if mem_size < phgmg_rom_stepper_memsize(rom). */
+PHGMG_DEF phgmg_result phgmg_rom_stepper_init(phgmg_rom_stepper *s, const phgmg_rom *rom, phgmg_real dt,
+                                              phgmg_real tol, int max_iter, void *mem, size_t mem_size);
+/* Forget the extrapolation history (call after changing x by hand). */
+PHGMG_DEF void phgmg_rom_stepper_reset(phgmg_rom_stepper *s);
+/* Stage times t + c_i dt, for evaluating u3. */
+PHGMG_DEF void phgmg_rom_stage_times(phgmg_real t, phgmg_real dt, phgmg_real tc[3]);
+/* One step: x (r) advanced in place. u3 = inputs at the three stage times
+   (3m values, u(t+c1 dt) first; NULL = 0). y (m, may be NULL) = output at the
+   new state. energy (may be NULL) += {supplied, dissipated} over the step.
+   On failure (PHGMG_ERR_NOT_CONVERGED, _NANINF, _SINGULAR) x, y, energy are untouched. */
+PHGMG_DEF phgmg_result phgmg_rom_step(phgmg_rom_stepper *s, phgmg_real *x, const phgmg_real *u3,
+                                      phgmg_real *y, phgmg_real energy[2]);
+
+#ifdef __cplusplus
+}
+#endif
+
+/* >>pod / >>reduce / >>deim / >>errors ====================================== */
+/* Offline reduction (double). A user gives a pH system and a snapshot matrix
+   X (N x ns, ns = n_t + 1 columns) and gets a reduced model that is again a
+   pH system (see >>online), plus the error measures of the paper (5.1). */
+#ifndef PHGMG_NO_OFFLINE
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* POD: the leading left singular vectors of X (N x ns). k = kmax modes, or
+   fewer: with tol > 0 only modes with sigma_k > tol * sigma_1 are kept.
+   V: N x kmax (ldv), S: kmax singular values (may be NULL). *k_out = modes kept. */
+PHGMG_DEF phgmg_result phgmg_pod(int N, int ns, const double *X, int ldx, int kmax, double tol,
+                                 double *V, int ldv, double *S, int *k_out,
+                                 const phgmg_allocator *alloc);
+/* Adjusted snapshots Xa = X - B B^+ X (B: N x m full column rank). Xa may alias X. */
+PHGMG_DEF phgmg_result phgmg_adjust_snapshots(int N, int m, const double *B, int ns, const double *X,
+                                              int ldx, double *Xa, int ldxa, const phgmg_allocator *alloc);
+
+typedef struct phgmg_reduce_opts {
+  phgmg_method method; /* required                                                  */
+  int r;               /* reduced order (GMG: includes the m port coordinates), required */
+  int rn;              /* GMG-QM lifting dimension r_n (0: 8)                        */
+  double lambda;       /* GMG-QM ridge parameter, applied to the un-normalised sum
+                          over snapshots (0: 1e-3; < 0: exactly zero)                 */
+  int deim;            /* separable nonlinear part: 1 = structure-preserving DEIM,
+                          0 = keep every term (exact, but O(n_terms) online)          */
+  double deim_tol;     /* DEIM modes: sigma_k / sigma_1 > deim_tol (0: 1e-8)          */
+  int deim_max;        /* cap on DEIM modes (0: no cap)                               */
+  int deim_allow_negative; /* 1: accept negative DEIM weights (reported in info)      */
+  double dt;           /* > 0: precompute the GL3 step map for this step
+                          (LINEAR map with quadratic H only)                          */
+  double degeneracy_tol; /* fail with PHGMG_ERR_DEGENERATE when the reciprocal
+                          condition of D^T G D at the snapshots is below this (0: 1e-12) */
+} phgmg_reduce_opts;
+
+typedef struct phgmg_reduce_info {
+  int deim_modes;          /* DEIM points kept (nd)                          */
+  int deim_negative;       /* number of negative DEIM weights               */
+  double deim_sigma_ratio; /* sigma_{nd+1}/sigma_1 of the nonlinear snapshots (0 if all kept) */
+  double rcond_dgd;        /* smallest rcond of D^T G D seen (at x = 0 and the snapshots) */
+  double rcond_jr;         /* rcond of J - R                                  */
+  double pod_sigma_ratio;  /* sigma_{r'+1}/sigma_1 of the (adjusted) snapshots */
+} phgmg_reduce_info;
+
+/* The reduced model with its offline data (bases for reconstruction, double
+   and phgmg_real copies of the small blocks). */
+typedef struct phgmg_reduced phgmg_reduced;
+
+/* Build a reduced model of `sys` from snapshots X (N x ns, ldx). The system must
+   validate (phgmg_ph_validate); GENERAL nonlinear Hamiltonians are not supported
+   (PHGMG_ERR_UNSUPPORTED); a separable nonlinear part needs the polynomial form
+   (sys->poly) for the reduced model. Errors: PHGMG_ERR_SIZE (r <= m for GMG,
+   r > rank of the snapshots, ...), PHGMG_ERR_RANK, PHGMG_ERR_DEGENERATE,
+   PHGMG_ERR_NEGATIVE_WEIGHT, PHGMG_ERR_NANINF, PHGMG_ERR_NOMEM. info may be NULL. */
+PHGMG_DEF phgmg_result phgmg_reduce(phgmg_reduced **out, const phgmg_ph_system *sys, const double *X,
+                                    int ldx, int ns, const phgmg_reduce_opts *opts,
+                                    phgmg_reduce_info *info, const phgmg_allocator *alloc);
+PHGMG_DEF void phgmg_reduced_destroy(phgmg_reduced *red);
+/* The online model (views into the reduced object; valid until destroy). */
+PHGMG_DEF const phgmg_rom *phgmg_reduced_rom(const phgmg_reduced *red);
+/* Offline double copy of the same model (identical layout, double arrays). */
+PHGMG_DEF int phgmg_reduced_N(const phgmg_reduced *red);
+/* Reconstruction x = phi(xr) (N). */
+PHGMG_DEF void phgmg_reduced_lift(const phgmg_reduced *red, const double *xr, double *x);
+/* Point reduction xr = rho(x) (r); rho(phi(xr)) = xr. */
+PHGMG_DEF void phgmg_reduced_restrict(const phgmg_reduced *red, const double *x, double *xr);
+/* Jacobian of phi at xr: D (N x r, ldd). */
+PHGMG_DEF void phgmg_reduced_dphi(const phgmg_reduced *red, const double *xr, double *D, int ldd);
+/* The reduction map W(xr) (N x r, ldw) in full dimension (for checks; O(N r^2)). */
+PHGMG_DEF phgmg_result phgmg_reduced_W(const phgmg_reduced *red, const double *xr, double *W, int ldw);
+
+/* Simulate the reduced model with the online GL3 stepper from xr0 over nsteps
+   steps of dt (u from uf at the stage times). Outputs (each may be NULL):
+   XR r x (nsteps+1), Y m x (nsteps+1), energy like phgmg_simulate (Hamiltonian
+   of the reduced model). tol/max_iter: Newton settings (<= 0: defaults). */
+PHGMG_DEF phgmg_result phgmg_reduced_simulate(const phgmg_reduced *red, const double *xr0, double t0,
+                                              double dt, int nsteps, phgmg_input_fn uf, void *uuser,
+                                              double tol, int max_iter, double *XR, double *Y,
+                                              const phgmg_energy *energy, phgmg_rom_stats *stats,
+                                              const phgmg_allocator *alloc);
+
+/* --- error measures (paper 5.1) --- */
+/* sqrt(sum_i ||A_i - B_i||^2 / sum_i ||A_i||^2) over ns columns of length n. */
+PHGMG_DEF double phgmg_rel_error(int n, int ns, const double *A, int lda, const double *B, int ldb);
+/* e_red: reduction error of a reduced trajectory XR (r x ns) against X. */
+PHGMG_DEF double phgmg_err_red(const phgmg_reduced *red, const double *X, int ldx, int ns,
+                               const double *XR, int ldxr);
+/* e_proj: projection error sqrt(sum ||x_i - phi(rho(x_i))||^2 / sum ||x_i||^2). */
+PHGMG_DEF double phgmg_err_proj(const phgmg_reduced *red, const double *X, int ldx, int ns);
+/* e_lowerbound (eq. non_app_lower_bound) of a GMG-QM model: the error of the
+   orthogonal projection onto span[B, V1, V2]. NaN for other kinds. */
+PHGMG_DEF double phgmg_err_lowerbound(const phgmg_reduced *red, const double *X, int ldx, int ns);
+/* e_energy(t_n) = |H[n] - H[0] - S[n] + D[n]| for n = 0..nsteps into e. */
+PHGMG_DEF void phgmg_err_energy(const phgmg_energy *energy, int nsteps, double *e);
+
+/* Hierarchical POD of paper 4.2.2: V1 = POD_p(X - BB^+X), V2 = POD_rn of the
+   residual (I - [B,V1][B,V1]^+) X. V1: N x p, V2: N x rn. */
+PHGMG_DEF phgmg_result phgmg_pod_hierarchical(int N, int m, const double *B, int ns, const double *X,
+                                              int ldx, int p, int rn, double *V1, double *V2,
+                                              const phgmg_allocator *alloc);
+
+/* Structure-preserving DEIM for a separable sum: F (nterms x ns) holds the
+   snapshots of the nonlinear gradient terms phi_k'(x_idx_k). Modes: sigma_k >
+   tol sigma_1 (capped by kmax if > 0). Points by Q-DEIM (pivoted QR of U^T).
+   Weights w = (P^T U)^{-T} U^T sw (sw = the terms' own weights, NULL = 1), so
+   sum_k sw_k phi_k ~ sum_j w_j phi_{pts_j}. pts, w: room for nterms entries.
+   *nd_out = points chosen, *nneg = negative weights. */
+PHGMG_DEF phgmg_result phgmg_deim(int nterms, int ns, const double *F, int ldf, const double *sw,
+                                  double tol, int kmax, int *pts, double *w, int *nd_out,
+                                  int *nneg, double *sigma_ratio, const phgmg_allocator *alloc);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* PHGMG_NO_OFFLINE */
+
+/* >>npy =================================================================== */
+/* NumPy .npy files (offline half): snapshot matrices, bases and reference
+   trajectories exchanged with Python.
+   Read: format versions 1.0, 2.0 and 3.0; dtypes '<f8', '>f8', '<f4', '>f4';
+   C or Fortran order; 0-d, 1-d and 2-d shapes. The result is always a
+   column-major double matrix: shape () is 1 x 1, shape (n,) is n x 1, shape
+   (r, c) is r x c. Empty shapes such as (0,) or (3, 0) give a zero-size matrix
+   (a valid pointer to no elements). Bytes after the data are ignored, as NumPy
+   does. Anything else (bad magic, bad header dict, other dtypes, more than two
+   dimensions, a dimension above INT_MAX, a header longer than
+   PHGMG_NPY_MAX_HEADER, truncated data) is PHGMG_ERR_FORMAT.
+   Write: format version 1.0, '<f8' (or '<f4' with PHGMG_NPY_F32), Fortran order
+   (or C order with PHGMG_NPY_C_ORDER), header padded so the data starts at a
+   multiple of 64 bytes, as NumPy writes it.
+   ndim selects the written shape: 2 gives (rows, cols); 1 gives (rows*cols,)
+   and needs rows == 1 or cols == 1; 0 gives () and needs rows == cols == 1.
+   The in-memory parser/serializer never touch files; the file functions are
+   compiled out by PHGMG_NO_STDIO. On failure the output arguments are left
+   unchanged and nothing stays allocated. */
+#ifndef PHGMG_NO_OFFLINE
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#ifndef PHGMG_NPY_MAX_HEADER
+#define PHGMG_NPY_MAX_HEADER 1048576 /* longest accepted header, bytes */
+#endif
+
+/* Flags of the writers (combine with |). */
+#define PHGMG_NPY_C_ORDER 1u /* row-major data, 'fortran_order': False       */
+#define PHGMG_NPY_F32     2u /* store float32 '<f4' (rounded) instead of '<f8' */
+
+/* Parse an in-memory .npy image buf[0..len). On success *out receives a
+   column-major rows x cols matrix (ld = rows) allocated with alloc (NULL =
+   default); release it with phgmg_npy_free. rows, cols and out are required,
+   ndim (0, 1 or 2) may be NULL. Errors: PHGMG_ERR_INVALID_ARG (NULL buf/out/
+   rows/cols), PHGMG_ERR_FORMAT, PHGMG_ERR_NOMEM. Safe on arbitrary bytes. */
+PHGMG_DEF phgmg_result phgmg_npy_parse(const void *buf, size_t len, double **out, int *rows,
+                                       int *cols, int *ndim, const phgmg_allocator *alloc);
+
+/* Serialize the rows x cols matrix A (column-major, leading dimension ld >=
+   max(1, rows)) as a .npy image into buf[0..cap). *len always receives the
+   number of bytes needed; with buf == NULL only that size is computed.
+   Errors: PHGMG_ERR_INVALID_ARG (NULL A with elements, NULL len, unknown
+   flags), PHGMG_ERR_SIZE (bad dimensions/ld/ndim), PHGMG_ERR_WORKSPACE
+   (cap < *len; nothing is written). */
+PHGMG_DEF phgmg_result phgmg_npy_serialize(const double *A, int rows, int cols, int ld, int ndim,
+                                           unsigned flags, void *buf, size_t cap, size_t *len);
+
+/* Free a matrix returned by phgmg_npy_parse / phgmg_npy_read (same allocator;
+   NULL pointer is a no-op). */
+PHGMG_DEF void phgmg_npy_free(double *p, const phgmg_allocator *alloc);
+
+#ifndef PHGMG_NO_STDIO
+/* Read a .npy file; outputs and errors as phgmg_npy_parse, plus PHGMG_ERR_IO
+   if the file cannot be opened or read. A file shorter than its header
+   promises is PHGMG_ERR_FORMAT. */
+PHGMG_DEF phgmg_result phgmg_npy_read(const char *path, double **out, int *rows, int *cols,
+                                      int *ndim, const phgmg_allocator *alloc);
+
+/* Write A (as phgmg_npy_serialize) to the file path, streaming, without
+   allocating. Errors as phgmg_npy_serialize (except WORKSPACE), plus
+   PHGMG_ERR_IO; a partly written file is removed. */
+PHGMG_DEF phgmg_result phgmg_npy_write(const char *path, const double *A, int rows, int cols,
+                                       int ld, int ndim, unsigned flags);
+#endif /* PHGMG_NO_STDIO */
 
 #ifdef __cplusplus
 }
@@ -386,6 +728,2804 @@ PHGMG__PRIV int *phgmg__ialloc(const phgmg_allocator *a, size_t n) {
   return PHGMG__CAST(int *, phgmg__alloc(a, n * sizeof(int)));
 }
 #endif
+
+/* >>linalg (implementation) ============================================== */
+#ifndef PHGMG_NO_OFFLINE
+
+/* ---- norms -------------------------------------------------------------- */
+PHGMG_DEF double phgmg_norm1(int m, int n, const double *A, int lda) {
+  double best = 0.0;
+  int i, j;
+  for (j = 0; j < n; ++j) {
+    const double *a = A + (size_t)j * (size_t)lda;
+    double s = 0.0;
+    for (i = 0; i < m; ++i) s += fabs(a[i]);
+    if (s > best || s != s) best = s;
+  }
+  return best;
+}
+
+PHGMG_DEF double phgmg_normf(int m, int n, const double *A, int lda) {
+  /* scaled sum of squares (LAPACK dlassq): scale^2 * ssq */
+  double scale = 0.0, ssq = 1.0;
+  int i, j;
+  for (j = 0; j < n; ++j) {
+    const double *a = A + (size_t)j * (size_t)lda;
+    for (i = 0; i < m; ++i) {
+      double v = fabs(a[i]);
+      if (v != 0.0 || v != v) {
+        if (v != v) return v;
+        if (scale < v) {
+          double r = scale / v;
+          ssq = 1.0 + ssq * r * r;
+          scale = v;
+        } else {
+          double r = v / scale;
+          ssq += r * r;
+        }
+      }
+    }
+  }
+  return scale * sqrt(ssq);
+}
+
+/* ---- gemv / gemm ---------------------------------------------------------- */
+PHGMG_DEF void phgmg_gemv(char trans, int m, int n, double alpha, const double *A, int lda,
+                          const double *x, double beta, double *y) {
+  int i, j;
+  int ny = (trans == 'N' || trans == 'n') ? m : n;
+  PHGMG_ASSERT(trans == 'N' || trans == 'n' || trans == 'T' || trans == 't');
+  if (m <= 0 || n <= 0) {
+    for (i = 0; i < ny; ++i) y[i] = (beta == 0.0) ? 0.0 : beta * y[i];
+    return;
+  }
+#ifdef PHGMG_USE_CBLAS
+  cblas_dgemv(CblasColMajor, (ny == m) ? CblasNoTrans : CblasTrans, m, n, alpha, A, lda, x, 1,
+              beta, y, 1);
+#else
+  if (beta == 0.0) {
+    for (i = 0; i < ny; ++i) y[i] = 0.0;
+  } else if (beta != 1.0) {
+    for (i = 0; i < ny; ++i) y[i] *= beta;
+  }
+  if (alpha == 0.0) return;
+  if (trans == 'N' || trans == 'n') {
+    /* y += alpha * A x, column sweeps (axpy) */
+    for (j = 0; j < n; ++j) {
+      const double *a = A + (size_t)j * (size_t)lda;
+      double t = alpha * x[j];
+      if (t == 0.0) continue;
+      for (i = 0; i < m; ++i) y[i] += t * a[i];
+    }
+  } else {
+    /* y += alpha * A^T x, dot products of columns */
+    for (j = 0; j < n; ++j) {
+      const double *a = A + (size_t)j * (size_t)lda;
+      double s0 = 0.0, s1 = 0.0;
+      for (i = 0; i + 1 < m; i += 2) { s0 += a[i] * x[i]; s1 += a[i + 1] * x[i + 1]; }
+      if (i < m) s0 += a[i] * x[i];
+      y[j] += alpha * (s0 + s1);
+    }
+  }
+#endif
+}
+
+#ifndef PHGMG_USE_CBLAS
+/* Block sizes of the portable gemm: an MC x KC panel of op(A) is packed
+   column-major (contiguous), then multiplied into C column by column in a
+   4-column register micro-kernel. */
+#ifndef PHGMG_GEMM_MC
+#define PHGMG_GEMM_MC 64
+#endif
+#ifndef PHGMG_GEMM_KC
+#define PHGMG_GEMM_KC 128
+#endif
+
+/* C(0:m,0:n) += Ap(m x kc, packed, ld m) * op(B)(kc x n) */
+PHGMG__PRIV void phgmg__gemm_kernel(int m, int n, int kc, const double *Ap, const double *B,
+                                    int ldb, int tb, double alpha, double *C, int ldc) {
+  int i, j, p;
+  for (j = 0; j + 4 <= n; j += 4) {
+    double *c0 = C + (size_t)j * (size_t)ldc, *c1 = c0 + ldc, *c2 = c1 + ldc, *c3 = c2 + ldc;
+    for (p = 0; p < kc; ++p) {
+      const double *a = Ap + (size_t)p * (size_t)m;
+      double b0, b1, b2, b3;
+      if (!tb) {
+        const double *bp = B + p + (size_t)j * (size_t)ldb;
+        b0 = bp[0]; b1 = bp[ldb]; b2 = bp[2 * (size_t)ldb]; b3 = bp[3 * (size_t)ldb];
+      } else {
+        const double *bp = B + j + (size_t)p * (size_t)ldb;
+        b0 = bp[0]; b1 = bp[1]; b2 = bp[2]; b3 = bp[3];
+      }
+      b0 *= alpha; b1 *= alpha; b2 *= alpha; b3 *= alpha;
+      for (i = 0; i < m; ++i) {
+        double av = a[i];
+        c0[i] += av * b0; c1[i] += av * b1; c2[i] += av * b2; c3[i] += av * b3;
+      }
+    }
+  }
+  for (; j < n; ++j) {
+    double *c0 = C + (size_t)j * (size_t)ldc;
+    for (p = 0; p < kc; ++p) {
+      const double *a = Ap + (size_t)p * (size_t)m;
+      double b0 = alpha * (tb ? B[j + (size_t)p * (size_t)ldb] : B[p + (size_t)j * (size_t)ldb]);
+      for (i = 0; i < m; ++i) c0[i] += a[i] * b0;
+    }
+  }
+}
+#endif
+
+PHGMG_DEF void phgmg_gemm(char transa, char transb, int m, int n, int k, double alpha,
+                          const double *A, int lda, const double *B, int ldb,
+                          double beta, double *C, int ldc) {
+  int ta = (transa == 'T' || transa == 't');
+  int tb = (transb == 'T' || transb == 't');
+  int i, j;
+  PHGMG_ASSERT(ta || transa == 'N' || transa == 'n');
+  PHGMG_ASSERT(tb || transb == 'N' || transb == 'n');
+  if (m <= 0 || n <= 0) return;
+#ifdef PHGMG_USE_CBLAS
+  if (k > 0) {
+    cblas_dgemm(CblasColMajor, ta ? CblasTrans : CblasNoTrans, tb ? CblasTrans : CblasNoTrans,
+                m, n, k, alpha, A, lda, B, ldb, beta, C, ldc);
+    return;
+  }
+#endif
+  for (j = 0; j < n; ++j) {
+    double *c = C + (size_t)j * (size_t)ldc;
+    if (beta == 0.0) for (i = 0; i < m; ++i) c[i] = 0.0;
+    else if (beta != 1.0) for (i = 0; i < m; ++i) c[i] *= beta;
+  }
+  if (alpha == 0.0 || k <= 0) return;
+#ifndef PHGMG_USE_CBLAS
+  {
+    /* pack buffer on the stack: MC*KC doubles */
+    double Ap[PHGMG_GEMM_MC * PHGMG_GEMM_KC];
+    int pc, ic, p;
+    for (pc = 0; pc < k; pc += PHGMG_GEMM_KC) {
+      int kc = PHGMG__MIN(PHGMG_GEMM_KC, k - pc);
+      for (ic = 0; ic < m; ic += PHGMG_GEMM_MC) {
+        int mc = PHGMG__MIN(PHGMG_GEMM_MC, m - ic);
+        /* pack op(A)(ic:ic+mc, pc:pc+kc) column-major with ld mc */
+        if (!ta) {
+          for (p = 0; p < kc; ++p) {
+            const double *src = A + ic + (size_t)(pc + p) * (size_t)lda;
+            memcpy(Ap + (size_t)p * (size_t)mc, src, (size_t)mc * sizeof(double));
+          }
+        } else {
+          for (i = 0; i < mc; ++i) {
+            const double *src = A + pc + (size_t)(ic + i) * (size_t)lda;
+            for (p = 0; p < kc; ++p) Ap[i + (size_t)p * (size_t)mc] = src[p];
+          }
+        }
+        phgmg__gemm_kernel(mc, n, kc, Ap,
+                           tb ? B + (size_t)pc * (size_t)ldb : B + pc, ldb, tb, alpha,
+                           C + ic, ldc);
+      }
+    }
+  }
+#endif
+}
+
+/* ---- real LU -------------------------------------------------------------- */
+PHGMG_DEF phgmg_result phgmg_lu_factor(int n, double *A, int lda, int *ipiv) {
+  int i, j, k;
+  phgmg_result rc = PHGMG_OK;
+  if (n < 0 || lda < PHGMG__MAX(n, 1)) return PHGMG_ERR_SIZE;
+  if (n == 0) return PHGMG_OK;
+  if (!A || !ipiv) return PHGMG_ERR_INVALID_ARG;
+  for (j = 0; j < n; ++j)
+    if (!phgmg__all_finite(A + (size_t)j * (size_t)lda, (size_t)n)) return PHGMG_ERR_NANINF;
+  for (k = 0; k < n; ++k) {
+    double *ak = A + (size_t)k * (size_t)lda;
+    int p = k;
+    double amax = fabs(ak[k]);
+    for (i = k + 1; i < n; ++i)
+      if (fabs(ak[i]) > amax) { amax = fabs(ak[i]); p = i; }
+    ipiv[k] = p;
+    if (amax == 0.0) { rc = PHGMG_ERR_SINGULAR; continue; }
+    if (p != k)
+      for (j = 0; j < n; ++j) {
+        double *c = A + (size_t)j * (size_t)lda, t = c[k];
+        c[k] = c[p]; c[p] = t;
+      }
+    {
+      double r = 1.0 / ak[k];
+      for (i = k + 1; i < n; ++i) ak[i] *= r;
+    }
+    for (j = k + 1; j < n; ++j) {
+      double *c = A + (size_t)j * (size_t)lda;
+      double t = c[k];
+      if (t == 0.0) continue;
+      for (i = k + 1; i < n; ++i) c[i] -= t * ak[i];
+    }
+  }
+  return rc;
+}
+
+PHGMG_DEF void phgmg_lu_solve(char trans, int n, const double *LU, int lda, const int *ipiv,
+                              int nrhs, double *B, int ldb) {
+  int i, j, k;
+  int tr = (trans == 'T' || trans == 't');
+  PHGMG_ASSERT(tr || trans == 'N' || trans == 'n');
+  for (j = 0; j < nrhs; ++j) {
+    double *b = B + (size_t)j * (size_t)ldb;
+    if (!tr) {
+      for (k = 0; k < n; ++k)
+        if (ipiv[k] != k) { double t = b[k]; b[k] = b[ipiv[k]]; b[ipiv[k]] = t; }
+      /* L y = b (unit lower), column oriented */
+      for (k = 0; k < n; ++k) {
+        const double *l = LU + (size_t)k * (size_t)lda;
+        double t = b[k];
+        if (t != 0.0) for (i = k + 1; i < n; ++i) b[i] -= t * l[i];
+      }
+      /* U x = y */
+      for (k = n - 1; k >= 0; --k) {
+        const double *u = LU + (size_t)k * (size_t)lda;
+        double t = b[k] / u[k];
+        b[k] = t;
+        if (t != 0.0) for (i = 0; i < k; ++i) b[i] -= t * u[i];
+      }
+    } else {
+      /* U^T y = b: dot products with columns of U */
+      for (k = 0; k < n; ++k) {
+        const double *u = LU + (size_t)k * (size_t)lda;
+        double s = b[k];
+        for (i = 0; i < k; ++i) s -= u[i] * b[i];
+        b[k] = s / u[k];
+      }
+      /* L^T z = y */
+      for (k = n - 1; k >= 0; --k) {
+        const double *l = LU + (size_t)k * (size_t)lda;
+        double s = b[k];
+        for (i = k + 1; i < n; ++i) s -= l[i] * b[i];
+        b[k] = s;
+      }
+      for (k = n - 1; k >= 0; --k)
+        if (ipiv[k] != k) { double t = b[k]; b[k] = b[ipiv[k]]; b[ipiv[k]] = t; }
+    }
+  }
+}
+
+/* ---- complex LU (interleaved re,im) ----------------------------------------- */
+PHGMG_DEF phgmg_result phgmg_zlu_factor(int n, double *A, int lda, int *ipiv) {
+  int i, j, k;
+  phgmg_result rc = PHGMG_OK;
+  if (n < 0 || lda < PHGMG__MAX(n, 1)) return PHGMG_ERR_SIZE;
+  if (n == 0) return PHGMG_OK;
+  if (!A || !ipiv) return PHGMG_ERR_INVALID_ARG;
+  for (j = 0; j < n; ++j)
+    if (!phgmg__all_finite(A + 2 * (size_t)j * (size_t)lda, 2 * (size_t)n)) return PHGMG_ERR_NANINF;
+  for (k = 0; k < n; ++k) {
+    double *ak = A + 2 * (size_t)k * (size_t)lda;
+    int p = k;
+    double amax = fabs(ak[2 * k]) + fabs(ak[2 * k + 1]);
+    for (i = k + 1; i < n; ++i) {
+      double v = fabs(ak[2 * i]) + fabs(ak[2 * i + 1]);
+      if (v > amax) { amax = v; p = i; }
+    }
+    ipiv[k] = p;
+    if (amax == 0.0) { rc = PHGMG_ERR_SINGULAR; continue; }
+    if (p != k)
+      for (j = 0; j < n; ++j) {
+        double *c = A + 2 * (size_t)j * (size_t)lda, t;
+        t = c[2 * k]; c[2 * k] = c[2 * p]; c[2 * p] = t;
+        t = c[2 * k + 1]; c[2 * k + 1] = c[2 * p + 1]; c[2 * p + 1] = t;
+      }
+    {
+      /* r = 1 / pivot (Smith's division) */
+      double pr = ak[2 * k], pi = ak[2 * k + 1], rr, ri;
+      if (fabs(pr) >= fabs(pi)) {
+        double q = pi / pr, d = pr + pi * q;
+        rr = 1.0 / d; ri = -q / d;
+      } else {
+        double q = pr / pi, d = pr * q + pi;
+        rr = q / d; ri = -1.0 / d;
+      }
+      for (i = k + 1; i < n; ++i) {
+        double xr = ak[2 * i], xi = ak[2 * i + 1];
+        ak[2 * i] = xr * rr - xi * ri;
+        ak[2 * i + 1] = xr * ri + xi * rr;
+      }
+    }
+    for (j = k + 1; j < n; ++j) {
+      double *c = A + 2 * (size_t)j * (size_t)lda;
+      double tr = c[2 * k], ti = c[2 * k + 1];
+      if (tr == 0.0 && ti == 0.0) continue;
+      for (i = k + 1; i < n; ++i) {
+        double lr = ak[2 * i], li = ak[2 * i + 1];
+        c[2 * i] -= tr * lr - ti * li;
+        c[2 * i + 1] -= tr * li + ti * lr;
+      }
+    }
+  }
+  return rc;
+}
+
+PHGMG_DEF void phgmg_zlu_solve(int n, const double *LU, int lda, const int *ipiv,
+                               int nrhs, double *B, int ldb) {
+  int i, j, k;
+  for (j = 0; j < nrhs; ++j) {
+    double *b = B + 2 * (size_t)j * (size_t)ldb;
+    for (k = 0; k < n; ++k) {
+      int p = ipiv[k];
+      if (p != k) {
+        double t = b[2 * k]; b[2 * k] = b[2 * p]; b[2 * p] = t;
+        t = b[2 * k + 1]; b[2 * k + 1] = b[2 * p + 1]; b[2 * p + 1] = t;
+      }
+    }
+    for (k = 0; k < n; ++k) {
+      const double *l = LU + 2 * (size_t)k * (size_t)lda;
+      double tr = b[2 * k], ti = b[2 * k + 1];
+      if (tr == 0.0 && ti == 0.0) continue;
+      for (i = k + 1; i < n; ++i) {
+        double lr = l[2 * i], li = l[2 * i + 1];
+        b[2 * i] -= tr * lr - ti * li;
+        b[2 * i + 1] -= tr * li + ti * lr;
+      }
+    }
+    for (k = n - 1; k >= 0; --k) {
+      const double *u = LU + 2 * (size_t)k * (size_t)lda;
+      double pr = u[2 * k], pi = u[2 * k + 1], xr = b[2 * k], xi = b[2 * k + 1], tr, ti;
+      if (fabs(pr) >= fabs(pi)) {
+        double q = pi / pr, d = pr + pi * q;
+        tr = (xr + xi * q) / d; ti = (xi - xr * q) / d;
+      } else {
+        double q = pr / pi, d = pr * q + pi;
+        tr = (xr * q + xi) / d; ti = (xi * q - xr) / d;
+      }
+      b[2 * k] = tr; b[2 * k + 1] = ti;
+      if (tr == 0.0 && ti == 0.0) continue;
+      for (i = 0; i < k; ++i) {
+        double ur = u[2 * i], ui = u[2 * i + 1];
+        b[2 * i] -= tr * ur - ti * ui;
+        b[2 * i + 1] -= tr * ui + ti * ur;
+      }
+    }
+  }
+}
+
+
+/* ---- condition estimate (Hager 1984, Higham 1988; LAPACK dlacn2) ---------- */
+PHGMG__PRIV double phgmg__asum(int n, const double *x) {
+  double s = 0.0;
+  int i;
+  for (i = 0; i < n; ++i) s += fabs(x[i]);
+  return s;
+}
+PHGMG__PRIV int phgmg__iamax(int n, const double *x) {
+  int i, j = 0;
+  double m = -1.0;
+  for (i = 0; i < n; ++i)
+    if (fabs(x[i]) > m) { m = fabs(x[i]); j = i; }
+  return j;
+}
+
+PHGMG_DEF double phgmg_lu_rcond(int n, const double *LU, int lda, const int *ipiv,
+                                double anorm1, double *work, int *iwork) {
+  double *x = work, est, estold, temp;
+  int *isgn = iwork;
+  int i, j, jlast, iter, same;
+  if (n <= 0) return 1.0;
+  if (!(anorm1 > 0.0) || anorm1 == HUGE_VAL) return 0.0;
+  for (i = 0; i < n; ++i) {
+    double d = LU[i + (size_t)i * (size_t)lda];
+    if (d == 0.0 || d != d) return 0.0;
+  }
+  for (i = 0; i < n; ++i) x[i] = 1.0 / (double)n;
+  phgmg_lu_solve('N', n, LU, lda, ipiv, 1, x, n);
+  if (n == 1) {
+    est = fabs(x[0]);
+  } else {
+    est = phgmg__asum(n, x);
+    for (i = 0; i < n; ++i) { isgn[i] = x[i] >= 0.0 ? 1 : -1; x[i] = (double)isgn[i]; }
+    phgmg_lu_solve('T', n, LU, lda, ipiv, 1, x, n);
+    j = phgmg__iamax(n, x);
+    for (iter = 2;; ++iter) {
+      for (i = 0; i < n; ++i) x[i] = 0.0;
+      x[j] = 1.0;
+      phgmg_lu_solve('N', n, LU, lda, ipiv, 1, x, n);
+      estold = est;
+      est = phgmg__asum(n, x);
+      same = 1;
+      for (i = 0; i < n; ++i)
+        if ((x[i] >= 0.0 ? 1 : -1) != isgn[i]) { same = 0; break; }
+      if (same || est <= estold) { if (est < estold) est = estold; break; }
+      for (i = 0; i < n; ++i) { isgn[i] = x[i] >= 0.0 ? 1 : -1; x[i] = (double)isgn[i]; }
+      phgmg_lu_solve('T', n, LU, lda, ipiv, 1, x, n);
+      jlast = j;
+      j = phgmg__iamax(n, x);
+      if (fabs(x[jlast]) == fabs(x[j]) || iter >= 5) break;
+    }
+    /* alternating-sign test vector */
+    for (i = 0; i < n; ++i)
+      x[i] = ((i & 1) ? -1.0 : 1.0) * (1.0 + (double)i / (double)(n - 1));
+    phgmg_lu_solve('N', n, LU, lda, ipiv, 1, x, n);
+    temp = 2.0 * phgmg__asum(n, x) / (3.0 * (double)n);
+    if (temp > est) est = temp;
+  }
+  if (!(est > 0.0) || est != est) return 0.0;
+  return (1.0 / est) / anorm1;
+}
+
+/* ---- Householder QR ---------------------------------------------------------- */
+/* Generate H = I - tau v v^T with v = (1, x) such that H (alpha; x) = (beta; 0).
+   n is the length including alpha. x is overwritten by v(1:). */
+PHGMG__PRIV void phgmg__larfg(int n, double *alpha, double *x, double *tau) {
+  double xnorm, beta, r;
+  int i;
+  if (n <= 1) { *tau = 0.0; return; }
+  xnorm = phgmg_normf(n - 1, 1, x, n - 1);
+  if (xnorm == 0.0) { *tau = 0.0; return; }
+  beta = -copysign(hypot(*alpha, xnorm), *alpha);
+  *tau = (beta - *alpha) / beta;
+  r = 1.0 / (*alpha - beta);
+  for (i = 0; i < n - 1; ++i) x[i] *= r;
+  *alpha = beta;
+}
+
+/* C (m x n) := (I - tau v v^T) C, v = (1, v[1..m-1]) (v[0] is not read). */
+PHGMG__PRIV void phgmg__larf_left(int m, int n, const double *v, double tau, double *C, int ldc) {
+  int i, j;
+  if (tau == 0.0) return;
+  for (j = 0; j < n; ++j) {
+    double *c = C + (size_t)j * (size_t)ldc;
+    double s = c[0];
+    for (i = 1; i < m; ++i) s += v[i] * c[i];
+    s *= tau;
+    if (s == 0.0) continue;
+    c[0] -= s;
+    for (i = 1; i < m; ++i) c[i] -= s * v[i];
+  }
+}
+
+PHGMG__PRIV int phgmg__mat_finite(int m, int n, const double *A, int lda) {
+  int j;
+  for (j = 0; j < n; ++j)
+    if (!phgmg__all_finite(A + (size_t)j * (size_t)lda, (size_t)m)) return 0;
+  return 1;
+}
+
+PHGMG_DEF phgmg_result phgmg_qr(int m, int n, double *A, int lda, double *tau) {
+  int k, kmin = PHGMG__MIN(m, n);
+  if (m < 0 || n < 0 || lda < PHGMG__MAX(m, 1)) return PHGMG_ERR_SIZE;
+  if (kmin == 0) return PHGMG_OK;
+  if (!A || !tau) return PHGMG_ERR_INVALID_ARG;
+  if (!phgmg__mat_finite(m, n, A, lda)) return PHGMG_ERR_NANINF;
+  for (k = 0; k < kmin; ++k) {
+    double *akk = A + k + (size_t)k * (size_t)lda;
+    phgmg__larfg(m - k, akk, akk + 1, &tau[k]);
+    if (k + 1 < n) phgmg__larf_left(m - k, n - k - 1, akk, tau[k], akk + lda, lda);
+  }
+  return PHGMG_OK;
+}
+
+/* QR with column pivoting, stopping early (at step k = *rank) once every
+   trailing column norm is <= tol (tol < 0: never). vn: 2n doubles. */
+PHGMG__PRIV void phgmg__qrcp_core(int m, int n, double *A, int lda, double *tau, int *jpvt,
+                                  double *vn, double tol, int *rank) {
+  double *vn1 = vn, *vn2 = vn + n;
+  const double tol3z = sqrt(PHGMG__EPS);
+  int i, j, k, kmin = PHGMG__MIN(m, n);
+  for (j = 0; j < n; ++j) {
+    jpvt[j] = j;
+    vn1[j] = vn2[j] = phgmg_normf(m, 1, A + (size_t)j * (size_t)lda, lda);
+  }
+  for (k = 0; k < kmin; ++k) {
+    int p = k + phgmg__iamax(n - k, vn1 + k);
+    double *ak = A + (size_t)k * (size_t)lda;
+    if (tol >= 0.0 && vn1[p] <= tol) break;
+    if (p != k) {
+      double *ap = A + (size_t)p * (size_t)lda, t;
+      int it;
+      for (i = 0; i < m; ++i) { t = ak[i]; ak[i] = ap[i]; ap[i] = t; }
+      it = jpvt[p]; jpvt[p] = jpvt[k]; jpvt[k] = it;
+      vn1[p] = vn1[k];
+      vn2[p] = vn2[k];
+    }
+    phgmg__larfg(m - k, ak + k, ak + k + 1, &tau[k]);
+    if (k + 1 < n) phgmg__larf_left(m - k, n - k - 1, ak + k, tau[k], ak + k + lda, lda);
+    /* downdate the trailing column norms (LAPACK dlaqp2 safeguard) */
+    for (j = k + 1; j < n; ++j) {
+      if (vn1[j] != 0.0) {
+        double *aj = A + (size_t)j * (size_t)lda;
+        double temp = fabs(aj[k]) / vn1[j], temp2;
+        temp = 1.0 - temp * temp;
+        if (temp < 0.0) temp = 0.0;
+        temp2 = temp * (vn1[j] / vn2[j]) * (vn1[j] / vn2[j]);
+        if (temp2 <= tol3z) {
+          vn1[j] = (k + 1 < m) ? phgmg_normf(m - k - 1, 1, aj + k + 1, m) : 0.0;
+          vn2[j] = vn1[j];
+        } else {
+          vn1[j] *= sqrt(temp);
+        }
+      }
+    }
+  }
+  *rank = k;
+}
+
+PHGMG_DEF phgmg_result phgmg_qrcp(int m, int n, double *A, int lda, double *tau, int *jpvt,
+                                  double *work) {
+  int r;
+  if (m < 0 || n < 0 || lda < PHGMG__MAX(m, 1)) return PHGMG_ERR_SIZE;
+  if (n == 0) return PHGMG_OK;
+  if (!A || !jpvt || !work || (m > 0 && !tau)) return PHGMG_ERR_INVALID_ARG;
+  if (!phgmg__mat_finite(m, n, A, lda)) return PHGMG_ERR_NANINF;
+  phgmg__qrcp_core(m, n, A, lda, tau, jpvt, work, -1.0, &r);
+  return PHGMG_OK;
+}
+
+PHGMG_DEF void phgmg_qr_form_q(int m, int k, double *A, int lda, const double *tau, double *work) {
+  int i, j;
+  (void)work;
+  for (i = k - 1; i >= 0; --i) {
+    double *ai = A + (size_t)i * (size_t)lda;
+    if (i + 1 < k) {
+      ai[i] = 1.0;
+      phgmg__larf_left(m - i, k - i - 1, ai + i, tau[i], ai + i + lda, lda);
+    }
+    for (j = i + 1; j < m; ++j) ai[j] *= -tau[i];
+    ai[i] = 1.0 - tau[i];
+    for (j = 0; j < i; ++j) ai[j] = 0.0;
+  }
+}
+
+PHGMG_DEF void phgmg_qr_apply(char trans, int m, int n, int k, const double *A, int lda,
+                              const double *tau, double *C, int ldc) {
+  int i;
+  int tr = (trans == 'T' || trans == 't');
+  PHGMG_ASSERT(tr || trans == 'N' || trans == 'n');
+  if (tr) {
+    for (i = 0; i < k; ++i)
+      phgmg__larf_left(m - i, n, A + i + (size_t)i * (size_t)lda, tau[i], C + i, ldc);
+  } else {
+    for (i = k - 1; i >= 0; --i)
+      phgmg__larf_left(m - i, n, A + i + (size_t)i * (size_t)lda, tau[i], C + i, ldc);
+  }
+}
+
+/* Solve R X = B, R n x n upper triangular (ldr), B n x nrhs (ldb), in place. */
+PHGMG__PRIV void phgmg__trsv_upper(int n, const double *R, int ldr, int nrhs, double *B, int ldb) {
+  int i, j, k;
+  for (j = 0; j < nrhs; ++j) {
+    double *b = B + (size_t)j * (size_t)ldb;
+    for (k = n - 1; k >= 0; --k) {
+      const double *r = R + (size_t)k * (size_t)ldr;
+      double t = b[k] / r[k];
+      b[k] = t;
+      if (t != 0.0) for (i = 0; i < k; ++i) b[i] -= t * r[i];
+    }
+  }
+}
+
+PHGMG_DEF phgmg_result phgmg_lstsq(int m, int n, int nrhs, const double *A, int lda,
+                                   const double *B, int ldb, double lambda,
+                                   double *X, int ldx, const phgmg_allocator *alloc) {
+  int mm, i, j;
+  double *W, *tau, *C, anorm;
+  if (m < 0 || n < 0 || nrhs < 0 || lda < PHGMG__MAX(m, 1) || ldb < PHGMG__MAX(m, 1) ||
+      ldx < PHGMG__MAX(n, 1))
+    return PHGMG_ERR_SIZE;
+  if (!(lambda >= 0.0)) return lambda != lambda ? PHGMG_ERR_NANINF : PHGMG_ERR_INVALID_ARG;
+  if (lambda == HUGE_VAL) return PHGMG_ERR_NANINF;
+  if (lambda == 0.0 && m < n) return PHGMG_ERR_RANK;
+  if (n == 0 || nrhs == 0) return PHGMG_OK;
+  if (!A || !B || !X) return PHGMG_ERR_INVALID_ARG;
+  if (!phgmg__mat_finite(m, n, A, lda) || !phgmg__mat_finite(m, nrhs, B, ldb))
+    return PHGMG_ERR_NANINF;
+  mm = lambda > 0.0 ? m + n : m;
+  W = phgmg__dalloc(alloc, (size_t)mm * (size_t)(n + nrhs) + (size_t)n);
+  if (!W) return PHGMG_ERR_NOMEM;
+  C = W + (size_t)mm * (size_t)n;
+  tau = C + (size_t)mm * (size_t)nrhs;
+  /* W = [A; sqrt(lambda) I], C = [B; 0] */
+  for (j = 0; j < n; ++j) {
+    double *w = W + (size_t)j * (size_t)mm;
+    memcpy(w, A + (size_t)j * (size_t)lda, (size_t)m * sizeof(double));
+    if (mm > m) {
+      for (i = m; i < mm; ++i) w[i] = 0.0;
+      w[m + j] = sqrt(lambda);
+    }
+  }
+  for (j = 0; j < nrhs; ++j) {
+    double *c = C + (size_t)j * (size_t)mm;
+    memcpy(c, B + (size_t)j * (size_t)ldb, (size_t)m * sizeof(double));
+    for (i = m; i < mm; ++i) c[i] = 0.0;
+  }
+  anorm = phgmg_normf(mm, n, W, mm);
+  phgmg_qr(mm, n, W, mm, tau);
+  for (j = 0; j < n; ++j) {
+    double d = fabs(W[j + (size_t)j * (size_t)mm]);
+    if (d <= (double)PHGMG__MAX(mm, n) * PHGMG__EPS * anorm || d == 0.0) {
+      phgmg__free(alloc, W);
+      return PHGMG_ERR_RANK;
+    }
+  }
+  phgmg_qr_apply('T', mm, nrhs, n, W, mm, tau, C, mm);
+  phgmg__trsv_upper(n, W, mm, nrhs, C, mm);
+  for (j = 0; j < nrhs; ++j)
+    memcpy(X + (size_t)j * (size_t)ldx, C + (size_t)j * (size_t)mm, (size_t)n * sizeof(double));
+  phgmg__free(alloc, W);
+  return PHGMG_OK;
+}
+
+/* ---- thin SVD: QRCP + second QR + one-sided Jacobi ----------------------------- */
+/* One-sided (Hestenes) Jacobi on the columns of X (r x r, ldx): X V = W diag(sigma),
+   V accumulated (r x r, ldv). On return X holds W diag(sigma). */
+PHGMG__PRIV phgmg_result phgmg__jacobi_1s(int r, double *X, int ldx, double *V, int ldv,
+                                          double *d) {
+  const double tol = PHGMG__EPS * sqrt((double)PHGMG__MAX(r, 1));
+  int sweep, p, q, i, rotated;
+  for (sweep = 0; sweep < 80; ++sweep) {
+    for (p = 0; p < r; ++p) {
+      double *xp = X + (size_t)p * (size_t)ldx, s = 0.0;
+      for (i = 0; i < r; ++i) s += xp[i] * xp[i];
+      d[p] = s;
+    }
+    rotated = 0;
+    for (p = 0; p < r - 1; ++p) {
+      double *xp = X + (size_t)p * (size_t)ldx, *vp = V + (size_t)p * (size_t)ldv;
+      for (q = p + 1; q < r; ++q) {
+        double *xq = X + (size_t)q * (size_t)ldx, *vq = V + (size_t)q * (size_t)ldv;
+        double alpha = d[p], beta = d[q], gamma = 0.0, zeta, t, c, s;
+        if (alpha == 0.0 || beta == 0.0) continue;
+        for (i = 0; i < r; ++i) gamma += xp[i] * xq[i];
+        if (fabs(gamma) <= tol * sqrt(alpha) * sqrt(beta)) continue;
+        rotated = 1;
+        zeta = (beta - alpha) / (2.0 * gamma);
+        t = (zeta >= 0.0 ? 1.0 : -1.0) / (fabs(zeta) + sqrt(1.0 + zeta * zeta));
+        c = 1.0 / sqrt(1.0 + t * t);
+        s = c * t;
+        for (i = 0; i < r; ++i) {
+          double a = xp[i], b = xq[i];
+          xp[i] = c * a - s * b;
+          xq[i] = s * a + c * b;
+        }
+        for (i = 0; i < r; ++i) {
+          double a = vp[i], b = vq[i];
+          vp[i] = c * a - s * b;
+          vq[i] = s * a + c * b;
+        }
+        d[p] = alpha - t * gamma;
+        d[q] = beta + t * gamma;
+        if (!(d[p] >= 0.0)) d[p] = 0.0;
+      }
+    }
+    if (!rotated) return PHGMG_OK;
+  }
+  return PHGMG_ERR_NOT_CONVERGED;
+}
+
+PHGMG_DEF phgmg_result phgmg_svd(int m, int n, const double *A, int lda, int kmax,
+                                 double *S, double *U, int ldu, double *V, int ldv,
+                                 int *k_out, int *rank_out, const phgmg_allocator *alloc) {
+  double *W = NULL, *tau, *vn, *Rt, *tau2, *X, *Vj, *d, anorm;
+  int *jpvt = NULL, *perm;
+  int r, rnz, k, i, j, kmin = PHGMG__MIN(m, n);
+  phgmg_result rc;
+  size_t nw;
+  if (m < 0 || n < 0 || kmax < 0 || lda < PHGMG__MAX(m, 1)) return PHGMG_ERR_SIZE;
+  if (kmax > 0 && (ldu < PHGMG__MAX(m, 1) || (V && ldv < PHGMG__MAX(n, 1)))) return PHGMG_ERR_SIZE;
+  if (!k_out || (kmin > 0 && !A) || (kmax > 0 && (!S || !U))) return PHGMG_ERR_INVALID_ARG;
+  if (kmin == 0) {
+    *k_out = 0;
+    if (rank_out) *rank_out = 0;
+    return PHGMG_OK;
+  }
+  if (!phgmg__mat_finite(m, n, A, lda)) return PHGMG_ERR_NANINF;
+  /* workspace: W (m x n), tau (kmin), vn (2n) */
+  nw = (size_t)m * (size_t)n + (size_t)kmin + 2 * (size_t)n;
+  W = phgmg__dalloc(alloc, nw);
+  jpvt = phgmg__ialloc(alloc, (size_t)n + (size_t)kmin);
+  if (!W || !jpvt) { phgmg__free(alloc, W); phgmg__free(alloc, jpvt); return PHGMG_ERR_NOMEM; }
+  perm = jpvt + n;
+  tau = W + (size_t)m * (size_t)n;
+  vn = tau + kmin;
+  for (j = 0; j < n; ++j)
+    memcpy(W + (size_t)j * (size_t)m, A + (size_t)j * (size_t)lda, (size_t)m * sizeof(double));
+  anorm = phgmg_normf(m, n, W, m);
+  phgmg__qrcp_core(m, n, W, m, tau, jpvt, vn, PHGMG__EPS * anorm, &r);
+  if (r == 0) {
+    *k_out = 0;
+    if (rank_out) *rank_out = 0;
+    phgmg__free(alloc, W);
+    phgmg__free(alloc, jpvt);
+    return PHGMG_OK;
+  }
+  {
+    /* second workspace: Rt (n x r), tau2 (r), X (r x r), Vj (r x r), d (r) */
+    double *W2 = phgmg__dalloc(alloc, (size_t)n * (size_t)r + 2 * (size_t)r * (size_t)r +
+                                          2 * (size_t)r);
+    if (!W2) { phgmg__free(alloc, W); phgmg__free(alloc, jpvt); return PHGMG_ERR_NOMEM; }
+    Rt = W2;
+    tau2 = Rt + (size_t)n * (size_t)r;
+    X = tau2 + r;
+    Vj = X + (size_t)r * (size_t)r;
+    d = Vj + (size_t)r * (size_t)r;
+    /* Rt = R^T, R = W(0:r, 0:n) upper trapezoidal */
+    for (i = 0; i < r; ++i) {
+      double *rt = Rt + (size_t)i * (size_t)n;
+      for (j = 0; j < i; ++j) rt[j] = 0.0;
+      for (j = i; j < n; ++j) rt[j] = W[i + (size_t)j * (size_t)m];
+    }
+    phgmg_qr(n, r, Rt, n, tau2);
+    /* X = R2^T (lower triangular), Vj = I */
+    for (j = 0; j < r; ++j) {
+      double *x = X + (size_t)j * (size_t)r, *v = Vj + (size_t)j * (size_t)r;
+      for (i = 0; i < r; ++i) {
+        x[i] = i >= j ? Rt[j + (size_t)i * (size_t)n] : 0.0;
+        v[i] = i == j ? 1.0 : 0.0;
+      }
+    }
+    rc = phgmg__jacobi_1s(r, X, r, Vj, r, d);
+    if (rc == PHGMG_OK) {
+      /* sigma_j = ||X(:,j)||, order descending */
+      for (j = 0; j < r; ++j) {
+        d[j] = phgmg_normf(r, 1, X + (size_t)j * (size_t)r, r);
+        perm[j] = j;
+      }
+      for (i = 1; i < r; ++i) { /* insertion sort, r is small */
+        int pj = perm[i];
+        for (j = i - 1; j >= 0 && d[perm[j]] < d[pj]; --j) perm[j + 1] = perm[j];
+        perm[j + 1] = pj;
+      }
+      rnz = r; /* an exactly zero singular value has no singular vector: drop it */
+      while (rnz > 0 && !(d[perm[rnz - 1]] > 0.0)) --rnz;
+      k = PHGMG__MIN(kmax, rnz);
+      for (j = 0; j < k; ++j) {
+        int c = perm[j];
+        double s = d[c], *u = U + (size_t)j * (size_t)ldu;
+        const double *x = X + (size_t)c * (size_t)r;
+        S[j] = s;
+        for (i = 0; i < r; ++i) u[i] = x[i] / s;
+        for (i = r; i < m; ++i) u[i] = 0.0;
+      }
+      /* U = Q [W; 0] with the r reflectors of the pivoted QR */
+      if (k > 0) phgmg_qr_apply('N', m, k, PHGMG__MIN(r, kmin), W, m, tau, U, ldu);
+      if (V && k > 0) {
+        /* V = P Q2 [Vj; 0]; Rt's reflectors give Q2 (n x r) */
+        int r2 = PHGMG__MIN(n, r);
+        for (j = 0; j < k; ++j) {
+          double *v = V + (size_t)j * (size_t)ldv, *y = vn;
+          const double *vj = Vj + (size_t)perm[j] * (size_t)r;
+          for (i = 0; i < r; ++i) y[i] = vj[i];
+          for (i = r; i < n; ++i) y[i] = 0.0;
+          phgmg_qr_apply('N', n, 1, r2, Rt, n, tau2, y, n);
+          for (i = 0; i < n; ++i) v[jpvt[i]] = y[i];
+        }
+      }
+      *k_out = k;
+      if (rank_out) *rank_out = rnz;
+    }
+    phgmg__free(alloc, W2);
+  }
+  phgmg__free(alloc, W);
+  phgmg__free(alloc, jpvt);
+  return rc;
+}
+
+/* ---- symmetric eigenproblem: cyclic Jacobi ------------------------------------ */
+PHGMG_DEF phgmg_result phgmg_sym_eig(int n, double *A, int lda, double *w, double *V, int ldv) {
+  int i, j, p, q, sweep, rotated;
+  double anorm;
+  if (n < 0 || lda < PHGMG__MAX(n, 1) || (V && ldv < PHGMG__MAX(n, 1))) return PHGMG_ERR_SIZE;
+  if (n == 0) return PHGMG_OK;
+  if (!A || !w) return PHGMG_ERR_INVALID_ARG;
+  if (!phgmg__mat_finite(n, n, A, lda)) return PHGMG_ERR_NANINF;
+  /* symmetrize: A := (A + A^T)/2 */
+  for (j = 0; j < n; ++j)
+    for (i = j + 1; i < n; ++i) {
+      double *aij = A + i + (size_t)j * (size_t)lda, *aji = A + j + (size_t)i * (size_t)lda;
+      double s = 0.5 * (*aij + *aji);
+      *aij = *aji = s;
+    }
+  if (V)
+    for (j = 0; j < n; ++j)
+      for (i = 0; i < n; ++i) V[i + (size_t)j * (size_t)ldv] = i == j ? 1.0 : 0.0;
+  anorm = phgmg_normf(n, n, A, lda);
+  for (sweep = 0; sweep < 100; ++sweep) {
+    rotated = 0;
+    for (p = 0; p < n - 1; ++p) {
+      double *ap = A + (size_t)p * (size_t)lda;
+      for (q = p + 1; q < n; ++q) {
+        double *aq = A + (size_t)q * (size_t)lda;
+        double apq = aq[p], app = ap[p], aqq = aq[q], theta, t, c, s;
+        if (fabs(apq) <= PHGMG__EPS * sqrt(fabs(app)) * sqrt(fabs(aqq)) ||
+            fabs(apq) <= PHGMG__EPS * PHGMG__EPS * anorm)
+          continue;
+        rotated = 1;
+        theta = (aqq - app) / (2.0 * apq);
+        t = (theta >= 0.0 ? 1.0 : -1.0) / (fabs(theta) + sqrt(1.0 + theta * theta));
+        c = 1.0 / sqrt(1.0 + t * t);
+        s = c * t;
+        for (i = 0; i < n; ++i) {
+          double a = ap[i], b = aq[i];
+          ap[i] = c * a - s * b;
+          aq[i] = s * a + c * b;
+        }
+        ap[p] = app - t * apq;
+        aq[q] = aqq + t * apq;
+        ap[q] = aq[p] = 0.0;
+        for (i = 0; i < n; ++i) { /* mirror the two columns into rows p, q */
+          if (i == p || i == q) continue;
+          A[p + (size_t)i * (size_t)lda] = ap[i];
+          A[q + (size_t)i * (size_t)lda] = aq[i];
+        }
+        if (V) {
+          double *vp = V + (size_t)p * (size_t)ldv, *vq = V + (size_t)q * (size_t)ldv;
+          for (i = 0; i < n; ++i) {
+            double a = vp[i], b = vq[i];
+            vp[i] = c * a - s * b;
+            vq[i] = s * a + c * b;
+          }
+        }
+      }
+    }
+    if (!rotated) break;
+  }
+  if (rotated) return PHGMG_ERR_NOT_CONVERGED;
+  for (i = 0; i < n; ++i) w[i] = A[i + (size_t)i * (size_t)lda];
+  /* selection sort ascending, swapping eigenvector columns */
+  for (i = 0; i < n - 1; ++i) {
+    int kmin = i;
+    for (j = i + 1; j < n; ++j)
+      if (w[j] < w[kmin]) kmin = j;
+    if (kmin != i) {
+      double t = w[i];
+      w[i] = w[kmin]; w[kmin] = t;
+      if (V) {
+        double *vi = V + (size_t)i * (size_t)ldv, *vk = V + (size_t)kmin * (size_t)ldv;
+        for (j = 0; j < n; ++j) { t = vi[j]; vi[j] = vk[j]; vk[j] = t; }
+      }
+    }
+  }
+  return PHGMG_OK;
+}
+
+#endif /* PHGMG_NO_OFFLINE */
+
+/* >>online (implementation) ============================================== */
+/* Everything here is in phgmg_real, allocation-free and N-independent. */
+#if PHGMG_REAL_IS_FLOAT
+#define PHGMG__RABS(x) fabsf(x)
+#define PHGMG__RSQRT(x) sqrtf(x)
+#define PHGMG__REPS 1.1920929e-07f
+#else
+#define PHGMG__RABS(x) fabs(x)
+#define PHGMG__RSQRT(x) sqrt(x)
+#define PHGMG__REPS 2.220446049250313e-16
+#endif
+#define PHGMG__R(x) ((phgmg_real)(x))
+#define PHGMG__ONLINE static PHGMG__UNUSED
+
+PHGMG__ONLINE int phgmg__r_finite(const phgmg_real *a, int n) {
+  phgmg_real acc = PHGMG__R(0);
+  int i;
+  for (i = 0; i < n; ++i) acc += a[i] * PHGMG__R(0);
+  return acc == PHGMG__R(0);
+}
+
+/* y = A x (A: rows x cols, column-major, ld = rows); beta = 0 or 1 (accumulate). */
+PHGMG__ONLINE void phgmg__r_gemv(int rows, int cols, const phgmg_real *A, const phgmg_real *x,
+                                 int accumulate, phgmg_real *y) {
+  int i, j;
+  if (!accumulate) for (i = 0; i < rows; ++i) y[i] = PHGMG__R(0);
+  for (j = 0; j < cols; ++j) {
+    const phgmg_real xj = x[j];
+    const phgmg_real *a = A + (size_t)j * (size_t)rows;
+    if (xj == PHGMG__R(0)) continue;
+    for (i = 0; i < rows; ++i) y[i] += a[i] * xj;
+  }
+}
+/* y (+)= A^T x (A: rows x cols). */
+PHGMG__ONLINE void phgmg__r_gemvt(int rows, int cols, const phgmg_real *A, const phgmg_real *x,
+                                  int accumulate, phgmg_real *y) {
+  int i, j;
+  for (j = 0; j < cols; ++j) {
+    const phgmg_real *a = A + (size_t)j * (size_t)rows;
+    phgmg_real s = PHGMG__R(0);
+    for (i = 0; i < rows; ++i) s += a[i] * x[i];
+    y[j] = accumulate ? y[j] + s : s;
+  }
+}
+
+/* LU with partial pivoting of an n x n matrix (ld n). 0 ok, -1 singular/non-finite. */
+PHGMG__ONLINE int phgmg__r_lu(int n, phgmg_real *A, int *piv) {
+  int i, j, k;
+  for (k = 0; k < n; ++k) {
+    int p = k;
+    phgmg_real amax = PHGMG__RABS(A[k + k * n]);
+    for (i = k + 1; i < n; ++i) {
+      phgmg_real v = PHGMG__RABS(A[i + k * n]);
+      if (v > amax) { amax = v; p = i; }
+    }
+    piv[k] = p;
+    if (!(amax > PHGMG__R(0)) || amax - amax != PHGMG__R(0)) return -1;
+    if (p != k)
+      for (j = 0; j < n; ++j) { phgmg_real t = A[k + j * n]; A[k + j * n] = A[p + j * n]; A[p + j * n] = t; }
+    {
+      const phgmg_real inv = PHGMG__R(1) / A[k + k * n];
+      for (i = k + 1; i < n; ++i) A[i + k * n] *= inv;
+    }
+    for (j = k + 1; j < n; ++j) {
+      const phgmg_real akj = A[k + j * n];
+      if (akj == PHGMG__R(0)) continue;
+      for (i = k + 1; i < n; ++i) A[i + j * n] -= A[i + k * n] * akj;
+    }
+  }
+  return 0;
+}
+PHGMG__ONLINE void phgmg__r_lu_solve(int n, const phgmg_real *LU, const int *piv, phgmg_real *b) {
+  int i, j;
+  for (i = 0; i < n; ++i)
+    if (piv[i] != i) { phgmg_real t = b[i]; b[i] = b[piv[i]]; b[piv[i]] = t; }
+  for (j = 0; j < n; ++j) {
+    const phgmg_real bj = b[j];
+    if (bj != PHGMG__R(0)) for (i = j + 1; i < n; ++i) b[i] -= LU[i + j * n] * bj;
+  }
+  for (j = n - 1; j >= 0; --j) {
+    b[j] /= LU[j + j * n];
+    if (b[j] != PHGMG__R(0)) for (i = 0; i < j; ++i) b[i] -= LU[i + j * n] * b[j];
+  }
+}
+
+/* Polynomial phi(s) = sum_k c_k s^k and its first two derivatives. */
+PHGMG__ONLINE void phgmg__r_poly(const phgmg_real *c, int deg, phgmg_real s, phgmg_real *v,
+                                 phgmg_real *d1, phgmg_real *d2) {
+  phgmg_real p0 = PHGMG__R(0), p1 = PHGMG__R(0), p2 = PHGMG__R(0);
+  int k;
+  for (k = deg; k >= 0; --k) {
+    p2 = p2 * s + PHGMG__R(2) * p1;
+    p1 = p1 * s + p0;
+    p0 = p0 * s + c[k];
+  }
+  if (v) *v = p0;
+  if (d1) *d1 = p1;
+  if (d2) *d2 = p2;
+}
+
+PHGMG_DEF phgmg_result phgmg_rom_check(const phgmg_rom *rom) {
+  if (!rom) return PHGMG_ERR_INVALID_ARG;
+  if (rom->r < 1 || rom->m < 0 || rom->m > rom->r || rom->nd < 0 || rom->rn < 0)
+    return PHGMG_ERR_SIZE;
+  if (rom->r > 4096 || rom->nd > (1 << 24) || rom->rn > 4096) return PHGMG_ERR_SIZE;
+  if (!rom->Qh || (rom->m > 0 && !rom->Bh)) return PHGMG_ERR_INVALID_ARG;
+  if (rom->kind == PHGMG_ROM_LINEAR) {
+    if (!rom->K || rom->rn != 0) return PHGMG_ERR_INVALID_ARG;
+  } else if (rom->kind == PHGMG_ROM_QUADRATIC) {
+    if (rom->rn < 1 || rom->r - rom->m < 1) return PHGMG_ERR_SIZE;
+    if (!rom->G00 || !rom->G01 || !rom->G10 || !rom->G11 || !rom->Q01 || !rom->Q11 || !rom->Ms)
+      return PHGMG_ERR_INVALID_ARG;
+    if (rom->nd > 0 && !rom->P1) return PHGMG_ERR_INVALID_ARG;
+  } else {
+    return PHGMG_ERR_INVALID_ARG;
+  }
+  if (rom->nd > 0 && (!rom->P0 || !rom->w || !rom->poly || rom->poly_deg < 0 || rom->poly_deg > 32))
+    return PHGMG_ERR_INVALID_ARG;
+  if (rom->Phi && (!rom->Gam || !rom->SX || !rom->SU || !(rom->dt > PHGMG__R(0))))
+    return PHGMG_ERR_INVALID_ARG;
+  return PHGMG_OK;
+}
+
+/* Evaluation work: one layout function used by the size query and by every
+   evaluator, so size and carving cannot drift. */
+typedef struct phgmg__romw {
+  phgmg_real *Lp, *q, *a1, *c, *d, *E, *t, *tmp, *xp, *fm, *g;
+} phgmg__romw;
+
+PHGMG__ONLINE size_t phgmg__romw_layout(const phgmg_rom *rom, phgmg_real *base, phgmg__romw *w) {
+  const size_t r = (size_t)rom->r, rn = (size_t)rom->rn, nd = (size_t)rom->nd;
+  size_t o = 0;
+  phgmg__romw dummy;
+  if (!w) w = &dummy;
+  w->Lp = base + o; o += rn * r;
+  w->q = base + o; o += rn;
+  w->a1 = base + o; o += rn;
+  w->c = base + o; o += nd;
+  w->d = base + o; o += nd;
+  w->E = base + o; o += r * r;
+  w->t = base + o; o += rn * r;
+  w->tmp = base + o; o += r;
+  w->xp = base + o; o += r;
+  w->fm = base + o; o += r;
+  w->g = base + o; o += r;
+  return o;
+}
+
+PHGMG_DEF size_t phgmg_rom_eval_work_size(const phgmg_rom *rom) {
+  return phgmg__romw_layout(rom, NULL, NULL);
+}
+
+/* q = M (x2 kron x2) via Lp (QUADRATIC), and the kept coordinates c. */
+PHGMG__ONLINE void phgmg__rom_prep(const phgmg_rom *rom, const phgmg_real *x, const phgmg__romw *w) {
+  const int r = rom->r, m = rom->m, rn = rom->rn, nd = rom->nd, p = r - m;
+  int i, j, k;
+  if (rom->kind == PHGMG_ROM_QUADRATIC) {
+    const phgmg_real *x2 = x + m;
+    for (k = 0; k < p; ++k) { /* Lp(:,k) = sum_j Ms(:, k*p + j) x2_j */
+      phgmg_real *l = w->Lp + (size_t)k * rn;
+      for (i = 0; i < rn; ++i) l[i] = PHGMG__R(0);
+      for (j = 0; j < p; ++j) {
+        const phgmg_real *ms = rom->Ms + ((size_t)k * p + j) * rn;
+        const phgmg_real xj = x2[j];
+        for (i = 0; i < rn; ++i) l[i] += ms[i] * xj;
+      }
+    }
+    phgmg__r_gemv(rn, p, w->Lp, x2, 0, w->q);
+    for (i = 0; i < rn; ++i) w->q[i] *= PHGMG__R(0.5);
+  }
+  if (nd > 0) {
+    phgmg__r_gemv(nd, r, rom->P0, x, 0, w->c);
+    if (rom->kind == PHGMG_ROM_QUADRATIC) phgmg__r_gemv(nd, rn, rom->P1, w->q, 1, w->c);
+  }
+}
+
+PHGMG_DEF phgmg_real phgmg_rom_hamiltonian(const phgmg_rom *rom, const phgmg_real *x, phgmg_real *work) {
+  phgmg__romw w;
+  phgmg_real h = PHGMG__R(0);
+  const int r = rom->r, rn = rom->rn;
+  int j;
+  phgmg__romw_layout(rom, work, &w);
+  phgmg__rom_prep(rom, x, &w);
+  phgmg__r_gemv(r, r, rom->Qh, x, 0, w.tmp);
+  if (rom->kind == PHGMG_ROM_QUADRATIC) {
+    phgmg__r_gemv(r, rn, rom->Q01, w.q, 1, w.tmp);
+    phgmg__r_gemv(r, rn, rom->Q01, w.q, 1, w.tmp); /* 2 x^T Q01 q */
+    phgmg__r_gemv(rn, rn, rom->Q11, w.q, 0, w.a1);
+    for (j = 0; j < rn; ++j) h += w.q[j] * w.a1[j];
+  }
+  for (j = 0; j < r; ++j) h += x[j] * w.tmp[j];
+  h *= PHGMG__R(0.5);
+  for (j = 0; j < rom->nd; ++j) {
+    phgmg_real v;
+    phgmg__r_poly(rom->poly, rom->poly_deg, w.c[j], &v, NULL, NULL);
+    h += rom->w[j] * v;
+  }
+  return h;
+}
+
+/* grad H into g (g must not alias the work areas other than w->g). */
+PHGMG__ONLINE void phgmg__rom_grad(const phgmg_rom *rom, const phgmg_real *x, phgmg_real *g,
+                                   const phgmg__romw *w) {
+  const int r = rom->r, m = rom->m, rn = rom->rn, nd = rom->nd, p = r - m;
+  int j;
+  phgmg__rom_prep(rom, x, w);
+  for (j = 0; j < nd; ++j) {
+    phgmg_real d1;
+    phgmg__r_poly(rom->poly, rom->poly_deg, w->c[j], NULL, &d1, NULL);
+    w->d[j] = rom->w[j] * d1;
+  }
+  phgmg__r_gemv(r, r, rom->Qh, x, 0, g);
+  if (nd > 0) phgmg__r_gemvt(nd, r, rom->P0, w->d, 1, g);
+  if (rom->kind == PHGMG_ROM_QUADRATIC) {
+    phgmg__r_gemv(r, rn, rom->Q01, w->q, 1, g);
+    phgmg__r_gemvt(r, rn, rom->Q01, x, 0, w->a1); /* a1 = Q01^T x + Q11 q + P1^T d */
+    phgmg__r_gemv(rn, rn, rom->Q11, w->q, 1, w->a1);
+    if (nd > 0) phgmg__r_gemvt(nd, rn, rom->P1, w->d, 1, w->a1);
+    phgmg__r_gemvt(rn, p, w->Lp, w->a1, 1, g + m); /* g2 += Lp^T a1 */
+  }
+}
+
+PHGMG_DEF void phgmg_rom_gradient(const phgmg_rom *rom, const phgmg_real *x, phgmg_real *g, phgmg_real *work) {
+  phgmg__romw w;
+  phgmg__romw_layout(rom, work, &w);
+  phgmg__rom_grad(rom, x, g, &w);
+}
+
+PHGMG_DEF void phgmg_rom_output(const phgmg_rom *rom, const phgmg_real *x, phgmg_real *y, phgmg_real *work) {
+  phgmg__romw w;
+  phgmg__romw_layout(rom, work, &w);
+  phgmg__rom_grad(rom, x, w.g, &w);
+  phgmg__r_gemvt(rom->r, rom->m, rom->Bh, w.g, 0, y);
+}
+
+/* E = D^T G D = G00 + G01 L + L^T (G10 + G11 L), L = [0, Lp] (QUADRATIC; Lp current). */
+PHGMG__ONLINE void phgmg__rom_dgd(const phgmg_rom *rom, const phgmg__romw *w) {
+  const int r = rom->r, m = rom->m, rn = rom->rn;
+  phgmg_real *E = w->E, *t = w->t;
+  int a, b, i;
+  for (b = 0; b < r; ++b) {
+    phgmg_real *tb = t + (size_t)b * rn;
+    for (i = 0; i < rn; ++i) tb[i] = rom->G10[i + (size_t)b * rn];
+    if (b >= m) phgmg__r_gemv(rn, rn, rom->G11, w->Lp + (size_t)(b - m) * rn, 1, tb);
+  }
+  for (b = 0; b < r * r; ++b) E[b] = rom->G00[b];
+  for (b = m; b < r; ++b) phgmg__r_gemv(r, rn, rom->G01, w->Lp + (size_t)(b - m) * rn, 1, E + (size_t)b * r);
+  for (b = 0; b < r; ++b)
+    for (a = m; a < r; ++a) {
+      const phgmg_real *la = w->Lp + (size_t)(a - m) * rn, *tb = t + (size_t)b * rn;
+      phgmg_real s = PHGMG__R(0);
+      for (i = 0; i < rn; ++i) s += la[i] * tb[i];
+      E[a + (size_t)b * r] += s;
+    }
+}
+
+/* Solve E z = b in place (E destroyed) by Gaussian elimination with partial
+   pivoting, without pivot storage. 0 ok, -1 singular. */
+PHGMG__ONLINE int phgmg__r_gesv1(int n, phgmg_real *E, phgmg_real *b) {
+  int i, j, k;
+  for (k = 0; k < n; ++k) {
+    int pv = k;
+    phgmg_real amax = PHGMG__RABS(E[k + k * n]);
+    for (i = k + 1; i < n; ++i)
+      if (PHGMG__RABS(E[i + k * n]) > amax) { amax = PHGMG__RABS(E[i + k * n]); pv = i; }
+    if (!(amax > PHGMG__R(0)) || amax - amax != PHGMG__R(0)) return -1;
+    if (pv != k) {
+      phgmg_real tt;
+      for (j = k; j < n; ++j) { tt = E[k + j * n]; E[k + j * n] = E[pv + j * n]; E[pv + j * n] = tt; }
+      tt = b[k]; b[k] = b[pv]; b[pv] = tt;
+    }
+    for (i = k + 1; i < n; ++i) {
+      const phgmg_real l = E[i + k * n] / E[k + k * n];
+      if (l == PHGMG__R(0)) continue;
+      for (j = k + 1; j < n; ++j) E[i + j * n] -= l * E[k + j * n];
+      b[i] -= l * b[k];
+    }
+  }
+  for (k = n - 1; k >= 0; --k) {
+    phgmg_real s = b[k];
+    for (j = k + 1; j < n; ++j) s -= E[k + j * n] * b[j];
+    b[k] = s / E[k + k * n];
+  }
+  return 0;
+}
+
+/* f = K(x) grad H(x) + Bh u; grad H left in w->g. f must not alias work. */
+PHGMG__ONLINE phgmg_result phgmg__rom_rhs(const phgmg_rom *rom, const phgmg_real *x, const phgmg_real *u,
+                                          phgmg_real *f, const phgmg__romw *w) {
+  const int r = rom->r;
+  phgmg__rom_grad(rom, x, w->g, w);
+  if (rom->kind == PHGMG_ROM_LINEAR) {
+    phgmg__r_gemv(r, r, rom->K, w->g, 0, f);
+  } else {
+    int i;
+    phgmg__rom_dgd(rom, w);
+    for (i = 0; i < r; ++i) f[i] = w->g[i];
+    if (phgmg__r_gesv1(r, w->E, f) != 0) return PHGMG_ERR_SINGULAR;
+  }
+  if (u && rom->m > 0) phgmg__r_gemv(r, rom->m, rom->Bh, u, 1, f);
+  return PHGMG_OK;
+}
+
+PHGMG_DEF phgmg_result phgmg_rom_rhs(const phgmg_rom *rom, const phgmg_real *x, const phgmg_real *u,
+                                     phgmg_real *f, phgmg_real *work) {
+  phgmg__romw w;
+  phgmg__romw_layout(rom, work, &w);
+  return phgmg__rom_rhs(rom, x, u, f, &w);
+}
+
+PHGMG_DEF phgmg_result phgmg_rom_structure(const phgmg_rom *rom, const phgmg_real *x, phgmg_real *Jr,
+                                           phgmg_real *Rr, phgmg_real *work) {
+  const int r = rom->r;
+  int a, b;
+  phgmg__romw w;
+  phgmg__romw_layout(rom, work, &w);
+  if (rom->kind == PHGMG_ROM_LINEAR) {
+    for (b = 0; b < r * r; ++b) Jr[b] = rom->K[b];
+  } else { /* K = E^{-1}, column by column */
+    phgmg__rom_prep(rom, x, &w);
+    for (b = 0; b < r; ++b) {
+      phgmg__rom_dgd(rom, &w);
+      for (a = 0; a < r; ++a) Jr[a + (size_t)b * r] = (a == b) ? PHGMG__R(1) : PHGMG__R(0);
+      if (phgmg__r_gesv1(r, w.E, Jr + (size_t)b * r) != 0) return PHGMG_ERR_SINGULAR;
+    }
+  }
+  for (b = 0; b < r; ++b)
+    for (a = 0; a <= b; ++a) {
+      const phgmg_real kab = Jr[a + (size_t)b * r], kba = Jr[b + (size_t)a * r];
+      Rr[a + (size_t)b * r] = Rr[b + (size_t)a * r] = -PHGMG__R(0.5) * (kab + kba);
+      Jr[a + (size_t)b * r] = PHGMG__R(0.5) * (kab - kba);
+      Jr[b + (size_t)a * r] = -Jr[a + (size_t)b * r];
+    }
+  return PHGMG_OK;
+}
+
+/* Newton Jacobian df/dx. */
+PHGMG__ONLINE phgmg_result phgmg__rom_jac(const phgmg_rom *rom, const phgmg_real *x, phgmg_real *Jf,
+                                          const phgmg__romw *w) {
+  const int r = rom->r;
+  int a, b, j;
+  if (rom->kind == PHGMG_ROM_LINEAR) {
+    /* Jf = K (Qh + P0^T diag(w phi''(c)) P0) */
+    phgmg_real *Hs = w->E;
+    phgmg__rom_prep(rom, x, w);
+    for (j = 0; j < rom->nd; ++j) {
+      phgmg_real d2;
+      phgmg__r_poly(rom->poly, rom->poly_deg, w->c[j], NULL, NULL, &d2);
+      w->d[j] = rom->w[j] * d2;
+    }
+    for (b = 0; b < r; ++b)
+      for (a = 0; a < r; ++a) {
+        phgmg_real s = rom->Qh[a + (size_t)b * r];
+        for (j = 0; j < rom->nd; ++j)
+          s += rom->P0[j + (size_t)a * rom->nd] * w->d[j] * rom->P0[j + (size_t)b * rom->nd];
+        Hs[a + (size_t)b * r] = s;
+      }
+    for (b = 0; b < r; ++b) phgmg__r_gemv(r, r, rom->K, Hs + (size_t)b * r, 0, Jf + (size_t)b * r);
+  } else {
+    /* central differences of the right-hand side (u = 0; f is affine in u) */
+#if PHGMG_REAL_IS_FLOAT
+    const phgmg_real hrel = PHGMG__R(4.9e-3);
+#else
+    const phgmg_real hrel = PHGMG__R(6.06e-6);
+#endif
+    for (b = 0; b < r; ++b) {
+      const phgmg_real hb = hrel * (PHGMG__R(1) + PHGMG__RABS(x[b]));
+      phgmg_real *col = Jf + (size_t)b * r;
+      phgmg_result rc;
+      for (a = 0; a < r; ++a) w->xp[a] = x[a];
+      w->xp[b] = x[b] + hb;
+      rc = phgmg__rom_rhs(rom, w->xp, NULL, col, w);
+      if (rc != PHGMG_OK) return rc;
+      w->xp[b] = x[b] - hb;
+      rc = phgmg__rom_rhs(rom, w->xp, NULL, w->fm, w);
+      if (rc != PHGMG_OK) return rc;
+      for (a = 0; a < r; ++a) col[a] = (col[a] - w->fm[a]) / (PHGMG__R(2) * hb);
+    }
+  }
+  return PHGMG_OK;
+}
+
+PHGMG_DEF phgmg_result phgmg_rom_jacobian(const phgmg_rom *rom, const phgmg_real *x, phgmg_real *Jf,
+                                          phgmg_real *work) {
+  phgmg__romw w;
+  phgmg__romw_layout(rom, work, &w);
+  return phgmg__rom_jac(rom, x, Jf, &w);
+}
+
+/* --- online GL3 stepper ------------------------------------------------- */
+typedef struct phgmg__romstep_mem {
+  phgmg_real *A, *b, *c, *lag; /* GL3 tableau (row-major A), extrapolation weights 3x4 */
+  phgmg_real *LU, *Jf, *Z, *F, *Res, *dZ, *Zp, *G, *Y, *work;
+  int *piv;
+} phgmg__romstep_mem;
+
+PHGMG__ONLINE size_t phgmg__romstep_layout(const phgmg_rom *rom, void *mem, phgmg__romstep_mem *L) {
+  const size_t r = (size_t)rom->r, n3 = 3 * r;
+  phgmg_real *base = PHGMG__CAST(phgmg_real *, mem);
+  size_t o = 0, reals;
+  phgmg__romstep_mem dummy;
+  if (!L) L = &dummy;
+  L->A = base + o; o += 9;
+  L->b = base + o; o += 3;
+  L->c = base + o; o += 3;
+  L->lag = base + o; o += 12;
+  L->LU = base + o; o += n3 * n3;
+  L->Jf = base + o; o += r * r;
+  L->Z = base + o; o += n3;
+  L->F = base + o; o += n3;
+  L->Res = base + o; o += n3;
+  L->dZ = base + o; o += n3;
+  L->Zp = base + o; o += n3;
+  L->G = base + o; o += n3;
+  L->Y = base + o; o += r;
+  L->work = base + o; o += phgmg_rom_eval_work_size(rom);
+  reals = o;
+  L->piv = mem ? PHGMG__CAST(int *, PHGMG__CAST(void *, base + reals)) : NULL;
+  return reals * sizeof(phgmg_real) + n3 * sizeof(int);
+}
+
+PHGMG_DEF size_t phgmg_rom_stepper_memsize(const phgmg_rom *rom) {
+  if (phgmg_rom_check(rom) != PHGMG_OK) return 0;
+  return phgmg__romstep_layout(rom, NULL, NULL);
+}
+
+PHGMG_DEF void phgmg_rom_stage_times(phgmg_real t, phgmg_real dt, phgmg_real tc[3]) {
+  const double s = sqrt(15.0) / 10.0;
+  tc[0] = t + dt * PHGMG__R(0.5 - s);
+  tc[1] = t + dt * PHGMG__R(0.5);
+  tc[2] = t + dt * PHGMG__R(0.5 + s);
+}
+
+PHGMG_DEF phgmg_result phgmg_rom_stepper_init(phgmg_rom_stepper *s, const phgmg_rom *rom, phgmg_real dt,
+                                              phgmg_real tol, int max_iter, void *mem, size_t mem_size) {
+  phgmg__romstep_mem L;
+  phgmg_result rc;
+  double A[9], c[3], b[3], s15 = sqrt(15.0);
+  int i, j, k;
+  if (!s || !mem) return PHGMG_ERR_INVALID_ARG;
+  rc = phgmg_rom_check(rom);
+  if (rc != PHGMG_OK) return rc;
+  if (!(dt > PHGMG__R(0)) || dt - dt != PHGMG__R(0)) return PHGMG_ERR_INVALID_ARG;
+  if (((size_t)mem) % sizeof(double) != 0) return PHGMG_ERR_INVALID_ARG;
+  if (mem_size < phgmg__romstep_layout(rom, NULL, NULL)) return PHGMG_ERR_WORKSPACE;
+  phgmg__romstep_layout(rom, mem, &L);
+  /* Gauss-Legendre 3 from the closed forms */
+  c[0] = 0.5 - s15 / 10.0; c[1] = 0.5; c[2] = 0.5 + s15 / 10.0;
+  b[0] = 5.0 / 18.0; b[1] = 4.0 / 9.0; b[2] = 5.0 / 18.0;
+  A[0] = 5.0 / 36.0;             A[1] = 2.0 / 9.0 - s15 / 15.0; A[2] = 5.0 / 36.0 - s15 / 30.0;
+  A[3] = 5.0 / 36.0 + s15 / 24.0; A[4] = 2.0 / 9.0;            A[5] = 5.0 / 36.0 - s15 / 24.0;
+  A[6] = 5.0 / 36.0 + s15 / 30.0; A[7] = 2.0 / 9.0 + s15 / 15.0; A[8] = 5.0 / 36.0;
+  for (i = 0; i < 9; ++i) L.A[i] = PHGMG__R(A[i]);
+  for (i = 0; i < 3; ++i) { L.b[i] = PHGMG__R(b[i]); L.c[i] = PHGMG__R(c[i]); }
+  /* Lagrange weights of the collocation polynomial (nodes 0, c1, c2, c3)
+     evaluated at 1 + c_k: lag[k*4 + j] */
+  for (k = 0; k < 3; ++k) {
+    const double nodes[4] = {0.0, c[0], c[1], c[2]};
+    const double tt = 1.0 + c[k];
+    for (j = 0; j < 4; ++j) {
+      double l = 1.0;
+      for (i = 0; i < 4; ++i)
+        if (i != j) l *= (tt - nodes[i]) / (nodes[j] - nodes[i]);
+      L.lag[k * 4 + j] = PHGMG__R(l);
+    }
+  }
+  s->rom = rom;
+  s->dt = dt;
+#if PHGMG_REAL_IS_FLOAT
+  s->tol = tol > PHGMG__R(0) ? tol : PHGMG__R(1e-5);
+#else
+  s->tol = tol > PHGMG__R(0) ? tol : PHGMG__R(1e-10);
+#endif
+  s->max_iter = max_iter > 0 ? max_iter : 10;
+  s->use_map = (rom->Phi != NULL && rom->kind == PHGMG_ROM_LINEAR && rom->nd == 0 &&
+                PHGMG__RABS(rom->dt - dt) <= PHGMG__R(8) * PHGMG__REPS * dt);
+  s->have_lu = 0;
+  s->have_prev = 0;
+  s->ws = PHGMG__CAST(phgmg_real *, mem);
+  s->ws_count = mem_size / sizeof(phgmg_real);
+  memset(&s->stats, 0, sizeof s->stats);
+  return PHGMG_OK;
+}
+
+PHGMG_DEF void phgmg_rom_stepper_reset(phgmg_rom_stepper *s) { s->have_prev = 0; }
+
+/* Stage residual Res = Z - h (A kron I) F(x + Z); returns inf-norm, or -1 on
+   failure (non-finite or singular). Stage gradients into G. */
+PHGMG__ONLINE phgmg_real phgmg__romstep_residual(phgmg_rom_stepper *s, const phgmg__romstep_mem *L,
+                                                 const phgmg_real *x, const phgmg_real *u3,
+                                                 phgmg_result *err) {
+  const phgmg_rom *rom = s->rom;
+  const int r = rom->r, m = rom->m;
+  phgmg__romw w;
+  phgmg_real nrm = PHGMG__R(0);
+  int i, j, a;
+  phgmg__romw_layout(rom, L->work, &w);
+  for (i = 0; i < 3; ++i) {
+    phgmg_result rc;
+    for (a = 0; a < r; ++a) L->Y[a] = x[a] + L->Z[i * r + a];
+    rc = phgmg__rom_rhs(rom, L->Y, u3 ? u3 + i * m : NULL, L->F + i * r, &w);
+    if (rc != PHGMG_OK) { *err = rc; return PHGMG__R(-1); }
+    for (a = 0; a < r; ++a) L->G[i * r + a] = w.g[a];
+  }
+  for (i = 0; i < 3; ++i)
+    for (a = 0; a < r; ++a) {
+      phgmg_real v = L->Z[i * r + a];
+      for (j = 0; j < 3; ++j) v -= s->dt * L->A[i * 3 + j] * L->F[j * r + a];
+      L->Res[i * r + a] = v;
+      if (PHGMG__RABS(v) > nrm) nrm = PHGMG__RABS(v);
+    }
+  if (!phgmg__r_finite(L->Res, 3 * r) || !phgmg__r_finite(L->G, 3 * r)) { *err = PHGMG_ERR_NANINF; return PHGMG__R(-1); }
+  return nrm;
+}
+
+/* Factor I - h (A kron Jf(x)). */
+PHGMG__ONLINE phgmg_result phgmg__romstep_factor(phgmg_rom_stepper *s, const phgmg__romstep_mem *L,
+                                                 const phgmg_real *x) {
+  const phgmg_rom *rom = s->rom;
+  const int r = rom->r, n3 = 3 * r;
+  phgmg__romw w;
+  phgmg_result rc;
+  int i, j, a, b;
+  phgmg__romw_layout(rom, L->work, &w);
+  rc = phgmg__rom_jac(rom, x, L->Jf, &w);
+  if (rc != PHGMG_OK) return rc;
+  if (!phgmg__r_finite(L->Jf, r * r)) return PHGMG_ERR_NANINF;
+  for (j = 0; j < 3; ++j)
+    for (b = 0; b < r; ++b)
+      for (i = 0; i < 3; ++i)
+        for (a = 0; a < r; ++a)
+          L->LU[(i * r + a) + (size_t)(j * r + b) * n3] =
+              ((i == j && a == b) ? PHGMG__R(1) : PHGMG__R(0)) - s->dt * L->A[i * 3 + j] * L->Jf[a + (size_t)b * r];
+  s->stats.factorizations++;
+  if (phgmg__r_lu(n3, L->LU, L->piv) != 0) { s->have_lu = 0; return PHGMG_ERR_SINGULAR; }
+  s->have_lu = 1;
+  return PHGMG_OK;
+}
+
+PHGMG__ONLINE phgmg_result phgmg__romstep_map(phgmg_rom_stepper *s, const phgmg__romstep_mem *L, phgmg_real *x,
+                                              const phgmg_real *u3, phgmg_real *y, phgmg_real energy[2]) {
+  const phgmg_rom *rom = s->rom;
+  const int r = rom->r, m = rom->m, n3 = 3 * r;
+  phgmg_real *xn = L->dZ;
+  int i, a;
+  phgmg__r_gemv(r, r, rom->Phi, x, 0, xn);
+  if (u3 && m > 0) phgmg__r_gemv(r, 3 * m, rom->Gam, u3, 1, xn);
+  if (!phgmg__r_finite(xn, r)) return PHGMG_ERR_NANINF;
+  if (energy) {
+    phgmg_real sup = PHGMG__R(0), dis = PHGMG__R(0);
+    phgmg__r_gemv(n3, r, rom->SX, x, 0, L->Z);             /* stage values */
+    if (u3 && m > 0) phgmg__r_gemv(n3, 3 * m, rom->SU, u3, 1, L->Z);
+    for (i = 0; i < 3; ++i) {
+      phgmg_real *gi = L->G + i * r, *ki = L->F + i * r, si = PHGMG__R(0), di = PHGMG__R(0);
+      phgmg__r_gemv(r, r, rom->Qh, L->Z + i * r, 0, gi);
+      phgmg__r_gemv(r, r, rom->K, gi, 0, ki);
+      for (a = 0; a < r; ++a) di -= gi[a] * ki[a];
+      if (u3 && m > 0) {
+        phgmg__r_gemvt(r, m, rom->Bh, gi, 0, L->Y);
+        for (a = 0; a < m; ++a) si += L->Y[a] * u3[i * m + a];
+      }
+      sup += L->b[i] * si;
+      dis += L->b[i] * di;
+    }
+    energy[0] += s->dt * sup;
+    energy[1] += s->dt * dis;
+  }
+  for (a = 0; a < r; ++a) x[a] = xn[a];
+  if (y) {
+    phgmg__r_gemv(r, r, rom->Qh, x, 0, L->Y);
+    phgmg__r_gemvt(r, m, rom->Bh, L->Y, 0, y);
+  }
+  (void)n3;
+  s->stats.steps++;
+  return PHGMG_OK;
+}
+
+PHGMG_DEF phgmg_result phgmg_rom_step(phgmg_rom_stepper *s, phgmg_real *x, const phgmg_real *u3,
+                                      phgmg_real *y, phgmg_real energy[2]) {
+  const phgmg_rom *rom;
+  phgmg__romstep_mem L;
+  int r, m, n3, attempt, i, a;
+  phgmg_result err = PHGMG_OK;
+  if (!s || !x || !s->rom) return PHGMG_ERR_INVALID_ARG;
+  rom = s->rom;
+  r = rom->r; m = rom->m; n3 = 3 * r;
+  if (!phgmg__r_finite(x, r) || (u3 && !phgmg__r_finite(u3, 3 * m))) return PHGMG_ERR_NANINF;
+  phgmg__romstep_layout(rom, s->ws, &L);
+  if (s->use_map) return phgmg__romstep_map(s, &L, x, u3, y, energy);
+
+  for (attempt = 0; attempt < 2; ++attempt) {
+    phgmg_real res, res_prev = PHGMG__R(0), theta_max = PHGMG__R(0);
+    int it = 0, fresh = 0, ok = 0;
+    if (!s->have_lu || attempt > 0) {
+      err = phgmg__romstep_factor(s, &L, x);
+      if (err != PHGMG_OK) break;
+      fresh = 1;
+    }
+    /* starting guess: extrapolated collocation polynomial, or zero */
+    for (i = 0; i < n3; ++i) L.Z[i] = (s->have_prev && attempt == 0) ? L.Zp[i] : PHGMG__R(0);
+    res = phgmg__romstep_residual(s, &L, x, u3, &err);
+    if (res < PHGMG__R(0)) {
+      if (err == PHGMG_ERR_NANINF && !fresh) continue; /* bad guess/factors: retry fresh */
+      break;
+    }
+    while (res > s->tol && it < s->max_iter) {
+      for (i = 0; i < n3; ++i) L.dZ[i] = -L.Res[i];
+      phgmg__r_lu_solve(n3, L.LU, L.piv, L.dZ);
+      for (i = 0; i < n3; ++i) L.Z[i] += L.dZ[i];
+      ++it;
+      s->stats.newton_iters++;
+      res_prev = res;
+      res = phgmg__romstep_residual(s, &L, x, u3, &err);
+      if (res < PHGMG__R(0)) break;
+      if (res_prev > PHGMG__R(0) && res / res_prev > theta_max) theta_max = res / res_prev;
+    }
+    if (res >= PHGMG__R(0) && res <= s->tol) ok = 1;
+    if (!ok) {
+      if (res >= PHGMG__R(0)) err = PHGMG_ERR_NOT_CONVERGED;
+      s->have_lu = 0;
+      if (fresh) break;   /* fresh factors did not help: give up */
+      continue;           /* stale factors: retry once with fresh ones */
+    }
+    /* converged: energy, new state, extrapolation data */
+    {
+      phgmg_real *xn = L.dZ;
+      for (a = 0; a < r; ++a) {
+        phgmg_real v = x[a];
+        for (i = 0; i < 3; ++i) v += s->dt * L.b[i] * L.F[i * r + a];
+        xn[a] = v;
+      }
+      if (!phgmg__r_finite(xn, r)) { err = PHGMG_ERR_NANINF; break; }
+      if (energy) {
+        phgmg_real sup = PHGMG__R(0), dis = PHGMG__R(0);
+        for (i = 0; i < 3; ++i) {
+          const phgmg_real *gi = L.G + i * r, *fi = L.F + i * r;
+          phgmg_real si = PHGMG__R(0), di = PHGMG__R(0);
+          /* dissipation rate gradH^T R gradH = -gradH^T K gradH = -g^T (f - Bh u) */
+          for (a = 0; a < r; ++a) di -= gi[a] * fi[a];
+          if (u3 && m > 0) {
+            phgmg__r_gemvt(r, m, rom->Bh, gi, 0, L.Y);
+            for (a = 0; a < m; ++a) { si += L.Y[a] * u3[i * m + a]; di += L.Y[a] * u3[i * m + a]; }
+          }
+          sup += L.b[i] * si;
+          dis += L.b[i] * di;
+        }
+        energy[0] += s->dt * sup;
+        energy[1] += s->dt * dis;
+      }
+      /* Zp_k = p(1 + c_k) - x_new, p the collocation polynomial (nodes 0, c_i) */
+      for (i = 0; i < 3; ++i)
+        for (a = 0; a < r; ++a) {
+          phgmg_real v = L.lag[i * 4] * x[a];
+          int j;
+          for (j = 0; j < 3; ++j) v += L.lag[i * 4 + 1 + j] * (x[a] + L.Z[j * r + a]);
+          L.Zp[i * r + a] = v - xn[a];
+        }
+      for (a = 0; a < r; ++a) x[a] = xn[a];
+      s->have_prev = 1;
+      if (theta_max > PHGMG__R(0.5)) s->have_lu = 0; /* slow contraction: refactor next step */
+      s->stats.steps++;
+      if (y) phgmg_rom_output(rom, x, y, L.work);
+      return PHGMG_OK;
+    }
+  }
+  s->stats.failures++;
+  s->have_prev = 0;
+  return err == PHGMG_OK ? PHGMG_ERR_NOT_CONVERGED : err;
+}
+
+#ifndef PHGMG_NO_OFFLINE
+/* >>pod / >>reduce (implementation) ======================================= */
+
+/* A small owner list: every array of a phgmg_reduced is allocated through it,
+   so destroy (and every error path) frees exactly what was allocated. */
+#define PHGMG__MAXBUF 48
+struct phgmg_reduced {
+  phgmg_allocator alloc;
+  int use_alloc;
+  void *bufs[PHGMG__MAXBUF];
+  int nbufs;
+  int N, m, r, p, rn, nd, method, kind;
+  double *V0, *V2;     /* N x r, N x rn                        */
+  double *QB, *RB;     /* thin QR of B: N x m, m x m           */
+  double *W;           /* N x r point reduction for SP1/SP2    */
+  double *M;           /* rn x p^2                             */
+  int *coord;          /* nd: coordinates of the kept terms    */
+  const phgmg_ph_system *sys;
+  /* double blocks (same meaning as the phgmg_rom fields) */
+  double *Bh, *Qh, *K, *G00, *G01, *G10, *G11, *Q01, *Q11, *Ms, *P0, *P1, *w, *poly;
+  double *Phi, *Gam, *SX, *SU;
+  double map_dt;       /* step of the precomputed map          */
+  phgmg_rom rom;       /* views into the phgmg_real copies     */
+};
+
+PHGMG__PRIV void *phgmg__red_alloc(phgmg_reduced *red, size_t bytes) {
+  void *p;
+  if (red->nbufs >= PHGMG__MAXBUF) return NULL;
+  p = phgmg__alloc(red->use_alloc ? &red->alloc : NULL, bytes);
+  if (p) red->bufs[red->nbufs++] = p;
+  return p;
+}
+PHGMG__PRIV double *phgmg__red_d(phgmg_reduced *red, size_t n) {
+  double *p = PHGMG__CAST(double *, phgmg__red_alloc(red, (n ? n : 1) * sizeof(double)));
+  if (p) memset(p, 0, (n ? n : 1) * sizeof(double));
+  return p;
+}
+
+PHGMG_DEF void phgmg_reduced_destroy(phgmg_reduced *red) {
+  int i;
+  phgmg_allocator a;
+  int use;
+  if (!red) return;
+  a = red->alloc;
+  use = red->use_alloc;
+  for (i = 0; i < red->nbufs; ++i) phgmg__free(use ? &a : NULL, red->bufs[i]);
+  phgmg__free(use ? &a : NULL, red);
+}
+
+PHGMG_DEF const phgmg_rom *phgmg_reduced_rom(const phgmg_reduced *red) { return red ? &red->rom : NULL; }
+PHGMG_DEF int phgmg_reduced_N(const phgmg_reduced *red) { return red ? red->N : 0; }
+
+/* C (m x n) = A^T B with A: k x m, B: k x n (column-major, tight). */
+PHGMG__PRIV void phgmg__atb(int k, int m, int n, const double *A, const double *B, double *C) {
+  phgmg_gemm('T', 'N', m, n, k, 1.0, A, k, B, k, 0.0, C, m);
+}
+
+PHGMG_DEF phgmg_result phgmg_pod(int N, int ns, const double *X, int ldx, int kmax, double tol,
+                                 double *V, int ldv, double *S, int *k_out,
+                                 const phgmg_allocator *alloc) {
+  double *s;
+  int k = 0, rank = 0, i;
+  phgmg_result rc;
+  if (!X || !V || !k_out) return PHGMG_ERR_INVALID_ARG;
+  if (N < 1 || ns < 1 || kmax < 1 || ldx < N || ldv < N || kmax > PHGMG__MIN(N, ns)) return PHGMG_ERR_SIZE;
+  s = phgmg__dalloc(alloc, (size_t)kmax);
+  if (!s) return PHGMG_ERR_NOMEM;
+  rc = phgmg_svd(N, ns, X, ldx, kmax, s, V, ldv, NULL, 1, &k, &rank, alloc);
+  if (rc == PHGMG_OK) {
+    if (tol > 0.0)
+      for (i = 0; i < k; ++i)
+        if (!(s[i] > tol * s[0])) { k = i; break; }
+    for (i = 0; i < k && S; ++i) S[i] = s[i];
+    *k_out = k;
+  }
+  phgmg__free(alloc, s);
+  return rc;
+}
+
+/* Thin QR of B (N x m): QB (N x m) orthonormal, RB (m x m) upper triangular.
+   PHGMG_ERR_RANK if B is rank deficient. */
+PHGMG__PRIV phgmg_result phgmg__thin_qr(int N, int m, const double *B, double *QB, double *RB,
+                                        const phgmg_allocator *alloc) {
+  double *tau, *work;
+  double rmax = 0.0;
+  int i, j;
+  phgmg_result rc;
+  tau = phgmg__dalloc(alloc, (size_t)(2 * m + 1));
+  if (!tau) return PHGMG_ERR_NOMEM;
+  work = tau + m;
+  for (j = 0; j < m; ++j) memcpy(QB + (size_t)j * N, B + (size_t)j * N, (size_t)N * sizeof(double));
+  rc = phgmg_qr(N, m, QB, N, tau);
+  if (rc == PHGMG_OK) {
+    for (j = 0; j < m; ++j)
+      for (i = 0; i < m; ++i) RB[i + j * m] = i <= j ? QB[i + (size_t)j * N] : 0.0;
+    for (j = 0; j < m; ++j) rmax = PHGMG__MAX(rmax, fabs(RB[j + j * m]));
+    for (j = 0; j < m; ++j)
+      if (!(fabs(RB[j + j * m]) > 1e3 * PHGMG__EPS * (double)N * rmax)) rc = PHGMG_ERR_RANK;
+    if (rc == PHGMG_OK) phgmg_qr_form_q(N, m, QB, N, tau, work);
+  }
+  phgmg__free(alloc, tau);
+  return rc;
+}
+
+/* Y = (I - Q Q^T) X for Q (N x k orthonormal), X N x ns; tmp: k x ns. */
+PHGMG__PRIV void phgmg__orth_remove(int N, int k, const double *Q, int ns, double *X, int ldx, double *tmp) {
+  if (k < 1) return;
+  phgmg_gemm('T', 'N', k, ns, N, 1.0, Q, N, X, ldx, 0.0, tmp, k);
+  phgmg_gemm('N', 'N', N, ns, k, -1.0, Q, N, tmp, k, 1.0, X, ldx);
+}
+
+PHGMG_DEF phgmg_result phgmg_adjust_snapshots(int N, int m, const double *B, int ns, const double *X,
+                                              int ldx, double *Xa, int ldxa, const phgmg_allocator *alloc) {
+  double *QB, *tmp;
+  phgmg_result rc;
+  int j;
+  if (!B || !X || !Xa) return PHGMG_ERR_INVALID_ARG;
+  if (N < 1 || m < 1 || m > N || ns < 1 || ldx < N || ldxa < N) return PHGMG_ERR_SIZE;
+  QB = phgmg__dalloc(alloc, (size_t)N * m + (size_t)m * m + (size_t)m * ns);
+  if (!QB) return PHGMG_ERR_NOMEM;
+  tmp = QB + (size_t)N * m;
+  rc = phgmg__thin_qr(N, m, B, QB, tmp, alloc);
+  if (rc == PHGMG_OK) {
+    if (Xa != X)
+      for (j = 0; j < ns; ++j) memcpy(Xa + (size_t)j * ldxa, X + (size_t)j * ldx, (size_t)N * sizeof(double));
+    phgmg__orth_remove(N, m, QB, ns, Xa, ldxa, tmp + (size_t)m * m);
+  }
+  phgmg__free(alloc, QB);
+  return rc;
+}
+
+PHGMG_DEF phgmg_result phgmg_pod_hierarchical(int N, int m, const double *B, int ns, const double *X,
+                                              int ldx, int p, int rn, double *V1, double *V2,
+                                              const phgmg_allocator *alloc) {
+  double *Xa, *tmp;
+  phgmg_result rc;
+  int k = 0;
+  if (!B || !X || !V1 || !V2) return PHGMG_ERR_INVALID_ARG;
+  if (p < 1 || rn < 1 || p + rn + m > PHGMG__MIN(N, ns + m)) return PHGMG_ERR_SIZE;
+  Xa = phgmg__dalloc(alloc, (size_t)N * ns + (size_t)p * ns);
+  if (!Xa) return PHGMG_ERR_NOMEM;
+  tmp = Xa + (size_t)N * ns;
+  rc = phgmg_adjust_snapshots(N, m, B, ns, X, ldx, Xa, N, alloc);
+  if (rc == PHGMG_OK) rc = phgmg_pod(N, ns, Xa, N, p, 0.0, V1, N, NULL, &k, alloc);
+  if (rc == PHGMG_OK && k < p) rc = PHGMG_ERR_SIZE;
+  if (rc == PHGMG_OK) {
+    phgmg__orth_remove(N, p, V1, ns, Xa, N, tmp);
+    rc = phgmg_pod(N, ns, Xa, N, rn, 0.0, V2, N, NULL, &k, alloc);
+    if (rc == PHGMG_OK && k < rn) rc = PHGMG_ERR_SIZE;
+  }
+  phgmg__free(alloc, Xa);
+  return rc;
+}
+
+PHGMG_DEF phgmg_result phgmg_deim(int nterms, int ns, const double *F, int ldf, const double *sw,
+                                  double tol, int kmax, int *pts, double *w, int *nd_out,
+                                  int *nneg, double *sigma_ratio, const phgmg_allocator *alloc) {
+  double *U, *S, *Ut, *tau, *work, *PU;
+  int *jpvt, *ipiv;
+  int k = 0, kk, rank = 0, i, j, neg = 0;
+  phgmg_result rc;
+  if (!F || !pts || !w || !nd_out) return PHGMG_ERR_INVALID_ARG;
+  if (nterms < 1 || ns < 1 || ldf < nterms) return PHGMG_ERR_SIZE;
+  if (!phgmg__all_finite(F, (size_t)ldf * (size_t)(ns - 1) + (size_t)nterms)) return PHGMG_ERR_NANINF;
+  if (tol <= 0.0) tol = 1e-8;
+  kk = PHGMG__MIN(nterms, ns);
+  if (kmax > 0) kk = PHGMG__MIN(kk, kmax + 1);
+  U = phgmg__dalloc(alloc, (size_t)nterms * kk + (size_t)kk + (size_t)kk * nterms + (size_t)kk +
+                               2 * (size_t)nterms + (size_t)kk * kk + (size_t)kk);
+  jpvt = phgmg__ialloc(alloc, (size_t)nterms + (size_t)kk);
+  if (!U || !jpvt) { phgmg__free(alloc, U); phgmg__free(alloc, jpvt); return PHGMG_ERR_NOMEM; }
+  S = U + (size_t)nterms * kk;
+  Ut = S + kk;
+  tau = Ut + (size_t)kk * nterms;
+  work = tau + kk;
+  PU = work + 2 * (size_t)nterms;
+  ipiv = jpvt + nterms;
+  rc = phgmg_svd(nterms, ns, F, ldf, kk, S, U, nterms, NULL, 1, &k, &rank, alloc);
+  if (rc == PHGMG_OK) {
+    int keep = 0;
+    for (i = 0; i < k; ++i) if (S[i] > tol * S[0]) keep = i + 1;
+    if (kmax > 0 && keep > kmax) keep = kmax;
+    if (keep < 1) keep = 1;
+    if (sigma_ratio) *sigma_ratio = (keep < k && S[0] > 0.0) ? S[keep] / S[0] : 0.0;
+    /* Q-DEIM: pivoted QR of U^T (keep x nterms); points = first keep pivots */
+    for (j = 0; j < nterms; ++j)
+      for (i = 0; i < keep; ++i) Ut[i + (size_t)j * keep] = U[j + (size_t)i * nterms];
+    rc = phgmg_qrcp(keep, nterms, Ut, keep, tau, jpvt, work);
+    if (rc == PHGMG_OK) {
+      /* w = (P^T U)^{-T} U^T sw: solve (P^T U)^T w = U^T sw */
+      for (i = 0; i < keep; ++i) pts[i] = jpvt[i];
+      for (j = 0; j < keep; ++j)       /* PU = P^T U (keep x keep) */
+        for (i = 0; i < keep; ++i) PU[i + (size_t)j * keep] = U[pts[i] + (size_t)j * nterms];
+      for (j = 0; j < keep; ++j) {
+        double sacc = 0.0;
+        for (i = 0; i < nterms; ++i) sacc += U[i + (size_t)j * nterms] * (sw ? sw[i] : 1.0);
+        w[j] = sacc;
+      }
+      rc = phgmg_lu_factor(keep, PU, keep, ipiv);
+      if (rc == PHGMG_OK) {
+        phgmg_lu_solve('T', keep, PU, keep, ipiv, 1, w, keep);
+        for (i = 0; i < keep; ++i) if (w[i] < 0.0) ++neg;
+        if (!phgmg__all_finite(w, (size_t)keep)) rc = PHGMG_ERR_NANINF;
+        *nd_out = keep;
+        if (nneg) *nneg = neg;
+      }
+    }
+  }
+  phgmg__free(alloc, U);
+  phgmg__free(alloc, jpvt);
+  return rc;
+}
+
+/* Lp (rn x p) = [sum_j Ms(:, k*p + j) x2_j]_k in double. */
+PHGMG__PRIV void phgmg__lp_d(int rn, int p, const double *Ms, const double *x2, double *Lp) {
+  int i, j, k;
+  for (k = 0; k < p; ++k) {
+    double *l = Lp + (size_t)k * rn;
+    for (i = 0; i < rn; ++i) l[i] = 0.0;
+    for (j = 0; j < p; ++j) {
+      const double *ms = Ms + ((size_t)k * p + j) * rn;
+      for (i = 0; i < rn; ++i) l[i] += ms[i] * x2[j];
+    }
+  }
+}
+
+/* E = G00 + G01 L + L^T (G10 + G11 L), L = [0, Lp]; tmp: rn x r. */
+PHGMG__PRIV void phgmg__dgd_d(const phgmg_reduced *red, const double *Lp, double *E, double *tmp) {
+  const int r = red->r, m = red->m, rn = red->rn;
+  int a, b, i;
+  for (b = 0; b < r; ++b) {
+    for (i = 0; i < rn; ++i) tmp[i + (size_t)b * rn] = red->G10[i + (size_t)b * rn];
+    if (b >= m) phgmg_gemv('N', rn, rn, 1.0, red->G11, rn, Lp + (size_t)(b - m) * rn, 1.0, tmp + (size_t)b * rn);
+  }
+  memcpy(E, red->G00, (size_t)r * r * sizeof(double));
+  for (b = m; b < r; ++b) phgmg_gemv('N', r, rn, 1.0, red->G01, r, Lp + (size_t)(b - m) * rn, 1.0, E + (size_t)b * r);
+  for (b = 0; b < r; ++b)
+    for (a = m; a < r; ++a) {
+      double s = 0.0;
+      for (i = 0; i < rn; ++i) s += Lp[i + (size_t)(a - m) * rn] * tmp[i + (size_t)b * rn];
+      E[a + (size_t)b * r] += s;
+    }
+}
+
+/* rcond of an r x r matrix (copied). -1 on allocation failure. */
+PHGMG__PRIV double phgmg__rcond_of(int n, const double *A, const phgmg_allocator *alloc) {
+  double *LU = phgmg__dalloc(alloc, (size_t)n * n + 2 * (size_t)n);
+  int *ip = phgmg__ialloc(alloc, 2 * (size_t)n);
+  double rc = -1.0;
+  if (LU && ip) {
+    double anorm = phgmg_norm1(n, n, A, n);
+    memcpy(LU, A, (size_t)n * n * sizeof(double));
+    if (phgmg_lu_factor(n, LU, n, ip) == PHGMG_OK)
+      rc = phgmg_lu_rcond(n, LU, n, ip, anorm, LU + (size_t)n * n, ip + n);
+    else
+      rc = 0.0;
+  }
+  phgmg__free(alloc, LU);
+  phgmg__free(alloc, ip);
+  return rc;
+}
+
+/* Inverse of an r x r matrix into Ainv. */
+PHGMG__PRIV phgmg_result phgmg__inv(int n, const double *A, double *Ainv, const phgmg_allocator *alloc) {
+  double *LU = phgmg__dalloc(alloc, (size_t)n * n);
+  int *ip = phgmg__ialloc(alloc, (size_t)n);
+  phgmg_result rc = PHGMG_ERR_NOMEM;
+  int i;
+  if (LU && ip) {
+    memcpy(LU, A, (size_t)n * n * sizeof(double));
+    rc = phgmg_lu_factor(n, LU, n, ip);
+    if (rc == PHGMG_OK) {
+      memset(Ainv, 0, (size_t)n * n * sizeof(double));
+      for (i = 0; i < n; ++i) Ainv[i + (size_t)i * n] = 1.0;
+      phgmg_lu_solve('N', n, LU, n, ip, n, Ainv, n);
+    }
+  }
+  phgmg__free(alloc, LU);
+  phgmg__free(alloc, ip);
+  return rc;
+}
+
+PHGMG__PRIV double phgmg__poly_d1(const double *c, int deg, double s) {
+  double p1 = 0.0, p0 = 0.0;
+  int k;
+  for (k = deg; k >= 0; --k) { p1 = p1 * s + p0; p0 = p0 * s + c[k]; }
+  return p1;
+}
+
+/* The exact GL3 step map of x' = Jf x + Bh u (see phgmg_rom). */
+PHGMG__PRIV phgmg_result phgmg__step_map(phgmg_reduced *red, double h, const phgmg_allocator *alloc) {
+  const int r = red->r, m = red->m, n3 = 3 * r, nc = r + 3 * m;
+  double c[3], b[3], A[9];
+  double *Jf = phgmg__dalloc(alloc, (size_t)r * r + (size_t)n3 * n3 + (size_t)n3 * nc);
+  int *ip = phgmg__ialloc(alloc, (size_t)n3);
+  double *M3, *RH;
+  phgmg_result rc = PHGMG_ERR_NOMEM;
+  int i, j, a, bb;
+  if (!Jf || !ip) goto done;
+  M3 = Jf + (size_t)r * r;
+  RH = M3 + (size_t)n3 * n3;
+  phgmg_gl3_coefficients(c, b, A);
+  phgmg_gemm('N', 'N', r, r, r, 1.0, red->K, r, red->Qh, r, 0.0, Jf, r);
+  for (j = 0; j < 3; ++j)
+    for (bb = 0; bb < r; ++bb)
+      for (i = 0; i < 3; ++i)
+        for (a = 0; a < r; ++a)
+          M3[(i * r + a) + (size_t)(j * r + bb) * n3] = (i == j && a == bb ? 1.0 : 0.0) - h * A[i * 3 + j] * Jf[a + (size_t)bb * r];
+  /* RH = [h (A kron Jf)(1 kron I),  h (A kron Bh)] */
+  for (i = 0; i < 3; ++i) {
+    for (bb = 0; bb < r; ++bb)
+      for (a = 0; a < r; ++a) {
+        double s = 0.0;
+        for (j = 0; j < 3; ++j) s += A[i * 3 + j];
+        RH[(i * r + a) + (size_t)bb * n3] = h * s * Jf[a + (size_t)bb * r];
+      }
+    for (j = 0; j < 3; ++j)
+      for (bb = 0; bb < m; ++bb)
+        for (a = 0; a < r; ++a)
+          RH[(i * r + a) + (size_t)(r + j * m + bb) * n3] = h * A[i * 3 + j] * red->Bh[a + (size_t)bb * r];
+  }
+  rc = phgmg_lu_factor(n3, M3, n3, ip);
+  if (rc != PHGMG_OK) goto done;
+  phgmg_lu_solve('N', n3, M3, n3, ip, nc, RH, n3);
+  rc = PHGMG_ERR_NOMEM;
+  red->SX = phgmg__red_d(red, (size_t)n3 * r);
+  red->SU = phgmg__red_d(red, (size_t)n3 * 3 * m);
+  red->Phi = phgmg__red_d(red, (size_t)r * r);
+  red->Gam = phgmg__red_d(red, (size_t)r * 3 * m);
+  if (!red->SX || !red->SU || !red->Phi || !red->Gam) goto done;
+  for (bb = 0; bb < r; ++bb)
+    for (a = 0; a < n3; ++a) red->SX[a + (size_t)bb * n3] = RH[a + (size_t)bb * n3] + (a % r == bb ? 1.0 : 0.0);
+  for (bb = 0; bb < 3 * m; ++bb)
+    for (a = 0; a < n3; ++a) red->SU[a + (size_t)bb * n3] = RH[a + (size_t)(r + bb) * n3];
+  /* Phi = I + h sum b_i Jf SX_i ; Gam = h sum b_i Jf SU_i + h [b_1 Bh, b_2 Bh, b_3 Bh] */
+  for (a = 0; a < r; ++a) red->Phi[a + (size_t)a * r] = 1.0;
+  for (i = 0; i < 3; ++i) {
+    phgmg_gemm('N', 'N', r, r, r, h * b[i], Jf, r, red->SX + i * r, n3, 1.0, red->Phi, r);
+    if (m > 0) phgmg_gemm('N', 'N', r, 3 * m, r, h * b[i], Jf, r, red->SU + i * r, n3, 1.0, red->Gam, r);
+    for (bb = 0; bb < m; ++bb)
+      for (a = 0; a < r; ++a) red->Gam[a + (size_t)(i * m + bb) * r] += h * b[i] * red->Bh[a + (size_t)bb * r];
+  }
+  rc = PHGMG_OK;
+done:
+  phgmg__free(alloc, Jf);
+  phgmg__free(alloc, ip);
+  return rc;
+}
+
+/* phgmg_real copy of a double array (NULL stays NULL). */
+PHGMG__PRIV phgmg_result phgmg__to_real(phgmg_reduced *red, const double *src, size_t n, const phgmg_real **dst) {
+  phgmg_real *d;
+  size_t i;
+  if (!src) { *dst = NULL; return PHGMG_OK; }
+  d = PHGMG__CAST(phgmg_real *, phgmg__red_alloc(red, (n ? n : 1) * sizeof(phgmg_real)));
+  if (!d) return PHGMG_ERR_NOMEM;
+  for (i = 0; i < n; ++i) d[i] = (phgmg_real)src[i];
+  *dst = d;
+  return PHGMG_OK;
+}
+
+PHGMG__PRIV phgmg_result phgmg__publish(phgmg_reduced *red) {
+  const size_t r = (size_t)red->r, m = (size_t)red->m, rn = (size_t)red->rn, nd = (size_t)red->nd;
+  const size_t p = (size_t)red->p;
+  phgmg_rom *o = &red->rom;
+  phgmg_result rc = PHGMG_OK;
+  memset(o, 0, sizeof *o);
+  o->kind = red->kind; o->method = red->method; o->r = red->r; o->m = red->m;
+  o->rn = red->rn; o->nd = red->nd; o->poly_deg = red->nd > 0 ? red->sys->poly_deg : 0;
+#define PHGMG__PUB(field, n) if (rc == PHGMG_OK) rc = phgmg__to_real(red, red->field, (n), &o->field)
+  PHGMG__PUB(Bh, r * m); PHGMG__PUB(Qh, r * r); PHGMG__PUB(K, r * r);
+  PHGMG__PUB(G00, r * r); PHGMG__PUB(G01, r * rn); PHGMG__PUB(G10, rn * r); PHGMG__PUB(G11, rn * rn);
+  PHGMG__PUB(Q01, r * rn); PHGMG__PUB(Q11, rn * rn); PHGMG__PUB(Ms, rn * p * p);
+  PHGMG__PUB(P0, nd * r); PHGMG__PUB(P1, nd * rn); PHGMG__PUB(w, nd);
+  PHGMG__PUB(poly, (size_t)(o->poly_deg + 1));
+  PHGMG__PUB(Phi, r * r); PHGMG__PUB(Gam, r * 3 * m); PHGMG__PUB(SX, 3 * r * r); PHGMG__PUB(SU, 3 * r * 3 * m);
+#undef PHGMG__PUB
+  o->dt = red->Phi ? (phgmg_real)red->map_dt : (phgmg_real)0;
+  return rc;
+}
+
+PHGMG_DEF phgmg_result phgmg_reduce(phgmg_reduced **out, const phgmg_ph_system *sys, const double *X,
+                                    int ldx, int ns, const phgmg_reduce_opts *opts,
+                                    phgmg_reduce_info *info, const phgmg_allocator *alloc) {
+  phgmg_reduced *red = NULL;
+  phgmg_jr_factor *jr = NULL;
+  phgmg_reduce_info inf;
+  phgmg_result rc;
+  double *T1 = NULL, *T2 = NULL, *T3 = NULL; /* temporaries */
+  int *pts = NULL;
+  int N, m, r, p, rn = 0, k = 0, i, j, a;
+  double lambda, degtol;
+  if (!out || !sys || !X || !opts) return PHGMG_ERR_INVALID_ARG;
+  *out = NULL;
+  memset(&inf, 0, sizeof inf);
+  N = sys->N; m = sys->m; r = opts->r;
+  if (N < 1 || m < 1 || ns < 1 || ldx < N) return PHGMG_ERR_SIZE;
+  if (opts->method < PHGMG_METHOD_GMG_POD || opts->method > PHGMG_METHOD_SP2) return PHGMG_ERR_INVALID_ARG;
+  if (opts->method == PHGMG_METHOD_GMG_POD || opts->method == PHGMG_METHOD_GMG_QM) {
+    if (r <= m || r > N) return PHGMG_ERR_SIZE;
+  } else if (r < 1 || r > N || r > ns) {
+    return PHGMG_ERR_SIZE;
+  }
+  if (sys->nl == PHGMG_NL_GENERAL) return PHGMG_ERR_UNSUPPORTED;
+  if (sys->nl == PHGMG_NL_SEPARABLE && (sys->poly_deg < 1 || !sys->poly)) return PHGMG_ERR_UNSUPPORTED;
+  if (!phgmg__all_finite(X, (size_t)ldx * (size_t)(ns - 1) + (size_t)N)) return PHGMG_ERR_NANINF;
+  rc = phgmg_ph_validate(sys, 0.0, &inf.rcond_jr, alloc);
+  if (rc != PHGMG_OK) return rc;
+  lambda = opts->lambda == 0.0 ? 1e-3 : (opts->lambda < 0.0 ? 0.0 : opts->lambda);
+  degtol = opts->degeneracy_tol > 0.0 ? opts->degeneracy_tol : 1e-12;
+
+  red = PHGMG__CAST(phgmg_reduced *, phgmg__alloc(alloc, sizeof(phgmg_reduced)));
+  if (!red) return PHGMG_ERR_NOMEM;
+  memset(red, 0, sizeof *red);
+  if (alloc) { red->alloc = *alloc; red->use_alloc = 1; }
+  red->N = N; red->m = m; red->r = r; red->method = opts->method; red->sys = sys;
+  red->kind = opts->method == PHGMG_METHOD_GMG_QM ? PHGMG_ROM_QUADRATIC : PHGMG_ROM_LINEAR;
+  p = (opts->method == PHGMG_METHOD_GMG_POD || opts->method == PHGMG_METHOD_GMG_QM) ? r - m : r;
+  red->p = p;
+  if (red->kind == PHGMG_ROM_QUADRATIC) {
+    rn = opts->rn > 0 ? opts->rn : 8;
+    /* the online q/Lp buffers of lift/dphi hold up to 64 x 64 */
+    if (rn > N - r || rn > 64 || rn * p > 64 * 64) { rc = PHGMG_ERR_SIZE; goto fail; }
+  }
+  red->rn = rn;
+
+#define PHGMG__NEED(ptr) do { if (!(ptr)) { rc = PHGMG_ERR_NOMEM; goto fail; } } while (0)
+#define PHGMG__TRY(expr) do { rc = (expr); if (rc != PHGMG_OK) goto fail; } while (0)
+  red->V0 = phgmg__red_d(red, (size_t)N * r); PHGMG__NEED(red->V0);
+  red->QB = phgmg__red_d(red, (size_t)N * m); PHGMG__NEED(red->QB);
+  red->RB = phgmg__red_d(red, (size_t)m * m); PHGMG__NEED(red->RB);
+  PHGMG__TRY(phgmg__thin_qr(N, m, sys->B, red->QB, red->RB, alloc));
+  T1 = phgmg__dalloc(alloc, (size_t)N * ns); PHGMG__NEED(T1);
+
+  if (red->method == PHGMG_METHOD_GMG_POD || red->method == PHGMG_METHOD_GMG_QM) {
+    double *S = NULL;
+    /* V0 = [B, V1], V1 = POD of the adjusted snapshots X - B B^+ X */
+    for (j = 0; j < ns; ++j) memcpy(T1 + (size_t)j * N, X + (size_t)j * ldx, (size_t)N * sizeof(double));
+    T2 = phgmg__dalloc(alloc, (size_t)PHGMG__MAX(m, p + 1) * ns + (size_t)p + 2); PHGMG__NEED(T2);
+    phgmg__orth_remove(N, m, red->QB, ns, T1, N, T2);
+    memcpy(red->V0, sys->B, (size_t)N * m * sizeof(double));
+    S = T2 + (size_t)PHGMG__MAX(m, p + 1) * ns;
+    T3 = phgmg__dalloc(alloc, (size_t)N * (p + 1)); PHGMG__NEED(T3);
+    PHGMG__TRY(phgmg_pod(N, ns, T1, N, PHGMG__MIN(p + 1, PHGMG__MIN(N, ns)), 0.0, T3, N, S, &k, alloc));
+    if (k < p) { rc = PHGMG_ERR_SIZE; goto fail; } /* r - m > rank of the adjusted snapshots */
+    memcpy(red->V0 + (size_t)N * m, T3, (size_t)N * p * sizeof(double));
+    inf.pod_sigma_ratio = (k > p && S[0] > 0.0) ? S[p] / S[0] : 0.0;
+    phgmg__free(alloc, T3); T3 = NULL;
+    if (red->kind == PHGMG_ROM_QUADRATIC) {
+      double *Z2, *Rq, *Kt, *Rqt, *Mt;
+      const int pp = p * p;
+      /* residual of the linear part, then V2 = POD of it */
+      phgmg__orth_remove(N, p, red->V0 + (size_t)N * m, ns, T1, N, T2);
+      red->V2 = phgmg__red_d(red, (size_t)N * rn); PHGMG__NEED(red->V2);
+      PHGMG__TRY(phgmg_pod(N, ns, T1, N, rn, 0.0, red->V2, N, NULL, &k, alloc));
+      if (k < rn) { rc = PHGMG_ERR_SIZE; goto fail; }
+      /* M by the ridge problem over the reduced snapshot coordinates */
+      T3 = phgmg__dalloc(alloc, (size_t)p * ns + (size_t)rn * ns + (size_t)ns * pp + (size_t)ns * rn + (size_t)pp * rn);
+      PHGMG__NEED(T3);
+      Z2 = T3; Rq = Z2 + (size_t)p * ns; Kt = Rq + (size_t)rn * ns; Rqt = Kt + (size_t)ns * pp; Mt = Rqt + (size_t)ns * rn;
+      phgmg_gemm('T', 'N', p, ns, N, 1.0, red->V0 + (size_t)N * m, N, X, ldx, 0.0, Z2, p);
+      phgmg_gemm('T', 'N', rn, ns, N, 1.0, red->V2, N, T1, N, 0.0, Rq, rn);
+      for (i = 0; i < ns; ++i) {
+        for (a = 0; a < p; ++a)
+          for (j = 0; j < p; ++j) Kt[i + (size_t)(a * p + j) * ns] = Z2[a + (size_t)i * p] * Z2[j + (size_t)i * p];
+        for (a = 0; a < rn; ++a) Rqt[i + (size_t)a * ns] = Rq[a + (size_t)i * rn];
+      }
+      PHGMG__TRY(phgmg_lstsq(ns, pp, rn, Kt, ns, Rqt, ns, lambda, Mt, pp, alloc));
+      red->M = phgmg__red_d(red, (size_t)rn * pp); PHGMG__NEED(red->M);
+      red->Ms = phgmg__red_d(red, (size_t)rn * pp); PHGMG__NEED(red->Ms);
+      for (a = 0; a < pp; ++a)
+        for (i = 0; i < rn; ++i) red->M[i + (size_t)a * rn] = Mt[a + (size_t)i * pp];
+      for (a = 0; a < p; ++a)
+        for (j = 0; j < p; ++j)
+          for (i = 0; i < rn; ++i)
+            red->Ms[i + (size_t)(a * p + j) * rn] = red->M[i + (size_t)(a * p + j) * rn] + red->M[i + (size_t)(j * p + a) * rn];
+      phgmg__free(alloc, T3); T3 = NULL;
+    }
+    /* G-blocks through a factorization of J - R */
+    PHGMG__TRY(phgmg_jr_factor_create(&jr, sys, NULL, alloc));
+    phgmg__free(alloc, T2);
+    T2 = phgmg__dalloc(alloc, (size_t)N * (r + rn)); PHGMG__NEED(T2);
+    memcpy(T2, red->V0, (size_t)N * r * sizeof(double));
+    if (rn) memcpy(T2 + (size_t)N * r, red->V2, (size_t)N * rn * sizeof(double));
+    phgmg_jr_solve(jr, 'N', r + rn, T2, N);           /* T2 = G [V0, V2] */
+    red->G00 = phgmg__red_d(red, (size_t)r * r); PHGMG__NEED(red->G00);
+    phgmg__atb(N, r, r, red->V0, T2, red->G00);
+    if (rn) {
+      red->G01 = phgmg__red_d(red, (size_t)r * rn); PHGMG__NEED(red->G01);
+      red->G10 = phgmg__red_d(red, (size_t)rn * r); PHGMG__NEED(red->G10);
+      red->G11 = phgmg__red_d(red, (size_t)rn * rn); PHGMG__NEED(red->G11);
+      phgmg__atb(N, r, rn, red->V0, T2 + (size_t)N * r, red->G01);
+      phgmg__atb(N, rn, r, red->V2, T2, red->G10);
+      phgmg__atb(N, rn, rn, red->V2, T2 + (size_t)N * r, red->G11);
+    }
+    red->Bh = phgmg__red_d(red, (size_t)r * m); PHGMG__NEED(red->Bh);
+    for (j = 0; j < m; ++j) red->Bh[j + (size_t)j * r] = 1.0;
+    /* non-degeneracy of D^T G D: at x = 0 and (QM) at every snapshot */
+    inf.rcond_dgd = phgmg__rcond_of(r, red->G00, alloc);
+    if (inf.rcond_dgd < 0.0) { rc = PHGMG_ERR_NOMEM; goto fail; }
+    if (red->kind == PHGMG_ROM_QUADRATIC) {
+      double *Lp, *E, *tmp, *x2;
+      T3 = phgmg__dalloc(alloc, (size_t)rn * p + (size_t)r * r + (size_t)rn * r + (size_t)p); PHGMG__NEED(T3);
+      Lp = T3; E = Lp + (size_t)rn * p; tmp = E + (size_t)r * r; x2 = tmp + (size_t)rn * r;
+      for (i = 0; i < ns; ++i) {
+        double rc_i;
+        phgmg_gemv('T', N, p, 1.0, red->V0 + (size_t)N * m, N, X + (size_t)i * ldx, 0.0, x2);
+        phgmg__lp_d(rn, p, red->Ms, x2, Lp);
+        phgmg__dgd_d(red, Lp, E, tmp);
+        rc_i = phgmg__rcond_of(r, E, alloc);
+        if (rc_i < 0.0) { rc = PHGMG_ERR_NOMEM; goto fail; }
+        if (rc_i < inf.rcond_dgd) inf.rcond_dgd = rc_i;
+      }
+      phgmg__free(alloc, T3); T3 = NULL;
+    }
+    if (!(inf.rcond_dgd >= degtol)) { rc = PHGMG_ERR_DEGENERATE; goto fail; }
+    if (red->kind == PHGMG_ROM_LINEAR) {
+      red->K = phgmg__red_d(red, (size_t)r * r); PHGMG__NEED(red->K);
+      PHGMG__TRY(phgmg__inv(r, red->G00, red->K, alloc));
+    }
+  } else {
+    /* SP1 / SP2: V0 = V_POD (r modes of X), W as in NUMERICS 6.3-6.4 */
+    double *Vg, *Ainv, *A2;
+    T3 = phgmg__dalloc(alloc, (size_t)N * r * 2 + 2 * (size_t)r * r + (size_t)r + 1); PHGMG__NEED(T3);
+    Vg = T3; A2 = Vg + (size_t)N * r; Ainv = A2 + (size_t)r * r;
+    PHGMG__TRY(phgmg_pod(N, ns, X, ldx, r, 0.0, red->V0, N, NULL, &k, alloc));
+    if (k < r) { rc = PHGMG_ERR_SIZE; goto fail; }
+    if (red->method == PHGMG_METHOD_SP1) {
+      phgmg_ph_apply(sys, 'Q', r, red->V0, N, Vg, N);   /* Vg := Q V */
+    } else {
+      for (j = 0; j < ns; ++j) phgmg_ph_gradient(sys, X + (size_t)j * ldx, T1 + (size_t)j * N);
+      PHGMG__TRY(phgmg_pod(N, ns, T1, N, r, 0.0, Vg, N, NULL, &k, alloc));
+      if (k < r) { rc = PHGMG_ERR_SIZE; goto fail; }
+    }
+    phgmg__atb(N, r, r, red->V0, Vg, A2);               /* V^T Vg */
+    inf.rcond_dgd = phgmg__rcond_of(r, A2, alloc);
+    if (!(inf.rcond_dgd >= degtol)) { rc = PHGMG_ERR_DEGENERATE; goto fail; }
+    PHGMG__TRY(phgmg__inv(r, A2, Ainv, alloc));
+    red->W = phgmg__red_d(red, (size_t)N * r); PHGMG__NEED(red->W);
+    phgmg_gemm('N', 'N', N, r, r, 1.0, Vg, N, Ainv, r, 0.0, red->W, N); /* W = Vg (V^T Vg)^{-1} */
+    /* K = W^T (J - R) W, Bh = W^T B */
+    phgmg_ph_apply(sys, 'J', r, red->W, N, Vg, N);
+    phgmg_ph_apply(sys, 'R', r, red->W, N, T1, N);
+    for (i = 0; i < N * r; ++i) Vg[i] -= T1[i];
+    red->K = phgmg__red_d(red, (size_t)r * r); PHGMG__NEED(red->K);
+    phgmg__atb(N, r, r, red->W, Vg, red->K);
+    red->Bh = phgmg__red_d(red, (size_t)r * m); PHGMG__NEED(red->Bh);
+    phgmg__atb(N, r, m, red->W, sys->B, red->Bh);
+    phgmg__free(alloc, T3); T3 = NULL;
+  }
+
+  /* quadratic part of H: Qh = V0^T Q V0 (and the V2 blocks) */
+  phgmg__free(alloc, T2);
+  T2 = phgmg__dalloc(alloc, (size_t)N * (r + rn)); PHGMG__NEED(T2);
+  phgmg_ph_apply(sys, 'Q', r, red->V0, N, T2, N);
+  if (rn) phgmg_ph_apply(sys, 'Q', rn, red->V2, N, T2 + (size_t)N * r, N);
+  red->Qh = phgmg__red_d(red, (size_t)r * r); PHGMG__NEED(red->Qh);
+  phgmg__atb(N, r, r, red->V0, T2, red->Qh);
+  for (j = 0; j < r; ++j)   /* exact symmetry */
+    for (i = 0; i < j; ++i) red->Qh[i + (size_t)j * r] = red->Qh[j + (size_t)i * r] = 0.5 * (red->Qh[i + (size_t)j * r] + red->Qh[j + (size_t)i * r]);
+  if (rn) {
+    red->Q01 = phgmg__red_d(red, (size_t)r * rn); PHGMG__NEED(red->Q01);
+    red->Q11 = phgmg__red_d(red, (size_t)rn * rn); PHGMG__NEED(red->Q11);
+    phgmg__atb(N, r, rn, red->V0, T2 + (size_t)N * r, red->Q01);
+    phgmg__atb(N, rn, rn, red->V2, T2 + (size_t)N * r, red->Q11);
+  }
+
+  /* separable nonlinear part: structure-preserving DEIM or every term */
+  if (sys->nl == PHGMG_NL_SEPARABLE && sys->nsep > 0) {
+    const int nt = sys->nsep;
+    int nd = 0, nneg = 0;
+    double *wt;
+    pts = phgmg__ialloc(alloc, (size_t)nt); PHGMG__NEED(pts);
+    wt = phgmg__dalloc(alloc, (size_t)nt); PHGMG__NEED(wt);
+    if (opts->deim) {
+      double *F = phgmg__dalloc(alloc, (size_t)nt * ns);
+      if (!F) { phgmg__free(alloc, wt); rc = PHGMG_ERR_NOMEM; goto fail; }
+      for (i = 0; i < ns; ++i)
+        for (a = 0; a < nt; ++a)
+          F[a + (size_t)i * nt] = phgmg__poly_d1(sys->poly, sys->poly_deg, X[sys->sep_idx[a] + (size_t)i * ldx]);
+      rc = phgmg_deim(nt, ns, F, nt, sys->sep_w, opts->deim_tol, opts->deim_max, pts, wt, &nd, &nneg,
+                      &inf.deim_sigma_ratio, alloc);
+      phgmg__free(alloc, F);
+      if (rc == PHGMG_OK && nneg > 0 && !opts->deim_allow_negative) rc = PHGMG_ERR_NEGATIVE_WEIGHT;
+      if (rc != PHGMG_OK) { phgmg__free(alloc, wt); goto fail; }
+    } else {
+      nd = nt;
+      for (a = 0; a < nt; ++a) { pts[a] = a; wt[a] = sys->sep_w ? sys->sep_w[a] : 1.0; }
+    }
+    inf.deim_modes = nd;
+    inf.deim_negative = nneg;
+    red->nd = nd;
+    red->coord = PHGMG__CAST(int *, phgmg__red_alloc(red, (size_t)nd * sizeof(int)));
+    red->w = phgmg__red_d(red, (size_t)nd);
+    red->P0 = phgmg__red_d(red, (size_t)nd * r);
+    red->P1 = rn ? phgmg__red_d(red, (size_t)nd * rn) : NULL;
+    red->poly = phgmg__red_d(red, (size_t)sys->poly_deg + 1);
+    if (!red->coord || !red->w || !red->P0 || (rn && !red->P1) || !red->poly) {
+      phgmg__free(alloc, wt); rc = PHGMG_ERR_NOMEM; goto fail;
+    }
+    for (j = 0; j < nd; ++j) {
+      const int cj = sys->sep_idx[pts[j]];
+      red->coord[j] = cj;
+      red->w[j] = wt[j];
+      for (a = 0; a < r; ++a) red->P0[j + (size_t)a * nd] = red->V0[cj + (size_t)a * N];
+      for (a = 0; a < rn; ++a) red->P1[j + (size_t)a * nd] = red->V2[cj + (size_t)a * N];
+    }
+    memcpy(red->poly, sys->poly, ((size_t)sys->poly_deg + 1) * sizeof(double));
+    phgmg__free(alloc, wt);
+  }
+  if (opts->dt > 0.0 && red->kind == PHGMG_ROM_LINEAR && red->nd == 0) {
+    red->map_dt = opts->dt;
+    PHGMG__TRY(phgmg__step_map(red, opts->dt, alloc));
+  }
+  PHGMG__TRY(phgmg__publish(red));
+#undef PHGMG__NEED
+#undef PHGMG__TRY
+  phgmg_jr_factor_destroy(jr);
+  phgmg__free(alloc, T1); phgmg__free(alloc, T2); phgmg__free(alloc, T3); phgmg__free(alloc, pts);
+  if (info) *info = inf;
+  *out = red;
+  return PHGMG_OK;
+fail:
+  phgmg_jr_factor_destroy(jr);
+  phgmg__free(alloc, T1); phgmg__free(alloc, T2); phgmg__free(alloc, T3); phgmg__free(alloc, pts);
+  phgmg_reduced_destroy(red);
+  if (info) *info = inf;
+  return rc;
+}
+
+PHGMG_DEF void phgmg_reduced_lift(const phgmg_reduced *red, const double *xr, double *x) {
+  phgmg_gemv('N', red->N, red->r, 1.0, red->V0, red->N, xr, 0.0, x);
+  if (red->kind == PHGMG_ROM_QUADRATIC) {
+    /* q = M (x2 kron x2) */
+    const int p = red->p, rn = red->rn;
+    const double *x2 = xr + red->m;
+    double q[64];
+    int i, a, j;
+    for (i = 0; i < rn && i < 64; ++i) {
+      double s = 0.0;
+      for (a = 0; a < p; ++a)
+        for (j = 0; j < p; ++j) s += red->M[i + (size_t)(a * p + j) * rn] * x2[a] * x2[j];
+      q[i] = s;
+    }
+    phgmg_gemv('N', red->N, PHGMG__MIN(rn, 64), 1.0, red->V2, red->N, q, 1.0, x);
+  }
+}
+
+PHGMG_DEF void phgmg_reduced_restrict(const phgmg_reduced *red, const double *x, double *xr) {
+  const int N = red->N, m = red->m, r = red->r;
+  if (red->method == PHGMG_METHOD_SP1 || red->method == PHGMG_METHOD_SP2) {
+    phgmg_gemv('T', N, r, 1.0, red->W, N, x, 0.0, xr);
+  } else {
+    /* [B, V1]^+ x = [RB^{-1} QB^T x; V1^T x]  (V1 is orthogonal to B) */
+    int i, j;
+    phgmg_gemv('T', N, m, 1.0, red->QB, N, x, 0.0, xr);
+    for (i = m - 1; i >= 0; --i) {
+      double s = xr[i];
+      for (j = i + 1; j < m; ++j) s -= red->RB[i + j * m] * xr[j];
+      xr[i] = s / red->RB[i + i * m];
+    }
+    phgmg_gemv('T', N, r - m, 1.0, red->V0 + (size_t)N * m, N, x, 0.0, xr + m);
+  }
+}
+
+PHGMG_DEF void phgmg_reduced_dphi(const phgmg_reduced *red, const double *xr, double *D, int ldd) {
+  const int N = red->N, r = red->r, m = red->m;
+  int j;
+  for (j = 0; j < r; ++j) memcpy(D + (size_t)j * ldd, red->V0 + (size_t)j * N, (size_t)N * sizeof(double));
+  if (red->kind == PHGMG_ROM_QUADRATIC) {
+    double Lp[64 * 64];
+    const int p = red->p, rn = red->rn;
+    if (rn * p > 64 * 64) return;
+    phgmg__lp_d(rn, p, red->Ms, xr + m, Lp);
+    phgmg_gemm('N', 'N', N, p, rn, 1.0, red->V2, N, Lp, rn, 1.0, D + (size_t)m * ldd, ldd);
+  }
+}
+
+PHGMG_DEF phgmg_result phgmg_reduced_W(const phgmg_reduced *red, const double *xr, double *W, int ldw) {
+  const int N = red->N, r = red->r;
+  phgmg_jr_factor *jr = NULL;
+  const phgmg_allocator *alloc = red->use_alloc ? &red->alloc : NULL;
+  double *D, *GtD, *E, *Einv;
+  phgmg_result rc;
+  int j;
+  if (red->method == PHGMG_METHOD_SP1 || red->method == PHGMG_METHOD_SP2) {
+    for (j = 0; j < r; ++j) memcpy(W + (size_t)j * ldw, red->W + (size_t)j * N, (size_t)N * sizeof(double));
+    return PHGMG_OK;
+  }
+  D = phgmg__dalloc(alloc, 2 * (size_t)N * r + 2 * (size_t)r * r);
+  if (!D) return PHGMG_ERR_NOMEM;
+  GtD = D + (size_t)N * r; E = GtD + (size_t)N * r; Einv = E + (size_t)r * r;
+  phgmg_reduced_dphi(red, xr, D, N);
+  memcpy(GtD, D, (size_t)N * r * sizeof(double));
+  rc = phgmg_jr_factor_create(&jr, red->sys, NULL, alloc);
+  if (rc == PHGMG_OK) {
+    phgmg_jr_solve(jr, 'T', r, GtD, N);                      /* G^T D */
+    phgmg__atb(N, r, r, GtD, D, E);                           /* (G^T D)^T D = D^T G D */
+    rc = phgmg__inv(r, E, Einv, alloc);
+    if (rc == PHGMG_OK)                                       /* W = G^T D E^{-T} */
+      phgmg_gemm('N', 'T', N, r, r, 1.0, GtD, N, Einv, r, 0.0, W, ldw);
+  }
+  phgmg_jr_factor_destroy(jr);
+  phgmg__free(alloc, D);
+  return rc;
+}
+
+PHGMG_DEF phgmg_result phgmg_reduced_simulate(const phgmg_reduced *red, const double *xr0, double t0,
+                                              double dt, int nsteps, phgmg_input_fn uf, void *uuser,
+                                              double tol, int max_iter, double *XR, double *Y,
+                                              const phgmg_energy *energy, phgmg_rom_stats *stats,
+                                              const phgmg_allocator *alloc) {
+  const phgmg_rom *rom;
+  phgmg_rom_stepper st;
+  size_t msz, nreal;
+  void *mem;
+  phgmg_real *x, *u3, *y, *ework, en[2];
+  double S = 0.0, D = 0.0;
+  int r, m, n, i, a;
+  phgmg_result rc;
+  if (!red || !xr0 || nsteps < 0 || !(dt > 0.0)) return PHGMG_ERR_INVALID_ARG;
+  rom = &red->rom; r = rom->r; m = rom->m;
+  msz = phgmg_rom_stepper_memsize(rom);
+  nreal = (size_t)r + 4 * (size_t)m + phgmg_rom_eval_work_size(rom);
+  mem = phgmg__alloc(alloc, ((msz + 15) / 16) * 16 + nreal * sizeof(phgmg_real));
+  if (!mem) return PHGMG_ERR_NOMEM;
+  x = PHGMG__CAST(phgmg_real *, PHGMG__CAST(void *, PHGMG__CAST(char *, mem) + ((msz + 15) / 16) * 16));
+  u3 = x + r; y = u3 + 3 * m; ework = y + m;
+  rc = phgmg_rom_stepper_init(&st, rom, (phgmg_real)dt, (phgmg_real)tol, max_iter, mem, msz);
+  if (rc != PHGMG_OK) { phgmg__free(alloc, mem); return rc; }
+  for (a = 0; a < r; ++a) x[a] = (phgmg_real)xr0[a];
+#define PHGMG__REC(nn) do { \
+    if (XR) for (a = 0; a < r; ++a) XR[a + (size_t)(nn) * r] = (double)x[a]; \
+    if (Y) { phgmg_rom_output(rom, x, y, ework); for (a = 0; a < m; ++a) Y[a + (size_t)(nn) * m] = (double)y[a]; } \
+    if (energy) { energy->H[nn] = (double)phgmg_rom_hamiltonian(rom, x, ework); energy->S[nn] = S; energy->D[nn] = D; } \
+  } while (0)
+  PHGMG__REC(0);
+  for (n = 0; n < nsteps; ++n) {
+    const double t = t0 + n * dt;
+    double ubuf[16];
+    const double s15 = sqrt(15.0) / 10.0, cs[3] = {0.5 - s15, 0.5, 0.5 + s15};
+    for (i = 0; i < 3; ++i) {
+      if (uf && m <= 16) {
+        uf(t + cs[i] * dt, ubuf, uuser);
+        for (a = 0; a < m; ++a) u3[i * m + a] = (phgmg_real)ubuf[a];
+      } else {
+        for (a = 0; a < m; ++a) u3[i * m + a] = (phgmg_real)0;
+      }
+    }
+    en[0] = en[1] = (phgmg_real)0;
+    rc = phgmg_rom_step(&st, x, u3, NULL, energy ? en : NULL);
+    if (rc != PHGMG_OK) break;
+    S += (double)en[0];
+    D += (double)en[1];
+    PHGMG__REC(n + 1);
+  }
+#undef PHGMG__REC
+  if (stats) *stats = st.stats;
+  phgmg__free(alloc, mem);
+  return rc;
+}
+
+/* --- error measures ------------------------------------------------------ */
+PHGMG_DEF double phgmg_rel_error(int n, int ns, const double *A, int lda, const double *B, int ldb) {
+  double num = 0.0, den = 0.0;
+  int i, j;
+  for (j = 0; j < ns; ++j)
+    for (i = 0; i < n; ++i) {
+      const double a = A[i + (size_t)j * lda], d = a - B[i + (size_t)j * ldb];
+      num += d * d;
+      den += a * a;
+    }
+  return den > 0.0 ? sqrt(num / den) : (num > 0.0 ? (double)INFINITY : 0.0);
+}
+
+/* sqrt(sum ||x_i - g(x_i)||^2 / sum ||x_i||^2) with g applied column-wise. */
+PHGMG__PRIV double phgmg__err_map(const phgmg_reduced *red, const double *X, int ldx, int ns,
+                                  const double *XR, int ldxr, int mode) {
+  const int N = red->N, r = red->r;
+  const phgmg_allocator *alloc = red->use_alloc ? &red->alloc : NULL;
+  double *xt = phgmg__dalloc(alloc, (size_t)N + (size_t)r + (size_t)(r + red->rn)), *xr;
+  double num = 0.0, den = 0.0;
+  int i, j;
+  if (!xt) return (double)NAN;
+  xr = xt + N;
+  for (j = 0; j < ns; ++j) {
+    const double *x = X + (size_t)j * ldx;
+    if (mode == 0) {            /* reduction error: phi(XR_j) */
+      phgmg_reduced_lift(red, XR + (size_t)j * ldxr, xt);
+    } else if (mode == 1) {     /* projection error: phi(rho(x)) */
+      phgmg_reduced_restrict(red, x, xr);
+      phgmg_reduced_lift(red, xr, xt);
+    } else {                    /* lower bound: orthogonal projection on [B, V1, V2] */
+      double *c = xr;
+      memcpy(xt, x, (size_t)N * sizeof(double));
+      phgmg__orth_remove(N, red->m, red->QB, 1, xt, N, c);
+      phgmg__orth_remove(N, red->r - red->m, red->V0 + (size_t)N * red->m, 1, xt, N, c);
+      phgmg__orth_remove(N, red->rn, red->V2, 1, xt, N, c);
+      for (i = 0; i < N; ++i) xt[i] = x[i] - xt[i];
+    }
+    for (i = 0; i < N; ++i) {
+      const double d = x[i] - xt[i];
+      num += d * d;
+      den += x[i] * x[i];
+    }
+  }
+  phgmg__free(alloc, xt);
+  return den > 0.0 ? sqrt(num / den) : 0.0;
+}
+
+PHGMG_DEF double phgmg_err_red(const phgmg_reduced *red, const double *X, int ldx, int ns,
+                               const double *XR, int ldxr) {
+  return phgmg__err_map(red, X, ldx, ns, XR, ldxr, 0);
+}
+PHGMG_DEF double phgmg_err_proj(const phgmg_reduced *red, const double *X, int ldx, int ns) {
+  return phgmg__err_map(red, X, ldx, ns, NULL, 0, 1);
+}
+PHGMG_DEF double phgmg_err_lowerbound(const phgmg_reduced *red, const double *X, int ldx, int ns) {
+  if (red->kind != PHGMG_ROM_QUADRATIC) return (double)NAN;
+  return phgmg__err_map(red, X, ldx, ns, NULL, 0, 2);
+}
+PHGMG_DEF void phgmg_err_energy(const phgmg_energy *energy, int nsteps, double *e) {
+  int n;
+  for (n = 0; n <= nsteps; ++n) e[n] = fabs(energy->H[n] - energy->H[0] - energy->S[n] + energy->D[n]);
+}
+#endif /* PHGMG_NO_OFFLINE */
+
+/* >>npy (implementation) ================================================== */
+#ifndef PHGMG_NO_OFFLINE
+#include <limits.h>
+#ifndef PHGMG_NO_STDIO
+#include <stdio.h>
+#endif
+
+/* What the header says, checked: a rows x cols result with count elements of
+   es bytes each (4 or 8), big-endian or not, stored in C order or not. */
+typedef struct phgmg__npy_hdr {
+  int rows, cols, ndim;
+  int es, big, corder;
+  size_t count;
+} phgmg__npy_hdr;
+
+/* 1 on a little-endian host (integers and doubles share the byte order on
+   every platform the library targets). */
+PHGMG__PRIV int phgmg__npy_host_little(void) {
+  const unsigned int one = 1u;
+  unsigned char c;
+  memcpy(&c, &one, 1);
+  return c == 1;
+}
+
+/* Preamble: magic, version, header length. p holds the first n bytes of the
+   file (n >= 10 suffices for version 1.0, 12 for 2.0/3.0). On success
+   *hoff is the offset of the header text and *hlen its length. */
+PHGMG__PRIV phgmg_result phgmg__npy_preamble(const unsigned char *p, size_t n, size_t *hoff,
+                                             size_t *hlen) {
+  static const unsigned char magic[6] = {0x93, 'N', 'U', 'M', 'P', 'Y'};
+  size_t hl;
+  if (n < 10 || memcmp(p, magic, 6) != 0 || p[7] != 0) return PHGMG_ERR_FORMAT;
+  if (p[6] == 1) {
+    hl = (size_t)p[8] | ((size_t)p[9] << 8);
+    *hoff = 10;
+  } else if (p[6] == 2 || p[6] == 3) {
+    unsigned long v;
+    if (n < 12) return PHGMG_ERR_FORMAT;
+    v = (unsigned long)p[8] | ((unsigned long)p[9] << 8) | ((unsigned long)p[10] << 16) |
+        ((unsigned long)p[11] << 24);
+    if (v > (unsigned long)PHGMG_NPY_MAX_HEADER) return PHGMG_ERR_FORMAT;
+    hl = (size_t)v;
+    *hoff = 12;
+  } else {
+    return PHGMG_ERR_FORMAT;
+  }
+  if (hl > (size_t)PHGMG_NPY_MAX_HEADER) return PHGMG_ERR_FORMAT;
+  *hlen = hl;
+  return PHGMG_OK;
+}
+
+PHGMG__PRIV size_t phgmg__npy_ws(const char *s, size_t n, size_t i) {
+  while (i < n && (s[i] == ' ' || s[i] == '\t' || s[i] == '\n' || s[i] == '\r')) ++i;
+  return i;
+}
+
+/* A quoted Python string without escapes at s[*i]: its body is s[*b .. *b+*l). */
+PHGMG__PRIV int phgmg__npy_str(const char *s, size_t n, size_t *i, size_t *b, size_t *l) {
+  size_t k = *i;
+  char q;
+  if (k >= n || (s[k] != '\'' && s[k] != '"')) return 0;
+  q = s[k++];
+  *b = k;
+  while (k < n && s[k] != q) {
+    if (s[k] == '\\' || s[k] == '\n' || s[k] == '\r') return 0;
+    ++k;
+  }
+  if (k >= n) return 0;
+  *l = k - *b;
+  *i = k + 1;
+  return 1;
+}
+
+/* Does s[b..b+l) equal the C string w? */
+PHGMG__PRIV int phgmg__npy_is(const char *s, size_t b, size_t l, const char *w) {
+  return strlen(w) == l && memcmp(s + b, w, l) == 0;
+}
+
+/* The identifier w at s[*i], not followed by another identifier character. */
+PHGMG__PRIV int phgmg__npy_word(const char *s, size_t n, size_t *i, const char *w) {
+  size_t l = strlen(w), e = *i + l;
+  char c;
+  if (n - *i < l || memcmp(s + *i, w, l) != 0) return 0;
+  if (e < n) {
+    c = s[e];
+    if ((c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_')
+      return 0;
+  }
+  *i = e;
+  return 1;
+}
+
+/* A non-negative decimal integer <= INT_MAX (Python 2's "L" suffix allowed). */
+PHGMG__PRIV int phgmg__npy_int(const char *s, size_t n, size_t *i, int *v) {
+  size_t k = *i;
+  long acc = 0;
+  if (k >= n || s[k] < '0' || s[k] > '9') return 0;
+  while (k < n && s[k] >= '0' && s[k] <= '9') {
+    int d = s[k] - '0';
+    if (acc > ((long)INT_MAX - d) / 10) return 0;
+    acc = acc * 10 + d;
+    ++k;
+  }
+  if (k < n && s[k] == 'L') ++k;
+  *v = (int)acc;
+  *i = k;
+  return 1;
+}
+
+/* A shape tuple: (), (n,), (r, c) with optional trailing comma (required
+   for one element, as in Python). More than two dimensions: 0. */
+PHGMG__PRIV int phgmg__npy_shape(const char *s, size_t n, size_t *i, int *dims, int *nd) {
+  size_t k = *i;
+  int cnt = 0, comma = 0;
+  if (k >= n || s[k] != '(') return 0;
+  k = phgmg__npy_ws(s, n, k + 1);
+  while (k < n && s[k] != ')') {
+    if (cnt == 2) return 0;
+    if (!phgmg__npy_int(s, n, &k, &dims[cnt])) return 0;
+    ++cnt;
+    k = phgmg__npy_ws(s, n, k);
+    comma = 0;
+    if (k < n && s[k] == ',') {
+      comma = 1;
+      k = phgmg__npy_ws(s, n, k + 1);
+    } else if (k < n && s[k] != ')') {
+      return 0;
+    }
+  }
+  if (k >= n) return 0;
+  if (cnt == 1 && !comma) return 0; /* "(5)" is an int, not a tuple */
+  *nd = cnt;
+  *i = k + 1;
+  return 1;
+}
+
+/* The header dict {'descr': ..., 'fortran_order': ..., 'shape': ...}, keys in
+   any order, each exactly once, nothing else but whitespace after it. */
+PHGMG__PRIV phgmg_result phgmg__npy_dict(const char *s, size_t n, phgmg__npy_hdr *h) {
+  size_t i = phgmg__npy_ws(s, n, 0), b, l;
+  int seen_descr = 0, seen_fo = 0, seen_shape = 0, fortran = 0, nd = 0;
+  int dims[2] = {0, 0};
+  if (i >= n || s[i] != '{') return PHGMG_ERR_FORMAT;
+  i = phgmg__npy_ws(s, n, i + 1);
+  while (i < n && s[i] != '}') {
+    if (!phgmg__npy_str(s, n, &i, &b, &l)) return PHGMG_ERR_FORMAT;
+    i = phgmg__npy_ws(s, n, i);
+    if (i >= n || s[i] != ':') return PHGMG_ERR_FORMAT;
+    i = phgmg__npy_ws(s, n, i + 1);
+    if (phgmg__npy_is(s, b, l, "descr")) {
+      size_t vb, vl;
+      if (seen_descr++ || !phgmg__npy_str(s, n, &i, &vb, &vl)) return PHGMG_ERR_FORMAT;
+      if (vl != 3 || (s[vb] != '<' && s[vb] != '>') || s[vb + 1] != 'f' ||
+          (s[vb + 2] != '8' && s[vb + 2] != '4'))
+        return PHGMG_ERR_FORMAT;
+      h->big = s[vb] == '>';
+      h->es = s[vb + 2] - '0';
+    } else if (phgmg__npy_is(s, b, l, "fortran_order")) {
+      if (seen_fo++) return PHGMG_ERR_FORMAT;
+      if (phgmg__npy_word(s, n, &i, "True")) fortran = 1;
+      else if (phgmg__npy_word(s, n, &i, "False")) fortran = 0;
+      else return PHGMG_ERR_FORMAT;
+    } else if (phgmg__npy_is(s, b, l, "shape")) {
+      if (seen_shape++ || !phgmg__npy_shape(s, n, &i, dims, &nd)) return PHGMG_ERR_FORMAT;
+    } else {
+      return PHGMG_ERR_FORMAT;
+    }
+    i = phgmg__npy_ws(s, n, i);
+    if (i < n && s[i] == ',') i = phgmg__npy_ws(s, n, i + 1);
+    else if (i < n && s[i] != '}') return PHGMG_ERR_FORMAT;
+  }
+  if (i >= n || !seen_descr || !seen_fo || !seen_shape) return PHGMG_ERR_FORMAT;
+  if (phgmg__npy_ws(s, n, i + 1) != n) return PHGMG_ERR_FORMAT;
+  h->ndim = nd;
+  h->rows = nd >= 1 ? dims[0] : 1;
+  h->cols = nd == 2 ? dims[1] : 1;
+  h->corder = nd == 2 && !fortran;
+  if (h->cols != 0 && (size_t)h->rows > ((size_t)-1) / 16 / (size_t)h->cols)
+    return PHGMG_ERR_FORMAT; /* the result would not fit in memory */
+  h->count = (size_t)h->rows * (size_t)h->cols;
+  return PHGMG_OK;
+}
+
+/* Decode n elements of file (flat) indices k0 .. k0+n-1 from src into the
+   column-major rows x cols matrix out. */
+PHGMG__PRIV void phgmg__npy_decode(const phgmg__npy_hdr *h, const unsigned char *src, size_t k0,
+                                   size_t n, double *out) {
+  const int es = h->es, swap = h->big == phgmg__npy_host_little();
+  size_t t, i = 0, j = 0, dst = k0;
+  unsigned char tmp[8];
+  int b;
+  if (n == 0) return;
+  if (h->corder) { i = k0 / (size_t)h->cols; j = k0 % (size_t)h->cols; }
+  for (t = 0; t < n; ++t, src += es) {
+    double v;
+    for (b = 0; b < es; ++b) tmp[b] = src[swap ? es - 1 - b : b];
+    if (es == 8) {
+      memcpy(&v, tmp, 8);
+    } else {
+      float f;
+      memcpy(&f, tmp, 4);
+      v = (double)f;
+    }
+    if (h->corder) {
+      dst = i + j * (size_t)h->rows;
+      if (++j == (size_t)h->cols) { j = 0; ++i; }
+    }
+    out[dst++] = v;
+  }
+}
+
+PHGMG_DEF phgmg_result phgmg_npy_parse(const void *buf, size_t len, double **out, int *rows,
+                                       int *cols, int *ndim, const phgmg_allocator *alloc) {
+  const unsigned char *p = PHGMG__CAST(const unsigned char *, buf);
+  phgmg__npy_hdr h;
+  size_t hoff = 0, hlen = 0, doff;
+  memset(&h, 0, sizeof h);
+  double *A;
+  phgmg_result rc;
+  if (!buf || !out || !rows || !cols) return PHGMG_ERR_INVALID_ARG;
+  rc = phgmg__npy_preamble(p, len, &hoff, &hlen);
+  if (rc != PHGMG_OK) return rc;
+  if (hlen > len - hoff) return PHGMG_ERR_FORMAT;
+  rc = phgmg__npy_dict(PHGMG__CAST(const char *, buf) + hoff, hlen, &h);
+  if (rc != PHGMG_OK) return rc;
+  doff = hoff + hlen;
+  if (h.count > (len - doff) / (size_t)h.es) return PHGMG_ERR_FORMAT; /* truncated */
+  A = phgmg__dalloc(alloc, h.count);
+  if (!A) return PHGMG_ERR_NOMEM;
+  phgmg__npy_decode(&h, p + doff, 0, h.count, A);
+  *out = A;
+  *rows = h.rows;
+  *cols = h.cols;
+  if (ndim) *ndim = h.ndim;
+  return PHGMG_OK;
+}
+
+PHGMG_DEF void phgmg_npy_free(double *p, const phgmg_allocator *alloc) { phgmg__free(alloc, p); }
+
+/* ---- writing ---- */
+
+/* Checks the writer arguments; *count receives rows*cols. */
+PHGMG__PRIV phgmg_result phgmg__npy_wcheck(const double *A, int rows, int cols, int ld, int ndim,
+                                           unsigned flags, size_t *count) {
+  if (flags & ~(PHGMG_NPY_C_ORDER | PHGMG_NPY_F32)) return PHGMG_ERR_INVALID_ARG;
+  if (rows < 0 || cols < 0 || ld < PHGMG__MAX(1, rows)) return PHGMG_ERR_SIZE;
+  if (ndim == 0) {
+    if (rows != 1 || cols != 1) return PHGMG_ERR_SIZE;
+  } else if (ndim == 1) {
+    if (rows != 1 && cols != 1) return PHGMG_ERR_SIZE;
+  } else if (ndim != 2) {
+    return PHGMG_ERR_SIZE;
+  }
+  if (cols != 0 && (size_t)rows > ((size_t)-1) / 16 / (size_t)cols) return PHGMG_ERR_SIZE;
+  *count = (size_t)rows * (size_t)cols;
+  if (!A && *count > 0) return PHGMG_ERR_INVALID_ARG;
+  return PHGMG_OK;
+}
+
+PHGMG__PRIV char *phgmg__npy_puts(char *d, const char *s) {
+  while (*s) *d++ = *s++;
+  return d;
+}
+PHGMG__PRIV char *phgmg__npy_putint(char *d, size_t v) {
+  char t[24];
+  int n = 0;
+  do { t[n++] = (char)('0' + (int)(v % 10)); v /= 10; } while (v);
+  while (n) *d++ = t[--n];
+  return d;
+}
+
+/* The complete version 1.0 preamble + header into dst (room for 256 bytes);
+   returns its length, a multiple of 64. */
+PHGMG__PRIV size_t phgmg__npy_header(unsigned char *dst, int rows, int cols, int ndim,
+                                     unsigned flags) {
+  char *s = PHGMG__CAST(char *, PHGMG__CAST(void *, dst)), *d = s + 10;
+  size_t used, total;
+  d = phgmg__npy_puts(d, (flags & PHGMG_NPY_F32) ? "{'descr': '<f4', " : "{'descr': '<f8', ");
+  d = phgmg__npy_puts(d, (flags & PHGMG_NPY_C_ORDER) ? "'fortran_order': False, "
+                                                     : "'fortran_order': True, ");
+  d = phgmg__npy_puts(d, "'shape': (");
+  if (ndim == 1) {
+    d = phgmg__npy_putint(d, (size_t)rows * (size_t)cols);
+    *d++ = ',';
+  } else if (ndim == 2) {
+    d = phgmg__npy_putint(d, (size_t)rows);
+    d = phgmg__npy_puts(d, ", ");
+    d = phgmg__npy_putint(d, (size_t)cols);
+  }
+  d = phgmg__npy_puts(d, "), }");
+  used = (size_t)(d - s) + 1; /* + the final newline */
+  total = (used + 63) / 64 * 64;
+  while ((size_t)(d - s) < total - 1) *d++ = ' ';
+  *d = '\n';
+  memcpy(s, "\x93NUMPY", 6);
+  dst[6] = 1;
+  dst[7] = 0;
+  dst[8] = (unsigned char)((total - 10) & 0xff);
+  dst[9] = (unsigned char)((total - 10) >> 8);
+  return total;
+}
+
+/* Encode n elements, continuing at element (*i, *j) of A in file order, as
+   little-endian f8 or f4 into dst; advances (*i, *j). */
+PHGMG__PRIV void phgmg__npy_encode(const double *A, int rows, int cols, int ld, unsigned flags,
+                                   size_t *i, size_t *j, size_t n, unsigned char *dst) {
+  const int f32 = (flags & PHGMG_NPY_F32) != 0, corder = (flags & PHGMG_NPY_C_ORDER) != 0;
+  const int es = f32 ? 4 : 8, swap = !phgmg__npy_host_little();
+  size_t t;
+  unsigned char tmp[8];
+  int b;
+  for (t = 0; t < n; ++t, dst += es) {
+    double v = A[*i + *j * (size_t)ld];
+    if (f32) {
+      float f = (float)v;
+      memcpy(tmp, &f, 4);
+    } else {
+      memcpy(tmp, &v, 8);
+    }
+    for (b = 0; b < es; ++b) dst[b] = tmp[swap ? es - 1 - b : b];
+    if (corder) {
+      if (++*j == (size_t)cols) { *j = 0; ++*i; }
+    } else {
+      if (++*i == (size_t)rows) { *i = 0; ++*j; }
+    }
+  }
+}
+
+PHGMG_DEF phgmg_result phgmg_npy_serialize(const double *A, int rows, int cols, int ld, int ndim,
+                                           unsigned flags, void *buf, size_t cap, size_t *len) {
+  unsigned char head[256];
+  size_t count = 0, hl, es = (flags & PHGMG_NPY_F32) ? 4 : 8, need, i = 0, j = 0;
+  phgmg_result rc;
+  if (!len) return PHGMG_ERR_INVALID_ARG;
+  rc = phgmg__npy_wcheck(A, rows, cols, ld, ndim, flags, &count);
+  if (rc != PHGMG_OK) return rc;
+  hl = phgmg__npy_header(head, rows, cols, ndim, flags);
+  need = hl + count * es;
+  *len = need;
+  if (!buf) return PHGMG_OK;
+  if (cap < need) return PHGMG_ERR_WORKSPACE;
+  memcpy(buf, head, hl);
+  phgmg__npy_encode(A, rows, cols, ld, flags, &i, &j, count,
+                    PHGMG__CAST(unsigned char *, buf) + hl);
+  return PHGMG_OK;
+}
+
+#ifndef PHGMG_NO_STDIO
+/* fread of exactly n bytes: PHGMG_OK, PHGMG_ERR_FORMAT at end of file,
+   PHGMG_ERR_IO on a read error. */
+PHGMG__PRIV phgmg_result phgmg__npy_fread(FILE *f, void *dst, size_t n) {
+  if (n == 0 || fread(dst, 1, n, f) == n) return PHGMG_OK;
+  return ferror(f) ? PHGMG_ERR_IO : PHGMG_ERR_FORMAT;
+}
+
+PHGMG_DEF phgmg_result phgmg_npy_read(const char *path, double **out, int *rows, int *cols,
+                                      int *ndim, const phgmg_allocator *alloc) {
+  unsigned char pre[12], chunk[4096];
+  size_t hoff = 0, hlen = 0, left, k = 0;
+  phgmg__npy_hdr h;
+  phgmg_result rc;
+  char *text;
+  double *A;
+  long size;
+  FILE *f;
+  memset(&h, 0, sizeof h);
+  if (!path || !out || !rows || !cols) return PHGMG_ERR_INVALID_ARG;
+  f = fopen(path, "rb");
+  if (!f) return PHGMG_ERR_IO;
+  /* preamble: 10 bytes, 12 for versions 2.0 and 3.0 */
+  rc = phgmg__npy_fread(f, pre, 10);
+  if (rc == PHGMG_OK && (pre[6] == 2 || pre[6] == 3)) rc = phgmg__npy_fread(f, pre + 10, 2);
+  if (rc == PHGMG_OK) rc = phgmg__npy_preamble(pre, (pre[6] == 2 || pre[6] == 3) ? 12 : 10,
+                                               &hoff, &hlen);
+  if (rc != PHGMG_OK) { fclose(f); return rc; }
+  /* a file shorter than the header it announces is malformed: check before
+     allocating (when the size is known) */
+  size = -1; /* unknown (not seekable): read on */
+  if (fseek(f, 0, SEEK_END) == 0) {
+    size = ftell(f);
+    if (fseek(f, (long)hoff, SEEK_SET) != 0) { fclose(f); return PHGMG_ERR_IO; }
+  }
+  if (size >= 0 && ((size_t)size < hoff || hlen > (size_t)size - hoff)) {
+    fclose(f);
+    return PHGMG_ERR_FORMAT;
+  }
+  text = PHGMG__CAST(char *, phgmg__alloc(alloc, hlen));
+  if (!text) { fclose(f); return PHGMG_ERR_NOMEM; }
+  rc = phgmg__npy_fread(f, text, hlen);
+  if (rc == PHGMG_OK) rc = phgmg__npy_dict(text, hlen, &h);
+  phgmg__free(alloc, text);
+  if (rc != PHGMG_OK) { fclose(f); return rc; }
+  if (size >= 0 && h.count > ((size_t)size - hoff - hlen) / (size_t)h.es) {
+    fclose(f);
+    return PHGMG_ERR_FORMAT; /* truncated data */
+  }
+  A = phgmg__dalloc(alloc, h.count);
+  if (!A) { fclose(f); return PHGMG_ERR_NOMEM; }
+  left = h.count;
+  while (left > 0 && rc == PHGMG_OK) {
+    size_t n = PHGMG__MIN(left, sizeof chunk / (size_t)h.es);
+    rc = phgmg__npy_fread(f, chunk, n * (size_t)h.es);
+    if (rc == PHGMG_OK) phgmg__npy_decode(&h, chunk, k, n, A);
+    k += n;
+    left -= n;
+  }
+  fclose(f);
+  if (rc != PHGMG_OK) { phgmg__free(alloc, A); return rc; }
+  *out = A;
+  *rows = h.rows;
+  *cols = h.cols;
+  if (ndim) *ndim = h.ndim;
+  return PHGMG_OK;
+}
+
+PHGMG_DEF phgmg_result phgmg_npy_write(const char *path, const double *A, int rows, int cols,
+                                       int ld, int ndim, unsigned flags) {
+  unsigned char head[256], chunk[4096];
+  size_t count = 0, hl, es = (flags & PHGMG_NPY_F32) ? 4 : 8, i = 0, j = 0, left;
+  phgmg_result rc;
+  int ok;
+  FILE *f;
+  if (!path) return PHGMG_ERR_INVALID_ARG;
+  rc = phgmg__npy_wcheck(A, rows, cols, ld, ndim, flags, &count);
+  if (rc != PHGMG_OK) return rc;
+  hl = phgmg__npy_header(head, rows, cols, ndim, flags);
+  f = fopen(path, "wb");
+  if (!f) return PHGMG_ERR_IO;
+  ok = fwrite(head, 1, hl, f) == hl;
+  for (left = count; ok && left > 0;) {
+    size_t n = PHGMG__MIN(left, sizeof chunk / es);
+    phgmg__npy_encode(A, rows, cols, ld, flags, &i, &j, n, chunk);
+    ok = fwrite(chunk, 1, n * es, f) == n * es;
+    left -= n;
+  }
+  if (fclose(f) != 0) ok = 0;
+  if (!ok) {
+    remove(path);
+    return PHGMG_ERR_IO;
+  }
+  return PHGMG_OK;
+}
+#endif /* PHGMG_NO_STDIO */
+#endif /* PHGMG_NO_OFFLINE */
 #endif /* PHGMG_IMPLEMENTATION_DONE */
 #endif /* PHGMG_IMPLEMENTATION */
 

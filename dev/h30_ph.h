@@ -46,6 +46,20 @@ typedef struct phgmg_ph_system {
   /* Hessian of H_nl: dense N x N (ld N) or banded like Q. */
   void (*hess_nl)(const double *x, double *Hs, void *user);
   void *user;
+  /* Optional caller-supplied solver for the shifted Newton matrices of the GL3
+     stepper, K(sigma) = sigma I - (J - R) Hess H(x_lin), sigma = sr + i si, so a
+     model can bring its own O(N) solve. Both NULL (default): the library's
+     dense or banded LU. Both set: at every (re)factorization the stepper calls
+     shifted_factor twice, with the real shift (gamma/h, 0) and the complex one
+     (alpha/h, -beta/h), and the linearization state x_lin (N); the callee must
+     keep both systems ready. shifted_solve(sr, si, rhs, user) then overwrites
+     rhs with K(sigma)^{-1} rhs, where rhs is a real N-vector if si == 0 and an
+     interleaved complex N-vector (2N doubles, re/im pairs) otherwise. A
+     non-PHGMG_OK return of shifted_factor (e.g. PHGMG_ERR_SINGULAR) is passed
+     on by phgmg_gl3_step. Not used by the linear step map (see >>gl3). */
+  phgmg_result (*shifted_factor)(double sr, double si, const double *x_lin, void *user);
+  void (*shifted_solve)(double sr, double si, double *rhs, void *user);
+  void *shifted_user;      /* `user` argument of the two callbacks above      */
 } phgmg_ph_system;
 
 /* Validation of a system. tol (<= 0: 1e-12) is relative to the matrix norms:
@@ -64,6 +78,20 @@ PHGMG_DEF void phgmg_ph_gradient(const phgmg_ph_system *sys, const double *x, do
 PHGMG_DEF void phgmg_ph_rhs(const phgmg_ph_system *sys, const double *x, const double *u, double *f);
 /* y (m) = B^T grad H(x). */
 PHGMG_DEF void phgmg_ph_output(const phgmg_ph_system *sys, const double *x, double *y);
+
+/* Y = M X for M in {'J','R','Q'} ('Q': the quadratic part of H only), dense or
+   banded storage; X is N x nrhs (ldx), Y is N x nrhs (ldy). */
+PHGMG_DEF void phgmg_ph_apply(const phgmg_ph_system *sys, char which, int nrhs,
+                              const double *X, int ldx, double *Y, int ldy);
+
+/* A factorization of J - R (dense LU or banded LU, by the system's storage),
+   for applying G = (J - R)^{-1} without forming it. */
+typedef struct phgmg_jr_factor phgmg_jr_factor;
+PHGMG_DEF phgmg_result phgmg_jr_factor_create(phgmg_jr_factor **out, const phgmg_ph_system *sys,
+                                              double *rcond_out, const phgmg_allocator *alloc);
+/* X <- (J - R)^{-1} X (trans 'N') or (J - R)^{-T} X (trans 'T'); X is N x nrhs. */
+PHGMG_DEF void phgmg_jr_solve(const phgmg_jr_factor *f, char trans, int nrhs, double *X, int ldx);
+PHGMG_DEF void phgmg_jr_factor_destroy(phgmg_jr_factor *f);
 
 /* >>gl3 =================================================================== */
 /* 3-stage Gauss-Legendre (order 6), simplified Newton on the transformed stage

@@ -1,0 +1,856 @@
+
+/* >>linalg (implementation) ============================================== */
+#ifndef PHGMG_NO_OFFLINE
+
+/* ---- norms -------------------------------------------------------------- */
+PHGMG_DEF double phgmg_norm1(int m, int n, const double *A, int lda) {
+  double best = 0.0;
+  int i, j;
+  for (j = 0; j < n; ++j) {
+    const double *a = A + (size_t)j * (size_t)lda;
+    double s = 0.0;
+    for (i = 0; i < m; ++i) s += fabs(a[i]);
+    if (s > best || s != s) best = s;
+  }
+  return best;
+}
+
+PHGMG_DEF double phgmg_normf(int m, int n, const double *A, int lda) {
+  /* scaled sum of squares (LAPACK dlassq): scale^2 * ssq */
+  double scale = 0.0, ssq = 1.0;
+  int i, j;
+  for (j = 0; j < n; ++j) {
+    const double *a = A + (size_t)j * (size_t)lda;
+    for (i = 0; i < m; ++i) {
+      double v = fabs(a[i]);
+      if (v != 0.0 || v != v) {
+        if (v != v) return v;
+        if (scale < v) {
+          double r = scale / v;
+          ssq = 1.0 + ssq * r * r;
+          scale = v;
+        } else {
+          double r = v / scale;
+          ssq += r * r;
+        }
+      }
+    }
+  }
+  return scale * sqrt(ssq);
+}
+
+/* ---- gemv / gemm ---------------------------------------------------------- */
+PHGMG_DEF void phgmg_gemv(char trans, int m, int n, double alpha, const double *A, int lda,
+                          const double *x, double beta, double *y) {
+  int i, j;
+  int ny = (trans == 'N' || trans == 'n') ? m : n;
+  PHGMG_ASSERT(trans == 'N' || trans == 'n' || trans == 'T' || trans == 't');
+  if (m <= 0 || n <= 0) {
+    for (i = 0; i < ny; ++i) y[i] = (beta == 0.0) ? 0.0 : beta * y[i];
+    return;
+  }
+#ifdef PHGMG_USE_CBLAS
+  cblas_dgemv(CblasColMajor, (ny == m) ? CblasNoTrans : CblasTrans, m, n, alpha, A, lda, x, 1,
+              beta, y, 1);
+#else
+  if (beta == 0.0) {
+    for (i = 0; i < ny; ++i) y[i] = 0.0;
+  } else if (beta != 1.0) {
+    for (i = 0; i < ny; ++i) y[i] *= beta;
+  }
+  if (alpha == 0.0) return;
+  if (trans == 'N' || trans == 'n') {
+    /* y += alpha * A x, column sweeps (axpy) */
+    for (j = 0; j < n; ++j) {
+      const double *a = A + (size_t)j * (size_t)lda;
+      double t = alpha * x[j];
+      if (t == 0.0) continue;
+      for (i = 0; i < m; ++i) y[i] += t * a[i];
+    }
+  } else {
+    /* y += alpha * A^T x, dot products of columns */
+    for (j = 0; j < n; ++j) {
+      const double *a = A + (size_t)j * (size_t)lda;
+      double s0 = 0.0, s1 = 0.0;
+      for (i = 0; i + 1 < m; i += 2) { s0 += a[i] * x[i]; s1 += a[i + 1] * x[i + 1]; }
+      if (i < m) s0 += a[i] * x[i];
+      y[j] += alpha * (s0 + s1);
+    }
+  }
+#endif
+}
+
+#ifndef PHGMG_USE_CBLAS
+/* Block sizes of the portable gemm: an MC x KC panel of op(A) is packed
+   column-major (contiguous), then multiplied into C column by column in a
+   4-column register micro-kernel. */
+#ifndef PHGMG_GEMM_MC
+#define PHGMG_GEMM_MC 64
+#endif
+#ifndef PHGMG_GEMM_KC
+#define PHGMG_GEMM_KC 128
+#endif
+
+/* C(0:m,0:n) += Ap(m x kc, packed, ld m) * op(B)(kc x n) */
+PHGMG__PRIV void phgmg__gemm_kernel(int m, int n, int kc, const double *Ap, const double *B,
+                                    int ldb, int tb, double alpha, double *C, int ldc) {
+  int i, j, p;
+  for (j = 0; j + 4 <= n; j += 4) {
+    double *c0 = C + (size_t)j * (size_t)ldc, *c1 = c0 + ldc, *c2 = c1 + ldc, *c3 = c2 + ldc;
+    for (p = 0; p < kc; ++p) {
+      const double *a = Ap + (size_t)p * (size_t)m;
+      double b0, b1, b2, b3;
+      if (!tb) {
+        const double *bp = B + p + (size_t)j * (size_t)ldb;
+        b0 = bp[0]; b1 = bp[ldb]; b2 = bp[2 * (size_t)ldb]; b3 = bp[3 * (size_t)ldb];
+      } else {
+        const double *bp = B + j + (size_t)p * (size_t)ldb;
+        b0 = bp[0]; b1 = bp[1]; b2 = bp[2]; b3 = bp[3];
+      }
+      b0 *= alpha; b1 *= alpha; b2 *= alpha; b3 *= alpha;
+      for (i = 0; i < m; ++i) {
+        double av = a[i];
+        c0[i] += av * b0; c1[i] += av * b1; c2[i] += av * b2; c3[i] += av * b3;
+      }
+    }
+  }
+  for (; j < n; ++j) {
+    double *c0 = C + (size_t)j * (size_t)ldc;
+    for (p = 0; p < kc; ++p) {
+      const double *a = Ap + (size_t)p * (size_t)m;
+      double b0 = alpha * (tb ? B[j + (size_t)p * (size_t)ldb] : B[p + (size_t)j * (size_t)ldb]);
+      for (i = 0; i < m; ++i) c0[i] += a[i] * b0;
+    }
+  }
+}
+#endif
+
+PHGMG_DEF void phgmg_gemm(char transa, char transb, int m, int n, int k, double alpha,
+                          const double *A, int lda, const double *B, int ldb,
+                          double beta, double *C, int ldc) {
+  int ta = (transa == 'T' || transa == 't');
+  int tb = (transb == 'T' || transb == 't');
+  int i, j;
+  PHGMG_ASSERT(ta || transa == 'N' || transa == 'n');
+  PHGMG_ASSERT(tb || transb == 'N' || transb == 'n');
+  if (m <= 0 || n <= 0) return;
+#ifdef PHGMG_USE_CBLAS
+  if (k > 0) {
+    cblas_dgemm(CblasColMajor, ta ? CblasTrans : CblasNoTrans, tb ? CblasTrans : CblasNoTrans,
+                m, n, k, alpha, A, lda, B, ldb, beta, C, ldc);
+    return;
+  }
+#endif
+  for (j = 0; j < n; ++j) {
+    double *c = C + (size_t)j * (size_t)ldc;
+    if (beta == 0.0) for (i = 0; i < m; ++i) c[i] = 0.0;
+    else if (beta != 1.0) for (i = 0; i < m; ++i) c[i] *= beta;
+  }
+  if (alpha == 0.0 || k <= 0) return;
+#ifndef PHGMG_USE_CBLAS
+  {
+    /* pack buffer on the stack: MC*KC doubles */
+    double Ap[PHGMG_GEMM_MC * PHGMG_GEMM_KC];
+    int pc, ic, p;
+    for (pc = 0; pc < k; pc += PHGMG_GEMM_KC) {
+      int kc = PHGMG__MIN(PHGMG_GEMM_KC, k - pc);
+      for (ic = 0; ic < m; ic += PHGMG_GEMM_MC) {
+        int mc = PHGMG__MIN(PHGMG_GEMM_MC, m - ic);
+        /* pack op(A)(ic:ic+mc, pc:pc+kc) column-major with ld mc */
+        if (!ta) {
+          for (p = 0; p < kc; ++p) {
+            const double *src = A + ic + (size_t)(pc + p) * (size_t)lda;
+            memcpy(Ap + (size_t)p * (size_t)mc, src, (size_t)mc * sizeof(double));
+          }
+        } else {
+          for (i = 0; i < mc; ++i) {
+            const double *src = A + pc + (size_t)(ic + i) * (size_t)lda;
+            for (p = 0; p < kc; ++p) Ap[i + (size_t)p * (size_t)mc] = src[p];
+          }
+        }
+        phgmg__gemm_kernel(mc, n, kc, Ap,
+                           tb ? B + (size_t)pc * (size_t)ldb : B + pc, ldb, tb, alpha,
+                           C + ic, ldc);
+      }
+    }
+  }
+#endif
+}
+
+/* ---- real LU -------------------------------------------------------------- */
+PHGMG_DEF phgmg_result phgmg_lu_factor(int n, double *A, int lda, int *ipiv) {
+  int i, j, k;
+  phgmg_result rc = PHGMG_OK;
+  if (n < 0 || lda < PHGMG__MAX(n, 1)) return PHGMG_ERR_SIZE;
+  if (n == 0) return PHGMG_OK;
+  if (!A || !ipiv) return PHGMG_ERR_INVALID_ARG;
+  for (j = 0; j < n; ++j)
+    if (!phgmg__all_finite(A + (size_t)j * (size_t)lda, (size_t)n)) return PHGMG_ERR_NANINF;
+  for (k = 0; k < n; ++k) {
+    double *ak = A + (size_t)k * (size_t)lda;
+    int p = k;
+    double amax = fabs(ak[k]);
+    for (i = k + 1; i < n; ++i)
+      if (fabs(ak[i]) > amax) { amax = fabs(ak[i]); p = i; }
+    ipiv[k] = p;
+    if (amax == 0.0) { rc = PHGMG_ERR_SINGULAR; continue; }
+    if (p != k)
+      for (j = 0; j < n; ++j) {
+        double *c = A + (size_t)j * (size_t)lda, t = c[k];
+        c[k] = c[p]; c[p] = t;
+      }
+    {
+      double r = 1.0 / ak[k];
+      for (i = k + 1; i < n; ++i) ak[i] *= r;
+    }
+    for (j = k + 1; j < n; ++j) {
+      double *c = A + (size_t)j * (size_t)lda;
+      double t = c[k];
+      if (t == 0.0) continue;
+      for (i = k + 1; i < n; ++i) c[i] -= t * ak[i];
+    }
+  }
+  return rc;
+}
+
+PHGMG_DEF void phgmg_lu_solve(char trans, int n, const double *LU, int lda, const int *ipiv,
+                              int nrhs, double *B, int ldb) {
+  int i, j, k;
+  int tr = (trans == 'T' || trans == 't');
+  PHGMG_ASSERT(tr || trans == 'N' || trans == 'n');
+  for (j = 0; j < nrhs; ++j) {
+    double *b = B + (size_t)j * (size_t)ldb;
+    if (!tr) {
+      for (k = 0; k < n; ++k)
+        if (ipiv[k] != k) { double t = b[k]; b[k] = b[ipiv[k]]; b[ipiv[k]] = t; }
+      /* L y = b (unit lower), column oriented */
+      for (k = 0; k < n; ++k) {
+        const double *l = LU + (size_t)k * (size_t)lda;
+        double t = b[k];
+        if (t != 0.0) for (i = k + 1; i < n; ++i) b[i] -= t * l[i];
+      }
+      /* U x = y */
+      for (k = n - 1; k >= 0; --k) {
+        const double *u = LU + (size_t)k * (size_t)lda;
+        double t = b[k] / u[k];
+        b[k] = t;
+        if (t != 0.0) for (i = 0; i < k; ++i) b[i] -= t * u[i];
+      }
+    } else {
+      /* U^T y = b: dot products with columns of U */
+      for (k = 0; k < n; ++k) {
+        const double *u = LU + (size_t)k * (size_t)lda;
+        double s = b[k];
+        for (i = 0; i < k; ++i) s -= u[i] * b[i];
+        b[k] = s / u[k];
+      }
+      /* L^T z = y */
+      for (k = n - 1; k >= 0; --k) {
+        const double *l = LU + (size_t)k * (size_t)lda;
+        double s = b[k];
+        for (i = k + 1; i < n; ++i) s -= l[i] * b[i];
+        b[k] = s;
+      }
+      for (k = n - 1; k >= 0; --k)
+        if (ipiv[k] != k) { double t = b[k]; b[k] = b[ipiv[k]]; b[ipiv[k]] = t; }
+    }
+  }
+}
+
+/* ---- complex LU (interleaved re,im) ----------------------------------------- */
+PHGMG_DEF phgmg_result phgmg_zlu_factor(int n, double *A, int lda, int *ipiv) {
+  int i, j, k;
+  phgmg_result rc = PHGMG_OK;
+  if (n < 0 || lda < PHGMG__MAX(n, 1)) return PHGMG_ERR_SIZE;
+  if (n == 0) return PHGMG_OK;
+  if (!A || !ipiv) return PHGMG_ERR_INVALID_ARG;
+  for (j = 0; j < n; ++j)
+    if (!phgmg__all_finite(A + 2 * (size_t)j * (size_t)lda, 2 * (size_t)n)) return PHGMG_ERR_NANINF;
+  for (k = 0; k < n; ++k) {
+    double *ak = A + 2 * (size_t)k * (size_t)lda;
+    int p = k;
+    double amax = fabs(ak[2 * k]) + fabs(ak[2 * k + 1]);
+    for (i = k + 1; i < n; ++i) {
+      double v = fabs(ak[2 * i]) + fabs(ak[2 * i + 1]);
+      if (v > amax) { amax = v; p = i; }
+    }
+    ipiv[k] = p;
+    if (amax == 0.0) { rc = PHGMG_ERR_SINGULAR; continue; }
+    if (p != k)
+      for (j = 0; j < n; ++j) {
+        double *c = A + 2 * (size_t)j * (size_t)lda, t;
+        t = c[2 * k]; c[2 * k] = c[2 * p]; c[2 * p] = t;
+        t = c[2 * k + 1]; c[2 * k + 1] = c[2 * p + 1]; c[2 * p + 1] = t;
+      }
+    {
+      /* r = 1 / pivot (Smith's division) */
+      double pr = ak[2 * k], pi = ak[2 * k + 1], rr, ri;
+      if (fabs(pr) >= fabs(pi)) {
+        double q = pi / pr, d = pr + pi * q;
+        rr = 1.0 / d; ri = -q / d;
+      } else {
+        double q = pr / pi, d = pr * q + pi;
+        rr = q / d; ri = -1.0 / d;
+      }
+      for (i = k + 1; i < n; ++i) {
+        double xr = ak[2 * i], xi = ak[2 * i + 1];
+        ak[2 * i] = xr * rr - xi * ri;
+        ak[2 * i + 1] = xr * ri + xi * rr;
+      }
+    }
+    for (j = k + 1; j < n; ++j) {
+      double *c = A + 2 * (size_t)j * (size_t)lda;
+      double tr = c[2 * k], ti = c[2 * k + 1];
+      if (tr == 0.0 && ti == 0.0) continue;
+      for (i = k + 1; i < n; ++i) {
+        double lr = ak[2 * i], li = ak[2 * i + 1];
+        c[2 * i] -= tr * lr - ti * li;
+        c[2 * i + 1] -= tr * li + ti * lr;
+      }
+    }
+  }
+  return rc;
+}
+
+PHGMG_DEF void phgmg_zlu_solve(int n, const double *LU, int lda, const int *ipiv,
+                               int nrhs, double *B, int ldb) {
+  int i, j, k;
+  for (j = 0; j < nrhs; ++j) {
+    double *b = B + 2 * (size_t)j * (size_t)ldb;
+    for (k = 0; k < n; ++k) {
+      int p = ipiv[k];
+      if (p != k) {
+        double t = b[2 * k]; b[2 * k] = b[2 * p]; b[2 * p] = t;
+        t = b[2 * k + 1]; b[2 * k + 1] = b[2 * p + 1]; b[2 * p + 1] = t;
+      }
+    }
+    for (k = 0; k < n; ++k) {
+      const double *l = LU + 2 * (size_t)k * (size_t)lda;
+      double tr = b[2 * k], ti = b[2 * k + 1];
+      if (tr == 0.0 && ti == 0.0) continue;
+      for (i = k + 1; i < n; ++i) {
+        double lr = l[2 * i], li = l[2 * i + 1];
+        b[2 * i] -= tr * lr - ti * li;
+        b[2 * i + 1] -= tr * li + ti * lr;
+      }
+    }
+    for (k = n - 1; k >= 0; --k) {
+      const double *u = LU + 2 * (size_t)k * (size_t)lda;
+      double pr = u[2 * k], pi = u[2 * k + 1], xr = b[2 * k], xi = b[2 * k + 1], tr, ti;
+      if (fabs(pr) >= fabs(pi)) {
+        double q = pi / pr, d = pr + pi * q;
+        tr = (xr + xi * q) / d; ti = (xi - xr * q) / d;
+      } else {
+        double q = pr / pi, d = pr * q + pi;
+        tr = (xr * q + xi) / d; ti = (xi * q - xr) / d;
+      }
+      b[2 * k] = tr; b[2 * k + 1] = ti;
+      if (tr == 0.0 && ti == 0.0) continue;
+      for (i = 0; i < k; ++i) {
+        double ur = u[2 * i], ui = u[2 * i + 1];
+        b[2 * i] -= tr * ur - ti * ui;
+        b[2 * i + 1] -= tr * ui + ti * ur;
+      }
+    }
+  }
+}
+
+
+/* ---- condition estimate (Hager 1984, Higham 1988; LAPACK dlacn2) ---------- */
+PHGMG__PRIV double phgmg__asum(int n, const double *x) {
+  double s = 0.0;
+  int i;
+  for (i = 0; i < n; ++i) s += fabs(x[i]);
+  return s;
+}
+PHGMG__PRIV int phgmg__iamax(int n, const double *x) {
+  int i, j = 0;
+  double m = -1.0;
+  for (i = 0; i < n; ++i)
+    if (fabs(x[i]) > m) { m = fabs(x[i]); j = i; }
+  return j;
+}
+
+PHGMG_DEF double phgmg_lu_rcond(int n, const double *LU, int lda, const int *ipiv,
+                                double anorm1, double *work, int *iwork) {
+  double *x = work, est, estold, temp;
+  int *isgn = iwork;
+  int i, j, jlast, iter, same;
+  if (n <= 0) return 1.0;
+  if (!(anorm1 > 0.0) || anorm1 == HUGE_VAL) return 0.0;
+  for (i = 0; i < n; ++i) {
+    double d = LU[i + (size_t)i * (size_t)lda];
+    if (d == 0.0 || d != d) return 0.0;
+  }
+  for (i = 0; i < n; ++i) x[i] = 1.0 / (double)n;
+  phgmg_lu_solve('N', n, LU, lda, ipiv, 1, x, n);
+  if (n == 1) {
+    est = fabs(x[0]);
+  } else {
+    est = phgmg__asum(n, x);
+    for (i = 0; i < n; ++i) { isgn[i] = x[i] >= 0.0 ? 1 : -1; x[i] = (double)isgn[i]; }
+    phgmg_lu_solve('T', n, LU, lda, ipiv, 1, x, n);
+    j = phgmg__iamax(n, x);
+    for (iter = 2;; ++iter) {
+      for (i = 0; i < n; ++i) x[i] = 0.0;
+      x[j] = 1.0;
+      phgmg_lu_solve('N', n, LU, lda, ipiv, 1, x, n);
+      estold = est;
+      est = phgmg__asum(n, x);
+      same = 1;
+      for (i = 0; i < n; ++i)
+        if ((x[i] >= 0.0 ? 1 : -1) != isgn[i]) { same = 0; break; }
+      if (same || est <= estold) { if (est < estold) est = estold; break; }
+      for (i = 0; i < n; ++i) { isgn[i] = x[i] >= 0.0 ? 1 : -1; x[i] = (double)isgn[i]; }
+      phgmg_lu_solve('T', n, LU, lda, ipiv, 1, x, n);
+      jlast = j;
+      j = phgmg__iamax(n, x);
+      if (fabs(x[jlast]) == fabs(x[j]) || iter >= 5) break;
+    }
+    /* alternating-sign test vector */
+    for (i = 0; i < n; ++i)
+      x[i] = ((i & 1) ? -1.0 : 1.0) * (1.0 + (double)i / (double)(n - 1));
+    phgmg_lu_solve('N', n, LU, lda, ipiv, 1, x, n);
+    temp = 2.0 * phgmg__asum(n, x) / (3.0 * (double)n);
+    if (temp > est) est = temp;
+  }
+  if (!(est > 0.0) || est != est) return 0.0;
+  return (1.0 / est) / anorm1;
+}
+
+/* ---- Householder QR ---------------------------------------------------------- */
+/* Generate H = I - tau v v^T with v = (1, x) such that H (alpha; x) = (beta; 0).
+   n is the length including alpha. x is overwritten by v(1:). */
+PHGMG__PRIV void phgmg__larfg(int n, double *alpha, double *x, double *tau) {
+  double xnorm, beta, r;
+  int i;
+  if (n <= 1) { *tau = 0.0; return; }
+  xnorm = phgmg_normf(n - 1, 1, x, n - 1);
+  if (xnorm == 0.0) { *tau = 0.0; return; }
+  beta = -copysign(hypot(*alpha, xnorm), *alpha);
+  *tau = (beta - *alpha) / beta;
+  r = 1.0 / (*alpha - beta);
+  for (i = 0; i < n - 1; ++i) x[i] *= r;
+  *alpha = beta;
+}
+
+/* C (m x n) := (I - tau v v^T) C, v = (1, v[1..m-1]) (v[0] is not read). */
+PHGMG__PRIV void phgmg__larf_left(int m, int n, const double *v, double tau, double *C, int ldc) {
+  int i, j;
+  if (tau == 0.0) return;
+  for (j = 0; j < n; ++j) {
+    double *c = C + (size_t)j * (size_t)ldc;
+    double s = c[0];
+    for (i = 1; i < m; ++i) s += v[i] * c[i];
+    s *= tau;
+    if (s == 0.0) continue;
+    c[0] -= s;
+    for (i = 1; i < m; ++i) c[i] -= s * v[i];
+  }
+}
+
+PHGMG__PRIV int phgmg__mat_finite(int m, int n, const double *A, int lda) {
+  int j;
+  for (j = 0; j < n; ++j)
+    if (!phgmg__all_finite(A + (size_t)j * (size_t)lda, (size_t)m)) return 0;
+  return 1;
+}
+
+PHGMG_DEF phgmg_result phgmg_qr(int m, int n, double *A, int lda, double *tau) {
+  int k, kmin = PHGMG__MIN(m, n);
+  if (m < 0 || n < 0 || lda < PHGMG__MAX(m, 1)) return PHGMG_ERR_SIZE;
+  if (kmin == 0) return PHGMG_OK;
+  if (!A || !tau) return PHGMG_ERR_INVALID_ARG;
+  if (!phgmg__mat_finite(m, n, A, lda)) return PHGMG_ERR_NANINF;
+  for (k = 0; k < kmin; ++k) {
+    double *akk = A + k + (size_t)k * (size_t)lda;
+    phgmg__larfg(m - k, akk, akk + 1, &tau[k]);
+    if (k + 1 < n) phgmg__larf_left(m - k, n - k - 1, akk, tau[k], akk + lda, lda);
+  }
+  return PHGMG_OK;
+}
+
+/* QR with column pivoting, stopping early (at step k = *rank) once every
+   trailing column norm is <= tol (tol < 0: never). vn: 2n doubles. */
+PHGMG__PRIV void phgmg__qrcp_core(int m, int n, double *A, int lda, double *tau, int *jpvt,
+                                  double *vn, double tol, int *rank) {
+  double *vn1 = vn, *vn2 = vn + n;
+  const double tol3z = sqrt(PHGMG__EPS);
+  int i, j, k, kmin = PHGMG__MIN(m, n);
+  for (j = 0; j < n; ++j) {
+    jpvt[j] = j;
+    vn1[j] = vn2[j] = phgmg_normf(m, 1, A + (size_t)j * (size_t)lda, lda);
+  }
+  for (k = 0; k < kmin; ++k) {
+    int p = k + phgmg__iamax(n - k, vn1 + k);
+    double *ak = A + (size_t)k * (size_t)lda;
+    if (tol >= 0.0 && vn1[p] <= tol) break;
+    if (p != k) {
+      double *ap = A + (size_t)p * (size_t)lda, t;
+      int it;
+      for (i = 0; i < m; ++i) { t = ak[i]; ak[i] = ap[i]; ap[i] = t; }
+      it = jpvt[p]; jpvt[p] = jpvt[k]; jpvt[k] = it;
+      vn1[p] = vn1[k];
+      vn2[p] = vn2[k];
+    }
+    phgmg__larfg(m - k, ak + k, ak + k + 1, &tau[k]);
+    if (k + 1 < n) phgmg__larf_left(m - k, n - k - 1, ak + k, tau[k], ak + k + lda, lda);
+    /* downdate the trailing column norms (LAPACK dlaqp2 safeguard) */
+    for (j = k + 1; j < n; ++j) {
+      if (vn1[j] != 0.0) {
+        double *aj = A + (size_t)j * (size_t)lda;
+        double temp = fabs(aj[k]) / vn1[j], temp2;
+        temp = 1.0 - temp * temp;
+        if (temp < 0.0) temp = 0.0;
+        temp2 = temp * (vn1[j] / vn2[j]) * (vn1[j] / vn2[j]);
+        if (temp2 <= tol3z) {
+          vn1[j] = (k + 1 < m) ? phgmg_normf(m - k - 1, 1, aj + k + 1, m) : 0.0;
+          vn2[j] = vn1[j];
+        } else {
+          vn1[j] *= sqrt(temp);
+        }
+      }
+    }
+  }
+  *rank = k;
+}
+
+PHGMG_DEF phgmg_result phgmg_qrcp(int m, int n, double *A, int lda, double *tau, int *jpvt,
+                                  double *work) {
+  int r;
+  if (m < 0 || n < 0 || lda < PHGMG__MAX(m, 1)) return PHGMG_ERR_SIZE;
+  if (n == 0) return PHGMG_OK;
+  if (!A || !jpvt || !work || (m > 0 && !tau)) return PHGMG_ERR_INVALID_ARG;
+  if (!phgmg__mat_finite(m, n, A, lda)) return PHGMG_ERR_NANINF;
+  phgmg__qrcp_core(m, n, A, lda, tau, jpvt, work, -1.0, &r);
+  return PHGMG_OK;
+}
+
+PHGMG_DEF void phgmg_qr_form_q(int m, int k, double *A, int lda, const double *tau, double *work) {
+  int i, j;
+  (void)work;
+  for (i = k - 1; i >= 0; --i) {
+    double *ai = A + (size_t)i * (size_t)lda;
+    if (i + 1 < k) {
+      ai[i] = 1.0;
+      phgmg__larf_left(m - i, k - i - 1, ai + i, tau[i], ai + i + lda, lda);
+    }
+    for (j = i + 1; j < m; ++j) ai[j] *= -tau[i];
+    ai[i] = 1.0 - tau[i];
+    for (j = 0; j < i; ++j) ai[j] = 0.0;
+  }
+}
+
+PHGMG_DEF void phgmg_qr_apply(char trans, int m, int n, int k, const double *A, int lda,
+                              const double *tau, double *C, int ldc) {
+  int i;
+  int tr = (trans == 'T' || trans == 't');
+  PHGMG_ASSERT(tr || trans == 'N' || trans == 'n');
+  if (tr) {
+    for (i = 0; i < k; ++i)
+      phgmg__larf_left(m - i, n, A + i + (size_t)i * (size_t)lda, tau[i], C + i, ldc);
+  } else {
+    for (i = k - 1; i >= 0; --i)
+      phgmg__larf_left(m - i, n, A + i + (size_t)i * (size_t)lda, tau[i], C + i, ldc);
+  }
+}
+
+/* Solve R X = B, R n x n upper triangular (ldr), B n x nrhs (ldb), in place. */
+PHGMG__PRIV void phgmg__trsv_upper(int n, const double *R, int ldr, int nrhs, double *B, int ldb) {
+  int i, j, k;
+  for (j = 0; j < nrhs; ++j) {
+    double *b = B + (size_t)j * (size_t)ldb;
+    for (k = n - 1; k >= 0; --k) {
+      const double *r = R + (size_t)k * (size_t)ldr;
+      double t = b[k] / r[k];
+      b[k] = t;
+      if (t != 0.0) for (i = 0; i < k; ++i) b[i] -= t * r[i];
+    }
+  }
+}
+
+PHGMG_DEF phgmg_result phgmg_lstsq(int m, int n, int nrhs, const double *A, int lda,
+                                   const double *B, int ldb, double lambda,
+                                   double *X, int ldx, const phgmg_allocator *alloc) {
+  int mm, i, j;
+  double *W, *tau, *C, anorm;
+  if (m < 0 || n < 0 || nrhs < 0 || lda < PHGMG__MAX(m, 1) || ldb < PHGMG__MAX(m, 1) ||
+      ldx < PHGMG__MAX(n, 1))
+    return PHGMG_ERR_SIZE;
+  if (!(lambda >= 0.0)) return lambda != lambda ? PHGMG_ERR_NANINF : PHGMG_ERR_INVALID_ARG;
+  if (lambda == HUGE_VAL) return PHGMG_ERR_NANINF;
+  if (lambda == 0.0 && m < n) return PHGMG_ERR_RANK;
+  if (n == 0 || nrhs == 0) return PHGMG_OK;
+  if (!A || !B || !X) return PHGMG_ERR_INVALID_ARG;
+  if (!phgmg__mat_finite(m, n, A, lda) || !phgmg__mat_finite(m, nrhs, B, ldb))
+    return PHGMG_ERR_NANINF;
+  mm = lambda > 0.0 ? m + n : m;
+  W = phgmg__dalloc(alloc, (size_t)mm * (size_t)(n + nrhs) + (size_t)n);
+  if (!W) return PHGMG_ERR_NOMEM;
+  C = W + (size_t)mm * (size_t)n;
+  tau = C + (size_t)mm * (size_t)nrhs;
+  /* W = [A; sqrt(lambda) I], C = [B; 0] */
+  for (j = 0; j < n; ++j) {
+    double *w = W + (size_t)j * (size_t)mm;
+    memcpy(w, A + (size_t)j * (size_t)lda, (size_t)m * sizeof(double));
+    if (mm > m) {
+      for (i = m; i < mm; ++i) w[i] = 0.0;
+      w[m + j] = sqrt(lambda);
+    }
+  }
+  for (j = 0; j < nrhs; ++j) {
+    double *c = C + (size_t)j * (size_t)mm;
+    memcpy(c, B + (size_t)j * (size_t)ldb, (size_t)m * sizeof(double));
+    for (i = m; i < mm; ++i) c[i] = 0.0;
+  }
+  anorm = phgmg_normf(mm, n, W, mm);
+  phgmg_qr(mm, n, W, mm, tau);
+  for (j = 0; j < n; ++j) {
+    double d = fabs(W[j + (size_t)j * (size_t)mm]);
+    if (d <= (double)PHGMG__MAX(mm, n) * PHGMG__EPS * anorm || d == 0.0) {
+      phgmg__free(alloc, W);
+      return PHGMG_ERR_RANK;
+    }
+  }
+  phgmg_qr_apply('T', mm, nrhs, n, W, mm, tau, C, mm);
+  phgmg__trsv_upper(n, W, mm, nrhs, C, mm);
+  for (j = 0; j < nrhs; ++j)
+    memcpy(X + (size_t)j * (size_t)ldx, C + (size_t)j * (size_t)mm, (size_t)n * sizeof(double));
+  phgmg__free(alloc, W);
+  return PHGMG_OK;
+}
+
+/* ---- thin SVD: QRCP + second QR + one-sided Jacobi ----------------------------- */
+/* One-sided (Hestenes) Jacobi on the columns of X (r x r, ldx): X V = W diag(sigma),
+   V accumulated (r x r, ldv). On return X holds W diag(sigma). */
+PHGMG__PRIV phgmg_result phgmg__jacobi_1s(int r, double *X, int ldx, double *V, int ldv,
+                                          double *d) {
+  const double tol = PHGMG__EPS * sqrt((double)PHGMG__MAX(r, 1));
+  int sweep, p, q, i, rotated;
+  for (sweep = 0; sweep < 80; ++sweep) {
+    for (p = 0; p < r; ++p) {
+      double *xp = X + (size_t)p * (size_t)ldx, s = 0.0;
+      for (i = 0; i < r; ++i) s += xp[i] * xp[i];
+      d[p] = s;
+    }
+    rotated = 0;
+    for (p = 0; p < r - 1; ++p) {
+      double *xp = X + (size_t)p * (size_t)ldx, *vp = V + (size_t)p * (size_t)ldv;
+      for (q = p + 1; q < r; ++q) {
+        double *xq = X + (size_t)q * (size_t)ldx, *vq = V + (size_t)q * (size_t)ldv;
+        double alpha = d[p], beta = d[q], gamma = 0.0, zeta, t, c, s;
+        if (alpha == 0.0 || beta == 0.0) continue;
+        for (i = 0; i < r; ++i) gamma += xp[i] * xq[i];
+        if (fabs(gamma) <= tol * sqrt(alpha) * sqrt(beta)) continue;
+        rotated = 1;
+        zeta = (beta - alpha) / (2.0 * gamma);
+        t = (zeta >= 0.0 ? 1.0 : -1.0) / (fabs(zeta) + sqrt(1.0 + zeta * zeta));
+        c = 1.0 / sqrt(1.0 + t * t);
+        s = c * t;
+        for (i = 0; i < r; ++i) {
+          double a = xp[i], b = xq[i];
+          xp[i] = c * a - s * b;
+          xq[i] = s * a + c * b;
+        }
+        for (i = 0; i < r; ++i) {
+          double a = vp[i], b = vq[i];
+          vp[i] = c * a - s * b;
+          vq[i] = s * a + c * b;
+        }
+        d[p] = alpha - t * gamma;
+        d[q] = beta + t * gamma;
+        if (!(d[p] >= 0.0)) d[p] = 0.0;
+      }
+    }
+    if (!rotated) return PHGMG_OK;
+  }
+  return PHGMG_ERR_NOT_CONVERGED;
+}
+
+PHGMG_DEF phgmg_result phgmg_svd(int m, int n, const double *A, int lda, int kmax,
+                                 double *S, double *U, int ldu, double *V, int ldv,
+                                 int *k_out, int *rank_out, const phgmg_allocator *alloc) {
+  double *W = NULL, *tau, *vn, *Rt, *tau2, *X, *Vj, *d, anorm;
+  int *jpvt = NULL, *perm;
+  int r, rnz, k, i, j, kmin = PHGMG__MIN(m, n);
+  phgmg_result rc;
+  size_t nw;
+  if (m < 0 || n < 0 || kmax < 0 || lda < PHGMG__MAX(m, 1)) return PHGMG_ERR_SIZE;
+  if (kmax > 0 && (ldu < PHGMG__MAX(m, 1) || (V && ldv < PHGMG__MAX(n, 1)))) return PHGMG_ERR_SIZE;
+  if (!k_out || (kmin > 0 && !A) || (kmax > 0 && (!S || !U))) return PHGMG_ERR_INVALID_ARG;
+  if (kmin == 0) {
+    *k_out = 0;
+    if (rank_out) *rank_out = 0;
+    return PHGMG_OK;
+  }
+  if (!phgmg__mat_finite(m, n, A, lda)) return PHGMG_ERR_NANINF;
+  /* workspace: W (m x n), tau (kmin), vn (2n) */
+  nw = (size_t)m * (size_t)n + (size_t)kmin + 2 * (size_t)n;
+  W = phgmg__dalloc(alloc, nw);
+  jpvt = phgmg__ialloc(alloc, (size_t)n + (size_t)kmin);
+  if (!W || !jpvt) { phgmg__free(alloc, W); phgmg__free(alloc, jpvt); return PHGMG_ERR_NOMEM; }
+  perm = jpvt + n;
+  tau = W + (size_t)m * (size_t)n;
+  vn = tau + kmin;
+  for (j = 0; j < n; ++j)
+    memcpy(W + (size_t)j * (size_t)m, A + (size_t)j * (size_t)lda, (size_t)m * sizeof(double));
+  anorm = phgmg_normf(m, n, W, m);
+  phgmg__qrcp_core(m, n, W, m, tau, jpvt, vn, PHGMG__EPS * anorm, &r);
+  if (r == 0) {
+    *k_out = 0;
+    if (rank_out) *rank_out = 0;
+    phgmg__free(alloc, W);
+    phgmg__free(alloc, jpvt);
+    return PHGMG_OK;
+  }
+  {
+    /* second workspace: Rt (n x r), tau2 (r), X (r x r), Vj (r x r), d (r) */
+    double *W2 = phgmg__dalloc(alloc, (size_t)n * (size_t)r + 2 * (size_t)r * (size_t)r +
+                                          2 * (size_t)r);
+    if (!W2) { phgmg__free(alloc, W); phgmg__free(alloc, jpvt); return PHGMG_ERR_NOMEM; }
+    Rt = W2;
+    tau2 = Rt + (size_t)n * (size_t)r;
+    X = tau2 + r;
+    Vj = X + (size_t)r * (size_t)r;
+    d = Vj + (size_t)r * (size_t)r;
+    /* Rt = R^T, R = W(0:r, 0:n) upper trapezoidal */
+    for (i = 0; i < r; ++i) {
+      double *rt = Rt + (size_t)i * (size_t)n;
+      for (j = 0; j < i; ++j) rt[j] = 0.0;
+      for (j = i; j < n; ++j) rt[j] = W[i + (size_t)j * (size_t)m];
+    }
+    phgmg_qr(n, r, Rt, n, tau2);
+    /* X = R2^T (lower triangular), Vj = I */
+    for (j = 0; j < r; ++j) {
+      double *x = X + (size_t)j * (size_t)r, *v = Vj + (size_t)j * (size_t)r;
+      for (i = 0; i < r; ++i) {
+        x[i] = i >= j ? Rt[j + (size_t)i * (size_t)n] : 0.0;
+        v[i] = i == j ? 1.0 : 0.0;
+      }
+    }
+    rc = phgmg__jacobi_1s(r, X, r, Vj, r, d);
+    if (rc == PHGMG_OK) {
+      /* sigma_j = ||X(:,j)||, order descending */
+      for (j = 0; j < r; ++j) {
+        d[j] = phgmg_normf(r, 1, X + (size_t)j * (size_t)r, r);
+        perm[j] = j;
+      }
+      for (i = 1; i < r; ++i) { /* insertion sort, r is small */
+        int pj = perm[i];
+        for (j = i - 1; j >= 0 && d[perm[j]] < d[pj]; --j) perm[j + 1] = perm[j];
+        perm[j + 1] = pj;
+      }
+      rnz = r; /* an exactly zero singular value has no singular vector: drop it */
+      while (rnz > 0 && !(d[perm[rnz - 1]] > 0.0)) --rnz;
+      k = PHGMG__MIN(kmax, rnz);
+      for (j = 0; j < k; ++j) {
+        int c = perm[j];
+        double s = d[c], *u = U + (size_t)j * (size_t)ldu;
+        const double *x = X + (size_t)c * (size_t)r;
+        S[j] = s;
+        for (i = 0; i < r; ++i) u[i] = x[i] / s;
+        for (i = r; i < m; ++i) u[i] = 0.0;
+      }
+      /* U = Q [W; 0] with the r reflectors of the pivoted QR */
+      if (k > 0) phgmg_qr_apply('N', m, k, PHGMG__MIN(r, kmin), W, m, tau, U, ldu);
+      if (V && k > 0) {
+        /* V = P Q2 [Vj; 0]; Rt's reflectors give Q2 (n x r) */
+        int r2 = PHGMG__MIN(n, r);
+        for (j = 0; j < k; ++j) {
+          double *v = V + (size_t)j * (size_t)ldv, *y = vn;
+          const double *vj = Vj + (size_t)perm[j] * (size_t)r;
+          for (i = 0; i < r; ++i) y[i] = vj[i];
+          for (i = r; i < n; ++i) y[i] = 0.0;
+          phgmg_qr_apply('N', n, 1, r2, Rt, n, tau2, y, n);
+          for (i = 0; i < n; ++i) v[jpvt[i]] = y[i];
+        }
+      }
+      *k_out = k;
+      if (rank_out) *rank_out = rnz;
+    }
+    phgmg__free(alloc, W2);
+  }
+  phgmg__free(alloc, W);
+  phgmg__free(alloc, jpvt);
+  return rc;
+}
+
+/* ---- symmetric eigenproblem: cyclic Jacobi ------------------------------------ */
+PHGMG_DEF phgmg_result phgmg_sym_eig(int n, double *A, int lda, double *w, double *V, int ldv) {
+  int i, j, p, q, sweep, rotated;
+  double anorm;
+  if (n < 0 || lda < PHGMG__MAX(n, 1) || (V && ldv < PHGMG__MAX(n, 1))) return PHGMG_ERR_SIZE;
+  if (n == 0) return PHGMG_OK;
+  if (!A || !w) return PHGMG_ERR_INVALID_ARG;
+  if (!phgmg__mat_finite(n, n, A, lda)) return PHGMG_ERR_NANINF;
+  /* symmetrize: A := (A + A^T)/2 */
+  for (j = 0; j < n; ++j)
+    for (i = j + 1; i < n; ++i) {
+      double *aij = A + i + (size_t)j * (size_t)lda, *aji = A + j + (size_t)i * (size_t)lda;
+      double s = 0.5 * (*aij + *aji);
+      *aij = *aji = s;
+    }
+  if (V)
+    for (j = 0; j < n; ++j)
+      for (i = 0; i < n; ++i) V[i + (size_t)j * (size_t)ldv] = i == j ? 1.0 : 0.0;
+  anorm = phgmg_normf(n, n, A, lda);
+  for (sweep = 0; sweep < 100; ++sweep) {
+    rotated = 0;
+    for (p = 0; p < n - 1; ++p) {
+      double *ap = A + (size_t)p * (size_t)lda;
+      for (q = p + 1; q < n; ++q) {
+        double *aq = A + (size_t)q * (size_t)lda;
+        double apq = aq[p], app = ap[p], aqq = aq[q], theta, t, c, s;
+        if (fabs(apq) <= PHGMG__EPS * sqrt(fabs(app)) * sqrt(fabs(aqq)) ||
+            fabs(apq) <= PHGMG__EPS * PHGMG__EPS * anorm)
+          continue;
+        rotated = 1;
+        theta = (aqq - app) / (2.0 * apq);
+        t = (theta >= 0.0 ? 1.0 : -1.0) / (fabs(theta) + sqrt(1.0 + theta * theta));
+        c = 1.0 / sqrt(1.0 + t * t);
+        s = c * t;
+        for (i = 0; i < n; ++i) {
+          double a = ap[i], b = aq[i];
+          ap[i] = c * a - s * b;
+          aq[i] = s * a + c * b;
+        }
+        ap[p] = app - t * apq;
+        aq[q] = aqq + t * apq;
+        ap[q] = aq[p] = 0.0;
+        for (i = 0; i < n; ++i) { /* mirror the two columns into rows p, q */
+          if (i == p || i == q) continue;
+          A[p + (size_t)i * (size_t)lda] = ap[i];
+          A[q + (size_t)i * (size_t)lda] = aq[i];
+        }
+        if (V) {
+          double *vp = V + (size_t)p * (size_t)ldv, *vq = V + (size_t)q * (size_t)ldv;
+          for (i = 0; i < n; ++i) {
+            double a = vp[i], b = vq[i];
+            vp[i] = c * a - s * b;
+            vq[i] = s * a + c * b;
+          }
+        }
+      }
+    }
+    if (!rotated) break;
+  }
+  if (rotated) return PHGMG_ERR_NOT_CONVERGED;
+  for (i = 0; i < n; ++i) w[i] = A[i + (size_t)i * (size_t)lda];
+  /* selection sort ascending, swapping eigenvector columns */
+  for (i = 0; i < n - 1; ++i) {
+    int kmin = i;
+    for (j = i + 1; j < n; ++j)
+      if (w[j] < w[kmin]) kmin = j;
+    if (kmin != i) {
+      double t = w[i];
+      w[i] = w[kmin]; w[kmin] = t;
+      if (V) {
+        double *vi = V + (size_t)i * (size_t)ldv, *vk = V + (size_t)kmin * (size_t)ldv;
+        for (j = 0; j < n; ++j) { t = vi[j]; vi[j] = vk[j]; vk[j] = t; }
+      }
+    }
+  }
+  return PHGMG_OK;
+}
+
+#endif /* PHGMG_NO_OFFLINE */
