@@ -455,122 +455,52 @@ PHGMG_DEF phgmg_result phgmg_rom_step(phgmg_rom_stepper *s, phgmg_real *x, const
 }
 #endif
 
-/* >>pod / >>reduce / >>deim / >>errors ====================================== */
-/* Offline reduction (double). A user gives a pH system and a snapshot matrix
-   X (N x ns, ns = n_t + 1 columns) and gets a reduced model that is again a
-   pH system (see >>online), plus the error measures of the paper (5.1). */
-#ifndef PHGMG_NO_OFFLINE
+/* >>export ================================================================ */
+/* A reduced model leaves the workstation in two forms:
+   - C source: static const arrays of phgmg_real plus a `static const phgmg_rom`
+     descriptor, to be compiled into firmware (flash);
+   - a binary file: magic "PHGMGROM", format version, scalar size (4 = float,
+     8 = double), the sizes, then the arrays, all little-endian. Loading checks
+     the magic, the version, the scalar type (it must match the build's
+     phgmg_real) and the sizes; a damaged file gives PHGMG_ERR_FORMAT.
+   Serialising and loading work in memory and need neither stdio nor heap;
+   the file helpers are compiled out with PHGMG_NO_STDIO or PHGMG_NO_OFFLINE.
+   A file written by a double build loads into a float build (values are
+   rounded once) and vice versa. */
 #ifdef __cplusplus
 extern "C" {
 #endif
 
-/* POD: the leading left singular vectors of X (N x ns). k = kmax modes, or
-   fewer: with tol > 0 only modes with sigma_k > tol * sigma_1 are kept.
-   V: N x kmax (ldv), S: kmax singular values (may be NULL). *k_out = modes kept. */
-PHGMG_DEF phgmg_result phgmg_pod(int N, int ns, const double *X, int ldx, int kmax, double tol,
-                                 double *V, int ldv, double *S, int *k_out,
-                                 const phgmg_allocator *alloc);
-/* Adjusted snapshots Xa = X - B B^+ X (B: N x m full column rank). Xa may alias X. */
-PHGMG_DEF phgmg_result phgmg_adjust_snapshots(int N, int m, const double *B, int ns, const double *X,
-                                              int ldx, double *Xa, int ldxa, const phgmg_allocator *alloc);
+#define PHGMG_ROM_FORMAT_VERSION 1u
 
-typedef struct phgmg_reduce_opts {
-  phgmg_method method; /* required                                                  */
-  int r;               /* reduced order (GMG: includes the m port coordinates), required */
-  int rn;              /* GMG-QM lifting dimension r_n (0: 8)                        */
-  double lambda;       /* GMG-QM ridge parameter, applied to the un-normalised sum
-                          over snapshots (0: 1e-3; < 0: exactly zero)                 */
-  int deim;            /* separable nonlinear part: 1 = structure-preserving DEIM,
-                          0 = keep every term (exact, but O(n_terms) online)          */
-  double deim_tol;     /* DEIM modes: sigma_k / sigma_1 > deim_tol (0: 1e-8)          */
-  int deim_max;        /* cap on DEIM modes (0: no cap)                               */
-  int deim_allow_negative; /* 1: accept negative DEIM weights (reported in info)      */
-  double dt;           /* > 0: precompute the GL3 step map for this step
-                          (LINEAR map with quadratic H only)                          */
-  double degeneracy_tol; /* fail with PHGMG_ERR_DEGENERATE when the reciprocal
-                          condition of D^T G D at the snapshots is below this (0: 1e-12) */
-} phgmg_reduce_opts;
+/* Bytes phgmg_rom_serialize writes for this model. */
+PHGMG_DEF size_t phgmg_rom_serialized_size(const phgmg_rom *rom);
+/* Serialise into buf (cap bytes). *written = bytes used. PHGMG_ERR_WORKSPACE if cap is too small. */
+PHGMG_DEF phgmg_result phgmg_rom_serialize(const phgmg_rom *rom, void *buf, size_t cap, size_t *written);
+/* Bytes of memory phgmg_rom_deserialize needs to hold the model in buf
+   (the arrays are copied, so buf may be freed afterwards). */
+PHGMG_DEF phgmg_result phgmg_rom_deserialize_size(const void *buf, size_t len, size_t *need);
+/* Rebuild a model from buf into caller memory mem (>= the size above, aligned
+   for double); rom's views point into mem. */
+PHGMG_DEF phgmg_result phgmg_rom_deserialize(const void *buf, size_t len, phgmg_rom *rom, void *mem,
+                                             size_t mem_size);
 
-typedef struct phgmg_reduce_info {
-  int deim_modes;          /* DEIM points kept (nd)                          */
-  int deim_negative;       /* number of negative DEIM weights               */
-  double deim_sigma_ratio; /* sigma_{nd+1}/sigma_1 of the nonlinear snapshots (0 if all kept) */
-  double rcond_dgd;        /* smallest rcond of D^T G D seen (at x = 0 and the snapshots) */
-  double rcond_jr;         /* rcond of J - R                                  */
-  double pod_sigma_ratio;  /* sigma_{r'+1}/sigma_1 of the (adjusted) snapshots */
-} phgmg_reduce_info;
-
-/* The reduced model with its offline data (bases for reconstruction, double
-   and phgmg_real copies of the small blocks). */
-typedef struct phgmg_reduced phgmg_reduced;
-
-/* Build a reduced model of `sys` from snapshots X (N x ns, ldx). The system must
-   validate (phgmg_ph_validate); GENERAL nonlinear Hamiltonians are not supported
-   (PHGMG_ERR_UNSUPPORTED); a separable nonlinear part needs the polynomial form
-   (sys->poly) for the reduced model. Errors: PHGMG_ERR_SIZE (r <= m for GMG,
-   r > rank of the snapshots, ...), PHGMG_ERR_RANK, PHGMG_ERR_DEGENERATE,
-   PHGMG_ERR_NEGATIVE_WEIGHT, PHGMG_ERR_NANINF, PHGMG_ERR_NOMEM. info may be NULL. */
-PHGMG_DEF phgmg_result phgmg_reduce(phgmg_reduced **out, const phgmg_ph_system *sys, const double *X,
-                                    int ldx, int ns, const phgmg_reduce_opts *opts,
-                                    phgmg_reduce_info *info, const phgmg_allocator *alloc);
-PHGMG_DEF void phgmg_reduced_destroy(phgmg_reduced *red);
-/* The online model (views into the reduced object; valid until destroy). */
-PHGMG_DEF const phgmg_rom *phgmg_reduced_rom(const phgmg_reduced *red);
-/* Offline double copy of the same model (identical layout, double arrays). */
-PHGMG_DEF int phgmg_reduced_N(const phgmg_reduced *red);
-/* Reconstruction x = phi(xr) (N). */
-PHGMG_DEF void phgmg_reduced_lift(const phgmg_reduced *red, const double *xr, double *x);
-/* Point reduction xr = rho(x) (r); rho(phi(xr)) = xr. */
-PHGMG_DEF void phgmg_reduced_restrict(const phgmg_reduced *red, const double *x, double *xr);
-/* Jacobian of phi at xr: D (N x r, ldd). */
-PHGMG_DEF void phgmg_reduced_dphi(const phgmg_reduced *red, const double *xr, double *D, int ldd);
-/* The reduction map W(xr) (N x r, ldw) in full dimension (for checks; O(N r^2)). */
-PHGMG_DEF phgmg_result phgmg_reduced_W(const phgmg_reduced *red, const double *xr, double *W, int ldw);
-
-/* Simulate the reduced model with the online GL3 stepper from xr0 over nsteps
-   steps of dt (u from uf at the stage times). Outputs (each may be NULL):
-   XR r x (nsteps+1), Y m x (nsteps+1), energy like phgmg_simulate (Hamiltonian
-   of the reduced model). tol/max_iter: Newton settings (<= 0: defaults). */
-PHGMG_DEF phgmg_result phgmg_reduced_simulate(const phgmg_reduced *red, const double *xr0, double t0,
-                                              double dt, int nsteps, phgmg_input_fn uf, void *uuser,
-                                              double tol, int max_iter, double *XR, double *Y,
-                                              const phgmg_energy *energy, phgmg_rom_stats *stats,
-                                              const phgmg_allocator *alloc);
-
-/* --- error measures (paper 5.1) --- */
-/* sqrt(sum_i ||A_i - B_i||^2 / sum_i ||A_i||^2) over ns columns of length n. */
-PHGMG_DEF double phgmg_rel_error(int n, int ns, const double *A, int lda, const double *B, int ldb);
-/* e_red: reduction error of a reduced trajectory XR (r x ns) against X. */
-PHGMG_DEF double phgmg_err_red(const phgmg_reduced *red, const double *X, int ldx, int ns,
-                               const double *XR, int ldxr);
-/* e_proj: projection error sqrt(sum ||x_i - phi(rho(x_i))||^2 / sum ||x_i||^2). */
-PHGMG_DEF double phgmg_err_proj(const phgmg_reduced *red, const double *X, int ldx, int ns);
-/* e_lowerbound (eq. non_app_lower_bound) of a GMG-QM model: the error of the
-   orthogonal projection onto span[B, V1, V2]. NaN for other kinds. */
-PHGMG_DEF double phgmg_err_lowerbound(const phgmg_reduced *red, const double *X, int ldx, int ns);
-/* e_energy(t_n) = |H[n] - H[0] - S[n] + D[n]| for n = 0..nsteps into e. */
-PHGMG_DEF void phgmg_err_energy(const phgmg_energy *energy, int nsteps, double *e);
-
-/* Hierarchical POD of paper 4.2.2: V1 = POD_p(X - BB^+X), V2 = POD_rn of the
-   residual (I - [B,V1][B,V1]^+) X. V1: N x p, V2: N x rn. */
-PHGMG_DEF phgmg_result phgmg_pod_hierarchical(int N, int m, const double *B, int ns, const double *X,
-                                              int ldx, int p, int rn, double *V1, double *V2,
-                                              const phgmg_allocator *alloc);
-
-/* Structure-preserving DEIM for a separable sum: F (nterms x ns) holds the
-   snapshots of the nonlinear gradient terms phi_k'(x_idx_k). Modes: sigma_k >
-   tol sigma_1 (capped by kmax if > 0). Points by Q-DEIM (pivoted QR of U^T).
-   Weights w = (P^T U)^{-T} U^T sw (sw = the terms' own weights, NULL = 1), so
-   sum_k sw_k phi_k ~ sum_j w_j phi_{pts_j}. pts, w: room for nterms entries.
-   *nd_out = points chosen, *nneg = negative weights. */
-PHGMG_DEF phgmg_result phgmg_deim(int nterms, int ns, const double *F, int ldf, const double *sw,
-                                  double tol, int kmax, int *pts, double *w, int *nd_out,
-                                  int *nneg, double *sigma_ratio, const phgmg_allocator *alloc);
+#if !defined(PHGMG_NO_STDIO) && !defined(PHGMG_NO_OFFLINE)
+/* Write the model as binary file. */
+PHGMG_DEF phgmg_result phgmg_rom_save(const phgmg_rom *rom, const char *path);
+/* Read a binary model file into one block allocated with alloc (NULL = default);
+   *rom views into *block, which the caller frees (alloc->free or free()). */
+PHGMG_DEF phgmg_result phgmg_rom_load(const char *path, phgmg_rom *rom, void **block,
+                                      const phgmg_allocator *alloc);
+/* Write the model as C source: arrays `<name>_<field>` and a descriptor
+   `static const phgmg_rom <name>` (scalar type: this build's phgmg_real;
+   values printed with enough digits to round-trip exactly). */
+PHGMG_DEF phgmg_result phgmg_rom_export_c(const phgmg_rom *rom, const char *name, const char *path);
+#endif
 
 #ifdef __cplusplus
 }
 #endif
-#endif /* PHGMG_NO_OFFLINE */
 
 /* >>npy =================================================================== */
 /* NumPy .npy files (offline half): snapshot matrices, bases and reference
@@ -811,46 +741,70 @@ PHGMG_DEF void phgmg_gemv(char trans, int m, int n, double alpha, const double *
 }
 
 #ifndef PHGMG_USE_CBLAS
-/* Block sizes of the portable gemm: an MC x KC panel of op(A) is packed
-   column-major (contiguous), then multiplied into C column by column in a
-   4-column register micro-kernel. */
+/* Portable GEMM: a block of op(A) (MC x KC) is packed into 8-row slivers (on
+   the stack, MC*KC doubles), then 8 x 6 tiles of C are computed by a
+   register-blocked micro-kernel that streams the matching 6 columns of op(B)
+   directly from B. With GCC/Clang the micro-kernel uses vector extensions
+   (define PHGMG_NO_VECTOR_EXT to get the plain C version). */
 #ifndef PHGMG_GEMM_MC
-#define PHGMG_GEMM_MC 64
+#define PHGMG_GEMM_MC 64 /* multiple of 8 */
 #endif
 #ifndef PHGMG_GEMM_KC
-#define PHGMG_GEMM_KC 128
+#define PHGMG_GEMM_KC 256
 #endif
+#define PHGMG__MR 8
+#define PHGMG__NR 6
 
-/* C(0:m,0:n) += Ap(m x kc, packed, ld m) * op(B)(kc x n) */
-PHGMG__PRIV void phgmg__gemm_kernel(int m, int n, int kc, const double *Ap, const double *B,
-                                    int ldb, int tb, double alpha, double *C, int ldc) {
-  int i, j, p;
-  for (j = 0; j + 4 <= n; j += 4) {
-    double *c0 = C + (size_t)j * (size_t)ldc, *c1 = c0 + ldc, *c2 = c1 + ldc, *c3 = c2 + ldc;
-    for (p = 0; p < kc; ++p) {
-      const double *a = Ap + (size_t)p * (size_t)m;
-      double b0, b1, b2, b3;
-      if (!tb) {
-        const double *bp = B + p + (size_t)j * (size_t)ldb;
-        b0 = bp[0]; b1 = bp[ldb]; b2 = bp[2 * (size_t)ldb]; b3 = bp[3 * (size_t)ldb];
-      } else {
-        const double *bp = B + j + (size_t)p * (size_t)ldb;
-        b0 = bp[0]; b1 = bp[1]; b2 = bp[2]; b3 = bp[3];
-      }
-      b0 *= alpha; b1 *= alpha; b2 *= alpha; b3 *= alpha;
-      for (i = 0; i < m; ++i) {
-        double av = a[i];
-        c0[i] += av * b0; c1[i] += av * b1; c2[i] += av * b2; c3[i] += av * b3;
-      }
-    }
+/* C(0:mr, 0:nr) += alpha * Ap * op(B)(0:kc, 0:nr), Ap packed (Ap[8p + i]);
+   op(B)(p, j) = B[p*bsp + j*bsj]. mr <= 8, nr <= 6. */
+PHGMG__PRIV void phgmg__gemm_micro(int kc, const double *Ap, const double *B, size_t bsp,
+                                   size_t bsj, int mr, int nr, double alpha, double *C, int ldc) {
+  double tile[PHGMG__MR * PHGMG__NR];
+  const double *b0 = B, *b1 = B + (nr > 1 ? bsj : 0), *b2 = B + (nr > 2 ? 2 * bsj : 0);
+  const double *b3 = B + (nr > 3 ? 3 * bsj : 0), *b4 = B + (nr > 4 ? 4 * bsj : 0);
+  const double *b5 = B + (nr > 5 ? 5 * bsj : 0);
+  int p, i, j;
+#if (defined(__GNUC__) || defined(__clang__)) && !defined(PHGMG_NO_VECTOR_EXT)
+  typedef double phgmg__v4 __attribute__((vector_size(32)));
+  phgmg__v4 c00, c01, c10, c11, c20, c21, c30, c31, c40, c41, c50, c51, a0, a1;
+  memset(&c00, 0, sizeof c00);
+  c01 = c10 = c11 = c20 = c21 = c30 = c31 = c40 = c41 = c50 = c51 = c00;
+  for (p = 0; p < kc; ++p) {
+    size_t o = (size_t)p * bsp;
+    double x;
+    memcpy(&a0, Ap, sizeof a0);
+    memcpy(&a1, Ap + 4, sizeof a1);
+    Ap += PHGMG__MR;
+    x = b0[o]; c00 += a0 * x; c01 += a1 * x;
+    x = b1[o]; c10 += a0 * x; c11 += a1 * x;
+    x = b2[o]; c20 += a0 * x; c21 += a1 * x;
+    x = b3[o]; c30 += a0 * x; c31 += a1 * x;
+    x = b4[o]; c40 += a0 * x; c41 += a1 * x;
+    x = b5[o]; c50 += a0 * x; c51 += a1 * x;
   }
-  for (; j < n; ++j) {
-    double *c0 = C + (size_t)j * (size_t)ldc;
-    for (p = 0; p < kc; ++p) {
-      const double *a = Ap + (size_t)p * (size_t)m;
-      double b0 = alpha * (tb ? B[j + (size_t)p * (size_t)ldb] : B[p + (size_t)j * (size_t)ldb]);
-      for (i = 0; i < m; ++i) c0[i] += a[i] * b0;
+  memcpy(tile + 0, &c00, sizeof c00); memcpy(tile + 4, &c01, sizeof c01);
+  memcpy(tile + 8, &c10, sizeof c10); memcpy(tile + 12, &c11, sizeof c11);
+  memcpy(tile + 16, &c20, sizeof c20); memcpy(tile + 20, &c21, sizeof c21);
+  memcpy(tile + 24, &c30, sizeof c30); memcpy(tile + 28, &c31, sizeof c31);
+  memcpy(tile + 32, &c40, sizeof c40); memcpy(tile + 36, &c41, sizeof c41);
+  memcpy(tile + 40, &c50, sizeof c50); memcpy(tile + 44, &c51, sizeof c51);
+#else
+  for (i = 0; i < PHGMG__MR * PHGMG__NR; ++i) tile[i] = 0.0;
+  for (p = 0; p < kc; ++p) {
+    size_t o = (size_t)p * bsp;
+    double x0 = b0[o], x1 = b1[o], x2 = b2[o], x3 = b3[o], x4 = b4[o], x5 = b5[o];
+    for (i = 0; i < PHGMG__MR; ++i) {
+      double a = Ap[i];
+      tile[i] += a * x0; tile[8 + i] += a * x1; tile[16 + i] += a * x2;
+      tile[24 + i] += a * x3; tile[32 + i] += a * x4; tile[40 + i] += a * x5;
     }
+    Ap += PHGMG__MR;
+  }
+#endif
+  for (j = 0; j < nr; ++j) {
+    double *c = C + (size_t)j * (size_t)ldc;
+    const double *t = tile + PHGMG__MR * j;
+    for (i = 0; i < mr; ++i) c[i] += alpha * t[i];
   }
 }
 #endif
@@ -865,7 +819,7 @@ PHGMG_DEF void phgmg_gemm(char transa, char transb, int m, int n, int k, double 
   PHGMG_ASSERT(tb || transb == 'N' || transb == 'n');
   if (m <= 0 || n <= 0) return;
 #ifdef PHGMG_USE_CBLAS
-  if (k > 0) {
+  if (k > 0 && alpha != 0.0) {
     cblas_dgemm(CblasColMajor, ta ? CblasTrans : CblasNoTrans, tb ? CblasTrans : CblasNoTrans,
                 m, n, k, alpha, A, lda, B, ldb, beta, C, ldc);
     return;
@@ -879,28 +833,43 @@ PHGMG_DEF void phgmg_gemm(char transa, char transb, int m, int n, int k, double 
   if (alpha == 0.0 || k <= 0) return;
 #ifndef PHGMG_USE_CBLAS
   {
-    /* pack buffer on the stack: MC*KC doubles */
     double Ap[PHGMG_GEMM_MC * PHGMG_GEMM_KC];
-    int pc, ic, p;
+    size_t bsp = tb ? (size_t)ldb : 1, bsj = tb ? 1 : (size_t)ldb;
+    int pc, ic, ir, jr, p;
     for (pc = 0; pc < k; pc += PHGMG_GEMM_KC) {
       int kc = PHGMG__MIN(PHGMG_GEMM_KC, k - pc);
       for (ic = 0; ic < m; ic += PHGMG_GEMM_MC) {
         int mc = PHGMG__MIN(PHGMG_GEMM_MC, m - ic);
-        /* pack op(A)(ic:ic+mc, pc:pc+kc) column-major with ld mc */
-        if (!ta) {
-          for (p = 0; p < kc; ++p) {
-            const double *src = A + ic + (size_t)(pc + p) * (size_t)lda;
-            memcpy(Ap + (size_t)p * (size_t)mc, src, (size_t)mc * sizeof(double));
-          }
-        } else {
-          for (i = 0; i < mc; ++i) {
-            const double *src = A + pc + (size_t)(ic + i) * (size_t)lda;
-            for (p = 0; p < kc; ++p) Ap[i + (size_t)p * (size_t)mc] = src[p];
+        /* pack op(A)(ic:ic+mc, pc:pc+kc) into 8-row slivers, zero padded */
+        for (ir = 0; ir < mc; ir += PHGMG__MR) {
+          int mr = PHGMG__MIN(PHGMG__MR, mc - ir);
+          double *dst = Ap + (size_t)ir * (size_t)kc;
+          if (!ta) {
+            for (p = 0; p < kc; ++p) {
+              const double *src = A + (ic + ir) + (size_t)(pc + p) * (size_t)lda;
+              double *d = dst + (size_t)p * PHGMG__MR;
+              for (i = 0; i < mr; ++i) d[i] = src[i];
+              for (; i < PHGMG__MR; ++i) d[i] = 0.0;
+            }
+          } else {
+            for (i = 0; i < PHGMG__MR; ++i) {
+              if (i < mr) {
+                const double *src = A + pc + (size_t)(ic + ir + i) * (size_t)lda;
+                for (p = 0; p < kc; ++p) dst[(size_t)p * PHGMG__MR + i] = src[p];
+              } else {
+                for (p = 0; p < kc; ++p) dst[(size_t)p * PHGMG__MR + i] = 0.0;
+              }
+            }
           }
         }
-        phgmg__gemm_kernel(mc, n, kc, Ap,
-                           tb ? B + (size_t)pc * (size_t)ldb : B + pc, ldb, tb, alpha,
-                           C + ic, ldc);
+        for (jr = 0; jr < n; jr += PHGMG__NR) {
+          int nr = PHGMG__MIN(PHGMG__NR, n - jr);
+          const double *bp = B + (size_t)pc * bsp + (size_t)jr * bsj;
+          for (ir = 0; ir < mc; ir += PHGMG__MR)
+            phgmg__gemm_micro(kc, Ap + (size_t)ir * (size_t)kc, bp, bsp, bsj,
+                              PHGMG__MIN(PHGMG__MR, mc - ir), nr, alpha,
+                              C + (ic + ir) + (size_t)jr * (size_t)ldc, ldc);
+        }
       }
     }
   }
@@ -2255,832 +2224,336 @@ PHGMG_DEF phgmg_result phgmg_rom_step(phgmg_rom_stepper *s, phgmg_real *x, const
   return err == PHGMG_OK ? PHGMG_ERR_NOT_CONVERGED : err;
 }
 
-#ifndef PHGMG_NO_OFFLINE
-/* >>pod / >>reduce (implementation) ======================================= */
+/* >>export (implementation) ============================================== */
+#include <stdint.h>
 
-/* A small owner list: every array of a phgmg_reduced is allocated through it,
-   so destroy (and every error path) frees exactly what was allocated. */
-#define PHGMG__MAXBUF 48
-struct phgmg_reduced {
-  phgmg_allocator alloc;
-  int use_alloc;
-  void *bufs[PHGMG__MAXBUF];
-  int nbufs;
-  int N, m, r, p, rn, nd, method, kind;
-  double *V0, *V2;     /* N x r, N x rn                        */
-  double *QB, *RB;     /* thin QR of B: N x m, m x m           */
-  double *W;           /* N x r point reduction for SP1/SP2    */
-  double *M;           /* rn x p^2                             */
-  int *coord;          /* nd: coordinates of the kept terms    */
-  const phgmg_ph_system *sys;
-  /* double blocks (same meaning as the phgmg_rom fields) */
-  double *Bh, *Qh, *K, *G00, *G01, *G10, *G11, *Q01, *Q11, *Ms, *P0, *P1, *w, *poly;
-  double *Phi, *Gam, *SX, *SU;
-  double map_dt;       /* step of the precomputed map          */
-  phgmg_rom rom;       /* views into the phgmg_real copies     */
-};
+/* The arrays of a phgmg_rom in file order, with their sizes. */
+#define PHGMG__NFIELDS 18
+typedef struct phgmg__field { size_t off; const char *name; } phgmg__field;
+static const phgmg__field phgmg__fields[PHGMG__NFIELDS] = {
+  {offsetof(phgmg_rom, Bh), "Bh"},   {offsetof(phgmg_rom, Qh), "Qh"},   {offsetof(phgmg_rom, K), "K"},
+  {offsetof(phgmg_rom, G00), "G00"}, {offsetof(phgmg_rom, G01), "G01"}, {offsetof(phgmg_rom, G10), "G10"},
+  {offsetof(phgmg_rom, G11), "G11"}, {offsetof(phgmg_rom, Q01), "Q01"}, {offsetof(phgmg_rom, Q11), "Q11"},
+  {offsetof(phgmg_rom, Ms), "Ms"},   {offsetof(phgmg_rom, P0), "P0"},   {offsetof(phgmg_rom, P1), "P1"},
+  {offsetof(phgmg_rom, w), "w"},     {offsetof(phgmg_rom, poly), "poly"}, {offsetof(phgmg_rom, Phi), "Phi"},
+  {offsetof(phgmg_rom, Gam), "Gam"}, {offsetof(phgmg_rom, SX), "SX"},   {offsetof(phgmg_rom, SU), "SU"}};
 
-PHGMG__PRIV void *phgmg__red_alloc(phgmg_reduced *red, size_t bytes) {
-  void *p;
-  if (red->nbufs >= PHGMG__MAXBUF) return NULL;
-  p = phgmg__alloc(red->use_alloc ? &red->alloc : NULL, bytes);
-  if (p) red->bufs[red->nbufs++] = p;
-  return p;
+PHGMG__ONLINE const phgmg_real **phgmg__field_ptr(phgmg_rom *rom, int i) {
+  return PHGMG__CAST(const phgmg_real **, PHGMG__CAST(void *, PHGMG__CAST(char *, PHGMG__CAST(void *, rom)) + phgmg__fields[i].off));
 }
-PHGMG__PRIV double *phgmg__red_d(phgmg_reduced *red, size_t n) {
-  double *p = PHGMG__CAST(double *, phgmg__red_alloc(red, (n ? n : 1) * sizeof(double)));
-  if (p) memset(p, 0, (n ? n : 1) * sizeof(double));
-  return p;
+PHGMG__ONLINE const phgmg_real *phgmg__field_get(const phgmg_rom *rom, int i) {
+  return *PHGMG__CAST(const phgmg_real *const *, PHGMG__CAST(const void *, PHGMG__CAST(const char *, PHGMG__CAST(const void *, rom)) + phgmg__fields[i].off));
+}
+/* Number of scalars of field i (0 if the field does not apply). */
+PHGMG__ONLINE size_t phgmg__field_len(const phgmg_rom *rom, int i) {
+  const size_t r = (size_t)rom->r, m = (size_t)rom->m, rn = (size_t)rom->rn, nd = (size_t)rom->nd;
+  const size_t p = (size_t)(rom->r - rom->m);
+  switch (i) {
+    case 0: return r * m;
+    case 1: return r * r;
+    case 2: return r * r;
+    case 3: return r * r;
+    case 4: return r * rn;
+    case 5: return rn * r;
+    case 6: return rn * rn;
+    case 7: return r * rn;
+    case 8: return rn * rn;
+    case 9: return rn * p * p;
+    case 10: return nd * r;
+    case 11: return nd * rn;
+    case 12: return nd;
+    case 13: return nd ? (size_t)rom->poly_deg + 1 : 0;
+    case 14: return r * r;
+    case 15: return r * 3 * m;
+    case 16: return 3 * r * r;
+    default: return 3 * r * 3 * m;
+  }
 }
 
-PHGMG_DEF void phgmg_reduced_destroy(phgmg_reduced *red) {
+#define PHGMG__HDR_BYTES (8 + 4 * 10 + 8)
+
+PHGMG__ONLINE void phgmg__put32(unsigned char *b, uint32_t v) {
+  b[0] = (unsigned char)(v & 255u); b[1] = (unsigned char)((v >> 8) & 255u);
+  b[2] = (unsigned char)((v >> 16) & 255u); b[3] = (unsigned char)((v >> 24) & 255u);
+}
+PHGMG__ONLINE uint32_t phgmg__get32(const unsigned char *b) {
+  return (uint32_t)b[0] | ((uint32_t)b[1] << 8) | ((uint32_t)b[2] << 16) | ((uint32_t)b[3] << 24);
+}
+PHGMG__ONLINE void phgmg__put_f64(unsigned char *b, double v) {
+  uint64_t u;
   int i;
-  phgmg_allocator a;
-  int use;
-  if (!red) return;
-  a = red->alloc;
-  use = red->use_alloc;
-  for (i = 0; i < red->nbufs; ++i) phgmg__free(use ? &a : NULL, red->bufs[i]);
-  phgmg__free(use ? &a : NULL, red);
+  memcpy(&u, &v, 8);
+  for (i = 0; i < 8; ++i) b[i] = (unsigned char)((u >> (8 * i)) & 255u);
 }
-
-PHGMG_DEF const phgmg_rom *phgmg_reduced_rom(const phgmg_reduced *red) { return red ? &red->rom : NULL; }
-PHGMG_DEF int phgmg_reduced_N(const phgmg_reduced *red) { return red ? red->N : 0; }
-
-/* C (m x n) = A^T B with A: k x m, B: k x n (column-major, tight). */
-PHGMG__PRIV void phgmg__atb(int k, int m, int n, const double *A, const double *B, double *C) {
-  phgmg_gemm('T', 'N', m, n, k, 1.0, A, k, B, k, 0.0, C, m);
-}
-
-PHGMG_DEF phgmg_result phgmg_pod(int N, int ns, const double *X, int ldx, int kmax, double tol,
-                                 double *V, int ldv, double *S, int *k_out,
-                                 const phgmg_allocator *alloc) {
-  double *s;
-  int k = 0, rank = 0, i;
-  phgmg_result rc;
-  if (!X || !V || !k_out) return PHGMG_ERR_INVALID_ARG;
-  if (N < 1 || ns < 1 || kmax < 1 || ldx < N || ldv < N || kmax > PHGMG__MIN(N, ns)) return PHGMG_ERR_SIZE;
-  s = phgmg__dalloc(alloc, (size_t)kmax);
-  if (!s) return PHGMG_ERR_NOMEM;
-  rc = phgmg_svd(N, ns, X, ldx, kmax, s, V, ldv, NULL, 1, &k, &rank, alloc);
-  if (rc == PHGMG_OK) {
-    if (tol > 0.0)
-      for (i = 0; i < k; ++i)
-        if (!(s[i] > tol * s[0])) { k = i; break; }
-    for (i = 0; i < k && S; ++i) S[i] = s[i];
-    *k_out = k;
-  }
-  phgmg__free(alloc, s);
-  return rc;
-}
-
-/* Thin QR of B (N x m): QB (N x m) orthonormal, RB (m x m) upper triangular.
-   PHGMG_ERR_RANK if B is rank deficient. */
-PHGMG__PRIV phgmg_result phgmg__thin_qr(int N, int m, const double *B, double *QB, double *RB,
-                                        const phgmg_allocator *alloc) {
-  double *tau, *work;
-  double rmax = 0.0;
-  int i, j;
-  phgmg_result rc;
-  tau = phgmg__dalloc(alloc, (size_t)(2 * m + 1));
-  if (!tau) return PHGMG_ERR_NOMEM;
-  work = tau + m;
-  for (j = 0; j < m; ++j) memcpy(QB + (size_t)j * N, B + (size_t)j * N, (size_t)N * sizeof(double));
-  rc = phgmg_qr(N, m, QB, N, tau);
-  if (rc == PHGMG_OK) {
-    for (j = 0; j < m; ++j)
-      for (i = 0; i < m; ++i) RB[i + j * m] = i <= j ? QB[i + (size_t)j * N] : 0.0;
-    for (j = 0; j < m; ++j) rmax = PHGMG__MAX(rmax, fabs(RB[j + j * m]));
-    for (j = 0; j < m; ++j)
-      if (!(fabs(RB[j + j * m]) > 1e3 * PHGMG__EPS * (double)N * rmax)) rc = PHGMG_ERR_RANK;
-    if (rc == PHGMG_OK) phgmg_qr_form_q(N, m, QB, N, tau, work);
-  }
-  phgmg__free(alloc, tau);
-  return rc;
-}
-
-/* Y = (I - Q Q^T) X for Q (N x k orthonormal), X N x ns; tmp: k x ns. */
-PHGMG__PRIV void phgmg__orth_remove(int N, int k, const double *Q, int ns, double *X, int ldx, double *tmp) {
-  if (k < 1) return;
-  phgmg_gemm('T', 'N', k, ns, N, 1.0, Q, N, X, ldx, 0.0, tmp, k);
-  phgmg_gemm('N', 'N', N, ns, k, -1.0, Q, N, tmp, k, 1.0, X, ldx);
-}
-
-PHGMG_DEF phgmg_result phgmg_adjust_snapshots(int N, int m, const double *B, int ns, const double *X,
-                                              int ldx, double *Xa, int ldxa, const phgmg_allocator *alloc) {
-  double *QB, *tmp;
-  phgmg_result rc;
-  int j;
-  if (!B || !X || !Xa) return PHGMG_ERR_INVALID_ARG;
-  if (N < 1 || m < 1 || m > N || ns < 1 || ldx < N || ldxa < N) return PHGMG_ERR_SIZE;
-  QB = phgmg__dalloc(alloc, (size_t)N * m + (size_t)m * m + (size_t)m * ns);
-  if (!QB) return PHGMG_ERR_NOMEM;
-  tmp = QB + (size_t)N * m;
-  rc = phgmg__thin_qr(N, m, B, QB, tmp, alloc);
-  if (rc == PHGMG_OK) {
-    if (Xa != X)
-      for (j = 0; j < ns; ++j) memcpy(Xa + (size_t)j * ldxa, X + (size_t)j * ldx, (size_t)N * sizeof(double));
-    phgmg__orth_remove(N, m, QB, ns, Xa, ldxa, tmp + (size_t)m * m);
-  }
-  phgmg__free(alloc, QB);
-  return rc;
-}
-
-PHGMG_DEF phgmg_result phgmg_pod_hierarchical(int N, int m, const double *B, int ns, const double *X,
-                                              int ldx, int p, int rn, double *V1, double *V2,
-                                              const phgmg_allocator *alloc) {
-  double *Xa, *tmp;
-  phgmg_result rc;
-  int k = 0;
-  if (!B || !X || !V1 || !V2) return PHGMG_ERR_INVALID_ARG;
-  if (p < 1 || rn < 1 || p + rn + m > PHGMG__MIN(N, ns + m)) return PHGMG_ERR_SIZE;
-  Xa = phgmg__dalloc(alloc, (size_t)N * ns + (size_t)p * ns);
-  if (!Xa) return PHGMG_ERR_NOMEM;
-  tmp = Xa + (size_t)N * ns;
-  rc = phgmg_adjust_snapshots(N, m, B, ns, X, ldx, Xa, N, alloc);
-  if (rc == PHGMG_OK) rc = phgmg_pod(N, ns, Xa, N, p, 0.0, V1, N, NULL, &k, alloc);
-  if (rc == PHGMG_OK && k < p) rc = PHGMG_ERR_SIZE;
-  if (rc == PHGMG_OK) {
-    phgmg__orth_remove(N, p, V1, ns, Xa, N, tmp);
-    rc = phgmg_pod(N, ns, Xa, N, rn, 0.0, V2, N, NULL, &k, alloc);
-    if (rc == PHGMG_OK && k < rn) rc = PHGMG_ERR_SIZE;
-  }
-  phgmg__free(alloc, Xa);
-  return rc;
-}
-
-PHGMG_DEF phgmg_result phgmg_deim(int nterms, int ns, const double *F, int ldf, const double *sw,
-                                  double tol, int kmax, int *pts, double *w, int *nd_out,
-                                  int *nneg, double *sigma_ratio, const phgmg_allocator *alloc) {
-  double *U, *S, *Ut, *tau, *work, *PU;
-  int *jpvt, *ipiv;
-  int k = 0, kk, rank = 0, i, j, neg = 0;
-  phgmg_result rc;
-  if (!F || !pts || !w || !nd_out) return PHGMG_ERR_INVALID_ARG;
-  if (nterms < 1 || ns < 1 || ldf < nterms) return PHGMG_ERR_SIZE;
-  if (!phgmg__all_finite(F, (size_t)ldf * (size_t)(ns - 1) + (size_t)nterms)) return PHGMG_ERR_NANINF;
-  if (tol <= 0.0) tol = 1e-8;
-  kk = PHGMG__MIN(nterms, ns);
-  if (kmax > 0) kk = PHGMG__MIN(kk, kmax + 1);
-  U = phgmg__dalloc(alloc, (size_t)nterms * kk + (size_t)kk + (size_t)kk * nterms + (size_t)kk +
-                               2 * (size_t)nterms + (size_t)kk * kk + (size_t)kk);
-  jpvt = phgmg__ialloc(alloc, (size_t)nterms + (size_t)kk);
-  if (!U || !jpvt) { phgmg__free(alloc, U); phgmg__free(alloc, jpvt); return PHGMG_ERR_NOMEM; }
-  S = U + (size_t)nterms * kk;
-  Ut = S + kk;
-  tau = Ut + (size_t)kk * nterms;
-  work = tau + kk;
-  PU = work + 2 * (size_t)nterms;
-  ipiv = jpvt + nterms;
-  rc = phgmg_svd(nterms, ns, F, ldf, kk, S, U, nterms, NULL, 1, &k, &rank, alloc);
-  if (rc == PHGMG_OK) {
-    int keep = 0;
-    for (i = 0; i < k; ++i) if (S[i] > tol * S[0]) keep = i + 1;
-    if (kmax > 0 && keep > kmax) keep = kmax;
-    if (keep < 1) keep = 1;
-    if (sigma_ratio) *sigma_ratio = (keep < k && S[0] > 0.0) ? S[keep] / S[0] : 0.0;
-    /* Q-DEIM: pivoted QR of U^T (keep x nterms); points = first keep pivots */
-    for (j = 0; j < nterms; ++j)
-      for (i = 0; i < keep; ++i) Ut[i + (size_t)j * keep] = U[j + (size_t)i * nterms];
-    rc = phgmg_qrcp(keep, nterms, Ut, keep, tau, jpvt, work);
-    if (rc == PHGMG_OK) {
-      /* w = (P^T U)^{-T} U^T sw: solve (P^T U)^T w = U^T sw */
-      for (i = 0; i < keep; ++i) pts[i] = jpvt[i];
-      for (j = 0; j < keep; ++j)       /* PU = P^T U (keep x keep) */
-        for (i = 0; i < keep; ++i) PU[i + (size_t)j * keep] = U[pts[i] + (size_t)j * nterms];
-      for (j = 0; j < keep; ++j) {
-        double sacc = 0.0;
-        for (i = 0; i < nterms; ++i) sacc += U[i + (size_t)j * nterms] * (sw ? sw[i] : 1.0);
-        w[j] = sacc;
-      }
-      rc = phgmg_lu_factor(keep, PU, keep, ipiv);
-      if (rc == PHGMG_OK) {
-        phgmg_lu_solve('T', keep, PU, keep, ipiv, 1, w, keep);
-        for (i = 0; i < keep; ++i) if (w[i] < 0.0) ++neg;
-        if (!phgmg__all_finite(w, (size_t)keep)) rc = PHGMG_ERR_NANINF;
-        *nd_out = keep;
-        if (nneg) *nneg = neg;
-      }
-    }
-  }
-  phgmg__free(alloc, U);
-  phgmg__free(alloc, jpvt);
-  return rc;
-}
-
-/* Lp (rn x p) = [sum_j Ms(:, k*p + j) x2_j]_k in double. */
-PHGMG__PRIV void phgmg__lp_d(int rn, int p, const double *Ms, const double *x2, double *Lp) {
-  int i, j, k;
-  for (k = 0; k < p; ++k) {
-    double *l = Lp + (size_t)k * rn;
-    for (i = 0; i < rn; ++i) l[i] = 0.0;
-    for (j = 0; j < p; ++j) {
-      const double *ms = Ms + ((size_t)k * p + j) * rn;
-      for (i = 0; i < rn; ++i) l[i] += ms[i] * x2[j];
-    }
-  }
-}
-
-/* E = G00 + G01 L + L^T (G10 + G11 L), L = [0, Lp]; tmp: rn x r. */
-PHGMG__PRIV void phgmg__dgd_d(const phgmg_reduced *red, const double *Lp, double *E, double *tmp) {
-  const int r = red->r, m = red->m, rn = red->rn;
-  int a, b, i;
-  for (b = 0; b < r; ++b) {
-    for (i = 0; i < rn; ++i) tmp[i + (size_t)b * rn] = red->G10[i + (size_t)b * rn];
-    if (b >= m) phgmg_gemv('N', rn, rn, 1.0, red->G11, rn, Lp + (size_t)(b - m) * rn, 1.0, tmp + (size_t)b * rn);
-  }
-  memcpy(E, red->G00, (size_t)r * r * sizeof(double));
-  for (b = m; b < r; ++b) phgmg_gemv('N', r, rn, 1.0, red->G01, r, Lp + (size_t)(b - m) * rn, 1.0, E + (size_t)b * r);
-  for (b = 0; b < r; ++b)
-    for (a = m; a < r; ++a) {
-      double s = 0.0;
-      for (i = 0; i < rn; ++i) s += Lp[i + (size_t)(a - m) * rn] * tmp[i + (size_t)b * rn];
-      E[a + (size_t)b * r] += s;
-    }
-}
-
-/* rcond of an r x r matrix (copied). -1 on allocation failure. */
-PHGMG__PRIV double phgmg__rcond_of(int n, const double *A, const phgmg_allocator *alloc) {
-  double *LU = phgmg__dalloc(alloc, (size_t)n * n + 2 * (size_t)n);
-  int *ip = phgmg__ialloc(alloc, 2 * (size_t)n);
-  double rc = -1.0;
-  if (LU && ip) {
-    double anorm = phgmg_norm1(n, n, A, n);
-    memcpy(LU, A, (size_t)n * n * sizeof(double));
-    if (phgmg_lu_factor(n, LU, n, ip) == PHGMG_OK)
-      rc = phgmg_lu_rcond(n, LU, n, ip, anorm, LU + (size_t)n * n, ip + n);
-    else
-      rc = 0.0;
-  }
-  phgmg__free(alloc, LU);
-  phgmg__free(alloc, ip);
-  return rc;
-}
-
-/* Inverse of an r x r matrix into Ainv. */
-PHGMG__PRIV phgmg_result phgmg__inv(int n, const double *A, double *Ainv, const phgmg_allocator *alloc) {
-  double *LU = phgmg__dalloc(alloc, (size_t)n * n);
-  int *ip = phgmg__ialloc(alloc, (size_t)n);
-  phgmg_result rc = PHGMG_ERR_NOMEM;
+PHGMG__ONLINE double phgmg__get_f64(const unsigned char *b) {
+  uint64_t u = 0;
+  double v;
   int i;
-  if (LU && ip) {
-    memcpy(LU, A, (size_t)n * n * sizeof(double));
-    rc = phgmg_lu_factor(n, LU, n, ip);
-    if (rc == PHGMG_OK) {
-      memset(Ainv, 0, (size_t)n * n * sizeof(double));
-      for (i = 0; i < n; ++i) Ainv[i + (size_t)i * n] = 1.0;
-      phgmg_lu_solve('N', n, LU, n, ip, n, Ainv, n);
-    }
-  }
-  phgmg__free(alloc, LU);
-  phgmg__free(alloc, ip);
-  return rc;
+  for (i = 0; i < 8; ++i) u |= (uint64_t)b[i] << (8 * i);
+  memcpy(&v, &u, 8);
+  return v;
 }
-
-PHGMG__PRIV double phgmg__poly_d1(const double *c, int deg, double s) {
-  double p1 = 0.0, p0 = 0.0;
-  int k;
-  for (k = deg; k >= 0; --k) { p1 = p1 * s + p0; p0 = p0 * s + c[k]; }
-  return p1;
+PHGMG__ONLINE void phgmg__put_f32(unsigned char *b, float v) {
+  uint32_t u;
+  memcpy(&u, &v, 4);
+  phgmg__put32(b, u);
 }
-
-/* The exact GL3 step map of x' = Jf x + Bh u (see phgmg_rom). */
-PHGMG__PRIV phgmg_result phgmg__step_map(phgmg_reduced *red, double h, const phgmg_allocator *alloc) {
-  const int r = red->r, m = red->m, n3 = 3 * r, nc = r + 3 * m;
-  double c[3], b[3], A[9];
-  double *Jf = phgmg__dalloc(alloc, (size_t)r * r + (size_t)n3 * n3 + (size_t)n3 * nc);
-  int *ip = phgmg__ialloc(alloc, (size_t)n3);
-  double *M3, *RH;
-  phgmg_result rc = PHGMG_ERR_NOMEM;
-  int i, j, a, bb;
-  if (!Jf || !ip) goto done;
-  M3 = Jf + (size_t)r * r;
-  RH = M3 + (size_t)n3 * n3;
-  phgmg_gl3_coefficients(c, b, A);
-  phgmg_gemm('N', 'N', r, r, r, 1.0, red->K, r, red->Qh, r, 0.0, Jf, r);
-  for (j = 0; j < 3; ++j)
-    for (bb = 0; bb < r; ++bb)
-      for (i = 0; i < 3; ++i)
-        for (a = 0; a < r; ++a)
-          M3[(i * r + a) + (size_t)(j * r + bb) * n3] = (i == j && a == bb ? 1.0 : 0.0) - h * A[i * 3 + j] * Jf[a + (size_t)bb * r];
-  /* RH = [h (A kron Jf)(1 kron I),  h (A kron Bh)] */
-  for (i = 0; i < 3; ++i) {
-    for (bb = 0; bb < r; ++bb)
-      for (a = 0; a < r; ++a) {
-        double s = 0.0;
-        for (j = 0; j < 3; ++j) s += A[i * 3 + j];
-        RH[(i * r + a) + (size_t)bb * n3] = h * s * Jf[a + (size_t)bb * r];
-      }
-    for (j = 0; j < 3; ++j)
-      for (bb = 0; bb < m; ++bb)
-        for (a = 0; a < r; ++a)
-          RH[(i * r + a) + (size_t)(r + j * m + bb) * n3] = h * A[i * 3 + j] * red->Bh[a + (size_t)bb * r];
-  }
-  rc = phgmg_lu_factor(n3, M3, n3, ip);
-  if (rc != PHGMG_OK) goto done;
-  phgmg_lu_solve('N', n3, M3, n3, ip, nc, RH, n3);
-  rc = PHGMG_ERR_NOMEM;
-  red->SX = phgmg__red_d(red, (size_t)n3 * r);
-  red->SU = phgmg__red_d(red, (size_t)n3 * 3 * m);
-  red->Phi = phgmg__red_d(red, (size_t)r * r);
-  red->Gam = phgmg__red_d(red, (size_t)r * 3 * m);
-  if (!red->SX || !red->SU || !red->Phi || !red->Gam) goto done;
-  for (bb = 0; bb < r; ++bb)
-    for (a = 0; a < n3; ++a) red->SX[a + (size_t)bb * n3] = RH[a + (size_t)bb * n3] + (a % r == bb ? 1.0 : 0.0);
-  for (bb = 0; bb < 3 * m; ++bb)
-    for (a = 0; a < n3; ++a) red->SU[a + (size_t)bb * n3] = RH[a + (size_t)(r + bb) * n3];
-  /* Phi = I + h sum b_i Jf SX_i ; Gam = h sum b_i Jf SU_i + h [b_1 Bh, b_2 Bh, b_3 Bh] */
-  for (a = 0; a < r; ++a) red->Phi[a + (size_t)a * r] = 1.0;
-  for (i = 0; i < 3; ++i) {
-    phgmg_gemm('N', 'N', r, r, r, h * b[i], Jf, r, red->SX + i * r, n3, 1.0, red->Phi, r);
-    if (m > 0) phgmg_gemm('N', 'N', r, 3 * m, r, h * b[i], Jf, r, red->SU + i * r, n3, 1.0, red->Gam, r);
-    for (bb = 0; bb < m; ++bb)
-      for (a = 0; a < r; ++a) red->Gam[a + (size_t)(i * m + bb) * r] += h * b[i] * red->Bh[a + (size_t)bb * r];
-  }
-  rc = PHGMG_OK;
-done:
-  phgmg__free(alloc, Jf);
-  phgmg__free(alloc, ip);
-  return rc;
+PHGMG__ONLINE float phgmg__get_f32(const unsigned char *b) {
+  uint32_t u = phgmg__get32(b);
+  float v;
+  memcpy(&v, &u, 4);
+  return v;
 }
-
-/* phgmg_real copy of a double array (NULL stays NULL). */
-PHGMG__PRIV phgmg_result phgmg__to_real(phgmg_reduced *red, const double *src, size_t n, const phgmg_real **dst) {
-  phgmg_real *d;
+PHGMG__ONLINE uint32_t phgmg__fnv1a(const unsigned char *b, size_t n) {
+  uint32_t h = 2166136261u;
   size_t i;
-  if (!src) { *dst = NULL; return PHGMG_OK; }
-  d = PHGMG__CAST(phgmg_real *, phgmg__red_alloc(red, (n ? n : 1) * sizeof(phgmg_real)));
-  if (!d) return PHGMG_ERR_NOMEM;
-  for (i = 0; i < n; ++i) d[i] = (phgmg_real)src[i];
-  *dst = d;
-  return PHGMG_OK;
+  for (i = 0; i < n; ++i) { h ^= b[i]; h *= 16777619u; }
+  return h;
 }
 
-PHGMG__PRIV phgmg_result phgmg__publish(phgmg_reduced *red) {
-  const size_t r = (size_t)red->r, m = (size_t)red->m, rn = (size_t)red->rn, nd = (size_t)red->nd;
-  const size_t p = (size_t)red->p;
-  phgmg_rom *o = &red->rom;
-  phgmg_result rc = PHGMG_OK;
-  memset(o, 0, sizeof *o);
-  o->kind = red->kind; o->method = red->method; o->r = red->r; o->m = red->m;
-  o->rn = red->rn; o->nd = red->nd; o->poly_deg = red->nd > 0 ? red->sys->poly_deg : 0;
-#define PHGMG__PUB(field, n) if (rc == PHGMG_OK) rc = phgmg__to_real(red, red->field, (n), &o->field)
-  PHGMG__PUB(Bh, r * m); PHGMG__PUB(Qh, r * r); PHGMG__PUB(K, r * r);
-  PHGMG__PUB(G00, r * r); PHGMG__PUB(G01, r * rn); PHGMG__PUB(G10, rn * r); PHGMG__PUB(G11, rn * rn);
-  PHGMG__PUB(Q01, r * rn); PHGMG__PUB(Q11, rn * rn); PHGMG__PUB(Ms, rn * p * p);
-  PHGMG__PUB(P0, nd * r); PHGMG__PUB(P1, nd * rn); PHGMG__PUB(w, nd);
-  PHGMG__PUB(poly, (size_t)(o->poly_deg + 1));
-  PHGMG__PUB(Phi, r * r); PHGMG__PUB(Gam, r * 3 * m); PHGMG__PUB(SX, 3 * r * r); PHGMG__PUB(SU, 3 * r * 3 * m);
-#undef PHGMG__PUB
-  o->dt = red->Phi ? (phgmg_real)red->map_dt : (phgmg_real)0;
-  return rc;
+PHGMG_DEF size_t phgmg_rom_serialized_size(const phgmg_rom *rom) {
+  size_t n = 0;
+  int i;
+  for (i = 0; i < PHGMG__NFIELDS; ++i)
+    if (phgmg__field_get(rom, i)) n += phgmg__field_len(rom, i);
+  return PHGMG__HDR_BYTES + n * sizeof(phgmg_real) + 4;
 }
 
-PHGMG_DEF phgmg_result phgmg_reduce(phgmg_reduced **out, const phgmg_ph_system *sys, const double *X,
-                                    int ldx, int ns, const phgmg_reduce_opts *opts,
-                                    phgmg_reduce_info *info, const phgmg_allocator *alloc) {
-  phgmg_reduced *red = NULL;
-  phgmg_jr_factor *jr = NULL;
-  phgmg_reduce_info inf;
-  phgmg_result rc;
-  double *T1 = NULL, *T2 = NULL, *T3 = NULL; /* temporaries */
-  int *pts = NULL;
-  int N, m, r, p, rn = 0, k = 0, i, j, a;
-  double lambda, degtol;
-  if (!out || !sys || !X || !opts) return PHGMG_ERR_INVALID_ARG;
-  *out = NULL;
-  memset(&inf, 0, sizeof inf);
-  N = sys->N; m = sys->m; r = opts->r;
-  if (N < 1 || m < 1 || ns < 1 || ldx < N) return PHGMG_ERR_SIZE;
-  if (opts->method < PHGMG_METHOD_GMG_POD || opts->method > PHGMG_METHOD_SP2) return PHGMG_ERR_INVALID_ARG;
-  if (opts->method == PHGMG_METHOD_GMG_POD || opts->method == PHGMG_METHOD_GMG_QM) {
-    if (r <= m || r > N) return PHGMG_ERR_SIZE;
-  } else if (r < 1 || r > N || r > ns) {
-    return PHGMG_ERR_SIZE;
-  }
-  if (sys->nl == PHGMG_NL_GENERAL) return PHGMG_ERR_UNSUPPORTED;
-  if (sys->nl == PHGMG_NL_SEPARABLE && (sys->poly_deg < 1 || !sys->poly)) return PHGMG_ERR_UNSUPPORTED;
-  if (!phgmg__all_finite(X, (size_t)ldx * (size_t)(ns - 1) + (size_t)N)) return PHGMG_ERR_NANINF;
-  rc = phgmg_ph_validate(sys, 0.0, &inf.rcond_jr, alloc);
+PHGMG_DEF phgmg_result phgmg_rom_serialize(const phgmg_rom *rom, void *buf, size_t cap, size_t *written) {
+  unsigned char *b = PHGMG__CAST(unsigned char *, buf);
+  size_t need, o;
+  uint32_t mask = 0;
+  int i;
+  phgmg_result rc = phgmg_rom_check(rom);
   if (rc != PHGMG_OK) return rc;
-  lambda = opts->lambda == 0.0 ? 1e-3 : (opts->lambda < 0.0 ? 0.0 : opts->lambda);
-  degtol = opts->degeneracy_tol > 0.0 ? opts->degeneracy_tol : 1e-12;
-
-  red = PHGMG__CAST(phgmg_reduced *, phgmg__alloc(alloc, sizeof(phgmg_reduced)));
-  if (!red) return PHGMG_ERR_NOMEM;
-  memset(red, 0, sizeof *red);
-  if (alloc) { red->alloc = *alloc; red->use_alloc = 1; }
-  red->N = N; red->m = m; red->r = r; red->method = opts->method; red->sys = sys;
-  red->kind = opts->method == PHGMG_METHOD_GMG_QM ? PHGMG_ROM_QUADRATIC : PHGMG_ROM_LINEAR;
-  p = (opts->method == PHGMG_METHOD_GMG_POD || opts->method == PHGMG_METHOD_GMG_QM) ? r - m : r;
-  red->p = p;
-  if (red->kind == PHGMG_ROM_QUADRATIC) {
-    rn = opts->rn > 0 ? opts->rn : 8;
-    /* the online q/Lp buffers of lift/dphi hold up to 64 x 64 */
-    if (rn > N - r || rn > 64 || rn * p > 64 * 64) { rc = PHGMG_ERR_SIZE; goto fail; }
+  if (!buf) return PHGMG_ERR_INVALID_ARG;
+  need = phgmg_rom_serialized_size(rom);
+  if (cap < need) return PHGMG_ERR_WORKSPACE;
+  for (i = 0; i < PHGMG__NFIELDS; ++i)
+    if (phgmg__field_get(rom, i)) mask |= 1u << i;
+  memcpy(b, "PHGMGROM", 8);
+  phgmg__put32(b + 8, PHGMG_ROM_FORMAT_VERSION);
+  phgmg__put32(b + 12, (uint32_t)sizeof(phgmg_real));
+  phgmg__put32(b + 16, (uint32_t)rom->kind);
+  phgmg__put32(b + 20, (uint32_t)rom->method);
+  phgmg__put32(b + 24, (uint32_t)rom->r);
+  phgmg__put32(b + 28, (uint32_t)rom->m);
+  phgmg__put32(b + 32, (uint32_t)rom->rn);
+  phgmg__put32(b + 36, (uint32_t)rom->nd);
+  phgmg__put32(b + 40, (uint32_t)rom->poly_deg);
+  phgmg__put32(b + 44, mask);
+  phgmg__put_f64(b + 48, (double)rom->dt);
+  o = PHGMG__HDR_BYTES;
+  for (i = 0; i < PHGMG__NFIELDS; ++i) {
+    const phgmg_real *a = phgmg__field_get(rom, i);
+    size_t k, n = phgmg__field_len(rom, i);
+    if (!a) continue;
+    for (k = 0; k < n; ++k, o += sizeof(phgmg_real)) {
+#if PHGMG_REAL_IS_FLOAT
+      phgmg__put_f32(b + o, a[k]);
+#else
+      phgmg__put_f64(b + o, a[k]);
+#endif
+    }
   }
-  red->rn = rn;
-
-#define PHGMG__NEED(ptr) do { if (!(ptr)) { rc = PHGMG_ERR_NOMEM; goto fail; } } while (0)
-#define PHGMG__TRY(expr) do { rc = (expr); if (rc != PHGMG_OK) goto fail; } while (0)
-  red->V0 = phgmg__red_d(red, (size_t)N * r); PHGMG__NEED(red->V0);
-  red->QB = phgmg__red_d(red, (size_t)N * m); PHGMG__NEED(red->QB);
-  red->RB = phgmg__red_d(red, (size_t)m * m); PHGMG__NEED(red->RB);
-  PHGMG__TRY(phgmg__thin_qr(N, m, sys->B, red->QB, red->RB, alloc));
-  T1 = phgmg__dalloc(alloc, (size_t)N * ns); PHGMG__NEED(T1);
-
-  if (red->method == PHGMG_METHOD_GMG_POD || red->method == PHGMG_METHOD_GMG_QM) {
-    double *S = NULL;
-    /* V0 = [B, V1], V1 = POD of the adjusted snapshots X - B B^+ X */
-    for (j = 0; j < ns; ++j) memcpy(T1 + (size_t)j * N, X + (size_t)j * ldx, (size_t)N * sizeof(double));
-    T2 = phgmg__dalloc(alloc, (size_t)PHGMG__MAX(m, p + 1) * ns + (size_t)p + 2); PHGMG__NEED(T2);
-    phgmg__orth_remove(N, m, red->QB, ns, T1, N, T2);
-    memcpy(red->V0, sys->B, (size_t)N * m * sizeof(double));
-    S = T2 + (size_t)PHGMG__MAX(m, p + 1) * ns;
-    T3 = phgmg__dalloc(alloc, (size_t)N * (p + 1)); PHGMG__NEED(T3);
-    PHGMG__TRY(phgmg_pod(N, ns, T1, N, PHGMG__MIN(p + 1, PHGMG__MIN(N, ns)), 0.0, T3, N, S, &k, alloc));
-    if (k < p) { rc = PHGMG_ERR_SIZE; goto fail; } /* r - m > rank of the adjusted snapshots */
-    memcpy(red->V0 + (size_t)N * m, T3, (size_t)N * p * sizeof(double));
-    inf.pod_sigma_ratio = (k > p && S[0] > 0.0) ? S[p] / S[0] : 0.0;
-    phgmg__free(alloc, T3); T3 = NULL;
-    if (red->kind == PHGMG_ROM_QUADRATIC) {
-      double *Z2, *Rq, *Kt, *Rqt, *Mt;
-      const int pp = p * p;
-      /* residual of the linear part, then V2 = POD of it */
-      phgmg__orth_remove(N, p, red->V0 + (size_t)N * m, ns, T1, N, T2);
-      red->V2 = phgmg__red_d(red, (size_t)N * rn); PHGMG__NEED(red->V2);
-      PHGMG__TRY(phgmg_pod(N, ns, T1, N, rn, 0.0, red->V2, N, NULL, &k, alloc));
-      if (k < rn) { rc = PHGMG_ERR_SIZE; goto fail; }
-      /* M by the ridge problem over the reduced snapshot coordinates */
-      T3 = phgmg__dalloc(alloc, (size_t)p * ns + (size_t)rn * ns + (size_t)ns * pp + (size_t)ns * rn + (size_t)pp * rn);
-      PHGMG__NEED(T3);
-      Z2 = T3; Rq = Z2 + (size_t)p * ns; Kt = Rq + (size_t)rn * ns; Rqt = Kt + (size_t)ns * pp; Mt = Rqt + (size_t)ns * rn;
-      phgmg_gemm('T', 'N', p, ns, N, 1.0, red->V0 + (size_t)N * m, N, X, ldx, 0.0, Z2, p);
-      phgmg_gemm('T', 'N', rn, ns, N, 1.0, red->V2, N, T1, N, 0.0, Rq, rn);
-      for (i = 0; i < ns; ++i) {
-        for (a = 0; a < p; ++a)
-          for (j = 0; j < p; ++j) Kt[i + (size_t)(a * p + j) * ns] = Z2[a + (size_t)i * p] * Z2[j + (size_t)i * p];
-        for (a = 0; a < rn; ++a) Rqt[i + (size_t)a * ns] = Rq[a + (size_t)i * rn];
-      }
-      PHGMG__TRY(phgmg_lstsq(ns, pp, rn, Kt, ns, Rqt, ns, lambda, Mt, pp, alloc));
-      red->M = phgmg__red_d(red, (size_t)rn * pp); PHGMG__NEED(red->M);
-      red->Ms = phgmg__red_d(red, (size_t)rn * pp); PHGMG__NEED(red->Ms);
-      for (a = 0; a < pp; ++a)
-        for (i = 0; i < rn; ++i) red->M[i + (size_t)a * rn] = Mt[a + (size_t)i * pp];
-      for (a = 0; a < p; ++a)
-        for (j = 0; j < p; ++j)
-          for (i = 0; i < rn; ++i)
-            red->Ms[i + (size_t)(a * p + j) * rn] = red->M[i + (size_t)(a * p + j) * rn] + red->M[i + (size_t)(j * p + a) * rn];
-      phgmg__free(alloc, T3); T3 = NULL;
-    }
-    /* G-blocks through a factorization of J - R */
-    PHGMG__TRY(phgmg_jr_factor_create(&jr, sys, NULL, alloc));
-    phgmg__free(alloc, T2);
-    T2 = phgmg__dalloc(alloc, (size_t)N * (r + rn)); PHGMG__NEED(T2);
-    memcpy(T2, red->V0, (size_t)N * r * sizeof(double));
-    if (rn) memcpy(T2 + (size_t)N * r, red->V2, (size_t)N * rn * sizeof(double));
-    phgmg_jr_solve(jr, 'N', r + rn, T2, N);           /* T2 = G [V0, V2] */
-    red->G00 = phgmg__red_d(red, (size_t)r * r); PHGMG__NEED(red->G00);
-    phgmg__atb(N, r, r, red->V0, T2, red->G00);
-    if (rn) {
-      red->G01 = phgmg__red_d(red, (size_t)r * rn); PHGMG__NEED(red->G01);
-      red->G10 = phgmg__red_d(red, (size_t)rn * r); PHGMG__NEED(red->G10);
-      red->G11 = phgmg__red_d(red, (size_t)rn * rn); PHGMG__NEED(red->G11);
-      phgmg__atb(N, r, rn, red->V0, T2 + (size_t)N * r, red->G01);
-      phgmg__atb(N, rn, r, red->V2, T2, red->G10);
-      phgmg__atb(N, rn, rn, red->V2, T2 + (size_t)N * r, red->G11);
-    }
-    red->Bh = phgmg__red_d(red, (size_t)r * m); PHGMG__NEED(red->Bh);
-    for (j = 0; j < m; ++j) red->Bh[j + (size_t)j * r] = 1.0;
-    /* non-degeneracy of D^T G D: at x = 0 and (QM) at every snapshot */
-    inf.rcond_dgd = phgmg__rcond_of(r, red->G00, alloc);
-    if (inf.rcond_dgd < 0.0) { rc = PHGMG_ERR_NOMEM; goto fail; }
-    if (red->kind == PHGMG_ROM_QUADRATIC) {
-      double *Lp, *E, *tmp, *x2;
-      T3 = phgmg__dalloc(alloc, (size_t)rn * p + (size_t)r * r + (size_t)rn * r + (size_t)p); PHGMG__NEED(T3);
-      Lp = T3; E = Lp + (size_t)rn * p; tmp = E + (size_t)r * r; x2 = tmp + (size_t)rn * r;
-      for (i = 0; i < ns; ++i) {
-        double rc_i;
-        phgmg_gemv('T', N, p, 1.0, red->V0 + (size_t)N * m, N, X + (size_t)i * ldx, 0.0, x2);
-        phgmg__lp_d(rn, p, red->Ms, x2, Lp);
-        phgmg__dgd_d(red, Lp, E, tmp);
-        rc_i = phgmg__rcond_of(r, E, alloc);
-        if (rc_i < 0.0) { rc = PHGMG_ERR_NOMEM; goto fail; }
-        if (rc_i < inf.rcond_dgd) inf.rcond_dgd = rc_i;
-      }
-      phgmg__free(alloc, T3); T3 = NULL;
-    }
-    if (!(inf.rcond_dgd >= degtol)) { rc = PHGMG_ERR_DEGENERATE; goto fail; }
-    if (red->kind == PHGMG_ROM_LINEAR) {
-      red->K = phgmg__red_d(red, (size_t)r * r); PHGMG__NEED(red->K);
-      PHGMG__TRY(phgmg__inv(r, red->G00, red->K, alloc));
-    }
-  } else {
-    /* SP1 / SP2: V0 = V_POD (r modes of X), W as in NUMERICS 6.3-6.4 */
-    double *Vg, *Ainv, *A2;
-    T3 = phgmg__dalloc(alloc, (size_t)N * r * 2 + 2 * (size_t)r * r + (size_t)r + 1); PHGMG__NEED(T3);
-    Vg = T3; A2 = Vg + (size_t)N * r; Ainv = A2 + (size_t)r * r;
-    PHGMG__TRY(phgmg_pod(N, ns, X, ldx, r, 0.0, red->V0, N, NULL, &k, alloc));
-    if (k < r) { rc = PHGMG_ERR_SIZE; goto fail; }
-    if (red->method == PHGMG_METHOD_SP1) {
-      phgmg_ph_apply(sys, 'Q', r, red->V0, N, Vg, N);   /* Vg := Q V */
-    } else {
-      for (j = 0; j < ns; ++j) phgmg_ph_gradient(sys, X + (size_t)j * ldx, T1 + (size_t)j * N);
-      PHGMG__TRY(phgmg_pod(N, ns, T1, N, r, 0.0, Vg, N, NULL, &k, alloc));
-      if (k < r) { rc = PHGMG_ERR_SIZE; goto fail; }
-    }
-    phgmg__atb(N, r, r, red->V0, Vg, A2);               /* V^T Vg */
-    inf.rcond_dgd = phgmg__rcond_of(r, A2, alloc);
-    if (!(inf.rcond_dgd >= degtol)) { rc = PHGMG_ERR_DEGENERATE; goto fail; }
-    PHGMG__TRY(phgmg__inv(r, A2, Ainv, alloc));
-    red->W = phgmg__red_d(red, (size_t)N * r); PHGMG__NEED(red->W);
-    phgmg_gemm('N', 'N', N, r, r, 1.0, Vg, N, Ainv, r, 0.0, red->W, N); /* W = Vg (V^T Vg)^{-1} */
-    /* K = W^T (J - R) W, Bh = W^T B */
-    phgmg_ph_apply(sys, 'J', r, red->W, N, Vg, N);
-    phgmg_ph_apply(sys, 'R', r, red->W, N, T1, N);
-    for (i = 0; i < N * r; ++i) Vg[i] -= T1[i];
-    red->K = phgmg__red_d(red, (size_t)r * r); PHGMG__NEED(red->K);
-    phgmg__atb(N, r, r, red->W, Vg, red->K);
-    red->Bh = phgmg__red_d(red, (size_t)r * m); PHGMG__NEED(red->Bh);
-    phgmg__atb(N, r, m, red->W, sys->B, red->Bh);
-    phgmg__free(alloc, T3); T3 = NULL;
-  }
-
-  /* quadratic part of H: Qh = V0^T Q V0 (and the V2 blocks) */
-  phgmg__free(alloc, T2);
-  T2 = phgmg__dalloc(alloc, (size_t)N * (r + rn)); PHGMG__NEED(T2);
-  phgmg_ph_apply(sys, 'Q', r, red->V0, N, T2, N);
-  if (rn) phgmg_ph_apply(sys, 'Q', rn, red->V2, N, T2 + (size_t)N * r, N);
-  red->Qh = phgmg__red_d(red, (size_t)r * r); PHGMG__NEED(red->Qh);
-  phgmg__atb(N, r, r, red->V0, T2, red->Qh);
-  for (j = 0; j < r; ++j)   /* exact symmetry */
-    for (i = 0; i < j; ++i) red->Qh[i + (size_t)j * r] = red->Qh[j + (size_t)i * r] = 0.5 * (red->Qh[i + (size_t)j * r] + red->Qh[j + (size_t)i * r]);
-  if (rn) {
-    red->Q01 = phgmg__red_d(red, (size_t)r * rn); PHGMG__NEED(red->Q01);
-    red->Q11 = phgmg__red_d(red, (size_t)rn * rn); PHGMG__NEED(red->Q11);
-    phgmg__atb(N, r, rn, red->V0, T2 + (size_t)N * r, red->Q01);
-    phgmg__atb(N, rn, rn, red->V2, T2 + (size_t)N * r, red->Q11);
-  }
-
-  /* separable nonlinear part: structure-preserving DEIM or every term */
-  if (sys->nl == PHGMG_NL_SEPARABLE && sys->nsep > 0) {
-    const int nt = sys->nsep;
-    int nd = 0, nneg = 0;
-    double *wt;
-    pts = phgmg__ialloc(alloc, (size_t)nt); PHGMG__NEED(pts);
-    wt = phgmg__dalloc(alloc, (size_t)nt); PHGMG__NEED(wt);
-    if (opts->deim) {
-      double *F = phgmg__dalloc(alloc, (size_t)nt * ns);
-      if (!F) { phgmg__free(alloc, wt); rc = PHGMG_ERR_NOMEM; goto fail; }
-      for (i = 0; i < ns; ++i)
-        for (a = 0; a < nt; ++a)
-          F[a + (size_t)i * nt] = phgmg__poly_d1(sys->poly, sys->poly_deg, X[sys->sep_idx[a] + (size_t)i * ldx]);
-      rc = phgmg_deim(nt, ns, F, nt, sys->sep_w, opts->deim_tol, opts->deim_max, pts, wt, &nd, &nneg,
-                      &inf.deim_sigma_ratio, alloc);
-      phgmg__free(alloc, F);
-      if (rc == PHGMG_OK && nneg > 0 && !opts->deim_allow_negative) rc = PHGMG_ERR_NEGATIVE_WEIGHT;
-      if (rc != PHGMG_OK) { phgmg__free(alloc, wt); goto fail; }
-    } else {
-      nd = nt;
-      for (a = 0; a < nt; ++a) { pts[a] = a; wt[a] = sys->sep_w ? sys->sep_w[a] : 1.0; }
-    }
-    inf.deim_modes = nd;
-    inf.deim_negative = nneg;
-    red->nd = nd;
-    red->coord = PHGMG__CAST(int *, phgmg__red_alloc(red, (size_t)nd * sizeof(int)));
-    red->w = phgmg__red_d(red, (size_t)nd);
-    red->P0 = phgmg__red_d(red, (size_t)nd * r);
-    red->P1 = rn ? phgmg__red_d(red, (size_t)nd * rn) : NULL;
-    red->poly = phgmg__red_d(red, (size_t)sys->poly_deg + 1);
-    if (!red->coord || !red->w || !red->P0 || (rn && !red->P1) || !red->poly) {
-      phgmg__free(alloc, wt); rc = PHGMG_ERR_NOMEM; goto fail;
-    }
-    for (j = 0; j < nd; ++j) {
-      const int cj = sys->sep_idx[pts[j]];
-      red->coord[j] = cj;
-      red->w[j] = wt[j];
-      for (a = 0; a < r; ++a) red->P0[j + (size_t)a * nd] = red->V0[cj + (size_t)a * N];
-      for (a = 0; a < rn; ++a) red->P1[j + (size_t)a * nd] = red->V2[cj + (size_t)a * N];
-    }
-    memcpy(red->poly, sys->poly, ((size_t)sys->poly_deg + 1) * sizeof(double));
-    phgmg__free(alloc, wt);
-  }
-  if (opts->dt > 0.0 && red->kind == PHGMG_ROM_LINEAR && red->nd == 0) {
-    red->map_dt = opts->dt;
-    PHGMG__TRY(phgmg__step_map(red, opts->dt, alloc));
-  }
-  PHGMG__TRY(phgmg__publish(red));
-#undef PHGMG__NEED
-#undef PHGMG__TRY
-  phgmg_jr_factor_destroy(jr);
-  phgmg__free(alloc, T1); phgmg__free(alloc, T2); phgmg__free(alloc, T3); phgmg__free(alloc, pts);
-  if (info) *info = inf;
-  *out = red;
+  phgmg__put32(b + o, phgmg__fnv1a(b, o));
+  if (written) *written = o + 4;
   return PHGMG_OK;
-fail:
-  phgmg_jr_factor_destroy(jr);
-  phgmg__free(alloc, T1); phgmg__free(alloc, T2); phgmg__free(alloc, T3); phgmg__free(alloc, pts);
-  phgmg_reduced_destroy(red);
-  if (info) *info = inf;
-  return rc;
 }
 
-PHGMG_DEF void phgmg_reduced_lift(const phgmg_reduced *red, const double *xr, double *x) {
-  phgmg_gemv('N', red->N, red->r, 1.0, red->V0, red->N, xr, 0.0, x);
-  if (red->kind == PHGMG_ROM_QUADRATIC) {
-    /* q = M (x2 kron x2) */
-    const int p = red->p, rn = red->rn;
-    const double *x2 = xr + red->m;
-    double q[64];
-    int i, a, j;
-    for (i = 0; i < rn && i < 64; ++i) {
-      double s = 0.0;
-      for (a = 0; a < p; ++a)
-        for (j = 0; j < p; ++j) s += red->M[i + (size_t)(a * p + j) * rn] * x2[a] * x2[j];
-      q[i] = s;
+/* Parse and validate the header; fills rom's scalars and returns the scalar
+   count of the payload and the file's scalar size. */
+PHGMG__ONLINE phgmg_result phgmg__rom_header(const unsigned char *b, size_t len, phgmg_rom *rom,
+                                             size_t *nscal, size_t *ssize, uint32_t *mask_out) {
+  uint32_t ver, ss, mask;
+  size_t n = 0, total;
+  int i;
+  if (!b) return PHGMG_ERR_INVALID_ARG;
+  if (len < PHGMG__HDR_BYTES + 4 || memcmp(b, "PHGMGROM", 8) != 0) return PHGMG_ERR_FORMAT;
+  ver = phgmg__get32(b + 8);
+  ss = phgmg__get32(b + 12);
+  if (ver != PHGMG_ROM_FORMAT_VERSION || (ss != 4 && ss != 8)) return PHGMG_ERR_FORMAT;
+  memset(rom, 0, sizeof *rom);
+  if (phgmg__get32(b + 24) > 4096u || phgmg__get32(b + 28) > 4096u || phgmg__get32(b + 32) > 4096u ||
+      phgmg__get32(b + 36) > (1u << 24) || phgmg__get32(b + 40) > 32u || phgmg__get32(b + 16) > 2u ||
+      phgmg__get32(b + 20) > 4u)
+    return PHGMG_ERR_FORMAT;
+  rom->kind = (int)phgmg__get32(b + 16);
+  rom->method = (int)phgmg__get32(b + 20);
+  rom->r = (int)phgmg__get32(b + 24);
+  rom->m = (int)phgmg__get32(b + 28);
+  rom->rn = (int)phgmg__get32(b + 32);
+  rom->nd = (int)phgmg__get32(b + 36);
+  rom->poly_deg = (int)phgmg__get32(b + 40);
+  mask = phgmg__get32(b + 44);
+  {
+    double dt = phgmg__get_f64(b + 48);
+    if (!(dt >= 0.0) || dt > 1e300) return PHGMG_ERR_FORMAT;
+    rom->dt = (phgmg_real)dt;
+  }
+  if (mask >> PHGMG__NFIELDS) return PHGMG_ERR_FORMAT;
+  if (rom->m > rom->r) return PHGMG_ERR_FORMAT;
+  for (i = 0; i < PHGMG__NFIELDS; ++i)
+    if (mask & (1u << i)) {
+      size_t k = phgmg__field_len(rom, i);
+      if (k > ((size_t)1 << 40)) return PHGMG_ERR_FORMAT;
+      n += k;
     }
-    phgmg_gemv('N', red->N, PHGMG__MIN(rn, 64), 1.0, red->V2, red->N, q, 1.0, x);
-  }
+  if (n > (len / ss)) return PHGMG_ERR_FORMAT;
+  total = PHGMG__HDR_BYTES + n * ss + 4;
+  if (total != len) return PHGMG_ERR_FORMAT;
+  if (phgmg__get32(b + total - 4) != phgmg__fnv1a(b, total - 4)) return PHGMG_ERR_FORMAT;
+  *nscal = n;
+  *ssize = ss;
+  *mask_out = mask;
+  return PHGMG_OK;
 }
 
-PHGMG_DEF void phgmg_reduced_restrict(const phgmg_reduced *red, const double *x, double *xr) {
-  const int N = red->N, m = red->m, r = red->r;
-  if (red->method == PHGMG_METHOD_SP1 || red->method == PHGMG_METHOD_SP2) {
-    phgmg_gemv('T', N, r, 1.0, red->W, N, x, 0.0, xr);
-  } else {
-    /* [B, V1]^+ x = [RB^{-1} QB^T x; V1^T x]  (V1 is orthogonal to B) */
-    int i, j;
-    phgmg_gemv('T', N, m, 1.0, red->QB, N, x, 0.0, xr);
-    for (i = m - 1; i >= 0; --i) {
-      double s = xr[i];
-      for (j = i + 1; j < m; ++j) s -= red->RB[i + j * m] * xr[j];
-      xr[i] = s / red->RB[i + i * m];
-    }
-    phgmg_gemv('T', N, r - m, 1.0, red->V0 + (size_t)N * m, N, x, 0.0, xr + m);
-  }
+PHGMG_DEF phgmg_result phgmg_rom_deserialize_size(const void *buf, size_t len, size_t *need) {
+  phgmg_rom tmp;
+  size_t n = 0, ss = 0;
+  uint32_t mask = 0;
+  phgmg_result rc = phgmg__rom_header(PHGMG__CAST(const unsigned char *, buf), len, &tmp, &n, &ss, &mask);
+  if (rc != PHGMG_OK) return rc;
+  if (need) *need = n * sizeof(phgmg_real) + sizeof(phgmg_real);
+  return PHGMG_OK;
 }
 
-PHGMG_DEF void phgmg_reduced_dphi(const phgmg_reduced *red, const double *xr, double *D, int ldd) {
-  const int N = red->N, r = red->r, m = red->m;
-  int j;
-  for (j = 0; j < r; ++j) memcpy(D + (size_t)j * ldd, red->V0 + (size_t)j * N, (size_t)N * sizeof(double));
-  if (red->kind == PHGMG_ROM_QUADRATIC) {
-    double Lp[64 * 64];
-    const int p = red->p, rn = red->rn;
-    if (rn * p > 64 * 64) return;
-    phgmg__lp_d(rn, p, red->Ms, xr + m, Lp);
-    phgmg_gemm('N', 'N', N, p, rn, 1.0, red->V2, N, Lp, rn, 1.0, D + (size_t)m * ldd, ldd);
-  }
-}
-
-PHGMG_DEF phgmg_result phgmg_reduced_W(const phgmg_reduced *red, const double *xr, double *W, int ldw) {
-  const int N = red->N, r = red->r;
-  phgmg_jr_factor *jr = NULL;
-  const phgmg_allocator *alloc = red->use_alloc ? &red->alloc : NULL;
-  double *D, *GtD, *E, *Einv;
+PHGMG_DEF phgmg_result phgmg_rom_deserialize(const void *buf, size_t len, phgmg_rom *rom, void *mem,
+                                             size_t mem_size) {
+  const unsigned char *b = PHGMG__CAST(const unsigned char *, buf);
+  phgmg_rom tmp;
+  size_t n = 0, ss = 0, o = PHGMG__HDR_BYTES, k;
+  uint32_t mask = 0;
+  phgmg_real *dst = PHGMG__CAST(phgmg_real *, mem);
   phgmg_result rc;
-  int j;
-  if (red->method == PHGMG_METHOD_SP1 || red->method == PHGMG_METHOD_SP2) {
-    for (j = 0; j < r; ++j) memcpy(W + (size_t)j * ldw, red->W + (size_t)j * N, (size_t)N * sizeof(double));
-    return PHGMG_OK;
+  int i;
+  if (!rom || !mem) return PHGMG_ERR_INVALID_ARG;
+  rc = phgmg__rom_header(b, len, &tmp, &n, &ss, &mask);
+  if (rc != PHGMG_OK) return rc;
+  if (mem_size < n * sizeof(phgmg_real) + sizeof(phgmg_real)) return PHGMG_ERR_WORKSPACE;
+  if (((size_t)mem) % sizeof(phgmg_real) != 0) return PHGMG_ERR_INVALID_ARG;
+  for (i = 0; i < PHGMG__NFIELDS; ++i) {
+    const size_t len_i = phgmg__field_len(&tmp, i);
+    if (!(mask & (1u << i))) { *phgmg__field_ptr(&tmp, i) = NULL; continue; }
+    for (k = 0; k < len_i; ++k, o += ss)
+      dst[k] = ss == 8 ? (phgmg_real)phgmg__get_f64(b + o) : (phgmg_real)phgmg__get_f32(b + o);
+    if (!phgmg__r_finite(dst, (int)len_i)) return PHGMG_ERR_FORMAT;
+    *phgmg__field_ptr(&tmp, i) = dst;
+    dst += len_i;
   }
-  D = phgmg__dalloc(alloc, 2 * (size_t)N * r + 2 * (size_t)r * r);
-  if (!D) return PHGMG_ERR_NOMEM;
-  GtD = D + (size_t)N * r; E = GtD + (size_t)N * r; Einv = E + (size_t)r * r;
-  phgmg_reduced_dphi(red, xr, D, N);
-  memcpy(GtD, D, (size_t)N * r * sizeof(double));
-  rc = phgmg_jr_factor_create(&jr, red->sys, NULL, alloc);
+  rc = phgmg_rom_check(&tmp);
+  if (rc != PHGMG_OK) return PHGMG_ERR_FORMAT;
+  /* fields required by the kind must be present, others absent */
+  if ((tmp.kind == PHGMG_ROM_QUADRATIC) != (tmp.Ms != NULL) || (tmp.nd == 0 && (tmp.P0 || tmp.w)))
+    return PHGMG_ERR_FORMAT;
+  *rom = tmp;
+  return PHGMG_OK;
+}
+
+#if !defined(PHGMG_NO_STDIO) && !defined(PHGMG_NO_OFFLINE)
+#include <stdio.h>
+PHGMG_DEF phgmg_result phgmg_rom_save(const phgmg_rom *rom, const char *path) {
+  size_t n, w = 0;
+  void *buf;
+  FILE *f;
+  phgmg_result rc = phgmg_rom_check(rom);
+  if (rc != PHGMG_OK) return rc;
+  if (!path) return PHGMG_ERR_INVALID_ARG;
+  n = phgmg_rom_serialized_size(rom);
+  buf = phgmg__alloc(NULL, n);
+  if (!buf) return PHGMG_ERR_NOMEM;
+  rc = phgmg_rom_serialize(rom, buf, n, &w);
   if (rc == PHGMG_OK) {
-    phgmg_jr_solve(jr, 'T', r, GtD, N);                      /* G^T D */
-    phgmg__atb(N, r, r, GtD, D, E);                           /* (G^T D)^T D = D^T G D */
-    rc = phgmg__inv(r, E, Einv, alloc);
-    if (rc == PHGMG_OK)                                       /* W = G^T D E^{-T} */
-      phgmg_gemm('N', 'T', N, r, r, 1.0, GtD, N, Einv, r, 0.0, W, ldw);
+    f = fopen(path, "wb");
+    if (!f) rc = PHGMG_ERR_IO;
+    else {
+      if (fwrite(buf, 1, w, f) != w) rc = PHGMG_ERR_IO;
+      if (fclose(f) != 0) rc = PHGMG_ERR_IO;
+    }
   }
-  phgmg_jr_factor_destroy(jr);
-  phgmg__free(alloc, D);
+  phgmg__free(NULL, buf);
   return rc;
 }
 
-PHGMG_DEF phgmg_result phgmg_reduced_simulate(const phgmg_reduced *red, const double *xr0, double t0,
-                                              double dt, int nsteps, phgmg_input_fn uf, void *uuser,
-                                              double tol, int max_iter, double *XR, double *Y,
-                                              const phgmg_energy *energy, phgmg_rom_stats *stats,
-                                              const phgmg_allocator *alloc) {
-  const phgmg_rom *rom;
-  phgmg_rom_stepper st;
-  size_t msz, nreal;
-  void *mem;
-  phgmg_real *x, *u3, *y, *ework, en[2];
-  double S = 0.0, D = 0.0;
-  int r, m, n, i, a;
+PHGMG_DEF phgmg_result phgmg_rom_load(const char *path, phgmg_rom *rom, void **block,
+                                      const phgmg_allocator *alloc) {
+  FILE *f;
+  long len;
+  unsigned char *buf = NULL;
+  void *mem = NULL;
+  size_t need = 0;
   phgmg_result rc;
-  if (!red || !xr0 || nsteps < 0 || !(dt > 0.0)) return PHGMG_ERR_INVALID_ARG;
-  rom = &red->rom; r = rom->r; m = rom->m;
-  msz = phgmg_rom_stepper_memsize(rom);
-  nreal = (size_t)r + 4 * (size_t)m + phgmg_rom_eval_work_size(rom);
-  mem = phgmg__alloc(alloc, ((msz + 15) / 16) * 16 + nreal * sizeof(phgmg_real));
-  if (!mem) return PHGMG_ERR_NOMEM;
-  x = PHGMG__CAST(phgmg_real *, PHGMG__CAST(void *, PHGMG__CAST(char *, mem) + ((msz + 15) / 16) * 16));
-  u3 = x + r; y = u3 + 3 * m; ework = y + m;
-  rc = phgmg_rom_stepper_init(&st, rom, (phgmg_real)dt, (phgmg_real)tol, max_iter, mem, msz);
+  if (!path || !rom || !block) return PHGMG_ERR_INVALID_ARG;
+  *block = NULL;
+  f = fopen(path, "rb");
+  if (!f) return PHGMG_ERR_IO;
+  if (fseek(f, 0, SEEK_END) != 0 || (len = ftell(f)) < 0 || fseek(f, 0, SEEK_SET) != 0) { fclose(f); return PHGMG_ERR_IO; }
+  if (len > (1L << 30)) { fclose(f); return PHGMG_ERR_FORMAT; }
+  buf = PHGMG__CAST(unsigned char *, phgmg__alloc(alloc, (size_t)len));
+  if (!buf) { fclose(f); return PHGMG_ERR_NOMEM; }
+  if (fread(buf, 1, (size_t)len, f) != (size_t)len) { fclose(f); phgmg__free(alloc, buf); return PHGMG_ERR_IO; }
+  fclose(f);
+  rc = phgmg_rom_deserialize_size(buf, (size_t)len, &need);
+  if (rc == PHGMG_OK) {
+    mem = phgmg__alloc(alloc, need);
+    if (!mem) rc = PHGMG_ERR_NOMEM;
+    else rc = phgmg_rom_deserialize(buf, (size_t)len, rom, mem, need);
+  }
+  phgmg__free(alloc, buf);
   if (rc != PHGMG_OK) { phgmg__free(alloc, mem); return rc; }
-  for (a = 0; a < r; ++a) x[a] = (phgmg_real)xr0[a];
-#define PHGMG__REC(nn) do { \
-    if (XR) for (a = 0; a < r; ++a) XR[a + (size_t)(nn) * r] = (double)x[a]; \
-    if (Y) { phgmg_rom_output(rom, x, y, ework); for (a = 0; a < m; ++a) Y[a + (size_t)(nn) * m] = (double)y[a]; } \
-    if (energy) { energy->H[nn] = (double)phgmg_rom_hamiltonian(rom, x, ework); energy->S[nn] = S; energy->D[nn] = D; } \
-  } while (0)
-  PHGMG__REC(0);
-  for (n = 0; n < nsteps; ++n) {
-    const double t = t0 + n * dt;
-    double ubuf[16];
-    const double s15 = sqrt(15.0) / 10.0, cs[3] = {0.5 - s15, 0.5, 0.5 + s15};
-    for (i = 0; i < 3; ++i) {
-      if (uf && m <= 16) {
-        uf(t + cs[i] * dt, ubuf, uuser);
-        for (a = 0; a < m; ++a) u3[i * m + a] = (phgmg_real)ubuf[a];
-      } else {
-        for (a = 0; a < m; ++a) u3[i * m + a] = (phgmg_real)0;
-      }
-    }
-    en[0] = en[1] = (phgmg_real)0;
-    rc = phgmg_rom_step(&st, x, u3, NULL, energy ? en : NULL);
-    if (rc != PHGMG_OK) break;
-    S += (double)en[0];
-    D += (double)en[1];
-    PHGMG__REC(n + 1);
+  *block = mem;
+  return PHGMG_OK;
+}
+
+PHGMG_DEF phgmg_result phgmg_rom_export_c(const phgmg_rom *rom, const char *name, const char *path) {
+  FILE *f;
+  int i, ok = 1;
+  size_t k;
+  phgmg_result rc = phgmg_rom_check(rom);
+  if (rc != PHGMG_OK) return rc;
+  if (!name || !path) return PHGMG_ERR_INVALID_ARG;
+  f = fopen(path, "w");
+  if (!f) return PHGMG_ERR_IO;
+  ok &= fprintf(f, "/* Reduced port-Hamiltonian model exported by phgmg %s.\n"
+                   "   kind %d, method %d, r = %d, m = %d, r_n = %d, DEIM points = %d.\n"
+                   "   Include after phgmg.h; build with the same scalar type. */\n",
+                PHGMG_VERSION_STRING, rom->kind, rom->method, rom->r, rom->m, rom->rn, rom->nd) > 0;
+  ok &= fprintf(f, "#if PHGMG_REAL_IS_FLOAT != %d\n#error \"%s was exported for phgmg_real = %s\"\n#endif\n",
+                PHGMG_REAL_IS_FLOAT, name, PHGMG_REAL_IS_FLOAT ? "float" : "double") > 0;
+  for (i = 0; i < PHGMG__NFIELDS; ++i) {
+    const phgmg_real *a = phgmg__field_get(rom, i);
+    const size_t n = phgmg__field_len(rom, i);
+    if (!a) continue;
+    ok &= fprintf(f, "static const phgmg_real %s_%s[%lu] = {", name, phgmg__fields[i].name, (unsigned long)n) > 0;
+    for (k = 0; k < n; ++k)
+#if PHGMG_REAL_IS_FLOAT
+      ok &= fprintf(f, "%s%.9gf", k % 6 ? ", " : "\n  ", (double)a[k]) > 0;
+#else
+      ok &= fprintf(f, "%s%.17g", k % 4 ? ", " : "\n  ", a[k]) > 0;
+#endif
+    ok &= fprintf(f, "};\n") > 0;
   }
-#undef PHGMG__REC
-  if (stats) *stats = st.stats;
-  phgmg__free(alloc, mem);
-  return rc;
-}
-
-/* --- error measures ------------------------------------------------------ */
-PHGMG_DEF double phgmg_rel_error(int n, int ns, const double *A, int lda, const double *B, int ldb) {
-  double num = 0.0, den = 0.0;
-  int i, j;
-  for (j = 0; j < ns; ++j)
-    for (i = 0; i < n; ++i) {
-      const double a = A[i + (size_t)j * lda], d = a - B[i + (size_t)j * ldb];
-      num += d * d;
-      den += a * a;
-    }
-  return den > 0.0 ? sqrt(num / den) : (num > 0.0 ? (double)INFINITY : 0.0);
-}
-
-/* sqrt(sum ||x_i - g(x_i)||^2 / sum ||x_i||^2) with g applied column-wise. */
-PHGMG__PRIV double phgmg__err_map(const phgmg_reduced *red, const double *X, int ldx, int ns,
-                                  const double *XR, int ldxr, int mode) {
-  const int N = red->N, r = red->r;
-  const phgmg_allocator *alloc = red->use_alloc ? &red->alloc : NULL;
-  double *xt = phgmg__dalloc(alloc, (size_t)N + (size_t)r + (size_t)(r + red->rn)), *xr;
-  double num = 0.0, den = 0.0;
-  int i, j;
-  if (!xt) return (double)NAN;
-  xr = xt + N;
-  for (j = 0; j < ns; ++j) {
-    const double *x = X + (size_t)j * ldx;
-    if (mode == 0) {            /* reduction error: phi(XR_j) */
-      phgmg_reduced_lift(red, XR + (size_t)j * ldxr, xt);
-    } else if (mode == 1) {     /* projection error: phi(rho(x)) */
-      phgmg_reduced_restrict(red, x, xr);
-      phgmg_reduced_lift(red, xr, xt);
-    } else {                    /* lower bound: orthogonal projection on [B, V1, V2] */
-      double *c = xr;
-      memcpy(xt, x, (size_t)N * sizeof(double));
-      phgmg__orth_remove(N, red->m, red->QB, 1, xt, N, c);
-      phgmg__orth_remove(N, red->r - red->m, red->V0 + (size_t)N * red->m, 1, xt, N, c);
-      phgmg__orth_remove(N, red->rn, red->V2, 1, xt, N, c);
-      for (i = 0; i < N; ++i) xt[i] = x[i] - xt[i];
-    }
-    for (i = 0; i < N; ++i) {
-      const double d = x[i] - xt[i];
-      num += d * d;
-      den += x[i] * x[i];
-    }
+  ok &= fprintf(f, "static const phgmg_rom %s = {\n  %d, %d, %d, %d, %d, %d, %d,\n ", name, rom->kind,
+                rom->method, rom->r, rom->m, rom->rn, rom->nd, rom->poly_deg) > 0;
+  for (i = 0; i < 14; ++i) {
+    if (phgmg__field_get(rom, i)) ok &= fprintf(f, " %s_%s,", name, phgmg__fields[i].name) > 0;
+    else ok &= fprintf(f, " NULL,") > 0;
   }
-  phgmg__free(alloc, xt);
-  return den > 0.0 ? sqrt(num / den) : 0.0;
+#if PHGMG_REAL_IS_FLOAT
+  ok &= fprintf(f, "\n  %.9gf,\n ", (double)rom->dt) > 0;
+#else
+  ok &= fprintf(f, "\n  %.17g,\n ", rom->dt) > 0;
+#endif
+  for (i = 14; i < PHGMG__NFIELDS; ++i) {
+    if (phgmg__field_get(rom, i)) ok &= fprintf(f, " %s_%s%s", name, phgmg__fields[i].name, i + 1 < PHGMG__NFIELDS ? "," : "") > 0;
+    else ok &= fprintf(f, " NULL%s", i + 1 < PHGMG__NFIELDS ? "," : "") > 0;
+  }
+  ok &= fprintf(f, "\n};\n") > 0;
+  if (fclose(f) != 0) ok = 0;
+  return ok ? PHGMG_OK : PHGMG_ERR_IO;
 }
-
-PHGMG_DEF double phgmg_err_red(const phgmg_reduced *red, const double *X, int ldx, int ns,
-                               const double *XR, int ldxr) {
-  return phgmg__err_map(red, X, ldx, ns, XR, ldxr, 0);
-}
-PHGMG_DEF double phgmg_err_proj(const phgmg_reduced *red, const double *X, int ldx, int ns) {
-  return phgmg__err_map(red, X, ldx, ns, NULL, 0, 1);
-}
-PHGMG_DEF double phgmg_err_lowerbound(const phgmg_reduced *red, const double *X, int ldx, int ns) {
-  if (red->kind != PHGMG_ROM_QUADRATIC) return (double)NAN;
-  return phgmg__err_map(red, X, ldx, ns, NULL, 0, 2);
-}
-PHGMG_DEF void phgmg_err_energy(const phgmg_energy *energy, int nsteps, double *e) {
-  int n;
-  for (n = 0; n <= nsteps; ++n) e[n] = fabs(energy->H[n] - energy->H[0] - energy->S[n] + energy->D[n]);
-}
-#endif /* PHGMG_NO_OFFLINE */
+#endif
 
 /* >>npy (implementation) ================================================== */
 #ifndef PHGMG_NO_OFFLINE

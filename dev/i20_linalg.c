@@ -81,46 +81,70 @@ PHGMG_DEF void phgmg_gemv(char trans, int m, int n, double alpha, const double *
 }
 
 #ifndef PHGMG_USE_CBLAS
-/* Block sizes of the portable gemm: an MC x KC panel of op(A) is packed
-   column-major (contiguous), then multiplied into C column by column in a
-   4-column register micro-kernel. */
+/* Portable GEMM: a block of op(A) (MC x KC) is packed into 8-row slivers (on
+   the stack, MC*KC doubles), then 8 x 6 tiles of C are computed by a
+   register-blocked micro-kernel that streams the matching 6 columns of op(B)
+   directly from B. With GCC/Clang the micro-kernel uses vector extensions
+   (define PHGMG_NO_VECTOR_EXT to get the plain C version). */
 #ifndef PHGMG_GEMM_MC
-#define PHGMG_GEMM_MC 64
+#define PHGMG_GEMM_MC 64 /* multiple of 8 */
 #endif
 #ifndef PHGMG_GEMM_KC
-#define PHGMG_GEMM_KC 128
+#define PHGMG_GEMM_KC 256
 #endif
+#define PHGMG__MR 8
+#define PHGMG__NR 6
 
-/* C(0:m,0:n) += Ap(m x kc, packed, ld m) * op(B)(kc x n) */
-PHGMG__PRIV void phgmg__gemm_kernel(int m, int n, int kc, const double *Ap, const double *B,
-                                    int ldb, int tb, double alpha, double *C, int ldc) {
-  int i, j, p;
-  for (j = 0; j + 4 <= n; j += 4) {
-    double *c0 = C + (size_t)j * (size_t)ldc, *c1 = c0 + ldc, *c2 = c1 + ldc, *c3 = c2 + ldc;
-    for (p = 0; p < kc; ++p) {
-      const double *a = Ap + (size_t)p * (size_t)m;
-      double b0, b1, b2, b3;
-      if (!tb) {
-        const double *bp = B + p + (size_t)j * (size_t)ldb;
-        b0 = bp[0]; b1 = bp[ldb]; b2 = bp[2 * (size_t)ldb]; b3 = bp[3 * (size_t)ldb];
-      } else {
-        const double *bp = B + j + (size_t)p * (size_t)ldb;
-        b0 = bp[0]; b1 = bp[1]; b2 = bp[2]; b3 = bp[3];
-      }
-      b0 *= alpha; b1 *= alpha; b2 *= alpha; b3 *= alpha;
-      for (i = 0; i < m; ++i) {
-        double av = a[i];
-        c0[i] += av * b0; c1[i] += av * b1; c2[i] += av * b2; c3[i] += av * b3;
-      }
-    }
+/* C(0:mr, 0:nr) += alpha * Ap * op(B)(0:kc, 0:nr), Ap packed (Ap[8p + i]);
+   op(B)(p, j) = B[p*bsp + j*bsj]. mr <= 8, nr <= 6. */
+PHGMG__PRIV void phgmg__gemm_micro(int kc, const double *Ap, const double *B, size_t bsp,
+                                   size_t bsj, int mr, int nr, double alpha, double *C, int ldc) {
+  double tile[PHGMG__MR * PHGMG__NR];
+  const double *b0 = B, *b1 = B + (nr > 1 ? bsj : 0), *b2 = B + (nr > 2 ? 2 * bsj : 0);
+  const double *b3 = B + (nr > 3 ? 3 * bsj : 0), *b4 = B + (nr > 4 ? 4 * bsj : 0);
+  const double *b5 = B + (nr > 5 ? 5 * bsj : 0);
+  int p, i, j;
+#if (defined(__GNUC__) || defined(__clang__)) && !defined(PHGMG_NO_VECTOR_EXT)
+  typedef double phgmg__v4 __attribute__((vector_size(32)));
+  phgmg__v4 c00, c01, c10, c11, c20, c21, c30, c31, c40, c41, c50, c51, a0, a1;
+  memset(&c00, 0, sizeof c00);
+  c01 = c10 = c11 = c20 = c21 = c30 = c31 = c40 = c41 = c50 = c51 = c00;
+  for (p = 0; p < kc; ++p) {
+    size_t o = (size_t)p * bsp;
+    double x;
+    memcpy(&a0, Ap, sizeof a0);
+    memcpy(&a1, Ap + 4, sizeof a1);
+    Ap += PHGMG__MR;
+    x = b0[o]; c00 += a0 * x; c01 += a1 * x;
+    x = b1[o]; c10 += a0 * x; c11 += a1 * x;
+    x = b2[o]; c20 += a0 * x; c21 += a1 * x;
+    x = b3[o]; c30 += a0 * x; c31 += a1 * x;
+    x = b4[o]; c40 += a0 * x; c41 += a1 * x;
+    x = b5[o]; c50 += a0 * x; c51 += a1 * x;
   }
-  for (; j < n; ++j) {
-    double *c0 = C + (size_t)j * (size_t)ldc;
-    for (p = 0; p < kc; ++p) {
-      const double *a = Ap + (size_t)p * (size_t)m;
-      double b0 = alpha * (tb ? B[j + (size_t)p * (size_t)ldb] : B[p + (size_t)j * (size_t)ldb]);
-      for (i = 0; i < m; ++i) c0[i] += a[i] * b0;
+  memcpy(tile + 0, &c00, sizeof c00); memcpy(tile + 4, &c01, sizeof c01);
+  memcpy(tile + 8, &c10, sizeof c10); memcpy(tile + 12, &c11, sizeof c11);
+  memcpy(tile + 16, &c20, sizeof c20); memcpy(tile + 20, &c21, sizeof c21);
+  memcpy(tile + 24, &c30, sizeof c30); memcpy(tile + 28, &c31, sizeof c31);
+  memcpy(tile + 32, &c40, sizeof c40); memcpy(tile + 36, &c41, sizeof c41);
+  memcpy(tile + 40, &c50, sizeof c50); memcpy(tile + 44, &c51, sizeof c51);
+#else
+  for (i = 0; i < PHGMG__MR * PHGMG__NR; ++i) tile[i] = 0.0;
+  for (p = 0; p < kc; ++p) {
+    size_t o = (size_t)p * bsp;
+    double x0 = b0[o], x1 = b1[o], x2 = b2[o], x3 = b3[o], x4 = b4[o], x5 = b5[o];
+    for (i = 0; i < PHGMG__MR; ++i) {
+      double a = Ap[i];
+      tile[i] += a * x0; tile[8 + i] += a * x1; tile[16 + i] += a * x2;
+      tile[24 + i] += a * x3; tile[32 + i] += a * x4; tile[40 + i] += a * x5;
     }
+    Ap += PHGMG__MR;
+  }
+#endif
+  for (j = 0; j < nr; ++j) {
+    double *c = C + (size_t)j * (size_t)ldc;
+    const double *t = tile + PHGMG__MR * j;
+    for (i = 0; i < mr; ++i) c[i] += alpha * t[i];
   }
 }
 #endif
@@ -135,7 +159,7 @@ PHGMG_DEF void phgmg_gemm(char transa, char transb, int m, int n, int k, double 
   PHGMG_ASSERT(tb || transb == 'N' || transb == 'n');
   if (m <= 0 || n <= 0) return;
 #ifdef PHGMG_USE_CBLAS
-  if (k > 0) {
+  if (k > 0 && alpha != 0.0) {
     cblas_dgemm(CblasColMajor, ta ? CblasTrans : CblasNoTrans, tb ? CblasTrans : CblasNoTrans,
                 m, n, k, alpha, A, lda, B, ldb, beta, C, ldc);
     return;
@@ -149,28 +173,43 @@ PHGMG_DEF void phgmg_gemm(char transa, char transb, int m, int n, int k, double 
   if (alpha == 0.0 || k <= 0) return;
 #ifndef PHGMG_USE_CBLAS
   {
-    /* pack buffer on the stack: MC*KC doubles */
     double Ap[PHGMG_GEMM_MC * PHGMG_GEMM_KC];
-    int pc, ic, p;
+    size_t bsp = tb ? (size_t)ldb : 1, bsj = tb ? 1 : (size_t)ldb;
+    int pc, ic, ir, jr, p;
     for (pc = 0; pc < k; pc += PHGMG_GEMM_KC) {
       int kc = PHGMG__MIN(PHGMG_GEMM_KC, k - pc);
       for (ic = 0; ic < m; ic += PHGMG_GEMM_MC) {
         int mc = PHGMG__MIN(PHGMG_GEMM_MC, m - ic);
-        /* pack op(A)(ic:ic+mc, pc:pc+kc) column-major with ld mc */
-        if (!ta) {
-          for (p = 0; p < kc; ++p) {
-            const double *src = A + ic + (size_t)(pc + p) * (size_t)lda;
-            memcpy(Ap + (size_t)p * (size_t)mc, src, (size_t)mc * sizeof(double));
-          }
-        } else {
-          for (i = 0; i < mc; ++i) {
-            const double *src = A + pc + (size_t)(ic + i) * (size_t)lda;
-            for (p = 0; p < kc; ++p) Ap[i + (size_t)p * (size_t)mc] = src[p];
+        /* pack op(A)(ic:ic+mc, pc:pc+kc) into 8-row slivers, zero padded */
+        for (ir = 0; ir < mc; ir += PHGMG__MR) {
+          int mr = PHGMG__MIN(PHGMG__MR, mc - ir);
+          double *dst = Ap + (size_t)ir * (size_t)kc;
+          if (!ta) {
+            for (p = 0; p < kc; ++p) {
+              const double *src = A + (ic + ir) + (size_t)(pc + p) * (size_t)lda;
+              double *d = dst + (size_t)p * PHGMG__MR;
+              for (i = 0; i < mr; ++i) d[i] = src[i];
+              for (; i < PHGMG__MR; ++i) d[i] = 0.0;
+            }
+          } else {
+            for (i = 0; i < PHGMG__MR; ++i) {
+              if (i < mr) {
+                const double *src = A + pc + (size_t)(ic + ir + i) * (size_t)lda;
+                for (p = 0; p < kc; ++p) dst[(size_t)p * PHGMG__MR + i] = src[p];
+              } else {
+                for (p = 0; p < kc; ++p) dst[(size_t)p * PHGMG__MR + i] = 0.0;
+              }
+            }
           }
         }
-        phgmg__gemm_kernel(mc, n, kc, Ap,
-                           tb ? B + (size_t)pc * (size_t)ldb : B + pc, ldb, tb, alpha,
-                           C + ic, ldc);
+        for (jr = 0; jr < n; jr += PHGMG__NR) {
+          int nr = PHGMG__MIN(PHGMG__NR, n - jr);
+          const double *bp = B + (size_t)pc * bsp + (size_t)jr * bsj;
+          for (ir = 0; ir < mc; ir += PHGMG__MR)
+            phgmg__gemm_micro(kc, Ap + (size_t)ir * (size_t)kc, bp, bsp, bsj,
+                              PHGMG__MIN(PHGMG__MR, mc - ir), nr, alpha,
+                              C + (ic + ir) + (size_t)jr * (size_t)ldc, ldc);
+        }
       }
     }
   }

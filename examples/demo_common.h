@@ -1,0 +1,95 @@
+/* Shared pieces of the two Section-5 demos (examples/msd_linear.c and
+   examples/msd_nonlinear.c): inputs, one reduction + simulation + error
+   evaluation, CSV output, timing. Include after phgmg.h. */
+#ifndef PHGMG_DEMO_COMMON_H
+#define PHGMG_DEMO_COMMON_H
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <math.h>
+#include <time.h>
+#include <sys/stat.h>
+
+static void demo_u_sin(double t, double *u, void *user) { (void)user; u[0] = 0.1 * sin(t); }
+static void demo_u_const(double t, double *u, void *user) { (void)user; (void)t; u[0] = 0.1; }
+
+static double demo_now(void) {
+  struct timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static void demo_die(const char *what, phgmg_result rc) {
+  fprintf(stderr, "error: %s: %s\n", what, phgmg_result_string(rc));
+  exit(1);
+}
+
+/* Result of one reduced model on one snapshot set. */
+typedef struct demo_rom_result {
+  double e_red, e_y, e_proj, e_lower;
+  phgmg_result rc;
+  phgmg_reduce_info info;
+  double t_offline, t_online;
+} demo_rom_result;
+
+/* Reduce `sys` from snapshots X (N x ns) with `opts`, simulate the ROM from
+   rho(x0) with the FOM's input, and measure e_red, e_y (against the FOM's
+   output Y), e_proj and (GMG-QM) e_lowerbound. If energy is non-NULL it gets
+   the ROM's energy bookkeeping. */
+static demo_rom_result demo_run_rom(const phgmg_ph_system *sys, const double *X, const double *Y,
+                                    int nsteps, double dt, phgmg_input_fn uf,
+                                    const phgmg_reduce_opts *opts, double newton_tol, int newton_it,
+                                    const phgmg_energy *energy) {
+  demo_rom_result res;
+  phgmg_reduced *red = NULL;
+  const int N = sys->N, m = sys->m, ns = nsteps + 1, r = opts->r;
+  double *XR, *YR, *xr0;
+  double t0;
+  memset(&res, 0, sizeof res);
+  res.e_red = res.e_y = res.e_proj = res.e_lower = NAN;
+  t0 = demo_now();
+  res.rc = phgmg_reduce(&red, sys, X, N, ns, opts, &res.info, NULL);
+  res.t_offline = demo_now() - t0;
+  if (res.rc != PHGMG_OK) return res;
+  XR = (double *)malloc(sizeof(double) * (size_t)r * ns);
+  YR = (double *)malloc(sizeof(double) * (size_t)m * ns);
+  xr0 = (double *)malloc(sizeof(double) * (size_t)r);
+  if (!XR || !YR || !xr0) { fprintf(stderr, "out of memory\n"); exit(1); }
+  phgmg_reduced_restrict(red, X, xr0);     /* rho(x0) (NUMERICS 6.7) */
+  t0 = demo_now();
+  res.rc = phgmg_reduced_simulate(red, xr0, 0.0, dt, nsteps, uf, NULL, newton_tol, newton_it, XR, YR,
+                                  energy, NULL, NULL);
+  res.t_online = demo_now() - t0;
+  if (res.rc == PHGMG_OK) {
+    res.e_red = phgmg_err_red(red, X, N, ns, XR, r);
+    res.e_y = phgmg_rel_error(m, ns, Y, m, YR, m);
+  }
+  res.e_proj = phgmg_err_proj(red, X, N, ns);
+  if (opts->method == PHGMG_METHOD_GMG_QM) res.e_lower = phgmg_err_lowerbound(red, X, N, ns);
+  free(XR); free(YR); free(xr0);
+  phgmg_reduced_destroy(red);
+  return res;
+}
+
+/* CSV: header, then rows of numbers (first column printed as an integer or a
+   time). NaN is written as "nan" (a failed or non-applicable entry). */
+static void demo_write_csv(const char *path, const char *header, int nrows, int ncols,
+                           const double *data /* row-major nrows x ncols */, int first_int) {
+  FILE *f = fopen(path, "w");
+  int i, j;
+  if (!f) { fprintf(stderr, "error: cannot write %s\n", path); exit(1); }
+  fprintf(f, "%s\n", header);
+  for (i = 0; i < nrows; ++i) {
+    for (j = 0; j < ncols; ++j) {
+      const double v = data[i * ncols + j];
+      if (j == 0 && first_int) fprintf(f, "%d", (int)v);
+      else if (isnan(v)) fprintf(f, "%snan", j ? "," : "");
+      else fprintf(f, "%s%.6e", j ? "," : "", v);
+    }
+    fprintf(f, "\n");
+  }
+  fclose(f);
+}
+
+static void demo_mkdir(const char *dir) { mkdir(dir, 0777); }
+#endif

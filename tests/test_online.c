@@ -1,0 +1,169 @@
+/* Online reduced-model path on hand-made models whose answers are known in
+   closed form: a harmonic oscillator (exact solution), energy balance of a
+   damped linear pH model (exact for GL3 with quadratic H), an analytic Jacobian
+   against finite differences, Newton failure leaving the state untouched, and
+   the workspace contract. */
+#define PHGMG_STATIC
+#define PHGMG_IMPLEMENTATION
+#include "../phgmg.h"
+#include "harness.h"
+
+static double osc_err(double h, double T) {
+  /* x' = K Qh x with K = [[0,1],[-1,0]], Qh = I: x = (cos t, -sin t) */
+  static const phgmg_real K[4] = {0, -1, 1, 0}, Qh[4] = {1, 0, 0, 1}, Bh[2] = {0, 1};
+  phgmg_rom rom;
+  phgmg_rom_stepper st;
+  static double mem[4096];
+  phgmg_real x[2] = {1, 0};
+  int n, nsteps = (int)(T / h + 0.5);
+  memset(&rom, 0, sizeof rom);
+  rom.kind = PHGMG_ROM_LINEAR; rom.r = 2; rom.m = 1; rom.K = K; rom.Qh = Qh; rom.Bh = Bh;
+  if (phgmg_rom_stepper_init(&st, &rom, (phgmg_real)h, (phgmg_real)1e-14, 10, mem, sizeof mem) != PHGMG_OK) return 1.0;
+  for (n = 0; n < nsteps; ++n)
+    if (phgmg_rom_step(&st, x, NULL, NULL, NULL) != PHGMG_OK) return 1.0;
+  return hypot((double)x[0] - cos(nsteps * h), (double)x[1] + sin(nsteps * h));
+}
+
+TEST(test_oscillator_order6) {
+  double e1 = osc_err(0.4, 8.0), e2 = osc_err(0.2, 8.0);
+  /* GL3 has order 6: halving h divides the error by ~64 */
+  CHECK(e1 < 1e-4);
+  CHECK_LE(40.0, e1 / e2);
+  CHECK_LE(e1 / e2, 90.0);
+}
+
+/* a random damped linear pH model of order r with m ports */
+static void make_linear(int r, int m, phgmg_real *K, phgmg_real *Qh, phgmg_real *Bh) {
+  double J[64], Rm[64], L[64], Qd[64];
+  int i, j, k;
+  for (i = 0; i < r * r; ++i) { J[i] = th_rand(); L[i] = 0.5 * th_rand(); Qd[i] = th_rand(); }
+  for (j = 0; j < r; ++j)
+    for (i = 0; i < r; ++i) {
+      double s = 0, q = 0;
+      for (k = 0; k < r; ++k) { s += L[i + k * r] * L[j + k * r]; q += Qd[i + k * r] * Qd[j + k * r]; }
+      Rm[i + j * r] = s;
+      K[i + j * r] = (phgmg_real)(0.5 * (J[i + j * r] - J[j + i * r]) - s);
+      Qh[i + j * r] = (phgmg_real)(q + (i == j ? 1.0 : 0.0));
+    }
+  for (i = 0; i < r * m; ++i) Bh[i] = (phgmg_real)th_rand();
+  (void)Rm;
+}
+
+TEST(test_linear_energy_balance) {
+  enum { r = 6, m = 2 };
+  phgmg_real K[r * r], Qh[r * r], Bh[r * m], x[r] = {0}, u3[3 * m], work[512], Jr[r * r], Rr[r * r];
+  phgmg_rom rom;
+  phgmg_rom_stepper st;
+  static double mem[8192];
+  double H0, S = 0, D = 0, maxrel = 0;
+  int n, i;
+  make_linear(r, m, K, Qh, Bh);
+  memset(&rom, 0, sizeof rom);
+  rom.kind = PHGMG_ROM_LINEAR; rom.r = r; rom.m = m; rom.K = K; rom.Qh = Qh; rom.Bh = Bh;
+  CHECK_RC(phgmg_rom_check(&rom), PHGMG_OK);
+  CHECK(phgmg_rom_eval_work_size(&rom) <= 512);
+  /* structure: Jr skew, Rr symmetric with K = Jr - Rr */
+  CHECK_RC(phgmg_rom_structure(&rom, x, Jr, Rr, work), PHGMG_OK);
+  for (i = 0; i < r * r; ++i) {
+    int a = i % r, b = i / r;
+    CHECK(Jr[a + b * r] == -Jr[b + a * r]);
+    CHECK(Rr[a + b * r] == Rr[b + a * r]);
+    CHECK(fabs((double)(Jr[i] - Rr[i] - K[i])) < 1e-15);
+  }
+  CHECK_RC(phgmg_rom_stepper_init(&st, &rom, 0.1, 1e-13, 10, mem, sizeof mem), PHGMG_OK);
+  for (i = 0; i < r; ++i) x[i] = (phgmg_real)th_rand();
+  H0 = (double)phgmg_rom_hamiltonian(&rom, x, work);
+  for (n = 0; n < 300; ++n) {
+    phgmg_real tc[3], en[2] = {0, 0};
+    double H;
+    phgmg_rom_stage_times(n * 0.1, 0.1, tc);
+    for (i = 0; i < 3; ++i) { u3[i * m] = (phgmg_real)sin((double)tc[i]); u3[i * m + 1] = (phgmg_real)0.3; }
+    CHECK_RC(phgmg_rom_step(&st, x, u3, NULL, en), PHGMG_OK);
+    S += (double)en[0]; D += (double)en[1];
+    H = (double)phgmg_rom_hamiltonian(&rom, x, work);
+    maxrel = PHGMG__MAX(maxrel, fabs(H - H0 - S + D) / (fabs(H0) + fabs(S) + fabs(D)));
+  }
+  /* Gauss quadrature is exact for the degree-5 integrand: round-off only */
+  CHECK_LE(maxrel, 1e-12);
+  CHECK(D > 0.0);
+  /* linear + quadratic H: simplified Newton converges in one iteration */
+  CHECK(st.stats.newton_iters <= st.stats.steps + 1);
+  CHECK(st.stats.factorizations == 1);
+}
+
+TEST(test_jacobian_fd_and_newton_failure) {
+  enum { r = 4, m = 1, nd = 3 };
+  phgmg_real K[r * r], Qh[r * r], Bh[r * m], P0[nd * r], w[nd], x[r], x0[r], work[512];
+  phgmg_real Jf[r * r], f1[r], f2[r], xp[r];
+  const phgmg_real poly[5] = {0, 0, 0, 0, (phgmg_real)0.25};
+  phgmg_rom rom;
+  phgmg_rom_stepper st;
+  static double mem[8192];
+  double maxerr = 0, scale = 0;
+  int a, b, i;
+  make_linear(r, m, K, Qh, Bh);
+  for (i = 0; i < nd * r; ++i) P0[i] = (phgmg_real)th_rand();
+  for (i = 0; i < nd; ++i) w[i] = (phgmg_real)(1.0 + i);
+  memset(&rom, 0, sizeof rom);
+  rom.kind = PHGMG_ROM_LINEAR; rom.r = r; rom.m = m; rom.K = K; rom.Qh = Qh; rom.Bh = Bh;
+  rom.nd = nd; rom.P0 = P0; rom.w = w; rom.poly = poly; rom.poly_deg = 4;
+  CHECK_RC(phgmg_rom_check(&rom), PHGMG_OK);
+  for (i = 0; i < r; ++i) x[i] = (phgmg_real)th_rand();
+  CHECK_RC(phgmg_rom_jacobian(&rom, x, Jf, work), PHGMG_OK);
+  for (b = 0; b < r; ++b) {
+    const double h = 1e-5;
+    for (i = 0; i < r; ++i) xp[i] = x[i];
+    xp[b] = x[b] + h; phgmg_rom_rhs(&rom, xp, NULL, f1, work);
+    xp[b] = x[b] - h; phgmg_rom_rhs(&rom, xp, NULL, f2, work);
+    for (a = 0; a < r; ++a) {
+      double fd = ((double)f1[a] - (double)f2[a]) / (2 * h);
+      maxerr = PHGMG__MAX(maxerr, fabs(fd - (double)Jf[a + b * r]));
+      scale = PHGMG__MAX(scale, fabs(fd));
+    }
+  }
+  CHECK_LE(maxerr, 1e-7 * scale);
+  /* Newton failure: a large state and a huge step for the quartic term */
+  CHECK_RC(phgmg_rom_stepper_init(&st, &rom, 50.0, 1e-12, 3, mem, sizeof mem), PHGMG_OK);
+  for (i = 0; i < r; ++i) x[i] = x0[i] = (phgmg_real)(30.0 * th_rand());
+  {
+    phgmg_result rc = phgmg_rom_step(&st, x, NULL, NULL, NULL);
+    CHECK(rc == PHGMG_ERR_NOT_CONVERGED || rc == PHGMG_ERR_NANINF);
+  }
+  CHECK(memcmp(x, x0, sizeof x) == 0);
+  CHECK(st.stats.failures == 1);
+}
+
+TEST(test_workspace_contract) {
+  static const phgmg_real K[4] = {0, -1, 1, 0}, Qh[4] = {1, 0, 0, 1}, Bh[2] = {0, 1};
+  phgmg_rom rom;
+  phgmg_rom_stepper st;
+  static double mem[4096];
+  size_t need;
+  memset(&rom, 0, sizeof rom);
+  rom.kind = PHGMG_ROM_LINEAR; rom.r = 2; rom.m = 1; rom.K = K; rom.Qh = Qh; rom.Bh = Bh;
+  need = phgmg_rom_stepper_memsize(&rom);
+  CHECK(need > 0);
+  CHECK(need <= PHGMG_ROM_STEPPER_MEMSIZE_MAX(2, 1, 0, 0));
+  CHECK_RC(phgmg_rom_stepper_init(&st, &rom, 0.1, 0, 0, mem, need - 1), PHGMG_ERR_WORKSPACE);
+  CHECK_RC(phgmg_rom_stepper_init(&st, &rom, 0.1, 0, 0, mem, need), PHGMG_OK);
+  CHECK_RC(phgmg_rom_stepper_init(&st, &rom, -0.1, 0, 0, mem, need), PHGMG_ERR_INVALID_ARG);
+  rom.r = 0;
+  CHECK_RC(phgmg_rom_check(&rom), PHGMG_ERR_SIZE);
+  rom.r = 2; rom.K = NULL;
+  CHECK_RC(phgmg_rom_check(&rom), PHGMG_ERR_INVALID_ARG);
+  rom.K = K;
+  {
+    phgmg_real x[2] = {1, 0};
+    phgmg_real u3[3] = {0, (phgmg_real)NAN, 0};
+    CHECK_RC(phgmg_rom_stepper_init(&st, &rom, 0.1, 0, 0, mem, need), PHGMG_OK);
+    CHECK_RC(phgmg_rom_step(&st, x, u3, NULL, NULL), PHGMG_ERR_NANINF);
+    CHECK(x[0] == 1 && x[1] == 0);
+  }
+}
+
+SUITE(online) {
+  RUN(test_oscillator_order6);
+  RUN(test_linear_energy_balance);
+  RUN(test_jacobian_fd_and_newton_failure);
+  RUN(test_workspace_contract);
+}
