@@ -455,6 +455,123 @@ PHGMG_DEF phgmg_result phgmg_rom_step(phgmg_rom_stepper *s, phgmg_real *x, const
 }
 #endif
 
+/* >>pod / >>reduce / >>deim / >>errors ====================================== */
+/* Offline reduction (double). A user gives a pH system and a snapshot matrix
+   X (N x ns, ns = n_t + 1 columns) and gets a reduced model that is again a
+   pH system (see >>online), plus the error measures of the paper (5.1). */
+#ifndef PHGMG_NO_OFFLINE
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* POD: the leading left singular vectors of X (N x ns). k = kmax modes, or
+   fewer: with tol > 0 only modes with sigma_k > tol * sigma_1 are kept.
+   V: N x kmax (ldv), S: kmax singular values (may be NULL). *k_out = modes kept. */
+PHGMG_DEF phgmg_result phgmg_pod(int N, int ns, const double *X, int ldx, int kmax, double tol,
+                                 double *V, int ldv, double *S, int *k_out,
+                                 const phgmg_allocator *alloc);
+/* Adjusted snapshots Xa = X - B B^+ X (B: N x m full column rank). Xa may alias X. */
+PHGMG_DEF phgmg_result phgmg_adjust_snapshots(int N, int m, const double *B, int ns, const double *X,
+                                              int ldx, double *Xa, int ldxa, const phgmg_allocator *alloc);
+
+typedef struct phgmg_reduce_opts {
+  phgmg_method method; /* required                                                  */
+  int r;               /* reduced order (GMG: includes the m port coordinates), required */
+  int rn;              /* GMG-QM lifting dimension r_n (0: 8)                        */
+  double lambda;       /* GMG-QM ridge parameter, applied to the un-normalised sum
+                          over snapshots (0: 1e-3; < 0: exactly zero)                 */
+  int deim;            /* separable nonlinear part: 1 = structure-preserving DEIM,
+                          0 = keep every term (exact, but O(n_terms) online)          */
+  double deim_tol;     /* DEIM modes: sigma_k / sigma_1 > deim_tol (0: 1e-8)          */
+  int deim_max;        /* cap on DEIM modes (0: no cap)                               */
+  int deim_allow_negative; /* 1: accept negative DEIM weights (reported in info)      */
+  double dt;           /* > 0: precompute the GL3 step map for this step
+                          (LINEAR map with quadratic H only)                          */
+  double degeneracy_tol; /* fail with PHGMG_ERR_DEGENERATE when the reciprocal
+                          condition of D^T G D at the snapshots is below this (0: 1e-12) */
+} phgmg_reduce_opts;
+
+typedef struct phgmg_reduce_info {
+  int deim_modes;          /* DEIM points kept (nd)                          */
+  int deim_negative;       /* number of negative DEIM weights               */
+  double deim_sigma_ratio; /* sigma_{nd+1}/sigma_1 of the nonlinear snapshots (0 if all kept) */
+  double rcond_dgd;        /* smallest rcond of D^T G D seen (at x = 0 and the snapshots) */
+  double rcond_jr;         /* rcond of J - R                                  */
+  double pod_sigma_ratio;  /* sigma_{r'+1}/sigma_1 of the (adjusted) snapshots */
+} phgmg_reduce_info;
+
+/* The reduced model with its offline data (bases for reconstruction, double
+   and phgmg_real copies of the small blocks). */
+typedef struct phgmg_reduced phgmg_reduced;
+
+/* Build a reduced model of `sys` from snapshots X (N x ns, ldx). The system must
+   validate (phgmg_ph_validate); GENERAL nonlinear Hamiltonians are not supported
+   (PHGMG_ERR_UNSUPPORTED); a separable nonlinear part needs the polynomial form
+   (sys->poly) for the reduced model. Errors: PHGMG_ERR_SIZE (r <= m for GMG,
+   r > rank of the snapshots, ...), PHGMG_ERR_RANK, PHGMG_ERR_DEGENERATE,
+   PHGMG_ERR_NEGATIVE_WEIGHT, PHGMG_ERR_NANINF, PHGMG_ERR_NOMEM. info may be NULL. */
+PHGMG_DEF phgmg_result phgmg_reduce(phgmg_reduced **out, const phgmg_ph_system *sys, const double *X,
+                                    int ldx, int ns, const phgmg_reduce_opts *opts,
+                                    phgmg_reduce_info *info, const phgmg_allocator *alloc);
+PHGMG_DEF void phgmg_reduced_destroy(phgmg_reduced *red);
+/* The online model (views into the reduced object; valid until destroy). */
+PHGMG_DEF const phgmg_rom *phgmg_reduced_rom(const phgmg_reduced *red);
+/* Offline double copy of the same model (identical layout, double arrays). */
+PHGMG_DEF int phgmg_reduced_N(const phgmg_reduced *red);
+/* Reconstruction x = phi(xr) (N). */
+PHGMG_DEF void phgmg_reduced_lift(const phgmg_reduced *red, const double *xr, double *x);
+/* Point reduction xr = rho(x) (r); rho(phi(xr)) = xr. */
+PHGMG_DEF void phgmg_reduced_restrict(const phgmg_reduced *red, const double *x, double *xr);
+/* Jacobian of phi at xr: D (N x r, ldd). */
+PHGMG_DEF void phgmg_reduced_dphi(const phgmg_reduced *red, const double *xr, double *D, int ldd);
+/* The reduction map W(xr) (N x r, ldw) in full dimension (for checks; O(N r^2)). */
+PHGMG_DEF phgmg_result phgmg_reduced_W(const phgmg_reduced *red, const double *xr, double *W, int ldw);
+
+/* Simulate the reduced model with the online GL3 stepper from xr0 over nsteps
+   steps of dt (u from uf at the stage times). Outputs (each may be NULL):
+   XR r x (nsteps+1), Y m x (nsteps+1), energy like phgmg_simulate (Hamiltonian
+   of the reduced model). tol/max_iter: Newton settings (<= 0: defaults). */
+PHGMG_DEF phgmg_result phgmg_reduced_simulate(const phgmg_reduced *red, const double *xr0, double t0,
+                                              double dt, int nsteps, phgmg_input_fn uf, void *uuser,
+                                              double tol, int max_iter, double *XR, double *Y,
+                                              const phgmg_energy *energy, phgmg_rom_stats *stats,
+                                              const phgmg_allocator *alloc);
+
+/* --- error measures (paper 5.1) --- */
+/* sqrt(sum_i ||A_i - B_i||^2 / sum_i ||A_i||^2) over ns columns of length n. */
+PHGMG_DEF double phgmg_rel_error(int n, int ns, const double *A, int lda, const double *B, int ldb);
+/* e_red: reduction error of a reduced trajectory XR (r x ns) against X. */
+PHGMG_DEF double phgmg_err_red(const phgmg_reduced *red, const double *X, int ldx, int ns,
+                               const double *XR, int ldxr);
+/* e_proj: projection error sqrt(sum ||x_i - phi(rho(x_i))||^2 / sum ||x_i||^2). */
+PHGMG_DEF double phgmg_err_proj(const phgmg_reduced *red, const double *X, int ldx, int ns);
+/* e_lowerbound (eq. non_app_lower_bound) of a GMG-QM model: the error of the
+   orthogonal projection onto span[B, V1, V2]. NaN for other kinds. */
+PHGMG_DEF double phgmg_err_lowerbound(const phgmg_reduced *red, const double *X, int ldx, int ns);
+/* e_energy(t_n) = |H[n] - H[0] - S[n] + D[n]| for n = 0..nsteps into e. */
+PHGMG_DEF void phgmg_err_energy(const phgmg_energy *energy, int nsteps, double *e);
+
+/* Hierarchical POD of paper 4.2.2: V1 = POD_p(X - BB^+X), V2 = POD_rn of the
+   residual (I - [B,V1][B,V1]^+) X. V1: N x p, V2: N x rn. */
+PHGMG_DEF phgmg_result phgmg_pod_hierarchical(int N, int m, const double *B, int ns, const double *X,
+                                              int ldx, int p, int rn, double *V1, double *V2,
+                                              const phgmg_allocator *alloc);
+
+/* Structure-preserving DEIM for a separable sum: F (nterms x ns) holds the
+   snapshots of the nonlinear gradient terms phi_k'(x_idx_k). Modes: sigma_k >
+   tol sigma_1 (capped by kmax if > 0). Points by Q-DEIM (pivoted QR of U^T).
+   Weights w = (P^T U)^{-T} U^T sw (sw = the terms' own weights, NULL = 1), so
+   sum_k sw_k phi_k ~ sum_j w_j phi_{pts_j}. pts, w: room for nterms entries.
+   *nd_out = points chosen, *nneg = negative weights. */
+PHGMG_DEF phgmg_result phgmg_deim(int nterms, int ns, const double *F, int ldf, const double *sw,
+                                  double tol, int kmax, int *pts, double *w, int *nd_out,
+                                  int *nneg, double *sigma_ratio, const phgmg_allocator *alloc);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* PHGMG_NO_OFFLINE */
+
 /* >>export ================================================================ */
 /* A reduced model leaves the workstation in two forms:
    - C source: static const arrays of phgmg_real plus a `static const phgmg_rom`
@@ -744,8 +861,9 @@ PHGMG_DEF void phgmg_gemv(char trans, int m, int n, double alpha, const double *
 /* Portable GEMM: a block of op(A) (MC x KC) is packed into 8-row slivers (on
    the stack, MC*KC doubles), then 8 x 6 tiles of C are computed by a
    register-blocked micro-kernel that streams the matching 6 columns of op(B)
-   directly from B. With GCC/Clang the micro-kernel uses vector extensions
-   (define PHGMG_NO_VECTOR_EXT to get the plain C version). */
+   directly from B. With GCC/Clang on an AVX target the micro-kernel uses
+   vector extensions (define PHGMG_NO_VECTOR_EXT for the plain C version,
+   which is the one used everywhere else). */
 #ifndef PHGMG_GEMM_MC
 #define PHGMG_GEMM_MC 64 /* multiple of 8 */
 #endif
@@ -764,7 +882,7 @@ PHGMG__PRIV void phgmg__gemm_micro(int kc, const double *Ap, const double *B, si
   const double *b3 = B + (nr > 3 ? 3 * bsj : 0), *b4 = B + (nr > 4 ? 4 * bsj : 0);
   const double *b5 = B + (nr > 5 ? 5 * bsj : 0);
   int p, i, j;
-#if (defined(__GNUC__) || defined(__clang__)) && !defined(PHGMG_NO_VECTOR_EXT)
+#if (defined(__GNUC__) || defined(__clang__)) && defined(__AVX__) && !defined(PHGMG_NO_VECTOR_EXT)
   typedef double phgmg__v4 __attribute__((vector_size(32)));
   phgmg__v4 c00, c01, c10, c11, c20, c21, c30, c31, c40, c41, c50, c51, a0, a1;
   memset(&c00, 0, sizeof c00);
@@ -877,39 +995,90 @@ PHGMG_DEF void phgmg_gemm(char transa, char transb, int m, int n, int k, double 
 }
 
 /* ---- real LU -------------------------------------------------------------- */
+/* Row interchanges k <-> ipiv[k], k in [k1, k2), applied to ncols columns of A. */
+PHGMG__PRIV void phgmg__laswp(int ncols, double *A, int lda, int k1, int k2, const int *ipiv) {
+  int j, k;
+  for (j = 0; j < ncols; ++j) {
+    double *c = A + (size_t)j * (size_t)lda;
+    for (k = k1; k < k2; ++k) {
+      int p = ipiv[k];
+      if (p != k) { double t = c[k]; c[k] = c[p]; c[p] = t; }
+    }
+  }
+}
+
+/* B := L^{-1} B with L n x n unit lower triangular; B n x nrhs. Recursive, the
+   off-diagonal blocks go through gemm. */
+PHGMG__PRIV void phgmg__trsm_llu(int n, int nrhs, const double *L, int ldl, double *B, int ldb) {
+  int i, j, k, n1;
+  if (n <= 32) {
+    for (j = 0; j < nrhs; ++j) {
+      double *b = B + (size_t)j * (size_t)ldb;
+      for (k = 0; k < n; ++k) {
+        const double *l = L + (size_t)k * (size_t)ldl;
+        double t = b[k];
+        if (t != 0.0) for (i = k + 1; i < n; ++i) b[i] -= t * l[i];
+      }
+    }
+    return;
+  }
+  n1 = n / 2;
+  phgmg__trsm_llu(n1, nrhs, L, ldl, B, ldb);
+  phgmg_gemm('N', 'N', n - n1, nrhs, n1, -1.0, L + n1, ldl, B, ldb, 1.0, B + n1, ldb);
+  phgmg__trsm_llu(n - n1, nrhs, L + n1 + (size_t)n1 * (size_t)ldl, ldl, B + n1, ldb);
+}
+
+/* Recursive LU with partial pivoting of an m x n panel (m >= n), ipiv relative
+   to the panel. Returns 1 if an exactly zero pivot column was met. */
+PHGMG__PRIV int phgmg__lu_rec(int m, int n, double *A, int lda, int *ipiv) {
+  int i, j, k, n1, sing = 0;
+  if (n <= 16) {
+    for (k = 0; k < n; ++k) {
+      double *ak = A + (size_t)k * (size_t)lda, amax = fabs(ak[k]), piv;
+      int p = k;
+      for (i = k + 1; i < m; ++i)
+        if (fabs(ak[i]) > amax) { amax = fabs(ak[i]); p = i; }
+      ipiv[k] = p;
+      if (amax == 0.0) { sing = 1; continue; } /* the column below is zero: L(:,k) = 0 */
+      if (p != k)
+        for (j = 0; j < n; ++j) {
+          double *c = A + (size_t)j * (size_t)lda, t = c[k];
+          c[k] = c[p]; c[p] = t;
+        }
+      piv = ak[k];
+      if (amax >= 2.2250738585072014e-308) {
+        double r = 1.0 / piv;
+        for (i = k + 1; i < m; ++i) ak[i] *= r;
+      } else {
+        for (i = k + 1; i < m; ++i) ak[i] /= piv;
+      }
+      for (j = k + 1; j < n; ++j) {
+        double *c = A + (size_t)j * (size_t)lda, t = c[k];
+        if (t != 0.0) for (i = k + 1; i < m; ++i) c[i] -= t * ak[i];
+      }
+    }
+    return sing;
+  }
+  n1 = n / 2;
+  sing = phgmg__lu_rec(m, n1, A, lda, ipiv);
+  phgmg__laswp(n - n1, A + (size_t)n1 * (size_t)lda, lda, 0, n1, ipiv);
+  phgmg__trsm_llu(n1, n - n1, A, lda, A + (size_t)n1 * (size_t)lda, lda);
+  phgmg_gemm('N', 'N', m - n1, n - n1, n1, -1.0, A + n1, lda, A + (size_t)n1 * (size_t)lda, lda,
+             1.0, A + n1 + (size_t)n1 * (size_t)lda, lda);
+  sing |= phgmg__lu_rec(m - n1, n - n1, A + n1 + (size_t)n1 * (size_t)lda, lda, ipiv + n1);
+  for (i = n1; i < n; ++i) ipiv[i] += n1;
+  phgmg__laswp(n1, A, lda, n1, n, ipiv);
+  return sing;
+}
+
 PHGMG_DEF phgmg_result phgmg_lu_factor(int n, double *A, int lda, int *ipiv) {
-  int i, j, k;
-  phgmg_result rc = PHGMG_OK;
+  int j;
   if (n < 0 || lda < PHGMG__MAX(n, 1)) return PHGMG_ERR_SIZE;
   if (n == 0) return PHGMG_OK;
   if (!A || !ipiv) return PHGMG_ERR_INVALID_ARG;
   for (j = 0; j < n; ++j)
     if (!phgmg__all_finite(A + (size_t)j * (size_t)lda, (size_t)n)) return PHGMG_ERR_NANINF;
-  for (k = 0; k < n; ++k) {
-    double *ak = A + (size_t)k * (size_t)lda;
-    int p = k;
-    double amax = fabs(ak[k]);
-    for (i = k + 1; i < n; ++i)
-      if (fabs(ak[i]) > amax) { amax = fabs(ak[i]); p = i; }
-    ipiv[k] = p;
-    if (amax == 0.0) { rc = PHGMG_ERR_SINGULAR; continue; }
-    if (p != k)
-      for (j = 0; j < n; ++j) {
-        double *c = A + (size_t)j * (size_t)lda, t = c[k];
-        c[k] = c[p]; c[p] = t;
-      }
-    {
-      double r = 1.0 / ak[k];
-      for (i = k + 1; i < n; ++i) ak[i] *= r;
-    }
-    for (j = k + 1; j < n; ++j) {
-      double *c = A + (size_t)j * (size_t)lda;
-      double t = c[k];
-      if (t == 0.0) continue;
-      for (i = k + 1; i < n; ++i) c[i] -= t * ak[i];
-    }
-  }
-  return rc;
+  return phgmg__lu_rec(n, n, A, lda, ipiv) ? PHGMG_ERR_SINGULAR : PHGMG_OK;
 }
 
 PHGMG_DEF void phgmg_lu_solve(char trans, int n, const double *LU, int lda, const int *ipiv,
@@ -1214,6 +1383,102 @@ PHGMG__PRIV void phgmg__qrcp_core(int m, int n, double *A, int lda, double *tau,
   *rank = k;
 }
 
+/* Blocked QR with column pivoting (LAPACK dlaqps scheme): nb reflectors at a
+   time with deferred trailing updates A -= V F^T through gemm. Stops early like
+   phgmg__qrcp_core. F: n x nb (ld n), aux: nb doubles, mark: n ints. */
+#define PHGMG__QRCP_NB 32
+PHGMG__PRIV void phgmg__qrcp_blocked(int m, int n, double *A, int lda, double *tau, int *jpvt,
+                                     double *vn, double *F, double *aux, int *mark, double tol,
+                                     int *rank) {
+  double *vn1 = vn, *vn2 = vn + n;
+  const double tol3z = sqrt(PHGMG__EPS);
+  const int ldf = PHGMG__MAX(n, 1);
+  int i, j, q, s = 0, kmin = PHGMG__MIN(m, n), stop = 0;
+  for (j = 0; j < n; ++j) {
+    jpvt[j] = j;
+    mark[j] = 0;
+    vn1[j] = vn2[j] = phgmg_normf(m, 1, A + (size_t)j * (size_t)lda, lda);
+  }
+  while (s < kmin && !stop) {
+    int nb = PHGMG__MIN(PHGMG__QRCP_NB, kmin - s), kk = 0, any_mark = 0;
+    /* F rows are indexed by (global column - s) */
+    while (kk < nb && !any_mark) {
+      int c = s + kk, p = c + phgmg__iamax(n - c, vn1 + c);
+      double *ac = A + (size_t)c * (size_t)lda, akk;
+      if (tol >= 0.0 && vn1[p] <= tol) { stop = 1; break; }
+      if (p != c) {
+        double *ap = A + (size_t)p * (size_t)lda, t;
+        int it;
+        for (i = 0; i < m; ++i) { t = ac[i]; ac[i] = ap[i]; ap[i] = t; }
+        for (q = 0; q < kk; ++q) {
+          double *fq = F + (size_t)q * (size_t)ldf;
+          t = fq[c - s]; fq[c - s] = fq[p - s]; fq[p - s] = t;
+        }
+        it = jpvt[p]; jpvt[p] = jpvt[c]; jpvt[c] = it;
+        vn1[p] = vn1[c];
+        vn2[p] = vn2[c];
+      }
+      /* pending updates of column c: A(c:m, c) -= A(c:m, s:c) F(c-s, 0:kk)^T */
+      for (q = 0; q < kk; ++q) {
+        const double *v = A + (size_t)(s + q) * (size_t)lda;
+        double f = F[(c - s) + (size_t)q * (size_t)ldf];
+        if (f != 0.0) for (i = c; i < m; ++i) ac[i] -= f * v[i];
+      }
+      phgmg__larfg(m - c, ac + c, ac + c + 1, &tau[c]);
+      akk = ac[c];
+      ac[c] = 1.0;
+      /* F(c+1-s : n-s, kk) = tau A(c:m, c+1:n)^T v  (stale trailing columns) */
+      if (c + 1 < n)
+        phgmg_gemv('T', m - c, n - c - 1, tau[c], A + c + (size_t)(c + 1) * (size_t)lda, lda,
+                   ac + c, 0.0, F + (c + 1 - s) + (size_t)kk * (size_t)ldf);
+      for (j = 0; j <= c - s; ++j) F[j + (size_t)kk * (size_t)ldf] = 0.0;
+      /* F(:, kk) -= tau F(:, 0:kk) (A(c:m, s:c)^T v) */
+      if (kk > 0) {
+        phgmg_gemv('T', m - c, kk, -tau[c], A + c + (size_t)s * (size_t)lda, lda, ac + c, 0.0, aux);
+        phgmg_gemv('N', n - s, kk, 1.0, F, ldf, aux, 1.0, F + (size_t)kk * (size_t)ldf);
+      }
+      /* row c of the trailing matrix: A(c, c+1:n) -= A(c, s:c+1) F(c+1-s:n-s, 0:kk+1)^T */
+      for (j = c + 1; j < n; ++j) {
+        double t = 0.0;
+        for (q = 0; q <= kk; ++q)
+          t += A[c + (size_t)(s + q) * (size_t)lda] * F[(j - s) + (size_t)q * (size_t)ldf];
+        A[c + (size_t)j * (size_t)lda] -= t;
+      }
+      /* downdate the partial column norms; a column whose norm cancelled too much
+         is marked for recomputation, which ends the block */
+      if (c + 1 < m) {
+        for (j = c + 1; j < n; ++j) {
+          if (vn1[j] != 0.0) {
+            double temp = fabs(A[c + (size_t)j * (size_t)lda]) / vn1[j], temp2;
+            temp = (1.0 + temp) * (1.0 - temp);
+            if (temp < 0.0) temp = 0.0;
+            temp2 = temp * (vn1[j] / vn2[j]) * (vn1[j] / vn2[j]);
+            if (temp2 <= tol3z) { mark[j] = 1; any_mark = 1; }
+            else vn1[j] *= sqrt(temp);
+          }
+        }
+      } else {
+        for (j = c + 1; j < n; ++j) vn1[j] = vn2[j] = 0.0;
+      }
+      ac[c] = akk;
+      ++kk;
+    }
+    if (stop) { s += kk; break; }
+    /* trailing update A(s+kk:m, s+kk:n) -= A(s+kk:m, s:s+kk) F(kk:n-s, 0:kk)^T */
+    if (s + kk < m && s + kk < n)
+      phgmg_gemm('N', 'T', m - s - kk, n - s - kk, kk, -1.0, A + (s + kk) + (size_t)s * (size_t)lda,
+                 lda, F + kk, ldf, 1.0, A + (s + kk) + (size_t)(s + kk) * (size_t)lda, lda);
+    s += kk;
+    if (any_mark)
+      for (j = s; j < n; ++j)
+        if (mark[j]) {
+          vn1[j] = vn2[j] = (s < m) ? phgmg_normf(m - s, 1, A + s + (size_t)j * (size_t)lda, m - s) : 0.0;
+          mark[j] = 0;
+        }
+  }
+  *rank = s;
+}
+
 PHGMG_DEF phgmg_result phgmg_qrcp(int m, int n, double *A, int lda, double *tau, int *jpvt,
                                   double *work) {
   int r;
@@ -1383,10 +1648,12 @@ PHGMG_DEF phgmg_result phgmg_svd(int m, int n, const double *A, int lda, int kma
     return PHGMG_OK;
   }
   if (!phgmg__mat_finite(m, n, A, lda)) return PHGMG_ERR_NANINF;
-  /* workspace: W (m x n), tau (kmin), vn (2n) */
-  nw = (size_t)m * (size_t)n + (size_t)kmin + 2 * (size_t)n;
+  /* workspace: W (m x n), tau (kmin), vn (2n), F (n x nb), aux (nb);
+     ints: jpvt (n), perm (kmin), mark (n) */
+  nw = (size_t)m * (size_t)n + (size_t)kmin + 2 * (size_t)n +
+       (size_t)(n + 1) * PHGMG__QRCP_NB;
   W = phgmg__dalloc(alloc, nw);
-  jpvt = phgmg__ialloc(alloc, (size_t)n + (size_t)kmin);
+  jpvt = phgmg__ialloc(alloc, 2 * (size_t)n + (size_t)kmin);
   if (!W || !jpvt) { phgmg__free(alloc, W); phgmg__free(alloc, jpvt); return PHGMG_ERR_NOMEM; }
   perm = jpvt + n;
   tau = W + (size_t)m * (size_t)n;
@@ -1394,7 +1661,8 @@ PHGMG_DEF phgmg_result phgmg_svd(int m, int n, const double *A, int lda, int kma
   for (j = 0; j < n; ++j)
     memcpy(W + (size_t)j * (size_t)m, A + (size_t)j * (size_t)lda, (size_t)m * sizeof(double));
   anorm = phgmg_normf(m, n, W, m);
-  phgmg__qrcp_core(m, n, W, m, tau, jpvt, vn, PHGMG__EPS * anorm, &r);
+  phgmg__qrcp_blocked(m, n, W, m, tau, jpvt, vn, vn + 2 * n, vn + 2 * n + (size_t)n * PHGMG__QRCP_NB,
+                      perm + kmin, PHGMG__EPS * anorm, &r);
   if (r == 0) {
     *k_out = 0;
     if (rank_out) *rank_out = 0;
@@ -1550,6 +1818,1696 @@ PHGMG_DEF phgmg_result phgmg_sym_eig(int n, double *A, int lda, double *w, doubl
     }
   }
   return PHGMG_OK;
+}
+
+#endif /* PHGMG_NO_OFFLINE */
+
+/* >>ph (implementation) ================================================== */
+#ifndef PHGMG_NO_OFFLINE
+
+/* Index of element (i,j), |i-j| <= kb, in the (2kb+1) x N band storage. */
+#define PHGMG__PHB(kb, i, j) \
+  ((size_t)((kb) + (i) - (j)) + (size_t)(j) * (size_t)(2 * (kb) + 1))
+
+/* Above this N a banded, non-diagonal R is checked for semidefiniteness by a
+   shifted band Cholesky instead of a dense eigenvalue computation. */
+#define PHGMG__PH_PSD_DENSE_MAX 2000
+
+/* Element (i,j) of J, R or Q (0 outside the band). */
+PHGMG__PRIV double phgmg__ph_at(const phgmg_ph_system *s, const double *M, int i, int j) {
+  if (s->storage == PHGMG_BANDED) {
+    int d = i - j;
+    if (d > s->kb || d < -s->kb) return 0.0;
+    return M[PHGMG__PHB(s->kb, i, j)];
+  }
+  return M[(size_t)i + (size_t)j * (size_t)s->N];
+}
+
+/* y = M x (overwrite) for a dense or banded system matrix. */
+PHGMG__PRIV void phgmg__ph_mv(const phgmg_ph_system *s, const double *M, const double *x,
+                              double *y) {
+  int N = s->N, i, j;
+  for (i = 0; i < N; ++i) y[i] = 0.0;
+  if (s->storage == PHGMG_BANDED) {
+    int kb = s->kb;
+    for (j = 0; j < N; ++j) {
+      double xj = x[j];
+      int i0 = PHGMG__MAX(0, j - kb), i1 = PHGMG__MIN(N - 1, j + kb);
+      const double *col = M + PHGMG__PHB(kb, 0, j);
+      if (xj == 0.0) continue;
+      for (i = i0; i <= i1; ++i) y[i] += col[i] * xj;
+    }
+  } else {
+    for (j = 0; j < N; ++j) {
+      const double *col = M + (size_t)j * (size_t)N;
+      double xj = x[j];
+      if (xj == 0.0) continue;
+      for (i = 0; i < N; ++i) y[i] += col[i] * xj;
+    }
+  }
+}
+
+/* x^T M y without temporaries. */
+PHGMG__PRIV double phgmg__ph_quad(const phgmg_ph_system *s, const double *M, const double *x,
+                                  const double *y) {
+  int N = s->N, i, j;
+  double acc = 0.0;
+  for (j = 0; j < N; ++j) {
+    double t = 0.0;
+    if (s->storage == PHGMG_BANDED) {
+      int kb = s->kb, i0 = PHGMG__MAX(0, j - kb), i1 = PHGMG__MIN(N - 1, j + kb);
+      const double *col = M + PHGMG__PHB(kb, 0, j);
+      for (i = i0; i <= i1; ++i) t += x[i] * col[i];
+    } else {
+      const double *col = M + (size_t)j * (size_t)N;
+      for (i = 0; i < N; ++i) t += x[i] * col[i];
+    }
+    acc += t * y[j];
+  }
+  return acc;
+}
+
+/* d-th derivative (d = 0,1,2) of the scalar nonlinearity of term k at v. */
+PHGMG__PRIV double phgmg__ph_phi(const phgmg_ph_system *s, int k, double v, int d) {
+  if (s->poly_deg > 0) {
+    int j;
+    double acc = 0.0;
+    for (j = s->poly_deg; j >= d; --j) {
+      double c = s->poly[j];
+      if (d == 1) c *= (double)j;
+      else if (d == 2) c *= (double)j * (double)(j - 1);
+      acc = acc * v + c;
+    }
+    return acc;
+  }
+  if (d == 0) return s->phi(k, v, s->user);
+  if (d == 1) return s->dphi(k, v, s->user);
+  return s->ddphi(k, v, s->user);
+}
+
+/* Structural checks shared by every entry point (no O(N^2) work). */
+PHGMG__PRIV phgmg_result phgmg__ph_check(const phgmg_ph_system *s) {
+  int k;
+  if (!s) return PHGMG_ERR_INVALID_ARG;
+  if (s->N <= 0 || s->m <= 0 || s->m > s->N) return PHGMG_ERR_SIZE;
+  if (s->storage != PHGMG_DENSE && s->storage != PHGMG_BANDED) return PHGMG_ERR_INVALID_ARG;
+  if (s->storage == PHGMG_BANDED && (s->kb < 0 || s->kb > s->N - 1)) return PHGMG_ERR_SIZE;
+  if (!s->J || !s->R || !s->Q || !s->B) return PHGMG_ERR_INVALID_ARG;
+  if ((s->shifted_factor == NULL) != (s->shifted_solve == NULL)) return PHGMG_ERR_INVALID_ARG;
+  switch (s->nl) {
+    case PHGMG_NL_NONE: break;
+    case PHGMG_NL_SEPARABLE:
+      if (s->nsep < 0 || s->poly_deg < 0) return PHGMG_ERR_SIZE;
+      if (s->nsep > 0 && !s->sep_idx) return PHGMG_ERR_INVALID_ARG;
+      for (k = 0; k < s->nsep; ++k)
+        if (s->sep_idx[k] < 0 || s->sep_idx[k] >= s->N) return PHGMG_ERR_SIZE;
+      if (s->poly_deg > 0) {
+        if (!s->poly) return PHGMG_ERR_INVALID_ARG;
+      } else if (s->nsep > 0 && (!s->phi || !s->dphi || !s->ddphi)) {
+        return PHGMG_ERR_INVALID_ARG;
+      }
+      break;
+    case PHGMG_NL_GENERAL:
+      if (!s->H_nl || !s->grad_nl || !s->hess_nl) return PHGMG_ERR_INVALID_ARG;
+      break;
+    default: return PHGMG_ERR_INVALID_ARG;
+  }
+  return PHGMG_OK;
+}
+
+/* Finiteness of the valid entries of a dense or banded system matrix. */
+PHGMG__PRIV int phgmg__ph_mat_finite(const phgmg_ph_system *s, const double *M) {
+  int N = s->N, j;
+  if (s->storage == PHGMG_DENSE) return phgmg__all_finite(M, (size_t)N * (size_t)N);
+  for (j = 0; j < N; ++j) {
+    int i0 = PHGMG__MAX(0, j - s->kb), i1 = PHGMG__MIN(N - 1, j + s->kb);
+    if (!phgmg__all_finite(M + PHGMG__PHB(s->kb, i0, j), (size_t)(i1 - i0 + 1))) return 0;
+  }
+  return 1;
+}
+
+/* g = Q x + grad H_nl(x); tmp (N doubles) is needed for GENERAL only. */
+PHGMG__PRIV void phgmg__ph_grad(const phgmg_ph_system *s, const double *x, double *g,
+                                double *tmp) {
+  int k, i;
+  phgmg__ph_mv(s, s->Q, x, g);
+  if (s->nl == PHGMG_NL_SEPARABLE) {
+    for (k = 0; k < s->nsep; ++k) {
+      int ix = s->sep_idx[k];
+      double w = s->sep_w ? s->sep_w[k] : 1.0;
+      g[ix] += w * phgmg__ph_phi(s, k, x[ix], 1);
+    }
+  } else if (s->nl == PHGMG_NL_GENERAL) {
+    s->grad_nl(x, tmp, s->user);
+    for (i = 0; i < s->N; ++i) g[i] += tmp[i];
+  }
+}
+
+/* A scratch vector of N doubles for the allocation-free public evaluators:
+   the stack for small N, the default allocator otherwise (NULL on failure). */
+#define PHGMG__PH_STACK 256
+PHGMG__PRIV double *phgmg__ph_scratch(int n, double *stackbuf) {
+  if (n <= PHGMG__PH_STACK) return stackbuf;
+  return phgmg__dalloc(NULL, (size_t)n);
+}
+PHGMG__PRIV void phgmg__ph_scratch_free(double *p, double *stackbuf) {
+  if (p != stackbuf) phgmg__free(NULL, p);
+}
+
+PHGMG_DEF double phgmg_ph_hamiltonian(const phgmg_ph_system *sys, const double *x) {
+  double H;
+  int k;
+  PHGMG_ASSERT(sys && x);
+  H = 0.5 * phgmg__ph_quad(sys, sys->Q, x, x);
+  if (sys->nl == PHGMG_NL_SEPARABLE) {
+    for (k = 0; k < sys->nsep; ++k)
+      H += (sys->sep_w ? sys->sep_w[k] : 1.0) * phgmg__ph_phi(sys, k, x[sys->sep_idx[k]], 0);
+  } else if (sys->nl == PHGMG_NL_GENERAL) {
+    H += sys->H_nl(x, sys->user);
+  }
+  return H;
+}
+
+PHGMG_DEF void phgmg_ph_gradient(const phgmg_ph_system *sys, const double *x, double *g) {
+  PHGMG_ASSERT(sys && x && g);
+  if (sys->nl == PHGMG_NL_GENERAL) {
+    double sb[PHGMG__PH_STACK], *tmp = phgmg__ph_scratch(sys->N, sb);
+    int i;
+    if (!tmp) { for (i = 0; i < sys->N; ++i) g[i] = NAN; return; }
+    phgmg__ph_grad(sys, x, g, tmp);
+    phgmg__ph_scratch_free(tmp, sb);
+  } else {
+    phgmg__ph_grad(sys, x, g, NULL);
+  }
+}
+
+/* Public evaluators that need a gradient scratch vector take it from the stack
+   (N <= 256) or the default allocator; if that fails the result is NaN. */
+PHGMG_DEF void phgmg_ph_rhs(const phgmg_ph_system *sys, const double *x, const double *u,
+                            double *f) {
+  double sb[PHGMG__PH_STACK], *g;
+  double *tmp = NULL;
+  int N, i, j;
+  PHGMG_ASSERT(sys && x && f);
+  N = sys->N;
+  g = phgmg__ph_scratch(N, sb);
+  if (g && sys->nl == PHGMG_NL_GENERAL) {
+    tmp = phgmg__dalloc(NULL, (size_t)N);
+    if (!tmp) { phgmg__ph_scratch_free(g, sb); g = NULL; }
+  }
+  if (!g) { for (i = 0; i < N; ++i) f[i] = NAN; return; }
+  phgmg__ph_grad(sys, x, g, tmp);
+  phgmg__ph_mv(sys, sys->J, g, f);
+  /* f -= R g, column by column (no second scratch vector) */
+  for (j = 0; j < N; ++j) {
+    double gj = g[j];
+    if (gj == 0.0) continue;
+    if (sys->storage == PHGMG_BANDED) {
+      int kb = sys->kb, i0 = PHGMG__MAX(0, j - kb), i1 = PHGMG__MIN(N - 1, j + kb);
+      const double *col = sys->R + PHGMG__PHB(kb, 0, j);
+      for (i = i0; i <= i1; ++i) f[i] -= col[i] * gj;
+    } else {
+      const double *col = sys->R + (size_t)j * (size_t)N;
+      for (i = 0; i < N; ++i) f[i] -= col[i] * gj;
+    }
+  }
+  if (u)
+    for (j = 0; j < sys->m; ++j) {
+      const double *bj = sys->B + (size_t)j * (size_t)N;
+      for (i = 0; i < N; ++i) f[i] += bj[i] * u[j];
+    }
+  phgmg__free(NULL, tmp);
+  phgmg__ph_scratch_free(g, sb);
+}
+
+PHGMG_DEF void phgmg_ph_output(const phgmg_ph_system *sys, const double *x, double *y) {
+  double sb[PHGMG__PH_STACK], *g, *tmp = NULL;
+  int N, i, j;
+  PHGMG_ASSERT(sys && x && y);
+  N = sys->N;
+  g = phgmg__ph_scratch(N, sb);
+  if (g && sys->nl == PHGMG_NL_GENERAL) {
+    tmp = phgmg__dalloc(NULL, (size_t)N);
+    if (!tmp) { phgmg__ph_scratch_free(g, sb); g = NULL; }
+  }
+  if (!g) { for (j = 0; j < sys->m; ++j) y[j] = NAN; return; }
+  phgmg__ph_grad(sys, x, g, tmp);
+  for (j = 0; j < sys->m; ++j) {
+    const double *bj = sys->B + (size_t)j * (size_t)N;
+    double acc = 0.0;
+    for (i = 0; i < N; ++i) acc += bj[i] * g[i];
+    y[j] = acc;
+  }
+  phgmg__free(NULL, tmp);
+  phgmg__ph_scratch_free(g, sb);
+}
+
+PHGMG_DEF void phgmg_ph_apply(const phgmg_ph_system *sys, char which, int nrhs,
+                              const double *X, int ldx, double *Y, int ldy) {
+  const double *M;
+  int c;
+  PHGMG_ASSERT(sys && X && Y && ldx >= sys->N && ldy >= sys->N);
+  M = which == 'J' || which == 'j' ? sys->J : which == 'R' || which == 'r' ? sys->R : sys->Q;
+  PHGMG_ASSERT(which == 'J' || which == 'j' || which == 'R' || which == 'r' || which == 'Q' ||
+               which == 'q');
+  if (sys->storage == PHGMG_DENSE) {
+    phgmg_gemm('N', 'N', sys->N, nrhs, sys->N, 1.0, M, sys->N, X, ldx, 0.0, Y, ldy);
+    return;
+  }
+  for (c = 0; c < nrhs; ++c)
+    phgmg__ph_mv(sys, M, X + (size_t)c * (size_t)ldx, Y + (size_t)c * (size_t)ldy);
+}
+
+/* ---- banded LU with partial pivoting (LAPACK dgbtf2/dgbtrs layout) -------- */
+/* ab is ldab x n, ldab >= 2kl+ku+1; A(i,j) sits at ab[(kl+ku+i-j) + j*ldab],
+   the top kl rows are fill-in space and must be zero on entry. ipiv[j] = row
+   swapped with j. *ue receives the actual upper bandwidth of U (<= kl+ku; ku
+   when no row was swapped), dinv the reciprocals of U's diagonal. */
+PHGMG__PRIV phgmg_result phgmg__gb_factor(int n, int kl, int ku, double *ab, int ldab, int *ipiv,
+                                          double *dinv, int *ue) {
+  int kv = kl + ku, j, ju = 0, uext = 0;
+  for (j = 0; j < n; ++j) {
+    int km = PHGMG__MIN(kl, n - 1 - j), jp = 0, p, c;
+    double *colj = ab + (size_t)j * (size_t)ldab + kv; /* colj[p] = A(j+p, j) */
+    double amax = fabs(colj[0]);
+    for (p = 1; p <= km; ++p)
+      if (fabs(colj[p]) > amax) { amax = fabs(colj[p]); jp = p; }
+    ipiv[j] = j + jp;
+    if (!(amax > 0.0)) return amax == 0.0 ? PHGMG_ERR_SINGULAR : PHGMG_ERR_NANINF;
+    if (amax == HUGE_VAL) return PHGMG_ERR_NANINF;
+    ju = PHGMG__MAX(ju, PHGMG__MIN(j + ku + jp, n - 1));
+    if (ju - j > uext) uext = ju - j;
+    if (jp != 0)
+      for (c = j; c <= ju; ++c) {
+        size_t a = (size_t)(kv + j - c) + (size_t)c * (size_t)ldab, b = a + (size_t)jp;
+        double t = ab[a];
+        ab[a] = ab[b];
+        ab[b] = t;
+      }
+    dinv[j] = 1.0 / colj[0];
+    if (km > 0) {
+      double r = dinv[j];
+      for (p = 1; p <= km; ++p) colj[p] *= r;
+      for (c = j + 1; c <= ju; ++c) {
+        double *colc = ab + (size_t)(kv + j - c) + (size_t)c * (size_t)ldab; /* A(j+p,c) */
+        double t = colc[0];
+        if (t != 0.0)
+          for (p = 1; p <= km; ++p) colc[p] -= colj[p] * t;
+      }
+    }
+  }
+  *ue = uext;
+  return PHGMG_OK;
+}
+
+/* Solve A x = b ('N') or A^T x = b ('T') with the band factors, b overwritten. */
+PHGMG__PRIV void phgmg__gb_solve(char trans, int n, int kl, int ku, int ue, const double *ab,
+                                 int ldab, const int *ipiv, const double *dinv, double *b) {
+  int kv = kl + ku, j, p;
+  if (trans == 'N' || trans == 'n') {
+    for (j = 0; j < n; ++j) {
+      int km = PHGMG__MIN(kl, n - 1 - j), jp = ipiv[j];
+      const double *l = ab + (size_t)j * (size_t)ldab + kv;
+      double t;
+      if (jp != j) { t = b[j]; b[j] = b[jp]; b[jp] = t; }
+      t = b[j];
+      if (t != 0.0)
+        for (p = 1; p <= km; ++p) b[j + p] -= l[p] * t;
+    }
+    for (j = n - 1; j >= 0; --j) {
+      int i0 = PHGMG__MAX(0, j - ue), i;
+      size_t base = (size_t)j * (size_t)ldab + (size_t)kv - (size_t)j; /* + i = U(i,j) */
+      double t = b[j] * dinv[j];
+      b[j] = t;
+      if (t != 0.0)
+        for (i = i0; i < j; ++i) b[i] -= ab[base + (size_t)i] * t;
+    }
+  } else {
+    for (j = 0; j < n; ++j) {
+      int i0 = PHGMG__MAX(0, j - ue), i;
+      size_t base = (size_t)j * (size_t)ldab + (size_t)kv - (size_t)j;
+      double t = b[j];
+      for (i = i0; i < j; ++i) t -= ab[base + (size_t)i] * b[i];
+      b[j] = t * dinv[j];
+    }
+    for (j = n - 2; j >= 0; --j) {
+      int km = PHGMG__MIN(kl, n - 1 - j), jp = ipiv[j];
+      const double *l = ab + (size_t)j * (size_t)ldab + kv;
+      double t = b[j];
+      for (p = 1; p <= km; ++p) t -= l[p] * b[j + p];
+      b[j] = t;
+      if (jp != j) { t = b[j]; b[j] = b[jp]; b[jp] = t; }
+    }
+  }
+}
+
+/* Complex (interleaved) versions: element r of column j at ab[2*(r + j*ldab)]. */
+PHGMG__PRIV phgmg_result phgmg__zgb_factor(int n, int kl, int ku, double *ab, int ldab,
+                                           int *ipiv, double *dinv, int *ue) {
+  int kv = kl + ku, j, ju = 0, uext = 0;
+  for (j = 0; j < n; ++j) {
+    int km = PHGMG__MIN(kl, n - 1 - j), jp = 0, p, c;
+    double *colj = ab + 2 * ((size_t)j * (size_t)ldab + (size_t)kv);
+    double amax = fabs(colj[0]) + fabs(colj[1]), pr, pi, rr, ri;
+    for (p = 1; p <= km; ++p) {
+      double v = fabs(colj[2 * p]) + fabs(colj[2 * p + 1]);
+      if (v > amax) { amax = v; jp = p; }
+    }
+    ipiv[j] = j + jp;
+    if (!(amax > 0.0)) return amax == 0.0 ? PHGMG_ERR_SINGULAR : PHGMG_ERR_NANINF;
+    if (amax == HUGE_VAL) return PHGMG_ERR_NANINF;
+    ju = PHGMG__MAX(ju, PHGMG__MIN(j + ku + jp, n - 1));
+    if (ju - j > uext) uext = ju - j;
+    if (jp != 0)
+      for (c = j; c <= ju; ++c) {
+        size_t a = 2 * ((size_t)(kv + j - c) + (size_t)c * (size_t)ldab), b = a + 2 * (size_t)jp;
+        double t = ab[a];
+        ab[a] = ab[b]; ab[b] = t;
+        t = ab[a + 1]; ab[a + 1] = ab[b + 1]; ab[b + 1] = t;
+      }
+    /* reciprocal of the pivot (Smith) */
+    pr = colj[0]; pi = colj[1];
+    if (fabs(pr) >= fabs(pi)) {
+      double q = pi / pr, d = pr + pi * q;
+      rr = 1.0 / d; ri = -q / d;
+    } else {
+      double q = pr / pi, d = pr * q + pi;
+      rr = q / d; ri = -1.0 / d;
+    }
+    dinv[2 * j] = rr; dinv[2 * j + 1] = ri;
+    if (km > 0) {
+      for (p = 1; p <= km; ++p) {
+        double xr = colj[2 * p], xi = colj[2 * p + 1];
+        colj[2 * p] = xr * rr - xi * ri;
+        colj[2 * p + 1] = xr * ri + xi * rr;
+      }
+      for (c = j + 1; c <= ju; ++c) {
+        double *colc = ab + 2 * ((size_t)(kv + j - c) + (size_t)c * (size_t)ldab);
+        double tr = colc[0], ti = colc[1];
+        if (tr == 0.0 && ti == 0.0) continue;
+        for (p = 1; p <= km; ++p) {
+          double lr = colj[2 * p], li = colj[2 * p + 1];
+          colc[2 * p] -= lr * tr - li * ti;
+          colc[2 * p + 1] -= lr * ti + li * tr;
+        }
+      }
+    }
+  }
+  *ue = uext;
+  return PHGMG_OK;
+}
+
+PHGMG__PRIV void phgmg__zgb_solve(int n, int kl, int ku, int ue, const double *ab, int ldab,
+                                  const int *ipiv, const double *dinv, double *b) {
+  int kv = kl + ku, j, p;
+  for (j = 0; j < n; ++j) {
+    int km = PHGMG__MIN(kl, n - 1 - j), jp = ipiv[j];
+    const double *l = ab + 2 * ((size_t)j * (size_t)ldab + (size_t)kv);
+    double tr, ti;
+    if (jp != j) {
+      tr = b[2 * j]; b[2 * j] = b[2 * jp]; b[2 * jp] = tr;
+      ti = b[2 * j + 1]; b[2 * j + 1] = b[2 * jp + 1]; b[2 * jp + 1] = ti;
+    }
+    tr = b[2 * j]; ti = b[2 * j + 1];
+    if (tr == 0.0 && ti == 0.0) continue;
+    for (p = 1; p <= km; ++p) {
+      double lr = l[2 * p], li = l[2 * p + 1];
+      b[2 * (j + p)] -= lr * tr - li * ti;
+      b[2 * (j + p) + 1] -= lr * ti + li * tr;
+    }
+  }
+  for (j = n - 1; j >= 0; --j) {
+    int i0 = PHGMG__MAX(0, j - ue), i;
+    size_t base = (size_t)j * (size_t)ldab + (size_t)kv - (size_t)j;
+    double xr = b[2 * j], xi = b[2 * j + 1], rr = dinv[2 * j], ri = dinv[2 * j + 1];
+    double tr = xr * rr - xi * ri, ti = xr * ri + xi * rr;
+    b[2 * j] = tr; b[2 * j + 1] = ti;
+    if (tr == 0.0 && ti == 0.0) continue;
+    for (i = i0; i < j; ++i) {
+      const double *u = ab + 2 * (base + (size_t)i);
+      b[2 * i] -= u[0] * tr - u[1] * ti;
+      b[2 * i + 1] -= u[0] * ti + u[1] * tr;
+    }
+  }
+}
+
+/* A band LU object (real), owned by the jr factor and the validator. */
+typedef struct phgmg__gbf {
+  int n, kl, ku, ldab, ue;
+  double *ab, *dinv;
+  int *ipiv;
+} phgmg__gbf;
+
+PHGMG__PRIV void phgmg__gbf_free(const phgmg_allocator *al, phgmg__gbf *f) {
+  phgmg__free(al, f->ab);
+  phgmg__free(al, f->dinv);
+  phgmg__free(al, f->ipiv);
+  f->ab = f->dinv = NULL;
+  f->ipiv = NULL;
+}
+
+/* Factor J - R of a banded system (kl = ku = kb). */
+PHGMG__PRIV phgmg_result phgmg__gbf_jr(const phgmg_allocator *al, const phgmg_ph_system *s,
+                                       phgmg__gbf *f) {
+  int N = s->N, kb = s->kb, i, j;
+  f->n = N; f->kl = kb; f->ku = kb; f->ldab = 3 * kb + 1; f->ue = 0;
+  f->ab = phgmg__dalloc(al, (size_t)f->ldab * (size_t)N);
+  f->dinv = phgmg__dalloc(al, (size_t)N);
+  f->ipiv = phgmg__ialloc(al, (size_t)N);
+  if (!f->ab || !f->dinv || !f->ipiv) { phgmg__gbf_free(al, f); return PHGMG_ERR_NOMEM; }
+  memset(f->ab, 0, sizeof(double) * (size_t)f->ldab * (size_t)N);
+  for (j = 0; j < N; ++j)
+    for (i = PHGMG__MAX(0, j - kb); i <= PHGMG__MIN(N - 1, j + kb); ++i) {
+      size_t k = PHGMG__PHB(kb, i, j);
+      f->ab[(size_t)(2 * kb + i - j) + (size_t)j * (size_t)f->ldab] = s->J[k] - s->R[k];
+    }
+  return phgmg__gb_factor(N, kb, kb, f->ab, f->ldab, f->ipiv, f->dinv, &f->ue);
+}
+
+PHGMG__PRIV void phgmg__gbf_solve(const phgmg__gbf *f, char trans, double *b) {
+  phgmg__gb_solve(trans, f->n, f->kl, f->ku, f->ue, f->ab, f->ldab, f->ipiv, f->dinv, b);
+}
+
+/* Hager/Higham estimate of ||A^{-1}||_1 from band factors (LAPACK dlacn2 logic).
+   work: 2n doubles, iwork: n ints. */
+PHGMG__PRIV double phgmg__gbf_inv_norm1(const phgmg__gbf *f, double *work, int *isgn) {
+  int n = f->n, i, j, jlast, iter, same;
+  double *x = work, est, estold, temp;
+  for (i = 0; i < n; ++i) x[i] = 1.0 / (double)n;
+  phgmg__gbf_solve(f, 'N', x);
+  if (n == 1) return fabs(x[0]);
+  est = 0.0;
+  for (i = 0; i < n; ++i) est += fabs(x[i]);
+  for (i = 0; i < n; ++i) { isgn[i] = x[i] >= 0.0 ? 1 : -1; x[i] = (double)isgn[i]; }
+  phgmg__gbf_solve(f, 'T', x);
+  j = 0;
+  for (i = 1; i < n; ++i) if (fabs(x[i]) > fabs(x[j])) j = i;
+  for (iter = 2;; ++iter) {
+    for (i = 0; i < n; ++i) x[i] = 0.0;
+    x[j] = 1.0;
+    phgmg__gbf_solve(f, 'N', x);
+    estold = est;
+    est = 0.0;
+    for (i = 0; i < n; ++i) est += fabs(x[i]);
+    same = 1;
+    for (i = 0; i < n; ++i)
+      if ((x[i] >= 0.0 ? 1 : -1) != isgn[i]) { same = 0; break; }
+    if (same || est <= estold) { if (est < estold) est = estold; break; }
+    for (i = 0; i < n; ++i) { isgn[i] = x[i] >= 0.0 ? 1 : -1; x[i] = (double)isgn[i]; }
+    phgmg__gbf_solve(f, 'T', x);
+    jlast = j;
+    j = 0;
+    for (i = 1; i < n; ++i) if (fabs(x[i]) > fabs(x[j])) j = i;
+    if (fabs(x[jlast]) == fabs(x[j]) || iter >= 5) break;
+  }
+  for (i = 0; i < n; ++i) x[i] = ((i & 1) ? -1.0 : 1.0) * (1.0 + (double)i / (double)(n - 1));
+  phgmg__gbf_solve(f, 'N', x);
+  temp = 0.0;
+  for (i = 0; i < n; ++i) temp += fabs(x[i]);
+  temp = 2.0 * temp / (3.0 * (double)n);
+  return temp > est ? temp : est;
+}
+
+/* ||J - R||_1 */
+PHGMG__PRIV double phgmg__ph_jr_norm1(const phgmg_ph_system *s) {
+  int N = s->N, i, j;
+  double best = 0.0;
+  for (j = 0; j < N; ++j) {
+    double acc = 0.0;
+    int i0 = 0, i1 = N - 1;
+    if (s->storage == PHGMG_BANDED) { i0 = PHGMG__MAX(0, j - s->kb); i1 = PHGMG__MIN(N - 1, j + s->kb); }
+    for (i = i0; i <= i1; ++i) acc += fabs(phgmg__ph_at(s, s->J, i, j) - phgmg__ph_at(s, s->R, i, j));
+    if (acc > best) best = acc;
+  }
+  return best;
+}
+
+/* ---- factorization of J - R ------------------------------------------------ */
+struct phgmg_jr_factor {
+  phgmg_allocator al;
+  int N;
+  phgmg_storage storage;
+  double *LU; /* dense */
+  int *ipiv;
+  phgmg__gbf gb; /* banded */
+};
+
+PHGMG_DEF void phgmg_jr_factor_destroy(phgmg_jr_factor *f) {
+  phgmg_allocator al;
+  if (!f) return;
+  al = f->al;
+  phgmg__free(&al, f->LU);
+  phgmg__free(&al, f->ipiv);
+  phgmg__gbf_free(&al, &f->gb);
+  phgmg__free(&al, f);
+}
+
+/* rcond of the factored J - R (0 if singular); NOMEM -> -1. */
+PHGMG__PRIV double phgmg__jr_rcond(const phgmg_jr_factor *f, const phgmg_ph_system *s) {
+  const phgmg_allocator *al = &f->al;
+  int N = f->N;
+  double anorm = phgmg__ph_jr_norm1(s), rc = 0.0;
+  double *work = phgmg__dalloc(al, 2 * (size_t)N);
+  int *iwork = phgmg__ialloc(al, (size_t)N);
+  if (!work || !iwork) {
+    phgmg__free(al, work); phgmg__free(al, iwork);
+    return -1.0;
+  }
+  if (!(anorm > 0.0)) rc = 0.0;
+  else if (f->storage == PHGMG_DENSE) {
+    rc = phgmg_lu_rcond(N, f->LU, N, f->ipiv, anorm, work, iwork);
+  } else {
+    double est = phgmg__gbf_inv_norm1(&f->gb, work, iwork);
+    rc = (est > 0.0 && est == est && est < HUGE_VAL) ? (1.0 / est) / anorm : 0.0;
+  }
+  phgmg__free(al, work);
+  phgmg__free(al, iwork);
+  return rc;
+}
+
+PHGMG_DEF phgmg_result phgmg_jr_factor_create(phgmg_jr_factor **out, const phgmg_ph_system *sys,
+                                              double *rcond_out, const phgmg_allocator *alloc) {
+  phgmg_jr_factor *f;
+  phgmg_result rc;
+  int N, i, j;
+  if (!out) return PHGMG_ERR_INVALID_ARG;
+  *out = NULL;
+  rc = phgmg__ph_check(sys);
+  if (rc != PHGMG_OK) return rc;
+  if (!phgmg__ph_mat_finite(sys, sys->J) || !phgmg__ph_mat_finite(sys, sys->R))
+    return PHGMG_ERR_NANINF;
+  N = sys->N;
+  f = PHGMG__CAST(phgmg_jr_factor *, phgmg__alloc(alloc, sizeof(phgmg_jr_factor)));
+  if (!f) return PHGMG_ERR_NOMEM;
+  memset(f, 0, sizeof *f);
+  if (alloc) f->al = *alloc;
+  f->N = N;
+  f->storage = sys->storage;
+  if (sys->storage == PHGMG_DENSE) {
+    f->LU = phgmg__dalloc(alloc, (size_t)N * (size_t)N);
+    f->ipiv = phgmg__ialloc(alloc, (size_t)N);
+    if (!f->LU || !f->ipiv) { phgmg_jr_factor_destroy(f); return PHGMG_ERR_NOMEM; }
+    for (j = 0; j < N; ++j)
+      for (i = 0; i < N; ++i) {
+        size_t k = (size_t)i + (size_t)j * (size_t)N;
+        f->LU[k] = sys->J[k] - sys->R[k];
+      }
+    rc = phgmg_lu_factor(N, f->LU, N, f->ipiv);
+  } else {
+    rc = phgmg__gbf_jr(alloc, sys, &f->gb);
+  }
+  if (rc != PHGMG_OK) {
+    if (rcond_out) *rcond_out = 0.0;
+    phgmg_jr_factor_destroy(f);
+    return rc;
+  }
+  if (rcond_out) {
+    double r = phgmg__jr_rcond(f, sys);
+    if (r < 0.0) { phgmg_jr_factor_destroy(f); return PHGMG_ERR_NOMEM; }
+    *rcond_out = r;
+  }
+  *out = f;
+  return PHGMG_OK;
+}
+
+PHGMG_DEF void phgmg_jr_solve(const phgmg_jr_factor *f, char trans, int nrhs, double *X, int ldx) {
+  int c;
+  PHGMG_ASSERT(f && X && ldx >= f->N);
+  PHGMG_ASSERT(trans == 'N' || trans == 'n' || trans == 'T' || trans == 't');
+  if (f->storage == PHGMG_DENSE) {
+    phgmg_lu_solve(trans, f->N, f->LU, f->N, f->ipiv, nrhs, X, ldx);
+    return;
+  }
+  for (c = 0; c < nrhs; ++c) phgmg__gbf_solve(&f->gb, trans, X + (size_t)c * (size_t)ldx);
+}
+
+/* ---- validation ------------------------------------------------------------- */
+/* Frobenius norms of M and of M + sign*M^T over the valid entries. */
+PHGMG__PRIV void phgmg__ph_sym_defect(const phgmg_ph_system *s, const double *M, double sign,
+                                      double *norm, double *defect) {
+  int N = s->N, i, j;
+  double a = 0.0, d = 0.0;
+  for (j = 0; j < N; ++j) {
+    int i0 = 0, i1 = N - 1;
+    if (s->storage == PHGMG_BANDED) { i0 = PHGMG__MAX(0, j - s->kb); i1 = PHGMG__MIN(N - 1, j + s->kb); }
+    for (i = i0; i <= i1; ++i) {
+      double mij = phgmg__ph_at(s, M, i, j), e = mij + sign * phgmg__ph_at(s, M, j, i);
+      a += mij * mij;
+      d += e * e;
+    }
+  }
+  *norm = sqrt(a);
+  *defect = sqrt(d);
+}
+
+/* Is the shifted banded symmetric matrix R + delta I positive definite?
+   Band Cholesky on the lower band, O(N kb^2). 1 yes, 0 no, -1 out of memory. */
+PHGMG__PRIV int phgmg__ph_band_chol_pd(const phgmg_ph_system *s, const double *R, double delta,
+                                       const phgmg_allocator *al) {
+  int N = s->N, kb = s->kb, i, j, k, ok = 1;
+  size_t ld = (size_t)kb + 1;
+  double *L = phgmg__dalloc(al, ld * (size_t)N); /* L(i,j) at L[(i-j) + j*ld] */
+  if (!L) return -1;
+  for (j = 0; j < N && ok; ++j) {
+    double d = R[PHGMG__PHB(kb, j, j)] + delta;
+    for (k = PHGMG__MAX(0, j - kb); k < j; ++k) {
+      double l = L[(size_t)(j - k) + (size_t)k * ld];
+      d -= l * l;
+    }
+    if (!(d > 0.0)) { ok = 0; break; }
+    d = sqrt(d);
+    L[(size_t)j * ld] = d;
+    for (i = j + 1; i <= PHGMG__MIN(N - 1, j + kb); ++i) {
+      double v = R[PHGMG__PHB(kb, i, j)];
+      for (k = PHGMG__MAX(0, i - kb); k < j; ++k)
+        v -= L[(size_t)(i - k) + (size_t)k * ld] * L[(size_t)(j - k) + (size_t)k * ld];
+      L[(size_t)(i - j) + (size_t)j * ld] = v / d;
+    }
+  }
+  phgmg__free(al, L);
+  return ok;
+}
+
+/* R positive semidefinite within tol (see the declaration). */
+PHGMG__PRIV phgmg_result phgmg__ph_check_psd(const phgmg_ph_system *s, double tol,
+                                             const phgmg_allocator *al) {
+  int N = s->N, i, j, diag = 1;
+  double dmax = 0.0, dmin = HUGE_VAL;
+  for (j = 0; j < N && diag; ++j) {
+    int i0 = 0, i1 = N - 1;
+    if (s->storage == PHGMG_BANDED) { i0 = PHGMG__MAX(0, j - s->kb); i1 = PHGMG__MIN(N - 1, j + s->kb); }
+    for (i = i0; i <= i1; ++i)
+      if (i != j && phgmg__ph_at(s, s->R, i, j) != 0.0) { diag = 0; break; }
+  }
+  if (diag) { /* the eigenvalues are the diagonal */
+    for (j = 0; j < N; ++j) {
+      double d = phgmg__ph_at(s, s->R, j, j);
+      if (fabs(d) > dmax) dmax = fabs(d);
+      if (d < dmin) dmin = d;
+    }
+    return dmin >= -tol * dmax ? PHGMG_OK : PHGMG_ERR_NOT_PSD;
+  }
+  if (s->storage == PHGMG_DENSE || N <= PHGMG__PH_PSD_DENSE_MAX) {
+    double *A = phgmg__dalloc(al, (size_t)N * (size_t)N), *w = phgmg__dalloc(al, (size_t)N);
+    phgmg_result rc;
+    if (!A || !w) { phgmg__free(al, A); phgmg__free(al, w); return PHGMG_ERR_NOMEM; }
+    for (j = 0; j < N; ++j)
+      for (i = 0; i < N; ++i) A[(size_t)i + (size_t)j * (size_t)N] = phgmg__ph_at(s, s->R, i, j);
+    rc = phgmg_sym_eig(N, A, N, w, NULL, 0);
+    if (rc == PHGMG_OK) {
+      double nrm = PHGMG__MAX(fabs(w[0]), fabs(w[N - 1]));
+      if (w[0] < -tol * nrm) rc = PHGMG_ERR_NOT_PSD;
+    }
+    phgmg__free(al, A);
+    phgmg__free(al, w);
+    return rc;
+  } else {
+    /* large banded: R + tol*||R||_1 I must admit a Cholesky factorization
+       (||R||_1 >= ||R||_2 for symmetric R, so this is slightly more lenient) */
+    double n1 = 0.0;
+    int r;
+    for (j = 0; j < N; ++j) {
+      double acc = 0.0;
+      for (i = PHGMG__MAX(0, j - s->kb); i <= PHGMG__MIN(N - 1, j + s->kb); ++i)
+        acc += fabs(s->R[PHGMG__PHB(s->kb, i, j)]);
+      if (acc > n1) n1 = acc;
+    }
+    if (n1 == 0.0) return PHGMG_OK;
+    r = phgmg__ph_band_chol_pd(s, s->R, tol * n1, al);
+    if (r < 0) return PHGMG_ERR_NOMEM;
+    return r ? PHGMG_OK : PHGMG_ERR_NOT_PSD;
+  }
+}
+
+PHGMG_DEF phgmg_result phgmg_ph_validate(const phgmg_ph_system *sys, double tol,
+                                         double *rcond_out, const phgmg_allocator *alloc) {
+  phgmg_result rc;
+  double nrm, def;
+  int N, m;
+  if (rcond_out) *rcond_out = 0.0;
+  rc = phgmg__ph_check(sys);
+  if (rc != PHGMG_OK) return rc;
+  if (!(tol > 0.0)) tol = 1e-12;
+  N = sys->N;
+  m = sys->m;
+  /* NaN / Inf */
+  if (!phgmg__ph_mat_finite(sys, sys->J) || !phgmg__ph_mat_finite(sys, sys->R) ||
+      !phgmg__ph_mat_finite(sys, sys->Q) ||
+      !phgmg__all_finite(sys->B, (size_t)N * (size_t)m))
+    return PHGMG_ERR_NANINF;
+  if (sys->nl == PHGMG_NL_SEPARABLE) {
+    if (sys->sep_w && !phgmg__all_finite(sys->sep_w, (size_t)sys->nsep)) return PHGMG_ERR_NANINF;
+    if (sys->poly_deg > 0 && !phgmg__all_finite(sys->poly, (size_t)sys->poly_deg + 1))
+      return PHGMG_ERR_NANINF;
+  }
+  /* structure */
+  phgmg__ph_sym_defect(sys, sys->J, 1.0, &nrm, &def);
+  if (def > tol * nrm) return PHGMG_ERR_NOT_SKEW;
+  phgmg__ph_sym_defect(sys, sys->R, -1.0, &nrm, &def);
+  if (def > tol * nrm) return PHGMG_ERR_NOT_SYMMETRIC;
+  phgmg__ph_sym_defect(sys, sys->Q, -1.0, &nrm, &def);
+  if (def > tol * nrm) return PHGMG_ERR_NOT_SYMMETRIC;
+  rc = phgmg__ph_check_psd(sys, tol, alloc);
+  if (rc != PHGMG_OK) return rc;
+  /* B full column rank: pivoted QR, |R(m-1,m-1)| > tol |R(0,0)| */
+  {
+    double *Bc = phgmg__dalloc(alloc, (size_t)N * (size_t)m);
+    double *tau = phgmg__dalloc(alloc, (size_t)m), *work = phgmg__dalloc(alloc, 2 * (size_t)m);
+    int *jpvt = phgmg__ialloc(alloc, (size_t)m);
+    if (!Bc || !tau || !work || !jpvt) rc = PHGMG_ERR_NOMEM;
+    else {
+      memcpy(Bc, sys->B, sizeof(double) * (size_t)N * (size_t)m);
+      rc = phgmg_qrcp(N, m, Bc, N, tau, jpvt, work);
+      if (rc == PHGMG_OK) {
+        double r00 = fabs(Bc[0]), rmm = fabs(Bc[(size_t)(m - 1) * (size_t)(N + 1)]);
+        if (!(r00 > 0.0) || !(rmm > tol * r00)) rc = PHGMG_ERR_RANK;
+      }
+    }
+    phgmg__free(alloc, Bc);
+    phgmg__free(alloc, tau);
+    phgmg__free(alloc, work);
+    phgmg__free(alloc, jpvt);
+    if (rc != PHGMG_OK) return rc;
+  }
+  /* J - R invertible */
+  {
+    phgmg_jr_factor *f = NULL;
+    double rcond = 0.0;
+    rc = phgmg_jr_factor_create(&f, sys, &rcond, alloc);
+    if (rc == PHGMG_ERR_NOMEM) return rc;
+    if (rc != PHGMG_OK) rcond = 0.0;
+    phgmg_jr_factor_destroy(f);
+    if (rcond_out) *rcond_out = rcond;
+    if (!(rcond > tol)) return PHGMG_ERR_SINGULAR;
+  }
+  return PHGMG_OK;
+}
+
+/* >>gl3 (implementation) ================================================= */
+
+PHGMG_DEF void phgmg_gl3_coefficients(double c[3], double b[3], double A[9]) {
+  const double s15 = sqrt(15.0);
+  c[0] = 0.5 - s15 / 10.0;
+  c[1] = 0.5;
+  c[2] = 0.5 + s15 / 10.0;
+  b[0] = 5.0 / 18.0;
+  b[1] = 4.0 / 9.0;
+  b[2] = 5.0 / 18.0;
+  A[0] = 5.0 / 36.0;         A[1] = 2.0 / 9.0 - s15 / 15.0; A[2] = 5.0 / 36.0 - s15 / 30.0;
+  A[3] = 5.0 / 36.0 + s15 / 24.0; A[4] = 2.0 / 9.0;       A[5] = 5.0 / 36.0 - s15 / 24.0;
+  A[6] = 5.0 / 36.0 + s15 / 30.0; A[7] = 2.0 / 9.0 + s15 / 15.0; A[8] = 5.0 / 36.0;
+}
+
+/* Inverse of a row-major 3x3 matrix; 0 if singular. */
+PHGMG__PRIV int phgmg__inv3(const double *M, double *Mi) {
+  double c00 = M[4] * M[8] - M[5] * M[7], c01 = M[5] * M[6] - M[3] * M[8],
+         c02 = M[3] * M[7] - M[4] * M[6];
+  double det = M[0] * c00 + M[1] * c01 + M[2] * c02, r;
+  if (det == 0.0) return 0;
+  r = 1.0 / det;
+  Mi[0] = c00 * r;
+  Mi[1] = (M[2] * M[7] - M[1] * M[8]) * r;
+  Mi[2] = (M[1] * M[5] - M[2] * M[4]) * r;
+  Mi[3] = c01 * r;
+  Mi[4] = (M[0] * M[8] - M[2] * M[6]) * r;
+  Mi[5] = (M[2] * M[3] - M[0] * M[5]) * r;
+  Mi[6] = c02 * r;
+  Mi[7] = (M[1] * M[6] - M[0] * M[7]) * r;
+  Mi[8] = (M[0] * M[4] - M[1] * M[3]) * r;
+  return 1;
+}
+
+/* Diagonalisation of A^{-1}: A^{-1} T = T [[gam,0,0],[0,alp,bet],[0,-bet,alp]],
+   i.e. gam is the real eigenvalue and alp +- i bet the complex pair (the roots
+   of z^3 - 12 z^2 + 60 z - 120); T = [t1, Re v, Im v] with A^{-1} v = (alp+i bet) v.
+   The eigenvectors are null vectors of A^{-1} - lambda I found as (bilinear)
+   cross products of two of its rows. Row-major T, Ti. */
+PHGMG__PRIV void phgmg__gl3_transform(const double A[9], double T[9], double Ti[9], double *gam,
+                                      double *alp, double *bet) {
+  double Ai[9], z = 3.6, p, q;
+  int it, a, b, k, best;
+  phgmg__inv3(A, Ai);
+  for (it = 0; it < 50; ++it) { /* Newton on the cubic from the right of the real root */
+    double f = ((z - 12.0) * z + 60.0) * z - 120.0, df = (3.0 * z - 24.0) * z + 60.0;
+    double dz = f / df;
+    z -= dz;
+    if (fabs(dz) <= 1e-16 * z) break;
+  }
+  *gam = z;
+  p = z - 12.0;           /* z^3 - 12z^2 + 60z - 120 = (z - gam)(z^2 + p z + q) */
+  q = 120.0 / z;
+  *alp = -0.5 * p;
+  *bet = sqrt(q - 0.25 * p * p);
+  { /* real eigenvector */
+    double M[9], v[3] = {0, 0, 0}, bestn = -1.0;
+    for (k = 0; k < 9; ++k) M[k] = Ai[k];
+    M[0] -= z; M[4] -= z; M[8] -= z;
+    for (best = 0; best < 3; ++best) {
+      double cv[3], n2;
+      a = best == 2 ? 1 : 0;
+      b = best == 0 ? 1 : 2;
+      cv[0] = M[a * 3 + 1] * M[b * 3 + 2] - M[a * 3 + 2] * M[b * 3 + 1];
+      cv[1] = M[a * 3 + 2] * M[b * 3 + 0] - M[a * 3 + 0] * M[b * 3 + 2];
+      cv[2] = M[a * 3 + 0] * M[b * 3 + 1] - M[a * 3 + 1] * M[b * 3 + 0];
+      n2 = cv[0] * cv[0] + cv[1] * cv[1] + cv[2] * cv[2];
+      if (n2 > bestn) { bestn = n2; v[0] = cv[0]; v[1] = cv[1]; v[2] = cv[2]; }
+    }
+    bestn = sqrt(bestn);
+    for (k = 0; k < 3; ++k) T[k * 3 + 0] = v[k] / bestn;
+  }
+  { /* complex eigenvector for alp + i bet */
+    double Mr[9], Mi[9], vr[3] = {0, 0, 0}, vi[3] = {0, 0, 0}, bestn = -1.0, sr, si, d;
+    int kk;
+    for (k = 0; k < 9; ++k) { Mr[k] = Ai[k]; Mi[k] = 0.0; }
+    for (k = 0; k < 3; ++k) { Mr[k * 4] -= *alp; Mi[k * 4] = -*bet; }
+    for (best = 0; best < 3; ++best) {
+      double cr[3], ci[3], n2 = 0.0;
+      int e;
+      a = best == 2 ? 1 : 0;
+      b = best == 0 ? 1 : 2;
+      for (e = 0; e < 3; ++e) {
+        int e1 = (e + 1) % 3, e2 = (e + 2) % 3;
+        /* (ra x rb)_e = ra[e1] rb[e2] - ra[e2] rb[e1], complex, no conjugation */
+        double xr = Mr[a * 3 + e1] * Mr[b * 3 + e2] - Mi[a * 3 + e1] * Mi[b * 3 + e2];
+        double xi = Mr[a * 3 + e1] * Mi[b * 3 + e2] + Mi[a * 3 + e1] * Mr[b * 3 + e2];
+        double yr = Mr[a * 3 + e2] * Mr[b * 3 + e1] - Mi[a * 3 + e2] * Mi[b * 3 + e1];
+        double yi = Mr[a * 3 + e2] * Mi[b * 3 + e1] + Mi[a * 3 + e2] * Mr[b * 3 + e1];
+        cr[e] = xr - yr;
+        ci[e] = xi - yi;
+        n2 += cr[e] * cr[e] + ci[e] * ci[e];
+      }
+      if (n2 > bestn) {
+        bestn = n2;
+        for (e = 0; e < 3; ++e) { vr[e] = cr[e]; vi[e] = ci[e]; }
+      }
+    }
+    /* scale so that the largest component is real and 1 */
+    kk = 0;
+    for (k = 1; k < 3; ++k)
+      if (vr[k] * vr[k] + vi[k] * vi[k] > vr[kk] * vr[kk] + vi[kk] * vi[kk]) kk = k;
+    d = vr[kk] * vr[kk] + vi[kk] * vi[kk];
+    sr = vr[kk] / d;
+    si = -vi[kk] / d; /* 1 / v_kk */
+    for (k = 0; k < 3; ++k) {
+      double xr = vr[k] * sr - vi[k] * si, xi = vr[k] * si + vi[k] * sr;
+      T[k * 3 + 1] = xr;
+      T[k * 3 + 2] = xi;
+    }
+    T[kk * 3 + 2] = 0.0;
+  }
+  phgmg__inv3(T, Ti);
+}
+
+#ifndef PHGMG_GL3_STEP_MAP_MAX_N
+#define PHGMG_GL3_STEP_MAP_MAX_N 1000
+#endif
+
+/* A banded matrix by its nonzero diagonals: v[d*n + i] = A(i, i + off[d]). */
+typedef struct phgmg__dia {
+  int n, nd;
+  int *off;
+  double *v;
+} phgmg__dia;
+
+PHGMG__PRIV void phgmg__dia_free(const phgmg_allocator *al, phgmg__dia *D) {
+  phgmg__free(al, D->off);
+  phgmg__free(al, D->v);
+  D->off = NULL;
+  D->v = NULL;
+  D->nd = 0;
+}
+
+/* From band storage (kb): M1 - M2 (M2 may be NULL). Keeps the diagonals with a
+   nonzero entry, plus the main one if force_main, or all of them if keep_all. */
+PHGMG__PRIV phgmg_result phgmg__dia_build(const phgmg_allocator *al, phgmg__dia *D, int n, int kb,
+                                          const double *M1, const double *M2, int force_main,
+                                          int keep_all) {
+  int o, i, d = 0;
+  D->n = n;
+  D->nd = 0;
+  D->off = phgmg__ialloc(al, (size_t)(2 * kb + 1));
+  D->v = phgmg__dalloc(al, (size_t)(2 * kb + 1) * (size_t)n);
+  if (!D->off || !D->v) { phgmg__dia_free(al, D); return PHGMG_ERR_NOMEM; }
+  for (o = -kb; o <= kb; ++o) {
+    double *vd = D->v + (size_t)d * (size_t)n;
+    int nz = 0;
+    for (i = 0; i < n; ++i) {
+      int j = i + o;
+      double val = 0.0;
+      if (j >= 0 && j < n) {
+        size_t k = PHGMG__PHB(kb, i, j);
+        val = M1 ? M1[k] : 0.0;
+        if (M2) val -= M2[k];
+      }
+      vd[i] = val;
+      if (val != 0.0) nz = 1;
+    }
+    if (nz || keep_all || (force_main && o == 0)) D->off[d++] = o;
+  }
+  D->nd = d;
+  return PHGMG_OK;
+}
+
+/* Refill all 2kb+1 diagonals of D (built with keep_all) from band storage. */
+PHGMG__PRIV void phgmg__dia_refill(phgmg__dia *D, int kb, const double *M) {
+  int n = D->n, d, i;
+  for (d = 0; d < D->nd; ++d) {
+    int o = D->off[d];
+    double *vd = D->v + (size_t)d * (size_t)n;
+    for (i = 0; i < n; ++i) {
+      int j = i + o;
+      vd[i] = (j >= 0 && j < n) ? M[PHGMG__PHB(kb, i, j)] : 0.0;
+    }
+  }
+}
+
+/* y = D x (overwrite) */
+PHGMG__PRIV void phgmg__dia_mv(const phgmg__dia *D, const double *x, double *y) {
+  int n = D->n, d, i;
+  for (i = 0; i < n; ++i) y[i] = 0.0;
+  for (d = 0; d < D->nd; ++d) {
+    int o = D->off[d], i0 = PHGMG__MAX(0, -o), i1 = PHGMG__MIN(n, n - o);
+    const double *vd = D->v + (size_t)d * (size_t)n;
+    for (i = i0; i < i1; ++i) y[i] += vd[i] * x[i + o];
+  }
+}
+
+/* ab (band LU layout, kv = kl+ku) += alpha * A * B for DIA A, B; if dd != NULL,
+   B is the diagonal matrix diag(dd) instead. */
+PHGMG__PRIV void phgmg__dia_prod_band(const phgmg__dia *A, const phgmg__dia *B, const double *dd,
+                                      double alpha, double *ab, int ldab, int kv) {
+  int n = A->n, da, db, i;
+  for (da = 0; da < A->nd; ++da) {
+    int oa = A->off[da];
+    const double *va = A->v + (size_t)da * (size_t)n;
+    if (dd) {
+      int i0 = PHGMG__MAX(0, -oa), i1 = PHGMG__MIN(n, n - oa);
+      for (i = i0; i < i1; ++i) {
+        int j = i + oa;
+        ab[(size_t)(kv - oa) + (size_t)j * (size_t)ldab] += alpha * va[i] * dd[j];
+      }
+      continue;
+    }
+    for (db = 0; db < B->nd; ++db) {
+      int ob = B->off[db], o = oa + ob, i0, i1;
+      const double *vb = B->v + (size_t)db * (size_t)n;
+      if (o >= n || o <= -n) continue;
+      i0 = PHGMG__MAX(0, PHGMG__MAX(-oa, -o));
+      i1 = PHGMG__MIN(n, PHGMG__MIN(n - oa, n - o));
+      for (i = i0; i < i1; ++i) {
+        int j = i + o;
+        ab[(size_t)(kv - o) + (size_t)j * (size_t)ldab] += alpha * va[i] * vb[i + oa];
+      }
+    }
+  }
+}
+
+enum { PHGMG__GL3_DENSE = 0, PHGMG__GL3_BANDED = 1, PHGMG__GL3_CALLBACK = 2, PHGMG__GL3_MAP = 3 };
+
+struct phgmg_gl3 {
+  phgmg_allocator al;
+  phgmg_ph_system sys;
+  int N, m, mode, linear;
+  double h, tol, contraction;
+  int max_iter;
+  double c[3], b[3], A[9], T[9], Ti[9], E[9], d[3];
+  double gam, alp, bet;
+  /* dense operators */
+  double *JR, *JRQ, *Hs, *K1, *K2;
+  int *ip1, *ip2;
+  /* banded operators */
+  phgmg__dia djr, dq, dh;
+  int kl, ku, ldab, ue1, ue2;
+  double *AB1, *AB2, *dinv1, *dinv2, *hband;
+  /* SEPARABLE: Hessian diagonal of the nonlinear part */
+  double *dd;
+  /* step map (dense linear): x+ = Phi x + Gam U, g_i = GX_i x + GU_i U */
+  double *Phi, *Gam, *GX, *GU;
+  /* work */
+  double *Z, *W, *Y, *G, *F, *U, *Zg, *Zprev, *xend, *xnew, *r1, *rc, *tmp, *TF;
+  int have_prev, need_factor;
+  double tend;
+  phgmg_gl3_stats st;
+};
+
+PHGMG_DEF void phgmg_gl3_destroy(phgmg_gl3 *s) {
+  phgmg_allocator al;
+  if (!s) return;
+  al = s->al;
+  phgmg__free(&al, s->JR); phgmg__free(&al, s->JRQ); phgmg__free(&al, s->Hs);
+  phgmg__free(&al, s->K1); phgmg__free(&al, s->K2);
+  phgmg__free(&al, s->ip1); phgmg__free(&al, s->ip2);
+  phgmg__dia_free(&al, &s->djr); phgmg__dia_free(&al, &s->dq); phgmg__dia_free(&al, &s->dh);
+  phgmg__free(&al, s->AB1); phgmg__free(&al, s->AB2);
+  phgmg__free(&al, s->dinv1); phgmg__free(&al, s->dinv2); phgmg__free(&al, s->hband);
+  phgmg__free(&al, s->dd);
+  phgmg__free(&al, s->Phi); phgmg__free(&al, s->Gam); phgmg__free(&al, s->GX);
+  phgmg__free(&al, s->GU);
+  phgmg__free(&al, s->Z); phgmg__free(&al, s->W); phgmg__free(&al, s->Y);
+  phgmg__free(&al, s->G); phgmg__free(&al, s->F); phgmg__free(&al, s->U);
+  phgmg__free(&al, s->Zg); phgmg__free(&al, s->Zprev); phgmg__free(&al, s->xend);
+  phgmg__free(&al, s->xnew); phgmg__free(&al, s->r1); phgmg__free(&al, s->rc);
+  phgmg__free(&al, s->tmp); phgmg__free(&al, s->TF);
+  phgmg__free(&al, s);
+}
+
+PHGMG_DEF const phgmg_gl3_stats *phgmg_gl3_get_stats(const phgmg_gl3 *s) {
+  return s ? &s->st : NULL;
+}
+
+/* Precompute the exact one-step map of a dense linear system (see >>gl3). */
+PHGMG__PRIV phgmg_result phgmg__gl3_build_map(phgmg_gl3 *s) {
+  const phgmg_allocator *al = &s->al;
+  const phgmg_ph_system *sys = &s->sys;
+  int N = s->N, m = s->m, nc = N + 3 * m, i, j, k, st;
+  size_t NN = (size_t)N * (size_t)N, Nc = (size_t)N * (size_t)nc;
+  double *M = NULL, *K1 = NULL, *K2 = NULL, *X1 = NULL, *X2 = NULL, *ZZ = NULL, *QZ = NULL;
+  int *ip1 = NULL, *ip2 = NULL;
+  double sum[3];
+  phgmg_result rc = PHGMG_OK;
+  M = phgmg__dalloc(al, NN);
+  K1 = phgmg__dalloc(al, NN);
+  K2 = phgmg__dalloc(al, 2 * NN);
+  X1 = phgmg__dalloc(al, Nc);
+  X2 = phgmg__dalloc(al, 2 * Nc);
+  ZZ = phgmg__dalloc(al, Nc);
+  QZ = phgmg__dalloc(al, Nc);
+  ip1 = phgmg__ialloc(al, (size_t)N);
+  ip2 = phgmg__ialloc(al, (size_t)N);
+  s->Phi = phgmg__dalloc(al, NN);
+  s->Gam = phgmg__dalloc(al, (size_t)N * 3 * (size_t)m);
+  s->GX = phgmg__dalloc(al, 3 * NN);
+  s->GU = phgmg__dalloc(al, 3 * (size_t)N * 3 * (size_t)m);
+  if (!M || !K1 || !K2 || !X1 || !X2 || !ZZ || !QZ || !ip1 || !ip2 || !s->Phi || !s->Gam ||
+      !s->GX || !s->GU) {
+    rc = PHGMG_ERR_NOMEM;
+    goto done;
+  }
+  /* M = (J - R) Q */
+  {
+    double *JR = K1; /* borrow K1 for J - R */
+    size_t e;
+    for (e = 0; e < NN; ++e) JR[e] = sys->J[e] - sys->R[e];
+    phgmg_gemm('N', 'N', N, N, N, 1.0, JR, N, sys->Q, N, 0.0, M, N);
+  }
+  if (!phgmg__all_finite(M, NN)) { rc = PHGMG_ERR_NANINF; goto done; }
+  for (k = 0; k < 3; ++k) sum[k] = s->Ti[k * 3] + s->Ti[k * 3 + 1] + s->Ti[k * 3 + 2];
+  /* K1 = gam/h I - M, K2 = (alp - i bet)/h I - M */
+  for (j = 0; j < N; ++j)
+    for (i = 0; i < N; ++i) {
+      size_t e = (size_t)i + (size_t)j * (size_t)N;
+      K1[e] = -M[e];
+      K2[2 * e] = -M[e];
+      K2[2 * e + 1] = 0.0;
+      if (i == j) {
+        K1[e] += s->gam / s->h;
+        K2[2 * e] += s->alp / s->h;
+        K2[2 * e + 1] = -s->bet / s->h;
+      }
+    }
+  rc = phgmg_lu_factor(N, K1, N, ip1);
+  if (rc == PHGMG_OK) rc = phgmg_zlu_factor(N, K2, N, ip2);
+  if (rc != PHGMG_OK) goto done;
+  /* right-hand sides: [sum_k M, Ti_k1 B, Ti_k2 B, Ti_k3 B] */
+  for (j = 0; j < N; ++j)
+    for (i = 0; i < N; ++i) {
+      size_t e = (size_t)i + (size_t)j * (size_t)N;
+      X1[e] = sum[0] * M[e];
+      X2[2 * e] = sum[1] * M[e];
+      X2[2 * e + 1] = sum[2] * M[e];
+    }
+  for (st = 0; st < 3; ++st)
+    for (j = 0; j < m; ++j)
+      for (i = 0; i < N; ++i) {
+        size_t e = (size_t)i + (size_t)(N + st * m + j) * (size_t)N;
+        double bij = sys->B[(size_t)i + (size_t)j * (size_t)N];
+        X1[e] = s->Ti[0 * 3 + st] * bij;
+        X2[2 * e] = s->Ti[1 * 3 + st] * bij;
+        X2[2 * e + 1] = s->Ti[2 * 3 + st] * bij;
+      }
+  phgmg_lu_solve('N', N, K1, N, ip1, nc, X1, N);
+  phgmg_zlu_solve(N, K2, N, ip2, nc, X2, N);
+  /* Z_i = T_i1 W1 + T_i2 Re W23 + T_i3 Im W23; Phi = I + sum d_i Zx_i, Gam = sum d_i Zu_i;
+     GX_i = Q (I + Zx_i), GU_i = Q Zu_i */
+  memset(s->Phi, 0, sizeof(double) * NN);
+  memset(s->Gam, 0, sizeof(double) * (size_t)N * 3 * (size_t)m);
+  for (st = 0; st < 3; ++st) {
+    double t1 = s->T[st * 3], t2 = s->T[st * 3 + 1], t3 = s->T[st * 3 + 2], di = s->d[st];
+    size_t e;
+    for (e = 0; e < Nc; ++e) ZZ[e] = t1 * X1[e] + t2 * X2[2 * e] + t3 * X2[2 * e + 1];
+    for (e = 0; e < NN; ++e) s->Phi[e] += di * ZZ[e];
+    for (e = 0; e < (size_t)N * 3 * (size_t)m; ++e) s->Gam[e] += di * ZZ[NN + e];
+    phgmg_gemm('N', 'N', N, nc, N, 1.0, sys->Q, N, ZZ, N, 0.0, QZ, N);
+    for (e = 0; e < NN; ++e) s->GX[(size_t)st * NN + e] = QZ[e] + sys->Q[e];
+    memcpy(s->GU + (size_t)st * (size_t)N * 3 * (size_t)m, QZ + NN,
+           sizeof(double) * (size_t)N * 3 * (size_t)m);
+  }
+  for (i = 0; i < N; ++i) s->Phi[(size_t)i * (size_t)(N + 1)] += 1.0;
+  if (!phgmg__all_finite(s->Phi, NN) || !phgmg__all_finite(s->Gam, (size_t)N * 3 * (size_t)m))
+    rc = PHGMG_ERR_NANINF;
+done:
+  phgmg__free(al, M); phgmg__free(al, K1); phgmg__free(al, K2);
+  phgmg__free(al, X1); phgmg__free(al, X2); phgmg__free(al, ZZ); phgmg__free(al, QZ);
+  phgmg__free(al, ip1); phgmg__free(al, ip2);
+  return rc;
+}
+
+PHGMG_DEF phgmg_result phgmg_gl3_create(phgmg_gl3 **out, const phgmg_ph_system *sys, double dt,
+                                        const phgmg_gl3_opts *opts, const phgmg_allocator *alloc) {
+  phgmg_gl3 *s;
+  phgmg_result rc;
+  int N, m, i, j, k;
+  size_t NN, N3;
+  if (!out) return PHGMG_ERR_INVALID_ARG;
+  *out = NULL;
+  rc = phgmg__ph_check(sys);
+  if (rc != PHGMG_OK) return rc;
+  if (!(dt > 0.0) || dt == HUGE_VAL) return PHGMG_ERR_INVALID_ARG;
+  if (opts && (opts->max_iter < 0 || opts->tol < 0.0 || opts->contraction < 0.0 ||
+               opts->tol != opts->tol || opts->contraction != opts->contraction))
+    return PHGMG_ERR_INVALID_ARG;
+  s = PHGMG__CAST(phgmg_gl3 *, phgmg__alloc(alloc, sizeof(phgmg_gl3)));
+  if (!s) return PHGMG_ERR_NOMEM;
+  memset(s, 0, sizeof *s);
+  if (alloc) s->al = *alloc;
+  s->sys = *sys;
+  N = s->N = sys->N;
+  m = s->m = sys->m;
+  NN = (size_t)N * (size_t)N;
+  N3 = 3 * (size_t)N;
+  s->h = dt;
+  s->tol = (opts && opts->tol > 0.0) ? opts->tol : 1e-10;
+  s->max_iter = (opts && opts->max_iter > 0) ? opts->max_iter : 10;
+  s->contraction = (opts && opts->contraction > 0.0) ? opts->contraction : 0.5;
+  s->linear = sys->nl == PHGMG_NL_NONE;
+  phgmg_gl3_coefficients(s->c, s->b, s->A);
+  phgmg__gl3_transform(s->A, s->T, s->Ti, &s->gam, &s->alp, &s->bet);
+  {
+    double Ai[9];
+    phgmg__inv3(s->A, Ai);
+    for (j = 0; j < 3; ++j) s->d[j] = s->b[0] * Ai[j] + s->b[1] * Ai[3 + j] + s->b[2] * Ai[6 + j];
+  }
+  /* extrapolation of the previous collocation polynomial p (p(0) = 0,
+     p(c_j) = Zprev_j): Z_i = p(1 + c_i) - p(1) = sum_j E_ij Zprev_j */
+  for (i = 0; i < 3; ++i)
+    for (j = 0; j < 3; ++j) {
+      double s1 = 1.0 + s->c[i], l1 = s1 / s->c[j], l0 = 1.0 / s->c[j];
+      for (k = 0; k < 3; ++k) {
+        if (k == j) continue;
+        l1 *= (s1 - s->c[k]) / (s->c[j] - s->c[k]);
+        l0 *= (1.0 - s->c[k]) / (s->c[j] - s->c[k]);
+      }
+      s->E[i * 3 + j] = l1 - l0;
+    }
+  if (s->linear && !(opts && opts->no_step_map) && sys->storage == PHGMG_DENSE &&
+      N <= PHGMG_GL3_STEP_MAP_MAX_N)
+    s->mode = PHGMG__GL3_MAP;
+  else if (sys->shifted_factor)
+    s->mode = PHGMG__GL3_CALLBACK;
+  else
+    s->mode = sys->storage == PHGMG_DENSE ? PHGMG__GL3_DENSE : PHGMG__GL3_BANDED;
+
+  s->U = phgmg__dalloc(&s->al, 3 * (size_t)m);
+  s->G = phgmg__dalloc(&s->al, N3);
+  s->xnew = phgmg__dalloc(&s->al, (size_t)N);
+  if (!s->U || !s->G || !s->xnew) { rc = PHGMG_ERR_NOMEM; goto fail; }
+  if (s->mode == PHGMG__GL3_MAP) {
+    if (!phgmg__ph_mat_finite(sys, sys->J) || !phgmg__ph_mat_finite(sys, sys->R) ||
+        !phgmg__ph_mat_finite(sys, sys->Q) || !phgmg__all_finite(sys->B, (size_t)N * (size_t)m)) {
+      rc = PHGMG_ERR_NANINF;
+      goto fail;
+    }
+    rc = phgmg__gl3_build_map(s);
+    if (rc != PHGMG_OK) goto fail;
+    *out = s;
+    return PHGMG_OK;
+  }
+  s->Z = phgmg__dalloc(&s->al, N3);
+  s->W = phgmg__dalloc(&s->al, N3);
+  s->Y = phgmg__dalloc(&s->al, N3);
+  s->F = phgmg__dalloc(&s->al, N3);
+  s->Zg = phgmg__dalloc(&s->al, N3);
+  s->Zprev = phgmg__dalloc(&s->al, N3);
+  s->xend = phgmg__dalloc(&s->al, (size_t)N);
+  s->r1 = phgmg__dalloc(&s->al, (size_t)N);
+  s->rc = phgmg__dalloc(&s->al, 2 * (size_t)N);
+  s->tmp = phgmg__dalloc(&s->al, (size_t)N);
+  s->TF = phgmg__dalloc(&s->al, N3);
+  if (!s->Z || !s->W || !s->Y || !s->F || !s->Zg || !s->Zprev || !s->xend || !s->r1 || !s->rc ||
+      !s->tmp || !s->TF) {
+    rc = PHGMG_ERR_NOMEM;
+    goto fail;
+  }
+  if (sys->nl == PHGMG_NL_SEPARABLE) {
+    s->dd = phgmg__dalloc(&s->al, (size_t)N);
+    if (!s->dd) { rc = PHGMG_ERR_NOMEM; goto fail; }
+  }
+  if (sys->storage == PHGMG_DENSE) {
+    s->JR = phgmg__dalloc(&s->al, NN);
+    if (!s->JR) { rc = PHGMG_ERR_NOMEM; goto fail; }
+    {
+      size_t e;
+      for (e = 0; e < NN; ++e) s->JR[e] = sys->J[e] - sys->R[e];
+    }
+    if (s->mode == PHGMG__GL3_DENSE) {
+      s->K1 = phgmg__dalloc(&s->al, NN);
+      s->K2 = phgmg__dalloc(&s->al, 2 * NN);
+      s->ip1 = phgmg__ialloc(&s->al, (size_t)N);
+      s->ip2 = phgmg__ialloc(&s->al, (size_t)N);
+      if (!s->K1 || !s->K2 || !s->ip1 || !s->ip2) { rc = PHGMG_ERR_NOMEM; goto fail; }
+      if (sys->nl == PHGMG_NL_GENERAL) {
+        s->Hs = phgmg__dalloc(&s->al, NN);
+        if (!s->Hs) { rc = PHGMG_ERR_NOMEM; goto fail; }
+      } else {
+        s->JRQ = phgmg__dalloc(&s->al, NN);
+        if (!s->JRQ) { rc = PHGMG_ERR_NOMEM; goto fail; }
+        phgmg_gemm('N', 'N', N, N, N, 1.0, s->JR, N, sys->Q, N, 0.0, s->JRQ, N);
+      }
+    }
+  } else {
+    int kb = sys->kb, amin = 0, amax = 0, bmin = 0, bmax = 0;
+    rc = phgmg__dia_build(&s->al, &s->djr, N, kb, sys->J, sys->R, 0, 0);
+    if (rc == PHGMG_OK) rc = phgmg__dia_build(&s->al, &s->dq, N, kb, sys->Q, NULL, 1, 0);
+    if (rc != PHGMG_OK) goto fail;
+    if (s->mode == PHGMG__GL3_BANDED) {
+      for (k = 0; k < s->djr.nd; ++k) {
+        amin = PHGMG__MIN(amin, s->djr.off[k]);
+        amax = PHGMG__MAX(amax, s->djr.off[k]);
+      }
+      for (k = 0; k < s->dq.nd; ++k) {
+        bmin = PHGMG__MIN(bmin, s->dq.off[k]);
+        bmax = PHGMG__MAX(bmax, s->dq.off[k]);
+      }
+      if (sys->nl == PHGMG_NL_GENERAL) {
+        bmin = -kb;
+        bmax = kb;
+        rc = phgmg__dia_build(&s->al, &s->dh, N, kb, NULL, NULL, 1, 1);
+        s->hband = phgmg__dalloc(&s->al, (size_t)(2 * kb + 1) * (size_t)N);
+        if (rc != PHGMG_OK || !s->hband) { rc = PHGMG_ERR_NOMEM; goto fail; }
+      }
+      s->kl = PHGMG__MIN(N - 1, -(amin + bmin));
+      s->ku = PHGMG__MIN(N - 1, amax + bmax);
+      s->ldab = 2 * s->kl + s->ku + 1;
+      s->AB1 = phgmg__dalloc(&s->al, (size_t)s->ldab * (size_t)N);
+      s->AB2 = phgmg__dalloc(&s->al, 2 * (size_t)s->ldab * (size_t)N);
+      s->dinv1 = phgmg__dalloc(&s->al, (size_t)N);
+      s->dinv2 = phgmg__dalloc(&s->al, 2 * (size_t)N);
+      s->ip1 = phgmg__ialloc(&s->al, (size_t)N);
+      s->ip2 = phgmg__ialloc(&s->al, (size_t)N);
+      if (!s->AB1 || !s->AB2 || !s->dinv1 || !s->dinv2 || !s->ip1 || !s->ip2) {
+        rc = PHGMG_ERR_NOMEM;
+        goto fail;
+      }
+    }
+  }
+  s->need_factor = 1;
+  *out = s;
+  return PHGMG_OK;
+fail:
+  phgmg_gl3_destroy(s);
+  return rc;
+}
+
+/* Evaluate the stages at Y_i = x + Z_i: gradients G_i and right-hand sides F_i. */
+PHGMG__PRIV void phgmg__gl3_eval(phgmg_gl3 *s, const double *x) {
+  const phgmg_ph_system *sys = &s->sys;
+  int N = s->N, m = s->m, st, i, k;
+  for (st = 0; st < 3; ++st) {
+    const double *z = s->Z + (size_t)st * (size_t)N;
+    double *y = s->Y + (size_t)st * (size_t)N;
+    for (i = 0; i < N; ++i) y[i] = x[i] + z[i];
+  }
+  if (sys->storage == PHGMG_DENSE)
+    phgmg_gemm('N', 'N', N, 3, N, 1.0, sys->Q, N, s->Y, N, 0.0, s->G, N);
+  else
+    for (st = 0; st < 3; ++st)
+      phgmg__dia_mv(&s->dq, s->Y + (size_t)st * (size_t)N, s->G + (size_t)st * (size_t)N);
+  for (st = 0; st < 3; ++st) {
+    const double *y = s->Y + (size_t)st * (size_t)N;
+    double *g = s->G + (size_t)st * (size_t)N;
+    if (sys->nl == PHGMG_NL_SEPARABLE) {
+      if (sys->poly_deg > 0) {
+        int deg = sys->poly_deg;
+        for (k = 0; k < sys->nsep; ++k) {
+          int ix = sys->sep_idx[k], j;
+          double v = y[ix], acc = (double)deg * sys->poly[deg];
+          for (j = deg - 1; j >= 1; --j) acc = acc * v + (double)j * sys->poly[j];
+          g[ix] += (sys->sep_w ? sys->sep_w[k] : 1.0) * acc;
+        }
+      } else {
+        for (k = 0; k < sys->nsep; ++k) {
+          int ix = sys->sep_idx[k];
+          g[ix] += (sys->sep_w ? sys->sep_w[k] : 1.0) * sys->dphi(k, y[ix], sys->user);
+        }
+      }
+    } else if (sys->nl == PHGMG_NL_GENERAL) {
+      sys->grad_nl(y, s->tmp, sys->user);
+      for (i = 0; i < N; ++i) g[i] += s->tmp[i];
+    }
+  }
+  if (sys->storage == PHGMG_DENSE)
+    phgmg_gemm('N', 'N', N, 3, N, 1.0, s->JR, N, s->G, N, 0.0, s->F, N);
+  else
+    for (st = 0; st < 3; ++st)
+      phgmg__dia_mv(&s->djr, s->G + (size_t)st * (size_t)N, s->F + (size_t)st * (size_t)N);
+  for (st = 0; st < 3; ++st) {
+    double *f = s->F + (size_t)st * (size_t)N;
+    const double *u = s->U + (size_t)st * (size_t)m;
+    for (k = 0; k < m; ++k) {
+      const double *bk = sys->B + (size_t)k * (size_t)N;
+      double uk = u[k];
+      if (uk == 0.0) continue;
+      for (i = 0; i < N; ++i) f[i] += bk[i] * uk;
+    }
+  }
+  s->st.rhs_evals += 3;
+}
+
+/* (Re)factor the shifted Newton matrices at x. */
+PHGMG__PRIV phgmg_result phgmg__gl3_factor(phgmg_gl3 *s, const double *x) {
+  const phgmg_ph_system *sys = &s->sys;
+  int N = s->N, i, j, k;
+  double sg = s->gam / s->h, sa = s->alp / s->h, sb = -s->bet / s->h;
+  phgmg_result rc;
+  s->st.factorizations++;
+  if (sys->nl == PHGMG_NL_SEPARABLE) {
+    for (i = 0; i < N; ++i) s->dd[i] = 0.0;
+    for (k = 0; k < sys->nsep; ++k) {
+      int ix = sys->sep_idx[k];
+      s->dd[ix] += (sys->sep_w ? sys->sep_w[k] : 1.0) * phgmg__ph_phi(sys, k, x[ix], 2);
+    }
+  }
+  if (s->mode == PHGMG__GL3_CALLBACK) {
+    rc = sys->shifted_factor(sg, 0.0, x, sys->shifted_user);
+    if (rc == PHGMG_OK) rc = sys->shifted_factor(sa, sb, x, sys->shifted_user);
+    return rc;
+  }
+  if (s->mode == PHGMG__GL3_DENSE) {
+    size_t NN = (size_t)N * (size_t)N, e;
+    /* K1 = -Jac */
+    if (sys->nl == PHGMG_NL_GENERAL) {
+      sys->hess_nl(x, s->Hs, sys->user);
+      for (e = 0; e < NN; ++e) s->Hs[e] += sys->Q[e];
+      phgmg_gemm('N', 'N', N, N, N, -1.0, s->JR, N, s->Hs, N, 0.0, s->K1, N);
+    } else {
+      for (e = 0; e < NN; ++e) s->K1[e] = -s->JRQ[e];
+      if (sys->nl == PHGMG_NL_SEPARABLE)
+        for (j = 0; j < N; ++j) {
+          double dj = s->dd[j];
+          const double *jc = s->JR + (size_t)j * (size_t)N;
+          double *kc = s->K1 + (size_t)j * (size_t)N;
+          if (dj == 0.0) continue;
+          for (i = 0; i < N; ++i) kc[i] -= jc[i] * dj;
+        }
+    }
+    for (e = 0; e < NN; ++e) { s->K2[2 * e] = s->K1[e]; s->K2[2 * e + 1] = 0.0; }
+    for (i = 0; i < N; ++i) {
+      size_t d = (size_t)i * (size_t)(N + 1);
+      s->K1[d] += sg;
+      s->K2[2 * d] += sa;
+      s->K2[2 * d + 1] = sb;
+    }
+    rc = phgmg_lu_factor(N, s->K1, N, s->ip1);
+    if (rc == PHGMG_OK) rc = phgmg_zlu_factor(N, s->K2, N, s->ip2);
+    return rc;
+  }
+  /* banded */
+  {
+    int kv = s->kl + s->ku, ld = s->ldab;
+    size_t tot = (size_t)ld * (size_t)N, e;
+    memset(s->AB1, 0, sizeof(double) * tot);
+    phgmg__dia_prod_band(&s->djr, &s->dq, NULL, -1.0, s->AB1, ld, kv);
+    if (sys->nl == PHGMG_NL_SEPARABLE) {
+      phgmg__dia_prod_band(&s->djr, NULL, s->dd, -1.0, s->AB1, ld, kv);
+    } else if (sys->nl == PHGMG_NL_GENERAL) {
+      sys->hess_nl(x, s->hband, sys->user);
+      phgmg__dia_refill(&s->dh, sys->kb, s->hband);
+      phgmg__dia_prod_band(&s->djr, &s->dh, NULL, -1.0, s->AB1, ld, kv);
+    }
+    for (e = 0; e < tot; ++e) { s->AB2[2 * e] = s->AB1[e]; s->AB2[2 * e + 1] = 0.0; }
+    for (j = 0; j < N; ++j) {
+      size_t d = (size_t)kv + (size_t)j * (size_t)ld;
+      s->AB1[d] += sg;
+      s->AB2[2 * d] += sa;
+      s->AB2[2 * d + 1] = sb;
+    }
+    if (!phgmg__all_finite(s->AB1, tot)) return PHGMG_ERR_NANINF;
+    rc = phgmg__gb_factor(N, s->kl, s->ku, s->AB1, ld, s->ip1, s->dinv1, &s->ue1);
+    if (rc == PHGMG_OK)
+      rc = phgmg__zgb_factor(N, s->kl, s->ku, s->AB2, ld, s->ip2, s->dinv2, &s->ue2);
+    return rc;
+  }
+}
+
+/* Solve with the real (K1) and the complex (K2) shifted matrix. */
+PHGMG__PRIV void phgmg__gl3_solve_real(phgmg_gl3 *s, double *r) {
+  if (s->mode == PHGMG__GL3_DENSE)
+    phgmg_lu_solve('N', s->N, s->K1, s->N, s->ip1, 1, r, s->N);
+  else if (s->mode == PHGMG__GL3_BANDED)
+    phgmg__gb_solve('N', s->N, s->kl, s->ku, s->ue1, s->AB1, s->ldab, s->ip1, s->dinv1, r);
+  else
+    s->sys.shifted_solve(s->gam / s->h, 0.0, r, s->sys.shifted_user);
+}
+PHGMG__PRIV void phgmg__gl3_solve_cplx(phgmg_gl3 *s, double *r) {
+  if (s->mode == PHGMG__GL3_DENSE)
+    phgmg_zlu_solve(s->N, s->K2, s->N, s->ip2, 1, r, s->N);
+  else if (s->mode == PHGMG__GL3_BANDED)
+    phgmg__zgb_solve(s->N, s->kl, s->ku, s->ue2, s->AB2, s->ldab, s->ip2, s->dinv2, r);
+  else
+    s->sys.shifted_solve(s->alp / s->h, -s->bet / s->h, r, s->sys.shifted_user);
+}
+
+/* Simplified Newton on the transformed stage system from the guess in s->Z.
+   fresh: the factors belong to this x (no early abort). On success s->Z, G, F
+   hold the converged stages. */
+PHGMG__PRIV phgmg_result phgmg__gl3_newton(phgmg_gl3 *s, const double *x, int fresh,
+                                           double *theta_max, double *res_out) {
+  int N = s->N, it = 0, ndiv = 0, i;
+  double h = s->h, ih = 1.0 / s->h, res_prev = 0.0, theta = 0.0;
+  double *Z0 = s->Z, *Z1 = s->Z + N, *Z2 = s->Z + 2 * (size_t)N;
+  double *W0 = s->W, *W1 = s->W + N, *W2 = s->W + 2 * (size_t)N;
+  const double *T = s->T, *Ti = s->Ti, *A = s->A;
+  *theta_max = 0.0;
+  for (i = 0; i < N; ++i) {
+    double z0 = Z0[i], z1 = Z1[i], z2 = Z2[i];
+    W0[i] = Ti[0] * z0 + Ti[1] * z1 + Ti[2] * z2;
+    W1[i] = Ti[3] * z0 + Ti[4] * z1 + Ti[5] * z2;
+    W2[i] = Ti[6] * z0 + Ti[7] * z1 + Ti[8] * z2;
+  }
+  for (;;) {
+    const double *F0 = s->F, *F1 = s->F + N, *F2 = s->F + 2 * (size_t)N;
+    double res = 0.0;
+    phgmg__gl3_eval(s, x);
+    if (!phgmg__all_finite(s->F, 3 * (size_t)N)) return PHGMG_ERR_NANINF;
+    for (i = 0; i < N; ++i) {
+      double f0 = F0[i], f1 = F1[i], f2 = F2[i], e0, e1, e2, w0 = W0[i], w1 = W1[i], w2 = W2[i];
+      e0 = fabs(Z0[i] - h * (A[0] * f0 + A[1] * f1 + A[2] * f2));
+      e1 = fabs(Z1[i] - h * (A[3] * f0 + A[4] * f1 + A[5] * f2));
+      e2 = fabs(Z2[i] - h * (A[6] * f0 + A[7] * f1 + A[8] * f2));
+      if (e0 > res) res = e0;
+      if (e1 > res) res = e1;
+      if (e2 > res) res = e2;
+      /* Newton right-hand sides in the transformed variables */
+      s->r1[i] = Ti[0] * f0 + Ti[1] * f1 + Ti[2] * f2 - s->gam * ih * w0;
+      s->rc[2 * i] = Ti[3] * f0 + Ti[4] * f1 + Ti[5] * f2 - (s->alp * w1 + s->bet * w2) * ih;
+      s->rc[2 * i + 1] = Ti[6] * f0 + Ti[7] * f1 + Ti[8] * f2 - (s->alp * w2 - s->bet * w1) * ih;
+    }
+    if (res != res) return PHGMG_ERR_NANINF;
+    if (it > 0) {
+      theta = res_prev > 0.0 ? res / res_prev : 0.0;
+      if (theta > *theta_max) *theta_max = theta;
+      ndiv = theta >= 1.0 ? ndiv + 1 : 0;
+    }
+    *res_out = res;
+    if (it >= 1 && res <= s->tol) return PHGMG_OK;
+    if (it >= s->max_iter) return PHGMG_ERR_NOT_CONVERGED;
+    if (it >= 1 && theta >= 1.0 && !fresh) return PHGMG_ERR_NOT_CONVERGED;
+    if (ndiv >= 2) return PHGMG_ERR_NOT_CONVERGED;
+    phgmg__gl3_solve_real(s, s->r1);
+    phgmg__gl3_solve_cplx(s, s->rc);
+    for (i = 0; i < N; ++i) {
+      double w0 = W0[i] + s->r1[i], w1 = W1[i] + s->rc[2 * i], w2 = W2[i] + s->rc[2 * i + 1];
+      W0[i] = w0; W1[i] = w1; W2[i] = w2;
+      Z0[i] = T[0] * w0 + T[1] * w1 + T[2] * w2;
+      Z1[i] = T[3] * w0 + T[4] * w1 + T[5] * w2;
+      Z2[i] = T[6] * w0 + T[7] * w1 + T[8] * w2;
+    }
+    if (!phgmg__all_finite(s->Z, 3 * (size_t)N)) return PHGMG_ERR_NANINF;
+    res_prev = res;
+    ++it;
+    s->st.newton_iters++;
+  }
+}
+
+/* Supplied and dissipated energy over a step from the stage gradients s->G. */
+PHGMG__PRIV void phgmg__gl3_energy(phgmg_gl3 *s, double energy_inc[2]) {
+  const phgmg_ph_system *sys = &s->sys;
+  int N = s->N, m = s->m, st, k, i;
+  double sup = 0.0, dis = 0.0;
+  for (st = 0; st < 3; ++st) {
+    const double *g = s->G + (size_t)st * (size_t)N, *u = s->U + (size_t)st * (size_t)m;
+    double yu = 0.0;
+    for (k = 0; k < m; ++k) {
+      const double *bk = sys->B + (size_t)k * (size_t)N;
+      double yk = 0.0;
+      for (i = 0; i < N; ++i) yk += bk[i] * g[i];
+      yu += yk * u[k];
+    }
+    sup += s->b[st] * yu;
+    dis += s->b[st] * phgmg__ph_quad(sys, sys->R, g, g);
+  }
+  energy_inc[0] = s->h * sup;
+  energy_inc[1] = s->h * dis;
+}
+
+PHGMG__PRIV phgmg_result phgmg__gl3_step_map(phgmg_gl3 *s, const double *x, double energy_inc[2]) {
+  int N = s->N, m = s->m, st;
+  size_t NN = (size_t)N * (size_t)N;
+  phgmg_gemv('N', N, N, 1.0, s->Phi, N, x, 0.0, s->xnew);
+  phgmg_gemv('N', N, 3 * m, 1.0, s->Gam, N, s->U, 1.0, s->xnew);
+  if (!phgmg__all_finite(s->xnew, (size_t)N)) return PHGMG_ERR_NANINF;
+  if (energy_inc) {
+    for (st = 0; st < 3; ++st) {
+      double *g = s->G + (size_t)st * (size_t)N;
+      phgmg_gemv('N', N, N, 1.0, s->GX + (size_t)st * NN, N, x, 0.0, g);
+      phgmg_gemv('N', N, 3 * m, 1.0, s->GU + (size_t)st * (size_t)N * 3 * (size_t)m, N, s->U,
+                 1.0, g);
+    }
+    phgmg__gl3_energy(s, energy_inc);
+  }
+  return PHGMG_OK;
+}
+
+PHGMG_DEF phgmg_result phgmg_gl3_step(phgmg_gl3 *s, double t, double *x, phgmg_input_fn uf,
+                                      void *uuser, double energy_inc[2]) {
+  int N, m, st, i, fresh = 0, cont;
+  double theta = 0.0, res = 0.0;
+  phgmg_result rc;
+  if (!s || !x) return PHGMG_ERR_INVALID_ARG;
+  N = s->N;
+  m = s->m;
+  for (st = 0; st < 3; ++st) {
+    double *u = s->U + (size_t)st * (size_t)m;
+    if (uf) uf(t + s->c[st] * s->h, u, uuser);
+    else for (i = 0; i < m; ++i) u[i] = 0.0;
+  }
+  if (!phgmg__all_finite(x, (size_t)N) || !phgmg__all_finite(s->U, 3 * (size_t)m))
+    return PHGMG_ERR_NANINF;
+  if (s->mode == PHGMG__GL3_MAP) {
+    rc = phgmg__gl3_step_map(s, x, energy_inc);
+    if (rc != PHGMG_OK) { s->st.failures++; return rc; }
+    memcpy(x, s->xnew, sizeof(double) * (size_t)N);
+    s->st.steps++;
+    return PHGMG_OK;
+  }
+  /* starting guess: extrapolate the previous collocation polynomial when this
+     step continues the previous one */
+  cont = s->have_prev && fabs(t - s->tend) <= 1e-6 * s->h + 4.0 * PHGMG__EPS * fabs(t) &&
+         memcmp(x, s->xend, sizeof(double) * (size_t)N) == 0;
+  if (cont) {
+    const double *P0 = s->Zprev, *P1 = s->Zprev + N, *P2 = s->Zprev + 2 * (size_t)N;
+    for (st = 0; st < 3; ++st) {
+      double e0 = s->E[st * 3], e1 = s->E[st * 3 + 1], e2 = s->E[st * 3 + 2];
+      double *zg = s->Zg + (size_t)st * (size_t)N;
+      for (i = 0; i < N; ++i) zg[i] = e0 * P0[i] + e1 * P1[i] + e2 * P2[i];
+    }
+  } else {
+    memset(s->Zg, 0, sizeof(double) * 3 * (size_t)N);
+  }
+  if (s->need_factor) {
+    rc = phgmg__gl3_factor(s, x);
+    if (rc != PHGMG_OK) { s->st.failures++; return rc; }
+    s->need_factor = 0;
+    fresh = 1;
+  }
+  if (s->linear) fresh = 1; /* the Jacobian does not depend on x */
+  memcpy(s->Z, s->Zg, sizeof(double) * 3 * (size_t)N);
+  rc = phgmg__gl3_newton(s, x, fresh, &theta, &res);
+  if (rc != PHGMG_OK && !fresh) {
+    s->st.failures++;
+    rc = phgmg__gl3_factor(s, x);
+    if (rc != PHGMG_OK) { s->need_factor = 1; s->st.failures++; return rc; }
+    fresh = 1;
+    memcpy(s->Z, s->Zg, sizeof(double) * 3 * (size_t)N);
+    rc = phgmg__gl3_newton(s, x, fresh, &theta, &res);
+  }
+  if (rc != PHGMG_OK) { s->st.failures++; return rc; }
+  if (!s->linear && theta > s->contraction) s->need_factor = 1;
+  {
+    const double *F0 = s->F, *F1 = s->F + N, *F2 = s->F + 2 * (size_t)N;
+    double hb0 = s->h * s->b[0], hb1 = s->h * s->b[1], hb2 = s->h * s->b[2];
+    for (i = 0; i < N; ++i) s->xnew[i] = x[i] + (hb0 * F0[i] + hb1 * F1[i] + hb2 * F2[i]);
+  }
+  if (!phgmg__all_finite(s->xnew, (size_t)N)) { s->st.failures++; return PHGMG_ERR_NANINF; }
+  if (energy_inc) phgmg__gl3_energy(s, energy_inc);
+  memcpy(s->Zprev, s->Z, sizeof(double) * 3 * (size_t)N);
+  memcpy(s->xend, s->xnew, sizeof(double) * (size_t)N);
+  s->tend = t + s->h;
+  s->have_prev = 1;
+  memcpy(x, s->xnew, sizeof(double) * (size_t)N);
+  s->st.steps++;
+  if (res > s->st.max_residual) s->st.max_residual = res;
+  return PHGMG_OK;
+}
+
+PHGMG_DEF phgmg_result phgmg_simulate(const phgmg_ph_system *sys, const double *x0, double t0,
+                                      double dt, int nsteps, phgmg_input_fn uf, void *uuser,
+                                      const phgmg_gl3_opts *opts, double *X, double *Y,
+                                      const phgmg_energy *energy, phgmg_gl3_stats *stats,
+                                      int *steps_done, const phgmg_allocator *alloc) {
+  phgmg_gl3 *s = NULL;
+  phgmg_result rc;
+  double *x = NULL, *g = NULL, *tmp = NULL;
+  int N, m, n, i, k, done = 0;
+  if (steps_done) *steps_done = 0;
+  if (stats) memset(stats, 0, sizeof *stats);
+  if (!sys || !x0 || nsteps < 0) return PHGMG_ERR_INVALID_ARG;
+  if (energy && (!energy->H || !energy->S || !energy->D)) return PHGMG_ERR_INVALID_ARG;
+  rc = phgmg_gl3_create(&s, sys, dt, opts, alloc);
+  if (rc != PHGMG_OK) return rc;
+  N = sys->N;
+  m = sys->m;
+  x = phgmg__dalloc(alloc, (size_t)N);
+  g = phgmg__dalloc(alloc, (size_t)N);
+  tmp = phgmg__dalloc(alloc, (size_t)N);
+  if (!x || !g || !tmp) { rc = PHGMG_ERR_NOMEM; goto done; }
+  memcpy(x, x0, sizeof(double) * (size_t)N);
+  for (n = 0;; ++n) {
+    /* record grid point n */
+    if (X) memcpy(X + (size_t)n * (size_t)N, x, sizeof(double) * (size_t)N);
+    if (Y) {
+      phgmg__ph_grad(sys, x, g, tmp);
+      for (k = 0; k < m; ++k) {
+        const double *bk = sys->B + (size_t)k * (size_t)N;
+        double acc = 0.0;
+        for (i = 0; i < N; ++i) acc += bk[i] * g[i];
+        Y[(size_t)k + (size_t)n * (size_t)m] = acc;
+      }
+    }
+    if (energy) {
+      energy->H[n] = phgmg_ph_hamiltonian(sys, x);
+      if (n == 0) { energy->S[0] = 0.0; energy->D[0] = 0.0; }
+    }
+    if (n == nsteps) break;
+    {
+      double inc[2] = {0.0, 0.0};
+      rc = phgmg_gl3_step(s, t0 + (double)n * dt, x, uf, uuser, energy ? inc : NULL);
+      if (rc != PHGMG_OK) break;
+      if (energy) {
+        energy->S[n + 1] = energy->S[n] + inc[0];
+        energy->D[n + 1] = energy->D[n] + inc[1];
+      }
+      ++done;
+    }
+  }
+done:
+  if (stats) *stats = s->st;
+  if (steps_done) *steps_done = done;
+  phgmg__free(alloc, x);
+  phgmg__free(alloc, g);
+  phgmg__free(alloc, tmp);
+  phgmg_gl3_destroy(s);
+  return rc;
 }
 
 #endif /* PHGMG_NO_OFFLINE */
@@ -2223,6 +4181,833 @@ PHGMG_DEF phgmg_result phgmg_rom_step(phgmg_rom_stepper *s, phgmg_real *x, const
   s->have_prev = 0;
   return err == PHGMG_OK ? PHGMG_ERR_NOT_CONVERGED : err;
 }
+
+#ifndef PHGMG_NO_OFFLINE
+/* >>pod / >>reduce (implementation) ======================================= */
+
+/* A small owner list: every array of a phgmg_reduced is allocated through it,
+   so destroy (and every error path) frees exactly what was allocated. */
+#define PHGMG__MAXBUF 48
+struct phgmg_reduced {
+  phgmg_allocator alloc;
+  int use_alloc;
+  void *bufs[PHGMG__MAXBUF];
+  int nbufs;
+  int N, m, r, p, rn, nd, method, kind;
+  double *V0, *V2;     /* N x r, N x rn                        */
+  double *QB, *RB;     /* thin QR of B: N x m, m x m           */
+  double *W;           /* N x r point reduction for SP1/SP2    */
+  double *M;           /* rn x p^2                             */
+  int *coord;          /* nd: coordinates of the kept terms    */
+  const phgmg_ph_system *sys;
+  /* double blocks (same meaning as the phgmg_rom fields) */
+  double *Bh, *Qh, *K, *G00, *G01, *G10, *G11, *Q01, *Q11, *Ms, *P0, *P1, *w, *poly;
+  double *Phi, *Gam, *SX, *SU;
+  double map_dt;       /* step of the precomputed map          */
+  phgmg_rom rom;       /* views into the phgmg_real copies     */
+};
+
+PHGMG__PRIV void *phgmg__red_alloc(phgmg_reduced *red, size_t bytes) {
+  void *p;
+  if (red->nbufs >= PHGMG__MAXBUF) return NULL;
+  p = phgmg__alloc(red->use_alloc ? &red->alloc : NULL, bytes);
+  if (p) red->bufs[red->nbufs++] = p;
+  return p;
+}
+PHGMG__PRIV double *phgmg__red_d(phgmg_reduced *red, size_t n) {
+  double *p = PHGMG__CAST(double *, phgmg__red_alloc(red, (n ? n : 1) * sizeof(double)));
+  if (p) memset(p, 0, (n ? n : 1) * sizeof(double));
+  return p;
+}
+
+PHGMG_DEF void phgmg_reduced_destroy(phgmg_reduced *red) {
+  int i;
+  phgmg_allocator a;
+  int use;
+  if (!red) return;
+  a = red->alloc;
+  use = red->use_alloc;
+  for (i = 0; i < red->nbufs; ++i) phgmg__free(use ? &a : NULL, red->bufs[i]);
+  phgmg__free(use ? &a : NULL, red);
+}
+
+PHGMG_DEF const phgmg_rom *phgmg_reduced_rom(const phgmg_reduced *red) { return red ? &red->rom : NULL; }
+PHGMG_DEF int phgmg_reduced_N(const phgmg_reduced *red) { return red ? red->N : 0; }
+
+/* C (m x n) = A^T B with A: k x m, B: k x n (column-major, tight). */
+PHGMG__PRIV void phgmg__atb(int k, int m, int n, const double *A, const double *B, double *C) {
+  phgmg_gemm('T', 'N', m, n, k, 1.0, A, k, B, k, 0.0, C, m);
+}
+
+PHGMG_DEF phgmg_result phgmg_pod(int N, int ns, const double *X, int ldx, int kmax, double tol,
+                                 double *V, int ldv, double *S, int *k_out,
+                                 const phgmg_allocator *alloc) {
+  double *s;
+  int k = 0, rank = 0, i;
+  phgmg_result rc;
+  if (!X || !V || !k_out) return PHGMG_ERR_INVALID_ARG;
+  if (N < 1 || ns < 1 || kmax < 1 || ldx < N || ldv < N || kmax > PHGMG__MIN(N, ns)) return PHGMG_ERR_SIZE;
+  s = phgmg__dalloc(alloc, (size_t)kmax);
+  if (!s) return PHGMG_ERR_NOMEM;
+  rc = phgmg_svd(N, ns, X, ldx, kmax, s, V, ldv, NULL, 1, &k, &rank, alloc);
+  if (rc == PHGMG_OK) {
+    if (tol > 0.0)
+      for (i = 0; i < k; ++i)
+        if (!(s[i] > tol * s[0])) { k = i; break; }
+    for (i = 0; i < k && S; ++i) S[i] = s[i];
+    *k_out = k;
+  }
+  phgmg__free(alloc, s);
+  return rc;
+}
+
+/* Thin QR of B (N x m): QB (N x m) orthonormal, RB (m x m) upper triangular.
+   PHGMG_ERR_RANK if B is rank deficient. */
+PHGMG__PRIV phgmg_result phgmg__thin_qr(int N, int m, const double *B, double *QB, double *RB,
+                                        const phgmg_allocator *alloc) {
+  double *tau, *work;
+  double rmax = 0.0;
+  int i, j;
+  phgmg_result rc;
+  tau = phgmg__dalloc(alloc, (size_t)(2 * m + 1));
+  if (!tau) return PHGMG_ERR_NOMEM;
+  work = tau + m;
+  for (j = 0; j < m; ++j) memcpy(QB + (size_t)j * N, B + (size_t)j * N, (size_t)N * sizeof(double));
+  rc = phgmg_qr(N, m, QB, N, tau);
+  if (rc == PHGMG_OK) {
+    for (j = 0; j < m; ++j)
+      for (i = 0; i < m; ++i) RB[i + j * m] = i <= j ? QB[i + (size_t)j * N] : 0.0;
+    for (j = 0; j < m; ++j) rmax = PHGMG__MAX(rmax, fabs(RB[j + j * m]));
+    for (j = 0; j < m; ++j)
+      if (!(fabs(RB[j + j * m]) > 1e3 * PHGMG__EPS * (double)N * rmax)) rc = PHGMG_ERR_RANK;
+    if (rc == PHGMG_OK) phgmg_qr_form_q(N, m, QB, N, tau, work);
+  }
+  phgmg__free(alloc, tau);
+  return rc;
+}
+
+/* Y = (I - Q Q^T) X for Q (N x k orthonormal), X N x ns; tmp: k x ns. */
+PHGMG__PRIV void phgmg__orth_remove(int N, int k, const double *Q, int ns, double *X, int ldx, double *tmp) {
+  if (k < 1) return;
+  phgmg_gemm('T', 'N', k, ns, N, 1.0, Q, N, X, ldx, 0.0, tmp, k);
+  phgmg_gemm('N', 'N', N, ns, k, -1.0, Q, N, tmp, k, 1.0, X, ldx);
+}
+
+PHGMG_DEF phgmg_result phgmg_adjust_snapshots(int N, int m, const double *B, int ns, const double *X,
+                                              int ldx, double *Xa, int ldxa, const phgmg_allocator *alloc) {
+  double *QB, *tmp;
+  phgmg_result rc;
+  int j;
+  if (!B || !X || !Xa) return PHGMG_ERR_INVALID_ARG;
+  if (N < 1 || m < 1 || m > N || ns < 1 || ldx < N || ldxa < N) return PHGMG_ERR_SIZE;
+  QB = phgmg__dalloc(alloc, (size_t)N * m + (size_t)m * m + (size_t)m * ns);
+  if (!QB) return PHGMG_ERR_NOMEM;
+  tmp = QB + (size_t)N * m;
+  rc = phgmg__thin_qr(N, m, B, QB, tmp, alloc);
+  if (rc == PHGMG_OK) {
+    if (Xa != X)
+      for (j = 0; j < ns; ++j) memcpy(Xa + (size_t)j * ldxa, X + (size_t)j * ldx, (size_t)N * sizeof(double));
+    phgmg__orth_remove(N, m, QB, ns, Xa, ldxa, tmp + (size_t)m * m);
+  }
+  phgmg__free(alloc, QB);
+  return rc;
+}
+
+PHGMG_DEF phgmg_result phgmg_pod_hierarchical(int N, int m, const double *B, int ns, const double *X,
+                                              int ldx, int p, int rn, double *V1, double *V2,
+                                              const phgmg_allocator *alloc) {
+  double *Xa, *tmp;
+  phgmg_result rc;
+  int k = 0;
+  if (!B || !X || !V1 || !V2) return PHGMG_ERR_INVALID_ARG;
+  if (p < 1 || rn < 1 || p + rn + m > PHGMG__MIN(N, ns + m)) return PHGMG_ERR_SIZE;
+  Xa = phgmg__dalloc(alloc, (size_t)N * ns + (size_t)p * ns);
+  if (!Xa) return PHGMG_ERR_NOMEM;
+  tmp = Xa + (size_t)N * ns;
+  rc = phgmg_adjust_snapshots(N, m, B, ns, X, ldx, Xa, N, alloc);
+  if (rc == PHGMG_OK) rc = phgmg_pod(N, ns, Xa, N, p, 0.0, V1, N, NULL, &k, alloc);
+  if (rc == PHGMG_OK && k < p) rc = PHGMG_ERR_SIZE;
+  if (rc == PHGMG_OK) {
+    phgmg__orth_remove(N, p, V1, ns, Xa, N, tmp);
+    rc = phgmg_pod(N, ns, Xa, N, rn, 0.0, V2, N, NULL, &k, alloc);
+    if (rc == PHGMG_OK && k < rn) rc = PHGMG_ERR_SIZE;
+  }
+  phgmg__free(alloc, Xa);
+  return rc;
+}
+
+PHGMG_DEF phgmg_result phgmg_deim(int nterms, int ns, const double *F, int ldf, const double *sw,
+                                  double tol, int kmax, int *pts, double *w, int *nd_out,
+                                  int *nneg, double *sigma_ratio, const phgmg_allocator *alloc) {
+  double *U, *S, *Ut, *tau, *work, *PU;
+  int *jpvt, *ipiv;
+  int k = 0, kk, rank = 0, i, j, neg = 0;
+  phgmg_result rc;
+  if (!F || !pts || !w || !nd_out) return PHGMG_ERR_INVALID_ARG;
+  if (nterms < 1 || ns < 1 || ldf < nterms) return PHGMG_ERR_SIZE;
+  if (!phgmg__all_finite(F, (size_t)ldf * (size_t)(ns - 1) + (size_t)nterms)) return PHGMG_ERR_NANINF;
+  if (tol <= 0.0) tol = 1e-8;
+  kk = PHGMG__MIN(nterms, ns);
+  if (kmax > 0) kk = PHGMG__MIN(kk, kmax + 1);
+  U = phgmg__dalloc(alloc, (size_t)nterms * kk + (size_t)kk + (size_t)kk * nterms + (size_t)kk +
+                               2 * (size_t)nterms + (size_t)kk * kk + (size_t)kk);
+  jpvt = phgmg__ialloc(alloc, (size_t)nterms + (size_t)kk);
+  if (!U || !jpvt) { phgmg__free(alloc, U); phgmg__free(alloc, jpvt); return PHGMG_ERR_NOMEM; }
+  S = U + (size_t)nterms * kk;
+  Ut = S + kk;
+  tau = Ut + (size_t)kk * nterms;
+  work = tau + kk;
+  PU = work + 2 * (size_t)nterms;
+  ipiv = jpvt + nterms;
+  rc = phgmg_svd(nterms, ns, F, ldf, kk, S, U, nterms, NULL, 1, &k, &rank, alloc);
+  if (rc == PHGMG_OK) {
+    int keep = 0;
+    for (i = 0; i < k; ++i) if (S[i] > tol * S[0]) keep = i + 1;
+    if (kmax > 0 && keep > kmax) keep = kmax;
+    if (keep < 1) keep = 1;
+    if (sigma_ratio) *sigma_ratio = (keep < k && S[0] > 0.0) ? S[keep] / S[0] : 0.0;
+    /* Q-DEIM: pivoted QR of U^T (keep x nterms); points = first keep pivots */
+    for (j = 0; j < nterms; ++j)
+      for (i = 0; i < keep; ++i) Ut[i + (size_t)j * keep] = U[j + (size_t)i * nterms];
+    rc = phgmg_qrcp(keep, nterms, Ut, keep, tau, jpvt, work);
+    if (rc == PHGMG_OK) {
+      /* w = (P^T U)^{-T} U^T sw: solve (P^T U)^T w = U^T sw */
+      for (i = 0; i < keep; ++i) pts[i] = jpvt[i];
+      for (j = 0; j < keep; ++j)       /* PU = P^T U (keep x keep) */
+        for (i = 0; i < keep; ++i) PU[i + (size_t)j * keep] = U[pts[i] + (size_t)j * nterms];
+      for (j = 0; j < keep; ++j) {
+        double sacc = 0.0;
+        for (i = 0; i < nterms; ++i) sacc += U[i + (size_t)j * nterms] * (sw ? sw[i] : 1.0);
+        w[j] = sacc;
+      }
+      rc = phgmg_lu_factor(keep, PU, keep, ipiv);
+      if (rc == PHGMG_OK) {
+        phgmg_lu_solve('T', keep, PU, keep, ipiv, 1, w, keep);
+        for (i = 0; i < keep; ++i) if (w[i] < 0.0) ++neg;
+        if (!phgmg__all_finite(w, (size_t)keep)) rc = PHGMG_ERR_NANINF;
+        *nd_out = keep;
+        if (nneg) *nneg = neg;
+      }
+    }
+  }
+  phgmg__free(alloc, U);
+  phgmg__free(alloc, jpvt);
+  return rc;
+}
+
+/* Lp (rn x p) = [sum_j Ms(:, k*p + j) x2_j]_k in double. */
+PHGMG__PRIV void phgmg__lp_d(int rn, int p, const double *Ms, const double *x2, double *Lp) {
+  int i, j, k;
+  for (k = 0; k < p; ++k) {
+    double *l = Lp + (size_t)k * rn;
+    for (i = 0; i < rn; ++i) l[i] = 0.0;
+    for (j = 0; j < p; ++j) {
+      const double *ms = Ms + ((size_t)k * p + j) * rn;
+      for (i = 0; i < rn; ++i) l[i] += ms[i] * x2[j];
+    }
+  }
+}
+
+/* E = G00 + G01 L + L^T (G10 + G11 L), L = [0, Lp]; tmp: rn x r. */
+PHGMG__PRIV void phgmg__dgd_d(const phgmg_reduced *red, const double *Lp, double *E, double *tmp) {
+  const int r = red->r, m = red->m, rn = red->rn;
+  int a, b, i;
+  for (b = 0; b < r; ++b) {
+    for (i = 0; i < rn; ++i) tmp[i + (size_t)b * rn] = red->G10[i + (size_t)b * rn];
+    if (b >= m) phgmg_gemv('N', rn, rn, 1.0, red->G11, rn, Lp + (size_t)(b - m) * rn, 1.0, tmp + (size_t)b * rn);
+  }
+  memcpy(E, red->G00, (size_t)r * r * sizeof(double));
+  for (b = m; b < r; ++b) phgmg_gemv('N', r, rn, 1.0, red->G01, r, Lp + (size_t)(b - m) * rn, 1.0, E + (size_t)b * r);
+  for (b = 0; b < r; ++b)
+    for (a = m; a < r; ++a) {
+      double s = 0.0;
+      for (i = 0; i < rn; ++i) s += Lp[i + (size_t)(a - m) * rn] * tmp[i + (size_t)b * rn];
+      E[a + (size_t)b * r] += s;
+    }
+}
+
+/* rcond of an r x r matrix (copied). -1 on allocation failure. */
+PHGMG__PRIV double phgmg__rcond_of(int n, const double *A, const phgmg_allocator *alloc) {
+  double *LU = phgmg__dalloc(alloc, (size_t)n * n + 2 * (size_t)n);
+  int *ip = phgmg__ialloc(alloc, 2 * (size_t)n);
+  double rc = -1.0;
+  if (LU && ip) {
+    double anorm = phgmg_norm1(n, n, A, n);
+    memcpy(LU, A, (size_t)n * n * sizeof(double));
+    if (phgmg_lu_factor(n, LU, n, ip) == PHGMG_OK)
+      rc = phgmg_lu_rcond(n, LU, n, ip, anorm, LU + (size_t)n * n, ip + n);
+    else
+      rc = 0.0;
+  }
+  phgmg__free(alloc, LU);
+  phgmg__free(alloc, ip);
+  return rc;
+}
+
+/* Inverse of an r x r matrix into Ainv. */
+PHGMG__PRIV phgmg_result phgmg__inv(int n, const double *A, double *Ainv, const phgmg_allocator *alloc) {
+  double *LU = phgmg__dalloc(alloc, (size_t)n * n);
+  int *ip = phgmg__ialloc(alloc, (size_t)n);
+  phgmg_result rc = PHGMG_ERR_NOMEM;
+  int i;
+  if (LU && ip) {
+    memcpy(LU, A, (size_t)n * n * sizeof(double));
+    rc = phgmg_lu_factor(n, LU, n, ip);
+    if (rc == PHGMG_OK) {
+      memset(Ainv, 0, (size_t)n * n * sizeof(double));
+      for (i = 0; i < n; ++i) Ainv[i + (size_t)i * n] = 1.0;
+      phgmg_lu_solve('N', n, LU, n, ip, n, Ainv, n);
+    }
+  }
+  phgmg__free(alloc, LU);
+  phgmg__free(alloc, ip);
+  return rc;
+}
+
+PHGMG__PRIV double phgmg__poly_d1(const double *c, int deg, double s) {
+  double p1 = 0.0, p0 = 0.0;
+  int k;
+  for (k = deg; k >= 0; --k) { p1 = p1 * s + p0; p0 = p0 * s + c[k]; }
+  return p1;
+}
+
+/* The exact GL3 step map of x' = Jf x + Bh u (see phgmg_rom). */
+PHGMG__PRIV phgmg_result phgmg__step_map(phgmg_reduced *red, double h, const phgmg_allocator *alloc) {
+  const int r = red->r, m = red->m, n3 = 3 * r, nc = r + 3 * m;
+  double c[3], b[3], A[9];
+  double *Jf = phgmg__dalloc(alloc, (size_t)r * r + (size_t)n3 * n3 + (size_t)n3 * nc);
+  int *ip = phgmg__ialloc(alloc, (size_t)n3);
+  double *M3, *RH;
+  phgmg_result rc = PHGMG_ERR_NOMEM;
+  int i, j, a, bb;
+  if (!Jf || !ip) goto done;
+  M3 = Jf + (size_t)r * r;
+  RH = M3 + (size_t)n3 * n3;
+  phgmg_gl3_coefficients(c, b, A);
+  phgmg_gemm('N', 'N', r, r, r, 1.0, red->K, r, red->Qh, r, 0.0, Jf, r);
+  for (j = 0; j < 3; ++j)
+    for (bb = 0; bb < r; ++bb)
+      for (i = 0; i < 3; ++i)
+        for (a = 0; a < r; ++a)
+          M3[(i * r + a) + (size_t)(j * r + bb) * n3] = (i == j && a == bb ? 1.0 : 0.0) - h * A[i * 3 + j] * Jf[a + (size_t)bb * r];
+  /* RH = [h (A kron Jf)(1 kron I),  h (A kron Bh)] */
+  for (i = 0; i < 3; ++i) {
+    for (bb = 0; bb < r; ++bb)
+      for (a = 0; a < r; ++a) {
+        double s = 0.0;
+        for (j = 0; j < 3; ++j) s += A[i * 3 + j];
+        RH[(i * r + a) + (size_t)bb * n3] = h * s * Jf[a + (size_t)bb * r];
+      }
+    for (j = 0; j < 3; ++j)
+      for (bb = 0; bb < m; ++bb)
+        for (a = 0; a < r; ++a)
+          RH[(i * r + a) + (size_t)(r + j * m + bb) * n3] = h * A[i * 3 + j] * red->Bh[a + (size_t)bb * r];
+  }
+  rc = phgmg_lu_factor(n3, M3, n3, ip);
+  if (rc != PHGMG_OK) goto done;
+  phgmg_lu_solve('N', n3, M3, n3, ip, nc, RH, n3);
+  rc = PHGMG_ERR_NOMEM;
+  red->SX = phgmg__red_d(red, (size_t)n3 * r);
+  red->SU = phgmg__red_d(red, (size_t)n3 * 3 * m);
+  red->Phi = phgmg__red_d(red, (size_t)r * r);
+  red->Gam = phgmg__red_d(red, (size_t)r * 3 * m);
+  if (!red->SX || !red->SU || !red->Phi || !red->Gam) goto done;
+  for (bb = 0; bb < r; ++bb)
+    for (a = 0; a < n3; ++a) red->SX[a + (size_t)bb * n3] = RH[a + (size_t)bb * n3] + (a % r == bb ? 1.0 : 0.0);
+  for (bb = 0; bb < 3 * m; ++bb)
+    for (a = 0; a < n3; ++a) red->SU[a + (size_t)bb * n3] = RH[a + (size_t)(r + bb) * n3];
+  /* Phi = I + h sum b_i Jf SX_i ; Gam = h sum b_i Jf SU_i + h [b_1 Bh, b_2 Bh, b_3 Bh] */
+  for (a = 0; a < r; ++a) red->Phi[a + (size_t)a * r] = 1.0;
+  for (i = 0; i < 3; ++i) {
+    phgmg_gemm('N', 'N', r, r, r, h * b[i], Jf, r, red->SX + i * r, n3, 1.0, red->Phi, r);
+    if (m > 0) phgmg_gemm('N', 'N', r, 3 * m, r, h * b[i], Jf, r, red->SU + i * r, n3, 1.0, red->Gam, r);
+    for (bb = 0; bb < m; ++bb)
+      for (a = 0; a < r; ++a) red->Gam[a + (size_t)(i * m + bb) * r] += h * b[i] * red->Bh[a + (size_t)bb * r];
+  }
+  rc = PHGMG_OK;
+done:
+  phgmg__free(alloc, Jf);
+  phgmg__free(alloc, ip);
+  return rc;
+}
+
+/* phgmg_real copy of a double array (NULL stays NULL). */
+PHGMG__PRIV phgmg_result phgmg__to_real(phgmg_reduced *red, const double *src, size_t n, const phgmg_real **dst) {
+  phgmg_real *d;
+  size_t i;
+  if (!src) { *dst = NULL; return PHGMG_OK; }
+  d = PHGMG__CAST(phgmg_real *, phgmg__red_alloc(red, (n ? n : 1) * sizeof(phgmg_real)));
+  if (!d) return PHGMG_ERR_NOMEM;
+  for (i = 0; i < n; ++i) d[i] = (phgmg_real)src[i];
+  *dst = d;
+  return PHGMG_OK;
+}
+
+PHGMG__PRIV phgmg_result phgmg__publish(phgmg_reduced *red) {
+  const size_t r = (size_t)red->r, m = (size_t)red->m, rn = (size_t)red->rn, nd = (size_t)red->nd;
+  const size_t p = (size_t)red->p;
+  phgmg_rom *o = &red->rom;
+  phgmg_result rc = PHGMG_OK;
+  memset(o, 0, sizeof *o);
+  o->kind = red->kind; o->method = red->method; o->r = red->r; o->m = red->m;
+  o->rn = red->rn; o->nd = red->nd; o->poly_deg = red->nd > 0 ? red->sys->poly_deg : 0;
+#define PHGMG__PUB(field, n) if (rc == PHGMG_OK) rc = phgmg__to_real(red, red->field, (n), &o->field)
+  PHGMG__PUB(Bh, r * m); PHGMG__PUB(Qh, r * r); PHGMG__PUB(K, r * r);
+  PHGMG__PUB(G00, r * r); PHGMG__PUB(G01, r * rn); PHGMG__PUB(G10, rn * r); PHGMG__PUB(G11, rn * rn);
+  PHGMG__PUB(Q01, r * rn); PHGMG__PUB(Q11, rn * rn); PHGMG__PUB(Ms, rn * p * p);
+  PHGMG__PUB(P0, nd * r); PHGMG__PUB(P1, nd * rn); PHGMG__PUB(w, nd);
+  PHGMG__PUB(poly, (size_t)(o->poly_deg + 1));
+  PHGMG__PUB(Phi, r * r); PHGMG__PUB(Gam, r * 3 * m); PHGMG__PUB(SX, 3 * r * r); PHGMG__PUB(SU, 3 * r * 3 * m);
+#undef PHGMG__PUB
+  o->dt = red->Phi ? (phgmg_real)red->map_dt : (phgmg_real)0;
+  return rc;
+}
+
+PHGMG_DEF phgmg_result phgmg_reduce(phgmg_reduced **out, const phgmg_ph_system *sys, const double *X,
+                                    int ldx, int ns, const phgmg_reduce_opts *opts,
+                                    phgmg_reduce_info *info, const phgmg_allocator *alloc) {
+  phgmg_reduced *red = NULL;
+  phgmg_jr_factor *jr = NULL;
+  phgmg_reduce_info inf;
+  phgmg_result rc;
+  double *T1 = NULL, *T2 = NULL, *T3 = NULL; /* temporaries */
+  int *pts = NULL;
+  int N, m, r, p, rn = 0, k = 0, i, j, a;
+  double lambda, degtol;
+  if (!out || !sys || !X || !opts) return PHGMG_ERR_INVALID_ARG;
+  *out = NULL;
+  memset(&inf, 0, sizeof inf);
+  N = sys->N; m = sys->m; r = opts->r;
+  if (N < 1 || m < 1 || ns < 1 || ldx < N) return PHGMG_ERR_SIZE;
+  if (opts->method < PHGMG_METHOD_GMG_POD || opts->method > PHGMG_METHOD_SP2) return PHGMG_ERR_INVALID_ARG;
+  if (opts->method == PHGMG_METHOD_GMG_POD || opts->method == PHGMG_METHOD_GMG_QM) {
+    if (r <= m || r > N) return PHGMG_ERR_SIZE;
+  } else if (r < 1 || r > N || r > ns) {
+    return PHGMG_ERR_SIZE;
+  }
+  if (sys->nl == PHGMG_NL_GENERAL) return PHGMG_ERR_UNSUPPORTED;
+  if (sys->nl == PHGMG_NL_SEPARABLE && (sys->poly_deg < 1 || !sys->poly)) return PHGMG_ERR_UNSUPPORTED;
+  if (!phgmg__all_finite(X, (size_t)ldx * (size_t)(ns - 1) + (size_t)N)) return PHGMG_ERR_NANINF;
+  rc = phgmg_ph_validate(sys, 0.0, &inf.rcond_jr, alloc);
+  if (rc != PHGMG_OK) return rc;
+  lambda = opts->lambda == 0.0 ? 1e-3 : (opts->lambda < 0.0 ? 0.0 : opts->lambda);
+  degtol = opts->degeneracy_tol > 0.0 ? opts->degeneracy_tol : 1e-12;
+
+  red = PHGMG__CAST(phgmg_reduced *, phgmg__alloc(alloc, sizeof(phgmg_reduced)));
+  if (!red) return PHGMG_ERR_NOMEM;
+  memset(red, 0, sizeof *red);
+  if (alloc) { red->alloc = *alloc; red->use_alloc = 1; }
+  red->N = N; red->m = m; red->r = r; red->method = opts->method; red->sys = sys;
+  red->kind = opts->method == PHGMG_METHOD_GMG_QM ? PHGMG_ROM_QUADRATIC : PHGMG_ROM_LINEAR;
+  p = (opts->method == PHGMG_METHOD_GMG_POD || opts->method == PHGMG_METHOD_GMG_QM) ? r - m : r;
+  red->p = p;
+  if (red->kind == PHGMG_ROM_QUADRATIC) {
+    rn = opts->rn > 0 ? opts->rn : 8;
+    /* the online q/Lp buffers of lift/dphi hold up to 64 x 64 */
+    if (rn > N - r || rn > 64 || rn * p > 64 * 64) { rc = PHGMG_ERR_SIZE; goto fail; }
+  }
+  red->rn = rn;
+
+#define PHGMG__NEED(ptr) do { if (!(ptr)) { rc = PHGMG_ERR_NOMEM; goto fail; } } while (0)
+#define PHGMG__TRY(expr) do { rc = (expr); if (rc != PHGMG_OK) goto fail; } while (0)
+  red->V0 = phgmg__red_d(red, (size_t)N * r); PHGMG__NEED(red->V0);
+  red->QB = phgmg__red_d(red, (size_t)N * m); PHGMG__NEED(red->QB);
+  red->RB = phgmg__red_d(red, (size_t)m * m); PHGMG__NEED(red->RB);
+  PHGMG__TRY(phgmg__thin_qr(N, m, sys->B, red->QB, red->RB, alloc));
+  T1 = phgmg__dalloc(alloc, (size_t)N * ns); PHGMG__NEED(T1);
+
+  if (red->method == PHGMG_METHOD_GMG_POD || red->method == PHGMG_METHOD_GMG_QM) {
+    double *S = NULL;
+    /* V0 = [B, V1], V1 = POD of the adjusted snapshots X - B B^+ X */
+    for (j = 0; j < ns; ++j) memcpy(T1 + (size_t)j * N, X + (size_t)j * ldx, (size_t)N * sizeof(double));
+    T2 = phgmg__dalloc(alloc, (size_t)PHGMG__MAX(m, p + 1) * ns + (size_t)p + 2); PHGMG__NEED(T2);
+    phgmg__orth_remove(N, m, red->QB, ns, T1, N, T2);
+    memcpy(red->V0, sys->B, (size_t)N * m * sizeof(double));
+    S = T2 + (size_t)PHGMG__MAX(m, p + 1) * ns;
+    T3 = phgmg__dalloc(alloc, (size_t)N * (p + 1)); PHGMG__NEED(T3);
+    PHGMG__TRY(phgmg_pod(N, ns, T1, N, PHGMG__MIN(p + 1, PHGMG__MIN(N, ns)), 0.0, T3, N, S, &k, alloc));
+    if (k < p) { rc = PHGMG_ERR_SIZE; goto fail; } /* r - m > rank of the adjusted snapshots */
+    memcpy(red->V0 + (size_t)N * m, T3, (size_t)N * p * sizeof(double));
+    inf.pod_sigma_ratio = (k > p && S[0] > 0.0) ? S[p] / S[0] : 0.0;
+    phgmg__free(alloc, T3); T3 = NULL;
+    if (red->kind == PHGMG_ROM_QUADRATIC) {
+      double *Z2, *Rq, *Kt, *Rqt, *Mt;
+      const int pp = p * p;
+      /* residual of the linear part, then V2 = POD of it */
+      phgmg__orth_remove(N, p, red->V0 + (size_t)N * m, ns, T1, N, T2);
+      red->V2 = phgmg__red_d(red, (size_t)N * rn); PHGMG__NEED(red->V2);
+      PHGMG__TRY(phgmg_pod(N, ns, T1, N, rn, 0.0, red->V2, N, NULL, &k, alloc));
+      if (k < rn) { rc = PHGMG_ERR_SIZE; goto fail; }
+      /* M by the ridge problem over the reduced snapshot coordinates */
+      T3 = phgmg__dalloc(alloc, (size_t)p * ns + (size_t)rn * ns + (size_t)ns * pp + (size_t)ns * rn + (size_t)pp * rn);
+      PHGMG__NEED(T3);
+      Z2 = T3; Rq = Z2 + (size_t)p * ns; Kt = Rq + (size_t)rn * ns; Rqt = Kt + (size_t)ns * pp; Mt = Rqt + (size_t)ns * rn;
+      phgmg_gemm('T', 'N', p, ns, N, 1.0, red->V0 + (size_t)N * m, N, X, ldx, 0.0, Z2, p);
+      phgmg_gemm('T', 'N', rn, ns, N, 1.0, red->V2, N, T1, N, 0.0, Rq, rn);
+      for (i = 0; i < ns; ++i) {
+        for (a = 0; a < p; ++a)
+          for (j = 0; j < p; ++j) Kt[i + (size_t)(a * p + j) * ns] = Z2[a + (size_t)i * p] * Z2[j + (size_t)i * p];
+        for (a = 0; a < rn; ++a) Rqt[i + (size_t)a * ns] = Rq[a + (size_t)i * rn];
+      }
+      PHGMG__TRY(phgmg_lstsq(ns, pp, rn, Kt, ns, Rqt, ns, lambda, Mt, pp, alloc));
+      red->M = phgmg__red_d(red, (size_t)rn * pp); PHGMG__NEED(red->M);
+      red->Ms = phgmg__red_d(red, (size_t)rn * pp); PHGMG__NEED(red->Ms);
+      for (a = 0; a < pp; ++a)
+        for (i = 0; i < rn; ++i) red->M[i + (size_t)a * rn] = Mt[a + (size_t)i * pp];
+      for (a = 0; a < p; ++a)
+        for (j = 0; j < p; ++j)
+          for (i = 0; i < rn; ++i)
+            red->Ms[i + (size_t)(a * p + j) * rn] = red->M[i + (size_t)(a * p + j) * rn] + red->M[i + (size_t)(j * p + a) * rn];
+      phgmg__free(alloc, T3); T3 = NULL;
+    }
+    /* G-blocks through a factorization of J - R */
+    PHGMG__TRY(phgmg_jr_factor_create(&jr, sys, NULL, alloc));
+    phgmg__free(alloc, T2);
+    T2 = phgmg__dalloc(alloc, (size_t)N * (r + rn)); PHGMG__NEED(T2);
+    memcpy(T2, red->V0, (size_t)N * r * sizeof(double));
+    if (rn) memcpy(T2 + (size_t)N * r, red->V2, (size_t)N * rn * sizeof(double));
+    phgmg_jr_solve(jr, 'N', r + rn, T2, N);           /* T2 = G [V0, V2] */
+    red->G00 = phgmg__red_d(red, (size_t)r * r); PHGMG__NEED(red->G00);
+    phgmg__atb(N, r, r, red->V0, T2, red->G00);
+    if (rn) {
+      red->G01 = phgmg__red_d(red, (size_t)r * rn); PHGMG__NEED(red->G01);
+      red->G10 = phgmg__red_d(red, (size_t)rn * r); PHGMG__NEED(red->G10);
+      red->G11 = phgmg__red_d(red, (size_t)rn * rn); PHGMG__NEED(red->G11);
+      phgmg__atb(N, r, rn, red->V0, T2 + (size_t)N * r, red->G01);
+      phgmg__atb(N, rn, r, red->V2, T2, red->G10);
+      phgmg__atb(N, rn, rn, red->V2, T2 + (size_t)N * r, red->G11);
+    }
+    red->Bh = phgmg__red_d(red, (size_t)r * m); PHGMG__NEED(red->Bh);
+    for (j = 0; j < m; ++j) red->Bh[j + (size_t)j * r] = 1.0;
+    /* non-degeneracy of D^T G D: at x = 0 and (QM) at every snapshot */
+    inf.rcond_dgd = phgmg__rcond_of(r, red->G00, alloc);
+    if (inf.rcond_dgd < 0.0) { rc = PHGMG_ERR_NOMEM; goto fail; }
+    if (red->kind == PHGMG_ROM_QUADRATIC) {
+      double *Lp, *E, *tmp, *x2;
+      T3 = phgmg__dalloc(alloc, (size_t)rn * p + (size_t)r * r + (size_t)rn * r + (size_t)p); PHGMG__NEED(T3);
+      Lp = T3; E = Lp + (size_t)rn * p; tmp = E + (size_t)r * r; x2 = tmp + (size_t)rn * r;
+      for (i = 0; i < ns; ++i) {
+        double rc_i;
+        phgmg_gemv('T', N, p, 1.0, red->V0 + (size_t)N * m, N, X + (size_t)i * ldx, 0.0, x2);
+        phgmg__lp_d(rn, p, red->Ms, x2, Lp);
+        phgmg__dgd_d(red, Lp, E, tmp);
+        rc_i = phgmg__rcond_of(r, E, alloc);
+        if (rc_i < 0.0) { rc = PHGMG_ERR_NOMEM; goto fail; }
+        if (rc_i < inf.rcond_dgd) inf.rcond_dgd = rc_i;
+      }
+      phgmg__free(alloc, T3); T3 = NULL;
+    }
+    if (!(inf.rcond_dgd >= degtol)) { rc = PHGMG_ERR_DEGENERATE; goto fail; }
+    if (red->kind == PHGMG_ROM_LINEAR) {
+      red->K = phgmg__red_d(red, (size_t)r * r); PHGMG__NEED(red->K);
+      PHGMG__TRY(phgmg__inv(r, red->G00, red->K, alloc));
+    }
+  } else {
+    /* SP1 / SP2: V0 = V_POD (r modes of X), W as in NUMERICS 6.3-6.4 */
+    double *Vg, *Ainv, *A2;
+    T3 = phgmg__dalloc(alloc, (size_t)N * r * 2 + 2 * (size_t)r * r + (size_t)r + 1); PHGMG__NEED(T3);
+    Vg = T3; A2 = Vg + (size_t)N * r; Ainv = A2 + (size_t)r * r;
+    PHGMG__TRY(phgmg_pod(N, ns, X, ldx, r, 0.0, red->V0, N, NULL, &k, alloc));
+    if (k < r) { rc = PHGMG_ERR_SIZE; goto fail; }
+    if (red->method == PHGMG_METHOD_SP1) {
+      phgmg_ph_apply(sys, 'Q', r, red->V0, N, Vg, N);   /* Vg := Q V */
+    } else {
+      for (j = 0; j < ns; ++j) phgmg_ph_gradient(sys, X + (size_t)j * ldx, T1 + (size_t)j * N);
+      PHGMG__TRY(phgmg_pod(N, ns, T1, N, r, 0.0, Vg, N, NULL, &k, alloc));
+      if (k < r) { rc = PHGMG_ERR_SIZE; goto fail; }
+    }
+    phgmg__atb(N, r, r, red->V0, Vg, A2);               /* V^T Vg */
+    inf.rcond_dgd = phgmg__rcond_of(r, A2, alloc);
+    if (!(inf.rcond_dgd >= degtol)) { rc = PHGMG_ERR_DEGENERATE; goto fail; }
+    PHGMG__TRY(phgmg__inv(r, A2, Ainv, alloc));
+    red->W = phgmg__red_d(red, (size_t)N * r); PHGMG__NEED(red->W);
+    phgmg_gemm('N', 'N', N, r, r, 1.0, Vg, N, Ainv, r, 0.0, red->W, N); /* W = Vg (V^T Vg)^{-1} */
+    /* K = W^T (J - R) W, Bh = W^T B */
+    phgmg_ph_apply(sys, 'J', r, red->W, N, Vg, N);
+    phgmg_ph_apply(sys, 'R', r, red->W, N, T1, N);
+    for (i = 0; i < N * r; ++i) Vg[i] -= T1[i];
+    red->K = phgmg__red_d(red, (size_t)r * r); PHGMG__NEED(red->K);
+    phgmg__atb(N, r, r, red->W, Vg, red->K);
+    red->Bh = phgmg__red_d(red, (size_t)r * m); PHGMG__NEED(red->Bh);
+    phgmg__atb(N, r, m, red->W, sys->B, red->Bh);
+    phgmg__free(alloc, T3); T3 = NULL;
+  }
+
+  /* quadratic part of H: Qh = V0^T Q V0 (and the V2 blocks) */
+  phgmg__free(alloc, T2);
+  T2 = phgmg__dalloc(alloc, (size_t)N * (r + rn)); PHGMG__NEED(T2);
+  phgmg_ph_apply(sys, 'Q', r, red->V0, N, T2, N);
+  if (rn) phgmg_ph_apply(sys, 'Q', rn, red->V2, N, T2 + (size_t)N * r, N);
+  red->Qh = phgmg__red_d(red, (size_t)r * r); PHGMG__NEED(red->Qh);
+  phgmg__atb(N, r, r, red->V0, T2, red->Qh);
+  for (j = 0; j < r; ++j)   /* exact symmetry */
+    for (i = 0; i < j; ++i) red->Qh[i + (size_t)j * r] = red->Qh[j + (size_t)i * r] = 0.5 * (red->Qh[i + (size_t)j * r] + red->Qh[j + (size_t)i * r]);
+  if (rn) {
+    red->Q01 = phgmg__red_d(red, (size_t)r * rn); PHGMG__NEED(red->Q01);
+    red->Q11 = phgmg__red_d(red, (size_t)rn * rn); PHGMG__NEED(red->Q11);
+    phgmg__atb(N, r, rn, red->V0, T2 + (size_t)N * r, red->Q01);
+    phgmg__atb(N, rn, rn, red->V2, T2 + (size_t)N * r, red->Q11);
+  }
+
+  /* separable nonlinear part: structure-preserving DEIM or every term */
+  if (sys->nl == PHGMG_NL_SEPARABLE && sys->nsep > 0) {
+    const int nt = sys->nsep;
+    int nd = 0, nneg = 0;
+    double *wt;
+    pts = phgmg__ialloc(alloc, (size_t)nt); PHGMG__NEED(pts);
+    wt = phgmg__dalloc(alloc, (size_t)nt); PHGMG__NEED(wt);
+    if (opts->deim) {
+      double *F = phgmg__dalloc(alloc, (size_t)nt * ns);
+      if (!F) { phgmg__free(alloc, wt); rc = PHGMG_ERR_NOMEM; goto fail; }
+      for (i = 0; i < ns; ++i)
+        for (a = 0; a < nt; ++a)
+          F[a + (size_t)i * nt] = phgmg__poly_d1(sys->poly, sys->poly_deg, X[sys->sep_idx[a] + (size_t)i * ldx]);
+      rc = phgmg_deim(nt, ns, F, nt, sys->sep_w, opts->deim_tol, opts->deim_max, pts, wt, &nd, &nneg,
+                      &inf.deim_sigma_ratio, alloc);
+      phgmg__free(alloc, F);
+      if (rc == PHGMG_OK && nneg > 0 && !opts->deim_allow_negative) rc = PHGMG_ERR_NEGATIVE_WEIGHT;
+      if (rc != PHGMG_OK) { phgmg__free(alloc, wt); goto fail; }
+    } else {
+      nd = nt;
+      for (a = 0; a < nt; ++a) { pts[a] = a; wt[a] = sys->sep_w ? sys->sep_w[a] : 1.0; }
+    }
+    inf.deim_modes = nd;
+    inf.deim_negative = nneg;
+    red->nd = nd;
+    red->coord = PHGMG__CAST(int *, phgmg__red_alloc(red, (size_t)nd * sizeof(int)));
+    red->w = phgmg__red_d(red, (size_t)nd);
+    red->P0 = phgmg__red_d(red, (size_t)nd * r);
+    red->P1 = rn ? phgmg__red_d(red, (size_t)nd * rn) : NULL;
+    red->poly = phgmg__red_d(red, (size_t)sys->poly_deg + 1);
+    if (!red->coord || !red->w || !red->P0 || (rn && !red->P1) || !red->poly) {
+      phgmg__free(alloc, wt); rc = PHGMG_ERR_NOMEM; goto fail;
+    }
+    for (j = 0; j < nd; ++j) {
+      const int cj = sys->sep_idx[pts[j]];
+      red->coord[j] = cj;
+      red->w[j] = wt[j];
+      for (a = 0; a < r; ++a) red->P0[j + (size_t)a * nd] = red->V0[cj + (size_t)a * N];
+      for (a = 0; a < rn; ++a) red->P1[j + (size_t)a * nd] = red->V2[cj + (size_t)a * N];
+    }
+    memcpy(red->poly, sys->poly, ((size_t)sys->poly_deg + 1) * sizeof(double));
+    phgmg__free(alloc, wt);
+  }
+  if (opts->dt > 0.0 && red->kind == PHGMG_ROM_LINEAR && red->nd == 0) {
+    red->map_dt = opts->dt;
+    PHGMG__TRY(phgmg__step_map(red, opts->dt, alloc));
+  }
+  PHGMG__TRY(phgmg__publish(red));
+#undef PHGMG__NEED
+#undef PHGMG__TRY
+  phgmg_jr_factor_destroy(jr);
+  phgmg__free(alloc, T1); phgmg__free(alloc, T2); phgmg__free(alloc, T3); phgmg__free(alloc, pts);
+  if (info) *info = inf;
+  *out = red;
+  return PHGMG_OK;
+fail:
+  phgmg_jr_factor_destroy(jr);
+  phgmg__free(alloc, T1); phgmg__free(alloc, T2); phgmg__free(alloc, T3); phgmg__free(alloc, pts);
+  phgmg_reduced_destroy(red);
+  if (info) *info = inf;
+  return rc;
+}
+
+PHGMG_DEF void phgmg_reduced_lift(const phgmg_reduced *red, const double *xr, double *x) {
+  phgmg_gemv('N', red->N, red->r, 1.0, red->V0, red->N, xr, 0.0, x);
+  if (red->kind == PHGMG_ROM_QUADRATIC) {
+    /* q = M (x2 kron x2) */
+    const int p = red->p, rn = red->rn;
+    const double *x2 = xr + red->m;
+    double q[64];
+    int i, a, j;
+    for (i = 0; i < rn && i < 64; ++i) {
+      double s = 0.0;
+      for (a = 0; a < p; ++a)
+        for (j = 0; j < p; ++j) s += red->M[i + (size_t)(a * p + j) * rn] * x2[a] * x2[j];
+      q[i] = s;
+    }
+    phgmg_gemv('N', red->N, PHGMG__MIN(rn, 64), 1.0, red->V2, red->N, q, 1.0, x);
+  }
+}
+
+PHGMG_DEF void phgmg_reduced_restrict(const phgmg_reduced *red, const double *x, double *xr) {
+  const int N = red->N, m = red->m, r = red->r;
+  if (red->method == PHGMG_METHOD_SP1 || red->method == PHGMG_METHOD_SP2) {
+    phgmg_gemv('T', N, r, 1.0, red->W, N, x, 0.0, xr);
+  } else {
+    /* [B, V1]^+ x = [RB^{-1} QB^T x; V1^T x]  (V1 is orthogonal to B) */
+    int i, j;
+    phgmg_gemv('T', N, m, 1.0, red->QB, N, x, 0.0, xr);
+    for (i = m - 1; i >= 0; --i) {
+      double s = xr[i];
+      for (j = i + 1; j < m; ++j) s -= red->RB[i + j * m] * xr[j];
+      xr[i] = s / red->RB[i + i * m];
+    }
+    phgmg_gemv('T', N, r - m, 1.0, red->V0 + (size_t)N * m, N, x, 0.0, xr + m);
+  }
+}
+
+PHGMG_DEF void phgmg_reduced_dphi(const phgmg_reduced *red, const double *xr, double *D, int ldd) {
+  const int N = red->N, r = red->r, m = red->m;
+  int j;
+  for (j = 0; j < r; ++j) memcpy(D + (size_t)j * ldd, red->V0 + (size_t)j * N, (size_t)N * sizeof(double));
+  if (red->kind == PHGMG_ROM_QUADRATIC) {
+    double Lp[64 * 64];
+    const int p = red->p, rn = red->rn;
+    if (rn * p > 64 * 64) return;
+    phgmg__lp_d(rn, p, red->Ms, xr + m, Lp);
+    phgmg_gemm('N', 'N', N, p, rn, 1.0, red->V2, N, Lp, rn, 1.0, D + (size_t)m * ldd, ldd);
+  }
+}
+
+PHGMG_DEF phgmg_result phgmg_reduced_W(const phgmg_reduced *red, const double *xr, double *W, int ldw) {
+  const int N = red->N, r = red->r;
+  phgmg_jr_factor *jr = NULL;
+  const phgmg_allocator *alloc = red->use_alloc ? &red->alloc : NULL;
+  double *D, *GtD, *E, *Einv;
+  phgmg_result rc;
+  int j;
+  if (red->method == PHGMG_METHOD_SP1 || red->method == PHGMG_METHOD_SP2) {
+    for (j = 0; j < r; ++j) memcpy(W + (size_t)j * ldw, red->W + (size_t)j * N, (size_t)N * sizeof(double));
+    return PHGMG_OK;
+  }
+  D = phgmg__dalloc(alloc, 2 * (size_t)N * r + 2 * (size_t)r * r);
+  if (!D) return PHGMG_ERR_NOMEM;
+  GtD = D + (size_t)N * r; E = GtD + (size_t)N * r; Einv = E + (size_t)r * r;
+  phgmg_reduced_dphi(red, xr, D, N);
+  memcpy(GtD, D, (size_t)N * r * sizeof(double));
+  rc = phgmg_jr_factor_create(&jr, red->sys, NULL, alloc);
+  if (rc == PHGMG_OK) {
+    phgmg_jr_solve(jr, 'T', r, GtD, N);                      /* G^T D */
+    phgmg__atb(N, r, r, GtD, D, E);                           /* (G^T D)^T D = D^T G D */
+    rc = phgmg__inv(r, E, Einv, alloc);
+    if (rc == PHGMG_OK)                                       /* W = G^T D E^{-T} */
+      phgmg_gemm('N', 'T', N, r, r, 1.0, GtD, N, Einv, r, 0.0, W, ldw);
+  }
+  phgmg_jr_factor_destroy(jr);
+  phgmg__free(alloc, D);
+  return rc;
+}
+
+PHGMG_DEF phgmg_result phgmg_reduced_simulate(const phgmg_reduced *red, const double *xr0, double t0,
+                                              double dt, int nsteps, phgmg_input_fn uf, void *uuser,
+                                              double tol, int max_iter, double *XR, double *Y,
+                                              const phgmg_energy *energy, phgmg_rom_stats *stats,
+                                              const phgmg_allocator *alloc) {
+  const phgmg_rom *rom;
+  phgmg_rom_stepper st;
+  size_t msz, nreal;
+  void *mem;
+  phgmg_real *x, *u3, *y, *ework, en[2];
+  double S = 0.0, D = 0.0;
+  int r, m, n, i, a;
+  phgmg_result rc;
+  if (!red || !xr0 || nsteps < 0 || !(dt > 0.0)) return PHGMG_ERR_INVALID_ARG;
+  rom = &red->rom; r = rom->r; m = rom->m;
+  msz = phgmg_rom_stepper_memsize(rom);
+  nreal = (size_t)r + 4 * (size_t)m + phgmg_rom_eval_work_size(rom);
+  mem = phgmg__alloc(alloc, ((msz + 15) / 16) * 16 + nreal * sizeof(phgmg_real));
+  if (!mem) return PHGMG_ERR_NOMEM;
+  x = PHGMG__CAST(phgmg_real *, PHGMG__CAST(void *, PHGMG__CAST(char *, mem) + ((msz + 15) / 16) * 16));
+  u3 = x + r; y = u3 + 3 * m; ework = y + m;
+  rc = phgmg_rom_stepper_init(&st, rom, (phgmg_real)dt, (phgmg_real)tol, max_iter, mem, msz);
+  if (rc != PHGMG_OK) { phgmg__free(alloc, mem); return rc; }
+  for (a = 0; a < r; ++a) x[a] = (phgmg_real)xr0[a];
+#define PHGMG__REC(nn) do { \
+    if (XR) for (a = 0; a < r; ++a) XR[a + (size_t)(nn) * r] = (double)x[a]; \
+    if (Y) { phgmg_rom_output(rom, x, y, ework); for (a = 0; a < m; ++a) Y[a + (size_t)(nn) * m] = (double)y[a]; } \
+    if (energy) { energy->H[nn] = (double)phgmg_rom_hamiltonian(rom, x, ework); energy->S[nn] = S; energy->D[nn] = D; } \
+  } while (0)
+  PHGMG__REC(0);
+  for (n = 0; n < nsteps; ++n) {
+    const double t = t0 + n * dt;
+    double ubuf[16];
+    const double s15 = sqrt(15.0) / 10.0, cs[3] = {0.5 - s15, 0.5, 0.5 + s15};
+    for (i = 0; i < 3; ++i) {
+      if (uf && m <= 16) {
+        uf(t + cs[i] * dt, ubuf, uuser);
+        for (a = 0; a < m; ++a) u3[i * m + a] = (phgmg_real)ubuf[a];
+      } else {
+        for (a = 0; a < m; ++a) u3[i * m + a] = (phgmg_real)0;
+      }
+    }
+    en[0] = en[1] = (phgmg_real)0;
+    rc = phgmg_rom_step(&st, x, u3, NULL, energy ? en : NULL);
+    if (rc != PHGMG_OK) break;
+    S += (double)en[0];
+    D += (double)en[1];
+    PHGMG__REC(n + 1);
+  }
+#undef PHGMG__REC
+  if (stats) *stats = st.stats;
+  phgmg__free(alloc, mem);
+  return rc;
+}
+
+/* --- error measures ------------------------------------------------------ */
+PHGMG_DEF double phgmg_rel_error(int n, int ns, const double *A, int lda, const double *B, int ldb) {
+  double num = 0.0, den = 0.0;
+  int i, j;
+  for (j = 0; j < ns; ++j)
+    for (i = 0; i < n; ++i) {
+      const double a = A[i + (size_t)j * lda], d = a - B[i + (size_t)j * ldb];
+      num += d * d;
+      den += a * a;
+    }
+  return den > 0.0 ? sqrt(num / den) : (num > 0.0 ? (double)INFINITY : 0.0);
+}
+
+/* sqrt(sum ||x_i - g(x_i)||^2 / sum ||x_i||^2) with g applied column-wise. */
+PHGMG__PRIV double phgmg__err_map(const phgmg_reduced *red, const double *X, int ldx, int ns,
+                                  const double *XR, int ldxr, int mode) {
+  const int N = red->N, r = red->r;
+  const phgmg_allocator *alloc = red->use_alloc ? &red->alloc : NULL;
+  double *xt = phgmg__dalloc(alloc, (size_t)N + (size_t)r + (size_t)(r + red->rn)), *xr;
+  double num = 0.0, den = 0.0;
+  int i, j;
+  if (!xt) return (double)NAN;
+  xr = xt + N;
+  for (j = 0; j < ns; ++j) {
+    const double *x = X + (size_t)j * ldx;
+    if (mode == 0) {            /* reduction error: phi(XR_j) */
+      phgmg_reduced_lift(red, XR + (size_t)j * ldxr, xt);
+    } else if (mode == 1) {     /* projection error: phi(rho(x)) */
+      phgmg_reduced_restrict(red, x, xr);
+      phgmg_reduced_lift(red, xr, xt);
+    } else {                    /* lower bound: orthogonal projection on [B, V1, V2] */
+      double *c = xr;
+      memcpy(xt, x, (size_t)N * sizeof(double));
+      phgmg__orth_remove(N, red->m, red->QB, 1, xt, N, c);
+      phgmg__orth_remove(N, red->r - red->m, red->V0 + (size_t)N * red->m, 1, xt, N, c);
+      phgmg__orth_remove(N, red->rn, red->V2, 1, xt, N, c);
+      for (i = 0; i < N; ++i) xt[i] = x[i] - xt[i];
+    }
+    for (i = 0; i < N; ++i) {
+      const double d = x[i] - xt[i];
+      num += d * d;
+      den += x[i] * x[i];
+    }
+  }
+  phgmg__free(alloc, xt);
+  return den > 0.0 ? sqrt(num / den) : 0.0;
+}
+
+PHGMG_DEF double phgmg_err_red(const phgmg_reduced *red, const double *X, int ldx, int ns,
+                               const double *XR, int ldxr) {
+  return phgmg__err_map(red, X, ldx, ns, XR, ldxr, 0);
+}
+PHGMG_DEF double phgmg_err_proj(const phgmg_reduced *red, const double *X, int ldx, int ns) {
+  return phgmg__err_map(red, X, ldx, ns, NULL, 0, 1);
+}
+PHGMG_DEF double phgmg_err_lowerbound(const phgmg_reduced *red, const double *X, int ldx, int ns) {
+  if (red->kind != PHGMG_ROM_QUADRATIC) return (double)NAN;
+  return phgmg__err_map(red, X, ldx, ns, NULL, 0, 2);
+}
+PHGMG_DEF void phgmg_err_energy(const phgmg_energy *energy, int nsteps, double *e) {
+  int n;
+  for (n = 0; n <= nsteps; ++n) e[n] = fabs(energy->H[n] - energy->H[0] - energy->S[n] + energy->D[n]);
+}
+#endif /* PHGMG_NO_OFFLINE */
 
 /* >>export (implementation) ============================================== */
 #include <stdint.h>

@@ -84,8 +84,9 @@ PHGMG_DEF void phgmg_gemv(char trans, int m, int n, double alpha, const double *
 /* Portable GEMM: a block of op(A) (MC x KC) is packed into 8-row slivers (on
    the stack, MC*KC doubles), then 8 x 6 tiles of C are computed by a
    register-blocked micro-kernel that streams the matching 6 columns of op(B)
-   directly from B. With GCC/Clang the micro-kernel uses vector extensions
-   (define PHGMG_NO_VECTOR_EXT to get the plain C version). */
+   directly from B. With GCC/Clang on an AVX target the micro-kernel uses
+   vector extensions (define PHGMG_NO_VECTOR_EXT for the plain C version,
+   which is the one used everywhere else). */
 #ifndef PHGMG_GEMM_MC
 #define PHGMG_GEMM_MC 64 /* multiple of 8 */
 #endif
@@ -104,7 +105,7 @@ PHGMG__PRIV void phgmg__gemm_micro(int kc, const double *Ap, const double *B, si
   const double *b3 = B + (nr > 3 ? 3 * bsj : 0), *b4 = B + (nr > 4 ? 4 * bsj : 0);
   const double *b5 = B + (nr > 5 ? 5 * bsj : 0);
   int p, i, j;
-#if (defined(__GNUC__) || defined(__clang__)) && !defined(PHGMG_NO_VECTOR_EXT)
+#if (defined(__GNUC__) || defined(__clang__)) && defined(__AVX__) && !defined(PHGMG_NO_VECTOR_EXT)
   typedef double phgmg__v4 __attribute__((vector_size(32)));
   phgmg__v4 c00, c01, c10, c11, c20, c21, c30, c31, c40, c41, c50, c51, a0, a1;
   memset(&c00, 0, sizeof c00);
@@ -217,39 +218,90 @@ PHGMG_DEF void phgmg_gemm(char transa, char transb, int m, int n, int k, double 
 }
 
 /* ---- real LU -------------------------------------------------------------- */
+/* Row interchanges k <-> ipiv[k], k in [k1, k2), applied to ncols columns of A. */
+PHGMG__PRIV void phgmg__laswp(int ncols, double *A, int lda, int k1, int k2, const int *ipiv) {
+  int j, k;
+  for (j = 0; j < ncols; ++j) {
+    double *c = A + (size_t)j * (size_t)lda;
+    for (k = k1; k < k2; ++k) {
+      int p = ipiv[k];
+      if (p != k) { double t = c[k]; c[k] = c[p]; c[p] = t; }
+    }
+  }
+}
+
+/* B := L^{-1} B with L n x n unit lower triangular; B n x nrhs. Recursive, the
+   off-diagonal blocks go through gemm. */
+PHGMG__PRIV void phgmg__trsm_llu(int n, int nrhs, const double *L, int ldl, double *B, int ldb) {
+  int i, j, k, n1;
+  if (n <= 32) {
+    for (j = 0; j < nrhs; ++j) {
+      double *b = B + (size_t)j * (size_t)ldb;
+      for (k = 0; k < n; ++k) {
+        const double *l = L + (size_t)k * (size_t)ldl;
+        double t = b[k];
+        if (t != 0.0) for (i = k + 1; i < n; ++i) b[i] -= t * l[i];
+      }
+    }
+    return;
+  }
+  n1 = n / 2;
+  phgmg__trsm_llu(n1, nrhs, L, ldl, B, ldb);
+  phgmg_gemm('N', 'N', n - n1, nrhs, n1, -1.0, L + n1, ldl, B, ldb, 1.0, B + n1, ldb);
+  phgmg__trsm_llu(n - n1, nrhs, L + n1 + (size_t)n1 * (size_t)ldl, ldl, B + n1, ldb);
+}
+
+/* Recursive LU with partial pivoting of an m x n panel (m >= n), ipiv relative
+   to the panel. Returns 1 if an exactly zero pivot column was met. */
+PHGMG__PRIV int phgmg__lu_rec(int m, int n, double *A, int lda, int *ipiv) {
+  int i, j, k, n1, sing = 0;
+  if (n <= 16) {
+    for (k = 0; k < n; ++k) {
+      double *ak = A + (size_t)k * (size_t)lda, amax = fabs(ak[k]), piv;
+      int p = k;
+      for (i = k + 1; i < m; ++i)
+        if (fabs(ak[i]) > amax) { amax = fabs(ak[i]); p = i; }
+      ipiv[k] = p;
+      if (amax == 0.0) { sing = 1; continue; } /* the column below is zero: L(:,k) = 0 */
+      if (p != k)
+        for (j = 0; j < n; ++j) {
+          double *c = A + (size_t)j * (size_t)lda, t = c[k];
+          c[k] = c[p]; c[p] = t;
+        }
+      piv = ak[k];
+      if (amax >= 2.2250738585072014e-308) {
+        double r = 1.0 / piv;
+        for (i = k + 1; i < m; ++i) ak[i] *= r;
+      } else {
+        for (i = k + 1; i < m; ++i) ak[i] /= piv;
+      }
+      for (j = k + 1; j < n; ++j) {
+        double *c = A + (size_t)j * (size_t)lda, t = c[k];
+        if (t != 0.0) for (i = k + 1; i < m; ++i) c[i] -= t * ak[i];
+      }
+    }
+    return sing;
+  }
+  n1 = n / 2;
+  sing = phgmg__lu_rec(m, n1, A, lda, ipiv);
+  phgmg__laswp(n - n1, A + (size_t)n1 * (size_t)lda, lda, 0, n1, ipiv);
+  phgmg__trsm_llu(n1, n - n1, A, lda, A + (size_t)n1 * (size_t)lda, lda);
+  phgmg_gemm('N', 'N', m - n1, n - n1, n1, -1.0, A + n1, lda, A + (size_t)n1 * (size_t)lda, lda,
+             1.0, A + n1 + (size_t)n1 * (size_t)lda, lda);
+  sing |= phgmg__lu_rec(m - n1, n - n1, A + n1 + (size_t)n1 * (size_t)lda, lda, ipiv + n1);
+  for (i = n1; i < n; ++i) ipiv[i] += n1;
+  phgmg__laswp(n1, A, lda, n1, n, ipiv);
+  return sing;
+}
+
 PHGMG_DEF phgmg_result phgmg_lu_factor(int n, double *A, int lda, int *ipiv) {
-  int i, j, k;
-  phgmg_result rc = PHGMG_OK;
+  int j;
   if (n < 0 || lda < PHGMG__MAX(n, 1)) return PHGMG_ERR_SIZE;
   if (n == 0) return PHGMG_OK;
   if (!A || !ipiv) return PHGMG_ERR_INVALID_ARG;
   for (j = 0; j < n; ++j)
     if (!phgmg__all_finite(A + (size_t)j * (size_t)lda, (size_t)n)) return PHGMG_ERR_NANINF;
-  for (k = 0; k < n; ++k) {
-    double *ak = A + (size_t)k * (size_t)lda;
-    int p = k;
-    double amax = fabs(ak[k]);
-    for (i = k + 1; i < n; ++i)
-      if (fabs(ak[i]) > amax) { amax = fabs(ak[i]); p = i; }
-    ipiv[k] = p;
-    if (amax == 0.0) { rc = PHGMG_ERR_SINGULAR; continue; }
-    if (p != k)
-      for (j = 0; j < n; ++j) {
-        double *c = A + (size_t)j * (size_t)lda, t = c[k];
-        c[k] = c[p]; c[p] = t;
-      }
-    {
-      double r = 1.0 / ak[k];
-      for (i = k + 1; i < n; ++i) ak[i] *= r;
-    }
-    for (j = k + 1; j < n; ++j) {
-      double *c = A + (size_t)j * (size_t)lda;
-      double t = c[k];
-      if (t == 0.0) continue;
-      for (i = k + 1; i < n; ++i) c[i] -= t * ak[i];
-    }
-  }
-  return rc;
+  return phgmg__lu_rec(n, n, A, lda, ipiv) ? PHGMG_ERR_SINGULAR : PHGMG_OK;
 }
 
 PHGMG_DEF void phgmg_lu_solve(char trans, int n, const double *LU, int lda, const int *ipiv,
@@ -554,6 +606,102 @@ PHGMG__PRIV void phgmg__qrcp_core(int m, int n, double *A, int lda, double *tau,
   *rank = k;
 }
 
+/* Blocked QR with column pivoting (LAPACK dlaqps scheme): nb reflectors at a
+   time with deferred trailing updates A -= V F^T through gemm. Stops early like
+   phgmg__qrcp_core. F: n x nb (ld n), aux: nb doubles, mark: n ints. */
+#define PHGMG__QRCP_NB 32
+PHGMG__PRIV void phgmg__qrcp_blocked(int m, int n, double *A, int lda, double *tau, int *jpvt,
+                                     double *vn, double *F, double *aux, int *mark, double tol,
+                                     int *rank) {
+  double *vn1 = vn, *vn2 = vn + n;
+  const double tol3z = sqrt(PHGMG__EPS);
+  const int ldf = PHGMG__MAX(n, 1);
+  int i, j, q, s = 0, kmin = PHGMG__MIN(m, n), stop = 0;
+  for (j = 0; j < n; ++j) {
+    jpvt[j] = j;
+    mark[j] = 0;
+    vn1[j] = vn2[j] = phgmg_normf(m, 1, A + (size_t)j * (size_t)lda, lda);
+  }
+  while (s < kmin && !stop) {
+    int nb = PHGMG__MIN(PHGMG__QRCP_NB, kmin - s), kk = 0, any_mark = 0;
+    /* F rows are indexed by (global column - s) */
+    while (kk < nb && !any_mark) {
+      int c = s + kk, p = c + phgmg__iamax(n - c, vn1 + c);
+      double *ac = A + (size_t)c * (size_t)lda, akk;
+      if (tol >= 0.0 && vn1[p] <= tol) { stop = 1; break; }
+      if (p != c) {
+        double *ap = A + (size_t)p * (size_t)lda, t;
+        int it;
+        for (i = 0; i < m; ++i) { t = ac[i]; ac[i] = ap[i]; ap[i] = t; }
+        for (q = 0; q < kk; ++q) {
+          double *fq = F + (size_t)q * (size_t)ldf;
+          t = fq[c - s]; fq[c - s] = fq[p - s]; fq[p - s] = t;
+        }
+        it = jpvt[p]; jpvt[p] = jpvt[c]; jpvt[c] = it;
+        vn1[p] = vn1[c];
+        vn2[p] = vn2[c];
+      }
+      /* pending updates of column c: A(c:m, c) -= A(c:m, s:c) F(c-s, 0:kk)^T */
+      for (q = 0; q < kk; ++q) {
+        const double *v = A + (size_t)(s + q) * (size_t)lda;
+        double f = F[(c - s) + (size_t)q * (size_t)ldf];
+        if (f != 0.0) for (i = c; i < m; ++i) ac[i] -= f * v[i];
+      }
+      phgmg__larfg(m - c, ac + c, ac + c + 1, &tau[c]);
+      akk = ac[c];
+      ac[c] = 1.0;
+      /* F(c+1-s : n-s, kk) = tau A(c:m, c+1:n)^T v  (stale trailing columns) */
+      if (c + 1 < n)
+        phgmg_gemv('T', m - c, n - c - 1, tau[c], A + c + (size_t)(c + 1) * (size_t)lda, lda,
+                   ac + c, 0.0, F + (c + 1 - s) + (size_t)kk * (size_t)ldf);
+      for (j = 0; j <= c - s; ++j) F[j + (size_t)kk * (size_t)ldf] = 0.0;
+      /* F(:, kk) -= tau F(:, 0:kk) (A(c:m, s:c)^T v) */
+      if (kk > 0) {
+        phgmg_gemv('T', m - c, kk, -tau[c], A + c + (size_t)s * (size_t)lda, lda, ac + c, 0.0, aux);
+        phgmg_gemv('N', n - s, kk, 1.0, F, ldf, aux, 1.0, F + (size_t)kk * (size_t)ldf);
+      }
+      /* row c of the trailing matrix: A(c, c+1:n) -= A(c, s:c+1) F(c+1-s:n-s, 0:kk+1)^T */
+      for (j = c + 1; j < n; ++j) {
+        double t = 0.0;
+        for (q = 0; q <= kk; ++q)
+          t += A[c + (size_t)(s + q) * (size_t)lda] * F[(j - s) + (size_t)q * (size_t)ldf];
+        A[c + (size_t)j * (size_t)lda] -= t;
+      }
+      /* downdate the partial column norms; a column whose norm cancelled too much
+         is marked for recomputation, which ends the block */
+      if (c + 1 < m) {
+        for (j = c + 1; j < n; ++j) {
+          if (vn1[j] != 0.0) {
+            double temp = fabs(A[c + (size_t)j * (size_t)lda]) / vn1[j], temp2;
+            temp = (1.0 + temp) * (1.0 - temp);
+            if (temp < 0.0) temp = 0.0;
+            temp2 = temp * (vn1[j] / vn2[j]) * (vn1[j] / vn2[j]);
+            if (temp2 <= tol3z) { mark[j] = 1; any_mark = 1; }
+            else vn1[j] *= sqrt(temp);
+          }
+        }
+      } else {
+        for (j = c + 1; j < n; ++j) vn1[j] = vn2[j] = 0.0;
+      }
+      ac[c] = akk;
+      ++kk;
+    }
+    if (stop) { s += kk; break; }
+    /* trailing update A(s+kk:m, s+kk:n) -= A(s+kk:m, s:s+kk) F(kk:n-s, 0:kk)^T */
+    if (s + kk < m && s + kk < n)
+      phgmg_gemm('N', 'T', m - s - kk, n - s - kk, kk, -1.0, A + (s + kk) + (size_t)s * (size_t)lda,
+                 lda, F + kk, ldf, 1.0, A + (s + kk) + (size_t)(s + kk) * (size_t)lda, lda);
+    s += kk;
+    if (any_mark)
+      for (j = s; j < n; ++j)
+        if (mark[j]) {
+          vn1[j] = vn2[j] = (s < m) ? phgmg_normf(m - s, 1, A + s + (size_t)j * (size_t)lda, m - s) : 0.0;
+          mark[j] = 0;
+        }
+  }
+  *rank = s;
+}
+
 PHGMG_DEF phgmg_result phgmg_qrcp(int m, int n, double *A, int lda, double *tau, int *jpvt,
                                   double *work) {
   int r;
@@ -723,10 +871,12 @@ PHGMG_DEF phgmg_result phgmg_svd(int m, int n, const double *A, int lda, int kma
     return PHGMG_OK;
   }
   if (!phgmg__mat_finite(m, n, A, lda)) return PHGMG_ERR_NANINF;
-  /* workspace: W (m x n), tau (kmin), vn (2n) */
-  nw = (size_t)m * (size_t)n + (size_t)kmin + 2 * (size_t)n;
+  /* workspace: W (m x n), tau (kmin), vn (2n), F (n x nb), aux (nb);
+     ints: jpvt (n), perm (kmin), mark (n) */
+  nw = (size_t)m * (size_t)n + (size_t)kmin + 2 * (size_t)n +
+       (size_t)(n + 1) * PHGMG__QRCP_NB;
   W = phgmg__dalloc(alloc, nw);
-  jpvt = phgmg__ialloc(alloc, (size_t)n + (size_t)kmin);
+  jpvt = phgmg__ialloc(alloc, 2 * (size_t)n + (size_t)kmin);
   if (!W || !jpvt) { phgmg__free(alloc, W); phgmg__free(alloc, jpvt); return PHGMG_ERR_NOMEM; }
   perm = jpvt + n;
   tau = W + (size_t)m * (size_t)n;
@@ -734,7 +884,8 @@ PHGMG_DEF phgmg_result phgmg_svd(int m, int n, const double *A, int lda, int kma
   for (j = 0; j < n; ++j)
     memcpy(W + (size_t)j * (size_t)m, A + (size_t)j * (size_t)lda, (size_t)m * sizeof(double));
   anorm = phgmg_normf(m, n, W, m);
-  phgmg__qrcp_core(m, n, W, m, tau, jpvt, vn, PHGMG__EPS * anorm, &r);
+  phgmg__qrcp_blocked(m, n, W, m, tau, jpvt, vn, vn + 2 * n, vn + 2 * n + (size_t)n * PHGMG__QRCP_NB,
+                      perm + kmin, PHGMG__EPS * anorm, &r);
   if (r == 0) {
     *k_out = 0;
     if (rank_out) *rank_out = 0;

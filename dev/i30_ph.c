@@ -720,7 +720,7 @@ PHGMG_DEF phgmg_result phgmg_ph_validate(const phgmg_ph_system *sys, double tol,
                                          double *rcond_out, const phgmg_allocator *alloc) {
   phgmg_result rc;
   double nrm, def;
-  int N, m, k;
+  int N, m;
   if (rcond_out) *rcond_out = 0.0;
   rc = phgmg__ph_check(sys);
   if (rc != PHGMG_OK) return rc;
@@ -777,7 +777,6 @@ PHGMG_DEF phgmg_result phgmg_ph_validate(const phgmg_ph_system *sys, double tol,
     if (rcond_out) *rcond_out = rcond;
     if (!(rcond > tol)) return PHGMG_ERR_SINGULAR;
   }
-  (void)k;
   return PHGMG_OK;
 }
 
@@ -837,7 +836,7 @@ PHGMG__PRIV void phgmg__gl3_transform(const double A[9], double T[9], double Ti[
   *alp = -0.5 * p;
   *bet = sqrt(q - 0.25 * p * p);
   { /* real eigenvector */
-    double M[9], v[3], bestn = -1.0;
+    double M[9], v[3] = {0, 0, 0}, bestn = -1.0;
     for (k = 0; k < 9; ++k) M[k] = Ai[k];
     M[0] -= z; M[4] -= z; M[8] -= z;
     for (best = 0; best < 3; ++best) {
@@ -966,8 +965,7 @@ PHGMG__PRIV void phgmg__dia_mv(const phgmg__dia *D, const double *x, double *y) 
   for (d = 0; d < D->nd; ++d) {
     int o = D->off[d], i0 = PHGMG__MAX(0, -o), i1 = PHGMG__MIN(n, n - o);
     const double *vd = D->v + (size_t)d * (size_t)n;
-    const double *xo = x + o;
-    for (i = i0; i < i1; ++i) y[i] += vd[i] * xo[i];
+    for (i = i0; i < i1; ++i) y[i] += vd[i] * x[i + o];
   }
 }
 
@@ -1083,7 +1081,6 @@ PHGMG__PRIV phgmg_result phgmg__gl3_build_map(phgmg_gl3 *s) {
     goto done;
   }
   /* M = (J - R) Q */
-  for (k = 0; k < (int)0 + 1; ++k) { /* (scope) */ }
   {
     double *JR = K1; /* borrow K1 for J - R */
     size_t e;
@@ -1245,7 +1242,6 @@ PHGMG_DEF phgmg_result phgmg_gl3_create(phgmg_gl3 **out, const phgmg_ph_system *
   if (sys->storage == PHGMG_DENSE) {
     s->JR = phgmg__dalloc(&s->al, NN);
     if (!s->JR) { rc = PHGMG_ERR_NOMEM; goto fail; }
-    for (k = 0; k < (int)1; ++k) { /* (scope) */ }
     {
       size_t e;
       for (e = 0; e < NN; ++e) s->JR[e] = sys->J[e] - sys->R[e];

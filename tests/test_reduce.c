@@ -1,0 +1,273 @@
+/* Reduction (issue 4 acceptance): at states along a trajectory, every reduced
+   model is a pH system (J skew, R PSD), the GMG models have Bh = [I; 0] and
+   W(x)^T Dphi(x) = I, and the reduced right-hand side equals
+   W(x)^T ((J - R) grad H(phi(x)) + B u) evaluated in full dimension — an
+   independent computation through phgmg_reduced_W. GMG-POD of the linear MSD
+   keeps the discrete energy balance to round-off. The online path never
+   calls the allocator. */
+#include <stdlib.h>
+static int g_alloc_fail = 0;  /* 1: every allocation fails */
+static long g_alloc_calls = 0;
+static void *test_malloc(size_t n) { g_alloc_calls++; return g_alloc_fail ? NULL : malloc(n); }
+#define PHGMG_MALLOC(sz, user) ((void)(user), test_malloc(sz))
+#define PHGMG_FREE(p, user) ((void)(user), free(p))
+#define PHGMG_STATIC
+#define PHGMG_IMPLEMENTATION
+#include "../phgmg.h"
+#include "harness.h"
+
+typedef struct tmodel {
+  phgmg_ph_system sys;
+  double *J, *R, *Q, *B, poly[5];
+  int *idx;
+} tmodel;
+
+static void tmodel_free(tmodel *t) { free(t->J); free(t->R); free(t->Q); free(t->B); free(t->idx); }
+
+/* Linear MSD of paper 5.2, x = (q1, p1, q2, p2, ...), dense. */
+static void linear_msd(tmodel *t, int n, double mass, double k, double c) {
+  const int N = 2 * n;
+  int i;
+  memset(t, 0, sizeof *t);
+  t->J = (double *)calloc((size_t)N * N, sizeof(double));
+  t->R = (double *)calloc((size_t)N * N, sizeof(double));
+  t->Q = (double *)calloc((size_t)N * N, sizeof(double));
+  t->B = (double *)calloc((size_t)N, sizeof(double));
+  for (i = 0; i < n; ++i) {
+    const int q = 2 * i, p = 2 * i + 1;
+    t->J[q + p * N] = 1; t->J[p + q * N] = -1;
+    t->R[p + p * N] = c;
+    t->Q[p + p * N] = 1.0 / mass;
+    t->Q[q + q * N] = (i == 0 ? k : 2 * k);
+    if (i + 1 < n) { t->Q[q + (q + 2) * N] = -k; t->Q[(q + 2) + q * N] = -k; }
+  }
+  t->B[1] = 1;
+  t->sys.N = N; t->sys.m = 1; t->sys.J = t->J; t->sys.R = t->R; t->sys.Q = t->Q; t->sys.B = t->B;
+}
+
+/* Nonlinear MSD of paper 5.3 in l-coordinates [l_1..l_n, v_1..v_n], dense. */
+static void nonlinear_msd(tmodel *t, int n, double gamma) {
+  const int N = 2 * n;
+  int i;
+  linear_msd(t, n, 1, 1, 1);
+  memset(t->J, 0, sizeof(double) * N * N); memset(t->R, 0, sizeof(double) * N * N);
+  memset(t->Q, 0, sizeof(double) * N * N); memset(t->B, 0, sizeof(double) * N);
+  for (i = 0; i < n; ++i) {   /* J = [[0, T],[-T^T, 0]], T = I - superdiag */
+    t->J[i + (n + i) * N] = 1; t->J[(n + i) + i * N] = -1;
+    if (i + 1 < n) { t->J[i + (n + i + 1) * N] = -1; t->J[(n + i + 1) + i * N] = 1; }
+    t->R[(n + i) + (n + i) * N] = gamma;
+    t->Q[i + i * N] = 1; t->Q[(n + i) + (n + i) * N] = 1;
+  }
+  t->B[n] = 1;
+  t->idx = (int *)malloc(sizeof(int) * n);
+  for (i = 0; i < n; ++i) t->idx[i] = i;
+  memset(t->poly, 0, sizeof t->poly); t->poly[4] = 0.25;
+  t->sys.nl = PHGMG_NL_SEPARABLE; t->sys.nsep = n; t->sys.sep_idx = t->idx;
+  t->sys.poly = t->poly; t->sys.poly_deg = 4;
+}
+
+static void u_sin(double t, double *u, void *user) { (void)user; u[0] = 0.1 * sin(t); }
+
+static double *snapshots(const phgmg_ph_system *sys, int nsteps, double tol, int maxit) {
+  double *X = (double *)malloc(sizeof(double) * sys->N * (nsteps + 1));
+  double *x0 = (double *)calloc((size_t)sys->N, sizeof(double));
+  phgmg_gl3_opts o;
+  memset(&o, 0, sizeof o); o.tol = tol; o.max_iter = maxit;
+  if (phgmg_simulate(sys, x0, 0.0, 0.1, nsteps, u_sin, NULL, &o, X, NULL, NULL, NULL, NULL, NULL) != PHGMG_OK) {
+    free(X); X = NULL;
+  }
+  free(x0);
+  return X;
+}
+
+static double maxabs(int n, const double *a) { double s = 0; int i; for (i = 0; i < n; ++i) s = PHGMG__MAX(s, fabs(a[i])); return s; }
+
+/* The structural checks of the acceptance list at the reduced states rho(x_i). */
+static void check_structure(const phgmg_ph_system *sys, const double *X, int ns, phgmg_method meth, int r) {
+  const int N = sys->N, m = sys->m;
+  phgmg_reduce_opts o;
+  phgmg_reduced *red = NULL;
+  phgmg_reduce_info info;
+  const phgmg_rom *rom;
+  double *W = (double *)malloc(sizeof(double) * N * r), *D = (double *)malloc(sizeof(double) * N * r);
+  double *xf = (double *)malloc(sizeof(double) * N), *g = (double *)malloc(sizeof(double) * N);
+  double *f = (double *)malloc(sizeof(double) * N), *JW = (double *)malloc(sizeof(double) * N * r);
+  double xr[32], fr[32], fref[32], Jr[1024], Rr[1024], Jref[1024], ev[32], work[8192], u = 0.07;
+  int s, i, j;
+  memset(&o, 0, sizeof o);
+  o.method = meth; o.r = r; o.rn = 8; o.lambda = 1e-3;
+  CHECK_RC(phgmg_reduce(&red, sys, X, N, ns, &o, &info, NULL), PHGMG_OK);
+  if (!red) goto done;
+  rom = phgmg_reduced_rom(red);
+  CHECK(phgmg_rom_eval_work_size(rom) <= 8192);
+  for (s = 0; s < 4; ++s) {
+    const double *x = X + (size_t)(ns - 1) * (s + 1) / 4 * N;
+    double nJ, nR, nf, emin;
+    phgmg_reduced_restrict(red, x, xr);
+    /* J skew and R PSD (the split), and both equal W^T J W, W^T R W in full dimension */
+    CHECK_RC(phgmg_rom_structure(rom, xr, Jr, Rr, work), PHGMG_OK);
+    CHECK_RC(phgmg_reduced_W(red, xr, W, N), PHGMG_OK);
+    phgmg_ph_apply(sys, 'J', r, W, N, JW, N);
+    phgmg_gemm('T', 'N', r, r, N, 1.0, W, N, JW, N, 0.0, Jref, r);
+    nJ = maxabs(r * r, Jref);
+    for (i = 0; i < r * r; ++i) Jref[i] -= Jr[i];
+    CHECK_LE(maxabs(r * r, Jref), 1e-10 * nJ);
+    for (i = 0; i < r; ++i) for (j = 0; j < r; ++j) Jref[i + j * r] = Jr[i + j * r] + Jr[j + i * r];
+    CHECK_LE(maxabs(r * r, Jref), 1e-12 * nJ);
+    phgmg_ph_apply(sys, 'R', r, W, N, JW, N);
+    phgmg_gemm('T', 'N', r, r, N, 1.0, W, N, JW, N, 0.0, Jref, r);
+    nR = maxabs(r * r, Jref);
+    for (i = 0; i < r * r; ++i) Jref[i] -= Rr[i];
+    CHECK_LE(maxabs(r * r, Jref), 1e-10 * nR);
+    memcpy(Jref, Rr, sizeof(double) * r * r);
+    CHECK_RC(phgmg_sym_eig(r, Jref, r, ev, NULL, 1), PHGMG_OK);
+    emin = ev[0];
+    CHECK_LE(-1e-12 * nR, emin);
+    /* GMG: Bh = [I; 0] and W^T Dphi = I */
+    if (meth == PHGMG_METHOD_GMG_POD || meth == PHGMG_METHOD_GMG_QM) {
+      for (j = 0; j < m; ++j) for (i = 0; i < r; ++i) CHECK(rom->Bh[i + j * r] == (i == j ? 1.0 : 0.0));
+      phgmg_reduced_dphi(red, xr, D, N);
+      phgmg_gemm('T', 'N', r, r, N, 1.0, W, N, D, N, 0.0, Jref, r);
+      for (i = 0; i < r; ++i) Jref[i + i * r] -= 1.0;
+      CHECK_LE(maxabs(r * r, Jref), 1e-10);
+    }
+    /* reduced rhs against W^T ((J - R) grad H(phi(x)) + B u) in full dimension;
+       SP2 replaces grad H by its oblique projection W V^T grad H (NUMERICS 6.3) */
+    CHECK_RC(phgmg_rom_rhs(rom, xr, &u, fr, work), PHGMG_OK);
+    phgmg_reduced_lift(red, xr, xf);
+    if (meth == PHGMG_METHOD_SP2) {
+      phgmg_ph_gradient(sys, xf, g);
+      phgmg_reduced_dphi(red, xr, D, N);
+      phgmg_gemv('T', N, r, 1.0, D, N, g, 0.0, fref);     /* V^T grad H */
+      phgmg_gemv('N', N, r, 1.0, W, N, fref, 0.0, g);      /* W V^T grad H */
+      phgmg_ph_apply(sys, 'J', 1, g, N, f, N);
+      phgmg_ph_apply(sys, 'R', 1, g, N, xf, N);
+      for (i = 0; i < N; ++i) f[i] = f[i] - xf[i] + sys->B[i] * u;
+    } else {
+      phgmg_ph_rhs(sys, xf, &u, f);
+    }
+    phgmg_gemv('T', N, r, 1.0, W, N, f, 0.0, fref);
+    nf = maxabs(r, fref);
+    for (i = 0; i < r; ++i) fref[i] -= fr[i];
+    CHECK_LE(maxabs(r, fref), 1e-10 * nf);
+    (void)g;
+  }
+done:
+  phgmg_reduced_destroy(red);
+  free(W); free(D); free(xf); free(g); free(f); free(JW);
+}
+
+TEST(test_structure_linear) {
+  tmodel t;
+  double *X;
+  const int rs[3] = {4, 12, 20};
+  int k;
+  linear_msd(&t, 50, 2, 1, 1);
+  X = snapshots(&t.sys, 400, 1e-10, 10);
+  CHECK(X != NULL);
+  if (X)
+    for (k = 0; k < 3; ++k) {
+      check_structure(&t.sys, X, 401, PHGMG_METHOD_GMG_POD, rs[k]);
+      check_structure(&t.sys, X, 401, PHGMG_METHOD_GMG_QM, rs[k]);
+      check_structure(&t.sys, X, 401, PHGMG_METHOD_SP1, rs[k]);
+    }
+  free(X);
+  tmodel_free(&t);
+}
+
+TEST(test_structure_nonlinear) {
+  tmodel t;
+  double *X;
+  const int rs[2] = {6, 16};
+  int k;
+  nonlinear_msd(&t, 60, 0.3);
+  X = snapshots(&t.sys, 400, 1e-8, 20);
+  CHECK(X != NULL);
+  if (X)
+    for (k = 0; k < 2; ++k) {
+      check_structure(&t.sys, X, 401, PHGMG_METHOD_GMG_POD, rs[k]);
+      check_structure(&t.sys, X, 401, PHGMG_METHOD_GMG_QM, rs[k]);
+      check_structure(&t.sys, X, 401, PHGMG_METHOD_SP2, rs[k]);
+    }
+  free(X);
+  tmodel_free(&t);
+}
+
+/* GMG-POD of the linear MSD: H(x_n) - H(x_0) = supplied - dissipated to round-off,
+   for the Newton path and the precomputed step map. */
+TEST(test_energy_balance_gmgpod) {
+  tmodel t;
+  double *X, H[401], S[401], D[401], e[401];
+  phgmg_energy en;
+  phgmg_reduce_opts o;
+  phgmg_reduced *red = NULL;
+  int pass;
+  linear_msd(&t, 50, 2, 1, 1);
+  X = snapshots(&t.sys, 400, 1e-10, 10);
+  en.H = H; en.S = S; en.D = D;
+  for (pass = 0; pass < 2 && X; ++pass) {
+    double xr[12] = {0}, emax, scale = 0;
+    int n;
+    memset(&o, 0, sizeof o);
+    o.method = PHGMG_METHOD_GMG_POD; o.r = 12; o.dt = pass ? 0.1 : 0.0;
+    CHECK_RC(phgmg_reduce(&red, &t.sys, X, t.sys.N, 401, &o, NULL, NULL), PHGMG_OK);
+    if (!red) break;
+    CHECK((phgmg_reduced_rom(red)->Phi != NULL) == (pass == 1));
+    CHECK_RC(phgmg_reduced_simulate(red, xr, 0.0, 0.1, 400, u_sin, NULL, 1e-12, 10, NULL, NULL, &en, NULL, NULL), PHGMG_OK);
+    phgmg_err_energy(&en, 400, e);
+    emax = maxabs(401, e);
+    for (n = 0; n <= 400; ++n) scale = PHGMG__MAX(scale, fabs(S[n]) + fabs(D[n]) + fabs(H[n]));
+    CHECK(scale > 1e-4);
+    CHECK_LE(emax, 1e-13 * scale);
+    phgmg_reduced_destroy(red); red = NULL;
+  }
+  free(X);
+  tmodel_free(&t);
+}
+
+/* Every ROM kind steps through the online API while the allocator fails on any
+   call: it is never called. Also the reduction error is small and decreasing. */
+TEST(test_online_never_allocates) {
+  tmodel t;
+  double *X;
+  const phgmg_method meths[4] = {PHGMG_METHOD_GMG_POD, PHGMG_METHOD_GMG_QM, PHGMG_METHOD_SP2, PHGMG_METHOD_SP1};
+  int k;
+  nonlinear_msd(&t, 40, 0.3);
+  X = snapshots(&t.sys, 300, 1e-8, 20);
+  for (k = 0; k < 4 && X; ++k) {
+    phgmg_reduce_opts o;
+    phgmg_reduced *red = NULL;
+    static double mem[1 << 16];
+    phgmg_rom_stepper st;
+    phgmg_real x[16] = {0}, u3[3], y[1], en[2] = {0, 0};
+    long calls;
+    int n, i;
+    memset(&o, 0, sizeof o);
+    o.method = meths[k]; o.r = 12; o.deim = 1; o.deim_allow_negative = 1; o.lambda = 1e-3;
+    CHECK_RC(phgmg_reduce(&red, &t.sys, X, t.sys.N, 301, &o, NULL, NULL), PHGMG_OK);
+    if (!red) continue;
+    CHECK(phgmg_rom_stepper_memsize(phgmg_reduced_rom(red)) <= sizeof mem);
+    calls = g_alloc_calls;
+    g_alloc_fail = 1;
+    CHECK_RC(phgmg_rom_stepper_init(&st, phgmg_reduced_rom(red), 0.1, 1e-8, 20, mem, sizeof mem), PHGMG_OK);
+    for (n = 0; n < 200; ++n) {
+      phgmg_real tc[3];
+      phgmg_rom_stage_times(n * 0.1, 0.1, tc);
+      for (i = 0; i < 3; ++i) u3[i] = (phgmg_real)(0.1 * sin((double)tc[i]));
+      if (phgmg_rom_step(&st, x, u3, y, en) != PHGMG_OK) break;
+    }
+    g_alloc_fail = 0;
+    CHECK(n == 200);
+    CHECK(g_alloc_calls == calls);
+    phgmg_reduced_destroy(red);
+  }
+  free(X);
+  tmodel_free(&t);
+}
+
+SUITE(reduce) {
+  RUN(test_structure_linear);
+  RUN(test_structure_nonlinear);
+  RUN(test_energy_balance_gmgpod);
+  RUN(test_online_never_allocates);
+}
