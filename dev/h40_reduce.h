@@ -33,6 +33,16 @@ typedef struct phgmg_reduce_opts {
                           (LINEAR map with quadratic H only)                          */
   double degeneracy_tol; /* fail with PHGMG_ERR_DEGENERATE when the reciprocal
                           condition of D^T G D at the snapshots is below this (0: 1e-12) */
+  /* Optional cache for studies over many r: the leading left singular vectors
+     (N x pod_cols, ld N, by descending singular value) of the matrix the
+     method PODs -- GMG-POD/GMG-QM: the adjusted snapshots X - B B^+ X (from
+     phgmg_adjust_snapshots + phgmg_pod); SP1/SP2: X itself. GMG-QM takes V1
+     from its first r-m columns and V2 from the next r_n (the POD of the
+     residual of V1 is exactly that tail). NULL: computed here. */
+  const double *pod_basis;
+  int pod_cols;
+  const double *grad_basis; /* SP2: same for the gradient snapshots (NULL: computed) */
+  int grad_cols;
 } phgmg_reduce_opts;
 
 typedef struct phgmg_reduce_info {

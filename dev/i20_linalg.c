@@ -2,6 +2,81 @@
 /* >>linalg (implementation) ============================================== */
 #ifndef PHGMG_NO_OFFLINE
 
+/* ---- level-1 helpers -------------------------------------------------------- */
+#if (defined(__GNUC__) || defined(__clang__)) && defined(__AVX__) && !defined(PHGMG_NO_VECTOR_EXT)
+#define PHGMG__VEC4 1
+typedef double phgmg__v4 __attribute__((vector_size(32)));
+#endif
+
+/* x . y with several independent partial sums (a dot product is otherwise
+   bound by the latency of one add chain). */
+PHGMG__PRIV double phgmg__dot(int n, const double *x, const double *y) {
+  int i = 0;
+  double s = 0.0;
+#ifdef PHGMG__VEC4
+  if (n >= 16) {
+    phgmg__v4 s0, s1, s2, s3, a, b;
+    double t[4];
+    memset(&s0, 0, sizeof s0);
+    s1 = s2 = s3 = s0;
+    for (; i + 16 <= n; i += 16) {
+      memcpy(&a, x + i, sizeof a); memcpy(&b, y + i, sizeof b); s0 += a * b;
+      memcpy(&a, x + i + 4, sizeof a); memcpy(&b, y + i + 4, sizeof b); s1 += a * b;
+      memcpy(&a, x + i + 8, sizeof a); memcpy(&b, y + i + 8, sizeof b); s2 += a * b;
+      memcpy(&a, x + i + 12, sizeof a); memcpy(&b, y + i + 12, sizeof b); s3 += a * b;
+    }
+    s0 = (s0 + s1) + (s2 + s3);
+    memcpy(t, &s0, sizeof t);
+    s = (t[0] + t[1]) + (t[2] + t[3]);
+  }
+#else
+  {
+    double s0 = 0.0, s1 = 0.0, s2 = 0.0, s3 = 0.0;
+    for (; i + 4 <= n; i += 4) {
+      s0 += x[i] * y[i]; s1 += x[i + 1] * y[i + 1];
+      s2 += x[i + 2] * y[i + 2]; s3 += x[i + 3] * y[i + 3];
+    }
+    s = (s0 + s1) + (s2 + s3);
+  }
+#endif
+  for (; i < n; ++i) s += x[i] * y[i];
+  return s;
+}
+
+/* y += a x */
+PHGMG__PRIV void phgmg__axpy(int n, double a, const double *x, double *y) {
+  int i = 0;
+#ifdef PHGMG__VEC4
+  for (; i + 8 <= n; i += 8) {
+    phgmg__v4 x0, x1, y0, y1;
+    memcpy(&x0, x + i, sizeof x0); memcpy(&x1, x + i + 4, sizeof x1);
+    memcpy(&y0, y + i, sizeof y0); memcpy(&y1, y + i + 4, sizeof y1);
+    y0 += a * x0; y1 += a * x1;
+    memcpy(y + i, &y0, sizeof y0); memcpy(y + i + 4, &y1, sizeof y1);
+  }
+#endif
+  for (; i < n; ++i) y[i] += a * x[i];
+}
+
+/* plane rotation of two vectors: (x, y) <- (c x - s y, s x + c y) */
+PHGMG__PRIV void phgmg__rot(int n, double *x, double *y, double c, double s) {
+  int i = 0;
+#ifdef PHGMG__VEC4
+  for (; i + 4 <= n; i += 4) {
+    phgmg__v4 a, b, u, v;
+    memcpy(&a, x + i, sizeof a); memcpy(&b, y + i, sizeof b);
+    u = c * a - s * b;
+    v = s * a + c * b;
+    memcpy(x + i, &u, sizeof u); memcpy(y + i, &v, sizeof v);
+  }
+#endif
+  for (; i < n; ++i) {
+    double a = x[i], b = y[i];
+    x[i] = c * a - s * b;
+    y[i] = s * a + c * b;
+  }
+}
+
 /* ---- norms -------------------------------------------------------------- */
 PHGMG_DEF double phgmg_norm1(int m, int n, const double *A, int lda) {
   double best = 0.0;
@@ -16,15 +91,31 @@ PHGMG_DEF double phgmg_norm1(int m, int n, const double *A, int lda) {
 }
 
 PHGMG_DEF double phgmg_normf(int m, int n, const double *A, int lda) {
-  /* scaled sum of squares (LAPACK dlassq): scale^2 * ssq */
-  double scale = 0.0, ssq = 1.0;
+  /* fast path: plain sum of squares when it neither overflows nor underflows */
+  double scale = 0.0, ssq = 0.0;
   int i, j;
+  for (j = 0; j < n; ++j) {
+    const double *a = A + (size_t)j * (size_t)lda;
+    ssq += phgmg__dot(m, a, a);
+  }
+  if (ssq == 0.0) { /* all zero, or every square underflowed: check */
+    for (j = 0; j < n; ++j)
+      for (i = 0; i < m; ++i)
+        if (A[i + (size_t)j * (size_t)lda] != 0.0) goto scaled;
+    return 0.0;
+  }
+  if (ssq > 1e-280 && ssq < 1e280) return sqrt(ssq);
+  if (ssq != ssq) return ssq; /* NaN in A */
+scaled:
+  /* scaled sum of squares (LAPACK dlassq): scale^2 * ssq */
+  ssq = 1.0;
   for (j = 0; j < n; ++j) {
     const double *a = A + (size_t)j * (size_t)lda;
     for (i = 0; i < m; ++i) {
       double v = fabs(a[i]);
       if (v != 0.0 || v != v) {
         if (v != v) return v;
+        if (v == HUGE_VAL) return v;
         if (scale < v) {
           double r = scale / v;
           ssq = 1.0 + ssq * r * r;
@@ -42,40 +133,39 @@ PHGMG_DEF double phgmg_normf(int m, int n, const double *A, int lda) {
 /* ---- gemv / gemm ---------------------------------------------------------- */
 PHGMG_DEF void phgmg_gemv(char trans, int m, int n, double alpha, const double *A, int lda,
                           const double *x, double beta, double *y) {
-  int i, j;
-  int ny = (trans == 'N' || trans == 'n') ? m : n;
-  PHGMG_ASSERT(trans == 'N' || trans == 'n' || trans == 'T' || trans == 't');
+  int i;
+  int tr = (trans == 'T' || trans == 't');
+  int ny = tr ? n : m;
+  PHGMG_ASSERT(tr || trans == 'N' || trans == 'n');
   if (m <= 0 || n <= 0) {
     for (i = 0; i < ny; ++i) y[i] = (beta == 0.0) ? 0.0 : beta * y[i];
     return;
   }
 #ifdef PHGMG_USE_CBLAS
-  cblas_dgemv(CblasColMajor, (ny == m) ? CblasNoTrans : CblasTrans, m, n, alpha, A, lda, x, 1,
-              beta, y, 1);
+  cblas_dgemv(CblasColMajor, tr ? CblasTrans : CblasNoTrans, m, n, alpha, A, lda, x, 1, beta, y, 1);
 #else
+  int j;
   if (beta == 0.0) {
     for (i = 0; i < ny; ++i) y[i] = 0.0;
   } else if (beta != 1.0) {
     for (i = 0; i < ny; ++i) y[i] *= beta;
   }
   if (alpha == 0.0) return;
-  if (trans == 'N' || trans == 'n') {
-    /* y += alpha * A x, column sweeps (axpy) */
-    for (j = 0; j < n; ++j) {
+  if (!tr) {
+    /* y += alpha * A x, four columns per sweep over y */
+    for (j = 0; j + 4 <= n; j += 4) {
+      const double *a0 = A + (size_t)j * (size_t)lda, *a1 = a0 + lda, *a2 = a1 + lda, *a3 = a2 + lda;
+      double t0 = alpha * x[j], t1 = alpha * x[j + 1], t2 = alpha * x[j + 2], t3 = alpha * x[j + 3];
+      for (i = 0; i < m; ++i) y[i] += t0 * a0[i] + t1 * a1[i] + t2 * a2[i] + t3 * a3[i];
+    }
+    for (; j < n; ++j) {
       const double *a = A + (size_t)j * (size_t)lda;
       double t = alpha * x[j];
-      if (t == 0.0) continue;
-      for (i = 0; i < m; ++i) y[i] += t * a[i];
+      phgmg__axpy(m, t, a, y);
     }
   } else {
     /* y += alpha * A^T x, dot products of columns */
-    for (j = 0; j < n; ++j) {
-      const double *a = A + (size_t)j * (size_t)lda;
-      double s0 = 0.0, s1 = 0.0;
-      for (i = 0; i + 1 < m; i += 2) { s0 += a[i] * x[i]; s1 += a[i + 1] * x[i + 1]; }
-      if (i < m) s0 += a[i] * x[i];
-      y[j] += alpha * (s0 + s1);
-    }
+    for (j = 0; j < n; ++j) y[j] += alpha * phgmg__dot(m, A + (size_t)j * (size_t)lda, x);
   }
 #endif
 }
@@ -105,8 +195,7 @@ PHGMG__PRIV void phgmg__gemm_micro(int kc, const double *Ap, const double *B, si
   const double *b3 = B + (nr > 3 ? 3 * bsj : 0), *b4 = B + (nr > 4 ? 4 * bsj : 0);
   const double *b5 = B + (nr > 5 ? 5 * bsj : 0);
   int p, i, j;
-#if (defined(__GNUC__) || defined(__clang__)) && defined(__AVX__) && !defined(PHGMG_NO_VECTOR_EXT)
-  typedef double phgmg__v4 __attribute__((vector_size(32)));
+#ifdef PHGMG__VEC4
   phgmg__v4 c00, c01, c10, c11, c20, c21, c30, c31, c40, c41, c50, c51, a0, a1;
   memset(&c00, 0, sizeof c00);
   c01 = c10 = c11 = c20 = c21 = c30 = c31 = c40 = c41 = c50 = c51 = c00;
@@ -233,14 +322,14 @@ PHGMG__PRIV void phgmg__laswp(int ncols, double *A, int lda, int k1, int k2, con
 /* B := L^{-1} B with L n x n unit lower triangular; B n x nrhs. Recursive, the
    off-diagonal blocks go through gemm. */
 PHGMG__PRIV void phgmg__trsm_llu(int n, int nrhs, const double *L, int ldl, double *B, int ldb) {
-  int i, j, k, n1;
+  int j, k, n1;
   if (n <= 32) {
     for (j = 0; j < nrhs; ++j) {
       double *b = B + (size_t)j * (size_t)ldb;
       for (k = 0; k < n; ++k) {
         const double *l = L + (size_t)k * (size_t)ldl;
         double t = b[k];
-        if (t != 0.0) for (i = k + 1; i < n; ++i) b[i] -= t * l[i];
+        if (t != 0.0) phgmg__axpy(n - k - 1, -t, l + k + 1, b + k + 1);
       }
     }
     return;
@@ -277,7 +366,7 @@ PHGMG__PRIV int phgmg__lu_rec(int m, int n, double *A, int lda, int *ipiv) {
       }
       for (j = k + 1; j < n; ++j) {
         double *c = A + (size_t)j * (size_t)lda, t = c[k];
-        if (t != 0.0) for (i = k + 1; i < m; ++i) c[i] -= t * ak[i];
+        if (t != 0.0) phgmg__axpy(m - k - 1, -t, ak + k + 1, c + k + 1);
       }
     }
     return sing;
@@ -306,7 +395,7 @@ PHGMG_DEF phgmg_result phgmg_lu_factor(int n, double *A, int lda, int *ipiv) {
 
 PHGMG_DEF void phgmg_lu_solve(char trans, int n, const double *LU, int lda, const int *ipiv,
                               int nrhs, double *B, int ldb) {
-  int i, j, k;
+  int j, k;
   int tr = (trans == 'T' || trans == 't');
   PHGMG_ASSERT(tr || trans == 'N' || trans == 'n');
   for (j = 0; j < nrhs; ++j) {
@@ -318,28 +407,28 @@ PHGMG_DEF void phgmg_lu_solve(char trans, int n, const double *LU, int lda, cons
       for (k = 0; k < n; ++k) {
         const double *l = LU + (size_t)k * (size_t)lda;
         double t = b[k];
-        if (t != 0.0) for (i = k + 1; i < n; ++i) b[i] -= t * l[i];
+        if (t != 0.0) phgmg__axpy(n - k - 1, -t, l + k + 1, b + k + 1);
       }
       /* U x = y */
       for (k = n - 1; k >= 0; --k) {
         const double *u = LU + (size_t)k * (size_t)lda;
         double t = b[k] / u[k];
         b[k] = t;
-        if (t != 0.0) for (i = 0; i < k; ++i) b[i] -= t * u[i];
+        if (t != 0.0) phgmg__axpy(k, -t, u, b);
       }
     } else {
       /* U^T y = b: dot products with columns of U */
       for (k = 0; k < n; ++k) {
         const double *u = LU + (size_t)k * (size_t)lda;
         double s = b[k];
-        for (i = 0; i < k; ++i) s -= u[i] * b[i];
+        s -= phgmg__dot(k, u, b);
         b[k] = s / u[k];
       }
       /* L^T z = y */
       for (k = n - 1; k >= 0; --k) {
         const double *l = LU + (size_t)k * (size_t)lda;
         double s = b[k];
-        for (i = k + 1; i < n; ++i) s -= l[i] * b[i];
+        s -= phgmg__dot(n - k - 1, l + k + 1, b + k + 1);
         b[k] = s;
       }
       for (k = n - 1; k >= 0; --k)
@@ -527,16 +616,14 @@ PHGMG__PRIV void phgmg__larfg(int n, double *alpha, double *x, double *tau) {
 
 /* C (m x n) := (I - tau v v^T) C, v = (1, v[1..m-1]) (v[0] is not read). */
 PHGMG__PRIV void phgmg__larf_left(int m, int n, const double *v, double tau, double *C, int ldc) {
-  int i, j;
+  int j;
   if (tau == 0.0) return;
   for (j = 0; j < n; ++j) {
     double *c = C + (size_t)j * (size_t)ldc;
-    double s = c[0];
-    for (i = 1; i < m; ++i) s += v[i] * c[i];
-    s *= tau;
+    double s = tau * (c[0] + phgmg__dot(m - 1, v + 1, c + 1));
     if (s == 0.0) continue;
     c[0] -= s;
-    for (i = 1; i < m; ++i) c[i] -= s * v[i];
+    phgmg__axpy(m - 1, -s, v + 1, c + 1);
   }
 }
 
@@ -645,7 +732,7 @@ PHGMG__PRIV void phgmg__qrcp_blocked(int m, int n, double *A, int lda, double *t
       for (q = 0; q < kk; ++q) {
         const double *v = A + (size_t)(s + q) * (size_t)lda;
         double f = F[(c - s) + (size_t)q * (size_t)ldf];
-        if (f != 0.0) for (i = c; i < m; ++i) ac[i] -= f * v[i];
+        if (f != 0.0) phgmg__axpy(m - c, -f, v + c, ac + c);
       }
       phgmg__larfg(m - c, ac + c, ac + c + 1, &tau[c]);
       akk = ac[c];
@@ -744,14 +831,14 @@ PHGMG_DEF void phgmg_qr_apply(char trans, int m, int n, int k, const double *A, 
 
 /* Solve R X = B, R n x n upper triangular (ldr), B n x nrhs (ldb), in place. */
 PHGMG__PRIV void phgmg__trsv_upper(int n, const double *R, int ldr, int nrhs, double *B, int ldb) {
-  int i, j, k;
+  int j, k;
   for (j = 0; j < nrhs; ++j) {
     double *b = B + (size_t)j * (size_t)ldb;
     for (k = n - 1; k >= 0; --k) {
       const double *r = R + (size_t)k * (size_t)ldr;
       double t = b[k] / r[k];
       b[k] = t;
-      if (t != 0.0) for (i = 0; i < k; ++i) b[i] -= t * r[i];
+      if (t != 0.0) phgmg__axpy(k, -t, r, b);
     }
   }
 }
@@ -808,47 +895,43 @@ PHGMG_DEF phgmg_result phgmg_lstsq(int m, int n, int nrhs, const double *A, int 
 }
 
 /* ---- thin SVD: QRCP + second QR + one-sided Jacobi ----------------------------- */
-/* One-sided (Hestenes) Jacobi on the columns of X (r x r, ldx): X V = W diag(sigma),
-   V accumulated (r x r, ldv). On return X holds W diag(sigma). */
+/* One-sided (Hestenes) Jacobi on the columns of X (r x r, ldx): X V = W diag(sigma).
+   V (r x r, ldv; may be NULL) accumulates the rotations. On return X holds
+   W diag(sigma). Pairs are visited block by block (a cyclic ordering) so that
+   2*PHGMG__JAC_BS columns stay in cache. d: r doubles. */
+#define PHGMG__JAC_BS 16
 PHGMG__PRIV phgmg_result phgmg__jacobi_1s(int r, double *X, int ldx, double *V, int ldv,
                                           double *d) {
   const double tol = PHGMG__EPS * sqrt((double)PHGMG__MAX(r, 1));
-  int sweep, p, q, i, rotated;
+  int sweep, p, q, ib, jb, rotated;
   for (sweep = 0; sweep < 80; ++sweep) {
     for (p = 0; p < r; ++p) {
-      double *xp = X + (size_t)p * (size_t)ldx, s = 0.0;
-      for (i = 0; i < r; ++i) s += xp[i] * xp[i];
-      d[p] = s;
+      const double *xp = X + (size_t)p * (size_t)ldx;
+      d[p] = phgmg__dot(r, xp, xp);
     }
     rotated = 0;
-    for (p = 0; p < r - 1; ++p) {
-      double *xp = X + (size_t)p * (size_t)ldx, *vp = V + (size_t)p * (size_t)ldv;
-      for (q = p + 1; q < r; ++q) {
-        double *xq = X + (size_t)q * (size_t)ldx, *vq = V + (size_t)q * (size_t)ldv;
-        double alpha = d[p], beta = d[q], gamma = 0.0, zeta, t, c, s;
-        if (alpha == 0.0 || beta == 0.0) continue;
-        for (i = 0; i < r; ++i) gamma += xp[i] * xq[i];
-        if (fabs(gamma) <= tol * sqrt(alpha) * sqrt(beta)) continue;
-        rotated = 1;
-        zeta = (beta - alpha) / (2.0 * gamma);
-        t = (zeta >= 0.0 ? 1.0 : -1.0) / (fabs(zeta) + sqrt(1.0 + zeta * zeta));
-        c = 1.0 / sqrt(1.0 + t * t);
-        s = c * t;
-        for (i = 0; i < r; ++i) {
-          double a = xp[i], b = xq[i];
-          xp[i] = c * a - s * b;
-          xq[i] = s * a + c * b;
+    for (ib = 0; ib < r; ib += PHGMG__JAC_BS)
+      for (jb = ib; jb < r; jb += PHGMG__JAC_BS)
+        for (p = ib; p < PHGMG__MIN(ib + PHGMG__JAC_BS, r); ++p) {
+          double *xp = X + (size_t)p * (size_t)ldx;
+          for (q = PHGMG__MAX(jb, p + 1); q < PHGMG__MIN(jb + PHGMG__JAC_BS, r); ++q) {
+            double *xq = X + (size_t)q * (size_t)ldx;
+            double alpha = d[p], beta = d[q], gamma, zeta, t, c, s;
+            if (alpha == 0.0 || beta == 0.0) continue;
+            gamma = phgmg__dot(r, xp, xq);
+            if (fabs(gamma) <= tol * sqrt(alpha) * sqrt(beta)) continue;
+            rotated = 1;
+            zeta = (beta - alpha) / (2.0 * gamma);
+            t = (zeta >= 0.0 ? 1.0 : -1.0) / (fabs(zeta) + sqrt(1.0 + zeta * zeta));
+            c = 1.0 / sqrt(1.0 + t * t);
+            s = c * t;
+            phgmg__rot(r, xp, xq, c, s);
+            if (V) phgmg__rot(r, V + (size_t)p * (size_t)ldv, V + (size_t)q * (size_t)ldv, c, s);
+            d[p] = alpha - t * gamma;
+            d[q] = beta + t * gamma;
+            if (!(d[p] >= 0.0)) d[p] = 0.0;
+          }
         }
-        for (i = 0; i < r; ++i) {
-          double a = vp[i], b = vq[i];
-          vp[i] = c * a - s * b;
-          vq[i] = s * a + c * b;
-        }
-        d[p] = alpha - t * gamma;
-        d[q] = beta + t * gamma;
-        if (!(d[p] >= 0.0)) d[p] = 0.0;
-      }
-    }
     if (!rotated) return PHGMG_OK;
   }
   return PHGMG_ERR_NOT_CONVERGED;
@@ -918,7 +1001,7 @@ PHGMG_DEF phgmg_result phgmg_svd(int m, int n, const double *A, int lda, int kma
         v[i] = i == j ? 1.0 : 0.0;
       }
     }
-    rc = phgmg__jacobi_1s(r, X, r, Vj, r, d);
+    rc = phgmg__jacobi_1s(r, X, r, V ? Vj : NULL, r, d);
     if (rc == PHGMG_OK) {
       /* sigma_j = ||X(:,j)||, order descending */
       for (j = 0; j < r; ++j) {

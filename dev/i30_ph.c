@@ -1016,12 +1016,18 @@ struct phgmg_gl3 {
   phgmg__dia djr, dq, dh;
   int kl, ku, ldab, ue1, ue2;
   double *AB1, *AB2, *dinv1, *dinv2, *hband;
-  /* SEPARABLE: Hessian diagonal of the nonlinear part */
+  /* SEPARABLE: Hessian diagonal of the nonlinear part; derivative of poly;
+     with poly: per-coordinate weights wc[i] = sum of w_k over terms on i */
   double *dd;
+  double *dpoly, *wc;
+  /* banded: J - R by rows (CSR) for the stage right-hand sides */
+  int *jr_ptr, *jr_col;
+  double *jr_val;
+  int nopiv1, nopiv2; /* banded factors without row interchanges */
   /* step map (dense linear): x+ = Phi x + Gam U, g_i = GX_i x + GU_i U */
   double *Phi, *Gam, *GX, *GU;
   /* work */
-  double *Z, *W, *Y, *G, *F, *U, *Zg, *Zprev, *xend, *xnew, *r1, *rc, *tmp, *TF;
+  double *Z, *W, *Y, *G, *F, *U, *Zprev, *xend, *xnew, *r1, *rc, *tmp, *TF;
   int have_prev, need_factor;
   double tend;
   phgmg_gl3_stats st;
@@ -1038,11 +1044,13 @@ PHGMG_DEF void phgmg_gl3_destroy(phgmg_gl3 *s) {
   phgmg__free(&al, s->AB1); phgmg__free(&al, s->AB2);
   phgmg__free(&al, s->dinv1); phgmg__free(&al, s->dinv2); phgmg__free(&al, s->hband);
   phgmg__free(&al, s->dd);
+  phgmg__free(&al, s->dpoly); phgmg__free(&al, s->wc);
+  phgmg__free(&al, s->jr_ptr); phgmg__free(&al, s->jr_col); phgmg__free(&al, s->jr_val);
   phgmg__free(&al, s->Phi); phgmg__free(&al, s->Gam); phgmg__free(&al, s->GX);
   phgmg__free(&al, s->GU);
   phgmg__free(&al, s->Z); phgmg__free(&al, s->W); phgmg__free(&al, s->Y);
   phgmg__free(&al, s->G); phgmg__free(&al, s->F); phgmg__free(&al, s->U);
-  phgmg__free(&al, s->Zg); phgmg__free(&al, s->Zprev); phgmg__free(&al, s->xend);
+  phgmg__free(&al, s->Zprev); phgmg__free(&al, s->xend);
   phgmg__free(&al, s->xnew); phgmg__free(&al, s->r1); phgmg__free(&al, s->rc);
   phgmg__free(&al, s->tmp); phgmg__free(&al, s->TF);
   phgmg__free(&al, s);
@@ -1223,14 +1231,13 @@ PHGMG_DEF phgmg_result phgmg_gl3_create(phgmg_gl3 **out, const phgmg_ph_system *
   s->W = phgmg__dalloc(&s->al, N3);
   s->Y = phgmg__dalloc(&s->al, N3);
   s->F = phgmg__dalloc(&s->al, N3);
-  s->Zg = phgmg__dalloc(&s->al, N3);
   s->Zprev = phgmg__dalloc(&s->al, N3);
   s->xend = phgmg__dalloc(&s->al, (size_t)N);
   s->r1 = phgmg__dalloc(&s->al, (size_t)N);
   s->rc = phgmg__dalloc(&s->al, 2 * (size_t)N);
   s->tmp = phgmg__dalloc(&s->al, (size_t)N);
   s->TF = phgmg__dalloc(&s->al, N3);
-  if (!s->Z || !s->W || !s->Y || !s->F || !s->Zg || !s->Zprev || !s->xend || !s->r1 || !s->rc ||
+  if (!s->Z || !s->W || !s->Y || !s->F || !s->Zprev || !s->xend || !s->r1 || !s->rc ||
       !s->tmp || !s->TF) {
     rc = PHGMG_ERR_NOMEM;
     goto fail;
@@ -1238,6 +1245,15 @@ PHGMG_DEF phgmg_result phgmg_gl3_create(phgmg_gl3 **out, const phgmg_ph_system *
   if (sys->nl == PHGMG_NL_SEPARABLE) {
     s->dd = phgmg__dalloc(&s->al, (size_t)N);
     if (!s->dd) { rc = PHGMG_ERR_NOMEM; goto fail; }
+    if (sys->poly_deg > 0) { /* dpoly[j] = (j+1) poly[j+1] */
+      s->dpoly = phgmg__dalloc(&s->al, (size_t)sys->poly_deg);
+      if (!s->dpoly) { rc = PHGMG_ERR_NOMEM; goto fail; }
+      for (k = 0; k < sys->poly_deg; ++k) s->dpoly[k] = (double)(k + 1) * sys->poly[k + 1];
+      s->wc = phgmg__dalloc(&s->al, (size_t)N);
+      if (!s->wc) { rc = PHGMG_ERR_NOMEM; goto fail; }
+      for (i = 0; i < N; ++i) s->wc[i] = 0.0;
+      for (k = 0; k < sys->nsep; ++k) s->wc[sys->sep_idx[k]] += sys->sep_w ? sys->sep_w[k] : 1.0;
+    }
   }
   if (sys->storage == PHGMG_DENSE) {
     s->JR = phgmg__dalloc(&s->al, NN);
@@ -1266,6 +1282,26 @@ PHGMG_DEF phgmg_result phgmg_gl3_create(phgmg_gl3 **out, const phgmg_ph_system *
     rc = phgmg__dia_build(&s->al, &s->djr, N, kb, sys->J, sys->R, 0, 0);
     if (rc == PHGMG_OK) rc = phgmg__dia_build(&s->al, &s->dq, N, kb, sys->Q, NULL, 1, 0);
     if (rc != PHGMG_OK) goto fail;
+    { /* CSR of J - R */
+      size_t nnz = 0;
+      int r, c;
+      for (r = 0; r < N; ++r)
+        for (c = PHGMG__MAX(0, r - kb); c <= PHGMG__MIN(N - 1, r + kb); ++c)
+          if (sys->J[PHGMG__PHB(kb, r, c)] - sys->R[PHGMG__PHB(kb, r, c)] != 0.0) ++nnz;
+      s->jr_ptr = phgmg__ialloc(&s->al, (size_t)N + 1);
+      s->jr_col = phgmg__ialloc(&s->al, nnz);
+      s->jr_val = phgmg__dalloc(&s->al, nnz);
+      if (!s->jr_ptr || !s->jr_col || !s->jr_val) { rc = PHGMG_ERR_NOMEM; goto fail; }
+      nnz = 0;
+      for (r = 0; r < N; ++r) {
+        s->jr_ptr[r] = (int)nnz;
+        for (c = PHGMG__MAX(0, r - kb); c <= PHGMG__MIN(N - 1, r + kb); ++c) {
+          double v = sys->J[PHGMG__PHB(kb, r, c)] - sys->R[PHGMG__PHB(kb, r, c)];
+          if (v != 0.0) { s->jr_col[nnz] = c; s->jr_val[nnz] = v; ++nnz; }
+        }
+      }
+      s->jr_ptr[N] = (int)nnz;
+    }
     if (s->mode == PHGMG__GL3_BANDED) {
       for (k = 0; k < s->djr.nd; ++k) {
         amin = PHGMG__MIN(amin, s->djr.off[k]);
@@ -1305,58 +1341,126 @@ fail:
   return rc;
 }
 
-/* Evaluate the stages at Y_i = x + Z_i: gradients G_i and right-hand sides F_i. */
+/* Banded: F_st = B u_st + (J - R) G_st, row by row from the CSR copy. */
+PHGMG__PRIV void phgmg__gl3_rhs_csr(phgmg_gl3 *s) {
+  int N = s->N, m = s->m, r, k, c;
+  const int *ptr = s->jr_ptr, *col = s->jr_col;
+  const double *val = s->jr_val, *B = s->sys.B, *U = s->U;
+  const double *G0 = s->G, *G1 = s->G + N, *G2 = s->G + 2 * (size_t)N;
+  double *F0 = s->F, *F1 = s->F + N, *F2 = s->F + 2 * (size_t)N;
+  for (r = 0; r < N; ++r) {
+    double a0 = 0.0, a1 = 0.0, a2 = 0.0;
+    for (k = ptr[r]; k < ptr[r + 1]; ++k) {
+      int j = col[k];
+      double v = val[k];
+      a0 += v * G0[j];
+      a1 += v * G1[j];
+      a2 += v * G2[j];
+    }
+    for (c = 0; c < m; ++c) {
+      double b = B[(size_t)r + (size_t)c * (size_t)N];
+      if (b == 0.0) continue;
+      a0 += b * U[c];
+      a1 += b * U[m + c];
+      a2 += b * U[2 * m + c];
+    }
+    F0[r] = a0;
+    F1[r] = a1;
+    F2[r] = a2;
+  }
+  s->st.rhs_evals += 3;
+}
+
+/* Evaluate the stages at Y_i = x + Z_i: gradients G_i and right-hand sides F_i
+   (Y_i is formed only where a callback or a dense product needs it). */
 PHGMG__PRIV void phgmg__gl3_eval(phgmg_gl3 *s, const double *x) {
   const phgmg_ph_system *sys = &s->sys;
   int N = s->N, m = s->m, st, i, k;
-  for (st = 0; st < 3; ++st) {
-    const double *z = s->Z + (size_t)st * (size_t)N;
-    double *y = s->Y + (size_t)st * (size_t)N;
-    for (i = 0; i < N; ++i) y[i] = x[i] + z[i];
-  }
-  if (sys->storage == PHGMG_DENSE)
+  int qdiag = sys->storage == PHGMG_BANDED && s->dq.nd == 1;
+  int need_y = !qdiag || sys->nl == PHGMG_NL_GENERAL;
+  if (need_y)
+    for (st = 0; st < 3; ++st) {
+      const double *z = s->Z + (size_t)st * (size_t)N;
+      double *y = s->Y + (size_t)st * (size_t)N;
+      for (i = 0; i < N; ++i) y[i] = x[i] + z[i];
+    }
+  if (sys->storage == PHGMG_DENSE) {
     phgmg_gemm('N', 'N', N, 3, N, 1.0, sys->Q, N, s->Y, N, 0.0, s->G, N);
-  else
+  } else if (qdiag) { /* Q diagonal: G = q .* (x + Z) in one pass */
+    const double *qd = s->dq.v;
+    if (s->wc) { /* ... plus the polynomial, coordinate-wise */
+      const double *wc = s->wc, *dp = s->dpoly;
+      int deg = sys->poly_deg;
+      for (st = 0; st < 3; ++st) {
+        const double *z = s->Z + (size_t)st * (size_t)N;
+        double *g = s->G + (size_t)st * (size_t)N;
+        for (i = 0; i < N; ++i) {
+          double y = x[i] + z[i], gi = qd[i] * y;
+          if (wc[i] != 0.0) {
+            double acc = dp[deg - 1];
+            int j;
+            for (j = deg - 2; j >= 0; --j) acc = acc * y + dp[j];
+            gi += wc[i] * acc;
+          }
+          g[i] = gi;
+        }
+      }
+      phgmg__gl3_rhs_csr(s);
+      return;
+    }
+    for (st = 0; st < 3; ++st) {
+      const double *z = s->Z + (size_t)st * (size_t)N;
+      double *g = s->G + (size_t)st * (size_t)N;
+      for (i = 0; i < N; ++i) g[i] = qd[i] * (x[i] + z[i]);
+    }
+  } else {
     for (st = 0; st < 3; ++st)
       phgmg__dia_mv(&s->dq, s->Y + (size_t)st * (size_t)N, s->G + (size_t)st * (size_t)N);
+  }
   for (st = 0; st < 3; ++st) {
-    const double *y = s->Y + (size_t)st * (size_t)N;
+    const double *z = s->Z + (size_t)st * (size_t)N;
     double *g = s->G + (size_t)st * (size_t)N;
     if (sys->nl == PHGMG_NL_SEPARABLE) {
+      const int *idx = sys->sep_idx;
+      const double *w = sys->sep_w;
       if (sys->poly_deg > 0) {
         int deg = sys->poly_deg;
+        const double *dp = s->dpoly;
         for (k = 0; k < sys->nsep; ++k) {
-          int ix = sys->sep_idx[k], j;
-          double v = y[ix], acc = (double)deg * sys->poly[deg];
-          for (j = deg - 1; j >= 1; --j) acc = acc * v + (double)j * sys->poly[j];
-          g[ix] += (sys->sep_w ? sys->sep_w[k] : 1.0) * acc;
+          int ix = idx[k], j;
+          double v = x[ix] + z[ix], acc = dp[deg - 1];
+          for (j = deg - 2; j >= 0; --j) acc = acc * v + dp[j];
+          g[ix] += w ? w[k] * acc : acc;
         }
       } else {
         for (k = 0; k < sys->nsep; ++k) {
-          int ix = sys->sep_idx[k];
-          g[ix] += (sys->sep_w ? sys->sep_w[k] : 1.0) * sys->dphi(k, y[ix], sys->user);
+          int ix = idx[k];
+          double d1 = sys->dphi(k, x[ix] + z[ix], sys->user);
+          g[ix] += w ? w[k] * d1 : d1;
         }
       }
     } else if (sys->nl == PHGMG_NL_GENERAL) {
-      sys->grad_nl(y, s->tmp, sys->user);
+      sys->grad_nl(s->Y + (size_t)st * (size_t)N, s->tmp, sys->user);
       for (i = 0; i < N; ++i) g[i] += s->tmp[i];
     }
   }
-  if (sys->storage == PHGMG_DENSE)
-    phgmg_gemm('N', 'N', N, 3, N, 1.0, s->JR, N, s->G, N, 0.0, s->F, N);
-  else
-    for (st = 0; st < 3; ++st)
-      phgmg__dia_mv(&s->djr, s->G + (size_t)st * (size_t)N, s->F + (size_t)st * (size_t)N);
+  if (sys->storage == PHGMG_BANDED) {
+    phgmg__gl3_rhs_csr(s);
+    return;
+  }
+  /* F = B U + (J - R) G */
   for (st = 0; st < 3; ++st) {
     double *f = s->F + (size_t)st * (size_t)N;
     const double *u = s->U + (size_t)st * (size_t)m;
-    for (k = 0; k < m; ++k) {
+    for (i = 0; i < N; ++i) f[i] = sys->B[i] * u[0];
+    for (k = 1; k < m; ++k) {
       const double *bk = sys->B + (size_t)k * (size_t)N;
       double uk = u[k];
       if (uk == 0.0) continue;
       for (i = 0; i < N; ++i) f[i] += bk[i] * uk;
     }
   }
+  phgmg_gemm('N', 'N', N, 3, N, 1.0, s->JR, N, s->G, N, 1.0, s->F, N);
   s->st.rhs_evals += 3;
 }
 
@@ -1432,7 +1536,51 @@ PHGMG__PRIV phgmg_result phgmg__gl3_factor(phgmg_gl3 *s, const double *x) {
     rc = phgmg__gb_factor(N, s->kl, s->ku, s->AB1, ld, s->ip1, s->dinv1, &s->ue1);
     if (rc == PHGMG_OK)
       rc = phgmg__zgb_factor(N, s->kl, s->ku, s->AB2, ld, s->ip2, s->dinv2, &s->ue2);
+    s->nopiv1 = s->nopiv2 = 1;
+    for (j = 0; j < N && rc == PHGMG_OK; ++j) {
+      if (s->ip1[j] != j) s->nopiv1 = 0;
+      if (s->ip2[j] != j) s->nopiv2 = 0;
+    }
     return rc;
+  }
+}
+
+/* Both band factorizations without row interchanges: row-oriented forward
+   and back substitution for the real and the complex system in one sweep, so
+   that their dependency chains overlap. L(j,i) and U(i,j) sit at
+   ab[(kv + j - i) + i*ldab] and ab[(kv + i - j) + j*ldab]. */
+PHGMG__PRIV void phgmg__gb_solve_pair_nopiv(int n, int kl, int ku, int ldab, const double *ab,
+                                            const double *dinv, const double *zab,
+                                            const double *zdinv, double *b, double *z) {
+  int kv = kl + ku, j, i;
+  size_t ld = (size_t)ldab;
+  for (j = 0; j < n; ++j) {
+    double t = b[j], tr = z[2 * j], ti = z[2 * j + 1];
+    for (i = PHGMG__MAX(0, j - kl); i < j; ++i) {
+      size_t e = (size_t)(kv + j - i) + (size_t)i * ld;
+      double lr = zab[2 * e], li = zab[2 * e + 1], xr = z[2 * i], xi = z[2 * i + 1];
+      t -= ab[e] * b[i];
+      tr -= lr * xr - li * xi;
+      ti -= lr * xi + li * xr;
+    }
+    b[j] = t;
+    z[2 * j] = tr;
+    z[2 * j + 1] = ti;
+  }
+  for (j = n - 1; j >= 0; --j) {
+    double t = b[j], tr = z[2 * j], ti = z[2 * j + 1], dr, di;
+    for (i = PHGMG__MIN(n - 1, j + ku); i > j; --i) {
+      size_t e = (size_t)(kv + j - i) + (size_t)i * ld;
+      double ur = zab[2 * e], ui = zab[2 * e + 1], xr = z[2 * i], xi = z[2 * i + 1];
+      t -= ab[e] * b[i];
+      tr -= ur * xr - ui * xi;
+      ti -= ur * xi + ui * xr;
+    }
+    b[j] = t * dinv[j];
+    dr = zdinv[2 * j];
+    di = zdinv[2 * j + 1];
+    z[2 * j] = tr * dr - ti * di;
+    z[2 * j + 1] = tr * di + ti * dr;
   }
 }
 
@@ -1473,14 +1621,14 @@ PHGMG__PRIV phgmg_result phgmg__gl3_newton(phgmg_gl3 *s, const double *x, int fr
   }
   for (;;) {
     const double *F0 = s->F, *F1 = s->F + N, *F2 = s->F + 2 * (size_t)N;
-    double res = 0.0;
+    double res = 0.0, chk = 0.0;
     phgmg__gl3_eval(s, x);
-    if (!phgmg__all_finite(s->F, 3 * (size_t)N)) return PHGMG_ERR_NANINF;
     for (i = 0; i < N; ++i) {
       double f0 = F0[i], f1 = F1[i], f2 = F2[i], e0, e1, e2, w0 = W0[i], w1 = W1[i], w2 = W2[i];
       e0 = fabs(Z0[i] - h * (A[0] * f0 + A[1] * f1 + A[2] * f2));
       e1 = fabs(Z1[i] - h * (A[3] * f0 + A[4] * f1 + A[5] * f2));
       e2 = fabs(Z2[i] - h * (A[6] * f0 + A[7] * f1 + A[8] * f2));
+      chk += e0 + e1 + e2; /* NaN/Inf detection */
       if (e0 > res) res = e0;
       if (e1 > res) res = e1;
       if (e2 > res) res = e2;
@@ -1489,7 +1637,7 @@ PHGMG__PRIV phgmg_result phgmg__gl3_newton(phgmg_gl3 *s, const double *x, int fr
       s->rc[2 * i] = Ti[3] * f0 + Ti[4] * f1 + Ti[5] * f2 - (s->alp * w1 + s->bet * w2) * ih;
       s->rc[2 * i + 1] = Ti[6] * f0 + Ti[7] * f1 + Ti[8] * f2 - (s->alp * w2 - s->bet * w1) * ih;
     }
-    if (res != res) return PHGMG_ERR_NANINF;
+    if (chk - chk != 0.0) return PHGMG_ERR_NANINF;
     if (it > 0) {
       theta = res_prev > 0.0 ? res / res_prev : 0.0;
       if (theta > *theta_max) *theta_max = theta;
@@ -1500,8 +1648,13 @@ PHGMG__PRIV phgmg_result phgmg__gl3_newton(phgmg_gl3 *s, const double *x, int fr
     if (it >= s->max_iter) return PHGMG_ERR_NOT_CONVERGED;
     if (it >= 1 && theta >= 1.0 && !fresh) return PHGMG_ERR_NOT_CONVERGED;
     if (ndiv >= 2) return PHGMG_ERR_NOT_CONVERGED;
-    phgmg__gl3_solve_real(s, s->r1);
-    phgmg__gl3_solve_cplx(s, s->rc);
+    if (s->mode == PHGMG__GL3_BANDED && s->nopiv1 && s->nopiv2) {
+      phgmg__gb_solve_pair_nopiv(N, s->kl, s->ku, s->ldab, s->AB1, s->dinv1, s->AB2, s->dinv2,
+                                 s->r1, s->rc);
+    } else {
+      phgmg__gl3_solve_real(s, s->r1);
+      phgmg__gl3_solve_cplx(s, s->rc);
+    }
     for (i = 0; i < N; ++i) {
       double w0 = W0[i] + s->r1[i], w1 = W1[i] + s->rc[2 * i], w2 = W2[i] + s->rc[2 * i + 1];
       W0[i] = w0; W1[i] = w1; W2[i] = w2;
@@ -1509,7 +1662,6 @@ PHGMG__PRIV phgmg_result phgmg__gl3_newton(phgmg_gl3 *s, const double *x, int fr
       Z1[i] = T[3] * w0 + T[4] * w1 + T[5] * w2;
       Z2[i] = T[6] * w0 + T[7] * w1 + T[8] * w2;
     }
-    if (!phgmg__all_finite(s->Z, 3 * (size_t)N)) return PHGMG_ERR_NANINF;
     res_prev = res;
     ++it;
     s->st.newton_iters++;
@@ -1555,6 +1707,22 @@ PHGMG__PRIV phgmg_result phgmg__gl3_step_map(phgmg_gl3 *s, const double *x, doub
   return PHGMG_OK;
 }
 
+/* Starting guess into s->Z: the previous step's collocation polynomial
+   extrapolated to the new stage times, or zero. */
+PHGMG__PRIV void phgmg__gl3_guess(phgmg_gl3 *s, int cont) {
+  int N = s->N, st, i;
+  if (!cont) {
+    memset(s->Z, 0, sizeof(double) * 3 * (size_t)N);
+    return;
+  }
+  for (st = 0; st < 3; ++st) {
+    const double *P0 = s->Zprev, *P1 = s->Zprev + N, *P2 = s->Zprev + 2 * (size_t)N;
+    double e0 = s->E[st * 3], e1 = s->E[st * 3 + 1], e2 = s->E[st * 3 + 2];
+    double *z = s->Z + (size_t)st * (size_t)N;
+    for (i = 0; i < N; ++i) z[i] = e0 * P0[i] + e1 * P1[i] + e2 * P2[i];
+  }
+}
+
 PHGMG_DEF phgmg_result phgmg_gl3_step(phgmg_gl3 *s, double t, double *x, phgmg_input_fn uf,
                                       void *uuser, double energy_inc[2]) {
   int N, m, st, i, fresh = 0, cont;
@@ -1568,8 +1736,7 @@ PHGMG_DEF phgmg_result phgmg_gl3_step(phgmg_gl3 *s, double t, double *x, phgmg_i
     if (uf) uf(t + s->c[st] * s->h, u, uuser);
     else for (i = 0; i < m; ++i) u[i] = 0.0;
   }
-  if (!phgmg__all_finite(x, (size_t)N) || !phgmg__all_finite(s->U, 3 * (size_t)m))
-    return PHGMG_ERR_NANINF;
+  if (!phgmg__all_finite(s->U, 3 * (size_t)m)) return PHGMG_ERR_NANINF;
   if (s->mode == PHGMG__GL3_MAP) {
     rc = phgmg__gl3_step_map(s, x, energy_inc);
     if (rc != PHGMG_OK) { s->st.failures++; return rc; }
@@ -1581,16 +1748,6 @@ PHGMG_DEF phgmg_result phgmg_gl3_step(phgmg_gl3 *s, double t, double *x, phgmg_i
      step continues the previous one */
   cont = s->have_prev && fabs(t - s->tend) <= 1e-6 * s->h + 4.0 * PHGMG__EPS * fabs(t) &&
          memcmp(x, s->xend, sizeof(double) * (size_t)N) == 0;
-  if (cont) {
-    const double *P0 = s->Zprev, *P1 = s->Zprev + N, *P2 = s->Zprev + 2 * (size_t)N;
-    for (st = 0; st < 3; ++st) {
-      double e0 = s->E[st * 3], e1 = s->E[st * 3 + 1], e2 = s->E[st * 3 + 2];
-      double *zg = s->Zg + (size_t)st * (size_t)N;
-      for (i = 0; i < N; ++i) zg[i] = e0 * P0[i] + e1 * P1[i] + e2 * P2[i];
-    }
-  } else {
-    memset(s->Zg, 0, sizeof(double) * 3 * (size_t)N);
-  }
   if (s->need_factor) {
     rc = phgmg__gl3_factor(s, x);
     if (rc != PHGMG_OK) { s->st.failures++; return rc; }
@@ -1598,26 +1755,34 @@ PHGMG_DEF phgmg_result phgmg_gl3_step(phgmg_gl3 *s, double t, double *x, phgmg_i
     fresh = 1;
   }
   if (s->linear) fresh = 1; /* the Jacobian does not depend on x */
-  memcpy(s->Z, s->Zg, sizeof(double) * 3 * (size_t)N);
+  phgmg__gl3_guess(s, cont);
   rc = phgmg__gl3_newton(s, x, fresh, &theta, &res);
   if (rc != PHGMG_OK && !fresh) {
     s->st.failures++;
     rc = phgmg__gl3_factor(s, x);
     if (rc != PHGMG_OK) { s->need_factor = 1; s->st.failures++; return rc; }
     fresh = 1;
-    memcpy(s->Z, s->Zg, sizeof(double) * 3 * (size_t)N);
+    phgmg__gl3_guess(s, cont);
     rc = phgmg__gl3_newton(s, x, fresh, &theta, &res);
   }
   if (rc != PHGMG_OK) { s->st.failures++; return rc; }
   if (!s->linear && theta > s->contraction) s->need_factor = 1;
   {
     const double *F0 = s->F, *F1 = s->F + N, *F2 = s->F + 2 * (size_t)N;
-    double hb0 = s->h * s->b[0], hb1 = s->h * s->b[1], hb2 = s->h * s->b[2];
-    for (i = 0; i < N; ++i) s->xnew[i] = x[i] + (hb0 * F0[i] + hb1 * F1[i] + hb2 * F2[i]);
+    double hb0 = s->h * s->b[0], hb1 = s->h * s->b[1], hb2 = s->h * s->b[2], chk = 0.0;
+    for (i = 0; i < N; ++i) {
+      double v = x[i] + (hb0 * F0[i] + hb1 * F1[i] + hb2 * F2[i]);
+      s->xnew[i] = v;
+      chk += v;
+    }
+    if (chk - chk != 0.0) { s->st.failures++; return PHGMG_ERR_NANINF; }
   }
-  if (!phgmg__all_finite(s->xnew, (size_t)N)) { s->st.failures++; return PHGMG_ERR_NANINF; }
   if (energy_inc) phgmg__gl3_energy(s, energy_inc);
-  memcpy(s->Zprev, s->Z, sizeof(double) * 3 * (size_t)N);
+  { /* keep the converged stages for the next guess */
+    double *t3 = s->Zprev;
+    s->Zprev = s->Z;
+    s->Z = t3;
+  }
   memcpy(s->xend, s->xnew, sizeof(double) * (size_t)N);
   s->tend = t + s->h;
   s->have_prev = 1;

@@ -10,8 +10,6 @@
 #include <time.h>
 #include <sys/stat.h>
 
-static void demo_u_sin(double t, double *u, void *user) { (void)user; u[0] = 0.1 * sin(t); }
-static void demo_u_const(double t, double *u, void *user) { (void)user; (void)t; u[0] = 0.1; }
 
 static double demo_now(void) {
   struct timespec ts;
@@ -69,6 +67,45 @@ static demo_rom_result demo_run_rom(const phgmg_ph_system *sys, const double *X,
   free(XR); free(YR); free(xr0);
   phgmg_reduced_destroy(red);
   return res;
+}
+
+/* POD bases computed once per snapshot set and shared by every r and method
+   (phgmg_reduce_opts.pod_basis / grad_basis). */
+typedef struct demo_cache {
+  double *adj, *plain, *grad;
+  int adj_cols, plain_cols, grad_cols;
+} demo_cache;
+
+static void demo_cache_build(demo_cache *c, const phgmg_ph_system *sys, const double *X, int ns, int kmax,
+                             int want_grad) {
+  const int N = sys->N;
+  double *T = (double *)malloc(sizeof(double) * (size_t)N * ns);
+  phgmg_result rc;
+  int j;
+  memset(c, 0, sizeof *c);
+  c->adj = (double *)malloc(sizeof(double) * (size_t)N * kmax);
+  c->plain = (double *)malloc(sizeof(double) * (size_t)N * kmax);
+  if (!T || !c->adj || !c->plain) { fprintf(stderr, "out of memory\n"); exit(1); }
+  rc = phgmg_adjust_snapshots(N, sys->m, sys->B, ns, X, N, T, N, NULL);
+  if (rc == PHGMG_OK) rc = phgmg_pod(N, ns, T, N, kmax, 0.0, c->adj, N, NULL, &c->adj_cols, NULL);
+  if (rc == PHGMG_OK) rc = phgmg_pod(N, ns, X, N, kmax, 0.0, c->plain, N, NULL, &c->plain_cols, NULL);
+  if (rc == PHGMG_OK && want_grad) {
+    c->grad = (double *)malloc(sizeof(double) * (size_t)N * kmax);
+    if (!c->grad) { fprintf(stderr, "out of memory\n"); exit(1); }
+    for (j = 0; j < ns; ++j) phgmg_ph_gradient(sys, X + (size_t)j * N, T + (size_t)j * N);
+    rc = phgmg_pod(N, ns, T, N, kmax, 0.0, c->grad, N, NULL, &c->grad_cols, NULL);
+  }
+  if (rc != PHGMG_OK) demo_die("POD of the snapshots", rc);
+  free(T);
+}
+static void demo_cache_free(demo_cache *c) { free(c->adj); free(c->plain); free(c->grad); }
+static void demo_cache_use(const demo_cache *c, phgmg_reduce_opts *o) {
+  if (o->method == PHGMG_METHOD_GMG_POD || o->method == PHGMG_METHOD_GMG_QM) {
+    o->pod_basis = c->adj; o->pod_cols = c->adj_cols;
+  } else {
+    o->pod_basis = c->plain; o->pod_cols = c->plain_cols;
+    o->grad_basis = c->grad; o->grad_cols = c->grad_cols;
+  }
 }
 
 /* CSV: header, then rows of numbers (first column printed as an integer or a
