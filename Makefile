@@ -19,7 +19,7 @@ FRAGS   := $(wildcard dev/h*.h dev/i*.c dev/z*.h)
 TESTSRC := $(wildcard tests/test_*.c)
 BUILD    = build
 
-.PHONY: all test test-plain test-asan compile-checks demo bench examples embedded fuzz clean
+.PHONY: all test test-plain test-asan compile-checks test-embedded-host test-npy demo bench examples embedded fuzz clean
 
 all: phgmg.h examples
 
@@ -37,7 +37,31 @@ $(BUILD)/test_run_asan: phgmg.h tests/run.c tests/harness.h tests/suites.inc $(T
 	@mkdir -p $(BUILD)
 	$(CC) $(CFLAGS_T) -O1 $(SANFLAGS) -o $@ tests/run.c $(TESTSRC) $(LDLIBS)
 
-test: test-plain test-asan compile-checks
+test: test-plain test-asan compile-checks test-embedded-host test-npy
+
+# Embedded path on the host: export the demo models (double and float), check
+# binary and C-source exports reproduce the in-memory outputs exactly, float vs double.
+$(BUILD)/export_model_d: examples/controller/export_model.c examples/controller/controller_run.h phgmg.h examples/msd_models.h
+	@mkdir -p $(BUILD)
+	$(CC) -std=c99 $(WARN) -O2 -o $@ $< $(LDLIBS)
+$(BUILD)/export_model_f: examples/controller/export_model.c examples/controller/controller_run.h phgmg.h examples/msd_models.h
+	@mkdir -p $(BUILD)
+	$(CC) -std=c99 $(WARN) -Wdouble-promotion -DPHGMG_REAL_FLOAT -O2 -o $@ $< $(LDLIBS)
+test-embedded-host: $(BUILD)/export_model_d $(BUILD)/export_model_f
+	sh examples/controller/check.sh $(BUILD)
+
+# Cross-compile the controller for Cortex-M4F (float and double), sizes, and a
+# run under qemu-system-arm when installed.
+embedded: $(BUILD)/export_model_d $(BUILD)/export_model_f
+	sh examples/controller/check.sh $(BUILD)
+	sh examples/controller/embedded.sh $(BUILD)
+
+# .npy round trips against real NumPy (Debian python3-numpy, /usr/bin/python3).
+$(BUILD)/npy_tool: tests/npy_tool.c phgmg.h
+	@mkdir -p $(BUILD)
+	$(CC) -std=c99 $(WARN) -O2 -o $@ $< $(LDLIBS)
+test-npy: $(BUILD)/npy_tool
+	/usr/bin/python3 tests/test_npy_numpy.py $(BUILD)/npy_tool
 
 test-plain: $(BUILD)/test_run
 	./$(BUILD)/test_run

@@ -104,23 +104,30 @@ typedef struct phgmg_matview {
 extern "C" {
 #endif
 
-/* C = alpha*op(A)*op(B) + beta*C; op(A) is m x k, op(B) is k x n. Cache blocked. */
+/* C = alpha*op(A)*op(B) + beta*C; op(A) is m x k, op(B) is k x n. beta = 0
+   overwrites C (NaN in C is not propagated). Cache blocked with a register-tiled
+   micro-kernel; uses PHGMG_GEMM_MC*PHGMG_GEMM_KC doubles of stack (128 KiB by
+   default; both macros can be set before including the implementation). */
 PHGMG_DEF void phgmg_gemm(char transa, char transb, int m, int n, int k, double alpha,
                           const double *A, int lda, const double *B, int ldb,
                           double beta, double *C, int ldc);
-/* y = alpha*op(A)*x + beta*y; A is m x n. */
+/* y = alpha*op(A)*x + beta*y; A is m x n (beta = 0 overwrites y). */
 PHGMG_DEF void phgmg_gemv(char trans, int m, int n, double alpha, const double *A, int lda,
                           const double *x, double beta, double *y);
 
-/* LU with partial pivoting, in place: P*A = L*U, ipiv[k] = row swapped with k.
+/* LU with partial pivoting, in place: P*A = L*U, ipiv[k] = row swapped with k
+   (0-based, applied in order k = 0..n-1). Recursive, blocked through gemm.
    PHGMG_ERR_SINGULAR if a pivot is exactly zero (the factors are then not usable),
-   PHGMG_ERR_NANINF if A holds NaN/Inf. */
+   PHGMG_ERR_NANINF if A holds NaN/Inf (A is then left unchanged). */
 PHGMG_DEF phgmg_result phgmg_lu_factor(int n, double *A, int lda, int *ipiv);
-/* Solve A X = B (trans 'N') or A^T X = B (trans 'T') with the factors; B is n x nrhs, overwritten. */
+/* Solve A X = B (trans 'N') or A^T X = B (trans 'T') with the factors; B is n x nrhs,
+   overwritten. Four or more right-hand sides go through blocked (gemm) solves. */
 PHGMG_DEF void phgmg_lu_solve(char trans, int n, const double *LU, int lda, const int *ipiv,
                               int nrhs, double *B, int ldb);
-/* Reciprocal 1-norm condition estimate (Hager/Higham) from the factors and ||A||_1.
-   Needs 2n doubles of workspace `work` and n ints `iwork`. 0 if singular. */
+/* Reciprocal 1-norm condition estimate (Hager/Higham, LAPACK dlacn2) from the
+   factors and ||A||_1: an upper bound of 1/(||A||_1 ||A^-1||_1), in practice
+   within a small factor of it. Needs 2n doubles of workspace `work` and n ints
+   `iwork`. 0 if a pivot is zero (or anorm1 is 0, NaN or Inf); 1 for n = 0. */
 PHGMG_DEF double phgmg_lu_rcond(int n, const double *LU, int lda, const int *ipiv,
                                 double anorm1, double *work, int *iwork);
 /* 1-norm of a general m x n matrix. */
@@ -128,7 +135,8 @@ PHGMG_DEF double phgmg_norm1(int m, int n, const double *A, int lda);
 /* Frobenius norm of a general m x n matrix (overflow-safe). */
 PHGMG_DEF double phgmg_normf(int m, int n, const double *A, int lda);
 
-/* Complex LU (interleaved storage, see above), partial pivoting. */
+/* Complex LU (interleaved storage, see above), partial pivoting (pivot = largest
+   |re| + |im|), in place, recursive and blocked. Results as phgmg_lu_factor. */
 PHGMG_DEF phgmg_result phgmg_zlu_factor(int n, double *A, int lda, int *ipiv);
 /* Solve A X = B, complex B (n x nrhs interleaved), overwritten. */
 PHGMG_DEF void phgmg_zlu_solve(int n, const double *LU, int lda, const int *ipiv,
@@ -137,8 +145,9 @@ PHGMG_DEF void phgmg_zlu_solve(int n, const double *LU, int lda, const int *ipiv
 /* Householder QR, in place (LAPACK dgeqrf layout: R in the upper triangle,
    reflectors below, scalars tau[min(m,n)]). */
 PHGMG_DEF phgmg_result phgmg_qr(int m, int n, double *A, int lda, double *tau);
-/* QR with column pivoting (dgeqp3 semantics): A*P = Q*R; jpvt[j] = original
-   index of column j (0-based). |R(k,k)| is non-increasing. work: 2n doubles. */
+/* QR with column pivoting (dgeqp3 semantics): A*P = Q*R; on return jpvt[j] =
+   original index of column j (0-based; jpvt is output only, every column is
+   free). |R(k,k)| is non-increasing. work: 2n doubles. */
 PHGMG_DEF phgmg_result phgmg_qrcp(int m, int n, double *A, int lda, double *tau, int *jpvt,
                                   double *work);
 /* Overwrite the first k columns of the factored A (m x k, k <= min(m,n) reflectors)
@@ -150,23 +159,31 @@ PHGMG_DEF void phgmg_qr_apply(char trans, int m, int n, int k, const double *A, 
 
 /* Least squares min ||A X - B||_F^2 + lambda ||X||_F^2 (A m x n, B m x nrhs,
    X n x nrhs). lambda = 0: plain least squares by Householder QR (m >= n, full
-   column rank, else PHGMG_ERR_RANK); lambda > 0: ridge via QR of [A; sqrt(lambda) I]. */
+   column rank, else PHGMG_ERR_RANK: some |R(j,j)| <= max(m,n) eps ||A||_F);
+   lambda > 0: ridge via QR of [A; sqrt(lambda) I] (any m). X is written only on
+   success. lambda < 0: PHGMG_ERR_INVALID_ARG. */
 PHGMG_DEF phgmg_result phgmg_lstsq(int m, int n, int nrhs, const double *A, int lda,
                                    const double *B, int ldb, double lambda,
                                    double *X, int ldx, const phgmg_allocator *alloc);
 
 /* Thin SVD of a (possibly tall, rank-deficient) m x n matrix: Householder QR
-   with column pivoting truncated at the numerical rank (trailing column norms
-   <= eps*||A||_F), then one-sided Jacobi on the small triangular factor.
-   Returns the k = min(kmax, numerical rank) leading triplets: S[k] descending,
-   U (m x k, ldu), V (n x k, ldv; may be NULL). *k_out = k.
-   *rank_out (may be NULL) = numerical rank. */
+   with column pivoting truncated at the numerical rank r (every trailing column
+   norm <= eps*||A||_F), then a second QR of R^T (n x r) and one-sided Jacobi on
+   the r x r triangular factor (Drmac-Veselic), U = Q*W, V = P*Q2*Vj.
+   Returns the k = min(kmax, r) leading triplets: S[k] descending, U (m x k,
+   ldu), V (n x k, ldv; may be NULL, which also saves time). *k_out = k;
+   kmax = 0 only computes the rank. *rank_out (may be NULL) = r. Cost grows
+   with r^3 (about 1 s for r ~ 800 on one core), A is not modified.
+   PHGMG_ERR_NANINF / _NOMEM / _NOT_CONVERGED (Jacobi, not seen in practice). */
 PHGMG_DEF phgmg_result phgmg_svd(int m, int n, const double *A, int lda, int kmax,
                                  double *S, double *U, int ldu, double *V, int ldv,
                                  int *k_out, int *rank_out, const phgmg_allocator *alloc);
 
-/* Symmetric eigenvalues (ascending) and optionally eigenvectors (V, n x n) by
-   cyclic Jacobi. A is n x n symmetric, destroyed. */
+/* Symmetric eigenvalues (ascending) and optionally eigenvectors (V, n x n, may
+   be NULL; V = A's eigenvectors in the order of w). A is n x n, used as
+   (A + A^T)/2, destroyed. n <= 24: cyclic Jacobi; larger n: Householder
+   tridiagonalization + implicit QL (EISPACK tred2/tql2), about 0.4 s (values
+   only) / 1 s (with vectors) at n = 1000. No allocation. */
 PHGMG_DEF phgmg_result phgmg_sym_eig(int n, double *A, int lda, double *w, double *V, int ldv);
 
 #ifdef __cplusplus
@@ -948,7 +965,7 @@ PHGMG_DEF void phgmg_gemv(char trans, int m, int n, double alpha, const double *
     for (; j < n; ++j) {
       const double *a = A + (size_t)j * (size_t)lda;
       double t = alpha * x[j];
-      for (i = 0; i < m; ++i) y[i] += t * a[i];
+      phgmg__axpy(m, t, a, y);
     }
   } else {
     /* y += alpha * A^T x, dot products of columns */
@@ -957,13 +974,13 @@ PHGMG_DEF void phgmg_gemv(char trans, int m, int n, double alpha, const double *
 #endif
 }
 
-#ifndef PHGMG_USE_CBLAS
-/* Portable GEMM: a block of op(A) (MC x KC) is packed into 8-row slivers (on
-   the stack, MC*KC doubles), then 8 x 6 tiles of C are computed by a
+/* Portable GEMM core: a block of op(A) (MC x KC) is packed into 8-row slivers
+   (on the stack, MC*KC doubles), then 8 x 6 tiles of C are computed by a
    register-blocked micro-kernel that streams the matching 6 columns of op(B)
-   directly from B. With GCC/Clang on an AVX target the micro-kernel uses
-   vector extensions (define PHGMG_NO_VECTOR_EXT for the plain C version,
-   which is the one used everywhere else). */
+   directly from B (any strides). With GCC/Clang on an AVX target the
+   micro-kernel uses vector extensions (define PHGMG_NO_VECTOR_EXT for the plain
+   C version, which is the one used everywhere else). It also serves the
+   complex products (interleaved storage seen as a real matrix). */
 #ifndef PHGMG_GEMM_MC
 #define PHGMG_GEMM_MC 64 /* multiple of 8 */
 #endif
@@ -1024,7 +1041,72 @@ PHGMG__PRIV void phgmg__gemm_micro(int kc, const double *Ap, const double *B, si
     for (i = 0; i < mr; ++i) c[i] += alpha * t[i];
   }
 }
-#endif
+
+/* C (m x n) += alpha * opA(A) * opB(B), opB(B)(p, j) = B[p*bsp + j*bsj];
+   amode 0: opA(A)(i, p) = A[i + p*lda]; 1: A[p + i*lda] (transposed);
+   2 (m even, A the real view of an interleaved complex matrix): rows 2r, 2r+1
+   of opA are (-Im, Re) of complex row r, i.e. the real view of i*A. */
+PHGMG__PRIV void phgmg__gemm_acc(int m, int n, int k, double alpha, int amode, const double *A,
+                                 int lda, const double *B, size_t bsp, size_t bsj, double *C,
+                                 int ldc) {
+  double Ap[PHGMG_GEMM_MC * PHGMG_GEMM_KC];
+  int pc, ic, ir, jr, p, i;
+  if (m <= 0 || n <= 0 || k <= 0 || alpha == 0.0) return;
+  for (pc = 0; pc < k; pc += PHGMG_GEMM_KC) {
+    int kc = PHGMG__MIN(PHGMG_GEMM_KC, k - pc);
+    for (ic = 0; ic < m; ic += PHGMG_GEMM_MC) {
+      int mc = PHGMG__MIN(PHGMG_GEMM_MC, m - ic);
+      /* pack opA(ic:ic+mc, pc:pc+kc) into 8-row slivers, zero padded */
+      for (ir = 0; ir < mc; ir += PHGMG__MR) {
+        int mr = PHGMG__MIN(PHGMG__MR, mc - ir);
+        double *dst = Ap + (size_t)ir * (size_t)kc;
+        if (amode == 0) {
+          for (p = 0; p < kc; ++p) {
+            const double *src = A + (ic + ir) + (size_t)(pc + p) * (size_t)lda;
+            double *d = dst + (size_t)p * PHGMG__MR;
+            for (i = 0; i < mr; ++i) d[i] = src[i];
+            for (; i < PHGMG__MR; ++i) d[i] = 0.0;
+          }
+        } else if (amode == 1) {
+          for (i = 0; i < PHGMG__MR; ++i) {
+            if (i < mr) {
+              const double *src = A + pc + (size_t)(ic + ir + i) * (size_t)lda;
+              for (p = 0; p < kc; ++p) dst[(size_t)p * PHGMG__MR + i] = src[p];
+            } else {
+              for (p = 0; p < kc; ++p) dst[(size_t)p * PHGMG__MR + i] = 0.0;
+            }
+          }
+        } else {
+          for (p = 0; p < kc; ++p) {
+            const double *src = A + (ic + ir) + (size_t)(pc + p) * (size_t)lda;
+            double *d = dst + (size_t)p * PHGMG__MR;
+            for (i = 0; i + 1 < mr; i += 2) { d[i] = -src[i + 1]; d[i + 1] = src[i]; }
+            for (; i < PHGMG__MR; ++i) d[i] = 0.0;
+          }
+        }
+      }
+      for (jr = 0; jr < n; jr += PHGMG__NR) {
+        int nr = PHGMG__MIN(PHGMG__NR, n - jr);
+        const double *bp = B + (size_t)pc * bsp + (size_t)jr * bsj;
+        for (ir = 0; ir < mc; ir += PHGMG__MR)
+          phgmg__gemm_micro(kc, Ap + (size_t)ir * (size_t)kc, bp, bsp, bsj,
+                            PHGMG__MIN(PHGMG__MR, mc - ir), nr, alpha,
+                            C + (ic + ir) + (size_t)jr * (size_t)ldc, ldc);
+      }
+    }
+  }
+}
+
+/* Complex C (m x n) += alpha * A (m x k) * B (k x n), alpha real, interleaved
+   storage with leading dimensions in complex elements: Re(C) and Im(C) come
+   from two real products on the interleaved views, [Re A; Im A] Re B +
+   [-Im A; Re A] Im B, so no flop is wasted. */
+PHGMG__PRIV void phgmg__zgemm_acc(int m, int n, int k, double alpha, const double *A, int lda,
+                                  const double *B, int ldb, double *C, int ldc) {
+  size_t bsj = 2 * (size_t)ldb;
+  phgmg__gemm_acc(2 * m, n, k, alpha, 0, A, 2 * lda, B, 2, bsj, C, 2 * ldc);
+  phgmg__gemm_acc(2 * m, n, k, alpha, 2, A, 2 * lda, B + 1, 2, bsj, C, 2 * ldc);
+}
 
 PHGMG_DEF void phgmg_gemm(char transa, char transb, int m, int n, int k, double alpha,
                           const double *A, int lda, const double *B, int ldb,
@@ -1047,50 +1129,7 @@ PHGMG_DEF void phgmg_gemm(char transa, char transb, int m, int n, int k, double 
     if (beta == 0.0) for (i = 0; i < m; ++i) c[i] = 0.0;
     else if (beta != 1.0) for (i = 0; i < m; ++i) c[i] *= beta;
   }
-  if (alpha == 0.0 || k <= 0) return;
-#ifndef PHGMG_USE_CBLAS
-  {
-    double Ap[PHGMG_GEMM_MC * PHGMG_GEMM_KC];
-    size_t bsp = tb ? (size_t)ldb : 1, bsj = tb ? 1 : (size_t)ldb;
-    int pc, ic, ir, jr, p;
-    for (pc = 0; pc < k; pc += PHGMG_GEMM_KC) {
-      int kc = PHGMG__MIN(PHGMG_GEMM_KC, k - pc);
-      for (ic = 0; ic < m; ic += PHGMG_GEMM_MC) {
-        int mc = PHGMG__MIN(PHGMG_GEMM_MC, m - ic);
-        /* pack op(A)(ic:ic+mc, pc:pc+kc) into 8-row slivers, zero padded */
-        for (ir = 0; ir < mc; ir += PHGMG__MR) {
-          int mr = PHGMG__MIN(PHGMG__MR, mc - ir);
-          double *dst = Ap + (size_t)ir * (size_t)kc;
-          if (!ta) {
-            for (p = 0; p < kc; ++p) {
-              const double *src = A + (ic + ir) + (size_t)(pc + p) * (size_t)lda;
-              double *d = dst + (size_t)p * PHGMG__MR;
-              for (i = 0; i < mr; ++i) d[i] = src[i];
-              for (; i < PHGMG__MR; ++i) d[i] = 0.0;
-            }
-          } else {
-            for (i = 0; i < PHGMG__MR; ++i) {
-              if (i < mr) {
-                const double *src = A + pc + (size_t)(ic + ir + i) * (size_t)lda;
-                for (p = 0; p < kc; ++p) dst[(size_t)p * PHGMG__MR + i] = src[p];
-              } else {
-                for (p = 0; p < kc; ++p) dst[(size_t)p * PHGMG__MR + i] = 0.0;
-              }
-            }
-          }
-        }
-        for (jr = 0; jr < n; jr += PHGMG__NR) {
-          int nr = PHGMG__MIN(PHGMG__NR, n - jr);
-          const double *bp = B + (size_t)pc * bsp + (size_t)jr * bsj;
-          for (ir = 0; ir < mc; ir += PHGMG__MR)
-            phgmg__gemm_micro(kc, Ap + (size_t)ir * (size_t)kc, bp, bsp, bsj,
-                              PHGMG__MIN(PHGMG__MR, mc - ir), nr, alpha,
-                              C + (ic + ir) + (size_t)jr * (size_t)ldc, ldc);
-        }
-      }
-    }
-  }
-#endif
+  phgmg__gemm_acc(m, n, k, alpha, ta, A, lda, B, tb ? (size_t)ldb : 1, tb ? 1 : (size_t)ldb, C, ldc);
 }
 
 /* ---- real LU -------------------------------------------------------------- */
@@ -1106,17 +1145,21 @@ PHGMG__PRIV void phgmg__laswp(int ncols, double *A, int lda, int k1, int k2, con
   }
 }
 
-/* B := L^{-1} B with L n x n unit lower triangular; B n x nrhs. Recursive, the
-   off-diagonal blocks go through gemm. */
+/* Triangular solves with n x n factors on B (n x nrhs), in place. Recursive
+   halving, the off-diagonal blocks go through gemm; small problems (n <= 32
+   or fewer than 4 right-hand sides) by column substitution.
+   llu: L^{-1} B, L unit lower.     lun: U^{-1} B, U upper.
+   utn: U^{-T} B.                   ltu: L^{-T} B, L unit lower. */
+#define PHGMG__TRSM_LEAF 32
 PHGMG__PRIV void phgmg__trsm_llu(int n, int nrhs, const double *L, int ldl, double *B, int ldb) {
-  int i, j, k, n1;
-  if (n <= 32) {
+  int j, k, n1;
+  if (n <= PHGMG__TRSM_LEAF || nrhs < 4) {
     for (j = 0; j < nrhs; ++j) {
       double *b = B + (size_t)j * (size_t)ldb;
       for (k = 0; k < n; ++k) {
         const double *l = L + (size_t)k * (size_t)ldl;
         double t = b[k];
-        if (t != 0.0) for (i = k + 1; i < n; ++i) b[i] -= t * l[i];
+        if (t != 0.0) phgmg__axpy(n - k - 1, -t, l + k + 1, b + k + 1);
       }
     }
     return;
@@ -1125,6 +1168,61 @@ PHGMG__PRIV void phgmg__trsm_llu(int n, int nrhs, const double *L, int ldl, doub
   phgmg__trsm_llu(n1, nrhs, L, ldl, B, ldb);
   phgmg_gemm('N', 'N', n - n1, nrhs, n1, -1.0, L + n1, ldl, B, ldb, 1.0, B + n1, ldb);
   phgmg__trsm_llu(n - n1, nrhs, L + n1 + (size_t)n1 * (size_t)ldl, ldl, B + n1, ldb);
+}
+PHGMG__PRIV void phgmg__trsm_lun(int n, int nrhs, const double *U, int ldu, double *B, int ldb) {
+  int j, k, n1;
+  if (n <= PHGMG__TRSM_LEAF || nrhs < 4) {
+    for (j = 0; j < nrhs; ++j) {
+      double *b = B + (size_t)j * (size_t)ldb;
+      for (k = n - 1; k >= 0; --k) {
+        const double *u = U + (size_t)k * (size_t)ldu;
+        double t = b[k] / u[k];
+        b[k] = t;
+        if (t != 0.0) phgmg__axpy(k, -t, u, b);
+      }
+    }
+    return;
+  }
+  n1 = n / 2;
+  phgmg__trsm_lun(n - n1, nrhs, U + n1 + (size_t)n1 * (size_t)ldu, ldu, B + n1, ldb);
+  phgmg_gemm('N', 'N', n1, nrhs, n - n1, -1.0, U + (size_t)n1 * (size_t)ldu, ldu, B + n1, ldb,
+             1.0, B, ldb);
+  phgmg__trsm_lun(n1, nrhs, U, ldu, B, ldb);
+}
+PHGMG__PRIV void phgmg__trsm_utn(int n, int nrhs, const double *U, int ldu, double *B, int ldb) {
+  int j, k, n1;
+  if (n <= PHGMG__TRSM_LEAF || nrhs < 4) {
+    for (j = 0; j < nrhs; ++j) {
+      double *b = B + (size_t)j * (size_t)ldb;
+      for (k = 0; k < n; ++k) {
+        const double *u = U + (size_t)k * (size_t)ldu;
+        b[k] = (b[k] - phgmg__dot(k, u, b)) / u[k];
+      }
+    }
+    return;
+  }
+  n1 = n / 2;
+  phgmg__trsm_utn(n1, nrhs, U, ldu, B, ldb);
+  phgmg_gemm('T', 'N', n - n1, nrhs, n1, -1.0, U + (size_t)n1 * (size_t)ldu, ldu, B, ldb, 1.0,
+             B + n1, ldb);
+  phgmg__trsm_utn(n - n1, nrhs, U + n1 + (size_t)n1 * (size_t)ldu, ldu, B + n1, ldb);
+}
+PHGMG__PRIV void phgmg__trsm_ltu(int n, int nrhs, const double *L, int ldl, double *B, int ldb) {
+  int j, k, n1;
+  if (n <= PHGMG__TRSM_LEAF || nrhs < 4) {
+    for (j = 0; j < nrhs; ++j) {
+      double *b = B + (size_t)j * (size_t)ldb;
+      for (k = n - 1; k >= 0; --k) {
+        const double *l = L + (size_t)k * (size_t)ldl;
+        b[k] -= phgmg__dot(n - k - 1, l + k + 1, b + k + 1);
+      }
+    }
+    return;
+  }
+  n1 = n / 2;
+  phgmg__trsm_ltu(n - n1, nrhs, L + n1 + (size_t)n1 * (size_t)ldl, ldl, B + n1, ldb);
+  phgmg_gemm('T', 'N', n1, nrhs, n - n1, -1.0, L + n1, ldl, B + n1, ldb, 1.0, B, ldb);
+  phgmg__trsm_ltu(n1, nrhs, L, ldl, B, ldb);
 }
 
 /* Recursive LU with partial pivoting of an m x n panel (m >= n), ipiv relative
@@ -1153,7 +1251,7 @@ PHGMG__PRIV int phgmg__lu_rec(int m, int n, double *A, int lda, int *ipiv) {
       }
       for (j = k + 1; j < n; ++j) {
         double *c = A + (size_t)j * (size_t)lda, t = c[k];
-        if (t != 0.0) for (i = k + 1; i < m; ++i) c[i] -= t * ak[i];
+        if (t != 0.0) phgmg__axpy(m - k - 1, -t, ak + k + 1, c + k + 1);
       }
     }
     return sing;
@@ -1182,42 +1280,19 @@ PHGMG_DEF phgmg_result phgmg_lu_factor(int n, double *A, int lda, int *ipiv) {
 
 PHGMG_DEF void phgmg_lu_solve(char trans, int n, const double *LU, int lda, const int *ipiv,
                               int nrhs, double *B, int ldb) {
-  int i, j, k;
+  int j, k;
   int tr = (trans == 'T' || trans == 't');
   PHGMG_ASSERT(tr || trans == 'N' || trans == 'n');
-  for (j = 0; j < nrhs; ++j) {
-    double *b = B + (size_t)j * (size_t)ldb;
-    if (!tr) {
-      for (k = 0; k < n; ++k)
-        if (ipiv[k] != k) { double t = b[k]; b[k] = b[ipiv[k]]; b[ipiv[k]] = t; }
-      /* L y = b (unit lower), column oriented */
-      for (k = 0; k < n; ++k) {
-        const double *l = LU + (size_t)k * (size_t)lda;
-        double t = b[k];
-        if (t != 0.0) for (i = k + 1; i < n; ++i) b[i] -= t * l[i];
-      }
-      /* U x = y */
-      for (k = n - 1; k >= 0; --k) {
-        const double *u = LU + (size_t)k * (size_t)lda;
-        double t = b[k] / u[k];
-        b[k] = t;
-        if (t != 0.0) for (i = 0; i < k; ++i) b[i] -= t * u[i];
-      }
-    } else {
-      /* U^T y = b: dot products with columns of U */
-      for (k = 0; k < n; ++k) {
-        const double *u = LU + (size_t)k * (size_t)lda;
-        double s = b[k];
-        for (i = 0; i < k; ++i) s -= u[i] * b[i];
-        b[k] = s / u[k];
-      }
-      /* L^T z = y */
-      for (k = n - 1; k >= 0; --k) {
-        const double *l = LU + (size_t)k * (size_t)lda;
-        double s = b[k];
-        for (i = k + 1; i < n; ++i) s -= l[i] * b[i];
-        b[k] = s;
-      }
+  if (n <= 0 || nrhs <= 0) return;
+  if (!tr) {
+    phgmg__laswp(nrhs, B, ldb, 0, n, ipiv);
+    phgmg__trsm_llu(n, nrhs, LU, lda, B, ldb);
+    phgmg__trsm_lun(n, nrhs, LU, lda, B, ldb);
+  } else {
+    phgmg__trsm_utn(n, nrhs, LU, lda, B, ldb);
+    phgmg__trsm_ltu(n, nrhs, LU, lda, B, ldb);
+    for (j = 0; j < nrhs; ++j) {
+      double *b = B + (size_t)j * (size_t)ldb;
       for (k = n - 1; k >= 0; --k)
         if (ipiv[k] != k) { double t = b[k]; b[k] = b[ipiv[k]]; b[ipiv[k]] = t; }
     }
@@ -1225,103 +1300,142 @@ PHGMG_DEF void phgmg_lu_solve(char trans, int n, const double *LU, int lda, cons
 }
 
 /* ---- complex LU (interleaved re,im) ----------------------------------------- */
+/* (cr, ci) = (ar + i ai) / (br + i bi), Smith's algorithm */
+PHGMG__PRIV void phgmg__zdiv(double ar, double ai, double br, double bi, double *cr, double *ci) {
+  if (fabs(br) >= fabs(bi)) {
+    double q = bi / br, d = br + bi * q;
+    *cr = (ar + ai * q) / d;
+    *ci = (ai - ar * q) / d;
+  } else {
+    double q = br / bi, d = br * q + bi;
+    *cr = (ar * q + ai) / d;
+    *ci = (ai * q - ar) / d;
+  }
+}
+
+/* y -= (tr + i ti) x over n complex entries */
+PHGMG__PRIV void phgmg__zaxpy_neg(int n, double tr, double ti, const double *x, double *y) {
+  int i;
+  for (i = 0; i < n; ++i) {
+    double xr = x[2 * i], xi = x[2 * i + 1];
+    y[2 * i] -= tr * xr - ti * xi;
+    y[2 * i + 1] -= tr * xi + ti * xr;
+  }
+}
+
+PHGMG__PRIV void phgmg__zlaswp(int ncols, double *A, int lda, int k1, int k2, const int *ipiv) {
+  int j, k;
+  for (j = 0; j < ncols; ++j) {
+    double *c = A + 2 * (size_t)j * (size_t)lda, t;
+    for (k = k1; k < k2; ++k) {
+      int p = ipiv[k];
+      if (p != k) {
+        t = c[2 * k]; c[2 * k] = c[2 * p]; c[2 * p] = t;
+        t = c[2 * k + 1]; c[2 * k + 1] = c[2 * p + 1]; c[2 * p + 1] = t;
+      }
+    }
+  }
+}
+
+/* complex L^{-1} B (unit lower) and U^{-1} B, as the real ones */
+PHGMG__PRIV void phgmg__ztrsm_llu(int n, int nrhs, const double *L, int ldl, double *B, int ldb) {
+  int j, k, n1;
+  if (n <= PHGMG__TRSM_LEAF || nrhs < 2) {
+    for (j = 0; j < nrhs; ++j) {
+      double *b = B + 2 * (size_t)j * (size_t)ldb;
+      for (k = 0; k < n; ++k) {
+        const double *l = L + 2 * (size_t)k * (size_t)ldl;
+        double tr = b[2 * k], ti = b[2 * k + 1];
+        if (tr != 0.0 || ti != 0.0) phgmg__zaxpy_neg(n - k - 1, tr, ti, l + 2 * (k + 1), b + 2 * (k + 1));
+      }
+    }
+    return;
+  }
+  n1 = n / 2;
+  phgmg__ztrsm_llu(n1, nrhs, L, ldl, B, ldb);
+  phgmg__zgemm_acc(n - n1, nrhs, n1, -1.0, L + 2 * n1, ldl, B, ldb, B + 2 * n1, ldb);
+  phgmg__ztrsm_llu(n - n1, nrhs, L + 2 * (n1 + (size_t)n1 * (size_t)ldl), ldl, B + 2 * n1, ldb);
+}
+PHGMG__PRIV void phgmg__ztrsm_lun(int n, int nrhs, const double *U, int ldu, double *B, int ldb) {
+  int j, k, n1;
+  if (n <= PHGMG__TRSM_LEAF || nrhs < 2) {
+    for (j = 0; j < nrhs; ++j) {
+      double *b = B + 2 * (size_t)j * (size_t)ldb;
+      for (k = n - 1; k >= 0; --k) {
+        const double *u = U + 2 * (size_t)k * (size_t)ldu;
+        double tr, ti;
+        phgmg__zdiv(b[2 * k], b[2 * k + 1], u[2 * k], u[2 * k + 1], &tr, &ti);
+        b[2 * k] = tr;
+        b[2 * k + 1] = ti;
+        if (tr != 0.0 || ti != 0.0) phgmg__zaxpy_neg(k, tr, ti, u, b);
+      }
+    }
+    return;
+  }
+  n1 = n / 2;
+  phgmg__ztrsm_lun(n - n1, nrhs, U + 2 * (n1 + (size_t)n1 * (size_t)ldu), ldu, B + 2 * n1, ldb);
+  phgmg__zgemm_acc(n1, nrhs, n - n1, -1.0, U + 2 * (size_t)n1 * (size_t)ldu, ldu, B + 2 * n1, ldb,
+                   B, ldb);
+  phgmg__ztrsm_lun(n1, nrhs, U, ldu, B, ldb);
+}
+
+/* Recursive complex LU of an m x n panel, as phgmg__lu_rec. */
+PHGMG__PRIV int phgmg__zlu_rec(int m, int n, double *A, int lda, int *ipiv) {
+  int i, k, n1, sing = 0;
+  if (n <= 8) {
+    for (k = 0; k < n; ++k) {
+      double *ak = A + 2 * (size_t)k * (size_t)lda, rr, ri;
+      double amax = fabs(ak[2 * k]) + fabs(ak[2 * k + 1]);
+      int p = k, j;
+      for (i = k + 1; i < m; ++i) {
+        double v = fabs(ak[2 * i]) + fabs(ak[2 * i + 1]);
+        if (v > amax) { amax = v; p = i; }
+      }
+      ipiv[k] = p;
+      if (amax == 0.0) { sing = 1; continue; }
+      if (p != k) phgmg__zlaswp(n, A, lda, k, k + 1, ipiv);
+      phgmg__zdiv(1.0, 0.0, ak[2 * k], ak[2 * k + 1], &rr, &ri);
+      for (i = k + 1; i < m; ++i) {
+        double xr = ak[2 * i], xi = ak[2 * i + 1];
+        ak[2 * i] = xr * rr - xi * ri;
+        ak[2 * i + 1] = xr * ri + xi * rr;
+      }
+      for (j = k + 1; j < n; ++j) {
+        double *c = A + 2 * (size_t)j * (size_t)lda, tr = c[2 * k], ti = c[2 * k + 1];
+        if (tr != 0.0 || ti != 0.0) phgmg__zaxpy_neg(m - k - 1, tr, ti, ak + 2 * (k + 1), c + 2 * (k + 1));
+      }
+    }
+    return sing;
+  }
+  n1 = n / 2;
+  sing = phgmg__zlu_rec(m, n1, A, lda, ipiv);
+  phgmg__zlaswp(n - n1, A + 2 * (size_t)n1 * (size_t)lda, lda, 0, n1, ipiv);
+  phgmg__ztrsm_llu(n1, n - n1, A, lda, A + 2 * (size_t)n1 * (size_t)lda, lda);
+  phgmg__zgemm_acc(m - n1, n - n1, n1, -1.0, A + 2 * n1, lda, A + 2 * (size_t)n1 * (size_t)lda, lda,
+                   A + 2 * (n1 + (size_t)n1 * (size_t)lda), lda);
+  sing |= phgmg__zlu_rec(m - n1, n - n1, A + 2 * (n1 + (size_t)n1 * (size_t)lda), lda, ipiv + n1);
+  for (i = n1; i < n; ++i) ipiv[i] += n1;
+  phgmg__zlaswp(n1, A, lda, n1, n, ipiv);
+  return sing;
+}
+
 PHGMG_DEF phgmg_result phgmg_zlu_factor(int n, double *A, int lda, int *ipiv) {
-  int i, j, k;
-  phgmg_result rc = PHGMG_OK;
+  int j;
   if (n < 0 || lda < PHGMG__MAX(n, 1)) return PHGMG_ERR_SIZE;
   if (n == 0) return PHGMG_OK;
   if (!A || !ipiv) return PHGMG_ERR_INVALID_ARG;
   for (j = 0; j < n; ++j)
     if (!phgmg__all_finite(A + 2 * (size_t)j * (size_t)lda, 2 * (size_t)n)) return PHGMG_ERR_NANINF;
-  for (k = 0; k < n; ++k) {
-    double *ak = A + 2 * (size_t)k * (size_t)lda;
-    int p = k;
-    double amax = fabs(ak[2 * k]) + fabs(ak[2 * k + 1]);
-    for (i = k + 1; i < n; ++i) {
-      double v = fabs(ak[2 * i]) + fabs(ak[2 * i + 1]);
-      if (v > amax) { amax = v; p = i; }
-    }
-    ipiv[k] = p;
-    if (amax == 0.0) { rc = PHGMG_ERR_SINGULAR; continue; }
-    if (p != k)
-      for (j = 0; j < n; ++j) {
-        double *c = A + 2 * (size_t)j * (size_t)lda, t;
-        t = c[2 * k]; c[2 * k] = c[2 * p]; c[2 * p] = t;
-        t = c[2 * k + 1]; c[2 * k + 1] = c[2 * p + 1]; c[2 * p + 1] = t;
-      }
-    {
-      /* r = 1 / pivot (Smith's division) */
-      double pr = ak[2 * k], pi = ak[2 * k + 1], rr, ri;
-      if (fabs(pr) >= fabs(pi)) {
-        double q = pi / pr, d = pr + pi * q;
-        rr = 1.0 / d; ri = -q / d;
-      } else {
-        double q = pr / pi, d = pr * q + pi;
-        rr = q / d; ri = -1.0 / d;
-      }
-      for (i = k + 1; i < n; ++i) {
-        double xr = ak[2 * i], xi = ak[2 * i + 1];
-        ak[2 * i] = xr * rr - xi * ri;
-        ak[2 * i + 1] = xr * ri + xi * rr;
-      }
-    }
-    for (j = k + 1; j < n; ++j) {
-      double *c = A + 2 * (size_t)j * (size_t)lda;
-      double tr = c[2 * k], ti = c[2 * k + 1];
-      if (tr == 0.0 && ti == 0.0) continue;
-      for (i = k + 1; i < n; ++i) {
-        double lr = ak[2 * i], li = ak[2 * i + 1];
-        c[2 * i] -= tr * lr - ti * li;
-        c[2 * i + 1] -= tr * li + ti * lr;
-      }
-    }
-  }
-  return rc;
+  return phgmg__zlu_rec(n, n, A, lda, ipiv) ? PHGMG_ERR_SINGULAR : PHGMG_OK;
 }
 
 PHGMG_DEF void phgmg_zlu_solve(int n, const double *LU, int lda, const int *ipiv,
                                int nrhs, double *B, int ldb) {
-  int i, j, k;
-  for (j = 0; j < nrhs; ++j) {
-    double *b = B + 2 * (size_t)j * (size_t)ldb;
-    for (k = 0; k < n; ++k) {
-      int p = ipiv[k];
-      if (p != k) {
-        double t = b[2 * k]; b[2 * k] = b[2 * p]; b[2 * p] = t;
-        t = b[2 * k + 1]; b[2 * k + 1] = b[2 * p + 1]; b[2 * p + 1] = t;
-      }
-    }
-    for (k = 0; k < n; ++k) {
-      const double *l = LU + 2 * (size_t)k * (size_t)lda;
-      double tr = b[2 * k], ti = b[2 * k + 1];
-      if (tr == 0.0 && ti == 0.0) continue;
-      for (i = k + 1; i < n; ++i) {
-        double lr = l[2 * i], li = l[2 * i + 1];
-        b[2 * i] -= tr * lr - ti * li;
-        b[2 * i + 1] -= tr * li + ti * lr;
-      }
-    }
-    for (k = n - 1; k >= 0; --k) {
-      const double *u = LU + 2 * (size_t)k * (size_t)lda;
-      double pr = u[2 * k], pi = u[2 * k + 1], xr = b[2 * k], xi = b[2 * k + 1], tr, ti;
-      if (fabs(pr) >= fabs(pi)) {
-        double q = pi / pr, d = pr + pi * q;
-        tr = (xr + xi * q) / d; ti = (xi - xr * q) / d;
-      } else {
-        double q = pr / pi, d = pr * q + pi;
-        tr = (xr * q + xi) / d; ti = (xi * q - xr) / d;
-      }
-      b[2 * k] = tr; b[2 * k + 1] = ti;
-      if (tr == 0.0 && ti == 0.0) continue;
-      for (i = 0; i < k; ++i) {
-        double ur = u[2 * i], ui = u[2 * i + 1];
-        b[2 * i] -= tr * ur - ti * ui;
-        b[2 * i + 1] -= tr * ui + ti * ur;
-      }
-    }
-  }
+  if (n <= 0 || nrhs <= 0) return;
+  phgmg__zlaswp(nrhs, B, ldb, 0, n, ipiv);
+  phgmg__ztrsm_llu(n, nrhs, LU, lda, B, ldb);
+  phgmg__ztrsm_lun(n, nrhs, LU, lda, B, ldb);
 }
-
 
 /* ---- condition estimate (Hager 1984, Higham 1988; LAPACK dlacn2) ---------- */
 PHGMG__PRIV double phgmg__asum(int n, const double *x) {
@@ -1403,14 +1517,14 @@ PHGMG__PRIV void phgmg__larfg(int n, double *alpha, double *x, double *tau) {
 
 /* C (m x n) := (I - tau v v^T) C, v = (1, v[1..m-1]) (v[0] is not read). */
 PHGMG__PRIV void phgmg__larf_left(int m, int n, const double *v, double tau, double *C, int ldc) {
-  int i, j;
+  int j;
   if (tau == 0.0) return;
   for (j = 0; j < n; ++j) {
     double *c = C + (size_t)j * (size_t)ldc;
     double s = tau * (c[0] + phgmg__dot(m - 1, v + 1, c + 1));
     if (s == 0.0) continue;
     c[0] -= s;
-    for (i = 1; i < m; ++i) c[i] -= s * v[i];
+    phgmg__axpy(m - 1, -s, v + 1, c + 1);
   }
 }
 
@@ -1519,7 +1633,7 @@ PHGMG__PRIV void phgmg__qrcp_blocked(int m, int n, double *A, int lda, double *t
       for (q = 0; q < kk; ++q) {
         const double *v = A + (size_t)(s + q) * (size_t)lda;
         double f = F[(c - s) + (size_t)q * (size_t)ldf];
-        if (f != 0.0) for (i = c; i < m; ++i) ac[i] -= f * v[i];
+        if (f != 0.0) phgmg__axpy(m - c, -f, v + c, ac + c);
       }
       phgmg__larfg(m - c, ac + c, ac + c + 1, &tau[c]);
       akk = ac[c];
@@ -1618,14 +1732,14 @@ PHGMG_DEF void phgmg_qr_apply(char trans, int m, int n, int k, const double *A, 
 
 /* Solve R X = B, R n x n upper triangular (ldr), B n x nrhs (ldb), in place. */
 PHGMG__PRIV void phgmg__trsv_upper(int n, const double *R, int ldr, int nrhs, double *B, int ldb) {
-  int i, j, k;
+  int j, k;
   for (j = 0; j < nrhs; ++j) {
     double *b = B + (size_t)j * (size_t)ldb;
     for (k = n - 1; k >= 0; --k) {
       const double *r = R + (size_t)k * (size_t)ldr;
       double t = b[k] / r[k];
       b[k] = t;
-      if (t != 0.0) for (i = 0; i < k; ++i) b[i] -= t * r[i];
+      if (t != 0.0) phgmg__axpy(k, -t, r, b);
     }
   }
 }
@@ -1682,47 +1796,43 @@ PHGMG_DEF phgmg_result phgmg_lstsq(int m, int n, int nrhs, const double *A, int 
 }
 
 /* ---- thin SVD: QRCP + second QR + one-sided Jacobi ----------------------------- */
-/* One-sided (Hestenes) Jacobi on the columns of X (r x r, ldx): X V = W diag(sigma),
-   V accumulated (r x r, ldv). On return X holds W diag(sigma). */
+/* One-sided (Hestenes) Jacobi on the columns of X (r x r, ldx): X V = W diag(sigma).
+   V (r x r, ldv; may be NULL) accumulates the rotations. On return X holds
+   W diag(sigma). Pairs are visited block by block (a cyclic ordering) so that
+   2*PHGMG__JAC_BS columns stay in cache. d: r doubles. */
+#define PHGMG__JAC_BS 16
 PHGMG__PRIV phgmg_result phgmg__jacobi_1s(int r, double *X, int ldx, double *V, int ldv,
                                           double *d) {
   const double tol = PHGMG__EPS * sqrt((double)PHGMG__MAX(r, 1));
-  int sweep, p, q, i, rotated;
+  int sweep, p, q, ib, jb, rotated;
   for (sweep = 0; sweep < 80; ++sweep) {
     for (p = 0; p < r; ++p) {
-      double *xp = X + (size_t)p * (size_t)ldx, s = 0.0;
-      for (i = 0; i < r; ++i) s += xp[i] * xp[i];
-      d[p] = s;
+      const double *xp = X + (size_t)p * (size_t)ldx;
+      d[p] = phgmg__dot(r, xp, xp);
     }
     rotated = 0;
-    for (p = 0; p < r - 1; ++p) {
-      double *xp = X + (size_t)p * (size_t)ldx, *vp = V + (size_t)p * (size_t)ldv;
-      for (q = p + 1; q < r; ++q) {
-        double *xq = X + (size_t)q * (size_t)ldx, *vq = V + (size_t)q * (size_t)ldv;
-        double alpha = d[p], beta = d[q], gamma = 0.0, zeta, t, c, s;
-        if (alpha == 0.0 || beta == 0.0) continue;
-        for (i = 0; i < r; ++i) gamma += xp[i] * xq[i];
-        if (fabs(gamma) <= tol * sqrt(alpha) * sqrt(beta)) continue;
-        rotated = 1;
-        zeta = (beta - alpha) / (2.0 * gamma);
-        t = (zeta >= 0.0 ? 1.0 : -1.0) / (fabs(zeta) + sqrt(1.0 + zeta * zeta));
-        c = 1.0 / sqrt(1.0 + t * t);
-        s = c * t;
-        for (i = 0; i < r; ++i) {
-          double a = xp[i], b = xq[i];
-          xp[i] = c * a - s * b;
-          xq[i] = s * a + c * b;
+    for (ib = 0; ib < r; ib += PHGMG__JAC_BS)
+      for (jb = ib; jb < r; jb += PHGMG__JAC_BS)
+        for (p = ib; p < PHGMG__MIN(ib + PHGMG__JAC_BS, r); ++p) {
+          double *xp = X + (size_t)p * (size_t)ldx;
+          for (q = PHGMG__MAX(jb, p + 1); q < PHGMG__MIN(jb + PHGMG__JAC_BS, r); ++q) {
+            double *xq = X + (size_t)q * (size_t)ldx;
+            double alpha = d[p], beta = d[q], gamma, zeta, t, c, s;
+            if (alpha == 0.0 || beta == 0.0) continue;
+            gamma = phgmg__dot(r, xp, xq);
+            if (fabs(gamma) <= tol * sqrt(alpha) * sqrt(beta)) continue;
+            rotated = 1;
+            zeta = (beta - alpha) / (2.0 * gamma);
+            t = (zeta >= 0.0 ? 1.0 : -1.0) / (fabs(zeta) + sqrt(1.0 + zeta * zeta));
+            c = 1.0 / sqrt(1.0 + t * t);
+            s = c * t;
+            phgmg__rot(r, xp, xq, c, s);
+            if (V) phgmg__rot(r, V + (size_t)p * (size_t)ldv, V + (size_t)q * (size_t)ldv, c, s);
+            d[p] = alpha - t * gamma;
+            d[q] = beta + t * gamma;
+            if (!(d[p] >= 0.0)) d[p] = 0.0;
+          }
         }
-        for (i = 0; i < r; ++i) {
-          double a = vp[i], b = vq[i];
-          vp[i] = c * a - s * b;
-          vq[i] = s * a + c * b;
-        }
-        d[p] = alpha - t * gamma;
-        d[q] = beta + t * gamma;
-        if (!(d[p] >= 0.0)) d[p] = 0.0;
-      }
-    }
     if (!rotated) return PHGMG_OK;
   }
   return PHGMG_ERR_NOT_CONVERGED;
@@ -1792,7 +1902,7 @@ PHGMG_DEF phgmg_result phgmg_svd(int m, int n, const double *A, int lda, int kma
         v[i] = i == j ? 1.0 : 0.0;
       }
     }
-    rc = phgmg__jacobi_1s(r, X, r, Vj, r, d);
+    rc = phgmg__jacobi_1s(r, X, r, V ? Vj : NULL, r, d);
     if (rc == PHGMG_OK) {
       /* sigma_j = ||X(:,j)||, order descending */
       for (j = 0; j < r; ++j) {
@@ -1839,26 +1949,17 @@ PHGMG_DEF phgmg_result phgmg_svd(int m, int n, const double *A, int lda, int kma
   return rc;
 }
 
-/* ---- symmetric eigenproblem: cyclic Jacobi ------------------------------------ */
-PHGMG_DEF phgmg_result phgmg_sym_eig(int n, double *A, int lda, double *w, double *V, int ldv) {
-  int i, j, p, q, sweep, rotated;
-  double anorm;
-  if (n < 0 || lda < PHGMG__MAX(n, 1) || (V && ldv < PHGMG__MAX(n, 1))) return PHGMG_ERR_SIZE;
-  if (n == 0) return PHGMG_OK;
-  if (!A || !w) return PHGMG_ERR_INVALID_ARG;
-  if (!phgmg__mat_finite(n, n, A, lda)) return PHGMG_ERR_NANINF;
-  /* symmetrize: A := (A + A^T)/2 */
-  for (j = 0; j < n; ++j)
-    for (i = j + 1; i < n; ++i) {
-      double *aij = A + i + (size_t)j * (size_t)lda, *aji = A + j + (size_t)i * (size_t)lda;
-      double s = 0.5 * (*aij + *aji);
-      *aij = *aji = s;
-    }
+/* ---- symmetric eigenproblem ------------------------------------------------------ */
+/* Cyclic Jacobi (small n): A symmetric, destroyed; w unsorted; V (if not NULL)
+   accumulates the rotations. */
+PHGMG__PRIV phgmg_result phgmg__sym_jacobi(int n, double *A, int lda, double *w, double *V,
+                                           int ldv) {
+  int i, j, p, q, sweep, rotated = 1;
+  double anorm = phgmg_normf(n, n, A, lda);
   if (V)
     for (j = 0; j < n; ++j)
       for (i = 0; i < n; ++i) V[i + (size_t)j * (size_t)ldv] = i == j ? 1.0 : 0.0;
-  anorm = phgmg_normf(n, n, A, lda);
-  for (sweep = 0; sweep < 100; ++sweep) {
+  for (sweep = 0; sweep < 100 && rotated; ++sweep) {
     rotated = 0;
     for (p = 0; p < n - 1; ++p) {
       double *ap = A + (size_t)p * (size_t)lda;
@@ -1873,11 +1974,7 @@ PHGMG_DEF phgmg_result phgmg_sym_eig(int n, double *A, int lda, double *w, doubl
         t = (theta >= 0.0 ? 1.0 : -1.0) / (fabs(theta) + sqrt(1.0 + theta * theta));
         c = 1.0 / sqrt(1.0 + t * t);
         s = c * t;
-        for (i = 0; i < n; ++i) {
-          double a = ap[i], b = aq[i];
-          ap[i] = c * a - s * b;
-          aq[i] = s * a + c * b;
-        }
+        phgmg__rot(n, ap, aq, c, s);
         ap[p] = app - t * apq;
         aq[q] = aqq + t * apq;
         ap[q] = aq[p] = 0.0;
@@ -1886,20 +1983,174 @@ PHGMG_DEF phgmg_result phgmg_sym_eig(int n, double *A, int lda, double *w, doubl
           A[p + (size_t)i * (size_t)lda] = ap[i];
           A[q + (size_t)i * (size_t)lda] = aq[i];
         }
-        if (V) {
-          double *vp = V + (size_t)p * (size_t)ldv, *vq = V + (size_t)q * (size_t)ldv;
-          for (i = 0; i < n; ++i) {
-            double a = vp[i], b = vq[i];
-            vp[i] = c * a - s * b;
-            vq[i] = s * a + c * b;
-          }
-        }
+        if (V) phgmg__rot(n, V + (size_t)p * (size_t)ldv, V + (size_t)q * (size_t)ldv, c, s);
       }
     }
-    if (!rotated) break;
   }
   if (rotated) return PHGMG_ERR_NOT_CONVERGED;
   for (i = 0; i < n; ++i) w[i] = A[i + (size_t)i * (size_t)lda];
+  return PHGMG_OK;
+}
+
+/* Householder tridiagonalization and implicit QL with shifts (the EISPACK
+   tred2/tql2 scheme, as in JAMA), in W (n x n, ldw): only the lower triangle
+   of W is read. vec: W ends up holding the eigenvectors. d (n) receives the
+   eigenvalues (unsorted), e (n) is workspace. Without vec, e may be column n-1
+   of W itself (that column is then not needed). */
+PHGMG__PRIV phgmg_result phgmg__sym_tridiag_ql(int n, double *W, int ldw, int vec, double *d,
+                                               double *e) {
+#define PHGMG__W(r, c) W[(size_t)(r) + (size_t)(c) * (size_t)ldw]
+  int i, j, k, l, m;
+  double f, g, h, tst1, dlast;
+  for (j = 0; j < n; ++j) d[j] = PHGMG__W(n - 1, j);
+  dlast = d[n - 1];
+  for (i = n - 1; i > 0; --i) {
+    double scale = 0.0;
+    h = 0.0;
+    for (k = 0; k < i; ++k) scale += fabs(d[k]);
+    if (scale == 0.0) {
+      e[i] = d[i - 1];
+      for (j = 0; j < i; ++j) {
+        d[j] = PHGMG__W(i - 1, j);
+        PHGMG__W(i, j) = 0.0;
+        if (vec) PHGMG__W(j, i) = 0.0;
+      }
+    } else {
+      double hh;
+      for (k = 0; k < i; ++k) { d[k] /= scale; h += d[k] * d[k]; }
+      f = d[i - 1];
+      g = sqrt(h);
+      if (f > 0) g = -g;
+      e[i] = scale * g;
+      h -= f * g;
+      d[i - 1] = f - g;
+      for (j = 0; j < i; ++j) e[j] = 0.0;
+      for (j = 0; j < i; ++j) {
+        const double *wj = &PHGMG__W(0, j);
+        f = d[j];
+        if (vec) PHGMG__W(j, i) = f;
+        g = e[j] + wj[j] * f + phgmg__dot(i - 1 - j, wj + j + 1, d + j + 1);
+        phgmg__axpy(i - 1 - j, f, wj + j + 1, e + j + 1);
+        e[j] = g;
+      }
+      f = 0.0;
+      for (j = 0; j < i; ++j) { e[j] /= h; f += e[j] * d[j]; }
+      hh = f / (h + h);
+      for (j = 0; j < i; ++j) e[j] -= hh * d[j];
+      for (j = 0; j < i; ++j) {
+        double *wj = &PHGMG__W(0, j);
+        f = d[j];
+        g = e[j];
+        phgmg__axpy(i - j, -f, e + j, wj + j);
+        phgmg__axpy(i - j, -g, d + j, wj + j);
+        d[j] = PHGMG__W(i - 1, j);
+        PHGMG__W(i, j) = 0.0;
+      }
+    }
+    d[i] = h;
+  }
+  if (vec) {
+    /* accumulate the transformations */
+    for (i = 0; i < n - 1; ++i) {
+      PHGMG__W(n - 1, i) = PHGMG__W(i, i);
+      PHGMG__W(i, i) = 1.0;
+      h = d[i + 1];
+      if (h != 0.0) {
+        const double *wi1 = &PHGMG__W(0, i + 1);
+        for (k = 0; k <= i; ++k) d[k] = wi1[k] / h;
+        for (j = 0; j <= i; ++j) {
+          double *wj = &PHGMG__W(0, j);
+          g = phgmg__dot(i + 1, wi1, wj);
+          phgmg__axpy(i + 1, -g, d, wj);
+        }
+      }
+      for (k = 0; k <= i; ++k) PHGMG__W(k, i + 1) = 0.0;
+    }
+    for (j = 0; j < n; ++j) { d[j] = PHGMG__W(n - 1, j); PHGMG__W(n - 1, j) = 0.0; }
+    PHGMG__W(n - 1, n - 1) = 1.0;
+  } else {
+    for (j = 0; j < n - 1; ++j) d[j] = PHGMG__W(j, j);
+    d[n - 1] = dlast;
+  }
+  /* implicit QL on the tridiagonal (d, e) */
+  for (i = 1; i < n; ++i) e[i - 1] = e[i];
+  e[n - 1] = 0.0;
+  f = 0.0;
+  tst1 = 0.0;
+  for (l = 0; l < n; ++l) {
+    tst1 = PHGMG__MAX(tst1, fabs(d[l]) + fabs(e[l]));
+    m = l;
+    while (m < n - 1 && fabs(e[m]) > PHGMG__EPS * tst1) ++m;
+    if (m > l) {
+      int iter = 0;
+      do {
+        double p, r, dl1, c, c2, c3, el1, s, s2;
+        if (++iter > 60) return PHGMG_ERR_NOT_CONVERGED;
+        g = d[l];
+        p = (d[l + 1] - g) / (2.0 * e[l]);
+        r = hypot(p, 1.0);
+        if (p < 0) r = -r;
+        d[l] = e[l] / (p + r);
+        d[l + 1] = e[l] * (p + r);
+        dl1 = d[l + 1];
+        h = g - d[l];
+        for (i = l + 2; i < n; ++i) d[i] -= h;
+        f += h;
+        p = d[m];
+        c = c2 = c3 = 1.0;
+        el1 = e[l + 1];
+        s = s2 = 0.0;
+        for (i = m - 1; i >= l; --i) {
+          c3 = c2;
+          c2 = c;
+          s2 = s;
+          g = c * e[i];
+          h = c * p;
+          r = hypot(p, e[i]);
+          e[i + 1] = s * r;
+          s = e[i] / r;
+          c = p / r;
+          p = c * d[i] - s * g;
+          d[i + 1] = h + s * (c * g + s * d[i]);
+          if (vec) phgmg__rot(n, &PHGMG__W(0, i), &PHGMG__W(0, i + 1), c, s);
+        }
+        p = -s * s2 * c3 * el1 * e[l] / dl1;
+        e[l] = s * p;
+        d[l] = c * p;
+      } while (fabs(e[l]) > PHGMG__EPS * tst1);
+    }
+    d[l] += f;
+    e[l] = 0.0;
+  }
+  return PHGMG_OK;
+#undef PHGMG__W
+}
+
+#define PHGMG__SYM_JACOBI_MAX 24
+PHGMG_DEF phgmg_result phgmg_sym_eig(int n, double *A, int lda, double *w, double *V, int ldv) {
+  int i, j;
+  phgmg_result rc;
+  if (n < 0 || lda < PHGMG__MAX(n, 1) || (V && ldv < PHGMG__MAX(n, 1))) return PHGMG_ERR_SIZE;
+  if (n == 0) return PHGMG_OK;
+  if (!A || !w) return PHGMG_ERR_INVALID_ARG;
+  if (!phgmg__mat_finite(n, n, A, lda)) return PHGMG_ERR_NANINF;
+  /* symmetrize: A := (A + A^T)/2 */
+  for (j = 0; j < n; ++j)
+    for (i = j + 1; i < n; ++i) {
+      double *aij = A + i + (size_t)j * (size_t)lda, *aji = A + j + (size_t)i * (size_t)lda;
+      double s = 0.5 * (*aij + *aji);
+      *aij = *aji = s;
+    }
+  if (n <= PHGMG__SYM_JACOBI_MAX) {
+    rc = phgmg__sym_jacobi(n, A, lda, w, V, ldv);
+  } else if (V) {
+    for (j = 0; j < n; ++j)
+      memcpy(V + (size_t)j * (size_t)ldv, A + (size_t)j * (size_t)lda, (size_t)n * sizeof(double));
+    rc = phgmg__sym_tridiag_ql(n, V, ldv, 1, w, A);
+  } else {
+    rc = phgmg__sym_tridiag_ql(n, A, lda, 0, w, A + (size_t)(n - 1) * (size_t)lda);
+  }
+  if (rc != PHGMG_OK) return rc;
   /* selection sort ascending, swapping eigenvector columns */
   for (i = 0; i < n - 1; ++i) {
     int kmin = i;
@@ -1921,6 +2172,14 @@ PHGMG_DEF phgmg_result phgmg_sym_eig(int n, double *A, int lda, double *w, doubl
 
 /* >>ph (implementation) ================================================== */
 #ifndef PHGMG_NO_OFFLINE
+
+/* a*b + c, fused where the target has a fast fma (the hot loops of the
+   stepper); plain otherwise (ISO C modes do not contract a*b + c). */
+#if defined(FP_FAST_FMA)
+#define PHGMG__FMA(a, b, c) fma((a), (b), (c))
+#else
+#define PHGMG__FMA(a, b, c) ((a) * (b) + (c))
+#endif
 
 /* Index of element (i,j), |i-j| <= kb, in the (2kb+1) x N band storage. */
 #define PHGMG__PHB(kb, i, j) \
@@ -2944,10 +3203,17 @@ struct phgmg_gl3 {
   int *jr_ptr, *jr_col;
   double *jr_val;
   int nopiv1, nopiv2; /* banded factors without row interchanges */
+  int nbnz;           /* banded: the nonzero entries of B (row, column, value) */
+  int *b_row, *b_col;
+  double *b_val;
   /* step map (dense linear): x+ = Phi x + Gam U, g_i = GX_i x + GU_i U */
   double *Phi, *Gam, *GX, *GU;
   /* work */
-  double *Z, *W, *Y, *G, *F, *U, *Zprev, *xend, *xnew, *r1, *rc, *tmp, *TF;
+  double *Z, *W, *Y, *G, *F, *U, *Zprev, *xend, *xnew, *tmp, *TF;
+  /* Newton right-hand sides, zero-padded by kl before and ku after (banded) */
+  double *r1buf, *rcbuf, *r1, *rc;
+  /* packed row-wise factors for the pivot-free banded solve (see below) */
+  double *pk;
   int have_prev, need_factor;
   double tend;
   phgmg_gl3_stats st;
@@ -2966,12 +3232,14 @@ PHGMG_DEF void phgmg_gl3_destroy(phgmg_gl3 *s) {
   phgmg__free(&al, s->dd);
   phgmg__free(&al, s->dpoly); phgmg__free(&al, s->wc);
   phgmg__free(&al, s->jr_ptr); phgmg__free(&al, s->jr_col); phgmg__free(&al, s->jr_val);
+  phgmg__free(&al, s->b_row); phgmg__free(&al, s->b_col); phgmg__free(&al, s->b_val);
   phgmg__free(&al, s->Phi); phgmg__free(&al, s->Gam); phgmg__free(&al, s->GX);
   phgmg__free(&al, s->GU);
   phgmg__free(&al, s->Z); phgmg__free(&al, s->W); phgmg__free(&al, s->Y);
   phgmg__free(&al, s->G); phgmg__free(&al, s->F); phgmg__free(&al, s->U);
   phgmg__free(&al, s->Zprev); phgmg__free(&al, s->xend);
-  phgmg__free(&al, s->xnew); phgmg__free(&al, s->r1); phgmg__free(&al, s->rc);
+  phgmg__free(&al, s->xnew); phgmg__free(&al, s->r1buf); phgmg__free(&al, s->rcbuf);
+  phgmg__free(&al, s->pk);
   phgmg__free(&al, s->tmp); phgmg__free(&al, s->TF);
   phgmg__free(&al, s);
 }
@@ -3153,11 +3421,9 @@ PHGMG_DEF phgmg_result phgmg_gl3_create(phgmg_gl3 **out, const phgmg_ph_system *
   s->F = phgmg__dalloc(&s->al, N3);
   s->Zprev = phgmg__dalloc(&s->al, N3);
   s->xend = phgmg__dalloc(&s->al, (size_t)N);
-  s->r1 = phgmg__dalloc(&s->al, (size_t)N);
-  s->rc = phgmg__dalloc(&s->al, 2 * (size_t)N);
   s->tmp = phgmg__dalloc(&s->al, (size_t)N);
   s->TF = phgmg__dalloc(&s->al, N3);
-  if (!s->Z || !s->W || !s->Y || !s->F || !s->Zprev || !s->xend || !s->r1 || !s->rc ||
+  if (!s->Z || !s->W || !s->Y || !s->F || !s->Zprev || !s->xend ||
       !s->tmp || !s->TF) {
     rc = PHGMG_ERR_NOMEM;
     goto fail;
@@ -3221,6 +3487,24 @@ PHGMG_DEF phgmg_result phgmg_gl3_create(phgmg_gl3 **out, const phgmg_ph_system *
         }
       }
       s->jr_ptr[N] = (int)nnz;
+      nnz = 0;
+      for (c = 0; c < m; ++c)
+        for (r = 0; r < N; ++r)
+          if (sys->B[(size_t)r + (size_t)c * (size_t)N] != 0.0) ++nnz;
+      s->b_row = phgmg__ialloc(&s->al, nnz);
+      s->b_col = phgmg__ialloc(&s->al, nnz);
+      s->b_val = phgmg__dalloc(&s->al, nnz);
+      if (!s->b_row || !s->b_col || !s->b_val) { rc = PHGMG_ERR_NOMEM; goto fail; }
+      s->nbnz = 0;
+      for (c = 0; c < m; ++c)
+        for (r = 0; r < N; ++r) {
+          double v = sys->B[(size_t)r + (size_t)c * (size_t)N];
+          if (v == 0.0) continue;
+          s->b_row[s->nbnz] = r;
+          s->b_col[s->nbnz] = c;
+          s->b_val[s->nbnz] = v;
+          s->nbnz++;
+        }
     }
     if (s->mode == PHGMG__GL3_BANDED) {
       for (k = 0; k < s->djr.nd; ++k) {
@@ -3253,6 +3537,20 @@ PHGMG_DEF phgmg_result phgmg_gl3_create(phgmg_gl3 **out, const phgmg_ph_system *
       }
     }
   }
+  {
+    size_t len = (size_t)N + (size_t)s->kl + (size_t)s->ku;
+    s->r1buf = phgmg__dalloc(&s->al, len);
+    s->rcbuf = phgmg__dalloc(&s->al, 2 * len);
+    if (!s->r1buf || !s->rcbuf) { rc = PHGMG_ERR_NOMEM; goto fail; }
+    memset(s->r1buf, 0, sizeof(double) * len);
+    memset(s->rcbuf, 0, sizeof(double) * 2 * len);
+    s->r1 = s->r1buf + s->kl;
+    s->rc = s->rcbuf + 2 * (size_t)s->kl;
+    if (s->mode == PHGMG__GL3_BANDED) {
+      s->pk = phgmg__dalloc(&s->al, (size_t)3 * (size_t)(s->kl + s->ku + 1) * (size_t)N);
+      if (!s->pk) { rc = PHGMG_ERR_NOMEM; goto fail; }
+    }
+  }
   s->need_factor = 1;
   *out = s;
   return PHGMG_OK;
@@ -3261,11 +3559,12 @@ fail:
   return rc;
 }
 
-/* Banded: F_st = B u_st + (J - R) G_st, row by row from the CSR copy. */
+/* Banded: F_st = (J - R) G_st row by row from the CSR copy, + B u_st over the
+   nonzero entries of B. */
 PHGMG__PRIV void phgmg__gl3_rhs_csr(phgmg_gl3 *s) {
-  int N = s->N, m = s->m, r, k, c;
+  int N = s->N, m = s->m, r, k;
   const int *ptr = s->jr_ptr, *col = s->jr_col;
-  const double *val = s->jr_val, *B = s->sys.B, *U = s->U;
+  const double *val = s->jr_val, *U = s->U;
   const double *G0 = s->G, *G1 = s->G + N, *G2 = s->G + 2 * (size_t)N;
   double *F0 = s->F, *F1 = s->F + N, *F2 = s->F + 2 * (size_t)N;
   for (r = 0; r < N; ++r) {
@@ -3273,20 +3572,20 @@ PHGMG__PRIV void phgmg__gl3_rhs_csr(phgmg_gl3 *s) {
     for (k = ptr[r]; k < ptr[r + 1]; ++k) {
       int j = col[k];
       double v = val[k];
-      a0 += v * G0[j];
-      a1 += v * G1[j];
-      a2 += v * G2[j];
-    }
-    for (c = 0; c < m; ++c) {
-      double b = B[(size_t)r + (size_t)c * (size_t)N];
-      if (b == 0.0) continue;
-      a0 += b * U[c];
-      a1 += b * U[m + c];
-      a2 += b * U[2 * m + c];
+      a0 = PHGMG__FMA(v, G0[j], a0);
+      a1 = PHGMG__FMA(v, G1[j], a1);
+      a2 = PHGMG__FMA(v, G2[j], a2);
     }
     F0[r] = a0;
     F1[r] = a1;
     F2[r] = a2;
+  }
+  for (k = 0; k < s->nbnz; ++k) {
+    int r0 = s->b_row[k], c = s->b_col[k];
+    double b = s->b_val[k];
+    F0[r0] += b * U[c];
+    F1[r0] += b * U[m + c];
+    F2[r0] += b * U[2 * m + c];
   }
   s->st.rhs_evals += 3;
 }
@@ -3308,21 +3607,30 @@ PHGMG__PRIV void phgmg__gl3_eval(phgmg_gl3 *s, const double *x) {
     phgmg_gemm('N', 'N', N, 3, N, 1.0, sys->Q, N, s->Y, N, 0.0, s->G, N);
   } else if (qdiag) { /* Q diagonal: G = q .* (x + Z) in one pass */
     const double *qd = s->dq.v;
-    if (s->wc) { /* ... plus the polynomial, coordinate-wise */
+    if (s->wc) { /* ... plus the polynomial, coordinate-wise, three stages per pass */
       const double *wc = s->wc, *dp = s->dpoly;
+      const double *z0 = s->Z, *z1 = s->Z + N, *z2 = s->Z + 2 * (size_t)N;
+      double *g0 = s->G, *g1 = s->G + N, *g2 = s->G + 2 * (size_t)N;
       int deg = sys->poly_deg;
-      for (st = 0; st < 3; ++st) {
-        const double *z = s->Z + (size_t)st * (size_t)N;
-        double *g = s->G + (size_t)st * (size_t)N;
-        for (i = 0; i < N; ++i) {
-          double y = x[i] + z[i], gi = qd[i] * y;
-          if (wc[i] != 0.0) {
-            double acc = dp[deg - 1];
-            int j;
-            for (j = deg - 2; j >= 0; --j) acc = acc * y + dp[j];
-            gi += wc[i] * acc;
+      for (i = 0; i < N; ++i) {
+        double xi = x[i], q = qd[i], w = wc[i];
+        double y0 = xi + z0[i], y1 = xi + z1[i], y2 = xi + z2[i];
+        if (w != 0.0) {
+          double p0 = dp[deg - 1], p1 = p0, p2 = p0;
+          int j;
+          for (j = deg - 2; j >= 0; --j) {
+            double c = dp[j];
+            p0 = PHGMG__FMA(p0, y0, c);
+            p1 = PHGMG__FMA(p1, y1, c);
+            p2 = PHGMG__FMA(p2, y2, c);
           }
-          g[i] = gi;
+          g0[i] = PHGMG__FMA(w, p0, q * y0);
+          g1[i] = PHGMG__FMA(w, p1, q * y1);
+          g2[i] = PHGMG__FMA(w, p2, q * y2);
+        } else {
+          g0[i] = q * y0;
+          g1[i] = q * y1;
+          g2[i] = q * y2;
         }
       }
       phgmg__gl3_rhs_csr(s);
@@ -3382,6 +3690,80 @@ PHGMG__PRIV void phgmg__gl3_eval(phgmg_gl3 *s, const double *x) {
   }
   phgmg_gemm('N', 'N', N, 3, N, 1.0, s->JR, N, s->G, N, 1.0, s->F, N);
   s->st.rhs_evals += 3;
+}
+
+/* Both band factorizations without row interchanges: the factors are repacked
+   row by row, pk + j*P (P = 3(kl+ku+1)) = [L(j, j-kl .. j-1) real (kl),
+   complex (2kl) | U(j, j+1 .. j+ku) / U(j,j) real (ku), complex (2ku) | 1/U(j,j) real,
+   complex (2)], zeros outside the matrix; the right-hand sides carry kl zeros
+   before and ku after, so the substitutions below run without bounds tests,
+   the real and the complex one in the same sweep (their dependency chains
+   overlap). */
+PHGMG__PRIV void phgmg__gl3_pack_nopiv(phgmg_gl3 *s) {
+  int n = s->N, kl = s->kl, ku = s->ku, kv = kl + ku, j, p;
+  size_t P = 3 * (size_t)(kl + ku + 1), ld = (size_t)s->ldab;
+  for (j = 0; j < n; ++j) {
+    double *r = s->pk + (size_t)j * P;
+    double *lr = r, *lc = r + kl, *ur = r + 3 * kl, *uc = r + 3 * kl + ku, *dg = r + 3 * (kl + ku);
+    for (p = 0; p < kl; ++p) {
+      int i = j - kl + p; /* L(j, i) in column i at row kv + j - i */
+      size_t e = (size_t)(kv + j - i) + (size_t)i * ld;
+      if (i < 0) { lr[p] = 0.0; lc[2 * p] = lc[2 * p + 1] = 0.0; continue; }
+      lr[p] = s->AB1[e];
+      lc[2 * p] = s->AB2[2 * e];
+      lc[2 * p + 1] = s->AB2[2 * e + 1];
+    }
+    dg[0] = s->dinv1[j];
+    dg[1] = s->dinv2[2 * j];
+    dg[2] = s->dinv2[2 * j + 1];
+    for (p = 0; p < ku; ++p) { /* U(j, i) / U(j, j), in column i at row kv + j - i */
+      int i = j + 1 + p;
+      size_t e = (size_t)(kv + j - i) + (size_t)i * ld;
+      double vr, vi;
+      if (i >= n) { ur[p] = 0.0; uc[2 * p] = uc[2 * p + 1] = 0.0; continue; }
+      ur[p] = s->AB1[e] * dg[0];
+      vr = s->AB2[2 * e];
+      vi = s->AB2[2 * e + 1];
+      uc[2 * p] = vr * dg[1] - vi * dg[2];
+      uc[2 * p + 1] = vr * dg[2] + vi * dg[1];
+    }
+  }
+}
+
+PHGMG__PRIV void phgmg__gl3_solve_packed(const phgmg_gl3 *s, double *b, double *z) {
+  int n = s->N, kl = s->kl, ku = s->ku, j, p;
+  size_t P = 3 * (size_t)(kl + ku + 1);
+  const double *r = s->pk;
+  for (j = 0; j < n; ++j, r += P) {
+    const double *lr = r, *lc = r + kl, *bb = b + j - kl, *zz = z + 2 * (j - kl);
+    double t = b[j], tr = z[2 * j], ti = z[2 * j + 1];
+    for (p = 0; p < kl; ++p) { /* the newest unknown comes last: short chains */
+      double cr = lc[2 * p], ci = lc[2 * p + 1], xr = zz[2 * p], xi = zz[2 * p + 1];
+      t = PHGMG__FMA(-lr[p], bb[p], t);
+      tr = PHGMG__FMA(-cr, xr, tr) + ci * xi;
+      ti = PHGMG__FMA(-cr, xi, ti) - ci * xr;
+    }
+    b[j] = t;
+    z[2 * j] = tr;
+    z[2 * j + 1] = ti;
+  }
+  r = s->pk + (size_t)(n - 1) * P;
+  for (j = n - 1; j >= 0; --j, r -= P) {
+    const double *ur = r + 3 * kl, *uc = ur + ku, *dg = uc + 2 * ku;
+    const double *bb = b + j + 1, *zz = z + 2 * (j + 1);
+    double br = z[2 * j], bi = z[2 * j + 1];
+    double t = b[j] * dg[0], tr = br * dg[1] - bi * dg[2], ti = br * dg[2] + bi * dg[1];
+    for (p = ku - 1; p >= 0; --p) {
+      double cr = uc[2 * p], ci = uc[2 * p + 1], xr = zz[2 * p], xi = zz[2 * p + 1];
+      t = PHGMG__FMA(-ur[p], bb[p], t);
+      tr = PHGMG__FMA(-cr, xr, tr) + ci * xi;
+      ti = PHGMG__FMA(-cr, xi, ti) - ci * xr;
+    }
+    b[j] = t;
+    z[2 * j] = tr;
+    z[2 * j + 1] = ti;
+    if (j == 0) break; /* r would step before the array */
+  }
 }
 
 /* (Re)factor the shifted Newton matrices at x. */
@@ -3461,46 +3843,8 @@ PHGMG__PRIV phgmg_result phgmg__gl3_factor(phgmg_gl3 *s, const double *x) {
       if (s->ip1[j] != j) s->nopiv1 = 0;
       if (s->ip2[j] != j) s->nopiv2 = 0;
     }
+    if (rc == PHGMG_OK && s->nopiv1 && s->nopiv2) phgmg__gl3_pack_nopiv(s);
     return rc;
-  }
-}
-
-/* Both band factorizations without row interchanges: row-oriented forward
-   and back substitution for the real and the complex system in one sweep, so
-   that their dependency chains overlap. L(j,i) and U(i,j) sit at
-   ab[(kv + j - i) + i*ldab] and ab[(kv + i - j) + j*ldab]. */
-PHGMG__PRIV void phgmg__gb_solve_pair_nopiv(int n, int kl, int ku, int ldab, const double *ab,
-                                            const double *dinv, const double *zab,
-                                            const double *zdinv, double *b, double *z) {
-  int kv = kl + ku, j, i;
-  size_t ld = (size_t)ldab;
-  for (j = 0; j < n; ++j) {
-    double t = b[j], tr = z[2 * j], ti = z[2 * j + 1];
-    for (i = PHGMG__MAX(0, j - kl); i < j; ++i) {
-      size_t e = (size_t)(kv + j - i) + (size_t)i * ld;
-      double lr = zab[2 * e], li = zab[2 * e + 1], xr = z[2 * i], xi = z[2 * i + 1];
-      t -= ab[e] * b[i];
-      tr -= lr * xr - li * xi;
-      ti -= lr * xi + li * xr;
-    }
-    b[j] = t;
-    z[2 * j] = tr;
-    z[2 * j + 1] = ti;
-  }
-  for (j = n - 1; j >= 0; --j) {
-    double t = b[j], tr = z[2 * j], ti = z[2 * j + 1], dr, di;
-    for (i = PHGMG__MIN(n - 1, j + ku); i > j; --i) {
-      size_t e = (size_t)(kv + j - i) + (size_t)i * ld;
-      double ur = zab[2 * e], ui = zab[2 * e + 1], xr = z[2 * i], xi = z[2 * i + 1];
-      t -= ab[e] * b[i];
-      tr -= ur * xr - ui * xi;
-      ti -= ur * xi + ui * xr;
-    }
-    b[j] = t * dinv[j];
-    dr = zdinv[2 * j];
-    di = zdinv[2 * j + 1];
-    z[2 * j] = tr * dr - ti * di;
-    z[2 * j + 1] = tr * di + ti * dr;
   }
 }
 
@@ -3542,20 +3886,22 @@ PHGMG__PRIV phgmg_result phgmg__gl3_newton(phgmg_gl3 *s, const double *x, int fr
   for (;;) {
     const double *F0 = s->F, *F1 = s->F + N, *F2 = s->F + 2 * (size_t)N;
     double res = 0.0, chk = 0.0;
+    double *r1 = s->r1, *rc = s->rc;
+    const double a00 = h * A[0], a01 = h * A[1], a02 = h * A[2], a10 = h * A[3], a11 = h * A[4],
+                 a12 = h * A[5], a20 = h * A[6], a21 = h * A[7], a22 = h * A[8];
+    const double t00 = Ti[0], t01 = Ti[1], t02 = Ti[2], t10 = Ti[3], t11 = Ti[4], t12 = Ti[5],
+                 t20 = Ti[6], t21 = Ti[7], t22 = Ti[8];
+    const double gih = s->gam * ih, aih = s->alp * ih, bih = s->bet * ih;
     phgmg__gl3_eval(s, x);
-    for (i = 0; i < N; ++i) {
-      double f0 = F0[i], f1 = F1[i], f2 = F2[i], e0, e1, e2, w0 = W0[i], w1 = W1[i], w2 = W2[i];
-      e0 = fabs(Z0[i] - h * (A[0] * f0 + A[1] * f1 + A[2] * f2));
-      e1 = fabs(Z1[i] - h * (A[3] * f0 + A[4] * f1 + A[5] * f2));
-      e2 = fabs(Z2[i] - h * (A[6] * f0 + A[7] * f1 + A[8] * f2));
-      chk += e0 + e1 + e2; /* NaN/Inf detection */
-      if (e0 > res) res = e0;
-      if (e1 > res) res = e1;
-      if (e2 > res) res = e2;
-      /* Newton right-hand sides in the transformed variables */
-      s->r1[i] = Ti[0] * f0 + Ti[1] * f1 + Ti[2] * f2 - s->gam * ih * w0;
-      s->rc[2 * i] = Ti[3] * f0 + Ti[4] * f1 + Ti[5] * f2 - (s->alp * w1 + s->bet * w2) * ih;
-      s->rc[2 * i + 1] = Ti[6] * f0 + Ti[7] * f1 + Ti[8] * f2 - (s->alp * w2 - s->bet * w1) * ih;
+    for (i = 0; i < N; ++i) { /* stage residual Z - h (A x I) F */
+      double f0 = F0[i], f1 = F1[i], f2 = F2[i], e0, e1, e2;
+      e0 = fabs(Z0[i] - PHGMG__FMA(a00, f0, PHGMG__FMA(a01, f1, a02 * f2)));
+      e1 = fabs(Z1[i] - PHGMG__FMA(a10, f0, PHGMG__FMA(a11, f1, a12 * f2)));
+      e2 = fabs(Z2[i] - PHGMG__FMA(a20, f0, PHGMG__FMA(a21, f1, a22 * f2)));
+      chk += (e0 + e1) + e2; /* NaN/Inf detection */
+      res = e0 > res ? e0 : res;
+      res = e1 > res ? e1 : res;
+      res = e2 > res ? e2 : res;
     }
     if (chk - chk != 0.0) return PHGMG_ERR_NANINF;
     if (it > 0) {
@@ -3568,19 +3914,31 @@ PHGMG__PRIV phgmg_result phgmg__gl3_newton(phgmg_gl3 *s, const double *x, int fr
     if (it >= s->max_iter) return PHGMG_ERR_NOT_CONVERGED;
     if (it >= 1 && theta >= 1.0 && !fresh) return PHGMG_ERR_NOT_CONVERGED;
     if (ndiv >= 2) return PHGMG_ERR_NOT_CONVERGED;
+    for (i = 0; i < N; ++i) { /* Newton right-hand sides in the transformed variables */
+      double f0 = F0[i], f1 = F1[i], f2 = F2[i], w0 = W0[i], w1 = W1[i], w2 = W2[i];
+      r1[i] = PHGMG__FMA(t00, f0, PHGMG__FMA(t01, f1, PHGMG__FMA(t02, f2, -gih * w0)));
+      rc[2 * i] =
+          PHGMG__FMA(t10, f0, PHGMG__FMA(t11, f1, PHGMG__FMA(t12, f2, -(aih * w1 + bih * w2))));
+      rc[2 * i + 1] =
+          PHGMG__FMA(t20, f0, PHGMG__FMA(t21, f1, PHGMG__FMA(t22, f2, bih * w1 - aih * w2)));
+    }
     if (s->mode == PHGMG__GL3_BANDED && s->nopiv1 && s->nopiv2) {
-      phgmg__gb_solve_pair_nopiv(N, s->kl, s->ku, s->ldab, s->AB1, s->dinv1, s->AB2, s->dinv2,
-                                 s->r1, s->rc);
+      phgmg__gl3_solve_packed(s, s->r1, s->rc);
     } else {
       phgmg__gl3_solve_real(s, s->r1);
       phgmg__gl3_solve_cplx(s, s->rc);
     }
-    for (i = 0; i < N; ++i) {
-      double w0 = W0[i] + s->r1[i], w1 = W1[i] + s->rc[2 * i], w2 = W2[i] + s->rc[2 * i + 1];
-      W0[i] = w0; W1[i] = w1; W2[i] = w2;
-      Z0[i] = T[0] * w0 + T[1] * w1 + T[2] * w2;
-      Z1[i] = T[3] * w0 + T[4] * w1 + T[5] * w2;
-      Z2[i] = T[6] * w0 + T[7] * w1 + T[8] * w2;
+    {
+      const double T00 = T[0], T01 = T[1], T02 = T[2], T10 = T[3], T11 = T[4], T12 = T[5],
+                   T20 = T[6], T21 = T[7], T22 = T[8];
+      const double *d1 = s->r1, *dc = s->rc;
+      for (i = 0; i < N; ++i) {
+        double w0 = W0[i] + d1[i], w1 = W1[i] + dc[2 * i], w2 = W2[i] + dc[2 * i + 1];
+        W0[i] = w0; W1[i] = w1; W2[i] = w2;
+        Z0[i] = PHGMG__FMA(T00, w0, PHGMG__FMA(T01, w1, T02 * w2));
+        Z1[i] = PHGMG__FMA(T10, w0, PHGMG__FMA(T11, w1, T12 * w2));
+        Z2[i] = PHGMG__FMA(T20, w0, PHGMG__FMA(T21, w1, T22 * w2));
+      }
     }
     res_prev = res;
     ++it;
@@ -4607,7 +4965,7 @@ PHGMG_DEF phgmg_result phgmg_deim(int nterms, int ns, const double *F, int ldf, 
   phgmg_result rc;
   if (!F || !pts || !w || !nd_out) return PHGMG_ERR_INVALID_ARG;
   if (nterms < 1 || ns < 1 || ldf < nterms) return PHGMG_ERR_SIZE;
-  if (!phgmg__all_finite(F, (size_t)ldf * (size_t)(ns - 1) + (size_t)nterms)) return PHGMG_ERR_NANINF;
+  if (!phgmg__mat_finite(nterms, ns, F, ldf)) return PHGMG_ERR_NANINF; /* padding rows are not data */
   if (tol <= 0.0) tol = 1e-8;
   kk = PHGMG__MIN(nterms, ns);
   if (kmax > 0) kk = PHGMG__MIN(kk, kmax + 1);
@@ -4849,7 +5207,7 @@ PHGMG_DEF phgmg_result phgmg_reduce(phgmg_reduced **out, const phgmg_ph_system *
   }
   if (sys->nl == PHGMG_NL_GENERAL) return PHGMG_ERR_UNSUPPORTED;
   if (sys->nl == PHGMG_NL_SEPARABLE && (sys->poly_deg < 1 || !sys->poly)) return PHGMG_ERR_UNSUPPORTED;
-  if (!phgmg__all_finite(X, (size_t)ldx * (size_t)(ns - 1) + (size_t)N)) return PHGMG_ERR_NANINF;
+  if (!phgmg__mat_finite(N, ns, X, ldx)) return PHGMG_ERR_NANINF; /* padding rows are not data */
   rc = phgmg_ph_validate(sys, 0.0, &inf.rcond_jr, alloc);
   if (rc != PHGMG_OK) return rc;
   lambda = opts->lambda == 0.0 ? 1e-3 : (opts->lambda < 0.0 ? 0.0 : opts->lambda);
@@ -5475,7 +5833,7 @@ PHGMG__ONLINE phgmg_result phgmg__rom_header(const unsigned char *b, size_t len,
   for (i = 0; i < PHGMG__NFIELDS; ++i)
     if (mask & (1u << i)) {
       size_t k = phgmg__field_len(rom, i);
-      if (k > ((size_t)1 << 40)) return PHGMG_ERR_FORMAT;
+      if (k > ((size_t)1 << 28)) return PHGMG_ERR_FORMAT;
       n += k;
     }
   if (n > (len / ss)) return PHGMG_ERR_FORMAT;
@@ -5607,9 +5965,9 @@ PHGMG_DEF phgmg_result phgmg_rom_export_c(const phgmg_rom *rom, const char *name
     ok &= fprintf(f, "static const phgmg_real %s_%s[%lu] = {", name, phgmg__fields[i].name, (unsigned long)n) > 0;
     for (k = 0; k < n; ++k)
 #if PHGMG_REAL_IS_FLOAT
-      ok &= fprintf(f, "%s%.9gf", k % 6 ? ", " : "\n  ", (double)a[k]) > 0;
+      ok &= fprintf(f, "%s%#.9gf", k == 0 ? "\n  " : (k % 6 ? ", " : ",\n  "), (double)a[k]) > 0;
 #else
-      ok &= fprintf(f, "%s%.17g", k % 4 ? ", " : "\n  ", a[k]) > 0;
+      ok &= fprintf(f, "%s%.17g", k == 0 ? "\n  " : (k % 4 ? ", " : ",\n  "), a[k]) > 0;
 #endif
     ok &= fprintf(f, "};\n") > 0;
   }
@@ -5620,7 +5978,7 @@ PHGMG_DEF phgmg_result phgmg_rom_export_c(const phgmg_rom *rom, const char *name
     else ok &= fprintf(f, " NULL,") > 0;
   }
 #if PHGMG_REAL_IS_FLOAT
-  ok &= fprintf(f, "\n  %.9gf,\n ", (double)rom->dt) > 0;
+  ok &= fprintf(f, "\n  %#.9gf,\n ", (double)rom->dt) > 0;
 #else
   ok &= fprintf(f, "\n  %.17g,\n ", rom->dt) > 0;
 #endif

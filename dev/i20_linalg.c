@@ -170,13 +170,13 @@ PHGMG_DEF void phgmg_gemv(char trans, int m, int n, double alpha, const double *
 #endif
 }
 
-#ifndef PHGMG_USE_CBLAS
-/* Portable GEMM: a block of op(A) (MC x KC) is packed into 8-row slivers (on
-   the stack, MC*KC doubles), then 8 x 6 tiles of C are computed by a
+/* Portable GEMM core: a block of op(A) (MC x KC) is packed into 8-row slivers
+   (on the stack, MC*KC doubles), then 8 x 6 tiles of C are computed by a
    register-blocked micro-kernel that streams the matching 6 columns of op(B)
-   directly from B. With GCC/Clang on an AVX target the micro-kernel uses
-   vector extensions (define PHGMG_NO_VECTOR_EXT for the plain C version,
-   which is the one used everywhere else). */
+   directly from B (any strides). With GCC/Clang on an AVX target the
+   micro-kernel uses vector extensions (define PHGMG_NO_VECTOR_EXT for the plain
+   C version, which is the one used everywhere else). It also serves the
+   complex products (interleaved storage seen as a real matrix). */
 #ifndef PHGMG_GEMM_MC
 #define PHGMG_GEMM_MC 64 /* multiple of 8 */
 #endif
@@ -237,7 +237,72 @@ PHGMG__PRIV void phgmg__gemm_micro(int kc, const double *Ap, const double *B, si
     for (i = 0; i < mr; ++i) c[i] += alpha * t[i];
   }
 }
-#endif
+
+/* C (m x n) += alpha * opA(A) * opB(B), opB(B)(p, j) = B[p*bsp + j*bsj];
+   amode 0: opA(A)(i, p) = A[i + p*lda]; 1: A[p + i*lda] (transposed);
+   2 (m even, A the real view of an interleaved complex matrix): rows 2r, 2r+1
+   of opA are (-Im, Re) of complex row r, i.e. the real view of i*A. */
+PHGMG__PRIV void phgmg__gemm_acc(int m, int n, int k, double alpha, int amode, const double *A,
+                                 int lda, const double *B, size_t bsp, size_t bsj, double *C,
+                                 int ldc) {
+  double Ap[PHGMG_GEMM_MC * PHGMG_GEMM_KC];
+  int pc, ic, ir, jr, p, i;
+  if (m <= 0 || n <= 0 || k <= 0 || alpha == 0.0) return;
+  for (pc = 0; pc < k; pc += PHGMG_GEMM_KC) {
+    int kc = PHGMG__MIN(PHGMG_GEMM_KC, k - pc);
+    for (ic = 0; ic < m; ic += PHGMG_GEMM_MC) {
+      int mc = PHGMG__MIN(PHGMG_GEMM_MC, m - ic);
+      /* pack opA(ic:ic+mc, pc:pc+kc) into 8-row slivers, zero padded */
+      for (ir = 0; ir < mc; ir += PHGMG__MR) {
+        int mr = PHGMG__MIN(PHGMG__MR, mc - ir);
+        double *dst = Ap + (size_t)ir * (size_t)kc;
+        if (amode == 0) {
+          for (p = 0; p < kc; ++p) {
+            const double *src = A + (ic + ir) + (size_t)(pc + p) * (size_t)lda;
+            double *d = dst + (size_t)p * PHGMG__MR;
+            for (i = 0; i < mr; ++i) d[i] = src[i];
+            for (; i < PHGMG__MR; ++i) d[i] = 0.0;
+          }
+        } else if (amode == 1) {
+          for (i = 0; i < PHGMG__MR; ++i) {
+            if (i < mr) {
+              const double *src = A + pc + (size_t)(ic + ir + i) * (size_t)lda;
+              for (p = 0; p < kc; ++p) dst[(size_t)p * PHGMG__MR + i] = src[p];
+            } else {
+              for (p = 0; p < kc; ++p) dst[(size_t)p * PHGMG__MR + i] = 0.0;
+            }
+          }
+        } else {
+          for (p = 0; p < kc; ++p) {
+            const double *src = A + (ic + ir) + (size_t)(pc + p) * (size_t)lda;
+            double *d = dst + (size_t)p * PHGMG__MR;
+            for (i = 0; i + 1 < mr; i += 2) { d[i] = -src[i + 1]; d[i + 1] = src[i]; }
+            for (; i < PHGMG__MR; ++i) d[i] = 0.0;
+          }
+        }
+      }
+      for (jr = 0; jr < n; jr += PHGMG__NR) {
+        int nr = PHGMG__MIN(PHGMG__NR, n - jr);
+        const double *bp = B + (size_t)pc * bsp + (size_t)jr * bsj;
+        for (ir = 0; ir < mc; ir += PHGMG__MR)
+          phgmg__gemm_micro(kc, Ap + (size_t)ir * (size_t)kc, bp, bsp, bsj,
+                            PHGMG__MIN(PHGMG__MR, mc - ir), nr, alpha,
+                            C + (ic + ir) + (size_t)jr * (size_t)ldc, ldc);
+      }
+    }
+  }
+}
+
+/* Complex C (m x n) += alpha * A (m x k) * B (k x n), alpha real, interleaved
+   storage with leading dimensions in complex elements: Re(C) and Im(C) come
+   from two real products on the interleaved views, [Re A; Im A] Re B +
+   [-Im A; Re A] Im B, so no flop is wasted. */
+PHGMG__PRIV void phgmg__zgemm_acc(int m, int n, int k, double alpha, const double *A, int lda,
+                                  const double *B, int ldb, double *C, int ldc) {
+  size_t bsj = 2 * (size_t)ldb;
+  phgmg__gemm_acc(2 * m, n, k, alpha, 0, A, 2 * lda, B, 2, bsj, C, 2 * ldc);
+  phgmg__gemm_acc(2 * m, n, k, alpha, 2, A, 2 * lda, B + 1, 2, bsj, C, 2 * ldc);
+}
 
 PHGMG_DEF void phgmg_gemm(char transa, char transb, int m, int n, int k, double alpha,
                           const double *A, int lda, const double *B, int ldb,
@@ -260,50 +325,7 @@ PHGMG_DEF void phgmg_gemm(char transa, char transb, int m, int n, int k, double 
     if (beta == 0.0) for (i = 0; i < m; ++i) c[i] = 0.0;
     else if (beta != 1.0) for (i = 0; i < m; ++i) c[i] *= beta;
   }
-  if (alpha == 0.0 || k <= 0) return;
-#ifndef PHGMG_USE_CBLAS
-  {
-    double Ap[PHGMG_GEMM_MC * PHGMG_GEMM_KC];
-    size_t bsp = tb ? (size_t)ldb : 1, bsj = tb ? 1 : (size_t)ldb;
-    int pc, ic, ir, jr, p;
-    for (pc = 0; pc < k; pc += PHGMG_GEMM_KC) {
-      int kc = PHGMG__MIN(PHGMG_GEMM_KC, k - pc);
-      for (ic = 0; ic < m; ic += PHGMG_GEMM_MC) {
-        int mc = PHGMG__MIN(PHGMG_GEMM_MC, m - ic);
-        /* pack op(A)(ic:ic+mc, pc:pc+kc) into 8-row slivers, zero padded */
-        for (ir = 0; ir < mc; ir += PHGMG__MR) {
-          int mr = PHGMG__MIN(PHGMG__MR, mc - ir);
-          double *dst = Ap + (size_t)ir * (size_t)kc;
-          if (!ta) {
-            for (p = 0; p < kc; ++p) {
-              const double *src = A + (ic + ir) + (size_t)(pc + p) * (size_t)lda;
-              double *d = dst + (size_t)p * PHGMG__MR;
-              for (i = 0; i < mr; ++i) d[i] = src[i];
-              for (; i < PHGMG__MR; ++i) d[i] = 0.0;
-            }
-          } else {
-            for (i = 0; i < PHGMG__MR; ++i) {
-              if (i < mr) {
-                const double *src = A + pc + (size_t)(ic + ir + i) * (size_t)lda;
-                for (p = 0; p < kc; ++p) dst[(size_t)p * PHGMG__MR + i] = src[p];
-              } else {
-                for (p = 0; p < kc; ++p) dst[(size_t)p * PHGMG__MR + i] = 0.0;
-              }
-            }
-          }
-        }
-        for (jr = 0; jr < n; jr += PHGMG__NR) {
-          int nr = PHGMG__MIN(PHGMG__NR, n - jr);
-          const double *bp = B + (size_t)pc * bsp + (size_t)jr * bsj;
-          for (ir = 0; ir < mc; ir += PHGMG__MR)
-            phgmg__gemm_micro(kc, Ap + (size_t)ir * (size_t)kc, bp, bsp, bsj,
-                              PHGMG__MIN(PHGMG__MR, mc - ir), nr, alpha,
-                              C + (ic + ir) + (size_t)jr * (size_t)ldc, ldc);
-        }
-      }
-    }
-  }
-#endif
+  phgmg__gemm_acc(m, n, k, alpha, ta, A, lda, B, tb ? (size_t)ldb : 1, tb ? 1 : (size_t)ldb, C, ldc);
 }
 
 /* ---- real LU -------------------------------------------------------------- */
@@ -319,11 +341,15 @@ PHGMG__PRIV void phgmg__laswp(int ncols, double *A, int lda, int k1, int k2, con
   }
 }
 
-/* B := L^{-1} B with L n x n unit lower triangular; B n x nrhs. Recursive, the
-   off-diagonal blocks go through gemm. */
+/* Triangular solves with n x n factors on B (n x nrhs), in place. Recursive
+   halving, the off-diagonal blocks go through gemm; small problems (n <= 32
+   or fewer than 4 right-hand sides) by column substitution.
+   llu: L^{-1} B, L unit lower.     lun: U^{-1} B, U upper.
+   utn: U^{-T} B.                   ltu: L^{-T} B, L unit lower. */
+#define PHGMG__TRSM_LEAF 32
 PHGMG__PRIV void phgmg__trsm_llu(int n, int nrhs, const double *L, int ldl, double *B, int ldb) {
   int j, k, n1;
-  if (n <= 32) {
+  if (n <= PHGMG__TRSM_LEAF || nrhs < 4) {
     for (j = 0; j < nrhs; ++j) {
       double *b = B + (size_t)j * (size_t)ldb;
       for (k = 0; k < n; ++k) {
@@ -338,6 +364,61 @@ PHGMG__PRIV void phgmg__trsm_llu(int n, int nrhs, const double *L, int ldl, doub
   phgmg__trsm_llu(n1, nrhs, L, ldl, B, ldb);
   phgmg_gemm('N', 'N', n - n1, nrhs, n1, -1.0, L + n1, ldl, B, ldb, 1.0, B + n1, ldb);
   phgmg__trsm_llu(n - n1, nrhs, L + n1 + (size_t)n1 * (size_t)ldl, ldl, B + n1, ldb);
+}
+PHGMG__PRIV void phgmg__trsm_lun(int n, int nrhs, const double *U, int ldu, double *B, int ldb) {
+  int j, k, n1;
+  if (n <= PHGMG__TRSM_LEAF || nrhs < 4) {
+    for (j = 0; j < nrhs; ++j) {
+      double *b = B + (size_t)j * (size_t)ldb;
+      for (k = n - 1; k >= 0; --k) {
+        const double *u = U + (size_t)k * (size_t)ldu;
+        double t = b[k] / u[k];
+        b[k] = t;
+        if (t != 0.0) phgmg__axpy(k, -t, u, b);
+      }
+    }
+    return;
+  }
+  n1 = n / 2;
+  phgmg__trsm_lun(n - n1, nrhs, U + n1 + (size_t)n1 * (size_t)ldu, ldu, B + n1, ldb);
+  phgmg_gemm('N', 'N', n1, nrhs, n - n1, -1.0, U + (size_t)n1 * (size_t)ldu, ldu, B + n1, ldb,
+             1.0, B, ldb);
+  phgmg__trsm_lun(n1, nrhs, U, ldu, B, ldb);
+}
+PHGMG__PRIV void phgmg__trsm_utn(int n, int nrhs, const double *U, int ldu, double *B, int ldb) {
+  int j, k, n1;
+  if (n <= PHGMG__TRSM_LEAF || nrhs < 4) {
+    for (j = 0; j < nrhs; ++j) {
+      double *b = B + (size_t)j * (size_t)ldb;
+      for (k = 0; k < n; ++k) {
+        const double *u = U + (size_t)k * (size_t)ldu;
+        b[k] = (b[k] - phgmg__dot(k, u, b)) / u[k];
+      }
+    }
+    return;
+  }
+  n1 = n / 2;
+  phgmg__trsm_utn(n1, nrhs, U, ldu, B, ldb);
+  phgmg_gemm('T', 'N', n - n1, nrhs, n1, -1.0, U + (size_t)n1 * (size_t)ldu, ldu, B, ldb, 1.0,
+             B + n1, ldb);
+  phgmg__trsm_utn(n - n1, nrhs, U + n1 + (size_t)n1 * (size_t)ldu, ldu, B + n1, ldb);
+}
+PHGMG__PRIV void phgmg__trsm_ltu(int n, int nrhs, const double *L, int ldl, double *B, int ldb) {
+  int j, k, n1;
+  if (n <= PHGMG__TRSM_LEAF || nrhs < 4) {
+    for (j = 0; j < nrhs; ++j) {
+      double *b = B + (size_t)j * (size_t)ldb;
+      for (k = n - 1; k >= 0; --k) {
+        const double *l = L + (size_t)k * (size_t)ldl;
+        b[k] -= phgmg__dot(n - k - 1, l + k + 1, b + k + 1);
+      }
+    }
+    return;
+  }
+  n1 = n / 2;
+  phgmg__trsm_ltu(n - n1, nrhs, L + n1 + (size_t)n1 * (size_t)ldl, ldl, B + n1, ldb);
+  phgmg_gemm('T', 'N', n1, nrhs, n - n1, -1.0, L + n1, ldl, B + n1, ldb, 1.0, B, ldb);
+  phgmg__trsm_ltu(n1, nrhs, L, ldl, B, ldb);
 }
 
 /* Recursive LU with partial pivoting of an m x n panel (m >= n), ipiv relative
@@ -398,39 +479,16 @@ PHGMG_DEF void phgmg_lu_solve(char trans, int n, const double *LU, int lda, cons
   int j, k;
   int tr = (trans == 'T' || trans == 't');
   PHGMG_ASSERT(tr || trans == 'N' || trans == 'n');
-  for (j = 0; j < nrhs; ++j) {
-    double *b = B + (size_t)j * (size_t)ldb;
-    if (!tr) {
-      for (k = 0; k < n; ++k)
-        if (ipiv[k] != k) { double t = b[k]; b[k] = b[ipiv[k]]; b[ipiv[k]] = t; }
-      /* L y = b (unit lower), column oriented */
-      for (k = 0; k < n; ++k) {
-        const double *l = LU + (size_t)k * (size_t)lda;
-        double t = b[k];
-        if (t != 0.0) phgmg__axpy(n - k - 1, -t, l + k + 1, b + k + 1);
-      }
-      /* U x = y */
-      for (k = n - 1; k >= 0; --k) {
-        const double *u = LU + (size_t)k * (size_t)lda;
-        double t = b[k] / u[k];
-        b[k] = t;
-        if (t != 0.0) phgmg__axpy(k, -t, u, b);
-      }
-    } else {
-      /* U^T y = b: dot products with columns of U */
-      for (k = 0; k < n; ++k) {
-        const double *u = LU + (size_t)k * (size_t)lda;
-        double s = b[k];
-        s -= phgmg__dot(k, u, b);
-        b[k] = s / u[k];
-      }
-      /* L^T z = y */
-      for (k = n - 1; k >= 0; --k) {
-        const double *l = LU + (size_t)k * (size_t)lda;
-        double s = b[k];
-        s -= phgmg__dot(n - k - 1, l + k + 1, b + k + 1);
-        b[k] = s;
-      }
+  if (n <= 0 || nrhs <= 0) return;
+  if (!tr) {
+    phgmg__laswp(nrhs, B, ldb, 0, n, ipiv);
+    phgmg__trsm_llu(n, nrhs, LU, lda, B, ldb);
+    phgmg__trsm_lun(n, nrhs, LU, lda, B, ldb);
+  } else {
+    phgmg__trsm_utn(n, nrhs, LU, lda, B, ldb);
+    phgmg__trsm_ltu(n, nrhs, LU, lda, B, ldb);
+    for (j = 0; j < nrhs; ++j) {
+      double *b = B + (size_t)j * (size_t)ldb;
       for (k = n - 1; k >= 0; --k)
         if (ipiv[k] != k) { double t = b[k]; b[k] = b[ipiv[k]]; b[ipiv[k]] = t; }
     }
@@ -438,103 +496,142 @@ PHGMG_DEF void phgmg_lu_solve(char trans, int n, const double *LU, int lda, cons
 }
 
 /* ---- complex LU (interleaved re,im) ----------------------------------------- */
+/* (cr, ci) = (ar + i ai) / (br + i bi), Smith's algorithm */
+PHGMG__PRIV void phgmg__zdiv(double ar, double ai, double br, double bi, double *cr, double *ci) {
+  if (fabs(br) >= fabs(bi)) {
+    double q = bi / br, d = br + bi * q;
+    *cr = (ar + ai * q) / d;
+    *ci = (ai - ar * q) / d;
+  } else {
+    double q = br / bi, d = br * q + bi;
+    *cr = (ar * q + ai) / d;
+    *ci = (ai * q - ar) / d;
+  }
+}
+
+/* y -= (tr + i ti) x over n complex entries */
+PHGMG__PRIV void phgmg__zaxpy_neg(int n, double tr, double ti, const double *x, double *y) {
+  int i;
+  for (i = 0; i < n; ++i) {
+    double xr = x[2 * i], xi = x[2 * i + 1];
+    y[2 * i] -= tr * xr - ti * xi;
+    y[2 * i + 1] -= tr * xi + ti * xr;
+  }
+}
+
+PHGMG__PRIV void phgmg__zlaswp(int ncols, double *A, int lda, int k1, int k2, const int *ipiv) {
+  int j, k;
+  for (j = 0; j < ncols; ++j) {
+    double *c = A + 2 * (size_t)j * (size_t)lda, t;
+    for (k = k1; k < k2; ++k) {
+      int p = ipiv[k];
+      if (p != k) {
+        t = c[2 * k]; c[2 * k] = c[2 * p]; c[2 * p] = t;
+        t = c[2 * k + 1]; c[2 * k + 1] = c[2 * p + 1]; c[2 * p + 1] = t;
+      }
+    }
+  }
+}
+
+/* complex L^{-1} B (unit lower) and U^{-1} B, as the real ones */
+PHGMG__PRIV void phgmg__ztrsm_llu(int n, int nrhs, const double *L, int ldl, double *B, int ldb) {
+  int j, k, n1;
+  if (n <= PHGMG__TRSM_LEAF || nrhs < 2) {
+    for (j = 0; j < nrhs; ++j) {
+      double *b = B + 2 * (size_t)j * (size_t)ldb;
+      for (k = 0; k < n; ++k) {
+        const double *l = L + 2 * (size_t)k * (size_t)ldl;
+        double tr = b[2 * k], ti = b[2 * k + 1];
+        if (tr != 0.0 || ti != 0.0) phgmg__zaxpy_neg(n - k - 1, tr, ti, l + 2 * (k + 1), b + 2 * (k + 1));
+      }
+    }
+    return;
+  }
+  n1 = n / 2;
+  phgmg__ztrsm_llu(n1, nrhs, L, ldl, B, ldb);
+  phgmg__zgemm_acc(n - n1, nrhs, n1, -1.0, L + 2 * n1, ldl, B, ldb, B + 2 * n1, ldb);
+  phgmg__ztrsm_llu(n - n1, nrhs, L + 2 * (n1 + (size_t)n1 * (size_t)ldl), ldl, B + 2 * n1, ldb);
+}
+PHGMG__PRIV void phgmg__ztrsm_lun(int n, int nrhs, const double *U, int ldu, double *B, int ldb) {
+  int j, k, n1;
+  if (n <= PHGMG__TRSM_LEAF || nrhs < 2) {
+    for (j = 0; j < nrhs; ++j) {
+      double *b = B + 2 * (size_t)j * (size_t)ldb;
+      for (k = n - 1; k >= 0; --k) {
+        const double *u = U + 2 * (size_t)k * (size_t)ldu;
+        double tr, ti;
+        phgmg__zdiv(b[2 * k], b[2 * k + 1], u[2 * k], u[2 * k + 1], &tr, &ti);
+        b[2 * k] = tr;
+        b[2 * k + 1] = ti;
+        if (tr != 0.0 || ti != 0.0) phgmg__zaxpy_neg(k, tr, ti, u, b);
+      }
+    }
+    return;
+  }
+  n1 = n / 2;
+  phgmg__ztrsm_lun(n - n1, nrhs, U + 2 * (n1 + (size_t)n1 * (size_t)ldu), ldu, B + 2 * n1, ldb);
+  phgmg__zgemm_acc(n1, nrhs, n - n1, -1.0, U + 2 * (size_t)n1 * (size_t)ldu, ldu, B + 2 * n1, ldb,
+                   B, ldb);
+  phgmg__ztrsm_lun(n1, nrhs, U, ldu, B, ldb);
+}
+
+/* Recursive complex LU of an m x n panel, as phgmg__lu_rec. */
+PHGMG__PRIV int phgmg__zlu_rec(int m, int n, double *A, int lda, int *ipiv) {
+  int i, k, n1, sing = 0;
+  if (n <= 8) {
+    for (k = 0; k < n; ++k) {
+      double *ak = A + 2 * (size_t)k * (size_t)lda, rr, ri;
+      double amax = fabs(ak[2 * k]) + fabs(ak[2 * k + 1]);
+      int p = k, j;
+      for (i = k + 1; i < m; ++i) {
+        double v = fabs(ak[2 * i]) + fabs(ak[2 * i + 1]);
+        if (v > amax) { amax = v; p = i; }
+      }
+      ipiv[k] = p;
+      if (amax == 0.0) { sing = 1; continue; }
+      if (p != k) phgmg__zlaswp(n, A, lda, k, k + 1, ipiv);
+      phgmg__zdiv(1.0, 0.0, ak[2 * k], ak[2 * k + 1], &rr, &ri);
+      for (i = k + 1; i < m; ++i) {
+        double xr = ak[2 * i], xi = ak[2 * i + 1];
+        ak[2 * i] = xr * rr - xi * ri;
+        ak[2 * i + 1] = xr * ri + xi * rr;
+      }
+      for (j = k + 1; j < n; ++j) {
+        double *c = A + 2 * (size_t)j * (size_t)lda, tr = c[2 * k], ti = c[2 * k + 1];
+        if (tr != 0.0 || ti != 0.0) phgmg__zaxpy_neg(m - k - 1, tr, ti, ak + 2 * (k + 1), c + 2 * (k + 1));
+      }
+    }
+    return sing;
+  }
+  n1 = n / 2;
+  sing = phgmg__zlu_rec(m, n1, A, lda, ipiv);
+  phgmg__zlaswp(n - n1, A + 2 * (size_t)n1 * (size_t)lda, lda, 0, n1, ipiv);
+  phgmg__ztrsm_llu(n1, n - n1, A, lda, A + 2 * (size_t)n1 * (size_t)lda, lda);
+  phgmg__zgemm_acc(m - n1, n - n1, n1, -1.0, A + 2 * n1, lda, A + 2 * (size_t)n1 * (size_t)lda, lda,
+                   A + 2 * (n1 + (size_t)n1 * (size_t)lda), lda);
+  sing |= phgmg__zlu_rec(m - n1, n - n1, A + 2 * (n1 + (size_t)n1 * (size_t)lda), lda, ipiv + n1);
+  for (i = n1; i < n; ++i) ipiv[i] += n1;
+  phgmg__zlaswp(n1, A, lda, n1, n, ipiv);
+  return sing;
+}
+
 PHGMG_DEF phgmg_result phgmg_zlu_factor(int n, double *A, int lda, int *ipiv) {
-  int i, j, k;
-  phgmg_result rc = PHGMG_OK;
+  int j;
   if (n < 0 || lda < PHGMG__MAX(n, 1)) return PHGMG_ERR_SIZE;
   if (n == 0) return PHGMG_OK;
   if (!A || !ipiv) return PHGMG_ERR_INVALID_ARG;
   for (j = 0; j < n; ++j)
     if (!phgmg__all_finite(A + 2 * (size_t)j * (size_t)lda, 2 * (size_t)n)) return PHGMG_ERR_NANINF;
-  for (k = 0; k < n; ++k) {
-    double *ak = A + 2 * (size_t)k * (size_t)lda;
-    int p = k;
-    double amax = fabs(ak[2 * k]) + fabs(ak[2 * k + 1]);
-    for (i = k + 1; i < n; ++i) {
-      double v = fabs(ak[2 * i]) + fabs(ak[2 * i + 1]);
-      if (v > amax) { amax = v; p = i; }
-    }
-    ipiv[k] = p;
-    if (amax == 0.0) { rc = PHGMG_ERR_SINGULAR; continue; }
-    if (p != k)
-      for (j = 0; j < n; ++j) {
-        double *c = A + 2 * (size_t)j * (size_t)lda, t;
-        t = c[2 * k]; c[2 * k] = c[2 * p]; c[2 * p] = t;
-        t = c[2 * k + 1]; c[2 * k + 1] = c[2 * p + 1]; c[2 * p + 1] = t;
-      }
-    {
-      /* r = 1 / pivot (Smith's division) */
-      double pr = ak[2 * k], pi = ak[2 * k + 1], rr, ri;
-      if (fabs(pr) >= fabs(pi)) {
-        double q = pi / pr, d = pr + pi * q;
-        rr = 1.0 / d; ri = -q / d;
-      } else {
-        double q = pr / pi, d = pr * q + pi;
-        rr = q / d; ri = -1.0 / d;
-      }
-      for (i = k + 1; i < n; ++i) {
-        double xr = ak[2 * i], xi = ak[2 * i + 1];
-        ak[2 * i] = xr * rr - xi * ri;
-        ak[2 * i + 1] = xr * ri + xi * rr;
-      }
-    }
-    for (j = k + 1; j < n; ++j) {
-      double *c = A + 2 * (size_t)j * (size_t)lda;
-      double tr = c[2 * k], ti = c[2 * k + 1];
-      if (tr == 0.0 && ti == 0.0) continue;
-      for (i = k + 1; i < n; ++i) {
-        double lr = ak[2 * i], li = ak[2 * i + 1];
-        c[2 * i] -= tr * lr - ti * li;
-        c[2 * i + 1] -= tr * li + ti * lr;
-      }
-    }
-  }
-  return rc;
+  return phgmg__zlu_rec(n, n, A, lda, ipiv) ? PHGMG_ERR_SINGULAR : PHGMG_OK;
 }
 
 PHGMG_DEF void phgmg_zlu_solve(int n, const double *LU, int lda, const int *ipiv,
                                int nrhs, double *B, int ldb) {
-  int i, j, k;
-  for (j = 0; j < nrhs; ++j) {
-    double *b = B + 2 * (size_t)j * (size_t)ldb;
-    for (k = 0; k < n; ++k) {
-      int p = ipiv[k];
-      if (p != k) {
-        double t = b[2 * k]; b[2 * k] = b[2 * p]; b[2 * p] = t;
-        t = b[2 * k + 1]; b[2 * k + 1] = b[2 * p + 1]; b[2 * p + 1] = t;
-      }
-    }
-    for (k = 0; k < n; ++k) {
-      const double *l = LU + 2 * (size_t)k * (size_t)lda;
-      double tr = b[2 * k], ti = b[2 * k + 1];
-      if (tr == 0.0 && ti == 0.0) continue;
-      for (i = k + 1; i < n; ++i) {
-        double lr = l[2 * i], li = l[2 * i + 1];
-        b[2 * i] -= tr * lr - ti * li;
-        b[2 * i + 1] -= tr * li + ti * lr;
-      }
-    }
-    for (k = n - 1; k >= 0; --k) {
-      const double *u = LU + 2 * (size_t)k * (size_t)lda;
-      double pr = u[2 * k], pi = u[2 * k + 1], xr = b[2 * k], xi = b[2 * k + 1], tr, ti;
-      if (fabs(pr) >= fabs(pi)) {
-        double q = pi / pr, d = pr + pi * q;
-        tr = (xr + xi * q) / d; ti = (xi - xr * q) / d;
-      } else {
-        double q = pr / pi, d = pr * q + pi;
-        tr = (xr * q + xi) / d; ti = (xi * q - xr) / d;
-      }
-      b[2 * k] = tr; b[2 * k + 1] = ti;
-      if (tr == 0.0 && ti == 0.0) continue;
-      for (i = 0; i < k; ++i) {
-        double ur = u[2 * i], ui = u[2 * i + 1];
-        b[2 * i] -= tr * ur - ti * ui;
-        b[2 * i + 1] -= tr * ui + ti * ur;
-      }
-    }
-  }
+  if (n <= 0 || nrhs <= 0) return;
+  phgmg__zlaswp(nrhs, B, ldb, 0, n, ipiv);
+  phgmg__ztrsm_llu(n, nrhs, LU, lda, B, ldb);
+  phgmg__ztrsm_lun(n, nrhs, LU, lda, B, ldb);
 }
-
 
 /* ---- condition estimate (Hager 1984, Higham 1988; LAPACK dlacn2) ---------- */
 PHGMG__PRIV double phgmg__asum(int n, const double *x) {
@@ -1048,26 +1145,17 @@ PHGMG_DEF phgmg_result phgmg_svd(int m, int n, const double *A, int lda, int kma
   return rc;
 }
 
-/* ---- symmetric eigenproblem: cyclic Jacobi ------------------------------------ */
-PHGMG_DEF phgmg_result phgmg_sym_eig(int n, double *A, int lda, double *w, double *V, int ldv) {
-  int i, j, p, q, sweep, rotated;
-  double anorm;
-  if (n < 0 || lda < PHGMG__MAX(n, 1) || (V && ldv < PHGMG__MAX(n, 1))) return PHGMG_ERR_SIZE;
-  if (n == 0) return PHGMG_OK;
-  if (!A || !w) return PHGMG_ERR_INVALID_ARG;
-  if (!phgmg__mat_finite(n, n, A, lda)) return PHGMG_ERR_NANINF;
-  /* symmetrize: A := (A + A^T)/2 */
-  for (j = 0; j < n; ++j)
-    for (i = j + 1; i < n; ++i) {
-      double *aij = A + i + (size_t)j * (size_t)lda, *aji = A + j + (size_t)i * (size_t)lda;
-      double s = 0.5 * (*aij + *aji);
-      *aij = *aji = s;
-    }
+/* ---- symmetric eigenproblem ------------------------------------------------------ */
+/* Cyclic Jacobi (small n): A symmetric, destroyed; w unsorted; V (if not NULL)
+   accumulates the rotations. */
+PHGMG__PRIV phgmg_result phgmg__sym_jacobi(int n, double *A, int lda, double *w, double *V,
+                                           int ldv) {
+  int i, j, p, q, sweep, rotated = 1;
+  double anorm = phgmg_normf(n, n, A, lda);
   if (V)
     for (j = 0; j < n; ++j)
       for (i = 0; i < n; ++i) V[i + (size_t)j * (size_t)ldv] = i == j ? 1.0 : 0.0;
-  anorm = phgmg_normf(n, n, A, lda);
-  for (sweep = 0; sweep < 100; ++sweep) {
+  for (sweep = 0; sweep < 100 && rotated; ++sweep) {
     rotated = 0;
     for (p = 0; p < n - 1; ++p) {
       double *ap = A + (size_t)p * (size_t)lda;
@@ -1082,11 +1170,7 @@ PHGMG_DEF phgmg_result phgmg_sym_eig(int n, double *A, int lda, double *w, doubl
         t = (theta >= 0.0 ? 1.0 : -1.0) / (fabs(theta) + sqrt(1.0 + theta * theta));
         c = 1.0 / sqrt(1.0 + t * t);
         s = c * t;
-        for (i = 0; i < n; ++i) {
-          double a = ap[i], b = aq[i];
-          ap[i] = c * a - s * b;
-          aq[i] = s * a + c * b;
-        }
+        phgmg__rot(n, ap, aq, c, s);
         ap[p] = app - t * apq;
         aq[q] = aqq + t * apq;
         ap[q] = aq[p] = 0.0;
@@ -1095,20 +1179,174 @@ PHGMG_DEF phgmg_result phgmg_sym_eig(int n, double *A, int lda, double *w, doubl
           A[p + (size_t)i * (size_t)lda] = ap[i];
           A[q + (size_t)i * (size_t)lda] = aq[i];
         }
-        if (V) {
-          double *vp = V + (size_t)p * (size_t)ldv, *vq = V + (size_t)q * (size_t)ldv;
-          for (i = 0; i < n; ++i) {
-            double a = vp[i], b = vq[i];
-            vp[i] = c * a - s * b;
-            vq[i] = s * a + c * b;
-          }
-        }
+        if (V) phgmg__rot(n, V + (size_t)p * (size_t)ldv, V + (size_t)q * (size_t)ldv, c, s);
       }
     }
-    if (!rotated) break;
   }
   if (rotated) return PHGMG_ERR_NOT_CONVERGED;
   for (i = 0; i < n; ++i) w[i] = A[i + (size_t)i * (size_t)lda];
+  return PHGMG_OK;
+}
+
+/* Householder tridiagonalization and implicit QL with shifts (the EISPACK
+   tred2/tql2 scheme, as in JAMA), in W (n x n, ldw): only the lower triangle
+   of W is read. vec: W ends up holding the eigenvectors. d (n) receives the
+   eigenvalues (unsorted), e (n) is workspace. Without vec, e may be column n-1
+   of W itself (that column is then not needed). */
+PHGMG__PRIV phgmg_result phgmg__sym_tridiag_ql(int n, double *W, int ldw, int vec, double *d,
+                                               double *e) {
+#define PHGMG__W(r, c) W[(size_t)(r) + (size_t)(c) * (size_t)ldw]
+  int i, j, k, l, m;
+  double f, g, h, tst1, dlast;
+  for (j = 0; j < n; ++j) d[j] = PHGMG__W(n - 1, j);
+  dlast = d[n - 1];
+  for (i = n - 1; i > 0; --i) {
+    double scale = 0.0;
+    h = 0.0;
+    for (k = 0; k < i; ++k) scale += fabs(d[k]);
+    if (scale == 0.0) {
+      e[i] = d[i - 1];
+      for (j = 0; j < i; ++j) {
+        d[j] = PHGMG__W(i - 1, j);
+        PHGMG__W(i, j) = 0.0;
+        if (vec) PHGMG__W(j, i) = 0.0;
+      }
+    } else {
+      double hh;
+      for (k = 0; k < i; ++k) { d[k] /= scale; h += d[k] * d[k]; }
+      f = d[i - 1];
+      g = sqrt(h);
+      if (f > 0) g = -g;
+      e[i] = scale * g;
+      h -= f * g;
+      d[i - 1] = f - g;
+      for (j = 0; j < i; ++j) e[j] = 0.0;
+      for (j = 0; j < i; ++j) {
+        const double *wj = &PHGMG__W(0, j);
+        f = d[j];
+        if (vec) PHGMG__W(j, i) = f;
+        g = e[j] + wj[j] * f + phgmg__dot(i - 1 - j, wj + j + 1, d + j + 1);
+        phgmg__axpy(i - 1 - j, f, wj + j + 1, e + j + 1);
+        e[j] = g;
+      }
+      f = 0.0;
+      for (j = 0; j < i; ++j) { e[j] /= h; f += e[j] * d[j]; }
+      hh = f / (h + h);
+      for (j = 0; j < i; ++j) e[j] -= hh * d[j];
+      for (j = 0; j < i; ++j) {
+        double *wj = &PHGMG__W(0, j);
+        f = d[j];
+        g = e[j];
+        phgmg__axpy(i - j, -f, e + j, wj + j);
+        phgmg__axpy(i - j, -g, d + j, wj + j);
+        d[j] = PHGMG__W(i - 1, j);
+        PHGMG__W(i, j) = 0.0;
+      }
+    }
+    d[i] = h;
+  }
+  if (vec) {
+    /* accumulate the transformations */
+    for (i = 0; i < n - 1; ++i) {
+      PHGMG__W(n - 1, i) = PHGMG__W(i, i);
+      PHGMG__W(i, i) = 1.0;
+      h = d[i + 1];
+      if (h != 0.0) {
+        const double *wi1 = &PHGMG__W(0, i + 1);
+        for (k = 0; k <= i; ++k) d[k] = wi1[k] / h;
+        for (j = 0; j <= i; ++j) {
+          double *wj = &PHGMG__W(0, j);
+          g = phgmg__dot(i + 1, wi1, wj);
+          phgmg__axpy(i + 1, -g, d, wj);
+        }
+      }
+      for (k = 0; k <= i; ++k) PHGMG__W(k, i + 1) = 0.0;
+    }
+    for (j = 0; j < n; ++j) { d[j] = PHGMG__W(n - 1, j); PHGMG__W(n - 1, j) = 0.0; }
+    PHGMG__W(n - 1, n - 1) = 1.0;
+  } else {
+    for (j = 0; j < n - 1; ++j) d[j] = PHGMG__W(j, j);
+    d[n - 1] = dlast;
+  }
+  /* implicit QL on the tridiagonal (d, e) */
+  for (i = 1; i < n; ++i) e[i - 1] = e[i];
+  e[n - 1] = 0.0;
+  f = 0.0;
+  tst1 = 0.0;
+  for (l = 0; l < n; ++l) {
+    tst1 = PHGMG__MAX(tst1, fabs(d[l]) + fabs(e[l]));
+    m = l;
+    while (m < n - 1 && fabs(e[m]) > PHGMG__EPS * tst1) ++m;
+    if (m > l) {
+      int iter = 0;
+      do {
+        double p, r, dl1, c, c2, c3, el1, s, s2;
+        if (++iter > 60) return PHGMG_ERR_NOT_CONVERGED;
+        g = d[l];
+        p = (d[l + 1] - g) / (2.0 * e[l]);
+        r = hypot(p, 1.0);
+        if (p < 0) r = -r;
+        d[l] = e[l] / (p + r);
+        d[l + 1] = e[l] * (p + r);
+        dl1 = d[l + 1];
+        h = g - d[l];
+        for (i = l + 2; i < n; ++i) d[i] -= h;
+        f += h;
+        p = d[m];
+        c = c2 = c3 = 1.0;
+        el1 = e[l + 1];
+        s = s2 = 0.0;
+        for (i = m - 1; i >= l; --i) {
+          c3 = c2;
+          c2 = c;
+          s2 = s;
+          g = c * e[i];
+          h = c * p;
+          r = hypot(p, e[i]);
+          e[i + 1] = s * r;
+          s = e[i] / r;
+          c = p / r;
+          p = c * d[i] - s * g;
+          d[i + 1] = h + s * (c * g + s * d[i]);
+          if (vec) phgmg__rot(n, &PHGMG__W(0, i), &PHGMG__W(0, i + 1), c, s);
+        }
+        p = -s * s2 * c3 * el1 * e[l] / dl1;
+        e[l] = s * p;
+        d[l] = c * p;
+      } while (fabs(e[l]) > PHGMG__EPS * tst1);
+    }
+    d[l] += f;
+    e[l] = 0.0;
+  }
+  return PHGMG_OK;
+#undef PHGMG__W
+}
+
+#define PHGMG__SYM_JACOBI_MAX 24
+PHGMG_DEF phgmg_result phgmg_sym_eig(int n, double *A, int lda, double *w, double *V, int ldv) {
+  int i, j;
+  phgmg_result rc;
+  if (n < 0 || lda < PHGMG__MAX(n, 1) || (V && ldv < PHGMG__MAX(n, 1))) return PHGMG_ERR_SIZE;
+  if (n == 0) return PHGMG_OK;
+  if (!A || !w) return PHGMG_ERR_INVALID_ARG;
+  if (!phgmg__mat_finite(n, n, A, lda)) return PHGMG_ERR_NANINF;
+  /* symmetrize: A := (A + A^T)/2 */
+  for (j = 0; j < n; ++j)
+    for (i = j + 1; i < n; ++i) {
+      double *aij = A + i + (size_t)j * (size_t)lda, *aji = A + j + (size_t)i * (size_t)lda;
+      double s = 0.5 * (*aij + *aji);
+      *aij = *aji = s;
+    }
+  if (n <= PHGMG__SYM_JACOBI_MAX) {
+    rc = phgmg__sym_jacobi(n, A, lda, w, V, ldv);
+  } else if (V) {
+    for (j = 0; j < n; ++j)
+      memcpy(V + (size_t)j * (size_t)ldv, A + (size_t)j * (size_t)lda, (size_t)n * sizeof(double));
+    rc = phgmg__sym_tridiag_ql(n, V, ldv, 1, w, A);
+  } else {
+    rc = phgmg__sym_tridiag_ql(n, A, lda, 0, w, A + (size_t)(n - 1) * (size_t)lda);
+  }
+  if (rc != PHGMG_OK) return rc;
   /* selection sort ascending, swapping eigenvector columns */
   for (i = 0; i < n - 1; ++i) {
     int kmin = i;

@@ -2,6 +2,14 @@
 /* >>ph (implementation) ================================================== */
 #ifndef PHGMG_NO_OFFLINE
 
+/* a*b + c, fused where the target has a fast fma (the hot loops of the
+   stepper); plain otherwise (ISO C modes do not contract a*b + c). */
+#if defined(FP_FAST_FMA)
+#define PHGMG__FMA(a, b, c) fma((a), (b), (c))
+#else
+#define PHGMG__FMA(a, b, c) ((a) * (b) + (c))
+#endif
+
 /* Index of element (i,j), |i-j| <= kb, in the (2kb+1) x N band storage. */
 #define PHGMG__PHB(kb, i, j) \
   ((size_t)((kb) + (i) - (j)) + (size_t)(j) * (size_t)(2 * (kb) + 1))
@@ -1024,10 +1032,17 @@ struct phgmg_gl3 {
   int *jr_ptr, *jr_col;
   double *jr_val;
   int nopiv1, nopiv2; /* banded factors without row interchanges */
+  int nbnz;           /* banded: the nonzero entries of B (row, column, value) */
+  int *b_row, *b_col;
+  double *b_val;
   /* step map (dense linear): x+ = Phi x + Gam U, g_i = GX_i x + GU_i U */
   double *Phi, *Gam, *GX, *GU;
   /* work */
-  double *Z, *W, *Y, *G, *F, *U, *Zprev, *xend, *xnew, *r1, *rc, *tmp, *TF;
+  double *Z, *W, *Y, *G, *F, *U, *Zprev, *xend, *xnew, *tmp, *TF;
+  /* Newton right-hand sides, zero-padded by kl before and ku after (banded) */
+  double *r1buf, *rcbuf, *r1, *rc;
+  /* packed row-wise factors for the pivot-free banded solve (see below) */
+  double *pk;
   int have_prev, need_factor;
   double tend;
   phgmg_gl3_stats st;
@@ -1046,12 +1061,14 @@ PHGMG_DEF void phgmg_gl3_destroy(phgmg_gl3 *s) {
   phgmg__free(&al, s->dd);
   phgmg__free(&al, s->dpoly); phgmg__free(&al, s->wc);
   phgmg__free(&al, s->jr_ptr); phgmg__free(&al, s->jr_col); phgmg__free(&al, s->jr_val);
+  phgmg__free(&al, s->b_row); phgmg__free(&al, s->b_col); phgmg__free(&al, s->b_val);
   phgmg__free(&al, s->Phi); phgmg__free(&al, s->Gam); phgmg__free(&al, s->GX);
   phgmg__free(&al, s->GU);
   phgmg__free(&al, s->Z); phgmg__free(&al, s->W); phgmg__free(&al, s->Y);
   phgmg__free(&al, s->G); phgmg__free(&al, s->F); phgmg__free(&al, s->U);
   phgmg__free(&al, s->Zprev); phgmg__free(&al, s->xend);
-  phgmg__free(&al, s->xnew); phgmg__free(&al, s->r1); phgmg__free(&al, s->rc);
+  phgmg__free(&al, s->xnew); phgmg__free(&al, s->r1buf); phgmg__free(&al, s->rcbuf);
+  phgmg__free(&al, s->pk);
   phgmg__free(&al, s->tmp); phgmg__free(&al, s->TF);
   phgmg__free(&al, s);
 }
@@ -1233,11 +1250,9 @@ PHGMG_DEF phgmg_result phgmg_gl3_create(phgmg_gl3 **out, const phgmg_ph_system *
   s->F = phgmg__dalloc(&s->al, N3);
   s->Zprev = phgmg__dalloc(&s->al, N3);
   s->xend = phgmg__dalloc(&s->al, (size_t)N);
-  s->r1 = phgmg__dalloc(&s->al, (size_t)N);
-  s->rc = phgmg__dalloc(&s->al, 2 * (size_t)N);
   s->tmp = phgmg__dalloc(&s->al, (size_t)N);
   s->TF = phgmg__dalloc(&s->al, N3);
-  if (!s->Z || !s->W || !s->Y || !s->F || !s->Zprev || !s->xend || !s->r1 || !s->rc ||
+  if (!s->Z || !s->W || !s->Y || !s->F || !s->Zprev || !s->xend ||
       !s->tmp || !s->TF) {
     rc = PHGMG_ERR_NOMEM;
     goto fail;
@@ -1301,6 +1316,24 @@ PHGMG_DEF phgmg_result phgmg_gl3_create(phgmg_gl3 **out, const phgmg_ph_system *
         }
       }
       s->jr_ptr[N] = (int)nnz;
+      nnz = 0;
+      for (c = 0; c < m; ++c)
+        for (r = 0; r < N; ++r)
+          if (sys->B[(size_t)r + (size_t)c * (size_t)N] != 0.0) ++nnz;
+      s->b_row = phgmg__ialloc(&s->al, nnz);
+      s->b_col = phgmg__ialloc(&s->al, nnz);
+      s->b_val = phgmg__dalloc(&s->al, nnz);
+      if (!s->b_row || !s->b_col || !s->b_val) { rc = PHGMG_ERR_NOMEM; goto fail; }
+      s->nbnz = 0;
+      for (c = 0; c < m; ++c)
+        for (r = 0; r < N; ++r) {
+          double v = sys->B[(size_t)r + (size_t)c * (size_t)N];
+          if (v == 0.0) continue;
+          s->b_row[s->nbnz] = r;
+          s->b_col[s->nbnz] = c;
+          s->b_val[s->nbnz] = v;
+          s->nbnz++;
+        }
     }
     if (s->mode == PHGMG__GL3_BANDED) {
       for (k = 0; k < s->djr.nd; ++k) {
@@ -1333,6 +1366,20 @@ PHGMG_DEF phgmg_result phgmg_gl3_create(phgmg_gl3 **out, const phgmg_ph_system *
       }
     }
   }
+  {
+    size_t len = (size_t)N + (size_t)s->kl + (size_t)s->ku;
+    s->r1buf = phgmg__dalloc(&s->al, len);
+    s->rcbuf = phgmg__dalloc(&s->al, 2 * len);
+    if (!s->r1buf || !s->rcbuf) { rc = PHGMG_ERR_NOMEM; goto fail; }
+    memset(s->r1buf, 0, sizeof(double) * len);
+    memset(s->rcbuf, 0, sizeof(double) * 2 * len);
+    s->r1 = s->r1buf + s->kl;
+    s->rc = s->rcbuf + 2 * (size_t)s->kl;
+    if (s->mode == PHGMG__GL3_BANDED) {
+      s->pk = phgmg__dalloc(&s->al, (size_t)3 * (size_t)(s->kl + s->ku + 1) * (size_t)N);
+      if (!s->pk) { rc = PHGMG_ERR_NOMEM; goto fail; }
+    }
+  }
   s->need_factor = 1;
   *out = s;
   return PHGMG_OK;
@@ -1341,11 +1388,12 @@ fail:
   return rc;
 }
 
-/* Banded: F_st = B u_st + (J - R) G_st, row by row from the CSR copy. */
+/* Banded: F_st = (J - R) G_st row by row from the CSR copy, + B u_st over the
+   nonzero entries of B. */
 PHGMG__PRIV void phgmg__gl3_rhs_csr(phgmg_gl3 *s) {
-  int N = s->N, m = s->m, r, k, c;
+  int N = s->N, m = s->m, r, k;
   const int *ptr = s->jr_ptr, *col = s->jr_col;
-  const double *val = s->jr_val, *B = s->sys.B, *U = s->U;
+  const double *val = s->jr_val, *U = s->U;
   const double *G0 = s->G, *G1 = s->G + N, *G2 = s->G + 2 * (size_t)N;
   double *F0 = s->F, *F1 = s->F + N, *F2 = s->F + 2 * (size_t)N;
   for (r = 0; r < N; ++r) {
@@ -1353,20 +1401,20 @@ PHGMG__PRIV void phgmg__gl3_rhs_csr(phgmg_gl3 *s) {
     for (k = ptr[r]; k < ptr[r + 1]; ++k) {
       int j = col[k];
       double v = val[k];
-      a0 += v * G0[j];
-      a1 += v * G1[j];
-      a2 += v * G2[j];
-    }
-    for (c = 0; c < m; ++c) {
-      double b = B[(size_t)r + (size_t)c * (size_t)N];
-      if (b == 0.0) continue;
-      a0 += b * U[c];
-      a1 += b * U[m + c];
-      a2 += b * U[2 * m + c];
+      a0 = PHGMG__FMA(v, G0[j], a0);
+      a1 = PHGMG__FMA(v, G1[j], a1);
+      a2 = PHGMG__FMA(v, G2[j], a2);
     }
     F0[r] = a0;
     F1[r] = a1;
     F2[r] = a2;
+  }
+  for (k = 0; k < s->nbnz; ++k) {
+    int r0 = s->b_row[k], c = s->b_col[k];
+    double b = s->b_val[k];
+    F0[r0] += b * U[c];
+    F1[r0] += b * U[m + c];
+    F2[r0] += b * U[2 * m + c];
   }
   s->st.rhs_evals += 3;
 }
@@ -1388,21 +1436,30 @@ PHGMG__PRIV void phgmg__gl3_eval(phgmg_gl3 *s, const double *x) {
     phgmg_gemm('N', 'N', N, 3, N, 1.0, sys->Q, N, s->Y, N, 0.0, s->G, N);
   } else if (qdiag) { /* Q diagonal: G = q .* (x + Z) in one pass */
     const double *qd = s->dq.v;
-    if (s->wc) { /* ... plus the polynomial, coordinate-wise */
+    if (s->wc) { /* ... plus the polynomial, coordinate-wise, three stages per pass */
       const double *wc = s->wc, *dp = s->dpoly;
+      const double *z0 = s->Z, *z1 = s->Z + N, *z2 = s->Z + 2 * (size_t)N;
+      double *g0 = s->G, *g1 = s->G + N, *g2 = s->G + 2 * (size_t)N;
       int deg = sys->poly_deg;
-      for (st = 0; st < 3; ++st) {
-        const double *z = s->Z + (size_t)st * (size_t)N;
-        double *g = s->G + (size_t)st * (size_t)N;
-        for (i = 0; i < N; ++i) {
-          double y = x[i] + z[i], gi = qd[i] * y;
-          if (wc[i] != 0.0) {
-            double acc = dp[deg - 1];
-            int j;
-            for (j = deg - 2; j >= 0; --j) acc = acc * y + dp[j];
-            gi += wc[i] * acc;
+      for (i = 0; i < N; ++i) {
+        double xi = x[i], q = qd[i], w = wc[i];
+        double y0 = xi + z0[i], y1 = xi + z1[i], y2 = xi + z2[i];
+        if (w != 0.0) {
+          double p0 = dp[deg - 1], p1 = p0, p2 = p0;
+          int j;
+          for (j = deg - 2; j >= 0; --j) {
+            double c = dp[j];
+            p0 = PHGMG__FMA(p0, y0, c);
+            p1 = PHGMG__FMA(p1, y1, c);
+            p2 = PHGMG__FMA(p2, y2, c);
           }
-          g[i] = gi;
+          g0[i] = PHGMG__FMA(w, p0, q * y0);
+          g1[i] = PHGMG__FMA(w, p1, q * y1);
+          g2[i] = PHGMG__FMA(w, p2, q * y2);
+        } else {
+          g0[i] = q * y0;
+          g1[i] = q * y1;
+          g2[i] = q * y2;
         }
       }
       phgmg__gl3_rhs_csr(s);
@@ -1462,6 +1519,80 @@ PHGMG__PRIV void phgmg__gl3_eval(phgmg_gl3 *s, const double *x) {
   }
   phgmg_gemm('N', 'N', N, 3, N, 1.0, s->JR, N, s->G, N, 1.0, s->F, N);
   s->st.rhs_evals += 3;
+}
+
+/* Both band factorizations without row interchanges: the factors are repacked
+   row by row, pk + j*P (P = 3(kl+ku+1)) = [L(j, j-kl .. j-1) real (kl),
+   complex (2kl) | U(j, j+1 .. j+ku) / U(j,j) real (ku), complex (2ku) | 1/U(j,j) real,
+   complex (2)], zeros outside the matrix; the right-hand sides carry kl zeros
+   before and ku after, so the substitutions below run without bounds tests,
+   the real and the complex one in the same sweep (their dependency chains
+   overlap). */
+PHGMG__PRIV void phgmg__gl3_pack_nopiv(phgmg_gl3 *s) {
+  int n = s->N, kl = s->kl, ku = s->ku, kv = kl + ku, j, p;
+  size_t P = 3 * (size_t)(kl + ku + 1), ld = (size_t)s->ldab;
+  for (j = 0; j < n; ++j) {
+    double *r = s->pk + (size_t)j * P;
+    double *lr = r, *lc = r + kl, *ur = r + 3 * kl, *uc = r + 3 * kl + ku, *dg = r + 3 * (kl + ku);
+    for (p = 0; p < kl; ++p) {
+      int i = j - kl + p; /* L(j, i) in column i at row kv + j - i */
+      size_t e = (size_t)(kv + j - i) + (size_t)i * ld;
+      if (i < 0) { lr[p] = 0.0; lc[2 * p] = lc[2 * p + 1] = 0.0; continue; }
+      lr[p] = s->AB1[e];
+      lc[2 * p] = s->AB2[2 * e];
+      lc[2 * p + 1] = s->AB2[2 * e + 1];
+    }
+    dg[0] = s->dinv1[j];
+    dg[1] = s->dinv2[2 * j];
+    dg[2] = s->dinv2[2 * j + 1];
+    for (p = 0; p < ku; ++p) { /* U(j, i) / U(j, j), in column i at row kv + j - i */
+      int i = j + 1 + p;
+      size_t e = (size_t)(kv + j - i) + (size_t)i * ld;
+      double vr, vi;
+      if (i >= n) { ur[p] = 0.0; uc[2 * p] = uc[2 * p + 1] = 0.0; continue; }
+      ur[p] = s->AB1[e] * dg[0];
+      vr = s->AB2[2 * e];
+      vi = s->AB2[2 * e + 1];
+      uc[2 * p] = vr * dg[1] - vi * dg[2];
+      uc[2 * p + 1] = vr * dg[2] + vi * dg[1];
+    }
+  }
+}
+
+PHGMG__PRIV void phgmg__gl3_solve_packed(const phgmg_gl3 *s, double *b, double *z) {
+  int n = s->N, kl = s->kl, ku = s->ku, j, p;
+  size_t P = 3 * (size_t)(kl + ku + 1);
+  const double *r = s->pk;
+  for (j = 0; j < n; ++j, r += P) {
+    const double *lr = r, *lc = r + kl, *bb = b + j - kl, *zz = z + 2 * (j - kl);
+    double t = b[j], tr = z[2 * j], ti = z[2 * j + 1];
+    for (p = 0; p < kl; ++p) { /* the newest unknown comes last: short chains */
+      double cr = lc[2 * p], ci = lc[2 * p + 1], xr = zz[2 * p], xi = zz[2 * p + 1];
+      t = PHGMG__FMA(-lr[p], bb[p], t);
+      tr = PHGMG__FMA(-cr, xr, tr) + ci * xi;
+      ti = PHGMG__FMA(-cr, xi, ti) - ci * xr;
+    }
+    b[j] = t;
+    z[2 * j] = tr;
+    z[2 * j + 1] = ti;
+  }
+  r = s->pk + (size_t)(n - 1) * P;
+  for (j = n - 1; j >= 0; --j, r -= P) {
+    const double *ur = r + 3 * kl, *uc = ur + ku, *dg = uc + 2 * ku;
+    const double *bb = b + j + 1, *zz = z + 2 * (j + 1);
+    double br = z[2 * j], bi = z[2 * j + 1];
+    double t = b[j] * dg[0], tr = br * dg[1] - bi * dg[2], ti = br * dg[2] + bi * dg[1];
+    for (p = ku - 1; p >= 0; --p) {
+      double cr = uc[2 * p], ci = uc[2 * p + 1], xr = zz[2 * p], xi = zz[2 * p + 1];
+      t = PHGMG__FMA(-ur[p], bb[p], t);
+      tr = PHGMG__FMA(-cr, xr, tr) + ci * xi;
+      ti = PHGMG__FMA(-cr, xi, ti) - ci * xr;
+    }
+    b[j] = t;
+    z[2 * j] = tr;
+    z[2 * j + 1] = ti;
+    if (j == 0) break; /* r would step before the array */
+  }
 }
 
 /* (Re)factor the shifted Newton matrices at x. */
@@ -1541,46 +1672,8 @@ PHGMG__PRIV phgmg_result phgmg__gl3_factor(phgmg_gl3 *s, const double *x) {
       if (s->ip1[j] != j) s->nopiv1 = 0;
       if (s->ip2[j] != j) s->nopiv2 = 0;
     }
+    if (rc == PHGMG_OK && s->nopiv1 && s->nopiv2) phgmg__gl3_pack_nopiv(s);
     return rc;
-  }
-}
-
-/* Both band factorizations without row interchanges: row-oriented forward
-   and back substitution for the real and the complex system in one sweep, so
-   that their dependency chains overlap. L(j,i) and U(i,j) sit at
-   ab[(kv + j - i) + i*ldab] and ab[(kv + i - j) + j*ldab]. */
-PHGMG__PRIV void phgmg__gb_solve_pair_nopiv(int n, int kl, int ku, int ldab, const double *ab,
-                                            const double *dinv, const double *zab,
-                                            const double *zdinv, double *b, double *z) {
-  int kv = kl + ku, j, i;
-  size_t ld = (size_t)ldab;
-  for (j = 0; j < n; ++j) {
-    double t = b[j], tr = z[2 * j], ti = z[2 * j + 1];
-    for (i = PHGMG__MAX(0, j - kl); i < j; ++i) {
-      size_t e = (size_t)(kv + j - i) + (size_t)i * ld;
-      double lr = zab[2 * e], li = zab[2 * e + 1], xr = z[2 * i], xi = z[2 * i + 1];
-      t -= ab[e] * b[i];
-      tr -= lr * xr - li * xi;
-      ti -= lr * xi + li * xr;
-    }
-    b[j] = t;
-    z[2 * j] = tr;
-    z[2 * j + 1] = ti;
-  }
-  for (j = n - 1; j >= 0; --j) {
-    double t = b[j], tr = z[2 * j], ti = z[2 * j + 1], dr, di;
-    for (i = PHGMG__MIN(n - 1, j + ku); i > j; --i) {
-      size_t e = (size_t)(kv + j - i) + (size_t)i * ld;
-      double ur = zab[2 * e], ui = zab[2 * e + 1], xr = z[2 * i], xi = z[2 * i + 1];
-      t -= ab[e] * b[i];
-      tr -= ur * xr - ui * xi;
-      ti -= ur * xi + ui * xr;
-    }
-    b[j] = t * dinv[j];
-    dr = zdinv[2 * j];
-    di = zdinv[2 * j + 1];
-    z[2 * j] = tr * dr - ti * di;
-    z[2 * j + 1] = tr * di + ti * dr;
   }
 }
 
@@ -1622,20 +1715,22 @@ PHGMG__PRIV phgmg_result phgmg__gl3_newton(phgmg_gl3 *s, const double *x, int fr
   for (;;) {
     const double *F0 = s->F, *F1 = s->F + N, *F2 = s->F + 2 * (size_t)N;
     double res = 0.0, chk = 0.0;
+    double *r1 = s->r1, *rc = s->rc;
+    const double a00 = h * A[0], a01 = h * A[1], a02 = h * A[2], a10 = h * A[3], a11 = h * A[4],
+                 a12 = h * A[5], a20 = h * A[6], a21 = h * A[7], a22 = h * A[8];
+    const double t00 = Ti[0], t01 = Ti[1], t02 = Ti[2], t10 = Ti[3], t11 = Ti[4], t12 = Ti[5],
+                 t20 = Ti[6], t21 = Ti[7], t22 = Ti[8];
+    const double gih = s->gam * ih, aih = s->alp * ih, bih = s->bet * ih;
     phgmg__gl3_eval(s, x);
-    for (i = 0; i < N; ++i) {
-      double f0 = F0[i], f1 = F1[i], f2 = F2[i], e0, e1, e2, w0 = W0[i], w1 = W1[i], w2 = W2[i];
-      e0 = fabs(Z0[i] - h * (A[0] * f0 + A[1] * f1 + A[2] * f2));
-      e1 = fabs(Z1[i] - h * (A[3] * f0 + A[4] * f1 + A[5] * f2));
-      e2 = fabs(Z2[i] - h * (A[6] * f0 + A[7] * f1 + A[8] * f2));
-      chk += e0 + e1 + e2; /* NaN/Inf detection */
-      if (e0 > res) res = e0;
-      if (e1 > res) res = e1;
-      if (e2 > res) res = e2;
-      /* Newton right-hand sides in the transformed variables */
-      s->r1[i] = Ti[0] * f0 + Ti[1] * f1 + Ti[2] * f2 - s->gam * ih * w0;
-      s->rc[2 * i] = Ti[3] * f0 + Ti[4] * f1 + Ti[5] * f2 - (s->alp * w1 + s->bet * w2) * ih;
-      s->rc[2 * i + 1] = Ti[6] * f0 + Ti[7] * f1 + Ti[8] * f2 - (s->alp * w2 - s->bet * w1) * ih;
+    for (i = 0; i < N; ++i) { /* stage residual Z - h (A x I) F */
+      double f0 = F0[i], f1 = F1[i], f2 = F2[i], e0, e1, e2;
+      e0 = fabs(Z0[i] - PHGMG__FMA(a00, f0, PHGMG__FMA(a01, f1, a02 * f2)));
+      e1 = fabs(Z1[i] - PHGMG__FMA(a10, f0, PHGMG__FMA(a11, f1, a12 * f2)));
+      e2 = fabs(Z2[i] - PHGMG__FMA(a20, f0, PHGMG__FMA(a21, f1, a22 * f2)));
+      chk += (e0 + e1) + e2; /* NaN/Inf detection */
+      res = e0 > res ? e0 : res;
+      res = e1 > res ? e1 : res;
+      res = e2 > res ? e2 : res;
     }
     if (chk - chk != 0.0) return PHGMG_ERR_NANINF;
     if (it > 0) {
@@ -1648,19 +1743,31 @@ PHGMG__PRIV phgmg_result phgmg__gl3_newton(phgmg_gl3 *s, const double *x, int fr
     if (it >= s->max_iter) return PHGMG_ERR_NOT_CONVERGED;
     if (it >= 1 && theta >= 1.0 && !fresh) return PHGMG_ERR_NOT_CONVERGED;
     if (ndiv >= 2) return PHGMG_ERR_NOT_CONVERGED;
+    for (i = 0; i < N; ++i) { /* Newton right-hand sides in the transformed variables */
+      double f0 = F0[i], f1 = F1[i], f2 = F2[i], w0 = W0[i], w1 = W1[i], w2 = W2[i];
+      r1[i] = PHGMG__FMA(t00, f0, PHGMG__FMA(t01, f1, PHGMG__FMA(t02, f2, -gih * w0)));
+      rc[2 * i] =
+          PHGMG__FMA(t10, f0, PHGMG__FMA(t11, f1, PHGMG__FMA(t12, f2, -(aih * w1 + bih * w2))));
+      rc[2 * i + 1] =
+          PHGMG__FMA(t20, f0, PHGMG__FMA(t21, f1, PHGMG__FMA(t22, f2, bih * w1 - aih * w2)));
+    }
     if (s->mode == PHGMG__GL3_BANDED && s->nopiv1 && s->nopiv2) {
-      phgmg__gb_solve_pair_nopiv(N, s->kl, s->ku, s->ldab, s->AB1, s->dinv1, s->AB2, s->dinv2,
-                                 s->r1, s->rc);
+      phgmg__gl3_solve_packed(s, s->r1, s->rc);
     } else {
       phgmg__gl3_solve_real(s, s->r1);
       phgmg__gl3_solve_cplx(s, s->rc);
     }
-    for (i = 0; i < N; ++i) {
-      double w0 = W0[i] + s->r1[i], w1 = W1[i] + s->rc[2 * i], w2 = W2[i] + s->rc[2 * i + 1];
-      W0[i] = w0; W1[i] = w1; W2[i] = w2;
-      Z0[i] = T[0] * w0 + T[1] * w1 + T[2] * w2;
-      Z1[i] = T[3] * w0 + T[4] * w1 + T[5] * w2;
-      Z2[i] = T[6] * w0 + T[7] * w1 + T[8] * w2;
+    {
+      const double T00 = T[0], T01 = T[1], T02 = T[2], T10 = T[3], T11 = T[4], T12 = T[5],
+                   T20 = T[6], T21 = T[7], T22 = T[8];
+      const double *d1 = s->r1, *dc = s->rc;
+      for (i = 0; i < N; ++i) {
+        double w0 = W0[i] + d1[i], w1 = W1[i] + dc[2 * i], w2 = W2[i] + dc[2 * i + 1];
+        W0[i] = w0; W1[i] = w1; W2[i] = w2;
+        Z0[i] = PHGMG__FMA(T00, w0, PHGMG__FMA(T01, w1, T02 * w2));
+        Z1[i] = PHGMG__FMA(T10, w0, PHGMG__FMA(T11, w1, T12 * w2));
+        Z2[i] = PHGMG__FMA(T20, w0, PHGMG__FMA(T21, w1, T22 * w2));
+      }
     }
     res_prev = res;
     ++it;

@@ -162,7 +162,7 @@ PHGMG_DEF phgmg_result phgmg_deim(int nterms, int ns, const double *F, int ldf, 
   phgmg_result rc;
   if (!F || !pts || !w || !nd_out) return PHGMG_ERR_INVALID_ARG;
   if (nterms < 1 || ns < 1 || ldf < nterms) return PHGMG_ERR_SIZE;
-  if (!phgmg__all_finite(F, (size_t)ldf * (size_t)(ns - 1) + (size_t)nterms)) return PHGMG_ERR_NANINF;
+  if (!phgmg__mat_finite(nterms, ns, F, ldf)) return PHGMG_ERR_NANINF; /* padding rows are not data */
   if (tol <= 0.0) tol = 1e-8;
   kk = PHGMG__MIN(nterms, ns);
   if (kmax > 0) kk = PHGMG__MIN(kk, kmax + 1);
@@ -404,7 +404,7 @@ PHGMG_DEF phgmg_result phgmg_reduce(phgmg_reduced **out, const phgmg_ph_system *
   }
   if (sys->nl == PHGMG_NL_GENERAL) return PHGMG_ERR_UNSUPPORTED;
   if (sys->nl == PHGMG_NL_SEPARABLE && (sys->poly_deg < 1 || !sys->poly)) return PHGMG_ERR_UNSUPPORTED;
-  if (!phgmg__all_finite(X, (size_t)ldx * (size_t)(ns - 1) + (size_t)N)) return PHGMG_ERR_NANINF;
+  if (!phgmg__mat_finite(N, ns, X, ldx)) return PHGMG_ERR_NANINF; /* padding rows are not data */
   rc = phgmg_ph_validate(sys, 0.0, &inf.rcond_jr, alloc);
   if (rc != PHGMG_OK) return rc;
   lambda = opts->lambda == 0.0 ? 1e-3 : (opts->lambda < 0.0 ? 0.0 : opts->lambda);

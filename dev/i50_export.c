@@ -171,7 +171,7 @@ PHGMG__ONLINE phgmg_result phgmg__rom_header(const unsigned char *b, size_t len,
   for (i = 0; i < PHGMG__NFIELDS; ++i)
     if (mask & (1u << i)) {
       size_t k = phgmg__field_len(rom, i);
-      if (k > ((size_t)1 << 40)) return PHGMG_ERR_FORMAT;
+      if (k > ((size_t)1 << 28)) return PHGMG_ERR_FORMAT;
       n += k;
     }
   if (n > (len / ss)) return PHGMG_ERR_FORMAT;
@@ -303,9 +303,9 @@ PHGMG_DEF phgmg_result phgmg_rom_export_c(const phgmg_rom *rom, const char *name
     ok &= fprintf(f, "static const phgmg_real %s_%s[%lu] = {", name, phgmg__fields[i].name, (unsigned long)n) > 0;
     for (k = 0; k < n; ++k)
 #if PHGMG_REAL_IS_FLOAT
-      ok &= fprintf(f, "%s%.9gf", k % 6 ? ", " : "\n  ", (double)a[k]) > 0;
+      ok &= fprintf(f, "%s%#.9gf", k == 0 ? "\n  " : (k % 6 ? ", " : ",\n  "), (double)a[k]) > 0;
 #else
-      ok &= fprintf(f, "%s%.17g", k % 4 ? ", " : "\n  ", a[k]) > 0;
+      ok &= fprintf(f, "%s%.17g", k == 0 ? "\n  " : (k % 4 ? ", " : ",\n  "), a[k]) > 0;
 #endif
     ok &= fprintf(f, "};\n") > 0;
   }
@@ -316,7 +316,7 @@ PHGMG_DEF phgmg_result phgmg_rom_export_c(const phgmg_rom *rom, const char *name
     else ok &= fprintf(f, " NULL,") > 0;
   }
 #if PHGMG_REAL_IS_FLOAT
-  ok &= fprintf(f, "\n  %.9gf,\n ", (double)rom->dt) > 0;
+  ok &= fprintf(f, "\n  %#.9gf,\n ", (double)rom->dt) > 0;
 #else
   ok &= fprintf(f, "\n  %.17g,\n ", rom->dt) > 0;
 #endif

@@ -210,8 +210,8 @@ TEST(test_norms) {
 static void lu_check(int n, const double *A) {
   int lda = n + 1, i, j, k;
   double *F = tl_new((size_t)lda * n), *PA = tl_new((size_t)n * n), *L = tl_new((size_t)n * n);
-  double *U = tl_new((size_t)n * n), *LU = tl_new((size_t)n * n), *x = tl_new((size_t)n * 2);
-  double *b = tl_new((size_t)n * 2), anorm = tl_norm1(n, n, A, n), r;
+  double *U = tl_new((size_t)n * n), *LU = tl_new((size_t)n * n), *x = tl_new((size_t)n * 5);
+  double *b = tl_new((size_t)n * 5), anorm = tl_norm1(n, n, A, n), r;
   int *ipiv = (int *)calloc((size_t)n, sizeof(int));
   for (j = 0; j < n; ++j) memcpy(F + (size_t)j * lda, A + (size_t)j * n, sizeof(double) * n);
   CHECK_RC(phgmg_lu_factor(n, F, lda, ipiv), PHGMG_OK);
@@ -235,18 +235,20 @@ static void lu_check(int n, const double *A) {
   tl_mul(0, 0, n, n, n, L, n, U, n, LU, n);
   for (i = 0; i < n * n; ++i) LU[i] -= PA[i];
   CHECK_LE(tl_norm1(n, n, LU, n), 10.0 * n * EPS * anorm);
-  /* solves, both transposes: ||A x - b||_1 <= 10 n eps ||A||_1 ||x||_1 */
-  for (k = 0; k < 2; ++k) {
-    tl_rand(n, 2, b, n);
-    memcpy(x, b, sizeof(double) * 2 * n);
-    phgmg_lu_solve(k ? 'T' : 'N', n, F, lda, ipiv, 2, x, n);
-    for (j = 0; j < 2; ++j) {
+  /* solves, both transposes, one right-hand side (substitution) and five
+     (blocked): ||A x - b||_1 <= 10 n eps ||A||_1 ||x||_1 per column */
+  for (k = 0; k < 4; ++k) {
+    int nr = (k & 2) ? 5 : 1, tr = k & 1;
+    tl_rand(n, nr, b, n);
+    memcpy(x, b, sizeof(double) * nr * n);
+    phgmg_lu_solve(tr ? 'T' : 'N', n, F, lda, ipiv, nr, x, n);
+    for (j = 0; j < nr; ++j) {
       double res = 0.0, xn = 0.0;
       for (i = 0; i < n; ++i) {
         double s = -b[i + j * n];
         int p;
         for (p = 0; p < n; ++p)
-          s += (k ? A[p + (size_t)i * n] : A[i + (size_t)p * n]) * x[p + j * n];
+          s += (tr ? A[p + (size_t)i * n] : A[i + (size_t)p * n]) * x[p + j * n];
         res += fabs(s);
         xn += fabs(x[i + j * n]);
       }
@@ -359,7 +361,7 @@ TEST(test_zlu) {
   for (s = 0; s < 4; ++s) {
     int n = ns[s], lda = n + 2, i, j, k;
     double *A = tl_new(2 * (size_t)n * n), *F = tl_new(2 * (size_t)lda * n);
-    double *P = tl_new(2 * (size_t)n * n), *x = tl_new(2 * (size_t)n), *b = tl_new(2 * (size_t)n);
+    double *P = tl_new(2 * (size_t)n * n), *x = tl_new(6 * (size_t)n), *b = tl_new(6 * (size_t)n);
     double err = 0.0, anorm = 0.0, res = 0.0, xn = 0.0;
     int *ipiv = (int *)calloc((size_t)n, sizeof(int));
     tl_rand(2 * n, n, A, 2 * n);
@@ -400,20 +402,28 @@ TEST(test_zlu) {
       err = fmax(err, cs);
     }
     CHECK_LE(err, 10.0 * n * EPS * anorm);
-    tl_rand(2 * n, 1, b, 2 * n);
-    memcpy(x, b, 2 * sizeof(double) * n);
-    phgmg_zlu_solve(n, F, lda, ipiv, 1, x, n);
-    for (i = 0; i < n; ++i) {
-      double sr = -b[2 * i], si = -b[2 * i + 1];
-      for (j = 0; j < n; ++j) {
-        double ar = A[2 * (i + j * n)], ai = A[2 * (i + j * n) + 1];
-        sr += ar * x[2 * j] - ai * x[2 * j + 1];
-        si += ar * x[2 * j + 1] + ai * x[2 * j];
+    /* one right-hand side (substitution), then three (blocked) */
+    for (k = 1; k <= 3; k += 2) {
+      int c;
+      tl_rand(2 * n, k, b, 2 * n);
+      memcpy(x, b, 2 * sizeof(double) * n * k);
+      phgmg_zlu_solve(n, F, lda, ipiv, k, x, n);
+      for (c = 0; c < k; ++c) {
+        const double *xc = x + 2 * (size_t)c * n, *bc = b + 2 * (size_t)c * n;
+        res = xn = 0.0;
+        for (i = 0; i < n; ++i) {
+          double sr = -bc[2 * i], si = -bc[2 * i + 1];
+          for (j = 0; j < n; ++j) {
+            double ar = A[2 * (i + j * n)], ai = A[2 * (i + j * n) + 1];
+            sr += ar * xc[2 * j] - ai * xc[2 * j + 1];
+            si += ar * xc[2 * j + 1] + ai * xc[2 * j];
+          }
+          res += hypot(sr, si);
+          xn += hypot(xc[2 * i], xc[2 * i + 1]);
+        }
+        CHECK_LE(res, 10.0 * n * EPS * anorm * xn);
       }
-      res += hypot(sr, si);
-      xn += hypot(x[2 * i], x[2 * i + 1]);
     }
-    CHECK_LE(res, 10.0 * n * EPS * anorm * xn);
     free(A); free(F); free(P); free(x); free(b); free(ipiv);
   }
   {
@@ -674,9 +684,10 @@ TEST(test_svd_edge) {
 
 /* ---- symmetric eigenproblem ---------------------------------------------------------- */
 TEST(test_sym_eig) {
-  const int ns[] = {1, 2, 9, 40};
+  /* n <= 24: cyclic Jacobi; larger: tridiagonalization + implicit QL */
+  const int ns[] = {1, 2, 9, 24, 25, 40, 150};
   int s;
-  for (s = 0; s < 4; ++s) {
+  for (s = 0; s < 7; ++s) {
     int n = ns[s], i, j, ld = n + 1;
     double *Q = tl_new((size_t)n * n), *QL = tl_new((size_t)n * n), *A = tl_new((size_t)ld * n);
     double *A0 = tl_new((size_t)n * n), *lam = tl_new((size_t)n), *w = tl_new((size_t)n);
@@ -713,6 +724,24 @@ TEST(test_sym_eig) {
     for (i = 0; i < n; ++i) err = fmax(err, fabs(w[i] - lam[i]));
     CHECK_LE(err, 10.0 * n * EPS * amax);
     free(Q); free(QL); free(A); free(A0); free(lam); free(w); free(V); free(AV);
+  }
+  {
+    /* diagonal (every Householder step degenerate) with a zero block: the
+       eigenvalues are the sorted diagonal, V a permutation */
+    const int n = 30;
+    double *A = tl_new((size_t)n * n), *V = tl_new((size_t)n * n), w[30];
+    int i, j;
+    for (i = 0; i < n; ++i) A[i + i * n] = (i % 3 == 0) ? 0.0 : (double)((i * 7) % n) - 10.0;
+    CHECK_RC(phgmg_sym_eig(n, A, n, w, V, n), PHGMG_OK);
+    for (i = 1; i < n; ++i) CHECK(w[i] >= w[i - 1]);
+    for (j = 0; j < n; ++j) {
+      int nz = 0, row = -1;
+      for (i = 0; i < n; ++i)
+        if (V[i + j * n] != 0.0) { nz++; row = i; }
+      CHECK(nz == 1 && fabs(V[row + j * n]) == 1.0);
+      if (nz == 1) CHECK(w[j] == ((row % 3 == 0) ? 0.0 : (double)((row * 7) % n) - 10.0));
+    }
+    free(A); free(V);
   }
   {
     /* closed form: [[2,1],[1,2]] has eigenvalues 1, 3 */

@@ -1,0 +1,119 @@
+#!/bin/sh
+# make bench: build and run the benchmarks, write bench/results.csv.
+#
+#   sh bench/run.sh
+#
+# 1. prints the machine line (CPU model, cores, compiler and flags, load);
+# 2. builds bench/bench_linalg.c, bench/bench_fom.c, bench/bench_rom.c into
+#    build/ (a missing or broken source is skipped with a warning) and runs
+#    each, appending `case,median_s,min_s,max_s,runs` lines to the CSV;
+# 3. if a CBLAS is installed, builds bench_linalg again with -DPHGMG_USE_CBLAS
+#    and records its cases with a `_cblas` suffix (one BLAS thread);
+# 4. builds the examples and times the whole demo (wall clock, one warm-up,
+#    then DEMO_RUNS runs) as case `demo_total`;
+# 5. prints the CSV as a table.
+# Environment: CC (default cc), BENCH_CSV (default bench/results.csv),
+# DEMO_RUNS (default 5).
+set -u
+cd "$(dirname "$0")/.." || exit 1
+
+CC=${CC:-cc}
+CFLAGS="-std=c99 -O2 -march=native"
+LIBS="-lm"
+BUILD=build
+CSV=${BENCH_CSV:-bench/results.csv}
+DEMO_RUNS=${DEMO_RUNS:-5}
+# one core: no BLAS threads
+OPENBLAS_NUM_THREADS=1; OMP_NUM_THREADS=1; export OPENBLAS_NUM_THREADS OMP_NUM_THREADS
+
+mkdir -p "$BUILD"
+cpu=$(grep -m1 'model name' /proc/cpuinfo 2>/dev/null | sed 's/^[^:]*: *//')
+[ -n "$cpu" ] || cpu=$(uname -m)
+mhz=$(grep -m1 'cpu MHz' /proc/cpuinfo 2>/dev/null | sed 's/^[^:]*: *//')
+cores=$(nproc 2>/dev/null || echo '?')
+ccver=$($CC --version 2>/dev/null | head -n 1)
+load=$(cut -d' ' -f1-3 /proc/loadavg 2>/dev/null)
+machine="machine: $cpu (${mhz:-?} MHz), $cores cores; $ccver; flags $CFLAGS; load average $load; $(date -u +%Y-%m-%dT%H:%MZ)"
+echo "$machine"
+echo "$machine" > "$BUILD/bench_machine.txt"
+
+make phgmg.h >/dev/null || { echo "run.sh: cannot build phgmg.h" >&2; exit 1; }
+echo "case,median_s,min_s,max_s,runs" > "$CSV"
+
+for prog in bench_linalg bench_fom bench_rom; do
+  src=bench/$prog.c
+  if [ ! -f "$src" ]; then
+    echo "run.sh: warning: $src is missing, skipped" >&2
+    continue
+  fi
+  echo
+  echo "== $prog"
+  if ! $CC $CFLAGS -o "$BUILD/$prog" "$src" $LIBS; then
+    echo "run.sh: warning: $src does not build, skipped" >&2
+    continue
+  fi
+  "./$BUILD/$prog" "$CSV" || echo "run.sh: warning: $prog failed (exit $?)" >&2
+done
+
+# CBLAS: the first of these libraries that links and runs a 1x1 dgemm
+if [ -f bench/bench_linalg.c ]; then
+  printf '#include <cblas.h>\nint main(void) { double a = 2, b = 3, c = 0;\n  cblas_dgemm(CblasColMajor, CblasNoTrans, CblasNoTrans, 1, 1, 1, 1.0, &a, 1, &b, 1, 0.0, &c, 1);\n  return c == 6.0 ? 0 : 1; }\n' > "$BUILD/cblas_probe.c"
+  cblas=""
+  for lib in -lopenblas -lcblas -lblas; do
+    if $CC -o "$BUILD/cblas_probe" "$BUILD/cblas_probe.c" $lib $LIBS >/dev/null 2>&1 && "./$BUILD/cblas_probe"; then
+      cblas=$lib
+      break
+    fi
+  done
+  if [ -n "$cblas" ]; then
+    echo
+    echo "== bench_linalg with -DPHGMG_USE_CBLAS ($cblas, 1 thread)"
+    tmp="$BUILD/bench_cblas.csv"
+    rm -f "$tmp"
+    if $CC $CFLAGS -DPHGMG_USE_CBLAS -o "$BUILD/bench_linalg_cblas" bench/bench_linalg.c $cblas $LIBS &&
+       "./$BUILD/bench_linalg_cblas" "$tmp"; then
+      awk -F, 'NR > 1 && NF == 5 { printf "%s_cblas,%s,%s,%s,%s\n", $1, $2, $3, $4, $5 }' "$tmp" >> "$CSV"
+    else
+      echo "run.sh: warning: the CBLAS build of bench_linalg failed" >&2
+    fi
+  else
+    echo "run.sh: no CBLAS found (cblas.h with -lopenblas, -lcblas or -lblas); _cblas cases skipped" >&2
+  fi
+fi
+
+# the whole demo, wall clock
+echo
+echo "== demo_total (make examples; msd_linear + msd_nonlinear, 1 warm-up + $DEMO_RUNS runs)"
+if make examples >/dev/null && [ -x "$BUILD/msd_linear" ] && [ -x "$BUILD/msd_nonlinear" ]; then
+  mkdir -p "$BUILD/bench_results"
+  times=""
+  i=0
+  ok=1
+  while [ $i -le "$DEMO_RUNS" ]; do
+    t0=$(date +%s.%N)
+    if ! { "./$BUILD/msd_linear" --out "$BUILD/bench_results" && "./$BUILD/msd_nonlinear" --out "$BUILD/bench_results"; } >/dev/null; then
+      echo "run.sh: warning: the demo failed" >&2
+      ok=0
+      break
+    fi
+    t1=$(date +%s.%N)
+    dt=$(awk -v a="$t0" -v b="$t1" 'BEGIN { printf "%.6f", b - a }')
+    if [ $i -eq 0 ]; then echo "  warm-up ${dt} s"; else echo "  run $i ${dt} s"; times="$times $dt"; fi
+    i=$((i + 1))
+  done
+  if [ $ok -eq 1 ]; then
+    echo $times | tr ' ' '\n' | sort -g | awk -v n="$DEMO_RUNS" '
+      { t[NR] = $1 }
+      END { med = (n % 2) ? t[(n + 1) / 2] : 0.5 * (t[n / 2] + t[n / 2 + 1]);
+            printf "demo_total,%.6f,%.6f,%.6f,%d\n", med, t[1], t[n], n }' >> "$CSV"
+  fi
+else
+  echo "run.sh: warning: make examples failed, demo_total skipped" >&2
+fi
+
+echo
+echo "$machine"
+awk -F, 'NR == 1 { printf "%-40s %12s %12s %12s %8s %5s\n", "case", "median_s", "min_s", "max_s", "spread", "runs"; next }
+         NF == 5 { sp = $2 > 0 ? 100 * ($4 - $3) / $2 : 0;
+                   printf "%-40s %12.6f %12.6f %12.6f %7.1f%% %5d\n", $1, $2, $3, $4, sp, $5 }' "$CSV"
+echo "(spread = (max - min) / median; written to $CSV)"

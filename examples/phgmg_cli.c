@@ -1,0 +1,1053 @@
+/* phgmg — the command-line reducer: bring a port-Hamiltonian model as NumPy
+   .npy arrays, get a structure-preserving reduced model back as .npy arrays,
+   as the binary model file and as C source for firmware, without writing C.
+
+   What it shows: the whole offline path of phgmg.h driven from files --
+   reading and checking J, R, B, Q (and an optional separable polynomial
+   nonlinearity), simulating the full model for snapshots (or reading them),
+   phgmg_reduce, and the three export forms -- plus the online path
+   (`simulate-rom`: load the model file, step it with the allocation-free GL3
+   stepper, write the outputs) so the reduced model can be compared with the
+   full one in Python. `phgmg --help` prints the manual (the text below in
+   help_lines); examples/npy_example/ is the worked example (tests/CLI.md).
+
+   Build: cc -std=c99 -O2 examples/phgmg_cli.c -o build/phgmg -lm
+   Exit status: 0 success, 1 bad data or a failed computation/file, 2 bad usage. */
+#define _POSIX_C_SOURCE 200809L
+#define PHGMG_STATIC
+#define PHGMG_IMPLEMENTATION
+#include "../phgmg.h"
+#include <errno.h>
+#include <limits.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/types.h>
+#include <time.h>
+
+/* The manual, one string per line (C99 caps a single literal at 4095 bytes). */
+static const char *const help_lines[] = {
+  "phgmg " PHGMG_VERSION_STRING " - structure-preserving model order reduction of port-Hamiltonian\n",
+  "systems (generalized manifold Galerkin), from NumPy .npy files.\n",
+  "\n",
+  "USAGE\n",
+  "  phgmg reduce --J J.npy --R R.npy --B B.npy --Q Q.npy\n",
+  "               (--X X.npy | --simulate [--dt 0.1] [--steps 1000] [--input sin] [--amp 0.1])\n",
+  "               --method gmg-pod|gmg-qm|sp1|sp2 --r R [--rn 8] [--lambda 1e-3]\n",
+  "               [--poly coeffs.npy --poly-idx idx.npy [--poly-w w.npy]] [DEIM options]\n",
+  "               --out DIR [--name rom] [--dt-map DT] [--save-snapshots] [--quiet]\n",
+  "  phgmg simulate-rom --model DIR/NAME.phgmgrom --out y.npy [--states xr.npy]\n",
+  "               [--dt DT] [--steps 1000] [--input sin] [--amp 0.1] [--quiet]\n",
+  "  phgmg info MODEL.phgmgrom\n",
+  "  phgmg --help | --version\n",
+  "\n",
+  "THE MODEL\n",
+  "  x' = (J - R) grad H(x) + B u(t),  y = B^T grad H(x),\n",
+  "  H(x) = 1/2 x^T Q x + sum_k w_k phi(x[idx_k]),  phi(s) = sum_j c_j s^j (optional).\n",
+  "  J (N x N) skew-symmetric, R (N x N) symmetric positive semidefinite, Q (N x N)\n",
+  "  symmetric positive definite (the Hessian of the quadratic energy), B (N x m)\n",
+  "  of full column rank, J - R nonsingular. The relative tolerance of these checks\n",
+  "  is 1e-12; a failing check names the file and prints the measured defect.\n",
+  "\n",
+  "COMMAND reduce\n",
+  "  --J FILE, --R FILE, --Q FILE   N x N matrices (required).\n",
+  "  --B FILE            N x m port matrix, or a vector of length N for m = 1 (required).\n",
+  "  --X FILE            snapshot matrix N x ns (ns >= 2 states, one per column; a\n",
+  "                      trajectory x(t_0), ..., x(t_n), normally starting at x = 0).\n",
+  "  --simulate          instead of --X: simulate the full model from x0 = 0 with the\n",
+  "                      3-stage Gauss-Legendre method (order 6) and use the steps+1\n",
+  "                      states as snapshots. Options:\n",
+  "    --dt DT           step (default 0.1)\n",
+  "    --steps N         number of steps (default 1000), t in [0, N*DT]\n",
+  "    --input KIND      sin: u(t) = AMP sin(t);  const: u(t) = AMP  (every port the\n",
+  "                      same; default sin);  or a FILE.npy (see INPUT FILES; AMP is\n",
+  "                      then not used)\n",
+  "    --amp AMP         amplitude (default 0.1)\n",
+  "    --newton-tol T    Newton tolerance (stage residual, inf-norm) for nonlinear\n",
+  "                      models (default 1e-10)\n",
+  "    --newton-iter K   Newton iteration cap per step (default 10)\n",
+  "  --method M          gmg-pod: linear map phi(x) = [B, V] x, GMG reduction (paper 4.2.1)\n",
+  "                      gmg-qm:  quadratic manifold phi(x) = [B, V1] x + V2 M (x2 kron x2)\n",
+  "                               (paper 4.2.2)\n",
+  "                      sp1:     SP1-POD, phi = V x, W = QV (V^T Q V)^-1 (baseline)\n",
+  "                      sp2:     SP2-POD, W from a POD of the gradient snapshots\n",
+  "                      (required)\n",
+  "  --r R               reduced order (required). For gmg-pod/gmg-qm it includes the m\n",
+  "                      port coordinates, so m < R <= N; R - m (gmg) or R (sp1/sp2) must\n",
+  "                      not exceed the rank of the (adjusted) snapshots.\n",
+  "  --rn K              gmg-qm lifting dimension r_n (default 8; K <= 64, K (R-m) <= 4096,\n",
+  "                      R + K <= N)\n",
+  "  --lambda L          gmg-qm ridge parameter, on the un-normalised sum over the\n",
+  "                      snapshots (default 1e-3; 0 = exactly zero)\n",
+  "  --poly FILE         separable polynomial nonlinearity: a vector of the\n",
+  "                      coefficients c_0, c_1, ..., c_d (constant first, d >= 1) of phi,\n",
+  "                      shared by every term. Needs --poly-idx.\n",
+  "  --poly-idx FILE     a vector of the 0-based state coordinates idx_k of the terms\n",
+  "                      (integers stored as float64, each in [0, N)).\n",
+  "  --poly-w FILE       a vector of the term weights w_k (default all 1).\n",
+  "  --no-deim           keep every nonlinear term online (exact, cost O(terms)).\n",
+  "                      Default: structure-preserving DEIM picks a few of them.\n",
+  "  --deim-tol T        DEIM keeps the modes with sigma_k / sigma_1 > T (default 1e-8)\n",
+  "  --deim-max K        at most K DEIM points (default: no cap)\n",
+  "  --deim-allow-negative  accept negative DEIM weights (the reduced energy may then\n",
+  "                      lose its lower bound); default: refuse with an error.\n",
+  "  --dt-map DT         precompute the exact GL3 step map for step DT in the model\n",
+  "                      (linear models with quadratic H; the online stepper then needs\n",
+  "                      no Newton iteration at that step). Default: the --dt of\n",
+  "                      --simulate, none with --X; 0 = none.\n",
+  "  --out DIR           output directory, created if missing (required).\n",
+  "  --name NAME         base name of the outputs and C identifier prefix (default rom;\n",
+  "                      letters, digits and _, not starting with a digit).\n",
+  "  --save-snapshots    also write NAME_snapshots.npy (N x ns) and NAME_fom_y.npy\n",
+  "                      (m x ns: the full model's output at the snapshots).\n",
+  "  --quiet             no progress lines on stderr.\n",
+  "\n",
+  "  Outputs in DIR:\n",
+  "    NAME.phgmgrom      the binary model file (phgmg_rom_load; for simulate-rom)\n",
+  "    NAME.c             C source: static const arrays NAME_<field> and a\n",
+  "                      `static const phgmg_rom NAME` (include after phgmg.h)\n",
+  "    NAME_<field>.npy   every array of the reduced model, float64, with its matrix\n",
+  "                      shape: Bh (r x m), Qh (r x r), K (r x r, = J_r - R_r), and as\n",
+  "                      they apply G00 G01 G10 G11 Q01 Q11 Ms (gmg-qm), P0 P1 w poly\n",
+  "                      (nonlinear), Phi Gam SX SU (step map); see phgmg.h >>online.\n",
+  "    NAME_V0.npy        the reduction basis V0 (N x r): x ~ V0 xr (gmg-pod, sp1, sp2)\n",
+  "    NAME_V2.npy, NAME_M.npy  (gmg-qm) V2 (N x r_n) and M (r_n x p^2, p = r - m):\n",
+  "                      x ~ V0 xr + V2 M kron(x2, x2), x2 = xr[m:]\n",
+  "    NAME.json          sizes, method, options, diagnostics and the list of files\n",
+  "  The reduced model (LINEAR kind) is x' = K grad H(x) + Bh u, y = Bh^T grad H(x),\n",
+  "  H(x) = 1/2 x^T Qh x (+ sum_j w_j phi(P0_j x)); it is again port-Hamiltonian.\n",
+  "\n",
+  "COMMAND simulate-rom\n",
+  "  Runs a reduced model from xr = 0 with the online GL3 stepper and writes its\n",
+  "  output y, an m x (steps+1) matrix (column n = y(n*DT)).\n",
+  "  --model FILE        a .phgmgrom file written by reduce (required)\n",
+  "  --out FILE          output .npy (required)\n",
+  "  --states FILE       also write the reduced states (r x (steps+1))\n",
+  "  --dt DT             step (default: the model's step-map DT if it has one, else 0.1)\n",
+  "  --steps N, --input KIND, --amp AMP, --newton-tol T, --newton-iter K:  as above\n",
+  "  --quiet             no progress lines\n",
+  "\n",
+  "COMMAND info MODEL\n",
+  "  Prints the sizes of a .phgmgrom file and the bytes of stepper memory its\n",
+  "  firmware needs (phgmg_rom_stepper_memsize).\n",
+  "\n",
+  "INPUT FILES (.npy)\n",
+  "  Read: format versions 1.0-3.0, float64 or float32, little- or big-endian, C or\n",
+  "  Fortran order, 0-d/1-d/2-d. Matrices are (rows, cols) as NumPy shows them, so\n",
+  "  np.save('J.npy', J) is all it takes. Values must be finite.\n",
+  "  --input FILE.npy:   either a 2-d table of shape (K, 1 + m): column 0 the times\n",
+  "                      (strictly increasing), columns 1..m the inputs at those times;\n",
+  "                      or, for m = 1, a vector of K samples u(k DT), k = 0..K-1.\n",
+  "                      u(t) is interpolated linearly, held constant outside.\n",
+  "  Written: format 1.0, '<f8', Fortran order (NumPy reads it as usual).\n",
+  "\n",
+  "EXAMPLES\n",
+  "  python3 examples/npy_example/make_model.py model     # the paper's linear MSD, N = 100\n",
+  "  phgmg reduce --J model/J.npy --R model/R.npy --B model/B.npy --Q model/Q.npy \\\n",
+  "        --simulate --dt 0.1 --steps 1000 --input sin --amp 0.1 \\\n",
+  "        --method gmg-pod --r 12 --out out --name msd\n",
+  "  phgmg simulate-rom --model out/msd.phgmgrom --dt 0.1 --steps 1000 --input sin \\\n",
+  "        --amp 0.1 --out out/y_rom.npy\n",
+  "  python3 examples/npy_example/compare.py --model model --rom-y out/y_rom.npy\n",
+  "  phgmg reduce ... --X X.npy --method gmg-qm --r 12 --rn 8 --lambda 1e-3 --out out\n",
+  "  phgmg reduce ... --poly c.npy --poly-idx idx.npy --simulate --method gmg-pod --r 16 --out out\n",
+  "\n",
+  "EXIT STATUS\n",
+  "  0 success; 1 a file could not be read/written, bad data, or a failed\n",
+  "  computation (the message names the file and the problem); 2 bad usage.\n",
+  NULL};
+
+static void print_help(void) {
+  int i;
+  for (i = 0; help_lines[i]; ++i) fputs(help_lines[i], stdout);
+}
+
+/* ---- messages ------------------------------------------------------------- */
+static int g_quiet = 0;
+
+static double now_s(void) {
+  struct timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* Progress line on stderr (suppressed by --quiet). */
+static void progress(const char *fmt, ...) {
+  va_list ap;
+  if (g_quiet) return;
+  fputs("phgmg: ", stderr);
+  va_start(ap, fmt);
+  vfprintf(stderr, fmt, ap);
+  va_end(ap);
+  fputc('\n', stderr);
+}
+
+/* Error on stderr; returns the exit status 1 for `return fail(...)`. */
+static int fail(const char *fmt, ...) {
+  va_list ap;
+  fputs("phgmg: error: ", stderr);
+  va_start(ap, fmt);
+  vfprintf(stderr, fmt, ap);
+  va_end(ap);
+  fputc('\n', stderr);
+  return 1;
+}
+
+/* Usage error: status 2. */
+static int usage_error(const char *fmt, ...) {
+  va_list ap;
+  fputs("phgmg: ", stderr);
+  va_start(ap, fmt);
+  vfprintf(stderr, fmt, ap);
+  va_end(ap);
+  fputs("\n(run 'phgmg --help' for the options)\n", stderr);
+  return 2;
+}
+
+/* ---- option values ------------------------------------------------------------ */
+static int parse_int(const char *opt, const char *s, int lo, int hi, int *out) {
+  char *end;
+  long v;
+  errno = 0;
+  v = strtol(s, &end, 10);
+  if (errno || end == s || *end || v < lo || v > hi) {
+    usage_error("%s: expected an integer in [%d, %d], got '%s'", opt, lo, hi, s);
+    return 0;
+  }
+  *out = (int)v;
+  return 1;
+}
+static int parse_double(const char *opt, const char *s, double lo, double *out) {
+  char *end;
+  double v;
+  errno = 0;
+  v = strtod(s, &end);
+  if (errno || end == s || *end || !isfinite(v) || v < lo) {
+    usage_error("%s: expected a finite number >= %g, got '%s'", opt, lo, s);
+    return 0;
+  }
+  *out = v;
+  return 1;
+}
+
+/* ---- matrices from .npy ----------------------------------------------------- */
+typedef struct mat {
+  double *a; /* column-major rows x cols */
+  int rows, cols, ndim;
+  const char *path;
+} mat;
+
+static void mat_free(mat *m) {
+  phgmg_npy_free(m->a, NULL);
+  m->a = NULL;
+}
+
+/* Read path into *m: a clear message naming the file (and the option it came
+   from) on failure. */
+static int mat_load(mat *m, const char *opt, const char *path) {
+  phgmg_result rc;
+  FILE *f;
+  size_t i, n;
+  memset(m, 0, sizeof *m);
+  m->path = path;
+  f = fopen(path, "rb");
+  if (!f) return fail("%s (%s): cannot open: %s", path, opt, strerror(errno));
+  fclose(f);
+  rc = phgmg_npy_read(path, &m->a, &m->rows, &m->cols, &m->ndim, NULL);
+  if (rc == PHGMG_ERR_FORMAT)
+    return fail("%s (%s): not a readable .npy array: %s (float64/float32, at most 2-d, "
+                "format 1.0-3.0)", path, opt, phgmg_result_string(rc));
+  if (rc != PHGMG_OK) return fail("%s (%s): %s", path, opt, phgmg_result_string(rc));
+  n = (size_t)m->rows * (size_t)m->cols;
+  for (i = 0; i < n; ++i)
+    if (!isfinite(m->a[i])) {
+      int r = (int)(i % (size_t)m->rows), c = (int)(i / (size_t)m->rows);
+      fail("%s (%s): NaN or Inf at element (%d, %d)", path, opt, r, c);
+      mat_free(m);
+      return 1;
+    }
+  return 0;
+}
+
+/* "shape (100, 99)" / "shape (100,)" / "shape ()" of a loaded array. */
+static const char *shape_str(const mat *m) {
+  static char buf[64];
+  if (m->ndim == 0) snprintf(buf, sizeof buf, "shape ()");
+  else if (m->ndim == 1) snprintf(buf, sizeof buf, "shape (%d,)", m->rows);
+  else snprintf(buf, sizeof buf, "shape (%d, %d)", m->rows, m->cols);
+  return buf;
+}
+
+static int is_vector(const mat *m) { return m->ndim <= 1 || m->rows == 1 || m->cols == 1; }
+
+/* ---- the input signal ------------------------------------------------------- */
+enum { IN_SIN = 0, IN_CONST = 1, IN_TABLE = 2, IN_GRID = 3 };
+typedef struct cli_input {
+  int kind, m;
+  double amp;
+  mat tab;        /* IN_TABLE: K x (1+m); IN_GRID: K samples on t = k*grid_dt */
+  double grid_dt;
+  /* progress of a long simulation, reported from the input callback */
+  int report;
+  double t_end, wall0, wall_last;
+} cli_input;
+
+static void table_eval(const cli_input *in, double t, double *u) {
+  const mat *T = &in->tab;
+  const int K = in->kind == IN_GRID ? T->rows * T->cols : T->rows;
+  int lo = 0, hi = K - 1, a;
+  double t_lo, t_hi, s;
+#define TIME(k) (in->kind == IN_GRID ? (double)(k) * in->grid_dt : T->a[(k)])
+#define VAL(k, a) (in->kind == IN_GRID ? T->a[(k)] : T->a[(k) + (size_t)((a) + 1) * (size_t)K])
+  if (K == 1 || t <= TIME(0)) { for (a = 0; a < in->m; ++a) u[a] = VAL(0, a); return; }
+  if (t >= TIME(K - 1)) { for (a = 0; a < in->m; ++a) u[a] = VAL(K - 1, a); return; }
+  while (hi - lo > 1) { /* TIME(lo) <= t < TIME(hi) */
+    const int mid = lo + (hi - lo) / 2;
+    if (TIME(mid) <= t) lo = mid; else hi = mid;
+  }
+  t_lo = TIME(lo); t_hi = TIME(hi);
+  s = (t - t_lo) / (t_hi - t_lo);
+  for (a = 0; a < in->m; ++a) u[a] = VAL(lo, a) + s * (VAL(hi, a) - VAL(lo, a));
+#undef TIME
+#undef VAL
+}
+
+static void input_fn(double t, double *u, void *user) {
+  cli_input *in = (cli_input *)user;
+  int a;
+  switch (in->kind) {
+    case IN_SIN: for (a = 0; a < in->m; ++a) u[a] = in->amp * sin(t); break;
+    case IN_CONST: for (a = 0; a < in->m; ++a) u[a] = in->amp; break;
+    default: table_eval(in, t, u); break;
+  }
+  if (in->report) { /* at most one progress line every 2 s */
+    const double w = now_s();
+    if (w - in->wall_last >= 2.0) {
+      in->wall_last = w;
+      progress("  ... t = %g of %g (%.0f%%, %.1f s)", t, in->t_end,
+               in->t_end > 0.0 ? 100.0 * t / in->t_end : 100.0, w - in->wall0);
+    }
+  }
+}
+
+/* Set up the input from --input/--amp for m ports and step dt. */
+static int input_setup(cli_input *in, const char *spec, double amp, int m, double dt) {
+  memset(in, 0, sizeof *in);
+  in->m = m;
+  in->amp = amp;
+  in->grid_dt = dt;
+  if (!strcmp(spec, "sin")) { in->kind = IN_SIN; return 0; }
+  if (!strcmp(spec, "const")) { in->kind = IN_CONST; return 0; }
+  if (mat_load(&in->tab, "--input", spec)) return 1;
+  if (in->tab.ndim == 2 && !(m == 1 && in->tab.cols == 1)) {
+    int k;
+    if (in->tab.cols != 1 + m || in->tab.rows < 1) {
+      fail("%s (--input): expected a table of shape (K, %d) (times, then %d input%s), got %s",
+           spec, 1 + m, m, m > 1 ? "s" : "", shape_str(&in->tab));
+      mat_free(&in->tab);
+      return 1;
+    }
+    for (k = 1; k < in->tab.rows; ++k)
+      if (!(in->tab.a[k] > in->tab.a[k - 1])) {
+        fail("%s (--input): the times in column 0 must increase strictly (row %d: %g after %g)",
+             spec, k, in->tab.a[k], in->tab.a[k - 1]);
+        mat_free(&in->tab);
+        return 1;
+      }
+    in->kind = IN_TABLE;
+    return 0;
+  }
+  if (m != 1 || in->tab.rows * in->tab.cols < 1) {
+    fail("%s (--input): a vector of samples needs a model with one input (m = %d) and at least "
+         "one sample; for m > 1 give a table of shape (K, %d); got %s",
+         spec, m, 1 + m, shape_str(&in->tab));
+    mat_free(&in->tab);
+    return 1;
+  }
+  in->kind = IN_GRID;
+  return 0;
+}
+
+static const char *input_desc(const cli_input *in, const char *spec) {
+  static char buf[600];
+  if (in->kind == IN_SIN) snprintf(buf, sizeof buf, "u(t) = %g sin(t)", in->amp);
+  else if (in->kind == IN_CONST) snprintf(buf, sizeof buf, "u(t) = %g", in->amp);
+  else snprintf(buf, sizeof buf, "u(t) from %s", spec);
+  return buf;
+}
+
+/* ---- files ---------------------------------------------------------------- */
+static int mkdir_p(const char *dir) {
+  char buf[4096];
+  size_t n = strlen(dir), i;
+  struct stat st;
+  if (n == 0 || n >= sizeof buf) return fail("%s (--out): bad directory name", dir);
+  memcpy(buf, dir, n + 1);
+  for (i = 1; i <= n; ++i) {
+    if (buf[i] == '/' || buf[i] == '\0') {
+      const char c = buf[i];
+      buf[i] = '\0';
+      if (mkdir(buf, 0777) != 0 && errno != EEXIST)
+        return fail("%s (--out): cannot create directory %s: %s", dir, buf, strerror(errno));
+      buf[i] = c;
+    }
+  }
+  if (stat(dir, &st) != 0 || !S_ISDIR(st.st_mode)) return fail("%s (--out): not a directory", dir);
+  return 0;
+}
+
+/* Write a rows x cols column-major array (ndim 2) and note it in the JSON file list. */
+typedef struct outlist {
+  char names[48][64];
+  int rows[48], cols[48], n;
+} outlist;
+
+static int write_npy(const char *path, const double *A, int rows, int cols, int ndim) {
+  phgmg_result rc = phgmg_npy_write(path, A, rows, cols, rows > 0 ? rows : 1, ndim, 0u);
+  if (rc != PHGMG_OK) return fail("%s: cannot write: %s (%s)", path, phgmg_result_string(rc), strerror(errno));
+  return 0;
+}
+
+static int write_field(const char *dir, const char *name, const char *field, const double *A,
+                       int rows, int cols, outlist *ol) {
+  char path[4096 + 256];
+  snprintf(path, sizeof path, "%s/%s_%s.npy", dir, name, field);
+  if (write_npy(path, A, rows, cols, 2)) return 1;
+  if (ol->n < 48) {
+    snprintf(ol->names[ol->n], sizeof ol->names[0], "%s_%s.npy", name, field);
+    ol->rows[ol->n] = rows; ol->cols[ol->n] = cols; ol->n++;
+  }
+  return 0;
+}
+
+/* The arrays of a phgmg_rom with their matrix shapes (phgmg.h >>online). */
+typedef struct rom_field { const char *name; const phgmg_real *a; int rows, cols; } rom_field;
+static int rom_fields(const phgmg_rom *rom, rom_field *f) {
+  const int r = rom->r, m = rom->m, rn = rom->rn, nd = rom->nd, p = rom->r - rom->m;
+  int n = 0;
+#define FIELD(nm, ptr, rr, cc) do { if ((ptr) && (rr) > 0 && (cc) > 0) { \
+      f[n].name = nm; f[n].a = ptr; f[n].rows = rr; f[n].cols = cc; ++n; } } while (0)
+  FIELD("Bh", rom->Bh, r, m);
+  FIELD("Qh", rom->Qh, r, r);
+  FIELD("K", rom->K, r, r);
+  if (rom->kind == PHGMG_ROM_QUADRATIC) {
+    FIELD("G00", rom->G00, r, r);
+    FIELD("G01", rom->G01, r, rn);
+    FIELD("G10", rom->G10, rn, r);
+    FIELD("G11", rom->G11, rn, rn);
+    FIELD("Q01", rom->Q01, r, rn);
+    FIELD("Q11", rom->Q11, rn, rn);
+    FIELD("Ms", rom->Ms, rn, p * p);
+  }
+  if (nd > 0) {
+    FIELD("P0", rom->P0, nd, r);
+    if (rom->kind == PHGMG_ROM_QUADRATIC) FIELD("P1", rom->P1, nd, rn);
+    FIELD("w", rom->w, nd, 1);
+    FIELD("poly", rom->poly, rom->poly_deg + 1, 1);
+  }
+  FIELD("Phi", rom->Phi, r, r);
+  FIELD("Gam", rom->Gam, r, 3 * m);
+  FIELD("SX", rom->SX, 3 * r, r);
+  FIELD("SU", rom->SU, 3 * r, 3 * m);
+#undef FIELD
+  return n;
+}
+
+static void json_str(FILE *f, const char *s) {
+  fputc('"', f);
+  for (; *s; ++s) {
+    const unsigned char c = (unsigned char)*s;
+    if (c == '"' || c == '\\') fprintf(f, "\\%c", c);
+    else if (c < 0x20) fprintf(f, "\\u%04x", c);
+    else fputc(c, f);
+  }
+  fputc('"', f);
+}
+/* Shortest of %.15g..%.17g that reads back exactly; null for NaN/Inf. */
+static void json_num(FILE *f, double v) {
+  char buf[40];
+  int prec;
+  if (!isfinite(v)) { fputs("null", f); return; }
+  for (prec = 15; prec < 17; ++prec) {
+    snprintf(buf, sizeof buf, "%.*g", prec, v);
+    if (strtod(buf, NULL) == v) break;
+  }
+  snprintf(buf, sizeof buf, "%.*g", prec, v);
+  fputs(buf, f);
+}
+
+static int valid_name(const char *s) {
+  const char *p;
+  if (!s[0] || (s[0] >= '0' && s[0] <= '9') || strlen(s) > 40) return 0;
+  for (p = s; *p; ++p)
+    if (!((*p >= 'a' && *p <= 'z') || (*p >= 'A' && *p <= 'Z') || (*p >= '0' && *p <= '9') || *p == '_'))
+      return 0;
+  return 1;
+}
+
+/* ---- validation messages ---------------------------------------------------- */
+/* ||A + s A^T||_F / ||A||_F (s = +1: skew defect, s = -1: symmetry defect). */
+static double sym_defect(const double *A, int N, double s) {
+  double num = 0.0, den = 0.0;
+  int i, j;
+  for (j = 0; j < N; ++j)
+    for (i = 0; i < N; ++i) {
+      const double d = A[i + (size_t)j * N] + s * A[j + (size_t)i * N];
+      num += d * d;
+      den += A[i + (size_t)j * N] * A[i + (size_t)j * N];
+    }
+  return den > 0.0 ? sqrt(num / den) : 0.0;
+}
+
+/* Explain a failed phgmg_ph_validate in terms of the files. */
+static int explain_validate(phgmg_result rc, const mat *J, const mat *R, const mat *B, const mat *Q,
+                            double rcond) {
+  const int N = J->rows;
+  switch (rc) {
+    case PHGMG_ERR_NOT_SKEW:
+      return fail("%s (--J): %s: ||J + J^T||_F / ||J||_F = %.3g (tolerance 1e-12)", J->path,
+                  phgmg_result_string(rc), sym_defect(J->a, N, 1.0));
+    case PHGMG_ERR_NOT_SYMMETRIC:
+      return fail("%s (--R): %s: ||R - R^T||_F / ||R||_F = %.3g (tolerance 1e-12)", R->path,
+                  phgmg_result_string(rc), sym_defect(R->a, N, -1.0));
+    case PHGMG_ERR_NOT_PSD:
+      return fail("%s (--R): %s (an eigenvalue below -1e-12 ||R||)", R->path, phgmg_result_string(rc));
+    case PHGMG_ERR_RANK:
+      return fail("%s (--B): %s: the %d columns of B are linearly dependent", B->path,
+                  phgmg_result_string(rc), B->cols);
+    case PHGMG_ERR_SINGULAR:
+      return fail("%s, %s (--J, --R): J - R is singular to working precision (rcond %.3g)", J->path,
+                  R->path, rcond);
+    default:
+      return fail("%s, %s, %s, %s: the system does not validate: %s", J->path, R->path, B->path,
+                  Q->path, phgmg_result_string(rc));
+  }
+}
+
+/* ---- reduce ------------------------------------------------------------------- */
+typedef struct reduce_args {
+  const char *J, *R, *B, *Q, *X, *poly, *poly_idx, *poly_w, *out, *name, *input, *method;
+  int simulate, steps, r, rn, no_deim, deim_max, deim_neg, save_snap, have_dt_map, newton_iter;
+  double dt, amp, lambda, deim_tol, dt_map, newton_tol;
+  int have_lambda;
+} reduce_args;
+
+static const char *method_name(int m) {
+  switch (m) {
+    case PHGMG_METHOD_GMG_POD: return "gmg-pod";
+    case PHGMG_METHOD_GMG_QM: return "gmg-qm";
+    case PHGMG_METHOD_SP1: return "sp1";
+    case PHGMG_METHOD_SP2: return "sp2";
+    default: return "unknown";
+  }
+}
+
+/* The value of option argv[*i] (advancing *i), or NULL after a usage message. */
+static const char *optval(int argc, char **argv, int *i) {
+  if (*i + 1 >= argc) { usage_error("%s needs a value", argv[*i]); return NULL; }
+  return argv[++*i];
+}
+
+static int parse_reduce(int argc, char **argv, reduce_args *A) {
+  int i;
+  memset(A, 0, sizeof *A);
+  A->dt = 0.1; A->steps = 1000; A->amp = 0.1; A->input = "sin"; A->rn = 8; A->lambda = 1e-3;
+  A->deim_tol = 1e-8; A->name = "rom"; A->newton_tol = 1e-10; A->newton_iter = 10;
+  for (i = 2; i < argc; ++i) {
+    const char *o = argv[i], *v;
+#define STR(opt, field) else if (!strcmp(o, opt)) { if (!(v = optval(argc, argv, &i))) return 2; A->field = v; }
+#define INT(opt, field, lo, hi) else if (!strcmp(o, opt)) { if (!(v = optval(argc, argv, &i)) || !parse_int(o, v, lo, hi, &A->field)) return 2; }
+#define DBL(opt, field, lo) else if (!strcmp(o, opt)) { if (!(v = optval(argc, argv, &i)) || !parse_double(o, v, lo, &A->field)) return 2; }
+    if (!strcmp(o, "--help") || !strcmp(o, "-h")) { print_help(); exit(0); }
+    STR("--J", J) STR("--R", R) STR("--B", B) STR("--Q", Q) STR("--X", X)
+    STR("--poly", poly) STR("--poly-idx", poly_idx) STR("--poly-w", poly_w)
+    STR("--out", out) STR("--name", name) STR("--input", input) STR("--method", method)
+    INT("--steps", steps, 1, INT_MAX - 1) INT("--r", r, 1, INT_MAX) INT("--rn", rn, 1, 64)
+    INT("--deim-max", deim_max, 1, INT_MAX) INT("--newton-iter", newton_iter, 1, 1000)
+    DBL("--amp", amp, -HUGE_VAL) DBL("--deim-tol", deim_tol, 0.0) DBL("--newton-tol", newton_tol, 0.0)
+    else if (!strcmp(o, "--dt")) {
+      if (!(v = optval(argc, argv, &i)) || !parse_double(o, v, 0.0, &A->dt)) return 2;
+      if (!(A->dt > 0.0)) return usage_error("--dt must be > 0");
+    }
+    else if (!strcmp(o, "--lambda")) {
+      if (!(v = optval(argc, argv, &i)) || !parse_double(o, v, 0.0, &A->lambda)) return 2;
+      A->have_lambda = 1;
+    }
+    else if (!strcmp(o, "--dt-map")) {
+      if (!(v = optval(argc, argv, &i)) || !parse_double(o, v, 0.0, &A->dt_map)) return 2;
+      A->have_dt_map = 1;
+    }
+    else if (!strcmp(o, "--simulate")) A->simulate = 1;
+    else if (!strcmp(o, "--no-deim")) A->no_deim = 1;
+    else if (!strcmp(o, "--deim-allow-negative")) A->deim_neg = 1;
+    else if (!strcmp(o, "--save-snapshots")) A->save_snap = 1;
+    else if (!strcmp(o, "--quiet")) g_quiet = 1;
+    else return usage_error("reduce: unknown option '%s'", o);
+#undef STR
+#undef INT
+#undef DBL
+  }
+  if (!A->J || !A->R || !A->B || !A->Q) return usage_error("reduce: --J, --R, --B and --Q are required");
+  if (!A->method) return usage_error("reduce: --method is required (gmg-pod, gmg-qm, sp1 or sp2)");
+  if (!A->r) return usage_error("reduce: --r is required");
+  if (!A->out) return usage_error("reduce: --out DIR is required");
+  if (!!A->X == !!A->simulate) return usage_error("reduce: give exactly one of --X FILE and --simulate");
+  if (!!A->poly != !!A->poly_idx) return usage_error("reduce: --poly and --poly-idx go together");
+  if (A->poly_w && !A->poly) return usage_error("reduce: --poly-w needs --poly and --poly-idx");
+  if (!valid_name(A->name))
+    return usage_error("--name '%s': must be a C identifier (letters, digits, _; not starting with a digit; "
+                       "at most 40 characters)", A->name);
+  if (!A->have_dt_map) A->dt_map = A->simulate ? A->dt : 0.0;
+  return 0;
+}
+
+typedef struct reduce_state {
+  mat J, R, B, Q, X, poly, pidx, pw;
+  int *idx;
+  double *Xsim, *Ysim, *V0;
+  cli_input in;
+  phgmg_reduced *red;
+} reduce_state;
+
+static void reduce_cleanup(reduce_state *S) {
+  mat_free(&S->J); mat_free(&S->R); mat_free(&S->B); mat_free(&S->Q); mat_free(&S->X);
+  mat_free(&S->poly); mat_free(&S->pidx); mat_free(&S->pw); mat_free(&S->in.tab);
+  free(S->idx); free(S->Xsim); free(S->Ysim); free(S->V0);
+  phgmg_reduced_destroy(S->red);
+}
+
+static int cmd_reduce_impl(const reduce_args *A, reduce_state *S) {
+  phgmg_ph_system sys;
+  phgmg_reduce_opts o;
+  phgmg_reduce_info info;
+  phgmg_result rc;
+  const phgmg_rom *rom;
+  rom_field fields[24];
+  outlist ol;
+  double rcond = 0.0, t0, t_sim = 0.0, t_red;
+  const double *X;
+  int N, m, ns, method, i, nf, k;
+  char path[4096 + 256];
+  FILE *jf;
+
+  if (!strcmp(A->method, "gmg-pod")) method = PHGMG_METHOD_GMG_POD;
+  else if (!strcmp(A->method, "gmg-qm")) method = PHGMG_METHOD_GMG_QM;
+  else if (!strcmp(A->method, "sp1")) method = PHGMG_METHOD_SP1;
+  else if (!strcmp(A->method, "sp2")) method = PHGMG_METHOD_SP2;
+  else return usage_error("--method '%s': expected gmg-pod, gmg-qm, sp1 or sp2", A->method);
+
+  /* --- the system --- */
+  if (mat_load(&S->J, "--J", A->J)) return 1;
+  N = S->J.rows;
+  if (S->J.ndim != 2 || S->J.cols != N || N < 1)
+    return fail("%s (--J): J must be a square N x N matrix, got %s", A->J, shape_str(&S->J));
+  progress("J: %s, N = %d", A->J, N);
+  if (mat_load(&S->R, "--R", A->R)) return 1;
+  if (S->R.ndim != 2 || S->R.rows != N || S->R.cols != N)
+    return fail("%s (--R): expected shape (%d, %d) (N x N, N = %d from %s), got %s", A->R, N, N, N, A->J,
+                shape_str(&S->R));
+  if (mat_load(&S->Q, "--Q", A->Q)) return 1;
+  if (S->Q.ndim != 2 || S->Q.rows != N || S->Q.cols != N)
+    return fail("%s (--Q): expected shape (%d, %d) (N x N, N = %d from %s), got %s", A->Q, N, N, N, A->J,
+                shape_str(&S->Q));
+  if (mat_load(&S->B, "--B", A->B)) return 1;
+  if (S->B.ndim == 0 || S->B.rows != N || S->B.cols < 1 || S->B.cols > N)
+    return fail("%s (--B): expected shape (%d, m) with 1 <= m <= %d, or (%d,), got %s", A->B, N, N, N,
+                shape_str(&S->B));
+  m = S->B.cols;
+  memset(&sys, 0, sizeof sys);
+  sys.N = N; sys.m = m; sys.storage = PHGMG_DENSE;
+  sys.J = S->J.a; sys.R = S->R.a; sys.Q = S->Q.a; sys.B = S->B.a;
+  sys.nl = PHGMG_NL_NONE;
+  if (A->poly) {
+    int nt;
+    if (mat_load(&S->poly, "--poly", A->poly)) return 1;
+    if (!is_vector(&S->poly) || S->poly.rows * S->poly.cols < 2)
+      return fail("%s (--poly): expected a vector of d+1 >= 2 coefficients (constant first), got %s",
+                  A->poly, shape_str(&S->poly));
+    if (mat_load(&S->pidx, "--poly-idx", A->poly_idx)) return 1;
+    nt = S->pidx.rows * S->pidx.cols;
+    if (!is_vector(&S->pidx) || nt < 1)
+      return fail("%s (--poly-idx): expected a non-empty vector of coordinates, got %s", A->poly_idx,
+                  shape_str(&S->pidx));
+    S->idx = (int *)malloc(sizeof(int) * (size_t)nt);
+    if (!S->idx) return fail("out of memory");
+    for (k = 0; k < nt; ++k) {
+      const double v = S->pidx.a[k];
+      if (!(v >= 0.0 && v < (double)N && v == floor(v)))
+        return fail("%s (--poly-idx): entry %d is %g; expected an integer coordinate in [0, %d)", A->poly_idx,
+                    k, v, N);
+      S->idx[k] = (int)v;
+    }
+    if (A->poly_w) {
+      if (mat_load(&S->pw, "--poly-w", A->poly_w)) return 1;
+      if (!is_vector(&S->pw) || S->pw.rows * S->pw.cols != nt)
+        return fail("%s (--poly-w): expected a vector of %d weights (one per entry of %s), got %s", A->poly_w,
+                    nt, A->poly_idx, shape_str(&S->pw));
+    }
+    sys.nl = PHGMG_NL_SEPARABLE;
+    sys.nsep = nt;
+    sys.sep_idx = S->idx;
+    sys.sep_w = A->poly_w ? S->pw.a : NULL;
+    sys.poly_deg = S->poly.rows * S->poly.cols - 1;
+    sys.poly = S->poly.a;
+    progress("nonlinear part: %d terms, polynomial of degree %d", nt, sys.poly_deg);
+  }
+  rc = phgmg_ph_validate(&sys, 0.0, &rcond, NULL);
+  if (rc != PHGMG_OK) return explain_validate(rc, &S->J, &S->R, &S->B, &S->Q, rcond);
+  progress("system: N = %d, m = %d, valid port-Hamiltonian (rcond(J - R) = %.3g)", N, m, rcond);
+
+  /* --- sizes that phgmg_reduce would refuse, explained up front --- */
+  if (method == PHGMG_METHOD_GMG_POD || method == PHGMG_METHOD_GMG_QM) {
+    if (A->r <= m || A->r > N)
+      return usage_error("--r %d: %s needs m < r <= N (m = %d ports from %s, N = %d)", A->r, A->method, m, A->B, N);
+    if (method == PHGMG_METHOD_GMG_QM && (A->rn > N - A->r || A->rn * (A->r - m) > 4096))
+      return usage_error("--rn %d: gmg-qm needs r + r_n <= N (= %d) and r_n (r - m) <= 4096", A->rn, N);
+  } else if (A->r > N) {
+    return usage_error("--r %d: needs r <= N = %d", A->r, N);
+  }
+
+  /* --- snapshots --- */
+  if (A->X) {
+    if (mat_load(&S->X, "--X", A->X)) return 1;
+    if (S->X.ndim != 2 || S->X.rows != N || S->X.cols < 2)
+      return fail("%s (--X): expected shape (%d, ns), ns >= 2 snapshots as columns (N = %d from %s), got %s",
+                  A->X, N, N, A->J, shape_str(&S->X));
+    X = S->X.a;
+    ns = S->X.cols;
+    progress("snapshots: %s, %d states", A->X, ns);
+  } else {
+    phgmg_gl3_opts go;
+    phgmg_gl3_stats st;
+    double *x0;
+    int done = 0;
+    if (input_setup(&S->in, A->input, A->amp, m, A->dt)) return 1;
+    ns = A->steps + 1;
+    S->Xsim = (double *)malloc(sizeof(double) * (size_t)N * (size_t)ns);
+    S->Ysim = (double *)malloc(sizeof(double) * (size_t)m * (size_t)ns);
+    x0 = (double *)calloc((size_t)N, sizeof(double));
+    if (!S->Xsim || !S->Ysim || !x0) { free(x0); return fail("out of memory for %d snapshots of size %d", ns, N); }
+    memset(&go, 0, sizeof go);
+    go.tol = A->newton_tol; go.max_iter = A->newton_iter;
+    progress("simulating the full model: %d steps of dt = %g, %s", A->steps, A->dt, input_desc(&S->in, A->input));
+    S->in.report = 1;
+    S->in.t_end = A->steps * A->dt;
+    S->in.wall0 = S->in.wall_last = t0 = now_s();
+    rc = phgmg_simulate(&sys, x0, 0.0, A->dt, A->steps, input_fn, &S->in, &go, S->Xsim, S->Ysim, NULL, &st,
+                        &done, NULL);
+    S->in.report = 0;
+    free(x0);
+    t_sim = now_s() - t0;
+    if (rc != PHGMG_OK)
+      return fail("full-order simulation failed at step %d of %d (t = %g): %s%s", done + 1, A->steps,
+                  done * A->dt, phgmg_result_string(rc),
+                  rc == PHGMG_ERR_NOT_CONVERGED ? " (try a smaller --dt or more --newton-iter)" : "");
+    progress("  done in %.2f s (%ld Newton iterations, %ld factorizations)", t_sim, st.newton_iters,
+             st.factorizations);
+    X = S->Xsim;
+  }
+
+  /* --- reduce --- */
+  memset(&o, 0, sizeof o);
+  o.method = (phgmg_method)method;
+  o.r = A->r;
+  o.rn = A->rn;
+  o.lambda = A->lambda > 0.0 ? A->lambda : -1.0; /* 0 on the command line = exactly zero */
+  o.deim = A->poly && !A->no_deim;
+  o.deim_tol = A->deim_tol > 0.0 ? A->deim_tol : 1e-300;
+  o.deim_max = A->deim_max;
+  o.deim_allow_negative = A->deim_neg;
+  o.dt = A->dt_map;
+  memset(&info, 0, sizeof info);
+  progress("reducing: %s, r = %d%s", A->method, A->r, method == PHGMG_METHOD_GMG_QM ? " (quadratic manifold)" : "");
+  t0 = now_s();
+  rc = phgmg_reduce(&S->red, &sys, X, N, ns, &o, &info, NULL);
+  t_red = now_s() - t0;
+  if (rc != PHGMG_OK) {
+    const char *src = A->X ? A->X : "the simulated snapshots";
+    switch (rc) {
+      case PHGMG_ERR_SIZE:
+        return fail("reduction failed: %s: r = %d%s exceeds the rank of %s (%d snapshots of size %d)",
+                    phgmg_result_string(rc), A->r, method == PHGMG_METHOD_GMG_QM ? " plus r_n" : "", src, ns, N);
+      case PHGMG_ERR_RANK:
+        return fail("reduction failed: %s (%s, or the port matrix %s)", phgmg_result_string(rc), src, A->B);
+      case PHGMG_ERR_DEGENERATE:
+        return fail("reduction failed: %s (try another --r, or for gmg-qm a larger --lambda)", phgmg_result_string(rc));
+      case PHGMG_ERR_NEGATIVE_WEIGHT:
+        return fail("reduction failed: %s (use --deim-allow-negative, a smaller --deim-tol, or --no-deim)",
+                    phgmg_result_string(rc));
+      default:
+        return fail("reduction failed: %s", phgmg_result_string(rc));
+    }
+  }
+  rom = phgmg_reduced_rom(S->red);
+  progress("  done in %.2f s: r = %d, m = %d%s; sigma_{r'+1}/sigma_1 = %.3g, rcond(D^T G D) = %.3g", t_red, rom->r,
+           rom->m, rom->nd ? "" : ", quadratic energy", info.pod_sigma_ratio, info.rcond_dgd);
+  if (rom->nd) progress("  DEIM: %d points, %d negative weights", info.deim_modes, info.deim_negative);
+
+  /* --- outputs --- */
+  if (mkdir_p(A->out)) return 1;
+  memset(&ol, 0, sizeof ol);
+  nf = rom_fields(rom, fields);
+  {
+    double *buf = NULL;
+    size_t cap = 0;
+    for (i = 0; i < nf; ++i) {
+      const size_t n = (size_t)fields[i].rows * (size_t)fields[i].cols;
+      size_t q;
+      if (n > cap) {
+        double *nb = (double *)realloc(buf, n * sizeof(double));
+        if (!nb) { free(buf); return fail("out of memory"); }
+        buf = nb; cap = n;
+      }
+      for (q = 0; q < n; ++q) buf[q] = (double)fields[i].a[q];
+      if (write_field(A->out, A->name, fields[i].name, buf, fields[i].rows, fields[i].cols, &ol)) { free(buf); return 1; }
+    }
+    free(buf);
+  }
+  {
+    /* V0 = Dphi(0), the linear part of the reduction map (exactly V0 for every method). */
+    double *xr0 = (double *)calloc((size_t)rom->r, sizeof(double));
+    S->V0 = (double *)malloc(sizeof(double) * (size_t)N * (size_t)rom->r);
+    if (!xr0 || !S->V0) { free(xr0); return fail("out of memory"); }
+    phgmg_reduced_dphi(S->red, xr0, S->V0, N);
+    free(xr0);
+    if (write_field(A->out, A->name, "V0", S->V0, N, rom->r, &ol)) return 1;
+  }
+  if (rom->kind == PHGMG_ROM_QUADRATIC) {
+    /* V2 and M of the quadratic map. phgmg.h has no public accessor for them
+       yet; this program compiles the implementation, so it reads them from the
+       reduced object directly. */
+    const int p = rom->r - rom->m;
+    if (write_field(A->out, A->name, "V2", S->red->V2, N, rom->rn, &ol)) return 1;
+    if (write_field(A->out, A->name, "M", S->red->M, rom->rn, p * p, &ol)) return 1;
+  }
+  if (A->save_snap) {
+    double *Y = S->Ysim;
+    if (!Y) { /* --X: the full model's output at the given snapshots */
+      S->Ysim = Y = (double *)malloc(sizeof(double) * (size_t)m * (size_t)ns);
+      if (!Y) return fail("out of memory");
+      for (k = 0; k < ns; ++k) phgmg_ph_output(&sys, X + (size_t)k * N, Y + (size_t)k * m);
+    }
+    if (write_field(A->out, A->name, "snapshots", X, N, ns, &ol)) return 1;
+    if (write_field(A->out, A->name, "fom_y", Y, m, ns, &ol)) return 1;
+  }
+  snprintf(path, sizeof path, "%s/%s.phgmgrom", A->out, A->name);
+  rc = phgmg_rom_save(rom, path);
+  if (rc != PHGMG_OK) return fail("%s: cannot write the model file: %s", path, phgmg_result_string(rc));
+  snprintf(path, sizeof path, "%s/%s.c", A->out, A->name);
+  rc = phgmg_rom_export_c(rom, A->name, path);
+  if (rc != PHGMG_OK) return fail("%s: cannot write the C source: %s", path, phgmg_result_string(rc));
+
+  snprintf(path, sizeof path, "%s/%s.json", A->out, A->name);
+  jf = fopen(path, "w");
+  if (!jf) return fail("%s: cannot write: %s", path, strerror(errno));
+  fprintf(jf, "{\n  \"phgmg_version\": \"%s\",\n  \"name\": ", PHGMG_VERSION_STRING);
+  json_str(jf, A->name);
+  fprintf(jf, ",\n  \"method\": \"%s\",\n  \"kind\": \"%s\",\n", method_name(method),
+          rom->kind == PHGMG_ROM_QUADRATIC ? "quadratic" : "linear");
+  fprintf(jf, "  \"N\": %d, \"m\": %d, \"r\": %d, \"rn\": %d, \"nd\": %d, \"poly_deg\": %d,\n", N, m, rom->r,
+          rom->rn, rom->nd, rom->nd ? rom->poly_deg : 0);
+  fprintf(jf, "  \"dt_map\": ");
+  json_num(jf, rom->Phi ? (double)rom->dt : 0.0);
+  fprintf(jf, ",\n  \"system\": {\"J\": ");
+  json_str(jf, A->J); fprintf(jf, ", \"R\": "); json_str(jf, A->R);
+  fprintf(jf, ", \"B\": "); json_str(jf, A->B); fprintf(jf, ", \"Q\": "); json_str(jf, A->Q);
+  if (A->poly) {
+    fprintf(jf, ", \"poly\": "); json_str(jf, A->poly);
+    fprintf(jf, ", \"poly_idx\": "); json_str(jf, A->poly_idx);
+    if (A->poly_w) { fprintf(jf, ", \"poly_w\": "); json_str(jf, A->poly_w); }
+  }
+  fprintf(jf, "},\n  \"snapshots\": {\"count\": %d, ", ns);
+  if (A->X) { fprintf(jf, "\"file\": "); json_str(jf, A->X); }
+  else {
+    fprintf(jf, "\"simulate\": {\"dt\": "); json_num(jf, A->dt);
+    fprintf(jf, ", \"steps\": %d, \"input\": ", A->steps); json_str(jf, A->input);
+    fprintf(jf, ", \"amp\": "); json_num(jf, A->amp);
+    fprintf(jf, ", \"newton_tol\": "); json_num(jf, A->newton_tol);
+    fprintf(jf, ", \"newton_iter\": %d, \"seconds\": ", A->newton_iter); json_num(jf, t_sim);
+    fprintf(jf, "}");
+  }
+  fprintf(jf, "},\n  \"options\": {\"rn\": %d, \"lambda\": ", o.rn);
+  json_num(jf, A->lambda);
+  fprintf(jf, ", \"deim\": %s, \"deim_tol\": ", o.deim ? "true" : "false");
+  json_num(jf, A->deim_tol);
+  fprintf(jf, ", \"deim_max\": %d, \"deim_allow_negative\": %s},\n", A->deim_max, A->deim_neg ? "true" : "false");
+  fprintf(jf, "  \"info\": {\"pod_sigma_ratio\": ");
+  json_num(jf, info.pod_sigma_ratio);
+  fprintf(jf, ", \"rcond_jr\": "); json_num(jf, info.rcond_jr);
+  fprintf(jf, ", \"rcond_dgd\": "); json_num(jf, info.rcond_dgd);
+  fprintf(jf, ", \"deim_modes\": %d, \"deim_negative\": %d, \"deim_sigma_ratio\": ", info.deim_modes, info.deim_negative);
+  json_num(jf, info.deim_sigma_ratio);
+  fprintf(jf, ", \"reduce_seconds\": "); json_num(jf, t_red);
+  fprintf(jf, "},\n  \"stepper_memsize_bytes\": %lu,\n", (unsigned long)phgmg_rom_stepper_memsize(rom));
+  fprintf(jf, "  \"reconstruction\": \"%s\",\n",
+          rom->kind == PHGMG_ROM_QUADRATIC ? "x = V0 @ xr + V2 @ (M @ kron(xr[m:], xr[m:]))" : "x = V0 @ xr");
+  fprintf(jf, "  \"files\": {\n    \"model\": \"%s.phgmgrom\",\n    \"c_source\": \"%s.c\",\n    \"arrays\": {",
+          A->name, A->name);
+  for (i = 0; i < ol.n; ++i)
+    fprintf(jf, "%s\n      \"%s\": [%d, %d]", i ? "," : "", ol.names[i], ol.rows[i], ol.cols[i]);
+  fprintf(jf, "\n    }\n  }\n}\n");
+  if (fclose(jf) != 0) return fail("%s: write error", path);
+
+  printf("wrote %s/%s.phgmgrom, %s/%s.c, %s/%s.json and %d arrays %s/%s_*.npy (%s, r = %d, m = %d, N = %d)\n",
+         A->out, A->name, A->out, A->name, A->out, A->name, ol.n, A->out, A->name, method_name(method), rom->r,
+         rom->m, N);
+  return 0;
+}
+
+static int cmd_reduce(int argc, char **argv) {
+  reduce_args A;
+  reduce_state S;
+  int rc = parse_reduce(argc, argv, &A);
+  if (rc) return rc;
+  memset(&S, 0, sizeof S);
+  rc = cmd_reduce_impl(&A, &S);
+  reduce_cleanup(&S);
+  return rc;
+}
+
+/* ---- simulate-rom --------------------------------------------------------------- */
+static int load_model(const char *path, phgmg_rom *rom, void **block) {
+  phgmg_result rc;
+  FILE *f = fopen(path, "rb");
+  if (!f) return fail("%s (--model): cannot open: %s", path, strerror(errno));
+  fclose(f);
+  rc = phgmg_rom_load(path, rom, block, NULL);
+  if (rc != PHGMG_OK)
+    return fail("%s (--model): not a usable phgmg model file: %s", path, phgmg_result_string(rc));
+  return 0;
+}
+
+static int cmd_simulate_rom(int argc, char **argv) {
+  const char *model = NULL, *out = NULL, *states = NULL, *inspec = "sin";
+  double dt = 0.0, amp = 0.1, newton_tol = 1e-10, t0;
+  int steps = 1000, newton_iter = 10, have_dt = 0, i, a, n, status = 1;
+  phgmg_rom rom;
+  void *block = NULL, *mem = NULL;
+  phgmg_real *x = NULL, *u3, *y, *ework;
+  double *Y = NULL, *XR = NULL, wall_last;
+  phgmg_rom_stepper st;
+  phgmg_result rc;
+  cli_input in;
+  size_t msz, nreal;
+  memset(&in, 0, sizeof in);
+  for (i = 2; i < argc; ++i) {
+    const char *o = argv[i], *v;
+    if (!strcmp(o, "--help") || !strcmp(o, "-h")) { print_help(); return 0; }
+    else if (!strcmp(o, "--model")) { if (!(model = optval(argc, argv, &i))) return 2; }
+    else if (!strcmp(o, "--out")) { if (!(out = optval(argc, argv, &i))) return 2; }
+    else if (!strcmp(o, "--states")) { if (!(states = optval(argc, argv, &i))) return 2; }
+    else if (!strcmp(o, "--input")) { if (!(inspec = optval(argc, argv, &i))) return 2; }
+    else if (!strcmp(o, "--dt")) {
+      if (!(v = optval(argc, argv, &i)) || !parse_double(o, v, 0.0, &dt)) return 2;
+      if (!(dt > 0.0)) return usage_error("--dt must be > 0");
+      have_dt = 1;
+    }
+    else if (!strcmp(o, "--amp")) { if (!(v = optval(argc, argv, &i)) || !parse_double(o, v, -HUGE_VAL, &amp)) return 2; }
+    else if (!strcmp(o, "--newton-tol")) { if (!(v = optval(argc, argv, &i)) || !parse_double(o, v, 0.0, &newton_tol)) return 2; }
+    else if (!strcmp(o, "--steps")) { if (!(v = optval(argc, argv, &i)) || !parse_int(o, v, 1, INT_MAX - 1, &steps)) return 2; }
+    else if (!strcmp(o, "--newton-iter")) { if (!(v = optval(argc, argv, &i)) || !parse_int(o, v, 1, 1000, &newton_iter)) return 2; }
+    else if (!strcmp(o, "--quiet")) g_quiet = 1;
+    else return usage_error("simulate-rom: unknown option '%s'", o);
+  }
+  if (!model || !out) return usage_error("simulate-rom: --model FILE and --out FILE are required");
+  if (load_model(model, &rom, &block)) return 1;
+  if (!have_dt) dt = rom.Phi ? (double)rom.dt : 0.1;
+  if (input_setup(&in, inspec, amp, rom.m, dt)) goto done;
+  msz = phgmg_rom_stepper_memsize(&rom);
+  nreal = (size_t)rom.r + 4 * (size_t)rom.m + phgmg_rom_eval_work_size(&rom);
+  mem = malloc(msz);
+  x = (phgmg_real *)malloc(nreal * sizeof(phgmg_real));
+  Y = (double *)malloc(sizeof(double) * (size_t)rom.m * ((size_t)steps + 1));
+  if (states) XR = (double *)malloc(sizeof(double) * (size_t)rom.r * ((size_t)steps + 1));
+  if (!mem || !x || !Y || (states && !XR)) { fail("out of memory for %d steps", steps); goto done; }
+  u3 = x + rom.r; y = u3 + 3 * rom.m; ework = y + rom.m;
+  rc = phgmg_rom_stepper_init(&st, &rom, (phgmg_real)dt, (phgmg_real)newton_tol, newton_iter, mem, msz);
+  if (rc != PHGMG_OK) { fail("%s: cannot set up the stepper: %s", model, phgmg_result_string(rc)); goto done; }
+  progress("simulating %s (r = %d, m = %d%s): %d steps of dt = %g%s, %s", model, rom.r, rom.m,
+           rom.kind == PHGMG_ROM_QUADRATIC ? ", quadratic manifold" : "", steps, dt,
+           st.use_map ? " (precomputed step map)" : "", input_desc(&in, inspec));
+  for (a = 0; a < rom.r; ++a) x[a] = (phgmg_real)0;
+  /* the same sequence of operations as phgmg_reduced_simulate */
+#define RECORD(nn) do { \
+    if (XR) for (a = 0; a < rom.r; ++a) XR[a + (size_t)(nn) * rom.r] = (double)x[a]; \
+    phgmg_rom_output(&rom, x, y, ework); \
+    for (a = 0; a < rom.m; ++a) Y[a + (size_t)(nn) * rom.m] = (double)y[a]; \
+  } while (0)
+  RECORD(0);
+  t0 = wall_last = now_s();
+  for (n = 0; n < steps; ++n) {
+    const double t = (double)n * dt;
+    const double s15 = sqrt(15.0) / 10.0, cs[3] = {0.5 - s15, 0.5, 0.5 + s15};
+    double ubuf[64], *ub = rom.m <= 64 ? ubuf : NULL;
+    int s;
+    if (!ub) { fail("%s: more than 64 inputs are not supported here", model); goto done; }
+    for (s = 0; s < 3; ++s) {
+      input_fn(t + cs[s] * dt, ub, &in);
+      for (a = 0; a < rom.m; ++a) u3[s * rom.m + a] = (phgmg_real)ub[a];
+    }
+    rc = phgmg_rom_step(&st, x, u3, NULL, NULL);
+    if (rc != PHGMG_OK) {
+      fail("%s: step %d (t = %g) failed: %s%s", model, n + 1, t, phgmg_result_string(rc),
+           rc == PHGMG_ERR_NOT_CONVERGED ? " (try a smaller --dt or more --newton-iter)" : "");
+      goto done;
+    }
+    RECORD(n + 1);
+    if (!g_quiet && (n & 255) == 255 && now_s() - wall_last >= 2.0) {
+      wall_last = now_s();
+      progress("  ... step %d of %d (%.1f s)", n + 1, steps, wall_last - t0);
+    }
+  }
+#undef RECORD
+  progress("  done in %.3f s (%ld Newton iterations, %ld factorizations)", now_s() - t0, st.stats.newton_iters,
+           st.stats.factorizations);
+  if (write_npy(out, Y, rom.m, steps + 1, 2)) goto done;
+  if (states && write_npy(states, XR, rom.r, steps + 1, 2)) goto done;
+  printf("wrote %s (%d x %d)%s%s\n", out, rom.m, steps + 1, states ? " and " : "", states ? states : "");
+  status = 0;
+done:
+  mat_free(&in.tab);
+  free(mem); free(x); free(Y); free(XR); free(block);
+  return status;
+}
+
+/* ---- info --------------------------------------------------------------------- */
+static int cmd_info(int argc, char **argv) {
+  phgmg_rom rom;
+  void *block = NULL;
+  rom_field f[24];
+  int nf, i;
+  if (argc != 3) return usage_error("usage: phgmg info MODEL.phgmgrom");
+  if (load_model(argv[2], &rom, &block)) return 1;
+  printf("%s: %s reduced model (%s), r = %d, m = %d", argv[2],
+         rom.kind == PHGMG_ROM_QUADRATIC ? "quadratic-manifold" : "linear", method_name(rom.method), rom.r, rom.m);
+  if (rom.kind == PHGMG_ROM_QUADRATIC) printf(", r_n = %d", rom.rn);
+  if (rom.nd) printf(", %d nonlinear terms (polynomial degree %d)", rom.nd, rom.poly_deg);
+  if (rom.Phi) printf(", step map for dt = %.17g", (double)rom.dt);
+  printf("\nstepper memory: %lu bytes; arrays:", (unsigned long)phgmg_rom_stepper_memsize(&rom));
+  nf = rom_fields(&rom, f);
+  for (i = 0; i < nf; ++i) printf(" %s %dx%d", f[i].name, f[i].rows, f[i].cols);
+  printf("\n");
+  free(block);
+  return 0;
+}
+
+int main(int argc, char **argv) {
+  if (argc < 2) {
+    fputs("usage: phgmg reduce ... | phgmg simulate-rom ... | phgmg info MODEL | phgmg --help\n", stderr);
+    return 2;
+  }
+  if (!strcmp(argv[1], "--help") || !strcmp(argv[1], "-h") || !strcmp(argv[1], "help")) {
+    print_help();
+    return 0;
+  }
+  if (!strcmp(argv[1], "--version")) { printf("phgmg %s\n", PHGMG_VERSION_STRING); return 0; }
+  if (!strcmp(argv[1], "reduce")) return cmd_reduce(argc, argv);
+  if (!strcmp(argv[1], "simulate-rom")) return cmd_simulate_rom(argc, argv);
+  if (!strcmp(argv[1], "info")) return cmd_info(argc, argv);
+  return usage_error("unknown command '%s' (expected reduce, simulate-rom or info)", argv[1]);
+}
