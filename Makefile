@@ -105,5 +105,13 @@ demo: $(EXAMPLES)
 	./$(BUILD)/msd_linear --out results && ./$(BUILD)/msd_nonlinear --out results && \
 	end=$$(date +%s.%N) && awk -v a=$$start -v b=$$end 'BEGIN { printf "make demo: total wall time %.2f s\n", b - a }'
 
+# Short fuzzing run of every reader of outside data (.npy, binary model files).
+fuzz:
+	sh tests/fuzz/run.sh 60
+
+# Timings of every phase into bench/results.csv (not part of make test).
+bench: phgmg.h examples
+	sh bench/run.sh
+
 clean:
 	rm -rf $(BUILD) results tests/suites.inc bench/results.csv

@@ -1,6 +1,95 @@
 /* phgmg.h — structure-preserving model order reduction of port-Hamiltonian
-   systems by generalized manifold Galerkin (GMG) reduction. Single header, C99.
-   (manual: written at the end of the first session; see README.md) */
+   systems by generalized manifold Galerkin (GMG) reduction.
+   Single-file C99 library (also compiles as C++), no dependencies beyond libc
+   and libm. MIT license at the end of the file.
+
+   Method: Glas & Mu, "Structure-Preserving Generalized Manifold Galerkin
+   Reduction for Port-Hamiltonian Systems". A pH system
+       x' = (J - R) grad H(x) + B u,   y = B^T grad H(x)
+   is reduced with an approximation map phi (linear [B, Vbar] or a quadratic
+   manifold) and the GMG reduction map W(xr) = F_G(Dphi(xr))^T, G = (J-R)^{-1};
+   the reduced model is again a pH system, with the same output structure.
+
+   QUICK START ----------------------------------------------------------------
+       #define PHGMG_IMPLEMENTATION      // in exactly one .c file
+       #include "phgmg.h"
+
+       phgmg_ph_system sys = {0};        // N, m, J, R, Q, B (column-major)
+       ... fill sys ...
+       phgmg_simulate(&sys, x0, 0.0, dt, nsteps, u_fn, NULL, NULL, X, Y, NULL, NULL, NULL, NULL);
+       phgmg_reduce_opts o = {0};  o.method = PHGMG_METHOD_GMG_POD;  o.r = 12;  o.dt = dt;
+       phgmg_reduced *red;  phgmg_reduce(&red, &sys, X, N, nsteps + 1, &o, NULL, NULL);
+       // online, allocation-free, float or double:
+       const phgmg_rom *rom = phgmg_reduced_rom(red);
+       phgmg_rom_stepper st;  static double mem[4096];
+       phgmg_rom_stepper_init(&st, rom, dt, 0, 0, mem, sizeof mem);
+       phgmg_rom_step(&st, xr, u3, y, NULL);      // u3 = u at the 3 stage times
+       phgmg_rom_export_c(rom, "my_model", "my_model.h");  // for firmware
+
+   CONTENTS (grep for the >>markers; same order in both halves) ---------------
+     >>config   configuration macros, version, scalar type
+     >>result   phgmg_result codes and phgmg_result_string
+     >>memory   allocator hooks, matrix views
+     >>linalg   dense kernels: GEMM, LU (real, complex), QR, QRCP, least squares,
+                thin SVD (QRCP + one-sided Jacobi), symmetric eigenvalues
+     >>ph       full-order pH systems: dense/banded storage, separable or general
+                nonlinear Hamiltonians, validation, J-R factorization
+     >>gl3      3-stage Gauss-Legendre (order 6) + simplified Newton, energy bookkeeping
+     >>online   reduced models (phgmg_rom), evaluation, allocation-free GL3 stepper
+     >>pod, >>reduce, >>deim, >>errors   POD, GMG-POD, GMG-QM, SP1, SP2, DEIM, error measures
+     >>export   C-source and binary export/import of reduced models
+     >>npy      NumPy .npy read/write
+
+   CONFIGURATION MACROS (define before including) ------------------------------
+     PHGMG_IMPLEMENTATION  compile the implementation in this translation unit
+     PHGMG_STATIC          all functions static (private copy per translation unit)
+     PHGMG_DEF             storage class of the public functions (default extern)
+     PHGMG_REAL_FLOAT      online scalar phgmg_real = float (default double);
+                           the offline half stays double
+     PHGMG_NO_OFFLINE      compile only the online half (+ export/import in memory):
+                           needs libm only, no heap, no stdio
+     PHGMG_NO_STDIO        no file functions (.npy files, model files, C export)
+     PHGMG_MALLOC(sz,u) / PHGMG_FREE(p,u)   default allocator (both or neither)
+     PHGMG_ASSERT(x)       internal invariant checks (default assert)
+     PHGMG_USE_CBLAS       use cblas_dgemm/cblas_dgemv (optional speed-up)
+
+   FUNCTIONS (one line each; full comments at the declarations) ---------------
+   core:    phgmg_result_string
+   linalg:  phgmg_gemm, phgmg_gemv, phgmg_lu_factor, phgmg_lu_solve, phgmg_lu_rcond,
+            phgmg_norm1, phgmg_normf, phgmg_zlu_factor, phgmg_zlu_solve, phgmg_qr,
+            phgmg_qrcp, phgmg_qr_form_q, phgmg_qr_apply, phgmg_lstsq (plain/ridge),
+            phgmg_svd (thin, rank-revealing), phgmg_sym_eig
+   ph:      phgmg_ph_validate (skew J, symmetric PSD R, rank B, cond(J-R), NaN),
+            phgmg_ph_hamiltonian, phgmg_ph_gradient, phgmg_ph_rhs, phgmg_ph_output,
+            phgmg_ph_apply (J, R or Q times a block), phgmg_jr_factor_create /
+            phgmg_jr_solve / phgmg_jr_factor_destroy (apply (J-R)^{-1} or ^{-T})
+   gl3:     phgmg_gl3_coefficients, phgmg_gl3_create / _step / _get_stats / _destroy,
+            phgmg_simulate (trajectory, outputs, energy H/S/D, stats)
+   online:  phgmg_rom_check, phgmg_rom_eval_work_size, phgmg_rom_hamiltonian,
+            phgmg_rom_gradient, phgmg_rom_rhs, phgmg_rom_output, phgmg_rom_structure
+            (J and R at a state), phgmg_rom_jacobian, phgmg_rom_stepper_memsize,
+            PHGMG_ROM_STEPPER_MEMSIZE_MAX, phgmg_rom_stepper_init, phgmg_rom_stepper_reset,
+            phgmg_rom_stage_times, phgmg_rom_step
+   reduce:  phgmg_pod, phgmg_adjust_snapshots, phgmg_pod_hierarchical, phgmg_deim,
+            phgmg_reduce, phgmg_reduced_destroy, phgmg_reduced_rom, phgmg_reduced_N,
+            phgmg_reduced_lift (phi), phgmg_reduced_restrict (rho), phgmg_reduced_dphi,
+            phgmg_reduced_W, phgmg_reduced_simulate
+   errors:  phgmg_rel_error, phgmg_err_red, phgmg_err_proj, phgmg_err_lowerbound,
+            phgmg_err_energy
+   export:  phgmg_rom_serialized_size, phgmg_rom_serialize, phgmg_rom_deserialize_size,
+            phgmg_rom_deserialize, phgmg_rom_save, phgmg_rom_load, phgmg_rom_export_c
+   npy:     phgmg_npy_parse, phgmg_npy_serialize, phgmg_npy_free, phgmg_npy_read,
+            phgmg_npy_write
+
+   OFFLINE / ONLINE, MEMORY, ERRORS -------------------------------------------
+   Offline functions (double) take a `const phgmg_allocator *` (NULL = default)
+   and free everything on every error path. The online half (phgmg_rom_*) never
+   allocates: ask phgmg_rom_stepper_memsize (or use the compile-time bound
+   PHGMG_ROM_STEPPER_MEMSIZE_MAX), hand over the memory, step; instances are
+   independent. Its cost does not depend on N. Every data-dependent failure is
+   a negative phgmg_result; on failure the caller's inputs (and the state of a
+   stepper) are unchanged. The library never prints, exits or aborts.
+*/
 #ifndef PHGMG_H_INCLUDED
 #define PHGMG_H_INCLUDED
 
@@ -516,6 +605,11 @@ typedef struct phgmg_reduce_opts {
   int pod_cols;
   const double *grad_basis; /* SP2: same for the gradient snapshots (NULL: computed) */
   int grad_cols;
+  /* Optional DEIM result from phgmg_deim on the same snapshots (it does not
+     depend on r or the method): term indices and weights. NULL: computed. */
+  const int *deim_pts;
+  const double *deim_w;
+  int deim_count;
 } phgmg_reduce_opts;
 
 typedef struct phgmg_reduce_info {
@@ -4933,24 +5027,34 @@ PHGMG_DEF phgmg_result phgmg_adjust_snapshots(int N, int m, const double *B, int
   return rc;
 }
 
+/* Numerical rank floor of snapshots X: singular values at or below it are
+   zero. Relative to X itself, not to the matrix being POD'd: the adjusted
+   snapshots and the residual of a basis carry rounding noise of this size,
+   and an SVD truncated relative to their own norm would count it as rank. */
+PHGMG__PRIV double phgmg__rank_floor(int N, int ns, const double *X, int ldx) {
+  return (double)PHGMG__MAX(N, ns) * PHGMG__EPS * phgmg_normf(N, ns, X, ldx);
+}
+
 PHGMG_DEF phgmg_result phgmg_pod_hierarchical(int N, int m, const double *B, int ns, const double *X,
                                               int ldx, int p, int rn, double *V1, double *V2,
                                               const phgmg_allocator *alloc) {
-  double *Xa, *tmp;
+  double *Xa, *tmp, *S, rfloor;
   phgmg_result rc;
   int k = 0;
   if (!B || !X || !V1 || !V2) return PHGMG_ERR_INVALID_ARG;
   if (p < 1 || rn < 1 || p + rn + m > PHGMG__MIN(N, ns + m)) return PHGMG_ERR_SIZE;
-  Xa = phgmg__dalloc(alloc, (size_t)N * ns + (size_t)p * ns);
+  Xa = phgmg__dalloc(alloc, (size_t)N * ns + (size_t)p * ns + (size_t)p + (size_t)rn);
   if (!Xa) return PHGMG_ERR_NOMEM;
   tmp = Xa + (size_t)N * ns;
+  S = tmp + (size_t)p * ns;
   rc = phgmg_adjust_snapshots(N, m, B, ns, X, ldx, Xa, N, alloc);
-  if (rc == PHGMG_OK) rc = phgmg_pod(N, ns, Xa, N, p, 0.0, V1, N, NULL, &k, alloc);
-  if (rc == PHGMG_OK && k < p) rc = PHGMG_ERR_SIZE;
+  rfloor = phgmg__rank_floor(N, ns, X, ldx);
+  if (rc == PHGMG_OK) rc = phgmg_pod(N, ns, Xa, N, p, 0.0, V1, N, S, &k, alloc);
+  if (rc == PHGMG_OK && (k < p || !(S[p - 1] > rfloor))) rc = PHGMG_ERR_SIZE;
   if (rc == PHGMG_OK) {
     phgmg__orth_remove(N, p, V1, ns, Xa, N, tmp);
-    rc = phgmg_pod(N, ns, Xa, N, rn, 0.0, V2, N, NULL, &k, alloc);
-    if (rc == PHGMG_OK && k < rn) rc = PHGMG_ERR_SIZE;
+    rc = phgmg_pod(N, ns, Xa, N, rn, 0.0, V2, N, S + p, &k, alloc);
+    if (rc == PHGMG_OK && (k < rn || !(S[p + rn - 1] > rfloor))) rc = PHGMG_ERR_SIZE;
   }
   phgmg__free(alloc, Xa);
   return rc;
@@ -5193,7 +5297,7 @@ PHGMG_DEF phgmg_result phgmg_reduce(phgmg_reduced **out, const phgmg_ph_system *
   double *T1 = NULL, *T2 = NULL, *T3 = NULL; /* temporaries */
   int *pts = NULL;
   int N, m, r, p, rn = 0, k = 0, i, j, a;
-  double lambda, degtol;
+  double lambda, degtol, rfloor;
   if (!out || !sys || !X || !opts) return PHGMG_ERR_INVALID_ARG;
   *out = NULL;
   memset(&inf, 0, sizeof inf);
@@ -5212,6 +5316,7 @@ PHGMG_DEF phgmg_result phgmg_reduce(phgmg_reduced **out, const phgmg_ph_system *
   if (rc != PHGMG_OK) return rc;
   lambda = opts->lambda == 0.0 ? 1e-3 : (opts->lambda < 0.0 ? 0.0 : opts->lambda);
   degtol = opts->degeneracy_tol > 0.0 ? opts->degeneracy_tol : 1e-12;
+  rfloor = phgmg__rank_floor(N, ns, X, ldx);
 
   red = PHGMG__CAST(phgmg_reduced *, phgmg__alloc(alloc, sizeof(phgmg_reduced)));
   if (!red) return PHGMG_ERR_NOMEM;
@@ -5240,7 +5345,7 @@ PHGMG_DEF phgmg_result phgmg_reduce(phgmg_reduced **out, const phgmg_ph_system *
     double *S = NULL;
     /* V0 = [B, V1], V1 = POD of the adjusted snapshots X - B B^+ X */
     for (j = 0; j < ns; ++j) memcpy(T1 + (size_t)j * N, X + (size_t)j * ldx, (size_t)N * sizeof(double));
-    T2 = phgmg__dalloc(alloc, (size_t)PHGMG__MAX(m, p + 1) * ns + (size_t)p + 2); PHGMG__NEED(T2);
+    T2 = phgmg__dalloc(alloc, (size_t)PHGMG__MAX(m, p + 1) * ns + (size_t)p + 2 + (size_t)rn); PHGMG__NEED(T2);
     phgmg__orth_remove(N, m, red->QB, ns, T1, N, T2);
     memcpy(red->V0, sys->B, (size_t)N * m * sizeof(double));
     S = T2 + (size_t)PHGMG__MAX(m, p + 1) * ns;
@@ -5250,7 +5355,7 @@ PHGMG_DEF phgmg_result phgmg_reduce(phgmg_reduced **out, const phgmg_ph_system *
     } else {
       T3 = phgmg__dalloc(alloc, (size_t)N * (p + 1)); PHGMG__NEED(T3);
       PHGMG__TRY(phgmg_pod(N, ns, T1, N, PHGMG__MIN(p + 1, PHGMG__MIN(N, ns)), 0.0, T3, N, S, &k, alloc));
-      if (k < p) { rc = PHGMG_ERR_SIZE; goto fail; } /* r - m > rank of the adjusted snapshots */
+      if (k < p || !(S[p - 1] > rfloor)) { rc = PHGMG_ERR_SIZE; goto fail; } /* r - m > rank of the adjusted snapshots */
       memcpy(red->V0 + (size_t)N * m, T3, (size_t)N * p * sizeof(double));
       inf.pod_sigma_ratio = (k > p && S[0] > 0.0) ? S[p] / S[0] : 0.0;
       phgmg__free(alloc, T3); T3 = NULL;
@@ -5264,8 +5369,8 @@ PHGMG_DEF phgmg_result phgmg_reduce(phgmg_reduced **out, const phgmg_ph_system *
       if (opts->pod_basis) {
         memcpy(red->V2, opts->pod_basis + (size_t)N * p, (size_t)N * rn * sizeof(double));
       } else {
-        PHGMG__TRY(phgmg_pod(N, ns, T1, N, rn, 0.0, red->V2, N, NULL, &k, alloc));
-        if (k < rn) { rc = PHGMG_ERR_SIZE; goto fail; }
+        PHGMG__TRY(phgmg_pod(N, ns, T1, N, rn, 0.0, red->V2, N, S + p + 2, &k, alloc));
+        if (k < rn || !(S[p + 1 + rn] > rfloor)) { rc = PHGMG_ERR_SIZE; goto fail; }
       }
       /* M by the ridge problem (eq. least_square_reg) over the reduced snapshot
          coordinates, in full Kronecker form. Columns (a,j) and (j,a) of
@@ -5355,8 +5460,8 @@ PHGMG_DEF phgmg_result phgmg_reduce(phgmg_reduced **out, const phgmg_ph_system *
       if (opts->pod_cols < r) { rc = PHGMG_ERR_SIZE; goto fail; }
       memcpy(red->V0, opts->pod_basis, (size_t)N * r * sizeof(double));
     } else {
-      PHGMG__TRY(phgmg_pod(N, ns, X, ldx, r, 0.0, red->V0, N, NULL, &k, alloc));
-      if (k < r) { rc = PHGMG_ERR_SIZE; goto fail; }
+      PHGMG__TRY(phgmg_pod(N, ns, X, ldx, r, 0.0, red->V0, N, Ainv + (size_t)r * r, &k, alloc));
+      if (k < r || !(Ainv[(size_t)r * r + r - 1] > rfloor)) { rc = PHGMG_ERR_SIZE; goto fail; }
     }
     if (red->method == PHGMG_METHOD_SP1) {
       phgmg_ph_apply(sys, 'Q', r, red->V0, N, Vg, N);   /* Vg := Q V */
@@ -5365,11 +5470,12 @@ PHGMG_DEF phgmg_result phgmg_reduce(phgmg_reduced **out, const phgmg_ph_system *
       memcpy(Vg, opts->grad_basis, (size_t)N * r * sizeof(double));
     } else {
       for (j = 0; j < ns; ++j) phgmg_ph_gradient(sys, X + (size_t)j * ldx, T1 + (size_t)j * N);
-      PHGMG__TRY(phgmg_pod(N, ns, T1, N, r, 0.0, Vg, N, NULL, &k, alloc));
-      if (k < r) { rc = PHGMG_ERR_SIZE; goto fail; }
+      PHGMG__TRY(phgmg_pod(N, ns, T1, N, r, 0.0, Vg, N, Ainv + (size_t)r * r, &k, alloc));
+      if (k < r || !(Ainv[(size_t)r * r + r - 1] > phgmg__rank_floor(N, ns, T1, N))) { rc = PHGMG_ERR_SIZE; goto fail; }
     }
     phgmg__atb(N, r, r, red->V0, Vg, A2);               /* V^T Vg */
     inf.rcond_dgd = phgmg__rcond_of(r, A2, alloc);
+    if (inf.rcond_dgd < 0.0) { rc = PHGMG_ERR_NOMEM; goto fail; }
     if (!(inf.rcond_dgd >= degtol)) { rc = PHGMG_ERR_DEGENERATE; goto fail; }
     PHGMG__TRY(phgmg__inv(r, A2, Ainv, alloc));
     red->W = phgmg__red_d(red, (size_t)N * r); PHGMG__NEED(red->W);
@@ -5408,7 +5514,17 @@ PHGMG_DEF phgmg_result phgmg_reduce(phgmg_reduced **out, const phgmg_ph_system *
     double *wt;
     pts = phgmg__ialloc(alloc, (size_t)nt); PHGMG__NEED(pts);
     wt = phgmg__dalloc(alloc, (size_t)nt); PHGMG__NEED(wt);
-    if (opts->deim) {
+    if (opts->deim && opts->deim_pts && opts->deim_w) {
+      if (opts->deim_count < 1 || opts->deim_count > nt) { phgmg__free(alloc, wt); rc = PHGMG_ERR_SIZE; goto fail; }
+      nd = opts->deim_count;
+      for (a = 0; a < nd; ++a) {
+        if (opts->deim_pts[a] < 0 || opts->deim_pts[a] >= nt) { phgmg__free(alloc, wt); rc = PHGMG_ERR_INVALID_ARG; goto fail; }
+        pts[a] = opts->deim_pts[a];
+        wt[a] = opts->deim_w[a];
+        if (wt[a] < 0.0) ++nneg;
+      }
+      if (nneg > 0 && !opts->deim_allow_negative) { phgmg__free(alloc, wt); rc = PHGMG_ERR_NEGATIVE_WEIGHT; goto fail; }
+    } else if (opts->deim) {
       double *F = phgmg__dalloc(alloc, (size_t)nt * ns);
       if (!F) { phgmg__free(alloc, wt); rc = PHGMG_ERR_NOMEM; goto fail; }
       for (i = 0; i < ns; ++i)
@@ -5417,6 +5533,8 @@ PHGMG_DEF phgmg_result phgmg_reduce(phgmg_reduced **out, const phgmg_ph_system *
       rc = phgmg_deim(nt, ns, F, nt, sys->sep_w, opts->deim_tol, opts->deim_max, pts, wt, &nd, &nneg,
                       &inf.deim_sigma_ratio, alloc);
       phgmg__free(alloc, F);
+      inf.deim_modes = nd;      /* reported on PHGMG_ERR_NEGATIVE_WEIGHT too */
+      inf.deim_negative = nneg;
       if (rc == PHGMG_OK && nneg > 0 && !opts->deim_allow_negative) rc = PHGMG_ERR_NEGATIVE_WEIGHT;
       if (rc != PHGMG_OK) { phgmg__free(alloc, wt); goto fail; }
     } else {

@@ -43,6 +43,11 @@ typedef struct phgmg_reduce_opts {
   int pod_cols;
   const double *grad_basis; /* SP2: same for the gradient snapshots (NULL: computed) */
   int grad_cols;
+  /* Optional DEIM result from phgmg_deim on the same snapshots (it does not
+     depend on r or the method): term indices and weights. NULL: computed. */
+  const int *deim_pts;
+  const double *deim_w;
+  int deim_count;
 } phgmg_reduce_opts;
 
 typedef struct phgmg_reduce_info {

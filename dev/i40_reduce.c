@@ -130,24 +130,34 @@ PHGMG_DEF phgmg_result phgmg_adjust_snapshots(int N, int m, const double *B, int
   return rc;
 }
 
+/* Numerical rank floor of snapshots X: singular values at or below it are
+   zero. Relative to X itself, not to the matrix being POD'd: the adjusted
+   snapshots and the residual of a basis carry rounding noise of this size,
+   and an SVD truncated relative to their own norm would count it as rank. */
+PHGMG__PRIV double phgmg__rank_floor(int N, int ns, const double *X, int ldx) {
+  return (double)PHGMG__MAX(N, ns) * PHGMG__EPS * phgmg_normf(N, ns, X, ldx);
+}
+
 PHGMG_DEF phgmg_result phgmg_pod_hierarchical(int N, int m, const double *B, int ns, const double *X,
                                               int ldx, int p, int rn, double *V1, double *V2,
                                               const phgmg_allocator *alloc) {
-  double *Xa, *tmp;
+  double *Xa, *tmp, *S, rfloor;
   phgmg_result rc;
   int k = 0;
   if (!B || !X || !V1 || !V2) return PHGMG_ERR_INVALID_ARG;
   if (p < 1 || rn < 1 || p + rn + m > PHGMG__MIN(N, ns + m)) return PHGMG_ERR_SIZE;
-  Xa = phgmg__dalloc(alloc, (size_t)N * ns + (size_t)p * ns);
+  Xa = phgmg__dalloc(alloc, (size_t)N * ns + (size_t)p * ns + (size_t)p + (size_t)rn);
   if (!Xa) return PHGMG_ERR_NOMEM;
   tmp = Xa + (size_t)N * ns;
+  S = tmp + (size_t)p * ns;
   rc = phgmg_adjust_snapshots(N, m, B, ns, X, ldx, Xa, N, alloc);
-  if (rc == PHGMG_OK) rc = phgmg_pod(N, ns, Xa, N, p, 0.0, V1, N, NULL, &k, alloc);
-  if (rc == PHGMG_OK && k < p) rc = PHGMG_ERR_SIZE;
+  rfloor = phgmg__rank_floor(N, ns, X, ldx);
+  if (rc == PHGMG_OK) rc = phgmg_pod(N, ns, Xa, N, p, 0.0, V1, N, S, &k, alloc);
+  if (rc == PHGMG_OK && (k < p || !(S[p - 1] > rfloor))) rc = PHGMG_ERR_SIZE;
   if (rc == PHGMG_OK) {
     phgmg__orth_remove(N, p, V1, ns, Xa, N, tmp);
-    rc = phgmg_pod(N, ns, Xa, N, rn, 0.0, V2, N, NULL, &k, alloc);
-    if (rc == PHGMG_OK && k < rn) rc = PHGMG_ERR_SIZE;
+    rc = phgmg_pod(N, ns, Xa, N, rn, 0.0, V2, N, S + p, &k, alloc);
+    if (rc == PHGMG_OK && (k < rn || !(S[p + rn - 1] > rfloor))) rc = PHGMG_ERR_SIZE;
   }
   phgmg__free(alloc, Xa);
   return rc;
@@ -390,7 +400,7 @@ PHGMG_DEF phgmg_result phgmg_reduce(phgmg_reduced **out, const phgmg_ph_system *
   double *T1 = NULL, *T2 = NULL, *T3 = NULL; /* temporaries */
   int *pts = NULL;
   int N, m, r, p, rn = 0, k = 0, i, j, a;
-  double lambda, degtol;
+  double lambda, degtol, rfloor;
   if (!out || !sys || !X || !opts) return PHGMG_ERR_INVALID_ARG;
   *out = NULL;
   memset(&inf, 0, sizeof inf);
@@ -409,6 +419,7 @@ PHGMG_DEF phgmg_result phgmg_reduce(phgmg_reduced **out, const phgmg_ph_system *
   if (rc != PHGMG_OK) return rc;
   lambda = opts->lambda == 0.0 ? 1e-3 : (opts->lambda < 0.0 ? 0.0 : opts->lambda);
   degtol = opts->degeneracy_tol > 0.0 ? opts->degeneracy_tol : 1e-12;
+  rfloor = phgmg__rank_floor(N, ns, X, ldx);
 
   red = PHGMG__CAST(phgmg_reduced *, phgmg__alloc(alloc, sizeof(phgmg_reduced)));
   if (!red) return PHGMG_ERR_NOMEM;
@@ -437,7 +448,7 @@ PHGMG_DEF phgmg_result phgmg_reduce(phgmg_reduced **out, const phgmg_ph_system *
     double *S = NULL;
     /* V0 = [B, V1], V1 = POD of the adjusted snapshots X - B B^+ X */
     for (j = 0; j < ns; ++j) memcpy(T1 + (size_t)j * N, X + (size_t)j * ldx, (size_t)N * sizeof(double));
-    T2 = phgmg__dalloc(alloc, (size_t)PHGMG__MAX(m, p + 1) * ns + (size_t)p + 2); PHGMG__NEED(T2);
+    T2 = phgmg__dalloc(alloc, (size_t)PHGMG__MAX(m, p + 1) * ns + (size_t)p + 2 + (size_t)rn); PHGMG__NEED(T2);
     phgmg__orth_remove(N, m, red->QB, ns, T1, N, T2);
     memcpy(red->V0, sys->B, (size_t)N * m * sizeof(double));
     S = T2 + (size_t)PHGMG__MAX(m, p + 1) * ns;
@@ -447,7 +458,7 @@ PHGMG_DEF phgmg_result phgmg_reduce(phgmg_reduced **out, const phgmg_ph_system *
     } else {
       T3 = phgmg__dalloc(alloc, (size_t)N * (p + 1)); PHGMG__NEED(T3);
       PHGMG__TRY(phgmg_pod(N, ns, T1, N, PHGMG__MIN(p + 1, PHGMG__MIN(N, ns)), 0.0, T3, N, S, &k, alloc));
-      if (k < p) { rc = PHGMG_ERR_SIZE; goto fail; } /* r - m > rank of the adjusted snapshots */
+      if (k < p || !(S[p - 1] > rfloor)) { rc = PHGMG_ERR_SIZE; goto fail; } /* r - m > rank of the adjusted snapshots */
       memcpy(red->V0 + (size_t)N * m, T3, (size_t)N * p * sizeof(double));
       inf.pod_sigma_ratio = (k > p && S[0] > 0.0) ? S[p] / S[0] : 0.0;
       phgmg__free(alloc, T3); T3 = NULL;
@@ -461,8 +472,8 @@ PHGMG_DEF phgmg_result phgmg_reduce(phgmg_reduced **out, const phgmg_ph_system *
       if (opts->pod_basis) {
         memcpy(red->V2, opts->pod_basis + (size_t)N * p, (size_t)N * rn * sizeof(double));
       } else {
-        PHGMG__TRY(phgmg_pod(N, ns, T1, N, rn, 0.0, red->V2, N, NULL, &k, alloc));
-        if (k < rn) { rc = PHGMG_ERR_SIZE; goto fail; }
+        PHGMG__TRY(phgmg_pod(N, ns, T1, N, rn, 0.0, red->V2, N, S + p + 2, &k, alloc));
+        if (k < rn || !(S[p + 1 + rn] > rfloor)) { rc = PHGMG_ERR_SIZE; goto fail; }
       }
       /* M by the ridge problem (eq. least_square_reg) over the reduced snapshot
          coordinates, in full Kronecker form. Columns (a,j) and (j,a) of
@@ -552,8 +563,8 @@ PHGMG_DEF phgmg_result phgmg_reduce(phgmg_reduced **out, const phgmg_ph_system *
       if (opts->pod_cols < r) { rc = PHGMG_ERR_SIZE; goto fail; }
       memcpy(red->V0, opts->pod_basis, (size_t)N * r * sizeof(double));
     } else {
-      PHGMG__TRY(phgmg_pod(N, ns, X, ldx, r, 0.0, red->V0, N, NULL, &k, alloc));
-      if (k < r) { rc = PHGMG_ERR_SIZE; goto fail; }
+      PHGMG__TRY(phgmg_pod(N, ns, X, ldx, r, 0.0, red->V0, N, Ainv + (size_t)r * r, &k, alloc));
+      if (k < r || !(Ainv[(size_t)r * r + r - 1] > rfloor)) { rc = PHGMG_ERR_SIZE; goto fail; }
     }
     if (red->method == PHGMG_METHOD_SP1) {
       phgmg_ph_apply(sys, 'Q', r, red->V0, N, Vg, N);   /* Vg := Q V */
@@ -562,11 +573,12 @@ PHGMG_DEF phgmg_result phgmg_reduce(phgmg_reduced **out, const phgmg_ph_system *
       memcpy(Vg, opts->grad_basis, (size_t)N * r * sizeof(double));
     } else {
       for (j = 0; j < ns; ++j) phgmg_ph_gradient(sys, X + (size_t)j * ldx, T1 + (size_t)j * N);
-      PHGMG__TRY(phgmg_pod(N, ns, T1, N, r, 0.0, Vg, N, NULL, &k, alloc));
-      if (k < r) { rc = PHGMG_ERR_SIZE; goto fail; }
+      PHGMG__TRY(phgmg_pod(N, ns, T1, N, r, 0.0, Vg, N, Ainv + (size_t)r * r, &k, alloc));
+      if (k < r || !(Ainv[(size_t)r * r + r - 1] > phgmg__rank_floor(N, ns, T1, N))) { rc = PHGMG_ERR_SIZE; goto fail; }
     }
     phgmg__atb(N, r, r, red->V0, Vg, A2);               /* V^T Vg */
     inf.rcond_dgd = phgmg__rcond_of(r, A2, alloc);
+    if (inf.rcond_dgd < 0.0) { rc = PHGMG_ERR_NOMEM; goto fail; }
     if (!(inf.rcond_dgd >= degtol)) { rc = PHGMG_ERR_DEGENERATE; goto fail; }
     PHGMG__TRY(phgmg__inv(r, A2, Ainv, alloc));
     red->W = phgmg__red_d(red, (size_t)N * r); PHGMG__NEED(red->W);
@@ -605,7 +617,17 @@ PHGMG_DEF phgmg_result phgmg_reduce(phgmg_reduced **out, const phgmg_ph_system *
     double *wt;
     pts = phgmg__ialloc(alloc, (size_t)nt); PHGMG__NEED(pts);
     wt = phgmg__dalloc(alloc, (size_t)nt); PHGMG__NEED(wt);
-    if (opts->deim) {
+    if (opts->deim && opts->deim_pts && opts->deim_w) {
+      if (opts->deim_count < 1 || opts->deim_count > nt) { phgmg__free(alloc, wt); rc = PHGMG_ERR_SIZE; goto fail; }
+      nd = opts->deim_count;
+      for (a = 0; a < nd; ++a) {
+        if (opts->deim_pts[a] < 0 || opts->deim_pts[a] >= nt) { phgmg__free(alloc, wt); rc = PHGMG_ERR_INVALID_ARG; goto fail; }
+        pts[a] = opts->deim_pts[a];
+        wt[a] = opts->deim_w[a];
+        if (wt[a] < 0.0) ++nneg;
+      }
+      if (nneg > 0 && !opts->deim_allow_negative) { phgmg__free(alloc, wt); rc = PHGMG_ERR_NEGATIVE_WEIGHT; goto fail; }
+    } else if (opts->deim) {
       double *F = phgmg__dalloc(alloc, (size_t)nt * ns);
       if (!F) { phgmg__free(alloc, wt); rc = PHGMG_ERR_NOMEM; goto fail; }
       for (i = 0; i < ns; ++i)
@@ -614,6 +636,8 @@ PHGMG_DEF phgmg_result phgmg_reduce(phgmg_reduced **out, const phgmg_ph_system *
       rc = phgmg_deim(nt, ns, F, nt, sys->sep_w, opts->deim_tol, opts->deim_max, pts, wt, &nd, &nneg,
                       &inf.deim_sigma_ratio, alloc);
       phgmg__free(alloc, F);
+      inf.deim_modes = nd;      /* reported on PHGMG_ERR_NEGATIVE_WEIGHT too */
+      inf.deim_negative = nneg;
       if (rc == PHGMG_OK && nneg > 0 && !opts->deim_allow_negative) rc = PHGMG_ERR_NEGATIVE_WEIGHT;
       if (rc != PHGMG_OK) { phgmg__free(alloc, wt); goto fail; }
     } else {

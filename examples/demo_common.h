@@ -72,9 +72,31 @@ static demo_rom_result demo_run_rom(const phgmg_ph_system *sys, const double *X,
 /* POD bases computed once per snapshot set and shared by every r and method
    (phgmg_reduce_opts.pod_basis / grad_basis). */
 typedef struct demo_cache {
-  double *adj, *plain, *grad;
-  int adj_cols, plain_cols, grad_cols;
+  double *adj, *plain, *grad, *deim_w;
+  int adj_cols, plain_cols, grad_cols, *deim_pts, deim_count;
 } demo_cache;
+
+/* DEIM points and weights of a separable nonlinear part (poly form), once per
+   snapshot set: they depend on neither r nor the method. */
+static void demo_cache_deim(demo_cache *c, const phgmg_ph_system *sys, const double *X, int ns, double tol) {
+  const int nt = sys->nsep;
+  double *F = (double *)malloc(sizeof(double) * (size_t)nt * ns);
+  int i, a, k, nneg = 0;
+  phgmg_result rc;
+  c->deim_pts = (int *)malloc(sizeof(int) * nt);
+  c->deim_w = (double *)malloc(sizeof(double) * nt);
+  if (!F || !c->deim_pts || !c->deim_w) { fprintf(stderr, "out of memory\n"); exit(1); }
+  for (i = 0; i < ns; ++i)
+    for (a = 0; a < nt; ++a) {
+      const double s = X[sys->sep_idx[a] + (size_t)i * sys->N];
+      double d = 0.0;
+      for (k = sys->poly_deg; k >= 1; --k) d = d * s + k * sys->poly[k];
+      F[a + (size_t)i * nt] = d;
+    }
+  rc = phgmg_deim(nt, ns, F, nt, sys->sep_w, tol, 0, c->deim_pts, c->deim_w, &c->deim_count, &nneg, NULL, NULL);
+  if (rc != PHGMG_OK) demo_die("DEIM", rc);
+  free(F);
+}
 
 static void demo_cache_build(demo_cache *c, const phgmg_ph_system *sys, const double *X, int ns, int kmax,
                              int want_grad) {
@@ -98,8 +120,9 @@ static void demo_cache_build(demo_cache *c, const phgmg_ph_system *sys, const do
   if (rc != PHGMG_OK) demo_die("POD of the snapshots", rc);
   free(T);
 }
-static void demo_cache_free(demo_cache *c) { free(c->adj); free(c->plain); free(c->grad); }
+static void demo_cache_free(demo_cache *c) { free(c->adj); free(c->plain); free(c->grad); free(c->deim_pts); free(c->deim_w); }
 static void demo_cache_use(const demo_cache *c, phgmg_reduce_opts *o) {
+  o->deim_pts = c->deim_pts; o->deim_w = c->deim_w; o->deim_count = c->deim_count;
   if (o->method == PHGMG_METHOD_GMG_POD || o->method == PHGMG_METHOD_GMG_QM) {
     o->pod_basis = c->adj; o->pod_cols = c->adj_cols;
   } else {

@@ -102,6 +102,7 @@ int main(int argc, char **argv) {
     printf("\nu = %s: FOM %.3f s (%ld Newton iterations, %ld factorizations), max e_energy %.2e\n",
            in ? "0.1" : "0.1 sin t", demo_now() - t0, gs.newton_iters, gs.factorizations, ecol[nsteps]);
     demo_cache_build(&cache, &M.sys, X, ns, rmax + rn + 1, 1);
+    demo_cache_deim(&cache, &M.sys, X, ns, deim_tol);
     printf("  %3s  %-22s %-22s %-22s %-10s %-10s %-10s %s\n", "r", "SP2-POD e_red / e_y",
            "GMG-POD e_red / e_y", "GMG-QM e_red / e_y", "proj POD", "proj QM", "lowerbnd", "lambda, DEIM pts");
     for (k = 0; k < nr; ++k) {

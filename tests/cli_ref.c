@@ -17,6 +17,11 @@
          the same for the nonlinear MSD with n masses as msd_nonlinear does it
          (Newton 1e-8 / 20, DEIM tol 1e-8 with negative weights allowed,
          cache with gradient POD), without a step map
+     cli_ref csim OUT.npy         (only when built with -DCLI_REF_ROM_C='"DIR/NAME.c"'
+                                  -DCLI_REF_ROM_NAME=NAME) simulate the model
+         exported as C source by `phgmg reduce` (static const arrays, as
+         firmware would), x0 = 0, u = 0.1 sin t, dt = 0.1, 1000 steps, with
+         the online stepper in a static buffer; writes y (1 x 1001)
      cli_ref compare A.npy B.npy TOL
          relative difference ||A - B||_F / ||A||_F (exit 1 if the shapes
          differ or it exceeds TOL; TOL = 0 asks for equality)
@@ -118,6 +123,36 @@ static int ref(int nonlinear, phgmg_method meth, int r, int n, const char *out) 
   return st;
 }
 
+#ifdef CLI_REF_ROM_C
+#include CLI_REF_ROM_C
+static int csim(const char *out) {
+  static double mem[1 << 16];
+  const phgmg_rom *rom = &CLI_REF_ROM_NAME;
+  phgmg_rom_stepper st;
+  phgmg_real x[64], u3[3], y[1], work[4096];
+  double Y[1001], tc[3];
+  const double s15 = sqrt(15.0) / 10.0;
+  int n, i;
+  phgmg_result rc;
+  if (rom->r > 64 || rom->m != 1 || phgmg_rom_eval_work_size(rom) > 4096) return die("csim sizes", PHGMG_ERR_SIZE);
+  rc = phgmg_rom_stepper_init(&st, rom, 0.1, 1e-10, 10, mem, sizeof mem);
+  if (rc != PHGMG_OK) return die("phgmg_rom_stepper_init", rc);
+  for (i = 0; i < rom->r; ++i) x[i] = 0.0;
+  phgmg_rom_output(rom, x, y, work);
+  Y[0] = y[0];
+  for (n = 0; n < 1000; ++n) {
+    tc[0] = 0.5 - s15; tc[1] = 0.5; tc[2] = 0.5 + s15;
+    for (i = 0; i < 3; ++i) msd_input_sin(n * 0.1 + tc[i] * 0.1, &u3[i], NULL);
+    rc = phgmg_rom_step(&st, x, u3, NULL, NULL);
+    if (rc != PHGMG_OK) return die("phgmg_rom_step", rc);
+    phgmg_rom_output(rom, x, y, work);
+    Y[n + 1] = y[0];
+  }
+  rc = phgmg_npy_write(out, Y, 1, 1001, 1, 2, 0u);
+  return rc == PHGMG_OK ? 0 : die(out, rc);
+}
+#endif
+
 static int compare(const char *a, const char *b, double tol) {
   double *A = NULL, *B = NULL, num = 0.0, den = 0.0, d;
   int ra, ca, rb, cb, st = 1;
@@ -177,6 +212,9 @@ int main(int argc, char **argv) {
     return ref(0, method_of(argv[3]), atoi(argv[4]), 0, argv[5]);
   if (argc == 7 && !strcmp(argv[1], "ref") && !strcmp(argv[2], "nonlinear") && method_of(argv[3]))
     return ref(1, method_of(argv[3]), atoi(argv[4]), atoi(argv[5]), argv[6]);
+#ifdef CLI_REF_ROM_C
+  if (argc == 3 && !strcmp(argv[1], "csim")) return csim(argv[2]);
+#endif
   if (argc == 5 && !strcmp(argv[1], "compare")) return compare(argv[2], argv[3], atof(argv[4]));
   fprintf(stderr, "usage: cli_ref model DIR | model-nl DIR n | ref linear METHOD r OUT.npy |\n"
                   "       ref nonlinear METHOD r n OUT.npy | compare A.npy B.npy TOL\n");

@@ -571,6 +571,643 @@ TEST(test_naninf_input_and_state) {
   msd_nonlinear_free(&M);
 }
 
+
+/* ---- non-physical systems ------------------------------------------------- */
+/* validate and reduce must both give `code` for the system. */
+static void expect_sys(const phgmg_ph_system *s, double tol, phgmg_result code, int line) {
+  const int N = s->N, ns = 16;
+  double *X = rand_mat(N, ns, 1.0), rc_out = 5.0;
+  phgmg_reduce_opts o = ropts(PHGMG_METHOD_GMG_POD, 3);
+  phgmg_result rc;
+  char msg[160];
+  guard_sys(s);
+  rc = phgmg_ph_validate(s, tol, &rc_out, NULL);
+  if (rc != code || !intact()) {
+    snprintf(msg, sizeof msg, "line %d: validate gave %s, inputs %s", line, phgmg_result_string(rc),
+             "compared");
+    th_fail_msg(__FILE__, line, msg);
+  }
+  if (code != PHGMG_ERR_SINGULAR && code != PHGMG_OK) CHECK(rc_out == 0.0 || rc_out == 5.0);
+  if (tol == 0.0) { /* phgmg_reduce validates with the default tolerance */
+    rc = reduce_g(s, X, N, ns, &o, NULL);
+    if (!intact() || rc != code) {
+      snprintf(msg, sizeof msg, "line %d: reduce gave %s", line, phgmg_result_string(rc));
+      th_fail_msg(__FILE__, line, msg);
+    }
+  }
+  free(X);
+}
+#define EXPECT_SYS(s, tol, code) expect_sys(s, tol, code, __LINE__)
+
+TEST(test_structure_violations) {
+  hsys h;
+  const int N = 8;
+  double keep;
+  hsys_make(&h, N, 0.5);
+  EXPECT_SYS(&h.sys, 0.0, PHGMG_OK);
+  /* J not skew: a broken pair, a diagonal entry; a defect at 1e-14 relative
+     passes the default tol 1e-12 but not tol 1e-15 */
+  h.J[1 + 0 * N] = -0.5;                EXPECT_SYS(&h.sys, 0.0, PHGMG_ERR_NOT_SKEW);
+  h.J[1 + 0 * N] = -1.0;
+  h.J[3 + 3 * N] = 1e-3;                EXPECT_SYS(&h.sys, 0.0, PHGMG_ERR_NOT_SKEW);
+  h.J[3 + 3 * N] = 0.0;
+  h.J[1 + 0 * N] = -1.0 - 1e-14;
+  EXPECT_SYS(&h.sys, 0.0, PHGMG_OK);
+  EXPECT_SYS(&h.sys, 1e-15, PHGMG_ERR_NOT_SKEW);
+  h.J[1 + 0 * N] = -1.0;
+  /* R not symmetric; Q not symmetric */
+  h.R[1 + 3 * N] = 0.1;                 EXPECT_SYS(&h.sys, 0.0, PHGMG_ERR_NOT_SYMMETRIC);
+  h.R[3 + 1 * N] = 0.1;                 EXPECT_SYS(&h.sys, 0.0, PHGMG_OK);
+  h.R[1 + 3 * N] = h.R[3 + 1 * N] = 0.0;
+  h.Q[0 + 2 * N] = 0.2;                 EXPECT_SYS(&h.sys, 0.0, PHGMG_ERR_NOT_SYMMETRIC);
+  h.Q[0 + 2 * N] = 0.0;
+  /* R indefinite: diagonal, and non-diagonal with eigenvalues 0.5 +- 2 */
+  h.R[5 + 5 * N] = -1e-3;               EXPECT_SYS(&h.sys, 0.0, PHGMG_ERR_NOT_PSD);
+  h.R[5 + 5 * N] = 0.5;
+  h.R[1 + 3 * N] = h.R[3 + 1 * N] = 2.0; EXPECT_SYS(&h.sys, 0.0, PHGMG_ERR_NOT_PSD);
+  h.R[1 + 3 * N] = h.R[3 + 1 * N] = 0.5; EXPECT_SYS(&h.sys, 0.0, PHGMG_OK); /* eigenvalues 0, 1 */
+  h.R[1 + 3 * N] = h.R[3 + 1 * N] = 0.0;
+  /* J - R singular: one pair decoupled (J = 0, R = 0 there), then nearly so */
+  h.J[6 + 7 * N] = h.J[7 + 6 * N] = 0.0;
+  h.R[7 + 7 * N] = 0.0;
+  EXPECT_SYS(&h.sys, 0.0, PHGMG_ERR_SINGULAR);
+  {
+    phgmg_jr_factor *f = NULL;
+    double rc_out = 3.0;
+    phgmg_result rc = phgmg_jr_factor_create(&f, &h.sys, &rc_out, NULL);
+    CHECK(rc == PHGMG_ERR_SINGULAR);
+    CHECK(f == NULL);
+  }
+  h.J[6 + 7 * N] = 1e-14; h.J[7 + 6 * N] = -1e-14;       /* cond ~ 1e14 */
+  EXPECT_SYS(&h.sys, 0.0, PHGMG_ERR_SINGULAR);
+  h.J[6 + 7 * N] = 1.0; h.J[7 + 6 * N] = -1.0; h.R[7 + 7 * N] = 0.5;
+  EXPECT_SYS(&h.sys, 0.0, PHGMG_OK);
+  /* B rank deficient: zero, two equal columns, nearly dependent columns */
+  keep = h.B[1];
+  h.B[1] = 0.0;                          EXPECT_SYS(&h.sys, 0.0, PHGMG_ERR_RANK);
+  h.B[1] = keep;
+  h.sys.m = 2;
+  h.B[N + 1] = 1.0;                      EXPECT_SYS(&h.sys, 0.0, PHGMG_ERR_RANK);
+  h.B[N + 2] = 1e-14;                    EXPECT_SYS(&h.sys, 0.0, PHGMG_ERR_RANK);
+  h.B[N + 2] = 1.0;                      EXPECT_SYS(&h.sys, 0.0, PHGMG_OK);
+  h.sys.m = 1;
+  hsys_free(&h);
+  /* banded, N above the dense-eigenvalue limit: R tridiagonal, the band
+     Cholesky decides. tridiag(-1, 2, -1) is PSD, tridiag(-1, 1, -1) is not. */
+  {
+    const int Nb = 2002, kb = 1;
+    double *J = (double *)calloc((size_t)3 * Nb, sizeof(double)), *R = (double *)calloc((size_t)3 * Nb, sizeof(double));
+    double *Q = (double *)calloc((size_t)3 * Nb, sizeof(double)), *B = (double *)calloc((size_t)Nb, sizeof(double));
+    phgmg_ph_system s;
+    int j;
+    for (j = 0; j < Nb; ++j) {
+      Q[kb + j * 3] = 1.0;
+      R[kb + j * 3] = 2.0;
+      if (j > 0) R[(kb - 1) + j * 3] = -1.0;      /* (j-1, j) */
+      if (j + 1 < Nb) R[(kb + 1) + j * 3] = -1.0; /* (j+1, j) */
+      if (j % 2 == 1) { J[(kb - 1) + j * 3] = 1.0; J[(kb + 1) + (j - 1) * 3] = -1.0; }
+    }
+    B[0] = 1.0;
+    memset(&s, 0, sizeof s);
+    s.N = Nb; s.m = 1; s.storage = PHGMG_BANDED; s.kb = kb; s.J = J; s.R = R; s.Q = Q; s.B = B;
+    guard_sys(&s); EXPECT(phgmg_ph_validate(&s, 0.0, NULL, NULL), PHGMG_OK);
+    for (j = 0; j < Nb; ++j) R[kb + j * 3] = 1.0;
+    guard_sys(&s); EXPECT(phgmg_ph_validate(&s, 0.0, NULL, NULL), PHGMG_ERR_NOT_PSD);
+    free(J); free(R); free(Q); free(B);
+  }
+}
+
+/* GMG non-degeneracy (paper Thm 3.1 / Sec. 3): D^T (J - R)^{-1} D must be
+   invertible. With R = 0, G = J^{-1} is skew-symmetric, so V^T G V is a skew
+   r x r matrix: singular for every odd r, whatever the basis. J - R = J stays
+   invertible, so the system itself validates. */
+TEST(test_gmg_degenerate) {
+  hsys h;
+  const int N = 10, ns = 24;
+  double *X = rand_mat(N, ns, 1.0);
+  phgmg_reduce_opts o;
+  phgmg_reduce_info info;
+  hsys_make(&h, N, 0.0);
+  guard_sys(&h.sys); EXPECT(phgmg_ph_validate(&h.sys, 0.0, NULL, NULL), PHGMG_OK);
+  o = ropts(PHGMG_METHOD_GMG_POD, 3);
+  EXPECT(reduce_g(&h.sys, X, N, ns, &o, &info), PHGMG_ERR_DEGENERATE);
+  CHECK_LE(info.rcond_dgd, 1e-12);
+  o.r = 5;
+  EXPECT(reduce_g(&h.sys, X, N, ns, &o, &info), PHGMG_ERR_DEGENERATE);
+  o = ropts(PHGMG_METHOD_GMG_QM, 3); o.rn = 2;
+  EXPECT(reduce_g(&h.sys, X, N, ns, &o, &info), PHGMG_ERR_DEGENERATE);
+  /* even r: a generic skew matrix is invertible */
+  o = ropts(PHGMG_METHOD_GMG_POD, 4);
+  EXPECT(reduce_g(&h.sys, X, N, ns, &o, &info), PHGMG_OK);
+  CHECK(info.rcond_dgd > 1e-6);
+  /* the threshold is the caller's: above the measured rcond it fails */
+  o.degeneracy_tol = 2.0 * info.rcond_dgd;
+  EXPECT(reduce_g(&h.sys, X, N, ns, &o, &info), PHGMG_ERR_DEGENERATE);
+  /* with damping on every second coordinate odd r works too (the paper's point) */
+  hsys_free(&h);
+  hsys_make(&h, N, 0.5);
+  o = ropts(PHGMG_METHOD_GMG_POD, 3);
+  EXPECT(reduce_g(&h.sys, X, N, ns, &o, &info), PHGMG_OK);
+  CHECK(info.rcond_dgd > 1e-6);
+  /* SP1: W = Q V (V^T Q V)^{-1} needs V^T Q V invertible; with Q singular and
+     r = N (V spans everything) it is not */
+  h.Q[9 + 9 * N] = 0.0;
+  o = ropts(PHGMG_METHOD_SP1, N);
+  EXPECT(reduce_g(&h.sys, X, N, ns, &o, &info), PHGMG_ERR_DEGENERATE);
+  o.r = N - 1;  /* generic snapshots: the POD basis is not Q-degenerate */
+  EXPECT(reduce_g(&h.sys, X, N, ns, &o, &info), PHGMG_OK);
+  hsys_free(&h);
+  free(X);
+  /* The nonlinear MSD in l-coordinates: J - R = [[0, T], [-T^T, -gamma I]],
+     so G = (J - R)^{-1} = [[-gamma T^-T T^-1, -T^-T], [T^-1, 0]]: the
+     velocity block of G vanishes. Snapshots whose l-part has rank one give a
+     basis D = [B, V1] (B = e_v1) whose span meets the velocity space in two
+     dimensions once r >= 3, and D^T G D has a 2 x 2 zero block in a 3 x 3
+     matrix: singular. r = 2 is fine. */
+  {
+    msd_nonlinear M;
+    msd_nl_opts no;
+    double Xl[6 * 12];
+    int i, j;
+    memset(&no, 0, sizeof no); no.n = 3;
+    CHECK(msd_nonlinear_build(&M, &no) == 0);
+    for (j = 0; j < 12; ++j)
+      for (i = 0; i < 6; ++i) Xl[i + j * 6] = i < 3 ? (0.5 + 0.1 * j) * (1.0 + i) : th_rand();
+    o = ropts(PHGMG_METHOD_GMG_POD, 3);
+    EXPECT(reduce_g(&M.sys, Xl, 6, 12, &o, &info), PHGMG_ERR_DEGENERATE);
+    o.r = 2;
+    EXPECT(reduce_g(&M.sys, Xl, 6, 12, &o, &info), PHGMG_OK);
+    CHECK(info.rcond_dgd > 1e-6);
+    msd_nonlinear_free(&M);
+  }
+}
+
+/* Snapshots whose rank is below what the method needs: PHGMG_ERR_SIZE. */
+TEST(test_snapshot_rank) {
+  msd_linear M;
+  const int N = 12, ns = 20;
+  double X[12 * 20], Z[12 * 20];
+  phgmg_reduce_opts o;
+  int i, j;
+  CHECK(msd_linear_build(&M, 6, NULL, NULL, NULL, PHGMG_DENSE) == 0);
+  /* rank 3, exactly: integer combinations of three integer vectors with no
+     component along B = e_2, so the adjusted snapshots keep rank 3 */
+  for (j = 0; j < ns; ++j)
+    for (i = 0; i < N; ++i) {
+      const double v1 = (double)((i * 7) % 5 - 2), v2 = (double)((i * 3) % 4 - 1), v3 = (double)(i % 2 ? i : -1);
+      X[i + j * N] = i == 1 ? 0.0 : (double)(j % 3 - 1) * v1 + (double)((j * j) % 5 - 2) * v2 + (double)(j % 4) * v3;
+    }
+  o = ropts(PHGMG_METHOD_SP1, 3); EXPECT(reduce_g(&M.sys, X, N, ns, &o, NULL), PHGMG_OK);
+  o.r = 4;                        EXPECT(reduce_g(&M.sys, X, N, ns, &o, NULL), PHGMG_ERR_SIZE);
+  o = ropts(PHGMG_METHOD_SP2, 3); EXPECT(reduce_g(&M.sys, X, N, ns, &o, NULL), PHGMG_OK);
+  o.r = 4;                        EXPECT(reduce_g(&M.sys, X, N, ns, &o, NULL), PHGMG_ERR_SIZE);
+  o = ropts(PHGMG_METHOD_GMG_POD, 4); /* r - m = 3 = rank */
+  EXPECT(reduce_g(&M.sys, X, N, ns, &o, NULL), PHGMG_OK);
+  o.r = 5;                        EXPECT(reduce_g(&M.sys, X, N, ns, &o, NULL), PHGMG_ERR_SIZE);
+  /* GMG-QM: V1 takes r - m = 2 of the 3 directions, V2 needs rn from the rest */
+  o = ropts(PHGMG_METHOD_GMG_QM, 3); o.rn = 1;
+  EXPECT(reduce_g(&M.sys, X, N, ns, &o, NULL), PHGMG_OK);
+  o.rn = 2;                       EXPECT(reduce_g(&M.sys, X, N, ns, &o, NULL), PHGMG_ERR_SIZE);
+  /* snapshots along B only: the adjusted snapshots vanish */
+  memset(Z, 0, sizeof Z);
+  for (j = 0; j < ns; ++j) Z[1 + j * N] = 1.0 + j;
+  o = ropts(PHGMG_METHOD_GMG_POD, 2); EXPECT(reduce_g(&M.sys, Z, N, ns, &o, NULL), PHGMG_ERR_SIZE);
+  o = ropts(PHGMG_METHOD_SP1, 1);     EXPECT(reduce_g(&M.sys, Z, N, ns, &o, NULL), PHGMG_OK);
+  o.r = 2;                            EXPECT(reduce_g(&M.sys, Z, N, ns, &o, NULL), PHGMG_ERR_SIZE);
+  /* all zero */
+  memset(Z, 0, sizeof Z);
+  o = ropts(PHGMG_METHOD_SP1, 1);     EXPECT(reduce_g(&M.sys, Z, N, ns, &o, NULL), PHGMG_ERR_SIZE);
+  o = ropts(PHGMG_METHOD_GMG_POD, 2); EXPECT(reduce_g(&M.sys, Z, N, ns, &o, NULL), PHGMG_ERR_SIZE);
+  /* the building blocks say the same */
+  {
+    double V[12 * 4], S[4];
+    int k = -1;
+    guard(X, sizeof X);
+    EXPECT(phgmg_pod(N, ns, X, N, 4, 0.0, V, N, S, &k, NULL), PHGMG_OK);
+    CHECK(k == 3);
+    guard(X, sizeof X);
+    EXPECT(phgmg_pod_hierarchical(N, 1, M.B, ns, X, N, 2, 2, V, V + 2 * N, NULL), PHGMG_ERR_SIZE);
+  }
+  msd_linear_free(&M);
+}
+
+/* Structure-preserving DEIM with a negative weight. The nonlinear MSD in
+   l-coordinates with n = 3: the quartic's gradient terms are l_k^3. Snapshots
+   with l = c_j z make the gradient snapshots rank one, U ~ z.^3 = (1, -0.6,
+   -0.6); Q-DEIM picks the largest entry (term 0) and the weight is
+   w = (P^T U)^{-T} U^T 1 = (1 - 0.6 - 0.6) / 1 = -0.2. (r = 2: with a rank-one
+   l-part, any GMG basis of r >= 3 is degenerate, see test_gmg_degenerate.) */
+TEST(test_deim_negative_weight) {
+  msd_nonlinear M;
+  msd_nl_opts no;
+  const int n = 3, N = 6, ns = 12;
+  double X[6 * 12], z[3];
+  phgmg_reduce_opts o;
+  phgmg_reduce_info info;
+  phgmg_reduced *red = NULL;
+  int j, i;
+  memset(&no, 0, sizeof no); no.n = n;
+  CHECK(msd_nonlinear_build(&M, &no) == 0);
+  z[0] = 1.0; z[1] = z[2] = cbrt(-0.6);
+  for (j = 0; j < ns; ++j) {
+    const double c = 0.3 + 0.1 * j;
+    for (i = 0; i < n; ++i) X[i + j * N] = c * z[i];
+    for (i = n; i < N; ++i) X[i + j * N] = th_rand();
+  }
+  o = ropts(PHGMG_METHOD_GMG_POD, 2); o.deim = 1;
+  memset(&info, 0, sizeof info);
+  EXPECT(reduce_g(&M.sys, X, N, ns, &o, &info), PHGMG_ERR_NEGATIVE_WEIGHT);
+  CHECK(info.deim_negative == 1 && info.deim_modes == 1);
+  o.deim_allow_negative = 1;
+  CHECK_RC(phgmg_reduce(&red, &M.sys, X, N, ns, &o, &info, NULL), PHGMG_OK);
+  if (red) {
+    const phgmg_rom *rom = phgmg_reduced_rom(red);
+    CHECK(rom->nd == 1 && info.deim_negative == 1);
+    CHECK_LE(fabs((double)rom->w[0] + 0.2), 1e-12);
+  }
+  phgmg_reduced_destroy(red);
+  /* GMG-QM and SP2 see the same gradient snapshots */
+  o = ropts(PHGMG_METHOD_GMG_QM, 2); o.rn = 1; o.deim = 1;
+  EXPECT(reduce_g(&M.sys, X, N, ns, &o, &info), PHGMG_ERR_NEGATIVE_WEIGHT);
+  o = ropts(PHGMG_METHOD_SP2, 3); o.deim = 1;
+  EXPECT(reduce_g(&M.sys, X, N, ns, &o, &info), PHGMG_ERR_NEGATIVE_WEIGHT);
+  /* without DEIM every term is kept with its own weight: no failure */
+  o.deim = 0;
+  EXPECT(reduce_g(&M.sys, X, N, ns, &o, &info), PHGMG_OK);
+  /* phgmg_deim itself reports the weight (its caller decides) */
+  {
+    const double u[3] = {1.0, -0.6, -0.6}, c[4] = {1, 2, 3, -1};
+    double F[12], w[3] = {9, 9, 9}, ratio = -1;
+    int pts[3] = {-1, -1, -1}, nd = -1, nneg = -1;
+    for (j = 0; j < 4; ++j) for (i = 0; i < 3; ++i) F[i + 3 * j] = u[i] * c[j];
+    guard(F, sizeof F);
+    EXPECT(phgmg_deim(3, 4, F, 3, NULL, 0.0, 0, pts, w, &nd, &nneg, &ratio, NULL), PHGMG_OK);
+    CHECK(nd == 1 && nneg == 1 && pts[0] == 0);
+    CHECK_LE(fabs(w[0] + 0.2), 1e-14);
+    F[4] = (double)NAN;
+    guard(F, sizeof F); guard(w, sizeof w); guard(pts, sizeof pts);
+    EXPECT(phgmg_deim(3, 4, F, 3, NULL, 0.0, 0, pts, w, &nd, &nneg, &ratio, NULL), PHGMG_ERR_NANINF);
+    guard(F, sizeof F);
+    EXPECT(phgmg_deim(0, 4, F, 3, NULL, 0.0, 0, pts, w, &nd, &nneg, &ratio, NULL), PHGMG_ERR_SIZE);
+    EXPECT(phgmg_deim(3, 4, F, 2, NULL, 0.0, 0, pts, w, &nd, &nneg, &ratio, NULL), PHGMG_ERR_SIZE);
+  }
+  msd_nonlinear_free(&M);
+}
+
+/* Newton failure: a stiff quartic model, a large state and a huge step. The
+   stepper returns the failure and leaves the state bit for bit as it was. */
+TEST(test_newton_failure) {
+  int st;
+  for (st = 0; st < 2; ++st) {
+    msd_nonlinear M;
+    msd_nl_opts no;
+    phgmg_gl3 *g = NULL;
+    phgmg_gl3_opts go;
+    double x[8], inc[2] = {1.5, 2.5}, X[8 * 3];
+    int i, done = -1;
+    memset(&no, 0, sizeof no); no.n = 4; no.storage = st ? PHGMG_BANDED : PHGMG_DENSE;
+    CHECK(msd_nonlinear_build(&M, &no) == 0);
+    memset(&go, 0, sizeof go); go.max_iter = 4;
+    CHECK_RC(phgmg_gl3_create(&g, &M.sys, 50.0, &go, NULL), PHGMG_OK);
+    for (i = 0; i < 8; ++i) x[i] = 30.0 * th_rand();
+    guard(x, sizeof x); guard(inc, sizeof inc);
+    EXPECT(phgmg_gl3_step(g, 0.0, x, u_sin, NULL, inc), PHGMG_ERR_NOT_CONVERGED);
+    CHECK(phgmg_gl3_get_stats(g)->failures >= 1 && phgmg_gl3_get_stats(g)->steps == 0);
+    /* the same stepper still takes a step where Newton can converge */
+    for (i = 0; i < 8; ++i) x[i] = 1e-3 * th_rand();
+    CHECK_RC(phgmg_gl3_step(g, 0.0, x, NULL, NULL, inc), PHGMG_OK);
+    phgmg_gl3_destroy(g);
+    /* phgmg_simulate reports it too, with the first column recorded */
+    for (i = 0; i < 8; ++i) x[i] = 30.0 * th_rand();
+    memset(X, 0, sizeof X);
+    guard(x, sizeof x); guard(X + 8, sizeof(double) * 16);
+    EXPECT(phgmg_simulate(&M.sys, x, 0.0, 50.0, 2, u_sin, NULL, &go, X, NULL, NULL, NULL, &done, NULL),
+           PHGMG_ERR_NOT_CONVERGED);
+    CHECK(done == 0 && memcmp(X, x, sizeof x) == 0);
+    msd_nonlinear_free(&M);
+  }
+  /* the online stepper on a reduced model of the same kind */
+  {
+    msd_nonlinear M;
+    msd_nl_opts no;
+    phgmg_reduce_opts o;
+    phgmg_reduced *red = NULL;
+    const int N = 16, ns = 40;
+    double *X = rand_mat(N, ns, 1.0);
+    memset(&no, 0, sizeof no); no.n = 8;
+    CHECK(msd_nonlinear_build(&M, &no) == 0);
+    o = ropts(PHGMG_METHOD_GMG_POD, 4);
+    CHECK_RC(phgmg_reduce(&red, &M.sys, X, N, ns, &o, NULL, NULL), PHGMG_OK);
+    if (red) {
+      static double mem[1 << 14];
+      phgmg_rom_stepper rs;
+      phgmg_real xr[4] = {40, -30, 35, 25}, y[1] = {3}, en[2] = {1, 2};
+      CHECK_RC(phgmg_rom_stepper_init(&rs, phgmg_reduced_rom(red), (phgmg_real)50.0, (phgmg_real)1e-12, 4, mem, sizeof mem), PHGMG_OK);
+      guard(xr, sizeof xr); guard(y, sizeof y); guard(en, sizeof en);
+      EXPECT(phgmg_rom_step(&rs, xr, NULL, y, en), PHGMG_ERR_NOT_CONVERGED);
+      CHECK(rs.stats.failures == 1 && rs.stats.steps == 0);
+    }
+    phgmg_reduced_destroy(red);
+    free(X);
+    msd_nonlinear_free(&M);
+  }
+}
+
+
+/* ---- model images: workspace, damage, round trips ------------------------- */
+static uint32_t rb_fnv(const unsigned char *b, size_t n) {
+  uint32_t h = 2166136261u;
+  size_t i;
+  for (i = 0; i < n; ++i) { h ^= b[i]; h *= 16777619u; }
+  return h;
+}
+static void rb_put32(unsigned char *b, uint32_t v) {
+  b[0] = (unsigned char)v; b[1] = (unsigned char)(v >> 8); b[2] = (unsigned char)(v >> 16); b[3] = (unsigned char)(v >> 24);
+}
+static uint32_t rb_get32(const unsigned char *b) {
+  return (uint32_t)b[0] | (uint32_t)b[1] << 8 | (uint32_t)b[2] << 16 | (uint32_t)b[3] << 24;
+}
+/* recompute the trailing checksum (the file format: FNV-1a over all but it) */
+static void reseal(unsigned char *b, size_t len) { rb_put32(b + len - 4, rb_fnv(b, len - 4)); }
+
+/* The header is 56 bytes: magic (8), version, scalar size, kind, method, r, m,
+   rn, nd, poly_deg, field mask (4 each), dt (8); then the scalars, then the
+   checksum. A copy of an image with 8-byte scalars re-encoded as float32. */
+static unsigned char *to_f32(const unsigned char *b, size_t len, size_t *len32) {
+  const size_t hdr = 56, n = (len - hdr - 4) / 8;
+  unsigned char *o = (unsigned char *)malloc(hdr + 4 * n + 4);
+  size_t i;
+  memcpy(o, b, hdr);
+  rb_put32(o + 12, 4);
+  for (i = 0; i < n; ++i) {
+    uint64_t u = 0;
+    double d;
+    float f;
+    uint32_t v;
+    int k;
+    for (k = 0; k < 8; ++k) u |= (uint64_t)b[hdr + 8 * i + k] << (8 * k);
+    memcpy(&d, &u, 8);
+    f = (float)d;
+    memcpy(&v, &f, 4);
+    rb_put32(o + hdr + 4 * i, v);
+  }
+  *len32 = hdr + 4 * n + 4;
+  reseal(o, *len32);
+  return o;
+}
+
+static void write_seed(const char *dir, const char *name, const void *b, size_t n) {
+  char path[512];
+  FILE *f;
+  if (!dir) return;
+  snprintf(path, sizeof path, "%s/%s", dir, name);
+  f = fopen(path, "wb");
+  if (!f) return;
+  if (fwrite(b, 1, n, f) != n) th_fail_msg(__FILE__, __LINE__, "writing a corpus file");
+  fclose(f);
+}
+
+/* Two models are the same if every field has the same length and values. */
+static int same_rom(const phgmg_rom *a, const phgmg_rom *b) {
+  int i;
+  if (a->kind != b->kind || a->method != b->method || a->r != b->r || a->m != b->m || a->rn != b->rn ||
+      a->nd != b->nd || a->poly_deg != b->poly_deg || a->dt != b->dt)
+    return 0;
+  for (i = 0; i < PHGMG__NFIELDS; ++i) {
+    const phgmg_real *x = phgmg__field_get(a, i), *y = phgmg__field_get(b, i);
+    const size_t n = phgmg__field_len(a, i);
+    if ((x == NULL) != (y == NULL)) return 0;
+    if (x && n && memcmp(x, y, n * sizeof(phgmg_real)) != 0) return 0;
+  }
+  return 1;
+}
+
+/* A few online steps from a fixed state; 0 on any failure. */
+static int rom_run(const phgmg_rom *rom, phgmg_real *x, int nsteps) {
+  static double mem[1 << 15];
+  phgmg_rom_stepper st;
+  phgmg_real u3[3 * 4] = {0};
+  int n, i;
+  if (phgmg_rom_stepper_memsize(rom) > sizeof mem || rom->m > 4) return 0;
+  if (phgmg_rom_stepper_init(&st, rom, rom->Phi ? rom->dt : (phgmg_real)0.1, 0, 0, mem, sizeof mem) != PHGMG_OK) return 0;
+  for (i = 0; i < rom->r; ++i) x[i] = (phgmg_real)(0.01 * (i + 1));
+  for (n = 0; n < nsteps; ++n) {
+    for (i = 0; i < 3 * rom->m; ++i) u3[i] = (phgmg_real)(0.1 * sin(0.3 * n + i));
+    if (phgmg_rom_step(&st, x, u3, NULL, NULL) != PHGMG_OK) return 0;
+  }
+  return 1;
+}
+
+/* Every check of one model's image; damaged variants go to the corpus too. */
+static void check_image(const phgmg_rom *rom, const char *name, const char *dir) {
+  static double mem[1 << 15], mem2[1 << 15];
+  const size_t len = phgmg_rom_serialized_size(rom);
+  unsigned char *b = (unsigned char *)malloc(len + 8), *d = (unsigned char *)malloc(len + 8);
+  size_t w = 0, need = 0, i, len32 = 0;
+  phgmg_rom r1, r2;
+  phgmg_real x1[64], x2[64];
+  char fname[96];
+  if (!b || !d) { free(b); free(d); CHECK(0); return; }
+  /* too small a buffer: nothing written */
+  memset(b, 0xee, len + 8);
+  guard(b, len + 8); guard(rom, sizeof *rom);
+  EXPECT(phgmg_rom_serialize(rom, b, len - 1, &w), PHGMG_ERR_WORKSPACE);
+  CHECK_RC(phgmg_rom_serialize(rom, b, len, &w), PHGMG_OK);
+  CHECK(w == len);
+  snprintf(fname, sizeof fname, "seed_%s.rom", name);
+  write_seed(dir, fname, b, len);
+  /* round trip, in too small and in enough memory */
+  CHECK_RC(phgmg_rom_deserialize_size(b, len, &need), PHGMG_OK);
+  CHECK(need <= sizeof mem);
+  memset(&r1, 0x77, sizeof r1);
+  guard(&r1, sizeof r1); guard(b, len);
+  EXPECT(phgmg_rom_deserialize(b, len, &r1, mem, need - 1), PHGMG_ERR_WORKSPACE);
+  CHECK_RC(phgmg_rom_deserialize(b, len, &r1, mem, need), PHGMG_OK);
+  CHECK(same_rom(rom, &r1));
+  CHECK_RC(phgmg_rom_serialize(&r1, d, len, &w), PHGMG_OK);
+  CHECK(w == len && memcmp(b, d, len) == 0);
+  /* the loaded model steps exactly like the original */
+  CHECK(rom_run(rom, x1, 5) && rom_run(&r1, x2, 5) && memcmp(x1, x2, sizeof(phgmg_real) * (size_t)rom->r) == 0);
+  /* every truncation, one extra byte, every single-byte change: FORMAT */
+  for (i = 0; i < len; ++i) {
+    phgmg_result rc = phgmg_rom_deserialize_size(b, i, &need);
+    if (rc != PHGMG_ERR_FORMAT) { CHECK_RC(rc, PHGMG_ERR_FORMAT); break; }
+  }
+  memcpy(d, b, len); d[len] = 0;
+  CHECK_RC(phgmg_rom_deserialize_size(d, len + 1, &need), PHGMG_ERR_FORMAT);
+  for (i = 0; i < len; ++i) {
+    phgmg_result rc;
+    d[i] ^= (unsigned char)(1u << (i % 8));
+    rc = phgmg_rom_deserialize(d, len, &r2, mem2, sizeof mem2);
+    d[i] = b[i];
+    if (rc != PHGMG_ERR_FORMAT) { CHECK_RC(rc, PHGMG_ERR_FORMAT); break; }
+  }
+  memcpy(d, b, len); d[len / 2] ^= 0x10;
+  snprintf(fname, sizeof fname, "bad_checksum_%s.rom", name);
+  write_seed(dir, fname, d, len);
+  /* damage behind a valid checksum: the header and the values are checked */
+  {
+    struct { size_t at; uint32_t v; const char *what; } hd[] = {
+      {8, 2, "version"}, {12, 2, "scalar"}, {16, 0, "kind0"}, {16, 3, "kind3"}, {20, 9, "method"},
+      {24, 0, "r0"}, {24, 5000, "rhuge"}, {28, 999, "m_gt_r"}, {40, 33, "polydeg"}, {44, 1u << 20, "mask"}};
+    size_t k;
+    for (k = 0; k < sizeof hd / sizeof hd[0]; ++k) {
+      phgmg_result rc;
+      memcpy(d, b, len);
+      rb_put32(d + hd[k].at, hd[k].v);
+      reseal(d, len);
+      memset(&r2, 0x55, sizeof r2);
+      guard(&r2, sizeof r2);
+      rc = phgmg_rom_deserialize(d, len, &r2, mem2, sizeof mem2);
+      CHECK(intact());
+      if (rc != PHGMG_ERR_FORMAT) {
+        char msg[128];
+        snprintf(msg, sizeof msg, "%s: header field %s: got %s", name, hd[k].what, phgmg_result_string(rc));
+        th_fail_msg(__FILE__, __LINE__, msg);
+      }
+      if (rom->kind == PHGMG_ROM_LINEAR && rom->nd > 0 && (k == 0 || k == 9 || k == 6)) {
+        snprintf(fname, sizeof fname, "bad_%s_%s.rom", hd[k].what, name);
+        write_seed(dir, fname, d, len);
+      }
+    }
+    /* the field mask without a required field (Qh): the sizes no longer add up;
+       with the length adjusted too it is caught by the model check */
+    memcpy(d, b, len);
+    rb_put32(d + 44, rb_get32(d + 44) & ~2u);
+    reseal(d, len);
+    CHECK_RC(phgmg_rom_deserialize(d, len, &r2, mem2, sizeof mem2), PHGMG_ERR_FORMAT);
+    /* a dt that is negative or NaN */
+    {
+      const double bad_dt[2] = {-1.0, (double)NAN};
+      for (k = 0; k < 2; ++k) {
+        uint64_t u;
+        int j;
+        memcpy(d, b, len);
+        memcpy(&u, &bad_dt[k], 8);
+        for (j = 0; j < 8; ++j) d[48 + j] = (unsigned char)(u >> (8 * j));
+        reseal(d, len);
+        CHECK_RC(phgmg_rom_deserialize(d, len, &r2, mem2, sizeof mem2), PHGMG_ERR_FORMAT);
+      }
+    }
+    /* NaN / Inf in the first, a middle and the last value */
+    if (rb_get32(b + 12) == 8) {
+      const size_t nval = (len - 60) / 8, at[3] = {0, nval / 2, nval - 1};
+      const uint64_t bits[2] = {0x7ff8000000000000ull, 0xfff0000000000000ull};
+      size_t a;
+      for (a = 0; a < 3; ++a)
+        for (k = 0; k < 2; ++k) {
+          int j;
+          memcpy(d, b, len);
+          for (j = 0; j < 8; ++j) d[56 + 8 * at[a] + j] = (unsigned char)(bits[k] >> (8 * j));
+          reseal(d, len);
+          CHECK_RC(phgmg_rom_deserialize(d, len, &r2, mem2, sizeof mem2), PHGMG_ERR_FORMAT);
+          if (a == 1 && k == 0 && rom->kind == PHGMG_ROM_QUADRATIC) {
+            snprintf(fname, sizeof fname, "bad_nan_%s.rom", name);
+            write_seed(dir, fname, d, len);
+          }
+        }
+    }
+  }
+  /* the same model with float32 scalars loads with the values rounded once */
+  if (rb_get32(b + 12) == 8) {
+    unsigned char *f = to_f32(b, len, &len32);
+    const unsigned char *src = b + 56;
+    size_t k, fld = 0;
+    int ok = 1, fi;
+    CHECK_RC(phgmg_rom_deserialize(f, len32, &r2, mem2, sizeof mem2), PHGMG_OK);
+    for (fi = 0; fi < PHGMG__NFIELDS; ++fi) {
+      const phgmg_real *a = phgmg__field_get(&r2, fi);
+      const size_t n = phgmg__field_len(&r2, fi);
+      if (!a) continue;
+      for (k = 0; k < n; ++k, ++fld) {
+        uint64_t u = 0;
+        double v;
+        int j;
+        for (j = 0; j < 8; ++j) u |= (uint64_t)src[8 * fld + j] << (8 * j);
+        memcpy(&v, &u, 8);
+        if (a[k] != (phgmg_real)(float)v) ok = 0;
+      }
+    }
+    CHECK(ok && 56 + 8 * fld + 4 == len);
+    if (rom->m == 1) {
+      snprintf(fname, sizeof fname, "seed_f32_%s.rom", name);
+      write_seed(dir, fname, f, len32);
+    }
+    free(f);
+  }
+  free(b);
+  free(d);
+}
+
+TEST(test_rom_images) {
+  const char *dir = getenv("PHGMG_ROM_CORPUS");
+  static const phgmg_real K[4] = {0, -1, 1, (phgmg_real)-0.1}, Qh[4] = {1, 0, 0, 2}, Bh[2] = {0, 1};
+  phgmg_rom osc;
+  int pass;
+  memset(&osc, 0, sizeof osc);
+  osc.kind = PHGMG_ROM_LINEAR; osc.r = 2; osc.m = 1; osc.K = K; osc.Qh = Qh; osc.Bh = Bh;
+  check_image(&osc, "osc", dir);
+  osc.m = 0; osc.Bh = NULL;
+  check_image(&osc, "osc_noport", dir);
+  for (pass = 0; pass < 2; ++pass) {
+    /* reduced models of both MSD examples from short simulations */
+    msd_linear L;
+    msd_nonlinear M;
+    msd_nl_opts no;
+    const phgmg_ph_system *s;
+    double *X, *x0;
+    int N, k;
+    const int ns = 61;
+    memset(&no, 0, sizeof no); no.n = 6;
+    if (pass == 0) { CHECK(msd_linear_build(&L, 8, NULL, NULL, NULL, PHGMG_DENSE) == 0); s = &L.sys; }
+    else { CHECK(msd_nonlinear_build(&M, &no) == 0); s = &M.sys; }
+    N = s->N;
+    X = (double *)malloc(sizeof(double) * (size_t)N * ns);
+    x0 = (double *)calloc((size_t)N, sizeof(double));
+    CHECK_RC(phgmg_simulate(s, x0, 0.0, 0.1, ns - 1, u_sin, NULL, NULL, X, NULL, NULL, NULL, NULL, NULL), PHGMG_OK);
+    for (k = 0; k < 3; ++k) {
+      static const char *names[2][3] = {{"lin_gmgpod_map", "lin_gmgqm", "lin_sp1"}, {"nl_gmgpod_deim", "nl_gmgqm_deim", "nl_sp2"}};
+      static const phgmg_method meth[2][3] = {{PHGMG_METHOD_GMG_POD, PHGMG_METHOD_GMG_QM, PHGMG_METHOD_SP1},
+                                             {PHGMG_METHOD_GMG_POD, PHGMG_METHOD_GMG_QM, PHGMG_METHOD_SP2}};
+      phgmg_reduce_opts o = ropts(meth[pass][k], 3);
+      phgmg_reduced *red = NULL;
+      o.dt = 0.1; o.deim = pass && k < 2; o.deim_allow_negative = 1;
+      CHECK_RC(phgmg_reduce(&red, s, X, N, ns, &o, NULL, NULL), PHGMG_OK);
+      if (red) check_image(phgmg_reduced_rom(red), names[pass][k], dir);
+      if (red && pass == 0 && k == 0) CHECK(phgmg_reduced_rom(red)->Phi != NULL);
+      if (red && pass == 1 && k == 1) CHECK(phgmg_reduced_rom(red)->P1 != NULL);
+      phgmg_reduced_destroy(red);
+    }
+    free(X); free(x0);
+    if (pass == 0) msd_linear_free(&L); else msd_nonlinear_free(&M);
+  }
+  /* files: a missing file, a damaged one; nothing allocated stays */
+  {
+    const char *path = "build/robust_tmp_model.rom";
+    phgmg_rom r1;
+    void *block = (void *)&r1;
+    long live = g_default_live;
+    memset(&r1, 0x42, sizeof r1);
+    guard(&r1, sizeof r1);
+    EXPECT(phgmg_rom_load("build/no/such/dir/model.rom", &r1, &block, NULL), PHGMG_ERR_IO);
+    CHECK(block == NULL);
+    if (phgmg_rom_save(&osc, path) == PHGMG_OK) {
+      FILE *f;
+      CHECK_RC(phgmg_rom_load(path, &r1, &block, NULL), PHGMG_OK);
+      CHECK(block != NULL && same_rom(&osc, &r1));
+      phgmg__free(NULL, block);
+      f = fopen(path, "r+b");
+      if (f) { fseek(f, 20, SEEK_SET); fputc(0x7f, f); fclose(f); }
+      memset(&r1, 0x42, sizeof r1);
+      guard(&r1, sizeof r1);
+      EXPECT(phgmg_rom_load(path, &r1, &block, NULL), PHGMG_ERR_FORMAT);
+      CHECK(block == NULL);
+      remove(path);
+    }
+    CHECK(g_default_live == live);
+  }
+}
+
 SUITE(robust) {
   RUN(test_dims_reduce);
   RUN(test_dims_validate);
@@ -578,4 +1215,10 @@ SUITE(robust) {
   RUN(test_dims_rom_stepper_init);
   RUN(test_naninf_system);
   RUN(test_naninf_input_and_state);
+  RUN(test_structure_violations);
+  RUN(test_gmg_degenerate);
+  RUN(test_snapshot_rank);
+  RUN(test_deim_negative_weight);
+  RUN(test_newton_failure);
+  RUN(test_rom_images);
 }

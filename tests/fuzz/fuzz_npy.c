@@ -1,7 +1,8 @@
 /* Fuzz harness for the .npy parser (phgmg_npy_parse), the reader of outside
    data in phgmg.h. Each input is parsed; on success the result must satisfy
    the documented shape rules, every element is read (so ASan sees any bad
-   bound), and serializing it and parsing again must give back the same bits.
+   bound), and serializing it (with each writer option) and parsing again
+   must give back the same bits.
    Anything else than PHGMG_OK / PHGMG_ERR_FORMAT / PHGMG_ERR_NOMEM aborts.
 
    libFuzzer (clang):
@@ -38,6 +39,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   double *A = NULL, *B = NULL, sum = 0.0;
   int rows = -1, cols = -1, ndim = -1, r2 = -1, c2 = -1, n2 = -1;
   size_t i, count, len = 0;
+  unsigned flags;
   unsigned char *img;
   phgmg_result rc = phgmg_npy_parse(data ? (const void *)data : (const void *)empty, size, &A,
                                     &rows, &cols, &ndim, NULL);
@@ -53,18 +55,26 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   fuzz_check(count <= size / 4, "more elements than bytes");
   for (i = 0; i < count; ++i) sum += A[i] * 0.0; /* touch every element */
   (void)sum;
-  /* round trip: serialize (f8, same ndim) and parse again, bit-exact */
-  rc = phgmg_npy_serialize(A, rows, cols, rows > 0 ? rows : 1, ndim, 0, NULL, 0, &len);
-  fuzz_check(rc == PHGMG_OK, "serialize size");
-  img = (unsigned char *)malloc(len);
-  fuzz_check(img != NULL, "malloc");
-  rc = phgmg_npy_serialize(A, rows, cols, rows > 0 ? rows : 1, ndim, 0, img, len, &len);
-  fuzz_check(rc == PHGMG_OK, "serialize");
-  rc = phgmg_npy_parse(img, len, &B, &r2, &c2, &n2, NULL);
-  fuzz_check(rc == PHGMG_OK && r2 == rows && c2 == cols && n2 == ndim, "re-parse shape");
-  fuzz_check(count == 0 || memcmp(A, B, count * sizeof(double)) == 0, "re-parse values");
-  free(img);
-  phgmg_npy_free(B, NULL);
+  /* round trip with every writer option: serialize, parse again, same bits
+     (float32: the same values as a C cast to float) */
+  for (flags = 0; flags < 4; ++flags) {
+    const int ld = rows > 0 ? rows : 1;
+    rc = phgmg_npy_serialize(A, rows, cols, ld, ndim, flags, NULL, 0, &len);
+    fuzz_check(rc == PHGMG_OK, "serialize size");
+    img = (unsigned char *)malloc(len);
+    fuzz_check(img != NULL, "malloc");
+    rc = phgmg_npy_serialize(A, rows, cols, ld, ndim, flags, img, len, &len);
+    fuzz_check(rc == PHGMG_OK, "serialize");
+    rc = phgmg_npy_parse(img, len, &B, &r2, &c2, &n2, NULL);
+    fuzz_check(rc == PHGMG_OK && r2 == rows && c2 == cols && n2 == ndim, "re-parse shape");
+    for (i = 0; i < count; ++i) {
+      double want = (flags & PHGMG_NPY_F32) ? (double)(float)A[i] : A[i];
+      fuzz_check(memcmp(&want, &B[i], sizeof want) == 0, "re-parse values");
+    }
+    free(img);
+    phgmg_npy_free(B, NULL);
+    B = NULL;
+  }
   phgmg_npy_free(A, NULL);
   return 0;
 }
