@@ -466,17 +466,20 @@ static void json_str(FILE *f, const char *s) {
   }
   fputc('"', f);
 }
-/* Shortest of %.15g..%.17g that reads back exactly; null for NaN/Inf. */
-static void json_num(FILE *f, double v) {
-  char buf[40];
+/* v as the shortest of %.15g..%.17g that reads back exactly (buf: 32 chars). */
+static const char *num_str(double v, char *buf) {
   int prec;
-  if (!isfinite(v)) { fputs("null", f); return; }
   for (prec = 15; prec < 17; ++prec) {
-    snprintf(buf, sizeof buf, "%.*g", prec, v);
-    if (strtod(buf, NULL) == v) break;
+    snprintf(buf, 32, "%.*g", prec, v);
+    if (strtod(buf, NULL) == v) return buf;
   }
-  snprintf(buf, sizeof buf, "%.*g", prec, v);
-  fputs(buf, f);
+  snprintf(buf, 32, "%.17g", v);
+  return buf;
+}
+/* A JSON number; null for NaN/Inf. */
+static void json_num(FILE *f, double v) {
+  char buf[32];
+  fputs(isfinite(v) ? num_str(v, buf) : "null", f);
 }
 
 static int valid_name(const char *s) {
@@ -1027,7 +1030,10 @@ static int cmd_info(int argc, char **argv) {
          rom.kind == PHGMG_ROM_QUADRATIC ? "quadratic-manifold" : "linear", method_name(rom.method), rom.r, rom.m);
   if (rom.kind == PHGMG_ROM_QUADRATIC) printf(", r_n = %d", rom.rn);
   if (rom.nd) printf(", %d nonlinear terms (polynomial degree %d)", rom.nd, rom.poly_deg);
-  if (rom.Phi) printf(", step map for dt = %.17g", (double)rom.dt);
+  if (rom.Phi) {
+    char buf[32];
+    printf(", step map for dt = %s", num_str((double)rom.dt, buf));
+  }
   printf("\nstepper memory: %lu bytes; arrays:", (unsigned long)phgmg_rom_stepper_memsize(&rom));
   nf = rom_fields(&rom, f);
   for (i = 0; i < nf; ++i) printf(" %s %dx%d", f[i].name, f[i].rows, f[i].cols);

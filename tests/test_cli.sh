@@ -139,7 +139,7 @@ if $CC -std=c99 -O0 -DCLI_REF_ROM_C="\"$T/out/msd.c\"" -DCLI_REF_ROM_NAME=msd -o
      -lm 2>"$T/cc.txt"; then
   pass
   run_ok "exported C model runs" "$CSIM" csim y_c.npy
-  run_ok "exported C model == model file" "$REF" compare out/y_rom.npy y_c.npy 0
+  run_ok "exported C model == model file" "$REF" compare out/y_rom.npy y_c.npy 1e-12
 else
   bad "the exported C source out/msd.c does not compile: $(head -n 5 "$T/cc.txt")"
 fi

@@ -102,14 +102,19 @@ typedef void (*oom_undo)(void *ctx);
 /* Count the allocations of a successful run, then fail the 1st, 2nd, ...
    one: each run must return PHGMG_ERR_NOMEM, leave no block alive and the
    inputs unchanged. Returns the number of allocator calls of the good run. */
+static falloc g_fa;  /* the sweep's counter (global: objects made earlier may use it) */
+static const phgmg_allocator g_fa_alloc = {fa_alloc, fa_free, &g_fa};
+
 static long oom_sweep(const char *name, oom_op op, oom_undo undo, void *ctx) {
   falloc f;
   phgmg_allocator a;
   long total, k;
   phgmg_result rc;
   char msg[200];
+  (void)f;
+#define f g_fa
   memset(&f, 0, sizeof f);
-  a.alloc = fa_alloc; a.free = fa_free; a.user = &f;
+  a = g_fa_alloc;
   rc = op(&a, ctx);
   CHECK(intact());
   if (rc != PHGMG_OK) {
@@ -133,6 +138,8 @@ static long oom_sweep(const char *name, oom_op op, oom_undo undo, void *ctx) {
       th_fail_msg(__FILE__, __LINE__, msg);
     }
   }
+  f.fail_at = 0;
+#undef f
   return total;
 }
 
@@ -1208,6 +1215,307 @@ TEST(test_rom_images) {
   }
 }
 
+
+/* ---- out of memory: every offline entry point ----------------------------- */
+typedef struct octx {
+  const phgmg_ph_system *sys;
+  const double *X;
+  int N, ns, variant;
+  phgmg_reduce_opts o;
+  phgmg_reduced *red;
+  phgmg_gl3 *g;
+  phgmg_jr_factor *jr;
+  double *A, *B, *out, *out2;
+  const char *path;
+  const void *img;
+  size_t img_len;
+  double x0[32], xr[8];  /* inputs guarded across the call: they live here */
+} octx;
+
+static void guard_in(const octx *c) {
+  guard_sys(c->sys);
+  if (c->X) guard(c->X, sizeof(double) * (size_t)c->N * (size_t)c->ns);
+}
+static phgmg_result op_reduce(const phgmg_allocator *a, void *v) {
+  octx *c = (octx *)v;
+  phgmg_result rc;
+  guard_in(c); guard(&c->o, sizeof c->o);
+  c->red = NULL;
+  rc = phgmg_reduce(&c->red, c->sys, c->X, c->N, c->ns, &c->o, NULL, a);
+  if (rc != PHGMG_OK && c->red) { th_fail_msg(__FILE__, __LINE__, "reduce: *out set on failure"); c->red = NULL; }
+  return rc;
+}
+static void undo_reduce(void *v) { octx *c = (octx *)v; phgmg_reduced_destroy(c->red); c->red = NULL; }
+
+static phgmg_result op_simulate(const phgmg_allocator *a, void *v) {
+  octx *c = (octx *)v;
+  double H[21], S[21], D[21], Y[21];
+  phgmg_energy en;
+  phgmg_gl3_opts go;
+  int i;
+  for (i = 0; i < c->N; ++i) c->x0[i] = 0.05 * sin(1.0 + i);
+  en.H = H; en.S = S; en.D = D;
+  memset(&go, 0, sizeof go); go.no_step_map = c->variant == 1;
+  guard_sys(c->sys); guard(c->x0, sizeof c->x0);
+  return phgmg_simulate(c->sys, c->x0, 0.0, 0.1, 20, u_sin, NULL, &go, c->out, Y, &en, NULL, NULL, a);
+}
+static phgmg_result op_gl3_create(const phgmg_allocator *a, void *v) {
+  octx *c = (octx *)v;
+  phgmg_gl3_opts go;
+  phgmg_result rc;
+  memset(&go, 0, sizeof go); go.no_step_map = c->variant == 1;
+  guard_sys(c->sys);
+  c->g = NULL;
+  rc = phgmg_gl3_create(&c->g, c->sys, 0.1, &go, a);
+  if (rc != PHGMG_OK && c->g) { th_fail_msg(__FILE__, __LINE__, "gl3_create: *out set on failure"); c->g = NULL; }
+  return rc;
+}
+static void undo_gl3(void *v) { octx *c = (octx *)v; phgmg_gl3_destroy(c->g); c->g = NULL; }
+static phgmg_result op_jr(const phgmg_allocator *a, void *v) {
+  octx *c = (octx *)v;
+  double rc_out = 0;
+  phgmg_result rc;
+  guard_sys(c->sys);
+  c->jr = NULL;
+  rc = phgmg_jr_factor_create(&c->jr, c->sys, &rc_out, a);
+  if (rc != PHGMG_OK && c->jr) { th_fail_msg(__FILE__, __LINE__, "jr_factor_create: *out set on failure"); c->jr = NULL; }
+  return rc;
+}
+static void undo_jr(void *v) { octx *c = (octx *)v; phgmg_jr_factor_destroy(c->jr); c->jr = NULL; }
+static phgmg_result op_validate(const phgmg_allocator *a, void *v) {
+  octx *c = (octx *)v;
+  double rc_out;
+  guard_sys(c->sys);
+  return phgmg_ph_validate(c->sys, 0.0, &rc_out, a);
+}
+/* dense kernels on a 20 x 12 matrix A and right-hand sides B (20 x 2) */
+static phgmg_result op_svd(const phgmg_allocator *a, void *v) {
+  octx *c = (octx *)v;
+  double S[12], U[20 * 12], V[12 * 12];
+  int k, rank;
+  guard(c->A, sizeof(double) * 240);
+  return phgmg_svd(20, 12, c->A, 20, 12, S, U, 20, V, 12, &k, &rank, a);
+}
+static phgmg_result op_lstsq(const phgmg_allocator *a, void *v) {
+  octx *c = (octx *)v;
+  double Xs[12 * 2];
+  guard(c->A, sizeof(double) * 240); guard(c->B, sizeof(double) * 40);
+  return phgmg_lstsq(20, 12, 2, c->A, 20, c->B, 20, c->variant ? 0.1 : 0.0, Xs, 12, a);
+}
+static phgmg_result op_pod(const phgmg_allocator *a, void *v) {
+  octx *c = (octx *)v;
+  double V[20 * 5], S[5];
+  int k;
+  guard(c->A, sizeof(double) * 240);
+  return phgmg_pod(20, 12, c->A, 20, 5, 1e-12, V, 20, S, &k, a);
+}
+static phgmg_result op_deim(const phgmg_allocator *a, void *v) {
+  octx *c = (octx *)v;
+  double w[20], ratio;
+  int pts[20], nd, nneg;
+  guard(c->A, sizeof(double) * 240);
+  return phgmg_deim(20, 12, c->A, 20, NULL, 1e-8, 0, pts, w, &nd, &nneg, &ratio, a);
+}
+static phgmg_result op_adjust(const phgmg_allocator *a, void *v) {
+  octx *c = (octx *)v;
+  double Xa[240];
+  guard(c->A, sizeof(double) * 240); guard(c->B, sizeof(double) * 40);
+  return phgmg_adjust_snapshots(20, 2, c->B, 12, c->A, 20, Xa, 20, a);
+}
+static phgmg_result op_podh(const phgmg_allocator *a, void *v) {
+  octx *c = (octx *)v;
+  double V1[20 * 4], V2[20 * 3];
+  guard(c->A, sizeof(double) * 240); guard(c->B, sizeof(double) * 40);
+  return phgmg_pod_hierarchical(20, 2, c->B, 12, c->A, 20, 4, 3, V1, V2, a);
+}
+static phgmg_result op_red_sim(const phgmg_allocator *a, void *v) {
+  octx *c = (octx *)v;
+  double XR[8 * 11], H[11], S[11], D[11], Y[11];
+  phgmg_energy en;
+  en.H = H; en.S = S; en.D = D;
+  memset(c->xr, 0, sizeof c->xr);
+  guard(c->xr, sizeof c->xr);
+  return phgmg_reduced_simulate(c->red, c->xr, 0.0, 0.1, 10, u_sin, NULL, 0, 0, XR, Y, &en, NULL, a);
+}
+static phgmg_result op_red_W(const phgmg_allocator *a, void *v) {
+  octx *c = (octx *)v;
+  int i;
+  (void)a; /* the model's own allocator (given to phgmg_reduce) */
+  for (i = 0; i < 8; ++i) c->xr[i] = 0.01 * (i % 3 - 1);
+  guard(c->xr, sizeof c->xr);
+  return phgmg_reduced_W(c->red, c->xr, c->out, c->N);
+}
+static phgmg_result op_npy_parse(const phgmg_allocator *a, void *v) {
+  octx *c = (octx *)v;
+  int rows, cols, nd;
+  guard(c->img, c->img_len);
+  c->out2 = NULL;
+  return phgmg_npy_parse(c->img, c->img_len, &c->out2, &rows, &cols, &nd, a);
+}
+static phgmg_result op_npy_read(const phgmg_allocator *a, void *v) {
+  octx *c = (octx *)v;
+  int rows, cols, nd;
+  c->out2 = NULL;
+  return phgmg_npy_read(c->path, &c->out2, &rows, &cols, &nd, a);
+}
+static void undo_npy(void *v) { octx *c = (octx *)v; phgmg_npy_free(c->out2, &g_fa_alloc); c->out2 = NULL; }
+static phgmg_result op_rom_load(const phgmg_allocator *a, void *v) {
+  octx *c = (octx *)v;
+  phgmg_rom rom;
+  void *block = NULL;
+  phgmg_result rc = phgmg_rom_load(c->path, &rom, &block, a);
+  if (rc == PHGMG_OK) phgmg__free(a, block);
+  else if (block) th_fail_msg(__FILE__, __LINE__, "rom_load: block set on failure");
+  return rc;
+}
+
+TEST(test_oom_reduce) {
+  msd_linear L;
+  msd_nonlinear M;
+  msd_nl_opts no;
+  octx c;
+  double *XL, *XM, *x0;
+  const int ns = 41;
+  int k;
+  CHECK(msd_linear_build(&L, 8, NULL, NULL, NULL, PHGMG_DENSE) == 0);
+  memset(&no, 0, sizeof no); no.n = 6;
+  CHECK(msd_nonlinear_build(&M, &no) == 0);
+  XL = (double *)malloc(sizeof(double) * 16 * ns);
+  XM = (double *)malloc(sizeof(double) * 12 * ns);
+  x0 = (double *)calloc(16, sizeof(double));
+  CHECK_RC(phgmg_simulate(&L.sys, x0, 0.0, 0.1, ns - 1, u_sin, NULL, NULL, XL, NULL, NULL, NULL, NULL, NULL), PHGMG_OK);
+  CHECK_RC(phgmg_simulate(&M.sys, x0, 0.0, 0.1, ns - 1, u_sin, NULL, NULL, XM, NULL, NULL, NULL, NULL, NULL), PHGMG_OK);
+  for (k = 0; k < 7; ++k) {
+    static const phgmg_method meth[7] = {PHGMG_METHOD_GMG_POD, PHGMG_METHOD_GMG_QM, PHGMG_METHOD_SP1,
+                                         PHGMG_METHOD_GMG_POD, PHGMG_METHOD_GMG_QM, PHGMG_METHOD_SP2, PHGMG_METHOD_SP2};
+    static const char *name[7] = {"reduce GMG-POD + step map", "reduce GMG-QM", "reduce SP1", "reduce GMG-POD + DEIM",
+                                  "reduce GMG-QM + DEIM", "reduce SP2 + DEIM", "reduce SP2, all terms"};
+    memset(&c, 0, sizeof c);
+    c.sys = k < 3 ? &L.sys : &M.sys; c.X = k < 3 ? XL : XM; c.N = c.sys->N; c.ns = ns;
+    c.o = ropts(meth[k], 4);
+    c.o.dt = 0.1; c.o.deim = k >= 3 && k < 6; c.o.deim_allow_negative = 1;
+    CHECK(oom_sweep(name[k], op_reduce, undo_reduce, &c) > 5);
+  }
+  /* the reduced model's own evaluations that allocate */
+  memset(&c, 0, sizeof c);
+  c.sys = &M.sys; c.X = XM; c.N = 12; c.ns = ns;
+  c.o = ropts(PHGMG_METHOD_GMG_QM, 4); c.o.deim = 1; c.o.deim_allow_negative = 1;
+  CHECK_RC(phgmg_reduce(&c.red, &M.sys, XM, 12, ns, &c.o, NULL, &g_fa_alloc), PHGMG_OK);
+  if (c.red) {
+    c.out = (double *)malloc(sizeof(double) * 12 * 4);
+    oom_sweep("reduced_simulate", op_red_sim, NULL, &c);
+    oom_sweep("reduced_W", op_red_W, NULL, &c);
+    g_fa.calls = 0; g_fa.fail_at = 1;
+    CHECK(phgmg_err_proj(c.red, XM, 12, ns) != phgmg_err_proj(c.red, XM, 12, ns)); /* NaN */
+    g_fa.fail_at = 0;
+    CHECK(phgmg_err_proj(c.red, XM, 12, ns) >= 0.0);
+    phgmg_reduced_destroy(c.red);
+    free(c.out);
+  }
+  free(XL); free(XM); free(x0);
+  msd_linear_free(&L);
+  msd_nonlinear_free(&M);
+}
+
+TEST(test_oom_simulate_and_factor) {
+  msd_linear L, Lb;
+  msd_nonlinear M, Mb;
+  msd_nl_opts no;
+  octx c;
+  double Xo[16 * 21];
+  int k;
+  CHECK(msd_linear_build(&L, 8, NULL, NULL, NULL, PHGMG_DENSE) == 0);
+  CHECK(msd_linear_build(&Lb, 8, NULL, NULL, NULL, PHGMG_BANDED) == 0);
+  memset(&no, 0, sizeof no); no.n = 6;
+  CHECK(msd_nonlinear_build(&M, &no) == 0);
+  no.storage = PHGMG_BANDED;
+  CHECK(msd_nonlinear_build(&Mb, &no) == 0);
+  for (k = 0; k < 5; ++k) {
+    static const char *name[5] = {"simulate linear (step map)", "simulate linear (Newton)", "simulate nonlinear dense",
+                                  "simulate nonlinear banded", "simulate linear banded"};
+    const phgmg_ph_system *s[5] = {&L.sys, &L.sys, &M.sys, &Mb.sys, &Lb.sys};
+    memset(&c, 0, sizeof c);
+    c.sys = s[k]; c.N = s[k]->N; c.variant = k == 1; c.out = Xo;
+    CHECK(oom_sweep(name[k], op_simulate, NULL, &c) > 0);
+    c.variant = k == 1;
+    CHECK(oom_sweep("gl3_create", op_gl3_create, undo_gl3, &c) > 0);
+    CHECK(oom_sweep("jr_factor_create", op_jr, undo_jr, &c) > 0);
+  }
+  /* validation: R diagonal (no allocation for the PSD test), R full (dense
+     eigenvalues), R banded beyond the dense limit (band Cholesky) */
+  memset(&c, 0, sizeof c);
+  c.sys = &L.sys; c.N = 16;
+  CHECK(oom_sweep("validate, diagonal R", op_validate, NULL, &c) > 0);
+  L.R[1 + 3 * 16] = L.R[3 + 1 * 16] = 0.5;
+  CHECK(oom_sweep("validate, full R", op_validate, NULL, &c) > 0);
+  {
+    const int Nb = 2002;
+    double *J = (double *)calloc((size_t)3 * Nb, sizeof(double)), *R = (double *)calloc((size_t)3 * Nb, sizeof(double));
+    double *Q = (double *)calloc((size_t)3 * Nb, sizeof(double)), *B = (double *)calloc((size_t)Nb, sizeof(double));
+    phgmg_ph_system sb;
+    int j;
+    for (j = 0; j < Nb; ++j) {
+      Q[1 + j * 3] = 1.0; R[1 + j * 3] = 2.0;
+      if (j > 0) R[j * 3] = -1.0;
+      if (j + 1 < Nb) R[2 + j * 3] = -1.0;
+      if (j % 2 == 1) { J[j * 3] = 1.0; J[2 + (j - 1) * 3] = -1.0; }
+    }
+    B[0] = 1.0;
+    memset(&sb, 0, sizeof sb);
+    sb.N = Nb; sb.m = 1; sb.storage = PHGMG_BANDED; sb.kb = 1; sb.J = J; sb.R = R; sb.Q = Q; sb.B = B;
+    c.sys = &sb; c.N = Nb;
+    CHECK(oom_sweep("validate, banded R (Cholesky)", op_validate, NULL, &c) > 0);
+    free(J); free(R); free(Q); free(B);
+  }
+  msd_linear_free(&L); msd_linear_free(&Lb);
+  msd_nonlinear_free(&M); msd_nonlinear_free(&Mb);
+}
+
+TEST(test_oom_kernels_and_readers) {
+  octx c;
+  double A[240], B[40];
+  int i;
+  memset(&c, 0, sizeof c);
+  for (i = 0; i < 240; ++i) A[i] = th_rand();
+  for (i = 0; i < 40; ++i) B[i] = th_rand();
+  c.A = A; c.B = B;
+  CHECK(oom_sweep("svd", op_svd, NULL, &c) > 0);
+  CHECK(oom_sweep("lstsq", op_lstsq, NULL, &c) > 0);
+  c.variant = 1;
+  CHECK(oom_sweep("lstsq ridge", op_lstsq, NULL, &c) > 0);
+  CHECK(oom_sweep("pod", op_pod, NULL, &c) > 0);
+  CHECK(oom_sweep("deim", op_deim, NULL, &c) > 0);
+  CHECK(oom_sweep("adjust_snapshots", op_adjust, NULL, &c) > 0);
+  CHECK(oom_sweep("pod_hierarchical", op_podh, NULL, &c) > 0);
+  /* readers of outside data */
+  {
+    size_t len = 0;
+    unsigned char *img;
+    CHECK_RC(phgmg_npy_serialize(A, 20, 12, 20, 2, 0, NULL, 0, &len), PHGMG_OK);
+    img = (unsigned char *)malloc(len);
+    CHECK_RC(phgmg_npy_serialize(A, 20, 12, 20, 2, 0, img, len, &len), PHGMG_OK);
+    c.img = img; c.img_len = len;
+    CHECK(oom_sweep("npy_parse", op_npy_parse, undo_npy, &c) > 0);
+    c.path = "build/robust_tmp.npy";
+    if (phgmg_npy_write(c.path, A, 20, 12, 20, 2, 0) == PHGMG_OK) {
+      CHECK(oom_sweep("npy_read", op_npy_read, undo_npy, &c) > 0);
+      remove(c.path);
+    }
+    free(img);
+  }
+  {
+    static const phgmg_real K[4] = {0, -1, 1, 0}, Qh[4] = {1, 0, 0, 1}, Bh[2] = {0, 1};
+    phgmg_rom rom;
+    memset(&rom, 0, sizeof rom);
+    rom.kind = PHGMG_ROM_LINEAR; rom.r = 2; rom.m = 1; rom.K = K; rom.Qh = Qh; rom.Bh = Bh;
+    c.path = "build/robust_tmp2.rom";
+    if (phgmg_rom_save(&rom, c.path) == PHGMG_OK) {
+      CHECK(oom_sweep("rom_load", op_rom_load, NULL, &c) > 0);
+      remove(c.path);
+    }
+  }
+}
+
 SUITE(robust) {
   RUN(test_dims_reduce);
   RUN(test_dims_validate);
@@ -1221,4 +1529,7 @@ SUITE(robust) {
   RUN(test_deim_negative_weight);
   RUN(test_newton_failure);
   RUN(test_rom_images);
+  RUN(test_oom_reduce);
+  RUN(test_oom_simulate_and_factor);
+  RUN(test_oom_kernels_and_readers);
 }
