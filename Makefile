@@ -19,7 +19,7 @@ FRAGS   := $(wildcard dev/h*.h dev/i*.c dev/z*.h)
 TESTSRC := $(wildcard tests/test_*.c)
 BUILD    = build
 
-.PHONY: all test test-plain test-asan compile-checks test-embedded-host test-npy demo bench examples embedded fuzz clean
+.PHONY: all test test-plain test-asan compile-checks test-embedded-host test-npy test-cli demo bench examples embedded fuzz clean
 
 all: phgmg.h examples
 
@@ -37,7 +37,7 @@ $(BUILD)/test_run_asan: phgmg.h tests/run.c tests/harness.h tests/suites.inc $(T
 	@mkdir -p $(BUILD)
 	$(CC) $(CFLAGS_T) -O1 $(SANFLAGS) -o $@ tests/run.c $(TESTSRC) $(LDLIBS)
 
-test: test-plain test-asan compile-checks test-embedded-host test-npy
+test: test-plain test-asan compile-checks test-embedded-host test-npy test-cli
 
 # Embedded path on the host: export the demo models (double and float), check
 # binary and C-source exports reproduce the in-memory outputs exactly, float vs double.
@@ -89,10 +89,18 @@ compile-checks: phgmg.h
 	$(CC) -std=c99 $(WARN) $(BUILD)/cc/s1.c $(BUILD)/cc/s2.c -o $(BUILD)/cc/static2 $(LDLIBS)
 	@echo "compile checks passed"
 
-EXAMPLES = $(BUILD)/msd_linear $(BUILD)/msd_nonlinear
+EXAMPLES = $(BUILD)/msd_linear $(BUILD)/msd_nonlinear $(BUILD)/phgmg
 EXHDRS   = examples/msd_models.h examples/demo_common.h examples/svgplot.h
 
 examples: $(EXAMPLES)
+
+# the command-line reducer (examples/phgmg_cli.c) is installed as build/phgmg
+$(BUILD)/phgmg: examples/phgmg_cli.c phgmg.h
+	@mkdir -p $(BUILD)
+	$(CC) $(OPTFLAGS) -o $@ $< $(LDLIBS)
+
+test-cli: $(BUILD)/phgmg
+	sh tests/test_cli.sh $(BUILD)/phgmg
 
 $(BUILD)/%: examples/%.c phgmg.h $(EXHDRS)
 	@mkdir -p $(BUILD)

@@ -49,6 +49,7 @@
      PHGMG_NO_OFFLINE      compile only the online half (+ export/import in memory):
                            needs libm only, no heap, no stdio
      PHGMG_NO_STDIO        no file functions (.npy files, model files, C export)
+     PHGMG_NPY_MAX_HEADER  longest accepted .npy header in bytes (default 1 MiB)
      PHGMG_MALLOC(sz,u) / PHGMG_FREE(p,u)   default allocator (both or neither)
      PHGMG_ASSERT(x)       internal invariant checks (default assert)
      PHGMG_USE_CBLAS       use cblas_dgemm/cblas_dgemv (optional speed-up)
@@ -975,6 +976,14 @@ PHGMG__PRIV void phgmg__rot(int n, double *x, double *y, double c, double s) {
   }
 }
 
+/* every entry of the m x n matrix finite */
+PHGMG__PRIV int phgmg__mat_finite(int m, int n, const double *A, int lda) {
+  int j;
+  for (j = 0; j < n; ++j)
+    if (!phgmg__all_finite(A + (size_t)j * (size_t)lda, (size_t)m)) return 0;
+  return 1;
+}
+
 /* ---- norms -------------------------------------------------------------- */
 PHGMG_DEF double phgmg_norm1(int m, int n, const double *A, int lda) {
   double best = 0.0;
@@ -1369,7 +1378,9 @@ PHGMG_DEF phgmg_result phgmg_lu_factor(int n, double *A, int lda, int *ipiv) {
   if (!A || !ipiv) return PHGMG_ERR_INVALID_ARG;
   for (j = 0; j < n; ++j)
     if (!phgmg__all_finite(A + (size_t)j * (size_t)lda, (size_t)n)) return PHGMG_ERR_NANINF;
-  return phgmg__lu_rec(n, n, A, lda, ipiv) ? PHGMG_ERR_SINGULAR : PHGMG_OK;
+  if (phgmg__lu_rec(n, n, A, lda, ipiv)) return PHGMG_ERR_SINGULAR;
+  /* finite input can still overflow (pivot growth) */
+  return phgmg__mat_finite(n, n, A, lda) ? PHGMG_OK : PHGMG_ERR_NANINF;
 }
 
 PHGMG_DEF void phgmg_lu_solve(char trans, int n, const double *LU, int lda, const int *ipiv,
@@ -1520,7 +1531,8 @@ PHGMG_DEF phgmg_result phgmg_zlu_factor(int n, double *A, int lda, int *ipiv) {
   if (!A || !ipiv) return PHGMG_ERR_INVALID_ARG;
   for (j = 0; j < n; ++j)
     if (!phgmg__all_finite(A + 2 * (size_t)j * (size_t)lda, 2 * (size_t)n)) return PHGMG_ERR_NANINF;
-  return phgmg__zlu_rec(n, n, A, lda, ipiv) ? PHGMG_ERR_SINGULAR : PHGMG_OK;
+  if (phgmg__zlu_rec(n, n, A, lda, ipiv)) return PHGMG_ERR_SINGULAR;
+  return phgmg__mat_finite(2 * n, n, A, 2 * lda) ? PHGMG_OK : PHGMG_ERR_NANINF;
 }
 
 PHGMG_DEF void phgmg_zlu_solve(int n, const double *LU, int lda, const int *ipiv,
@@ -1620,13 +1632,6 @@ PHGMG__PRIV void phgmg__larf_left(int m, int n, const double *v, double tau, dou
     c[0] -= s;
     phgmg__axpy(m - 1, -s, v + 1, c + 1);
   }
-}
-
-PHGMG__PRIV int phgmg__mat_finite(int m, int n, const double *A, int lda) {
-  int j;
-  for (j = 0; j < n; ++j)
-    if (!phgmg__all_finite(A + (size_t)j * (size_t)lda, (size_t)m)) return 0;
-  return 1;
 }
 
 PHGMG_DEF phgmg_result phgmg_qr(int m, int n, double *A, int lda, double *tau) {
@@ -4239,6 +4244,8 @@ done:
 #endif
 #define PHGMG__R(x) ((phgmg_real)(x))
 #define PHGMG__ONLINE static PHGMG__UNUSED
+/* base + o, or NULL when only sizes are wanted (NULL + o is undefined). */
+#define PHGMG__CARVE(base, o) ((base) ? (base) + (o) : NULL)
 
 PHGMG__ONLINE int phgmg__r_finite(const phgmg_real *a, int n) {
   phgmg_real acc = PHGMG__R(0);
@@ -4360,17 +4367,17 @@ PHGMG__ONLINE size_t phgmg__romw_layout(const phgmg_rom *rom, phgmg_real *base, 
   size_t o = 0;
   phgmg__romw dummy;
   if (!w) w = &dummy;
-  w->Lp = base + o; o += rn * r;
-  w->q = base + o; o += rn;
-  w->a1 = base + o; o += rn;
-  w->c = base + o; o += nd;
-  w->d = base + o; o += nd;
-  w->E = base + o; o += r * r;
-  w->t = base + o; o += rn * r;
-  w->tmp = base + o; o += r;
-  w->xp = base + o; o += r;
-  w->fm = base + o; o += r;
-  w->g = base + o; o += r;
+  w->Lp = PHGMG__CARVE(base, o); o += rn * r;
+  w->q = PHGMG__CARVE(base, o); o += rn;
+  w->a1 = PHGMG__CARVE(base, o); o += rn;
+  w->c = PHGMG__CARVE(base, o); o += nd;
+  w->d = PHGMG__CARVE(base, o); o += nd;
+  w->E = PHGMG__CARVE(base, o); o += r * r;
+  w->t = PHGMG__CARVE(base, o); o += rn * r;
+  w->tmp = PHGMG__CARVE(base, o); o += r;
+  w->xp = PHGMG__CARVE(base, o); o += r;
+  w->fm = PHGMG__CARVE(base, o); o += r;
+  w->g = PHGMG__CARVE(base, o); o += r;
   return o;
 }
 
@@ -4628,20 +4635,20 @@ PHGMG__ONLINE size_t phgmg__romstep_layout(const phgmg_rom *rom, void *mem, phgm
   size_t o = 0, reals;
   phgmg__romstep_mem dummy;
   if (!L) L = &dummy;
-  L->A = base + o; o += 9;
-  L->b = base + o; o += 3;
-  L->c = base + o; o += 3;
-  L->lag = base + o; o += 12;
-  L->LU = base + o; o += n3 * n3;
-  L->Jf = base + o; o += r * r;
-  L->Z = base + o; o += n3;
-  L->F = base + o; o += n3;
-  L->Res = base + o; o += n3;
-  L->dZ = base + o; o += n3;
-  L->Zp = base + o; o += n3;
-  L->G = base + o; o += n3;
-  L->Y = base + o; o += r;
-  L->work = base + o; o += phgmg_rom_eval_work_size(rom);
+  L->A = PHGMG__CARVE(base, o); o += 9;
+  L->b = PHGMG__CARVE(base, o); o += 3;
+  L->c = PHGMG__CARVE(base, o); o += 3;
+  L->lag = PHGMG__CARVE(base, o); o += 12;
+  L->LU = PHGMG__CARVE(base, o); o += n3 * n3;
+  L->Jf = PHGMG__CARVE(base, o); o += r * r;
+  L->Z = PHGMG__CARVE(base, o); o += n3;
+  L->F = PHGMG__CARVE(base, o); o += n3;
+  L->Res = PHGMG__CARVE(base, o); o += n3;
+  L->dZ = PHGMG__CARVE(base, o); o += n3;
+  L->Zp = PHGMG__CARVE(base, o); o += n3;
+  L->G = PHGMG__CARVE(base, o); o += n3;
+  L->Y = PHGMG__CARVE(base, o); o += r;
+  L->work = PHGMG__CARVE(base, o); o += phgmg_rom_eval_work_size(rom);
   reals = o;
   L->piv = mem ? PHGMG__CAST(int *, PHGMG__CAST(void *, base + reals)) : NULL;
   return reals * sizeof(phgmg_real) + n3 * sizeof(int);
@@ -5669,17 +5676,19 @@ PHGMG_DEF phgmg_result phgmg_reduced_simulate(const phgmg_reduced *red, const do
   size_t msz, nreal;
   void *mem;
   phgmg_real *x, *u3, *y, *ework, en[2];
-  double S = 0.0, D = 0.0;
+  double *ubuf, S = 0.0, D = 0.0;
   int r, m, n, i, a;
   phgmg_result rc;
   if (!red || !xr0 || nsteps < 0 || !(dt > 0.0)) return PHGMG_ERR_INVALID_ARG;
   rom = &red->rom; r = rom->r; m = rom->m;
   msz = phgmg_rom_stepper_memsize(rom);
   nreal = (size_t)r + 4 * (size_t)m + phgmg_rom_eval_work_size(rom);
-  mem = phgmg__alloc(alloc, ((msz + 15) / 16) * 16 + nreal * sizeof(phgmg_real));
+  mem = phgmg__alloc(alloc, ((msz + 15) / 16) * 16 + nreal * sizeof(phgmg_real) + (size_t)m * sizeof(double) + 16);
   if (!mem) return PHGMG_ERR_NOMEM;
   x = PHGMG__CAST(phgmg_real *, PHGMG__CAST(void *, PHGMG__CAST(char *, mem) + ((msz + 15) / 16) * 16));
   u3 = x + r; y = u3 + 3 * m; ework = y + m;
+  ubuf = PHGMG__CAST(double *, PHGMG__CAST(void *, PHGMG__CAST(char *, mem) + ((msz + 15) / 16) * 16 +
+                                                    ((nreal * sizeof(phgmg_real) + 15) / 16) * 16));
   rc = phgmg_rom_stepper_init(&st, rom, (phgmg_real)dt, (phgmg_real)tol, max_iter, mem, msz);
   if (rc != PHGMG_OK) { phgmg__free(alloc, mem); return rc; }
   for (a = 0; a < r; ++a) x[a] = (phgmg_real)xr0[a];
@@ -5691,10 +5700,9 @@ PHGMG_DEF phgmg_result phgmg_reduced_simulate(const phgmg_reduced *red, const do
   PHGMG__REC(0);
   for (n = 0; n < nsteps; ++n) {
     const double t = t0 + n * dt;
-    double ubuf[16];
     const double s15 = sqrt(15.0) / 10.0, cs[3] = {0.5 - s15, 0.5, 0.5 + s15};
     for (i = 0; i < 3; ++i) {
-      if (uf && m <= 16) {
+      if (uf) {
         uf(t + cs[i] * dt, ubuf, uuser);
         for (a = 0; a < m; ++a) u3[i * m + a] = (phgmg_real)ubuf[a];
       } else {
@@ -5944,6 +5952,9 @@ PHGMG__ONLINE phgmg_result phgmg__rom_header(const unsigned char *b, size_t len,
   {
     double dt = phgmg__get_f64(b + 48);
     if (!(dt >= 0.0) || dt > 1e300) return PHGMG_ERR_FORMAT;
+#if PHGMG_REAL_IS_FLOAT
+    if (dt > 3.4e38) return PHGMG_ERR_FORMAT; /* would be Inf as float */
+#endif
     rom->dt = (phgmg_real)dt;
   }
   if (mask >> PHGMG__NFIELDS) return PHGMG_ERR_FORMAT;

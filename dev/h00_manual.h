@@ -49,6 +49,7 @@
      PHGMG_NO_OFFLINE      compile only the online half (+ export/import in memory):
                            needs libm only, no heap, no stdio
      PHGMG_NO_STDIO        no file functions (.npy files, model files, C export)
+     PHGMG_NPY_MAX_HEADER  longest accepted .npy header in bytes (default 1 MiB)
      PHGMG_MALLOC(sz,u) / PHGMG_FREE(p,u)   default allocator (both or neither)
      PHGMG_ASSERT(x)       internal invariant checks (default assert)
      PHGMG_USE_CBLAS       use cblas_dgemm/cblas_dgemv (optional speed-up)

@@ -77,6 +77,14 @@ PHGMG__PRIV void phgmg__rot(int n, double *x, double *y, double c, double s) {
   }
 }
 
+/* every entry of the m x n matrix finite */
+PHGMG__PRIV int phgmg__mat_finite(int m, int n, const double *A, int lda) {
+  int j;
+  for (j = 0; j < n; ++j)
+    if (!phgmg__all_finite(A + (size_t)j * (size_t)lda, (size_t)m)) return 0;
+  return 1;
+}
+
 /* ---- norms -------------------------------------------------------------- */
 PHGMG_DEF double phgmg_norm1(int m, int n, const double *A, int lda) {
   double best = 0.0;
@@ -471,7 +479,9 @@ PHGMG_DEF phgmg_result phgmg_lu_factor(int n, double *A, int lda, int *ipiv) {
   if (!A || !ipiv) return PHGMG_ERR_INVALID_ARG;
   for (j = 0; j < n; ++j)
     if (!phgmg__all_finite(A + (size_t)j * (size_t)lda, (size_t)n)) return PHGMG_ERR_NANINF;
-  return phgmg__lu_rec(n, n, A, lda, ipiv) ? PHGMG_ERR_SINGULAR : PHGMG_OK;
+  if (phgmg__lu_rec(n, n, A, lda, ipiv)) return PHGMG_ERR_SINGULAR;
+  /* finite input can still overflow (pivot growth) */
+  return phgmg__mat_finite(n, n, A, lda) ? PHGMG_OK : PHGMG_ERR_NANINF;
 }
 
 PHGMG_DEF void phgmg_lu_solve(char trans, int n, const double *LU, int lda, const int *ipiv,
@@ -622,7 +632,8 @@ PHGMG_DEF phgmg_result phgmg_zlu_factor(int n, double *A, int lda, int *ipiv) {
   if (!A || !ipiv) return PHGMG_ERR_INVALID_ARG;
   for (j = 0; j < n; ++j)
     if (!phgmg__all_finite(A + 2 * (size_t)j * (size_t)lda, 2 * (size_t)n)) return PHGMG_ERR_NANINF;
-  return phgmg__zlu_rec(n, n, A, lda, ipiv) ? PHGMG_ERR_SINGULAR : PHGMG_OK;
+  if (phgmg__zlu_rec(n, n, A, lda, ipiv)) return PHGMG_ERR_SINGULAR;
+  return phgmg__mat_finite(2 * n, n, A, 2 * lda) ? PHGMG_OK : PHGMG_ERR_NANINF;
 }
 
 PHGMG_DEF void phgmg_zlu_solve(int n, const double *LU, int lda, const int *ipiv,
@@ -722,13 +733,6 @@ PHGMG__PRIV void phgmg__larf_left(int m, int n, const double *v, double tau, dou
     c[0] -= s;
     phgmg__axpy(m - 1, -s, v + 1, c + 1);
   }
-}
-
-PHGMG__PRIV int phgmg__mat_finite(int m, int n, const double *A, int lda) {
-  int j;
-  for (j = 0; j < n; ++j)
-    if (!phgmg__all_finite(A + (size_t)j * (size_t)lda, (size_t)m)) return 0;
-  return 1;
 }
 
 PHGMG_DEF phgmg_result phgmg_qr(int m, int n, double *A, int lda, double *tau) {

@@ -12,6 +12,8 @@
 #endif
 #define PHGMG__R(x) ((phgmg_real)(x))
 #define PHGMG__ONLINE static PHGMG__UNUSED
+/* base + o, or NULL when only sizes are wanted (NULL + o is undefined). */
+#define PHGMG__CARVE(base, o) ((base) ? (base) + (o) : NULL)
 
 PHGMG__ONLINE int phgmg__r_finite(const phgmg_real *a, int n) {
   phgmg_real acc = PHGMG__R(0);
@@ -133,17 +135,17 @@ PHGMG__ONLINE size_t phgmg__romw_layout(const phgmg_rom *rom, phgmg_real *base, 
   size_t o = 0;
   phgmg__romw dummy;
   if (!w) w = &dummy;
-  w->Lp = base + o; o += rn * r;
-  w->q = base + o; o += rn;
-  w->a1 = base + o; o += rn;
-  w->c = base + o; o += nd;
-  w->d = base + o; o += nd;
-  w->E = base + o; o += r * r;
-  w->t = base + o; o += rn * r;
-  w->tmp = base + o; o += r;
-  w->xp = base + o; o += r;
-  w->fm = base + o; o += r;
-  w->g = base + o; o += r;
+  w->Lp = PHGMG__CARVE(base, o); o += rn * r;
+  w->q = PHGMG__CARVE(base, o); o += rn;
+  w->a1 = PHGMG__CARVE(base, o); o += rn;
+  w->c = PHGMG__CARVE(base, o); o += nd;
+  w->d = PHGMG__CARVE(base, o); o += nd;
+  w->E = PHGMG__CARVE(base, o); o += r * r;
+  w->t = PHGMG__CARVE(base, o); o += rn * r;
+  w->tmp = PHGMG__CARVE(base, o); o += r;
+  w->xp = PHGMG__CARVE(base, o); o += r;
+  w->fm = PHGMG__CARVE(base, o); o += r;
+  w->g = PHGMG__CARVE(base, o); o += r;
   return o;
 }
 
@@ -401,20 +403,20 @@ PHGMG__ONLINE size_t phgmg__romstep_layout(const phgmg_rom *rom, void *mem, phgm
   size_t o = 0, reals;
   phgmg__romstep_mem dummy;
   if (!L) L = &dummy;
-  L->A = base + o; o += 9;
-  L->b = base + o; o += 3;
-  L->c = base + o; o += 3;
-  L->lag = base + o; o += 12;
-  L->LU = base + o; o += n3 * n3;
-  L->Jf = base + o; o += r * r;
-  L->Z = base + o; o += n3;
-  L->F = base + o; o += n3;
-  L->Res = base + o; o += n3;
-  L->dZ = base + o; o += n3;
-  L->Zp = base + o; o += n3;
-  L->G = base + o; o += n3;
-  L->Y = base + o; o += r;
-  L->work = base + o; o += phgmg_rom_eval_work_size(rom);
+  L->A = PHGMG__CARVE(base, o); o += 9;
+  L->b = PHGMG__CARVE(base, o); o += 3;
+  L->c = PHGMG__CARVE(base, o); o += 3;
+  L->lag = PHGMG__CARVE(base, o); o += 12;
+  L->LU = PHGMG__CARVE(base, o); o += n3 * n3;
+  L->Jf = PHGMG__CARVE(base, o); o += r * r;
+  L->Z = PHGMG__CARVE(base, o); o += n3;
+  L->F = PHGMG__CARVE(base, o); o += n3;
+  L->Res = PHGMG__CARVE(base, o); o += n3;
+  L->dZ = PHGMG__CARVE(base, o); o += n3;
+  L->Zp = PHGMG__CARVE(base, o); o += n3;
+  L->G = PHGMG__CARVE(base, o); o += n3;
+  L->Y = PHGMG__CARVE(base, o); o += r;
+  L->work = PHGMG__CARVE(base, o); o += phgmg_rom_eval_work_size(rom);
   reals = o;
   L->piv = mem ? PHGMG__CAST(int *, PHGMG__CAST(void *, base + reals)) : NULL;
   return reals * sizeof(phgmg_real) + n3 * sizeof(int);

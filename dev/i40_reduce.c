@@ -772,17 +772,19 @@ PHGMG_DEF phgmg_result phgmg_reduced_simulate(const phgmg_reduced *red, const do
   size_t msz, nreal;
   void *mem;
   phgmg_real *x, *u3, *y, *ework, en[2];
-  double S = 0.0, D = 0.0;
+  double *ubuf, S = 0.0, D = 0.0;
   int r, m, n, i, a;
   phgmg_result rc;
   if (!red || !xr0 || nsteps < 0 || !(dt > 0.0)) return PHGMG_ERR_INVALID_ARG;
   rom = &red->rom; r = rom->r; m = rom->m;
   msz = phgmg_rom_stepper_memsize(rom);
   nreal = (size_t)r + 4 * (size_t)m + phgmg_rom_eval_work_size(rom);
-  mem = phgmg__alloc(alloc, ((msz + 15) / 16) * 16 + nreal * sizeof(phgmg_real));
+  mem = phgmg__alloc(alloc, ((msz + 15) / 16) * 16 + nreal * sizeof(phgmg_real) + (size_t)m * sizeof(double) + 16);
   if (!mem) return PHGMG_ERR_NOMEM;
   x = PHGMG__CAST(phgmg_real *, PHGMG__CAST(void *, PHGMG__CAST(char *, mem) + ((msz + 15) / 16) * 16));
   u3 = x + r; y = u3 + 3 * m; ework = y + m;
+  ubuf = PHGMG__CAST(double *, PHGMG__CAST(void *, PHGMG__CAST(char *, mem) + ((msz + 15) / 16) * 16 +
+                                                    ((nreal * sizeof(phgmg_real) + 15) / 16) * 16));
   rc = phgmg_rom_stepper_init(&st, rom, (phgmg_real)dt, (phgmg_real)tol, max_iter, mem, msz);
   if (rc != PHGMG_OK) { phgmg__free(alloc, mem); return rc; }
   for (a = 0; a < r; ++a) x[a] = (phgmg_real)xr0[a];
@@ -794,10 +796,9 @@ PHGMG_DEF phgmg_result phgmg_reduced_simulate(const phgmg_reduced *red, const do
   PHGMG__REC(0);
   for (n = 0; n < nsteps; ++n) {
     const double t = t0 + n * dt;
-    double ubuf[16];
     const double s15 = sqrt(15.0) / 10.0, cs[3] = {0.5 - s15, 0.5, 0.5 + s15};
     for (i = 0; i < 3; ++i) {
-      if (uf && m <= 16) {
+      if (uf) {
         uf(t + cs[i] * dt, ubuf, uuser);
         for (a = 0; a < m; ++a) u3[i * m + a] = (phgmg_real)ubuf[a];
       } else {

@@ -164,6 +164,9 @@ PHGMG__ONLINE phgmg_result phgmg__rom_header(const unsigned char *b, size_t len,
   {
     double dt = phgmg__get_f64(b + 48);
     if (!(dt >= 0.0) || dt > 1e300) return PHGMG_ERR_FORMAT;
+#if PHGMG_REAL_IS_FLOAT
+    if (dt > 3.4e38) return PHGMG_ERR_FORMAT; /* would be Inf as float */
+#endif
     rom->dt = (phgmg_real)dt;
   }
   if (mask >> PHGMG__NFIELDS) return PHGMG_ERR_FORMAT;

@@ -14,7 +14,6 @@
    Build: cc -std=c99 -O2 examples/phgmg_cli.c -o build/phgmg -lm
    Exit status: 0 success, 1 bad data or a failed computation/file, 2 bad usage. */
 #define _POSIX_C_SOURCE 200809L
-#define PHGMG_STATIC
 #define PHGMG_IMPLEMENTATION
 #include "../phgmg.h"
 #include <errno.h>

@@ -105,6 +105,11 @@ cat "$T/out.txt"
 run_ok "info" "$P" info out/msd.phgmgrom
 grep -F -q "r = 12, m = 1" "$T/out.txt" || bad "info does not print the sizes"
 
+# the same reduction from the saved snapshots (--X) gives the same model
+run_ok "reduce --X" "$P" reduce $SYS --X out/msd_snapshots.npy --dt-map 0.1 --method gmg-pod --r 12 --out ox --name m --quiet
+run_ok "simulate-rom --X model" "$P" simulate-rom --model ox/m.phgmgrom $ROMSIM --out ox/y.npy --quiet
+run_ok "--X snapshots == --simulate" "$REF" compare out/y_rom.npy ox/y.npy 0
+
 for meth in gmg-qm sp1; do
   run_ok "reduce $meth" "$P" reduce $SYS $SIM --method $meth --r 12 --out o_$meth --name m --quiet
   run_ok "simulate-rom $meth" "$P" simulate-rom --model o_$meth/m.phgmgrom $ROMSIM --out o_$meth/y.npy --quiet
@@ -184,6 +189,16 @@ np.save('int.npy', np.zeros((100, 100), dtype=np.int64))
 Q = np.load('model/Q.npy'); Q[3, 3] = np.nan; np.save('Q_nan.npy', Q)
 np.save('J_3d.npy', np.zeros((2, 2, 2)))
 "
+  # explicit unit weights of the nonlinear terms == the default
+  run_ok "write w1.npy" "$PY" -c "import numpy as np; np.save('w1.npy', np.ones(20))"
+  run_ok "reduce --poly-w" "$P" reduce --J nl/J.npy --R nl/R.npy --B nl/B.npy --Q nl/Q.npy --poly nl/poly.npy \
+    --poly-idx nl/idx.npy --poly-w w1.npy --deim-allow-negative $SIM --newton-tol 1e-8 --newton-iter 20 \
+    --method gmg-pod --r 10 --out onlw --name nlm --quiet
+  run_ok "simulate-rom --poly-w" "$P" simulate-rom --model onlw/nlm.phgmgrom $ROMSIM --newton-tol 1e-8 \
+    --newton-iter 20 --out onlw/y.npy --quiet
+  run_ok "--poly-w ones == default" "$REF" compare onl/y.npy onlw/y.npy 0
+  run_err "poly-w length" 1 "w1.npy (--poly-w): expected a vector of 100 weights" "$P" reduce $SYS $SIM \
+    --method gmg-pod --r 12 --out e --poly nl/poly.npy --poly-idx model/B.npy --poly-w w1.npy
   run_ok "simulate-rom const" "$P" simulate-rom --model out/msd.phgmgrom --input const --amp 0.1 --out yc.npy --quiet
   for u in u_grid u_tab u_tabbe; do
     run_ok "simulate-rom --input $u.npy" "$P" simulate-rom --model out/msd.phgmgrom --input $u.npy --out y_$u.npy --quiet

@@ -312,6 +312,12 @@ TEST(test_lu_singular_naninf) {
   CHECK(B[0] == A[0] && B[1] == A[1] && B[8] == A[8]); /* input left unchanged */
   B[4] = INFINITY;
   CHECK_RC(phgmg_lu_factor(3, B, 3, ipiv), PHGMG_ERR_NANINF);
+  {
+    /* finite input whose elimination overflows: A = [a -a; a a], a = 1.5e308,
+       multiplier 1, U(1,1) = a - (-a) = Inf */
+    double G[4] = {1.5e308, 1.5e308, -1.5e308, 1.5e308};
+    CHECK_RC(phgmg_lu_factor(2, G, 2, ipiv), PHGMG_ERR_NANINF);
+  }
   CHECK_RC(phgmg_lu_factor(-1, B, 3, ipiv), PHGMG_ERR_SIZE);
   CHECK_RC(phgmg_lu_factor(3, B, 2, ipiv), PHGMG_ERR_SIZE);
   CHECK_RC(phgmg_lu_factor(0, B, 1, ipiv), PHGMG_OK);
@@ -535,6 +541,46 @@ TEST(test_qrcp_rank) {
   }
 }
 
+/* The blocked pivoted QR used by the SVD (private): A P = Q R across several
+   32-column blocks, non-increasing |R(k,k)|, and early stop at the rank. */
+TEST(test_qrcp_blocked) {
+  const int m = 130, n = 110, r = 70;
+  double *X = tl_new((size_t)m * r), *Y = tl_new((size_t)n * r), *A = tl_new((size_t)m * n);
+  double *F = tl_new((size_t)m * n), *tau = tl_new((size_t)n), *vn = tl_new(2 * (size_t)n);
+  double *Fw = tl_new((size_t)(n + 1) * PHGMG__QRCP_NB), *Q = tl_new((size_t)m * n);
+  double *R = tl_new((size_t)n * n), *AP = tl_new((size_t)m * n), anorm;
+  int *jpvt = (int *)calloc((size_t)n, sizeof(int)), *mark = (int *)calloc((size_t)n, sizeof(int));
+  int pass, i, j, rank;
+  tl_rand(m, r, X, m);
+  tl_rand(n, r, Y, n);
+  tl_mul(0, 1, m, n, r, X, m, Y, n, A, m);
+  for (j = 0; j < n; ++j) /* columns over 6 decades: pivoting and norm downdating matter */
+    for (i = 0; i < m; ++i) A[i + (size_t)j * m] *= pow(10.0, -6.0 * (double)((j * 37) % n) / n);
+  anorm = phgmg_normf(m, n, A, m);
+  for (pass = 0; pass < 2; ++pass) {
+    int k;
+    memcpy(F, A, sizeof(double) * m * n);
+    phgmg__qrcp_blocked(m, n, F, m, tau, jpvt, vn, Fw, Fw + (size_t)n * PHGMG__QRCP_NB, mark,
+                        pass ? PHGMG__EPS * anorm : -1.0, &rank);
+    CHECK(rank == (pass ? r : n));
+    k = rank;
+    for (j = 1; j < k; ++j)
+      CHECK_LE(fabs(F[j + (size_t)j * m]), fabs(F[j - 1 + (size_t)(j - 1) * m]) * (1 + 1e-13));
+    if (!pass) CHECK_LE(fabs(F[r + (size_t)r * m]), 1e-12 * fabs(F[0]));
+    for (j = 0; j < n; ++j)
+      for (i = 0; i < k; ++i) R[i + (size_t)j * k] = i <= j ? F[i + (size_t)j * m] : 0.0;
+    memcpy(Q, F, sizeof(double) * m * k);
+    phgmg_qr_form_q(m, k, Q, m, tau, NULL);
+    CHECK_LE(tl_orth_err(m, k, Q, m), 10.0 * n * EPS);
+    tl_mul(0, 0, m, n, k, Q, m, R, k, AP, m);
+    for (j = 0; j < n; ++j)
+      for (i = 0; i < m; ++i) AP[i + (size_t)j * m] -= A[i + (size_t)jpvt[j] * m];
+    CHECK_LE(phgmg_normf(m, n, AP, m), 10.0 * m * EPS * anorm);
+  }
+  free(X); free(Y); free(A); free(F); free(tau); free(vn); free(Fw); free(Q); free(R); free(AP);
+  free(jpvt); free(mark);
+}
+
 /* ---- least squares ----------------------------------------------------------------- */
 /* Solve the SPD system M x = y (n x n) by Cholesky, independent of the library. */
 static void tl_chol_solve(int n, double *M, int nrhs, double *Y) {
@@ -680,6 +726,22 @@ TEST(test_svd_edge) {
     CHECK_LE(fabs(S[1] - 3.0), 4 * EPS);
     CHECK_LE(fabs(fabs(U[1]) - 1.0), 4 * EPS); /* u1 = +-e2 */
   }
+  {
+    /* a column and a row: sigma = ||a||, the singular vector is a / ||a|| */
+    double a[5] = {3, -4, 12, 0, 84}, Uc[5], Vc[5], nrm = 85.0; /* 9+16+144+7056 = 85^2 */
+    int i;
+    CHECK_RC(phgmg_svd(5, 1, a, 5, 1, S, Uc, 5, Vc, 1, &k, &rank, NULL), PHGMG_OK);
+    CHECK(k == 1 && rank == 1);
+    CHECK_LE(fabs(S[0] - nrm), 4 * EPS * nrm);
+    for (i = 0; i < 5; ++i) CHECK_LE(fabs(Uc[i] * Vc[0] - a[i] / nrm), 4 * EPS);
+    CHECK_RC(phgmg_svd(1, 5, a, 1, 3, S, Uc, 1, Vc, 5, &k, &rank, NULL), PHGMG_OK);
+    CHECK(k == 1 && rank == 1);
+    CHECK_LE(fabs(S[0] - nrm), 4 * EPS * nrm);
+    for (i = 0; i < 5; ++i) CHECK_LE(fabs(Vc[i] * Uc[0] - a[i] / nrm), 4 * EPS);
+    /* kmax = 0: rank only */
+    CHECK_RC(phgmg_svd(1, 5, a, 1, 0, NULL, NULL, 1, NULL, 5, &k, &rank, NULL), PHGMG_OK);
+    CHECK(k == 0 && rank == 1);
+  }
 }
 
 /* ---- symmetric eigenproblem ---------------------------------------------------------- */
@@ -803,6 +865,7 @@ SUITE(linalg) {
   RUN(test_zlu);
   RUN(test_qr);
   RUN(test_qrcp_rank);
+  RUN(test_qrcp_blocked);
   RUN(test_lstsq);
   RUN(test_svd_known);
   RUN(test_svd_edge);

@@ -1,0 +1,85 @@
+#!/bin/sh
+# Short fuzzing run of every reader of outside data in phgmg.h:
+#   npy      phgmg_npy_parse                    (tests/fuzz/fuzz_npy.c)
+#   rom      phgmg_rom_deserialize + online path (tests/fuzz/fuzz_rom.c)
+#   rom_f32  the same in a PHGMG_REAL_FLOAT build
+# Usage: sh tests/fuzz/run.sh [SECONDS]   (per target, default 60)
+# With clang's libFuzzer: builds each harness with
+# -fsanitize=fuzzer,address,undefined and runs it for SECONDS
+# (-max_total_time), starting from the seed corpus in tests/fuzz/corpus/<name>;
+# new inputs go to build/fuzz/corpus_<target> (the repository's corpus is not
+# touched), crashes to build/fuzz/crash-<target>-*. Without libFuzzer: builds
+# the plain drivers with gcc (or cc) + ASan/UBSan and runs the seed corpus
+# once. Exit status 1 on any crash, hang, leak or sanitizer report.
+set -u
+secs=${1:-60}
+case "$secs" in ''|*[!0-9]*) echo "usage: $0 [SECONDS]" >&2; exit 2 ;; esac
+cd "$(dirname "$0")/../.." || exit 2
+make -s phgmg.h || exit 2
+out=build/fuzz
+mkdir -p "$out"
+
+# libFuzzer dictionary of the binary model format: magic, versions, scalar
+# sizes, kinds, a field mask with every bit.
+printf '%s\n' '"PHGMGROM"' '"\x01\x00\x00\x00"' '"\x02\x00\x00\x00"' '"\x04\x00\x00\x00"' \
+  '"\x08\x00\x00\x00"' '"\xff\xff\x03\x00"' '"\x00\x00\x00\x00\x00\x00\xf0\x7f"' > "$out/rom.dict"
+
+have_libfuzzer=0
+if command -v clang >/dev/null 2>&1; then
+  printf '#include <stdint.h>\n#include <stddef.h>\nint LLVMFuzzerTestOneInput(const uint8_t *d, size_t n) { (void)d; (void)n; return 0; }\n' \
+    > "$out/probe.c"
+  if clang -fsanitize=fuzzer,address,undefined "$out/probe.c" -o "$out/probe" >/dev/null 2>&1; then
+    have_libfuzzer=1
+  fi
+fi
+
+fail=0
+# target  source  extra-flags  corpus  dictionary
+targets='npy tests/fuzz/fuzz_npy.c - npy tests/fuzz/npy.dict
+rom tests/fuzz/fuzz_rom.c - rom build/fuzz/rom.dict
+rom_f32 tests/fuzz/fuzz_rom.c -DPHGMG_REAL_FLOAT rom build/fuzz/rom.dict'
+
+if [ $have_libfuzzer = 1 ]; then
+  echo "fuzz: clang libFuzzer + ASan + UBSan, ${secs} s per target"
+  echo "$targets" | while read -r t src flags corpus dict; do
+    [ "$flags" = - ] && flags=
+    bin="$out/fuzz_$t"
+    # shellcheck disable=SC2086
+    if ! clang -g -O1 -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all $flags "$src" -o "$bin" -lm; then
+      echo "fuzz: $t: build failed"; exit 1
+    fi
+    mkdir -p "$out/corpus_$t"
+    log="$out/fuzz_$t.log"
+    ASAN_OPTIONS=detect_leaks=1 "$bin" -max_total_time="$secs" -timeout=10 -rss_limit_mb=2048 \
+      -print_final_stats=1 -dict="$dict" -artifact_prefix="$out/crash-$t-" \
+      "$out/corpus_$t" "tests/fuzz/corpus/$corpus" </dev/null >"$log" 2>&1
+    rc=$?
+    runs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -n 1)
+    cov=$(grep -o 'cov: [0-9]*' "$log" | tail -n 1)
+    files=$(ls "$out/corpus_$t" | wc -l)
+    if [ $rc -ne 0 ]; then
+      echo "fuzz: $t: FINDING (exit $rc) after ${runs:-?} runs; see $log and $out/crash-$t-*"
+      tail -n 40 "$log"
+      exit 1
+    fi
+    echo "fuzz: $t: ${runs:-?} runs in ${secs} s, ${cov:-cov: ?}, work corpus $files files, no finding"
+  done || fail=1
+else
+  cc=gcc
+  command -v gcc >/dev/null 2>&1 || cc=cc
+  echo "fuzz: clang's libFuzzer is not available; building the plain drivers with $cc + ASan/UBSan" \
+       "and running the seed corpus only (no fuzzing)"
+  echo "$targets" | while read -r t src flags corpus dict; do
+    [ "$flags" = - ] && flags=
+    bin="$out/fuzz_${t}_run"
+    # shellcheck disable=SC2086
+    if ! $cc -std=c99 -g -O1 -fsanitize=address,undefined -fno-sanitize-recover=all $flags "$src" -o "$bin" -lm; then
+      echo "fuzz: $t: build failed"; exit 1
+    fi
+    # shellcheck disable=SC2046
+    if ! ASAN_OPTIONS=detect_leaks=1 "$bin" $(ls -d "tests/fuzz/corpus/$corpus"/[!.]*) </dev/null; then
+      echo "fuzz: $t: FINDING on the seed corpus"; exit 1
+    fi
+  done || fail=1
+fi
+exit $fail
