@@ -8,9 +8,7 @@
 CC      ?= cc
 CXX     ?= c++
 WARN     = -Wall -Wextra -Werror -pedantic -Wshadow
-CFLAGS_T = -std=c99 $(WARN) -O2 -g $(DEVFLAGS)
-# TEMPORARY while fragments are being written in parallel; removed when all are defined.
-DEVFLAGS = -Wno-unused-function
+CFLAGS_T = -std=c99 $(WARN) -O2 -g
 SANFLAGS = -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=all
 OPTFLAGS = -std=c99 $(WARN) -O2 -march=native
 LDLIBS   = -lm
@@ -87,6 +85,8 @@ compile-checks: phgmg.h
 	$(CXX) -std=c++11 -Wall -Wextra -Werror -DPHGMG_REAL_FLOAT -c $(BUILD)/cc/impl.cpp -o $(BUILD)/cc/a.o
 	$(CC) -std=c99 $(WARN) -c $(BUILD)/cc/decl.c -o $(BUILD)/cc/a.o
 	$(CC) -std=c99 $(WARN) $(BUILD)/cc/s1.c $(BUILD)/cc/s2.c -o $(BUILD)/cc/static2 $(LDLIBS)
+	if command -v clang >/dev/null 2>&1; then clang -std=c99 $(WARN) -Wdouble-promotion -c $(BUILD)/cc/impl.c -o $(BUILD)/cc/a.o && \
+	  clang -std=c99 $(WARN) -Wdouble-promotion -DPHGMG_REAL_FLOAT -c $(BUILD)/cc/impl.c -o $(BUILD)/cc/a.o; fi
 	@echo "compile checks passed"
 
 EXAMPLES = $(BUILD)/msd_linear $(BUILD)/msd_nonlinear $(BUILD)/phgmg

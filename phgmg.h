@@ -345,15 +345,26 @@ typedef struct phgmg_ph_system {
 } phgmg_ph_system;
 
 /* Validation of a system. tol (<= 0: 1e-12) is relative to the matrix norms:
-   ||J + J^T|| <= tol ||J||, ||R - R^T|| <= tol ||R||, lambda_min(R) >= -tol ||R||,
-   B full column rank, 1/cond_1(J - R) > tol (rcond_out, may be NULL, receives
-   the estimate), no NaN/Inf, sizes consistent.
-   Returns PHGMG_ERR_SIZE / _NANINF / _NOT_SKEW / _NOT_SYMMETRIC / _NOT_PSD /
-   _RANK / _SINGULAR / _NOMEM. */
+   ||J + J^T|| <= tol ||J||, ||R - R^T|| <= tol ||R||, ||Q - Q^T|| <= tol ||Q||
+   (Frobenius), lambda_min(R) >= -tol ||R||_2, B full column rank (pivoted QR:
+   |R_mm| > tol |R_11|), 1/cond_1(J - R) > tol (rcond_out, may be NULL, receives
+   the estimate), no NaN/Inf (only entries inside the band are read for BANDED
+   storage), sizes consistent (N >= 1, 1 <= m <= N, 0 <= kb < N, sep_idx in
+   range), the callbacks the nonlinear kind needs are set. lambda_min(R): exact
+   for a diagonal R, else phgmg_sym_eig on a dense copy (dense R, or banded with
+   N <= 2000); a larger banded R must admit a Cholesky factorization of
+   R + tol ||R||_1 I in band storage (O(N kb^2), a slightly looser bound since
+   ||R||_1 >= ||R||_2). Checks run in this order and the first failure is
+   returned: PHGMG_ERR_INVALID_ARG (NULL pointers, missing callbacks) / _SIZE /
+   _NANINF / _NOT_SKEW / _NOT_SYMMETRIC (R or Q) / _NOT_PSD / _RANK / _SINGULAR,
+   or _NOMEM. The system is never modified. */
 PHGMG_DEF phgmg_result phgmg_ph_validate(const phgmg_ph_system *sys, double tol,
                                          double *rcond_out, const phgmg_allocator *alloc);
 
-/* Hamiltonian, its gradient and the output at a state. */
+/* Hamiltonian, its gradient and the output at a state. These evaluators do
+   not take an allocator: where they need a scratch vector of N doubles
+   (gradient of a GENERAL part, rhs, output) it is on the stack for N <= 256
+   and from the default allocator above; if that fails the result is NaN. */
 PHGMG_DEF double phgmg_ph_hamiltonian(const phgmg_ph_system *sys, const double *x);
 PHGMG_DEF void phgmg_ph_gradient(const phgmg_ph_system *sys, const double *x, double *g);
 /* f = (J - R) grad H(x) + B u  (u may be NULL = 0). */
@@ -367,19 +378,49 @@ PHGMG_DEF void phgmg_ph_apply(const phgmg_ph_system *sys, char which, int nrhs,
                               const double *X, int ldx, double *Y, int ldy);
 
 /* A factorization of J - R (dense LU or banded LU, by the system's storage),
-   for applying G = (J - R)^{-1} without forming it. */
+   for applying G = (J - R)^{-1} without forming it. PHGMG_ERR_SINGULAR for an
+   exactly zero pivot, PHGMG_ERR_NANINF, _NOMEM; rcond_out (may be NULL): the
+   reciprocal 1-norm condition estimate. */
 typedef struct phgmg_jr_factor phgmg_jr_factor;
 PHGMG_DEF phgmg_result phgmg_jr_factor_create(phgmg_jr_factor **out, const phgmg_ph_system *sys,
                                               double *rcond_out, const phgmg_allocator *alloc);
 /* X <- (J - R)^{-1} X (trans 'N') or (J - R)^{-T} X (trans 'T'); X is N x nrhs. */
 PHGMG_DEF void phgmg_jr_solve(const phgmg_jr_factor *f, char trans, int nrhs, double *X, int ldx);
+/* Frees the factorization (NULL is fine). */
 PHGMG_DEF void phgmg_jr_factor_destroy(phgmg_jr_factor *f);
 
 /* >>gl3 =================================================================== */
 /* 3-stage Gauss-Legendre (order 6), simplified Newton on the transformed stage
    system (one real and one complex N x N solve per iteration), factorization
    reuse, extrapolated starting guess. For linear systems (nl == NONE) with a
-   fixed step a precomputed step map is used unless opts.no_step_map. */
+   fixed step a precomputed step map is used unless opts.no_step_map.
+   Details:
+   - Newton iterates on Z_i = Y_i - x_n, always makes at least one update and
+     stops when ||Z - h (A x I) F(Z)||_inf <= tol (absolute), at most max_iter
+     updates. Jac = (J - R) Hess H(x_n), factored as gam/h I - Jac (real) and
+     (alp - i bet)/h I - Jac (complex): dense LU, banded LU with lower/upper
+     bandwidth from the nonzero diagonals of J - R and Q (plus kb for a GENERAL
+     Hessian), or the caller's shifted_* callbacks. Factors are reused across
+     steps; the next step refactors when the largest contraction rate
+     res_{k+1}/res_k of a step exceeded opts.contraction. With factors from an
+     earlier state a rising residual aborts at once and the step is retried
+     once with fresh factors; with fresh factors two successive rises or
+     max_iter give PHGMG_ERR_NOT_CONVERGED.
+   - The starting guess extrapolates the previous step's collocation polynomial
+     when the call continues the previous one (same x as it returned, t = its
+     end time), else Z = 0.
+   - Step map: nl == NONE, DENSE storage and N <= PHGMG_GL3_STEP_MAP_MAX_N
+     (default 1000; 4 N^2 + 12 N m doubles, O(N^3) at create): x+ = Phi x +
+     Gam [u_1; u_2; u_3] and the stage gradients by similar maps. A linear
+     system otherwise factors once and converges in one update per step.
+   - Stats: newton_iters counts updates (linear solves), rhs_evals counts
+     evaluations of f at one state (3 per stage-system evaluation),
+     factorizations counts (real + complex) factorization pairs, failures counts
+     Newton attempts that failed (including ones a retry rescued) and steps that
+     returned an error. */
+#ifndef PHGMG_GL3_STEP_MAP_MAX_N
+#define PHGMG_GL3_STEP_MAP_MAX_N 1000
+#endif
 
 /* u(t) into u[m]. */
 typedef void (*phgmg_input_fn)(double t, double *u, void *user);
@@ -405,20 +446,27 @@ typedef struct phgmg_energy {
   double *H, *S, *D;   /* each nsteps+1, caller-provided */
 } phgmg_energy;
 
-/* A stepper object for one system and one step size (allocates once). */
+/* A stepper object for one system and one step size (allocates once). The
+   system's matrices are read at create (and, for callbacks and B, while
+   stepping), so they must outlive the stepper. Checks sizes and arguments
+   only (PHGMG_ERR_INVALID_ARG for dt <= 0 or bad options); call
+   phgmg_ph_validate for the structure. */
 typedef struct phgmg_gl3 phgmg_gl3;
 PHGMG_DEF phgmg_result phgmg_gl3_create(phgmg_gl3 **out, const phgmg_ph_system *sys, double dt,
                                         const phgmg_gl3_opts *opts, const phgmg_allocator *alloc);
+/* Frees the stepper (NULL is fine). */
 PHGMG_DEF void phgmg_gl3_destroy(phgmg_gl3 *s);
 /* One step from (t, x) to t + dt; x updated in place on success, untouched on
-   failure (PHGMG_ERR_NOT_CONVERGED, PHGMG_ERR_NANINF, PHGMG_ERR_SINGULAR).
-   uf may be NULL (u = 0). energy_inc (may be NULL) receives
-   {supplied, dissipated} over the step. */
+   failure (PHGMG_ERR_NOT_CONVERGED, PHGMG_ERR_NANINF, PHGMG_ERR_SINGULAR, or a
+   shifted_factor code). u is evaluated at the stage times t + c_i dt; uf may be
+   NULL (u = 0). energy_inc (may be NULL) receives {supplied, dissipated} over
+   the step, at the stage values. */
 PHGMG_DEF phgmg_result phgmg_gl3_step(phgmg_gl3 *s, double t, double *x, phgmg_input_fn uf,
                                       void *uuser, double energy_inc[2]);
+/* Totals since create (see the details above). */
 PHGMG_DEF const phgmg_gl3_stats *phgmg_gl3_get_stats(const phgmg_gl3 *s);
 
-/* Simulate nsteps steps from x0 at t0. Outputs (each may be NULL):
+/* Simulate nsteps steps from x0 at t0 (t_n = t0 + n dt). Outputs (each may be NULL):
    X: N x (nsteps+1) trajectory (ld N), Y: m x (nsteps+1) outputs (ld m),
    energy: bookkeeping as above; stats: totals. On a step failure the
    buffers hold the steps done so far and the failing code is returned;
@@ -2448,7 +2496,7 @@ PHGMG_DEF void phgmg_ph_gradient(const phgmg_ph_system *sys, const double *x, do
   if (sys->nl == PHGMG_NL_GENERAL) {
     double sb[PHGMG__PH_STACK], *tmp = phgmg__ph_scratch(sys->N, sb);
     int i;
-    if (!tmp) { for (i = 0; i < sys->N; ++i) g[i] = NAN; return; }
+    if (!tmp) { for (i = 0; i < sys->N; ++i) g[i] = (double)NAN; return; }
     phgmg__ph_grad(sys, x, g, tmp);
     phgmg__ph_scratch_free(tmp, sb);
   } else {
@@ -2470,7 +2518,7 @@ PHGMG_DEF void phgmg_ph_rhs(const phgmg_ph_system *sys, const double *x, const d
     tmp = phgmg__dalloc(NULL, (size_t)N);
     if (!tmp) { phgmg__ph_scratch_free(g, sb); g = NULL; }
   }
-  if (!g) { for (i = 0; i < N; ++i) f[i] = NAN; return; }
+  if (!g) { for (i = 0; i < N; ++i) f[i] = (double)NAN; return; }
   phgmg__ph_grad(sys, x, g, tmp);
   phgmg__ph_mv(sys, sys->J, g, f);
   /* f -= R g, column by column (no second scratch vector) */
@@ -2505,7 +2553,7 @@ PHGMG_DEF void phgmg_ph_output(const phgmg_ph_system *sys, const double *x, doub
     tmp = phgmg__dalloc(NULL, (size_t)N);
     if (!tmp) { phgmg__ph_scratch_free(g, sb); g = NULL; }
   }
-  if (!g) { for (j = 0; j < sys->m; ++j) y[j] = NAN; return; }
+  if (!g) { for (j = 0; j < sys->m; ++j) y[j] = (double)NAN; return; }
   phgmg__ph_grad(sys, x, g, tmp);
   for (j = 0; j < sys->m; ++j) {
     const double *bj = sys->B + (size_t)j * (size_t)N;
@@ -2790,8 +2838,12 @@ PHGMG__PRIV double phgmg__ph_jr_norm1(const phgmg_ph_system *s) {
   for (j = 0; j < N; ++j) {
     double acc = 0.0;
     int i0 = 0, i1 = N - 1;
-    if (s->storage == PHGMG_BANDED) { i0 = PHGMG__MAX(0, j - s->kb); i1 = PHGMG__MIN(N - 1, j + s->kb); }
-    for (i = i0; i <= i1; ++i) acc += fabs(phgmg__ph_at(s, s->J, i, j) - phgmg__ph_at(s, s->R, i, j));
+    if (s->storage == PHGMG_BANDED) {
+      i0 = PHGMG__MAX(0, j - s->kb);
+      i1 = PHGMG__MIN(N - 1, j + s->kb);
+    }
+    for (i = i0; i <= i1; ++i)
+      acc += fabs(phgmg__ph_at(s, s->J, i, j) - phgmg__ph_at(s, s->R, i, j));
     if (acc > best) best = acc;
   }
   return best;
@@ -2904,7 +2956,10 @@ PHGMG__PRIV void phgmg__ph_sym_defect(const phgmg_ph_system *s, const double *M,
   double a = 0.0, d = 0.0;
   for (j = 0; j < N; ++j) {
     int i0 = 0, i1 = N - 1;
-    if (s->storage == PHGMG_BANDED) { i0 = PHGMG__MAX(0, j - s->kb); i1 = PHGMG__MIN(N - 1, j + s->kb); }
+    if (s->storage == PHGMG_BANDED) {
+      i0 = PHGMG__MAX(0, j - s->kb);
+      i1 = PHGMG__MIN(N - 1, j + s->kb);
+    }
     for (i = i0; i <= i1; ++i) {
       double mij = phgmg__ph_at(s, M, i, j), e = mij + sign * phgmg__ph_at(s, M, j, i);
       a += mij * mij;
@@ -2950,7 +3005,10 @@ PHGMG__PRIV phgmg_result phgmg__ph_check_psd(const phgmg_ph_system *s, double to
   double dmax = 0.0, dmin = HUGE_VAL;
   for (j = 0; j < N && diag; ++j) {
     int i0 = 0, i1 = N - 1;
-    if (s->storage == PHGMG_BANDED) { i0 = PHGMG__MAX(0, j - s->kb); i1 = PHGMG__MIN(N - 1, j + s->kb); }
+    if (s->storage == PHGMG_BANDED) {
+      i0 = PHGMG__MAX(0, j - s->kb);
+      i1 = PHGMG__MIN(N - 1, j + s->kb);
+    }
     for (i = i0; i <= i1; ++i)
       if (i != j && phgmg__ph_at(s, s->R, i, j) != 0.0) { diag = 0; break; }
   }
@@ -3173,10 +3231,6 @@ PHGMG__PRIV void phgmg__gl3_transform(const double A[9], double T[9], double Ti[
   phgmg__inv3(T, Ti);
 }
 
-#ifndef PHGMG_GL3_STEP_MAP_MAX_N
-#define PHGMG_GL3_STEP_MAP_MAX_N 1000
-#endif
-
 /* A banded matrix by its nonzero diagonals: v[d*n + i] = A(i, i + off[d]). */
 typedef struct phgmg__dia {
   int n, nd;
@@ -3308,7 +3362,7 @@ struct phgmg_gl3 {
   /* step map (dense linear): x+ = Phi x + Gam U, g_i = GX_i x + GU_i U */
   double *Phi, *Gam, *GX, *GU;
   /* work */
-  double *Z, *W, *Y, *G, *F, *U, *Zprev, *xend, *xnew, *tmp, *TF;
+  double *Z, *W, *Y, *G, *F, *U, *Zprev, *xend, *xnew, *tmp;
   /* Newton right-hand sides, zero-padded by kl before and ku after (banded) */
   double *r1buf, *rcbuf, *r1, *rc;
   /* packed row-wise factors for the pivot-free banded solve (see below) */
@@ -3339,7 +3393,7 @@ PHGMG_DEF void phgmg_gl3_destroy(phgmg_gl3 *s) {
   phgmg__free(&al, s->Zprev); phgmg__free(&al, s->xend);
   phgmg__free(&al, s->xnew); phgmg__free(&al, s->r1buf); phgmg__free(&al, s->rcbuf);
   phgmg__free(&al, s->pk);
-  phgmg__free(&al, s->tmp); phgmg__free(&al, s->TF);
+  phgmg__free(&al, s->tmp);
   phgmg__free(&al, s);
 }
 
@@ -3521,9 +3575,8 @@ PHGMG_DEF phgmg_result phgmg_gl3_create(phgmg_gl3 **out, const phgmg_ph_system *
   s->Zprev = phgmg__dalloc(&s->al, N3);
   s->xend = phgmg__dalloc(&s->al, (size_t)N);
   s->tmp = phgmg__dalloc(&s->al, (size_t)N);
-  s->TF = phgmg__dalloc(&s->al, N3);
   if (!s->Z || !s->W || !s->Y || !s->F || !s->Zprev || !s->xend ||
-      !s->tmp || !s->TF) {
+      !s->tmp) {
     rc = PHGMG_ERR_NOMEM;
     goto fail;
   }

@@ -25,14 +25,13 @@ LIBS="-lm"
 BUILD=build
 CSV=${BENCH_CSV:-bench/results.csv}
 DEMO_RUNS=${DEMO_RUNS:-5}
-# one core: no BLAS threads
-OPENBLAS_NUM_THREADS=1; OMP_NUM_THREADS=1; export OPENBLAS_NUM_THREADS OMP_NUM_THREADS
-
 mkdir -p "$BUILD"
 cpu=$(grep -m1 'model name' /proc/cpuinfo 2>/dev/null | sed 's/^[^:]*: *//')
 [ -n "$cpu" ] || cpu=$(uname -m)
 mhz=$(grep -m1 'cpu MHz' /proc/cpuinfo 2>/dev/null | sed 's/^[^:]*: *//')
-cores=$(nproc 2>/dev/null || echo '?')
+cores=$(grep -c '^processor' /proc/cpuinfo 2>/dev/null || echo '?')
+# one core: no BLAS threads (set after counting: nproc honours OMP_NUM_THREADS)
+OPENBLAS_NUM_THREADS=1; OMP_NUM_THREADS=1; export OPENBLAS_NUM_THREADS OMP_NUM_THREADS
 ccver=$($CC --version 2>/dev/null | head -n 1)
 load=$(cut -d' ' -f1-3 /proc/loadavg 2>/dev/null)
 machine="machine: $cpu (${mhz:-?} MHz), $cores cores; $ccver; flags $CFLAGS; load average $load; $(date -u +%Y-%m-%dT%H:%MZ)"

@@ -178,7 +178,7 @@ PHGMG_DEF void phgmg_ph_gradient(const phgmg_ph_system *sys, const double *x, do
   if (sys->nl == PHGMG_NL_GENERAL) {
     double sb[PHGMG__PH_STACK], *tmp = phgmg__ph_scratch(sys->N, sb);
     int i;
-    if (!tmp) { for (i = 0; i < sys->N; ++i) g[i] = NAN; return; }
+    if (!tmp) { for (i = 0; i < sys->N; ++i) g[i] = (double)NAN; return; }
     phgmg__ph_grad(sys, x, g, tmp);
     phgmg__ph_scratch_free(tmp, sb);
   } else {
@@ -200,7 +200,7 @@ PHGMG_DEF void phgmg_ph_rhs(const phgmg_ph_system *sys, const double *x, const d
     tmp = phgmg__dalloc(NULL, (size_t)N);
     if (!tmp) { phgmg__ph_scratch_free(g, sb); g = NULL; }
   }
-  if (!g) { for (i = 0; i < N; ++i) f[i] = NAN; return; }
+  if (!g) { for (i = 0; i < N; ++i) f[i] = (double)NAN; return; }
   phgmg__ph_grad(sys, x, g, tmp);
   phgmg__ph_mv(sys, sys->J, g, f);
   /* f -= R g, column by column (no second scratch vector) */
@@ -235,7 +235,7 @@ PHGMG_DEF void phgmg_ph_output(const phgmg_ph_system *sys, const double *x, doub
     tmp = phgmg__dalloc(NULL, (size_t)N);
     if (!tmp) { phgmg__ph_scratch_free(g, sb); g = NULL; }
   }
-  if (!g) { for (j = 0; j < sys->m; ++j) y[j] = NAN; return; }
+  if (!g) { for (j = 0; j < sys->m; ++j) y[j] = (double)NAN; return; }
   phgmg__ph_grad(sys, x, g, tmp);
   for (j = 0; j < sys->m; ++j) {
     const double *bj = sys->B + (size_t)j * (size_t)N;
@@ -520,8 +520,12 @@ PHGMG__PRIV double phgmg__ph_jr_norm1(const phgmg_ph_system *s) {
   for (j = 0; j < N; ++j) {
     double acc = 0.0;
     int i0 = 0, i1 = N - 1;
-    if (s->storage == PHGMG_BANDED) { i0 = PHGMG__MAX(0, j - s->kb); i1 = PHGMG__MIN(N - 1, j + s->kb); }
-    for (i = i0; i <= i1; ++i) acc += fabs(phgmg__ph_at(s, s->J, i, j) - phgmg__ph_at(s, s->R, i, j));
+    if (s->storage == PHGMG_BANDED) {
+      i0 = PHGMG__MAX(0, j - s->kb);
+      i1 = PHGMG__MIN(N - 1, j + s->kb);
+    }
+    for (i = i0; i <= i1; ++i)
+      acc += fabs(phgmg__ph_at(s, s->J, i, j) - phgmg__ph_at(s, s->R, i, j));
     if (acc > best) best = acc;
   }
   return best;
@@ -634,7 +638,10 @@ PHGMG__PRIV void phgmg__ph_sym_defect(const phgmg_ph_system *s, const double *M,
   double a = 0.0, d = 0.0;
   for (j = 0; j < N; ++j) {
     int i0 = 0, i1 = N - 1;
-    if (s->storage == PHGMG_BANDED) { i0 = PHGMG__MAX(0, j - s->kb); i1 = PHGMG__MIN(N - 1, j + s->kb); }
+    if (s->storage == PHGMG_BANDED) {
+      i0 = PHGMG__MAX(0, j - s->kb);
+      i1 = PHGMG__MIN(N - 1, j + s->kb);
+    }
     for (i = i0; i <= i1; ++i) {
       double mij = phgmg__ph_at(s, M, i, j), e = mij + sign * phgmg__ph_at(s, M, j, i);
       a += mij * mij;
@@ -680,7 +687,10 @@ PHGMG__PRIV phgmg_result phgmg__ph_check_psd(const phgmg_ph_system *s, double to
   double dmax = 0.0, dmin = HUGE_VAL;
   for (j = 0; j < N && diag; ++j) {
     int i0 = 0, i1 = N - 1;
-    if (s->storage == PHGMG_BANDED) { i0 = PHGMG__MAX(0, j - s->kb); i1 = PHGMG__MIN(N - 1, j + s->kb); }
+    if (s->storage == PHGMG_BANDED) {
+      i0 = PHGMG__MAX(0, j - s->kb);
+      i1 = PHGMG__MIN(N - 1, j + s->kb);
+    }
     for (i = i0; i <= i1; ++i)
       if (i != j && phgmg__ph_at(s, s->R, i, j) != 0.0) { diag = 0; break; }
   }
@@ -903,10 +913,6 @@ PHGMG__PRIV void phgmg__gl3_transform(const double A[9], double T[9], double Ti[
   phgmg__inv3(T, Ti);
 }
 
-#ifndef PHGMG_GL3_STEP_MAP_MAX_N
-#define PHGMG_GL3_STEP_MAP_MAX_N 1000
-#endif
-
 /* A banded matrix by its nonzero diagonals: v[d*n + i] = A(i, i + off[d]). */
 typedef struct phgmg__dia {
   int n, nd;
@@ -1038,7 +1044,7 @@ struct phgmg_gl3 {
   /* step map (dense linear): x+ = Phi x + Gam U, g_i = GX_i x + GU_i U */
   double *Phi, *Gam, *GX, *GU;
   /* work */
-  double *Z, *W, *Y, *G, *F, *U, *Zprev, *xend, *xnew, *tmp, *TF;
+  double *Z, *W, *Y, *G, *F, *U, *Zprev, *xend, *xnew, *tmp;
   /* Newton right-hand sides, zero-padded by kl before and ku after (banded) */
   double *r1buf, *rcbuf, *r1, *rc;
   /* packed row-wise factors for the pivot-free banded solve (see below) */
@@ -1069,7 +1075,7 @@ PHGMG_DEF void phgmg_gl3_destroy(phgmg_gl3 *s) {
   phgmg__free(&al, s->Zprev); phgmg__free(&al, s->xend);
   phgmg__free(&al, s->xnew); phgmg__free(&al, s->r1buf); phgmg__free(&al, s->rcbuf);
   phgmg__free(&al, s->pk);
-  phgmg__free(&al, s->tmp); phgmg__free(&al, s->TF);
+  phgmg__free(&al, s->tmp);
   phgmg__free(&al, s);
 }
 
@@ -1251,9 +1257,8 @@ PHGMG_DEF phgmg_result phgmg_gl3_create(phgmg_gl3 **out, const phgmg_ph_system *
   s->Zprev = phgmg__dalloc(&s->al, N3);
   s->xend = phgmg__dalloc(&s->al, (size_t)N);
   s->tmp = phgmg__dalloc(&s->al, (size_t)N);
-  s->TF = phgmg__dalloc(&s->al, N3);
   if (!s->Z || !s->W || !s->Y || !s->F || !s->Zprev || !s->xend ||
-      !s->tmp || !s->TF) {
+      !s->tmp) {
     rc = PHGMG_ERR_NOMEM;
     goto fail;
   }

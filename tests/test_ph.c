@@ -94,7 +94,10 @@ TEST(test_gl3_coefficients) {
     for (i = 0; i < 3; ++i)
       for (j = 0; j < 3; ++j) {
         double s = 0, u = 0;
-        for (k = 0; k < 3; ++k) { s += A[i * 3 + k] * T[k * 3 + j]; u += Ti[i * 3 + k] * T[k * 3 + j]; }
+        for (k = 0; k < 3; ++k) {
+          s += A[i * 3 + k] * T[k * 3 + j];
+          u += Ti[i * 3 + k] * T[k * 3 + j];
+        }
         AT[i * 3 + j] = s;
         CHECK_LE(fabs(u - (i == j)), 1e-14);
       }
@@ -541,7 +544,8 @@ TEST(test_gl3_linear_order6) {
       CHECK_RC(phgmg_gl3_create(&g, &s, Tend / nsteps, &o, NULL), PHGMG_OK);
       if (!g) return;
       CHECK(g->mode == (map ? PHGMG__GL3_MAP : PHGMG__GL3_DENSE));
-      for (i = 0; i < nsteps; ++i) CHECK_RC(phgmg_gl3_step(g, i * (Tend / nsteps), x, NULL, NULL, NULL), PHGMG_OK);
+      for (i = 0; i < nsteps; ++i)
+        CHECK_RC(phgmg_gl3_step(g, i * (Tend / nsteps), x, NULL, NULL, NULL), PHGMG_OK);
       err[lev] = fmax(fabs(x[0] - ex[0]), fabs(x[1] - ex[1]));
       phgmg_gl3_destroy(g);
     }
@@ -888,8 +892,38 @@ TEST(test_gl3_refactor_policy) {
   CHECK_LE(max_abs_diff(X[0], X[2], 202), 1e-10 * max_abs(X[0], 202));
 }
 
+/* ---- N = 1, kb = 0: x' = -r q x, the GL3 stability function exactly ------------------ */
+TEST(test_gl3_scalar) {
+  double J = 0.0, R = 0.5, Q = 2.0, B = 1.0, z = -1.0 * 0.3; /* h lambda, lambda = -R Q */
+  /* Gauss-Legendre s = 3 is the (3,3) Pade approximant of exp */
+  double Rz = (1 + z / 2 + z * z / 10 + z * z * z / 120) /
+              (1 - z / 2 + z * z / 10 - z * z * z / 120);
+  int v;
+  for (v = 0; v < 3; ++v) {
+    phgmg_ph_system s;
+    phgmg_gl3 *g = NULL;
+    phgmg_gl3_opts o;
+    double x = 1.0;
+    int i;
+    memset(&s, 0, sizeof s);
+    s.N = 1; s.m = 1; s.J = &J; s.R = &R; s.Q = &Q; s.B = &B;
+    s.storage = v == 2 ? PHGMG_BANDED : PHGMG_DENSE;
+    memset(&o, 0, sizeof o);
+    o.no_step_map = v == 1;
+    CHECK_RC(phgmg_ph_validate(&s, 0.0, NULL, NULL), PHGMG_OK);
+    CHECK_RC(phgmg_gl3_create(&g, &s, 0.3, &o, NULL), PHGMG_OK);
+    if (!g) return;
+    for (i = 0; i < 10; ++i) CHECK_RC(phgmg_gl3_step(g, 0.3 * i, &x, NULL, NULL, NULL), PHGMG_OK);
+    CHECK_LE(fabs(x - pow(Rz, 10)), 1e-15);
+    phgmg_gl3_destroy(g);
+  }
+}
+
 /* ---- failures: state untouched ------------------------------------------------------- */
-static void u_nan_late(double t, double *u, void *user) { (void)user; u[0] = t > 0.55 ? tnan() : 0.1; }
+static void u_nan_late(double t, double *u, void *user) {
+  (void)user;
+  u[0] = t > 0.55 ? tnan() : 0.1;
+}
 
 TEST(test_gl3_failures) {
   double J[4], R[4], Q[4], B[2], poly[5];
@@ -1106,6 +1140,7 @@ SUITE(ph) {
   RUN(test_gl3_msd_paths_agree);
   RUN(test_gl3_shifted_solves);
   RUN(test_gl3_refactor_policy);
+  RUN(test_gl3_scalar);
   RUN(test_gl3_failures);
   RUN(test_gl3_msd_paper_energy);
   RUN(test_alloc_failures);

@@ -15,6 +15,7 @@
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <time.h>
 /* The default allocator goes through a counter (blocks alive), so the calls
    that take no allocator are checked for leaks as well. (Routing it through a
    volatile function pointer also keeps GCC 12 -O2 from a false
@@ -31,13 +32,26 @@ static void rb_free(void *p) { if (p) { g_default_live--; free(p); } }
 #include "harness.h"
 #include "../examples/msd_models.h"
 
+/* A scratch file name under build/, distinct between concurrent runs (the
+   plain and the sanitizer build of the suite). Tests that need a file skip
+   that part when it cannot be written. */
+static const char *tmp_path(const char *ext) {
+  static char buf[4][96];
+  static int k = 0;
+  char *b = buf[k++ & 3];
+  snprintf(b, sizeof buf[0], "build/robust_tmp_%lx_%d.%s",
+           (unsigned long)((uintptr_t)&k ^ (uintptr_t)time(NULL) ^ (uintptr_t)clock()), k, ext);
+  return b;
+}
+
 /* ---- guards: copies of the caller's data, compared after the call ------- */
 #define RB_NGUARD 32
 static struct { const void *p; size_t n; unsigned char *copy; } rb_g[RB_NGUARD];
 static int rb_ng = 0;
 
 static void guard(const void *p, size_t n) {
-  if (!p || n == 0 || rb_ng >= RB_NGUARD) return;
+  if (!p || n == 0) return;
+  if (rb_ng >= RB_NGUARD) { th_fail_msg(__FILE__, __LINE__, "too many guards (missing intact())"); return; }
   rb_g[rb_ng].p = p;
   rb_g[rb_ng].n = n;
   rb_g[rb_ng].copy = (unsigned char *)malloc(n);
@@ -200,7 +214,7 @@ static phgmg_result reduce_g(const phgmg_ph_system *sys, const double *X, int ld
 TEST(test_dims_reduce) {
   msd_linear M;
   phgmg_reduce_opts o;
-  phgmg_reduced *red = (phgmg_reduced *)&o;
+  phgmg_reduced *red = NULL;
   phgmg_ph_system s;
   double *X;
   const int N = 12, ns = 20;
@@ -493,20 +507,20 @@ TEST(test_naninf_input_and_state) {
   msd_linear L;
   msd_nonlinear M;
   msd_nl_opts no;
-  double x0[12], X[12 * 6], Y[6], xs[12];
+  double x0[12], X[12 * 6], Y[6];
   int done = -1, k, i;
   CHECK(msd_linear_build(&L, 6, NULL, NULL, NULL, PHGMG_DENSE) == 0);
   memset(&no, 0, sizeof no); no.n = 6;
   CHECK(msd_nonlinear_build(&M, &no) == 0);
   for (i = 0; i < 12; ++i) x0[i] = 0.1 * th_rand();
   for (k = 0; k < 3; ++k) {
-    const phgmg_ph_system *s = k == 0 ? &L.sys : &M.sys;
+    /* k = 0: linear, step map; 1: nonlinear, Newton; 2: linear, Newton */
+    const phgmg_ph_system *s = k == 1 ? &M.sys : &L.sys;
     phgmg_gl3_opts go;
     memset(&go, 0, sizeof go);
-    go.no_step_map = k == 2; /* k = 0: linear step map; 1, 2: Newton */
-    if (k == 2) s = &L.sys;
+    go.no_step_map = k == 2;
     /* a NaN input at the third step: two steps recorded, the rest untouched */
-    memset(X, 0x5a, sizeof X); memcpy(xs, X, sizeof xs);
+    memset(X, 0x5a, sizeof X);
     guard(x0, sizeof x0); guard(X + 3 * 12, sizeof(double) * 3 * 12);
     EXPECT(phgmg_simulate(s, x0, 0.0, 0.1, 5, u_nan_late, NULL, &go, X, Y, NULL, NULL, &done, NULL), PHGMG_ERR_NANINF);
     CHECK(done == 2);
@@ -535,7 +549,6 @@ TEST(test_naninf_input_and_state) {
       CHECK(done == 0);
     }
   }
-  (void)xs;
   /* the online stepper: NaN / Inf in x or in u3; x, y, energy untouched */
   {
     static double mem[4096];
@@ -1190,7 +1203,7 @@ TEST(test_rom_images) {
   }
   /* files: a missing file, a damaged one; nothing allocated stays */
   {
-    const char *path = "build/robust_tmp_model.rom";
+    const char *path = tmp_path("rom");
     phgmg_rom r1;
     void *block = (void *)&r1;
     long live = g_default_live;
@@ -1496,7 +1509,7 @@ TEST(test_oom_kernels_and_readers) {
     CHECK_RC(phgmg_npy_serialize(A, 20, 12, 20, 2, 0, img, len, &len), PHGMG_OK);
     c.img = img; c.img_len = len;
     CHECK(oom_sweep("npy_parse", op_npy_parse, undo_npy, &c) > 0);
-    c.path = "build/robust_tmp.npy";
+    c.path = tmp_path("npy");
     if (phgmg_npy_write(c.path, A, 20, 12, 20, 2, 0) == PHGMG_OK) {
       CHECK(oom_sweep("npy_read", op_npy_read, undo_npy, &c) > 0);
       remove(c.path);
@@ -1508,13 +1521,16 @@ TEST(test_oom_kernels_and_readers) {
     phgmg_rom rom;
     memset(&rom, 0, sizeof rom);
     rom.kind = PHGMG_ROM_LINEAR; rom.r = 2; rom.m = 1; rom.K = K; rom.Qh = Qh; rom.Bh = Bh;
-    c.path = "build/robust_tmp2.rom";
+    c.path = tmp_path("rom");
     if (phgmg_rom_save(&rom, c.path) == PHGMG_OK) {
       CHECK(oom_sweep("rom_load", op_rom_load, NULL, &c) > 0);
       remove(c.path);
     }
   }
 }
+
+/* Everything allocated through the default allocator was freed. */
+TEST(test_default_allocator_balanced) { CHECK(g_default_live == 0); }
 
 SUITE(robust) {
   RUN(test_dims_reduce);
@@ -1532,4 +1548,5 @@ SUITE(robust) {
   RUN(test_oom_reduce);
   RUN(test_oom_simulate_and_factor);
   RUN(test_oom_kernels_and_readers);
+  RUN(test_default_allocator_balanced);
 }
