@@ -583,8 +583,12 @@ typedef struct phgmg_rom_stepper {
   phgmg_rom_stats stats;
 } phgmg_rom_stepper;
 
-/* Bytes of caller memory phgmg_rom_stepper_init needs for this model. */
+/* Bytes of caller memory phgmg_rom_stepper_init needs for this model, stepped
+   with its own step (rom->dt) -- small when the model carries a step map. */
 PHGMG_DEF size_t phgmg_rom_stepper_memsize(const phgmg_rom *rom);
+/* The same for stepping with dt (a model with a step map for another dt
+   needs the Newton workspace). */
+PHGMG_DEF size_t phgmg_rom_stepper_memsize_dt(const phgmg_rom *rom, phgmg_real dt);
 /* Compile-time upper bound in bytes for static buffers (r, m, rn, nd as above). */
 #define PHGMG_ROM_STEPPER_MEMSIZE_MAX(r, m, rn, nd) \
   (sizeof(phgmg_real) * (size_t)(9 * (r) * (r) + 30 * (r) + 3 * (m) + 4 * (rn) * (r) + 2 * (rn) * (rn) + 6 * (rn) + 3 * (nd) + 64) \
@@ -4682,34 +4686,47 @@ typedef struct phgmg__romstep_mem {
   int *piv;
 } phgmg__romstep_mem;
 
-PHGMG__ONLINE size_t phgmg__romstep_layout(const phgmg_rom *rom, void *mem, phgmg__romstep_mem *L) {
+/* Two layouts: the full one for Newton, and a small one when the model is
+   stepped with its precomputed step map (no stage system, no LU). */
+PHGMG__ONLINE size_t phgmg__romstep_layout(const phgmg_rom *rom, int map_only, void *mem, phgmg__romstep_mem *L) {
   const size_t r = (size_t)rom->r, n3 = 3 * r;
   phgmg_real *base = PHGMG__CAST(phgmg_real *, mem);
   size_t o = 0, reals;
   phgmg__romstep_mem dummy;
   if (!L) L = &dummy;
-  L->A = PHGMG__CARVE(base, o); o += 9;
-  L->b = PHGMG__CARVE(base, o); o += 3;
-  L->c = PHGMG__CARVE(base, o); o += 3;
-  L->lag = PHGMG__CARVE(base, o); o += 12;
-  L->LU = PHGMG__CARVE(base, o); o += n3 * n3;
-  L->Jf = PHGMG__CARVE(base, o); o += r * r;
-  L->Z = PHGMG__CARVE(base, o); o += n3;
-  L->F = PHGMG__CARVE(base, o); o += n3;
-  L->Res = PHGMG__CARVE(base, o); o += n3;
-  L->dZ = PHGMG__CARVE(base, o); o += n3;
-  L->Zp = PHGMG__CARVE(base, o); o += n3;
-  L->G = PHGMG__CARVE(base, o); o += n3;
-  L->Y = PHGMG__CARVE(base, o); o += r;
-  L->work = PHGMG__CARVE(base, o); o += phgmg_rom_eval_work_size(rom);
+  L->A = base + o; o += 9;
+  L->b = base + o; o += 3;
+  L->c = base + o; o += 3;
+  L->lag = base + o; o += 12;
+  L->LU = base + o; o += map_only ? 0 : n3 * n3;
+  L->Jf = base + o; o += map_only ? 0 : r * r;
+  L->Z = base + o; o += n3;
+  L->F = base + o; o += n3;
+  L->Res = base + o; o += map_only ? 0 : n3;
+  L->dZ = base + o; o += map_only ? r : n3;
+  L->Zp = base + o; o += map_only ? 0 : n3;
+  L->G = base + o; o += n3;
+  L->Y = base + o; o += r;
+  L->work = base + o; o += map_only ? 0 : phgmg_rom_eval_work_size(rom);
   reals = o;
   L->piv = mem ? PHGMG__CAST(int *, PHGMG__CAST(void *, base + reals)) : NULL;
-  return reals * sizeof(phgmg_real) + n3 * sizeof(int);
+  return reals * sizeof(phgmg_real) + (map_only ? 0 : n3 * sizeof(int));
+}
+
+/* Does stepping with dt use the model's precomputed step map? */
+PHGMG__ONLINE int phgmg__rom_uses_map(const phgmg_rom *rom, phgmg_real dt) {
+  return rom->Phi != NULL && rom->kind == PHGMG_ROM_LINEAR && rom->nd == 0 &&
+         PHGMG__RABS(rom->dt - dt) <= PHGMG__R(8) * PHGMG__REPS * dt;
 }
 
 PHGMG_DEF size_t phgmg_rom_stepper_memsize(const phgmg_rom *rom) {
   if (phgmg_rom_check(rom) != PHGMG_OK) return 0;
-  return phgmg__romstep_layout(rom, NULL, NULL);
+  return phgmg__romstep_layout(rom, phgmg__rom_uses_map(rom, rom->dt), NULL, NULL);
+}
+
+PHGMG_DEF size_t phgmg_rom_stepper_memsize_dt(const phgmg_rom *rom, phgmg_real dt) {
+  if (phgmg_rom_check(rom) != PHGMG_OK) return 0;
+  return phgmg__romstep_layout(rom, phgmg__rom_uses_map(rom, dt), NULL, NULL);
 }
 
 PHGMG_DEF void phgmg_rom_stage_times(phgmg_real t, phgmg_real dt, phgmg_real tc[3]) {
@@ -4724,14 +4741,15 @@ PHGMG_DEF phgmg_result phgmg_rom_stepper_init(phgmg_rom_stepper *s, const phgmg_
   phgmg__romstep_mem L;
   phgmg_result rc;
   double A[9], c[3], b[3], s15 = sqrt(15.0);
-  int i, j, k;
+  int i, j, k, use_map;
   if (!s || !mem) return PHGMG_ERR_INVALID_ARG;
   rc = phgmg_rom_check(rom);
   if (rc != PHGMG_OK) return rc;
   if (!(dt > PHGMG__R(0)) || dt - dt != PHGMG__R(0)) return PHGMG_ERR_INVALID_ARG;
   if (((size_t)mem) % sizeof(double) != 0) return PHGMG_ERR_INVALID_ARG;
-  if (mem_size < phgmg__romstep_layout(rom, NULL, NULL)) return PHGMG_ERR_WORKSPACE;
-  phgmg__romstep_layout(rom, mem, &L);
+  use_map = phgmg__rom_uses_map(rom, dt);
+  if (mem_size < phgmg__romstep_layout(rom, use_map, NULL, NULL)) return PHGMG_ERR_WORKSPACE;
+  phgmg__romstep_layout(rom, use_map, mem, &L);
   /* Gauss-Legendre 3 from the closed forms */
   c[0] = 0.5 - s15 / 10.0; c[1] = 0.5; c[2] = 0.5 + s15 / 10.0;
   b[0] = 5.0 / 18.0; b[1] = 4.0 / 9.0; b[2] = 5.0 / 18.0;
@@ -4760,8 +4778,7 @@ PHGMG_DEF phgmg_result phgmg_rom_stepper_init(phgmg_rom_stepper *s, const phgmg_
   s->tol = tol > PHGMG__R(0) ? tol : PHGMG__R(1e-10);
 #endif
   s->max_iter = max_iter > 0 ? max_iter : 10;
-  s->use_map = (rom->Phi != NULL && rom->kind == PHGMG_ROM_LINEAR && rom->nd == 0 &&
-                PHGMG__RABS(rom->dt - dt) <= PHGMG__R(8) * PHGMG__REPS * dt);
+  s->use_map = use_map;
   s->have_lu = 0;
   s->have_prev = 0;
   s->ws = PHGMG__CAST(phgmg_real *, mem);
@@ -4873,7 +4890,7 @@ PHGMG_DEF phgmg_result phgmg_rom_step(phgmg_rom_stepper *s, phgmg_real *x, const
   rom = s->rom;
   r = rom->r; m = rom->m; n3 = 3 * r;
   if (!phgmg__r_finite(x, r) || (u3 && !phgmg__r_finite(u3, 3 * m))) return PHGMG_ERR_NANINF;
-  phgmg__romstep_layout(rom, s->ws, &L);
+  phgmg__romstep_layout(rom, s->use_map, s->ws, &L);
   if (s->use_map) return phgmg__romstep_map(s, &L, x, u3, y, energy);
 
   for (attempt = 0; attempt < 2; ++attempt) {

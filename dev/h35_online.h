@@ -97,8 +97,12 @@ typedef struct phgmg_rom_stepper {
   phgmg_rom_stats stats;
 } phgmg_rom_stepper;
 
-/* Bytes of caller memory phgmg_rom_stepper_init needs for this model. */
+/* Bytes of caller memory phgmg_rom_stepper_init needs for this model, stepped
+   with its own step (rom->dt) -- small when the model carries a step map. */
 PHGMG_DEF size_t phgmg_rom_stepper_memsize(const phgmg_rom *rom);
+/* The same for stepping with dt (a model with a step map for another dt
+   needs the Newton workspace). */
+PHGMG_DEF size_t phgmg_rom_stepper_memsize_dt(const phgmg_rom *rom, phgmg_real dt);
 /* Compile-time upper bound in bytes for static buffers (r, m, rn, nd as above). */
 #define PHGMG_ROM_STEPPER_MEMSIZE_MAX(r, m, rn, nd) \
   (sizeof(phgmg_real) * (size_t)(9 * (r) * (r) + 30 * (r) + 3 * (m) + 4 * (rn) * (r) + 2 * (rn) * (rn) + 6 * (rn) + 3 * (nd) + 64) \
