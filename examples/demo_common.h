@@ -10,14 +10,20 @@
 #include <time.h>
 #include <sys/stat.h>
 
+#if defined(__GNUC__) || defined(__clang__)
+#define DEMO_FN static __attribute__((unused))
+#else
+#define DEMO_FN static
+#endif
 
-static double demo_now(void) {
+
+DEMO_FN double demo_now(void) {
   struct timespec ts;
   clock_gettime(CLOCK_MONOTONIC, &ts);
   return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-static void demo_die(const char *what, phgmg_result rc) {
+DEMO_FN void demo_die(const char *what, phgmg_result rc) {
   fprintf(stderr, "error: %s: %s\n", what, phgmg_result_string(rc));
   exit(1);
 }
@@ -34,7 +40,7 @@ typedef struct demo_rom_result {
    rho(x0) with the FOM's input, and measure e_red, e_y (against the FOM's
    output Y), e_proj and (GMG-QM) e_lowerbound. If energy is non-NULL it gets
    the ROM's energy bookkeeping. */
-static demo_rom_result demo_run_rom(const phgmg_ph_system *sys, const double *X, const double *Y,
+DEMO_FN demo_rom_result demo_run_rom(const phgmg_ph_system *sys, const double *X, const double *Y,
                                     int nsteps, double dt, phgmg_input_fn uf,
                                     const phgmg_reduce_opts *opts, double newton_tol, int newton_it,
                                     const phgmg_energy *energy) {
@@ -78,7 +84,7 @@ typedef struct demo_cache {
 
 /* DEIM points and weights of a separable nonlinear part (poly form), once per
    snapshot set: they depend on neither r nor the method. */
-static void demo_cache_deim(demo_cache *c, const phgmg_ph_system *sys, const double *X, int ns, double tol) {
+DEMO_FN void demo_cache_deim(demo_cache *c, const phgmg_ph_system *sys, const double *X, int ns, double tol) {
   const int nt = sys->nsep;
   double *F = (double *)malloc(sizeof(double) * (size_t)nt * ns);
   int i, a, k, nneg = 0;
@@ -98,7 +104,7 @@ static void demo_cache_deim(demo_cache *c, const phgmg_ph_system *sys, const dou
   free(F);
 }
 
-static void demo_cache_build(demo_cache *c, const phgmg_ph_system *sys, const double *X, int ns, int kmax,
+DEMO_FN void demo_cache_build(demo_cache *c, const phgmg_ph_system *sys, const double *X, int ns, int kmax,
                              int want_grad) {
   const int N = sys->N;
   double *T = (double *)malloc(sizeof(double) * (size_t)N * ns);
@@ -120,8 +126,8 @@ static void demo_cache_build(demo_cache *c, const phgmg_ph_system *sys, const do
   if (rc != PHGMG_OK) demo_die("POD of the snapshots", rc);
   free(T);
 }
-static void demo_cache_free(demo_cache *c) { free(c->adj); free(c->plain); free(c->grad); free(c->deim_pts); free(c->deim_w); }
-static void demo_cache_use(const demo_cache *c, phgmg_reduce_opts *o) {
+DEMO_FN void demo_cache_free(demo_cache *c) { free(c->adj); free(c->plain); free(c->grad); free(c->deim_pts); free(c->deim_w); }
+DEMO_FN void demo_cache_use(const demo_cache *c, phgmg_reduce_opts *o) {
   o->deim_pts = c->deim_pts; o->deim_w = c->deim_w; o->deim_count = c->deim_count;
   if (o->method == PHGMG_METHOD_GMG_POD || o->method == PHGMG_METHOD_GMG_QM) {
     o->pod_basis = c->adj; o->pod_cols = c->adj_cols;
@@ -133,7 +139,7 @@ static void demo_cache_use(const demo_cache *c, phgmg_reduce_opts *o) {
 
 /* CSV: header, then rows of numbers (first column printed as an integer or a
    time). NaN is written as "nan" (a failed or non-applicable entry). */
-static void demo_write_csv(const char *path, const char *header, int nrows, int ncols,
+DEMO_FN void demo_write_csv(const char *path, const char *header, int nrows, int ncols,
                            const double *data /* row-major nrows x ncols */, int first_int) {
   FILE *f = fopen(path, "w");
   int i, j;
@@ -151,5 +157,5 @@ static void demo_write_csv(const char *path, const char *header, int nrows, int 
   fclose(f);
 }
 
-static void demo_mkdir(const char *dir) { mkdir(dir, 0777); }
+DEMO_FN void demo_mkdir(const char *dir) { mkdir(dir, 0777); }
 #endif
