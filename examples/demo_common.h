@@ -9,6 +9,7 @@
 #include <math.h>
 #include <time.h>
 #include <sys/stat.h>
+#include "svgplot.h"
 
 #if defined(__GNUC__) || defined(__clang__)
 #define DEMO_FN static __attribute__((unused))
@@ -158,4 +159,41 @@ DEMO_FN void demo_write_csv(const char *path, const char *header, int nrows, int
 }
 
 DEMO_FN void demo_mkdir(const char *dir) { mkdir(dir, 0777); }
+
+/* Writes the three error tables of one example and input
+   (<out>/<example>_<input>_{e_red,e_y,e_proj}.csv) and draws its state panel
+   (methods, projection errors, lower bound) and output panel into fig
+   (panels in and 2 + in). tred/ty: nr x (nmeth+1) rows "r, method...";
+   tproj: nr x 4 rows "r, GMG-POD, GMG-QM, lowerbound". */
+DEMO_FN void demo_tables_and_panels(const char *out, const char *example, const char *input, int in,
+                                    const char *methods_header, const char *const *meth_name, int nmeth,
+                                    int nr, const double *rx, const double *tred, const double *ty,
+                                    const double *tproj, svgplot_fig *fig) {
+  static const char *pn[3] = {"e_proj GMG-POD", "e_proj GMG-QM", "e_lowerbound"};
+  char path[512], title[128];
+  double *col = (double *)malloc(sizeof(double) * (size_t)nr);
+  int j, k;
+  if (!col) { fprintf(stderr, "out of memory\n"); exit(1); }
+  snprintf(path, sizeof path, "%s/%s_%s_e_red.csv", out, example, input);
+  demo_write_csv(path, methods_header, nr, nmeth + 1, tred, 1);
+  snprintf(path, sizeof path, "%s/%s_%s_e_y.csv", out, example, input);
+  demo_write_csv(path, methods_header, nr, nmeth + 1, ty, 1);
+  snprintf(path, sizeof path, "%s/%s_%s_e_proj.csv", out, example, input);
+  demo_write_csv(path, "r,GMG-POD,GMG-QM,lowerbound", nr, 4, tproj, 1);
+  snprintf(title, sizeof title, "(%c) state error, u = %s", 'a' + in, in ? "0.1" : "0.1 sin t");
+  svgplot_panel(fig, in, title, "reduced order r", "relative state error");
+  snprintf(title, sizeof title, "(%c) output error, u = %s", 'c' + in, in ? "0.1" : "0.1 sin t");
+  svgplot_panel(fig, 2 + in, title, "reduced order r", "relative output error e_y");
+  for (j = 0; j < nmeth; ++j) {
+    for (k = 0; k < nr; ++k) col[k] = tred[k * (nmeth + 1) + 1 + j];
+    svgplot_series(fig, in, meth_name[j], nr, rx, col, j | SVGPLOT_MARKERS);
+    for (k = 0; k < nr; ++k) col[k] = ty[k * (nmeth + 1) + 1 + j];
+    svgplot_series(fig, 2 + in, meth_name[j], nr, rx, col, j | SVGPLOT_MARKERS);
+  }
+  for (j = 0; j < 3; ++j) {
+    for (k = 0; k < nr; ++k) col[k] = tproj[k * 4 + 1 + j];
+    svgplot_series(fig, in, pn[j], nr, rx, col, 4 + j);
+  }
+  free(col);
+}
 #endif

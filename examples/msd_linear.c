@@ -23,7 +23,6 @@
 #include "../phgmg.h"
 #include "msd_models.h"
 #include "demo_common.h"
-#include "svgplot.h"
 
 #define NMETH 3
 static const char *meth_name[NMETH] = {"SP1-POD", "GMG-POD", "GMG-QM"};
@@ -97,35 +96,8 @@ int main(int argc, char **argv) {
       }
       printf("  %9.3e  %9.3e  %9.3e\n", tproj[k * 4 + 1], tproj[k * 4 + 2], tproj[k * 4 + 3]);
     }
-    snprintf(path, sizeof path, "%s/linear_%s_e_red.csv", out, inname[in]);
-    demo_write_csv(path, "r,SP1-POD,GMG-POD,GMG-QM", nr, NMETH + 1, tred, 1);
-    snprintf(path, sizeof path, "%s/linear_%s_e_y.csv", out, inname[in]);
-    demo_write_csv(path, "r,SP1-POD,GMG-POD,GMG-QM", nr, NMETH + 1, ty, 1);
-    snprintf(path, sizeof path, "%s/linear_%s_e_proj.csv", out, inname[in]);
-    demo_write_csv(path, "r,GMG-POD,GMG-QM,lowerbound", nr, 4, tproj, 1);
-    /* figure: state panel (methods + projection errors + lower bound), output panel */
-    {
-      const int ps = in, po = 2 + in;
-      int j;
-      char title[128];
-      snprintf(title, sizeof title, "(%c) state error, u = %s", 'a' + in, in ? "0.1" : "0.1 sin t");
-      svgplot_panel(fig, ps, title, "reduced order r", "relative state error");
-      snprintf(title, sizeof title, "(%c) output error, u = %s", 'c' + in, in ? "0.1" : "0.1 sin t");
-      svgplot_panel(fig, po, title, "reduced order r", "relative output error e_y");
-      for (j = 0; j < NMETH; ++j) {
-        int kk;
-        for (kk = 0; kk < nr; ++kk) col[kk] = tred[kk * (NMETH + 1) + 1 + j];
-        svgplot_series(fig, ps, meth_name[j], nr, rx, col, j | SVGPLOT_MARKERS);
-        for (kk = 0; kk < nr; ++kk) col[kk] = ty[kk * (NMETH + 1) + 1 + j];
-        svgplot_series(fig, po, meth_name[j], nr, rx, col, j | SVGPLOT_MARKERS);
-      }
-      for (j = 0; j < 3; ++j) {
-        static const char *pn[3] = {"e_proj GMG-POD", "e_proj GMG-QM", "e_lowerbound"};
-        int kk;
-        for (kk = 0; kk < nr; ++kk) col[kk] = tproj[kk * 4 + 1 + j];
-        svgplot_series(fig, ps, pn[j], nr, rx, col, 4 + j);
-      }
-    }
+    demo_tables_and_panels(out, "linear", inname[in], in, "r,SP1-POD,GMG-POD,GMG-QM", meth_name, NMETH, nr, rx,
+                           tred, ty, tproj, fig);
     demo_cache_free(&cache);
     free(X); free(Y); free(x0); free(tred); free(ty); free(tproj); free(rx); free(col);
   }
