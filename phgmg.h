@@ -4694,20 +4694,20 @@ PHGMG__ONLINE size_t phgmg__romstep_layout(const phgmg_rom *rom, int map_only, v
   size_t o = 0, reals;
   phgmg__romstep_mem dummy;
   if (!L) L = &dummy;
-  L->A = base + o; o += 9;
-  L->b = base + o; o += 3;
-  L->c = base + o; o += 3;
-  L->lag = base + o; o += 12;
-  L->LU = base + o; o += map_only ? 0 : n3 * n3;
-  L->Jf = base + o; o += map_only ? 0 : r * r;
-  L->Z = base + o; o += n3;
-  L->F = base + o; o += n3;
-  L->Res = base + o; o += map_only ? 0 : n3;
-  L->dZ = base + o; o += map_only ? r : n3;
-  L->Zp = base + o; o += map_only ? 0 : n3;
-  L->G = base + o; o += n3;
-  L->Y = base + o; o += r;
-  L->work = base + o; o += map_only ? 0 : phgmg_rom_eval_work_size(rom);
+  L->A = PHGMG__CARVE(base, o); o += 9;
+  L->b = PHGMG__CARVE(base, o); o += 3;
+  L->c = PHGMG__CARVE(base, o); o += 3;
+  L->lag = PHGMG__CARVE(base, o); o += 12;
+  L->LU = PHGMG__CARVE(base, o); o += map_only ? 0 : n3 * n3;
+  L->Jf = PHGMG__CARVE(base, o); o += map_only ? 0 : r * r;
+  L->Z = PHGMG__CARVE(base, o); o += n3;
+  L->F = PHGMG__CARVE(base, o); o += n3;
+  L->Res = PHGMG__CARVE(base, o); o += map_only ? 0 : n3;
+  L->dZ = PHGMG__CARVE(base, o); o += map_only ? r : n3;
+  L->Zp = PHGMG__CARVE(base, o); o += map_only ? 0 : n3;
+  L->G = PHGMG__CARVE(base, o); o += n3;
+  L->Y = PHGMG__CARVE(base, o); o += r;
+  L->work = PHGMG__CARVE(base, o); o += map_only ? 0 : phgmg_rom_eval_work_size(rom);
   reals = o;
   L->piv = mem ? PHGMG__CAST(int *, PHGMG__CAST(void *, base + reals)) : NULL;
   return reals * sizeof(phgmg_real) + (map_only ? 0 : n3 * sizeof(int));
@@ -5600,6 +5600,9 @@ PHGMG_DEF phgmg_result phgmg_reduce(phgmg_reduced **out, const phgmg_ph_system *
         wt[a] = opts->deim_w[a];
         if (wt[a] < 0.0) ++nneg;
       }
+      inf.deim_modes = nd;
+      inf.deim_negative = nneg;
+      if (!phgmg__all_finite(wt, (size_t)nd)) { phgmg__free(alloc, wt); rc = PHGMG_ERR_NANINF; goto fail; }
       if (nneg > 0 && !opts->deim_allow_negative) { phgmg__free(alloc, wt); rc = PHGMG_ERR_NEGATIVE_WEIGHT; goto fail; }
     } else if (opts->deim) {
       double *F = phgmg__dalloc(alloc, (size_t)nt * ns);

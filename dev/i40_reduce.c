@@ -626,6 +626,9 @@ PHGMG_DEF phgmg_result phgmg_reduce(phgmg_reduced **out, const phgmg_ph_system *
         wt[a] = opts->deim_w[a];
         if (wt[a] < 0.0) ++nneg;
       }
+      inf.deim_modes = nd;
+      inf.deim_negative = nneg;
+      if (!phgmg__all_finite(wt, (size_t)nd)) { phgmg__free(alloc, wt); rc = PHGMG_ERR_NANINF; goto fail; }
       if (nneg > 0 && !opts->deim_allow_negative) { phgmg__free(alloc, wt); rc = PHGMG_ERR_NEGATIVE_WEIGHT; goto fail; }
     } else if (opts->deim) {
       double *F = phgmg__dalloc(alloc, (size_t)nt * ns);

@@ -59,6 +59,30 @@ static void guard(const void *p, size_t n) {
   memcpy(rb_g[rb_ng].copy, p, n);
   ++rb_ng;
 }
+/* Structs are compared member by member (their padding bytes are not data). */
+static const phgmg_ph_system *rb_sysp = NULL;
+static phgmg_ph_system rb_sys;
+static const phgmg_reduce_opts *rb_optp = NULL;
+static phgmg_reduce_opts rb_opt;
+#define RB_NE(a, b, f) ((a)->f != (b)->f)
+static int sys_same(const phgmg_ph_system *a, const phgmg_ph_system *b) {
+  return !(RB_NE(a, b, N) || RB_NE(a, b, m) || RB_NE(a, b, storage) || RB_NE(a, b, kb) || RB_NE(a, b, J) ||
+           RB_NE(a, b, R) || RB_NE(a, b, Q) || RB_NE(a, b, B) || RB_NE(a, b, nl) || RB_NE(a, b, nsep) ||
+           RB_NE(a, b, sep_idx) || RB_NE(a, b, sep_w) || RB_NE(a, b, phi) || RB_NE(a, b, dphi) ||
+           RB_NE(a, b, ddphi) || RB_NE(a, b, poly_deg) || RB_NE(a, b, poly) || RB_NE(a, b, H_nl) ||
+           RB_NE(a, b, grad_nl) || RB_NE(a, b, hess_nl) || RB_NE(a, b, user) || RB_NE(a, b, shifted_factor) ||
+           RB_NE(a, b, shifted_solve) || RB_NE(a, b, shifted_user));
+}
+static int opts_same(const phgmg_reduce_opts *a, const phgmg_reduce_opts *b) {
+  return !(RB_NE(a, b, method) || RB_NE(a, b, r) || RB_NE(a, b, rn) || RB_NE(a, b, lambda) || RB_NE(a, b, deim) ||
+           RB_NE(a, b, deim_tol) || RB_NE(a, b, deim_max) || RB_NE(a, b, deim_allow_negative) || RB_NE(a, b, dt) ||
+           RB_NE(a, b, degeneracy_tol) || RB_NE(a, b, pod_basis) || RB_NE(a, b, pod_cols) ||
+           RB_NE(a, b, grad_basis) || RB_NE(a, b, grad_cols) || RB_NE(a, b, deim_pts) || RB_NE(a, b, deim_w) ||
+           RB_NE(a, b, deim_count));
+}
+#undef RB_NE
+static void guard_opts(const phgmg_reduce_opts *o) { rb_optp = o; rb_opt = *o; }
+
 /* 1 if every guarded buffer still holds its bytes; drops the guards. */
 static int intact(void) {
   int ok = 1, i;
@@ -67,12 +91,17 @@ static int intact(void) {
     free(rb_g[i].copy);
   }
   rb_ng = 0;
+  if (rb_sysp && !sys_same(rb_sysp, &rb_sys)) ok = 0;
+  if (rb_optp && !opts_same(rb_optp, &rb_opt)) ok = 0;
+  rb_sysp = NULL;
+  rb_optp = NULL;
   return ok;
 }
 /* The system struct and every array it points to (sizes permitting). */
 static void guard_sys(const phgmg_ph_system *s) {
   size_t len;
-  guard(s, sizeof *s);
+  rb_sysp = s;
+  rb_sys = *s;
   if (s->N < 1 || s->m < 1 || s->m > s->N) return;
   len = s->storage == PHGMG_BANDED && s->kb >= 0 && s->kb < s->N ? (size_t)(2 * s->kb + 1) * (size_t)s->N
                                                                  : (size_t)s->N * (size_t)s->N;
@@ -203,7 +232,7 @@ static phgmg_result reduce_g(const phgmg_ph_system *sys, const double *X, int ld
   phgmg_result rc;
   guard_sys(sys);
   if (X && sys->N > 0 && ns > 0 && ldx >= sys->N) guard(X, sizeof(double) * (size_t)ldx * (size_t)ns);
-  guard(o, sizeof *o);
+  guard_opts(o);
   rc = phgmg_reduce(&red, sys, X, ldx, ns, o, info, NULL);
   if (rc != PHGMG_OK) CHECK(red == NULL);
   phgmg_reduced_destroy(red);
@@ -851,8 +880,26 @@ TEST(test_deim_negative_weight) {
   EXPECT(reduce_g(&M.sys, X, N, ns, &o, &info), PHGMG_ERR_NEGATIVE_WEIGHT);
   o = ropts(PHGMG_METHOD_SP2, 3); o.deim = 1;
   EXPECT(reduce_g(&M.sys, X, N, ns, &o, &info), PHGMG_ERR_NEGATIVE_WEIGHT);
+  /* a cached DEIM result (opts.deim_pts/deim_w) is checked the same way */
+  {
+    int cpts[2] = {0, 2};
+    double cw[2] = {1.5, -0.2};
+    o = ropts(PHGMG_METHOD_GMG_POD, 2); o.deim = 1;
+    o.deim_pts = cpts; o.deim_w = cw; o.deim_count = 2;
+    guard(cpts, sizeof cpts); guard(cw, sizeof cw);
+    EXPECT(reduce_g(&M.sys, X, N, ns, &o, &info), PHGMG_ERR_NEGATIVE_WEIGHT);
+    CHECK(info.deim_negative == 1 && info.deim_modes == 2);
+    cw[1] = (double)NAN;
+    EXPECT(reduce_g(&M.sys, X, N, ns, &o, &info), PHGMG_ERR_NANINF);
+    cw[1] = 0.2; cpts[1] = 3;   /* only 3 terms */
+    EXPECT(reduce_g(&M.sys, X, N, ns, &o, &info), PHGMG_ERR_INVALID_ARG);
+    cpts[1] = 2; o.deim_count = 4;
+    EXPECT(reduce_g(&M.sys, X, N, ns, &o, &info), PHGMG_ERR_SIZE);
+    o.deim_count = 2;
+    EXPECT(reduce_g(&M.sys, X, N, ns, &o, &info), PHGMG_OK);
+  }
   /* without DEIM every term is kept with its own weight: no failure */
-  o.deim = 0;
+  o = ropts(PHGMG_METHOD_SP2, 3);
   EXPECT(reduce_g(&M.sys, X, N, ns, &o, &info), PHGMG_OK);
   /* phgmg_deim itself reports the weight (its caller decides) */
   {
@@ -1252,7 +1299,7 @@ static void guard_in(const octx *c) {
 static phgmg_result op_reduce(const phgmg_allocator *a, void *v) {
   octx *c = (octx *)v;
   phgmg_result rc;
-  guard_in(c); guard(&c->o, sizeof c->o);
+  guard_in(c); guard_opts(&c->o);
   c->red = NULL;
   rc = phgmg_reduce(&c->red, c->sys, c->X, c->N, c->ns, &c->o, NULL, a);
   if (rc != PHGMG_OK && c->red) { th_fail_msg(__FILE__, __LINE__, "reduce: *out set on failure"); c->red = NULL; }

@@ -6,9 +6,12 @@
      memory) may come back on failure, with the output model untouched;
    - a loaded model must pass phgmg_rom_check, serialise back to the same
      bytes when the file's scalar size is the build's, and reload identically;
-   - every online evaluator and a few phgmg_rom_step calls (static workspace,
-     no allocation) run on it: no crash, no sanitizer report; a failed step
-     leaves x untouched, a successful one gives a finite x.
+   - every online evaluator and a few phgmg_rom_step calls run on it, with the
+     model, the evaluation work and the stepper memory in heap blocks of
+     exactly the size the size queries give (so ASan sees any overrun of
+     them), with the model's own dt and with another one: no crash, no
+     sanitizer report; a failed step leaves x untouched, a successful one gives
+     a finite x.
    Every input is also tried with its trailing checksum recomputed, so that
    mutations get past the FNV-1a check to the header and value checks.
 
@@ -37,10 +40,9 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
 #define FZ_HDR 56                 /* header bytes of the format        */
 #define FZ_MAXLEN (1u << 20)      /* inputs longer than this: checksum left as is */
-static double fz_model[1 << 16];  /* the loaded model (512 KB)         */
+#define FZ_MAXMEM ((size_t)1 << 22) /* larger models are only loaded       */
 static double fz_model2[1 << 16]; /* the reloaded copy                 */
-static double fz_step[1 << 16];   /* stepper memory                    */
-static phgmg_real fz_work[1 << 14], fz_x[4096], fz_x0[4096], fz_v[4096], fz_u3[3 * 4096];
+static phgmg_real fz_x[4096], fz_x0[4096], fz_v[4096], fz_u3[3 * 4096], fz_y[4096];
 static phgmg_real fz_M1[1 << 14], fz_M2[1 << 14];
 static unsigned char fz_buf[FZ_MAXLEN], fz_out[FZ_MAXLEN];
 
@@ -58,39 +60,31 @@ static int fz_finite(const phgmg_real *a, int n) {
   return 1;
 }
 
-static void fz_online(const phgmg_rom *rom) {
+/* A few steps of dt from a small and from a large state, with exactly
+   phgmg_rom_stepper_memsize_dt bytes: Newton may fail, nothing may break. */
+static void fz_steps(const phgmg_rom *rom, phgmg_real dt) {
   const int r = rom->r, m = rom->m;
-  const size_t wsz = phgmg_rom_eval_work_size(rom), msz = phgmg_rom_stepper_memsize(rom);
+  const size_t msz = phgmg_rom_stepper_memsize_dt(rom, dt);
   phgmg_rom_stepper st;
+  void *mem;
   int i, n, start;
   fuzz_check(msz > 0, "stepper memsize of a checked model");
   fuzz_check(msz <= PHGMG_ROM_STEPPER_MEMSIZE_MAX(r, m, rom->rn, rom->nd), "memsize above the compile-time bound");
-  for (i = 0; i < 3 * m; ++i) fz_u3[i] = (phgmg_real)(0.1 * (i % 3 - 1));
-  if (wsz <= sizeof fz_work / sizeof fz_work[0] && (size_t)r * (size_t)r <= sizeof fz_M1 / sizeof fz_M1[0]) {
-    phgmg_real h;
-    for (i = 0; i < r; ++i) fz_x[i] = (phgmg_real)(0.1 * (i + 1));
-    h = phgmg_rom_hamiltonian(rom, fz_x, fz_work);
-    (void)h;
-    phgmg_rom_gradient(rom, fz_x, fz_v, fz_work);
-    (void)phgmg_rom_rhs(rom, fz_x, fz_u3, fz_v, fz_work);
-    if (m > 0) phgmg_rom_output(rom, fz_x, fz_v, fz_work);
-    (void)phgmg_rom_structure(rom, fz_x, fz_M1, fz_M2, fz_work);
-    (void)phgmg_rom_jacobian(rom, fz_x, fz_M1, fz_work);
-  }
-  if (msz > sizeof fz_step) return;
-  /* from a small and from a large state: Newton may fail, nothing may break */
+  if (msz > FZ_MAXMEM) return;
+  mem = malloc(msz);
+  fuzz_check(mem != NULL, "malloc");
   for (start = 0; start < 2; ++start) {
-    const phgmg_real dt = rom->Phi ? rom->dt : (phgmg_real)0.1;
-    phgmg_real y[4096], en[2] = {0, 0};
-    if (phgmg_rom_stepper_init(&st, rom, dt, 0, 4, fz_step, sizeof fz_step) != PHGMG_OK) {
-      fuzz_check(!(dt - dt == (phgmg_real)0) || !(dt > (phgmg_real)0), "stepper init refused a checked model");
-      return;
+    phgmg_real en[2] = {0, 0};
+    phgmg_result rc = phgmg_rom_stepper_init(&st, rom, dt, 0, 4, mem, msz);
+    if (rc != PHGMG_OK) {
+      fuzz_check(rc == PHGMG_ERR_INVALID_ARG && !(dt - dt == (phgmg_real)0 && dt > (phgmg_real)0),
+                 "stepper init refused a checked model");
+      break;
     }
     for (i = 0; i < r; ++i) fz_x[i] = (phgmg_real)((start ? 100.0 : 0.01) * (i % 5 - 2));
     for (n = 0; n < 3; ++n) {
-      phgmg_result rc;
       memcpy(fz_x0, fz_x, sizeof(phgmg_real) * (size_t)r);
-      rc = phgmg_rom_step(&st, fz_x, fz_u3, m > 0 ? y : NULL, en);
+      rc = phgmg_rom_step(&st, fz_x, fz_u3, m > 0 ? fz_y : NULL, en);
       if (rc == PHGMG_OK) {
         fuzz_check(fz_finite(fz_x, r), "a successful step gave a non-finite state");
       } else {
@@ -101,10 +95,35 @@ static void fz_online(const phgmg_rom *rom) {
       }
     }
   }
+  free(mem);
+}
+
+static void fz_online(const phgmg_rom *rom) {
+  const int r = rom->r, m = rom->m;
+  const size_t wsz = phgmg_rom_eval_work_size(rom);
+  int i;
+  for (i = 0; i < 3 * m; ++i) fz_u3[i] = (phgmg_real)(0.1 * (i % 3 - 1));
+  if (wsz * sizeof(phgmg_real) <= FZ_MAXMEM && (size_t)r * (size_t)r <= sizeof fz_M1 / sizeof fz_M1[0]) {
+    phgmg_real h, *work = (phgmg_real *)malloc((wsz ? wsz : 1) * sizeof(phgmg_real));
+    fuzz_check(work != NULL, "malloc");
+    for (i = 0; i < r; ++i) fz_x[i] = (phgmg_real)(0.1 * (i + 1));
+    h = phgmg_rom_hamiltonian(rom, fz_x, work);
+    (void)h;
+    phgmg_rom_gradient(rom, fz_x, fz_v, work);
+    (void)phgmg_rom_rhs(rom, fz_x, fz_u3, fz_v, work);
+    if (m > 0) phgmg_rom_output(rom, fz_x, fz_v, work);
+    (void)phgmg_rom_structure(rom, fz_x, fz_M1, fz_M2, work);
+    (void)phgmg_rom_jacobian(rom, fz_x, fz_M1, work);
+    free(work);
+  }
+  /* with the model's own step (its step map, if any) and with another one */
+  fz_steps(rom, rom->Phi ? rom->dt : (phgmg_real)0.1);
+  fz_steps(rom, rom->Phi ? rom->dt * (phgmg_real)0.5 : (phgmg_real)0.05);
 }
 
 static void fz_one(const uint8_t *data, size_t size) {
   size_t need = 0, w = 0;
+  void *model;
   phgmg_rom rom, back, keep;
   phgmg_result rc, rc2;
   memset(&rom, 0xa5, sizeof rom);
@@ -112,21 +131,21 @@ static void fz_one(const uint8_t *data, size_t size) {
   rc = phgmg_rom_deserialize_size(data, size, &need);
   if (rc != PHGMG_OK) {
     fuzz_check(rc == PHGMG_ERR_FORMAT, "size query: unexpected result");
-    rc2 = phgmg_rom_deserialize(data, size, &rom, fz_model, sizeof fz_model);
+    rc2 = phgmg_rom_deserialize(data, size, &rom, fz_model2, sizeof fz_model2);
     fuzz_check(rc2 == rc, "size query and loader disagree");
     fuzz_check(memcmp(&rom, &keep, sizeof rom) == 0, "model changed on failure");
     return;
   }
   fuzz_check(need >= sizeof(phgmg_real) && need <= (size / 4 + 1) * sizeof(phgmg_real), "size query: implausible size");
-  if (need > sizeof fz_model) {
-    rc = phgmg_rom_deserialize(data, size, &rom, fz_model, sizeof fz_model);
-    fuzz_check(rc == PHGMG_ERR_WORKSPACE, "too small memory not reported");
-    return;
-  }
-  rc = phgmg_rom_deserialize(data, size, &rom, fz_model, need);
+  model = malloc(need);
+  fuzz_check(model != NULL, "malloc");
+  rc = phgmg_rom_deserialize(data, size, &rom, model, need - 1);
+  fuzz_check(rc == PHGMG_ERR_WORKSPACE && memcmp(&rom, &keep, sizeof rom) == 0, "too small memory not reported");
+  rc = phgmg_rom_deserialize(data, size, &rom, model, need);
   if (rc != PHGMG_OK) {
     fuzz_check(rc == PHGMG_ERR_FORMAT, "loader: unexpected result");
     fuzz_check(memcmp(&rom, &keep, sizeof rom) == 0, "model changed on failure");
+    free(model);
     return;
   }
   fuzz_check(phgmg_rom_check(&rom) == PHGMG_OK, "a loaded model fails phgmg_rom_check");
@@ -146,6 +165,7 @@ static void fz_one(const uint8_t *data, size_t size) {
   fuzz_check(back.kind == rom.kind && back.r == rom.r && back.m == rom.m && back.rn == rom.rn && back.nd == rom.nd,
              "reloaded sizes");
   fz_online(&rom);
+  free(model);
 }
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {

@@ -3,7 +3,8 @@
 #   npy      phgmg_npy_parse                    (tests/fuzz/fuzz_npy.c)
 #   rom      phgmg_rom_deserialize + online path (tests/fuzz/fuzz_rom.c)
 #   rom_f32  the same in a PHGMG_REAL_FLOAT build
-# Usage: sh tests/fuzz/run.sh [SECONDS]   (per target, default 60)
+# Usage: sh tests/fuzz/run.sh [SECONDS]   (per target, default 60; 0 = only
+#        replay the corpus, a quick regression check)
 # With clang's libFuzzer: builds each harness with
 # -fsanitize=fuzzer,address,undefined and runs it for SECONDS
 # (-max_total_time), starting from the seed corpus in tests/fuzz/corpus/<name>;
@@ -40,7 +41,8 @@ rom tests/fuzz/fuzz_rom.c - rom build/fuzz/rom.dict
 rom_f32 tests/fuzz/fuzz_rom.c -DPHGMG_REAL_FLOAT rom build/fuzz/rom.dict'
 
 if [ $have_libfuzzer = 1 ]; then
-  echo "fuzz: clang libFuzzer + ASan + UBSan, ${secs} s per target"
+  if [ "$secs" = 0 ]; then echo "fuzz: clang libFuzzer + ASan + UBSan, replaying the corpus only"
+  else echo "fuzz: clang libFuzzer + ASan + UBSan, ${secs} s per target"; fi
   echo "$targets" | while read -r t src flags corpus dict; do
     [ "$flags" = - ] && flags=
     bin="$out/fuzz_$t"
@@ -50,19 +52,25 @@ if [ $have_libfuzzer = 1 ]; then
     fi
     mkdir -p "$out/corpus_$t"
     log="$out/fuzz_$t.log"
-    ASAN_OPTIONS=detect_leaks=1 "$bin" -max_total_time="$secs" -timeout=10 -rss_limit_mb=2048 \
-      -print_final_stats=1 -dict="$dict" -artifact_prefix="$out/crash-$t-" \
-      "$out/corpus_$t" "tests/fuzz/corpus/$corpus" </dev/null >"$log" 2>&1
+    if [ "$secs" = 0 ]; then
+      ASAN_OPTIONS=detect_leaks=1 "$bin" -runs=0 -print_final_stats=1 -artifact_prefix="$out/crash-$t-" \
+        "tests/fuzz/corpus/$corpus" </dev/null >"$log" 2>&1
+    else
+      ASAN_OPTIONS=detect_leaks=1 "$bin" -max_total_time="$secs" -timeout=10 -rss_limit_mb=2048 \
+        -print_final_stats=1 -dict="$dict" -artifact_prefix="$out/crash-$t-" \
+        "$out/corpus_$t" "tests/fuzz/corpus/$corpus" </dev/null >"$log" 2>&1
+    fi
     rc=$?
     runs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -n 1)
     cov=$(grep -o 'cov: [0-9]*' "$log" | tail -n 1)
-    files=$(ls "$out/corpus_$t" | wc -l)
+    files=$(find "$out/corpus_$t" -type f | wc -l)
     if [ $rc -ne 0 ]; then
       echo "fuzz: $t: FINDING (exit $rc) after ${runs:-?} runs; see $log and $out/crash-$t-*"
       tail -n 40 "$log"
       exit 1
     fi
-    echo "fuzz: $t: ${runs:-?} runs in ${secs} s, ${cov:-cov: ?}, work corpus $files files, no finding"
+    if [ "$secs" = 0 ]; then echo "fuzz: $t: ${runs:-?} corpus inputs replayed, ${cov:-cov: ?}, no finding"
+    else echo "fuzz: $t: ${runs:-?} runs in ${secs} s, ${cov:-cov: ?}, work corpus $files files, no finding"; fi
   done || fail=1
 else
   cc=gcc
@@ -76,6 +84,7 @@ else
     if ! $cc -std=c99 -g -O1 -fsanitize=address,undefined -fno-sanitize-recover=all $flags "$src" -o "$bin" -lm; then
       echo "fuzz: $t: build failed"; exit 1
     fi
+    printf 'fuzz: %s: ' "$t"
     # shellcheck disable=SC2046
     if ! ASAN_OPTIONS=detect_leaks=1 "$bin" $(ls -d "tests/fuzz/corpus/$corpus"/[!.]*) </dev/null; then
       echo "fuzz: $t: FINDING on the seed corpus"; exit 1
