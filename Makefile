@@ -13,16 +13,12 @@ SANFLAGS = -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-re
 OPTFLAGS = -std=c99 $(WARN) -O2 -march=native
 LDLIBS   = -lm
 
-FRAGS   := $(wildcard dev/h*.h dev/i*.c dev/z*.h)
 TESTSRC := $(wildcard tests/test_*.c)
 BUILD    = build
 
-.PHONY: all test test-plain test-asan compile-checks test-embedded-host test-npy test-cli test-demo demo bench examples embedded fuzz clean
+.PHONY: all test test-plain test-asan compile-checks test-embedded-host test-npy test-cli test-demo test-fuzz-replay demo bench examples embedded fuzz clean
 
 all: phgmg.h examples
-
-phgmg.h: $(FRAGS) dev/amalgamate.sh
-	sh dev/amalgamate.sh
 
 tests/suites.inc: $(TESTSRC)
 	grep -h '^SUITE(' $(TESTSRC) | sed 's/^SUITE(\([a-z0-9_]*\)).*/SUITE_DECL(\1)/' > $@
@@ -35,7 +31,11 @@ $(BUILD)/test_run_asan: phgmg.h tests/run.c tests/harness.h tests/suites.inc $(T
 	@mkdir -p $(BUILD)
 	$(CC) $(CFLAGS_T) -O1 $(SANFLAGS) -o $@ tests/run.c $(TESTSRC) $(LDLIBS)
 
-test: test-plain test-asan compile-checks test-embedded-host test-npy test-cli test-demo
+test: test-plain test-asan compile-checks test-embedded-host test-npy test-cli test-demo test-fuzz-replay
+
+# Replay the fuzz corpora of every reader (clang sanitizers when available; ~6 s).
+test-fuzz-replay:
+	sh tests/fuzz/run.sh 0
 
 # The whole Section-5 study, then the paper's qualitative claims on its CSVs.
 test-demo: demo

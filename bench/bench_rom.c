@@ -280,7 +280,7 @@ static int online_fn(void *vc, int phase) {
   return 0;
 }
 
-/* Flops of one run of the online stepper as implemented in dev/i35_online.c
+/* Flops of one run of the online stepper as implemented in the >>online section of phgmg.h
    (multiply and add counted separately; comparisons, copies and pivoting
    not counted), from the model's sizes and the stepper's statistics. */
 static double rom_grad_flops(const phgmg_rom *R) {
