@@ -591,7 +591,7 @@ PHGMG_DEF size_t phgmg_rom_stepper_memsize(const phgmg_rom *rom);
 PHGMG_DEF size_t phgmg_rom_stepper_memsize_dt(const phgmg_rom *rom, phgmg_real dt);
 /* Compile-time upper bound in bytes for static buffers (r, m, rn, nd as above). */
 #define PHGMG_ROM_STEPPER_MEMSIZE_MAX(r, m, rn, nd) \
-  (sizeof(phgmg_real) * (size_t)(9 * (r) * (r) + 30 * (r) + 3 * (m) + 4 * (rn) * (r) + 2 * (rn) * (rn) + 6 * (rn) + 3 * (nd) + 64) \
+  (sizeof(phgmg_real) * (size_t)(12 * (r) * (r) + 32 * (r) + 3 * (m) + 4 * (rn) * (r) + 2 * (rn) * (rn) + 6 * (rn) + 3 * (nd) + 64) \
    + sizeof(int) * (size_t)(4 * (r) + 8) + 64)
 /* Set up a stepper in caller memory (mem must be aligned for phgmg_real and
    int; anything from malloc or a static phgmg_real array is). tol <= 0 gives
@@ -4417,6 +4417,7 @@ PHGMG_DEF phgmg_result phgmg_rom_check(const phgmg_rom *rom) {
    evaluator, so size and carving cannot drift. */
 typedef struct phgmg__romw {
   phgmg_real *Lp, *q, *a1, *c, *d, *E, *t, *tmp, *xp, *fm, *g;
+  int *piv; /* r pivots of the LU of E, carved from the same real array */
 } phgmg__romw;
 
 PHGMG__ONLINE size_t phgmg__romw_layout(const phgmg_rom *rom, phgmg_real *base, phgmg__romw *w) {
@@ -4435,6 +4436,8 @@ PHGMG__ONLINE size_t phgmg__romw_layout(const phgmg_rom *rom, phgmg_real *base, 
   w->xp = PHGMG__CARVE(base, o); o += r;
   w->fm = PHGMG__CARVE(base, o); o += r;
   w->g = PHGMG__CARVE(base, o); o += r;
+  w->piv = base ? PHGMG__CAST(int *, PHGMG__CAST(void *, base + o)) : NULL;
+  o += (r * sizeof(int) + sizeof(phgmg_real) - 1) / sizeof(phgmg_real);
   return o;
 }
 
@@ -4546,36 +4549,6 @@ PHGMG__ONLINE void phgmg__rom_dgd(const phgmg_rom *rom, const phgmg__romw *w) {
     }
 }
 
-/* Solve E z = b in place (E destroyed) by Gaussian elimination with partial
-   pivoting, without pivot storage. 0 ok, -1 singular. */
-PHGMG__ONLINE int phgmg__r_gesv1(int n, phgmg_real *E, phgmg_real *b) {
-  int i, j, k;
-  for (k = 0; k < n; ++k) {
-    int pv = k;
-    phgmg_real amax = PHGMG__RABS(E[k + k * n]);
-    for (i = k + 1; i < n; ++i)
-      if (PHGMG__RABS(E[i + k * n]) > amax) { amax = PHGMG__RABS(E[i + k * n]); pv = i; }
-    if (!(amax > PHGMG__R(0)) || amax - amax != PHGMG__R(0)) return -1;
-    if (pv != k) {
-      phgmg_real tt;
-      for (j = k; j < n; ++j) { tt = E[k + j * n]; E[k + j * n] = E[pv + j * n]; E[pv + j * n] = tt; }
-      tt = b[k]; b[k] = b[pv]; b[pv] = tt;
-    }
-    for (i = k + 1; i < n; ++i) {
-      const phgmg_real l = E[i + k * n] / E[k + k * n];
-      if (l == PHGMG__R(0)) continue;
-      for (j = k + 1; j < n; ++j) E[i + j * n] -= l * E[k + j * n];
-      b[i] -= l * b[k];
-    }
-  }
-  for (k = n - 1; k >= 0; --k) {
-    phgmg_real s = b[k];
-    for (j = k + 1; j < n; ++j) s -= E[k + j * n] * b[j];
-    b[k] = s / E[k + k * n];
-  }
-  return 0;
-}
-
 /* f = K(x) grad H(x) + Bh u; grad H left in w->g. f must not alias work. */
 PHGMG__ONLINE phgmg_result phgmg__rom_rhs(const phgmg_rom *rom, const phgmg_real *x, const phgmg_real *u,
                                           phgmg_real *f, const phgmg__romw *w) {
@@ -4587,7 +4560,8 @@ PHGMG__ONLINE phgmg_result phgmg__rom_rhs(const phgmg_rom *rom, const phgmg_real
     int i;
     phgmg__rom_dgd(rom, w);
     for (i = 0; i < r; ++i) f[i] = w->g[i];
-    if (phgmg__r_gesv1(r, w->E, f) != 0) return PHGMG_ERR_SINGULAR;
+    if (phgmg__r_lu(r, w->E, w->piv) != 0) return PHGMG_ERR_SINGULAR;
+    phgmg__r_lu_solve(r, w->E, w->piv, f);
   }
   if (u && rom->m > 0) phgmg__r_gemv(r, rom->m, rom->Bh, u, 1, f);
   return PHGMG_OK;
@@ -4608,12 +4582,13 @@ PHGMG_DEF phgmg_result phgmg_rom_structure(const phgmg_rom *rom, const phgmg_rea
   phgmg__romw_layout(rom, work, &w);
   if (rom->kind == PHGMG_ROM_LINEAR) {
     for (b = 0; b < r * r; ++b) Jr[b] = rom->K[b];
-  } else { /* K = E^{-1}, column by column */
+  } else { /* K = E^{-1}: one LU, r solves */
     phgmg__rom_prep(rom, x, &w);
+    phgmg__rom_dgd(rom, &w);
+    if (phgmg__r_lu(r, w.E, w.piv) != 0) return PHGMG_ERR_SINGULAR;
     for (b = 0; b < r; ++b) {
-      phgmg__rom_dgd(rom, &w);
       for (a = 0; a < r; ++a) Jr[a + (size_t)b * r] = (a == b) ? PHGMG__R(1) : PHGMG__R(0);
-      if (phgmg__r_gesv1(r, w.E, Jr + (size_t)b * r) != 0) return PHGMG_ERR_SINGULAR;
+      phgmg__r_lu_solve(r, w.E, w.piv, Jr + (size_t)b * r);
     }
   }
   for (b = 0; b < r; ++b)

@@ -144,6 +144,23 @@ TEST(test_workspace_contract) {
   need = phgmg_rom_stepper_memsize(&rom);
   CHECK(need > 0);
   CHECK(need <= PHGMG_ROM_STEPPER_MEMSIZE_MAX(2, 1, 0, 0));
+  { /* the compile-time bound covers every size and kind (Newton workspace) */
+    static phgmg_real big[64 * 64 * 64];
+    const phgmg_real poly[3] = {0, 0, 1};
+    phgmg_rom q;
+    int r, rn, nd, bad = 0;
+    for (r = 2; r <= 40; ++r)
+      for (rn = 0; rn <= 12; rn += 4)
+        for (nd = 0; nd <= 50; nd += 25) {
+          memset(&q, 0, sizeof q);
+          q.kind = rn ? PHGMG_ROM_QUADRATIC : PHGMG_ROM_LINEAR; q.r = r; q.m = 1; q.rn = rn; q.nd = nd;
+          q.Bh = q.Qh = q.K = q.G00 = q.G01 = q.G10 = q.G11 = q.Q01 = q.Q11 = q.Ms = big;
+          if (nd) { q.P0 = q.P1 = q.w = big; q.poly = poly; q.poly_deg = 2; }
+          if (phgmg_rom_stepper_memsize(&q) == 0 ||
+              phgmg_rom_stepper_memsize(&q) > PHGMG_ROM_STEPPER_MEMSIZE_MAX(r, 1, rn, nd)) bad++;
+        }
+    CHECK(bad == 0);
+  }
   CHECK_RC(phgmg_rom_stepper_init(&st, &rom, 0.1, 0, 0, mem, need - 1), PHGMG_ERR_WORKSPACE);
   CHECK_RC(phgmg_rom_stepper_init(&st, &rom, 0.1, 0, 0, mem, need), PHGMG_OK);
   CHECK_RC(phgmg_rom_stepper_init(&st, &rom, -0.1, 0, 0, mem, need), PHGMG_ERR_INVALID_ARG);
