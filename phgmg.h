@@ -68,7 +68,8 @@
             phgmg_simulate (trajectory, outputs, energy H/S/D, stats)
    online:  phgmg_rom_check, phgmg_rom_eval_work_size, phgmg_rom_hamiltonian,
             phgmg_rom_gradient, phgmg_rom_rhs, phgmg_rom_output, phgmg_rom_structure
-            (J and R at a state), phgmg_rom_jacobian, phgmg_rom_stepper_memsize,
+            (J and R at a state), phgmg_rom_hessian, phgmg_rom_jacobian (analytic),
+            phgmg_rom_stepper_memsize,
             PHGMG_ROM_STEPPER_MEMSIZE_MAX, phgmg_rom_stepper_init, phgmg_rom_stepper_reset,
             phgmg_rom_stage_times, phgmg_rom_step
    reduce:  phgmg_pod, phgmg_adjust_snapshots, phgmg_pod_hierarchical, phgmg_deim,
@@ -562,14 +563,20 @@ PHGMG_DEF void phgmg_rom_output(const phgmg_rom *rom, const phgmg_real *x, phgmg
 /* The reduced structure matrices at x: Jr = (K - K^T)/2 (skew), Rr = -(K + K^T)/2 (sym PSD), r x r. */
 PHGMG_DEF phgmg_result phgmg_rom_structure(const phgmg_rom *rom, const phgmg_real *x, phgmg_real *Jr,
                                            phgmg_real *Rr, phgmg_real *work);
-/* Newton Jacobian of the right-hand side, d f / d x (r x r): analytic for LINEAR
-   models; for QUADRATIC ones a central finite difference of phgmg_rom_rhs. */
+/* The reduced Hessian d^2 H / dx^2 at x (r x r; symmetric -- also with DEIM,
+   whose weights make the reduced gradient an exact gradient). */
+PHGMG_DEF void phgmg_rom_hessian(const phgmg_rom *rom, const phgmg_real *x, phgmg_real *H, phgmg_real *work);
+/* Newton Jacobian of the right-hand side, d f / d x (r x r), analytic for both
+   kinds (QUADRATIC: includes the derivative of K(x) = (D^T G D)^{-1}; independent of u).
+   PHGMG_ERR_SINGULAR if D^T G D is singular at x. */
 PHGMG_DEF phgmg_result phgmg_rom_jacobian(const phgmg_rom *rom, const phgmg_real *x, phgmg_real *Jf,
                                           phgmg_real *work);
 
 /* --- the online stepper (GL3, simplified Newton on the 3r stage system) --- */
 typedef struct phgmg_rom_stats {
   long steps, newton_iters, factorizations, failures;
+  long e_refreshes; /* QUADRATIC: new LU of E = D^T G D alone (after a slow step) */
+  long exact_steps; /* QUADRATIC: steps solved with exact stage values (see phgmg_rom_step) */
 } phgmg_rom_stats;
 
 typedef struct phgmg_rom_stepper {
@@ -578,6 +585,8 @@ typedef struct phgmg_rom_stepper {
   int max_iter;           /* Newton cap per step                                        */
   int use_map;            /* 1 if the precomputed step map is used                      */
   int have_lu, have_prev; /* internal: factors valid / extrapolation data valid        */
+  int stale_e;            /* internal (QUADRATIC): refactor E = D^T G D before the next step */
+  int exact_hold;         /* internal (QUADRATIC): steps left with exact stage values   */
   phgmg_real *ws;         /* caller memory, carved by init                              */
   size_t ws_count;
   phgmg_rom_stats stats;
@@ -606,7 +615,17 @@ PHGMG_DEF void phgmg_rom_stage_times(phgmg_real t, phgmg_real dt, phgmg_real tc[
 /* One step: x (r) advanced in place. u3 = inputs at the three stage times
    (3m values, u(t+c1 dt) first; NULL = 0). y (m, may be NULL) = output at the
    new state. energy (may be NULL) += {supplied, dissipated} over the step.
-   On failure (PHGMG_ERR_NOT_CONVERGED, _NANINF, _SINGULAR) x, y, energy are untouched. */
+   On failure (PHGMG_ERR_NOT_CONVERGED, _NANINF, _SINGULAR) x, y, energy are untouched.
+   Newton: simplified (the LU of I - dt (A kron Jf) is kept across steps and
+   renewed after a failure or when the contraction is slower than 1/2), started
+   from the extrapolated collocation polynomial of the last step. QUADRATIC
+   models are solved in mass-matrix form, E(x) x' = g(x) + E(x) Bh u with
+   E = D^T G D: the stage values Phi_i = E(Y_i)^{-1} g(Y_i) are unknowns beside
+   the stage increments, so an iteration needs products E(Y_i) Phi_i and solves
+   with frozen factors of E, never a factorisation per stage (E alone is
+   refactored after a step that needed more than one iteration). The converged
+   stages are those of the usual GL3 method; tol bounds the stage residual
+   linearised in Phi and the last correction of Phi (times dt A). */
 PHGMG_DEF phgmg_result phgmg_rom_step(phgmg_rom_stepper *s, phgmg_real *x, const phgmg_real *u3,
                                       phgmg_real *y, phgmg_real energy[2]);
 
@@ -4311,24 +4330,43 @@ PHGMG__ONLINE int phgmg__r_finite(const phgmg_real *a, int n) {
   return acc == PHGMG__R(0);
 }
 
-/* y = A x (A: rows x cols, column-major, ld = rows); beta = 0 or 1 (accumulate). */
+/* y = A x (A: rows x cols, column-major, ld = rows); beta = 0 or 1 (accumulate).
+   The small online kernels take four columns per sweep: a quarter of the
+   loads and stores of y, and four independent products per element (these
+   sizes are latency-bound, not bandwidth-bound). */
 PHGMG__ONLINE void phgmg__r_gemv(int rows, int cols, const phgmg_real *A, const phgmg_real *x,
                                  int accumulate, phgmg_real *y) {
-  int i, j;
+  const size_t ld = (size_t)rows;
+  int i, j = 0;
   if (!accumulate) for (i = 0; i < rows; ++i) y[i] = PHGMG__R(0);
-  for (j = 0; j < cols; ++j) {
+  for (; j + 4 <= cols; j += 4) {
+    const phgmg_real x0 = x[j], x1 = x[j + 1], x2 = x[j + 2], x3 = x[j + 3];
+    const phgmg_real *a0 = A + (size_t)j * ld, *a1 = a0 + ld, *a2 = a1 + ld, *a3 = a2 + ld;
+    for (i = 0; i < rows; ++i) y[i] += (a0[i] * x0 + a1[i] * x1) + (a2[i] * x2 + a3[i] * x3);
+  }
+  for (; j < cols; ++j) {
     const phgmg_real xj = x[j];
-    const phgmg_real *a = A + (size_t)j * (size_t)rows;
-    if (xj == PHGMG__R(0)) continue;
+    const phgmg_real *a = A + (size_t)j * ld;
     for (i = 0; i < rows; ++i) y[i] += a[i] * xj;
   }
 }
-/* y (+)= A^T x (A: rows x cols). */
+/* y (+)= A^T x (A: rows x cols); four dot products per sweep. */
 PHGMG__ONLINE void phgmg__r_gemvt(int rows, int cols, const phgmg_real *A, const phgmg_real *x,
                                   int accumulate, phgmg_real *y) {
-  int i, j;
-  for (j = 0; j < cols; ++j) {
-    const phgmg_real *a = A + (size_t)j * (size_t)rows;
+  const size_t ld = (size_t)rows;
+  int i, j = 0;
+  for (; j + 4 <= cols; j += 4) {
+    const phgmg_real *a0 = A + (size_t)j * ld, *a1 = a0 + ld, *a2 = a1 + ld, *a3 = a2 + ld;
+    phgmg_real s0 = PHGMG__R(0), s1 = PHGMG__R(0), s2 = PHGMG__R(0), s3 = PHGMG__R(0);
+    for (i = 0; i < rows; ++i) {
+      const phgmg_real xi = x[i];
+      s0 += a0[i] * xi; s1 += a1[i] * xi; s2 += a2[i] * xi; s3 += a3[i] * xi;
+    }
+    if (accumulate) { y[j] += s0; y[j + 1] += s1; y[j + 2] += s2; y[j + 3] += s3; }
+    else { y[j] = s0; y[j + 1] = s1; y[j + 2] = s2; y[j + 3] = s3; }
+  }
+  for (; j < cols; ++j) {
+    const phgmg_real *a = A + (size_t)j * ld;
     phgmg_real s = PHGMG__R(0);
     for (i = 0; i < rows; ++i) s += a[i] * x[i];
     y[j] = accumulate ? y[j] + s : s;
@@ -4416,7 +4454,7 @@ PHGMG_DEF phgmg_result phgmg_rom_check(const phgmg_rom *rom) {
 /* Evaluation work: one layout function used by the size query and by every
    evaluator, so size and carving cannot drift. */
 typedef struct phgmg__romw {
-  phgmg_real *Lp, *q, *a1, *c, *d, *E, *t, *tmp, *xp, *fm, *g;
+  phgmg_real *Lp, *q, *a1, *b1, *b2, *c, *d, *E, *t, *tmp, *xp, *fm, *g;
   int *piv; /* r pivots of the LU of E, carved from the same real array */
 } phgmg__romw;
 
@@ -4428,6 +4466,8 @@ PHGMG__ONLINE size_t phgmg__romw_layout(const phgmg_rom *rom, phgmg_real *base, 
   w->Lp = PHGMG__CARVE(base, o); o += rn * r;
   w->q = PHGMG__CARVE(base, o); o += rn;
   w->a1 = PHGMG__CARVE(base, o); o += rn;
+  w->b1 = PHGMG__CARVE(base, o); o += rn;
+  w->b2 = PHGMG__CARVE(base, o); o += rn;
   w->c = PHGMG__CARVE(base, o); o += nd;
   w->d = PHGMG__CARVE(base, o); o += nd;
   w->E = PHGMG__CARVE(base, o); o += r * r;
@@ -4448,18 +4488,11 @@ PHGMG_DEF size_t phgmg_rom_eval_work_size(const phgmg_rom *rom) {
 /* q = M (x2 kron x2) via Lp (QUADRATIC), and the kept coordinates c. */
 PHGMG__ONLINE void phgmg__rom_prep(const phgmg_rom *rom, const phgmg_real *x, const phgmg__romw *w) {
   const int r = rom->r, m = rom->m, rn = rom->rn, nd = rom->nd, p = r - m;
-  int i, j, k;
+  int i, k;
   if (rom->kind == PHGMG_ROM_QUADRATIC) {
     const phgmg_real *x2 = x + m;
-    for (k = 0; k < p; ++k) { /* Lp(:,k) = sum_j Ms(:, k*p + j) x2_j */
-      phgmg_real *l = w->Lp + (size_t)k * rn;
-      for (i = 0; i < rn; ++i) l[i] = PHGMG__R(0);
-      for (j = 0; j < p; ++j) {
-        const phgmg_real *ms = rom->Ms + ((size_t)k * p + j) * rn;
-        const phgmg_real xj = x2[j];
-        for (i = 0; i < rn; ++i) l[i] += ms[i] * xj;
-      }
-    }
+    for (k = 0; k < p; ++k) /* Lp(:,k) = sum_j Ms(:, k*p + j) x2_j: block k of Ms times x2 */
+      phgmg__r_gemv(rn, p, rom->Ms + (size_t)k * p * rn, x2, 0, w->Lp + (size_t)k * rn);
     phgmg__r_gemv(rn, p, w->Lp, x2, 0, w->q);
     for (i = 0; i < rn; ++i) w->q[i] *= PHGMG__R(0.5);
   }
@@ -4532,7 +4565,7 @@ PHGMG_DEF void phgmg_rom_output(const phgmg_rom *rom, const phgmg_real *x, phgmg
 PHGMG__ONLINE void phgmg__rom_dgd(const phgmg_rom *rom, const phgmg__romw *w) {
   const int r = rom->r, m = rom->m, rn = rom->rn;
   phgmg_real *E = w->E, *t = w->t;
-  int a, b, i;
+  int b, i;
   for (b = 0; b < r; ++b) {
     phgmg_real *tb = t + (size_t)b * rn;
     for (i = 0; i < rn; ++i) tb[i] = rom->G10[i + (size_t)b * rn];
@@ -4540,13 +4573,7 @@ PHGMG__ONLINE void phgmg__rom_dgd(const phgmg_rom *rom, const phgmg__romw *w) {
   }
   for (b = 0; b < r * r; ++b) E[b] = rom->G00[b];
   for (b = m; b < r; ++b) phgmg__r_gemv(r, rn, rom->G01, w->Lp + (size_t)(b - m) * rn, 1, E + (size_t)b * r);
-  for (b = 0; b < r; ++b)
-    for (a = m; a < r; ++a) {
-      const phgmg_real *la = w->Lp + (size_t)(a - m) * rn, *tb = t + (size_t)b * rn;
-      phgmg_real s = PHGMG__R(0);
-      for (i = 0; i < rn; ++i) s += la[i] * tb[i];
-      E[a + (size_t)b * r] += s;
-    }
+  for (b = 0; b < r; ++b) phgmg__r_gemvt(rn, r - m, w->Lp, t + (size_t)b * rn, 1, E + (size_t)b * r + m);
 }
 
 /* f = K(x) grad H(x) + Bh u; grad H left in w->g. f must not alias work. */
@@ -4601,50 +4628,114 @@ PHGMG_DEF phgmg_result phgmg_rom_structure(const phgmg_rom *rom, const phgmg_rea
   return PHGMG_OK;
 }
 
-/* Newton Jacobian df/dx. */
-PHGMG__ONLINE phgmg_result phgmg__rom_jac(const phgmg_rom *rom, const phgmg_real *x, phgmg_real *Jf,
-                                          const phgmg__romw *w) {
-  const int r = rom->r;
-  int a, b, j;
-  if (rom->kind == PHGMG_ROM_LINEAR) {
-    /* Jf = K (Qh + P0^T diag(w phi''(c)) P0) */
-    phgmg_real *Hs = w->E;
-    phgmg__rom_prep(rom, x, w);
-    for (j = 0; j < rom->nd; ++j) {
-      phgmg_real d2;
-      phgmg__r_poly(rom->poly, rom->poly_deg, w->c[j], NULL, NULL, &d2);
-      w->d[j] = rom->w[j] * d2;
-    }
-    for (b = 0; b < r; ++b)
+/* The reduced Hessian H = d grad H / dx (r x r, symmetric) at x; grad H left
+   in w->g. With phi(x) = V0 x + V2 q(x2), D = V0 + V2 L, L = [0, Lp]:
+     H = D^T Q D + (P0 + P1 L)^T diag(w phi''(c)) (P0 + P1 L) + [0 0; 0 Hq],
+   D^T Q D = Qh + Q01 L + (Q01 L)^T + L^T Q11 L and Hq(a,b) = Ms(:, a p + b)^T a1
+   (the curvature of the manifold against V2^T grad H). */
+PHGMG__ONLINE void phgmg__rom_hess(const phgmg_rom *rom, const phgmg_real *x, phgmg_real *H,
+                                   const phgmg__romw *w) {
+  const int r = rom->r, m = rom->m, rn = rom->rn, nd = rom->nd, p = r - m;
+  int a, b, j, k, i;
+  phgmg__rom_grad(rom, x, w->g, w);
+  for (b = 0; b < r * r; ++b) H[b] = rom->Qh[b];
+  if (rom->kind == PHGMG_ROM_QUADRATIC) {
+    for (k = 0; k < p; ++k) {
+      const phgmg_real *lk = w->Lp + (size_t)k * rn;
+      phgmg__r_gemv(r, rn, rom->Q01, lk, 0, w->tmp); /* column m+k of Q01 L */
       for (a = 0; a < r; ++a) {
-        phgmg_real s = rom->Qh[a + (size_t)b * r];
-        for (j = 0; j < rom->nd; ++j)
-          s += rom->P0[j + (size_t)a * rom->nd] * w->d[j] * rom->P0[j + (size_t)b * rom->nd];
-        Hs[a + (size_t)b * r] = s;
+        H[a + (size_t)(m + k) * r] += w->tmp[a];
+        H[(m + k) + (size_t)a * r] += w->tmp[a];
       }
-    for (b = 0; b < r; ++b) phgmg__r_gemv(r, r, rom->K, Hs + (size_t)b * r, 0, Jf + (size_t)b * r);
-  } else {
-    /* central differences of the right-hand side (u = 0; f is affine in u) */
-#if PHGMG_REAL_IS_FLOAT
-    const phgmg_real hrel = PHGMG__R(4.9e-3);
-#else
-    const phgmg_real hrel = PHGMG__R(6.06e-6);
-#endif
-    for (b = 0; b < r; ++b) {
-      const phgmg_real hb = hrel * (PHGMG__R(1) + PHGMG__RABS(x[b]));
-      phgmg_real *col = Jf + (size_t)b * r;
-      phgmg_result rc;
-      for (a = 0; a < r; ++a) w->xp[a] = x[a];
-      w->xp[b] = x[b] + hb;
-      rc = phgmg__rom_rhs(rom, w->xp, NULL, col, w);
-      if (rc != PHGMG_OK) return rc;
-      w->xp[b] = x[b] - hb;
-      rc = phgmg__rom_rhs(rom, w->xp, NULL, w->fm, w);
-      if (rc != PHGMG_OK) return rc;
-      for (a = 0; a < r; ++a) col[a] = (col[a] - w->fm[a]) / (PHGMG__R(2) * hb);
+      phgmg__r_gemv(rn, rn, rom->Q11, lk, 0, w->b1);
+      for (a = 0; a < p; ++a) {
+        const phgmg_real *la = w->Lp + (size_t)a * rn, *ms = rom->Ms + ((size_t)a * p + k) * rn;
+        phgmg_real s = PHGMG__R(0);
+        for (i = 0; i < rn; ++i) s += la[i] * w->b1[i] + ms[i] * w->a1[i];
+        H[(m + a) + (size_t)(m + k) * r] += s;
+      }
     }
   }
+  for (j = 0; j < nd; ++j) {
+    phgmg_real d2, wj;
+    phgmg__r_poly(rom->poly, rom->poly_deg, w->c[j], NULL, NULL, &d2);
+    wj = rom->w[j] * d2;
+    if (wj == PHGMG__R(0)) continue;
+    for (a = 0; a < r; ++a) w->xp[a] = rom->P0[j + (size_t)a * nd]; /* row j of P0 + P1 L */
+    if (rom->kind == PHGMG_ROM_QUADRATIC)
+      for (k = 0; k < p; ++k) {
+        const phgmg_real *lk = w->Lp + (size_t)k * rn;
+        phgmg_real s = PHGMG__R(0);
+        for (i = 0; i < rn; ++i) s += rom->P1[j + (size_t)i * nd] * lk[i];
+        w->xp[m + k] += s;
+      }
+    for (b = 0; b < r; ++b) {
+      const phgmg_real wb = wj * w->xp[b];
+      phgmg_real *hb = H + (size_t)b * r;
+      for (a = 0; a < r; ++a) hb[a] += wb * w->xp[a];
+    }
+  }
+}
+
+/* out = E v, E = D^T G D at the point whose Lp is in w (QUADRATIC), without
+   forming E: G00 v + G01 (L v) + L^T (G10 v + G11 L v). Uses w->b1, w->b2. */
+PHGMG__ONLINE void phgmg__rom_eapply(const phgmg_rom *rom, const phgmg__romw *w, const phgmg_real *v,
+                                     phgmg_real *out) {
+  const int r = rom->r, m = rom->m, rn = rom->rn, p = r - m;
+  phgmg__r_gemv(rn, p, w->Lp, v + m, 0, w->b2);
+  phgmg__r_gemv(rn, r, rom->G10, v, 0, w->b1);
+  phgmg__r_gemv(rn, rn, rom->G11, w->b2, 1, w->b1);
+  phgmg__r_gemv(r, r, rom->G00, v, 0, out);
+  phgmg__r_gemv(r, rn, rom->G01, w->b2, 1, out);
+  phgmg__r_gemvt(rn, p, w->Lp, w->b1, 1, out + m);
+}
+
+/* Newton Jacobian df/dx, analytic for both kinds.
+   LINEAR: Jf = K H.  QUADRATIC: f = E^{-1} g + Bh u with E = D^T G D, so
+     Jf = E^{-1} (H - C),  C(:, b) = (dE/dx_b) v,  v = E^{-1} g.
+   E depends on x2 through L only: dL/dx_{m+j} = [0, Ms_j], Ms_j(:,k) = Ms(:, j p + k), and
+     C(:, m+j) = (G01 + L^T G11) s_j + [0; Ms_j^T t],  s_j = Ms_j v2,  t = (G10 + G11 L) v.
+   On return (QUADRATIC) w->E/w->piv hold the LU of E(x) and w->fm = v. */
+PHGMG__ONLINE phgmg_result phgmg__rom_jac(const phgmg_rom *rom, const phgmg_real *x, phgmg_real *Jf,
+                                          const phgmg__romw *w) {
+  const int r = rom->r, m = rom->m, rn = rom->rn, p = r - m;
+  int a, b, j, k, i;
+  if (rom->kind == PHGMG_ROM_LINEAR) {
+    phgmg_real *Hs = w->E;
+    phgmg__rom_hess(rom, x, Hs, w);
+    for (b = 0; b < r; ++b) phgmg__r_gemv(r, r, rom->K, Hs + (size_t)b * r, 0, Jf + (size_t)b * r);
+    return PHGMG_OK;
+  }
+  phgmg__rom_hess(rom, x, Jf, w); /* Jf = H; w->g, w->Lp at x */
+  phgmg__rom_dgd(rom, w);
+  if (phgmg__r_lu(r, w->E, w->piv) != 0) return PHGMG_ERR_SINGULAR;
+  for (a = 0; a < r; ++a) w->fm[a] = w->g[a];
+  phgmg__r_lu_solve(r, w->E, w->piv, w->fm); /* v */
+  phgmg__r_gemv(rn, p, w->Lp, w->fm + m, 0, w->b2); /* t = G10 v + G11 L v */
+  phgmg__r_gemv(rn, r, rom->G10, w->fm, 0, w->b1);
+  phgmg__r_gemv(rn, rn, rom->G11, w->b2, 1, w->b1);
+  for (j = 0; j < p; ++j) {
+    phgmg_real *sj = w->t; /* s_j (rn) */
+    phgmg_real *cj = Jf + (size_t)(m + j) * r;
+    phgmg__r_gemv(rn, p, rom->Ms + (size_t)j * p * rn, w->fm + m, 0, sj);
+    phgmg__r_gemv(rn, rn, rom->G11, sj, 0, w->b2);
+    phgmg__r_gemv(r, rn, rom->G01, sj, 0, w->tmp);
+    for (k = 0; k < p; ++k) {
+      const phgmg_real *lk = w->Lp + (size_t)k * rn, *ms = rom->Ms + ((size_t)j * p + k) * rn;
+      phgmg_real s = PHGMG__R(0);
+      for (i = 0; i < rn; ++i) s += lk[i] * w->b2[i] + ms[i] * w->b1[i];
+      w->tmp[m + k] += s;
+    }
+    for (a = 0; a < r; ++a) cj[a] -= w->tmp[a];
+  }
+  for (b = 0; b < r; ++b) phgmg__r_lu_solve(r, w->E, w->piv, Jf + (size_t)b * r);
   return PHGMG_OK;
+}
+
+PHGMG_DEF void phgmg_rom_hessian(const phgmg_rom *rom, const phgmg_real *x, phgmg_real *H, phgmg_real *work) {
+  phgmg__romw w;
+  phgmg__romw_layout(rom, work, &w);
+  phgmg__rom_hess(rom, x, H, &w);
 }
 
 PHGMG_DEF phgmg_result phgmg_rom_jacobian(const phgmg_rom *rom, const phgmg_real *x, phgmg_real *Jf,
@@ -4658,7 +4749,10 @@ PHGMG_DEF phgmg_result phgmg_rom_jacobian(const phgmg_rom *rom, const phgmg_real
 typedef struct phgmg__romstep_mem {
   phgmg_real *A, *b, *c, *lag; /* GL3 tableau (row-major A), extrapolation weights 3x4 */
   phgmg_real *LU, *Jf, *Z, *F, *Res, *dZ, *Zp, *G, *Y, *work;
-  int *piv;
+  /* QUADRATIC (mass-matrix form): frozen LU of E, stage values Phi = E^{-1} g,
+     their extrapolation, E_f^{-1} (E Phi - g), quadratic extrapolation weights 3x3 */
+  phgmg_real *Ef, *Phi, *Php, *Del, *lagq;
+  int *piv, *pivf;
 } phgmg__romstep_mem;
 
 /* Two layouts: the full one for Newton, and a small one when the model is
@@ -4668,6 +4762,7 @@ PHGMG__ONLINE size_t phgmg__romstep_layout(const phgmg_rom *rom, int map_only, v
   phgmg_real *base = PHGMG__CAST(phgmg_real *, mem);
   size_t o = 0, reals;
   phgmg__romstep_mem dummy;
+  const int mm = !map_only && rom->kind == PHGMG_ROM_QUADRATIC;
   if (!L) L = &dummy;
   L->A = PHGMG__CARVE(base, o); o += 9;
   L->b = PHGMG__CARVE(base, o); o += 3;
@@ -4683,9 +4778,15 @@ PHGMG__ONLINE size_t phgmg__romstep_layout(const phgmg_rom *rom, int map_only, v
   L->G = PHGMG__CARVE(base, o); o += n3;
   L->Y = PHGMG__CARVE(base, o); o += r;
   L->work = PHGMG__CARVE(base, o); o += map_only ? 0 : phgmg_rom_eval_work_size(rom);
+  L->Ef = mm ? PHGMG__CARVE(base, o) : NULL; o += mm ? r * r : 0;
+  L->Phi = mm ? PHGMG__CARVE(base, o) : NULL; o += mm ? n3 : 0;
+  L->Php = mm ? PHGMG__CARVE(base, o) : NULL; o += mm ? n3 : 0;
+  L->Del = mm ? PHGMG__CARVE(base, o) : NULL; o += mm ? n3 : 0;
+  L->lagq = mm ? PHGMG__CARVE(base, o) : NULL; o += mm ? 9 : 0;
   reals = o;
   L->piv = mem ? PHGMG__CAST(int *, PHGMG__CAST(void *, base + reals)) : NULL;
-  return reals * sizeof(phgmg_real) + (map_only ? 0 : n3 * sizeof(int));
+  L->pivf = mem ? L->piv + (map_only ? 0 : n3) : NULL;
+  return reals * sizeof(phgmg_real) + ((map_only ? 0 : n3) + (mm ? r : 0)) * sizeof(int);
 }
 
 /* Does stepping with dt use the model's precomputed step map? */
@@ -4744,6 +4845,13 @@ PHGMG_DEF phgmg_result phgmg_rom_stepper_init(phgmg_rom_stepper *s, const phgmg_
         if (i != j) l *= (tt - nodes[i]) / (nodes[j] - nodes[i]);
       L.lag[k * 4 + j] = PHGMG__R(l);
     }
+    if (L.lagq) /* the quadratic through (c_j, Phi_j) at 1 + c_k (Phi ~ p', degree 2) */
+      for (j = 0; j < 3; ++j) {
+        double l = 1.0;
+        for (i = 0; i < 3; ++i)
+          if (i != j) l *= (tt - c[i]) / (c[j] - c[i]);
+        L.lagq[k * 3 + j] = PHGMG__R(l);
+      }
   }
   s->rom = rom;
   s->dt = dt;
@@ -4756,6 +4864,8 @@ PHGMG_DEF phgmg_result phgmg_rom_stepper_init(phgmg_rom_stepper *s, const phgmg_
   s->use_map = use_map;
   s->have_lu = 0;
   s->have_prev = 0;
+  s->stale_e = 0;
+  s->exact_hold = 0;
   s->ws = PHGMG__CAST(phgmg_real *, mem);
   s->ws_count = mem_size / sizeof(phgmg_real);
   memset(&s->stats, 0, sizeof s->stats);
@@ -4765,9 +4875,18 @@ PHGMG_DEF phgmg_result phgmg_rom_stepper_init(phgmg_rom_stepper *s, const phgmg_
 PHGMG_DEF void phgmg_rom_stepper_reset(phgmg_rom_stepper *s) { s->have_prev = 0; }
 
 /* Stage residual Res = Z - h (A kron I) F(x + Z); returns inf-norm, or -1 on
-   failure (non-finite or singular). Stage gradients into G. */
+   failure (non-finite or singular). Stage gradients into G.
+   QUADRATIC models are stepped in mass-matrix form: f = E(x)^{-1} g(x) + Bh u
+   with E = D^T G D, and the stage values Phi_i = E(Y_i)^{-1} g(Y_i) are Newton
+   unknowns beside Z (no factorisation of E(Y_i) per evaluation; E(Y_i) Phi_i
+   is a product, phgmg__rom_eapply). Then F = Phi + Bh u, Del_i =
+   E_f^{-1} (E(Y_i) Phi_i - g(Y_i)) with the frozen factors E_f, and
+   Res = Z - h (A kron I) F + h (A kron I) Del (the right-hand side of the
+   reduced Newton system). The norm is max |Z - h A F| + |h A Del| taken
+   componentwise, which bounds the residual of the eliminated equations to
+   first order; at convergence the solution is that of the usual GL3 stages. */
 PHGMG__ONLINE phgmg_real phgmg__romstep_residual(phgmg_rom_stepper *s, const phgmg__romstep_mem *L,
-                                                 const phgmg_real *x, const phgmg_real *u3,
+                                                 const phgmg_real *x, const phgmg_real *u3, int mm,
                                                  phgmg_result *err) {
   const phgmg_rom *rom = s->rom;
   const int r = rom->r, m = rom->m;
@@ -4776,18 +4895,29 @@ PHGMG__ONLINE phgmg_real phgmg__romstep_residual(phgmg_rom_stepper *s, const phg
   int i, j, a;
   phgmg__romw_layout(rom, L->work, &w);
   for (i = 0; i < 3; ++i) {
-    phgmg_result rc;
+    phgmg_real *fi = L->F + i * r;
     for (a = 0; a < r; ++a) L->Y[a] = x[a] + L->Z[i * r + a];
-    rc = phgmg__rom_rhs(rom, L->Y, u3 ? u3 + i * m : NULL, L->F + i * r, &w);
-    if (rc != PHGMG_OK) { *err = rc; return PHGMG__R(-1); }
+    if (mm) {
+      phgmg_real *di = L->Del + i * r, *pi = L->Phi + i * r;
+      phgmg__rom_grad(rom, L->Y, w.g, &w);
+      phgmg__rom_eapply(rom, &w, pi, di);
+      for (a = 0; a < r; ++a) { di[a] -= w.g[a]; fi[a] = pi[a]; }
+      phgmg__r_lu_solve(r, L->Ef, L->pivf, di);
+      if (u3 && m > 0) phgmg__r_gemv(r, m, rom->Bh, u3 + i * m, 1, fi);
+    } else {
+      phgmg_result rc = phgmg__rom_rhs(rom, L->Y, u3 ? u3 + i * m : NULL, fi, &w);
+      if (rc != PHGMG_OK) { *err = rc; return PHGMG__R(-1); }
+    }
     for (a = 0; a < r; ++a) L->G[i * r + a] = w.g[a];
   }
   for (i = 0; i < 3; ++i)
     for (a = 0; a < r; ++a) {
-      phgmg_real v = L->Z[i * r + a];
+      phgmg_real v = L->Z[i * r + a], e = PHGMG__R(0);
       for (j = 0; j < 3; ++j) v -= s->dt * L->A[i * 3 + j] * L->F[j * r + a];
-      L->Res[i * r + a] = v;
-      if (PHGMG__RABS(v) > nrm) nrm = PHGMG__RABS(v);
+      if (mm) for (j = 0; j < 3; ++j) e += s->dt * L->A[i * 3 + j] * L->Del[j * r + a];
+      L->Res[i * r + a] = v + e;
+      if (PHGMG__RABS(v + e) > nrm) nrm = PHGMG__RABS(v + e);
+      if (PHGMG__RABS(e) > nrm) nrm = PHGMG__RABS(e);
     }
   if (!phgmg__r_finite(L->Res, 3 * r) || !phgmg__r_finite(L->G, 3 * r)) { *err = PHGMG_ERR_NANINF; return PHGMG__R(-1); }
   return nrm;
@@ -4803,8 +4933,12 @@ PHGMG__ONLINE phgmg_result phgmg__romstep_factor(phgmg_rom_stepper *s, const phg
   int i, j, a, b;
   phgmg__romw_layout(rom, L->work, &w);
   rc = phgmg__rom_jac(rom, x, L->Jf, &w);
-  if (rc != PHGMG_OK) return rc;
-  if (!phgmg__r_finite(L->Jf, r * r)) return PHGMG_ERR_NANINF;
+  if (rc != PHGMG_OK) { s->have_lu = 0; return rc; }
+  if (!phgmg__r_finite(L->Jf, r * r)) { s->have_lu = 0; return PHGMG_ERR_NANINF; }
+  if (L->Ef) { /* keep the LU of E(x) the Jacobian was built with */
+    for (i = 0; i < r * r; ++i) L->Ef[i] = w.E[i];
+    for (i = 0; i < r; ++i) L->pivf[i] = w.piv[i];
+  }
   for (j = 0; j < 3; ++j)
     for (b = 0; b < r; ++b)
       for (i = 0; i < 3; ++i)
@@ -4859,7 +4993,7 @@ PHGMG_DEF phgmg_result phgmg_rom_step(phgmg_rom_stepper *s, phgmg_real *x, const
                                       phgmg_real *y, phgmg_real energy[2]) {
   const phgmg_rom *rom;
   phgmg__romstep_mem L;
-  int r, m, n3, attempt, i, a;
+  int r, m, n3, attempt, i, a, tried_fresh = 0, exact = 0;
   phgmg_result err = PHGMG_OK;
   if (!s || !x || !s->rom) return PHGMG_ERR_INVALID_ARG;
   rom = s->rom;
@@ -4867,43 +5001,95 @@ PHGMG_DEF phgmg_result phgmg_rom_step(phgmg_rom_stepper *s, phgmg_real *x, const
   if (!phgmg__r_finite(x, r) || (u3 && !phgmg__r_finite(u3, 3 * m))) return PHGMG_ERR_NANINF;
   phgmg__romstep_layout(rom, s->use_map, s->ws, &L);
   if (s->use_map) return phgmg__romstep_map(s, &L, x, u3, y, energy);
+  if (s->exact_hold > 0) { s->exact_hold--; exact = 1; }
 
-  for (attempt = 0; attempt < 2; ++attempt) {
+  /* attempts: (1) the kept factors; (2) fresh factors at x; (3) QUADRATIC only:
+     the same Newton with exact stage values F = phgmg_rom_rhs (a factorisation
+     of E per stage) -- for when E varies too fast for frozen factors. */
+  for (attempt = 0; attempt < 3; ++attempt) {
     phgmg_real res, res_prev = PHGMG__R(0), theta_max = PHGMG__R(0);
-    int it = 0, fresh = 0, ok = 0;
-    if (!s->have_lu || attempt > 0) {
+    int mm = L.Phi != NULL && !exact;
+    int it = 0, ok = 0;
+    if (!s->have_lu || (attempt > 0 && !tried_fresh)) {
       err = phgmg__romstep_factor(s, &L, x);
       if (err != PHGMG_OK) break;
-      fresh = 1;
+      tried_fresh = 1;
+    }
+    else if (mm && s->stale_e) { /* the last step was slow: new factors of E only (r x r) */
+      phgmg__romw w;
+      phgmg__romw_layout(rom, L.work, &w);
+      phgmg__rom_prep(rom, x, &w);
+      phgmg__rom_dgd(rom, &w);
+      for (i = 0; i < r * r; ++i) L.Ef[i] = w.E[i];
+      if (phgmg__r_lu(r, L.Ef, L.pivf) != 0) { s->have_lu = 0; err = PHGMG_ERR_SINGULAR; break; }
+      s->stale_e = 0;
+      s->stats.e_refreshes++;
     }
     /* starting guess: extrapolated collocation polynomial, or zero */
     for (i = 0; i < n3; ++i) L.Z[i] = (s->have_prev && attempt == 0) ? L.Zp[i] : PHGMG__R(0);
-    res = phgmg__romstep_residual(s, &L, x, u3, &err);
+    if (mm) { /* Phi: extrapolated, or E(x)^{-1} g(x) at every stage */
+      if (s->have_prev && attempt == 0) {
+        for (i = 0; i < n3; ++i) L.Phi[i] = L.Php[i];
+      } else {
+        phgmg__romw w;
+        phgmg__romw_layout(rom, L.work, &w);
+        err = phgmg__rom_rhs(rom, x, NULL, L.Phi, &w);
+        if (err != PHGMG_OK) break;
+        for (a = 0; a < r; ++a) L.Phi[r + a] = L.Phi[2 * r + a] = L.Phi[a];
+      }
+    }
+    res = phgmg__romstep_residual(s, &L, x, u3, mm, &err);
     if (res < PHGMG__R(0)) {
-      if (err == PHGMG_ERR_NANINF && !fresh) continue; /* bad guess/factors: retry fresh */
+      if (err == PHGMG_ERR_NANINF && !tried_fresh) continue; /* bad guess/factors: retry fresh */
+      if (err == PHGMG_ERR_NANINF && mm) { exact = 1; continue; }
       break;
     }
     while (res > s->tol && it < s->max_iter) {
       for (i = 0; i < n3; ++i) L.dZ[i] = -L.Res[i];
       phgmg__r_lu_solve(n3, L.LU, L.piv, L.dZ);
       for (i = 0; i < n3; ++i) L.Z[i] += L.dZ[i];
+      if (mm) /* dPhi_i = Jf dZ_i - Del_i */
+        for (i = 0; i < 3; ++i) {
+          phgmg__r_gemv(r, r, L.Jf, L.dZ + i * r, 1, L.Phi + i * r);
+          for (a = 0; a < r; ++a) L.Phi[i * r + a] -= L.Del[i * r + a];
+        }
       ++it;
       s->stats.newton_iters++;
       res_prev = res;
-      res = phgmg__romstep_residual(s, &L, x, u3, &err);
+      res = phgmg__romstep_residual(s, &L, x, u3, mm, &err);
       if (res < PHGMG__R(0)) break;
+      if (mm && res > s->tol && res > PHGMG__R(0.25) * res_prev) {
+        /* slow: the frozen E is too far from E(Y_i) here. Exact stage values
+           from this iterate on, and for the next steps. */
+        mm = 0; exact = 1; s->exact_hold = 16;
+        res = phgmg__romstep_residual(s, &L, x, u3, 0, &err);
+        if (res < PHGMG__R(0)) break;
+        continue;
+      }
       if (res_prev > PHGMG__R(0) && res / res_prev > theta_max) theta_max = res / res_prev;
     }
     if (res >= PHGMG__R(0) && res <= s->tol) ok = 1;
     if (!ok) {
       if (res >= PHGMG__R(0)) err = PHGMG_ERR_NOT_CONVERGED;
-      s->have_lu = 0;
-      if (fresh) break;   /* fresh factors did not help: give up */
-      continue;           /* stale factors: retry once with fresh ones */
+      if (!tried_fresh) continue;      /* stale factors: retry with fresh ones */
+      if (mm) { exact = 1; continue; } /* frozen E too far off: exact stages */
+      break;
     }
     /* converged: energy, new state, extrapolation data */
     {
       phgmg_real *xn = L.dZ;
+      if (mm) { /* the last correction: Phi_i - Del_i ~ E(Y_i)^{-1} g(Y_i) */
+        for (i = 0; i < n3; ++i) { L.Phi[i] -= L.Del[i]; L.F[i] -= L.Del[i]; }
+      } else if (L.Phi) { /* exact stages: Phi = F - Bh u, for the extrapolation */
+        int k;
+        s->stats.exact_steps++;
+        for (i = 0; i < n3; ++i) L.Phi[i] = L.F[i];
+        if (u3)
+          for (i = 0; i < 3; ++i)
+            for (k = 0; k < m; ++k)
+              for (a = 0; a < r; ++a) L.Phi[i * r + a] -= rom->Bh[a + (size_t)k * r] * u3[i * m + k];
+        s->stale_e = 1;
+      }
       for (a = 0; a < r; ++a) {
         phgmg_real v = x[a];
         for (i = 0; i < 3; ++i) v += s->dt * L.b[i] * L.F[i * r + a];
@@ -4934,10 +5120,14 @@ PHGMG_DEF phgmg_result phgmg_rom_step(phgmg_rom_stepper *s, phgmg_real *x, const
           int j;
           for (j = 0; j < 3; ++j) v += L.lag[i * 4 + 1 + j] * (x[a] + L.Z[j * r + a]);
           L.Zp[i * r + a] = v - xn[a];
+          if (L.Phi)
+            L.Php[i * r + a] = L.lagq[i * 3] * L.Phi[a] + L.lagq[i * 3 + 1] * L.Phi[r + a] +
+                               L.lagq[i * 3 + 2] * L.Phi[2 * r + a];
         }
       for (a = 0; a < r; ++a) x[a] = xn[a];
       s->have_prev = 1;
       if (theta_max > PHGMG__R(0.5)) s->have_lu = 0; /* slow contraction: refactor next step */
+      s->stale_e = it > 1;                           /* more than one iteration: fresh E next step */
       s->stats.steps++;
       if (y) phgmg_rom_output(rom, x, y, L.work);
       return PHGMG_OK;
@@ -4945,6 +5135,7 @@ PHGMG_DEF phgmg_result phgmg_rom_step(phgmg_rom_stepper *s, phgmg_real *x, const
   }
   s->stats.failures++;
   s->have_prev = 0;
+  s->have_lu = 0;
   return err == PHGMG_OK ? PHGMG_ERR_NOT_CONVERGED : err;
 }
 

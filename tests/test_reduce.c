@@ -157,6 +157,174 @@ done:
   free(W); free(D); free(xf); free(g); free(f); free(JW);
 }
 
+/* The analytic derivatives of the online model against central differences
+   at states along the trajectory: the Newton Jacobian d f/dx against
+   differences of phgmg_rom_rhs, the reduced Hessian against differences of
+   phgmg_rom_gradient. The Hessian must also be symmetric to 1e-10 (it is not
+   symmetrised anywhere): with DEIM this says the structure-preserving weights
+   make the reduced gradient an exact gradient. Difference step h = 1e-5 (1 + |x|):
+   truncation ~h^2 and cancellation ~eps/h, both far below the 1e-6 bound. */
+static void check_derivatives(const phgmg_ph_system *sys, const double *X, int ns, phgmg_method meth, int r,
+                              int deim) {
+  const int N = sys->N;
+  phgmg_reduce_opts o;
+  phgmg_reduced *red = NULL;
+  const phgmg_rom *rom;
+  double xr[32], xp[32], f1[32], f2[32], Jf[1024], Hs[1024], work[8192];
+  int s, a, b;
+  memset(&o, 0, sizeof o);
+  o.method = meth; o.r = r; o.rn = 8; o.lambda = 1e-3; o.deim = deim; o.deim_allow_negative = 1;
+  CHECK_RC(phgmg_reduce(&red, sys, X, N, ns, &o, NULL, NULL), PHGMG_OK);
+  if (!red) return;
+  rom = phgmg_reduced_rom(red);
+  CHECK(deim == 0 || rom->nd > 0);
+  for (s = 0; s < 4; ++s) {
+    double ej = 0, sj = 0, eh = 0, sh = 0, asym = 0;
+    phgmg_reduced_restrict(red, X + (size_t)(ns - 1) * (s + 1) / 4 * N, xr);
+    CHECK_RC(phgmg_rom_jacobian(rom, xr, Jf, work), PHGMG_OK);
+    phgmg_rom_hessian(rom, xr, Hs, work);
+    for (b = 0; b < r; ++b) {
+      const double h = 1e-5 * (1.0 + fabs(xr[b]));
+      double g1[32], g2[32];
+      memcpy(xp, xr, sizeof(double) * r);
+      xp[b] = xr[b] + h;
+      CHECK_RC(phgmg_rom_rhs(rom, xp, NULL, f1, work), PHGMG_OK);
+      phgmg_rom_gradient(rom, xp, g1, work);
+      xp[b] = xr[b] - h;
+      CHECK_RC(phgmg_rom_rhs(rom, xp, NULL, f2, work), PHGMG_OK);
+      phgmg_rom_gradient(rom, xp, g2, work);
+      for (a = 0; a < r; ++a) {
+        const double fd = (f1[a] - f2[a]) / (2 * h), gd = (g1[a] - g2[a]) / (2 * h);
+        ej = PHGMG__MAX(ej, fabs(fd - Jf[a + b * r])); sj = PHGMG__MAX(sj, fabs(fd));
+        eh = PHGMG__MAX(eh, fabs(gd - Hs[a + b * r])); sh = PHGMG__MAX(sh, fabs(gd));
+        asym = PHGMG__MAX(asym, fabs(Hs[a + b * r] - Hs[b + a * r]));
+      }
+    }
+    CHECK(sj > 0 && sh > 0);
+    CHECK_LE(ej, 1e-6 * sj);
+    CHECK_LE(eh, 1e-6 * sh);
+    CHECK_LE(asym, 1e-10 * sh);
+  }
+  phgmg_reduced_destroy(red);
+}
+
+TEST(test_derivatives_every_rom) {
+  tmodel t;
+  double *X;
+  const int rl[3] = {4, 12, 20}, rnl[2] = {6, 16};
+  int k;
+  linear_msd(&t, 50, 2, 1, 1);
+  X = snapshots(&t.sys, 400, 1e-10, 10);
+  CHECK(X != NULL);
+  for (k = 0; k < 3 && X; ++k) {
+    check_derivatives(&t.sys, X, 401, PHGMG_METHOD_GMG_POD, rl[k], 0);
+    check_derivatives(&t.sys, X, 401, PHGMG_METHOD_GMG_QM, rl[k], 0);
+    check_derivatives(&t.sys, X, 401, PHGMG_METHOD_SP1, rl[k], 0);
+  }
+  free(X);
+  tmodel_free(&t);
+  nonlinear_msd(&t, 60, 0.3);
+  X = snapshots(&t.sys, 400, 1e-8, 20);
+  CHECK(X != NULL);
+  for (k = 0; k < 2 && X; ++k) {
+    int deim;
+    for (deim = 0; deim < 2; ++deim) {
+      check_derivatives(&t.sys, X, 401, PHGMG_METHOD_GMG_POD, rnl[k], deim);
+      check_derivatives(&t.sys, X, 401, PHGMG_METHOD_GMG_QM, rnl[k], deim);
+      check_derivatives(&t.sys, X, 401, PHGMG_METHOD_SP2, rnl[k], deim);
+    }
+  }
+  free(X);
+  tmodel_free(&t);
+}
+
+/* The online stepper of a GMG-QM model (mass-matrix Newton with frozen
+   factors) against an independent GL3: full Newton on the stage equations
+   Z - dt (A kron I) F(x + Z) = 0 with F = phgmg_rom_rhs (exact solves with
+   D^T G D) and the Jacobian refreshed at every stage and iteration, to 1e-14.
+   Both solve the same collocation equations, so after 200 steps the states
+   agree to the Newton tolerances (1e-12 for the stepper). */
+static void gl3_reference(const phgmg_rom *rom, double *x, double t, double dt, double *work) {
+  const int r = rom->r, n3 = 3 * rom->r;
+  double c[3], b[3], A[9], Z[96], F[96], Y[32], Jf[3 * 1024], M[96 * 96], Res[96], u;
+  int piv[96], it, i, j, a, k;
+  phgmg_gl3_coefficients(c, b, A);
+  memset(Z, 0, sizeof Z);
+  for (it = 0; it < 30; ++it) {
+    double nrm = 0;
+    for (i = 0; i < 3; ++i) {
+      for (a = 0; a < r; ++a) Y[a] = x[a] + Z[i * r + a];
+      u = 0.1 * sin(t + c[i] * dt);
+      CHECK_RC(phgmg_rom_rhs(rom, Y, &u, F + i * r, work), PHGMG_OK);
+      CHECK_RC(phgmg_rom_jacobian(rom, Y, Jf + i * r * r, work), PHGMG_OK);
+    }
+    for (i = 0; i < 3; ++i)
+      for (a = 0; a < r; ++a) {
+        double v = Z[i * r + a];
+        for (j = 0; j < 3; ++j) v -= dt * A[i * 3 + j] * F[j * r + a];
+        Res[i * r + a] = -v;
+        nrm = PHGMG__MAX(nrm, fabs(v));
+      }
+    if (nrm <= 1e-14) break;
+    for (j = 0; j < 3; ++j) /* block (i, j) = delta_ij I - dt A_ij Jf(Y_j) */
+      for (k = 0; k < r; ++k)
+        for (i = 0; i < 3; ++i)
+          for (a = 0; a < r; ++a)
+            M[(i * r + a) + (size_t)(j * r + k) * n3] =
+                (i == j && a == k ? 1.0 : 0.0) - dt * A[i * 3 + j] * Jf[j * r * r + a + k * r];
+    CHECK_RC(phgmg_lu_factor(n3, M, n3, piv), PHGMG_OK);
+    phgmg_lu_solve('N', n3, M, n3, piv, 1, Res, n3);
+    for (i = 0; i < n3; ++i) Z[i] += Res[i];
+  }
+  CHECK(it < 30);
+  for (i = 0; i < 3; ++i)
+    for (a = 0; a < r; ++a) x[a] += dt * b[i] * F[i * r + a];
+}
+
+TEST(test_qm_stepper_matches_reference_gl3) {
+  tmodel t;
+  double *X;
+  int pass;
+  nonlinear_msd(&t, 40, 0.3);
+  X = snapshots(&t.sys, 300, 1e-10, 20);
+  CHECK(X != NULL);
+  for (pass = 0; pass < 2 && X; ++pass) {
+    phgmg_reduce_opts o;
+    phgmg_reduced *red = NULL;
+    const phgmg_rom *rom;
+    static double mem[1 << 16];
+    double work[8192], x[32], xref[32], dmax = 0, xmax = 0;
+    phgmg_rom_stepper st;
+    int n, a;
+    memset(&o, 0, sizeof o);
+    o.method = PHGMG_METHOD_GMG_QM; o.r = pass ? 16 : 8; o.rn = 8; o.lambda = 1e-6; o.deim = pass;
+    o.deim_allow_negative = 1;
+    CHECK_RC(phgmg_reduce(&red, &t.sys, X, t.sys.N, 301, &o, NULL, NULL), PHGMG_OK);
+    if (!red) continue;
+    rom = phgmg_reduced_rom(red);
+    phgmg_reduced_restrict(red, X + (size_t)40 * t.sys.N, x);
+    memcpy(xref, x, sizeof(double) * rom->r);
+    CHECK_RC(phgmg_rom_stepper_init(&st, rom, 0.1, 1e-12, 20, mem, sizeof mem), PHGMG_OK);
+    for (n = 0; n < 200; ++n) {
+      double u3[3], tc[3];
+      phgmg_rom_stage_times(4.0 + n * 0.1, 0.1, tc);
+      for (a = 0; a < 3; ++a) u3[a] = 0.1 * sin(tc[a]);
+      if (phgmg_rom_step(&st, x, u3, NULL, NULL) != PHGMG_OK) break;
+      gl3_reference(rom, xref, 4.0 + n * 0.1, 0.1, work);
+    }
+    CHECK(n == 200);
+    for (a = 0; a < rom->r; ++a) {
+      dmax = PHGMG__MAX(dmax, fabs(x[a] - xref[a]));
+      xmax = PHGMG__MAX(xmax, fabs(xref[a]));
+    }
+    CHECK(xmax > 1e-3);
+    CHECK_LE(dmax, 1e-9 * xmax);
+    phgmg_reduced_destroy(red);
+  }
+  free(X);
+  tmodel_free(&t);
+}
+
 TEST(test_structure_linear) {
   tmodel t;
   double *X;
@@ -268,6 +436,8 @@ TEST(test_online_never_allocates) {
 SUITE(reduce) {
   RUN(test_structure_linear);
   RUN(test_structure_nonlinear);
+  RUN(test_derivatives_every_rom);
+  RUN(test_qm_stepper_matches_reference_gl3);
   RUN(test_energy_balance_gmgpod);
   RUN(test_online_never_allocates);
 }
