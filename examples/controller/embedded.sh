@@ -24,6 +24,23 @@ for t in f d; do
     printf '%-7s %-11s ' "$ty" "$m"; arm-none-eabi-size "$elf" | tail -n 1 | awk '{ printf "text %7d  data %5d  bss %6d\n", $1, $2, $3 }'
   done
 done
+echo "Online code alone (PHGMG_STATIC, -ffunction-sections -fdata-sections -Wl,--gc-sections):"
+echo "bytes of the phgmg_* functions and ctrl_run (init + step + output loop) in the linked image"
+for t in f d; do
+  if [ $t = f ]; then fl="-DPHGMG_REAL_FLOAT"; ty=float; else fl=""; ty=double; fi
+  for m in $MODELS; do
+    elf="$B/cm4/code_${m}_$t.elf"
+    arm-none-eabi-gcc $ARMF -std=c99 -Wall -Wextra -Werror $fl -DPHGMG_NO_OFFLINE -DPHGMG_STATIC \
+      -ffunction-sections -fdata-sections -Wl,--gc-sections \
+      -DMODEL_HEADER="\"$m.h\"" -DMODEL_NAME=$m -I"$B/emb_$t" --specs=rdimon.specs \
+      -T examples/controller/mps2_an386.ld examples/controller/controller.c \
+      examples/controller/cm4_startup.c -lm -o "$elf"
+    arm-none-eabi-nm -S -t d "$elf" | awk -v ty="$ty" -v m="$m" '
+      ($3 == "t" || $3 == "T") && $4 ~ /^(phgmg|ctrl_run)/ { code += $2 }
+      ($3 == "r" || $3 == "R") && $4 ~ /^ph_/ { data += $2 }
+      END { printf "%-7s %-11s online code %6d bytes (%.1f KiB)\n", ty, m, code, code / 1024 }'
+  done
+done
 if command -v qemu-system-arm >/dev/null; then
   echo "Running under qemu-system-arm -M mps2-an386 (semihosting), compared with the host reference:"
   for t in f d; do
