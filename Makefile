@@ -114,6 +114,7 @@ demo: $(EXAMPLES)
 	@mkdir -p results
 	@start=$$(date +%s.%N); \
 	./$(BUILD)/msd_linear --out results && ./$(BUILD)/msd_nonlinear --out results && \
+	./$(BUILD)/msd_linear --lambda auto --rmin 6 --out results && \
 	end=$$(date +%s.%N) && awk -v a=$$start -v b=$$end 'BEGIN { printf "make demo: total wall time %.2f s\n", b - a }' && \
 	/usr/bin/python3 tests/check_claims.py results
 

@@ -73,7 +73,8 @@
             PHGMG_ROM_STEPPER_MEMSIZE_MAX, phgmg_rom_stepper_init, phgmg_rom_stepper_reset,
             phgmg_rom_stage_times, phgmg_rom_step
    reduce:  phgmg_pod, phgmg_adjust_snapshots, phgmg_pod_hierarchical, phgmg_deim,
-            phgmg_reduce, phgmg_reduced_destroy, phgmg_reduced_rom, phgmg_reduced_N,
+            phgmg_reduce (GMG-QM ridge lambda fixed or chosen by validation on
+            held-out blocks of snapshots: opts.lambda_auto), phgmg_reduced_destroy, phgmg_reduced_rom, phgmg_reduced_N,
             phgmg_reduced_lift (phi), phgmg_reduced_restrict (rho), phgmg_reduced_dphi,
             phgmg_reduced_W, phgmg_reduced_simulate
    errors:  phgmg_rel_error, phgmg_err_red, phgmg_err_proj, phgmg_err_lowerbound,
@@ -657,7 +658,8 @@ typedef struct phgmg_reduce_opts {
   int r;               /* reduced order (GMG: includes the m port coordinates), required */
   int rn;              /* GMG-QM lifting dimension r_n (0: 8)                        */
   double lambda;       /* GMG-QM ridge parameter, applied to the un-normalised sum
-                          over snapshots (0: 1e-3; < 0: exactly zero)                 */
+                          over snapshots (0: 1e-3; < 0: exactly zero; ignored with
+                          lambda_auto, below)                                         */
   int deim;            /* separable nonlinear part: 1 = structure-preserving DEIM,
                           0 = keep every term (exact, but O(n_terms) online)          */
   double deim_tol;     /* DEIM modes: sigma_k / sigma_1 > deim_tol (0: 1e-8)          */
@@ -682,6 +684,31 @@ typedef struct phgmg_reduce_opts {
   const int *deim_pts;
   const double *deim_w;
   int deim_count;
+  /* GMG-QM automatic lambda (all zero = off: the paper's fixed lambda above).
+     lambda_auto = 1: the snapshots are cut into lambda_blocks contiguous
+     blocks in time, block j going to validation fold j mod lambda_folds. For
+     each fold, M is fitted on the other snapshots for every lambda of the grid
+     lambda_min * 10^(g / lambda_per_decade) <= lambda_max (one thin SVD of
+     the training rows, then a small product per lambda) and predicts the
+     quadratic correction V2^T x of the held-out snapshots. The lambda with
+     the smallest held-out error summed over the folds (ties within a relative
+     1e-6: the largest) fits M on all snapshots. Guard: while rcond(D^T G D)
+     at some snapshot is below lambda_rcond times its value at x = 0 (or below
+     degeneracy_tol), the next larger grid lambda is used (info.lambda_raised).
+     Cost: lambda_folds SVDs of (ns - ns/folds) x p(p+1)/2 matrices, about
+     50 ms at r - m = 18, ns = 1001. Errors: PHGMG_ERR_INVALID_ARG for
+     lambda_auto not 0/1, bounds negative, NaN, Inf or lambda_min > lambda_max,
+     lambda_per_decade outside 1..100, lambda_folds < 2, lambda_blocks < 0,
+     lambda_rcond outside [0, 1], a grid of more than 1000 points;
+     PHGMG_ERR_SIZE for lambda_blocks < lambda_folds or > ns. Off: ignored. */
+  int lambda_auto;
+  double lambda_min;     /* smallest grid lambda, > 0 (0: 1e-14)                 */
+  double lambda_max;     /* largest grid lambda (0: 1)                           */
+  int lambda_per_decade; /* grid points per decade, 1..100 (0: 4)                */
+  int lambda_folds;      /* validation folds, >= 2 (0: 5)                        */
+  int lambda_blocks;     /* contiguous blocks, lambda_folds..ns (0: min(ns, 100)) */
+  double lambda_rcond;   /* conditioning guard, relative to rcond(D^T G D) at x = 0,
+                            in [0, 1] (0: 1e-6)                                  */
 } phgmg_reduce_opts;
 
 typedef struct phgmg_reduce_info {
@@ -691,6 +718,14 @@ typedef struct phgmg_reduce_info {
   double rcond_dgd;        /* smallest rcond of D^T G D seen (at x = 0 and the snapshots) */
   double rcond_jr;         /* rcond of J - R                                  */
   double pod_sigma_ratio;  /* sigma_{r'+1}/sigma_1 of the (adjusted) snapshots */
+  double lambda;           /* GMG-QM: the ridge lambda used (fixed or chosen)  */
+  double lambda_cv_err;    /* lambda_auto: held-out relative error of the quadratic
+                              correction at that lambda, sum ||V2^T x - M(z kron z)||^2
+                              / sum ||V2^T x||^2 over the blocks (1 = no better than
+                              M = 0); 0 without lambda_auto                      */
+  int lambda_grid;         /* lambda_auto: grid points tried (0 without)       */
+  int lambda_raised;       /* lambda_auto: grid steps above the validated optimum
+                              taken because of the non-degeneracy check         */
 } phgmg_reduce_info;
 
 /* The reduced model with its offline data (bases for reconstruction, double
@@ -5530,6 +5565,151 @@ PHGMG__PRIV phgmg_result phgmg__publish(phgmg_reduced *red) {
   return rc;
 }
 
+/* GMG-QM ridge validation (phgmg_reduce_opts.lambda_auto). The rows of K
+   (ns x nc, the distinct Kronecker columns of the reduced snapshots) and Y
+   (ns x rn, their V2 coordinates) are cut into nblk contiguous blocks (in
+   time), block j going to fold j mod nfold. For each fold, one thin SVD
+   K_tr = U S V^T of the other rows (through a QR when there are at least nc
+   of them: K_tr = Q R, R = Ur S V^T, U^T Y_tr = Ur^T Q^T Y_tr) gives the
+   ridge solution t(lam) = V diag(s / (s^2 + lam)) U^T Y_tr for every lam of
+   the grid;
+   err[g] = sum over folds ||Y_ho - K_ho t(grid[g])||_F^2 / ||Y||_F^2
+   (1: no better than t = 0). Blocks, not single rows: on a fine time grid a
+   snapshot is nearly a copy of its neighbours. */
+PHGMG__PRIV phgmg_result phgmg__ridge_cv(int ns, int nc, int rn, const double *K, int ldk, const double *Y,
+                                         int ldy, int ngrid, const double *grid, int nfold, int nblk,
+                                         double *err, const phgmg_allocator *alloc) {
+  double *buf, *Kt, *Yt, *Kh, *Yh, *U, *S, *V, *C, *Wd, *P, *Pr, *Rm, *tau, den = 0.0;
+  const int gb = PHGMG__MIN(ngrid, 32);
+  int *fold, f, g, g0, i, j, a, k, nho_max = 0, ntr_max = 0, kk;
+  phgmg_result rc = PHGMG_OK;
+  fold = phgmg__ialloc(alloc, (size_t)ns);
+  if (!fold) return PHGMG_ERR_NOMEM;
+  for (i = 0; i < ns; ++i) fold[i] = (int)(((long)i * nblk / ns) % nfold);
+  for (f = 0; f < nfold; ++f) {
+    int c = 0;
+    for (i = 0; i < ns; ++i) c += fold[i] == f;
+    nho_max = PHGMG__MAX(nho_max, c);
+    ntr_max = PHGMG__MAX(ntr_max, ns - c);
+  }
+  kk = PHGMG__MIN(ntr_max, nc);
+  buf = phgmg__dalloc(alloc, (size_t)ntr_max * (nc + rn + kk) + (size_t)kk * (1 + nc + rn + (size_t)rn * gb) +
+                                 (size_t)nho_max * (nc + rn + kk + (size_t)rn * gb) + (size_t)nc * (nc + 1));
+  if (!buf) { phgmg__free(alloc, fold); return PHGMG_ERR_NOMEM; }
+  Kt = buf; Yt = Kt + (size_t)ntr_max * nc; U = Yt + (size_t)ntr_max * rn; S = U + (size_t)ntr_max * kk;
+  V = S + kk; C = V + (size_t)nc * kk; Wd = C + (size_t)kk * rn; Kh = Wd + (size_t)kk * rn * gb;
+  Yh = Kh + (size_t)nho_max * nc; P = Yh + (size_t)nho_max * rn; Pr = P + (size_t)nho_max * kk;
+  Rm = Pr + (size_t)nho_max * rn * gb; tau = Rm + (size_t)nc * nc;
+  for (g = 0; g < ngrid; ++g) err[g] = 0.0;
+  for (a = 0; a < rn; ++a)
+    for (i = 0; i < ns; ++i) den += Y[i + (size_t)a * ldy] * Y[i + (size_t)a * ldy];
+  for (f = 0; f < nfold; ++f) {
+    int ntr = 0, nho = 0;
+    for (i = 0; i < ns; ++i) nho += fold[i] == f;
+    ntr = ns - nho;
+    if (nho == 0) continue;
+    for (j = 0; j < nc + rn; ++j) {
+      const double *src = j < nc ? K + (size_t)j * ldk : Y + (size_t)(j - nc) * ldy;
+      double *dt = j < nc ? Kt + (size_t)j * ntr : Yt + (size_t)(j - nc) * ntr;
+      double *dh = j < nc ? Kh + (size_t)j * nho : Yh + (size_t)(j - nc) * nho;
+      int it = 0, ih = 0;
+      for (i = 0; i < ns; ++i) {
+        if (fold[i] == f) dh[ih++] = src[i];
+        else dt[it++] = src[i];
+      }
+    }
+    k = 0;
+    if (ntr >= nc) {
+      rc = phgmg_qr(ntr, nc, Kt, ntr, tau);
+      if (rc != PHGMG_OK) break;
+      phgmg_qr_apply('T', ntr, rn, nc, Kt, ntr, tau, Yt, ntr);           /* Q^T Y_tr */
+      for (j = 0; j < nc; ++j)
+        for (i = 0; i < nc; ++i) Rm[i + (size_t)j * nc] = i <= j ? Kt[i + (size_t)j * ntr] : 0.0;
+      rc = phgmg_svd(nc, nc, Rm, nc, nc, S, U, nc, V, nc, &k, NULL, alloc);
+      if (rc != PHGMG_OK) break;
+      if (k > 0) phgmg_gemm('T', 'N', k, rn, nc, 1.0, U, nc, Yt, ntr, 0.0, C, k);   /* U^T Y_tr */
+    } else if (ntr > 0) {
+      rc = phgmg_svd(ntr, nc, Kt, ntr, ntr, S, U, ntr, V, nc, &k, NULL, alloc);
+      if (rc != PHGMG_OK) break;
+      if (k > 0) phgmg_gemm('T', 'N', k, rn, ntr, 1.0, U, ntr, Yt, ntr, 0.0, C, k);
+    }
+    if (k > 0) {
+      phgmg_gemm('N', 'N', nho, k, nc, 1.0, Kh, nho, V, nc, 0.0, P, nho);  /* K_ho V   */
+    }
+    for (g0 = 0; g0 < ngrid; g0 += gb) {   /* gb grid points per product */
+      const int ng1 = PHGMG__MIN(gb, ngrid - g0);
+      if (k > 0) {
+        for (g = 0; g < ng1; ++g)
+          for (j = 0; j < k; ++j) {
+            const double w = S[j] / (S[j] * S[j] + grid[g0 + g]);
+            for (a = 0; a < rn; ++a) Wd[j + (size_t)(g * rn + a) * k] = w * C[j + (size_t)a * k];
+          }
+        phgmg_gemm('N', 'N', nho, rn * ng1, k, 1.0, P, nho, Wd, k, 0.0, Pr, nho);
+      } else {
+        for (i = 0; i < nho * rn * ng1; ++i) Pr[i] = 0.0;
+      }
+      for (g = 0; g < ng1; ++g) {
+        const double *pg = Pr + (size_t)g * rn * nho;
+        double sum = 0.0;
+        for (i = 0; i < nho * rn; ++i) {
+          const double d = Yh[i] - pg[i];
+          sum += d * d;
+        }
+        err[g0 + g] += sum;
+      }
+    }
+  }
+  phgmg__free(alloc, buf);
+  phgmg__free(alloc, fold);
+  if (rc != PHGMG_OK) return rc;
+  for (g = 0; g < ngrid; ++g) {
+    err[g] = den > 0.0 ? err[g] / den : 0.0;
+    if (!(err[g] <= HUGE_VAL)) return PHGMG_ERR_NANINF;
+  }
+  return PHGMG_OK;
+}
+
+/* Grid of the automatic lambda: lo * 10^(g / pd), g = 0.. while <= hi (with
+   a relative slack of 1e-9 so that hi itself is reached). grid may be NULL
+   (count only). Returns the number of points, -1 for bad bounds. */
+PHGMG__PRIV int phgmg__lambda_grid(double lo, double hi, int pd, double *grid) {
+  int n, g;
+  double span;
+  if (!(lo > 0.0) || !(hi >= lo) || hi == HUGE_VAL || pd < 1 || pd > 100) return -1;
+  span = log10(hi / lo) * pd;
+  if (!(span < 1000.0)) return -1;
+  n = (int)floor(span + 1e-9) + 1;
+  if (grid)
+    for (g = 0; g < n; ++g) grid[g] = lo * pow(10.0, (double)g / pd);
+  return n;
+}
+
+/* M (and Ms = 2 M) of the quadratic manifold from the ridge problem over the
+   p(p+1)/2 distinct Kronecker columns Kt (ns x nc) with right-hand sides Rqt
+   (ns x rn); Mt (nc x rn) is scratch. red->M/Ms are allocated on first use. */
+PHGMG__PRIV phgmg_result phgmg__qm_fit(phgmg_reduced *red, int ns, const double *Kt, const double *Rqt,
+                                       double lambda, double *Mt, const phgmg_allocator *alloc) {
+  const int p = red->p, rn = red->rn, nc = p * (p + 1) / 2;
+  const double s2 = sqrt(2.0);
+  int a, j, i, c;
+  phgmg_result rc = phgmg_lstsq(ns, nc, rn, Kt, ns, Rqt, ns, lambda, Mt, nc, alloc);
+  if (rc != PHGMG_OK) return rc;
+  if (!red->M) red->M = phgmg__red_d(red, (size_t)rn * p * p);
+  if (!red->Ms) red->Ms = phgmg__red_d(red, (size_t)rn * p * p);
+  if (!red->M || !red->Ms) return PHGMG_ERR_NOMEM;
+  for (a = 0, c = 0; a < p; ++a)
+    for (j = a; j < p; ++j, ++c)
+      for (i = 0; i < rn; ++i) {
+        const double t = Mt[c + (size_t)i * nc];
+        const double v = a == j ? t : t / s2;
+        red->M[i + (size_t)(a * p + j) * rn] = v;
+        red->M[i + (size_t)(j * p + a) * rn] = v;
+        red->Ms[i + (size_t)(a * p + j) * rn] = 2.0 * v;
+        red->Ms[i + (size_t)(j * p + a) * rn] = 2.0 * v;
+      }
+  return PHGMG_OK;
+}
+
 PHGMG_DEF phgmg_result phgmg_reduce(phgmg_reduced **out, const phgmg_ph_system *sys, const double *X,
                                     int ldx, int ns, const phgmg_reduce_opts *opts,
                                     phgmg_reduce_info *info, const phgmg_allocator *alloc) {
@@ -5538,8 +5718,10 @@ PHGMG_DEF phgmg_result phgmg_reduce(phgmg_reduced **out, const phgmg_ph_system *
   phgmg_reduce_info inf;
   phgmg_result rc;
   double *T1 = NULL, *T2 = NULL, *T3 = NULL; /* temporaries */
+  double *Tq = NULL;   /* GMG-QM ridge problem: Kt, Rqt, Mt (kept for a refit) */
+  double *lg = NULL;   /* automatic lambda: grid and validation errors        */
   int *pts = NULL;
-  int N, m, r, p, rn = 0, k = 0, i, j, a;
+  int N, m, r, p, rn = 0, k = 0, i, j, a, ng = 0, gsel = -1;
   double lambda, degtol, rfloor;
   if (!out || !sys || !X || !opts) return PHGMG_ERR_INVALID_ARG;
   *out = NULL;
@@ -5558,6 +5740,17 @@ PHGMG_DEF phgmg_result phgmg_reduce(phgmg_reduced **out, const phgmg_ph_system *
   rc = phgmg_ph_validate(sys, 0.0, &inf.rcond_jr, alloc);
   if (rc != PHGMG_OK) return rc;
   lambda = opts->lambda == 0.0 ? 1e-3 : (opts->lambda < 0.0 ? 0.0 : opts->lambda);
+  if (opts->lambda_auto) {
+    const double lo = opts->lambda_min == 0.0 ? 1e-14 : opts->lambda_min;
+    const double hi = opts->lambda_max == 0.0 ? 1.0 : opts->lambda_max;
+    const int nf = opts->lambda_folds == 0 ? 5 : opts->lambda_folds;
+    const int nb = opts->lambda_blocks == 0 ? PHGMG__MIN(ns, 100) : opts->lambda_blocks;
+    if (opts->lambda_auto != 1 || opts->lambda_per_decade < 0 || nf < 2 || nb < 0) return PHGMG_ERR_INVALID_ARG;
+    if (!(opts->lambda_rcond >= 0.0 && opts->lambda_rcond <= 1.0)) return PHGMG_ERR_INVALID_ARG;
+    ng = phgmg__lambda_grid(lo, hi, opts->lambda_per_decade == 0 ? 4 : opts->lambda_per_decade, NULL);
+    if (ng < 1) return PHGMG_ERR_INVALID_ARG;
+    if (nb < nf || nb > ns) return PHGMG_ERR_SIZE;
+  }
   degtol = opts->degeneracy_tol > 0.0 ? opts->degeneracy_tol : 1e-12;
   rfloor = phgmg__rank_floor(N, ns, X, ldx);
 
@@ -5605,7 +5798,6 @@ PHGMG_DEF phgmg_result phgmg_reduce(phgmg_reduced **out, const phgmg_ph_system *
     }
     if (red->kind == PHGMG_ROM_QUADRATIC) {
       double *Z2, *Rq, *Kt, *Rqt, *Mt;
-      const int pp = p * p;
       /* residual of the linear part, then V2 = POD of it */
       phgmg__orth_remove(N, p, red->V0 + (size_t)N * m, ns, T1, N, T2);
       red->V2 = phgmg__red_d(red, (size_t)N * rn); PHGMG__NEED(red->V2);
@@ -5620,14 +5812,16 @@ PHGMG_DEF phgmg_result phgmg_reduce(phgmg_reduced **out, const phgmg_ph_system *
          x2 kron x2 are equal, so the (unique) ridge solution has
          M(:,(a,j)) = M(:,(j,a)); we solve the equivalent problem over the
          p(p+1)/2 distinct columns (off-diagonal ones scaled by sqrt 2, unknown
-         t = sqrt 2 M(:,(a,j))) and expand. Same minimiser, 4x fewer flops. */
+         t = sqrt 2 M(:,(a,j))) and expand. Same minimiser, 4x fewer flops.
+         opts.lambda_auto: lambda from the grid by validation on contiguous
+         blocks of snapshots (phgmg__ridge_cv), then the same fit on all. */
       {
         const int nc = p * (p + 1) / 2;
         const double s2 = sqrt(2.0);
         int c;
-        T3 = phgmg__dalloc(alloc, (size_t)p * ns + (size_t)rn * ns + (size_t)ns * nc + (size_t)ns * rn + (size_t)nc * rn);
-        PHGMG__NEED(T3);
-        Z2 = T3; Rq = Z2 + (size_t)p * ns; Kt = Rq + (size_t)rn * ns; Rqt = Kt + (size_t)ns * nc; Mt = Rqt + (size_t)ns * rn;
+        T3 = phgmg__dalloc(alloc, (size_t)p * ns + (size_t)rn * ns); PHGMG__NEED(T3);
+        Tq = phgmg__dalloc(alloc, (size_t)ns * nc + (size_t)ns * rn + (size_t)nc * rn); PHGMG__NEED(Tq);
+        Z2 = T3; Rq = Z2 + (size_t)p * ns; Kt = Tq; Rqt = Kt + (size_t)ns * nc; Mt = Rqt + (size_t)ns * rn;
         phgmg_gemm('T', 'N', p, ns, N, 1.0, red->V0 + (size_t)N * m, N, X, ldx, 0.0, Z2, p);
         phgmg_gemm('T', 'N', rn, ns, N, 1.0, red->V2, N, T1, N, 0.0, Rq, rn);
         for (i = 0; i < ns; ++i) {
@@ -5636,19 +5830,27 @@ PHGMG_DEF phgmg_result phgmg_reduce(phgmg_reduced **out, const phgmg_ph_system *
               Kt[i + (size_t)c * ns] = (a == j ? 1.0 : s2) * Z2[a + (size_t)i * p] * Z2[j + (size_t)i * p];
           for (a = 0; a < rn; ++a) Rqt[i + (size_t)a * ns] = Rq[a + (size_t)i * rn];
         }
-        PHGMG__TRY(phgmg_lstsq(ns, nc, rn, Kt, ns, Rqt, ns, lambda, Mt, nc, alloc));
-        red->M = phgmg__red_d(red, (size_t)rn * pp); PHGMG__NEED(red->M);
-        red->Ms = phgmg__red_d(red, (size_t)rn * pp); PHGMG__NEED(red->Ms);
-        for (a = 0, c = 0; a < p; ++a)
-          for (j = a; j < p; ++j, ++c)
-            for (i = 0; i < rn; ++i) {
-              const double t = Mt[c + (size_t)i * nc];
-              const double v = a == j ? t : t / s2;
-              red->M[i + (size_t)(a * p + j) * rn] = v;
-              red->M[i + (size_t)(j * p + a) * rn] = v;
-              red->Ms[i + (size_t)(a * p + j) * rn] = 2.0 * v;
-              red->Ms[i + (size_t)(j * p + a) * rn] = 2.0 * v;
-            }
+        if (ng > 0) {
+          /* automatic lambda: validation over contiguous blocks of snapshots */
+          const int nfold = opts->lambda_folds == 0 ? 5 : opts->lambda_folds;
+          const int nblk = opts->lambda_blocks == 0 ? PHGMG__MIN(ns, 100) : opts->lambda_blocks;
+          double best;
+          lg = phgmg__dalloc(alloc, 2 * (size_t)ng); PHGMG__NEED(lg);
+          phgmg__lambda_grid(opts->lambda_min == 0.0 ? 1e-14 : opts->lambda_min,
+                             opts->lambda_max == 0.0 ? 1.0 : opts->lambda_max,
+                             opts->lambda_per_decade == 0 ? 4 : opts->lambda_per_decade, lg);
+          PHGMG__TRY(phgmg__ridge_cv(ns, nc, rn, Kt, ns, Rqt, ns, ng, lg,
+                                     nfold, nblk, lg + ng, alloc));
+          for (gsel = 0, c = 1; c < ng; ++c) if (lg[ng + c] < lg[ng + gsel]) gsel = c;
+          best = lg[ng + gsel];
+          for (c = ng - 1; c > gsel; --c) if (lg[ng + c] <= best * (1.0 + 1e-6)) { gsel = c; break; }
+          lambda = lg[gsel];
+          inf.lambda_cv_err = lg[ng + gsel];
+          inf.lambda_grid = ng;
+        }
+        PHGMG__TRY(phgmg__qm_fit(red, ns, Kt, Rqt, lambda, Mt, alloc));
+        inf.lambda = lambda;
+        if (gsel < 0) { phgmg__free(alloc, Tq); Tq = NULL; } /* no refit without the grid */
       }
       phgmg__free(alloc, T3); T3 = NULL;
     }
@@ -5676,16 +5878,35 @@ PHGMG_DEF phgmg_result phgmg_reduce(phgmg_reduced **out, const phgmg_ph_system *
     if (inf.rcond_dgd < 0.0) { rc = PHGMG_ERR_NOMEM; goto fail; }
     if (red->kind == PHGMG_ROM_QUADRATIC) {
       double *Lp, *E, *tmp, *x2;
+      /* automatic lambda: an M that (nearly) degenerates D^T G D somewhere on
+         the snapshots (rcond below lambda_rcond times its value at x = 0)
+         moves to the next larger grid lambda (M -> 0 as lambda grows, and
+         D^T G D -> G00, the matrix at x = 0) */
+      const double rc0 = inf.rcond_dgd;
+      const double lrc = rc0 * (opts->lambda_rcond == 0.0 ? 1e-6 : opts->lambda_rcond);
+      const int can_raise = gsel >= 0 && rc0 >= degtol;
       T3 = phgmg__dalloc(alloc, (size_t)rn * p + (size_t)r * r + (size_t)rn * r + (size_t)p); PHGMG__NEED(T3);
       Lp = T3; E = Lp + (size_t)rn * p; tmp = E + (size_t)r * r; x2 = tmp + (size_t)rn * r;
-      for (i = 0; i < ns; ++i) {
-        double rc_i;
-        phgmg_gemv('T', N, p, 1.0, red->V0 + (size_t)N * m, N, X + (size_t)i * ldx, 0.0, x2);
-        phgmg__lp_d(rn, p, red->Ms, x2, Lp);
-        phgmg__dgd_d(red, Lp, E, tmp);
-        rc_i = phgmg__rcond_of(r, E, alloc);
-        if (rc_i < 0.0) { rc = PHGMG_ERR_NOMEM; goto fail; }
-        if (rc_i < inf.rcond_dgd) inf.rcond_dgd = rc_i;
+      for (;;) {
+        const int nc = p * (p + 1) / 2;
+        const int more = can_raise && gsel + 1 < ng;
+        for (i = 0; i < ns; ++i) {
+          double rc_i;
+          phgmg_gemv('T', N, p, 1.0, red->V0 + (size_t)N * m, N, X + (size_t)i * ldx, 0.0, x2);
+          phgmg__lp_d(rn, p, red->Ms, x2, Lp);
+          phgmg__dgd_d(red, Lp, E, tmp);
+          rc_i = phgmg__rcond_of(r, E, alloc);
+          if (rc_i < 0.0) { rc = PHGMG_ERR_NOMEM; goto fail; }
+          if (rc_i < inf.rcond_dgd) inf.rcond_dgd = rc_i;
+          if (more && !(rc_i >= degtol && rc_i >= lrc)) break; /* raised anyway */
+        }
+        if ((inf.rcond_dgd >= degtol && inf.rcond_dgd >= lrc) || !more) break;
+        ++gsel;
+        ++inf.lambda_raised;
+        lambda = inf.lambda = lg[gsel];
+        inf.lambda_cv_err = lg[ng + gsel];
+        inf.rcond_dgd = rc0;
+        PHGMG__TRY(phgmg__qm_fit(red, ns, Tq, Tq + (size_t)ns * nc, lambda, Tq + (size_t)ns * (nc + rn), alloc));
       }
       phgmg__free(alloc, T3); T3 = NULL;
     }
@@ -5817,12 +6038,14 @@ PHGMG_DEF phgmg_result phgmg_reduce(phgmg_reduced **out, const phgmg_ph_system *
 #undef PHGMG__TRY
   phgmg_jr_factor_destroy(jr);
   phgmg__free(alloc, T1); phgmg__free(alloc, T2); phgmg__free(alloc, T3); phgmg__free(alloc, pts);
+  phgmg__free(alloc, Tq); phgmg__free(alloc, lg);
   if (info) *info = inf;
   *out = red;
   return PHGMG_OK;
 fail:
   phgmg_jr_factor_destroy(jr);
   phgmg__free(alloc, T1); phgmg__free(alloc, T2); phgmg__free(alloc, T3); phgmg__free(alloc, pts);
+  phgmg__free(alloc, Tq); phgmg__free(alloc, lg);
   phgmg_reduced_destroy(red);
   if (info) *info = inf;
   return rc;

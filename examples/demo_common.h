@@ -34,6 +34,7 @@ typedef struct demo_rom_result {
   double e_red, e_y, e_proj, e_lower;
   phgmg_result rc;
   phgmg_reduce_info info;
+  phgmg_rom_stats stats;   /* of the reduced simulation (stats.failures: failed Newton solves) */
   double t_offline, t_online;
 } demo_rom_result;
 
@@ -63,7 +64,7 @@ DEMO_FN demo_rom_result demo_run_rom(const phgmg_ph_system *sys, const double *X
   phgmg_reduced_restrict(red, X, xr0);     /* rho(x0) (NUMERICS 6.7) */
   t0 = demo_now();
   res.rc = phgmg_reduced_simulate(red, xr0, 0.0, dt, nsteps, uf, NULL, newton_tol, newton_it, XR, YR,
-                                  energy, NULL, NULL);
+                                  energy, &res.stats, NULL);
   res.t_online = demo_now() - t0;
   if (res.rc == PHGMG_OK) {
     res.e_red = phgmg_err_red(red, X, N, ns, XR, r);
@@ -159,6 +160,66 @@ DEMO_FN void demo_write_csv(const char *path, const char *header, int nrows, int
 }
 
 DEMO_FN void demo_mkdir(const char *dir) { mkdir(dir, 0777); }
+
+/* --lambda L|auto: a number (fixed GMG-QM ridge parameter) or "auto"
+   (phgmg_reduce_opts.lambda_auto with the default grid and folds). Returns
+   1 for auto, 0 for a number (stored in *lambda), -1 for anything else. */
+DEMO_FN int demo_parse_lambda(const char *arg, double *lambda) {
+  char *end;
+  double v;
+  if (!strcmp(arg, "auto")) return 1;
+  v = strtod(arg, &end);
+  if (end == arg || *end != '\0') return -1;
+  *lambda = v;
+  return 0;
+}
+
+/* The automatic-lambda study of one example and input: rows
+   "r, GMG-POD e_red, GMG-QM-auto e_red, lambda chosen, e_lowerbound, Newton
+   failures" (nr x 6, row-major) into <out>/<example>_<input>_lambda_auto.csv. */
+DEMO_FN void demo_write_lambda_auto(const char *out, const char *example, const char *input, int nr,
+                                    const double *rows) {
+  char path[512];
+  snprintf(path, sizeof path, "%s/%s_%s_lambda_auto.csv", out, example, input);
+  demo_write_csv(path, "r,GMG-POD,GMG-QM-auto,lambda,lowerbound,newton_failures", nr, 6, rows, 1);
+}
+
+/* Newton failures of one reduced simulation: the stepper's count, at least 1
+   when the simulation stopped on PHGMG_ERR_NOT_CONVERGED. */
+DEMO_FN double demo_newton_failures(const demo_rom_result *res) {
+  long f = res->stats.failures;
+  if (res->rc == PHGMG_ERR_NOT_CONVERGED && f < 1) f = 1;
+  return (double)f;
+}
+
+/* One row of the automatic-lambda study at order `base->r`: GMG-POD and
+   GMG-QM with lambda_auto (both with the other settings of `base`), the row
+   "r, GMG-POD e_red, GMG-QM-auto e_red, lambda, e_lowerbound, Newton
+   failures" into row[6], and one line on the terminal. */
+DEMO_FN void demo_lambda_auto_row(const phgmg_ph_system *sys, const double *X, const double *Y, int nsteps,
+                                  double dt, phgmg_input_fn uf, const demo_cache *cache,
+                                  const phgmg_reduce_opts *base, double newton_tol, int newton_it, double *row) {
+  phgmg_reduce_opts o = *base;
+  demo_rom_result res;
+  o.method = PHGMG_METHOD_GMG_POD; o.lambda_auto = 0;
+  demo_cache_use(cache, &o);
+  res = demo_run_rom(sys, X, Y, nsteps, dt, uf, &o, newton_tol, newton_it, NULL);
+  if (res.rc != PHGMG_OK) fprintf(stderr, "  [GMG-POD r=%d: %s]\n", o.r, phgmg_result_string(res.rc));
+  row[0] = o.r; row[1] = res.e_red;
+  o = *base;
+  o.method = PHGMG_METHOD_GMG_QM; o.lambda_auto = 1;
+  demo_cache_use(cache, &o);
+  res = demo_run_rom(sys, X, Y, nsteps, dt, uf, &o, newton_tol, newton_it, NULL);
+  if (res.rc != PHGMG_OK) fprintf(stderr, "  [GMG-QM r=%d: %s]\n", o.r, phgmg_result_string(res.rc));
+  row[2] = res.e_red; row[3] = res.info.lambda > 0.0 ? res.info.lambda : NAN; row[4] = res.e_lower;
+  row[5] = demo_newton_failures(&res);
+  printf("  %3d  %9.3e  %9.3e  %6.2f  %8.2e%-3s %8.2e  %9.3e  %6.2f  %.0f\n", o.r, row[1], row[2], row[1] / row[2],
+         row[3], res.info.lambda_raised ? " +" : "", res.info.lambda_cv_err, row[4], row[2] / row[4], row[5]);
+}
+DEMO_FN void demo_lambda_auto_header(const char *input) {
+  printf("\nu = %s  (lambda: + = raised by the conditioning guard)\n  %3s  %-10s %-10s %-7s %-11s %-9s %-10s %-7s %s\n",
+         input, "r", "GMG-POD", "QM-auto", "ratio", "lambda", "val.err", "lowerbnd", "QM/lb", "Newton failures");
+}
 
 /* Writes the three error tables of one example and input
    (<out>/<example>_<input>_{e_red,e_y,e_proj}.csv) and draws its state panel

@@ -433,6 +433,284 @@ TEST(test_online_never_allocates) {
   tmodel_free(&t);
 }
 
+/* ---- automatic ridge parameter of GMG-QM (opts.lambda_auto) -------------- */
+
+/* The multi-lambda validation of phgmg__ridge_cv (one SVD per fold) against
+   the definition computed another way: for every fold (block j of nblk
+   contiguous row blocks goes to fold j mod nfold) and lambda, the ridge
+   solution on the other rows by phgmg_lstsq (QR of [A; sqrt(lambda) I]) and
+   its squared error on the fold's rows, summed and divided by ||Y||_F^2. */
+TEST(test_lambda_cv_against_lstsq) {
+  enum { NS = 90, NC = 7, RN = 3, NG = 6, NF = 3, NB = 12 };
+  static double K[NS * NC], Y[NS * RN], Kt[NS * NC], Yt[NS * RN], T[NC * RN];
+  const double grid[NG] = {1e-12, 1e-8, 1e-4, 1e-2, 1.0, 1e6};
+  double err[NG], den = 0.0;
+  int i, j, a, g, f;
+  for (i = 0; i < NS; ++i) {   /* smooth "trajectory" features, noisy targets */
+    const double t = 0.1 * i;
+    for (j = 0; j < NC; ++j) K[i + j * NS] = sin((j + 1) * 0.37 * t + j) + 0.05 * th_rand();
+    for (a = 0; a < RN; ++a) {
+      Y[i + a * NS] = 0.02 * th_rand();
+      for (j = 0; j < NC; ++j) Y[i + a * NS] += (0.3 * (a + 1) - 0.1 * j) * K[i + j * NS];
+      den += Y[i + a * NS] * Y[i + a * NS];
+    }
+  }
+  CHECK_RC(phgmg__ridge_cv(NS, NC, RN, K, NS, Y, NS, NG, grid, NF, NB, err, NULL), PHGMG_OK);
+  for (g = 0; g < NG; ++g) {
+    double sum = 0.0;
+    for (f = 0; f < NF; ++f) {
+      int ntr = 0;
+      for (i = 0; i < NS; ++i)
+        if ((i * NB / NS) % NF != f) {
+          for (j = 0; j < NC; ++j) Kt[ntr + j * NS] = K[i + j * NS];
+          for (a = 0; a < RN; ++a) Yt[ntr + a * NS] = Y[i + a * NS];
+          ++ntr;
+        }
+      CHECK(ntr > NC && ntr < NS);
+      CHECK_RC(phgmg_lstsq(ntr, NC, RN, Kt, NS, Yt, NS, grid[g], T, NC, NULL), PHGMG_OK);
+      for (i = 0; i < NS; ++i)
+        if ((i * NB / NS) % NF == f)
+          for (a = 0; a < RN; ++a) {
+            double d = Y[i + a * NS];
+            for (j = 0; j < NC; ++j) d -= K[i + j * NS] * T[j + a * NC];
+            sum += d * d;
+          }
+    }
+    CHECK_LE(fabs(err[g] - sum / den), 1e-9 * (sum / den) + 1e-15);
+  }
+  /* large lambda: no better than t = 0; the noise level bounds the best one */
+  CHECK_LE(fabs(err[NG - 1] - 1.0), 0.05);
+  CHECK_LE(err[1], 0.01);
+}
+
+/* Snapshots exactly on a quadratic manifold x = B u + V1 z + V2 M (z kron z)
+   (V1, V2 orthonormal, orthogonal to B; the set is symmetric under z -> -z, so
+   the POD of the adjusted snapshots separates span V1 from span V2 exactly).
+   The automatic lambda must find a small lambda, predict held-out blocks
+   almost exactly, and reproduce the manifold at fresh points (so M is
+   recovered), where the paper's lambda = 1e-3 cannot. */
+TEST(test_lambda_auto_exact_manifold) {
+  enum { P = 4, RN = 3, NH = 150, NSN = 2 * NH };
+  tmodel t;
+  const int r = P + 1;
+  int N, i, j, a, b, pass;
+  double *V = NULL, *X = NULL, Mt[RN * P * P], z[P], x2[P * P], xr[8];
+  double err_fresh[2] = {0, 0};
+  phgmg_reduce_info info;
+  linear_msd(&t, 20, 2, 1, 1);
+  N = t.sys.N;
+  V = (double *)malloc(sizeof(double) * N * (P + RN));
+  X = (double *)malloc(sizeof(double) * N * NSN);
+  /* orthonormal V = [V1, V2], orthogonal to B = e_2 (Gram-Schmidt twice) */
+  for (j = 0; j < P + RN; ++j) {
+    int pass2;
+    for (i = 0; i < N; ++i) V[i + j * N] = th_rand();
+    for (pass2 = 0; pass2 < 2; ++pass2) {
+      double nrm = 0;
+      V[1 + j * N] = 0.0;
+      for (b = 0; b < j; ++b) {
+        double d = 0;
+        for (i = 0; i < N; ++i) d += V[i + b * N] * V[i + j * N];
+        for (i = 0; i < N; ++i) V[i + j * N] -= d * V[i + b * N];
+      }
+      for (i = 0; i < N; ++i) nrm += V[i + j * N] * V[i + j * N];
+      for (i = 0; i < N; ++i) V[i + j * N] /= sqrt(nrm);
+    }
+  }
+  /* M symmetric in the Kronecker sense: M(:,(a,b)) = M(:,(b,a)) */
+  for (a = 0; a < P; ++a)
+    for (b = a; b < P; ++b)
+      for (i = 0; i < RN; ++i) Mt[i + (a * P + b) * RN] = Mt[i + (b * P + a) * RN] = 0.05 * th_rand();
+#define ON_MANIFOLD(zz, u, x) do { \
+    for (i = 0; i < N; ++i) (x)[i] = 0.0; \
+    (x)[1] = (u); \
+    for (a = 0; a < P; ++a) for (b = 0; b < P; ++b) x2[a * P + b] = (zz)[a] * (zz)[b]; \
+    for (a = 0; a < P; ++a) for (i = 0; i < N; ++i) (x)[i] += V[i + a * N] * (zz)[a]; \
+    for (a = 0; a < RN; ++a) { double q = 0; for (b = 0; b < P * P; ++b) q += Mt[a + b * RN] * x2[b]; \
+      for (i = 0; i < N; ++i) (x)[i] += V[i + (P + a) * N] * q; } } while (0)
+  for (j = 0; j < NH; ++j) {   /* a smooth trajectory and its mirror image */
+    /* frequencies not in arithmetic progression: with equally spaced ones
+       the products z_a z_b along the trajectory are linearly dependent and M
+       is not determined by the data (the minimum-norm M misses fresh points) */
+    static const double om[P] = {0.7, 1.9, 1.1, 2.9};
+    const double tt = 0.1 * j;
+    for (a = 0; a < P; ++a) z[a] = (1.0 - 0.2 * a) * sin(om[a] * tt + 0.7 * a);
+    ON_MANIFOLD(z, 0.3 * cos(tt), X + (size_t)j * N);
+    for (a = 0; a < P; ++a) z[a] = -z[a];
+    ON_MANIFOLD(z, -0.3 * cos(tt), X + (size_t)(NH + j) * N);
+  }
+  for (pass = 0; pass < 2; ++pass) {
+    phgmg_reduce_opts o;
+    phgmg_reduced *red = NULL;
+    double xf[64], xl[64];
+    int g, on_grid = 0;
+    memset(&o, 0, sizeof o);
+    o.method = PHGMG_METHOD_GMG_QM; o.r = r; o.rn = RN; o.lambda_auto = pass == 0;
+    CHECK_RC(phgmg_reduce(&red, &t.sys, X, N, NSN, &o, &info, NULL), PHGMG_OK);
+    if (!red) break;
+    if (pass == 0) {
+      CHECK(info.lambda_grid == 57);               /* 1e-14 .. 1 at 4 per decade */
+      for (g = 0; g < 57; ++g) on_grid |= fabs(info.lambda - 1e-14 * pow(10.0, g / 4.0)) <= 1e-9 * info.lambda;
+      CHECK(on_grid);
+      CHECK_LE(info.lambda, 1e-8);
+      CHECK_LE(info.lambda_cv_err, 1e-12);
+      CHECK(info.lambda_raised == 0);
+    } else {
+      CHECK(info.lambda == 1e-3 && info.lambda_grid == 0 && info.lambda_cv_err == 0.0);
+    }
+    for (j = 0; j < 20; ++j) {   /* fresh points on the manifold, inside the data range */
+      double num = 0, dd = 0;
+      for (a = 0; a < P; ++a) z[a] = 0.8 * (1.0 - 0.2 * a) * th_rand();
+      ON_MANIFOLD(z, 0.1 * th_rand(), xf);
+      phgmg_reduced_restrict(red, xf, xr);
+      phgmg_reduced_lift(red, xr, xl);
+      for (i = 0; i < N; ++i) { num += (xl[i] - xf[i]) * (xl[i] - xf[i]); dd += xf[i] * xf[i]; }
+      err_fresh[pass] = PHGMG__MAX(err_fresh[pass], sqrt(num / dd));
+    }
+    phgmg_reduced_destroy(red);
+  }
+#undef ON_MANIFOLD
+  CHECK_LE(err_fresh[0], 1e-10);
+  CHECK_LE(1e-7, err_fresh[1]);   /* the paper's lambda shrinks M visibly */
+  free(V); free(X);
+  tmodel_free(&t);
+}
+
+/* Linear MSD snapshots: the chosen lambda is a grid point whose held-out
+   error is no worse than at either end of the grid (each end evaluated by a
+   one-point grid), the guard moves up the grid by whole steps, and the
+   in-sample projection error is below the paper's lambda = 1e-3. */
+TEST(test_lambda_auto_linear_msd) {
+  tmodel t;
+  double *X;
+  phgmg_reduce_opts o;
+  phgmg_reduce_info info, ilo, ihi, ig, ipod;
+  phgmg_reduced *red = NULL;
+  double ep_auto = 1, ep_paper = 0;
+  const int r = 12, ns = 401;
+  linear_msd(&t, 50, 2, 1, 1);
+  X = snapshots(&t.sys, ns - 1, 1e-10, 10);
+  CHECK(X != NULL);
+  if (!X) { tmodel_free(&t); return; }
+  memset(&o, 0, sizeof o);
+  o.method = PHGMG_METHOD_GMG_QM; o.r = r; o.rn = 8; o.lambda_auto = 1; o.lambda_rcond = 1e-300; /* no guard */
+  CHECK_RC(phgmg_reduce(&red, &t.sys, X, t.sys.N, ns, &o, &info, NULL), PHGMG_OK);
+  if (red) { ep_auto = phgmg_err_proj(red, X, t.sys.N, ns); phgmg_reduced_destroy(red); red = NULL; }
+  CHECK(info.lambda_raised == 0);
+  CHECK(info.lambda >= 1e-14 * (1 - 1e-12) && info.lambda <= 1.0);
+  CHECK_LE(fabs(4.0 * log10(info.lambda / 1e-14) - floor(4.0 * log10(info.lambda / 1e-14) + 0.5)), 1e-9);
+  o.lambda_min = o.lambda_max = 1e-14;
+  CHECK_RC(phgmg_reduce(&red, &t.sys, X, t.sys.N, ns, &o, &ilo, NULL), PHGMG_OK);
+  phgmg_reduced_destroy(red); red = NULL;
+  o.lambda_min = o.lambda_max = 1.0;
+  CHECK_RC(phgmg_reduce(&red, &t.sys, X, t.sys.N, ns, &o, &ihi, NULL), PHGMG_OK);
+  phgmg_reduced_destroy(red); red = NULL;
+  CHECK(ilo.lambda_grid == 1 && ihi.lambda_grid == 1 && ilo.lambda == 1e-14 && ihi.lambda == 1.0);
+  CHECK_LE(info.lambda_cv_err, ilo.lambda_cv_err);
+  CHECK_LE(info.lambda_cv_err, ihi.lambda_cv_err);
+  CHECK_LE(info.lambda_cv_err, 0.5);          /* the quadratic term predicts held-out blocks */
+  CHECK_LE(0.9, ihi.lambda_cv_err);           /* lambda = 1: M ~ 0 */
+  /* against the paper's fixed lambda: the ridge residual on the training data
+     grows with lambda, so a smaller lambda projects the snapshots better */
+  CHECK(info.lambda < 1e-3);
+  memset(&o, 0, sizeof o);
+  o.method = PHGMG_METHOD_GMG_QM; o.r = r; o.rn = 8;
+  CHECK_RC(phgmg_reduce(&red, &t.sys, X, t.sys.N, ns, &o, NULL, NULL), PHGMG_OK);
+  if (red) { ep_paper = phgmg_err_proj(red, X, t.sys.N, ns); phgmg_reduced_destroy(red); red = NULL; }
+  CHECK_LE(ep_auto, ep_paper);
+  /* a strict guard (rcond at every snapshot >= 0.5 x its value at x = 0, which
+     is GMG-POD's rcond at the same r) moves lambda up by whole grid steps */
+  memset(&o, 0, sizeof o);
+  o.method = PHGMG_METHOD_GMG_POD; o.r = r;
+  CHECK_RC(phgmg_reduce(&red, &t.sys, X, t.sys.N, ns, &o, &ipod, NULL), PHGMG_OK);
+  phgmg_reduced_destroy(red); red = NULL;
+  o.method = PHGMG_METHOD_GMG_QM; o.rn = 8; o.lambda_auto = 1; o.lambda_rcond = 0.5;
+  CHECK_RC(phgmg_reduce(&red, &t.sys, X, t.sys.N, ns, &o, &ig, NULL), PHGMG_OK);
+  phgmg_reduced_destroy(red); red = NULL;
+  CHECK(ig.lambda_raised > 0);
+  CHECK_LE(fabs(ig.lambda / info.lambda - pow(10.0, ig.lambda_raised / 4.0)), 1e-9 * ig.lambda / info.lambda);
+  CHECK(ig.rcond_dgd >= 0.5 * ipod.rcond_dgd * (1 - 1e-12) || ig.lambda == 1.0);
+  free(X);
+  tmodel_free(&t);
+}
+
+/* Bad grid options and sizes, and every allocation failure of the automatic
+   path: PHGMG_ERR_NOMEM with nothing left allocated. */
+typedef struct tcount { long calls, fail_at, live; } tcount;
+static void *tc_alloc(size_t n, void *u) {
+  tcount *c = (tcount *)u;
+  void *p;
+  if (++c->calls == c->fail_at) return NULL;
+  p = malloc(n);
+  if (p) c->live++;
+  return p;
+}
+static void tc_free(void *p, void *u) { if (p) { ((tcount *)u)->live--; free(p); } }
+
+TEST(test_lambda_auto_options_and_oom) {
+  tmodel t;
+  double *X;
+  phgmg_reduce_opts o, b;
+  phgmg_reduce_info info;
+  phgmg_reduced *red = NULL;
+  tcount c;
+  phgmg_allocator al;
+  long total, k;
+  const int ns = 121;
+  linear_msd(&t, 15, 2, 1, 1);
+  X = snapshots(&t.sys, ns - 1, 1e-10, 10);
+  CHECK(X != NULL);
+  if (!X) { tmodel_free(&t); return; }
+  memset(&b, 0, sizeof b);
+  b.method = PHGMG_METHOD_GMG_QM; b.r = 5; b.rn = 3; b.lambda_auto = 1;
+#define BAD(field, val, code) do { o = b; o.field = (val); \
+    CHECK_RC(phgmg_reduce(&red, &t.sys, X, t.sys.N, ns, &o, NULL, NULL), code); CHECK(red == NULL); } while (0)
+  BAD(lambda_auto, 2, PHGMG_ERR_INVALID_ARG);
+  BAD(lambda_auto, -1, PHGMG_ERR_INVALID_ARG);
+  BAD(lambda_min, -1e-6, PHGMG_ERR_INVALID_ARG);
+  BAD(lambda_min, (double)NAN, PHGMG_ERR_INVALID_ARG);
+  BAD(lambda_min, 2.0, PHGMG_ERR_INVALID_ARG);          /* above lambda_max = 1 */
+  BAD(lambda_max, (double)INFINITY, PHGMG_ERR_INVALID_ARG);
+  BAD(lambda_max, -1.0, PHGMG_ERR_INVALID_ARG);
+  BAD(lambda_per_decade, -1, PHGMG_ERR_INVALID_ARG);
+  BAD(lambda_per_decade, 101, PHGMG_ERR_INVALID_ARG);
+  BAD(lambda_folds, 1, PHGMG_ERR_INVALID_ARG);
+  BAD(lambda_folds, -2, PHGMG_ERR_INVALID_ARG);
+  BAD(lambda_blocks, -1, PHGMG_ERR_INVALID_ARG);
+  BAD(lambda_rcond, -0.5, PHGMG_ERR_INVALID_ARG);
+  BAD(lambda_rcond, 1.5, PHGMG_ERR_INVALID_ARG);
+  BAD(lambda_rcond, (double)NAN, PHGMG_ERR_INVALID_ARG);
+  o = b; o.lambda_min = 1e-300; o.lambda_per_decade = 100;  /* 30000 points */
+  CHECK_RC(phgmg_reduce(&red, &t.sys, X, t.sys.N, ns, &o, NULL, NULL), PHGMG_ERR_INVALID_ARG);
+  BAD(lambda_blocks, 4, PHGMG_ERR_SIZE);                   /* fewer blocks than the 5 folds */
+  BAD(lambda_blocks, ns + 1, PHGMG_ERR_SIZE);
+  BAD(lambda_folds, ns + 1, PHGMG_ERR_SIZE);
+  /* the options are ignored when lambda_auto is off */
+  o = b; o.lambda_auto = 0; o.lambda_min = -1.0; o.lambda_folds = 1;
+  CHECK_RC(phgmg_reduce(&red, &t.sys, X, t.sys.N, ns, &o, NULL, NULL), PHGMG_OK);
+  phgmg_reduced_destroy(red); red = NULL;
+#undef BAD
+  /* allocation failures (with a guard that raises lambda, so the refit path runs) */
+  o = b; o.lambda_rcond = 0.5;
+  memset(&c, 0, sizeof c);
+  al.alloc = tc_alloc; al.free = tc_free; al.user = &c;
+  CHECK_RC(phgmg_reduce(&red, &t.sys, X, t.sys.N, ns, &o, &info, &al), PHGMG_OK);
+  phgmg_reduced_destroy(red); red = NULL;
+  CHECK(info.lambda_grid == 57 && info.lambda_raised > 0);
+  CHECK(c.live == 0);
+  total = c.calls;
+  for (k = 1; k <= total; ++k) {
+    phgmg_result rc;
+    c.calls = 0; c.live = 0; c.fail_at = k;
+    rc = phgmg_reduce(&red, &t.sys, X, t.sys.N, ns, &o, NULL, &al);
+    if (rc == PHGMG_OK) { phgmg_reduced_destroy(red); red = NULL; }
+    CHECK_RC(rc, PHGMG_ERR_NOMEM);
+    CHECK(c.live == 0 && red == NULL);
+  }
+  free(X);
+  tmodel_free(&t);
+}
+
 SUITE(reduce) {
   RUN(test_structure_linear);
   RUN(test_structure_nonlinear);
@@ -440,4 +718,8 @@ SUITE(reduce) {
   RUN(test_qm_stepper_matches_reference_gl3);
   RUN(test_energy_balance_gmgpod);
   RUN(test_online_never_allocates);
+  RUN(test_lambda_cv_against_lstsq);
+  RUN(test_lambda_auto_exact_manifold);
+  RUN(test_lambda_auto_linear_msd);
+  RUN(test_lambda_auto_options_and_oom);
 }
