@@ -10,7 +10,8 @@
 # 3. if a CBLAS is installed, builds bench_linalg again with -DPHGMG_USE_CBLAS
 #    and records its cases with a `_cblas` suffix (one BLAS thread);
 # 4. builds the examples (`make examples`; if that fails, the two demo
-#    programs directly, without -Werror) and times the whole demo (wall
+#    programs directly, without -Werror) and times the whole demo (the three
+#    runs `make demo` makes: linear, nonlinear, linear with --lambda auto; wall
 #    clock, one warm-up, then DEMO_RUNS runs) as case `demo_total`, and its
 #    CPU time (user + sys of the two programs; robust to other load on the
 #    machine) as `demo_total_cpu`;
@@ -85,7 +86,7 @@ fi
 
 # the whole demo, wall clock
 echo
-echo "== demo_total (make examples; msd_linear + msd_nonlinear, 1 warm-up + $DEMO_RUNS runs)"
+echo "== demo_total (make examples; the three runs of make demo, 1 warm-up + $DEMO_RUNS runs)"
 demo_lin="$BUILD/msd_linear"
 demo_nl="$BUILD/msd_nonlinear"
 if ! make examples >/dev/null; then
@@ -105,7 +106,8 @@ if [ -x "$demo_lin" ] && [ -x "$demo_nl" ]; then
   while [ $i -le "$DEMO_RUNS" ]; do
     times > "$BUILD/bench_times0"   # CPU time of the children so far (no subshell: a builtin)
     t0=$(date +%s.%N)
-    if ! { "./$demo_lin" --out "$BUILD/bench_results" && "./$demo_nl" --out "$BUILD/bench_results"; } >/dev/null; then
+    if ! { "./$demo_lin" --out "$BUILD/bench_results" && "./$demo_nl" --out "$BUILD/bench_results" &&
+           "./$demo_lin" --lambda auto --rmin 6 --out "$BUILD/bench_results"; } >/dev/null; then
       echo "run.sh: warning: the demo failed" >&2
       ok=0
       break
