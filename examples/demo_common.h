@@ -216,9 +216,47 @@ DEMO_FN void demo_lambda_auto_row(const phgmg_ph_system *sys, const double *X, c
   printf("  %3d  %9.3e  %9.3e  %6.2f  %8.2e%-3s %8.2e  %9.3e  %6.2f  %.0f\n", o.r, row[1], row[2], row[1] / row[2],
          row[3], res.info.lambda_raised ? " +" : "", res.info.lambda_cv_err, row[4], row[2] / row[4], row[5]);
 }
+
 DEMO_FN void demo_lambda_auto_header(const char *input) {
   printf("\nu = %s  (lambda: + = raised by the conditioning guard)\n  %3s  %-10s %-10s %-7s %-11s %-9s %-10s %-7s %s\n",
          input, "r", "GMG-POD", "QM-auto", "ratio", "lambda", "val.err", "lowerbnd", "QM/lb", "Newton failures");
+}
+
+/* --lambda auto, one example: for u = 0.1 sin t and u = 0.1, the full-order
+   trajectory, then GMG-POD against GMG-QM with the automatic lambda for
+   r = rmin, rmin + rstep, ..., rmax (a table and a CSV per input).
+   base: the reduce options shared by every r (rn, DEIM, step map). */
+DEMO_FN void demo_lambda_auto_study(const phgmg_ph_system *sys, const char *out, const char *example,
+                                    int rmin, int rmax, int rstep, const phgmg_reduce_opts *base,
+                                    double newton_tol, int newton_it, int nsteps, double dt) {
+  const int N = sys->N, ns = nsteps + 1, nr = (rmax - rmin) / rstep + 1;
+  const char *inname[2] = {"sin", "const"};
+  phgmg_input_fn inf[2] = {msd_input_sin, msd_input_const};
+  int in, k;
+  for (in = 0; in < 2; ++in) {
+    double *X = (double *)malloc(sizeof(double) * N * ns), *Y = (double *)malloc(sizeof(double) * ns);
+    double *x0 = (double *)calloc((size_t)N, sizeof(double));
+    double *rows = (double *)malloc(sizeof(double) * nr * 6);
+    phgmg_gl3_opts go;
+    phgmg_result rc;
+    demo_cache cache;
+    if (!X || !Y || !x0 || !rows) { fprintf(stderr, "out of memory\n"); exit(1); }
+    memset(&go, 0, sizeof go); go.tol = newton_tol; go.max_iter = newton_it;
+    rc = phgmg_simulate(sys, x0, 0.0, dt, nsteps, inf[in], NULL, &go, X, Y, NULL, NULL, NULL, NULL);
+    if (rc != PHGMG_OK) demo_die("full-order simulation", rc);
+    demo_cache_build(&cache, sys, X, ns, rmax + base->rn + 1, 0);
+    if (base->deim) demo_cache_deim(&cache, sys, X, ns, base->deim_tol);
+    demo_lambda_auto_header(in ? "0.1" : "0.1 sin t");
+    for (k = 0; k < nr; ++k) {
+      phgmg_reduce_opts o = *base;
+      o.r = rmin + k * rstep;
+      demo_lambda_auto_row(sys, X, Y, nsteps, dt, inf[in], &cache, &o, newton_tol, newton_it, rows + k * 6);
+    }
+    demo_write_lambda_auto(out, example, inname[in], nr, rows);
+    demo_cache_free(&cache);
+    free(X); free(Y); free(x0); free(rows);
+  }
+  printf("\nwrote %s/%s_sin_lambda_auto.csv and %s/%s_const_lambda_auto.csv\n", out, example, out, example);
 }
 
 /* Writes the three error tables of one example and input

@@ -39,38 +39,17 @@ static const phgmg_method meth_id[NMETH] = {PHGMG_METHOD_SP1, PHGMG_METHOD_GMG_P
 /* --lambda auto: GMG-POD against GMG-QM with the automatic lambda, per r. */
 static int lambda_auto_study(msd_linear *M, const char *out, int rmin, int rmax, int rstep, int rn,
                              int nsteps, double dt) {
-  const int N = M->sys.N, ns = nsteps + 1, nr = (rmax - rmin) / rstep + 1;
-  const char *inname[2] = {"sin", "const"};
-  phgmg_input_fn inf[2] = {msd_input_sin, msd_input_const};
-  int in, k;
+  const int N = M->sys.N;
   printf("Linear MSD, N = %d, %d steps of dt = %g; r = %d..%d; GMG-QM r_n = %d, lambda automatic\n"
          "(library defaults: grid 1e-14..1 at 4 per decade, 5-fold validation over 100 contiguous\n"
          "blocks of snapshots, conditioning guard 1e-6)\n",
          N, nsteps, dt, rmin, rmax, rn);
-  for (in = 0; in < 2; ++in) {
-    double *X = (double *)malloc(sizeof(double) * N * ns), *Y = (double *)malloc(sizeof(double) * ns);
-    double *x0 = (double *)calloc((size_t)N, sizeof(double));
-    double *rows = (double *)malloc(sizeof(double) * nr * 6);
-    phgmg_gl3_opts go;
-    phgmg_result rc;
-    demo_cache cache;
-    if (!X || !Y || !x0 || !rows) { fprintf(stderr, "out of memory\n"); exit(1); }
-    memset(&go, 0, sizeof go); go.tol = 1e-10; go.max_iter = 10;
-    rc = phgmg_simulate(&M->sys, x0, 0.0, dt, nsteps, inf[in], NULL, &go, X, Y, NULL, NULL, NULL, NULL);
-    if (rc != PHGMG_OK) demo_die("full-order simulation", rc);
-    demo_cache_build(&cache, &M->sys, X, ns, rmax + rn + 1, 0);
-    demo_lambda_auto_header(in ? "0.1" : "0.1 sin t");
-    for (k = 0; k < nr; ++k) {
-      phgmg_reduce_opts o;
-      memset(&o, 0, sizeof o);
-      o.r = rmin + k * rstep; o.rn = rn; o.dt = dt;
-      demo_lambda_auto_row(&M->sys, X, Y, nsteps, dt, inf[in], &cache, &o, 1e-10, 10, rows + k * 6);
-    }
-    demo_write_lambda_auto(out, "linear", inname[in], nr, rows);
-    demo_cache_free(&cache);
-    free(X); free(Y); free(x0); free(rows);
+  {
+    phgmg_reduce_opts o;
+    memset(&o, 0, sizeof o);
+    o.rn = rn; o.dt = dt;
+    demo_lambda_auto_study(&M->sys, out, "linear", rmin, rmax, rstep, &o, 1e-10, 10, nsteps, dt);
   }
-  printf("\nwrote %s/linear_sin_lambda_auto.csv and %s/linear_const_lambda_auto.csv\n", out, out);
   return 0;
 }
 
