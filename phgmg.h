@@ -624,7 +624,8 @@ PHGMG_DEF void phgmg_rom_stage_times(phgmg_real t, phgmg_real dt, phgmg_real tc[
    E = D^T G D: the stage values Phi_i = E(Y_i)^{-1} g(Y_i) are unknowns beside
    the stage increments, so an iteration needs products E(Y_i) Phi_i and solves
    with frozen factors of E, never a factorisation per stage (E alone is
-   refactored after a step that needed more than one iteration). The converged
+   refactored every 8 steps and after a step that needed more than one
+   iteration). The converged
    stages are those of the usual GL3 method; tol bounds the stage residual
    linearised in Phi and the last correction of Phi (times dt A). */
 PHGMG_DEF phgmg_result phgmg_rom_step(phgmg_rom_stepper *s, phgmg_real *x, const phgmg_real *u3,
@@ -5162,7 +5163,10 @@ PHGMG_DEF phgmg_result phgmg_rom_step(phgmg_rom_stepper *s, phgmg_real *x, const
       for (a = 0; a < r; ++a) x[a] = xn[a];
       s->have_prev = 1;
       if (theta_max > PHGMG__R(0.5)) s->have_lu = 0; /* slow contraction: refactor next step */
-      s->stale_e = it > 1;                           /* more than one iteration: fresh E next step */
+      /* fresh factors of E next step after a step with more than one
+         iteration, and every 8 steps: the last correction Phi - Del is exact
+         up to (I - E_f^{-1} E(Y)) Del, so E_f must not drift far */
+      s->stale_e = it > 1 || s->stats.steps % 8 == 7;
       s->stats.steps++;
       if (y) phgmg_rom_output(rom, x, y, L.work);
       return PHGMG_OK;
