@@ -19,6 +19,9 @@
      offline_<kind>_<model>_r20      the whole phgmg_reduce, no POD cache
      rom_<model>_<kind>_r<8|16|20>   1000 steps of phgmg_rom_step, static workspace
      rom_nonlinear_<kind>_r20_N4000  the same reduced model built from the N = 4000 chain
+     rom_nonlinear_interleaved_<kind>_r20_N<1000|4000>
+                                     the N = 1000 and N = 4000 models run alternately
+                                     (ratio of the medians: the online-cost-flat-in-N check)
    Linear kinds: sp1, gmgpod (both with the precomputed step map), gmgqm;
    nonlinear: gmgpod_deim, sp2_deim, gmgqm_deim.
 
@@ -640,6 +643,54 @@ int main(int argc, char **argv) {
     red = build(&nl4, PHGMG_METHOD_GMG_QM, 20, nl_lambda(&nl4, 20), 0);
     online_case("rom_nonlinear_gmgqm_deim_r20_N4000", &nl4, red);
     phgmg_reduced_destroy(red);
+  }
+  { /* the same comparison interleaved: N = 1000 and N = 4000 models alternate
+       run by run, so that slow phases of a shared machine hit both alike */
+    static const phgmg_method km[3] = {PHGMG_METHOD_GMG_POD, PHGMG_METHOD_SP2, PHGMG_METHOD_GMG_QM};
+    static const char *kn[3] = {"gmgpod_deim", "sp2_deim", "gmgqm_deim"};
+    for (k = 0; k < 3; ++k) if (!g_only || strstr("rom_nonlinear_interleaved", g_only)) {
+      phgmg_reduced *r1 = build(&nl1, km[k], 20, km[k] == PHGMG_METHOD_GMG_QM ? nl_lambda(&nl1, 20) : 0.0, 0);
+      phgmg_reduced *r4 = build(&nl4, km[k], 20, km[k] == PHGMG_METHOD_GMG_QM ? nl_lambda(&nl4, 20) : 0.0, 0);
+      online_ctx c[2];
+      double t[2][RUNS_ON];
+      timing T[2];
+      int run, j;
+      for (j = 0; j < 2; ++j) {
+        const model_data *md = j ? &nl4 : &nl1;
+        double xr[64];
+        int a;
+        memset(&c[j], 0, sizeof c[j]);
+        c[j].rom = phgmg_reduced_rom(j ? r4 : r1);
+        c[j].tol = (phgmg_real)md->tol;
+        c[j].maxit = md->maxit;
+        c[j].y = (phgmg_real *)xmalloc(sizeof(phgmg_real) * NS);
+        phgmg_reduced_restrict(j ? r4 : r1, md->X, xr);
+        for (a = 0; a < c[j].rom->r; ++a) c[j].x0[a] = (phgmg_real)xr[a];
+      }
+      for (run = -1; run < RUNS_ON; ++run)
+        for (j = 0; j < 2; ++j) {
+          double t0;
+          if (online_fn(&c[j], 0) != 0) die("interleaved setup", PHGMG_ERR_INVALID_ARG);
+          t0 = now_cpu();
+          if (online_fn(&c[j], 1) != 0) die("interleaved run", PHGMG_ERR_NOT_CONVERGED);
+          if (run >= 0) t[j][run] = now_cpu() - t0;
+        }
+      for (j = 0; j < 2; ++j) {
+        char nm[96];
+        T[j].med = median_of(t[j], RUNS_ON);
+        T[j].mn = t[j][0]; T[j].mx = t[j][RUNS_ON - 1]; T[j].wall = T[j].med; T[j].runs = RUNS_ON;
+        snprintf(nm, sizeof nm, "rom_nonlinear_interleaved_%s_r20_N%d", kn[k], j ? 4000 : 1000);
+        if (g_csv) { fprintf(g_csv, "%s,%.9f,%.9f,%.9f,%d\n", nm, T[j].med, T[j].mn, T[j].mx, RUNS_ON); fflush(g_csv); }
+        snprintf(extra, sizeof extra, "%9.3f  interleaved%s", 1e6 * T[j].med / NSTEPS,
+                 j ? "" : "  (N = 4000 / N = 1000 on the next line)");
+        if (j) snprintf(extra, sizeof extra, "%9.3f  interleaved; N = 4000 / N = 1000 = %.3f", 1e6 * T[j].med / NSTEPS,
+                        T[1].med / T[0].med);
+        row(nm, T[j], extra);
+      }
+      free(c[0].y); free(c[1].y);
+      phgmg_reduced_destroy(r1);
+      phgmg_reduced_destroy(r4);
+    }
   }
   printf("flop/st: flops per step of the algorithm as implemented (bench_rom.c: rom_flops); "
          "machine peaks: %.2f GFLOP/s (machine_fma_peak), triad %.2f GB/s DRAM, %.2f GB/s L3\n", g_peak, g_bw_dram,
