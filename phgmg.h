@@ -4713,14 +4713,20 @@ PHGMG__ONLINE void phgmg__rom_hess(const phgmg_rom *rom, const phgmg_real *x, ph
   }
 }
 
+/* w->b2 = L v and w->b1 = (G10 + G11 L) v at the point whose Lp is in w (QUADRATIC). */
+PHGMG__ONLINE void phgmg__rom_lv(const phgmg_rom *rom, const phgmg__romw *w, const phgmg_real *v) {
+  const int r = rom->r, m = rom->m, rn = rom->rn;
+  phgmg__r_gemv(rn, r - m, w->Lp, v + m, 0, w->b2);
+  phgmg__r_gemv(rn, r, rom->G10, v, 0, w->b1);
+  phgmg__r_gemv(rn, rn, rom->G11, w->b2, 1, w->b1);
+}
+
 /* out = E v, E = D^T G D at the point whose Lp is in w (QUADRATIC), without
    forming E: G00 v + G01 (L v) + L^T (G10 v + G11 L v). Uses w->b1, w->b2. */
 PHGMG__ONLINE void phgmg__rom_eapply(const phgmg_rom *rom, const phgmg__romw *w, const phgmg_real *v,
                                      phgmg_real *out) {
   const int r = rom->r, m = rom->m, rn = rom->rn, p = r - m;
-  phgmg__r_gemv(rn, p, w->Lp, v + m, 0, w->b2);
-  phgmg__r_gemv(rn, r, rom->G10, v, 0, w->b1);
-  phgmg__r_gemv(rn, rn, rom->G11, w->b2, 1, w->b1);
+  phgmg__rom_lv(rom, w, v);
   phgmg__r_gemv(r, r, rom->G00, v, 0, out);
   phgmg__r_gemv(r, rn, rom->G01, w->b2, 1, out);
   phgmg__r_gemvt(rn, p, w->Lp, w->b1, 1, out + m);
@@ -4747,9 +4753,7 @@ PHGMG__ONLINE phgmg_result phgmg__rom_jac(const phgmg_rom *rom, const phgmg_real
   if (phgmg__r_lu(r, w->E, w->piv) != 0) return PHGMG_ERR_SINGULAR;
   for (a = 0; a < r; ++a) w->fm[a] = w->g[a];
   phgmg__r_lu_solve(r, w->E, w->piv, w->fm); /* v */
-  phgmg__r_gemv(rn, p, w->Lp, w->fm + m, 0, w->b2); /* t = G10 v + G11 L v */
-  phgmg__r_gemv(rn, r, rom->G10, w->fm, 0, w->b1);
-  phgmg__r_gemv(rn, rn, rom->G11, w->b2, 1, w->b1);
+  phgmg__rom_lv(rom, w, w->fm); /* t = G10 v + G11 L v in w->b1 */
   for (j = 0; j < p; ++j) {
     phgmg_real *sj = w->t; /* s_j (rn) */
     phgmg_real *cj = Jf + (size_t)(m + j) * r;
@@ -4959,6 +4963,13 @@ PHGMG__ONLINE phgmg_real phgmg__romstep_residual(phgmg_rom_stepper *s, const phg
   return nrm;
 }
 
+/* Keep the LU of E in w (w->E, w->piv) as the frozen factors E_f (QUADRATIC). */
+PHGMG__ONLINE void phgmg__romstep_keep_e(const phgmg__romstep_mem *L, const phgmg__romw *w, int r) {
+  int i;
+  for (i = 0; i < r * r; ++i) L->Ef[i] = w->E[i];
+  for (i = 0; i < r; ++i) L->pivf[i] = w->piv[i];
+}
+
 /* Factor I - h (A kron Jf(x)). */
 PHGMG__ONLINE phgmg_result phgmg__romstep_factor(phgmg_rom_stepper *s, const phgmg__romstep_mem *L,
                                                  const phgmg_real *x) {
@@ -4971,10 +4982,7 @@ PHGMG__ONLINE phgmg_result phgmg__romstep_factor(phgmg_rom_stepper *s, const phg
   rc = phgmg__rom_jac(rom, x, L->Jf, &w);
   if (rc != PHGMG_OK) { s->have_lu = 0; return rc; }
   if (!phgmg__r_finite(L->Jf, r * r)) { s->have_lu = 0; return PHGMG_ERR_NANINF; }
-  if (L->Ef) { /* keep the LU of E(x) the Jacobian was built with */
-    for (i = 0; i < r * r; ++i) L->Ef[i] = w.E[i];
-    for (i = 0; i < r; ++i) L->pivf[i] = w.piv[i];
-  }
+  if (L->Ef) phgmg__romstep_keep_e(L, &w, r); /* the LU of E(x) the Jacobian was built with */
   for (j = 0; j < 3; ++j)
     for (b = 0; b < r; ++b)
       for (i = 0; i < 3; ++i)
@@ -5056,8 +5064,8 @@ PHGMG_DEF phgmg_result phgmg_rom_step(phgmg_rom_stepper *s, phgmg_real *x, const
       phgmg__romw_layout(rom, L.work, &w);
       phgmg__rom_prep(rom, x, &w);
       phgmg__rom_dgd(rom, &w);
-      for (i = 0; i < r * r; ++i) L.Ef[i] = w.E[i];
-      if (phgmg__r_lu(r, L.Ef, L.pivf) != 0) { s->have_lu = 0; err = PHGMG_ERR_SINGULAR; break; }
+      if (phgmg__r_lu(r, w.E, w.piv) != 0) { s->have_lu = 0; err = PHGMG_ERR_SINGULAR; break; }
+      phgmg__romstep_keep_e(&L, &w, r);
       s->stale_e = 0;
       s->stats.e_refreshes++;
     }
