@@ -766,11 +766,31 @@ typedef struct phgmg_reduce_info {
 typedef struct phgmg_reduced phgmg_reduced;
 
 /* Build a reduced model of `sys` from snapshots X (N x ns, ldx). The system must
-   validate (phgmg_ph_validate); GENERAL nonlinear Hamiltonians are not supported
-   (PHGMG_ERR_UNSUPPORTED); a separable nonlinear part needs the polynomial form
-   (sys->poly) for the reduced model. Errors: PHGMG_ERR_SIZE (r <= m for GMG,
-   r > rank of the snapshots, ...), PHGMG_ERR_RANK, PHGMG_ERR_DEGENERATE,
-   PHGMG_ERR_NEGATIVE_WEIGHT, PHGMG_ERR_NANINF, PHGMG_ERR_NOMEM. info may be NULL. */
+   validate (phgmg_ph_validate). The pipeline (each stage a function of its own,
+   phgmg__stage_*): basis (POD; [B, V1] for GMG) -> manifold (GMG-QM: V2 and the
+   ridge fit of M; GMG_MANIFOLD: V2 and your eta) -> reduction blocks (GMG: the
+   G-blocks V0^T G V0 ... and the non-degeneracy check; SP1/SP2: W) ->
+   Hamiltonian terms (quadratic blocks; a separable part by DEIM or every term;
+   a GENERAL part) -> GL3 step map (LINEAR map, quadratic H, opts.dt > 0).
+   Every kind of Hamiltonian reduces with every method:
+   - quadratic, and separable with the built-in exp-polynomial family: the
+     online cost is independent of N, the model exports (C and binary);
+   - separable with callbacks: the online model calls the system's phi/dphi/
+     ddphi through phgmg_rom.phi_cb (O(nd) per evaluation; the C export names
+     the function `<name>_phi` for the firmware to supply; no binary export);
+   - GENERAL (H_nl, grad, Hessian by callbacks): the reduced gradient
+     Dphi^T grad H_nl(phi(x)) and Hessian are evaluated in FULL dimension
+     through phgmg_rom.ham_cb -- O(N) per gradient, O(N^2 r) (dense) or
+     O(N kb r) (banded) per Hessian, info.online_full_dim = 1; the reduced
+     object must outlive the model and is not thread-safe in evaluation; not
+     exportable (PHGMG_ERR_UNSUPPORTED); DEIM does not apply (opts.deim = 1
+     gives PHGMG_ERR_UNSUPPORTED).
+   Errors: PHGMG_ERR_INVALID_ARG (NULL, bad options: method, deim not 0/1,
+   deim_tol NaN or outside [0, 1), dt NaN/Inf/negative, lambda NaN,
+   GMG_MANIFOLD without eta or rn), PHGMG_ERR_SIZE (r <= m for GMG, r > rank of
+   the snapshots, polynomial degree > 32, ...), PHGMG_ERR_RANK, _DEGENERATE,
+   _NEGATIVE_WEIGHT, _NANINF, _NOMEM, _UNSUPPORTED. *out is NULL on every
+   failure (when out itself is not NULL). info may be NULL. */
 PHGMG_DEF phgmg_result phgmg_reduce(phgmg_reduced **out, const phgmg_ph_system *sys, const double *X,
                                     int ldx, int ns, const phgmg_reduce_opts *opts,
                                     phgmg_reduce_info *info, const phgmg_allocator *alloc);
