@@ -319,11 +319,21 @@ typedef struct phgmg_ph_system {
   const int *sep_idx;      /* SEPARABLE: coordinate of term k (0-based)      */
   const double *sep_w;     /* SEPARABLE: weights (NULL = all 1)              */
   phgmg_phi_fn phi, dphi, ddphi;
-  /* SEPARABLE, optional: if poly_deg > 0, phi_k(s) = sum_j poly[j] s^j for every
-     k (the callbacks may then be NULL). Reduced models can be exported only
-     when the nonlinearity is given this way. */
+  /* SEPARABLE, optional built-in exp-polynomial family, used iff poly_deg > 0
+     or nexp > 0 (the callbacks phi/dphi/ddphi may then be NULL):
+         phi_k(s) = sum_{j=0}^{poly_deg} c_j s^j + sum_{e<nexp} a_e exp(b_e s),
+     c = poly + t (poly_deg+1), (a_e, b_e) = expo[2 (t nexp + e)], expo[2 (t nexp + e) + 1],
+     with t = 0 for every term (phi_nfun 0 or 1) or t = k (phi_nfun == nsep, one
+     function per term). poly may be NULL when poly_deg == 0 (c = 0); expo is
+     needed iff nexp > 0. Limits: poly_deg <= 32, nexp <= 8, finite coefficients.
+     E.g. Toda phi(s) = e^s - 1 - s: poly_deg = 1, poly = {-1, -1}, nexp = 1,
+     expo = {1, 1}; cosh(s) = expo {0.5, 1, 0.5, -1}. Reduced models can be
+     exported only when the nonlinearity is given this way. */
   int poly_deg;
-  const double *poly;      /* poly_deg+1 coefficients, constant term first   */
+  const double *poly;      /* (phi_nfun or 1) x (poly_deg+1) coefficients, constant term first */
+  int nexp;                /* SEPARABLE: exponentials per function (0: none)            */
+  const double *expo;      /* pairs (a_e, b_e): expo[2*(t*nexp+e)], expo[2*(t*nexp+e)+1] */
+  int phi_nfun;            /* 0 or 1: one function for every term; nsep: one per term   */
   /* GENERAL */
   double (*H_nl)(const double *x, void *user);
   void (*grad_nl)(const double *x, double *g, void *user);
@@ -547,6 +557,34 @@ typedef struct phgmg_rom {
   const phgmg_real *Gam;  /* r x 3m   (u3 = [u(t+c1 h); u(t+c2 h); u(t+c3 h)]) */
   const phgmg_real *SX;   /* 3r x r   */
   const phgmg_real *SU;   /* 3r x 3m  */
+  /* separable nonlinearity beyond a shared polynomial (nd > 0). Term j of the
+     reduced Hamiltonian is w_j phi_j(s_j), s_j = P0_j x (+ P1_j q), with
+         phi_j(s) = sum_{i<=poly_deg} c_i s^i + sum_{e<nexp} a_e exp(b_e s),
+     c = poly + t (poly_deg+1), (a_e, b_e) = expo[2 (t nexp + e)], [... + 1],
+     t = 0 (nphi 0 or 1) or t = j (nphi == nd). poly may be NULL if poly_deg == 0. */
+  int nexp;                 /* separable: exponentials per function (0: none), <= 8    */
+  int nphi;                 /* 0/1: one function for every kept term; nd: one per kept term
+                               (then poly is nd x (poly_deg+1), row j = kept term j)  */
+  const phgmg_real *expo;   /* nphi (or 1) x nexp pairs (a, b), like phgmg_ph_system */
+  void (*phi_cb)(int term, phgmg_real s, phgmg_real d[3], void *user); /* if set: overrides
+                               poly/expo; d = phi, phi', phi'' of full-model term `term` */
+  const int *term;          /* nd: full-model index of each kept term (passed to phi_cb; NULL: j) */
+  void *phi_user;
+  /* QUADRATIC kind, manifold by callback instead of Ms:
+     phi(x) = V0 x + V2 eta(x2), x2 = x[m..r-1] (p = r - m), eta: R^p -> R^rn.
+     eta_cb fills q = eta(x2) (rn), Dq = d eta/d x2 (rn x p, col-major) and
+     D2q (rn x p*p, same layout as Ms: D2q(:, k*p + j) = d^2 eta / dx2_k dx2_j);
+     any output pointer may be NULL when not needed. For the built-in quadratic map
+     q = M(x2 kron x2) = L x2 / 2, Dq = L, D2q = Ms. With eta_cb set, Ms is not read.
+     The Jacobian / structure formulas above hold with L = Dq. */
+  void (*eta_cb)(const phgmg_real *x2, phgmg_real *q, phgmg_real *Dq, phgmg_real *D2q, void *user);
+  void *eta_user;
+  /* general nonlinear Hamiltonian part by callback on the REDUCED state (not exportable;
+     used for PHGMG_NL_GENERAL systems, whose reduced model evaluates it in full dimension):
+     adds Hn(x) to H, its gradient (r) to grad H and its Hessian (r x r) to the Hessian.
+     Any output pointer may be NULL. */
+  void (*ham_cb)(const phgmg_real *x, phgmg_real *Hn, phgmg_real *g, phgmg_real *Hs, void *user);
+  void *ham_user;
 } phgmg_rom;
 
 /* Checks a model's sizes and pointers for consistency (not its values). */
@@ -2449,22 +2487,69 @@ PHGMG__PRIV double phgmg__ph_quad(const phgmg_ph_system *s, const double *M, con
   return acc;
 }
 
+/* Built-in exp-polynomial form of the separable nonlinearity in use? */
+#define PHGMG__PH_BUILTIN(s) ((s)->poly_deg > 0 || (s)->nexp > 0)
+/* Function index t of term k for the built-in form (0: shared). */
+#define PHGMG__PH_FUN(s, k) ((s)->phi_nfun > 1 ? (k) : 0)
+
 /* d-th derivative (d = 0,1,2) of the scalar nonlinearity of term k at v. */
 PHGMG__PRIV double phgmg__ph_phi(const phgmg_ph_system *s, int k, double v, int d) {
-  if (s->poly_deg > 0) {
-    int j;
+  if (PHGMG__PH_BUILTIN(s)) {
+    int j, e, t = PHGMG__PH_FUN(s, k);
     double acc = 0.0;
-    for (j = s->poly_deg; j >= d; --j) {
-      double c = s->poly[j];
-      if (d == 1) c *= (double)j;
-      else if (d == 2) c *= (double)j * (double)(j - 1);
-      acc = acc * v + c;
+    if (s->poly) {
+      const double *c = s->poly + (size_t)t * (size_t)(s->poly_deg + 1);
+      for (j = s->poly_deg; j >= d; --j) {
+        double cj = c[j];
+        if (d == 1) cj *= (double)j;
+        else if (d == 2) cj *= (double)j * (double)(j - 1);
+        acc = acc * v + cj;
+      }
+    }
+    if (s->nexp > 0) {
+      const double *p = s->expo + 2 * (size_t)t * (size_t)s->nexp;
+      for (e = 0; e < s->nexp; ++e) {
+        double a = p[2 * e], b = p[2 * e + 1];
+        if (d == 1) a *= b;
+        else if (d == 2) a *= b * b;
+        acc += a * exp(b * v);
+      }
     }
     return acc;
   }
   if (d == 0) return s->phi(k, v, s->user);
   if (d == 1) return s->dphi(k, v, s->user);
   return s->ddphi(k, v, s->user);
+}
+
+/* phi_k, phi_k', phi_k'' at x at once (built-in form or callbacks). */
+PHGMG__PRIV void phgmg__ph_phi3(const phgmg_ph_system *s, int k, double x, double d[3]) {
+  if (PHGMG__PH_BUILTIN(s)) {
+    int j, e, t = PHGMG__PH_FUN(s, k);
+    double v0 = 0.0, v1 = 0.0, v2 = 0.0;
+    if (s->poly) {
+      const double *c = s->poly + (size_t)t * (size_t)(s->poly_deg + 1);
+      for (j = s->poly_deg; j >= 0; --j) { /* Horner with derivatives */
+        v2 = v2 * x + 2.0 * v1;
+        v1 = v1 * x + v0;
+        v0 = v0 * x + c[j];
+      }
+    }
+    if (s->nexp > 0) {
+      const double *p = s->expo + 2 * (size_t)t * (size_t)s->nexp;
+      for (e = 0; e < s->nexp; ++e) {
+        double b = p[2 * e + 1], ae = p[2 * e] * exp(b * x);
+        v0 += ae;
+        v1 += ae * b;
+        v2 += ae * b * b;
+      }
+    }
+    d[0] = v0; d[1] = v1; d[2] = v2;
+    return;
+  }
+  d[0] = s->phi(k, x, s->user);
+  d[1] = s->dphi(k, x, s->user);
+  d[2] = s->ddphi(k, x, s->user);
 }
 
 /* Structural checks shared by every entry point (no O(N^2) work). */
@@ -2479,12 +2564,17 @@ PHGMG__PRIV phgmg_result phgmg__ph_check(const phgmg_ph_system *s) {
   switch (s->nl) {
     case PHGMG_NL_NONE: break;
     case PHGMG_NL_SEPARABLE:
-      if (s->nsep < 0 || s->poly_deg < 0) return PHGMG_ERR_SIZE;
+      if (s->nsep < 0 || s->poly_deg < 0 || s->poly_deg > 32 || s->nexp < 0 || s->nexp > 8)
+        return PHGMG_ERR_SIZE;
+      if (s->phi_nfun < 0 || (s->phi_nfun > 1 && s->phi_nfun != s->nsep)) return PHGMG_ERR_SIZE;
       if (s->nsep > 0 && !s->sep_idx) return PHGMG_ERR_INVALID_ARG;
       for (k = 0; k < s->nsep; ++k)
         if (s->sep_idx[k] < 0 || s->sep_idx[k] >= s->N) return PHGMG_ERR_SIZE;
-      if (s->poly_deg > 0) {
-        if (!s->poly) return PHGMG_ERR_INVALID_ARG;
+      if (PHGMG__PH_BUILTIN(s)) {
+        size_t nf = (size_t)(s->phi_nfun > 1 ? s->phi_nfun : 1);
+        if ((s->poly_deg > 0 && !s->poly) || (s->nexp > 0 && !s->expo)) return PHGMG_ERR_INVALID_ARG;
+        if (s->poly && !phgmg__all_finite(s->poly, nf * (size_t)(s->poly_deg + 1))) return PHGMG_ERR_NANINF;
+        if (s->nexp > 0 && !phgmg__all_finite(s->expo, nf * 2 * (size_t)s->nexp)) return PHGMG_ERR_NANINF;
       } else if (s->nsep > 0 && (!s->phi || !s->dphi || !s->ddphi)) {
         return PHGMG_ERR_INVALID_ARG;
       }
