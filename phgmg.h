@@ -641,6 +641,11 @@ PHGMG_DEF size_t phgmg_rom_stepper_memsize_dt(const phgmg_rom *rom, phgmg_real d
 #define PHGMG_ROM_STEPPER_MEMSIZE_MAX(r, m, rn, nd) \
   (sizeof(phgmg_real) * (size_t)(12 * (r) * (r) + 32 * (r) + 3 * (m) + 4 * (rn) * (r) + 2 * (rn) * (rn) + 6 * (rn) + 3 * (nd) + 64) \
    + sizeof(int) * (size_t)(4 * (r) + 8) + 64)
+/* The same bound for a model with eta_cb and/or ham_cb set (room for D2q,
+   rn x (r-m)^2 <= rn r^2, and for the ham_cb gradient and Hessian). */
+#define PHGMG_ROM_STEPPER_MEMSIZE_MAX_CB(r, m, rn, nd) \
+  (PHGMG_ROM_STEPPER_MEMSIZE_MAX(r, m, rn, nd) + \
+   sizeof(phgmg_real) * (size_t)((rn) * (r) * (r) + (r) * (r) + (r) + 8))
 /* Set up a stepper in caller memory (mem must be aligned for phgmg_real and
    int; anything from malloc or a static phgmg_real array is). tol <= 0 gives
    1e-10 (double) / 1e-5 (float); max_iter <= 0 gives 10. PHGMG_ERR_WORKSPACE
@@ -3732,10 +3737,12 @@ PHGMG_DEF phgmg_result phgmg_gl3_create(phgmg_gl3 **out, const phgmg_ph_system *
   if (sys->nl == PHGMG_NL_SEPARABLE) {
     s->dd = phgmg__dalloc(&s->al, (size_t)N);
     if (!s->dd) { rc = PHGMG_ERR_NOMEM; goto fail; }
-    if (sys->poly_deg > 0) { /* dpoly[j] = (j+1) poly[j+1] */
-      s->dpoly = phgmg__dalloc(&s->al, (size_t)sys->poly_deg);
-      if (!s->dpoly) { rc = PHGMG_ERR_NOMEM; goto fail; }
-      for (k = 0; k < sys->poly_deg; ++k) s->dpoly[k] = (double)(k + 1) * sys->poly[k + 1];
+    if (PHGMG__PH_BUILTIN(sys) && sys->phi_nfun <= 1) { /* one shared function */
+      if (sys->poly_deg > 0) { /* dpoly[j] = (j+1) poly[j+1] */
+        s->dpoly = phgmg__dalloc(&s->al, (size_t)sys->poly_deg);
+        if (!s->dpoly) { rc = PHGMG_ERR_NOMEM; goto fail; }
+        for (k = 0; k < sys->poly_deg; ++k) s->dpoly[k] = (double)(k + 1) * sys->poly[k + 1];
+      }
       s->wc = phgmg__dalloc(&s->al, (size_t)N);
       if (!s->wc) { rc = PHGMG_ERR_NOMEM; goto fail; }
       for (i = 0; i < N; ++i) s->wc[i] = 0.0;
@@ -3909,21 +3916,27 @@ PHGMG__PRIV void phgmg__gl3_eval(phgmg_gl3 *s, const double *x) {
   } else if (qdiag) { /* Q diagonal: G = q .* (x + Z) in one pass */
     const double *qd = s->dq.v;
     if (s->wc) { /* ... plus the polynomial, coordinate-wise, three stages per pass */
-      const double *wc = s->wc, *dp = s->dpoly;
+      const double *wc = s->wc, *dp = s->dpoly, *ex = sys->expo;
       const double *z0 = s->Z, *z1 = s->Z + N, *z2 = s->Z + 2 * (size_t)N;
       double *g0 = s->G, *g1 = s->G + N, *g2 = s->G + 2 * (size_t)N;
-      int deg = sys->poly_deg;
+      int deg = sys->poly_deg, ne = sys->nexp;
       for (i = 0; i < N; ++i) {
         double xi = x[i], q = qd[i], w = wc[i];
         double y0 = xi + z0[i], y1 = xi + z1[i], y2 = xi + z2[i];
         if (w != 0.0) {
-          double p0 = dp[deg - 1], p1 = p0, p2 = p0;
+          double p0 = deg > 0 ? dp[deg - 1] : 0.0, p1 = p0, p2 = p0;
           int j;
           for (j = deg - 2; j >= 0; --j) {
             double c = dp[j];
             p0 = PHGMG__FMA(p0, y0, c);
             p1 = PHGMG__FMA(p1, y1, c);
             p2 = PHGMG__FMA(p2, y2, c);
+          }
+          for (j = 0; j < ne; ++j) { /* d/ds a e^{bs} = a b e^{bs} */
+            double ab = ex[2 * j] * ex[2 * j + 1], b = ex[2 * j + 1];
+            p0 = PHGMG__FMA(ab, exp(b * y0), p0);
+            p1 = PHGMG__FMA(ab, exp(b * y1), p1);
+            p2 = PHGMG__FMA(ab, exp(b * y2), p2);
           }
           g0[i] = PHGMG__FMA(w, p0, q * y0);
           g1[i] = PHGMG__FMA(w, p1, q * y1);
@@ -3952,19 +3965,20 @@ PHGMG__PRIV void phgmg__gl3_eval(phgmg_gl3 *s, const double *x) {
     if (sys->nl == PHGMG_NL_SEPARABLE) {
       const int *idx = sys->sep_idx;
       const double *w = sys->sep_w;
-      if (sys->poly_deg > 0) {
-        int deg = sys->poly_deg;
-        const double *dp = s->dpoly;
+      if (s->wc) { /* one shared built-in function: derivative coefficients precomputed */
+        int deg = sys->poly_deg, ne = sys->nexp;
+        const double *dp = s->dpoly, *ex = sys->expo;
         for (k = 0; k < sys->nsep; ++k) {
           int ix = idx[k], j;
-          double v = x[ix] + z[ix], acc = dp[deg - 1];
+          double v = x[ix] + z[ix], acc = deg > 0 ? dp[deg - 1] : 0.0;
           for (j = deg - 2; j >= 0; --j) acc = acc * v + dp[j];
+          for (j = 0; j < ne; ++j) acc += ex[2 * j] * ex[2 * j + 1] * exp(ex[2 * j + 1] * v);
           g[ix] += w ? w[k] * acc : acc;
         }
-      } else {
+      } else { /* per-term built-in functions or callbacks */
         for (k = 0; k < sys->nsep; ++k) {
           int ix = idx[k];
-          double d1 = sys->dphi(k, x[ix] + z[ix], sys->user);
+          double d1 = phgmg__ph_phi(sys, k, x[ix] + z[ix], 1);
           g[ix] += w ? w[k] * d1 : d1;
         }
       }
@@ -4437,10 +4451,12 @@ done:
 /* Everything here is in phgmg_real, allocation-free and N-independent. */
 #if PHGMG_REAL_IS_FLOAT
 #define PHGMG__RABS(x) fabsf(x)
+#define PHGMG__REXP(x) expf(x)
 #define PHGMG__RSQRT(x) sqrtf(x)
 #define PHGMG__REPS 1.1920929e-07f
 #else
 #define PHGMG__RABS(x) fabs(x)
+#define PHGMG__REXP(x) exp(x)
 #define PHGMG__RSQRT(x) sqrt(x)
 #define PHGMG__REPS 2.220446049250313e-16
 #endif
@@ -4554,6 +4570,31 @@ PHGMG__ONLINE void phgmg__r_poly(const phgmg_real *c, int deg, phgmg_real s, phg
   if (d2) *d2 = p2;
 }
 
+/* d = phi_j, phi_j', phi_j'' at s for kept term j: phi_cb if set, else the
+   exp-polynomial (shared, or row j when nphi == nd). */
+PHGMG__ONLINE void phgmg__r_phi(const phgmg_rom *rom, int j, phgmg_real s, phgmg_real d[3]) {
+  const int t = rom->nphi > 1 ? j : 0;
+  int e;
+  if (rom->phi_cb) {
+    rom->phi_cb(rom->term ? rom->term[j] : j, s, d, rom->phi_user);
+    return;
+  }
+  if (rom->poly) {
+    phgmg__r_poly(rom->poly + (size_t)t * (size_t)(rom->poly_deg + 1), rom->poly_deg, s, &d[0], &d[1], &d[2]);
+  } else {
+    d[0] = d[1] = d[2] = PHGMG__R(0);
+  }
+  if (rom->nexp > 0) {
+    const phgmg_real *ex = rom->expo + 2 * (size_t)t * (size_t)rom->nexp;
+    for (e = 0; e < rom->nexp; ++e) {
+      const phgmg_real b = ex[2 * e + 1], ae = ex[2 * e] * PHGMG__REXP(b * s);
+      d[0] += ae;
+      d[1] += ae * b;
+      d[2] += ae * b * b;
+    }
+  }
+}
+
 PHGMG_DEF phgmg_result phgmg_rom_check(const phgmg_rom *rom) {
   if (!rom) return PHGMG_ERR_INVALID_ARG;
   if (rom->r < 1 || rom->m < 0 || rom->m > rom->r || rom->nd < 0 || rom->rn < 0)
@@ -4564,14 +4605,22 @@ PHGMG_DEF phgmg_result phgmg_rom_check(const phgmg_rom *rom) {
     if (!rom->K || rom->rn != 0) return PHGMG_ERR_INVALID_ARG;
   } else if (rom->kind == PHGMG_ROM_QUADRATIC) {
     if (rom->rn < 1 || rom->r - rom->m < 1) return PHGMG_ERR_SIZE;
-    if (!rom->G00 || !rom->G01 || !rom->G10 || !rom->G11 || !rom->Q01 || !rom->Q11 || !rom->Ms)
+    if (!rom->G00 || !rom->G01 || !rom->G10 || !rom->G11 || !rom->Q01 || !rom->Q11 ||
+        (!rom->Ms && !rom->eta_cb))
       return PHGMG_ERR_INVALID_ARG;
     if (rom->nd > 0 && !rom->P1) return PHGMG_ERR_INVALID_ARG;
   } else {
     return PHGMG_ERR_INVALID_ARG;
   }
-  if (rom->nd > 0 && (!rom->P0 || !rom->w || !rom->poly || rom->poly_deg < 0 || rom->poly_deg > 32))
-    return PHGMG_ERR_INVALID_ARG;
+  if (rom->nd > 0) {
+    if (!rom->P0 || !rom->w) return PHGMG_ERR_INVALID_ARG;
+    if (rom->poly_deg < 0 || rom->poly_deg > 32) return PHGMG_ERR_INVALID_ARG;
+    if (rom->nexp < 0 || rom->nexp > 8) return PHGMG_ERR_SIZE;
+    if (rom->nphi < 0 || (rom->nphi > 1 && rom->nphi != rom->nd)) return PHGMG_ERR_SIZE;
+    if (!rom->phi_cb && ((rom->poly_deg > 0 && !rom->poly) || (rom->nexp > 0 && !rom->expo) ||
+                         (!rom->poly && rom->nexp == 0)))
+      return PHGMG_ERR_INVALID_ARG;
+  }
   if (rom->Phi && (!rom->Gam || !rom->SX || !rom->SU || !(rom->dt > PHGMG__R(0))))
     return PHGMG_ERR_INVALID_ARG;
   return PHGMG_OK;
@@ -4581,6 +4630,10 @@ PHGMG_DEF phgmg_result phgmg_rom_check(const phgmg_rom *rom) {
    evaluator, so size and carving cannot drift. */
 typedef struct phgmg__romw {
   phgmg_real *Lp, *q, *a1, *b1, *b2, *c, *d, *E, *t, *tmp, *xp, *fm, *g;
+  phgmg_real *D2;       /* eta_cb: D2q (rn x p*p), else NULL */
+  phgmg_real *hg, *hH;  /* ham_cb: its gradient (r) and Hessian (r x r), else NULL */
+  const phgmg_real *Ms; /* second derivatives of the manifold: rom->Ms or D2 */
+  int d2;               /* eta_cb: prep also fills D2 (set by Hessian/Jacobian callers) */
   int *piv; /* r pivots of the LU of E, carved from the same real array */
 } phgmg__romw;
 
@@ -4602,6 +4655,14 @@ PHGMG__ONLINE size_t phgmg__romw_layout(const phgmg_rom *rom, phgmg_real *base, 
   w->xp = PHGMG__CARVE(base, o); o += r;
   w->fm = PHGMG__CARVE(base, o); o += r;
   w->g = PHGMG__CARVE(base, o); o += r;
+  w->D2 = rom->eta_cb ? PHGMG__CARVE(base, o) : NULL;
+  o += rom->eta_cb ? rn * (r - (size_t)rom->m) * (r - (size_t)rom->m) : 0;
+  w->hg = rom->ham_cb ? PHGMG__CARVE(base, o) : NULL;
+  o += rom->ham_cb ? r : 0;
+  w->hH = rom->ham_cb ? PHGMG__CARVE(base, o) : NULL;
+  o += rom->ham_cb ? r * r : 0;
+  w->Ms = rom->eta_cb ? w->D2 : rom->Ms;
+  w->d2 = 0;
   w->piv = base ? PHGMG__CAST(int *, PHGMG__CAST(void *, base + o)) : NULL;
   o += (r * sizeof(int) + sizeof(phgmg_real) - 1) / sizeof(phgmg_real);
   return o;
@@ -4611,11 +4672,14 @@ PHGMG_DEF size_t phgmg_rom_eval_work_size(const phgmg_rom *rom) {
   return phgmg__romw_layout(rom, NULL, NULL);
 }
 
-/* q = M (x2 kron x2) via Lp (QUADRATIC), and the kept coordinates c. */
+/* q = M (x2 kron x2) via Lp (QUADRATIC), and the kept coordinates c. With
+   eta_cb: one call gives q, Lp = Dq (and D2q into w->D2 when w->d2). */
 PHGMG__ONLINE void phgmg__rom_prep(const phgmg_rom *rom, const phgmg_real *x, const phgmg__romw *w) {
   const int r = rom->r, m = rom->m, rn = rom->rn, nd = rom->nd, p = r - m;
   int i, k;
-  if (rom->kind == PHGMG_ROM_QUADRATIC) {
+  if (rom->kind == PHGMG_ROM_QUADRATIC && rom->eta_cb) {
+    rom->eta_cb(x + m, w->q, w->Lp, w->d2 ? w->D2 : NULL, rom->eta_user);
+  } else if (rom->kind == PHGMG_ROM_QUADRATIC) {
     const phgmg_real *x2 = x + m;
     for (k = 0; k < p; ++k) /* Lp(:,k) = sum_j Ms(:, k*p + j) x2_j: block k of Ms times x2 */
       phgmg__r_gemv(rn, p, rom->Ms + (size_t)k * p * rn, x2, 0, w->Lp + (size_t)k * rn);
@@ -4645,9 +4709,14 @@ PHGMG_DEF phgmg_real phgmg_rom_hamiltonian(const phgmg_rom *rom, const phgmg_rea
   for (j = 0; j < r; ++j) h += x[j] * w.tmp[j];
   h *= PHGMG__R(0.5);
   for (j = 0; j < rom->nd; ++j) {
-    phgmg_real v;
-    phgmg__r_poly(rom->poly, rom->poly_deg, w.c[j], &v, NULL, NULL);
-    h += rom->w[j] * v;
+    phgmg_real d[3];
+    phgmg__r_phi(rom, j, w.c[j], d);
+    h += rom->w[j] * d[0];
+  }
+  if (rom->ham_cb) {
+    phgmg_real hn = PHGMG__R(0);
+    rom->ham_cb(x, &hn, NULL, NULL, rom->ham_user);
+    h += hn;
   }
   return h;
 }
@@ -4659,11 +4728,15 @@ PHGMG__ONLINE void phgmg__rom_grad(const phgmg_rom *rom, const phgmg_real *x, ph
   int j;
   phgmg__rom_prep(rom, x, w);
   for (j = 0; j < nd; ++j) {
-    phgmg_real d1;
-    phgmg__r_poly(rom->poly, rom->poly_deg, w->c[j], NULL, &d1, NULL);
-    w->d[j] = rom->w[j] * d1;
+    phgmg_real d[3];
+    phgmg__r_phi(rom, j, w->c[j], d);
+    w->d[j] = rom->w[j] * d[1];
   }
   phgmg__r_gemv(r, r, rom->Qh, x, 0, g);
+  if (rom->ham_cb) {
+    rom->ham_cb(x, NULL, w->hg, NULL, rom->ham_user);
+    for (j = 0; j < r; ++j) g[j] += w->hg[j];
+  }
   if (nd > 0) phgmg__r_gemvt(nd, r, rom->P0, w->d, 1, g);
   if (rom->kind == PHGMG_ROM_QUADRATIC) {
     phgmg__r_gemv(r, rn, rom->Q01, w->q, 1, g);
@@ -4775,17 +4848,21 @@ PHGMG__ONLINE void phgmg__rom_hess(const phgmg_rom *rom, const phgmg_real *x, ph
       }
       phgmg__r_gemv(rn, rn, rom->Q11, lk, 0, w->b1);
       for (a = 0; a < p; ++a) {
-        const phgmg_real *la = w->Lp + (size_t)a * rn, *ms = rom->Ms + ((size_t)a * p + k) * rn;
+        const phgmg_real *la = w->Lp + (size_t)a * rn, *ms = w->Ms + ((size_t)a * p + k) * rn;
         phgmg_real s = PHGMG__R(0);
         for (i = 0; i < rn; ++i) s += la[i] * w->b1[i] + ms[i] * w->a1[i];
         H[(m + a) + (size_t)(m + k) * r] += s;
       }
     }
   }
+  if (rom->ham_cb) {
+    rom->ham_cb(x, NULL, NULL, w->hH, rom->ham_user);
+    for (b = 0; b < r * r; ++b) H[b] += w->hH[b];
+  }
   for (j = 0; j < nd; ++j) {
-    phgmg_real d2, wj;
-    phgmg__r_poly(rom->poly, rom->poly_deg, w->c[j], NULL, NULL, &d2);
-    wj = rom->w[j] * d2;
+    phgmg_real d[3], wj;
+    phgmg__r_phi(rom, j, w->c[j], d);
+    wj = rom->w[j] * d[2];
     if (wj == PHGMG__R(0)) continue;
     for (a = 0; a < r; ++a) w->xp[a] = rom->P0[j + (size_t)a * nd]; /* row j of P0 + P1 L */
     if (rom->kind == PHGMG_ROM_QUADRATIC)
@@ -4847,11 +4924,11 @@ PHGMG__ONLINE phgmg_result phgmg__rom_jac(const phgmg_rom *rom, const phgmg_real
   for (j = 0; j < p; ++j) {
     phgmg_real *sj = w->t; /* s_j (rn) */
     phgmg_real *cj = Jf + (size_t)(m + j) * r;
-    phgmg__r_gemv(rn, p, rom->Ms + (size_t)j * p * rn, w->fm + m, 0, sj);
+    phgmg__r_gemv(rn, p, w->Ms + (size_t)j * p * rn, w->fm + m, 0, sj);
     phgmg__r_gemv(rn, rn, rom->G11, sj, 0, w->b2);
     phgmg__r_gemv(r, rn, rom->G01, sj, 0, w->tmp);
     for (k = 0; k < p; ++k) {
-      const phgmg_real *lk = w->Lp + (size_t)k * rn, *ms = rom->Ms + ((size_t)j * p + k) * rn;
+      const phgmg_real *lk = w->Lp + (size_t)k * rn, *ms = w->Ms + ((size_t)j * p + k) * rn;
       phgmg_real s = PHGMG__R(0);
       for (i = 0; i < rn; ++i) s += lk[i] * w->b2[i] + ms[i] * w->b1[i];
       w->tmp[m + k] += s;
@@ -4865,6 +4942,7 @@ PHGMG__ONLINE phgmg_result phgmg__rom_jac(const phgmg_rom *rom, const phgmg_real
 PHGMG_DEF void phgmg_rom_hessian(const phgmg_rom *rom, const phgmg_real *x, phgmg_real *H, phgmg_real *work) {
   phgmg__romw w;
   phgmg__romw_layout(rom, work, &w);
+  w.d2 = 1;
   phgmg__rom_hess(rom, x, H, &w);
 }
 
@@ -4872,6 +4950,7 @@ PHGMG_DEF phgmg_result phgmg_rom_jacobian(const phgmg_rom *rom, const phgmg_real
                                           phgmg_real *work) {
   phgmg__romw w;
   phgmg__romw_layout(rom, work, &w);
+  w.d2 = 1;
   return phgmg__rom_jac(rom, x, Jf, &w);
 }
 
@@ -5069,6 +5148,7 @@ PHGMG__ONLINE phgmg_result phgmg__romstep_factor(phgmg_rom_stepper *s, const phg
   phgmg_result rc;
   int i, j, a, b;
   phgmg__romw_layout(rom, L->work, &w);
+  w.d2 = 1;
   rc = phgmg__rom_jac(rom, x, L->Jf, &w);
   if (rc != PHGMG_OK) { s->have_lu = 0; return rc; }
   if (!phgmg__r_finite(L->Jf, r * r)) { s->have_lu = 0; return PHGMG_ERR_NANINF; }
