@@ -6435,7 +6435,7 @@ PHGMG_DEF void phgmg_err_energy(const phgmg_energy *energy, int nsteps, double *
 #include <stdint.h>
 
 /* The arrays of a phgmg_rom in file order, with their sizes. */
-#define PHGMG__NFIELDS 18
+#define PHGMG__NFIELDS 19
 typedef struct phgmg__field { size_t off; const char *name; } phgmg__field;
 static const phgmg__field phgmg__fields[PHGMG__NFIELDS] = {
   {offsetof(phgmg_rom, Bh), "Bh"},   {offsetof(phgmg_rom, Qh), "Qh"},   {offsetof(phgmg_rom, K), "K"},
@@ -6443,7 +6443,8 @@ static const phgmg__field phgmg__fields[PHGMG__NFIELDS] = {
   {offsetof(phgmg_rom, G11), "G11"}, {offsetof(phgmg_rom, Q01), "Q01"}, {offsetof(phgmg_rom, Q11), "Q11"},
   {offsetof(phgmg_rom, Ms), "Ms"},   {offsetof(phgmg_rom, P0), "P0"},   {offsetof(phgmg_rom, P1), "P1"},
   {offsetof(phgmg_rom, w), "w"},     {offsetof(phgmg_rom, poly), "poly"}, {offsetof(phgmg_rom, Phi), "Phi"},
-  {offsetof(phgmg_rom, Gam), "Gam"}, {offsetof(phgmg_rom, SX), "SX"},   {offsetof(phgmg_rom, SU), "SU"}};
+  {offsetof(phgmg_rom, Gam), "Gam"}, {offsetof(phgmg_rom, SX), "SX"},   {offsetof(phgmg_rom, SU), "SU"},
+  {offsetof(phgmg_rom, expo), "expo"}};
 
 PHGMG__ONLINE const phgmg_real **phgmg__field_ptr(phgmg_rom *rom, int i) {
   return PHGMG__CAST(const phgmg_real **, PHGMG__CAST(void *, PHGMG__CAST(char *, PHGMG__CAST(void *, rom)) + phgmg__fields[i].off));
@@ -6454,7 +6455,7 @@ PHGMG__ONLINE const phgmg_real *phgmg__field_get(const phgmg_rom *rom, int i) {
 /* Number of scalars of field i (0 if the field does not apply). */
 PHGMG__ONLINE size_t phgmg__field_len(const phgmg_rom *rom, int i) {
   const size_t r = (size_t)rom->r, m = (size_t)rom->m, rn = (size_t)rom->rn, nd = (size_t)rom->nd;
-  const size_t p = (size_t)(rom->r - rom->m);
+  const size_t p = (size_t)(rom->r - rom->m), nf = (size_t)(rom->nphi > 1 ? rom->nphi : 1);
   switch (i) {
     case 0: return r * m;
     case 1: return r * r;
@@ -6469,15 +6470,26 @@ PHGMG__ONLINE size_t phgmg__field_len(const phgmg_rom *rom, int i) {
     case 10: return nd * r;
     case 11: return nd * rn;
     case 12: return nd;
-    case 13: return nd ? (size_t)rom->poly_deg + 1 : 0;
+    case 13: return nd ? nf * ((size_t)rom->poly_deg + 1) : 0;
     case 14: return r * r;
     case 15: return r * 3 * m;
     case 16: return 3 * r * r;
-    default: return 3 * r * 3 * m;
+    case 17: return 3 * r * 3 * m;
+    default: return nd ? nf * 2 * (size_t)rom->nexp : 0;
   }
 }
 
 #define PHGMG__HDR_BYTES (8 + 4 * 10 + 8)
+/* Version 2 (written only when a model needs it): nexp, nphi, nterm after the
+   version-1 header; the expo field (mask bit 18); nterm (0 or nd) uint32 term
+   indices after the scalars. */
+#define PHGMG__HDR2_BYTES (PHGMG__HDR_BYTES + 12)
+PHGMG__ONLINE int phgmg__rom_v2(const phgmg_rom *rom) {
+  return rom->nd > 0 && (rom->nexp > 0 || rom->nphi > 1 || rom->term);
+}
+PHGMG__ONLINE size_t phgmg__rom_nterm(const phgmg_rom *rom) {
+  return phgmg__rom_v2(rom) && rom->term ? (size_t)rom->nd : 0;
+}
 
 PHGMG__ONLINE void phgmg__put32(unsigned char *b, uint32_t v) {
   b[0] = (unsigned char)(v & 255u); b[1] = (unsigned char)((v >> 8) & 255u);
@@ -6523,23 +6535,25 @@ PHGMG_DEF size_t phgmg_rom_serialized_size(const phgmg_rom *rom) {
   int i;
   for (i = 0; i < PHGMG__NFIELDS; ++i)
     if (phgmg__field_get(rom, i)) n += phgmg__field_len(rom, i);
-  return PHGMG__HDR_BYTES + n * sizeof(phgmg_real) + 4;
+  if (!phgmg__rom_v2(rom)) return PHGMG__HDR_BYTES + n * sizeof(phgmg_real) + 4;
+  return PHGMG__HDR2_BYTES + n * sizeof(phgmg_real) + 4 * phgmg__rom_nterm(rom) + 4;
 }
 
 PHGMG_DEF phgmg_result phgmg_rom_serialize(const phgmg_rom *rom, void *buf, size_t cap, size_t *written) {
   unsigned char *b = PHGMG__CAST(unsigned char *, buf);
-  size_t need, o;
+  size_t need, o, k;
   uint32_t mask = 0;
   int i;
   phgmg_result rc = phgmg_rom_check(rom);
   if (rc != PHGMG_OK) return rc;
+  if (rom->phi_cb || rom->eta_cb || rom->ham_cb) return PHGMG_ERR_UNSUPPORTED;
   if (!buf) return PHGMG_ERR_INVALID_ARG;
   need = phgmg_rom_serialized_size(rom);
   if (cap < need) return PHGMG_ERR_WORKSPACE;
   for (i = 0; i < PHGMG__NFIELDS; ++i)
     if (phgmg__field_get(rom, i)) mask |= 1u << i;
   memcpy(b, "PHGMGROM", 8);
-  phgmg__put32(b + 8, PHGMG_ROM_FORMAT_VERSION);
+  phgmg__put32(b + 8, phgmg__rom_v2(rom) ? PHGMG_ROM_FORMAT_VERSION : 1u);
   phgmg__put32(b + 12, (uint32_t)sizeof(phgmg_real));
   phgmg__put32(b + 16, (uint32_t)rom->kind);
   phgmg__put32(b + 20, (uint32_t)rom->method);
@@ -6551,9 +6565,15 @@ PHGMG_DEF phgmg_result phgmg_rom_serialize(const phgmg_rom *rom, void *buf, size
   phgmg__put32(b + 44, mask);
   phgmg__put_f64(b + 48, (double)rom->dt);
   o = PHGMG__HDR_BYTES;
+  if (phgmg__rom_v2(rom)) {
+    phgmg__put32(b + o, (uint32_t)rom->nexp);
+    phgmg__put32(b + o + 4, (uint32_t)rom->nphi);
+    phgmg__put32(b + o + 8, (uint32_t)phgmg__rom_nterm(rom));
+    o = PHGMG__HDR2_BYTES;
+  }
   for (i = 0; i < PHGMG__NFIELDS; ++i) {
     const phgmg_real *a = phgmg__field_get(rom, i);
-    size_t k, n = phgmg__field_len(rom, i);
+    size_t n = phgmg__field_len(rom, i);
     if (!a) continue;
     for (k = 0; k < n; ++k, o += sizeof(phgmg_real)) {
 #if PHGMG_REAL_IS_FLOAT
@@ -6563,6 +6583,7 @@ PHGMG_DEF phgmg_result phgmg_rom_serialize(const phgmg_rom *rom, void *buf, size
 #endif
     }
   }
+  for (k = 0; k < phgmg__rom_nterm(rom); ++k, o += 4) phgmg__put32(b + o, (uint32_t)rom->term[k]);
   phgmg__put32(b + o, phgmg__fnv1a(b, o));
   if (written) *written = o + 4;
   return PHGMG_OK;
@@ -6571,16 +6592,26 @@ PHGMG_DEF phgmg_result phgmg_rom_serialize(const phgmg_rom *rom, void *buf, size
 /* Parse and validate the header; fills rom's scalars and returns the scalar
    count of the payload and the file's scalar size. */
 PHGMG__ONLINE phgmg_result phgmg__rom_header(const unsigned char *b, size_t len, phgmg_rom *rom,
-                                             size_t *nscal, size_t *ssize, uint32_t *mask_out) {
+                                             size_t *nscal, size_t *ssize, uint32_t *mask_out,
+                                             size_t *nterm_out) {
   uint32_t ver, ss, mask;
-  size_t n = 0, total;
+  size_t n = 0, total, hdr = PHGMG__HDR_BYTES, nterm = 0;
   int i;
   if (!b) return PHGMG_ERR_INVALID_ARG;
   if (len < PHGMG__HDR_BYTES + 4 || memcmp(b, "PHGMGROM", 8) != 0) return PHGMG_ERR_FORMAT;
   ver = phgmg__get32(b + 8);
   ss = phgmg__get32(b + 12);
-  if (ver != PHGMG_ROM_FORMAT_VERSION || (ss != 4 && ss != 8)) return PHGMG_ERR_FORMAT;
+  if ((ver != 1u && ver != PHGMG_ROM_FORMAT_VERSION) || (ss != 4 && ss != 8)) return PHGMG_ERR_FORMAT;
   memset(rom, 0, sizeof *rom);
+  if (ver == 2u) {
+    if (len < PHGMG__HDR2_BYTES + 4) return PHGMG_ERR_FORMAT;
+    hdr = PHGMG__HDR2_BYTES;
+    if (phgmg__get32(b + 56) > 8u || phgmg__get32(b + 60) > (1u << 24) || phgmg__get32(b + 64) > (1u << 24))
+      return PHGMG_ERR_FORMAT;
+    rom->nexp = (int)phgmg__get32(b + 56);
+    rom->nphi = (int)phgmg__get32(b + 60);
+    nterm = (size_t)phgmg__get32(b + 64);
+  }
   if (phgmg__get32(b + 24) > 4096u || phgmg__get32(b + 28) > 4096u || phgmg__get32(b + 32) > 4096u ||
       phgmg__get32(b + 36) > (1u << 24) || phgmg__get32(b + 40) > 32u || phgmg__get32(b + 16) > 2u ||
       phgmg__get32(b + 20) > 4u)
@@ -6601,8 +6632,10 @@ PHGMG__ONLINE phgmg_result phgmg__rom_header(const unsigned char *b, size_t len,
 #endif
     rom->dt = (phgmg_real)dt;
   }
-  if (mask >> PHGMG__NFIELDS) return PHGMG_ERR_FORMAT;
+  if (mask >> (ver == 1u ? 18 : PHGMG__NFIELDS)) return PHGMG_ERR_FORMAT;
   if (rom->m > rom->r) return PHGMG_ERR_FORMAT;
+  if ((rom->nphi > 1 && rom->nphi != rom->nd) || (nterm != 0 && nterm != (size_t)rom->nd))
+    return PHGMG_ERR_FORMAT;
   for (i = 0; i < PHGMG__NFIELDS; ++i)
     if (mask & (1u << i)) {
       size_t k = phgmg__field_len(rom, i);
@@ -6610,12 +6643,13 @@ PHGMG__ONLINE phgmg_result phgmg__rom_header(const unsigned char *b, size_t len,
       n += k;
     }
   if (n > (len / ss)) return PHGMG_ERR_FORMAT;
-  total = PHGMG__HDR_BYTES + n * ss + 4;
+  total = hdr + n * ss + 4 * nterm + 4;
   if (total != len) return PHGMG_ERR_FORMAT;
   if (phgmg__get32(b + total - 4) != phgmg__fnv1a(b, total - 4)) return PHGMG_ERR_FORMAT;
   *nscal = n;
   *ssize = ss;
   *mask_out = mask;
+  *nterm_out = nterm;
   return PHGMG_OK;
 }
 
@@ -6623,9 +6657,10 @@ PHGMG_DEF phgmg_result phgmg_rom_deserialize_size(const void *buf, size_t len, s
   phgmg_rom tmp;
   size_t n = 0, ss = 0;
   uint32_t mask = 0;
-  phgmg_result rc = phgmg__rom_header(PHGMG__CAST(const unsigned char *, buf), len, &tmp, &n, &ss, &mask);
+  size_t nterm = 0;
+  phgmg_result rc = phgmg__rom_header(PHGMG__CAST(const unsigned char *, buf), len, &tmp, &n, &ss, &mask, &nterm);
   if (rc != PHGMG_OK) return rc;
-  if (need) *need = n * sizeof(phgmg_real) + sizeof(phgmg_real);
+  if (need) *need = n * sizeof(phgmg_real) + sizeof(phgmg_real) + nterm * sizeof(int);
   return PHGMG_OK;
 }
 
@@ -6633,15 +6668,16 @@ PHGMG_DEF phgmg_result phgmg_rom_deserialize(const void *buf, size_t len, phgmg_
                                              size_t mem_size) {
   const unsigned char *b = PHGMG__CAST(const unsigned char *, buf);
   phgmg_rom tmp;
-  size_t n = 0, ss = 0, o = PHGMG__HDR_BYTES, k;
+  size_t n = 0, ss = 0, o, k, nterm = 0;
   uint32_t mask = 0;
   phgmg_real *dst = PHGMG__CAST(phgmg_real *, mem);
   phgmg_result rc;
   int i;
   if (!rom || !mem) return PHGMG_ERR_INVALID_ARG;
-  rc = phgmg__rom_header(b, len, &tmp, &n, &ss, &mask);
+  rc = phgmg__rom_header(b, len, &tmp, &n, &ss, &mask, &nterm);
   if (rc != PHGMG_OK) return rc;
-  if (mem_size < n * sizeof(phgmg_real) + sizeof(phgmg_real)) return PHGMG_ERR_WORKSPACE;
+  if (mem_size < n * sizeof(phgmg_real) + sizeof(phgmg_real) + nterm * sizeof(int)) return PHGMG_ERR_WORKSPACE;
+  o = phgmg__get32(b + 8) == 1u ? PHGMG__HDR_BYTES : PHGMG__HDR2_BYTES;
   if (((size_t)mem) % sizeof(phgmg_real) != 0) return PHGMG_ERR_INVALID_ARG;
   for (i = 0; i < PHGMG__NFIELDS; ++i) {
     const size_t len_i = phgmg__field_len(&tmp, i);
@@ -6651,6 +6687,15 @@ PHGMG_DEF phgmg_result phgmg_rom_deserialize(const void *buf, size_t len, phgmg_
     if (!phgmg__r_finite(dst, (int)len_i)) return PHGMG_ERR_FORMAT;
     *phgmg__field_ptr(&tmp, i) = dst;
     dst += len_i;
+  }
+  if (nterm) { /* the term indices follow the scalars in mem */
+    int *ti = PHGMG__CAST(int *, PHGMG__CAST(void *, dst));
+    for (k = 0; k < nterm; ++k, o += 4) {
+      uint32_t v = phgmg__get32(b + o);
+      if (v > (1u << 30)) return PHGMG_ERR_FORMAT;
+      ti[k] = (int)v;
+    }
+    tmp.term = ti;
   }
   rc = phgmg_rom_check(&tmp);
   if (rc != PHGMG_OK) return PHGMG_ERR_FORMAT;
@@ -6722,6 +6767,7 @@ PHGMG_DEF phgmg_result phgmg_rom_export_c(const phgmg_rom *rom, const char *name
   size_t k;
   phgmg_result rc = phgmg_rom_check(rom);
   if (rc != PHGMG_OK) return rc;
+  if (rom->ham_cb) return PHGMG_ERR_UNSUPPORTED;
   if (!name || !path) return PHGMG_ERR_INVALID_ARG;
   f = fopen(path, "w");
   if (!f) return PHGMG_ERR_IO;
@@ -6734,7 +6780,7 @@ PHGMG_DEF phgmg_result phgmg_rom_export_c(const phgmg_rom *rom, const char *name
   for (i = 0; i < PHGMG__NFIELDS; ++i) {
     const phgmg_real *a = phgmg__field_get(rom, i);
     const size_t n = phgmg__field_len(rom, i);
-    if (!a) continue;
+    if (!a || n == 0) continue; /* no zero-length arrays in C */
     ok &= fprintf(f, "static const phgmg_real %s_%s[%lu] = {", name, phgmg__fields[i].name, (unsigned long)n) > 0;
     for (k = 0; k < n; ++k)
 #if PHGMG_REAL_IS_FLOAT
@@ -6744,10 +6790,22 @@ PHGMG_DEF phgmg_result phgmg_rom_export_c(const phgmg_rom *rom, const char *name
 #endif
     ok &= fprintf(f, "};\n") > 0;
   }
+  if (rom->term && rom->nd > 0) {
+    ok &= fprintf(f, "static const int %s_term[%d] = {", name, rom->nd) > 0;
+    for (i = 0; i < rom->nd; ++i) ok &= fprintf(f, "%s%d", i == 0 ? "\n  " : (i % 12 ? ", " : ",\n  "), rom->term[i]) > 0;
+    ok &= fprintf(f, "};\n") > 0;
+  }
+  if (rom->phi_cb)
+    ok &= fprintf(f, "/* supplied by the firmware: phi, phi', phi'' of full-model term `term` at s */\n"
+                     "extern void %s_phi(int term, phgmg_real s, phgmg_real d[3], void *user);\n", name) > 0;
+  if (rom->eta_cb)
+    ok &= fprintf(f, "/* supplied by the firmware: the manifold q = eta(x2), Dq, D2q (see phgmg_rom) */\n"
+                     "extern void %s_eta(const phgmg_real *x2, phgmg_real *q, phgmg_real *Dq, phgmg_real *D2q,\n"
+                     "                   void *user);\n", name) > 0;
   ok &= fprintf(f, "static const phgmg_rom %s = {\n  %d, %d, %d, %d, %d, %d, %d,\n ", name, rom->kind,
                 rom->method, rom->r, rom->m, rom->rn, rom->nd, rom->poly_deg) > 0;
   for (i = 0; i < 14; ++i) {
-    if (phgmg__field_get(rom, i)) ok &= fprintf(f, " %s_%s,", name, phgmg__fields[i].name) > 0;
+    if (phgmg__field_get(rom, i) && phgmg__field_len(rom, i) > 0) ok &= fprintf(f, " %s_%s,", name, phgmg__fields[i].name) > 0;
     else ok &= fprintf(f, " NULL,") > 0;
   }
 #if PHGMG_REAL_IS_FLOAT
@@ -6755,11 +6813,21 @@ PHGMG_DEF phgmg_result phgmg_rom_export_c(const phgmg_rom *rom, const char *name
 #else
   ok &= fprintf(f, "\n  %.17g,\n ", rom->dt) > 0;
 #endif
-  for (i = 14; i < PHGMG__NFIELDS; ++i) {
-    if (phgmg__field_get(rom, i)) ok &= fprintf(f, " %s_%s%s", name, phgmg__fields[i].name, i + 1 < PHGMG__NFIELDS ? "," : "") > 0;
-    else ok &= fprintf(f, " NULL%s", i + 1 < PHGMG__NFIELDS ? "," : "") > 0;
+  for (i = 14; i < 18; ++i) {
+    if (phgmg__field_get(rom, i) && phgmg__field_len(rom, i) > 0) ok &= fprintf(f, " %s_%s,", name, phgmg__fields[i].name) > 0;
+    else ok &= fprintf(f, " NULL,") > 0;
   }
-  ok &= fprintf(f, "\n};\n") > 0;
+  /* nexp, nphi, expo, phi_cb, term, phi_user, eta_cb, eta_user (ham_cb, ham_user: 0) */
+  ok &= fprintf(f, "\n  %d, %d,", rom->nexp, rom->nphi) > 0;
+  if (rom->expo && phgmg__field_len(rom, 18) > 0) ok &= fprintf(f, " %s_expo,", name) > 0;
+  else ok &= fprintf(f, " NULL,") > 0;
+  if (rom->phi_cb) ok &= fprintf(f, " %s_phi,", name) > 0;
+  else ok &= fprintf(f, " 0,") > 0;
+  if (rom->term && rom->nd > 0) ok &= fprintf(f, " %s_term, NULL,", name) > 0;
+  else ok &= fprintf(f, " NULL, NULL,") > 0;
+  if (rom->eta_cb) ok &= fprintf(f, " %s_eta, NULL,", name) > 0;
+  else ok &= fprintf(f, " 0, NULL,") > 0;
+  ok &= fprintf(f, " 0, NULL\n};\n") > 0;
   if (fclose(f) != 0) ok = 0;
   return ok ? PHGMG_OK : PHGMG_ERR_IO;
 }
