@@ -533,7 +533,7 @@ typedef struct phgmg_rom {
   int r, m;      /* reduced order, ports                             */
   int rn;        /* QUADRATIC: lifting dimension r_n, else 0         */
   int nd;        /* separable nonlinear terms kept online (DEIM points), 0 = quadratic H */
-  int poly_deg;  /* degree of the shared polynomial phi (nd > 0)     */
+  int poly_deg;  /* degree of the polynomial part of phi (nd > 0; see nexp/nphi below) */
   const phgmg_real *Bh;   /* r x m   reduced port matrix (W^T B; [I;0] for GMG)   */
   const phgmg_real *Qh;   /* r x r   V0^T Q V0                                     */
   const phgmg_real *K;    /* r x r   LINEAR: J - R reduced (constant)              */
@@ -549,7 +549,7 @@ typedef struct phgmg_rom {
   const phgmg_real *P0;   /* nd x r   rows of V0 at the kept coordinates */
   const phgmg_real *P1;   /* nd x rn  rows of V2 (QUADRATIC)             */
   const phgmg_real *w;    /* nd       weights (structure-preserving DEIM) */
-  const phgmg_real *poly; /* poly_deg+1 coefficients of phi, constant first */
+  const phgmg_real *poly; /* (nphi or 1) x (poly_deg+1) coefficients of phi, constant first */
   /* precomputed GL3 step map (LINEAR, nd == 0; NULL if absent) for step dt:
      x+ = Phi x + Gam u3, stage values Y = SX x + SU u3 (for the energy). */
   phgmg_real dt;
@@ -582,7 +582,10 @@ typedef struct phgmg_rom {
   /* general nonlinear Hamiltonian part by callback on the REDUCED state (not exportable;
      used for PHGMG_NL_GENERAL systems, whose reduced model evaluates it in full dimension):
      adds Hn(x) to H, its gradient (r) to grad H and its Hessian (r x r) to the Hessian.
-     Any output pointer may be NULL. */
+     The callback WRITES (does not add to) its non-NULL outputs: *Hn, g (r), Hs
+     (r x r, col-major, symmetric); the library adds them. Any output pointer may be NULL.
+     Workspace: phgmg_rom_eval_work_size / the stepper memsize include the room the
+     callbacks need; for static buffers use PHGMG_ROM_STEPPER_MEMSIZE_MAX_CB. */
   void (*ham_cb)(const phgmg_real *x, phgmg_real *Hn, phgmg_real *g, phgmg_real *Hs, void *user);
   void *ham_user;
 } phgmg_rom;
@@ -855,12 +858,23 @@ PHGMG_DEF phgmg_result phgmg_deim(int nterms, int ns, const double *F, int ldf, 
    Serialising and loading work in memory and need neither stdio nor heap;
    the file helpers are compiled out with PHGMG_NO_STDIO or PHGMG_NO_OFFLINE.
    A file written by a double build loads into a float build (values are
-   rounded once) and vice versa. */
+   rounded once) and vice versa.
+   Callbacks cannot be stored: phgmg_rom_serialize / _save refuse a model with
+   phi_cb, eta_cb or ham_cb (PHGMG_ERR_UNSUPPORTED). phgmg_rom_export_c refuses
+   ham_cb; for phi_cb / eta_cb it declares and references
+       extern void <name>_phi(int term, phgmg_real s, phgmg_real d[3], void *user);
+       extern void <name>_eta(const phgmg_real *x2, phgmg_real *q, phgmg_real *Dq,
+                              phgmg_real *D2q, void *user);
+   which the firmware supplies (user = NULL); the term indices are exported
+   as `static const int <name>_term[nd]`. */
 #ifdef __cplusplus
 extern "C" {
 #endif
 
-#define PHGMG_ROM_FORMAT_VERSION 1u
+/* Format version 2 adds the exp-polynomial data (nexp, nphi, expo, per-term
+   poly) and the term indices; a model without them is still written as
+   version 1, and both versions load. */
+#define PHGMG_ROM_FORMAT_VERSION 2u
 
 /* Bytes phgmg_rom_serialize writes for this model. */
 PHGMG_DEF size_t phgmg_rom_serialized_size(const phgmg_rom *rom);
