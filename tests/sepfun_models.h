@@ -28,16 +28,17 @@ typedef struct sf_model {
   phgmg_rom rom;
 } sf_model;
 
-static const double sf_morse_D = 0.7, sf_morse_a = 1.3;
+#define sf_morse_D 0.7
+#define sf_morse_a 1.3
 
 /* deterministic uniform [-1, 1) (own generator: the same data in every program) */
-static double sf_rand(unsigned long long *s) {
+static PHGMG__UNUSED double sf_rand(unsigned long long *s) {
   *s ^= *s >> 12; *s ^= *s << 25; *s ^= *s >> 27;
   return (double)((*s * 2685821657736338717ULL) >> 11) / 4503599627370496.0 - 1.0;
 }
 
 /* C = A^T B, A: N x a, B: N x b (double), C: a x b (phgmg_real) */
-static void sf_atb(int a, int b, const double *A, const double *B, const double *M, phgmg_real *C) {
+static PHGMG__UNUSED void sf_atb(int a, int b, const double *A, const double *B, const double *M, phgmg_real *C) {
   int i, j, k, l;
   for (j = 0; j < b; ++j)
     for (i = 0; i < a; ++i) {
@@ -52,7 +53,7 @@ static void sf_atb(int a, int b, const double *A, const double *B, const double 
     }
 }
 
-static void sf_build(sf_model *M, unsigned long long seed) {
+static PHGMG__UNUSED void sf_build(sf_model *M, unsigned long long seed) {
   unsigned long long s = seed;
   double L[SF_N * SF_N], Mr[SF_RN * SF_P * SF_P];
   int i, j, k, p = SF_P;
@@ -112,7 +113,7 @@ static void sf_build(sf_model *M, unsigned long long seed) {
 
 /* phi_cb evaluating the same exp-polynomial rows with the same arithmetic as the
    library (Horner, then a e^{bs} per exponential): results equal bit for bit. */
-static void sf_phi_same(int term, phgmg_real s, phgmg_real d[3], void *user) {
+static PHGMG__UNUSED void sf_phi_same(int term, phgmg_real s, phgmg_real d[3], void *user) {
   const sf_model *M = (const sf_model *)user;
   int j = (term - 10) / 7, k, e;
   const phgmg_real *c = M->poly + 2 * j, *ex = M->expo + 4 * j;
@@ -123,5 +124,47 @@ static void sf_phi_same(int term, phgmg_real s, phgmg_real d[3], void *user) {
     p0 += ae; p1 += ae * b; p2 += ae * b * b;
   }
   d[0] = p0; d[1] = p1; d[2] = p2;
+}
+
+/* The same functions without user data, by full-model term index (term = 10 + 7 j,
+   kind j % 3): what firmware supplies as <name>_phi for an exported model. */
+static PHGMG__UNUSED void sf_phi_table(int term, phgmg_real s, phgmg_real d[3], void *user) {
+  int j = (term - 10) / 7, k, e;
+  const phgmg_real D = (phgmg_real)sf_morse_D, a = (phgmg_real)sf_morse_a;
+  phgmg_real c[2], ex[4], p0 = 0, p1 = 0, p2 = 0;
+  (void)user;
+  switch (j % 3) {
+    case 0: c[0] = -1; c[1] = -1; ex[0] = 1; ex[1] = 1; ex[2] = 0; ex[3] = 0; break;
+    case 1: c[0] = -1; c[1] = 0; ex[0] = 0.5f; ex[1] = 1; ex[2] = 0.5f; ex[3] = -1; break;
+    default: c[0] = D; c[1] = 0; ex[0] = -2 * D; ex[1] = -a; ex[2] = D; ex[3] = -2 * a; break;
+  }
+  for (k = 1; k >= 0; --k) { p2 = p2 * s + 2 * p1; p1 = p1 * s + p0; p0 = p0 * s + c[k]; }
+  for (e = 0; e < 2; ++e) {
+    const phgmg_real b = ex[2 * e + 1], ae = ex[2 * e] * (phgmg_real)exp((double)(b * s));
+    p0 += ae; p1 += ae * b; p2 += ae * b * b;
+  }
+  d[0] = p0; d[1] = p1; d[2] = p2;
+}
+/* A fixed cubic manifold without user data (what firmware supplies as <name>_eta):
+   eta_i = 1/2 sum_k a_ik x_k^2 + c_i S^3, S = sum_k x_k,
+   a_ik = 0.3 (1 + i + k) / (1 + i), c_i = 0.05 (i + 1). */
+static PHGMG__UNUSED void sf_eta_fixed(const phgmg_real *x2, phgmg_real *q, phgmg_real *Dq, phgmg_real *D2q,
+                                      void *user) {
+  int i, k, j;
+  phgmg_real S = 0;
+  (void)user;
+  for (k = 0; k < SF_P; ++k) S += x2[k];
+  for (i = 0; i < SF_RN; ++i) {
+    const phgmg_real c = (phgmg_real)0.05 * (phgmg_real)(i + 1);
+    phgmg_real qi = c * S * S * S;
+    for (k = 0; k < SF_P; ++k) {
+      const phgmg_real a = (phgmg_real)0.3 * (phgmg_real)(1 + i + k) / (phgmg_real)(1 + i);
+      qi += a * x2[k] * x2[k] / 2;
+      if (Dq) Dq[i + k * SF_RN] = a * x2[k] + 3 * c * S * S;
+      if (D2q)
+        for (j = 0; j < SF_P; ++j) D2q[i + (k * SF_P + j) * SF_RN] = (j == k ? a : (phgmg_real)0) + 6 * c * S;
+    }
+    if (q) q[i] = qi;
+  }
 }
 #endif
