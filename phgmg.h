@@ -505,14 +505,17 @@ PHGMG_DEF void phgmg_gl3_coefficients(double c[3], double b[3], double A[9]);
        x' = K(x) grad H(x) + Bh u,   y = Bh^T grad H(x),
        K(x) = J(x) - R(x)  (J skew, R symmetric positive semidefinite),
    with, for a LINEAR map phi(x) = V0 x:   K constant,
-       H(x) = 1/2 x^T Qh x + sum_j w_j poly(P0_j x),
+       H(x) = 1/2 x^T Qh x + sum_j w_j phi_j(P0_j x),
    and for the QUADRATIC map phi(x) = V0 x + V2 q(x2), q = M (x2 kron x2),
    x = (x1, x2), x1 in R^m, x2 in R^p, p = r - m:
        K(x) = (Dphi^T G Dphi)^{-1},  G = (J - R)^{-1},  Dphi = V0 + V2 [0, L(x2)],
        L(:,k) = sum_j Ms(:, k*p + j) x2_j,   q = L x2 / 2,
-       H(x) = 1/2 phi^T Q phi + sum_j w_j poly(P0_j x + P1_j q),
+       H(x) = 1/2 phi^T Q phi + sum_j w_j phi_j(P0_j x + P1_j q),
    where every product with N-dimensional data was precomputed offline
-   (G00 = V0^T G V0, ... see the fields). The online cost is independent of N. */
+   (G00 = V0^T G V0, ... see the fields). The online cost is independent of N.
+   phi_j is an exp-polynomial (shared or one per kept term) or a callback
+   (phi_cb); q may come from a callback eta_cb instead of Ms; a general
+   Hamiltonian part may be added by ham_cb (see the fields at the end). */
 #ifdef __cplusplus
 extern "C" {
 #endif
@@ -2541,6 +2544,22 @@ PHGMG__PRIV double phgmg__ph_phi(const phgmg_ph_system *s, int k, double v, int 
   return s->ddphi(k, v, s->user);
 }
 
+/* phi_t'(v) of built-in function t (no branches on the derivative order). */
+PHGMG__PRIV double phgmg__ph_dphi_builtin(const phgmg_ph_system *s, int t, double v) {
+  const int deg = s->poly_deg, ne = s->nexp;
+  double acc = 0.0;
+  int j;
+  if (deg > 0) {
+    const double *c = s->poly + (size_t)t * (size_t)(deg + 1);
+    for (j = deg; j >= 1; --j) acc = acc * v + (double)j * c[j];
+  }
+  if (ne > 0) {
+    const double *p = s->expo + 2 * (size_t)t * (size_t)ne;
+    for (j = 0; j < ne; ++j) acc += p[2 * j] * p[2 * j + 1] * exp(p[2 * j + 1] * v);
+  }
+  return acc;
+}
+
 /* phi_k, phi_k', phi_k'' at x at once (built-in form or callbacks). */
 PHGMG__PRIV void phgmg__ph_phi3(const phgmg_ph_system *s, int k, double x, double d[3]) {
   if (PHGMG__PH_BUILTIN(s)) {
@@ -3989,7 +4008,13 @@ PHGMG__PRIV void phgmg__gl3_eval(phgmg_gl3 *s, const double *x) {
           for (j = 0; j < ne; ++j) acc += ex[2 * j] * ex[2 * j + 1] * exp(ex[2 * j + 1] * v);
           g[ix] += w ? w[k] * acc : acc;
         }
-      } else { /* per-term built-in functions or callbacks */
+      } else if (PHGMG__PH_BUILTIN(sys)) { /* one built-in function per term */
+        for (k = 0; k < sys->nsep; ++k) {
+          int ix = idx[k];
+          double d1 = phgmg__ph_dphi_builtin(sys, k, x[ix] + z[ix]);
+          g[ix] += w ? w[k] * d1 : d1;
+        }
+      } else { /* callbacks */
         for (k = 0; k < sys->nsep; ++k) {
           int ix = idx[k];
           double d1 = phgmg__ph_phi(sys, k, x[ix] + z[ix], 1);
