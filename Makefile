@@ -50,6 +50,7 @@ $(BUILD)/export_model_f: examples/controller/export_model.c examples/controller/
 	$(CC) -std=c99 $(WARN) -Wdouble-promotion -DPHGMG_REAL_FLOAT -O2 -o $@ $< $(LDLIBS)
 test-embedded-host: $(BUILD)/export_model_d $(BUILD)/export_model_f
 	sh examples/controller/check.sh $(BUILD)
+	sh tests/sepfun_export.sh $(BUILD)
 
 # Cross-compile the controller for Cortex-M4F (float and double), sizes, and a
 # run under qemu-system-arm when installed.

@@ -319,12 +319,21 @@ typedef struct phgmg_ph_system {
   const int *sep_idx;      /* SEPARABLE: coordinate of term k (0-based)      */
   const double *sep_w;     /* SEPARABLE: weights (NULL = all 1)              */
   phgmg_phi_fn phi, dphi, ddphi;
-  /* SEPARABLE, optional: if poly_deg > 0, phi_k(s) = sum_j poly[j] s^j for every
-     k (the callbacks may then be NULL). Reduced models can be exported only
-     when the nonlinearity is given this way. */
+  /* SEPARABLE, optional built-in exp-polynomial family, used iff poly_deg > 0
+     or nexp > 0 (the callbacks phi/dphi/ddphi may then be NULL):
+         phi_k(s) = sum_{j=0}^{poly_deg} c_j s^j + sum_{e<nexp} a_e exp(b_e s),
+     c = poly + t (poly_deg+1), (a_e, b_e) = expo[2 (t nexp + e)], expo[2 (t nexp + e) + 1],
+     with t = 0 for every term (phi_nfun 0 or 1) or t = k (phi_nfun == nsep, one
+     function per term). poly may be NULL when poly_deg == 0 (c = 0); expo is
+     needed iff nexp > 0. Limits: poly_deg <= 32, nexp <= 8, finite coefficients.
+     E.g. Toda phi(s) = e^s - 1 - s: poly_deg = 1, poly = {-1, -1}, nexp = 1,
+     expo = {1, 1}; cosh(s) = expo {0.5, 1, 0.5, -1}. Reduced models can be
+     exported only when the nonlinearity is given this way. */
   int poly_deg;
-  const double *poly;      /* poly_deg+1 coefficients, constant term first   */
-  int nexp; const double *expo; int phi_nfun; /*TMPB*/
+  const double *poly;      /* (phi_nfun or 1) x (poly_deg+1) coefficients, constant term first */
+  int nexp;                /* SEPARABLE: exponentials per function (0: none)            */
+  const double *expo;      /* pairs (a_e, b_e): expo[2*(t*nexp+e)], expo[2*(t*nexp+e)+1] */
+  int phi_nfun;            /* 0 or 1: one function for every term; nsep: one per term   */
   /* GENERAL */
   double (*H_nl)(const double *x, void *user);
   void (*grad_nl)(const double *x, double *g, void *user);
@@ -496,14 +505,17 @@ PHGMG_DEF void phgmg_gl3_coefficients(double c[3], double b[3], double A[9]);
        x' = K(x) grad H(x) + Bh u,   y = Bh^T grad H(x),
        K(x) = J(x) - R(x)  (J skew, R symmetric positive semidefinite),
    with, for a LINEAR map phi(x) = V0 x:   K constant,
-       H(x) = 1/2 x^T Qh x + sum_j w_j poly(P0_j x),
+       H(x) = 1/2 x^T Qh x + sum_j w_j phi_j(P0_j x),
    and for the QUADRATIC map phi(x) = V0 x + V2 q(x2), q = M (x2 kron x2),
    x = (x1, x2), x1 in R^m, x2 in R^p, p = r - m:
        K(x) = (Dphi^T G Dphi)^{-1},  G = (J - R)^{-1},  Dphi = V0 + V2 [0, L(x2)],
        L(:,k) = sum_j Ms(:, k*p + j) x2_j,   q = L x2 / 2,
-       H(x) = 1/2 phi^T Q phi + sum_j w_j poly(P0_j x + P1_j q),
+       H(x) = 1/2 phi^T Q phi + sum_j w_j phi_j(P0_j x + P1_j q),
    where every product with N-dimensional data was precomputed offline
-   (G00 = V0^T G V0, ... see the fields). The online cost is independent of N. */
+   (G00 = V0^T G V0, ... see the fields). The online cost is independent of N.
+   phi_j is an exp-polynomial (shared or one per kept term) or a callback
+   (phi_cb); q may come from a callback eta_cb instead of Ms; a general
+   Hamiltonian part may be added by ham_cb (see the fields at the end). */
 #ifdef __cplusplus
 extern "C" {
 #endif
@@ -531,7 +543,7 @@ typedef struct phgmg_rom {
   int r, m;      /* reduced order, ports                             */
   int rn;        /* QUADRATIC: lifting dimension r_n, else 0         */
   int nd;        /* separable nonlinear terms kept online (DEIM points), 0 = quadratic H */
-  int poly_deg;  /* degree of the shared polynomial phi (nd > 0)     */
+  int poly_deg;  /* degree of the polynomial part of phi (nd > 0; see nexp/nphi below) */
   const phgmg_real *Bh;   /* r x m   reduced port matrix (W^T B; [I;0] for GMG)   */
   const phgmg_real *Qh;   /* r x r   V0^T Q V0                                     */
   const phgmg_real *K;    /* r x r   LINEAR: J - R reduced (constant)              */
@@ -547,7 +559,7 @@ typedef struct phgmg_rom {
   const phgmg_real *P0;   /* nd x r   rows of V0 at the kept coordinates */
   const phgmg_real *P1;   /* nd x rn  rows of V2 (QUADRATIC)             */
   const phgmg_real *w;    /* nd       weights (structure-preserving DEIM) */
-  const phgmg_real *poly; /* poly_deg+1 coefficients of phi, constant first */
+  const phgmg_real *poly; /* (nphi or 1) x (poly_deg+1) coefficients of phi, constant first */
   /* precomputed GL3 step map (LINEAR, nd == 0; NULL if absent) for step dt:
      x+ = Phi x + Gam u3, stage values Y = SX x + SU u3 (for the energy). */
   phgmg_real dt;
@@ -555,10 +567,37 @@ typedef struct phgmg_rom {
   const phgmg_real *Gam;  /* r x 3m   (u3 = [u(t+c1 h); u(t+c2 h); u(t+c3 h)]) */
   const phgmg_real *SX;   /* 3r x r   */
   const phgmg_real *SU;   /* 3r x 3m  */
-  int nexp; int nphi; const phgmg_real *expo; /*TMPB*/
-  void (*phi_cb)(int term, phgmg_real s, phgmg_real d[3], void *user); const int *term; void *phi_user; /*TMPB*/
-  void (*eta_cb)(const phgmg_real *x2, phgmg_real *q, phgmg_real *Dq, phgmg_real *D2q, void *user); void *eta_user; /*TMPB*/
-  void (*ham_cb)(const phgmg_real *x, phgmg_real *Hn, phgmg_real *g, phgmg_real *Hs, void *user); void *ham_user; /*TMPB*/
+  /* separable nonlinearity beyond a shared polynomial (nd > 0). Term j of the
+     reduced Hamiltonian is w_j phi_j(s_j), s_j = P0_j x (+ P1_j q), with
+         phi_j(s) = sum_{i<=poly_deg} c_i s^i + sum_{e<nexp} a_e exp(b_e s),
+     c = poly + t (poly_deg+1), (a_e, b_e) = expo[2 (t nexp + e)], [... + 1],
+     t = 0 (nphi 0 or 1) or t = j (nphi == nd). poly may be NULL if poly_deg == 0. */
+  int nexp;                 /* separable: exponentials per function (0: none), <= 8    */
+  int nphi;                 /* 0/1: one function for every kept term; nd: one per kept term
+                               (then poly is nd x (poly_deg+1), row j = kept term j)  */
+  const phgmg_real *expo;   /* nphi (or 1) x nexp pairs (a, b), like phgmg_ph_system */
+  void (*phi_cb)(int term, phgmg_real s, phgmg_real d[3], void *user); /* if set: overrides
+                               poly/expo; d = phi, phi', phi'' of full-model term `term` */
+  const int *term;          /* nd: full-model index of each kept term (passed to phi_cb; NULL: j) */
+  void *phi_user;
+  /* QUADRATIC kind, manifold by callback instead of Ms:
+     phi(x) = V0 x + V2 eta(x2), x2 = x[m..r-1] (p = r - m), eta: R^p -> R^rn.
+     eta_cb fills q = eta(x2) (rn), Dq = d eta/d x2 (rn x p, col-major) and
+     D2q (rn x p*p, same layout as Ms: D2q(:, k*p + j) = d^2 eta / dx2_k dx2_j);
+     any output pointer may be NULL when not needed. For the built-in quadratic map
+     q = M(x2 kron x2) = L x2 / 2, Dq = L, D2q = Ms. With eta_cb set, Ms is not read.
+     The Jacobian / structure formulas above hold with L = Dq. */
+  void (*eta_cb)(const phgmg_real *x2, phgmg_real *q, phgmg_real *Dq, phgmg_real *D2q, void *user);
+  void *eta_user;
+  /* general nonlinear Hamiltonian part by callback on the REDUCED state (not exportable;
+     used for PHGMG_NL_GENERAL systems, whose reduced model evaluates it in full dimension):
+     adds Hn(x) to H, its gradient (r) to grad H and its Hessian (r x r) to the Hessian.
+     The callback WRITES (does not add to) its non-NULL outputs: *Hn, g (r), Hs
+     (r x r, col-major, symmetric); the library adds them. Any output pointer may be NULL.
+     Workspace: phgmg_rom_eval_work_size / the stepper memsize include the room the
+     callbacks need; for static buffers use PHGMG_ROM_STEPPER_MEMSIZE_MAX_CB. */
+  void (*ham_cb)(const phgmg_real *x, phgmg_real *Hn, phgmg_real *g, phgmg_real *Hs, void *user);
+  void *ham_user;
 } phgmg_rom;
 
 /* Checks a model's sizes and pointers for consistency (not its values). */
@@ -615,6 +654,11 @@ PHGMG_DEF size_t phgmg_rom_stepper_memsize_dt(const phgmg_rom *rom, phgmg_real d
 #define PHGMG_ROM_STEPPER_MEMSIZE_MAX(r, m, rn, nd) \
   (sizeof(phgmg_real) * (size_t)(12 * (r) * (r) + 32 * (r) + 3 * (m) + 4 * (rn) * (r) + 2 * (rn) * (rn) + 6 * (rn) + 3 * (nd) + 64) \
    + sizeof(int) * (size_t)(4 * (r) + 8) + 64)
+/* The same bound for a model with eta_cb and/or ham_cb set (room for D2q,
+   rn x (r-m)^2 <= rn r^2, and for the ham_cb gradient and Hessian). */
+#define PHGMG_ROM_STEPPER_MEMSIZE_MAX_CB(r, m, rn, nd) \
+  (PHGMG_ROM_STEPPER_MEMSIZE_MAX(r, m, rn, nd) + \
+   sizeof(phgmg_real) * (size_t)((rn) * (r) * (r) + (r) * (r) + (r) + 8))
 /* Set up a stepper in caller memory (mem must be aligned for phgmg_real and
    int; anything from malloc or a static phgmg_real array is). tol <= 0 gives
    1e-10 (double) / 1e-5 (float); max_iter <= 0 gives 10. PHGMG_ERR_WORKSPACE
@@ -864,12 +908,23 @@ PHGMG_DEF phgmg_result phgmg_deim(int nterms, int ns, const double *F, int ldf, 
    Serialising and loading work in memory and need neither stdio nor heap;
    the file helpers are compiled out with PHGMG_NO_STDIO or PHGMG_NO_OFFLINE.
    A file written by a double build loads into a float build (values are
-   rounded once) and vice versa. */
+   rounded once) and vice versa.
+   Callbacks cannot be stored: phgmg_rom_serialize / _save refuse a model with
+   phi_cb, eta_cb or ham_cb (PHGMG_ERR_UNSUPPORTED). phgmg_rom_export_c refuses
+   ham_cb; for phi_cb / eta_cb it declares and references
+       extern void <name>_phi(int term, phgmg_real s, phgmg_real d[3], void *user);
+       extern void <name>_eta(const phgmg_real *x2, phgmg_real *q, phgmg_real *Dq,
+                              phgmg_real *D2q, void *user);
+   which the firmware supplies (user = NULL); the term indices are exported
+   as `static const int <name>_term[nd]`. */
 #ifdef __cplusplus
 extern "C" {
 #endif
 
-#define PHGMG_ROM_FORMAT_VERSION 1u
+/* Format version 2 adds the exp-polynomial data (nexp, nphi, expo, per-term
+   poly) and the term indices; a model without them is still written as
+   version 1, and both versions load. */
+#define PHGMG_ROM_FORMAT_VERSION 2u
 
 /* Bytes phgmg_rom_serialize writes for this model. */
 PHGMG_DEF size_t phgmg_rom_serialized_size(const phgmg_rom *rom);
@@ -2501,22 +2556,85 @@ PHGMG__PRIV double phgmg__ph_quad(const phgmg_ph_system *s, const double *M, con
   return acc;
 }
 
+/* Built-in exp-polynomial form of the separable nonlinearity in use? */
+#define PHGMG__PH_BUILTIN(s) ((s)->poly_deg > 0 || (s)->nexp > 0)
+/* Function index t of term k for the built-in form (0: shared). */
+#define PHGMG__PH_FUN(s, k) ((s)->phi_nfun > 1 ? (k) : 0)
+
 /* d-th derivative (d = 0,1,2) of the scalar nonlinearity of term k at v. */
 PHGMG__PRIV double phgmg__ph_phi(const phgmg_ph_system *s, int k, double v, int d) {
-  if (s->poly_deg > 0) {
-    int j;
+  if (PHGMG__PH_BUILTIN(s)) {
+    int j, e, t = PHGMG__PH_FUN(s, k);
     double acc = 0.0;
-    for (j = s->poly_deg; j >= d; --j) {
-      double c = s->poly[j];
-      if (d == 1) c *= (double)j;
-      else if (d == 2) c *= (double)j * (double)(j - 1);
-      acc = acc * v + c;
+    if (s->poly) {
+      const double *c = s->poly + (size_t)t * (size_t)(s->poly_deg + 1);
+      for (j = s->poly_deg; j >= d; --j) {
+        double cj = c[j];
+        if (d == 1) cj *= (double)j;
+        else if (d == 2) cj *= (double)j * (double)(j - 1);
+        acc = acc * v + cj;
+      }
+    }
+    if (s->nexp > 0) {
+      const double *p = s->expo + 2 * (size_t)t * (size_t)s->nexp;
+      for (e = 0; e < s->nexp; ++e) {
+        double a = p[2 * e], b = p[2 * e + 1];
+        if (d == 1) a *= b;
+        else if (d == 2) a *= b * b;
+        acc += a * exp(b * v);
+      }
     }
     return acc;
   }
   if (d == 0) return s->phi(k, v, s->user);
   if (d == 1) return s->dphi(k, v, s->user);
   return s->ddphi(k, v, s->user);
+}
+
+/* phi_t'(v) of built-in function t (no branches on the derivative order). */
+PHGMG__PRIV double phgmg__ph_dphi_builtin(const phgmg_ph_system *s, int t, double v) {
+  const int deg = s->poly_deg, ne = s->nexp;
+  double acc = 0.0;
+  int j;
+  if (deg > 0) {
+    const double *c = s->poly + (size_t)t * (size_t)(deg + 1);
+    for (j = deg; j >= 1; --j) acc = acc * v + (double)j * c[j];
+  }
+  if (ne > 0) {
+    const double *p = s->expo + 2 * (size_t)t * (size_t)ne;
+    for (j = 0; j < ne; ++j) acc += p[2 * j] * p[2 * j + 1] * exp(p[2 * j + 1] * v);
+  }
+  return acc;
+}
+
+/* phi_k, phi_k', phi_k'' at x at once (built-in form or callbacks). */
+PHGMG__PRIV void phgmg__ph_phi3(const phgmg_ph_system *s, int k, double x, double d[3]) {
+  if (PHGMG__PH_BUILTIN(s)) {
+    int j, e, t = PHGMG__PH_FUN(s, k);
+    double v0 = 0.0, v1 = 0.0, v2 = 0.0;
+    if (s->poly) {
+      const double *c = s->poly + (size_t)t * (size_t)(s->poly_deg + 1);
+      for (j = s->poly_deg; j >= 0; --j) { /* Horner with derivatives */
+        v2 = v2 * x + 2.0 * v1;
+        v1 = v1 * x + v0;
+        v0 = v0 * x + c[j];
+      }
+    }
+    if (s->nexp > 0) {
+      const double *p = s->expo + 2 * (size_t)t * (size_t)s->nexp;
+      for (e = 0; e < s->nexp; ++e) {
+        double b = p[2 * e + 1], ae = p[2 * e] * exp(b * x);
+        v0 += ae;
+        v1 += ae * b;
+        v2 += ae * b * b;
+      }
+    }
+    d[0] = v0; d[1] = v1; d[2] = v2;
+    return;
+  }
+  d[0] = s->phi(k, x, s->user);
+  d[1] = s->dphi(k, x, s->user);
+  d[2] = s->ddphi(k, x, s->user);
 }
 
 /* Structural checks shared by every entry point (no O(N^2) work). */
@@ -2531,12 +2649,17 @@ PHGMG__PRIV phgmg_result phgmg__ph_check(const phgmg_ph_system *s) {
   switch (s->nl) {
     case PHGMG_NL_NONE: break;
     case PHGMG_NL_SEPARABLE:
-      if (s->nsep < 0 || s->poly_deg < 0) return PHGMG_ERR_SIZE;
+      if (s->nsep < 0 || s->poly_deg < 0 || s->poly_deg > 32 || s->nexp < 0 || s->nexp > 8)
+        return PHGMG_ERR_SIZE;
+      if (s->phi_nfun < 0 || (s->phi_nfun > 1 && s->phi_nfun != s->nsep)) return PHGMG_ERR_SIZE;
       if (s->nsep > 0 && !s->sep_idx) return PHGMG_ERR_INVALID_ARG;
       for (k = 0; k < s->nsep; ++k)
         if (s->sep_idx[k] < 0 || s->sep_idx[k] >= s->N) return PHGMG_ERR_SIZE;
-      if (s->poly_deg > 0) {
-        if (!s->poly) return PHGMG_ERR_INVALID_ARG;
+      if (PHGMG__PH_BUILTIN(s)) {
+        size_t nf = (size_t)(s->phi_nfun > 1 ? s->phi_nfun : 1);
+        if ((s->poly_deg > 0 && !s->poly) || (s->nexp > 0 && !s->expo)) return PHGMG_ERR_INVALID_ARG;
+        if (s->poly && !phgmg__all_finite(s->poly, nf * (size_t)(s->poly_deg + 1))) return PHGMG_ERR_NANINF;
+        if (s->nexp > 0 && !phgmg__all_finite(s->expo, nf * 2 * (size_t)s->nexp)) return PHGMG_ERR_NANINF;
       } else if (s->nsep > 0 && (!s->phi || !s->dphi || !s->ddphi)) {
         return PHGMG_ERR_INVALID_ARG;
       }
@@ -3694,10 +3817,12 @@ PHGMG_DEF phgmg_result phgmg_gl3_create(phgmg_gl3 **out, const phgmg_ph_system *
   if (sys->nl == PHGMG_NL_SEPARABLE) {
     s->dd = phgmg__dalloc(&s->al, (size_t)N);
     if (!s->dd) { rc = PHGMG_ERR_NOMEM; goto fail; }
-    if (sys->poly_deg > 0) { /* dpoly[j] = (j+1) poly[j+1] */
-      s->dpoly = phgmg__dalloc(&s->al, (size_t)sys->poly_deg);
-      if (!s->dpoly) { rc = PHGMG_ERR_NOMEM; goto fail; }
-      for (k = 0; k < sys->poly_deg; ++k) s->dpoly[k] = (double)(k + 1) * sys->poly[k + 1];
+    if (PHGMG__PH_BUILTIN(sys) && sys->phi_nfun <= 1) { /* one shared function */
+      if (sys->poly_deg > 0) { /* dpoly[j] = (j+1) poly[j+1] */
+        s->dpoly = phgmg__dalloc(&s->al, (size_t)sys->poly_deg);
+        if (!s->dpoly) { rc = PHGMG_ERR_NOMEM; goto fail; }
+        for (k = 0; k < sys->poly_deg; ++k) s->dpoly[k] = (double)(k + 1) * sys->poly[k + 1];
+      }
       s->wc = phgmg__dalloc(&s->al, (size_t)N);
       if (!s->wc) { rc = PHGMG_ERR_NOMEM; goto fail; }
       for (i = 0; i < N; ++i) s->wc[i] = 0.0;
@@ -3871,21 +3996,27 @@ PHGMG__PRIV void phgmg__gl3_eval(phgmg_gl3 *s, const double *x) {
   } else if (qdiag) { /* Q diagonal: G = q .* (x + Z) in one pass */
     const double *qd = s->dq.v;
     if (s->wc) { /* ... plus the polynomial, coordinate-wise, three stages per pass */
-      const double *wc = s->wc, *dp = s->dpoly;
+      const double *wc = s->wc, *dp = s->dpoly, *ex = sys->expo;
       const double *z0 = s->Z, *z1 = s->Z + N, *z2 = s->Z + 2 * (size_t)N;
       double *g0 = s->G, *g1 = s->G + N, *g2 = s->G + 2 * (size_t)N;
-      int deg = sys->poly_deg;
+      int deg = sys->poly_deg, ne = sys->nexp;
       for (i = 0; i < N; ++i) {
         double xi = x[i], q = qd[i], w = wc[i];
         double y0 = xi + z0[i], y1 = xi + z1[i], y2 = xi + z2[i];
         if (w != 0.0) {
-          double p0 = dp[deg - 1], p1 = p0, p2 = p0;
+          double p0 = deg > 0 ? dp[deg - 1] : 0.0, p1 = p0, p2 = p0;
           int j;
           for (j = deg - 2; j >= 0; --j) {
             double c = dp[j];
             p0 = PHGMG__FMA(p0, y0, c);
             p1 = PHGMG__FMA(p1, y1, c);
             p2 = PHGMG__FMA(p2, y2, c);
+          }
+          for (j = 0; j < ne; ++j) { /* d/ds a e^{bs} = a b e^{bs} */
+            double ab = ex[2 * j] * ex[2 * j + 1], b = ex[2 * j + 1];
+            p0 = PHGMG__FMA(ab, exp(b * y0), p0);
+            p1 = PHGMG__FMA(ab, exp(b * y1), p1);
+            p2 = PHGMG__FMA(ab, exp(b * y2), p2);
           }
           g0[i] = PHGMG__FMA(w, p0, q * y0);
           g1[i] = PHGMG__FMA(w, p1, q * y1);
@@ -3914,19 +4045,26 @@ PHGMG__PRIV void phgmg__gl3_eval(phgmg_gl3 *s, const double *x) {
     if (sys->nl == PHGMG_NL_SEPARABLE) {
       const int *idx = sys->sep_idx;
       const double *w = sys->sep_w;
-      if (sys->poly_deg > 0) {
-        int deg = sys->poly_deg;
-        const double *dp = s->dpoly;
+      if (s->wc) { /* one shared built-in function: derivative coefficients precomputed */
+        int deg = sys->poly_deg, ne = sys->nexp;
+        const double *dp = s->dpoly, *ex = sys->expo;
         for (k = 0; k < sys->nsep; ++k) {
           int ix = idx[k], j;
-          double v = x[ix] + z[ix], acc = dp[deg - 1];
+          double v = x[ix] + z[ix], acc = deg > 0 ? dp[deg - 1] : 0.0;
           for (j = deg - 2; j >= 0; --j) acc = acc * v + dp[j];
+          for (j = 0; j < ne; ++j) acc += ex[2 * j] * ex[2 * j + 1] * exp(ex[2 * j + 1] * v);
           g[ix] += w ? w[k] * acc : acc;
         }
-      } else {
+      } else if (PHGMG__PH_BUILTIN(sys)) { /* one built-in function per term */
         for (k = 0; k < sys->nsep; ++k) {
           int ix = idx[k];
-          double d1 = sys->dphi(k, x[ix] + z[ix], sys->user);
+          double d1 = phgmg__ph_dphi_builtin(sys, k, x[ix] + z[ix]);
+          g[ix] += w ? w[k] * d1 : d1;
+        }
+      } else { /* callbacks */
+        for (k = 0; k < sys->nsep; ++k) {
+          int ix = idx[k];
+          double d1 = phgmg__ph_phi(sys, k, x[ix] + z[ix], 1);
           g[ix] += w ? w[k] * d1 : d1;
         }
       }
@@ -4399,10 +4537,12 @@ done:
 /* Everything here is in phgmg_real, allocation-free and N-independent. */
 #if PHGMG_REAL_IS_FLOAT
 #define PHGMG__RABS(x) fabsf(x)
+#define PHGMG__REXP(x) expf(x)
 #define PHGMG__RSQRT(x) sqrtf(x)
 #define PHGMG__REPS 1.1920929e-07f
 #else
 #define PHGMG__RABS(x) fabs(x)
+#define PHGMG__REXP(x) exp(x)
 #define PHGMG__RSQRT(x) sqrt(x)
 #define PHGMG__REPS 2.220446049250313e-16
 #endif
@@ -4516,6 +4656,31 @@ PHGMG__ONLINE void phgmg__r_poly(const phgmg_real *c, int deg, phgmg_real s, phg
   if (d2) *d2 = p2;
 }
 
+/* d = phi_j, phi_j', phi_j'' at s for kept term j: phi_cb if set, else the
+   exp-polynomial (shared, or row j when nphi == nd). */
+PHGMG__ONLINE void phgmg__r_phi(const phgmg_rom *rom, int j, phgmg_real s, phgmg_real d[3]) {
+  const int t = rom->nphi > 1 ? j : 0;
+  int e;
+  if (rom->phi_cb) {
+    rom->phi_cb(rom->term ? rom->term[j] : j, s, d, rom->phi_user);
+    return;
+  }
+  if (rom->poly) {
+    phgmg__r_poly(rom->poly + (size_t)t * (size_t)(rom->poly_deg + 1), rom->poly_deg, s, &d[0], &d[1], &d[2]);
+  } else {
+    d[0] = d[1] = d[2] = PHGMG__R(0);
+  }
+  if (rom->nexp > 0) {
+    const phgmg_real *ex = rom->expo + 2 * (size_t)t * (size_t)rom->nexp;
+    for (e = 0; e < rom->nexp; ++e) {
+      const phgmg_real b = ex[2 * e + 1], ae = ex[2 * e] * PHGMG__REXP(b * s);
+      d[0] += ae;
+      d[1] += ae * b;
+      d[2] += ae * b * b;
+    }
+  }
+}
+
 PHGMG_DEF phgmg_result phgmg_rom_check(const phgmg_rom *rom) {
   if (!rom) return PHGMG_ERR_INVALID_ARG;
   if (rom->r < 1 || rom->m < 0 || rom->m > rom->r || rom->nd < 0 || rom->rn < 0)
@@ -4526,14 +4691,22 @@ PHGMG_DEF phgmg_result phgmg_rom_check(const phgmg_rom *rom) {
     if (!rom->K || rom->rn != 0) return PHGMG_ERR_INVALID_ARG;
   } else if (rom->kind == PHGMG_ROM_QUADRATIC) {
     if (rom->rn < 1 || rom->r - rom->m < 1) return PHGMG_ERR_SIZE;
-    if (!rom->G00 || !rom->G01 || !rom->G10 || !rom->G11 || !rom->Q01 || !rom->Q11 || !rom->Ms)
+    if (!rom->G00 || !rom->G01 || !rom->G10 || !rom->G11 || !rom->Q01 || !rom->Q11 ||
+        (!rom->Ms && !rom->eta_cb))
       return PHGMG_ERR_INVALID_ARG;
     if (rom->nd > 0 && !rom->P1) return PHGMG_ERR_INVALID_ARG;
   } else {
     return PHGMG_ERR_INVALID_ARG;
   }
-  if (rom->nd > 0 && (!rom->P0 || !rom->w || !rom->poly || rom->poly_deg < 0 || rom->poly_deg > 32))
-    return PHGMG_ERR_INVALID_ARG;
+  if (rom->nd > 0) {
+    if (!rom->P0 || !rom->w) return PHGMG_ERR_INVALID_ARG;
+    if (rom->poly_deg < 0 || rom->poly_deg > 32) return PHGMG_ERR_INVALID_ARG;
+    if (rom->nexp < 0 || rom->nexp > 8) return PHGMG_ERR_SIZE;
+    if (rom->nphi < 0 || (rom->nphi > 1 && rom->nphi != rom->nd)) return PHGMG_ERR_SIZE;
+    if (!rom->phi_cb && ((rom->poly_deg > 0 && !rom->poly) || (rom->nexp > 0 && !rom->expo) ||
+                         (!rom->poly && rom->nexp == 0)))
+      return PHGMG_ERR_INVALID_ARG;
+  }
   if (rom->Phi && (!rom->Gam || !rom->SX || !rom->SU || !(rom->dt > PHGMG__R(0))))
     return PHGMG_ERR_INVALID_ARG;
   return PHGMG_OK;
@@ -4543,6 +4716,10 @@ PHGMG_DEF phgmg_result phgmg_rom_check(const phgmg_rom *rom) {
    evaluator, so size and carving cannot drift. */
 typedef struct phgmg__romw {
   phgmg_real *Lp, *q, *a1, *b1, *b2, *c, *d, *E, *t, *tmp, *xp, *fm, *g;
+  phgmg_real *D2;       /* eta_cb: D2q (rn x p*p), else NULL */
+  phgmg_real *hg, *hH;  /* ham_cb: its gradient (r) and Hessian (r x r), else NULL */
+  const phgmg_real *Ms; /* second derivatives of the manifold: rom->Ms or D2 */
+  int d2;               /* eta_cb: prep also fills D2 (set by Hessian/Jacobian callers) */
   int *piv; /* r pivots of the LU of E, carved from the same real array */
 } phgmg__romw;
 
@@ -4564,6 +4741,14 @@ PHGMG__ONLINE size_t phgmg__romw_layout(const phgmg_rom *rom, phgmg_real *base, 
   w->xp = PHGMG__CARVE(base, o); o += r;
   w->fm = PHGMG__CARVE(base, o); o += r;
   w->g = PHGMG__CARVE(base, o); o += r;
+  w->D2 = rom->eta_cb ? PHGMG__CARVE(base, o) : NULL;
+  o += rom->eta_cb ? rn * (r - (size_t)rom->m) * (r - (size_t)rom->m) : 0;
+  w->hg = rom->ham_cb ? PHGMG__CARVE(base, o) : NULL;
+  o += rom->ham_cb ? r : 0;
+  w->hH = rom->ham_cb ? PHGMG__CARVE(base, o) : NULL;
+  o += rom->ham_cb ? r * r : 0;
+  w->Ms = rom->eta_cb ? w->D2 : rom->Ms;
+  w->d2 = 0;
   w->piv = base ? PHGMG__CAST(int *, PHGMG__CAST(void *, base + o)) : NULL;
   o += (r * sizeof(int) + sizeof(phgmg_real) - 1) / sizeof(phgmg_real);
   return o;
@@ -4573,11 +4758,14 @@ PHGMG_DEF size_t phgmg_rom_eval_work_size(const phgmg_rom *rom) {
   return phgmg__romw_layout(rom, NULL, NULL);
 }
 
-/* q = M (x2 kron x2) via Lp (QUADRATIC), and the kept coordinates c. */
+/* q = M (x2 kron x2) via Lp (QUADRATIC), and the kept coordinates c. With
+   eta_cb: one call gives q, Lp = Dq (and D2q into w->D2 when w->d2). */
 PHGMG__ONLINE void phgmg__rom_prep(const phgmg_rom *rom, const phgmg_real *x, const phgmg__romw *w) {
   const int r = rom->r, m = rom->m, rn = rom->rn, nd = rom->nd, p = r - m;
   int i, k;
-  if (rom->kind == PHGMG_ROM_QUADRATIC) {
+  if (rom->kind == PHGMG_ROM_QUADRATIC && rom->eta_cb) {
+    rom->eta_cb(x + m, w->q, w->Lp, w->d2 ? w->D2 : NULL, rom->eta_user);
+  } else if (rom->kind == PHGMG_ROM_QUADRATIC) {
     const phgmg_real *x2 = x + m;
     for (k = 0; k < p; ++k) /* Lp(:,k) = sum_j Ms(:, k*p + j) x2_j: block k of Ms times x2 */
       phgmg__r_gemv(rn, p, rom->Ms + (size_t)k * p * rn, x2, 0, w->Lp + (size_t)k * rn);
@@ -4607,9 +4795,14 @@ PHGMG_DEF phgmg_real phgmg_rom_hamiltonian(const phgmg_rom *rom, const phgmg_rea
   for (j = 0; j < r; ++j) h += x[j] * w.tmp[j];
   h *= PHGMG__R(0.5);
   for (j = 0; j < rom->nd; ++j) {
-    phgmg_real v;
-    phgmg__r_poly(rom->poly, rom->poly_deg, w.c[j], &v, NULL, NULL);
-    h += rom->w[j] * v;
+    phgmg_real d[3];
+    phgmg__r_phi(rom, j, w.c[j], d);
+    h += rom->w[j] * d[0];
+  }
+  if (rom->ham_cb) {
+    phgmg_real hn = PHGMG__R(0);
+    rom->ham_cb(x, &hn, NULL, NULL, rom->ham_user);
+    h += hn;
   }
   return h;
 }
@@ -4621,11 +4814,15 @@ PHGMG__ONLINE void phgmg__rom_grad(const phgmg_rom *rom, const phgmg_real *x, ph
   int j;
   phgmg__rom_prep(rom, x, w);
   for (j = 0; j < nd; ++j) {
-    phgmg_real d1;
-    phgmg__r_poly(rom->poly, rom->poly_deg, w->c[j], NULL, &d1, NULL);
-    w->d[j] = rom->w[j] * d1;
+    phgmg_real d[3];
+    phgmg__r_phi(rom, j, w->c[j], d);
+    w->d[j] = rom->w[j] * d[1];
   }
   phgmg__r_gemv(r, r, rom->Qh, x, 0, g);
+  if (rom->ham_cb) {
+    rom->ham_cb(x, NULL, w->hg, NULL, rom->ham_user);
+    for (j = 0; j < r; ++j) g[j] += w->hg[j];
+  }
   if (nd > 0) phgmg__r_gemvt(nd, r, rom->P0, w->d, 1, g);
   if (rom->kind == PHGMG_ROM_QUADRATIC) {
     phgmg__r_gemv(r, rn, rom->Q01, w->q, 1, g);
@@ -4737,17 +4934,21 @@ PHGMG__ONLINE void phgmg__rom_hess(const phgmg_rom *rom, const phgmg_real *x, ph
       }
       phgmg__r_gemv(rn, rn, rom->Q11, lk, 0, w->b1);
       for (a = 0; a < p; ++a) {
-        const phgmg_real *la = w->Lp + (size_t)a * rn, *ms = rom->Ms + ((size_t)a * p + k) * rn;
+        const phgmg_real *la = w->Lp + (size_t)a * rn, *ms = w->Ms + ((size_t)a * p + k) * rn;
         phgmg_real s = PHGMG__R(0);
         for (i = 0; i < rn; ++i) s += la[i] * w->b1[i] + ms[i] * w->a1[i];
         H[(m + a) + (size_t)(m + k) * r] += s;
       }
     }
   }
+  if (rom->ham_cb) {
+    rom->ham_cb(x, NULL, NULL, w->hH, rom->ham_user);
+    for (b = 0; b < r * r; ++b) H[b] += w->hH[b];
+  }
   for (j = 0; j < nd; ++j) {
-    phgmg_real d2, wj;
-    phgmg__r_poly(rom->poly, rom->poly_deg, w->c[j], NULL, NULL, &d2);
-    wj = rom->w[j] * d2;
+    phgmg_real d[3], wj;
+    phgmg__r_phi(rom, j, w->c[j], d);
+    wj = rom->w[j] * d[2];
     if (wj == PHGMG__R(0)) continue;
     for (a = 0; a < r; ++a) w->xp[a] = rom->P0[j + (size_t)a * nd]; /* row j of P0 + P1 L */
     if (rom->kind == PHGMG_ROM_QUADRATIC)
@@ -4809,11 +5010,11 @@ PHGMG__ONLINE phgmg_result phgmg__rom_jac(const phgmg_rom *rom, const phgmg_real
   for (j = 0; j < p; ++j) {
     phgmg_real *sj = w->t; /* s_j (rn) */
     phgmg_real *cj = Jf + (size_t)(m + j) * r;
-    phgmg__r_gemv(rn, p, rom->Ms + (size_t)j * p * rn, w->fm + m, 0, sj);
+    phgmg__r_gemv(rn, p, w->Ms + (size_t)j * p * rn, w->fm + m, 0, sj);
     phgmg__r_gemv(rn, rn, rom->G11, sj, 0, w->b2);
     phgmg__r_gemv(r, rn, rom->G01, sj, 0, w->tmp);
     for (k = 0; k < p; ++k) {
-      const phgmg_real *lk = w->Lp + (size_t)k * rn, *ms = rom->Ms + ((size_t)j * p + k) * rn;
+      const phgmg_real *lk = w->Lp + (size_t)k * rn, *ms = w->Ms + ((size_t)j * p + k) * rn;
       phgmg_real s = PHGMG__R(0);
       for (i = 0; i < rn; ++i) s += lk[i] * w->b2[i] + ms[i] * w->b1[i];
       w->tmp[m + k] += s;
@@ -4827,6 +5028,7 @@ PHGMG__ONLINE phgmg_result phgmg__rom_jac(const phgmg_rom *rom, const phgmg_real
 PHGMG_DEF void phgmg_rom_hessian(const phgmg_rom *rom, const phgmg_real *x, phgmg_real *H, phgmg_real *work) {
   phgmg__romw w;
   phgmg__romw_layout(rom, work, &w);
+  w.d2 = 1;
   phgmg__rom_hess(rom, x, H, &w);
 }
 
@@ -4834,6 +5036,7 @@ PHGMG_DEF phgmg_result phgmg_rom_jacobian(const phgmg_rom *rom, const phgmg_real
                                           phgmg_real *work) {
   phgmg__romw w;
   phgmg__romw_layout(rom, work, &w);
+  w.d2 = 1;
   return phgmg__rom_jac(rom, x, Jf, &w);
 }
 
@@ -5031,6 +5234,7 @@ PHGMG__ONLINE phgmg_result phgmg__romstep_factor(phgmg_rom_stepper *s, const phg
   phgmg_result rc;
   int i, j, a, b;
   phgmg__romw_layout(rom, L->work, &w);
+  w.d2 = 1;
   rc = phgmg__rom_jac(rom, x, L->Jf, &w);
   if (rc != PHGMG_OK) { s->have_lu = 0; return rc; }
   if (!phgmg__r_finite(L->Jf, r * r)) { s->have_lu = 0; return PHGMG_ERR_NANINF; }
@@ -5730,8 +5934,9 @@ PHGMG__PRIV phgmg_result phgmg__publish(phgmg_reduced *red) {
   PHGMG__PUB(Phi, r * r); PHGMG__PUB(Gam, r * 3 * m); PHGMG__PUB(SX, 3 * r * r); PHGMG__PUB(SU, 3 * r * 3 * m);
 #undef PHGMG__PUB
   o->dt = red->Phi ? (phgmg_real)red->map_dt : (phgmg_real)0;
-  o->term = red->term;
-  if (nd > 0 && !red->poly && !red->expo) { o->phi_cb = phgmg__phi_tramp; o->phi_user = red; }
+  if (nd > 0 && !red->poly && !red->expo) {   /* callbacks: they need the full-model term index */
+    o->phi_cb = phgmg__phi_tramp; o->phi_user = red; o->term = red->term;
+  }
   if (red->eta) { o->eta_cb = red->eta; o->eta_user = red->eta_user; }
   if (red->gwork) { o->ham_cb = phgmg__ham_general; o->ham_user = red; }
   return rc;
@@ -6677,7 +6882,7 @@ PHGMG_DEF void phgmg_err_energy(const phgmg_energy *energy, int nsteps, double *
 #include <stdint.h>
 
 /* The arrays of a phgmg_rom in file order, with their sizes. */
-#define PHGMG__NFIELDS 18
+#define PHGMG__NFIELDS 19
 typedef struct phgmg__field { size_t off; const char *name; } phgmg__field;
 static const phgmg__field phgmg__fields[PHGMG__NFIELDS] = {
   {offsetof(phgmg_rom, Bh), "Bh"},   {offsetof(phgmg_rom, Qh), "Qh"},   {offsetof(phgmg_rom, K), "K"},
@@ -6685,7 +6890,8 @@ static const phgmg__field phgmg__fields[PHGMG__NFIELDS] = {
   {offsetof(phgmg_rom, G11), "G11"}, {offsetof(phgmg_rom, Q01), "Q01"}, {offsetof(phgmg_rom, Q11), "Q11"},
   {offsetof(phgmg_rom, Ms), "Ms"},   {offsetof(phgmg_rom, P0), "P0"},   {offsetof(phgmg_rom, P1), "P1"},
   {offsetof(phgmg_rom, w), "w"},     {offsetof(phgmg_rom, poly), "poly"}, {offsetof(phgmg_rom, Phi), "Phi"},
-  {offsetof(phgmg_rom, Gam), "Gam"}, {offsetof(phgmg_rom, SX), "SX"},   {offsetof(phgmg_rom, SU), "SU"}};
+  {offsetof(phgmg_rom, Gam), "Gam"}, {offsetof(phgmg_rom, SX), "SX"},   {offsetof(phgmg_rom, SU), "SU"},
+  {offsetof(phgmg_rom, expo), "expo"}};
 
 PHGMG__ONLINE const phgmg_real **phgmg__field_ptr(phgmg_rom *rom, int i) {
   return PHGMG__CAST(const phgmg_real **, PHGMG__CAST(void *, PHGMG__CAST(char *, PHGMG__CAST(void *, rom)) + phgmg__fields[i].off));
@@ -6696,7 +6902,7 @@ PHGMG__ONLINE const phgmg_real *phgmg__field_get(const phgmg_rom *rom, int i) {
 /* Number of scalars of field i (0 if the field does not apply). */
 PHGMG__ONLINE size_t phgmg__field_len(const phgmg_rom *rom, int i) {
   const size_t r = (size_t)rom->r, m = (size_t)rom->m, rn = (size_t)rom->rn, nd = (size_t)rom->nd;
-  const size_t p = (size_t)(rom->r - rom->m);
+  const size_t p = (size_t)(rom->r - rom->m), nf = (size_t)(rom->nphi > 1 ? rom->nphi : 1);
   switch (i) {
     case 0: return r * m;
     case 1: return r * r;
@@ -6711,15 +6917,26 @@ PHGMG__ONLINE size_t phgmg__field_len(const phgmg_rom *rom, int i) {
     case 10: return nd * r;
     case 11: return nd * rn;
     case 12: return nd;
-    case 13: return nd ? (size_t)rom->poly_deg + 1 : 0;
+    case 13: return nd ? nf * ((size_t)rom->poly_deg + 1) : 0;
     case 14: return r * r;
     case 15: return r * 3 * m;
     case 16: return 3 * r * r;
-    default: return 3 * r * 3 * m;
+    case 17: return 3 * r * 3 * m;
+    default: return nd ? nf * 2 * (size_t)rom->nexp : 0;
   }
 }
 
 #define PHGMG__HDR_BYTES (8 + 4 * 10 + 8)
+/* Version 2 (written only when a model needs it): nexp, nphi, nterm after the
+   version-1 header; the expo field (mask bit 18); nterm (0 or nd) uint32 term
+   indices after the scalars. */
+#define PHGMG__HDR2_BYTES (PHGMG__HDR_BYTES + 12)
+PHGMG__ONLINE int phgmg__rom_v2(const phgmg_rom *rom) {
+  return rom->nd > 0 && (rom->nexp > 0 || rom->nphi > 1 || rom->term);
+}
+PHGMG__ONLINE size_t phgmg__rom_nterm(const phgmg_rom *rom) {
+  return phgmg__rom_v2(rom) && rom->term ? (size_t)rom->nd : 0;
+}
 
 PHGMG__ONLINE void phgmg__put32(unsigned char *b, uint32_t v) {
   b[0] = (unsigned char)(v & 255u); b[1] = (unsigned char)((v >> 8) & 255u);
@@ -6765,23 +6982,25 @@ PHGMG_DEF size_t phgmg_rom_serialized_size(const phgmg_rom *rom) {
   int i;
   for (i = 0; i < PHGMG__NFIELDS; ++i)
     if (phgmg__field_get(rom, i)) n += phgmg__field_len(rom, i);
-  return PHGMG__HDR_BYTES + n * sizeof(phgmg_real) + 4;
+  if (!phgmg__rom_v2(rom)) return PHGMG__HDR_BYTES + n * sizeof(phgmg_real) + 4;
+  return PHGMG__HDR2_BYTES + n * sizeof(phgmg_real) + 4 * phgmg__rom_nterm(rom) + 4;
 }
 
 PHGMG_DEF phgmg_result phgmg_rom_serialize(const phgmg_rom *rom, void *buf, size_t cap, size_t *written) {
   unsigned char *b = PHGMG__CAST(unsigned char *, buf);
-  size_t need, o;
+  size_t need, o, k;
   uint32_t mask = 0;
   int i;
   phgmg_result rc = phgmg_rom_check(rom);
   if (rc != PHGMG_OK) return rc;
+  if (rom->phi_cb || rom->eta_cb || rom->ham_cb) return PHGMG_ERR_UNSUPPORTED;
   if (!buf) return PHGMG_ERR_INVALID_ARG;
   need = phgmg_rom_serialized_size(rom);
   if (cap < need) return PHGMG_ERR_WORKSPACE;
   for (i = 0; i < PHGMG__NFIELDS; ++i)
     if (phgmg__field_get(rom, i)) mask |= 1u << i;
   memcpy(b, "PHGMGROM", 8);
-  phgmg__put32(b + 8, PHGMG_ROM_FORMAT_VERSION);
+  phgmg__put32(b + 8, phgmg__rom_v2(rom) ? PHGMG_ROM_FORMAT_VERSION : 1u);
   phgmg__put32(b + 12, (uint32_t)sizeof(phgmg_real));
   phgmg__put32(b + 16, (uint32_t)rom->kind);
   phgmg__put32(b + 20, (uint32_t)rom->method);
@@ -6793,9 +7012,15 @@ PHGMG_DEF phgmg_result phgmg_rom_serialize(const phgmg_rom *rom, void *buf, size
   phgmg__put32(b + 44, mask);
   phgmg__put_f64(b + 48, (double)rom->dt);
   o = PHGMG__HDR_BYTES;
+  if (phgmg__rom_v2(rom)) {
+    phgmg__put32(b + o, (uint32_t)rom->nexp);
+    phgmg__put32(b + o + 4, (uint32_t)rom->nphi);
+    phgmg__put32(b + o + 8, (uint32_t)phgmg__rom_nterm(rom));
+    o = PHGMG__HDR2_BYTES;
+  }
   for (i = 0; i < PHGMG__NFIELDS; ++i) {
     const phgmg_real *a = phgmg__field_get(rom, i);
-    size_t k, n = phgmg__field_len(rom, i);
+    size_t n = phgmg__field_len(rom, i);
     if (!a) continue;
     for (k = 0; k < n; ++k, o += sizeof(phgmg_real)) {
 #if PHGMG_REAL_IS_FLOAT
@@ -6805,6 +7030,7 @@ PHGMG_DEF phgmg_result phgmg_rom_serialize(const phgmg_rom *rom, void *buf, size
 #endif
     }
   }
+  for (k = 0; k < phgmg__rom_nterm(rom); ++k, o += 4) phgmg__put32(b + o, (uint32_t)rom->term[k]);
   phgmg__put32(b + o, phgmg__fnv1a(b, o));
   if (written) *written = o + 4;
   return PHGMG_OK;
@@ -6813,16 +7039,26 @@ PHGMG_DEF phgmg_result phgmg_rom_serialize(const phgmg_rom *rom, void *buf, size
 /* Parse and validate the header; fills rom's scalars and returns the scalar
    count of the payload and the file's scalar size. */
 PHGMG__ONLINE phgmg_result phgmg__rom_header(const unsigned char *b, size_t len, phgmg_rom *rom,
-                                             size_t *nscal, size_t *ssize, uint32_t *mask_out) {
+                                             size_t *nscal, size_t *ssize, uint32_t *mask_out,
+                                             size_t *nterm_out) {
   uint32_t ver, ss, mask;
-  size_t n = 0, total;
+  size_t n = 0, total, hdr = PHGMG__HDR_BYTES, nterm = 0;
   int i;
   if (!b) return PHGMG_ERR_INVALID_ARG;
   if (len < PHGMG__HDR_BYTES + 4 || memcmp(b, "PHGMGROM", 8) != 0) return PHGMG_ERR_FORMAT;
   ver = phgmg__get32(b + 8);
   ss = phgmg__get32(b + 12);
-  if (ver != PHGMG_ROM_FORMAT_VERSION || (ss != 4 && ss != 8)) return PHGMG_ERR_FORMAT;
+  if ((ver != 1u && ver != PHGMG_ROM_FORMAT_VERSION) || (ss != 4 && ss != 8)) return PHGMG_ERR_FORMAT;
   memset(rom, 0, sizeof *rom);
+  if (ver == 2u) {
+    if (len < PHGMG__HDR2_BYTES + 4) return PHGMG_ERR_FORMAT;
+    hdr = PHGMG__HDR2_BYTES;
+    if (phgmg__get32(b + 56) > 8u || phgmg__get32(b + 60) > (1u << 24) || phgmg__get32(b + 64) > (1u << 24))
+      return PHGMG_ERR_FORMAT;
+    rom->nexp = (int)phgmg__get32(b + 56);
+    rom->nphi = (int)phgmg__get32(b + 60);
+    nterm = (size_t)phgmg__get32(b + 64);
+  }
   if (phgmg__get32(b + 24) > 4096u || phgmg__get32(b + 28) > 4096u || phgmg__get32(b + 32) > 4096u ||
       phgmg__get32(b + 36) > (1u << 24) || phgmg__get32(b + 40) > 32u || phgmg__get32(b + 16) > 2u ||
       phgmg__get32(b + 20) > 4u)
@@ -6843,8 +7079,10 @@ PHGMG__ONLINE phgmg_result phgmg__rom_header(const unsigned char *b, size_t len,
 #endif
     rom->dt = (phgmg_real)dt;
   }
-  if (mask >> PHGMG__NFIELDS) return PHGMG_ERR_FORMAT;
+  if (mask >> (ver == 1u ? 18 : PHGMG__NFIELDS)) return PHGMG_ERR_FORMAT;
   if (rom->m > rom->r) return PHGMG_ERR_FORMAT;
+  if ((rom->nphi > 1 && rom->nphi != rom->nd) || (nterm != 0 && nterm != (size_t)rom->nd))
+    return PHGMG_ERR_FORMAT;
   for (i = 0; i < PHGMG__NFIELDS; ++i)
     if (mask & (1u << i)) {
       size_t k = phgmg__field_len(rom, i);
@@ -6852,12 +7090,13 @@ PHGMG__ONLINE phgmg_result phgmg__rom_header(const unsigned char *b, size_t len,
       n += k;
     }
   if (n > (len / ss)) return PHGMG_ERR_FORMAT;
-  total = PHGMG__HDR_BYTES + n * ss + 4;
+  total = hdr + n * ss + 4 * nterm + 4;
   if (total != len) return PHGMG_ERR_FORMAT;
   if (phgmg__get32(b + total - 4) != phgmg__fnv1a(b, total - 4)) return PHGMG_ERR_FORMAT;
   *nscal = n;
   *ssize = ss;
   *mask_out = mask;
+  *nterm_out = nterm;
   return PHGMG_OK;
 }
 
@@ -6865,9 +7104,10 @@ PHGMG_DEF phgmg_result phgmg_rom_deserialize_size(const void *buf, size_t len, s
   phgmg_rom tmp;
   size_t n = 0, ss = 0;
   uint32_t mask = 0;
-  phgmg_result rc = phgmg__rom_header(PHGMG__CAST(const unsigned char *, buf), len, &tmp, &n, &ss, &mask);
+  size_t nterm = 0;
+  phgmg_result rc = phgmg__rom_header(PHGMG__CAST(const unsigned char *, buf), len, &tmp, &n, &ss, &mask, &nterm);
   if (rc != PHGMG_OK) return rc;
-  if (need) *need = n * sizeof(phgmg_real) + sizeof(phgmg_real);
+  if (need) *need = n * sizeof(phgmg_real) + sizeof(phgmg_real) + nterm * sizeof(int);
   return PHGMG_OK;
 }
 
@@ -6875,15 +7115,16 @@ PHGMG_DEF phgmg_result phgmg_rom_deserialize(const void *buf, size_t len, phgmg_
                                              size_t mem_size) {
   const unsigned char *b = PHGMG__CAST(const unsigned char *, buf);
   phgmg_rom tmp;
-  size_t n = 0, ss = 0, o = PHGMG__HDR_BYTES, k;
+  size_t n = 0, ss = 0, o, k, nterm = 0;
   uint32_t mask = 0;
   phgmg_real *dst = PHGMG__CAST(phgmg_real *, mem);
   phgmg_result rc;
   int i;
   if (!rom || !mem) return PHGMG_ERR_INVALID_ARG;
-  rc = phgmg__rom_header(b, len, &tmp, &n, &ss, &mask);
+  rc = phgmg__rom_header(b, len, &tmp, &n, &ss, &mask, &nterm);
   if (rc != PHGMG_OK) return rc;
-  if (mem_size < n * sizeof(phgmg_real) + sizeof(phgmg_real)) return PHGMG_ERR_WORKSPACE;
+  if (mem_size < n * sizeof(phgmg_real) + sizeof(phgmg_real) + nterm * sizeof(int)) return PHGMG_ERR_WORKSPACE;
+  o = phgmg__get32(b + 8) == 1u ? PHGMG__HDR_BYTES : PHGMG__HDR2_BYTES;
   if (((size_t)mem) % sizeof(phgmg_real) != 0) return PHGMG_ERR_INVALID_ARG;
   for (i = 0; i < PHGMG__NFIELDS; ++i) {
     const size_t len_i = phgmg__field_len(&tmp, i);
@@ -6893,6 +7134,15 @@ PHGMG_DEF phgmg_result phgmg_rom_deserialize(const void *buf, size_t len, phgmg_
     if (!phgmg__r_finite(dst, (int)len_i)) return PHGMG_ERR_FORMAT;
     *phgmg__field_ptr(&tmp, i) = dst;
     dst += len_i;
+  }
+  if (nterm) { /* the term indices follow the scalars in mem */
+    int *ti = PHGMG__CAST(int *, PHGMG__CAST(void *, dst));
+    for (k = 0; k < nterm; ++k, o += 4) {
+      uint32_t v = phgmg__get32(b + o);
+      if (v > (1u << 30)) return PHGMG_ERR_FORMAT;
+      ti[k] = (int)v;
+    }
+    tmp.term = ti;
   }
   rc = phgmg_rom_check(&tmp);
   if (rc != PHGMG_OK) return PHGMG_ERR_FORMAT;
@@ -6964,6 +7214,7 @@ PHGMG_DEF phgmg_result phgmg_rom_export_c(const phgmg_rom *rom, const char *name
   size_t k;
   phgmg_result rc = phgmg_rom_check(rom);
   if (rc != PHGMG_OK) return rc;
+  if (rom->ham_cb) return PHGMG_ERR_UNSUPPORTED;
   if (!name || !path) return PHGMG_ERR_INVALID_ARG;
   f = fopen(path, "w");
   if (!f) return PHGMG_ERR_IO;
@@ -6976,7 +7227,7 @@ PHGMG_DEF phgmg_result phgmg_rom_export_c(const phgmg_rom *rom, const char *name
   for (i = 0; i < PHGMG__NFIELDS; ++i) {
     const phgmg_real *a = phgmg__field_get(rom, i);
     const size_t n = phgmg__field_len(rom, i);
-    if (!a) continue;
+    if (!a || n == 0) continue; /* no zero-length arrays in C */
     ok &= fprintf(f, "static const phgmg_real %s_%s[%lu] = {", name, phgmg__fields[i].name, (unsigned long)n) > 0;
     for (k = 0; k < n; ++k)
 #if PHGMG_REAL_IS_FLOAT
@@ -6986,10 +7237,22 @@ PHGMG_DEF phgmg_result phgmg_rom_export_c(const phgmg_rom *rom, const char *name
 #endif
     ok &= fprintf(f, "};\n") > 0;
   }
+  if (rom->term && rom->nd > 0) {
+    ok &= fprintf(f, "static const int %s_term[%d] = {", name, rom->nd) > 0;
+    for (i = 0; i < rom->nd; ++i) ok &= fprintf(f, "%s%d", i == 0 ? "\n  " : (i % 12 ? ", " : ",\n  "), rom->term[i]) > 0;
+    ok &= fprintf(f, "};\n") > 0;
+  }
+  if (rom->phi_cb)
+    ok &= fprintf(f, "/* supplied by the firmware: phi, phi', phi'' of full-model term `term` at s */\n"
+                     "extern void %s_phi(int term, phgmg_real s, phgmg_real d[3], void *user);\n", name) > 0;
+  if (rom->eta_cb)
+    ok &= fprintf(f, "/* supplied by the firmware: the manifold q = eta(x2), Dq, D2q (see phgmg_rom) */\n"
+                     "extern void %s_eta(const phgmg_real *x2, phgmg_real *q, phgmg_real *Dq, phgmg_real *D2q,\n"
+                     "                   void *user);\n", name) > 0;
   ok &= fprintf(f, "static const phgmg_rom %s = {\n  %d, %d, %d, %d, %d, %d, %d,\n ", name, rom->kind,
                 rom->method, rom->r, rom->m, rom->rn, rom->nd, rom->poly_deg) > 0;
   for (i = 0; i < 14; ++i) {
-    if (phgmg__field_get(rom, i)) ok &= fprintf(f, " %s_%s,", name, phgmg__fields[i].name) > 0;
+    if (phgmg__field_get(rom, i) && phgmg__field_len(rom, i) > 0) ok &= fprintf(f, " %s_%s,", name, phgmg__fields[i].name) > 0;
     else ok &= fprintf(f, " NULL,") > 0;
   }
 #if PHGMG_REAL_IS_FLOAT
@@ -6997,11 +7260,21 @@ PHGMG_DEF phgmg_result phgmg_rom_export_c(const phgmg_rom *rom, const char *name
 #else
   ok &= fprintf(f, "\n  %.17g,\n ", rom->dt) > 0;
 #endif
-  for (i = 14; i < PHGMG__NFIELDS; ++i) {
-    if (phgmg__field_get(rom, i)) ok &= fprintf(f, " %s_%s%s", name, phgmg__fields[i].name, i + 1 < PHGMG__NFIELDS ? "," : "") > 0;
-    else ok &= fprintf(f, " NULL%s", i + 1 < PHGMG__NFIELDS ? "," : "") > 0;
+  for (i = 14; i < 18; ++i) {
+    if (phgmg__field_get(rom, i) && phgmg__field_len(rom, i) > 0) ok &= fprintf(f, " %s_%s,", name, phgmg__fields[i].name) > 0;
+    else ok &= fprintf(f, " NULL,") > 0;
   }
-  ok &= fprintf(f, "\n};\n") > 0;
+  /* nexp, nphi, expo, phi_cb, term, phi_user, eta_cb, eta_user (ham_cb, ham_user: 0) */
+  ok &= fprintf(f, "\n  %d, %d,", rom->nexp, rom->nphi) > 0;
+  if (rom->expo && phgmg__field_len(rom, 18) > 0) ok &= fprintf(f, " %s_expo,", name) > 0;
+  else ok &= fprintf(f, " NULL,") > 0;
+  if (rom->phi_cb) ok &= fprintf(f, " %s_phi,", name) > 0;
+  else ok &= fprintf(f, " 0,") > 0;
+  if (rom->term && rom->nd > 0) ok &= fprintf(f, " %s_term, NULL,", name) > 0;
+  else ok &= fprintf(f, " NULL, NULL,") > 0;
+  if (rom->eta_cb) ok &= fprintf(f, " %s_eta, NULL,", name) > 0;
+  else ok &= fprintf(f, " 0, NULL,") > 0;
+  ok &= fprintf(f, " 0, NULL\n};\n") > 0;
   if (fclose(f) != 0) ok = 0;
   return ok ? PHGMG_OK : PHGMG_ERR_IO;
 }
