@@ -539,8 +539,7 @@ static int stage_commit(staged *sg) {
   for (k = 0; k < sg->n; ++k)
     if (rename(sg->tmp[k], sg->fin[k]) != 0) {
       fail("%s: cannot rename %s into place: %s", sg->fin[k], sg->tmp[k], strerror(errno));
-      for (; k < sg->n; ++k) remove(sg->tmp[k]);
-      sg->n = 0; /* (the names leak here; the program exits) */
+      stage_abort(sg); /* removes the files not yet renamed, frees the names */
       return 1;
     }
   stage_abort(sg); /* frees the names; the temporary files are gone */
