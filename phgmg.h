@@ -3162,7 +3162,7 @@ PHGMG__PRIV phgmg_result phgmg__ph_check_psd(const phgmg_ph_system *s, double to
 PHGMG__PRIV phgmg_result phgmg__ph_check_q_pd(const phgmg_ph_system *s, const phgmg_allocator *al) {
   const int N = s->N, kb = s->storage == PHGMG_BANDED ? s->kb : N - 1;
   const size_t ld = (size_t)kb + 1;
-  int i, j, k, diag = 1;
+  int i, j, diag = 1;
   double *L;
   phgmg_result rc = PHGMG_OK;
   for (j = 0; j < N && diag; ++j)
@@ -3173,23 +3173,19 @@ PHGMG__PRIV phgmg_result phgmg__ph_check_q_pd(const phgmg_ph_system *s, const ph
       if (!(phgmg__ph_at(s, s->Q, j, j) > 0.0)) return PHGMG_ERR_Q_NOT_PD;
     return PHGMG_OK;
   }
-  L = phgmg__dalloc(al, ld * (size_t)N); /* L(i,j) at L[(i-j) + j*ld] */
+  L = phgmg__dalloc(al, ld * (size_t)N); /* row i: L(i,k), i-kb <= k <= i, contiguous */
   if (!L) return PHGMG_ERR_NOMEM;
-  for (j = 0; j < N && rc == PHGMG_OK; ++j) {
-    double d = phgmg__ph_at(s, s->Q, j, j);
-    for (k = PHGMG__MAX(0, j - kb); k < j; ++k) {
-      const double l = L[(size_t)(j - k) + (size_t)k * ld];
-      d -= l * l;
+  for (i = 0; i < N && rc == PHGMG_OK; ++i) { /* row by row, inner products over contiguous rows */
+    double *Li = L + (size_t)i * (size_t)kb + (size_t)kb; /* Li[k] = L(i,k) */
+    const int i0 = PHGMG__MAX(0, i - kb);
+    double d;
+    for (j = i0; j < i; ++j) {
+      const double *Lj = L + (size_t)j * (size_t)kb + (size_t)kb;
+      Li[j] = (phgmg__ph_at(s, s->Q, i, j) - phgmg__dot(j - i0, Li + i0, Lj + i0)) / Lj[j];
     }
-    if (!(d > 0.0)) { rc = PHGMG_ERR_Q_NOT_PD; break; }
-    d = sqrt(d);
-    L[(size_t)j * ld] = d;
-    for (i = j + 1; i <= PHGMG__MIN(N - 1, j + kb); ++i) {
-      double v = phgmg__ph_at(s, s->Q, i, j);
-      for (k = PHGMG__MAX(0, i - kb); k < j; ++k)
-        v -= L[(size_t)(i - k) + (size_t)k * ld] * L[(size_t)(j - k) + (size_t)k * ld];
-      L[(size_t)(i - j) + (size_t)j * ld] = v / d;
-    }
+    d = phgmg__ph_at(s, s->Q, i, i) - phgmg__dot(i - i0, Li + i0, Li + i0);
+    if (!(d > 0.0)) rc = PHGMG_ERR_Q_NOT_PD;
+    else Li[i] = sqrt(d);
   }
   phgmg__free(al, L);
   return rc;
