@@ -60,7 +60,7 @@
             phgmg_norm1, phgmg_normf, phgmg_zlu_factor, phgmg_zlu_solve, phgmg_qr,
             phgmg_qrcp, phgmg_qr_form_q, phgmg_qr_apply, phgmg_lstsq (plain/ridge),
             phgmg_svd (thin, rank-revealing), phgmg_sym_eig
-   ph:      phgmg_ph_validate (skew J, symmetric PSD R, rank B, cond(J-R), NaN),
+   ph:      phgmg_ph_validate (skew J, symmetric PSD R, symmetric PD Q, rank B, cond(J-R), NaN),
             phgmg_ph_hamiltonian, phgmg_ph_gradient, phgmg_ph_rhs, phgmg_ph_output,
             phgmg_ph_apply (J, R or Q times a block), phgmg_jr_factor_create /
             phgmg_jr_solve / phgmg_jr_factor_destroy (apply (J-R)^{-1} or ^{-T})
@@ -660,7 +660,9 @@ extern "C" {
 
 /* POD: the leading left singular vectors of X (N x ns). k = kmax modes, or
    fewer: with tol > 0 only modes with sigma_k > tol * sigma_1 are kept.
-   V: N x kmax (ldv), S: kmax singular values (may be NULL). *k_out = modes kept. */
+   V: N x kmax (ldv), S: kmax singular values (may be NULL). *k_out = modes kept.
+   Independent of the magnitude of X within the floating-point range (the SVD
+   scales internally by a power of two, see phgmg_svd). */
 PHGMG_DEF phgmg_result phgmg_pod(int N, int ns, const double *X, int ldx, int kmax, double tol,
                                  double *V, int ldv, double *S, int *k_out,
                                  const phgmg_allocator *alloc);
@@ -773,7 +775,9 @@ PHGMG_DEF phgmg_result phgmg_reduced_W(const phgmg_reduced *red, const double *x
 /* Simulate the reduced model with the online GL3 stepper from xr0 over nsteps
    steps of dt (u from uf at the stage times). Outputs (each may be NULL):
    XR r x (nsteps+1), Y m x (nsteps+1), energy like phgmg_simulate (Hamiltonian
-   of the reduced model). tol/max_iter: Newton settings (<= 0: defaults). */
+   of the reduced model). tol/max_iter: Newton settings (<= 0: defaults).
+   The stepper memory is sized for dt (phgmg_rom_stepper_memsize_dt), so a
+   model with a step map for another dt is stepped with Newton. */
 PHGMG_DEF phgmg_result phgmg_reduced_simulate(const phgmg_reduced *red, const double *xr0, double t0,
                                               double dt, int nsteps, phgmg_input_fn uf, void *uuser,
                                               double tol, int max_iter, double *XR, double *Y,
