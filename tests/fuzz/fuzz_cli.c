@@ -6,8 +6,12 @@
    inside the scratch directory), at most 48 tokens; the resulting command
    line is run. Any exit status is fine (0, 1, 2); sanitizers, leaks and
    hangs are findings. Before each run the scratch directory is restored, so
-   a run never sees what an earlier one wrote. Everything is written below
-   the scratch directory (/tmp/phgmg_fuzz_cli_XXXXXX, removed at exit).
+   a run never sees what an earlier one wrote. The command runs with the
+   scratch directory (/tmp/phgmg_fuzz_cli_XXXXXX, removed at exit) as its
+   working directory, so whatever it writes -- also under a relative name
+   such as "2" after --out -- stays there; the harness returns to the
+   starting directory afterwards (libFuzzer's corpus paths are relative).
+   run.sh passes an absolute -artifact_prefix for the same reason.
 
    libFuzzer (clang):
      clang -g -O1 -fsanitize=fuzzer,address,undefined tests/fuzz/fuzz_cli.c \
@@ -18,12 +22,14 @@
 #include "../../examples/phgmg_cli.c"
 #undef main
 #include <dirent.h>
+#include <fcntl.h>
 #include <stdint.h>
 #include <unistd.h>
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
 static char g_dir[64];
+static int g_home = -1; /* the starting working directory */
 static char g_tok[96][128];
 static int g_ntok;
 static unsigned char *g_rom;
@@ -139,7 +145,9 @@ static void init(void) {
   argv[argc++] = (char *)"--out"; argv[argc++] = g_tok[g_ntok - 5];
   argv[argc++] = (char *)"--quiet";
   argv[argc] = NULL;
+  if (chdir(g_dir) != 0) fz_die("chdir");
   if (phgmg_cli_main(argc, argv) != 0) fz_die("cannot make the scratch model");
+  if (fchdir(g_home) != 0) fz_die("fchdir");
   snprintf(path, sizeof path, "%s/o/rom.phgmgrom", g_dir);
   f = fopen(path, "rb");
   if (!f || fseek(f, 0, SEEK_END) != 0 || (n = ftell(f)) <= 0 || fseek(f, 0, SEEK_SET) != 0)
@@ -154,6 +162,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   char *argv[50];
   int argc = 0;
   size_t i;
+  if (g_home < 0 && (g_home = open(".", O_RDONLY)) < 0) fz_die("cannot open the working directory");
   if (!g_dir[0]) init();
   restore();
   argv[argc++] = (char *)"phgmg";
@@ -161,7 +170,9 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   argv[argc] = NULL;
   g_quiet = 0;
   fflush(stdout);
+  if (chdir(g_dir) != 0) fz_die("chdir");
   (void)phgmg_cli_main(argc, argv);
+  if (fchdir(g_home) != 0) fz_die("fchdir");
   fflush(stdout);
   return 0;
 }

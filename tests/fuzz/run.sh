@@ -63,12 +63,12 @@ if [ $have_libfuzzer = 1 ]; then
     log="$out/fuzz_$t.log"
     if [ "$secs" = 0 ]; then
       # shellcheck disable=SC2086
-      ASAN_OPTIONS=detect_leaks=1 "$bin" -runs=0 -print_final_stats=1 -artifact_prefix="$out/crash-$t-" \
+      ASAN_OPTIONS=detect_leaks=1 "$bin" -runs=0 -print_final_stats=1 -artifact_prefix="$PWD/$out/crash-$t-" \
         $rflags "tests/fuzz/corpus/$corpus" </dev/null >"$log" 2>&1
     else
       # shellcheck disable=SC2086
       ASAN_OPTIONS=detect_leaks=1 "$bin" -max_total_time="$secs" -timeout=10 -rss_limit_mb=2048 \
-        -print_final_stats=1 $dictopt $rflags -artifact_prefix="$out/crash-$t-" \
+        -print_final_stats=1 $dictopt $rflags -artifact_prefix="$PWD/$out/crash-$t-" \
         "$out/corpus_$t" "tests/fuzz/corpus/$corpus" </dev/null >"$log" 2>&1
     fi
     rc=$?
