@@ -60,7 +60,7 @@
             phgmg_norm1, phgmg_normf, phgmg_zlu_factor, phgmg_zlu_solve, phgmg_qr,
             phgmg_qrcp, phgmg_qr_form_q, phgmg_qr_apply, phgmg_lstsq (plain/ridge),
             phgmg_svd (thin, rank-revealing), phgmg_sym_eig
-   ph:      phgmg_ph_validate (skew J, symmetric PSD R, rank B, cond(J-R), NaN),
+   ph:      phgmg_ph_validate (skew J, symmetric PSD R, symmetric PD Q, rank B, cond(J-R), NaN),
             phgmg_ph_hamiltonian, phgmg_ph_gradient, phgmg_ph_rhs, phgmg_ph_output,
             phgmg_ph_apply (J, R or Q times a block), phgmg_jr_factor_create /
             phgmg_jr_solve / phgmg_jr_factor_destroy (apply (J-R)^{-1} or ^{-T})
@@ -151,13 +151,17 @@ extern "C" {
   X(PHGMG_ERR_NEGATIVE_WEIGHT, -13, "DEIM produced a negative weight")                   \
   X(PHGMG_ERR_FORMAT,          -14, "malformed or unsupported file/data format")         \
   X(PHGMG_ERR_IO,              -15, "I/O error")                                         \
-  X(PHGMG_ERR_UNSUPPORTED,     -16, "operation not supported for this model kind")
+  X(PHGMG_ERR_UNSUPPORTED,     -16, "operation not supported for this model kind")       \
+  X(PHGMG_ERR_Q_NOT_SYMMETRIC, -17, "Q is not symmetric")                               \
+  X(PHGMG_ERR_Q_NOT_PD,        -18, "Q is not positive definite")                       \
+  X(PHGMG_ERR_DTYPE,           -19, "unsupported .npy dtype (complex, object, string, ...)") \
+  X(PHGMG_ERR_INEXACT,         -20, "integer beyond 2^53 in magnitude: not exact as a double")
 
 typedef enum phgmg_result {
 #define PHGMG__X(name, val, str) name = val,
   PHGMG__RESULT_LIST(PHGMG__X)
 #undef PHGMG__X
-  PHGMG__RESULT_END_ = -17
+  PHGMG__RESULT_END_ = -21
 } phgmg_result;
 
 /* A stable, human-readable description of a result code (never NULL). */
@@ -264,7 +268,10 @@ PHGMG_DEF phgmg_result phgmg_lstsq(int m, int n, int nrhs, const double *A, int 
    the r x r triangular factor (Drmac-Veselic), U = Q*W, V = P*Q2*Vj.
    Returns the k = min(kmax, r) leading triplets: S[k] descending, U (m x k,
    ldu), V (n x k, ldv; may be NULL, which also saves time). *k_out = k;
-   kmax = 0 only computes the rank. *rank_out (may be NULL) = r. Cost grows
+   kmax = 0 only computes the rank. *rank_out (may be NULL) = r. A whose
+   largest |entry| is outside [2^-256, 2^256] is scaled internally by a power
+   of two (exact; as LAPACK does), so the results do not depend on the data's
+   magnitude anywhere in the floating-point range. Cost grows
    with r^3 (about 1 s for r ~ 800 on one core), A is not modified.
    PHGMG_ERR_NANINF / _NOMEM / _NOT_CONVERGED (Jacobi, not seen in practice). */
 PHGMG_DEF phgmg_result phgmg_svd(int m, int n, const double *A, int lda, int kmax,
@@ -366,10 +373,14 @@ typedef struct phgmg_ph_system {
    for a diagonal R, else phgmg_sym_eig on a dense copy (dense R, or banded with
    N <= 2000); a larger banded R must admit a Cholesky factorization of
    R + tol ||R||_1 I in band storage (O(N kb^2), a slightly looser bound since
-   ||R||_1 >= ||R||_2). Checks run in this order and the first failure is
-   returned: PHGMG_ERR_INVALID_ARG (NULL pointers, missing callbacks) / _SIZE /
-   _NANINF / _NOT_SKEW / _NOT_SYMMETRIC (R or Q) / _NOT_PSD / _RANK / _SINGULAR,
-   or _NOMEM. The system is never modified. */
+   ||R||_1 >= ||R||_2). Q positive definite: exact for a diagonal Q (every
+   diagonal entry > 0), else a Cholesky factorization of Q (dense, or in band
+   storage, O(N kb^2)) must meet only positive pivots (no tolerance: positive
+   definite to working precision). Checks run in this order and the first
+   failure is returned: PHGMG_ERR_INVALID_ARG (NULL pointers, missing
+   callbacks) / _SIZE / _NANINF / _NOT_SKEW / _NOT_SYMMETRIC (R) /
+   _Q_NOT_SYMMETRIC / _NOT_PSD (R) / _Q_NOT_PD / _RANK / _SINGULAR, or _NOMEM.
+   The system is never modified. */
 PHGMG_DEF phgmg_result phgmg_ph_validate(const phgmg_ph_system *sys, double tol,
                                          double *rcond_out, const phgmg_allocator *alloc);
 
@@ -661,8 +672,11 @@ PHGMG_DEF size_t phgmg_rom_stepper_memsize_dt(const phgmg_rom *rom, phgmg_real d
    sizeof(phgmg_real) * (size_t)((rn) * (r) * (r) + (r) * (r) + (r) + 8))
 /* Set up a stepper in caller memory (mem must be aligned for phgmg_real and
    int; anything from malloc or a static phgmg_real array is). tol <= 0 gives
-   1e-10 (double) / 1e-5 (float); max_iter <= 0 gives 10. PHGMG_ERR_WORKSPACE
-   if mem_size < phgmg_rom_stepper_memsize(rom). */
+   1e-10 (double) / 1e-5 (float); a tol that is NaN or infinite is
+   PHGMG_ERR_INVALID_ARG; max_iter <= 0 gives 10. PHGMG_ERR_WORKSPACE if
+   mem_size < phgmg_rom_stepper_memsize_dt(rom, dt) (which equals
+   phgmg_rom_stepper_memsize(rom) when dt is the model's own step, or the
+   model has no step map). */
 PHGMG_DEF phgmg_result phgmg_rom_stepper_init(phgmg_rom_stepper *s, const phgmg_rom *rom, phgmg_real dt,
                                               phgmg_real tol, int max_iter, void *mem, size_t mem_size);
 /* Forget the extrapolation history (call after changing x by hand). */
@@ -702,7 +716,9 @@ extern "C" {
 
 /* POD: the leading left singular vectors of X (N x ns). k = kmax modes, or
    fewer: with tol > 0 only modes with sigma_k > tol * sigma_1 are kept.
-   V: N x kmax (ldv), S: kmax singular values (may be NULL). *k_out = modes kept. */
+   V: N x kmax (ldv), S: kmax singular values (may be NULL). *k_out = modes kept.
+   Independent of the magnitude of X within the floating-point range (the SVD
+   scales internally by a power of two, see phgmg_svd). */
 PHGMG_DEF phgmg_result phgmg_pod(int N, int ns, const double *X, int ldx, int kmax, double tol,
                                  double *V, int ldv, double *S, int *k_out,
                                  const phgmg_allocator *alloc);
@@ -841,7 +857,7 @@ PHGMG_DEF phgmg_result phgmg_reduce(phgmg_reduced **out, const phgmg_ph_system *
 PHGMG_DEF void phgmg_reduced_destroy(phgmg_reduced *red);
 /* The online model (views into the reduced object; valid until destroy). */
 PHGMG_DEF const phgmg_rom *phgmg_reduced_rom(const phgmg_reduced *red);
-/* Offline double copy of the same model (identical layout, double arrays). */
+/* The full-order dimension N the model was reduced from (0 for NULL). */
 PHGMG_DEF int phgmg_reduced_N(const phgmg_reduced *red);
 /* Reconstruction x = phi(xr) (N). */
 PHGMG_DEF void phgmg_reduced_lift(const phgmg_reduced *red, const double *xr, double *x);
@@ -855,7 +871,9 @@ PHGMG_DEF phgmg_result phgmg_reduced_W(const phgmg_reduced *red, const double *x
 /* Simulate the reduced model with the online GL3 stepper from xr0 over nsteps
    steps of dt (u from uf at the stage times). Outputs (each may be NULL):
    XR r x (nsteps+1), Y m x (nsteps+1), energy like phgmg_simulate (Hamiltonian
-   of the reduced model). tol/max_iter: Newton settings (<= 0: defaults). */
+   of the reduced model). tol/max_iter: Newton settings (<= 0: defaults).
+   The stepper memory is sized for dt (phgmg_rom_stepper_memsize_dt), so a
+   model with a step map for another dt is stepped with Newton. */
 PHGMG_DEF phgmg_result phgmg_reduced_simulate(const phgmg_reduced *red, const double *xr0, double t0,
                                               double dt, int nsteps, phgmg_input_fn uf, void *uuser,
                                               double tol, int max_iter, double *XR, double *Y,
@@ -958,14 +976,20 @@ PHGMG_DEF phgmg_result phgmg_rom_export_c(const phgmg_rom *rom, const char *name
 /* >>npy =================================================================== */
 /* NumPy .npy files (offline half): snapshot matrices, bases and reference
    trajectories exchanged with Python.
-   Read: format versions 1.0, 2.0 and 3.0; dtypes '<f8', '>f8', '<f4', '>f4';
-   C or Fortran order; 0-d, 1-d and 2-d shapes. The result is always a
-   column-major double matrix: shape () is 1 x 1, shape (n,) is n x 1, shape
-   (r, c) is r x c. Empty shapes such as (0,) or (3, 0) give a zero-size matrix
-   (a valid pointer to no elements). Bytes after the data are ignored, as NumPy
-   does. Anything else (bad magic, bad header dict, other dtypes, more than two
-   dimensions, a dimension above INT_MAX, a header longer than
-   PHGMG_NPY_MAX_HEADER, truncated data) is PHGMG_ERR_FORMAT.
+   Read: format versions 1.0, 2.0 and 3.0; dtypes float64/float32 ('<f8',
+   '>f8', '<f4', '>f4'), the integers int8 ... int64 and uint8 ... uint64
+   ('<i1' '<i2' '<i4' '<i8' '<u1' '<u2' '<u4' '<u8', big-endian '>' too, '|'
+   for the one-byte ones) and bool ('|b1'); C or Fortran order; 0-d, 1-d and
+   2-d shapes. The result is always a column-major double matrix: shape () is
+   1 x 1, shape (n,) is n x 1, shape (r, c) is r x c. Integers convert
+   exactly; an (u)int64 beyond 2^53 in magnitude is PHGMG_ERR_INEXACT. bool
+   gives 0 and 1. Another dtype (complex, float16, strings, objects,
+   structured, native-order '=f8') is PHGMG_ERR_DTYPE. Empty shapes such as
+   (0,) or (3, 0) give a zero-size matrix (a valid pointer to no elements).
+   Bytes after the data are ignored, as NumPy does. Anything else (bad magic,
+   bad header dict, more than two dimensions, a dimension above INT_MAX, a
+   header longer than PHGMG_NPY_MAX_HEADER, truncated data) is
+   PHGMG_ERR_FORMAT.
    Write: format version 1.0, '<f8' (or '<f4' with PHGMG_NPY_F32), Fortran order
    (or C order with PHGMG_NPY_C_ORDER), header padded so the data starts at a
    multiple of 64 bytes, as NumPy writes it.
@@ -991,7 +1015,9 @@ extern "C" {
    column-major rows x cols matrix (ld = rows) allocated with alloc (NULL =
    default); release it with phgmg_npy_free. rows, cols and out are required,
    ndim (0, 1 or 2) may be NULL. Errors: PHGMG_ERR_INVALID_ARG (NULL buf/out/
-   rows/cols), PHGMG_ERR_FORMAT, PHGMG_ERR_NOMEM. Safe on arbitrary bytes. */
+   rows/cols), PHGMG_ERR_FORMAT, PHGMG_ERR_DTYPE, PHGMG_ERR_INEXACT,
+   PHGMG_ERR_NOMEM; *out, *rows, *cols, *ndim are then unchanged. Safe on
+   arbitrary bytes. */
 PHGMG_DEF phgmg_result phgmg_npy_parse(const void *buf, size_t len, double **out, int *rows,
                                        int *cols, int *ndim, const phgmg_allocator *alloc);
 
@@ -1011,13 +1037,16 @@ PHGMG_DEF void phgmg_npy_free(double *p, const phgmg_allocator *alloc);
 #ifndef PHGMG_NO_STDIO
 /* Read a .npy file; outputs and errors as phgmg_npy_parse, plus PHGMG_ERR_IO
    if the file cannot be opened or read. A file shorter than its header
-   promises is PHGMG_ERR_FORMAT. */
+   promises is PHGMG_ERR_FORMAT (checked before allocating for a regular file;
+   from a pipe the buffer grows with the data that actually arrives). */
 PHGMG_DEF phgmg_result phgmg_npy_read(const char *path, double **out, int *rows, int *cols,
                                       int *ndim, const phgmg_allocator *alloc);
 
 /* Write A (as phgmg_npy_serialize) to the file path, streaming, without
    allocating. Errors as phgmg_npy_serialize (except WORKSPACE), plus
-   PHGMG_ERR_IO; a partly written file is removed. */
+   PHGMG_ERR_IO. After a write error a file this call created is removed; an
+   existing path (a file, a device, a pipe, a symbolic link) is never removed
+   (an existing regular file may then be left partly written). */
 PHGMG_DEF phgmg_result phgmg_npy_write(const char *path, const double *A, int rows, int cols,
                                        int ld, int ndim, unsigned flags);
 #endif /* PHGMG_NO_STDIO */
@@ -2151,12 +2180,31 @@ PHGMG__PRIV phgmg_result phgmg__jacobi_1s(int r, double *X, int ldx, double *V, 
   return PHGMG_ERR_NOT_CONVERGED;
 }
 
+/* Scale the m x n matrix W (ld m) by a power of two into a safe range, as
+   LAPACK's drivers do: if its largest |entry| lies outside [2^-256, 2^256],
+   W is multiplied (exactly) by 2^-e so that it lies in [1/2, 1); returns e
+   (0: not scaled). The singular values of the input are those of W times 2^e;
+   the singular vectors are the same. Inside the range nothing changes, so
+   results for ordinary data are bit for bit those of the unscaled code. */
+PHGMG__PRIV int phgmg__svd_scale(int m, int n, double *W) {
+  const size_t cnt = (size_t)m * (size_t)n;
+  double amax = 0.0;
+  size_t t;
+  int e = 0;
+  for (t = 0; t < cnt; ++t)
+    if (fabs(W[t]) > amax) amax = fabs(W[t]);
+  if (amax == 0.0 || (amax >= ldexp(1.0, -256) && amax <= ldexp(1.0, 256))) return 0;
+  (void)frexp(amax, &e); /* amax = f 2^e, f in [1/2, 1) */
+  for (t = 0; t < cnt; ++t) W[t] = ldexp(W[t], -e);
+  return e;
+}
+
 PHGMG_DEF phgmg_result phgmg_svd(int m, int n, const double *A, int lda, int kmax,
                                  double *S, double *U, int ldu, double *V, int ldv,
                                  int *k_out, int *rank_out, const phgmg_allocator *alloc) {
   double *W = NULL, *tau, *vn, *Rt, *tau2, *X, *Vj, *d, anorm;
   int *jpvt = NULL, *perm;
-  int r, rnz, k, i, j, kmin = PHGMG__MIN(m, n);
+  int r, rnz, k, i, j, kmin = PHGMG__MIN(m, n), esc;
   phgmg_result rc;
   size_t nw;
   if (m < 0 || n < 0 || kmax < 0 || lda < PHGMG__MAX(m, 1)) return PHGMG_ERR_SIZE;
@@ -2180,6 +2228,7 @@ PHGMG_DEF phgmg_result phgmg_svd(int m, int n, const double *A, int lda, int kma
   vn = tau + kmin;
   for (j = 0; j < n; ++j)
     memcpy(W + (size_t)j * (size_t)m, A + (size_t)j * (size_t)lda, (size_t)m * sizeof(double));
+  esc = phgmg__svd_scale(m, n, W);
   anorm = phgmg_normf(m, n, W, m);
   phgmg__qrcp_blocked(m, n, W, m, tau, jpvt, vn, vn + 2 * n, vn + 2 * n + (size_t)n * PHGMG__QRCP_NB,
                       perm + kmin, PHGMG__EPS * anorm, &r);
@@ -2234,7 +2283,7 @@ PHGMG_DEF phgmg_result phgmg_svd(int m, int n, const double *A, int lda, int kma
         int c = perm[j];
         double s = d[c], *u = U + (size_t)j * (size_t)ldu;
         const double *x = X + (size_t)c * (size_t)r;
-        S[j] = s;
+        S[j] = ldexp(s, esc); /* undo the scaling of phgmg__svd_scale (exact) */
         for (i = 0; i < r; ++i) u[i] = x[i] / s;
         for (i = r; i < m; ++i) u[i] = 0.0;
       }
@@ -3286,6 +3335,41 @@ PHGMG__PRIV phgmg_result phgmg__ph_check_psd(const phgmg_ph_system *s, double to
   }
 }
 
+/* Q positive definite: every diagonal entry > 0 for a diagonal Q, else a
+   Cholesky factorization of Q (lower triangle, band storage of half-bandwidth
+   kb, N - 1 for dense) must find only positive pivots; O(N kb^2). */
+PHGMG__PRIV phgmg_result phgmg__ph_check_q_pd(const phgmg_ph_system *s, const phgmg_allocator *al) {
+  const int N = s->N, kb = s->storage == PHGMG_BANDED ? s->kb : N - 1;
+  const size_t ld = (size_t)kb + 1;
+  int i, j, diag = 1;
+  double *L;
+  phgmg_result rc = PHGMG_OK;
+  for (j = 0; j < N && diag; ++j)
+    for (i = PHGMG__MAX(0, j - kb); i <= PHGMG__MIN(N - 1, j + kb); ++i)
+      if (i != j && phgmg__ph_at(s, s->Q, i, j) != 0.0) { diag = 0; break; }
+  if (diag) {
+    for (j = 0; j < N; ++j)
+      if (!(phgmg__ph_at(s, s->Q, j, j) > 0.0)) return PHGMG_ERR_Q_NOT_PD;
+    return PHGMG_OK;
+  }
+  L = phgmg__dalloc(al, ld * (size_t)N); /* row i: L(i,k), i-kb <= k <= i, contiguous */
+  if (!L) return PHGMG_ERR_NOMEM;
+  for (i = 0; i < N && rc == PHGMG_OK; ++i) { /* row by row, inner products over contiguous rows */
+    double *Li = L + (size_t)i * (size_t)kb + (size_t)kb; /* Li[k] = L(i,k) */
+    const int i0 = PHGMG__MAX(0, i - kb);
+    double d;
+    for (j = i0; j < i; ++j) {
+      const double *Lj = L + (size_t)j * (size_t)kb + (size_t)kb;
+      Li[j] = (phgmg__ph_at(s, s->Q, i, j) - phgmg__dot(j - i0, Li + i0, Lj + i0)) / Lj[j];
+    }
+    d = phgmg__ph_at(s, s->Q, i, i) - phgmg__dot(i - i0, Li + i0, Li + i0);
+    if (!(d > 0.0)) rc = PHGMG_ERR_Q_NOT_PD;
+    else Li[i] = sqrt(d);
+  }
+  phgmg__free(al, L);
+  return rc;
+}
+
 PHGMG_DEF phgmg_result phgmg_ph_validate(const phgmg_ph_system *sys, double tol,
                                          double *rcond_out, const phgmg_allocator *alloc) {
   phgmg_result rc;
@@ -3313,8 +3397,10 @@ PHGMG_DEF phgmg_result phgmg_ph_validate(const phgmg_ph_system *sys, double tol,
   phgmg__ph_sym_defect(sys, sys->R, -1.0, &nrm, &def);
   if (def > tol * nrm) return PHGMG_ERR_NOT_SYMMETRIC;
   phgmg__ph_sym_defect(sys, sys->Q, -1.0, &nrm, &def);
-  if (def > tol * nrm) return PHGMG_ERR_NOT_SYMMETRIC;
+  if (def > tol * nrm) return PHGMG_ERR_Q_NOT_SYMMETRIC;
   rc = phgmg__ph_check_psd(sys, tol, alloc);
+  if (rc != PHGMG_OK) return rc;
+  rc = phgmg__ph_check_q_pd(sys, alloc);
   if (rc != PHGMG_OK) return rc;
   /* B full column rank: pivoted QR, |R(m-1,m-1)| > tol |R(0,0)| */
   {
@@ -5117,6 +5203,7 @@ PHGMG_DEF phgmg_result phgmg_rom_stepper_init(phgmg_rom_stepper *s, const phgmg_
   rc = phgmg_rom_check(rom);
   if (rc != PHGMG_OK) return rc;
   if (!(dt > PHGMG__R(0)) || dt - dt != PHGMG__R(0)) return PHGMG_ERR_INVALID_ARG;
+  if (tol != tol || tol - tol != PHGMG__R(0)) return PHGMG_ERR_INVALID_ARG; /* NaN, +-Inf */
   if (((size_t)mem) % sizeof(double) != 0) return PHGMG_ERR_INVALID_ARG;
   use_map = phgmg__rom_uses_map(rom, dt);
   if (mem_size < phgmg__romstep_layout(rom, use_map, NULL, NULL)) return PHGMG_ERR_WORKSPACE;
@@ -6772,7 +6859,7 @@ PHGMG_DEF phgmg_result phgmg_reduced_simulate(const phgmg_reduced *red, const do
   phgmg_result rc;
   if (!red || !xr0 || nsteps < 0 || !(dt > 0.0)) return PHGMG_ERR_INVALID_ARG;
   rom = &red->rom; r = rom->r; m = rom->m;
-  msz = phgmg_rom_stepper_memsize(rom);
+  msz = phgmg_rom_stepper_memsize_dt(rom, (phgmg_real)dt);
   nreal = (size_t)r + 4 * (size_t)m + phgmg_rom_eval_work_size(rom);
   mem = phgmg__alloc(alloc, ((msz + 15) / 16) * 16 + nreal * sizeof(phgmg_real) + (size_t)m * sizeof(double) + 16);
   if (!mem) return PHGMG_ERR_NOMEM;
@@ -7288,10 +7375,12 @@ PHGMG_DEF phgmg_result phgmg_rom_export_c(const phgmg_rom *rom, const char *name
 #endif
 
 /* What the header says, checked: a rows x cols result with count elements of
-   es bytes each (4 or 8), big-endian or not, stored in C order or not. */
+   es bytes each (1, 2, 4 or 8) of kind 'f' (float), 'i' (signed integer),
+   'u' (unsigned integer) or 'b' (bool), big-endian or not, stored in C order
+   or not. */
 typedef struct phgmg__npy_hdr {
   int rows, cols, ndim;
-  int es, big, corder;
+  int es, big, corder, kind;
   size_t count;
 } phgmg__npy_hdr;
 
@@ -7416,6 +7505,31 @@ PHGMG__PRIV int phgmg__npy_shape(const char *s, size_t n, size_t *i, int *dims, 
   return 1;
 }
 
+/* The dtype string d[0..l) (the value of 'descr'): '<' or '>' and f4, f8,
+   i1, i2, i4, i8, u1, u2, u4, u8 or b1 ('|' also for the one-byte ones, as
+   NumPy writes them). Any other dtype (complex 'c16', half 'f2', strings,
+   objects, dates, native '=f8', ...) is PHGMG_ERR_DTYPE. */
+PHGMG__PRIV phgmg_result phgmg__npy_descr(const char *d, size_t l, phgmg__npy_hdr *h) {
+  char o, k;
+  int es;
+  if (l != 3 || d[2] < '1' || d[2] > '8') return PHGMG_ERR_DTYPE;
+  o = d[0];
+  k = d[1];
+  es = d[2] - '0';
+  if (o != '<' && o != '>' && !(o == '|' && es == 1)) return PHGMG_ERR_DTYPE;
+  if (k == 'f') {
+    if (es != 4 && es != 8) return PHGMG_ERR_DTYPE;
+  } else if (k == 'i' || k == 'u') {
+    if (es != 1 && es != 2 && es != 4 && es != 8) return PHGMG_ERR_DTYPE;
+  } else if (k != 'b' || es != 1) {
+    return PHGMG_ERR_DTYPE;
+  }
+  h->kind = k;
+  h->es = es;
+  h->big = o == '>';
+  return PHGMG_OK;
+}
+
 /* The header dict {'descr': ..., 'fortran_order': ..., 'shape': ...}, keys in
    any order, each exactly once, nothing else but whitespace after it. */
 PHGMG__PRIV phgmg_result phgmg__npy_dict(const char *s, size_t n, phgmg__npy_hdr *h) {
@@ -7431,12 +7545,12 @@ PHGMG__PRIV phgmg_result phgmg__npy_dict(const char *s, size_t n, phgmg__npy_hdr
     i = phgmg__npy_ws(s, n, i + 1);
     if (phgmg__npy_is(s, b, l, "descr")) {
       size_t vb, vl;
-      if (seen_descr++ || !phgmg__npy_str(s, n, &i, &vb, &vl)) return PHGMG_ERR_FORMAT;
-      if (vl != 3 || (s[vb] != '<' && s[vb] != '>') || s[vb + 1] != 'f' ||
-          (s[vb + 2] != '8' && s[vb + 2] != '4'))
-        return PHGMG_ERR_FORMAT;
-      h->big = s[vb] == '>';
-      h->es = s[vb + 2] - '0';
+      phgmg_result rc;
+      if (seen_descr++) return PHGMG_ERR_FORMAT;
+      if (i < n && s[i] == '[') return PHGMG_ERR_DTYPE; /* a structured dtype */
+      if (!phgmg__npy_str(s, n, &i, &vb, &vl)) return PHGMG_ERR_FORMAT;
+      rc = phgmg__npy_descr(s + vb, vl, h);
+      if (rc != PHGMG_OK) return rc;
     } else if (phgmg__npy_is(s, b, l, "fortran_order")) {
       if (seen_fo++) return PHGMG_ERR_FORMAT;
       if (phgmg__npy_word(s, n, &i, "True")) fortran = 1;
@@ -7463,25 +7577,48 @@ PHGMG__PRIV phgmg_result phgmg__npy_dict(const char *s, size_t n, phgmg__npy_hdr
   return PHGMG_OK;
 }
 
+/* One integer element (es bytes at src, big-endian or not) as a double:
+   exact; *inexact is set if |value| > 2^53 (8-byte integers only). */
+PHGMG__PRIV double phgmg__npy_int_elem(const phgmg__npy_hdr *h, const unsigned char *src,
+                                       int *inexact) {
+  const int es = h->es;
+  unsigned long long u = 0, sign = 1ull << (8 * es - 1), lim = 1ull << 53;
+  int b;
+  for (b = 0; b < es; ++b) u |= (unsigned long long)src[h->big ? es - 1 - b : b] << (8 * b);
+  if (h->kind == 'b') return u != 0 ? 1.0 : 0.0;
+  if (h->kind == 'i' && (u & sign)) { /* negative: magnitude 2^(8es) - u */
+    const unsigned long long mag = es == 8 ? ~u + 1 : (sign << 1) - u;
+    if (mag > lim) *inexact = 1;
+    return -(double)mag;
+  }
+  if (u > lim) *inexact = 1;
+  return (double)u;
+}
+
 /* Decode n elements of file (flat) indices k0 .. k0+n-1 from src into the
-   column-major rows x cols matrix out. */
-PHGMG__PRIV void phgmg__npy_decode(const phgmg__npy_hdr *h, const unsigned char *src, size_t k0,
-                                   size_t n, double *out) {
+   column-major rows x cols matrix out. Returns PHGMG_ERR_INEXACT if an
+   integer is beyond 2^53 in magnitude, else PHGMG_OK. */
+PHGMG__PRIV phgmg_result phgmg__npy_decode(const phgmg__npy_hdr *h, const unsigned char *src,
+                                           size_t k0, size_t n, double *out) {
   const int es = h->es, swap = h->big == phgmg__npy_host_little();
   size_t t, i = 0, j = 0, dst = k0;
   unsigned char tmp[8];
-  int b;
-  if (n == 0) return;
+  int b, inexact = 0;
+  if (n == 0) return PHGMG_OK;
   if (h->corder) { i = k0 / (size_t)h->cols; j = k0 % (size_t)h->cols; }
   for (t = 0; t < n; ++t, src += es) {
     double v;
-    for (b = 0; b < es; ++b) tmp[b] = src[swap ? es - 1 - b : b];
-    if (es == 8) {
-      memcpy(&v, tmp, 8);
+    if (h->kind != 'f') {
+      v = phgmg__npy_int_elem(h, src, &inexact);
     } else {
-      float f;
-      memcpy(&f, tmp, 4);
-      v = (double)f;
+      for (b = 0; b < es; ++b) tmp[b] = src[swap ? es - 1 - b : b];
+      if (es == 8) {
+        memcpy(&v, tmp, 8);
+      } else {
+        float f;
+        memcpy(&f, tmp, 4);
+        v = (double)f;
+      }
     }
     if (h->corder) {
       dst = i + j * (size_t)h->rows;
@@ -7489,6 +7626,7 @@ PHGMG__PRIV void phgmg__npy_decode(const phgmg__npy_hdr *h, const unsigned char 
     }
     out[dst++] = v;
   }
+  return inexact ? PHGMG_ERR_INEXACT : PHGMG_OK;
 }
 
 PHGMG_DEF phgmg_result phgmg_npy_parse(const void *buf, size_t len, double **out, int *rows,
@@ -7509,7 +7647,8 @@ PHGMG_DEF phgmg_result phgmg_npy_parse(const void *buf, size_t len, double **out
   if (h.count > (len - doff) / (size_t)h.es) return PHGMG_ERR_FORMAT; /* truncated */
   A = phgmg__dalloc(alloc, h.count);
   if (!A) return PHGMG_ERR_NOMEM;
-  phgmg__npy_decode(&h, p + doff, 0, h.count, A);
+  rc = phgmg__npy_decode(&h, p + doff, 0, h.count, A);
+  if (rc != PHGMG_OK) { phgmg__free(alloc, A); return rc; }
   *out = A;
   *rows = h.rows;
   *cols = h.cols;
@@ -7635,6 +7774,44 @@ PHGMG__PRIV phgmg_result phgmg__npy_fread(FILE *f, void *dst, size_t n) {
   return ferror(f) ? PHGMG_ERR_IO : PHGMG_ERR_FORMAT;
 }
 
+/* The data of a stream of unknown length (a pipe) after its header: read into
+   a byte buffer that grows with what actually arrives (64 KiB, then doubling,
+   never beyond the count * es bytes the header announces), then decoded into
+   a new matrix *A. A stream shorter than announced is PHGMG_ERR_FORMAT once
+   its end is reached, having allocated about twice what it held. */
+PHGMG__PRIV phgmg_result phgmg__npy_read_stream(FILE *f, const phgmg__npy_hdr *h, double **A,
+                                                const phgmg_allocator *alloc) {
+  const size_t need = h->count * (size_t)h->es;
+  size_t cap = 0, have = 0;
+  unsigned char *raw = NULL;
+  phgmg_result rc = PHGMG_OK;
+  while (have < need && rc == PHGMG_OK) {
+    size_t got;
+    if (have == cap) {
+      const size_t ncap = cap == 0 ? PHGMG__MIN(need, (size_t)65536)
+                                   : (cap > need / 2 ? need : 2 * cap);
+      unsigned char *nb = PHGMG__CAST(unsigned char *, phgmg__alloc(alloc, ncap));
+      if (!nb) { rc = PHGMG_ERR_NOMEM; break; }
+      if (have) memcpy(nb, raw, have);
+      phgmg__free(alloc, raw);
+      raw = nb;
+      cap = ncap;
+    }
+    got = fread(raw + have, 1, cap - have, f);
+    have += got;
+    if (have < cap) rc = ferror(f) ? PHGMG_ERR_IO : PHGMG_ERR_FORMAT; /* end of the stream */
+  }
+  *A = NULL;
+  if (rc == PHGMG_OK) {
+    *A = phgmg__dalloc(alloc, h->count);
+    if (!*A) rc = PHGMG_ERR_NOMEM;
+    else rc = phgmg__npy_decode(h, raw, 0, h->count, *A);
+    if (rc != PHGMG_OK) { phgmg__free(alloc, *A); *A = NULL; }
+  }
+  phgmg__free(alloc, raw);
+  return rc;
+}
+
 PHGMG_DEF phgmg_result phgmg_npy_read(const char *path, double **out, int *rows, int *cols,
                                       int *ndim, const phgmg_allocator *alloc) {
   unsigned char pre[12], chunk[4096];
@@ -7676,18 +7853,24 @@ PHGMG_DEF phgmg_result phgmg_npy_read(const char *path, double **out, int *rows,
     fclose(f);
     return PHGMG_ERR_FORMAT; /* truncated data */
   }
-  A = phgmg__dalloc(alloc, h.count);
-  if (!A) { fclose(f); return PHGMG_ERR_NOMEM; }
-  left = h.count;
-  while (left > 0 && rc == PHGMG_OK) {
-    size_t n = PHGMG__MIN(left, sizeof chunk / (size_t)h.es);
-    rc = phgmg__npy_fread(f, chunk, n * (size_t)h.es);
-    if (rc == PHGMG_OK) phgmg__npy_decode(&h, chunk, k, n, A);
-    k += n;
-    left -= n;
+  if (size < 0) { /* a pipe: the buffer grows with what arrives */
+    rc = phgmg__npy_read_stream(f, &h, &A, alloc);
+    fclose(f);
+    if (rc != PHGMG_OK) return rc;
+  } else {
+    A = phgmg__dalloc(alloc, h.count);
+    if (!A) { fclose(f); return PHGMG_ERR_NOMEM; }
+    left = h.count;
+    while (left > 0 && rc == PHGMG_OK) {
+      size_t n = PHGMG__MIN(left, sizeof chunk / (size_t)h.es);
+      rc = phgmg__npy_fread(f, chunk, n * (size_t)h.es);
+      if (rc == PHGMG_OK) rc = phgmg__npy_decode(&h, chunk, k, n, A);
+      k += n;
+      left -= n;
+    }
+    fclose(f);
+    if (rc != PHGMG_OK) { phgmg__free(alloc, A); return rc; }
   }
-  fclose(f);
-  if (rc != PHGMG_OK) { phgmg__free(alloc, A); return rc; }
   *out = A;
   *rows = h.rows;
   *cols = h.cols;
@@ -7700,13 +7883,17 @@ PHGMG_DEF phgmg_result phgmg_npy_write(const char *path, const double *A, int ro
   unsigned char head[256], chunk[4096];
   size_t count = 0, hl, es = (flags & PHGMG_NPY_F32) ? 4 : 8, i = 0, j = 0, left;
   phgmg_result rc;
-  int ok;
+  int ok, created;
   FILE *f;
   if (!path) return PHGMG_ERR_INVALID_ARG;
   rc = phgmg__npy_wcheck(A, rows, cols, ld, ndim, flags, &count);
   if (rc != PHGMG_OK) return rc;
   hl = phgmg__npy_header(head, rows, cols, ndim, flags);
-  f = fopen(path, "wb");
+  /* "x": create a new file only (fails if the name exists, also as a
+     symbolic link); only a file made here is removed after an error */
+  f = fopen(path, "wbx");
+  created = f != NULL;
+  if (!f) f = fopen(path, "wb");
   if (!f) return PHGMG_ERR_IO;
   ok = fwrite(head, 1, hl, f) == hl;
   for (left = count; ok && left > 0;) {
@@ -7717,7 +7904,7 @@ PHGMG_DEF phgmg_result phgmg_npy_write(const char *path, const double *A, int ro
   }
   if (fclose(f) != 0) ok = 0;
   if (!ok) {
-    remove(path);
+    if (created) remove(path);
     return PHGMG_ERR_IO;
   }
   return PHGMG_OK;
