@@ -153,7 +153,7 @@ extern "C" {
   X(PHGMG_ERR_IO,              -15, "I/O error")                                         \
   X(PHGMG_ERR_UNSUPPORTED,     -16, "operation not supported for this model kind")       \
   X(PHGMG_ERR_Q_NOT_SYMMETRIC, -17, "Q is not symmetric")                               \
-  X(PHGMG_ERR_Q_NOT_PD,        -18, "Q is not positive definite")                       \
+  X(PHGMG_ERR_Q_NOT_PD,        -18, "Q is not positive definite (semidefinite for a nonlinear H)")                       \
   X(PHGMG_ERR_DTYPE,           -19, "unsupported .npy dtype (complex, object, string, ...)") \
   X(PHGMG_ERR_INEXACT,         -20, "integer beyond 2^53 in magnitude: not exact as a double")
 
@@ -373,10 +373,13 @@ typedef struct phgmg_ph_system {
    for a diagonal R, else phgmg_sym_eig on a dense copy (dense R, or banded with
    N <= 2000); a larger banded R must admit a Cholesky factorization of
    R + tol ||R||_1 I in band storage (O(N kb^2), a slightly looser bound since
-   ||R||_1 >= ||R||_2). Q positive definite: exact for a diagonal Q (every
-   diagonal entry > 0), else a Cholesky factorization of Q (dense, or in band
-   storage, O(N kb^2)) must meet only positive pivots (no tolerance: positive
-   definite to working precision). Checks run in this order and the first
+   ||R||_1 >= ||R||_2). Q positive definite when H is quadratic (nl == NONE):
+   exact for a diagonal Q (every diagonal entry > 0), else a Cholesky
+   factorization of Q (dense, or in band storage, O(N kb^2)) must meet only
+   positive pivots (no tolerance: positive definite to working precision).
+   With a nonlinear part Q need only be positive SEMIdefinite (the nonlinear
+   part may carry the convexity, e.g. a Toda chain's H = |p|^2/2 + sum
+   (e^l - 1 - l) has Q = 0 on the l block): the same test on Q + tol ||Q||_1 I. Checks run in this order and the first
    failure is returned: PHGMG_ERR_INVALID_ARG (NULL pointers, missing
    callbacks) / _SIZE / _NANINF / _NOT_SKEW / _NOT_SYMMETRIC (R) /
    _Q_NOT_SYMMETRIC / _NOT_PSD (R) / _Q_NOT_PD / _RANK / _SINGULAR, or _NOMEM.
@@ -3338,18 +3341,27 @@ PHGMG__PRIV phgmg_result phgmg__ph_check_psd(const phgmg_ph_system *s, double to
 /* Q positive definite: every diagonal entry > 0 for a diagonal Q, else a
    Cholesky factorization of Q (lower triangle, band storage of half-bandwidth
    kb, N - 1 for dense) must find only positive pivots; O(N kb^2). */
-PHGMG__PRIV phgmg_result phgmg__ph_check_q_pd(const phgmg_ph_system *s, const phgmg_allocator *al) {
+PHGMG__PRIV phgmg_result phgmg__ph_check_q_pd(const phgmg_ph_system *s, double tol, const phgmg_allocator *al) {
   const int N = s->N, kb = s->storage == PHGMG_BANDED ? s->kb : N - 1;
   const size_t ld = (size_t)kb + 1;
   int i, j, diag = 1;
-  double *L;
+  double *L, shift = 0.0;
   phgmg_result rc = PHGMG_OK;
   for (j = 0; j < N && diag; ++j)
     for (i = PHGMG__MAX(0, j - kb); i <= PHGMG__MIN(N - 1, j + kb); ++i)
       if (i != j && phgmg__ph_at(s, s->Q, i, j) != 0.0) { diag = 0; break; }
+  if (s->nl != PHGMG_NL_NONE) {   /* semidefinite: Q + tol ||Q||_1 I must be definite */
+    double n1 = 0.0;
+    for (j = 0; j < N; ++j) {
+      double cs = 0.0;
+      for (i = PHGMG__MAX(0, j - kb); i <= PHGMG__MIN(N - 1, j + kb); ++i) cs += fabs(phgmg__ph_at(s, s->Q, i, j));
+      n1 = PHGMG__MAX(n1, cs);
+    }
+    shift = PHGMG__MAX(tol * n1, 1e-300);
+  }
   if (diag) {
     for (j = 0; j < N; ++j)
-      if (!(phgmg__ph_at(s, s->Q, j, j) > 0.0)) return PHGMG_ERR_Q_NOT_PD;
+      if (!(phgmg__ph_at(s, s->Q, j, j) + shift > 0.0)) return PHGMG_ERR_Q_NOT_PD;
     return PHGMG_OK;
   }
   L = phgmg__dalloc(al, ld * (size_t)N); /* row i: L(i,k), i-kb <= k <= i, contiguous */
@@ -3362,7 +3374,7 @@ PHGMG__PRIV phgmg_result phgmg__ph_check_q_pd(const phgmg_ph_system *s, const ph
       const double *Lj = L + (size_t)j * (size_t)kb + (size_t)kb;
       Li[j] = (phgmg__ph_at(s, s->Q, i, j) - phgmg__dot(j - i0, Li + i0, Lj + i0)) / Lj[j];
     }
-    d = phgmg__ph_at(s, s->Q, i, i) - phgmg__dot(i - i0, Li + i0, Li + i0);
+    d = phgmg__ph_at(s, s->Q, i, i) + shift - phgmg__dot(i - i0, Li + i0, Li + i0);
     if (!(d > 0.0)) rc = PHGMG_ERR_Q_NOT_PD;
     else Li[i] = sqrt(d);
   }
@@ -3400,7 +3412,7 @@ PHGMG_DEF phgmg_result phgmg_ph_validate(const phgmg_ph_system *sys, double tol,
   if (def > tol * nrm) return PHGMG_ERR_Q_NOT_SYMMETRIC;
   rc = phgmg__ph_check_psd(sys, tol, alloc);
   if (rc != PHGMG_OK) return rc;
-  rc = phgmg__ph_check_q_pd(sys, alloc);
+  rc = phgmg__ph_check_q_pd(sys, tol, alloc);
   if (rc != PHGMG_OK) return rc;
   /* B full column rank: pivoted QR, |R(m-1,m-1)| > tol |R(0,0)| */
   {

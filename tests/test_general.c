@@ -260,8 +260,63 @@ TEST(test_eta_reproduces_qm_and_cubic_structure) {
   phgmg_reduced_destroy(qm);
 }
 
+/* Toda chain: phi(s) = e^s - 1 - s on every l (exp-polynomial: poly {-1, -1},
+   expo {(1, 1)}), Q = blockdiag(0, I): Q is only semidefinite, which a
+   nonlinear H may have. The built-in form and the same function by callbacks
+   give the same reduced models (online outputs to 1e-14, every method, with
+   and without DEIM). */
+static double toda_phi(int k, double s, void *u) { (void)k; (void)u; return exp(s) - 1.0 - s; }
+static double toda_dphi(int k, double s, void *u) { (void)k; (void)u; return exp(s) - 1.0; }
+static double toda_ddphi(int k, double s, void *u) { (void)k; (void)u; return exp(s); }
+
+TEST(test_toda_builtin_equals_callbacks) {
+  static gmodel t;
+  static gfom f;
+  static const double tpoly[2] = {-1.0, -1.0}, texpo[2] = {1.0, 1.0};
+  phgmg_ph_system cb;
+  const phgmg_method meths[4] = {PHGMG_METHOD_GMG_POD, PHGMG_METHOD_GMG_QM, PHGMG_METHOD_SP1, PHGMG_METHOD_SP2};
+  int a, d, i;
+  g_model(&t);
+  for (i = 0; i < GN; ++i) t.Q[i + i * 2 * GN] = 0.0;
+  t.sys.poly = tpoly; t.sys.poly_deg = 1; t.sys.nexp = 1; t.sys.expo = texpo;
+  CHECK_RC(phgmg_ph_validate(&t.sys, 0.0, NULL, NULL), PHGMG_OK);
+  t.Q[0] = -1e-3;   /* indefinite: refused */
+  CHECK_RC(phgmg_ph_validate(&t.sys, 0.0, NULL, NULL), PHGMG_ERR_Q_NOT_PD);
+  t.Q[0] = 0.0;
+  CHECK(g_fom(&t.sys, &f));
+  cb = t.sys;
+  cb.poly = NULL; cb.poly_deg = 0; cb.nexp = 0; cb.expo = NULL;
+  cb.phi = toda_phi; cb.dphi = toda_dphi; cb.ddphi = toda_ddphi;
+  for (a = 0; a < 4; ++a)
+    for (d = 0; d < 2; ++d) {
+      phgmg_reduce_opts o;
+      phgmg_reduced *r1 = NULL, *r2 = NULL;
+      memset(&o, 0, sizeof o);
+      o.method = meths[a]; o.r = 12; o.rn = 6; o.deim = d; o.deim_allow_negative = 1;
+      CHECK_RC(phgmg_reduce(&r1, &t.sys, f.X, t.sys.N, GNS, &o, NULL, NULL), PHGMG_OK);
+      CHECK_RC(phgmg_reduce(&r2, &cb, f.X, cb.N, GNS, &o, NULL, NULL), PHGMG_OK);
+      if (r1 && r2) {
+        static double XR1[12 * GNS], XR2[12 * GNS], Y1[GNS], Y2[GNS];
+        double xr0[12], dmax = 0, ymax = 0, xs = 0, ys = 0;
+        int k;
+        CHECK(phgmg_reduced_rom(r1)->phi_cb == NULL && phgmg_reduced_rom(r2)->phi_cb != NULL);
+        CHECK(phgmg_reduced_rom(r1)->nexp == 1);
+        memset(xr0, 0, sizeof xr0);
+        CHECK_RC(phgmg_reduced_simulate(r1, xr0, 0.0, 0.1, GNS - 1, g_u, NULL, 0, 0, XR1, Y1, NULL, NULL, NULL), PHGMG_OK);
+        CHECK_RC(phgmg_reduced_simulate(r2, xr0, 0.0, 0.1, GNS - 1, g_u, NULL, 0, 0, XR2, Y2, NULL, NULL, NULL), PHGMG_OK);
+        for (k = 0; k < 12 * GNS; ++k) { dmax = PHGMG__MAX(dmax, fabs(XR1[k] - XR2[k])); xs = PHGMG__MAX(xs, fabs(XR1[k])); }
+        for (k = 0; k < GNS; ++k) { ymax = PHGMG__MAX(ymax, fabs(Y1[k] - Y2[k])); ys = PHGMG__MAX(ys, fabs(Y1[k])); }
+        CHECK_LE(dmax, 1e-14 * xs);
+        CHECK_LE(ymax, 1e-14 * ys);
+      }
+      phgmg_reduced_destroy(r1);
+      phgmg_reduced_destroy(r2);
+    }
+}
+
 SUITE(general) {
   RUN(test_callbacks_equal_polynomial);
   RUN(test_general_equals_separable);
   RUN(test_eta_reproduces_qm_and_cubic_structure);
+  RUN(test_toda_builtin_equals_callbacks);
 }
