@@ -5505,12 +5505,18 @@ PHGMG_DEF phgmg_result phgmg_deim_select(int nterms, int ns, const double *F, in
   return rc;
 }
 
-/* Lawson-Hanson core shared by phgmg_nnls and phgmg_ecsw. Two forms of the
+/* Lawson-Hanson core shared by phgmg_nnls and phgmg_ecsw. Three forms of the
    same problem min ||C x - d||^2 + rr0 (x >= 0, n unknowns):
-   QR form (C k x n, d): passive least squares by Householder QR (phgmg_lstsq);
-   Gram form (G = C^T C n x n, c = C^T d, dd = ||d||^2 + rr0): passive normal
-   equations by a Cholesky factor L of G_PP, extended by one row per added
-   index and refactored after drops. */
+   QR form (C k x n and d; G NULL): passive least squares by Householder QR
+   (phgmg_lstsq), gradient C^T (d - C x);
+   Gram form (G = C^T C n x n, c = C^T d, dd = ||d||^2 + rr0; C NULL): passive
+   normal equations by a Cholesky factor L of G_PP, extended by one row per
+   added index and refactored after drops; gradient c - G x;
+   hybrid (G, c and C, d): as the Gram form, but each passive solve gets one
+   step of refinement with the true residual d - C_P z (corrected semi-normal
+   equations: QR-like accuracy while cond(C_P) < ~1e7), the residual is
+   computed from C, and a claim of optimality by the Gram gradient is checked
+   with the true gradient C^T (d - C x) (one pass over C). */
 typedef struct phgmg__nnls_prob {
   int n, k;
   const double *C, *d; int ldc;   /* QR form (C != NULL)  */
@@ -5523,6 +5529,7 @@ typedef struct phgmg__nnls_ws {
   int *P, *flag;          /* passive list; flag: 1 passive, 2 excluded until the next step */
   int np;
   double *z, *g, *L, *Cp; /* z, gradient: n; L: n x n (Gram); Cp: k x n (QR) */
+  double *r;              /* k: residual (hybrid)                              */
 } phgmg__nnls_ws;
 
 /* Cholesky of G_PP into L (lower, ld n) from scratch; 0 if not positive. */
@@ -5560,26 +5567,40 @@ PHGMG__PRIV int phgmg__nnls_chol_add(const phgmg__nnls_prob *pb, phgmg__nnls_ws 
   return 1;
 }
 
-/* z_P = passive least-squares solution (scattered into z by position in P). */
+/* z = (L L^T)^{-1} b_P (b gathered through P, or b itself when P is NULL; z may alias b). */
+PHGMG__PRIV void phgmg__nnls_chol_solve(int n, int np, const double *L, const double *b, const int *P, double *z) {
+  int i, t;
+  for (i = 0; i < np; ++i) {
+    double s = P ? b[P[i]] : b[i];
+    for (t = 0; t < i; ++t) s -= L[i + (size_t)t * n] * z[t];
+    z[i] = s / L[i + (size_t)i * n];
+  }
+  for (i = np - 1; i >= 0; --i) {
+    double s = z[i];
+    for (t = i + 1; t < np; ++t) s -= L[t + (size_t)i * n] * z[t];
+    z[i] = s / L[i + (size_t)i * n];
+  }
+}
+
+/* z_P = passive least-squares solution (z[i] belongs to P[i]). */
 PHGMG__PRIV phgmg_result phgmg__nnls_solve(const phgmg__nnls_prob *pb, phgmg__nnls_ws *ws,
                                            const phgmg_allocator *alloc) {
   const int n = pb->n, np = ws->np;
   int i, t;
-  if (pb->C) {
+  if (!pb->G) {
     for (i = 0; i < np; ++i)
       memcpy(ws->Cp + (size_t)i * pb->k, pb->C + (size_t)ws->P[i] * pb->ldc, (size_t)pb->k * sizeof(double));
     if (np > pb->k) return PHGMG_ERR_RANK;
     return phgmg_lstsq(pb->k, np, 1, ws->Cp, pb->k, pb->d, pb->k, 0.0, ws->z, n, alloc);
   }
-  for (i = 0; i < np; ++i) { /* L y = c_P, then L^T z = y */
-    double s = pb->c[ws->P[i]];
-    for (t = 0; t < i; ++t) s -= ws->L[i + (size_t)t * n] * ws->z[t];
-    ws->z[i] = s / ws->L[i + (size_t)i * n];
-  }
-  for (i = np - 1; i >= 0; --i) {
-    double s = ws->z[i];
-    for (t = i + 1; t < np; ++t) s -= ws->L[t + (size_t)i * n] * ws->z[t];
-    ws->z[i] = s / ws->L[i + (size_t)i * n];
+  phgmg__nnls_chol_solve(n, np, ws->L, pb->c, ws->P, ws->z);
+  if (pb->C) { /* refinement: z += (L L^T)^{-1} C_P^T (d - C_P z) */
+    double *h = ws->g; /* the gradient is recomputed after every solve */
+    memcpy(ws->r, pb->d, (size_t)pb->k * sizeof(double));
+    for (t = 0; t < np; ++t) phgmg__axpy(pb->k, -ws->z[t], pb->C + (size_t)ws->P[t] * pb->ldc, ws->r);
+    for (i = 0; i < np; ++i) h[i] = phgmg__dot(pb->k, pb->C + (size_t)ws->P[i] * pb->ldc, ws->r);
+    phgmg__nnls_chol_solve(n, np, ws->L, h, NULL, h);
+    for (i = 0; i < np; ++i) ws->z[i] += h[i];
   }
   return PHGMG_OK;
 }
@@ -5590,21 +5611,19 @@ PHGMG__PRIV double phgmg__nnls_grad(const phgmg__nnls_prob *pb, phgmg__nnls_ws *
   const int n = pb->n;
   int i, j;
   double r2 = 0.0;
-  if (pb->C) {
+  if (pb->C) { /* true residual */
     memcpy(tmp, pb->d, (size_t)pb->k * sizeof(double));
-    for (j = 0; j < ws->np; ++j) {
-      const double *cj = pb->C + (size_t)ws->P[j] * pb->ldc, xj = x[ws->P[j]];
-      for (i = 0; i < pb->k; ++i) tmp[i] -= cj[i] * xj;
-    }
+    for (j = 0; j < ws->np; ++j) phgmg__axpy(pb->k, -x[ws->P[j]], pb->C + (size_t)ws->P[j] * pb->ldc, tmp);
     for (i = 0; i < pb->k; ++i) r2 += tmp[i] * tmp[i];
-    phgmg_gemv('T', pb->k, n, 1.0, pb->C, pb->ldc, tmp, 0.0, ws->g);
-    return r2 + pb->rr0;
+    r2 += pb->rr0;
+    if (!pb->G) {
+      phgmg_gemv('T', pb->k, n, 1.0, pb->C, pb->ldc, tmp, 0.0, ws->g);
+      return r2;
+    }
   }
   memcpy(ws->g, pb->c, (size_t)n * sizeof(double));
-  for (j = 0; j < ws->np; ++j) {
-    const double *gj = pb->G + (size_t)ws->P[j] * pb->ldg, xj = x[ws->P[j]];
-    for (i = 0; i < n; ++i) ws->g[i] -= gj[i] * xj;
-  }
+  for (j = 0; j < ws->np; ++j) phgmg__axpy(n, -x[ws->P[j]], pb->G + (size_t)ws->P[j] * pb->ldg, ws->g);
+  if (pb->C) return r2;
   r2 = pb->dd;
   for (j = 0; j < ws->np; ++j) r2 -= x[ws->P[j]] * (pb->c[ws->P[j]] + ws->g[ws->P[j]]);
   return r2 > 0.0 ? r2 : 0.0;
@@ -5642,7 +5661,7 @@ PHGMG__PRIV phgmg_result phgmg__nnls_inner(const phgmg__nnls_prob *pb, phgmg__nn
     for (i = 0; i < ws->np; ++i) x[ws->P[i]] += alpha * (ws->z[i] - x[ws->P[i]]);
     x[ws->P[imin]] = 0.0;
     phgmg__nnls_drop(ws, x);
-    if (!pb->C && !phgmg__nnls_chol(pb, ws)) return PHGMG_ERR_NOT_CONVERGED;
+    if (pb->G && !phgmg__nnls_chol(pb, ws)) return PHGMG_ERR_NOT_CONVERGED;
     rc = phgmg__nnls_solve(pb, ws, alloc);
     if (rc == PHGMG_ERR_RANK) rc = PHGMG_ERR_NOT_CONVERGED; /* a subset of a full-rank set: rounding */
   }
@@ -5661,12 +5680,13 @@ PHGMG__PRIV phgmg_result phgmg__nnls_core(const phgmg__nnls_prob *pb, double sto
   int iter = 0, i;
   phgmg_result rc = PHGMG_OK;
   ws.P = phgmg__ialloc(alloc, 2 * (size_t)n);
-  ws.z = phgmg__dalloc(alloc, 2 * (size_t)n + (size_t)pb->k + (pb->C ? (size_t)pb->k * n : (size_t)n * n));
+  ws.z = phgmg__dalloc(alloc, 2 * (size_t)n + 2 * (size_t)pb->k + (pb->G ? (size_t)n * n : (size_t)pb->k * n));
   if (!ws.P || !ws.z) { phgmg__free(alloc, ws.P); phgmg__free(alloc, ws.z); return PHGMG_ERR_NOMEM; }
   ws.flag = ws.P + n;
   ws.g = ws.z + n;
   tmp = ws.g + n;
-  ws.L = ws.Cp = tmp + pb->k;
+  ws.r = tmp + pb->k;
+  ws.L = ws.Cp = ws.r + pb->k;
   ws.np = 0;
   for (i = 0; i < n; ++i) { x[i] = 0.0; ws.flag[i] = 0; }
   for (;;) {
@@ -5676,11 +5696,16 @@ PHGMG__PRIV phgmg_result phgmg__nnls_core(const phgmg__nnls_prob *pb, double sto
     if (stop2 > 0.0 && r2 <= stop2) break;
     for (i = 0; i < n; ++i)
       if (ws.flag[i] == 0 && ws.g[i] > gmax) { gmax = ws.g[i]; j = i; }
+    if (j < 0 && pb->G && pb->C) { /* hybrid: confirm with the true gradient */
+      phgmg_gemv('T', pb->k, n, 1.0, pb->C, pb->ldc, tmp, 0.0, ws.g);
+      for (i = 0; i < n; ++i)
+        if (ws.flag[i] == 0 && ws.g[i] > gmax) { gmax = ws.g[i]; j = i; }
+    }
     if (j < 0) break; /* optimal */
     if (iter >= max_iter) { rc = PHGMG_ERR_NOT_CONVERGED; break; }
     ws.P[ws.np++] = j;
     ws.flag[j] = 1;
-    if (!pb->C && !phgmg__nnls_chol_add(pb, &ws)) { --ws.np; ws.flag[j] = 2; continue; }
+    if (pb->G && !phgmg__nnls_chol_add(pb, &ws)) { --ws.np; ws.flag[j] = 2; continue; }
     ++iter;
     rc = phgmg__nnls_inner(pb, &ws, x, &iter, max_iter, alloc);
     if (rc == PHGMG_ERR_RANK) { /* j dependent on P numerically: exclude it until the next step */
@@ -5727,6 +5752,10 @@ PHGMG_DEF phgmg_result phgmg_nnls(int m, int n, const double *A, int lda, const 
       for (i = j + 1; i < n; ++i) Q[i + (size_t)j * m] = 0.0;
     for (i = n; i < m; ++i) pb.rr0 += qb[i] * qb[i];
     pb.C = Q; pb.ldc = m; pb.k = n; pb.d = qb;
+    if (!phgmg__all_finite(qb, (size_t)m)) { /* a rank-deficient A can drive phgmg_qr into a
+                                                subnormal pivot: work on A itself then */
+      pb.C = A; pb.ldc = lda; pb.k = m; pb.d = b; pb.rr0 = 0.0;
+    }
   } else {
     pb.C = A; pb.ldc = lda; pb.k = m; pb.d = b;
   }
@@ -5791,8 +5820,11 @@ PHGMG_DEF phgmg_result phgmg_ecsw(int nterms, int nrows, const double *Gm, int l
   phgmg_gemv('T', m, n, 1.0, Gm, ldg, target, 0.0, c);
   memset(&pb, 0, sizeof pb);
   pb.n = n; pb.G = G; pb.ldg = n; pb.c = c; pb.dd = tn * tn;
+  pb.C = Gm; pb.ldc = ldg; pb.k = m; pb.d = target;
   for (j = 0; j < n; ++j) pb.wtol += G[j + (size_t)j * n];
-  pb.wtol = 10.0 * (double)PHGMG__MAX(m, n) * PHGMG__EPS * sqrt(pb.wtol) * tn;
+  /* the true gradient is checked at the end (hybrid form), so the threshold
+     only has to sit above the rounding of C^T r, not at the Gram form's level */
+  pb.wtol = 10.0 * PHGMG__EPS * sqrt(pb.wtol) * tn;
   tint = tol;
   for (attempt = 0; attempt < 4; ++attempt) {
     const double stop2 = (tint * tn) * (tint * tn);
