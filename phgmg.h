@@ -850,6 +850,22 @@ PHGMG_DEF phgmg_result phgmg_ecsw(int nterms, int nrows, const double *Gm, int l
                                   double tol, int *pts, double *w, int *nd_out, double *resid_out,
                                   const phgmg_allocator *alloc);
 
+/* phgmg_ecsw for the common case of terms l_k linear in the reduced
+   coordinates (GMG-POD, SP1, SP2: l_k = row of the basis), without forming
+   the ns r x nterms training matrix. F (nterms x ns, ldf) = phi_k'(l_k(x_i))
+   as for phgmg_deim; Vt (nterms x r, ldvt): row k = d l_k / d(reduced
+   coordinates) (e.g. V[idx_k, :]); sw: the terms' weights (NULL = 1). The
+   training rows (i, a) = F[k, i] Vt[k, a], target = sum_k sw_k (...). Uses
+   F = U S W^T: the rows (j, a) = S_j U[k, j] Vt[k, a] for the modes sigma_j >
+   1e-3 tol sigma_1 have (up to that truncation) the same Gram matrix, so
+   phgmg_ecsw runs on q r rows instead of ns r; the residual
+   ||F^T diag(w - sw) Vt||_F / ||F^T diag(sw) Vt||_F is then computed on the
+   full rows, and if it misses tol the fit is redone with every mode.
+   Outputs, tol and errors as phgmg_ecsw (resid_out: on the full rows). */
+PHGMG_DEF phgmg_result phgmg_ecsw_separable(int nterms, int ns, const double *F, int ldf, int r,
+                                            const double *Vt, int ldvt, const double *sw, double tol,
+                                            int *pts, double *w, int *nd_out, double *resid_out,
+                                            const phgmg_allocator *alloc);
 
 #ifdef __cplusplus
 }
@@ -5843,6 +5859,71 @@ PHGMG_DEF phgmg_result phgmg_ecsw(int nterms, int nrows, const double *Gm, int l
     if (resid_out) *resid_out = rel;
   }
   phgmg__free(alloc, G);
+  return rc;
+}
+
+/* ||F^T diag(a) Vt||_F (ns x r) for a (nterms); B: nterms x r, Y: ns x r scratch. */
+PHGMG__PRIV double phgmg__sep_norm(int nt, int ns, const double *F, int ldf, int r, const double *Vt, int ldvt,
+                                   const double *a, double *B, double *Y) {
+  int k, c;
+  for (c = 0; c < r; ++c)
+    for (k = 0; k < nt; ++k) B[k + (size_t)c * nt] = a[k] * Vt[k + (size_t)c * ldvt];
+  phgmg_gemm('T', 'N', ns, r, nt, 1.0, F, ldf, B, nt, 0.0, Y, ns);
+  return phgmg_normf(ns, r, Y, ns);
+}
+
+PHGMG_DEF phgmg_result phgmg_ecsw_separable(int nterms, int ns, const double *F, int ldf, int r, const double *Vt,
+                                            int ldvt, const double *sw, double tol, int *pts, double *w,
+                                            int *nd_out, double *resid_out, const phgmg_allocator *alloc) {
+  const int nt = nterms, kk = PHGMG__MIN(nterms, ns);
+  double *U, *S, *Gc, *tc, *dw, *B, *Y, tn, rel = 0.0;
+  int ks = 0, rank = 0, q, j, a, i, k, pass, nd = 0, mc;
+  phgmg_result rc;
+  if (!F || !Vt || !pts || !w || !nd_out) return PHGMG_ERR_INVALID_ARG;
+  if (tol != tol) return PHGMG_ERR_INVALID_ARG;
+  if (nt < 1 || ns < 1 || r < 1 || ldf < nt || ldvt < nt) return PHGMG_ERR_SIZE;
+  if (!phgmg__mat_finite(nt, ns, F, ldf) || !phgmg__mat_finite(nt, r, Vt, ldvt) ||
+      (sw && !phgmg__all_finite(sw, (size_t)nt)))
+    return PHGMG_ERR_NANINF;
+  if (tol <= 0.0) tol = 1e-6;
+  U = phgmg__dalloc(alloc, (size_t)nt * kk + (size_t)kk + 2 * (size_t)nt + (size_t)nt * r + (size_t)ns * r);
+  if (!U) return PHGMG_ERR_NOMEM;
+  S = U + (size_t)nt * kk;
+  dw = S + kk;            /* nt: w - sw (dense), then sw */
+  B = dw + 2 * (size_t)nt;
+  Y = B + (size_t)nt * r;
+  for (i = 0; i < nt; ++i) dw[nt + i] = sw ? sw[i] : 1.0;
+  tn = phgmg__sep_norm(nt, ns, F, ldf, r, Vt, ldvt, dw + nt, B, Y);
+  *nd_out = 0;
+  if (resid_out) *resid_out = 0.0;
+  rc = phgmg_svd(nt, ns, F, ldf, kk, S, U, nt, NULL, 1, &ks, &rank, alloc);
+  for (pass = 0; rc == PHGMG_OK && pass < 2 && tn > 0.0; ++pass) {
+    /* pass 0: modes with sigma_j > 1e-3 tol sigma_1; pass 1 (if tol missed): all */
+    for (q = 0; q < ks && (pass == 1 || S[q] > 1e-3 * tol * S[0]); ++q) {}
+    if (q < 1) q = 1;
+    mc = q * r;
+    Gc = phgmg__dalloc(alloc, (size_t)mc * nt + (size_t)mc);
+    if (!Gc) { rc = PHGMG_ERR_NOMEM; break; }
+    tc = Gc + (size_t)mc * nt;
+    for (k = 0; k < nt; ++k)
+      for (j = 0; j < q; ++j)
+        for (a = 0; a < r; ++a)
+          Gc[j * r + a + (size_t)k * mc] = S[j] * U[k + (size_t)j * nt] * Vt[k + (size_t)a * ldvt];
+    phgmg_gemv('N', mc, nt, 1.0, Gc, mc, dw + nt, 0.0, tc);
+    rc = phgmg_ecsw(nt, mc, Gc, mc, tc, 0.5 * tol, pts, w, &nd, NULL, alloc);
+    phgmg__free(alloc, Gc);
+    if (rc != PHGMG_OK && rc != PHGMG_ERR_NOT_CONVERGED) break;
+    for (i = 0; i < nt; ++i) dw[i] = -dw[nt + i];
+    for (i = 0; i < nd; ++i) dw[pts[i]] += w[i];
+    rel = phgmg__sep_norm(nt, ns, F, ldf, r, Vt, ldvt, dw, B, Y) / tn;
+    rc = rel <= tol ? PHGMG_OK : PHGMG_ERR_NOT_CONVERGED;
+    if (rc == PHGMG_OK || q >= ks) break;
+  }
+  if (rc == PHGMG_OK || rc == PHGMG_ERR_NOT_CONVERGED) {
+    *nd_out = tn > 0.0 ? nd : 0;
+    if (resid_out) *resid_out = rel;
+  }
+  phgmg__free(alloc, U);
   return rc;
 }
 

@@ -281,6 +281,31 @@ TEST(test_ecsw_exact_sparse) {
    phi(l) = l^2/2 + l^4/4; reduced basis V (N x R, orthonormal columns). */
 static double hy_phi(double l) { return 0.5 * l * l + 0.25 * l * l * l * l; }
 static double hy_dphi(double l) { return l + l * l * l; }
+/* relative error of the quadrature's reduced gradient over the training
+   snapshots Z (R x NSN), recomputed term by term */
+static double hy_grad_err(int N, int R, int NSN, const double *V, const double *Z, int nd, const int *pts,
+                          const double *w) {
+  double e = 0.0, s = 0.0;
+  int i, a, b, j, k;
+  for (i = 0; i < NSN; ++i)
+    for (a = 0; a < R; ++a) {
+      double full = 0.0, red = 0.0;
+      for (k = 0; k < N; ++k) {
+        double l = 0.0;
+        for (b = 0; b < R; ++b) l += V[k + b * N] * Z[b + i * R];
+        full += hy_dphi(l) * V[k + a * N];
+      }
+      for (j = 0; j < nd; ++j) {
+        double l = 0.0;
+        for (b = 0; b < R; ++b) l += V[pts[j] + b * N] * Z[b + i * R];
+        red += w[j] * hy_dphi(l) * V[pts[j] + a * N];
+      }
+      e += (full - red) * (full - red);
+      s += full * full;
+    }
+  return sqrt(e / s);
+}
+
 /* H_r(z) = sum_j w_j phi((V z)_{pts_j}) */
 static double hy_hred(int N, int R, const double *V, const double *z, int nd, const int *pts, const double *w) {
   double h = 0.0;
@@ -323,6 +348,24 @@ TEST(test_ecsw_convex_bounded) {
   CHECK_LE(rel, 1e-6);
   for (j = 0; j < nd; ++j) CHECK(w[j] > 0.0);
   /* the reduced gradient on the training snapshots, term by term */
+  CHECK_LE(hy_grad_err(N, R, NSN, V, Z, nd, pts, w), 1e-6);
+  /* the separable entry point (rows never formed) on the same data */
+  {
+    static double F[N * NSN];
+    double w2[N], rel2 = -1.0;
+    int p2[N], nd2 = 0;
+    for (k = 0; k < N; ++k)
+      for (i = 0; i < NSN; ++i) {
+        double l = 0.0;
+        for (a = 0; a < R; ++a) l += V[k + a * N] * Z[a + i * R];
+        F[k + i * N] = hy_dphi(l);
+      }
+    CHECK_RC(phgmg_ecsw_separable(N, NSN, F, N, R, V, N, NULL, 1e-6, p2, w2, &nd2, &rel2, NULL), PHGMG_OK);
+    CHECK(nd2 > 0 && nd2 < N / 2);
+    for (j = 0; j < nd2; ++j) CHECK(w2[j] > 0.0 && (j == 0 || p2[j] > p2[j - 1]));
+    CHECK_LE(rel2, 1e-6);
+    CHECK_LE(fabs(hy_grad_err(N, R, NSN, V, Z, nd2, p2, w2) - rel2), 1e-9);
+  }
   for (i = 0; i < NSN; ++i)
     for (a = 0; a < R; ++a) {
       double full = 0.0, red = 0.0;
@@ -397,11 +440,11 @@ static void hy_free(void *p, void *u) {
 
 TEST(test_hyper_nomem) {
   enum { M = 40, N = 20 };
-  static double A[M * N], b[M], x[N], w[N];
-  int pts[N], nd, fn, k, i;
+  static double A[M * N], b[M], x[N], w[N], w2[M];
+  int pts[N], pts2[M], nd, fn, k, i;
   for (i = 0; i < M * N; ++i) A[i] = th_rand();
   for (i = 0; i < M; ++i) b[i] = th_rand();
-  for (fn = 0; fn < 3; ++fn)
+  for (fn = 0; fn < 4; ++fn)
     for (k = 0; k < 50; ++k) {
       hy_fail f = {0, 0, 0};
       phgmg_allocator al;
@@ -410,7 +453,8 @@ TEST(test_hyper_nomem) {
       al.alloc = hy_alloc; al.free = hy_free; al.user = &f;
       if (fn == 0) rc = phgmg_nnls(M, N, A, M, b, 0.0, 0, x, NULL, NULL, &al);
       else if (fn == 1) rc = phgmg_ecsw(N, M, A, M, b, 0.0, pts, w, &nd, NULL, &al);
-      else rc = phgmg_deim_select(M, N, A, M, NULL, 1e-8, 0, PHGMG_DEIM_GREEDY, pts, w, &nd, NULL, NULL, &al);
+      else if (fn == 2) rc = phgmg_deim_select(M, N, A, M, NULL, 1e-8, 0, PHGMG_DEIM_GREEDY, pts, w, &nd, NULL, NULL, &al);
+      else rc = phgmg_ecsw_separable(M, N, A, M, 5, A, M, NULL, 0.0, pts2, w2, &nd, NULL, &al);
       CHECK(f.live == 0);
       if (f.calls <= k) { CHECK(rc != PHGMG_ERR_NOMEM); break; } /* every call site was hit */
       CHECK_RC(rc, PHGMG_ERR_NOMEM);
