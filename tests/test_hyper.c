@@ -154,6 +154,26 @@ TEST(test_nnls_kkt) {
   }
 }
 
+/* Rank-deficient A (every third column twice the one before it, one zero
+   column), over- and underdetermined: still the KKT point. */
+TEST(test_nnls_rank_deficient) {
+  static const int dims[][2] = {{40, 30}, {25, 40}, {60, 12}};
+  int c, i, j;
+  for (c = 0; c < 3; ++c) {
+    const int m = dims[c][0], n = dims[c][1];
+    double *A = (double *)malloc(sizeof(double) * (size_t)(m * n + m + n)), *b = A + m * n, *x = b + m, res = 0.0;
+    int nz = 0;
+    for (i = 0; i < m * n; ++i) A[i] = th_rand();
+    for (j = 1; j < n; j += 3)
+      for (i = 0; i < m; ++i) A[i + j * m] = 2.0 * A[i + (j - 1) * m];
+    for (i = 0; i < m; ++i) { A[i + 3 * m] = 0.0; b[i] = th_rand() + 0.2; }
+    CHECK_RC(phgmg_nnls(m, n, A, m, b, 0.0, 0, x, &res, &nz, NULL), PHGMG_OK);
+    hy_check_kkt(m, n, A, b, x, 1e-11 * phgmg_normf(m, n, A, m) * phgmg_normf(m, 1, b, m));
+    CHECK(x[3] == 0.0);
+    free(A);
+  }
+}
+
 TEST(test_nnls_stop_and_errors) {
   const int m = 50, n = 30;
   double A[1500], b[50], x[30], res = 0.0, bn, nanv = 0.0;
@@ -464,6 +484,7 @@ TEST(test_hyper_nomem) {
 SUITE(hyper) {
   RUN(test_nnls_bruteforce);
   RUN(test_nnls_kkt);
+  RUN(test_nnls_rank_deficient);
   RUN(test_nnls_stop_and_errors);
   RUN(test_deim_greedy);
   RUN(test_ecsw_exact_sparse);
