@@ -729,6 +729,13 @@ PHGMG_DEF phgmg_result phgmg_pod(int N, int ns, const double *X, int ldx, int km
 PHGMG_DEF phgmg_result phgmg_adjust_snapshots(int N, int m, const double *B, int ns, const double *X,
                                               int ldx, double *Xa, int ldxa, const phgmg_allocator *alloc);
 
+/* Hyper-reduction of a separable part (phgmg_reduce_opts.hyper, with deim = 1). */
+typedef enum phgmg_hyper {
+  PHGMG_HYPER_ECSW = 0,   /* default: w >= 0 by NNLS fit of the reduced gradient (ECSW) */
+  PHGMG_HYPER_QDEIM = 1,  /* structure-preserving DEIM, Q-DEIM points (the paper's)     */
+  PHGMG_HYPER_GREEDY = 2  /* structure-preserving DEIM, greedy DEIM points             */
+} phgmg_hyper;
+
 typedef struct phgmg_reduce_opts {
   phgmg_method method; /* required                                                  */
   int r;               /* reduced order (GMG: includes the m port coordinates), required */
@@ -741,6 +748,13 @@ typedef struct phgmg_reduce_opts {
   double deim_tol;     /* DEIM modes: sigma_k / sigma_1 > deim_tol (0: 1e-8)          */
   int deim_max;        /* cap on DEIM modes (0: no cap)                               */
   int deim_allow_negative; /* 1: accept negative DEIM weights (reported in info)      */
+  int hyper;           /* with deim = 1, the hyper-reduction (phgmg_hyper):
+                          0 / PHGMG_HYPER_ECSW: empirical quadrature with weights >= 0
+                          by non-negative least squares (default; never a negative
+                          weight); PHGMG_HYPER_QDEIM / _GREEDY: the paper's
+                          structure-preserving DEIM with Q-DEIM or greedy points    */
+  double hyper_tol;    /* ECSW: relative residual of the reduced nonlinear gradient
+                          over the training snapshots (0: 1e-6)                     */
   double dt;           /* > 0: precompute the GL3 step map for this step
                           (LINEAR map with quadratic H only)                          */
   double degeneracy_tol; /* fail with PHGMG_ERR_DEGENERATE when the reciprocal
@@ -822,6 +836,10 @@ typedef struct phgmg_reduce_info {
                               be exported. 0: online cost independent of N. */
   int online_callbacks;    /* 1: the reduced model calls back into user code
                               (separable functions, eta or a GENERAL part)     */
+  int hyper_method;        /* phgmg_hyper used (with deim = 1), -1 without    */
+  double hyper_min_weight; /* smallest weight of the kept terms                */
+  double hyper_residual;   /* ECSW: relative training residual of the reduced
+                              nonlinear gradient; 0 for DEIM                   */
 } phgmg_reduce_info;
 
 /* The reduced model with its offline data (bases for reconstruction, double
@@ -6754,6 +6772,8 @@ PHGMG__PRIV phgmg_result phgmg__reduce_check(const phgmg_ph_system *sys, const d
   }
   if (o->method == PHGMG_METHOD_GMG_MANIFOLD && (!o->eta || o->rn < 1)) return PHGMG_ERR_INVALID_ARG;
   if (o->deim != 0 && o->deim != 1) return PHGMG_ERR_INVALID_ARG;
+  if (o->hyper < PHGMG_HYPER_ECSW || o->hyper > PHGMG_HYPER_GREEDY) return PHGMG_ERR_INVALID_ARG;
+  if (!(o->hyper_tol >= 0.0 && o->hyper_tol < 1.0)) return PHGMG_ERR_INVALID_ARG;
   if (o->deim && sys->nl == PHGMG_NL_GENERAL) return PHGMG_ERR_UNSUPPORTED;
   if (!(o->deim_tol >= 0.0 && o->deim_tol < 1.0) || o->deim_max < 0) return PHGMG_ERR_INVALID_ARG;
   if (!(o->dt >= 0.0) || o->dt == HUGE_VAL) return PHGMG_ERR_INVALID_ARG;
@@ -7146,6 +7166,69 @@ PHGMG__PRIV phgmg_result phgmg__stage_quadratic_terms(phgmg__rctx *c) {
   return PHGMG_OK;
 }
 
+/* ECSW for GMG-QM / GMG_MANIFOLD: rows (i, a) of the training matrix are
+   phi_k'(x_i[idx_k]) Dphi(rho(x_i))[idx_k, a] over the snapshots (every
+   `stride`-th, so that it holds at most 2e7 entries), target = its columns
+   times the terms' weights. */
+PHGMG__PRIV phgmg_result phgmg__hyper_ecsw_manifold(phgmg__rctx *c, const double *F, int *pts, double *wt, int *nd) {
+  const phgmg_reduced *red = c->red;
+  const phgmg_ph_system *sys = c->sys;
+  const int nt = sys->nsep, r = red->r, m = red->m, p = red->p, rn = red->rn, N = red->N;
+  const int stride = (int)(((double)c->ns * r * nt) / 2e7) + 1, nsu = (c->ns + stride - 1) / stride;
+  const size_t nrow = (size_t)nsu * r;
+  double *Gm = phgmg__dalloc(c->alloc, nrow * nt + nrow + (size_t)r + (size_t)rn * p);
+  double *tg, *xr, *Dq;
+  int i, k, a, j, u;
+  phgmg_result rc;
+  if (!Gm) return PHGMG_ERR_NOMEM;
+  tg = Gm + nrow * nt; xr = tg + nrow; Dq = xr + r;
+  for (u = 0; u < nsu; ++u) {
+    i = u * stride;
+    phgmg_reduced_restrict(red, c->X + (size_t)i * c->ldx, xr);
+    phgmg__eta_d(red, xr + m, NULL, Dq, NULL, red->rwork);
+    for (k = 0; k < nt; ++k) {
+      const int ix = sys->sep_idx[k];
+      const double f = F[k + (size_t)i * nt];
+      double *g = Gm + (size_t)u * r + (size_t)k * nrow;
+      for (a = 0; a < r; ++a) g[a] = f * red->V0[ix + (size_t)a * N];
+      for (a = 0; a < p; ++a) {
+        double s = 0.0;
+        for (j = 0; j < rn; ++j) s += red->V2[ix + (size_t)j * N] * Dq[j + (size_t)a * rn];
+        g[m + a] += f * s;
+      }
+    }
+  }
+  for (a = 0; a < (int)nrow; ++a) tg[a] = 0.0;
+  for (k = 0; k < nt; ++k) {
+    const double sw = sys->sep_w ? sys->sep_w[k] : 1.0;
+    for (a = 0; a < (int)nrow; ++a) tg[a] += sw * Gm[a + (size_t)k * nrow];
+  }
+  rc = phgmg_ecsw(nt, (int)nrow, Gm, (int)nrow, tg, c->o->hyper_tol, pts, wt, nd, &c->inf.hyper_residual, c->alloc);
+  phgmg__free(c->alloc, Gm);
+  return rc;
+}
+
+/* Hyper-reduction by empirical quadrature (ECSW, opts.hyper = 0): terms and
+   weights w >= 0 that reproduce the reduced gradient of the nonlinear part
+   over the training snapshots to hyper_tol (phgmg_ecsw). With w >= 0 and a
+   convex phi the reduced Hamiltonian stays convex and bounded below. */
+PHGMG__PRIV phgmg_result phgmg__hyper_ecsw(phgmg__rctx *c, const double *F, int *pts, double *wt, int *nd) {
+  const phgmg_reduced *red = c->red;
+  const int nt = c->sys->nsep, r = red->r, N = red->N;
+  double *Vt;
+  int k, a;
+  phgmg_result rc;
+  if (red->kind == PHGMG_ROM_QUADRATIC) return phgmg__hyper_ecsw_manifold(c, F, pts, wt, nd);
+  Vt = phgmg__dalloc(c->alloc, (size_t)nt * r);   /* rows of V0 at the terms */
+  if (!Vt) return PHGMG_ERR_NOMEM;
+  for (a = 0; a < r; ++a)
+    for (k = 0; k < nt; ++k) Vt[k + (size_t)a * nt] = red->V0[c->sys->sep_idx[k] + (size_t)a * N];
+  rc = phgmg_ecsw_separable(nt, c->ns, F, nt, r, Vt, nt, c->sys->sep_w, c->o->hyper_tol, pts, wt, nd,
+                            &c->inf.hyper_residual, c->alloc);
+  phgmg__free(c->alloc, Vt);
+  return rc;
+}
+
 /* Points and weights of the separable sum: the caller's (opts.deim_pts),
    structure-preserving DEIM on the snapshots of the terms' gradients, or
    every term with its own weight. pts/wt have room for nsep entries. */
@@ -7171,15 +7254,24 @@ PHGMG__PRIV phgmg_result phgmg__separable_points(phgmg__rctx *c, int *pts, doubl
     for (i = 0; i < ns; ++i)
       for (a = 0; a < nt; ++a)
         F[a + (size_t)i * nt] = phgmg__ph_phi(sys, a, c->X[sys->sep_idx[a] + (size_t)i * c->ldx], 1);
-    rc = phgmg_deim(nt, ns, F, nt, sys->sep_w, o->deim_tol, o->deim_max, pts, wt, nd, &nneg,
-                    &c->inf.deim_sigma_ratio, c->alloc);
+    if (o->hyper == PHGMG_HYPER_ECSW)
+      rc = phgmg__hyper_ecsw(c, F, pts, wt, nd);
+    else
+      rc = phgmg_deim_select(nt, ns, F, nt, sys->sep_w, o->deim_tol, o->deim_max,
+                             o->hyper == PHGMG_HYPER_GREEDY ? PHGMG_DEIM_GREEDY : PHGMG_DEIM_QDEIM,
+                             pts, wt, nd, &nneg, &c->inf.deim_sigma_ratio, c->alloc);
     phgmg__free(c->alloc, F);
+    c->inf.hyper_method = o->hyper;
   } else {
     *nd = nt;
     for (a = 0; a < nt; ++a) { pts[a] = a; wt[a] = sys->sep_w ? sys->sep_w[a] : 1.0; }
   }
   c->inf.deim_modes = *nd;      /* reported on PHGMG_ERR_NEGATIVE_WEIGHT too */
   c->inf.deim_negative = nneg;
+  if (rc == PHGMG_OK && *nd > 0) {
+    c->inf.hyper_min_weight = wt[0];
+    for (a = 1; a < *nd; ++a) c->inf.hyper_min_weight = PHGMG__MIN(c->inf.hyper_min_weight, wt[a]);
+  }
   if (rc == PHGMG_OK && nneg > 0 && !o->deim_allow_negative) rc = PHGMG_ERR_NEGATIVE_WEIGHT;
   return rc;
 }
@@ -7270,6 +7362,7 @@ PHGMG_DEF phgmg_result phgmg_reduce(phgmg_reduced **out, const phgmg_ph_system *
   if (!sys || !X || !opts) return PHGMG_ERR_INVALID_ARG;
   memset(&c, 0, sizeof c);
   c.sys = sys; c.o = opts; c.X = X; c.ldx = ldx; c.ns = ns; c.alloc = alloc; c.gsel = -1;
+  c.inf.hyper_method = -1;
   rc = phgmg__reduce_check(sys, X, ldx, ns, opts);
   if (rc == PHGMG_OK) rc = phgmg_ph_validate(sys, 0.0, &c.inf.rcond_jr, alloc);
   if (rc != PHGMG_OK) {
