@@ -419,9 +419,27 @@ PHGMG_DEF void phgmg_jr_factor_destroy(phgmg_jr_factor *f);
      evaluations of f at one state (3 per stage-system evaluation),
      factorizations counts (real + complex) factorization pairs, failures counts
      Newton attempts that failed (including ones a retry rescued) and steps that
-     returned an error. */
+     returned an error.
+   - Tiny entries: a chain started at rest carries a wave whose tail decays
+     through the subnormal range (|v| < DBL_MIN), where some processors compute
+     ~100x slower, and a polynomial nonlinearity underflows long before that
+     (y^3 for |y| < 3e-103). The stepper therefore sets to zero, in its own
+     vectors, every entry below tau = max(DBL_MIN, PHGMG_GL3_FLUSH_REL ||x||_inf)
+     (x: the state at the start of the step): the stage increments and their
+     transformed copies after each Newton update, the new state (tau of the new
+     state), and in the pivot-free banded solve the tail the substitutions
+     carry beyond the support of the right-hand side (the sweeps stop after
+     kl resp. ku zero rows, which also skips the O(N) work on a state still
+     at rest there). An entry 1e-60 below the largest one changes nothing at any
+     Newton tolerance; the results agree with opts.keep_tiny = 1 (no flushing)
+     to far below tol. The floating-point environment (rounding mode,
+     MXCSR/FTZ/DAZ) is neither read nor changed. With a dense, pivoting
+     banded or callback solve the tails are flushed after the solve only. */
 #ifndef PHGMG_GL3_STEP_MAP_MAX_N
 #define PHGMG_GL3_STEP_MAP_MAX_N 1000
+#endif
+#ifndef PHGMG_GL3_FLUSH_REL
+#define PHGMG_GL3_FLUSH_REL 1e-60 /* relative flush threshold (see Tiny entries) */
 #endif
 
 /* u(t) into u[m]. */
@@ -432,6 +450,7 @@ typedef struct phgmg_gl3_opts {
   int max_iter;        /* Newton iteration cap per step (0: 10)                      */
   int no_step_map;     /* 1: never use the precomputed linear step map               */
   double contraction;  /* refactor when the contraction rate exceeds this (0: 0.5)    */
+  int keep_tiny;       /* 1: never flush tiny entries (see Tiny entries above)       */
 } phgmg_gl3_opts;
 
 typedef struct phgmg_gl3_stats {
@@ -3177,6 +3196,15 @@ PHGMG_DEF phgmg_result phgmg_ph_validate(const phgmg_ph_system *sys, double tol,
 
 /* >>gl3 (implementation) ================================================= */
 
+#define PHGMG__DBL_MIN 2.2250738585072014e-308 /* smallest normal double */
+
+/* Set entries with |v_i| < tau to zero (tau >= DBL_MIN: no subnormal is left;
+   see Tiny entries in >>gl3). Branch-free, so it vectorises. */
+PHGMG__PRIV void phgmg__flush_tiny(double *v, size_t n, double tau) {
+  size_t i;
+  for (i = 0; i < n; ++i) v[i] = fabs(v[i]) < tau ? 0.0 : v[i];
+}
+
 PHGMG_DEF void phgmg_gl3_coefficients(double c[3], double b[3], double A[9]) {
   const double s15 = sqrt(15.0);
   c[0] = 0.5 - s15 / 10.0;
@@ -3429,6 +3457,9 @@ struct phgmg_gl3 {
   int have_prev, need_factor;
   double tend;
   phgmg_gl3_stats st;
+  /* tiny entries: flush threshold of this step, ||xend||_inf, 0 = keep_tiny */
+  double ftau, xamax;
+  int flush;
 };
 
 PHGMG_DEF void phgmg_gl3_destroy(phgmg_gl3 *s) {
@@ -3584,6 +3615,8 @@ PHGMG_DEF phgmg_result phgmg_gl3_create(phgmg_gl3 **out, const phgmg_ph_system *
   s->tol = (opts && opts->tol > 0.0) ? opts->tol : 1e-10;
   s->max_iter = (opts && opts->max_iter > 0) ? opts->max_iter : 10;
   s->contraction = (opts && opts->contraction > 0.0) ? opts->contraction : 0.5;
+  s->flush = !(opts && opts->keep_tiny);
+  s->ftau = s->flush ? PHGMG__DBL_MIN : 0.0;
   s->linear = sys->nl == PHGMG_NL_NONE;
   phgmg_gl3_coefficients(s->c, s->b, s->A);
   phgmg__gl3_transform(s->A, s->T, s->Ti, &s->gam, &s->alp, &s->bet);
@@ -3941,41 +3974,84 @@ PHGMG__PRIV void phgmg__gl3_pack_nopiv(phgmg_gl3 *s) {
   }
 }
 
+/* One row of the forward (L) sweep of the packed solve, into t, tr, ti. */
+#define PHGMG__GL3_FWD_ROW(j)                                                   \
+  do {                                                                          \
+    const double *lr = r, *lc = r + kl, *bb = b + (j) - kl, *zz = z + 2 * ((j) - kl); \
+    t = b[j]; tr = z[2 * (j)]; ti = z[2 * (j) + 1];                             \
+    for (p = 0; p < kl; ++p) { /* the newest unknown comes last: short chains */ \
+      double cr = lc[2 * p], ci = lc[2 * p + 1], xr = zz[2 * p], xi = zz[2 * p + 1]; \
+      t = PHGMG__FMA(-lr[p], bb[p], t);                                         \
+      tr = PHGMG__FMA(-cr, xr, tr) + ci * xi;                                   \
+      ti = PHGMG__FMA(-cr, xi, ti) - ci * xr;                                   \
+    }                                                                           \
+  } while (0)
+/* One row of the backward (U) sweep. */
+#define PHGMG__GL3_BWD_ROW(j)                                                   \
+  do {                                                                          \
+    const double *ur = r + 3 * kl, *uc = ur + ku, *dg = uc + 2 * ku;            \
+    const double *bb = b + (j) + 1, *zz = z + 2 * ((j) + 1);                    \
+    double br = z[2 * (j)], bi = z[2 * (j) + 1];                                \
+    t = b[j] * dg[0]; tr = br * dg[1] - bi * dg[2]; ti = br * dg[2] + bi * dg[1]; \
+    for (p = ku - 1; p >= 0; --p) {                                             \
+      double cr = uc[2 * p], ci = uc[2 * p + 1], xr = zz[2 * p], xi = zz[2 * p + 1]; \
+      t = PHGMG__FMA(-ur[p], bb[p], t);                                         \
+      tr = PHGMG__FMA(-cr, xr, tr) + ci * xi;                                   \
+      ti = PHGMG__FMA(-cr, xi, ti) - ci * xr;                                   \
+    }                                                                           \
+  } while (0)
+
+/* The right-hand sides vanish outside rows j0..j1 (a wave still far from the
+   chain's ends): the forward sweep starts at j0, and beyond j1 it only carries
+   the tail that L^{-1} spreads, which decays geometrically; those entries are
+   flushed below s->ftau and the sweep stops after kl zero rows (all later rows
+   are zero). The backward sweep does the same below j0 with ku zero rows. */
 PHGMG__PRIV void phgmg__gl3_solve_packed(const phgmg_gl3 *s, double *b, double *z) {
-  int n = s->N, kl = s->kl, ku = s->ku, j, p;
+  int n = s->N, kl = s->kl, ku = s->ku, j, p, j0, j1, run;
   size_t P = 3 * (size_t)(kl + ku + 1);
-  const double *r = s->pk;
-  for (j = 0; j < n; ++j, r += P) {
-    const double *lr = r, *lc = r + kl, *bb = b + j - kl, *zz = z + 2 * (j - kl);
-    double t = b[j], tr = z[2 * j], ti = z[2 * j + 1];
-    for (p = 0; p < kl; ++p) { /* the newest unknown comes last: short chains */
-      double cr = lc[2 * p], ci = lc[2 * p + 1], xr = zz[2 * p], xi = zz[2 * p + 1];
-      t = PHGMG__FMA(-lr[p], bb[p], t);
-      tr = PHGMG__FMA(-cr, xr, tr) + ci * xi;
-      ti = PHGMG__FMA(-cr, xi, ti) - ci * xr;
-    }
+  const double tau = s->ftau;
+  const double *r;
+  double t, tr, ti;
+  for (j1 = n - 1; j1 >= 0 && b[j1] == 0.0 && z[2 * j1] == 0.0 && z[2 * j1 + 1] == 0.0; --j1) {}
+  if (j1 < 0) return; /* zero right-hand side, zero solution */
+  for (j0 = 0; b[j0] == 0.0 && z[2 * j0] == 0.0 && z[2 * j0 + 1] == 0.0; ++j0) {}
+  for (j = j0, r = s->pk + (size_t)j0 * P; j <= j1; ++j, r += P) {
+    PHGMG__GL3_FWD_ROW(j);
     b[j] = t;
     z[2 * j] = tr;
     z[2 * j + 1] = ti;
   }
-  r = s->pk + (size_t)(n - 1) * P;
-  for (j = n - 1; j >= 0; --j, r -= P) {
-    const double *ur = r + 3 * kl, *uc = ur + ku, *dg = uc + 2 * ku;
-    const double *bb = b + j + 1, *zz = z + 2 * (j + 1);
-    double br = z[2 * j], bi = z[2 * j + 1];
-    double t = b[j] * dg[0], tr = br * dg[1] - bi * dg[2], ti = br * dg[2] + bi * dg[1];
-    for (p = ku - 1; p >= 0; --p) {
-      double cr = uc[2 * p], ci = uc[2 * p + 1], xr = zz[2 * p], xi = zz[2 * p + 1];
-      t = PHGMG__FMA(-ur[p], bb[p], t);
-      tr = PHGMG__FMA(-cr, xr, tr) + ci * xi;
-      ti = PHGMG__FMA(-cr, xi, ti) - ci * xr;
-    }
+  for (run = 0; j < n && run < kl; ++j, r += P) { /* the tail below the support */
+    PHGMG__GL3_FWD_ROW(j);
+    t = fabs(t) < tau ? 0.0 : t;
+    tr = fabs(tr) < tau ? 0.0 : tr;
+    ti = fabs(ti) < tau ? 0.0 : ti;
     b[j] = t;
     z[2 * j] = tr;
     z[2 * j + 1] = ti;
-    if (j == 0) break; /* r would step before the array */
+    run = (t == 0.0 && tr == 0.0 && ti == 0.0) ? run + 1 : 0;
+  }
+  for (j = j - 1; j >= j0; --j) { /* rows from j on are zero */
+    r = s->pk + (size_t)j * P;
+    PHGMG__GL3_BWD_ROW(j);
+    b[j] = t;
+    z[2 * j] = tr;
+    z[2 * j + 1] = ti;
+  }
+  for (run = 0; j >= 0 && run < ku; --j) { /* the tail above the support */
+    r = s->pk + (size_t)j * P;
+    PHGMG__GL3_BWD_ROW(j);
+    t = fabs(t) < tau ? 0.0 : t;
+    tr = fabs(tr) < tau ? 0.0 : tr;
+    ti = fabs(ti) < tau ? 0.0 : ti;
+    b[j] = t;
+    z[2 * j] = tr;
+    z[2 * j + 1] = ti;
+    run = (t == 0.0 && tr == 0.0 && ti == 0.0) ? run + 1 : 0;
   }
 }
+#undef PHGMG__GL3_FWD_ROW
+#undef PHGMG__GL3_BWD_ROW
 
 /* (Re)factor the shifted Newton matrices at x. */
 PHGMG__PRIV phgmg_result phgmg__gl3_factor(phgmg_gl3 *s, const double *x) {
@@ -4142,13 +4218,19 @@ PHGMG__PRIV phgmg_result phgmg__gl3_newton(phgmg_gl3 *s, const double *x, int fr
     {
       const double T00 = T[0], T01 = T[1], T02 = T[2], T10 = T[3], T11 = T[4], T12 = T[5],
                    T20 = T[6], T21 = T[7], T22 = T[8];
-      const double *d1 = s->r1, *dc = s->rc;
-      for (i = 0; i < N; ++i) {
-        double w0 = W0[i] + d1[i], w1 = W1[i] + dc[2 * i], w2 = W2[i] + dc[2 * i + 1];
+      const double *d1 = s->r1, *dc = s->rc, tau = s->ftau;
+      for (i = 0; i < N; ++i) { /* update, tiny entries flushed (see >>gl3) */
+        double w0 = W0[i] + d1[i], w1 = W1[i] + dc[2 * i], w2 = W2[i] + dc[2 * i + 1], z0, z1, z2;
+        w0 = fabs(w0) < tau ? 0.0 : w0;
+        w1 = fabs(w1) < tau ? 0.0 : w1;
+        w2 = fabs(w2) < tau ? 0.0 : w2;
         W0[i] = w0; W1[i] = w1; W2[i] = w2;
-        Z0[i] = PHGMG__FMA(T00, w0, PHGMG__FMA(T01, w1, T02 * w2));
-        Z1[i] = PHGMG__FMA(T10, w0, PHGMG__FMA(T11, w1, T12 * w2));
-        Z2[i] = PHGMG__FMA(T20, w0, PHGMG__FMA(T21, w1, T22 * w2));
+        z0 = PHGMG__FMA(T00, w0, PHGMG__FMA(T01, w1, T02 * w2));
+        z1 = PHGMG__FMA(T10, w0, PHGMG__FMA(T11, w1, T12 * w2));
+        z2 = PHGMG__FMA(T20, w0, PHGMG__FMA(T21, w1, T22 * w2));
+        Z0[i] = fabs(z0) < tau ? 0.0 : z0;
+        Z1[i] = fabs(z1) < tau ? 0.0 : z1;
+        Z2[i] = fabs(z2) < tau ? 0.0 : z2;
       }
     }
     res_prev = res;
@@ -4244,6 +4326,13 @@ PHGMG_DEF phgmg_result phgmg_gl3_step(phgmg_gl3 *s, double t, double *x, phgmg_i
     fresh = 1;
   }
   if (s->linear) fresh = 1; /* the Jacobian does not depend on x */
+  if (s->flush) { /* flush threshold from ||x||_inf (known when continuing) */
+    double am = 0.0;
+    if (cont) am = s->xamax;
+    else
+      for (i = 0; i < N; ++i) am = fabs(x[i]) > am ? fabs(x[i]) : am;
+    s->ftau = PHGMG__MAX(PHGMG__DBL_MIN, PHGMG_GL3_FLUSH_REL * am);
+  }
   phgmg__gl3_guess(s, cont);
   rc = phgmg__gl3_newton(s, x, fresh, &theta, &res);
   if (rc != PHGMG_OK && !fresh) {
@@ -4258,13 +4347,17 @@ PHGMG_DEF phgmg_result phgmg_gl3_step(phgmg_gl3 *s, double t, double *x, phgmg_i
   if (!s->linear && theta > s->contraction) s->need_factor = 1;
   {
     const double *F0 = s->F, *F1 = s->F + N, *F2 = s->F + 2 * (size_t)N;
-    double hb0 = s->h * s->b[0], hb1 = s->h * s->b[1], hb2 = s->h * s->b[2], chk = 0.0;
+    double hb0 = s->h * s->b[0], hb1 = s->h * s->b[1], hb2 = s->h * s->b[2], chk = 0.0, am = 0.0;
     for (i = 0; i < N; ++i) {
       double v = x[i] + (hb0 * F0[i] + hb1 * F1[i] + hb2 * F2[i]);
       s->xnew[i] = v;
       chk += v;
+      am = fabs(v) > am ? fabs(v) : am;
     }
     if (chk - chk != 0.0) { s->st.failures++; return PHGMG_ERR_NANINF; }
+    s->xamax = am;
+    if (s->flush)
+      phgmg__flush_tiny(s->xnew, (size_t)N, PHGMG__MAX(PHGMG__DBL_MIN, PHGMG_GL3_FLUSH_REL * am));
   }
   if (energy_inc) phgmg__gl3_energy(s, energy_inc);
   { /* keep the converged stages for the next guess */
@@ -4995,6 +5088,20 @@ PHGMG__ONLINE phgmg_result phgmg__romstep_factor(phgmg_rom_stepper *s, const phg
   return PHGMG_OK;
 }
 
+/* Reduced states that decay freely pass through the subnormal range, slow on
+   some processors: phgmg_rom_step sets entries below the smallest normal
+   (DBL_MIN, FLT_MIN in float builds) of its new state and extrapolation data
+   to zero (never touching the floating-point environment). */
+#if PHGMG_REAL_IS_FLOAT
+#define PHGMG__R_MINNORM 1.17549435e-38F
+#else
+#define PHGMG__R_MINNORM 2.2250738585072014e-308
+#endif
+PHGMG__ONLINE void phgmg__r_flush_subnormal(phgmg_real *v, int n) {
+  int i;
+  for (i = 0; i < n; ++i) v[i] = PHGMG__RABS(v[i]) < PHGMG__R_MINNORM ? PHGMG__R(0) : v[i];
+}
+
 PHGMG__ONLINE phgmg_result phgmg__romstep_map(phgmg_rom_stepper *s, const phgmg__romstep_mem *L, phgmg_real *x,
                                               const phgmg_real *u3, phgmg_real *y, phgmg_real energy[2]) {
   const phgmg_rom *rom = s->rom;
@@ -5004,6 +5111,7 @@ PHGMG__ONLINE phgmg_result phgmg__romstep_map(phgmg_rom_stepper *s, const phgmg_
   phgmg__r_gemv(r, r, rom->Phi, x, 0, xn);
   if (u3 && m > 0) phgmg__r_gemv(r, 3 * m, rom->Gam, u3, 1, xn);
   if (!phgmg__r_finite(xn, r)) return PHGMG_ERR_NANINF;
+  phgmg__r_flush_subnormal(xn, r);
   if (energy) {
     phgmg_real sup = PHGMG__R(0), dis = PHGMG__R(0);
     phgmg__r_gemv(n3, r, rom->SX, x, 0, L->Z);             /* stage values */
@@ -5168,6 +5276,9 @@ PHGMG_DEF phgmg_result phgmg_rom_step(phgmg_rom_stepper *s, phgmg_real *x, const
             L.Php[i * r + a] = L.lagq[i * 3] * L.Phi[a] + L.lagq[i * 3 + 1] * L.Phi[r + a] +
                                L.lagq[i * 3 + 2] * L.Phi[2 * r + a];
         }
+      phgmg__r_flush_subnormal(xn, r);
+      phgmg__r_flush_subnormal(L.Zp, n3);
+      if (L.Php) phgmg__r_flush_subnormal(L.Php, n3);
       for (a = 0; a < r; ++a) x[a] = xn[a];
       s->have_prev = 1;
       if (theta_max > PHGMG__R(0.5)) s->have_lu = 0; /* slow contraction: refactor next step */
