@@ -6329,38 +6329,91 @@ PHGMG_DEF double phgmg_rel_error(int n, int ns, const double *A, int lda, const 
   return den > 0.0 ? sqrt(num / den) : (num > 0.0 ? (double)INFINITY : 0.0);
 }
 
-/* sqrt(sum ||x_i - g(x_i)||^2 / sum ||x_i||^2) with g applied column-wise. */
+/* Columns per block of the error measures: GEMMs of N x 64 blocks, bounded
+   workspace (N x 64 + small). */
+#define PHGMG__ERR_NB 64
+
+/* Xt = g(X) for nb columns of X as block operations (mode as phgmg__err_map);
+   C: (r + rn) x nb, Qb: 64 x nb. */
+PHGMG__PRIV void phgmg__err_map_block(const phgmg_reduced *red, const double *X, int ldx, int nb,
+                                      const double *XR, int ldxr, int mode, double *Xt, double *C,
+                                      double *Qb) {
+  const int N = red->N, r = red->r, m = red->m, rn = red->rn;
+  int i, j, k;
+  if (mode == 2) { /* x - (I - P_{V2})(I - P_{V1})(I - P_{QB}) x, as in orth_remove */
+    for (k = 0; k < nb; ++k) memcpy(Xt + (size_t)k * N, X + (size_t)k * ldx, (size_t)N * sizeof(double));
+    phgmg__orth_remove(N, m, red->QB, nb, Xt, N, C);
+    phgmg__orth_remove(N, r - m, red->V0 + (size_t)N * m, nb, Xt, N, C);
+    phgmg__orth_remove(N, rn, red->V2, nb, Xt, N, C);
+    for (k = 0; k < nb; ++k)
+      for (i = 0; i < N; ++i) Xt[i + (size_t)k * N] = X[i + (size_t)k * ldx] - Xt[i + (size_t)k * N];
+    return;
+  }
+  if (mode == 1) { /* C = rho(X), as phgmg_reduced_restrict */
+    if (red->method == PHGMG_METHOD_SP1 || red->method == PHGMG_METHOD_SP2) {
+      phgmg_gemm('T', 'N', r, nb, N, 1.0, red->W, N, X, ldx, 0.0, C, r);
+    } else {
+      phgmg_gemm('T', 'N', m, nb, N, 1.0, red->QB, N, X, ldx, 0.0, C, r);
+      for (k = 0; k < nb; ++k) { /* RB^{-1} on the first m coordinates */
+        double *xr = C + (size_t)k * r;
+        for (i = m - 1; i >= 0; --i) {
+          double sm = xr[i];
+          for (j = i + 1; j < m; ++j) sm -= red->RB[i + j * m] * xr[j];
+          xr[i] = sm / red->RB[i + i * m];
+        }
+      }
+      phgmg_gemm('T', 'N', r - m, nb, N, 1.0, red->V0 + (size_t)N * m, N, X, ldx, 0.0, C + m, r);
+    }
+    XR = C;
+    ldxr = r;
+  }
+  /* Xt = phi(XR), as phgmg_reduced_lift */
+  phgmg_gemm('N', 'N', N, nb, r, 1.0, red->V0, N, XR, ldxr, 0.0, Xt, N);
+  if (red->kind == PHGMG_ROM_QUADRATIC) {
+    const int p = red->p, rq = PHGMG__MIN(rn, 64);
+    int a;
+    for (k = 0; k < nb; ++k) {
+      const double *x2 = XR + (size_t)k * ldxr + m;
+      for (i = 0; i < rq; ++i) {
+        double sm = 0.0;
+        for (a = 0; a < p; ++a)
+          for (j = 0; j < p; ++j) sm += red->M[i + (size_t)(a * p + j) * rn] * x2[a] * x2[j];
+        Qb[i + (size_t)k * rq] = sm;
+      }
+    }
+    phgmg_gemm('N', 'N', N, nb, rq, 1.0, red->V2, N, Qb, rq, 1.0, Xt, N);
+  }
+}
+
+/* sqrt(sum ||x_i - g(x_i)||^2 / sum ||x_i||^2) with g applied column-wise,
+   PHGMG__ERR_NB columns at a time (GEMM instead of per-column GEMV).
+   mode 0: g(x_i) = phi(XR_i); 1: phi(rho(x_i)); 2: orthogonal projection on
+   [B, V1, V2]. */
 PHGMG__PRIV double phgmg__err_map(const phgmg_reduced *red, const double *X, int ldx, int ns,
                                   const double *XR, int ldxr, int mode) {
-  const int N = red->N, r = red->r;
+  const int N = red->N, r = red->r, nbmax = PHGMG__MIN(ns, PHGMG__ERR_NB);
   const phgmg_allocator *alloc = red->use_alloc ? &red->alloc : NULL;
-  double *xt = phgmg__dalloc(alloc, (size_t)N + (size_t)r + (size_t)(r + red->rn)), *xr;
-  double num = 0.0, den = 0.0;
-  int i, j;
-  if (!xt) return (double)NAN;
-  xr = xt + N;
-  for (j = 0; j < ns; ++j) {
-    const double *x = X + (size_t)j * ldx;
-    if (mode == 0) {            /* reduction error: phi(XR_j) */
-      phgmg_reduced_lift(red, XR + (size_t)j * ldxr, xt);
-    } else if (mode == 1) {     /* projection error: phi(rho(x)) */
-      phgmg_reduced_restrict(red, x, xr);
-      phgmg_reduced_lift(red, xr, xt);
-    } else {                    /* lower bound: orthogonal projection on [B, V1, V2] */
-      double *c = xr;
-      memcpy(xt, x, (size_t)N * sizeof(double));
-      phgmg__orth_remove(N, red->m, red->QB, 1, xt, N, c);
-      phgmg__orth_remove(N, red->r - red->m, red->V0 + (size_t)N * red->m, 1, xt, N, c);
-      phgmg__orth_remove(N, red->rn, red->V2, 1, xt, N, c);
-      for (i = 0; i < N; ++i) xt[i] = x[i] - xt[i];
-    }
-    for (i = 0; i < N; ++i) {
-      const double d = x[i] - xt[i];
-      num += d * d;
-      den += x[i] * x[i];
+  double *Xt, *C, *Qb, num = 0.0, den = 0.0;
+  int i, j0, k;
+  if (ns < 1) return 0.0;
+  Xt = phgmg__dalloc(alloc, (size_t)nbmax * ((size_t)N + (size_t)(r + red->rn) + 64));
+  if (!Xt) return (double)NAN;
+  C = Xt + (size_t)N * nbmax;
+  Qb = C + (size_t)(r + red->rn) * nbmax;
+  for (j0 = 0; j0 < ns; j0 += nbmax) {
+    const int nb = PHGMG__MIN(nbmax, ns - j0);
+    const double *Xb = X + (size_t)j0 * ldx;
+    phgmg__err_map_block(red, Xb, ldx, nb, XR ? XR + (size_t)j0 * ldxr : NULL, ldxr, mode, Xt, C, Qb);
+    for (k = 0; k < nb; ++k) {
+      const double *x = Xb + (size_t)k * ldx, *xt = Xt + (size_t)k * N;
+      for (i = 0; i < N; ++i) {
+        const double d = x[i] - xt[i];
+        num += d * d;
+        den += x[i] * x[i];
+      }
     }
   }
-  phgmg__free(alloc, xt);
+  phgmg__free(alloc, Xt);
   return den > 0.0 ? sqrt(num / den) : 0.0;
 }
 
