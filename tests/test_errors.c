@@ -82,7 +82,7 @@ static double te_compare(int n_masses, int ns, int ld, int r, int *count) {
     worst = 1.0;
   for (j = 0; j < ns; ++j) {
     memcpy(X + (size_t)j * ld, X0 + (size_t)j * N, (size_t)N * sizeof(double));
-    X[(size_t)j * ld + N] = 1e300 * (ld > N); /* padding must not be read */
+    if (ld > N) X[(size_t)j * ld + N] = 1e300; /* padding must not be read */
   }
   for (meth = PHGMG_METHOD_GMG_POD; meth <= PHGMG_METHOD_SP2 && worst < 1.0; ++meth) {
     phgmg_reduce_opts ro;
