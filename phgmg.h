@@ -7703,6 +7703,10 @@ PHGMG__PRIV void phgmg__err_map_block(const phgmg_reduced *red, const double *X,
     int a;
     for (k = 0; k < nb; ++k) {
       const double *x2 = XR + (size_t)k * ldxr + m;
+      if (red->eta) {   /* the caller's eta */
+        phgmg__eta_d(red, x2, Qb + (size_t)k * rq, NULL, NULL, red->rwork);
+        continue;
+      }
       for (i = 0; i < rq; ++i) {
         double sm = 0.0;
         for (a = 0; a < p; ++a)
