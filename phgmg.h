@@ -7288,13 +7288,13 @@ PHGMG__PRIV phgmg_result phgmg__stage_quadratic_terms(phgmg__rctx *c) {
 
 /* ECSW for GMG-QM / GMG_MANIFOLD: rows (i, a) of the training matrix are
    phi_k'(x_i[idx_k]) Dphi(rho(x_i))[idx_k, a] over the snapshots (every
-   `stride`-th, so that it holds at most 2e7 entries), target = its columns
+   `stride`-th, so that it holds at most 4e6 entries), target = its columns
    times the terms' weights. */
 PHGMG__PRIV phgmg_result phgmg__hyper_ecsw_manifold(phgmg__rctx *c, const double *F, int *pts, double *wt, int *nd) {
   const phgmg_reduced *red = c->red;
   const phgmg_ph_system *sys = c->sys;
   const int nt = sys->nsep, r = red->r, m = red->m, p = red->p, rn = red->rn, N = red->N;
-  const int stride = (int)(((double)c->ns * r * nt) / 2e7) + 1, nsu = (c->ns + stride - 1) / stride;
+  const int stride = (int)(((double)c->ns * r * nt) / 4e6) + 1, nsu = (c->ns + stride - 1) / stride;
   const size_t nrow = (size_t)nsu * r;
   double *Gm = phgmg__dalloc(c->alloc, nrow * nt + nrow + (size_t)r + (size_t)rn * p);
   double *tg, *xr, *Dq;

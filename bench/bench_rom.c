@@ -18,7 +18,7 @@
      offline_deim_nonlinear          nonlinear-gradient snapshots + phgmg_deim (tol 1e-8)
      hyper_ecsw_N1000_r20            phgmg_ecsw (tol 1e-6) on the 20020 x 500 training rows
                                      of the GMG-POD basis (r = 20), rows given
-     hyper_ecsw_separable_N1000_r20  gradient snapshots + phgmg_ecsw_separable (same fit,
+     offline_hyper_nonlinear_r20  gradient snapshots + phgmg_ecsw_separable (same fit,
                                      rows never formed)
      offline_<kind>_<model>_r20      the whole phgmg_reduce, no POD cache
      rom_<model>_<kind>_r<8|16|20>   1000 steps of phgmg_rom_step, static workspace
@@ -604,7 +604,7 @@ int main(int argc, char **argv) {
     snprintf(extra, sizeof extra, "%d x %d gradient snapshots, rank %d (nominal %.2f GFLOP), %d DEIM points, %d negative weights",
              MN1.sys.nsep, NS, rank, 4.0 * MN1.sys.nsep * NS * rank * 1e-9, dc.nd, dc.nneg);
     row("offline_deim_nonlinear", T, extra);
-    if (!g_only || strstr("hyper_ecsw_N1000_r20 hyper_ecsw_separable_N1000_r20", g_only)) {
+    if (!g_only || strstr("hyper_ecsw_N1000_r20 offline_hyper_nonlinear_r20", g_only)) {
       const int nt = MN1.sys.nsep, m = NS * r; /* r = 20 */
       ecsw_ctx ec;
       double *V0 = (double *)xmalloc(sizeof(double) * (size_t)N * r), *Xa = (double *)xmalloc(sizeof(double) * (size_t)N * NS);
@@ -632,7 +632,7 @@ int main(int argc, char **argv) {
         for (i = 0; i < m; ++i) tg[i] += Gm[i + (size_t)k * m];
       }
       for (sep = 0; sep < 2; ++sep) {
-        const char *nm = sep ? "hyper_ecsw_separable_N1000_r20" : "hyper_ecsw_N1000_r20";
+        const char *nm = sep ? "offline_hyper_nonlinear_r20" : "hyper_ecsw_N1000_r20";
         ec.sep = sep;
         T = bench(nm, RUNS_OFF, ecsw_fn, &ec);
         for (wmin = 1e300, i = 0; i < ec.nd; ++i) if (ec.w[i] < wmin) wmin = ec.w[i];
