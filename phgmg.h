@@ -449,7 +449,9 @@ PHGMG_DEF void phgmg_jr_factor_destroy(phgmg_jr_factor *f);
      ~100x slower, and a polynomial nonlinearity underflows long before that
      (y^3 for |y| < 3e-103). The stepper therefore sets to zero, in its own
      vectors, every entry below tau = max(DBL_MIN, PHGMG_GL3_FLUSH_REL ||x||_inf)
-     (x: the state at the start of the step): the new state, the converged
+     (x: the state at the start of the step; with the step map: the new
+     state relative to itself, and the map matrices relative to their largest
+     entry, once at create): the new state, the converged
      stages kept for the next guess, and in the pivot-free banded solve the
      tail the substitutions carry beyond the support of the right-hand side
      (the sweeps stop after kl resp. ku zero rows, which also skips the O(N)
@@ -3585,6 +3587,22 @@ PHGMG__PRIV void phgmg__flush_tiny(double *v, size_t n, double tau) {
   for (; i < n; ++i) v[i] = fabs(v[i]) < tau ? 0.0 : v[i];
 }
 
+/* Flush v relative to its own largest entry: tau = max(DBL_MIN, REL ||v||_inf). */
+PHGMG__PRIV void phgmg__flush_tiny_rel(double *v, size_t n) {
+  double m0 = 0.0, m1 = 0.0, m2 = 0.0, m3 = 0.0;
+  size_t i;
+  for (i = 0; i + 4 <= n; i += 4) {
+    double a0 = fabs(v[i]), a1 = fabs(v[i + 1]), a2 = fabs(v[i + 2]), a3 = fabs(v[i + 3]);
+    m0 = a0 > m0 ? a0 : m0;
+    m1 = a1 > m1 ? a1 : m1;
+    m2 = a2 > m2 ? a2 : m2;
+    m3 = a3 > m3 ? a3 : m3;
+  }
+  for (; i < n; ++i) m0 = fabs(v[i]) > m0 ? fabs(v[i]) : m0;
+  m0 = PHGMG__MAX(PHGMG__MAX(m0, m1), PHGMG__MAX(m2, m3));
+  phgmg__flush_tiny(v, n, PHGMG__MAX(PHGMG__DBL_MIN, PHGMG_GL3_FLUSH_REL * m0));
+}
+
 PHGMG_DEF void phgmg_gl3_coefficients(double c[3], double b[3], double A[9]) {
   const double s15 = sqrt(15.0);
   c[0] = 0.5 - s15 / 10.0;
@@ -3943,6 +3961,11 @@ PHGMG__PRIV phgmg_result phgmg__gl3_build_map(phgmg_gl3 *s) {
       }
   phgmg_lu_solve('N', N, K1, N, ip1, nc, X1, N);
   phgmg_zlu_solve(N, K2, N, ip2, nc, X2, N);
+  if (s->flush) /* solutions decay along a chain: keep the products below clear of subnormals */
+    for (j = 0; j < nc; ++j) {
+      phgmg__flush_tiny_rel(X1 + (size_t)j * (size_t)N, (size_t)N);
+      phgmg__flush_tiny_rel(X2 + 2 * (size_t)j * (size_t)N, 2 * (size_t)N);
+    }
   /* Z_i = T_i1 W1 + T_i2 Re W23 + T_i3 Im W23; Phi = I + sum d_i Zx_i, Gam = sum d_i Zu_i;
      GX_i = Q (I + Zx_i), GU_i = Q Zu_i */
   memset(s->Phi, 0, sizeof(double) * NN);
@@ -4037,6 +4060,16 @@ PHGMG_DEF phgmg_result phgmg_gl3_create(phgmg_gl3 **out, const phgmg_ph_system *
     }
     rc = phgmg__gl3_build_map(s);
     if (rc != PHGMG_OK) goto fail;
+    if (s->flush) { /* the maps decay along a chain: tiny entries flushed once, per column */
+      for (i = 0; i < 3 * N; ++i) {
+        if (i < N) phgmg__flush_tiny_rel(s->Phi + (size_t)i * (size_t)N, (size_t)N);
+        phgmg__flush_tiny_rel(s->GX + (size_t)i * (size_t)N, (size_t)N);
+      }
+      for (i = 0; i < 9 * m; ++i) {
+        if (i < 3 * m) phgmg__flush_tiny_rel(s->Gam + (size_t)i * (size_t)N, (size_t)N);
+        phgmg__flush_tiny_rel(s->GU + (size_t)i * (size_t)N, (size_t)N);
+      }
+    }
     *out = s;
     return PHGMG_OK;
   }
@@ -4704,6 +4737,7 @@ PHGMG_DEF phgmg_result phgmg_gl3_step(phgmg_gl3 *s, double t, double *x, phgmg_i
   if (s->mode == PHGMG__GL3_MAP) {
     rc = phgmg__gl3_step_map(s, x, energy_inc);
     if (rc != PHGMG_OK) { s->st.failures++; return rc; }
+    if (s->flush) phgmg__flush_tiny_rel(s->xnew, (size_t)N); /* O(N) against the O(N^2) map */
     memcpy(x, s->xnew, sizeof(double) * (size_t)N);
     s->st.steps++;
     return PHGMG_OK;

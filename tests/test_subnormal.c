@@ -91,6 +91,37 @@ TEST(test_gl3_flush_agrees_with_unflushed) {
   msd_nonlinear_free(&M);
 }
 
+/* The same for the linear dense chain stepped by the precomputed map (its
+   matrices and the state flushed): agreement to far below the tolerance. */
+TEST(test_gl3_map_flush_agrees) {
+  msd_linear L;
+  phgmg_gl3_opts g;
+  enum { NL = 300, NSL = 200 };
+  size_t len = (size_t)NL * (NSL + 1), i;
+  double *Xf = (double *)calloc(len, sizeof(double)), *Xk = (double *)calloc(len, sizeof(double));
+  double x0[NL], dmax = 0.0;
+  long sub_f = 0, sub_k = 0;
+  CHECK(msd_linear_build(&L, NL / 2, NULL, NULL, NULL, PHGMG_DENSE) == 0);
+  memset(&g, 0, sizeof g);
+  memset(x0, 0, sizeof x0);
+  CHECK_RC(phgmg_simulate(&L.sys, x0, 0.0, 0.1, NSL, msd_input_sin, NULL, &g, Xf, NULL, NULL, NULL,
+                          NULL, NULL), PHGMG_OK);
+  g.keep_tiny = 1;
+  CHECK_RC(phgmg_simulate(&L.sys, x0, 0.0, 0.1, NSL, msd_input_sin, NULL, &g, Xk, NULL, NULL, NULL,
+                          NULL, NULL), PHGMG_OK);
+  for (i = 0; i < len; ++i) {
+    sub_f += ts_subnormal(Xf[i]);
+    sub_k += ts_subnormal(Xk[i]);
+    dmax = fmax(dmax, fabs(Xf[i] - Xk[i]));
+  }
+  CHECK(sub_k > 100);
+  CHECK(sub_f == 0);
+  CHECK_LE(dmax, 1e-14); /* rounding: the map is exact, only 1e-60-relative entries differ */
+  msd_linear_free(&L);
+  free(Xf);
+  free(Xk);
+}
+
 #if TS_MXCSR
 #define TS_DE 0x0002u /* MXCSR denormal-operand flag */
 #endif
@@ -99,20 +130,23 @@ TEST(test_gl3_flush_agrees_with_unflushed) {
    produced a tiny inexact result (FE_UNDERFLOW): after the first two steps
    from rest (whose flush threshold cannot know the state's scale yet), the
    chain runs without either; without flushing (keep_tiny) both are raised. */
-static int ts_tiny_arith(int keep_tiny, int *de) {
+static int ts_tiny_arith(int keep_tiny, int linear, int *de) {
   msd_nonlinear M;
+  msd_linear L;
   phgmg_gl3_opts g;
   phgmg_gl3 *s = NULL;
   double x[TS_N];
   int n, uf = -1;
   *de = -1;
   if (ts_chain(&M, TS_N) != 0) return -1;
+  /* linear: the dense chain with N = 300, stepped by the precomputed map */
+  if (msd_linear_build(&L, 150, NULL, NULL, NULL, PHGMG_DENSE) != 0) { msd_nonlinear_free(&M); return -1; }
   memset(&g, 0, sizeof g);
   g.tol = TS_TOL;
   g.max_iter = 20;
   g.keep_tiny = keep_tiny;
   memset(x, 0, sizeof x);
-  if (phgmg_gl3_create(&s, &M.sys, 0.1, &g, NULL) == PHGMG_OK) {
+  if (phgmg_gl3_create(&s, linear ? &L.sys : &M.sys, 0.1, &g, NULL) == PHGMG_OK) {
     for (n = 0; n < 2; ++n) phgmg_gl3_step(s, 0.1 * n, x, msd_input_sin, NULL, NULL);
     feclearexcept(FE_ALL_EXCEPT);
 #if TS_MXCSR
@@ -128,19 +162,22 @@ static int ts_tiny_arith(int keep_tiny, int *de) {
   }
   phgmg_gl3_destroy(s);
   msd_nonlinear_free(&M);
+  msd_linear_free(&L);
   return uf;
 }
 
 TEST(test_gl3_no_subnormal_arithmetic) {
-  int de_f, de_k, uf_f, uf_k;
-  uf_f = ts_tiny_arith(0, &de_f);
-  uf_k = ts_tiny_arith(1, &de_k);
-  CHECK(uf_k == 1); /* the check can fail: without flushing the tail underflows */
-  CHECK(uf_f == 0);
+  int de_f, de_k, uf_f, uf_k, lin;
+  for (lin = 0; lin < 2; ++lin) { /* nonlinear banded (Newton), linear dense (step map) */
+    uf_f = ts_tiny_arith(0, lin, &de_f);
+    uf_k = ts_tiny_arith(1, lin, &de_k);
+    CHECK(uf_k == 1); /* the check can fail: without flushing the tail underflows */
+    CHECK(uf_f == 0);
 #if TS_MXCSR
-  CHECK(de_k == 1);
-  CHECK(de_f == 0);
+    CHECK(de_k == 1);
+    CHECK(de_f == 0);
 #endif
+  }
   feclearexcept(FE_ALL_EXCEPT);
 }
 
@@ -309,6 +346,7 @@ TEST(test_rom_step_flushes_subnormal) {
 
 SUITE(subnormal) {
   RUN(test_gl3_flush_agrees_with_unflushed);
+  RUN(test_gl3_map_flush_agrees);
   RUN(test_gl3_no_subnormal_arithmetic);
   RUN(test_fenv_unchanged);
   RUN(test_rom_step_flushes_subnormal);
