@@ -324,6 +324,7 @@ typedef struct phgmg_ph_system {
      when the nonlinearity is given this way. */
   int poly_deg;
   const double *poly;      /* poly_deg+1 coefficients, constant term first   */
+  int nexp; const double *expo; int phi_nfun; /*TMPB*/
   /* GENERAL */
   double (*H_nl)(const double *x, void *user);
   void (*grad_nl)(const double *x, double *g, void *user);
@@ -512,8 +513,15 @@ typedef enum phgmg_method {
   PHGMG_METHOD_GMG_POD = 1, /* phi = [B, Vbar] x, GMG reduction (paper 4.2.1)         */
   PHGMG_METHOD_GMG_QM = 2,  /* quadratic manifold, GMG reduction (paper 4.2.2)        */
   PHGMG_METHOD_SP1 = 3,     /* SP1-POD: phi = V_POD x, W = QV(V^TQV)^-1 (eq. 5.3)     */
-  PHGMG_METHOD_SP2 = 4      /* SP2-POD: W = V_gradH (V_POD^T V_gradH)^-1 (NUMERICS 6.3) */
+  PHGMG_METHOD_SP2 = 4,     /* SP2-POD: W = V_gradH (V_POD^T V_gradH)^-1 (NUMERICS 6.3) */
+  PHGMG_METHOD_GMG_MANIFOLD = 5 /* your own manifold phi = [B, V1] x + V2 eta(x2), GMG reduction */
 } phgmg_method;
+
+/* A manifold map eta: R^p -> R^rn (p = r - m) and its derivatives at x2:
+   q = eta(x2) (rn), Dq = d eta / d x2 (rn x p, column-major), D2q (rn x p*p):
+   D2q(:, k*p + j) = d^2 eta / dx2_k dx2_j. Any output may be NULL (not needed
+   by the caller). Used by phgmg_reduce_opts.eta and phgmg_rom.eta_cb. */
+typedef void (*phgmg_eta_fn)(const phgmg_real *x2, phgmg_real *q, phgmg_real *Dq, phgmg_real *D2q, void *user);
 
 #define PHGMG_ROM_MAGIC 0x50484731u /* "PHG1" */
 
@@ -547,6 +555,10 @@ typedef struct phgmg_rom {
   const phgmg_real *Gam;  /* r x 3m   (u3 = [u(t+c1 h); u(t+c2 h); u(t+c3 h)]) */
   const phgmg_real *SX;   /* 3r x r   */
   const phgmg_real *SU;   /* 3r x 3m  */
+  int nexp; int nphi; const phgmg_real *expo; /*TMPB*/
+  void (*phi_cb)(int term, phgmg_real s, phgmg_real d[3], void *user); const int *term; void *phi_user; /*TMPB*/
+  void (*eta_cb)(const phgmg_real *x2, phgmg_real *q, phgmg_real *Dq, phgmg_real *D2q, void *user); void *eta_user; /*TMPB*/
+  void (*ham_cb)(const phgmg_real *x, phgmg_real *Hn, phgmg_real *g, phgmg_real *Hs, void *user); void *ham_user; /*TMPB*/
 } phgmg_rom;
 
 /* Checks a model's sizes and pointers for consistency (not its values). */
@@ -710,6 +722,20 @@ typedef struct phgmg_reduce_opts {
   int lambda_blocks;     /* contiguous blocks, lambda_folds..ns (0: min(ns, 100)) */
   double lambda_rcond;   /* conditioning guard, relative to rcond(D^T G D) at x = 0,
                             in [0, 1] (0: 1e-6)                                  */
+  /* PHGMG_METHOD_GMG_MANIFOLD (required there, ignored otherwise): your own
+     manifold phi(x) = B x1 + V1 x2 + V2 eta(x2), x = (x1, x2), with eta:
+     R^p -> R^rn (p = r - m, rn = opts.rn >= 1) and its first and second
+     derivatives by this callback (see phgmg_eta_fn). This is the paper's
+     general embedding phi = B x1 + Vbar eta~(x2) with Vbar = [V1, V2] and
+     eta~(x2) = (x2, eta(x2)): the identity part keeps the point reduction
+     rho(x) = ([B, V1]^+ x) a left inverse of phi. V1, V2 come from the
+     hierarchical POD (as for GMG-QM) or from opts.pod_basis (checked to be
+     orthonormal and orthogonal to B: PHGMG_ERR_RANK otherwise). The reduced
+     model calls eta online (phgmg_rom.eta_cb); its online cost stays
+     independent of N (the same G- and Q-blocks as GMG-QM). GMG-QM is the
+     built-in case eta(x2) = M (x2 kron x2). */
+  phgmg_eta_fn eta;
+  void *eta_user;
 } phgmg_reduce_opts;
 
 typedef struct phgmg_reduce_info {
@@ -727,6 +753,12 @@ typedef struct phgmg_reduce_info {
   int lambda_grid;         /* lambda_auto: grid points tried (0 without)       */
   int lambda_raised;       /* lambda_auto: grid steps above the validated optimum
                               taken because of the non-degeneracy check         */
+  int online_full_dim;     /* 1: the reduced model evaluates a GENERAL nonlinear part
+                              in full dimension -- O(N) per gradient, O(N^2 r)
+                              (dense) or O(N kb r) (banded) per Hessian; it cannot
+                              be exported. 0: online cost independent of N. */
+  int online_callbacks;    /* 1: the reduced model calls back into user code
+                              (separable functions, eta or a GENERAL part)     */
 } phgmg_reduce_info;
 
 /* The reduced model with its offline data (bases for reconstruction, double
@@ -5205,8 +5237,15 @@ struct phgmg_reduced {
   int *coord;          /* nd: coordinates of the kept terms    */
   const phgmg_ph_system *sys;
   /* double blocks (same meaning as the phgmg_rom fields) */
-  double *Bh, *Qh, *K, *G00, *G01, *G10, *G11, *Q01, *Q11, *Ms, *P0, *P1, *w, *poly;
+  double *Bh, *Qh, *K, *G00, *G01, *G10, *G11, *Q01, *Q11, *Ms, *P0, *P1, *w;
   double *Phi, *Gam, *SX, *SU;
+  double *poly, *expo; /* separable functions (built-in family): nphi rows */
+  int nphi, nexp;
+  int *term;           /* nd: full-model index of each kept term */
+  phgmg_eta_fn eta;    /* GMG_MANIFOLD: the caller's eta          */
+  void *eta_user;
+  phgmg_real *rwork;   /* eta scratch: p + rn (1 + p + p^2)       */
+  double *gwork;       /* GENERAL part: full-dimension workspace  */
   double map_dt;       /* step of the precomputed map          */
   phgmg_rom rom;       /* views into the phgmg_real copies     */
 };
@@ -5545,6 +5584,98 @@ done:
   return rc;
 }
 
+/* The separable part uses the built-in exp-polynomial family (else callbacks). */
+PHGMG__PRIV int phgmg__sep_builtin(const phgmg_ph_system *s) { return s->poly_deg > 0 || s->nexp > 0; }
+
+/* eta and its derivatives at x2, in double: the built-in quadratic map
+   (q = M (x2 kron x2) = L x2 / 2, Dq = L, D2q = Ms) or the caller's eta
+   (GMG_MANIFOLD, in phgmg_real). Outputs may be NULL. rw: phgmg_real scratch
+   of p + rn (1 + p + p^2) entries, used with a callback only. */
+PHGMG__PRIV void phgmg__eta_d(const phgmg_reduced *red, const double *x2, double *q, double *Dq, double *D2q,
+                              phgmg_real *rw) {
+  const int p = red->p, rn = red->rn;
+  int i;
+  if (!red->eta) {
+    double Lb[64 * 64], *L = Dq ? Dq : Lb;
+    phgmg__lp_d(rn, p, red->Ms, x2, L);
+    if (q) phgmg_gemv('N', rn, p, 0.5, L, rn, x2, 0.0, q);
+    if (D2q) memcpy(D2q, red->Ms, (size_t)rn * p * p * sizeof(double));
+  } else {
+    phgmg_real *x2r = rw, *qr = x2r + p, *Dr = qr + rn, *D2r = Dr + (size_t)rn * p;
+    for (i = 0; i < p; ++i) x2r[i] = (phgmg_real)x2[i];
+    red->eta(x2r, q ? qr : NULL, Dq ? Dr : NULL, D2q ? D2r : NULL, red->eta_user);
+    if (q) for (i = 0; i < rn; ++i) q[i] = (double)qr[i];
+    if (Dq) for (i = 0; i < rn * p; ++i) Dq[i] = (double)Dr[i];
+    if (D2q) for (i = 0; i < rn * p * p; ++i) D2q[i] = (double)D2r[i];
+  }
+}
+
+/* Online callback of a separable part given by callbacks: evaluates the
+   system's phi_term and its derivatives (the reduced object is the context). */
+PHGMG__PRIV void phgmg__phi_tramp(int term, phgmg_real s, phgmg_real d[3], void *user) {
+  const phgmg_reduced *red = PHGMG__CAST(const phgmg_reduced *, user);
+  int k;
+  for (k = 0; k < 3; ++k) d[k] = (phgmg_real)phgmg__ph_phi(red->sys, term, (double)s, k);
+}
+
+/* Y (N x r) = Hs X for the Hessian of a GENERAL part, dense or banded like Q. */
+PHGMG__PRIV void phgmg__hess_apply(const phgmg_ph_system *sys, const double *Hs, int r, const double *X, double *Y) {
+  const int N = sys->N;
+  int i, j, a;
+  if (sys->storage == PHGMG_DENSE) {
+    phgmg_gemm('N', 'N', N, r, N, 1.0, Hs, N, X, N, 0.0, Y, N);
+    return;
+  }
+  memset(Y, 0, (size_t)N * r * sizeof(double));
+  for (a = 0; a < r; ++a)
+    for (j = 0; j < N; ++j) {
+      const double xj = X[j + (size_t)a * N];
+      const int i0 = PHGMG__MAX(0, j - sys->kb), i1 = PHGMG__MIN(N - 1, j + sys->kb);
+      for (i = i0; i <= i1; ++i) Y[i + (size_t)a * N] += Hs[PHGMG__PHB(sys->kb, i, j)] * xj;
+    }
+}
+
+/* Online callback of a GENERAL nonlinear part (phgmg_rom.ham_cb): H_nl(phi(x)),
+   Dphi^T grad H_nl(phi(x)) and Dphi^T Hess Dphi + sum_i (V2^T grad)_i D2eta_i,
+   in full dimension with the reduced object's workspace (so one reduced model
+   is not evaluated from two threads at once). */
+PHGMG__PRIV void phgmg__ham_general(const phgmg_real *x, phgmg_real *Hn, phgmg_real *g, phgmg_real *Hs, void *user) {
+  phgmg_reduced *red = PHGMG__CAST(phgmg_reduced *, user);
+  const phgmg_ph_system *sys = red->sys;
+  const int N = red->N, r = red->r, m = red->m, p = red->p, rn = red->rn;
+  const size_t nh = sys->storage == PHGMG_BANDED ? (size_t)(2 * sys->kb + 1) * N : (size_t)N * N;
+  double *xr = red->gwork, *xf = xr + r, *gf = xf + N, *HN = gf + N, *D = HN + nh, *T = D + (size_t)N * r;
+  double *v = T + (size_t)N * r, *D2 = v + rn, *Hr = D2 + (size_t)rn * p * p;
+  int a, b, i;
+  for (a = 0; a < r; ++a) xr[a] = (double)x[a];
+  phgmg_reduced_lift(red, xr, xf);
+  if (Hn) *Hn = (phgmg_real)sys->H_nl(xf, sys->user);
+  if (!g && !Hs) return;
+  sys->grad_nl(xf, gf, sys->user);
+  phgmg_reduced_dphi(red, xr, D, N);
+  if (g) {
+    phgmg_gemv('T', N, r, 1.0, D, N, gf, 0.0, Hr);
+    for (a = 0; a < r; ++a) g[a] = (phgmg_real)Hr[a];
+  }
+  if (!Hs) return;
+  sys->hess_nl(xf, HN, sys->user);
+  phgmg__hess_apply(sys, HN, r, D, T);
+  phgmg__atb(N, r, r, D, T, Hr);
+  if (red->kind == PHGMG_ROM_QUADRATIC) {   /* curvature of the manifold */
+    phgmg_gemv('T', N, rn, 1.0, red->V2, N, gf, 0.0, v);
+    phgmg__eta_d(red, xr + m, NULL, NULL, D2, red->rwork);
+    for (b = 0; b < p; ++b)
+      for (a = 0; a < p; ++a) {
+        double s = 0.0;
+        for (i = 0; i < rn; ++i) s += v[i] * D2[i + ((size_t)a * p + b) * rn];
+        Hr[(m + a) + (size_t)(m + b) * r] += s;
+      }
+  }
+  for (b = 0; b < r; ++b)   /* symmetric to round-off; make it exact */
+    for (a = 0; a < r; ++a) Hs[a + (size_t)b * r] = (phgmg_real)(0.5 * (Hr[a + (size_t)b * r] + Hr[b + (size_t)a * r]));
+}
+
+
 /* phgmg_real copy of a double array (NULL stays NULL). */
 PHGMG__PRIV phgmg_result phgmg__to_real(phgmg_reduced *red, const double *src, size_t n, const phgmg_real **dst) {
   phgmg_real *d;
@@ -5557,23 +5688,32 @@ PHGMG__PRIV phgmg_result phgmg__to_real(phgmg_reduced *red, const double *src, s
   return PHGMG_OK;
 }
 
+/* The online model: phgmg_real copies of the blocks, and the callbacks
+   through which it evaluates what has no fixed coefficients (separable
+   functions given by callbacks, the caller's eta, a GENERAL part). */
 PHGMG__PRIV phgmg_result phgmg__publish(phgmg_reduced *red) {
   const size_t r = (size_t)red->r, m = (size_t)red->m, rn = (size_t)red->rn, nd = (size_t)red->nd;
-  const size_t p = (size_t)red->p;
+  const size_t p = (size_t)red->p, nf = (size_t)(red->nphi > 1 ? red->nphi : 1);
   phgmg_rom *o = &red->rom;
   phgmg_result rc = PHGMG_OK;
   memset(o, 0, sizeof *o);
   o->kind = red->kind; o->method = red->method; o->r = red->r; o->m = red->m;
-  o->rn = red->rn; o->nd = red->nd; o->poly_deg = red->nd > 0 ? red->sys->poly_deg : 0;
+  o->rn = red->rn; o->nd = red->nd;
+  o->poly_deg = red->poly ? red->sys->poly_deg : 0;
+  o->nexp = red->nexp; o->nphi = red->nphi;
 #define PHGMG__PUB(field, n) if (rc == PHGMG_OK) rc = phgmg__to_real(red, red->field, (n), &o->field)
   PHGMG__PUB(Bh, r * m); PHGMG__PUB(Qh, r * r); PHGMG__PUB(K, r * r);
   PHGMG__PUB(G00, r * r); PHGMG__PUB(G01, r * rn); PHGMG__PUB(G10, rn * r); PHGMG__PUB(G11, rn * rn);
   PHGMG__PUB(Q01, r * rn); PHGMG__PUB(Q11, rn * rn); PHGMG__PUB(Ms, rn * p * p);
   PHGMG__PUB(P0, nd * r); PHGMG__PUB(P1, nd * rn); PHGMG__PUB(w, nd);
-  PHGMG__PUB(poly, (size_t)(o->poly_deg + 1));
+  PHGMG__PUB(poly, nf * (size_t)(o->poly_deg + 1)); PHGMG__PUB(expo, nf * 2 * (size_t)red->nexp);
   PHGMG__PUB(Phi, r * r); PHGMG__PUB(Gam, r * 3 * m); PHGMG__PUB(SX, 3 * r * r); PHGMG__PUB(SU, 3 * r * 3 * m);
 #undef PHGMG__PUB
   o->dt = red->Phi ? (phgmg_real)red->map_dt : (phgmg_real)0;
+  o->term = red->term;
+  if (nd > 0 && !red->poly && !red->expo) { o->phi_cb = phgmg__phi_tramp; o->phi_user = red; }
+  if (red->eta) { o->eta_cb = red->eta; o->eta_user = red->eta_user; }
+  if (red->gwork) { o->ham_cb = phgmg__ham_general; o->ham_user = red; }
   return rc;
 }
 
@@ -5722,362 +5862,614 @@ PHGMG__PRIV phgmg_result phgmg__qm_fit(phgmg_reduced *red, int ns, const double 
   return PHGMG_OK;
 }
 
-PHGMG_DEF phgmg_result phgmg_reduce(phgmg_reduced **out, const phgmg_ph_system *sys, const double *X,
-                                    int ldx, int ns, const phgmg_reduce_opts *opts,
-                                    phgmg_reduce_info *info, const phgmg_allocator *alloc) {
-  phgmg_reduced *red = NULL;
-  phgmg_jr_factor *jr = NULL;
+/* ---- phgmg_reduce: a pipeline of named stages ----------------------------
+   basis (phgmg__stage_basis) -> manifold fit (phgmg__stage_manifold) ->
+   reduction blocks (phgmg__stage_gmg_blocks / phgmg__stage_sp_blocks) ->
+   Hamiltonian terms (phgmg__stage_quadratic_terms, phgmg__stage_separable_terms,
+   phgmg__stage_general_term) -> step map -> publish. The stages share one
+   context; each frees what it allocates for itself, the context owns what
+   crosses stages (phgmg__rctx_free). */
+typedef struct phgmg__rctx {
+  phgmg_reduced *red;
+  const phgmg_ph_system *sys;
+  const phgmg_reduce_opts *o;
+  const double *X;
+  int ldx, ns;
+  const phgmg_allocator *alloc;
   phgmg_reduce_info inf;
-  phgmg_result rc;
-  double *T1 = NULL, *T2 = NULL, *T3 = NULL; /* temporaries */
-  double *Tq = NULL;   /* GMG-QM ridge problem: Kt, Rqt, Mt (kept for a refit) */
-  double *lg = NULL;   /* automatic lambda: grid and validation errors        */
-  int *pts = NULL;
-  int N, m, r, p, rn = 0, k = 0, i, j, a, ng = 0, gsel = -1;
-  double lambda, degtol, rfloor;
-  if (!out || !sys || !X || !opts) return PHGMG_ERR_INVALID_ARG;
-  *out = NULL;
-  memset(&inf, 0, sizeof inf);
-  N = sys->N; m = sys->m; r = opts->r;
+  double *Xa;              /* N x ns: X minus its part in span[B] (GMG), then minus V1 (QM) */
+  double rfloor, degtol, lambda;
+  int ng, gsel;            /* automatic lambda: grid size and chosen point (-1: fixed lambda) */
+  double *lg;              /* grid (ng) and validation errors (ng)          */
+  double *Tq;              /* ridge problem Kt, Rqt, Mt kept for a refit   */
+  phgmg_jr_factor *jr;     /* factorization of J - R (GMG)                 */
+} phgmg__rctx;
+
+PHGMG__PRIV void phgmg__rctx_free(phgmg__rctx *c) {
+  phgmg_jr_factor_destroy(c->jr);
+  phgmg__free(c->alloc, c->Xa);
+  phgmg__free(c->alloc, c->lg);
+  phgmg__free(c->alloc, c->Tq);
+  c->jr = NULL; c->Xa = c->lg = c->Tq = NULL;
+}
+
+PHGMG__PRIV int phgmg__is_gmg(int method) {
+  return method == PHGMG_METHOD_GMG_POD || method == PHGMG_METHOD_GMG_QM || method == PHGMG_METHOD_GMG_MANIFOLD;
+}
+
+/* Options and sizes; nothing allocated. */
+PHGMG__PRIV phgmg_result phgmg__reduce_check(const phgmg_ph_system *sys, const double *X, int ldx, int ns,
+                                             const phgmg_reduce_opts *o) {
+  const int N = sys->N, m = sys->m, r = o->r;
   if (N < 1 || m < 1 || ns < 1 || ldx < N) return PHGMG_ERR_SIZE;
-  if (opts->method < PHGMG_METHOD_GMG_POD || opts->method > PHGMG_METHOD_SP2) return PHGMG_ERR_INVALID_ARG;
-  if (opts->method == PHGMG_METHOD_GMG_POD || opts->method == PHGMG_METHOD_GMG_QM) {
+  if (o->method < PHGMG_METHOD_GMG_POD || o->method > PHGMG_METHOD_GMG_MANIFOLD) return PHGMG_ERR_INVALID_ARG;
+  if (phgmg__is_gmg(o->method)) {
     if (r <= m || r > N) return PHGMG_ERR_SIZE;
   } else if (r < 1 || r > N || r > ns) {
     return PHGMG_ERR_SIZE;
   }
-  if (sys->nl == PHGMG_NL_GENERAL) return PHGMG_ERR_UNSUPPORTED;
-  if (sys->nl == PHGMG_NL_SEPARABLE && (sys->poly_deg < 1 || !sys->poly)) return PHGMG_ERR_UNSUPPORTED;
+  if (o->method == PHGMG_METHOD_GMG_MANIFOLD && (!o->eta || o->rn < 1)) return PHGMG_ERR_INVALID_ARG;
+  if (o->deim != 0 && o->deim != 1) return PHGMG_ERR_INVALID_ARG;
+  if (o->deim && sys->nl == PHGMG_NL_GENERAL) return PHGMG_ERR_UNSUPPORTED;
+  if (!(o->deim_tol >= 0.0 && o->deim_tol < 1.0) || o->deim_max < 0) return PHGMG_ERR_INVALID_ARG;
+  if (!(o->dt >= 0.0) || o->dt == HUGE_VAL) return PHGMG_ERR_INVALID_ARG;
+  if (o->lambda != o->lambda || !(o->degeneracy_tol >= 0.0 && o->degeneracy_tol < 1.0)) return PHGMG_ERR_INVALID_ARG;
+  if (sys->nl == PHGMG_NL_SEPARABLE && sys->poly_deg > 32) return PHGMG_ERR_SIZE;
   if (!phgmg__mat_finite(N, ns, X, ldx)) return PHGMG_ERR_NANINF; /* padding rows are not data */
-  rc = phgmg_ph_validate(sys, 0.0, &inf.rcond_jr, alloc);
-  if (rc != PHGMG_OK) return rc;
-  lambda = opts->lambda == 0.0 ? 1e-3 : (opts->lambda < 0.0 ? 0.0 : opts->lambda);
-  if (opts->lambda_auto) {
-    const double lo = opts->lambda_min == 0.0 ? 1e-14 : opts->lambda_min;
-    const double hi = opts->lambda_max == 0.0 ? 1.0 : opts->lambda_max;
-    const int nf = opts->lambda_folds == 0 ? 5 : opts->lambda_folds;
-    const int nb = opts->lambda_blocks == 0 ? PHGMG__MIN(ns, 100) : opts->lambda_blocks;
-    if (opts->lambda_auto != 1 || opts->lambda_per_decade < 0 || nf < 2 || nb < 0) return PHGMG_ERR_INVALID_ARG;
-    if (!(opts->lambda_rcond >= 0.0 && opts->lambda_rcond <= 1.0)) return PHGMG_ERR_INVALID_ARG;
-    ng = phgmg__lambda_grid(lo, hi, opts->lambda_per_decade == 0 ? 4 : opts->lambda_per_decade, NULL);
-    if (ng < 1) return PHGMG_ERR_INVALID_ARG;
+  if (o->lambda_auto) {
+    const double lo = o->lambda_min == 0.0 ? 1e-14 : o->lambda_min;
+    const double hi = o->lambda_max == 0.0 ? 1.0 : o->lambda_max;
+    const int nf = o->lambda_folds == 0 ? 5 : o->lambda_folds;
+    const int nb = o->lambda_blocks == 0 ? PHGMG__MIN(ns, 100) : o->lambda_blocks;
+    if (o->lambda_auto != 1 || o->lambda_per_decade < 0 || nf < 2 || nb < 0) return PHGMG_ERR_INVALID_ARG;
+    if (!(o->lambda_rcond >= 0.0 && o->lambda_rcond <= 1.0)) return PHGMG_ERR_INVALID_ARG;
+    if (phgmg__lambda_grid(lo, hi, o->lambda_per_decade == 0 ? 4 : o->lambda_per_decade, NULL) < 1)
+      return PHGMG_ERR_INVALID_ARG;
     if (nb < nf || nb > ns) return PHGMG_ERR_SIZE;
   }
-  degtol = opts->degeneracy_tol > 0.0 ? opts->degeneracy_tol : 1e-12;
-  rfloor = phgmg__rank_floor(N, ns, X, ldx);
+  return PHGMG_OK;
+}
 
-  red = PHGMG__CAST(phgmg_reduced *, phgmg__alloc(alloc, sizeof(phgmg_reduced)));
+/* The reduced object with its sizes (no data yet). */
+PHGMG__PRIV phgmg_result phgmg__reduce_new(phgmg__rctx *c) {
+  const phgmg_reduce_opts *o = c->o;
+  phgmg_reduced *red = PHGMG__CAST(phgmg_reduced *, phgmg__alloc(c->alloc, sizeof(phgmg_reduced)));
   if (!red) return PHGMG_ERR_NOMEM;
   memset(red, 0, sizeof *red);
-  if (alloc) { red->alloc = *alloc; red->use_alloc = 1; }
-  red->N = N; red->m = m; red->r = r; red->method = opts->method; red->sys = sys;
-  red->kind = opts->method == PHGMG_METHOD_GMG_QM ? PHGMG_ROM_QUADRATIC : PHGMG_ROM_LINEAR;
-  p = (opts->method == PHGMG_METHOD_GMG_POD || opts->method == PHGMG_METHOD_GMG_QM) ? r - m : r;
-  red->p = p;
+  c->red = red;
+  if (c->alloc) { red->alloc = *c->alloc; red->use_alloc = 1; }
+  red->N = c->sys->N; red->m = c->sys->m; red->r = o->r; red->method = o->method; red->sys = c->sys;
+  red->kind = (o->method == PHGMG_METHOD_GMG_QM || o->method == PHGMG_METHOD_GMG_MANIFOLD)
+                  ? PHGMG_ROM_QUADRATIC : PHGMG_ROM_LINEAR;
+  red->p = phgmg__is_gmg(o->method) ? o->r - red->m : o->r;
   if (red->kind == PHGMG_ROM_QUADRATIC) {
-    rn = opts->rn > 0 ? opts->rn : 8;
-    /* the online q/Lp buffers of lift/dphi hold up to 64 x 64 */
-    if (rn > N - r || rn > 64 || rn * p > 64 * 64) { rc = PHGMG_ERR_SIZE; goto fail; }
+    red->rn = o->rn > 0 ? o->rn : 8;
+    /* the q/Lp buffers of lift/dphi hold up to 64 x 64 */
+    if (red->rn > red->N - red->r || red->rn > 64 || red->rn * red->p > 64 * 64) return PHGMG_ERR_SIZE;
   }
-  red->rn = rn;
+  if (o->method == PHGMG_METHOD_GMG_MANIFOLD) {
+    const size_t p = (size_t)red->p, rn = (size_t)red->rn;
+    red->eta = o->eta;
+    red->eta_user = o->eta_user;
+    red->rwork = PHGMG__CAST(phgmg_real *, phgmg__red_alloc(red, (p + rn * (1 + p + p * p)) * sizeof(phgmg_real)));
+    if (!red->rwork) return PHGMG_ERR_NOMEM;
+  }
+  return PHGMG_OK;
+}
 
-#define PHGMG__NEED(ptr) do { if (!(ptr)) { rc = PHGMG_ERR_NOMEM; goto fail; } } while (0)
-#define PHGMG__TRY(expr) do { rc = (expr); if (rc != PHGMG_OK) goto fail; } while (0)
-  red->V0 = phgmg__red_d(red, (size_t)N * r); PHGMG__NEED(red->V0);
-  red->QB = phgmg__red_d(red, (size_t)N * m); PHGMG__NEED(red->QB);
-  red->RB = phgmg__red_d(red, (size_t)m * m); PHGMG__NEED(red->RB);
-  PHGMG__TRY(phgmg__thin_qr(N, m, sys->B, red->QB, red->RB, alloc));
-  T1 = phgmg__dalloc(alloc, (size_t)N * ns); PHGMG__NEED(T1);
+/* A caller's basis (GMG: [V1, V2] from opts.pod_basis) must be orthonormal
+   and orthogonal to B; the hierarchical POD gives that by construction. */
+PHGMG__PRIV phgmg_result phgmg__check_given_basis(const phgmg_reduced *red, const double *V, int k,
+                                                   const phgmg_allocator *alloc) {
+  const int N = red->N, m = red->m;
+  double *G = phgmg__dalloc(alloc, (size_t)(k + m) * k);
+  double err = 0.0;
+  int i, j;
+  if (!G) return PHGMG_ERR_NOMEM;
+  phgmg__atb(N, k, k, V, V, G);
+  for (j = 0; j < k; ++j)
+    for (i = 0; i < k; ++i) err = PHGMG__MAX(err, fabs(G[i + (size_t)j * k] - (i == j ? 1.0 : 0.0)));
+  phgmg__atb(N, m, k, red->QB, V, G);
+  for (i = 0; i < m * k; ++i) err = PHGMG__MAX(err, fabs(G[i]));
+  phgmg__free(alloc, G);
+  return err <= 1e-8 ? PHGMG_OK : PHGMG_ERR_RANK;
+}
 
-  if (red->method == PHGMG_METHOD_GMG_POD || red->method == PHGMG_METHOD_GMG_QM) {
-    double *S = NULL;
-    /* V0 = [B, V1], V1 = POD of the adjusted snapshots X - B B^+ X */
-    for (j = 0; j < ns; ++j) memcpy(T1 + (size_t)j * N, X + (size_t)j * ldx, (size_t)N * sizeof(double));
-    T2 = phgmg__dalloc(alloc, (size_t)PHGMG__MAX(m, p + 1) * ns + (size_t)p + 2 + (size_t)rn); PHGMG__NEED(T2);
-    phgmg__orth_remove(N, m, red->QB, ns, T1, N, T2);
-    memcpy(red->V0, sys->B, (size_t)N * m * sizeof(double));
-    S = T2 + (size_t)PHGMG__MAX(m, p + 1) * ns;
-    if (opts->pod_basis) {
-      if (opts->pod_cols < p + rn) { rc = PHGMG_ERR_SIZE; goto fail; }
-      memcpy(red->V0 + (size_t)N * m, opts->pod_basis, (size_t)N * p * sizeof(double));
-    } else {
-      T3 = phgmg__dalloc(alloc, (size_t)N * (p + 1)); PHGMG__NEED(T3);
-      PHGMG__TRY(phgmg_pod(N, ns, T1, N, PHGMG__MIN(p + 1, PHGMG__MIN(N, ns)), 0.0, T3, N, S, &k, alloc));
-      if (k < p || !(S[p - 1] > rfloor)) { rc = PHGMG_ERR_SIZE; goto fail; } /* r - m > rank of the adjusted snapshots */
-      memcpy(red->V0 + (size_t)N * m, T3, (size_t)N * p * sizeof(double));
-      inf.pod_sigma_ratio = (k > p && S[0] > 0.0) ? S[p] / S[0] : 0.0;
-      phgmg__free(alloc, T3); T3 = NULL;
+/* Stage 1, basis. GMG: V0 = [B, V1], V1 = POD of the adjusted snapshots
+   X - B B^+ X (c->Xa keeps them, for the manifold stage). SP1/SP2: V0 =
+   V_POD of X. opts.pod_basis replaces the POD. */
+PHGMG__PRIV phgmg_result phgmg__stage_basis(phgmg__rctx *c) {
+  phgmg_reduced *red = c->red;
+  const int N = red->N, m = red->m, p = red->p, ns = c->ns;
+  const int need = p + (red->kind == PHGMG_ROM_QUADRATIC ? red->rn : 0);
+  double *S, *tmp;
+  int k = 0, j;
+  phgmg_result rc;
+  red->V0 = phgmg__red_d(red, (size_t)N * red->r);
+  red->QB = phgmg__red_d(red, (size_t)N * m);
+  red->RB = phgmg__red_d(red, (size_t)m * m);
+  if (!red->V0 || !red->QB || !red->RB) return PHGMG_ERR_NOMEM;
+  rc = phgmg__thin_qr(N, m, c->sys->B, red->QB, red->RB, c->alloc);
+  if (rc != PHGMG_OK) return rc;
+  if (c->o->pod_basis && c->o->pod_cols < need) return PHGMG_ERR_SIZE;
+  if (!phgmg__is_gmg(red->method)) {
+    if (c->o->pod_basis) {
+      memcpy(red->V0, c->o->pod_basis, (size_t)N * p * sizeof(double));
+      return PHGMG_OK;
     }
-    if (red->kind == PHGMG_ROM_QUADRATIC) {
-      double *Z2, *Rq, *Kt, *Rqt, *Mt;
-      /* residual of the linear part, then V2 = POD of it */
-      phgmg__orth_remove(N, p, red->V0 + (size_t)N * m, ns, T1, N, T2);
-      red->V2 = phgmg__red_d(red, (size_t)N * rn); PHGMG__NEED(red->V2);
-      if (opts->pod_basis) {
-        memcpy(red->V2, opts->pod_basis + (size_t)N * p, (size_t)N * rn * sizeof(double));
-      } else {
-        PHGMG__TRY(phgmg_pod(N, ns, T1, N, rn, 0.0, red->V2, N, S + p + 2, &k, alloc));
-        if (k < rn || !(S[p + 1 + rn] > rfloor)) { rc = PHGMG_ERR_SIZE; goto fail; }
-      }
-      /* M by the ridge problem (eq. least_square_reg) over the reduced snapshot
-         coordinates, in full Kronecker form. Columns (a,j) and (j,a) of
-         x2 kron x2 are equal, so the (unique) ridge solution has
-         M(:,(a,j)) = M(:,(j,a)); we solve the equivalent problem over the
-         p(p+1)/2 distinct columns (off-diagonal ones scaled by sqrt 2, unknown
-         t = sqrt 2 M(:,(a,j))) and expand. Same minimiser, 4x fewer flops.
-         opts.lambda_auto: lambda from the grid by validation on contiguous
-         blocks of snapshots (phgmg__ridge_cv), then the same fit on all. */
-      {
-        const int nc = p * (p + 1) / 2;
-        const double s2 = sqrt(2.0);
-        int c;
-        T3 = phgmg__dalloc(alloc, (size_t)p * ns + (size_t)rn * ns); PHGMG__NEED(T3);
-        Tq = phgmg__dalloc(alloc, (size_t)ns * nc + (size_t)ns * rn + (size_t)nc * rn); PHGMG__NEED(Tq);
-        Z2 = T3; Rq = Z2 + (size_t)p * ns; Kt = Tq; Rqt = Kt + (size_t)ns * nc; Mt = Rqt + (size_t)ns * rn;
-        phgmg_gemm('T', 'N', p, ns, N, 1.0, red->V0 + (size_t)N * m, N, X, ldx, 0.0, Z2, p);
-        phgmg_gemm('T', 'N', rn, ns, N, 1.0, red->V2, N, T1, N, 0.0, Rq, rn);
-        for (i = 0; i < ns; ++i) {
-          for (a = 0, c = 0; a < p; ++a)
-            for (j = a; j < p; ++j, ++c)
-              Kt[i + (size_t)c * ns] = (a == j ? 1.0 : s2) * Z2[a + (size_t)i * p] * Z2[j + (size_t)i * p];
-          for (a = 0; a < rn; ++a) Rqt[i + (size_t)a * ns] = Rq[a + (size_t)i * rn];
-        }
-        if (ng > 0) {
-          /* automatic lambda: validation over contiguous blocks of snapshots */
-          const int nfold = opts->lambda_folds == 0 ? 5 : opts->lambda_folds;
-          const int nblk = opts->lambda_blocks == 0 ? PHGMG__MIN(ns, 100) : opts->lambda_blocks;
-          double best;
-          lg = phgmg__dalloc(alloc, 2 * (size_t)ng); PHGMG__NEED(lg);
-          phgmg__lambda_grid(opts->lambda_min == 0.0 ? 1e-14 : opts->lambda_min,
-                             opts->lambda_max == 0.0 ? 1.0 : opts->lambda_max,
-                             opts->lambda_per_decade == 0 ? 4 : opts->lambda_per_decade, lg);
-          PHGMG__TRY(phgmg__ridge_cv(ns, nc, rn, Kt, ns, Rqt, ns, ng, lg,
-                                     nfold, nblk, lg + ng, alloc));
-          for (gsel = 0, c = 1; c < ng; ++c) if (lg[ng + c] < lg[ng + gsel]) gsel = c;
-          best = lg[ng + gsel];
-          for (c = ng - 1; c > gsel; --c) if (lg[ng + c] <= best * (1.0 + 1e-6)) { gsel = c; break; }
-          lambda = lg[gsel];
-          inf.lambda_cv_err = lg[ng + gsel];
-          inf.lambda_grid = ng;
-        }
-        PHGMG__TRY(phgmg__qm_fit(red, ns, Kt, Rqt, lambda, Mt, alloc));
-        inf.lambda = lambda;
-        if (gsel < 0) { phgmg__free(alloc, Tq); Tq = NULL; } /* no refit without the grid */
-      }
-      phgmg__free(alloc, T3); T3 = NULL;
-    }
-    /* G-blocks through a factorization of J - R */
-    PHGMG__TRY(phgmg_jr_factor_create(&jr, sys, NULL, alloc));
-    phgmg__free(alloc, T2);
-    T2 = phgmg__dalloc(alloc, (size_t)N * (r + rn)); PHGMG__NEED(T2);
-    memcpy(T2, red->V0, (size_t)N * r * sizeof(double));
-    if (rn) memcpy(T2 + (size_t)N * r, red->V2, (size_t)N * rn * sizeof(double));
-    phgmg_jr_solve(jr, 'N', r + rn, T2, N);           /* T2 = G [V0, V2] */
-    red->G00 = phgmg__red_d(red, (size_t)r * r); PHGMG__NEED(red->G00);
-    phgmg__atb(N, r, r, red->V0, T2, red->G00);
-    if (rn) {
-      red->G01 = phgmg__red_d(red, (size_t)r * rn); PHGMG__NEED(red->G01);
-      red->G10 = phgmg__red_d(red, (size_t)rn * r); PHGMG__NEED(red->G10);
-      red->G11 = phgmg__red_d(red, (size_t)rn * rn); PHGMG__NEED(red->G11);
-      phgmg__atb(N, r, rn, red->V0, T2 + (size_t)N * r, red->G01);
-      phgmg__atb(N, rn, r, red->V2, T2, red->G10);
-      phgmg__atb(N, rn, rn, red->V2, T2 + (size_t)N * r, red->G11);
-    }
-    red->Bh = phgmg__red_d(red, (size_t)r * m); PHGMG__NEED(red->Bh);
-    for (j = 0; j < m; ++j) red->Bh[j + (size_t)j * r] = 1.0;
-    /* non-degeneracy of D^T G D: at x = 0 and (QM) at every snapshot */
-    inf.rcond_dgd = phgmg__rcond_of(r, red->G00, alloc);
-    if (inf.rcond_dgd < 0.0) { rc = PHGMG_ERR_NOMEM; goto fail; }
-    if (red->kind == PHGMG_ROM_QUADRATIC) {
-      double *Lp, *E, *tmp, *x2;
-      /* automatic lambda: an M that (nearly) degenerates D^T G D somewhere on
-         the snapshots (rcond below lambda_rcond times its value at x = 0)
-         moves to the next larger grid lambda (M -> 0 as lambda grows, and
-         D^T G D -> G00, the matrix at x = 0) */
-      const double rc0 = inf.rcond_dgd;
-      const double lrc = rc0 * (opts->lambda_rcond == 0.0 ? 1e-6 : opts->lambda_rcond);
-      const int can_raise = gsel >= 0 && rc0 >= degtol;
-      T3 = phgmg__dalloc(alloc, (size_t)rn * p + (size_t)r * r + (size_t)rn * r + (size_t)p); PHGMG__NEED(T3);
-      Lp = T3; E = Lp + (size_t)rn * p; tmp = E + (size_t)r * r; x2 = tmp + (size_t)rn * r;
-      for (;;) {
-        const int nc = p * (p + 1) / 2;
-        const int more = can_raise && gsel + 1 < ng;
-        for (i = 0; i < ns; ++i) {
-          double rc_i;
-          phgmg_gemv('T', N, p, 1.0, red->V0 + (size_t)N * m, N, X + (size_t)i * ldx, 0.0, x2);
-          phgmg__lp_d(rn, p, red->Ms, x2, Lp);
-          phgmg__dgd_d(red, Lp, E, tmp);
-          rc_i = phgmg__rcond_of(r, E, alloc);
-          if (rc_i < 0.0) { rc = PHGMG_ERR_NOMEM; goto fail; }
-          if (rc_i < inf.rcond_dgd) inf.rcond_dgd = rc_i;
-          if (more && !(rc_i >= degtol && rc_i >= lrc)) break; /* raised anyway */
-        }
-        if ((inf.rcond_dgd >= degtol && inf.rcond_dgd >= lrc) || !more) break;
-        ++gsel;
-        ++inf.lambda_raised;
-        lambda = inf.lambda = lg[gsel];
-        inf.lambda_cv_err = lg[ng + gsel];
-        inf.rcond_dgd = rc0;
-        PHGMG__TRY(phgmg__qm_fit(red, ns, Tq, Tq + (size_t)ns * nc, lambda, Tq + (size_t)ns * (nc + rn), alloc));
-      }
-      phgmg__free(alloc, T3); T3 = NULL;
-    }
-    if (!(inf.rcond_dgd >= degtol)) { rc = PHGMG_ERR_DEGENERATE; goto fail; }
-    if (red->kind == PHGMG_ROM_LINEAR) {
-      red->K = phgmg__red_d(red, (size_t)r * r); PHGMG__NEED(red->K);
-      PHGMG__TRY(phgmg__inv(r, red->G00, red->K, alloc));
-    }
+    S = phgmg__dalloc(c->alloc, (size_t)p);
+    if (!S) return PHGMG_ERR_NOMEM;
+    rc = phgmg_pod(N, ns, c->X, c->ldx, p, 0.0, red->V0, N, S, &k, c->alloc);
+    if (rc == PHGMG_OK && (k < p || !(S[p - 1] > c->rfloor))) rc = PHGMG_ERR_SIZE;
+    phgmg__free(c->alloc, S);
+    return rc;
+  }
+  c->Xa = phgmg__dalloc(c->alloc, (size_t)N * ns);
+  tmp = phgmg__dalloc(c->alloc, (size_t)PHGMG__MAX(m, 1) * ns + (size_t)N * (p + 1) + (size_t)p + 1);
+  if (!c->Xa || !tmp) { phgmg__free(c->alloc, tmp); return PHGMG_ERR_NOMEM; }
+  for (j = 0; j < ns; ++j) memcpy(c->Xa + (size_t)j * N, c->X + (size_t)j * c->ldx, (size_t)N * sizeof(double));
+  phgmg__orth_remove(N, m, red->QB, ns, c->Xa, N, tmp);
+  memcpy(red->V0, c->sys->B, (size_t)N * m * sizeof(double));
+  if (c->o->pod_basis) {
+    memcpy(red->V0 + (size_t)N * m, c->o->pod_basis, (size_t)N * p * sizeof(double));
+    if (red->method == PHGMG_METHOD_GMG_MANIFOLD)
+      rc = phgmg__check_given_basis(red, c->o->pod_basis, need, c->alloc);
   } else {
-    /* SP1 / SP2: V0 = V_POD (r modes of X), W as in NUMERICS 6.3-6.4 */
-    double *Vg, *Ainv, *A2;
-    T3 = phgmg__dalloc(alloc, (size_t)N * r * 2 + 2 * (size_t)r * r + (size_t)r + 1); PHGMG__NEED(T3);
-    Vg = T3; A2 = Vg + (size_t)N * r; Ainv = A2 + (size_t)r * r;
-    if (opts->pod_basis) {
-      if (opts->pod_cols < r) { rc = PHGMG_ERR_SIZE; goto fail; }
-      memcpy(red->V0, opts->pod_basis, (size_t)N * r * sizeof(double));
-    } else {
-      PHGMG__TRY(phgmg_pod(N, ns, X, ldx, r, 0.0, red->V0, N, Ainv + (size_t)r * r, &k, alloc));
-      if (k < r || !(Ainv[(size_t)r * r + r - 1] > rfloor)) { rc = PHGMG_ERR_SIZE; goto fail; }
+    double *V1 = tmp + (size_t)PHGMG__MAX(m, 1) * ns;
+    S = V1 + (size_t)N * (p + 1);
+    rc = phgmg_pod(N, ns, c->Xa, N, PHGMG__MIN(p + 1, PHGMG__MIN(N, ns)), 0.0, V1, N, S, &k, c->alloc);
+    if (rc == PHGMG_OK && (k < p || !(S[p - 1] > c->rfloor))) rc = PHGMG_ERR_SIZE; /* r - m > rank */
+    if (rc == PHGMG_OK) {
+      memcpy(red->V0 + (size_t)N * m, V1, (size_t)N * p * sizeof(double));
+      c->inf.pod_sigma_ratio = (k > p && S[0] > 0.0) ? S[p] / S[0] : 0.0;
     }
-    if (red->method == PHGMG_METHOD_SP1) {
-      phgmg_ph_apply(sys, 'Q', r, red->V0, N, Vg, N);   /* Vg := Q V */
-    } else if (opts->grad_basis) {
-      if (opts->grad_cols < r) { rc = PHGMG_ERR_SIZE; goto fail; }
-      memcpy(Vg, opts->grad_basis, (size_t)N * r * sizeof(double));
-    } else {
-      for (j = 0; j < ns; ++j) phgmg_ph_gradient(sys, X + (size_t)j * ldx, T1 + (size_t)j * N);
-      PHGMG__TRY(phgmg_pod(N, ns, T1, N, r, 0.0, Vg, N, Ainv + (size_t)r * r, &k, alloc));
-      if (k < r || !(Ainv[(size_t)r * r + r - 1] > phgmg__rank_floor(N, ns, T1, N))) { rc = PHGMG_ERR_SIZE; goto fail; }
-    }
-    phgmg__atb(N, r, r, red->V0, Vg, A2);               /* V^T Vg */
-    inf.rcond_dgd = phgmg__rcond_of(r, A2, alloc);
-    if (inf.rcond_dgd < 0.0) { rc = PHGMG_ERR_NOMEM; goto fail; }
-    if (!(inf.rcond_dgd >= degtol)) { rc = PHGMG_ERR_DEGENERATE; goto fail; }
-    PHGMG__TRY(phgmg__inv(r, A2, Ainv, alloc));
-    red->W = phgmg__red_d(red, (size_t)N * r); PHGMG__NEED(red->W);
-    phgmg_gemm('N', 'N', N, r, r, 1.0, Vg, N, Ainv, r, 0.0, red->W, N); /* W = Vg (V^T Vg)^{-1} */
-    /* K = W^T (J - R) W, Bh = W^T B */
-    phgmg_ph_apply(sys, 'J', r, red->W, N, Vg, N);
-    phgmg_ph_apply(sys, 'R', r, red->W, N, T1, N);
-    for (i = 0; i < N * r; ++i) Vg[i] -= T1[i];
-    red->K = phgmg__red_d(red, (size_t)r * r); PHGMG__NEED(red->K);
-    phgmg__atb(N, r, r, red->W, Vg, red->K);
-    red->Bh = phgmg__red_d(red, (size_t)r * m); PHGMG__NEED(red->Bh);
-    phgmg__atb(N, r, m, red->W, sys->B, red->Bh);
-    phgmg__free(alloc, T3); T3 = NULL;
   }
+  phgmg__free(c->alloc, tmp);
+  return rc;
+}
 
-  /* quadratic part of H: Qh = V0^T Q V0 (and the V2 blocks) */
-  phgmg__free(alloc, T2);
-  T2 = phgmg__dalloc(alloc, (size_t)N * (r + rn)); PHGMG__NEED(T2);
-  phgmg_ph_apply(sys, 'Q', r, red->V0, N, T2, N);
-  if (rn) phgmg_ph_apply(sys, 'Q', rn, red->V2, N, T2 + (size_t)N * r, N);
-  red->Qh = phgmg__red_d(red, (size_t)r * r); PHGMG__NEED(red->Qh);
-  phgmg__atb(N, r, r, red->V0, T2, red->Qh);
-  for (j = 0; j < r; ++j)   /* exact symmetry */
-    for (i = 0; i < j; ++i) red->Qh[i + (size_t)j * r] = red->Qh[j + (size_t)i * r] = 0.5 * (red->Qh[i + (size_t)j * r] + red->Qh[j + (size_t)i * r]);
+/* GMG-QM ridge problem (eq. least_square_reg) over the reduced snapshot
+   coordinates, in full Kronecker form. Columns (a,j) and (j,a) of x2 kron x2
+   are equal, so the (unique) ridge solution has M(:,(a,j)) = M(:,(j,a)); the
+   equivalent problem over the p(p+1)/2 distinct columns (off-diagonal ones
+   scaled by sqrt 2, unknown t = sqrt 2 M(:,(a,j))) has the same minimiser
+   with 4x fewer flops. c->Tq = [Kt (ns x nc), Rqt (ns x rn), Mt (nc x rn)]. */
+PHGMG__PRIV phgmg_result phgmg__qm_problem(phgmg__rctx *c) {
+  phgmg_reduced *red = c->red;
+  const int N = red->N, m = red->m, p = red->p, rn = red->rn, ns = c->ns, nc = p * (p + 1) / 2;
+  const double s2 = sqrt(2.0);
+  double *Z2, *Rq, *Kt, *Rqt;
+  int i, a, j, cc;
+  Z2 = phgmg__dalloc(c->alloc, (size_t)p * ns + (size_t)rn * ns);
+  c->Tq = phgmg__dalloc(c->alloc, (size_t)ns * nc + (size_t)ns * rn + (size_t)nc * rn);
+  if (!Z2 || !c->Tq) { phgmg__free(c->alloc, Z2); return PHGMG_ERR_NOMEM; }
+  Rq = Z2 + (size_t)p * ns; Kt = c->Tq; Rqt = Kt + (size_t)ns * nc;
+  phgmg_gemm('T', 'N', p, ns, N, 1.0, red->V0 + (size_t)N * m, N, c->X, c->ldx, 0.0, Z2, p);
+  phgmg_gemm('T', 'N', rn, ns, N, 1.0, red->V2, N, c->Xa, N, 0.0, Rq, rn);
+  for (i = 0; i < ns; ++i) {
+    for (a = 0, cc = 0; a < p; ++a)
+      for (j = a; j < p; ++j, ++cc)
+        Kt[i + (size_t)cc * ns] = (a == j ? 1.0 : s2) * Z2[a + (size_t)i * p] * Z2[j + (size_t)i * p];
+    for (a = 0; a < rn; ++a) Rqt[i + (size_t)a * ns] = Rq[a + (size_t)i * rn];
+  }
+  phgmg__free(c->alloc, Z2);
+  return PHGMG_OK;
+}
+
+/* opts.lambda_auto: validation over contiguous blocks of snapshots picks the
+   grid lambda (ties within 1e-6 relative: the largest). */
+PHGMG__PRIV phgmg_result phgmg__qm_lambda_auto(phgmg__rctx *c) {
+  const phgmg_reduce_opts *o = c->o;
+  const int ns = c->ns, p = c->red->p, rn = c->red->rn, nc = p * (p + 1) / 2, ng = c->ng;
+  const int nfold = o->lambda_folds == 0 ? 5 : o->lambda_folds;
+  const int nblk = o->lambda_blocks == 0 ? PHGMG__MIN(ns, 100) : o->lambda_blocks;
+  double best, *lg;
+  int g;
+  phgmg_result rc;
+  lg = c->lg = phgmg__dalloc(c->alloc, 2 * (size_t)ng);
+  if (!lg) return PHGMG_ERR_NOMEM;
+  phgmg__lambda_grid(o->lambda_min == 0.0 ? 1e-14 : o->lambda_min, o->lambda_max == 0.0 ? 1.0 : o->lambda_max,
+                     o->lambda_per_decade == 0 ? 4 : o->lambda_per_decade, lg);
+  rc = phgmg__ridge_cv(ns, nc, rn, c->Tq, ns, c->Tq + (size_t)ns * nc, ns, ng, lg, nfold, nblk, lg + ng, c->alloc);
+  if (rc != PHGMG_OK) return rc;
+  for (c->gsel = 0, g = 1; g < ng; ++g) if (lg[ng + g] < lg[ng + c->gsel]) c->gsel = g;
+  best = lg[ng + c->gsel];
+  for (g = ng - 1; g > c->gsel; --g) if (lg[ng + g] <= best * (1.0 + 1e-6)) { c->gsel = g; break; }
+  c->lambda = lg[c->gsel];
+  c->inf.lambda_cv_err = lg[ng + c->gsel];
+  c->inf.lambda_grid = ng;
+  return PHGMG_OK;
+}
+
+/* Stage 2, manifold (QUADRATIC kind): V2 = POD of the residual of [B, V1]
+   (paper 4.2.2) or the caller's; then GMG-QM fits M (eq. least_square_reg,
+   lambda fixed or by validation); GMG_MANIFOLD takes the caller's eta. */
+PHGMG__PRIV phgmg_result phgmg__stage_manifold(phgmg__rctx *c) {
+  phgmg_reduced *red = c->red;
+  const int N = red->N, m = red->m, p = red->p, rn = red->rn, ns = c->ns;
+  phgmg_result rc = PHGMG_OK;
+  int k = 0;
+  if (red->kind != PHGMG_ROM_QUADRATIC) return PHGMG_OK;
+  red->V2 = phgmg__red_d(red, (size_t)N * rn);
+  if (!red->V2) return PHGMG_ERR_NOMEM;
+  {
+    double *tmp = phgmg__dalloc(c->alloc, (size_t)p * ns + (size_t)rn);
+    if (!tmp) return PHGMG_ERR_NOMEM;
+    phgmg__orth_remove(N, p, red->V0 + (size_t)N * m, ns, c->Xa, N, tmp);
+    if (c->o->pod_basis) {
+      memcpy(red->V2, c->o->pod_basis + (size_t)N * p, (size_t)N * rn * sizeof(double));
+    } else {
+      rc = phgmg_pod(N, ns, c->Xa, N, rn, 0.0, red->V2, N, tmp, &k, c->alloc);
+      if (rc == PHGMG_OK && (k < rn || !(tmp[rn - 1] > c->rfloor))) rc = PHGMG_ERR_SIZE;
+    }
+    phgmg__free(c->alloc, tmp);
+  }
+  if (rc != PHGMG_OK || red->method == PHGMG_METHOD_GMG_MANIFOLD) return rc;
+  rc = phgmg__qm_problem(c);
+  if (rc == PHGMG_OK && c->ng > 0) rc = phgmg__qm_lambda_auto(c);
+  if (rc == PHGMG_OK) {
+    const int nc = p * (p + 1) / 2;
+    rc = phgmg__qm_fit(red, ns, c->Tq, c->Tq + (size_t)ns * nc, c->lambda, c->Tq + (size_t)ns * (nc + rn), c->alloc);
+    c->inf.lambda = c->lambda;
+  }
+  if (c->gsel < 0) { phgmg__free(c->alloc, c->Tq); c->Tq = NULL; } /* no refit without the grid */
+  return rc;
+}
+
+/* Smallest rcond of D^T G D over the snapshots (QUADRATIC kind); with the
+   automatic lambda, stops early at the first snapshot that would raise it. */
+PHGMG__PRIV phgmg_result phgmg__dgd_rcond_snapshots(phgmg__rctx *c, double stop_below, double *rmin) {
+  phgmg_reduced *red = c->red;
+  const int N = red->N, m = red->m, p = red->p, rn = red->rn, r = red->r;
+  double *Lp, *E, *tmp, *x2;
+  int i;
+  Lp = phgmg__dalloc(c->alloc, (size_t)rn * p + (size_t)r * r + (size_t)rn * r + (size_t)p);
+  if (!Lp) return PHGMG_ERR_NOMEM;
+  E = Lp + (size_t)rn * p; tmp = E + (size_t)r * r; x2 = tmp + (size_t)rn * r;
+  for (i = 0; i < c->ns; ++i) {
+    double rc_i;
+    phgmg_gemv('T', N, p, 1.0, red->V0 + (size_t)N * m, N, c->X + (size_t)i * c->ldx, 0.0, x2);
+    phgmg__eta_d(red, x2, NULL, Lp, NULL, red->rwork);
+    phgmg__dgd_d(red, Lp, E, tmp);
+    rc_i = phgmg__rcond_of(r, E, c->alloc);
+    if (rc_i < 0.0) { phgmg__free(c->alloc, Lp); return PHGMG_ERR_NOMEM; }
+    if (rc_i < *rmin) *rmin = rc_i;
+    if (!(rc_i >= stop_below)) break;
+  }
+  phgmg__free(c->alloc, Lp);
+  return PHGMG_OK;
+}
+
+/* Non-degeneracy of D^T G D at x = 0 and (QUADRATIC) at every snapshot. With
+   the automatic lambda, an M that (nearly) degenerates it (rcond below
+   lambda_rcond times its value at x = 0) moves to the next larger grid
+   lambda (M -> 0 as lambda grows, and D^T G D -> G00). */
+PHGMG__PRIV phgmg_result phgmg__check_degeneracy(phgmg__rctx *c) {
+  phgmg_reduced *red = c->red;
+  const double rc0 = phgmg__rcond_of(red->r, red->G00, c->alloc);
+  const double lrc = rc0 * (c->o->lambda_rcond == 0.0 ? 1e-6 : c->o->lambda_rcond);
+  const int can_raise = c->gsel >= 0 && rc0 >= c->degtol;
+  phgmg_result rc;
+  if (rc0 < 0.0) return PHGMG_ERR_NOMEM;
+  c->inf.rcond_dgd = rc0;
+  while (red->kind == PHGMG_ROM_QUADRATIC) {
+    const int more = can_raise && c->gsel + 1 < c->ng;
+    const int nc = red->p * (red->p + 1) / 2;
+    rc = phgmg__dgd_rcond_snapshots(c, more ? PHGMG__MAX(c->degtol, lrc) : -1.0, &c->inf.rcond_dgd);
+    if (rc != PHGMG_OK) return rc;
+    if ((c->inf.rcond_dgd >= c->degtol && c->inf.rcond_dgd >= lrc) || !more) break;
+    ++c->gsel;
+    ++c->inf.lambda_raised;
+    c->lambda = c->inf.lambda = c->lg[c->gsel];
+    c->inf.lambda_cv_err = c->lg[c->ng + c->gsel];
+    c->inf.rcond_dgd = rc0;
+    rc = phgmg__qm_fit(red, c->ns, c->Tq, c->Tq + (size_t)c->ns * nc, c->lambda,
+                       c->Tq + (size_t)c->ns * (nc + red->rn), c->alloc);
+    if (rc != PHGMG_OK) return rc;
+  }
+  return c->inf.rcond_dgd >= c->degtol ? PHGMG_OK : PHGMG_ERR_DEGENERATE;
+}
+
+/* Stage 3a, GMG blocks (paper 4.2): G = (J - R)^{-1} through a factorization,
+   G00 = V0^T G V0 (and the V2 blocks), Bh = [I; 0], the non-degeneracy
+   check, and K = G00^{-1} for the linear map. */
+PHGMG__PRIV phgmg_result phgmg__stage_gmg_blocks(phgmg__rctx *c) {
+  phgmg_reduced *red = c->red;
+  const int N = red->N, m = red->m, r = red->r, rn = red->rn;
+  double *GV;
+  int j;
+  phgmg_result rc = phgmg_jr_factor_create(&c->jr, c->sys, NULL, c->alloc);
+  if (rc != PHGMG_OK) return rc;
+  GV = phgmg__dalloc(c->alloc, (size_t)N * (r + rn));
+  if (!GV) return PHGMG_ERR_NOMEM;
+  memcpy(GV, red->V0, (size_t)N * r * sizeof(double));
+  if (rn) memcpy(GV + (size_t)N * r, red->V2, (size_t)N * rn * sizeof(double));
+  phgmg_jr_solve(c->jr, 'N', r + rn, GV, N);           /* GV = G [V0, V2] */
+  red->G00 = phgmg__red_d(red, (size_t)r * r);
+  red->Bh = phgmg__red_d(red, (size_t)r * m);
   if (rn) {
-    red->Q01 = phgmg__red_d(red, (size_t)r * rn); PHGMG__NEED(red->Q01);
-    red->Q11 = phgmg__red_d(red, (size_t)rn * rn); PHGMG__NEED(red->Q11);
-    phgmg__atb(N, r, rn, red->V0, T2 + (size_t)N * r, red->Q01);
-    phgmg__atb(N, rn, rn, red->V2, T2 + (size_t)N * r, red->Q11);
+    red->G01 = phgmg__red_d(red, (size_t)r * rn);
+    red->G10 = phgmg__red_d(red, (size_t)rn * r);
+    red->G11 = phgmg__red_d(red, (size_t)rn * rn);
   }
+  if (!red->G00 || !red->Bh || (rn && (!red->G01 || !red->G10 || !red->G11))) {
+    phgmg__free(c->alloc, GV);
+    return PHGMG_ERR_NOMEM;
+  }
+  phgmg__atb(N, r, r, red->V0, GV, red->G00);
+  if (rn) {
+    phgmg__atb(N, r, rn, red->V0, GV + (size_t)N * r, red->G01);
+    phgmg__atb(N, rn, r, red->V2, GV, red->G10);
+    phgmg__atb(N, rn, rn, red->V2, GV + (size_t)N * r, red->G11);
+  }
+  phgmg__free(c->alloc, GV);
+  for (j = 0; j < m; ++j) red->Bh[j + (size_t)j * r] = 1.0;
+  rc = phgmg__check_degeneracy(c);
+  if (rc != PHGMG_OK || red->kind != PHGMG_ROM_LINEAR) return rc;
+  red->K = phgmg__red_d(red, (size_t)r * r);
+  if (!red->K) return PHGMG_ERR_NOMEM;
+  return phgmg__inv(r, red->G00, red->K, c->alloc);
+}
 
-  /* separable nonlinear part: structure-preserving DEIM or every term */
-  if (sys->nl == PHGMG_NL_SEPARABLE && sys->nsep > 0) {
-    const int nt = sys->nsep;
-    int nd = 0, nneg = 0;
-    double *wt;
-    pts = phgmg__ialloc(alloc, (size_t)nt); PHGMG__NEED(pts);
-    wt = phgmg__dalloc(alloc, (size_t)nt); PHGMG__NEED(wt);
-    if (opts->deim && opts->deim_pts && opts->deim_w) {
-      if (opts->deim_count < 1 || opts->deim_count > nt) { phgmg__free(alloc, wt); rc = PHGMG_ERR_SIZE; goto fail; }
-      nd = opts->deim_count;
-      for (a = 0; a < nd; ++a) {
-        if (opts->deim_pts[a] < 0 || opts->deim_pts[a] >= nt) { phgmg__free(alloc, wt); rc = PHGMG_ERR_INVALID_ARG; goto fail; }
-        pts[a] = opts->deim_pts[a];
-        wt[a] = opts->deim_w[a];
-        if (wt[a] < 0.0) ++nneg;
-      }
-      inf.deim_modes = nd;
-      inf.deim_negative = nneg;
-      if (!phgmg__all_finite(wt, (size_t)nd)) { phgmg__free(alloc, wt); rc = PHGMG_ERR_NANINF; goto fail; }
-      if (nneg > 0 && !opts->deim_allow_negative) { phgmg__free(alloc, wt); rc = PHGMG_ERR_NEGATIVE_WEIGHT; goto fail; }
-    } else if (opts->deim) {
-      double *F = phgmg__dalloc(alloc, (size_t)nt * ns);
-      if (!F) { phgmg__free(alloc, wt); rc = PHGMG_ERR_NOMEM; goto fail; }
-      for (i = 0; i < ns; ++i)
-        for (a = 0; a < nt; ++a)
-          F[a + (size_t)i * nt] = phgmg__poly_d1(sys->poly, sys->poly_deg, X[sys->sep_idx[a] + (size_t)i * ldx]);
-      rc = phgmg_deim(nt, ns, F, nt, sys->sep_w, opts->deim_tol, opts->deim_max, pts, wt, &nd, &nneg,
-                      &inf.deim_sigma_ratio, alloc);
-      phgmg__free(alloc, F);
-      inf.deim_modes = nd;      /* reported on PHGMG_ERR_NEGATIVE_WEIGHT too */
-      inf.deim_negative = nneg;
-      if (rc == PHGMG_OK && nneg > 0 && !opts->deim_allow_negative) rc = PHGMG_ERR_NEGATIVE_WEIGHT;
-      if (rc != PHGMG_OK) { phgmg__free(alloc, wt); goto fail; }
-    } else {
-      nd = nt;
-      for (a = 0; a < nt; ++a) { pts[a] = a; wt[a] = sys->sep_w ? sys->sep_w[a] : 1.0; }
+/* The test basis of SP1 (Q V) or SP2 (POD of the gradient snapshots) into Vg. */
+PHGMG__PRIV phgmg_result phgmg__sp_test_basis(phgmg__rctx *c, double *Vg) {
+  phgmg_reduced *red = c->red;
+  const int N = red->N, r = red->r, ns = c->ns;
+  double *Fg, *S;
+  int j, k = 0;
+  phgmg_result rc;
+  if (red->method == PHGMG_METHOD_SP1) {
+    phgmg_ph_apply(c->sys, 'Q', r, red->V0, N, Vg, N);
+    return PHGMG_OK;
+  }
+  if (c->o->grad_basis) {
+    if (c->o->grad_cols < r) return PHGMG_ERR_SIZE;
+    memcpy(Vg, c->o->grad_basis, (size_t)N * r * sizeof(double));
+    return PHGMG_OK;
+  }
+  Fg = phgmg__dalloc(c->alloc, (size_t)N * ns + (size_t)r);
+  if (!Fg) return PHGMG_ERR_NOMEM;
+  S = Fg + (size_t)N * ns;
+  for (j = 0; j < ns; ++j) phgmg_ph_gradient(c->sys, c->X + (size_t)j * c->ldx, Fg + (size_t)j * N);
+  rc = phgmg_pod(N, ns, Fg, N, r, 0.0, Vg, N, S, &k, c->alloc);
+  if (rc == PHGMG_OK && (k < r || !(S[r - 1] > phgmg__rank_floor(N, ns, Fg, N)))) rc = PHGMG_ERR_SIZE;
+  phgmg__free(c->alloc, Fg);
+  return rc;
+}
+
+/* Stage 3b, SP1/SP2 blocks (NUMERICS 6.3-6.4): W = Vg (V^T Vg)^{-1},
+   K = W^T (J - R) W, Bh = W^T B. */
+PHGMG__PRIV phgmg_result phgmg__stage_sp_blocks(phgmg__rctx *c) {
+  phgmg_reduced *red = c->red;
+  const int N = red->N, r = red->r, m = red->m;
+  double *Vg, *A2, *Ainv, *T;
+  int i;
+  phgmg_result rc;
+  Vg = phgmg__dalloc(c->alloc, 2 * (size_t)N * r + 2 * (size_t)r * r);
+  if (!Vg) return PHGMG_ERR_NOMEM;
+  T = Vg + (size_t)N * r; A2 = T + (size_t)N * r; Ainv = A2 + (size_t)r * r;
+  rc = phgmg__sp_test_basis(c, Vg);
+  if (rc == PHGMG_OK) {
+    phgmg__atb(N, r, r, red->V0, Vg, A2);               /* V^T Vg */
+    c->inf.rcond_dgd = phgmg__rcond_of(r, A2, c->alloc);
+    if (c->inf.rcond_dgd < 0.0) rc = PHGMG_ERR_NOMEM;
+    else if (!(c->inf.rcond_dgd >= c->degtol)) rc = PHGMG_ERR_DEGENERATE;
+  }
+  if (rc == PHGMG_OK) rc = phgmg__inv(r, A2, Ainv, c->alloc);
+  if (rc == PHGMG_OK) {
+    red->W = phgmg__red_d(red, (size_t)N * r);
+    red->K = phgmg__red_d(red, (size_t)r * r);
+    red->Bh = phgmg__red_d(red, (size_t)r * m);
+    if (!red->W || !red->K || !red->Bh) rc = PHGMG_ERR_NOMEM;
+  }
+  if (rc == PHGMG_OK) {
+    phgmg_gemm('N', 'N', N, r, r, 1.0, Vg, N, Ainv, r, 0.0, red->W, N);
+    phgmg_ph_apply(c->sys, 'J', r, red->W, N, Vg, N);
+    phgmg_ph_apply(c->sys, 'R', r, red->W, N, T, N);
+    for (i = 0; i < N * r; ++i) Vg[i] -= T[i];
+    phgmg__atb(N, r, r, red->W, Vg, red->K);
+    phgmg__atb(N, r, m, red->W, c->sys->B, red->Bh);
+  }
+  phgmg__free(c->alloc, Vg);
+  return rc;
+}
+
+/* Stage 4a, quadratic part of H: Qh = V0^T Q V0 (exactly symmetric), and
+   the V2 blocks Q01 = V0^T Q V2, Q11 = V2^T Q V2. */
+PHGMG__PRIV phgmg_result phgmg__stage_quadratic_terms(phgmg__rctx *c) {
+  phgmg_reduced *red = c->red;
+  const int N = red->N, r = red->r, rn = red->rn;
+  double *QV = phgmg__dalloc(c->alloc, (size_t)N * (r + rn));
+  int i, j;
+  red->Qh = phgmg__red_d(red, (size_t)r * r);
+  if (rn) {
+    red->Q01 = phgmg__red_d(red, (size_t)r * rn);
+    red->Q11 = phgmg__red_d(red, (size_t)rn * rn);
+  }
+  if (!QV || !red->Qh || (rn && (!red->Q01 || !red->Q11))) { phgmg__free(c->alloc, QV); return PHGMG_ERR_NOMEM; }
+  phgmg_ph_apply(c->sys, 'Q', r, red->V0, N, QV, N);
+  if (rn) phgmg_ph_apply(c->sys, 'Q', rn, red->V2, N, QV + (size_t)N * r, N);
+  phgmg__atb(N, r, r, red->V0, QV, red->Qh);
+  for (j = 0; j < r; ++j)
+    for (i = 0; i < j; ++i)
+      red->Qh[i + (size_t)j * r] = red->Qh[j + (size_t)i * r] =
+          0.5 * (red->Qh[i + (size_t)j * r] + red->Qh[j + (size_t)i * r]);
+  if (rn) {
+    phgmg__atb(N, r, rn, red->V0, QV + (size_t)N * r, red->Q01);
+    phgmg__atb(N, rn, rn, red->V2, QV + (size_t)N * r, red->Q11);
+  }
+  phgmg__free(c->alloc, QV);
+  return PHGMG_OK;
+}
+
+/* Points and weights of the separable sum: the caller's (opts.deim_pts),
+   structure-preserving DEIM on the snapshots of the terms' gradients, or
+   every term with its own weight. pts/wt have room for nsep entries. */
+PHGMG__PRIV phgmg_result phgmg__separable_points(phgmg__rctx *c, int *pts, double *wt, int *nd) {
+  const phgmg_ph_system *sys = c->sys;
+  const phgmg_reduce_opts *o = c->o;
+  const int nt = sys->nsep, ns = c->ns;
+  int a, i, nneg = 0;
+  phgmg_result rc = PHGMG_OK;
+  if (o->deim && o->deim_pts && o->deim_w) {
+    if (o->deim_count < 1 || o->deim_count > nt) return PHGMG_ERR_SIZE;
+    *nd = o->deim_count;
+    for (a = 0; a < *nd; ++a) {
+      if (o->deim_pts[a] < 0 || o->deim_pts[a] >= nt) return PHGMG_ERR_INVALID_ARG;
+      pts[a] = o->deim_pts[a];
+      wt[a] = o->deim_w[a];
+      if (wt[a] < 0.0) ++nneg;
     }
-    inf.deim_modes = nd;
-    inf.deim_negative = nneg;
+    if (!phgmg__all_finite(wt, (size_t)*nd)) return PHGMG_ERR_NANINF;
+  } else if (o->deim) {
+    double *F = phgmg__dalloc(c->alloc, (size_t)nt * ns);
+    if (!F) return PHGMG_ERR_NOMEM;
+    for (i = 0; i < ns; ++i)
+      for (a = 0; a < nt; ++a)
+        F[a + (size_t)i * nt] = phgmg__ph_phi(sys, a, c->X[sys->sep_idx[a] + (size_t)i * c->ldx], 1);
+    rc = phgmg_deim(nt, ns, F, nt, sys->sep_w, o->deim_tol, o->deim_max, pts, wt, nd, &nneg,
+                    &c->inf.deim_sigma_ratio, c->alloc);
+    phgmg__free(c->alloc, F);
+  } else {
+    *nd = nt;
+    for (a = 0; a < nt; ++a) { pts[a] = a; wt[a] = sys->sep_w ? sys->sep_w[a] : 1.0; }
+  }
+  c->inf.deim_modes = *nd;      /* reported on PHGMG_ERR_NEGATIVE_WEIGHT too */
+  c->inf.deim_negative = nneg;
+  if (rc == PHGMG_OK && nneg > 0 && !o->deim_allow_negative) rc = PHGMG_ERR_NEGATIVE_WEIGHT;
+  return rc;
+}
+
+/* The scalar functions of the kept terms: the built-in exp-polynomial family
+   (shared, or one row per kept term) or, for callbacks, the full-model index
+   of each kept term (the online model calls back through the system). */
+PHGMG__PRIV phgmg_result phgmg__separable_functions(phgmg_reduced *red, const int *pts) {
+  const phgmg_ph_system *sys = red->sys;
+  const int nd = red->nd, deg = sys->poly_deg, ne = sys->nexp;
+  const int per = sys->phi_nfun > 1, nf = per ? nd : 1;
+  int j;
+  red->term = PHGMG__CAST(int *, phgmg__red_alloc(red, (size_t)nd * sizeof(int)));
+  if (!red->term) return PHGMG_ERR_NOMEM;
+  for (j = 0; j < nd; ++j) red->term[j] = pts[j];
+  if (!phgmg__sep_builtin(sys)) return PHGMG_OK;  /* callbacks */
+  red->nphi = per ? nd : 1;
+  red->nexp = ne;
+  red->poly = phgmg__red_d(red, (size_t)nf * (deg + 1));
+  red->expo = ne ? phgmg__red_d(red, (size_t)nf * 2 * ne) : NULL;
+  if (!red->poly || (ne && !red->expo)) return PHGMG_ERR_NOMEM;
+  for (j = 0; j < nf; ++j) {
+    const int t = per ? pts[j] : 0;
+    if (sys->poly) memcpy(red->poly + (size_t)j * (deg + 1), sys->poly + (size_t)t * (deg + 1), ((size_t)deg + 1) * sizeof(double));
+    if (ne) memcpy(red->expo + (size_t)j * 2 * ne, sys->expo + (size_t)t * 2 * ne, 2 * (size_t)ne * sizeof(double));
+  }
+  return PHGMG_OK;
+}
+
+/* Stage 4b, separable nonlinear part sum_k w_k phi_k(x_{idx_k}): kept terms
+   (DEIM or all), their weights, and the rows P0 = V0(idx, :), P1 = V2(idx, :)
+   through which the online model evaluates them. */
+PHGMG__PRIV phgmg_result phgmg__stage_separable_terms(phgmg__rctx *c) {
+  phgmg_reduced *red = c->red;
+  const int N = red->N, r = red->r, rn = red->rn, nt = c->sys->nsep;
+  int *pts, nd = 0, j, a;
+  double *wt;
+  phgmg_result rc;
+  if (c->sys->nl != PHGMG_NL_SEPARABLE || nt < 1) return PHGMG_OK;
+  pts = phgmg__ialloc(c->alloc, (size_t)nt);
+  wt = phgmg__dalloc(c->alloc, (size_t)nt);
+  rc = (pts && wt) ? phgmg__separable_points(c, pts, wt, &nd) : PHGMG_ERR_NOMEM;
+  if (rc == PHGMG_OK) {
     red->nd = nd;
     red->coord = PHGMG__CAST(int *, phgmg__red_alloc(red, (size_t)nd * sizeof(int)));
     red->w = phgmg__red_d(red, (size_t)nd);
     red->P0 = phgmg__red_d(red, (size_t)nd * r);
     red->P1 = rn ? phgmg__red_d(red, (size_t)nd * rn) : NULL;
-    red->poly = phgmg__red_d(red, (size_t)sys->poly_deg + 1);
-    if (!red->coord || !red->w || !red->P0 || (rn && !red->P1) || !red->poly) {
-      phgmg__free(alloc, wt); rc = PHGMG_ERR_NOMEM; goto fail;
-    }
+    if (!red->coord || !red->w || !red->P0 || (rn && !red->P1)) rc = PHGMG_ERR_NOMEM;
+  }
+  if (rc == PHGMG_OK) {
     for (j = 0; j < nd; ++j) {
-      const int cj = sys->sep_idx[pts[j]];
+      const int cj = c->sys->sep_idx[pts[j]];
       red->coord[j] = cj;
       red->w[j] = wt[j];
       for (a = 0; a < r; ++a) red->P0[j + (size_t)a * nd] = red->V0[cj + (size_t)a * N];
       for (a = 0; a < rn; ++a) red->P1[j + (size_t)a * nd] = red->V2[cj + (size_t)a * N];
     }
-    memcpy(red->poly, sys->poly, ((size_t)sys->poly_deg + 1) * sizeof(double));
-    phgmg__free(alloc, wt);
+    rc = phgmg__separable_functions(red, pts);
   }
-  if (opts->dt > 0.0 && red->kind == PHGMG_ROM_LINEAR && red->nd == 0) {
-    red->map_dt = opts->dt;
-    PHGMG__TRY(phgmg__step_map(red, opts->dt, alloc));
-  }
-  PHGMG__TRY(phgmg__publish(red));
-#undef PHGMG__NEED
-#undef PHGMG__TRY
-  phgmg_jr_factor_destroy(jr);
-  phgmg__free(alloc, T1); phgmg__free(alloc, T2); phgmg__free(alloc, T3); phgmg__free(alloc, pts);
-  phgmg__free(alloc, Tq); phgmg__free(alloc, lg);
-  if (info) *info = inf;
-  *out = red;
-  return PHGMG_OK;
-fail:
-  phgmg_jr_factor_destroy(jr);
-  phgmg__free(alloc, T1); phgmg__free(alloc, T2); phgmg__free(alloc, T3); phgmg__free(alloc, pts);
-  phgmg__free(alloc, Tq); phgmg__free(alloc, lg);
-  phgmg_reduced_destroy(red);
-  if (info) *info = inf;
+  phgmg__free(c->alloc, pts);
+  phgmg__free(c->alloc, wt);
   return rc;
+}
+
+/* Stage 4c, a GENERAL nonlinear part: the reduced model evaluates
+   H_nl(phi(x)), Dphi^T grad H_nl(phi(x)) and the Hessian in full dimension
+   through phgmg__ham_general (O(N) per gradient; the Hessian O(N^2 r) dense,
+   O(N kb r) banded). Workspace: x (N), g (N), the Hessian, Dphi (N x r). */
+PHGMG__PRIV phgmg_result phgmg__stage_general_term(phgmg__rctx *c) {
+  phgmg_reduced *red = c->red;
+  const int N = red->N, r = red->r;
+  const size_t nh = c->sys->storage == PHGMG_BANDED ? (size_t)(2 * c->sys->kb + 1) * N : (size_t)N * N;
+  const size_t rn = (size_t)red->rn, p = (size_t)red->p;
+  if (c->sys->nl != PHGMG_NL_GENERAL) return PHGMG_OK;
+  c->inf.online_full_dim = 1;
+  red->gwork = phgmg__red_d(red, (size_t)r + 2 * (size_t)N + nh + 2 * (size_t)N * r + rn + rn * p * p + (size_t)r * r);
+  return red->gwork ? PHGMG_OK : PHGMG_ERR_NOMEM;
+}
+
+PHGMG_DEF phgmg_result phgmg_reduce(phgmg_reduced **out, const phgmg_ph_system *sys, const double *X,
+                                    int ldx, int ns, const phgmg_reduce_opts *opts,
+                                    phgmg_reduce_info *info, const phgmg_allocator *alloc) {
+  phgmg__rctx c;
+  phgmg_result rc;
+  if (!out) return PHGMG_ERR_INVALID_ARG;
+  *out = NULL;
+  if (!sys || !X || !opts) return PHGMG_ERR_INVALID_ARG;
+  memset(&c, 0, sizeof c);
+  c.sys = sys; c.o = opts; c.X = X; c.ldx = ldx; c.ns = ns; c.alloc = alloc; c.gsel = -1;
+  rc = phgmg__reduce_check(sys, X, ldx, ns, opts);
+  if (rc == PHGMG_OK) rc = phgmg_ph_validate(sys, 0.0, &c.inf.rcond_jr, alloc);
+  if (rc != PHGMG_OK) {
+    if (info) *info = c.inf;
+    return rc;
+  }
+  c.lambda = opts->lambda == 0.0 ? 1e-3 : (opts->lambda < 0.0 ? 0.0 : opts->lambda);
+  if (opts->lambda_auto && opts->method == PHGMG_METHOD_GMG_QM)
+    c.ng = phgmg__lambda_grid(opts->lambda_min == 0.0 ? 1e-14 : opts->lambda_min,
+                              opts->lambda_max == 0.0 ? 1.0 : opts->lambda_max,
+                              opts->lambda_per_decade == 0 ? 4 : opts->lambda_per_decade, NULL);
+  c.degtol = opts->degeneracy_tol > 0.0 ? opts->degeneracy_tol : 1e-12;
+  c.rfloor = phgmg__rank_floor(sys->N, ns, X, ldx);
+  rc = phgmg__reduce_new(&c);
+  if (rc == PHGMG_OK) rc = phgmg__stage_basis(&c);
+  if (rc == PHGMG_OK) rc = phgmg__stage_manifold(&c);
+  if (rc == PHGMG_OK) rc = phgmg__is_gmg(opts->method) ? phgmg__stage_gmg_blocks(&c) : phgmg__stage_sp_blocks(&c);
+  if (rc == PHGMG_OK) rc = phgmg__stage_quadratic_terms(&c);
+  if (rc == PHGMG_OK) rc = phgmg__stage_separable_terms(&c);
+  if (rc == PHGMG_OK) rc = phgmg__stage_general_term(&c);
+  if (rc == PHGMG_OK && opts->dt > 0.0 && c.red->kind == PHGMG_ROM_LINEAR && c.red->nd == 0 &&
+      sys->nl != PHGMG_NL_GENERAL) {
+    c.red->map_dt = opts->dt;
+    rc = phgmg__step_map(c.red, opts->dt, alloc);
+  }
+  if (rc == PHGMG_OK) rc = phgmg__publish(c.red);
+  if (rc == PHGMG_OK)
+    c.inf.online_callbacks = c.red->rom.phi_cb || c.red->rom.eta_cb || c.red->rom.ham_cb;
+  phgmg__rctx_free(&c);
+  if (info) *info = c.inf;
+  if (rc != PHGMG_OK) {
+    phgmg_reduced_destroy(c.red);
+    return rc;
+  }
+  *out = c.red;
+  return PHGMG_OK;
 }
 
 PHGMG_DEF void phgmg_reduced_lift(const phgmg_reduced *red, const double *xr, double *x) {
   phgmg_gemv('N', red->N, red->r, 1.0, red->V0, red->N, xr, 0.0, x);
-  if (red->kind == PHGMG_ROM_QUADRATIC) {
-    /* q = M (x2 kron x2) */
-    const int p = red->p, rn = red->rn;
-    const double *x2 = xr + red->m;
+  if (red->kind == PHGMG_ROM_QUADRATIC) {   /* + V2 eta(x2) */
     double q[64];
-    int i, a, j;
-    for (i = 0; i < rn && i < 64; ++i) {
-      double s = 0.0;
-      for (a = 0; a < p; ++a)
-        for (j = 0; j < p; ++j) s += red->M[i + (size_t)(a * p + j) * rn] * x2[a] * x2[j];
-      q[i] = s;
-    }
-    phgmg_gemv('N', red->N, PHGMG__MIN(rn, 64), 1.0, red->V2, red->N, q, 1.0, x);
+    phgmg__eta_d(red, xr + red->m, q, NULL, NULL, red->rwork);
+    phgmg_gemv('N', red->N, red->rn, 1.0, red->V2, red->N, q, 1.0, x);
   }
 }
 
@@ -6106,7 +6498,7 @@ PHGMG_DEF void phgmg_reduced_dphi(const phgmg_reduced *red, const double *xr, do
     double Lp[64 * 64];
     const int p = red->p, rn = red->rn;
     if (rn * p > 64 * 64) return;
-    phgmg__lp_d(rn, p, red->Ms, xr + m, Lp);
+    phgmg__eta_d(red, xr + m, NULL, Lp, NULL, red->rwork);
     phgmg_gemm('N', 'N', N, p, rn, 1.0, red->V2, N, Lp, rn, 1.0, D + (size_t)m * ldd, ldd);
   }
 }

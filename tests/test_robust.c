@@ -296,11 +296,13 @@ TEST(test_dims_reduce) {
   /* bad options and unsupported model kinds */
   o = ropts((phgmg_method)0, 4);
   EXPECT(reduce_g(&M.sys, X, N, ns, &o, NULL), PHGMG_ERR_INVALID_ARG);
-  o = ropts((phgmg_method)5, 4);
+  o = ropts((phgmg_method)6, 4);
   EXPECT(reduce_g(&M.sys, X, N, ns, &o, NULL), PHGMG_ERR_INVALID_ARG);
-  o = ropts(PHGMG_METHOD_GMG_POD, 4);
+  o = ropts(PHGMG_METHOD_GMG_MANIFOLD, 4);   /* needs its eta */
+  EXPECT(reduce_g(&M.sys, X, N, ns, &o, NULL), PHGMG_ERR_INVALID_ARG);
+  o = ropts(PHGMG_METHOD_GMG_POD, 4);        /* GENERAL without its callbacks */
   s = M.sys; s.nl = PHGMG_NL_GENERAL;
-  EXPECT(reduce_g(&s, X, N, ns, &o, NULL), PHGMG_ERR_UNSUPPORTED);
+  EXPECT(reduce_g(&s, X, N, ns, &o, NULL), PHGMG_ERR_INVALID_ARG);
   free(X);
   msd_linear_free(&M);
 }
