@@ -4,7 +4,7 @@
    reduced order r, an unseen test input, and a figure.
 
    Model (physical parameters, dimensionless units; the defaults):
-     n = 150 masses of m = 1 (N = 300), a damper gamma = 0.3 on every mass
+     n = 100 masses of m = 1 (N = 200), a damper gamma = 0.3 on every mass
      (the paper's Section 5.3 chain), mass n tied to a wall, mass 1 driven by
      the force u, output y = velocity of mass 1 (collocated port). Bonds:
      Morse potential phi(s) = D (1 - e^{-a s})^2 of the extension s, depth
@@ -18,8 +18,12 @@
      Q = diag(k, 1/m) holds the harmonic part, the separable part is the
      anharmonic rest psi(s) = phi(s) - s^2/2 in phgmg's exp-polynomial form
      (psi = D - D a^2 s^2 - 2D e^{-as} + D e^{-2as}).
-   Simulation: Gauss-Legendre-3 with Newton (tol 1e-8, 20 iterations),
-     t in (0, 100], dt = 0.1, x0 = 0 (as the paper's chain).
+   Simulation: Gauss-Legendre-3 with Newton (tol 1e-10 on the stage residual,
+     20 iterations), t in (0, 100], dt = 0.1, x0 = 0 (as the paper's chain).
+     The tolerance is tighter than the paper's 1e-8 because with exponentials
+     the energy-balance error is what we compare: at 1e-8 it is set by where
+     Newton stops (FOM 1.5e-10 against 4.9e-11 at 1e-10 and 2.2e-11 at 1e-12),
+     at 1e-10 every model is within a few times its round-off/quadrature floor.
    Training: snapshots of u = 0.1 sin t. Test (unseen): u = 0.06 sin(0.6 t) +
      0.06 sin(1.5 t); the reduced models built from the training snapshots
      are simulated with it and compared with the full model under it.
@@ -33,7 +37,7 @@
 
    Output: <out>/morse_errors.csv (one row per model, plus a FOM row),
    <out>/fig_morse.svg, and tables on the terminal.
-   Options: --n N (masses, default 150), --rmin/--rmax/--rstep (6..20 step 2),
+   Options: --n N (masses, default 100), --rmin/--rmax/--rstep (6..20 step 2),
             --rn K (8), --deim-tol T (1e-8), --out DIR (results). */
 #define _POSIX_C_SOURCE 200809L
 #define PHGMG_IMPLEMENTATION
@@ -197,17 +201,19 @@ static void write_csv(const char *path, int nr, const int *rs, const rom_row *ro
    input, (d) max energy-balance error on the training input, against r;
    one colour and dash per method, with markers = with DEIM, without =
    every term kept (the two coincide where DEIM costs no accuracy). */
-static void figure(const char *path, int nr, const int *rs, const rom_row *rows, const traj *train) {
+static void figure(const char *path, int nr, const int *rs, const rom_row *rows, const traj *train, int N) {
   static const char *ptitle[4] = {"(a) state error e_red, u = 0.1 sin t (training)",
                                   "(b) output error e_y, u = 0.1 sin t (training)",
                                   "(c) output error e_y, unseen two-tone input",
                                   "(d) max energy-balance error, training input"};
   static const char *ylab[4] = {"relative state error", "relative output error", "relative output error",
                                 "max_t e_energy(t)"};
-  svgplot_fig *fig = svgplot_new("Morse chain (n = 150, N = 300): errors of the reduced models against r", 4);
+  svgplot_fig *fig;
   double *x = (double *)malloc(sizeof(double) * nr), *y = (double *)malloc(sizeof(double) * nr);
   int p, j, d, k;
-  char name[64];
+  char name[96];
+  snprintf(name, sizeof name, "Morse chain (n = %d, N = %d): errors of the reduced models against r", N / 2, N);
+  fig = svgplot_new(name, 4);
   if (!fig || !x || !y) { fprintf(stderr, "out of memory\n"); exit(1); }
   svgplot_size(fig, 2000, 520);
   for (k = 0; k < nr; ++k) x[k] = rs[k];
@@ -250,7 +256,7 @@ static void print_table(const char *title, int nr, const int *rs, const rom_row 
 }
 
 int main(int argc, char **argv) {
-  int n = 150, rmin = 6, rmax = 20, rstep = 2, rn = 8, nr, k, j, d, i, *rs;
+  int n = 100, rmin = 6, rmax = 20, rstep = 2, rn = 8, nr, k, j, d, i, *rs;
   double deim_tol = 1e-8, t_start = demo_now(), worst = 0.0, fails = 0.0, *work;
   const char *out = "results";
   char path[512];
@@ -322,7 +328,7 @@ int main(int argc, char **argv) {
   snprintf(path, sizeof path, "%s/morse_errors.csv", out);
   write_csv(path, nr, rs, rows, &train, &test, M.sys.N);
   snprintf(path, sizeof path, "%s/fig_morse.svg", out);
-  figure(path, nr, rs, rows, &train);
+  figure(path, nr, rs, rows, &train, M.sys.N);
   demo_cache_free(&cache);
   free(train.X); free(train.Y); free(train.EH); free(test.X); free(test.Y); free(test.EH);
   free(rs); free(rows); free(work);

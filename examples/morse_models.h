@@ -7,7 +7,7 @@
 
        morse_chain M;
        morse_opts o = {0};            // zero = the defaults below
-       o.n = 150;
+       o.n = 100;
        if (morse_chain_build(&M, &o) == 0) { ... phgmg_simulate(&M.sys, ...) ...; morse_chain_free(&M); }
 
    Model. n masses m in a row, mass n tied to a wall by a bond, mass 1 free
