@@ -4,7 +4,8 @@ example") on results/morse_errors.csv written by examples/morse_chain.c:
   - every reduced model was built and simulated (rc 0, finite errors) for
     every r = 6..20 step 2, every method (SP1-POD, SP2-POD, GMG-POD, GMG-QM),
     with DEIM and with every term kept;
-  - zero Newton failures (training and test input);
+  - zero Newton failures (training and test input; the models without DEIM
+    see the test input only with morse_chain --all-terms-test);
   - errors decrease with r: GMG-POD and GMG-QM, with and without DEIM,
     e_red and e_y on the training input strictly decrease from each r to the
     next; every method's e_red and e_y at r = 20 are below those at r = 6;
@@ -50,12 +51,16 @@ def val(r, m, dd, q):
 for (r, m, dd), row in sorted(rom.items()):
     tag = f"morse {m}{' + DEIM' if dd else ''} r={r}"
     claim(int(row["rc"]) == 0, f"{tag}: reduced and simulated (rc {row['rc']})")
-    claim(all(math.isfinite(float(row[q])) for q in ("e_red", "e_y", "e_red_test", "e_y_test", "energy",
-                                                        "energy_test")), f"{tag}: finite errors")
+    # the models without DEIM are simulated with the test input only with
+    # morse_chain --all-terms-test (nan otherwise); the DEIM models always
+    tested = dd == 1 or not math.isnan(float(row["e_y_test"]))
+    qs = ("e_red", "e_y", "energy") + (("e_red_test", "e_y_test", "energy_test") if tested else ())
+    claim(all(math.isfinite(float(row[q])) for q in qs), f"{tag}: finite errors")
     claim(float(row["newton_failures"]) == 0, f"{tag}: Newton failures {row['newton_failures']} == 0")
     e, et = float(row["energy"]), float(row["energy_test"])
     claim(e <= 10 * fom_en, f"{tag}: max energy error {e:.3e} within 10x of the FOM's {fom_en:.3e} (training)")
-    claim(et <= 10 * fom_en_test, f"{tag}: max energy error {et:.3e} within 10x of the FOM's {fom_en_test:.3e} (test)")
+    if tested:
+        claim(et <= 10 * fom_en_test, f"{tag}: max energy error {et:.3e} within 10x of the FOM's {fom_en_test:.3e} (test)")
 
 for dd in (0, 1):
     suffix = " + DEIM" if dd else ""
