@@ -41,7 +41,9 @@
             --rn K (8), --deim-tol T (1e-8), --out DIR (results),
             --all-terms-test: simulate the models without DEIM with the test
             input as well (by default only the DEIM models, to keep make demo
-            fast; the errors with and without DEIM agree to 1e-6 relative). */
+            fast; the errors with and without DEIM agree to 1e-6 relative),
+            --callbacks: psi through the callbacks morse_psi/dpsi/ddpsi instead
+            of the built-in exp-polynomial (same numbers; not exportable). */
 #define _POSIX_C_SOURCE 200809L
 #define PHGMG_IMPLEMENTATION
 #include "../phgmg.h"
@@ -264,7 +266,7 @@ static void print_table(const char *title, int nr, const int *rs, const rom_row 
 }
 
 int main(int argc, char **argv) {
-  int n = 100, rmin = 6, rmax = 20, rstep = 2, rn = 8, nr, k, j, d, i, *rs, all_test = 0;
+  int n = 100, rmin = 6, rmax = 20, rstep = 2, rn = 8, nr, k, j, d, i, *rs, all_test = 0, callbacks = 0;
   double deim_tol = 1e-8, t_start = demo_now(), worst = 0.0, fails = 0.0, *work;
   const char *out = "results";
   char path[512];
@@ -282,9 +284,10 @@ int main(int argc, char **argv) {
     else if (!strcmp(argv[i], "--deim-tol") && i + 1 < argc) deim_tol = atof(argv[++i]);
     else if (!strcmp(argv[i], "--out") && i + 1 < argc) out = argv[++i];
     else if (!strcmp(argv[i], "--all-terms-test")) all_test = 1;
+    else if (!strcmp(argv[i], "--callbacks")) callbacks = 1;
     else {
       fprintf(stderr, "usage: %s [--n N] [--rmin R] [--rmax R] [--rstep S] [--rn K] [--deim-tol T] [--out DIR]\n"
-                      "          [--all-terms-test]\n",
+                      "          [--all-terms-test] [--callbacks]\n",
               argv[0]);
       return 2;
     }
@@ -295,14 +298,22 @@ int main(int argc, char **argv) {
   memset(&mo, 0, sizeof mo);
   mo.n = n;
   if (morse_chain_build(&M, &mo) != 0) { fprintf(stderr, "model\n"); return 1; }
+  if (callbacks) { /* the same psi through the user callbacks instead of the built-in form */
+    M.sys.poly_deg = 0; M.sys.poly = NULL;
+#if MORSE_HAVE_EXPPOLY
+    M.sys.nexp = 0; M.sys.expo = NULL;
+#endif
+  }
   rs = (int *)malloc(sizeof(int) * nr);
   rows = (rom_row *)calloc((size_t)nr * NMETH * 2, sizeof(rom_row));
   work = (double *)malloc(sizeof(double) * (NSTEPS + 1));
   if (!rs || !rows || !work) { fprintf(stderr, "out of memory\n"); return 1; }
   printf("Morse chain, n = %d masses (N = %d), m = %g, gamma = %g, D = %g, a = %g (harmonic stiffness %g);\n"
          "%d steps of dt = %g, Newton tol %g; r = %d..%d step %d; GMG-QM r_n = %d, lambda = max(0.2 e_proj, "
-         "10^-2.5);\nDEIM tol %g. Training input u = 0.1 sin t, test input u = 0.06 sin 0.6t + 0.06 sin 1.5t\n",
-         n, M.sys.N, M.mass, M.gamma, M.D, M.a, M.k, NSTEPS, DT, NEWTON_TOL, rmin, rmax, rstep, rn, deim_tol);
+         "10^-2.5);\nDEIM tol %g. Training input u = 0.1 sin t, test input u = 0.06 sin 0.6t + 0.06 sin 1.5t\n"
+         "psi = phi - k s^2/2 given as %s\n",
+         n, M.sys.N, M.mass, M.gamma, M.D, M.a, M.k, NSTEPS, DT, NEWTON_TOL, rmin, rmax, rstep, rn, deim_tol,
+         callbacks ? "callbacks (--callbacks)" : "phgmg's exp-polynomial");
   fom_run(&M.sys, morse_input_train, &train, work);
   fom_run(&M.sys, morse_input_test, &test, work);
   printf("FOM: training %.3f s (%ld Newton iterations), max e_energy %.2e; test %.3f s, max e_energy %.2e\n",
