@@ -265,9 +265,70 @@ static void print_table(const char *title, int nr, const int *rs, const rom_row 
   }
 }
 
+/* Every method with and without DEIM at every r (rows[(k * NMETH + j) * 2 + d]). */
+static void study(const morse_chain *M, const traj *train, const traj *test, const demo_cache *cache, int nr,
+                  int *rs, int rmin, int rstep, int rn, double deim_tol, int all_test, rom_row *rows) {
+  int k, d, j;
+  for (k = 0; k < nr; ++k) {
+    rs[k] = rmin + k * rstep;
+    for (d = 0; d < 2; ++d) {
+      double proj_pod = NAN;
+      for (j = 0; j < NMETH; ++j) {
+        rom_row *w = &rows[(k * NMETH + j) * 2 + d];
+        phgmg_reduce_opts o;
+        memset(&o, 0, sizeof o);
+        o.method = meth_id[j]; o.r = rs[k]; o.rn = rn; o.deim = d; o.deim_tol = deim_tol;
+        o.deim_allow_negative = 1;
+        if (meth_id[j] == PHGMG_METHOD_GMG_QM) o.lambda = fmax(0.2 * proj_pod, pow(10.0, -2.5));
+        demo_cache_use(cache, &o);
+        *w = rom_run(M, train, d || all_test ? test : NULL, &o);
+        if (meth_id[j] == PHGMG_METHOD_GMG_POD) proj_pod = w->e_proj;
+        if (w->rc != PHGMG_OK)
+          fprintf(stderr, "  [%s r=%d%s: %s]\n", meth_name[j], rs[k], d ? " DEIM" : "", phgmg_result_string(w->rc));
+      }
+    }
+  }
+}
+
+/* Tables, DEIM against every term, time per step at r = 16, energy and Newton summary. */
+static void summary(int nr, const int *rs, const rom_row *rows, const traj *train, const traj *test, int all_test) {
+  double worst = 0.0, fails = 0.0;
+  int k, j;
+  print_table("With structure-preserving DEIM (training input: e_red, e_y; unseen input: e_y test)", nr, rs, rows, 1,
+              1);
+  print_table(all_test ? "Every term kept (no DEIM)" : "Every term kept (no DEIM), training input", nr, rs, rows, 0,
+              all_test);
+  {
+    double dmax = 0.0;
+    for (k = 0; k < nr * NMETH; ++k) {
+      const rom_row *w1 = &rows[2 * k + 1], *w0 = &rows[2 * k];
+      dmax = fmax(dmax, fmax(fabs(w1->e_red - w0->e_red) / w0->e_red, fabs(w1->e_y - w0->e_y) / w0->e_y));
+      if (all_test) dmax = fmax(dmax, fabs(w1->e_y_test - w0->e_y_test) / w0->e_y_test);
+    }
+    printf("DEIM against every term: errors differ by at most %.1e relative\n", dmax);
+  }
+  for (k = 0; k < nr; ++k) {
+    if (rs[k] != 16) continue;
+    printf("\nTime per step at r = 16 (energy bookkeeping included): FOM %.1f us;", 1e6 * (train->secs + test->secs) / (2.0 * NSTEPS));
+    for (j = 0; j < NMETH; ++j) {
+      const rom_row *w1 = &rows[(k * NMETH + j) * 2 + 1], *w0 = &rows[(k * NMETH + j) * 2];
+      printf("%s %s %.1f / %.1f us", j ? "," : "", meth_name[j], 1e6 * w1->t_online / (w1->nsim * (double)NSTEPS),
+             1e6 * w0->t_online / ((w0->nsim > 0 ? w0->nsim : 1) * (double)NSTEPS));
+    }
+    printf("\n  (reduced: with DEIM / every term kept)\n");
+  }
+  for (k = 0; k < nr * NMETH * 2; ++k) {
+    fails += rows[k].fails;
+    worst = fmax(worst, rows[k].energy / train->emax);
+    if (!isnan(rows[k].energy_test)) worst = fmax(worst, rows[k].energy_test / test->emax);
+  }
+  printf("\nEnergy balance: worst max_t e_energy of a reduced model / the full model's = %.2f; Newton failures %.0f\n",
+         worst, fails);
+}
+
 int main(int argc, char **argv) {
-  int n = 100, rmin = 6, rmax = 20, rstep = 2, rn = 8, nr, k, j, d, i, *rs, all_test = 0, callbacks = 0;
-  double deim_tol = 1e-8, t_start = demo_now(), worst = 0.0, fails = 0.0, *work;
+  int n = 100, rmin = 6, rmax = 20, rstep = 2, rn = 8, nr, i, *rs, all_test = 0, callbacks = 0;
+  double deim_tol = 1e-8, t_start = demo_now(), *work;
   const char *out = "results";
   char path[512];
   morse_chain M;
@@ -321,53 +382,8 @@ int main(int argc, char **argv) {
   demo_cache_build(&cache, &M.sys, train.X, NSTEPS + 1, rmax + rn + 1, 1);
   deim_cache(&cache, &M, train.X, NSTEPS + 1, deim_tol);
   printf("DEIM: %d of %d bonds\n", cache.deim_count, n);
-  for (k = 0; k < nr; ++k) {
-    rs[k] = rmin + k * rstep;
-    for (d = 0; d < 2; ++d) {
-      double proj_pod = NAN;
-      for (j = 0; j < NMETH; ++j) {
-        rom_row *w = &rows[(k * NMETH + j) * 2 + d];
-        phgmg_reduce_opts o;
-        memset(&o, 0, sizeof o);
-        o.method = meth_id[j]; o.r = rs[k]; o.rn = rn; o.deim = d; o.deim_tol = deim_tol;
-        o.deim_allow_negative = 1;
-        if (meth_id[j] == PHGMG_METHOD_GMG_QM) o.lambda = fmax(0.2 * proj_pod, pow(10.0, -2.5));
-        demo_cache_use(&cache, &o);
-        *w = rom_run(&M, &train, d || all_test ? &test : NULL, &o);
-        if (meth_id[j] == PHGMG_METHOD_GMG_POD) proj_pod = w->e_proj;
-        if (w->rc != PHGMG_OK)
-          fprintf(stderr, "  [%s r=%d%s: %s]\n", meth_name[j], rs[k], d ? " DEIM" : "", phgmg_result_string(w->rc));
-        fails += w->fails;
-        worst = fmax(worst, w->energy / train.emax);
-        if (!isnan(w->energy_test)) worst = fmax(worst, w->energy_test / test.emax);
-      }
-    }
-  }
-  print_table("With structure-preserving DEIM (training input: e_red, e_y; unseen input: e_y test)", nr, rs, rows, 1,
-              1);
-  print_table(all_test ? "Every term kept (no DEIM)" : "Every term kept (no DEIM), training input", nr, rs, rows, 0,
-              all_test);
-  {
-    double dmax = 0.0;
-    for (k = 0; k < nr * NMETH; ++k) {
-      const rom_row *w1 = &rows[2 * k + 1], *w0 = &rows[2 * k];
-      dmax = fmax(dmax, fmax(fabs(w1->e_red - w0->e_red) / w0->e_red, fabs(w1->e_y - w0->e_y) / w0->e_y));
-      if (all_test) dmax = fmax(dmax, fabs(w1->e_y_test - w0->e_y_test) / w0->e_y_test);
-    }
-    printf("DEIM against every term: errors differ by at most %.1e relative\n", dmax);
-  }
-  for (k = 0; k < nr; ++k) {
-    if (rs[k] != 16) continue;
-    printf("\nTime per step at r = 16 (energy bookkeeping included): FOM %.1f us;", 1e6 * (train.secs + test.secs) / (2.0 * NSTEPS));
-    for (j = 0; j < NMETH; ++j) {
-      const rom_row *w1 = &rows[(k * NMETH + j) * 2 + 1], *w0 = &rows[(k * NMETH + j) * 2];
-      printf("%s %s %.1f / %.1f us", j ? "," : "", meth_name[j], 1e6 * w1->t_online / (w1->nsim * (double)NSTEPS),
-             1e6 * w0->t_online / ((w0->nsim > 0 ? w0->nsim : 1) * (double)NSTEPS));
-    }
-    printf("\n  (reduced: with DEIM / every term kept)\n");
-  }
-  printf("\nEnergy balance: worst max_t e_energy of a reduced model / the full model's = %.2f; Newton failures %.0f\n",
-         worst, fails);
+  study(&M, &train, &test, &cache, nr, rs, rmin, rstep, rn, deim_tol, all_test, rows);
+  summary(nr, rs, rows, &train, &test, all_test);
   snprintf(path, sizeof path, "%s/morse_errors.csv", out);
   write_csv(path, nr, rs, rows, &train, &test, M.sys.N);
   snprintf(path, sizeof path, "%s/fig_morse.svg", out);
