@@ -33,7 +33,8 @@ $(BUILD)/test_run_asan: phgmg.h tests/run.c tests/harness.h tests/suites.inc $(T
 
 test: test-plain test-asan compile-checks test-embedded-host test-npy test-cli test-demo test-fuzz-replay
 
-# Replay the fuzz corpora of every reader (clang sanitizers when available; ~6 s).
+# Replay the fuzz corpora of every reader and of the CLI's argument handling
+# (clang sanitizers when available; ~15 s, mostly building the five harnesses).
 test-fuzz-replay:
 	sh tests/fuzz/run.sh 0
 
@@ -50,6 +51,7 @@ $(BUILD)/export_model_f: examples/controller/export_model.c examples/controller/
 	$(CC) -std=c99 $(WARN) -Wdouble-promotion -DPHGMG_REAL_FLOAT -O2 -o $@ $< $(LDLIBS)
 test-embedded-host: $(BUILD)/export_model_d $(BUILD)/export_model_f
 	sh examples/controller/check.sh $(BUILD)
+	sh tests/sepfun_export.sh $(BUILD)
 
 # Cross-compile the controller for Cortex-M4F (float and double), sizes, and a
 # run under qemu-system-arm when installed.
@@ -119,7 +121,9 @@ demo: $(EXAMPLES)
 	end=$$(date +%s.%N) && awk -v a=$$start -v b=$$end 'BEGIN { printf "make demo: total wall time %.2f s\n", b - a }' && \
 	/usr/bin/python3 tests/check_claims.py results && /usr/bin/python3 tests/check_morse.py results
 
-# Short fuzzing run of every reader of outside data (.npy, binary model files).
+# Short fuzzing run of every reader of outside data (.npy in memory and
+# streamed from a file and a pipe, binary model files) and of the CLI's
+# argument handling: 60 s per target.
 fuzz:
 	sh tests/fuzz/run.sh 60
 

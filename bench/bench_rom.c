@@ -16,6 +16,10 @@
      offline_qmfit_nonlinear_r20     ridge fit of M (GMG-QM, r = 20, r_n = 8):
                                      reduced coordinates, Kronecker design, lstsq
      offline_deim_nonlinear          nonlinear-gradient snapshots + phgmg_deim (tol 1e-8)
+     hyper_ecsw_N1000_r20            phgmg_ecsw (tol 1e-6) on the 20020 x 500 training rows
+                                     of the GMG-POD basis (r = 20), rows given
+     hyper_ecsw_separable_N1000_r20  gradient snapshots + phgmg_ecsw_separable (same fit,
+                                     rows never formed)
      offline_<kind>_<model>_r20      the whole phgmg_reduce, no POD cache
      rom_<model>_<kind>_r<8|16|20>   1000 steps of phgmg_rom_step, static workspace
      rom_nonlinear_<kind>_r20_N4000  the same reduced model built from the N = 4000 chain
@@ -259,6 +263,35 @@ static int deim_fn(void *vc, int phase) {
       c->F[k + (size_t)i * nt] = 4.0 * s->poly[4] * l * l * l + 3.0 * s->poly[3] * l * l + 2.0 * s->poly[2] * l + s->poly[1];
     }
   return phgmg_deim(nt, NS, c->F, nt, NULL, 1e-8, 0, c->pts, c->w, &c->nd, &c->nneg, NULL, NULL) == PHGMG_OK ? 0 : -1;
+}
+
+/* Hyper-reduction with non-negative weights (issue 14) on the N = 1000 chain:
+   GMG-POD basis V0 = [B, 19 POD modes of the adjusted snapshots] (r = 20);
+   training rows (snapshot i, coordinate a) = phi'(l_k(x_i)) V0[idx_k, a]
+   (ns r = 20020 rows, one column per term). sep = 0: phgmg_ecsw on the
+   formed rows (Gm given, not timed); sep = 1: the gradient snapshots F and
+   phgmg_ecsw_separable (rows never formed; F's construction timed). */
+typedef struct ecsw_ctx {
+  const msd_nonlinear *M;
+  const double *X, *V0, *Gm, *t;
+  double *F, *Vt, *w, rel;
+  int *pts, nd, sep;
+} ecsw_ctx;
+static int ecsw_fn(void *vc, int phase) {
+  ecsw_ctx *c = (ecsw_ctx *)vc;
+  const phgmg_ph_system *s = &c->M->sys;
+  const int nt = s->nsep, N = s->N;
+  int i, k;
+  if (phase == 0) return 0;
+  if (!c->sep)
+    return phgmg_ecsw(nt, NS * 20, c->Gm, NS * 20, c->t, 1e-6, c->pts, c->w, &c->nd, &c->rel, NULL) == PHGMG_OK ? 0 : -1;
+  for (i = 0; i < NS; ++i)
+    for (k = 0; k < nt; ++k) {
+      const double l = c->X[s->sep_idx[k] + (size_t)i * N];
+      c->F[k + (size_t)i * nt] = 4.0 * s->poly[4] * l * l * l;
+    }
+  return phgmg_ecsw_separable(nt, NS, c->F, nt, 20, c->Vt, nt, NULL, 1e-6, c->pts, c->w, &c->nd, &c->rel, NULL) ==
+         PHGMG_OK ? 0 : -1;
 }
 
 /* ---- online -------------------------------------------------------------- */
@@ -571,6 +604,44 @@ int main(int argc, char **argv) {
     snprintf(extra, sizeof extra, "%d x %d gradient snapshots, rank %d (nominal %.2f GFLOP), %d DEIM points, %d negative weights",
              MN1.sys.nsep, NS, rank, 4.0 * MN1.sys.nsep * NS * rank * 1e-9, dc.nd, dc.nneg);
     row("offline_deim_nonlinear", T, extra);
+    if (!g_only || strstr("hyper_ecsw_N1000_r20 hyper_ecsw_separable_N1000_r20", g_only)) {
+      const int nt = MN1.sys.nsep, m = NS * r; /* r = 20 */
+      ecsw_ctx ec;
+      double *V0 = (double *)xmalloc(sizeof(double) * (size_t)N * r), *Xa = (double *)xmalloc(sizeof(double) * (size_t)N * NS);
+      double *Gm = (double *)xmalloc(sizeof(double) * (size_t)m * nt), *tg = (double *)xmalloc(sizeof(double) * (size_t)m);
+      double wmin;
+      int a, sep;
+      phgmg_result prc = phgmg_adjust_snapshots(N, 1, MN1.sys.B, NS, nl1.X, N, Xa, N, NULL);
+      memcpy(V0, MN1.sys.B, sizeof(double) * (size_t)N); /* B is a unit vector orthogonal to the adjusted snapshots */
+      if (prc == PHGMG_OK) prc = phgmg_pod(N, NS, Xa, N, r - 1, 0.0, V0 + N, N, NULL, &kk, NULL);
+      if (prc != PHGMG_OK) die("hyper basis", prc);
+      memset(&ec, 0, sizeof ec);
+      ec.M = &MN1; ec.X = nl1.X; ec.V0 = V0; ec.Gm = Gm; ec.t = tg;
+      ec.F = (double *)xmalloc(sizeof(double) * (size_t)nt * NS);
+      ec.Vt = (double *)xmalloc(sizeof(double) * (size_t)nt * r);
+      ec.w = (double *)xmalloc(sizeof(double) * (size_t)nt);
+      ec.pts = (int *)xmalloc(sizeof(int) * (size_t)nt);
+      for (k = 0; k < nt; ++k)
+        for (a = 0; a < r; ++a) ec.Vt[k + (size_t)a * nt] = V0[MN1.sys.sep_idx[k] + (size_t)a * N];
+      for (i = 0; i < m; ++i) tg[i] = 0.0;
+      for (k = 0; k < nt; ++k) {
+        for (i = 0; i < NS; ++i) {
+          const double l = nl1.X[MN1.sys.sep_idx[k] + (size_t)i * N], d = 4.0 * MN1.sys.poly[4] * l * l * l;
+          for (a = 0; a < r; ++a) Gm[i * r + a + (size_t)k * m] = d * ec.Vt[k + (size_t)a * nt];
+        }
+        for (i = 0; i < m; ++i) tg[i] += Gm[i + (size_t)k * m];
+      }
+      for (sep = 0; sep < 2; ++sep) {
+        const char *nm = sep ? "hyper_ecsw_separable_N1000_r20" : "hyper_ecsw_N1000_r20";
+        ec.sep = sep;
+        T = bench(nm, RUNS_OFF, ecsw_fn, &ec);
+        for (wmin = 1e300, i = 0; i < ec.nd; ++i) if (ec.w[i] < wmin) wmin = ec.w[i];
+        snprintf(extra, sizeof extra, "%s: %d x %d, tol 1e-6: %d points (DEIM 1e-8: %d), residual %.2e, min weight %.3f",
+                 sep ? "F + phgmg_ecsw_separable" : "phgmg_ecsw", sep ? nt : m, sep ? NS : nt, ec.nd, dc.nd, ec.rel, wmin);
+        row(nm, T, extra);
+      }
+      free(V0); free(Xa); free(Gm); free(tg); free(ec.F); free(ec.Vt); free(ec.w); free(ec.pts);
+    }
     free(dc.F); free(dc.w); free(dc.pts);
 
     {

@@ -17,6 +17,7 @@
 #define PHGMG_IMPLEMENTATION
 #include "../phgmg.h"
 #include <errno.h>
+#include <float.h>
 #include <limits.h>
 #include <math.h>
 #include <stdarg.h>
@@ -85,7 +86,7 @@ static const char *const help_lines[] = {
   "                      coefficients c_0, c_1, ..., c_d (constant first, d >= 1) of phi,\n",
   "                      shared by every term. Needs --poly-idx.\n",
   "  --poly-idx FILE     a vector of the 0-based state coordinates idx_k of the terms\n",
-  "                      (integers stored as float64, each in [0, N)).\n",
+  "                      (each in [0, N); any integer dtype, e.g. np.arange, or float64).\n",
   "  --poly-w FILE       a vector of the term weights w_k (default all 1).\n",
   "  --no-deim           keep every nonlinear term online (exact, cost O(terms)).\n",
   "                      Default: structure-preserving DEIM picks a few of them.\n",
@@ -99,7 +100,9 @@ static const char *const help_lines[] = {
   "                      --simulate, none with --X; 0 = none.\n",
   "  --out DIR           output directory, created if missing (required).\n",
   "  --name NAME         base name of the outputs and C identifier prefix (default rom;\n",
-  "                      letters, digits and _, not starting with a digit).\n",
+  "                      letters, digits and _, not starting with a digit; not a C/C++\n",
+  "                      keyword, not starting with phgmg or _, not a name of the C\n",
+  "                      library headers phgmg.h includes).\n",
   "  --save-snapshots    also write NAME_snapshots.npy (N x ns) and NAME_fom_y.npy\n",
   "                      (m x ns: the full model's output at the snapshots).\n",
   "  --quiet             no progress lines on stderr.\n",
@@ -116,6 +119,9 @@ static const char *const help_lines[] = {
   "    NAME_V2.npy, NAME_M.npy  (gmg-qm) V2 (N x r_n) and M (r_n x p^2, p = r - m):\n",
   "                      x ~ V0 xr + V2 M kron(x2, x2), x2 = xr[m:]\n",
   "    NAME.json          sizes, method, options, diagnostics and the list of files\n",
+  "  A run writes all of these or none: they are written under temporary names and\n",
+  "  renamed at the end; NAME_*.npy arrays of an earlier run with the same NAME that\n",
+  "  this run does not produce (another method) are removed.\n",
   "  The reduced model (LINEAR kind) is x' = K grad H(x) + Bh u, y = Bh^T grad H(x),\n",
   "  H(x) = 1/2 x^T Qh x (+ sum_j w_j phi(P0_j x)); it is again port-Hamiltonian.\n",
   "\n",
@@ -124,19 +130,23 @@ static const char *const help_lines[] = {
   "  output y, an m x (steps+1) matrix (column n = y(n*DT)).\n",
   "  --model FILE        a .phgmgrom file written by reduce (required)\n",
   "  --out FILE          output .npy (required)\n",
-  "  --states FILE       also write the reduced states (r x (steps+1))\n",
+  "  --states FILE       also write the reduced states (r x (steps+1)); written together\n",
+  "                      with --out: both or neither\n",
   "  --dt DT             step (default: the model's step-map DT if it has one, else 0.1)\n",
   "  --steps N, --input KIND, --amp AMP, --newton-tol T, --newton-iter K:  as above\n",
   "  --quiet             no progress lines\n",
   "\n",
   "COMMAND info MODEL\n",
   "  Prints the sizes of a .phgmgrom file and the bytes of stepper memory its\n",
-  "  firmware needs (phgmg_rom_stepper_memsize).\n",
+  "  firmware needs (phgmg_rom_stepper_memsize; with a step map also the bytes for\n",
+  "  stepping with another dt, phgmg_rom_stepper_memsize_dt).\n",
   "\n",
   "INPUT FILES (.npy)\n",
-  "  Read: format versions 1.0-3.0, float64 or float32, little- or big-endian, C or\n",
-  "  Fortran order, 0-d/1-d/2-d. Matrices are (rows, cols) as NumPy shows them, so\n",
-  "  np.save('J.npy', J) is all it takes. Values must be finite.\n",
+  "  Read: format versions 1.0-3.0, float64, float32, int8-int64, uint8-uint64 or\n",
+  "  bool, little- or big-endian, C or Fortran order, 0-d/1-d/2-d. Matrices are\n",
+  "  (rows, cols) as NumPy shows them, so np.save('J.npy', J) is all it takes.\n",
+  "  Values must be finite; 64-bit integers at most 2^53 in magnitude (exact as\n",
+  "  doubles).\n",
   "  --input FILE.npy:   either a 2-d table of shape (K, 1 + m): column 0 the times\n",
   "                      (strictly increasing), columns 1..m the inputs at those times;\n",
   "                      or, for m = 1, a vector of K samples u(k DT), k = 0..K-1.\n",
@@ -144,15 +154,20 @@ static const char *const help_lines[] = {
   "  Written: format 1.0, '<f8', Fortran order (NumPy reads it as usual).\n",
   "\n",
   "EXAMPLES\n",
-  "  python3 examples/npy_example/make_model.py model     # the paper's linear MSD, N = 100\n",
+  "  /usr/bin/python3 examples/npy_example/make_model.py model  # the paper's linear MSD, N = 100\n",
   "  phgmg reduce --J model/J.npy --R model/R.npy --B model/B.npy --Q model/Q.npy \\\n",
   "        --simulate --dt 0.1 --steps 1000 --input sin --amp 0.1 \\\n",
   "        --method gmg-pod --r 12 --out out --name msd\n",
   "  phgmg simulate-rom --model out/msd.phgmgrom --dt 0.1 --steps 1000 --input sin \\\n",
   "        --amp 0.1 --out out/y_rom.npy\n",
-  "  python3 examples/npy_example/compare.py --model model --rom-y out/y_rom.npy\n",
+  "  /usr/bin/python3 examples/npy_example/compare.py --model model --rom-y out/y_rom.npy\n",
   "  phgmg reduce ... --X X.npy --method gmg-qm --r 12 --rn 8 --lambda 1e-3 --out out\n",
   "  phgmg reduce ... --poly c.npy --poly-idx idx.npy --simulate --method gmg-pod --r 16 --out out\n",
+  "\n",
+  "OPTIONS\n",
+  "  Each option may be given once; a repeated option is a usage error. Numbers\n",
+  "  must be finite doubles of normal magnitude (0 or |x| >= 2.2e-308). A run whose\n",
+  "  arrays would need more than 4 GiB (--steps, --simulate) is refused up front.\n",
   "\n",
   "EXIT STATUS\n",
   "  0 success; 1 a file could not be read/written, bad data, or a failed\n",
@@ -224,11 +239,43 @@ static int parse_double(const char *opt, const char *s, double lo, double *out) 
   double v;
   errno = 0;
   v = strtod(s, &end);
+  if (end != s && !*end && errno == ERANGE) { /* a number, but out of the double range */
+    if (fabs(v) <= DBL_MIN)
+      usage_error("%s: '%s' is too small in magnitude for a normal double (0 or at least %g)", opt, s,
+                  DBL_MIN);
+    else
+      usage_error("%s: '%s' is too large for a double (at most %g)", opt, s, DBL_MAX);
+    return 0;
+  }
   if (errno || end == s || *end || !isfinite(v) || v < lo) {
     usage_error("%s: expected a finite number >= %g, got '%s'", opt, lo, s);
     return 0;
   }
   *out = v;
+  return 1;
+}
+
+/* Each option once: 1 (after a usage message) if o was seen before in this
+   command line. seen[] holds up to 64 names. */
+static int repeated_opt(const char *o, const char **seen, int *nseen) {
+  int k;
+  for (k = 0; k < *nseen; ++k)
+    if (!strcmp(seen[k], o)) {
+      usage_error("%s given more than once (each option may be given once)", o);
+      return 1;
+    }
+  if (*nseen < 64) seen[(*nseen)++] = o;
+  return 0;
+}
+
+/* The largest total of arrays a run may allocate up front. */
+#define CLI_MAX_BYTES (4.0 * 1024.0 * 1024.0 * 1024.0)
+
+/* 1 (after a message) if count doubles exceed CLI_MAX_BYTES. */
+static int too_big(double count, const char *what) {
+  if (8.0 * count <= CLI_MAX_BYTES) return 0;
+  usage_error("%s would need %.3g GB (limit %.3g GB); use fewer --steps", what, 8.0 * count / 1e9,
+              CLI_MAX_BYTES / 1e9);
   return 1;
 }
 
@@ -246,19 +293,58 @@ static void mat_free(mat *m) {
 
 /* Read path into *m: a clear message naming the file (and the option it came
    from) on failure. */
+/* The dtype string of a .npy file's header ("?" if not found), for messages. */
+static const char *npy_dtype_of(const char *path) {
+  static char d[32];
+  char head[4096], *p, *e;
+  size_t n;
+  FILE *f = fopen(path, "rb");
+  strcpy(d, "?");
+  if (!f) return d;
+  n = fread(head, 1, sizeof head - 1, f);
+  fclose(f);
+  head[n] = '\0';
+  if (n < 12) return d;
+  p = strstr(head + (head[6] == 1 ? 10 : 12), "descr"); /* the header text */
+  if (p) p = strchr(p, ':');
+  if (!p) return d;
+  p += 1 + strspn(p + 1, " ");
+  if (*p != '\'' && *p != '"') { snprintf(d, sizeof d, "%.20s...", p); return d; }
+  e = strchr(p + 1, *p);
+  if (e && e - p - 1 < (long)sizeof d) { memcpy(d, p + 1, (size_t)(e - p - 1)); d[e - p - 1] = '\0'; }
+  return d;
+}
+
+/* 1 (after a message naming the option) if path is a directory. */
+static int is_dir(const char *path, const char *opt) {
+  struct stat st;
+  if (stat(path, &st) == 0 && S_ISDIR(st.st_mode)) {
+    fail("%s (%s): cannot read: is a directory (I/O error)", path, opt);
+    return 1;
+  }
+  return 0;
+}
+
 static int mat_load(mat *m, const char *opt, const char *path) {
   phgmg_result rc;
   FILE *f;
   size_t i, n;
   memset(m, 0, sizeof *m);
   m->path = path;
+  if (is_dir(path, opt)) return 1;
   f = fopen(path, "rb");
   if (!f) return fail("%s (%s): cannot open: %s", path, opt, strerror(errno));
   fclose(f);
   rc = phgmg_npy_read(path, &m->a, &m->rows, &m->cols, &m->ndim, NULL);
   if (rc == PHGMG_ERR_FORMAT)
-    return fail("%s (%s): not a readable .npy array: %s (float64/float32, at most 2-d, "
+    return fail("%s (%s): not a readable .npy array: %s (float64/float32/integer/bool, at most 2-d, "
                 "format 1.0-3.0)", path, opt, phgmg_result_string(rc));
+  if (rc == PHGMG_ERR_DTYPE)
+    return fail("%s (%s): dtype '%s' is not supported (float64, float32, int8-int64, uint8-uint64 "
+                "or bool)", path, opt, npy_dtype_of(path));
+  if (rc == PHGMG_ERR_INEXACT)
+    return fail("%s (%s): dtype '%s': a value beyond 2^53 in magnitude, which a double cannot "
+                "hold exactly", path, opt, npy_dtype_of(path));
   if (rc != PHGMG_OK) return fail("%s (%s): %s", path, opt, phgmg_result_string(rc));
   n = (size_t)m->rows * (size_t)m->cols;
   for (i = 0; i < n; ++i)
@@ -332,14 +418,19 @@ static void input_fn(double t, double *u, void *user) {
   }
 }
 
-/* Set up the input from --input/--amp for m ports and step dt. */
+/* Set up the input from --input/--amp for m ports and step dt. Returns 0, or
+   the exit status after a message (2: neither a kind nor an existing file). */
 static int input_setup(cli_input *in, const char *spec, double amp, int m, double dt) {
+  struct stat st;
+  const size_t l = strlen(spec);
   memset(in, 0, sizeof *in);
   in->m = m;
   in->amp = amp;
   in->grid_dt = dt;
   if (!strcmp(spec, "sin")) { in->kind = IN_SIN; return 0; }
   if (!strcmp(spec, "const")) { in->kind = IN_CONST; return 0; }
+  if (stat(spec, &st) != 0 && (l < 4 || strcmp(spec + l - 4, ".npy") != 0))
+    return usage_error("--input '%s': expected sin, const or a FILE.npy, and there is no file '%s'", spec, spec);
   if (mat_load(&in->tab, "--input", spec)) return 1;
   if (in->tab.ndim == 2 && !(m == 1 && in->tab.cols == 1)) {
     int k;
@@ -398,6 +489,63 @@ static int mkdir_p(const char *dir) {
   return 0;
 }
 
+/* All or none: every output of a run is written under a temporary name
+   (FINAL.tmp) and renamed to its final name only when all were written
+   (stage_commit); after a failure stage_abort removes the temporary files, so
+   the outputs of an earlier run stay as they were. An existing final path
+   that is not a regular file (a device, a pipe, a symbolic link) is written
+   directly, as the user asked. */
+typedef struct staged {
+  char *fin[64], *tmp[64];
+  int n;
+} staged;
+
+static void stage_abort(staged *sg) {
+  int k;
+  for (k = 0; k < sg->n; ++k) {
+    remove(sg->tmp[k]);
+    free(sg->fin[k]);
+    free(sg->tmp[k]);
+  }
+  sg->n = 0;
+}
+
+/* The path to write for the output `path` (NULL after a message). */
+static const char *stage_path(staged *sg, const char *path) {
+  struct stat st;
+  const size_t l = strlen(path);
+  if (lstat(path, &st) == 0) {
+    if (S_ISDIR(st.st_mode)) { fail("%s: cannot write: is a directory", path); return NULL; }
+    if (!S_ISREG(st.st_mode)) return path;
+  }
+  if (sg->n == 64) { fail("%s: too many outputs", path); return NULL; }
+  sg->fin[sg->n] = (char *)malloc(l + 1);
+  sg->tmp[sg->n] = (char *)malloc(l + 5);
+  if (!sg->fin[sg->n] || !sg->tmp[sg->n]) {
+    free(sg->fin[sg->n]); free(sg->tmp[sg->n]);
+    fail("out of memory");
+    return NULL;
+  }
+  memcpy(sg->fin[sg->n], path, l + 1);
+  memcpy(sg->tmp[sg->n], path, l);
+  memcpy(sg->tmp[sg->n] + l, ".tmp", 5);
+  return sg->tmp[sg->n++];
+}
+
+/* Rename every staged file to its final name; 1 after a message on failure
+   (the files not yet renamed are removed). */
+static int stage_commit(staged *sg) {
+  int k;
+  for (k = 0; k < sg->n; ++k)
+    if (rename(sg->tmp[k], sg->fin[k]) != 0) {
+      fail("%s: cannot rename %s into place: %s", sg->fin[k], sg->tmp[k], strerror(errno));
+      stage_abort(sg); /* removes the files not yet renamed, frees the names */
+      return 1;
+    }
+  stage_abort(sg); /* frees the names; the temporary files are gone */
+  return 0;
+}
+
 /* Write a rows x cols column-major array (ndim 2) and note it in the JSON file list. */
 typedef struct outlist {
   char names[48][64];
@@ -411,10 +559,11 @@ static int write_npy(const char *path, const double *A, int rows, int cols, int 
 }
 
 static int write_field(const char *dir, const char *name, const char *field, const double *A,
-                       int rows, int cols, outlist *ol) {
+                       int rows, int cols, outlist *ol, staged *sg) {
   char path[4096 + 256];
+  const char *wp;
   snprintf(path, sizeof path, "%s/%s_%s.npy", dir, name, field);
-  if (write_npy(path, A, rows, cols, 2)) return 1;
+  if (!(wp = stage_path(sg, path)) || write_npy(wp, A, rows, cols, 2)) return 1;
   if (ol->n < 48) {
     snprintf(ol->names[ol->n], sizeof ol->names[0], "%s_%s.npy", name, field);
     ol->rows[ol->n] = rows; ol->cols[ol->n] = cols; ol->n++;
@@ -481,13 +630,86 @@ static void json_num(FILE *f, double v) {
   fputs(isfinite(v) ? num_str(v, buf) : "null", f);
 }
 
-static int valid_name(const char *s) {
+/* Identifiers the exported C source (NAME, NAME_<field>) must not take: C
+   (C89-C23) and C++ keywords, and names the C library headers that phgmg.h
+   includes (math.h, string.h, stdlib.h, stdio.h, stdint.h, limits.h,
+   assert.h, stddef.h, float.h) declare or define. */
+static const char *const reserved_kw[] = {
+  /* C keywords */
+  "auto", "break", "case", "char", "const", "continue", "default", "do", "double", "else", "enum",
+  "extern", "float", "for", "goto", "if", "inline", "int", "long", "register", "restrict", "return",
+  "short", "signed", "sizeof", "static", "struct", "switch", "typedef", "union", "unsigned", "void",
+  "volatile", "while", "bool", "true", "false", "alignas", "alignof", "constexpr", "nullptr",
+  "static_assert", "thread_local", "typeof", "typeof_unqual",
+  /* C++ keywords */
+  "and", "and_eq", "asm", "bitand", "bitor", "catch", "char8_t", "char16_t", "char32_t", "class",
+  "compl", "concept", "consteval", "constinit", "const_cast", "co_await", "co_return", "co_yield",
+  "decltype", "delete", "dynamic_cast", "explicit", "export", "friend", "mutable", "namespace", "new",
+  "noexcept", "not", "not_eq", "operator", "or", "or_eq", "private", "protected", "public",
+  "reinterpret_cast", "requires", "static_cast", "template", "this", "throw", "try", "typeid",
+  "typename", "using", "virtual", "wchar_t", "xor", "xor_eq",
+  /* library types and macros */
+  "size_t", "ptrdiff_t", "max_align_t", "wint_t", "FILE", "fpos_t", "div_t", "ldiv_t", "lldiv_t",
+  "float_t", "double_t", "int8_t", "int16_t", "int32_t", "int64_t", "uint8_t", "uint16_t", "uint32_t",
+  "uint64_t", "intptr_t", "uintptr_t", "intmax_t", "uintmax_t", "NULL", "EOF", "BUFSIZ", "stdin",
+  "stdout", "stderr", "errno", "assert", "offsetof", "INFINITY", "NAN", "HUGE_VAL", "HUGE_VALF",
+  "HUGE_VALL", "EXIT_SUCCESS", "EXIT_FAILURE", "RAND_MAX", "MB_CUR_MAX", "SEEK_SET", "SEEK_CUR",
+  "SEEK_END", "TMP_MAX", "FILENAME_MAX", "FOPEN_MAX", "L_tmpnam", "CHAR_BIT", "NDEBUG",
+  NULL};
+static const char *const math_names[] = { /* math.h (also with the suffixes f and l) */
+  "acos", "asin", "atan", "atan2", "cos", "sin", "tan", "acosh", "asinh", "atanh", "cosh", "sinh",
+  "tanh", "exp", "exp2", "expm1", "frexp", "ilogb", "ldexp", "log", "log10", "log1p", "log2", "logb",
+  "modf", "scalbn", "scalbln", "cbrt", "fabs", "hypot", "pow", "sqrt", "erf", "erfc", "lgamma",
+  "tgamma", "ceil", "floor", "nearbyint", "rint", "lrint", "llrint", "round", "lround", "llround",
+  "trunc", "fmod", "remainder", "remquo", "copysign", "nan", "nextafter", "nexttoward", "fdim",
+  "fmax", "fmin", "fma", "isfinite", "isinf", "isnan", "isnormal", "signbit", "fpclassify",
+  "isgreater", "isless", "isunordered", "gamma", "j0", "j1", "jn", "y0", "y1", "yn",
+  NULL};
+static const char *const reserved_names[] = {
+  /* string.h */
+  "memcpy", "memmove", "memset", "memcmp", "memchr", "strcpy", "strncpy", "strcat", "strncat",
+  "strcmp", "strncmp", "strcoll", "strxfrm", "strchr", "strrchr", "strspn", "strcspn", "strpbrk",
+  "strstr", "strtok", "strerror", "strlen", "strdup", "strndup",
+  /* stdlib.h */
+  "malloc", "calloc", "realloc", "free", "abort", "exit", "atexit", "at_quick_exit", "quick_exit",
+  "_Exit", "getenv", "system", "abs", "labs", "llabs", "div", "ldiv", "lldiv", "atof", "atoi", "atol",
+  "atoll", "strtod", "strtof", "strtold", "strtol", "strtoll", "strtoul", "strtoull", "rand", "srand",
+  "qsort", "bsearch", "aligned_alloc", "mblen", "mbtowc", "wctomb", "mbstowcs", "wcstombs",
+  /* stdio.h */
+  "fopen", "freopen", "fclose", "fflush", "remove", "rename", "tmpfile", "tmpnam", "setbuf",
+  "setvbuf", "fprintf", "fscanf", "printf", "scanf", "snprintf", "sprintf", "sscanf", "vfprintf",
+  "vfscanf", "vprintf", "vscanf", "vsnprintf", "vsprintf", "vsscanf", "fgetc", "fgets", "fputc",
+  "fputs", "getc", "getchar", "gets", "putc", "putchar", "puts", "ungetc", "fread", "fwrite",
+  "fgetpos", "fseek", "fsetpos", "ftell", "rewind", "clearerr", "feof", "ferror", "perror",
+  "main",
+  NULL};
+
+/* A name usable as the C identifier prefix of the exported source: NULL if
+   fine, else why not. */
+static const char *name_problem(const char *s) {
   const char *p;
-  if (!s[0] || (s[0] >= '0' && s[0] <= '9') || strlen(s) > 40) return 0;
+  int k;
+  if (!s[0] || (s[0] >= '0' && s[0] <= '9') || strlen(s) > 40)
+    return "must be a C identifier (letters, digits, _; not starting with a digit; at most 40 characters)";
   for (p = s; *p; ++p)
     if (!((*p >= 'a' && *p <= 'z') || (*p >= 'A' && *p <= 'Z') || (*p >= '0' && *p <= '9') || *p == '_'))
-      return 0;
-  return 1;
+      return "must be a C identifier (letters, digits, _; not starting with a digit; at most 40 characters)";
+  if (s[0] == '_') return "must not start with _ (reserved identifiers)";
+  if ((s[0] == 'p' || s[0] == 'P') && (s[1] == 'h' || s[1] == 'H') && (s[2] == 'g' || s[2] == 'G') &&
+      (s[3] == 'm' || s[3] == 'M') && (s[4] == 'g' || s[4] == 'G'))
+    return "must not start with phgmg (the library's names)";
+  if (strlen(s) > 4 && (!strcmp(s + strlen(s) - 4, "_MAX") || !strcmp(s + strlen(s) - 4, "_MIN")))
+    return "must not end in _MAX or _MIN (macros of <limits.h>, <float.h>, <stdint.h>)";
+  for (k = 0; reserved_kw[k]; ++k)
+    if (!strcmp(s, reserved_kw[k])) return "is a C/C++ keyword or a type or macro of the C library";
+  for (k = 0; reserved_names[k]; ++k)
+    if (!strcmp(s, reserved_names[k])) return "is a function of the C library headers phgmg.h includes";
+  for (k = 0; math_names[k]; ++k) {
+    const size_t l = strlen(math_names[k]);
+    if (!strncmp(s, math_names[k], l) && (s[l] == '\0' || ((s[l] == 'f' || s[l] == 'l') && s[l + 1] == '\0')))
+      return "is a function of <math.h>";
+  }
+  return NULL;
 }
 
 /* ---- validation messages ---------------------------------------------------- */
@@ -515,8 +737,14 @@ static int explain_validate(phgmg_result rc, const mat *J, const mat *R, const m
     case PHGMG_ERR_NOT_SYMMETRIC:
       return fail("%s (--R): %s: ||R - R^T||_F / ||R||_F = %.3g (tolerance 1e-12)", R->path,
                   phgmg_result_string(rc), sym_defect(R->a, N, -1.0));
+    case PHGMG_ERR_Q_NOT_SYMMETRIC:
+      return fail("%s (--Q): %s: ||Q - Q^T||_F / ||Q||_F = %.3g (tolerance 1e-12)", Q->path,
+                  phgmg_result_string(rc), sym_defect(Q->a, N, -1.0));
     case PHGMG_ERR_NOT_PSD:
       return fail("%s (--R): %s (an eigenvalue below -1e-12 ||R||)", R->path, phgmg_result_string(rc));
+    case PHGMG_ERR_Q_NOT_PD:
+      return fail("%s (--Q): %s (its Cholesky factorization meets a pivot <= 0)", Q->path,
+                  phgmg_result_string(rc));
     case PHGMG_ERR_RANK:
       return fail("%s (--B): %s: the %d columns of B are linearly dependent", B->path,
                   phgmg_result_string(rc), B->cols);
@@ -553,8 +781,10 @@ static const char *optval(int argc, char **argv, int *i) {
   return argv[++*i];
 }
 
+/* Returns 0, the usage status 2, or -1 after printing --help. */
 static int parse_reduce(int argc, char **argv, reduce_args *A) {
-  int i;
+  const char *seen[64];
+  int i, nseen = 0;
   memset(A, 0, sizeof *A);
   A->dt = 0.1; A->steps = 1000; A->amp = 0.1; A->input = "sin"; A->rn = 8; A->lambda = 1e-3;
   A->deim_tol = 1e-8; A->name = "rom"; A->newton_tol = 1e-10; A->newton_iter = 10;
@@ -563,7 +793,8 @@ static int parse_reduce(int argc, char **argv, reduce_args *A) {
 #define STR(opt, field) else if (!strcmp(o, opt)) { if (!(v = optval(argc, argv, &i))) return 2; A->field = v; }
 #define INT(opt, field, lo, hi) else if (!strcmp(o, opt)) { if (!(v = optval(argc, argv, &i)) || !parse_int(o, v, lo, hi, &A->field)) return 2; }
 #define DBL(opt, field, lo) else if (!strcmp(o, opt)) { if (!(v = optval(argc, argv, &i)) || !parse_double(o, v, lo, &A->field)) return 2; }
-    if (!strcmp(o, "--help") || !strcmp(o, "-h")) { print_help(); exit(0); }
+    if (!strcmp(o, "--help") || !strcmp(o, "-h")) { print_help(); return -1; }
+    if (repeated_opt(o, seen, &nseen)) return 2;
     STR("--J", J) STR("--R", R) STR("--B", B) STR("--Q", Q) STR("--X", X)
     STR("--poly", poly) STR("--poly-idx", poly_idx) STR("--poly-w", poly_w)
     STR("--out", out) STR("--name", name) STR("--input", input) STR("--method", method)
@@ -599,10 +830,10 @@ static int parse_reduce(int argc, char **argv, reduce_args *A) {
   if (!!A->X == !!A->simulate) return usage_error("reduce: give exactly one of --X FILE and --simulate");
   if (!!A->poly != !!A->poly_idx) return usage_error("reduce: --poly and --poly-idx go together");
   if (A->poly_w && !A->poly) return usage_error("reduce: --poly-w needs --poly and --poly-idx");
-  if (!valid_name(A->name))
-    return usage_error("--name '%s': must be a C identifier (letters, digits, _; not starting with a digit; "
-                       "at most 40 characters)", A->name);
+  if (name_problem(A->name)) return usage_error("--name '%s': %s", A->name, name_problem(A->name));
   if (!A->have_dt_map) A->dt_map = A->simulate ? A->dt : 0.0;
+  if (A->simulate && too_big((double)A->steps + 1.0, "--simulate --steps: the snapshots (N x (steps+1)) alone"))
+    return 2; /* N >= 1: a first check before reading J */
   return 0;
 }
 
@@ -612,6 +843,7 @@ typedef struct reduce_state {
   double *Xsim, *Ysim, *V0;
   cli_input in;
   phgmg_reduced *red;
+  staged sg; /* the outputs, renamed into place at the end */
 } reduce_state;
 
 static void reduce_cleanup(reduce_state *S) {
@@ -619,6 +851,26 @@ static void reduce_cleanup(reduce_state *S) {
   mat_free(&S->poly); mat_free(&S->pidx); mat_free(&S->pw); mat_free(&S->in.tab);
   free(S->idx); free(S->Xsim); free(S->Ysim); free(S->V0);
   phgmg_reduced_destroy(S->red);
+  stage_abort(&S->sg); /* after a failure: no output of this run stays */
+}
+
+/* Remove the arrays NAME_<field>.npy (regular files) of an earlier run in dir
+   that this run (list ol) did not write, e.g. after another method. */
+static void remove_stale(const char *dir, const char *name, const outlist *ol) {
+  static const char *const all[] = {"Bh", "Qh", "K", "G00", "G01", "G10", "G11", "Q01", "Q11", "Ms",
+                                    "P0", "P1", "w", "poly", "Phi", "Gam", "SX", "SU", "V0", "V2", "M",
+                                    "snapshots", "fom_y", NULL};
+  char path[4096 + 256], file[128];
+  struct stat st;
+  int k, i, mine;
+  for (k = 0; all[k]; ++k) {
+    snprintf(file, sizeof file, "%s_%s.npy", name, all[k]);
+    for (i = 0, mine = 0; i < ol->n && !mine; ++i) mine = !strcmp(ol->names[i], file);
+    snprintf(path, sizeof path, "%s/%s", dir, file);
+    if (!mine && lstat(path, &st) == 0 && S_ISREG(st.st_mode)) {
+      if (remove(path) == 0) progress("removed %s (an array of an earlier run, not written by this one)", path);
+    }
+  }
 }
 
 static int cmd_reduce_impl(const reduce_args *A, reduce_state *S) {
@@ -633,6 +885,7 @@ static int cmd_reduce_impl(const reduce_args *A, reduce_state *S) {
   const double *X;
   int N, m, ns, method, i, nf, k;
   char path[4096 + 256];
+  const char *wp;
   FILE *jf;
 
   if (!strcmp(A->method, "gmg-pod")) method = PHGMG_METHOD_GMG_POD;
@@ -726,8 +979,10 @@ static int cmd_reduce_impl(const reduce_args *A, reduce_state *S) {
     phgmg_gl3_stats st;
     double *x0;
     int done = 0;
-    if (input_setup(&S->in, A->input, A->amp, m, A->dt)) return 1;
+    if ((k = input_setup(&S->in, A->input, A->amp, m, A->dt)) != 0) return k;
     ns = A->steps + 1;
+    if (too_big(((double)N + (double)m) * (double)ns, "--simulate: the snapshots (N x (steps+1)) and outputs"))
+      return 2;
     S->Xsim = (double *)malloc(sizeof(double) * (size_t)N * (size_t)ns);
     S->Ysim = (double *)malloc(sizeof(double) * (size_t)m * (size_t)ns);
     x0 = (double *)calloc((size_t)N, sizeof(double));
@@ -806,7 +1061,7 @@ static int cmd_reduce_impl(const reduce_args *A, reduce_state *S) {
         buf = nb; cap = n;
       }
       for (q = 0; q < n; ++q) buf[q] = (double)fields[i].a[q];
-      if (write_field(A->out, A->name, fields[i].name, buf, fields[i].rows, fields[i].cols, &ol)) { free(buf); return 1; }
+      if (write_field(A->out, A->name, fields[i].name, buf, fields[i].rows, fields[i].cols, &ol, &S->sg)) { free(buf); return 1; }
     }
     free(buf);
   }
@@ -817,15 +1072,15 @@ static int cmd_reduce_impl(const reduce_args *A, reduce_state *S) {
     if (!xr0 || !S->V0) { free(xr0); return fail("out of memory"); }
     phgmg_reduced_dphi(S->red, xr0, S->V0, N);
     free(xr0);
-    if (write_field(A->out, A->name, "V0", S->V0, N, rom->r, &ol)) return 1;
+    if (write_field(A->out, A->name, "V0", S->V0, N, rom->r, &ol, &S->sg)) return 1;
   }
   if (rom->kind == PHGMG_ROM_QUADRATIC) {
     /* V2 and M of the quadratic map. phgmg.h has no public accessor for them
        yet; this program compiles the implementation, so it reads them from the
        reduced object directly. */
     const int p = rom->r - rom->m;
-    if (write_field(A->out, A->name, "V2", S->red->V2, N, rom->rn, &ol)) return 1;
-    if (write_field(A->out, A->name, "M", S->red->M, rom->rn, p * p, &ol)) return 1;
+    if (write_field(A->out, A->name, "V2", S->red->V2, N, rom->rn, &ol, &S->sg)) return 1;
+    if (write_field(A->out, A->name, "M", S->red->M, rom->rn, p * p, &ol, &S->sg)) return 1;
   }
   if (A->save_snap) {
     double *Y = S->Ysim;
@@ -834,18 +1089,21 @@ static int cmd_reduce_impl(const reduce_args *A, reduce_state *S) {
       if (!Y) return fail("out of memory");
       for (k = 0; k < ns; ++k) phgmg_ph_output(&sys, X + (size_t)k * N, Y + (size_t)k * m);
     }
-    if (write_field(A->out, A->name, "snapshots", X, N, ns, &ol)) return 1;
-    if (write_field(A->out, A->name, "fom_y", Y, m, ns, &ol)) return 1;
+    if (write_field(A->out, A->name, "snapshots", X, N, ns, &ol, &S->sg)) return 1;
+    if (write_field(A->out, A->name, "fom_y", Y, m, ns, &ol, &S->sg)) return 1;
   }
   snprintf(path, sizeof path, "%s/%s.phgmgrom", A->out, A->name);
-  rc = phgmg_rom_save(rom, path);
+  if (!(wp = stage_path(&S->sg, path))) return 1;
+  rc = phgmg_rom_save(rom, wp);
   if (rc != PHGMG_OK) return fail("%s: cannot write the model file: %s", path, phgmg_result_string(rc));
   snprintf(path, sizeof path, "%s/%s.c", A->out, A->name);
-  rc = phgmg_rom_export_c(rom, A->name, path);
+  if (!(wp = stage_path(&S->sg, path))) return 1;
+  rc = phgmg_rom_export_c(rom, A->name, wp);
   if (rc != PHGMG_OK) return fail("%s: cannot write the C source: %s", path, phgmg_result_string(rc));
 
   snprintf(path, sizeof path, "%s/%s.json", A->out, A->name);
-  jf = fopen(path, "w");
+  if (!(wp = stage_path(&S->sg, path))) return 1;
+  jf = fopen(wp, "w");
   if (!jf) return fail("%s: cannot write: %s", path, strerror(errno));
   fprintf(jf, "{\n  \"phgmg_version\": \"%s\",\n  \"name\": ", PHGMG_VERSION_STRING);
   json_str(jf, A->name);
@@ -894,6 +1152,8 @@ static int cmd_reduce_impl(const reduce_args *A, reduce_state *S) {
     fprintf(jf, "%s\n      \"%s\": [%d, %d]", i ? "," : "", ol.names[i], ol.rows[i], ol.cols[i]);
   fprintf(jf, "\n    }\n  }\n}\n");
   if (fclose(jf) != 0) return fail("%s: write error", path);
+  if (stage_commit(&S->sg)) return 1;
+  remove_stale(A->out, A->name, &ol);
 
   printf("wrote %s/%s.phgmgrom, %s/%s.c, %s/%s.json and %d arrays %s/%s_*.npy (%s, r = %d, m = %d, N = %d)\n",
          A->out, A->name, A->out, A->name, A->out, A->name, ol.n, A->out, A->name, method_name(method), rom->r,
@@ -905,7 +1165,7 @@ static int cmd_reduce(int argc, char **argv) {
   reduce_args A;
   reduce_state S;
   int rc = parse_reduce(argc, argv, &A);
-  if (rc) return rc;
+  if (rc) return rc < 0 ? 0 : rc;
   memset(&S, 0, sizeof S);
   rc = cmd_reduce_impl(&A, &S);
   reduce_cleanup(&S);
@@ -913,14 +1173,17 @@ static int cmd_reduce(int argc, char **argv) {
 }
 
 /* ---- simulate-rom --------------------------------------------------------------- */
-static int load_model(const char *path, phgmg_rom *rom, void **block) {
+/* opt names where the path came from ("--model", or "info" for the argument). */
+static int load_model(const char *path, const char *opt, phgmg_rom *rom, void **block) {
   phgmg_result rc;
-  FILE *f = fopen(path, "rb");
-  if (!f) return fail("%s (--model): cannot open: %s", path, strerror(errno));
+  FILE *f;
+  if (is_dir(path, opt)) return 1;
+  f = fopen(path, "rb");
+  if (!f) return fail("%s (%s): cannot open: %s", path, opt, strerror(errno));
   fclose(f);
   rc = phgmg_rom_load(path, rom, block, NULL);
   if (rc != PHGMG_OK)
-    return fail("%s (--model): not a usable phgmg model file: %s", path, phgmg_result_string(rc));
+    return fail("%s (%s): not a usable phgmg model file: %s", path, opt, phgmg_result_string(rc));
   return 0;
 }
 
@@ -936,10 +1199,15 @@ static int cmd_simulate_rom(int argc, char **argv) {
   phgmg_result rc;
   cli_input in;
   size_t msz, nreal;
+  staged sg;
+  const char *seen[64], *wp;
+  int nseen = 0;
   memset(&in, 0, sizeof in);
+  memset(&sg, 0, sizeof sg);
   for (i = 2; i < argc; ++i) {
     const char *o = argv[i], *v;
     if (!strcmp(o, "--help") || !strcmp(o, "-h")) { print_help(); return 0; }
+    if (repeated_opt(o, seen, &nseen)) return 2;
     else if (!strcmp(o, "--model")) { if (!(model = optval(argc, argv, &i))) return 2; }
     else if (!strcmp(o, "--out")) { if (!(out = optval(argc, argv, &i))) return 2; }
     else if (!strcmp(o, "--states")) { if (!(states = optval(argc, argv, &i))) return 2; }
@@ -957,10 +1225,16 @@ static int cmd_simulate_rom(int argc, char **argv) {
     else return usage_error("simulate-rom: unknown option '%s'", o);
   }
   if (!model || !out) return usage_error("simulate-rom: --model FILE and --out FILE are required");
-  if (load_model(model, &rom, &block)) return 1;
+  if (load_model(model, "--model", &rom, &block)) return 1;
   if (!have_dt) dt = rom.Phi ? (double)rom.dt : 0.1;
-  if (input_setup(&in, inspec, amp, rom.m, dt)) goto done;
-  msz = phgmg_rom_stepper_memsize(&rom);
+  if (too_big(((double)rom.m + (states ? (double)rom.r : 0.0)) * ((double)steps + 1.0),
+              "--steps: the outputs (m x (steps+1), states r x (steps+1))")) {
+    status = 2;
+    goto done;
+  }
+  if ((status = input_setup(&in, inspec, amp, rom.m, dt)) != 0) goto done;
+  status = 1;
+  msz = phgmg_rom_stepper_memsize_dt(&rom, (phgmg_real)dt);
   nreal = (size_t)rom.r + 4 * (size_t)rom.m + phgmg_rom_eval_work_size(&rom);
   mem = malloc(msz);
   x = (phgmg_real *)malloc(nreal * sizeof(phgmg_real));
@@ -1007,11 +1281,14 @@ static int cmd_simulate_rom(int argc, char **argv) {
 #undef RECORD
   progress("  done in %.3f s (%ld Newton iterations, %ld factorizations)", now_s() - t0, st.stats.newton_iters,
            st.stats.factorizations);
-  if (write_npy(out, Y, rom.m, steps + 1, 2)) goto done;
-  if (states && write_npy(states, XR, rom.r, steps + 1, 2)) goto done;
+  /* both outputs or neither */
+  if (!(wp = stage_path(&sg, out)) || write_npy(wp, Y, rom.m, steps + 1, 2)) goto done;
+  if (states && (!(wp = stage_path(&sg, states)) || write_npy(wp, XR, rom.r, steps + 1, 2))) goto done;
+  if (stage_commit(&sg)) goto done;
   printf("wrote %s (%d x %d)%s%s\n", out, rom.m, steps + 1, states ? " and " : "", states ? states : "");
   status = 0;
 done:
+  stage_abort(&sg);
   mat_free(&in.tab);
   free(mem); free(x); free(Y); free(XR); free(block);
   return status;
@@ -1024,7 +1301,7 @@ static int cmd_info(int argc, char **argv) {
   rom_field f[24];
   int nf, i;
   if (argc != 3) return usage_error("usage: phgmg info MODEL.phgmgrom");
-  if (load_model(argv[2], &rom, &block)) return 1;
+  if (load_model(argv[2], "info", &rom, &block)) return 1;
   printf("%s: %s reduced model (%s), r = %d, m = %d", argv[2],
          rom.kind == PHGMG_ROM_QUADRATIC ? "quadratic-manifold" : "linear", method_name(rom.method), rom.r, rom.m);
   if (rom.kind == PHGMG_ROM_QUADRATIC) printf(", r_n = %d", rom.rn);
@@ -1033,7 +1310,13 @@ static int cmd_info(int argc, char **argv) {
     char buf[32];
     printf(", step map for dt = %s", num_str((double)rom.dt, buf));
   }
-  printf("\nstepper memory: %lu bytes; arrays:", (unsigned long)phgmg_rom_stepper_memsize(&rom));
+  printf("\nstepper memory: %lu bytes", (unsigned long)phgmg_rom_stepper_memsize(&rom));
+  if (rom.Phi) { /* the step map serves its own dt only; another dt needs the Newton workspace */
+    const phgmg_real other = rom.dt * (phgmg_real)2;
+    printf(" (at the step map's dt; %lu bytes for another dt)",
+           (unsigned long)phgmg_rom_stepper_memsize_dt(&rom, other));
+  }
+  printf("; arrays:");
   nf = rom_fields(&rom, f);
   for (i = 0; i < nf; ++i) printf(" %s %dx%d", f[i].name, f[i].rows, f[i].cols);
   printf("\n");

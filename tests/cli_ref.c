@@ -22,6 +22,7 @@
          exported as C source by `phgmg reduce` (static const arrays, as
          firmware would), x0 = 0, u = 0.1 sin t, dt = 0.1, 1000 steps, with
          the online stepper in a static buffer; writes y (1 x 1001)
+     cli_ref scale IN.npy OUT.npy C    OUT = C * IN (2-d), for the magnitude checks
      cli_ref compare A.npy B.npy TOL
          relative difference ||A - B||_F / ||A||_F (exit 1 if the shapes
          differ or it exceeds TOL; TOL = 0 asks for equality)
@@ -180,7 +181,20 @@ done:
   return st;
 }
 
+static int scale(const char *in, const char *out, double c) {
+  double *A = NULL;
+  int r, k;
+  size_t i;
+  phgmg_result rc = phgmg_npy_read(in, &A, &r, &k, NULL, NULL);
+  if (rc != PHGMG_OK) return die(in, rc);
+  for (i = 0; i < (size_t)r * (size_t)k; ++i) A[i] *= c;
+  rc = phgmg_npy_write(out, A, r, k, r > 0 ? r : 1, 2, 0u);
+  phgmg_npy_free(A, NULL);
+  return rc == PHGMG_OK ? 0 : die(out, rc);
+}
+
 int main(int argc, char **argv) {
+  if (argc == 5 && !strcmp(argv[1], "scale")) return scale(argv[2], argv[3], atof(argv[4]));
   if (argc == 3 && !strcmp(argv[1], "model")) {
     msd_linear M;
     int st;

@@ -185,7 +185,9 @@ np.save('u_tab.npy', np.array([[0.0, 0.1], [50.0, 0.1], [200.0, 0.1]]))
 np.save('u_tabbe.npy', np.asfortranarray(np.array([[0.0, 0.1], [200.0, 0.1]], dtype='>f8')))
 np.save('u_bad.npy', np.zeros((4, 3)))
 np.save('u_dec.npy', np.array([[0.0, 0.1], [0.0, 0.2]]))
-np.save('int.npy', np.zeros((100, 100), dtype=np.int64))
+np.save('cplx.npy', np.zeros((100, 100), dtype=complex))
+np.save('idx64.npy', np.arange(20))
+np.save('idx32be.npy', np.arange(20, dtype='>i4'))
 Q = np.load('model/Q.npy'); Q[3, 3] = np.nan; np.save('Q_nan.npy', Q)
 np.save('J_3d.npy', np.zeros((2, 2, 2)))
 "
@@ -206,8 +208,19 @@ np.save('J_3d.npy', np.zeros((2, 2, 2)))
   done
   run_err "input table shape" 1 "u_bad.npy" "$P" simulate-rom --model out/msd.phgmgrom --input u_bad.npy --out y.npy
   run_err "input times" 1 "u_dec.npy" "$P" simulate-rom --model out/msd.phgmgrom --input u_dec.npy --out y.npy
-  run_err "int64 npy" 1 "int.npy" "$P" reduce --J int.npy --R model/R.npy --B model/B.npy --Q model/Q.npy $SIM \
-    --method gmg-pod --r 12 --out e
+  run_err "complex npy names its dtype" 1 "cplx.npy (--J): dtype '<c16' is not supported" "$P" reduce \
+    --J cplx.npy --R model/R.npy --B model/B.npy --Q model/Q.npy $SIM --method gmg-pod --r 12 --out e
+  # issue 13: NumPy's default int64 index array (np.arange) and an int32 one load
+  run_ok "reduce --poly-idx int64" "$P" reduce --J nl/J.npy --R nl/R.npy --B nl/B.npy --Q nl/Q.npy --poly nl/poly.npy \
+    --poly-idx idx64.npy --deim-allow-negative $SIM --newton-tol 1e-8 --newton-iter 20 --method gmg-pod --r 10 \
+    --out onli --name nlm --quiet
+  run_ok "simulate-rom --poly-idx int64" "$P" simulate-rom --model onli/nlm.phgmgrom $ROMSIM --newton-tol 1e-8 \
+    --newton-iter 20 --out onli/y.npy --quiet
+  run_ok "int64 idx == float64 idx" "$REF" compare onl/y.npy onli/y.npy 0
+  run_ok "reduce --poly-idx int32" "$P" reduce --J nl/J.npy --R nl/R.npy --B nl/B.npy --Q nl/Q.npy --poly nl/poly.npy \
+    --poly-idx idx32be.npy --deim-allow-negative $SIM --newton-tol 1e-8 --newton-iter 20 --method gmg-pod --r 10 \
+    --out onli32 --name nlm --quiet
+  run_ok "int32 idx == float64 idx (model files)" cmp onli/nlm.phgmgrom onli32/nlm.phgmgrom
   run_err "NaN in Q" 1 "Q_nan.npy" "$P" reduce --J model/J.npy --R model/R.npy --B model/B.npy --Q Q_nan.npy $SIM \
     --method gmg-pod --r 12 --out e
   run_err "3-d npy" 1 "J_3d.npy" "$P" reduce --J J_3d.npy --R model/R.npy --B model/B.npy --Q model/Q.npy $SIM \
@@ -247,6 +260,70 @@ run_err "model file missing" 1 "nomodel.phgmgrom" "$P" simulate-rom --model nomo
 run_err "model file malformed" 1 "garbage.npy (--model)" "$P" simulate-rom --model garbage.npy --out y.npy
 run_err "simulate-rom unwritable" 1 "nodir/y.npy" "$P" simulate-rom --model out/msd.phgmgrom --out nodir/y.npy
 run_err "out is a file" 1 "garbage.npy (--out)" "$P" reduce $J_ $R_ $B_ $Q_ $SIM --method gmg-pod --r 12 --out garbage.npy
+
+# ---- 6. issue 19: defects found by testing as a new user and as an attacker ---------
+# 1: a model with a step map (dt 0.1) stepped with another dt
+run_ok "D1 simulate-rom --dt 0.05 on a dt-0.1 step-map model" "$P" simulate-rom --model out/msd.phgmgrom --dt 0.05 \
+  --steps 200 --out y_d1.npy --quiet
+run_ok "D1 info" "$P" info out/msd.phgmgrom
+grep -F -q "for another dt" "$T/out.txt" || bad "D1: info does not give the stepper memory for another dt"
+# 2: --out through a symbolic link to a device: the write fails, the link stays
+if [ -w /dev/full ]; then
+  ln -s /dev/full full_link.npy
+  run_err "D2 write to a link to /dev/full fails" 1 "full_link.npy" "$P" simulate-rom --model out/msd.phgmgrom \
+    --steps 10 --out full_link.npy --quiet
+  [ -L full_link.npy ] && pass || bad "D2: the symbolic link full_link.npy was removed"
+fi
+# 3: the snapshots times 1e-200 give the same model (POD invariant to magnitude)
+run_ok "D3 scale X" "$REF" scale out/msd_snapshots.npy x_tiny.npy 1e-200
+run_ok "D3 reduce --X tiny" "$P" reduce $SYS --X x_tiny.npy --dt-map 0.1 --method gmg-pod --r 12 --out o_tiny --name m --quiet
+run_ok "D3 simulate-rom tiny" "$P" simulate-rom --model o_tiny/m.phgmgrom $ROMSIM --out o_tiny/y.npy --quiet
+run_ok "D3 X*1e-200 gives the model of X (1e-9)" "$REF" compare ox/y.npy o_tiny/y.npy 1e-9
+# 4, 5: Q's own culprit; Q positive definite checked
+run_err "D4 Q not symmetric names Q" 1 "model/J.npy (--Q): Q is not symmetric" "$P" reduce --J model/J.npy \
+  --R model/R.npy --B model/B.npy --Q model/J.npy $SIM --method gmg-pod --r 12 --out e
+run_err "D5 Q singular (Q = R)" 1 "model/R.npy (--Q): Q is not positive definite" "$P" reduce --J model/J.npy \
+  --R model/R.npy --B model/B.npy --Q model/R.npy $SIM --method gmg-pod --r 12 --out e
+[ -e e ] && bad "D5: a failed run left the output directory e" || pass
+# 7: all outputs or none
+run_ok "D7 gmg-qm into o7" "$P" reduce $SYS $SIM --method gmg-qm --r 12 --out o7 --name m --quiet
+run_ok "D7 gmg-pod into o7" "$P" reduce $SYS $SIM --method gmg-pod --r 12 --out o7 --name m --quiet
+[ -e o7/m_V2.npy ] || [ -e o7/m_M.npy ] || [ -e o7/m_G00.npy ] && bad "D7: gmg-qm arrays left beside gmg-pod ones" || pass
+rm o7/m.json && mkdir o7/m.json
+(cd o7 && cksum m.phgmgrom m.c m_*.npy) >sums_before.txt
+run_err "D7 failing run (m.json is a directory)" 1 "m.json" "$P" reduce $SYS $SIM --method gmg-pod --r 14 --out o7 \
+  --name m --quiet
+(cd o7 && cksum m.phgmgrom m.c m_*.npy) >sums_after.txt
+cmp -s sums_before.txt sums_after.txt && pass || bad "D7: a failed r = 14 run changed the r = 12 outputs"
+ls o7 | grep -q '\.tmp$' && bad "D7: temporary files left in o7" || pass
+run_err "D7 failing --states" 1 "nodir/xr.npy" "$P" simulate-rom --model out/msd.phgmgrom --steps 10 --out y7.npy \
+  --states nodir/xr.npy --quiet
+[ -e y7.npy ] && bad "D7: a failing --states left y7.npy behind" || pass
+# 11: names the exported C cannot take
+for n in int while class phgmg_x PHGMGrom _x sqrt sqrtf memcpy NULL INT_MAX; do
+  run_err "D11 --name $n refused" 2 "--name '$n'" "$P" reduce $SYS $SIM --method gmg-pod --r 12 --out e --name $n
+done
+# 12: CLI details
+run_err "D12 --steps cap" 2 "would need" "$P" simulate-rom --model out/msd.phgmgrom --steps 2147483646 --out y12.npy
+run_err "D12 --simulate --steps cap" 2 "would need" "$P" reduce $SYS --simulate --steps 2000000000 \
+  --method gmg-pod --r 12 --out e
+run_err "D12 --dt 1e-320" 2 "too small in magnitude" "$P" simulate-rom --model out/msd.phgmgrom --dt 1e-320 --out y12.npy
+run_err "D12 --dt 1e999" 2 "too large" "$P" simulate-rom --model out/msd.phgmgrom --dt 1e999 --out y12.npy
+run_err "D12 --input square" 2 "expected sin, const or a FILE.npy" "$P" simulate-rom --model out/msd.phgmgrom \
+  --input square --out y12.npy
+run_err "D12 info names no option" 1 "nomodel.phgmgrom (info)" "$P" info nomodel.phgmgrom
+run_err "D12 directory as model" 1 "is a directory" "$P" simulate-rom --model out --out y12.npy
+run_err "D12 directory as info model" 1 "is a directory" "$P" info out
+run_err "D12 directory as npy" 1 "model (--J): cannot read: is a directory" "$P" reduce --J model $R_ $B_ $Q_ $TAIL
+run_err "D12 repeated option" 2 "--dt given more than once" "$P" simulate-rom --model out/msd.phgmgrom --dt 0.1 \
+  --dt 0.2 --out y12.npy
+run_err "D12 repeated reduce option" 2 "--r given more than once" "$P" reduce $SYS $SIM --method gmg-pod --r 12 --r 14 \
+  --out e
+[ -e y12.npy ] && bad "D12: a refused run wrote y12.npy" || pass
+# 13: --help calls the Python that has NumPy, as the README does
+run_ok "D13 help" "$P" --help
+grep -F -q "/usr/bin/python3 examples/npy_example/make_model.py" "$T/out.txt" || bad "D13: --help examples do not use /usr/bin/python3"
+grep -E -q "^  python3 " "$T/out.txt" && bad "D13: --help still calls plain python3" || pass
 
 echo "test_cli: $npass passed, $nfail failed"
 [ "$nfail" -eq 0 ]

@@ -171,14 +171,7 @@ TEST(test_npy_parse_malformed) {
     "{'descr': '<f8', 'fortran_order': False}",                       /* no shape */
     "{'descr': '<f8', 'shape': (2, 3)}",                              /* no order */
     "{'fortran_order': False, 'shape': (2, 3)}",                      /* no descr */
-    "{'descr': '<i8', 'fortran_order': False, 'shape': (2, 3), }",   /* dtypes */
-    "{'descr': '<f2', 'fortran_order': False, 'shape': (2, 3), }",
-    "{'descr': '<c16', 'fortran_order': False, 'shape': (2, 3), }",
-    "{'descr': '|u1', 'fortran_order': False, 'shape': (2, 3), }",
-    "{'descr': '=f8', 'fortran_order': False, 'shape': (2, 3), }",
-    "{'descr': 'f8', 'fortran_order': False, 'shape': (2, 3), }",
-    "{'descr': '<f16', 'fortran_order': False, 'shape': (2, 3), }",
-    "{'descr': [('a', '<f8')], 'fortran_order': False, 'shape': (2, 3), }",
+    "{'descr': <f8, 'fortran_order': False, 'shape': (2, 3), }",     /* unquoted dtype */
     "{'descr': '<f8', 'fortran_order': 0, 'shape': (2, 3), }",       /* order values */
     "{'descr': '<f8', 'fortran_order': true, 'shape': (2, 3), }",
     "{'descr': '<f8', 'fortran_order': Truest, 'shape': (2, 3), }",
@@ -216,6 +209,18 @@ TEST(test_npy_parse_malformed) {
   for (t = 0; t < sizeof bad / sizeof bad[0]; ++t) {
     len = npyt_image(buf, 1, bad[t], data, nd);
     npyt_expect_fail(buf, len, PHGMG_ERR_FORMAT, (int)t); /* index into bad[] */
+  }
+  {
+    /* unsupported dtypes (issue 19): PHGMG_ERR_DTYPE */
+    static const char *dt[] = {"'<f2'", "'<c16'", "'<c8'", "'=f8'", "'f8'", "'<f16'", "'|f8'",
+                               "'|i2'", "'<i3'", "'<b2'", "'<U5'", "'|S3'", "'|O'", "'<M8'",
+                               "'<m8'", "'|V8'", "''", "[('a', '<f8')]"};
+    char hd[160];
+    for (t = 0; t < sizeof dt / sizeof dt[0]; ++t) {
+      snprintf(hd, sizeof hd, "{'descr': %s, 'fortran_order': False, 'shape': (2, 3), }", dt[t]);
+      len = npyt_image(buf, 1, hd, data, nd);
+      npyt_expect_fail(buf, len, PHGMG_ERR_DTYPE, 1000 + (int)t);
+    }
   }
   {
     /* NUL inside the header */
@@ -307,7 +312,7 @@ TEST(test_npy_parse_mutations) {
       memcpy(b2, buf, len);
       b2[pos] = vals[v];
       rc = phgmg_npy_parse(b2, len, &A, &r, &k, &dim, &a);
-      CHECK(rc == PHGMG_OK || rc == PHGMG_ERR_FORMAT);
+      CHECK(rc == PHGMG_OK || rc == PHGMG_ERR_FORMAT || rc == PHGMG_ERR_DTYPE);
       if (rc == PHGMG_OK) {
         ++okcount;
         CHECK(r >= 0 && k >= 0 && dim >= 0 && dim <= 2);

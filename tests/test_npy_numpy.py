@@ -8,8 +8,12 @@ and 3.0 when this NumPy has it; '<f8', '>f8', '<f4', '>f4'; C and Fortran
 order; 0-d, 1-d, 2-d, 1x1 and empty shapes; NaN/Inf/-0/subnormals), has
 npy_tool read each one and write it back (Fortran or C order, float64 or
 float32), and checks with NumPy that the values round trip exactly and that
-the written header is what was asked for. Files NumPy writes but phgmg does
-not support (other dtypes, 3-d, truncated) must be refused with exit status 1.
+the written header is what was asked for. Integer and bool arrays (int8 ...
+int64, uint8 ... uint64, both byte orders, bool; issue 13) must read back as
+exactly the same values in float64, also through a pipe; NumPy's default
+int64 index array (np.arange) included. Files NumPy writes but phgmg does
+not support (complex, float16, int64 beyond 2^53, 3-d, structured,
+truncated) must be refused with exit status 1 and a message saying why.
 Exit status: 0 if every check passed, 1 otherwise; a summary is printed.
 """
 import os
@@ -152,15 +156,60 @@ def main():
             if r.returncode != 0 or not same(np.load(dst), a):
                 fails.append("manual fortran header %r" % (shape,))
 
-        # files NumPy writes that phgmg must refuse cleanly (exit status 1)
+        # integer and bool dtypes: exact values in float64 (file and pipe)
+        ints = []
+        for kind in "iu":
+            for size in [1, 2, 4, 8]:
+                info = np.iinfo(np.dtype("%s%d" % (kind, size)))
+                lo, hi = max(info.min, -2 ** 53), min(info.max, 2 ** 53)
+                for bo in "<>":
+                    dt = np.dtype("%s%s%d" % (bo, kind, size))
+                    vals = np.array([[lo, hi, 0], [1, lo // 3, hi // 7]], dtype=dt)
+                    ints.append(("%s %s" % (dt.str, "C"), vals))
+                    ints.append(("%s %s" % (dt.str, "F"), np.asfortranarray(vals)))
+                    ints.append(("%s 1-d" % dt.str, np.arange(11, dtype=dt)))
+        ints.append(("arange default", np.arange(20)))            # nl_idx.npy as users write it
+        ints.append(("bool", np.array([[True, False], [False, True], [True, True]])))
+        ints.append(("bool 0-d", np.array(True)))
+        for name, a in ints:
+            for ver in vers:
+                src = os.path.join(tmp, "int.npy")
+                with open(src, "wb") as f:
+                    fmt.write_array(f, a, version=ver)
+                nfiles += 1
+                for how in ["file", "pipe"]:
+                    dst = os.path.join(tmp, "out.npy")
+                    if os.path.exists(dst):
+                        os.remove(dst)
+                    if how == "file":
+                        r = run("copy", src, dst)
+                    else:
+                        r = subprocess.run([tool, "copy", "/dev/stdin", dst],
+                                           input=open(src, "rb").read(), capture_output=True)
+                    nchecks += 1
+                    what = "%s v%d.0 (%s)" % (name, ver[0], how)
+                    if r.returncode != 0:
+                        fails.append("%s: exit %d %r" % (what, r.returncode, r.stderr))
+                        continue
+                    b = np.load(dst)
+                    want = a.astype(np.float64)
+                    if b.dtype != np.float64 or not same(b, want):
+                        fails.append("%s: values differ" % what)
+                    if not np.array_equal(b.astype(a.dtype), a):  # and back, exactly
+                        fails.append("%s: not exact" % what)
+
+        # files NumPy writes that phgmg must refuse cleanly (exit status 1),
+        # with the reason in the message
         bad = {
-            "int64": np.arange(6, dtype="<i8").reshape(2, 3),
-            "complex": np.ones(3, dtype="<c16"),
-            "float16": np.ones(3, dtype="<f2"),
-            "3d": np.zeros((2, 2, 2)),
-            "structured": np.zeros(2, dtype=[("a", "<f8"), ("b", "<f8")]),
+            "int64 2^53+1": (np.array([0, 2 ** 53 + 1], dtype="<i8"), "2^53"),
+            "int64 -2^53-1": (np.array([-(2 ** 53) - 1], dtype=">i8"), "2^53"),
+            "uint64 max": (np.array([2 ** 64 - 1], dtype="<u8"), "2^53"),
+            "complex": (np.ones(3, dtype="<c16"), "dtype"),
+            "float16": (np.ones(3, dtype="<f2"), "dtype"),
+            "3d": (np.zeros((2, 2, 2)), "malformed"),
+            "structured": (np.zeros(2, dtype=[("a", "<f8"), ("b", "<f8")]), "dtype"),
         }
-        for name, a in bad.items():
+        for name, (a, why) in bad.items():
             src = os.path.join(tmp, "bad.npy")
             with open(src, "wb") as f:
                 fmt.write_array(f, a, version=(1, 0))
@@ -169,6 +218,8 @@ def main():
             nchecks += 1
             if r.returncode != 1 or os.path.exists(os.path.join(tmp, "never.npy")):
                 fails.append("refuse %s: exit %d" % (name, r.returncode))
+            elif why not in r.stderr:
+                fails.append("refuse %s: message %r does not say %r" % (name, r.stderr, why))
         src = os.path.join(tmp, "trunc.npy")
         full = os.path.join(tmp, "full.npy")
         np.save(full, rng.standard_normal((4, 4)))

@@ -157,7 +157,7 @@ TEST(test_validate_codes) {
   t = t0; tsys_point(&t); t.R[1 + 3 * 6] = 0.5;
   CHECK_RC(validate_untouched(&t, NULL), PHGMG_ERR_NOT_SYMMETRIC);
   t = t0; tsys_point(&t); t.Q[0 + 4 * 6] = 0.5;
-  CHECK_RC(validate_untouched(&t, NULL), PHGMG_ERR_NOT_SYMMETRIC);
+  CHECK_RC(validate_untouched(&t, NULL), PHGMG_ERR_Q_NOT_SYMMETRIC);
   /* R indefinite: negative diagonal (diagonal R) and a symmetric 2x2 block
      [1 2; 2 1] with eigenvalue -1 (eigenvalue path) */
   t = t0; tsys_point(&t); t.R[3 + 3 * 6] = -0.5;

@@ -670,7 +670,7 @@ TEST(test_structure_violations) {
   h.R[1 + 3 * N] = 0.1;                 EXPECT_SYS(&h.sys, 0.0, PHGMG_ERR_NOT_SYMMETRIC);
   h.R[3 + 1 * N] = 0.1;                 EXPECT_SYS(&h.sys, 0.0, PHGMG_OK);
   h.R[1 + 3 * N] = h.R[3 + 1 * N] = 0.0;
-  h.Q[0 + 2 * N] = 0.2;                 EXPECT_SYS(&h.sys, 0.0, PHGMG_ERR_NOT_SYMMETRIC);
+  h.Q[0 + 2 * N] = 0.2;                 EXPECT_SYS(&h.sys, 0.0, PHGMG_ERR_Q_NOT_SYMMETRIC);
   h.Q[0 + 2 * N] = 0.0;
   /* R indefinite: diagonal, and non-diagonal with eigenvalues 0.5 +- 2 */
   h.R[5 + 5 * N] = -1e-3;               EXPECT_SYS(&h.sys, 0.0, PHGMG_ERR_NOT_PSD);
@@ -760,13 +760,14 @@ TEST(test_gmg_degenerate) {
   o = ropts(PHGMG_METHOD_GMG_POD, 3);
   EXPECT(reduce_g(&h.sys, X, N, ns, &o, &info), PHGMG_OK);
   CHECK(info.rcond_dgd > 1e-6);
-  /* SP1: W = Q V (V^T Q V)^{-1} needs V^T Q V invertible; with Q singular and
-     r = N (V spans everything) it is not */
+  /* SP1: W = Q V (V^T Q V)^{-1} needs V^T Q V invertible, which a positive
+     definite Q guarantees; a singular Q is refused up front by the validation
+     (issue 19, defect 5), whatever r */
   h.Q[9 + 9 * N] = 0.0;
   o = ropts(PHGMG_METHOD_SP1, N);
-  EXPECT(reduce_g(&h.sys, X, N, ns, &o, &info), PHGMG_ERR_DEGENERATE);
-  o.r = N - 1;  /* generic snapshots: the POD basis is not Q-degenerate */
-  EXPECT(reduce_g(&h.sys, X, N, ns, &o, &info), PHGMG_OK);
+  EXPECT(reduce_g(&h.sys, X, N, ns, &o, &info), PHGMG_ERR_Q_NOT_PD);
+  o.r = N - 1;
+  EXPECT(reduce_g(&h.sys, X, N, ns, &o, &info), PHGMG_ERR_Q_NOT_PD);
   hsys_free(&h);
   free(X);
   /* The nonlinear MSD in l-coordinates: J - R = [[0, T], [-T^T, -gamma I]],

@@ -49,3 +49,18 @@ put("bad_hlen.npy", good[:8] + b"\xff\xff" + good[10:])
 put("bad_int64.npy", npy(np.arange(6, dtype="<i8")))
 put("bad_3d.npy", npy(np.zeros((1, 2, 1))))
 put("bad_notuple.npy", good.replace(b"(2, 3)", b"(6)   "))
+# integer and bool dtypes (issue 13), refused ones, and a short stream that
+# claims a huge shape (issue 19, defect 10: a pipe's buffer must grow with
+# the data; fuzz_npy_stream.c reads these from a file and a pipe too)
+for dt in ["<i1", "|u1", "<i2", ">i2", "<u2", "<i4", ">u4", "<i8", ">i8", "<u8"]:
+    name = dt.replace("<", "l").replace(">", "b").replace("|", "n")
+    put("int_%s_c_2x3.npy" % name, npy(np.arange(6, dtype=dt).reshape(2, 3)))
+put("int_arange_default.npy", npy(np.arange(20)))
+put("int_li4_f_2x3.npy", npy(np.asfortranarray(np.arange(6, dtype="<i4").reshape(2, 3))))
+put("bool_2x2.npy", npy(np.array([[True, False], [False, True]])))
+put("bad_int64_big.npy", npy(np.array([2 ** 53 + 1, -5], dtype="<i8")))
+put("bad_uint64_max.npy", npy(np.array([2 ** 64 - 1], dtype="<u8")))
+put("bad_complex.npy", npy(np.ones(2, dtype="<c16")))
+h = "{'descr': '<f8', 'fortran_order': False, 'shape': (200000, 200000), }"
+h = h + " " * (117 - len(h)) + "\n"
+put("bad_huge_claim.npy", b"\x93NUMPY\x01\x00" + bytes([len(h), 0]) + h.encode() + b"\0" * 64)

@@ -1,8 +1,12 @@
 #!/bin/sh
 # Short fuzzing run of every reader of outside data in phgmg.h:
-#   npy      phgmg_npy_parse                    (tests/fuzz/fuzz_npy.c)
-#   rom      phgmg_rom_deserialize + online path (tests/fuzz/fuzz_rom.c)
-#   rom_f32  the same in a PHGMG_REAL_FLOAT build
+#   npy         phgmg_npy_parse                    (tests/fuzz/fuzz_npy.c)
+#   npy_stream  phgmg_npy_read from a file and a pipe against phgmg_npy_parse
+#               on the same bytes                  (tests/fuzz/fuzz_npy_stream.c)
+#   rom         phgmg_rom_deserialize + online path (tests/fuzz/fuzz_rom.c)
+#   rom_f32     the same in a PHGMG_REAL_FLOAT build
+#   cli         the argument handling of the phgmg command line on a tiny model
+#               in a scratch directory              (tests/fuzz/fuzz_cli.c)
 # Usage: sh tests/fuzz/run.sh [SECONDS]   (per target, default 60; 0 = only
 #        replay the corpus, a quick regression check)
 # With clang's libFuzzer: builds each harness with
@@ -35,16 +39,21 @@ if command -v clang >/dev/null 2>&1; then
 fi
 
 fail=0
-# target  source  extra-flags  corpus  dictionary
-targets='npy tests/fuzz/fuzz_npy.c - npy tests/fuzz/npy.dict
-rom tests/fuzz/fuzz_rom.c - rom build/fuzz/rom.dict
-rom_f32 tests/fuzz/fuzz_rom.c -DPHGMG_REAL_FLOAT rom build/fuzz/rom.dict'
+# target  source  extra-flags  corpus  dictionary  libFuzzer-flags ('-': none)
+targets='npy tests/fuzz/fuzz_npy.c - npy tests/fuzz/npy.dict -
+npy_stream tests/fuzz/fuzz_npy_stream.c - npy tests/fuzz/npy.dict -
+rom tests/fuzz/fuzz_rom.c - rom build/fuzz/rom.dict -
+rom_f32 tests/fuzz/fuzz_rom.c -DPHGMG_REAL_FLOAT rom build/fuzz/rom.dict -
+cli tests/fuzz/fuzz_cli.c - cli - -close_fd_mask=3'
 
 if [ $have_libfuzzer = 1 ]; then
   if [ "$secs" = 0 ]; then echo "fuzz: clang libFuzzer + ASan + UBSan, replaying the corpus only"
   else echo "fuzz: clang libFuzzer + ASan + UBSan, ${secs} s per target"; fi
-  echo "$targets" | while read -r t src flags corpus dict; do
+  echo "$targets" | while read -r t src flags corpus dict rflags; do
     [ "$flags" = - ] && flags=
+    [ "$rflags" = - ] && rflags=
+    dictopt=
+    [ "$dict" = - ] || dictopt="-dict=$dict"
     bin="$out/fuzz_$t"
     # shellcheck disable=SC2086
     if ! clang -g -O1 -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all $flags "$src" -o "$bin" -lm; then
@@ -53,11 +62,13 @@ if [ $have_libfuzzer = 1 ]; then
     mkdir -p "$out/corpus_$t"
     log="$out/fuzz_$t.log"
     if [ "$secs" = 0 ]; then
-      ASAN_OPTIONS=detect_leaks=1 "$bin" -runs=0 -print_final_stats=1 -artifact_prefix="$out/crash-$t-" \
-        "tests/fuzz/corpus/$corpus" </dev/null >"$log" 2>&1
+      # shellcheck disable=SC2086
+      ASAN_OPTIONS=detect_leaks=1 "$bin" -runs=0 -print_final_stats=1 -artifact_prefix="$PWD/$out/crash-$t-" \
+        $rflags "tests/fuzz/corpus/$corpus" </dev/null >"$log" 2>&1
     else
+      # shellcheck disable=SC2086
       ASAN_OPTIONS=detect_leaks=1 "$bin" -max_total_time="$secs" -timeout=10 -rss_limit_mb=2048 \
-        -print_final_stats=1 -dict="$dict" -artifact_prefix="$out/crash-$t-" \
+        -print_final_stats=1 $dictopt $rflags -artifact_prefix="$PWD/$out/crash-$t-" \
         "$out/corpus_$t" "tests/fuzz/corpus/$corpus" </dev/null >"$log" 2>&1
     fi
     rc=$?
@@ -77,7 +88,7 @@ else
   command -v gcc >/dev/null 2>&1 || cc=cc
   echo "fuzz: clang's libFuzzer is not available; building the plain drivers with $cc + ASan/UBSan" \
        "and running the seed corpus only (no fuzzing)"
-  echo "$targets" | while read -r t src flags corpus dict; do
+  echo "$targets" | while read -r t src flags corpus dict rflags; do
     [ "$flags" = - ] && flags=
     bin="$out/fuzz_${t}_run"
     # shellcheck disable=SC2086
@@ -85,10 +96,13 @@ else
       echo "fuzz: $t: build failed"; exit 1
     fi
     printf 'fuzz: %s: ' "$t"
+    log="$out/fuzz_${t}_run.log"
     # shellcheck disable=SC2046
-    if ! ASAN_OPTIONS=detect_leaks=1 "$bin" $(ls -d "tests/fuzz/corpus/$corpus"/[!.]*) </dev/null; then
+    if ! ASAN_OPTIONS=detect_leaks=1 "$bin" $(ls -d "tests/fuzz/corpus/$corpus"/[!.]*) </dev/null >"$log" 2>&1; then
+      tail -n 40 "$log"
       echo "fuzz: $t: FINDING on the seed corpus"; exit 1
     fi
+    tail -n 1 "$log"
   done || fail=1
 fi
 exit $fail

@@ -1,0 +1,199 @@
+/* Fuzz harness for the argument handling of the `phgmg` command line
+   (examples/phgmg_cli.c, compiled in with its main renamed) on a tiny model
+   (N = 4, m = 1) in a scratch directory. Each input byte picks one token
+   of a vocabulary (commands, every option, numbers good and bad, the scratch
+   model's files, a malformed and an integer .npy, a directory, output paths
+   inside the scratch directory), at most 48 tokens; the resulting command
+   line is run. Any exit status is fine (0, 1, 2); sanitizers, leaks and
+   hangs are findings. Before each run the scratch directory is restored, so
+   a run never sees what an earlier one wrote. The command runs with the
+   scratch directory (/tmp/phgmg_fuzz_cli_XXXXXX, removed at exit) as its
+   working directory, so whatever it writes -- also under a relative name
+   such as "2" after --out -- stays there; the harness returns to the
+   starting directory afterwards (libFuzzer's corpus paths are relative).
+   run.sh passes an absolute -artifact_prefix for the same reason.
+
+   libFuzzer (clang):
+     clang -g -O1 -fsanitize=fuzzer,address,undefined tests/fuzz/fuzz_cli.c \
+           -o build/fuzz_cli -lm
+     ./build/fuzz_cli -max_total_time=60 -close_fd_mask=3 build/fuzz/corpus_cli tests/fuzz/corpus/cli
+   Plain driver (runs every file named on the command line), as fuzz_npy.c. */
+#define main phgmg_cli_main
+#include "../../examples/phgmg_cli.c"
+#undef main
+#include <dirent.h>
+#include <fcntl.h>
+#include <stdint.h>
+#include <unistd.h>
+
+int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
+
+static char g_dir[64];
+static int g_home = -1; /* the starting working directory */
+static char g_tok[96][128];
+static int g_ntok;
+static unsigned char *g_rom;
+static size_t g_rom_len;
+
+/* the tiny model: the 2-mass MSD, x = (q1, p1, q2, p2) */
+static const double J4[16] = {0, -1, 0, 0, 1, 0, 0, 0, 0, 0, 0, -1, 0, 0, 1, 0};
+static const double R4[16] = {0, 0, 0, 0, 0, 0.5, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0.5};
+static const double Q4[16] = {2, 0, -1, 0, 0, 1, 0, 0, -1, 0, 1, 0, 0, 0, 0, 1};
+static const double B4[4] = {0, 1, 0, 0};
+static const double poly[5] = {0, 0, 0, 0, 0.25}, idx[2] = {0, 2};
+
+static void fz_die(const char *what) {
+  fprintf(stderr, "fuzz_cli: %s\n", what);
+  abort();
+}
+
+static void put_npy(const char *name, const double *A, int rows, int cols) {
+  char path[256];
+  snprintf(path, sizeof path, "%s/%s", g_dir, name);
+  if (phgmg_npy_write(path, A, rows, cols, rows, 2, 0u) != PHGMG_OK) fz_die("cannot write the model");
+}
+
+static void put_bytes(const char *name, const void *b, size_t n) {
+  char path[256];
+  FILE *f;
+  snprintf(path, sizeof path, "%s/%s", g_dir, name);
+  f = fopen(path, "wb");
+  if (!f || (n && fwrite(b, 1, n, f) != n)) fz_die("cannot write a scratch file");
+  fclose(f);
+}
+
+/* Remove everything in dir (one level of subdirectories, as the CLI makes). */
+static void clear_dir(const char *dir, int depth) {
+  DIR *d = opendir(dir);
+  struct dirent *e;
+  char path[4096 + 300];
+  struct stat st;
+  if (!d) return;
+  while ((e = readdir(d)) != NULL) {
+    if (!strcmp(e->d_name, ".") || !strcmp(e->d_name, "..")) continue;
+    snprintf(path, sizeof path, "%s/%s", dir, e->d_name);
+    if (lstat(path, &st) == 0 && S_ISDIR(st.st_mode)) {
+      if (depth < 3) clear_dir(path, depth + 1);
+      rmdir(path);
+    } else {
+      unlink(path);
+    }
+  }
+  closedir(d);
+}
+
+static void cleanup(void) {
+  if (g_dir[0]) { clear_dir(g_dir, 0); rmdir(g_dir); }
+  free(g_rom);
+}
+
+/* The scratch directory as every run starts it. */
+static void restore(void) {
+  static const unsigned char int_idx[] = /* np.arange(2, dtype='<i8'): [0, 1] */
+    "\x93NUMPY\x01\x00\x76\x00{'descr': '<i8', 'fortran_order': False, 'shape': (2,), }"
+    "                                                     \n"
+    "\x00\x00\x00\x00\x00\x00\x00\x00\x01\x00\x00\x00\x00\x00\x00\x00";
+  double X[4 * 8];
+  int k;
+  clear_dir(g_dir, 0);
+  for (k = 0; k < 32; ++k) X[k] = sin(0.7 * k) + 0.1 * k; /* 8 generic snapshots */
+  put_npy("J.npy", J4, 4, 4); put_npy("R.npy", R4, 4, 4); put_npy("Q.npy", Q4, 4, 4);
+  put_npy("B.npy", B4, 4, 1); put_npy("X.npy", X, 4, 8); put_npy("poly.npy", poly, 5, 1);
+  put_npy("idx.npy", idx, 2, 1); put_npy("u.npy", X, 8, 1);
+  put_bytes("idx_i8.npy", int_idx, sizeof int_idx - 1);
+  put_bytes("garbage.npy", "not an npy file", 15);
+  if (g_rom) put_bytes("m.phgmgrom", g_rom, g_rom_len);
+  {
+    char path[256];
+    snprintf(path, sizeof path, "%s/adir", g_dir);
+    mkdir(path, 0700);
+  }
+}
+
+static void init(void) {
+  static const char *const words[] = {
+    "reduce", "simulate-rom", "info", "--help", "--version", "--J", "--R", "--B", "--Q", "--X",
+    "--simulate", "--dt", "--steps", "--input", "--amp", "--newton-tol", "--newton-iter", "--method",
+    "gmg-pod", "gmg-qm", "sp1", "sp2", "--r", "--rn", "--lambda", "--poly", "--poly-idx", "--poly-w",
+    "--no-deim", "--deim-tol", "--deim-max", "--deim-allow-negative", "--dt-map", "--out", "--name",
+    "--save-snapshots", "--quiet", "--model", "--states", "sin", "const", "square", "0", "1", "2", "3",
+    "-1", "0.1", "0.05", "1e-320", "1e999", "nan", "2147483646", "1x", "", "int", "m", NULL};
+  static const char *const files[] = {"J.npy", "R.npy", "Q.npy", "B.npy", "X.npy", "poly.npy", "idx.npy",
+                                      "idx_i8.npy", "u.npy", "garbage.npy", "m.phgmgrom", "adir", "o",
+                                      "y.npy", "xr.npy", "nofile.npy", "o/m.phgmgrom", NULL};
+  char *argv[24];
+  int k, argc = 0;
+  FILE *f;
+  long n;
+  char path[256];
+  strcpy(g_dir, "/tmp/phgmg_fuzz_cli_XXXXXX");
+  if (!mkdtemp(g_dir)) fz_die("mkdtemp");
+  atexit(cleanup);
+  for (k = 0; words[k]; ++k) strcpy(g_tok[g_ntok++], words[k]);
+  for (k = 0; files[k]; ++k) snprintf(g_tok[g_ntok++], sizeof g_tok[0], "%s/%s", g_dir, files[k]);
+  /* the model file, made once by the CLI itself */
+  restore();
+  argv[argc++] = (char *)"phgmg"; argv[argc++] = (char *)"reduce";
+  argv[argc++] = (char *)"--J"; argv[argc++] = g_tok[g_ntok - 17];
+  argv[argc++] = (char *)"--R"; argv[argc++] = g_tok[g_ntok - 16];
+  argv[argc++] = (char *)"--Q"; argv[argc++] = g_tok[g_ntok - 15];
+  argv[argc++] = (char *)"--B"; argv[argc++] = g_tok[g_ntok - 14];
+  argv[argc++] = (char *)"--X"; argv[argc++] = g_tok[g_ntok - 13];
+  argv[argc++] = (char *)"--dt-map"; argv[argc++] = (char *)"0.1";
+  argv[argc++] = (char *)"--method"; argv[argc++] = (char *)"gmg-pod";
+  argv[argc++] = (char *)"--r"; argv[argc++] = (char *)"3";
+  argv[argc++] = (char *)"--out"; argv[argc++] = g_tok[g_ntok - 5];
+  argv[argc++] = (char *)"--quiet";
+  argv[argc] = NULL;
+  if (chdir(g_dir) != 0) fz_die("chdir");
+  if (phgmg_cli_main(argc, argv) != 0) fz_die("cannot make the scratch model");
+  if (fchdir(g_home) != 0) fz_die("fchdir");
+  snprintf(path, sizeof path, "%s/o/rom.phgmgrom", g_dir);
+  f = fopen(path, "rb");
+  if (!f || fseek(f, 0, SEEK_END) != 0 || (n = ftell(f)) <= 0 || fseek(f, 0, SEEK_SET) != 0)
+    fz_die("no scratch model");
+  g_rom = (unsigned char *)malloc((size_t)n);
+  if (!g_rom || fread(g_rom, 1, (size_t)n, f) != (size_t)n) fz_die("cannot read the scratch model");
+  g_rom_len = (size_t)n;
+  fclose(f);
+}
+
+int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
+  char *argv[50];
+  int argc = 0;
+  size_t i;
+  if (g_home < 0 && (g_home = open(".", O_RDONLY)) < 0) fz_die("cannot open the working directory");
+  if (!g_dir[0]) init();
+  restore();
+  argv[argc++] = (char *)"phgmg";
+  for (i = 0; i < size && argc < 49; ++i) argv[argc++] = g_tok[data[i] % g_ntok];
+  argv[argc] = NULL;
+  g_quiet = 0;
+  fflush(stdout);
+  if (chdir(g_dir) != 0) fz_die("chdir");
+  (void)phgmg_cli_main(argc, argv);
+  if (fchdir(g_home) != 0) fz_die("fchdir");
+  fflush(stdout);
+  return 0;
+}
+
+#ifndef PHGMG_LIBFUZZER
+#if defined(__GNUC__) || defined(__clang__)
+__attribute__((weak))
+#endif
+int main(int argc, char **argv) {
+  int k, nok = 0;
+  for (k = 1; k < argc; ++k) {
+    FILE *f = fopen(argv[k], "rb");
+    unsigned char buf[256];
+    size_t n;
+    if (!f) { fprintf(stderr, "fuzz_cli: cannot open %s\n", argv[k]); return 1; }
+    n = fread(buf, 1, sizeof buf, f);
+    fclose(f);
+    LLVMFuzzerTestOneInput(buf, n);
+    ++nok;
+  }
+  printf("fuzz_cli: %d inputs ran without findings\n", nok);
+  return 0;
+}
+#endif

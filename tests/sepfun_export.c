@@ -1,0 +1,84 @@
+/* Exported C source of exp-polynomial, phi_cb and eta_cb reduced models (issue 13).
+   Without MODEL_HEADER: build three hand-made models (tests/sepfun_models.h), write
+   them with phgmg_rom_export_c into DIR and their reference outputs into
+   DIR/<name>.ref. With -DMODEL_HEADER="<name>.h" -DMODEL_NAME=<name> (and
+   PHGMG_NO_OFFLINE): include the exported model, print the same outputs; the
+   script tests/sepfun_export.sh compares them byte for byte (C and C++). */
+#define PHGMG_IMPLEMENTATION
+#include "../phgmg.h"
+#include <stdio.h>
+#include <math.h>
+#include "sepfun_models.h"
+
+#ifdef MODEL_HEADER
+#include MODEL_HEADER
+/* firmware-supplied nonlinearity of the phi_cb model */
+void sfx_cb_phi(int term, phgmg_real s, phgmg_real d[3], void *user) { sf_phi_table(term, s, d, user); }
+/* firmware-supplied manifold of the eta_cb model */
+void sfx_eta_eta(const phgmg_real *x2, phgmg_real *q, phgmg_real *Dq, phgmg_real *D2q, void *user) {
+  sf_eta_fixed(x2, q, Dq, D2q, user);
+}
+#endif
+
+static int print_outputs(const phgmg_rom *rom, FILE *f) {
+  static phgmg_real work[4096];
+  static double mem[1 << 14];
+  phgmg_real x[SF_R] = {0.3f, -0.2f, 0.25f, 0.1f, -0.3f}, g[SF_R], fx[SF_R], Hs[SF_R * SF_R],
+             Jf[SF_R * SF_R], u3[3 * SF_M], y[SF_M], tc[3];
+  phgmg_rom_stepper st;
+  int i, n, k;
+  if (phgmg_rom_check(rom) != PHGMG_OK) return 1;
+  fprintf(f, "%.17g\n", (double)phgmg_rom_hamiltonian(rom, x, work));
+  phgmg_rom_gradient(rom, x, g, work);
+  phgmg_rom_hessian(rom, x, Hs, work);
+  if (phgmg_rom_rhs(rom, x, NULL, fx, work) != PHGMG_OK || phgmg_rom_jacobian(rom, x, Jf, work) != PHGMG_OK) return 1;
+  for (i = 0; i < SF_R; ++i) fprintf(f, "%.17g %.17g\n", (double)g[i], (double)fx[i]);
+  for (i = 0; i < SF_R * SF_R; ++i) fprintf(f, "%.17g %.17g\n", (double)Hs[i], (double)Jf[i]);
+  if (phgmg_rom_stepper_init(&st, rom, (phgmg_real)0.05, 0, 0, mem, sizeof mem) != PHGMG_OK) return 1;
+  for (n = 0; n < 100; ++n) {
+    phgmg_rom_stage_times((phgmg_real)(0.05 * n), (phgmg_real)0.05, tc);
+    for (i = 0; i < 3; ++i)
+      for (k = 0; k < SF_M; ++k) u3[i * SF_M + k] = (phgmg_real)(0.5 * sin((1.0 + k) * (double)tc[i]));
+    if (phgmg_rom_step(&st, x, u3, y, NULL) != PHGMG_OK) return 1;
+    fprintf(f, "%.17g %.17g\n", (double)y[0], (double)y[1]);
+  }
+  return 0;
+}
+
+int main(int argc, char **argv) {
+#ifdef MODEL_HEADER
+  (void)argc; (void)argv;
+  return print_outputs(&MODEL_NAME, stdout);
+#else
+  static sf_model Md;
+  phgmg_rom cb, et;
+  char path[512];
+  FILE *f;
+  int rc = 0;
+  if (argc < 2) return 2;
+  sf_build(&Md, 5u);
+  cb = Md.rom;
+  cb.phi_cb = sf_phi_table; cb.poly = NULL; cb.expo = NULL; cb.poly_deg = 0; cb.nexp = 0; cb.nphi = 0;
+  et = Md.rom;
+  et.Ms = NULL; et.eta_cb = sf_eta_fixed; et.term = NULL; et.nphi = 1; /* shared Toda row */
+  snprintf(path, sizeof path, "%s/sfx_eta.h", argv[1]);
+  if (phgmg_rom_export_c(&et, "sfx_eta", path) != PHGMG_OK) return 1;
+  snprintf(path, sizeof path, "%s/sfx_eta.ref", argv[1]);
+  if (!(f = fopen(path, "w"))) return 1;
+  rc |= print_outputs(&et, f);
+  fclose(f);
+  snprintf(path, sizeof path, "%s/sfx_poly.h", argv[1]);
+  if (phgmg_rom_export_c(&Md.rom, "sfx_poly", path) != PHGMG_OK) return 1;
+  snprintf(path, sizeof path, "%s/sfx_cb.h", argv[1]);
+  if (phgmg_rom_export_c(&cb, "sfx_cb", path) != PHGMG_OK) return 1;
+  snprintf(path, sizeof path, "%s/sfx_poly.ref", argv[1]);
+  if (!(f = fopen(path, "w"))) return 1;
+  rc |= print_outputs(&Md.rom, f);
+  fclose(f);
+  snprintf(path, sizeof path, "%s/sfx_cb.ref", argv[1]);
+  if (!(f = fopen(path, "w"))) return 1;
+  rc |= print_outputs(&cb, f);
+  fclose(f);
+  return rc;
+#endif
+}
