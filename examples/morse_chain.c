@@ -361,9 +361,7 @@ int main(int argc, char **argv) {
   if (morse_chain_build(&M, &mo) != 0) { fprintf(stderr, "model\n"); return 1; }
   if (callbacks) { /* the same psi through the user callbacks instead of the built-in form */
     M.sys.poly_deg = 0; M.sys.poly = NULL;
-#if MORSE_HAVE_EXPPOLY
     M.sys.nexp = 0; M.sys.expo = NULL;
-#endif
   }
   rs = (int *)malloc(sizeof(int) * nr);
   rows = (rom_row *)calloc((size_t)nr * NMETH * 2, sizeof(rom_row));

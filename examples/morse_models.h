@@ -30,7 +30,7 @@
    twice: as phgmg's built-in exp-polynomial (poly = {D, 0, -D a^2}, expo =
    {(-2D, -a), (D, -2a)}, shared by all terms) and as the callbacks
    morse_psi / morse_dpsi / morse_ddpsi (user = the morse_chain), which compute
-   the same functions; see MORSE_HAVE_EXPPOLY below.
+   the same functions (examples/morse_chain.c --callbacks uses those).
    Storage: banded, interleaved order (l_1, p_1, l_2, p_2, ...), kb = 3;
    idx_l[i], idx_p[i] give the positions of l_{i+1}, p_{i+1}.
 
@@ -46,12 +46,6 @@
 #define MORSE_FN static __attribute__((unused))
 #else
 #define MORSE_FN static
-#endif
-
-/* 1: fill phgmg_ph_system's exp-polynomial fields (nexp, expo, phi_nfun;
-   needs a phgmg.h that has them); 0: callbacks only. */
-#ifndef MORSE_HAVE_EXPPOLY
-#define MORSE_HAVE_EXPPOLY 1
 #endif
 
 typedef struct morse_opts {
@@ -157,13 +151,11 @@ MORSE_FN int morse_chain_build(morse_chain *M, const morse_opts *o) {
   M->sys.sep_w = NULL;
   M->sys.phi = morse_psi; M->sys.dphi = morse_dpsi; M->sys.ddphi = morse_ddpsi;
   M->sys.user = M;
-#if MORSE_HAVE_EXPPOLY
   M->sys.poly_deg = 2;
   M->sys.poly = M->poly;
   M->sys.nexp = 2;
   M->sys.expo = M->expo;
   M->sys.phi_nfun = 0;
-#endif
   return 0;
 }
 
