@@ -82,14 +82,27 @@ static const char *const help_lines[] = {
   "                      R + K <= N)\n",
   "  --lambda L          gmg-qm ridge parameter, on the un-normalised sum over the\n",
   "                      snapshots (default 1e-3; 0 = exactly zero)\n",
-  "  --poly FILE         separable polynomial nonlinearity: a vector of the\n",
-  "                      coefficients c_0, c_1, ..., c_d (constant first, d >= 1) of phi,\n",
-  "                      shared by every term. Needs --poly-idx.\n",
+  "  --poly FILE         separable nonlinearity H_nl = sum_k w_k phi_k(x[idx_k]) from the\n",
+  "                      exp-polynomial family phi(s) = sum_j c_j s^j + sum_e a_e exp(b_e s):\n",
+  "                      the coefficients c_0, ..., c_d (constant first) as a vector\n",
+  "                      (shared by every term) or a matrix (terms, d+1), one row per term.\n",
+  "  --exp FILE          the exponentials (a_e, b_e): a matrix (n_exp, 2) shared by every\n",
+  "                      term, or (terms, 2 n_exp) with rows a_1 b_1 a_2 b_2 ... per term\n",
+  "                      (a (terms, 2) matrix with up to 8 terms is per term only beside\n",
+  "                      a per-term --poly).\n",
+  "  --potential NAME    a named potential instead of --poly/--exp: toda (e^s - 1 - s),\n",
+  "                      cosh:A ((cosh(A s) - 1)/A^2), morse:D:A (D (1 - e^{-A s})^2),\n",
+  "                      fpu:K3:K4 (K3 s^3/3 + K4 s^4/4). --poly, --exp or --potential\n",
+  "                      need --poly-idx.\n",
   "  --poly-idx FILE     a vector of the 0-based state coordinates idx_k of the terms\n",
   "                      (each in [0, N); any integer dtype, e.g. np.arange, or float64).\n",
   "  --poly-w FILE       a vector of the term weights w_k (default all 1).\n",
   "  --no-deim           keep every nonlinear term online (exact, cost O(terms)).\n",
   "                      Default: structure-preserving DEIM picks a few of them.\n",
+  "  --hyper H           hyper-reduction of the nonlinear terms: ecsw (default; weights\n",
+  "                      >= 0 by non-negative least squares), qdeim or greedy (the\n",
+  "                      paper's structure-preserving DEIM; weights may be negative)\n",
+  "  --hyper-tol T       ecsw: relative training residual of the reduced gradient (1e-6)\n",
   "  --deim-tol T        DEIM keeps the modes with sigma_k / sigma_1 > T (default 1e-8)\n",
   "  --deim-max K        at most K DEIM points (default: no cap)\n",
   "  --deim-allow-negative  accept negative DEIM weights (the reduced energy may then\n",
@@ -594,7 +607,8 @@ static int rom_fields(const phgmg_rom *rom, rom_field *f) {
     FIELD("P0", rom->P0, nd, r);
     if (rom->kind == PHGMG_ROM_QUADRATIC) FIELD("P1", rom->P1, nd, rn);
     FIELD("w", rom->w, nd, 1);
-    FIELD("poly", rom->poly, rom->poly_deg + 1, 1);
+    FIELD("poly", rom->poly, rom->nphi > 1 ? rom->nphi : 1, rom->poly_deg + 1);
+    if (rom->nexp) FIELD("expo", rom->expo, rom->nphi > 1 ? rom->nphi : 1, 2 * rom->nexp);
   }
   FIELD("Phi", rom->Phi, r, r);
   FIELD("Gam", rom->Gam, r, 3 * m);
@@ -760,6 +774,8 @@ static int explain_validate(phgmg_result rc, const mat *J, const mat *R, const m
 /* ---- reduce ------------------------------------------------------------------- */
 typedef struct reduce_args {
   const char *J, *R, *B, *Q, *X, *poly, *poly_idx, *poly_w, *out, *name, *input, *method;
+  const char *expf, *potential, *hyper;
+  double hyper_tol;
   int simulate, steps, r, rn, no_deim, deim_max, deim_neg, save_snap, have_dt_map, newton_iter;
   double dt, amp, lambda, deim_tol, dt_map, newton_tol;
   int have_lambda;
@@ -797,6 +813,8 @@ static int parse_reduce(int argc, char **argv, reduce_args *A) {
     if (repeated_opt(o, seen, &nseen)) return 2;
     STR("--J", J) STR("--R", R) STR("--B", B) STR("--Q", Q) STR("--X", X)
     STR("--poly", poly) STR("--poly-idx", poly_idx) STR("--poly-w", poly_w)
+    STR("--exp", expf) STR("--potential", potential) STR("--hyper", hyper)
+    DBL("--hyper-tol", hyper_tol, 0.0)
     STR("--out", out) STR("--name", name) STR("--input", input) STR("--method", method)
     INT("--steps", steps, 1, INT_MAX - 1) INT("--r", r, 1, INT_MAX) INT("--rn", rn, 1, 64)
     INT("--deim-max", deim_max, 1, INT_MAX) INT("--newton-iter", newton_iter, 1, 1000)
@@ -828,8 +846,13 @@ static int parse_reduce(int argc, char **argv, reduce_args *A) {
   if (!A->r) return usage_error("reduce: --r is required");
   if (!A->out) return usage_error("reduce: --out DIR is required");
   if (!!A->X == !!A->simulate) return usage_error("reduce: give exactly one of --X FILE and --simulate");
-  if (!!A->poly != !!A->poly_idx) return usage_error("reduce: --poly and --poly-idx go together");
-  if (A->poly_w && !A->poly) return usage_error("reduce: --poly-w needs --poly and --poly-idx");
+  if (A->potential && (A->poly || A->expf)) return usage_error("reduce: --potential replaces --poly and --exp");
+  if (!!(A->poly || A->expf || A->potential) != !!A->poly_idx)
+    return usage_error("reduce: --poly/--exp/--potential and --poly-idx go together");
+  if (A->poly_w && !A->poly_idx) return usage_error("reduce: --poly-w needs a nonlinear part (--poly-idx)");
+  if (A->hyper && strcmp(A->hyper, "ecsw") && strcmp(A->hyper, "qdeim") && strcmp(A->hyper, "greedy"))
+    return usage_error("--hyper '%s': expected ecsw, qdeim or greedy", A->hyper);
+  if (!(A->hyper_tol < 1.0)) return usage_error("--hyper-tol must be < 1");
   if (name_problem(A->name)) return usage_error("--name '%s': %s", A->name, name_problem(A->name));
   if (!A->have_dt_map) A->dt_map = A->simulate ? A->dt : 0.0;
   if (A->simulate && too_big((double)A->steps + 1.0, "--simulate --steps: the snapshots (N x (steps+1)) alone"))
@@ -838,18 +861,98 @@ static int parse_reduce(int argc, char **argv, reduce_args *A) {
 }
 
 typedef struct reduce_state {
-  mat J, R, B, Q, X, poly, pidx, pw;
+  mat J, R, B, Q, X, poly, pidx, pw, ex;
   int *idx;
+  double *fpoly, *fexp, named[8]; /* the family's coefficients as phgmg_ph_system wants them */
   double *Xsim, *Ysim, *V0;
   cli_input in;
   phgmg_reduced *red;
   staged sg; /* the outputs, renamed into place at the end */
 } reduce_state;
 
+/* A named potential (--potential) as exp-polynomial coefficients into S->named:
+   returns the degree and the exponential count, -1 for an unknown name. */
+static int named_potential(const char *spec, double *c, int *deg, int *nexp) {
+  double p1 = 1.0, p2 = 1.0;
+  int n = 0;
+  const char *colon = strchr(spec, ':');
+  size_t len = colon ? (size_t)(colon - spec) : strlen(spec);
+  if (colon) {
+    char *end;
+    p1 = strtod(colon + 1, &end);
+    n = 1;
+    if (*end == ':') { p2 = strtod(end + 1, &end); n = 2; }
+    if (*end || !isfinite(p1) || !isfinite(p2)) return -1;
+  }
+  memset(c, 0, 8 * sizeof(double));
+  if (len == 4 && !strncmp(spec, "toda", 4) && n == 0) {        /* e^s - 1 - s */
+    c[0] = -1.0; c[1] = -1.0; *deg = 1; *nexp = 1; c[2] = 1.0; c[3] = 1.0;
+  } else if (len == 4 && !strncmp(spec, "cosh", 4) && n <= 1 && p1 != 0.0) { /* (cosh(a s) - 1)/a^2 */
+    c[0] = -1.0 / (p1 * p1); *deg = 0; *nexp = 2;
+    c[1] = 0.5 / (p1 * p1); c[2] = p1; c[3] = 0.5 / (p1 * p1); c[4] = -p1;
+  } else if (len == 5 && !strncmp(spec, "morse", 5) && n == 2 && p2 != 0.0) { /* D (1 - e^{-a s})^2 */
+    c[0] = p1; *deg = 0; *nexp = 2; c[1] = -2.0 * p1; c[2] = -p2; c[3] = p1; c[4] = -2.0 * p2;
+  } else if (len == 3 && !strncmp(spec, "fpu", 3) && n == 2) {  /* k3 s^3/3 + k4 s^4/4 */
+    c[3] = p1 / 3.0; c[4] = p2 / 4.0; *deg = 4; *nexp = 0;
+  } else {
+    return -1;
+  }
+  return 0;
+}
+
+/* The exp-polynomial family of the separable part from --potential, or
+   --poly (vector: shared; (terms, d+1): per term) and --exp ((n_exp, 2):
+   shared; (terms, 2 n_exp): per term), into sys (row-major per term). */
+static int load_family(const reduce_args *A, reduce_state *S, phgmg_ph_system *sys, int nt) {
+  int deg = 0, ne = 0, per_p = 0, per_e = 0, t, j, k;
+  if (A->potential) {
+    if (named_potential(A->potential, S->named, &deg, &ne))
+      return fail("--potential '%s': expected toda, cosh:A (A != 0), morse:D:A (A != 0) or fpu:K3:K4", A->potential);
+    sys->poly_deg = deg; sys->poly = S->named; sys->nexp = ne; sys->expo = S->named + deg + 1;
+    return 0;
+  }
+  if (A->poly) {
+    if (mat_load(&S->poly, "--poly", A->poly)) return 1;
+    per_p = !is_vector(&S->poly);
+    if (per_p && S->poly.rows != nt)
+      return fail("%s (--poly): expected a vector of d+1 coefficients or a (%d, d+1) matrix, got %s", A->poly, nt,
+                  shape_str(&S->poly));
+    deg = (per_p ? S->poly.cols : S->poly.rows * S->poly.cols) - 1;
+    if (deg < 0 || deg > 32) return fail("%s (--poly): degree %d; expected 0..32", A->poly, deg);
+  }
+  if (A->expf) {
+    if (mat_load(&S->ex, "--exp", A->expf)) return 1;
+    /* (terms, 2 n_exp) is per term; a (terms, 2) matrix is ambiguous for up to 8
+       terms and is then per term only beside a per-term --poly */
+    per_e = S->ex.rows == nt && S->ex.cols % 2 == 0 && (S->ex.cols != 2 || nt > 8 || per_p);
+    ne = per_e ? S->ex.cols / 2 : S->ex.rows;
+    if ((!per_e && S->ex.cols != 2) || ne < 1 || ne > 8)
+      return fail("%s (--exp): expected (n_exp, 2) pairs (a, b) or a (%d, 2 n_exp) matrix, 1 <= n_exp <= 8, got %s",
+                  A->expf, nt, shape_str(&S->ex));
+  }
+  sys->phi_nfun = (per_p || per_e) ? nt : 0;
+  t = sys->phi_nfun ? nt : 1;
+  S->fpoly = (double *)calloc((size_t)t * (size_t)(deg + 1), sizeof(double));
+  S->fexp = (double *)calloc((size_t)t * 2 * (size_t)(ne ? ne : 1), sizeof(double));
+  if (!S->fpoly || !S->fexp) return fail("out of memory");
+  for (k = 0; k < t; ++k) {   /* row-major per function: mat is column-major */
+    for (j = 0; A->poly && j <= deg; ++j)
+      S->fpoly[(size_t)k * (deg + 1) + j] = per_p ? S->poly.a[k + (size_t)j * S->poly.rows] : S->poly.a[j];
+    for (j = 0; j < ne; ++j) {
+      S->fexp[(size_t)k * 2 * ne + 2 * j] = per_e ? S->ex.a[k + (size_t)(2 * j) * S->ex.rows] : S->ex.a[j];
+      S->fexp[(size_t)k * 2 * ne + 2 * j + 1] =
+          per_e ? S->ex.a[k + (size_t)(2 * j + 1) * S->ex.rows] : S->ex.a[j + S->ex.rows];
+    }
+  }
+  if (deg < 1 && ne == 0) return fail("--poly: a nonlinear part needs degree >= 1 or --exp");
+  sys->poly_deg = deg; sys->poly = S->fpoly; sys->nexp = ne; sys->expo = ne ? S->fexp : NULL;
+  return 0;
+}
+
 static void reduce_cleanup(reduce_state *S) {
   mat_free(&S->J); mat_free(&S->R); mat_free(&S->B); mat_free(&S->Q); mat_free(&S->X);
-  mat_free(&S->poly); mat_free(&S->pidx); mat_free(&S->pw); mat_free(&S->in.tab);
-  free(S->idx); free(S->Xsim); free(S->Ysim); free(S->V0);
+  mat_free(&S->poly); mat_free(&S->pidx); mat_free(&S->pw); mat_free(&S->ex); mat_free(&S->in.tab);
+  free(S->idx); free(S->fpoly); free(S->fexp); free(S->Xsim); free(S->Ysim); free(S->V0);
   phgmg_reduced_destroy(S->red);
   stage_abort(&S->sg); /* after a failure: no output of this run stays */
 }
@@ -858,7 +961,7 @@ static void reduce_cleanup(reduce_state *S) {
    that this run (list ol) did not write, e.g. after another method. */
 static void remove_stale(const char *dir, const char *name, const outlist *ol) {
   static const char *const all[] = {"Bh", "Qh", "K", "G00", "G01", "G10", "G11", "Q01", "Q11", "Ms",
-                                    "P0", "P1", "w", "poly", "Phi", "Gam", "SX", "SU", "V0", "V2", "M",
+                                    "P0", "P1", "w", "poly", "expo", "Phi", "Gam", "SX", "SU", "V0", "V2", "M",
                                     "snapshots", "fom_y", NULL};
   char path[4096 + 256], file[128];
   struct stat st;
@@ -917,12 +1020,8 @@ static int cmd_reduce_impl(const reduce_args *A, reduce_state *S) {
   sys.N = N; sys.m = m; sys.storage = PHGMG_DENSE;
   sys.J = S->J.a; sys.R = S->R.a; sys.Q = S->Q.a; sys.B = S->B.a;
   sys.nl = PHGMG_NL_NONE;
-  if (A->poly) {
+  if (A->poly_idx) {
     int nt;
-    if (mat_load(&S->poly, "--poly", A->poly)) return 1;
-    if (!is_vector(&S->poly) || S->poly.rows * S->poly.cols < 2)
-      return fail("%s (--poly): expected a vector of d+1 >= 2 coefficients (constant first), got %s",
-                  A->poly, shape_str(&S->poly));
     if (mat_load(&S->pidx, "--poly-idx", A->poly_idx)) return 1;
     nt = S->pidx.rows * S->pidx.cols;
     if (!is_vector(&S->pidx) || nt < 1)
@@ -947,9 +1046,10 @@ static int cmd_reduce_impl(const reduce_args *A, reduce_state *S) {
     sys.nsep = nt;
     sys.sep_idx = S->idx;
     sys.sep_w = A->poly_w ? S->pw.a : NULL;
-    sys.poly_deg = S->poly.rows * S->poly.cols - 1;
-    sys.poly = S->poly.a;
-    progress("nonlinear part: %d terms, polynomial of degree %d", nt, sys.poly_deg);
+    if (load_family(A, S, &sys, nt)) return 1;
+    progress("nonlinear part: %d terms, %s, polynomial degree %d, %d exponentials%s", nt,
+             A->potential ? A->potential : "exp-polynomial", sys.poly_deg, sys.nexp,
+             sys.phi_nfun > 1 ? " (one function per term)" : "");
   }
   rc = phgmg_ph_validate(&sys, 0.0, &rcond, NULL);
   if (rc != PHGMG_OK) return explain_validate(rc, &S->J, &S->R, &S->B, &S->Q, rcond);
@@ -1013,7 +1113,10 @@ static int cmd_reduce_impl(const reduce_args *A, reduce_state *S) {
   o.r = A->r;
   o.rn = A->rn;
   o.lambda = A->lambda > 0.0 ? A->lambda : -1.0; /* 0 on the command line = exactly zero */
-  o.deim = A->poly && !A->no_deim;
+  o.deim = A->poly_idx && !A->no_deim;
+  o.hyper = !A->hyper || !strcmp(A->hyper, "ecsw") ? PHGMG_HYPER_ECSW
+            : !strcmp(A->hyper, "qdeim") ? PHGMG_HYPER_QDEIM : PHGMG_HYPER_GREEDY;
+  o.hyper_tol = A->hyper_tol;
   o.deim_tol = A->deim_tol > 0.0 ? A->deim_tol : 1e-300;
   o.deim_max = A->deim_max;
   o.deim_allow_negative = A->deim_neg;
@@ -1043,7 +1146,10 @@ static int cmd_reduce_impl(const reduce_args *A, reduce_state *S) {
   rom = phgmg_reduced_rom(S->red);
   progress("  done in %.2f s: r = %d, m = %d%s; sigma_{r'+1}/sigma_1 = %.3g, rcond(D^T G D) = %.3g", t_red, rom->r,
            rom->m, rom->nd ? "" : ", quadratic energy", info.pod_sigma_ratio, info.rcond_dgd);
-  if (rom->nd) progress("  DEIM: %d points, %d negative weights", info.deim_modes, info.deim_negative);
+  if (rom->nd && o.deim)
+    progress("  hyper-reduction %s: %d points, %d negative weights, smallest weight %.3g, training residual %.2g",
+             A->hyper ? A->hyper : "ecsw", info.deim_modes, info.deim_negative, info.hyper_min_weight,
+             info.hyper_residual);
 
   /* --- outputs --- */
   if (mkdir_p(A->out)) return 1;
@@ -1116,8 +1222,10 @@ static int cmd_reduce_impl(const reduce_args *A, reduce_state *S) {
   fprintf(jf, ",\n  \"system\": {\"J\": ");
   json_str(jf, A->J); fprintf(jf, ", \"R\": "); json_str(jf, A->R);
   fprintf(jf, ", \"B\": "); json_str(jf, A->B); fprintf(jf, ", \"Q\": "); json_str(jf, A->Q);
-  if (A->poly) {
-    fprintf(jf, ", \"poly\": "); json_str(jf, A->poly);
+  if (A->poly_idx) {
+    if (A->poly) { fprintf(jf, ", \"poly\": "); json_str(jf, A->poly); }
+    if (A->expf) { fprintf(jf, ", \"exp\": "); json_str(jf, A->expf); }
+    if (A->potential) { fprintf(jf, ", \"potential\": "); json_str(jf, A->potential); }
     fprintf(jf, ", \"poly_idx\": "); json_str(jf, A->poly_idx);
     if (A->poly_w) { fprintf(jf, ", \"poly_w\": "); json_str(jf, A->poly_w); }
   }
@@ -1305,7 +1413,8 @@ static int cmd_info(int argc, char **argv) {
   printf("%s: %s reduced model (%s), r = %d, m = %d", argv[2],
          rom.kind == PHGMG_ROM_QUADRATIC ? "quadratic-manifold" : "linear", method_name(rom.method), rom.r, rom.m);
   if (rom.kind == PHGMG_ROM_QUADRATIC) printf(", r_n = %d", rom.rn);
-  if (rom.nd) printf(", %d nonlinear terms (polynomial degree %d)", rom.nd, rom.poly_deg);
+  if (rom.nd) printf(", %d nonlinear terms (polynomial degree %d, %d exponentials%s)", rom.nd, rom.poly_deg, rom.nexp,
+                     rom.nphi > 1 ? ", one function per term" : "");
   if (rom.Phi) {
     char buf[32];
     printf(", step map for dt = %s", num_str((double)rom.dt, buf));

@@ -866,8 +866,15 @@ TEST(test_deim_negative_weight) {
     for (i = 0; i < n; ++i) X[i + j * N] = c * z[i];
     for (i = n; i < N; ++i) X[i + j * N] = th_rand();
   }
+  /* the default hyper-reduction (ECSW) keeps every weight >= 0 here */
   o = ropts(PHGMG_METHOD_GMG_POD, 2); o.deim = 1;
   memset(&info, 0, sizeof info);
+  CHECK_RC(phgmg_reduce(&red, &M.sys, X, N, ns, &o, &info, NULL), PHGMG_OK);
+  CHECK(info.hyper_method == PHGMG_HYPER_ECSW && info.deim_negative == 0 && info.hyper_min_weight > 0.0);
+  CHECK(info.hyper_residual <= 1e-6);
+  phgmg_reduced_destroy(red); red = NULL;
+  /* the paper's DEIM gives one negative weight */
+  o.hyper = PHGMG_HYPER_QDEIM;
   EXPECT(reduce_g(&M.sys, X, N, ns, &o, &info), PHGMG_ERR_NEGATIVE_WEIGHT);
   CHECK(info.deim_negative == 1 && info.deim_modes == 1);
   o.deim_allow_negative = 1;
@@ -879,9 +886,9 @@ TEST(test_deim_negative_weight) {
   }
   phgmg_reduced_destroy(red);
   /* GMG-QM and SP2 see the same gradient snapshots */
-  o = ropts(PHGMG_METHOD_GMG_QM, 2); o.rn = 1; o.deim = 1;
+  o = ropts(PHGMG_METHOD_GMG_QM, 2); o.rn = 1; o.deim = 1; o.hyper = PHGMG_HYPER_QDEIM;
   EXPECT(reduce_g(&M.sys, X, N, ns, &o, &info), PHGMG_ERR_NEGATIVE_WEIGHT);
-  o = ropts(PHGMG_METHOD_SP2, 3); o.deim = 1;
+  o = ropts(PHGMG_METHOD_SP2, 3); o.deim = 1; o.hyper = PHGMG_HYPER_QDEIM;
   EXPECT(reduce_g(&M.sys, X, N, ns, &o, &info), PHGMG_ERR_NEGATIVE_WEIGHT);
   /* a cached DEIM result (opts.deim_pts/deim_w) is checked the same way */
   {
