@@ -9,7 +9,7 @@
 set -eu
 B=${1:-build}
 ARMF="-mcpu=cortex-m4 -mthumb -mfloat-abi=hard -mfpu=fpv4-sp-d16 -Os"
-MODELS="lin_gmgpod lin_gmgqm lin_sp1 nl_gmgpod nl_gmgqm nl_sp2"
+MODELS="lin_gmgpod lin_gmgqm lin_sp1 nl_gmgpod nl_gmgqm nl_sp2 mo_gmgpod mo_gmgqm mo_sp2"
 mkdir -p "$B/cm4"
 command -v arm-none-eabi-gcc >/dev/null || { echo "arm-none-eabi-gcc not found (apt-get install gcc-arm-none-eabi libnewlib-arm-none-eabi)"; exit 1; }
 echo "Cortex-M4F images (text = code + constant model data in flash, bss = static workspace):"

@@ -2,7 +2,10 @@
 
    Builds the demo's reduced models at r = 16 (linear MSD: SP1-POD, GMG-POD
    with its step map, GMG-QM; nonlinear MSD, n = 500: SP2-POD, GMG-POD and
-   GMG-QM with structure-preserving DEIM), then for each model:
+   GMG-QM with structure-preserving DEIM; the Morse chain of
+   examples/morse_chain.c, n = 100, whose Hamiltonian is an exp-polynomial:
+   SP2-POD, GMG-POD and GMG-QM with structure-preserving DEIM), then for each
+   model:
      - steps it in memory for 1000 steps of dt = 0.1 with u = 0.1 sin t and
        writes the outputs to <dir>/<name>.ref (the reference);
      - saves it as a binary model file <dir>/<name>.phgmgrom, loads that file
@@ -15,6 +18,7 @@
 #define PHGMG_IMPLEMENTATION
 #include "../../phgmg.h"
 #include "../msd_models.h"
+#include "../morse_models.h"
 #include <stdio.h>
 #include "controller_run.h"
 
@@ -70,6 +74,8 @@ int main(int argc, char **argv) {
   msd_linear L;
   msd_nonlinear M;
   msd_nl_opts mo;
+  morse_chain C;
+  morse_opts co;
   phgmg_gl3_opts go;
   double *X, *x0;
   int bad = 0;
@@ -97,6 +103,21 @@ int main(int argc, char **argv) {
   bad |= do_model(argv[1], "nl_gmgpod", &M.sys, X, ns, PHGMG_METHOD_GMG_POD, 1, 0);
   bad |= do_model(argv[1], "nl_gmgqm", &M.sys, X, ns, PHGMG_METHOD_GMG_QM, 1, 5e-3);
   free(X); free(x0);
+  /* Morse chain (issue 13): exp-polynomial separable part, training input
+     u = 0.1 sin t, Newton tol 1e-10 as in examples/morse_chain.c; GMG-QM with
+     that example's lambda rule max(0.2 e_proj(16), 10^-2.5) = 10^-2.5 */
+  memset(&co, 0, sizeof co);
+  co.n = 100;
+  if (morse_chain_build(&C, &co) != 0) return 1;
+  X = (double *)malloc(sizeof(double) * C.sys.N * ns);
+  x0 = (double *)calloc((size_t)C.sys.N, sizeof(double));
+  go.tol = 1e-10; go.max_iter = 20;
+  if (phgmg_simulate(&C.sys, x0, 0, 0.1, nsteps, morse_input_train, NULL, &go, X, NULL, NULL, NULL, NULL, NULL) != PHGMG_OK) return 1;
+  bad |= do_model(argv[1], "mo_sp2", &C.sys, X, ns, PHGMG_METHOD_SP2, 1, 0);
+  bad |= do_model(argv[1], "mo_gmgpod", &C.sys, X, ns, PHGMG_METHOD_GMG_POD, 1, 0);
+  bad |= do_model(argv[1], "mo_gmgqm", &C.sys, X, ns, PHGMG_METHOD_GMG_QM, 1, pow(10.0, -2.5));
+  free(X); free(x0);
+  morse_chain_free(&C);
   msd_linear_free(&L);
   msd_nonlinear_free(&M);
   return bad;
