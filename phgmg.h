@@ -3991,36 +3991,12 @@ done:
   return rc;
 }
 
-PHGMG_DEF phgmg_result phgmg_gl3_create(phgmg_gl3 **out, const phgmg_ph_system *sys, double dt,
-                                        const phgmg_gl3_opts *opts, const phgmg_allocator *alloc) {
-  phgmg_gl3 *s;
-  phgmg_result rc;
-  int N, m, i, j, k;
-  size_t NN, N3;
-  if (!out) return PHGMG_ERR_INVALID_ARG;
-  *out = NULL;
-  rc = phgmg__ph_check(sys);
-  if (rc != PHGMG_OK) return rc;
-  if (!(dt > 0.0) || dt == HUGE_VAL) return PHGMG_ERR_INVALID_ARG;
-  if (opts && (opts->max_iter < 0 || opts->tol < 0.0 || opts->contraction < 0.0 ||
-               opts->tol != opts->tol || opts->contraction != opts->contraction))
-    return PHGMG_ERR_INVALID_ARG;
-  s = PHGMG__CAST(phgmg_gl3 *, phgmg__alloc(alloc, sizeof(phgmg_gl3)));
-  if (!s) return PHGMG_ERR_NOMEM;
-  memset(s, 0, sizeof *s);
-  if (alloc) s->al = *alloc;
-  s->sys = *sys;
-  N = s->N = sys->N;
-  m = s->m = sys->m;
-  NN = (size_t)N * (size_t)N;
-  N3 = 3 * (size_t)N;
-  s->h = dt;
-  s->tol = (opts && opts->tol > 0.0) ? opts->tol : 1e-10;
-  s->max_iter = (opts && opts->max_iter > 0) ? opts->max_iter : 10;
-  s->contraction = (opts && opts->contraction > 0.0) ? opts->contraction : 0.5;
-  s->flush = !(opts && opts->keep_tiny);
-  s->ftau = s->flush ? PHGMG__DBL_MIN : 0.0;
-  s->linear = sys->nl == PHGMG_NL_NONE;
+/* GL3 coefficients, the transformation of A^{-1}, the extrapolation matrix
+   of the previous collocation polynomial, and the solver mode. */
+PHGMG__PRIV void phgmg__gl3_setup_method(phgmg_gl3 *s, const phgmg_gl3_opts *opts) {
+  const phgmg_ph_system *sys = &s->sys;
+  const int N = s->N;
+  int i, j, k;
   phgmg_gl3_coefficients(s->c, s->b, s->A);
   phgmg__gl3_transform(s->A, s->T, s->Ti, &s->gam, &s->alp, &s->bet);
   {
@@ -4048,31 +4024,38 @@ PHGMG_DEF phgmg_result phgmg_gl3_create(phgmg_gl3 **out, const phgmg_ph_system *
   else
     s->mode = sys->storage == PHGMG_DENSE ? PHGMG__GL3_DENSE : PHGMG__GL3_BANDED;
 
-  s->U = phgmg__dalloc(&s->al, 3 * (size_t)m);
-  s->G = phgmg__dalloc(&s->al, N3);
-  s->xnew = phgmg__dalloc(&s->al, (size_t)N);
-  if (!s->U || !s->G || !s->xnew) { rc = PHGMG_ERR_NOMEM; goto fail; }
-  if (s->mode == PHGMG__GL3_MAP) {
-    if (!phgmg__ph_mat_finite(sys, sys->J) || !phgmg__ph_mat_finite(sys, sys->R) ||
-        !phgmg__ph_mat_finite(sys, sys->Q) || !phgmg__all_finite(sys->B, (size_t)N * (size_t)m)) {
-      rc = PHGMG_ERR_NANINF;
-      goto fail;
+}
+
+/* Linear system, dense, small: the precomputed step map (tiny entries of the
+   maps flushed once). */
+PHGMG__PRIV phgmg_result phgmg__gl3_setup_map(phgmg_gl3 *s) {
+  const phgmg_ph_system *sys = &s->sys;
+  const int N = s->N, m = s->m;
+  int i;
+  phgmg_result rc;
+  if (!phgmg__ph_mat_finite(sys, sys->J) || !phgmg__ph_mat_finite(sys, sys->R) ||
+      !phgmg__ph_mat_finite(sys, sys->Q) || !phgmg__all_finite(sys->B, (size_t)N * (size_t)m)) return PHGMG_ERR_NANINF;
+  rc = phgmg__gl3_build_map(s);
+  if (rc != PHGMG_OK) return rc;
+  if (s->flush) { /* the maps decay along a chain: tiny entries flushed once, per column */
+    for (i = 0; i < 3 * N; ++i) {
+      if (i < N) phgmg__flush_tiny_rel(s->Phi + (size_t)i * (size_t)N, (size_t)N);
+      phgmg__flush_tiny_rel(s->GX + (size_t)i * (size_t)N, (size_t)N);
     }
-    rc = phgmg__gl3_build_map(s);
-    if (rc != PHGMG_OK) goto fail;
-    if (s->flush) { /* the maps decay along a chain: tiny entries flushed once, per column */
-      for (i = 0; i < 3 * N; ++i) {
-        if (i < N) phgmg__flush_tiny_rel(s->Phi + (size_t)i * (size_t)N, (size_t)N);
-        phgmg__flush_tiny_rel(s->GX + (size_t)i * (size_t)N, (size_t)N);
-      }
-      for (i = 0; i < 9 * m; ++i) {
-        if (i < 3 * m) phgmg__flush_tiny_rel(s->Gam + (size_t)i * (size_t)N, (size_t)N);
-        phgmg__flush_tiny_rel(s->GU + (size_t)i * (size_t)N, (size_t)N);
-      }
+    for (i = 0; i < 9 * m; ++i) {
+      if (i < 3 * m) phgmg__flush_tiny_rel(s->Gam + (size_t)i * (size_t)N, (size_t)N);
+      phgmg__flush_tiny_rel(s->GU + (size_t)i * (size_t)N, (size_t)N);
     }
-    *out = s;
-    return PHGMG_OK;
   }
+  return PHGMG_OK;
+}
+
+/* Newton vectors, and the fast path of a shared built-in separable function. */
+PHGMG__PRIV phgmg_result phgmg__gl3_setup_newton(phgmg_gl3 *s) {
+  const phgmg_ph_system *sys = &s->sys;
+  const int N = s->N;
+  const size_t N3 = 3 * (size_t)N;
+  int i, k;
   s->Z = phgmg__dalloc(&s->al, N3);
   s->W = phgmg__dalloc(&s->al, N3);
   s->Y = phgmg__dalloc(&s->al, N3);
@@ -4081,141 +4064,205 @@ PHGMG_DEF phgmg_result phgmg_gl3_create(phgmg_gl3 **out, const phgmg_ph_system *
   s->xend = phgmg__dalloc(&s->al, (size_t)N);
   s->tmp = phgmg__dalloc(&s->al, (size_t)N);
   if (!s->Z || !s->W || !s->Y || !s->F || !s->Zprev || !s->xend ||
-      !s->tmp) {
-    rc = PHGMG_ERR_NOMEM;
-    goto fail;
-  }
+      !s->tmp) return PHGMG_ERR_NOMEM;
   if (sys->nl == PHGMG_NL_SEPARABLE) {
     s->dd = phgmg__dalloc(&s->al, (size_t)N);
-    if (!s->dd) { rc = PHGMG_ERR_NOMEM; goto fail; }
+    if (!s->dd) return PHGMG_ERR_NOMEM;
     if (PHGMG__PH_BUILTIN(sys) && sys->phi_nfun <= 1) { /* one shared function */
       if (sys->poly_deg > 0) { /* dpoly[j] = (j+1) poly[j+1] */
         s->dpoly = phgmg__dalloc(&s->al, (size_t)sys->poly_deg);
-        if (!s->dpoly) { rc = PHGMG_ERR_NOMEM; goto fail; }
+        if (!s->dpoly) return PHGMG_ERR_NOMEM;
         for (k = 0; k < sys->poly_deg; ++k) s->dpoly[k] = (double)(k + 1) * sys->poly[k + 1];
       }
       s->wc = phgmg__dalloc(&s->al, (size_t)N);
-      if (!s->wc) { rc = PHGMG_ERR_NOMEM; goto fail; }
+      if (!s->wc) return PHGMG_ERR_NOMEM;
       for (i = 0; i < N; ++i) s->wc[i] = 0.0;
       for (k = 0; k < sys->nsep; ++k) s->wc[sys->sep_idx[k]] += sys->sep_w ? sys->sep_w[k] : 1.0;
     }
   }
-  if (sys->storage == PHGMG_DENSE) {
-    s->JR = phgmg__dalloc(&s->al, NN);
-    if (!s->JR) { rc = PHGMG_ERR_NOMEM; goto fail; }
-    {
-      size_t e;
-      for (e = 0; e < NN; ++e) s->JR[e] = sys->J[e] - sys->R[e];
-    }
-    if (s->mode == PHGMG__GL3_DENSE) {
-      s->K1 = phgmg__dalloc(&s->al, NN);
-      s->K2 = phgmg__dalloc(&s->al, 2 * NN);
-      s->ip1 = phgmg__ialloc(&s->al, (size_t)N);
-      s->ip2 = phgmg__ialloc(&s->al, (size_t)N);
-      if (!s->K1 || !s->K2 || !s->ip1 || !s->ip2) { rc = PHGMG_ERR_NOMEM; goto fail; }
-      if (sys->nl == PHGMG_NL_GENERAL) {
-        s->Hs = phgmg__dalloc(&s->al, NN);
-        if (!s->Hs) { rc = PHGMG_ERR_NOMEM; goto fail; }
-      } else {
-        s->JRQ = phgmg__dalloc(&s->al, NN);
-        if (!s->JRQ) { rc = PHGMG_ERR_NOMEM; goto fail; }
-        phgmg_gemm('N', 'N', N, N, N, 1.0, s->JR, N, sys->Q, N, 0.0, s->JRQ, N);
-      }
-    }
-  } else {
-    int kb = sys->kb, amin = 0, amax = 0, bmin = 0, bmax = 0;
-    rc = phgmg__dia_build(&s->al, &s->djr, N, kb, sys->J, sys->R, 0, 0);
-    if (rc == PHGMG_OK) rc = phgmg__dia_build(&s->al, &s->dq, N, kb, sys->Q, NULL, 1, 0);
-    if (rc != PHGMG_OK) goto fail;
-    { /* CSR of J - R */
-      size_t nnz = 0;
-      int r, c;
-      for (r = 0; r < N; ++r)
-        for (c = PHGMG__MAX(0, r - kb); c <= PHGMG__MIN(N - 1, r + kb); ++c)
-          if (sys->J[PHGMG__PHB(kb, r, c)] - sys->R[PHGMG__PHB(kb, r, c)] != 0.0) ++nnz;
-      s->jr_ptr = phgmg__ialloc(&s->al, (size_t)N + 1);
-      s->jr_col = phgmg__ialloc(&s->al, nnz);
-      s->jr_val = phgmg__dalloc(&s->al, nnz);
-      if (!s->jr_ptr || !s->jr_col || !s->jr_val) { rc = PHGMG_ERR_NOMEM; goto fail; }
-      nnz = 0;
-      for (r = 0; r < N; ++r) {
-        s->jr_ptr[r] = (int)nnz;
-        for (c = PHGMG__MAX(0, r - kb); c <= PHGMG__MIN(N - 1, r + kb); ++c) {
-          double v = sys->J[PHGMG__PHB(kb, r, c)] - sys->R[PHGMG__PHB(kb, r, c)];
-          if (v != 0.0) { s->jr_col[nnz] = c; s->jr_val[nnz] = v; ++nnz; }
-        }
-      }
-      s->jr_ptr[N] = (int)nnz;
-      nnz = 0;
-      for (c = 0; c < m; ++c)
-        for (r = 0; r < N; ++r)
-          if (sys->B[(size_t)r + (size_t)c * (size_t)N] != 0.0) ++nnz;
-      s->b_row = phgmg__ialloc(&s->al, nnz);
-      s->b_col = phgmg__ialloc(&s->al, nnz);
-      s->b_val = phgmg__dalloc(&s->al, nnz);
-      if (!s->b_row || !s->b_col || !s->b_val) { rc = PHGMG_ERR_NOMEM; goto fail; }
-      s->nbnz = 0;
-      for (c = 0; c < m; ++c)
-        for (r = 0; r < N; ++r) {
-          double v = sys->B[(size_t)r + (size_t)c * (size_t)N];
-          if (v == 0.0) continue;
-          s->b_row[s->nbnz] = r;
-          s->b_col[s->nbnz] = c;
-          s->b_val[s->nbnz] = v;
-          s->nbnz++;
-        }
-    }
-    if (s->mode == PHGMG__GL3_BANDED) {
-      for (k = 0; k < s->djr.nd; ++k) {
-        amin = PHGMG__MIN(amin, s->djr.off[k]);
-        amax = PHGMG__MAX(amax, s->djr.off[k]);
-      }
-      for (k = 0; k < s->dq.nd; ++k) {
-        bmin = PHGMG__MIN(bmin, s->dq.off[k]);
-        bmax = PHGMG__MAX(bmax, s->dq.off[k]);
-      }
-      if (sys->nl == PHGMG_NL_GENERAL) {
-        bmin = -kb;
-        bmax = kb;
-        rc = phgmg__dia_build(&s->al, &s->dh, N, kb, NULL, NULL, 1, 1);
-        s->hband = phgmg__dalloc(&s->al, (size_t)(2 * kb + 1) * (size_t)N);
-        if (rc != PHGMG_OK || !s->hband) { rc = PHGMG_ERR_NOMEM; goto fail; }
-      }
-      s->kl = PHGMG__MIN(N - 1, -(amin + bmin));
-      s->ku = PHGMG__MIN(N - 1, amax + bmax);
-      s->ldab = 2 * s->kl + s->ku + 1;
-      s->AB1 = phgmg__dalloc(&s->al, (size_t)s->ldab * (size_t)N);
-      s->AB2 = phgmg__dalloc(&s->al, 2 * (size_t)s->ldab * (size_t)N);
-      s->dinv1 = phgmg__dalloc(&s->al, (size_t)N);
-      s->dinv2 = phgmg__dalloc(&s->al, 2 * (size_t)N);
-      s->ip1 = phgmg__ialloc(&s->al, (size_t)N);
-      s->ip2 = phgmg__ialloc(&s->al, (size_t)N);
-      if (!s->AB1 || !s->AB2 || !s->dinv1 || !s->dinv2 || !s->ip1 || !s->ip2) {
-        rc = PHGMG_ERR_NOMEM;
-        goto fail;
-      }
+  return PHGMG_OK;
+}
+
+/* Dense storage: J - R, the LU workspaces and (J - R) Q. */
+PHGMG__PRIV phgmg_result phgmg__gl3_setup_dense(phgmg_gl3 *s) {
+  const phgmg_ph_system *sys = &s->sys;
+  const int N = s->N;
+  const size_t NN = (size_t)N * (size_t)N;
+  s->JR = phgmg__dalloc(&s->al, NN);
+  if (!s->JR) return PHGMG_ERR_NOMEM;
+  {
+    size_t e;
+    for (e = 0; e < NN; ++e) s->JR[e] = sys->J[e] - sys->R[e];
+  }
+  if (s->mode == PHGMG__GL3_DENSE) {
+    s->K1 = phgmg__dalloc(&s->al, NN);
+    s->K2 = phgmg__dalloc(&s->al, 2 * NN);
+    s->ip1 = phgmg__ialloc(&s->al, (size_t)N);
+    s->ip2 = phgmg__ialloc(&s->al, (size_t)N);
+    if (!s->K1 || !s->K2 || !s->ip1 || !s->ip2) return PHGMG_ERR_NOMEM;
+    if (sys->nl == PHGMG_NL_GENERAL) {
+      s->Hs = phgmg__dalloc(&s->al, NN);
+      if (!s->Hs) return PHGMG_ERR_NOMEM;
+    } else {
+      s->JRQ = phgmg__dalloc(&s->al, NN);
+      if (!s->JRQ) return PHGMG_ERR_NOMEM;
+      phgmg_gemm('N', 'N', N, N, N, 1.0, s->JR, N, sys->Q, N, 0.0, s->JRQ, N);
     }
   }
+  return PHGMG_OK;
+}
+
+/* Banded storage: CSR of J - R and of B for the right-hand side. */
+PHGMG__PRIV phgmg_result phgmg__gl3_csr(phgmg_gl3 *s) {
+  const phgmg_ph_system *sys = &s->sys;
+  const int N = s->N, m = s->m, kb = sys->kb;
+  size_t nnz = 0;
+  int r, c;
+  for (r = 0; r < N; ++r)
+    for (c = PHGMG__MAX(0, r - kb); c <= PHGMG__MIN(N - 1, r + kb); ++c)
+      if (sys->J[PHGMG__PHB(kb, r, c)] - sys->R[PHGMG__PHB(kb, r, c)] != 0.0) ++nnz;
+  s->jr_ptr = phgmg__ialloc(&s->al, (size_t)N + 1);
+  s->jr_col = phgmg__ialloc(&s->al, nnz);
+  s->jr_val = phgmg__dalloc(&s->al, nnz);
+  if (!s->jr_ptr || !s->jr_col || !s->jr_val) return PHGMG_ERR_NOMEM;
+  nnz = 0;
+  for (r = 0; r < N; ++r) {
+    s->jr_ptr[r] = (int)nnz;
+    for (c = PHGMG__MAX(0, r - kb); c <= PHGMG__MIN(N - 1, r + kb); ++c) {
+      double v = sys->J[PHGMG__PHB(kb, r, c)] - sys->R[PHGMG__PHB(kb, r, c)];
+      if (v != 0.0) { s->jr_col[nnz] = c; s->jr_val[nnz] = v; ++nnz; }
+    }
+  }
+  s->jr_ptr[N] = (int)nnz;
+  nnz = 0;
+  for (c = 0; c < m; ++c)
+    for (r = 0; r < N; ++r)
+      if (sys->B[(size_t)r + (size_t)c * (size_t)N] != 0.0) ++nnz;
+  s->b_row = phgmg__ialloc(&s->al, nnz);
+  s->b_col = phgmg__ialloc(&s->al, nnz);
+  s->b_val = phgmg__dalloc(&s->al, nnz);
+  if (!s->b_row || !s->b_col || !s->b_val) return PHGMG_ERR_NOMEM;
+  s->nbnz = 0;
+  for (c = 0; c < m; ++c)
+    for (r = 0; r < N; ++r) {
+      double v = sys->B[(size_t)r + (size_t)c * (size_t)N];
+      if (v == 0.0) continue;
+      s->b_row[s->nbnz] = r;
+      s->b_col[s->nbnz] = c;
+      s->b_val[s->nbnz] = v;
+      s->nbnz++;
+    }
+  return PHGMG_OK;
+}
+
+/* Banded storage: diagonals of J - R and Q, the CSR forms, and the band LU
+   workspaces (bandwidths from the nonzero diagonals). */
+PHGMG__PRIV phgmg_result phgmg__gl3_setup_banded(phgmg_gl3 *s) {
+  const phgmg_ph_system *sys = &s->sys;
+  const int N = s->N;
+  int k;
+  phgmg_result rc;
+  int kb = sys->kb, amin = 0, amax = 0, bmin = 0, bmax = 0;
+  rc = phgmg__dia_build(&s->al, &s->djr, N, kb, sys->J, sys->R, 0, 0);
+  if (rc == PHGMG_OK) rc = phgmg__dia_build(&s->al, &s->dq, N, kb, sys->Q, NULL, 1, 0);
+  if (rc != PHGMG_OK) return rc;
+  rc = phgmg__gl3_csr(s);
+  if (rc != PHGMG_OK) return rc;
+  if (s->mode == PHGMG__GL3_BANDED) {
+    for (k = 0; k < s->djr.nd; ++k) {
+      amin = PHGMG__MIN(amin, s->djr.off[k]);
+      amax = PHGMG__MAX(amax, s->djr.off[k]);
+    }
+    for (k = 0; k < s->dq.nd; ++k) {
+      bmin = PHGMG__MIN(bmin, s->dq.off[k]);
+      bmax = PHGMG__MAX(bmax, s->dq.off[k]);
+    }
+    if (sys->nl == PHGMG_NL_GENERAL) {
+      bmin = -kb;
+      bmax = kb;
+      rc = phgmg__dia_build(&s->al, &s->dh, N, kb, NULL, NULL, 1, 1);
+      s->hband = phgmg__dalloc(&s->al, (size_t)(2 * kb + 1) * (size_t)N);
+      if (rc != PHGMG_OK || !s->hband) return PHGMG_ERR_NOMEM;
+    }
+    s->kl = PHGMG__MIN(N - 1, -(amin + bmin));
+    s->ku = PHGMG__MIN(N - 1, amax + bmax);
+    s->ldab = 2 * s->kl + s->ku + 1;
+    s->AB1 = phgmg__dalloc(&s->al, (size_t)s->ldab * (size_t)N);
+    s->AB2 = phgmg__dalloc(&s->al, 2 * (size_t)s->ldab * (size_t)N);
+    s->dinv1 = phgmg__dalloc(&s->al, (size_t)N);
+    s->dinv2 = phgmg__dalloc(&s->al, 2 * (size_t)N);
+    s->ip1 = phgmg__ialloc(&s->al, (size_t)N);
+    s->ip2 = phgmg__ialloc(&s->al, (size_t)N);
+    if (!s->AB1 || !s->AB2 || !s->dinv1 || !s->dinv2 || !s->ip1 || !s->ip2) return PHGMG_ERR_NOMEM;
+  }
+  return PHGMG_OK;
+}
+
+/* Right-hand-side buffers of the solves (padded by the bandwidths). */
+PHGMG__PRIV phgmg_result phgmg__gl3_setup_buffers(phgmg_gl3 *s) {
+  const int N = s->N;
   {
     size_t len = (size_t)N + (size_t)s->kl + (size_t)s->ku;
     s->r1buf = phgmg__dalloc(&s->al, len);
     s->rcbuf = phgmg__dalloc(&s->al, 2 * len);
-    if (!s->r1buf || !s->rcbuf) { rc = PHGMG_ERR_NOMEM; goto fail; }
+    if (!s->r1buf || !s->rcbuf) return PHGMG_ERR_NOMEM;
     memset(s->r1buf, 0, sizeof(double) * len);
     memset(s->rcbuf, 0, sizeof(double) * 2 * len);
     s->r1 = s->r1buf + s->kl;
     s->rc = s->rcbuf + 2 * (size_t)s->kl;
     if (s->mode == PHGMG__GL3_BANDED) {
       s->pk = phgmg__dalloc(&s->al, (size_t)3 * (size_t)(s->kl + s->ku + 1) * (size_t)N);
-      if (!s->pk) { rc = PHGMG_ERR_NOMEM; goto fail; }
+      if (!s->pk) return PHGMG_ERR_NOMEM;
     }
   }
-  s->need_factor = 1;
+  return PHGMG_OK;
+}
+
+PHGMG_DEF phgmg_result phgmg_gl3_create(phgmg_gl3 **out, const phgmg_ph_system *sys, double dt,
+                                        const phgmg_gl3_opts *opts, const phgmg_allocator *alloc) {
+  phgmg_gl3 *s;
+  phgmg_result rc;
+  if (!out) return PHGMG_ERR_INVALID_ARG;
+  *out = NULL;
+  rc = phgmg__ph_check(sys);
+  if (rc != PHGMG_OK) return rc;
+  if (!(dt > 0.0) || dt == HUGE_VAL) return PHGMG_ERR_INVALID_ARG;
+  if (opts && (opts->max_iter < 0 || opts->tol < 0.0 || opts->contraction < 0.0 ||
+               opts->tol != opts->tol || opts->contraction != opts->contraction))
+    return PHGMG_ERR_INVALID_ARG;
+  s = PHGMG__CAST(phgmg_gl3 *, phgmg__alloc(alloc, sizeof(phgmg_gl3)));
+  if (!s) return PHGMG_ERR_NOMEM;
+  memset(s, 0, sizeof *s);
+  if (alloc) s->al = *alloc;
+  s->sys = *sys;
+  s->N = sys->N;
+  s->m = sys->m;
+  s->h = dt;
+  s->tol = (opts && opts->tol > 0.0) ? opts->tol : 1e-10;
+  s->max_iter = (opts && opts->max_iter > 0) ? opts->max_iter : 10;
+  s->contraction = (opts && opts->contraction > 0.0) ? opts->contraction : 0.5;
+  s->flush = !(opts && opts->keep_tiny);
+  s->ftau = s->flush ? PHGMG__DBL_MIN : 0.0;
+  s->linear = sys->nl == PHGMG_NL_NONE;
+  phgmg__gl3_setup_method(s, opts);
+  s->U = phgmg__dalloc(&s->al, 3 * (size_t)s->m);
+  s->G = phgmg__dalloc(&s->al, 3 * (size_t)s->N);
+  s->xnew = phgmg__dalloc(&s->al, (size_t)s->N);
+  rc = (s->U && s->G && s->xnew) ? PHGMG_OK : PHGMG_ERR_NOMEM;
+  if (rc == PHGMG_OK && s->mode == PHGMG__GL3_MAP) {
+    rc = phgmg__gl3_setup_map(s);
+  } else if (rc == PHGMG_OK) {
+    rc = phgmg__gl3_setup_newton(s);
+    if (rc == PHGMG_OK) rc = sys->storage == PHGMG_DENSE ? phgmg__gl3_setup_dense(s) : phgmg__gl3_setup_banded(s);
+    if (rc == PHGMG_OK) rc = phgmg__gl3_setup_buffers(s);
+    s->need_factor = 1;
+  }
+  if (rc != PHGMG_OK) {
+    phgmg_gl3_destroy(s);
+    return rc;
+  }
   *out = s;
   return PHGMG_OK;
-fail:
-  phgmg_gl3_destroy(s);
-  return rc;
 }
 
 /* Banded: F_st = (J - R) G_st row by row from the CSR copy, + B u_st over the
