@@ -92,7 +92,7 @@ compile-checks: phgmg.h
 	  clang -std=c99 $(WARN) -Wdouble-promotion -DPHGMG_REAL_FLOAT -c $(BUILD)/cc/impl.c -o $(BUILD)/cc/a.o; fi
 	@echo "compile checks passed"
 
-EXAMPLES = $(BUILD)/msd_linear $(BUILD)/msd_nonlinear $(BUILD)/phgmg
+EXAMPLES = $(BUILD)/msd_linear $(BUILD)/msd_nonlinear $(BUILD)/phgmg $(BUILD)/linear_bases
 EXHDRS   = examples/msd_models.h examples/demo_common.h examples/svgplot.h
 
 examples: $(EXAMPLES)
@@ -115,8 +115,10 @@ demo: $(EXAMPLES)
 	@start=$$(date +%s.%N); \
 	./$(BUILD)/msd_linear --out results && ./$(BUILD)/msd_nonlinear --out results && \
 	./$(BUILD)/msd_linear --lambda auto --rmin 6 --out results && \
+	./$(BUILD)/linear_bases --out results && \
 	end=$$(date +%s.%N) && awk -v a=$$start -v b=$$end 'BEGIN { printf "make demo: total wall time %.2f s\n", b - a }' && \
-	/usr/bin/python3 tests/check_claims.py results
+	/usr/bin/python3 tests/check_claims.py results && \
+	/usr/bin/python3 tests/check_linear.py results
 
 # Short fuzzing run of every reader of outside data (.npy, binary model files).
 fuzz:

@@ -82,7 +82,7 @@
    errors:  phgmg_rel_error, phgmg_err_red, phgmg_err_proj, phgmg_err_lowerbound,
             phgmg_err_energy
    linear:  phgmg_lyap, phgmg_care, phgmg_lyap_residual, phgmg_care_residual, phgmg_ph_abc,
-            phgmg_bt, phgmg_prbt, phgmg_linear_basis, phgmg_ss_transfer, phgmg_reduced_abc,
+            phgmg_bt, phgmg_prbt, phgmg_prbt_riccati, phgmg_linear_basis, phgmg_ss_transfer, phgmg_reduced_abc,
             phgmg_ss_error
    export:  phgmg_rom_serialized_size, phgmg_rom_serialize, phgmg_rom_deserialize_size,
             phgmg_rom_deserialize, phgmg_rom_save, phgmg_rom_load, phgmg_rom_export_c
@@ -896,7 +896,15 @@ PHGMG_DEF phgmg_result phgmg_bt(const phgmg_ph_system *sys, int r, double *Ar, d
 typedef struct phgmg_prbt_opts {
   double eps; /* feedthrough regularisation D = eps ||C B||_F I (0: 1e-10; see phgmg_prbt) */
   double dt;  /* > 0: precompute the GL3 step map of the reduced model for this step   */
+  /* Optional cache for studies over many r: the two Riccati solutions from
+     phgmg_prbt_riccati with the same eps (N x N each; both or neither). */
+  const double *X, *Y;
 } phgmg_prbt_opts;
+
+/* The positive-real Riccati solutions of phgmg_prbt (X: Q-eq, Y: P-eq, N x N),
+   for phgmg_prbt_opts.X/Y. eps <= 0: 1e-10. */
+PHGMG_DEF phgmg_result phgmg_prbt_riccati(const phgmg_ph_system *sys, double eps, double *X, double *Y,
+                                          const phgmg_allocator *alloc);
 
 /* Positive-real balanced truncation with a pH reduced model (method
    PHGMG_METHOD_PRBT, kind LINEAR). The positive-real lemma's Riccati
@@ -7139,7 +7147,12 @@ PHGMG_DEF phgmg_result phgmg_prbt(phgmg_reduced **out, const phgmg_ph_system *sy
   if (rc == PHGMG_OK) {
     phgmg_gemm('N', 'N', m, m, N, 1.0, C, m, sys->B, N, 0.0, CB, m);
     s = 2.0 * eps * phgmg_normf(m, m, CB, m);
-    rc = phgmg__pr_riccati(N, m, A, sys->B, C, s, X, Y, alloc);
+    if (opts && opts->X && opts->Y) {
+      memcpy(X, opts->X, (size_t)N * N * sizeof(double));
+      memcpy(Y, opts->Y, (size_t)N * N * sizeof(double));
+    } else {
+      rc = phgmg__pr_riccati(N, m, A, sys->B, C, s, X, Y, alloc);
+    }
   }
   if (rc == PHGMG_OK && info_xb) {   /* ||X B - C^T|| / ||C|| */
     double *XB = phgmg__dalloc(alloc, (size_t)N * m);
@@ -7176,6 +7189,27 @@ PHGMG_DEF phgmg_result phgmg_prbt(phgmg_reduced **out, const phgmg_ph_system *sy
   if (rc != PHGMG_OK) { phgmg_reduced_destroy(red); return rc; }
   *out = red;
   return PHGMG_OK;
+}
+
+PHGMG_DEF phgmg_result phgmg_prbt_riccati(const phgmg_ph_system *sys, double eps, double *X, double *Y,
+                                          const phgmg_allocator *alloc) {
+  int N, m;
+  double *A, *C, CBn;
+  phgmg_result rc;
+  if (!sys || !X || !Y) return PHGMG_ERR_INVALID_ARG;
+  N = sys->N; m = sys->m;
+  if (N < 1 || m < 1 || m > N) return PHGMG_ERR_SIZE;
+  A = phgmg__dalloc(alloc, (size_t)N * N + (size_t)m * N + (size_t)m * m);
+  if (!A) return PHGMG_ERR_NOMEM;
+  C = A + (size_t)N * N;
+  rc = phgmg_ph_abc(sys, A, C, alloc);
+  if (rc == PHGMG_OK) {
+    phgmg_gemm('N', 'N', m, m, N, 1.0, C, m, sys->B, N, 0.0, C + (size_t)m * N, m);
+    CBn = phgmg_normf(m, m, C + (size_t)m * N, m);
+    rc = phgmg__pr_riccati(N, m, A, sys->B, C, 2.0 * (eps > 0.0 ? eps : 1e-10) * CBn, X, Y, alloc);
+  }
+  phgmg__free(alloc, A);
+  return rc;
 }
 
 /* Frequency grid ends from the system (see phgmg_basis_opts). */
