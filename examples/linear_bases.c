@@ -15,7 +15,10 @@
    input_independent,e_y; the issue's columns r,input,method,
    input_independent,e_y plus the system), results/linear_bases_bode.svg
    (largest singular value of G(i w) of the two-port chain and of its r = 12
-   models), and an H-infinity / H2 error table on the terminal.
+   models), results/linear_bases_structure.csv (two-port chain, every pH
+   model: smallest eigenvalue of R relative to the largest, energy-balance
+   error relative to max H over 1000 steps of the `mix` input), and an
+   H-infinity / H2 error table on the terminal.
    Usage: linear_bases [--out DIR] */
 #define _POSIX_C_SOURCE 200809L
 #define PHGMG_IMPLEMENTATION
@@ -191,6 +194,50 @@ static void study_free(study *S) {
   free(S->pod); free(S->T); free(S->W); free(S->A); free(S->C); free(S->Xr); free(S->Yr);
 }
 
+/* Structure and passivity of a pH model (methods 0-3 GMG, 5 PRBT): the
+   smallest eigenvalue of R = -(K + K^T)/2 relative to the largest, and the
+   largest energy-balance error |H_n - H_0 - S_n + D_n| / max H over 1000
+   steps of the `mix` input with the step map. */
+static void structure_row(const study *S, int j, int r, FILE *f) {
+  const int N = S->sys->N, m = S->sys->m;
+  static double H[1001], Su[1001], D[1001];
+  double Rr[RMAX * RMAX], w[RMAX], xr0[RMAX] = {0}, e = 0.0, hmax = 0.0;
+  phgmg_energy en;
+  phgmg_reduced *red = NULL;
+  phgmg_result rc;
+  input_ctx ic;
+  int a, b;
+  if (j == 5) {
+    phgmg_prbt_opts po;
+    memset(&po, 0, sizeof po);
+    po.dt = 0.1; po.X = S->Xr; po.Y = S->Yr;
+    rc = phgmg_prbt(&red, S->sys, r, &po, NULL, NULL, NULL);
+  } else {
+    phgmg_reduce_opts o;
+    memset(&o, 0, sizeof o);
+    o.method = PHGMG_METHOD_GMG_POD; o.r = r; o.dt = 0.1;
+    o.pod_basis = j == 0 ? S->pod : S->bas[j - 1]; o.pod_cols = RMAX;
+    rc = phgmg_reduce(&red, S->sys, S->X[0], N, 1001, &o, NULL, NULL);
+  }
+  if (rc != PHGMG_OK) { phgmg_reduced_destroy(red); return; }
+  {
+    const phgmg_rom *rom = phgmg_reduced_rom(red);
+    for (b = 0; b < r; ++b)
+      for (a = 0; a < r; ++a) Rr[a + b * r] = -0.5 * ((double)rom->K[a + b * r] + (double)rom->K[b + a * r]);
+  }
+  phgmg_sym_eig(r, Rr, r, w, NULL, 0);
+  ic.m = m; ic.which = 5;
+  en.H = H; en.S = Su; en.D = D;
+  rc = phgmg_reduced_simulate(red, xr0, 0.0, 0.1, 1000, input_fn, &ic, 1e-12, 10, NULL, NULL, &en, NULL, NULL);
+  for (a = 0; a <= 1000 && rc == PHGMG_OK; ++a) {
+    e = fmax(e, fabs(H[a] - H[0] - Su[a] + D[a]));
+    hmax = fmax(hmax, fabs(H[a]));
+  }
+  fprintf(f, "%d,%s,%.3e,%.3e\n", r, meth_name[j], w[0] / fmax(fabs(w[r - 1]), 1e-300),
+          rc == PHGMG_OK ? e / hmax : NAN);
+  phgmg_reduced_destroy(red);
+}
+
 /* Bode: sigma_max(G(i w)) of the full model and of the r = 12 models. */
 static void bode(const study *S, const char *path) {
   const int N = S->sys->N, m = S->sys->m, nw = 80, r = 12;
@@ -285,6 +332,17 @@ int main(int argc, char **argv) {
                          &h2r, NULL);
           printf("  %2d %-12s %9.2e  %9.2e\n", r, meth_name[j], hi / hr, h2 / h2r);
         }
+      {
+        FILE *fs;
+        snprintf(path, sizeof path, "%s/linear_bases_structure.csv", out);
+        fs = fopen(path, "w");
+        if (!fs) { fprintf(stderr, "cannot write %s\n", path); return 1; }
+        fprintf(fs, "r,method,min_eig_R_rel,energy_err_rel\n");
+        for (r = 4; r <= RMAX; ++r)
+          for (j = 0; j < NMETH; ++j)
+            if (j != 4) structure_row(&S, j, r, fs);
+        fclose(fs);
+      }
       snprintf(path, sizeof path, "%s/linear_bases_bode.svg", out);
       bode(&S, path);
       g_nosim = 0;

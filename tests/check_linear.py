@@ -1,7 +1,10 @@
 #!/usr/bin/env python3
 """Checks results/linear_bases_e_y.csv from `make demo` (issue 16).
 Hard checks (exit 1 on failure): every (system, r = 4..20 with r > m, input,
-method) row present with a finite e_y; six inputs, the first the training one.
+method) row present with a finite e_y; six inputs, the first the training one; every pH model of the two-port
+chain (results/linear_bases_structure.csv: GMG on each basis, PRBT, r = 4..20)
+has R PSD (smallest eigenvalue >= -1e-12 x the largest) and keeps the energy
+balance to round-off (max |H_n - H_0 - S_n + D_n| <= 1e-10 max H).
 The issue's acceptance claims are measured and printed as MET / NOT MET
 (they are targets of the issue, not guaranteed properties of the methods):
   - r = 12..20, every unseen input: best input-independent GMG e_y <= GMG-POD / 10;
@@ -27,6 +30,13 @@ for s, m in systems.items():
                 v = e.get((s, r, i, me))
                 if v is None or not math.isfinite(v):
                     print(f"FAIL  {s} r={r} {i} {me}: e_y {v}"); fails += 1
+st = list(csv.DictReader(open(f"{d}/linear_bases_structure.csv")))
+if len(st) != 17 * 5:
+    print(f"FAIL  structure rows {len(st)} != 85"); fails += 1
+for w in st:
+    mr, ee = float(w["min_eig_R_rel"]), float(w["energy_err_rel"])
+    if not (mr >= -1e-12 and ee <= 1e-10):
+        print(f"FAIL  structure r={w['r']} {w['method']}: min eig R {mr:.2e}, energy error {ee:.2e}"); fails += 1
 unseen = [i for i in inputs if i != "train_sin"]
 for s in systems:
     met10 = met3 = tot = 0
