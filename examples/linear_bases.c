@@ -11,11 +11,10 @@
    steps, x0 = 0) on the training input and five inputs no construction
    sees; e_y = sqrt(sum ||y - y_r||^2 / sum ||y||^2).
 
-   Output: results/linear_bases_e_y.csv (r,system,input,method,
-   input_independent,e_y; the issue's columns r,input,method,
-   input_independent,e_y plus the system), results/linear_bases_bode.svg
-   (largest singular value of G(i w) of the two-port chain and of its r = 12
-   models), results/linear_bases_structure.csv (two-port chain, every pH
+   Output: results/linear_bases_e_y.csv (r,input,method,input_independent,
+   e_y,system), results/linear_bases_bode.svg (largest singular value of
+   G(i w) of the two-port chain and of its r = 12 models, and of the errors
+   G - G_r), results/linear_bases_structure.csv (two-port chain, every pH
    model: smallest eigenvalue of R relative to the largest, energy-balance
    error relative to max H over 1000 steps of the `mix` input), and an
    H-infinity / H2 error table on the terminal.
@@ -242,19 +241,29 @@ static void structure_row(const study *S, int j, int r, FILE *f) {
 static void bode(const study *S, const char *path) {
   const int N = S->sys->N, m = S->sys->m, nw = 80, r = 12;
   double lw[80], sg[80], G[8], Ar[RMAX * RMAX], Br[RMAX * 2], Cr[RMAX * 2], ey[NIN];
-  svgplot_fig *fig = svgplot_new("Two-port chain: largest singular value of G(i w), full model and r = 12", 1);
-  int j, k;
-  svgplot_size(fig, 900, 520);
-  svgplot_panel(fig, 0, "sigma_max G(i w)", "log10 w", "sigma_max");
+  static double Gf[80 * 8];
+  double se[80];
+  svgplot_fig *fig = svgplot_new("Two-port chain, r = 12: largest singular value of G(i w) and of the error", 2);
+  int j, k, q;
+  svgplot_size(fig, 1500, 520);
+  svgplot_panel(fig, 0, "(a) sigma_max G(i w)", "log10 w", "sigma_max");
+  svgplot_panel(fig, 1, "(b) sigma_max (G - G_r)(i w)", "log10 w", "sigma_max");
   for (j = -1; j < NMETH; ++j) {
     if (j >= 0) run_method(S, j, r, ey, Ar, Br, Cr);
     for (k = 0; k < nw; ++k) {
       lw[k] = -2.0 + 3.5 * k / (nw - 1);
-      if (j < 0) phgmg_ss_transfer(N, m, m, S->A, S->sys->B, S->C, pow(10.0, lw[k]), G, NULL);
-      else phgmg_ss_transfer(r, m, m, Ar, Br, Cr, pow(10.0, lw[k]), G, NULL);
-      sg[k] = phgmg__zsigma_max(m, m, G);
+      if (j < 0) {
+        phgmg_ss_transfer(N, m, m, S->A, S->sys->B, S->C, pow(10.0, lw[k]), Gf + 8 * k, NULL);
+        sg[k] = phgmg__zsigma_max(m, m, Gf + 8 * k);
+      } else {
+        phgmg_ss_transfer(r, m, m, Ar, Br, Cr, pow(10.0, lw[k]), G, NULL);
+        sg[k] = phgmg__zsigma_max(m, m, G);
+        for (q = 0; q < 8; ++q) G[q] = Gf[8 * k + q] - G[q];
+        se[k] = phgmg__zsigma_max(m, m, G);
+      }
     }
     svgplot_series(fig, 0, j < 0 ? "full model" : meth_name[j], nw, lw, sg, j + 1);
+    if (j >= 0) svgplot_series(fig, 1, meth_name[j], nw, lw, se, j + 1);
   }
   if (svgplot_save(fig, path) != 0) fprintf(stderr, "cannot write %s\n", path);
   svgplot_free(fig);
@@ -283,7 +292,7 @@ int main(int argc, char **argv) {
   snprintf(path, sizeof path, "%s/linear_bases_e_y.csv", out);
   f = fopen(path, "w");
   if (!f) { fprintf(stderr, "cannot write %s\n", path); return 1; }
-  fprintf(f, "r,system,input,method,input_independent,e_y\n");
+  fprintf(f, "r,input,method,input_independent,e_y,system\n");
   for (sysk = 0; sysk < 2; ++sysk) {
     const phgmg_ph_system *sys = sysk ? &M2.sys : &M1.sys;
     const char *sname = sysk ? "two_port_chain" : "paper_chain";
@@ -299,7 +308,7 @@ int main(int argc, char **argv) {
         if (r <= sys->m) { printf("  %-21s", "-"); continue; }
         run_method(&S, j, r, ey, Ar, Br, Cr);
         for (in = 0; in < NIN; ++in) {
-          fprintf(f, "%d,%s,%s,%s,%d,%.6e\n", r, sname, in_name[in], meth_name[j], meth_indep[j], ey[in]);
+          fprintf(f, "%d,%s,%s,%d,%.6e,%s\n", r, in_name[in], meth_name[j], meth_indep[j], ey[in], sname);
           if (in > 0 && !(ey[in] <= worst)) worst = ey[in];
         }
         printf("  %9.2e / %9.2e", ey[2], worst);
