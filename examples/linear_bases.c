@@ -6,7 +6,10 @@
    2) it compares, for r = 4..20, GMG-POD trained on u = 0.1 sin t with GMG
    on three input-independent bases (frequency-sampled, impulse responses,
    balanced right basis; phgmg_linear_basis), balanced truncation (BT,
-   reference, not pH) and positive-real balanced truncation (PRBT, pH form).
+   reference, not pH) and positive-real balanced truncation (PRBT, pH form;
+   PRBT-LTI: the same projection W^T A T, W^T B, C T without the pH form,
+   i.e. with the balanced output C T, for comparison with PRBT codes whose
+   pH form carries a feedthrough and P != 0).
    Every reduced model is simulated with the same GL3 scheme (dt = 0.1, 1000
    steps, x0 = 0) on the training input and five inputs no construction
    sees; e_y = sqrt(sum ||y - y_r||^2 / sum ||y||^2).
@@ -26,11 +29,12 @@
 #include "demo_common.h"
 
 #define NIN 6
-#define NMETH 6
+#define NMETH 7
 #define RMAX 20
 static const char *in_name[NIN] = {"train_sin", "const", "sin3_alt", "chirp", "pulse", "mix"};
-static const char *meth_name[NMETH] = {"GMG-POD", "GMG-FREQ", "GMG-IMPULSE", "GMG-BAL", "BT", "PRBT"};
-static const int meth_indep[NMETH] = {0, 1, 1, 1, 1, 1};
+static const char *meth_name[NMETH] = {"GMG-POD", "GMG-FREQ", "GMG-IMPULSE", "GMG-BAL", "BT", "PRBT",
+                                       "PRBT-LTI"};
+static const int meth_indep[NMETH] = {0, 1, 1, 1, 1, 1, 1};
 static int g_nosim;   /* 1: build the models only (H-inf table, Bode) */
 
 typedef struct { int m, which; } input_ctx;
@@ -115,7 +119,7 @@ static void run_method(const study *S, int j, int r, double ey[NIN], double *Ar,
   int in;
   if (j == 4) {
     bt_r(S, r, Ar, Br, Cr);
-  } else if (j == 5) {
+  } else if (j == 5 || j == 6) {
     phgmg_prbt_opts po;
     memset(&po, 0, sizeof po);
     po.dt = 0.1; po.X = S->Xr; po.Y = S->Yr;
@@ -127,13 +131,34 @@ static void run_method(const study *S, int j, int r, double ey[NIN], double *Ar,
     o.pod_basis = j == 0 ? S->pod : S->bas[j - 1]; o.pod_cols = RMAX;
     rc = phgmg_reduce(&red, S->sys, S->X[0], N, 1001, &o, NULL, NULL);
   }
+  if (red && j == 6) {   /* PRBT's projection (T, W) without the pH form: W^T A T, W^T B, C T */
+    double *Tm = (double *)malloc(sizeof(double) * N * r * 2), *Wm = Tm + (size_t)N * r, e[RMAX];
+    int a;
+    for (a = 0; a < r; ++a) {
+      memset(e, 0, sizeof e);
+      e[a] = 1.0;
+      phgmg_reduced_lift(red, e, Tm + (size_t)a * N);
+    }
+    phgmg_reduced_W(red, e, Wm, N);
+    {
+      double *AT = (double *)malloc(sizeof(double) * N * r);
+      phgmg_gemm('N', 'N', N, r, N, 1.0, S->A, N, Tm, N, 0.0, AT, N);
+      phgmg_gemm('T', 'N', r, r, N, 1.0, Wm, N, AT, N, 0.0, Ar, r);
+      phgmg_gemm('T', 'N', r, m, N, 1.0, Wm, N, S->sys->B, N, 0.0, Br, r);
+      phgmg_gemm('N', 'N', m, r, N, 1.0, S->C, m, Tm, N, 0.0, Cr, m);
+      free(AT);
+    }
+    free(Tm);
+    phgmg_reduced_destroy(red);
+    red = NULL;
+  }
   if (red) phgmg_reduced_abc(red, Ar, Br, Cr);
   for (in = 0; in < NIN; ++in) {
     input_ctx ic;
     ic.m = m; ic.which = in;
     ey[in] = NAN;
     if (rc != PHGMG_OK || g_nosim) continue;
-    if (j == 4) {
+    if (j == 4 || j == 6) {
       if (sim_abc(r, m, Ar, Br, Cr, 1000, 0.1, &ic, YR) == 0) ey[in] = e_y_of(S, in, YR);
     } else if (phgmg_reduced_simulate(red, xr0, 0.0, 0.1, 1000, input_fn, &ic, 1e-12, 10, NULL, YR, NULL, NULL,
                                       NULL) == PHGMG_OK) {
@@ -349,7 +374,7 @@ int main(int argc, char **argv) {
         fprintf(fs, "r,method,min_eig_R_rel,energy_err_rel\n");
         for (r = 4; r <= RMAX; ++r)
           for (j = 0; j < NMETH; ++j)
-            if (j != 4) structure_row(&S, j, r, fs);
+            if (j != 4 && j != 6) structure_row(&S, j, r, fs);
         fclose(fs);
       }
       snprintf(path, sizeof path, "%s/linear_bases_bode.svg", out);
