@@ -19,7 +19,7 @@ e = {}
 for w in rows:
     e[(w["system"], int(w["r"]), w["input"], w["method"])] = float(w["e_y"])
 systems = {"paper_chain": 1, "two_port_chain": 2}
-methods = ["GMG-POD", "GMG-FREQ", "GMG-IMPULSE", "GMG-BAL", "BT", "PRBT"]
+methods = ["GMG-POD", "GMG-FREQ", "GMG-IMPULSE", "GMG-BAL", "BT", "PRBT", "PRBT-LTI"]
 inputs = sorted({w["input"] for w in rows})
 if len(inputs) != 6 or "train_sin" not in inputs:
     print(f"FAIL  inputs {inputs}"); fails += 1
