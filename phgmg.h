@@ -931,7 +931,11 @@ PHGMG_DEF phgmg_result phgmg_prbt_riccati(const phgmg_ph_system *sys, double eps
    PHGMG_ERR_NOT_CONVERGED, as is a sign iteration that does not converge).
    Lift: x = T xr (phgmg_reduced_lift); restrict: xr = W^T x. prsv (may be
    NULL): the first r positive-real singular values; info_xb (may be NULL):
-   ||X B - C^T||_F / ||C||_F. The system must outlive the model. */
+   ||X B - C^T||_F / ||C||_F. The system must outlive the model. Errors:
+   PHGMG_ERR_INVALID_ARG (NULL, negative/NaN eps or dt, only one of X/Y),
+   PHGMG_ERR_UNSUPPORTED (nl != NONE), the codes of phgmg_ph_validate,
+   PHGMG_ERR_SIZE (r outside 1..N), PHGMG_ERR_NOT_CONVERGED / _SINGULAR,
+   PHGMG_ERR_RANK (Gramian rank below r), PHGMG_ERR_NOMEM; *out is NULL on failure. */
 PHGMG_DEF phgmg_result phgmg_prbt(phgmg_reduced **out, const phgmg_ph_system *sys, int r,
                                   const phgmg_prbt_opts *opts, double *prsv, double *info_xb,
                                   const phgmg_allocator *alloc);
@@ -7044,6 +7048,9 @@ PHGMG_DEF phgmg_result phgmg_bt(const phgmg_ph_system *sys, int r, double *Ar, d
   double *A, *C, *P, *O, *Tb, *Wb, *S;
   phgmg_result rc;
   if (!sys || !Ar || !Br || !Cr) return PHGMG_ERR_INVALID_ARG;
+  if (sys->nl != PHGMG_NL_NONE) return PHGMG_ERR_UNSUPPORTED;
+  rc = phgmg_ph_validate(sys, 0.0, NULL, alloc);
+  if (rc != PHGMG_OK) return rc;
   N = sys->N; m = sys->m;
   if (r < 1 || r > N) return PHGMG_ERR_SIZE;
   A = phgmg__dalloc(alloc, 3 * (size_t)N * N + (size_t)m * N + 2 * (size_t)N * r + r);
@@ -7132,13 +7139,14 @@ PHGMG_DEF phgmg_result phgmg_prbt(phgmg_reduced **out, const phgmg_ph_system *sy
   if (!out) return PHGMG_ERR_INVALID_ARG;
   *out = NULL;
   if (!sys) return PHGMG_ERR_INVALID_ARG;
-  N = sys->N; m = sys->m;
-  if (r < 1 || r > N || N < 1 || m < 1) return PHGMG_ERR_SIZE;
   if (sys->nl != PHGMG_NL_NONE) return PHGMG_ERR_UNSUPPORTED;
+  if (opts && (opts->eps < 0.0 || opts->dt < 0.0 || !isfinite(opts->eps) || !isfinite(opts->dt) ||
+               (!opts->X) != (!opts->Y))) return PHGMG_ERR_INVALID_ARG;
   eps = opts && opts->eps > 0.0 ? opts->eps : 1e-10;
-  if (opts && (opts->eps < 0.0 || opts->dt < 0.0 || !isfinite(opts->eps) || !isfinite(opts->dt))) return PHGMG_ERR_INVALID_ARG;
   rc = phgmg_ph_validate(sys, 0.0, NULL, alloc);
   if (rc != PHGMG_OK) return rc;
+  N = sys->N; m = sys->m;
+  if (r < 1 || r > N) return PHGMG_ERR_SIZE;
   A = phgmg__dalloc(alloc, 3 * (size_t)N * N + (size_t)m * N + 2 * (size_t)r * r + (size_t)m * r + 2 * (size_t)r * m + r + (size_t)m * m);
   red = PHGMG__CAST(phgmg_reduced *, phgmg__alloc(alloc, sizeof(phgmg_reduced)));
   if (!A || !red) { phgmg__free(alloc, A); phgmg__free(alloc, red); return PHGMG_ERR_NOMEM; }
@@ -7205,8 +7213,10 @@ PHGMG_DEF phgmg_result phgmg_prbt_riccati(const phgmg_ph_system *sys, double eps
   double *A, *C, CBn;
   phgmg_result rc;
   if (!sys || !X || !Y) return PHGMG_ERR_INVALID_ARG;
+  if (sys->nl != PHGMG_NL_NONE) return PHGMG_ERR_UNSUPPORTED;
+  rc = phgmg_ph_validate(sys, 0.0, NULL, alloc);
+  if (rc != PHGMG_OK) return rc;
   N = sys->N; m = sys->m;
-  if (N < 1 || m < 1 || m > N) return PHGMG_ERR_SIZE;
   A = phgmg__dalloc(alloc, (size_t)N * N + (size_t)m * N + (size_t)m * m);
   if (!A) return PHGMG_ERR_NOMEM;
   C = A + (size_t)N * N;
@@ -7299,10 +7309,12 @@ PHGMG_DEF phgmg_result phgmg_linear_basis(const phgmg_ph_system *sys, phgmg_basi
   double *X = NULL;
   phgmg_result rc;
   if (!sys || !V) return PHGMG_ERR_INVALID_ARG;
-  N = sys->N; m = sys->m;
   if (kind < PHGMG_BASIS_FREQ || kind > PHGMG_BASIS_BALANCED) return PHGMG_ERR_INVALID_ARG;
-  if (k < 1 || k > N - m) return PHGMG_ERR_SIZE;
   if (sys->nl != PHGMG_NL_NONE) return PHGMG_ERR_UNSUPPORTED;
+  rc = phgmg_ph_validate(sys, 0.0, NULL, alloc);
+  if (rc != PHGMG_OK) return rc;
+  N = sys->N; m = sys->m;
+  if (k < 1 || k > N - m) return PHGMG_ERR_SIZE;
   memset(V, 0, (size_t)N * k * sizeof(double));
   if (kind == PHGMG_BASIS_BALANCED) {   /* QR of [B, T_k] in order */
     double *M = phgmg__dalloc(alloc, (size_t)N * (m + k) + (size_t)k * k + 2 * (size_t)m * k + 2 * (size_t)(m + k)), *tau;

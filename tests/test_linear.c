@@ -186,7 +186,37 @@ TEST(test_bases_orthonormal_to_b) {
   CHECK_RC(phgmg_linear_basis(&s, PHGMG_BASIS_FREQ, CH_N, NULL, V, NULL, NULL), PHGMG_ERR_SIZE);
 }
 
+TEST(test_bad_arguments) {
+  phgmg_ph_system s = chain2();
+  phgmg_reduced *red = (phgmg_reduced *)&s;   /* must be reset to NULL on failure */
+  phgmg_prbt_opts o;
+  double Ar[4], Br[4], Cr[4], x = 1.0, nanv = NAN;
+  static double Jbad[CH_N * CH_N];
+  memset(&o, 0, sizeof o);
+  CHECK_RC(phgmg_prbt(&red, NULL, 4, NULL, NULL, NULL, NULL), PHGMG_ERR_INVALID_ARG);
+  CHECK(red == NULL);
+  CHECK_RC(phgmg_prbt(&red, &s, 0, NULL, NULL, NULL, NULL), PHGMG_ERR_SIZE);
+  CHECK_RC(phgmg_prbt(&red, &s, CH_N + 1, NULL, NULL, NULL, NULL), PHGMG_ERR_SIZE);
+  o.eps = -1.0;
+  CHECK_RC(phgmg_prbt(&red, &s, 4, &o, NULL, NULL, NULL), PHGMG_ERR_INVALID_ARG);
+  o.eps = 0.0; o.X = chQ;    /* X without Y */
+  CHECK_RC(phgmg_prbt(&red, &s, 4, &o, NULL, NULL, NULL), PHGMG_ERR_INVALID_ARG);
+  CHECK(red == NULL);
+  s.nl = PHGMG_NL_GENERAL;
+  CHECK_RC(phgmg_prbt(&red, &s, 4, NULL, NULL, NULL, NULL), PHGMG_ERR_UNSUPPORTED);
+  CHECK_RC(phgmg_bt(&s, 2, Ar, Br, Cr, NULL, NULL, NULL, NULL), PHGMG_ERR_UNSUPPORTED);
+  s.nl = PHGMG_NL_NONE;
+  memcpy(Jbad, chJ, sizeof Jbad);   /* J not skew */
+  Jbad[0 + 1 * CH_N] = 2.0;
+  s.J = Jbad;
+  CHECK_RC(phgmg_bt(&s, 2, Ar, Br, Cr, NULL, NULL, NULL, NULL), PHGMG_ERR_NOT_SKEW);
+  CHECK_RC(phgmg_linear_basis(&s, PHGMG_BASIS_FREQ, 4, NULL, chR, NULL, NULL), PHGMG_ERR_NOT_SKEW);
+  CHECK_RC(phgmg_lyap(1, &nanv, &x, Ar, NULL, NULL), PHGMG_ERR_NANINF);
+  CHECK_RC(phgmg_care(0, &x, &x, &x, Ar, NULL, NULL), PHGMG_ERR_SIZE);
+}
+
 SUITE(linear) {
+  RUN(test_bad_arguments);
   RUN(test_lyap_closed_form_and_residual);
   RUN(test_care_closed_form_and_residual);
   RUN(test_bt_bound_and_transfer);
