@@ -160,6 +160,19 @@ TEST(test_prbt_structure_energy_export) {
     CHECK(need <= sizeof mem);
     CHECK_RC(phgmg_rom_deserialize(buf, wr, &back, mem, sizeof mem), PHGMG_OK);
     CHECK(back.method == PHGMG_METHOD_PRBT);
+    CHECK(back.Phi != NULL && back.r == r && back.m == 2);
+  }
+  /* C export (firmware path) */
+  {
+    const char *path = "build/test_linear_prbt_export.h";
+    FILE *f;
+    long len = 0;
+    CHECK_RC(phgmg_rom_export_c(rom, "prbt12", path), PHGMG_OK);
+    f = fopen(path, "rb");
+    CHECK(f != NULL);
+    if (f) { fseek(f, 0, SEEK_END); len = ftell(f); fclose(f); }
+    CHECK(len > 1000);
+    remove(path);
   }
   phgmg_reduced_destroy(red);
 }
