@@ -35,6 +35,19 @@ static void report(FILE *csv, const char *name, double *t, int runs) {
   if (csv) fprintf(csv, "%s,%.6f,%.6f,%.6f,%d\n", name, med, t[0], t[runs - 1], runs);
 }
 
+/* ||A^T X + X A - X K X + L||_F / ||L||_F (T: n^2 scratch; clobbers K X into T first) */
+static double res_over_l(int n, const double *A, const double *K, const double *L, const double *X, double *T) {
+  double *KX = (double *)malloc(sizeof(double) * (size_t)n * n), r;
+  memcpy(T, L, sizeof(double) * (size_t)n * n);
+  phgmg_gemm('T', 'N', n, n, n, 1.0, A, n, X, n, 1.0, T, n);
+  phgmg_gemm('N', 'N', n, n, n, 1.0, X, n, A, n, 1.0, T, n);
+  phgmg_gemm('N', 'N', n, n, n, 1.0, K, n, X, n, 0.0, KX, n);
+  phgmg_gemm('N', 'N', n, n, n, -1.0, X, n, KX, n, 1.0, T, n);
+  r = phgmg_normf(n, n, T, n) / phgmg_normf(n, n, L, n);
+  free(KX);
+  return r;
+}
+
 int main(int argc, char **argv) {
   const int n = 500, N = 2 * n;
   double *mv = (double *)malloc(sizeof(double) * n), *A, *C, *F, *X, *Y, *K, *L, CB[4], s, t[16];
@@ -89,10 +102,11 @@ int main(int argc, char **argv) {
     phgmg_gemm('N', 'N', N, N, 2, -1.0 / s, M.sys.B, N, C, 2, 1.0, A, N);            /* A - B S^-1 C */
     phgmg_gemm('N', 'T', N, N, 2, -1.0 / s, M.sys.B, N, M.sys.B, N, 0.0, K, N);
     phgmg_gemm('T', 'N', N, N, 2, 1.0 / s, C, 2, C, 2, 0.0, L, N);
-    printf("prbt_N1000_r20: Riccati residuals %.2e (Q-eq)", phgmg_care_residual(N, A, K, L, X, NULL));
+    printf("prbt_N1000_r20: Riccati residuals %.2e (Q-eq, phgmg_care_residual), %.2e (Q-eq, ||res|| / ||L||)",
+           phgmg_care_residual(N, A, K, L, X, NULL), res_over_l(N, A, K, L, X, F));
     for (i = 0; i < N; ++i) { int j; for (j = 0; j < i; ++j) { double a = A[i + (size_t)j * N]; A[i + (size_t)j * N] = A[j + (size_t)i * N]; A[j + (size_t)i * N] = a; } }
     for (i = 0; i < N * N; ++i) { double a = K[i]; K[i] = -L[i]; L[i] = -a; }
-    printf(", %.2e (P-eq)\n", phgmg_care_residual(N, A, K, L, Y, NULL));
+    printf(", %.2e / %.2e (P-eq)\n", phgmg_care_residual(N, A, K, L, Y, NULL), res_over_l(N, A, K, L, Y, F));
   }
   if (csv) fclose(csv);
   free(A); free(mv);

@@ -75,6 +75,15 @@ TEST(test_care_closed_form_and_residual) {
     phgmg_gemm('N', 'T', CH_N, CH_N, 2, -1.0 / sc, chB, CH_N, chB, CH_N, 0.0, K, CH_N);
     phgmg_gemm('T', 'N', CH_N, CH_N, 2, 1.0 / sc, C, 2, C, 2, 0.0, L, CH_N);
     CHECK_LE(phgmg_care_residual(CH_N, A, K, L, X, NULL), 1e-10);
+    {   /* the stricter measure ||res|| / ||L|| (L ~ 1/eps dominates the normalisation above) */
+      static double T[CH_N * CH_N], KX[CH_N * CH_N];
+      memcpy(T, L, sizeof T);
+      phgmg_gemm('T', 'N', CH_N, CH_N, CH_N, 1.0, A, CH_N, X, CH_N, 1.0, T, CH_N);
+      phgmg_gemm('N', 'N', CH_N, CH_N, CH_N, 1.0, X, CH_N, A, CH_N, 1.0, T, CH_N);
+      phgmg_gemm('N', 'N', CH_N, CH_N, CH_N, 1.0, K, CH_N, X, CH_N, 0.0, KX, CH_N);
+      phgmg_gemm('N', 'N', CH_N, CH_N, CH_N, -1.0, X, CH_N, KX, CH_N, 1.0, T, CH_N);
+      CHECK_LE(phgmg_normf(CH_N, CH_N, T, CH_N) / phgmg_normf(CH_N, CH_N, L, CH_N), 1e-10);
+    }
   }
 }
 
