@@ -851,7 +851,8 @@ PHGMG_DEF phgmg_result phgmg_deim(int nterms, int ns, const double *F, int ldf, 
    truncation (square-root method) as reference, positive-real balanced
    truncation (PRBT) returning a pH reduced model, input-independent bases for
    GMG-POD (pass them through phgmg_reduce_opts.pod_basis), transfer functions
-   and H-infinity / H2 errors. Cost O(n^3) per sign step (~25-40 steps). */
+   and H-infinity / H2 errors. Cost O(n^3) per sign step (15-17 steps on the
+   mass-spring-damper chains; tests/test_linear.c, bench/bench_linear.c). */
 #ifndef PHGMG_NO_OFFLINE
 #ifdef __cplusplus
 extern "C" {
@@ -860,14 +861,16 @@ extern "C" {
 /* Lyapunov equation A X + X A^T + F = 0 (A n x n stable, F symmetric), X
    n x n (all ld = n). Sign iteration Z <- (Z/c + c Z^-1)/2, E <- (E/c + c
    Z^-1 E Z^-T)/2 from Z = A, E = F; X = E/2. *iters (may be NULL) = steps.
-   PHGMG_ERR_SINGULAR (A singular, e.g. not stable), _NOT_CONVERGED, _NANINF. */
+   PHGMG_ERR_SINGULAR (A singular, or not stable: the sign of A is not -I),
+   _NOT_CONVERGED, _NANINF, _NOMEM. */
 PHGMG_DEF phgmg_result phgmg_lyap(int n, const double *A, const double *F, double *X, int *iters,
                                   const phgmg_allocator *alloc);
 /* Riccati equation A^T X + X A - X K X + L = 0 (K, L symmetric, n x n): the
    stabilizing solution (A - K X stable) from the sign of the Hamiltonian
    matrix H = [A, -K; -L, -A^T]: [W12; W22 + I] X = -[W11 + I; W21] by least
    squares, X symmetrised. H must have no eigenvalue on the imaginary axis
-   (else PHGMG_ERR_NOT_CONVERGED or _SINGULAR). */
+   (else PHGMG_ERR_NOT_CONVERGED or _SINGULAR, or -- close to the axis -- an
+   inaccurate X: check phgmg_care_residual). */
 PHGMG_DEF phgmg_result phgmg_care(int n, const double *A, const double *K, const double *L, double *X,
                                   int *iters, const phgmg_allocator *alloc);
 /* Relative residuals ||A X + X A^T + F||_F / (2 ||A||_F ||X||_F + ||F||_F) and
