@@ -37,6 +37,8 @@
      >>gl3      3-stage Gauss-Legendre (order 6) + simplified Newton, energy bookkeeping
      >>online   reduced models (phgmg_rom), evaluation, allocation-free GL3 stepper
      >>pod, >>reduce, >>deim, >>errors   POD, GMG-POD, GMG-QM, SP1, SP2, DEIM, error measures
+     >>linear   linear pH systems: Lyapunov/Riccati (sign function), balanced truncation,
+                positive-real BT in pH form, input-independent GMG bases, H-inf/H2
      >>export   C-source and binary export/import of reduced models
      >>npy      NumPy .npy read/write
 
@@ -79,6 +81,9 @@
             phgmg_reduced_W, phgmg_reduced_simulate
    errors:  phgmg_rel_error, phgmg_err_red, phgmg_err_proj, phgmg_err_lowerbound,
             phgmg_err_energy
+   linear:  phgmg_lyap, phgmg_care, phgmg_lyap_residual, phgmg_care_residual, phgmg_ph_abc,
+            phgmg_bt, phgmg_prbt, phgmg_prbt_riccati, phgmg_linear_basis, phgmg_ss_transfer, phgmg_reduced_abc,
+            phgmg_ss_error
    export:  phgmg_rom_serialized_size, phgmg_rom_serialize, phgmg_rom_deserialize_size,
             phgmg_rom_deserialize, phgmg_rom_save, phgmg_rom_load, phgmg_rom_export_c
    npy:     phgmg_npy_parse, phgmg_npy_serialize, phgmg_npy_free, phgmg_npy_read,
@@ -563,7 +568,8 @@ typedef enum phgmg_method {
   PHGMG_METHOD_GMG_QM = 2,  /* quadratic manifold, GMG reduction (paper 4.2.2)        */
   PHGMG_METHOD_SP1 = 3,     /* SP1-POD: phi = V_POD x, W = QV(V^TQV)^-1 (eq. 5.3)     */
   PHGMG_METHOD_SP2 = 4,     /* SP2-POD: W = V_gradH (V_POD^T V_gradH)^-1 (NUMERICS 6.3) */
-  PHGMG_METHOD_GMG_MANIFOLD = 5 /* your own manifold phi = [B, V1] x + V2 eta(x2), GMG reduction */
+  PHGMG_METHOD_GMG_MANIFOLD = 5, /* your own manifold phi = [B, V1] x + V2 eta(x2), GMG reduction */
+  PHGMG_METHOD_PRBT = 6     /* positive-real balanced truncation, pH form (phgmg_prbt, >>linear) */
 } phgmg_method;
 
 /* A manifold map eta: R^p -> R^rn (p = r - m) and its derivatives at x2:
@@ -1032,6 +1038,159 @@ PHGMG_DEF phgmg_result phgmg_ecsw_separable(int nterms, int ns, const double *F,
                                             const double *Vt, int ldvt, const double *sw, double tol,
                                             int *pts, double *w, int *nd_out, double *resid_out,
                                             const phgmg_allocator *alloc);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* PHGMG_NO_OFFLINE */
+
+/* >>linear ================================================================ */
+/* Linear pH systems with a quadratic Hamiltonian (nl == NONE), dense up to a
+   few thousand states: x' = A x + B u, y = C x with A = (J - R) Q, C = B^T Q
+   and zero feedthrough. Matrix equations by the matrix sign function (only
+   LU inverses and products; Frobenius-norm scaling while far from
+   convergence; stop one unscaled step after d = ||Z+ - Z||_1 / ||Z+||_1 <=
+   1e-10, or after d <= 1e-4 stops halving (round-off level of an
+   ill-conditioned sign); at most 100 steps, else PHGMG_ERR_NOT_CONVERGED;
+   check the residual with phgmg_lyap_residual / phgmg_care_residual), balanced
+   truncation (square-root method) as reference, positive-real balanced
+   truncation (PRBT) returning a pH reduced model, input-independent bases for
+   GMG-POD (pass them through phgmg_reduce_opts.pod_basis), transfer functions
+   and H-infinity / H2 errors. Cost O(n^3) per sign step (15-17 steps on the
+   mass-spring-damper chains; tests/test_linear.c, bench/bench_linear.c). */
+#ifndef PHGMG_NO_OFFLINE
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Lyapunov equation A X + X A^T + F = 0 (A n x n stable, F symmetric), X
+   n x n (all ld = n). Sign iteration Z <- (Z/c + c Z^-1)/2, E <- (E/c + c
+   Z^-1 E Z^-T)/2 from Z = A, E = F; X = E/2. *iters (may be NULL) = steps.
+   PHGMG_ERR_SINGULAR (A singular, or not stable: the sign of A is not -I),
+   _NOT_CONVERGED, _NANINF, _NOMEM. */
+PHGMG_DEF phgmg_result phgmg_lyap(int n, const double *A, const double *F, double *X, int *iters,
+                                  const phgmg_allocator *alloc);
+/* Riccati equation A^T X + X A - X K X + L = 0 (K, L symmetric, n x n): the
+   stabilizing solution (A - K X stable) from the sign of the Hamiltonian
+   matrix H = [A, -K; -L, -A^T]: [W12; W22 + I] X = -[W11 + I; W21] by least
+   squares, X symmetrised. H must have no eigenvalue on the imaginary axis
+   (else PHGMG_ERR_NOT_CONVERGED or _SINGULAR, or -- close to the axis -- an
+   inaccurate X: check phgmg_care_residual). */
+PHGMG_DEF phgmg_result phgmg_care(int n, const double *A, const double *K, const double *L, double *X,
+                                  int *iters, const phgmg_allocator *alloc);
+/* Relative residuals ||A X + X A^T + F||_F / (2 ||A||_F ||X||_F + ||F||_F) and
+   ||A^T X + X A - X K X + L||_F / (2 ||A||_F ||X||_F + ||X||_F^2 ||K||_F + ||L||_F);
+   NaN when out of memory. */
+PHGMG_DEF double phgmg_lyap_residual(int n, const double *A, const double *F, const double *X,
+                                     const phgmg_allocator *alloc);
+PHGMG_DEF double phgmg_care_residual(int n, const double *A, const double *K, const double *L,
+                                     const double *X, const phgmg_allocator *alloc);
+
+/* Dense A = (J - R) Q (N x N) and C = B^T Q (m x N) of a system (dense or
+   banded storage; nl must be NONE: PHGMG_ERR_UNSUPPORTED). Either may be NULL. */
+PHGMG_DEF phgmg_result phgmg_ph_abc(const phgmg_ph_system *sys, double *A, double *C,
+                                    const phgmg_allocator *alloc);
+
+/* Balanced truncation (square-root method), reference: Gramians P, O from
+   A P + P A^T + B B^T = 0, A^T O + O A + C^T C = 0; P = Lp Lp^T, O = Lo Lo^T
+   (symmetric eigen-decompositions, negative round-off eigenvalues dropped),
+   Lo^T Lp = U S V^T, T = Lp V_r S_r^{-1/2}, W = Lo U_r S_r^{-1/2};
+   Ar = W^T A T (r x r), Br = W^T B (r x m), Cr = C T (m x r). Not a pH
+   model in general (hence plain matrices). hsv (may be NULL): the first r
+   Hankel singular values; T, W (N x r, may be NULL): the bases. */
+PHGMG_DEF phgmg_result phgmg_bt(const phgmg_ph_system *sys, int r, double *Ar, double *Br, double *Cr,
+                                double *hsv, double *T, double *W, const phgmg_allocator *alloc);
+
+typedef struct phgmg_prbt_opts {
+  double eps; /* feedthrough regularisation D = eps ||C B||_F I (0: 1e-10; see phgmg_prbt) */
+  double dt;  /* > 0: precompute the GL3 step map of the reduced model for this step   */
+  /* Optional cache for studies over many r: the two Riccati solutions from
+     phgmg_prbt_riccati with the same eps (N x N each; both or neither). */
+  const double *X, *Y;
+} phgmg_prbt_opts;
+
+/* The positive-real Riccati solutions of phgmg_prbt (X: Q-eq, Y: P-eq, N x N),
+   for phgmg_prbt_opts.X/Y. eps <= 0: 1e-10. */
+PHGMG_DEF phgmg_result phgmg_prbt_riccati(const phgmg_ph_system *sys, double eps, double *X, double *Y,
+                                          const phgmg_allocator *alloc);
+
+/* Positive-real balanced truncation with a pH reduced model (method
+   PHGMG_METHOD_PRBT, kind LINEAR). The positive-real lemma's Riccati
+   equations need D + D^T > 0; a pH system has D = 0, so D = d I with
+   d = eps ||C B||_F is used: with S = 2 d I,
+     Q-eq  A^T X + X A + (X B - C^T) S^-1 (X B - C^T)^T = 0,
+     P-eq  A Y + Y A^T + (Y C^T - B) S^-1 (Y C^T - B)^T = 0,
+   minimal (stabilizing) solutions by phgmg_care. Balancing Y, X as in phgmg_bt
+   gives Ar, Br, Cr and Sigma_r (the leading positive-real singular values);
+   Sigma_r solves the reduced Q-equation exactly, so the reduced model in pH
+   form is  Qh = Sigma_r (PD), Jh = skew(Ar Sigma_r^-1), Rh = Sigma_r^-1 F
+   S^-1 F^T Sigma_r^-1 / 2 with F = Sigma_r Br - Cr^T (PSD by construction),
+   Bh = Br, output Bh^T Qh x. Effect of the regularisation: the model drops
+   D = d I and replaces the output Cr by Br^T Sigma_r; both differences are
+   O(sqrt(eps)) relative (measured ||X B - C^T|| / ||C||: 8e-3, 8e-4, 8e-5 at
+   eps = 1e-6, 1e-8, 1e-10 on the two-port chain); much smaller eps makes the
+   Hamiltonian matrix too ill-conditioned for the sign function (its
+   eigenvalues approach the imaginary axis at 0 and infinity, where the
+   positive-real Popov function of a zero-feedthrough chain vanishes).
+   Measured on the two-port chain (N = 100, r = 12/16/20, relative H-inf
+   error): eps = 1e-8: 1.8e-3/2.6e-4/2.0e-4, 1e-9: 1.7e-3/2.3e-4/1.3e-4,
+   1e-10: 1.8e-3/4.1e-4/2.3e-4; at 1e-11 the sign iteration loses the
+   minimal solution (a positive-real singular value > 1: returned as
+   PHGMG_ERR_NOT_CONVERGED, as is a sign iteration that does not converge).
+   Lift: x = T xr (phgmg_reduced_lift); restrict: xr = W^T x. prsv (may be
+   NULL): the first r positive-real singular values; info_xb (may be NULL):
+   ||X B - C^T||_F / ||C||_F. The system must outlive the model. Errors:
+   PHGMG_ERR_INVALID_ARG (NULL, negative/NaN eps or dt, only one of X/Y),
+   PHGMG_ERR_UNSUPPORTED (nl != NONE), the codes of phgmg_ph_validate,
+   PHGMG_ERR_SIZE (r outside 1..N), PHGMG_ERR_NOT_CONVERGED / _SINGULAR,
+   PHGMG_ERR_RANK (Gramian rank below r), PHGMG_ERR_NOMEM; *out is NULL on failure. */
+PHGMG_DEF phgmg_result phgmg_prbt(phgmg_reduced **out, const phgmg_ph_system *sys, int r,
+                                  const phgmg_prbt_opts *opts, double *prsv, double *info_xb,
+                                  const phgmg_allocator *alloc);
+
+typedef enum phgmg_basis_kind {
+  PHGMG_BASIS_FREQ = 1,     /* Re, Im of (i w I - A)^{-1} B, w log-spaced      */
+  PHGMG_BASIS_IMPULSE = 2,  /* x(t) = e^{At} B sampled by GL3 steps            */
+  PHGMG_BASIS_BALANCED = 3  /* balanced right basis T of phgmg_bt, in order    */
+} phgmg_basis_kind;
+
+typedef struct phgmg_basis_opts {
+  int nw;             /* FREQ: frequencies (0: 60)                               */
+  double wmin, wmax;  /* FREQ: grid ends (0: from the system: wmin = 1 /
+                         (10 ||A^-1||_1), wmax = 2 ||A||_1, which bracket every
+                         eigenvalue modulus of A: |lambda| in [1/||A^-1||, ||A||]) */
+  double dt;          /* IMPULSE: step (0: 0.1)                                   */
+  int nsteps;         /* IMPULSE: steps (0: 1000)                                 */
+} phgmg_basis_opts;
+
+/* An input-independent basis V (N x k, ld N) for GMG: orthonormal and
+   orthogonal to B, ordered (FREQ, IMPULSE: POD of the snapshots after
+   removing their B-component; BALANCED: Gram-Schmidt of [B, T] in order,
+   B's part dropped). Pass it as opts.pod_basis / pod_cols = k to
+   phgmg_reduce (GMG-POD takes its first r - m columns). opts may be NULL.
+   *k_out (may be NULL) = columns filled (fewer if the snapshots have lower
+   rank; the rest is zero). */
+PHGMG_DEF phgmg_result phgmg_linear_basis(const phgmg_ph_system *sys, phgmg_basis_kind kind, int k,
+                                          const phgmg_basis_opts *opts, double *V, int *k_out,
+                                          const phgmg_allocator *alloc);
+
+/* Transfer function G(i w) = C (i w I - A)^{-1} B of a state-space model
+   (A n x n, B n x m, C p x n), complex p x m interleaved (re, im) in G. */
+PHGMG_DEF phgmg_result phgmg_ss_transfer(int n, int m, int p, const double *A, const double *B,
+                                         const double *C, double w, double *G, const phgmg_allocator *alloc);
+/* A reduced LINEAR model with quadratic H as (A, B, C) = (K Qh, Bh, Bh^T Qh)
+   (r x r, r x m, m x r), from its double blocks. */
+PHGMG_DEF phgmg_result phgmg_reduced_abc(const phgmg_reduced *red, double *A, double *B, double *C);
+/* Errors between two models with the same ports (m inputs, p outputs):
+   hinf = max over nw log-spaced w in [wmin, wmax] of sigma_max(G1 - G2),
+   hinf_ref = the same of G1 (for a relative error); h2 = the H2 norm of the
+   error system by one Lyapunov equation of size n1 + n2 (both stable),
+   h2_ref = ||G1||_H2. Any output may be NULL. */
+PHGMG_DEF phgmg_result phgmg_ss_error(int n1, const double *A1, const double *B1, const double *C1,
+                                      int n2, const double *A2, const double *B2, const double *C2,
+                                      int m, int p, int nw, double wmin, double wmax, double *hinf,
+                                      double *hinf_ref, double *h2, double *h2_ref,
+                                      const phgmg_allocator *alloc);
 
 #ifdef __cplusplus
 }
@@ -7613,7 +7772,7 @@ PHGMG_DEF void phgmg_reduced_lift(const phgmg_reduced *red, const double *xr, do
 
 PHGMG_DEF void phgmg_reduced_restrict(const phgmg_reduced *red, const double *x, double *xr) {
   const int N = red->N, m = red->m, r = red->r;
-  if (red->method == PHGMG_METHOD_SP1 || red->method == PHGMG_METHOD_SP2) {
+  if (red->method == PHGMG_METHOD_SP1 || red->method == PHGMG_METHOD_SP2 || red->method == PHGMG_METHOD_PRBT) {
     phgmg_gemv('T', N, r, 1.0, red->W, N, x, 0.0, xr);
   } else {
     /* [B, V1]^+ x = [RB^{-1} QB^T x; V1^T x]  (V1 is orthogonal to B) */
@@ -7648,7 +7807,7 @@ PHGMG_DEF phgmg_result phgmg_reduced_W(const phgmg_reduced *red, const double *x
   double *D, *GtD, *E, *Einv;
   phgmg_result rc;
   int j;
-  if (red->method == PHGMG_METHOD_SP1 || red->method == PHGMG_METHOD_SP2) {
+  if (red->method == PHGMG_METHOD_SP1 || red->method == PHGMG_METHOD_SP2 || red->method == PHGMG_METHOD_PRBT) {
     for (j = 0; j < r; ++j) memcpy(W + (size_t)j * ldw, red->W + (size_t)j * N, (size_t)N * sizeof(double));
     return PHGMG_OK;
   }
@@ -7848,6 +8007,672 @@ PHGMG_DEF void phgmg_err_energy(const phgmg_energy *energy, int nsteps, double *
 }
 #endif /* PHGMG_NO_OFFLINE */
 
+/* >>linear (implementation) ============================================== */
+#ifndef PHGMG_NO_OFFLINE
+
+/* One scaled Newton step of the sign function on Z (n x n, in place), with
+   the same congruence on E (n x n symmetric, may be NULL): Zi = Z^{-1},
+   Z <- (Z/c + c Zi)/2, E <- (E/c + c Zi E Zi^T)/2. *d = ||Z+ - Z||_1 / ||Z+||_1.
+   scale = 0: c = 1. work: 3 n^2 doubles. */
+PHGMG__PRIV phgmg_result phgmg__sign_step(int n, double *Z, double *E, int scale, double *d, double *work,
+                                          const phgmg_allocator *alloc) {
+  double *Zi = work, *T = Zi + (size_t)n * n, *T2 = T + (size_t)n * n, c = 1.0, num = 0.0, den = 0.0;
+  const size_t nn = (size_t)n * n;
+  size_t i;
+  phgmg_result rc = phgmg__inv(n, Z, Zi, alloc);
+  if (rc != PHGMG_OK) return rc;
+  if (!phgmg__all_finite(Zi, nn)) return PHGMG_ERR_NANINF;
+  if (scale) c = sqrt(phgmg_normf(n, n, Z, n) / phgmg_normf(n, n, Zi, n));
+  if (!(c > 0.0) || !isfinite(c)) c = 1.0;
+  if (E) {
+    phgmg_gemm('N', 'N', n, n, n, 1.0, Zi, n, E, n, 0.0, T, n);
+    phgmg_gemm('N', 'T', n, n, n, 1.0, T, n, Zi, n, 0.0, T2, n);
+    for (i = 0; i < nn; ++i) E[i] = 0.5 * (E[i] / c + c * T2[i]);
+  }
+  for (i = 0; i < nn; ++i) {
+    const double zn = 0.5 * (Z[i] / c + c * Zi[i]);
+    T[i] = zn - Z[i];
+    Z[i] = zn;
+  }
+  num = phgmg_norm1(n, n, T, n);
+  den = phgmg_norm1(n, n, Z, n);
+  *d = den > 0.0 ? num / den : (double)INFINITY;
+  return PHGMG_OK;
+}
+
+/* Sign iteration driver: scaled while d > 1e-2; stop one unscaled step after
+   d <= 1e-10, or after d <= 1e-4 stops halving (stagnation at the round-off
+   level of an ill-conditioned problem: the callers' residuals tell). */
+PHGMG__PRIV phgmg_result phgmg__sign_iter(int n, double *Z, double *E, int *iters, const phgmg_allocator *alloc) {
+  double *work = phgmg__dalloc(alloc, 3 * (size_t)n * n), d = 1.0, dprev;
+  phgmg_result rc = PHGMG_ERR_NOT_CONVERGED;
+  int it, done = 0;
+  if (!work) return PHGMG_ERR_NOMEM;
+  for (it = 0; it < 100; ++it) {
+    phgmg_result s;
+    dprev = d;
+    s = phgmg__sign_step(n, Z, E, d > 1e-2, &d, work, alloc);
+    if (s != PHGMG_OK) { rc = s; break; }
+    if (done) { rc = PHGMG_OK; ++it; break; }
+    /* converged, or stagnating at the round-off level of an ill-conditioned sign */
+    if (d <= 1e-10 || (d <= 1e-4 && dprev <= 1e-2 && d > 0.5 * dprev)) done = 1;
+  }
+  if (iters) *iters = it;
+  phgmg__free(alloc, work);
+  return rc;
+}
+
+PHGMG_DEF phgmg_result phgmg_lyap(int n, const double *A, const double *F, double *X, int *iters,
+                                  const phgmg_allocator *alloc) {
+  const size_t nn = (size_t)n * n;
+  double *Z;
+  phgmg_result rc;
+  size_t i;
+  int j, k;
+  if (!A || !F || !X) return PHGMG_ERR_INVALID_ARG;
+  if (n < 1) return PHGMG_ERR_SIZE;
+  if (!phgmg__all_finite(A, nn) || !phgmg__all_finite(F, nn)) return PHGMG_ERR_NANINF;
+  Z = phgmg__dalloc(alloc, 2 * nn);
+  if (!Z) return PHGMG_ERR_NOMEM;
+  memcpy(Z, A, nn * sizeof(double));
+  memcpy(Z + nn, F, nn * sizeof(double));
+  rc = phgmg__sign_iter(n, Z, Z + nn, iters, alloc);
+  if (rc == PHGMG_OK) {
+    for (i = 0; i < nn; ++i)   /* sign(A) = -I for a stable A */
+      if (fabs(Z[i] + ((i % (size_t)n) == i / (size_t)n ? 1.0 : 0.0)) > 1e-6) rc = PHGMG_ERR_SINGULAR;
+  }
+  if (rc == PHGMG_OK)
+    for (k = 0; k < n; ++k)
+      for (j = 0; j < n; ++j)
+        X[j + (size_t)k * n] = 0.25 * (Z[nn + j + (size_t)k * n] + Z[nn + k + (size_t)j * n]);
+  phgmg__free(alloc, Z);
+  return rc;
+}
+
+PHGMG_DEF phgmg_result phgmg_care(int n, const double *A, const double *K, const double *L, double *X,
+                                  int *iters, const phgmg_allocator *alloc) {
+  const int n2 = 2 * n;
+  const size_t nn = (size_t)n * n;
+  double *H, *M, *Rh;
+  phgmg_result rc;
+  int i, j;
+  if (!A || !K || !L || !X) return PHGMG_ERR_INVALID_ARG;
+  if (n < 1) return PHGMG_ERR_SIZE;
+  if (!phgmg__all_finite(A, nn) || !phgmg__all_finite(K, nn) || !phgmg__all_finite(L, nn)) return PHGMG_ERR_NANINF;
+  H = phgmg__dalloc(alloc, 4 * nn + 2 * (size_t)n2 * n);
+  if (!H) return PHGMG_ERR_NOMEM;
+  M = H + 4 * nn; Rh = M + (size_t)n2 * n;
+  for (j = 0; j < n; ++j)
+    for (i = 0; i < n; ++i) {
+      H[i + (size_t)j * n2] = A[i + (size_t)j * n];
+      H[i + (size_t)(j + n) * n2] = -K[i + (size_t)j * n];
+      H[(i + n) + (size_t)j * n2] = -L[i + (size_t)j * n];
+      H[(i + n) + (size_t)(j + n) * n2] = -A[j + (size_t)i * n];
+    }
+  rc = phgmg__sign_iter(n2, H, NULL, iters, alloc);
+  if (rc == PHGMG_OK) {
+    for (j = 0; j < n; ++j)
+      for (i = 0; i < n; ++i) {
+        M[i + (size_t)j * n2] = H[i + (size_t)(j + n) * n2];                                   /* W12 */
+        M[(i + n) + (size_t)j * n2] = H[(i + n) + (size_t)(j + n) * n2] + (i == j ? 1.0 : 0.0); /* W22 + I */
+        Rh[i + (size_t)j * n2] = -(H[i + (size_t)j * n2] + (i == j ? 1.0 : 0.0));              /* -(W11 + I) */
+        Rh[(i + n) + (size_t)j * n2] = -H[(i + n) + (size_t)j * n2];                          /* -W21 */
+      }
+    rc = phgmg_lstsq(n2, n, n, M, n2, Rh, n2, 0.0, H, n, alloc);
+  }
+  if (rc == PHGMG_OK)
+    for (j = 0; j < n; ++j)
+      for (i = 0; i < n; ++i) X[i + (size_t)j * n] = 0.5 * (H[i + (size_t)j * n] + H[j + (size_t)i * n]);
+  phgmg__free(alloc, H);
+  return rc;
+}
+
+PHGMG_DEF double phgmg_lyap_residual(int n, const double *A, const double *F, const double *X,
+                                     const phgmg_allocator *alloc) {
+  double *T = phgmg__dalloc(alloc, (size_t)n * n), res;
+  if (!T) return (double)NAN;
+  memcpy(T, F, (size_t)n * n * sizeof(double));
+  phgmg_gemm('N', 'N', n, n, n, 1.0, A, n, X, n, 1.0, T, n);
+  phgmg_gemm('N', 'T', n, n, n, 1.0, X, n, A, n, 1.0, T, n);
+  res = phgmg_normf(n, n, T, n) /
+        (2.0 * phgmg_normf(n, n, A, n) * phgmg_normf(n, n, X, n) + phgmg_normf(n, n, F, n));
+  phgmg__free(alloc, T);
+  return res;
+}
+
+PHGMG_DEF double phgmg_care_residual(int n, const double *A, const double *K, const double *L,
+                                     const double *X, const phgmg_allocator *alloc) {
+  double *T = phgmg__dalloc(alloc, 2 * (size_t)n * n), *KX, res, nx;
+  if (!T) return (double)NAN;
+  KX = T + (size_t)n * n;
+  memcpy(T, L, (size_t)n * n * sizeof(double));
+  phgmg_gemm('T', 'N', n, n, n, 1.0, A, n, X, n, 1.0, T, n);
+  phgmg_gemm('N', 'N', n, n, n, 1.0, X, n, A, n, 1.0, T, n);
+  phgmg_gemm('N', 'N', n, n, n, 1.0, K, n, X, n, 0.0, KX, n);
+  phgmg_gemm('N', 'N', n, n, n, -1.0, X, n, KX, n, 1.0, T, n);
+  nx = phgmg_normf(n, n, X, n);
+  res = phgmg_normf(n, n, T, n) / (2.0 * phgmg_normf(n, n, A, n) * nx + nx * nx * phgmg_normf(n, n, K, n) +
+                                   phgmg_normf(n, n, L, n));
+  phgmg__free(alloc, T);
+  return res;
+}
+
+PHGMG_DEF phgmg_result phgmg_ph_abc(const phgmg_ph_system *sys, double *A, double *C,
+                                    const phgmg_allocator *alloc) {
+  int N, m, i;
+  double *I, *Qd, *T;
+  if (!sys) return PHGMG_ERR_INVALID_ARG;
+  if (sys->nl != PHGMG_NL_NONE) return PHGMG_ERR_UNSUPPORTED;
+  N = sys->N; m = sys->m;
+  if (N < 1 || m < 1 || m > N) return PHGMG_ERR_SIZE;
+  I = phgmg__dalloc(alloc, 3 * (size_t)N * N);
+  if (!I) return PHGMG_ERR_NOMEM;
+  Qd = I + (size_t)N * N; T = Qd + (size_t)N * N;
+  memset(I, 0, (size_t)N * N * sizeof(double));
+  for (i = 0; i < N; ++i) I[i + (size_t)i * N] = 1.0;
+  phgmg_ph_apply(sys, 'Q', N, I, N, Qd, N);
+  if (A) {
+    phgmg_ph_apply(sys, 'J', N, Qd, N, A, N);
+    phgmg_ph_apply(sys, 'R', N, Qd, N, T, N);
+    for (i = 0; i < N * N; ++i) A[i] -= T[i];
+  }
+  if (C) phgmg_gemm('T', 'N', m, N, N, 1.0, sys->B, N, Qd, N, 0.0, C, m);
+  phgmg__free(alloc, I);
+  return PHGMG_OK;
+}
+
+/* L with X = L L^T for a symmetric PSD X (n x n): V diag(sqrt(max(w, 0))).
+   X is destroyed; L needs n^2 + n doubles. */
+PHGMG__PRIV phgmg_result phgmg__psd_sqrt(int n, double *X, double *L) {
+  double *ev = L + (size_t)n * n; /* the caller gives L with n^2 + n doubles */
+  phgmg_result rc = phgmg_sym_eig(n, X, n, ev, L, n);
+  int i, j;
+  if (rc != PHGMG_OK) return rc;
+  for (j = 0; j < n; ++j) {
+    const double s = ev[j] > 0.0 ? sqrt(ev[j]) : 0.0;
+    for (i = 0; i < n; ++i) L[i + (size_t)j * n] *= s;
+  }
+  return PHGMG_OK;
+}
+
+/* Square-root balancing of Gramian-like P (controllability) and O: T, W
+   (N x r), S (r values). P and O are destroyed. */
+PHGMG__PRIV phgmg_result phgmg__balance(int N, int r, double *P, double *O, double *T, double *W, double *S,
+                                        const phgmg_allocator *alloc) {
+  double *Lp = phgmg__dalloc(alloc, 3 * ((size_t)N * N + N) + 2 * (size_t)N * r + r), *Lo, *M, *U, *Vv, *sv;
+  phgmg_result rc;
+  int k = 0, rank = 0, i, j;
+  if (!Lp) return PHGMG_ERR_NOMEM;
+  Lo = Lp + (size_t)N * N + N; M = Lo + (size_t)N * N + N; U = M + (size_t)N * N + N;
+  Vv = U + (size_t)N * r; sv = Vv + (size_t)N * r;
+  rc = phgmg__psd_sqrt(N, P, Lp);
+  if (rc == PHGMG_OK) rc = phgmg__psd_sqrt(N, O, Lo);
+  if (rc == PHGMG_OK) {
+    memset(M, 0, (size_t)N * N * sizeof(double));
+    phgmg_gemm('T', 'N', N, N, N, 1.0, Lo, N, Lp, N, 1.0, M, N);
+    rc = phgmg_svd(N, N, M, N, r, sv, U, N, Vv, N, &k, &rank, alloc);
+  }
+  if (rc == PHGMG_OK && (k < r || !(sv[r - 1] > 0.0))) rc = PHGMG_ERR_RANK;
+  if (rc == PHGMG_OK) {
+    for (j = 0; j < r; ++j) {
+      const double s = 1.0 / sqrt(sv[j]);
+      for (i = 0; i < N; ++i) { U[i + (size_t)j * N] *= s; Vv[i + (size_t)j * N] *= s; }
+      S[j] = sv[j];
+    }
+    phgmg_gemm('N', 'N', N, r, N, 1.0, Lp, N, Vv, N, 0.0, T, N);
+    phgmg_gemm('N', 'N', N, r, N, 1.0, Lo, N, U, N, 0.0, W, N);
+  }
+  phgmg__free(alloc, Lp);
+  return rc;
+}
+
+/* Ar = W^T A T, Br = W^T B, Cr = C T. */
+PHGMG__PRIV phgmg_result phgmg__project_abc(int N, int m, int r, const double *A, const double *B, const double *C,
+                                            const double *T, const double *W, double *Ar, double *Br, double *Cr,
+                                            const phgmg_allocator *alloc) {
+  double *AT = phgmg__dalloc(alloc, (size_t)N * r);
+  if (!AT) return PHGMG_ERR_NOMEM;
+  phgmg_gemm('N', 'N', N, r, N, 1.0, A, N, T, N, 0.0, AT, N);
+  phgmg_gemm('T', 'N', r, r, N, 1.0, W, N, AT, N, 0.0, Ar, r);
+  phgmg_gemm('T', 'N', r, m, N, 1.0, W, N, B, N, 0.0, Br, r);
+  phgmg_gemm('N', 'N', m, r, N, 1.0, C, m, T, N, 0.0, Cr, m);
+  phgmg__free(alloc, AT);
+  return PHGMG_OK;
+}
+
+PHGMG_DEF phgmg_result phgmg_bt(const phgmg_ph_system *sys, int r, double *Ar, double *Br, double *Cr,
+                                double *hsv, double *T, double *W, const phgmg_allocator *alloc) {
+  int N, m;
+  double *A, *C, *P, *O, *Tb, *Wb, *S;
+  phgmg_result rc;
+  if (!sys || !Ar || !Br || !Cr) return PHGMG_ERR_INVALID_ARG;
+  if (sys->nl != PHGMG_NL_NONE) return PHGMG_ERR_UNSUPPORTED;
+  rc = phgmg_ph_validate(sys, 0.0, NULL, alloc);
+  if (rc != PHGMG_OK) return rc;
+  N = sys->N; m = sys->m;
+  if (r < 1 || r > N) return PHGMG_ERR_SIZE;
+  A = phgmg__dalloc(alloc, 3 * (size_t)N * N + (size_t)m * N + 2 * (size_t)N * r + r);
+  if (!A) return PHGMG_ERR_NOMEM;
+  C = A + (size_t)N * N; P = C + (size_t)m * N; O = P + (size_t)N * N; Tb = O + (size_t)N * N;
+  Wb = Tb + (size_t)N * r; S = Wb + (size_t)N * r;
+  rc = phgmg_ph_abc(sys, A, C, alloc);
+  if (rc == PHGMG_OK) {   /* F = B B^T into O, then P; F = C^T C into O */
+    phgmg_gemm('N', 'T', N, N, m, 1.0, sys->B, N, sys->B, N, 0.0, O, N);
+    rc = phgmg_lyap(N, A, O, P, NULL, alloc);
+  }
+  if (rc == PHGMG_OK) {
+    double *At = Tb; /* not yet used: borrow for A^T? needs N*N; use a fresh block */
+    (void)At;
+    At = phgmg__dalloc(alloc, 2 * (size_t)N * N);
+    if (!At) rc = PHGMG_ERR_NOMEM;
+    else {
+      int i, j;
+      for (j = 0; j < N; ++j)
+        for (i = 0; i < N; ++i) At[i + (size_t)j * N] = A[j + (size_t)i * N];
+      phgmg_gemm('T', 'N', N, N, m, 1.0, C, m, C, m, 0.0, At + (size_t)N * N, N);
+      rc = phgmg_lyap(N, At, At + (size_t)N * N, O, NULL, alloc);
+      phgmg__free(alloc, At);
+    }
+  }
+  if (rc == PHGMG_OK) rc = phgmg__balance(N, r, P, O, Tb, Wb, S, alloc);
+  if (rc == PHGMG_OK) rc = phgmg__project_abc(N, m, r, A, sys->B, C, Tb, Wb, Ar, Br, Cr, alloc);
+  if (rc == PHGMG_OK) {
+    if (hsv) memcpy(hsv, S, (size_t)r * sizeof(double));
+    if (T) memcpy(T, Tb, (size_t)N * r * sizeof(double));
+    if (W) memcpy(W, Wb, (size_t)N * r * sizeof(double));
+  }
+  phgmg__free(alloc, A);
+  return rc;
+}
+
+/* The two positive-real Riccati solutions (minimal, stabilizing) with
+   S = s I: X (Q-eq) and Y (P-eq). */
+PHGMG__PRIV phgmg_result phgmg__pr_riccati(int N, int m, const double *A, const double *B, const double *C, double s,
+                                           double *X, double *Y, const phgmg_allocator *alloc) {
+  const size_t nn = (size_t)N * N;
+  double *At = phgmg__dalloc(alloc, 4 * nn), *K, *L, *Att;
+  phgmg_result rc;
+  int i, j;
+  if (!At) return PHGMG_ERR_NOMEM;
+  K = At + nn; L = K + nn; Att = L + nn;
+  memcpy(At, A, nn * sizeof(double));
+  phgmg_gemm('N', 'N', N, N, m, -1.0 / s, B, N, C, m, 1.0, At, N);      /* A - B S^-1 C */
+  phgmg_gemm('N', 'T', N, N, m, -1.0 / s, B, N, B, N, 0.0, K, N);       /* -B S^-1 B^T  */
+  phgmg_gemm('T', 'N', N, N, m, 1.0 / s, C, m, C, m, 0.0, L, N);        /*  C^T S^-1 C  */
+  rc = phgmg_care(N, At, K, L, X, NULL, alloc);
+  if (rc == PHGMG_OK) {       /* dual: (A^T, C^T, B^T) */
+    for (j = 0; j < N; ++j)
+      for (i = 0; i < N; ++i) Att[i + (size_t)j * N] = At[j + (size_t)i * N];
+    for (i = 0; i < (int)nn; ++i) { const double t = K[i]; K[i] = -L[i]; L[i] = -t; }
+    rc = phgmg_care(N, Att, K, L, Y, NULL, alloc);
+  }
+  phgmg__free(alloc, At);
+  return rc;
+}
+
+/* The pH blocks of a PR-balanced truncation (see phgmg_prbt). */
+PHGMG__PRIV void phgmg__prbt_ph(int r, int m, const double *Ar, const double *Br, const double *Cr, const double *S,
+                                double s, double *Qh, double *K, double *F) {
+  int i, j, a;
+  for (j = 0; j < r; ++j)
+    for (i = 0; i < r; ++i) Qh[i + (size_t)j * r] = i == j ? S[i] : 0.0;
+  for (a = 0; a < m; ++a)       /* F = Sigma Br - Cr^T */
+    for (i = 0; i < r; ++i) F[i + (size_t)a * r] = S[i] * Br[i + (size_t)a * r] - Cr[a + (size_t)i * m];
+  for (j = 0; j < r; ++j)
+    for (i = 0; i < r; ++i) {
+      double rr = 0.0;
+      for (a = 0; a < m; ++a) rr += F[i + (size_t)a * r] * F[j + (size_t)a * r];
+      rr /= 2.0 * s * S[i] * S[j];
+      K[i + (size_t)j * r] = 0.5 * (Ar[i + (size_t)j * r] / S[j] - Ar[j + (size_t)i * r] / S[i]) - rr;
+    }
+}
+
+PHGMG_DEF phgmg_result phgmg_prbt(phgmg_reduced **out, const phgmg_ph_system *sys, int r,
+                                  const phgmg_prbt_opts *opts, double *prsv, double *info_xb,
+                                  const phgmg_allocator *alloc) {
+  int N, m;
+  double *A, *C, *X, *Y, *Ar, *Cr, *S, *F, *CB, s, eps;
+  phgmg_reduced *red;
+  phgmg_result rc;
+  if (!out) return PHGMG_ERR_INVALID_ARG;
+  *out = NULL;
+  if (!sys) return PHGMG_ERR_INVALID_ARG;
+  if (sys->nl != PHGMG_NL_NONE) return PHGMG_ERR_UNSUPPORTED;
+  if (opts && (opts->eps < 0.0 || opts->dt < 0.0 || !isfinite(opts->eps) || !isfinite(opts->dt) ||
+               (!opts->X) != (!opts->Y))) return PHGMG_ERR_INVALID_ARG;
+  eps = opts && opts->eps > 0.0 ? opts->eps : 1e-10;
+  rc = phgmg_ph_validate(sys, 0.0, NULL, alloc);
+  if (rc != PHGMG_OK) return rc;
+  N = sys->N; m = sys->m;
+  if (r < 1 || r > N) return PHGMG_ERR_SIZE;
+  A = phgmg__dalloc(alloc, 3 * (size_t)N * N + (size_t)m * N + 2 * (size_t)r * r + (size_t)m * r + 2 * (size_t)r * m + r + (size_t)m * m);
+  red = PHGMG__CAST(phgmg_reduced *, phgmg__alloc(alloc, sizeof(phgmg_reduced)));
+  if (!A || !red) { phgmg__free(alloc, A); phgmg__free(alloc, red); return PHGMG_ERR_NOMEM; }
+  memset(red, 0, sizeof *red);
+  if (alloc) { red->alloc = *alloc; red->use_alloc = 1; }
+  red->N = N; red->m = m; red->r = r; red->p = r; red->method = PHGMG_METHOD_PRBT;
+  red->kind = PHGMG_ROM_LINEAR; red->sys = sys;
+  C = A + (size_t)N * N; X = C + (size_t)m * N; Y = X + (size_t)N * N; Ar = Y + (size_t)N * N;
+  Cr = Ar + (size_t)r * r; S = Cr + (size_t)m * r; F = S + r; CB = F + (size_t)r * m;
+  rc = phgmg_ph_abc(sys, A, C, alloc);
+  if (rc == PHGMG_OK) {
+    phgmg_gemm('N', 'N', m, m, N, 1.0, C, m, sys->B, N, 0.0, CB, m);
+    s = 2.0 * eps * phgmg_normf(m, m, CB, m);
+    if (opts && opts->X && opts->Y) {
+      memcpy(X, opts->X, (size_t)N * N * sizeof(double));
+      memcpy(Y, opts->Y, (size_t)N * N * sizeof(double));
+    } else {
+      rc = phgmg__pr_riccati(N, m, A, sys->B, C, s, X, Y, alloc);
+    }
+  }
+  if (rc == PHGMG_OK && info_xb) {   /* ||X B - C^T|| / ||C|| */
+    double *XB = phgmg__dalloc(alloc, (size_t)N * m);
+    int i, a;
+    if (!XB) rc = PHGMG_ERR_NOMEM;
+    else {
+      phgmg_gemm('N', 'N', N, m, N, 1.0, X, N, sys->B, N, 0.0, XB, N);
+      for (a = 0; a < m; ++a)
+        for (i = 0; i < N; ++i) XB[i + (size_t)a * N] -= C[a + (size_t)i * m];
+      *info_xb = phgmg_normf(N, m, XB, N) / phgmg_normf(m, N, C, m);
+      phgmg__free(alloc, XB);
+    }
+  }
+  if (rc == PHGMG_OK) {
+    red->V0 = phgmg__red_d(red, (size_t)N * r);
+    red->W = phgmg__red_d(red, (size_t)N * r);
+    red->Bh = phgmg__red_d(red, (size_t)r * m);
+    red->Qh = phgmg__red_d(red, (size_t)r * r);
+    red->K = phgmg__red_d(red, (size_t)r * r);
+    if (!red->V0 || !red->W || !red->Bh || !red->Qh || !red->K) rc = PHGMG_ERR_NOMEM;
+  }
+  if (rc == PHGMG_OK) rc = phgmg__balance(N, r, Y, X, red->V0, red->W, S, alloc);
+  /* minimal solutions give positive-real singular values <= 1: a larger one
+     means the Riccati solutions are not accurate (eps too small) */
+  if (rc == PHGMG_OK && !(S[0] <= 1.0 + 1e-6)) rc = PHGMG_ERR_NOT_CONVERGED;
+  if (rc == PHGMG_OK) rc = phgmg__project_abc(N, m, r, A, sys->B, C, red->V0, red->W, Ar, red->Bh, Cr, alloc);
+  if (rc == PHGMG_OK) {
+    phgmg__prbt_ph(r, m, Ar, red->Bh, Cr, S, s, red->Qh, red->K, F);
+    if (prsv) memcpy(prsv, S, (size_t)r * sizeof(double));
+    if (opts && opts->dt > 0.0) {
+      red->map_dt = opts->dt;
+      rc = phgmg__step_map(red, opts->dt, alloc);
+    }
+  }
+  if (rc == PHGMG_OK) rc = phgmg__publish(red);
+  phgmg__free(alloc, A);
+  if (rc != PHGMG_OK) { phgmg_reduced_destroy(red); return rc; }
+  *out = red;
+  return PHGMG_OK;
+}
+
+PHGMG_DEF phgmg_result phgmg_prbt_riccati(const phgmg_ph_system *sys, double eps, double *X, double *Y,
+                                          const phgmg_allocator *alloc) {
+  int N, m;
+  double *A, *C, CBn;
+  phgmg_result rc;
+  if (!sys || !X || !Y) return PHGMG_ERR_INVALID_ARG;
+  if (sys->nl != PHGMG_NL_NONE) return PHGMG_ERR_UNSUPPORTED;
+  rc = phgmg_ph_validate(sys, 0.0, NULL, alloc);
+  if (rc != PHGMG_OK) return rc;
+  N = sys->N; m = sys->m;
+  A = phgmg__dalloc(alloc, (size_t)N * N + (size_t)m * N + (size_t)m * m);
+  if (!A) return PHGMG_ERR_NOMEM;
+  C = A + (size_t)N * N;
+  rc = phgmg_ph_abc(sys, A, C, alloc);
+  if (rc == PHGMG_OK) {
+    phgmg_gemm('N', 'N', m, m, N, 1.0, C, m, sys->B, N, 0.0, C + (size_t)m * N, m);
+    CBn = phgmg_normf(m, m, C + (size_t)m * N, m);
+    rc = phgmg__pr_riccati(N, m, A, sys->B, C, 2.0 * (eps > 0.0 ? eps : 1e-10) * CBn, X, Y, alloc);
+  }
+  phgmg__free(alloc, A);
+  return rc;
+}
+
+/* Frequency grid ends from the system (see phgmg_basis_opts). */
+PHGMG__PRIV phgmg_result phgmg__freq_range(int N, const double *A, double *wmin, double *wmax,
+                                           const phgmg_allocator *alloc) {
+  double *LU = phgmg__dalloc(alloc, (size_t)N * N + 2 * (size_t)N), an, rc1;
+  int *ip = phgmg__ialloc(alloc, 2 * (size_t)N);
+  phgmg_result rc = PHGMG_ERR_NOMEM;
+  if (LU && ip) {
+    memcpy(LU, A, (size_t)N * N * sizeof(double));
+    an = phgmg_norm1(N, N, A, N);
+    rc = phgmg_lu_factor(N, LU, N, ip);
+    if (rc == PHGMG_OK) {
+      rc1 = phgmg_lu_rcond(N, LU, N, ip, an, LU + (size_t)N * N, ip + N);
+      if (!(rc1 > 0.0)) rc = PHGMG_ERR_SINGULAR;
+      else { *wmin = rc1 * an / 10.0; *wmax = 2.0 * an; }   /* 1/||A^-1|| = rcond ||A|| */
+    }
+  }
+  phgmg__free(alloc, LU);
+  phgmg__free(alloc, ip);
+  return rc;
+}
+
+/* Snapshots for FREQ (N x 2 nw m) or IMPULSE (N x (nsteps+1) m) into *Xo. */
+PHGMG__PRIV phgmg_result phgmg__basis_snapshots(const phgmg_ph_system *sys, phgmg_basis_kind kind,
+                                                const phgmg_basis_opts *o, double **Xo, int *ns,
+                                                const phgmg_allocator *alloc) {
+  const int N = sys->N, m = sys->m;
+  phgmg_result rc = PHGMG_OK;
+  double *X;
+  int a, i, j;
+  if (kind == PHGMG_BASIS_FREQ) {
+    const int nw = o && o->nw > 0 ? o->nw : 60;
+    double wmin = o ? o->wmin : 0.0, wmax = o ? o->wmax : 0.0, *A, *Z, *Bz;
+    int *ip;
+    A = phgmg__dalloc(alloc, (size_t)N * N + 2 * (size_t)N * N + 2 * (size_t)N * m);
+    ip = phgmg__ialloc(alloc, (size_t)N);
+    X = phgmg__dalloc(alloc, (size_t)N * 2 * nw * m);
+    if (!A || !ip || !X) { phgmg__free(alloc, A); phgmg__free(alloc, ip); phgmg__free(alloc, X); return PHGMG_ERR_NOMEM; }
+    Z = A + (size_t)N * N; Bz = Z + 2 * (size_t)N * N;
+    rc = phgmg_ph_abc(sys, A, NULL, alloc);
+    if (rc == PHGMG_OK && !(wmin > 0.0 && wmax > wmin)) rc = phgmg__freq_range(N, A, &wmin, &wmax, alloc);
+    for (j = 0; rc == PHGMG_OK && j < nw; ++j) {
+      const double w = wmin * pow(wmax / wmin, nw > 1 ? (double)j / (nw - 1) : 0.0);
+      for (i = 0; i < 2 * N * N; ++i) Z[i] = 0.0;
+      for (i = 0; i < N * N; ++i) Z[2 * i] = -A[i];
+      for (i = 0; i < N; ++i) Z[2 * (i + (size_t)i * N) + 1] = w;
+      for (i = 0; i < N * m; ++i) { Bz[2 * i] = sys->B[i]; Bz[2 * i + 1] = 0.0; }
+      rc = phgmg_zlu_factor(N, Z, N, ip);
+      if (rc != PHGMG_OK) break;
+      phgmg_zlu_solve(N, Z, N, ip, m, Bz, N);
+      for (a = 0; a < m; ++a)
+        for (i = 0; i < N; ++i) {
+          X[i + (size_t)((2 * j) * m + a) * N] = Bz[2 * (i + (size_t)a * N)];
+          X[i + (size_t)((2 * j + 1) * m + a) * N] = Bz[2 * (i + (size_t)a * N) + 1];
+        }
+    }
+    phgmg__free(alloc, A); phgmg__free(alloc, ip);
+    *ns = 2 * nw * m;
+  } else {
+    const int nst = o && o->nsteps > 0 ? o->nsteps : 1000;
+    const double dt = o && o->dt > 0.0 ? o->dt : 0.1;
+    X = phgmg__dalloc(alloc, (size_t)N * (nst + 1) * m);
+    if (!X) return PHGMG_ERR_NOMEM;
+    for (a = 0; a < m && rc == PHGMG_OK; ++a)   /* x(0+) = B e_a, u = 0 */
+      rc = phgmg_simulate(sys, sys->B + (size_t)a * N, 0.0, dt, nst, NULL, NULL, NULL,
+                          X + (size_t)a * (nst + 1) * N, NULL, NULL, NULL, NULL, alloc);
+    *ns = (nst + 1) * m;
+  }
+  if (rc != PHGMG_OK) { phgmg__free(alloc, X); return rc; }
+  *Xo = X;
+  return PHGMG_OK;
+}
+
+PHGMG_DEF phgmg_result phgmg_linear_basis(const phgmg_ph_system *sys, phgmg_basis_kind kind, int k,
+                                          const phgmg_basis_opts *opts, double *V, int *k_out,
+                                          const phgmg_allocator *alloc) {
+  int N, m, ns = 0, kk = 0;
+  double *X = NULL;
+  phgmg_result rc;
+  if (!sys || !V) return PHGMG_ERR_INVALID_ARG;
+  if (kind < PHGMG_BASIS_FREQ || kind > PHGMG_BASIS_BALANCED) return PHGMG_ERR_INVALID_ARG;
+  if (sys->nl != PHGMG_NL_NONE) return PHGMG_ERR_UNSUPPORTED;
+  rc = phgmg_ph_validate(sys, 0.0, NULL, alloc);
+  if (rc != PHGMG_OK) return rc;
+  N = sys->N; m = sys->m;
+  if (k < 1 || k > N - m) return PHGMG_ERR_SIZE;
+  memset(V, 0, (size_t)N * k * sizeof(double));
+  if (kind == PHGMG_BASIS_BALANCED) {   /* QR of [B, T_k] in order */
+    double *M = phgmg__dalloc(alloc, (size_t)N * (m + k) + (size_t)k * k + 2 * (size_t)m * k + 2 * (size_t)(m + k)), *tau;
+    if (!M) return PHGMG_ERR_NOMEM;
+    tau = M + (size_t)N * (m + k);
+    memcpy(M, sys->B, (size_t)N * m * sizeof(double));
+    rc = phgmg_bt(sys, k, tau + (m + k), tau + (m + k) + (size_t)k * k, tau + (m + k) + (size_t)k * k + (size_t)k * m,
+                  NULL, M + (size_t)N * m, NULL, alloc);
+    if (rc == PHGMG_OK) rc = phgmg_qr(N, m + k, M, N, tau);
+    if (rc == PHGMG_OK) {
+      phgmg_qr_form_q(N, m + k, M, N, tau, tau + (m + k));
+      memcpy(V, M + (size_t)N * m, (size_t)N * k * sizeof(double));
+      kk = k;
+    }
+    phgmg__free(alloc, M);
+  } else {
+    rc = phgmg__basis_snapshots(sys, kind, opts, &X, &ns, alloc);
+    if (rc == PHGMG_OK) rc = phgmg_adjust_snapshots(N, m, sys->B, ns, X, N, X, N, alloc);
+    if (rc == PHGMG_OK) rc = phgmg_pod(N, ns, X, N, k, 0.0, V, N, NULL, &kk, alloc);
+    phgmg__free(alloc, X);
+  }
+  if (k_out) *k_out = kk;
+  return rc;
+}
+
+PHGMG_DEF phgmg_result phgmg_ss_transfer(int n, int m, int p, const double *A, const double *B,
+                                         const double *C, double w, double *G, const phgmg_allocator *alloc) {
+  double *Z, *Bz;
+  int *ip, i, a, b;
+  phgmg_result rc;
+  if (!A || !B || !C || !G) return PHGMG_ERR_INVALID_ARG;
+  if (n < 1 || m < 1 || p < 1) return PHGMG_ERR_SIZE;
+  Z = phgmg__dalloc(alloc, 2 * (size_t)n * n + 2 * (size_t)n * m);
+  ip = phgmg__ialloc(alloc, (size_t)n);
+  if (!Z || !ip) { phgmg__free(alloc, Z); phgmg__free(alloc, ip); return PHGMG_ERR_NOMEM; }
+  Bz = Z + 2 * (size_t)n * n;
+  for (i = 0; i < n * n; ++i) { Z[2 * i] = -A[i]; Z[2 * i + 1] = 0.0; }
+  for (i = 0; i < n; ++i) Z[2 * (i + (size_t)i * n) + 1] = w;
+  for (i = 0; i < n * m; ++i) { Bz[2 * i] = B[i]; Bz[2 * i + 1] = 0.0; }
+  rc = phgmg_zlu_factor(n, Z, n, ip);
+  if (rc == PHGMG_OK) {
+    phgmg_zlu_solve(n, Z, n, ip, m, Bz, n);
+    for (b = 0; b < m; ++b)
+      for (a = 0; a < p; ++a) {
+        double re = 0.0, im = 0.0;
+        for (i = 0; i < n; ++i) {
+          re += C[a + (size_t)i * p] * Bz[2 * (i + (size_t)b * n)];
+          im += C[a + (size_t)i * p] * Bz[2 * (i + (size_t)b * n) + 1];
+        }
+        G[2 * (a + (size_t)b * p)] = re;
+        G[2 * (a + (size_t)b * p) + 1] = im;
+      }
+  }
+  phgmg__free(alloc, Z);
+  phgmg__free(alloc, ip);
+  return rc;
+}
+
+PHGMG_DEF phgmg_result phgmg_reduced_abc(const phgmg_reduced *red, double *A, double *B, double *C) {
+  int r, m, i, a;
+  if (!red || !A || !B || !C) return PHGMG_ERR_INVALID_ARG;
+  if (red->kind != PHGMG_ROM_LINEAR || red->nd != 0 || !red->K || !red->Qh) return PHGMG_ERR_UNSUPPORTED;
+  r = red->r; m = red->m;
+  phgmg_gemm('N', 'N', r, r, r, 1.0, red->K, r, red->Qh, r, 0.0, A, r);
+  memcpy(B, red->Bh, (size_t)r * m * sizeof(double));
+  for (a = 0; a < m; ++a)
+    for (i = 0; i < r; ++i) {
+      double s = 0.0;
+      int j;
+      for (j = 0; j < r; ++j) s += red->Bh[j + (size_t)a * r] * red->Qh[j + (size_t)i * r];
+      C[a + (size_t)i * m] = s;
+    }
+  return PHGMG_OK;
+}
+
+/* Largest singular value of a complex p x m matrix (interleaved), through
+   the symmetric real embedding of E^H E. */
+PHGMG__PRIV double phgmg__zsigma_max(int p, int m, const double *E) {
+  double H[2 * 16 * 2 * 16], w[32];
+  int i, j, k;
+  if (m > 16) return (double)NAN;
+  for (i = 0; i < m; ++i)
+    for (j = 0; j < m; ++j) {
+      double re = 0.0, im = 0.0;   /* (E^H E)_ij = sum_k conj(E_ki) E_kj */
+      for (k = 0; k < p; ++k) {
+        const double ar = E[2 * (k + (size_t)i * p)], ai = E[2 * (k + (size_t)i * p) + 1];
+        const double br = E[2 * (k + (size_t)j * p)], bi = E[2 * (k + (size_t)j * p) + 1];
+        re += ar * br + ai * bi;
+        im += ar * bi - ai * br;
+      }
+      H[i + j * 2 * m] = re; H[(i + m) + (j + m) * 2 * m] = re;
+      H[(i + m) + j * 2 * m] = im; H[i + (j + m) * 2 * m] = -im;
+    }
+  if (phgmg_sym_eig(2 * m, H, 2 * m, w, NULL, 0) != PHGMG_OK) return (double)NAN;
+  return sqrt(w[2 * m - 1] > 0.0 ? w[2 * m - 1] : 0.0);
+}
+
+PHGMG_DEF phgmg_result phgmg_ss_error(int n1, const double *A1, const double *B1, const double *C1,
+                                      int n2, const double *A2, const double *B2, const double *C2,
+                                      int m, int p, int nw, double wmin, double wmax, double *hinf,
+                                      double *hinf_ref, double *h2, double *h2_ref,
+                                      const phgmg_allocator *alloc) {
+  const int n = n1 + n2;
+  double *G1, *G2, *Ae, *Fe, *Pe, *Ce, hi = 0.0, hr = 0.0;
+  phgmg_result rc = PHGMG_OK;
+  int j, i, k;
+  if (!A1 || !B1 || !C1 || !A2 || !B2 || !C2) return PHGMG_ERR_INVALID_ARG;
+  if (n1 < 1 || n2 < 1 || m < 1 || p < 1 || m > 16 || nw < 1 || !(wmin > 0.0) || !(wmax >= wmin)) return PHGMG_ERR_SIZE;
+  G1 = phgmg__dalloc(alloc, 4 * (size_t)p * m + 3 * (size_t)n * n + (size_t)p * n);
+  if (!G1) return PHGMG_ERR_NOMEM;
+  G2 = G1 + 2 * (size_t)p * m; Ae = G2 + 2 * (size_t)p * m; Fe = Ae + (size_t)n * n; Pe = Fe + (size_t)n * n;
+  Ce = Pe + (size_t)n * n;
+  for (j = 0; j < nw && rc == PHGMG_OK; ++j) {
+    const double w = wmin * pow(wmax / wmin, nw > 1 ? (double)j / (nw - 1) : 0.0);
+    rc = phgmg_ss_transfer(n1, m, p, A1, B1, C1, w, G1, alloc);
+    if (rc == PHGMG_OK) rc = phgmg_ss_transfer(n2, m, p, A2, B2, C2, w, G2, alloc);
+    if (rc != PHGMG_OK) break;
+    hr = PHGMG__MAX(hr, phgmg__zsigma_max(p, m, G1));
+    for (i = 0; i < 2 * p * m; ++i) G2[i] = G1[i] - G2[i];
+    hi = PHGMG__MAX(hi, phgmg__zsigma_max(p, m, G2));
+  }
+  if (rc == PHGMG_OK && (h2 || h2_ref)) {   /* error system: blockdiag(A1, A2), [B1; B2], [C1, -C2] */
+    double *Bf = phgmg__dalloc(alloc, (size_t)n * m);
+    if (!Bf) rc = PHGMG_ERR_NOMEM;
+    else {
+      memset(Ae, 0, (size_t)n * n * sizeof(double));
+      for (j = 0; j < n1; ++j) for (i = 0; i < n1; ++i) Ae[i + (size_t)j * n] = A1[i + (size_t)j * n1];
+      for (j = 0; j < n2; ++j) for (i = 0; i < n2; ++i) Ae[(n1 + i) + (size_t)(n1 + j) * n] = A2[i + (size_t)j * n2];
+      for (k = 0; k < m; ++k) {
+        for (i = 0; i < n1; ++i) Bf[i + (size_t)k * n] = B1[i + (size_t)k * n1];
+        for (i = 0; i < n2; ++i) Bf[n1 + i + (size_t)k * n] = B2[i + (size_t)k * n2];
+      }
+      for (i = 0; i < n1; ++i) for (k = 0; k < p; ++k) Ce[k + (size_t)i * p] = C1[k + (size_t)i * p];
+      for (i = 0; i < n2; ++i) for (k = 0; k < p; ++k) Ce[k + (size_t)(n1 + i) * p] = -C2[k + (size_t)i * p];
+      phgmg_gemm('N', 'T', n, n, m, 1.0, Bf, n, Bf, n, 0.0, Fe, n);
+      rc = phgmg_lyap(n, Ae, Fe, Pe, NULL, alloc);
+      if (rc == PHGMG_OK) {
+        double te = 0.0, t1 = 0.0;
+        for (k = 0; k < p; ++k)
+          for (i = 0; i < n; ++i)
+            for (j = 0; j < n; ++j) {
+              const double v = Ce[k + (size_t)i * p] * Pe[i + (size_t)j * n] * Ce[k + (size_t)j * p];
+              te += v;
+              if (i < n1 && j < n1) t1 += v;
+            }
+        if (h2) *h2 = sqrt(te > 0.0 ? te : 0.0);
+        if (h2_ref) *h2_ref = sqrt(t1 > 0.0 ? t1 : 0.0);
+      }
+      phgmg__free(alloc, Bf);
+    }
+  }
+  if (rc == PHGMG_OK) {
+    if (hinf) *hinf = hi;
+    if (hinf_ref) *hinf_ref = hr;
+  }
+  phgmg__free(alloc, G1);
+  return rc;
+}
+#endif /* PHGMG_NO_OFFLINE */
+
 /* >>export (implementation) ============================================== */
 #include <stdint.h>
 
@@ -8031,7 +8856,7 @@ PHGMG__ONLINE phgmg_result phgmg__rom_header(const unsigned char *b, size_t len,
   }
   if (phgmg__get32(b + 24) > 4096u || phgmg__get32(b + 28) > 4096u || phgmg__get32(b + 32) > 4096u ||
       phgmg__get32(b + 36) > (1u << 24) || phgmg__get32(b + 40) > 32u || phgmg__get32(b + 16) > 2u ||
-      phgmg__get32(b + 20) > 4u)
+      phgmg__get32(b + 20) > 6u)
     return PHGMG_ERR_FORMAT;
   rom->kind = (int)phgmg__get32(b + 16);
   rom->method = (int)phgmg__get32(b + 20);

@@ -4,7 +4,8 @@
 #   sh bench/run.sh
 #
 # 1. prints the machine line (CPU model, cores, compiler and flags, load);
-# 2. builds bench/bench_linalg.c, bench/bench_fom.c, bench/bench_rom.c into
+# 2. builds bench/bench_linalg.c, bench/bench_fom.c, bench/bench_rom.c,
+#    bench/bench_linear.c (lyap_N1000, prbt_N1000_r20: about a minute) into
 #    build/ (a missing or broken source is skipped with a warning) and runs
 #    each, appending `case,median_s,min_s,max_s,runs` lines to the CSV;
 # 3. if a CBLAS is installed, builds bench_linalg again with -DPHGMG_USE_CBLAS
@@ -43,7 +44,7 @@ echo "$machine" > "$BUILD/bench_machine.txt"
 make phgmg.h >/dev/null || { echo "run.sh: cannot build phgmg.h" >&2; exit 1; }
 echo "case,median_s,min_s,max_s,runs" > "$CSV"
 
-for prog in bench_linalg bench_fom bench_rom; do
+for prog in bench_linalg bench_fom bench_rom bench_linear; do
   src=bench/$prog.c
   if [ ! -f "$src" ]; then
     echo "run.sh: warning: $src is missing, skipped" >&2

@@ -1,0 +1,115 @@
+/* Linear pH systems (>>linear) at N = 1000: the two-port mass-spring-damper
+   chain of Gugercin et al. 2012 with 500 masses (m_i = k_i = 4, c_i = 1,
+   forces on masses 1 and 2). Cases:
+     lyap_N1000       controllability Gramian A P + P A^T + B B^T = 0 (sign function)
+     prbt_N1000_r20   positive-real balanced truncation to r = 20 (two Riccati
+                      equations of order 1000 by the sign function of 2000 x 2000
+                      Hamiltonian matrices, balancing, pH form, step map)
+   Prints the relative residuals (Lyapunov; both Riccati equations) and
+   appends `case,median_s,min_s,max_s,runs` to the CSV argv[1] (if given).
+   BENCH_LINEAR_RUNS (default 1) runs per case; no warm-up (each run is seconds).
+     cc -std=c99 -O2 -march=native bench/bench_linear.c -lm && ./a.out out.csv  */
+#define _POSIX_C_SOURCE 199309L
+#define PHGMG_IMPLEMENTATION
+#include "../phgmg.h"
+#include "../examples/msd_models.h"
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+static double now(void) {
+  struct timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+static int cmp_double(const void *a, const void *b) {
+  double x = *(const double *)a, y = *(const double *)b;
+  return x < y ? -1 : (x > y ? 1 : 0);
+}
+static void report(FILE *csv, const char *name, double *t, int runs) {
+  double med;
+  qsort(t, (size_t)runs, sizeof(double), cmp_double);
+  med = (runs & 1) ? t[runs / 2] : 0.5 * (t[runs / 2 - 1] + t[runs / 2]);
+  printf("%-16s median %.3f s  min %.3f s  max %.3f s  (%d runs)\n", name, med, t[0], t[runs - 1], runs);
+  if (csv) fprintf(csv, "%s,%.6f,%.6f,%.6f,%d\n", name, med, t[0], t[runs - 1], runs);
+}
+
+/* ||A^T X + X A - X K X + L||_F / ||L||_F (T: n^2 scratch; clobbers K X into T first) */
+static double res_over_l(int n, const double *A, const double *K, const double *L, const double *X, double *T) {
+  double *KX = (double *)malloc(sizeof(double) * (size_t)n * n), r;
+  memcpy(T, L, sizeof(double) * (size_t)n * n);
+  phgmg_gemm('T', 'N', n, n, n, 1.0, A, n, X, n, 1.0, T, n);
+  phgmg_gemm('N', 'N', n, n, n, 1.0, X, n, A, n, 1.0, T, n);
+  phgmg_gemm('N', 'N', n, n, n, 1.0, K, n, X, n, 0.0, KX, n);
+  phgmg_gemm('N', 'N', n, n, n, -1.0, X, n, KX, n, 1.0, T, n);
+  r = phgmg_normf(n, n, T, n) / phgmg_normf(n, n, L, n);
+  free(KX);
+  return r;
+}
+
+int main(int argc, char **argv) {
+  const int n = 500, N = 2 * n;
+  double *mv = (double *)malloc(sizeof(double) * n), *A, *C, *F, *X, *Y, *K, *L, CB[4], s, t[16];
+  const char *env = getenv("BENCH_LINEAR_RUNS");
+  int runs = env ? atoi(env) : 1, i, it = 0;
+  msd_linear M;
+  FILE *csv = NULL;
+  phgmg_result rc;
+  if (runs < 1 || runs > 16) runs = 1;
+  if (argc > 1) {
+    csv = fopen(argv[1], "a");
+    if (!csv) { fprintf(stderr, "bench_linear: cannot open %s\n", argv[1]); return 1; }
+  }
+  for (i = 0; i < n; ++i) mv[i] = 4.0;
+  if (msd_linear_build(&M, n, mv, mv, NULL, PHGMG_DENSE) != 0) return 1;
+  {
+    double *B2 = (double *)calloc((size_t)2 * N, sizeof(double));
+    B2[1] = 1.0; B2[N + 3] = 1.0;
+    free(M.B); M.B = B2; M.sys.B = B2; M.sys.m = 2;
+  }
+  A = (double *)malloc(sizeof(double) * N * N * 6 + sizeof(double) * 2 * N);
+  C = A + (size_t)N * N; F = C + 2 * (size_t)N; X = F + (size_t)N * N; Y = X + (size_t)N * N;
+  K = Y + (size_t)N * N; L = K + (size_t)N * N;
+  if (phgmg_ph_abc(&M.sys, A, C, NULL) != PHGMG_OK) return 1;
+  phgmg_gemm('N', 'T', N, N, 2, 1.0, M.sys.B, N, M.sys.B, N, 0.0, F, N);
+  for (i = 0; i < runs; ++i) {
+    double t0 = now();
+    rc = phgmg_lyap(N, A, F, X, &it, NULL);
+    t[i] = now() - t0;
+    if (rc != PHGMG_OK) { fprintf(stderr, "lyap: %s\n", phgmg_result_string(rc)); return 1; }
+  }
+  printf("lyap_N1000: %d sign steps, relative residual %.2e\n", it, phgmg_lyap_residual(N, A, F, X, NULL));
+  report(csv, "lyap_N1000", t, runs);
+  for (i = 0; i < runs; ++i) {
+    phgmg_reduced *red = NULL;
+    phgmg_prbt_opts o;
+    double t0 = now(), xb = 0.0;
+    memset(&o, 0, sizeof o);
+    o.dt = 0.1;
+    rc = phgmg_prbt(&red, &M.sys, 20, &o, NULL, &xb, NULL);
+    t[i] = now() - t0;
+    if (rc != PHGMG_OK) { fprintf(stderr, "prbt: %s\n", phgmg_result_string(rc)); return 1; }
+    if (i == 0) printf("prbt_N1000_r20: ||X B - C^T|| / ||C|| = %.2e\n", xb);
+    phgmg_reduced_destroy(red);
+  }
+  report(csv, "prbt_N1000_r20", t, runs);
+  /* residuals of the two Riccati equations (outside the timing) */
+  phgmg_gemm('N', 'N', 2, 2, N, 1.0, C, 2, M.sys.B, N, 0.0, CB, 2);
+  s = 2e-10 * phgmg_normf(2, 2, CB, 2);
+  rc = phgmg_prbt_riccati(&M.sys, 0.0, X, Y, NULL);
+  if (rc == PHGMG_OK) {
+    phgmg_gemm('N', 'N', N, N, 2, -1.0 / s, M.sys.B, N, C, 2, 1.0, A, N);            /* A - B S^-1 C */
+    phgmg_gemm('N', 'T', N, N, 2, -1.0 / s, M.sys.B, N, M.sys.B, N, 0.0, K, N);
+    phgmg_gemm('T', 'N', N, N, 2, 1.0 / s, C, 2, C, 2, 0.0, L, N);
+    printf("prbt_N1000_r20: Riccati residuals %.2e (Q-eq, phgmg_care_residual), %.2e (Q-eq, ||res|| / ||L||)",
+           phgmg_care_residual(N, A, K, L, X, NULL), res_over_l(N, A, K, L, X, F));
+    for (i = 0; i < N; ++i) { int j; for (j = 0; j < i; ++j) { double a = A[i + (size_t)j * N]; A[i + (size_t)j * N] = A[j + (size_t)i * N]; A[j + (size_t)i * N] = a; } }
+    for (i = 0; i < N * N; ++i) { double a = K[i]; K[i] = -L[i]; L[i] = -a; }
+    printf(", %.2e / %.2e (P-eq)\n", phgmg_care_residual(N, A, K, L, Y, NULL), res_over_l(N, A, K, L, Y, F));
+  }
+  if (csv) fclose(csv);
+  free(A); free(mv);
+  msd_linear_free(&M);
+  return 0;
+}
