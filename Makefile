@@ -119,8 +119,7 @@ demo: $(EXAMPLES)
 	./$(BUILD)/msd_linear --out results && ./$(BUILD)/msd_nonlinear --out results && \
 	./$(BUILD)/msd_linear --lambda auto --rmin 6 --out results && ./$(BUILD)/morse_chain --out results && \
 	./$(BUILD)/linear_bases --out results && \
-	end=$$(date +%s.%N) && awk -v a=$$start -v b=$$end 'BEGIN { printf "make demo: total wall time %.2f s
-", b - a }' && \
+	end=$$(date +%s.%N) && awk -v a=$$start -v b=$$end 'BEGIN { printf "make demo: total wall time %.2f s\n", b - a }' && \
 	/usr/bin/python3 tests/check_claims.py results && /usr/bin/python3 tests/check_morse.py results && \
 	/usr/bin/python3 tests/check_linear.py results
 
