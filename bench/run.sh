@@ -59,6 +59,13 @@ for prog in bench_linalg bench_fom bench_rom bench_linear; do
   "./$BUILD/$prog" "$CSV" || echo "run.sh: warning: $prog failed (exit $?)" >&2
 done
 
+# the hyper-reduction choices side by side (a table, not timing cases)
+echo
+echo "== hyper_study"
+if $CC $CFLAGS -o "$BUILD/hyper_study" bench/hyper_study.c $LIBS; then
+  "./$BUILD/hyper_study" | tee "$BUILD/hyper_study.txt"
+fi
+
 # CBLAS: the first of these libraries that links and runs a 1x1 dgemm
 if [ -f bench/bench_linalg.c ]; then
   printf '#include <cblas.h>\nint main(void) { double a = 2, b = 3, c = 0;\n  cblas_dgemm(CblasColMajor, CblasNoTrans, CblasNoTrans, 1, 1, 1, 1.0, &a, 1, &b, 1, 0.0, &c, 1);\n  return c == 6.0 ? 0 : 1; }\n' > "$BUILD/cblas_probe.c"
