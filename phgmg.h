@@ -5842,155 +5842,190 @@ PHGMG__ONLINE phgmg_result phgmg__romstep_map(phgmg_rom_stepper *s, const phgmg_
   return PHGMG_OK;
 }
 
+/* Before a Newton attempt: factors of the stage matrix (kept, or fresh at x
+   on a retry), a refresh of E's factors after a slow step (QUADRATIC), and the
+   starting guess (extrapolated collocation polynomial, or zero; Phi at every
+   stage). */
+PHGMG__ONLINE phgmg_result phgmg__romstep_start(phgmg_rom_stepper *s, const phgmg__romstep_mem *L, const phgmg_real *x,
+                                                int attempt, int mm, int *tried_fresh) {
+  const phgmg_rom *rom = s->rom;
+  const int r = rom->r, n3 = 3 * r;
+  int i, a;
+  phgmg_result err;
+  if (!s->have_lu || (attempt > 0 && !*tried_fresh)) {
+    err = phgmg__romstep_factor(s, L, x);
+    if (err != PHGMG_OK) return err;
+    *tried_fresh = 1;
+  }
+  else if (mm && s->stale_e) { /* the last step was slow: new factors of E only (r x r) */
+    phgmg__romw w;
+    phgmg__romw_layout(rom, L->work, &w);
+    phgmg__rom_prep(rom, x, &w);
+    phgmg__rom_dgd(rom, &w);
+    if (phgmg__r_lu(r, w.E, w.piv) != 0) { s->have_lu = 0; return PHGMG_ERR_SINGULAR; }
+    phgmg__romstep_keep_e(L, &w, r);
+    s->stale_e = 0;
+    s->stats.e_refreshes++;
+  }
+  /* starting guess: extrapolated collocation polynomial, or zero */
+  for (i = 0; i < n3; ++i) L->Z[i] = (s->have_prev && attempt == 0) ? L->Zp[i] : PHGMG__R(0);
+  if (mm) { /* Phi: extrapolated, or E(x)^{-1} g(x) at every stage */
+    if (s->have_prev && attempt == 0) {
+      for (i = 0; i < n3; ++i) L->Phi[i] = L->Php[i];
+    } else {
+      phgmg__romw w;
+      phgmg__romw_layout(rom, L->work, &w);
+      err = phgmg__rom_rhs(rom, x, NULL, L->Phi, &w);
+      if (err != PHGMG_OK) return err;
+      for (a = 0; a < r; ++a) L->Phi[r + a] = L->Phi[2 * r + a] = L->Phi[a];
+    }
+  }
+  return PHGMG_OK;
+}
+
+/* Simplified Newton on the stage system from the residual res; in
+   mass-matrix form (mm) a slow contraction switches to exact stage values.
+   Returns the final residual (negative after a failure, with *err). */
+PHGMG__ONLINE phgmg_real phgmg__romstep_iterate(phgmg_rom_stepper *s, const phgmg__romstep_mem *L, const phgmg_real *x,
+                                               const phgmg_real *u3, phgmg_real res, int *mm, int *exact, int *it,
+                                               phgmg_real *theta_max, phgmg_result *err) {
+  const int r = s->rom->r, n3 = 3 * r;
+  phgmg_real res_prev = PHGMG__R(0);
+  int i, a;
+  while (res > s->tol && *it < s->max_iter) {
+    for (i = 0; i < n3; ++i) L->dZ[i] = -L->Res[i];
+    phgmg__r_lu_solve(n3, L->LU, L->piv, L->dZ);
+    for (i = 0; i < n3; ++i) L->Z[i] += L->dZ[i];
+    if (*mm) /* dPhi_i = Jf dZ_i - Del_i */
+      for (i = 0; i < 3; ++i) {
+        phgmg__r_gemv(r, r, L->Jf, L->dZ + i * r, 1, L->Phi + i * r);
+        for (a = 0; a < r; ++a) L->Phi[i * r + a] -= L->Del[i * r + a];
+      }
+    ++*it;
+    s->stats.newton_iters++;
+    res_prev = res;
+    res = phgmg__romstep_residual(s, L, x, u3, *mm, err);
+    if (res < PHGMG__R(0)) break;
+    if (*mm && res > s->tol && res > PHGMG__R(0.25) * res_prev) {
+      /* slow: the frozen E is too far from E(Y_i) here. Exact stage values
+         from this iterate on, and for the next steps. */
+      *mm = 0; *exact = 1; s->exact_hold = 16;
+      res = phgmg__romstep_residual(s, L, x, u3, 0, err);
+      if (res < PHGMG__R(0)) break;
+      continue;
+    }
+    if (res_prev > PHGMG__R(0) && res / res_prev > *theta_max) *theta_max = res / res_prev;
+  }
+  return res;
+}
+
+/* A converged step: the stage values of the last correction, the new state,
+   the energy over the step, the extrapolation data, when to refactor. */
+PHGMG__ONLINE phgmg_result phgmg__romstep_accept(phgmg_rom_stepper *s, const phgmg__romstep_mem *L, phgmg_real *x,
+                                                 const phgmg_real *u3, phgmg_real *y, phgmg_real energy[2], int mm,
+                                                 int it, phgmg_real theta_max) {
+  const phgmg_rom *rom = s->rom;
+  const int r = rom->r, m = rom->m, n3 = 3 * r;
+  int i, a;
+  phgmg_real *xn = L->dZ;
+  if (mm) { /* the last correction: Phi_i - Del_i ~ E(Y_i)^{-1} g(Y_i) */
+    for (i = 0; i < n3; ++i) { L->Phi[i] -= L->Del[i]; L->F[i] -= L->Del[i]; }
+  } else if (L->Phi) { /* exact stages: Phi = F - Bh u, for the extrapolation */
+    int k;
+    s->stats.exact_steps++;
+    for (i = 0; i < n3; ++i) L->Phi[i] = L->F[i];
+    if (u3)
+      for (i = 0; i < 3; ++i)
+        for (k = 0; k < m; ++k)
+          for (a = 0; a < r; ++a) L->Phi[i * r + a] -= rom->Bh[a + (size_t)k * r] * u3[i * m + k];
+    s->stale_e = 1;
+  }
+  for (a = 0; a < r; ++a) {
+    phgmg_real v = x[a];
+    for (i = 0; i < 3; ++i) v += s->dt * L->b[i] * L->F[i * r + a];
+    xn[a] = v;
+  }
+  if (!phgmg__r_finite(xn, r)) return PHGMG_ERR_NANINF;
+  if (energy) {
+    phgmg_real sup = PHGMG__R(0), dis = PHGMG__R(0);
+    for (i = 0; i < 3; ++i) {
+      const phgmg_real *gi = L->G + i * r, *fi = L->F + i * r;
+      phgmg_real si = PHGMG__R(0), di = PHGMG__R(0);
+      /* dissipation rate gradH^T R gradH = -gradH^T K gradH = -g^T (f - Bh u) */
+      for (a = 0; a < r; ++a) di -= gi[a] * fi[a];
+      if (u3 && m > 0) {
+        phgmg__r_gemvt(r, m, rom->Bh, gi, 0, L->Y);
+        for (a = 0; a < m; ++a) { si += L->Y[a] * u3[i * m + a]; di += L->Y[a] * u3[i * m + a]; }
+      }
+      sup += L->b[i] * si;
+      dis += L->b[i] * di;
+    }
+    energy[0] += s->dt * sup;
+    energy[1] += s->dt * dis;
+  }
+  /* Zp_k = p(1 + c_k) - x_new, p the collocation polynomial (nodes 0, c_i) */
+  for (i = 0; i < 3; ++i)
+    for (a = 0; a < r; ++a) {
+      phgmg_real v = L->lag[i * 4] * x[a];
+      int j;
+      for (j = 0; j < 3; ++j) v += L->lag[i * 4 + 1 + j] * (x[a] + L->Z[j * r + a]);
+      L->Zp[i * r + a] = v - xn[a];
+      if (L->Phi)
+        L->Php[i * r + a] = L->lagq[i * 3] * L->Phi[a] + L->lagq[i * 3 + 1] * L->Phi[r + a] +
+                           L->lagq[i * 3 + 2] * L->Phi[2 * r + a];
+    }
+  phgmg__r_flush_subnormal(xn, r);
+  phgmg__r_flush_subnormal(L->Zp, n3);
+  if (L->Php) phgmg__r_flush_subnormal(L->Php, n3);
+  for (a = 0; a < r; ++a) x[a] = xn[a];
+  s->have_prev = 1;
+  if (theta_max > PHGMG__R(0.5)) s->have_lu = 0; /* slow contraction: refactor next step */
+  /* fresh factors of E next step after a step with more than one
+     iteration, and every 8 steps: the last correction Phi - Del is exact
+     up to (I - E_f^{-1} E(Y)) Del, so E_f must not drift far */
+  s->stale_e = it > 1 || s->stats.steps % 8 == 7;
+  s->stats.steps++;
+  if (y) phgmg_rom_output(rom, x, y, L->work);
+  return PHGMG_OK;
+}
+
 PHGMG_DEF phgmg_result phgmg_rom_step(phgmg_rom_stepper *s, phgmg_real *x, const phgmg_real *u3,
                                       phgmg_real *y, phgmg_real energy[2]) {
   const phgmg_rom *rom;
   phgmg__romstep_mem L;
-  int r, m, n3, attempt, i, a, tried_fresh = 0, exact = 0;
+  int r, m, attempt, tried_fresh = 0, exact = 0;
   phgmg_result err = PHGMG_OK;
   if (!s || !x || !s->rom) return PHGMG_ERR_INVALID_ARG;
   rom = s->rom;
-  r = rom->r; m = rom->m; n3 = 3 * r;
+  r = rom->r; m = rom->m;
   if (!phgmg__r_finite(x, r) || (u3 && !phgmg__r_finite(u3, 3 * m))) return PHGMG_ERR_NANINF;
   phgmg__romstep_layout(rom, s->use_map, s->ws, &L);
   if (s->use_map) return phgmg__romstep_map(s, &L, x, u3, y, energy);
   if (s->exact_hold > 0) { s->exact_hold--; exact = 1; }
-
   /* attempts: (1) the kept factors; (2) fresh factors at x; (3) QUADRATIC only:
      the same Newton with exact stage values F = phgmg_rom_rhs (a factorisation
      of E per stage) -- for when E varies too fast for frozen factors. */
   for (attempt = 0; attempt < 3; ++attempt) {
-    phgmg_real res, res_prev = PHGMG__R(0), theta_max = PHGMG__R(0);
-    int mm = L.Phi != NULL && !exact;
-    int it = 0, ok = 0;
-    if (!s->have_lu || (attempt > 0 && !tried_fresh)) {
-      err = phgmg__romstep_factor(s, &L, x);
-      if (err != PHGMG_OK) break;
-      tried_fresh = 1;
-    }
-    else if (mm && s->stale_e) { /* the last step was slow: new factors of E only (r x r) */
-      phgmg__romw w;
-      phgmg__romw_layout(rom, L.work, &w);
-      phgmg__rom_prep(rom, x, &w);
-      phgmg__rom_dgd(rom, &w);
-      if (phgmg__r_lu(r, w.E, w.piv) != 0) { s->have_lu = 0; err = PHGMG_ERR_SINGULAR; break; }
-      phgmg__romstep_keep_e(&L, &w, r);
-      s->stale_e = 0;
-      s->stats.e_refreshes++;
-    }
-    /* starting guess: extrapolated collocation polynomial, or zero */
-    for (i = 0; i < n3; ++i) L.Z[i] = (s->have_prev && attempt == 0) ? L.Zp[i] : PHGMG__R(0);
-    if (mm) { /* Phi: extrapolated, or E(x)^{-1} g(x) at every stage */
-      if (s->have_prev && attempt == 0) {
-        for (i = 0; i < n3; ++i) L.Phi[i] = L.Php[i];
-      } else {
-        phgmg__romw w;
-        phgmg__romw_layout(rom, L.work, &w);
-        err = phgmg__rom_rhs(rom, x, NULL, L.Phi, &w);
-        if (err != PHGMG_OK) break;
-        for (a = 0; a < r; ++a) L.Phi[r + a] = L.Phi[2 * r + a] = L.Phi[a];
-      }
-    }
+    phgmg_real res, theta_max = PHGMG__R(0);
+    int mm = L.Phi != NULL && !exact, it = 0;
+    err = phgmg__romstep_start(s, &L, x, attempt, mm, &tried_fresh);
+    if (err != PHGMG_OK) break;
     res = phgmg__romstep_residual(s, &L, x, u3, mm, &err);
     if (res < PHGMG__R(0)) {
       if (err == PHGMG_ERR_NANINF && !tried_fresh) continue; /* bad guess/factors: retry fresh */
       if (err == PHGMG_ERR_NANINF && mm) { exact = 1; continue; }
       break;
     }
-    while (res > s->tol && it < s->max_iter) {
-      for (i = 0; i < n3; ++i) L.dZ[i] = -L.Res[i];
-      phgmg__r_lu_solve(n3, L.LU, L.piv, L.dZ);
-      for (i = 0; i < n3; ++i) L.Z[i] += L.dZ[i];
-      if (mm) /* dPhi_i = Jf dZ_i - Del_i */
-        for (i = 0; i < 3; ++i) {
-          phgmg__r_gemv(r, r, L.Jf, L.dZ + i * r, 1, L.Phi + i * r);
-          for (a = 0; a < r; ++a) L.Phi[i * r + a] -= L.Del[i * r + a];
-        }
-      ++it;
-      s->stats.newton_iters++;
-      res_prev = res;
-      res = phgmg__romstep_residual(s, &L, x, u3, mm, &err);
-      if (res < PHGMG__R(0)) break;
-      if (mm && res > s->tol && res > PHGMG__R(0.25) * res_prev) {
-        /* slow: the frozen E is too far from E(Y_i) here. Exact stage values
-           from this iterate on, and for the next steps. */
-        mm = 0; exact = 1; s->exact_hold = 16;
-        res = phgmg__romstep_residual(s, &L, x, u3, 0, &err);
-        if (res < PHGMG__R(0)) break;
-        continue;
-      }
-      if (res_prev > PHGMG__R(0) && res / res_prev > theta_max) theta_max = res / res_prev;
-    }
-    if (res >= PHGMG__R(0) && res <= s->tol) ok = 1;
-    if (!ok) {
-      if (res >= PHGMG__R(0)) err = PHGMG_ERR_NOT_CONVERGED;
-      if (!tried_fresh) continue;      /* stale factors: retry with fresh ones */
-      if (mm) { exact = 1; continue; } /* frozen E too far off: exact stages */
+    res = phgmg__romstep_iterate(s, &L, x, u3, res, &mm, &exact, &it, &theta_max, &err);
+    if (res >= PHGMG__R(0) && res <= s->tol) {
+      err = phgmg__romstep_accept(s, &L, x, u3, y, energy, mm, it, theta_max);
+      if (err == PHGMG_OK) return PHGMG_OK;
       break;
     }
-    /* converged: energy, new state, extrapolation data */
-    {
-      phgmg_real *xn = L.dZ;
-      if (mm) { /* the last correction: Phi_i - Del_i ~ E(Y_i)^{-1} g(Y_i) */
-        for (i = 0; i < n3; ++i) { L.Phi[i] -= L.Del[i]; L.F[i] -= L.Del[i]; }
-      } else if (L.Phi) { /* exact stages: Phi = F - Bh u, for the extrapolation */
-        int k;
-        s->stats.exact_steps++;
-        for (i = 0; i < n3; ++i) L.Phi[i] = L.F[i];
-        if (u3)
-          for (i = 0; i < 3; ++i)
-            for (k = 0; k < m; ++k)
-              for (a = 0; a < r; ++a) L.Phi[i * r + a] -= rom->Bh[a + (size_t)k * r] * u3[i * m + k];
-        s->stale_e = 1;
-      }
-      for (a = 0; a < r; ++a) {
-        phgmg_real v = x[a];
-        for (i = 0; i < 3; ++i) v += s->dt * L.b[i] * L.F[i * r + a];
-        xn[a] = v;
-      }
-      if (!phgmg__r_finite(xn, r)) { err = PHGMG_ERR_NANINF; break; }
-      if (energy) {
-        phgmg_real sup = PHGMG__R(0), dis = PHGMG__R(0);
-        for (i = 0; i < 3; ++i) {
-          const phgmg_real *gi = L.G + i * r, *fi = L.F + i * r;
-          phgmg_real si = PHGMG__R(0), di = PHGMG__R(0);
-          /* dissipation rate gradH^T R gradH = -gradH^T K gradH = -g^T (f - Bh u) */
-          for (a = 0; a < r; ++a) di -= gi[a] * fi[a];
-          if (u3 && m > 0) {
-            phgmg__r_gemvt(r, m, rom->Bh, gi, 0, L.Y);
-            for (a = 0; a < m; ++a) { si += L.Y[a] * u3[i * m + a]; di += L.Y[a] * u3[i * m + a]; }
-          }
-          sup += L.b[i] * si;
-          dis += L.b[i] * di;
-        }
-        energy[0] += s->dt * sup;
-        energy[1] += s->dt * dis;
-      }
-      /* Zp_k = p(1 + c_k) - x_new, p the collocation polynomial (nodes 0, c_i) */
-      for (i = 0; i < 3; ++i)
-        for (a = 0; a < r; ++a) {
-          phgmg_real v = L.lag[i * 4] * x[a];
-          int j;
-          for (j = 0; j < 3; ++j) v += L.lag[i * 4 + 1 + j] * (x[a] + L.Z[j * r + a]);
-          L.Zp[i * r + a] = v - xn[a];
-          if (L.Phi)
-            L.Php[i * r + a] = L.lagq[i * 3] * L.Phi[a] + L.lagq[i * 3 + 1] * L.Phi[r + a] +
-                               L.lagq[i * 3 + 2] * L.Phi[2 * r + a];
-        }
-      phgmg__r_flush_subnormal(xn, r);
-      phgmg__r_flush_subnormal(L.Zp, n3);
-      if (L.Php) phgmg__r_flush_subnormal(L.Php, n3);
-      for (a = 0; a < r; ++a) x[a] = xn[a];
-      s->have_prev = 1;
-      if (theta_max > PHGMG__R(0.5)) s->have_lu = 0; /* slow contraction: refactor next step */
-      /* fresh factors of E next step after a step with more than one
-         iteration, and every 8 steps: the last correction Phi - Del is exact
-         up to (I - E_f^{-1} E(Y)) Del, so E_f must not drift far */
-      s->stale_e = it > 1 || s->stats.steps % 8 == 7;
-      s->stats.steps++;
-      if (y) phgmg_rom_output(rom, x, y, L.work);
-      return PHGMG_OK;
-    }
+    if (res >= PHGMG__R(0)) err = PHGMG_ERR_NOT_CONVERGED;
+    if (!tried_fresh) continue;      /* stale factors: retry with fresh ones */
+    if (mm) { exact = 1; continue; } /* frozen E too far off: exact stages */
+    break;
   }
   s->stats.failures++;
   s->have_prev = 0;
