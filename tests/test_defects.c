@@ -329,6 +329,57 @@ TEST(test_defect_npy_write_keeps_link) {
   rmdir(dir);
 }
 
+/* Defects 6, 8, 9 (phgmg_reduce): a polynomial degree the reduced model cannot
+   hold is refused up front; *out is NULL after every failure, also for NULL
+   sys/X/opts; NaN deim_tol and NaN/Inf/negative opts.dt are refused. */
+TEST(test_defect_reduce_options) {
+  dmodel t;
+  const int n = 10, N = 20, ns = 41;
+  double *X = (double *)malloc(sizeof(double) * N * ns), x0[20], poly[34];
+  int idx[10], i;
+  phgmg_reduce_opts o;
+  phgmg_reduced *red = (phgmg_reduced *)&t;   /* a non-NULL sentinel */
+  phgmg_ph_system s;
+  dmodel_msd(&t, n);
+  memset(x0, 0, sizeof x0);
+  CHECK_RC(phgmg_simulate(&t.sys, x0, 0.0, 0.1, ns - 1, d_u_sin, NULL, NULL, X, NULL, NULL, NULL, NULL, NULL), PHGMG_OK);
+  memset(&o, 0, sizeof o);
+  o.method = PHGMG_METHOD_GMG_POD; o.r = 4;
+  /* 8: NULL arguments leave *out NULL */
+  CHECK_RC(phgmg_reduce(&red, NULL, X, N, ns, &o, NULL, NULL), PHGMG_ERR_INVALID_ARG);
+  CHECK(red == NULL);
+  red = (phgmg_reduced *)&t;
+  CHECK_RC(phgmg_reduce(&red, &t.sys, NULL, N, ns, &o, NULL, NULL), PHGMG_ERR_INVALID_ARG);
+  CHECK(red == NULL);
+  red = (phgmg_reduced *)&t;
+  CHECK_RC(phgmg_reduce(&red, &t.sys, X, N, ns, NULL, NULL, NULL), PHGMG_ERR_INVALID_ARG);
+  CHECK(red == NULL);
+  /* 9: NaN deim_tol, NaN / Inf / negative dt */
+  o.deim_tol = (double)NAN;
+  CHECK_RC(phgmg_reduce(&red, &t.sys, X, N, ns, &o, NULL, NULL), PHGMG_ERR_INVALID_ARG);
+  o.deim_tol = 0.0; o.dt = (double)NAN;
+  CHECK_RC(phgmg_reduce(&red, &t.sys, X, N, ns, &o, NULL, NULL), PHGMG_ERR_INVALID_ARG);
+  o.dt = (double)INFINITY;
+  CHECK_RC(phgmg_reduce(&red, &t.sys, X, N, ns, &o, NULL, NULL), PHGMG_ERR_INVALID_ARG);
+  o.dt = -0.1;
+  CHECK_RC(phgmg_reduce(&red, &t.sys, X, N, ns, &o, NULL, NULL), PHGMG_ERR_INVALID_ARG);
+  o.dt = 0.0;
+  CHECK(red == NULL);
+  /* 6: degree 33 is refused by phgmg_reduce (phgmg_rom_check's limit is 32) */
+  memset(poly, 0, sizeof poly);
+  poly[33] = 1e-30; poly[4] = 0.25;
+  for (i = 0; i < n; ++i) idx[i] = 2 * i;
+  s = t.sys; s.nl = PHGMG_NL_SEPARABLE; s.nsep = n; s.sep_idx = idx; s.poly = poly; s.poly_deg = 33;
+  CHECK(phgmg_reduce(&red, &s, X, N, ns, &o, NULL, NULL) != PHGMG_OK);
+  CHECK(red == NULL);
+  s.poly_deg = 32; poly[32] = 1e-30; poly[33] = 0.0;   /* the largest degree a model holds */
+  CHECK_RC(phgmg_reduce(&red, &s, X, N, ns, &o, NULL, NULL), PHGMG_OK);
+  if (red) CHECK_RC(phgmg_rom_check(phgmg_reduced_rom(red)), PHGMG_OK);
+  phgmg_reduced_destroy(red);
+  free(X);
+  dmodel_free(&t);
+}
+
 SUITE(defects) {
   RUN(test_defect_q_checks);
   RUN(test_defect_other_dt);
@@ -336,4 +387,5 @@ SUITE(defects) {
   RUN(test_defect_npy_int_dtypes);
   RUN(test_defect_npy_pipe_growth);
   RUN(test_defect_npy_write_keeps_link);
+  RUN(test_defect_reduce_options);
 }
