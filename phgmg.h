@@ -4457,6 +4457,87 @@ PHGMG__PRIV void phgmg__gl3_rhs_csr(phgmg_gl3 *s) {
 
 /* Evaluate the stages at Y_i = x + Z_i: gradients G_i and right-hand sides F_i
    (Y_i is formed only where a callback or a dense product needs it). */
+/* G = Q (x + Z) + grad of one shared built-in separable function, for a
+   diagonal Q: coordinate-wise, the three stages in one pass. */
+PHGMG__PRIV void phgmg__gl3_grad_fused(phgmg_gl3 *s, const double *x) {
+  const phgmg_ph_system *sys = &s->sys;
+  const int N = s->N;
+  const double *qd = s->dq.v;
+  int i;
+  const double *wc = s->wc, *dp = s->dpoly, *ex = sys->expo;
+  const double *z0 = s->Z, *z1 = s->Z + N, *z2 = s->Z + 2 * (size_t)N;
+  double *g0 = s->G, *g1 = s->G + N, *g2 = s->G + 2 * (size_t)N;
+  int deg = sys->poly_deg, ne = sys->nexp;
+  for (i = 0; i < N; ++i) {
+    double xi = x[i], q = qd[i], w = wc[i];
+    double y0 = xi + z0[i], y1 = xi + z1[i], y2 = xi + z2[i];
+    if (w != 0.0) {
+      double p0 = deg > 0 ? dp[deg - 1] : 0.0, p1 = p0, p2 = p0;
+      int j;
+      for (j = deg - 2; j >= 0; --j) {
+        double c = dp[j];
+        p0 = PHGMG__FMA(p0, y0, c);
+        p1 = PHGMG__FMA(p1, y1, c);
+        p2 = PHGMG__FMA(p2, y2, c);
+      }
+      for (j = 0; j < ne; ++j) { /* d/ds a e^{bs} = a b e^{bs} */
+        double ab = ex[2 * j] * ex[2 * j + 1], b = ex[2 * j + 1];
+        p0 = PHGMG__FMA(ab, exp(b * y0), p0);
+        p1 = PHGMG__FMA(ab, exp(b * y1), p1);
+        p2 = PHGMG__FMA(ab, exp(b * y2), p2);
+      }
+      g0[i] = PHGMG__FMA(w, p0, q * y0);
+      g1[i] = PHGMG__FMA(w, p1, q * y1);
+      g2[i] = PHGMG__FMA(w, p2, q * y2);
+    } else {
+      g0[i] = q * y0;
+      g1[i] = q * y1;
+      g2[i] = q * y2;
+    }
+  }
+}
+
+/* Adds the gradient of the nonlinear part at the stage values x + Z_st to
+   G_st: a shared built-in separable function (derivative coefficients
+   precomputed), one built-in function per term, callbacks, or GENERAL. */
+PHGMG__PRIV void phgmg__gl3_grad_nl(phgmg_gl3 *s, const double *x, int st) {
+  const phgmg_ph_system *sys = &s->sys;
+  const int N = s->N;
+  const double *z = s->Z + (size_t)st * (size_t)N;
+  double *g = s->G + (size_t)st * (size_t)N;
+  int i, k;
+  if (sys->nl == PHGMG_NL_SEPARABLE) {
+    const int *idx = sys->sep_idx;
+    const double *w = sys->sep_w;
+    if (s->wc) { /* one shared built-in function: derivative coefficients precomputed */
+      int deg = sys->poly_deg, ne = sys->nexp;
+      const double *dp = s->dpoly, *ex = sys->expo;
+      for (k = 0; k < sys->nsep; ++k) {
+        int ix = idx[k], j;
+        double v = x[ix] + z[ix], acc = deg > 0 ? dp[deg - 1] : 0.0;
+        for (j = deg - 2; j >= 0; --j) acc = acc * v + dp[j];
+        for (j = 0; j < ne; ++j) acc += ex[2 * j] * ex[2 * j + 1] * exp(ex[2 * j + 1] * v);
+        g[ix] += w ? w[k] * acc : acc;
+      }
+    } else if (PHGMG__PH_BUILTIN(sys)) { /* one built-in function per term */
+      for (k = 0; k < sys->nsep; ++k) {
+        int ix = idx[k];
+        double d1 = phgmg__ph_dphi_builtin(sys, k, x[ix] + z[ix]);
+        g[ix] += w ? w[k] * d1 : d1;
+      }
+    } else { /* callbacks */
+      for (k = 0; k < sys->nsep; ++k) {
+        int ix = idx[k];
+        double d1 = phgmg__ph_phi(sys, k, x[ix] + z[ix], 1);
+        g[ix] += w ? w[k] * d1 : d1;
+      }
+    }
+  } else if (sys->nl == PHGMG_NL_GENERAL) {
+    sys->grad_nl(s->Y + (size_t)st * (size_t)N, s->tmp, sys->user);
+    for (i = 0; i < N; ++i) g[i] += s->tmp[i];
+  }
+}
+
 PHGMG__PRIV void phgmg__gl3_eval(phgmg_gl3 *s, const double *x) {
   const phgmg_ph_system *sys = &s->sys;
   int N = s->N, m = s->m, st, i, k;
@@ -4472,38 +4553,8 @@ PHGMG__PRIV void phgmg__gl3_eval(phgmg_gl3 *s, const double *x) {
     phgmg_gemm('N', 'N', N, 3, N, 1.0, sys->Q, N, s->Y, N, 0.0, s->G, N);
   } else if (qdiag) { /* Q diagonal: G = q .* (x + Z) in one pass */
     const double *qd = s->dq.v;
-    if (s->wc) { /* ... plus the polynomial, coordinate-wise, three stages per pass */
-      const double *wc = s->wc, *dp = s->dpoly, *ex = sys->expo;
-      const double *z0 = s->Z, *z1 = s->Z + N, *z2 = s->Z + 2 * (size_t)N;
-      double *g0 = s->G, *g1 = s->G + N, *g2 = s->G + 2 * (size_t)N;
-      int deg = sys->poly_deg, ne = sys->nexp;
-      for (i = 0; i < N; ++i) {
-        double xi = x[i], q = qd[i], w = wc[i];
-        double y0 = xi + z0[i], y1 = xi + z1[i], y2 = xi + z2[i];
-        if (w != 0.0) {
-          double p0 = deg > 0 ? dp[deg - 1] : 0.0, p1 = p0, p2 = p0;
-          int j;
-          for (j = deg - 2; j >= 0; --j) {
-            double c = dp[j];
-            p0 = PHGMG__FMA(p0, y0, c);
-            p1 = PHGMG__FMA(p1, y1, c);
-            p2 = PHGMG__FMA(p2, y2, c);
-          }
-          for (j = 0; j < ne; ++j) { /* d/ds a e^{bs} = a b e^{bs} */
-            double ab = ex[2 * j] * ex[2 * j + 1], b = ex[2 * j + 1];
-            p0 = PHGMG__FMA(ab, exp(b * y0), p0);
-            p1 = PHGMG__FMA(ab, exp(b * y1), p1);
-            p2 = PHGMG__FMA(ab, exp(b * y2), p2);
-          }
-          g0[i] = PHGMG__FMA(w, p0, q * y0);
-          g1[i] = PHGMG__FMA(w, p1, q * y1);
-          g2[i] = PHGMG__FMA(w, p2, q * y2);
-        } else {
-          g0[i] = q * y0;
-          g1[i] = q * y1;
-          g2[i] = q * y2;
-        }
-      }
+    if (s->wc) { /* ... plus the shared built-in function */
+      phgmg__gl3_grad_fused(s, x);
       phgmg__gl3_rhs_csr(s);
       return;
     }
@@ -4516,40 +4567,8 @@ PHGMG__PRIV void phgmg__gl3_eval(phgmg_gl3 *s, const double *x) {
     for (st = 0; st < 3; ++st)
       phgmg__dia_mv(&s->dq, s->Y + (size_t)st * (size_t)N, s->G + (size_t)st * (size_t)N);
   }
-  for (st = 0; st < 3; ++st) {
-    const double *z = s->Z + (size_t)st * (size_t)N;
-    double *g = s->G + (size_t)st * (size_t)N;
-    if (sys->nl == PHGMG_NL_SEPARABLE) {
-      const int *idx = sys->sep_idx;
-      const double *w = sys->sep_w;
-      if (s->wc) { /* one shared built-in function: derivative coefficients precomputed */
-        int deg = sys->poly_deg, ne = sys->nexp;
-        const double *dp = s->dpoly, *ex = sys->expo;
-        for (k = 0; k < sys->nsep; ++k) {
-          int ix = idx[k], j;
-          double v = x[ix] + z[ix], acc = deg > 0 ? dp[deg - 1] : 0.0;
-          for (j = deg - 2; j >= 0; --j) acc = acc * v + dp[j];
-          for (j = 0; j < ne; ++j) acc += ex[2 * j] * ex[2 * j + 1] * exp(ex[2 * j + 1] * v);
-          g[ix] += w ? w[k] * acc : acc;
-        }
-      } else if (PHGMG__PH_BUILTIN(sys)) { /* one built-in function per term */
-        for (k = 0; k < sys->nsep; ++k) {
-          int ix = idx[k];
-          double d1 = phgmg__ph_dphi_builtin(sys, k, x[ix] + z[ix]);
-          g[ix] += w ? w[k] * d1 : d1;
-        }
-      } else { /* callbacks */
-        for (k = 0; k < sys->nsep; ++k) {
-          int ix = idx[k];
-          double d1 = phgmg__ph_phi(sys, k, x[ix] + z[ix], 1);
-          g[ix] += w ? w[k] * d1 : d1;
-        }
-      }
-    } else if (sys->nl == PHGMG_NL_GENERAL) {
-      sys->grad_nl(s->Y + (size_t)st * (size_t)N, s->tmp, sys->user);
-      for (i = 0; i < N; ++i) g[i] += s->tmp[i];
-    }
-  }
+  if (sys->nl != PHGMG_NL_NONE)
+    for (st = 0; st < 3; ++st) phgmg__gl3_grad_nl(s, x, st);
   if (sys->storage == PHGMG_BANDED) {
     phgmg__gl3_rhs_csr(s);
     return;
