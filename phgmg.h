@@ -559,6 +559,12 @@ typedef struct phgmg_rom {
   void (*phi_cb)(int term, phgmg_real s, phgmg_real d[3], void *user); const int *term; void *phi_user; /*TMPB*/
   void (*eta_cb)(const phgmg_real *x2, phgmg_real *q, phgmg_real *Dq, phgmg_real *D2q, void *user); void *eta_user; /*TMPB*/
   void (*ham_cb)(const phgmg_real *x, phgmg_real *Hn, phgmg_real *g, phgmg_real *Hs, void *user); void *ham_user; /*TMPB*/
+  /* training envelope (optional, NULL = none): per reduced coordinate, the
+     range of the training snapshots' reduced coordinates rho(x_j), widened by
+     10 % of its width on each side. The stepper counts the steps that end
+     outside it (phgmg_rom_stats.outside_steps): the "left the training
+     region" indicator of a deployed model. */
+  const phgmg_real *env_lo, *env_hi; /* r each */
 } phgmg_rom;
 
 /* Checks a model's sizes and pointers for consistency (not its values). */
@@ -590,6 +596,9 @@ typedef struct phgmg_rom_stats {
   long steps, newton_iters, factorizations, failures;
   long e_refreshes; /* QUADRATIC: new LU of E = D^T G D alone (after a slow step) */
   long exact_steps; /* QUADRATIC: steps solved with exact stage values (see phgmg_rom_step) */
+  long outside_steps;       /* steps that ended outside the training envelope (rom->env_lo/hi) */
+  long consec_failures;     /* failed steps since the last successful one */
+  long max_consec_failures; /* longest run of failed steps so far */
 } phgmg_rom_stats;
 
 typedef struct phgmg_rom_stepper {
@@ -666,6 +675,30 @@ PHGMG_DEF phgmg_result phgmg_pod(int N, int ns, const double *X, int ldx, int km
 PHGMG_DEF phgmg_result phgmg_adjust_snapshots(int N, int m, const double *B, int ns, const double *X,
                                               int ldx, double *Xa, int ldxa, const phgmg_allocator *alloc);
 
+/* One run of the full model: input u (NULL: u = 0) from x0 (NULL: 0) at t0,
+   nsteps steps of dt. A snapshot set of several runs keeps them one after
+   the other, run k in runs[k].nsteps + 1 columns (phgmg_simulate_inputs);
+   phgmg_reduce_opts.runs tells the reduction where they are and how they
+   were made (validation by simulation, below). */
+typedef struct phgmg_run {
+  phgmg_input_fn u;
+  void *user;
+  const double *x0;
+  double t0, dt;
+  int nsteps;
+} phgmg_run;
+
+/* Columns of a snapshot set of nrun runs: sum of (nsteps + 1); -1 for a bad
+   run (nsteps < 0, dt not positive and finite). */
+PHGMG_DEF int phgmg_runs_columns(int nrun, const phgmg_run *runs);
+/* Simulate the runs (phgmg_simulate with opts go, may be NULL) into one
+   snapshot set: X (N x phgmg_runs_columns, ldx), Y (m x the same, may be
+   NULL), col (nrun + 1, may be NULL): run k in columns col[k]..col[k+1]-1.
+   Stops at the first failing run (its code; the columns before it hold data). */
+PHGMG_DEF phgmg_result phgmg_simulate_inputs(const phgmg_ph_system *sys, int nrun, const phgmg_run *runs,
+                                             const phgmg_gl3_opts *go, double *X, int ldx, double *Y, int *col,
+                                             const phgmg_allocator *alloc);
+
 typedef struct phgmg_reduce_opts {
   phgmg_method method; /* required                                                  */
   int r;               /* reduced order (GMG: includes the m port coordinates), required */
@@ -698,7 +731,11 @@ typedef struct phgmg_reduce_opts {
   const double *deim_w;
   int deim_count;
   /* GMG-QM automatic lambda (all zero = off: the paper's fixed lambda above).
-     lambda_auto = 1: the snapshots are cut into lambda_blocks contiguous
+     lambda_auto = 1 (recommended): validation by simulation of the reduced
+     model, see opts.runs below; it starts from the regression choice of
+     lambda_auto = 2 and moves towards the linear limit.
+     lambda_auto = 2 (regression only; picks lambda ~ 1e-12 on one trajectory,
+     which overfits -- NUMERICS 8.2): the snapshots are cut into lambda_blocks contiguous
      blocks in time, block j going to validation fold j mod lambda_folds. For
      each fold, M is fitted on the other snapshots for every lambda of the grid
      lambda_min * 10^(g / lambda_per_decade) <= lambda_max (one thin SVD of
@@ -710,7 +747,7 @@ typedef struct phgmg_reduce_opts {
      degeneracy_tol), the next larger grid lambda is used (info.lambda_raised).
      Cost: lambda_folds SVDs of (ns - ns/folds) x p(p+1)/2 matrices, about
      50 ms at r - m = 18, ns = 1001. Errors: PHGMG_ERR_INVALID_ARG for
-     lambda_auto not 0/1, bounds negative, NaN, Inf or lambda_min > lambda_max,
+     lambda_auto not 0/1/2, bounds negative, NaN, Inf or lambda_min > lambda_max,
      lambda_per_decade outside 1..100, lambda_folds < 2, lambda_blocks < 0,
      lambda_rcond outside [0, 1], a grid of more than 1000 points;
      PHGMG_ERR_SIZE for lambda_blocks < lambda_folds or > ns. Off: ignored. */
@@ -736,6 +773,37 @@ typedef struct phgmg_reduce_opts {
      built-in case eta(x2) = M (x2 kron x2). */
   phgmg_eta_fn eta;
   void *eta_user;
+  /* The runs that made X (nrun >= 1, columns as phgmg_simulate_inputs lays
+     them out; sum of nsteps + 1 must equal ns: PHGMG_ERR_SIZE otherwise).
+     0/NULL: X is one run of unknown input. With runs, the validation blocks
+     of the regression (lambda_auto = 2) are the runs (lambda_folds = nrun for
+     nrun >= 2), and lambda_auto = 1 validates by simulation (NUMERICS 8.2):
+     the reduced model is simulated, for the candidate lambdas, on every
+     training run and on probe runs it was not fitted to -- the full model
+     driven from runs[0].x0 by (a) a constant input at the RMS level of
+     runs[0].u (per port) and (b) runs[0].u played 1.5x faster -- and its output
+     error e_y is compared with the linear limit M = 0 (GMG-POD on the same
+     basis). Candidates: lambda_max, then one per decade down to the
+     regression optimum; a candidate is admissible if no simulation fails
+     (a Newton failure, or more than 4 Newton iterations per step on average:
+     the predicted-trouble guard) and every run's e_y is at most
+     lambda_tolerance times the linear limit's; the admissible one with the
+     smallest product of the ratios is kept, else M = 0
+     (info.lambda = HUGE_VAL). Without runs, lambda_auto = 1 cannot simulate
+     and keeps M = 0. Cost: two full-model probe runs plus (nrun + 2) reduced
+     simulations per candidate (about 10-60 ms per candidate on the paper's
+     chains). */
+  int nrun;
+  const phgmg_run *runs;
+  double lambda_tolerance; /* admissible ratio to the linear limit (0: 1.02) */
+  double newton_tol;       /* validation simulations: Newton tolerance (0: 1e-10) */
+  int newton_iter;         /* validation simulations: iteration cap (0: 20)      */
+  /* GMG-QM manifold: 0 = the paper's hierarchical POD (V1 = leading POD modes);
+     1 = greedy: V1 chosen column by column among the leading 2(r - m) + rn
+     POD modes of the adjusted snapshots, each time the mode that most
+     reduces the quadratic-manifold residual (Schwerdtner & Peherstorfer 2024),
+     V2 = the best rn of the remaining ones. */
+  int manifold;
 } phgmg_reduce_opts;
 
 typedef struct phgmg_reduce_info {
@@ -759,6 +827,9 @@ typedef struct phgmg_reduce_info {
                               be exported. 0: online cost independent of N. */
   int online_callbacks;    /* 1: the reduced model calls back into user code
                               (separable functions, eta or a GENERAL part)     */
+  int lambda_candidates;   /* lambda_auto = 1: candidate lambdas simulated     */
+  double lambda_val_ratio; /* lambda_auto = 1: largest e_y ratio of the chosen
+                              model to the linear limit over the validation runs */
 } phgmg_reduce_info;
 
 /* The reduced model with its offline data (bases for reconstruction, double
@@ -5065,6 +5136,23 @@ PHGMG__ONLINE phgmg_result phgmg__romstep_map(phgmg_rom_stepper *s, const phgmg_
   return PHGMG_OK;
 }
 
+/* Deployment counters after a step: consecutive failures, and whether the
+   state left the training envelope (rom->env_lo/hi). Returns rc. */
+PHGMG__ONLINE phgmg_result phgmg__rom_track(phgmg_rom_stepper *s, const phgmg_real *x, phgmg_result rc) {
+  const phgmg_rom *rom = s->rom;
+  int a;
+  if (rc != PHGMG_OK) {
+    if (++s->stats.consec_failures > s->stats.max_consec_failures)
+      s->stats.max_consec_failures = s->stats.consec_failures;
+    return rc;
+  }
+  s->stats.consec_failures = 0;
+  if (rom->env_lo && rom->env_hi)
+    for (a = 0; a < rom->r; ++a)
+      if (!(x[a] >= rom->env_lo[a] && x[a] <= rom->env_hi[a])) { s->stats.outside_steps++; break; }
+  return rc;
+}
+
 PHGMG_DEF phgmg_result phgmg_rom_step(phgmg_rom_stepper *s, phgmg_real *x, const phgmg_real *u3,
                                       phgmg_real *y, phgmg_real energy[2]) {
   const phgmg_rom *rom;
@@ -5076,7 +5164,7 @@ PHGMG_DEF phgmg_result phgmg_rom_step(phgmg_rom_stepper *s, phgmg_real *x, const
   r = rom->r; m = rom->m; n3 = 3 * r;
   if (!phgmg__r_finite(x, r) || (u3 && !phgmg__r_finite(u3, 3 * m))) return PHGMG_ERR_NANINF;
   phgmg__romstep_layout(rom, s->use_map, s->ws, &L);
-  if (s->use_map) return phgmg__romstep_map(s, &L, x, u3, y, energy);
+  if (s->use_map) return phgmg__rom_track(s, x, phgmg__romstep_map(s, &L, x, u3, y, energy));
   if (s->exact_hold > 0) { s->exact_hold--; exact = 1; }
 
   /* attempts: (1) the kept factors; (2) fresh factors at x; (3) QUADRATIC only:
@@ -5209,13 +5297,13 @@ PHGMG_DEF phgmg_result phgmg_rom_step(phgmg_rom_stepper *s, phgmg_real *x, const
       s->stale_e = it > 1 || s->stats.steps % 8 == 7;
       s->stats.steps++;
       if (y) phgmg_rom_output(rom, x, y, L.work);
-      return PHGMG_OK;
+      return phgmg__rom_track(s, x, PHGMG_OK);
     }
   }
   s->stats.failures++;
   s->have_prev = 0;
   s->have_lu = 0;
-  return err == PHGMG_OK ? PHGMG_ERR_NOT_CONVERGED : err;
+  return phgmg__rom_track(s, x, err == PHGMG_OK ? PHGMG_ERR_NOT_CONVERGED : err);
 }
 
 #ifndef PHGMG_NO_OFFLINE
@@ -5248,6 +5336,7 @@ struct phgmg_reduced {
   double *gwork;       /* GENERAL part: full-dimension workspace  */
   double map_dt;       /* step of the precomputed map          */
   phgmg_rom rom;       /* views into the phgmg_real copies     */
+  double *env;         /* 2r: training envelope (lo, hi) of rho(x_j), widened */
 };
 
 PHGMG__PRIV void *phgmg__red_alloc(phgmg_reduced *red, size_t bytes) {
@@ -5728,9 +5817,19 @@ PHGMG__PRIV phgmg_result phgmg__publish(phgmg_reduced *red) {
    err[g] = sum over folds ||Y_ho - K_ho t(grid[g])||_F^2 / ||Y||_F^2
    (1: no better than t = 0). Blocks, not single rows: on a fine time grid a
    snapshot is nearly a copy of its neighbours. */
+PHGMG__PRIV phgmg_result phgmg__ridge_cv_runs(int ns, int nc, int rn, const double *K, int ldk, const double *Y,
+                                              int ldy, int ngrid, const double *grid, int nfold, int nblk,
+                                              const int *runcol, double *err, const phgmg_allocator *alloc);
 PHGMG__PRIV phgmg_result phgmg__ridge_cv(int ns, int nc, int rn, const double *K, int ldk, const double *Y,
                                          int ldy, int ngrid, const double *grid, int nfold, int nblk,
                                          double *err, const phgmg_allocator *alloc) {
+  return phgmg__ridge_cv_runs(ns, nc, rn, K, ldk, Y, ldy, ngrid, grid, nfold, nblk, NULL, err, alloc);
+}
+/* The same with runcol (nfold + 1 column offsets, or NULL): fold f = run f
+   (leave one run out) instead of blocks in time. */
+PHGMG__PRIV phgmg_result phgmg__ridge_cv_runs(int ns, int nc, int rn, const double *K, int ldk, const double *Y,
+                                              int ldy, int ngrid, const double *grid, int nfold, int nblk,
+                                              const int *runcol, double *err, const phgmg_allocator *alloc) {
   double *buf, *Kt, *Yt, *Kh, *Yh, *U, *S, *V, *C, *Wd, *P, *Pr, *Rm, *tau, den = 0.0;
   const int gb = PHGMG__MIN(ngrid, 32);
   int *fold, f, g, g0, i, j, a, k, nho_max = 0, ntr_max = 0, kk;
@@ -5738,6 +5837,9 @@ PHGMG__PRIV phgmg_result phgmg__ridge_cv(int ns, int nc, int rn, const double *K
   fold = phgmg__ialloc(alloc, (size_t)ns);
   if (!fold) return PHGMG_ERR_NOMEM;
   for (i = 0; i < ns; ++i) fold[i] = (int)(((long)i * nblk / ns) % nfold);
+  if (runcol)
+    for (f = 0; f < nfold; ++f)
+      for (i = runcol[f]; i < runcol[f + 1]; ++i) fold[i] = f;
   for (f = 0; f < nfold; ++f) {
     int c = 0;
     for (i = 0; i < ns; ++i) c += fold[i] == f;
@@ -5883,6 +5985,7 @@ typedef struct phgmg__rctx {
   double *lg;              /* grid (ng) and validation errors (ng)          */
   double *Tq;              /* ridge problem Kt, Rqt, Mt kept for a refit   */
   phgmg_jr_factor *jr;     /* factorization of J - R (GMG)                 */
+  int *runcol;             /* opts.runs: nrun + 1 column offsets (NULL: one run) */
 } phgmg__rctx;
 
 PHGMG__PRIV void phgmg__rctx_free(phgmg__rctx *c) {
@@ -5890,11 +5993,25 @@ PHGMG__PRIV void phgmg__rctx_free(phgmg__rctx *c) {
   phgmg__free(c->alloc, c->Xa);
   phgmg__free(c->alloc, c->lg);
   phgmg__free(c->alloc, c->Tq);
-  c->jr = NULL; c->Xa = c->lg = c->Tq = NULL;
+  phgmg__free(c->alloc, c->runcol);
+  c->jr = NULL; c->Xa = c->lg = c->Tq = NULL; c->runcol = NULL;
 }
 
 PHGMG__PRIV int phgmg__is_gmg(int method) {
   return method == PHGMG_METHOD_GMG_POD || method == PHGMG_METHOD_GMG_QM || method == PHGMG_METHOD_GMG_MANIFOLD;
+}
+
+/* The deployment options (runs, validation, manifold). */
+#define PHGMG__NVAL_MAX 66 /* training runs + 2 probes */
+PHGMG__PRIV phgmg_result phgmg__deploy_check(const phgmg_reduce_opts *o, int ns) {
+  if (o->nrun < 0 || (o->nrun > 0 && !o->runs) || o->nrun > PHGMG__NVAL_MAX - 2) return PHGMG_ERR_INVALID_ARG;
+  if (o->nrun > 0 && phgmg_runs_columns(o->nrun, o->runs) < 0) return PHGMG_ERR_INVALID_ARG;
+  if (o->nrun > 0 && phgmg_runs_columns(o->nrun, o->runs) != ns) return PHGMG_ERR_SIZE;
+  if (!(o->lambda_tolerance == 0.0 || (o->lambda_tolerance >= 1.0 && o->lambda_tolerance < HUGE_VAL)))
+    return PHGMG_ERR_INVALID_ARG;
+  if (!(o->newton_tol >= 0.0 && o->newton_tol < 1.0) || o->newton_iter < 0) return PHGMG_ERR_INVALID_ARG;
+  if (o->manifold != 0 && o->manifold != 1) return PHGMG_ERR_INVALID_ARG;
+  return PHGMG_OK;
 }
 
 /* Options and sizes; nothing allocated. */
@@ -5921,12 +6038,24 @@ PHGMG__PRIV phgmg_result phgmg__reduce_check(const phgmg_ph_system *sys, const d
     const double hi = o->lambda_max == 0.0 ? 1.0 : o->lambda_max;
     const int nf = o->lambda_folds == 0 ? 5 : o->lambda_folds;
     const int nb = o->lambda_blocks == 0 ? PHGMG__MIN(ns, 100) : o->lambda_blocks;
-    if (o->lambda_auto != 1 || o->lambda_per_decade < 0 || nf < 2 || nb < 0) return PHGMG_ERR_INVALID_ARG;
+    if ((o->lambda_auto != 1 && o->lambda_auto != 2) || o->lambda_per_decade < 0 || nf < 2 || nb < 0)
+      return PHGMG_ERR_INVALID_ARG;
     if (!(o->lambda_rcond >= 0.0 && o->lambda_rcond <= 1.0)) return PHGMG_ERR_INVALID_ARG;
     if (phgmg__lambda_grid(lo, hi, o->lambda_per_decade == 0 ? 4 : o->lambda_per_decade, NULL) < 1)
       return PHGMG_ERR_INVALID_ARG;
     if (nb < nf || nb > ns) return PHGMG_ERR_SIZE;
   }
+  return phgmg__deploy_check(o, ns);
+}
+
+/* Column offsets of opts.runs (checked by phgmg__deploy_check). */
+PHGMG__PRIV phgmg_result phgmg__runs_layout(phgmg__rctx *c) {
+  int k;
+  if (c->o->nrun < 1) return PHGMG_OK;
+  c->runcol = phgmg__ialloc(c->alloc, (size_t)c->o->nrun + 1);
+  if (!c->runcol) return PHGMG_ERR_NOMEM;
+  c->runcol[0] = 0;
+  for (k = 0; k < c->o->nrun; ++k) c->runcol[k + 1] = c->runcol[k] + c->o->runs[k].nsteps + 1;
   return PHGMG_OK;
 }
 
@@ -6061,7 +6190,8 @@ PHGMG__PRIV phgmg_result phgmg__qm_problem(phgmg__rctx *c) {
 PHGMG__PRIV phgmg_result phgmg__qm_lambda_auto(phgmg__rctx *c) {
   const phgmg_reduce_opts *o = c->o;
   const int ns = c->ns, p = c->red->p, rn = c->red->rn, nc = p * (p + 1) / 2, ng = c->ng;
-  const int nfold = o->lambda_folds == 0 ? 5 : o->lambda_folds;
+  const int byrun = o->nrun >= 2 && c->runcol;   /* leave one run out */
+  const int nfold = byrun ? o->nrun : (o->lambda_folds == 0 ? 5 : o->lambda_folds);
   const int nblk = o->lambda_blocks == 0 ? PHGMG__MIN(ns, 100) : o->lambda_blocks;
   double best, *lg;
   int g;
@@ -6070,7 +6200,8 @@ PHGMG__PRIV phgmg_result phgmg__qm_lambda_auto(phgmg__rctx *c) {
   if (!lg) return PHGMG_ERR_NOMEM;
   phgmg__lambda_grid(o->lambda_min == 0.0 ? 1e-14 : o->lambda_min, o->lambda_max == 0.0 ? 1.0 : o->lambda_max,
                      o->lambda_per_decade == 0 ? 4 : o->lambda_per_decade, lg);
-  rc = phgmg__ridge_cv(ns, nc, rn, c->Tq, ns, c->Tq + (size_t)ns * nc, ns, ng, lg, nfold, nblk, lg + ng, c->alloc);
+  rc = phgmg__ridge_cv_runs(ns, nc, rn, c->Tq, ns, c->Tq + (size_t)ns * nc, ns, ng, lg, nfold, nblk,
+                            byrun ? c->runcol : NULL, lg + ng, c->alloc);
   if (rc != PHGMG_OK) return rc;
   for (c->gsel = 0, g = 1; g < ng; ++g) if (lg[ng + g] < lg[ng + c->gsel]) c->gsel = g;
   best = lg[ng + c->gsel];
@@ -6168,6 +6299,269 @@ PHGMG__PRIV phgmg_result phgmg__check_degeneracy(phgmg__rctx *c) {
     if (rc != PHGMG_OK) return rc;
   }
   return c->inf.rcond_dgd >= c->degtol ? PHGMG_OK : PHGMG_ERR_DEGENERATE;
+}
+
+/* ---- deployment: runs, validation by simulation, training envelope -------- */
+PHGMG_DEF int phgmg_runs_columns(int nrun, const phgmg_run *runs) {
+  long tot = 0;
+  int k;
+  if (nrun < 1 || !runs) return -1;
+  for (k = 0; k < nrun; ++k) {
+    if (runs[k].nsteps < 0 || !(runs[k].dt > 0.0) || runs[k].dt == HUGE_VAL || runs[k].t0 != runs[k].t0) return -1;
+    tot += runs[k].nsteps + 1L;
+    if (tot > 2147483647L) return -1;
+  }
+  return (int)tot;
+}
+
+PHGMG_DEF phgmg_result phgmg_simulate_inputs(const phgmg_ph_system *sys, int nrun, const phgmg_run *runs,
+                                             const phgmg_gl3_opts *go, double *X, int ldx, double *Y, int *col,
+                                             const phgmg_allocator *alloc) {
+  double *z, *T = NULL;
+  int k, c0 = 0, nmax = 0, N;
+  phgmg_result rc = PHGMG_OK;
+  if (!sys || !runs || !X) return PHGMG_ERR_INVALID_ARG;
+  if (phgmg_runs_columns(nrun, runs) < 0) return PHGMG_ERR_INVALID_ARG;
+  N = sys->N;
+  if (N < 1 || ldx < N) return PHGMG_ERR_SIZE;
+  for (k = 0; k < nrun; ++k) nmax = PHGMG__MAX(nmax, runs[k].nsteps + 1);
+  z = phgmg__dalloc(alloc, (size_t)N);
+  if (z && ldx != N) T = phgmg__dalloc(alloc, (size_t)N * nmax);
+  if (!z || (ldx != N && !T)) { phgmg__free(alloc, z); return PHGMG_ERR_NOMEM; }
+  memset(z, 0, (size_t)N * sizeof(double));
+  for (k = 0; k < nrun && rc == PHGMG_OK; ++k) {
+    const phgmg_run *q = runs + k;
+    double *dst = T ? T : X + (size_t)c0 * ldx;
+    int j;
+    if (col) col[k] = c0;
+    rc = phgmg_simulate(sys, q->x0 ? q->x0 : z, q->t0, q->dt, q->nsteps, q->u, q->user, go, dst,
+                        Y ? Y + (size_t)c0 * sys->m : NULL, NULL, NULL, NULL, alloc);
+    if (T)
+      for (j = 0; j <= q->nsteps; ++j)
+        memcpy(X + (size_t)(c0 + j) * ldx, T + (size_t)j * N, (size_t)N * sizeof(double));
+    c0 += q->nsteps + 1;
+  }
+  if (col && rc == PHGMG_OK) col[nrun] = c0;
+  phgmg__free(alloc, T);
+  phgmg__free(alloc, z);
+  return rc;
+}
+
+/* Training envelope of the reduced coordinates (phgmg_rom.env_lo/hi): the
+   range of rho(x_j) over the snapshots, widened by 10 % of the width (and
+   a floor of 1e-12 times the largest magnitude) on each side. */
+PHGMG__PRIV phgmg_result phgmg__stage_envelope(phgmg__rctx *c) {
+  phgmg_reduced *red = c->red;
+  const int r = red->r;
+  double *xr, big = 0.0;
+  int j, a;
+  phgmg_result rc;
+  red->env = phgmg__red_d(red, 2 * (size_t)r);
+  xr = phgmg__dalloc(c->alloc, (size_t)r);
+  if (!red->env || !xr) { phgmg__free(c->alloc, xr); return PHGMG_ERR_NOMEM; }
+  for (j = 0; j < c->ns; ++j) {
+    phgmg_reduced_restrict(red, c->X + (size_t)j * c->ldx, xr);
+    for (a = 0; a < r; ++a) {
+      if (j == 0 || xr[a] < red->env[a]) red->env[a] = xr[a];
+      if (j == 0 || xr[a] > red->env[r + a]) red->env[r + a] = xr[a];
+    }
+  }
+  for (a = 0; a < r; ++a) big = PHGMG__MAX(big, PHGMG__MAX(fabs(red->env[a]), fabs(red->env[r + a])));
+  for (a = 0; a < r; ++a) {
+    const double w = 0.1 * (red->env[r + a] - red->env[a]) + 1e-12 * big;
+    red->env[a] -= w;
+    red->env[r + a] += w;
+  }
+  phgmg__free(c->alloc, xr);
+  rc = phgmg__to_real(red, red->env, (size_t)r, &red->rom.env_lo);
+  if (rc == PHGMG_OK) rc = phgmg__to_real(red, red->env + r, (size_t)r, &red->rom.env_hi);
+  return rc;
+}
+
+/* Probe inputs of the lambda validation: a constant at `level` (mode 0) or
+   the run's input played 1.5x faster (mode 1). */
+typedef struct phgmg__probe {
+  const phgmg_run *run;
+  const double *level;
+  int mode, m;
+} phgmg__probe;
+PHGMG__PRIV void phgmg__probe_u(double t, double *u, void *user) {
+  const phgmg__probe *p = PHGMG__CAST(const phgmg__probe *, user);
+  int a;
+  if (p->mode == 0) {
+    for (a = 0; a < p->m; ++a) u[a] = p->level[a];
+  } else if (p->run->u) {
+    p->run->u(p->run->t0 + 1.5 * (t - p->run->t0), u, p->run->user);
+  } else {
+    for (a = 0; a < p->m; ++a) u[a] = 0.0;
+  }
+}
+
+/* The validation set: the training runs (reference outputs from the
+   snapshots) and the two probe runs (reference outputs from the full model). */
+typedef struct phgmg__vset {
+  int nv, nmax;
+  phgmg_input_fn u[PHGMG__NVAL_MAX];
+  void *user[PHGMG__NVAL_MAX];
+  const double *x0[PHGMG__NVAL_MAX];
+  double t0[PHGMG__NVAL_MAX], dt[PHGMG__NVAL_MAX];
+  int nsteps[PHGMG__NVAL_MAX];
+  double *Yref[PHGMG__NVAL_MAX];
+  double base[PHGMG__NVAL_MAX], ey[PHGMG__NVAL_MAX];
+  phgmg__probe probe[2];
+  double *buf;             /* every Yref, the level, zeros (x0), Yr, xr0 */
+  double *Yr, *xr0;
+} phgmg__vset;
+
+PHGMG__PRIV phgmg_result phgmg__vset_build(phgmg__rctx *c, phgmg__vset *v) {
+  const phgmg_ph_system *sys = c->sys;
+  const phgmg_run *run = c->o->runs;
+  const int N = sys->N, m = sys->m, nrun = c->o->nrun;
+  size_t tot = 0, off;
+  double *level, *zero, *g;
+  int k, j, a;
+  phgmg_gl3_opts go;
+  v->nv = nrun + 2;
+  v->nmax = 0;
+  for (k = 0; k < nrun; ++k) { tot += (size_t)m * (run[k].nsteps + 1); v->nmax = PHGMG__MAX(v->nmax, run[k].nsteps + 1); }
+  tot += 2 * (size_t)m * (run[0].nsteps + 1);
+  v->buf = phgmg__dalloc(c->alloc, tot + (size_t)m + 2 * (size_t)N + (size_t)m * v->nmax + (size_t)c->red->r);
+  if (!v->buf) return PHGMG_ERR_NOMEM;
+  level = v->buf + tot; zero = level + m; g = zero + N; v->Yr = g + N; v->xr0 = v->Yr + (size_t)m * v->nmax;
+  memset(zero, 0, (size_t)N * sizeof(double));
+  for (k = 0, off = 0; k < nrun; ++k) {   /* training runs: y = B^T grad H(x_j) */
+    v->u[k] = run[k].u; v->user[k] = run[k].user; v->x0[k] = c->X + (size_t)c->runcol[k] * c->ldx;
+    v->t0[k] = run[k].t0; v->dt[k] = run[k].dt; v->nsteps[k] = run[k].nsteps; v->Yref[k] = v->buf + off;
+    for (j = 0; j <= run[k].nsteps; ++j) {
+      phgmg_ph_gradient(sys, c->X + (size_t)(c->runcol[k] + j) * c->ldx, g);
+      phgmg_gemv('T', N, m, 1.0, sys->B, N, g, 0.0, v->Yref[k] + (size_t)j * m);
+    }
+    off += (size_t)m * (run[k].nsteps + 1);
+  }
+  for (a = 0; a < m; ++a) {   /* RMS of runs[0].u per port at the step times */
+    double s2 = 0.0;
+    for (j = 0; j <= run[0].nsteps; ++j) {
+      if (run[0].u) run[0].u(run[0].t0 + j * run[0].dt, g, run[0].user);
+      else g[a] = 0.0;
+      s2 += g[a] * g[a];
+    }
+    level[a] = sqrt(s2 / (run[0].nsteps + 1));
+  }
+  memset(&go, 0, sizeof go);
+  go.tol = c->o->newton_tol > 0.0 ? c->o->newton_tol : 1e-10;
+  go.max_iter = c->o->newton_iter > 0 ? c->o->newton_iter : 20;
+  for (k = nrun; k < nrun + 2; ++k) {
+    phgmg__probe *p = v->probe + (k - nrun);
+    phgmg_result rc;
+    p->run = run; p->level = level; p->mode = k - nrun; p->m = m;
+    v->u[k] = phgmg__probe_u; v->user[k] = p; v->x0[k] = run[0].x0 ? run[0].x0 : zero;
+    v->t0[k] = run[0].t0; v->dt[k] = run[0].dt; v->nsteps[k] = run[0].nsteps; v->Yref[k] = v->buf + off;
+    off += (size_t)m * (run[0].nsteps + 1);
+    rc = phgmg_simulate(sys, v->x0[k], v->t0[k], v->dt[k], v->nsteps[k], v->u[k], v->user[k], &go, NULL,
+                        v->Yref[k], NULL, NULL, NULL, c->alloc);
+    if (rc == PHGMG_ERR_NOMEM) return rc;
+    if (rc != PHGMG_OK) { v->nv = k; break; }   /* the full model itself fails: no probe */
+  }
+  return PHGMG_OK;
+}
+
+/* Simulate the current reduced model on every validation run: v->ey, and
+   *ok = 0 if a run fails or needs more than 4 Newton iterations per step. */
+PHGMG__PRIV phgmg_result phgmg__vset_eval(phgmg__rctx *c, phgmg__vset *v, int *ok) {
+  const int m = c->sys->m;
+  const double tol = c->o->newton_tol > 0.0 ? c->o->newton_tol : 1e-10;
+  const int it = c->o->newton_iter > 0 ? c->o->newton_iter : 20;
+  int k;
+  *ok = 1;
+  for (k = 0; k < v->nv; ++k) {
+    phgmg_rom_stats st;
+    phgmg_result rc;
+    memset(&st, 0, sizeof st);
+    phgmg_reduced_restrict(c->red, v->x0[k], v->xr0);
+    rc = phgmg_reduced_simulate(c->red, v->xr0, v->t0[k], v->dt[k], v->nsteps[k], v->u[k], v->user[k], tol, it,
+                                NULL, v->Yr, NULL, &st, c->alloc);
+    if (rc == PHGMG_ERR_NOMEM) return rc;
+    v->ey[k] = rc == PHGMG_OK ? phgmg_rel_error(m, v->nsteps[k] + 1, v->Yref[k], m, v->Yr, m) : HUGE_VAL;
+    if (rc != PHGMG_OK || st.newton_iters > 4 * st.steps || !(v->ey[k] < HUGE_VAL)) *ok = 0;
+  }
+  return PHGMG_OK;
+}
+
+/* M at grid point g (g < 0: M = 0, the linear limit), in double and in the
+   online model's own copy ms. */
+PHGMG__PRIV phgmg_result phgmg__qm_set(phgmg__rctx *c, int g, phgmg_real *ms) {
+  phgmg_reduced *red = c->red;
+  const int p = red->p, rn = red->rn, nc = p * (p + 1) / 2;
+  const size_t n = (size_t)rn * p * p;
+  size_t i;
+  if (g < 0) {
+    memset(red->M, 0, n * sizeof(double));
+    memset(red->Ms, 0, n * sizeof(double));
+  } else {
+    phgmg_result rc = phgmg__qm_fit(red, c->ns, c->Tq, c->Tq + (size_t)c->ns * nc, c->lg[g],
+                                    c->Tq + (size_t)c->ns * (nc + rn), c->alloc);
+    if (rc != PHGMG_OK) return rc;
+  }
+  for (i = 0; i < n; ++i) ms[i] = (phgmg_real)red->Ms[i];
+  return PHGMG_OK;
+}
+
+/* opts.lambda_auto = 1 (after publish): validation by simulation, see the
+   comment at phgmg_reduce_opts.runs. Candidates from lambda_max down, one
+   per decade, to the regression optimum; stops after two inadmissible
+   candidates in a row (the error grows as lambda falls). */
+PHGMG__PRIV phgmg_result phgmg__stage_lambda_validate(phgmg__rctx *c) {
+  phgmg_reduced *red = c->red;
+  const phgmg_reduce_opts *o = c->o;
+  const int pd = o->lambda_per_decade == 0 ? 4 : o->lambda_per_decade;
+  const double tolr = o->lambda_tolerance > 0.0 ? o->lambda_tolerance : 1.02;
+  const size_t n = (size_t)red->rn * red->p * red->p;
+  phgmg__vset *v;
+  phgmg_real *ms;
+  double best_score = 0.0, best_ratio = 1.0;
+  int best = -1, g, bad = 0, ok, k;
+  phgmg_result rc;
+  if (red->method != PHGMG_METHOD_GMG_QM || o->lambda_auto != 1 || c->gsel < 0) return PHGMG_OK;
+  ms = PHGMG__CAST(phgmg_real *, phgmg__red_alloc(red, (n ? n : 1) * sizeof(phgmg_real)));
+  if (!ms) return PHGMG_ERR_NOMEM;
+  red->rom.Ms = ms;
+  if (o->nrun < 1) {   /* nothing to simulate: the linear limit */
+    c->inf.lambda = c->lambda = HUGE_VAL;
+    return phgmg__qm_set(c, -1, ms);
+  }
+  v = PHGMG__CAST(phgmg__vset *, phgmg__alloc(c->alloc, sizeof(phgmg__vset)));
+  if (!v) return PHGMG_ERR_NOMEM;
+  memset(v, 0, sizeof *v);
+  rc = phgmg__vset_build(c, v);
+  if (rc == PHGMG_OK) rc = phgmg__qm_set(c, -1, ms);
+  if (rc == PHGMG_OK) rc = phgmg__vset_eval(c, v, &ok);
+  for (k = 0; k < v->nv && rc == PHGMG_OK; ++k) v->base[k] = v->ey[k] < HUGE_VAL ? v->ey[k] : 1.0;
+  for (g = c->ng - 1; rc == PHGMG_OK && g >= c->gsel; g = (g - pd >= c->gsel || g == c->gsel) ? g - pd : c->gsel) {
+    double score = 0.0, worst = 0.0;
+    rc = phgmg__qm_set(c, g, ms);
+    if (rc == PHGMG_OK) rc = phgmg__vset_eval(c, v, &ok);
+    if (rc != PHGMG_OK) break;
+    c->inf.lambda_candidates++;
+    for (k = 0; k < v->nv && ok; ++k) {
+      const double ratio = (v->ey[k] + 1e-14) / (v->base[k] + 1e-14);
+      score += log(ratio);
+      worst = PHGMG__MAX(worst, ratio);
+    }
+    ok = ok && worst <= tolr;
+    if (ok && score < best_score) { best = g; best_score = score; best_ratio = worst; }
+    bad = ok ? 0 : bad + 1;
+    if (bad >= 2 || g == c->gsel) break;
+  }
+  if (rc == PHGMG_OK) rc = phgmg__qm_set(c, best, ms);
+  if (rc == PHGMG_OK) {
+    c->gsel = best;
+    c->inf.lambda = c->lambda = best < 0 ? HUGE_VAL : c->lg[best];
+    c->inf.lambda_cv_err = best < 0 ? 1.0 : c->lg[c->ng + best];
+    c->inf.lambda_val_ratio = best_ratio;
+  }
+  phgmg__free(c->alloc, v->buf);
+  phgmg__free(c->alloc, v);
+  return rc;
 }
 
 /* Stage 3a, GMG blocks (paper 4.2): G = (J - R)^{-1} through a factorization,
@@ -6439,7 +6833,8 @@ PHGMG_DEF phgmg_result phgmg_reduce(phgmg_reduced **out, const phgmg_ph_system *
                               opts->lambda_per_decade == 0 ? 4 : opts->lambda_per_decade, NULL);
   c.degtol = opts->degeneracy_tol > 0.0 ? opts->degeneracy_tol : 1e-12;
   c.rfloor = phgmg__rank_floor(sys->N, ns, X, ldx);
-  rc = phgmg__reduce_new(&c);
+  rc = phgmg__runs_layout(&c);
+  if (rc == PHGMG_OK) rc = phgmg__reduce_new(&c);
   if (rc == PHGMG_OK) rc = phgmg__stage_basis(&c);
   if (rc == PHGMG_OK) rc = phgmg__stage_manifold(&c);
   if (rc == PHGMG_OK) rc = phgmg__is_gmg(opts->method) ? phgmg__stage_gmg_blocks(&c) : phgmg__stage_sp_blocks(&c);
@@ -6452,6 +6847,8 @@ PHGMG_DEF phgmg_result phgmg_reduce(phgmg_reduced **out, const phgmg_ph_system *
     rc = phgmg__step_map(c.red, opts->dt, alloc);
   }
   if (rc == PHGMG_OK) rc = phgmg__publish(c.red);
+  if (rc == PHGMG_OK) rc = phgmg__stage_envelope(&c);
+  if (rc == PHGMG_OK) rc = phgmg__stage_lambda_validate(&c);
   if (rc == PHGMG_OK)
     c.inf.online_callbacks = c.red->rom.phi_cb || c.red->rom.eta_cb || c.red->rom.ham_cb;
   phgmg__rctx_free(&c);
