@@ -560,8 +560,8 @@ typedef struct phgmg_rom {
   void (*eta_cb)(const phgmg_real *x2, phgmg_real *q, phgmg_real *Dq, phgmg_real *D2q, void *user); void *eta_user; /*TMPB*/
   void (*ham_cb)(const phgmg_real *x, phgmg_real *Hn, phgmg_real *g, phgmg_real *Hs, void *user); void *ham_user; /*TMPB*/
   /* training envelope (optional, NULL = none): per reduced coordinate, the
-     range of the training snapshots' reduced coordinates rho(x_j), widened by
-     10 % of its width on each side. The stepper counts the steps that end
+     range of the training snapshots' reduced coordinates rho(x_j), widened
+     on each side by 10 % of its width plus 2 % of the largest width. The stepper counts the steps that end
      outside it (phgmg_rom_stats.outside_steps): the "left the training
      region" indicator of a deployed model. */
   const phgmg_real *env_lo, *env_hi; /* r each */
@@ -6002,9 +6002,9 @@ PHGMG__PRIV int phgmg__is_gmg(int method) {
 }
 
 /* The deployment options (runs, validation, manifold). */
-#define PHGMG__NVAL_MAX 66 /* training runs + 2 probes */
+#define PHGMG__NVAL_MAX 67 /* training runs + 3 probes */
 PHGMG__PRIV phgmg_result phgmg__deploy_check(const phgmg_reduce_opts *o, int ns) {
-  if (o->nrun < 0 || (o->nrun > 0 && !o->runs) || o->nrun > PHGMG__NVAL_MAX - 2) return PHGMG_ERR_INVALID_ARG;
+  if (o->nrun < 0 || (o->nrun > 0 && !o->runs) || o->nrun > PHGMG__NVAL_MAX - 3) return PHGMG_ERR_INVALID_ARG;
   if (o->nrun > 0 && phgmg_runs_columns(o->nrun, o->runs) < 0) return PHGMG_ERR_INVALID_ARG;
   if (o->nrun > 0 && phgmg_runs_columns(o->nrun, o->runs) != ns) return PHGMG_ERR_SIZE;
   if (!(o->lambda_tolerance == 0.0 || (o->lambda_tolerance >= 1.0 && o->lambda_tolerance < HUGE_VAL)))
@@ -6348,8 +6348,9 @@ PHGMG_DEF phgmg_result phgmg_simulate_inputs(const phgmg_ph_system *sys, int nru
 }
 
 /* Training envelope of the reduced coordinates (phgmg_rom.env_lo/hi): the
-   range of rho(x_j) over the snapshots, widened by 10 % of the width (and
-   a floor of 1e-12 times the largest magnitude) on each side. */
+   range of rho(x_j) over the snapshots, widened on each side by 10 % of its
+   width plus 2 % of the largest width (a coordinate the training barely
+   moves must not fire on the reduced model's own error). */
 PHGMG__PRIV phgmg_result phgmg__stage_envelope(phgmg__rctx *c) {
   phgmg_reduced *red = c->red;
   const int r = red->r;
@@ -6366,9 +6367,9 @@ PHGMG__PRIV phgmg_result phgmg__stage_envelope(phgmg__rctx *c) {
       if (j == 0 || xr[a] > red->env[r + a]) red->env[r + a] = xr[a];
     }
   }
-  for (a = 0; a < r; ++a) big = PHGMG__MAX(big, PHGMG__MAX(fabs(red->env[a]), fabs(red->env[r + a])));
+  for (a = 0; a < r; ++a) big = PHGMG__MAX(big, red->env[r + a] - red->env[a]);
   for (a = 0; a < r; ++a) {
-    const double w = 0.1 * (red->env[r + a] - red->env[a]) + 1e-12 * big;
+    const double w = 0.1 * (red->env[r + a] - red->env[a]) + 0.02 * big;
     red->env[a] -= w;
     red->env[r + a] += w;
   }
@@ -6378,8 +6379,9 @@ PHGMG__PRIV phgmg_result phgmg__stage_envelope(phgmg__rctx *c) {
   return rc;
 }
 
-/* Probe inputs of the lambda validation: a constant at `level` (mode 0) or
-   the run's input played 1.5x faster (mode 1). */
+/* Probe inputs of the lambda validation: a constant at `level` (mode 0),
+   the run's input played 1.5x faster (mode 1), a square wave level *
+   sign(u(t)) (mode 2). */
 typedef struct phgmg__probe {
   const phgmg_run *run;
   const double *level;
@@ -6390,7 +6392,10 @@ PHGMG__PRIV void phgmg__probe_u(double t, double *u, void *user) {
   int a;
   if (p->mode == 0) {
     for (a = 0; a < p->m; ++a) u[a] = p->level[a];
-  } else if (p->run->u) {
+  } else if (p->mode == 2 && p->run->u) {   /* square wave: level * sign(u(t)) */
+    p->run->u(t, u, p->run->user);
+    for (a = 0; a < p->m; ++a) u[a] = u[a] > 0.0 ? p->level[a] : (u[a] < 0.0 ? -p->level[a] : 0.0);
+  } else if (p->mode == 1 && p->run->u) {
     p->run->u(p->run->t0 + 1.5 * (t - p->run->t0), u, p->run->user);
   } else {
     for (a = 0; a < p->m; ++a) u[a] = 0.0;
@@ -6408,7 +6413,7 @@ typedef struct phgmg__vset {
   int nsteps[PHGMG__NVAL_MAX];
   double *Yref[PHGMG__NVAL_MAX];
   double base[PHGMG__NVAL_MAX], ey[PHGMG__NVAL_MAX];
-  phgmg__probe probe[2];
+  phgmg__probe probe[3];
   double *buf;             /* every Yref, the level, zeros (x0), Yr, xr0 */
   double *Yr, *xr0;
 } phgmg__vset;
@@ -6421,10 +6426,10 @@ PHGMG__PRIV phgmg_result phgmg__vset_build(phgmg__rctx *c, phgmg__vset *v) {
   double *level, *zero, *g;
   int k, j, a;
   phgmg_gl3_opts go;
-  v->nv = nrun + 2;
+  v->nv = nrun + 3;
   v->nmax = 0;
   for (k = 0; k < nrun; ++k) { tot += (size_t)m * (run[k].nsteps + 1); v->nmax = PHGMG__MAX(v->nmax, run[k].nsteps + 1); }
-  tot += 2 * (size_t)m * (run[0].nsteps + 1);
+  tot += 3 * (size_t)m * (run[0].nsteps + 1);
   v->buf = phgmg__dalloc(c->alloc, tot + (size_t)m + 2 * (size_t)N + (size_t)m * v->nmax + (size_t)c->red->r);
   if (!v->buf) return PHGMG_ERR_NOMEM;
   level = v->buf + tot; zero = level + m; g = zero + N; v->Yr = g + N; v->xr0 = v->Yr + (size_t)m * v->nmax;
@@ -6450,7 +6455,7 @@ PHGMG__PRIV phgmg_result phgmg__vset_build(phgmg__rctx *c, phgmg__vset *v) {
   memset(&go, 0, sizeof go);
   go.tol = c->o->newton_tol > 0.0 ? c->o->newton_tol : 1e-10;
   go.max_iter = c->o->newton_iter > 0 ? c->o->newton_iter : 20;
-  for (k = nrun; k < nrun + 2; ++k) {
+  for (k = nrun; k < nrun + 3; ++k) {
     phgmg__probe *p = v->probe + (k - nrun);
     phgmg_result rc;
     p->run = run; p->level = level; p->mode = k - nrun; p->m = m;
@@ -6518,8 +6523,8 @@ PHGMG__PRIV phgmg_result phgmg__stage_lambda_validate(phgmg__rctx *c) {
   const size_t n = (size_t)red->rn * red->p * red->p;
   phgmg__vset *v;
   phgmg_real *ms;
-  double best_score = 0.0, best_ratio = 1.0;
-  int best = -1, g, bad = 0, ok, k;
+  double best_score = 0.0, best_ratio = 1.0, cand_score[64], cand_worst[64];
+  int best = -1, g, bad = 0, ok, k, ncand = 0, cand_g[64], cand_ok[64];
   phgmg_result rc;
   if (red->method != PHGMG_METHOD_GMG_QM || o->lambda_auto != 1 || c->gsel < 0) return PHGMG_OK;
   ms = PHGMG__CAST(phgmg_real *, phgmg__red_alloc(red, (n ? n : 1) * sizeof(phgmg_real)));
@@ -6549,9 +6554,17 @@ PHGMG__PRIV phgmg_result phgmg__stage_lambda_validate(phgmg__rctx *c) {
     }
     ok = ok && worst <= tolr;
     if (ok && score < best_score) { best = g; best_score = score; best_ratio = worst; }
+    if (ncand < 64) { cand_g[ncand] = g; cand_ok[ncand] = ok; cand_score[ncand] = score; cand_worst[ncand++] = worst; }
     bad = ok ? 0 : bad + 1;
     if (bad >= 2 || g == c->gsel) break;
   }
+  /* the largest admissible lambda with at least half the best gain (a
+     safety margin towards the linear limit) */
+  for (k = 0; k < ncand && best >= 0; ++k)
+    if (cand_ok[k] && cand_score[k] <= 0.5 * best_score) {
+      best = cand_g[k]; best_ratio = cand_worst[k];
+      break;
+    }
   if (rc == PHGMG_OK) rc = phgmg__qm_set(c, best, ms);
   if (rc == PHGMG_OK) {
     c->gsel = best;
