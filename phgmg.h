@@ -869,6 +869,35 @@ PHGMG_DEF phgmg_result phgmg_reduced_simulate(const phgmg_reduced *red, const do
                                               const phgmg_energy *energy, phgmg_rom_stats *stats,
                                               const phgmg_allocator *alloc);
 
+/* --- a check before shipping --- */
+typedef struct phgmg_validation {
+  double e_red;        /* reduction error of the reduced trajectory (over the steps done) */
+  double e_y;          /* relative output error (over the steps done)                     */
+  double e_proj;       /* projection error of the test trajectory onto the model's manifold */
+  double e_energy;     /* max_n |H_n - H_0 - S_n + D_n| of the reduced model (steps done)  */
+  double e_energy_fom; /* the same for the full model (the integrator's own level)        */
+  double y_scale;      /* max |y| of the full model (for reading e_y)                      */
+  int nsteps;          /* steps asked for                                                 */
+  int steps_done;      /* steps the reduced model completed                               */
+  int first_failure;   /* index n of the first failed step (t_n -> t_n+1), -1: none      */
+  phgmg_result rom_rc; /* the reduced simulation's code (PHGMG_OK if it completed)       */
+  phgmg_rom_stats stats; /* Newton statistics, training-envelope count of the reduced run */
+  int pass;            /* 1: completed, no Newton failure, e_y <= the limit given      */
+} phgmg_validation;
+
+/* Full model against reduced model on one run (phgmg_run: input, x0, t0, dt,
+   nsteps): simulates sys (the full model the reduced one came from) and the
+   reduced model from rho(x0) with the online stepper (tol/max_iter <= 0:
+   defaults 1e-10 / 20), and fills *v. pass = 1 when the reduced run completes
+   without any failed Newton solve and e_y <= ey_max (ey_max <= 0: no limit
+   on e_y). Returns PHGMG_OK when the comparison was made (a failing reduced
+   model is a result, v->pass = 0, not an error); PHGMG_ERR_INVALID_ARG /
+   _SIZE for bad arguments (sys->N or m not the model's), the full model's
+   code if it fails, PHGMG_ERR_NOMEM. Cost: one full and one reduced run. */
+PHGMG_DEF phgmg_result phgmg_reduced_validate(const phgmg_reduced *red, const phgmg_ph_system *sys,
+                                              const phgmg_run *run, double tol, int max_iter, double ey_max,
+                                              phgmg_validation *v, const phgmg_allocator *alloc);
+
 /* --- error measures (paper 5.1) --- */
 /* sqrt(sum_i ||A_i - B_i||^2 / sum_i ||A_i||^2) over ns columns of length n. */
 PHGMG_DEF double phgmg_rel_error(int n, int ns, const double *A, int lda, const double *B, int ldb);
@@ -6998,6 +7027,61 @@ PHGMG_DEF phgmg_result phgmg_reduced_simulate(const phgmg_reduced *red, const do
   return rc;
 }
 
+PHGMG_DEF phgmg_result phgmg_reduced_validate(const phgmg_reduced *red, const phgmg_ph_system *sys,
+                                              const phgmg_run *run, double tol, int max_iter, double ey_max,
+                                              phgmg_validation *v, const phgmg_allocator *alloc) {
+  int N, m, r, ns, k, done, j;
+  size_t nb;
+  double *buf, *X, *Y, *XR, *YR, *xr0, *H, *S, *D, *Hf, *Sf, *Df;
+  phgmg_energy ef, er;
+  phgmg_gl3_opts go;
+  phgmg_result rc;
+  if (!v) return PHGMG_ERR_INVALID_ARG;
+  memset(v, 0, sizeof *v);
+  v->first_failure = -1;
+  if (!red || !sys || !run) return PHGMG_ERR_INVALID_ARG;
+  if (phgmg_runs_columns(1, run) < 0 || !(tol < 1.0) || ey_max != ey_max) return PHGMG_ERR_INVALID_ARG;
+  N = red->N; m = red->m; r = red->r; ns = run->nsteps + 1;
+  if (sys->N != N || sys->m != m) return PHGMG_ERR_SIZE;
+  nb = (size_t)N * ns + (size_t)m * ns * 2 + (size_t)r * ns + (size_t)r + 6 * (size_t)ns + (size_t)N;
+  buf = phgmg__dalloc(alloc, nb);
+  if (!buf) return PHGMG_ERR_NOMEM;
+  X = buf; Y = X + (size_t)N * ns; YR = Y + (size_t)m * ns; XR = YR + (size_t)m * ns; xr0 = XR + (size_t)r * ns;
+  H = xr0 + r; S = H + ns; D = S + ns; Hf = D + ns; Sf = Hf + ns; Df = Sf + ns;
+  memset(Df + ns, 0, (size_t)N * sizeof(double));    /* x0 = 0 when run->x0 is NULL */
+  ef.H = Hf; ef.S = Sf; ef.D = Df; er.H = H; er.S = S; er.D = D;
+  memset(&go, 0, sizeof go);
+  go.tol = tol > 0.0 ? tol : 1e-10;
+  go.max_iter = max_iter > 0 ? max_iter : 20;
+  rc = phgmg_simulate(sys, run->x0 ? run->x0 : Df + ns, run->t0, run->dt, run->nsteps, run->u, run->user, &go, X, Y,
+                      &ef, NULL, NULL, alloc);
+  if (rc != PHGMG_OK) { phgmg__free(alloc, buf); return rc; }
+  for (k = 0; k < r * ns; ++k) XR[k] = NAN;
+  phgmg_reduced_restrict(red, X, xr0);
+  v->rom_rc = phgmg_reduced_simulate(red, xr0, run->t0, run->dt, run->nsteps, run->u, run->user, go.tol,
+                                     go.max_iter, XR, YR, &er, &v->stats, alloc);
+  if (v->rom_rc == PHGMG_ERR_NOMEM) { phgmg__free(alloc, buf); return PHGMG_ERR_NOMEM; }
+  for (done = 0; done + 1 < ns && XR[(size_t)(done + 1) * r] == XR[(size_t)(done + 1) * r]; ++done) {}
+  v->nsteps = run->nsteps;
+  v->steps_done = v->rom_rc == PHGMG_OK ? run->nsteps : done;
+  if (v->rom_rc != PHGMG_OK) v->first_failure = v->steps_done;
+  v->e_red = phgmg_err_red(red, X, N, v->steps_done + 1, XR, r);
+  v->e_y = phgmg_rel_error(m, v->steps_done + 1, Y, m, YR, m);
+  v->e_proj = phgmg_err_proj(red, X, N, ns);
+  for (j = 0; j < ns; ++j) {
+    const double efj = fabs(Hf[j] - Hf[0] - Sf[j] + Df[j]);
+    if (efj > v->e_energy_fom) v->e_energy_fom = efj;
+    if (j <= v->steps_done) {
+      const double erj = fabs(H[j] - H[0] - S[j] + D[j]);
+      if (!(erj <= v->e_energy)) v->e_energy = erj;
+    }
+    for (k = 0; k < m; ++k) v->y_scale = PHGMG__MAX(v->y_scale, fabs(Y[k + (size_t)j * m]));
+  }
+  v->pass = v->rom_rc == PHGMG_OK && v->stats.failures == 0 && (ey_max <= 0.0 || v->e_y <= ey_max);
+  phgmg__free(alloc, buf);
+  return PHGMG_OK;
+}
+
 /* --- error measures ------------------------------------------------------ */
 PHGMG_DEF double phgmg_rel_error(int n, int ns, const double *A, int lda, const double *B, int ldb) {
   double num = 0.0, den = 0.0;
@@ -7067,7 +7151,7 @@ PHGMG_DEF void phgmg_err_energy(const phgmg_energy *energy, int nsteps, double *
 #include <stdint.h>
 
 /* The arrays of a phgmg_rom in file order, with their sizes. */
-#define PHGMG__NFIELDS 18
+#define PHGMG__NFIELDS 20
 typedef struct phgmg__field { size_t off; const char *name; } phgmg__field;
 static const phgmg__field phgmg__fields[PHGMG__NFIELDS] = {
   {offsetof(phgmg_rom, Bh), "Bh"},   {offsetof(phgmg_rom, Qh), "Qh"},   {offsetof(phgmg_rom, K), "K"},
@@ -7075,7 +7159,8 @@ static const phgmg__field phgmg__fields[PHGMG__NFIELDS] = {
   {offsetof(phgmg_rom, G11), "G11"}, {offsetof(phgmg_rom, Q01), "Q01"}, {offsetof(phgmg_rom, Q11), "Q11"},
   {offsetof(phgmg_rom, Ms), "Ms"},   {offsetof(phgmg_rom, P0), "P0"},   {offsetof(phgmg_rom, P1), "P1"},
   {offsetof(phgmg_rom, w), "w"},     {offsetof(phgmg_rom, poly), "poly"}, {offsetof(phgmg_rom, Phi), "Phi"},
-  {offsetof(phgmg_rom, Gam), "Gam"}, {offsetof(phgmg_rom, SX), "SX"},   {offsetof(phgmg_rom, SU), "SU"}};
+  {offsetof(phgmg_rom, Gam), "Gam"}, {offsetof(phgmg_rom, SX), "SX"},   {offsetof(phgmg_rom, SU), "SU"},
+  {offsetof(phgmg_rom, env_lo), "env_lo"}, {offsetof(phgmg_rom, env_hi), "env_hi"}};
 
 PHGMG__ONLINE const phgmg_real **phgmg__field_ptr(phgmg_rom *rom, int i) {
   return PHGMG__CAST(const phgmg_real **, PHGMG__CAST(void *, PHGMG__CAST(char *, PHGMG__CAST(void *, rom)) + phgmg__fields[i].off));
@@ -7105,7 +7190,8 @@ PHGMG__ONLINE size_t phgmg__field_len(const phgmg_rom *rom, int i) {
     case 14: return r * r;
     case 15: return r * 3 * m;
     case 16: return 3 * r * r;
-    default: return 3 * r * 3 * m;
+    case 17: return 3 * r * 3 * m;
+    default: return r;   /* env_lo, env_hi */
   }
 }
 
@@ -7387,10 +7473,12 @@ PHGMG_DEF phgmg_result phgmg_rom_export_c(const phgmg_rom *rom, const char *name
 #else
   ok &= fprintf(f, "\n  %.17g,\n ", rom->dt) > 0;
 #endif
-  for (i = 14; i < PHGMG__NFIELDS; ++i) {
-    if (phgmg__field_get(rom, i)) ok &= fprintf(f, " %s_%s%s", name, phgmg__fields[i].name, i + 1 < PHGMG__NFIELDS ? "," : "") > 0;
-    else ok &= fprintf(f, " NULL%s", i + 1 < PHGMG__NFIELDS ? "," : "") > 0;
+  for (i = 14; i < 18; ++i) {
+    if (phgmg__field_get(rom, i)) ok &= fprintf(f, " %s_%s%s", name, phgmg__fields[i].name, i + 1 < 18 ? "," : "") > 0;
+    else ok &= fprintf(f, " NULL%s", i + 1 < 18 ? "," : "") > 0;
   }
+  if (rom->env_lo && rom->env_hi) /* nexp, nphi, expo, phi_cb, term, phi_user, eta_cb, eta_user, ham_cb, ham_user, envelope */
+    ok &= fprintf(f, ",\n  0, 0, NULL, NULL, NULL, NULL, NULL, NULL, NULL, NULL, %s_env_lo, %s_env_hi", name, name) > 0;
   ok &= fprintf(f, "\n};\n") > 0;
   if (fclose(f) != 0) ok = 0;
   return ok ? PHGMG_OK : PHGMG_ERR_IO;
