@@ -804,6 +804,12 @@ typedef struct phgmg_reduce_opts {
      reduces the quadratic-manifold residual (Schwerdtner & Peherstorfer 2024),
      V2 = the best rn of the remaining ones. */
   int manifold;
+  /* lambda_auto = 1 with lambda_train_only = 1: validate on the training runs
+     alone (no probe runs): the most accurate model on the training inputs
+     that simulates them without Newton trouble. Use it with several training
+     runs, or to measure the manifold's best case; it does not guard against
+     inputs unlike the training ones. */
+  int lambda_train_only;
 } phgmg_reduce_opts;
 
 typedef struct phgmg_reduce_info {
@@ -6040,6 +6046,7 @@ PHGMG__PRIV phgmg_result phgmg__deploy_check(const phgmg_reduce_opts *o, int ns)
     return PHGMG_ERR_INVALID_ARG;
   if (!(o->newton_tol >= 0.0 && o->newton_tol < 1.0) || o->newton_iter < 0) return PHGMG_ERR_INVALID_ARG;
   if (o->manifold != 0 && o->manifold != 1) return PHGMG_ERR_INVALID_ARG;
+  if (o->lambda_train_only != 0 && o->lambda_train_only != 1) return PHGMG_ERR_INVALID_ARG;
   return PHGMG_OK;
 }
 
@@ -6241,6 +6248,75 @@ PHGMG__PRIV phgmg_result phgmg__qm_lambda_auto(phgmg__rctx *c) {
   return PHGMG_OK;
 }
 
+/* opts.manifold = 1, greedy linear part (Schwerdtner & Peherstorfer 2024):
+   among the q = min(p + rn, available) leading POD modes U of the adjusted
+   snapshots, V1 takes one mode at a time -- the one whose reduced
+   coordinates z (with those already taken) best predict the remaining
+   modes' coordinates by the quadratic ridge fit M (z kron z). Works in the
+   q POD coordinates S = U^T Xa of every k-th snapshot (k = ceil(ns / 400)),
+   so a trial costs one small least-squares solve. Writes V1 into red->V0. */
+PHGMG__PRIV phgmg_result phgmg__qm_greedy(phgmg__rctx *c) {
+  phgmg_reduced *red = c->red;
+  const int N = red->N, m = red->m, p = red->p, rn = red->rn, ns = c->ns;
+  const int st = (ns + 399) / 400, nsub = (ns + st - 1) / st;
+  const int navail = c->o->pod_basis ? c->o->pod_cols : PHGMG__MIN(N, ns) - 1;
+  const int q = PHGMG__MIN(p + rn, navail);
+  const double lam = c->lambda > 0.0 ? c->lambda : 1e-12;
+  double *U, *S, *Kt, *Rt, *T, best_err;
+  int *sel, *used, j, k, a, b, i, cc, best, nc, nr, kk = 0;
+  phgmg_result rc = PHGMG_OK;
+  if (q <= p) return PHGMG_OK;   /* no choice: the leading modes */
+  U = phgmg__dalloc(c->alloc, (size_t)N * q + (size_t)q * ns + (size_t)q);
+  Kt = phgmg__dalloc(c->alloc, (size_t)nsub * (p * (p + 1) / 2) + (size_t)nsub * q + (size_t)(p * (p + 1) / 2) * q);
+  sel = phgmg__ialloc(c->alloc, 2 * (size_t)q);
+  if (!U || !Kt || !sel) { phgmg__free(c->alloc, U); phgmg__free(c->alloc, Kt); phgmg__free(c->alloc, sel); return PHGMG_ERR_NOMEM; }
+  S = U + (size_t)N * q; Rt = Kt + (size_t)nsub * (p * (p + 1) / 2); T = Rt + (size_t)nsub * q;
+  used = sel + q;
+  if (c->o->pod_basis) memcpy(U, c->o->pod_basis, (size_t)N * q * sizeof(double));
+  else {
+    rc = phgmg_pod(N, ns, c->Xa, N, q, 0.0, U, N, S, &kk, c->alloc);
+    if (rc == PHGMG_OK && kk < q) rc = PHGMG_ERR_SIZE;
+  }
+  if (rc == PHGMG_OK) phgmg_gemm('T', 'N', q, ns, N, 1.0, U, N, c->Xa, N, 0.0, S, q);
+  for (k = 0; k < q; ++k) used[k] = 0;
+  for (j = 0; j < p && rc == PHGMG_OK; ++j) {
+    best = -1; best_err = HUGE_VAL;
+    nc = (j + 1) * (j + 2) / 2; nr = q - j - 1;
+    for (k = 0; k < q && rc == PHGMG_OK; ++k) {
+      double err = 0.0;
+      if (used[k]) continue;
+      sel[j] = k;
+      for (i = 0; i < nsub; ++i) {
+        const double *s = S + (size_t)(i * st) * q;
+        for (a = 0, cc = 0; a <= j; ++a)
+          for (b = a; b <= j; ++b, ++cc) Kt[i + (size_t)cc * nsub] = (a == b ? 1.0 : sqrt(2.0)) * s[sel[a]] * s[sel[b]];
+        for (a = 0, cc = 0; a < q; ++a)
+          if (!used[a] && a != k) Rt[i + (size_t)(cc++) * nsub] = s[a];
+      }
+      if (nr > 0) {
+        rc = phgmg_lstsq(nsub, nc, nr, Kt, nsub, Rt, nsub, lam, T, nc, c->alloc);
+        if (rc != PHGMG_OK) break;
+        for (a = 0; a < nr; ++a)
+          for (i = 0; i < nsub; ++i) {
+            double d = Rt[i + (size_t)a * nsub];
+            for (cc = 0; cc < nc; ++cc) d -= Kt[i + (size_t)cc * nsub] * T[cc + (size_t)a * nc];
+            err += d * d;
+          }
+      }
+      if (err < best_err) { best_err = err; best = k; }
+    }
+    if (rc != PHGMG_OK) break;
+    sel[j] = best;
+    used[best] = 1;
+  }
+  if (rc == PHGMG_OK)
+    for (j = 0; j < p; ++j) memcpy(red->V0 + (size_t)N * (m + j), U + (size_t)N * sel[j], (size_t)N * sizeof(double));
+  phgmg__free(c->alloc, U);
+  phgmg__free(c->alloc, Kt);
+  phgmg__free(c->alloc, sel);
+  return rc;
+}
+
 /* Stage 2, manifold (QUADRATIC kind): V2 = POD of the residual of [B, V1]
    (paper 4.2.2) or the caller's; then GMG-QM fits M (eq. least_square_reg,
    lambda fixed or by validation); GMG_MANIFOLD takes the caller's eta. */
@@ -6252,11 +6328,15 @@ PHGMG__PRIV phgmg_result phgmg__stage_manifold(phgmg__rctx *c) {
   if (red->kind != PHGMG_ROM_QUADRATIC) return PHGMG_OK;
   red->V2 = phgmg__red_d(red, (size_t)N * rn);
   if (!red->V2) return PHGMG_ERR_NOMEM;
+  if (c->o->manifold == 1 && red->method == PHGMG_METHOD_GMG_QM) {
+    rc = phgmg__qm_greedy(c);
+    if (rc != PHGMG_OK) return rc;
+  }
   {
     double *tmp = phgmg__dalloc(c->alloc, (size_t)p * ns + (size_t)rn);
     if (!tmp) return PHGMG_ERR_NOMEM;
     phgmg__orth_remove(N, p, red->V0 + (size_t)N * m, ns, c->Xa, N, tmp);
-    if (c->o->pod_basis) {
+    if (c->o->pod_basis && c->o->manifold == 0) {
       memcpy(red->V2, c->o->pod_basis + (size_t)N * p, (size_t)N * rn * sizeof(double));
     } else {
       rc = phgmg_pod(N, ns, c->Xa, N, rn, 0.0, red->V2, N, tmp, &k, c->alloc);
@@ -6484,6 +6564,7 @@ PHGMG__PRIV phgmg_result phgmg__vset_build(phgmg__rctx *c, phgmg__vset *v) {
   memset(&go, 0, sizeof go);
   go.tol = c->o->newton_tol > 0.0 ? c->o->newton_tol : 1e-10;
   go.max_iter = c->o->newton_iter > 0 ? c->o->newton_iter : 20;
+  if (c->o->lambda_train_only) { v->nv = nrun; return PHGMG_OK; }
   for (k = nrun; k < nrun + 3; ++k) {
     phgmg__probe *p = v->probe + (k - nrun);
     phgmg_result rc;
@@ -6589,7 +6670,7 @@ PHGMG__PRIV phgmg_result phgmg__stage_lambda_validate(phgmg__rctx *c) {
   }
   /* the largest admissible lambda with at least half the best gain (a
      safety margin towards the linear limit) */
-  for (k = 0; k < ncand && best >= 0; ++k)
+  for (k = 0; k < ncand && best >= 0 && !o->lambda_train_only; ++k)
     if (cand_ok[k] && cand_score[k] <= 0.5 * best_score) {
       best = cand_g[k]; best_ratio = cand_worst[k];
       break;
