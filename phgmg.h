@@ -805,8 +805,10 @@ typedef struct phgmg_reduce_opts {
      V2 = the best rn of the remaining ones. */
   int manifold;
   /* lambda_auto = 1 with lambda_train_only = 1: validate on the training runs
-     alone (no probe runs): the most accurate model on the training inputs
-     that simulates them without Newton trouble. Use it with several training
+     alone (no probe runs): from the regression optimum up (one per decade),
+     the first lambda whose model simulates every training run without Newton
+     trouble and with e_y at most lambda_tolerance times the linear limit's --
+     the most accurate model on the training inputs, in practice. Use it with several training
      runs, or to measure the manifold's best case; it does not guard against
      inputs unlike the training ones. */
   int lambda_train_only;
@@ -6651,7 +6653,18 @@ PHGMG__PRIV phgmg_result phgmg__stage_lambda_validate(phgmg__rctx *c) {
   if (rc == PHGMG_OK) rc = phgmg__qm_set(c, -1, ms);
   if (rc == PHGMG_OK) rc = phgmg__vset_eval(c, v, &ok);
   for (k = 0; k < v->nv && rc == PHGMG_OK; ++k) v->base[k] = v->ey[k] < HUGE_VAL ? v->ey[k] : 1.0;
-  for (g = c->ng - 1; rc == PHGMG_OK && g >= c->gsel; g = (g - pd >= c->gsel || g == c->gsel) ? g - pd : c->gsel) {
+  /* training runs alone: up from the regression optimum, the first admissible */
+  for (g = c->gsel; rc == PHGMG_OK && o->lambda_train_only && g < c->ng; g += pd) {
+    double worst = 0.0;
+    rc = phgmg__qm_set(c, g, ms);
+    if (rc == PHGMG_OK) rc = phgmg__vset_eval(c, v, &ok);
+    if (rc != PHGMG_OK) break;
+    c->inf.lambda_candidates++;
+    for (k = 0; k < v->nv && ok; ++k) worst = PHGMG__MAX(worst, (v->ey[k] + 1e-14) / (v->base[k] + 1e-14));
+    if (ok && worst <= tolr) { best = g; best_ratio = worst; break; }
+  }
+  for (g = c->ng - 1; rc == PHGMG_OK && !o->lambda_train_only && g >= c->gsel;
+       g = (g - pd >= c->gsel || g == c->gsel) ? g - pd : c->gsel) {
     double score = 0.0, worst = 0.0;
     rc = phgmg__qm_set(c, g, ms);
     if (rc == PHGMG_OK) rc = phgmg__vset_eval(c, v, &ok);
