@@ -799,10 +799,13 @@ typedef struct phgmg_reduce_opts {
   double newton_tol;       /* validation simulations: Newton tolerance (0: 1e-10) */
   int newton_iter;         /* validation simulations: iteration cap (0: 20)      */
   /* GMG-QM manifold: 0 = the paper's hierarchical POD (V1 = leading POD modes);
-     1 = greedy: V1 chosen column by column among the leading 2(r - m) + rn
-     POD modes of the adjusted snapshots, each time the mode that most
-     reduces the quadratic-manifold residual (Schwerdtner & Peherstorfer 2024),
-     V2 = the best rn of the remaining ones. */
+     1 = greedy: V1 chosen column by column among the leading (r - m) + rn
+     POD modes of the adjusted snapshots, each time the mode whose
+     coordinates best predict the other candidates' by the quadratic ridge
+     fit (Schwerdtner & Peherstorfer 2024; ridge lambda 1e-9 with lambda_auto,
+     else opts.lambda; every ceil(ns/400)-th snapshot); V2 = POD of what
+     [B, V1] leaves, as for 0. Cost: about (r - m)(r - m + rn) small
+     least-squares solves (0.1-0.5 s at r = 20). */
   int manifold;
   /* lambda_auto = 1 with lambda_train_only = 1: validate on the training runs
      alone (no probe runs): from the regression optimum up (one per decade),
@@ -6254,7 +6257,8 @@ PHGMG__PRIV phgmg_result phgmg__qm_lambda_auto(phgmg__rctx *c) {
    among the q = min(p + rn, available) leading POD modes U of the adjusted
    snapshots, V1 takes one mode at a time -- the one whose reduced
    coordinates z (with those already taken) best predict the remaining
-   modes' coordinates by the quadratic ridge fit M (z kron z). Works in the
+   modes' coordinates by the quadratic ridge fit M (z kron z) (ridge lambda
+   1e-9 under lambda_auto, whose lambda is not known yet; else opts.lambda). Works in the
    q POD coordinates S = U^T Xa of every k-th snapshot (k = ceil(ns / 400)),
    so a trial costs one small least-squares solve. Writes V1 into red->V0. */
 PHGMG__PRIV phgmg_result phgmg__qm_greedy(phgmg__rctx *c) {
@@ -6263,7 +6267,7 @@ PHGMG__PRIV phgmg_result phgmg__qm_greedy(phgmg__rctx *c) {
   const int st = (ns + 399) / 400, nsub = (ns + st - 1) / st;
   const int navail = c->o->pod_basis ? c->o->pod_cols : PHGMG__MIN(N, ns) - 1;
   const int q = PHGMG__MIN(p + rn, navail);
-  const double lam = c->lambda > 0.0 ? c->lambda : 1e-12;
+  const double lam = c->o->lambda_auto ? 1e-9 : (c->lambda > 0.0 ? c->lambda : 1e-12);
   double *U, *S, *Kt, *Rt, *T, best_err;
   int *sel, *used, j, k, a, b, i, cc, best, nc, nr, kk = 0;
   phgmg_result rc = PHGMG_OK;
