@@ -177,13 +177,13 @@ DEMO_FN int demo_parse_lambda(const char *arg, double *lambda) {
 /* The automatic-lambda study of one example and input: rows
    "r, GMG-POD e_red, GMG-QM-auto e_red, lambda chosen, e_lowerbound, Newton
    failures" (nr x 6, row-major) into <out>/<example>_<input>_lambda_auto.csv. */
-#define DEMO_LA_COLS 9
+#define DEMO_LA_COLS 10
 DEMO_FN void demo_write_lambda_auto(const char *out, const char *example, const char *input, int nr,
                                     const double *rows) {
   char path[512];
   snprintf(path, sizeof path, "%s/%s_%s_lambda_auto.csv", out, example, input);
-  demo_write_csv(path, "r,GMG-POD,GMG-QM-auto,lambda,lowerbound,newton_failures,GMG-QM-greedy,lambda_greedy,"
-                 "newton_failures_greedy", nr, DEMO_LA_COLS, rows, 1);
+  demo_write_csv(path, "r,GMG-POD,GMG-QM-auto,lambda,lowerbound,newton_failures,GMG-QM-best,lambda_best,"
+                 "newton_failures_best,best_is_greedy", nr, DEMO_LA_COLS, rows, 1);
 }
 
 /* Newton failures of one reduced simulation: the stepper's count, at least 1
@@ -206,12 +206,25 @@ DEMO_FN void demo_lambda_auto_row(const phgmg_ph_system *sys, const double *X, c
   phgmg_run run;
   memset(&run, 0, sizeof run);
   run.u = uf; run.dt = dt; run.nsteps = nsteps;
-  /* the better manifold's best case on the training input: greedy linear
-     part, lambda validated on the training run alone */
-  o.method = PHGMG_METHOD_GMG_QM; o.lambda_auto = 1; o.lambda_train_only = 1; o.manifold = 1;
-  o.nrun = 1; o.runs = &run; o.newton_tol = newton_tol; o.newton_iter = newton_it;
-  demo_cache_use(cache, &o);
-  res = demo_run_rom(sys, X, Y, nsteps, dt, uf, &o, newton_tol, newton_it, NULL);
+  /* the better manifold's best case on the training input: lambda validated
+     on the training run alone, for the hierarchical POD and the greedy linear
+     part; kept: the one whose validated training e_y (relative to the linear
+     limit, info.lambda_val_ratio) is smaller -- model selection on the
+     training output, not on e_red */
+  {
+    demo_rom_result rm[2];
+    int g, pick;
+    for (g = 0; g < 2; ++g) {
+      o = *base;
+      o.method = PHGMG_METHOD_GMG_QM; o.lambda_auto = 1; o.lambda_train_only = 1; o.manifold = g;
+      o.nrun = 1; o.runs = &run; o.newton_tol = newton_tol; o.newton_iter = newton_it;
+      demo_cache_use(cache, &o);
+      rm[g] = demo_run_rom(sys, X, Y, nsteps, dt, uf, &o, newton_tol, newton_it, NULL);
+    }
+    pick = rm[1].rc == PHGMG_OK && (rm[0].rc != PHGMG_OK || rm[1].info.lambda_val_ratio < rm[0].info.lambda_val_ratio);
+    res = rm[pick];
+    row[9] = pick;
+  }
   row[6] = res.e_red; row[7] = res.info.lambda < HUGE_VAL ? res.info.lambda : NAN; row[8] = demo_newton_failures(&res);
   o = *base;
   o.method = PHGMG_METHOD_GMG_POD; o.lambda_auto = 0;
@@ -228,17 +241,18 @@ DEMO_FN void demo_lambda_auto_row(const phgmg_ph_system *sys, const double *X, c
   row[2] = res.e_red; row[3] = res.info.lambda > 0.0 && res.info.lambda < HUGE_VAL ? res.info.lambda : NAN;
   row[4] = res.e_lower;
   row[5] = demo_newton_failures(&res);
-  printf("  %3d  %9.3e  %9.3e  %6.2f  %8.2e%-3s %9.3e  %6.2f  %.0f   %9.3e  %6.2f  %8.2e  %.0f\n", o.r, row[1], row[2],
+  printf("  %3d  %9.3e  %9.3e  %6.2f  %8.2e%-3s %9.3e  %6.2f  %.0f   %9.3e%s %6.2f  %8.2e  %.0f\n", o.r, row[1], row[2],
          row[1] / row[2], row[3], res.info.lambda_raised ? " +" : "", row[4], row[2] / row[4], row[5], row[6],
-         row[1] / row[6], row[7], row[8]);
+         row[9] > 0 ? "g" : " ", row[1] / row[6], row[7], row[8]);
 }
 
 DEMO_FN void demo_lambda_auto_header(const char *input) {
   printf("\nu = %s  (e_red; QM-auto: lambda_auto = 1, validated by simulation on the training run and probe runs;\n"
-         "QM-greedy: greedy linear part (opts.manifold = 1), lambda validated on the training run alone;\n"
+         "QM-best: lambda validated on the training run alone, hierarchical POD or greedy linear part\n"
+         "(opts.manifold = 1, marked g), whichever validates better on the training output;\n"
          "lambda nan = the linear limit M = 0; "
          "+ = raised by the conditioning guard)\n  %3s  %-10s %-10s %-7s %-11s %-10s %-7s %-4s %-10s %-7s %-9s %s\n",
-         input, "r", "GMG-POD", "QM-auto", "ratio", "lambda", "lowerbnd", "QM/lb", "fail", "QM-greedy", "ratio",
+         input, "r", "GMG-POD", "QM-auto", "ratio", "lambda", "lowerbnd", "QM/lb", "fail", "QM-best", "ratio",
          "lambda", "fail");
 }
 

@@ -51,9 +51,10 @@ for ex, sp in (("linear", "SP1-POD"), ("nonlinear", "SP2-POD")):
 import os
 full = "--full" in sys.argv
 # Issue 15: lambda_auto = 1 (validated by simulation) never worse than GMG-POD
-# on the training input and free of Newton failures; the better manifold
-# (greedy linear part, lambda validated on the training run alone: QM-greedy)
-# 3x (linear) / 1.5x (nonlinear) below GMG-POD at r = 8..20 on u = 0.1 sin t.
+# on the training input and free of Newton failures; lambda validated on the
+# training run alone, hierarchical or greedy manifold by training output
+# (QM-best): 3x (linear) / 1.5x (nonlinear) below GMG-POD at r = 8..20 on
+# u = 0.1 sin t.
 for ex in ("linear", "nonlinear"):
     for inp in ("sin", "const"):
         name = f"{ex}_{inp}_lambda_auto.csv"
@@ -65,12 +66,12 @@ for ex in ("linear", "nonlinear"):
             claim(all(r in rs for r in range(6, 21)), f"{ex} {inp} lambda auto: rows for every r = 6..20 (got {rs})")
         for k, r in enumerate(rs):
             pod, qm, nf = t["GMG-POD"][k], t["GMG-QM-auto"][k], t["newton_failures"][k]
-            qt, nft = t["GMG-QM-greedy"][k], t["newton_failures_greedy"][k]
+            qt, nft = t["GMG-QM-best"][k], t["newton_failures_best"][k]
             claim(qm <= 1.05 * pod, f"{ex} {inp} r={r}: GMG-QM-auto e_red {qm:.3e} <= 1.05 GMG-POD {pod:.3e}")
-            claim(nf == 0 and nft == 0, f"{ex} {inp} r={r}: Newton failures auto {nf:g}, greedy {nft:g} == 0")
+            claim(nf == 0 and nft == 0, f"{ex} {inp} r={r}: Newton failures auto {nf:g}, best {nft:g} == 0")
             if inp == "sin" and 8 <= r <= 20:
                 f = 3.0 if ex == "linear" else 1.5
-                claim(qt <= pod / f, f"{ex} {inp} r={r}: GMG-QM-greedy e_red {qt:.3e} <= GMG-POD/{f:g} {pod / f:.3e}")
+                claim(qt <= pod / f, f"{ex} {inp} r={r}: GMG-QM-best e_red {qt:.3e} <= GMG-POD/{f:g} {pod / f:.3e}")
 # Issue 15, generalization (<ex>_generalization.csv): trained on 0.1 sin t
 # alone, GMG-QM (lambda_auto = 1) has no Newton failure and its e_y on every
 # other input is at most 1.2x GMG-POD's; trained on two runs, the e_y over
