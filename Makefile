@@ -129,7 +129,7 @@ demo: $(EXAMPLES)
 	@mkdir -p results
 	@start=$$(date +%s.%N); \
 	./$(BUILD)/msd_linear --out results && ./$(BUILD)/msd_nonlinear --out results && \
-	./$(BUILD)/msd_linear --lambda auto --rmin 8 --rstep 4 --out results && \
+	./$(BUILD)/msd_linear --lambda auto --rmin 8 --rmax 14 --rstep 6 --out results && \
 	./$(BUILD)/msd_linear --generalization 8,12,16 --out results && \
 	end=$$(date +%s.%N) && awk -v a=$$start -v b=$$end 'BEGIN { printf "make demo: total wall time %.2f s\n", b - a }' && \
 	/usr/bin/python3 tests/check_claims.py results
