@@ -7156,7 +7156,7 @@ PHGMG_DEF phgmg_result phgmg_reduced_validate(const phgmg_reduced *red, const ph
   rc = phgmg_simulate(sys, run->x0 ? run->x0 : Df + ns, run->t0, run->dt, run->nsteps, run->u, run->user, &go, X, Y,
                       &ef, NULL, NULL, alloc);
   if (rc != PHGMG_OK) { phgmg__free(alloc, buf); return rc; }
-  for (k = 0; k < r * ns; ++k) XR[k] = NAN;
+  for (k = 0; k < r * ns; ++k) XR[k] = (double)NAN;
   phgmg_reduced_restrict(red, X, xr0);
   v->rom_rc = phgmg_reduced_simulate(red, xr0, run->t0, run->dt, run->nsteps, run->u, run->user, go.tol,
                                      go.max_iter, XR, YR, &er, &v->stats, alloc);
