@@ -7168,6 +7168,10 @@ PHGMG_DEF phgmg_result phgmg_reduced_validate(const phgmg_reduced *red, const ph
   v->e_red = phgmg_err_red(red, X, N, v->steps_done + 1, XR, r);
   v->e_y = phgmg_rel_error(m, v->steps_done + 1, Y, m, YR, m);
   v->e_proj = phgmg_err_proj(red, X, N, ns);
+  if (v->e_red != v->e_red || v->e_proj != v->e_proj) { /* the error maps could not allocate (data are finite) */
+    phgmg__free(alloc, buf);
+    return PHGMG_ERR_NOMEM;
+  }
   for (j = 0; j < ns; ++j) {
     const double efj = fabs(Hf[j] - Hf[0] - Sf[j] + Df[j]);
     if (efj > v->e_energy_fom) v->e_energy_fom = efj;

@@ -299,7 +299,66 @@ TEST(test_greedy_manifold_picks_pod_modes) {
   msd_linear_free(&M);
 }
 
+/* Every allocation failure of the validated lambda (lambda_auto = 1 with
+   runs), the envelope and the greedy manifold: PHGMG_ERR_NOMEM, nothing left. */
+typedef struct tcount { long calls, fail_at, live; } tcount;
+static void *tc_alloc(size_t n, void *u) {
+  tcount *c = (tcount *)u;
+  void *p;
+  if (++c->calls == c->fail_at) return NULL;
+  p = malloc(n);
+  if (p) c->live++;
+  return p;
+}
+static void tc_free(void *p, void *u) { if (p) { ((tcount *)u)->live--; free(p); } }
+
+TEST(test_deploy_oom) {
+  msd_linear M;
+  const int ns = 81;
+  double *X;
+  phgmg_reduce_opts o;
+  phgmg_reduced *red = NULL;
+  phgmg_run run;
+  phgmg_validation v;
+  tcount c;
+  phgmg_allocator al;
+  long total, k;
+  int pass;
+  CHECK(msd_linear_build(&M, 15, NULL, NULL, NULL, PHGMG_DENSE) == 0);
+  X = sim(&M.sys, msd_input_sin, ns - 1, NULL);
+  CHECK(X != NULL);
+  if (!X) { msd_linear_free(&M); return; }
+  memset(&run, 0, sizeof run);
+  run.u = msd_input_sin; run.dt = 0.1; run.nsteps = ns - 1;
+  al.alloc = tc_alloc; al.free = tc_free; al.user = &c;
+  for (pass = 0; pass < 2; ++pass) {
+    memset(&o, 0, sizeof o);
+    o.method = PHGMG_METHOD_GMG_QM; o.r = 5; o.rn = 3; o.lambda_auto = 1; o.nrun = 1; o.runs = &run;
+    o.manifold = pass; o.lambda_train_only = pass;
+    memset(&c, 0, sizeof c);
+    CHECK_RC(phgmg_reduce(&red, &M.sys, X, M.sys.N, ns, &o, NULL, &al), PHGMG_OK);
+    if (red) CHECK_RC(phgmg_reduced_validate(red, &M.sys, &run, 0, 0, 0, &v, &al), PHGMG_OK);
+    phgmg_reduced_destroy(red); red = NULL;
+    CHECK(c.live == 0);
+    total = c.calls;
+    for (k = 1; k <= total; ++k) {
+      phgmg_result rc;
+      c.calls = 0; c.live = 0; c.fail_at = k;
+      rc = phgmg_reduce(&red, &M.sys, X, M.sys.N, ns, &o, NULL, &al);
+      if (rc == PHGMG_OK) {
+        rc = phgmg_reduced_validate(red, &M.sys, &run, 0, 0, 0, &v, &al);
+        phgmg_reduced_destroy(red); red = NULL;
+      }
+      CHECK_RC(rc, PHGMG_ERR_NOMEM);
+      CHECK(c.live == 0 && red == NULL);
+    }
+  }
+  free(X);
+  msd_linear_free(&M);
+}
+
 SUITE(deploy) {
+  RUN(test_deploy_oom);
   RUN(test_simulate_inputs_layout);
   RUN(test_deploy_options);
   RUN(test_lambda_auto_without_runs_is_linear_limit);
