@@ -565,6 +565,11 @@ typedef struct phgmg_rom {
      outside it (phgmg_rom_stats.outside_steps): the "left the training
      region" indicator of a deployed model. */
   const phgmg_real *env_lo, *env_hi; /* r each */
+  /* QUADRATIC (optional, NULL = none): 1 value, 1.2 times the largest size
+     ||M (x2 kron x2)|| of the quadratic correction over the training
+     snapshots; steps whose correction is larger are counted in
+     phgmg_rom_stats.q_outside_steps (0 for M = 0). */
+  const phgmg_real *q_max;
 } phgmg_rom;
 
 /* Checks a model's sizes and pointers for consistency (not its values). */
@@ -599,6 +604,7 @@ typedef struct phgmg_rom_stats {
   long outside_steps;       /* steps that ended outside the training envelope (rom->env_lo/hi) */
   long consec_failures;     /* failed steps since the last successful one */
   long max_consec_failures; /* longest run of failed steps so far */
+  long q_outside_steps;     /* QUADRATIC: steps whose quadratic correction exceeded rom->q_max */
 } phgmg_rom_stats;
 
 typedef struct phgmg_rom_stepper {
@@ -5192,6 +5198,19 @@ PHGMG__ONLINE phgmg_result phgmg__rom_track(phgmg_rom_stepper *s, const phgmg_re
   if (rom->env_lo && rom->env_hi)
     for (a = 0; a < rom->r; ++a)
       if (!(x[a] >= rom->env_lo[a] && x[a] <= rom->env_hi[a])) { s->stats.outside_steps++; break; }
+  if (rom->q_max && rom->Ms && rom->kind == PHGMG_ROM_QUADRATIC) { /* ||q||, q = Ms (x2 kron x2) / 2 */
+    const int m = rom->m, p = rom->r - rom->m, rn = rom->rn;
+    phgmg_real s2 = PHGMG__R(0);
+    int i, k, j;
+    for (i = 0; i < rn; ++i) {
+      phgmg_real qi = PHGMG__R(0);
+      for (k = 0; k < p; ++k)
+        for (j = 0; j < p; ++j) qi += rom->Ms[i + (size_t)(k * p + j) * rn] * x[m + k] * x[m + j];
+      qi *= PHGMG__R(0.5);
+      s2 += qi * qi;
+    }
+    if (!(s2 <= rom->q_max[0] * rom->q_max[0])) s->stats.q_outside_steps++;
+  }
   return rc;
 }
 
@@ -5379,6 +5398,7 @@ struct phgmg_reduced {
   double map_dt;       /* step of the precomputed map          */
   phgmg_rom rom;       /* views into the phgmg_real copies     */
   double *env;         /* 2r: training envelope (lo, hi) of rho(x_j), widened */
+  double *qmax;        /* 1: phgmg_rom.q_max (QUADRATIC)                       */
 };
 
 PHGMG__PRIV void *phgmg__red_alloc(phgmg_reduced *red, size_t bytes) {
@@ -6464,6 +6484,28 @@ PHGMG_DEF phgmg_result phgmg_simulate_inputs(const phgmg_ph_system *sys, int nru
   return rc;
 }
 
+/* phgmg_rom.q_max: 1.2 max_j ||M (x2_j kron x2_j)|| over the snapshots'
+   reduced coordinates x2_j (the final M: run after the lambda validation). */
+PHGMG__PRIV phgmg_result phgmg__q_envelope(phgmg__rctx *c) {
+  phgmg_reduced *red = c->red;
+  const int r = red->r, m = red->m, rn = red->rn;
+  double *xr, q[64], qmax = 0.0;
+  int j, i;
+  red->qmax = phgmg__red_d(red, 1);
+  xr = phgmg__dalloc(c->alloc, (size_t)r);
+  if (!red->qmax || !xr) { phgmg__free(c->alloc, xr); return PHGMG_ERR_NOMEM; }
+  for (j = 0; j < c->ns; ++j) {
+    double s2 = 0.0;
+    phgmg_reduced_restrict(red, c->X + (size_t)j * c->ldx, xr);
+    phgmg__eta_d(red, xr + m, q, NULL, NULL, red->rwork);
+    for (i = 0; i < rn; ++i) s2 += q[i] * q[i];
+    qmax = PHGMG__MAX(qmax, sqrt(s2));
+  }
+  red->qmax[0] = 1.2 * qmax;
+  phgmg__free(c->alloc, xr);
+  return phgmg__to_real(red, red->qmax, 1, &red->rom.q_max);
+}
+
 /* Training envelope of the reduced coordinates (phgmg_rom.env_lo/hi): the
    range of rho(x_j) over the snapshots, widened on each side by 10 % of its
    width plus 2 % of the largest width (a coordinate the training barely
@@ -6493,6 +6535,7 @@ PHGMG__PRIV phgmg_result phgmg__stage_envelope(phgmg__rctx *c) {
   phgmg__free(c->alloc, xr);
   rc = phgmg__to_real(red, red->env, (size_t)r, &red->rom.env_lo);
   if (rc == PHGMG_OK) rc = phgmg__to_real(red, red->env + r, (size_t)r, &red->rom.env_hi);
+  if (rc == PHGMG_OK && red->kind == PHGMG_ROM_QUADRATIC && red->M && !red->eta) rc = phgmg__q_envelope(c);
   return rc;
 }
 
@@ -6989,8 +7032,8 @@ PHGMG_DEF phgmg_result phgmg_reduce(phgmg_reduced **out, const phgmg_ph_system *
     rc = phgmg__step_map(c.red, opts->dt, alloc);
   }
   if (rc == PHGMG_OK) rc = phgmg__publish(c.red);
-  if (rc == PHGMG_OK) rc = phgmg__stage_envelope(&c);
   if (rc == PHGMG_OK) rc = phgmg__stage_lambda_validate(&c);
+  if (rc == PHGMG_OK) rc = phgmg__stage_envelope(&c);
   if (rc == PHGMG_OK)
     c.inf.online_callbacks = c.red->rom.phi_cb || c.red->rom.eta_cb || c.red->rom.ham_cb;
   phgmg__rctx_free(&c);
@@ -7255,7 +7298,7 @@ PHGMG_DEF void phgmg_err_energy(const phgmg_energy *energy, int nsteps, double *
 #include <stdint.h>
 
 /* The arrays of a phgmg_rom in file order, with their sizes. */
-#define PHGMG__NFIELDS 20
+#define PHGMG__NFIELDS 21
 typedef struct phgmg__field { size_t off; const char *name; } phgmg__field;
 static const phgmg__field phgmg__fields[PHGMG__NFIELDS] = {
   {offsetof(phgmg_rom, Bh), "Bh"},   {offsetof(phgmg_rom, Qh), "Qh"},   {offsetof(phgmg_rom, K), "K"},
@@ -7264,7 +7307,8 @@ static const phgmg__field phgmg__fields[PHGMG__NFIELDS] = {
   {offsetof(phgmg_rom, Ms), "Ms"},   {offsetof(phgmg_rom, P0), "P0"},   {offsetof(phgmg_rom, P1), "P1"},
   {offsetof(phgmg_rom, w), "w"},     {offsetof(phgmg_rom, poly), "poly"}, {offsetof(phgmg_rom, Phi), "Phi"},
   {offsetof(phgmg_rom, Gam), "Gam"}, {offsetof(phgmg_rom, SX), "SX"},   {offsetof(phgmg_rom, SU), "SU"},
-  {offsetof(phgmg_rom, env_lo), "env_lo"}, {offsetof(phgmg_rom, env_hi), "env_hi"}};
+  {offsetof(phgmg_rom, env_lo), "env_lo"}, {offsetof(phgmg_rom, env_hi), "env_hi"},
+  {offsetof(phgmg_rom, q_max), "q_max"}};
 
 PHGMG__ONLINE const phgmg_real **phgmg__field_ptr(phgmg_rom *rom, int i) {
   return PHGMG__CAST(const phgmg_real **, PHGMG__CAST(void *, PHGMG__CAST(char *, PHGMG__CAST(void *, rom)) + phgmg__fields[i].off));
@@ -7295,7 +7339,8 @@ PHGMG__ONLINE size_t phgmg__field_len(const phgmg_rom *rom, int i) {
     case 15: return r * 3 * m;
     case 16: return 3 * r * r;
     case 17: return 3 * r * 3 * m;
-    default: return r;   /* env_lo, env_hi */
+    case 18: case 19: return r;   /* env_lo, env_hi */
+    default: return 1;            /* q_max */
   }
 }
 
@@ -7581,8 +7626,13 @@ PHGMG_DEF phgmg_result phgmg_rom_export_c(const phgmg_rom *rom, const char *name
     if (phgmg__field_get(rom, i)) ok &= fprintf(f, " %s_%s%s", name, phgmg__fields[i].name, i + 1 < 18 ? "," : "") > 0;
     else ok &= fprintf(f, " NULL%s", i + 1 < 18 ? "," : "") > 0;
   }
-  if (rom->env_lo && rom->env_hi) /* nexp, nphi, expo, phi_cb, term, phi_user, eta_cb, eta_user, ham_cb, ham_user, envelope */
-    ok &= fprintf(f, ",\n  0, 0, NULL, NULL, NULL, NULL, NULL, NULL, NULL, NULL, %s_env_lo, %s_env_hi", name, name) > 0;
+  if (rom->env_lo || rom->env_hi || rom->q_max) { /* nexp, nphi, expo, phi_cb, term, phi_user, eta_cb, eta_user, ham_cb, ham_user, envelope */
+    ok &= fprintf(f, ",\n  0, 0, NULL, NULL, NULL, NULL, NULL, NULL, NULL, NULL") > 0;
+    for (i = 18; i < 21; ++i) {
+      if (phgmg__field_get(rom, i)) ok &= fprintf(f, ", %s_%s", name, phgmg__fields[i].name) > 0;
+      else ok &= fprintf(f, ", NULL") > 0;
+    }
+  }
   ok &= fprintf(f, "\n};\n") > 0;
   if (fclose(f) != 0) ok = 0;
   return ok ? PHGMG_OK : PHGMG_ERR_IO;

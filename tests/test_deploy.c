@@ -214,13 +214,23 @@ TEST(test_validate_and_indicator) {
     CHECK_LE(v.e_energy_fom, 1e-12);
     CHECK(v.stats.outside_steps == 0);    /* silent on the training input */
     CHECK(v.stats.steps == NS - 1 && v.stats.failures == 0);
+    CHECK(phgmg_reduced_rom(pod)->q_max == NULL && v.stats.q_outside_steps == 0);
     CHECK_RC(phgmg_reduced_validate(qm, &M.sys, &run, 1e-10, 20, 0.1, &v, NULL), PHGMG_OK);
-    CHECK(v.pass == 1 && v.stats.outside_steps == 0);
+    CHECK(v.pass == 1 && v.stats.outside_steps == 0 && v.stats.q_outside_steps == 0);
+    CHECK(phgmg_reduced_rom(qm)->q_max != NULL);
     run.u = msd_input_const;
     CHECK_RC(phgmg_reduced_validate(qm, &M.sys, &run, 1e-10, 20, 0.1, &v, NULL), PHGMG_OK);
     CHECK_LE(0.3, v.e_red);               /* a model that left its training region ... */
     CHECK(v.stats.outside_steps > (NS - 1) / 2);  /* ... and says so */
+    CHECK(v.stats.q_outside_steps > (NS - 1) / 2);
     CHECK(v.pass == 0);
+    /* 0.1 sin 2t: the coordinates stay inside their ranges, the quadratic
+       correction does not -- and it grows long before the Newton failure */
+    run.u = u_sin2;
+    CHECK_RC(phgmg_reduced_validate(qm, &M.sys, &run, 1e-10, 20, 0.1, &v, NULL), PHGMG_OK);
+    CHECK_LE(0.3, v.e_red);
+    CHECK(v.stats.q_outside_steps > 50);
+    run.u = msd_input_const;
     run.nsteps = -1;
     CHECK_RC(phgmg_reduced_validate(qm, &M.sys, &run, 1e-10, 20, 0.1, &v, NULL), PHGMG_ERR_INVALID_ARG);
   }
