@@ -1047,8 +1047,9 @@ static int cmd_info(int argc, char **argv) {
    Builds (and writes, as reduce does) the reduced model, then runs full and
    reduced model on each test input (KIND as --input; default: the training
    input) with phgmg_reduced_validate and prints e_red, e_y, e_proj, the energy
-   error, Newton statistics, training-envelope steps and the first failing
-   step. Exit status 1 if any test fails (a Newton failure in the reduced run,
+   error, Newton statistics (iterations per step), the steps outside the
+   training envelope (outside) and with a quadratic correction above the
+   training maximum (q-out), and the first failing step. Exit status 1 if any test fails (a Newton failure in the reduced run,
    or e_y above --max-ey, default 0.1); 0 if all pass; 2 bad usage. */
 static int cmd_validate(int argc, char **argv) {
   const char *tests[16], *reduce_argv[256];
@@ -1088,8 +1089,8 @@ static int cmd_validate(int argc, char **argv) {
       sys.nl = PHGMG_NL_SEPARABLE; sys.nsep = S.pidx.rows * S.pidx.cols; sys.sep_idx = S.idx;
       sys.sep_w = A.poly_w ? S.pw.a : NULL; sys.poly_deg = S.poly.rows * S.poly.cols - 1; sys.poly = S.poly.a;
     }
-    printf("%-24s %10s %10s %10s %10s %10s %8s %8s %8s  %s\n", "test input", "e_red", "e_y", "e_proj", "e_energy",
-           "(FOM)", "newton", "outside", "fail@", "verdict");
+    printf("%-24s %10s %10s %10s %10s %10s %8s %8s %8s %8s  %s\n", "test input", "e_red", "e_y", "e_proj", "e_energy",
+           "(FOM)", "newton", "outside", "q-out", "fail@", "verdict");
     for (k = 0; k < nt; ++k) {
       cli_input in;
       phgmg_run run;
@@ -1101,9 +1102,9 @@ static int cmd_validate(int argc, char **argv) {
       rc = phgmg_reduced_validate(S.red, &sys, &run, A.newton_tol, A.newton_iter, max_ey, &v, NULL);
       mat_free(&in.tab);
       if (rc != PHGMG_OK) { status = fail("validate: %s: %s", tests[k], phgmg_result_string(rc)); break; }
-      printf("%-24s %10.3e %10.3e %10.3e %10.3e %10.3e %8.2f %8ld %8d  %s\n", tests[k], v.e_red, v.e_y, v.e_proj,
+      printf("%-24s %10.3e %10.3e %10.3e %10.3e %10.3e %8.2f %8ld %8ld %8d  %s\n", tests[k], v.e_red, v.e_y, v.e_proj,
              v.e_energy, v.e_energy_fom, v.stats.steps ? (double)v.stats.newton_iters / v.stats.steps : 0.0,
-             v.stats.outside_steps, v.first_failure, v.pass ? "pass" : "FAIL");
+             v.stats.outside_steps, v.stats.q_outside_steps, v.first_failure, v.pass ? "pass" : "FAIL");
       if (!v.pass) {
         status = 1;
         if (v.first_failure >= 0)
