@@ -804,7 +804,9 @@ typedef struct phgmg_reduce_opts {
   int nrun;
   const phgmg_run *runs;
   double lambda_tolerance; /* admissible ratio to the linear limit (0: 1.02) */
-  double newton_tol;       /* validation simulations: Newton tolerance (0: 1e-10) */
+  double newton_tol;       /* validation simulations: Newton tolerance (0: 1e-10 for
+                              the full model; the stepper's default for the reduced
+                              one, 1e-10 double / 1e-5 float)                     */
   int newton_iter;         /* validation simulations: iteration cap (0: 20)      */
   /* GMG-QM manifold: 0 = the paper's hierarchical POD (V1 = leading POD modes);
      1 = greedy: V1 chosen column by column among the leading (r - m) + rn
@@ -907,7 +909,8 @@ typedef struct phgmg_validation {
 /* Full model against reduced model on one run (phgmg_run: input, x0, t0, dt,
    nsteps): simulates sys (the full model the reduced one came from) and the
    reduced model from rho(x0) with the online stepper (tol/max_iter <= 0:
-   defaults 1e-10 / 20), and fills *v. pass = 1 when the reduced run completes
+   defaults 1e-10 for the full model, the stepper's default for the reduced
+   one (1e-10 double, 1e-5 float) / 20), and fills *v. pass = 1 when the reduced run completes
    without any failed Newton solve and e_y <= ey_max (ey_max <= 0: no limit
    on e_y). Returns PHGMG_OK when the comparison was made (a failing reduced
    model is a result, v->pass = 0, not an error); PHGMG_ERR_INVALID_ARG /
@@ -6635,7 +6638,7 @@ PHGMG__PRIV phgmg_result phgmg__vset_build(phgmg__rctx *c, phgmg__vset *v) {
    *ok = 0 if a run fails or needs more than 4 Newton iterations per step. */
 PHGMG__PRIV phgmg_result phgmg__vset_eval(phgmg__rctx *c, phgmg__vset *v, int *ok) {
   const int m = c->sys->m;
-  const double tol = c->o->newton_tol > 0.0 ? c->o->newton_tol : 1e-10;
+  const double tol = c->o->newton_tol;   /* 0: the stepper's default (1e-10 double, 1e-5 float) */
   const int it = c->o->newton_iter > 0 ? c->o->newton_iter : 20;
   int k;
   *ok = 1;
@@ -7201,8 +7204,8 @@ PHGMG_DEF phgmg_result phgmg_reduced_validate(const phgmg_reduced *red, const ph
   if (rc != PHGMG_OK) { phgmg__free(alloc, buf); return rc; }
   for (k = 0; k < r * ns; ++k) XR[k] = (double)NAN;
   phgmg_reduced_restrict(red, X, xr0);
-  v->rom_rc = phgmg_reduced_simulate(red, xr0, run->t0, run->dt, run->nsteps, run->u, run->user, go.tol,
-                                     go.max_iter, XR, YR, &er, &v->stats, alloc);
+  v->rom_rc = phgmg_reduced_simulate(red, xr0, run->t0, run->dt, run->nsteps, run->u, run->user,
+                                     tol > 0.0 ? tol : 0.0, go.max_iter, XR, YR, &er, &v->stats, alloc);
   if (v->rom_rc == PHGMG_ERR_NOMEM) { phgmg__free(alloc, buf); return PHGMG_ERR_NOMEM; }
   for (done = 0; done + 1 < ns && XR[(size_t)(done + 1) * r] == XR[(size_t)(done + 1) * r]; ++done) {}
   v->nsteps = run->nsteps;
