@@ -16,7 +16,7 @@ LDLIBS   = -lm
 TESTSRC := $(wildcard tests/test_*.c)
 BUILD    = build
 
-.PHONY: all test test-plain test-asan compile-checks test-embedded-host test-npy test-cli test-demo test-fuzz-replay demo bench examples embedded fuzz clean
+.PHONY: test-validate test-deploy all test test-plain test-asan compile-checks test-embedded-host test-npy test-cli test-demo test-fuzz-replay demo bench examples embedded fuzz clean
 
 all: phgmg.h examples
 
@@ -31,7 +31,22 @@ $(BUILD)/test_run_asan: phgmg.h tests/run.c tests/harness.h tests/suites.inc $(T
 	@mkdir -p $(BUILD)
 	$(CC) $(CFLAGS_T) -O1 $(SANFLAGS) -o $@ tests/run.c $(TESTSRC) $(LDLIBS)
 
-test: test-plain test-asan compile-checks test-embedded-host test-npy test-cli test-demo test-fuzz-replay
+test: test-plain test-asan compile-checks test-embedded-host test-npy test-cli test-demo test-fuzz-replay test-validate
+
+# `phgmg validate` and the deployment checks (tests/test_validate.sh, a few seconds).
+test-validate: $(BUILD)/phgmg
+	sh tests/test_validate.sh $(BUILD)/phgmg
+
+# Issue 15's acceptance at every r = 6..20 on both chains (GMG-QM with the
+# validated lambda on five inputs, one and two training runs; the training-only
+# validated model against GMG-POD); minutes, not part of make test.
+test-deploy: $(EXAMPLES)
+	@mkdir -p results/deploy
+	./$(BUILD)/msd_linear --lambda auto --rmin 6 --out results/deploy
+	./$(BUILD)/msd_nonlinear --lambda auto --rmin 6 --rstep 1 --out results/deploy
+	./$(BUILD)/msd_linear --generalization 6,7,8,9,10,11,12,13,14,15,16,17,18,19,20 --out results/deploy
+	./$(BUILD)/msd_nonlinear --generalization 6,7,8,9,10,11,12,13,14,15,16,17,18,19,20 --out results/deploy
+	/usr/bin/python3 tests/check_claims.py results/deploy --full
 
 # Replay the fuzz corpora of every reader and of the CLI's argument handling
 # (clang sanitizers when available; ~15 s, mostly building the five harnesses).
@@ -117,8 +132,9 @@ demo: $(EXAMPLES)
 	@mkdir -p results
 	@start=$$(date +%s.%N); \
 	./$(BUILD)/msd_linear --out results && ./$(BUILD)/msd_nonlinear --out results && \
-	./$(BUILD)/msd_linear --lambda auto --rmin 6 --out results && ./$(BUILD)/morse_chain --out results && \
-	./$(BUILD)/linear_bases --out results && \
+	./$(BUILD)/msd_linear --lambda auto --rmin 8 --rmax 14 --rstep 6 --out results && \
+	./$(BUILD)/msd_linear --generalization 8,12,16 --out results && \
+	./$(BUILD)/morse_chain --out results && ./$(BUILD)/linear_bases --out results && \
 	end=$$(date +%s.%N) && awk -v a=$$start -v b=$$end 'BEGIN { printf "make demo: total wall time %.2f s\n", b - a }' && \
 	/usr/bin/python3 tests/check_claims.py results && /usr/bin/python3 tests/check_morse.py results && \
 	/usr/bin/python3 tests/check_linear.py results

@@ -641,6 +641,17 @@ typedef struct phgmg_rom {
      callbacks need; for static buffers use PHGMG_ROM_STEPPER_MEMSIZE_MAX_CB. */
   void (*ham_cb)(const phgmg_real *x, phgmg_real *Hn, phgmg_real *g, phgmg_real *Hs, void *user);
   void *ham_user;
+  /* training envelope (optional, NULL = none): per reduced coordinate, the
+     range of the training snapshots' reduced coordinates rho(x_j), widened
+     on each side by 10 % of its width plus 2 % of the largest width. The stepper counts the steps that end
+     outside it (phgmg_rom_stats.outside_steps): the "left the training
+     region" indicator of a deployed model. */
+  const phgmg_real *env_lo, *env_hi; /* r each */
+  /* QUADRATIC (optional, NULL = none): 1 value, 1.2 times the largest size
+     ||M (x2 kron x2)|| of the quadratic correction over the training
+     snapshots; steps whose correction is larger are counted in
+     phgmg_rom_stats.q_outside_steps (0 for M = 0). */
+  const phgmg_real *q_max;
 } phgmg_rom;
 
 /* Checks a model's sizes and pointers for consistency (not its values). */
@@ -672,6 +683,10 @@ typedef struct phgmg_rom_stats {
   long steps, newton_iters, factorizations, failures;
   long e_refreshes; /* QUADRATIC: new LU of E = D^T G D alone (after a slow step) */
   long exact_steps; /* QUADRATIC: steps solved with exact stage values (see phgmg_rom_step) */
+  long outside_steps;       /* steps that ended outside the training envelope (rom->env_lo/hi) */
+  long consec_failures;     /* failed steps since the last successful one */
+  long max_consec_failures; /* longest run of failed steps so far */
+  long q_outside_steps;     /* QUADRATIC: steps whose quadratic correction exceeded rom->q_max */
 } phgmg_rom_stats;
 
 typedef struct phgmg_rom_stepper {
@@ -765,6 +780,30 @@ typedef enum phgmg_hyper {
   PHGMG_HYPER_GREEDY = 2  /* structure-preserving DEIM, greedy DEIM points             */
 } phgmg_hyper;
 
+/* One run of the full model: input u (NULL: u = 0) from x0 (NULL: 0) at t0,
+   nsteps steps of dt. A snapshot set of several runs keeps them one after
+   the other, run k in runs[k].nsteps + 1 columns (phgmg_simulate_inputs);
+   phgmg_reduce_opts.runs tells the reduction where they are and how they
+   were made (validation by simulation, below). */
+typedef struct phgmg_run {
+  phgmg_input_fn u;
+  void *user;
+  const double *x0;
+  double t0, dt;
+  int nsteps;
+} phgmg_run;
+
+/* Columns of a snapshot set of nrun runs: sum of (nsteps + 1); -1 for a bad
+   run (nsteps < 0, dt not positive and finite). */
+PHGMG_DEF int phgmg_runs_columns(int nrun, const phgmg_run *runs);
+/* Simulate the runs (phgmg_simulate with opts go, may be NULL) into one
+   snapshot set: X (N x phgmg_runs_columns, ldx), Y (m x the same, may be
+   NULL), col (nrun + 1, may be NULL): run k in columns col[k]..col[k+1]-1.
+   Stops at the first failing run (its code; the columns before it hold data). */
+PHGMG_DEF phgmg_result phgmg_simulate_inputs(const phgmg_ph_system *sys, int nrun, const phgmg_run *runs,
+                                             const phgmg_gl3_opts *go, double *X, int ldx, double *Y, int *col,
+                                             const phgmg_allocator *alloc);
+
 typedef struct phgmg_reduce_opts {
   phgmg_method method; /* required                                                  */
   int r;               /* reduced order (GMG: includes the m port coordinates), required */
@@ -804,7 +843,11 @@ typedef struct phgmg_reduce_opts {
   const double *deim_w;
   int deim_count;
   /* GMG-QM automatic lambda (all zero = off: the paper's fixed lambda above).
-     lambda_auto = 1: the snapshots are cut into lambda_blocks contiguous
+     lambda_auto = 1 (recommended): validation by simulation of the reduced
+     model, see opts.runs below; it starts from the regression choice of
+     lambda_auto = 2 and moves towards the linear limit.
+     lambda_auto = 2 (regression only; picks lambda ~ 1e-12 on one trajectory,
+     which overfits -- NUMERICS 8.2): the snapshots are cut into lambda_blocks contiguous
      blocks in time, block j going to validation fold j mod lambda_folds. For
      each fold, M is fitted on the other snapshots for every lambda of the grid
      lambda_min * 10^(g / lambda_per_decade) <= lambda_max (one thin SVD of
@@ -816,7 +859,7 @@ typedef struct phgmg_reduce_opts {
      degeneracy_tol), the next larger grid lambda is used (info.lambda_raised).
      Cost: lambda_folds SVDs of (ns - ns/folds) x p(p+1)/2 matrices, about
      50 ms at r - m = 18, ns = 1001. Errors: PHGMG_ERR_INVALID_ARG for
-     lambda_auto not 0/1, bounds negative, NaN, Inf or lambda_min > lambda_max,
+     lambda_auto not 0/1/2, bounds negative, NaN, Inf or lambda_min > lambda_max,
      lambda_per_decade outside 1..100, lambda_folds < 2, lambda_blocks < 0,
      lambda_rcond outside [0, 1], a grid of more than 1000 points;
      PHGMG_ERR_SIZE for lambda_blocks < lambda_folds or > ns. Off: ignored. */
@@ -842,6 +885,52 @@ typedef struct phgmg_reduce_opts {
      built-in case eta(x2) = M (x2 kron x2). */
   phgmg_eta_fn eta;
   void *eta_user;
+  /* The runs that made X (nrun >= 1, columns as phgmg_simulate_inputs lays
+     them out; sum of nsteps + 1 must equal ns: PHGMG_ERR_SIZE otherwise).
+     0/NULL: X is one run of unknown input. With runs, the regression
+     validation of lambda_auto = 2 leaves one run out (for nrun >= 2), and
+     lambda_auto = 1 validates by simulation (NUMERICS 8.2): the finished
+     reduced model is simulated, for candidate lambdas, on every training run
+     (reference: the snapshots' outputs) and on three probe runs it was not
+     fitted to -- the full model driven from runs[0].x0 by a constant at the
+     RMS level of runs[0].u (per port), by runs[0].u played 1.5x faster and by
+     the square wave RMS * sign(runs[0].u(t)) -- and each run's output error
+     e_y is compared with the linear limit M = 0 (GMG-POD on the same basis).
+     Candidates: lambda_max, then one per decade (lambda_per_decade grid
+     steps) down to the regression optimum; the descent stops after two
+     inadmissible candidates in a row. Admissible: no simulation fails, at
+     most 4 Newton iterations per step on average (the predicted-trouble
+     guard), and every run's e_y at most lambda_tolerance times the linear
+     limit's. Kept: the largest admissible lambda with at least half of the
+     best admissible gain (sum of log ratios); none: M = 0 (info.lambda =
+     HUGE_VAL). Without runs, lambda_auto = 1 cannot simulate and keeps M = 0.
+     Cost: three full-model probe runs plus (nrun + 3) reduced runs per
+     candidate, 4-8 candidates: 0.3-0.5 s on the paper's linear chain and 1-2.5 s
+     on its nonlinear chain (N = 1000, DEIM) at r = 20, 1000 steps. */
+  int nrun;
+  const phgmg_run *runs;
+  double lambda_tolerance; /* admissible ratio to the linear limit (0: 1.02) */
+  double newton_tol;       /* validation simulations: Newton tolerance (0: 1e-10 for
+                              the full model; the stepper's default for the reduced
+                              one, 1e-10 double / 1e-5 float)                     */
+  int newton_iter;         /* validation simulations: iteration cap (0: 20)      */
+  /* GMG-QM manifold: 0 = the paper's hierarchical POD (V1 = leading POD modes);
+     1 = greedy: V1 chosen column by column among the leading (r - m) + rn
+     POD modes of the adjusted snapshots, each time the mode whose
+     coordinates best predict the other candidates' by the quadratic ridge
+     fit (Schwerdtner & Peherstorfer 2024; ridge lambda 1e-9 with lambda_auto,
+     else opts.lambda; every ceil(ns/400)-th snapshot); V2 = POD of what
+     [B, V1] leaves, as for 0. Cost: about (r - m)(r - m + rn) small
+     least-squares solves (0.1-0.5 s at r = 20). */
+  int manifold;
+  /* lambda_auto = 1 with lambda_train_only = 1: validate on the training runs
+     alone (no probe runs): from the regression optimum up (one per decade),
+     the first lambda whose model simulates every training run without Newton
+     trouble and with e_y at most lambda_tolerance times the linear limit's --
+     the most accurate model on the training inputs, in practice. Use it with several training
+     runs, or to measure the manifold's best case; it does not guard against
+     inputs unlike the training ones. */
+  int lambda_train_only;
 } phgmg_reduce_opts;
 
 typedef struct phgmg_reduce_info {
@@ -869,6 +958,9 @@ typedef struct phgmg_reduce_info {
   double hyper_min_weight; /* smallest weight of the kept terms                */
   double hyper_residual;   /* ECSW: relative training residual of the reduced
                               nonlinear gradient; 0 for DEIM                   */
+  int lambda_candidates;   /* lambda_auto = 1: candidate lambdas simulated     */
+  double lambda_val_ratio; /* lambda_auto = 1: largest e_y ratio of the chosen
+                              model to the linear limit over the validation runs */
 } phgmg_reduce_info;
 
 /* The reduced model with its offline data (bases for reconstruction, double
@@ -929,6 +1021,36 @@ PHGMG_DEF phgmg_result phgmg_reduced_simulate(const phgmg_reduced *red, const do
                                               double tol, int max_iter, double *XR, double *Y,
                                               const phgmg_energy *energy, phgmg_rom_stats *stats,
                                               const phgmg_allocator *alloc);
+
+/* --- a check before shipping --- */
+typedef struct phgmg_validation {
+  double e_red;        /* reduction error of the reduced trajectory (over the steps done) */
+  double e_y;          /* relative output error (over the steps done)                     */
+  double e_proj;       /* projection error of the test trajectory onto the model's manifold */
+  double e_energy;     /* max_n |H_n - H_0 - S_n + D_n| of the reduced model (steps done)  */
+  double e_energy_fom; /* the same for the full model (the integrator's own level)        */
+  double y_scale;      /* max |y| of the full model (for reading e_y)                      */
+  int nsteps;          /* steps asked for                                                 */
+  int steps_done;      /* steps the reduced model completed                               */
+  int first_failure;   /* index n of the first failed step (t_n -> t_n+1), -1: none      */
+  phgmg_result rom_rc; /* the reduced simulation's code (PHGMG_OK if it completed)       */
+  phgmg_rom_stats stats; /* Newton statistics, training-envelope count of the reduced run */
+  int pass;            /* 1: completed, no Newton failure, e_y <= the limit given      */
+} phgmg_validation;
+
+/* Full model against reduced model on one run (phgmg_run: input, x0, t0, dt,
+   nsteps): simulates sys (the full model the reduced one came from) and the
+   reduced model from rho(x0) with the online stepper (tol/max_iter <= 0:
+   defaults 1e-10 for the full model, the stepper's default for the reduced
+   one (1e-10 double, 1e-5 float) / 20), and fills *v. pass = 1 when the reduced run completes
+   without any failed Newton solve and e_y <= ey_max (ey_max <= 0: no limit
+   on e_y). Returns PHGMG_OK when the comparison was made (a failing reduced
+   model is a result, v->pass = 0, not an error); PHGMG_ERR_INVALID_ARG /
+   _SIZE for bad arguments (sys->N or m not the model's), the full model's
+   code if it fails, PHGMG_ERR_NOMEM. Cost: one full and one reduced run. */
+PHGMG_DEF phgmg_result phgmg_reduced_validate(const phgmg_reduced *red, const phgmg_ph_system *sys,
+                                              const phgmg_run *run, double tol, int max_iter, double ey_max,
+                                              phgmg_validation *v, const phgmg_allocator *alloc);
 
 /* --- error measures (paper 5.1) --- */
 /* sqrt(sum_i ||A_i - B_i||^2 / sum_i ||A_i||^2) over ns columns of length n. */
@@ -6008,6 +6130,36 @@ PHGMG__ONLINE phgmg_result phgmg__romstep_accept(phgmg_rom_stepper *s, const phg
   return PHGMG_OK;
 }
 
+/* Deployment counters after a step: consecutive failures, and whether the
+   state left the training envelope (rom->env_lo/hi). Returns rc. */
+PHGMG__ONLINE phgmg_result phgmg__rom_track(phgmg_rom_stepper *s, const phgmg_real *x, phgmg_result rc) {
+  const phgmg_rom *rom = s->rom;
+  int a;
+  if (rc != PHGMG_OK) {
+    if (++s->stats.consec_failures > s->stats.max_consec_failures)
+      s->stats.max_consec_failures = s->stats.consec_failures;
+    return rc;
+  }
+  s->stats.consec_failures = 0;
+  if (rom->env_lo && rom->env_hi)
+    for (a = 0; a < rom->r; ++a)
+      if (!(x[a] >= rom->env_lo[a] && x[a] <= rom->env_hi[a])) { s->stats.outside_steps++; break; }
+  if (rom->q_max && rom->Ms && rom->kind == PHGMG_ROM_QUADRATIC) { /* ||q||, q = Ms (x2 kron x2) / 2 */
+    const int m = rom->m, p = rom->r - rom->m, rn = rom->rn;
+    phgmg_real s2 = PHGMG__R(0);
+    int i, k, j;
+    for (i = 0; i < rn; ++i) {
+      phgmg_real qi = PHGMG__R(0);
+      for (k = 0; k < p; ++k)
+        for (j = 0; j < p; ++j) qi += rom->Ms[i + (size_t)(k * p + j) * rn] * x[m + k] * x[m + j];
+      qi *= PHGMG__R(0.5);
+      s2 += qi * qi;
+    }
+    if (!(s2 <= rom->q_max[0] * rom->q_max[0])) s->stats.q_outside_steps++;
+  }
+  return rc;
+}
+
 PHGMG_DEF phgmg_result phgmg_rom_step(phgmg_rom_stepper *s, phgmg_real *x, const phgmg_real *u3,
                                       phgmg_real *y, phgmg_real energy[2]) {
   const phgmg_rom *rom;
@@ -6019,7 +6171,7 @@ PHGMG_DEF phgmg_result phgmg_rom_step(phgmg_rom_stepper *s, phgmg_real *x, const
   r = rom->r; m = rom->m;
   if (!phgmg__r_finite(x, r) || (u3 && !phgmg__r_finite(u3, 3 * m))) return PHGMG_ERR_NANINF;
   phgmg__romstep_layout(rom, s->use_map, s->ws, &L);
-  if (s->use_map) return phgmg__romstep_map(s, &L, x, u3, y, energy);
+  if (s->use_map) return phgmg__rom_track(s, x, phgmg__romstep_map(s, &L, x, u3, y, energy));
   if (s->exact_hold > 0) { s->exact_hold--; exact = 1; }
   /* attempts: (1) the kept factors; (2) fresh factors at x; (3) QUADRATIC only:
      the same Newton with exact stage values F = phgmg_rom_rhs (a factorisation
@@ -6038,7 +6190,7 @@ PHGMG_DEF phgmg_result phgmg_rom_step(phgmg_rom_stepper *s, phgmg_real *x, const
     res = phgmg__romstep_iterate(s, &L, x, u3, res, &mm, &exact, &it, &theta_max, &err);
     if (res >= PHGMG__R(0) && res <= s->tol) {
       err = phgmg__romstep_accept(s, &L, x, u3, y, energy, mm, it, theta_max);
-      if (err == PHGMG_OK) return PHGMG_OK;
+      if (err == PHGMG_OK) return phgmg__rom_track(s, x, PHGMG_OK);
       break;
     }
     if (res >= PHGMG__R(0)) err = PHGMG_ERR_NOT_CONVERGED;
@@ -6049,7 +6201,7 @@ PHGMG_DEF phgmg_result phgmg_rom_step(phgmg_rom_stepper *s, phgmg_real *x, const
   s->stats.failures++;
   s->have_prev = 0;
   s->have_lu = 0;
-  return err == PHGMG_OK ? PHGMG_ERR_NOT_CONVERGED : err;
+  return phgmg__rom_track(s, x, err == PHGMG_OK ? PHGMG_ERR_NOT_CONVERGED : err);
 }
 
 #ifndef PHGMG_NO_OFFLINE
@@ -6082,6 +6234,8 @@ struct phgmg_reduced {
   double *gwork;       /* GENERAL part: full-dimension workspace  */
   double map_dt;       /* step of the precomputed map          */
   phgmg_rom rom;       /* views into the phgmg_real copies     */
+  double *env;         /* 2r: training envelope (lo, hi) of rho(x_j), widened */
+  double *qmax;        /* 1: phgmg_rom.q_max (QUADRATIC)                       */
 };
 
 PHGMG__PRIV void *phgmg__red_alloc(phgmg_reduced *red, size_t bytes) {
@@ -7004,9 +7158,19 @@ PHGMG__PRIV phgmg_result phgmg__publish(phgmg_reduced *red) {
    err[g] = sum over folds ||Y_ho - K_ho t(grid[g])||_F^2 / ||Y||_F^2
    (1: no better than t = 0). Blocks, not single rows: on a fine time grid a
    snapshot is nearly a copy of its neighbours. */
+PHGMG__PRIV phgmg_result phgmg__ridge_cv_runs(int ns, int nc, int rn, const double *K, int ldk, const double *Y,
+                                              int ldy, int ngrid, const double *grid, int nfold, int nblk,
+                                              const int *runcol, double *err, const phgmg_allocator *alloc);
 PHGMG__PRIV phgmg_result phgmg__ridge_cv(int ns, int nc, int rn, const double *K, int ldk, const double *Y,
                                          int ldy, int ngrid, const double *grid, int nfold, int nblk,
                                          double *err, const phgmg_allocator *alloc) {
+  return phgmg__ridge_cv_runs(ns, nc, rn, K, ldk, Y, ldy, ngrid, grid, nfold, nblk, NULL, err, alloc);
+}
+/* The same with runcol (nfold + 1 column offsets, or NULL): fold f = run f
+   (leave one run out) instead of blocks in time. */
+PHGMG__PRIV phgmg_result phgmg__ridge_cv_runs(int ns, int nc, int rn, const double *K, int ldk, const double *Y,
+                                              int ldy, int ngrid, const double *grid, int nfold, int nblk,
+                                              const int *runcol, double *err, const phgmg_allocator *alloc) {
   double *buf, *Kt, *Yt, *Kh, *Yh, *U, *S, *V, *C, *Wd, *P, *Pr, *Rm, *tau, den = 0.0;
   const int gb = PHGMG__MIN(ngrid, 32);
   int *fold, f, g, g0, i, j, a, k, nho_max = 0, ntr_max = 0, kk;
@@ -7014,6 +7178,9 @@ PHGMG__PRIV phgmg_result phgmg__ridge_cv(int ns, int nc, int rn, const double *K
   fold = phgmg__ialloc(alloc, (size_t)ns);
   if (!fold) return PHGMG_ERR_NOMEM;
   for (i = 0; i < ns; ++i) fold[i] = (int)(((long)i * nblk / ns) % nfold);
+  if (runcol)
+    for (f = 0; f < nfold; ++f)
+      for (i = runcol[f]; i < runcol[f + 1]; ++i) fold[i] = f;
   for (f = 0; f < nfold; ++f) {
     int c = 0;
     for (i = 0; i < ns; ++i) c += fold[i] == f;
@@ -7159,6 +7326,7 @@ typedef struct phgmg__rctx {
   double *lg;              /* grid (ng) and validation errors (ng)          */
   double *Tq;              /* ridge problem Kt, Rqt, Mt kept for a refit   */
   phgmg_jr_factor *jr;     /* factorization of J - R (GMG)                 */
+  int *runcol;             /* opts.runs: nrun + 1 column offsets (NULL: one run) */
 } phgmg__rctx;
 
 PHGMG__PRIV void phgmg__rctx_free(phgmg__rctx *c) {
@@ -7166,11 +7334,26 @@ PHGMG__PRIV void phgmg__rctx_free(phgmg__rctx *c) {
   phgmg__free(c->alloc, c->Xa);
   phgmg__free(c->alloc, c->lg);
   phgmg__free(c->alloc, c->Tq);
-  c->jr = NULL; c->Xa = c->lg = c->Tq = NULL;
+  phgmg__free(c->alloc, c->runcol);
+  c->jr = NULL; c->Xa = c->lg = c->Tq = NULL; c->runcol = NULL;
 }
 
 PHGMG__PRIV int phgmg__is_gmg(int method) {
   return method == PHGMG_METHOD_GMG_POD || method == PHGMG_METHOD_GMG_QM || method == PHGMG_METHOD_GMG_MANIFOLD;
+}
+
+/* The deployment options (runs, validation, manifold). */
+#define PHGMG__NVAL_MAX 67 /* training runs + 3 probes */
+PHGMG__PRIV phgmg_result phgmg__deploy_check(const phgmg_reduce_opts *o, int ns) {
+  if (o->nrun < 0 || (o->nrun > 0 && !o->runs) || o->nrun > PHGMG__NVAL_MAX - 3) return PHGMG_ERR_INVALID_ARG;
+  if (o->nrun > 0 && phgmg_runs_columns(o->nrun, o->runs) < 0) return PHGMG_ERR_INVALID_ARG;
+  if (o->nrun > 0 && phgmg_runs_columns(o->nrun, o->runs) != ns) return PHGMG_ERR_SIZE;
+  if (!(o->lambda_tolerance == 0.0 || (o->lambda_tolerance >= 1.0 && o->lambda_tolerance < HUGE_VAL)))
+    return PHGMG_ERR_INVALID_ARG;
+  if (!(o->newton_tol >= 0.0 && o->newton_tol < 1.0) || o->newton_iter < 0) return PHGMG_ERR_INVALID_ARG;
+  if (o->manifold != 0 && o->manifold != 1) return PHGMG_ERR_INVALID_ARG;
+  if (o->lambda_train_only != 0 && o->lambda_train_only != 1) return PHGMG_ERR_INVALID_ARG;
+  return PHGMG_OK;
 }
 
 /* Options and sizes; nothing allocated. */
@@ -7199,12 +7382,24 @@ PHGMG__PRIV phgmg_result phgmg__reduce_check(const phgmg_ph_system *sys, const d
     const double hi = o->lambda_max == 0.0 ? 1.0 : o->lambda_max;
     const int nf = o->lambda_folds == 0 ? 5 : o->lambda_folds;
     const int nb = o->lambda_blocks == 0 ? PHGMG__MIN(ns, 100) : o->lambda_blocks;
-    if (o->lambda_auto != 1 || o->lambda_per_decade < 0 || nf < 2 || nb < 0) return PHGMG_ERR_INVALID_ARG;
+    if ((o->lambda_auto != 1 && o->lambda_auto != 2) || o->lambda_per_decade < 0 || nf < 2 || nb < 0)
+      return PHGMG_ERR_INVALID_ARG;
     if (!(o->lambda_rcond >= 0.0 && o->lambda_rcond <= 1.0)) return PHGMG_ERR_INVALID_ARG;
     if (phgmg__lambda_grid(lo, hi, o->lambda_per_decade == 0 ? 4 : o->lambda_per_decade, NULL) < 1)
       return PHGMG_ERR_INVALID_ARG;
     if (nb < nf || nb > ns) return PHGMG_ERR_SIZE;
   }
+  return phgmg__deploy_check(o, ns);
+}
+
+/* Column offsets of opts.runs (checked by phgmg__deploy_check). */
+PHGMG__PRIV phgmg_result phgmg__runs_layout(phgmg__rctx *c) {
+  int k;
+  if (c->o->nrun < 1) return PHGMG_OK;
+  c->runcol = phgmg__ialloc(c->alloc, (size_t)c->o->nrun + 1);
+  if (!c->runcol) return PHGMG_ERR_NOMEM;
+  c->runcol[0] = 0;
+  for (k = 0; k < c->o->nrun; ++k) c->runcol[k + 1] = c->runcol[k] + c->o->runs[k].nsteps + 1;
   return PHGMG_OK;
 }
 
@@ -7339,7 +7534,8 @@ PHGMG__PRIV phgmg_result phgmg__qm_problem(phgmg__rctx *c) {
 PHGMG__PRIV phgmg_result phgmg__qm_lambda_auto(phgmg__rctx *c) {
   const phgmg_reduce_opts *o = c->o;
   const int ns = c->ns, p = c->red->p, rn = c->red->rn, nc = p * (p + 1) / 2, ng = c->ng;
-  const int nfold = o->lambda_folds == 0 ? 5 : o->lambda_folds;
+  const int byrun = o->nrun >= 2 && c->runcol;   /* leave one run out */
+  const int nfold = byrun ? o->nrun : (o->lambda_folds == 0 ? 5 : o->lambda_folds);
   const int nblk = o->lambda_blocks == 0 ? PHGMG__MIN(ns, 100) : o->lambda_blocks;
   double best, *lg;
   int g;
@@ -7348,7 +7544,8 @@ PHGMG__PRIV phgmg_result phgmg__qm_lambda_auto(phgmg__rctx *c) {
   if (!lg) return PHGMG_ERR_NOMEM;
   phgmg__lambda_grid(o->lambda_min == 0.0 ? 1e-14 : o->lambda_min, o->lambda_max == 0.0 ? 1.0 : o->lambda_max,
                      o->lambda_per_decade == 0 ? 4 : o->lambda_per_decade, lg);
-  rc = phgmg__ridge_cv(ns, nc, rn, c->Tq, ns, c->Tq + (size_t)ns * nc, ns, ng, lg, nfold, nblk, lg + ng, c->alloc);
+  rc = phgmg__ridge_cv_runs(ns, nc, rn, c->Tq, ns, c->Tq + (size_t)ns * nc, ns, ng, lg, nfold, nblk,
+                            byrun ? c->runcol : NULL, lg + ng, c->alloc);
   if (rc != PHGMG_OK) return rc;
   for (c->gsel = 0, g = 1; g < ng; ++g) if (lg[ng + g] < lg[ng + c->gsel]) c->gsel = g;
   best = lg[ng + c->gsel];
@@ -7357,6 +7554,76 @@ PHGMG__PRIV phgmg_result phgmg__qm_lambda_auto(phgmg__rctx *c) {
   c->inf.lambda_cv_err = lg[ng + c->gsel];
   c->inf.lambda_grid = ng;
   return PHGMG_OK;
+}
+
+/* opts.manifold = 1, greedy linear part (Schwerdtner & Peherstorfer 2024):
+   among the q = min(p + rn, available) leading POD modes U of the adjusted
+   snapshots, V1 takes one mode at a time -- the one whose reduced
+   coordinates z (with those already taken) best predict the remaining
+   modes' coordinates by the quadratic ridge fit M (z kron z) (ridge lambda
+   1e-9 under lambda_auto, whose lambda is not known yet; else opts.lambda). Works in the
+   q POD coordinates S = U^T Xa of every k-th snapshot (k = ceil(ns / 400)),
+   so a trial costs one small least-squares solve. Writes V1 into red->V0. */
+PHGMG__PRIV phgmg_result phgmg__qm_greedy(phgmg__rctx *c) {
+  phgmg_reduced *red = c->red;
+  const int N = red->N, m = red->m, p = red->p, rn = red->rn, ns = c->ns;
+  const int st = (ns + 399) / 400, nsub = (ns + st - 1) / st;
+  const int navail = c->o->pod_basis ? c->o->pod_cols : PHGMG__MIN(N, ns) - 1;
+  const int q = PHGMG__MIN(p + rn, navail);
+  const double lam = c->o->lambda_auto ? 1e-9 : (c->lambda > 0.0 ? c->lambda : 1e-12);
+  double *U, *S, *Kt, *Rt, *T, best_err;
+  int *sel, *used, j, k, a, b, i, cc, best, nc, nr, kk = 0;
+  phgmg_result rc = PHGMG_OK;
+  if (q <= p) return PHGMG_OK;   /* no choice: the leading modes */
+  U = phgmg__dalloc(c->alloc, (size_t)N * q + (size_t)q * ns + (size_t)q);
+  Kt = phgmg__dalloc(c->alloc, (size_t)nsub * (p * (p + 1) / 2) + (size_t)nsub * q + (size_t)(p * (p + 1) / 2) * q);
+  sel = phgmg__ialloc(c->alloc, 2 * (size_t)q);
+  if (!U || !Kt || !sel) { phgmg__free(c->alloc, U); phgmg__free(c->alloc, Kt); phgmg__free(c->alloc, sel); return PHGMG_ERR_NOMEM; }
+  S = U + (size_t)N * q; Rt = Kt + (size_t)nsub * (p * (p + 1) / 2); T = Rt + (size_t)nsub * q;
+  used = sel + q;
+  if (c->o->pod_basis) memcpy(U, c->o->pod_basis, (size_t)N * q * sizeof(double));
+  else {
+    rc = phgmg_pod(N, ns, c->Xa, N, q, 0.0, U, N, S, &kk, c->alloc);
+    if (rc == PHGMG_OK && kk < q) rc = PHGMG_ERR_SIZE;
+  }
+  if (rc == PHGMG_OK) phgmg_gemm('T', 'N', q, ns, N, 1.0, U, N, c->Xa, N, 0.0, S, q);
+  for (k = 0; k < q; ++k) used[k] = 0;
+  for (j = 0; j < p && rc == PHGMG_OK; ++j) {
+    best = -1; best_err = HUGE_VAL;
+    nc = (j + 1) * (j + 2) / 2; nr = q - j - 1;
+    for (k = 0; k < q && rc == PHGMG_OK; ++k) {
+      double err = 0.0;
+      if (used[k]) continue;
+      sel[j] = k;
+      for (i = 0; i < nsub; ++i) {
+        const double *s = S + (size_t)(i * st) * q;
+        for (a = 0, cc = 0; a <= j; ++a)
+          for (b = a; b <= j; ++b, ++cc) Kt[i + (size_t)cc * nsub] = (a == b ? 1.0 : sqrt(2.0)) * s[sel[a]] * s[sel[b]];
+        for (a = 0, cc = 0; a < q; ++a)
+          if (!used[a] && a != k) Rt[i + (size_t)(cc++) * nsub] = s[a];
+      }
+      if (nr > 0) {
+        rc = phgmg_lstsq(nsub, nc, nr, Kt, nsub, Rt, nsub, lam, T, nc, c->alloc);
+        if (rc != PHGMG_OK) break;
+        for (a = 0; a < nr; ++a)
+          for (i = 0; i < nsub; ++i) {
+            double d = Rt[i + (size_t)a * nsub];
+            for (cc = 0; cc < nc; ++cc) d -= Kt[i + (size_t)cc * nsub] * T[cc + (size_t)a * nc];
+            err += d * d;
+          }
+      }
+      if (err < best_err) { best_err = err; best = k; }
+    }
+    if (rc != PHGMG_OK) break;
+    sel[j] = best;
+    used[best] = 1;
+  }
+  if (rc == PHGMG_OK)
+    for (j = 0; j < p; ++j) memcpy(red->V0 + (size_t)N * (m + j), U + (size_t)N * sel[j], (size_t)N * sizeof(double));
+  phgmg__free(c->alloc, U);
+  phgmg__free(c->alloc, Kt);
+  phgmg__free(c->alloc, sel);
+  return rc;
 }
 
 /* Stage 2, manifold (QUADRATIC kind): V2 = POD of the residual of [B, V1]
@@ -7370,11 +7637,15 @@ PHGMG__PRIV phgmg_result phgmg__stage_manifold(phgmg__rctx *c) {
   if (red->kind != PHGMG_ROM_QUADRATIC) return PHGMG_OK;
   red->V2 = phgmg__red_d(red, (size_t)N * rn);
   if (!red->V2) return PHGMG_ERR_NOMEM;
+  if (c->o->manifold == 1 && red->method == PHGMG_METHOD_GMG_QM) {
+    rc = phgmg__qm_greedy(c);
+    if (rc != PHGMG_OK) return rc;
+  }
   {
     double *tmp = phgmg__dalloc(c->alloc, (size_t)p * ns + (size_t)rn);
     if (!tmp) return PHGMG_ERR_NOMEM;
     phgmg__orth_remove(N, p, red->V0 + (size_t)N * m, ns, c->Xa, N, tmp);
-    if (c->o->pod_basis) {
+    if (c->o->pod_basis && c->o->manifold == 0) {
       memcpy(red->V2, c->o->pod_basis + (size_t)N * p, (size_t)N * rn * sizeof(double));
     } else {
       rc = phgmg_pod(N, ns, c->Xa, N, rn, 0.0, red->V2, N, tmp, &k, c->alloc);
@@ -7446,6 +7717,317 @@ PHGMG__PRIV phgmg_result phgmg__check_degeneracy(phgmg__rctx *c) {
     if (rc != PHGMG_OK) return rc;
   }
   return c->inf.rcond_dgd >= c->degtol ? PHGMG_OK : PHGMG_ERR_DEGENERATE;
+}
+
+/* ---- deployment: runs, validation by simulation, training envelope -------- */
+PHGMG_DEF int phgmg_runs_columns(int nrun, const phgmg_run *runs) {
+  long tot = 0;
+  int k;
+  if (nrun < 1 || !runs) return -1;
+  for (k = 0; k < nrun; ++k) {
+    if (runs[k].nsteps < 0 || !(runs[k].dt > 0.0) || runs[k].dt == HUGE_VAL || runs[k].t0 != runs[k].t0) return -1;
+    tot += runs[k].nsteps + 1L;
+    if (tot > 2147483647L) return -1;
+  }
+  return (int)tot;
+}
+
+PHGMG_DEF phgmg_result phgmg_simulate_inputs(const phgmg_ph_system *sys, int nrun, const phgmg_run *runs,
+                                             const phgmg_gl3_opts *go, double *X, int ldx, double *Y, int *col,
+                                             const phgmg_allocator *alloc) {
+  double *z, *T = NULL;
+  int k, c0 = 0, nmax = 0, N;
+  phgmg_result rc = PHGMG_OK;
+  if (!sys || !runs || !X) return PHGMG_ERR_INVALID_ARG;
+  if (phgmg_runs_columns(nrun, runs) < 0) return PHGMG_ERR_INVALID_ARG;
+  N = sys->N;
+  if (N < 1 || ldx < N) return PHGMG_ERR_SIZE;
+  for (k = 0; k < nrun; ++k) nmax = PHGMG__MAX(nmax, runs[k].nsteps + 1);
+  z = phgmg__dalloc(alloc, (size_t)N);
+  if (z && ldx != N) T = phgmg__dalloc(alloc, (size_t)N * nmax);
+  if (!z || (ldx != N && !T)) { phgmg__free(alloc, z); return PHGMG_ERR_NOMEM; }
+  memset(z, 0, (size_t)N * sizeof(double));
+  for (k = 0; k < nrun && rc == PHGMG_OK; ++k) {
+    const phgmg_run *q = runs + k;
+    double *dst = T ? T : X + (size_t)c0 * ldx;
+    int j;
+    if (col) col[k] = c0;
+    rc = phgmg_simulate(sys, q->x0 ? q->x0 : z, q->t0, q->dt, q->nsteps, q->u, q->user, go, dst,
+                        Y ? Y + (size_t)c0 * sys->m : NULL, NULL, NULL, NULL, alloc);
+    if (T)
+      for (j = 0; j <= q->nsteps; ++j)
+        memcpy(X + (size_t)(c0 + j) * ldx, T + (size_t)j * N, (size_t)N * sizeof(double));
+    c0 += q->nsteps + 1;
+  }
+  if (col && rc == PHGMG_OK) col[nrun] = c0;
+  phgmg__free(alloc, T);
+  phgmg__free(alloc, z);
+  return rc;
+}
+
+/* phgmg_rom.q_max: 1.2 max_j ||M (x2_j kron x2_j)|| over the snapshots'
+   reduced coordinates x2_j (the final M: run after the lambda validation). */
+PHGMG__PRIV phgmg_result phgmg__q_envelope(phgmg__rctx *c) {
+  phgmg_reduced *red = c->red;
+  const int r = red->r, m = red->m, rn = red->rn;
+  double *xr, q[64], qmax = 0.0;
+  int j, i;
+  red->qmax = phgmg__red_d(red, 1);
+  xr = phgmg__dalloc(c->alloc, (size_t)r);
+  if (!red->qmax || !xr) { phgmg__free(c->alloc, xr); return PHGMG_ERR_NOMEM; }
+  for (j = 0; j < c->ns; ++j) {
+    double s2 = 0.0;
+    phgmg_reduced_restrict(red, c->X + (size_t)j * c->ldx, xr);
+    phgmg__eta_d(red, xr + m, q, NULL, NULL, red->rwork);
+    for (i = 0; i < rn; ++i) s2 += q[i] * q[i];
+    qmax = PHGMG__MAX(qmax, sqrt(s2));
+  }
+  red->qmax[0] = 1.2 * qmax;
+  phgmg__free(c->alloc, xr);
+  return phgmg__to_real(red, red->qmax, 1, &red->rom.q_max);
+}
+
+/* Training envelope of the reduced coordinates (phgmg_rom.env_lo/hi): the
+   range of rho(x_j) over the snapshots, widened on each side by 10 % of its
+   width plus 2 % of the largest width (a coordinate the training barely
+   moves must not fire on the reduced model's own error). */
+PHGMG__PRIV phgmg_result phgmg__stage_envelope(phgmg__rctx *c) {
+  phgmg_reduced *red = c->red;
+  const int r = red->r;
+  double *xr, big = 0.0;
+  int j, a;
+  phgmg_result rc;
+  red->env = phgmg__red_d(red, 2 * (size_t)r);
+  xr = phgmg__dalloc(c->alloc, (size_t)r);
+  if (!red->env || !xr) { phgmg__free(c->alloc, xr); return PHGMG_ERR_NOMEM; }
+  for (j = 0; j < c->ns; ++j) {
+    phgmg_reduced_restrict(red, c->X + (size_t)j * c->ldx, xr);
+    for (a = 0; a < r; ++a) {
+      if (j == 0 || xr[a] < red->env[a]) red->env[a] = xr[a];
+      if (j == 0 || xr[a] > red->env[r + a]) red->env[r + a] = xr[a];
+    }
+  }
+  for (a = 0; a < r; ++a) big = PHGMG__MAX(big, red->env[r + a] - red->env[a]);
+  for (a = 0; a < r; ++a) {
+    const double w = 0.1 * (red->env[r + a] - red->env[a]) + 0.02 * big;
+    red->env[a] -= w;
+    red->env[r + a] += w;
+  }
+  phgmg__free(c->alloc, xr);
+  rc = phgmg__to_real(red, red->env, (size_t)r, &red->rom.env_lo);
+  if (rc == PHGMG_OK) rc = phgmg__to_real(red, red->env + r, (size_t)r, &red->rom.env_hi);
+  if (rc == PHGMG_OK && red->kind == PHGMG_ROM_QUADRATIC && red->M && !red->eta) rc = phgmg__q_envelope(c);
+  return rc;
+}
+
+/* Probe inputs of the lambda validation: a constant at `level` (mode 0),
+   the run's input played 1.5x faster (mode 1), a square wave level *
+   sign(u(t)) (mode 2). */
+typedef struct phgmg__probe {
+  const phgmg_run *run;
+  const double *level;
+  int mode, m;
+} phgmg__probe;
+PHGMG__PRIV void phgmg__probe_u(double t, double *u, void *user) {
+  const phgmg__probe *p = PHGMG__CAST(const phgmg__probe *, user);
+  int a;
+  if (p->mode == 0) {
+    for (a = 0; a < p->m; ++a) u[a] = p->level[a];
+  } else if (p->mode == 2 && p->run->u) {   /* square wave: level * sign(u(t)) */
+    p->run->u(t, u, p->run->user);
+    for (a = 0; a < p->m; ++a) u[a] = u[a] > 0.0 ? p->level[a] : (u[a] < 0.0 ? -p->level[a] : 0.0);
+  } else if (p->mode == 1 && p->run->u) {
+    p->run->u(p->run->t0 + 1.5 * (t - p->run->t0), u, p->run->user);
+  } else {
+    for (a = 0; a < p->m; ++a) u[a] = 0.0;
+  }
+}
+
+/* The validation set: the training runs (reference outputs from the
+   snapshots) and the two probe runs (reference outputs from the full model). */
+typedef struct phgmg__vset {
+  int nv, nmax;
+  phgmg_input_fn u[PHGMG__NVAL_MAX];
+  void *user[PHGMG__NVAL_MAX];
+  const double *x0[PHGMG__NVAL_MAX];
+  double t0[PHGMG__NVAL_MAX], dt[PHGMG__NVAL_MAX];
+  int nsteps[PHGMG__NVAL_MAX];
+  double *Yref[PHGMG__NVAL_MAX];
+  double base[PHGMG__NVAL_MAX], ey[PHGMG__NVAL_MAX];
+  phgmg__probe probe[3];
+  double *buf;             /* every Yref, the level, zeros (x0), Yr, xr0 */
+  double *Yr, *xr0;
+} phgmg__vset;
+
+PHGMG__PRIV phgmg_result phgmg__vset_build(phgmg__rctx *c, phgmg__vset *v) {
+  const phgmg_ph_system *sys = c->sys;
+  const phgmg_run *run = c->o->runs;
+  const int N = sys->N, m = sys->m, nrun = c->o->nrun;
+  size_t tot = 0, off;
+  double *level, *zero, *g;
+  int k, j, a;
+  phgmg_gl3_opts go;
+  v->nv = nrun + 3;
+  v->nmax = 0;
+  for (k = 0; k < nrun; ++k) { tot += (size_t)m * (run[k].nsteps + 1); v->nmax = PHGMG__MAX(v->nmax, run[k].nsteps + 1); }
+  tot += 3 * (size_t)m * (run[0].nsteps + 1);
+  v->buf = phgmg__dalloc(c->alloc, tot + (size_t)m + 2 * (size_t)N + (size_t)m * v->nmax + (size_t)c->red->r);
+  if (!v->buf) return PHGMG_ERR_NOMEM;
+  level = v->buf + tot; zero = level + m; g = zero + N; v->Yr = g + N; v->xr0 = v->Yr + (size_t)m * v->nmax;
+  memset(zero, 0, (size_t)N * sizeof(double));
+  for (k = 0, off = 0; k < nrun; ++k) {   /* training runs: y = B^T grad H(x_j) */
+    v->u[k] = run[k].u; v->user[k] = run[k].user; v->x0[k] = c->X + (size_t)c->runcol[k] * c->ldx;
+    v->t0[k] = run[k].t0; v->dt[k] = run[k].dt; v->nsteps[k] = run[k].nsteps; v->Yref[k] = v->buf + off;
+    for (j = 0; j <= run[k].nsteps; ++j) {
+      phgmg_ph_gradient(sys, c->X + (size_t)(c->runcol[k] + j) * c->ldx, g);
+      phgmg_gemv('T', N, m, 1.0, sys->B, N, g, 0.0, v->Yref[k] + (size_t)j * m);
+    }
+    off += (size_t)m * (run[k].nsteps + 1);
+  }
+  for (a = 0; a < m; ++a) {   /* RMS of runs[0].u per port at the step times */
+    double s2 = 0.0;
+    for (j = 0; j <= run[0].nsteps; ++j) {
+      if (run[0].u) run[0].u(run[0].t0 + j * run[0].dt, g, run[0].user);
+      else g[a] = 0.0;
+      s2 += g[a] * g[a];
+    }
+    level[a] = sqrt(s2 / (run[0].nsteps + 1));
+  }
+  memset(&go, 0, sizeof go);
+  go.tol = c->o->newton_tol > 0.0 ? c->o->newton_tol : 1e-10;
+  go.max_iter = c->o->newton_iter > 0 ? c->o->newton_iter : 20;
+  if (c->o->lambda_train_only) { v->nv = nrun; return PHGMG_OK; }
+  for (k = nrun; k < nrun + 3; ++k) {
+    phgmg__probe *p = v->probe + (k - nrun);
+    phgmg_result rc;
+    p->run = run; p->level = level; p->mode = k - nrun; p->m = m;
+    v->u[k] = phgmg__probe_u; v->user[k] = p; v->x0[k] = run[0].x0 ? run[0].x0 : zero;
+    v->t0[k] = run[0].t0; v->dt[k] = run[0].dt; v->nsteps[k] = run[0].nsteps; v->Yref[k] = v->buf + off;
+    off += (size_t)m * (run[0].nsteps + 1);
+    rc = phgmg_simulate(sys, v->x0[k], v->t0[k], v->dt[k], v->nsteps[k], v->u[k], v->user[k], &go, NULL,
+                        v->Yref[k], NULL, NULL, NULL, c->alloc);
+    if (rc == PHGMG_ERR_NOMEM) return rc;
+    if (rc != PHGMG_OK) { v->nv = k; break; }   /* the full model itself fails: no probe */
+  }
+  return PHGMG_OK;
+}
+
+/* Simulate the current reduced model on every validation run: v->ey, and
+   *ok = 0 if a run fails or needs more than 4 Newton iterations per step. */
+PHGMG__PRIV phgmg_result phgmg__vset_eval(phgmg__rctx *c, phgmg__vset *v, int *ok) {
+  const int m = c->sys->m;
+  const double tol = c->o->newton_tol;   /* 0: the stepper's default (1e-10 double, 1e-5 float) */
+  const int it = c->o->newton_iter > 0 ? c->o->newton_iter : 20;
+  int k;
+  *ok = 1;
+  for (k = 0; k < v->nv; ++k) {
+    phgmg_rom_stats st;
+    phgmg_result rc;
+    memset(&st, 0, sizeof st);
+    phgmg_reduced_restrict(c->red, v->x0[k], v->xr0);
+    rc = phgmg_reduced_simulate(c->red, v->xr0, v->t0[k], v->dt[k], v->nsteps[k], v->u[k], v->user[k], tol, it,
+                                NULL, v->Yr, NULL, &st, c->alloc);
+    if (rc == PHGMG_ERR_NOMEM) return rc;
+    v->ey[k] = rc == PHGMG_OK ? phgmg_rel_error(m, v->nsteps[k] + 1, v->Yref[k], m, v->Yr, m) : HUGE_VAL;
+    if (rc != PHGMG_OK || st.newton_iters > 4 * st.steps || !(v->ey[k] < HUGE_VAL)) *ok = 0;
+  }
+  return PHGMG_OK;
+}
+
+/* M at grid point g (g < 0: M = 0, the linear limit), in double and in the
+   online model's own copy ms. */
+PHGMG__PRIV phgmg_result phgmg__qm_set(phgmg__rctx *c, int g, phgmg_real *ms) {
+  phgmg_reduced *red = c->red;
+  const int p = red->p, rn = red->rn, nc = p * (p + 1) / 2;
+  const size_t n = (size_t)rn * p * p;
+  size_t i;
+  if (g < 0) {
+    memset(red->M, 0, n * sizeof(double));
+    memset(red->Ms, 0, n * sizeof(double));
+  } else {
+    phgmg_result rc = phgmg__qm_fit(red, c->ns, c->Tq, c->Tq + (size_t)c->ns * nc, c->lg[g],
+                                    c->Tq + (size_t)c->ns * (nc + rn), c->alloc);
+    if (rc != PHGMG_OK) return rc;
+  }
+  for (i = 0; i < n; ++i) ms[i] = (phgmg_real)red->Ms[i];
+  return PHGMG_OK;
+}
+
+/* opts.lambda_auto = 1 (after publish): validation by simulation, see the
+   comment at phgmg_reduce_opts.runs. Candidates from lambda_max down, one
+   per decade, to the regression optimum; stops after two inadmissible
+   candidates in a row (the error grows as lambda falls). */
+PHGMG__PRIV phgmg_result phgmg__stage_lambda_validate(phgmg__rctx *c) {
+  phgmg_reduced *red = c->red;
+  const phgmg_reduce_opts *o = c->o;
+  const int pd = o->lambda_per_decade == 0 ? 4 : o->lambda_per_decade;
+  const double tolr = o->lambda_tolerance > 0.0 ? o->lambda_tolerance : 1.02;
+  const size_t n = (size_t)red->rn * red->p * red->p;
+  phgmg__vset *v;
+  phgmg_real *ms;
+  double best_score = 0.0, best_ratio = 1.0, cand_score[64], cand_worst[64];
+  int best = -1, g, bad = 0, ok, k, ncand = 0, cand_g[64], cand_ok[64];
+  phgmg_result rc;
+  if (red->method != PHGMG_METHOD_GMG_QM || o->lambda_auto != 1 || c->gsel < 0) return PHGMG_OK;
+  ms = PHGMG__CAST(phgmg_real *, phgmg__red_alloc(red, (n ? n : 1) * sizeof(phgmg_real)));
+  if (!ms) return PHGMG_ERR_NOMEM;
+  red->rom.Ms = ms;
+  if (o->nrun < 1) {   /* nothing to simulate: the linear limit */
+    c->inf.lambda = c->lambda = HUGE_VAL;
+    return phgmg__qm_set(c, -1, ms);
+  }
+  v = PHGMG__CAST(phgmg__vset *, phgmg__alloc(c->alloc, sizeof(phgmg__vset)));
+  if (!v) return PHGMG_ERR_NOMEM;
+  memset(v, 0, sizeof *v);
+  rc = phgmg__vset_build(c, v);
+  if (rc == PHGMG_OK) rc = phgmg__qm_set(c, -1, ms);
+  if (rc == PHGMG_OK) rc = phgmg__vset_eval(c, v, &ok);
+  for (k = 0; k < v->nv && rc == PHGMG_OK; ++k) v->base[k] = v->ey[k] < HUGE_VAL ? v->ey[k] : 1.0;
+  /* training runs alone: up from the regression optimum, the first admissible */
+  for (g = c->gsel; rc == PHGMG_OK && o->lambda_train_only && g < c->ng; g += pd) {
+    double worst = 0.0;
+    rc = phgmg__qm_set(c, g, ms);
+    if (rc == PHGMG_OK) rc = phgmg__vset_eval(c, v, &ok);
+    if (rc != PHGMG_OK) break;
+    c->inf.lambda_candidates++;
+    for (k = 0; k < v->nv && ok; ++k) worst = PHGMG__MAX(worst, (v->ey[k] + 1e-14) / (v->base[k] + 1e-14));
+    if (ok && worst <= tolr) { best = g; best_ratio = worst; break; }
+  }
+  for (g = c->ng - 1; rc == PHGMG_OK && !o->lambda_train_only && g >= c->gsel;
+       g = (g - pd >= c->gsel || g == c->gsel) ? g - pd : c->gsel) {
+    double score = 0.0, worst = 0.0;
+    rc = phgmg__qm_set(c, g, ms);
+    if (rc == PHGMG_OK) rc = phgmg__vset_eval(c, v, &ok);
+    if (rc != PHGMG_OK) break;
+    c->inf.lambda_candidates++;
+    for (k = 0; k < v->nv && ok; ++k) {
+      const double ratio = (v->ey[k] + 1e-14) / (v->base[k] + 1e-14);
+      score += log(ratio);
+      worst = PHGMG__MAX(worst, ratio);
+    }
+    ok = ok && worst <= tolr;
+    if (ok && score < best_score) { best = g; best_score = score; best_ratio = worst; }
+    if (ncand < 64) { cand_g[ncand] = g; cand_ok[ncand] = ok; cand_score[ncand] = score; cand_worst[ncand++] = worst; }
+    bad = ok ? 0 : bad + 1;
+    if (bad >= 2 || g == c->gsel) break;
+  }
+  /* the largest admissible lambda with at least half the best gain (a
+     safety margin towards the linear limit) */
+  for (k = 0; k < ncand && best >= 0 && !o->lambda_train_only; ++k)
+    if (cand_ok[k] && cand_score[k] <= 0.5 * best_score) {
+      best = cand_g[k]; best_ratio = cand_worst[k];
+      break;
+    }
+  if (rc == PHGMG_OK) rc = phgmg__qm_set(c, best, ms);
+  if (rc == PHGMG_OK) {
+    c->gsel = best;
+    c->inf.lambda = c->lambda = best < 0 ? HUGE_VAL : c->lg[best];
+    c->inf.lambda_cv_err = best < 0 ? 1.0 : c->lg[c->ng + best];
+    c->inf.lambda_val_ratio = best_ratio;
+  }
+  phgmg__free(c->alloc, v->buf);
+  phgmg__free(c->alloc, v);
+  return rc;
 }
 
 /* Stage 3a, GMG blocks (paper 4.2): G = (J - R)^{-1} through a factorization,
@@ -7790,7 +8372,8 @@ PHGMG_DEF phgmg_result phgmg_reduce(phgmg_reduced **out, const phgmg_ph_system *
                               opts->lambda_per_decade == 0 ? 4 : opts->lambda_per_decade, NULL);
   c.degtol = opts->degeneracy_tol > 0.0 ? opts->degeneracy_tol : 1e-12;
   c.rfloor = phgmg__rank_floor(sys->N, ns, X, ldx);
-  rc = phgmg__reduce_new(&c);
+  rc = phgmg__runs_layout(&c);
+  if (rc == PHGMG_OK) rc = phgmg__reduce_new(&c);
   if (rc == PHGMG_OK) rc = phgmg__stage_basis(&c);
   if (rc == PHGMG_OK) rc = phgmg__stage_manifold(&c);
   if (rc == PHGMG_OK) rc = phgmg__is_gmg(opts->method) ? phgmg__stage_gmg_blocks(&c) : phgmg__stage_sp_blocks(&c);
@@ -7803,6 +8386,8 @@ PHGMG_DEF phgmg_result phgmg_reduce(phgmg_reduced **out, const phgmg_ph_system *
     rc = phgmg__step_map(c.red, opts->dt, alloc);
   }
   if (rc == PHGMG_OK) rc = phgmg__publish(c.red);
+  if (rc == PHGMG_OK) rc = phgmg__stage_lambda_validate(&c);
+  if (rc == PHGMG_OK) rc = phgmg__stage_envelope(&c);
   if (rc == PHGMG_OK)
     c.inf.online_callbacks = c.red->rom.phi_cb || c.red->rom.eta_cb || c.red->rom.ham_cb;
   phgmg__rctx_free(&c);
@@ -7937,6 +8522,65 @@ PHGMG_DEF phgmg_result phgmg_reduced_simulate(const phgmg_reduced *red, const do
   if (stats) *stats = st.stats;
   phgmg__free(alloc, mem);
   return rc;
+}
+
+PHGMG_DEF phgmg_result phgmg_reduced_validate(const phgmg_reduced *red, const phgmg_ph_system *sys,
+                                              const phgmg_run *run, double tol, int max_iter, double ey_max,
+                                              phgmg_validation *v, const phgmg_allocator *alloc) {
+  int N, m, r, ns, k, done, j;
+  size_t nb;
+  double *buf, *X, *Y, *XR, *YR, *xr0, *H, *S, *D, *Hf, *Sf, *Df;
+  phgmg_energy ef, er;
+  phgmg_gl3_opts go;
+  phgmg_result rc;
+  if (!v) return PHGMG_ERR_INVALID_ARG;
+  memset(v, 0, sizeof *v);
+  v->first_failure = -1;
+  if (!red || !sys || !run) return PHGMG_ERR_INVALID_ARG;
+  if (phgmg_runs_columns(1, run) < 0 || !(tol < 1.0) || ey_max != ey_max) return PHGMG_ERR_INVALID_ARG;
+  N = red->N; m = red->m; r = red->r; ns = run->nsteps + 1;
+  if (sys->N != N || sys->m != m) return PHGMG_ERR_SIZE;
+  nb = (size_t)N * ns + (size_t)m * ns * 2 + (size_t)r * ns + (size_t)r + 6 * (size_t)ns + (size_t)N;
+  buf = phgmg__dalloc(alloc, nb);
+  if (!buf) return PHGMG_ERR_NOMEM;
+  X = buf; Y = X + (size_t)N * ns; YR = Y + (size_t)m * ns; XR = YR + (size_t)m * ns; xr0 = XR + (size_t)r * ns;
+  H = xr0 + r; S = H + ns; D = S + ns; Hf = D + ns; Sf = Hf + ns; Df = Sf + ns;
+  memset(Df + ns, 0, (size_t)N * sizeof(double));    /* x0 = 0 when run->x0 is NULL */
+  ef.H = Hf; ef.S = Sf; ef.D = Df; er.H = H; er.S = S; er.D = D;
+  memset(&go, 0, sizeof go);
+  go.tol = tol > 0.0 ? tol : 1e-10;
+  go.max_iter = max_iter > 0 ? max_iter : 20;
+  rc = phgmg_simulate(sys, run->x0 ? run->x0 : Df + ns, run->t0, run->dt, run->nsteps, run->u, run->user, &go, X, Y,
+                      &ef, NULL, NULL, alloc);
+  if (rc != PHGMG_OK) { phgmg__free(alloc, buf); return rc; }
+  for (k = 0; k < r * ns; ++k) XR[k] = (double)NAN;
+  phgmg_reduced_restrict(red, X, xr0);
+  v->rom_rc = phgmg_reduced_simulate(red, xr0, run->t0, run->dt, run->nsteps, run->u, run->user,
+                                     tol > 0.0 ? tol : 0.0, go.max_iter, XR, YR, &er, &v->stats, alloc);
+  if (v->rom_rc == PHGMG_ERR_NOMEM) { phgmg__free(alloc, buf); return PHGMG_ERR_NOMEM; }
+  for (done = 0; done + 1 < ns && XR[(size_t)(done + 1) * r] == XR[(size_t)(done + 1) * r]; ++done) {}
+  v->nsteps = run->nsteps;
+  v->steps_done = v->rom_rc == PHGMG_OK ? run->nsteps : done;
+  if (v->rom_rc != PHGMG_OK) v->first_failure = v->steps_done;
+  v->e_red = phgmg_err_red(red, X, N, v->steps_done + 1, XR, r);
+  v->e_y = phgmg_rel_error(m, v->steps_done + 1, Y, m, YR, m);
+  v->e_proj = phgmg_err_proj(red, X, N, ns);
+  if (v->e_red != v->e_red || v->e_proj != v->e_proj) { /* the error maps could not allocate (data are finite) */
+    phgmg__free(alloc, buf);
+    return PHGMG_ERR_NOMEM;
+  }
+  for (j = 0; j < ns; ++j) {
+    const double efj = fabs(Hf[j] - Hf[0] - Sf[j] + Df[j]);
+    if (efj > v->e_energy_fom) v->e_energy_fom = efj;
+    if (j <= v->steps_done) {
+      const double erj = fabs(H[j] - H[0] - S[j] + D[j]);
+      if (!(erj <= v->e_energy)) v->e_energy = erj;
+    }
+    for (k = 0; k < m; ++k) v->y_scale = PHGMG__MAX(v->y_scale, fabs(Y[k + (size_t)j * m]));
+  }
+  v->pass = v->rom_rc == PHGMG_OK && v->stats.failures == 0 && (ey_max <= 0.0 || v->e_y <= ey_max);
+  phgmg__free(alloc, buf);
+  return PHGMG_OK;
 }
 
 /* --- error measures ------------------------------------------------------ */
@@ -8731,7 +9375,7 @@ PHGMG_DEF phgmg_result phgmg_ss_error(int n1, const double *A1, const double *B1
 #include <stdint.h>
 
 /* The arrays of a phgmg_rom in file order, with their sizes. */
-#define PHGMG__NFIELDS 19
+#define PHGMG__NFIELDS 22
 typedef struct phgmg__field { size_t off; const char *name; } phgmg__field;
 static const phgmg__field phgmg__fields[PHGMG__NFIELDS] = {
   {offsetof(phgmg_rom, Bh), "Bh"},   {offsetof(phgmg_rom, Qh), "Qh"},   {offsetof(phgmg_rom, K), "K"},
@@ -8740,7 +9384,9 @@ static const phgmg__field phgmg__fields[PHGMG__NFIELDS] = {
   {offsetof(phgmg_rom, Ms), "Ms"},   {offsetof(phgmg_rom, P0), "P0"},   {offsetof(phgmg_rom, P1), "P1"},
   {offsetof(phgmg_rom, w), "w"},     {offsetof(phgmg_rom, poly), "poly"}, {offsetof(phgmg_rom, Phi), "Phi"},
   {offsetof(phgmg_rom, Gam), "Gam"}, {offsetof(phgmg_rom, SX), "SX"},   {offsetof(phgmg_rom, SU), "SU"},
-  {offsetof(phgmg_rom, expo), "expo"}};
+  {offsetof(phgmg_rom, expo), "expo"},
+  {offsetof(phgmg_rom, env_lo), "env_lo"}, {offsetof(phgmg_rom, env_hi), "env_hi"},
+  {offsetof(phgmg_rom, q_max), "q_max"}};
 
 PHGMG__ONLINE const phgmg_real **phgmg__field_ptr(phgmg_rom *rom, int i) {
   return PHGMG__CAST(const phgmg_real **, PHGMG__CAST(void *, PHGMG__CAST(char *, PHGMG__CAST(void *, rom)) + phgmg__fields[i].off));
@@ -8771,13 +9417,16 @@ PHGMG__ONLINE size_t phgmg__field_len(const phgmg_rom *rom, int i) {
     case 15: return r * 3 * m;
     case 16: return 3 * r * r;
     case 17: return 3 * r * 3 * m;
-    default: return nd ? nf * 2 * (size_t)rom->nexp : 0;
+    case 18: return nd ? nf * 2 * (size_t)rom->nexp : 0;
+    case 19: case 20: return r;   /* env_lo, env_hi */
+    default: return 1;            /* q_max */
   }
 }
 
 #define PHGMG__HDR_BYTES (8 + 4 * 10 + 8)
 /* Version 2 (written only when a model needs it): nexp, nphi, nterm after the
-   version-1 header; the expo field (mask bit 18); nterm (0 or nd) uint32 term
+   version-1 header; the expo field (mask bit 18; the training envelope and
+   q_max, bits 19-21, may sit in either version); nterm (0 or nd) uint32 term
    indices after the scalars. */
 #define PHGMG__HDR2_BYTES (PHGMG__HDR_BYTES + 12)
 PHGMG__ONLINE int phgmg__rom_v2(const phgmg_rom *rom) {
@@ -8928,7 +9577,8 @@ PHGMG__ONLINE phgmg_result phgmg__rom_header(const unsigned char *b, size_t len,
 #endif
     rom->dt = (phgmg_real)dt;
   }
-  if (mask >> (ver == 1u ? 18 : PHGMG__NFIELDS)) return PHGMG_ERR_FORMAT;
+  /* version 1: every field but expo (bit 18, which needs the version-2 header) */
+  if ((mask >> PHGMG__NFIELDS) || (ver == 1u && (mask & (1u << 18)))) return PHGMG_ERR_FORMAT;
   if (rom->m > rom->r) return PHGMG_ERR_FORMAT;
   if ((rom->nphi > 1 && rom->nphi != rom->nd) || (nterm != 0 && nterm != (size_t)rom->nd))
     return PHGMG_ERR_FORMAT;
@@ -9113,7 +9763,7 @@ PHGMG_DEF phgmg_result phgmg_rom_export_c(const phgmg_rom *rom, const char *name
     if (phgmg__field_get(rom, i) && phgmg__field_len(rom, i) > 0) ok &= fprintf(f, " %s_%s,", name, phgmg__fields[i].name) > 0;
     else ok &= fprintf(f, " NULL,") > 0;
   }
-  /* nexp, nphi, expo, phi_cb, term, phi_user, eta_cb, eta_user (ham_cb, ham_user: 0) */
+  /* nexp, nphi, expo, phi_cb, term, phi_user, eta_cb, eta_user, (ham_cb, ham_user: 0), envelope */
   ok &= fprintf(f, "\n  %d, %d,", rom->nexp, rom->nphi) > 0;
   if (rom->expo && phgmg__field_len(rom, 18) > 0) ok &= fprintf(f, " %s_expo,", name) > 0;
   else ok &= fprintf(f, " NULL,") > 0;
@@ -9123,7 +9773,12 @@ PHGMG_DEF phgmg_result phgmg_rom_export_c(const phgmg_rom *rom, const char *name
   else ok &= fprintf(f, " NULL, NULL,") > 0;
   if (rom->eta_cb) ok &= fprintf(f, " %s_eta, NULL,", name) > 0;
   else ok &= fprintf(f, " 0, NULL,") > 0;
-  ok &= fprintf(f, " 0, NULL\n};\n") > 0;
+  ok &= fprintf(f, " 0, NULL") > 0;
+  for (i = 19; i < 22; ++i) { /* env_lo, env_hi, q_max */
+    if (phgmg__field_get(rom, i)) ok &= fprintf(f, ", %s_%s", name, phgmg__fields[i].name) > 0;
+    else ok &= fprintf(f, ", NULL") > 0;
+  }
+  ok &= fprintf(f, "\n};\n") > 0;
   if (fclose(f) != 0) ok = 0;
   return ok ? PHGMG_OK : PHGMG_ERR_IO;
 }

@@ -177,11 +177,13 @@ DEMO_FN int demo_parse_lambda(const char *arg, double *lambda) {
 /* The automatic-lambda study of one example and input: rows
    "r, GMG-POD e_red, GMG-QM-auto e_red, lambda chosen, e_lowerbound, Newton
    failures" (nr x 6, row-major) into <out>/<example>_<input>_lambda_auto.csv. */
+#define DEMO_LA_COLS 10
 DEMO_FN void demo_write_lambda_auto(const char *out, const char *example, const char *input, int nr,
                                     const double *rows) {
   char path[512];
   snprintf(path, sizeof path, "%s/%s_%s_lambda_auto.csv", out, example, input);
-  demo_write_csv(path, "r,GMG-POD,GMG-QM-auto,lambda,lowerbound,newton_failures", nr, 6, rows, 1);
+  demo_write_csv(path, "r,GMG-POD,GMG-QM-auto,lambda,lowerbound,newton_failures,GMG-QM-best,lambda_best,"
+                 "newton_failures_best,best_is_greedy", nr, DEMO_LA_COLS, rows, 1);
 }
 
 /* Newton failures of one reduced simulation: the stepper's count, at least 1
@@ -201,6 +203,30 @@ DEMO_FN void demo_lambda_auto_row(const phgmg_ph_system *sys, const double *X, c
                                   const phgmg_reduce_opts *base, double newton_tol, int newton_it, double *row) {
   phgmg_reduce_opts o = *base;
   demo_rom_result res;
+  phgmg_run run;
+  memset(&run, 0, sizeof run);
+  run.u = uf; run.dt = dt; run.nsteps = nsteps;
+  /* the better manifold's best case on the training input: lambda validated
+     on the training run alone, for the hierarchical POD and the greedy linear
+     part; kept: the one with the smaller training state error e_red (model
+     selection on the training run -- what this column reports; no claim on
+     other inputs) */
+  {
+    demo_rom_result rm[2];
+    int g, pick;
+    for (g = 0; g < 2; ++g) {
+      o = *base;
+      o.method = PHGMG_METHOD_GMG_QM; o.lambda_auto = 1; o.lambda_train_only = 1; o.manifold = g;
+      o.nrun = 1; o.runs = &run; o.newton_tol = newton_tol; o.newton_iter = newton_it;
+      demo_cache_use(cache, &o);
+      rm[g] = demo_run_rom(sys, X, Y, nsteps, dt, uf, &o, newton_tol, newton_it, NULL);
+    }
+    pick = rm[1].rc == PHGMG_OK && (rm[0].rc != PHGMG_OK || rm[1].e_red < rm[0].e_red);
+    res = rm[pick];
+    row[9] = pick;
+  }
+  row[6] = res.e_red; row[7] = res.info.lambda < HUGE_VAL ? res.info.lambda : NAN; row[8] = demo_newton_failures(&res);
+  o = *base;
   o.method = PHGMG_METHOD_GMG_POD; o.lambda_auto = 0;
   demo_cache_use(cache, &o);
   res = demo_run_rom(sys, X, Y, nsteps, dt, uf, &o, newton_tol, newton_it, NULL);
@@ -208,18 +234,26 @@ DEMO_FN void demo_lambda_auto_row(const phgmg_ph_system *sys, const double *X, c
   row[0] = o.r; row[1] = res.e_red;
   o = *base;
   o.method = PHGMG_METHOD_GMG_QM; o.lambda_auto = 1;
+  o.nrun = 1; o.runs = &run; o.newton_tol = newton_tol; o.newton_iter = newton_it;
   demo_cache_use(cache, &o);
   res = demo_run_rom(sys, X, Y, nsteps, dt, uf, &o, newton_tol, newton_it, NULL);
   if (res.rc != PHGMG_OK) fprintf(stderr, "  [GMG-QM r=%d: %s]\n", o.r, phgmg_result_string(res.rc));
-  row[2] = res.e_red; row[3] = res.info.lambda > 0.0 ? res.info.lambda : NAN; row[4] = res.e_lower;
+  row[2] = res.e_red; row[3] = res.info.lambda > 0.0 && res.info.lambda < HUGE_VAL ? res.info.lambda : NAN;
+  row[4] = res.e_lower;
   row[5] = demo_newton_failures(&res);
-  printf("  %3d  %9.3e  %9.3e  %6.2f  %8.2e%-3s %8.2e  %9.3e  %6.2f  %.0f\n", o.r, row[1], row[2], row[1] / row[2],
-         row[3], res.info.lambda_raised ? " +" : "", res.info.lambda_cv_err, row[4], row[2] / row[4], row[5]);
+  printf("  %3d  %9.3e  %9.3e  %6.2f  %8.2e%-3s %9.3e  %6.2f  %.0f   %9.3e%s %6.2f  %8.2e  %.0f\n", o.r, row[1], row[2],
+         row[1] / row[2], row[3], res.info.lambda_raised ? " +" : "", row[4], row[2] / row[4], row[5], row[6],
+         row[9] > 0 ? "g" : " ", row[1] / row[6], row[7], row[8]);
 }
 
 DEMO_FN void demo_lambda_auto_header(const char *input) {
-  printf("\nu = %s  (lambda: + = raised by the conditioning guard)\n  %3s  %-10s %-10s %-7s %-11s %-9s %-10s %-7s %s\n",
-         input, "r", "GMG-POD", "QM-auto", "ratio", "lambda", "val.err", "lowerbnd", "QM/lb", "Newton failures");
+  printf("\nu = %s  (e_red; QM-auto: lambda_auto = 1, validated by simulation on the training run and probe runs;\n"
+         "QM-best: lambda validated on the training run alone, hierarchical POD or greedy linear part\n"
+         "(opts.manifold = 1, marked g), whichever has the smaller training e_red;\n"
+         "lambda nan = the linear limit M = 0; "
+         "+ = raised by the conditioning guard)\n  %3s  %-10s %-10s %-7s %-11s %-10s %-7s %-4s %-10s %-7s %-9s %s\n",
+         input, "r", "GMG-POD", "QM-auto", "ratio", "lambda", "lowerbnd", "QM/lb", "fail", "QM-best", "ratio",
+         "lambda", "fail");
 }
 
 /* --lambda auto, one example: for u = 0.1 sin t and u = 0.1, the full-order
@@ -236,7 +270,7 @@ DEMO_FN void demo_lambda_auto_study(const phgmg_ph_system *sys, const char *out,
   for (in = 0; in < 2; ++in) {
     double *X = (double *)malloc(sizeof(double) * N * ns), *Y = (double *)malloc(sizeof(double) * ns);
     double *x0 = (double *)calloc((size_t)N, sizeof(double));
-    double *rows = (double *)malloc(sizeof(double) * nr * 6);
+    double *rows = (double *)malloc(sizeof(double) * nr * DEMO_LA_COLS);
     phgmg_gl3_opts go;
     phgmg_result rc;
     demo_cache cache;
@@ -250,7 +284,7 @@ DEMO_FN void demo_lambda_auto_study(const phgmg_ph_system *sys, const char *out,
     for (k = 0; k < nr; ++k) {
       phgmg_reduce_opts o = *base;
       o.r = rmin + k * rstep;
-      demo_lambda_auto_row(sys, X, Y, nsteps, dt, inf[in], &cache, &o, newton_tol, newton_it, rows + k * 6);
+      demo_lambda_auto_row(sys, X, Y, nsteps, dt, inf[in], &cache, &o, newton_tol, newton_it, rows + k * DEMO_LA_COLS);
     }
     demo_write_lambda_auto(out, example, inname[in], nr, rows);
     demo_cache_free(&cache);
@@ -294,5 +328,123 @@ DEMO_FN void demo_tables_and_panels(const char *out, const char *example, const 
     svgplot_series(fig, in, pn[j], nr, rx, col, 4 + j);
   }
   free(col);
+}
+/* ---- generalization study (issue 15): train on one run (u = 0.1 sin t) or
+   two (plus a multisine), test on five inputs ---------------------------- */
+DEMO_FN void demo_u_sin2(double t, double *u, void *p) { (void)p; u[0] = 0.1 * sin(2.0 * t); }
+DEMO_FN void demo_u_chirp(double t, double *u, void *p) { (void)p; u[0] = 0.1 * sin(0.2 * t + 0.01 * t * t); }
+/* random piecewise constant: a new level in [-0.1, 0.1] every 5 time units (hash of the interval index) */
+DEMO_FN void demo_u_pwc(double t, double *u, void *p) {
+  unsigned k = (unsigned)(t / 5.0), h = k * 2654435761u;
+  (void)p;
+  h ^= h >> 13; h *= 0x5bd1e995u; h ^= h >> 15;
+  u[0] = 0.1 * (2.0 * (double)(h % 10000u) / 9999.0 - 1.0);
+}
+/* the second training input: a multisine 0.05 (sin 0.5t + sin 1.5t + sin 3t) (not a test input) */
+DEMO_FN void demo_u_multisine(double t, double *u, void *p) {
+  (void)p;
+  u[0] = 0.05 * (sin(0.5 * t) + sin(1.5 * t) + sin(3.0 * t));
+}
+#define DEMO_NIN 5
+static const char *const demo_in_name[DEMO_NIN] = {"0.1 sin t", "0.1", "0.1 sin 2t", "chirp", "random pwc"};
+#define DEMO_GEN_COLS 11
+/* rows: r, training runs (1|2), method (1 GMG-POD, 2 GMG-QM lambda_auto = 1),
+   e_y on the five inputs, Newton failures over the five, lambda (nan: M = 0 or POD). */
+DEMO_FN void demo_generalization_study(const phgmg_ph_system *sys, const char *out, const char *example,
+                                       const int *rlist, int nr, const phgmg_reduce_opts *base, double tol, int it,
+                                       int nsteps, double dt, svgplot_fig *fig, int panel0) {
+  static phgmg_input_fn inf[DEMO_NIN] = {msd_input_sin, msd_input_const, demo_u_sin2, demo_u_chirp, demo_u_pwc};
+  static phgmg_input_fn train2 = demo_u_multisine;
+  const int N = sys->N, m = sys->m, ns = nsteps + 1;
+  double *X = (double *)malloc(sizeof(double) * (size_t)N * ns * (DEMO_NIN + 1));
+  double *Y = (double *)malloc(sizeof(double) * (size_t)m * ns * DEMO_NIN);
+  double *YR = (double *)malloc(sizeof(double) * (size_t)m * ns), *xr0 = (double *)calloc(64, sizeof(double));
+  double *rows = (double *)calloc((size_t)(nr > 0 ? nr : 1) * 4 * DEMO_GEN_COLS, sizeof(double));
+  double rx[64], col[4][64], t_study = demo_now();
+  phgmg_run runs[2];
+  phgmg_gl3_opts go;
+  char path[512], title[160];
+  int i, k, tr, me, nrow = 0;
+  if (!X || !Y || !YR || !xr0 || !rows || nr > 64) { fprintf(stderr, "out of memory\n"); exit(1); }
+  memset(&go, 0, sizeof go); go.tol = tol; go.max_iter = it;
+  memset(runs, 0, sizeof runs);
+  for (i = 0; i < 2; ++i) { runs[i].u = i ? train2 : inf[0]; runs[i].dt = dt; runs[i].nsteps = nsteps; }
+  /* training snapshots: columns 0..2ns-1 of Xt (run 1, then run 2); test runs: X */
+  if (phgmg_simulate_inputs(sys, 2, runs, &go, X, N, NULL, NULL, NULL) != PHGMG_OK)
+    demo_die("full-order simulation (training runs)", PHGMG_ERR_NOT_CONVERGED);
+  for (i = 1; i < DEMO_NIN; ++i) {
+    phgmg_run run;
+    phgmg_result rc;
+    memset(&run, 0, sizeof run);
+    run.u = inf[i]; run.dt = dt; run.nsteps = nsteps;
+    rc = phgmg_simulate_inputs(sys, 1, &run, &go, X + (size_t)(i + 1) * N * ns, N, Y + (size_t)i * m * ns, NULL, NULL);
+    if (rc != PHGMG_OK) demo_die("full-order simulation (generalization study)", rc);
+  }
+  for (i = 0; i < ns; ++i) phgmg_ph_output(sys, X + (size_t)i * N, Y + (size_t)i * m);   /* input 0 = run 1 */
+  printf("\nGeneralization (%s): e_y on each input; trained on u = 0.1 sin t alone (1 run) or on\n"
+         "0.1 sin t and 0.05 (sin 0.5t + sin 1.5t + sin 3t) (2 runs); GMG-QM with lambda_auto = 1\n"
+         "  %3s %-4s %-8s %10s %10s %10s %10s %10s %5s %9s\n", example, "r", "runs", "method", demo_in_name[0],
+         demo_in_name[1], demo_in_name[2], demo_in_name[3], demo_in_name[4], "fail", "lambda");
+  for (k = 0; k < nr; ++k)
+    for (tr = 1; tr <= 2; ++tr)
+      for (me = 1; me <= 2; ++me) {
+        phgmg_reduce_opts o = *base;
+        phgmg_reduce_info info;
+        phgmg_reduced *red = NULL;
+        phgmg_result rc;
+        double *row = rows + (size_t)nrow++ * DEMO_GEN_COLS, fails = 0;
+        o.r = rlist[k];
+        o.method = me == 1 ? PHGMG_METHOD_GMG_POD : PHGMG_METHOD_GMG_QM;
+        o.lambda_auto = me == 2; o.nrun = tr; o.runs = runs; o.newton_tol = tol; o.newton_iter = it;
+        row[0] = o.r; row[1] = tr; row[2] = me; row[10] = NAN;
+        rc = phgmg_reduce(&red, sys, X, N, tr * ns, &o, &info, NULL);
+        if (rc != PHGMG_OK) { fprintf(stderr, "  [%s r=%d: %s]\n", example, o.r, phgmg_result_string(rc)); for (i = 3; i < 10; ++i) row[i] = NAN; continue; }
+        if (me == 2 && info.lambda < HUGE_VAL) row[10] = info.lambda;
+        for (i = 0; i < DEMO_NIN; ++i) {
+          phgmg_rom_stats st;
+          rc = phgmg_reduced_simulate(red, xr0, 0.0, dt, nsteps, inf[i], NULL, tol, it, NULL, YR, NULL, &st, NULL);
+          fails += (double)st.failures + (rc == PHGMG_ERR_NOT_CONVERGED && st.failures == 0);
+          row[3 + i] = rc == PHGMG_OK ? phgmg_rel_error(m, ns, Y + (size_t)i * m * ns, m, YR, m) : NAN;
+        }
+        row[8] = fails; row[9] = 0;
+        phgmg_reduced_destroy(red);
+        printf("  %3d %-4d %-8s %10.3e %10.3e %10.3e %10.3e %10.3e %5.0f %9.2e\n", o.r, tr, me == 1 ? "GMG-POD" : "GMG-QM",
+               row[3], row[4], row[5], row[6], row[7], row[8], row[10]);
+      }
+  snprintf(path, sizeof path, "%s/%s_generalization.csv", out, example);
+  demo_write_csv(path, "r,runs,method,sin,const,sin2,chirp,pwc,newton_failures,unused,lambda", nrow, DEMO_GEN_COLS,
+                 rows, 1);
+  /* figure: (a) worst e_y over the four other inputs, one training run; (b)
+     worst e_y over the four other inputs, 1 and 2 runs */
+  for (k = 0; k < nr; ++k) {
+    rx[k] = rlist[k];
+    for (tr = 0; tr < 2; ++tr)
+      for (me = 0; me < 2; ++me) {
+        const double *row = rows + (size_t)(k * 4 + tr * 2 + me) * DEMO_GEN_COLS;
+        double w = 0;
+        for (i = 1; i < DEMO_NIN; ++i) w = isnan(row[3 + i]) || isnan(w) ? NAN : (row[3 + i] > w ? row[3 + i] : w);
+        col[tr * 2 + me][k] = w;
+      }
+  }
+  snprintf(title, sizeof title, "(%c) %s, trained on 0.1 sin t: worst e_y on 4 other inputs", 'a' + panel0, example);
+  svgplot_panel(fig, panel0, title, "reduced order r", "relative output error e_y");
+  svgplot_series(fig, panel0, "GMG-POD", nr, rx, col[0], 0 | SVGPLOT_MARKERS);
+  svgplot_series(fig, panel0, "GMG-QM (lambda auto)", nr, rx, col[1], 1 | SVGPLOT_MARKERS);
+  for (k = 0; k < nr; ++k) { /* held-out inputs only, one run */
+    for (me = 0; me < 2; ++me) {
+      const double *row = rows + (size_t)(k * 4 + me) * DEMO_GEN_COLS;
+      double w = 0;
+      for (i = 1; i < DEMO_NIN; ++i) w = isnan(row[3 + i]) || isnan(w) ? NAN : (row[3 + i] > w ? row[3 + i] : w);
+      col[me][k] = w;
+    }
+  }
+  snprintf(title, sizeof title, "(%c) %s: worst e_y on the 4 held-out inputs", 'a' + panel0 + 1, example);
+  svgplot_panel(fig, panel0 + 1, title, "reduced order r", "relative output error e_y");
+  svgplot_series(fig, panel0 + 1, "GMG-POD, 1 run", nr, rx, col[0], 0 | SVGPLOT_MARKERS);
+  svgplot_series(fig, panel0 + 1, "GMG-QM, 1 run", nr, rx, col[1], 1 | SVGPLOT_MARKERS);
+  svgplot_series(fig, panel0 + 1, "GMG-POD, 2 runs", nr, rx, col[2], 2 | SVGPLOT_MARKERS);
+  svgplot_series(fig, panel0 + 1, "GMG-QM, 2 runs", nr, rx, col[3], 3 | SVGPLOT_MARKERS);
+  printf("wrote %s (study %.2f s)\n", path, demo_now() - t_study);
+  free(X); free(Y); free(YR); free(xr0); free(rows);
 }
 #endif

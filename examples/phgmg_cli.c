@@ -1433,6 +1433,85 @@ static int cmd_info(int argc, char **argv) {
   return 0;
 }
 
+/* ---- validate: reduce, then check the reduced model against the full one ----
+   phgmg validate <every option of reduce> [--test-input KIND]... [--test-amp A]
+                  [--test-steps N] [--max-ey E]
+   Builds (and writes, as reduce does) the reduced model, then runs full and
+   reduced model on each test input (KIND as --input; default: the training
+   input) with phgmg_reduced_validate and prints e_red, e_y, e_proj, the energy
+   error, Newton statistics (iterations per step), the steps outside the
+   training envelope (outside) and with a quadratic correction above the
+   training maximum (q-out), and the first failing step. Exit status 1 if any test fails (a Newton failure in the reduced run,
+   or e_y above --max-ey, default 0.1); 0 if all pass; 2 bad usage. */
+static int cmd_validate(int argc, char **argv) {
+  const char *tests[16], *reduce_argv[256];
+  double amp_t = -HUGE_VAL, max_ey = 0.1;
+  int nt = 0, rargc = 0, steps_t = 0, i, k, status = 0;
+  reduce_args A;
+  reduce_state S;
+  for (i = 0; i < argc; ++i) {
+    const char *v;
+    if (i >= 2 && !strcmp(argv[i], "--test-input")) {
+      if (!(v = optval(argc, argv, &i))) return 2;
+      if (nt >= 16) return usage_error("validate: at most 16 --test-input");
+      tests[nt++] = v;
+    } else if (i >= 2 && !strcmp(argv[i], "--test-amp")) {
+      if (!(v = optval(argc, argv, &i)) || !parse_double("--test-amp", v, -HUGE_VAL, &amp_t)) return 2;
+    } else if (i >= 2 && !strcmp(argv[i], "--test-steps")) {
+      if (!(v = optval(argc, argv, &i)) || !parse_int("--test-steps", v, 1, INT_MAX - 1, &steps_t)) return 2;
+    } else if (i >= 2 && !strcmp(argv[i], "--max-ey")) {
+      if (!(v = optval(argc, argv, &i)) || !parse_double("--max-ey", v, 0.0, &max_ey)) return 2;
+    } else {
+      if (rargc >= 255) return usage_error("validate: too many arguments");
+      reduce_argv[rargc++] = argv[i];
+    }
+  }
+  reduce_argv[rargc] = NULL;
+  if ((i = parse_reduce(rargc, (char **)reduce_argv, &A)) != 0) return i;
+  if (!A.simulate) return usage_error("validate: needs --simulate (the full model is simulated on the test inputs)");
+  if (nt == 0) tests[nt++] = A.input;
+  memset(&S, 0, sizeof S);
+  status = cmd_reduce_impl(&A, &S);
+  if (status == 0) {
+    phgmg_ph_system sys;
+    memset(&sys, 0, sizeof sys);
+    sys.N = S.J.rows; sys.m = S.B.cols; sys.storage = PHGMG_DENSE;
+    sys.J = S.J.a; sys.R = S.R.a; sys.Q = S.Q.a; sys.B = S.B.a; sys.nl = PHGMG_NL_NONE;
+    if (A.poly) {
+      sys.nl = PHGMG_NL_SEPARABLE; sys.nsep = S.pidx.rows * S.pidx.cols; sys.sep_idx = S.idx;
+      sys.sep_w = A.poly_w ? S.pw.a : NULL; sys.poly_deg = S.poly.rows * S.poly.cols - 1; sys.poly = S.poly.a;
+    }
+    printf("%-24s %10s %10s %10s %10s %10s %8s %8s %8s %8s  %s\n", "test input", "e_red", "e_y", "e_proj", "e_energy",
+           "(FOM)", "newton", "outside", "q-out", "fail@", "verdict");
+    for (k = 0; k < nt; ++k) {
+      cli_input in;
+      phgmg_run run;
+      phgmg_validation v;
+      phgmg_result rc;
+      if (input_setup(&in, tests[k], amp_t > -HUGE_VAL ? amp_t : A.amp, sys.m, A.dt)) { status = 1; break; }
+      memset(&run, 0, sizeof run);
+      run.u = input_fn; run.user = &in; run.dt = A.dt; run.nsteps = steps_t ? steps_t : A.steps;
+      rc = phgmg_reduced_validate(S.red, &sys, &run, A.newton_tol, A.newton_iter, max_ey, &v, NULL);
+      mat_free(&in.tab);
+      if (rc != PHGMG_OK) { status = fail("validate: %s: %s", tests[k], phgmg_result_string(rc)); break; }
+      printf("%-24s %10.3e %10.3e %10.3e %10.3e %10.3e %8.2f %8ld %8ld %8d  %s\n", tests[k], v.e_red, v.e_y, v.e_proj,
+             v.e_energy, v.e_energy_fom, v.stats.steps ? (double)v.stats.newton_iters / v.stats.steps : 0.0,
+             v.stats.outside_steps, v.stats.q_outside_steps, v.first_failure, v.pass ? "pass" : "FAIL");
+      if (!v.pass) {
+        status = 1;
+        if (v.first_failure >= 0)
+          printf("  first failing step: %d (t = %g -> %g): %s\n", v.first_failure, v.first_failure * A.dt,
+                 (v.first_failure + 1) * A.dt, phgmg_result_string(v.rom_rc));
+        else
+          printf("  e_y %.3e above --max-ey %g\n", v.e_y, max_ey);
+      }
+    }
+    printf("validate: %s\n", status ? "FAILED" : "passed");
+  }
+  reduce_cleanup(&S);
+  return status;
+}
+
 int main(int argc, char **argv) {
   if (argc < 2) {
     fputs("usage: phgmg reduce ... | phgmg simulate-rom ... | phgmg info MODEL | phgmg --help\n", stderr);
@@ -1446,5 +1525,6 @@ int main(int argc, char **argv) {
   if (!strcmp(argv[1], "reduce")) return cmd_reduce(argc, argv);
   if (!strcmp(argv[1], "simulate-rom")) return cmd_simulate_rom(argc, argv);
   if (!strcmp(argv[1], "info")) return cmd_info(argc, argv);
+  if (!strcmp(argv[1], "validate")) return cmd_validate(argc, argv);
   return usage_error("unknown command '%s' (expected reduce, simulate-rom or info)", argv[1]);
 }

@@ -545,7 +545,7 @@ TEST(test_lambda_auto_exact_manifold) {
     double xf[64], xl[64];
     int g, on_grid = 0;
     memset(&o, 0, sizeof o);
-    o.method = PHGMG_METHOD_GMG_QM; o.r = r; o.rn = RN; o.lambda_auto = pass == 0;
+    o.method = PHGMG_METHOD_GMG_QM; o.r = r; o.rn = RN; o.lambda_auto = pass == 0 ? 2 : 0;
     CHECK_RC(phgmg_reduce(&red, &t.sys, X, N, NSN, &o, &info, NULL), PHGMG_OK);
     if (!red) break;
     if (pass == 0) {
@@ -593,7 +593,7 @@ TEST(test_lambda_auto_linear_msd) {
   CHECK(X != NULL);
   if (!X) { tmodel_free(&t); return; }
   memset(&o, 0, sizeof o);
-  o.method = PHGMG_METHOD_GMG_QM; o.r = r; o.rn = 8; o.lambda_auto = 1; o.lambda_rcond = 1e-300; /* no guard */
+  o.method = PHGMG_METHOD_GMG_QM; o.r = r; o.rn = 8; o.lambda_auto = 2; o.lambda_rcond = 1e-300; /* no guard */
   CHECK_RC(phgmg_reduce(&red, &t.sys, X, t.sys.N, ns, &o, &info, NULL), PHGMG_OK);
   if (red) { ep_auto = phgmg_err_proj(red, X, t.sys.N, ns); phgmg_reduced_destroy(red); red = NULL; }
   CHECK(info.lambda_raised == 0);
@@ -624,7 +624,7 @@ TEST(test_lambda_auto_linear_msd) {
   o.method = PHGMG_METHOD_GMG_POD; o.r = r;
   CHECK_RC(phgmg_reduce(&red, &t.sys, X, t.sys.N, ns, &o, &ipod, NULL), PHGMG_OK);
   phgmg_reduced_destroy(red); red = NULL;
-  o.method = PHGMG_METHOD_GMG_QM; o.rn = 8; o.lambda_auto = 1; o.lambda_rcond = 0.5;
+  o.method = PHGMG_METHOD_GMG_QM; o.rn = 8; o.lambda_auto = 2; o.lambda_rcond = 0.5;
   CHECK_RC(phgmg_reduce(&red, &t.sys, X, t.sys.N, ns, &o, &ig, NULL), PHGMG_OK);
   phgmg_reduced_destroy(red); red = NULL;
   CHECK(ig.lambda_raised > 0);
@@ -662,10 +662,10 @@ TEST(test_lambda_auto_options_and_oom) {
   CHECK(X != NULL);
   if (!X) { tmodel_free(&t); return; }
   memset(&b, 0, sizeof b);
-  b.method = PHGMG_METHOD_GMG_QM; b.r = 5; b.rn = 3; b.lambda_auto = 1;
+  b.method = PHGMG_METHOD_GMG_QM; b.r = 5; b.rn = 3; b.lambda_auto = 2;
 #define BAD(field, val, code) do { o = b; o.field = (val); \
     CHECK_RC(phgmg_reduce(&red, &t.sys, X, t.sys.N, ns, &o, NULL, NULL), code); CHECK(red == NULL); } while (0)
-  BAD(lambda_auto, 2, PHGMG_ERR_INVALID_ARG);
+  BAD(lambda_auto, 3, PHGMG_ERR_INVALID_ARG);
   BAD(lambda_auto, -1, PHGMG_ERR_INVALID_ARG);
   BAD(lambda_min, -1e-6, PHGMG_ERR_INVALID_ARG);
   BAD(lambda_min, (double)NAN, PHGMG_ERR_INVALID_ARG);

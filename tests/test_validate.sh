@@ -1,0 +1,64 @@
+#!/bin/sh
+# test_validate.sh — `phgmg validate` (examples/phgmg_cli.c, issue 15): reduce,
+# then check the reduced model against the full one on test inputs.
+#
+# Usage: sh tests/test_validate.sh build/phgmg      (from the repository root)
+#
+# 1. A sound model (GMG-POD, r = 12, the paper's linear MSD trained on
+#    u = 0.1 sin t) passes on the training input and on u = 0.1: exit 0.
+# 2. An overfitted GMG-QM (lambda = 1e-12, r = 8) fails on u = 0.1 (e_y above
+#    --max-ey): exit 1, and on u = 0.1 sin 2t (an input file) its Newton
+#    solve fails: exit 1 and the first failing step is reported (step 290 of
+#    1000, t = 29, measured; the check accepts any step in 1..999).
+# 3. Bad usage exits 2.
+# The model comes from examples/npy_example/make_model.py (NumPy); skipped
+# with a note if /usr/bin/python3 has no NumPy.
+set -u
+P=${1:-build/phgmg}
+case "$P" in /*) ;; *) P="$PWD/$P" ;; esac
+ROOT=$(cd "$(dirname "$0")/.." && pwd)
+PY=/usr/bin/python3
+T=$(mktemp -d "${TMPDIR:-/tmp}/phgmg_val.XXXXXX") || exit 1
+trap 'rm -rf "$T"' EXIT INT TERM
+npass=0
+nfail=0
+pass() { npass=$((npass + 1)); }
+bad() { echo "FAIL: $*"; nfail=$((nfail + 1)); }
+[ -x "$P" ] || { echo "test_validate: $P is not an executable (build it first)"; exit 1; }
+if ! $PY -c 'import numpy' >/dev/null 2>&1; then
+  echo "test_validate: skipped (no NumPy for $PY)"
+  exit 0
+fi
+cd "$T" || exit 1
+$PY "$ROOT/examples/npy_example/make_model.py" m >/dev/null || { echo "FAIL: make_model.py"; exit 1; }
+$PY -c "import numpy as np; t = np.arange(1001) * 0.1; np.save('sin2.npy', 0.1 * np.sin(2 * t))" || exit 1
+M="--J m/J.npy --R m/R.npy --B m/B.npy --Q m/Q.npy --simulate --quiet"
+
+# 1. a sound model passes
+$P validate $M --method gmg-pod --r 12 --out o1 --test-input sin --test-input const > v1.txt 2>&1
+rc=$?
+[ $rc -eq 0 ] && pass || bad "GMG-POD r=12: exit $rc (expected 0)"
+grep -q "validate: passed" v1.txt && pass || bad "GMG-POD r=12: no 'validate: passed'"
+[ "$(grep -c ' pass$' v1.txt)" -eq 2 ] && pass || bad "GMG-POD r=12: expected two passing test inputs"
+[ -f o1/rom.phgmgrom ] && pass || bad "validate did not write the model"
+
+# 2. an overfitted quadratic manifold fails, with the first failing step
+$P validate $M --method gmg-qm --r 8 --lambda 1e-12 --out o2 --test-input const > v2.txt 2>&1
+rc=$?
+[ $rc -eq 1 ] && pass || bad "GMG-QM lambda=1e-12 on u = 0.1: exit $rc (expected 1)"
+grep -q "above --max-ey" v2.txt && pass || bad "GMG-QM on u = 0.1: no e_y verdict"
+$P validate $M --method gmg-qm --r 8 --lambda 1e-12 --out o3 --test-input sin --test-input sin2.npy > v3.txt 2>&1
+rc=$?
+[ $rc -eq 1 ] && pass || bad "GMG-QM lambda=1e-12 on sin 2t: exit $rc (expected 1)"
+step=$(sed -n 's/.*first failing step: \([0-9]*\) .*/\1/p' v3.txt | head -1)
+if [ -n "$step" ] && [ "$step" -ge 1 ] && [ "$step" -le 999 ]; then pass; else bad "no first failing step reported (got '$step')"; cat v3.txt; fi
+grep -q "^sin  .* pass$" v3.txt && pass || bad "the training input should pass (v3)"
+
+# 3. usage
+$P validate $M --method gmg-pod --r 12 --out o4 --max-ey > /dev/null 2>&1
+[ $? -eq 2 ] && pass || bad "--max-ey without a value: expected exit 2"
+$P validate --J m/J.npy --R m/R.npy --B m/B.npy --Q m/Q.npy --X nothing.npy --method gmg-pod --r 12 --out o5 > /dev/null 2>&1
+[ $? -eq 2 ] && pass || bad "validate with --X: expected exit 2"
+
+echo "test_validate: $npass passed, $nfail failed"
+[ $nfail -eq 0 ]
