@@ -42,6 +42,10 @@ static const char *const help_lines[] = {
   "  phgmg simulate-rom --model DIR/NAME.phgmgrom --out y.npy [--states xr.npy]\n",
   "               [--dt DT] [--steps 1000] [--input sin] [--amp 0.1] [--quiet]\n",
   "  phgmg info MODEL.phgmgrom\n",
+  "  phgmg validate <the options of reduce> [--test-input KIND]... [--test-amp A]\n",
+  "               [--test-steps N] [--max-ey E]   (reduce, then run full and reduced\n",
+  "               model on each test input: e_red, e_y, e_proj, energy, Newton, the\n",
+  "               first failing step; exit 1 if one fails or e_y > E, default 0.1)\n",
   "  phgmg --help | --version\n",
   "\n",
   "THE MODEL\n",
@@ -1514,7 +1518,7 @@ static int cmd_validate(int argc, char **argv) {
 
 int main(int argc, char **argv) {
   if (argc < 2) {
-    fputs("usage: phgmg reduce ... | phgmg simulate-rom ... | phgmg info MODEL | phgmg --help\n", stderr);
+    fputs("usage: phgmg reduce ... | phgmg simulate-rom ... | phgmg info MODEL | phgmg validate ... | phgmg --help\n", stderr);
     return 2;
   }
   if (!strcmp(argv[1], "--help") || !strcmp(argv[1], "-h") || !strcmp(argv[1], "help")) {
