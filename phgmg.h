@@ -65,7 +65,10 @@
    ph:      phgmg_ph_validate (skew J, symmetric PSD R, symmetric PD Q, rank B, cond(J-R), NaN),
             phgmg_ph_hamiltonian, phgmg_ph_gradient, phgmg_ph_rhs, phgmg_ph_output,
             phgmg_ph_apply (J, R or Q times a block), phgmg_jr_factor_create /
-            phgmg_jr_solve / phgmg_jr_factor_destroy (apply (J-R)^{-1} or ^{-T})
+            phgmg_jr_solve / phgmg_jr_factor_destroy (apply (J-R)^{-1} or ^{-T}),
+            phgmg_ph_sparse_create / _system / _perm / _sep_idx / _to_banded_order /
+            _to_user_order / _destroy (CSC input, reverse Cuthill-McKee, banded),
+            phgmg_rcm (the ordering alone)
    gl3:     phgmg_gl3_coefficients, phgmg_gl3_create / _step / _get_stats / _destroy,
             phgmg_simulate (trajectory, outputs, energy H/S/D, stats)
    online:  phgmg_rom_check, phgmg_rom_eval_work_size, phgmg_rom_hamiltonian,
@@ -419,6 +422,111 @@ PHGMG_DEF phgmg_result phgmg_jr_factor_create(phgmg_jr_factor **out, const phgmg
 PHGMG_DEF void phgmg_jr_solve(const phgmg_jr_factor *f, char trans, int nrhs, double *X, int ldx);
 /* Frees the factorization (NULL is fine). */
 PHGMG_DEF void phgmg_jr_factor_destroy(phgmg_jr_factor *f);
+
+/* --- sparse input ---------------------------------------------------------
+   A matrix in compressed sparse column form (0-based, SciPy's csc_matrix
+   fields indptr/indices/data): column j holds rows rowidx[colptr[j] ..
+   colptr[j+1]-1], strictly increasing within the column, with values in
+   `values`; colptr[0] = 0, colptr[n_cols] = nnz. Explicit zeros are allowed
+   (they count in the pattern). Views: never owned. */
+typedef struct phgmg_csc {
+  int n_rows, n_cols;
+  const int *colptr;    /* n_cols + 1 */
+  const int *rowidx;    /* nnz        */
+  const double *values; /* nnz        */
+} phgmg_csc;
+
+/* Reverse Cuthill-McKee ordering of the symmetric pattern of |A_0| + ... +
+   |A_{na-1}| (each N x N CSC; the pattern is symmetrized, the diagonal
+   ignored): per connected component a breadth-first search from a
+   pseudo-peripheral node (George-Liu), neighbours visited by increasing
+   degree, the whole order reversed. perm (N) receives the new order:
+   position i holds original index perm[i]. kb_out (may be NULL): the
+   half-bandwidth max |inv(perm)[r] - inv(perm)[c]| over every stored entry.
+   O(nnz log) time, O(N + nnz) memory. PHGMG_ERR_INVALID_ARG (NULL), _SIZE
+   (N < 1, na < 1, a matrix not N x N), _FORMAT (colptr not starting at 0 or
+   decreasing, row index out of range, unsorted or duplicate rows), _NOMEM. */
+PHGMG_DEF phgmg_result phgmg_rcm(int N, int na, const phgmg_csc *const *A, int *perm, int *kb_out,
+                                 const phgmg_allocator *alloc);
+
+/* A sparse pH system in a bandwidth-reducing order. phgmg_ph_sparse_create
+   takes J, R, Q as N x N CSC matrices in the caller's ("user") ordering and B
+   dense (N x m, ld N) or, if B is NULL, as the N x m CSC matrix Bcsc; it
+   computes phgmg_rcm of J, R, Q, keeps the better of that order and the given
+   one (smaller half-bandwidth; a tie keeps the given order), and stores
+   P^T J P, P^T R P, P^T Q P in band storage (>>ph above) with that
+   half-bandwidth kb and P^T B dense, where P is the permutation: state entry
+   i of the banded ("internal") ordering is entry perm[i] of the user's.
+   phgmg_ph_sparse_system gives the ready phgmg_ph_system (BANDED, nl = NONE):
+   copy it to add a nonlinear part. Nothing is densified: O(N kb + nnz) memory,
+   the GL3 stepper, phgmg_jr_factor, phgmg_ph_validate cost O(N kb^2), solves
+   O(N kb). Call phgmg_ph_validate on the system for the structural checks
+   (skew J, symmetric PSD R, ...: the usual codes; a nonsymmetric pattern is
+   fine, the band covers the symmetrized pattern). info (may be NULL): the
+   half-bandwidths, and wide = 1 when kb > N/4: the banded path then costs
+   about as much as dense storage or more ((2kb+1) N doubles per matrix, LU
+   fill up to 3kb+1 rows) -- such a model is better given dense.
+   Errors: PHGMG_ERR_INVALID_ARG (NULL out/J/R/Q, both B and Bcsc NULL),
+   _SIZE (N < 1, m < 1 or m > N, a matrix of the wrong shape), _FORMAT (as
+   phgmg_rcm, also for Bcsc), _NANINF (a stored value or an entry of B not
+   finite), _NOMEM. *out is NULL on failure.
+
+   Orderings. Every reduction is permutation-equivariant (NUMERICS 3): reduce
+   the internal system with snapshots in the internal ordering
+   (phgmg_ph_sparse_to_banded_order on the user's snapshot matrix, or simulate
+   the internal system). The reduced model (phgmg_reduced_rom) is then the
+   same as the user-ordered one; only full-dimension quantities are permuted:
+   phgmg_reduced_lift/_dphi/_W give internal-order vectors and rows (map them
+   with phgmg_ph_sparse_to_user_order), phgmg_reduced_restrict and the error
+   measures take internal-order states. A GENERAL nonlinear part's callbacks
+   receive internal-order states (and a banded Hessian in the internal order);
+   a SEPARABLE one needs its coordinates remapped (phgmg_ph_sparse_sep_idx).
+
+       phgmg_ph_sparse *sp; phgmg_ph_sparse_info inf;
+       phgmg_ph_sparse_create(&sp, N, m, &J, &R, &Q, B, NULL, &inf, NULL);
+       phgmg_ph_system sys = *phgmg_ph_sparse_system(sp);
+       sys.nl = PHGMG_NL_SEPARABLE; ... phi, poly ...;
+       phgmg_ph_sparse_sep_idx(sp, nsep, my_idx, &sys);   // remapped
+       phgmg_ph_sparse_to_banded_order(sp, 1, x0_user, N, x0, N);
+       phgmg_simulate(&sys, x0, ...X...);                 // internal order
+       phgmg_ph_sparse_to_user_order(sp, nsteps + 1, X, N, X_user, N);
+       phgmg_ph_sparse_destroy(sp);                       // after sys's last use */
+typedef struct phgmg_ph_sparse phgmg_ph_sparse;
+typedef struct phgmg_ph_sparse_info {
+  int kb;        /* half-bandwidth of the stored (internal) ordering        */
+  int kb_input;  /* half-bandwidth of the given ordering                    */
+  int kb_rcm;    /* half-bandwidth of the reverse Cuthill-McKee ordering    */
+  int permuted;  /* 1: RCM order used, 0: the given order kept (perm = id)  */
+  int wide;      /* 1: kb > N/4, banded costs about as much as dense or more */
+  long nnz;      /* stored entries of J, R, Q together                       */
+} phgmg_ph_sparse_info;
+PHGMG_DEF phgmg_result phgmg_ph_sparse_create(phgmg_ph_sparse **out, int N, int m, const phgmg_csc *J,
+                                              const phgmg_csc *R, const phgmg_csc *Q, const double *B,
+                                              const phgmg_csc *Bcsc, phgmg_ph_sparse_info *info,
+                                              const phgmg_allocator *alloc);
+/* The banded, permuted system (valid until destroy; NULL for NULL). */
+PHGMG_DEF const phgmg_ph_system *phgmg_ph_sparse_system(const phgmg_ph_sparse *sp);
+/* The permutation (N): internal index i is user index perm[i]; NULL for NULL. */
+PHGMG_DEF const int *phgmg_ph_sparse_perm(const phgmg_ph_sparse *sp);
+/* Remap a separable part's coordinates: term k acts on user coordinate
+   sep_idx_user[k]; stores the internal coordinates in sp (replacing an
+   earlier call's array) and, if sys is not NULL, sets sys->nsep = nsep and
+   sys->sep_idx to that array (term order, weights and phi_k are unchanged).
+   idx_out (may be NULL) also receives the nsep internal coordinates.
+   PHGMG_ERR_INVALID_ARG (NULL sp or sep_idx_user), _SIZE (nsep < 1, an
+   index outside 0..N-1), _NOMEM. */
+PHGMG_DEF phgmg_result phgmg_ph_sparse_sep_idx(phgmg_ph_sparse *sp, int nsep, const int *sep_idx_user,
+                                               int *idx_out, phgmg_ph_system *sys);
+/* Y (N x ncols, ldy) = rows of X (N x ncols, ldx) moved from the user's to
+   the internal ordering: Y[i] = X[perm[i]]; _to_user_order the inverse,
+   Y[perm[i]] = X[i]. Snapshot matrices, trajectories, lifted states. X and Y
+   must not overlap. O(N ncols). */
+PHGMG_DEF void phgmg_ph_sparse_to_banded_order(const phgmg_ph_sparse *sp, int ncols, const double *X,
+                                               int ldx, double *Y, int ldy);
+PHGMG_DEF void phgmg_ph_sparse_to_user_order(const phgmg_ph_sparse *sp, int ncols, const double *X,
+                                             int ldx, double *Y, int ldy);
+/* Frees the object and its arrays (NULL is fine). */
+PHGMG_DEF void phgmg_ph_sparse_destroy(phgmg_ph_sparse *sp);
 
 /* >>gl3 =================================================================== */
 /* 3-stage Gauss-Legendre (order 6), simplified Newton on the transformed stage
@@ -3847,6 +3955,353 @@ PHGMG_DEF phgmg_result phgmg_ph_validate(const phgmg_ph_system *sys, double tol,
     if (!(rcond > tol)) return PHGMG_ERR_SINGULAR;
   }
   return PHGMG_OK;
+}
+
+/* ---- sparse input: CSC checks, reverse Cuthill-McKee, banded conversion ---- */
+
+/* Structure of an nr x nc CSC matrix (see phgmg_csc). */
+PHGMG__PRIV phgmg_result phgmg__csc_check(const phgmg_csc *A, int nr, int nc) {
+  int j, p;
+  if (!A || !A->colptr) return PHGMG_ERR_INVALID_ARG;
+  if (A->n_rows != nr || A->n_cols != nc) return PHGMG_ERR_SIZE;
+  if (A->colptr[0] != 0) return PHGMG_ERR_FORMAT;
+  for (j = 0; j < nc; ++j)
+    if (A->colptr[j + 1] < A->colptr[j]) return PHGMG_ERR_FORMAT;
+  if (A->colptr[nc] > 0 && (!A->rowidx || !A->values)) return PHGMG_ERR_INVALID_ARG;
+  for (j = 0; j < nc; ++j)
+    for (p = A->colptr[j]; p < A->colptr[j + 1]; ++p) {
+      int r = A->rowidx[p];
+      if (r < 0 || r >= nr) return PHGMG_ERR_FORMAT;
+      if (p > A->colptr[j] && r <= A->rowidx[p - 1]) return PHGMG_ERR_FORMAT; /* unsorted/duplicate */
+    }
+  return PHGMG_OK;
+}
+
+/* Half-bandwidth max |ip[r] - ip[c]| of the stored entries (ip NULL: identity). */
+PHGMG__PRIV int phgmg__csc_bandwidth(const phgmg_csc *A, const int *ip) {
+  int j, p, kb = 0;
+  for (j = 0; j < A->n_cols; ++j)
+    for (p = A->colptr[j]; p < A->colptr[j + 1]; ++p) {
+      int r = A->rowidx[p], d = ip ? ip[r] - ip[j] : r - j;
+      if (d < 0) d = -d;
+      if (d > kb) kb = d;
+    }
+  return kb;
+}
+
+/* Symmetrized off-diagonal pattern of na N x N CSC matrices as adjacency lists
+   (xadj N+1, adj), duplicates removed. */
+PHGMG__PRIV phgmg_result phgmg__sym_graph(int N, int na, const phgmg_csc *const *A, int **xadj_out,
+                                          int **adj_out, const phgmg_allocator *alloc) {
+  int *xadj = phgmg__ialloc(alloc, (size_t)N + 1), *pos = phgmg__ialloc(alloc, (size_t)N + 1), *adj = NULL;
+  size_t total = 0;
+  int a, i, j, p, w;
+  *xadj_out = *adj_out = NULL;
+  if (!xadj || !pos) { phgmg__free(alloc, xadj); phgmg__free(alloc, pos); return PHGMG_ERR_NOMEM; }
+  memset(xadj, 0, sizeof(int) * ((size_t)N + 1));
+  for (a = 0; a < na; ++a)
+    for (j = 0; j < N; ++j)
+      for (p = A[a]->colptr[j]; p < A[a]->colptr[j + 1]; ++p)
+        if (A[a]->rowidx[p] != j) { xadj[A[a]->rowidx[p] + 1]++; xadj[j + 1]++; total += 2; }
+  if (total > (size_t)0x7ffffffe) { phgmg__free(alloc, xadj); phgmg__free(alloc, pos); return PHGMG_ERR_SIZE; }
+  adj = phgmg__ialloc(alloc, total);
+  if (!adj) { phgmg__free(alloc, xadj); phgmg__free(alloc, pos); return PHGMG_ERR_NOMEM; }
+  for (i = 0; i < N; ++i) xadj[i + 1] += xadj[i];
+  memcpy(pos, xadj, sizeof(int) * ((size_t)N + 1));
+  for (a = 0; a < na; ++a)
+    for (j = 0; j < N; ++j)
+      for (p = A[a]->colptr[j]; p < A[a]->colptr[j + 1]; ++p) {
+        int r = A[a]->rowidx[p];
+        if (r != j) { adj[pos[r]++] = j; adj[pos[j]++] = r; }
+      }
+  /* remove duplicates in place: pos[] becomes the "last seen in list" mark */
+  for (i = 0; i < N; ++i) pos[i] = -1;
+  for (i = 0, w = 0; i < N; ++i) {
+    int start = xadj[i], end = xadj[i + 1];
+    xadj[i] = w;
+    for (p = start; p < end; ++p)
+      if (pos[adj[p]] != i) { pos[adj[p]] = i; adj[w++] = adj[p]; }
+  }
+  xadj[N] = w;
+  phgmg__free(alloc, pos);
+  *xadj_out = xadj;
+  *adj_out = adj;
+  return PHGMG_OK;
+}
+
+/* Sort q[0..n) by (deg, index): insertion sort for short runs, else heapsort. */
+PHGMG__PRIV int phgmg__rcm_less(const int *deg, int a, int b) {
+  return deg[a] < deg[b] || (deg[a] == deg[b] && a < b);
+}
+PHGMG__PRIV void phgmg__rcm_sift(int *q, int start, int n, const int *deg) {
+  int root = start;
+  while (2 * root + 1 < n) {
+    int c = 2 * root + 1, t;
+    if (c + 1 < n && phgmg__rcm_less(deg, q[c], q[c + 1])) ++c;
+    if (!phgmg__rcm_less(deg, q[root], q[c])) return;
+    t = q[root]; q[root] = q[c]; q[c] = t;
+    root = c;
+  }
+}
+PHGMG__PRIV void phgmg__rcm_sort(int *q, int n, const int *deg) {
+  int i, j, t;
+  if (n <= 32) {
+    for (i = 1; i < n; ++i) {
+      t = q[i];
+      for (j = i; j > 0 && phgmg__rcm_less(deg, t, q[j - 1]); --j) q[j] = q[j - 1];
+      q[j] = t;
+    }
+    return;
+  }
+  for (i = n / 2 - 1; i >= 0; --i) phgmg__rcm_sift(q, i, n, deg);
+  for (i = n - 1; i > 0; --i) {
+    t = q[0]; q[0] = q[i]; q[i] = t;
+    phgmg__rcm_sift(q, 0, i, deg);
+  }
+}
+
+/* Breadth-first search from root over nodes with level -1 (one component):
+   q receives the nodes in visiting order (neighbours by increasing degree when
+   sorted), level their distance from root. Returns the count; *nlev the
+   number of levels. */
+PHGMG__PRIV int phgmg__rcm_bfs(const int *xadj, const int *adj, const int *deg, int root, int *level,
+                               int *q, int sorted, int *nlev) {
+  int head = 0, tail = 1, p;
+  q[0] = root;
+  level[root] = 0;
+  while (head < tail) {
+    int u = q[head++], t0 = tail;
+    for (p = xadj[u]; p < xadj[u + 1]; ++p)
+      if (level[adj[p]] < 0) { level[adj[p]] = level[u] + 1; q[tail++] = adj[p]; }
+    if (sorted) phgmg__rcm_sort(q + t0, tail - t0, deg);
+  }
+  *nlev = level[q[tail - 1]] + 1;
+  return tail;
+}
+
+/* Pseudo-peripheral node of the component of start (George-Liu): repeat a
+   search from a least-degree node of the last level while the depth grows. */
+PHGMG__PRIV int phgmg__rcm_peripheral(const int *xadj, const int *adj, const int *deg, int start,
+                                      int *level, int *q) {
+  int root = start, nlev, cnt, it, i;
+  cnt = phgmg__rcm_bfs(xadj, adj, deg, root, level, q, 0, &nlev);
+  for (it = 0; it < 16; ++it) {
+    int best = -1, nlev2, cnt2;
+    for (i = cnt - 1; i >= 0 && level[q[i]] == nlev - 1; --i)
+      if (best < 0 || phgmg__rcm_less(deg, q[i], best)) best = q[i];
+    for (i = 0; i < cnt; ++i) level[q[i]] = -1;
+    if (best < 0 || best == root) return root;
+    cnt2 = phgmg__rcm_bfs(xadj, adj, deg, best, level, q, 0, &nlev2);
+    if (nlev2 <= nlev) {
+      for (i = 0; i < cnt2; ++i) level[q[i]] = -1;
+      return root;
+    }
+    root = best;
+    nlev = nlev2;
+    cnt = cnt2;
+  }
+  for (i = 0; i < cnt; ++i) level[q[i]] = -1;
+  return root;
+}
+
+PHGMG_DEF phgmg_result phgmg_rcm(int N, int na, const phgmg_csc *const *A, int *perm, int *kb_out,
+                                 const phgmg_allocator *alloc) {
+  int *xadj = NULL, *adj = NULL, *deg = NULL, *level = NULL, *q = NULL;
+  int a, i, done = 0, kb = 0;
+  phgmg_result rc;
+  if (kb_out) *kb_out = 0;
+  if (!A || !perm) return PHGMG_ERR_INVALID_ARG;
+  if (N < 1 || na < 1) return PHGMG_ERR_SIZE;
+  for (a = 0; a < na; ++a)
+    if ((rc = phgmg__csc_check(A[a], N, N)) != PHGMG_OK) return rc;
+  rc = phgmg__sym_graph(N, na, A, &xadj, &adj, alloc);
+  if (rc != PHGMG_OK) return rc;
+  deg = phgmg__ialloc(alloc, (size_t)N);
+  level = phgmg__ialloc(alloc, (size_t)N);
+  q = phgmg__ialloc(alloc, (size_t)N);
+  if (!deg || !level || !q) rc = PHGMG_ERR_NOMEM;
+  else {
+    for (i = 0; i < N; ++i) { deg[i] = xadj[i + 1] - xadj[i]; level[i] = -1; }
+    for (i = 0; i < N; ++i) {
+      int root, nlev;
+      if (level[i] >= 0) continue; /* numbered in an earlier component */
+      root = phgmg__rcm_peripheral(xadj, adj, deg, i, level, q);
+      done += phgmg__rcm_bfs(xadj, adj, deg, root, level, perm + done, 1, &nlev);
+    }
+    for (i = 0; i < N / 2; ++i) { int t = perm[i]; perm[i] = perm[N - 1 - i]; perm[N - 1 - i] = t; }
+    for (i = 0; i < N; ++i) q[perm[i]] = i; /* inverse */
+    for (a = 0; a < na; ++a) {
+      int k = phgmg__csc_bandwidth(A[a], q);
+      if (k > kb) kb = k;
+    }
+    if (kb_out) *kb_out = kb;
+  }
+  phgmg__free(alloc, xadj);
+  phgmg__free(alloc, adj);
+  phgmg__free(alloc, deg);
+  phgmg__free(alloc, level);
+  phgmg__free(alloc, q);
+  return rc;
+}
+
+struct phgmg_ph_sparse {
+  phgmg_ph_system sys;
+  phgmg_allocator a;
+  const phgmg_allocator *alloc; /* &a or NULL */
+  int *perm, *iperm, *sep;
+  double *J, *R, *Q, *B;
+};
+
+PHGMG_DEF void phgmg_ph_sparse_destroy(phgmg_ph_sparse *sp) {
+  const phgmg_allocator *alloc;
+  if (!sp) return;
+  alloc = sp->alloc;
+  phgmg__free(alloc, sp->perm);
+  phgmg__free(alloc, sp->iperm);
+  phgmg__free(alloc, sp->sep);
+  phgmg__free(alloc, sp->J);
+  phgmg__free(alloc, sp->R);
+  phgmg__free(alloc, sp->Q);
+  phgmg__free(alloc, sp->B);
+  phgmg__free(alloc, sp);
+}
+
+/* Scatter an N x N CSC matrix into band storage (kb) of the permuted order. */
+PHGMG__PRIV void phgmg__csc_to_band(const phgmg_csc *A, const int *ip, int kb, double *band) {
+  int j, p;
+  const size_t ld = (size_t)(2 * kb + 1);
+  for (j = 0; j < A->n_cols; ++j)
+    for (p = A->colptr[j]; p < A->colptr[j + 1]; ++p) {
+      int r = ip[A->rowidx[p]], c = ip[j];
+      band[(size_t)(kb + r - c) + (size_t)c * ld] = A->values[p];
+    }
+}
+
+/* Argument and data checks of phgmg_ph_sparse_create. */
+PHGMG__PRIV phgmg_result phgmg__ph_sparse_check(int N, int m, const phgmg_csc *const *A, const double *B,
+                                                const phgmg_csc *Bcsc) {
+  int a;
+  phgmg_result rc;
+  if (!A[0] || !A[1] || !A[2] || (!B && !Bcsc)) return PHGMG_ERR_INVALID_ARG;
+  if (N < 1 || m < 1 || m > N) return PHGMG_ERR_SIZE;
+  for (a = 0; a < 3; ++a)
+    if ((rc = phgmg__csc_check(A[a], N, N)) != PHGMG_OK) return rc;
+  if (!B && (rc = phgmg__csc_check(Bcsc, N, m)) != PHGMG_OK) return rc;
+  for (a = 0; a < 3; ++a)
+    if (!phgmg__all_finite(A[a]->values, (size_t)A[a]->colptr[N])) return PHGMG_ERR_NANINF;
+  if (B ? !phgmg__all_finite(B, (size_t)N * (size_t)m)
+        : !phgmg__all_finite(Bcsc->values, (size_t)Bcsc->colptr[m]))
+    return PHGMG_ERR_NANINF;
+  return PHGMG_OK;
+}
+
+PHGMG_DEF phgmg_result phgmg_ph_sparse_create(phgmg_ph_sparse **out, int N, int m, const phgmg_csc *J,
+                                              const phgmg_csc *R, const phgmg_csc *Q, const double *B,
+                                              const phgmg_csc *Bcsc, phgmg_ph_sparse_info *info,
+                                              const phgmg_allocator *alloc) {
+  const phgmg_csc *A[3];
+  phgmg_ph_sparse *sp;
+  phgmg_result rc;
+  int a, i, j, kb_in = 0, kb_rcm = 0, kb;
+  size_t len;
+  A[0] = J; A[1] = R; A[2] = Q;
+  if (info) memset(info, 0, sizeof *info);
+  if (!out) return PHGMG_ERR_INVALID_ARG;
+  *out = NULL;
+  if ((rc = phgmg__ph_sparse_check(N, m, A, B, Bcsc)) != PHGMG_OK) return rc;
+  sp = PHGMG__CAST(phgmg_ph_sparse *, phgmg__alloc(alloc, sizeof *sp));
+  if (!sp) return PHGMG_ERR_NOMEM;
+  memset(sp, 0, sizeof *sp);
+  if (alloc) { sp->a = *alloc; sp->alloc = &sp->a; }
+  sp->perm = phgmg__ialloc(alloc, (size_t)N);
+  sp->iperm = phgmg__ialloc(alloc, (size_t)N);
+  if (!sp->perm || !sp->iperm) { phgmg_ph_sparse_destroy(sp); return PHGMG_ERR_NOMEM; }
+  rc = phgmg_rcm(N, 3, A, sp->perm, &kb_rcm, alloc);
+  if (rc != PHGMG_OK) { phgmg_ph_sparse_destroy(sp); return rc; }
+  for (a = 0; a < 3; ++a) {
+    int k = phgmg__csc_bandwidth(A[a], NULL);
+    if (k > kb_in) kb_in = k;
+  }
+  if (kb_rcm >= kb_in)
+    for (i = 0; i < N; ++i) sp->perm[i] = i;
+  kb = kb_rcm < kb_in ? kb_rcm : kb_in;
+  for (i = 0; i < N; ++i) sp->iperm[sp->perm[i]] = i;
+  len = (size_t)(2 * kb + 1) * (size_t)N;
+  sp->J = phgmg__dalloc(alloc, len);
+  sp->R = phgmg__dalloc(alloc, len);
+  sp->Q = phgmg__dalloc(alloc, len);
+  sp->B = phgmg__dalloc(alloc, (size_t)N * (size_t)m);
+  if (!sp->J || !sp->R || !sp->Q || !sp->B) { phgmg_ph_sparse_destroy(sp); return PHGMG_ERR_NOMEM; }
+  memset(sp->J, 0, sizeof(double) * len);
+  memset(sp->R, 0, sizeof(double) * len);
+  memset(sp->Q, 0, sizeof(double) * len);
+  phgmg__csc_to_band(J, sp->iperm, kb, sp->J);
+  phgmg__csc_to_band(R, sp->iperm, kb, sp->R);
+  phgmg__csc_to_band(Q, sp->iperm, kb, sp->Q);
+  if (B) {
+    for (j = 0; j < m; ++j)
+      for (i = 0; i < N; ++i) sp->B[i + (size_t)j * N] = B[sp->perm[i] + (size_t)j * N];
+  } else {
+    int p;
+    memset(sp->B, 0, sizeof(double) * (size_t)N * (size_t)m);
+    for (j = 0; j < m; ++j)
+      for (p = Bcsc->colptr[j]; p < Bcsc->colptr[j + 1]; ++p)
+        sp->B[sp->iperm[Bcsc->rowidx[p]] + (size_t)j * N] = Bcsc->values[p];
+  }
+  sp->sys.N = N;
+  sp->sys.m = m;
+  sp->sys.storage = PHGMG_BANDED;
+  sp->sys.kb = kb;
+  sp->sys.J = sp->J; sp->sys.R = sp->R; sp->sys.Q = sp->Q; sp->sys.B = sp->B;
+  sp->sys.nl = PHGMG_NL_NONE;
+  if (info) {
+    info->kb = kb;
+    info->kb_input = kb_in;
+    info->kb_rcm = kb_rcm;
+    info->permuted = kb_rcm < kb_in;
+    info->wide = 4 * (long)kb > (long)N;
+    info->nnz = (long)J->colptr[N] + (long)R->colptr[N] + (long)Q->colptr[N];
+  }
+  *out = sp;
+  return PHGMG_OK;
+}
+
+PHGMG_DEF const phgmg_ph_system *phgmg_ph_sparse_system(const phgmg_ph_sparse *sp) {
+  return sp ? &sp->sys : NULL;
+}
+PHGMG_DEF const int *phgmg_ph_sparse_perm(const phgmg_ph_sparse *sp) { return sp ? sp->perm : NULL; }
+
+PHGMG_DEF phgmg_result phgmg_ph_sparse_sep_idx(phgmg_ph_sparse *sp, int nsep, const int *sep_idx_user,
+                                               int *idx_out, phgmg_ph_system *sys) {
+  int k, *s;
+  if (!sp || !sep_idx_user) return PHGMG_ERR_INVALID_ARG;
+  if (nsep < 1) return PHGMG_ERR_SIZE;
+  for (k = 0; k < nsep; ++k)
+    if (sep_idx_user[k] < 0 || sep_idx_user[k] >= sp->sys.N) return PHGMG_ERR_SIZE;
+  s = phgmg__ialloc(sp->alloc, (size_t)nsep);
+  if (!s) return PHGMG_ERR_NOMEM;
+  for (k = 0; k < nsep; ++k) s[k] = sp->iperm[sep_idx_user[k]];
+  if (idx_out) memcpy(idx_out, s, sizeof(int) * (size_t)nsep);
+  phgmg__free(sp->alloc, sp->sep);
+  sp->sep = s;
+  if (sys) { sys->nsep = nsep; sys->sep_idx = s; }
+  return PHGMG_OK;
+}
+
+PHGMG_DEF void phgmg_ph_sparse_to_banded_order(const phgmg_ph_sparse *sp, int ncols, const double *X,
+                                               int ldx, double *Y, int ldy) {
+  int i, j;
+  if (!sp || !X || !Y) return;
+  for (j = 0; j < ncols; ++j)
+    for (i = 0; i < sp->sys.N; ++i) Y[i + (size_t)j * ldy] = X[sp->perm[i] + (size_t)j * ldx];
+}
+
+PHGMG_DEF void phgmg_ph_sparse_to_user_order(const phgmg_ph_sparse *sp, int ncols, const double *X,
+                                             int ldx, double *Y, int ldy) {
+  int i, j;
+  if (!sp || !X || !Y) return;
+  for (j = 0; j < ncols; ++j)
+    for (i = 0; i < sp->sys.N; ++i) Y[sp->perm[i] + (size_t)j * ldy] = X[i + (size_t)j * ldx];
 }
 
 /* >>gl3 (implementation) ================================================= */

@@ -35,6 +35,7 @@ static const char *const help_lines[] = {
   "\n",
   "USAGE\n",
   "  phgmg reduce --J J.npy --R R.npy --B B.npy --Q Q.npy\n",
+  "               (or --J-coo/--R-coo/--Q-coo for sparse J, R, Q; see SPARSE MATRICES)\n",
   "               (--X X.npy | --simulate [--dt 0.1] [--steps 1000] [--input sin] [--amp 0.1])\n",
   "               --method gmg-pod|gmg-qm|sp1|sp2 --r R [--rn 8] [--lambda 1e-3]\n",
   "               [--poly coeffs.npy --poly-idx idx.npy [--poly-w w.npy]] [DEIM options]\n",
@@ -59,6 +60,9 @@ static const char *const help_lines[] = {
   "COMMAND reduce\n",
   "  --J FILE, --R FILE, --Q FILE   N x N matrices (required).\n",
   "  --B FILE            N x m port matrix, or a vector of length N for m = 1 (required).\n",
+  "  --J-coo SPEC, --R-coo SPEC, --Q-coo SPEC   instead of --J, --R, --Q: sparse\n",
+  "                      matrices as coordinate triplets (all three together; N from\n",
+  "                      --B); see SPARSE MATRICES.\n",
   "  --X FILE            snapshot matrix N x ns (ns >= 2 states, one per column; a\n",
   "                      trajectory x(t_0), ..., x(t_n), normally starting at x = 0).\n",
   "  --simulate          instead of --X: simulate the full model from x0 = 0 with the\n",
@@ -157,6 +161,17 @@ static const char *const help_lines[] = {
   "  Prints the sizes of a .phgmgrom file and the bytes of stepper memory its\n",
   "  firmware needs (phgmg_rom_stepper_memsize; with a step map also the bytes for\n",
   "  stepping with another dt, phgmg_rom_stepper_memsize_dt).\n",
+  "\n",
+  "SPARSE MATRICES\n",
+  "  SPEC is one (nnz, 3) array of rows (row, col, value), or three vectors\n",
+  "  rows.npy,cols.npy,vals.npy (comma-separated, no spaces): 0-based integer indices\n",
+  "  in [0, N), duplicates summed (as scipy.sparse does). phgmg orders the states by\n",
+  "  reverse Cuthill-McKee and works in band storage (O(N kb^2)); V0, V2 and the\n",
+  "  snapshots are written in your ordering, --poly-idx and --X are in your ordering.\n",
+  "  From SciPy (A any scipy.sparse matrix):\n",
+  "    c = A.tocoo(); np.save('J_rows.npy', c.row); np.save('J_cols.npy', c.col)\n",
+  "    np.save('J_vals.npy', c.data)     # --J-coo J_rows.npy,J_cols.npy,J_vals.npy\n",
+  "    np.save('J.npy', np.column_stack([c.row, c.col, c.data]))   # --J-coo J.npy\n",
   "\n",
   "INPUT FILES (.npy)\n",
   "  Read: format versions 1.0-3.0, float64, float32, int8-int64, uint8-uint64 or\n",
@@ -778,6 +793,7 @@ static int explain_validate(phgmg_result rc, const mat *J, const mat *R, const m
 /* ---- reduce ------------------------------------------------------------------- */
 typedef struct reduce_args {
   const char *J, *R, *B, *Q, *X, *poly, *poly_idx, *poly_w, *out, *name, *input, *method;
+  const char *Jcoo, *Rcoo, *Qcoo; /* sparse J, R, Q as coordinate triplets */
   const char *expf, *potential, *hyper;
   double hyper_tol;
   int simulate, steps, r, rn, no_deim, deim_max, deim_neg, save_snap, have_dt_map, newton_iter;
@@ -816,6 +832,7 @@ static int parse_reduce(int argc, char **argv, reduce_args *A) {
     if (!strcmp(o, "--help") || !strcmp(o, "-h")) { print_help(); return -1; }
     if (repeated_opt(o, seen, &nseen)) return 2;
     STR("--J", J) STR("--R", R) STR("--B", B) STR("--Q", Q) STR("--X", X)
+    STR("--J-coo", Jcoo) STR("--R-coo", Rcoo) STR("--Q-coo", Qcoo)
     STR("--poly", poly) STR("--poly-idx", poly_idx) STR("--poly-w", poly_w)
     STR("--exp", expf) STR("--potential", potential) STR("--hyper", hyper)
     DBL("--hyper-tol", hyper_tol, 0.0)
@@ -845,7 +862,12 @@ static int parse_reduce(int argc, char **argv, reduce_args *A) {
 #undef INT
 #undef DBL
   }
-  if (!A->J || !A->R || !A->B || !A->Q) return usage_error("reduce: --J, --R, --B and --Q are required");
+  if ((A->J || A->R || A->Q) && (A->Jcoo || A->Rcoo || A->Qcoo))
+    return usage_error("reduce: give J, R, Q either dense (--J, --R, --Q) or sparse (--J-coo, --R-coo, --Q-coo)");
+  if (A->Jcoo || A->Rcoo || A->Qcoo) {
+    if (!A->Jcoo || !A->Rcoo || !A->Qcoo || !A->B)
+      return usage_error("reduce: --J-coo, --R-coo, --Q-coo and --B are required together");
+  } else if (!A->J || !A->R || !A->B || !A->Q) return usage_error("reduce: --J, --R, --B and --Q are required");
   if (!A->method) return usage_error("reduce: --method is required (gmg-pod, gmg-qm, sp1 or sp2)");
   if (!A->r) return usage_error("reduce: --r is required");
   if (!A->out) return usage_error("reduce: --out DIR is required");
@@ -864,11 +886,111 @@ static int parse_reduce(int argc, char **argv, reduce_args *A) {
   return 0;
 }
 
+/* ---- sparse matrices from coordinate triplets ------------------------------------ */
+typedef struct cli_csc {
+  phgmg_csc A;
+  int *cp, *ri;
+  double *v;
+} cli_csc;
+static void cli_csc_free(cli_csc *c) { free(c->cp); free(c->ri); free(c->v); memset(c, 0, sizeof *c); }
+
+/* Entry k of a triplet source: rows/cols/vals three vectors, or one (nnz, 3) array. */
+static int coo_index(const mat *M, int k, int which, int nnz, const char *spec, const char *opt, int N, int *out) {
+  const double v = M->a[(size_t)k + (size_t)which * (size_t)nnz];
+  if (!(v >= 0.0 && v < (double)N && v == floor(v)))
+    return fail("%s (%s): entry %d: %s index %g; expected an integer in [0, %d) (N from --B)", spec, opt, k,
+                which == 0 ? "row" : "column", v, N);
+  *out = (int)v;
+  return 0;
+}
+
+/* --X-coo SPEC into an N x N CSC matrix (columns sorted, duplicates summed). */
+static int load_coo(cli_csc *c, const char *opt, const char *spec, int N) {
+  mat M[3];
+  int nf = 1, nnz, k, j, p, q, err = 0;
+  const mat *rows, *cols, *vals;
+  char buf[3][4096];
+  memset(M, 0, sizeof M);
+  memset(c, 0, sizeof *c);
+  if (strchr(spec, ',')) {
+    const char *a = spec, *b = strchr(a, ','), *e = b ? strchr(b + 1, ',') : NULL;
+    if (!b || !e || strchr(e + 1, ',') || b - a >= 4096 || e - b - 1 >= 4096 || strlen(e + 1) >= 4096)
+      return usage_error("%s '%s': expected rows.npy,cols.npy,vals.npy or one (nnz, 3) FILE.npy", opt, spec);
+    memcpy(buf[0], a, (size_t)(b - a)); buf[0][b - a] = '\0';
+    memcpy(buf[1], b + 1, (size_t)(e - b - 1)); buf[1][e - b - 1] = '\0';
+    strcpy(buf[2], e + 1);
+    nf = 3;
+  } else {
+    strcpy(buf[0], "");
+  }
+  for (k = 0; k < nf; ++k)
+    if (mat_load(&M[k], opt, nf == 3 ? buf[k] : spec)) { for (j = 0; j < k; ++j) mat_free(&M[j]); return 1; }
+  if (nf == 1) {
+    if (M[0].ndim != 2 || M[0].cols != 3) {
+      err = fail("%s (%s): expected an (nnz, 3) array of (row, col, value), got %s", spec, opt, shape_str(&M[0]));
+      goto done;
+    }
+    rows = cols = vals = &M[0];
+    nnz = M[0].rows;
+  } else {
+    nnz = M[0].rows * M[0].cols;
+    for (k = 0; k < 3; ++k)
+      if (!is_vector(&M[k]) || M[k].rows * M[k].cols != nnz) {
+        err = fail("%s (%s): rows, cols and vals must be vectors of one length (%d), got %s for %s", spec, opt, nnz,
+                   shape_str(&M[k]), buf[k]);
+        goto done;
+      }
+    rows = &M[0]; cols = &M[1]; vals = &M[2];
+  }
+  c->cp = (int *)calloc((size_t)N + 1, sizeof(int));
+  c->ri = (int *)malloc(sizeof(int) * ((size_t)nnz + 1));
+  c->v = (double *)malloc(sizeof(double) * ((size_t)nnz + 1));
+  if (!c->cp || !c->ri || !c->v) { err = fail("out of memory"); goto done; }
+  for (k = 0; k < nnz && !err; ++k) { /* count per column */
+    int col;
+    if ((err = coo_index(cols, k, nf == 3 ? 0 : 1, nnz, spec, opt, N, &col)) == 0) c->cp[col + 1]++;
+  }
+  for (j = 0; j < N && !err; ++j) c->cp[j + 1] += c->cp[j];
+  for (k = 0; k < nnz && !err; ++k) { /* place; cp[j] advances to the end of column j */
+    int r, col;
+    if ((err = coo_index(rows, k, 0, nnz, spec, opt, N, &r)) != 0) break;
+    coo_index(cols, k, nf == 3 ? 0 : 1, nnz, spec, opt, N, &col);
+    c->ri[c->cp[col]] = r;
+    c->v[c->cp[col]++] = vals->a[(size_t)k + (nf == 3 ? 0u : 2u) * (size_t)nnz];
+  }
+  if (err) goto done;
+  for (j = N; j > 0; --j) c->cp[j] = c->cp[j - 1];
+  c->cp[0] = 0;
+  for (j = 0, q = 0; j < N; ++j) { /* sort each column by row (insertion), sum duplicates */
+    int start = c->cp[j], end = c->cp[j + 1];
+    for (p = start + 1; p < end; ++p) {
+      int r = c->ri[p], t;
+      double v = c->v[p];
+      for (t = p; t > start && c->ri[t - 1] > r; --t) { c->ri[t] = c->ri[t - 1]; c->v[t] = c->v[t - 1]; }
+      c->ri[t] = r; c->v[t] = v;
+    }
+    c->cp[j] = q;
+    for (p = start; p < end; ++p) {
+      if (q > c->cp[j] && c->ri[q - 1] == c->ri[p]) c->v[q - 1] += c->v[p];
+      else { c->ri[q] = c->ri[p]; c->v[q] = c->v[p]; ++q; }
+    }
+  }
+  c->cp[N] = q;
+  c->A.n_rows = c->A.n_cols = N;
+  c->A.colptr = c->cp; c->A.rowidx = c->ri; c->A.values = c->v;
+done:
+  for (k = 0; k < nf; ++k) mat_free(&M[k]);
+  return err;
+}
+
 typedef struct reduce_state {
   mat J, R, B, Q, X, poly, pidx, pw, ex;
   int *idx;
   double *fpoly, *fexp, named[8]; /* the family's coefficients as phgmg_ph_system wants them */
   double *Xsim, *Ysim, *V0;
+  cli_csc cJ, cR, cQ;     /* sparse input (--J-coo ...) */
+  phgmg_ph_sparse *sp;    /* its banded, RCM-ordered system; NULL for dense input */
+  double *Xperm, *Uord;   /* snapshots in the internal order; un-permuted output */
   cli_input in;
   phgmg_reduced *red;
   staged sg; /* the outputs, renamed into place at the end */
@@ -957,6 +1079,8 @@ static void reduce_cleanup(reduce_state *S) {
   mat_free(&S->J); mat_free(&S->R); mat_free(&S->B); mat_free(&S->Q); mat_free(&S->X);
   mat_free(&S->poly); mat_free(&S->pidx); mat_free(&S->pw); mat_free(&S->ex); mat_free(&S->in.tab);
   free(S->idx); free(S->fpoly); free(S->fexp); free(S->Xsim); free(S->Ysim); free(S->V0);
+  cli_csc_free(&S->cJ); cli_csc_free(&S->cR); cli_csc_free(&S->cQ);
+  phgmg_ph_sparse_destroy(S->sp); free(S->Xperm); free(S->Uord);
   phgmg_reduced_destroy(S->red);
   stage_abort(&S->sg); /* after a failure: no output of this run stays */
 }
@@ -978,6 +1102,40 @@ static void remove_stale(const char *dir, const char *name, const outlist *ol) {
       if (remove(path) == 0) progress("removed %s (an array of an earlier run, not written by this one)", path);
     }
   }
+}
+
+/* The sparse system (--J-coo, --R-coo, --Q-coo, --B) into S->sp and sys. */
+static int load_sparse_system(const reduce_args *A, reduce_state *S, phgmg_ph_system *sys) {
+  phgmg_ph_sparse_info inf;
+  phgmg_result rc;
+  int N, m;
+  if (mat_load(&S->B, "--B", A->B)) return 1;
+  N = S->B.rows;
+  if (S->B.ndim == 0 || N < 1 || S->B.cols < 1 || S->B.cols > N)
+    return fail("%s (--B): expected shape (N, m) with 1 <= m <= N, or (N,), got %s", A->B, shape_str(&S->B));
+  m = S->B.cols;
+  if (load_coo(&S->cJ, "--J-coo", A->Jcoo, N) || load_coo(&S->cR, "--R-coo", A->Rcoo, N) ||
+      load_coo(&S->cQ, "--Q-coo", A->Qcoo, N))
+    return 1;
+  rc = phgmg_ph_sparse_create(&S->sp, N, m, &S->cJ.A, &S->cR.A, &S->cQ.A, S->B.a, NULL, &inf, NULL);
+  if (rc != PHGMG_OK) return fail("sparse J, R, Q: %s", phgmg_result_string(rc));
+  *sys = *phgmg_ph_sparse_system(S->sp);
+  progress("sparse J, R, Q: N = %d, %ld stored entries; half-bandwidth %d (given order %d, reverse "
+           "Cuthill-McKee %d)%s", N, inf.nnz, inf.kb, inf.kb_input, inf.kb_rcm,
+           inf.wide ? "; wide band (kb > N/4): dense .npy input would be as fast" : "");
+  return 0;
+}
+
+/* write_field of an N x cols full-dimension array, in the user's ordering. */
+static int write_user_field(const reduce_args *A, reduce_state *S, const char *field, const double *M, int cols,
+                            outlist *ol) {
+  const int N = S->sp ? phgmg_ph_sparse_system(S->sp)->N : 0;
+  if (!S->sp) return write_field(A->out, A->name, field, M, S->J.rows, cols, ol, &S->sg);
+  free(S->Uord);
+  S->Uord = (double *)malloc(sizeof(double) * (size_t)N * (size_t)cols + 1);
+  if (!S->Uord) return fail("out of memory");
+  phgmg_ph_sparse_to_user_order(S->sp, cols, M, N, S->Uord, N);
+  return write_field(A->out, A->name, field, S->Uord, N, cols, ol, &S->sg);
 }
 
 static int cmd_reduce_impl(const reduce_args *A, reduce_state *S) {
@@ -1002,28 +1160,34 @@ static int cmd_reduce_impl(const reduce_args *A, reduce_state *S) {
   else return usage_error("--method '%s': expected gmg-pod, gmg-qm, sp1 or sp2", A->method);
 
   /* --- the system --- */
-  if (mat_load(&S->J, "--J", A->J)) return 1;
-  N = S->J.rows;
-  if (S->J.ndim != 2 || S->J.cols != N || N < 1)
-    return fail("%s (--J): J must be a square N x N matrix, got %s", A->J, shape_str(&S->J));
-  progress("J: %s, N = %d", A->J, N);
-  if (mat_load(&S->R, "--R", A->R)) return 1;
-  if (S->R.ndim != 2 || S->R.rows != N || S->R.cols != N)
-    return fail("%s (--R): expected shape (%d, %d) (N x N, N = %d from %s), got %s", A->R, N, N, N, A->J,
-                shape_str(&S->R));
-  if (mat_load(&S->Q, "--Q", A->Q)) return 1;
-  if (S->Q.ndim != 2 || S->Q.rows != N || S->Q.cols != N)
-    return fail("%s (--Q): expected shape (%d, %d) (N x N, N = %d from %s), got %s", A->Q, N, N, N, A->J,
-                shape_str(&S->Q));
-  if (mat_load(&S->B, "--B", A->B)) return 1;
-  if (S->B.ndim == 0 || S->B.rows != N || S->B.cols < 1 || S->B.cols > N)
-    return fail("%s (--B): expected shape (%d, m) with 1 <= m <= %d, or (%d,), got %s", A->B, N, N, N,
-                shape_str(&S->B));
-  m = S->B.cols;
-  memset(&sys, 0, sizeof sys);
-  sys.N = N; sys.m = m; sys.storage = PHGMG_DENSE;
-  sys.J = S->J.a; sys.R = S->R.a; sys.Q = S->Q.a; sys.B = S->B.a;
-  sys.nl = PHGMG_NL_NONE;
+  if (A->Jcoo) {
+    if (load_sparse_system(A, S, &sys)) return 1;
+    N = sys.N;
+    m = sys.m;
+  } else {
+    if (mat_load(&S->J, "--J", A->J)) return 1;
+    N = S->J.rows;
+    if (S->J.ndim != 2 || S->J.cols != N || N < 1)
+      return fail("%s (--J): J must be a square N x N matrix, got %s", A->J, shape_str(&S->J));
+    progress("J: %s, N = %d", A->J, N);
+    if (mat_load(&S->R, "--R", A->R)) return 1;
+    if (S->R.ndim != 2 || S->R.rows != N || S->R.cols != N)
+      return fail("%s (--R): expected shape (%d, %d) (N x N, N = %d from %s), got %s", A->R, N, N, N, A->J,
+                  shape_str(&S->R));
+    if (mat_load(&S->Q, "--Q", A->Q)) return 1;
+    if (S->Q.ndim != 2 || S->Q.rows != N || S->Q.cols != N)
+      return fail("%s (--Q): expected shape (%d, %d) (N x N, N = %d from %s), got %s", A->Q, N, N, N, A->J,
+                  shape_str(&S->Q));
+    if (mat_load(&S->B, "--B", A->B)) return 1;
+    if (S->B.ndim == 0 || S->B.rows != N || S->B.cols < 1 || S->B.cols > N)
+      return fail("%s (--B): expected shape (%d, m) with 1 <= m <= %d, or (%d,), got %s", A->B, N, N, N,
+                  shape_str(&S->B));
+    m = S->B.cols;
+    memset(&sys, 0, sizeof sys);
+    sys.N = N; sys.m = m; sys.storage = PHGMG_DENSE;
+    sys.J = S->J.a; sys.R = S->R.a; sys.Q = S->Q.a; sys.B = S->B.a;
+    sys.nl = PHGMG_NL_NONE;
+  }
   if (A->poly_idx) {
     int nt;
     if (mat_load(&S->pidx, "--poly-idx", A->poly_idx)) return 1;
@@ -1049,6 +1213,8 @@ static int cmd_reduce_impl(const reduce_args *A, reduce_state *S) {
     sys.nl = PHGMG_NL_SEPARABLE;
     sys.nsep = nt;
     sys.sep_idx = S->idx;
+    if (S->sp && (rc = phgmg_ph_sparse_sep_idx(S->sp, nt, S->idx, NULL, &sys)) != PHGMG_OK)
+      return fail("%s (--poly-idx): %s", A->poly_idx, phgmg_result_string(rc));
     sys.sep_w = A->poly_w ? S->pw.a : NULL;
     if (load_family(A, S, &sys, nt)) return 1;
     progress("nonlinear part: %d terms, %s, polynomial degree %d, %d exponentials%s", nt,
@@ -1056,6 +1222,9 @@ static int cmd_reduce_impl(const reduce_args *A, reduce_state *S) {
              sys.phi_nfun > 1 ? " (one function per term)" : "");
   }
   rc = phgmg_ph_validate(&sys, 0.0, &rcond, NULL);
+  if (rc != PHGMG_OK && S->sp)
+    return fail("the sparse system (%s, %s, %s, %s) is not valid: %s%s", A->Jcoo, A->Rcoo, A->Qcoo, A->B,
+                phgmg_result_string(rc), rc == PHGMG_ERR_SINGULAR ? " (J - R singular)" : "");
   if (rc != PHGMG_OK) return explain_validate(rc, &S->J, &S->R, &S->B, &S->Q, rcond);
   progress("system: N = %d, m = %d, valid port-Hamiltonian (rcond(J - R) = %.3g)", N, m, rcond);
 
@@ -1077,6 +1246,12 @@ static int cmd_reduce_impl(const reduce_args *A, reduce_state *S) {
                   A->X, N, N, A->J, shape_str(&S->X));
     X = S->X.a;
     ns = S->X.cols;
+    if (S->sp) { /* into the internal (banded) ordering */
+      S->Xperm = (double *)malloc(sizeof(double) * (size_t)N * (size_t)ns);
+      if (!S->Xperm) return fail("out of memory");
+      phgmg_ph_sparse_to_banded_order(S->sp, ns, X, N, S->Xperm, N);
+      X = S->Xperm;
+    }
     progress("snapshots: %s, %d states", A->X, ns);
   } else {
     phgmg_gl3_opts go;
@@ -1182,14 +1357,14 @@ static int cmd_reduce_impl(const reduce_args *A, reduce_state *S) {
     if (!xr0 || !S->V0) { free(xr0); return fail("out of memory"); }
     phgmg_reduced_dphi(S->red, xr0, S->V0, N);
     free(xr0);
-    if (write_field(A->out, A->name, "V0", S->V0, N, rom->r, &ol, &S->sg)) return 1;
+    if (write_user_field(A, S, "V0", S->V0, rom->r, &ol)) return 1;
   }
   if (rom->kind == PHGMG_ROM_QUADRATIC) {
     /* V2 and M of the quadratic map. phgmg.h has no public accessor for them
        yet; this program compiles the implementation, so it reads them from the
        reduced object directly. */
     const int p = rom->r - rom->m;
-    if (write_field(A->out, A->name, "V2", S->red->V2, N, rom->rn, &ol, &S->sg)) return 1;
+    if (write_user_field(A, S, "V2", S->red->V2, rom->rn, &ol)) return 1;
     if (write_field(A->out, A->name, "M", S->red->M, rom->rn, p * p, &ol, &S->sg)) return 1;
   }
   if (A->save_snap) {
@@ -1199,7 +1374,7 @@ static int cmd_reduce_impl(const reduce_args *A, reduce_state *S) {
       if (!Y) return fail("out of memory");
       for (k = 0; k < ns; ++k) phgmg_ph_output(&sys, X + (size_t)k * N, Y + (size_t)k * m);
     }
-    if (write_field(A->out, A->name, "snapshots", X, N, ns, &ol, &S->sg)) return 1;
+    if (write_user_field(A, S, "snapshots", X, ns, &ol)) return 1;
     if (write_field(A->out, A->name, "fom_y", Y, m, ns, &ol, &S->sg)) return 1;
   }
   snprintf(path, sizeof path, "%s/%s.phgmgrom", A->out, A->name);
@@ -1224,8 +1399,9 @@ static int cmd_reduce_impl(const reduce_args *A, reduce_state *S) {
   fprintf(jf, "  \"dt_map\": ");
   json_num(jf, rom->Phi ? (double)rom->dt : 0.0);
   fprintf(jf, ",\n  \"system\": {\"J\": ");
-  json_str(jf, A->J); fprintf(jf, ", \"R\": "); json_str(jf, A->R);
-  fprintf(jf, ", \"B\": "); json_str(jf, A->B); fprintf(jf, ", \"Q\": "); json_str(jf, A->Q);
+  json_str(jf, A->J ? A->J : A->Jcoo); fprintf(jf, ", \"R\": "); json_str(jf, A->R ? A->R : A->Rcoo);
+  fprintf(jf, ", \"B\": "); json_str(jf, A->B); fprintf(jf, ", \"Q\": "); json_str(jf, A->Q ? A->Q : A->Qcoo);
+  if (S->sp) fprintf(jf, ", \"sparse\": true, \"kb\": %d", sys.kb);
   if (A->poly_idx) {
     if (A->poly) { fprintf(jf, ", \"poly\": "); json_str(jf, A->poly); }
     if (A->expf) { fprintf(jf, ", \"exp\": "); json_str(jf, A->expf); }
