@@ -7468,6 +7468,27 @@ done:
   return rc;
 }
 
+/* XR (r x ns, ld r) = rho of ns snapshots at once (GEMM; phgmg_reduced_restrict
+   column by column gives the same values up to rounding). */
+PHGMG__PRIV void phgmg__restrict_block(const phgmg_reduced *red, int ns, const double *X, int ldx, double *XR) {
+  const int N = red->N, m = red->m, r = red->r;
+  int i, j, k;
+  if (red->method == PHGMG_METHOD_SP1 || red->method == PHGMG_METHOD_SP2 || red->method == PHGMG_METHOD_PRBT) {
+    phgmg_gemm('T', 'N', r, ns, N, 1.0, red->W, N, X, ldx, 0.0, XR, r);
+    return;
+  }
+  phgmg_gemm('T', 'N', m, ns, N, 1.0, red->QB, N, X, ldx, 0.0, XR, r);
+  phgmg_gemm('T', 'N', r - m, ns, N, 1.0, red->V0 + (size_t)N * m, N, X, ldx, 0.0, XR + m, r);
+  for (k = 0; k < ns; ++k) {   /* RB^{-1} on the port coordinates */
+    double *xr = XR + (size_t)k * r;
+    for (i = m - 1; i >= 0; --i) {
+      double sm = xr[i];
+      for (j = i + 1; j < m; ++j) sm -= red->RB[i + j * m] * xr[j];
+      xr[i] = sm / red->RB[i + i * m];
+    }
+  }
+}
+
 /* The separable part uses the built-in exp-polynomial family (else callbacks). */
 PHGMG__PRIV int phgmg__sep_builtin(const phgmg_ph_system *s) { return s->poly_deg > 0 || s->nexp > 0; }
 
@@ -8228,12 +8249,12 @@ PHGMG__PRIV phgmg_result phgmg__q_envelope(phgmg__rctx *c) {
   double *xr, q[64], qmax = 0.0;
   int j, i;
   red->qmax = phgmg__red_d(red, 1);
-  xr = phgmg__dalloc(c->alloc, (size_t)r);
+  xr = phgmg__dalloc(c->alloc, (size_t)r * c->ns);
   if (!red->qmax || !xr) { phgmg__free(c->alloc, xr); return PHGMG_ERR_NOMEM; }
+  phgmg__restrict_block(red, c->ns, c->X, c->ldx, xr);
   for (j = 0; j < c->ns; ++j) {
     double s2 = 0.0;
-    phgmg_reduced_restrict(red, c->X + (size_t)j * c->ldx, xr);
-    phgmg__eta_d(red, xr + m, q, NULL, NULL, red->rwork);
+    phgmg__eta_d(red, xr + (size_t)j * r + m, q, NULL, NULL, red->rwork);
     for (i = 0; i < rn; ++i) s2 += q[i] * q[i];
     qmax = PHGMG__MAX(qmax, sqrt(s2));
   }
@@ -8253,13 +8274,14 @@ PHGMG__PRIV phgmg_result phgmg__stage_envelope(phgmg__rctx *c) {
   int j, a;
   phgmg_result rc;
   red->env = phgmg__red_d(red, 2 * (size_t)r);
-  xr = phgmg__dalloc(c->alloc, (size_t)r);
+  xr = phgmg__dalloc(c->alloc, (size_t)r * c->ns);
   if (!red->env || !xr) { phgmg__free(c->alloc, xr); return PHGMG_ERR_NOMEM; }
+  phgmg__restrict_block(red, c->ns, c->X, c->ldx, xr);
   for (j = 0; j < c->ns; ++j) {
-    phgmg_reduced_restrict(red, c->X + (size_t)j * c->ldx, xr);
+    const double *xj = xr + (size_t)j * r;
     for (a = 0; a < r; ++a) {
-      if (j == 0 || xr[a] < red->env[a]) red->env[a] = xr[a];
-      if (j == 0 || xr[a] > red->env[r + a]) red->env[r + a] = xr[a];
+      if (j == 0 || xj[a] < red->env[a]) red->env[a] = xj[a];
+      if (j == 0 || xj[a] > red->env[r + a]) red->env[r + a] = xj[a];
     }
   }
   for (a = 0; a < r; ++a) big = PHGMG__MAX(big, red->env[r + a] - red->env[a]);
