@@ -78,10 +78,17 @@
             PHGMG_ROM_STEPPER_MEMSIZE_MAX, phgmg_rom_stepper_init, phgmg_rom_stepper_reset,
             phgmg_rom_stage_times, phgmg_rom_step
    reduce:  phgmg_pod, phgmg_adjust_snapshots, phgmg_pod_hierarchical, phgmg_deim,
-            phgmg_reduce (GMG-QM ridge lambda fixed or chosen by validation on
-            held-out blocks of snapshots: opts.lambda_auto), phgmg_reduced_destroy, phgmg_reduced_rom, phgmg_reduced_N,
+            phgmg_deim_select (Q-DEIM / greedy), phgmg_nnls, phgmg_ecsw,
+            phgmg_ecsw_separable (non-negative empirical quadrature),
+            phgmg_runs_columns, phgmg_simulate_inputs (several training runs),
+            phgmg_reduce (pipeline of named stages; every Hamiltonian kind --
+            quadratic, separable exp-polynomial or callbacks, GENERAL -- with
+            GMG-POD, GMG-QM, your own manifold eta (GMG_MANIFOLD), SP1, SP2;
+            hyper-reduction opts.hyper: ECSW w >= 0 by default, Q-DEIM, greedy;
+            GMG-QM lambda fixed or validated by simulation: opts.lambda_auto),
+            phgmg_reduced_destroy, phgmg_reduced_rom, phgmg_reduced_N,
             phgmg_reduced_lift (phi), phgmg_reduced_restrict (rho), phgmg_reduced_dphi,
-            phgmg_reduced_W, phgmg_reduced_simulate
+            phgmg_reduced_W, phgmg_reduced_simulate, phgmg_reduced_validate
    errors:  phgmg_rel_error, phgmg_err_red, phgmg_err_proj, phgmg_err_lowerbound,
             phgmg_err_energy
    linear:  phgmg_lyap, phgmg_care, phgmg_lyap_residual, phgmg_care_residual, phgmg_ph_abc,
