@@ -55,6 +55,8 @@
      PHGMG_MALLOC(sz,u) / PHGMG_FREE(p,u)   default allocator (both or neither)
      PHGMG_ASSERT(x)       internal invariant checks (default assert)
      PHGMG_USE_CBLAS       use cblas_dgemm/cblas_dgemv (optional speed-up)
+     PHGMG_USE_OPENMP      with -fopenmp: phgmg_gemm runs its row blocks in
+                           parallel (off by default; same results; OMP_NUM_THREADS)
      PHGMG_POD_RANDOMIZED_MIN  phgmg_pod with tol <= 0 switches to the randomized
                            POD when N*ns >= this (default 0: never; see phgmg_pod)
      PHGMG_POD_OVERSAMPLE, PHGMG_POD_POWER_ITERS, PHGMG_POD_SEED  its parameters
@@ -212,7 +214,9 @@ extern "C" {
 /* C = alpha*op(A)*op(B) + beta*C; op(A) is m x k, op(B) is k x n. beta = 0
    overwrites C (NaN in C is not propagated). Cache blocked with a register-tiled
    micro-kernel; uses PHGMG_GEMM_MC*PHGMG_GEMM_KC doubles of stack (128 KiB by
-   default; both macros can be set before including the implementation). */
+   default, per thread; both macros can be set before including the
+   implementation). With PHGMG_USE_OPENMP and -fopenmp, row blocks run in
+   parallel for large products (bit-identical to the serial result). */
 PHGMG_DEF void phgmg_gemm(char transa, char transb, int m, int n, int k, double alpha,
                           const double *A, int lda, const double *B, int ldb,
                           double beta, double *C, int ldc);
@@ -1713,54 +1717,73 @@ PHGMG__PRIV void phgmg__gemm_micro(int kc, const double *Ap, const double *B, si
    amode 0: opA(A)(i, p) = A[i + p*lda]; 1: A[p + i*lda] (transposed);
    2 (m even, A the real view of an interleaved complex matrix): rows 2r, 2r+1
    of opA are (-Im, Re) of complex row r, i.e. the real view of i*A. */
+/* One row block ic:ic+mc of the product over k block pc:pc+kc (see below):
+   packs its own copy of opA (stack), so row blocks are independent. */
+PHGMG__PRIV void phgmg__gemm_rowblock(int ic, int mc, int pc, int kc, int n, double alpha, int amode,
+                                      const double *A, int lda, const double *B, size_t bsp,
+                                      size_t bsj, double *C, int ldc) {
+  double Ap[PHGMG_GEMM_MC * PHGMG_GEMM_KC];
+  int ir, jr, p, i;
+  /* pack opA(ic:ic+mc, pc:pc+kc) into 8-row slivers, zero padded */
+  for (ir = 0; ir < mc; ir += PHGMG__MR) {
+    int mr = PHGMG__MIN(PHGMG__MR, mc - ir);
+    double *dst = Ap + (size_t)ir * (size_t)kc;
+    if (amode == 0) {
+      for (p = 0; p < kc; ++p) {
+        const double *src = A + (ic + ir) + (size_t)(pc + p) * (size_t)lda;
+        double *d = dst + (size_t)p * PHGMG__MR;
+        for (i = 0; i < mr; ++i) d[i] = src[i];
+        for (; i < PHGMG__MR; ++i) d[i] = 0.0;
+      }
+    } else if (amode == 1) {
+      for (i = 0; i < PHGMG__MR; ++i) {
+        if (i < mr) {
+          const double *src = A + pc + (size_t)(ic + ir + i) * (size_t)lda;
+          for (p = 0; p < kc; ++p) dst[(size_t)p * PHGMG__MR + i] = src[p];
+        } else {
+          for (p = 0; p < kc; ++p) dst[(size_t)p * PHGMG__MR + i] = 0.0;
+        }
+      }
+    } else {
+      for (p = 0; p < kc; ++p) {
+        const double *src = A + (ic + ir) + (size_t)(pc + p) * (size_t)lda;
+        double *d = dst + (size_t)p * PHGMG__MR;
+        for (i = 0; i + 1 < mr; i += 2) { d[i] = -src[i + 1]; d[i + 1] = src[i]; }
+        for (; i < PHGMG__MR; ++i) d[i] = 0.0;
+      }
+    }
+  }
+  for (jr = 0; jr < n; jr += PHGMG__NR) {
+    int nr = PHGMG__MIN(PHGMG__NR, n - jr);
+    const double *bp = B + (size_t)pc * bsp + (size_t)jr * bsj;
+    for (ir = 0; ir < mc; ir += PHGMG__MR)
+      phgmg__gemm_micro(kc, Ap + (size_t)ir * (size_t)kc, bp, bsp, bsj,
+                        PHGMG__MIN(PHGMG__MR, mc - ir), nr, alpha,
+                        C + (ic + ir) + (size_t)jr * (size_t)ldc, ldc);
+  }
+}
+
+/* C (m x n) += alpha * opA(A) * opB(B), opB(B)(p, j) = B[p*bsp + j*bsj];
+   amode 0: opA(A)(i, p) = A[i + p*lda]; 1: A[p + i*lda] (transposed);
+   2 (m even, A the real view of an interleaved complex matrix): rows 2r, 2r+1
+   of opA are (-Im, Re) of complex row r, i.e. the real view of i*A.
+   With PHGMG_USE_OPENMP (and -fopenmp) the row blocks of one k block run in
+   parallel when the block holds more than ~4 Mflop; every entry of C is still
+   summed by one thread in the same order, so the result does not depend on the
+   number of threads. */
 PHGMG__PRIV void phgmg__gemm_acc(int m, int n, int k, double alpha, int amode, const double *A,
                                  int lda, const double *B, size_t bsp, size_t bsj, double *C,
                                  int ldc) {
-  double Ap[PHGMG_GEMM_MC * PHGMG_GEMM_KC];
-  int pc, ic, ir, jr, p, i;
+  int pc, ic;
   if (m <= 0 || n <= 0 || k <= 0 || alpha == 0.0) return;
   for (pc = 0; pc < k; pc += PHGMG_GEMM_KC) {
     int kc = PHGMG__MIN(PHGMG_GEMM_KC, k - pc);
-    for (ic = 0; ic < m; ic += PHGMG_GEMM_MC) {
-      int mc = PHGMG__MIN(PHGMG_GEMM_MC, m - ic);
-      /* pack opA(ic:ic+mc, pc:pc+kc) into 8-row slivers, zero padded */
-      for (ir = 0; ir < mc; ir += PHGMG__MR) {
-        int mr = PHGMG__MIN(PHGMG__MR, mc - ir);
-        double *dst = Ap + (size_t)ir * (size_t)kc;
-        if (amode == 0) {
-          for (p = 0; p < kc; ++p) {
-            const double *src = A + (ic + ir) + (size_t)(pc + p) * (size_t)lda;
-            double *d = dst + (size_t)p * PHGMG__MR;
-            for (i = 0; i < mr; ++i) d[i] = src[i];
-            for (; i < PHGMG__MR; ++i) d[i] = 0.0;
-          }
-        } else if (amode == 1) {
-          for (i = 0; i < PHGMG__MR; ++i) {
-            if (i < mr) {
-              const double *src = A + pc + (size_t)(ic + ir + i) * (size_t)lda;
-              for (p = 0; p < kc; ++p) dst[(size_t)p * PHGMG__MR + i] = src[p];
-            } else {
-              for (p = 0; p < kc; ++p) dst[(size_t)p * PHGMG__MR + i] = 0.0;
-            }
-          }
-        } else {
-          for (p = 0; p < kc; ++p) {
-            const double *src = A + (ic + ir) + (size_t)(pc + p) * (size_t)lda;
-            double *d = dst + (size_t)p * PHGMG__MR;
-            for (i = 0; i + 1 < mr; i += 2) { d[i] = -src[i + 1]; d[i + 1] = src[i]; }
-            for (; i < PHGMG__MR; ++i) d[i] = 0.0;
-          }
-        }
-      }
-      for (jr = 0; jr < n; jr += PHGMG__NR) {
-        int nr = PHGMG__MIN(PHGMG__NR, n - jr);
-        const double *bp = B + (size_t)pc * bsp + (size_t)jr * bsj;
-        for (ir = 0; ir < mc; ir += PHGMG__MR)
-          phgmg__gemm_micro(kc, Ap + (size_t)ir * (size_t)kc, bp, bsp, bsj,
-                            PHGMG__MIN(PHGMG__MR, mc - ir), nr, alpha,
-                            C + (ic + ir) + (size_t)jr * (size_t)ldc, ldc);
-      }
-    }
+#ifdef PHGMG_USE_OPENMP
+#pragma omp parallel for schedule(static) if ((double)m * (double)n * (double)kc > 2e6)
+#endif
+    for (ic = 0; ic < m; ic += PHGMG_GEMM_MC)
+      phgmg__gemm_rowblock(ic, PHGMG__MIN(PHGMG_GEMM_MC, m - ic), pc, kc, n, alpha, amode, A, lda,
+                           B, bsp, bsj, C, ldc);
   }
 }
 
