@@ -6182,7 +6182,7 @@ PHGMG_DEF phgmg_result phgmg_pod(int N, int ns, const double *X, int ldx, int km
   if (N < 1 || ns < 1 || kmax < 1 || ldx < N || ldv < N || kmax > PHGMG__MIN(N, ns)) return PHGMG_ERR_SIZE;
 #if PHGMG_POD_RANDOMIZED_MIN > 0
   if (!(tol > 0.0) && (double)N * (double)ns >= (double)(PHGMG_POD_RANDOMIZED_MIN) &&
-      4 * (kmax + PHGMG_POD_OVERSAMPLE) <= PHGMG__MIN(N, ns))
+      kmax + PHGMG_POD_OVERSAMPLE <= PHGMG__MIN(N, ns) / 4)
     return phgmg_pod_randomized(N, ns, X, ldx, kmax, PHGMG_POD_POWER_ITERS, PHGMG_POD_SEED,
                                 V, ldv, S, k_out, alloc);
 #endif
