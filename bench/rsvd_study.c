@@ -7,7 +7,10 @@
    and, unless --no-exact, by phgmg_pod (exact). Prints wall times, the largest
    relative error of the 40 singular values and the largest sine of the
    subspace angles between the two bases (|| V - Ve Ve^T V ||_2 estimate by the
-   Frobenius norm). --q Q sets the power iterations.
+   Frobenius norm). --q Q sets the power iterations. --reduce: also time the
+   whole phgmg_reduce (GMG-POD, r = 20, deim = 1 with the default ECSW
+   hyper-reduction); build with -DPHGMG_POD_RANDOMIZED_MIN=50000000 to see it
+   with the randomized POD inside.
      cc -std=c99 -O2 -march=native bench/rsvd_study.c -lm
      ./a.out [--no-exact] [--q 2] 4000 16000 64000                          */
 #define _POSIX_C_SOURCE 199309L
@@ -36,7 +39,7 @@ static void *xmalloc(size_t n) {
 }
 
 int main(int argc, char **argv) {
-  int a, exact = 1, q = 2;
+  int a, exact = 1, q = 2, red = 0;
   for (a = 1; a < argc; ++a) {
     msd_nonlinear M;
     msd_nl_opts mo;
@@ -46,6 +49,7 @@ int main(int argc, char **argv) {
     phgmg_result rc;
     if (!strcmp(argv[a], "--no-exact")) { exact = 0; continue; }
     if (!strcmp(argv[a], "--q") && a + 1 < argc) { q = atoi(argv[++a]); continue; }
+    if (!strcmp(argv[a], "--reduce")) { red = 1; continue; }
     N = atoi(argv[a]);
     memset(&mo, 0, sizeof mo);
     mo.n = N / 2;
@@ -86,6 +90,17 @@ int main(int argc, char **argv) {
     if (exact) printf("  exact %7.3f s  speed-up %5.1f  max rel err sigma_1..%d %.2e  subspace (F) %.2e", tex,
                       tex / trand, K, serr, ang);
     printf("  sigma_1 %.4e sigma_%d/sigma_1 %.2e\n", S[0], K, S[K - 1] / S[0]);
+    if (red) {
+      phgmg_reduce_opts o;
+      phgmg_reduced *rd = NULL;
+      memset(&o, 0, sizeof o);
+      o.method = PHGMG_METHOD_GMG_POD; o.r = 20; o.deim = 1;
+      t0 = now_wall();
+      rc = phgmg_reduce(&rd, &M.sys, X, N, NS, &o, NULL, NULL);
+      printf("  phgmg_reduce GMG-POD r 20 deim: %s, %.2f s (PHGMG_POD_RANDOMIZED_MIN %.0f)\n",
+             phgmg_result_string(rc), now_wall() - t0, (double)PHGMG_POD_RANDOMIZED_MIN);
+      phgmg_reduced_destroy(rd);
+    }
     fflush(stdout);
     free(X); free(x0); free(V);
     msd_nonlinear_free(&M);
