@@ -775,8 +775,8 @@ PHGMG_DEF phgmg_result phgmg_pod(int N, int ns, const double *X, int ldx, int km
    of X (N x ns) at cost O(N ns l (2 + 2 power_iters)) with l = kmax + oversampling
    (PHGMG_POD_OVERSAMPLE, default 20; l is capped at min(N, ns)). Steps: a
    Gaussian test matrix Omega (ns x l) from a private generator seeded by `seed`
-   (splitmix64 + Marsaglia polar: the same seed gives the same result on every
-   run and platform with the same libm log); Y = X Omega, orthonormalised by
+   (splitmix64 + Marsaglia polar: the same seed gives the same bits on every
+   run of the same build); Y = X Omega, orthonormalised by
    Householder QR; power_iters times Z = X^T Q, QR, Y = X Z, QR; finally
    B^T = X^T Q (ns x l) and its thin SVD (phgmg_svd), V = Q * (right singular
    vectors of B^T). Extra memory: N*l + O(ns*l) doubles (X itself is not copied;
@@ -785,8 +785,9 @@ PHGMG_DEF phgmg_result phgmg_pod(int N, int ns, const double *X, int ldx, int km
    exact ones); with a decaying spectrum the error of sigma_j falls like
    (sigma_{l+1}/sigma_j)^(2(2q+1)) with q = power_iters: on the paper's chain
    (k = 40, sigma_40/sigma_1 = 5e-5) q = 2 gives all 40 values to 1e-14
-   relative with oversampling 20 (5e-10 with 10; hence the default 20). Values far below
-   sigma_{l+1} are NOT accurate, hence no tolerance argument: a truncation
+   relative with oversampling 20 (5e-10 with 10; hence the default 20). With a
+   slowly decaying spectrum raise power_iters. Values near or below sigma_{l+1}
+   are NOT accurate, hence no tolerance argument: a truncation
    sigma_k > tol*sigma_1 with a small tol (DEIM's 1e-8) needs the exact
    phgmg_pod/phgmg_svd. *k_out = min(kmax, numerical rank of B^T); S (may be
    NULL) the k values. Magnitude-independent as phgmg_pod (power-of-two scaling
