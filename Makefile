@@ -105,6 +105,9 @@ compile-checks: phgmg.h
 	$(CXX) -std=c++11 -Wall -Wextra -Werror -DPHGMG_REAL_FLOAT -c $(BUILD)/cc/impl.cpp -o $(BUILD)/cc/a.o
 	$(CC) -std=c99 $(WARN) -c $(BUILD)/cc/decl.c -o $(BUILD)/cc/a.o
 	$(CC) -std=c99 $(WARN) $(BUILD)/cc/s1.c $(BUILD)/cc/s2.c -o $(BUILD)/cc/static2 $(LDLIBS)
+	if printf 'int main(void){return 0;}\n' | $(CC) -fopenmp -x c - -o $(BUILD)/cc/omp >/dev/null 2>&1; then \
+	  $(CC) -std=c99 $(WARN) -fopenmp -DPHGMG_USE_OPENMP -c $(BUILD)/cc/impl.c -o $(BUILD)/cc/a.o && \
+	  $(CXX) -std=c++11 -Wall -Wextra -Werror -fopenmp -DPHGMG_USE_OPENMP -c $(BUILD)/cc/impl.cpp -o $(BUILD)/cc/a.o; fi
 	if command -v clang >/dev/null 2>&1; then clang -std=c99 $(WARN) -Wdouble-promotion -c $(BUILD)/cc/impl.c -o $(BUILD)/cc/a.o && \
 	  clang -std=c99 $(WARN) -Wdouble-promotion -DPHGMG_REAL_FLOAT -c $(BUILD)/cc/impl.c -o $(BUILD)/cc/a.o; fi
 	@echo "compile checks passed"

@@ -55,6 +55,12 @@
      PHGMG_MALLOC(sz,u) / PHGMG_FREE(p,u)   default allocator (both or neither)
      PHGMG_ASSERT(x)       internal invariant checks (default assert)
      PHGMG_USE_CBLAS       use cblas_dgemm/cblas_dgemv (optional speed-up)
+     PHGMG_USE_OPENMP      with -fopenmp: phgmg_gemm runs its row blocks in
+                           parallel (off by default; same results; OMP_NUM_THREADS)
+     PHGMG_POD_RANDOMIZED_MIN  phgmg_pod with tol <= 0 switches to the randomized
+                           POD when N*ns >= this (default 0: never; see phgmg_pod)
+     PHGMG_POD_OVERSAMPLE, PHGMG_POD_POWER_ITERS, PHGMG_POD_SEED  its parameters
+                           (20, 2, a fixed seed)
 
    FUNCTIONS (one line each; full comments at the declarations) ---------------
    core:    phgmg_result_string
@@ -77,7 +83,7 @@
             phgmg_rom_stepper_memsize,
             PHGMG_ROM_STEPPER_MEMSIZE_MAX, phgmg_rom_stepper_init, phgmg_rom_stepper_reset,
             phgmg_rom_stage_times, phgmg_rom_step
-   reduce:  phgmg_pod, phgmg_adjust_snapshots, phgmg_pod_hierarchical, phgmg_deim,
+   reduce:  phgmg_pod, phgmg_pod_randomized, phgmg_adjust_snapshots, phgmg_pod_hierarchical, phgmg_deim,
             phgmg_deim_select (Q-DEIM / greedy), phgmg_nnls, phgmg_ecsw,
             phgmg_ecsw_separable (non-negative empirical quadrature),
             phgmg_runs_columns, phgmg_simulate_inputs (several training runs),
@@ -218,7 +224,9 @@ extern "C" {
 /* C = alpha*op(A)*op(B) + beta*C; op(A) is m x k, op(B) is k x n. beta = 0
    overwrites C (NaN in C is not propagated). Cache blocked with a register-tiled
    micro-kernel; uses PHGMG_GEMM_MC*PHGMG_GEMM_KC doubles of stack (128 KiB by
-   default; both macros can be set before including the implementation). */
+   default, per thread; both macros can be set before including the
+   implementation). With PHGMG_USE_OPENMP and -fopenmp, row blocks run in
+   parallel for large products (bit-identical to the serial result). */
 PHGMG_DEF void phgmg_gemm(char transa, char transb, int m, int n, int k, double alpha,
                           const double *A, int lda, const double *B, int ldb,
                           double beta, double *C, int ldc);
@@ -880,10 +888,46 @@ extern "C" {
    fewer: with tol > 0 only modes with sigma_k > tol * sigma_1 are kept.
    V: N x kmax (ldv), S: kmax singular values (may be NULL). *k_out = modes kept.
    Independent of the magnitude of X within the floating-point range (the SVD
-   scales internally by a power of two, see phgmg_svd). */
+   scales internally by a power of two, see phgmg_svd). Exact path: the thin
+   SVD of X (cost ~ N ns r with r the numerical rank, a copy of X in memory).
+   Optional automatic switch (off by default): compiled with
+   PHGMG_POD_RANDOMIZED_MIN = M > 0, a call with tol <= 0, N*ns >= M and
+   4*(kmax + PHGMG_POD_OVERSAMPLE) <= min(N, ns) returns
+   phgmg_pod_randomized(..., PHGMG_POD_POWER_ITERS (2), PHGMG_POD_SEED, ...)
+   instead (same bits). tol > 0 always takes the exact path: a tolerance
+   truncation (DEIM's 1e-8) needs the small singular values accurately, which
+   the randomized method does not give. */
 PHGMG_DEF phgmg_result phgmg_pod(int N, int ns, const double *X, int ldx, int kmax, double tol,
                                  double *V, int ldv, double *S, int *k_out,
                                  const phgmg_allocator *alloc);
+/* Randomized POD (Halko, Martinsson & Tropp 2011: randomized range finder with
+   power iterations, Algs. 4.4 and 5.1): the leading kmax left singular vectors
+   of X (N x ns) at cost O(N ns l (2 + 2 power_iters)) with l = kmax + oversampling
+   (PHGMG_POD_OVERSAMPLE, default 20; l is capped at min(N, ns)). Steps: a
+   Gaussian test matrix Omega (ns x l) from a private generator seeded by `seed`
+   (splitmix64 + Marsaglia polar: the same seed gives the same bits on every
+   run of the same build); Y = X Omega, orthonormalised by
+   Householder QR; power_iters times Z = X^T Q, QR, Y = X Z, QR; finally
+   B^T = X^T Q (ns x l) and its thin SVD (phgmg_svd), V = Q * (right singular
+   vectors of B^T). Extra memory: N*l + O(ns*l) doubles (X itself is not copied;
+   the exact phgmg_pod copies it), so at most about twice the snapshots.
+   Accuracy: the singular values are Rayleigh-Ritz values (never larger than the
+   exact ones); with a decaying spectrum the error of sigma_j falls like
+   (sigma_{l+1}/sigma_j)^(2(2q+1)) with q = power_iters: on the paper's chain
+   (k = 40, sigma_40/sigma_1 = 5e-5) q = 2 gives all 40 values to 1e-14
+   relative with oversampling 20 (5e-10 with 10; hence the default 20). With a
+   slowly decaying spectrum raise power_iters. Values near or below sigma_{l+1}
+   are NOT accurate, hence no tolerance argument: a truncation
+   sigma_k > tol*sigma_1 with a small tol (DEIM's 1e-8) needs the exact
+   phgmg_pod/phgmg_svd. *k_out = min(kmax, numerical rank of B^T); S (may be
+   NULL) the k values. Magnitude-independent as phgmg_pod (power-of-two scaling
+   when max|X| is outside [2^-256, 2^256]). Deterministic, single-threaded
+   unless the GEMM runs with PHGMG_USE_OPENMP (the result is the same).
+   PHGMG_ERR_INVALID_ARG (NULL, power_iters < 0), _SIZE, _NANINF, _NOMEM. */
+PHGMG_DEF phgmg_result phgmg_pod_randomized(int N, int ns, const double *X, int ldx, int kmax,
+                                            int power_iters, unsigned long seed, double *V,
+                                            int ldv, double *S, int *k_out,
+                                            const phgmg_allocator *alloc);
 /* Adjusted snapshots Xa = X - B B^+ X (B: N x m full column rank). Xa may alias X. */
 PHGMG_DEF phgmg_result phgmg_adjust_snapshots(int N, int m, const double *B, int ns, const double *X,
                                               int ldx, double *Xa, int ldxa, const phgmg_allocator *alloc);
@@ -1911,54 +1955,73 @@ PHGMG__PRIV void phgmg__gemm_micro(int kc, const double *Ap, const double *B, si
    amode 0: opA(A)(i, p) = A[i + p*lda]; 1: A[p + i*lda] (transposed);
    2 (m even, A the real view of an interleaved complex matrix): rows 2r, 2r+1
    of opA are (-Im, Re) of complex row r, i.e. the real view of i*A. */
+/* One row block ic:ic+mc of the product over k block pc:pc+kc (see below):
+   packs its own copy of opA (stack), so row blocks are independent. */
+PHGMG__PRIV void phgmg__gemm_rowblock(int ic, int mc, int pc, int kc, int n, double alpha, int amode,
+                                      const double *A, int lda, const double *B, size_t bsp,
+                                      size_t bsj, double *C, int ldc) {
+  double Ap[PHGMG_GEMM_MC * PHGMG_GEMM_KC];
+  int ir, jr, p, i;
+  /* pack opA(ic:ic+mc, pc:pc+kc) into 8-row slivers, zero padded */
+  for (ir = 0; ir < mc; ir += PHGMG__MR) {
+    int mr = PHGMG__MIN(PHGMG__MR, mc - ir);
+    double *dst = Ap + (size_t)ir * (size_t)kc;
+    if (amode == 0) {
+      for (p = 0; p < kc; ++p) {
+        const double *src = A + (ic + ir) + (size_t)(pc + p) * (size_t)lda;
+        double *d = dst + (size_t)p * PHGMG__MR;
+        for (i = 0; i < mr; ++i) d[i] = src[i];
+        for (; i < PHGMG__MR; ++i) d[i] = 0.0;
+      }
+    } else if (amode == 1) {
+      for (i = 0; i < PHGMG__MR; ++i) {
+        if (i < mr) {
+          const double *src = A + pc + (size_t)(ic + ir + i) * (size_t)lda;
+          for (p = 0; p < kc; ++p) dst[(size_t)p * PHGMG__MR + i] = src[p];
+        } else {
+          for (p = 0; p < kc; ++p) dst[(size_t)p * PHGMG__MR + i] = 0.0;
+        }
+      }
+    } else {
+      for (p = 0; p < kc; ++p) {
+        const double *src = A + (ic + ir) + (size_t)(pc + p) * (size_t)lda;
+        double *d = dst + (size_t)p * PHGMG__MR;
+        for (i = 0; i + 1 < mr; i += 2) { d[i] = -src[i + 1]; d[i + 1] = src[i]; }
+        for (; i < PHGMG__MR; ++i) d[i] = 0.0;
+      }
+    }
+  }
+  for (jr = 0; jr < n; jr += PHGMG__NR) {
+    int nr = PHGMG__MIN(PHGMG__NR, n - jr);
+    const double *bp = B + (size_t)pc * bsp + (size_t)jr * bsj;
+    for (ir = 0; ir < mc; ir += PHGMG__MR)
+      phgmg__gemm_micro(kc, Ap + (size_t)ir * (size_t)kc, bp, bsp, bsj,
+                        PHGMG__MIN(PHGMG__MR, mc - ir), nr, alpha,
+                        C + (ic + ir) + (size_t)jr * (size_t)ldc, ldc);
+  }
+}
+
+/* C (m x n) += alpha * opA(A) * opB(B), opB(B)(p, j) = B[p*bsp + j*bsj];
+   amode 0: opA(A)(i, p) = A[i + p*lda]; 1: A[p + i*lda] (transposed);
+   2 (m even, A the real view of an interleaved complex matrix): rows 2r, 2r+1
+   of opA are (-Im, Re) of complex row r, i.e. the real view of i*A.
+   With PHGMG_USE_OPENMP (and -fopenmp) the row blocks of one k block run in
+   parallel when the block holds more than ~4 Mflop; every entry of C is still
+   summed by one thread in the same order, so the result does not depend on the
+   number of threads. */
 PHGMG__PRIV void phgmg__gemm_acc(int m, int n, int k, double alpha, int amode, const double *A,
                                  int lda, const double *B, size_t bsp, size_t bsj, double *C,
                                  int ldc) {
-  double Ap[PHGMG_GEMM_MC * PHGMG_GEMM_KC];
-  int pc, ic, ir, jr, p, i;
+  int pc, ic;
   if (m <= 0 || n <= 0 || k <= 0 || alpha == 0.0) return;
   for (pc = 0; pc < k; pc += PHGMG_GEMM_KC) {
     int kc = PHGMG__MIN(PHGMG_GEMM_KC, k - pc);
-    for (ic = 0; ic < m; ic += PHGMG_GEMM_MC) {
-      int mc = PHGMG__MIN(PHGMG_GEMM_MC, m - ic);
-      /* pack opA(ic:ic+mc, pc:pc+kc) into 8-row slivers, zero padded */
-      for (ir = 0; ir < mc; ir += PHGMG__MR) {
-        int mr = PHGMG__MIN(PHGMG__MR, mc - ir);
-        double *dst = Ap + (size_t)ir * (size_t)kc;
-        if (amode == 0) {
-          for (p = 0; p < kc; ++p) {
-            const double *src = A + (ic + ir) + (size_t)(pc + p) * (size_t)lda;
-            double *d = dst + (size_t)p * PHGMG__MR;
-            for (i = 0; i < mr; ++i) d[i] = src[i];
-            for (; i < PHGMG__MR; ++i) d[i] = 0.0;
-          }
-        } else if (amode == 1) {
-          for (i = 0; i < PHGMG__MR; ++i) {
-            if (i < mr) {
-              const double *src = A + pc + (size_t)(ic + ir + i) * (size_t)lda;
-              for (p = 0; p < kc; ++p) dst[(size_t)p * PHGMG__MR + i] = src[p];
-            } else {
-              for (p = 0; p < kc; ++p) dst[(size_t)p * PHGMG__MR + i] = 0.0;
-            }
-          }
-        } else {
-          for (p = 0; p < kc; ++p) {
-            const double *src = A + (ic + ir) + (size_t)(pc + p) * (size_t)lda;
-            double *d = dst + (size_t)p * PHGMG__MR;
-            for (i = 0; i + 1 < mr; i += 2) { d[i] = -src[i + 1]; d[i + 1] = src[i]; }
-            for (; i < PHGMG__MR; ++i) d[i] = 0.0;
-          }
-        }
-      }
-      for (jr = 0; jr < n; jr += PHGMG__NR) {
-        int nr = PHGMG__MIN(PHGMG__NR, n - jr);
-        const double *bp = B + (size_t)pc * bsp + (size_t)jr * bsj;
-        for (ir = 0; ir < mc; ir += PHGMG__MR)
-          phgmg__gemm_micro(kc, Ap + (size_t)ir * (size_t)kc, bp, bsp, bsj,
-                            PHGMG__MIN(PHGMG__MR, mc - ir), nr, alpha,
-                            C + (ic + ir) + (size_t)jr * (size_t)ldc, ldc);
-      }
-    }
+#ifdef PHGMG_USE_OPENMP
+#pragma omp parallel for schedule(static) if ((double)m * (double)n * (double)kc > 2e6)
+#endif
+    for (ic = 0; ic < m; ic += PHGMG_GEMM_MC)
+      phgmg__gemm_rowblock(ic, PHGMG__MIN(PHGMG_GEMM_MC, m - ic), pc, kc, n, alpha, amode, A, lda,
+                           B, bsp, bsj, C, ldc);
   }
 }
 
@@ -6732,6 +6795,19 @@ PHGMG__PRIV void phgmg__atb(int k, int m, int n, const double *A, const double *
   phgmg_gemm('T', 'N', m, n, k, 1.0, A, k, B, k, 0.0, C, m);
 }
 
+#ifndef PHGMG_POD_OVERSAMPLE
+#define PHGMG_POD_OVERSAMPLE 20
+#endif
+#ifndef PHGMG_POD_RANDOMIZED_MIN
+#define PHGMG_POD_RANDOMIZED_MIN 0
+#endif
+#ifndef PHGMG_POD_POWER_ITERS
+#define PHGMG_POD_POWER_ITERS 2
+#endif
+#ifndef PHGMG_POD_SEED
+#define PHGMG_POD_SEED 20260611ul
+#endif
+
 PHGMG_DEF phgmg_result phgmg_pod(int N, int ns, const double *X, int ldx, int kmax, double tol,
                                  double *V, int ldv, double *S, int *k_out,
                                  const phgmg_allocator *alloc) {
@@ -6740,6 +6816,12 @@ PHGMG_DEF phgmg_result phgmg_pod(int N, int ns, const double *X, int ldx, int km
   phgmg_result rc;
   if (!X || !V || !k_out) return PHGMG_ERR_INVALID_ARG;
   if (N < 1 || ns < 1 || kmax < 1 || ldx < N || ldv < N || kmax > PHGMG__MIN(N, ns)) return PHGMG_ERR_SIZE;
+#if PHGMG_POD_RANDOMIZED_MIN > 0
+  if (!(tol > 0.0) && (double)N * (double)ns >= (double)(PHGMG_POD_RANDOMIZED_MIN) &&
+      kmax + PHGMG_POD_OVERSAMPLE <= PHGMG__MIN(N, ns) / 4)
+    return phgmg_pod_randomized(N, ns, X, ldx, kmax, PHGMG_POD_POWER_ITERS, PHGMG_POD_SEED,
+                                V, ldv, S, k_out, alloc);
+#endif
   s = phgmg__dalloc(alloc, (size_t)kmax);
   if (!s) return PHGMG_ERR_NOMEM;
   rc = phgmg_svd(N, ns, X, ldx, kmax, s, V, ldv, NULL, 1, &k, &rank, alloc);
@@ -6751,6 +6833,119 @@ PHGMG_DEF phgmg_result phgmg_pod(int N, int ns, const double *X, int ldx, int km
     *k_out = k;
   }
   phgmg__free(alloc, s);
+  return rc;
+}
+
+/* ---- randomized POD ---------------------------------------------------- */
+
+/* splitmix64 (Steele, Lea & Flood 2014): a full-period 64-bit generator. */
+PHGMG__PRIV unsigned long long phgmg__splitmix64(unsigned long long *state) {
+  unsigned long long z = (*state += 0x9E3779B97F4A7C15ull);
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+  return z ^ (z >> 31);
+}
+
+/* n standard normal numbers times 2^e (Marsaglia's polar method on splitmix64). */
+PHGMG__PRIV void phgmg__gauss_fill(size_t n, unsigned long long *state, int e, double *out) {
+  size_t t = 0;
+  while (t < n) {
+    double u = (double)(phgmg__splitmix64(state) >> 11) * ldexp(1.0, -52) - 1.0;
+    double v = (double)(phgmg__splitmix64(state) >> 11) * ldexp(1.0, -52) - 1.0;
+    double s = u * u + v * v, f;
+    if (s >= 1.0 || s == 0.0) continue;
+    f = ldexp(sqrt(-2.0 * log(s) / s), e);
+    out[t++] = u * f;
+    if (t < n) out[t++] = v * f;
+  }
+}
+
+/* Largest |entry| of X (N x ns); -1 if X holds NaN or Inf. */
+PHGMG__PRIV double phgmg__absmax_finite(int N, int ns, const double *X, int ldx) {
+  double amax = 0.0;
+  int i, j;
+  for (j = 0; j < ns; ++j) {
+    const double *x = X + (size_t)j * (size_t)ldx;
+    double cmax = 0.0;
+    for (i = 0; i < N; ++i) {
+      double a = fabs(x[i]);
+      cmax = a > cmax ? a : cmax;
+      if (!(a <= 1.7976931348623157e308)) return -1.0;
+    }
+    if (cmax > amax) amax = cmax;
+  }
+  return amax;
+}
+
+/* Q (m x l, ld m) <- orthonormal basis of its columns (Householder QR, thin Q). */
+PHGMG__PRIV phgmg_result phgmg__orth(int m, int l, double *Q, double *tau) {
+  phgmg_result rc = phgmg_qr(m, l, Q, m, tau);
+  if (rc == PHGMG_OK) phgmg_qr_form_q(m, l, Q, m, tau, NULL);
+  return rc;
+}
+
+/* A (m x n, tight) *= 2^e (no-op for e = 0). */
+PHGMG__PRIV void phgmg__scale2(size_t cnt, double *A, int e) {
+  size_t t;
+  if (e != 0)
+    for (t = 0; t < cnt; ++t) A[t] = ldexp(A[t], e);
+}
+
+PHGMG_DEF phgmg_result phgmg_pod_randomized(int N, int ns, const double *X, int ldx, int kmax,
+                                            int power_iters, unsigned long seed, double *V,
+                                            int ldv, double *S, int *k_out,
+                                            const phgmg_allocator *alloc) {
+  double *Y, *Z, *Uz, *Ub, *tau, *s, amax;
+  int l, it, i, k = 0, e = 0;
+  unsigned long long state = (unsigned long long)seed;
+  size_t ny, nz;
+  phgmg_result rc = PHGMG_OK;
+  if (!X || !V || !k_out || power_iters < 0) return PHGMG_ERR_INVALID_ARG;
+  if (N < 1 || ns < 1 || kmax < 1 || ldx < N || ldv < N || kmax > PHGMG__MIN(N, ns)) return PHGMG_ERR_SIZE;
+  amax = phgmg__absmax_finite(N, ns, X, ldx);
+  if (amax < 0.0) return PHGMG_ERR_NANINF;
+  if (amax == 0.0) { *k_out = 0; return PHGMG_OK; }
+  /* out of [2^-256, 2^256]: multiply every factor applied to X by 2^-e (exact) */
+  if (amax < ldexp(1.0, -256) || amax > ldexp(1.0, 256)) {
+    (void)frexp(amax, &e);
+    e = PHGMG__MAX(-1000, PHGMG__MIN(1000, e));
+  }
+  l = PHGMG__MIN(kmax + PHGMG_POD_OVERSAMPLE, PHGMG__MIN(N, ns));
+  ny = (size_t)N * (size_t)l;
+  nz = (size_t)ns * (size_t)l;
+  Y = phgmg__dalloc(alloc, ny);
+  Z = phgmg__dalloc(alloc, 2 * nz + (size_t)l * (size_t)l + 2 * (size_t)l);
+  if (!Y || !Z) { phgmg__free(alloc, Y); phgmg__free(alloc, Z); return PHGMG_ERR_NOMEM; }
+  Uz = Z + nz;
+  Ub = Uz + nz;
+  tau = Ub + (size_t)l * (size_t)l;
+  s = tau + l;
+  phgmg__gauss_fill(nz, &state, -e, Z);
+  phgmg_gemm('N', 'N', N, l, ns, 1.0, X, ldx, Z, ns, 0.0, Y, N);
+  rc = phgmg__orth(N, l, Y, tau);
+  for (it = 0; it < power_iters && rc == PHGMG_OK; ++it) {
+    phgmg__scale2(ny, Y, -e);
+    phgmg_gemm('T', 'N', ns, l, N, 1.0, X, ldx, Y, N, 0.0, Z, ns);
+    rc = phgmg__orth(ns, l, Z, tau);
+    if (rc != PHGMG_OK) break;
+    phgmg__scale2(nz, Z, -e);
+    phgmg_gemm('N', 'N', N, l, ns, 1.0, X, ldx, Z, ns, 0.0, Y, N);
+    rc = phgmg__orth(N, l, Y, tau);
+  }
+  if (rc == PHGMG_OK) {
+    /* Z = 2^-e B^T = X^T (2^-e Q); its SVD Uz diag(s) Ub^T gives U = Q Ub */
+    phgmg__scale2(ny, Y, -e);
+    phgmg_gemm('T', 'N', ns, l, N, 1.0, X, ldx, Y, N, 0.0, Z, ns);
+    phgmg__scale2(ny, Y, e);
+    rc = phgmg_svd(ns, l, Z, ns, kmax, s, Uz, ns, Ub, l, &k, NULL, alloc);
+  }
+  if (rc == PHGMG_OK) {
+    if (k > 0) phgmg_gemm('N', 'N', N, k, l, 1.0, Y, N, Ub, l, 0.0, V, ldv);
+    for (i = 0; i < k && S; ++i) S[i] = ldexp(s[i], e);
+    *k_out = k;
+  }
+  phgmg__free(alloc, Y);
+  phgmg__free(alloc, Z);
   return rc;
 }
 
