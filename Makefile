@@ -16,22 +16,39 @@ LDLIBS   = -lm
 TESTSRC := $(wildcard tests/test_*.c)
 BUILD    = build
 
-.PHONY: test-validate test-deploy all test test-plain test-asan compile-checks test-embedded-host test-npy test-cli test-demo test-fuzz-replay demo bench examples embedded fuzz clean
+.PHONY: test-build test-validate test-deploy all test test-plain test-asan compile-checks test-embedded-host test-npy test-cli test-demo test-fuzz-replay demo bench examples embedded fuzz clean
 
 all: phgmg.h examples
 
 tests/suites.inc: $(TESTSRC)
 	grep -h '^SUITE(' $(TESTSRC) | sed 's/^SUITE(\([a-z0-9_]*\)).*/SUITE_DECL(\1)/' > $@
 
-$(BUILD)/test_run: phgmg.h tests/run.c tests/harness.h tests/suites.inc $(TESTSRC)
-	@mkdir -p $(BUILD)
-	$(CC) $(CFLAGS_T) -o $@ tests/run.c $(TESTSRC) $(LDLIBS)
+# One object per test file (each includes the implementation with PHGMG_STATIC),
+# so that the builds run in parallel (make test builds them with -j2).
+TESTOBJ      = $(patsubst tests/%.c,$(BUILD)/obj/%.o,tests/run.c $(TESTSRC))
+TESTOBJ_ASAN = $(patsubst tests/%.c,$(BUILD)/obj_asan/%.o,tests/run.c $(TESTSRC))
 
-$(BUILD)/test_run_asan: phgmg.h tests/run.c tests/harness.h tests/suites.inc $(TESTSRC)
-	@mkdir -p $(BUILD)
-	$(CC) $(CFLAGS_T) -O1 $(SANFLAGS) -o $@ tests/run.c $(TESTSRC) $(LDLIBS)
+$(BUILD)/obj/%.o: tests/%.c phgmg.h tests/harness.h tests/suites.inc
+	@mkdir -p $(BUILD)/obj
+	$(CC) $(CFLAGS_T) -c -o $@ $<
 
-test: test-plain test-asan compile-checks test-embedded-host test-npy test-cli test-demo test-fuzz-replay test-validate
+$(BUILD)/obj_asan/%.o: tests/%.c phgmg.h tests/harness.h tests/suites.inc
+	@mkdir -p $(BUILD)/obj_asan
+	$(CC) $(CFLAGS_T) -O1 $(SANFLAGS) -c -o $@ $<
+
+$(BUILD)/test_run: $(TESTOBJ)
+	$(CC) $(CFLAGS_T) -o $@ $(TESTOBJ) $(LDLIBS)
+
+$(BUILD)/test_run_asan: $(TESTOBJ_ASAN)
+	$(CC) $(CFLAGS_T) -O1 $(SANFLAGS) -o $@ $(TESTOBJ_ASAN) $(LDLIBS)
+
+test: test-build test-plain test-asan compile-checks test-embedded-host test-npy test-cli test-demo test-fuzz-replay test-validate
+
+# Everything make test compiles, built first on both cores (the compiles are
+# most of its time); the runs below then go one after the other.
+test-build: tests/suites.inc
+	$(MAKE) -j2 $(BUILD)/test_run $(BUILD)/test_run_asan $(EXAMPLES) $(BUILD)/npy_tool \
+	  $(BUILD)/export_model_d $(BUILD)/export_model_f
 
 # `phgmg validate` and the deployment checks (tests/test_validate.sh, a few seconds).
 test-validate: $(BUILD)/phgmg
