@@ -7603,13 +7603,6 @@ PHGMG__PRIV phgmg_result phgmg__inv(int n, const double *A, double *Ainv, const 
   return rc;
 }
 
-PHGMG__PRIV double phgmg__poly_d1(const double *c, int deg, double s) {
-  double p1 = 0.0, p0 = 0.0;
-  int k;
-  for (k = deg; k >= 0; --k) { p1 = p1 * s + p0; p0 = p0 * s + c[k]; }
-  return p1;
-}
-
 /* The exact GL3 step map of x' = Jf x + Bh u (see phgmg_rom). */
 PHGMG__PRIV phgmg_result phgmg__step_map(phgmg_reduced *red, double h, const phgmg_allocator *alloc) {
   const int r = red->r, m = red->m, n3 = 3 * r, nc = r + 3 * m;
@@ -7691,8 +7684,6 @@ PHGMG__PRIV void phgmg__restrict_block(const phgmg_reduced *red, int ns, const d
   }
 }
 
-/* The separable part uses the built-in exp-polynomial family (else callbacks). */
-PHGMG__PRIV int phgmg__sep_builtin(const phgmg_ph_system *s) { return s->poly_deg > 0 || s->nexp > 0; }
 
 /* eta and its derivatives at x2, in double: the built-in quadratic map
    (q = M (x2 kron x2) = L x2 / 2, Dq = L, D2q = Ms) or the caller's eta
@@ -8851,16 +8842,19 @@ PHGMG__PRIV phgmg_result phgmg__hyper_ecsw_manifold(phgmg__rctx *c, const double
   const int nt = sys->nsep, r = red->r, m = red->m, p = red->p, rn = red->rn, N = red->N;
   const int stride = (int)(((double)c->ns * r * nt) / 4e6) + 1, nsu = (c->ns + stride - 1) / stride;
   const size_t nrow = (size_t)nsu * r;
-  double *Gm = phgmg__dalloc(c->alloc, nrow * nt + nrow + (size_t)r + (size_t)rn * p);
-  double *tg, *xr, *Dq;
+  double *Gm = phgmg__dalloc(c->alloc, nrow * nt + nrow + nrow + (size_t)rn * p);
+  double *tg, *XR, *Dq;
   int i, k, a, j, u;
   phgmg_result rc;
   if (!Gm) return PHGMG_ERR_NOMEM;
-  tg = Gm + nrow * nt; xr = tg + nrow; Dq = xr + r;
+  tg = Gm + nrow * nt; XR = tg + nrow; Dq = XR + nrow;
+  if ((double)c->ldx * stride <= 2147483647.0)   /* rho of the used snapshots */
+    phgmg__restrict_block(red, nsu, c->X, c->ldx * stride, XR);
+  else
+    for (u = 0; u < nsu; ++u) phgmg_reduced_restrict(red, c->X + (size_t)u * stride * c->ldx, XR + (size_t)u * r);
   for (u = 0; u < nsu; ++u) {
     i = u * stride;
-    phgmg_reduced_restrict(red, c->X + (size_t)i * c->ldx, xr);
-    phgmg__eta_d(red, xr + m, NULL, Dq, NULL, red->rwork);
+    phgmg__eta_d(red, XR + (size_t)u * r + m, NULL, Dq, NULL, red->rwork);
     for (k = 0; k < nt; ++k) {
       const int ix = sys->sep_idx[k];
       const double f = F[k + (size_t)i * nt];
@@ -8962,7 +8956,7 @@ PHGMG__PRIV phgmg_result phgmg__separable_functions(phgmg_reduced *red, const in
   red->term = PHGMG__CAST(int *, phgmg__red_alloc(red, (size_t)nd * sizeof(int)));
   if (!red->term) return PHGMG_ERR_NOMEM;
   for (j = 0; j < nd; ++j) red->term[j] = pts[j];
-  if (!phgmg__sep_builtin(sys)) return PHGMG_OK;  /* callbacks */
+  if (!PHGMG__PH_BUILTIN(sys)) return PHGMG_OK;  /* callbacks */
   red->nphi = per ? nd : 1;
   red->nexp = ne;
   red->poly = phgmg__red_d(red, (size_t)nf * (deg + 1));
