@@ -1658,6 +1658,7 @@ PHGMG_DEF phgmg_result phgmg_npy_write(const char *path, const double *A, int ro
 #define PHGMG__MIN(a, b) ((a) < (b) ? (a) : (b))
 #define PHGMG__MAX(a, b) ((a) > (b) ? (a) : (b))
 #define PHGMG__EPS 2.220446049250313e-16
+#define PHGMG__DBL_MIN 2.2250738585072014e-308 /* smallest normal double */
 
 /* >>result (implementation) ============================================== */
 PHGMG_DEF const char *phgmg_result_string(phgmg_result r) {
@@ -2433,17 +2434,32 @@ PHGMG_DEF double phgmg_lu_rcond(int n, const double *LU, int lda, const int *ipi
 /* ---- Householder QR ---------------------------------------------------------- */
 /* Generate H = I - tau v v^T with v = (1, x) such that H (alpha; x) = (beta; 0).
    n is the length including alpha. x is overwritten by v(1:). */
+#define PHGMG__LARFG_SAFMIN (PHGMG__DBL_MIN / PHGMG__EPS)
 PHGMG__PRIV void phgmg__larfg(int n, double *alpha, double *x, double *tau) {
   double xnorm, beta, r;
-  int i;
+  int i, knt = 0;
   if (n <= 1) { *tau = 0.0; return; }
   xnorm = phgmg_normf(n - 1, 1, x, n - 1);
   if (xnorm == 0.0) { *tau = 0.0; return; }
   beta = -copysign(hypot(*alpha, xnorm), *alpha);
+  /* A tiny (e.g. subnormal) column: 1 / (alpha - beta) would overflow and
+     turn x into Inf/NaN. Scale the column up by powers of two (exact) until
+     beta is safe, as LAPACK's dlarfg does, and scale beta back at the end;
+     beta is recomputed from the scaled column so that tau = 2 / v^T v. */
+  while (fabs(beta) < PHGMG__LARFG_SAFMIN && knt < 8) {
+    ++knt;
+    for (i = 0; i < n - 1; ++i) x[i] = ldexp(x[i], 256);
+    *alpha = ldexp(*alpha, 256);
+    beta = ldexp(beta, 256);
+  }
+  if (knt) { /* beta again from the scaled (now normal) column, as LAPACK does */
+    xnorm = phgmg_normf(n - 1, 1, x, n - 1);
+    beta = -copysign(hypot(*alpha, xnorm), *alpha);
+  }
   *tau = (beta - *alpha) / beta;
   r = 1.0 / (*alpha - beta);
   for (i = 0; i < n - 1; ++i) x[i] *= r;
-  *alpha = beta;
+  *alpha = ldexp(beta, -256 * knt);
 }
 
 /* C (m x n) := (I - tau v v^T) C, v = (1, v[1..m-1]) (v[0] is not read). */
@@ -2941,13 +2957,14 @@ PHGMG__PRIV phgmg_result phgmg__sym_jacobi(int n, double *A, int lda, double *w,
    of W is read. vec: W ends up holding the eigenvectors. d (n) receives the
    eigenvalues (unsorted), e (n) is workspace. Without vec, e may be column n-1
    of W itself (that column is then not needed). */
-PHGMG__PRIV phgmg_result phgmg__sym_tridiag_ql(int n, double *W, int ldw, int vec, double *d,
-                                               double *e) {
+/* tred2: Householder reduction of the symmetric W (lower triangle) to
+   tridiagonal form; d, e receive the diagonal and the subdiagonal (e[i] couples
+   i-1 and i), with vec W keeps the reflectors for phgmg__tred2_vectors. */
+PHGMG__PRIV void phgmg__tred2(int n, double *W, int ldw, int vec, double *d, double *e) {
 #define PHGMG__W(r, c) W[(size_t)(r) + (size_t)(c) * (size_t)ldw]
-  int i, j, k, l, m;
-  double f, g, h, tst1, dlast;
+  int i, j, k;
+  double f, g, h;
   for (j = 0; j < n; ++j) d[j] = PHGMG__W(n - 1, j);
-  dlast = d[n - 1];
   for (i = n - 1; i > 0; --i) {
     double scale = 0.0;
     h = 0.0;
@@ -2993,30 +3010,41 @@ PHGMG__PRIV phgmg_result phgmg__sym_tridiag_ql(int n, double *W, int ldw, int ve
     }
     d[i] = h;
   }
-  if (vec) {
-    /* accumulate the transformations */
-    for (i = 0; i < n - 1; ++i) {
-      PHGMG__W(n - 1, i) = PHGMG__W(i, i);
-      PHGMG__W(i, i) = 1.0;
-      h = d[i + 1];
-      if (h != 0.0) {
-        const double *wi1 = &PHGMG__W(0, i + 1);
-        for (k = 0; k <= i; ++k) d[k] = wi1[k] / h;
-        for (j = 0; j <= i; ++j) {
-          double *wj = &PHGMG__W(0, j);
-          g = phgmg__dot(i + 1, wi1, wj);
-          phgmg__axpy(i + 1, -g, d, wj);
-        }
+#undef PHGMG__W
+}
+
+/* Accumulate the reflectors tred2 left in W into the orthogonal matrix W
+   (d holds the h values on entry, the tridiagonal's diagonal on exit). */
+PHGMG__PRIV void phgmg__tred2_vectors(int n, double *W, int ldw, double *d) {
+#define PHGMG__W(r, c) W[(size_t)(r) + (size_t)(c) * (size_t)ldw]
+  int i, j, k;
+  double g, h;
+  for (i = 0; i < n - 1; ++i) {
+    PHGMG__W(n - 1, i) = PHGMG__W(i, i);
+    PHGMG__W(i, i) = 1.0;
+    h = d[i + 1];
+    if (h != 0.0) {
+      const double *wi1 = &PHGMG__W(0, i + 1);
+      for (k = 0; k <= i; ++k) d[k] = wi1[k] / h;
+      for (j = 0; j <= i; ++j) {
+        double *wj = &PHGMG__W(0, j);
+        g = phgmg__dot(i + 1, wi1, wj);
+        phgmg__axpy(i + 1, -g, d, wj);
       }
-      for (k = 0; k <= i; ++k) PHGMG__W(k, i + 1) = 0.0;
     }
-    for (j = 0; j < n; ++j) { d[j] = PHGMG__W(n - 1, j); PHGMG__W(n - 1, j) = 0.0; }
-    PHGMG__W(n - 1, n - 1) = 1.0;
-  } else {
-    for (j = 0; j < n - 1; ++j) d[j] = PHGMG__W(j, j);
-    d[n - 1] = dlast;
+    for (k = 0; k <= i; ++k) PHGMG__W(k, i + 1) = 0.0;
   }
-  /* implicit QL on the tridiagonal (d, e) */
+  for (j = 0; j < n; ++j) { d[j] = PHGMG__W(n - 1, j); PHGMG__W(n - 1, j) = 0.0; }
+  PHGMG__W(n - 1, n - 1) = 1.0;
+#undef PHGMG__W
+}
+
+/* tql2: implicit QL iteration on the tridiagonal (d, e from tred2; e shifted
+   here), rotating the columns of W when vec. */
+PHGMG__PRIV phgmg_result phgmg__tql2(int n, double *W, int ldw, int vec, double *d, double *e) {
+#define PHGMG__W(r, c) W[(size_t)(r) + (size_t)(c) * (size_t)ldw]
+  int i, l, m;
+  double f, g, h, tst1;
   for (i = 1; i < n; ++i) e[i - 1] = e[i];
   e[n - 1] = 0.0;
   f = 0.0;
@@ -3068,6 +3096,20 @@ PHGMG__PRIV phgmg_result phgmg__sym_tridiag_ql(int n, double *W, int ldw, int ve
   }
   return PHGMG_OK;
 #undef PHGMG__W
+}
+
+PHGMG__PRIV phgmg_result phgmg__sym_tridiag_ql(int n, double *W, int ldw, int vec, double *d,
+                                               double *e) {
+  const double dlast = W[(size_t)(n - 1) + (size_t)(n - 1) * (size_t)ldw];
+  int j;
+  phgmg__tred2(n, W, ldw, vec, d, e);
+  if (vec) {
+    phgmg__tred2_vectors(n, W, ldw, d);
+  } else {
+    for (j = 0; j < n - 1; ++j) d[j] = W[(size_t)j + (size_t)j * (size_t)ldw];
+    d[n - 1] = dlast;
+  }
+  return phgmg__tql2(n, W, ldw, vec, d, e);
 }
 
 #define PHGMG__SYM_JACOBI_MAX 24
@@ -4376,7 +4418,6 @@ PHGMG_DEF void phgmg_ph_sparse_to_user_order(const phgmg_ph_sparse *sp, int ncol
 
 /* >>gl3 (implementation) ================================================= */
 
-#define PHGMG__DBL_MIN 2.2250738585072014e-308 /* smallest normal double */
 
 /* Set entries with |v_i| < tau to zero (tau >= DBL_MIN: no subnormal is left;
    see Tiny entries in >>gl3). Four at a time: GCC -O2 vectorises this form

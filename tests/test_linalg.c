@@ -497,6 +497,33 @@ TEST(test_qr) {
   }
 }
 
+/* A subnormal matrix: the reflectors must not overflow (1 / (alpha - beta)
+   with a subnormal beta is Inf). Entries are small integers times 2^-1050,
+   exact as subnormals; R must be 2^-1050 R(A) up to the subnormal resolution
+   2^-1074 (relative 2^-24 of the entries), and Q orthonormal to round-off. */
+TEST(test_qr_subnormal) {
+  const int m = 12, n = 5, k = 5;
+  double A[60], F[60], tau[5], Q[60], work[5];
+  int i, j;
+  unsigned s = 7u;
+  for (i = 0; i < m * n; ++i) {
+    s = s * 1103515245u + 12345u;
+    A[i] = (double)((int)((s >> 16) % 17u) - 8);
+    F[i] = ldexp(A[i], -1050);
+  }
+  CHECK_RC(phgmg_qr(m, n, A, m, tau), PHGMG_OK);
+  CHECK_RC(phgmg_qr(m, n, F, m, tau), PHGMG_OK);
+  for (j = 0; j < n; ++j)
+    for (i = 0; i <= j; ++i) {
+      double r = ldexp(F[i + j * m], 1050);
+      CHECK(isfinite(r));
+      CHECK_LE(fabs(fabs(r) - fabs(A[i + j * m])), 1e-5 * 8.0 * m);
+    }
+  memcpy(Q, F, sizeof Q);
+  phgmg_qr_form_q(m, k, Q, m, tau, work);
+  CHECK_LE(tl_orth_err(m, k, Q, m), 100.0 * EPS);
+}
+
 TEST(test_qrcp_rank) {
   const int dims[][3] = {{80, 60, 17}, {50, 90, 30}, {40, 40, 1}};
   int s;
@@ -864,6 +891,7 @@ SUITE(linalg) {
   RUN(test_lu_rcond);
   RUN(test_zlu);
   RUN(test_qr);
+  RUN(test_qr_subnormal);
   RUN(test_qrcp_rank);
   RUN(test_qrcp_blocked);
   RUN(test_lstsq);
