@@ -963,6 +963,13 @@ PHGMG_DEF phgmg_result phgmg_simulate_inputs(const phgmg_ph_system *sys, int nru
                                              const phgmg_gl3_opts *go, double *X, int ldx, double *Y, int *col,
                                              const phgmg_allocator *alloc);
 
+/* GMG-QM manifold constructions (phgmg_reduce_opts.manifold). */
+enum {
+  PHGMG_MANIFOLD_POD = 0,    /* the paper's hierarchical POD                       */
+  PHGMG_MANIFOLD_GREEDY = 1, /* greedy linear part (Schwerdtner & Peherstorfer 2024) */
+  PHGMG_MANIFOLD_ALTMIN = 2  /* alternating minimization of V1, V2 and M           */
+};
+
 typedef struct phgmg_reduce_opts {
   phgmg_method method; /* required                                                  */
   int r;               /* reduced order (GMG: includes the m port coordinates), required */
@@ -1080,7 +1087,15 @@ typedef struct phgmg_reduce_opts {
      fit (Schwerdtner & Peherstorfer 2024; ridge lambda 1e-9 with lambda_auto,
      else opts.lambda; every ceil(ns/400)-th snapshot); V2 = POD of what
      [B, V1] leaves, as for 0. Cost: about (r - m)(r - m + rn) small
-     least-squares solves (0.1-0.5 s at r = 20). */
+     least-squares solves (0.1-0.5 s at r = 20).
+     2 = alternating minimization (PHGMG_MANIFOLD_ALTMIN; after Geelen,
+     Balzano, Wright & Willcox 2023): V1, V2 rotated within the leading
+     2 (r - m + rn) POD modes of the adjusted snapshots, alternating the ridge
+     fit of M with an orthogonal Procrustes step (extrapolated while that
+     helps), started from 0, each sweep kept only if the training objective
+     sum ||x - phi(rho(x))||^2 + lam ||M||^2 decreases (so it ends at or below
+     the hierarchical POD's; info.manifold_obj0/obj; lam as for 1); at most
+     100 sweeps. B stays in the span, [B, V1, V2] orthonormal. */
   int manifold;
   /* lambda_auto = 1 with lambda_train_only = 1: validate on the training runs
      alone (no probe runs): from the regression optimum up (one per decade),
@@ -1120,6 +1135,12 @@ typedef struct phgmg_reduce_info {
   int lambda_candidates;   /* lambda_auto = 1: candidate lambdas simulated     */
   double lambda_val_ratio; /* lambda_auto = 1: largest e_y ratio of the chosen
                               model to the linear limit over the validation runs */
+  /* manifold = PHGMG_MANIFOLD_ALTMIN: the objective sum_i ||x_i - phi(rho(x_i))||^2
+     + lam ||M||^2 over the snapshots (lam: the ridge parameter of the sweeps) at
+     the start (the hierarchical POD) and at the end, and the sweeps kept; the
+     final M is then refitted with the lambda in force (fixed or automatic). */
+  double manifold_obj0, manifold_obj;
+  int manifold_sweeps;
 } phgmg_reduce_info;
 
 /* The reduced model with its offline data (bases for reconstruction, double
@@ -8020,7 +8041,7 @@ PHGMG__PRIV phgmg_result phgmg__deploy_check(const phgmg_reduce_opts *o, int ns)
   if (!(o->lambda_tolerance == 0.0 || (o->lambda_tolerance >= 1.0 && o->lambda_tolerance < HUGE_VAL)))
     return PHGMG_ERR_INVALID_ARG;
   if (!(o->newton_tol >= 0.0 && o->newton_tol < 1.0) || o->newton_iter < 0) return PHGMG_ERR_INVALID_ARG;
-  if (o->manifold != 0 && o->manifold != 1) return PHGMG_ERR_INVALID_ARG;
+  if (o->manifold < PHGMG_MANIFOLD_POD || o->manifold > PHGMG_MANIFOLD_ALTMIN) return PHGMG_ERR_INVALID_ARG;
   if (o->lambda_train_only != 0 && o->lambda_train_only != 1) return PHGMG_ERR_INVALID_ARG;
   return PHGMG_OK;
 }
@@ -8295,6 +8316,161 @@ PHGMG__PRIV phgmg_result phgmg__qm_greedy(phgmg__rctx *c) {
   return rc;
 }
 
+/* opts.manifold = PHGMG_MANIFOLD_ALTMIN, one evaluation in the q POD
+   coordinates S (q x ns) of the adjusted snapshots, for the orthonormal
+   Q = [Q1, Q2] (q x (p + rn)): Z = Q1^T S, the ridge fit T (nc x rn) of
+   Q2^T S over the distinct Kronecker columns Kt of Z (as phgmg__qm_problem),
+   W = [Z; (Kt T)^T] ((p + rn) x ns) and the objective
+   *f = ||S - Q W||_F^2 + lam ||T||_F^2. Kt (ns x nc), Yt (ns x rn) scratch. */
+PHGMG__PRIV phgmg_result phgmg__altmin_eval(int q, int ns, int p, int rn, const double *S, const double *Q,
+                                            double lam, double *Kt, double *Yt, double *T, double *W,
+                                            double *R, double *f, const phgmg_allocator *alloc) {
+  const int k = p + rn, nc = p * (p + 1) / 2;
+  const double s2 = sqrt(2.0);
+  double sum = 0.0;
+  int i, a, j, cc;
+  phgmg_result rc;
+  phgmg_gemm('T', 'N', k, ns, q, 1.0, Q, q, S, q, 0.0, W, k);   /* [Z; Q2^T S] */
+  for (i = 0; i < ns; ++i) {
+    const double *z = W + (size_t)i * k;
+    for (a = 0, cc = 0; a < p; ++a)
+      for (j = a; j < p; ++j, ++cc) Kt[i + (size_t)cc * ns] = (a == j ? 1.0 : s2) * z[a] * z[j];
+    for (a = 0; a < rn; ++a) Yt[i + (size_t)a * ns] = z[p + a];
+  }
+  rc = phgmg_lstsq(ns, nc, rn, Kt, ns, Yt, ns, lam, T, nc, alloc);
+  if (rc != PHGMG_OK) return rc;
+  phgmg_gemm('N', 'N', ns, rn, nc, 1.0, Kt, ns, T, nc, 0.0, Yt, ns);   /* the fitted correction */
+  for (i = 0; i < ns; ++i)
+    for (a = 0; a < rn; ++a) W[p + a + (size_t)i * k] = Yt[i + (size_t)a * ns];
+  memcpy(R, S, (size_t)q * ns * sizeof(double));
+  phgmg_gemm('N', 'N', q, ns, k, -1.0, Q, q, W, k, 1.0, R, q);
+  for (i = 0; i < q * ns; ++i) sum += R[i] * R[i];
+  for (i = 0; i < nc * rn; ++i) sum += lam * T[i] * T[i];
+  *f = sum;
+  return sum <= HUGE_VAL ? PHGMG_OK : PHGMG_ERR_NANINF;
+}
+
+/* The orthonormal polar factor Q = U V^T of A = U Sigma V^T (q x k, thin
+   SVD): the orthonormal matrix nearest to A. U (q x k), V (k x k), sv (k)
+   scratch. PHGMG_ERR_RANK when A is rank deficient (not unique then). */
+PHGMG__PRIV phgmg_result phgmg__polar(int q, int k, const double *A, double *U, double *V, double *sv, double *Q,
+                                      const phgmg_allocator *alloc) {
+  int kk = 0;
+  phgmg_result rc = phgmg_svd(q, k, A, q, k, sv, U, q, V, k, &kk, NULL, alloc);
+  if (rc != PHGMG_OK) return rc;
+  if (kk < k) return PHGMG_ERR_RANK;
+  phgmg_gemm('N', 'T', q, k, k, 1.0, U, q, V, k, 0.0, Q, q);
+  return PHGMG_OK;
+}
+
+/* Workspace of the alternating minimization (phgmg__qm_altmin). */
+typedef struct phgmg__altmin_ws {
+  int q, ns, p, rn, k;
+  double lam;
+  const double *S;                    /* q x ns POD coordinates               */
+  double *Q, *W, *Qn, *Wn, *Qb, *Wb;  /* current, step, trial (q x k, k x ns)  */
+  double *Kt, *Yt, *T, *R, *A, *U, *V, *sv;
+} phgmg__altmin_ws;
+
+/* One sweep from (Q, W, *f): the Procrustes step Qn = polar(S W^T), i.e. the
+   orthonormal Q minimising ||S - Q W||_F for the current latent values W,
+   with M refitted; then, while it lowers the objective, the extrapolation
+   polar(Q + beta (Qn - Q)), beta = 2, 4, 8 (the plain step converges
+   linearly and slowly). Kept (into Q, W, *f) only if the objective
+   decreased: *moved = 1. */
+PHGMG__PRIV phgmg_result phgmg__altmin_sweep(phgmg__altmin_ws *w, double *f, int *moved,
+                                             const phgmg_allocator *alloc) {
+  const int q = w->q, k = w->k;
+  double fn, fb, beta;
+  int i;
+  phgmg_result rc;
+  *moved = 0;
+  phgmg_gemm('N', 'T', q, k, w->ns, 1.0, w->S, q, w->W, k, 0.0, w->A, q);
+  rc = phgmg__polar(q, k, w->A, w->U, w->V, w->sv, w->Qn, alloc);
+  if (rc == PHGMG_OK)
+    rc = phgmg__altmin_eval(q, w->ns, w->p, w->rn, w->S, w->Qn, w->lam, w->Kt, w->Yt, w->T, w->Wn, w->R, &fn, alloc);
+  if (rc != PHGMG_OK || !(fn < *f)) return rc;
+  for (beta = 2.0; beta <= 8.0; beta *= 2.0) {
+    for (i = 0; i < q * k; ++i) w->A[i] = w->Q[i] + beta * (w->Qn[i] - w->Q[i]);
+    rc = phgmg__polar(q, k, w->A, w->U, w->V, w->sv, w->Qb, alloc);
+    if (rc == PHGMG_OK)
+      rc = phgmg__altmin_eval(q, w->ns, w->p, w->rn, w->S, w->Qb, w->lam, w->Kt, w->Yt, w->T, w->Wb, w->R, &fb, alloc);
+    if (rc == PHGMG_ERR_NOMEM) return rc;
+    if (rc != PHGMG_OK || !(fb < fn)) break;
+    memcpy(w->Qn, w->Qb, (size_t)q * k * sizeof(double));
+    memcpy(w->Wn, w->Wb, (size_t)k * w->ns * sizeof(double));
+    fn = fb;
+  }
+  memcpy(w->Q, w->Qn, (size_t)q * k * sizeof(double));
+  memcpy(w->W, w->Wn, (size_t)k * w->ns * sizeof(double));
+  *f = fn;
+  *moved = 1;
+  return PHGMG_OK;
+}
+
+/* opts.manifold = PHGMG_MANIFOLD_ALTMIN: alternating minimization of the
+   linear and quadratic parts (after Geelen, Balzano, Wright & Willcox 2023).
+   In the coordinates S = U^T Xa of the q = min(2 (p + rn), rank) leading POD
+   modes U of the adjusted snapshots Xa = X - B B^+ X, with V1 = U Q1,
+   V2 = U Q2 and Q = [Q1, Q2] orthonormal (so [B, V1, V2] stays orthonormal
+   and B in the span, as the hierarchical POD has it), the objective is
+   sum_i ||x_i - phi(rho(x_i))||^2 + lam ||M||^2 (lam as phgmg__qm_greedy).
+   Start: Q = the leading p + rn coordinates (the hierarchical POD). Each
+   sweep (phgmg__altmin_sweep) moves Q by the orthogonal Procrustes step and
+   refits M; a sweep is kept only if the objective decreases, so it never
+   increases. Stop: no decrease, a relative decrease below 1e-5, or 100
+   sweeps. Writes V1 into red->V0 and V2 into red->V2. */
+PHGMG__PRIV phgmg_result phgmg__qm_altmin(phgmg__rctx *c) {
+  phgmg_reduced *red = c->red;
+  const int N = red->N, m = red->m, p = red->p, rn = red->rn, ns = c->ns, k = p + rn, nc = p * (p + 1) / 2;
+  const int navail = c->o->pod_basis ? c->o->pod_cols : PHGMG__MIN(N, ns) - 1;
+  double *U, *S, f = HUGE_VAL, f0, tot = 0.0, outside;
+  int it, kk = 0, i, q = PHGMG__MIN(2 * k, navail), moved = 0;
+  phgmg__altmin_ws w;
+  phgmg_result rc = PHGMG_OK;
+  if (q < k) return PHGMG_ERR_SIZE;
+  U = phgmg__dalloc(c->alloc, (size_t)N * q + (size_t)q * ns * 2 + (size_t)q * k * 5 + (size_t)k * (k + 1) +
+                                  (size_t)k * ns * 3 + (size_t)ns * (nc + rn) + (size_t)nc * rn);
+  if (!U) return PHGMG_ERR_NOMEM;
+  memset(&w, 0, sizeof w);
+  S = U + (size_t)N * q; w.R = S + (size_t)q * ns; w.Q = w.R + (size_t)q * ns; w.Qn = w.Q + (size_t)q * k;
+  w.Qb = w.Qn + (size_t)q * k; w.A = w.Qb + (size_t)q * k; w.U = w.A + (size_t)q * k; w.V = w.U + (size_t)q * k;
+  w.sv = w.V + (size_t)k * k; w.W = w.sv + k; w.Wn = w.W + (size_t)k * ns; w.Wb = w.Wn + (size_t)k * ns;
+  w.Kt = w.Wb + (size_t)k * ns; w.Yt = w.Kt + (size_t)ns * nc; w.T = w.Yt + (size_t)ns * rn;
+  if (c->o->pod_basis) memcpy(U, c->o->pod_basis, (size_t)N * q * sizeof(double));
+  else {
+    rc = phgmg_pod(N, ns, c->Xa, N, q, 0.0, U, N, NULL, &kk, c->alloc);
+    if (rc == PHGMG_OK && kk < k) rc = PHGMG_ERR_SIZE;
+    q = kk;   /* the numerical rank may cut the candidates */
+  }
+  w.q = q; w.ns = ns; w.p = p; w.rn = rn; w.k = k; w.S = S;
+  w.lam = c->o->lambda_auto ? 1e-9 : c->lambda;
+  if (rc == PHGMG_OK) {
+    phgmg_gemm('T', 'N', q, ns, N, 1.0, U, N, c->Xa, N, 0.0, S, q);
+    for (i = 0; i < N * ns; ++i) tot += c->Xa[i] * c->Xa[i];
+    for (i = 0; i < q * ns; ++i) tot -= S[i] * S[i];
+    outside = PHGMG__MAX(tot, 0.0);                    /* what no Q in span U can represent */
+    for (i = 0; i < q * k; ++i) w.Q[i] = (i % q) == (i / q) ? 1.0 : 0.0;
+    rc = phgmg__altmin_eval(q, ns, p, rn, S, w.Q, w.lam, w.Kt, w.Yt, w.T, w.W, w.R, &f, c->alloc);
+    if (rc == PHGMG_OK) c->inf.manifold_obj0 = c->inf.manifold_obj = f + outside;
+    for (it = 0; rc == PHGMG_OK && it < 100; ++it) {
+      f0 = f;
+      rc = phgmg__altmin_sweep(&w, &f, &moved, c->alloc);
+      if (rc != PHGMG_OK || !moved) break;
+      c->inf.manifold_sweeps = it + 1;
+      c->inf.manifold_obj = f + outside;
+      if (f > f0 * (1.0 - 1e-5)) break;
+    }
+    if (rc != PHGMG_ERR_NOMEM) rc = PHGMG_OK;   /* no fit or no unique step: the last Q (at worst the POD) */
+  }
+  if (rc == PHGMG_OK) {   /* V1 = U Q1, V2 = U Q2 */
+    phgmg_gemm('N', 'N', N, p, q, 1.0, U, N, w.Q, q, 0.0, red->V0 + (size_t)N * m, N);
+    phgmg_gemm('N', 'N', N, rn, q, 1.0, U, N, w.Q + (size_t)q * p, q, 0.0, red->V2, N);
+  }
+  phgmg__free(c->alloc, U);
+  return rc;
+}
+
 /* Stage 2, manifold (QUADRATIC kind): V2 = POD of the residual of [B, V1]
    (paper 4.2.2) or the caller's; then GMG-QM fits M (eq. least_square_reg,
    lambda fixed or by validation); GMG_MANIFOLD takes the caller's eta. */
@@ -8306,15 +8482,21 @@ PHGMG__PRIV phgmg_result phgmg__stage_manifold(phgmg__rctx *c) {
   if (red->kind != PHGMG_ROM_QUADRATIC) return PHGMG_OK;
   red->V2 = phgmg__red_d(red, (size_t)N * rn);
   if (!red->V2) return PHGMG_ERR_NOMEM;
-  if (c->o->manifold == 1 && red->method == PHGMG_METHOD_GMG_QM) {
+  if (c->o->manifold == PHGMG_MANIFOLD_GREEDY && red->method == PHGMG_METHOD_GMG_QM) {
     rc = phgmg__qm_greedy(c);
+    if (rc != PHGMG_OK) return rc;
+  }
+  if (c->o->manifold == PHGMG_MANIFOLD_ALTMIN && red->method == PHGMG_METHOD_GMG_QM) {
+    rc = phgmg__qm_altmin(c);   /* V1 and V2 */
     if (rc != PHGMG_OK) return rc;
   }
   {
     double *tmp = phgmg__dalloc(c->alloc, (size_t)p * ns + (size_t)rn);
     if (!tmp) return PHGMG_ERR_NOMEM;
     phgmg__orth_remove(N, p, red->V0 + (size_t)N * m, ns, c->Xa, N, tmp);
-    if (c->o->pod_basis && c->o->manifold == 0) {
+    if (c->o->manifold == PHGMG_MANIFOLD_ALTMIN && red->method == PHGMG_METHOD_GMG_QM) {
+      /* V2 from the alternating minimization */
+    } else if (c->o->pod_basis && c->o->manifold == PHGMG_MANIFOLD_POD) {
       memcpy(red->V2, c->o->pod_basis + (size_t)N * p, (size_t)N * rn * sizeof(double));
     } else {
       rc = phgmg_pod(N, ns, c->Xa, N, rn, 0.0, red->V2, N, tmp, &k, c->alloc);

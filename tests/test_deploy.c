@@ -83,7 +83,8 @@ TEST(test_deploy_options) {
   BAD(lambda_tolerance, (double)NAN, PHGMG_ERR_INVALID_ARG);
   BAD(newton_tol, -1.0, PHGMG_ERR_INVALID_ARG);
   BAD(newton_iter, -1, PHGMG_ERR_INVALID_ARG);
-  BAD(manifold, 2, PHGMG_ERR_INVALID_ARG);
+  BAD(manifold, 3, PHGMG_ERR_INVALID_ARG);
+  BAD(manifold, -1, PHGMG_ERR_INVALID_ARG);
   BAD(lambda_train_only, 2, PHGMG_ERR_INVALID_ARG);
   BAD(lambda_auto, 3, PHGMG_ERR_INVALID_ARG);
 #undef BAD
