@@ -1095,7 +1095,14 @@ typedef struct phgmg_reduce_opts {
      helps), started from 0, each sweep kept only if the training objective
      sum ||x - phi(rho(x))||^2 + lam ||M||^2 decreases (so it ends at or below
      the hierarchical POD's; info.manifold_obj0/obj; lam as for 1); at most
-     100 sweeps. B stays in the span, [B, V1, V2] orthonormal. */
+     100 sweeps. B stays in the span, [B, V1, V2] orthonormal.
+     With lambda_auto = 1 the linear limit M = 0 on the altmin basis is not
+     GMG-POD, so the validation also simulates GMG-POD and admits a lambda
+     only if the model beats both; with none admissible and the altmin linear
+     limit worse than GMG-POD, the model of manifold = 0 is returned
+     (info.manifold_fallback = 1). Cost: 0.05-2.5 s for the sweeps at r = 8-20
+     (N-independent but for one POD), plus one GMG-POD build and its
+     validation runs under lambda_auto = 1. */
   int manifold;
   /* lambda_auto = 1 with lambda_train_only = 1: validate on the training runs
      alone (no probe runs): from the regression optimum up (one per decade),
@@ -1141,6 +1148,10 @@ typedef struct phgmg_reduce_info {
      final M is then refitted with the lambda in force (fixed or automatic). */
   double manifold_obj0, manifold_obj;
   int manifold_sweeps;
+  /* 1: altmin under lambda_auto = 1 gave no model at least as good as GMG-POD
+     on every validation run (within lambda_tolerance), so the returned model
+     is the one of manifold = PHGMG_MANIFOLD_POD (same options otherwise) */
+  int manifold_fallback;
 } phgmg_reduce_info;
 
 /* The reduced model with its offline data (bases for reconstruction, double
@@ -8017,6 +8028,8 @@ typedef struct phgmg__rctx {
   double *Tq;              /* ridge problem Kt, Rqt, Mt kept for a refit   */
   phgmg_jr_factor *jr;     /* factorization of J - R (GMG)                 */
   int *runcol;             /* opts.runs: nrun + 1 column offsets (NULL: one run) */
+  int fallback_pod;        /* altmin under lambda_auto = 1 found no model as good as
+                              GMG-POD: phgmg_reduce redoes it with manifold = POD */
 } phgmg__rctx;
 
 PHGMG__PRIV void phgmg__rctx_free(phgmg__rctx *c) {
@@ -8805,6 +8818,36 @@ PHGMG__PRIV phgmg_result phgmg__qm_set(phgmg__rctx *c, int g, phgmg_real *ms) {
   return PHGMG_OK;
 }
 
+/* The validation reference of an altmin manifold (lambda_auto = 1): its own
+   linear limit M = 0 is not GMG-POD (V1 is not the POD basis), so GMG-POD
+   itself (phgmg_reduce with the same options, method GMG_POD) is simulated on
+   the validation runs too and the reference becomes the smaller of the two
+   errors per run: a kept lambda then also beats GMG-POD. If the altmin
+   linear limit (lim_ok: it simulates) is itself not within tolr of GMG-POD on
+   every run, c->fallback_pod = 1: without an admissible lambda the reduction
+   is redone with the hierarchical POD manifold. */
+PHGMG__PRIV phgmg_result phgmg__altmin_reference(phgmg__rctx *c, phgmg__vset *v, int lim_ok, double tolr) {
+  phgmg_reduce_opts o = *c->o;
+  phgmg_reduced *pod = NULL, *keep = c->red;
+  int k, ok = 0;
+  phgmg_result rc;
+  o.method = PHGMG_METHOD_GMG_POD; o.lambda_auto = 0; o.manifold = PHGMG_MANIFOLD_POD; o.nrun = 0; o.runs = NULL;
+  o.dt = 0.0;
+  rc = phgmg_reduce(&pod, c->sys, c->X, c->ldx, c->ns, &o, NULL, c->alloc);
+  if (rc == PHGMG_ERR_NOMEM) return rc;
+  if (rc != PHGMG_OK) return PHGMG_OK;   /* no GMG-POD to compare with: the linear limit alone */
+  c->red = pod;
+  rc = phgmg__vset_eval(c, v, &ok);
+  c->red = keep;
+  phgmg_reduced_destroy(pod);
+  if (rc != PHGMG_OK || !ok) return rc;
+  for (k = 0; k < v->nv; ++k) {
+    if (!lim_ok || v->base[k] > tolr * v->ey[k] + 1e-14) c->fallback_pod = 1;
+    v->base[k] = PHGMG__MIN(v->base[k], v->ey[k]);
+  }
+  return PHGMG_OK;
+}
+
 /* opts.lambda_auto = 1 (after publish): validation by simulation, see the
    comment at phgmg_reduce_opts.runs. Candidates from lambda_max down, one
    per decade, to the regression optimum; stops after two inadmissible
@@ -8835,6 +8878,7 @@ PHGMG__PRIV phgmg_result phgmg__stage_lambda_validate(phgmg__rctx *c) {
   if (rc == PHGMG_OK) rc = phgmg__qm_set(c, -1, ms);
   if (rc == PHGMG_OK) rc = phgmg__vset_eval(c, v, &ok);
   for (k = 0; k < v->nv && rc == PHGMG_OK; ++k) v->base[k] = v->ey[k] < HUGE_VAL ? v->ey[k] : 1.0;
+  if (rc == PHGMG_OK && o->manifold == PHGMG_MANIFOLD_ALTMIN) rc = phgmg__altmin_reference(c, v, ok, tolr);
   /* training runs alone: up from the regression optimum, the first admissible */
   for (g = c->gsel; rc == PHGMG_OK && o->lambda_train_only && g < c->ng; g += pd) {
     double worst = 0.0;
@@ -8870,6 +8914,8 @@ PHGMG__PRIV phgmg_result phgmg__stage_lambda_validate(phgmg__rctx *c) {
       best = cand_g[k]; best_ratio = cand_worst[k];
       break;
     }
+  if (rc == PHGMG_OK && best < 0 && c->fallback_pod) rc = PHGMG_OK;   /* redone with manifold = POD */
+  else c->fallback_pod = 0;
   if (rc == PHGMG_OK) rc = phgmg__qm_set(c, best, ms);
   if (rc == PHGMG_OK) {
     c->gsel = best;
@@ -9203,6 +9249,23 @@ PHGMG__PRIV phgmg_result phgmg__stage_general_term(phgmg__rctx *c) {
   return red->gwork ? PHGMG_OK : PHGMG_ERR_NOMEM;
 }
 
+/* manifold = ALTMIN under lambda_auto = 1 without a model as good as GMG-POD
+   (phgmg__altmin_reference): the same reduction with the hierarchical POD
+   manifold; info keeps the altmin objective and sets manifold_fallback. */
+PHGMG__PRIV phgmg_result phgmg__reduce_fallback_pod(phgmg_reduced **out, const phgmg__rctx *c,
+                                                    phgmg_reduce_info *info) {
+  phgmg_reduce_opts o = *c->o;
+  phgmg_reduce_info inf;
+  phgmg_result rc;
+  phgmg_reduced_destroy(c->red);
+  o.manifold = PHGMG_MANIFOLD_POD;
+  rc = phgmg_reduce(out, c->sys, c->X, c->ldx, c->ns, &o, &inf, c->alloc);
+  inf.manifold_obj0 = c->inf.manifold_obj0; inf.manifold_obj = c->inf.manifold_obj;
+  inf.manifold_sweeps = c->inf.manifold_sweeps; inf.manifold_fallback = 1;
+  if (info) *info = inf;
+  return rc;
+}
+
 PHGMG_DEF phgmg_result phgmg_reduce(phgmg_reduced **out, const phgmg_ph_system *sys, const double *X,
                                     int ldx, int ns, const phgmg_reduce_opts *opts,
                                     phgmg_reduce_info *info, const phgmg_allocator *alloc) {
@@ -9246,6 +9309,7 @@ PHGMG_DEF phgmg_result phgmg_reduce(phgmg_reduced **out, const phgmg_ph_system *
   if (rc == PHGMG_OK)
     c.inf.online_callbacks = c.red->rom.phi_cb || c.red->rom.eta_cb || c.red->rom.ham_cb;
   phgmg__rctx_free(&c);
+  if (rc == PHGMG_OK && c.fallback_pod) return phgmg__reduce_fallback_pod(out, &c, info);
   if (info) *info = c.inf;
   if (rc != PHGMG_OK) {
     phgmg_reduced_destroy(c.red);
