@@ -7,7 +7,8 @@
    the worst e_y over four other inputs (0.1, 0.1 sin 2t, a chirp, a random
    piecewise-constant signal), Newton failures over all five, reduce time.
    GMG-POD (M = 0) on the same r for reference.
-   Usage: altmin_study linear|nonlinear [--lambda L|auto] [--r 8,10,...] [--two]
+   QM-alt* = altmin fell back to the POD manifold (lambda auto, not better than GMG-POD).
+   Usage: altmin_study linear|nonlinear [--lambda L|auto] [--train-only] [--r 8,10,...] [--rn 8] [--two]
    Build: make build/altmin_study (or cc -O2 -march=native bench/altmin_study.c -lm). */
 #define _POSIX_C_SOURCE 199309L
 #include <stdio.h>
@@ -36,7 +37,7 @@ static phgmg_input_fn inf[NIN] = {u_sin, u_const, u_sin2, u_chirp, u_pwc};
 int main(int argc, char **argv) {
   const int nsteps = 1000, ns = nsteps + 1;
   const double dt = 0.1;
-  int rl[64], nr = 0, i, k, me, lauto = 0, two = 0, nonlin, N, ntr;
+  int rl[64], nr = 0, i, k, me, lauto = 0, two = 0, tonly = 0, rn = 8, nonlin, N, ntr;
   double lambda = 0.0, tol = 1e-10;
   const char *rs = "8,10,12,14,16,18,20";
   msd_linear L;
@@ -51,6 +52,8 @@ int main(int argc, char **argv) {
     if (!strcmp(argv[i], "--lambda") && i + 1 < argc) { ++i; if (!strcmp(argv[i], "auto")) lauto = 1; else lambda = atof(argv[i]); }
     else if (!strcmp(argv[i], "--r") && i + 1 < argc) rs = argv[++i];
     else if (!strcmp(argv[i], "--two")) two = 1;
+    else if (!strcmp(argv[i], "--train-only")) tonly = 1;
+    else if (!strcmp(argv[i], "--rn") && i + 1 < argc) rn = atoi(argv[++i]);
     else { fprintf(stderr, "bad argument %s\n", argv[i]); return 2; }
   }
   { const char *q = rs; char *end; while (*q && nr < 64) { rl[nr++] = (int)strtol(q, &end, 10); if (end == q) break; q = *end == ',' ? end + 1 : end; } }
@@ -84,6 +87,7 @@ int main(int argc, char **argv) {
   }
   printf("%s chain, N = %d, trained on %s, lambda %s\n", nonlin ? "nonlinear" : "linear", N,
          two ? "0.1 sin t + multisine" : "0.1 sin t", lauto ? "auto (validated by simulation)" : argv[0] ? (lambda > 0 ? "fixed" : lambda < 0 ? "0" : "1e-3") : "");
+  if (tonly) printf("lambda_train_only = 1 (validated on the training run(s) alone)\n");
   printf("%3s %-7s %5s %9s %9s %9s %9s %9s %9s %9s %4s %8s %6s\n", "r", "method", "sweep", "obj0", "obj", "e_proj", "e_lowb",
          "e_red", "e_y(tr)", "e_y(oth)", "fail", "lambda", "t[s]");
   for (k = 0; k < nr; ++k)
@@ -95,8 +99,8 @@ int main(int argc, char **argv) {
       double t0, tred, ered = NAN, eytr = NAN, eyo = 0, fails = 0, eproj, elb;
       memset(&o, 0, sizeof o);
       o.method = me < 0 ? PHGMG_METHOD_GMG_POD : PHGMG_METHOD_GMG_QM;
-      o.r = rl[k]; o.rn = 8; o.manifold = me < 0 ? 0 : me; o.lambda = lambda;
-      o.lambda_auto = me >= 0 && lauto; o.nrun = ntr; o.runs = runs; o.newton_tol = tol; o.newton_iter = 20;
+      o.r = rl[k]; o.rn = rn; o.manifold = me < 0 ? 0 : me; o.lambda = lambda;
+      o.lambda_auto = me >= 0 && lauto; o.lambda_train_only = tonly; o.nrun = ntr; o.runs = runs; o.newton_tol = tol; o.newton_iter = 20;
       if (nonlin) { o.deim = 1; o.deim_tol = 1e-8; o.deim_allow_negative = 1; }
       t0 = now_s();
       rc = phgmg_reduce(&red, sys, X, N, ntr * ns, &o, &info, NULL);
@@ -117,7 +121,8 @@ int main(int argc, char **argv) {
         }
       }
       printf("%3d %-7s %5d %9.2e %9.2e %9.2e %9.2e %9.2e %9.2e %9.2e %4.0f %8.1e %6.2f\n", o.r,
-             me < 0 ? "POD" : me == 0 ? "QM-pod" : me == 1 ? "QM-grdy" : "QM-alt", info.manifold_sweeps,
+             me < 0 ? "POD" : me == 0 ? "QM-pod" : me == 1 ? "QM-grdy" : info.manifold_fallback ? "QM-alt*" : "QM-alt",
+             info.manifold_sweeps,
              sqrt(info.manifold_obj0), sqrt(info.manifold_obj), eproj, elb, ered, eytr, eyo, fails,
              me < 0 ? 0.0 : info.lambda, tred);
       fflush(stdout);
