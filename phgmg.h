@@ -8329,6 +8329,31 @@ PHGMG__PRIV phgmg_result phgmg__qm_greedy(phgmg__rctx *c) {
   return rc;
 }
 
+/* A scratch arena for the many small solves of the alternating minimization:
+   allocations bump a pointer in a block allocated once (reset before each
+   solve, whose allocations do not outlive it); what does not fit goes to the
+   caller's allocator. Frees inside the block are no-ops. */
+typedef struct phgmg__arena {
+  unsigned char *base;
+  size_t cap, used;
+  const phgmg_allocator *up;
+} phgmg__arena;
+PHGMG__PRIV void *phgmg__arena_alloc(size_t n, void *u) {
+  phgmg__arena *a = (phgmg__arena *)u;
+  n = (n + 63) & ~(size_t)63;
+  if (n <= a->cap - a->used) {
+    void *p = a->base + a->used;
+    a->used += n;
+    return p;
+  }
+  return phgmg__alloc(a->up, n);
+}
+PHGMG__PRIV void phgmg__arena_free(void *p, void *u) {
+  phgmg__arena *a = (phgmg__arena *)u;
+  if (p && (unsigned char *)p >= a->base && (unsigned char *)p < a->base + a->cap) return;
+  phgmg__free(a->up, p);
+}
+
 /* opts.manifold = PHGMG_MANIFOLD_ALTMIN, one evaluation in the q POD
    coordinates S (q x ns) of the adjusted snapshots, for the orthonormal
    Q = [Q1, Q2] (q x (p + rn)): Z = Q1^T S, the ridge fit T (nc x rn) of
@@ -8350,6 +8375,7 @@ PHGMG__PRIV phgmg_result phgmg__altmin_eval(int q, int ns, int p, int rn, const 
       for (j = a; j < p; ++j, ++cc) Kt[i + (size_t)cc * ns] = (a == j ? 1.0 : s2) * z[a] * z[j];
     for (a = 0; a < rn; ++a) Yt[i + (size_t)a * ns] = z[p + a];
   }
+  if (alloc && alloc->alloc == phgmg__arena_alloc) ((phgmg__arena *)alloc->user)->used = 0;
   rc = phgmg_lstsq(ns, nc, rn, Kt, ns, Yt, ns, lam, T, nc, alloc);
   if (rc != PHGMG_OK) return rc;
   phgmg_gemm('N', 'N', ns, rn, nc, 1.0, Kt, ns, T, nc, 0.0, Yt, ns);   /* the fitted correction */
@@ -8369,7 +8395,9 @@ PHGMG__PRIV phgmg_result phgmg__altmin_eval(int q, int ns, int p, int rn, const 
 PHGMG__PRIV phgmg_result phgmg__polar(int q, int k, const double *A, double *U, double *V, double *sv, double *Q,
                                       const phgmg_allocator *alloc) {
   int kk = 0;
-  phgmg_result rc = phgmg_svd(q, k, A, q, k, sv, U, q, V, k, &kk, NULL, alloc);
+  phgmg_result rc;
+  if (alloc && alloc->alloc == phgmg__arena_alloc) ((phgmg__arena *)alloc->user)->used = 0;
+  rc = phgmg_svd(q, k, A, q, k, sv, U, q, V, k, &kk, NULL, alloc);
   if (rc != PHGMG_OK) return rc;
   if (kk < k) return PHGMG_ERR_RANK;
   phgmg_gemm('N', 'T', q, k, k, 1.0, U, q, V, k, 0.0, Q, q);
@@ -8383,6 +8411,7 @@ typedef struct phgmg__altmin_ws {
   const double *S;                    /* q x ns POD coordinates               */
   double *Q, *W, *Qn, *Wn, *Qb, *Wb;  /* current, step, trial (q x k, k x ns)  */
   double *Kt, *Yt, *T, *R, *A, *U, *V, *sv;
+  phgmg_allocator al;                 /* the scratch arena (phgmg__arena)     */
 } phgmg__altmin_ws;
 
 /* One sweep from (Q, W, *f): the Procrustes step Qn = polar(S W^T), i.e. the
@@ -8391,23 +8420,22 @@ typedef struct phgmg__altmin_ws {
    polar(Q + beta (Qn - Q)), beta = 2, 4, 8 (the plain step converges
    linearly and slowly). Kept (into Q, W, *f) only if the objective
    decreased: *moved = 1. */
-PHGMG__PRIV phgmg_result phgmg__altmin_sweep(phgmg__altmin_ws *w, double *f, int *moved,
-                                             const phgmg_allocator *alloc) {
+PHGMG__PRIV phgmg_result phgmg__altmin_sweep(phgmg__altmin_ws *w, double *f, int *moved) {
   const int q = w->q, k = w->k;
   double fn, fb, beta;
   int i;
   phgmg_result rc;
   *moved = 0;
   phgmg_gemm('N', 'T', q, k, w->ns, 1.0, w->S, q, w->W, k, 0.0, w->A, q);
-  rc = phgmg__polar(q, k, w->A, w->U, w->V, w->sv, w->Qn, alloc);
+  rc = phgmg__polar(q, k, w->A, w->U, w->V, w->sv, w->Qn, &w->al);
   if (rc == PHGMG_OK)
-    rc = phgmg__altmin_eval(q, w->ns, w->p, w->rn, w->S, w->Qn, w->lam, w->Kt, w->Yt, w->T, w->Wn, w->R, &fn, alloc);
+    rc = phgmg__altmin_eval(q, w->ns, w->p, w->rn, w->S, w->Qn, w->lam, w->Kt, w->Yt, w->T, w->Wn, w->R, &fn, &w->al);
   if (rc != PHGMG_OK || !(fn < *f)) return rc;
   for (beta = 2.0; beta <= 8.0; beta *= 2.0) {
     for (i = 0; i < q * k; ++i) w->A[i] = w->Q[i] + beta * (w->Qn[i] - w->Q[i]);
-    rc = phgmg__polar(q, k, w->A, w->U, w->V, w->sv, w->Qb, alloc);
+    rc = phgmg__polar(q, k, w->A, w->U, w->V, w->sv, w->Qb, &w->al);
     if (rc == PHGMG_OK)
-      rc = phgmg__altmin_eval(q, w->ns, w->p, w->rn, w->S, w->Qb, w->lam, w->Kt, w->Yt, w->T, w->Wb, w->R, &fb, alloc);
+      rc = phgmg__altmin_eval(q, w->ns, w->p, w->rn, w->S, w->Qb, w->lam, w->Kt, w->Yt, w->T, w->Wb, w->R, &fb, &w->al);
     if (rc == PHGMG_ERR_NOMEM) return rc;
     if (rc != PHGMG_OK || !(fb < fn)) break;
     memcpy(w->Qn, w->Qb, (size_t)q * k * sizeof(double));
@@ -8440,12 +8468,20 @@ PHGMG__PRIV phgmg_result phgmg__qm_altmin(phgmg__rctx *c) {
   double *U, *S, f = HUGE_VAL, f0, tot = 0.0, outside;
   int it, kk = 0, i, q = PHGMG__MIN(2 * k, navail), moved = 0;
   phgmg__altmin_ws w;
+  phgmg__arena ar;
+  size_t nar;
   phgmg_result rc = PHGMG_OK;
   if (q < k) return PHGMG_ERR_SIZE;
+  /* arena: phgmg_lstsq's [K; sqrt(lam) I], [Y; 0] and tau, and room for the q x k SVDs */
+  nar = (size_t)(ns + nc) * (nc + rn) + (size_t)nc + 16 * (size_t)(q + k) * k + 4096;
   U = phgmg__dalloc(c->alloc, (size_t)N * q + (size_t)q * ns * 2 + (size_t)q * k * 5 + (size_t)k * (k + 1) +
-                                  (size_t)k * ns * 3 + (size_t)ns * (nc + rn) + (size_t)nc * rn);
+                                  (size_t)k * ns * 3 + (size_t)ns * (nc + rn) + (size_t)nc * rn + nar);
   if (!U) return PHGMG_ERR_NOMEM;
   memset(&w, 0, sizeof w);
+  ar.base = (unsigned char *)(U + (size_t)N * q + (size_t)q * ns * 2 + (size_t)q * k * 5 + (size_t)k * (k + 1) +
+                              (size_t)k * ns * 3 + (size_t)ns * (nc + rn) + (size_t)nc * rn);
+  ar.cap = nar * sizeof(double); ar.used = 0; ar.up = c->alloc;
+  w.al.alloc = phgmg__arena_alloc; w.al.free = phgmg__arena_free; w.al.user = &ar;
   S = U + (size_t)N * q; w.R = S + (size_t)q * ns; w.Q = w.R + (size_t)q * ns; w.Qn = w.Q + (size_t)q * k;
   w.Qb = w.Qn + (size_t)q * k; w.A = w.Qb + (size_t)q * k; w.U = w.A + (size_t)q * k; w.V = w.U + (size_t)q * k;
   w.sv = w.V + (size_t)k * k; w.W = w.sv + k; w.Wn = w.W + (size_t)k * ns; w.Wb = w.Wn + (size_t)k * ns;
@@ -8464,11 +8500,11 @@ PHGMG__PRIV phgmg_result phgmg__qm_altmin(phgmg__rctx *c) {
     for (i = 0; i < q * ns; ++i) tot -= S[i] * S[i];
     outside = PHGMG__MAX(tot, 0.0);                    /* what no Q in span U can represent */
     for (i = 0; i < q * k; ++i) w.Q[i] = (i % q) == (i / q) ? 1.0 : 0.0;
-    rc = phgmg__altmin_eval(q, ns, p, rn, S, w.Q, w.lam, w.Kt, w.Yt, w.T, w.W, w.R, &f, c->alloc);
+    rc = phgmg__altmin_eval(q, ns, p, rn, S, w.Q, w.lam, w.Kt, w.Yt, w.T, w.W, w.R, &f, &w.al);
     if (rc == PHGMG_OK) c->inf.manifold_obj0 = c->inf.manifold_obj = f + outside;
     for (it = 0; rc == PHGMG_OK && it < 100; ++it) {
       f0 = f;
-      rc = phgmg__altmin_sweep(&w, &f, &moved, c->alloc);
+      rc = phgmg__altmin_sweep(&w, &f, &moved);
       if (rc != PHGMG_OK || !moved) break;
       c->inf.manifold_sweeps = it + 1;
       c->inf.manifold_obj = f + outside;

@@ -419,10 +419,12 @@ TEST(test_deploy_oom) {
   memset(&run, 0, sizeof run);
   run.u = msd_input_sin; run.dt = 0.1; run.nsteps = ns - 1;
   al.alloc = tc_alloc; al.free = tc_free; al.user = &c;
-  for (pass = 0; pass < 3; ++pass) {   /* manifold POD, greedy, altmin */
+  for (pass = 0; pass < 4; ++pass) {   /* manifold POD, greedy, altmin (fixed lambda, lambda_auto = 1) */
     memset(&o, 0, sizeof o);
     o.method = PHGMG_METHOD_GMG_QM; o.r = 5; o.rn = 3; o.lambda_auto = 1; o.nrun = 1; o.runs = &run;
-    o.manifold = pass; o.lambda_train_only = pass == 1;
+    o.manifold = pass < 3 ? pass : PHGMG_MANIFOLD_ALTMIN; o.lambda_train_only = pass == 1;
+    if (pass == 2) { o.r = 4; o.rn = 2; o.lambda_auto = 0; }
+    if (pass == 3) { o.r = 3; o.rn = 1; }   /* with the GMG-POD reference and the fallback: small */
     memset(&c, 0, sizeof c);
     CHECK_RC(phgmg_reduce(&red, &M.sys, X, M.sys.N, ns, &o, NULL, &al), PHGMG_OK);
     if (red) CHECK_RC(phgmg_reduced_validate(red, &M.sys, &run, 0, 0, 0, &v, &al), PHGMG_OK);
