@@ -8521,7 +8521,8 @@ PHGMG__PRIV phgmg_result phgmg__qm_altmin(phgmg__rctx *c) {
 }
 
 /* Stage 2, manifold (QUADRATIC kind): V2 = POD of the residual of [B, V1]
-   (paper 4.2.2) or the caller's; then GMG-QM fits M (eq. least_square_reg,
+   (paper 4.2.2; V1 greedy with opts.manifold = 1), V1 and V2 by alternating
+   minimization (opts.manifold = 2), or the caller's; then GMG-QM fits M (eq. least_square_reg,
    lambda fixed or by validation); GMG_MANIFOLD takes the caller's eta. */
 PHGMG__PRIV phgmg_result phgmg__stage_manifold(phgmg__rctx *c) {
   phgmg_reduced *red = c->red;
