@@ -963,6 +963,13 @@ PHGMG_DEF phgmg_result phgmg_simulate_inputs(const phgmg_ph_system *sys, int nru
                                              const phgmg_gl3_opts *go, double *X, int ldx, double *Y, int *col,
                                              const phgmg_allocator *alloc);
 
+/* GMG-QM manifold constructions (phgmg_reduce_opts.manifold). */
+enum {
+  PHGMG_MANIFOLD_POD = 0,    /* the paper's hierarchical POD                       */
+  PHGMG_MANIFOLD_GREEDY = 1, /* greedy linear part (Schwerdtner & Peherstorfer 2024) */
+  PHGMG_MANIFOLD_ALTMIN = 2  /* alternating minimization of V1, V2 and M           */
+};
+
 typedef struct phgmg_reduce_opts {
   phgmg_method method; /* required                                                  */
   int r;               /* reduced order (GMG: includes the m port coordinates), required */
@@ -1080,7 +1087,22 @@ typedef struct phgmg_reduce_opts {
      fit (Schwerdtner & Peherstorfer 2024; ridge lambda 1e-9 with lambda_auto,
      else opts.lambda; every ceil(ns/400)-th snapshot); V2 = POD of what
      [B, V1] leaves, as for 0. Cost: about (r - m)(r - m + rn) small
-     least-squares solves (0.1-0.5 s at r = 20). */
+     least-squares solves (0.1-0.5 s at r = 20).
+     2 = alternating minimization (PHGMG_MANIFOLD_ALTMIN; after Geelen,
+     Balzano, Wright & Willcox 2023): V1, V2 rotated within the leading
+     2 (r - m + rn) POD modes of the adjusted snapshots, alternating the ridge
+     fit of M with an orthogonal Procrustes step (extrapolated while that
+     helps), started from 0, each sweep kept only if the training objective
+     sum ||x - phi(rho(x))||^2 + lam ||M||^2 decreases (so it ends at or below
+     the hierarchical POD's; info.manifold_obj0/obj; lam as for 1); at most
+     100 sweeps. B stays in the span, [B, V1, V2] orthonormal.
+     With lambda_auto = 1 the linear limit M = 0 on the altmin basis is not
+     GMG-POD, so the validation also simulates GMG-POD and admits a lambda
+     only if the model beats both; with none admissible and the altmin linear
+     limit worse than GMG-POD, the model of manifold = 0 is returned
+     (info.manifold_fallback = 1). Cost: 0.05-2.5 s for the sweeps at r = 8-20
+     (N-independent but for one POD), plus one GMG-POD build and its
+     validation runs under lambda_auto = 1. */
   int manifold;
   /* lambda_auto = 1 with lambda_train_only = 1: validate on the training runs
      alone (no probe runs): from the regression optimum up (one per decade),
@@ -1120,6 +1142,16 @@ typedef struct phgmg_reduce_info {
   int lambda_candidates;   /* lambda_auto = 1: candidate lambdas simulated     */
   double lambda_val_ratio; /* lambda_auto = 1: largest e_y ratio of the chosen
                               model to the linear limit over the validation runs */
+  /* manifold = PHGMG_MANIFOLD_ALTMIN: the objective sum_i ||x_i - phi(rho(x_i))||^2
+     + lam ||M||^2 over the snapshots (lam: the ridge parameter of the sweeps) at
+     the start (the hierarchical POD) and at the end, and the sweeps kept; the
+     final M is then refitted with the lambda in force (fixed or automatic). */
+  double manifold_obj0, manifold_obj;
+  int manifold_sweeps;
+  /* 1: altmin under lambda_auto = 1 gave no model at least as good as GMG-POD
+     on every validation run (within lambda_tolerance), so the returned model
+     is the one of manifold = PHGMG_MANIFOLD_POD (same options otherwise) */
+  int manifold_fallback;
 } phgmg_reduce_info;
 
 /* The reduced model with its offline data (bases for reconstruction, double
@@ -8037,6 +8069,8 @@ typedef struct phgmg__rctx {
   double *Tq;              /* ridge problem Kt, Rqt, Mt kept for a refit   */
   phgmg_jr_factor *jr;     /* factorization of J - R (GMG)                 */
   int *runcol;             /* opts.runs: nrun + 1 column offsets (NULL: one run) */
+  int fallback_pod;        /* altmin under lambda_auto = 1 found no model as good as
+                              GMG-POD: phgmg_reduce redoes it with manifold = POD */
 } phgmg__rctx;
 
 PHGMG__PRIV void phgmg__rctx_free(phgmg__rctx *c) {
@@ -8061,7 +8095,7 @@ PHGMG__PRIV phgmg_result phgmg__deploy_check(const phgmg_reduce_opts *o, int ns)
   if (!(o->lambda_tolerance == 0.0 || (o->lambda_tolerance >= 1.0 && o->lambda_tolerance < HUGE_VAL)))
     return PHGMG_ERR_INVALID_ARG;
   if (!(o->newton_tol >= 0.0 && o->newton_tol < 1.0) || o->newton_iter < 0) return PHGMG_ERR_INVALID_ARG;
-  if (o->manifold != 0 && o->manifold != 1) return PHGMG_ERR_INVALID_ARG;
+  if (o->manifold < PHGMG_MANIFOLD_POD || o->manifold > PHGMG_MANIFOLD_ALTMIN) return PHGMG_ERR_INVALID_ARG;
   if (o->lambda_train_only != 0 && o->lambda_train_only != 1) return PHGMG_ERR_INVALID_ARG;
   return PHGMG_OK;
 }
@@ -8336,8 +8370,200 @@ PHGMG__PRIV phgmg_result phgmg__qm_greedy(phgmg__rctx *c) {
   return rc;
 }
 
+/* A scratch arena for the many small solves of the alternating minimization:
+   allocations bump a pointer in a block allocated once (reset before each
+   solve, whose allocations do not outlive it); what does not fit goes to the
+   caller's allocator. Frees inside the block are no-ops. */
+typedef struct phgmg__arena {
+  unsigned char *base;
+  size_t cap, used;
+  const phgmg_allocator *up;
+} phgmg__arena;
+PHGMG__PRIV void *phgmg__arena_alloc(size_t n, void *u) {
+  phgmg__arena *a = (phgmg__arena *)u;
+  n = (n + 63) & ~(size_t)63;
+  if (n <= a->cap - a->used) {
+    void *p = a->base + a->used;
+    a->used += n;
+    return p;
+  }
+  return phgmg__alloc(a->up, n);
+}
+PHGMG__PRIV void phgmg__arena_free(void *p, void *u) {
+  phgmg__arena *a = (phgmg__arena *)u;
+  if (p && (unsigned char *)p >= a->base && (unsigned char *)p < a->base + a->cap) return;
+  phgmg__free(a->up, p);
+}
+
+/* opts.manifold = PHGMG_MANIFOLD_ALTMIN, one evaluation in the q POD
+   coordinates S (q x ns) of the adjusted snapshots, for the orthonormal
+   Q = [Q1, Q2] (q x (p + rn)): Z = Q1^T S, the ridge fit T (nc x rn) of
+   Q2^T S over the distinct Kronecker columns Kt of Z (as phgmg__qm_problem),
+   W = [Z; (Kt T)^T] ((p + rn) x ns) and the objective
+   *f = ||S - Q W||_F^2 + lam ||T||_F^2. Kt (ns x nc), Yt (ns x rn) scratch. */
+PHGMG__PRIV phgmg_result phgmg__altmin_eval(int q, int ns, int p, int rn, const double *S, const double *Q,
+                                            double lam, double *Kt, double *Yt, double *T, double *W,
+                                            double *R, double *f, const phgmg_allocator *alloc) {
+  const int k = p + rn, nc = p * (p + 1) / 2;
+  const double s2 = sqrt(2.0);
+  double sum = 0.0;
+  int i, a, j, cc;
+  phgmg_result rc;
+  phgmg_gemm('T', 'N', k, ns, q, 1.0, Q, q, S, q, 0.0, W, k);   /* [Z; Q2^T S] */
+  for (i = 0; i < ns; ++i) {
+    const double *z = W + (size_t)i * k;
+    for (a = 0, cc = 0; a < p; ++a)
+      for (j = a; j < p; ++j, ++cc) Kt[i + (size_t)cc * ns] = (a == j ? 1.0 : s2) * z[a] * z[j];
+    for (a = 0; a < rn; ++a) Yt[i + (size_t)a * ns] = z[p + a];
+  }
+  if (alloc && alloc->alloc == phgmg__arena_alloc) ((phgmg__arena *)alloc->user)->used = 0;
+  rc = phgmg_lstsq(ns, nc, rn, Kt, ns, Yt, ns, lam, T, nc, alloc);
+  if (rc != PHGMG_OK) return rc;
+  phgmg_gemm('N', 'N', ns, rn, nc, 1.0, Kt, ns, T, nc, 0.0, Yt, ns);   /* the fitted correction */
+  for (i = 0; i < ns; ++i)
+    for (a = 0; a < rn; ++a) W[p + a + (size_t)i * k] = Yt[i + (size_t)a * ns];
+  memcpy(R, S, (size_t)q * ns * sizeof(double));
+  phgmg_gemm('N', 'N', q, ns, k, -1.0, Q, q, W, k, 1.0, R, q);
+  for (i = 0; i < q * ns; ++i) sum += R[i] * R[i];
+  for (i = 0; i < nc * rn; ++i) sum += lam * T[i] * T[i];
+  *f = sum;
+  return sum <= HUGE_VAL ? PHGMG_OK : PHGMG_ERR_NANINF;
+}
+
+/* The orthonormal polar factor Q = U V^T of A = U Sigma V^T (q x k, thin
+   SVD): the orthonormal matrix nearest to A. U (q x k), V (k x k), sv (k)
+   scratch. PHGMG_ERR_RANK when A is rank deficient (not unique then). */
+PHGMG__PRIV phgmg_result phgmg__polar(int q, int k, const double *A, double *U, double *V, double *sv, double *Q,
+                                      const phgmg_allocator *alloc) {
+  int kk = 0;
+  phgmg_result rc;
+  if (alloc && alloc->alloc == phgmg__arena_alloc) ((phgmg__arena *)alloc->user)->used = 0;
+  rc = phgmg_svd(q, k, A, q, k, sv, U, q, V, k, &kk, NULL, alloc);
+  if (rc != PHGMG_OK) return rc;
+  if (kk < k) return PHGMG_ERR_RANK;
+  phgmg_gemm('N', 'T', q, k, k, 1.0, U, q, V, k, 0.0, Q, q);
+  return PHGMG_OK;
+}
+
+/* Workspace of the alternating minimization (phgmg__qm_altmin). */
+typedef struct phgmg__altmin_ws {
+  int q, ns, p, rn, k;
+  double lam;
+  const double *S;                    /* q x ns POD coordinates               */
+  double *Q, *W, *Qn, *Wn, *Qb, *Wb;  /* current, step, trial (q x k, k x ns)  */
+  double *Kt, *Yt, *T, *R, *A, *U, *V, *sv;
+  phgmg_allocator al;                 /* the scratch arena (phgmg__arena)     */
+} phgmg__altmin_ws;
+
+/* One sweep from (Q, W, *f): the Procrustes step Qn = polar(S W^T), i.e. the
+   orthonormal Q minimising ||S - Q W||_F for the current latent values W,
+   with M refitted; then, while it lowers the objective, the extrapolation
+   polar(Q + beta (Qn - Q)), beta = 2, 4, 8 (the plain step converges
+   linearly and slowly). Kept (into Q, W, *f) only if the objective
+   decreased: *moved = 1. */
+PHGMG__PRIV phgmg_result phgmg__altmin_sweep(phgmg__altmin_ws *w, double *f, int *moved) {
+  const int q = w->q, k = w->k;
+  double fn, fb, beta;
+  int i;
+  phgmg_result rc;
+  *moved = 0;
+  phgmg_gemm('N', 'T', q, k, w->ns, 1.0, w->S, q, w->W, k, 0.0, w->A, q);
+  rc = phgmg__polar(q, k, w->A, w->U, w->V, w->sv, w->Qn, &w->al);
+  if (rc == PHGMG_OK)
+    rc = phgmg__altmin_eval(q, w->ns, w->p, w->rn, w->S, w->Qn, w->lam, w->Kt, w->Yt, w->T, w->Wn, w->R, &fn, &w->al);
+  if (rc != PHGMG_OK || !(fn < *f)) return rc;
+  for (beta = 2.0; beta <= 8.0; beta *= 2.0) {
+    for (i = 0; i < q * k; ++i) w->A[i] = w->Q[i] + beta * (w->Qn[i] - w->Q[i]);
+    rc = phgmg__polar(q, k, w->A, w->U, w->V, w->sv, w->Qb, &w->al);
+    if (rc == PHGMG_OK)
+      rc = phgmg__altmin_eval(q, w->ns, w->p, w->rn, w->S, w->Qb, w->lam, w->Kt, w->Yt, w->T, w->Wb, w->R, &fb, &w->al);
+    if (rc == PHGMG_ERR_NOMEM) return rc;
+    if (rc != PHGMG_OK || !(fb < fn)) break;
+    memcpy(w->Qn, w->Qb, (size_t)q * k * sizeof(double));
+    memcpy(w->Wn, w->Wb, (size_t)k * w->ns * sizeof(double));
+    fn = fb;
+  }
+  memcpy(w->Q, w->Qn, (size_t)q * k * sizeof(double));
+  memcpy(w->W, w->Wn, (size_t)k * w->ns * sizeof(double));
+  *f = fn;
+  *moved = 1;
+  return PHGMG_OK;
+}
+
+/* opts.manifold = PHGMG_MANIFOLD_ALTMIN: alternating minimization of the
+   linear and quadratic parts (after Geelen, Balzano, Wright & Willcox 2023).
+   In the coordinates S = U^T Xa of the q = min(2 (p + rn), rank) leading POD
+   modes U of the adjusted snapshots Xa = X - B B^+ X, with V1 = U Q1,
+   V2 = U Q2 and Q = [Q1, Q2] orthonormal (so [B, V1, V2] stays orthonormal
+   and B in the span, as the hierarchical POD has it), the objective is
+   sum_i ||x_i - phi(rho(x_i))||^2 + lam ||M||^2 (lam as phgmg__qm_greedy).
+   Start: Q = the leading p + rn coordinates (the hierarchical POD). Each
+   sweep (phgmg__altmin_sweep) moves Q by the orthogonal Procrustes step and
+   refits M; a sweep is kept only if the objective decreases, so it never
+   increases. Stop: no decrease, a relative decrease below 1e-5, or 100
+   sweeps. Writes V1 into red->V0 and V2 into red->V2. */
+PHGMG__PRIV phgmg_result phgmg__qm_altmin(phgmg__rctx *c) {
+  phgmg_reduced *red = c->red;
+  const int N = red->N, m = red->m, p = red->p, rn = red->rn, ns = c->ns, k = p + rn, nc = p * (p + 1) / 2;
+  const int navail = c->o->pod_basis ? c->o->pod_cols : PHGMG__MIN(N, ns) - 1;
+  double *U, *S, f = HUGE_VAL, f0, tot = 0.0, outside;
+  int it, kk = 0, i, q = PHGMG__MIN(2 * k, navail), moved = 0;
+  phgmg__altmin_ws w;
+  phgmg__arena ar;
+  size_t nar;
+  phgmg_result rc = PHGMG_OK;
+  if (q < k) return PHGMG_ERR_SIZE;
+  /* arena: phgmg_lstsq's [K; sqrt(lam) I], [Y; 0] and tau, and room for the q x k SVDs */
+  nar = (size_t)(ns + nc) * (nc + rn) + (size_t)nc + 16 * (size_t)(q + k) * k + 4096;
+  U = phgmg__dalloc(c->alloc, (size_t)N * q + (size_t)q * ns * 2 + (size_t)q * k * 5 + (size_t)k * (k + 1) +
+                                  (size_t)k * ns * 3 + (size_t)ns * (nc + rn) + (size_t)nc * rn + nar);
+  if (!U) return PHGMG_ERR_NOMEM;
+  memset(&w, 0, sizeof w);
+  ar.base = (unsigned char *)(U + (size_t)N * q + (size_t)q * ns * 2 + (size_t)q * k * 5 + (size_t)k * (k + 1) +
+                              (size_t)k * ns * 3 + (size_t)ns * (nc + rn) + (size_t)nc * rn);
+  ar.cap = nar * sizeof(double); ar.used = 0; ar.up = c->alloc;
+  w.al.alloc = phgmg__arena_alloc; w.al.free = phgmg__arena_free; w.al.user = &ar;
+  S = U + (size_t)N * q; w.R = S + (size_t)q * ns; w.Q = w.R + (size_t)q * ns; w.Qn = w.Q + (size_t)q * k;
+  w.Qb = w.Qn + (size_t)q * k; w.A = w.Qb + (size_t)q * k; w.U = w.A + (size_t)q * k; w.V = w.U + (size_t)q * k;
+  w.sv = w.V + (size_t)k * k; w.W = w.sv + k; w.Wn = w.W + (size_t)k * ns; w.Wb = w.Wn + (size_t)k * ns;
+  w.Kt = w.Wb + (size_t)k * ns; w.Yt = w.Kt + (size_t)ns * nc; w.T = w.Yt + (size_t)ns * rn;
+  if (c->o->pod_basis) memcpy(U, c->o->pod_basis, (size_t)N * q * sizeof(double));
+  else {
+    rc = phgmg_pod(N, ns, c->Xa, N, q, 0.0, U, N, NULL, &kk, c->alloc);
+    if (rc == PHGMG_OK && kk < k) rc = PHGMG_ERR_SIZE;
+    q = kk;   /* the numerical rank may cut the candidates */
+  }
+  w.q = q; w.ns = ns; w.p = p; w.rn = rn; w.k = k; w.S = S;
+  w.lam = c->o->lambda_auto ? 1e-9 : c->lambda;
+  if (rc == PHGMG_OK) {
+    phgmg_gemm('T', 'N', q, ns, N, 1.0, U, N, c->Xa, N, 0.0, S, q);
+    for (i = 0; i < N * ns; ++i) tot += c->Xa[i] * c->Xa[i];
+    for (i = 0; i < q * ns; ++i) tot -= S[i] * S[i];
+    outside = PHGMG__MAX(tot, 0.0);                    /* what no Q in span U can represent */
+    for (i = 0; i < q * k; ++i) w.Q[i] = (i % q) == (i / q) ? 1.0 : 0.0;
+    rc = phgmg__altmin_eval(q, ns, p, rn, S, w.Q, w.lam, w.Kt, w.Yt, w.T, w.W, w.R, &f, &w.al);
+    if (rc == PHGMG_OK) c->inf.manifold_obj0 = c->inf.manifold_obj = f + outside;
+    for (it = 0; rc == PHGMG_OK && it < 100; ++it) {
+      f0 = f;
+      rc = phgmg__altmin_sweep(&w, &f, &moved);
+      if (rc != PHGMG_OK || !moved) break;
+      c->inf.manifold_sweeps = it + 1;
+      c->inf.manifold_obj = f + outside;
+      if (f > f0 * (1.0 - 1e-5)) break;
+    }
+    if (rc != PHGMG_ERR_NOMEM) rc = PHGMG_OK;   /* no fit or no unique step: the last Q (at worst the POD) */
+  }
+  if (rc == PHGMG_OK) {   /* V1 = U Q1, V2 = U Q2 */
+    phgmg_gemm('N', 'N', N, p, q, 1.0, U, N, w.Q, q, 0.0, red->V0 + (size_t)N * m, N);
+    phgmg_gemm('N', 'N', N, rn, q, 1.0, U, N, w.Q + (size_t)q * p, q, 0.0, red->V2, N);
+  }
+  phgmg__free(c->alloc, U);
+  return rc;
+}
+
 /* Stage 2, manifold (QUADRATIC kind): V2 = POD of the residual of [B, V1]
-   (paper 4.2.2) or the caller's; then GMG-QM fits M (eq. least_square_reg,
+   (paper 4.2.2; V1 greedy with opts.manifold = 1), V1 and V2 by alternating
+   minimization (opts.manifold = 2), or the caller's; then GMG-QM fits M (eq. least_square_reg,
    lambda fixed or by validation); GMG_MANIFOLD takes the caller's eta. */
 PHGMG__PRIV phgmg_result phgmg__stage_manifold(phgmg__rctx *c) {
   phgmg_reduced *red = c->red;
@@ -8347,15 +8573,21 @@ PHGMG__PRIV phgmg_result phgmg__stage_manifold(phgmg__rctx *c) {
   if (red->kind != PHGMG_ROM_QUADRATIC) return PHGMG_OK;
   red->V2 = phgmg__red_d(red, (size_t)N * rn);
   if (!red->V2) return PHGMG_ERR_NOMEM;
-  if (c->o->manifold == 1 && red->method == PHGMG_METHOD_GMG_QM) {
+  if (c->o->manifold == PHGMG_MANIFOLD_GREEDY && red->method == PHGMG_METHOD_GMG_QM) {
     rc = phgmg__qm_greedy(c);
+    if (rc != PHGMG_OK) return rc;
+  }
+  if (c->o->manifold == PHGMG_MANIFOLD_ALTMIN && red->method == PHGMG_METHOD_GMG_QM) {
+    rc = phgmg__qm_altmin(c);   /* V1 and V2 */
     if (rc != PHGMG_OK) return rc;
   }
   {
     double *tmp = phgmg__dalloc(c->alloc, (size_t)p * ns + (size_t)rn);
     if (!tmp) return PHGMG_ERR_NOMEM;
     phgmg__orth_remove(N, p, red->V0 + (size_t)N * m, ns, c->Xa, N, tmp);
-    if (c->o->pod_basis && c->o->manifold == 0) {
+    if (c->o->manifold == PHGMG_MANIFOLD_ALTMIN && red->method == PHGMG_METHOD_GMG_QM) {
+      /* V2 from the alternating minimization */
+    } else if (c->o->pod_basis && c->o->manifold == PHGMG_MANIFOLD_POD) {
       memcpy(red->V2, c->o->pod_basis + (size_t)N * p, (size_t)N * rn * sizeof(double));
     } else {
       rc = phgmg_pod(N, ns, c->Xa, N, rn, 0.0, red->V2, N, tmp, &k, c->alloc);
@@ -8664,6 +8896,36 @@ PHGMG__PRIV phgmg_result phgmg__qm_set(phgmg__rctx *c, int g, phgmg_real *ms) {
   return PHGMG_OK;
 }
 
+/* The validation reference of an altmin manifold (lambda_auto = 1): its own
+   linear limit M = 0 is not GMG-POD (V1 is not the POD basis), so GMG-POD
+   itself (phgmg_reduce with the same options, method GMG_POD) is simulated on
+   the validation runs too and the reference becomes the smaller of the two
+   errors per run: a kept lambda then also beats GMG-POD. If the altmin
+   linear limit (lim_ok: it simulates) is itself not within tolr of GMG-POD on
+   every run, c->fallback_pod = 1: without an admissible lambda the reduction
+   is redone with the hierarchical POD manifold. */
+PHGMG__PRIV phgmg_result phgmg__altmin_reference(phgmg__rctx *c, phgmg__vset *v, int lim_ok, double tolr) {
+  phgmg_reduce_opts o = *c->o;
+  phgmg_reduced *pod = NULL, *keep = c->red;
+  int k, ok = 0;
+  phgmg_result rc;
+  o.method = PHGMG_METHOD_GMG_POD; o.lambda_auto = 0; o.manifold = PHGMG_MANIFOLD_POD; o.nrun = 0; o.runs = NULL;
+  o.dt = 0.0;
+  rc = phgmg_reduce(&pod, c->sys, c->X, c->ldx, c->ns, &o, NULL, c->alloc);
+  if (rc == PHGMG_ERR_NOMEM) return rc;
+  if (rc != PHGMG_OK) return PHGMG_OK;   /* no GMG-POD to compare with: the linear limit alone */
+  c->red = pod;
+  rc = phgmg__vset_eval(c, v, &ok);
+  c->red = keep;
+  phgmg_reduced_destroy(pod);
+  if (rc != PHGMG_OK || !ok) return rc;
+  for (k = 0; k < v->nv; ++k) {
+    if (!lim_ok || v->base[k] > tolr * v->ey[k] + 1e-14) c->fallback_pod = 1;
+    v->base[k] = PHGMG__MIN(v->base[k], v->ey[k]);
+  }
+  return PHGMG_OK;
+}
+
 /* opts.lambda_auto = 1 (after publish): validation by simulation, see the
    comment at phgmg_reduce_opts.runs. Candidates from lambda_max down, one
    per decade, to the regression optimum; stops after two inadmissible
@@ -8694,6 +8956,7 @@ PHGMG__PRIV phgmg_result phgmg__stage_lambda_validate(phgmg__rctx *c) {
   if (rc == PHGMG_OK) rc = phgmg__qm_set(c, -1, ms);
   if (rc == PHGMG_OK) rc = phgmg__vset_eval(c, v, &ok);
   for (k = 0; k < v->nv && rc == PHGMG_OK; ++k) v->base[k] = v->ey[k] < HUGE_VAL ? v->ey[k] : 1.0;
+  if (rc == PHGMG_OK && o->manifold == PHGMG_MANIFOLD_ALTMIN) rc = phgmg__altmin_reference(c, v, ok, tolr);
   /* training runs alone: up from the regression optimum, the first admissible */
   for (g = c->gsel; rc == PHGMG_OK && o->lambda_train_only && g < c->ng; g += pd) {
     double worst = 0.0;
@@ -8729,6 +8992,8 @@ PHGMG__PRIV phgmg_result phgmg__stage_lambda_validate(phgmg__rctx *c) {
       best = cand_g[k]; best_ratio = cand_worst[k];
       break;
     }
+  if (rc == PHGMG_OK && best < 0 && c->fallback_pod) rc = PHGMG_OK;   /* redone with manifold = POD */
+  else c->fallback_pod = 0;
   if (rc == PHGMG_OK) rc = phgmg__qm_set(c, best, ms);
   if (rc == PHGMG_OK) {
     c->gsel = best;
@@ -9062,6 +9327,23 @@ PHGMG__PRIV phgmg_result phgmg__stage_general_term(phgmg__rctx *c) {
   return red->gwork ? PHGMG_OK : PHGMG_ERR_NOMEM;
 }
 
+/* manifold = ALTMIN under lambda_auto = 1 without a model as good as GMG-POD
+   (phgmg__altmin_reference): the same reduction with the hierarchical POD
+   manifold; info keeps the altmin objective and sets manifold_fallback. */
+PHGMG__PRIV phgmg_result phgmg__reduce_fallback_pod(phgmg_reduced **out, const phgmg__rctx *c,
+                                                    phgmg_reduce_info *info) {
+  phgmg_reduce_opts o = *c->o;
+  phgmg_reduce_info inf;
+  phgmg_result rc;
+  phgmg_reduced_destroy(c->red);
+  o.manifold = PHGMG_MANIFOLD_POD;
+  rc = phgmg_reduce(out, c->sys, c->X, c->ldx, c->ns, &o, &inf, c->alloc);
+  inf.manifold_obj0 = c->inf.manifold_obj0; inf.manifold_obj = c->inf.manifold_obj;
+  inf.manifold_sweeps = c->inf.manifold_sweeps; inf.manifold_fallback = 1;
+  if (info) *info = inf;
+  return rc;
+}
+
 PHGMG_DEF phgmg_result phgmg_reduce(phgmg_reduced **out, const phgmg_ph_system *sys, const double *X,
                                     int ldx, int ns, const phgmg_reduce_opts *opts,
                                     phgmg_reduce_info *info, const phgmg_allocator *alloc) {
@@ -9105,6 +9387,7 @@ PHGMG_DEF phgmg_result phgmg_reduce(phgmg_reduced **out, const phgmg_ph_system *
   if (rc == PHGMG_OK)
     c.inf.online_callbacks = c.red->rom.phi_cb || c.red->rom.eta_cb || c.red->rom.ham_cb;
   phgmg__rctx_free(&c);
+  if (rc == PHGMG_OK && c.fallback_pod) return phgmg__reduce_fallback_pod(out, &c, info);
   if (info) *info = c.inf;
   if (rc != PHGMG_OK) {
     phgmg_reduced_destroy(c.red);

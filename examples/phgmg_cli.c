@@ -37,7 +37,8 @@ static const char *const help_lines[] = {
   "  phgmg reduce --J J.npy --R R.npy --B B.npy --Q Q.npy\n",
   "               (or --J-coo/--R-coo/--Q-coo for sparse J, R, Q; see SPARSE MATRICES)\n",
   "               (--X X.npy | --simulate [--dt 0.1] [--steps 1000] [--input sin] [--amp 0.1])\n",
-  "               --method gmg-pod|gmg-qm|sp1|sp2 --r R [--rn 8] [--lambda 1e-3]\n",
+  "               --method gmg-pod|gmg-qm|sp1|sp2 --r R [--rn 8] [--lambda 1e-3|auto|cv]\n",
+  "               [--manifold pod|greedy|altmin] [--train-input KIND]...\n",
   "               [--poly coeffs.npy --poly-idx idx.npy [--poly-w w.npy]] [DEIM options]\n",
   "               --out DIR [--name rom] [--dt-map DT] [--save-snapshots] [--quiet]\n",
   "  phgmg simulate-rom --model DIR/NAME.phgmgrom --out y.npy [--states xr.npy]\n",
@@ -46,7 +47,8 @@ static const char *const help_lines[] = {
   "  phgmg validate <the options of reduce> [--test-input KIND]... [--test-amp A]\n",
   "               [--test-steps N] [--max-ey E]   (reduce, then run full and reduced\n",
   "               model on each test input: e_red, e_y, e_proj, energy, Newton, the\n",
-  "               first failing step; exit 1 if one fails or e_y > E, default 0.1)\n",
+  "               first failing step; exit 1 if one fails or e_y > E, default 0.1;\n",
+  "               default test inputs: the training input(s))\n",
   "  phgmg --help | --version\n",
   "\n",
   "THE MODEL\n",
@@ -89,7 +91,25 @@ static const char *const help_lines[] = {
   "  --rn K              gmg-qm lifting dimension r_n (default 8; K <= 64, K (R-m) <= 4096,\n",
   "                      R + K <= N)\n",
   "  --lambda L          gmg-qm ridge parameter, on the un-normalised sum over the\n",
-  "                      snapshots (default 1e-3; 0 = exactly zero)\n",
+  "                      snapshots (default 1e-3; 0 = exactly zero). Or:\n",
+  "    --lambda auto     validated by simulation (safe choice): the reduced model is\n",
+  "                      simulated for candidate lambdas on the training runs and on\n",
+  "                      three probe inputs and compared with M = 0 (GMG-POD on the\n",
+  "                      same basis); no safe lambda: M = 0. Needs --simulate (with\n",
+  "                      --X the inputs are unknown and M = 0 is kept). Costs seconds.\n",
+  "    --lambda cv       regression only (held-out time blocks; one run per fold with\n",
+  "                      several --train-input): fits the snapshots closely, but may\n",
+  "                      give a model that fails on other inputs.\n",
+  "  --manifold KIND     gmg-qm linear part of the manifold: pod (default, the paper's\n",
+  "                      hierarchical POD), greedy (V1 chosen among POD modes by the\n",
+  "                      quadratic fit), altmin (alternating minimization of V1, V2\n",
+  "                      and M over the snapshots, started from pod; B stays in the\n",
+  "                      span). Representation error: altmin <= pod on the snapshots.\n",
+  "  --train-input KIND  with --simulate, instead of --input: one training run per\n",
+  "                      --train-input (repeatable, up to 16; KIND as --input), each\n",
+  "                      from x0 = 0 with the same --dt, --steps and --amp; the\n",
+  "                      snapshots of all runs together, the run boundaries known to\n",
+  "                      the reduction and to --lambda auto/cv.\n",
   "  --poly FILE         separable nonlinearity H_nl = sum_k w_k phi_k(x[idx_k]) from the\n",
   "                      exp-polynomial family phi(s) = sum_j c_j s^j + sum_e a_e exp(b_e s):\n",
   "                      the coefficients c_0, ..., c_d (constant first) as a vector\n",
@@ -799,6 +819,11 @@ typedef struct reduce_args {
   int simulate, steps, r, rn, no_deim, deim_max, deim_neg, save_snap, have_dt_map, newton_iter;
   double dt, amp, lambda, deim_tol, dt_map, newton_tol;
   int have_lambda;
+  int lambda_auto;              /* --lambda auto (1) / cv (2) */
+  int manifold;                 /* --manifold pod (0) / greedy (1) / altmin (2) */
+  const char *manifold_s;
+  const char *train[16];        /* --train-input KIND, repeatable */
+  int ntrain;
 } reduce_args;
 
 static const char *method_name(int m) {
@@ -822,7 +847,7 @@ static int parse_reduce(int argc, char **argv, reduce_args *A) {
   const char *seen[64];
   int i, nseen = 0;
   memset(A, 0, sizeof *A);
-  A->dt = 0.1; A->steps = 1000; A->amp = 0.1; A->input = "sin"; A->rn = 8; A->lambda = 1e-3;
+  A->dt = 0.1; A->steps = 1000; A->amp = 0.1; A->rn = 8; A->lambda = 1e-3;
   A->deim_tol = 1e-8; A->name = "rom"; A->newton_tol = 1e-10; A->newton_iter = 10;
   for (i = 2; i < argc; ++i) {
     const char *o = argv[i], *v;
@@ -830,6 +855,12 @@ static int parse_reduce(int argc, char **argv, reduce_args *A) {
 #define INT(opt, field, lo, hi) else if (!strcmp(o, opt)) { if (!(v = optval(argc, argv, &i)) || !parse_int(o, v, lo, hi, &A->field)) return 2; }
 #define DBL(opt, field, lo) else if (!strcmp(o, opt)) { if (!(v = optval(argc, argv, &i)) || !parse_double(o, v, lo, &A->field)) return 2; }
     if (!strcmp(o, "--help") || !strcmp(o, "-h")) { print_help(); return -1; }
+    if (!strcmp(o, "--train-input")) {   /* repeatable: one training run each */
+      if (!(v = optval(argc, argv, &i))) return 2;
+      if (A->ntrain >= 16) return usage_error("reduce: at most 16 --train-input");
+      A->train[A->ntrain++] = v;
+      continue;
+    }
     if (repeated_opt(o, seen, &nseen)) return 2;
     STR("--J", J) STR("--R", R) STR("--B", B) STR("--Q", Q) STR("--X", X)
     STR("--J-coo", Jcoo) STR("--R-coo", Rcoo) STR("--Q-coo", Qcoo)
@@ -845,8 +876,19 @@ static int parse_reduce(int argc, char **argv, reduce_args *A) {
       if (!(A->dt > 0.0)) return usage_error("--dt must be > 0");
     }
     else if (!strcmp(o, "--lambda")) {
-      if (!(v = optval(argc, argv, &i)) || !parse_double(o, v, 0.0, &A->lambda)) return 2;
+      if (!(v = optval(argc, argv, &i))) return 2;
+      if (!strcmp(v, "auto")) A->lambda_auto = 1;
+      else if (!strcmp(v, "cv")) A->lambda_auto = 2;
+      else if (!parse_double(o, v, 0.0, &A->lambda)) return 2;
       A->have_lambda = 1;
+    }
+    else if (!strcmp(o, "--manifold")) {
+      if (!(v = optval(argc, argv, &i))) return 2;
+      A->manifold_s = v;
+      if (!strcmp(v, "pod")) A->manifold = PHGMG_MANIFOLD_POD;
+      else if (!strcmp(v, "greedy")) A->manifold = PHGMG_MANIFOLD_GREEDY;
+      else if (!strcmp(v, "altmin")) A->manifold = PHGMG_MANIFOLD_ALTMIN;
+      else return usage_error("--manifold '%s': expected pod, greedy or altmin", v);
     }
     else if (!strcmp(o, "--dt-map")) {
       if (!(v = optval(argc, argv, &i)) || !parse_double(o, v, 0.0, &A->dt_map)) return 2;
@@ -880,6 +922,12 @@ static int parse_reduce(int argc, char **argv, reduce_args *A) {
     return usage_error("--hyper '%s': expected ecsw, qdeim or greedy", A->hyper);
   if (!(A->hyper_tol < 1.0)) return usage_error("--hyper-tol must be < 1");
   if (name_problem(A->name)) return usage_error("--name '%s': %s", A->name, name_problem(A->name));
+  if (A->ntrain && !A->simulate) return usage_error("reduce: --train-input needs --simulate");
+  if (A->ntrain && A->input)
+    return usage_error("reduce: give the training input either by --input or by --train-input, not both");
+  if (!A->input) A->input = A->ntrain ? A->train[0] : "sin";
+  if ((A->lambda_auto || A->manifold_s) && strcmp(A->method, "gmg-qm") != 0)
+    return usage_error("reduce: --lambda auto/cv and --manifold apply to --method gmg-qm only");
   if (!A->have_dt_map) A->dt_map = A->simulate ? A->dt : 0.0;
   if (A->simulate && too_big((double)A->steps + 1.0, "--simulate --steps: the snapshots (N x (steps+1)) alone"))
     return 2; /* N >= 1: a first check before reading J */
@@ -992,6 +1040,9 @@ typedef struct reduce_state {
   phgmg_ph_sparse *sp;    /* its banded, RCM-ordered system; NULL for dense input */
   double *Xperm, *Uord;   /* snapshots in the internal order; un-permuted output */
   cli_input in;
+  cli_input tin[16];      /* --train-input 2..: the further training inputs */
+  phgmg_run runs[16];     /* the training runs (with --simulate), for phgmg_reduce */
+  int nrun;
   phgmg_reduced *red;
   staged sg; /* the outputs, renamed into place at the end */
 } reduce_state;
@@ -1078,6 +1129,7 @@ static int load_family(const reduce_args *A, reduce_state *S, phgmg_ph_system *s
 static void reduce_cleanup(reduce_state *S) {
   mat_free(&S->J); mat_free(&S->R); mat_free(&S->B); mat_free(&S->Q); mat_free(&S->X);
   mat_free(&S->poly); mat_free(&S->pidx); mat_free(&S->pw); mat_free(&S->ex); mat_free(&S->in.tab);
+  { int k; for (k = 0; k < 16; ++k) mat_free(&S->tin[k].tab); }
   free(S->idx); free(S->fpoly); free(S->fexp); free(S->Xsim); free(S->Ysim); free(S->V0);
   cli_csc_free(&S->cJ); cli_csc_free(&S->cR); cli_csc_free(&S->cQ);
   phgmg_ph_sparse_destroy(S->sp); free(S->Xperm); free(S->Uord);
@@ -1258,8 +1310,11 @@ static int cmd_reduce_impl(const reduce_args *A, reduce_state *S) {
     phgmg_gl3_stats st;
     double *x0;
     int done = 0;
+    const int nrun = A->ntrain ? A->ntrain : 1;
     if ((k = input_setup(&S->in, A->input, A->amp, m, A->dt)) != 0) return k;
-    ns = A->steps + 1;
+    for (i = 1; i < nrun; ++i)
+      if ((k = input_setup(&S->tin[i], A->train[i], A->amp, m, A->dt)) != 0) return k;
+    ns = nrun * (A->steps + 1);
     if (too_big(((double)N + (double)m) * (double)ns, "--simulate: the snapshots (N x (steps+1)) and outputs"))
       return 2;
     S->Xsim = (double *)malloc(sizeof(double) * (size_t)N * (size_t)ns);
@@ -1268,21 +1323,31 @@ static int cmd_reduce_impl(const reduce_args *A, reduce_state *S) {
     if (!S->Xsim || !S->Ysim || !x0) { free(x0); return fail("out of memory for %d snapshots of size %d", ns, N); }
     memset(&go, 0, sizeof go);
     go.tol = A->newton_tol; go.max_iter = A->newton_iter;
-    progress("simulating the full model: %d steps of dt = %g, %s", A->steps, A->dt, input_desc(&S->in, A->input));
-    S->in.report = 1;
-    S->in.t_end = A->steps * A->dt;
-    S->in.wall0 = S->in.wall_last = t0 = now_s();
-    rc = phgmg_simulate(&sys, x0, 0.0, A->dt, A->steps, input_fn, &S->in, &go, S->Xsim, S->Ysim, NULL, &st,
-                        &done, NULL);
-    S->in.report = 0;
+    t0 = now_s();
+    for (i = 0; i < nrun; ++i) {   /* run i in columns i (steps + 1) ..; from x0 = 0 */
+      cli_input *in = i ? &S->tin[i] : &S->in;
+      const size_t c0 = (size_t)i * (size_t)(A->steps + 1);
+      progress("simulating the full model: %d steps of dt = %g, %s", A->steps, A->dt,
+               input_desc(in, i ? A->train[i] : A->input));
+      in->report = 1;
+      in->t_end = A->steps * A->dt;
+      in->wall0 = in->wall_last = now_s();
+      rc = phgmg_simulate(&sys, x0, 0.0, A->dt, A->steps, input_fn, in, &go, S->Xsim + c0 * (size_t)N,
+                          S->Ysim + c0 * (size_t)m, NULL, &st, &done, NULL);
+      in->report = 0;
+      if (rc != PHGMG_OK) {
+        free(x0);
+        return fail("full-order simulation failed at step %d of %d (t = %g): %s%s", done + 1, A->steps,
+                    done * A->dt, phgmg_result_string(rc),
+                    rc == PHGMG_ERR_NOT_CONVERGED ? " (try a smaller --dt or more --newton-iter)" : "");
+      }
+      progress("  done (%ld Newton iterations, %ld factorizations)", st.newton_iters, st.factorizations);
+      memset(&S->runs[i], 0, sizeof S->runs[i]);
+      S->runs[i].u = input_fn; S->runs[i].user = in; S->runs[i].dt = A->dt; S->runs[i].nsteps = A->steps;
+    }
+    S->nrun = nrun;
     free(x0);
     t_sim = now_s() - t0;
-    if (rc != PHGMG_OK)
-      return fail("full-order simulation failed at step %d of %d (t = %g): %s%s", done + 1, A->steps,
-                  done * A->dt, phgmg_result_string(rc),
-                  rc == PHGMG_ERR_NOT_CONVERGED ? " (try a smaller --dt or more --newton-iter)" : "");
-    progress("  done in %.2f s (%ld Newton iterations, %ld factorizations)", t_sim, st.newton_iters,
-             st.factorizations);
     X = S->Xsim;
   }
 
@@ -1300,6 +1365,10 @@ static int cmd_reduce_impl(const reduce_args *A, reduce_state *S) {
   o.deim_max = A->deim_max;
   o.deim_allow_negative = A->deim_neg;
   o.dt = A->dt_map;
+  o.lambda_auto = A->lambda_auto;
+  o.manifold = A->manifold;
+  if (S->nrun > 0) { o.nrun = S->nrun; o.runs = S->runs; } /* --simulate: the runs are known */
+  if (A->lambda_auto == 1) { o.newton_tol = A->newton_tol; o.newton_iter = A->newton_iter; }
   memset(&info, 0, sizeof info);
   progress("reducing: %s, r = %d%s", A->method, A->r, method == PHGMG_METHOD_GMG_QM ? " (quadratic manifold)" : "");
   t0 = now_s();
@@ -1325,6 +1394,10 @@ static int cmd_reduce_impl(const reduce_args *A, reduce_state *S) {
   rom = phgmg_reduced_rom(S->red);
   progress("  done in %.2f s: r = %d, m = %d%s; sigma_{r'+1}/sigma_1 = %.3g, rcond(D^T G D) = %.3g", t_red, rom->r,
            rom->m, rom->nd ? "" : ", quadratic energy", info.pod_sigma_ratio, info.rcond_dgd);
+  if (method == PHGMG_METHOD_GMG_QM && (A->lambda_auto || A->manifold))
+    progress("  manifold %s, lambda %s: %.3g%s", A->manifold_s ? A->manifold_s : "pod",
+             A->lambda_auto == 1 ? "auto" : A->lambda_auto == 2 ? "cv" : "fixed", info.lambda,
+             info.lambda == HUGE_VAL ? " (M = 0: no safe quadratic correction found)" : "");
   if (rom->nd && o.deim)
     progress("  hyper-reduction %s: %d points, %d negative weights, smallest weight %.3g, training residual %.2g",
              A->hyper ? A->hyper : "ecsw", info.deim_modes, info.deim_negative, info.hyper_min_weight,
@@ -1414,13 +1487,24 @@ static int cmd_reduce_impl(const reduce_args *A, reduce_state *S) {
   else {
     fprintf(jf, "\"simulate\": {\"dt\": "); json_num(jf, A->dt);
     fprintf(jf, ", \"steps\": %d, \"input\": ", A->steps); json_str(jf, A->input);
+    if (A->ntrain) {
+      fprintf(jf, ", \"train_inputs\": [");
+      for (i = 0; i < A->ntrain; ++i) { if (i) fprintf(jf, ", "); json_str(jf, A->train[i]); }
+      fprintf(jf, "]");
+    }
     fprintf(jf, ", \"amp\": "); json_num(jf, A->amp);
     fprintf(jf, ", \"newton_tol\": "); json_num(jf, A->newton_tol);
     fprintf(jf, ", \"newton_iter\": %d, \"seconds\": ", A->newton_iter); json_num(jf, t_sim);
     fprintf(jf, "}");
   }
   fprintf(jf, "},\n  \"options\": {\"rn\": %d, \"lambda\": ", o.rn);
-  json_num(jf, A->lambda);
+  if (A->lambda_auto) json_str(jf, A->lambda_auto == 1 ? "auto" : "cv");
+  else json_num(jf, A->lambda);
+  fprintf(jf, ", \"lambda_used\": ");
+  json_num(jf, info.lambda == HUGE_VAL ? -1.0 : info.lambda);
+  fprintf(jf, ", \"manifold\": ");
+  json_str(jf, A->manifold_s ? A->manifold_s : "pod");
+  fprintf(jf, ", \"training_runs\": %d", S->nrun);
   fprintf(jf, ", \"deim\": %s, \"deim_tol\": ", o.deim ? "true" : "false");
   json_num(jf, A->deim_tol);
   fprintf(jf, ", \"deim_max\": %d, \"deim_allow_negative\": %s},\n", A->deim_max, A->deim_neg ? "true" : "false");
@@ -1649,6 +1733,8 @@ static int cmd_validate(int argc, char **argv) {
   reduce_argv[rargc] = NULL;
   if ((i = parse_reduce(rargc, (char **)reduce_argv, &A)) != 0) return i;
   if (!A.simulate) return usage_error("validate: needs --simulate (the full model is simulated on the test inputs)");
+  if (nt == 0 && A.ntrain)   /* default: the training inputs */
+    for (i = 0; i < A.ntrain; ++i) tests[nt++] = A.train[i];
   if (nt == 0) tests[nt++] = A.input;
   memset(&S, 0, sizeof S);
   status = cmd_reduce_impl(&A, &S);

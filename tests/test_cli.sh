@@ -429,5 +429,55 @@ else
   echo "test_cli: section 7 skipped (no NumPy for $PY)"
 fi
 
+# ---- 8. issue 15: --lambda auto|cv, --manifold, --train-input ----------------------
+# --manifold altmin: the training representation error sum ||x - phi(rho(x))||^2
+# (computed here with NumPy from the written V0, V2, M and the snapshots, the
+# ridge lambda 1e-10 for both, negligible here) is at most the hierarchical POD's; --train-input
+# twice simulates two runs (2 (steps + 1) snapshots, both in the json) and
+# `validate` then checks both training inputs by default; --lambda auto writes
+# the chosen lambda; bad combinations are usage errors (exit 2).
+for o in --manifold altmin greedy --train-input "--lambda auto" "lambda cv"; do
+  "$P" --help | grep -F -q -- "$o" || bad "--help does not explain $o"
+done
+QSIM="--simulate --dt 0.1 --steps 300 --quiet"
+run_ok "reduce --manifold pod" "$P" reduce $SYS $QSIM --method gmg-qm --r 10 --rn 4 --lambda 1e-10 --manifold pod --out q8 --name p --save-snapshots
+run_ok "reduce --manifold altmin" "$P" reduce $SYS $QSIM --method gmg-qm --r 10 --rn 4 --lambda 1e-10 --manifold altmin --out q8 --name a
+grep -F -q '"manifold": "altmin"' q8/a.json || bad "json does not name the altmin manifold"
+if [ "$HAVE_NP" = 1 ]; then
+  run_ok "altmin representation error <= POD" "$PY" - <<'PYEOF'
+import numpy as np
+X = np.load("q8/p_snapshots.npy"); m = 1
+def err(n):
+    V0, V2, M = (np.load(f"q8/{n}_{k}.npy") for k in ("V0", "V2", "M"))
+    xr = np.linalg.lstsq(V0, X, rcond=None)[0]          # rho(x) = [B, V1]^+ x
+    x2 = xr[m:]
+    q = np.einsum("ik,jk->ijk", x2, x2).reshape(x2.shape[0] ** 2, -1)
+    return np.sum((X - V0 @ xr - V2 @ (M @ q)) ** 2)
+ep, ea = err("p"), err("a")
+V0 = np.load("q8/a_V0.npy"); V2 = np.load("q8/a_V2.npy"); V = np.hstack([V0[:, m:], V2])
+assert np.max(np.abs(V.T @ V - np.eye(V.shape[1]))) < 1e-12, "altmin [V1, V2] not orthonormal"
+assert np.max(np.abs(V.T @ V0[:, :m])) < 1e-12, "altmin [V1, V2] not orthogonal to B"
+assert ea <= ep, f"altmin training error {ea} above POD's {ep}"
+assert ea < 0.99 * ep, f"altmin did not improve on POD ({ea} vs {ep})"
+PYEOF
+fi
+run_ok "reduce --train-input x2 --lambda auto" "$P" reduce $SYS $QSIM --method gmg-qm --r 10 --rn 4 --lambda auto --train-input sin --train-input const --out q8 --name t
+grep -F -q '"count": 602' q8/t.json || bad "two training runs: expected 602 snapshots in the json"
+grep -F -q '"training_runs": 2' q8/t.json || bad "json does not count the training runs"
+grep -F -q '"train_inputs": ["sin", "const"]' q8/t.json || bad "json does not list the training inputs"
+grep -F -q '"lambda": "auto"' q8/t.json || bad "json does not record --lambda auto"
+grep -q '"lambda_used": [-0-9]' q8/t.json || bad "json has no lambda_used"
+"$P" validate $SYS $QSIM --method gmg-pod --r 10 --train-input sin --train-input const --out q8v > val.txt 2>&1
+[ $? -eq 0 ] && pass || bad "validate with two training inputs: nonzero exit"
+[ "$(grep -c ' pass$' val.txt)" -eq 2 ] && pass || bad "validate did not check both training inputs by default"
+run_ok "reduce --lambda cv" "$P" reduce $SYS $QSIM --method gmg-qm --r 10 --rn 4 --lambda cv --out q8 --name c
+grep -F -q '"lambda": "cv"' q8/c.json || bad "json does not record --lambda cv"
+run_err "manifold unknown" 2 "expected pod, greedy or altmin" "$P" reduce $SYS $QSIM --method gmg-qm --r 10 --manifold best --out q8
+run_err "manifold with gmg-pod" 2 "gmg-qm only" "$P" reduce $SYS $QSIM --method gmg-pod --r 10 --manifold altmin --out q8
+run_err "lambda auto with sp1" 2 "gmg-qm only" "$P" reduce $SYS $QSIM --method sp1 --r 10 --lambda auto --out q8
+run_err "lambda word" 2 "--lambda" "$P" reduce $SYS $QSIM --method gmg-qm --r 10 --lambda often --out q8
+run_err "train-input with --X" 2 "needs --simulate" "$P" reduce $SYS --X out/msd_snapshots.npy --train-input sin --method gmg-qm --r 10 --out q8
+run_err "train-input with --input" 2 "not both" "$P" reduce $SYS $QSIM --input sin --train-input const --method gmg-qm --r 10 --out q8
+
 echo "test_cli: $npass passed, $nfail failed"
 [ "$nfail" -eq 0 ]

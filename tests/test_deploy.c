@@ -14,6 +14,8 @@
 static void u_sin2(double t, double *u, void *p) { (void)p; u[0] = 0.1 * sin(2.0 * t); }
 static void u_steps(double t, double *u, void *p) { (void)p; u[0] = ((int)(t / 7.0) % 3 - 1) * 0.08; }
 
+static double maxabs_d(int n, const double *a) { double s = 0; int i; for (i = 0; i < n; ++i) s = PHGMG__MAX(s, fabs(a[i])); return s; }
+
 static double *sim(const phgmg_ph_system *sys, phgmg_input_fn u, int nsteps, double *Y) {
   double *X = (double *)malloc(sizeof(double) * sys->N * (nsteps + 1));
   phgmg_run run;
@@ -83,7 +85,8 @@ TEST(test_deploy_options) {
   BAD(lambda_tolerance, (double)NAN, PHGMG_ERR_INVALID_ARG);
   BAD(newton_tol, -1.0, PHGMG_ERR_INVALID_ARG);
   BAD(newton_iter, -1, PHGMG_ERR_INVALID_ARG);
-  BAD(manifold, 2, PHGMG_ERR_INVALID_ARG);
+  BAD(manifold, 3, PHGMG_ERR_INVALID_ARG);
+  BAD(manifold, -1, PHGMG_ERR_INVALID_ARG);
   BAD(lambda_train_only, 2, PHGMG_ERR_INVALID_ARG);
   BAD(lambda_auto, 3, PHGMG_ERR_INVALID_ARG);
 #undef BAD
@@ -309,6 +312,81 @@ TEST(test_greedy_manifold_picks_pod_modes) {
   msd_linear_free(&M);
 }
 
+/* Alternating minimization (opts.manifold = PHGMG_MANIFOLD_ALTMIN), with the
+   exact least-squares fit (lambda = 0 both in the sweeps and in the final fit):
+   - it starts from the hierarchical POD: info.manifold_obj0 equals the POD
+     manifold's training error sum ||x - phi(rho(x))||^2, measured here by
+     phgmg_err_proj on the published model (an independent computation);
+   - the objective never increases: the altmin manifold's training error (again
+     by phgmg_err_proj) is at most the POD one's, and equals info.manifold_obj;
+   - GMG structure: [B, V1, V2] with V1, V2 orthonormal and orthogonal to B
+     (and to each other), Bh = [I; 0], J skew and R PSD at reduced states,
+     rcond(D^T G D) above the degeneracy floor. */
+static double sumsq(int n, int ns, const double *X) {
+  double s = 0;
+  int i;
+  for (i = 0; i < n * ns; ++i) s += X[i] * X[i];
+  return s;
+}
+TEST(test_altmin_manifold) {
+  msd_linear M;
+  enum { NS = 401, N = 100, P = 8, RN = 4, R = P + 1 };
+  double *X, G[(P + RN) * (P + RN)], Jr[R * R], Rr[R * R], ev[R], xr[R], work[8192], nx, e_pod, e_alt, d;
+  phgmg_reduce_opts o;
+  phgmg_reduce_info ip, ia;
+  phgmg_reduced *pod = NULL, *alt = NULL;
+  const phgmg_rom *rom;
+  int i, j, s;
+  CHECK(msd_linear_build(&M, 50, NULL, NULL, NULL, PHGMG_DENSE) == 0);
+  X = sim(&M.sys, msd_input_sin, NS - 1, NULL);
+  CHECK(X != NULL);
+  if (!X) { msd_linear_free(&M); return; }
+  nx = sumsq(N, NS, X);
+  memset(&o, 0, sizeof o);
+  o.method = PHGMG_METHOD_GMG_QM; o.r = R; o.rn = RN; o.lambda = -1.0;   /* exactly 0 */
+  o.manifold = PHGMG_MANIFOLD_POD;
+  CHECK_RC(phgmg_reduce(&pod, &M.sys, X, N, NS, &o, &ip, NULL), PHGMG_OK);
+  o.manifold = PHGMG_MANIFOLD_ALTMIN;
+  CHECK_RC(phgmg_reduce(&alt, &M.sys, X, N, NS, &o, &ia, NULL), PHGMG_OK);
+  if (pod && alt) {
+    e_pod = phgmg_err_proj(pod, X, N, NS);
+    e_alt = phgmg_err_proj(alt, X, N, NS);
+    CHECK_LE(fabs(e_pod * e_pod * nx - ia.manifold_obj0), 1e-8 * ia.manifold_obj0);
+    CHECK_LE(fabs(e_alt * e_alt * nx - ia.manifold_obj), 1e-8 * ia.manifold_obj);
+    CHECK_LE(ia.manifold_obj, ia.manifold_obj0);
+    CHECK_LE(e_alt, e_pod);
+    CHECK(ia.manifold_sweeps >= 1);
+    CHECK(ip.manifold_sweeps == 0 && ip.manifold_obj0 == 0.0);
+    /* [V1, V2] orthonormal and orthogonal to B */
+    phgmg_gemm('T', 'N', P, P, N, 1.0, alt->V0 + N, N, alt->V0 + N, N, 0.0, G, P + RN);
+    phgmg_gemm('T', 'N', RN, RN, N, 1.0, alt->V2, N, alt->V2, N, 0.0, G + P + (size_t)P * (P + RN), P + RN);
+    phgmg_gemm('T', 'N', RN, P, N, 1.0, alt->V2, N, alt->V0 + N, N, 0.0, G + P, P + RN);
+    for (j = 0; j < P; ++j) for (i = 0; i < P + RN; ++i) {
+      const double want = (i == j) ? 1.0 : 0.0;
+      CHECK_LE(fabs(G[i + j * (P + RN)] - want), 1e-12);
+    }
+    for (j = P; j < P + RN; ++j) for (i = P; i < P + RN; ++i) CHECK_LE(fabs(G[i + j * (P + RN)] - (i == j)), 1e-12);
+    phgmg_gemv('T', N, P, 1.0, alt->V0 + N, N, M.sys.B, 0.0, G);
+    phgmg_gemv('T', N, RN, 1.0, alt->V2, N, M.sys.B, 0.0, G + P);
+    CHECK_LE(maxabs_d(P + RN, G), 1e-12);
+    rom = phgmg_reduced_rom(alt);
+    for (i = 0; i < R; ++i) CHECK(rom->Bh[i] == (i == 0 ? 1.0 : 0.0));
+    CHECK(ia.rcond_dgd > 1e-12);
+    for (s = 1; s <= 4; ++s) {
+      phgmg_reduced_restrict(alt, X + (size_t)(NS - 1) * s / 4 * N, xr);
+      CHECK_RC(phgmg_rom_structure(rom, xr, Jr, Rr, work), PHGMG_OK);
+      for (i = 0, d = 0; i < R; ++i) for (j = 0; j < R; ++j) d = PHGMG__MAX(d, fabs(Jr[i + j * R] + Jr[j + i * R]));
+      CHECK_LE(d, 1e-12 * (maxabs_d(R * R, Jr) + 1e-300));
+      CHECK_RC(phgmg_sym_eig(R, Rr, R, ev, NULL, 1), PHGMG_OK);
+      CHECK_LE(-1e-12 * (fabs(ev[R - 1]) + 1e-300), ev[0]);
+    }
+  }
+  phgmg_reduced_destroy(pod);
+  phgmg_reduced_destroy(alt);
+  free(X);
+  msd_linear_free(&M);
+}
+
 /* Every allocation failure of the validated lambda (lambda_auto = 1 with
    runs), the envelope and the greedy manifold: PHGMG_ERR_NOMEM, nothing left. */
 typedef struct tcount { long calls, fail_at, live; } tcount;
@@ -341,10 +419,12 @@ TEST(test_deploy_oom) {
   memset(&run, 0, sizeof run);
   run.u = msd_input_sin; run.dt = 0.1; run.nsteps = ns - 1;
   al.alloc = tc_alloc; al.free = tc_free; al.user = &c;
-  for (pass = 0; pass < 2; ++pass) {
+  for (pass = 0; pass < 4; ++pass) {   /* manifold POD, greedy, altmin (fixed lambda, lambda_auto = 1) */
     memset(&o, 0, sizeof o);
     o.method = PHGMG_METHOD_GMG_QM; o.r = 5; o.rn = 3; o.lambda_auto = 1; o.nrun = 1; o.runs = &run;
-    o.manifold = pass; o.lambda_train_only = pass;
+    o.manifold = pass < 3 ? pass : PHGMG_MANIFOLD_ALTMIN; o.lambda_train_only = pass == 1;
+    if (pass == 2) { o.r = 4; o.rn = 2; o.lambda_auto = 0; }
+    if (pass == 3) { o.r = 3; o.rn = 1; }   /* with the GMG-POD reference and the fallback: small */
     memset(&c, 0, sizeof c);
     CHECK_RC(phgmg_reduce(&red, &M.sys, X, M.sys.N, ns, &o, NULL, &al), PHGMG_OK);
     if (red) CHECK_RC(phgmg_reduced_validate(red, &M.sys, &run, 0, 0, 0, &v, &al), PHGMG_OK);
@@ -376,4 +456,5 @@ SUITE(deploy) {
   RUN(test_validate_and_indicator);
   RUN(test_consecutive_failures);
   RUN(test_greedy_manifold_picks_pod_modes);
+  RUN(test_altmin_manifold);
 }

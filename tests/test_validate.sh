@@ -10,6 +10,7 @@
 #    --max-ey): exit 1, and on u = 0.1 sin 2t (an input file) its Newton
 #    solve fails: exit 1 and the first failing step is reported (step 290 of
 #    1000, t = 29, measured; the check accepts any step in 1..999).
+#    With --lambda auto (pod or altmin manifold) the same r = 8 passes on all three.
 # 3. Bad usage exits 2.
 # The model comes from examples/npy_example/make_model.py (NumPy); skipped
 # with a note if /usr/bin/python3 has no NumPy.
@@ -53,6 +54,17 @@ rc=$?
 step=$(sed -n 's/.*first failing step: \([0-9]*\) .*/\1/p' v3.txt | head -1)
 if [ -n "$step" ] && [ "$step" -ge 1 ] && [ "$step" -le 999 ]; then pass; else bad "no first failing step reported (got '$step')"; cat v3.txt; fi
 grep -q "^sin  .* pass$" v3.txt && pass || bad "the training input should pass (v3)"
+
+# 2b. the same reduction with the validated lambda (--lambda auto, issue 15)
+#     passes where lambda = 1e-12 failed: u = 0.1 and u = 0.1 sin 2t; also with
+#     the altmin manifold
+for man in pod altmin; do
+  $P validate $M --method gmg-qm --r 8 --lambda auto --manifold $man --out o6 --test-input sin --test-input const \
+     --test-input sin2.npy > v6.txt 2>&1
+  rc=$?
+  [ $rc -eq 0 ] && pass || { bad "GMG-QM --lambda auto --manifold $man r=8: exit $rc (expected 0)"; cat v6.txt; }
+  [ "$(grep -c ' pass$' v6.txt)" -eq 3 ] && pass || bad "GMG-QM --lambda auto --manifold $man: expected three passing inputs"
+done
 
 # 3. usage
 $P validate $M --method gmg-pod --r 12 --out o4 --max-ey > /dev/null 2>&1

@@ -1,0 +1,112 @@
+/* twotrain_study.c -- why two training runs (0.1 sin t + the multisine
+   0.05 (sin 0.5t + sin 1.5t + sin 3t)) can be worse than one (0.1 sin t) on
+   held-out inputs at small r (issue 15). For GMG-POD on the chosen chain, with
+   every nonlinear term (deim 0) and with ECSW hyper-reduction (deim 1), per
+   held-out input (0.1, 0.1 sin 2t, chirp, random pwc): e_proj of the held-out
+   trajectory onto the model's basis (what the basis can represent at all)
+   and e_y of the reduced model; 1 run vs 2 runs.
+   Usage: twotrain_study linear|nonlinear [--r 6,7,8,10,12] [--balance]
+   (--balance: run 2 scaled to run 1's norm before the POD; linear chain or deim 0 only) */
+#define _POSIX_C_SOURCE 199309L
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#define PHGMG_IMPLEMENTATION
+#include "../phgmg.h"
+#include "../examples/msd_models.h"
+
+static void u_sin(double t, double *u, void *p) { (void)p; u[0] = 0.1 * sin(t); }
+static void u_const(double t, double *u, void *p) { (void)p; (void)t; u[0] = 0.1; }
+static void u_sin2(double t, double *u, void *p) { (void)p; u[0] = 0.1 * sin(2.0 * t); }
+static void u_chirp(double t, double *u, void *p) { (void)p; u[0] = 0.1 * sin(0.2 * t + 0.01 * t * t); }
+static void u_pwc(double t, double *u, void *p) {
+  unsigned k = (unsigned)(t / 5.0), h = k * 2654435761u;
+  (void)p;
+  h ^= h >> 13; h *= 0x5bd1e995u; h ^= h >> 15;
+  u[0] = 0.1 * (2.0 * (double)(h % 10000u) / 9999.0 - 1.0);
+}
+static void u_multisine(double t, double *u, void *p) { (void)p; u[0] = 0.05 * (sin(0.5 * t) + sin(1.5 * t) + sin(3.0 * t)); }
+#define NHO 4
+static phgmg_input_fn ho[NHO] = {u_const, u_sin2, u_chirp, u_pwc};
+static const char *hon[NHO] = {"0.1", "sin 2t", "chirp", "pwc"};
+
+int main(int argc, char **argv) {
+  const int nsteps = 1000, ns = nsteps + 1;
+  const double dt = 0.1;
+  int rl[64], nr = 0, i, k, tr, dm, nonlin, N, balance = 0;
+  const char *rs = "6,7,8,10,12";
+  double tol = 1e-10, *X, *Y, *YR, xr0[64] = {0};
+  msd_linear L;
+  msd_nonlinear NL;
+  const phgmg_ph_system *sys;
+  phgmg_run runs[2];
+  phgmg_gl3_opts go;
+  if (argc < 2) return 2;
+  nonlin = !strcmp(argv[1], "nonlinear");
+  for (i = 2; i < argc; ++i) {
+    if (!strcmp(argv[i], "--r") && i + 1 < argc) rs = argv[++i];
+    else if (!strcmp(argv[i], "--balance")) balance = 1;
+  }
+  { const char *q = rs; char *end; while (*q && nr < 64) { rl[nr++] = (int)strtol(q, &end, 10); if (end == q) break; q = *end == ',' ? end + 1 : end; } }
+  if (nonlin) {
+    msd_nl_opts mo;
+    memset(&mo, 0, sizeof mo);
+    mo.n = 500; mo.storage = PHGMG_BANDED;
+    if (msd_nonlinear_build(&NL, &mo) != 0) return 1;
+    sys = &NL.sys; tol = 1e-8;
+  } else {
+    if (msd_linear_build(&L, 50, NULL, NULL, NULL, PHGMG_DENSE) != 0) return 1;
+    sys = &L.sys;
+  }
+  N = sys->N;
+  X = (double *)malloc(sizeof(double) * (size_t)N * ns * (2 + NHO));
+  Y = (double *)malloc(sizeof(double) * (size_t)ns * (2 + NHO));
+  YR = (double *)malloc(sizeof(double) * ns);
+  if (!X || !Y || !YR) return 1;
+  memset(&go, 0, sizeof go); go.tol = tol; go.max_iter = 20;
+  memset(runs, 0, sizeof runs);
+  for (i = 0; i < 2; ++i) { runs[i].u = i ? u_multisine : u_sin; runs[i].dt = dt; runs[i].nsteps = nsteps; }
+  if (phgmg_simulate_inputs(sys, 2, runs, &go, X, N, Y, NULL, NULL) != PHGMG_OK) return 1;
+  for (i = 0; i < NHO; ++i) {
+    phgmg_run run;
+    memset(&run, 0, sizeof run);
+    run.u = ho[i]; run.dt = dt; run.nsteps = nsteps;
+    if (phgmg_simulate_inputs(sys, 1, &run, &go, X + (size_t)(2 + i) * N * ns, N, Y + (size_t)(2 + i) * ns, NULL, NULL) != PHGMG_OK) return 1;
+  }
+  if (balance) {   /* scale run 2 to the Frobenius norm of run 1 (equal weight in the POD) */
+    double n1 = 0, n2 = 0;
+    for (i = 0; i < N * ns; ++i) { n1 += X[i] * X[i]; n2 += X[(size_t)N * ns + i] * X[(size_t)N * ns + i]; }
+    printf("run norms: sin %.4g, multisine %.4g; run 2 scaled by %.4g\n", sqrt(n1), sqrt(n2), sqrt(n1 / n2));
+    for (i = 0; i < N * ns; ++i) X[(size_t)N * ns + i] *= sqrt(n1 / n2);
+  }
+  printf("%s chain, GMG-POD; per held-out input: e_proj of its trajectory onto the basis / e_y\n", nonlin ? "nonlinear" : "linear");
+  printf("%3s %4s %4s", "r", "runs", "deim");
+  for (i = 0; i < NHO; ++i) printf(" %9s-proj %9s-e_y", hon[i], hon[i]);
+  printf(" %8s\n", "ecsw_pts");
+  for (k = 0; k < nr; ++k)
+    for (dm = 0; dm <= nonlin; ++dm)
+      for (tr = 1; tr <= 2; ++tr) {
+        phgmg_reduce_opts o;
+        phgmg_reduce_info info;
+        phgmg_reduced *red = NULL;
+        phgmg_result rc;
+        memset(&o, 0, sizeof o);
+        o.method = PHGMG_METHOD_GMG_POD; o.r = rl[k]; o.deim = nonlin && dm; o.deim_tol = 1e-8; o.deim_allow_negative = 1;
+        rc = phgmg_reduce(&red, sys, X, N, tr * ns, &o, &info, NULL);
+        if (rc != PHGMG_OK) { printf("%3d %4d reduce: %s\n", o.r, tr, phgmg_result_string(rc)); continue; }
+        printf("%3d %4d %4d", o.r, tr, o.deim);
+        for (i = 0; i < NHO; ++i) {
+          const double *Xi = X + (size_t)(2 + i) * N * ns;
+          double ey;
+          rc = phgmg_reduced_simulate(red, xr0, 0.0, dt, nsteps, ho[i], NULL, tol, 20, NULL, YR, NULL, NULL, NULL);
+          ey = rc == PHGMG_OK ? phgmg_rel_error(1, ns, Y + (size_t)(2 + i) * ns, 1, YR, 1) : NAN;
+          printf(" %14.3e %13.3e", phgmg_err_proj(red, Xi, N, ns), ey);
+        }
+        printf(" %8d\n", info.deim_modes);
+        fflush(stdout);
+        phgmg_reduced_destroy(red);
+      }
+  free(X); free(Y); free(YR);
+  if (nonlin) msd_nonlinear_free(&NL); else msd_linear_free(&L);
+  return 0;
+}
