@@ -186,6 +186,55 @@ TEST(test_prbt_structure_energy_export) {
   phgmg_reduced_destroy(red);
 }
 
+/* The zero-feedthrough limit (eps = 0): X B = C^T to round-off, the Lyapunov
+   inequality A^T X + X A <= 0, and minimality checked against two independent
+   solutions: the system's own Q (X <= Q) and the regularised Riccati
+   solutions X_eps (positive-real lemma with D = d I: a larger D enlarges the
+   feasible set, so X_eps <= X, and X_eps increases to X as eps -> 0,
+   ||X - X_eps|| shrinking with eps). */
+TEST(test_prbt_zero_feedthrough_limit) {
+  phgmg_ph_system s = chain2();
+  const int N = CH_N, m = 2;
+  static double X[CH_N * CH_N], Y[CH_N * CH_N], Xe[CH_N * CH_N], Ye[CH_N * CH_N], A[CH_N * CH_N], C[2 * CH_N],
+      M[CH_N * CH_N], w[CH_N];
+  double xb = 0.0, nx, d[2];
+  int i, j, k;
+  CHECK_RC(phgmg_prbt_riccati(&s, 0.0, X, Y, NULL), PHGMG_OK);
+  CHECK_RC(phgmg_ph_abc(&s, A, C, NULL), PHGMG_OK);
+  nx = phgmg_normf(N, N, X, N);
+  for (j = 0; j < m; ++j)
+    for (i = 0; i < N; ++i) {
+      double t = -C[j + i * m];
+      for (k = 0; k < N; ++k) t += X[i + k * N] * chB[k + j * N];
+      xb = PHGMG__MAX(xb, fabs(t));
+    }
+  CHECK_LE(xb, 1e-12 * nx);
+  phgmg_gemm('T', 'N', N, N, N, 1.0, A, N, X, N, 0.0, M, N);
+  phgmg_gemm('N', 'N', N, N, N, 1.0, X, N, A, N, 1.0, M, N);
+  CHECK_RC(phgmg_sym_eig(N, M, N, w, NULL, 0), PHGMG_OK);
+  CHECK_LE(w[N - 1], 1e-12 * fabs(w[0]));
+  for (i = 0; i < N * N; ++i) M[i] = chQ[i] - X[i];
+  CHECK_RC(phgmg_sym_eig(N, M, N, w, NULL, 0), PHGMG_OK);
+  CHECK(w[0] >= -1e-12 * nx);
+  for (k = 0; k < 2; ++k) {
+    CHECK_RC(phgmg_prbt_riccati(&s, k ? 1e-8 : 1e-6, Xe, Ye, NULL), PHGMG_OK);
+    for (i = 0; i < N * N; ++i) M[i] = X[i] - Xe[i];
+    d[k] = phgmg_normf(N, N, M, N) / nx;
+    CHECK_RC(phgmg_sym_eig(N, M, N, w, NULL, 0), PHGMG_OK);
+    CHECK(w[0] >= -1e-9 * nx);
+  }
+  CHECK(d[1] < 0.2 * d[0] && d[0] < 1e-1);
+  /* the dual solution: Y C^T = B */
+  xb = 0.0;
+  for (j = 0; j < m; ++j)
+    for (i = 0; i < N; ++i) {
+      double t = -chB[i + j * N];
+      for (k = 0; k < N; ++k) t += Y[i + k * N] * C[j + k * m];
+      xb = PHGMG__MAX(xb, fabs(t));
+    }
+  CHECK_LE(xb, 1e-12 * phgmg_normf(N, N, Y, N));
+}
+
 TEST(test_bases_orthonormal_to_b) {
   phgmg_ph_system s = chain2();
   static double V[CH_N * 18];
@@ -243,5 +292,6 @@ SUITE(linear) {
   RUN(test_care_closed_form_and_residual);
   RUN(test_bt_bound_and_transfer);
   RUN(test_prbt_structure_energy_export);
+  RUN(test_prbt_zero_feedthrough_limit);
   RUN(test_bases_orthonormal_to_b);
 }
