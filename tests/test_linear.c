@@ -213,6 +213,11 @@ TEST(test_prbt_zero_feedthrough_limit) {
   phgmg_gemm('N', 'N', N, N, N, 1.0, X, N, A, N, 1.0, M, N);
   CHECK_RC(phgmg_sym_eig(N, M, N, w, NULL, 0), PHGMG_OK);
   CHECK_LE(w[N - 1], 1e-12 * fabs(w[0]));
+  {   /* the Riccati equation (Schur complement zero) <=> A^T X + X A has rank m */
+    double num = 0.0, den = 0.0;
+    for (i = 0; i < N; ++i) { den += w[i] * w[i]; if (i >= m) num += w[i] * w[i]; }
+    CHECK_LE(sqrt(num / den), 1e-10);
+  }
   for (i = 0; i < N * N; ++i) M[i] = chQ[i] - X[i];
   CHECK_RC(phgmg_sym_eig(N, M, N, w, NULL, 0), PHGMG_OK);
   CHECK(w[0] >= -1e-12 * nx);
