@@ -9700,29 +9700,71 @@ PHGMG__PRIV phgmg_result phgmg__pr_riccati(int N, int m, const double *A, const 
 }
 
 
+/* Orthonormal basis V (n2 x k) of the (numerical) kernel of H (n2 x n2,
+   destroyed: LU factors): inverse iteration on H^T H (two solves a step, 4
+   steps; convergence ratio (sigma_k+1 / sigma_k)^2 per step, sigma_k ~ eps_mach
+   ||H|| for an exact kernel) from deterministic +-1 start vectors, Gram-Schmidt
+   in between. A zero pivot is shifted by eps_mach ||H||_1. work: n2 ints. */
+PHGMG__PRIV phgmg_result phgmg__kernel_inviter(int n2, double *H, int k, double *V, int *ipiv) {
+  const double h1 = phgmg_norm1(n2, n2, H, n2);
+  unsigned long seed = 12345u;
+  phgmg_result rc;
+  int i, j, l, it;
+  for (j = 0; j < k; ++j)
+    for (i = 0; i < n2; ++i) {
+      seed = seed * 1103515245u + 12345u;
+      V[i + (size_t)j * n2] = ((seed >> 16) & 1u) ? 1.0 : -1.0;
+    }
+  rc = phgmg_lu_factor(n2, H, n2, ipiv);
+  if (rc == PHGMG_ERR_SINGULAR)
+    for (i = 0; i < n2; ++i)
+      if (H[i + (size_t)i * n2] == 0.0) H[i + (size_t)i * n2] = 2.2e-16 * h1;
+  if (rc != PHGMG_OK && rc != PHGMG_ERR_SINGULAR) return rc;
+  for (it = 0; it < 4; ++it) {
+    phgmg_lu_solve('T', n2, H, n2, ipiv, k, V, n2);
+    phgmg_lu_solve('N', n2, H, n2, ipiv, k, V, n2);
+    for (j = 0; j < k; ++j) {   /* modified Gram-Schmidt, twice */
+      double *v = V + (size_t)j * n2, nv;
+      int pass;
+      for (pass = 0; pass < 2; ++pass)
+        for (l = 0; l < j; ++l) {
+          const double *u = V + (size_t)l * n2;
+          double d = 0.0;
+          for (i = 0; i < n2; ++i) d += u[i] * v[i];
+          for (i = 0; i < n2; ++i) v[i] -= d * u[i];
+        }
+      nv = phgmg_normf(n2, 1, v, n2);
+      if (!(nv > 0.0) || !isfinite(nv)) return PHGMG_ERR_NOT_CONVERGED;
+      for (i = 0; i < n2; ++i) v[i] /= nv;
+    }
+  }
+  return PHGMG_OK;
+}
+
 /* Riccati A^T X + X A - X K X + L = 0 (n x n) whose Hamiltonian H = [A, -K;
-   -L, -A^T] may have, besides eigenvalues off the imaginary axis, a cluster of
-   Jordan pairs at 0 (the positive-real Riccati of a system whose Popov
-   function vanishes at w = 0, e.g. a chain driven by forces with velocity
-   outputs). The solution belongs to the Lagrangian subspace spanned by the
+   -L, -A^T] may have, besides eigenvalues off the imaginary axis, k Jordan
+   pairs at 0 (the positive-real Riccati of a system whose Popov function
+   vanishes at w = 0, e.g. a chain driven by forces with velocity outputs).
+   The minimal solution X belongs to the Lagrangian subspace spanned by the
    stable eigenvectors and the eigenvectors (not the principal vectors) of the
-   cluster: range(P + H Pc) with P = (I - sign(H + sI))/2 (eigenvalues with Re
-   < -s) and Pc = (sign(H + sI) - sign(H - sI))/2 (the cluster, |Re| < s),
-   s = 1e-6 ||H||_1: round-off splits a Jordan pair at 0 by about sqrt(eps_mach)
-   ||H|| << s, and s must stay below the other eigenvalues' |Re| (1.4e-3 and
-   3e-4 ||H||_1 on the two chains of examples/linear_bases.c). With [M1; M2] =
-   P + H Pc, X M1 = M2 by least squares. Without a cluster Pc = 0 and this is
-   phgmg_care's solution. */
+   pairs at 0, i.e. range(P) + ker H with P = (I - sign(H + sI))/2 (the
+   eigenvalues with Re < -s), s = 1e-6 ||H||_1: round-off splits a Jordan pair
+   at 0 by about sqrt(eps_mach) ||H|| << s, and s must stay below the other
+   eigenvalues' |Re| (1.4e-3 and 3e-4 ||H||_1 on the two chains of
+   examples/linear_bases.c). k = trace(I - P) - n (a projector's trace is its
+   rank); ker H by phgmg__kernel_inviter. With [M1; M2] = [P, ker H],
+   X M1 = M2 by least squares. Without pairs at 0 (k = 0) X is phgmg_care's
+   solution. */
 PHGMG__PRIV phgmg_result phgmg__care_cluster(int n, const double *A, const double *K, const double *L, double *X,
                                              const phgmg_allocator *alloc) {
   const int n2 = 2 * n;
   const size_t q = (size_t)n2 * n2;
-  double *H = phgmg__dalloc(alloc, 3 * q), *Wm, *Wp, sig;
+  double *H, *W, *Mt, sig, tr = 0.0;
+  int *ipiv = phgmg__ialloc(alloc, (size_t)n2), k = 0, nr, r, c;
   phgmg_result rc;
-  size_t i;
-  int r, c;
-  if (!H) return PHGMG_ERR_NOMEM;
-  Wm = H + q; Wp = Wm + q;
+  H = phgmg__dalloc(alloc, 2 * q + 2 * (size_t)(n2 + n) * n + (size_t)n2 * n);
+  if (!H || !ipiv) { phgmg__free(alloc, H); phgmg__free(alloc, ipiv); return PHGMG_ERR_NOMEM; }
+  W = H + q; Mt = W + q;
   for (c = 0; c < n; ++c)
     for (r = 0; r < n; ++r) {
       H[r + (size_t)c * n2] = A[r + (size_t)c * n];
@@ -9731,29 +9773,34 @@ PHGMG__PRIV phgmg_result phgmg__care_cluster(int n, const double *A, const doubl
       H[(r + n) + (size_t)(c + n) * n2] = -A[c + (size_t)r * n];
     }
   sig = 1e-6 * phgmg_norm1(n2, n2, H, n2);
-  memcpy(Wm, H, q * sizeof(double));
-  memcpy(Wp, H, q * sizeof(double));
-  for (r = 0; r < n2; ++r) { Wm[r + (size_t)r * n2] += sig; Wp[r + (size_t)r * n2] -= sig; }
-  rc = phgmg__sign_iter(n2, Wm, NULL, NULL, alloc);
-  if (rc == PHGMG_OK) rc = phgmg__sign_iter(n2, Wp, NULL, NULL, alloc);
+  memcpy(W, H, q * sizeof(double));
+  for (r = 0; r < n2; ++r) W[r + (size_t)r * n2] += sig;
+  rc = phgmg__sign_iter(n2, W, NULL, NULL, alloc);
   if (rc == PHGMG_OK) {
-    for (i = 0; i < q; ++i) {   /* Wp <- Pc, Wm <- P */
-      Wp[i] = 0.5 * (Wm[i] - Wp[i]);
-      Wm[i] = -0.5 * Wm[i];
-    }
-    for (r = 0; r < n2; ++r) Wm[r + (size_t)r * n2] += 0.5;
-    phgmg_gemm('N', 'N', n2, n2, n2, 1.0, H, n2, Wp, n2, 1.0, Wm, n2);   /* M = P + H Pc */
-    for (c = 0; c < n2; ++c)   /* H <- [M1^T, M2^T] (n2 x n each) */
-      for (r = 0; r < n; ++r) {
-        H[c + (size_t)r * n2] = Wm[r + (size_t)c * n2];
-        H[c + (size_t)(r + n) * n2] = Wm[(r + n) + (size_t)c * n2];
-      }
-    rc = phgmg_lstsq(n2, n, n, H, n2, H + (size_t)n * n2, n2, 0.0, Wp, n, alloc);
+    for (r = 0; r < n2; ++r) tr += 0.5 * (1.0 + W[r + (size_t)r * n2]);
+    k = (int)floor(tr - n + 0.5);
+    if (k < 0 || k > n) rc = PHGMG_ERR_NOT_CONVERGED;
   }
+  nr = n2 + k;
+  if (rc == PHGMG_OK) {   /* Mt = [M1^T, M2^T] ((n2 + k) x n each): rows of P^T, then of V^T */
+    double *V = Mt + 2 * (size_t)nr * n;
+    for (c = 0; c < n2; ++c)
+      for (r = 0; r < n2; ++r) {
+        const double p = (r == c ? 0.5 : 0.0) - 0.5 * W[r + (size_t)c * n2];   /* P(r, c) */
+        Mt[c + (size_t)(r < n ? r : r - n) * nr + (r < n ? 0 : (size_t)n * nr)] = p;
+      }
+    if (k > 0) rc = phgmg__kernel_inviter(n2, H, k, V, ipiv);
+    if (rc == PHGMG_OK)
+      for (c = 0; c < k; ++c)
+        for (r = 0; r < n2; ++r)
+          Mt[(n2 + c) + (size_t)(r < n ? r : r - n) * nr + (r < n ? 0 : (size_t)n * nr)] = V[r + (size_t)c * n2];
+  }
+  if (rc == PHGMG_OK) rc = phgmg_lstsq(nr, n, n, Mt, nr, Mt + (size_t)n * nr, nr, 0.0, W, n, alloc);
   if (rc == PHGMG_OK)
     for (c = 0; c < n; ++c)
-      for (r = 0; r < n; ++r) X[r + (size_t)c * n] = 0.5 * (Wp[r + (size_t)c * n] + Wp[c + (size_t)r * n]);
+      for (r = 0; r < n; ++r) X[r + (size_t)c * n] = 0.5 * (W[r + (size_t)c * n] + W[c + (size_t)r * n]);
   phgmg__free(alloc, H);
+  phgmg__free(alloc, ipiv);
   return rc;
 }
 
