@@ -84,10 +84,12 @@ int main(int argc, char **argv) {
   /* residuals of the two zero-feedthrough Riccati equations (outside the
      timing): the constraint X B = C^T and the equation itself, which says
      that M = A^T X + X A (Schur complement zero) has rank m:
-     ||M - (its rank-m part)||_F / ||M||_F, and the same for Y (A Y + Y A^T). */
+     ||M - (its rank-m part)||_F over ||M||_F (strict: M is a difference of
+     two products of norm ||A|| ||X|| >> ||M|| for Y) and over 2 ||A||_F
+     ||X||_F (the scale of phgmg_care_residual); the same for Y (A Y + Y A^T). */
   rc = phgmg_prbt_riccati(&M.sys, 0.0, X, Y, NULL);
   if (rc == PHGMG_OK) {
-    double rx[2], xbc[2];
+    double rx[2], rn[2], xbc[2];
     int e;
     for (e = 0; e < 2; ++e) {
       const double *Z = e ? Y : X, *P = e ? C : M.sys.B;   /* X B = C^T, Y C^T = B */
@@ -113,9 +115,11 @@ int main(int argc, char **argv) {
       num = den = 0.0;   /* ascending: the m = 2 of largest modulus are the two most negative */
       for (i = 0; i < N; ++i) { den += w[i] * w[i]; if (i >= 2) num += w[i] * w[i]; }
       rx[e] = sqrt(num / den);
+      rn[e] = sqrt(num) / (2.0 * phgmg_normf(N, N, A, N) * phgmg_normf(N, N, Z, N));
     }
-    printf("prbt_N1000_r20: ||X B - C^T||/||C|| %.1e, ||Y C^T - B||/||B|| %.1e; Riccati residuals "
-           "(rank-m defect of A^T X + X A, A Y + Y A^T) %.2e, %.2e\n", xbc[0], xbc[1], rx[0], rx[1]);
+    printf("prbt_N1000_r20: ||X B - C^T||/||C|| %.1e, ||Y C^T - B||/||B|| %.1e; Riccati residuals: "
+           "rank-m defect of A^T X + X A, A Y + Y A^T over their norms %.2e, %.2e; over 2 ||A||_F ||X||_F "
+           "(phgmg_care_residual's scale) %.2e, %.2e\n", xbc[0], xbc[1], rx[0], rx[1], rn[0], rn[1]);
   }
   if (csv) fclose(csv);
   free(A); free(mv);

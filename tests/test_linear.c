@@ -212,7 +212,7 @@ TEST(test_prbt_zero_feedthrough_limit) {
   phgmg_gemm('T', 'N', N, N, N, 1.0, A, N, X, N, 0.0, M, N);
   phgmg_gemm('N', 'N', N, N, N, 1.0, X, N, A, N, 1.0, M, N);
   CHECK_RC(phgmg_sym_eig(N, M, N, w, NULL, 0), PHGMG_OK);
-  CHECK_LE(w[N - 1], 1e-12 * fabs(w[0]));
+  CHECK_LE(w[N - 1], 1e-14 * phgmg_normf(N, N, A, N) * nx);   /* <= 0 up to the round-off of the products */
   {   /* the Riccati equation (Schur complement zero) <=> A^T X + X A has rank m */
     double num = 0.0, den = 0.0;
     for (i = 0; i < N; ++i) { den += w[i] * w[i]; if (i >= m) num += w[i] * w[i]; }
@@ -238,6 +238,16 @@ TEST(test_prbt_zero_feedthrough_limit) {
       xb = PHGMG__MAX(xb, fabs(t));
     }
   CHECK_LE(xb, 1e-12 * phgmg_normf(N, N, Y, N));
+  /* and its equation: A Y + Y A^T <= 0 of rank m */
+  phgmg_gemm('N', 'N', N, N, N, 1.0, A, N, Y, N, 0.0, M, N);
+  phgmg_gemm('N', 'T', N, N, N, 1.0, Y, N, A, N, 1.0, M, N);
+  CHECK_RC(phgmg_sym_eig(N, M, N, w, NULL, 0), PHGMG_OK);
+  CHECK_LE(w[N - 1], 1e-14 * phgmg_normf(N, N, A, N) * phgmg_normf(N, N, Y, N));
+  {
+    double num = 0.0, den = 0.0;
+    for (i = 0; i < N; ++i) { den += w[i] * w[i]; if (i >= m) num += w[i] * w[i]; }
+    CHECK_LE(sqrt(num / den), 1e-10);
+  }
 }
 
 TEST(test_bases_orthonormal_to_b) {
