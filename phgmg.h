@@ -1409,18 +1409,18 @@ PHGMG_DEF phgmg_result phgmg_prbt_riccati(const phgmg_ph_system *sys, double eps
    Popov function still vanishes at w = 0 on chains driven by forces (G(0) =
    0), so its Hamiltonian has Jordan pairs at 0: the solution is taken from
    the stable eigenvectors plus the cluster's eigenvectors (two shifted sign
-   iterations, see phgmg__care_cluster). Then X B = C^T holds to round-off,
-   Sigma_r Br = Cr^T, and the pH form is Qh = Sigma_r, Jh = skew(Ar
-   Sigma_r^-1), Rh = the PSD part of -sym(Ar Sigma_r^-1) (a principal block
-   of -(A^T X + X A) >= 0 in balanced coordinates; the clipped negative
-   eigenvalues are round-off, relative 1e-7 when sigma_r ~ 1e-8), Bh = Br,
-   output Bh^T Qh x = Cr x: the balanced projection itself, without an output
-   change. Cost: 4 sign iterations of size 2(N - m) (2 per equation).
+   iteration and the kernel of the Hamiltonian, see phgmg__care_cluster). Then
+   X B = C^T holds to round-off, Sigma_r Br = Cr^T, and the pH form is
+   Qh = Sigma_r, Jh = skew(Ar Sigma_r^-1), Rh = Sigma_r^-1 F F^T Sigma_r^-1 / 2
+   with F = Tr^T Lf and -(A^T X + X A) = Lf Lf^T (rank m, in factored form
+   from the deflated equation: PSD by construction; clipping the round-off
+   negative eigenvalues of -sym(Ar Sigma_r^-1) instead cost 1e-6 in e_y once
+   sigma_r ~ 1e-8), Bh = Br, output Bh^T Qh x = Cr x: the balanced projection
+   itself, without an output change. Cost: one sign iteration of size
+   2(N - m) per equation, as the regularised path.
    Measured (examples/linear_bases.c, e_y worst unseen input, PRBT / BT):
-   two-port chain r = 12/16/20: 1.8e-3/9.1e-5/2.0e-5 vs 6.5e-4/5.7e-5/1.3e-5;
-   paper's chain r = 12/16/18: 1.3e-4/1.2e-6/1.5e-7 vs 3.4e-5/5.0e-7/3.7e-8;
-   at r = 19, 20 on the paper's chain the PSD clipping costs 1e-6 (the
-   unclipped projection reaches 6e-9).
+   two-port chain r = 12/16/20: 1.7e-3/9.1e-5/2.0e-5 vs 6.5e-4/5.7e-5/1.3e-5;
+   paper's chain r = 12/16/20: 1.3e-4/1.2e-6/6.1e-9 vs 3.4e-5/5.0e-7/1.7e-9.
    If S is not positive definite (or C B not symmetric), or opts->eps > 0:
    the regularised lemma with D = d I, d = eps ||C B||_F (eps 1e-10 in the
    fallback), S = 2 d I:
@@ -9940,6 +9940,56 @@ PHGMG__PRIV phgmg_result phgmg__pr_zero_d(int N, int m, const double *A, const d
   return rc;
 }
 
+/* The factor Lf (N x m) of -(A^T X + X A) = Lf Lf^T for the minimal
+   zero-feedthrough solution X of phgmg__pr_zero_d (rank m: the Schur
+   complement vanishes). In the frame T = [B, Nc], At = T^-1 A T, T^T X T =
+   diag(C B, Z), Ls Ls^T = S: -(At^T Xt + Xt At) = G G^T with G = [Ls;
+   -(Z A21 + A12^T C B) Ls^-T], so Lf = T^-T G: exact in the theory and PSD
+   by construction (no clipping of round-off eigenvalues). */
+PHGMG__PRIV phgmg_result phgmg__pr_factor(int N, int m, const double *A, const double *B, const double *C,
+                                          const double *X, double *Lf, const phgmg_allocator *alloc) {
+  const int n = N - m;
+  const size_t nn = (size_t)N * N;
+  double *T = phgmg__dalloc(alloc, 5 * nn + 2 * (size_t)m * m + 2 * (size_t)N * m), *Ti, *At, *W, *Z, *CB, *S, *G,
+         *Ft;
+  phgmg_result rc;
+  int i, j, a, b;
+  if (!T) return PHGMG_ERR_NOMEM;
+  Ti = T + nn; At = Ti + nn; W = At + nn; Z = W + nn; CB = Z + nn; S = CB + (size_t)m * m; G = S + (size_t)m * m;
+  Ft = G + (size_t)N * m;
+  phgmg_gemm('N', 'N', m, m, N, 1.0, C, m, B, N, 0.0, CB, m);
+  rc = phgmg__ker_frame(N, m, B, C, T, alloc);
+  if (rc == PHGMG_OK) rc = phgmg__inv(N, T, Ti, alloc);
+  if (rc == PHGMG_OK) {
+    phgmg_gemm('N', 'N', N, N, N, 1.0, A, N, T, N, 0.0, W, N);
+    phgmg_gemm('N', 'N', N, N, N, 1.0, Ti, N, W, N, 0.0, At, N);   /* At = Ti A T */
+    for (b = 0; b < m; ++b)   /* S = -(CB A11 + A11^T CB) */
+      for (a = 0; a < m; ++a) {
+        double t = 0.0;
+        for (j = 0; j < m; ++j) t += CB[a + (size_t)j * m] * At[j + (size_t)b * N] + At[j + (size_t)a * N] * CB[j + (size_t)b * m];
+        S[a + (size_t)b * m] = -t;
+      }
+    if (phgmg__chol_small(m, S) != 0) rc = PHGMG_ERR_SINGULAR;
+  }
+  if (rc == PHGMG_OK) {
+    phgmg_gemm('N', 'N', N, n, N, 1.0, X, N, T + (size_t)N * m, N, 0.0, W, N);          /* X Nc */
+    phgmg_gemm('T', 'N', n, n, N, 1.0, T + (size_t)N * m, N, W, N, 0.0, Z, n);          /* Z = Nc^T X Nc */
+    phgmg_gemm('N', 'N', n, m, n, 1.0, Z, n, At + m, N, 0.0, Ft, n);                    /* Z A21 */
+    phgmg_gemm('T', 'N', n, m, m, 1.0, At + (size_t)m * N, N, CB, m, 1.0, Ft, n);      /* + A12^T CB */
+    for (b = 0; b < m; ++b)
+      for (a = 0; a < m; ++a) G[a + (size_t)b * N] = a >= b ? S[a + (size_t)b * m] : 0.0;
+    for (i = 0; i < n; ++i)   /* rows m..: -Ft Ls^-T (row i solves Ls g = -Ft(i,:)^T) */
+      for (a = 0; a < m; ++a) {
+        double t = -Ft[i + (size_t)a * n];
+        for (b = 0; b < a; ++b) t -= S[a + (size_t)b * m] * G[(m + i) + (size_t)b * N];
+        G[(m + i) + (size_t)a * N] = t / S[a + (size_t)a * m];
+      }
+    phgmg_gemm('T', 'N', N, m, N, 1.0, Ti, N, G, N, 0.0, Lf, N);                        /* Lf = Ti^T G */
+  }
+  phgmg__free(alloc, T);
+  return rc;
+}
+
 /* X (Q-eq) and Y (P-eq, from the dual (A^T, C^T, B^T)) by phgmg__pr_zero_d. */
 PHGMG__PRIV phgmg_result phgmg__pr_zero_d_both(int N, int m, const double *A, const double *B, const double *C,
                                                double *X, double *Y, const phgmg_allocator *alloc) {
@@ -9957,14 +10007,18 @@ PHGMG__PRIV phgmg_result phgmg__pr_zero_d_both(int N, int m, const double *A, co
   phgmg__free(alloc, At);
   return rc;
 }
-/* The pH blocks of a PR-balanced truncation (see phgmg_prbt). */
+/* The pH blocks of a PR-balanced truncation (see phgmg_prbt): Qh = Sigma,
+   K = skew(Ar Sigma^-1) - Sigma^-1 F F^T Sigma^-1 / (2 s). Br, Cr non-NULL:
+   F = Sigma Br - Cr^T (regularised); else F (r x m) is given (exact case:
+   Tr^T Lf with -(A^T X + X A) = Lf Lf^T, s = 1/2... passed as s). */
 PHGMG__PRIV void phgmg__prbt_ph(int r, int m, const double *Ar, const double *Br, const double *Cr, const double *S,
                                 double s, double *Qh, double *K, double *F) {
   int i, j, a;
   for (j = 0; j < r; ++j)
     for (i = 0; i < r; ++i) Qh[i + (size_t)j * r] = i == j ? S[i] : 0.0;
-  for (a = 0; a < m; ++a)       /* F = Sigma Br - Cr^T */
-    for (i = 0; i < r; ++i) F[i + (size_t)a * r] = S[i] * Br[i + (size_t)a * r] - Cr[a + (size_t)i * m];
+  if (Br && Cr)
+    for (a = 0; a < m; ++a)       /* F = Sigma Br - Cr^T */
+      for (i = 0; i < r; ++i) F[i + (size_t)a * r] = S[i] * Br[i + (size_t)a * r] - Cr[a + (size_t)i * m];
   for (j = 0; j < r; ++j)
     for (i = 0; i < r; ++i) {
       double rr = 0.0;
@@ -9974,42 +10028,11 @@ PHGMG__PRIV void phgmg__prbt_ph(int r, int m, const double *Ar, const double *Br
     }
 }
 
-/* The pH blocks of a PR-balanced truncation from the exact (zero-feedthrough)
-   Riccati solutions: Qh = Sigma_r, Rh = the PSD part of -sym(Ar Sigma_r^-1)
-   (negative eigenvalues are round-off: Sigma_r (Jh - Rh) ... is a principal
-   block of -(A^T X + X A) >= 0 in balanced coordinates), Jh = skew(Ar
-   Sigma_r^-1). work: 3 r^2 + r doubles. */
-PHGMG__PRIV phgmg_result phgmg__prbt_ph_exact(int r, const double *Ar, const double *S, double *Qh, double *K,
-                                              double *work) {
-  double *Rs = work, *V = Rs + (size_t)r * r, *Rp = V + (size_t)r * r, *w = Rp + (size_t)r * r;
-  phgmg_result rc;
-  int i, j, k;
-  for (j = 0; j < r; ++j)
-    for (i = 0; i < r; ++i) {
-      Qh[i + (size_t)j * r] = i == j ? S[i] : 0.0;
-      Rs[i + (size_t)j * r] = -0.5 * (Ar[i + (size_t)j * r] / S[j] + Ar[j + (size_t)i * r] / S[i]);
-    }
-  rc = phgmg_sym_eig(r, Rs, r, w, V, r);
-  if (rc != PHGMG_OK) return rc;
-  for (j = 0; j < r; ++j)
-    for (i = 0; i < r; ++i) {
-      double t = 0.0;
-      for (k = 0; k < r; ++k)
-        if (w[k] > 0.0) t += V[i + (size_t)k * r] * w[k] * V[j + (size_t)k * r];
-      Rp[i + (size_t)j * r] = t;
-    }
-  for (j = 0; j < r; ++j)
-    for (i = 0; i < r; ++i)
-      K[i + (size_t)j * r] = 0.5 * (Ar[i + (size_t)j * r] / S[j] - Ar[j + (size_t)i * r] / S[i]) -
-                             0.5 * (Rp[i + (size_t)j * r] + Rp[j + (size_t)i * r]);
-  return PHGMG_OK;
-}
-
 PHGMG_DEF phgmg_result phgmg_prbt(phgmg_reduced **out, const phgmg_ph_system *sys, int r,
                                   const phgmg_prbt_opts *opts, double *prsv, double *info_xb,
                                   const phgmg_allocator *alloc) {
   int N, m;
-  double *A, *C, *X, *Y, *Ar, *Cr, *S, *F, *CB, *Wk, s = 1.0, eps;
+  double *A, *C, *X, *Y, *Ar, *Cr, *S, *F, *CB, *Lf, s = 1.0, eps;
   int exact;
   phgmg_reduced *red;
   phgmg_result rc;
@@ -10026,7 +10049,7 @@ PHGMG_DEF phgmg_result phgmg_prbt(phgmg_reduced **out, const phgmg_ph_system *sy
   N = sys->N; m = sys->m;
   if (r < 1 || r > N) return PHGMG_ERR_SIZE;
   A = phgmg__dalloc(alloc, 3 * (size_t)N * N + (size_t)m * N + 2 * (size_t)r * r + (size_t)m * r + 2 * (size_t)r * m + r + (size_t)m * m +
-                          3 * (size_t)r * r + r);
+                          (size_t)N * m);
   red = PHGMG__CAST(phgmg_reduced *, phgmg__alloc(alloc, sizeof(phgmg_reduced)));
   if (!A || !red) { phgmg__free(alloc, A); phgmg__free(alloc, red); return PHGMG_ERR_NOMEM; }
   memset(red, 0, sizeof *red);
@@ -10035,7 +10058,7 @@ PHGMG_DEF phgmg_result phgmg_prbt(phgmg_reduced **out, const phgmg_ph_system *sy
   red->kind = PHGMG_ROM_LINEAR; red->sys = sys;
   C = A + (size_t)N * N; X = C + (size_t)m * N; Y = X + (size_t)N * N; Ar = Y + (size_t)N * N;
   Cr = Ar + (size_t)r * r; S = Cr + (size_t)m * r; F = S + r; CB = F + (size_t)r * m;
-  Wk = CB + (size_t)m * m;
+  Lf = CB + (size_t)m * m;
   rc = phgmg_ph_abc(sys, A, C, alloc);
   if (rc == PHGMG_OK) {
     phgmg_gemm('N', 'N', m, m, N, 1.0, C, m, sys->B, N, 0.0, CB, m);
@@ -10069,14 +10092,19 @@ PHGMG_DEF phgmg_result phgmg_prbt(phgmg_reduced **out, const phgmg_ph_system *sy
     red->K = phgmg__red_d(red, (size_t)r * r);
     if (!red->V0 || !red->W || !red->Bh || !red->Qh || !red->K) rc = PHGMG_ERR_NOMEM;
   }
+  if (rc == PHGMG_OK && exact) rc = phgmg__pr_factor(N, m, A, sys->B, C, X, Lf, alloc);
   if (rc == PHGMG_OK) rc = phgmg__balance(N, r, Y, X, red->V0, red->W, S, alloc);
   /* minimal solutions give positive-real singular values <= 1: a larger one
      means the Riccati solutions are not accurate (eps too small) */
   if (rc == PHGMG_OK && !(S[0] <= 1.0 + 1e-6)) rc = PHGMG_ERR_NOT_CONVERGED;
   if (rc == PHGMG_OK) rc = phgmg__project_abc(N, m, r, A, sys->B, C, red->V0, red->W, Ar, red->Bh, Cr, alloc);
   if (rc == PHGMG_OK) {
-    if (exact) rc = phgmg__prbt_ph_exact(r, Ar, S, red->Qh, red->K, Wk);
-    else phgmg__prbt_ph(r, m, Ar, red->Bh, Cr, S, s, red->Qh, red->K, F);
+    if (exact) {   /* F = Tr^T Lf */
+      phgmg_gemm('T', 'N', r, m, N, 1.0, red->V0, N, Lf, N, 0.0, F, r);
+      phgmg__prbt_ph(r, m, Ar, NULL, NULL, S, 1.0, red->Qh, red->K, F);
+    } else {
+      phgmg__prbt_ph(r, m, Ar, red->Bh, Cr, S, s, red->Qh, red->K, F);
+    }
     if (prsv) memcpy(prsv, S, (size_t)r * sizeof(double));
     if (rc == PHGMG_OK && opts && opts->dt > 0.0) {
       red->map_dt = opts->dt;
