@@ -158,6 +158,30 @@ TEST(test_prbt_structure_energy_export) {
     phgmg_reduced_restrict(red, x, xb2);
     for (i = 0; i < r; ++i) CHECK_LE(fabs(xb2[i] - xr[i]), 1e-9);
   }
+  /* the pH model is the balanced projection itself (exact Gramians): its
+     (K Qh, Bh, Bh^T Qh) against (W^T A T, W^T B, C T) from the lift/restrict
+     bases, in H-infinity over a frequency grid (the regularised form differed
+     by 1e-3 here: dropped feedthrough and a changed output) */
+  {
+    static double T[CH_N * 12], W[CH_N * 12], A[CH_N * CH_N], C[2 * CH_N], AT[CH_N * 12];
+    double Ap[144], Bp[24], Cp[24], Ah[144], Bhh[24], Chh[24], e[12], hi = 0.0, hr = 0.0;
+    int a;
+    CHECK_RC(phgmg_ph_abc(&s, A, C, NULL), PHGMG_OK);
+    for (a = 0; a < r; ++a) {
+      memset(e, 0, sizeof e);
+      e[a] = 1.0;
+      phgmg_reduced_lift(red, e, T + a * CH_N);
+    }
+    CHECK_RC(phgmg_reduced_W(red, e, W, CH_N), PHGMG_OK);
+    phgmg_gemm('N', 'N', CH_N, r, CH_N, 1.0, A, CH_N, T, CH_N, 0.0, AT, CH_N);
+    phgmg_gemm('T', 'N', r, r, CH_N, 1.0, W, CH_N, AT, CH_N, 0.0, Ap, r);
+    phgmg_gemm('T', 'N', r, 2, CH_N, 1.0, W, CH_N, chB, CH_N, 0.0, Bp, r);
+    phgmg_gemm('N', 'N', 2, r, CH_N, 1.0, C, 2, T, CH_N, 0.0, Cp, 2);
+    CHECK_RC(phgmg_reduced_abc(red, Ah, Bhh, Chh), PHGMG_OK);
+    CHECK_RC(phgmg_ss_error(r, Ap, Bp, Cp, r, Ah, Bhh, Chh, 2, 2, 200, 1e-3, 1e2, &hi, &hr, NULL, NULL, NULL),
+             PHGMG_OK);
+    CHECK_LE(hi, 1e-10 * hr);
+  }
   /* serialize round trip keeps the method id */
   {
     static unsigned char buf[65536];
