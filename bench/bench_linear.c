@@ -2,9 +2,10 @@
    chain of Gugercin et al. 2012 with 500 masses (m_i = k_i = 4, c_i = 1,
    forces on masses 1 and 2). Cases:
      lyap_N1000       controllability Gramian A P + P A^T + B B^T = 0 (sign function)
-     prbt_N1000_r20   positive-real balanced truncation to r = 20 (two Riccati
-                      equations of order 1000 by the sign function of 2000 x 2000
-                      Hamiltonian matrices, balancing, pH form, step map)
+     prbt_N1000_r20   positive-real balanced truncation to r = 20 (two zero-feedthrough
+                      Riccati equations, deflated to order N - m = 998: one shifted sign
+                      iteration of a 1996 x 1996 Hamiltonian and its kernel each;
+                      balancing, pH form, step map)
    Prints the relative residuals (Lyapunov; both Riccati equations) and
    appends `case,median_s,min_s,max_s,runs` to the CSV argv[1] (if given).
    BENCH_LINEAR_RUNS (default 1) runs per case; no warm-up (each run is seconds).
