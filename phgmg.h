@@ -1415,7 +1415,8 @@ PHGMG_DEF phgmg_result phgmg_bt(const phgmg_ph_system *sys, int r, double *Ar, d
                                 double *hsv, double *T, double *W, const phgmg_allocator *alloc);
 
 typedef struct phgmg_prbt_opts {
-  double eps; /* feedthrough regularisation D = eps ||C B||_F I (0: 1e-10; see phgmg_prbt) */
+  double eps; /* 0: zero feedthrough handled exactly (see phgmg_prbt); > 0: regularisation
+                 D = eps ||C B||_F I (the previous default was 1e-10) */
   double dt;  /* > 0: precompute the GL3 step map of the reduced model for this step   */
   /* Optional cache for studies over many r: the two Riccati solutions from
      phgmg_prbt_riccati with the same eps (N x N each; both or neither). */
@@ -1423,33 +1424,50 @@ typedef struct phgmg_prbt_opts {
 } phgmg_prbt_opts;
 
 /* The positive-real Riccati solutions of phgmg_prbt (X: Q-eq, Y: P-eq, N x N),
-   for phgmg_prbt_opts.X/Y. eps <= 0: 1e-10. */
+   for phgmg_prbt_opts.X/Y. eps <= 0: the exact zero-feedthrough solutions (as
+   phgmg_prbt with eps = 0, same fallback); eps > 0: regularised. */
 PHGMG_DEF phgmg_result phgmg_prbt_riccati(const phgmg_ph_system *sys, double eps, double *X, double *Y,
                                           const phgmg_allocator *alloc);
 
 /* Positive-real balanced truncation with a pH reduced model (method
-   PHGMG_METHOD_PRBT, kind LINEAR). The positive-real lemma's Riccati
-   equations need D + D^T > 0; a pH system has D = 0, so D = d I with
-   d = eps ||C B||_F is used: with S = 2 d I,
+   PHGMG_METHOD_PRBT, kind LINEAR). Gramians: the minimal solutions X (Q-eq)
+   and Y (P-eq) of the positive-real lemma. A pH system has zero feedthrough,
+   where the lemma's Riccati equations are singular.
+   Default (opts->eps = 0): the exact limit. The lemma with D = 0 reads
+   A^T X + X A <= 0, X B = C^T. In the frame T = [B, Nc] (Nc: ker C) the
+   constraint fixes T^T X T = diag(C B, Z), and the Schur complement is a
+   regular positive-real Riccati equation for Z (size N - m) with feedthrough
+   S = 2 B^T Q R Q B (must be positive definite: every port damped). Its
+   Popov function still vanishes at w = 0 on chains driven by forces (G(0) =
+   0), so its Hamiltonian has Jordan pairs at 0: the solution is taken from
+   the stable eigenvectors plus the cluster's eigenvectors (two shifted sign
+   iteration and the kernel of the Hamiltonian, see phgmg__care_cluster). Then
+   X B = C^T holds to round-off, Sigma_r Br = Cr^T, and the pH form is
+   Qh = Sigma_r, Jh = skew(Ar Sigma_r^-1), Rh = Sigma_r^-1 F F^T Sigma_r^-1 / 2
+   with F = Tr^T Lf and -(A^T X + X A) = Lf Lf^T (rank m, in factored form
+   from the deflated equation: PSD by construction; clipping the round-off
+   negative eigenvalues of -sym(Ar Sigma_r^-1) instead cost 1e-6 in e_y once
+   sigma_r ~ 1e-8), Bh = Br, output Bh^T Qh x = Cr x: the balanced projection
+   itself, without an output change. Cost: one sign iteration of size
+   2(N - m) per equation, as the regularised path.
+   Measured (examples/linear_bases.c, e_y worst unseen input, PRBT / BT):
+   two-port chain r = 12/16/20: 1.7e-3/9.1e-5/2.0e-5 vs 6.5e-4/5.7e-5/1.3e-5;
+   paper's chain r = 12/16/20: 1.3e-4/1.2e-6/6.1e-9 vs 3.4e-5/5.0e-7/1.7e-9.
+   If S is not positive definite (or C B not symmetric), or opts->eps > 0:
+   the regularised lemma with D = d I, d = eps ||C B||_F (eps 1e-10 in the
+   fallback), S = 2 d I:
      Q-eq  A^T X + X A + (X B - C^T) S^-1 (X B - C^T)^T = 0,
      P-eq  A Y + Y A^T + (Y C^T - B) S^-1 (Y C^T - B)^T = 0,
-   minimal (stabilizing) solutions by phgmg_care. Balancing Y, X as in phgmg_bt
-   gives Ar, Br, Cr and Sigma_r (the leading positive-real singular values);
-   Sigma_r solves the reduced Q-equation exactly, so the reduced model in pH
-   form is  Qh = Sigma_r (PD), Jh = skew(Ar Sigma_r^-1), Rh = Sigma_r^-1 F
-   S^-1 F^T Sigma_r^-1 / 2 with F = Sigma_r Br - Cr^T (PSD by construction),
-   Bh = Br, output Bh^T Qh x. Effect of the regularisation: the model drops
-   D = d I and replaces the output Cr by Br^T Sigma_r; both differences are
-   O(sqrt(eps)) relative (measured ||X B - C^T|| / ||C||: 8e-3, 8e-4, 8e-5 at
-   eps = 1e-6, 1e-8, 1e-10 on the two-port chain); much smaller eps makes the
-   Hamiltonian matrix too ill-conditioned for the sign function (its
-   eigenvalues approach the imaginary axis at 0 and infinity, where the
-   positive-real Popov function of a zero-feedthrough chain vanishes).
-   Measured on the two-port chain (N = 100, r = 12/16/20, relative H-inf
-   error): eps = 1e-8: 1.8e-3/2.6e-4/2.0e-4, 1e-9: 1.7e-3/2.3e-4/1.3e-4,
-   1e-10: 1.8e-3/4.1e-4/2.3e-4; at 1e-11 the sign iteration loses the
-   minimal solution (a positive-real singular value > 1: returned as
-   PHGMG_ERR_NOT_CONVERGED, as is a sign iteration that does not converge).
+   stabilizing solutions by phgmg_care; pH form Qh = Sigma_r, Jh = skew(Ar
+   Sigma_r^-1), Rh = Sigma_r^-1 F S^-1 F^T Sigma_r^-1 / 2 with F = Sigma_r Br
+   - Cr^T (PSD by construction), Bh = Br, output Bh^T Qh x. Its cost: the
+   model drops D = d I and replaces the output Cr by Br^T Sigma_r; both
+   differences are O(sqrt(eps)) relative (||X B - C^T|| / ||C||: 8e-3, 8e-4,
+   8e-5 at eps = 1e-6, 1e-8, 1e-10 on the two-port chain), which is why the
+   regularised PRBT levels off near 1e-5 (e_y) while BT keeps falling;
+   much smaller eps makes the Hamiltonian too ill-conditioned for the sign
+   function (at 1e-11 it loses the minimal solution: a positive-real
+   singular value > 1, returned as PHGMG_ERR_NOT_CONVERGED).
    Lift: x = T xr (phgmg_reduced_lift); restrict: xr = W^T x. prsv (may be
    NULL): the first r positive-real singular values; info_xb (may be NULL):
    ||X B - C^T||_F / ||C||_F. The system must outlive the model. Errors:
@@ -10005,14 +10023,326 @@ PHGMG__PRIV phgmg_result phgmg__pr_riccati(int N, int m, const double *A, const 
   return rc;
 }
 
-/* The pH blocks of a PR-balanced truncation (see phgmg_prbt). */
+
+/* Orthonormal basis V (n2 x k) of the (numerical) kernel of H (n2 x n2,
+   destroyed: LU factors): inverse iteration on H^T H (two solves a step, 4
+   steps; convergence ratio (sigma_k+1 / sigma_k)^2 per step, sigma_k ~ eps_mach
+   ||H|| for an exact kernel) from deterministic +-1 start vectors, Gram-Schmidt
+   in between. A zero pivot is shifted by eps_mach ||H||_1. work: n2 ints. */
+PHGMG__PRIV phgmg_result phgmg__kernel_inviter(int n2, double *H, int k, double *V, int *ipiv) {
+  const double h1 = phgmg_norm1(n2, n2, H, n2);
+  unsigned long seed = 12345u;
+  phgmg_result rc;
+  int i, j, l, it;
+  for (j = 0; j < k; ++j)
+    for (i = 0; i < n2; ++i) {
+      seed = seed * 1103515245u + 12345u;
+      V[i + (size_t)j * n2] = ((seed >> 16) & 1u) ? 1.0 : -1.0;
+    }
+  rc = phgmg_lu_factor(n2, H, n2, ipiv);
+  if (rc == PHGMG_ERR_SINGULAR)
+    for (i = 0; i < n2; ++i)
+      if (H[i + (size_t)i * n2] == 0.0) H[i + (size_t)i * n2] = 2.2e-16 * h1;
+  if (rc != PHGMG_OK && rc != PHGMG_ERR_SINGULAR) return rc;
+  for (it = 0; it < 4; ++it) {
+    phgmg_lu_solve('T', n2, H, n2, ipiv, k, V, n2);
+    phgmg_lu_solve('N', n2, H, n2, ipiv, k, V, n2);
+    for (j = 0; j < k; ++j) {   /* modified Gram-Schmidt, twice */
+      double *v = V + (size_t)j * n2, nv;
+      int pass;
+      for (pass = 0; pass < 2; ++pass)
+        for (l = 0; l < j; ++l) {
+          const double *u = V + (size_t)l * n2;
+          double d = 0.0;
+          for (i = 0; i < n2; ++i) d += u[i] * v[i];
+          for (i = 0; i < n2; ++i) v[i] -= d * u[i];
+        }
+      nv = phgmg_normf(n2, 1, v, n2);
+      if (!(nv > 0.0) || !isfinite(nv)) return PHGMG_ERR_NOT_CONVERGED;
+      for (i = 0; i < n2; ++i) v[i] /= nv;
+    }
+  }
+  return PHGMG_OK;
+}
+
+/* Riccati A^T X + X A - X K X + L = 0 (n x n) whose Hamiltonian H = [A, -K;
+   -L, -A^T] may have, besides eigenvalues off the imaginary axis, k Jordan
+   pairs at 0 (the positive-real Riccati of a system whose Popov function
+   vanishes at w = 0, e.g. a chain driven by forces with velocity outputs).
+   The minimal solution X belongs to the Lagrangian subspace spanned by the
+   stable eigenvectors and the eigenvectors (not the principal vectors) of the
+   pairs at 0, i.e. range(P) + ker H with P = (I - sign(H + sI))/2 (the
+   eigenvalues with Re < -s), s = 1e-6 ||H||_1: round-off splits a Jordan pair
+   at 0 by about sqrt(eps_mach) ||H|| << s, and s must stay below the other
+   eigenvalues' |Re| (1.4e-3 and 3e-4 ||H||_1 on the two chains of
+   examples/linear_bases.c). k = trace(I - P) - n (a projector's trace is its
+   rank); ker H by phgmg__kernel_inviter. With [M1; M2] = [P, ker H],
+   X M1 = M2 by least squares. Without pairs at 0 (k = 0) X is phgmg_care's
+   solution. */
+PHGMG__PRIV phgmg_result phgmg__care_cluster(int n, const double *A, const double *K, const double *L, double *X,
+                                             const phgmg_allocator *alloc) {
+  const int n2 = 2 * n;
+  const size_t q = (size_t)n2 * n2;
+  double *H, *W, *Mt, sig, tr = 0.0;
+  int *ipiv = phgmg__ialloc(alloc, (size_t)n2), k = 0, nr, r, c;
+  phgmg_result rc;
+  H = phgmg__dalloc(alloc, 2 * q + 2 * (size_t)(n2 + n) * n + (size_t)n2 * n);
+  if (!H || !ipiv) { phgmg__free(alloc, H); phgmg__free(alloc, ipiv); return PHGMG_ERR_NOMEM; }
+  W = H + q; Mt = W + q;
+  for (c = 0; c < n; ++c)
+    for (r = 0; r < n; ++r) {
+      H[r + (size_t)c * n2] = A[r + (size_t)c * n];
+      H[r + (size_t)(c + n) * n2] = -K[r + (size_t)c * n];
+      H[(r + n) + (size_t)c * n2] = -L[r + (size_t)c * n];
+      H[(r + n) + (size_t)(c + n) * n2] = -A[c + (size_t)r * n];
+    }
+  sig = 1e-6 * phgmg_norm1(n2, n2, H, n2);
+  memcpy(W, H, q * sizeof(double));
+  for (r = 0; r < n2; ++r) W[r + (size_t)r * n2] += sig;
+  rc = phgmg__sign_iter(n2, W, NULL, NULL, alloc);
+  if (rc == PHGMG_OK) {
+    for (r = 0; r < n2; ++r) tr += 0.5 * (1.0 + W[r + (size_t)r * n2]);
+    k = (int)floor(tr - n + 0.5);
+    if (k < 0 || k > n) rc = PHGMG_ERR_NOT_CONVERGED;
+  }
+  nr = n2 + k;
+  if (rc == PHGMG_OK) {   /* Mt = [M1^T, M2^T] ((n2 + k) x n each): rows of P^T, then of V^T */
+    double *V = Mt + 2 * (size_t)nr * n;
+    for (c = 0; c < n2; ++c)
+      for (r = 0; r < n2; ++r) {
+        const double p = (r == c ? 0.5 : 0.0) - 0.5 * W[r + (size_t)c * n2];   /* P(r, c) */
+        Mt[c + (size_t)(r < n ? r : r - n) * nr + (r < n ? 0 : (size_t)n * nr)] = p;
+      }
+    if (k > 0) rc = phgmg__kernel_inviter(n2, H, k, V, ipiv);
+    if (rc == PHGMG_OK)
+      for (c = 0; c < k; ++c)
+        for (r = 0; r < n2; ++r)
+          Mt[(n2 + c) + (size_t)(r < n ? r : r - n) * nr + (r < n ? 0 : (size_t)n * nr)] = V[r + (size_t)c * n2];
+  }
+  if (rc == PHGMG_OK) rc = phgmg_lstsq(nr, n, n, Mt, nr, Mt + (size_t)n * nr, nr, 0.0, W, n, alloc);
+  if (rc == PHGMG_OK)
+    for (c = 0; c < n; ++c)
+      for (r = 0; r < n; ++r) X[r + (size_t)c * n] = 0.5 * (W[r + (size_t)c * n] + W[c + (size_t)r * n]);
+  phgmg__free(alloc, H);
+  phgmg__free(alloc, ipiv);
+  return rc;
+}
+
+/* Lower Cholesky factor of a small symmetric m x m S in place; -1 unless PD. */
+PHGMG__PRIV int phgmg__chol_small(int m, double *S) {
+  int i, j, k;
+  for (j = 0; j < m; ++j) {
+    double d = S[j + (size_t)j * m];
+    for (k = 0; k < j; ++k) d -= S[j + (size_t)k * m] * S[j + (size_t)k * m];
+    if (!(d > 0.0)) return -1;
+    d = sqrt(d);
+    S[j + (size_t)j * m] = d;
+    for (i = j + 1; i < m; ++i) {
+      double t = S[i + (size_t)j * m];
+      for (k = 0; k < j; ++k) t -= S[i + (size_t)k * m] * S[j + (size_t)k * m];
+      S[i + (size_t)j * m] = t / d;
+    }
+    for (i = 0; i < j; ++i) S[i + (size_t)j * m] = 0.0;
+  }
+  return 0;
+}
+
+/* T = [B, Nc] (N x N) with Nc an orthonormal basis of ker C (the last N - m
+   columns of Q in C^T = Q R). */
+PHGMG__PRIV phgmg_result phgmg__ker_frame(int N, int m, const double *B, const double *C, double *T,
+                                          const phgmg_allocator *alloc) {
+  double *Ct = phgmg__dalloc(alloc, (size_t)N * m + m);
+  phgmg_result rc;
+  int i, j;
+  if (!Ct) return PHGMG_ERR_NOMEM;
+  for (j = 0; j < m; ++j)
+    for (i = 0; i < N; ++i) Ct[i + (size_t)j * N] = C[j + (size_t)i * m];
+  rc = phgmg_qr(N, m, Ct, N, Ct + (size_t)N * m);
+  if (rc == PHGMG_OK) {
+    memcpy(T, B, (size_t)N * m * sizeof(double));
+    memset(T + (size_t)N * m, 0, (size_t)N * (N - m) * sizeof(double));
+    for (j = 0; j < N - m; ++j) T[(m + j) + (size_t)(m + j) * N] = 1.0;
+    phgmg_qr_apply('N', N, N - m, m, Ct, N, Ct + (size_t)N * m, T + (size_t)N * m, N);
+  }
+  phgmg__free(alloc, Ct);
+  return rc;
+}
+
+/* Deflated Riccati data of the zero-feedthrough positive-real problem (see
+   phgmg__pr_zero_d): with At = T^-1 A T in blocks (m, n = N - m), Ls Ls^T =
+   S = -(C A B + (C A B)^T), B' = A21 Ls^-T, C' = -Ls^-1 (C B) A12: Ah = A22 -
+   B' C', K = -B' B'^T, L = C'^T C' (n x n each). PHGMG_ERR_SINGULAR unless
+   S is positive definite. */
+PHGMG__PRIV phgmg_result phgmg__pr_deflate(int N, int m, const double *At, const double *CB, double *Ah,
+                                           double *K, double *L, double *work) {
+  const int n = N - m;
+  double *S = work, *Bp = S + (size_t)m * m, *Cp = Bp + (size_t)n * m, *CA = Cp + (size_t)m * n;
+  int i, j, a, b;
+  for (b = 0; b < m; ++b)   /* S = -(CB A11 + A11^T CB) */
+    for (a = 0; a < m; ++a) {
+      double t = 0.0;
+      for (j = 0; j < m; ++j) t += CB[a + (size_t)j * m] * At[j + (size_t)b * N] + At[j + (size_t)a * N] * CB[j + (size_t)b * m];
+      S[a + (size_t)b * m] = -t;
+    }
+  if (phgmg__chol_small(m, S) != 0) return PHGMG_ERR_SINGULAR;
+  for (i = 0; i < n; ++i)   /* B' = A21 Ls^-T: row i solves Ls b = A21(i,:)^T */
+    for (a = 0; a < m; ++a) {
+      double t = At[(m + i) + (size_t)a * N];
+      for (b = 0; b < a; ++b) t -= S[a + (size_t)b * m] * Bp[i + (size_t)b * n];
+      Bp[i + (size_t)a * n] = t / S[a + (size_t)a * m];
+    }
+  for (j = 0; j < n; ++j) {   /* C' = -Ls^-1 CB A12 */
+    for (a = 0; a < m; ++a) {
+      double t = 0.0;
+      for (b = 0; b < m; ++b) t += CB[a + (size_t)b * m] * At[b + (size_t)(m + j) * N];
+      CA[a] = -t;
+    }
+    for (a = 0; a < m; ++a) {
+      double t = CA[a];
+      for (b = 0; b < a; ++b) t -= S[a + (size_t)b * m] * Cp[b + (size_t)j * m];
+      Cp[a + (size_t)j * m] = t / S[a + (size_t)a * m];
+    }
+  }
+  for (j = 0; j < n; ++j)
+    for (i = 0; i < n; ++i) Ah[i + (size_t)j * n] = At[(m + i) + (size_t)(m + j) * N];
+  phgmg_gemm('N', 'N', n, n, m, -1.0, Bp, n, Cp, m, 1.0, Ah, n);
+  phgmg_gemm('N', 'T', n, n, m, -1.0, Bp, n, Bp, n, 0.0, K, n);
+  phgmg_gemm('T', 'N', n, n, m, 1.0, Cp, m, Cp, m, 0.0, L, n);
+  return PHGMG_OK;
+}
+
+/* Minimal solution X (N x N) of the positive-real lemma with zero
+   feedthrough, the limit eps -> 0 of the regularised Riccati: A^T X + X A <= 0
+   and X B = C^T. In the frame T = [B, Nc] (Nc: ker C) the constraint fixes
+   T^T X T = diag(C B, Z) (C B must be symmetric positive definite, as B^T Q B
+   of a pH system), and the Schur complement of the Lyapunov inequality is a
+   regular positive-real Riccati inequality for Z (n = N - m) with feedthrough
+   S = -(C A B + (C A B)^T) (= 2 B^T Q R Q B for a pH system; positive
+   definite needed: every port damped, else PHGMG_ERR_SINGULAR); its minimal
+   solution by phgmg__care_cluster, X = T^-T diag(C B, Z) T^-1. */
+PHGMG__PRIV phgmg_result phgmg__pr_zero_d(int N, int m, const double *A, const double *B, const double *C,
+                                          double *X, const phgmg_allocator *alloc) {
+  const int n = N - m;
+  const size_t nn = (size_t)N * N, qq = (size_t)n * n;
+  double *T, *Ti, *At, *CB, *work, *Ah, *K, *L, *Z;
+  phgmg_result rc;
+  int i, j;
+  if (n < 1) return PHGMG_ERR_SIZE;
+  T = phgmg__dalloc(alloc, 3 * nn + 4 * qq + 2 * (size_t)m * m + 2 * (size_t)n * m + m);
+  if (!T) return PHGMG_ERR_NOMEM;
+  Ti = T + nn; At = Ti + nn; Ah = At + nn; K = Ah + qq; L = K + qq; Z = L + qq; CB = Z + qq;
+  work = CB + (size_t)m * m;
+  phgmg_gemm('N', 'N', m, m, N, 1.0, C, m, B, N, 0.0, CB, m);
+  rc = PHGMG_OK;
+  for (j = 0; j < m; ++j)   /* C B symmetric (X B = C^T makes B^T X B = C B) */
+    for (i = 0; i < j; ++i)
+      if (fabs(CB[i + (size_t)j * m] - CB[j + (size_t)i * m]) > 1e-12 * phgmg_normf(m, m, CB, m))
+        rc = PHGMG_ERR_SINGULAR;
+  if (rc == PHGMG_OK) rc = phgmg__ker_frame(N, m, B, C, T, alloc);
+  if (rc == PHGMG_OK) rc = phgmg__inv(N, T, Ti, alloc);
+  if (rc == PHGMG_OK) {   /* At = Ti A T (X as scratch) */
+    phgmg_gemm('N', 'N', N, N, N, 1.0, A, N, T, N, 0.0, X, N);
+    phgmg_gemm('N', 'N', N, N, N, 1.0, Ti, N, X, N, 0.0, At, N);
+    rc = phgmg__pr_deflate(N, m, At, CB, Ah, K, L, work);
+  }
+  if (rc == PHGMG_OK) rc = phgmg__care_cluster(n, Ah, K, L, Z, alloc);
+  if (rc == PHGMG_OK) {   /* X = Ti^T diag(CB, Z) Ti */
+    memset(At, 0, nn * sizeof(double));
+    for (j = 0; j < m; ++j)
+      for (i = 0; i < m; ++i) At[i + (size_t)j * N] = CB[i + (size_t)j * m];
+    for (j = 0; j < n; ++j)
+      for (i = 0; i < n; ++i) At[(m + i) + (size_t)(m + j) * N] = Z[i + (size_t)j * n];
+    phgmg_gemm('N', 'N', N, N, N, 1.0, At, N, Ti, N, 0.0, T, N);
+    phgmg_gemm('T', 'N', N, N, N, 1.0, Ti, N, T, N, 0.0, X, N);
+    for (j = 0; j < N; ++j)
+      for (i = 0; i < j; ++i) {
+        const double t = 0.5 * (X[i + (size_t)j * N] + X[j + (size_t)i * N]);
+        X[i + (size_t)j * N] = t; X[j + (size_t)i * N] = t;
+      }
+  }
+  phgmg__free(alloc, T);
+  return rc;
+}
+
+/* The factor Lf (N x m) of -(A^T X + X A) = Lf Lf^T for the minimal
+   zero-feedthrough solution X of phgmg__pr_zero_d (rank m: the Schur
+   complement vanishes). In the frame T = [B, Nc], At = T^-1 A T, T^T X T =
+   diag(C B, Z), Ls Ls^T = S: -(At^T Xt + Xt At) = G G^T with G = [Ls;
+   -(Z A21 + A12^T C B) Ls^-T], so Lf = T^-T G: exact in the theory and PSD
+   by construction (no clipping of round-off eigenvalues). */
+PHGMG__PRIV phgmg_result phgmg__pr_factor(int N, int m, const double *A, const double *B, const double *C,
+                                          const double *X, double *Lf, const phgmg_allocator *alloc) {
+  const int n = N - m;
+  const size_t nn = (size_t)N * N;
+  double *T = phgmg__dalloc(alloc, 5 * nn + 2 * (size_t)m * m + 2 * (size_t)N * m), *Ti, *At, *W, *Z, *CB, *S, *G,
+         *Ft;
+  phgmg_result rc;
+  int i, j, a, b;
+  if (!T) return PHGMG_ERR_NOMEM;
+  Ti = T + nn; At = Ti + nn; W = At + nn; Z = W + nn; CB = Z + nn; S = CB + (size_t)m * m; G = S + (size_t)m * m;
+  Ft = G + (size_t)N * m;
+  phgmg_gemm('N', 'N', m, m, N, 1.0, C, m, B, N, 0.0, CB, m);
+  rc = phgmg__ker_frame(N, m, B, C, T, alloc);
+  if (rc == PHGMG_OK) rc = phgmg__inv(N, T, Ti, alloc);
+  if (rc == PHGMG_OK) {
+    phgmg_gemm('N', 'N', N, N, N, 1.0, A, N, T, N, 0.0, W, N);
+    phgmg_gemm('N', 'N', N, N, N, 1.0, Ti, N, W, N, 0.0, At, N);   /* At = Ti A T */
+    for (b = 0; b < m; ++b)   /* S = -(CB A11 + A11^T CB) */
+      for (a = 0; a < m; ++a) {
+        double t = 0.0;
+        for (j = 0; j < m; ++j) t += CB[a + (size_t)j * m] * At[j + (size_t)b * N] + At[j + (size_t)a * N] * CB[j + (size_t)b * m];
+        S[a + (size_t)b * m] = -t;
+      }
+    if (phgmg__chol_small(m, S) != 0) rc = PHGMG_ERR_SINGULAR;
+  }
+  if (rc == PHGMG_OK) {
+    phgmg_gemm('N', 'N', N, n, N, 1.0, X, N, T + (size_t)N * m, N, 0.0, W, N);          /* X Nc */
+    phgmg_gemm('T', 'N', n, n, N, 1.0, T + (size_t)N * m, N, W, N, 0.0, Z, n);          /* Z = Nc^T X Nc */
+    phgmg_gemm('N', 'N', n, m, n, 1.0, Z, n, At + m, N, 0.0, Ft, n);                    /* Z A21 */
+    phgmg_gemm('T', 'N', n, m, m, 1.0, At + (size_t)m * N, N, CB, m, 1.0, Ft, n);      /* + A12^T CB */
+    for (b = 0; b < m; ++b)
+      for (a = 0; a < m; ++a) G[a + (size_t)b * N] = a >= b ? S[a + (size_t)b * m] : 0.0;
+    for (i = 0; i < n; ++i)   /* rows m..: -Ft Ls^-T (row i solves Ls g = -Ft(i,:)^T) */
+      for (a = 0; a < m; ++a) {
+        double t = -Ft[i + (size_t)a * n];
+        for (b = 0; b < a; ++b) t -= S[a + (size_t)b * m] * G[(m + i) + (size_t)b * N];
+        G[(m + i) + (size_t)a * N] = t / S[a + (size_t)a * m];
+      }
+    phgmg_gemm('T', 'N', N, m, N, 1.0, Ti, N, G, N, 0.0, Lf, N);                        /* Lf = Ti^T G */
+  }
+  phgmg__free(alloc, T);
+  return rc;
+}
+
+/* X (Q-eq) and Y (P-eq, from the dual (A^T, C^T, B^T)) by phgmg__pr_zero_d. */
+PHGMG__PRIV phgmg_result phgmg__pr_zero_d_both(int N, int m, const double *A, const double *B, const double *C,
+                                               double *X, double *Y, const phgmg_allocator *alloc) {
+  double *At = phgmg__dalloc(alloc, (size_t)N * N + 2 * (size_t)N * m), *Ct, *Bt;
+  phgmg_result rc;
+  int i, j;
+  if (!At) return PHGMG_ERR_NOMEM;
+  Ct = At + (size_t)N * N; Bt = Ct + (size_t)N * m;
+  for (j = 0; j < N; ++j)
+    for (i = 0; i < N; ++i) At[i + (size_t)j * N] = A[j + (size_t)i * N];
+  for (j = 0; j < m; ++j)
+    for (i = 0; i < N; ++i) { Ct[i + (size_t)j * N] = C[j + (size_t)i * m]; Bt[j + (size_t)i * m] = B[i + (size_t)j * N]; }
+  rc = phgmg__pr_zero_d(N, m, A, B, C, X, alloc);
+  if (rc == PHGMG_OK) rc = phgmg__pr_zero_d(N, m, At, Ct, Bt, Y, alloc);
+  phgmg__free(alloc, At);
+  return rc;
+}
+/* The pH blocks of a PR-balanced truncation (see phgmg_prbt): Qh = Sigma,
+   K = skew(Ar Sigma^-1) - Sigma^-1 F F^T Sigma^-1 / (2 s). Br, Cr non-NULL:
+   F = Sigma Br - Cr^T (regularised); else F (r x m) is given (exact case:
+   Tr^T Lf with -(A^T X + X A) = Lf Lf^T, s = 1/2... passed as s). */
 PHGMG__PRIV void phgmg__prbt_ph(int r, int m, const double *Ar, const double *Br, const double *Cr, const double *S,
                                 double s, double *Qh, double *K, double *F) {
   int i, j, a;
   for (j = 0; j < r; ++j)
     for (i = 0; i < r; ++i) Qh[i + (size_t)j * r] = i == j ? S[i] : 0.0;
-  for (a = 0; a < m; ++a)       /* F = Sigma Br - Cr^T */
-    for (i = 0; i < r; ++i) F[i + (size_t)a * r] = S[i] * Br[i + (size_t)a * r] - Cr[a + (size_t)i * m];
+  if (Br && Cr)
+    for (a = 0; a < m; ++a)       /* F = Sigma Br - Cr^T */
+      for (i = 0; i < r; ++i) F[i + (size_t)a * r] = S[i] * Br[i + (size_t)a * r] - Cr[a + (size_t)i * m];
   for (j = 0; j < r; ++j)
     for (i = 0; i < r; ++i) {
       double rr = 0.0;
@@ -10026,7 +10356,8 @@ PHGMG_DEF phgmg_result phgmg_prbt(phgmg_reduced **out, const phgmg_ph_system *sy
                                   const phgmg_prbt_opts *opts, double *prsv, double *info_xb,
                                   const phgmg_allocator *alloc) {
   int N, m;
-  double *A, *C, *X, *Y, *Ar, *Cr, *S, *F, *CB, s, eps;
+  double *A, *C, *X, *Y, *Ar, *Cr, *S, *F, *CB, *Lf, s = 1.0, eps;
+  int exact;
   phgmg_reduced *red;
   phgmg_result rc;
   if (!out) return PHGMG_ERR_INVALID_ARG;
@@ -10035,12 +10366,14 @@ PHGMG_DEF phgmg_result phgmg_prbt(phgmg_reduced **out, const phgmg_ph_system *sy
   if (sys->nl != PHGMG_NL_NONE) return PHGMG_ERR_UNSUPPORTED;
   if (opts && (opts->eps < 0.0 || opts->dt < 0.0 || !isfinite(opts->eps) || !isfinite(opts->dt) ||
                (!opts->X) != (!opts->Y))) return PHGMG_ERR_INVALID_ARG;
-  eps = opts && opts->eps > 0.0 ? opts->eps : 1e-10;
+  exact = !(opts && opts->eps > 0.0);
+  eps = exact ? 1e-10 : opts->eps;
   rc = phgmg_ph_validate(sys, 0.0, NULL, alloc);
   if (rc != PHGMG_OK) return rc;
   N = sys->N; m = sys->m;
   if (r < 1 || r > N) return PHGMG_ERR_SIZE;
-  A = phgmg__dalloc(alloc, 3 * (size_t)N * N + (size_t)m * N + 2 * (size_t)r * r + (size_t)m * r + 2 * (size_t)r * m + r + (size_t)m * m);
+  A = phgmg__dalloc(alloc, 3 * (size_t)N * N + (size_t)m * N + 2 * (size_t)r * r + (size_t)m * r + 2 * (size_t)r * m + r + (size_t)m * m +
+                          (size_t)N * m);
   red = PHGMG__CAST(phgmg_reduced *, phgmg__alloc(alloc, sizeof(phgmg_reduced)));
   if (!A || !red) { phgmg__free(alloc, A); phgmg__free(alloc, red); return PHGMG_ERR_NOMEM; }
   memset(red, 0, sizeof *red);
@@ -10049,6 +10382,7 @@ PHGMG_DEF phgmg_result phgmg_prbt(phgmg_reduced **out, const phgmg_ph_system *sy
   red->kind = PHGMG_ROM_LINEAR; red->sys = sys;
   C = A + (size_t)N * N; X = C + (size_t)m * N; Y = X + (size_t)N * N; Ar = Y + (size_t)N * N;
   Cr = Ar + (size_t)r * r; S = Cr + (size_t)m * r; F = S + r; CB = F + (size_t)r * m;
+  Lf = CB + (size_t)m * m;
   rc = phgmg_ph_abc(sys, A, C, alloc);
   if (rc == PHGMG_OK) {
     phgmg_gemm('N', 'N', m, m, N, 1.0, C, m, sys->B, N, 0.0, CB, m);
@@ -10057,7 +10391,9 @@ PHGMG_DEF phgmg_result phgmg_prbt(phgmg_reduced **out, const phgmg_ph_system *sy
       memcpy(X, opts->X, (size_t)N * N * sizeof(double));
       memcpy(Y, opts->Y, (size_t)N * N * sizeof(double));
     } else {
-      rc = phgmg__pr_riccati(N, m, A, sys->B, C, s, X, Y, alloc);
+      if (exact) rc = phgmg__pr_zero_d_both(N, m, A, sys->B, C, X, Y, alloc);
+      if (exact && rc == PHGMG_ERR_SINGULAR) { exact = 0; rc = PHGMG_OK; }   /* a port without damping */
+      if (!exact) rc = phgmg__pr_riccati(N, m, A, sys->B, C, s, X, Y, alloc);
     }
   }
   if (rc == PHGMG_OK && info_xb) {   /* ||X B - C^T|| / ||C|| */
@@ -10080,15 +10416,21 @@ PHGMG_DEF phgmg_result phgmg_prbt(phgmg_reduced **out, const phgmg_ph_system *sy
     red->K = phgmg__red_d(red, (size_t)r * r);
     if (!red->V0 || !red->W || !red->Bh || !red->Qh || !red->K) rc = PHGMG_ERR_NOMEM;
   }
+  if (rc == PHGMG_OK && exact) rc = phgmg__pr_factor(N, m, A, sys->B, C, X, Lf, alloc);
   if (rc == PHGMG_OK) rc = phgmg__balance(N, r, Y, X, red->V0, red->W, S, alloc);
   /* minimal solutions give positive-real singular values <= 1: a larger one
      means the Riccati solutions are not accurate (eps too small) */
   if (rc == PHGMG_OK && !(S[0] <= 1.0 + 1e-6)) rc = PHGMG_ERR_NOT_CONVERGED;
   if (rc == PHGMG_OK) rc = phgmg__project_abc(N, m, r, A, sys->B, C, red->V0, red->W, Ar, red->Bh, Cr, alloc);
   if (rc == PHGMG_OK) {
-    phgmg__prbt_ph(r, m, Ar, red->Bh, Cr, S, s, red->Qh, red->K, F);
+    if (exact) {   /* F = Tr^T Lf */
+      phgmg_gemm('T', 'N', r, m, N, 1.0, red->V0, N, Lf, N, 0.0, F, r);
+      phgmg__prbt_ph(r, m, Ar, NULL, NULL, S, 1.0, red->Qh, red->K, F);
+    } else {
+      phgmg__prbt_ph(r, m, Ar, red->Bh, Cr, S, s, red->Qh, red->K, F);
+    }
     if (prsv) memcpy(prsv, S, (size_t)r * sizeof(double));
-    if (opts && opts->dt > 0.0) {
+    if (rc == PHGMG_OK && opts && opts->dt > 0.0) {
       red->map_dt = opts->dt;
       rc = phgmg__step_map(red, opts->dt, alloc);
     }
@@ -10117,7 +10459,9 @@ PHGMG_DEF phgmg_result phgmg_prbt_riccati(const phgmg_ph_system *sys, double eps
   if (rc == PHGMG_OK) {
     phgmg_gemm('N', 'N', m, m, N, 1.0, C, m, sys->B, N, 0.0, C + (size_t)m * N, m);
     CBn = phgmg_normf(m, m, C + (size_t)m * N, m);
-    rc = phgmg__pr_riccati(N, m, A, sys->B, C, 2.0 * (eps > 0.0 ? eps : 1e-10) * CBn, X, Y, alloc);
+    rc = eps > 0.0 ? PHGMG_ERR_SINGULAR : phgmg__pr_zero_d_both(N, m, A, sys->B, C, X, Y, alloc);
+    if (rc == PHGMG_ERR_SINGULAR)
+      rc = phgmg__pr_riccati(N, m, A, sys->B, C, 2.0 * (eps > 0.0 ? eps : 1e-10) * CBn, X, Y, alloc);
   }
   phgmg__free(alloc, A);
   return rc;

@@ -6,10 +6,11 @@
    2) it compares, for r = 4..20, GMG-POD trained on u = 0.1 sin t with GMG
    on three input-independent bases (frequency-sampled, impulse responses,
    balanced right basis; phgmg_linear_basis), balanced truncation (BT,
-   reference, not pH) and positive-real balanced truncation (PRBT, pH form;
-   PRBT-LTI: the same projection W^T A T, W^T B, C T without the pH form,
-   i.e. with the balanced output C T, for comparison with PRBT codes whose
-   pH form carries a feedthrough and P != 0).
+   reference, not pH) and positive-real balanced truncation (PRBT, pH form,
+   exact zero-feedthrough Gramians; PRBT-LTI: the same projection W^T A T,
+   W^T B, C T without the pH form: with exact Gramians the output C T equals
+   the pH output Bh^T Qh x to round-off and Jh - Rh = Ar Sigma_r^-1 up to the
+   Riccati residual, so the two agree to 2-3 digits).
    Every reduced model is simulated with the same GL3 scheme (dt = 0.1, 1000
    steps, x0 = 0) on the training input and five inputs no construction
    sees; e_y = sqrt(sum ||y - y_r||^2 / sum ||y||^2).

@@ -158,6 +158,30 @@ TEST(test_prbt_structure_energy_export) {
     phgmg_reduced_restrict(red, x, xb2);
     for (i = 0; i < r; ++i) CHECK_LE(fabs(xb2[i] - xr[i]), 1e-9);
   }
+  /* the pH model is the balanced projection itself (exact Gramians): its
+     (K Qh, Bh, Bh^T Qh) against (W^T A T, W^T B, C T) from the lift/restrict
+     bases, in H-infinity over a frequency grid (the regularised form differed
+     by 1e-3 here: dropped feedthrough and a changed output) */
+  {
+    static double T[CH_N * 12], W[CH_N * 12], A[CH_N * CH_N], C[2 * CH_N], AT[CH_N * 12];
+    double Ap[144], Bp[24], Cp[24], Ah[144], Bhh[24], Chh[24], e[12], hi = 0.0, hr = 0.0;
+    int a;
+    CHECK_RC(phgmg_ph_abc(&s, A, C, NULL), PHGMG_OK);
+    for (a = 0; a < r; ++a) {
+      memset(e, 0, sizeof e);
+      e[a] = 1.0;
+      phgmg_reduced_lift(red, e, T + a * CH_N);
+    }
+    CHECK_RC(phgmg_reduced_W(red, e, W, CH_N), PHGMG_OK);
+    phgmg_gemm('N', 'N', CH_N, r, CH_N, 1.0, A, CH_N, T, CH_N, 0.0, AT, CH_N);
+    phgmg_gemm('T', 'N', r, r, CH_N, 1.0, W, CH_N, AT, CH_N, 0.0, Ap, r);
+    phgmg_gemm('T', 'N', r, 2, CH_N, 1.0, W, CH_N, chB, CH_N, 0.0, Bp, r);
+    phgmg_gemm('N', 'N', 2, r, CH_N, 1.0, C, 2, T, CH_N, 0.0, Cp, 2);
+    CHECK_RC(phgmg_reduced_abc(red, Ah, Bhh, Chh), PHGMG_OK);
+    CHECK_RC(phgmg_ss_error(r, Ap, Bp, Cp, r, Ah, Bhh, Chh, 2, 2, 200, 1e-3, 1e2, &hi, &hr, NULL, NULL, NULL),
+             PHGMG_OK);
+    CHECK_LE(hi, 1e-10 * hr);
+  }
   /* serialize round trip keeps the method id */
   {
     static unsigned char buf[65536];
@@ -184,6 +208,70 @@ TEST(test_prbt_structure_energy_export) {
     remove(path);
   }
   phgmg_reduced_destroy(red);
+}
+
+/* The zero-feedthrough limit (eps = 0): X B = C^T to round-off, the Lyapunov
+   inequality A^T X + X A <= 0, and minimality checked against two independent
+   solutions: the system's own Q (X <= Q) and the regularised Riccati
+   solutions X_eps (positive-real lemma with D = d I: a larger D enlarges the
+   feasible set, so X_eps <= X, and X_eps increases to X as eps -> 0,
+   ||X - X_eps|| shrinking with eps). */
+TEST(test_prbt_zero_feedthrough_limit) {
+  phgmg_ph_system s = chain2();
+  const int N = CH_N, m = 2;
+  static double X[CH_N * CH_N], Y[CH_N * CH_N], Xe[CH_N * CH_N], Ye[CH_N * CH_N], A[CH_N * CH_N], C[2 * CH_N],
+      M[CH_N * CH_N], w[CH_N];
+  double xb = 0.0, nx, d[2];
+  int i, j, k;
+  CHECK_RC(phgmg_prbt_riccati(&s, 0.0, X, Y, NULL), PHGMG_OK);
+  CHECK_RC(phgmg_ph_abc(&s, A, C, NULL), PHGMG_OK);
+  nx = phgmg_normf(N, N, X, N);
+  for (j = 0; j < m; ++j)
+    for (i = 0; i < N; ++i) {
+      double t = -C[j + i * m];
+      for (k = 0; k < N; ++k) t += X[i + k * N] * chB[k + j * N];
+      xb = PHGMG__MAX(xb, fabs(t));
+    }
+  CHECK_LE(xb, 1e-12 * nx);
+  phgmg_gemm('T', 'N', N, N, N, 1.0, A, N, X, N, 0.0, M, N);
+  phgmg_gemm('N', 'N', N, N, N, 1.0, X, N, A, N, 1.0, M, N);
+  CHECK_RC(phgmg_sym_eig(N, M, N, w, NULL, 0), PHGMG_OK);
+  CHECK_LE(w[N - 1], 1e-14 * phgmg_normf(N, N, A, N) * nx);   /* <= 0 up to the round-off of the products */
+  {   /* the Riccati equation (Schur complement zero) <=> A^T X + X A has rank m */
+    double num = 0.0, den = 0.0;
+    for (i = 0; i < N; ++i) { den += w[i] * w[i]; if (i >= m) num += w[i] * w[i]; }
+    CHECK_LE(sqrt(num / den), 1e-10);
+  }
+  for (i = 0; i < N * N; ++i) M[i] = chQ[i] - X[i];
+  CHECK_RC(phgmg_sym_eig(N, M, N, w, NULL, 0), PHGMG_OK);
+  CHECK(w[0] >= -1e-12 * nx);
+  for (k = 0; k < 2; ++k) {
+    CHECK_RC(phgmg_prbt_riccati(&s, k ? 1e-8 : 1e-6, Xe, Ye, NULL), PHGMG_OK);
+    for (i = 0; i < N * N; ++i) M[i] = X[i] - Xe[i];
+    d[k] = phgmg_normf(N, N, M, N) / nx;
+    CHECK_RC(phgmg_sym_eig(N, M, N, w, NULL, 0), PHGMG_OK);
+    CHECK(w[0] >= -1e-9 * nx);
+  }
+  CHECK(d[1] < 0.2 * d[0] && d[0] < 1e-1);
+  /* the dual solution: Y C^T = B */
+  xb = 0.0;
+  for (j = 0; j < m; ++j)
+    for (i = 0; i < N; ++i) {
+      double t = -chB[i + j * N];
+      for (k = 0; k < N; ++k) t += Y[i + k * N] * C[j + k * m];
+      xb = PHGMG__MAX(xb, fabs(t));
+    }
+  CHECK_LE(xb, 1e-12 * phgmg_normf(N, N, Y, N));
+  /* and its equation: A Y + Y A^T <= 0 of rank m */
+  phgmg_gemm('N', 'N', N, N, N, 1.0, A, N, Y, N, 0.0, M, N);
+  phgmg_gemm('N', 'T', N, N, N, 1.0, Y, N, A, N, 1.0, M, N);
+  CHECK_RC(phgmg_sym_eig(N, M, N, w, NULL, 0), PHGMG_OK);
+  CHECK_LE(w[N - 1], 1e-14 * phgmg_normf(N, N, A, N) * phgmg_normf(N, N, Y, N));
+  {
+    double num = 0.0, den = 0.0;
+    for (i = 0; i < N; ++i) { den += w[i] * w[i]; if (i >= m) num += w[i] * w[i]; }
+    CHECK_LE(sqrt(num / den), 1e-10);
+  }
 }
 
 TEST(test_bases_orthonormal_to_b) {
@@ -243,5 +331,6 @@ SUITE(linear) {
   RUN(test_care_closed_form_and_residual);
   RUN(test_bt_bound_and_transfer);
   RUN(test_prbt_structure_energy_export);
+  RUN(test_prbt_zero_feedthrough_limit);
   RUN(test_bases_orthonormal_to_b);
 }
