@@ -1225,6 +1225,69 @@ PHGMG_DEF double phgmg_err_lowerbound(const phgmg_reduced *red, const double *X,
 /* e_energy(t_n) = |H[n] - H[0] - S[n] + D[n]| for n = 0..nsteps into e. */
 PHGMG_DEF void phgmg_err_energy(const phgmg_energy *energy, int nsteps, double *e);
 
+/* --- studies over many reduced orders of one snapshot set ---------------
+   phgmg_reduce alone redoes, for every call, work that grows with N ns r:
+   the POD, the snapshots' coordinates, the envelope and non-degeneracy
+   checks over the snapshots, the G- and Q-applications, the error measures.
+   The bases of a study over r are nested (GMG: V0 = [B, Ua_1..p], V2 =
+   Ua_{p+1..p+rn}; SP1/SP2: V = Up_1..r), so a study computes once, for the
+   largest basis: the POD of the adjusted snapshots Xa = X - BB^+X (Ua) and
+   of X (Up) (the hierarchical POD of every order from one factorisation),
+   the gradient snapshots' POD (Ug, SP2), the coordinates Ua^T Xa, QB^T X,
+   Up^T X, (Q Up)^T X, Ug^T X (K x ns), the residual tails
+   T(k) = sum_i ||(I - P_k) x_i||^2 (the part of X outside the first k
+   modes, from ||R_K||_F^2 plus sums of squared coordinates: no
+   cancellation), [B, Ua]^T G [B, Ua] and [B, Ua]^T Q [B, Ua], and the DEIM
+   points (at their first use). phgmg_study_reduce then builds the same
+   model as phgmg_reduce with opts.pod_basis (and grad_basis) set to the
+   study's bases, taking every snapshot quantity from the coordinates
+   (O(K ns r) per model instead of O(N ns r)), and phgmg_study_errors
+   evaluates e_red, e_proj, e_lowerbound in reduced coordinates (the bases
+   are orthonormal: ||x - phi||^2 = T(k) + ||coordinates - reduced
+   values||^2). Results agree with phgmg_reduce + phgmg_err_* to rounding
+   (tests/test_study.c). X must stay unchanged while the study lives. */
+typedef struct phgmg_study phgmg_study;
+#define PHGMG_STUDY_GMG 1u /* GMG-POD / GMG-QM: Ua, coordinates, tails, G- and Q-blocks */
+#define PHGMG_STUDY_SP 2u  /* SP1 (and SP2's trial basis): Up, coordinates, tails    */
+#define PHGMG_STUDY_SP2 4u /* SP2: Ug (POD of grad H(x_i)) and Ug^T X                  */
+typedef struct phgmg_study_opts {
+  unsigned what; /* PHGMG_STUDY_* flags (0: GMG | SP)                                   */
+  int kmax;      /* modes per POD: the largest r - m + rn (GMG) or r (SP) to be asked,
+                    <= min(N, ns) (fewer are kept if the snapshots have lower rank)   */
+} phgmg_study_opts;
+/* Cost: one thin SVD of N x ns per basis asked for plus O(N ns kmax).
+   PHGMG_ERR_INVALID_ARG (NULL), _SIZE (kmax < 1 or > min(N, ns), ldx < N),
+   _NANINF, _RANK (B), _NOMEM, a solve's code (G = (J - R)^{-1}). */
+PHGMG_DEF phgmg_result phgmg_study_create(phgmg_study **out, const phgmg_ph_system *sys, const double *X,
+                                          int ldx, int ns, const phgmg_study_opts *so,
+                                          const phgmg_allocator *alloc);
+PHGMG_DEF void phgmg_study_destroy(phgmg_study *st);
+/* A study's basis, for phgmg_reduce_opts.pod_basis / grad_basis of your own
+   calls: which = 'a' (POD of the adjusted snapshots: GMG), 'p' (POD of X:
+   SP1/SP2), 'g' (POD of the gradient snapshots: SP2). N x *cols, ld N,
+   valid until destroy; NULL (and *cols = 0) if the study has none. */
+PHGMG_DEF const double *phgmg_study_basis(const phgmg_study *st, char which, int *cols);
+/* phgmg_reduce(out, sys, X, ldx, ns, opts', info, alloc) of the study's
+   system and snapshots, with opts' = opts plus the study's bases where
+   opts leaves pod_basis / grad_basis NULL (GMG-POD, GMG-QM, SP1, SP2), and
+   with opts.deim = 1, hyper QDEIM or GREEDY and no deim_pts: the study's
+   DEIM points (computed at the first such call, reused while deim_tol,
+   deim_max and the point selection are the same). The fast path (snapshot
+   quantities from coordinates) applies to GMG-POD, GMG-QM with manifold 0,
+   SP1 and SP2 on the study's own bases and r - m + rn (GMG) / r (SP) within
+   its modes; other models are built exactly as phgmg_reduce builds them.
+   Not thread-safe on one study (the DEIM cache). */
+PHGMG_DEF phgmg_result phgmg_study_reduce(phgmg_study *st, const phgmg_reduce_opts *opts, phgmg_reduced **out,
+                                          phgmg_reduce_info *info);
+/* Error measures over the study's snapshots: e_red of a reduced trajectory
+   XR (r x ns, ldxr; NULL: e_red = NaN), e_proj, e_lowerbound (NaN unless
+   GMG-QM / GMG_MANIFOLD), each output may be NULL. Through coordinates
+   (O(ns r^2)) for a model the study built on its bases; else
+   phgmg_err_red / _proj / _lowerbound on the study's X. PHGMG_ERR_INVALID_ARG
+   (NULL st or red), _SIZE (red not of the study's N, m). */
+PHGMG_DEF phgmg_result phgmg_study_errors(const phgmg_study *st, const phgmg_reduced *red, const double *XR,
+                                          int ldxr, double *e_red, double *e_proj, double *e_lower);
+
 /* Hierarchical POD of paper 4.2.2: V1 = POD_p(X - BB^+X), V2 = POD_rn of the
    residual (I - [B,V1][B,V1]^+) X. V1: N x p, V2: N x rn. */
 PHGMG_DEF phgmg_result phgmg_pod_hierarchical(int N, int m, const double *B, int ns, const double *X,
@@ -6734,7 +6797,7 @@ PHGMG_DEF phgmg_result phgmg_rom_step(phgmg_rom_stepper *s, phgmg_real *x, const
 
 /* A small owner list: every array of a phgmg_reduced is allocated through it,
    so destroy (and every error path) frees exactly what was allocated. */
-#define PHGMG__MAXBUF 48
+#define PHGMG__MAXBUF 56
 struct phgmg_reduced {
   phgmg_allocator alloc;
   int use_alloc;
@@ -6761,6 +6824,33 @@ struct phgmg_reduced {
   phgmg_rom rom;       /* views into the phgmg_real copies     */
   double *env;         /* 2r: training envelope (lo, hi) of rho(x_j), widened */
   double *qmax;        /* 1: phgmg_rom.q_max (QUADRATIC)                       */
+  double *Ainv;        /* SP1/SP2: (V^T Vg)^{-1}, r x r (W = Vg Ainv)          */
+  const phgmg_study *study; /* the study that built it on its cached basis (else NULL) */
+  int sbasis;          /* with study: 1 GMG ([B, Ua_1..p(+rn)]), 2 SP1, 3 SP2 (Up_1..r) */
+};
+
+/* A study (phgmg_study_create): what every reduction of one snapshot set
+   shares, computed once. K* = modes kept; coordinates are K* x ns (ld K*). */
+struct phgmg_study {
+  phgmg_allocator alloc;
+  int use_alloc;
+  const phgmg_ph_system *sys;
+  const double *X;
+  int ldx, ns, N, m;
+  double xx;               /* ||X||_F^2                                          */
+  double *QB, *RB;         /* thin QR of B (N x m, m x m)                        */
+  double *Ua, *Ca, *CB, *Ta, *Gf, *Qf; /* GMG: POD of Xa = X - BB^+X (N x ka), Ua^T Xa,
+                              QB^T X (m x ns), tails Ta[k] = sum_i ||(I - P_[QB, Ua_1..k]) x_i||^2
+                              (ka + 1), [B, Ua]^T G [B, Ua] and [B, Ua]^T Q [B, Ua] ((m+ka)^2) */
+  int ka;
+  double *Up, *Cp, *Tp, *Cq; /* SP: POD of X (N x kp), Up^T X, tails Tp (kp + 1), (Q Up)^T X */
+  int kp;
+  double *Ug, *Cg;         /* SP2: POD of the gradient snapshots (N x kg), Ug^T X */
+  int kg;
+  int deim_have, deim_method, deim_max, deim_nd, deim_nneg; /* DEIM cache (first use) */
+  double deim_tol, deim_sigma;
+  int *deim_pts;
+  double *deim_w;
 };
 
 PHGMG__PRIV void *phgmg__red_alloc(phgmg_reduced *red, size_t bytes) {
@@ -7996,6 +8086,8 @@ typedef struct phgmg__rctx {
   double *Tq;              /* ridge problem Kt, Rqt, Mt kept for a refit   */
   phgmg_jr_factor *jr;     /* factorization of J - R (GMG)                 */
   int *runcol;             /* opts.runs: nrun + 1 column offsets (NULL: one run) */
+  const phgmg_study *st;   /* phgmg_study_reduce: the study (else NULL)     */
+  int sf;                  /* fast path on the study's basis: 1 GMG, 2 SP1, 3 SP2 (0: none) */
 } phgmg__rctx;
 
 PHGMG__PRIV void phgmg__rctx_free(phgmg__rctx *c) {
@@ -8146,6 +8238,11 @@ PHGMG__PRIV phgmg_result phgmg__stage_basis(phgmg__rctx *c) {
     phgmg__free(c->alloc, S);
     return rc;
   }
+  if (c->sf == 1) { /* the study's basis: Xa is not needed (its coordinates are cached) */
+    memcpy(red->V0, c->sys->B, (size_t)N * m * sizeof(double));
+    memcpy(red->V0 + (size_t)N * m, c->o->pod_basis, (size_t)N * p * sizeof(double));
+    return PHGMG_OK;
+  }
   c->Xa = phgmg__dalloc(c->alloc, (size_t)N * ns);
   tmp = phgmg__dalloc(c->alloc, (size_t)PHGMG__MAX(m, 1) * ns + (size_t)N * (p + 1) + (size_t)p + 1);
   if (!c->Xa || !tmp) { phgmg__free(c->alloc, tmp); return PHGMG_ERR_NOMEM; }
@@ -8186,8 +8283,16 @@ PHGMG__PRIV phgmg_result phgmg__qm_problem(phgmg__rctx *c) {
   c->Tq = phgmg__dalloc(c->alloc, (size_t)ns * nc + (size_t)ns * rn + (size_t)nc * rn);
   if (!Z2 || !c->Tq) { phgmg__free(c->alloc, Z2); return PHGMG_ERR_NOMEM; }
   Rq = Z2 + (size_t)p * ns; Kt = c->Tq; Rqt = Kt + (size_t)ns * nc;
-  phgmg_gemm('T', 'N', p, ns, N, 1.0, red->V0 + (size_t)N * m, N, c->X, c->ldx, 0.0, Z2, p);
-  phgmg_gemm('T', 'N', rn, ns, N, 1.0, red->V2, N, c->Xa, N, 0.0, Rq, rn);
+  if (c->sf == 1) { /* V1^T X = Ua_1..p^T Xa, V2^T Xa = Ua_p+1..p+rn^T Xa (coordinates) */
+    const int ka = c->st->ka;
+    for (i = 0; i < ns; ++i) {
+      memcpy(Z2 + (size_t)i * p, c->st->Ca + (size_t)i * ka, (size_t)p * sizeof(double));
+      memcpy(Rq + (size_t)i * rn, c->st->Ca + (size_t)i * ka + p, (size_t)rn * sizeof(double));
+    }
+  } else {
+    phgmg_gemm('T', 'N', p, ns, N, 1.0, red->V0 + (size_t)N * m, N, c->X, c->ldx, 0.0, Z2, p);
+    phgmg_gemm('T', 'N', rn, ns, N, 1.0, red->V2, N, c->Xa, N, 0.0, Rq, rn);
+  }
   for (i = 0; i < ns; ++i) {
     for (a = 0, cc = 0; a < p; ++a)
       for (j = a; j < p; ++j, ++cc)
@@ -8313,7 +8418,7 @@ PHGMG__PRIV phgmg_result phgmg__stage_manifold(phgmg__rctx *c) {
   {
     double *tmp = phgmg__dalloc(c->alloc, (size_t)p * ns + (size_t)rn);
     if (!tmp) return PHGMG_ERR_NOMEM;
-    phgmg__orth_remove(N, p, red->V0 + (size_t)N * m, ns, c->Xa, N, tmp);
+    if (c->sf != 1) phgmg__orth_remove(N, p, red->V0 + (size_t)N * m, ns, c->Xa, N, tmp);
     if (c->o->pod_basis && c->o->manifold == 0) {
       memcpy(red->V2, c->o->pod_basis + (size_t)N * p, (size_t)N * rn * sizeof(double));
     } else {
@@ -8334,27 +8439,47 @@ PHGMG__PRIV phgmg_result phgmg__stage_manifold(phgmg__rctx *c) {
   return rc;
 }
 
+/* rcond of E (n x n, ld n; overwritten by its LU). ip: 2n ints, work: 2n. */
+PHGMG__PRIV double phgmg__rcond_inplace(int n, double *E, int *ip, double *work) {
+  const double anorm = phgmg_norm1(n, n, E, n);
+  if (phgmg_lu_factor(n, E, n, ip) != PHGMG_OK) return 0.0;
+  return phgmg_lu_rcond(n, E, n, ip, anorm, work, ip + n);
+}
+
 /* Smallest rcond of D^T G D over the snapshots (QUADRATIC kind); with the
-   automatic lambda, stops early at the first snapshot that would raise it. */
+   automatic lambda, stops early at the first snapshot that would raise it.
+   The snapshots' x2 = V1^T x_i come 64 at a time from one GEMM
+   (or from the study's coordinates); E and its rcond per snapshot in one
+   workspace. */
 PHGMG__PRIV phgmg_result phgmg__dgd_rcond_snapshots(phgmg__rctx *c, double stop_below, double *rmin) {
   phgmg_reduced *red = c->red;
-  const int N = red->N, m = red->m, p = red->p, rn = red->rn, r = red->r;
-  double *Lp, *E, *tmp, *x2;
-  int i;
-  Lp = phgmg__dalloc(c->alloc, (size_t)rn * p + (size_t)r * r + (size_t)rn * r + (size_t)p);
-  if (!Lp) return PHGMG_ERR_NOMEM;
-  E = Lp + (size_t)rn * p; tmp = E + (size_t)r * r; x2 = tmp + (size_t)rn * r;
-  for (i = 0; i < c->ns; ++i) {
-    double rc_i;
-    phgmg_gemv('T', N, p, 1.0, red->V0 + (size_t)N * m, N, c->X + (size_t)i * c->ldx, 0.0, x2);
-    phgmg__eta_d(red, x2, NULL, Lp, NULL, red->rwork);
-    phgmg__dgd_d(red, Lp, E, tmp);
-    rc_i = phgmg__rcond_of(r, E, c->alloc);
-    if (rc_i < 0.0) { phgmg__free(c->alloc, Lp); return PHGMG_ERR_NOMEM; }
-    if (rc_i < *rmin) *rmin = rc_i;
-    if (!(rc_i >= stop_below)) break;
+  const int N = red->N, m = red->m, p = red->p, rn = red->rn, r = red->r, nbmax = 64;
+  double *Lp, *E, *tmp, *X2, *wk;
+  int *ip, i, j0, ld2 = p;
+  Lp = phgmg__dalloc(c->alloc, (size_t)rn * p + (size_t)r * r + (size_t)rn * r + (size_t)p * nbmax + 2 * (size_t)r);
+  ip = phgmg__ialloc(c->alloc, 2 * (size_t)r);
+  if (!Lp || !ip) { phgmg__free(c->alloc, Lp); phgmg__free(c->alloc, ip); return PHGMG_ERR_NOMEM; }
+  E = Lp + (size_t)rn * p; tmp = E + (size_t)r * r; X2 = tmp + (size_t)rn * r; wk = X2 + (size_t)p * nbmax;
+  for (j0 = 0; j0 < c->ns; j0 += nbmax) {
+    const int nb = PHGMG__MIN(nbmax, c->ns - j0);
+    const double *x2b = X2;
+    if (c->sf == 1) {
+      x2b = c->st->Ca + (size_t)j0 * c->st->ka;
+      ld2 = c->st->ka;
+    } else {
+      phgmg_gemm('T', 'N', p, nb, N, 1.0, red->V0 + (size_t)N * m, N, c->X + (size_t)j0 * c->ldx, c->ldx, 0.0, X2, p);
+    }
+    for (i = 0; i < nb; ++i) {
+      double rc_i;
+      phgmg__eta_d(red, x2b + (size_t)i * ld2, NULL, Lp, NULL, red->rwork);
+      phgmg__dgd_d(red, Lp, E, tmp);
+      rc_i = phgmg__rcond_inplace(r, E, ip, wk);
+      if (rc_i < *rmin) *rmin = rc_i;
+      if (!(rc_i >= stop_below)) { j0 = c->ns; break; }
+    }
   }
   phgmg__free(c->alloc, Lp);
+  phgmg__free(c->alloc, ip);
   return PHGMG_OK;
 }
 
@@ -8434,6 +8559,34 @@ PHGMG_DEF phgmg_result phgmg_simulate_inputs(const phgmg_ph_system *sys, int nru
   return rc;
 }
 
+/* XR (r x ns) = rho of the snapshots: from the study's coordinates on its
+   bases (GMG: [RB^{-1} QB^T x; Ua_1..p^T Xa]; SP: Ainv^T Vg^T x), else
+   phgmg__restrict_block. */
+PHGMG__PRIV void phgmg__restrict_snapshots(const phgmg__rctx *c, double *XR) {
+  const phgmg_reduced *red = c->red;
+  const phgmg_study *st = c->st;
+  const int r = red->r, m = red->m, ns = c->ns;
+  int i, j, k;
+  if (c->sf == 1) {
+    for (k = 0; k < ns; ++k) {
+      double *xr = XR + (size_t)k * r;
+      memcpy(xr, st->CB + (size_t)k * m, (size_t)m * sizeof(double));
+      for (i = m - 1; i >= 0; --i) {
+        double sm = xr[i];
+        for (j = i + 1; j < m; ++j) sm -= red->RB[i + j * m] * xr[j];
+        xr[i] = sm / red->RB[i + i * m];
+      }
+      memcpy(xr + m, st->Ca + (size_t)k * st->ka, (size_t)(r - m) * sizeof(double));
+    }
+  } else if (c->sf == 2 || c->sf == 3) {
+    const double *Cv = c->sf == 2 ? st->Cq : st->Cg;
+    const int ld = c->sf == 2 ? st->kp : st->kg;
+    phgmg_gemm('T', 'N', r, ns, r, 1.0, red->Ainv, r, Cv, ld, 0.0, XR, r);
+  } else {
+    phgmg__restrict_block(red, ns, c->X, c->ldx, XR);
+  }
+}
+
 /* phgmg_rom.q_max: 1.2 max_j ||M (x2_j kron x2_j)|| over the snapshots'
    reduced coordinates x2_j (the final M: run after the lambda validation). */
 PHGMG__PRIV phgmg_result phgmg__q_envelope(phgmg__rctx *c) {
@@ -8444,7 +8597,7 @@ PHGMG__PRIV phgmg_result phgmg__q_envelope(phgmg__rctx *c) {
   red->qmax = phgmg__red_d(red, 1);
   xr = phgmg__dalloc(c->alloc, (size_t)r * c->ns);
   if (!red->qmax || !xr) { phgmg__free(c->alloc, xr); return PHGMG_ERR_NOMEM; }
-  phgmg__restrict_block(red, c->ns, c->X, c->ldx, xr);
+  phgmg__restrict_snapshots(c, xr);
   for (j = 0; j < c->ns; ++j) {
     double s2 = 0.0;
     phgmg__eta_d(red, xr + (size_t)j * r + m, q, NULL, NULL, red->rwork);
@@ -8469,7 +8622,7 @@ PHGMG__PRIV phgmg_result phgmg__stage_envelope(phgmg__rctx *c) {
   red->env = phgmg__red_d(red, 2 * (size_t)r);
   xr = phgmg__dalloc(c->alloc, (size_t)r * c->ns);
   if (!red->env || !xr) { phgmg__free(c->alloc, xr); return PHGMG_ERR_NOMEM; }
-  phgmg__restrict_block(red, c->ns, c->X, c->ldx, xr);
+  phgmg__restrict_snapshots(c, xr);
   for (j = 0; j < c->ns; ++j) {
     const double *xj = xr + (size_t)j * r;
     for (a = 0; a < r; ++a) {
@@ -8703,18 +8856,41 @@ PHGMG__PRIV phgmg_result phgmg__stage_lambda_validate(phgmg__rctx *c) {
 /* Stage 3a, GMG blocks (paper 4.2): G = (J - R)^{-1} through a factorization,
    G00 = V0^T G V0 (and the V2 blocks), Bh = [I; 0], the non-degeneracy
    check, and K = G00^{-1} for the linear map. */
+/* B (nr x ncol, ld nr) = A(i0 : i0+nr, j0 : j0+ncol) (A: ld lda). */
+PHGMG__PRIV void phgmg__subblock(int nr, int ncol, const double *A, int lda, int i0, int j0, double *B) {
+  int i, j;
+  for (j = 0; j < ncol; ++j)
+    for (i = 0; i < nr; ++i) B[i + (size_t)j * nr] = A[(i0 + i) + (size_t)(j0 + j) * lda];
+}
+
+/* The study's G-blocks: [B, V1, V2] are the first r + rn columns of [B, Ua]. */
+PHGMG__PRIV phgmg_result phgmg__study_gmg_blocks(phgmg__rctx *c) {
+  phgmg_reduced *red = c->red;
+  const int r = red->r, rn = red->rn, nf = red->m + c->st->ka;
+  phgmg__subblock(r, r, c->st->Gf, nf, 0, 0, red->G00);
+  if (rn) {
+    phgmg__subblock(r, rn, c->st->Gf, nf, 0, r, red->G01);
+    phgmg__subblock(rn, r, c->st->Gf, nf, r, 0, red->G10);
+    phgmg__subblock(rn, rn, c->st->Gf, nf, r, r, red->G11);
+  }
+  return PHGMG_OK;
+}
+
 PHGMG__PRIV phgmg_result phgmg__stage_gmg_blocks(phgmg__rctx *c) {
   phgmg_reduced *red = c->red;
   const int N = red->N, m = red->m, r = red->r, rn = red->rn;
-  double *GV;
+  double *GV = NULL;
   int j;
-  phgmg_result rc = phgmg_jr_factor_create(&c->jr, c->sys, NULL, c->alloc);
-  if (rc != PHGMG_OK) return rc;
-  GV = phgmg__dalloc(c->alloc, (size_t)N * (r + rn));
-  if (!GV) return PHGMG_ERR_NOMEM;
-  memcpy(GV, red->V0, (size_t)N * r * sizeof(double));
-  if (rn) memcpy(GV + (size_t)N * r, red->V2, (size_t)N * rn * sizeof(double));
-  phgmg_jr_solve(c->jr, 'N', r + rn, GV, N);           /* GV = G [V0, V2] */
+  phgmg_result rc = PHGMG_OK;
+  if (c->sf != 1) {
+    rc = phgmg_jr_factor_create(&c->jr, c->sys, NULL, c->alloc);
+    if (rc != PHGMG_OK) return rc;
+    GV = phgmg__dalloc(c->alloc, (size_t)N * (r + rn));
+    if (!GV) return PHGMG_ERR_NOMEM;
+    memcpy(GV, red->V0, (size_t)N * r * sizeof(double));
+    if (rn) memcpy(GV + (size_t)N * r, red->V2, (size_t)N * rn * sizeof(double));
+    phgmg_jr_solve(c->jr, 'N', r + rn, GV, N);           /* GV = G [V0, V2] */
+  }
   red->G00 = phgmg__red_d(red, (size_t)r * r);
   red->Bh = phgmg__red_d(red, (size_t)r * m);
   if (rn) {
@@ -8726,8 +8902,12 @@ PHGMG__PRIV phgmg_result phgmg__stage_gmg_blocks(phgmg__rctx *c) {
     phgmg__free(c->alloc, GV);
     return PHGMG_ERR_NOMEM;
   }
-  phgmg__atb(N, r, r, red->V0, GV, red->G00);
-  if (rn) {
+  if (c->sf == 1) {
+    phgmg__study_gmg_blocks(c);
+  } else {
+    phgmg__atb(N, r, r, red->V0, GV, red->G00);
+  }
+  if (rn && c->sf != 1) {
     phgmg__atb(N, r, rn, red->V0, GV + (size_t)N * r, red->G01);
     phgmg__atb(N, rn, r, red->V2, GV, red->G10);
     phgmg__atb(N, rn, rn, red->V2, GV + (size_t)N * r, red->G11);
@@ -8790,8 +8970,10 @@ PHGMG__PRIV phgmg_result phgmg__stage_sp_blocks(phgmg__rctx *c) {
     red->W = phgmg__red_d(red, (size_t)N * r);
     red->K = phgmg__red_d(red, (size_t)r * r);
     red->Bh = phgmg__red_d(red, (size_t)r * m);
-    if (!red->W || !red->K || !red->Bh) rc = PHGMG_ERR_NOMEM;
+    red->Ainv = phgmg__red_d(red, (size_t)r * r);
+    if (!red->W || !red->K || !red->Bh || !red->Ainv) rc = PHGMG_ERR_NOMEM;
   }
+  if (rc == PHGMG_OK) memcpy(red->Ainv, Ainv, (size_t)r * r * sizeof(double));
   if (rc == PHGMG_OK) {
     phgmg_gemm('N', 'N', N, r, r, 1.0, Vg, N, Ainv, r, 0.0, red->W, N);
     phgmg_ph_apply(c->sys, 'J', r, red->W, N, Vg, N);
@@ -8817,14 +8999,23 @@ PHGMG__PRIV phgmg_result phgmg__stage_quadratic_terms(phgmg__rctx *c) {
     red->Q11 = phgmg__red_d(red, (size_t)rn * rn);
   }
   if (!QV || !red->Qh || (rn && (!red->Q01 || !red->Q11))) { phgmg__free(c->alloc, QV); return PHGMG_ERR_NOMEM; }
-  phgmg_ph_apply(c->sys, 'Q', r, red->V0, N, QV, N);
-  if (rn) phgmg_ph_apply(c->sys, 'Q', rn, red->V2, N, QV + (size_t)N * r, N);
-  phgmg__atb(N, r, r, red->V0, QV, red->Qh);
+  if (c->sf == 1) { /* sub-blocks of the study's [B, Ua]^T Q [B, Ua] */
+    const int nf = red->m + c->st->ka;
+    phgmg__subblock(r, r, c->st->Qf, nf, 0, 0, red->Qh);
+    if (rn) {
+      phgmg__subblock(r, rn, c->st->Qf, nf, 0, r, red->Q01);
+      phgmg__subblock(rn, rn, c->st->Qf, nf, r, r, red->Q11);
+    }
+  } else {
+    phgmg_ph_apply(c->sys, 'Q', r, red->V0, N, QV, N);
+    if (rn) phgmg_ph_apply(c->sys, 'Q', rn, red->V2, N, QV + (size_t)N * r, N);
+    phgmg__atb(N, r, r, red->V0, QV, red->Qh);
+  }
   for (j = 0; j < r; ++j)
     for (i = 0; i < j; ++i)
       red->Qh[i + (size_t)j * r] = red->Qh[j + (size_t)i * r] =
           0.5 * (red->Qh[i + (size_t)j * r] + red->Qh[j + (size_t)i * r]);
-  if (rn) {
+  if (rn && c->sf != 1) {
     phgmg__atb(N, r, rn, red->V0, QV + (size_t)N * r, red->Q01);
     phgmg__atb(N, rn, rn, red->V2, QV + (size_t)N * r, red->Q11);
   }
@@ -9021,9 +9212,24 @@ PHGMG__PRIV phgmg_result phgmg__stage_general_term(phgmg__rctx *c) {
   return red->gwork ? PHGMG_OK : PHGMG_ERR_NOMEM;
 }
 
-PHGMG_DEF phgmg_result phgmg_reduce(phgmg_reduced **out, const phgmg_ph_system *sys, const double *X,
-                                    int ldx, int ns, const phgmg_reduce_opts *opts,
-                                    phgmg_reduce_info *info, const phgmg_allocator *alloc) {
+/* Which fast path of a study applies to opts (0: none): the study's own
+   bases, orders within its modes (phgmg_study_reduce). */
+PHGMG__PRIV int phgmg__study_fast(const phgmg_study *st, const phgmg_reduce_opts *o, int m) {
+  if (!st) return 0;
+  if ((o->method == PHGMG_METHOD_GMG_POD || (o->method == PHGMG_METHOD_GMG_QM && o->manifold == 0)) && st->Ua &&
+      o->pod_basis == st->Ua && o->r - m + (o->method == PHGMG_METHOD_GMG_QM ? (o->rn > 0 ? o->rn : 8) : 0) <= st->ka)
+    return 1;
+  if (o->method == PHGMG_METHOD_SP1 && st->Up && st->Cq && o->pod_basis == st->Up && o->r <= st->kp) return 2;
+  if (o->method == PHGMG_METHOD_SP2 && st->Up && st->Ug && o->pod_basis == st->Up && o->grad_basis == st->Ug &&
+      o->r <= st->kp && o->r <= st->kg)
+    return 3;
+  return 0;
+}
+
+PHGMG__PRIV phgmg_result phgmg__reduce_run(phgmg_reduced **out, const phgmg_ph_system *sys, const double *X,
+                                           int ldx, int ns, const phgmg_reduce_opts *opts,
+                                           phgmg_reduce_info *info, const phgmg_allocator *alloc,
+                                           const phgmg_study *st) {
   phgmg__rctx c;
   phgmg_result rc;
   if (!out) return PHGMG_ERR_INVALID_ARG;
@@ -9031,6 +9237,8 @@ PHGMG_DEF phgmg_result phgmg_reduce(phgmg_reduced **out, const phgmg_ph_system *
   if (!sys || !X || !opts) return PHGMG_ERR_INVALID_ARG;
   memset(&c, 0, sizeof c);
   c.sys = sys; c.o = opts; c.X = X; c.ldx = ldx; c.ns = ns; c.alloc = alloc; c.gsel = -1;
+  c.st = st;
+  c.sf = phgmg__study_fast(st, opts, sys->m);
   c.inf.hyper_method = -1;
   rc = phgmg__reduce_check(sys, X, ldx, ns, opts);
   if (rc == PHGMG_OK) rc = phgmg_ph_validate(sys, 0.0, &c.inf.rcond_jr, alloc);
@@ -9047,6 +9255,7 @@ PHGMG_DEF phgmg_result phgmg_reduce(phgmg_reduced **out, const phgmg_ph_system *
   c.rfloor = phgmg__rank_floor(sys->N, ns, X, ldx);
   rc = phgmg__runs_layout(&c);
   if (rc == PHGMG_OK) rc = phgmg__reduce_new(&c);
+  if (rc == PHGMG_OK && c.sf) { c.red->study = st; c.red->sbasis = c.sf; }
   if (rc == PHGMG_OK) rc = phgmg__stage_basis(&c);
   if (rc == PHGMG_OK) rc = phgmg__stage_manifold(&c);
   if (rc == PHGMG_OK) rc = phgmg__is_gmg(opts->method) ? phgmg__stage_gmg_blocks(&c) : phgmg__stage_sp_blocks(&c);
@@ -9071,6 +9280,12 @@ PHGMG_DEF phgmg_result phgmg_reduce(phgmg_reduced **out, const phgmg_ph_system *
   }
   *out = c.red;
   return PHGMG_OK;
+}
+
+PHGMG_DEF phgmg_result phgmg_reduce(phgmg_reduced **out, const phgmg_ph_system *sys, const double *X,
+                                    int ldx, int ns, const phgmg_reduce_opts *opts,
+                                    phgmg_reduce_info *info, const phgmg_allocator *alloc) {
+  return phgmg__reduce_run(out, sys, X, ldx, ns, opts, info, alloc, NULL);
 }
 
 PHGMG_DEF void phgmg_reduced_lift(const phgmg_reduced *red, const double *xr, double *x) {
@@ -9375,6 +9590,289 @@ PHGMG_DEF double phgmg_err_lowerbound(const phgmg_reduced *red, const double *X,
 PHGMG_DEF void phgmg_err_energy(const phgmg_energy *energy, int nsteps, double *e) {
   int n;
   for (n = 0; n <= nsteps; ++n) e[n] = fabs(energy->H[n] - energy->H[0] - energy->S[n] + energy->D[n]);
+}
+
+/* --- studies (phgmg_study_*) ------------------------------------------- */
+PHGMG_DEF void phgmg_study_destroy(phgmg_study *st) {
+  phgmg_allocator a;
+  const phgmg_allocator *al;
+  if (!st) return;
+  a = st->alloc;
+  al = st->use_alloc ? &a : NULL;
+  phgmg__free(al, st->QB); phgmg__free(al, st->Ua); phgmg__free(al, st->Up); phgmg__free(al, st->Ug);
+  phgmg__free(al, st->deim_pts); phgmg__free(al, st->deim_w);
+  phgmg__free(al, st);
+}
+
+PHGMG_DEF const double *phgmg_study_basis(const phgmg_study *st, char which, int *cols) {
+  const double *b = NULL;
+  int k = 0;
+  if (st && which == 'a') { b = st->Ua; k = st->ka; }
+  if (st && which == 'p') { b = st->Up; k = st->kp; }
+  if (st && which == 'g') { b = st->Ug; k = st->kg; }
+  if (cols) *cols = b ? k : 0;
+  return b;
+}
+
+/* sum of squares of an n x ns matrix (ld n). */
+PHGMG__PRIV double phgmg__sumsq(int n, int ns, const double *A, int lda) {
+  double s = 0.0;
+  int i, j;
+  for (j = 0; j < ns; ++j)
+    for (i = 0; i < n; ++i) s += A[i + (size_t)j * lda] * A[i + (size_t)j * lda];
+  return s;
+}
+
+/* POD of T (N x ns, ld N; destroyed) into U (N x kmax): *k = modes with
+   sigma > rfloor; C = U^T T (k x ns); tails Tl[j] = ||T - U_1..j C_1..j||_F^2
+   (j = 0..k) from the residual of all k modes plus squared coordinates. */
+PHGMG__PRIV phgmg_result phgmg__study_pod(const phgmg_study *st, double *T, int kmax, double rfloor, double *U,
+                                          int *k, double *C, double *Tl, const phgmg_allocator *alloc) {
+  const int N = st->N, ns = st->ns;
+  double *S = phgmg__dalloc(alloc, (size_t)kmax);
+  int j, i;
+  phgmg_result rc;
+  if (!S) return PHGMG_ERR_NOMEM;
+  rc = phgmg_pod(N, ns, T, N, kmax, 0.0, U, N, S, k, alloc);
+  for (j = 0; rc == PHGMG_OK && j < *k; ++j)
+    if (!(S[j] > rfloor)) { *k = j; break; }
+  phgmg__free(alloc, S);
+  if (rc != PHGMG_OK) return rc;
+  if (*k < 1) return PHGMG_ERR_SIZE;
+  phgmg_gemm('T', 'N', *k, ns, N, 1.0, U, N, T, N, 0.0, C, *k);
+  if (!Tl) return PHGMG_OK;
+  phgmg_gemm('N', 'N', N, ns, *k, -1.0, U, N, C, *k, 1.0, T, N);   /* T = residual of all k modes */
+  Tl[*k] = phgmg__sumsq(N, ns, T, N);
+  for (j = *k - 1; j >= 0; --j) {
+    double s = 0.0;
+    for (i = 0; i < ns; ++i) s += C[j + (size_t)i * *k] * C[j + (size_t)i * *k];
+    Tl[j] = Tl[j + 1] + s;
+  }
+  return PHGMG_OK;
+}
+
+/* GMG part: Ua, Ca = Ua^T Xa, CB = QB^T X, tails Ta, Gf, Qf. T: N x ns scratch. */
+PHGMG__PRIV phgmg_result phgmg__study_gmg(phgmg_study *st, int kmax, double *T, const phgmg_allocator *alloc) {
+  const int N = st->N, m = st->m, ns = st->ns;
+  const size_t nf = (size_t)m + (size_t)kmax;
+  double *V, *GV;
+  phgmg_jr_factor *jr = NULL;
+  phgmg_result rc;
+  st->Ua = phgmg__dalloc(alloc, (size_t)N * kmax + (size_t)kmax * ns + (size_t)m * ns + (size_t)kmax + 1 + 2 * nf * nf);
+  if (!st->Ua) return PHGMG_ERR_NOMEM;
+  st->Ca = st->Ua + (size_t)N * kmax; st->CB = st->Ca + (size_t)kmax * ns; st->Ta = st->CB + (size_t)m * ns;
+  st->Gf = st->Ta + kmax + 1; st->Qf = st->Gf + nf * nf;
+  rc = phgmg_adjust_snapshots(N, m, st->sys->B, ns, st->X, st->ldx, T, N, alloc);
+  if (rc == PHGMG_OK)
+    rc = phgmg__study_pod(st, T, kmax, phgmg__rank_floor(N, ns, st->X, st->ldx), st->Ua, &st->ka, st->Ca, st->Ta, alloc);
+  if (rc != PHGMG_OK) return rc;
+  phgmg_gemm('T', 'N', m, ns, N, 1.0, st->QB, N, st->X, st->ldx, 0.0, st->CB, m);
+  /* [B, Ua]^T G [B, Ua] and [B, Ua]^T Q [B, Ua] (ld m + ka) */
+  V = phgmg__dalloc(alloc, 2 * (size_t)N * (m + st->ka));
+  if (!V) return PHGMG_ERR_NOMEM;
+  GV = V + (size_t)N * (m + st->ka);
+  memcpy(V, st->sys->B, (size_t)N * m * sizeof(double));
+  memcpy(V + (size_t)N * m, st->Ua, (size_t)N * st->ka * sizeof(double));
+  memcpy(GV, V, (size_t)N * (m + st->ka) * sizeof(double));
+  rc = phgmg_jr_factor_create(&jr, st->sys, NULL, alloc);
+  if (rc == PHGMG_OK) {
+    phgmg_jr_solve(jr, 'N', m + st->ka, GV, N);
+    phgmg__atb(N, m + st->ka, m + st->ka, V, GV, st->Gf);
+    phgmg_ph_apply(st->sys, 'Q', m + st->ka, V, N, GV, N);
+    phgmg__atb(N, m + st->ka, m + st->ka, V, GV, st->Qf);
+  }
+  phgmg_jr_factor_destroy(jr);
+  phgmg__free(alloc, V);
+  return rc;
+}
+
+/* SP part: Up, Cp = Up^T X, tails Tp, Cq = (Q Up)^T X; with SP2 also Ug
+   (POD of the gradient snapshots) and Cg = Ug^T X. T: N x ns scratch. */
+PHGMG__PRIV phgmg_result phgmg__study_sp(phgmg_study *st, int kmax, int sp2, double *T, const phgmg_allocator *alloc) {
+  const int N = st->N, ns = st->ns;
+  int j;
+  phgmg_result rc;
+  st->Up = phgmg__dalloc(alloc, (size_t)N * kmax + 2 * (size_t)kmax * ns + (size_t)kmax + 1);
+  if (!st->Up) return PHGMG_ERR_NOMEM;
+  st->Cp = st->Up + (size_t)N * kmax; st->Cq = st->Cp + (size_t)kmax * ns; st->Tp = st->Cq + (size_t)kmax * ns;
+  for (j = 0; j < ns; ++j) memcpy(T + (size_t)j * N, st->X + (size_t)j * st->ldx, (size_t)N * sizeof(double));
+  rc = phgmg__study_pod(st, T, kmax, phgmg__rank_floor(N, ns, st->X, st->ldx), st->Up, &st->kp, st->Cp, st->Tp, alloc);
+  if (rc != PHGMG_OK) return rc;
+  phgmg_ph_apply(st->sys, 'Q', st->kp, st->Up, N, T, N);                /* Q Up */
+  phgmg_gemm('T', 'N', st->kp, ns, N, 1.0, T, N, st->X, st->ldx, 0.0, st->Cq, st->kp);
+  if (!sp2) return PHGMG_OK;
+  st->Ug = phgmg__dalloc(alloc, (size_t)N * kmax + (size_t)kmax * ns);
+  if (!st->Ug) return PHGMG_ERR_NOMEM;
+  st->Cg = st->Ug + (size_t)N * kmax;
+  for (j = 0; j < ns; ++j) phgmg_ph_gradient(st->sys, st->X + (size_t)j * st->ldx, T + (size_t)j * N);
+  rc = phgmg__study_pod(st, T, kmax, phgmg__rank_floor(N, ns, T, N), st->Ug, &st->kg, st->Cg, NULL, alloc);
+  if (rc == PHGMG_OK)   /* Cg = Ug^T X (the coordinates above were of the gradients) */
+    phgmg_gemm('T', 'N', st->kg, ns, N, 1.0, st->Ug, N, st->X, st->ldx, 0.0, st->Cg, st->kg);
+  return rc;
+}
+
+PHGMG_DEF phgmg_result phgmg_study_create(phgmg_study **out, const phgmg_ph_system *sys, const double *X,
+                                          int ldx, int ns, const phgmg_study_opts *so,
+                                          const phgmg_allocator *alloc) {
+  phgmg_study *st;
+  unsigned what;
+  double *T;
+  int N;
+  phgmg_result rc;
+  if (!out) return PHGMG_ERR_INVALID_ARG;
+  *out = NULL;
+  if (!sys || !X || !so) return PHGMG_ERR_INVALID_ARG;
+  what = so->what ? so->what : (PHGMG_STUDY_GMG | PHGMG_STUDY_SP);
+  if (what & PHGMG_STUDY_SP2) what |= PHGMG_STUDY_SP;
+  N = sys->N;
+  if (N < 1 || sys->m < 1 || ns < 1 || ldx < N || so->kmax < 1 || so->kmax > PHGMG__MIN(N, ns)) return PHGMG_ERR_SIZE;
+  if (!phgmg__mat_finite(N, ns, X, ldx)) return PHGMG_ERR_NANINF;
+  rc = phgmg_ph_validate(sys, 0.0, NULL, alloc);
+  if (rc != PHGMG_OK) return rc;
+  st = PHGMG__CAST(phgmg_study *, phgmg__alloc(alloc, sizeof(phgmg_study)));
+  if (!st) return PHGMG_ERR_NOMEM;
+  memset(st, 0, sizeof *st);
+  if (alloc) { st->alloc = *alloc; st->use_alloc = 1; }
+  st->sys = sys; st->X = X; st->ldx = ldx; st->ns = ns; st->N = N; st->m = sys->m;
+  st->xx = phgmg__sumsq(N, ns, X, ldx);
+  st->QB = phgmg__dalloc(alloc, (size_t)N * sys->m + (size_t)sys->m * sys->m);
+  T = phgmg__dalloc(alloc, (size_t)N * ns);
+  rc = st->QB && T ? PHGMG_OK : PHGMG_ERR_NOMEM;
+  if (rc == PHGMG_OK) {
+    st->RB = st->QB + (size_t)N * sys->m;
+    rc = phgmg__thin_qr(N, sys->m, sys->B, st->QB, st->RB, alloc);
+  }
+  if (rc == PHGMG_OK && (what & PHGMG_STUDY_GMG)) rc = phgmg__study_gmg(st, so->kmax, T, alloc);
+  if (rc == PHGMG_OK && (what & PHGMG_STUDY_SP)) rc = phgmg__study_sp(st, so->kmax, (what & PHGMG_STUDY_SP2) != 0, T, alloc);
+  phgmg__free(alloc, T);
+  if (rc != PHGMG_OK) { phgmg_study_destroy(st); return rc; }
+  *out = st;
+  return PHGMG_OK;
+}
+
+/* The study's DEIM points for opts (computed at the first use, kept while
+   tol, cap and point selection are the same). 0 if not applicable or failed
+   (phgmg_reduce then computes and reports). */
+PHGMG__PRIV int phgmg__study_deim(phgmg_study *st, const phgmg_reduce_opts *o) {
+  const phgmg_ph_system *sys = st->sys;
+  const phgmg_allocator *alloc = st->use_alloc ? &st->alloc : NULL;
+  const int nt = sys->nsep, ns = st->ns;
+  const int meth = o->hyper == PHGMG_HYPER_GREEDY ? PHGMG_DEIM_GREEDY : PHGMG_DEIM_QDEIM;
+  double *F;
+  int a, i;
+  phgmg_result rc;
+  if (o->deim != 1 || o->deim_pts || sys->nl != PHGMG_NL_SEPARABLE || nt < 1 ||
+      (o->hyper != PHGMG_HYPER_QDEIM && o->hyper != PHGMG_HYPER_GREEDY) || !(o->deim_tol >= 0.0 && o->deim_tol < 1.0))
+    return 0;
+  if (st->deim_have && st->deim_tol == o->deim_tol && st->deim_max == o->deim_max && st->deim_method == meth) return 1;
+  st->deim_have = 0;
+  if (!st->deim_pts) st->deim_pts = phgmg__ialloc(alloc, (size_t)nt);
+  if (!st->deim_w) st->deim_w = phgmg__dalloc(alloc, (size_t)nt);
+  F = phgmg__dalloc(alloc, (size_t)nt * ns);
+  if (!st->deim_pts || !st->deim_w || !F) { phgmg__free(alloc, F); return 0; }
+  for (i = 0; i < ns; ++i)
+    for (a = 0; a < nt; ++a)
+      F[a + (size_t)i * nt] = phgmg__ph_phi(sys, a, st->X[sys->sep_idx[a] + (size_t)i * st->ldx], 1);
+  rc = phgmg_deim_select(nt, ns, F, nt, sys->sep_w, o->deim_tol, o->deim_max, meth, st->deim_pts, st->deim_w,
+                         &st->deim_nd, &st->deim_nneg, &st->deim_sigma, alloc);
+  phgmg__free(alloc, F);
+  if (rc != PHGMG_OK) return 0;
+  st->deim_have = 1; st->deim_tol = o->deim_tol; st->deim_max = o->deim_max; st->deim_method = meth;
+  return 1;
+}
+
+PHGMG_DEF phgmg_result phgmg_study_reduce(phgmg_study *st, const phgmg_reduce_opts *opts, phgmg_reduced **out,
+                                          phgmg_reduce_info *info) {
+  phgmg_reduce_opts o;
+  phgmg_result rc;
+  int deim;
+  if (out) *out = NULL;
+  if (!st || !opts || !out) return PHGMG_ERR_INVALID_ARG;
+  o = *opts;
+  if ((o.method == PHGMG_METHOD_GMG_POD || o.method == PHGMG_METHOD_GMG_QM) && st->Ua && !o.pod_basis) {
+    o.pod_basis = st->Ua; o.pod_cols = st->ka;
+  }
+  if ((o.method == PHGMG_METHOD_SP1 || o.method == PHGMG_METHOD_SP2) && st->Up && !o.pod_basis) {
+    o.pod_basis = st->Up; o.pod_cols = st->kp;
+  }
+  if (o.method == PHGMG_METHOD_SP2 && st->Ug && !o.grad_basis) { o.grad_basis = st->Ug; o.grad_cols = st->kg; }
+  deim = phgmg__study_deim(st, &o);
+  if (deim) { o.deim_pts = st->deim_pts; o.deim_w = st->deim_w; o.deim_count = st->deim_nd; }
+  rc = phgmg__reduce_run(out, st->sys, st->X, st->ldx, st->ns, &o, info, st->use_alloc ? &st->alloc : NULL, st);
+  if (info && deim) { info->deim_sigma_ratio = st->deim_sigma; info->hyper_method = o.hyper; }
+  return rc;
+}
+
+/* Squared error sums of a fast-path model over the study's snapshots:
+   s[0] (e_red; needs XR), s[1] (e_proj). GMG: x - phi(xr) = (I - P_k) x +
+   QB (QB^T x - RB xr1) + V1 (Ua1^T x - xr2) + V2 (Ua2^T x - q(xr2)) with
+   orthonormal [QB, V1, V2], k = p + rn; SP: x - V xr = (I - P_r) x + V (Up^T x - xr),
+   rho(x) = Ainv^T Vg^T x. */
+PHGMG__PRIV void phgmg__study_err_sums(const phgmg_study *st, const phgmg_reduced *red, const double *XR, int ldxr,
+                                       double s[2]) {
+  const int m = red->m, r = red->r, p = red->p, rn = red->rn, ns = st->ns;
+  double q[64], q2[64];
+  int i, a, b;
+  if (red->sbasis == 1) {
+    const int ka = st->ka;
+    s[0] = s[1] = st->Ta[p + rn];
+    for (i = 0; i < ns; ++i) {
+      const double *ca = st->Ca + (size_t)i * ka, *cb = st->CB + (size_t)i * m;
+      if (rn) {
+        phgmg__eta_d(red, ca, q, NULL, NULL, red->rwork);
+        for (a = 0; a < rn; ++a) s[1] += (ca[p + a] - q[a]) * (ca[p + a] - q[a]);
+      }
+      if (!XR) continue;
+      {
+        const double *xr = XR + (size_t)i * ldxr;
+        for (a = 0; a < m; ++a) {
+          double d = cb[a];
+          for (b = a; b < m; ++b) d -= red->RB[a + b * m] * xr[b];
+          s[0] += d * d;
+        }
+        for (a = 0; a < p; ++a) s[0] += (ca[a] - xr[m + a]) * (ca[a] - xr[m + a]);
+        if (rn) {
+          phgmg__eta_d(red, xr + m, q2, NULL, NULL, red->rwork);
+          for (a = 0; a < rn; ++a) s[0] += (ca[p + a] - q2[a]) * (ca[p + a] - q2[a]);
+        }
+      }
+    }
+    return;
+  }
+  {
+    const double *Cv = red->sbasis == 2 ? st->Cq : st->Cg;
+    const int ld = red->sbasis == 2 ? st->kp : st->kg, kp = st->kp;
+    s[0] = s[1] = st->Tp[r];
+    for (i = 0; i < ns; ++i) {
+      const double *cp = st->Cp + (size_t)i * kp, *cv = Cv + (size_t)i * ld;
+      for (a = 0; a < r; ++a) {
+        double w = 0.0;
+        for (b = 0; b < r; ++b) w += red->Ainv[b + (size_t)a * r] * cv[b];
+        s[1] += (cp[a] - w) * (cp[a] - w);
+        if (XR) s[0] += (cp[a] - XR[a + (size_t)i * ldxr]) * (cp[a] - XR[a + (size_t)i * ldxr]);
+      }
+    }
+  }
+}
+
+PHGMG_DEF phgmg_result phgmg_study_errors(const phgmg_study *st, const phgmg_reduced *red, const double *XR,
+                                          int ldxr, double *e_red, double *e_proj, double *e_lower) {
+  double s[2];
+  if (!st || !red) return PHGMG_ERR_INVALID_ARG;
+  if (red->N != st->N || red->m != st->m || (XR && ldxr < red->r)) return PHGMG_ERR_SIZE;
+  if (red->study != st || red->sbasis == 0 || red->rn > 64) {
+    if (e_red) *e_red = XR ? phgmg_err_red(red, st->X, st->ldx, st->ns, XR, ldxr) : (double)NAN;
+    if (e_proj) *e_proj = phgmg_err_proj(red, st->X, st->ldx, st->ns);
+    if (e_lower) *e_lower = phgmg_err_lowerbound(red, st->X, st->ldx, st->ns);
+    return PHGMG_OK;
+  }
+  phgmg__study_err_sums(st, red, XR, ldxr, s);
+  if (e_red) *e_red = !XR ? (double)NAN : (st->xx > 0.0 ? sqrt(s[0] / st->xx) : 0.0);
+  if (e_proj) *e_proj = st->xx > 0.0 ? sqrt(s[1] / st->xx) : 0.0;
+  if (e_lower)
+    *e_lower = red->kind != PHGMG_ROM_QUADRATIC ? (double)NAN
+                                                : (st->xx > 0.0 ? sqrt(st->Ta[red->p + red->rn] / st->xx) : 0.0);
+  return PHGMG_OK;
 }
 #endif /* PHGMG_NO_OFFLINE */
 
