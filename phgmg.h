@@ -8680,7 +8680,53 @@ typedef struct phgmg__vset {
   phgmg__probe probe[3];
   double *buf;             /* every Yref, the level, zeros (x0), Yr, xr0 */
   double *Yr, *xr0;
+  int rep[PHGMG__NVAL_MAX];   /* the run simulated for run k (itself, or an identical one) */
+  int order[PHGMG__NVAL_MAX]; /* evaluation order: probes first (they fail first) */
 } phgmg__vset;
+
+/* Do validation runs j and k drive the reduced model identically (same x0,
+   t0, dt, steps, and bit-identical inputs at every stage time, as
+   phgmg_reduced_simulate samples them)? ub: 2m doubles. */
+PHGMG__PRIV int phgmg__vrun_same(const phgmg__rctx *c, const phgmg__vset *v, int j, int k, double *ub) {
+  const int N = c->sys->N, m = c->sys->m;
+  const double s15 = sqrt(15.0) / 10.0, cs[3] = {0.5 - s15, 0.5, 0.5 + s15};
+  int n, i, a;
+  if (v->t0[j] != v->t0[k] || v->dt[j] != v->dt[k] || v->nsteps[j] != v->nsteps[k]) return 0;
+  if (v->x0[j] != v->x0[k] && memcmp(v->x0[j], v->x0[k], (size_t)N * sizeof(double)) != 0) return 0;
+  if (v->u[j] == v->u[k] && v->user[j] == v->user[k]) return 1;
+  for (n = 0; n < v->nsteps[j]; ++n) {
+    const double t = v->t0[j] + n * v->dt[j];
+    for (i = 0; i < 3; ++i) {
+      for (a = 0; a < 2 * m; ++a) ub[a] = 0.0;
+      if (v->u[j]) v->u[j](t + cs[i] * v->dt[j], ub, v->user[j]);
+      if (v->u[k]) v->u[k](t + cs[i] * v->dt[j], ub + m, v->user[k]);
+      if (memcmp(ub, ub + m, (size_t)m * sizeof(double)) != 0) return 0;
+    }
+  }
+  return 1;
+}
+
+/* Evaluation order (probes, then the training runs) and, for each run, the
+   first run in that order that is identical to it (simulated once). */
+PHGMG__PRIV phgmg_result phgmg__vset_dedupe(const phgmg__rctx *c, phgmg__vset *v) {
+  const int nrun = c->o->nrun;
+  double *ub = phgmg__dalloc(c->alloc, 2 * (size_t)c->sys->m);
+  int i, j, n = 0;
+  if (!ub) return PHGMG_ERR_NOMEM;
+  for (i = nrun; i < v->nv; ++i) v->order[n++] = i;
+  for (i = 0; i < nrun && i < v->nv; ++i) v->order[n++] = i;
+  for (i = 0; i < v->nv; ++i) {
+    const int k = v->order[i];
+    v->rep[k] = k;
+    for (j = 0; j < i; ++j)
+      if (v->rep[v->order[j]] == v->order[j] && phgmg__vrun_same(c, v, v->order[j], k, ub)) {
+        v->rep[k] = v->order[j];
+        break;
+      }
+  }
+  phgmg__free(c->alloc, ub);
+  return PHGMG_OK;
+}
 
 PHGMG__PRIV phgmg_result phgmg__vset_build(phgmg__rctx *c, phgmg__vset *v) {
   const phgmg_ph_system *sys = c->sys;
@@ -8719,7 +8765,7 @@ PHGMG__PRIV phgmg_result phgmg__vset_build(phgmg__rctx *c, phgmg__vset *v) {
   memset(&go, 0, sizeof go);
   go.tol = c->o->newton_tol > 0.0 ? c->o->newton_tol : 1e-10;
   go.max_iter = c->o->newton_iter > 0 ? c->o->newton_iter : 20;
-  if (c->o->lambda_train_only) { v->nv = nrun; return PHGMG_OK; }
+  if (c->o->lambda_train_only) { v->nv = nrun; return phgmg__vset_dedupe(c, v); }
   for (k = nrun; k < nrun + 3; ++k) {
     phgmg__probe *p = v->probe + (k - nrun);
     phgmg_result rc;
@@ -8732,27 +8778,39 @@ PHGMG__PRIV phgmg_result phgmg__vset_build(phgmg__rctx *c, phgmg__vset *v) {
     if (rc == PHGMG_ERR_NOMEM) return rc;
     if (rc != PHGMG_OK) { v->nv = k; break; }   /* the full model itself fails: no probe */
   }
-  return PHGMG_OK;
+  return phgmg__vset_dedupe(c, v);
 }
 
 /* Simulate the current reduced model on every validation run: v->ey, and
-   *ok = 0 if a run fails or needs more than 4 Newton iterations per step. */
-PHGMG__PRIV phgmg_result phgmg__vset_eval(phgmg__rctx *c, phgmg__vset *v, int *ok) {
+   *ok = 0 if a run fails or needs more than 4 Newton iterations per step.
+   Identical runs (v->rep) are simulated once. With tolr > 0 (a candidate,
+   not the linear limit), the evaluation stops at the first run that makes
+   the candidate inadmissible (*ok = 0, or an e_y ratio to v->base above
+   tolr): the remaining e_y are not needed (left HUGE_VAL). */
+PHGMG__PRIV phgmg_result phgmg__vset_eval(phgmg__rctx *c, phgmg__vset *v, int *ok, double tolr) {
   const int m = c->sys->m;
   const double tol = c->o->newton_tol;   /* 0: the stepper's default (1e-10 double, 1e-5 float) */
   const int it = c->o->newton_iter > 0 ? c->o->newton_iter : 20;
-  int k;
+  int i, k, j;
   *ok = 1;
-  for (k = 0; k < v->nv; ++k) {
+  for (k = 0; k < v->nv; ++k) v->ey[k] = HUGE_VAL;
+  for (i = 0; i < v->nv; ++i) {
     phgmg_rom_stats st;
     phgmg_result rc;
+    k = v->order[i];
+    if (v->rep[k] != k) continue;
     memset(&st, 0, sizeof st);
     phgmg_reduced_restrict(c->red, v->x0[k], v->xr0);
     rc = phgmg_reduced_simulate(c->red, v->xr0, v->t0[k], v->dt[k], v->nsteps[k], v->u[k], v->user[k], tol, it,
                                 NULL, v->Yr, NULL, &st, c->alloc);
     if (rc == PHGMG_ERR_NOMEM) return rc;
-    v->ey[k] = rc == PHGMG_OK ? phgmg_rel_error(m, v->nsteps[k] + 1, v->Yref[k], m, v->Yr, m) : HUGE_VAL;
-    if (rc != PHGMG_OK || st.newton_iters > 4 * st.steps || !(v->ey[k] < HUGE_VAL)) *ok = 0;
+    for (j = 0; j < v->nv; ++j) {
+      if (v->rep[j] != k) continue;
+      v->ey[j] = rc == PHGMG_OK ? phgmg_rel_error(m, v->nsteps[j] + 1, v->Yref[j], m, v->Yr, m) : HUGE_VAL;
+      if (rc != PHGMG_OK || st.newton_iters > 4 * st.steps || !(v->ey[j] < HUGE_VAL)) *ok = 0;
+      if (tolr > 0.0 && *ok && (v->ey[j] + 1e-14) / (v->base[j] + 1e-14) > tolr) *ok = -1;
+    }
+    if (tolr > 0.0 && *ok != 1) { *ok = *ok < 0; break; }
   }
   return PHGMG_OK;
 }
@@ -8804,13 +8862,13 @@ PHGMG__PRIV phgmg_result phgmg__stage_lambda_validate(phgmg__rctx *c) {
   memset(v, 0, sizeof *v);
   rc = phgmg__vset_build(c, v);
   if (rc == PHGMG_OK) rc = phgmg__qm_set(c, -1, ms);
-  if (rc == PHGMG_OK) rc = phgmg__vset_eval(c, v, &ok);
+  if (rc == PHGMG_OK) rc = phgmg__vset_eval(c, v, &ok, 0.0);
   for (k = 0; k < v->nv && rc == PHGMG_OK; ++k) v->base[k] = v->ey[k] < HUGE_VAL ? v->ey[k] : 1.0;
   /* training runs alone: up from the regression optimum, the first admissible */
   for (g = c->gsel; rc == PHGMG_OK && o->lambda_train_only && g < c->ng; g += pd) {
     double worst = 0.0;
     rc = phgmg__qm_set(c, g, ms);
-    if (rc == PHGMG_OK) rc = phgmg__vset_eval(c, v, &ok);
+    if (rc == PHGMG_OK) rc = phgmg__vset_eval(c, v, &ok, tolr);
     if (rc != PHGMG_OK) break;
     c->inf.lambda_candidates++;
     for (k = 0; k < v->nv && ok; ++k) worst = PHGMG__MAX(worst, (v->ey[k] + 1e-14) / (v->base[k] + 1e-14));
@@ -8820,7 +8878,7 @@ PHGMG__PRIV phgmg_result phgmg__stage_lambda_validate(phgmg__rctx *c) {
        g = (g - pd >= c->gsel || g == c->gsel) ? g - pd : c->gsel) {
     double score = 0.0, worst = 0.0;
     rc = phgmg__qm_set(c, g, ms);
-    if (rc == PHGMG_OK) rc = phgmg__vset_eval(c, v, &ok);
+    if (rc == PHGMG_OK) rc = phgmg__vset_eval(c, v, &ok, tolr);
     if (rc != PHGMG_OK) break;
     c->inf.lambda_candidates++;
     for (k = 0; k < v->nv && ok; ++k) {
