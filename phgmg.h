@@ -6028,13 +6028,16 @@ PHGMG_DEF size_t phgmg_rom_eval_work_size(const phgmg_rom *rom) {
    eta_cb: one call gives q, Lp = Dq (and D2q into w->D2 when w->d2). */
 PHGMG__ONLINE void phgmg__rom_prep(const phgmg_rom *rom, const phgmg_real *x, const phgmg__romw *w) {
   const int r = rom->r, m = rom->m, rn = rom->rn, nd = rom->nd, p = r - m;
-  int i, k;
+  int i;
   if (rom->kind == PHGMG_ROM_QUADRATIC && rom->eta_cb) {
     rom->eta_cb(x + m, w->q, w->Lp, w->d2 ? w->D2 : NULL, rom->eta_user);
   } else if (rom->kind == PHGMG_ROM_QUADRATIC) {
     const phgmg_real *x2 = x + m;
-    for (k = 0; k < p; ++k) /* Lp(:,k) = sum_j Ms(:, k*p + j) x2_j: block k of Ms times x2 */
-      phgmg__r_gemv(rn, p, rom->Ms + (size_t)k * p * rn, x2, 0, w->Lp + (size_t)k * rn);
+    /* Lp(:,k) = sum_j Ms(:, k*p + j) x2_j. Ms is symmetrised (Ms(:, k*p + j) =
+       Ms(:, j*p + k)), so all of Lp (rn p) is one product of the (rn p) x p
+       matrix whose column j is Ms(:, j*p .. j*p + p - 1) with x2: the same
+       products in the same order as block k of Ms times x2, in one sweep. */
+    phgmg__r_gemv(rn * p, p, rom->Ms, x2, 0, w->Lp);
     phgmg__r_gemv(rn, p, w->Lp, x2, 0, w->q);
     for (i = 0; i < rn; ++i) w->q[i] *= PHGMG__R(0.5);
   }
