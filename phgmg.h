@@ -6854,6 +6854,14 @@ struct phgmg_study {
   double deim_tol, deim_sigma;
   int *deim_pts;
   double *deim_w;
+  /* lambda_auto = 1 validation data (first use): the snapshots' outputs
+     B^T grad H(x_j) (m x ns), and the probe runs' full-model outputs for
+     one runs[0] (key: its input, x0 (copy), t0, dt, steps; Newton settings) */
+  double *Yt, *Yp, *px0;
+  int pnv, pn, pit, phave;
+  phgmg_input_fn pu;
+  void *puser;
+  double pt0, pdt, ptol;
 };
 
 PHGMG__PRIV void *phgmg__red_alloc(phgmg_reduced *red, size_t bytes) {
@@ -8089,7 +8097,7 @@ typedef struct phgmg__rctx {
   double *Tq;              /* ridge problem Kt, Rqt, Mt kept for a refit   */
   phgmg_jr_factor *jr;     /* factorization of J - R (GMG)                 */
   int *runcol;             /* opts.runs: nrun + 1 column offsets (NULL: one run) */
-  const phgmg_study *st;   /* phgmg_study_reduce: the study (else NULL)     */
+  phgmg_study *st;         /* phgmg_study_reduce: the study (else NULL)     */
   int sf;                  /* fast path on the study's basis: 1 GMG, 2 SP1, 3 SP2 (0: none) */
 } phgmg__rctx;
 
@@ -8731,6 +8739,49 @@ PHGMG__PRIV phgmg_result phgmg__vset_dedupe(const phgmg__rctx *c, phgmg__vset *v
   return PHGMG_OK;
 }
 
+/* A study's cache of the probe runs' reference outputs (v->Yref of runs
+   nrun..nrun+2, v->nv) for one runs[0] and Newton setting. store = 0: fill
+   v from the cache if it matches (returns 1); store = 1: keep v's. */
+PHGMG__PRIV int phgmg__study_probes(phgmg__rctx *c, phgmg__vset *v, const double *level, const double *zero,
+                                    size_t off, const phgmg_gl3_opts *go, int store) {
+  phgmg_study *st = c->st;
+  const phgmg_run *r0 = c->o->runs;
+  const int N = c->sys->N, m = c->sys->m, nrun = c->o->nrun;
+  const double *x0 = r0->x0 ? r0->x0 : zero;
+  const size_t ny = (size_t)m * (r0->nsteps + 1);
+  int k;
+  if (!st) return 0;
+  if (!store) {
+    if (!st->phave || st->pu != r0->u || st->puser != r0->user || st->pt0 != r0->t0 || st->pdt != r0->dt ||
+        st->pn != r0->nsteps || st->ptol != go->tol || st->pit != go->max_iter ||
+        memcmp(st->px0, x0, (size_t)N * sizeof(double)) != 0)
+      return 0;
+    v->nv = st->pnv;
+    for (k = nrun; k < nrun + 3; ++k) {
+      phgmg__probe *p = v->probe + (k - nrun);
+      p->run = r0; p->level = level; p->mode = k - nrun; p->m = m;
+      v->u[k] = phgmg__probe_u; v->user[k] = p; v->x0[k] = x0;
+      v->t0[k] = r0->t0; v->dt[k] = r0->dt; v->nsteps[k] = r0->nsteps;
+      v->Yref[k] = v->buf + off + (size_t)(k - nrun) * ny;
+      if (k < v->nv) memcpy(v->Yref[k], st->Yp + (size_t)(k - nrun) * ny, ny * sizeof(double));
+    }
+    return 1;
+  }
+  {
+    const phgmg_allocator *sa = st->use_alloc ? &st->alloc : NULL;
+    phgmg__free(sa, st->Yp);
+    st->phave = 0;
+    st->Yp = phgmg__dalloc(sa, 3 * ny + (size_t)N);
+    if (!st->Yp) return 0;
+    st->px0 = st->Yp + 3 * ny;
+    memcpy(st->px0, x0, (size_t)N * sizeof(double));
+    for (k = nrun; k < v->nv; ++k) memcpy(st->Yp + (size_t)(k - nrun) * ny, v->Yref[k], ny * sizeof(double));
+    st->pnv = v->nv; st->pu = r0->u; st->puser = r0->user; st->pt0 = r0->t0; st->pdt = r0->dt; st->pn = r0->nsteps;
+    st->ptol = go->tol; st->pit = go->max_iter; st->phave = 1;
+  }
+  return 1;
+}
+
 PHGMG__PRIV phgmg_result phgmg__vset_build(phgmg__rctx *c, phgmg__vset *v) {
   const phgmg_ph_system *sys = c->sys;
   const phgmg_run *run = c->o->runs;
@@ -8747,12 +8798,24 @@ PHGMG__PRIV phgmg_result phgmg__vset_build(phgmg__rctx *c, phgmg__vset *v) {
   if (!v->buf) return PHGMG_ERR_NOMEM;
   level = v->buf + tot; zero = level + m; g = zero + N; v->Yr = g + N; v->xr0 = v->Yr + (size_t)m * v->nmax;
   memset(zero, 0, (size_t)N * sizeof(double));
+  if (c->st && !c->st->Yt) {   /* a study keeps the snapshots' outputs */
+    const phgmg_allocator *sa = c->st->use_alloc ? &c->st->alloc : NULL;
+    c->st->Yt = phgmg__dalloc(sa, (size_t)m * c->ns);
+    for (j = 0; c->st->Yt && j < c->ns; ++j) {
+      phgmg_ph_gradient(sys, c->X + (size_t)j * c->ldx, g);
+      phgmg_gemv('T', N, m, 1.0, sys->B, N, g, 0.0, c->st->Yt + (size_t)j * m);
+    }
+  }
   for (k = 0, off = 0; k < nrun; ++k) {   /* training runs: y = B^T grad H(x_j) */
     v->u[k] = run[k].u; v->user[k] = run[k].user; v->x0[k] = c->X + (size_t)c->runcol[k] * c->ldx;
     v->t0[k] = run[k].t0; v->dt[k] = run[k].dt; v->nsteps[k] = run[k].nsteps; v->Yref[k] = v->buf + off;
-    for (j = 0; j <= run[k].nsteps; ++j) {
-      phgmg_ph_gradient(sys, c->X + (size_t)(c->runcol[k] + j) * c->ldx, g);
-      phgmg_gemv('T', N, m, 1.0, sys->B, N, g, 0.0, v->Yref[k] + (size_t)j * m);
+    if (c->st && c->st->Yt) {
+      memcpy(v->Yref[k], c->st->Yt + (size_t)c->runcol[k] * m, (size_t)m * (run[k].nsteps + 1) * sizeof(double));
+    } else {
+      for (j = 0; j <= run[k].nsteps; ++j) {
+        phgmg_ph_gradient(sys, c->X + (size_t)(c->runcol[k] + j) * c->ldx, g);
+        phgmg_gemv('T', N, m, 1.0, sys->B, N, g, 0.0, v->Yref[k] + (size_t)j * m);
+      }
     }
     off += (size_t)m * (run[k].nsteps + 1);
   }
@@ -8769,6 +8832,7 @@ PHGMG__PRIV phgmg_result phgmg__vset_build(phgmg__rctx *c, phgmg__vset *v) {
   go.tol = c->o->newton_tol > 0.0 ? c->o->newton_tol : 1e-10;
   go.max_iter = c->o->newton_iter > 0 ? c->o->newton_iter : 20;
   if (c->o->lambda_train_only) { v->nv = nrun; return phgmg__vset_dedupe(c, v); }
+  if (phgmg__study_probes(c, v, level, zero, off, &go, 0)) return phgmg__vset_dedupe(c, v);
   for (k = nrun; k < nrun + 3; ++k) {
     phgmg__probe *p = v->probe + (k - nrun);
     phgmg_result rc;
@@ -8781,6 +8845,7 @@ PHGMG__PRIV phgmg_result phgmg__vset_build(phgmg__rctx *c, phgmg__vset *v) {
     if (rc == PHGMG_ERR_NOMEM) return rc;
     if (rc != PHGMG_OK) { v->nv = k; break; }   /* the full model itself fails: no probe */
   }
+  phgmg__study_probes(c, v, level, zero, 0, &go, 1);
   return phgmg__vset_dedupe(c, v);
 }
 
@@ -9290,7 +9355,7 @@ PHGMG__PRIV int phgmg__study_fast(const phgmg_study *st, const phgmg_reduce_opts
 PHGMG__PRIV phgmg_result phgmg__reduce_run(phgmg_reduced **out, const phgmg_ph_system *sys, const double *X,
                                            int ldx, int ns, const phgmg_reduce_opts *opts,
                                            phgmg_reduce_info *info, const phgmg_allocator *alloc,
-                                           const phgmg_study *st) {
+                                           phgmg_study *st) {
   phgmg__rctx c;
   phgmg_result rc;
   if (!out) return PHGMG_ERR_INVALID_ARG;
@@ -9662,6 +9727,7 @@ PHGMG_DEF void phgmg_study_destroy(phgmg_study *st) {
   al = st->use_alloc ? &a : NULL;
   phgmg__free(al, st->QB); phgmg__free(al, st->Ua); phgmg__free(al, st->Up); phgmg__free(al, st->Ug);
   phgmg__free(al, st->deim_pts); phgmg__free(al, st->deim_w);
+  phgmg__free(al, st->Yt); phgmg__free(al, st->Yp);
   phgmg__free(al, st);
 }
 
