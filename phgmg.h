@@ -1284,7 +1284,7 @@ PHGMG_DEF phgmg_result phgmg_study_reduce(phgmg_study *st, const phgmg_reduce_op
    GMG-QM / GMG_MANIFOLD), each output may be NULL. Through coordinates
    (O(ns r^2)) for a model the study built on its bases; else
    phgmg_err_red / _proj / _lowerbound on the study's X. PHGMG_ERR_INVALID_ARG
-   (NULL st or red), _SIZE (red not of the study's N, m). */
+   (NULL st or red), _SIZE (red not of the study's N, m), _NOMEM. */
 PHGMG_DEF phgmg_result phgmg_study_errors(const phgmg_study *st, const phgmg_reduced *red, const double *XR,
                                           int ldxr, double *e_red, double *e_proj, double *e_lower);
 
@@ -9930,41 +9930,68 @@ PHGMG_DEF phgmg_result phgmg_study_reduce(phgmg_study *st, const phgmg_reduce_op
   return rc;
 }
 
+/* Q (rn x nb) = M (x2_i kron x2_i) of the built-in quadratic map for nb
+   points x2_i = X2(:, i) (ld ld2), as one GEMM; K: p^2 x nb scratch. */
+PHGMG__PRIV void phgmg__q_block(const phgmg_reduced *red, int nb, const double *X2, int ld2, double *K, double *Q) {
+  const int p = red->p, rn = red->rn;
+  int i, a, j;
+  for (i = 0; i < nb; ++i) {
+    const double *x = X2 + (size_t)i * ld2;
+    double *k = K + (size_t)i * p * p;
+    for (a = 0; a < p; ++a)
+      for (j = 0; j < p; ++j) k[a * p + j] = x[a] * x[j];
+  }
+  phgmg_gemm('N', 'N', rn, nb, p * p, 1.0, red->M, rn, K, p * p, 0.0, Q, rn);
+}
+
+/* Squared error sums of a fast-path GMG model, snapshots j0..j0+nb-1:
+   x - phi(xr) = (I - P_k) x + QB (QB^T x - RB xr1) + V1 (Ua1^T x - xr2) +
+   V2 (Ua2^T x - q(xr2)) with orthonormal [QB, V1, V2], k = p + rn (the tail
+   is added by the caller); q by phgmg__q_block. w: p^2 nb + 2 rn nb. */
+PHGMG__PRIV void phgmg__study_err_gmg(const phgmg_study *st, const phgmg_reduced *red, const double *XR, int ldxr,
+                                      int j0, int nb, double *w, double s[2]) {
+  const int m = red->m, p = red->p, rn = red->rn, ka = st->ka;
+  double *K = w, *Q1 = K + (size_t)p * p * nb, *Q2 = Q1 + (size_t)rn * nb;
+  int i, a, b;
+  if (rn) {
+    phgmg__q_block(red, nb, st->Ca + (size_t)j0 * ka, ka, K, Q1);
+    if (XR) phgmg__q_block(red, nb, XR + (size_t)j0 * ldxr + m, ldxr, K, Q2);
+  }
+  for (i = 0; i < nb; ++i) {
+    const double *ca = st->Ca + (size_t)(j0 + i) * ka, *cb = st->CB + (size_t)(j0 + i) * m;
+    for (a = 0; a < rn; ++a) s[1] += (ca[p + a] - Q1[a + (size_t)i * rn]) * (ca[p + a] - Q1[a + (size_t)i * rn]);
+    if (XR) {
+      const double *xr = XR + (size_t)(j0 + i) * ldxr;
+      for (a = 0; a < m; ++a) {
+        double d = cb[a];
+        for (b = a; b < m; ++b) d -= red->RB[a + b * m] * xr[b];
+        s[0] += d * d;
+      }
+      for (a = 0; a < p; ++a) s[0] += (ca[a] - xr[m + a]) * (ca[a] - xr[m + a]);
+      for (a = 0; a < rn; ++a) s[0] += (ca[p + a] - Q2[a + (size_t)i * rn]) * (ca[p + a] - Q2[a + (size_t)i * rn]);
+    }
+  }
+}
+
 /* Squared error sums of a fast-path model over the study's snapshots:
-   s[0] (e_red; needs XR), s[1] (e_proj). GMG: x - phi(xr) = (I - P_k) x +
-   QB (QB^T x - RB xr1) + V1 (Ua1^T x - xr2) + V2 (Ua2^T x - q(xr2)) with
-   orthonormal [QB, V1, V2], k = p + rn; SP: x - V xr = (I - P_r) x + V (Up^T x - xr),
-   rho(x) = Ainv^T Vg^T x. */
-PHGMG__PRIV void phgmg__study_err_sums(const phgmg_study *st, const phgmg_reduced *red, const double *XR, int ldxr,
-                                       double s[2]) {
-  const int m = red->m, r = red->r, p = red->p, rn = red->rn, ns = st->ns;
-  double q[64], q2[64];
+   s[0] (e_red; needs XR), s[1] (e_proj). GMG: phgmg__study_err_gmg; SP:
+   x - V xr = (I - P_r) x + V (Up^T x - xr), rho(x) = Ainv^T Vg^T x.
+   0 if the workspace cannot be allocated. */
+PHGMG__PRIV int phgmg__study_err_sums(const phgmg_study *st, const phgmg_reduced *red, const double *XR, int ldxr,
+                                      double s[2]) {
+  const int r = red->r, ns = st->ns;
   int i, a, b;
   if (red->sbasis == 1) {
-    const int ka = st->ka;
+    const phgmg_allocator *alloc = red->use_alloc ? &red->alloc : NULL;
+    const int nbmax = PHGMG__ERR_NB, p = red->p, rn = red->rn;
+    double *w = phgmg__dalloc(alloc, (size_t)nbmax * ((size_t)p * p + 2 * (size_t)rn) + 1);
+    int j0;
+    if (!w) return 0;
     s[0] = s[1] = st->Ta[p + rn];
-    for (i = 0; i < ns; ++i) {
-      const double *ca = st->Ca + (size_t)i * ka, *cb = st->CB + (size_t)i * m;
-      if (rn) {
-        phgmg__eta_d(red, ca, q, NULL, NULL, red->rwork);
-        for (a = 0; a < rn; ++a) s[1] += (ca[p + a] - q[a]) * (ca[p + a] - q[a]);
-      }
-      if (!XR) continue;
-      {
-        const double *xr = XR + (size_t)i * ldxr;
-        for (a = 0; a < m; ++a) {
-          double d = cb[a];
-          for (b = a; b < m; ++b) d -= red->RB[a + b * m] * xr[b];
-          s[0] += d * d;
-        }
-        for (a = 0; a < p; ++a) s[0] += (ca[a] - xr[m + a]) * (ca[a] - xr[m + a]);
-        if (rn) {
-          phgmg__eta_d(red, xr + m, q2, NULL, NULL, red->rwork);
-          for (a = 0; a < rn; ++a) s[0] += (ca[p + a] - q2[a]) * (ca[p + a] - q2[a]);
-        }
-      }
-    }
-    return;
+    for (j0 = 0; j0 < ns; j0 += nbmax)
+      phgmg__study_err_gmg(st, red, XR, ldxr, j0, PHGMG__MIN(nbmax, ns - j0), w, s);
+    phgmg__free(alloc, w);
+    return 1;
   }
   {
     const double *Cv = red->sbasis == 2 ? st->Cq : st->Cg;
@@ -9980,6 +10007,7 @@ PHGMG__PRIV void phgmg__study_err_sums(const phgmg_study *st, const phgmg_reduce
       }
     }
   }
+  return 1;
 }
 
 PHGMG_DEF phgmg_result phgmg_study_errors(const phgmg_study *st, const phgmg_reduced *red, const double *XR,
@@ -9993,7 +10021,7 @@ PHGMG_DEF phgmg_result phgmg_study_errors(const phgmg_study *st, const phgmg_red
     if (e_lower) *e_lower = phgmg_err_lowerbound(red, st->X, st->ldx, st->ns);
     return PHGMG_OK;
   }
-  phgmg__study_err_sums(st, red, XR, ldxr, s);
+  if (!phgmg__study_err_sums(st, red, XR, ldxr, s)) return PHGMG_ERR_NOMEM;
   if (e_red) *e_red = !XR ? (double)NAN : (st->xx > 0.0 ? sqrt(s[0] / st->xx) : 0.0);
   if (e_proj) *e_proj = st->xx > 0.0 ? sqrt(s[1] / st->xx) : 0.0;
   if (e_lower)
