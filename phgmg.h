@@ -8128,9 +8128,10 @@ PHGMG__PRIV phgmg_result phgmg__deploy_check(const phgmg_reduce_opts *o, int ns)
   return PHGMG_OK;
 }
 
-/* Options and sizes; nothing allocated. */
+/* Options and sizes; nothing allocated. X_checked: X is known finite (a
+   study checked it). */
 PHGMG__PRIV phgmg_result phgmg__reduce_check(const phgmg_ph_system *sys, const double *X, int ldx, int ns,
-                                             const phgmg_reduce_opts *o) {
+                                             const phgmg_reduce_opts *o, int X_checked) {
   const int N = sys->N, m = sys->m, r = o->r;
   if (N < 1 || m < 1 || ns < 1 || ldx < N) return PHGMG_ERR_SIZE;
   if (o->method < PHGMG_METHOD_GMG_POD || o->method > PHGMG_METHOD_GMG_MANIFOLD) return PHGMG_ERR_INVALID_ARG;
@@ -8148,7 +8149,7 @@ PHGMG__PRIV phgmg_result phgmg__reduce_check(const phgmg_ph_system *sys, const d
   if (!(o->dt >= 0.0) || o->dt == HUGE_VAL) return PHGMG_ERR_INVALID_ARG;
   if (o->lambda != o->lambda || !(o->degeneracy_tol >= 0.0 && o->degeneracy_tol < 1.0)) return PHGMG_ERR_INVALID_ARG;
   if (sys->nl == PHGMG_NL_SEPARABLE && sys->poly_deg > 32) return PHGMG_ERR_SIZE;
-  if (!phgmg__mat_finite(N, ns, X, ldx)) return PHGMG_ERR_NANINF; /* padding rows are not data */
+  if (!X_checked && !phgmg__mat_finite(N, ns, X, ldx)) return PHGMG_ERR_NANINF; /* padding rows are not data */
   if (o->lambda_auto) {
     const double lo = o->lambda_min == 0.0 ? 1e-14 : o->lambda_min;
     const double hi = o->lambda_max == 0.0 ? 1.0 : o->lambda_max;
@@ -9366,7 +9367,7 @@ PHGMG__PRIV phgmg_result phgmg__reduce_run(phgmg_reduced **out, const phgmg_ph_s
   c.st = st;
   c.sf = phgmg__study_fast(st, opts, sys->m);
   c.inf.hyper_method = -1;
-  rc = phgmg__reduce_check(sys, X, ldx, ns, opts);
+  rc = phgmg__reduce_check(sys, X, ldx, ns, opts, st != NULL);
   if (rc == PHGMG_OK) rc = phgmg_ph_validate(sys, 0.0, &c.inf.rcond_jr, alloc);
   if (rc != PHGMG_OK) {
     if (info) *info = c.inf;
