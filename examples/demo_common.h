@@ -117,20 +117,25 @@ DEMO_FN void demo_cache_deim(demo_cache *c, const phgmg_ph_system *sys, const do
 }
 
 /* The study of snapshot set X (N x ns, kept by the study: X must outlive
-   the cache): bases of kmax modes, SP2's gradient basis if want_grad. */
-DEMO_FN void demo_cache_build(demo_cache *c, const phgmg_ph_system *sys, const double *X, int ns, int kmax,
-                             int want_grad) {
+   the cache): bases of kmax modes for `what` (PHGMG_STUDY_* flags). */
+DEMO_FN void demo_cache_build_what(demo_cache *c, const phgmg_ph_system *sys, const double *X, int ns, int kmax,
+                                   unsigned what) {
   phgmg_study_opts so;
   phgmg_result rc;
   memset(c, 0, sizeof *c);
   memset(&so, 0, sizeof so);
-  so.what = PHGMG_STUDY_GMG | PHGMG_STUDY_SP | (want_grad ? PHGMG_STUDY_SP2 : 0u);
+  so.what = what;
   so.kmax = kmax;
   rc = phgmg_study_create(&c->st, sys, X, sys->N, ns, &so, NULL);
   if (rc != PHGMG_OK) demo_die("POD of the snapshots", rc);
   c->adj = phgmg_study_basis(c->st, 'a', &c->adj_cols);
   c->plain = phgmg_study_basis(c->st, 'p', &c->plain_cols);
   c->grad = phgmg_study_basis(c->st, 'g', &c->grad_cols);
+}
+/* Every method's bases (GMG and SP1), SP2's gradient basis if want_grad. */
+DEMO_FN void demo_cache_build(demo_cache *c, const phgmg_ph_system *sys, const double *X, int ns, int kmax,
+                             int want_grad) {
+  demo_cache_build_what(c, sys, X, ns, kmax, PHGMG_STUDY_GMG | PHGMG_STUDY_SP | (want_grad ? PHGMG_STUDY_SP2 : 0u));
 }
 DEMO_FN void demo_cache_free(demo_cache *c) { phgmg_study_destroy(c->st); free(c->deim_pts); free(c->deim_w); }
 DEMO_FN void demo_cache_use(const demo_cache *c, phgmg_reduce_opts *o) {
@@ -284,7 +289,7 @@ DEMO_FN void demo_lambda_auto_study(const phgmg_ph_system *sys, const char *out,
     memset(&go, 0, sizeof go); go.tol = newton_tol; go.max_iter = newton_it;
     rc = phgmg_simulate(sys, x0, 0.0, dt, nsteps, inf[in], NULL, &go, X, Y, NULL, NULL, NULL, NULL);
     if (rc != PHGMG_OK) demo_die("full-order simulation", rc);
-    demo_cache_build(&cache, sys, X, ns, rmax + base->rn + 1, 0);
+    demo_cache_build_what(&cache, sys, X, ns, rmax + base->rn + 1, PHGMG_STUDY_GMG); /* GMG-POD, GMG-QM only */
     if (base->deim) demo_cache_deim(&cache, sys, X, ns, base->deim_tol);
     demo_lambda_auto_header(in ? "0.1" : "0.1 sin t");
     for (k = 0; k < nr; ++k) {
