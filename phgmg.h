@@ -6858,6 +6858,9 @@ struct phgmg_study {
      B^T grad H(x_j) (m x ns), and the probe runs' full-model outputs for
      one runs[0] (key: its input, x0 (copy), t0, dt, steps; Newton settings) */
   double *Yt, *Yp, *px0;
+  double *cv;              /* lambda_auto regression errors on the grid (first use; key below) */
+  int cv_p, cv_rn, cv_ng, cv_nf, cv_nb;
+  double cv_lo, cv_hi;
   int pnv, pn, pit, phave;
   phgmg_input_fn pu;
   void *puser;
@@ -8330,9 +8333,24 @@ PHGMG__PRIV phgmg_result phgmg__qm_lambda_auto(phgmg__rctx *c) {
   if (!lg) return PHGMG_ERR_NOMEM;
   phgmg__lambda_grid(o->lambda_min == 0.0 ? 1e-14 : o->lambda_min, o->lambda_max == 0.0 ? 1.0 : o->lambda_max,
                      o->lambda_per_decade == 0 ? 4 : o->lambda_per_decade, lg);
-  rc = phgmg__ridge_cv_runs(ns, nc, rn, c->Tq, ns, c->Tq + (size_t)ns * nc, ns, ng, lg, nfold, nblk,
-                            byrun ? c->runcol : NULL, lg + ng, c->alloc);
-  if (rc != PHGMG_OK) return rc;
+  if (c->sf == 1 && !byrun && c->st->cv && c->st->cv_p == p && c->st->cv_rn == rn && c->st->cv_ng == ng &&
+      c->st->cv_nf == nfold && c->st->cv_nb == nblk && c->st->cv_lo == lg[0] && c->st->cv_hi == lg[ng - 1]) {
+    memcpy(lg + ng, c->st->cv, (size_t)ng * sizeof(double));   /* the study's: same problem, same basis */
+  } else {
+    rc = phgmg__ridge_cv_runs(ns, nc, rn, c->Tq, ns, c->Tq + (size_t)ns * nc, ns, ng, lg, nfold, nblk,
+                              byrun ? c->runcol : NULL, lg + ng, c->alloc);
+    if (rc != PHGMG_OK) return rc;
+    if (c->sf == 1 && !byrun) {
+      const phgmg_allocator *sa = c->st->use_alloc ? &c->st->alloc : NULL;
+      phgmg__free(sa, c->st->cv);
+      c->st->cv = phgmg__dalloc(sa, (size_t)ng);
+      if (c->st->cv) {
+        memcpy(c->st->cv, lg + ng, (size_t)ng * sizeof(double));
+        c->st->cv_p = p; c->st->cv_rn = rn; c->st->cv_ng = ng; c->st->cv_nf = nfold; c->st->cv_nb = nblk;
+        c->st->cv_lo = lg[0]; c->st->cv_hi = lg[ng - 1];
+      }
+    }
+  }
   for (c->gsel = 0, g = 1; g < ng; ++g) if (lg[ng + g] < lg[ng + c->gsel]) c->gsel = g;
   best = lg[ng + c->gsel];
   for (g = ng - 1; g > c->gsel; --g) if (lg[ng + g] <= best * (1.0 + 1e-6)) { c->gsel = g; break; }
@@ -9728,7 +9746,7 @@ PHGMG_DEF void phgmg_study_destroy(phgmg_study *st) {
   al = st->use_alloc ? &a : NULL;
   phgmg__free(al, st->QB); phgmg__free(al, st->Ua); phgmg__free(al, st->Up); phgmg__free(al, st->Ug);
   phgmg__free(al, st->deim_pts); phgmg__free(al, st->deim_w);
-  phgmg__free(al, st->Yt); phgmg__free(al, st->Yp);
+  phgmg__free(al, st->Yt); phgmg__free(al, st->Yp); phgmg__free(al, st->cv);
   phgmg__free(al, st);
 }
 
