@@ -1064,7 +1064,9 @@ typedef struct phgmg_reduce_opts {
      best admissible gain (sum of log ratios); none: M = 0 (info.lambda =
      HUGE_VAL). Without runs, lambda_auto = 1 cannot simulate and keeps M = 0.
      Cost: three full-model probe runs plus (nrun + 3) reduced runs per
-     candidate, 4-8 candidates: 0.3-0.5 s on the paper's linear chain and 1-2.5 s
+     candidate (runs with the same x0 and bit-identical inputs at every
+     stage time are simulated once; a candidate's evaluation stops at its
+     first inadmissible run), 4-8 candidates: 0.3-0.5 s on the paper's linear chain and 1-2.5 s
      on its nonlinear chain (N = 1000, DEIM) at r = 20, 1000 steps. */
   int nrun;
   const phgmg_run *runs;
