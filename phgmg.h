@@ -720,7 +720,8 @@ typedef struct phgmg_rom {
   const phgmg_real *G11;  /* rn x rn V2^T G V2 */
   const phgmg_real *Q01;  /* r x rn  V0^T Q V2 */
   const phgmg_real *Q11;  /* rn x rn V2^T Q V2 */
-  const phgmg_real *Ms;   /* rn x p*p symmetrised M: Ms(:,k*p+j) = M(:,k*p+j) + M(:,j*p+k) */
+  const phgmg_real *Ms;   /* rn x p*p symmetrised M: Ms(:,k*p+j) = M(:,k*p+j) + M(:,j*p+k)
+                             (symmetric in (k, j); the online code may read either order) */
   /* separable nonlinear part (nd > 0) */
   const phgmg_real *P0;   /* nd x r   rows of V0 at the kept coordinates */
   const phgmg_real *P1;   /* nd x rn  rows of V2 (QUADRATIC)             */
