@@ -720,7 +720,8 @@ typedef struct phgmg_rom {
   const phgmg_real *G11;  /* rn x rn V2^T G V2 */
   const phgmg_real *Q01;  /* r x rn  V0^T Q V2 */
   const phgmg_real *Q11;  /* rn x rn V2^T Q V2 */
-  const phgmg_real *Ms;   /* rn x p*p symmetrised M: Ms(:,k*p+j) = M(:,k*p+j) + M(:,j*p+k) */
+  const phgmg_real *Ms;   /* rn x p*p symmetrised M: Ms(:,k*p+j) = M(:,k*p+j) + M(:,j*p+k)
+                             (symmetric in (k, j); the online code may read either order) */
   /* separable nonlinear part (nd > 0) */
   const phgmg_real *P0;   /* nd x r   rows of V0 at the kept coordinates */
   const phgmg_real *P1;   /* nd x rn  rows of V2 (QUADRATIC)             */
@@ -1071,7 +1072,9 @@ typedef struct phgmg_reduce_opts {
      best admissible gain (sum of log ratios); none: M = 0 (info.lambda =
      HUGE_VAL). Without runs, lambda_auto = 1 cannot simulate and keeps M = 0.
      Cost: three full-model probe runs plus (nrun + 3) reduced runs per
-     candidate, 4-8 candidates: 0.3-0.5 s on the paper's linear chain and 1-2.5 s
+     candidate (runs with the same x0 and bit-identical inputs at every
+     stage time are simulated once; a candidate's evaluation stops at its
+     first inadmissible run), 4-8 candidates: 0.3-0.5 s on the paper's linear chain and 1-2.5 s
      on its nonlinear chain (N = 1000, DEIM) at r = 20, 1000 steps. */
   int nrun;
   const phgmg_run *runs;
@@ -1256,6 +1259,69 @@ PHGMG_DEF double phgmg_err_proj(const phgmg_reduced *red, const double *X, int l
 PHGMG_DEF double phgmg_err_lowerbound(const phgmg_reduced *red, const double *X, int ldx, int ns);
 /* e_energy(t_n) = |H[n] - H[0] - S[n] + D[n]| for n = 0..nsteps into e. */
 PHGMG_DEF void phgmg_err_energy(const phgmg_energy *energy, int nsteps, double *e);
+
+/* --- studies over many reduced orders of one snapshot set ---------------
+   phgmg_reduce alone redoes, for every call, work that grows with N ns r:
+   the POD, the snapshots' coordinates, the envelope and non-degeneracy
+   checks over the snapshots, the G- and Q-applications, the error measures.
+   The bases of a study over r are nested (GMG: V0 = [B, Ua_1..p], V2 =
+   Ua_{p+1..p+rn}; SP1/SP2: V = Up_1..r), so a study computes once, for the
+   largest basis: the POD of the adjusted snapshots Xa = X - BB^+X (Ua) and
+   of X (Up) (the hierarchical POD of every order from one factorisation),
+   the gradient snapshots' POD (Ug, SP2), the coordinates Ua^T Xa, QB^T X,
+   Up^T X, (Q Up)^T X, Ug^T X (K x ns), the residual tails
+   T(k) = sum_i ||(I - P_k) x_i||^2 (the part of X outside the first k
+   modes, from ||R_K||_F^2 plus sums of squared coordinates: no
+   cancellation), [B, Ua]^T G [B, Ua] and [B, Ua]^T Q [B, Ua], and the DEIM
+   points (at their first use). phgmg_study_reduce then builds the same
+   model as phgmg_reduce with opts.pod_basis (and grad_basis) set to the
+   study's bases, taking every snapshot quantity from the coordinates
+   (O(K ns r) per model instead of O(N ns r)), and phgmg_study_errors
+   evaluates e_red, e_proj, e_lowerbound in reduced coordinates (the bases
+   are orthonormal: ||x - phi||^2 = T(k) + ||coordinates - reduced
+   values||^2). Results agree with phgmg_reduce + phgmg_err_* to rounding
+   (tests/test_study.c). X must stay unchanged while the study lives. */
+typedef struct phgmg_study phgmg_study;
+#define PHGMG_STUDY_GMG 1u /* GMG-POD / GMG-QM: Ua, coordinates, tails, G- and Q-blocks */
+#define PHGMG_STUDY_SP 2u  /* SP1 (and SP2's trial basis): Up, coordinates, tails    */
+#define PHGMG_STUDY_SP2 4u /* SP2: Ug (POD of grad H(x_i)) and Ug^T X                  */
+typedef struct phgmg_study_opts {
+  unsigned what; /* PHGMG_STUDY_* flags (0: GMG | SP)                                   */
+  int kmax;      /* modes per POD: the largest r - m + rn (GMG) or r (SP) to be asked,
+                    <= min(N, ns) (fewer are kept if the snapshots have lower rank)   */
+} phgmg_study_opts;
+/* Cost: one thin SVD of N x ns per basis asked for plus O(N ns kmax).
+   PHGMG_ERR_INVALID_ARG (NULL), _SIZE (kmax < 1 or > min(N, ns), ldx < N),
+   _NANINF, _RANK (B), _NOMEM, a solve's code (G = (J - R)^{-1}). */
+PHGMG_DEF phgmg_result phgmg_study_create(phgmg_study **out, const phgmg_ph_system *sys, const double *X,
+                                          int ldx, int ns, const phgmg_study_opts *so,
+                                          const phgmg_allocator *alloc);
+PHGMG_DEF void phgmg_study_destroy(phgmg_study *st);
+/* A study's basis, for phgmg_reduce_opts.pod_basis / grad_basis of your own
+   calls: which = 'a' (POD of the adjusted snapshots: GMG), 'p' (POD of X:
+   SP1/SP2), 'g' (POD of the gradient snapshots: SP2). N x *cols, ld N,
+   valid until destroy; NULL (and *cols = 0) if the study has none. */
+PHGMG_DEF const double *phgmg_study_basis(const phgmg_study *st, char which, int *cols);
+/* phgmg_reduce(out, sys, X, ldx, ns, opts', info, alloc) of the study's
+   system and snapshots, with opts' = opts plus the study's bases where
+   opts leaves pod_basis / grad_basis NULL (GMG-POD, GMG-QM, SP1, SP2), and
+   with opts.deim = 1, hyper QDEIM or GREEDY and no deim_pts: the study's
+   DEIM points (computed at the first such call, reused while deim_tol,
+   deim_max and the point selection are the same). The fast path (snapshot
+   quantities from coordinates) applies to GMG-POD, GMG-QM with manifold 0,
+   SP1 and SP2 on the study's own bases and r - m + rn (GMG) / r (SP) within
+   its modes; other models are built exactly as phgmg_reduce builds them.
+   Not thread-safe on one study (the DEIM cache). */
+PHGMG_DEF phgmg_result phgmg_study_reduce(phgmg_study *st, const phgmg_reduce_opts *opts, phgmg_reduced **out,
+                                          phgmg_reduce_info *info);
+/* Error measures over the study's snapshots: e_red of a reduced trajectory
+   XR (r x ns, ldxr; NULL: e_red = NaN), e_proj, e_lowerbound (NaN unless
+   GMG-QM / GMG_MANIFOLD), each output may be NULL. Through coordinates
+   (O(ns r^2)) for a model the study built on its bases; else
+   phgmg_err_red / _proj / _lowerbound on the study's X. PHGMG_ERR_INVALID_ARG
+   (NULL st or red), _SIZE (red not of the study's N, m), _NOMEM. */
+PHGMG_DEF phgmg_result phgmg_study_errors(const phgmg_study *st, const phgmg_reduced *red, const double *XR,
+                                          int ldxr, double *e_red, double *e_proj, double *e_lower);
 
 /* Hierarchical POD of paper 4.2.2: V1 = POD_p(X - BB^+X), V2 = POD_rn of the
    residual (I - [B,V1][B,V1]^+) X. V1: N x p, V2: N x rn. */
@@ -5852,10 +5918,26 @@ PHGMG__ONLINE int phgmg__r_finite(const phgmg_real *a, int n) {
   return acc == PHGMG__R(0);
 }
 
+/* y[0..n) -= a[0..n) * s. Four entries per step as straight-line code: the
+   compiler's SLP vectoriser turns each group into vector operations (no
+   runtime alias checks needed; the loop form stays scalar at -O2 because y
+   might alias a), with the same operations per entry. */
+PHGMG__ONLINE void phgmg__r_axmy(int n, phgmg_real s, const phgmg_real *a, phgmg_real *y) {
+  int i = 0;
+  for (; i + 4 <= n; i += 4) {
+    const phgmg_real a0 = a[i], a1 = a[i + 1], a2 = a[i + 2], a3 = a[i + 3];
+    const phgmg_real y0 = y[i], y1 = y[i + 1], y2 = y[i + 2], y3 = y[i + 3];
+    y[i] = y0 - a0 * s; y[i + 1] = y1 - a1 * s; y[i + 2] = y2 - a2 * s; y[i + 3] = y3 - a3 * s;
+  }
+  for (; i < n; ++i) y[i] -= a[i] * s;
+}
+
 /* y = A x (A: rows x cols, column-major, ld = rows); beta = 0 or 1 (accumulate).
    The small online kernels take four columns per sweep: a quarter of the
    loads and stores of y, and four independent products per element (these
-   sizes are latency-bound, not bandwidth-bound). */
+   sizes are latency-bound, not bandwidth-bound); four rows per step as
+   straight-line code, which the SLP vectoriser turns into vector
+   operations (same operations per entry as the plain loop). */
 PHGMG__ONLINE void phgmg__r_gemv(int rows, int cols, const phgmg_real *A, const phgmg_real *x,
                                  int accumulate, phgmg_real *y) {
   const size_t ld = (size_t)rows;
@@ -5864,13 +5946,17 @@ PHGMG__ONLINE void phgmg__r_gemv(int rows, int cols, const phgmg_real *A, const 
   for (; j + 4 <= cols; j += 4) {
     const phgmg_real x0 = x[j], x1 = x[j + 1], x2 = x[j + 2], x3 = x[j + 3];
     const phgmg_real *a0 = A + (size_t)j * ld, *a1 = a0 + ld, *a2 = a1 + ld, *a3 = a2 + ld;
-    for (i = 0; i < rows; ++i) y[i] += (a0[i] * x0 + a1[i] * x1) + (a2[i] * x2 + a3[i] * x3);
+    for (i = 0; i + 4 <= rows; i += 4) {
+      const phgmg_real t0 = (a0[i] * x0 + a1[i] * x1) + (a2[i] * x2 + a3[i] * x3);
+      const phgmg_real t1 = (a0[i + 1] * x0 + a1[i + 1] * x1) + (a2[i + 1] * x2 + a3[i + 1] * x3);
+      const phgmg_real t2 = (a0[i + 2] * x0 + a1[i + 2] * x1) + (a2[i + 2] * x2 + a3[i + 2] * x3);
+      const phgmg_real t3 = (a0[i + 3] * x0 + a1[i + 3] * x1) + (a2[i + 3] * x2 + a3[i + 3] * x3);
+      const phgmg_real y0 = y[i], y1 = y[i + 1], y2 = y[i + 2], y3 = y[i + 3];
+      y[i] = y0 + t0; y[i + 1] = y1 + t1; y[i + 2] = y2 + t2; y[i + 3] = y3 + t3;
+    }
+    for (; i < rows; ++i) y[i] += (a0[i] * x0 + a1[i] * x1) + (a2[i] * x2 + a3[i] * x3);
   }
-  for (; j < cols; ++j) {
-    const phgmg_real xj = x[j];
-    const phgmg_real *a = A + (size_t)j * ld;
-    for (i = 0; i < rows; ++i) y[i] += a[i] * xj;
-  }
+  for (; j < cols; ++j) phgmg__r_axmy(rows, -x[j], A + (size_t)j * ld, y);
 }
 /* y (+)= A^T x (A: rows x cols); four dot products per sweep. */
 PHGMG__ONLINE void phgmg__r_gemvt(int rows, int cols, const phgmg_real *A, const phgmg_real *x,
@@ -5916,7 +6002,7 @@ PHGMG__ONLINE int phgmg__r_lu(int n, phgmg_real *A, int *piv) {
     for (j = k + 1; j < n; ++j) {
       const phgmg_real akj = A[k + j * n];
       if (akj == PHGMG__R(0)) continue;
-      for (i = k + 1; i < n; ++i) A[i + j * n] -= A[i + k * n] * akj;
+      phgmg__r_axmy(n - k - 1, akj, A + k + 1 + k * n, A + k + 1 + j * n);
     }
   }
   return 0;
@@ -5927,11 +6013,11 @@ PHGMG__ONLINE void phgmg__r_lu_solve(int n, const phgmg_real *LU, const int *piv
     if (piv[i] != i) { phgmg_real t = b[i]; b[i] = b[piv[i]]; b[piv[i]] = t; }
   for (j = 0; j < n; ++j) {
     const phgmg_real bj = b[j];
-    if (bj != PHGMG__R(0)) for (i = j + 1; i < n; ++i) b[i] -= LU[i + j * n] * bj;
+    if (bj != PHGMG__R(0)) phgmg__r_axmy(n - j - 1, bj, LU + j + 1 + j * n, b + j + 1);
   }
   for (j = n - 1; j >= 0; --j) {
     b[j] /= LU[j + j * n];
-    if (b[j] != PHGMG__R(0)) for (i = 0; i < j; ++i) b[i] -= LU[i + j * n] * b[j];
+    if (b[j] != PHGMG__R(0)) phgmg__r_axmy(j, b[j], LU + j * n, b);
   }
 }
 
@@ -6056,13 +6142,16 @@ PHGMG_DEF size_t phgmg_rom_eval_work_size(const phgmg_rom *rom) {
    eta_cb: one call gives q, Lp = Dq (and D2q into w->D2 when w->d2). */
 PHGMG__ONLINE void phgmg__rom_prep(const phgmg_rom *rom, const phgmg_real *x, const phgmg__romw *w) {
   const int r = rom->r, m = rom->m, rn = rom->rn, nd = rom->nd, p = r - m;
-  int i, k;
+  int i;
   if (rom->kind == PHGMG_ROM_QUADRATIC && rom->eta_cb) {
     rom->eta_cb(x + m, w->q, w->Lp, w->d2 ? w->D2 : NULL, rom->eta_user);
   } else if (rom->kind == PHGMG_ROM_QUADRATIC) {
     const phgmg_real *x2 = x + m;
-    for (k = 0; k < p; ++k) /* Lp(:,k) = sum_j Ms(:, k*p + j) x2_j: block k of Ms times x2 */
-      phgmg__r_gemv(rn, p, rom->Ms + (size_t)k * p * rn, x2, 0, w->Lp + (size_t)k * rn);
+    /* Lp(:,k) = sum_j Ms(:, k*p + j) x2_j. Ms is symmetrised (Ms(:, k*p + j) =
+       Ms(:, j*p + k)), so all of Lp (rn p) is one product of the (rn p) x p
+       matrix whose column j is Ms(:, j*p .. j*p + p - 1) with x2: the same
+       products in the same order as block k of Ms times x2, in one sweep. */
+    phgmg__r_gemv(rn * p, p, rom->Ms, x2, 0, w->Lp);
     phgmg__r_gemv(rn, p, w->Lp, x2, 0, w->q);
     for (i = 0; i < rn; ++i) w->q[i] *= PHGMG__R(0.5);
   }
@@ -6825,7 +6914,7 @@ PHGMG_DEF phgmg_result phgmg_rom_step(phgmg_rom_stepper *s, phgmg_real *x, const
 
 /* A small owner list: every array of a phgmg_reduced is allocated through it,
    so destroy (and every error path) frees exactly what was allocated. */
-#define PHGMG__MAXBUF 48
+#define PHGMG__MAXBUF 56
 struct phgmg_reduced {
   phgmg_allocator alloc;
   int use_alloc;
@@ -6852,6 +6941,44 @@ struct phgmg_reduced {
   phgmg_rom rom;       /* views into the phgmg_real copies     */
   double *env;         /* 2r: training envelope (lo, hi) of rho(x_j), widened */
   double *qmax;        /* 1: phgmg_rom.q_max (QUADRATIC)                       */
+  double *Ainv;        /* SP1/SP2: (V^T Vg)^{-1}, r x r (W = Vg Ainv)          */
+  const phgmg_study *study; /* the study that built it on its cached basis (else NULL) */
+  int sbasis;          /* with study: 1 GMG ([B, Ua_1..p(+rn)]), 2 SP1, 3 SP2 (Up_1..r) */
+};
+
+/* A study (phgmg_study_create): what every reduction of one snapshot set
+   shares, computed once. K* = modes kept; coordinates are K* x ns (ld K*). */
+struct phgmg_study {
+  phgmg_allocator alloc;
+  int use_alloc;
+  const phgmg_ph_system *sys;
+  const double *X;
+  int ldx, ns, N, m;
+  double xx;               /* ||X||_F^2                                          */
+  double *QB, *RB;         /* thin QR of B (N x m, m x m)                        */
+  double *Ua, *Ca, *CB, *Ta, *Gf, *Qf; /* GMG: POD of Xa = X - BB^+X (N x ka), Ua^T Xa,
+                              QB^T X (m x ns), tails Ta[k] = sum_i ||(I - P_[QB, Ua_1..k]) x_i||^2
+                              (ka + 1), [B, Ua]^T G [B, Ua] and [B, Ua]^T Q [B, Ua] ((m+ka)^2) */
+  int ka;
+  double *Up, *Cp, *Tp, *Cq; /* SP: POD of X (N x kp), Up^T X, tails Tp (kp + 1), (Q Up)^T X */
+  int kp;
+  double *Ug, *Cg;         /* SP2: POD of the gradient snapshots (N x kg), Ug^T X */
+  int kg;
+  int deim_have, deim_method, deim_max, deim_nd, deim_nneg; /* DEIM cache (first use) */
+  double deim_tol, deim_sigma;
+  int *deim_pts;
+  double *deim_w;
+  /* lambda_auto = 1 validation data (first use): the snapshots' outputs
+     B^T grad H(x_j) (m x ns), and the probe runs' full-model outputs for
+     one runs[0] (key: its input, x0 (copy), t0, dt, steps; Newton settings) */
+  double *Yt, *Yp, *px0;
+  double *cv;              /* lambda_auto regression errors on the grid (first use; key below) */
+  int cv_p, cv_rn, cv_ng, cv_nf, cv_nb;
+  double cv_lo, cv_hi;
+  int pnv, pn, pit, phave;
+  phgmg_input_fn pu;
+  void *puser;
+  double pt0, pdt, ptol;
 };
 
 PHGMG__PRIV void *phgmg__red_alloc(phgmg_reduced *red, size_t bytes) {
@@ -8089,6 +8216,8 @@ typedef struct phgmg__rctx {
   int *runcol;             /* opts.runs: nrun + 1 column offsets (NULL: one run) */
   int fallback_pod;        /* altmin under lambda_auto = 1 found no model as good as
                               GMG-POD: phgmg_reduce redoes it with manifold = POD */
+  phgmg_study *st;         /* phgmg_study_reduce: the study (else NULL)     */
+  int sf;                  /* fast path on the study's basis: 1 GMG, 2 SP1, 3 SP2 (0: none) */
 } phgmg__rctx;
 
 PHGMG__PRIV void phgmg__rctx_free(phgmg__rctx *c) {
@@ -8118,9 +8247,10 @@ PHGMG__PRIV phgmg_result phgmg__deploy_check(const phgmg_reduce_opts *o, int ns)
   return PHGMG_OK;
 }
 
-/* Options and sizes; nothing allocated. */
+/* Options and sizes; nothing allocated. X_checked: X is known finite (a
+   study checked it). */
 PHGMG__PRIV phgmg_result phgmg__reduce_check(const phgmg_ph_system *sys, const double *X, int ldx, int ns,
-                                             const phgmg_reduce_opts *o) {
+                                             const phgmg_reduce_opts *o, int X_checked) {
   const int N = sys->N, m = sys->m, r = o->r;
   if (N < 1 || m < 1 || ns < 1 || ldx < N) return PHGMG_ERR_SIZE;
   if (o->method < PHGMG_METHOD_GMG_POD || o->method > PHGMG_METHOD_GMG_MANIFOLD) return PHGMG_ERR_INVALID_ARG;
@@ -8138,7 +8268,7 @@ PHGMG__PRIV phgmg_result phgmg__reduce_check(const phgmg_ph_system *sys, const d
   if (!(o->dt >= 0.0) || o->dt == HUGE_VAL) return PHGMG_ERR_INVALID_ARG;
   if (o->lambda != o->lambda || !(o->degeneracy_tol >= 0.0 && o->degeneracy_tol < 1.0)) return PHGMG_ERR_INVALID_ARG;
   if (sys->nl == PHGMG_NL_SEPARABLE && sys->poly_deg > 32) return PHGMG_ERR_SIZE;
-  if (!phgmg__mat_finite(N, ns, X, ldx)) return PHGMG_ERR_NANINF; /* padding rows are not data */
+  if (!X_checked && !phgmg__mat_finite(N, ns, X, ldx)) return PHGMG_ERR_NANINF; /* padding rows are not data */
   if (o->lambda_auto) {
     const double lo = o->lambda_min == 0.0 ? 1e-14 : o->lambda_min;
     const double hi = o->lambda_max == 0.0 ? 1.0 : o->lambda_max;
@@ -8239,6 +8369,11 @@ PHGMG__PRIV phgmg_result phgmg__stage_basis(phgmg__rctx *c) {
     phgmg__free(c->alloc, S);
     return rc;
   }
+  if (c->sf == 1) { /* the study's basis: Xa is not needed (its coordinates are cached) */
+    memcpy(red->V0, c->sys->B, (size_t)N * m * sizeof(double));
+    memcpy(red->V0 + (size_t)N * m, c->o->pod_basis, (size_t)N * p * sizeof(double));
+    return PHGMG_OK;
+  }
   c->Xa = phgmg__dalloc(c->alloc, (size_t)N * ns);
   tmp = phgmg__dalloc(c->alloc, (size_t)PHGMG__MAX(m, 1) * ns + (size_t)N * (p + 1) + (size_t)p + 1);
   if (!c->Xa || !tmp) { phgmg__free(c->alloc, tmp); return PHGMG_ERR_NOMEM; }
@@ -8279,8 +8414,16 @@ PHGMG__PRIV phgmg_result phgmg__qm_problem(phgmg__rctx *c) {
   c->Tq = phgmg__dalloc(c->alloc, (size_t)ns * nc + (size_t)ns * rn + (size_t)nc * rn);
   if (!Z2 || !c->Tq) { phgmg__free(c->alloc, Z2); return PHGMG_ERR_NOMEM; }
   Rq = Z2 + (size_t)p * ns; Kt = c->Tq; Rqt = Kt + (size_t)ns * nc;
-  phgmg_gemm('T', 'N', p, ns, N, 1.0, red->V0 + (size_t)N * m, N, c->X, c->ldx, 0.0, Z2, p);
-  phgmg_gemm('T', 'N', rn, ns, N, 1.0, red->V2, N, c->Xa, N, 0.0, Rq, rn);
+  if (c->sf == 1) { /* V1^T X = Ua_1..p^T Xa, V2^T Xa = Ua_p+1..p+rn^T Xa (coordinates) */
+    const int ka = c->st->ka;
+    for (i = 0; i < ns; ++i) {
+      memcpy(Z2 + (size_t)i * p, c->st->Ca + (size_t)i * ka, (size_t)p * sizeof(double));
+      memcpy(Rq + (size_t)i * rn, c->st->Ca + (size_t)i * ka + p, (size_t)rn * sizeof(double));
+    }
+  } else {
+    phgmg_gemm('T', 'N', p, ns, N, 1.0, red->V0 + (size_t)N * m, N, c->X, c->ldx, 0.0, Z2, p);
+    phgmg_gemm('T', 'N', rn, ns, N, 1.0, red->V2, N, c->Xa, N, 0.0, Rq, rn);
+  }
   for (i = 0; i < ns; ++i) {
     for (a = 0, cc = 0; a < p; ++a)
       for (j = a; j < p; ++j, ++cc)
@@ -8306,9 +8449,24 @@ PHGMG__PRIV phgmg_result phgmg__qm_lambda_auto(phgmg__rctx *c) {
   if (!lg) return PHGMG_ERR_NOMEM;
   phgmg__lambda_grid(o->lambda_min == 0.0 ? 1e-14 : o->lambda_min, o->lambda_max == 0.0 ? 1.0 : o->lambda_max,
                      o->lambda_per_decade == 0 ? 4 : o->lambda_per_decade, lg);
-  rc = phgmg__ridge_cv_runs(ns, nc, rn, c->Tq, ns, c->Tq + (size_t)ns * nc, ns, ng, lg, nfold, nblk,
-                            byrun ? c->runcol : NULL, lg + ng, c->alloc);
-  if (rc != PHGMG_OK) return rc;
+  if (c->sf == 1 && !byrun && c->st->cv && c->st->cv_p == p && c->st->cv_rn == rn && c->st->cv_ng == ng &&
+      c->st->cv_nf == nfold && c->st->cv_nb == nblk && c->st->cv_lo == lg[0] && c->st->cv_hi == lg[ng - 1]) {
+    memcpy(lg + ng, c->st->cv, (size_t)ng * sizeof(double));   /* the study's: same problem, same basis */
+  } else {
+    rc = phgmg__ridge_cv_runs(ns, nc, rn, c->Tq, ns, c->Tq + (size_t)ns * nc, ns, ng, lg, nfold, nblk,
+                              byrun ? c->runcol : NULL, lg + ng, c->alloc);
+    if (rc != PHGMG_OK) return rc;
+    if (c->sf == 1 && !byrun) {
+      const phgmg_allocator *sa = c->st->use_alloc ? &c->st->alloc : NULL;
+      phgmg__free(sa, c->st->cv);
+      c->st->cv = phgmg__dalloc(sa, (size_t)ng);
+      if (c->st->cv) {
+        memcpy(c->st->cv, lg + ng, (size_t)ng * sizeof(double));
+        c->st->cv_p = p; c->st->cv_rn = rn; c->st->cv_ng = ng; c->st->cv_nf = nfold; c->st->cv_nb = nblk;
+        c->st->cv_lo = lg[0]; c->st->cv_hi = lg[ng - 1];
+      }
+    }
+  }
   for (c->gsel = 0, g = 1; g < ng; ++g) if (lg[ng + g] < lg[ng + c->gsel]) c->gsel = g;
   best = lg[ng + c->gsel];
   for (g = ng - 1; g > c->gsel; --g) if (lg[ng + g] <= best * (1.0 + 1e-6)) { c->gsel = g; break; }
@@ -8602,7 +8760,7 @@ PHGMG__PRIV phgmg_result phgmg__stage_manifold(phgmg__rctx *c) {
   {
     double *tmp = phgmg__dalloc(c->alloc, (size_t)p * ns + (size_t)rn);
     if (!tmp) return PHGMG_ERR_NOMEM;
-    phgmg__orth_remove(N, p, red->V0 + (size_t)N * m, ns, c->Xa, N, tmp);
+    if (c->sf != 1) phgmg__orth_remove(N, p, red->V0 + (size_t)N * m, ns, c->Xa, N, tmp);
     if (c->o->manifold == PHGMG_MANIFOLD_ALTMIN && red->method == PHGMG_METHOD_GMG_QM) {
       /* V2 from the alternating minimization */
     } else if (c->o->pod_basis && c->o->manifold == PHGMG_MANIFOLD_POD) {
@@ -8625,27 +8783,47 @@ PHGMG__PRIV phgmg_result phgmg__stage_manifold(phgmg__rctx *c) {
   return rc;
 }
 
+/* rcond of E (n x n, ld n; overwritten by its LU). ip: 2n ints, work: 2n. */
+PHGMG__PRIV double phgmg__rcond_inplace(int n, double *E, int *ip, double *work) {
+  const double anorm = phgmg_norm1(n, n, E, n);
+  if (phgmg_lu_factor(n, E, n, ip) != PHGMG_OK) return 0.0;
+  return phgmg_lu_rcond(n, E, n, ip, anorm, work, ip + n);
+}
+
 /* Smallest rcond of D^T G D over the snapshots (QUADRATIC kind); with the
-   automatic lambda, stops early at the first snapshot that would raise it. */
+   automatic lambda, stops early at the first snapshot that would raise it.
+   The snapshots' x2 = V1^T x_i come 64 at a time from one GEMM
+   (or from the study's coordinates); E and its rcond per snapshot in one
+   workspace. */
 PHGMG__PRIV phgmg_result phgmg__dgd_rcond_snapshots(phgmg__rctx *c, double stop_below, double *rmin) {
   phgmg_reduced *red = c->red;
-  const int N = red->N, m = red->m, p = red->p, rn = red->rn, r = red->r;
-  double *Lp, *E, *tmp, *x2;
-  int i;
-  Lp = phgmg__dalloc(c->alloc, (size_t)rn * p + (size_t)r * r + (size_t)rn * r + (size_t)p);
-  if (!Lp) return PHGMG_ERR_NOMEM;
-  E = Lp + (size_t)rn * p; tmp = E + (size_t)r * r; x2 = tmp + (size_t)rn * r;
-  for (i = 0; i < c->ns; ++i) {
-    double rc_i;
-    phgmg_gemv('T', N, p, 1.0, red->V0 + (size_t)N * m, N, c->X + (size_t)i * c->ldx, 0.0, x2);
-    phgmg__eta_d(red, x2, NULL, Lp, NULL, red->rwork);
-    phgmg__dgd_d(red, Lp, E, tmp);
-    rc_i = phgmg__rcond_of(r, E, c->alloc);
-    if (rc_i < 0.0) { phgmg__free(c->alloc, Lp); return PHGMG_ERR_NOMEM; }
-    if (rc_i < *rmin) *rmin = rc_i;
-    if (!(rc_i >= stop_below)) break;
+  const int N = red->N, m = red->m, p = red->p, rn = red->rn, r = red->r, nbmax = 64;
+  double *Lp, *E, *tmp, *X2, *wk;
+  int *ip, i, j0, ld2 = p;
+  Lp = phgmg__dalloc(c->alloc, (size_t)rn * p + (size_t)r * r + (size_t)rn * r + (size_t)p * nbmax + 2 * (size_t)r);
+  ip = phgmg__ialloc(c->alloc, 2 * (size_t)r);
+  if (!Lp || !ip) { phgmg__free(c->alloc, Lp); phgmg__free(c->alloc, ip); return PHGMG_ERR_NOMEM; }
+  E = Lp + (size_t)rn * p; tmp = E + (size_t)r * r; X2 = tmp + (size_t)rn * r; wk = X2 + (size_t)p * nbmax;
+  for (j0 = 0; j0 < c->ns; j0 += nbmax) {
+    const int nb = PHGMG__MIN(nbmax, c->ns - j0);
+    const double *x2b = X2;
+    if (c->sf == 1) {
+      x2b = c->st->Ca + (size_t)j0 * c->st->ka;
+      ld2 = c->st->ka;
+    } else {
+      phgmg_gemm('T', 'N', p, nb, N, 1.0, red->V0 + (size_t)N * m, N, c->X + (size_t)j0 * c->ldx, c->ldx, 0.0, X2, p);
+    }
+    for (i = 0; i < nb; ++i) {
+      double rc_i;
+      phgmg__eta_d(red, x2b + (size_t)i * ld2, NULL, Lp, NULL, red->rwork);
+      phgmg__dgd_d(red, Lp, E, tmp);
+      rc_i = phgmg__rcond_inplace(r, E, ip, wk);
+      if (rc_i < *rmin) *rmin = rc_i;
+      if (!(rc_i >= stop_below)) { j0 = c->ns; break; }
+    }
   }
   phgmg__free(c->alloc, Lp);
+  phgmg__free(c->alloc, ip);
   return PHGMG_OK;
 }
 
@@ -8725,6 +8903,34 @@ PHGMG_DEF phgmg_result phgmg_simulate_inputs(const phgmg_ph_system *sys, int nru
   return rc;
 }
 
+/* XR (r x ns) = rho of the snapshots: from the study's coordinates on its
+   bases (GMG: [RB^{-1} QB^T x; Ua_1..p^T Xa]; SP: Ainv^T Vg^T x), else
+   phgmg__restrict_block. */
+PHGMG__PRIV void phgmg__restrict_snapshots(const phgmg__rctx *c, double *XR) {
+  const phgmg_reduced *red = c->red;
+  const phgmg_study *st = c->st;
+  const int r = red->r, m = red->m, ns = c->ns;
+  int i, j, k;
+  if (c->sf == 1) {
+    for (k = 0; k < ns; ++k) {
+      double *xr = XR + (size_t)k * r;
+      memcpy(xr, st->CB + (size_t)k * m, (size_t)m * sizeof(double));
+      for (i = m - 1; i >= 0; --i) {
+        double sm = xr[i];
+        for (j = i + 1; j < m; ++j) sm -= red->RB[i + j * m] * xr[j];
+        xr[i] = sm / red->RB[i + i * m];
+      }
+      memcpy(xr + m, st->Ca + (size_t)k * st->ka, (size_t)(r - m) * sizeof(double));
+    }
+  } else if (c->sf == 2 || c->sf == 3) {
+    const double *Cv = c->sf == 2 ? st->Cq : st->Cg;
+    const int ld = c->sf == 2 ? st->kp : st->kg;
+    phgmg_gemm('T', 'N', r, ns, r, 1.0, red->Ainv, r, Cv, ld, 0.0, XR, r);
+  } else {
+    phgmg__restrict_block(red, ns, c->X, c->ldx, XR);
+  }
+}
+
 /* phgmg_rom.q_max: 1.2 max_j ||M (x2_j kron x2_j)|| over the snapshots'
    reduced coordinates x2_j (the final M: run after the lambda validation). */
 PHGMG__PRIV phgmg_result phgmg__q_envelope(phgmg__rctx *c) {
@@ -8735,7 +8941,7 @@ PHGMG__PRIV phgmg_result phgmg__q_envelope(phgmg__rctx *c) {
   red->qmax = phgmg__red_d(red, 1);
   xr = phgmg__dalloc(c->alloc, (size_t)r * c->ns);
   if (!red->qmax || !xr) { phgmg__free(c->alloc, xr); return PHGMG_ERR_NOMEM; }
-  phgmg__restrict_block(red, c->ns, c->X, c->ldx, xr);
+  phgmg__restrict_snapshots(c, xr);
   for (j = 0; j < c->ns; ++j) {
     double s2 = 0.0;
     phgmg__eta_d(red, xr + (size_t)j * r + m, q, NULL, NULL, red->rwork);
@@ -8760,7 +8966,7 @@ PHGMG__PRIV phgmg_result phgmg__stage_envelope(phgmg__rctx *c) {
   red->env = phgmg__red_d(red, 2 * (size_t)r);
   xr = phgmg__dalloc(c->alloc, (size_t)r * c->ns);
   if (!red->env || !xr) { phgmg__free(c->alloc, xr); return PHGMG_ERR_NOMEM; }
-  phgmg__restrict_block(red, c->ns, c->X, c->ldx, xr);
+  phgmg__restrict_snapshots(c, xr);
   for (j = 0; j < c->ns; ++j) {
     const double *xj = xr + (size_t)j * r;
     for (a = 0; a < r; ++a) {
@@ -8818,7 +9024,96 @@ typedef struct phgmg__vset {
   phgmg__probe probe[3];
   double *buf;             /* every Yref, the level, zeros (x0), Yr, xr0 */
   double *Yr, *xr0;
+  int rep[PHGMG__NVAL_MAX];   /* the run simulated for run k (itself, or an identical one) */
+  int order[PHGMG__NVAL_MAX]; /* evaluation order: probes first (they fail first) */
 } phgmg__vset;
+
+/* Do validation runs j and k drive the reduced model identically (same x0,
+   t0, dt, steps, and bit-identical inputs at every stage time, as
+   phgmg_reduced_simulate samples them)? ub: 2m doubles. */
+PHGMG__PRIV int phgmg__vrun_same(const phgmg__rctx *c, const phgmg__vset *v, int j, int k, double *ub) {
+  const int N = c->sys->N, m = c->sys->m;
+  const double s15 = sqrt(15.0) / 10.0, cs[3] = {0.5 - s15, 0.5, 0.5 + s15};
+  int n, i, a;
+  if (v->t0[j] != v->t0[k] || v->dt[j] != v->dt[k] || v->nsteps[j] != v->nsteps[k]) return 0;
+  if (v->x0[j] != v->x0[k] && memcmp(v->x0[j], v->x0[k], (size_t)N * sizeof(double)) != 0) return 0;
+  if (v->u[j] == v->u[k] && v->user[j] == v->user[k]) return 1;
+  for (n = 0; n < v->nsteps[j]; ++n) {
+    const double t = v->t0[j] + n * v->dt[j];
+    for (i = 0; i < 3; ++i) {
+      for (a = 0; a < 2 * m; ++a) ub[a] = 0.0;
+      if (v->u[j]) v->u[j](t + cs[i] * v->dt[j], ub, v->user[j]);
+      if (v->u[k]) v->u[k](t + cs[i] * v->dt[j], ub + m, v->user[k]);
+      if (memcmp(ub, ub + m, (size_t)m * sizeof(double)) != 0) return 0;
+    }
+  }
+  return 1;
+}
+
+/* Evaluation order (probes, then the training runs) and, for each run, the
+   first run in that order that is identical to it (simulated once). */
+PHGMG__PRIV phgmg_result phgmg__vset_dedupe(const phgmg__rctx *c, phgmg__vset *v) {
+  const int nrun = c->o->nrun;
+  double *ub = phgmg__dalloc(c->alloc, 2 * (size_t)c->sys->m);
+  int i, j, n = 0;
+  if (!ub) return PHGMG_ERR_NOMEM;
+  for (i = nrun; i < v->nv; ++i) v->order[n++] = i;
+  for (i = 0; i < nrun && i < v->nv; ++i) v->order[n++] = i;
+  for (i = 0; i < v->nv; ++i) {
+    const int k = v->order[i];
+    v->rep[k] = k;
+    for (j = 0; j < i; ++j)
+      if (v->rep[v->order[j]] == v->order[j] && phgmg__vrun_same(c, v, v->order[j], k, ub)) {
+        v->rep[k] = v->order[j];
+        break;
+      }
+  }
+  phgmg__free(c->alloc, ub);
+  return PHGMG_OK;
+}
+
+/* A study's cache of the probe runs' reference outputs (v->Yref of runs
+   nrun..nrun+2, v->nv) for one runs[0] and Newton setting. store = 0: fill
+   v from the cache if it matches (returns 1); store = 1: keep v's. */
+PHGMG__PRIV int phgmg__study_probes(phgmg__rctx *c, phgmg__vset *v, const double *level, const double *zero,
+                                    size_t off, const phgmg_gl3_opts *go, int store) {
+  phgmg_study *st = c->st;
+  const phgmg_run *r0 = c->o->runs;
+  const int N = c->sys->N, m = c->sys->m, nrun = c->o->nrun;
+  const double *x0 = r0->x0 ? r0->x0 : zero;
+  const size_t ny = (size_t)m * (r0->nsteps + 1);
+  int k;
+  if (!st) return 0;
+  if (!store) {
+    if (!st->phave || st->pu != r0->u || st->puser != r0->user || st->pt0 != r0->t0 || st->pdt != r0->dt ||
+        st->pn != r0->nsteps || st->ptol != go->tol || st->pit != go->max_iter ||
+        memcmp(st->px0, x0, (size_t)N * sizeof(double)) != 0)
+      return 0;
+    v->nv = st->pnv;
+    for (k = nrun; k < nrun + 3; ++k) {
+      phgmg__probe *p = v->probe + (k - nrun);
+      p->run = r0; p->level = level; p->mode = k - nrun; p->m = m;
+      v->u[k] = phgmg__probe_u; v->user[k] = p; v->x0[k] = x0;
+      v->t0[k] = r0->t0; v->dt[k] = r0->dt; v->nsteps[k] = r0->nsteps;
+      v->Yref[k] = v->buf + off + (size_t)(k - nrun) * ny;
+      if (k < v->nv) memcpy(v->Yref[k], st->Yp + (size_t)(k - nrun) * ny, ny * sizeof(double));
+    }
+    return 1;
+  }
+  {
+    const phgmg_allocator *sa = st->use_alloc ? &st->alloc : NULL;
+    phgmg__free(sa, st->Yp);
+    st->phave = 0;
+    st->Yp = phgmg__dalloc(sa, 3 * ny + (size_t)N);
+    if (!st->Yp) return 0;
+    st->px0 = st->Yp + 3 * ny;
+    memcpy(st->px0, x0, (size_t)N * sizeof(double));
+    for (k = nrun; k < v->nv; ++k) memcpy(st->Yp + (size_t)(k - nrun) * ny, v->Yref[k], ny * sizeof(double));
+    st->pnv = v->nv; st->pu = r0->u; st->puser = r0->user; st->pt0 = r0->t0; st->pdt = r0->dt; st->pn = r0->nsteps;
+    st->ptol = go->tol; st->pit = go->max_iter; st->phave = 1;
+  }
+  return 1;
+}
 
 PHGMG__PRIV phgmg_result phgmg__vset_build(phgmg__rctx *c, phgmg__vset *v) {
   const phgmg_ph_system *sys = c->sys;
@@ -8836,12 +9131,24 @@ PHGMG__PRIV phgmg_result phgmg__vset_build(phgmg__rctx *c, phgmg__vset *v) {
   if (!v->buf) return PHGMG_ERR_NOMEM;
   level = v->buf + tot; zero = level + m; g = zero + N; v->Yr = g + N; v->xr0 = v->Yr + (size_t)m * v->nmax;
   memset(zero, 0, (size_t)N * sizeof(double));
+  if (c->st && !c->st->Yt) {   /* a study keeps the snapshots' outputs */
+    const phgmg_allocator *sa = c->st->use_alloc ? &c->st->alloc : NULL;
+    c->st->Yt = phgmg__dalloc(sa, (size_t)m * c->ns);
+    for (j = 0; c->st->Yt && j < c->ns; ++j) {
+      phgmg_ph_gradient(sys, c->X + (size_t)j * c->ldx, g);
+      phgmg_gemv('T', N, m, 1.0, sys->B, N, g, 0.0, c->st->Yt + (size_t)j * m);
+    }
+  }
   for (k = 0, off = 0; k < nrun; ++k) {   /* training runs: y = B^T grad H(x_j) */
     v->u[k] = run[k].u; v->user[k] = run[k].user; v->x0[k] = c->X + (size_t)c->runcol[k] * c->ldx;
     v->t0[k] = run[k].t0; v->dt[k] = run[k].dt; v->nsteps[k] = run[k].nsteps; v->Yref[k] = v->buf + off;
-    for (j = 0; j <= run[k].nsteps; ++j) {
-      phgmg_ph_gradient(sys, c->X + (size_t)(c->runcol[k] + j) * c->ldx, g);
-      phgmg_gemv('T', N, m, 1.0, sys->B, N, g, 0.0, v->Yref[k] + (size_t)j * m);
+    if (c->st && c->st->Yt) {
+      memcpy(v->Yref[k], c->st->Yt + (size_t)c->runcol[k] * m, (size_t)m * (run[k].nsteps + 1) * sizeof(double));
+    } else {
+      for (j = 0; j <= run[k].nsteps; ++j) {
+        phgmg_ph_gradient(sys, c->X + (size_t)(c->runcol[k] + j) * c->ldx, g);
+        phgmg_gemv('T', N, m, 1.0, sys->B, N, g, 0.0, v->Yref[k] + (size_t)j * m);
+      }
     }
     off += (size_t)m * (run[k].nsteps + 1);
   }
@@ -8857,7 +9164,8 @@ PHGMG__PRIV phgmg_result phgmg__vset_build(phgmg__rctx *c, phgmg__vset *v) {
   memset(&go, 0, sizeof go);
   go.tol = c->o->newton_tol > 0.0 ? c->o->newton_tol : 1e-10;
   go.max_iter = c->o->newton_iter > 0 ? c->o->newton_iter : 20;
-  if (c->o->lambda_train_only) { v->nv = nrun; return PHGMG_OK; }
+  if (c->o->lambda_train_only) { v->nv = nrun; return phgmg__vset_dedupe(c, v); }
+  if (phgmg__study_probes(c, v, level, zero, off, &go, 0)) return phgmg__vset_dedupe(c, v);
   for (k = nrun; k < nrun + 3; ++k) {
     phgmg__probe *p = v->probe + (k - nrun);
     phgmg_result rc;
@@ -8870,27 +9178,40 @@ PHGMG__PRIV phgmg_result phgmg__vset_build(phgmg__rctx *c, phgmg__vset *v) {
     if (rc == PHGMG_ERR_NOMEM) return rc;
     if (rc != PHGMG_OK) { v->nv = k; break; }   /* the full model itself fails: no probe */
   }
-  return PHGMG_OK;
+  phgmg__study_probes(c, v, level, zero, 0, &go, 1);
+  return phgmg__vset_dedupe(c, v);
 }
 
 /* Simulate the current reduced model on every validation run: v->ey, and
-   *ok = 0 if a run fails or needs more than 4 Newton iterations per step. */
-PHGMG__PRIV phgmg_result phgmg__vset_eval(phgmg__rctx *c, phgmg__vset *v, int *ok) {
+   *ok = 0 if a run fails or needs more than 4 Newton iterations per step.
+   Identical runs (v->rep) are simulated once. With tolr > 0 (a candidate,
+   not the linear limit), the evaluation stops at the first run that makes
+   the candidate inadmissible (*ok = 0, or an e_y ratio to v->base above
+   tolr): the remaining e_y are not needed (left HUGE_VAL). */
+PHGMG__PRIV phgmg_result phgmg__vset_eval(phgmg__rctx *c, phgmg__vset *v, int *ok, double tolr) {
   const int m = c->sys->m;
   const double tol = c->o->newton_tol;   /* 0: the stepper's default (1e-10 double, 1e-5 float) */
   const int it = c->o->newton_iter > 0 ? c->o->newton_iter : 20;
-  int k;
+  int i, k, j;
   *ok = 1;
-  for (k = 0; k < v->nv; ++k) {
+  for (k = 0; k < v->nv; ++k) v->ey[k] = HUGE_VAL;
+  for (i = 0; i < v->nv; ++i) {
     phgmg_rom_stats st;
     phgmg_result rc;
+    k = v->order[i];
+    if (v->rep[k] != k) continue;
     memset(&st, 0, sizeof st);
     phgmg_reduced_restrict(c->red, v->x0[k], v->xr0);
     rc = phgmg_reduced_simulate(c->red, v->xr0, v->t0[k], v->dt[k], v->nsteps[k], v->u[k], v->user[k], tol, it,
                                 NULL, v->Yr, NULL, &st, c->alloc);
     if (rc == PHGMG_ERR_NOMEM) return rc;
-    v->ey[k] = rc == PHGMG_OK ? phgmg_rel_error(m, v->nsteps[k] + 1, v->Yref[k], m, v->Yr, m) : HUGE_VAL;
-    if (rc != PHGMG_OK || st.newton_iters > 4 * st.steps || !(v->ey[k] < HUGE_VAL)) *ok = 0;
+    for (j = 0; j < v->nv; ++j) {
+      if (v->rep[j] != k) continue;
+      v->ey[j] = rc == PHGMG_OK ? phgmg_rel_error(m, v->nsteps[j] + 1, v->Yref[j], m, v->Yr, m) : HUGE_VAL;
+      if (rc != PHGMG_OK || st.newton_iters > 4 * st.steps || !(v->ey[j] < HUGE_VAL)) *ok = 0;
+      if (tolr > 0.0 && *ok && (v->ey[j] + 1e-14) / (v->base[j] + 1e-14) > tolr) *ok = -1;
+    }
+    if (tolr > 0.0 && *ok != 1) { *ok = *ok < 0; break; }
   }
   return PHGMG_OK;
 }
@@ -8933,7 +9254,7 @@ PHGMG__PRIV phgmg_result phgmg__altmin_reference(phgmg__rctx *c, phgmg__vset *v,
   if (rc == PHGMG_ERR_NOMEM) return rc;
   if (rc != PHGMG_OK) return PHGMG_OK;   /* no GMG-POD to compare with: the linear limit alone */
   c->red = pod;
-  rc = phgmg__vset_eval(c, v, &ok);
+  rc = phgmg__vset_eval(c, v, &ok, 0.0);   /* every run: the reference */
   c->red = keep;
   phgmg_reduced_destroy(pod);
   if (rc != PHGMG_OK || !ok) return rc;
@@ -8972,14 +9293,14 @@ PHGMG__PRIV phgmg_result phgmg__stage_lambda_validate(phgmg__rctx *c) {
   memset(v, 0, sizeof *v);
   rc = phgmg__vset_build(c, v);
   if (rc == PHGMG_OK) rc = phgmg__qm_set(c, -1, ms);
-  if (rc == PHGMG_OK) rc = phgmg__vset_eval(c, v, &ok);
+  if (rc == PHGMG_OK) rc = phgmg__vset_eval(c, v, &ok, 0.0);
   for (k = 0; k < v->nv && rc == PHGMG_OK; ++k) v->base[k] = v->ey[k] < HUGE_VAL ? v->ey[k] : 1.0;
   if (rc == PHGMG_OK && o->manifold == PHGMG_MANIFOLD_ALTMIN) rc = phgmg__altmin_reference(c, v, ok, tolr);
   /* training runs alone: up from the regression optimum, the first admissible */
   for (g = c->gsel; rc == PHGMG_OK && o->lambda_train_only && g < c->ng; g += pd) {
     double worst = 0.0;
     rc = phgmg__qm_set(c, g, ms);
-    if (rc == PHGMG_OK) rc = phgmg__vset_eval(c, v, &ok);
+    if (rc == PHGMG_OK) rc = phgmg__vset_eval(c, v, &ok, tolr);
     if (rc != PHGMG_OK) break;
     c->inf.lambda_candidates++;
     for (k = 0; k < v->nv && ok; ++k) worst = PHGMG__MAX(worst, (v->ey[k] + 1e-14) / (v->base[k] + 1e-14));
@@ -8989,7 +9310,7 @@ PHGMG__PRIV phgmg_result phgmg__stage_lambda_validate(phgmg__rctx *c) {
        g = (g - pd >= c->gsel || g == c->gsel) ? g - pd : c->gsel) {
     double score = 0.0, worst = 0.0;
     rc = phgmg__qm_set(c, g, ms);
-    if (rc == PHGMG_OK) rc = phgmg__vset_eval(c, v, &ok);
+    if (rc == PHGMG_OK) rc = phgmg__vset_eval(c, v, &ok, tolr);
     if (rc != PHGMG_OK) break;
     c->inf.lambda_candidates++;
     for (k = 0; k < v->nv && ok; ++k) {
@@ -9027,18 +9348,41 @@ PHGMG__PRIV phgmg_result phgmg__stage_lambda_validate(phgmg__rctx *c) {
 /* Stage 3a, GMG blocks (paper 4.2): G = (J - R)^{-1} through a factorization,
    G00 = V0^T G V0 (and the V2 blocks), Bh = [I; 0], the non-degeneracy
    check, and K = G00^{-1} for the linear map. */
+/* B (nr x ncol, ld nr) = A(i0 : i0+nr, j0 : j0+ncol) (A: ld lda). */
+PHGMG__PRIV void phgmg__subblock(int nr, int ncol, const double *A, int lda, int i0, int j0, double *B) {
+  int i, j;
+  for (j = 0; j < ncol; ++j)
+    for (i = 0; i < nr; ++i) B[i + (size_t)j * nr] = A[(i0 + i) + (size_t)(j0 + j) * lda];
+}
+
+/* The study's G-blocks: [B, V1, V2] are the first r + rn columns of [B, Ua]. */
+PHGMG__PRIV phgmg_result phgmg__study_gmg_blocks(phgmg__rctx *c) {
+  phgmg_reduced *red = c->red;
+  const int r = red->r, rn = red->rn, nf = red->m + c->st->ka;
+  phgmg__subblock(r, r, c->st->Gf, nf, 0, 0, red->G00);
+  if (rn) {
+    phgmg__subblock(r, rn, c->st->Gf, nf, 0, r, red->G01);
+    phgmg__subblock(rn, r, c->st->Gf, nf, r, 0, red->G10);
+    phgmg__subblock(rn, rn, c->st->Gf, nf, r, r, red->G11);
+  }
+  return PHGMG_OK;
+}
+
 PHGMG__PRIV phgmg_result phgmg__stage_gmg_blocks(phgmg__rctx *c) {
   phgmg_reduced *red = c->red;
   const int N = red->N, m = red->m, r = red->r, rn = red->rn;
-  double *GV;
+  double *GV = NULL;
   int j;
-  phgmg_result rc = phgmg_jr_factor_create(&c->jr, c->sys, NULL, c->alloc);
-  if (rc != PHGMG_OK) return rc;
-  GV = phgmg__dalloc(c->alloc, (size_t)N * (r + rn));
-  if (!GV) return PHGMG_ERR_NOMEM;
-  memcpy(GV, red->V0, (size_t)N * r * sizeof(double));
-  if (rn) memcpy(GV + (size_t)N * r, red->V2, (size_t)N * rn * sizeof(double));
-  phgmg_jr_solve(c->jr, 'N', r + rn, GV, N);           /* GV = G [V0, V2] */
+  phgmg_result rc = PHGMG_OK;
+  if (c->sf != 1) {
+    rc = phgmg_jr_factor_create(&c->jr, c->sys, NULL, c->alloc);
+    if (rc != PHGMG_OK) return rc;
+    GV = phgmg__dalloc(c->alloc, (size_t)N * (r + rn));
+    if (!GV) return PHGMG_ERR_NOMEM;
+    memcpy(GV, red->V0, (size_t)N * r * sizeof(double));
+    if (rn) memcpy(GV + (size_t)N * r, red->V2, (size_t)N * rn * sizeof(double));
+    phgmg_jr_solve(c->jr, 'N', r + rn, GV, N);           /* GV = G [V0, V2] */
+  }
   red->G00 = phgmg__red_d(red, (size_t)r * r);
   red->Bh = phgmg__red_d(red, (size_t)r * m);
   if (rn) {
@@ -9050,8 +9394,12 @@ PHGMG__PRIV phgmg_result phgmg__stage_gmg_blocks(phgmg__rctx *c) {
     phgmg__free(c->alloc, GV);
     return PHGMG_ERR_NOMEM;
   }
-  phgmg__atb(N, r, r, red->V0, GV, red->G00);
-  if (rn) {
+  if (c->sf == 1) {
+    phgmg__study_gmg_blocks(c);
+  } else {
+    phgmg__atb(N, r, r, red->V0, GV, red->G00);
+  }
+  if (rn && c->sf != 1) {
     phgmg__atb(N, r, rn, red->V0, GV + (size_t)N * r, red->G01);
     phgmg__atb(N, rn, r, red->V2, GV, red->G10);
     phgmg__atb(N, rn, rn, red->V2, GV + (size_t)N * r, red->G11);
@@ -9114,8 +9462,10 @@ PHGMG__PRIV phgmg_result phgmg__stage_sp_blocks(phgmg__rctx *c) {
     red->W = phgmg__red_d(red, (size_t)N * r);
     red->K = phgmg__red_d(red, (size_t)r * r);
     red->Bh = phgmg__red_d(red, (size_t)r * m);
-    if (!red->W || !red->K || !red->Bh) rc = PHGMG_ERR_NOMEM;
+    red->Ainv = phgmg__red_d(red, (size_t)r * r);
+    if (!red->W || !red->K || !red->Bh || !red->Ainv) rc = PHGMG_ERR_NOMEM;
   }
+  if (rc == PHGMG_OK) memcpy(red->Ainv, Ainv, (size_t)r * r * sizeof(double));
   if (rc == PHGMG_OK) {
     phgmg_gemm('N', 'N', N, r, r, 1.0, Vg, N, Ainv, r, 0.0, red->W, N);
     phgmg_ph_apply(c->sys, 'J', r, red->W, N, Vg, N);
@@ -9141,14 +9491,23 @@ PHGMG__PRIV phgmg_result phgmg__stage_quadratic_terms(phgmg__rctx *c) {
     red->Q11 = phgmg__red_d(red, (size_t)rn * rn);
   }
   if (!QV || !red->Qh || (rn && (!red->Q01 || !red->Q11))) { phgmg__free(c->alloc, QV); return PHGMG_ERR_NOMEM; }
-  phgmg_ph_apply(c->sys, 'Q', r, red->V0, N, QV, N);
-  if (rn) phgmg_ph_apply(c->sys, 'Q', rn, red->V2, N, QV + (size_t)N * r, N);
-  phgmg__atb(N, r, r, red->V0, QV, red->Qh);
+  if (c->sf == 1) { /* sub-blocks of the study's [B, Ua]^T Q [B, Ua] */
+    const int nf = red->m + c->st->ka;
+    phgmg__subblock(r, r, c->st->Qf, nf, 0, 0, red->Qh);
+    if (rn) {
+      phgmg__subblock(r, rn, c->st->Qf, nf, 0, r, red->Q01);
+      phgmg__subblock(rn, rn, c->st->Qf, nf, r, r, red->Q11);
+    }
+  } else {
+    phgmg_ph_apply(c->sys, 'Q', r, red->V0, N, QV, N);
+    if (rn) phgmg_ph_apply(c->sys, 'Q', rn, red->V2, N, QV + (size_t)N * r, N);
+    phgmg__atb(N, r, r, red->V0, QV, red->Qh);
+  }
   for (j = 0; j < r; ++j)
     for (i = 0; i < j; ++i)
       red->Qh[i + (size_t)j * r] = red->Qh[j + (size_t)i * r] =
           0.5 * (red->Qh[i + (size_t)j * r] + red->Qh[j + (size_t)i * r]);
-  if (rn) {
+  if (rn && c->sf != 1) {
     phgmg__atb(N, r, rn, red->V0, QV + (size_t)N * r, red->Q01);
     phgmg__atb(N, rn, rn, red->V2, QV + (size_t)N * r, red->Q11);
   }
@@ -9362,9 +9721,24 @@ PHGMG__PRIV phgmg_result phgmg__reduce_fallback_pod(phgmg_reduced **out, const p
   return rc;
 }
 
-PHGMG_DEF phgmg_result phgmg_reduce(phgmg_reduced **out, const phgmg_ph_system *sys, const double *X,
-                                    int ldx, int ns, const phgmg_reduce_opts *opts,
-                                    phgmg_reduce_info *info, const phgmg_allocator *alloc) {
+/* Which fast path of a study applies to opts (0: none): the study's own
+   bases, orders within its modes (phgmg_study_reduce). */
+PHGMG__PRIV int phgmg__study_fast(const phgmg_study *st, const phgmg_reduce_opts *o, int m) {
+  if (!st) return 0;
+  if ((o->method == PHGMG_METHOD_GMG_POD || (o->method == PHGMG_METHOD_GMG_QM && o->manifold == PHGMG_MANIFOLD_POD)) && st->Ua &&
+      o->pod_basis == st->Ua && o->r - m + (o->method == PHGMG_METHOD_GMG_QM ? (o->rn > 0 ? o->rn : 8) : 0) <= st->ka)
+    return 1;
+  if (o->method == PHGMG_METHOD_SP1 && st->Up && st->Cq && o->pod_basis == st->Up && o->r <= st->kp) return 2;
+  if (o->method == PHGMG_METHOD_SP2 && st->Up && st->Ug && o->pod_basis == st->Up && o->grad_basis == st->Ug &&
+      o->r <= st->kp && o->r <= st->kg)
+    return 3;
+  return 0;
+}
+
+PHGMG__PRIV phgmg_result phgmg__reduce_run(phgmg_reduced **out, const phgmg_ph_system *sys, const double *X,
+                                           int ldx, int ns, const phgmg_reduce_opts *opts,
+                                           phgmg_reduce_info *info, const phgmg_allocator *alloc,
+                                           phgmg_study *st) {
   phgmg__rctx c;
   phgmg_result rc;
   if (!out) return PHGMG_ERR_INVALID_ARG;
@@ -9372,8 +9746,10 @@ PHGMG_DEF phgmg_result phgmg_reduce(phgmg_reduced **out, const phgmg_ph_system *
   if (!sys || !X || !opts) return PHGMG_ERR_INVALID_ARG;
   memset(&c, 0, sizeof c);
   c.sys = sys; c.o = opts; c.X = X; c.ldx = ldx; c.ns = ns; c.alloc = alloc; c.gsel = -1;
+  c.st = st;
+  c.sf = phgmg__study_fast(st, opts, sys->m);
   c.inf.hyper_method = -1;
-  rc = phgmg__reduce_check(sys, X, ldx, ns, opts);
+  rc = phgmg__reduce_check(sys, X, ldx, ns, opts, st != NULL);
   if (rc == PHGMG_OK) rc = phgmg_ph_validate(sys, 0.0, &c.inf.rcond_jr, alloc);
   if (rc != PHGMG_OK) {
     if (info) *info = c.inf;
@@ -9388,6 +9764,7 @@ PHGMG_DEF phgmg_result phgmg_reduce(phgmg_reduced **out, const phgmg_ph_system *
   c.rfloor = phgmg__rank_floor(sys->N, ns, X, ldx);
   rc = phgmg__runs_layout(&c);
   if (rc == PHGMG_OK) rc = phgmg__reduce_new(&c);
+  if (rc == PHGMG_OK && c.sf) { c.red->study = st; c.red->sbasis = c.sf; }
   if (rc == PHGMG_OK) rc = phgmg__stage_basis(&c);
   if (rc == PHGMG_OK) rc = phgmg__stage_manifold(&c);
   if (rc == PHGMG_OK) rc = phgmg__is_gmg(opts->method) ? phgmg__stage_gmg_blocks(&c) : phgmg__stage_sp_blocks(&c);
@@ -9413,6 +9790,12 @@ PHGMG_DEF phgmg_result phgmg_reduce(phgmg_reduced **out, const phgmg_ph_system *
   }
   *out = c.red;
   return PHGMG_OK;
+}
+
+PHGMG_DEF phgmg_result phgmg_reduce(phgmg_reduced **out, const phgmg_ph_system *sys, const double *X,
+                                    int ldx, int ns, const phgmg_reduce_opts *opts,
+                                    phgmg_reduce_info *info, const phgmg_allocator *alloc) {
+  return phgmg__reduce_run(out, sys, X, ldx, ns, opts, info, alloc, NULL);
 }
 
 PHGMG_DEF void phgmg_reduced_lift(const phgmg_reduced *red, const double *xr, double *x) {
@@ -9717,6 +10100,318 @@ PHGMG_DEF double phgmg_err_lowerbound(const phgmg_reduced *red, const double *X,
 PHGMG_DEF void phgmg_err_energy(const phgmg_energy *energy, int nsteps, double *e) {
   int n;
   for (n = 0; n <= nsteps; ++n) e[n] = fabs(energy->H[n] - energy->H[0] - energy->S[n] + energy->D[n]);
+}
+
+/* --- studies (phgmg_study_*) ------------------------------------------- */
+PHGMG_DEF void phgmg_study_destroy(phgmg_study *st) {
+  phgmg_allocator a;
+  const phgmg_allocator *al;
+  if (!st) return;
+  a = st->alloc;
+  al = st->use_alloc ? &a : NULL;
+  phgmg__free(al, st->QB); phgmg__free(al, st->Ua); phgmg__free(al, st->Up); phgmg__free(al, st->Ug);
+  phgmg__free(al, st->deim_pts); phgmg__free(al, st->deim_w);
+  phgmg__free(al, st->Yt); phgmg__free(al, st->Yp); phgmg__free(al, st->cv);
+  phgmg__free(al, st);
+}
+
+PHGMG_DEF const double *phgmg_study_basis(const phgmg_study *st, char which, int *cols) {
+  const double *b = NULL;
+  int k = 0;
+  if (st && which == 'a') { b = st->Ua; k = st->ka; }
+  if (st && which == 'p') { b = st->Up; k = st->kp; }
+  if (st && which == 'g') { b = st->Ug; k = st->kg; }
+  if (cols) *cols = b ? k : 0;
+  return b;
+}
+
+/* sum of squares of an n x ns matrix (ld n). */
+PHGMG__PRIV double phgmg__sumsq(int n, int ns, const double *A, int lda) {
+  double s = 0.0;
+  int i, j;
+  for (j = 0; j < ns; ++j)
+    for (i = 0; i < n; ++i) s += A[i + (size_t)j * lda] * A[i + (size_t)j * lda];
+  return s;
+}
+
+/* POD of T (N x ns, ld N; destroyed) into U (N x kmax): *k = modes with
+   sigma > rfloor; C = U^T T (k x ns); tails Tl[j] = ||T - U_1..j C_1..j||_F^2
+   (j = 0..k) from the residual of all k modes plus squared coordinates. */
+PHGMG__PRIV phgmg_result phgmg__study_pod(const phgmg_study *st, double *T, int kmax, double rfloor, double *U,
+                                          int *k, double *C, double *Tl, const phgmg_allocator *alloc) {
+  const int N = st->N, ns = st->ns;
+  double *S = phgmg__dalloc(alloc, (size_t)kmax);
+  int j, i;
+  phgmg_result rc;
+  if (!S) return PHGMG_ERR_NOMEM;
+  rc = phgmg_pod(N, ns, T, N, kmax, 0.0, U, N, S, k, alloc);
+  for (j = 0; rc == PHGMG_OK && j < *k; ++j)
+    if (!(S[j] > rfloor)) { *k = j; break; }
+  phgmg__free(alloc, S);
+  if (rc != PHGMG_OK) return rc;
+  if (*k < 1) return PHGMG_ERR_SIZE;
+  phgmg_gemm('T', 'N', *k, ns, N, 1.0, U, N, T, N, 0.0, C, *k);
+  if (!Tl) return PHGMG_OK;
+  phgmg_gemm('N', 'N', N, ns, *k, -1.0, U, N, C, *k, 1.0, T, N);   /* T = residual of all k modes */
+  Tl[*k] = phgmg__sumsq(N, ns, T, N);
+  for (j = *k - 1; j >= 0; --j) {
+    double s = 0.0;
+    for (i = 0; i < ns; ++i) s += C[j + (size_t)i * *k] * C[j + (size_t)i * *k];
+    Tl[j] = Tl[j + 1] + s;
+  }
+  return PHGMG_OK;
+}
+
+/* GMG part: Ua, Ca = Ua^T Xa, CB = QB^T X, tails Ta, Gf, Qf. T: N x ns scratch. */
+PHGMG__PRIV phgmg_result phgmg__study_gmg(phgmg_study *st, int kmax, double *T, const phgmg_allocator *alloc) {
+  const int N = st->N, m = st->m, ns = st->ns;
+  const size_t nf = (size_t)m + (size_t)kmax;
+  double *V, *GV;
+  phgmg_jr_factor *jr = NULL;
+  phgmg_result rc;
+  st->Ua = phgmg__dalloc(alloc, (size_t)N * kmax + (size_t)kmax * ns + (size_t)m * ns + (size_t)kmax + 1 + 2 * nf * nf);
+  if (!st->Ua) return PHGMG_ERR_NOMEM;
+  st->Ca = st->Ua + (size_t)N * kmax; st->CB = st->Ca + (size_t)kmax * ns; st->Ta = st->CB + (size_t)m * ns;
+  st->Gf = st->Ta + kmax + 1; st->Qf = st->Gf + nf * nf;
+  rc = phgmg_adjust_snapshots(N, m, st->sys->B, ns, st->X, st->ldx, T, N, alloc);
+  if (rc == PHGMG_OK)
+    rc = phgmg__study_pod(st, T, kmax, phgmg__rank_floor(N, ns, st->X, st->ldx), st->Ua, &st->ka, st->Ca, st->Ta, alloc);
+  if (rc != PHGMG_OK) return rc;
+  phgmg_gemm('T', 'N', m, ns, N, 1.0, st->QB, N, st->X, st->ldx, 0.0, st->CB, m);
+  /* [B, Ua]^T G [B, Ua] and [B, Ua]^T Q [B, Ua] (ld m + ka) */
+  V = phgmg__dalloc(alloc, 2 * (size_t)N * (m + st->ka));
+  if (!V) return PHGMG_ERR_NOMEM;
+  GV = V + (size_t)N * (m + st->ka);
+  memcpy(V, st->sys->B, (size_t)N * m * sizeof(double));
+  memcpy(V + (size_t)N * m, st->Ua, (size_t)N * st->ka * sizeof(double));
+  memcpy(GV, V, (size_t)N * (m + st->ka) * sizeof(double));
+  rc = phgmg_jr_factor_create(&jr, st->sys, NULL, alloc);
+  if (rc == PHGMG_OK) {
+    phgmg_jr_solve(jr, 'N', m + st->ka, GV, N);
+    phgmg__atb(N, m + st->ka, m + st->ka, V, GV, st->Gf);
+    phgmg_ph_apply(st->sys, 'Q', m + st->ka, V, N, GV, N);
+    phgmg__atb(N, m + st->ka, m + st->ka, V, GV, st->Qf);
+  }
+  phgmg_jr_factor_destroy(jr);
+  phgmg__free(alloc, V);
+  return rc;
+}
+
+/* SP part: Up, Cp = Up^T X, tails Tp, Cq = (Q Up)^T X; with SP2 also Ug
+   (POD of the gradient snapshots) and Cg = Ug^T X. T: N x ns scratch. */
+PHGMG__PRIV phgmg_result phgmg__study_sp(phgmg_study *st, int kmax, int sp2, double *T, const phgmg_allocator *alloc) {
+  const int N = st->N, ns = st->ns;
+  int j;
+  phgmg_result rc;
+  st->Up = phgmg__dalloc(alloc, (size_t)N * kmax + 2 * (size_t)kmax * ns + (size_t)kmax + 1);
+  if (!st->Up) return PHGMG_ERR_NOMEM;
+  st->Cp = st->Up + (size_t)N * kmax; st->Cq = st->Cp + (size_t)kmax * ns; st->Tp = st->Cq + (size_t)kmax * ns;
+  for (j = 0; j < ns; ++j) memcpy(T + (size_t)j * N, st->X + (size_t)j * st->ldx, (size_t)N * sizeof(double));
+  rc = phgmg__study_pod(st, T, kmax, phgmg__rank_floor(N, ns, st->X, st->ldx), st->Up, &st->kp, st->Cp, st->Tp, alloc);
+  if (rc != PHGMG_OK) return rc;
+  phgmg_ph_apply(st->sys, 'Q', st->kp, st->Up, N, T, N);                /* Q Up */
+  phgmg_gemm('T', 'N', st->kp, ns, N, 1.0, T, N, st->X, st->ldx, 0.0, st->Cq, st->kp);
+  if (!sp2) return PHGMG_OK;
+  st->Ug = phgmg__dalloc(alloc, (size_t)N * kmax + (size_t)kmax * ns);
+  if (!st->Ug) return PHGMG_ERR_NOMEM;
+  st->Cg = st->Ug + (size_t)N * kmax;
+  for (j = 0; j < ns; ++j) phgmg_ph_gradient(st->sys, st->X + (size_t)j * st->ldx, T + (size_t)j * N);
+  rc = phgmg__study_pod(st, T, kmax, phgmg__rank_floor(N, ns, T, N), st->Ug, &st->kg, st->Cg, NULL, alloc);
+  if (rc == PHGMG_OK)   /* Cg = Ug^T X (the coordinates above were of the gradients) */
+    phgmg_gemm('T', 'N', st->kg, ns, N, 1.0, st->Ug, N, st->X, st->ldx, 0.0, st->Cg, st->kg);
+  return rc;
+}
+
+PHGMG_DEF phgmg_result phgmg_study_create(phgmg_study **out, const phgmg_ph_system *sys, const double *X,
+                                          int ldx, int ns, const phgmg_study_opts *so,
+                                          const phgmg_allocator *alloc) {
+  phgmg_study *st;
+  unsigned what;
+  double *T;
+  int N;
+  phgmg_result rc;
+  if (!out) return PHGMG_ERR_INVALID_ARG;
+  *out = NULL;
+  if (!sys || !X || !so) return PHGMG_ERR_INVALID_ARG;
+  what = so->what ? so->what : (PHGMG_STUDY_GMG | PHGMG_STUDY_SP);
+  if (what & PHGMG_STUDY_SP2) what |= PHGMG_STUDY_SP;
+  N = sys->N;
+  if (N < 1 || sys->m < 1 || ns < 1 || ldx < N || so->kmax < 1 || so->kmax > PHGMG__MIN(N, ns)) return PHGMG_ERR_SIZE;
+  if (!phgmg__mat_finite(N, ns, X, ldx)) return PHGMG_ERR_NANINF;
+  rc = phgmg_ph_validate(sys, 0.0, NULL, alloc);
+  if (rc != PHGMG_OK) return rc;
+  st = PHGMG__CAST(phgmg_study *, phgmg__alloc(alloc, sizeof(phgmg_study)));
+  if (!st) return PHGMG_ERR_NOMEM;
+  memset(st, 0, sizeof *st);
+  if (alloc) { st->alloc = *alloc; st->use_alloc = 1; }
+  st->sys = sys; st->X = X; st->ldx = ldx; st->ns = ns; st->N = N; st->m = sys->m;
+  st->xx = phgmg__sumsq(N, ns, X, ldx);
+  st->QB = phgmg__dalloc(alloc, (size_t)N * sys->m + (size_t)sys->m * sys->m);
+  T = phgmg__dalloc(alloc, (size_t)N * ns);
+  rc = st->QB && T ? PHGMG_OK : PHGMG_ERR_NOMEM;
+  if (rc == PHGMG_OK) {
+    st->RB = st->QB + (size_t)N * sys->m;
+    rc = phgmg__thin_qr(N, sys->m, sys->B, st->QB, st->RB, alloc);
+  }
+  if (rc == PHGMG_OK && (what & PHGMG_STUDY_GMG)) rc = phgmg__study_gmg(st, so->kmax, T, alloc);
+  if (rc == PHGMG_OK && (what & PHGMG_STUDY_SP)) rc = phgmg__study_sp(st, so->kmax, (what & PHGMG_STUDY_SP2) != 0, T, alloc);
+  phgmg__free(alloc, T);
+  if (rc != PHGMG_OK) { phgmg_study_destroy(st); return rc; }
+  *out = st;
+  return PHGMG_OK;
+}
+
+/* The study's DEIM points for opts (computed at the first use, kept while
+   tol, cap and point selection are the same). 0 if not applicable or failed
+   (phgmg_reduce then computes and reports). */
+PHGMG__PRIV int phgmg__study_deim(phgmg_study *st, const phgmg_reduce_opts *o) {
+  const phgmg_ph_system *sys = st->sys;
+  const phgmg_allocator *alloc = st->use_alloc ? &st->alloc : NULL;
+  const int nt = sys->nsep, ns = st->ns;
+  const int meth = o->hyper == PHGMG_HYPER_GREEDY ? PHGMG_DEIM_GREEDY : PHGMG_DEIM_QDEIM;
+  double *F;
+  int a, i;
+  phgmg_result rc;
+  if (o->deim != 1 || o->deim_pts || sys->nl != PHGMG_NL_SEPARABLE || nt < 1 ||
+      (o->hyper != PHGMG_HYPER_QDEIM && o->hyper != PHGMG_HYPER_GREEDY) || !(o->deim_tol >= 0.0 && o->deim_tol < 1.0))
+    return 0;
+  if (st->deim_have && st->deim_tol == o->deim_tol && st->deim_max == o->deim_max && st->deim_method == meth) return 1;
+  st->deim_have = 0;
+  if (!st->deim_pts) st->deim_pts = phgmg__ialloc(alloc, (size_t)nt);
+  if (!st->deim_w) st->deim_w = phgmg__dalloc(alloc, (size_t)nt);
+  F = phgmg__dalloc(alloc, (size_t)nt * ns);
+  if (!st->deim_pts || !st->deim_w || !F) { phgmg__free(alloc, F); return 0; }
+  for (i = 0; i < ns; ++i)
+    for (a = 0; a < nt; ++a)
+      F[a + (size_t)i * nt] = phgmg__ph_phi(sys, a, st->X[sys->sep_idx[a] + (size_t)i * st->ldx], 1);
+  rc = phgmg_deim_select(nt, ns, F, nt, sys->sep_w, o->deim_tol, o->deim_max, meth, st->deim_pts, st->deim_w,
+                         &st->deim_nd, &st->deim_nneg, &st->deim_sigma, alloc);
+  phgmg__free(alloc, F);
+  if (rc != PHGMG_OK) return 0;
+  st->deim_have = 1; st->deim_tol = o->deim_tol; st->deim_max = o->deim_max; st->deim_method = meth;
+  return 1;
+}
+
+PHGMG_DEF phgmg_result phgmg_study_reduce(phgmg_study *st, const phgmg_reduce_opts *opts, phgmg_reduced **out,
+                                          phgmg_reduce_info *info) {
+  phgmg_reduce_opts o;
+  phgmg_result rc;
+  int deim;
+  if (out) *out = NULL;
+  if (!st || !opts || !out) return PHGMG_ERR_INVALID_ARG;
+  o = *opts;
+  if ((o.method == PHGMG_METHOD_GMG_POD || o.method == PHGMG_METHOD_GMG_QM) && st->Ua && !o.pod_basis) {
+    o.pod_basis = st->Ua; o.pod_cols = st->ka;
+  }
+  if ((o.method == PHGMG_METHOD_SP1 || o.method == PHGMG_METHOD_SP2) && st->Up && !o.pod_basis) {
+    o.pod_basis = st->Up; o.pod_cols = st->kp;
+  }
+  if (o.method == PHGMG_METHOD_SP2 && st->Ug && !o.grad_basis) { o.grad_basis = st->Ug; o.grad_cols = st->kg; }
+  deim = phgmg__study_deim(st, &o);
+  if (deim) { o.deim_pts = st->deim_pts; o.deim_w = st->deim_w; o.deim_count = st->deim_nd; }
+  rc = phgmg__reduce_run(out, st->sys, st->X, st->ldx, st->ns, &o, info, st->use_alloc ? &st->alloc : NULL, st);
+  if (info && deim) { info->deim_sigma_ratio = st->deim_sigma; info->hyper_method = o.hyper; }
+  return rc;
+}
+
+/* Q (rn x nb) = M (x2_i kron x2_i) of the built-in quadratic map for nb
+   points x2_i = X2(:, i) (ld ld2), as one GEMM; K: p^2 x nb scratch. */
+PHGMG__PRIV void phgmg__q_block(const phgmg_reduced *red, int nb, const double *X2, int ld2, double *K, double *Q) {
+  const int p = red->p, rn = red->rn;
+  int i, a, j;
+  for (i = 0; i < nb; ++i) {
+    const double *x = X2 + (size_t)i * ld2;
+    double *k = K + (size_t)i * p * p;
+    for (a = 0; a < p; ++a)
+      for (j = 0; j < p; ++j) k[a * p + j] = x[a] * x[j];
+  }
+  phgmg_gemm('N', 'N', rn, nb, p * p, 1.0, red->M, rn, K, p * p, 0.0, Q, rn);
+}
+
+/* Squared error sums of a fast-path GMG model, snapshots j0..j0+nb-1:
+   x - phi(xr) = (I - P_k) x + QB (QB^T x - RB xr1) + V1 (Ua1^T x - xr2) +
+   V2 (Ua2^T x - q(xr2)) with orthonormal [QB, V1, V2], k = p + rn (the tail
+   is added by the caller); q by phgmg__q_block. w: p^2 nb + 2 rn nb. */
+PHGMG__PRIV void phgmg__study_err_gmg(const phgmg_study *st, const phgmg_reduced *red, const double *XR, int ldxr,
+                                      int j0, int nb, double *w, double s[2]) {
+  const int m = red->m, p = red->p, rn = red->rn, ka = st->ka;
+  double *K = w, *Q1 = K + (size_t)p * p * nb, *Q2 = Q1 + (size_t)rn * nb;
+  int i, a, b;
+  if (rn) {
+    phgmg__q_block(red, nb, st->Ca + (size_t)j0 * ka, ka, K, Q1);
+    if (XR) phgmg__q_block(red, nb, XR + (size_t)j0 * ldxr + m, ldxr, K, Q2);
+  }
+  for (i = 0; i < nb; ++i) {
+    const double *ca = st->Ca + (size_t)(j0 + i) * ka, *cb = st->CB + (size_t)(j0 + i) * m;
+    for (a = 0; a < rn; ++a) s[1] += (ca[p + a] - Q1[a + (size_t)i * rn]) * (ca[p + a] - Q1[a + (size_t)i * rn]);
+    if (XR) {
+      const double *xr = XR + (size_t)(j0 + i) * ldxr;
+      for (a = 0; a < m; ++a) {
+        double d = cb[a];
+        for (b = a; b < m; ++b) d -= red->RB[a + b * m] * xr[b];
+        s[0] += d * d;
+      }
+      for (a = 0; a < p; ++a) s[0] += (ca[a] - xr[m + a]) * (ca[a] - xr[m + a]);
+      for (a = 0; a < rn; ++a) s[0] += (ca[p + a] - Q2[a + (size_t)i * rn]) * (ca[p + a] - Q2[a + (size_t)i * rn]);
+    }
+  }
+}
+
+/* Squared error sums of a fast-path model over the study's snapshots:
+   s[0] (e_red; needs XR), s[1] (e_proj). GMG: phgmg__study_err_gmg; SP:
+   x - V xr = (I - P_r) x + V (Up^T x - xr), rho(x) = Ainv^T Vg^T x.
+   0 if the workspace cannot be allocated. */
+PHGMG__PRIV int phgmg__study_err_sums(const phgmg_study *st, const phgmg_reduced *red, const double *XR, int ldxr,
+                                      double s[2]) {
+  const int r = red->r, ns = st->ns;
+  int i, a, b;
+  if (red->sbasis == 1) {
+    const phgmg_allocator *alloc = red->use_alloc ? &red->alloc : NULL;
+    const int nbmax = PHGMG__ERR_NB, p = red->p, rn = red->rn;
+    double *w = phgmg__dalloc(alloc, (size_t)nbmax * ((size_t)p * p + 2 * (size_t)rn) + 1);
+    int j0;
+    if (!w) return 0;
+    s[0] = s[1] = st->Ta[p + rn];
+    for (j0 = 0; j0 < ns; j0 += nbmax)
+      phgmg__study_err_gmg(st, red, XR, ldxr, j0, PHGMG__MIN(nbmax, ns - j0), w, s);
+    phgmg__free(alloc, w);
+    return 1;
+  }
+  {
+    const double *Cv = red->sbasis == 2 ? st->Cq : st->Cg;
+    const int ld = red->sbasis == 2 ? st->kp : st->kg, kp = st->kp;
+    s[0] = s[1] = st->Tp[r];
+    for (i = 0; i < ns; ++i) {
+      const double *cp = st->Cp + (size_t)i * kp, *cv = Cv + (size_t)i * ld;
+      for (a = 0; a < r; ++a) {
+        double w = 0.0;
+        for (b = 0; b < r; ++b) w += red->Ainv[b + (size_t)a * r] * cv[b];
+        s[1] += (cp[a] - w) * (cp[a] - w);
+        if (XR) s[0] += (cp[a] - XR[a + (size_t)i * ldxr]) * (cp[a] - XR[a + (size_t)i * ldxr]);
+      }
+    }
+  }
+  return 1;
+}
+
+PHGMG_DEF phgmg_result phgmg_study_errors(const phgmg_study *st, const phgmg_reduced *red, const double *XR,
+                                          int ldxr, double *e_red, double *e_proj, double *e_lower) {
+  double s[2];
+  if (!st || !red) return PHGMG_ERR_INVALID_ARG;
+  if (red->N != st->N || red->m != st->m || (XR && ldxr < red->r)) return PHGMG_ERR_SIZE;
+  if (red->study != st || red->sbasis == 0 || red->rn > 64) {
+    if (e_red) *e_red = XR ? phgmg_err_red(red, st->X, st->ldx, st->ns, XR, ldxr) : (double)NAN;
+    if (e_proj) *e_proj = phgmg_err_proj(red, st->X, st->ldx, st->ns);
+    if (e_lower) *e_lower = phgmg_err_lowerbound(red, st->X, st->ldx, st->ns);
+    return PHGMG_OK;
+  }
+  if (!phgmg__study_err_sums(st, red, XR, ldxr, s)) return PHGMG_ERR_NOMEM;
+  if (e_red) *e_red = !XR ? (double)NAN : (st->xx > 0.0 ? sqrt(s[0] / st->xx) : 0.0);
+  if (e_proj) *e_proj = st->xx > 0.0 ? sqrt(s[1] / st->xx) : 0.0;
+  if (e_lower)
+    *e_lower = red->kind != PHGMG_ROM_QUADRATIC ? (double)NAN
+                                                : (st->xx > 0.0 ? sqrt(st->Ta[red->p + red->rn] / st->xx) : 0.0);
+  return PHGMG_OK;
 }
 #endif /* PHGMG_NO_OFFLINE */
 

@@ -12,7 +12,8 @@
 #    and records its cases with a `_cblas` suffix (one BLAS thread);
 # 4. builds the examples (`make examples`; if that fails, the two demo
 #    programs directly, without -Werror) and times the whole demo (the three
-#    runs `make demo` makes: linear, nonlinear, linear with --lambda auto; wall
+#    runs `make demo` makes, with its arguments: linear, nonlinear, linear with
+#    --lambda auto --rmin 8 --rmax 14 --rstep 6; wall
 #    clock, one warm-up, then DEMO_RUNS runs) as case `demo_total`, and its
 #    CPU time (user + sys of the two programs; robust to other load on the
 #    machine) as `demo_total_cpu`;
@@ -115,7 +116,7 @@ if [ -x "$demo_lin" ] && [ -x "$demo_nl" ]; then
     times > "$BUILD/bench_times0"   # CPU time of the children so far (no subshell: a builtin)
     t0=$(date +%s.%N)
     if ! { "./$demo_lin" --out "$BUILD/bench_results" && "./$demo_nl" --out "$BUILD/bench_results" &&
-           "./$demo_lin" --lambda auto --rmin 6 --out "$BUILD/bench_results"; } >/dev/null; then
+           "./$demo_lin" --lambda auto --rmin 8 --rmax 14 --rstep 6 --out "$BUILD/bench_results"; } >/dev/null; then
       echo "run.sh: warning: the demo failed" >&2
       ok=0
       break

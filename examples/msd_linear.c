@@ -136,7 +136,7 @@ int main(int argc, char **argv) {
         memset(&o, 0, sizeof o);
         o.method = meth_id[j]; o.r = r; o.rn = rn; o.lambda = lambda; o.dt = dt;
         demo_cache_use(&cache, &o);
-        res = demo_run_rom(&M.sys, X, Y, nsteps, dt, inf[in], &o, 1e-10, 10, NULL);
+        res = demo_run_rom(&cache, &M.sys, X, Y, nsteps, dt, inf[in], &o, 1e-10, 10, NULL);
         if (res.rc != PHGMG_OK) fprintf(stderr, "  [%s r=%d: %s]\n", meth_name[j], r, phgmg_result_string(res.rc));
         tred[k * (NMETH + 1) + 1 + j] = res.e_red;
         ty[k * (NMETH + 1) + 1 + j] = res.e_y;

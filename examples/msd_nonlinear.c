@@ -176,7 +176,7 @@ int main(int argc, char **argv) {
           REH = (double *)malloc(sizeof(double) * 3 * ns);
           ren.H = REH; ren.S = REH + ns; ren.D = REH + 2 * ns;
         }
-        res = demo_run_rom(&M.sys, X, Y, nsteps, dt, inf[in], &o, 1e-8, 20, REH ? &ren : NULL);
+        res = demo_run_rom(&cache, &M.sys, X, Y, nsteps, dt, inf[in], &o, 1e-8, 20, REH ? &ren : NULL);
         if (res.rc != PHGMG_OK) fprintf(stderr, "  [%s r=%d: %s]\n", meth_name[j], r, phgmg_result_string(res.rc));
         if (REH) {
           if (res.rc == PHGMG_OK) {
