@@ -1090,6 +1090,15 @@ typedef struct phgmg_reduce_opts {
      runs, or to measure the manifold's best case; it does not guard against
      inputs unlike the training ones. */
   int lambda_train_only;
+  /* Optional progress report for long reductions (NULL: none; the library
+     itself never prints): phgmg_reduce calls progress(phase, progress_user)
+     as each stage starts, phase one of "basis" (snapshot adjustment and POD),
+     "manifold", "blocks" (reduced operators), "hamiltonian" (quadratic terms),
+     "hyper-reduction" (the separable part: gradient snapshots and DEIM/ECSW),
+     "finish" (general term, step map, validation), and "done" at the end of
+     a successful reduction. Called from the calling thread only. */
+  void (*progress)(const char *phase, void *user);
+  void *progress_user;
 } phgmg_reduce_opts;
 
 typedef struct phgmg_reduce_info {
@@ -7423,19 +7432,15 @@ PHGMG__PRIV double phgmg__ecsw_resid(int m, int n, const double *Gm, int ldg, co
   return phgmg_normf(m, 1, r, m);
 }
 
-PHGMG_DEF phgmg_result phgmg_ecsw(int nterms, int nrows, const double *Gm, int ldg, const double *target,
-                                  double tol, int *pts, double *w, int *nd_out, double *resid_out,
-                                  const phgmg_allocator *alloc) {
-  const int n = nterms, m = nrows;
+/* phgmg_ecsw on checked arguments (tol > 0): Lawson-Hanson in the hybrid
+   Gram form over all n columns (the Gram matrix n x n in memory). */
+PHGMG__PRIV phgmg_result phgmg__ecsw_gram(int n, int m, const double *Gm, int ldg, const double *target,
+                                          double tol, int *pts, double *w, int *nd_out, double *resid_out,
+                                          const phgmg_allocator *alloc) {
   phgmg__nnls_prob pb;
   double *G, *c, *x, *r, tn, rel = 0.0, res2 = 0.0;
   int j, nd = 0;
   phgmg_result rc = PHGMG_OK;
-  if (!Gm || !target || !pts || !w || !nd_out) return PHGMG_ERR_INVALID_ARG;
-  if (tol != tol) return PHGMG_ERR_INVALID_ARG;
-  if (n < 1 || m < 1 || ldg < m) return PHGMG_ERR_SIZE;
-  if (!phgmg__mat_finite(m, n, Gm, ldg) || !phgmg__all_finite(target, (size_t)m)) return PHGMG_ERR_NANINF;
-  if (tol <= 0.0) tol = 1e-6;
   tn = phgmg_normf(m, 1, target, m);
   *nd_out = 0;
   if (resid_out) *resid_out = 0.0;
@@ -7469,6 +7474,152 @@ PHGMG_DEF phgmg_result phgmg_ecsw(int nterms, int nrows, const double *Gm, int l
   return rc;
 }
 
+/* ---- ECSW with candidate screening (many terms) ----------------------
+   Lawson-Hanson over n candidate terms needs the Gram matrix n x n (the
+   hybrid form above): 8 n^2 bytes and m n^2 flops, out of reach at n = 10^5.
+   The points it keeps are few (tens to hundreds), so the fit is made on a
+   working set W of candidates that grows by screening: the gradient of the
+   full problem g = Gm^T (target - Gm w) is computed for all n terms (one
+   product with the training matrix), the PHGMG_ECSW_SCREEN_ADD terms outside
+   W with the largest positive g join W, and phgmg__ecsw_gram solves the
+   problem restricted to W (rows = all training rows, so its residual is the
+   full problem's residual, not an estimate). Repeated until the residual
+   meets tol, or no term outside W has a positive gradient (then w is optimal
+   over all n terms, as Lawson-Hanson's: PHGMG_ERR_NOT_CONVERGED if above
+   tol). Each round solves from zero on W, so the result is Lawson-Hanson's
+   greedy solution on the final W: w >= 0 by construction. The two ways to
+   apply the training matrix are callbacks (explicit Gm; the separable
+   product F^T diag(.) Vt that never forms it). */
+#ifndef PHGMG_ECSW_SCREEN_MIN
+#define PHGMG_ECSW_SCREEN_MIN 4096 /* terms from which phgmg_ecsw(_separable) screens */
+#endif
+#ifndef PHGMG_ECSW_SCREEN_ADD
+#define PHGMG_ECSW_SCREEN_ADD 64   /* candidates added per round */
+#endif
+typedef struct phgmg__ecsw_op {
+  /* g (n) = Gm^T res (res: m training rows); h: scratch of op's own size */
+  void (*grad)(const struct phgmg__ecsw_op *op, const double *res, double *g, double *h);
+  /* col (m) = column j of Gm */
+  void (*col)(const struct phgmg__ecsw_op *op, int j, double *col);
+  int n, m;
+  size_t hsize;                       /* doubles of scratch for grad */
+  const double *A; int lda;           /* explicit Gm (m x n), or F (n x ns) */
+  const double *Vt; int ldvt, ns, r;  /* separable: Vt (n x r); row (i, a) = a * ns + i */
+} phgmg__ecsw_op;
+
+PHGMG__PRIV void phgmg__ecsw_grad_dense(const phgmg__ecsw_op *op, const double *res, double *g, double *h) {
+  (void)h;
+  phgmg_gemv('T', op->m, op->n, 1.0, op->A, op->lda, res, 0.0, g);
+}
+PHGMG__PRIV void phgmg__ecsw_col_dense(const phgmg__ecsw_op *op, int j, double *col) {
+  memcpy(col, op->A + (size_t)j * op->lda, (size_t)op->m * sizeof(double));
+}
+/* g_k = sum_a Vt[k, a] (F res)[k, a], res ns x r: 2 n ns r flops (one GEMM). */
+PHGMG__PRIV void phgmg__ecsw_grad_sep(const phgmg__ecsw_op *op, const double *res, double *g, double *h) {
+  const int n = op->n;
+  int k, a;
+  phgmg_gemm('N', 'N', n, op->r, op->ns, 1.0, op->A, op->lda, res, op->ns, 0.0, h, n);
+  for (k = 0; k < n; ++k) g[k] = 0.0;
+  for (a = 0; a < op->r; ++a)
+    for (k = 0; k < n; ++k) g[k] += op->Vt[k + (size_t)a * op->ldvt] * h[k + (size_t)a * n];
+}
+PHGMG__PRIV void phgmg__ecsw_col_sep(const phgmg__ecsw_op *op, int j, double *col) {
+  int i, a;
+  for (a = 0; a < op->r; ++a) {
+    const double v = op->Vt[j + (size_t)a * op->ldvt];
+    for (i = 0; i < op->ns; ++i) col[i + (size_t)a * op->ns] = op->A[j + (size_t)i * op->lda] * v;
+  }
+}
+
+/* Add to W (nw entries, inW flags) up to `add` terms outside W with the
+   largest g > gtol (largest first). Returns the number added. */
+PHGMG__PRIV int phgmg__ecsw_screen_add(int n, const double *g, double gtol, int add, int *W, int nw, char *inW) {
+  int cnt = 0, k;
+  while (cnt < add) {
+    int best = -1;
+    double gb = gtol;
+    for (k = 0; k < n; ++k)
+      if (!inW[k] && g[k] > gb) { gb = g[k]; best = k; }
+    if (best < 0) break;
+    inW[best] = 1;
+    W[nw + cnt++] = best;
+  }
+  return cnt;
+}
+
+/* The screening driver (see above). target: m (not 0); tol > 0. */
+PHGMG__PRIV phgmg_result phgmg__ecsw_screened(const phgmg__ecsw_op *op, const double *target, double tol, int *pts, double *w, int *nd_out, double *resid_out,
+                                              const phgmg_allocator *alloc) {
+  const int n = op->n, m = op->m;
+  const int wmax = PHGMG__MIN(n, 16 * PHGMG_ECSW_SCREEN_ADD);
+  double *Gw, *res, *g, *h, *ww, gtol, rel = HUGE_VAL;
+  int *W, *pw, nw = 0, nd = 0, i, j;
+  char *inW;
+  phgmg_result rc = PHGMG_ERR_NOT_CONVERGED;
+  Gw = phgmg__dalloc(alloc, (size_t)m * wmax + (size_t)m + (size_t)n + op->hsize + (size_t)wmax);
+  W = phgmg__ialloc(alloc, 2 * (size_t)wmax + (size_t)n);
+  if (!Gw || !W) { phgmg__free(alloc, Gw); phgmg__free(alloc, W); return PHGMG_ERR_NOMEM; }
+  res = Gw + (size_t)m * wmax;
+  g = res + m;
+  h = g + n;
+  ww = h + op->hsize;
+  pw = W + wmax;
+  inW = (char *)(pw + wmax);   /* n flags in the int tail (n ints >= n chars) */
+  memset(inW, 0, (size_t)n);
+  memcpy(res, target, (size_t)m * sizeof(double));
+  op->grad(op, target, g, h);  /* gradient at w = 0; its scale sets the threshold */
+  for (gtol = 0.0, j = 0; j < n; ++j) gtol = PHGMG__MAX(gtol, fabs(g[j]));
+  gtol *= 1e3 * PHGMG__EPS;
+  for (;;) {
+    const int add = phgmg__ecsw_screen_add(n, g, gtol, PHGMG__MIN(PHGMG_ECSW_SCREEN_ADD, wmax - nw), W, nw, inW);
+    if (add == 0) break;          /* optimal over all terms (or W full) */
+    for (j = nw; j < nw + add; ++j) op->col(op, W[j], Gw + (size_t)j * m);
+    nw += add;
+    rc = phgmg__ecsw_gram(nw, m, Gw, m, target, tol, pw, ww, &nd, &rel, alloc);
+    if (rc != PHGMG_OK && rc != PHGMG_ERR_NOT_CONVERGED) break;
+    if (rc == PHGMG_OK) break;    /* tol met on the full rows */
+    memcpy(res, target, (size_t)m * sizeof(double));
+    for (j = 0; j < nd; ++j) phgmg__axpy(m, -ww[j], Gw + (size_t)pw[j] * m, res);
+    op->grad(op, res, g, h);
+  }
+  if (rc == PHGMG_OK || rc == PHGMG_ERR_NOT_CONVERGED) {
+    for (j = 0; j < nd; ++j) { /* W is in screening order: insertion sort to ascending terms */
+      const int pj = W[pw[j]];
+      const double wj = ww[j];
+      for (i = j; i > 0 && pts[i - 1] > pj; --i) { pts[i] = pts[i - 1]; w[i] = w[i - 1]; }
+      pts[i] = pj;
+      w[i] = wj;
+    }
+    *nd_out = nd;
+    if (resid_out) *resid_out = rel == HUGE_VAL ? 1.0 : rel;
+  }
+  phgmg__free(alloc, Gw);
+  phgmg__free(alloc, W);
+  return rc;
+}
+
+PHGMG_DEF phgmg_result phgmg_ecsw(int nterms, int nrows, const double *Gm, int ldg, const double *target,
+                                  double tol, int *pts, double *w, int *nd_out, double *resid_out,
+                                  const phgmg_allocator *alloc) {
+  const int n = nterms, m = nrows;
+  phgmg__ecsw_op op;
+  double tn;
+  if (!Gm || !target || !pts || !w || !nd_out) return PHGMG_ERR_INVALID_ARG;
+  if (tol != tol) return PHGMG_ERR_INVALID_ARG;
+  if (n < 1 || m < 1 || ldg < m) return PHGMG_ERR_SIZE;
+  if (!phgmg__mat_finite(m, n, Gm, ldg) || !phgmg__all_finite(target, (size_t)m)) return PHGMG_ERR_NANINF;
+  if (tol <= 0.0) tol = 1e-6;
+  if (n < PHGMG_ECSW_SCREEN_MIN) return phgmg__ecsw_gram(n, m, Gm, ldg, target, tol, pts, w, nd_out, resid_out, alloc);
+  tn = phgmg_normf(m, 1, target, m);
+  *nd_out = 0;
+  if (resid_out) *resid_out = 0.0;
+  if (tn == 0.0) return PHGMG_OK;
+  memset(&op, 0, sizeof op);
+  op.grad = phgmg__ecsw_grad_dense; op.col = phgmg__ecsw_col_dense;
+  op.n = n; op.m = m; op.A = Gm; op.lda = ldg;
+  return phgmg__ecsw_screened(&op, target, tol, pts, w, nd_out, resid_out, alloc);
+}
+
 /* ||F^T diag(a) Vt||_F (ns x r) for a (nterms); B: nterms x r, Y: ns x r scratch. */
 PHGMG__PRIV double phgmg__sep_norm(int nt, int ns, const double *F, int ldf, int r, const double *Vt, int ldvt,
                                    const double *a, double *B, double *Y) {
@@ -7477,6 +7628,34 @@ PHGMG__PRIV double phgmg__sep_norm(int nt, int ns, const double *F, int ldf, int
     for (k = 0; k < nt; ++k) B[k + (size_t)c * nt] = a[k] * Vt[k + (size_t)c * ldvt];
   phgmg_gemm('T', 'N', ns, r, nt, 1.0, F, ldf, B, nt, 0.0, Y, ns);
   return phgmg_normf(ns, r, Y, ns);
+}
+
+/* phgmg_ecsw_separable with screening (nterms >= PHGMG_ECSW_SCREEN_MIN):
+   training rows (i, a) = F[k, i] Vt[k, a] in full (row a ns + i), never
+   formed beyond the working set. */
+PHGMG__PRIV phgmg_result phgmg__ecsw_sep_screened(int nt, int ns, const double *F, int ldf, int r, const double *Vt,
+                                                  int ldvt, const double *sw, double tol, int *pts, double *w,
+                                                  int *nd_out, double *resid_out, const phgmg_allocator *alloc) {
+  phgmg__ecsw_op op;
+  double *B, *T, tn;
+  int i;
+  phgmg_result rc;
+  if ((double)ns * r > 2147483647.0) return PHGMG_ERR_SIZE;
+  B = phgmg__dalloc(alloc, (size_t)nt * r + (size_t)ns * r + (size_t)nt);
+  if (!B) return PHGMG_ERR_NOMEM;
+  T = B + (size_t)nt * r;
+  for (i = 0; i < nt; ++i) T[(size_t)ns * r + i] = sw ? sw[i] : 1.0;
+  tn = phgmg__sep_norm(nt, ns, F, ldf, r, Vt, ldvt, T + (size_t)ns * r, B, T); /* T = F^T diag(sw) Vt */
+  *nd_out = 0;
+  if (resid_out) *resid_out = 0.0;
+  if (tn == 0.0) { phgmg__free(alloc, B); return PHGMG_OK; }
+  memset(&op, 0, sizeof op);
+  op.grad = phgmg__ecsw_grad_sep; op.col = phgmg__ecsw_col_sep;
+  op.n = nt; op.m = ns * r; op.hsize = (size_t)nt * r;
+  op.A = F; op.lda = ldf; op.Vt = Vt; op.ldvt = ldvt; op.ns = ns; op.r = r;
+  rc = phgmg__ecsw_screened(&op, T, tol, pts, w, nd_out, resid_out, alloc);
+  phgmg__free(alloc, B);
+  return rc;
 }
 
 PHGMG_DEF phgmg_result phgmg_ecsw_separable(int nterms, int ns, const double *F, int ldf, int r, const double *Vt,
@@ -7493,6 +7672,8 @@ PHGMG_DEF phgmg_result phgmg_ecsw_separable(int nterms, int ns, const double *F,
       (sw && !phgmg__all_finite(sw, (size_t)nt)))
     return PHGMG_ERR_NANINF;
   if (tol <= 0.0) tol = 1e-6;
+  if (nt >= PHGMG_ECSW_SCREEN_MIN) return phgmg__ecsw_sep_screened(nt, ns, F, ldf, r, Vt, ldvt, sw, tol, pts, w,
+                                                                   nd_out, resid_out, alloc);
   U = phgmg__dalloc(alloc, (size_t)nt * kk + (size_t)kk + 2 * (size_t)nt + (size_t)nt * r + (size_t)ns * r);
   if (!U) return PHGMG_ERR_NOMEM;
   S = U + (size_t)nt * kk;
@@ -9021,6 +9202,11 @@ PHGMG__PRIV phgmg_result phgmg__stage_general_term(phgmg__rctx *c) {
   return red->gwork ? PHGMG_OK : PHGMG_ERR_NOMEM;
 }
 
+/* opts->progress, if set (see phgmg_reduce_opts). */
+PHGMG__PRIV void phgmg__progress(const phgmg_reduce_opts *o, const char *phase) {
+  if (o->progress) o->progress(phase, o->progress_user);
+}
+
 PHGMG_DEF phgmg_result phgmg_reduce(phgmg_reduced **out, const phgmg_ph_system *sys, const double *X,
                                     int ldx, int ns, const phgmg_reduce_opts *opts,
                                     phgmg_reduce_info *info, const phgmg_allocator *alloc) {
@@ -9047,12 +9233,15 @@ PHGMG_DEF phgmg_result phgmg_reduce(phgmg_reduced **out, const phgmg_ph_system *
   c.rfloor = phgmg__rank_floor(sys->N, ns, X, ldx);
   rc = phgmg__runs_layout(&c);
   if (rc == PHGMG_OK) rc = phgmg__reduce_new(&c);
-  if (rc == PHGMG_OK) rc = phgmg__stage_basis(&c);
-  if (rc == PHGMG_OK) rc = phgmg__stage_manifold(&c);
-  if (rc == PHGMG_OK) rc = phgmg__is_gmg(opts->method) ? phgmg__stage_gmg_blocks(&c) : phgmg__stage_sp_blocks(&c);
-  if (rc == PHGMG_OK) rc = phgmg__stage_quadratic_terms(&c);
-  if (rc == PHGMG_OK) rc = phgmg__stage_separable_terms(&c);
-  if (rc == PHGMG_OK) rc = phgmg__stage_general_term(&c);
+  if (rc == PHGMG_OK) { phgmg__progress(opts, "basis"); rc = phgmg__stage_basis(&c); }
+  if (rc == PHGMG_OK) { phgmg__progress(opts, "manifold"); rc = phgmg__stage_manifold(&c); }
+  if (rc == PHGMG_OK) {
+    phgmg__progress(opts, "blocks");
+    rc = phgmg__is_gmg(opts->method) ? phgmg__stage_gmg_blocks(&c) : phgmg__stage_sp_blocks(&c);
+  }
+  if (rc == PHGMG_OK) { phgmg__progress(opts, "hamiltonian"); rc = phgmg__stage_quadratic_terms(&c); }
+  if (rc == PHGMG_OK) { phgmg__progress(opts, "hyper-reduction"); rc = phgmg__stage_separable_terms(&c); }
+  if (rc == PHGMG_OK) { phgmg__progress(opts, "finish"); rc = phgmg__stage_general_term(&c); }
   if (rc == PHGMG_OK && opts->dt > 0.0 && c.red->kind == PHGMG_ROM_LINEAR && c.red->nd == 0 &&
       sys->nl != PHGMG_NL_GENERAL) {
     c.red->map_dt = opts->dt;
@@ -9069,6 +9258,7 @@ PHGMG_DEF phgmg_result phgmg_reduce(phgmg_reduced **out, const phgmg_ph_system *
     phgmg_reduced_destroy(c.red);
     return rc;
   }
+  phgmg__progress(opts, "done");
   *out = c.red;
   return PHGMG_OK;
 }
