@@ -1129,6 +1129,11 @@ typedef struct phgmg_reduce_info {
   int lambda_candidates;   /* lambda_auto = 1: candidate lambdas simulated     */
   double lambda_val_ratio; /* lambda_auto = 1: largest e_y ratio of the chosen
                               model to the linear limit over the validation runs */
+  int pod_randomized;      /* the basis POD: 0 exact SVD; 1 randomized (large
+                              N*ns, see phgmg_reduce: it passed its check);
+                              -1 randomized, check failed, exact SVD used     */
+  double pod_check;        /* randomized POD: ||X W - V diag(S)||_F / S_1 (the
+                              triplets' backward error); 0 on the exact path  */
 } phgmg_reduce_info;
 
 /* The reduced model with its offline data (bases for reconstruction, double
@@ -6900,10 +6905,13 @@ PHGMG__PRIV void phgmg__scale2(size_t cnt, double *A, int e) {
     for (t = 0; t < cnt; ++t) A[t] = ldexp(A[t], e);
 }
 
-PHGMG_DEF phgmg_result phgmg_pod_randomized(int N, int ns, const double *X, int ldx, int kmax,
-                                            int power_iters, unsigned long seed, double *V,
-                                            int ldv, double *S, int *k_out,
-                                            const phgmg_allocator *alloc) {
+/* phgmg_pod_randomized; with chk != NULL also the a-posteriori check
+   *chk = ||X W - V diag(S)||_F / S_1 (W = the right singular vectors, ns x k:
+   X^T V = W diag(S) holds by construction, so the k triplets are exact for a
+   perturbation of X of 2-norm at most *chk S_1). One more product with X (k columns). */
+PHGMG__PRIV phgmg_result phgmg__pod_rand_core(int N, int ns, const double *X, int ldx, int kmax, int power_iters,
+                                              unsigned long seed, double *V, int ldv, double *S, int *k_out,
+                                              double *chk, const phgmg_allocator *alloc) {
   double *Y, *Z, *Uz, *Ub, *tau, *s, amax;
   int l, it, i, k = 0, e = 0;
   unsigned long long state = (unsigned long long)seed;
@@ -6952,10 +6960,53 @@ PHGMG_DEF phgmg_result phgmg_pod_randomized(int N, int ns, const double *X, int 
     if (k > 0) phgmg_gemm('N', 'N', N, k, l, 1.0, Y, N, Ub, l, 0.0, V, ldv);
     for (i = 0; i < k && S; ++i) S[i] = ldexp(s[i], e);
     *k_out = k;
+    if (chk && k > 0) { /* Y (N x k) = 2^-e X Uz - V diag(s) (Y is free now) */
+      phgmg__scale2(nz, Uz, -e);
+      phgmg_gemm('N', 'N', N, k, ns, 1.0, X, ldx, Uz, ns, 0.0, Y, N);
+      for (it = 0; it < k; ++it) phgmg__axpy(N, -s[it], V + (size_t)it * ldv, Y + (size_t)it * N);
+      *chk = phgmg_normf(N, k, Y, N) / s[0];
+    }
   }
   phgmg__free(alloc, Y);
   phgmg__free(alloc, Z);
   return rc;
+}
+
+PHGMG_DEF phgmg_result phgmg_pod_randomized(int N, int ns, const double *X, int ldx, int kmax,
+                                            int power_iters, unsigned long seed, double *V,
+                                            int ldv, double *S, int *k_out,
+                                            const phgmg_allocator *alloc) {
+  return phgmg__pod_rand_core(N, ns, X, ldx, kmax, power_iters, seed, V, ldv, S, k_out, NULL, alloc);
+}
+
+/* The POD phgmg_reduce uses (its stage_basis). Exact (phgmg_pod) unless the
+   snapshot matrix is large, N*ns >= PHGMG_POD_AUTO_MIN (default 2e7: N >= 20 000
+   at 1001 snapshots), and few modes are wanted, 4 (k + PHGMG_POD_OVERSAMPLE) <=
+   min(N, ns): then phgmg_pod_randomized with its default power iterations,
+   accepted if the a-posteriori check ||X W - V diag(S)||_F <= PHGMG_POD_CHECK_TOL
+   (default 1e-10) S_1 holds and all k modes came out, else the exact POD
+   (fallback). *how: 0 exact, 1 randomized, -1 randomized rejected -> exact;
+   *chk: the check's value (0 on the exact path). PHGMG_POD_AUTO_MIN <= 0: always exact. */
+#ifndef PHGMG_POD_AUTO_MIN
+#define PHGMG_POD_AUTO_MIN 2e7
+#endif
+#ifndef PHGMG_POD_CHECK_TOL
+#define PHGMG_POD_CHECK_TOL 1e-10
+#endif
+PHGMG__PRIV phgmg_result phgmg__pod_auto(int N, int ns, const double *X, int ldx, int k, double *V, int ldv,
+                                         double *S, int *k_out, int *how, double *chk,
+                                         const phgmg_allocator *alloc) {
+  *how = 0;
+  *chk = 0.0;
+  if ((double)(PHGMG_POD_AUTO_MIN) > 0.0 && (double)N * (double)ns >= (double)(PHGMG_POD_AUTO_MIN) &&
+      4 * (k + PHGMG_POD_OVERSAMPLE) <= PHGMG__MIN(N, ns)) {
+    phgmg_result rc = phgmg__pod_rand_core(N, ns, X, ldx, k, PHGMG_POD_POWER_ITERS, PHGMG_POD_SEED, V, ldv, S,
+                                           k_out, chk, alloc);
+    if (rc == PHGMG_ERR_NOMEM || rc == PHGMG_ERR_NANINF) return rc;
+    if (rc == PHGMG_OK && *k_out == k && *chk <= PHGMG_POD_CHECK_TOL) { *how = 1; return PHGMG_OK; }
+    *how = -1;
+  }
+  return phgmg_pod(N, ns, X, ldx, k, 0.0, V, ldv, S, k_out, alloc);
 }
 
 /* Thin QR of B (N x m): QB (N x m) orthonormal, RB (m x m) upper triangular.
@@ -8322,7 +8373,8 @@ PHGMG__PRIV phgmg_result phgmg__stage_basis(phgmg__rctx *c) {
     }
     S = phgmg__dalloc(c->alloc, (size_t)p);
     if (!S) return PHGMG_ERR_NOMEM;
-    rc = phgmg_pod(N, ns, c->X, c->ldx, p, 0.0, red->V0, N, S, &k, c->alloc);
+    rc = phgmg__pod_auto(N, ns, c->X, c->ldx, p, red->V0, N, S, &k, &c->inf.pod_randomized, &c->inf.pod_check,
+                         c->alloc);
     if (rc == PHGMG_OK && (k < p || !(S[p - 1] > c->rfloor))) rc = PHGMG_ERR_SIZE;
     phgmg__free(c->alloc, S);
     return rc;
@@ -8340,7 +8392,8 @@ PHGMG__PRIV phgmg_result phgmg__stage_basis(phgmg__rctx *c) {
   } else {
     double *V1 = tmp + (size_t)PHGMG__MAX(m, 1) * ns;
     S = V1 + (size_t)N * (p + 1);
-    rc = phgmg_pod(N, ns, c->Xa, N, PHGMG__MIN(p + 1, PHGMG__MIN(N, ns)), 0.0, V1, N, S, &k, c->alloc);
+    rc = phgmg__pod_auto(N, ns, c->Xa, N, PHGMG__MIN(p + 1, PHGMG__MIN(N, ns)), V1, N, S, &k, &c->inf.pod_randomized,
+                         &c->inf.pod_check, c->alloc);
     if (rc == PHGMG_OK && (k < p || !(S[p - 1] > c->rfloor))) rc = PHGMG_ERR_SIZE; /* r - m > rank */
     if (rc == PHGMG_OK) {
       memcpy(red->V0 + (size_t)N * m, V1, (size_t)N * p * sizeof(double));

@@ -118,8 +118,10 @@ int main(int argc, char **argv) {
     t[i] = now_cpu() - c0;
     w[i] = now_wall() - w[i];
     if (rc != PHGMG_OK) { fprintf(stderr, "bench_scale: phgmg_reduce: %s\n", phgmg_result_string(rc)); return 1; }
-    printf("  run %d: wall %.3f s, CPU %.3f s; %d ECSW points, training residual %.2e, POD sigma_r/sigma_1 %.2e\n",
-           i + 1, w[i], t[i], info.deim_modes, info.hyper_residual, info.pod_sigma_ratio);
+    printf("  run %d: wall %.3f s, CPU %.3f s; POD %s (check %.2e), sigma_r/sigma_1 %.2e; %d ECSW points, "
+           "training residual %.2e\n", i + 1, w[i], t[i],
+           info.pod_randomized == 1 ? "randomized" : info.pod_randomized ? "exact (randomized rejected)" : "exact",
+           info.pod_check, info.pod_sigma_ratio, info.deim_modes, info.hyper_residual);
     fflush(stdout);
     phgmg_reduced_destroy(red);
   }
