@@ -6905,14 +6905,34 @@ PHGMG__PRIV void phgmg__scale2(size_t cnt, double *A, int e) {
     for (t = 0; t < cnt; ++t) A[t] = ldexp(A[t], e);
 }
 
-/* phgmg_pod_randomized; with chk != NULL also the a-posteriori check
+/* Products with Xa = X - QB CB (QB N x m orthonormal, CB = QB^T X m x ns;
+   QB NULL: Xa = X). t = 'N': Out (N x l, ld N) = Xa M (M ns x l, ld ns);
+   t = 'T': Out (ns x l) = Xa^T M (M N x l). T: m x l scratch. */
+PHGMG__PRIV void phgmg__xa_mul(char t, int N, int ns, int l, const double *X, int ldx, const double *QB, int m,
+                               const double *CB, const double *M, double *Out, double *T) {
+  if (t == 'N') {
+    phgmg_gemm('N', 'N', N, l, ns, 1.0, X, ldx, M, ns, 0.0, Out, N);
+    if (!QB) return;
+    phgmg_gemm('N', 'N', m, l, ns, 1.0, CB, m, M, ns, 0.0, T, m);
+    phgmg_gemm('N', 'N', N, l, m, -1.0, QB, N, T, m, 1.0, Out, N);
+  } else {
+    phgmg_gemm('T', 'N', ns, l, N, 1.0, X, ldx, M, N, 0.0, Out, ns);
+    if (!QB) return;
+    phgmg_gemm('T', 'N', m, l, N, 1.0, QB, N, M, N, 0.0, T, m);
+    phgmg_gemm('T', 'N', ns, l, m, -1.0, CB, m, T, m, 1.0, Out, ns);
+  }
+}
+
+/* phgmg_pod_randomized of X, or of X - QB CB (see phgmg__xa_mul; the scaling
+   by 2^-e from max|X|); with chk != NULL also the a-posteriori check
    *chk = ||X W - V diag(S)||_F / S_1 (W = the right singular vectors, ns x k:
    X^T V = W diag(S) holds by construction, so the k triplets are exact for a
    perturbation of X of 2-norm at most *chk S_1). One more product with X (k columns). */
-PHGMG__PRIV phgmg_result phgmg__pod_rand_core(int N, int ns, const double *X, int ldx, int kmax, int power_iters,
+PHGMG__PRIV phgmg_result phgmg__pod_rand_core(int N, int ns, const double *X, int ldx, const double *QB, int m,
+                                              const double *CB, int kmax, int power_iters,
                                               unsigned long seed, double *V, int ldv, double *S, int *k_out,
                                               double *chk, const phgmg_allocator *alloc) {
-  double *Y, *Z, *Uz, *Ub, *tau, *s, amax;
+  double *Y, *Z, *Uz, *Ub, *tau, *s, *T, amax;
   int l, it, i, k = 0, e = 0;
   unsigned long long state = (unsigned long long)seed;
   size_t ny, nz;
@@ -6931,28 +6951,29 @@ PHGMG__PRIV phgmg_result phgmg__pod_rand_core(int N, int ns, const double *X, in
   ny = (size_t)N * (size_t)l;
   nz = (size_t)ns * (size_t)l;
   Y = phgmg__dalloc(alloc, ny);
-  Z = phgmg__dalloc(alloc, 2 * nz + (size_t)l * (size_t)l + 2 * (size_t)l);
+  Z = phgmg__dalloc(alloc, 2 * nz + (size_t)l * (size_t)l + 2 * (size_t)l + (size_t)(QB ? m : 0) * (size_t)l);
   if (!Y || !Z) { phgmg__free(alloc, Y); phgmg__free(alloc, Z); return PHGMG_ERR_NOMEM; }
   Uz = Z + nz;
   Ub = Uz + nz;
   tau = Ub + (size_t)l * (size_t)l;
   s = tau + l;
+  T = s + l;
   phgmg__gauss_fill(nz, &state, -e, Z);
-  phgmg_gemm('N', 'N', N, l, ns, 1.0, X, ldx, Z, ns, 0.0, Y, N);
+  phgmg__xa_mul('N', N, ns, l, X, ldx, QB, m, CB, Z, Y, T);
   rc = phgmg__orth(N, l, Y, tau);
   for (it = 0; it < power_iters && rc == PHGMG_OK; ++it) {
     phgmg__scale2(ny, Y, -e);
-    phgmg_gemm('T', 'N', ns, l, N, 1.0, X, ldx, Y, N, 0.0, Z, ns);
+    phgmg__xa_mul('T', N, ns, l, X, ldx, QB, m, CB, Y, Z, T);
     rc = phgmg__orth(ns, l, Z, tau);
     if (rc != PHGMG_OK) break;
     phgmg__scale2(nz, Z, -e);
-    phgmg_gemm('N', 'N', N, l, ns, 1.0, X, ldx, Z, ns, 0.0, Y, N);
+    phgmg__xa_mul('N', N, ns, l, X, ldx, QB, m, CB, Z, Y, T);
     rc = phgmg__orth(N, l, Y, tau);
   }
   if (rc == PHGMG_OK) {
     /* Z = 2^-e B^T = X^T (2^-e Q); its SVD Uz diag(s) Ub^T gives U = Q Ub */
     phgmg__scale2(ny, Y, -e);
-    phgmg_gemm('T', 'N', ns, l, N, 1.0, X, ldx, Y, N, 0.0, Z, ns);
+    phgmg__xa_mul('T', N, ns, l, X, ldx, QB, m, CB, Y, Z, T);
     phgmg__scale2(ny, Y, e);
     rc = phgmg_svd(ns, l, Z, ns, kmax, s, Uz, ns, Ub, l, &k, NULL, alloc);
   }
@@ -6962,7 +6983,7 @@ PHGMG__PRIV phgmg_result phgmg__pod_rand_core(int N, int ns, const double *X, in
     *k_out = k;
     if (chk && k > 0) { /* Y (N x k) = 2^-e X Uz - V diag(s) (Y is free now) */
       phgmg__scale2(nz, Uz, -e);
-      phgmg_gemm('N', 'N', N, k, ns, 1.0, X, ldx, Uz, ns, 0.0, Y, N);
+      phgmg__xa_mul('N', N, ns, k, X, ldx, QB, m, CB, Uz, Y, T);
       for (it = 0; it < k; ++it) phgmg__axpy(N, -s[it], V + (size_t)it * ldv, Y + (size_t)it * N);
       *chk = phgmg_normf(N, k, Y, N) / s[0];
     }
@@ -6976,7 +6997,7 @@ PHGMG_DEF phgmg_result phgmg_pod_randomized(int N, int ns, const double *X, int 
                                             int power_iters, unsigned long seed, double *V,
                                             int ldv, double *S, int *k_out,
                                             const phgmg_allocator *alloc) {
-  return phgmg__pod_rand_core(N, ns, X, ldx, kmax, power_iters, seed, V, ldv, S, k_out, NULL, alloc);
+  return phgmg__pod_rand_core(N, ns, X, ldx, NULL, 0, NULL, kmax, power_iters, seed, V, ldv, S, k_out, NULL, alloc);
 }
 
 /* The POD phgmg_reduce uses (its stage_basis). Exact (phgmg_pod) unless the
@@ -6986,22 +7007,25 @@ PHGMG_DEF phgmg_result phgmg_pod_randomized(int N, int ns, const double *X, int 
    accepted if the a-posteriori check ||X W - V diag(S)||_F <= PHGMG_POD_CHECK_TOL
    (default 1e-10) S_1 holds and all k modes came out, else the exact POD
    (fallback). *how: 0 exact, 1 randomized, -1 randomized rejected -> exact;
-   *chk: the check's value (0 on the exact path). PHGMG_POD_AUTO_MIN <= 0: always exact. */
+   *chk: the check's value (untouched when not tried). GMG-POD/SP at large N
+   skip the N x ns copy of the adjusted snapshots (phgmg__basis_pod_implicit). PHGMG_POD_AUTO_MIN <= 0: always exact. */
 #ifndef PHGMG_POD_AUTO_MIN
 #define PHGMG_POD_AUTO_MIN 2e7
 #endif
 #ifndef PHGMG_POD_CHECK_TOL
 #define PHGMG_POD_CHECK_TOL 1e-10
 #endif
+PHGMG__PRIV int phgmg__pod_rand_wanted(int N, int ns, int k) {
+  return (double)(PHGMG_POD_AUTO_MIN) > 0.0 && (double)N * (double)ns >= (double)(PHGMG_POD_AUTO_MIN) &&
+         4 * (k + PHGMG_POD_OVERSAMPLE) <= PHGMG__MIN(N, ns);
+}
+/* *how on entry: -1 = the randomized POD was rejected already (exact only). */
 PHGMG__PRIV phgmg_result phgmg__pod_auto(int N, int ns, const double *X, int ldx, int k, double *V, int ldv,
                                          double *S, int *k_out, int *how, double *chk,
                                          const phgmg_allocator *alloc) {
-  *how = 0;
-  *chk = 0.0;
-  if ((double)(PHGMG_POD_AUTO_MIN) > 0.0 && (double)N * (double)ns >= (double)(PHGMG_POD_AUTO_MIN) &&
-      4 * (k + PHGMG_POD_OVERSAMPLE) <= PHGMG__MIN(N, ns)) {
-    phgmg_result rc = phgmg__pod_rand_core(N, ns, X, ldx, k, PHGMG_POD_POWER_ITERS, PHGMG_POD_SEED, V, ldv, S,
-                                           k_out, chk, alloc);
+  if (*how != -1 && phgmg__pod_rand_wanted(N, ns, k)) {
+    phgmg_result rc = phgmg__pod_rand_core(N, ns, X, ldx, NULL, 0, NULL, k, PHGMG_POD_POWER_ITERS, PHGMG_POD_SEED, V,
+                                           ldv, S, k_out, chk, alloc);
     if (rc == PHGMG_ERR_NOMEM || rc == PHGMG_ERR_NANINF) return rc;
     if (rc == PHGMG_OK && *k_out == k && *chk <= PHGMG_POD_CHECK_TOL) { *how = 1; return PHGMG_OK; }
     *how = -1;
@@ -8349,6 +8373,38 @@ PHGMG__PRIV phgmg_result phgmg__check_given_basis(const phgmg_reduced *red, cons
   return err <= 1e-8 ? PHGMG_OK : PHGMG_ERR_RANK;
 }
 
+/* GMG: V1 (the first p of k POD modes, N x k) and S into V0 and info. */
+PHGMG__PRIV phgmg_result phgmg__basis_take(phgmg__rctx *c, const double *V1, const double *S, int k) {
+  phgmg_reduced *red = c->red;
+  const int N = red->N, m = red->m, p = red->p;
+  if (k < p || !(S[p - 1] > c->rfloor)) return PHGMG_ERR_SIZE; /* r - m > rank */
+  memcpy(red->V0 + (size_t)N * m, V1, (size_t)N * p * sizeof(double));
+  c->inf.pod_sigma_ratio = (k > p && S[0] > 0.0) ? S[p] / S[0] : 0.0;
+  return PHGMG_OK;
+}
+
+/* GMG with a linear basis (no manifold stage that needs the adjusted
+   snapshots) and a large snapshot set (phgmg__pod_rand_wanted): the
+   randomized POD of Xa = X - QB (QB^T X) applied as a product, without the
+   N x ns copy. PHGMG_ERR_NOT_CONVERGED: not tried or its check failed (the
+   caller then forms Xa and takes the exact POD). tmp: as stage_basis's. */
+PHGMG__PRIV phgmg_result phgmg__basis_pod_implicit(phgmg__rctx *c, double *tmp) {
+  phgmg_reduced *red = c->red;
+  const int N = red->N, m = red->m, p = red->p, ns = c->ns, kk = PHGMG__MIN(p + 1, PHGMG__MIN(N, ns));
+  double *V1 = tmp + (size_t)PHGMG__MAX(m, 1) * ns, *S = V1 + (size_t)N * (p + 1);
+  int k = 0;
+  phgmg_result rc;
+  if (!phgmg__pod_rand_wanted(N, ns, kk)) return PHGMG_ERR_NOT_CONVERGED;
+  phgmg_gemm('T', 'N', m, ns, N, 1.0, red->QB, N, c->X, c->ldx, 0.0, tmp, m); /* CB = QB^T X */
+  rc = phgmg__pod_rand_core(N, ns, c->X, c->ldx, red->QB, m, tmp, kk, PHGMG_POD_POWER_ITERS, PHGMG_POD_SEED, V1, N, S,
+                            &k, &c->inf.pod_check, c->alloc);
+  if (rc == PHGMG_ERR_NOMEM || rc == PHGMG_ERR_NANINF) return rc;
+  c->inf.pod_randomized = -1;
+  if (rc != PHGMG_OK || k != kk || !(c->inf.pod_check <= PHGMG_POD_CHECK_TOL)) return PHGMG_ERR_NOT_CONVERGED;
+  c->inf.pod_randomized = 1;
+  return phgmg__basis_take(c, V1, S, k);
+}
+
 /* Stage 1, basis. GMG: V0 = [B, V1], V1 = POD of the adjusted snapshots
    X - B B^+ X (c->Xa keeps them, for the manifold stage). SP1/SP2: V0 =
    V_POD of X. opts.pod_basis replaces the POD. */
@@ -8379,12 +8435,18 @@ PHGMG__PRIV phgmg_result phgmg__stage_basis(phgmg__rctx *c) {
     phgmg__free(c->alloc, S);
     return rc;
   }
-  c->Xa = phgmg__dalloc(c->alloc, (size_t)N * ns);
   tmp = phgmg__dalloc(c->alloc, (size_t)PHGMG__MAX(m, 1) * ns + (size_t)N * (p + 1) + (size_t)p + 1);
-  if (!c->Xa || !tmp) { phgmg__free(c->alloc, tmp); return PHGMG_ERR_NOMEM; }
+  if (!tmp) return PHGMG_ERR_NOMEM;
+  memcpy(red->V0, c->sys->B, (size_t)N * m * sizeof(double));
+  if (!c->o->pod_basis && red->kind != PHGMG_ROM_QUADRATIC) { /* large: randomized, X - QB QB^T X implicit */
+    rc = phgmg__basis_pod_implicit(c, tmp);
+    if (rc != PHGMG_ERR_NOT_CONVERGED) { phgmg__free(c->alloc, tmp); return rc; }
+    rc = PHGMG_OK;
+  }
+  c->Xa = phgmg__dalloc(c->alloc, (size_t)N * ns);
+  if (!c->Xa) { phgmg__free(c->alloc, tmp); return PHGMG_ERR_NOMEM; }
   for (j = 0; j < ns; ++j) memcpy(c->Xa + (size_t)j * N, c->X + (size_t)j * c->ldx, (size_t)N * sizeof(double));
   phgmg__orth_remove(N, m, red->QB, ns, c->Xa, N, tmp);
-  memcpy(red->V0, c->sys->B, (size_t)N * m * sizeof(double));
   if (c->o->pod_basis) {
     memcpy(red->V0 + (size_t)N * m, c->o->pod_basis, (size_t)N * p * sizeof(double));
     if (red->method == PHGMG_METHOD_GMG_MANIFOLD)
@@ -8394,11 +8456,7 @@ PHGMG__PRIV phgmg_result phgmg__stage_basis(phgmg__rctx *c) {
     S = V1 + (size_t)N * (p + 1);
     rc = phgmg__pod_auto(N, ns, c->Xa, N, PHGMG__MIN(p + 1, PHGMG__MIN(N, ns)), V1, N, S, &k, &c->inf.pod_randomized,
                          &c->inf.pod_check, c->alloc);
-    if (rc == PHGMG_OK && (k < p || !(S[p - 1] > c->rfloor))) rc = PHGMG_ERR_SIZE; /* r - m > rank */
-    if (rc == PHGMG_OK) {
-      memcpy(red->V0 + (size_t)N * m, V1, (size_t)N * p * sizeof(double));
-      c->inf.pod_sigma_ratio = (k > p && S[0] > 0.0) ? S[p] / S[0] : 0.0;
-    }
+    if (rc == PHGMG_OK) rc = phgmg__basis_take(c, V1, S, k);
   }
   phgmg__free(c->alloc, tmp);
   return rc;

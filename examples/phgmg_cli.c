@@ -231,6 +231,12 @@ static void progress(const char *fmt, ...) {
   fputc('\n', stderr);
 }
 
+/* phgmg_reduce_opts.progress: one line per reduction phase, with the time
+   since the reduction started (user: its start time, now_s()). */
+static void reduce_phase(const char *phase, void *user) {
+  if (strcmp(phase, "done") != 0) progress("  ... %s (%.1f s)", phase, now_s() - *(const double *)user);
+}
+
 /* Error on stderr; returns the exit status 1 for `return fail(...)`. */
 static int fail(const char *fmt, ...) {
   va_list ap;
@@ -1303,6 +1309,7 @@ static int cmd_reduce_impl(const reduce_args *A, reduce_state *S) {
   memset(&info, 0, sizeof info);
   progress("reducing: %s, r = %d%s", A->method, A->r, method == PHGMG_METHOD_GMG_QM ? " (quadratic manifold)" : "");
   t0 = now_s();
+  if (!g_quiet) { o.progress = reduce_phase; o.progress_user = &t0; }
   rc = phgmg_reduce(&S->red, &sys, X, N, ns, &o, &info, NULL);
   t_red = now_s() - t0;
   if (rc != PHGMG_OK) {
