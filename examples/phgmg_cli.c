@@ -232,7 +232,8 @@ static void progress(const char *fmt, ...) {
 }
 
 /* phgmg_reduce_opts.progress: one line per reduction phase, with the time
-   since the reduction started (user: its start time, now_s()). */
+   since the reduction started (user: its start time, now_s()). Set for long
+   reductions only (N * ns >= 1e7, e.g. N >= 10 000 with 1001 snapshots). */
 static void reduce_phase(const char *phase, void *user) {
   if (strcmp(phase, "done") != 0) progress("  ... %s (%.1f s)", phase, now_s() - *(const double *)user);
 }
@@ -1309,7 +1310,7 @@ static int cmd_reduce_impl(const reduce_args *A, reduce_state *S) {
   memset(&info, 0, sizeof info);
   progress("reducing: %s, r = %d%s", A->method, A->r, method == PHGMG_METHOD_GMG_QM ? " (quadratic manifold)" : "");
   t0 = now_s();
-  if (!g_quiet) { o.progress = reduce_phase; o.progress_user = &t0; }
+  if (!g_quiet && (double)N * (double)ns >= 1e7) { o.progress = reduce_phase; o.progress_user = &t0; }
   rc = phgmg_reduce(&S->red, &sys, X, N, ns, &o, &info, NULL);
   t_red = now_s() - t0;
   if (rc != PHGMG_OK) {
