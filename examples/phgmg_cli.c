@@ -1333,6 +1333,9 @@ static int cmd_reduce_impl(const reduce_args *A, reduce_state *S) {
   rom = phgmg_reduced_rom(S->red);
   progress("  done in %.2f s: r = %d, m = %d%s; sigma_{r'+1}/sigma_1 = %.3g, rcond(D^T G D) = %.3g", t_red, rom->r,
            rom->m, rom->nd ? "" : ", quadratic energy", info.pod_sigma_ratio, info.rcond_dgd);
+  if (info.pod_randomized)
+    progress("  POD: %s (a-posteriori check %.2g)", info.pod_randomized > 0 ? "randomized (large snapshot set)"
+             : "exact SVD (the randomized POD failed its check)", info.pod_check);
   if (rom->nd && o.deim)
     progress("  hyper-reduction %s: %d points, %d negative weights, smallest weight %.3g, training residual %.2g",
              A->hyper ? A->hyper : "ecsw", info.deim_modes, info.deim_negative, info.hyper_min_weight,
