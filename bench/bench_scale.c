@@ -14,7 +14,7 @@
    of the CPU time go to the CSV. The acceptance target is 15 s.
 
    Usage: bench_scale [out.csv] [N] [runs]
-     N (default 256000, even), runs (default 3). With N other than 256000 the
+     out.csv "" (empty): no CSV. N (default 256000, even), runs (default 3). With N other than 256000 the
      case is named offline_gmgpod_N<N>. BENCH_SCALE_SNAP=file caches the
      snapshots in a raw file (read if it exists with the right size, else
      written), to skip the full-order run on repeated calls.
@@ -77,7 +77,7 @@ int main(int argc, char **argv) {
   phgmg_gl3_opts go;
   phgmg_reduce_opts o;
   phgmg_reduce_info info;
-  const char *csv = argc > 1 ? argv[1] : NULL, *cache = getenv("BENCH_SCALE_SNAP");
+  const char *csv = argc > 1 && argv[1][0] ? argv[1] : NULL, *cache = getenv("BENCH_SCALE_SNAP");
   const int N = argc > 2 ? atoi(argv[2]) : 256000;
   int runs = argc > 3 ? atoi(argv[3]) : 3, i;
   double *X, *x0, t[16], w[16], t0, c0;
