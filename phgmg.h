@@ -7590,11 +7590,14 @@ PHGMG__PRIV phgmg_result phgmg__ecsw_gram(int n, int m, const double *Gm, int ld
    product with the training matrix), the PHGMG_ECSW_SCREEN_ADD terms outside
    W with the largest positive g join W, and phgmg__ecsw_gram solves the
    problem restricted to W (rows = all training rows, so its residual is the
-   full problem's residual, not an estimate). Repeated until the residual
-   meets tol, or no term outside W has a positive gradient (then w is optimal
-   over all n terms, as Lawson-Hanson's: PHGMG_ERR_NOT_CONVERGED if above
-   tol). Each round solves from zero on W, so the result is Lawson-Hanson's
-   greedy solution on the final W: w >= 0 by construction. The two ways to
+   full problem's residual, not an estimate); then W is pruned to the terms
+   with w > 0 (a top-gradient batch is mostly neighbours of one another:
+   without pruning W fills with terms the fit never uses). Repeated until the
+   residual meets tol, or no term outside W has a positive gradient (then w
+   is optimal over all n terms, as Lawson-Hanson's: PHGMG_ERR_NOT_CONVERGED
+   if above tol), or after PHGMG_ECSW_SCREEN_ROUNDS (200) rounds. Each round
+   solves from zero on W, so the result is Lawson-Hanson's greedy solution
+   on the final W: w >= 0 by construction. The two ways to
    apply the training matrix are callbacks (explicit Gm; the separable
    product F^T diag(.) Vt that never forms it). */
 #ifndef PHGMG_ECSW_SCREEN_MIN
@@ -7602,6 +7605,9 @@ PHGMG__PRIV phgmg_result phgmg__ecsw_gram(int n, int m, const double *Gm, int ld
 #endif
 #ifndef PHGMG_ECSW_SCREEN_ADD
 #define PHGMG_ECSW_SCREEN_ADD 64   /* candidates added per round */
+#endif
+#ifndef PHGMG_ECSW_SCREEN_ROUNDS
+#define PHGMG_ECSW_SCREEN_ROUNDS 200 /* cap on screening rounds */
 #endif
 typedef struct phgmg__ecsw_op {
   /* g (n) = Gm^T res (res: m training rows); h: scratch of op's own size */
@@ -7660,7 +7666,7 @@ PHGMG__PRIV phgmg_result phgmg__ecsw_screened(const phgmg__ecsw_op *op, const do
   const int n = op->n, m = op->m;
   const int wmax = PHGMG__MIN(n, 16 * PHGMG_ECSW_SCREEN_ADD);
   double *Gw, *res, *g, *h, *ww, gtol, rel = HUGE_VAL;
-  int *W, *pw, nw = 0, nd = 0, i, j;
+  int *W, *pw, nw = 0, nd = 0, i, j, rounds = 0;
   char *inW;
   phgmg_result rc = PHGMG_ERR_NOT_CONVERGED;
   Gw = phgmg__dalloc(alloc, (size_t)m * wmax + (size_t)m + (size_t)n + op->hsize + (size_t)wmax);
@@ -7688,6 +7694,17 @@ PHGMG__PRIV phgmg_result phgmg__ecsw_screened(const phgmg__ecsw_op *op, const do
     memcpy(res, target, (size_t)m * sizeof(double));
     for (j = 0; j < nd; ++j) phgmg__axpy(m, -ww[j], Gw + (size_t)pw[j] * m, res);
     op->grad(op, res, g, h);
+    if (++rounds >= PHGMG_ECSW_SCREEN_ROUNDS) break;
+    /* prune W to the support (pw ascending): terms at weight 0 leave W and may
+       return later; W stays near nd + PHGMG_ECSW_SCREEN_ADD */
+    for (j = 0; j < nw; ++j) inW[W[j]] = 0;
+    for (j = 0; j < nd; ++j) {
+      W[j] = W[pw[j]];
+      inW[W[j]] = 1;
+      if (pw[j] != j) memcpy(Gw + (size_t)j * m, Gw + (size_t)pw[j] * m, (size_t)m * sizeof(double));
+      pw[j] = j;
+    }
+    nw = nd;
   }
   if (rc == PHGMG_OK || rc == PHGMG_ERR_NOT_CONVERGED) {
     for (j = 0; j < nd; ++j) { /* W is in screening order: insertion sort to ascending terms */
