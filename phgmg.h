@@ -67,6 +67,7 @@
      PHGMG_ECSW_SCREEN_MIN phgmg_ecsw(_separable) screen candidates from this many
                            terms on (default 4096; no n x n Gram matrix)
      PHGMG_ECSW_SCREEN_ADD candidates added per screening round (default 64)
+     PHGMG_ECSW_SCREEN_ROUNDS  cap on screening rounds (default 200)
 
    FUNCTIONS (one line each; full comments at the declarations) ---------------
    core:    phgmg_result_string
