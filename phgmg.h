@@ -61,6 +61,13 @@
                            POD when N*ns >= this (default 0: never; see phgmg_pod)
      PHGMG_POD_OVERSAMPLE, PHGMG_POD_POWER_ITERS, PHGMG_POD_SEED  its parameters
                            (20, 2, a fixed seed)
+     PHGMG_POD_AUTO_MIN    phgmg_reduce takes the randomized POD (checked, exact
+                           fallback) when N*ns >= this (default 2e7; <= 0: never)
+     PHGMG_POD_CHECK_TOL   its acceptance: backward error <= this * sigma_1 (1e-10)
+     PHGMG_ECSW_SCREEN_MIN phgmg_ecsw(_separable) screen candidates from this many
+                           terms on (default 4096; no n x n Gram matrix)
+     PHGMG_ECSW_SCREEN_ADD candidates added per screening round (default 64)
+     PHGMG_ECSW_SCREEN_ROUNDS  cap on screening rounds (default 200)
 
    FUNCTIONS (one line each; full comments at the declarations) ---------------
    core:    phgmg_result_string
@@ -1115,6 +1122,15 @@ typedef struct phgmg_reduce_opts {
      runs, or to measure the manifold's best case; it does not guard against
      inputs unlike the training ones. */
   int lambda_train_only;
+  /* Optional progress report for long reductions (NULL: none; the library
+     itself never prints): phgmg_reduce calls progress(phase, progress_user)
+     as each stage starts, phase one of "basis" (snapshot adjustment and POD),
+     "manifold", "blocks" (reduced operators), "hamiltonian" (quadratic terms),
+     "hyper-reduction" (the separable part: gradient snapshots and DEIM/ECSW),
+     "finish" (general term, step map, validation), and "done" at the end of
+     a successful reduction. Called from the calling thread only. */
+  void (*progress)(const char *phase, void *user);
+  void *progress_user;
 } phgmg_reduce_opts;
 
 typedef struct phgmg_reduce_info {
@@ -1155,6 +1171,11 @@ typedef struct phgmg_reduce_info {
      on every validation run (within lambda_tolerance), so the returned model
      is the one of manifold = PHGMG_MANIFOLD_POD (same options otherwise) */
   int manifold_fallback;
+  int pod_randomized;      /* the basis POD: 0 exact SVD; 1 randomized (large
+                              N*ns, see phgmg_reduce: it passed its check);
+                              -1 randomized, check failed, exact SVD used     */
+  double pod_check;        /* randomized POD: ||X W - V diag(S)||_F / S_1 (the
+                              triplets' backward error); 0 on the exact path  */
 } phgmg_reduce_info;
 
 /* The reduced model with its offline data (bases for reconstruction, double
@@ -1181,6 +1202,17 @@ typedef struct phgmg_reduced phgmg_reduced;
      object must outlive the model and is not thread-safe in evaluation; not
      exportable (PHGMG_ERR_UNSUPPORTED); DEIM does not apply (opts.deim = 1
      gives PHGMG_ERR_UNSUPPORTED).
+   POD of the basis: the exact SVD (phgmg_pod), except for large snapshot sets
+   (N*ns >= PHGMG_POD_AUTO_MIN, default 2e7, and 4 (r' + 20) <= min(N, ns) for
+   the r' modes wanted): phgmg_pod_randomized (2 power iterations, 20 extra
+   columns), then the a-posteriori check ||X W - V diag(S)||_F <= 1e-10 S_1
+   (PHGMG_POD_CHECK_TOL; W: its right singular vectors, X^T V = W diag(S) by
+   construction, so the modes are the exact POD of a matrix within that
+   distance of X); if it fails, the exact SVD. info.pod_randomized and
+   info.pod_check say which. GMG-POD then works on X - B B^+ X implicitly,
+   without its N x ns copy (GMG-QM/GMG_MANIFOLD keep the copy: their
+   manifold stage needs it, and take the exact POD there). The paper's demo models
+   (N <= 4000) stay on the exact path, bit for bit.
    Errors: PHGMG_ERR_INVALID_ARG (NULL, bad options: method, deim not 0/1,
    deim_tol NaN or outside [0, 1), dt NaN/Inf/negative, lambda NaN,
    GMG_MANIFOLD without eta or rn), PHGMG_ERR_SIZE (r <= m for GMG, r > rank of
@@ -1394,6 +1426,17 @@ PHGMG_DEF phgmg_result phgmg_nnls(int m, int n, const double *A, int lda, const 
    orthogonal map (Gm' = Q^T Gm, target' = Q^T target) give the same weights
    at less cost; phgmg_ecsw_separable does this for terms linear in the
    reduced coordinates.
+   Many terms (nterms >= PHGMG_ECSW_SCREEN_MIN, default 4096): the n x n Gram
+   matrix is never formed. Screening: the full gradient Gm^T (target - Gm w)
+   (one pass over Gm) picks the PHGMG_ECSW_SCREEN_ADD (64) terms with the
+   largest positive gradient into a working set W, the method above solves
+   the problem restricted to W (all rows: its residual is the true one), and
+   this repeats until tol is met or no term outside W has a positive
+   gradient (w then optimal over all terms, as above). Same guarantees:
+   w > 0 on the kept terms, residual <= tol or PHGMG_ERR_NOT_CONVERGED
+   (also if W reaches 16 * PHGMG_ECSW_SCREEN_ADD terms). Memory nrows *
+   |W| + O(nrows + nterms); on the paper's chain at N = 256 000 (128 000
+   terms, 20 020 rows) 3 rounds, 28 points, about 2 s.
    Errors: PHGMG_ERR_INVALID_ARG, PHGMG_ERR_SIZE, PHGMG_ERR_NANINF,
    PHGMG_ERR_NOT_CONVERGED (tol not met: outputs hold the best found),
    PHGMG_ERR_NOMEM. */
@@ -1412,6 +1455,10 @@ PHGMG_DEF phgmg_result phgmg_ecsw(int nterms, int nrows, const double *Gm, int l
    phgmg_ecsw runs on q r rows instead of ns r; the residual
    ||F^T diag(w - sw) Vt||_F / ||F^T diag(sw) Vt||_F is then computed on the
    full rows, and if it misses tol the fit is redone with every mode.
+   From PHGMG_ECSW_SCREEN_MIN terms on: no SVD of F; the screening of
+   phgmg_ecsw on the full ns r rows, applied as F^T diag(.) Vt products
+   (gradient: one GEMM with F, 2 nterms ns r flops per round; only the
+   working set's columns are formed).
    Outputs, tol and errors as phgmg_ecsw (resid_out: on the full rows). */
 PHGMG_DEF phgmg_result phgmg_ecsw_separable(int nterms, int ns, const double *F, int ldf, int r,
                                             const double *Vt, int ldvt, const double *sw, double tol,
@@ -7109,11 +7156,34 @@ PHGMG__PRIV void phgmg__scale2(size_t cnt, double *A, int e) {
     for (t = 0; t < cnt; ++t) A[t] = ldexp(A[t], e);
 }
 
-PHGMG_DEF phgmg_result phgmg_pod_randomized(int N, int ns, const double *X, int ldx, int kmax,
-                                            int power_iters, unsigned long seed, double *V,
-                                            int ldv, double *S, int *k_out,
-                                            const phgmg_allocator *alloc) {
-  double *Y, *Z, *Uz, *Ub, *tau, *s, amax;
+/* Products with Xa = X - QB CB (QB N x m orthonormal, CB = QB^T X m x ns;
+   QB NULL: Xa = X). t = 'N': Out (N x l, ld N) = Xa M (M ns x l, ld ns);
+   t = 'T': Out (ns x l) = Xa^T M (M N x l). T: m x l scratch. */
+PHGMG__PRIV void phgmg__xa_mul(char t, int N, int ns, int l, const double *X, int ldx, const double *QB, int m,
+                               const double *CB, const double *M, double *Out, double *T) {
+  if (t == 'N') {
+    phgmg_gemm('N', 'N', N, l, ns, 1.0, X, ldx, M, ns, 0.0, Out, N);
+    if (!QB) return;
+    phgmg_gemm('N', 'N', m, l, ns, 1.0, CB, m, M, ns, 0.0, T, m);
+    phgmg_gemm('N', 'N', N, l, m, -1.0, QB, N, T, m, 1.0, Out, N);
+  } else {
+    phgmg_gemm('T', 'N', ns, l, N, 1.0, X, ldx, M, N, 0.0, Out, ns);
+    if (!QB) return;
+    phgmg_gemm('T', 'N', m, l, N, 1.0, QB, N, M, N, 0.0, T, m);
+    phgmg_gemm('T', 'N', ns, l, m, -1.0, CB, m, T, m, 1.0, Out, ns);
+  }
+}
+
+/* phgmg_pod_randomized of X, or of X - QB CB (see phgmg__xa_mul; the scaling
+   by 2^-e from max|X|); with chk != NULL also the a-posteriori check
+   *chk = ||X W - V diag(S)||_F / S_1 (W = the right singular vectors, ns x k:
+   X^T V = W diag(S) holds by construction, so the k triplets are exact for a
+   perturbation of X of 2-norm at most *chk S_1). One more product with X (k columns). */
+PHGMG__PRIV phgmg_result phgmg__pod_rand_core(int N, int ns, const double *X, int ldx, const double *QB, int m,
+                                              const double *CB, int kmax, int power_iters,
+                                              unsigned long seed, double *V, int ldv, double *S, int *k_out,
+                                              double *chk, const phgmg_allocator *alloc) {
+  double *Y, *Z, *Uz, *Ub, *tau, *s, *T, amax;
   int l, it, i, k = 0, e = 0;
   unsigned long long state = (unsigned long long)seed;
   size_t ny, nz;
@@ -7132,28 +7202,29 @@ PHGMG_DEF phgmg_result phgmg_pod_randomized(int N, int ns, const double *X, int 
   ny = (size_t)N * (size_t)l;
   nz = (size_t)ns * (size_t)l;
   Y = phgmg__dalloc(alloc, ny);
-  Z = phgmg__dalloc(alloc, 2 * nz + (size_t)l * (size_t)l + 2 * (size_t)l);
+  Z = phgmg__dalloc(alloc, 2 * nz + (size_t)l * (size_t)l + 2 * (size_t)l + (size_t)(QB ? m : 0) * (size_t)l);
   if (!Y || !Z) { phgmg__free(alloc, Y); phgmg__free(alloc, Z); return PHGMG_ERR_NOMEM; }
   Uz = Z + nz;
   Ub = Uz + nz;
   tau = Ub + (size_t)l * (size_t)l;
   s = tau + l;
+  T = s + l;
   phgmg__gauss_fill(nz, &state, -e, Z);
-  phgmg_gemm('N', 'N', N, l, ns, 1.0, X, ldx, Z, ns, 0.0, Y, N);
+  phgmg__xa_mul('N', N, ns, l, X, ldx, QB, m, CB, Z, Y, T);
   rc = phgmg__orth(N, l, Y, tau);
   for (it = 0; it < power_iters && rc == PHGMG_OK; ++it) {
     phgmg__scale2(ny, Y, -e);
-    phgmg_gemm('T', 'N', ns, l, N, 1.0, X, ldx, Y, N, 0.0, Z, ns);
+    phgmg__xa_mul('T', N, ns, l, X, ldx, QB, m, CB, Y, Z, T);
     rc = phgmg__orth(ns, l, Z, tau);
     if (rc != PHGMG_OK) break;
     phgmg__scale2(nz, Z, -e);
-    phgmg_gemm('N', 'N', N, l, ns, 1.0, X, ldx, Z, ns, 0.0, Y, N);
+    phgmg__xa_mul('N', N, ns, l, X, ldx, QB, m, CB, Z, Y, T);
     rc = phgmg__orth(N, l, Y, tau);
   }
   if (rc == PHGMG_OK) {
     /* Z = 2^-e B^T = X^T (2^-e Q); its SVD Uz diag(s) Ub^T gives U = Q Ub */
     phgmg__scale2(ny, Y, -e);
-    phgmg_gemm('T', 'N', ns, l, N, 1.0, X, ldx, Y, N, 0.0, Z, ns);
+    phgmg__xa_mul('T', N, ns, l, X, ldx, QB, m, CB, Y, Z, T);
     phgmg__scale2(ny, Y, e);
     rc = phgmg_svd(ns, l, Z, ns, kmax, s, Uz, ns, Ub, l, &k, NULL, alloc);
   }
@@ -7161,10 +7232,56 @@ PHGMG_DEF phgmg_result phgmg_pod_randomized(int N, int ns, const double *X, int 
     if (k > 0) phgmg_gemm('N', 'N', N, k, l, 1.0, Y, N, Ub, l, 0.0, V, ldv);
     for (i = 0; i < k && S; ++i) S[i] = ldexp(s[i], e);
     *k_out = k;
+    if (chk && k > 0) { /* Y (N x k) = 2^-e X Uz - V diag(s) (Y is free now) */
+      phgmg__scale2(nz, Uz, -e);
+      phgmg__xa_mul('N', N, ns, k, X, ldx, QB, m, CB, Uz, Y, T);
+      for (it = 0; it < k; ++it) phgmg__axpy(N, -s[it], V + (size_t)it * ldv, Y + (size_t)it * N);
+      *chk = phgmg_normf(N, k, Y, N) / s[0];
+    }
   }
   phgmg__free(alloc, Y);
   phgmg__free(alloc, Z);
   return rc;
+}
+
+PHGMG_DEF phgmg_result phgmg_pod_randomized(int N, int ns, const double *X, int ldx, int kmax,
+                                            int power_iters, unsigned long seed, double *V,
+                                            int ldv, double *S, int *k_out,
+                                            const phgmg_allocator *alloc) {
+  return phgmg__pod_rand_core(N, ns, X, ldx, NULL, 0, NULL, kmax, power_iters, seed, V, ldv, S, k_out, NULL, alloc);
+}
+
+/* The POD phgmg_reduce uses (its stage_basis). Exact (phgmg_pod) unless the
+   snapshot matrix is large, N*ns >= PHGMG_POD_AUTO_MIN (default 2e7: N >= 20 000
+   at 1001 snapshots), and few modes are wanted, 4 (k + PHGMG_POD_OVERSAMPLE) <=
+   min(N, ns): then phgmg_pod_randomized with its default power iterations,
+   accepted if the a-posteriori check ||X W - V diag(S)||_F <= PHGMG_POD_CHECK_TOL
+   (default 1e-10) S_1 holds and all k modes came out, else the exact POD
+   (fallback). *how: 0 exact, 1 randomized, -1 randomized rejected -> exact;
+   *chk: the check's value (untouched when not tried). GMG-POD/SP at large N
+   skip the N x ns copy of the adjusted snapshots (phgmg__basis_pod_implicit). PHGMG_POD_AUTO_MIN <= 0: always exact. */
+#ifndef PHGMG_POD_AUTO_MIN
+#define PHGMG_POD_AUTO_MIN 2e7
+#endif
+#ifndef PHGMG_POD_CHECK_TOL
+#define PHGMG_POD_CHECK_TOL 1e-10
+#endif
+PHGMG__PRIV int phgmg__pod_rand_wanted(int N, int ns, int k) {
+  return (double)(PHGMG_POD_AUTO_MIN) > 0.0 && (double)N * (double)ns >= (double)(PHGMG_POD_AUTO_MIN) &&
+         4 * (k + PHGMG_POD_OVERSAMPLE) <= PHGMG__MIN(N, ns);
+}
+/* *how on entry: -1 = the randomized POD was rejected already (exact only). */
+PHGMG__PRIV phgmg_result phgmg__pod_auto(int N, int ns, const double *X, int ldx, int k, double *V, int ldv,
+                                         double *S, int *k_out, int *how, double *chk,
+                                         const phgmg_allocator *alloc) {
+  if (*how != -1 && phgmg__pod_rand_wanted(N, ns, k)) {
+    phgmg_result rc = phgmg__pod_rand_core(N, ns, X, ldx, NULL, 0, NULL, k, PHGMG_POD_POWER_ITERS, PHGMG_POD_SEED, V,
+                                           ldv, S, k_out, chk, alloc);
+    if (rc == PHGMG_ERR_NOMEM || rc == PHGMG_ERR_NANINF) return rc;
+    if (rc == PHGMG_OK && *k_out == k && *chk <= PHGMG_POD_CHECK_TOL) { *how = 1; return PHGMG_OK; }
+    *how = -1;
+  }
+  return phgmg_pod(N, ns, X, ldx, k, 0.0, V, ldv, S, k_out, alloc);
 }
 
 /* Thin QR of B (N x m): QB (N x m) orthonormal, RB (m x m) upper triangular.
@@ -7641,19 +7758,15 @@ PHGMG__PRIV double phgmg__ecsw_resid(int m, int n, const double *Gm, int ldg, co
   return phgmg_normf(m, 1, r, m);
 }
 
-PHGMG_DEF phgmg_result phgmg_ecsw(int nterms, int nrows, const double *Gm, int ldg, const double *target,
-                                  double tol, int *pts, double *w, int *nd_out, double *resid_out,
-                                  const phgmg_allocator *alloc) {
-  const int n = nterms, m = nrows;
+/* phgmg_ecsw on checked arguments (tol > 0): Lawson-Hanson in the hybrid
+   Gram form over all n columns (the Gram matrix n x n in memory). */
+PHGMG__PRIV phgmg_result phgmg__ecsw_gram(int n, int m, const double *Gm, int ldg, const double *target,
+                                          double tol, int *pts, double *w, int *nd_out, double *resid_out,
+                                          const phgmg_allocator *alloc) {
   phgmg__nnls_prob pb;
   double *G, *c, *x, *r, tn, rel = 0.0, res2 = 0.0;
   int j, nd = 0;
   phgmg_result rc = PHGMG_OK;
-  if (!Gm || !target || !pts || !w || !nd_out) return PHGMG_ERR_INVALID_ARG;
-  if (tol != tol) return PHGMG_ERR_INVALID_ARG;
-  if (n < 1 || m < 1 || ldg < m) return PHGMG_ERR_SIZE;
-  if (!phgmg__mat_finite(m, n, Gm, ldg) || !phgmg__all_finite(target, (size_t)m)) return PHGMG_ERR_NANINF;
-  if (tol <= 0.0) tol = 1e-6;
   tn = phgmg_normf(m, 1, target, m);
   *nd_out = 0;
   if (resid_out) *resid_out = 0.0;
@@ -7687,6 +7800,169 @@ PHGMG_DEF phgmg_result phgmg_ecsw(int nterms, int nrows, const double *Gm, int l
   return rc;
 }
 
+/* ---- ECSW with candidate screening (many terms) ----------------------
+   Lawson-Hanson over n candidate terms needs the Gram matrix n x n (the
+   hybrid form above): 8 n^2 bytes and m n^2 flops, out of reach at n = 10^5.
+   The points it keeps are few (tens to hundreds), so the fit is made on a
+   working set W of candidates that grows by screening: the gradient of the
+   full problem g = Gm^T (target - Gm w) is computed for all n terms (one
+   product with the training matrix), the PHGMG_ECSW_SCREEN_ADD terms outside
+   W with the largest positive g join W, and phgmg__ecsw_gram solves the
+   problem restricted to W (rows = all training rows, so its residual is the
+   full problem's residual, not an estimate); then W is pruned to the terms
+   with w > 0 (a top-gradient batch is mostly neighbours of one another:
+   without pruning W fills with terms the fit never uses). Repeated until the
+   residual meets tol, or no term outside W has a positive gradient (then w
+   is optimal over all n terms, as Lawson-Hanson's: PHGMG_ERR_NOT_CONVERGED
+   if above tol), or after PHGMG_ECSW_SCREEN_ROUNDS (200) rounds. Each round
+   solves from zero on W, so the result is Lawson-Hanson's greedy solution
+   on the final W: w >= 0 by construction. The two ways to
+   apply the training matrix are callbacks (explicit Gm; the separable
+   product F^T diag(.) Vt that never forms it). */
+#ifndef PHGMG_ECSW_SCREEN_MIN
+#define PHGMG_ECSW_SCREEN_MIN 4096 /* terms from which phgmg_ecsw(_separable) screens */
+#endif
+#ifndef PHGMG_ECSW_SCREEN_ADD
+#define PHGMG_ECSW_SCREEN_ADD 64   /* candidates added per round */
+#endif
+#ifndef PHGMG_ECSW_SCREEN_ROUNDS
+#define PHGMG_ECSW_SCREEN_ROUNDS 200 /* cap on screening rounds */
+#endif
+typedef struct phgmg__ecsw_op {
+  /* g (n) = Gm^T res (res: m training rows); h: scratch of op's own size */
+  void (*grad)(const struct phgmg__ecsw_op *op, const double *res, double *g, double *h);
+  /* col (m) = column j of Gm */
+  void (*col)(const struct phgmg__ecsw_op *op, int j, double *col);
+  int n, m;
+  size_t hsize;                       /* doubles of scratch for grad */
+  const double *A; int lda;           /* explicit Gm (m x n), or F (n x ns) */
+  const double *Vt; int ldvt, ns, r;  /* separable: Vt (n x r); row (i, a) = a * ns + i */
+} phgmg__ecsw_op;
+
+PHGMG__PRIV void phgmg__ecsw_grad_dense(const phgmg__ecsw_op *op, const double *res, double *g, double *h) {
+  (void)h;
+  phgmg_gemv('T', op->m, op->n, 1.0, op->A, op->lda, res, 0.0, g);
+}
+PHGMG__PRIV void phgmg__ecsw_col_dense(const phgmg__ecsw_op *op, int j, double *col) {
+  memcpy(col, op->A + (size_t)j * op->lda, (size_t)op->m * sizeof(double));
+}
+/* g_k = sum_a Vt[k, a] (F res)[k, a], res ns x r: 2 n ns r flops (one GEMM). */
+PHGMG__PRIV void phgmg__ecsw_grad_sep(const phgmg__ecsw_op *op, const double *res, double *g, double *h) {
+  const int n = op->n;
+  int k, a;
+  phgmg_gemm('N', 'N', n, op->r, op->ns, 1.0, op->A, op->lda, res, op->ns, 0.0, h, n);
+  for (k = 0; k < n; ++k) g[k] = 0.0;
+  for (a = 0; a < op->r; ++a)
+    for (k = 0; k < n; ++k) g[k] += op->Vt[k + (size_t)a * op->ldvt] * h[k + (size_t)a * n];
+}
+PHGMG__PRIV void phgmg__ecsw_col_sep(const phgmg__ecsw_op *op, int j, double *col) {
+  int i, a;
+  for (a = 0; a < op->r; ++a) {
+    const double v = op->Vt[j + (size_t)a * op->ldvt];
+    for (i = 0; i < op->ns; ++i) col[i + (size_t)a * op->ns] = op->A[j + (size_t)i * op->lda] * v;
+  }
+}
+
+/* Add to W (nw entries, inW flags) up to `add` terms outside W with the
+   largest g > gtol (largest first). Returns the number added. */
+PHGMG__PRIV int phgmg__ecsw_screen_add(int n, const double *g, double gtol, int add, int *W, int nw, char *inW) {
+  int cnt = 0, k;
+  while (cnt < add) {
+    int best = -1;
+    double gb = gtol;
+    for (k = 0; k < n; ++k)
+      if (!inW[k] && g[k] > gb) { gb = g[k]; best = k; }
+    if (best < 0) break;
+    inW[best] = 1;
+    W[nw + cnt++] = best;
+  }
+  return cnt;
+}
+
+/* The screening driver (see above). target: m (not 0); tol > 0. */
+PHGMG__PRIV phgmg_result phgmg__ecsw_screened(const phgmg__ecsw_op *op, const double *target, double tol, int *pts, double *w, int *nd_out, double *resid_out,
+                                              const phgmg_allocator *alloc) {
+  const int n = op->n, m = op->m;
+  const int wmax = PHGMG__MIN(n, 16 * PHGMG_ECSW_SCREEN_ADD);
+  double *Gw, *res, *g, *h, *ww, gtol, rel = HUGE_VAL;
+  int *W, *pw, nw = 0, nd = 0, i, j, rounds = 0;
+  char *inW;
+  phgmg_result rc = PHGMG_ERR_NOT_CONVERGED;
+  Gw = phgmg__dalloc(alloc, (size_t)m * wmax + (size_t)m + (size_t)n + op->hsize + (size_t)wmax);
+  W = phgmg__ialloc(alloc, 2 * (size_t)wmax + (size_t)n);
+  if (!Gw || !W) { phgmg__free(alloc, Gw); phgmg__free(alloc, W); return PHGMG_ERR_NOMEM; }
+  res = Gw + (size_t)m * wmax;
+  g = res + m;
+  h = g + n;
+  ww = h + op->hsize;
+  pw = W + wmax;
+  inW = (char *)(pw + wmax);   /* n flags in the int tail (n ints >= n chars) */
+  memset(inW, 0, (size_t)n);
+  memcpy(res, target, (size_t)m * sizeof(double));
+  op->grad(op, target, g, h);  /* gradient at w = 0; its scale sets the threshold */
+  for (gtol = 0.0, j = 0; j < n; ++j) gtol = PHGMG__MAX(gtol, fabs(g[j]));
+  gtol *= 1e3 * PHGMG__EPS;
+  for (;;) {
+    const int add = phgmg__ecsw_screen_add(n, g, gtol, PHGMG__MIN(PHGMG_ECSW_SCREEN_ADD, wmax - nw), W, nw, inW);
+    if (add == 0) break;          /* optimal over all terms (or W full) */
+    for (j = nw; j < nw + add; ++j) op->col(op, W[j], Gw + (size_t)j * m);
+    nw += add;
+    rc = phgmg__ecsw_gram(nw, m, Gw, m, target, tol, pw, ww, &nd, &rel, alloc);
+    if (rc != PHGMG_OK && rc != PHGMG_ERR_NOT_CONVERGED) break;
+    if (rc == PHGMG_OK) break;    /* tol met on the full rows */
+    memcpy(res, target, (size_t)m * sizeof(double));
+    for (j = 0; j < nd; ++j) phgmg__axpy(m, -ww[j], Gw + (size_t)pw[j] * m, res);
+    op->grad(op, res, g, h);
+    if (++rounds >= PHGMG_ECSW_SCREEN_ROUNDS) break;
+    /* prune W to the support (pw ascending): terms at weight 0 leave W and may
+       return later; W stays near nd + PHGMG_ECSW_SCREEN_ADD */
+    for (j = 0; j < nw; ++j) inW[W[j]] = 0;
+    for (j = 0; j < nd; ++j) {
+      W[j] = W[pw[j]];
+      inW[W[j]] = 1;
+      if (pw[j] != j) memcpy(Gw + (size_t)j * m, Gw + (size_t)pw[j] * m, (size_t)m * sizeof(double));
+      pw[j] = j;
+    }
+    nw = nd;
+  }
+  if (rc == PHGMG_OK || rc == PHGMG_ERR_NOT_CONVERGED) {
+    for (j = 0; j < nd; ++j) { /* W is in screening order: insertion sort to ascending terms */
+      const int pj = W[pw[j]];
+      const double wj = ww[j];
+      for (i = j; i > 0 && pts[i - 1] > pj; --i) { pts[i] = pts[i - 1]; w[i] = w[i - 1]; }
+      pts[i] = pj;
+      w[i] = wj;
+    }
+    *nd_out = nd;
+    if (resid_out) *resid_out = rel == HUGE_VAL ? 1.0 : rel;
+  }
+  phgmg__free(alloc, Gw);
+  phgmg__free(alloc, W);
+  return rc;
+}
+
+PHGMG_DEF phgmg_result phgmg_ecsw(int nterms, int nrows, const double *Gm, int ldg, const double *target,
+                                  double tol, int *pts, double *w, int *nd_out, double *resid_out,
+                                  const phgmg_allocator *alloc) {
+  const int n = nterms, m = nrows;
+  phgmg__ecsw_op op;
+  double tn;
+  if (!Gm || !target || !pts || !w || !nd_out) return PHGMG_ERR_INVALID_ARG;
+  if (tol != tol) return PHGMG_ERR_INVALID_ARG;
+  if (n < 1 || m < 1 || ldg < m) return PHGMG_ERR_SIZE;
+  if (!phgmg__mat_finite(m, n, Gm, ldg) || !phgmg__all_finite(target, (size_t)m)) return PHGMG_ERR_NANINF;
+  if (tol <= 0.0) tol = 1e-6;
+  if (n < PHGMG_ECSW_SCREEN_MIN) return phgmg__ecsw_gram(n, m, Gm, ldg, target, tol, pts, w, nd_out, resid_out, alloc);
+  tn = phgmg_normf(m, 1, target, m);
+  *nd_out = 0;
+  if (resid_out) *resid_out = 0.0;
+  if (tn == 0.0) return PHGMG_OK;
+  memset(&op, 0, sizeof op);
+  op.grad = phgmg__ecsw_grad_dense; op.col = phgmg__ecsw_col_dense;
+  op.n = n; op.m = m; op.A = Gm; op.lda = ldg;
+  return phgmg__ecsw_screened(&op, target, tol, pts, w, nd_out, resid_out, alloc);
+}
+
 /* ||F^T diag(a) Vt||_F (ns x r) for a (nterms); B: nterms x r, Y: ns x r scratch. */
 PHGMG__PRIV double phgmg__sep_norm(int nt, int ns, const double *F, int ldf, int r, const double *Vt, int ldvt,
                                    const double *a, double *B, double *Y) {
@@ -7695,6 +7971,34 @@ PHGMG__PRIV double phgmg__sep_norm(int nt, int ns, const double *F, int ldf, int
     for (k = 0; k < nt; ++k) B[k + (size_t)c * nt] = a[k] * Vt[k + (size_t)c * ldvt];
   phgmg_gemm('T', 'N', ns, r, nt, 1.0, F, ldf, B, nt, 0.0, Y, ns);
   return phgmg_normf(ns, r, Y, ns);
+}
+
+/* phgmg_ecsw_separable with screening (nterms >= PHGMG_ECSW_SCREEN_MIN):
+   training rows (i, a) = F[k, i] Vt[k, a] in full (row a ns + i), never
+   formed beyond the working set. */
+PHGMG__PRIV phgmg_result phgmg__ecsw_sep_screened(int nt, int ns, const double *F, int ldf, int r, const double *Vt,
+                                                  int ldvt, const double *sw, double tol, int *pts, double *w,
+                                                  int *nd_out, double *resid_out, const phgmg_allocator *alloc) {
+  phgmg__ecsw_op op;
+  double *B, *T, tn;
+  int i;
+  phgmg_result rc;
+  if ((double)ns * r > 2147483647.0) return PHGMG_ERR_SIZE;
+  B = phgmg__dalloc(alloc, (size_t)nt * r + (size_t)ns * r + (size_t)nt);
+  if (!B) return PHGMG_ERR_NOMEM;
+  T = B + (size_t)nt * r;
+  for (i = 0; i < nt; ++i) T[(size_t)ns * r + i] = sw ? sw[i] : 1.0;
+  tn = phgmg__sep_norm(nt, ns, F, ldf, r, Vt, ldvt, T + (size_t)ns * r, B, T); /* T = F^T diag(sw) Vt */
+  *nd_out = 0;
+  if (resid_out) *resid_out = 0.0;
+  if (tn == 0.0) { phgmg__free(alloc, B); return PHGMG_OK; }
+  memset(&op, 0, sizeof op);
+  op.grad = phgmg__ecsw_grad_sep; op.col = phgmg__ecsw_col_sep;
+  op.n = nt; op.m = ns * r; op.hsize = (size_t)nt * r;
+  op.A = F; op.lda = ldf; op.Vt = Vt; op.ldvt = ldvt; op.ns = ns; op.r = r;
+  rc = phgmg__ecsw_screened(&op, T, tol, pts, w, nd_out, resid_out, alloc);
+  phgmg__free(alloc, B);
+  return rc;
 }
 
 PHGMG_DEF phgmg_result phgmg_ecsw_separable(int nterms, int ns, const double *F, int ldf, int r, const double *Vt,
@@ -7711,6 +8015,8 @@ PHGMG_DEF phgmg_result phgmg_ecsw_separable(int nterms, int ns, const double *F,
       (sw && !phgmg__all_finite(sw, (size_t)nt)))
     return PHGMG_ERR_NANINF;
   if (tol <= 0.0) tol = 1e-6;
+  if (nt >= PHGMG_ECSW_SCREEN_MIN) return phgmg__ecsw_sep_screened(nt, ns, F, ldf, r, Vt, ldvt, sw, tol, pts, w,
+                                                                   nd_out, resid_out, alloc);
   U = phgmg__dalloc(alloc, (size_t)nt * kk + (size_t)kk + 2 * (size_t)nt + (size_t)nt * r + (size_t)ns * r);
   if (!U) return PHGMG_ERR_NOMEM;
   S = U + (size_t)nt * kk;
@@ -8340,6 +8646,38 @@ PHGMG__PRIV phgmg_result phgmg__check_given_basis(const phgmg_reduced *red, cons
   return err <= 1e-8 ? PHGMG_OK : PHGMG_ERR_RANK;
 }
 
+/* GMG: V1 (the first p of k POD modes, N x k) and S into V0 and info. */
+PHGMG__PRIV phgmg_result phgmg__basis_take(phgmg__rctx *c, const double *V1, const double *S, int k) {
+  phgmg_reduced *red = c->red;
+  const int N = red->N, m = red->m, p = red->p;
+  if (k < p || !(S[p - 1] > c->rfloor)) return PHGMG_ERR_SIZE; /* r - m > rank */
+  memcpy(red->V0 + (size_t)N * m, V1, (size_t)N * p * sizeof(double));
+  c->inf.pod_sigma_ratio = (k > p && S[0] > 0.0) ? S[p] / S[0] : 0.0;
+  return PHGMG_OK;
+}
+
+/* GMG with a linear basis (no manifold stage that needs the adjusted
+   snapshots) and a large snapshot set (phgmg__pod_rand_wanted): the
+   randomized POD of Xa = X - QB (QB^T X) applied as a product, without the
+   N x ns copy. PHGMG_ERR_NOT_CONVERGED: not tried or its check failed (the
+   caller then forms Xa and takes the exact POD). tmp: as stage_basis's. */
+PHGMG__PRIV phgmg_result phgmg__basis_pod_implicit(phgmg__rctx *c, double *tmp) {
+  phgmg_reduced *red = c->red;
+  const int N = red->N, m = red->m, p = red->p, ns = c->ns, kk = PHGMG__MIN(p + 1, PHGMG__MIN(N, ns));
+  double *V1 = tmp + (size_t)PHGMG__MAX(m, 1) * ns, *S = V1 + (size_t)N * (p + 1);
+  int k = 0;
+  phgmg_result rc;
+  if (!phgmg__pod_rand_wanted(N, ns, kk)) return PHGMG_ERR_NOT_CONVERGED;
+  phgmg_gemm('T', 'N', m, ns, N, 1.0, red->QB, N, c->X, c->ldx, 0.0, tmp, m); /* CB = QB^T X */
+  rc = phgmg__pod_rand_core(N, ns, c->X, c->ldx, red->QB, m, tmp, kk, PHGMG_POD_POWER_ITERS, PHGMG_POD_SEED, V1, N, S,
+                            &k, &c->inf.pod_check, c->alloc);
+  if (rc == PHGMG_ERR_NOMEM || rc == PHGMG_ERR_NANINF) return rc;
+  c->inf.pod_randomized = -1;
+  if (rc != PHGMG_OK || k != kk || !(c->inf.pod_check <= PHGMG_POD_CHECK_TOL)) return PHGMG_ERR_NOT_CONVERGED;
+  c->inf.pod_randomized = 1;
+  return phgmg__basis_take(c, V1, S, k);
+}
+
 /* Stage 1, basis. GMG: V0 = [B, V1], V1 = POD of the adjusted snapshots
    X - B B^+ X (c->Xa keeps them, for the manifold stage). SP1/SP2: V0 =
    V_POD of X. opts.pod_basis replaces the POD. */
@@ -8364,7 +8702,8 @@ PHGMG__PRIV phgmg_result phgmg__stage_basis(phgmg__rctx *c) {
     }
     S = phgmg__dalloc(c->alloc, (size_t)p);
     if (!S) return PHGMG_ERR_NOMEM;
-    rc = phgmg_pod(N, ns, c->X, c->ldx, p, 0.0, red->V0, N, S, &k, c->alloc);
+    rc = phgmg__pod_auto(N, ns, c->X, c->ldx, p, red->V0, N, S, &k, &c->inf.pod_randomized, &c->inf.pod_check,
+                         c->alloc);
     if (rc == PHGMG_OK && (k < p || !(S[p - 1] > c->rfloor))) rc = PHGMG_ERR_SIZE;
     phgmg__free(c->alloc, S);
     return rc;
@@ -8374,12 +8713,18 @@ PHGMG__PRIV phgmg_result phgmg__stage_basis(phgmg__rctx *c) {
     memcpy(red->V0 + (size_t)N * m, c->o->pod_basis, (size_t)N * p * sizeof(double));
     return PHGMG_OK;
   }
-  c->Xa = phgmg__dalloc(c->alloc, (size_t)N * ns);
   tmp = phgmg__dalloc(c->alloc, (size_t)PHGMG__MAX(m, 1) * ns + (size_t)N * (p + 1) + (size_t)p + 1);
-  if (!c->Xa || !tmp) { phgmg__free(c->alloc, tmp); return PHGMG_ERR_NOMEM; }
+  if (!tmp) return PHGMG_ERR_NOMEM;
+  memcpy(red->V0, c->sys->B, (size_t)N * m * sizeof(double));
+  if (!c->o->pod_basis && red->kind != PHGMG_ROM_QUADRATIC) { /* large: randomized, X - QB QB^T X implicit */
+    rc = phgmg__basis_pod_implicit(c, tmp);
+    if (rc != PHGMG_ERR_NOT_CONVERGED) { phgmg__free(c->alloc, tmp); return rc; }
+    rc = PHGMG_OK;
+  }
+  c->Xa = phgmg__dalloc(c->alloc, (size_t)N * ns);
+  if (!c->Xa) { phgmg__free(c->alloc, tmp); return PHGMG_ERR_NOMEM; }
   for (j = 0; j < ns; ++j) memcpy(c->Xa + (size_t)j * N, c->X + (size_t)j * c->ldx, (size_t)N * sizeof(double));
   phgmg__orth_remove(N, m, red->QB, ns, c->Xa, N, tmp);
-  memcpy(red->V0, c->sys->B, (size_t)N * m * sizeof(double));
   if (c->o->pod_basis) {
     memcpy(red->V0 + (size_t)N * m, c->o->pod_basis, (size_t)N * p * sizeof(double));
     if (red->method == PHGMG_METHOD_GMG_MANIFOLD)
@@ -8387,12 +8732,9 @@ PHGMG__PRIV phgmg_result phgmg__stage_basis(phgmg__rctx *c) {
   } else {
     double *V1 = tmp + (size_t)PHGMG__MAX(m, 1) * ns;
     S = V1 + (size_t)N * (p + 1);
-    rc = phgmg_pod(N, ns, c->Xa, N, PHGMG__MIN(p + 1, PHGMG__MIN(N, ns)), 0.0, V1, N, S, &k, c->alloc);
-    if (rc == PHGMG_OK && (k < p || !(S[p - 1] > c->rfloor))) rc = PHGMG_ERR_SIZE; /* r - m > rank */
-    if (rc == PHGMG_OK) {
-      memcpy(red->V0 + (size_t)N * m, V1, (size_t)N * p * sizeof(double));
-      c->inf.pod_sigma_ratio = (k > p && S[0] > 0.0) ? S[p] / S[0] : 0.0;
-    }
+    rc = phgmg__pod_auto(N, ns, c->Xa, N, PHGMG__MIN(p + 1, PHGMG__MIN(N, ns)), V1, N, S, &k, &c->inf.pod_randomized,
+                         &c->inf.pod_check, c->alloc);
+    if (rc == PHGMG_OK) rc = phgmg__basis_take(c, V1, S, k);
   }
   phgmg__free(c->alloc, tmp);
   return rc;
@@ -9721,6 +10063,11 @@ PHGMG__PRIV phgmg_result phgmg__reduce_fallback_pod(phgmg_reduced **out, const p
   return rc;
 }
 
+/* opts->progress, if set (see phgmg_reduce_opts). */
+PHGMG__PRIV void phgmg__progress(const phgmg_reduce_opts *o, const char *phase) {
+  if (o->progress) o->progress(phase, o->progress_user);
+}
+
 /* Which fast path of a study applies to opts (0: none): the study's own
    bases, orders within its modes (phgmg_study_reduce). */
 PHGMG__PRIV int phgmg__study_fast(const phgmg_study *st, const phgmg_reduce_opts *o, int m) {
@@ -9765,12 +10112,15 @@ PHGMG__PRIV phgmg_result phgmg__reduce_run(phgmg_reduced **out, const phgmg_ph_s
   rc = phgmg__runs_layout(&c);
   if (rc == PHGMG_OK) rc = phgmg__reduce_new(&c);
   if (rc == PHGMG_OK && c.sf) { c.red->study = st; c.red->sbasis = c.sf; }
-  if (rc == PHGMG_OK) rc = phgmg__stage_basis(&c);
-  if (rc == PHGMG_OK) rc = phgmg__stage_manifold(&c);
-  if (rc == PHGMG_OK) rc = phgmg__is_gmg(opts->method) ? phgmg__stage_gmg_blocks(&c) : phgmg__stage_sp_blocks(&c);
-  if (rc == PHGMG_OK) rc = phgmg__stage_quadratic_terms(&c);
-  if (rc == PHGMG_OK) rc = phgmg__stage_separable_terms(&c);
-  if (rc == PHGMG_OK) rc = phgmg__stage_general_term(&c);
+  if (rc == PHGMG_OK) { phgmg__progress(opts, "basis"); rc = phgmg__stage_basis(&c); }
+  if (rc == PHGMG_OK) { phgmg__progress(opts, "manifold"); rc = phgmg__stage_manifold(&c); }
+  if (rc == PHGMG_OK) {
+    phgmg__progress(opts, "blocks");
+    rc = phgmg__is_gmg(opts->method) ? phgmg__stage_gmg_blocks(&c) : phgmg__stage_sp_blocks(&c);
+  }
+  if (rc == PHGMG_OK) { phgmg__progress(opts, "hamiltonian"); rc = phgmg__stage_quadratic_terms(&c); }
+  if (rc == PHGMG_OK) { phgmg__progress(opts, "hyper-reduction"); rc = phgmg__stage_separable_terms(&c); }
+  if (rc == PHGMG_OK) { phgmg__progress(opts, "finish"); rc = phgmg__stage_general_term(&c); }
   if (rc == PHGMG_OK && opts->dt > 0.0 && c.red->kind == PHGMG_ROM_LINEAR && c.red->nd == 0 &&
       sys->nl != PHGMG_NL_GENERAL) {
     c.red->map_dt = opts->dt;
@@ -9788,6 +10138,7 @@ PHGMG__PRIV phgmg_result phgmg__reduce_run(phgmg_reduced **out, const phgmg_ph_s
     phgmg_reduced_destroy(c.red);
     return rc;
   }
+  phgmg__progress(opts, "done");
   *out = c.red;
   return PHGMG_OK;
 }

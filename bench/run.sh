@@ -5,7 +5,10 @@
 #
 # 1. prints the machine line (CPU model, cores, compiler and flags, load);
 # 2. builds bench/bench_linalg.c, bench/bench_fom.c, bench/bench_rom.c,
-#    bench/bench_linear.c (lyap_N1000, prbt_N1000_r20: about a minute) into
+#    bench/bench_linear.c (lyap_N1000, prbt_N1000_r20: about a minute),
+#    bench/bench_scale.c (offline_gmgpod_N256000: the whole reduction of the
+#    nonlinear chain at N = 256 000, 3 runs after a ~30 s full-order run for
+#    the snapshots; about 2 minutes and 5 GB of memory) into
 #    build/ (a missing or broken source is skipped with a warning) and runs
 #    each, appending `case,median_s,min_s,max_s,runs` lines to the CSV;
 # 3. if a CBLAS is installed, builds bench_linalg again with -DPHGMG_USE_CBLAS
@@ -45,7 +48,7 @@ echo "$machine" > "$BUILD/bench_machine.txt"
 make phgmg.h >/dev/null || { echo "run.sh: cannot build phgmg.h" >&2; exit 1; }
 echo "case,median_s,min_s,max_s,runs" > "$CSV"
 
-for prog in bench_linalg bench_fom bench_rom bench_linear; do
+for prog in bench_linalg bench_fom bench_rom bench_linear bench_scale; do
   src=bench/$prog.c
   if [ ! -f "$src" ]; then
     echo "run.sh: warning: $src is missing, skipped" >&2

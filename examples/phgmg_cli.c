@@ -251,6 +251,13 @@ static void progress(const char *fmt, ...) {
   fputc('\n', stderr);
 }
 
+/* phgmg_reduce_opts.progress: one line per reduction phase, with the time
+   since the reduction started (user: its start time, now_s()). Set for long
+   reductions only (N * ns >= 1e7, e.g. N >= 10 000 with 1001 snapshots). */
+static void reduce_phase(const char *phase, void *user) {
+  if (strcmp(phase, "done") != 0) progress("  ... %s (%.1f s)", phase, now_s() - *(const double *)user);
+}
+
 /* Error on stderr; returns the exit status 1 for `return fail(...)`. */
 static int fail(const char *fmt, ...) {
   va_list ap;
@@ -1372,6 +1379,7 @@ static int cmd_reduce_impl(const reduce_args *A, reduce_state *S) {
   memset(&info, 0, sizeof info);
   progress("reducing: %s, r = %d%s", A->method, A->r, method == PHGMG_METHOD_GMG_QM ? " (quadratic manifold)" : "");
   t0 = now_s();
+  if (!g_quiet && (double)N * (double)ns >= 1e7) { o.progress = reduce_phase; o.progress_user = &t0; }
   rc = phgmg_reduce(&S->red, &sys, X, N, ns, &o, &info, NULL);
   t_red = now_s() - t0;
   if (rc != PHGMG_OK) {
@@ -1398,6 +1406,9 @@ static int cmd_reduce_impl(const reduce_args *A, reduce_state *S) {
     progress("  manifold %s, lambda %s: %.3g%s", A->manifold_s ? A->manifold_s : "pod",
              A->lambda_auto == 1 ? "auto" : A->lambda_auto == 2 ? "cv" : "fixed", info.lambda,
              info.lambda == HUGE_VAL ? " (M = 0: no safe quadratic correction found)" : "");
+  if (info.pod_randomized)
+    progress("  POD: %s (a-posteriori check %.2g)", info.pod_randomized > 0 ? "randomized (large snapshot set)"
+             : "exact SVD (the randomized POD failed its check)", info.pod_check);
   if (rom->nd && o.deim)
     progress("  hyper-reduction %s: %d points, %d negative weights, smallest weight %.3g, training residual %.2g",
              A->hyper ? A->hyper : "ecsw", info.deim_modes, info.deim_negative, info.hyper_min_weight,
