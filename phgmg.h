@@ -8518,6 +8518,9 @@ typedef struct phgmg__rctx {
   int ng, gsel;            /* automatic lambda: grid size and chosen point (-1: fixed lambda) */
   double *lg;              /* grid (ng) and validation errors (ng)          */
   double *Tq;              /* ridge problem Kt, Rqt, Mt kept for a refit   */
+  double *V2h;             /* hierarchical POD: modes p+1..p+rn of the basis
+                              stage's factorisation (N x rn), for stage 2     */
+  int v2ok;                /* V2h holds rn modes above the rank floor       */
   phgmg_jr_factor *jr;     /* factorization of J - R (GMG)                 */
   int *runcol;             /* opts.runs: nrun + 1 column offsets (NULL: one run) */
   int fallback_pod;        /* altmin under lambda_auto = 1 found no model as good as
@@ -8532,7 +8535,8 @@ PHGMG__PRIV void phgmg__rctx_free(phgmg__rctx *c) {
   phgmg__free(c->alloc, c->lg);
   phgmg__free(c->alloc, c->Tq);
   phgmg__free(c->alloc, c->runcol);
-  c->jr = NULL; c->Xa = c->lg = c->Tq = NULL; c->runcol = NULL;
+  phgmg__free(c->alloc, c->V2h);
+  c->jr = NULL; c->Xa = c->lg = c->Tq = c->V2h = NULL; c->runcol = NULL;
 }
 
 PHGMG__PRIV int phgmg__is_gmg(int method) {
@@ -8646,14 +8650,30 @@ PHGMG__PRIV phgmg_result phgmg__check_given_basis(const phgmg_reduced *red, cons
   return err <= 1e-8 ? PHGMG_OK : PHGMG_ERR_RANK;
 }
 
-/* GMG: V1 (the first p of k POD modes, N x k) and S into V0 and info. */
+/* GMG: V1 (the first p of k POD modes, N x k) and S into V0 and info. With
+   c->V2h (hierarchical POD manifold), modes p+1..p+rn go there: the POD of
+   (I - V1 V1^T) Xa that stage 2 needs is the rest of the same SVD. */
 PHGMG__PRIV phgmg_result phgmg__basis_take(phgmg__rctx *c, const double *V1, const double *S, int k) {
   phgmg_reduced *red = c->red;
-  const int N = red->N, m = red->m, p = red->p;
+  const int N = red->N, m = red->m, p = red->p, rn = red->rn;
   if (k < p || !(S[p - 1] > c->rfloor)) return PHGMG_ERR_SIZE; /* r - m > rank */
   memcpy(red->V0 + (size_t)N * m, V1, (size_t)N * p * sizeof(double));
   c->inf.pod_sigma_ratio = (k > p && S[0] > 0.0) ? S[p] / S[0] : 0.0;
+  if (c->V2h && k >= p + rn && S[p + rn - 1] > c->rfloor) {
+    memcpy(c->V2h, V1 + (size_t)N * p, (size_t)N * rn * sizeof(double));
+    c->v2ok = 1;
+  }
   return PHGMG_OK;
+}
+
+/* Stage 2 can take V2 from the basis stage's SVD: the hierarchical POD
+   manifold (GMG-QM with manifold = POD, or your own eta) without a given
+   basis. */
+PHGMG__PRIV int phgmg__v2_from_basis(const phgmg__rctx *c) {
+  const phgmg_reduced *red = c->red;
+  if (red->kind != PHGMG_ROM_QUADRATIC || c->o->pod_basis) return 0;
+  return red->method == PHGMG_METHOD_GMG_MANIFOLD ||
+         (red->method == PHGMG_METHOD_GMG_QM && c->o->manifold == PHGMG_MANIFOLD_POD);
 }
 
 /* GMG with a linear basis (no manifold stage that needs the adjusted
@@ -8686,7 +8706,7 @@ PHGMG__PRIV phgmg_result phgmg__stage_basis(phgmg__rctx *c) {
   const int N = red->N, m = red->m, p = red->p, ns = c->ns;
   const int need = p + (red->kind == PHGMG_ROM_QUADRATIC ? red->rn : 0);
   double *S, *tmp;
-  int k = 0, j;
+  int k = 0, j, kk;
   phgmg_result rc;
   red->V0 = phgmg__red_d(red, (size_t)N * red->r);
   red->QB = phgmg__red_d(red, (size_t)N * m);
@@ -8713,8 +8733,14 @@ PHGMG__PRIV phgmg_result phgmg__stage_basis(phgmg__rctx *c) {
     memcpy(red->V0 + (size_t)N * m, c->o->pod_basis, (size_t)N * p * sizeof(double));
     return PHGMG_OK;
   }
-  tmp = phgmg__dalloc(c->alloc, (size_t)PHGMG__MAX(m, 1) * ns + (size_t)N * (p + 1) + (size_t)p + 1);
+  kk = phgmg__v2_from_basis(c) ? p + red->rn + 1 : p + 1;
+  kk = PHGMG__MIN(kk, PHGMG__MIN(N, ns));
+  tmp = phgmg__dalloc(c->alloc, (size_t)PHGMG__MAX(m, 1) * ns + (size_t)N * (p + red->rn + 1) + (size_t)p + red->rn + 1);
   if (!tmp) return PHGMG_ERR_NOMEM;
+  if (phgmg__v2_from_basis(c)) {
+    c->V2h = phgmg__dalloc(c->alloc, (size_t)N * red->rn);
+    if (!c->V2h) { phgmg__free(c->alloc, tmp); return PHGMG_ERR_NOMEM; }
+  }
   memcpy(red->V0, c->sys->B, (size_t)N * m * sizeof(double));
   if (!c->o->pod_basis && red->kind != PHGMG_ROM_QUADRATIC) { /* large: randomized, X - QB QB^T X implicit */
     rc = phgmg__basis_pod_implicit(c, tmp);
@@ -8731,9 +8757,8 @@ PHGMG__PRIV phgmg_result phgmg__stage_basis(phgmg__rctx *c) {
       rc = phgmg__check_given_basis(red, c->o->pod_basis, need, c->alloc);
   } else {
     double *V1 = tmp + (size_t)PHGMG__MAX(m, 1) * ns;
-    S = V1 + (size_t)N * (p + 1);
-    rc = phgmg__pod_auto(N, ns, c->Xa, N, PHGMG__MIN(p + 1, PHGMG__MIN(N, ns)), V1, N, S, &k, &c->inf.pod_randomized,
-                         &c->inf.pod_check, c->alloc);
+    S = V1 + (size_t)N * (p + red->rn + 1);
+    rc = phgmg__pod_auto(N, ns, c->Xa, N, kk, V1, N, S, &k, &c->inf.pod_randomized, &c->inf.pod_check, c->alloc);
     if (rc == PHGMG_OK) rc = phgmg__basis_take(c, V1, S, k);
   }
   phgmg__free(c->alloc, tmp);
@@ -9107,6 +9132,8 @@ PHGMG__PRIV phgmg_result phgmg__stage_manifold(phgmg__rctx *c) {
       /* V2 from the alternating minimization */
     } else if (c->o->pod_basis && c->o->manifold == PHGMG_MANIFOLD_POD) {
       memcpy(red->V2, c->o->pod_basis + (size_t)N * p, (size_t)N * rn * sizeof(double));
+    } else if (c->v2ok && phgmg__v2_from_basis(c)) { /* the same SVD's next modes */
+      memcpy(red->V2, c->V2h, (size_t)N * rn * sizeof(double));
     } else {
       rc = phgmg_pod(N, ns, c->Xa, N, rn, 0.0, red->V2, N, tmp, &k, c->alloc);
       if (rc == PHGMG_OK && (k < rn || !(tmp[rn - 1] > c->rfloor))) rc = PHGMG_ERR_SIZE;

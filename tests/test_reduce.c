@@ -580,6 +580,59 @@ TEST(test_lambda_auto_exact_manifold) {
    error is no worse than at either end of the grid (each end evaluated by a
    one-point grid), the guard moves up the grid by whole steps, and the
    in-sample projection error is below the paper's lambda = 1e-3. */
+/* GMG-QM's V2 is the POD of (I - V1 V1^T) Xa (paper 4.2.2), which
+   phgmg_reduce takes from the basis stage's SVD of Xa (modes p+1..p+rn).
+   Independent check: the POD of the explicitly deflated snapshots spans the
+   same space, to the perturbation bound eps sigma_1 / gap (Wedin). */
+TEST(test_qm_v2_is_hierarchical_pod) {
+  tmodel t;
+  double *X, *Xa, *U, *S, *P;
+  phgmg_reduce_opts o;
+  phgmg_reduced *red = NULL;
+  const int r = 12, rn = 8, ns = 401;
+  int N, m, p, k = 0, i, j;
+  linear_msd(&t, 50, 2, 1, 1);
+  N = t.sys.N; m = t.sys.m; p = r - m;
+  X = snapshots(&t.sys, ns - 1, 1e-10, 10);
+  CHECK(X != NULL);
+  if (!X) { tmodel_free(&t); return; }
+  memset(&o, 0, sizeof o);
+  o.method = PHGMG_METHOD_GMG_QM; o.r = r; o.rn = rn;
+  CHECK_RC(phgmg_reduce(&red, &t.sys, X, N, ns, &o, NULL, NULL), PHGMG_OK);
+  Xa = (double *)malloc(sizeof(double) * (size_t)N * ns);
+  U = (double *)malloc(sizeof(double) * (size_t)N * (rn + 1));
+  S = (double *)malloc(sizeof(double) * (size_t)(rn + 1 + p + 1));
+  P = (double *)malloc(sizeof(double) * (size_t)rn * rn);
+  if (red && Xa && U && S && P) {
+    double s1, gap, err = 0.0;
+    CHECK_RC(phgmg_adjust_snapshots(N, m, t.sys.B, ns, X, N, Xa, N, NULL), PHGMG_OK);
+    CHECK_RC(phgmg_pod(N, ns, Xa, N, 1, 0.0, U, N, S, &k, NULL), PHGMG_OK);
+    s1 = S[0];
+    for (j = 0; j < ns; ++j) { /* Xa := (I - V1 V1^T) Xa, V1 = the model's */
+      double c[64];
+      phgmg_gemv('T', N, p, 1.0, red->V0 + (size_t)N * m, N, Xa + (size_t)j * N, 0.0, c);
+      phgmg_gemv('N', N, p, -1.0, red->V0 + (size_t)N * m, N, c, 1.0, Xa + (size_t)j * N);
+    }
+    CHECK_RC(phgmg_pod(N, ns, Xa, N, rn + 1, 0.0, U, N, S, &k, NULL), PHGMG_OK);
+    CHECK(k == rn + 1);
+    gap = S[rn - 1] - S[rn];
+    CHECK(gap > 0.0);
+    /* || U_rn^T V2 || singular values ~ 1: || V2 - U U^T V2 ||_F */
+    phgmg_gemm('T', 'N', rn, rn, N, 1.0, U, N, red->V2, N, 0.0, P, rn);
+    for (j = 0; j < rn; ++j)
+      for (i = 0; i < N; ++i) {
+        double v = red->V2[i + (size_t)j * N];
+        int a;
+        for (a = 0; a < rn; ++a) v -= U[i + (size_t)a * N] * P[a + (size_t)j * rn];
+        err += v * v;
+      }
+    CHECK_LE(sqrt(err), 1e3 * 2.220446049250313e-16 * s1 / gap);
+  }
+  free(Xa); free(U); free(S); free(P); free(X);
+  phgmg_reduced_destroy(red);
+  tmodel_free(&t);
+}
+
 TEST(test_lambda_auto_linear_msd) {
   tmodel t;
   double *X;
@@ -720,6 +773,7 @@ SUITE(reduce) {
   RUN(test_online_never_allocates);
   RUN(test_lambda_cv_against_lstsq);
   RUN(test_lambda_auto_exact_manifold);
+  RUN(test_qm_v2_is_hierarchical_pod);
   RUN(test_lambda_auto_linear_msd);
   RUN(test_lambda_auto_options_and_oom);
 }
