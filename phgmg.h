@@ -7634,10 +7634,29 @@ PHGMG__PRIV phgmg_result phgmg__nnls_inner(const phgmg__nnls_prob *pb, phgmg__nn
   return rc;
 }
 
-/* Lawson-Hanson from x = 0 (x: n, zeroed here). Stops when the squared
-   residual <= stop2 (stop2 <= 0: at optimality). *res2 = final squared residual. */
-PHGMG__PRIV phgmg_result phgmg__nnls_core(const phgmg__nnls_prob *pb, double stop2, int max_iter, double *x,
-                                          double *res2, const phgmg_allocator *alloc) {
+/* Warm start (Gram form): the passive set P = the support of x; kept only
+   if the least-squares solution on P is positive (x_P := it), as at a
+   Lawson-Hanson step; otherwise x = 0, P empty (a cold start). */
+PHGMG__PRIV void phgmg__nnls_warm(const phgmg__nnls_prob *pb, phgmg__nnls_ws *ws, double *x,
+                                  const phgmg_allocator *alloc) {
+  int i, ok;
+  for (i = 0; i < pb->n; ++i)
+    if (x[i] > 0.0) { ws->P[ws->np++] = i; ws->flag[i] = 1; }
+  ok = ws->np > 0 && phgmg__nnls_chol(pb, ws) && phgmg__nnls_solve(pb, ws, alloc) == PHGMG_OK;
+  for (i = 0; ok && i < ws->np; ++i) ok = ws->z[i] > 0.0;
+  for (i = 0; i < ws->np; ++i) x[ws->P[i]] = ok ? ws->z[i] : 0.0;
+  if (!ok) {
+    for (i = 0; i < pb->n; ++i) { x[i] = 0.0; ws->flag[i] = 0; }
+    ws->np = 0;
+  }
+}
+
+/* Lawson-Hanson from x = 0 (warm = 0: x zeroed here) or, in the Gram form,
+   from the support of the given x >= 0 (warm = 1, phgmg__nnls_warm). Stops
+   when the squared residual <= stop2 (stop2 <= 0: at optimality).
+   *res2 = final squared residual. */
+PHGMG__PRIV phgmg_result phgmg__nnls_core(const phgmg__nnls_prob *pb, double stop2, int max_iter, int warm,
+                                          double *x, double *res2, const phgmg_allocator *alloc) {
   const int n = pb->n;
   phgmg__nnls_ws ws;
   double *tmp;
@@ -7652,7 +7671,9 @@ PHGMG__PRIV phgmg_result phgmg__nnls_core(const phgmg__nnls_prob *pb, double sto
   ws.r = tmp + pb->k;
   ws.L = ws.Cp = ws.r + pb->k;
   ws.np = 0;
-  for (i = 0; i < n; ++i) { x[i] = 0.0; ws.flag[i] = 0; }
+  for (i = 0; i < n; ++i) ws.flag[i] = 0;
+  if (warm && pb->G) phgmg__nnls_warm(pb, &ws, x, alloc);
+  else for (i = 0; i < n; ++i) x[i] = 0.0;
   for (;;) {
     double r2 = phgmg__nnls_grad(pb, &ws, x, tmp), gmax = pb->wtol;
     int j = -1;
@@ -7723,8 +7744,8 @@ PHGMG_DEF phgmg_result phgmg_nnls(int m, int n, const double *A, int lda, const 
   } else {
     pb.C = A; pb.ldc = lda; pb.k = m; pb.d = b;
   }
-  rc = phgmg__nnls_core(&pb, tol > 0.0 ? (tol * bn) * (tol * bn) : 0.0, max_iter > 0 ? max_iter : 3 * n, x,
-                        &res2, alloc);
+  rc = phgmg__nnls_core(&pb, tol > 0.0 ? (tol * bn) * (tol * bn) : 0.0, max_iter > 0 ? max_iter : 3 * n, 0,
+                        x, &res2, alloc);
   phgmg__free(alloc, Q);
   if (rc != PHGMG_OK && rc != PHGMG_ERR_NOT_CONVERGED) return rc;
   for (j = 0; j < n; ++j) if (x[j] > 0.0) ++nz;
@@ -7759,10 +7780,11 @@ PHGMG__PRIV double phgmg__ecsw_resid(int m, int n, const double *Gm, int ldg, co
 }
 
 /* phgmg_ecsw on checked arguments (tol > 0): Lawson-Hanson in the hybrid
-   Gram form over all n columns (the Gram matrix n x n in memory). */
+   Gram form over all n columns (the Gram matrix n x n in memory); x0 (n,
+   >= 0, or NULL: from zero) is a warm start (phgmg__nnls_warm). */
 PHGMG__PRIV phgmg_result phgmg__ecsw_gram(int n, int m, const double *Gm, int ldg, const double *target,
-                                          double tol, int *pts, double *w, int *nd_out, double *resid_out,
-                                          const phgmg_allocator *alloc) {
+                                          double tol, const double *x0, int *pts, double *w, int *nd_out,
+                                          double *resid_out, const phgmg_allocator *alloc) {
   phgmg__nnls_prob pb;
   double *G, *c, *x, *r, tn, rel = 0.0, res2 = 0.0;
   int j, nd = 0;
@@ -7785,7 +7807,8 @@ PHGMG__PRIV phgmg_result phgmg__ecsw_gram(int n, int m, const double *Gm, int ld
   /* the true gradient is checked at the end (hybrid form), so the threshold
      only has to sit above the rounding of C^T r, not at the Gram form's level */
   pb.wtol = 10.0 * PHGMG__EPS * sqrt(pb.wtol) * tn;
-  rc = phgmg__nnls_core(&pb, (tol * tn) * (tol * tn), 3 * n, x, &res2, alloc);
+  if (x0) memcpy(x, x0, (size_t)n * sizeof(double));
+  rc = phgmg__nnls_core(&pb, (tol * tn) * (tol * tn), 3 * n, x0 != NULL, x, &res2, alloc);
   if (rc == PHGMG_OK || rc == PHGMG_ERR_NOT_CONVERGED) { /* residual of the weights as returned */
     rel = phgmg__ecsw_resid(m, n, Gm, ldg, target, x, r) / tn;
     rc = rel <= tol ? PHGMG_OK : PHGMG_ERR_NOT_CONVERGED; /* optimal above tol, or capped */
@@ -7815,8 +7838,9 @@ PHGMG__PRIV phgmg_result phgmg__ecsw_gram(int n, int m, const double *Gm, int ld
    residual meets tol, or no term outside W has a positive gradient (then w
    is optimal over all n terms, as Lawson-Hanson's: PHGMG_ERR_NOT_CONVERGED
    if above tol), or after PHGMG_ECSW_SCREEN_ROUNDS (200) rounds. Each round
-   solves from zero on W, so the result is Lawson-Hanson's greedy solution
-   on the final W: w >= 0 by construction. The two ways to
+   continues Lawson-Hanson on W from the last round's weights (warm start:
+   its support as the passive set, phgmg__nnls_warm), so w >= 0 by
+   construction and a round costs the steps for the new terms only. The two ways to
    apply the training matrix are callbacks (explicit Gm; the separable
    product F^T diag(.) Vt that never forms it). */
 #ifndef PHGMG_ECSW_SCREEN_MIN
@@ -7884,17 +7908,18 @@ PHGMG__PRIV phgmg_result phgmg__ecsw_screened(const phgmg__ecsw_op *op, const do
                                               const phgmg_allocator *alloc) {
   const int n = op->n, m = op->m;
   const int wmax = PHGMG__MIN(n, 16 * PHGMG_ECSW_SCREEN_ADD);
-  double *Gw, *res, *g, *h, *ww, gtol, rel = HUGE_VAL;
+  double *Gw, *res, *g, *h, *ww, *x0, gtol, rel = HUGE_VAL;
   int *W, *pw, nw = 0, nd = 0, i, j, rounds = 0;
   char *inW;
   phgmg_result rc = PHGMG_ERR_NOT_CONVERGED;
-  Gw = phgmg__dalloc(alloc, (size_t)m * wmax + (size_t)m + (size_t)n + op->hsize + (size_t)wmax);
+  Gw = phgmg__dalloc(alloc, (size_t)m * wmax + (size_t)m + (size_t)n + op->hsize + 2 * (size_t)wmax);
   W = phgmg__ialloc(alloc, 2 * (size_t)wmax + (size_t)n);
   if (!Gw || !W) { phgmg__free(alloc, Gw); phgmg__free(alloc, W); return PHGMG_ERR_NOMEM; }
   res = Gw + (size_t)m * wmax;
   g = res + m;
   h = g + n;
   ww = h + op->hsize;
+  x0 = ww + wmax;              /* the last round's weights on W: a warm start */
   pw = W + wmax;
   inW = (char *)(pw + wmax);   /* n flags in the int tail (n ints >= n chars) */
   memset(inW, 0, (size_t)n);
@@ -7905,9 +7930,9 @@ PHGMG__PRIV phgmg_result phgmg__ecsw_screened(const phgmg__ecsw_op *op, const do
   for (;;) {
     const int add = phgmg__ecsw_screen_add(n, g, gtol, PHGMG__MIN(PHGMG_ECSW_SCREEN_ADD, wmax - nw), W, nw, inW);
     if (add == 0) break;          /* optimal over all terms (or W full) */
-    for (j = nw; j < nw + add; ++j) op->col(op, W[j], Gw + (size_t)j * m);
+    for (j = nw; j < nw + add; ++j) { op->col(op, W[j], Gw + (size_t)j * m); x0[j] = 0.0; }
     nw += add;
-    rc = phgmg__ecsw_gram(nw, m, Gw, m, target, tol, pw, ww, &nd, &rel, alloc);
+    rc = phgmg__ecsw_gram(nw, m, Gw, m, target, tol, rounds ? x0 : NULL, pw, ww, &nd, &rel, alloc);
     if (rc != PHGMG_OK && rc != PHGMG_ERR_NOT_CONVERGED) break;
     if (rc == PHGMG_OK) break;    /* tol met on the full rows */
     memcpy(res, target, (size_t)m * sizeof(double));
@@ -7922,6 +7947,7 @@ PHGMG__PRIV phgmg_result phgmg__ecsw_screened(const phgmg__ecsw_op *op, const do
       inW[W[j]] = 1;
       if (pw[j] != j) memcpy(Gw + (size_t)j * m, Gw + (size_t)pw[j] * m, (size_t)m * sizeof(double));
       pw[j] = j;
+      x0[j] = ww[j];
     }
     nw = nd;
   }
@@ -7952,7 +7978,8 @@ PHGMG_DEF phgmg_result phgmg_ecsw(int nterms, int nrows, const double *Gm, int l
   if (n < 1 || m < 1 || ldg < m) return PHGMG_ERR_SIZE;
   if (!phgmg__mat_finite(m, n, Gm, ldg) || !phgmg__all_finite(target, (size_t)m)) return PHGMG_ERR_NANINF;
   if (tol <= 0.0) tol = 1e-6;
-  if (n < PHGMG_ECSW_SCREEN_MIN) return phgmg__ecsw_gram(n, m, Gm, ldg, target, tol, pts, w, nd_out, resid_out, alloc);
+  if (n < PHGMG_ECSW_SCREEN_MIN)
+    return phgmg__ecsw_gram(n, m, Gm, ldg, target, tol, NULL, pts, w, nd_out, resid_out, alloc);
   tn = phgmg_normf(m, 1, target, m);
   *nd_out = 0;
   if (resid_out) *resid_out = 0.0;

@@ -145,8 +145,18 @@ TEST(test_nnls_kkt) {
     phgmg_gemv('T', m, n, 1.0, A, m, b, 0.0, cg);
     memset(&pb, 0, sizeof pb);
     pb.n = n; pb.G = G; pb.ldg = n; pb.c = cg; pb.dd = bn * bn; pb.wtol = 1e-13 * an * bn;
-    CHECK_RC(phgmg__nnls_core(&pb, 0.0, 3 * n, xg, &res2, NULL), PHGMG_OK);
+    CHECK_RC(phgmg__nnls_core(&pb, 0.0, 3 * n, 0, xg, &res2, NULL), PHGMG_OK);
     hy_check_kkt(m, n, A, b, xg, 1e-9 * an * bn);
+    { /* warm start from every other term of the optimum's support (the
+         screened ECSW's rounds): the same optimum (KKT) */
+      double *xw = (double *)malloc(sizeof(double) * (size_t)n), r2w;
+      int cnt = 0;
+      for (i = 0; i < n; ++i) xw[i] = (x[i] > 0.0 && (cnt++ % 2 == 0)) ? x[i] : 0.0;
+      CHECK_RC(phgmg__nnls_core(&pb, 0.0, 3 * n, 1, xw, &r2w, NULL), PHGMG_OK);
+      hy_check_kkt(m, n, A, b, xw, 1e-9 * an * bn);
+      CHECK_LE(fabs(hy_resid(m, n, A, b, xw) - res), 1e-8 * bn);
+      free(xw);
+    }
     if (m >= n) /* unique optimum */
       for (i = 0; i < n; ++i) CHECK_LE(fabs(xg[i] - x[i]), 1e-7);
     CHECK_LE(fabs(hy_resid(m, n, A, b, xg) - res), 1e-8 * bn);
