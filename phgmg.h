@@ -2007,6 +2007,12 @@ scaled:
   return scale * sqrt(ssq);
 }
 
+/* sum of squares of an n x ns matrix (ld lda): ||A||_F^2 by phgmg_normf. */
+PHGMG__PRIV double phgmg__sumsq(int n, int ns, const double *A, int lda) {
+  const double f = phgmg_normf(n, ns, A, lda);
+  return f * f;
+}
+
 /* ---- gemv / gemm ---------------------------------------------------------- */
 PHGMG_DEF void phgmg_gemv(char trans, int m, int n, double alpha, const double *A, int lda,
                           const double *x, double beta, double *y) {
@@ -9107,8 +9113,7 @@ PHGMG__PRIV phgmg_result phgmg__qm_altmin(phgmg__rctx *c) {
   w.lam = c->o->lambda_auto ? 1e-9 : c->lambda;
   if (rc == PHGMG_OK) {
     phgmg_gemm('T', 'N', q, ns, N, 1.0, U, N, c->Xa, N, 0.0, S, q);
-    for (i = 0; i < N * ns; ++i) tot += c->Xa[i] * c->Xa[i];
-    for (i = 0; i < q * ns; ++i) tot -= S[i] * S[i];
+    tot = phgmg__sumsq(N, ns, c->Xa, N) - phgmg__sumsq(q, ns, S, q);
     outside = PHGMG__MAX(tot, 0.0);                    /* what no Q in span U can represent */
     for (i = 0; i < q * k; ++i) w.Q[i] = (i % q) == (i / q) ? 1.0 : 0.0;
     rc = phgmg__altmin_eval(q, ns, p, rn, S, w.Q, w.lam, w.Kt, w.Yt, w.T, w.W, w.R, &f, &w.al);
@@ -10528,15 +10533,6 @@ PHGMG_DEF const double *phgmg_study_basis(const phgmg_study *st, char which, int
   if (st && which == 'g') { b = st->Ug; k = st->kg; }
   if (cols) *cols = b ? k : 0;
   return b;
-}
-
-/* sum of squares of an n x ns matrix (ld n). */
-PHGMG__PRIV double phgmg__sumsq(int n, int ns, const double *A, int lda) {
-  double s = 0.0;
-  int i, j;
-  for (j = 0; j < ns; ++j)
-    for (i = 0; i < n; ++i) s += A[i + (size_t)j * lda] * A[i + (size_t)j * lda];
-  return s;
 }
 
 /* POD of T (N x ns, ld N; destroyed) into U (N x kmax): *k = modes with
