@@ -36,7 +36,8 @@ static const char *const help_lines[] = {
   "USAGE\n",
   "  phgmg reduce --J J.npy --R R.npy --B B.npy --Q Q.npy\n",
   "               (or --J-coo/--R-coo/--Q-coo for sparse J, R, Q; see SPARSE MATRICES)\n",
-  "               (--X X.npy | --simulate [--dt 0.1] [--steps 1000] [--input sin] [--amp 0.1])\n",
+  "               (--X X.npy [--X-input KIND] (repeatable) | --simulate [--dt 0.1] [--steps 1000]\n",
+  "               [--input sin] [--amp 0.1])\n",
   "               --method gmg-pod|gmg-qm|sp1|sp2 --r R [--rn 8] [--lambda 1e-3|auto|cv]\n",
   "               [--manifold pod|greedy|altmin] [--train-input KIND]...\n",
   "               [--poly coeffs.npy --poly-idx idx.npy [--poly-w w.npy]] [DEIM options]\n",
@@ -48,7 +49,8 @@ static const char *const help_lines[] = {
   "               [--test-steps N] [--max-ey E]   (reduce, then run full and reduced\n",
   "               model on each test input: e_red, e_y, e_proj, energy, Newton, the\n",
   "               first failing step; exit 1 if one fails or e_y > E, default 0.1;\n",
-  "               default test inputs: the training input(s))\n",
+  "               default test inputs: the training input(s); with --X the\n",
+  "               --X-input runs, else --test-input is required)\n",
   "  phgmg --help | --version\n",
   "\n",
   "THE MODEL\n",
@@ -67,6 +69,13 @@ static const char *const help_lines[] = {
   "                      --B); see SPARSE MATRICES.\n",
   "  --X FILE            snapshot matrix N x ns (ns >= 2 states, one per column; a\n",
   "                      trajectory x(t_0), ..., x(t_n), normally starting at x = 0).\n",
+  "                      Repeatable (up to 16): one training run per file, the runs'\n",
+  "                      boundaries known to the reduction (--lambda cv folds).\n",
+  "  --X-input KIND      the input that made each --X run (one per --X, same order;\n",
+  "                      KIND as --input, sampled with --dt = the snapshots' step):\n",
+  "                      --lambda auto then simulates the runs from their first\n",
+  "                      snapshot, and validate tests them by default. Without it\n",
+  "                      the inputs are unknown: --lambda auto keeps M = 0.\n",
   "  --simulate          instead of --X: simulate the full model from x0 = 0 with the\n",
   "                      3-stage Gauss-Legendre method (order 6) and use the steps+1\n",
   "                      states as snapshots. Options:\n",
@@ -95,8 +104,8 @@ static const char *const help_lines[] = {
   "    --lambda auto     validated by simulation (safe choice): the reduced model is\n",
   "                      simulated for candidate lambdas on the training runs and on\n",
   "                      three probe inputs and compared with M = 0 (GMG-POD on the\n",
-  "                      same basis); no safe lambda: M = 0. Needs --simulate (with\n",
-  "                      --X the inputs are unknown and M = 0 is kept). Costs seconds.\n",
+  "                      same basis); no safe lambda: M = 0. Needs the training\n",
+  "                      inputs (--simulate, or --X with --X-input). Costs seconds.\n",
   "    --lambda cv       regression only (held-out time blocks; one run per fold with\n",
   "                      several --train-input): fits the snapshots closely, but may\n",
   "                      give a model that fails on other inputs.\n",
@@ -831,6 +840,10 @@ typedef struct reduce_args {
   const char *manifold_s;
   const char *train[16];        /* --train-input KIND, repeatable */
   int ntrain;
+  const char *xs[16];           /* --X FILE, repeatable: one run each (X = xs[0]) */
+  int nx;
+  const char *xin[16];          /* --X-input KIND, repeatable: the input of each --X run */
+  int nxin;
 } reduce_args;
 
 static const char *method_name(int m) {
@@ -868,8 +881,16 @@ static int parse_reduce(int argc, char **argv, reduce_args *A) {
       A->train[A->ntrain++] = v;
       continue;
     }
+    if (!strcmp(o, "--X") || !strcmp(o, "--X-input")) {   /* repeatable: one run each */
+      const int isx = o[3] == 0;
+      if (!(v = optval(argc, argv, &i))) return 2;
+      if ((isx ? A->nx : A->nxin) >= 16) return usage_error("reduce: at most 16 %s", o);
+      if (isx) A->xs[A->nx++] = v; else A->xin[A->nxin++] = v;
+      A->X = A->xs[0];
+      continue;
+    }
     if (repeated_opt(o, seen, &nseen)) return 2;
-    STR("--J", J) STR("--R", R) STR("--B", B) STR("--Q", Q) STR("--X", X)
+    STR("--J", J) STR("--R", R) STR("--B", B) STR("--Q", Q)
     STR("--J-coo", Jcoo) STR("--R-coo", Rcoo) STR("--Q-coo", Qcoo)
     STR("--poly", poly) STR("--poly-idx", poly_idx) STR("--poly-w", poly_w)
     STR("--exp", expf) STR("--potential", potential) STR("--hyper", hyper)
@@ -930,6 +951,9 @@ static int parse_reduce(int argc, char **argv, reduce_args *A) {
   if (!(A->hyper_tol < 1.0)) return usage_error("--hyper-tol must be < 1");
   if (name_problem(A->name)) return usage_error("--name '%s': %s", A->name, name_problem(A->name));
   if (A->ntrain && !A->simulate) return usage_error("reduce: --train-input needs --simulate");
+  if (A->nxin && A->nxin != A->nx)
+    return usage_error("reduce: %d --X-input for %d --X files: give one input per --X file, in the same order",
+                       A->nxin, A->nx);
   if (A->ntrain && A->input)
     return usage_error("reduce: give the training input either by --input or by --train-input, not both");
   if (!A->input) A->input = A->ntrain ? A->train[0] : "sin";
@@ -1048,8 +1072,12 @@ typedef struct reduce_state {
   double *Xperm, *Uord;   /* snapshots in the internal order; un-permuted output */
   cli_input in;
   cli_input tin[16];      /* --train-input 2..: the further training inputs */
-  phgmg_run runs[16];     /* the training runs (with --simulate), for phgmg_reduce */
+  phgmg_run runs[16];     /* the training runs (--simulate, several --X), for phgmg_reduce */
   int nrun;
+  mat Xs[16];             /* --X files 2..16 (the first is X) */
+  double *Xcat;           /* several --X: their columns one after the other */
+  cli_input xinp[16];     /* --X-input: the input of each --X run */
+  phgmg_ph_system sys;    /* the full model as reduced (internal ordering for sparse input) */
   phgmg_reduced *red;
   staged sg; /* the outputs, renamed into place at the end */
 } reduce_state;
@@ -1136,7 +1164,8 @@ static int load_family(const reduce_args *A, reduce_state *S, phgmg_ph_system *s
 static void reduce_cleanup(reduce_state *S) {
   mat_free(&S->J); mat_free(&S->R); mat_free(&S->B); mat_free(&S->Q); mat_free(&S->X);
   mat_free(&S->poly); mat_free(&S->pidx); mat_free(&S->pw); mat_free(&S->ex); mat_free(&S->in.tab);
-  { int k; for (k = 0; k < 16; ++k) mat_free(&S->tin[k].tab); }
+  { int k; for (k = 0; k < 16; ++k) { mat_free(&S->tin[k].tab); mat_free(&S->Xs[k]); mat_free(&S->xinp[k].tab); } }
+  free(S->Xcat);
   free(S->idx); free(S->fpoly); free(S->fexp); free(S->Xsim); free(S->Ysim); free(S->V0);
   cli_csc_free(&S->cJ); cli_csc_free(&S->cR); cli_csc_free(&S->cQ);
   phgmg_ph_sparse_destroy(S->sp); free(S->Xperm); free(S->Uord);
@@ -1197,6 +1226,64 @@ static int write_user_field(const reduce_args *A, reduce_state *S, const char *f
   return write_field(A->out, A->name, field, S->Uord, N, cols, ol, &S->sg);
 }
 
+/* The --X files (one run each) as one snapshot set in the internal ordering,
+   with the runs' boundaries (and, with --X-input, their inputs) in S->runs. */
+static int load_snapshot_files(const reduce_args *A, reduce_state *S, int N, int m, const double **Xo, int *nso) {
+  double *X;
+  size_t col = 0;
+  int k, ns = 0;
+  for (k = 0; k < A->nx; ++k) {
+    mat *F = k ? &S->Xs[k] : &S->X;
+    if (mat_load(F, "--X", A->xs[k])) return 1;
+    if (F->ndim != 2 || F->rows != N || F->cols < 2)
+      return fail("%s (--X): expected shape (%d, ns), ns >= 2 snapshots as columns (N = %d from %s), got %s",
+                  A->xs[k], N, N, A->J ? A->J : A->B, shape_str(F));
+    if (F->cols > INT_MAX - ns) return fail("%s (--X): too many snapshots in all", A->xs[k]);
+    ns += F->cols;
+  }
+  if (A->nx == 1) X = S->X.a;
+  else {   /* the runs one after the other */
+    S->Xcat = X = (double *)malloc(sizeof(double) * (size_t)N * (size_t)ns);
+    if (!X) return fail("out of memory for %d snapshots of size %d", ns, N);
+    for (k = 0; k < A->nx; ++k) {
+      const mat *F = k ? &S->Xs[k] : &S->X;
+      memcpy(X + col * (size_t)N, F->a, sizeof(double) * (size_t)N * (size_t)F->cols);
+      col += (size_t)F->cols;
+    }
+  }
+  if (S->sp) { /* into the internal (banded) ordering */
+    S->Xperm = (double *)malloc(sizeof(double) * (size_t)N * (size_t)ns);
+    if (!S->Xperm) return fail("out of memory");
+    phgmg_ph_sparse_to_banded_order(S->sp, ns, X, N, S->Xperm, N);
+    X = S->Xperm;
+  }
+  /* Run boundaries: with the inputs known (--X-input) every use (--lambda auto
+     simulates the runs from their first snapshot); without, only the folds of
+     --lambda cv (a run with an unknown input must not be simulated as u = 0). */
+  if (A->nxin || (A->nx > 1 && A->lambda_auto != 1)) {
+    col = 0;
+    for (k = 0; k < A->nx; ++k) {
+      const int c = k ? S->Xs[k].cols : S->X.cols;
+      memset(&S->runs[k], 0, sizeof S->runs[k]);
+      if (A->nxin) {
+        int e = input_setup(&S->xinp[k], A->xin[k], A->amp, m, A->dt);
+        if (e) return e;
+        S->runs[k].u = input_fn; S->runs[k].user = &S->xinp[k];
+        S->runs[k].x0 = X + col * (size_t)N;
+      }
+      S->runs[k].dt = A->dt; S->runs[k].nsteps = c - 1;
+      col += (size_t)c;
+    }
+    S->nrun = A->nx;
+  }
+  for (k = 0; k < A->nx; ++k)
+    progress("snapshots: %s, %d states%s%s", A->xs[k], k ? S->Xs[k].cols : S->X.cols, A->nxin ? ", input " : "",
+             A->nxin ? A->xin[k] : "");
+  *Xo = X;
+  *nso = ns;
+  return 0;
+}
+
 static int cmd_reduce_impl(const reduce_args *A, reduce_state *S) {
   phgmg_ph_system sys;
   phgmg_reduce_opts o;
@@ -1206,8 +1293,8 @@ static int cmd_reduce_impl(const reduce_args *A, reduce_state *S) {
   rom_field fields[24];
   outlist ol;
   double rcond = 0.0, t0, t_sim = 0.0, t_red;
-  const double *X;
-  int N, m, ns, method, i, nf, k;
+  const double *X = NULL;
+  int N, m, ns = 0, method, i, nf, k;
   char path[4096 + 256];
   const char *wp;
   FILE *jf;
@@ -1286,6 +1373,7 @@ static int cmd_reduce_impl(const reduce_args *A, reduce_state *S) {
                 phgmg_result_string(rc), rc == PHGMG_ERR_SINGULAR ? " (J - R singular)" : "");
   if (rc != PHGMG_OK) return explain_validate(rc, &S->J, &S->R, &S->B, &S->Q, rcond);
   progress("system: N = %d, m = %d, valid port-Hamiltonian (rcond(J - R) = %.3g)", N, m, rcond);
+  S->sys = sys;
 
   /* --- sizes that phgmg_reduce would refuse, explained up front --- */
   if (method == PHGMG_METHOD_GMG_POD || method == PHGMG_METHOD_GMG_QM) {
@@ -1299,19 +1387,7 @@ static int cmd_reduce_impl(const reduce_args *A, reduce_state *S) {
 
   /* --- snapshots --- */
   if (A->X) {
-    if (mat_load(&S->X, "--X", A->X)) return 1;
-    if (S->X.ndim != 2 || S->X.rows != N || S->X.cols < 2)
-      return fail("%s (--X): expected shape (%d, ns), ns >= 2 snapshots as columns (N = %d from %s), got %s",
-                  A->X, N, N, A->J, shape_str(&S->X));
-    X = S->X.a;
-    ns = S->X.cols;
-    if (S->sp) { /* into the internal (banded) ordering */
-      S->Xperm = (double *)malloc(sizeof(double) * (size_t)N * (size_t)ns);
-      if (!S->Xperm) return fail("out of memory");
-      phgmg_ph_sparse_to_banded_order(S->sp, ns, X, N, S->Xperm, N);
-      X = S->Xperm;
-    }
-    progress("snapshots: %s, %d states", A->X, ns);
+    if (load_snapshot_files(A, S, N, m, &X, &ns)) return 1;
   } else {
     phgmg_gl3_opts go;
     phgmg_gl3_stats st;
@@ -1494,7 +1570,19 @@ static int cmd_reduce_impl(const reduce_args *A, reduce_state *S) {
     if (A->poly_w) { fprintf(jf, ", \"poly_w\": "); json_str(jf, A->poly_w); }
   }
   fprintf(jf, "},\n  \"snapshots\": {\"count\": %d, ", ns);
-  if (A->X) { fprintf(jf, "\"file\": "); json_str(jf, A->X); }
+  if (A->X) {
+    fprintf(jf, "\"file\": "); json_str(jf, A->X);
+    if (A->nx > 1 || A->nxin) {
+      fprintf(jf, ", \"files\": [");
+      for (i = 0; i < A->nx; ++i) { if (i) fprintf(jf, ", "); json_str(jf, A->xs[i]); }
+      fprintf(jf, "]");
+    }
+    if (A->nxin) {
+      fprintf(jf, ", \"inputs\": [");
+      for (i = 0; i < A->nxin; ++i) { if (i) fprintf(jf, ", "); json_str(jf, A->xin[i]); }
+      fprintf(jf, "], \"dt\": "); json_num(jf, A->dt);
+    }
+  }
   else {
     fprintf(jf, "\"simulate\": {\"dt\": "); json_num(jf, A->dt);
     fprintf(jf, ", \"steps\": %d, \"input\": ", A->steps); json_str(jf, A->input);
@@ -1743,21 +1831,17 @@ static int cmd_validate(int argc, char **argv) {
   }
   reduce_argv[rargc] = NULL;
   if ((i = parse_reduce(rargc, (char **)reduce_argv, &A)) != 0) return i;
-  if (!A.simulate) return usage_error("validate: needs --simulate (the full model is simulated on the test inputs)");
   if (nt == 0 && A.ntrain)   /* default: the training inputs */
     for (i = 0; i < A.ntrain; ++i) tests[nt++] = A.train[i];
+  if (nt == 0 && A.nxin)     /* --X: the inputs of the snapshot runs */
+    for (i = 0; i < A.nxin; ++i) tests[nt++] = A.xin[i];
+  if (nt == 0 && !A.simulate)
+    return usage_error("validate: with --X give --test-input (or --X-input): the inputs that made the snapshots are unknown");
   if (nt == 0) tests[nt++] = A.input;
   memset(&S, 0, sizeof S);
   status = cmd_reduce_impl(&A, &S);
   if (status == 0) {
-    phgmg_ph_system sys;
-    memset(&sys, 0, sizeof sys);
-    sys.N = S.J.rows; sys.m = S.B.cols; sys.storage = PHGMG_DENSE;
-    sys.J = S.J.a; sys.R = S.R.a; sys.Q = S.Q.a; sys.B = S.B.a; sys.nl = PHGMG_NL_NONE;
-    if (A.poly) {
-      sys.nl = PHGMG_NL_SEPARABLE; sys.nsep = S.pidx.rows * S.pidx.cols; sys.sep_idx = S.idx;
-      sys.sep_w = A.poly_w ? S.pw.a : NULL; sys.poly_deg = S.poly.rows * S.poly.cols - 1; sys.poly = S.poly.a;
-    }
+    const phgmg_ph_system sys = S.sys;   /* as reduced: any potential, sparse input in its internal order */
     printf("%-24s %10s %10s %10s %10s %10s %8s %8s %8s %8s  %s\n", "test input", "e_red", "e_y", "e_proj", "e_energy",
            "(FOM)", "newton", "outside", "q-out", "fail@", "verdict");
     for (k = 0; k < nt; ++k) {

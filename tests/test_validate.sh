@@ -70,7 +70,61 @@ done
 $P validate $M --method gmg-pod --r 12 --out o4 --max-ey > /dev/null 2>&1
 [ $? -eq 2 ] && pass || bad "--max-ey without a value: expected exit 2"
 $P validate --J m/J.npy --R m/R.npy --B m/B.npy --Q m/Q.npy --X nothing.npy --method gmg-pod --r 12 --out o5 > /dev/null 2>&1
-[ $? -eq 2 ] && pass || bad "validate with --X: expected exit 2"
+[ $? -eq 2 ] && pass || bad "validate with --X and no test input: expected exit 2"
+
+# 4. validate checks against the model that was reduced: a nonlinear potential
+#    (toda on every spring, amplitude 1 so that it matters). On the training
+#    input the full run equals the training snapshots, so the reported e_proj
+#    must equal the projection error of the saved snapshots onto span(V0),
+#    computed here by NumPy (before the fix validate simulated the linear part
+#    only and reported the linear trajectory's e_proj).
+$PY -c "import numpy as np; np.save('idx.npy', np.arange(0, 100, 2))" || exit 1
+$P validate $M --potential toda --poly-idx idx.npy --no-deim --amp 1 --method gmg-pod --r 12 --out o7 \
+   --save-snapshots --max-ey 1 > v7.txt 2>&1
+rc=$?
+[ $rc -eq 0 ] && pass || { bad "toda validate: exit $rc (expected 0)"; cat v7.txt; }
+ep=$(awk '$1 == "sin" {print $4}' v7.txt)
+$PY - "$ep" <<'PYEOF' && pass || bad "toda validate: e_proj $ep is not the projection error of the training snapshots"
+import sys, numpy as np
+X = np.load('o7/rom_snapshots.npy'); V = np.load('o7/rom_V0.npy')
+Qb, _ = np.linalg.qr(V)
+e = np.linalg.norm(X - Qb @ (Qb.T @ X)) / np.linalg.norm(X)
+ep = float(sys.argv[1])
+ok = abs(ep - e) <= 1e-3 * e   # validate prints 4 significant digits
+print("toda: e_proj reported %.6e, NumPy %.6e" % (ep, e))
+sys.exit(0 if ok else 1)
+PYEOF
+
+# 5. several --X files (one run each) with their inputs (--X-input) give the
+#    same reduced model as simulating the same runs (--simulate --train-input):
+#    boundaries and inputs reach --lambda auto; with --X and no known input,
+#    validate needs --test-input; the counts must match.
+N5="--J m/J.npy --R m/R.npy --B m/B.npy --Q m/Q.npy --quiet"
+$P reduce $N5 --simulate --input sin --method gmg-pod --r 4 --out s1 --save-snapshots > /dev/null 2>&1 || bad "snapshots 1"
+$P reduce $N5 --simulate --input sin2.npy --method gmg-pod --r 4 --out s2 --save-snapshots > /dev/null 2>&1 || bad "snapshots 2"
+$P reduce $N5 --simulate --train-input sin --train-input sin2.npy --method gmg-qm --r 10 --lambda auto --out a1 \
+   > /dev/null 2>&1 || bad "reduce --train-input x2"
+$P validate $N5 --X s1/rom_snapshots.npy --X s2/rom_snapshots.npy --X-input sin --X-input sin2.npy --method gmg-qm \
+   --r 10 --lambda auto --out a2 > v8.txt 2>&1
+rc=$?
+[ $rc -eq 0 ] && pass || { bad "validate --X x2 --X-input x2: exit $rc (expected 0)"; cat v8.txt; }
+[ "$(grep -c ' pass$' v8.txt)" -eq 2 ] && pass || bad "validate --X: expected the two --X-input runs as test inputs"
+$PY - <<'PYEOF' && pass || bad "--X x2 with --X-input: not the model of --simulate --train-input x2"
+import json, sys, numpy as np
+a, b = json.load(open('a1/rom.json')), json.load(open('a2/rom.json'))
+ok = a["options"]["lambda_used"] == b["options"]["lambda_used"] and b["options"]["training_runs"] == 2
+for f in ("Qh", "G11", "Q11", "Ms", "V0"):
+    x, y = np.load('a1/rom_%s.npy' % f), np.load('a2/rom_%s.npy' % f)
+    ok = ok and x.shape == y.shape and np.allclose(x, y, rtol=1e-9, atol=1e-12 * max(1.0, np.abs(x).max()))
+print("lambda_used", a["options"]["lambda_used"], b["options"]["lambda_used"])
+sys.exit(0 if ok else 1)
+PYEOF
+$P reduce $N5 --X s1/rom_snapshots.npy --X s2/rom_snapshots.npy --method gmg-qm --r 10 --lambda cv --out a3 > /dev/null 2>&1 \
+  && grep -q '"training_runs": 2' a3/rom.json && pass || bad "--X x2 --lambda cv: the run boundaries were not passed"
+$P validate $N5 --X s1/rom_snapshots.npy --method gmg-pod --r 10 --out a4 > /dev/null 2>&1
+[ $? -eq 2 ] && pass || bad "validate --X without a test input: expected exit 2"
+$P reduce $N5 --X s1/rom_snapshots.npy --X s2/rom_snapshots.npy --X-input sin --method gmg-pod --r 10 --out a5 > /dev/null 2>&1
+[ $? -eq 2 ] && pass || bad "2 --X, 1 --X-input: expected exit 2"
 
 echo "test_validate: $npass passed, $nfail failed"
 [ $nfail -eq 0 ]
