@@ -1284,27 +1284,13 @@ static int load_snapshot_files(const reduce_args *A, reduce_state *S, int N, int
   return 0;
 }
 
-static int cmd_reduce_impl(const reduce_args *A, reduce_state *S) {
+/* The full model from the files: dense or sparse J, R, Q, B and the nonlinear
+   part, checked (phgmg_ph_validate), into S->sys. */
+static int load_system(const reduce_args *A, reduce_state *S) {
   phgmg_ph_system sys;
-  phgmg_reduce_opts o;
-  phgmg_reduce_info info;
   phgmg_result rc;
-  const phgmg_rom *rom;
-  rom_field fields[24];
-  outlist ol;
-  double rcond = 0.0, t0, t_sim = 0.0, t_red;
-  const double *X = NULL;
-  int N, m, ns = 0, method, i, nf, k;
-  char path[4096 + 256];
-  const char *wp;
-  FILE *jf;
-
-  if (!strcmp(A->method, "gmg-pod")) method = PHGMG_METHOD_GMG_POD;
-  else if (!strcmp(A->method, "gmg-qm")) method = PHGMG_METHOD_GMG_QM;
-  else if (!strcmp(A->method, "sp1")) method = PHGMG_METHOD_SP1;
-  else if (!strcmp(A->method, "sp2")) method = PHGMG_METHOD_SP2;
-  else return usage_error("--method '%s': expected gmg-pod, gmg-qm, sp1 or sp2", A->method);
-
+  double rcond = 0.0;
+  int N, m, k;
   /* --- the system --- */
   if (A->Jcoo) {
     if (load_sparse_system(A, S, &sys)) return 1;
@@ -1375,7 +1361,11 @@ static int cmd_reduce_impl(const reduce_args *A, reduce_state *S) {
   progress("system: N = %d, m = %d, valid port-Hamiltonian (rcond(J - R) = %.3g)", N, m, rcond);
   S->sys = sys;
 
-  /* --- sizes that phgmg_reduce would refuse, explained up front --- */
+  return 0;
+}
+
+/* Sizes that phgmg_reduce would refuse, explained up front. */
+static int check_sizes(const reduce_args *A, int method, int N, int m) {
   if (method == PHGMG_METHOD_GMG_POD || method == PHGMG_METHOD_GMG_QM) {
     if (A->r <= m || A->r > N)
       return usage_error("--r %d: %s needs m < r <= N (m = %d ports from %s, N = %d)", A->r, A->method, m, A->B, N);
@@ -1385,55 +1375,72 @@ static int cmd_reduce_impl(const reduce_args *A, reduce_state *S) {
     return usage_error("--r %d: needs r <= N = %d", A->r, N);
   }
 
-  /* --- snapshots --- */
-  if (A->X) {
-    if (load_snapshot_files(A, S, N, m, &X, &ns)) return 1;
-  } else {
-    phgmg_gl3_opts go;
-    phgmg_gl3_stats st;
-    double *x0;
-    int done = 0;
-    const int nrun = A->ntrain ? A->ntrain : 1;
-    if ((k = input_setup(&S->in, A->input, A->amp, m, A->dt)) != 0) return k;
-    for (i = 1; i < nrun; ++i)
-      if ((k = input_setup(&S->tin[i], A->train[i], A->amp, m, A->dt)) != 0) return k;
-    ns = nrun * (A->steps + 1);
-    if (too_big(((double)N + (double)m) * (double)ns, "--simulate: the snapshots (N x (steps+1)) and outputs"))
-      return 2;
-    S->Xsim = (double *)malloc(sizeof(double) * (size_t)N * (size_t)ns);
-    S->Ysim = (double *)malloc(sizeof(double) * (size_t)m * (size_t)ns);
-    x0 = (double *)calloc((size_t)N, sizeof(double));
-    if (!S->Xsim || !S->Ysim || !x0) { free(x0); return fail("out of memory for %d snapshots of size %d", ns, N); }
-    memset(&go, 0, sizeof go);
-    go.tol = A->newton_tol; go.max_iter = A->newton_iter;
-    t0 = now_s();
-    for (i = 0; i < nrun; ++i) {   /* run i in columns i (steps + 1) ..; from x0 = 0 */
-      cli_input *in = i ? &S->tin[i] : &S->in;
-      const size_t c0 = (size_t)i * (size_t)(A->steps + 1);
-      progress("simulating the full model: %d steps of dt = %g, %s", A->steps, A->dt,
-               input_desc(in, i ? A->train[i] : A->input));
-      in->report = 1;
-      in->t_end = A->steps * A->dt;
-      in->wall0 = in->wall_last = now_s();
-      rc = phgmg_simulate(&sys, x0, 0.0, A->dt, A->steps, input_fn, in, &go, S->Xsim + c0 * (size_t)N,
-                          S->Ysim + c0 * (size_t)m, NULL, &st, &done, NULL);
-      in->report = 0;
-      if (rc != PHGMG_OK) {
-        free(x0);
-        return fail("full-order simulation failed at step %d of %d (t = %g): %s%s", done + 1, A->steps,
-                    done * A->dt, phgmg_result_string(rc),
-                    rc == PHGMG_ERR_NOT_CONVERGED ? " (try a smaller --dt or more --newton-iter)" : "");
-      }
-      progress("  done (%ld Newton iterations, %ld factorizations)", st.newton_iters, st.factorizations);
-      memset(&S->runs[i], 0, sizeof S->runs[i]);
-      S->runs[i].u = input_fn; S->runs[i].user = in; S->runs[i].dt = A->dt; S->runs[i].nsteps = A->steps;
-    }
-    S->nrun = nrun;
-    free(x0);
-    t_sim = now_s() - t0;
-    X = S->Xsim;
-  }
+  return 0;
+}
 
+/* --simulate: the training runs (--input, or each --train-input) from x0 = 0,
+   one after the other in S->Xsim, their outputs in S->Ysim, S->runs. */
+static int simulate_training_runs(const reduce_args *A, reduce_state *S, const double **Xo, int *nso, double *t_sim) {
+  const int N = S->sys.N, m = S->sys.m;
+  phgmg_result rc;
+  double t0;
+  int ns, i, k;
+  phgmg_gl3_opts go;
+  phgmg_gl3_stats st;
+  double *x0;
+  int done = 0;
+  const int nrun = A->ntrain ? A->ntrain : 1;
+  if ((k = input_setup(&S->in, A->input, A->amp, m, A->dt)) != 0) return k;
+  for (i = 1; i < nrun; ++i)
+    if ((k = input_setup(&S->tin[i], A->train[i], A->amp, m, A->dt)) != 0) return k;
+  ns = nrun * (A->steps + 1);
+  if (too_big(((double)N + (double)m) * (double)ns, "--simulate: the snapshots (N x (steps+1)) and outputs"))
+    return 2;
+  S->Xsim = (double *)malloc(sizeof(double) * (size_t)N * (size_t)ns);
+  S->Ysim = (double *)malloc(sizeof(double) * (size_t)m * (size_t)ns);
+  x0 = (double *)calloc((size_t)N, sizeof(double));
+  if (!S->Xsim || !S->Ysim || !x0) { free(x0); return fail("out of memory for %d snapshots of size %d", ns, N); }
+  memset(&go, 0, sizeof go);
+  go.tol = A->newton_tol; go.max_iter = A->newton_iter;
+  t0 = now_s();
+  for (i = 0; i < nrun; ++i) {   /* run i in columns i (steps + 1) ..; from x0 = 0 */
+    cli_input *in = i ? &S->tin[i] : &S->in;
+    const size_t c0 = (size_t)i * (size_t)(A->steps + 1);
+    progress("simulating the full model: %d steps of dt = %g, %s", A->steps, A->dt,
+             input_desc(in, i ? A->train[i] : A->input));
+    in->report = 1;
+    in->t_end = A->steps * A->dt;
+    in->wall0 = in->wall_last = now_s();
+    rc = phgmg_simulate(&S->sys, x0, 0.0, A->dt, A->steps, input_fn, in, &go, S->Xsim + c0 * (size_t)N,
+                        S->Ysim + c0 * (size_t)m, NULL, &st, &done, NULL);
+    in->report = 0;
+    if (rc != PHGMG_OK) {
+      free(x0);
+      return fail("full-order simulation failed at step %d of %d (t = %g): %s%s", done + 1, A->steps,
+                  done * A->dt, phgmg_result_string(rc),
+                  rc == PHGMG_ERR_NOT_CONVERGED ? " (try a smaller --dt or more --newton-iter)" : "");
+    }
+    progress("  done (%ld Newton iterations, %ld factorizations)", st.newton_iters, st.factorizations);
+    memset(&S->runs[i], 0, sizeof S->runs[i]);
+    S->runs[i].u = input_fn; S->runs[i].user = in; S->runs[i].dt = A->dt; S->runs[i].nsteps = A->steps;
+  }
+  S->nrun = nrun;
+  free(x0);
+  *t_sim = now_s() - t0;
+  *Xo = S->Xsim;
+  *nso = ns;
+  return 0;
+}
+
+/* phgmg_reduce with the options of the command line; reports what it did. */
+static int run_reduction(const reduce_args *A, reduce_state *S, int method, const double *X, int ns,
+                         phgmg_reduce_opts *op, phgmg_reduce_info *ip, double *t_red) {
+  const int N = S->sys.N;
+  phgmg_reduce_opts o;
+  phgmg_reduce_info info;
+  phgmg_result rc;
+  const phgmg_rom *rom;
+  double t0;
   /* --- reduce --- */
   memset(&o, 0, sizeof o);
   o.method = (phgmg_method)method;
@@ -1456,8 +1463,8 @@ static int cmd_reduce_impl(const reduce_args *A, reduce_state *S) {
   progress("reducing: %s, r = %d%s", A->method, A->r, method == PHGMG_METHOD_GMG_QM ? " (quadratic manifold)" : "");
   t0 = now_s();
   if (!g_quiet && (double)N * (double)ns >= 1e7) { o.progress = reduce_phase; o.progress_user = &t0; }
-  rc = phgmg_reduce(&S->red, &sys, X, N, ns, &o, &info, NULL);
-  t_red = now_s() - t0;
+  rc = phgmg_reduce(&S->red, &S->sys, X, N, ns, &o, &info, NULL);
+  *t_red = now_s() - t0;
   if (rc != PHGMG_OK) {
     const char *src = A->X ? A->X : "the simulated snapshots";
     switch (rc) {
@@ -1476,7 +1483,7 @@ static int cmd_reduce_impl(const reduce_args *A, reduce_state *S) {
     }
   }
   rom = phgmg_reduced_rom(S->red);
-  progress("  done in %.2f s: r = %d, m = %d%s; sigma_{r'+1}/sigma_1 = %.3g, rcond(D^T G D) = %.3g", t_red, rom->r,
+  progress("  done in %.2f s: r = %d, m = %d%s; sigma_{r'+1}/sigma_1 = %.3g, rcond(D^T G D) = %.3g", *t_red, rom->r,
            rom->m, rom->nd ? "" : ", quadratic energy", info.pod_sigma_ratio, info.rcond_dgd);
   if (method == PHGMG_METHOD_GMG_QM && (A->lambda_auto || A->manifold))
     progress("  manifold %s, lambda %s: %.3g%s", A->manifold_s ? A->manifold_s : "pod",
@@ -1490,9 +1497,21 @@ static int cmd_reduce_impl(const reduce_args *A, reduce_state *S) {
              A->hyper ? A->hyper : "ecsw", info.deim_modes, info.deim_negative, info.hyper_min_weight,
              info.hyper_residual);
 
+  *op = o;
+  *ip = info;
+  return 0;
+}
+
+/* The reduced model's arrays (NAME_*.npy), V0 = Dphi(0), V2 and M of a
+   quadratic map, and with --save-snapshots the snapshots and their outputs. */
+static int write_arrays(const reduce_args *A, reduce_state *S, const double *X, int ns, outlist *ol) {
+  const phgmg_rom *rom = phgmg_reduced_rom(S->red);
+  const int N = S->sys.N, m = S->sys.m;
+  rom_field fields[24];
+  int i, k, nf;
   /* --- outputs --- */
   if (mkdir_p(A->out)) return 1;
-  memset(&ol, 0, sizeof ol);
+  memset(ol, 0, sizeof *ol);
   nf = rom_fields(rom, fields);
   {
     double *buf = NULL;
@@ -1506,7 +1525,7 @@ static int cmd_reduce_impl(const reduce_args *A, reduce_state *S) {
         buf = nb; cap = n;
       }
       for (q = 0; q < n; ++q) buf[q] = (double)fields[i].a[q];
-      if (write_field(A->out, A->name, fields[i].name, buf, fields[i].rows, fields[i].cols, &ol, &S->sg)) { free(buf); return 1; }
+      if (write_field(A->out, A->name, fields[i].name, buf, fields[i].rows, fields[i].cols, ol, &S->sg)) { free(buf); return 1; }
     }
     free(buf);
   }
@@ -1517,35 +1536,38 @@ static int cmd_reduce_impl(const reduce_args *A, reduce_state *S) {
     if (!xr0 || !S->V0) { free(xr0); return fail("out of memory"); }
     phgmg_reduced_dphi(S->red, xr0, S->V0, N);
     free(xr0);
-    if (write_user_field(A, S, "V0", S->V0, rom->r, &ol)) return 1;
+    if (write_user_field(A, S, "V0", S->V0, rom->r, ol)) return 1;
   }
   if (rom->kind == PHGMG_ROM_QUADRATIC) {
     /* V2 and M of the quadratic map. phgmg.h has no public accessor for them
        yet; this program compiles the implementation, so it reads them from the
        reduced object directly. */
     const int p = rom->r - rom->m;
-    if (write_user_field(A, S, "V2", S->red->V2, rom->rn, &ol)) return 1;
-    if (write_field(A->out, A->name, "M", S->red->M, rom->rn, p * p, &ol, &S->sg)) return 1;
+    if (write_user_field(A, S, "V2", S->red->V2, rom->rn, ol)) return 1;
+    if (write_field(A->out, A->name, "M", S->red->M, rom->rn, p * p, ol, &S->sg)) return 1;
   }
   if (A->save_snap) {
     double *Y = S->Ysim;
     if (!Y) { /* --X: the full model's output at the given snapshots */
       S->Ysim = Y = (double *)malloc(sizeof(double) * (size_t)m * (size_t)ns);
       if (!Y) return fail("out of memory");
-      for (k = 0; k < ns; ++k) phgmg_ph_output(&sys, X + (size_t)k * N, Y + (size_t)k * m);
+      for (k = 0; k < ns; ++k) phgmg_ph_output(&S->sys, X + (size_t)k * N, Y + (size_t)k * m);
     }
-    if (write_user_field(A, S, "snapshots", X, ns, &ol)) return 1;
-    if (write_field(A->out, A->name, "fom_y", Y, m, ns, &ol, &S->sg)) return 1;
+    if (write_user_field(A, S, "snapshots", X, ns, ol)) return 1;
+    if (write_field(A->out, A->name, "fom_y", Y, m, ns, ol, &S->sg)) return 1;
   }
-  snprintf(path, sizeof path, "%s/%s.phgmgrom", A->out, A->name);
-  if (!(wp = stage_path(&S->sg, path))) return 1;
-  rc = phgmg_rom_save(rom, wp);
-  if (rc != PHGMG_OK) return fail("%s: cannot write the model file: %s", path, phgmg_result_string(rc));
-  snprintf(path, sizeof path, "%s/%s.c", A->out, A->name);
-  if (!(wp = stage_path(&S->sg, path))) return 1;
-  rc = phgmg_rom_export_c(rom, A->name, wp);
-  if (rc != PHGMG_OK) return fail("%s: cannot write the C source: %s", path, phgmg_result_string(rc));
+  return 0;
+}
 
+/* NAME.json: what was reduced, how, and where the outputs are. */
+static int write_json(const reduce_args *A, reduce_state *S, int method, int ns, double t_sim, double t_red,
+                      const phgmg_reduce_opts *o, const phgmg_reduce_info *info, const outlist *ol) {
+  const phgmg_rom *rom = phgmg_reduced_rom(S->red);
+  const int N = S->sys.N, m = S->sys.m;
+  char path[4096 + 256];
+  const char *wp;
+  FILE *jf;
+  int i;
   snprintf(path, sizeof path, "%s/%s.json", A->out, A->name);
   if (!(wp = stage_path(&S->sg, path))) return 1;
   jf = fopen(wp, "w");
@@ -1561,7 +1583,7 @@ static int cmd_reduce_impl(const reduce_args *A, reduce_state *S) {
   fprintf(jf, ",\n  \"system\": {\"J\": ");
   json_str(jf, A->J ? A->J : A->Jcoo); fprintf(jf, ", \"R\": "); json_str(jf, A->R ? A->R : A->Rcoo);
   fprintf(jf, ", \"B\": "); json_str(jf, A->B); fprintf(jf, ", \"Q\": "); json_str(jf, A->Q ? A->Q : A->Qcoo);
-  if (S->sp) fprintf(jf, ", \"sparse\": true, \"kb\": %d", sys.kb);
+  if (S->sp) fprintf(jf, ", \"sparse\": true, \"kb\": %d", S->sys.kb);
   if (A->poly_idx) {
     if (A->poly) { fprintf(jf, ", \"poly\": "); json_str(jf, A->poly); }
     if (A->expf) { fprintf(jf, ", \"exp\": "); json_str(jf, A->expf); }
@@ -1596,40 +1618,85 @@ static int cmd_reduce_impl(const reduce_args *A, reduce_state *S) {
     fprintf(jf, ", \"newton_iter\": %d, \"seconds\": ", A->newton_iter); json_num(jf, t_sim);
     fprintf(jf, "}");
   }
-  fprintf(jf, "},\n  \"options\": {\"rn\": %d, \"lambda\": ", o.rn);
+  fprintf(jf, "},\n  \"options\": {\"rn\": %d, \"lambda\": ", o->rn);
   if (A->lambda_auto) json_str(jf, A->lambda_auto == 1 ? "auto" : "cv");
   else json_num(jf, A->lambda);
   fprintf(jf, ", \"lambda_used\": ");
-  json_num(jf, info.lambda == HUGE_VAL ? -1.0 : info.lambda);
+  json_num(jf, info->lambda == HUGE_VAL ? -1.0 : info->lambda);
   fprintf(jf, ", \"manifold\": ");
   json_str(jf, A->manifold_s ? A->manifold_s : "pod");
   fprintf(jf, ", \"training_runs\": %d", S->nrun);
-  fprintf(jf, ", \"deim\": %s, \"deim_tol\": ", o.deim ? "true" : "false");
+  fprintf(jf, ", \"deim\": %s, \"deim_tol\": ", o->deim ? "true" : "false");
   json_num(jf, A->deim_tol);
   fprintf(jf, ", \"deim_max\": %d, \"deim_allow_negative\": %s},\n", A->deim_max, A->deim_neg ? "true" : "false");
   fprintf(jf, "  \"info\": {\"pod_sigma_ratio\": ");
-  json_num(jf, info.pod_sigma_ratio);
-  fprintf(jf, ", \"rcond_jr\": "); json_num(jf, info.rcond_jr);
-  fprintf(jf, ", \"rcond_dgd\": "); json_num(jf, info.rcond_dgd);
-  fprintf(jf, ", \"deim_modes\": %d, \"deim_negative\": %d, \"deim_sigma_ratio\": ", info.deim_modes, info.deim_negative);
-  json_num(jf, info.deim_sigma_ratio);
+  json_num(jf, info->pod_sigma_ratio);
+  fprintf(jf, ", \"rcond_jr\": "); json_num(jf, info->rcond_jr);
+  fprintf(jf, ", \"rcond_dgd\": "); json_num(jf, info->rcond_dgd);
+  fprintf(jf, ", \"deim_modes\": %d, \"deim_negative\": %d, \"deim_sigma_ratio\": ", info->deim_modes, info->deim_negative);
+  json_num(jf, info->deim_sigma_ratio);
   fprintf(jf, ", \"reduce_seconds\": "); json_num(jf, t_red);
   fprintf(jf, "},\n  \"stepper_memsize_bytes\": %lu,\n", (unsigned long)phgmg_rom_stepper_memsize(rom));
   fprintf(jf, "  \"reconstruction\": \"%s\",\n",
           rom->kind == PHGMG_ROM_QUADRATIC ? "x = V0 @ xr + V2 @ (M @ kron(xr[m:], xr[m:]))" : "x = V0 @ xr");
   fprintf(jf, "  \"files\": {\n    \"model\": \"%s.phgmgrom\",\n    \"c_source\": \"%s.c\",\n    \"arrays\": {",
           A->name, A->name);
-  for (i = 0; i < ol.n; ++i)
-    fprintf(jf, "%s\n      \"%s\": [%d, %d]", i ? "," : "", ol.names[i], ol.rows[i], ol.cols[i]);
+  for (i = 0; i < ol->n; ++i)
+    fprintf(jf, "%s\n      \"%s\": [%d, %d]", i ? "," : "", ol->names[i], ol->rows[i], ol->cols[i]);
   fprintf(jf, "\n    }\n  }\n}\n");
   if (fclose(jf) != 0) return fail("%s: write error", path);
+  return 0;
+}
+
+/* The model file, its C source and the json record (written last: it lists
+   the arrays); then every output of this run moves into place. */
+static int write_model_files(const reduce_args *A, reduce_state *S, int method, int ns, double t_sim, double t_red,
+                             const phgmg_reduce_opts *o, const phgmg_reduce_info *info, const outlist *ol) {
+  const phgmg_rom *rom = phgmg_reduced_rom(S->red);
+  const int N = S->sys.N;
+  phgmg_result rc;
+  char path[4096 + 256];
+  const char *wp;
+  snprintf(path, sizeof path, "%s/%s.phgmgrom", A->out, A->name);
+  if (!(wp = stage_path(&S->sg, path))) return 1;
+  rc = phgmg_rom_save(rom, wp);
+  if (rc != PHGMG_OK) return fail("%s: cannot write the model file: %s", path, phgmg_result_string(rc));
+  snprintf(path, sizeof path, "%s/%s.c", A->out, A->name);
+  if (!(wp = stage_path(&S->sg, path))) return 1;
+  rc = phgmg_rom_export_c(rom, A->name, wp);
+  if (rc != PHGMG_OK) return fail("%s: cannot write the C source: %s", path, phgmg_result_string(rc));
+
+  if (write_json(A, S, method, ns, t_sim, t_red, o, info, ol)) return 1;
   if (stage_commit(&S->sg)) return 1;
-  remove_stale(A->out, A->name, &ol);
+  remove_stale(A->out, A->name, ol);
 
   printf("wrote %s/%s.phgmgrom, %s/%s.c, %s/%s.json and %d arrays %s/%s_*.npy (%s, r = %d, m = %d, N = %d)\n",
-         A->out, A->name, A->out, A->name, A->out, A->name, ol.n, A->out, A->name, method_name(method), rom->r,
+         A->out, A->name, A->out, A->name, A->out, A->name, ol->n, A->out, A->name, method_name(method), rom->r,
          rom->m, N);
   return 0;
+}
+
+static int cmd_reduce_impl(const reduce_args *A, reduce_state *S) {
+  phgmg_reduce_opts o;
+  phgmg_reduce_info info;
+  outlist ol;
+  double t_sim = 0.0, t_red = 0.0;
+  const double *X = NULL;
+  int ns = 0, method, e;
+  memset(&o, 0, sizeof o);
+  memset(&info, 0, sizeof info);
+  if (!strcmp(A->method, "gmg-pod")) method = PHGMG_METHOD_GMG_POD;
+  else if (!strcmp(A->method, "gmg-qm")) method = PHGMG_METHOD_GMG_QM;
+  else if (!strcmp(A->method, "sp1")) method = PHGMG_METHOD_SP1;
+  else if (!strcmp(A->method, "sp2")) method = PHGMG_METHOD_SP2;
+  else return usage_error("--method '%s': expected gmg-pod, gmg-qm, sp1 or sp2", A->method);
+  if ((e = load_system(A, S)) != 0) return e;
+  if ((e = check_sizes(A, method, S->sys.N, S->sys.m)) != 0) return e;
+  e = A->X ? load_snapshot_files(A, S, S->sys.N, S->sys.m, &X, &ns) : simulate_training_runs(A, S, &X, &ns, &t_sim);
+  if (e) return e;
+  if ((e = run_reduction(A, S, method, X, ns, &o, &info, &t_red)) != 0) return e;
+  if ((e = write_arrays(A, S, X, ns, &ol)) != 0) return e;
+  return write_model_files(A, S, method, ns, t_sim, t_red, &o, &info, &ol);
 }
 
 static int cmd_reduce(int argc, char **argv) {
