@@ -2966,12 +2966,91 @@ PHGMG__PRIV int phgmg__svd_scale(int m, int n, double *W) {
   return e;
 }
 
+/* phgmg_svd after the pivoted QR A P = Q R (W: reflectors and R, rank r):
+   the one-sided Jacobi SVD of R^T's triangular factor, then U = Q [.; 0] and
+   V = P Q2 [.; 0]; the singular values scaled back by 2^esc. */
+PHGMG__PRIV phgmg_result phgmg__svd_from_qr(int m, int n, int r, const double *W, const double *tau,
+                                             const int *jpvt, int *perm, double *vn, int kmax, int esc, double *S,
+                                             double *U, int ldu, double *V, int ldv, int *k_out, int *rank_out,
+                                             const phgmg_allocator *alloc) {
+  const int kmin = PHGMG__MIN(m, n);
+  double *Rt, *tau2, *X, *Vj, *d;
+  int i, j, k, rnz;
+  phgmg_result rc;
+  /* second workspace: Rt (n x r), tau2 (r), X (r x r), Vj (r x r), d (r) */
+  double *W2 = phgmg__dalloc(alloc, (size_t)n * (size_t)r + 2 * (size_t)r * (size_t)r +
+                                        2 * (size_t)r);
+  if (!W2) return PHGMG_ERR_NOMEM;
+  Rt = W2;
+  tau2 = Rt + (size_t)n * (size_t)r;
+  X = tau2 + r;
+  Vj = X + (size_t)r * (size_t)r;
+  d = Vj + (size_t)r * (size_t)r;
+  /* Rt = R^T, R = W(0:r, 0:n) upper trapezoidal */
+  for (i = 0; i < r; ++i) {
+    double *rt = Rt + (size_t)i * (size_t)n;
+    for (j = 0; j < i; ++j) rt[j] = 0.0;
+    for (j = i; j < n; ++j) rt[j] = W[i + (size_t)j * (size_t)m];
+  }
+  phgmg_qr(n, r, Rt, n, tau2);
+  /* X = R2^T (lower triangular), Vj = I */
+  for (j = 0; j < r; ++j) {
+    double *x = X + (size_t)j * (size_t)r, *v = Vj + (size_t)j * (size_t)r;
+    for (i = 0; i < r; ++i) {
+      x[i] = i >= j ? Rt[j + (size_t)i * (size_t)n] : 0.0;
+      v[i] = i == j ? 1.0 : 0.0;
+    }
+  }
+  rc = phgmg__jacobi_1s(r, X, r, V ? Vj : NULL, r, d);
+  if (rc == PHGMG_OK) {
+    /* sigma_j = ||X(:,j)||, order descending */
+    for (j = 0; j < r; ++j) {
+      d[j] = phgmg_normf(r, 1, X + (size_t)j * (size_t)r, r);
+      perm[j] = j;
+    }
+    for (i = 1; i < r; ++i) { /* insertion sort, r is small */
+      int pj = perm[i];
+      for (j = i - 1; j >= 0 && d[perm[j]] < d[pj]; --j) perm[j + 1] = perm[j];
+      perm[j + 1] = pj;
+    }
+    rnz = r; /* an exactly zero singular value has no singular vector: drop it */
+    while (rnz > 0 && !(d[perm[rnz - 1]] > 0.0)) --rnz;
+    k = PHGMG__MIN(kmax, rnz);
+    for (j = 0; j < k; ++j) {
+      int c = perm[j];
+      double s = d[c], *u = U + (size_t)j * (size_t)ldu;
+      const double *x = X + (size_t)c * (size_t)r;
+      S[j] = ldexp(s, esc); /* undo the scaling of phgmg__svd_scale (exact) */
+      for (i = 0; i < r; ++i) u[i] = x[i] / s;
+      for (i = r; i < m; ++i) u[i] = 0.0;
+    }
+    /* U = Q [W; 0] with the r reflectors of the pivoted QR */
+    if (k > 0) phgmg_qr_apply('N', m, k, PHGMG__MIN(r, kmin), W, m, tau, U, ldu);
+    if (V && k > 0) {
+      /* V = P Q2 [Vj; 0]; Rt's reflectors give Q2 (n x r) */
+      int r2 = PHGMG__MIN(n, r);
+      for (j = 0; j < k; ++j) {
+        double *v = V + (size_t)j * (size_t)ldv, *y = vn;
+        const double *vj = Vj + (size_t)perm[j] * (size_t)r;
+        for (i = 0; i < r; ++i) y[i] = vj[i];
+        for (i = r; i < n; ++i) y[i] = 0.0;
+        phgmg_qr_apply('N', n, 1, r2, Rt, n, tau2, y, n);
+        for (i = 0; i < n; ++i) v[jpvt[i]] = y[i];
+      }
+    }
+    *k_out = k;
+    if (rank_out) *rank_out = rnz;
+  }
+  phgmg__free(alloc, W2);
+  return rc;
+}
+
 PHGMG_DEF phgmg_result phgmg_svd(int m, int n, const double *A, int lda, int kmax,
                                  double *S, double *U, int ldu, double *V, int ldv,
                                  int *k_out, int *rank_out, const phgmg_allocator *alloc) {
-  double *W = NULL, *tau, *vn, *Rt, *tau2, *X, *Vj, *d, anorm;
+  double *W = NULL, *tau, *vn, anorm;
   int *jpvt = NULL, *perm;
-  int r, rnz, k, i, j, kmin = PHGMG__MIN(m, n), esc;
+  int r, j, kmin = PHGMG__MIN(m, n), esc;
   phgmg_result rc;
   size_t nw;
   if (m < 0 || n < 0 || kmax < 0 || lda < PHGMG__MAX(m, 1)) return PHGMG_ERR_SIZE;
@@ -3006,73 +3085,7 @@ PHGMG_DEF phgmg_result phgmg_svd(int m, int n, const double *A, int lda, int kma
     phgmg__free(alloc, jpvt);
     return PHGMG_OK;
   }
-  {
-    /* second workspace: Rt (n x r), tau2 (r), X (r x r), Vj (r x r), d (r) */
-    double *W2 = phgmg__dalloc(alloc, (size_t)n * (size_t)r + 2 * (size_t)r * (size_t)r +
-                                          2 * (size_t)r);
-    if (!W2) { phgmg__free(alloc, W); phgmg__free(alloc, jpvt); return PHGMG_ERR_NOMEM; }
-    Rt = W2;
-    tau2 = Rt + (size_t)n * (size_t)r;
-    X = tau2 + r;
-    Vj = X + (size_t)r * (size_t)r;
-    d = Vj + (size_t)r * (size_t)r;
-    /* Rt = R^T, R = W(0:r, 0:n) upper trapezoidal */
-    for (i = 0; i < r; ++i) {
-      double *rt = Rt + (size_t)i * (size_t)n;
-      for (j = 0; j < i; ++j) rt[j] = 0.0;
-      for (j = i; j < n; ++j) rt[j] = W[i + (size_t)j * (size_t)m];
-    }
-    phgmg_qr(n, r, Rt, n, tau2);
-    /* X = R2^T (lower triangular), Vj = I */
-    for (j = 0; j < r; ++j) {
-      double *x = X + (size_t)j * (size_t)r, *v = Vj + (size_t)j * (size_t)r;
-      for (i = 0; i < r; ++i) {
-        x[i] = i >= j ? Rt[j + (size_t)i * (size_t)n] : 0.0;
-        v[i] = i == j ? 1.0 : 0.0;
-      }
-    }
-    rc = phgmg__jacobi_1s(r, X, r, V ? Vj : NULL, r, d);
-    if (rc == PHGMG_OK) {
-      /* sigma_j = ||X(:,j)||, order descending */
-      for (j = 0; j < r; ++j) {
-        d[j] = phgmg_normf(r, 1, X + (size_t)j * (size_t)r, r);
-        perm[j] = j;
-      }
-      for (i = 1; i < r; ++i) { /* insertion sort, r is small */
-        int pj = perm[i];
-        for (j = i - 1; j >= 0 && d[perm[j]] < d[pj]; --j) perm[j + 1] = perm[j];
-        perm[j + 1] = pj;
-      }
-      rnz = r; /* an exactly zero singular value has no singular vector: drop it */
-      while (rnz > 0 && !(d[perm[rnz - 1]] > 0.0)) --rnz;
-      k = PHGMG__MIN(kmax, rnz);
-      for (j = 0; j < k; ++j) {
-        int c = perm[j];
-        double s = d[c], *u = U + (size_t)j * (size_t)ldu;
-        const double *x = X + (size_t)c * (size_t)r;
-        S[j] = ldexp(s, esc); /* undo the scaling of phgmg__svd_scale (exact) */
-        for (i = 0; i < r; ++i) u[i] = x[i] / s;
-        for (i = r; i < m; ++i) u[i] = 0.0;
-      }
-      /* U = Q [W; 0] with the r reflectors of the pivoted QR */
-      if (k > 0) phgmg_qr_apply('N', m, k, PHGMG__MIN(r, kmin), W, m, tau, U, ldu);
-      if (V && k > 0) {
-        /* V = P Q2 [Vj; 0]; Rt's reflectors give Q2 (n x r) */
-        int r2 = PHGMG__MIN(n, r);
-        for (j = 0; j < k; ++j) {
-          double *v = V + (size_t)j * (size_t)ldv, *y = vn;
-          const double *vj = Vj + (size_t)perm[j] * (size_t)r;
-          for (i = 0; i < r; ++i) y[i] = vj[i];
-          for (i = r; i < n; ++i) y[i] = 0.0;
-          phgmg_qr_apply('N', n, 1, r2, Rt, n, tau2, y, n);
-          for (i = 0; i < n; ++i) v[jpvt[i]] = y[i];
-        }
-      }
-      *k_out = k;
-      if (rank_out) *rank_out = rnz;
-    }
-    phgmg__free(alloc, W2);
-  }
+  rc = phgmg__svd_from_qr(m, n, r, W, tau, jpvt, perm, vn, kmax, esc, S, U, ldu, V, ldv, k_out, rank_out, alloc);
   phgmg__free(alloc, W);
   phgmg__free(alloc, jpvt);
   return rc;
