@@ -5,7 +5,7 @@
    held-out input (0.1, 0.1 sin 2t, chirp, random pwc): e_proj of the held-out
    trajectory onto the model's basis (what the basis can represent at all)
    and e_y of the reduced model; 1 run vs 2 runs.
-   Usage: twotrain_study linear|nonlinear [--r 6,7,8,10,12] [--balance]
+   Usage: twotrain_study linear|nonlinear [--r 6,7,8,10,12] [--balance] [--second multisine|steps|mssteps]
    (--balance: run 2 scaled to run 1's norm before the POD; linear chain or deim 0 only) */
 #define _POSIX_C_SOURCE 199309L
 #include <stdio.h>
@@ -26,6 +26,19 @@ static void u_pwc(double t, double *u, void *p) {
   u[0] = 0.1 * (2.0 * (double)(h % 10000u) / 9999.0 - 1.0);
 }
 static void u_multisine(double t, double *u, void *p) { (void)p; u[0] = 0.05 * (sin(0.5 * t) + sin(1.5 * t) + sin(3.0 * t)); }
+/* random steps: another hash and hold time than the held-out pwc (7 s, not 5 s) */
+static void u_steps(double t, double *u, void *p) {
+  unsigned k = (unsigned)(t / 7.0) + 977u, h = k * 2246822519u;
+  (void)p;
+  h ^= h >> 15; h *= 0x85ebca6bu; h ^= h >> 13;
+  u[0] = 0.1 * (2.0 * (double)(h % 10000u) / 9999.0 - 1.0);
+}
+/* half the multisine plus half the random steps: the band and the static content */
+static void u_mssteps(double t, double *u, void *p) {
+  double a, b;
+  u_multisine(t, &a, p); u_steps(t, &b, p);
+  u[0] = 0.5 * (a + b);
+}
 #define NHO 4
 static phgmg_input_fn ho[NHO] = {u_const, u_sin2, u_chirp, u_pwc};
 static const char *hon[NHO] = {"0.1", "sin 2t", "chirp", "pwc"};
@@ -34,6 +47,7 @@ int main(int argc, char **argv) {
   const int nsteps = 1000, ns = nsteps + 1;
   const double dt = 0.1;
   int rl[64], nr = 0, i, k, tr, dm, nonlin, N, balance = 0;
+  phgmg_input_fn second = u_multisine;
   const char *rs = "6,7,8,10,12";
   double tol = 1e-10, *X, *Y, *YR, xr0[64] = {0};
   msd_linear L;
@@ -46,6 +60,10 @@ int main(int argc, char **argv) {
   for (i = 2; i < argc; ++i) {
     if (!strcmp(argv[i], "--r") && i + 1 < argc) rs = argv[++i];
     else if (!strcmp(argv[i], "--balance")) balance = 1;
+    else if (!strcmp(argv[i], "--second") && i + 1 < argc) {
+      ++i;
+      second = !strcmp(argv[i], "steps") ? u_steps : !strcmp(argv[i], "mssteps") ? u_mssteps : u_multisine;
+    }
   }
   { const char *q = rs; char *end; while (*q && nr < 64) { rl[nr++] = (int)strtol(q, &end, 10); if (end == q) break; q = *end == ',' ? end + 1 : end; } }
   if (nonlin) {
@@ -65,7 +83,7 @@ int main(int argc, char **argv) {
   if (!X || !Y || !YR) return 1;
   memset(&go, 0, sizeof go); go.tol = tol; go.max_iter = 20;
   memset(runs, 0, sizeof runs);
-  for (i = 0; i < 2; ++i) { runs[i].u = i ? u_multisine : u_sin; runs[i].dt = dt; runs[i].nsteps = nsteps; }
+  for (i = 0; i < 2; ++i) { runs[i].u = i ? second : u_sin; runs[i].dt = dt; runs[i].nsteps = nsteps; }
   if (phgmg_simulate_inputs(sys, 2, runs, &go, X, N, Y, NULL, NULL) != PHGMG_OK) return 1;
   for (i = 0; i < NHO; ++i) {
     phgmg_run run;
