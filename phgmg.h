@@ -5524,6 +5524,14 @@ PHGMG__PRIV void phgmg__gl3_pack_nopiv(phgmg_gl3 *s) {
     }                                                                           \
   } while (0)
 
+/* Row j of a tail sweep: the values flushed below tau, stored; 1 if all are zero. */
+PHGMG__PRIV int phgmg__gl3_put_flushed(double *b, double *z, int j, double t, double tr, double ti, double tau) {
+  b[j] = fabs(t) < tau ? 0.0 : t;
+  z[2 * j] = fabs(tr) < tau ? 0.0 : tr;
+  z[2 * j + 1] = fabs(ti) < tau ? 0.0 : ti;
+  return b[j] == 0.0 && z[2 * j] == 0.0 && z[2 * j + 1] == 0.0;
+}
+
 /* The right-hand sides vanish outside rows j0..j1 (a wave still far from the
    chain's ends): the forward sweep starts at j0, and beyond j1 it only carries
    the tail that L^{-1} spreads, which decays geometrically; those entries are
@@ -5546,13 +5554,7 @@ PHGMG__PRIV void phgmg__gl3_solve_packed(const phgmg_gl3 *s, double *b, double *
   }
   for (run = 0; j < n && run < kl; ++j, r += P) { /* the tail below the support */
     PHGMG__GL3_FWD_ROW(j);
-    t = fabs(t) < tau ? 0.0 : t;
-    tr = fabs(tr) < tau ? 0.0 : tr;
-    ti = fabs(ti) < tau ? 0.0 : ti;
-    b[j] = t;
-    z[2 * j] = tr;
-    z[2 * j + 1] = ti;
-    run = (t == 0.0 && tr == 0.0 && ti == 0.0) ? run + 1 : 0;
+    run = phgmg__gl3_put_flushed(b, z, j, t, tr, ti, tau) ? run + 1 : 0;
   }
   for (j = j - 1; j >= j0; --j) { /* rows from j on are zero */
     r = s->pk + (size_t)j * P;
@@ -5564,13 +5566,7 @@ PHGMG__PRIV void phgmg__gl3_solve_packed(const phgmg_gl3 *s, double *b, double *
   for (run = 0; j >= 0 && run < ku; --j) { /* the tail above the support */
     r = s->pk + (size_t)j * P;
     PHGMG__GL3_BWD_ROW(j);
-    t = fabs(t) < tau ? 0.0 : t;
-    tr = fabs(tr) < tau ? 0.0 : tr;
-    ti = fabs(ti) < tau ? 0.0 : ti;
-    b[j] = t;
-    z[2 * j] = tr;
-    z[2 * j + 1] = ti;
-    run = (t == 0.0 && tr == 0.0 && ti == 0.0) ? run + 1 : 0;
+    run = phgmg__gl3_put_flushed(b, z, j, t, tr, ti, tau) ? run + 1 : 0;
   }
 }
 #undef PHGMG__GL3_FWD_ROW
