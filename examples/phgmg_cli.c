@@ -100,12 +100,13 @@ static const char *const help_lines[] = {
   "  --rn K              gmg-qm lifting dimension r_n (default 8; K <= 64, K (R-m) <= 4096,\n",
   "                      R + K <= N)\n",
   "  --lambda L          gmg-qm ridge parameter, on the un-normalised sum over the\n",
-  "                      snapshots (default 1e-3; 0 = exactly zero). Or:\n",
-  "    --lambda auto     validated by simulation (safe choice): the reduced model is\n",
-  "                      simulated for candidate lambdas on the training runs and on\n",
-  "                      three probe inputs and compared with M = 0 (GMG-POD on the\n",
-  "                      same basis); no safe lambda: M = 0. Needs the training\n",
-  "                      inputs (--simulate, or --X with --X-input). Costs seconds.\n",
+  "                      snapshots (0 = exactly zero; the paper's value is 1e-3). Or:\n",
+  "    --lambda auto     the default: validated by simulation (the safe choice):\n",
+  "                      the reduced model is simulated for candidate lambdas on\n",
+  "                      the training runs and on three probe inputs and compared\n",
+  "                      with M = 0 (GMG-POD on the same basis); no safe lambda:\n",
+  "                      M = 0. Needs the training inputs (--simulate, or --X with\n",
+  "                      --X-input; else M = 0). Costs seconds.\n",
   "    --lambda cv       regression only (held-out time blocks; one run per fold with\n",
   "                      several --train-input): fits the snapshots closely, but may\n",
   "                      give a model that fails on other inputs.\n",
@@ -959,6 +960,9 @@ static int parse_reduce(int argc, char **argv, reduce_args *A) {
   if (!A->input) A->input = A->ntrain ? A->train[0] : "sin";
   if ((A->lambda_auto || A->manifold_s) && strcmp(A->method, "gmg-qm") != 0)
     return usage_error("reduce: --lambda auto/cv and --manifold apply to --method gmg-qm only");
+  /* gmg-qm without --lambda: the validated choice (a fixed lambda can give a
+     model whose Newton solve fails on inputs unlike the training run) */
+  if (!A->have_lambda && !strcmp(A->method, "gmg-qm")) A->lambda_auto = 1;
   if (!A->have_dt_map) A->dt_map = A->simulate ? A->dt : 0.0;
   if (A->simulate && too_big((double)A->steps + 1.0, "--simulate --steps: the snapshots (N x (steps+1)) alone"))
     return 2; /* N >= 1: a first check before reading J */
