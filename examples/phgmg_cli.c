@@ -97,8 +97,8 @@ static const char *const help_lines[] = {
   "  --r R               reduced order (required). For gmg-pod/gmg-qm it includes the m\n",
   "                      port coordinates, so m < R <= N; R - m (gmg) or R (sp1/sp2) must\n",
   "                      not exceed the rank of the (adjusted) snapshots.\n",
-  "  --rn K              gmg-qm lifting dimension r_n (default 8; K <= 64, K (R-m) <= 4096,\n",
-  "                      R + K <= N)\n",
+  "  --rn K              gmg-qm lifting dimension r_n (default 8, or the largest that\n",
+  "                      fits; K <= 64, K (R-m) <= 4096, R + K <= N)\n",
   "  --lambda L          gmg-qm ridge parameter, on the un-normalised sum over the\n",
   "                      snapshots (0 = exactly zero; the paper's value is 1e-3). Or:\n",
   "    --lambda auto     the default: validated by simulation (the safe choice):\n",
@@ -868,7 +868,7 @@ static int parse_reduce(int argc, char **argv, reduce_args *A) {
   const char *seen[64];
   int i, nseen = 0;
   memset(A, 0, sizeof *A);
-  A->dt = 0.1; A->steps = 1000; A->amp = 0.1; A->rn = 8; A->lambda = 1e-3;
+  A->dt = 0.1; A->steps = 1000; A->amp = 0.1; A->rn = 0; A->lambda = 1e-3;
   A->deim_tol = 1e-8; A->name = "rom"; A->newton_tol = 1e-10; A->newton_iter = 10;
   for (i = 2; i < argc; ++i) {
     const char *o = argv[i], *v;
@@ -1373,8 +1373,10 @@ static int check_sizes(const reduce_args *A, int method, int N, int m) {
   if (method == PHGMG_METHOD_GMG_POD || method == PHGMG_METHOD_GMG_QM) {
     if (A->r <= m || A->r > N)
       return usage_error("--r %d: %s needs m < r <= N (m = %d ports from %s, N = %d)", A->r, A->method, m, A->B, N);
-    if (method == PHGMG_METHOD_GMG_QM && (A->rn > N - A->r || A->rn * (A->r - m) > 4096))
+    if (method == PHGMG_METHOD_GMG_QM && A->rn && (A->rn > N - A->r || A->rn * (A->r - m) > 4096))
       return usage_error("--rn %d: gmg-qm needs r + r_n <= N (= %d) and r_n (r - m) <= 4096", A->rn, N);
+    if (method == PHGMG_METHOD_GMG_QM && A->r >= N)
+      return usage_error("--r %d: gmg-qm needs r < N (= %d): room for at least one quadratic mode", A->r, N);
   } else if (A->r > N) {
     return usage_error("--r %d: needs r <= N = %d", A->r, N);
   }
@@ -1436,6 +1438,13 @@ static int simulate_training_runs(const reduce_args *A, reduce_state *S, const d
   return 0;
 }
 
+/* gmg-qm's r_n without --rn: 8, or what fits (r + r_n <= N, r_n (r - m) <= 4096). */
+static int default_rn(int N, int r, int m) {
+  int rn = PHGMG__MIN(8, N - r);
+  if (r > m) rn = PHGMG__MIN(rn, 4096 / (r - m));
+  return PHGMG__MAX(rn, 1);
+}
+
 /* phgmg_reduce with the options of the command line; reports what it did. */
 static int run_reduction(const reduce_args *A, reduce_state *S, int method, const double *X, int ns,
                          phgmg_reduce_opts *op, phgmg_reduce_info *ip, double *t_red) {
@@ -1449,7 +1458,7 @@ static int run_reduction(const reduce_args *A, reduce_state *S, int method, cons
   memset(&o, 0, sizeof o);
   o.method = (phgmg_method)method;
   o.r = A->r;
-  o.rn = A->rn;
+  o.rn = A->rn ? A->rn : default_rn(N, A->r, S->sys.m);
   o.lambda = A->lambda > 0.0 ? A->lambda : -1.0; /* 0 on the command line = exactly zero */
   o.deim = A->poly_idx && !A->no_deim;
   o.hyper = !A->hyper || !strcmp(A->hyper, "ecsw") ? PHGMG_HYPER_ECSW

@@ -1,10 +1,10 @@
 #!/usr/bin/env python3
 import numpy as np, sys, os
-# random_chain.py SEED OUTDIR: a mass-spring-damper chain with random masses, stiffnesses and damping, its
+# random_chain.py SEED OUTDIR [MASSES (150)]: a mass-spring-damper chain with random masses, stiffnesses and damping, its
 # states in a random order (a model no test was written for)
 seed, out = int(sys.argv[1]), sys.argv[2]
 rng = np.random.default_rng(seed); os.makedirs(out, exist_ok=True)
-n = 150; N = 2 * n
+n = int(sys.argv[3]) if len(sys.argv) > 3 else 150; N = 2 * n
 k = rng.uniform(0.1, 10, n); mm = rng.uniform(0.1, 10, n); c = rng.uniform(0, 2, n)
 J = np.zeros((N, N)); R = np.zeros((N, N)); Q = np.zeros((N, N))
 for i in range(n):

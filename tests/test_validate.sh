@@ -143,5 +143,15 @@ for seed in 1 5; do
   grep -q '"lambda": "auto"' rd$seed/rom.json && pass || bad "random chain $seed: the default lambda is not auto"
 done
 
+# 7. a small model (N = 10): gmg-qm without --rn takes the largest r_n that
+#    fits (r + r_n <= N: 6 at r = 4) instead of refusing the default 8
+$PY "$ROOT/tests/random_chain.py" 3 small 5 || exit 1
+$P reduce --J small/J.npy --R small/R.npy --B small/B.npy --Q small/Q.npy --simulate --steps 200 --quiet \
+   --method gmg-qm --r 4 --out sq > /dev/null 2>&1 && grep -q '"rn": 6' sq/rom.json && pass \
+  || bad "N = 10, gmg-qm r = 4 without --rn: expected r_n = 6"
+$P reduce --J small/J.npy --R small/R.npy --B small/B.npy --Q small/Q.npy --simulate --steps 200 --quiet \
+   --method gmg-qm --r 4 --rn 8 --out sq2 > /dev/null 2>&1
+[ $? -eq 2 ] && pass || bad "N = 10, --rn 8 at r = 4: expected the usage error"
+
 echo "test_validate: $npass passed, $nfail failed"
 [ $nfail -eq 0 ]
