@@ -12129,6 +12129,10 @@ PHGMG__PRIV phgmg_result phgmg__basis_h2(const phgmg_ph_system *sys, int k, cons
   if (rc == PHGMG_OK) rc = phgmg__h2gmg_init(&h, sys, k, alloc);
   if (rc == PHGMG_OK) {
     rc = phgmg__h2gmg_lbfgs(&h, M + (size_t)N * m, maxit, &f, alloc);
+    if (rc == PHGMG_ERR_SINGULAR && opts && opts->V0) {   /* V0 infeasible: the balanced start */
+      rc = phgmg_linear_basis(sys, PHGMG_BASIS_BALANCED, k, NULL, M + (size_t)N * m, NULL, alloc);
+      if (rc == PHGMG_OK) rc = phgmg__h2gmg_lbfgs(&h, M + (size_t)N * m, maxit, &f, alloc);
+    }
     phgmg__h2gmg_free(&h, alloc);
   }
   if (rc == PHGMG_OK) {
