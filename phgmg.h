@@ -12040,12 +12040,12 @@ PHGMG__PRIV double phgmg__h2gmg_eval(phgmg__h2gmg *h, const double *Vbar, double
 }
 
 /* Minimises f = phgmg__h2gmg_eval over x = Vbar (n = N k entries) by L-BFGS
-   (memory 8, Armijo backtracking, first step of unit length); stops after
+   (memory 50, Armijo backtracking, first step of unit length); stops after
    maxit iterations or when a line search fails twice in a row (the second
    time from a steepest-descent step). *f_out: the last f. */
 PHGMG__PRIV phgmg_result phgmg__h2gmg_lbfgs(phgmg__h2gmg *h, double *x, int maxit, double *f_out,
                                             const phgmg_allocator *alloc) {
-  enum { MEM = 8 };
+  enum { MEM = 50 };
   const int n = h->N * h->k;
   double *g = phgmg__dalloc(alloc, (size_t)n * (4 + 2 * MEM)), *d, *xn, *gn, *S, *Y, rho[MEM], al[MEM], f, fn = 0.0;
   int it, nm = 0, head = 0, i, l, fails = 0;
