@@ -4,8 +4,11 @@
    100, one port; and the two-port chain of Gugercin, Polyuga, Beattie & van
    der Schaft 2012: N = 100, m_i = k_i = 4, c_i = 1, forces on masses 1 and
    2) it compares, for r = 4..20, GMG-POD trained on u = 0.1 sin t with GMG
-   on three input-independent bases (frequency-sampled, impulse responses,
-   balanced right basis; phgmg_linear_basis), balanced truncation (BT,
+   on four input-independent bases (frequency-sampled, impulse responses,
+   balanced right basis, and GMG-H2: for each r the basis whose GMG model has
+   the least H2 error found by L-BFGS, 1000 steps from the balanced basis for
+   r >= 12, 300 below, --h2-iters N to change the 1000; phgmg_linear_basis),
+   balanced truncation (BT,
    reference, not pH) and positive-real balanced truncation (PRBT, pH form,
    exact zero-feedthrough Gramians; PRBT-LTI: the same projection W^T A T,
    W^T B, C T without the pH form: with exact Gramians the output C T equals
@@ -22,7 +25,7 @@
    model: smallest eigenvalue of R relative to the largest, energy-balance
    error relative to max H over 1000 steps of the `mix` input), and an
    H-infinity / H2 error table on the terminal.
-   Usage: linear_bases [--out DIR] */
+   Usage: linear_bases [--out DIR] [--h2-iters N] */
 #define _POSIX_C_SOURCE 200809L
 #define PHGMG_IMPLEMENTATION
 #include "../phgmg.h"
