@@ -7,7 +7,8 @@
                       iteration of a 1996 x 1996 Hamiltonian and its kernel each;
                       balancing, pH form, step map)
      h2basis_N1000_r20_20it  phgmg_linear_basis kind H2 for r = 20 (k = 18): the complex
-                      Schur form of A once, then 20 L-BFGS steps of O(N^2 r) each (measured: Schur 9.7 s, 60 ms a step, shared machine)
+                      Schur form of A once, then 20 L-BFGS steps of O(N^2 r) each
+                      (measured: Schur 9.7 s, 60 ms a step, shared machine)
    Prints the relative residuals (Lyapunov; both Riccati equations) and
    appends `case,median_s,min_s,max_s,runs` to the CSV argv[1] (if given).
    BENCH_LINEAR_RUNS (default 1) runs per case; no warm-up (each run is seconds).
