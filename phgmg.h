@@ -11664,19 +11664,39 @@ PHGMG__PRIV phgmg_result phgmg__basis_snapshots(const phgmg_ph_system *sys, phgm
 PHGMG__PRIV void phgmg__zgemm(char ta, char tb, int m, int n, int k, const double *A, int lda, const double *B,
                               int ldb, double *C, int ldc) {
   int i, j, l;
-  for (j = 0; j < n; ++j)
-    for (i = 0; i < m; ++i) {
-      double sr = 0.0, si = 0.0;
-      for (l = 0; l < k; ++l) {
-        const double *a = ta == 'N' ? A + 2 * (i + (size_t)l * lda) : A + 2 * (l + (size_t)i * lda);
-        const double *b = tb == 'N' ? B + 2 * (l + (size_t)j * ldb) : B + 2 * (j + (size_t)l * ldb);
-        const double ai = ta == 'N' ? a[1] : -a[1], bi = tb == 'N' ? b[1] : -b[1];
-        sr += a[0] * b[0] - ai * bi;
-        si += a[0] * bi + ai * b[0];
+  if (ta == 'C' && tb == 'N') {   /* C_ij = conj(A(:, i)) . B(:, j) */
+    for (j = 0; j < n; ++j)
+      for (i = 0; i < m; ++i) {
+        const double *a = A + 2 * (size_t)i * lda, *b = B + 2 * (size_t)j * ldb;
+        double si = 0.0;
+        for (l = 0; l < k; ++l) si += a[2 * l] * b[2 * l + 1] - a[2 * l + 1] * b[2 * l];
+        C[2 * (i + (size_t)j * ldc)] = phgmg__dot(2 * k, a, b);
+        C[2 * (i + (size_t)j * ldc) + 1] = si;
       }
-      C[2 * (i + (size_t)j * ldc)] = sr;
-      C[2 * (i + (size_t)j * ldc) + 1] = si;
+    return;
+  }
+  for (j = 0; j < n; ++j) {
+    double *c = C + 2 * (size_t)j * ldc;
+    for (i = 0; i < 2 * m; ++i) c[i] = 0.0;
+    for (l = 0; l < k; ++l) {
+      double br, bi;
+      if (tb == 'N') { br = B[2 * (l + (size_t)j * ldb)]; bi = B[2 * (l + (size_t)j * ldb) + 1]; }
+      else { br = B[2 * (j + (size_t)l * ldb)]; bi = -B[2 * (j + (size_t)l * ldb) + 1]; }
+      if (ta == 'N') {   /* c += A(:, l) b */
+        const double *a = A + 2 * (size_t)l * lda;
+        for (i = 0; i < m; ++i) {
+          c[2 * i] += a[2 * i] * br - a[2 * i + 1] * bi;
+          c[2 * i + 1] += a[2 * i] * bi + a[2 * i + 1] * br;
+        }
+      } else {           /* c_i += conj(A(l, i)) b */
+        for (i = 0; i < m; ++i) {
+          const double ar = A[2 * (l + (size_t)i * lda)], ai = -A[2 * (l + (size_t)i * lda) + 1];
+          c[2 * i] += ar * br - ai * bi;
+          c[2 * i + 1] += ar * bi + ai * br;
+        }
+      }
     }
+  }
 }
 
 /* Complex Givens rotation G = [c s; -conj(s) c] (c real) with G [a; b] = [rho; 0]. */
@@ -12077,28 +12097,24 @@ PHGMG__PRIV phgmg_result phgmg__h2gmg_lbfgs(phgmg__h2gmg *h, double *x, int maxi
     for (i = 0; i < n; ++i) d[i] = -g[i];
     for (l = 0; l < nm; ++l) {   /* two-loop recursion, newest first */
       const int q = (head - 1 - l + MEM) % MEM;
-      double s = 0.0;
-      for (i = 0; i < n; ++i) s += S[(size_t)q * n + i] * d[i];
-      al[q] = rho[q] * s;
-      for (i = 0; i < n; ++i) d[i] -= al[q] * Y[(size_t)q * n + i];
+      al[q] = rho[q] * phgmg__dot(n, S + (size_t)q * n, d);
+      phgmg__axpy(n, -al[q], Y + (size_t)q * n, d);
     }
     if (nm) {
       const int q = (head - 1 + MEM) % MEM;
-      for (i = 0; i < n; ++i) { sy += S[(size_t)q * n + i] * Y[(size_t)q * n + i]; yy += Y[(size_t)q * n + i] * Y[(size_t)q * n + i]; }
+      sy = phgmg__dot(n, S + (size_t)q * n, Y + (size_t)q * n);
+      yy = phgmg__dot(n, Y + (size_t)q * n, Y + (size_t)q * n);
       gam = sy / yy;
     } else {
-      for (i = 0; i < n; ++i) yy += g[i] * g[i];
+      yy = phgmg__dot(n, g, g);
       gam = yy > 0.0 ? 1.0 / sqrt(yy) : 1.0;
     }
     for (i = 0; i < n; ++i) d[i] *= gam;
     for (l = nm - 1; l >= 0; --l) {
       const int q = (head - 1 - l + MEM) % MEM;
-      double s = 0.0;
-      for (i = 0; i < n; ++i) s += Y[(size_t)q * n + i] * d[i];
-      s = al[q] - rho[q] * s;
-      for (i = 0; i < n; ++i) d[i] += s * S[(size_t)q * n + i];
+      phgmg__axpy(n, al[q] - rho[q] * phgmg__dot(n, Y + (size_t)q * n, d), S + (size_t)q * n, d);
     }
-    for (i = 0; i < n; ++i) gd += g[i] * d[i];
+    gd = phgmg__dot(n, g, d);
     if (!(gd < 0.0)) { nm = 0; continue; }   /* not a descent direction: restart */
     for (ls = 0; ls < 40; ++ls, t *= 0.5) {
       for (i = 0; i < n; ++i) xn[i] = x[i] + t * d[i];
