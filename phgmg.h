@@ -1632,7 +1632,7 @@ typedef struct phgmg_basis_opts {
    O(N^2 r) per step (N = 100, r = 12: 0.3-0.7 ms). Stops after opts->maxit
    steps (default 1000) or when the line search fails twice; a local
    minimum, slow to converge (measured, examples/linear_bases.c: on the
-   paper's chain ||G - G_r||_H2 / ||G||_H2 at r = 12 is 1.4e-4 / 7.1e-5 /
+   paper's chain ||G - G_r||_H2 / ||G||_H2 at r = 12 is 1.4e-4 / 6.9e-5 /
    6.0e-5 after 300 / 1000 / 1500 steps). opts->h2_rel (may be NULL): the
    relative H2 error reached. PHGMG_ERR_SINGULAR: V^T G V singular or Ar
    unstable at the start (e.g. r = 3 with two force ports, where B^T G B = 0). */
