@@ -11759,9 +11759,10 @@ PHGMG__PRIV void phgmg__hessenberg(int n, double *H, double *U, double *v) {
     }
     for (i = 0; i < n; ++i) {   /* H <- H (I - 2 v v^T / v^T v), U likewise */
       double sh = 0.0, su = 0.0;
-      for (j = 0; j < len; ++j) { sh += H[i + (size_t)(k + 1 + j) * n] * v[j]; su += U[i + (size_t)(k + 1 + j) * n] * v[j]; }
+      double *hr = H + i + (size_t)(k + 1) * n, *ur = U + i + (size_t)(k + 1) * n;   /* row i, from column k+1 */
+      for (j = 0; j < len; ++j) { sh += hr[(size_t)j * n] * v[j]; su += ur[(size_t)j * n] * v[j]; }
       sh *= 2.0 / vtv; su *= 2.0 / vtv;
-      for (j = 0; j < len; ++j) { H[i + (size_t)(k + 1 + j) * n] -= sh * v[j]; U[i + (size_t)(k + 1 + j) * n] -= su * v[j]; }
+      for (j = 0; j < len; ++j) { hr[(size_t)j * n] -= sh * v[j]; ur[(size_t)j * n] -= su * v[j]; }
     }
     for (i = k + 2; i < n; ++i) H[i + (size_t)k * n] = 0.0;
   }
@@ -11818,7 +11819,10 @@ PHGMG__PRIV phgmg_result phgmg__zschur(int n, const double *A, int lda, double *
       const double *t = T + 2 * (lo + (size_t)(lo - 1) * n), *u = T + 2 * ((lo - 1) + (size_t)(lo - 1) * n);
       double s = hypot(u[0], u[1]) + hypot(t[2 * n], t[2 * n + 1]);
       if (s == 0.0) s = hn;
-      if (hypot(t[0], t[1]) <= eps * s) { T[2 * (lo + (size_t)(lo - 1) * n)] = 0.0; T[2 * (lo + (size_t)(lo - 1) * n) + 1] = 0.0; break; }
+      if (hypot(t[0], t[1]) <= eps * s) {
+        T[2 * (lo + (size_t)(lo - 1) * n)] = T[2 * (lo + (size_t)(lo - 1) * n) + 1] = 0.0;
+        break;
+      }
     }
     if (lo == hi) { --hi; it = 0; continue; }
     if (++total > 30 * n) return PHGMG_ERR_NOT_CONVERGED;
@@ -11992,7 +11996,10 @@ PHGMG__PRIV phgmg_result phgmg__h2gmg_gram(const phgmg__h2gmg *h, const double *
   for (j = 0; j < r; ++j)   /* Cr Z (m x r complex) */
     for (a = 0; a < m; ++a) {
       double sr = 0.0, si = 0.0;
-      for (i = 0; i < r; ++i) { sr += Cr[a + (size_t)i * r] * Z[2 * (i + (size_t)j * r)]; si += Cr[a + (size_t)i * r] * Z[2 * (i + (size_t)j * r) + 1]; }
+      for (i = 0; i < r; ++i) {
+        sr += Cr[a + (size_t)i * r] * Z[2 * (i + (size_t)j * r)];
+        si += Cr[a + (size_t)i * r] * Z[2 * (i + (size_t)j * r) + 1];
+      }
       CrZ[2 * (a + (size_t)j * m)] = sr; CrZ[2 * (a + (size_t)j * m) + 1] = si;
     }
   phgmg__zgemm('N', 'N', N, r, m, h->UC, N, CrZ, m, Yq, N);
