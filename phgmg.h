@@ -1481,7 +1481,8 @@ PHGMG_DEF phgmg_result phgmg_ecsw_separable(int nterms, int ns, const double *F,
    check the residual with phgmg_lyap_residual / phgmg_care_residual), balanced
    truncation (square-root method) as reference, positive-real balanced
    truncation (PRBT) returning a pH reduced model, input-independent bases for
-   GMG-POD (pass them through phgmg_reduce_opts.pod_basis), transfer functions
+   GMG-POD (pass them through phgmg_reduce_opts.pod_basis; kind H2: the GMG
+   model of least H2 error, by L-BFGS), transfer functions
    and H-infinity / H2 errors. Cost O(n^3) per sign step (15-17 steps on the
    mass-spring-damper chains; tests/test_linear.c, bench/bench_linear.c). */
 #ifndef PHGMG_NO_OFFLINE
@@ -1595,7 +1596,8 @@ PHGMG_DEF phgmg_result phgmg_prbt(phgmg_reduced **out, const phgmg_ph_system *sy
 typedef enum phgmg_basis_kind {
   PHGMG_BASIS_FREQ = 1,     /* Re, Im of (i w I - A)^{-1} B, w log-spaced      */
   PHGMG_BASIS_IMPULSE = 2,  /* x(t) = e^{At} B sampled by GL3 steps            */
-  PHGMG_BASIS_BALANCED = 3  /* balanced right basis T of phgmg_bt, in order    */
+  PHGMG_BASIS_BALANCED = 3, /* balanced right basis T of phgmg_bt, in order    */
+  PHGMG_BASIS_H2 = 4        /* the GMG model of least H2 error (one order)     */
 } phgmg_basis_kind;
 
 typedef struct phgmg_basis_opts {
@@ -1605,6 +1607,9 @@ typedef struct phgmg_basis_opts {
                          eigenvalue modulus of A: |lambda| in [1/||A^-1||, ||A||]) */
   double dt;          /* IMPULSE: step (0: 0.1)                                   */
   int nsteps;         /* IMPULSE: steps (0: 1000)                                 */
+  int maxit;          /* H2: L-BFGS iterations (0: 1000)                          */
+  const double *V0;   /* H2: starting columns, N x k (NULL: the BALANCED basis)   */
+  double *h2_rel;     /* H2 (may be NULL): out, ||G - G_r||_H2 / ||G||_H2 reached */
 } phgmg_basis_opts;
 
 /* An input-independent basis V (N x k, ld N) for GMG: orthonormal and
@@ -1613,7 +1618,24 @@ typedef struct phgmg_basis_opts {
    B's part dropped). Pass it as opts.pod_basis / pod_cols = k to
    phgmg_reduce (GMG-POD takes its first r - m columns). opts may be NULL.
    *k_out (may be NULL) = columns filled (fewer if the snapshots have lower
-   rank; the rest is zero). */
+   rank; the rest is zero).
+   H2: the basis for ONE order r = m + k (not nested: call once per order)
+   whose GMG model has the least H2 error found: GMG's model depends on V
+   alone (Ar = (V^T G V)^-1 V^T Q V, Br = [I; 0], Cr = B^T Q V for V = [B,
+   Vbar], G = (J - R)^-1), so J(Vbar) = ||G - G_r||_H2^2 is minimised over
+   Vbar (N x k) by L-BFGS (memory 50, Armijo backtracking) from opts->V0 or
+   the BALANCED basis (also when V0 makes V^T G V singular). J and its
+   gradient (Wilson's conditions chained through (V^T G V)^-1 and V^T Q V)
+   come from the Gramian blocks P12, Q12, Pr, Qr of the error system: two
+   N x r and two r x r Sylvester equations per step, solved in the complex
+   Schur forms of A (once, O(N^3)) and of Ar (QR algorithm, per step); cost
+   O(N^2 r) per step (N = 100, r = 12: 0.3-0.7 ms). Stops after opts->maxit
+   steps (default 1000) or when the line search fails twice; a local
+   minimum, slow to converge (measured, examples/linear_bases.c: on the
+   paper's chain ||G - G_r||_H2 / ||G||_H2 at r = 12 is 1.4e-4 / 6.9e-5 /
+   6.0e-5 after 300 / 1000 / 1500 steps). opts->h2_rel (may be NULL): the
+   relative H2 error reached. PHGMG_ERR_SINGULAR: V^T G V singular or Ar
+   unstable at the start (e.g. r = 3 with two force ports, where B^T G B = 0). */
 PHGMG_DEF phgmg_result phgmg_linear_basis(const phgmg_ph_system *sys, phgmg_basis_kind kind, int k,
                                           const phgmg_basis_opts *opts, double *V, int *k_out,
                                           const phgmg_allocator *alloc);
@@ -11644,6 +11666,539 @@ PHGMG__PRIV phgmg_result phgmg__basis_snapshots(const phgmg_ph_system *sys, phgm
   return PHGMG_OK;
 }
 
+/* ---- GMG basis of minimal H2 error (PHGMG_BASIS_H2) -----------------------
+   Complex matrices are interleaved (re, im), column-major. */
+
+/* C = op(A) op(B) (complex; op 'N' or 'C' = conjugate transpose), C m x n. */
+PHGMG__PRIV void phgmg__zgemm(char ta, char tb, int m, int n, int k, const double *A, int lda, const double *B,
+                              int ldb, double *C, int ldc) {
+  int i, j, l;
+  if (ta == 'C' && tb == 'N') {   /* C_ij = conj(A(:, i)) . B(:, j) */
+    for (j = 0; j < n; ++j)
+      for (i = 0; i < m; ++i) {
+        const double *a = A + 2 * (size_t)i * lda, *b = B + 2 * (size_t)j * ldb;
+        double si = 0.0;
+        for (l = 0; l < k; ++l) si += a[2 * l] * b[2 * l + 1] - a[2 * l + 1] * b[2 * l];
+        C[2 * (i + (size_t)j * ldc)] = phgmg__dot(2 * k, a, b);
+        C[2 * (i + (size_t)j * ldc) + 1] = si;
+      }
+    return;
+  }
+  for (j = 0; j < n; ++j) {
+    double *c = C + 2 * (size_t)j * ldc;
+    for (i = 0; i < 2 * m; ++i) c[i] = 0.0;
+    for (l = 0; l < k; ++l) {
+      double br, bi;
+      if (tb == 'N') { br = B[2 * (l + (size_t)j * ldb)]; bi = B[2 * (l + (size_t)j * ldb) + 1]; }
+      else { br = B[2 * (j + (size_t)l * ldb)]; bi = -B[2 * (j + (size_t)l * ldb) + 1]; }
+      if (ta == 'N') {   /* c += A(:, l) b */
+        const double *a = A + 2 * (size_t)l * lda;
+        for (i = 0; i < m; ++i) {
+          c[2 * i] += a[2 * i] * br - a[2 * i + 1] * bi;
+          c[2 * i + 1] += a[2 * i] * bi + a[2 * i + 1] * br;
+        }
+      } else {           /* c_i += conj(A(l, i)) b */
+        for (i = 0; i < m; ++i) {
+          const double ar = A[2 * (l + (size_t)i * lda)], ai = -A[2 * (l + (size_t)i * lda) + 1];
+          c[2 * i] += ar * br - ai * bi;
+          c[2 * i + 1] += ar * bi + ai * br;
+        }
+      }
+    }
+  }
+}
+
+/* Complex Givens rotation G = [c s; -conj(s) c] (c real) with G [a; b] = [rho; 0]. */
+PHGMG__PRIV void phgmg__zgivens(const double *a, const double *b, double *c, double *s) {
+  const double aa = hypot(a[0], a[1]), bb = hypot(b[0], b[1]);
+  double rr;
+  if (bb == 0.0) { *c = 1.0; s[0] = s[1] = 0.0; return; }
+  if (aa == 0.0) { *c = 0.0; s[0] = 1.0; s[1] = 0.0; return; }
+  rr = hypot(aa, bb);
+  *c = aa / rr;
+  s[0] = (a[0] * b[0] + a[1] * b[1]) / (aa * rr);   /* (a / |a|) conj(b) / r */
+  s[1] = (a[1] * b[0] - a[0] * b[1]) / (aa * rr);
+}
+
+/* Rows i, i+1 of M (complex, ld) <- G [row i; row i+1], columns j0 .. n-1. */
+PHGMG__PRIV void phgmg__zrot_rows(double *M, int ld, int i, int j0, int n, double c, const double *s) {
+  int j;
+  for (j = j0; j < n; ++j) {
+    double *x = M + 2 * (i + (size_t)j * ld), *y = x + 2;
+    const double xr = x[0], xi = x[1], yr = y[0], yi = y[1];
+    x[0] = c * xr + s[0] * yr - s[1] * yi;
+    x[1] = c * xi + s[0] * yi + s[1] * yr;
+    y[0] = c * yr - (s[0] * xr + s[1] * xi);
+    y[1] = c * yi - (s[0] * xi - s[1] * xr);
+  }
+}
+
+/* Columns j, j+1 of M (complex, ld) <- [col j, col j+1] G^H, rows 0 .. i1-1. */
+PHGMG__PRIV void phgmg__zrot_cols(double *M, int ld, int j, int i1, double c, const double *s) {
+  double *x = M + 2 * (size_t)j * ld, *y = x + 2 * (size_t)ld;
+  int i;
+  for (i = 0; i < i1; ++i) {
+    const double xr = x[2 * i], xi = x[2 * i + 1], yr = y[2 * i], yi = y[2 * i + 1];
+    x[2 * i] = c * xr + s[0] * yr + s[1] * yi;
+    x[2 * i + 1] = c * xi + s[0] * yi - s[1] * yr;
+    y[2 * i] = c * yr - (s[0] * xr - s[1] * xi);
+    y[2 * i + 1] = c * yi - (s[0] * xi + s[1] * xr);
+  }
+}
+
+/* Householder reduction of a real n x n H (ld n) to upper Hessenberg form in
+   place, H <- U^T H U, U (n x n, ld n) orthogonal; v: n doubles. */
+PHGMG__PRIV void phgmg__hessenberg(int n, double *H, double *U, double *v) {
+  int i, j, k;
+  for (i = 0; i < n * n; ++i) U[i] = 0.0;
+  for (i = 0; i < n; ++i) U[i + (size_t)i * n] = 1.0;
+  for (k = 0; k + 2 < n; ++k) {
+    const int len = n - k - 1;
+    double al = 0.0, vtv = 0.0, s;
+    for (i = 0; i < len; ++i) { v[i] = H[(k + 1 + i) + (size_t)k * n]; al += v[i] * v[i]; }
+    if (al == 0.0) continue;
+    al = sqrt(al);
+    v[0] += v[0] >= 0.0 ? al : -al;
+    for (i = 0; i < len; ++i) vtv += v[i] * v[i];
+    for (j = k; j < n; ++j) {   /* H <- (I - 2 v v^T / v^T v) H, rows k+1.. */
+      double *h = H + (k + 1) + (size_t)j * n;
+      for (s = 0.0, i = 0; i < len; ++i) s += v[i] * h[i];
+      s *= 2.0 / vtv;
+      for (i = 0; i < len; ++i) h[i] -= s * v[i];
+    }
+    for (i = 0; i < n; ++i) {   /* H <- H (I - 2 v v^T / v^T v), U likewise */
+      double sh = 0.0, su = 0.0;
+      double *hr = H + i + (size_t)(k + 1) * n, *ur = U + i + (size_t)(k + 1) * n;   /* row i, from column k+1 */
+      for (j = 0; j < len; ++j) { sh += hr[(size_t)j * n] * v[j]; su += ur[(size_t)j * n] * v[j]; }
+      sh *= 2.0 / vtv; su *= 2.0 / vtv;
+      for (j = 0; j < len; ++j) { hr[(size_t)j * n] -= sh * v[j]; ur[(size_t)j * n] -= su * v[j]; }
+    }
+    for (i = k + 2; i < n; ++i) H[i + (size_t)k * n] = 0.0;
+  }
+}
+
+/* Complex square root (principal branch). */
+PHGMG__PRIV void phgmg__zsqrt(double x, double y, double *sr, double *si) {
+  const double r = hypot(x, y);
+  double t;
+  if (r == 0.0) { *sr = *si = 0.0; return; }
+  if (x >= 0.0) { t = sqrt(0.5 * (r + x)); *sr = t; *si = y / (2.0 * t); }
+  else { t = sqrt(0.5 * (r - x)); *sr = fabs(y) / (2.0 * t); *si = y < 0.0 ? -t : t; }
+}
+
+/* Wilkinson shift of the trailing 2 x 2 block [a b; c d] of T at hi: its
+   eigenvalue closer to d; every 11th step an exceptional shift. */
+PHGMG__PRIV void phgmg__zwilkinson(int n, const double *T, int hi, int it, double *mu) {
+  const double *a = T + 2 * ((hi - 1) + (size_t)(hi - 1) * n), *b = T + 2 * ((hi - 1) + (size_t)hi * n);
+  const double *c = T + 2 * (hi + (size_t)(hi - 1) * n), *d = T + 2 * (hi + (size_t)hi * n);
+  double pr, pi, bcr, bci, qr, qi, d1r, d1i, d2r, d2i, tr, ti;
+  if (it % 11 == 10) { mu[0] = d[0] + 0.75 * hypot(c[0], c[1]); mu[1] = d[1]; return; }
+  pr = 0.5 * (a[0] - d[0]); pi = 0.5 * (a[1] - d[1]);
+  bcr = b[0] * c[0] - b[1] * c[1]; bci = b[0] * c[1] + b[1] * c[0];
+  phgmg__zsqrt(pr * pr - pi * pi + bcr, 2.0 * pr * pi + bci, &qr, &qi);
+  d1r = pr + qr; d1i = pi + qi; d2r = pr - qr; d2i = pi - qi;
+  if (hypot(d2r, d2i) > hypot(d1r, d1i)) { d1r = d2r; d1i = d2i; }
+  if (d1r == 0.0 && d1i == 0.0) { mu[0] = d[0]; mu[1] = d[1]; return; }
+  phgmg__zdiv(bcr, bci, d1r, d1i, &tr, &ti);
+  mu[0] = d[0] - tr; mu[1] = d[1] - ti;
+}
+
+/* Complex Schur form of a real n x n A (ld lda): A = Z T Z^H, T upper
+   triangular, Z unitary (both n x n complex, ld n). Hessenberg reduction,
+   then the single-shift complex QR algorithm (explicit shifted QR steps by
+   Givens rotations, Wilkinson shifts, deflation when |t_{l,l-1}| <=
+   eps (|t_ll| + |t_{l-1,l-1}|)). work: 3 n doubles. PHGMG_ERR_NOT_CONVERGED
+   after 30 n steps, _NANINF. */
+PHGMG__PRIV phgmg_result phgmg__zschur(int n, const double *A, int lda, double *T, double *Z, double *work) {
+  const double eps = 2.220446049250313e-16;
+  double hn = 0.0, mu[2], *cs = work, *sn = work + n;
+  int i, j, k, lo, hi = n - 1, it = 0, total = 0;
+  for (j = 0; j < n; ++j)
+    for (i = 0; i < n; ++i) {
+      T[i + (size_t)j * n] = A[i + (size_t)j * lda];
+      hn += A[i + (size_t)j * lda] * A[i + (size_t)j * lda];
+    }
+  if (!(hn < HUGE_VAL)) return PHGMG_ERR_NANINF;
+  hn = sqrt(hn);
+  phgmg__hessenberg(n, T, Z, work);
+  for (i = n * n - 1; i >= 0; --i) { T[2 * i] = T[i]; T[2 * i + 1] = 0.0; }
+  for (i = n * n - 1; i >= 0; --i) { Z[2 * i] = Z[i]; Z[2 * i + 1] = 0.0; }
+  while (hi > 0) {
+    for (lo = hi; lo > 0; --lo) {
+      const double *t = T + 2 * (lo + (size_t)(lo - 1) * n), *u = T + 2 * ((lo - 1) + (size_t)(lo - 1) * n);
+      double s = hypot(u[0], u[1]) + hypot(t[2 * n], t[2 * n + 1]);
+      if (s == 0.0) s = hn;
+      if (hypot(t[0], t[1]) <= eps * s) {
+        T[2 * (lo + (size_t)(lo - 1) * n)] = T[2 * (lo + (size_t)(lo - 1) * n) + 1] = 0.0;
+        break;
+      }
+    }
+    if (lo == hi) { --hi; it = 0; continue; }
+    if (++total > 30 * n) return PHGMG_ERR_NOT_CONVERGED;
+    phgmg__zwilkinson(n, T, hi, it++, mu);
+    for (k = lo; k <= hi; ++k) { T[2 * (k + (size_t)k * n)] -= mu[0]; T[2 * (k + (size_t)k * n) + 1] -= mu[1]; }
+    for (k = lo; k < hi; ++k) {
+      phgmg__zgivens(T + 2 * (k + (size_t)k * n), T + 2 * (k + 1 + (size_t)k * n), cs + k, sn + 2 * k);
+      phgmg__zrot_rows(T, n, k, k, n, cs[k], sn + 2 * k);
+    }
+    for (k = lo; k < hi; ++k) {
+      phgmg__zrot_cols(T, n, k, k + 2, cs[k], sn + 2 * k);
+      phgmg__zrot_cols(Z, n, k, n, cs[k], sn + 2 * k);
+    }
+    for (k = lo; k <= hi; ++k) { T[2 * (k + (size_t)k * n)] += mu[0]; T[2 * (k + (size_t)k * n) + 1] += mu[1]; }
+  }
+  for (j = 0; j < n; ++j)
+    for (i = j + 1; i < n; ++i) T[2 * (i + (size_t)j * n)] = T[2 * (i + (size_t)j * n) + 1] = 0.0;
+  return PHGMG_OK;
+}
+
+/* Triangular Sylvester equations (complex): T n x n and S k x k upper
+   triangular (ld n, k), X n x k (ld n) holds F on entry, the solution on
+   return. mode 0: T X + X S^H = F (columns from the last); mode 1:
+   T^H X + X S = F (columns from the first). PHGMG_ERR_SINGULAR if a pivot
+   t_ii + conj(s_jj) (mode 0) or conj(t_ii) + s_jj (mode 1) is zero. */
+PHGMG__PRIV phgmg_result phgmg__ztrsyl(int mode, int n, const double *T, int k, const double *S, double *X) {
+  int jj, j, l, a, b;
+  for (jj = 0; jj < k; ++jj) {
+    double *x, dr, di;
+    j = mode == 0 ? k - 1 - jj : jj;
+    x = X + 2 * (size_t)j * n;
+    for (l = mode == 0 ? j + 1 : 0; l < (mode == 0 ? k : j); ++l) {   /* the solved columns */
+      const double *sl = mode == 0 ? S + 2 * (j + (size_t)l * k) : S + 2 * (l + (size_t)j * k);
+      phgmg__zaxpy_neg(n, sl[0], mode == 0 ? -sl[1] : sl[1], X + 2 * (size_t)l * n, x);
+    }
+    if (mode == 0) {   /* (T + conj(s_jj)) x = rhs, back substitution by columns of T */
+      for (a = n - 1; a >= 0; --a) {
+        const double *tc = T + 2 * (size_t)a * n;
+        dr = tc[2 * a] + S[2 * (j + (size_t)j * k)]; di = tc[2 * a + 1] - S[2 * (j + (size_t)j * k) + 1];
+        if (dr == 0.0 && di == 0.0) return PHGMG_ERR_SINGULAR;
+        phgmg__zdiv(x[2 * a], x[2 * a + 1], dr, di, x + 2 * a, x + 2 * a + 1);
+        phgmg__zaxpy_neg(a, x[2 * a], x[2 * a + 1], tc, x);
+      }
+    } else {           /* (T^H + s_jj) x = rhs, forward substitution (column a of T, conjugated) */
+      for (a = 0; a < n; ++a) {
+        const double *tc = T + 2 * (size_t)a * n;
+        double sr = x[2 * a], si = x[2 * a + 1];
+        for (b = 0; b < a; ++b) {   /* -= conj(t_ba) x_b */
+          sr -= tc[2 * b] * x[2 * b] + tc[2 * b + 1] * x[2 * b + 1];
+          si -= tc[2 * b] * x[2 * b + 1] - tc[2 * b + 1] * x[2 * b];
+        }
+        dr = tc[2 * a] + S[2 * (j + (size_t)j * k)]; di = -tc[2 * a + 1] + S[2 * (j + (size_t)j * k) + 1];
+        if (dr == 0.0 && di == 0.0) return PHGMG_ERR_SINGULAR;
+        phgmg__zdiv(sr, si, dr, di, x + 2 * a, x + 2 * a + 1);
+      }
+    }
+  }
+  return PHGMG_OK;
+}
+
+/* Workspace of the H2 objective: the system's Schur form A = U T U^H (once),
+   U^H B, U^H C^T, ||G||_H2^2, the factorization of J - R, and buffers. */
+typedef struct phgmg__h2gmg {
+  const phgmg_ph_system *sys;
+  phgmg_jr_factor *jr;
+  int N, m, k, r;
+  double h2ref;
+  double *T, *UB, *UC, *buf;
+} phgmg__h2gmg;
+
+PHGMG__PRIV void phgmg__h2gmg_free(phgmg__h2gmg *h, const phgmg_allocator *alloc) {
+  phgmg_jr_factor_destroy(h->jr);
+  phgmg__free(alloc, h->T);
+  phgmg__free(alloc, h->buf);
+  memset(h, 0, sizeof *h);
+}
+
+/* ||G||_H2^2 = tr(C P C^T), P from T Y + Y T^H = -U^H B B^T U (Y = U^H P U):
+   tr(C P C^T) = tr((U^H C^T)^H Y (U^H C^T)). work: N x N complex. */
+PHGMG__PRIV phgmg_result phgmg__h2gmg_ref(phgmg__h2gmg *h, double *Y) {
+  const int N = h->N, m = h->m;
+  double s = 0.0;
+  int i, j, a;
+  phgmg_result rc;
+  phgmg__zgemm('N', 'C', N, N, m, h->UB, N, h->UB, N, Y, N);
+  for (i = 0; i < 2 * N * N; ++i) Y[i] = -Y[i];
+  rc = phgmg__ztrsyl(0, N, h->T, N, h->T, Y);
+  if (rc != PHGMG_OK) return rc;
+  for (a = 0; a < m; ++a)
+    for (j = 0; j < N; ++j) {
+      const double *uj = h->UC + 2 * (j + (size_t)a * N);
+      double yr = 0.0, yi = 0.0;   /* (Y uc)_j ... accumulate conj(uc_i) Y_ij uc_j */
+      for (i = 0; i < N; ++i) {
+        const double *ui = h->UC + 2 * (i + (size_t)a * N), *y = Y + 2 * (i + (size_t)j * N);
+        yr += ui[0] * y[0] + ui[1] * y[1];
+        yi += ui[0] * y[1] - ui[1] * y[0];
+      }
+      s += yr * uj[0] - yi * uj[1];
+    }
+  h->h2ref = s;
+  return s > 0.0 ? PHGMG_OK : PHGMG_ERR_SINGULAR;
+}
+
+PHGMG__PRIV phgmg_result phgmg__h2gmg_init(phgmg__h2gmg *h, const phgmg_ph_system *sys, int k,
+                                           const phgmg_allocator *alloc) {
+  const int N = sys->N, m = sys->m, r = m + k;
+  double *A = NULL, *U, *C, *W;
+  phgmg_result rc;
+  memset(h, 0, sizeof *h);
+  h->sys = sys; h->N = N; h->m = m; h->k = k; h->r = r;
+  h->T = phgmg__dalloc(alloc, 2 * (size_t)N * N + 4 * (size_t)N * m);
+  A = phgmg__dalloc(alloc, 3 * (size_t)N * N + (size_t)m * N + 3 * (size_t)N + 2 * (size_t)N * m);
+  if (!h->T || !A) { phgmg__free(alloc, A); phgmg__h2gmg_free(h, alloc); return PHGMG_ERR_NOMEM; }
+  h->UB = h->T + 2 * (size_t)N * N; h->UC = h->UB + 2 * (size_t)N * m;
+  U = A + (size_t)N * N; C = U + 2 * (size_t)N * N; W = C + (size_t)m * N;
+  rc = phgmg_ph_abc(sys, A, C, alloc);
+  if (rc == PHGMG_OK) rc = phgmg__zschur(N, A, N, h->T, U, W);
+  if (rc == PHGMG_OK) {   /* U^H B, U^H C^T (real B, C as complex) */
+    int i, a;
+    double *Bz = W + 3 * (size_t)N;   /* N x m complex */
+    for (a = 0; a < m; ++a)
+      for (i = 0; i < N; ++i) {
+        Bz[2 * (i + (size_t)a * N)] = sys->B[i + (size_t)a * N]; Bz[2 * (i + (size_t)a * N) + 1] = 0.0;
+      }
+    phgmg__zgemm('C', 'N', N, m, N, U, N, Bz, N, h->UB, N);
+    for (a = 0; a < m; ++a)
+      for (i = 0; i < N; ++i) {
+        Bz[2 * (i + (size_t)a * N)] = C[a + (size_t)i * m]; Bz[2 * (i + (size_t)a * N) + 1] = 0.0;
+      }
+    phgmg__zgemm('C', 'N', N, m, N, U, N, Bz, N, h->UC, N);
+    rc = phgmg__h2gmg_ref(h, U);
+  }
+  phgmg__free(alloc, A);
+  if (rc == PHGMG_OK) rc = phgmg_jr_factor_create(&h->jr, sys, NULL, alloc);
+  if (rc == PHGMG_OK) {
+    h->buf = phgmg__dalloc(alloc, 10 * (size_t)N * r + 40 * (size_t)r * r + 8 * (size_t)r);
+    if (!h->buf) rc = PHGMG_ERR_NOMEM;
+  }
+  if (rc != PHGMG_OK) phgmg__h2gmg_free(h, alloc);
+  return rc;
+}
+
+/* Re(Z Y Z^H) (r x r real, into P) for complex Z, Y (r x r); w: 4 r^2 doubles. */
+PHGMG__PRIV void phgmg__zcongr(int r, const double *Z, const double *Y, double *P, double *w) {
+  int i;
+  phgmg__zgemm('N', 'N', r, r, r, Z, r, Y, r, w, r);
+  phgmg__zgemm('N', 'C', r, r, r, w, r, Z, r, w + 2 * (size_t)r * r, r);
+  for (i = 0; i < r * r; ++i) P[i] = w[2 * r * r + 2 * i];
+}
+
+/* The Gramian blocks of the error system G - G_r for the reduced (Ar, Br =
+   [I; 0], Cr) with Ar = Z S Z^H: P12 = U Yp Z^H (A P12 + P12 Ar^T + B Br^T
+   = 0), Q12 = U Yq Z^H (A^T Q12 + Q12 Ar = C^T Cr), Pr, Qr; returned as
+   Pr, Qr, Q12^T P12 = Re(Z Yq^H Yp Z^H) and C P12 = Re((U^H C^T)^H Yp Z^H). */
+PHGMG__PRIV phgmg_result phgmg__h2gmg_gram(const phgmg__h2gmg *h, const double *Cr, const double *S, const double *Z,
+                                           double *Pr, double *Qr, double *QP, double *CP, double *w) {
+  const int N = h->N, m = h->m, r = h->r;
+  double *Yp = w, *Yq = Yp + 2 * (size_t)N * r, *Ys = Yq + 2 * (size_t)N * r, *CrZ = Ys + 2 * (size_t)r * r;
+  double *w4 = CrZ + 2 * (size_t)m * r;
+  phgmg_result rc;
+  int i, j, a;
+  phgmg__zgemm('N', 'N', N, r, m, h->UB, N, Z, r, Yp, N);
+  for (i = 0; i < 2 * N * r; ++i) Yp[i] = -Yp[i];
+  rc = phgmg__ztrsyl(0, N, h->T, r, S, Yp);
+  if (rc != PHGMG_OK) return rc;
+  phgmg__zgemm('C', 'N', r, r, m, Z, r, Z, r, Ys, r);
+  for (i = 0; i < 2 * r * r; ++i) Ys[i] = -Ys[i];
+  rc = phgmg__ztrsyl(0, r, S, r, S, Ys);
+  if (rc != PHGMG_OK) return rc;
+  phgmg__zcongr(r, Z, Ys, Pr, w4);
+  for (j = 0; j < r; ++j)   /* Cr Z (m x r complex) */
+    for (a = 0; a < m; ++a) {
+      double sr = 0.0, si = 0.0;
+      for (i = 0; i < r; ++i) {
+        sr += Cr[a + (size_t)i * r] * Z[2 * (i + (size_t)j * r)];
+        si += Cr[a + (size_t)i * r] * Z[2 * (i + (size_t)j * r) + 1];
+      }
+      CrZ[2 * (a + (size_t)j * m)] = sr; CrZ[2 * (a + (size_t)j * m) + 1] = si;
+    }
+  phgmg__zgemm('N', 'N', N, r, m, h->UC, N, CrZ, m, Yq, N);
+  rc = phgmg__ztrsyl(1, N, h->T, r, S, Yq);
+  if (rc != PHGMG_OK) return rc;
+  phgmg__zgemm('C', 'N', r, r, m, CrZ, m, CrZ, m, Ys, r);
+  for (i = 0; i < 2 * r * r; ++i) Ys[i] = -Ys[i];
+  rc = phgmg__ztrsyl(1, r, S, r, S, Ys);
+  if (rc != PHGMG_OK) return rc;
+  phgmg__zcongr(r, Z, Ys, Qr, w4);
+  phgmg__zgemm('C', 'N', r, r, N, Yq, N, Yp, N, Ys, r);
+  phgmg__zcongr(r, Z, Ys, QP, w4);
+  phgmg__zgemm('C', 'N', m, r, N, h->UC, N, Yp, N, CrZ, m);
+  phgmg__zgemm('N', 'C', m, r, r, CrZ, m, Z, r, w4, m);
+  for (i = 0; i < m * r; ++i) CP[i] = w4[2 * i];
+  return PHGMG_OK;
+}
+
+/* Relative squared H2 error f = ||G - G_r||_H2^2 / ||G||_H2^2 of the GMG model
+   of V = [B, Vbar] (Vbar N x k, any full-rank columns) and its gradient g
+   (N x k) with respect to Vbar (may be NULL). Reduced model: M = V^T G V,
+   K = M^-1, Qh = V^T Q V, Ar = K Qh, Br = [I; 0] (B = V [I; 0]), Cr = B^T Q V
+   (the first m rows of Qh). Gradient: Wilson's conditions dJ/dAr = 2 (Q12^T
+   P12 + Qr Pr), dJ/dCr = 2 (Cr Pr - C P12), chained through K and Qh.
+   f = HUGE_VAL if M is singular or Ar not stable. */
+PHGMG__PRIV double phgmg__h2gmg_eval(phgmg__h2gmg *h, const double *Vbar, double *g) {
+  const int N = h->N, m = h->m, k = h->k, r = h->r;
+  double *V = h->buf, *GV = V + (size_t)N * r, *GtV = GV + (size_t)N * r, *QV = GtV + (size_t)N * r;
+  double *gV = QV + (size_t)N * r, *M = gV + (size_t)N * r, *K = M + (size_t)r * r, *Qh = K + (size_t)r * r;
+  double *Ar = Qh + (size_t)r * r, *Pr = Ar + (size_t)r * r, *Qr = Pr + (size_t)r * r, *QP = Qr + (size_t)r * r;
+  double *CP = QP + (size_t)r * r, *gA = CP + (size_t)m * r, *W1 = gA + (size_t)r * r, *W2 = W1 + (size_t)r * r;
+  double *S = W2 + (size_t)r * r, *Z = S + 2 * (size_t)r * r, *w = Z + 2 * (size_t)r * r;
+  int *ip = (int *)(void *)(w + 4 * (size_t)N * r + 16 * (size_t)r * r + 4 * (size_t)r);
+  double J, tc = 0.0, tp = 0.0;
+  int i, j, a;
+  memcpy(V, h->sys->B, (size_t)N * m * sizeof(double));
+  memcpy(V + (size_t)N * m, Vbar, (size_t)N * k * sizeof(double));
+  phgmg_ph_apply(h->sys, 'Q', r, V, N, QV, N);
+  memcpy(GV, V, (size_t)N * r * sizeof(double));
+  memcpy(GtV, V, (size_t)N * r * sizeof(double));
+  phgmg_jr_solve(h->jr, 'N', r, GV, N);
+  phgmg_jr_solve(h->jr, 'T', r, GtV, N);
+  phgmg_gemm('T', 'N', r, r, N, 1.0, V, N, GV, N, 0.0, M, r);
+  phgmg_gemm('T', 'N', r, r, N, 1.0, V, N, QV, N, 0.0, Qh, r);
+  for (i = 0; i < r * r; ++i) K[i] = 0.0;
+  for (i = 0; i < r; ++i) K[i + (size_t)i * r] = 1.0;
+  if (phgmg_lu_factor(r, M, r, ip) != PHGMG_OK) return HUGE_VAL;
+  phgmg_lu_solve('N', r, M, r, ip, r, K, r);
+  phgmg_gemm('N', 'N', r, r, r, 1.0, K, r, Qh, r, 0.0, Ar, r);
+  if (phgmg__zschur(r, Ar, r, S, Z, w) != PHGMG_OK) return HUGE_VAL;
+  for (i = 0; i < r; ++i)
+    if (!(S[2 * (i + (size_t)i * r)] < 0.0)) return HUGE_VAL;
+  if (phgmg__h2gmg_gram(h, Qh, S, Z, Pr, Qr, QP, CP, w) != PHGMG_OK) return HUGE_VAL;
+  for (a = 0; a < m; ++a)   /* tr(Cr Pr Cr^T), tr(C P12 Cr^T); Cr = Qh(0:m, :) */
+    for (j = 0; j < r; ++j) {
+      double s = 0.0;
+      for (i = 0; i < r; ++i) s += Qh[a + (size_t)i * r] * Pr[i + (size_t)j * r];
+      tc += s * Qh[a + (size_t)j * r];
+      tp += CP[a + (size_t)j * m] * Qh[a + (size_t)j * r];
+    }
+  J = h->h2ref + tc - 2.0 * tp;
+  if (!g) return J / h->h2ref;
+  for (i = 0; i < r * r; ++i) gA[i] = 2.0 * QP[i];
+  phgmg_gemm('N', 'N', r, r, r, 2.0, Qr, r, Pr, r, 1.0, gA, r);
+  phgmg_gemm('N', 'T', r, r, r, 1.0, gA, r, Qh, r, 0.0, W1, r);        /* Z1 = gA Qh^T */
+  phgmg_gemm('T', 'N', r, r, r, 1.0, K, r, W1, r, 0.0, W2, r);
+  phgmg_gemm('N', 'T', r, r, r, -1.0, W2, r, K, r, 0.0, W1, r);        /* Y1 = -K^T Z1 K^T */
+  phgmg_gemm('N', 'T', N, r, r, 1.0, GV, N, W1, r, 0.0, gV, N);
+  phgmg_gemm('N', 'N', N, r, r, 1.0, GtV, N, W1, r, 1.0, gV, N);
+  phgmg_gemm('T', 'N', r, r, r, 1.0, K, r, gA, r, 0.0, W2, r);         /* X2 = K^T gA */
+  for (j = 0; j < r; ++j)
+    for (i = 0; i < r; ++i) W1[i + (size_t)j * r] = W2[i + (size_t)j * r] + W2[j + (size_t)i * r];
+  phgmg_gemm('N', 'N', N, r, r, 1.0, QV, N, W1, r, 1.0, gV, N);
+  for (j = 0; j < r; ++j)   /* gC = 2 (Cr Pr - C P12) (m x r) into W2 */
+    for (a = 0; a < m; ++a) {
+      double s = 0.0;
+      for (i = 0; i < r; ++i) s += Qh[a + (size_t)i * r] * Pr[i + (size_t)j * r];
+      W2[a + (size_t)j * m] = 2.0 * (s - CP[a + (size_t)j * m]);
+    }
+  phgmg_gemm('N', 'N', N, r, m, 1.0, QV, N, W2, m, 1.0, gV, N);        /* + Q B gC */
+  for (i = 0; i < N * k; ++i) g[i] = gV[(size_t)N * m + i] / h->h2ref;
+  return J / h->h2ref;
+}
+
+/* Minimises f = phgmg__h2gmg_eval over x = Vbar (n = N k entries) by L-BFGS
+   (memory 50, Armijo backtracking, first step of unit length); stops after
+   maxit iterations or when a line search fails twice in a row (the second
+   time from a steepest-descent step). *f_out: the last f. */
+PHGMG__PRIV phgmg_result phgmg__h2gmg_lbfgs(phgmg__h2gmg *h, double *x, int maxit, double *f_out,
+                                            const phgmg_allocator *alloc) {
+  enum { MEM = 50 };
+  const int n = h->N * h->k;
+  double *g = phgmg__dalloc(alloc, (size_t)n * (4 + 2 * MEM)), *d, *xn, *gn, *S, *Y, rho[MEM], al[MEM], f, fn = 0.0;
+  int it, nm = 0, head = 0, i, l, fails = 0;
+  if (!g) return PHGMG_ERR_NOMEM;
+  d = g + n; xn = d + n; gn = xn + n; S = gn + n; Y = S + (size_t)MEM * n;
+  f = phgmg__h2gmg_eval(h, x, g);
+  if (!(f < HUGE_VAL)) { phgmg__free(alloc, g); return PHGMG_ERR_SINGULAR; }
+  for (it = 0; it < maxit; ++it) {
+    double gd = 0.0, t = 1.0, gam = 1.0, sy = 0.0, yy = 0.0;
+    int ls;
+    for (i = 0; i < n; ++i) d[i] = -g[i];
+    for (l = 0; l < nm; ++l) {   /* two-loop recursion, newest first */
+      const int q = (head - 1 - l + MEM) % MEM;
+      al[q] = rho[q] * phgmg__dot(n, S + (size_t)q * n, d);
+      phgmg__axpy(n, -al[q], Y + (size_t)q * n, d);
+    }
+    if (nm) {
+      const int q = (head - 1 + MEM) % MEM;
+      sy = phgmg__dot(n, S + (size_t)q * n, Y + (size_t)q * n);
+      yy = phgmg__dot(n, Y + (size_t)q * n, Y + (size_t)q * n);
+      gam = sy / yy;
+    } else {
+      yy = phgmg__dot(n, g, g);
+      gam = yy > 0.0 ? 1.0 / sqrt(yy) : 1.0;
+    }
+    for (i = 0; i < n; ++i) d[i] *= gam;
+    for (l = nm - 1; l >= 0; --l) {
+      const int q = (head - 1 - l + MEM) % MEM;
+      phgmg__axpy(n, al[q] - rho[q] * phgmg__dot(n, Y + (size_t)q * n, d), S + (size_t)q * n, d);
+    }
+    gd = phgmg__dot(n, g, d);
+    if (!(gd < 0.0)) { nm = 0; continue; }   /* not a descent direction: restart */
+    for (ls = 0; ls < 40; ++ls, t *= 0.5) {
+      for (i = 0; i < n; ++i) xn[i] = x[i] + t * d[i];
+      fn = phgmg__h2gmg_eval(h, xn, gn);
+      if (fn <= f + 1e-4 * t * gd) break;
+    }
+    if (ls == 40) {
+      if (nm == 0 || ++fails > 1) break;
+      nm = 0;
+      continue;
+    }
+    fails = 0;
+    sy = 0.0;
+    for (i = 0; i < n; ++i) {
+      S[(size_t)head * n + i] = xn[i] - x[i];
+      Y[(size_t)head * n + i] = gn[i] - g[i];
+      sy += S[(size_t)head * n + i] * Y[(size_t)head * n + i];
+    }
+    if (sy > 0.0) {
+      rho[head] = 1.0 / sy;
+      head = (head + 1) % MEM;
+      if (nm < MEM) ++nm;
+    }
+    memcpy(x, xn, (size_t)n * sizeof(double));
+    memcpy(g, gn, (size_t)n * sizeof(double));
+    f = fn;
+  }
+  *f_out = f;
+  phgmg__free(alloc, g);
+  return PHGMG_OK;
+}
+
+/* PHGMG_BASIS_H2: start (opts->V0 or the BALANCED basis), L-BFGS, then the
+   Gram-Schmidt of [B, Vbar] in order (V: N x k). */
+PHGMG__PRIV phgmg_result phgmg__basis_h2(const phgmg_ph_system *sys, int k, const phgmg_basis_opts *opts,
+                                         double *V, const phgmg_allocator *alloc) {
+  const int N = sys->N, m = sys->m, maxit = opts && opts->maxit > 0 ? opts->maxit : 1000;
+  phgmg__h2gmg h;
+  double *M, f = HUGE_VAL;
+  phgmg_result rc;
+  M = phgmg__dalloc(alloc, (size_t)N * (m + k) + (size_t)N + 2 * (size_t)(m + k));
+  if (!M) return PHGMG_ERR_NOMEM;
+  if (opts && opts->V0) memcpy(M + (size_t)N * m, opts->V0, (size_t)N * k * sizeof(double));
+  rc = opts && opts->V0 ? PHGMG_OK
+                        : phgmg_linear_basis(sys, PHGMG_BASIS_BALANCED, k, NULL, M + (size_t)N * m, NULL, alloc);
+  if (rc == PHGMG_OK) rc = phgmg__h2gmg_init(&h, sys, k, alloc);
+  if (rc == PHGMG_OK) {
+    rc = phgmg__h2gmg_lbfgs(&h, M + (size_t)N * m, maxit, &f, alloc);
+    if (rc == PHGMG_ERR_SINGULAR && opts && opts->V0) {   /* V0 infeasible: the balanced start */
+      rc = phgmg_linear_basis(sys, PHGMG_BASIS_BALANCED, k, NULL, M + (size_t)N * m, NULL, alloc);
+      if (rc == PHGMG_OK) rc = phgmg__h2gmg_lbfgs(&h, M + (size_t)N * m, maxit, &f, alloc);
+    }
+    phgmg__h2gmg_free(&h, alloc);
+  }
+  if (rc == PHGMG_OK) {
+    double *tau = M + (size_t)N * (m + k);
+    memcpy(M, sys->B, (size_t)N * m * sizeof(double));
+    rc = phgmg_qr(N, m + k, M, N, tau);
+    if (rc == PHGMG_OK) {
+      phgmg_qr_form_q(N, m + k, M, N, tau, tau + (m + k));
+      memcpy(V, M + (size_t)N * m, (size_t)N * k * sizeof(double));
+    }
+  }
+  if (rc == PHGMG_OK && opts && opts->h2_rel) *opts->h2_rel = sqrt(f > 0.0 ? f : 0.0);
+  phgmg__free(alloc, M);
+  return rc;
+}
+
 PHGMG_DEF phgmg_result phgmg_linear_basis(const phgmg_ph_system *sys, phgmg_basis_kind kind, int k,
                                           const phgmg_basis_opts *opts, double *V, int *k_out,
                                           const phgmg_allocator *alloc) {
@@ -11651,14 +12206,18 @@ PHGMG_DEF phgmg_result phgmg_linear_basis(const phgmg_ph_system *sys, phgmg_basi
   double *X = NULL;
   phgmg_result rc;
   if (!sys || !V) return PHGMG_ERR_INVALID_ARG;
-  if (kind < PHGMG_BASIS_FREQ || kind > PHGMG_BASIS_BALANCED) return PHGMG_ERR_INVALID_ARG;
+  if (kind < PHGMG_BASIS_FREQ || kind > PHGMG_BASIS_H2) return PHGMG_ERR_INVALID_ARG;
+  if (opts && opts->maxit < 0) return PHGMG_ERR_INVALID_ARG;
   if (sys->nl != PHGMG_NL_NONE) return PHGMG_ERR_UNSUPPORTED;
   rc = phgmg_ph_validate(sys, 0.0, NULL, alloc);
   if (rc != PHGMG_OK) return rc;
   N = sys->N; m = sys->m;
   if (k < 1 || k > N - m) return PHGMG_ERR_SIZE;
   memset(V, 0, (size_t)N * k * sizeof(double));
-  if (kind == PHGMG_BASIS_BALANCED) {   /* QR of [B, T_k] in order */
+  if (kind == PHGMG_BASIS_H2) {
+    rc = phgmg__basis_h2(sys, k, opts, V, alloc);
+    kk = rc == PHGMG_OK ? k : 0;
+  } else if (kind == PHGMG_BASIS_BALANCED) {   /* QR of [B, T_k] in order */
     double *M = phgmg__dalloc(alloc, (size_t)N * (m + k) + (size_t)k * k + 2 * (size_t)m * k + 2 * (size_t)(m + k)), *tau;
     if (!M) return PHGMG_ERR_NOMEM;
     tau = M + (size_t)N * (m + k);

@@ -4,8 +4,11 @@
    100, one port; and the two-port chain of Gugercin, Polyuga, Beattie & van
    der Schaft 2012: N = 100, m_i = k_i = 4, c_i = 1, forces on masses 1 and
    2) it compares, for r = 4..20, GMG-POD trained on u = 0.1 sin t with GMG
-   on three input-independent bases (frequency-sampled, impulse responses,
-   balanced right basis; phgmg_linear_basis), balanced truncation (BT,
+   on four input-independent bases (frequency-sampled, impulse responses,
+   balanced right basis, and GMG-H2: for each r the basis whose GMG model has
+   the least H2 error found by L-BFGS, 120 (r - m) steps from the balanced
+   basis for r >= 12, 300 below, --h2-iters N for N steps; phgmg_linear_basis),
+   balanced truncation (BT,
    reference, not pH) and positive-real balanced truncation (PRBT, pH form,
    exact zero-feedthrough Gramians; PRBT-LTI: the same projection W^T A T,
    W^T B, C T without the pH form: with exact Gramians the output C T equals
@@ -22,7 +25,7 @@
    model: smallest eigenvalue of R relative to the largest, energy-balance
    error relative to max H over 1000 steps of the `mix` input), and an
    H-infinity / H2 error table on the terminal.
-   Usage: linear_bases [--out DIR] */
+   Usage: linear_bases [--out DIR] [--h2-iters N] */
 #define _POSIX_C_SOURCE 200809L
 #define PHGMG_IMPLEMENTATION
 #include "../phgmg.h"
@@ -30,12 +33,14 @@
 #include "demo_common.h"
 
 #define NIN 6
-#define NMETH 7
+#define NMETH 8
 #define RMAX 20
 static const char *in_name[NIN] = {"train_sin", "const", "sin3_alt", "chirp", "pulse", "mix"};
 static const char *meth_name[NMETH] = {"GMG-POD", "GMG-FREQ", "GMG-IMPULSE", "GMG-BAL", "BT", "PRBT",
-                                       "PRBT-LTI"};
-static const int meth_indep[NMETH] = {0, 1, 1, 1, 1, 1, 1};
+                                       "PRBT-LTI", "GMG-H2"};
+static const int meth_indep[NMETH] = {0, 1, 1, 1, 1, 1, 1, 1};
+static int g_h2_iters = 0;   /* --h2-iters N: L-BFGS steps of GMG-H2 per order r >= 12; 0: 120 per basis
+                                column, 120 (r - m) (300 steps below r = 12) */
 static int g_nosim;   /* 1: build the models only (H-inf table, Bode) */
 
 typedef struct { int m, which; } input_ctx;
@@ -92,6 +97,8 @@ typedef struct {
   const phgmg_ph_system *sys;
   double *X[NIN], *Y[NIN];   /* FOM trajectories and outputs */
   double *pod, *bas[3];      /* N x (N - m) columns (first RMAX used) */
+  double *h2[RMAX + 1];      /* GMG-H2: one basis per order r (N x (r - m)) */
+  double h2rel[RMAX + 1], h2time;
   double *T, *W, *A, *C;     /* BT bases (N x RMAX), full A, C */
   double *Xr, *Yr;           /* PRBT Riccati solutions */
 } study;
@@ -129,8 +136,8 @@ static void run_method(const study *S, int j, int r, double ey[NIN], double *Ar,
     phgmg_reduce_opts o;
     memset(&o, 0, sizeof o);
     o.method = PHGMG_METHOD_GMG_POD; o.r = r; o.dt = 0.1;
-    o.pod_basis = j == 0 ? S->pod : S->bas[j - 1]; o.pod_cols = RMAX;
-    rc = phgmg_reduce(&red, S->sys, S->X[0], N, 1001, &o, NULL, NULL);
+    o.pod_basis = j == 0 ? S->pod : j == 7 ? S->h2[r] : S->bas[j - 1]; o.pod_cols = j == 7 ? r - m : RMAX;
+    rc = o.pod_basis ? phgmg_reduce(&red, S->sys, S->X[0], N, 1001, &o, NULL, NULL) : PHGMG_ERR_INVALID_ARG;
   }
   if (red && j == 6) {   /* PRBT's projection (T, W) without the pH form: W^T A T, W^T B, C T */
     double *Tm = (double *)malloc(sizeof(double) * N * r * 2), *Wm = Tm + (size_t)N * r, e[RMAX];
@@ -171,6 +178,35 @@ static void run_method(const study *S, int j, int r, double ey[NIN], double *Ar,
   free(YR);
 }
 
+/* GMG-H2 bases for r = 4 .. RMAX, each from the balanced start with 120
+   L-BFGS steps per basis column for r >= 12 (the acceptance range; 1320 at r
+   = 12, 2280 at r = 20 on the paper's chain; --h2-iters N: N steps), 300 below
+   (phgmg_linear_basis, kind H2). With 1000 steps for every order the paper's
+   chain met issue 16's 10x target in 40-42 of 45 cases, with 80 per column
+   in 44. (Starting from
+   the order r - 1 optimum plus one balanced column was tried: at the same
+   iteration count it ended 2-3x higher in H2 error on the paper's chain.) */
+static void study_h2(study *S) {
+  const int N = S->sys->N, m = S->sys->m;
+  double t0 = demo_now();
+  int r;
+  for (r = 4; r <= RMAX; ++r) {
+    phgmg_basis_opts bo;
+    phgmg_result rc;
+    memset(&bo, 0, sizeof bo);
+    bo.maxit = r >= 12 ? (g_h2_iters > 0 ? g_h2_iters : 120 * (r - m)) : 300;
+    bo.h2_rel = &S->h2rel[r];
+    S->h2[r] = (double *)malloc(sizeof(double) * N * (r - m));
+    rc = phgmg_linear_basis(S->sys, PHGMG_BASIS_H2, r - m, &bo, S->h2[r], NULL, NULL);
+    if (rc != PHGMG_OK) {   /* reported; its rows get NaN and check_linear.py fails */
+      fprintf(stderr, "  [GMG-H2 basis r=%d: %s]\n", r, phgmg_result_string(rc));
+      free(S->h2[r]);
+      S->h2[r] = NULL;
+    }
+  }
+  S->h2time = demo_now() - t0;
+}
+
 static void study_setup(study *S, const phgmg_ph_system *sys) {
   const int N = sys->N, m = sys->m;
   double *x0 = (double *)calloc((size_t)N, sizeof(double)), hsv[RMAX], Ab[RMAX * RMAX], Bb[RMAX * 2], Cb[RMAX * 2];
@@ -199,6 +235,7 @@ static void study_setup(study *S, const phgmg_ph_system *sys) {
     rc = phgmg_linear_basis(sys, (phgmg_basis_kind)(PHGMG_BASIS_FREQ + k), RMAX, NULL, S->bas[k], NULL, NULL);
     if (rc != PHGMG_OK) demo_die("input-independent basis", rc);
   }
+  study_h2(S);
   S->T = (double *)malloc(sizeof(double) * N * RMAX);
   S->W = (double *)malloc(sizeof(double) * N * RMAX);
   S->A = (double *)malloc(sizeof(double) * N * N);
@@ -216,6 +253,7 @@ static void study_free(study *S) {
   int k;
   for (k = 0; k < NIN; ++k) { free(S->X[k]); free(S->Y[k]); }
   for (k = 0; k < 3; ++k) free(S->bas[k]);
+  for (k = 0; k <= RMAX; ++k) free(S->h2[k]);
   free(S->pod); free(S->T); free(S->W); free(S->A); free(S->C); free(S->Xr); free(S->Yr);
 }
 
@@ -241,8 +279,8 @@ static void structure_row(const study *S, int j, int r, FILE *f) {
     phgmg_reduce_opts o;
     memset(&o, 0, sizeof o);
     o.method = PHGMG_METHOD_GMG_POD; o.r = r; o.dt = 0.1;
-    o.pod_basis = j == 0 ? S->pod : S->bas[j - 1]; o.pod_cols = RMAX;
-    rc = phgmg_reduce(&red, S->sys, S->X[0], N, 1001, &o, NULL, NULL);
+    o.pod_basis = j == 0 ? S->pod : j == 7 ? S->h2[r] : S->bas[j - 1]; o.pod_cols = j == 7 ? r - m : RMAX;
+    rc = o.pod_basis ? phgmg_reduce(&red, S->sys, S->X[0], N, 1001, &o, NULL, NULL) : PHGMG_ERR_INVALID_ARG;
   }
   if (rc != PHGMG_OK) { phgmg_reduced_destroy(red); return; }
   {
@@ -306,7 +344,8 @@ int main(int argc, char **argv) {
   int i, sysk;
   for (i = 1; i < argc; ++i) {
     if (!strcmp(argv[i], "--out") && i + 1 < argc) out = argv[++i];
-    else { fprintf(stderr, "usage: %s [--out DIR]\n", argv[0]); return 2; }
+    else if (!strcmp(argv[i], "--h2-iters") && i + 1 < argc) g_h2_iters = atoi(argv[++i]);
+    else { fprintf(stderr, "usage: %s [--out DIR] [--h2-iters N]\n", argv[0]); return 2; }
   }
   demo_mkdir(out);
   for (i = 0; i < 50; ++i) { m2[i] = 4.0; k2[i] = 4.0; c2[i] = 1.0; }
@@ -324,6 +363,9 @@ int main(int argc, char **argv) {
     const char *sname = sysk ? "two_port_chain" : "paper_chain";
     int r, j, in;
     study_setup(&S, sys);
+    printf("\n%s: GMG-H2 bases (r = 4..%d; L-BFGS steps for r >= 12: %s) in %.2f s; ||G - G_r||_H2 / ||G||_H2 at "
+           "r = 12, 16, 20: %.2e, %.2e, %.2e\n", sname, RMAX, g_h2_iters > 0 ? "--h2-iters" : "120 (r - m)", S.h2time, S.h2rel[12],
+           S.h2rel[16], S.h2rel[20]);
     printf("\n%s (N = %d, m = %d): e_y on the unseen input sin3_alt / worst unseen input\n  r", sname, sys->N, sys->m);
     for (j = 0; j < NMETH; ++j) printf("  %-21s", meth_name[j]);
     printf("\n");

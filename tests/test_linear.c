@@ -325,6 +325,173 @@ TEST(test_bad_arguments) {
   CHECK_RC(phgmg_care(0, &x, &x, &x, Ar, NULL, NULL), PHGMG_ERR_SIZE);
 }
 
+/* The complex Schur form of a non-normal real matrix with known eigenvalues:
+   A = H D H (H a Householder reflection), D block upper triangular with the
+   2 x 2 blocks [a b; -b a] (eigenvalues a +- i b) and two real entries. */
+TEST(test_zschur_known_eigenvalues) {
+  enum { n = 10 };
+  static const double ab[4][2] = {{-1.0, 2.0}, {-0.5, 0.3}, {0.2, 1.0}, {-2.0, 1e-3}};
+  const double ev[n][2] = {{-1.0, 2.0}, {-1.0, -2.0}, {-0.5, 0.3}, {-0.5, -0.3}, {0.2, 1.0}, {0.2, -1.0},
+                           {-2.0, 1e-3}, {-2.0, -1e-3}, {3.0, 0.0}, {-4.0, 0.0}};
+  double D[n * n], Hh[n * n], A[n * n], W[n * n], T[2 * n * n], Z[2 * n * n], ZT[2 * n * n], R[2 * n * n], w[n],
+      work[3 * n], wtw = 0.0, an;
+  int i, j, b, l, used[n];
+  memset(D, 0, sizeof D);
+  for (b = 0; b < 4; ++b) {
+    D[2 * b + 2 * b * n] = D[2 * b + 1 + (2 * b + 1) * n] = ab[b][0];
+    D[2 * b + (2 * b + 1) * n] = ab[b][1]; D[2 * b + 1 + 2 * b * n] = -ab[b][1];
+  }
+  D[8 + 8 * n] = 3.0; D[9 + 9 * n] = -4.0;
+  for (j = 0; j < n; ++j)   /* non-normal: entries above the blocks */
+    for (i = 0; i < j; ++i) if (D[i + j * n] == 0.0 && (i / 2 != j / 2)) D[i + j * n] = 0.5 * (i + 1) - 0.25 * j;
+  for (i = 0; i < n; ++i) { w[i] = i + 1.0; wtw += w[i] * w[i]; }
+  for (j = 0; j < n; ++j)
+    for (i = 0; i < n; ++i) Hh[i + j * n] = (i == j ? 1.0 : 0.0) - 2.0 * w[i] * w[j] / wtw;
+  phgmg_gemm('N', 'N', n, n, n, 1.0, Hh, n, D, n, 0.0, W, n);
+  phgmg_gemm('N', 'N', n, n, n, 1.0, W, n, Hh, n, 0.0, A, n);
+  an = phgmg_normf(n, n, A, n);
+  CHECK_RC(phgmg__zschur(n, A, n, T, Z, work), PHGMG_OK);
+  for (j = 0; j < n; ++j)
+    for (i = j + 1; i < n; ++i) CHECK(T[2 * (i + j * n)] == 0.0 && T[2 * (i + j * n) + 1] == 0.0);
+  phgmg__zgemm('N', 'N', n, n, n, Z, n, T, n, ZT, n);   /* Z T Z^H - A */
+  phgmg__zgemm('N', 'C', n, n, n, ZT, n, Z, n, R, n);
+  for (i = 0; i < n * n; ++i) CHECK_LE(hypot(R[2 * i] - A[i], R[2 * i + 1]), 1e-13 * an);
+  phgmg__zgemm('C', 'N', n, n, n, Z, n, Z, n, R, n);    /* Z^H Z - I */
+  for (j = 0; j < n; ++j)
+    for (i = 0; i < n; ++i) CHECK_LE(hypot(R[2 * (i + j * n)] - (i == j), R[2 * (i + j * n) + 1]), 1e-13);
+  for (i = 0; i < n; ++i) used[i] = 0;
+  for (l = 0; l < n; ++l) {   /* every eigenvalue once on the diagonal */
+    int best = -1;
+    double dmin = HUGE_VAL;
+    for (i = 0; i < n; ++i) {
+      const double d = hypot(T[2 * (i + i * n)] - ev[l][0], T[2 * (i + i * n) + 1] - ev[l][1]);
+      if (!used[i] && d < dmin) { dmin = d; best = i; }
+    }
+    CHECK_LE(dmin, 1e-12 * an);
+    if (best >= 0) used[best] = 1;
+  }
+}
+
+/* Triangular Sylvester equations, both modes, against the products. */
+TEST(test_ztrsyl_residual) {
+  enum { n = 7, k = 4 };
+  double T[2 * n * n], S[2 * k * k], F[2 * n * k], X[2 * n * k], P[2 * n * k], Q[2 * n * k];
+  int i, j, mode;
+  memset(T, 0, sizeof T); memset(S, 0, sizeof S);
+  for (j = 0; j < n; ++j)
+    for (i = 0; i <= j; ++i) {
+      T[2 * (i + j * n)] = i == j ? -1.0 - 0.1 * i : 0.3 * (i + 1) - 0.2 * j;
+      T[2 * (i + j * n) + 1] = i == j ? 0.5 * i : 0.1 * (j - i);
+    }
+  for (j = 0; j < k; ++j)
+    for (i = 0; i <= j; ++i) {
+      S[2 * (i + j * k)] = i == j ? -0.5 - j : 0.7 - 0.1 * i;
+      S[2 * (i + j * k) + 1] = i == j ? 1.0 - j : -0.2 * j;
+    }
+  for (i = 0; i < 2 * n * k; ++i) F[i] = sin(1.0 + i);
+  for (mode = 0; mode < 2; ++mode) {
+    memcpy(X, F, sizeof X);
+    CHECK_RC(phgmg__ztrsyl(mode, n, T, k, S, X), PHGMG_OK);
+    if (mode == 0) { phgmg__zgemm('N', 'N', n, k, n, T, n, X, n, P, n); phgmg__zgemm('N', 'C', n, k, k, X, n, S, k, Q, n); }
+    else { phgmg__zgemm('C', 'N', n, k, n, T, n, X, n, P, n); phgmg__zgemm('N', 'N', n, k, k, X, n, S, k, Q, n); }
+    for (i = 0; i < 2 * n * k; ++i) CHECK_LE(fabs(P[i] + Q[i] - F[i]), 1e-13);
+  }
+  T[2 * (3 + 3 * n)] = -S[2 * (1 + 1 * k)]; T[2 * (3 + 3 * n) + 1] = S[2 * (1 + 1 * k) + 1];   /* t_33 + conj(s_11) = 0 */
+  memcpy(X, F, sizeof X);
+  CHECK_RC(phgmg__ztrsyl(0, n, T, k, S, X), PHGMG_ERR_SINGULAR);
+}
+
+/* The GMG model of V = [B, Vbar] computed directly: G = (J - R)^-1 by a dense
+   inverse, Ar = (V^T G V)^-1 V^T Q V, Br = (V^T G V)^-1 V^T G B, Cr = B^T Q V;
+   then its relative H2 error by phgmg_ss_error (a Lyapunov equation of size N + r). */
+static double h2_direct(int k, const double *Vbar) {
+  enum { N = CH_N, m = 2 };
+  static double JR[N * N], G[N * N], V[N * 22], GV[N * 22], QV[N * 22], A[N * N], C[m * N];
+  double M[22 * 22], Ar[22 * 22], Br[22 * m], Cr[m * 22], h2 = NAN, h2r = NAN;
+  int ip[N], ip2[22], i, j;
+  const int r = m + k;
+  phgmg_ph_system s = chain2();
+  for (i = 0; i < N * N; ++i) { JR[i] = chJ[i] - chR[i]; G[i] = 0.0; }
+  for (i = 0; i < N; ++i) G[i + i * N] = 1.0;
+  if (phgmg_lu_factor(N, JR, N, ip) != PHGMG_OK) return NAN;
+  phgmg_lu_solve('N', N, JR, N, ip, N, G, N);
+  memcpy(V, chB, sizeof(double) * N * m);
+  memcpy(V + N * m, Vbar, sizeof(double) * N * k);
+  phgmg_gemm('N', 'N', N, r, N, 1.0, G, N, V, N, 0.0, GV, N);
+  phgmg_gemm('N', 'N', N, r, N, 1.0, chQ, N, V, N, 0.0, QV, N);
+  phgmg_gemm('T', 'N', r, r, N, 1.0, V, N, GV, N, 0.0, M, r);
+  phgmg_gemm('T', 'N', r, r, N, 1.0, V, N, QV, N, 0.0, Ar, r);
+  phgmg_gemm('T', 'N', r, m, N, 1.0, V, N, GV, N, 0.0, Br, r);   /* V^T G B: B = the first m columns of V */
+  for (j = 0; j < r; ++j)
+    for (i = 0; i < m; ++i) Cr[i + j * m] = QV[i == 0 ? 1 + j * N : 3 + j * N];   /* B^T Q V: rows 1, 3 */
+  if (phgmg_lu_factor(r, M, r, ip2) != PHGMG_OK) return NAN;
+  phgmg_lu_solve('N', r, M, r, ip2, r, Ar, r);
+  phgmg_lu_solve('N', r, M, r, ip2, m, Br, r);
+  if (phgmg_ph_abc(&s, A, C, NULL) != PHGMG_OK) return NAN;
+  if (phgmg_ss_error(N, A, chB, C, r, Ar, Br, Cr, m, m, 1, 1.0, 1.0, NULL, NULL, &h2, &h2r, NULL) != PHGMG_OK)
+    return NAN;
+  return h2 / h2r;
+}
+
+/* The H2 objective of PHGMG_BASIS_H2 and its gradient against independent
+   computations (direct GMG model + Lyapunov; central differences). */
+TEST(test_h2_objective_gradient) {
+  enum { k = 10 };
+  phgmg_ph_system s = chain2();
+  static double V[CH_N * k], g[CH_N * k], d[CH_N * k], Xp[CH_N * k];
+  phgmg__h2gmg h;
+  double f, e, fp, fm, gd = 0.0;
+  int i;
+  CHECK_RC(phgmg_linear_basis(&s, PHGMG_BASIS_BALANCED, k, NULL, V, NULL, NULL), PHGMG_OK);
+  CHECK_RC(phgmg__h2gmg_init(&h, &s, k, NULL), PHGMG_OK);
+  f = phgmg__h2gmg_eval(&h, V, g);
+  e = h2_direct(k, V);
+  CHECK_LE(fabs(sqrt(f) - e), 1e-7 * e);
+  for (i = 0; i < CH_N * k; ++i) { d[i] = sin(0.7 * i + 0.1); gd += g[i] * d[i]; }
+  for (i = 0; i < CH_N * k; ++i) Xp[i] = V[i] + 1e-6 * d[i];
+  fp = phgmg__h2gmg_eval(&h, Xp, NULL);
+  for (i = 0; i < CH_N * k; ++i) Xp[i] = V[i] - 1e-6 * d[i];
+  fm = phgmg__h2gmg_eval(&h, Xp, NULL);
+  CHECK_LE(fabs((fp - fm) / 2e-6 - gd), 1e-5 * fabs(gd));
+  for (i = 0; i < CH_N * k; ++i) d[i] = V[i];   /* same span, other coordinates: same f */
+  for (i = 0; i < CH_N; ++i) { d[i] = 2.0 * V[i] + V[i + CH_N] + 0.5 * chB[i]; }
+  CHECK_LE(fabs(phgmg__h2gmg_eval(&h, d, NULL) - f), 1e-9 * f);
+  phgmg__h2gmg_free(&h, NULL);
+}
+
+/* PHGMG_BASIS_H2: orthonormal, orthogonal to B, its reported H2 error is the
+   direct one, and below the balanced start's; bad arguments. */
+TEST(test_h2_basis) {
+  enum { k = 10 };
+  phgmg_ph_system s = chain2();
+  static double V[CH_N * k], V0[CH_N * k];
+  double Gm[k * k], BV[2 * k], h2 = NAN, e0;
+  phgmg_basis_opts bo;
+  int i, j, kk = 0;
+  CHECK_RC(phgmg_linear_basis(&s, PHGMG_BASIS_BALANCED, k, NULL, V0, NULL, NULL), PHGMG_OK);
+  e0 = h2_direct(k, V0);
+  memset(&bo, 0, sizeof bo);
+  bo.maxit = 100; bo.h2_rel = &h2;
+  CHECK_RC(phgmg_linear_basis(&s, PHGMG_BASIS_H2, k, &bo, V, &kk, NULL), PHGMG_OK);
+  CHECK(kk == k);
+  phgmg_gemm('T', 'N', k, k, CH_N, 1.0, V, CH_N, V, CH_N, 0.0, Gm, k);
+  phgmg_gemm('T', 'N', 2, k, CH_N, 1.0, chB, CH_N, V, CH_N, 0.0, BV, 2);
+  for (j = 0; j < k; ++j)
+    for (i = 0; i < k; ++i) CHECK_LE(fabs(Gm[i + j * k] - (i == j ? 1.0 : 0.0)), 1e-12);
+  for (i = 0; i < 2 * k; ++i) CHECK_LE(fabs(BV[i]), 1e-12);
+  CHECK_LE(fabs(h2 - h2_direct(k, V)), 1e-6 * h2);
+  CHECK(h2 < e0);
+  memset(V0, 0, sizeof V0);   /* an infeasible start (V^T G V singular): the balanced start instead */
+  bo.V0 = V0; bo.maxit = 5;
+  CHECK_RC(phgmg_linear_basis(&s, PHGMG_BASIS_H2, k, &bo, V, NULL, NULL), PHGMG_OK);
+  bo.V0 = NULL; bo.maxit = -1;
+  CHECK_RC(phgmg_linear_basis(&s, PHGMG_BASIS_H2, k, &bo, V, NULL, NULL), PHGMG_ERR_INVALID_ARG);
+  bo.maxit = 5;   /* r = 3 with two force ports: V^T G V is singular for every V (B^T G B = 0) */
+  CHECK_RC(phgmg_linear_basis(&s, PHGMG_BASIS_H2, 1, &bo, V, NULL, NULL), PHGMG_ERR_SINGULAR);
+  CHECK_RC(phgmg_linear_basis(&s, PHGMG_BASIS_H2, CH_N - 1, &bo, V, NULL, NULL), PHGMG_ERR_SIZE);
+  CHECK_RC(phgmg_linear_basis(&s, PHGMG_BASIS_H2, k, &bo, NULL, NULL, NULL), PHGMG_ERR_INVALID_ARG);
+}
+
 SUITE(linear) {
   RUN(test_bad_arguments);
   RUN(test_lyap_closed_form_and_residual);
@@ -333,4 +500,8 @@ SUITE(linear) {
   RUN(test_prbt_structure_energy_export);
   RUN(test_prbt_zero_feedthrough_limit);
   RUN(test_bases_orthonormal_to_b);
+  RUN(test_zschur_known_eigenvalues);
+  RUN(test_ztrsyl_residual);
+  RUN(test_h2_objective_gradient);
+  RUN(test_h2_basis);
 }
