@@ -5,7 +5,7 @@
 #
 # 1. prints the machine line (CPU model, cores, compiler and flags, load);
 # 2. builds bench/bench_linalg.c, bench/bench_fom.c, bench/bench_rom.c,
-#    bench/bench_linear.c (lyap_N1000, prbt_N1000_r20: about a minute),
+#    bench/bench_linear.c (lyap_N1000, prbt_N1000_r20, h2basis_N1000_r20_20it: about a minute and a half),
 #    bench/bench_scale.c (offline_gmgpod_N256000: the whole reduction of the
 #    nonlinear chain at N = 256 000, 3 runs after a ~30 s full-order run for
 #    the snapshots; about 2 minutes and 5 GB of memory) into
