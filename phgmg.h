@@ -9996,21 +9996,53 @@ PHGMG__PRIV phgmg_result phgmg__hyper_ecsw_manifold(phgmg__rctx *c, const double
    weights w >= 0 that reproduce the reduced gradient of the nonlinear part
    over the training snapshots to hyper_tol (phgmg_ecsw). With w >= 0 and a
    convex phi the reduced Hamiltonian stays convex and bounded below. */
-PHGMG__PRIV phgmg_result phgmg__hyper_ecsw(phgmg__rctx *c, const double *F, int *pts, double *wt, int *nd) {
+/* ECSW of a linear-kind model on the terms live[0..nl) (F: nl x ns, their
+   gradients at the snapshots); pts come back as full term indices. */
+PHGMG__PRIV phgmg_result phgmg__hyper_ecsw(phgmg__rctx *c, const double *F, int nl, const int *live, int *pts,
+                                          double *wt, int *nd) {
   const phgmg_reduced *red = c->red;
-  const int nt = c->sys->nsep, r = red->r, N = red->N;
-  double *Vt;
+  const int r = red->r, N = red->N;
+  double *Vt, *sw;
   int k, a;
   phgmg_result rc;
-  if (red->kind == PHGMG_ROM_QUADRATIC) return phgmg__hyper_ecsw_manifold(c, F, pts, wt, nd);
-  Vt = phgmg__dalloc(c->alloc, (size_t)nt * r);   /* rows of V0 at the terms */
+  Vt = phgmg__dalloc(c->alloc, (size_t)nl * (r + 1));   /* rows of V0 at the terms, weights */
   if (!Vt) return PHGMG_ERR_NOMEM;
+  sw = Vt + (size_t)nl * r;
   for (a = 0; a < r; ++a)
-    for (k = 0; k < nt; ++k) Vt[k + (size_t)a * nt] = red->V0[c->sys->sep_idx[k] + (size_t)a * N];
-  rc = phgmg_ecsw_separable(nt, c->ns, F, nt, r, Vt, nt, c->sys->sep_w, c->o->hyper_tol, pts, wt, nd,
+    for (k = 0; k < nl; ++k) Vt[k + (size_t)a * nl] = red->V0[c->sys->sep_idx[live[k]] + (size_t)a * N];
+  for (k = 0; k < nl; ++k) sw[k] = c->sys->sep_w ? c->sys->sep_w[live[k]] : 1.0;
+  rc = phgmg_ecsw_separable(nl, c->ns, F, nl, r, Vt, nl, sw, c->o->hyper_tol, pts, wt, nd,
                             &c->inf.hyper_residual, c->alloc);
+  for (k = 0; rc == PHGMG_OK && k < *nd; ++k) pts[k] = live[pts[k]];   /* ascending stays ascending */
   phgmg__free(c->alloc, Vt);
   return rc;
+}
+
+/* The terms' gradients phi_k'(x_i[idx_k]) at the snapshots into a new F
+   (nl x ns) for the terms live[0..nl). For ECSW on a linear-kind model
+   (compact = 1) only the terms whose gradient is not zero at every snapshot
+   are live: a zero column of the fit is never chosen, and in a large model
+   driven locally most terms stay at rest (argument 0, phi'(0) = 0), so F
+   shrinks from nsep rows to the moving ones. Otherwise every term is live. */
+PHGMG__PRIV phgmg_result phgmg__separable_gradients(phgmg__rctx *c, int compact, double **Fo, int **liveo, int *nlo) {
+  const phgmg_ph_system *sys = c->sys;
+  const int nt = sys->nsep, ns = c->ns;
+  int *live = phgmg__ialloc(c->alloc, (size_t)nt), nl = 0, a, i;
+  double *F;
+  if (!live) return PHGMG_ERR_NOMEM;
+  for (a = 0; a < nt; ++a) live[a] = !compact || phgmg__ph_phi(sys, a, 0.0, 1) != 0.0;
+  for (i = 0; compact && i < ns; ++i) {
+    const double *x = c->X + (size_t)i * c->ldx;
+    for (a = 0; a < nt; ++a) live[a] |= x[sys->sep_idx[a]] != 0.0;
+  }
+  for (a = 0; a < nt; ++a) if (live[a]) live[nl++] = a;   /* in place: nl <= a */
+  F = phgmg__dalloc(c->alloc, (size_t)(nl ? nl : 1) * ns);
+  if (!F) { phgmg__free(c->alloc, live); return PHGMG_ERR_NOMEM; }
+  for (i = 0; i < ns; ++i)
+    for (a = 0; a < nl; ++a)
+      F[a + (size_t)i * nl] = phgmg__ph_phi(sys, live[a], c->X[sys->sep_idx[live[a]] + (size_t)i * c->ldx], 1);
+  *Fo = F; *liveo = live; *nlo = nl;
+  return PHGMG_OK;
 }
 
 /* Points and weights of the separable sum: the caller's (opts.deim_pts),
@@ -10020,7 +10052,7 @@ PHGMG__PRIV phgmg_result phgmg__separable_points(phgmg__rctx *c, int *pts, doubl
   const phgmg_ph_system *sys = c->sys;
   const phgmg_reduce_opts *o = c->o;
   const int nt = sys->nsep, ns = c->ns;
-  int a, i, nneg = 0;
+  int a, nneg = 0;
   phgmg_result rc = PHGMG_OK;
   if (o->deim && o->deim_pts && o->deim_w) {
     if (o->deim_count < 1 || o->deim_count > nt) return PHGMG_ERR_SIZE;
@@ -10033,18 +10065,23 @@ PHGMG__PRIV phgmg_result phgmg__separable_points(phgmg__rctx *c, int *pts, doubl
     }
     if (!phgmg__all_finite(wt, (size_t)*nd)) return PHGMG_ERR_NANINF;
   } else if (o->deim) {
-    double *F = phgmg__dalloc(c->alloc, (size_t)nt * ns);
-    if (!F) return PHGMG_ERR_NOMEM;
-    for (i = 0; i < ns; ++i)
-      for (a = 0; a < nt; ++a)
-        F[a + (size_t)i * nt] = phgmg__ph_phi(sys, a, c->X[sys->sep_idx[a] + (size_t)i * c->ldx], 1);
-    if (o->hyper == PHGMG_HYPER_ECSW)
-      rc = phgmg__hyper_ecsw(c, F, pts, wt, nd);
+    const int ecsw = o->hyper == PHGMG_HYPER_ECSW, quad = c->red->kind == PHGMG_ROM_QUADRATIC;
+    double *F = NULL;
+    int *live = NULL, nl = 0;
+    rc = phgmg__separable_gradients(c, ecsw && !quad, &F, &live, &nl);
+    if (rc != PHGMG_OK) return rc;
+    if (ecsw && quad)
+      rc = phgmg__hyper_ecsw_manifold(c, F, pts, wt, nd);
+    else if (ecsw && nl == 0)
+      *nd = 0;   /* no term ever moves: nothing to keep */
+    else if (ecsw)
+      rc = phgmg__hyper_ecsw(c, F, nl, live, pts, wt, nd);
     else
       rc = phgmg_deim_select(nt, ns, F, nt, sys->sep_w, o->deim_tol, o->deim_max,
                              o->hyper == PHGMG_HYPER_GREEDY ? PHGMG_DEIM_GREEDY : PHGMG_DEIM_QDEIM,
                              pts, wt, nd, &nneg, &c->inf.deim_sigma_ratio, c->alloc);
     phgmg__free(c->alloc, F);
+    phgmg__free(c->alloc, live);
     c->inf.hyper_method = o->hyper;
   } else {
     *nd = nt;
