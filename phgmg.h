@@ -9951,11 +9951,12 @@ PHGMG__PRIV phgmg_result phgmg__stage_quadratic_terms(phgmg__rctx *c) {
    phi_k'(x_i[idx_k]) Dphi(rho(x_i))[idx_k, a] over the snapshots (every
    `stride`-th, so that it holds at most 4e6 entries), target = its columns
    times the terms' weights. */
-PHGMG__PRIV phgmg_result phgmg__hyper_ecsw_manifold(phgmg__rctx *c, const double *F, int *pts, double *wt, int *nd) {
+PHGMG__PRIV phgmg_result phgmg__hyper_ecsw_manifold(phgmg__rctx *c, const double *F, int nt, const int *live,
+                                                   int *pts, double *wt, int *nd) {
   const phgmg_reduced *red = c->red;
   const phgmg_ph_system *sys = c->sys;
-  const int nt = sys->nsep, r = red->r, m = red->m, p = red->p, rn = red->rn, N = red->N;
-  const int stride = (int)(((double)c->ns * r * nt) / 4e6) + 1, nsu = (c->ns + stride - 1) / stride;
+  const int r = red->r, m = red->m, p = red->p, rn = red->rn, N = red->N;
+  const int stride = (int)(((double)c->ns * r * sys->nsep) / 4e6) + 1, nsu = (c->ns + stride - 1) / stride;
   const size_t nrow = (size_t)nsu * r;
   double *Gm = phgmg__dalloc(c->alloc, nrow * nt + nrow + nrow + (size_t)rn * p);
   double *tg, *XR, *Dq;
@@ -9971,7 +9972,7 @@ PHGMG__PRIV phgmg_result phgmg__hyper_ecsw_manifold(phgmg__rctx *c, const double
     i = u * stride;
     phgmg__eta_d(red, XR + (size_t)u * r + m, NULL, Dq, NULL, red->rwork);
     for (k = 0; k < nt; ++k) {
-      const int ix = sys->sep_idx[k];
+      const int ix = sys->sep_idx[live[k]];
       const double f = F[k + (size_t)i * nt];
       double *g = Gm + (size_t)u * r + (size_t)k * nrow;
       for (a = 0; a < r; ++a) g[a] = f * red->V0[ix + (size_t)a * N];
@@ -9984,10 +9985,11 @@ PHGMG__PRIV phgmg_result phgmg__hyper_ecsw_manifold(phgmg__rctx *c, const double
   }
   for (a = 0; a < (int)nrow; ++a) tg[a] = 0.0;
   for (k = 0; k < nt; ++k) {
-    const double sw = sys->sep_w ? sys->sep_w[k] : 1.0;
+    const double sw = sys->sep_w ? sys->sep_w[live[k]] : 1.0;
     for (a = 0; a < (int)nrow; ++a) tg[a] += sw * Gm[a + (size_t)k * nrow];
   }
   rc = phgmg_ecsw(nt, (int)nrow, Gm, (int)nrow, tg, c->o->hyper_tol, pts, wt, nd, &c->inf.hyper_residual, c->alloc);
+  for (k = 0; rc == PHGMG_OK && k < *nd; ++k) pts[k] = live[pts[k]];   /* ascending stays ascending */
   phgmg__free(c->alloc, Gm);
   return rc;
 }
@@ -9995,8 +9997,8 @@ PHGMG__PRIV phgmg_result phgmg__hyper_ecsw_manifold(phgmg__rctx *c, const double
 /* Hyper-reduction by empirical quadrature (ECSW, opts.hyper = 0): terms and
    weights w >= 0 that reproduce the reduced gradient of the nonlinear part
    over the training snapshots to hyper_tol (phgmg_ecsw). With w >= 0 and a
-   convex phi the reduced Hamiltonian stays convex and bounded below. */
-/* ECSW of a linear-kind model on the terms live[0..nl) (F: nl x ns, their
+   convex phi the reduced Hamiltonian stays convex and bounded below. Here
+   for a linear-kind model, on the terms live[0..nl) (F: nl x ns, their
    gradients at the snapshots); pts come back as full term indices. */
 PHGMG__PRIV phgmg_result phgmg__hyper_ecsw(phgmg__rctx *c, const double *F, int nl, const int *live, int *pts,
                                           double *wt, int *nd) {
@@ -10019,9 +10021,8 @@ PHGMG__PRIV phgmg_result phgmg__hyper_ecsw(phgmg__rctx *c, const double *F, int 
 }
 
 /* The terms' gradients phi_k'(x_i[idx_k]) at the snapshots into a new F
-   (nl x ns) for the terms live[0..nl). For ECSW on a linear-kind model
-   (compact = 1) only the terms whose gradient is not zero at every snapshot
-   are live: a zero column of the fit is never chosen, and in a large model
+   (nl x ns) for the terms live[0..nl). For ECSW (compact = 1) only the
+   terms whose gradient is not zero at every snapshot are live: a zero column of the fit is never chosen, and in a large model
    driven locally most terms stay at rest (argument 0, phi'(0) = 0), so F
    shrinks from nsep rows to the moving ones. Otherwise every term is live. */
 PHGMG__PRIV phgmg_result phgmg__separable_gradients(phgmg__rctx *c, int compact, double **Fo, int **liveo, int *nlo) {
@@ -10068,12 +10069,12 @@ PHGMG__PRIV phgmg_result phgmg__separable_points(phgmg__rctx *c, int *pts, doubl
     const int ecsw = o->hyper == PHGMG_HYPER_ECSW, quad = c->red->kind == PHGMG_ROM_QUADRATIC;
     double *F = NULL;
     int *live = NULL, nl = 0;
-    rc = phgmg__separable_gradients(c, ecsw && !quad, &F, &live, &nl);
+    rc = phgmg__separable_gradients(c, ecsw, &F, &live, &nl);
     if (rc != PHGMG_OK) return rc;
-    if (ecsw && quad)
-      rc = phgmg__hyper_ecsw_manifold(c, F, pts, wt, nd);
-    else if (ecsw && nl == 0)
+    if (ecsw && nl == 0)
       *nd = 0;   /* no term ever moves: nothing to keep */
+    else if (ecsw && quad)
+      rc = phgmg__hyper_ecsw_manifold(c, F, nl, live, pts, wt, nd);
     else if (ecsw)
       rc = phgmg__hyper_ecsw(c, F, nl, live, pts, wt, nd);
     else

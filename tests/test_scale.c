@@ -295,8 +295,63 @@ TEST(test_reduce_ecsw_skips_resting_terms) {
   msd_nonlinear_free(&M);
 }
 
+/* The same for GMG-QM (ECSW of the manifold's training rows): the chain with
+   its terms in the given order and in reverse is one model, so both fits keep
+   the same springs with the same weights -- the reversed one only through
+   the map back from the moving terms (its moving terms are the last ones). */
+TEST(test_reduce_ecsw_qm_skips_resting_terms) {
+  msd_nonlinear M;
+  msd_nl_opts mo;
+  phgmg_gl3_opts go;
+  phgmg_reduce_opts o;
+  phgmg_reduced *red[2] = {NULL, NULL};
+  const int ns = 41;
+  double *X, *x0;
+  int N, nt, k, v, *ridx;
+  phgmg_ph_system sys[2];
+  memset(&mo, 0, sizeof mo);
+  mo.n = 200;
+  mo.storage = PHGMG_BANDED;
+  CHECK(msd_nonlinear_build(&M, &mo) == 0);
+  N = M.sys.N;
+  nt = M.sys.nsep;
+  ridx = (int *)malloc(sizeof(int) * (size_t)nt);
+  for (k = 0; k < nt; ++k) ridx[k] = M.sys.sep_idx[nt - 1 - k];
+  sys[0] = sys[1] = M.sys;
+  sys[1].sep_idx = ridx;
+  X = (double *)malloc(sizeof(double) * (size_t)N * ns);
+  x0 = (double *)calloc((size_t)N, sizeof(double));
+  memset(&go, 0, sizeof go);
+  go.tol = 1e-10;
+  CHECK_RC(phgmg_simulate(&M.sys, x0, 0.0, 0.1, ns - 1, msd_input_sin, NULL, &go, X, NULL, NULL, NULL, NULL, NULL),
+           PHGMG_OK);
+  for (v = 0; v < 2; ++v) {
+    memset(&o, 0, sizeof o);
+    o.method = PHGMG_METHOD_GMG_QM;
+    o.r = 8;
+    o.rn = 4;
+    o.deim = 1;
+    CHECK_RC(phgmg_reduce(&red[v], &sys[v], X, N, ns, &o, NULL, NULL), PHGMG_OK);
+  }
+  if (red[0] && red[1]) {
+    const phgmg_rom *a = phgmg_reduced_rom(red[0]), *b = phgmg_reduced_rom(red[1]);
+    CHECK(a->nd == b->nd && a->nd > 0);
+    CHECK(red[0]->term[a->nd - 1] < nt / 2);   /* the premise: the moving springs are the first ones */
+    for (k = 0; k < a->nd && a->nd == b->nd; ++k) {
+      const int kb = b->nd - 1 - k;             /* reversed listing, ascending order */
+      CHECK(red[1]->term[kb] == nt - 1 - red[0]->term[k]);
+      CHECK_LE(fabs((double)b->w[kb] - (double)a->w[k]), 1e-8 * fabs((double)a->w[k]));
+    }
+  }
+  phgmg_reduced_destroy(red[0]);
+  phgmg_reduced_destroy(red[1]);
+  free(X); free(x0); free(ridx);
+  msd_nonlinear_free(&M);
+}
+
 SUITE(scale) {
   RUN(test_reduce_ecsw_skips_resting_terms);
+  RUN(test_reduce_ecsw_qm_skips_resting_terms);
   RUN(test_ecsw_screened_separable);
   RUN(test_ecsw_screened_optimal);
   RUN(test_reduce_pod_randomized_and_fallback);
