@@ -12020,6 +12020,20 @@ PHGMG__PRIV void phgmg__zcongr(int r, const double *Z, const double *Y, double *
   for (i = 0; i < r * r; ++i) P[i] = w[2 * r * r + 2 * i];
 }
 
+/* A Gramian of the reduced model in Ar's Schur coordinates: Re(Z Y Z^H)
+   into out, where S Y + Y S^H = -F^H F (mode 0; the transposed equation for
+   mode 1, as phgmg__ztrsyl) and F is m x r complex (ld ldf). Ys: 2 r^2. */
+PHGMG__PRIV phgmg_result phgmg__h2gmg_small_gram(int mode, int r, int m, const double *S, const double *Z,
+                                                 const double *F, int ldf, double *Ys, double *out, double *w4) {
+  phgmg_result rc;
+  int i;
+  phgmg__zgemm('C', 'N', r, r, m, F, ldf, F, ldf, Ys, r);
+  for (i = 0; i < 2 * r * r; ++i) Ys[i] = -Ys[i];
+  rc = phgmg__ztrsyl(mode, r, S, r, S, Ys);
+  if (rc == PHGMG_OK) phgmg__zcongr(r, Z, Ys, out, w4);
+  return rc;
+}
+
 /* The Gramian blocks of the error system G - G_r for the reduced (Ar, Br =
    [I; 0], Cr) with Ar = Z S Z^H: P12 = U Yp Z^H (A P12 + P12 Ar^T + B Br^T
    = 0), Q12 = U Yq Z^H (A^T Q12 + Q12 Ar = C^T Cr), Pr, Qr; returned as
@@ -12035,11 +12049,8 @@ PHGMG__PRIV phgmg_result phgmg__h2gmg_gram(const phgmg__h2gmg *h, const double *
   for (i = 0; i < 2 * N * r; ++i) Yp[i] = -Yp[i];
   rc = phgmg__ztrsyl(0, N, h->T, r, S, Yp);
   if (rc != PHGMG_OK) return rc;
-  phgmg__zgemm('C', 'N', r, r, m, Z, r, Z, r, Ys, r);
-  for (i = 0; i < 2 * r * r; ++i) Ys[i] = -Ys[i];
-  rc = phgmg__ztrsyl(0, r, S, r, S, Ys);
+  rc = phgmg__h2gmg_small_gram(0, r, m, S, Z, Z, r, Ys, Pr, w4);   /* Br^H Z = Z's first m rows */
   if (rc != PHGMG_OK) return rc;
-  phgmg__zcongr(r, Z, Ys, Pr, w4);
   for (j = 0; j < r; ++j)   /* Cr Z (m x r complex) */
     for (a = 0; a < m; ++a) {
       double sr = 0.0, si = 0.0;
@@ -12052,11 +12063,8 @@ PHGMG__PRIV phgmg_result phgmg__h2gmg_gram(const phgmg__h2gmg *h, const double *
   phgmg__zgemm('N', 'N', N, r, m, h->UC, N, CrZ, m, Yq, N);
   rc = phgmg__ztrsyl(1, N, h->T, r, S, Yq);
   if (rc != PHGMG_OK) return rc;
-  phgmg__zgemm('C', 'N', r, r, m, CrZ, m, CrZ, m, Ys, r);
-  for (i = 0; i < 2 * r * r; ++i) Ys[i] = -Ys[i];
-  rc = phgmg__ztrsyl(1, r, S, r, S, Ys);
+  rc = phgmg__h2gmg_small_gram(1, r, m, S, Z, CrZ, m, Ys, Qr, w4);
   if (rc != PHGMG_OK) return rc;
-  phgmg__zcongr(r, Z, Ys, Qr, w4);
   phgmg__zgemm('C', 'N', r, r, N, Yq, N, Yp, N, Ys, r);
   phgmg__zcongr(r, Z, Ys, QP, w4);
   phgmg__zgemm('C', 'N', m, r, N, h->UC, N, Yp, N, CrZ, m);
