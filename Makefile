@@ -23,10 +23,17 @@ all: phgmg.h examples
 tests/suites.inc: $(TESTSRC)
 	grep -h '^SUITE(' $(TESTSRC) | sed 's/^SUITE(\([a-z0-9_]*\)).*/SUITE_DECL(\1)/' > $@
 
-# One object per test file (each includes the implementation with PHGMG_STATIC),
-# so that the builds run in parallel (make test builds them with -j2).
-TESTOBJ      = $(patsubst tests/%.c,$(BUILD)/obj/%.o,tests/run.c $(TESTSRC))
-TESTOBJ_ASAN = $(patsubst tests/%.c,$(BUILD)/obj_asan/%.o,tests/run.c $(TESTSRC))
+# Each unit includes the implementation with PHGMG_STATIC; the units build in
+# parallel (make test builds them with -j2).
+# The files that configure the implementation are units of their own; the
+# others are compiled together in tests/unity_a.c and tests/unity_b.c (one
+# copy of the implementation per unit: the compiles are most of make test).
+TEST_SOLO    = tests/test_reduce.c tests/test_robust.c tests/test_rsvd.c tests/test_scale.c
+TEST_UNITS   = tests/run.c tests/unity_a.c tests/unity_b.c $(TEST_SOLO)
+TESTOBJ      = $(patsubst tests/%.c,$(BUILD)/obj/%.o,$(TEST_UNITS))
+TESTOBJ_ASAN = $(patsubst tests/%.c,$(BUILD)/obj_asan/%.o,$(TEST_UNITS))
+$(BUILD)/obj/unity_%.o $(BUILD)/obj_asan/unity_%.o: $(filter-out $(TEST_SOLO),$(TESTSRC)) \
+  examples/msd_models.h tests/sepfun_models.h
 
 $(BUILD)/obj/%.o: tests/%.c phgmg.h tests/harness.h tests/suites.inc
 	@mkdir -p $(BUILD)/obj

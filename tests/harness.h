@@ -17,10 +17,14 @@ void th_fail_msg(const char *file, int line, const char *expr);
 
 #define TEST(name) static void name(void)
 #define RUN(name) th_run(th_suite_name_, #name, name)
+/* A suite's body gets its name as a parameter (no file-level static), so that
+   several test files can share one translation unit (tests/unit_*.c); the
+   random numbers below restart at each suite, as in a file of its own. */
 #define SUITE(s) \
+  static void th_suite_body_##s(const char *th_suite_name_); \
   void suite_##s(void); \
-  static const char *th_suite_name_ = #s; \
-  void suite_##s(void)
+  void suite_##s(void) { th_rand_reset(); th_suite_body_##s(#s); } \
+  static void th_suite_body_##s(const char *th_suite_name_)
 #define CHECK(cond) do { if (!(cond)) th_fail_msg(__FILE__, __LINE__, #cond); } while (0)
 /* a <= b with both printed on failure */
 #define CHECK_LE(a, b) do { double th_a_ = (double)(a), th_b_ = (double)(b); \
@@ -34,9 +38,15 @@ void th_fail_msg(const char *file, int line, const char *expr);
       th_fail_msg(__FILE__, __LINE__, th_m_); } } while (0)
 
 /* Deterministic random numbers for tests (xorshift64*), uniform in [-1, 1). */
-static inline double th_rand(void) {
+static inline unsigned long long *th_rand_state(void) {
   static unsigned long long s = 0x9E3779B97F4A7C15ULL;
+  return &s;
+}
+static inline void th_rand_reset(void) { *th_rand_state() = 0x9E3779B97F4A7C15ULL; }
+static inline double th_rand(void) {
+  unsigned long long *p = th_rand_state(), s = *p;
   s ^= s >> 12; s ^= s << 25; s ^= s >> 27;
+  *p = s;
   return (double)((s * 2685821657736338717ULL) >> 11) / 4503599627370496.0 - 1.0;
 }
 #endif
