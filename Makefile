@@ -49,7 +49,18 @@ $(BUILD)/test_run: $(TESTOBJ)
 $(BUILD)/test_run_asan: $(TESTOBJ_ASAN)
 	$(CC) $(CFLAGS_T) -O1 $(SANFLAGS) -o $@ $(TESTOBJ_ASAN) $(LDLIBS)
 
-test: test-build test-plain test-asan compile-checks test-embedded-host test-npy test-cli test-demo test-fuzz-replay test-validate
+# After the compiles, the single-core stages run in two lanes on both cores
+# (each lane's output is printed whole when it ends; a failure stops make test).
+test: test-build
+	$(MAKE) test-plain
+	$(MAKE) -j2 --output-sync=target test-lane-asan test-lane-host
+	$(MAKE) -j2 --output-sync=target test-lane-demo test-lane-tools
+
+test-lane-asan: test-asan
+test-lane-host: compile-checks test-embedded-host
+test-lane-demo: test-demo
+test-lane-tools: test-fuzz-replay test-npy test-cli test-validate
+.PHONY: test-lane-asan test-lane-host test-lane-demo test-lane-tools
 
 # Everything make test compiles, built first on both cores (the compiles are
 # most of its time); the runs below then go one after the other.
