@@ -4,7 +4,8 @@
    every nonlinear term (deim 0) and with ECSW hyper-reduction (deim 1), per
    held-out input (0.1, 0.1 sin 2t, chirp, random pwc): e_proj of the held-out
    trajectory onto the model's basis (what the basis can represent at all)
-   and e_y of the reduced model; 1 run vs 2 runs.
+   and e_y of the reduced model; 1 run vs 2 runs; a last summary line counts
+   the (r, input) pairs and orders where the second run lowered e_y (deim 0).
    Usage: twotrain_study linear|nonlinear [--r 6,7,8,10,12] [--balance] [--second multisine|steps|mssteps]
    (--balance: run 2 scaled to run 1's norm before the POD; linear chain or deim 0 only) */
 #define _POSIX_C_SOURCE 199309L
