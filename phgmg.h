@@ -1524,7 +1524,14 @@ PHGMG_DEF phgmg_result phgmg_ph_abc(const phgmg_ph_system *sys, double *A, doubl
    Lo^T Lp = U S V^T, T = Lp V_r S_r^{-1/2}, W = Lo U_r S_r^{-1/2};
    Ar = W^T A T (r x r), Br = W^T B (r x m), Cr = C T (m x r). Not a pH
    model in general (hence plain matrices). hsv (may be NULL): the first r
-   Hankel singular values; T, W (N x r, may be NULL): the bases. */
+   Hankel singular values; T, W (N x r, may be NULL): the bases.
+   A must be asymptotically stable. A pH system is stable but may be lossless
+   in some mode (R = 0, or a mode the dampers do not reach: eigenvalues on the
+   imaginary axis), where the Gramians do not exist: BT, PRBT and the BALANCED
+   and H2 bases of phgmg_linear_basis then fail with PHGMG_ERR_NOT_CONVERGED
+   or PHGMG_ERR_SINGULAR (the sign iteration of phgmg_lyap / phgmg_care), and
+   write no model (tests/test_linear.c). GMG and SP with the data-driven bases
+   (snapshots, FREQ, IMPULSE) still apply. */
 PHGMG_DEF phgmg_result phgmg_bt(const phgmg_ph_system *sys, int r, double *Ar, double *Br, double *Cr,
                                 double *hsv, double *T, double *W, const phgmg_allocator *alloc);
 

@@ -326,6 +326,34 @@ TEST(test_bad_arguments) {
   CHECK_RC(phgmg_care(0, &x, &x, &x, Ar, NULL, NULL), PHGMG_ERR_SIZE);
 }
 
+/* A lossless system (R = 0: the chain without dampers) has purely imaginary
+   eigenvalues, so its Gramians do not exist: BT, PRBT and the balanced and
+   least-H2 bases must refuse it with their documented codes, never return a
+   basis or model. */
+TEST(test_lossless_system_refused) {
+  phgmg_ph_system s = chain2();
+  phgmg_reduced *red = (phgmg_reduced *)&s;
+  static double Rz[CH_N * CH_N], V[CH_N * 10], A[CH_N * CH_N], F[CH_N * CH_N], X[CH_N * CH_N];
+  double Ar[36], Br[12], Cr[12];
+  int k_out = -1, i;
+  phgmg_result rc[5];
+  memset(Rz, 0, sizeof Rz);
+  s.R = Rz;
+  CHECK_RC(phgmg_ph_validate(&s, 0.0, NULL, NULL), PHGMG_OK);   /* a valid pH system */
+  for (i = 0; i < CH_N * CH_N; ++i) F[i] = (i % (CH_N + 1)) == 0;
+  CHECK_RC(phgmg_ph_abc(&s, A, NULL, NULL), PHGMG_OK);
+  rc[0] = phgmg_lyap(CH_N, A, F, X, NULL, NULL);
+  rc[1] = phgmg_bt(&s, 6, Ar, Br, Cr, NULL, NULL, NULL, NULL);
+  rc[2] = phgmg_prbt(&red, &s, 6, NULL, NULL, NULL, NULL);
+  CHECK(red == NULL);
+  rc[3] = phgmg_linear_basis(&s, PHGMG_BASIS_BALANCED, 4, NULL, V, &k_out, NULL);
+  rc[4] = phgmg_linear_basis(&s, PHGMG_BASIS_H2, 4, NULL, V, &k_out, NULL);
+  for (i = 0; i < 5; ++i) CHECK(rc[i] == PHGMG_ERR_NOT_CONVERGED || rc[i] == PHGMG_ERR_SINGULAR);
+  /* the data-driven bases do not need Gramians */
+  CHECK_RC(phgmg_linear_basis(&s, PHGMG_BASIS_IMPULSE, 4, NULL, V, &k_out, NULL), PHGMG_OK);
+  CHECK(k_out == 4);
+}
+
 /* The complex Schur form of a non-normal real matrix with known eigenvalues:
    A = H D H (H a Householder reflection), D block upper triangular with the
    2 x 2 blocks [a b; -b a] (eigenvalues a +- i b) and two real entries. */
@@ -500,6 +528,7 @@ SUITE(linear) {
   RUN(test_bt_bound_and_transfer);
   RUN(test_prbt_structure_energy_export);
   RUN(test_prbt_zero_feedthrough_limit);
+  RUN(test_lossless_system_refused);
   RUN(test_bases_orthonormal_to_b);
   RUN(test_zschur_known_eigenvalues);
   RUN(test_ztrsyl_residual);
