@@ -18,21 +18,11 @@
 #define PHGMG_IMPLEMENTATION
 #include "../phgmg.h"
 #include "../examples/msd_models.h"
+#include "../examples/demo_common.h"
 
-static double now_s(void) { struct timespec t; clock_gettime(CLOCK_MONOTONIC, &t); return t.tv_sec + 1e-9 * t.tv_nsec; }
-static void u_sin(double t, double *u, void *p) { (void)p; u[0] = 0.1 * sin(t); }
-static void u_const(double t, double *u, void *p) { (void)p; (void)t; u[0] = 0.1; }
-static void u_sin2(double t, double *u, void *p) { (void)p; u[0] = 0.1 * sin(2.0 * t); }
-static void u_chirp(double t, double *u, void *p) { (void)p; u[0] = 0.1 * sin(0.2 * t + 0.01 * t * t); }
-static void u_pwc(double t, double *u, void *p) {
-  unsigned k = (unsigned)(t / 5.0), h = k * 2654435761u;
-  (void)p;
-  h ^= h >> 13; h *= 0x5bd1e995u; h ^= h >> 15;
-  u[0] = 0.1 * (2.0 * (double)(h % 10000u) / 9999.0 - 1.0);
-}
-static void u_multisine(double t, double *u, void *p) { (void)p; u[0] = 0.05 * (sin(0.5 * t) + sin(1.5 * t) + sin(3.0 * t)); }
+/* the inputs of make demo's generalization study (examples/demo_common.h) */
 #define NIN 5
-static phgmg_input_fn inf[NIN] = {u_sin, u_const, u_sin2, u_chirp, u_pwc};
+static phgmg_input_fn inf[NIN] = {msd_input_sin, msd_input_const, demo_u_sin2, demo_u_chirp, demo_u_pwc};
 
 int main(int argc, char **argv) {
   const int nsteps = 1000, ns = nsteps + 1;
@@ -76,7 +66,7 @@ int main(int argc, char **argv) {
   if (!X || !Y || !XR || !YR) return 1;
   memset(&go, 0, sizeof go); go.tol = tol; go.max_iter = 20;
   memset(runs, 0, sizeof runs);
-  for (i = 0; i < 2; ++i) { runs[i].u = i ? u_multisine : u_sin; runs[i].dt = dt; runs[i].nsteps = nsteps; }
+  for (i = 0; i < 2; ++i) { runs[i].u = i ? demo_u_multisine : msd_input_sin; runs[i].dt = dt; runs[i].nsteps = nsteps; }
   /* columns: run sin, [multisine], then the four other inputs */
   if (phgmg_simulate_inputs(sys, ntr, runs, &go, X, N, Y, NULL, NULL) != PHGMG_OK) return 1;
   for (i = 1; i < NIN; ++i) {
@@ -102,9 +92,9 @@ int main(int argc, char **argv) {
       o.r = rl[k]; o.rn = rn; o.manifold = me < 0 ? 0 : me; o.lambda = lambda;
       o.lambda_auto = me >= 0 && lauto; o.lambda_train_only = tonly; o.nrun = ntr; o.runs = runs; o.newton_tol = tol; o.newton_iter = 20;
       if (nonlin) { o.deim = 1; o.deim_tol = 1e-8; o.deim_allow_negative = 1; }
-      t0 = now_s();
+      t0 = demo_now();
       rc = phgmg_reduce(&red, sys, X, N, ntr * ns, &o, &info, NULL);
-      tred = now_s() - t0;
+      tred = demo_now() - t0;
       if (rc != PHGMG_OK) { printf("%3d %-7s reduce: %s\n", o.r, me < 0 ? "POD" : me == 0 ? "QM-pod" : me == 1 ? "QM-grdy" : "QM-alt", phgmg_result_string(rc)); continue; }
       eproj = phgmg_err_proj(red, X, N, ntr * ns);
       elb = me < 0 ? NAN : phgmg_err_lowerbound(red, X, N, ntr * ns);

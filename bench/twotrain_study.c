@@ -15,18 +15,10 @@
 #define PHGMG_IMPLEMENTATION
 #include "../phgmg.h"
 #include "../examples/msd_models.h"
+#include "../examples/demo_common.h"
 
-static void u_sin(double t, double *u, void *p) { (void)p; u[0] = 0.1 * sin(t); }
-static void u_const(double t, double *u, void *p) { (void)p; (void)t; u[0] = 0.1; }
-static void u_sin2(double t, double *u, void *p) { (void)p; u[0] = 0.1 * sin(2.0 * t); }
-static void u_chirp(double t, double *u, void *p) { (void)p; u[0] = 0.1 * sin(0.2 * t + 0.01 * t * t); }
-static void u_pwc(double t, double *u, void *p) {
-  unsigned k = (unsigned)(t / 5.0), h = k * 2654435761u;
-  (void)p;
-  h ^= h >> 13; h *= 0x5bd1e995u; h ^= h >> 15;
-  u[0] = 0.1 * (2.0 * (double)(h % 10000u) / 9999.0 - 1.0);
-}
-static void u_multisine(double t, double *u, void *p) { (void)p; u[0] = 0.05 * (sin(0.5 * t) + sin(1.5 * t) + sin(3.0 * t)); }
+/* the inputs of make demo's generalization study (examples/demo_common.h),
+   and two more candidates for the second training run */
 /* random steps: another hash and hold time than the held-out pwc (7 s, not 5 s) */
 static void u_steps(double t, double *u, void *p) {
   unsigned k = (unsigned)(t / 7.0) + 977u, h = k * 2246822519u;
@@ -37,11 +29,11 @@ static void u_steps(double t, double *u, void *p) {
 /* half the multisine plus half the random steps: the band and the static content */
 static void u_mssteps(double t, double *u, void *p) {
   double a, b;
-  u_multisine(t, &a, p); u_steps(t, &b, p);
+  demo_u_multisine(t, &a, p); u_steps(t, &b, p);
   u[0] = 0.5 * (a + b);
 }
 #define NHO 4
-static phgmg_input_fn ho[NHO] = {u_const, u_sin2, u_chirp, u_pwc};
+static phgmg_input_fn ho[NHO] = {msd_input_const, demo_u_sin2, demo_u_chirp, demo_u_pwc};
 static const char *hon[NHO] = {"0.1", "sin 2t", "chirp", "pwc"};
 
 int main(int argc, char **argv) {
@@ -49,7 +41,7 @@ int main(int argc, char **argv) {
   const double dt = 0.1;
   int rl[64], nr = 0, i, k, tr, dm, nonlin, N, balance = 0, nimp = 0, ncmp = 0, ngm = 0;
   double ey2[64][2][NHO], lsum = 0;   /* e_y without hyper-reduction, 1 and 2 runs */
-  phgmg_input_fn second = u_multisine;
+  phgmg_input_fn second = demo_u_multisine;
   const char *rs = "6,7,8,10,12";
   double tol = 1e-10, *X, *Y, *YR, xr0[64] = {0};
   msd_linear L;
@@ -66,7 +58,7 @@ int main(int argc, char **argv) {
     else if (!strcmp(argv[i], "--balance")) balance = 1;
     else if (!strcmp(argv[i], "--second") && i + 1 < argc) {
       ++i;
-      second = !strcmp(argv[i], "steps") ? u_steps : !strcmp(argv[i], "mssteps") ? u_mssteps : u_multisine;
+      second = !strcmp(argv[i], "steps") ? u_steps : !strcmp(argv[i], "mssteps") ? u_mssteps : demo_u_multisine;
     }
   }
   { const char *q = rs; char *end; while (*q && nr < 64) { rl[nr++] = (int)strtol(q, &end, 10); if (end == q) break; q = *end == ',' ? end + 1 : end; } }
@@ -87,7 +79,7 @@ int main(int argc, char **argv) {
   if (!X || !Y || !YR) return 1;
   memset(&go, 0, sizeof go); go.tol = tol; go.max_iter = 20;
   memset(runs, 0, sizeof runs);
-  for (i = 0; i < 2; ++i) { runs[i].u = i ? second : u_sin; runs[i].dt = dt; runs[i].nsteps = nsteps; }
+  for (i = 0; i < 2; ++i) { runs[i].u = i ? second : msd_input_sin; runs[i].dt = dt; runs[i].nsteps = nsteps; }
   if (phgmg_simulate_inputs(sys, 2, runs, &go, X, N, Y, NULL, NULL) != PHGMG_OK) return 1;
   for (i = 0; i < NHO; ++i) {
     phgmg_run run;
