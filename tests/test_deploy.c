@@ -181,6 +181,122 @@ TEST(test_lambda_auto_generalizes) {
   msd_linear_free(&M);
 }
 
+/* The lambda_auto = 1 selection recomputed from its documentation
+   (phgmg_reduce_opts.runs), with every candidate evaluated in full (the
+   library stops a candidate at its first inadmissible run): candidates from
+   lambda_max down one per decade to the regression optimum (lambda_auto = 2's
+   choice), each a GMG-QM model with that fixed lambda, simulated on the
+   training run and the three probe runs (a constant at the training input's
+   RMS, the input 1.5x faster, the square wave RMS * sign(u)) against the
+   linear limit (GMG-POD on the same basis); admissible: every run simulates,
+   <= 4 Newton iterations per step, every e_y ratio <= 1.02; the descent stops
+   after two inadmissible candidates in a row; kept: the first candidate with
+   at least half the best gain (sum of log ratios), none: M = 0 (HUGE_VAL). */
+static double ra_rms;
+static void ra_const(double t, double *u, void *p) { (void)t; (void)p; u[0] = ra_rms; }
+static void ra_fast(double t, double *u, void *p) { msd_input_sin(1.5 * t, u, p); }
+static void ra_square(double t, double *u, void *p) {
+  msd_input_sin(t, u, p);
+  u[0] = u[0] > 0.0 ? ra_rms : (u[0] < 0.0 ? -ra_rms : 0.0);
+}
+/* e_y of red on the four runs (HUGE_VAL where it fails); *ok = 0 on a failure
+   or more than 4 Newton iterations per step */
+static void ra_eval(const phgmg_reduced *red, int ns, phgmg_input_fn *u, const double *Yref, double *ey, int *ok) {
+  double YR[601], xr0[32] = {0};   /* r <= 32 */
+  int k;
+  *ok = 1;
+  for (k = 0; k < 4; ++k) {
+    phgmg_rom_stats st;
+    phgmg_result rc;
+    memset(&st, 0, sizeof st);
+    rc = phgmg_reduced_simulate(red, xr0, 0.0, 0.1, ns - 1, u[k], NULL, 0.0, 20, NULL, YR, NULL, &st, NULL);
+    ey[k] = rc == PHGMG_OK ? phgmg_rel_error(1, ns, Yref + (size_t)k * ns, 1, YR, 1) : HUGE_VAL;
+    if (rc != PHGMG_OK || st.newton_iters > 4 * st.steps || !(ey[k] < HUGE_VAL)) *ok = 0;
+  }
+}
+static double ra_expected(const phgmg_ph_system *sys, const double *X, int ns, int r, const phgmg_run *run,
+                          const double *Yref, phgmg_input_fn *u, int *ncand) {
+  const double lo = 1e-14;
+  const int pd = 4, ng = 57;   /* the default grid 1e-14 .. 1, four points per decade */
+  double base[4], ey[4], lam_reg, best_score = 0.0, cs[64];
+  int g, gsel, k, ok, bad = 0, nc = 0, cg[64], cok[64], best = -1;
+  phgmg_reduce_opts o;
+  phgmg_reduce_info info;
+  phgmg_reduced *red = NULL;
+  memset(&o, 0, sizeof o);
+  o.method = PHGMG_METHOD_GMG_POD; o.r = r;
+  if (phgmg_reduce(&red, sys, X, sys->N, ns, &o, NULL, NULL) != PHGMG_OK) return NAN;
+  ra_eval(red, ns, u, Yref, base, &ok);
+  phgmg_reduced_destroy(red);
+  for (k = 0; k < 4; ++k) if (!(base[k] < HUGE_VAL)) base[k] = 1.0;
+  o.method = PHGMG_METHOD_GMG_QM; o.rn = 8; o.lambda_auto = 2; o.nrun = 1; o.runs = run;
+  if (phgmg_reduce(&red, sys, X, sys->N, ns, &o, &info, NULL) != PHGMG_OK) return NAN;
+  phgmg_reduced_destroy(red);
+  lam_reg = info.lambda;
+  gsel = (int)floor(pd * log10(lam_reg / lo) + 0.5);
+  for (g = ng - 1; g >= gsel; g = (g - pd >= gsel || g == gsel) ? g - pd : gsel) {
+    double score = 0.0, worst = 0.0;
+    o.lambda_auto = 0; o.lambda = lo * pow(10.0, (double)g / pd);
+    if (phgmg_reduce(&red, sys, X, sys->N, ns, &o, NULL, NULL) != PHGMG_OK) return NAN;
+    ra_eval(red, ns, u, Yref, ey, &ok);
+    phgmg_reduced_destroy(red);
+    for (k = 0; k < 4 && ok; ++k) {
+      const double q = (ey[k] + 1e-14) / (base[k] + 1e-14);
+      score += log(q);
+      worst = PHGMG__MAX(worst, q);
+    }
+    ok = ok && worst <= 1.02;
+    if (ok && score < best_score) { best = g; best_score = score; }
+    cg[nc] = g; cok[nc] = ok; cs[nc++] = score;
+    bad = ok ? 0 : bad + 1;
+    if (bad >= 2 || g == gsel) break;
+  }
+  *ncand = nc;
+  for (k = 0; k < nc && best >= 0; ++k)
+    if (cok[k] && cs[k] <= 0.5 * best_score) { best = cg[k]; break; }
+  return best < 0 ? HUGE_VAL : lo * pow(10.0, (double)best / pd);
+}
+TEST(test_lambda_auto_rule_recomputed) {
+  msd_linear M;
+  enum { NS = 601 };
+  static double Yref[4 * NS];
+  phgmg_input_fn u[4] = {msd_input_sin, ra_const, ra_fast, ra_square};
+  double *X, s2 = 0.0, *Xp;
+  phgmg_run run;
+  /* orders with each outcome: the linear limit (8, 15), lambda 1e-2 / 1e-1 / 1
+     (6, 7, 10, 18); at r = 13 the half-gain rule keeps 1e-1 where the best
+     gain is at 1e-2, at r = 15 a candidate's worst ratio (1.035) is just
+     above the tolerance 1.02 (the descent stops one candidate earlier) */
+  static const int rs[7] = {6, 7, 8, 10, 13, 15, 18};
+  int i, k, j, r, ncand = 0, finite = 0;
+  CHECK(msd_linear_build(&M, 50, NULL, NULL, NULL, PHGMG_DENSE) == 0);
+  X = sim(&M.sys, msd_input_sin, NS - 1, Yref);
+  for (i = 0; i < NS; ++i) { double v; msd_input_sin(0.1 * i, &v, NULL); s2 += v * v; }
+  ra_rms = sqrt(s2 / NS);
+  for (k = 1; k < 4; ++k) { Xp = sim(&M.sys, u[k], NS - 1, Yref + (size_t)k * NS); CHECK(Xp != NULL); free(Xp); }
+  memset(&run, 0, sizeof run);
+  run.u = msd_input_sin; run.dt = 0.1; run.nsteps = NS - 1;
+  for (j = 0; j < 7 && X; ++j) {
+    phgmg_reduce_opts o;
+    phgmg_reduce_info info;
+    phgmg_reduced *red = NULL;
+    double want;
+    r = rs[j];
+    want = ra_expected(&M.sys, X, NS, r, &run, Yref, u, &ncand);
+    memset(&o, 0, sizeof o);
+    o.method = PHGMG_METHOD_GMG_QM; o.r = r; o.rn = 8; o.lambda_auto = 1; o.nrun = 1; o.runs = &run;
+    CHECK_RC(phgmg_reduce(&red, &M.sys, X, M.sys.N, NS, &o, &info, NULL), PHGMG_OK);
+    phgmg_reduced_destroy(red);
+    CHECK(!isnan(want));
+    CHECK(info.lambda_candidates == ncand);
+    if (want == HUGE_VAL) CHECK(info.lambda == HUGE_VAL);
+    else { CHECK_LE(fabs(info.lambda / want - 1.0), 1e-9); ++finite; }
+  }
+  CHECK(finite == 5);   /* the outcomes listed above */
+  free(X);
+  msd_linear_free(&M);
+}
+
 /* phgmg_reduced_validate against the same numbers computed directly, and the
    training-envelope indicator: silent on the training input, firing when an
    overfitted model is driven by a constant (state error above 0.3). */
@@ -453,6 +569,7 @@ SUITE(deploy) {
   RUN(test_deploy_options);
   RUN(test_lambda_auto_without_runs_is_linear_limit);
   RUN(test_lambda_auto_generalizes);
+  RUN(test_lambda_auto_rule_recomputed);
   RUN(test_validate_and_indicator);
   RUN(test_consecutive_failures);
   RUN(test_greedy_manifold_picks_pod_modes);
