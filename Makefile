@@ -50,11 +50,13 @@ $(BUILD)/test_run_asan: $(TESTOBJ_ASAN)
 	$(CC) $(CFLAGS_T) -O1 $(SANFLAGS) -o $@ $(TESTOBJ_ASAN) $(LDLIBS)
 
 # After the compiles, the single-core stages run in two lanes on both cores
-# (each lane's output is printed whole when it ends; a failure stops make test).
+# (each lane's output is printed whole when it ends -- GNU make 4's
+# --output-sync, left out by older makes; a failure stops make test).
+SYNC = $(if $(filter output-sync,$(.FEATURES)),--output-sync=target,)
 test: test-build
 	$(MAKE) test-plain
-	$(MAKE) -j2 --output-sync=target test-lane-asan test-lane-host
-	$(MAKE) -j2 --output-sync=target test-lane-demo test-lane-tools
+	$(MAKE) -j2 $(SYNC) test-lane-asan test-lane-host
+	$(MAKE) -j2 $(SYNC) test-lane-demo test-lane-tools
 
 test-lane-asan: test-asan
 test-lane-host: compile-checks test-embedded-host
