@@ -56,29 +56,193 @@ static int lambda_auto_study(msd_nonlinear *M, const char *out, int rmin, int rm
   return 0;
 }
 
-int main(int argc, char **argv) {
-  int n = 500, rmin = 6, rmax = 20, rstep = 2, rn = 8, renergy = 16, i, in, nr, k, j, lauto = 0;
-  double mass = 1.0, lambda_fixed = 0.0, deim_tol = 1e-8, t_start = demo_now();
-  const char *out = "results", *gen = NULL;
-  const int nsteps = 1000, ns = nsteps + 1;
-  const double dt = 0.1;
-  const char *inname[2] = {"sin", "const"};
-  phgmg_input_fn inf[2] = {msd_input_sin, msd_input_const};
-  char path[512];
-  svgplot_fig *fig, *fige;
+/* The settings of a run (command line) and the model. */
+typedef struct nl_setup {
   msd_nonlinear M;
+  const char *out;
+  int n, rmin, rmax, rstep, nr, rn, renergy, nsteps;
+  double mass, lambda_fixed, deim_tol, dt;
+} nl_setup;
+
+/* --generalization: issue 15's study at the listed r */
+static int generalization_main(nl_setup *S, const char *gen) {
+  int rl[64], nrl = 0;
+  char *end, path[512];
+  const char *q = gen;
+  phgmg_reduce_opts o;
+  svgplot_fig *gf = svgplot_new("Nonlinear chain: GMG-POD and GMG-QM (lambda validated by simulation) on inputs they were not trained on", 2);
+  while (*q && nrl < 64) { rl[nrl++] = (int)strtol(q, &end, 10); if (end == q) break; q = *end == ',' ? end + 1 : end; }
+  memset(&o, 0, sizeof o);
+  o.rn = S->rn; o.deim = 1; o.deim_tol = S->deim_tol; o.deim_allow_negative = 1;
+  svgplot_size(gf, 1200, 480);
+  demo_generalization_study(&S->M.sys, S->out, "nonlinear", rl, nrl, &o, 1e-8, 20, S->nsteps, S->dt, gf, 0);
+  snprintf(path, sizeof path, "%s/fig_generalization_nonlinear.svg", S->out);
+  if (svgplot_save(gf, path) != 0) { fprintf(stderr, "cannot write %s\n", path); return 1; }
+  svgplot_free(gf);
+  return 0;
+}
+
+/* Per-input result arrays of the paper study (rows of the CSVs). */
+typedef struct nl_tables {
+  double *tred, *ty, *tproj, *rx;   /* nr x (NMETH + 1), nr x (NMETH + 1), nr x 4, nr */
+  double *eng, *ecol, *tt;          /* ns x (NMETH + 2), ns, ns: energy-balance errors */
+} nl_tables;
+
+/* One reduced order (row k, r) of the paper tables: the three methods on the
+   snapshots X of input u, with the energy study at r = renergy. */
+static void paper_order(nl_setup *S, demo_cache *cache, const double *X, const double *Y, phgmg_input_fn u, int k,
+                        nl_tables *T) {
+  const int r = S->rmin + k * S->rstep, ns = S->nsteps + 1;
+  double lam = S->lambda_fixed;
+  int ndeim = 0, nneg = 0, i, j;
+  T->rx[k] = r;
+  T->tred[k * (NMETH + 1)] = T->ty[k * (NMETH + 1)] = T->tproj[k * 4] = r;
+  T->tproj[k * 4 + 1] = T->tproj[k * 4 + 2] = T->tproj[k * 4 + 3] = NAN;
+  printf("  %3d", r);
+  for (j = 0; j < NMETH; ++j) {
+    phgmg_reduce_opts o;
+    demo_rom_result res;
+    phgmg_energy ren;
+    double *REH = NULL;
+    memset(&o, 0, sizeof o);
+    o.method = meth_id[j]; o.r = r; o.rn = S->rn; o.deim = 1; o.deim_tol = S->deim_tol; o.deim_allow_negative = 1;
+    if (meth_id[j] == PHGMG_METHOD_GMG_QM) {
+      if (!(lam > 0)) lam = fmax(0.2 * T->tproj[k * 4 + 1], pow(10.0, -2.5));
+      o.lambda = lam;
+    }
+    demo_cache_use(cache, &o);
+    if (r == S->renergy) {
+      REH = (double *)malloc(sizeof(double) * 3 * ns);
+      ren.H = REH; ren.S = REH + ns; ren.D = REH + 2 * ns;
+    }
+    res = demo_run_rom(cache, &S->M.sys, X, Y, S->nsteps, S->dt, u, &o, 1e-8, 20, REH ? &ren : NULL);
+    if (res.rc != PHGMG_OK) fprintf(stderr, "  [%s r=%d: %s]\n", meth_name[j], r, phgmg_result_string(res.rc));
+    if (REH) {
+      if (res.rc == PHGMG_OK) {
+        phgmg_err_energy(&ren, S->nsteps, T->ecol);
+        for (i = 0; i < ns; ++i) T->eng[i * (NMETH + 2) + 2 + j] = T->ecol[i];
+      }
+      free(REH);
+    }
+    T->tred[k * (NMETH + 1) + 1 + j] = res.e_red;
+    T->ty[k * (NMETH + 1) + 1 + j] = res.e_y;
+    if (meth_id[j] == PHGMG_METHOD_GMG_POD) T->tproj[k * 4 + 1] = res.e_proj;
+    if (meth_id[j] == PHGMG_METHOD_GMG_QM) { T->tproj[k * 4 + 2] = res.e_proj; T->tproj[k * 4 + 3] = res.e_lower; }
+    ndeim = PHGMG__MAX(ndeim, res.info.deim_modes);
+    nneg += res.info.deim_negative;
+    printf("  %9.3e / %9.3e", res.e_red, res.e_y);
+  }
+  printf("  %9.3e  %9.3e  %9.3e  %.2e, %d%s\n", T->tproj[k * 4 + 1], T->tproj[k * 4 + 2], T->tproj[k * 4 + 3], lam,
+         ndeim, nneg ? " (negative weights!)" : "");
+}
+
+/* Panel `in` of the energy figure (paper Fig. 4): e_energy(t) of the FOM and the ROMs. */
+static void energy_panel(svgplot_fig *fige, int in, int renergy, int ns, nl_tables *T) {
+  static const char *en_name[4] = {"FOM", "SP2-POD", "GMG-POD", "GMG-QM"};
+  static const int en_style[4] = {3, 0, 1, 2};
+  char title[128];
+  int i, j;
+  snprintf(title, sizeof title, "(%c) u = %s, r = %d", 'a' + in, in ? "0.1" : "0.1 sin t", renergy);
+  svgplot_panel(fige, in, title, "time t", "e_energy(t)");
+  for (j = 0; j < NMETH + 1; ++j) {
+    for (i = 0; i < ns; ++i) T->ecol[i] = T->eng[i * (NMETH + 2) + 1 + j];
+    svgplot_series(fige, in, en_name[j], ns, T->tt, T->ecol, en_style[j]);
+  }
+}
+
+/* One input of the paper study (in = 0: u = 0.1 sin t, 1: u = 0.1): the FOM
+   with its energy balance, every order, the CSVs and figure panels. */
+static void paper_input(nl_setup *S, int in, svgplot_fig *fig, svgplot_fig *fige) {
+  static const char *inname[2] = {"sin", "const"};
+  static phgmg_input_fn inf[2] = {msd_input_sin, msd_input_const};
+  const int N = S->M.sys.N, ns = S->nsteps + 1, nr = S->nr;
+  double *X = (double *)malloc(sizeof(double) * N * ns), *Y = (double *)malloc(sizeof(double) * ns);
+  double *x0 = (double *)calloc((size_t)N, sizeof(double));
+  double *EH = (double *)malloc(sizeof(double) * 3 * ns), t0 = demo_now();
+  nl_tables T;
+  phgmg_energy en;
+  phgmg_gl3_opts go;
+  phgmg_gl3_stats gs;
+  phgmg_result rc;
+  demo_cache cache;
+  char path[512];
+  int k, j;
+  T.tred = (double *)malloc(sizeof(double) * nr * (NMETH + 1));
+  T.ty = (double *)malloc(sizeof(double) * nr * (NMETH + 1));
+  T.tproj = (double *)malloc(sizeof(double) * nr * 4);
+  T.rx = (double *)malloc(sizeof(double) * nr);
+  T.eng = (double *)malloc(sizeof(double) * ns * (NMETH + 2));
+  T.ecol = (double *)malloc(sizeof(double) * ns); T.tt = (double *)malloc(sizeof(double) * ns);
+  if (!X || !Y || !x0 || !EH || !T.tred || !T.ty || !T.tproj || !T.rx || !T.eng || !T.ecol || !T.tt)
+    demo_die("allocation", PHGMG_ERR_NOMEM);
+  en.H = EH; en.S = EH + ns; en.D = EH + 2 * ns;
+  memset(&go, 0, sizeof go); go.tol = 1e-8; go.max_iter = 20;
+  rc = phgmg_simulate(&S->M.sys, x0, 0.0, S->dt, S->nsteps, inf[in], NULL, &go, X, Y, &en, &gs, NULL, NULL);
+  if (rc != PHGMG_OK) demo_die("full-order simulation", rc);
+  phgmg_err_energy(&en, S->nsteps, T.ecol);
+  for (k = 0; k < ns; ++k) {
+    T.eng[k * (NMETH + 2)] = T.tt[k] = k * S->dt;
+    T.eng[k * (NMETH + 2) + 1] = T.ecol[k];
+    for (j = 0; j < NMETH; ++j) T.eng[k * (NMETH + 2) + 2 + j] = NAN;
+  }
+  printf("\nu = %s: FOM %.3f s (%ld Newton iterations, %ld factorizations), max e_energy %.2e\n",
+         in ? "0.1" : "0.1 sin t", demo_now() - t0, gs.newton_iters, gs.factorizations, T.ecol[S->nsteps]);
+  demo_cache_build(&cache, &S->M.sys, X, ns, S->rmax + S->rn + 1, 1);
+  demo_cache_deim(&cache, &S->M.sys, X, ns, S->deim_tol);
+  printf("  %3s  %-22s %-22s %-22s %-10s %-10s %-10s %s\n", "r", "SP2-POD e_red / e_y",
+         "GMG-POD e_red / e_y", "GMG-QM e_red / e_y", "proj POD", "proj QM", "lowerbnd", "lambda, DEIM pts");
+  for (k = 0; k < nr; ++k) paper_order(S, &cache, X, Y, inf[in], k, &T);
+  demo_tables_and_panels(S->out, "nonlinear", inname[in], in, "r,SP2-POD,GMG-POD,GMG-QM", meth_name, NMETH, nr,
+                         T.rx, T.tred, T.ty, T.tproj, fig);
+  snprintf(path, sizeof path, "%s/nonlinear_%s_energy.csv", S->out, inname[in]);
+  demo_write_csv(path, "t,FOM,SP2-POD,GMG-POD,GMG-QM", ns, NMETH + 2, T.eng, 0);
+  energy_panel(fige, in, S->renergy, ns, &T);
+  demo_cache_free(&cache);
+  free(X); free(Y); free(x0); free(EH);
+  free(T.tred); free(T.ty); free(T.tproj); free(T.rx); free(T.eng); free(T.ecol); free(T.tt);
+}
+
+/* The paper tables and Figs. 3 and 4 (both inputs). */
+static int paper_main(nl_setup *S) {
+  char path[512];
+  int in;
+  svgplot_fig *fig = svgplot_new("Nonlinear mass-spring-damper (paper Fig. 3): relative errors against the reduced order", 4);
+  svgplot_fig *fige = svgplot_new("Energy-balance error e_energy(t) (paper Fig. 4)", 2);
+  svgplot_size(fig, 1760, 480);
+  printf("Nonlinear MSD, n = %d masses (N = %d), mass %g, %d steps of dt = %g; r = %d..%d step %d;\n"
+         "GMG-QM r_n = %d, lambda = %s; DEIM tol %g\n", S->n, S->M.sys.N, S->mass, S->nsteps, S->dt,
+         S->rmin, S->rmax, S->rstep, S->rn, S->lambda_fixed > 0 ? "fixed" : "max(0.2 e_proj, 10^-2.5)", S->deim_tol);
+  for (in = 0; in < 2; ++in) paper_input(S, in, fig, fige);
+  snprintf(path, sizeof path, "%s/fig3_nonlinear.svg", S->out);
+  if (svgplot_save(fig, path) != 0) { fprintf(stderr, "cannot write %s\n", path); return 1; }
+  snprintf(path, sizeof path, "%s/fig4_energy.svg", S->out);
+  if (svgplot_save(fige, path) != 0) { fprintf(stderr, "cannot write %s\n", path); return 1; }
+  svgplot_free(fig);
+  svgplot_free(fige);
+  printf("\nwrote %s/nonlinear_*.csv, %s/fig3_nonlinear.svg, %s/fig4_energy.svg\n", S->out, S->out, S->out);
+  return 0;
+}
+
+int main(int argc, char **argv) {
+  int i, lauto = 0, rc;
+  double t_start = demo_now();
+  const char *gen = NULL;
+  nl_setup S;
   msd_nl_opts mo;
+  memset(&S, 0, sizeof S);
+  S.n = 500; S.mass = 1.0; S.out = "results"; S.rmin = 6; S.rmax = 20; S.rstep = 2; S.rn = 8; S.renergy = 16; S.deim_tol = 1e-8;
+  S.nsteps = 1000; S.dt = 0.1;
   for (i = 1; i < argc; ++i) {
-    if (!strcmp(argv[i], "--n") && i + 1 < argc) n = atoi(argv[++i]);
-    else if (!strcmp(argv[i], "--mass") && i + 1 < argc) mass = atof(argv[++i]);
-    else if (!strcmp(argv[i], "--rmin") && i + 1 < argc) rmin = atoi(argv[++i]);
-    else if (!strcmp(argv[i], "--rmax") && i + 1 < argc) rmax = atoi(argv[++i]);
-    else if (!strcmp(argv[i], "--rstep") && i + 1 < argc) rstep = atoi(argv[++i]);
-    else if (!strcmp(argv[i], "--rn") && i + 1 < argc) rn = atoi(argv[++i]);
-    else if (!strcmp(argv[i], "--lambda") && i + 1 < argc && (lauto = demo_parse_lambda(argv[i + 1], &lambda_fixed)) >= 0) ++i;
-    else if (!strcmp(argv[i], "--deim-tol") && i + 1 < argc) deim_tol = atof(argv[++i]);
-    else if (!strcmp(argv[i], "--renergy") && i + 1 < argc) renergy = atoi(argv[++i]);
-    else if (!strcmp(argv[i], "--out") && i + 1 < argc) out = argv[++i];
+    if (!strcmp(argv[i], "--n") && i + 1 < argc) S.n = atoi(argv[++i]);
+    else if (!strcmp(argv[i], "--mass") && i + 1 < argc) S.mass = atof(argv[++i]);
+    else if (!strcmp(argv[i], "--rmin") && i + 1 < argc) S.rmin = atoi(argv[++i]);
+    else if (!strcmp(argv[i], "--rmax") && i + 1 < argc) S.rmax = atoi(argv[++i]);
+    else if (!strcmp(argv[i], "--rstep") && i + 1 < argc) S.rstep = atoi(argv[++i]);
+    else if (!strcmp(argv[i], "--rn") && i + 1 < argc) S.rn = atoi(argv[++i]);
+    else if (!strcmp(argv[i], "--lambda") && i + 1 < argc && (lauto = demo_parse_lambda(argv[i + 1], &S.lambda_fixed)) >= 0) ++i;
+    else if (!strcmp(argv[i], "--deim-tol") && i + 1 < argc) S.deim_tol = atof(argv[++i]);
+    else if (!strcmp(argv[i], "--renergy") && i + 1 < argc) S.renergy = atoi(argv[++i]);
+    else if (!strcmp(argv[i], "--out") && i + 1 < argc) S.out = argv[++i];
     else if (!strcmp(argv[i], "--generalization") && i + 1 < argc) gen = argv[++i];
     else {
       fprintf(stderr, "usage: %s [--n N] [--mass M] [--rmin R] [--rmax R] [--rstep S] [--rn K] [--lambda L|auto] [--generalization R,R,...]\n"
@@ -86,143 +250,17 @@ int main(int argc, char **argv) {
       return 2;
     }
   }
-  if (rmin < 2 || rmax < rmin || rstep < 1 || n < 4) { fprintf(stderr, "bad arguments\n"); return 2; }
-  nr = (rmax - rmin) / rstep + 1;
-  demo_mkdir(out);
+  if (S.rmin < 2 || S.rmax < S.rmin || S.rstep < 1 || S.n < 4) { fprintf(stderr, "bad arguments\n"); return 2; }
+  S.nr = (S.rmax - S.rmin) / S.rstep + 1;
+  demo_mkdir(S.out);
   memset(&mo, 0, sizeof mo);
-  mo.n = n; mo.mass = mass; mo.storage = PHGMG_BANDED;
-  if (msd_nonlinear_build(&M, &mo) != 0) { fprintf(stderr, "model\n"); return 1; }
-  if (gen) { /* --generalization: issue 15's study at the listed r */
-    int rl[64], nrl = 0;
-    char *end;
-    const char *q = gen;
-    phgmg_reduce_opts o;
-    svgplot_fig *gf = svgplot_new("Nonlinear chain: GMG-POD and GMG-QM (lambda validated by simulation) on inputs they were not trained on", 2);
-    while (*q && nrl < 64) { rl[nrl++] = (int)strtol(q, &end, 10); if (end == q) break; q = *end == ',' ? end + 1 : end; }
-    memset(&o, 0, sizeof o);
-    o.rn = rn; o.deim = 1; o.deim_tol = deim_tol; o.deim_allow_negative = 1;
-    svgplot_size(gf, 1200, 480);
-    demo_generalization_study(&M.sys, out, "nonlinear", rl, nrl, &o, 1e-8, 20, nsteps, dt, gf, 0);
-    snprintf(path, sizeof path, "%s/fig_generalization_nonlinear.svg", out);
-    if (svgplot_save(gf, path) != 0) { fprintf(stderr, "cannot write %s\n", path); return 1; }
-    svgplot_free(gf);
-    msd_nonlinear_free(&M);
-    printf("nonlinear generalization demo wall time: %.2f s\n", demo_now() - t_start);
-    return 0;
-  }
-  if (lauto) {
-    int rc_all = lambda_auto_study(&M, out, rmin, rmax, rstep, rn, deim_tol, nsteps, dt);
-    msd_nonlinear_free(&M);
-    printf("nonlinear lambda-auto demo wall time: %.2f s\n", demo_now() - t_start);
-    return rc_all;
-  }
-  fig = svgplot_new("Nonlinear mass-spring-damper (paper Fig. 3): relative errors against the reduced order", 4);
-  svgplot_size(fig, 1760, 480);
-  fige = svgplot_new("Energy-balance error e_energy(t) (paper Fig. 4)", 2);
-  printf("Nonlinear MSD, n = %d masses (N = %d), mass %g, %d steps of dt = %g; r = %d..%d step %d;\n"
-         "GMG-QM r_n = %d, lambda = %s; DEIM tol %g\n", n, M.sys.N, mass, nsteps, dt, rmin, rmax, rstep, rn,
-         lambda_fixed > 0 ? "fixed" : "max(0.2 e_proj, 10^-2.5)", deim_tol);
-  for (in = 0; in < 2; ++in) {
-    const int N = M.sys.N;
-    double *X = (double *)malloc(sizeof(double) * N * ns), *Y = (double *)malloc(sizeof(double) * ns);
-    double *x0 = (double *)calloc((size_t)N, sizeof(double));
-    double *tred = (double *)malloc(sizeof(double) * nr * (NMETH + 1));
-    double *ty = (double *)malloc(sizeof(double) * nr * (NMETH + 1));
-    double *tproj = (double *)malloc(sizeof(double) * nr * 4);
-    double *rx = (double *)malloc(sizeof(double) * nr), *col = (double *)malloc(sizeof(double) * nr);
-    double *EH = (double *)malloc(sizeof(double) * 3 * ns), *eng = (double *)malloc(sizeof(double) * ns * (NMETH + 2));
-    double *ecol = (double *)malloc(sizeof(double) * ns), *tt = (double *)malloc(sizeof(double) * ns);
-    phgmg_energy en;
-    phgmg_gl3_opts go;
-    phgmg_gl3_stats gs;
-    phgmg_result rc;
-    demo_cache cache;
-    double t0 = demo_now();
-    en.H = EH; en.S = EH + ns; en.D = EH + 2 * ns;
-    memset(&go, 0, sizeof go); go.tol = 1e-8; go.max_iter = 20;
-    rc = phgmg_simulate(&M.sys, x0, 0.0, dt, nsteps, inf[in], NULL, &go, X, Y, &en, &gs, NULL, NULL);
-    if (rc != PHGMG_OK) demo_die("full-order simulation", rc);
-    for (k = 0; k < ns; ++k) { eng[k * (NMETH + 2)] = tt[k] = k * dt; eng[k * (NMETH + 2) + 1] = NAN; }
-    phgmg_err_energy(&en, nsteps, ecol);
-    for (k = 0; k < ns; ++k) eng[k * (NMETH + 2) + 1] = ecol[k];
-    for (j = 0; j < NMETH; ++j) for (k = 0; k < ns; ++k) eng[k * (NMETH + 2) + 2 + j] = NAN;
-    printf("\nu = %s: FOM %.3f s (%ld Newton iterations, %ld factorizations), max e_energy %.2e\n",
-           in ? "0.1" : "0.1 sin t", demo_now() - t0, gs.newton_iters, gs.factorizations, ecol[nsteps]);
-    demo_cache_build(&cache, &M.sys, X, ns, rmax + rn + 1, 1);
-    demo_cache_deim(&cache, &M.sys, X, ns, deim_tol);
-    printf("  %3s  %-22s %-22s %-22s %-10s %-10s %-10s %s\n", "r", "SP2-POD e_red / e_y",
-           "GMG-POD e_red / e_y", "GMG-QM e_red / e_y", "proj POD", "proj QM", "lowerbnd", "lambda, DEIM pts");
-    for (k = 0; k < nr; ++k) {
-      const int r = rmin + k * rstep;
-      double lam = lambda_fixed;
-      int ndeim = 0, nneg = 0;
-      rx[k] = r;
-      tred[k * (NMETH + 1)] = ty[k * (NMETH + 1)] = tproj[k * 4] = r;
-      tproj[k * 4 + 1] = tproj[k * 4 + 2] = tproj[k * 4 + 3] = NAN;
-      printf("  %3d", r);
-      for (j = 0; j < NMETH; ++j) {
-        phgmg_reduce_opts o;
-        demo_rom_result res;
-        phgmg_energy ren;
-        double *REH = NULL;
-        memset(&o, 0, sizeof o);
-        o.method = meth_id[j]; o.r = r; o.rn = rn; o.deim = 1; o.deim_tol = deim_tol; o.deim_allow_negative = 1;
-        if (meth_id[j] == PHGMG_METHOD_GMG_QM) {
-          if (!(lam > 0)) lam = fmax(0.2 * tproj[k * 4 + 1], pow(10.0, -2.5));
-          o.lambda = lam;
-        }
-        demo_cache_use(&cache, &o);
-        if (r == renergy) {
-          REH = (double *)malloc(sizeof(double) * 3 * ns);
-          ren.H = REH; ren.S = REH + ns; ren.D = REH + 2 * ns;
-        }
-        res = demo_run_rom(&cache, &M.sys, X, Y, nsteps, dt, inf[in], &o, 1e-8, 20, REH ? &ren : NULL);
-        if (res.rc != PHGMG_OK) fprintf(stderr, "  [%s r=%d: %s]\n", meth_name[j], r, phgmg_result_string(res.rc));
-        if (REH) {
-          if (res.rc == PHGMG_OK) {
-            phgmg_err_energy(&ren, nsteps, ecol);
-            for (i = 0; i < ns; ++i) eng[i * (NMETH + 2) + 2 + j] = ecol[i];
-          }
-          free(REH);
-        }
-        tred[k * (NMETH + 1) + 1 + j] = res.e_red;
-        ty[k * (NMETH + 1) + 1 + j] = res.e_y;
-        if (meth_id[j] == PHGMG_METHOD_GMG_POD) tproj[k * 4 + 1] = res.e_proj;
-        if (meth_id[j] == PHGMG_METHOD_GMG_QM) { tproj[k * 4 + 2] = res.e_proj; tproj[k * 4 + 3] = res.e_lower; }
-        ndeim = PHGMG__MAX(ndeim, res.info.deim_modes);
-        nneg += res.info.deim_negative;
-        printf("  %9.3e / %9.3e", res.e_red, res.e_y);
-      }
-      printf("  %9.3e  %9.3e  %9.3e  %.2e, %d%s\n", tproj[k * 4 + 1], tproj[k * 4 + 2], tproj[k * 4 + 3], lam, ndeim,
-             nneg ? " (negative weights!)" : "");
-    }
-    demo_tables_and_panels(out, "nonlinear", inname[in], in, "r,SP2-POD,GMG-POD,GMG-QM", meth_name, NMETH, nr, rx,
-                           tred, ty, tproj, fig);
-    snprintf(path, sizeof path, "%s/nonlinear_%s_energy.csv", out, inname[in]);
-    demo_write_csv(path, "t,FOM,SP2-POD,GMG-POD,GMG-QM", ns, NMETH + 2, eng, 0);
-    {
-      char title[128];
-      snprintf(title, sizeof title, "(%c) u = %s, r = %d", 'a' + in, in ? "0.1" : "0.1 sin t", renergy);
-      svgplot_panel(fige, in, title, "time t", "e_energy(t)");
-      for (j = 0; j < NMETH + 1; ++j) {
-        static const char *en_name[4] = {"FOM", "SP2-POD", "GMG-POD", "GMG-QM"};
-        static const int en_style[4] = {3, 0, 1, 2};
-        for (i = 0; i < ns; ++i) ecol[i] = eng[i * (NMETH + 2) + 1 + j];
-        svgplot_series(fige, in, en_name[j], ns, tt, ecol, en_style[j]);
-      }
-    }
-    demo_cache_free(&cache);
-    free(X); free(Y); free(x0); free(tred); free(ty); free(tproj); free(rx); free(col);
-    free(EH); free(eng); free(ecol); free(tt);
-  }
-  snprintf(path, sizeof path, "%s/fig3_nonlinear.svg", out);
-  if (svgplot_save(fig, path) != 0) { fprintf(stderr, "cannot write %s\n", path); return 1; }
-  snprintf(path, sizeof path, "%s/fig4_energy.svg", out);
-  if (svgplot_save(fige, path) != 0) { fprintf(stderr, "cannot write %s\n", path); return 1; }
-  svgplot_free(fig);
-  svgplot_free(fige);
-  msd_nonlinear_free(&M);
-  printf("\nwrote %s/nonlinear_*.csv, %s/fig3_nonlinear.svg, %s/fig4_energy.svg\nnonlinear demo wall time: %.2f s\n",
-         out, out, out, demo_now() - t_start);
-  return 0;
+  mo.n = S.n; mo.mass = S.mass; mo.storage = PHGMG_BANDED;
+  if (msd_nonlinear_build(&S.M, &mo) != 0) { fprintf(stderr, "model\n"); return 1; }
+  if (gen) rc = generalization_main(&S, gen);
+  else if (lauto) rc = lambda_auto_study(&S.M, S.out, S.rmin, S.rmax, S.rstep, S.rn, S.deim_tol, S.nsteps, S.dt);
+  else rc = paper_main(&S);
+  msd_nonlinear_free(&S.M);
+  printf("nonlinear %sdemo wall time: %.2f s\n", gen ? "generalization " : lauto ? "lambda-auto " : "",
+         demo_now() - t_start);
+  return rc;
 }
