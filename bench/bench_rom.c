@@ -457,13 +457,310 @@ static void fom_reference(const char *name, model_data *md, double tol, int maxi
   free(c.x0);
 }
 
+/* Machine probes: FMA peak, DRAM and L3 triad bandwidth (g_peak, g_bw_*). */
+static void bench_machine(void) {
+  char extra[160];
+  int i;
+  peak_ctx pc;
+  triad_ctx tc;
+  timing T;
+  pc.iters = 4000000; pc.sink = 0.0;
+  T = bench("machine_fma_peak", RUNS_OFF, peak_fn, &pc);
+  g_peak = (double)pc.iters * PEAK_ACC * 8.0 / T.med * 1e-9;
+  snprintf(extra, sizeof extra, "%s: %.2f GFLOP/s (12 independent 4-wide FMA chains)%s",
+#if defined(__AVX2__) && defined(__FMA__)
+           "AVX2 FMA",
+#else
+           "scalar",
+#endif
+           g_peak, pc.sink == 12345.0 ? " " : "");
+  row("machine_fma_peak", T, extra);
+  tc.n = 4L << 20; /* 3 x 32 MiB: from DRAM */
+  tc.a = (double *)xmalloc(sizeof(double) * (size_t)tc.n);
+  tc.b = (double *)xmalloc(sizeof(double) * (size_t)tc.n);
+  tc.c = (double *)xmalloc(sizeof(double) * (size_t)tc.n);
+  for (i = 0; i < tc.n; ++i) { tc.a[i] = 0.0; tc.b[i] = 1.0; tc.c[i] = 2.0; }
+  T = bench("machine_triad_4M", RUNS_OFF, triad_fn, &tc);
+  g_bw_dram = 24.0 * (double)tc.n / T.med * 1e-9;
+  snprintf(extra, sizeof extra, "a = b + s c over 3 x 32 MiB (DRAM): %.2f GB/s (24 bytes per element)", g_bw_dram);
+  row("machine_triad_4M", T, extra);
+  tc.n = 256L << 10; /* 3 x 2 MiB: beyond L2, inside L3; 64 sweeps per run */
+  {
+    triad_ctx t2 = tc;
+    T = bench("machine_triad_256K_x64", RUNS_OFF, triad64_fn, &t2);
+    g_bw_l3 = 64.0 * 24.0 * (double)tc.n / T.med * 1e-9;
+    snprintf(extra, sizeof extra, "the same over 3 x 2 MiB (L3), 64 sweeps: %.2f GB/s", g_bw_l3);
+    row("machine_triad_256K_x64", T, extra);
+  }
+  free(tc.a); free(tc.b); free(tc.c);
+}
+
+/* Offline: the POD of the nonlinear N = 1000 snapshots (r = 20). */
+static void bench_offline_pod(const model_data *nl1) {
+  const int N = nl1->sys->N;
+  pod_ctx pc;
+  timing T;
+  int rank = 0, kk = 0;
+  double s1;
+  char extra[160];
+  /* numerical rank of the snapshots, for the nominal POD flop count 4 N ns rank */
+  {
+    double *U = (double *)xmalloc(sizeof(double) * N), ss;
+    if (phgmg_svd(N, NS, nl1->X, N, 1, &ss, U, N, NULL, 1, &kk, &rank, NULL) != PHGMG_OK) die("svd", PHGMG_ERR_RANK);
+    s1 = ss;
+    free(U);
+  }
+  pc.N = N; pc.k = 20; pc.X = nl1->X;
+  pc.V = (double *)xmalloc(sizeof(double) * (size_t)N * 20); pc.S = (double *)xmalloc(sizeof(double) * 20);
+  T = bench("offline_pod_nonlinear_r20", RUNS_OFF, pod_fn, &pc);
+  snprintf(extra, sizeof extra, "numerical rank %d, sigma1 %.3e; nominal 4 N ns rank = %.2f GFLOP -> %.2f GFLOP/s",
+           rank, s1, 4.0 * N * NS * rank * 1e-9, 4.0 * N * NS * rank / T.med * 1e-9);
+  row("offline_pod_nonlinear_r20", T, extra);
+  free(pc.V); free(pc.S);
+}
+
+/* Offline: the GMG-QM ridge fit at r = 20 (V1, V2 from the hierarchical POD, untimed). */
+static void bench_offline_qmfit(const model_data *nl1, double lam20) {
+  const int N = nl1->sys->N, p = 20 - 1;
+  qm_ctx qc;
+  timing T;
+  char extra[160];
+  /* QM fit: V1 (p modes) and V2 (r_n modes) from the hierarchical POD, untimed */
+  memset(&qc, 0, sizeof qc);
+  qc.N = N; qc.p = p; qc.rn = RN; qc.lambda = lam20; qc.X = nl1->X;
+  {
+    double *V1 = (double *)xmalloc(sizeof(double) * (size_t)N * p), *V2 = (double *)xmalloc(sizeof(double) * (size_t)N * RN);
+    double *Xr = (double *)xmalloc(sizeof(double) * (size_t)N * NS), *B0 = (double *)xmalloc(sizeof(double) * (size_t)N * (p + 1));
+    double *C = (double *)xmalloc(sizeof(double) * (size_t)(p + 1) * NS);
+    phgmg_result prc = phgmg_pod_hierarchical(N, 1, nl1->sys->B, NS, nl1->X, N, p, RN, V1, V2, NULL);
+    if (prc != PHGMG_OK) die("phgmg_pod_hierarchical", prc);
+    /* residual (I - P) X with P the orthogonal projector onto [B, V1] (B is a unit vector orthogonal to V1) */
+    memcpy(B0, nl1->sys->B, sizeof(double) * (size_t)N);
+    memcpy(B0 + N, V1, sizeof(double) * (size_t)N * p);
+    memcpy(Xr, nl1->X, sizeof(double) * (size_t)N * NS);
+    phgmg_gemm('T', 'N', p + 1, NS, N, 1.0, B0, N, nl1->X, N, 0.0, C, p + 1);
+    phgmg_gemm('N', 'N', N, NS, p + 1, -1.0, B0, N, C, p + 1, 1.0, Xr, N);
+    qc.V1 = V1; qc.V2 = V2; qc.Xres = Xr;
+    qc.Z2 = (double *)xmalloc(sizeof(double) * (size_t)p * NS);
+    qc.Rq = (double *)xmalloc(sizeof(double) * (size_t)RN * NS);
+    qc.Kt = (double *)xmalloc(sizeof(double) * (size_t)NS * (p * (p + 1) / 2));
+    qc.Rqt = (double *)xmalloc(sizeof(double) * (size_t)NS * RN);
+    qc.Mt = (double *)xmalloc(sizeof(double) * (size_t)(p * (p + 1) / 2) * RN);
+    T = bench("offline_qmfit_nonlinear_r20", RUNS_OFF, qm_fn, &qc);
+    {
+      const double nc = p * (p + 1) / 2.0, mm = NS + nc;
+      const double fl = 2.0 * (p + RN) * NS * N + 2.0 * mm * nc * nc - 2.0 / 3.0 * nc * nc * nc + 4.0 * mm * nc * RN;
+      snprintf(extra, sizeof extra, "lambda %.3e, %d x %d ridge LS, %d rhs; nominal %.3f GFLOP -> %.2f GFLOP/s",
+               lam20, NS, (int)nc, RN, fl * 1e-9, fl / T.med * 1e-9);
+    }
+    row("offline_qmfit_nonlinear_r20", T, extra);
+    free(V1); free(V2); free(Xr); free(B0); free(C);
+    free(qc.Z2); free(qc.Rq); free(qc.Kt); free(qc.Rqt); free(qc.Mt);
+  }
+}
+
+/* Offline: DEIM of the quartic terms, and ECSW on the same gradient snapshots. */
+static void bench_offline_hyper(const msd_nonlinear *MN1, const model_data *nl1) {
+  const int N = nl1->sys->N, r = 20;
+  deim_ctx dc;
+  timing T;
+  int rank = 0, kk = 0, i, k;
+  char extra[160];
+  memset(&dc, 0, sizeof dc);
+  dc.M = MN1; dc.X = nl1->X;
+  dc.F = (double *)xmalloc(sizeof(double) * (size_t)MN1->sys.nsep * NS);
+  dc.w = (double *)xmalloc(sizeof(double) * (size_t)MN1->sys.nsep);
+  dc.pts = (int *)xmalloc(sizeof(int) * (size_t)MN1->sys.nsep);
+  T = bench("offline_deim_nonlinear", RUNS_OFF, deim_fn, &dc);
+  { /* numerical rank of the gradient snapshots, for the nominal 4 nterms ns rank */
+    double *U = (double *)xmalloc(sizeof(double) * (size_t)MN1->sys.nsep), ss;
+    if (phgmg_svd(MN1->sys.nsep, NS, dc.F, MN1->sys.nsep, 1, &ss, U, MN1->sys.nsep, NULL, 1, &kk, &rank, NULL) != PHGMG_OK)
+      die("svd", PHGMG_ERR_RANK);
+    free(U);
+  }
+  snprintf(extra, sizeof extra, "%d x %d gradient snapshots, rank %d (nominal %.2f GFLOP), %d DEIM points, %d negative weights",
+           MN1->sys.nsep, NS, rank, 4.0 * MN1->sys.nsep * NS * rank * 1e-9, dc.nd, dc.nneg);
+  row("offline_deim_nonlinear", T, extra);
+  if (!g_only || strstr("hyper_ecsw_N1000_r20 offline_hyper_nonlinear_r20", g_only)) {
+    const int nt = MN1->sys.nsep, m = NS * r; /* r = 20 */
+    ecsw_ctx ec;
+    double *V0 = (double *)xmalloc(sizeof(double) * (size_t)N * r), *Xa = (double *)xmalloc(sizeof(double) * (size_t)N * NS);
+    double *Gm = (double *)xmalloc(sizeof(double) * (size_t)m * nt), *tg = (double *)xmalloc(sizeof(double) * (size_t)m);
+    double wmin;
+    int a, sep;
+    phgmg_result prc = phgmg_adjust_snapshots(N, 1, MN1->sys.B, NS, nl1->X, N, Xa, N, NULL);
+    memcpy(V0, MN1->sys.B, sizeof(double) * (size_t)N); /* B is a unit vector orthogonal to the adjusted snapshots */
+    if (prc == PHGMG_OK) prc = phgmg_pod(N, NS, Xa, N, r - 1, 0.0, V0 + N, N, NULL, &kk, NULL);
+    if (prc != PHGMG_OK) die("hyper basis", prc);
+    memset(&ec, 0, sizeof ec);
+    ec.M = MN1; ec.X = nl1->X; ec.V0 = V0; ec.Gm = Gm; ec.t = tg;
+    ec.F = (double *)xmalloc(sizeof(double) * (size_t)nt * NS);
+    ec.Vt = (double *)xmalloc(sizeof(double) * (size_t)nt * r);
+    ec.w = (double *)xmalloc(sizeof(double) * (size_t)nt);
+    ec.pts = (int *)xmalloc(sizeof(int) * (size_t)nt);
+    for (k = 0; k < nt; ++k)
+      for (a = 0; a < r; ++a) ec.Vt[k + (size_t)a * nt] = V0[MN1->sys.sep_idx[k] + (size_t)a * N];
+    for (i = 0; i < m; ++i) tg[i] = 0.0;
+    for (k = 0; k < nt; ++k) {
+      for (i = 0; i < NS; ++i) {
+        const double l = nl1->X[MN1->sys.sep_idx[k] + (size_t)i * N], d = 4.0 * MN1->sys.poly[4] * l * l * l;
+        for (a = 0; a < r; ++a) Gm[i * r + a + (size_t)k * m] = d * ec.Vt[k + (size_t)a * nt];
+      }
+      for (i = 0; i < m; ++i) tg[i] += Gm[i + (size_t)k * m];
+    }
+    for (sep = 0; sep < 2; ++sep) {
+      const char *nm = sep ? "offline_hyper_nonlinear_r20" : "hyper_ecsw_N1000_r20";
+      ec.sep = sep;
+      T = bench(nm, RUNS_OFF, ecsw_fn, &ec);
+      for (wmin = 1e300, i = 0; i < ec.nd; ++i) if (ec.w[i] < wmin) wmin = ec.w[i];
+      snprintf(extra, sizeof extra, "%s: %d x %d, tol 1e-6: %d points (DEIM 1e-8: %d), residual %.2e, min weight %.3f",
+               sep ? "F + phgmg_ecsw_separable" : "phgmg_ecsw", sep ? nt : m, sep ? NS : nt, ec.nd, dc.nd, ec.rel, wmin);
+      row(nm, T, extra);
+    }
+    free(V0); free(Xa); free(Gm); free(tg); free(ec.F); free(ec.Vt); free(ec.w); free(ec.pts);
+  }
+  free(dc.F); free(dc.w); free(dc.pts);
+}
+
+/* Offline: whole phgmg_reduce of every method at r = 20. */
+static void bench_offline_reduce(const model_data *lin, const model_data *nl1, double lam20) {
+  reduce_ctx rc;
+  timing T;
+  int i;
+  char extra[160];
+  {
+    static const struct { const char *name; phgmg_method m; int lin, map; } oc[] = {
+      {"offline_gmgpod_nonlinear_r20", PHGMG_METHOD_GMG_POD, 0, 0},
+      {"offline_sp2_nonlinear_r20", PHGMG_METHOD_SP2, 0, 0},
+      {"offline_gmgqm_nonlinear_r20", PHGMG_METHOD_GMG_QM, 0, 0},
+      {"offline_sp1_linear_r20", PHGMG_METHOD_SP1, 1, 1},
+      {"offline_gmgpod_linear_r20", PHGMG_METHOD_GMG_POD, 1, 1},
+      {"offline_gmgqm_linear_r20", PHGMG_METHOD_GMG_QM, 1, 0},
+    };
+    for (i = 0; i < (int)(sizeof oc / sizeof oc[0]); ++i) {
+      const model_data *md = oc[i].lin ? lin : nl1;
+      memset(&rc, 0, sizeof rc);
+      rc.sys = md->sys; rc.X = md->X;
+      rc.o.method = oc[i].m; rc.o.r = 20; rc.o.rn = RN;
+      rc.o.lambda = oc[i].lin ? 1e-3 : lam20;
+      rc.o.deim = 1; rc.o.deim_tol = 1e-8; rc.o.deim_allow_negative = 1;
+      if (oc[i].map) rc.o.dt = DT;
+      T = bench(oc[i].name, RUNS_OFF, reduce_fn, &rc);
+      snprintf(extra, sizeof extra, "whole phgmg_reduce, N = %d%s", md->sys->N,
+               oc[i].map ? ", with the GL3 step map" : (oc[i].lin ? "" : ", DEIM"));
+      row(oc[i].name, T, extra);
+      phgmg_reduced_destroy(rc.red);
+    }
+  }
+}
+
+/* Online: every method at r = 8, 16, 20 on the linear and the nonlinear chain,
+   and the r = 20 models of the N = 4000 chain (online cost must not depend on N). */
+static void bench_online(const model_data *lin, const model_data *nl1, const model_data *nl4) {
+  static const int rs[3] = {8, 16, 20};
+  char name[96];
+  int k;
+  for (k = 0; k < 3; ++k) {
+    const int r = rs[k];
+    phgmg_reduced *red;
+    snprintf(name, sizeof name, "rom_linear_sp1_r%d", r);
+    red = build(lin, PHGMG_METHOD_SP1, r, 0.0, 1);
+    online_case(name, lin, red);
+    phgmg_reduced_destroy(red);
+    snprintf(name, sizeof name, "rom_linear_gmgpod_r%d", r);
+    red = build(lin, PHGMG_METHOD_GMG_POD, r, 0.0, 1);
+    online_case(name, lin, red);
+    phgmg_reduced_destroy(red);
+    snprintf(name, sizeof name, "rom_linear_gmgqm_r%d", r);
+    red = build(lin, PHGMG_METHOD_GMG_QM, r, 1e-3, 0);
+    online_case(name, lin, red);
+    phgmg_reduced_destroy(red);
+  }
+  for (k = 0; k < 3; ++k) {
+    const int r = rs[k];
+    phgmg_reduced *red;
+    snprintf(name, sizeof name, "rom_nonlinear_gmgpod_deim_r%d", r);
+    red = build(nl1, PHGMG_METHOD_GMG_POD, r, 0.0, 0);
+    online_case(name, nl1, red);
+    phgmg_reduced_destroy(red);
+    snprintf(name, sizeof name, "rom_nonlinear_sp2_deim_r%d", r);
+    red = build(nl1, PHGMG_METHOD_SP2, r, 0.0, 0);
+    online_case(name, nl1, red);
+    phgmg_reduced_destroy(red);
+    snprintf(name, sizeof name, "rom_nonlinear_gmgqm_deim_r%d", r);
+    red = build(nl1, PHGMG_METHOD_GMG_QM, r, nl_lambda(nl1, r), 0);
+    online_case(name, nl1, red);
+    phgmg_reduced_destroy(red);
+  }
+    phgmg_reduced *red;
+    red = build(nl4, PHGMG_METHOD_GMG_POD, 20, 0.0, 0);
+    online_case("rom_nonlinear_gmgpod_deim_r20_N4000", nl4, red);
+    phgmg_reduced_destroy(red);
+    red = build(nl4, PHGMG_METHOD_SP2, 20, 0.0, 0);
+    online_case("rom_nonlinear_sp2_deim_r20_N4000", nl4, red);
+    phgmg_reduced_destroy(red);
+    red = build(nl4, PHGMG_METHOD_GMG_QM, 20, nl_lambda(nl4, 20), 0);
+    online_case("rom_nonlinear_gmgqm_deim_r20_N4000", nl4, red);
+    phgmg_reduced_destroy(red);
+}
+
+/* Online, interleaved: the N = 1000 and N = 4000 models alternate run by run,
+   so that slow phases of a shared machine hit both alike. */
+static void bench_online_interleaved(const model_data *nl1, const model_data *nl4) {
+  static const phgmg_method km[3] = {PHGMG_METHOD_GMG_POD, PHGMG_METHOD_SP2, PHGMG_METHOD_GMG_QM};
+  static const char *kn[3] = {"gmgpod_deim", "sp2_deim", "gmgqm_deim"};
+  char extra[160];
+  int k;
+  for (k = 0; k < 3; ++k) if (!g_only || strstr("rom_nonlinear_interleaved", g_only)) {
+    phgmg_reduced *r1 = build(nl1, km[k], 20, km[k] == PHGMG_METHOD_GMG_QM ? nl_lambda(nl1, 20) : 0.0, 0);
+    phgmg_reduced *r4 = build(nl4, km[k], 20, km[k] == PHGMG_METHOD_GMG_QM ? nl_lambda(nl4, 20) : 0.0, 0);
+    online_ctx c[2];
+    double t[2][RUNS_ON];
+    timing T[2];
+    int run, j;
+    for (j = 0; j < 2; ++j) {
+      const model_data *md = j ? nl4 : nl1;
+      double xr[64];
+      int a;
+      memset(&c[j], 0, sizeof c[j]);
+      c[j].rom = phgmg_reduced_rom(j ? r4 : r1);
+      c[j].tol = (phgmg_real)md->tol;
+      c[j].maxit = md->maxit;
+      c[j].y = (phgmg_real *)xmalloc(sizeof(phgmg_real) * NS);
+      phgmg_reduced_restrict(j ? r4 : r1, md->X, xr);
+      for (a = 0; a < c[j].rom->r; ++a) c[j].x0[a] = (phgmg_real)xr[a];
+    }
+    for (run = -1; run < RUNS_ON; ++run)
+      for (j = 0; j < 2; ++j) {
+        double t0;
+        if (online_fn(&c[j], 0) != 0) die("interleaved setup", PHGMG_ERR_INVALID_ARG);
+        t0 = now_cpu();
+        if (online_fn(&c[j], 1) != 0) die("interleaved run", PHGMG_ERR_NOT_CONVERGED);
+        if (run >= 0) t[j][run] = now_cpu() - t0;
+      }
+    for (j = 0; j < 2; ++j) {
+      char nm[96];
+      T[j].med = median_of(t[j], RUNS_ON);
+      T[j].mn = t[j][0]; T[j].mx = t[j][RUNS_ON - 1]; T[j].wall = T[j].med; T[j].runs = RUNS_ON;
+      snprintf(nm, sizeof nm, "rom_nonlinear_interleaved_%s_r20_N%d", kn[k], j ? 4000 : 1000);
+      if (g_csv) { fprintf(g_csv, "%s,%.9f,%.9f,%.9f,%d\n", nm, T[j].med, T[j].mn, T[j].mx, RUNS_ON); fflush(g_csv); }
+      snprintf(extra, sizeof extra, "%9.3f  interleaved%s", 1e6 * T[j].med / NSTEPS,
+               j ? "" : "  (N = 4000 / N = 1000 on the next line)");
+      if (j) snprintf(extra, sizeof extra, "%9.3f  interleaved; N = 4000 / N = 1000 = %.3f", 1e6 * T[j].med / NSTEPS,
+                      T[1].med / T[0].med);
+      row(nm, T[j], extra);
+    }
+    free(c[0].y); free(c[1].y);
+    phgmg_reduced_destroy(r1);
+    phgmg_reduced_destroy(r4);
+  }
+}
+
 int main(int argc, char **argv) {
   msd_linear ML;
   msd_nonlinear MN1, MN4;
   msd_nl_opts mo;
   model_data lin, nl1, nl4;
-  static const int rs[3] = {8, 16, 20};
-  char name[96], extra[160];
   int i, k;
   g_only = getenv("BENCH_ROM_ONLY");
   if (argc > 1) {
@@ -479,40 +776,7 @@ int main(int argc, char **argv) {
   }
   row_head();
 
-  { /* machine probes */
-    peak_ctx pc;
-    triad_ctx tc;
-    timing T;
-    pc.iters = 4000000; pc.sink = 0.0;
-    T = bench("machine_fma_peak", RUNS_OFF, peak_fn, &pc);
-    g_peak = (double)pc.iters * PEAK_ACC * 8.0 / T.med * 1e-9;
-    snprintf(extra, sizeof extra, "%s: %.2f GFLOP/s (12 independent 4-wide FMA chains)%s",
-#if defined(__AVX2__) && defined(__FMA__)
-             "AVX2 FMA",
-#else
-             "scalar",
-#endif
-             g_peak, pc.sink == 12345.0 ? " " : "");
-    row("machine_fma_peak", T, extra);
-    tc.n = 4L << 20; /* 3 x 32 MiB: from DRAM */
-    tc.a = (double *)xmalloc(sizeof(double) * (size_t)tc.n);
-    tc.b = (double *)xmalloc(sizeof(double) * (size_t)tc.n);
-    tc.c = (double *)xmalloc(sizeof(double) * (size_t)tc.n);
-    for (i = 0; i < tc.n; ++i) { tc.a[i] = 0.0; tc.b[i] = 1.0; tc.c[i] = 2.0; }
-    T = bench("machine_triad_4M", RUNS_OFF, triad_fn, &tc);
-    g_bw_dram = 24.0 * (double)tc.n / T.med * 1e-9;
-    snprintf(extra, sizeof extra, "a = b + s c over 3 x 32 MiB (DRAM): %.2f GB/s (24 bytes per element)", g_bw_dram);
-    row("machine_triad_4M", T, extra);
-    tc.n = 256L << 10; /* 3 x 2 MiB: beyond L2, inside L3; 64 sweeps per run */
-    {
-      triad_ctx t2 = tc;
-      T = bench("machine_triad_256K_x64", RUNS_OFF, triad64_fn, &t2);
-      g_bw_l3 = 64.0 * 24.0 * (double)tc.n / T.med * 1e-9;
-      snprintf(extra, sizeof extra, "the same over 3 x 2 MiB (L3), 64 sweeps: %.2f GB/s", g_bw_l3);
-      row("machine_triad_256K_x64", T, extra);
-    }
-    free(tc.a); free(tc.b); free(tc.c);
-  }
+  bench_machine();
 
   /* models and full-order references (their trajectories are the snapshots) */
   if (msd_linear_build(&ML, 50, NULL, NULL, NULL, PHGMG_DENSE) != 0) die("linear model", PHGMG_ERR_NOMEM);
@@ -532,237 +796,15 @@ int main(int argc, char **argv) {
   fom_reference("ref_fom_nonlinear_N1000", &nl1, 1e-8, 20);
   fom_reference("ref_fom_nonlinear_N4000", &nl4, 1e-8, 20);
 
-  { /* offline on the nonlinear N = 1000 snapshots (and the linear model) */
-    const int N = nl1.sys->N, r = 20, p = r - 1;
-    pod_ctx pc;
-    qm_ctx qc;
-    deim_ctx dc;
-    reduce_ctx rc;
-    timing T;
-    int rank = 0, kk = 0;
-    double s1, lam20 = nl_lambda(&nl1, 20);
-    /* numerical rank of the snapshots, for the nominal POD flop count 4 N ns rank */
-    {
-      double *U = (double *)xmalloc(sizeof(double) * N), ss;
-      if (phgmg_svd(N, NS, nl1.X, N, 1, &ss, U, N, NULL, 1, &kk, &rank, NULL) != PHGMG_OK) die("svd", PHGMG_ERR_RANK);
-      s1 = ss;
-      free(U);
-    }
-    pc.N = N; pc.k = 20; pc.X = nl1.X;
-    pc.V = (double *)xmalloc(sizeof(double) * (size_t)N * 20); pc.S = (double *)xmalloc(sizeof(double) * 20);
-    T = bench("offline_pod_nonlinear_r20", RUNS_OFF, pod_fn, &pc);
-    snprintf(extra, sizeof extra, "numerical rank %d, sigma1 %.3e; nominal 4 N ns rank = %.2f GFLOP -> %.2f GFLOP/s",
-             rank, s1, 4.0 * N * NS * rank * 1e-9, 4.0 * N * NS * rank / T.med * 1e-9);
-    row("offline_pod_nonlinear_r20", T, extra);
-    free(pc.V); free(pc.S);
-
-    /* QM fit: V1 (p modes) and V2 (r_n modes) from the hierarchical POD, untimed */
-    memset(&qc, 0, sizeof qc);
-    qc.N = N; qc.p = p; qc.rn = RN; qc.lambda = lam20; qc.X = nl1.X;
-    {
-      double *V1 = (double *)xmalloc(sizeof(double) * (size_t)N * p), *V2 = (double *)xmalloc(sizeof(double) * (size_t)N * RN);
-      double *Xr = (double *)xmalloc(sizeof(double) * (size_t)N * NS), *B0 = (double *)xmalloc(sizeof(double) * (size_t)N * (p + 1));
-      double *C = (double *)xmalloc(sizeof(double) * (size_t)(p + 1) * NS);
-      phgmg_result prc = phgmg_pod_hierarchical(N, 1, nl1.sys->B, NS, nl1.X, N, p, RN, V1, V2, NULL);
-      if (prc != PHGMG_OK) die("phgmg_pod_hierarchical", prc);
-      /* residual (I - P) X with P the orthogonal projector onto [B, V1] (B is a unit vector orthogonal to V1) */
-      memcpy(B0, nl1.sys->B, sizeof(double) * (size_t)N);
-      memcpy(B0 + N, V1, sizeof(double) * (size_t)N * p);
-      memcpy(Xr, nl1.X, sizeof(double) * (size_t)N * NS);
-      phgmg_gemm('T', 'N', p + 1, NS, N, 1.0, B0, N, nl1.X, N, 0.0, C, p + 1);
-      phgmg_gemm('N', 'N', N, NS, p + 1, -1.0, B0, N, C, p + 1, 1.0, Xr, N);
-      qc.V1 = V1; qc.V2 = V2; qc.Xres = Xr;
-      qc.Z2 = (double *)xmalloc(sizeof(double) * (size_t)p * NS);
-      qc.Rq = (double *)xmalloc(sizeof(double) * (size_t)RN * NS);
-      qc.Kt = (double *)xmalloc(sizeof(double) * (size_t)NS * (p * (p + 1) / 2));
-      qc.Rqt = (double *)xmalloc(sizeof(double) * (size_t)NS * RN);
-      qc.Mt = (double *)xmalloc(sizeof(double) * (size_t)(p * (p + 1) / 2) * RN);
-      T = bench("offline_qmfit_nonlinear_r20", RUNS_OFF, qm_fn, &qc);
-      {
-        const double nc = p * (p + 1) / 2.0, mm = NS + nc;
-        const double fl = 2.0 * (p + RN) * NS * N + 2.0 * mm * nc * nc - 2.0 / 3.0 * nc * nc * nc + 4.0 * mm * nc * RN;
-        snprintf(extra, sizeof extra, "lambda %.3e, %d x %d ridge LS, %d rhs; nominal %.3f GFLOP -> %.2f GFLOP/s",
-                 lam20, NS, (int)nc, RN, fl * 1e-9, fl / T.med * 1e-9);
-      }
-      row("offline_qmfit_nonlinear_r20", T, extra);
-      free(V1); free(V2); free(Xr); free(B0); free(C);
-      free(qc.Z2); free(qc.Rq); free(qc.Kt); free(qc.Rqt); free(qc.Mt);
-    }
-
-    memset(&dc, 0, sizeof dc);
-    dc.M = &MN1; dc.X = nl1.X;
-    dc.F = (double *)xmalloc(sizeof(double) * (size_t)MN1.sys.nsep * NS);
-    dc.w = (double *)xmalloc(sizeof(double) * (size_t)MN1.sys.nsep);
-    dc.pts = (int *)xmalloc(sizeof(int) * (size_t)MN1.sys.nsep);
-    T = bench("offline_deim_nonlinear", RUNS_OFF, deim_fn, &dc);
-    { /* numerical rank of the gradient snapshots, for the nominal 4 nterms ns rank */
-      double *U = (double *)xmalloc(sizeof(double) * (size_t)MN1.sys.nsep), ss;
-      if (phgmg_svd(MN1.sys.nsep, NS, dc.F, MN1.sys.nsep, 1, &ss, U, MN1.sys.nsep, NULL, 1, &kk, &rank, NULL) != PHGMG_OK)
-        die("svd", PHGMG_ERR_RANK);
-      free(U);
-    }
-    snprintf(extra, sizeof extra, "%d x %d gradient snapshots, rank %d (nominal %.2f GFLOP), %d DEIM points, %d negative weights",
-             MN1.sys.nsep, NS, rank, 4.0 * MN1.sys.nsep * NS * rank * 1e-9, dc.nd, dc.nneg);
-    row("offline_deim_nonlinear", T, extra);
-    if (!g_only || strstr("hyper_ecsw_N1000_r20 offline_hyper_nonlinear_r20", g_only)) {
-      const int nt = MN1.sys.nsep, m = NS * r; /* r = 20 */
-      ecsw_ctx ec;
-      double *V0 = (double *)xmalloc(sizeof(double) * (size_t)N * r), *Xa = (double *)xmalloc(sizeof(double) * (size_t)N * NS);
-      double *Gm = (double *)xmalloc(sizeof(double) * (size_t)m * nt), *tg = (double *)xmalloc(sizeof(double) * (size_t)m);
-      double wmin;
-      int a, sep;
-      phgmg_result prc = phgmg_adjust_snapshots(N, 1, MN1.sys.B, NS, nl1.X, N, Xa, N, NULL);
-      memcpy(V0, MN1.sys.B, sizeof(double) * (size_t)N); /* B is a unit vector orthogonal to the adjusted snapshots */
-      if (prc == PHGMG_OK) prc = phgmg_pod(N, NS, Xa, N, r - 1, 0.0, V0 + N, N, NULL, &kk, NULL);
-      if (prc != PHGMG_OK) die("hyper basis", prc);
-      memset(&ec, 0, sizeof ec);
-      ec.M = &MN1; ec.X = nl1.X; ec.V0 = V0; ec.Gm = Gm; ec.t = tg;
-      ec.F = (double *)xmalloc(sizeof(double) * (size_t)nt * NS);
-      ec.Vt = (double *)xmalloc(sizeof(double) * (size_t)nt * r);
-      ec.w = (double *)xmalloc(sizeof(double) * (size_t)nt);
-      ec.pts = (int *)xmalloc(sizeof(int) * (size_t)nt);
-      for (k = 0; k < nt; ++k)
-        for (a = 0; a < r; ++a) ec.Vt[k + (size_t)a * nt] = V0[MN1.sys.sep_idx[k] + (size_t)a * N];
-      for (i = 0; i < m; ++i) tg[i] = 0.0;
-      for (k = 0; k < nt; ++k) {
-        for (i = 0; i < NS; ++i) {
-          const double l = nl1.X[MN1.sys.sep_idx[k] + (size_t)i * N], d = 4.0 * MN1.sys.poly[4] * l * l * l;
-          for (a = 0; a < r; ++a) Gm[i * r + a + (size_t)k * m] = d * ec.Vt[k + (size_t)a * nt];
-        }
-        for (i = 0; i < m; ++i) tg[i] += Gm[i + (size_t)k * m];
-      }
-      for (sep = 0; sep < 2; ++sep) {
-        const char *nm = sep ? "offline_hyper_nonlinear_r20" : "hyper_ecsw_N1000_r20";
-        ec.sep = sep;
-        T = bench(nm, RUNS_OFF, ecsw_fn, &ec);
-        for (wmin = 1e300, i = 0; i < ec.nd; ++i) if (ec.w[i] < wmin) wmin = ec.w[i];
-        snprintf(extra, sizeof extra, "%s: %d x %d, tol 1e-6: %d points (DEIM 1e-8: %d), residual %.2e, min weight %.3f",
-                 sep ? "F + phgmg_ecsw_separable" : "phgmg_ecsw", sep ? nt : m, sep ? NS : nt, ec.nd, dc.nd, ec.rel, wmin);
-        row(nm, T, extra);
-      }
-      free(V0); free(Xa); free(Gm); free(tg); free(ec.F); free(ec.Vt); free(ec.w); free(ec.pts);
-    }
-    free(dc.F); free(dc.w); free(dc.pts);
-
-    {
-      static const struct { const char *name; phgmg_method m; int lin, map; } oc[] = {
-        {"offline_gmgpod_nonlinear_r20", PHGMG_METHOD_GMG_POD, 0, 0},
-        {"offline_sp2_nonlinear_r20", PHGMG_METHOD_SP2, 0, 0},
-        {"offline_gmgqm_nonlinear_r20", PHGMG_METHOD_GMG_QM, 0, 0},
-        {"offline_sp1_linear_r20", PHGMG_METHOD_SP1, 1, 1},
-        {"offline_gmgpod_linear_r20", PHGMG_METHOD_GMG_POD, 1, 1},
-        {"offline_gmgqm_linear_r20", PHGMG_METHOD_GMG_QM, 1, 0},
-      };
-      for (i = 0; i < (int)(sizeof oc / sizeof oc[0]); ++i) {
-        const model_data *md = oc[i].lin ? &lin : &nl1;
-        memset(&rc, 0, sizeof rc);
-        rc.sys = md->sys; rc.X = md->X;
-        rc.o.method = oc[i].m; rc.o.r = 20; rc.o.rn = RN;
-        rc.o.lambda = oc[i].lin ? 1e-3 : lam20;
-        rc.o.deim = 1; rc.o.deim_tol = 1e-8; rc.o.deim_allow_negative = 1;
-        if (oc[i].map) rc.o.dt = DT;
-        T = bench(oc[i].name, RUNS_OFF, reduce_fn, &rc);
-        snprintf(extra, sizeof extra, "whole phgmg_reduce, N = %d%s", md->sys->N,
-                 oc[i].map ? ", with the GL3 step map" : (oc[i].lin ? "" : ", DEIM"));
-        row(oc[i].name, T, extra);
-        phgmg_reduced_destroy(rc.red);
-      }
-    }
+  {
+    const double lam20 = nl_lambda(&nl1, 20);
+    bench_offline_pod(&nl1);
+    bench_offline_qmfit(&nl1, lam20);
+    bench_offline_hyper(&MN1, &nl1);
+    bench_offline_reduce(&lin, &nl1, lam20);
   }
-
-  /* online */
-  for (k = 0; k < 3; ++k) {
-    const int r = rs[k];
-    phgmg_reduced *red;
-    snprintf(name, sizeof name, "rom_linear_sp1_r%d", r);
-    red = build(&lin, PHGMG_METHOD_SP1, r, 0.0, 1);
-    online_case(name, &lin, red);
-    phgmg_reduced_destroy(red);
-    snprintf(name, sizeof name, "rom_linear_gmgpod_r%d", r);
-    red = build(&lin, PHGMG_METHOD_GMG_POD, r, 0.0, 1);
-    online_case(name, &lin, red);
-    phgmg_reduced_destroy(red);
-    snprintf(name, sizeof name, "rom_linear_gmgqm_r%d", r);
-    red = build(&lin, PHGMG_METHOD_GMG_QM, r, 1e-3, 0);
-    online_case(name, &lin, red);
-    phgmg_reduced_destroy(red);
-  }
-  for (k = 0; k < 3; ++k) {
-    const int r = rs[k];
-    phgmg_reduced *red;
-    snprintf(name, sizeof name, "rom_nonlinear_gmgpod_deim_r%d", r);
-    red = build(&nl1, PHGMG_METHOD_GMG_POD, r, 0.0, 0);
-    online_case(name, &nl1, red);
-    phgmg_reduced_destroy(red);
-    snprintf(name, sizeof name, "rom_nonlinear_sp2_deim_r%d", r);
-    red = build(&nl1, PHGMG_METHOD_SP2, r, 0.0, 0);
-    online_case(name, &nl1, red);
-    phgmg_reduced_destroy(red);
-    snprintf(name, sizeof name, "rom_nonlinear_gmgqm_deim_r%d", r);
-    red = build(&nl1, PHGMG_METHOD_GMG_QM, r, nl_lambda(&nl1, r), 0);
-    online_case(name, &nl1, red);
-    phgmg_reduced_destroy(red);
-  }
-  { /* the same reduced models from the N = 4000 chain: online cost must not depend on N */
-    phgmg_reduced *red;
-    red = build(&nl4, PHGMG_METHOD_GMG_POD, 20, 0.0, 0);
-    online_case("rom_nonlinear_gmgpod_deim_r20_N4000", &nl4, red);
-    phgmg_reduced_destroy(red);
-    red = build(&nl4, PHGMG_METHOD_SP2, 20, 0.0, 0);
-    online_case("rom_nonlinear_sp2_deim_r20_N4000", &nl4, red);
-    phgmg_reduced_destroy(red);
-    red = build(&nl4, PHGMG_METHOD_GMG_QM, 20, nl_lambda(&nl4, 20), 0);
-    online_case("rom_nonlinear_gmgqm_deim_r20_N4000", &nl4, red);
-    phgmg_reduced_destroy(red);
-  }
-  { /* the same comparison interleaved: N = 1000 and N = 4000 models alternate
-       run by run, so that slow phases of a shared machine hit both alike */
-    static const phgmg_method km[3] = {PHGMG_METHOD_GMG_POD, PHGMG_METHOD_SP2, PHGMG_METHOD_GMG_QM};
-    static const char *kn[3] = {"gmgpod_deim", "sp2_deim", "gmgqm_deim"};
-    for (k = 0; k < 3; ++k) if (!g_only || strstr("rom_nonlinear_interleaved", g_only)) {
-      phgmg_reduced *r1 = build(&nl1, km[k], 20, km[k] == PHGMG_METHOD_GMG_QM ? nl_lambda(&nl1, 20) : 0.0, 0);
-      phgmg_reduced *r4 = build(&nl4, km[k], 20, km[k] == PHGMG_METHOD_GMG_QM ? nl_lambda(&nl4, 20) : 0.0, 0);
-      online_ctx c[2];
-      double t[2][RUNS_ON];
-      timing T[2];
-      int run, j;
-      for (j = 0; j < 2; ++j) {
-        const model_data *md = j ? &nl4 : &nl1;
-        double xr[64];
-        int a;
-        memset(&c[j], 0, sizeof c[j]);
-        c[j].rom = phgmg_reduced_rom(j ? r4 : r1);
-        c[j].tol = (phgmg_real)md->tol;
-        c[j].maxit = md->maxit;
-        c[j].y = (phgmg_real *)xmalloc(sizeof(phgmg_real) * NS);
-        phgmg_reduced_restrict(j ? r4 : r1, md->X, xr);
-        for (a = 0; a < c[j].rom->r; ++a) c[j].x0[a] = (phgmg_real)xr[a];
-      }
-      for (run = -1; run < RUNS_ON; ++run)
-        for (j = 0; j < 2; ++j) {
-          double t0;
-          if (online_fn(&c[j], 0) != 0) die("interleaved setup", PHGMG_ERR_INVALID_ARG);
-          t0 = now_cpu();
-          if (online_fn(&c[j], 1) != 0) die("interleaved run", PHGMG_ERR_NOT_CONVERGED);
-          if (run >= 0) t[j][run] = now_cpu() - t0;
-        }
-      for (j = 0; j < 2; ++j) {
-        char nm[96];
-        T[j].med = median_of(t[j], RUNS_ON);
-        T[j].mn = t[j][0]; T[j].mx = t[j][RUNS_ON - 1]; T[j].wall = T[j].med; T[j].runs = RUNS_ON;
-        snprintf(nm, sizeof nm, "rom_nonlinear_interleaved_%s_r20_N%d", kn[k], j ? 4000 : 1000);
-        if (g_csv) { fprintf(g_csv, "%s,%.9f,%.9f,%.9f,%d\n", nm, T[j].med, T[j].mn, T[j].mx, RUNS_ON); fflush(g_csv); }
-        snprintf(extra, sizeof extra, "%9.3f  interleaved%s", 1e6 * T[j].med / NSTEPS,
-                 j ? "" : "  (N = 4000 / N = 1000 on the next line)");
-        if (j) snprintf(extra, sizeof extra, "%9.3f  interleaved; N = 4000 / N = 1000 = %.3f", 1e6 * T[j].med / NSTEPS,
-                        T[1].med / T[0].med);
-        row(nm, T[j], extra);
-      }
-      free(c[0].y); free(c[1].y);
-      phgmg_reduced_destroy(r1);
-      phgmg_reduced_destroy(r4);
-    }
-  }
+  bench_online(&lin, &nl1, &nl4);
+  bench_online_interleaved(&nl1, &nl4);
   printf("flop/st: flops per step of the algorithm as implemented (bench_rom.c: rom_flops); "
          "machine peaks: %.2f GFLOP/s (machine_fma_peak), triad %.2f GB/s DRAM, %.2f GB/s L3\n", g_peak, g_bw_dram,
          g_bw_l3);
