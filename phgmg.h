@@ -183,13 +183,14 @@ extern "C" {
   X(PHGMG_ERR_Q_NOT_SYMMETRIC, -17, "Q is not symmetric")                               \
   X(PHGMG_ERR_Q_NOT_PD,        -18, "Q is not positive definite (semidefinite for a nonlinear H)")                       \
   X(PHGMG_ERR_DTYPE,           -19, "unsupported .npy dtype (complex, object, string, ...)") \
-  X(PHGMG_ERR_INEXACT,         -20, "integer beyond 2^53 in magnitude: not exact as a double")
+  X(PHGMG_ERR_INEXACT,         -20, "integer beyond 2^53 in magnitude: not exact as a double") \
+  X(PHGMG_ERR_NOT_STABLE,      -21, "system not asymptotically stable (an undamped mode: eigenvalue on the imaginary axis)")
 
 typedef enum phgmg_result {
 #define PHGMG__X(name, val, str) name = val,
   PHGMG__RESULT_LIST(PHGMG__X)
 #undef PHGMG__X
-  PHGMG__RESULT_END_ = -21
+  PHGMG__RESULT_END_ = -22
 } phgmg_result;
 
 /* A stable, human-readable description of a result code (never NULL). */
@@ -1527,11 +1528,13 @@ PHGMG_DEF phgmg_result phgmg_ph_abc(const phgmg_ph_system *sys, double *A, doubl
    Hankel singular values; T, W (N x r, may be NULL): the bases.
    A must be asymptotically stable. A pH system is stable but may be lossless
    in some mode (R = 0, or a mode the dampers do not reach: eigenvalues on the
-   imaginary axis), where the Gramians do not exist: BT, PRBT and the BALANCED
-   and H2 bases of phgmg_linear_basis then fail with PHGMG_ERR_NOT_CONVERGED
-   or PHGMG_ERR_SINGULAR (the sign iteration of phgmg_lyap / phgmg_care), and
-   write no model (tests/test_linear.c). GMG and SP with the data-driven bases
-   (snapshots, FREQ, IMPULSE) still apply. */
+   imaginary axis), where the Gramians do not exist: BT, PRBT,
+   phgmg_prbt_riccati and the BALANCED and H2 bases of phgmg_linear_basis then
+   fail with PHGMG_ERR_NOT_STABLE and write no model (after a failed Gramian
+   solve the eigenvalues of A are checked: Re >= -1e-8 max |lambda|; other
+   failures keep their code). GMG and SP with the data-driven bases
+   (snapshots, FREQ, IMPULSE) still apply. phgmg_lyap / phgmg_care themselves
+   report such an A as PHGMG_ERR_NOT_CONVERGED or PHGMG_ERR_SINGULAR. */
 PHGMG_DEF phgmg_result phgmg_bt(const phgmg_ph_system *sys, int r, double *Ar, double *Br, double *Cr,
                                 double *hsv, double *T, double *W, const phgmg_allocator *alloc);
 
@@ -1595,7 +1598,8 @@ PHGMG_DEF phgmg_result phgmg_prbt_riccati(const phgmg_ph_system *sys, double eps
    PHGMG_ERR_INVALID_ARG (NULL, negative/NaN eps or dt, only one of X/Y),
    PHGMG_ERR_UNSUPPORTED (nl != NONE), the codes of phgmg_ph_validate,
    PHGMG_ERR_SIZE (r outside 1..N), PHGMG_ERR_NOT_CONVERGED / _SINGULAR,
-   PHGMG_ERR_RANK (Gramian rank below r), PHGMG_ERR_NOMEM; *out is NULL on failure. */
+   PHGMG_ERR_RANK (Gramian rank below r), PHGMG_ERR_NOT_STABLE (an undamped mode,
+   see phgmg_bt), PHGMG_ERR_NOMEM; *out is NULL on failure. */
 PHGMG_DEF phgmg_result phgmg_prbt(phgmg_reduced **out, const phgmg_ph_system *sys, int r,
                                   const phgmg_prbt_opts *opts, double *prsv, double *info_xb,
                                   const phgmg_allocator *alloc);
@@ -1642,7 +1646,9 @@ typedef struct phgmg_basis_opts {
    paper's chain ||G - G_r||_H2 / ||G||_H2 at r = 12 is 1.4e-4 / 6.9e-5 /
    6.0e-5 after 300 / 1000 / 1500 steps). opts->h2_rel (may be NULL): the
    relative H2 error reached. PHGMG_ERR_SINGULAR: V^T G V singular or Ar
-   unstable at the start (e.g. r = 3 with two force ports, where B^T G B = 0). */
+   unstable at the start (e.g. r = 3 with two force ports, where B^T G B = 0);
+   BALANCED, H2: PHGMG_ERR_NOT_STABLE when the Gramians / the H2 norm of the
+   system fail to exist because of an undamped mode (see phgmg_bt). */
 PHGMG_DEF phgmg_result phgmg_linear_basis(const phgmg_ph_system *sys, phgmg_basis_kind kind, int k,
                                           const phgmg_basis_opts *opts, double *V, int *k_out,
                                           const phgmg_allocator *alloc);
@@ -11125,6 +11131,38 @@ PHGMG__PRIV phgmg_result phgmg__project_abc(int N, int m, int r, const double *A
   return PHGMG_OK;
 }
 
+PHGMG__PRIV phgmg_result phgmg__zschur(int n, const double *A, int lda, double *T, double *Z, double *work);
+
+/* 1 when the diagonal of a complex Schur form T (n x n, ld n) has an
+   eigenvalue on the imaginary axis to working precision: Re >= -1e-8 max |lambda|. */
+PHGMG__PRIV int phgmg__schur_undamped(int n, const double *T) {
+  double amax = 0.0, remax = -HUGE_VAL;
+  int i;
+  for (i = 0; i < n; ++i) {
+    const double re = T[2 * (i + (size_t)i * n)], im = T[2 * (i + (size_t)i * n) + 1];
+    amax = PHGMG__MAX(amax, hypot(re, im));
+    remax = PHGMG__MAX(remax, re);
+  }
+  return n > 0 && remax >= -1e-8 * amax;
+}
+
+/* After a failed Gramian solve (Lyapunov or Riccati: NOT_CONVERGED or
+   SINGULAR) for A = (J - R) Q of a pH system: PHGMG_ERR_NOT_STABLE when A
+   has an undamped mode (the eigenvalues of a pH system lie in the closed
+   left half plane, so the failure comes from the imaginary axis), else rc.
+   Eigenvalues from the complex Schur form, O(N^3), on the failure path only. */
+PHGMG__PRIV phgmg_result phgmg__gramian_failure(int n, const double *A, phgmg_result rc, const phgmg_allocator *alloc) {
+  double *T;
+  if (rc != PHGMG_ERR_NOT_CONVERGED && rc != PHGMG_ERR_SINGULAR) return rc;
+  T = phgmg__dalloc(alloc, 4 * (size_t)n * n + 3 * (size_t)n);
+  if (!T) return rc;
+  if (phgmg__zschur(n, A, n, T, T + 2 * (size_t)n * n, T + 4 * (size_t)n * n) == PHGMG_OK &&
+      phgmg__schur_undamped(n, T))
+    rc = PHGMG_ERR_NOT_STABLE;
+  phgmg__free(alloc, T);
+  return rc;
+}
+
 PHGMG_DEF phgmg_result phgmg_bt(const phgmg_ph_system *sys, int r, double *Ar, double *Br, double *Cr,
                                 double *hsv, double *T, double *W, const phgmg_allocator *alloc) {
   int N, m;
@@ -11146,9 +11184,7 @@ PHGMG_DEF phgmg_result phgmg_bt(const phgmg_ph_system *sys, int r, double *Ar, d
     rc = phgmg_lyap(N, A, O, P, NULL, alloc);
   }
   if (rc == PHGMG_OK) {
-    double *At = Tb; /* not yet used: borrow for A^T? needs N*N; use a fresh block */
-    (void)At;
-    At = phgmg__dalloc(alloc, 2 * (size_t)N * N);
+    double *At = phgmg__dalloc(alloc, 2 * (size_t)N * N);   /* A^T and C^T C */
     if (!At) rc = PHGMG_ERR_NOMEM;
     else {
       int i, j;
@@ -11159,6 +11195,7 @@ PHGMG_DEF phgmg_result phgmg_bt(const phgmg_ph_system *sys, int r, double *Ar, d
       phgmg__free(alloc, At);
     }
   }
+  rc = phgmg__gramian_failure(N, A, rc, alloc);
   if (rc == PHGMG_OK) rc = phgmg__balance(N, r, P, O, Tb, Wb, S, alloc);
   if (rc == PHGMG_OK) rc = phgmg__project_abc(N, m, r, A, sys->B, C, Tb, Wb, Ar, Br, Cr, alloc);
   if (rc == PHGMG_OK) {
@@ -11566,6 +11603,7 @@ PHGMG_DEF phgmg_result phgmg_prbt(phgmg_reduced **out, const phgmg_ph_system *sy
       if (exact) rc = phgmg__pr_zero_d_both(N, m, A, sys->B, C, X, Y, alloc);
       if (exact && rc == PHGMG_ERR_SINGULAR) { exact = 0; rc = PHGMG_OK; }   /* a port without damping */
       if (!exact) rc = phgmg__pr_riccati(N, m, A, sys->B, C, s, X, Y, alloc);
+      rc = phgmg__gramian_failure(N, A, rc, alloc);
     }
   }
   if (rc == PHGMG_OK && info_xb) {   /* ||X B - C^T|| / ||C|| */
@@ -11634,6 +11672,7 @@ PHGMG_DEF phgmg_result phgmg_prbt_riccati(const phgmg_ph_system *sys, double eps
     rc = eps > 0.0 ? PHGMG_ERR_SINGULAR : phgmg__pr_zero_d_both(N, m, A, sys->B, C, X, Y, alloc);
     if (rc == PHGMG_ERR_SINGULAR)
       rc = phgmg__pr_riccati(N, m, A, sys->B, C, 2.0 * (eps > 0.0 ? eps : 1e-10) * CBn, X, Y, alloc);
+    rc = phgmg__gramian_failure(N, A, rc, alloc);
   }
   phgmg__free(alloc, A);
   return rc;
@@ -12008,6 +12047,8 @@ PHGMG__PRIV phgmg_result phgmg__h2gmg_init(phgmg__h2gmg *h, const phgmg_ph_syste
       }
     phgmg__zgemm('C', 'N', N, m, N, U, N, Bz, N, h->UC, N);
     rc = phgmg__h2gmg_ref(h, U);
+    if ((rc == PHGMG_ERR_SINGULAR || rc == PHGMG_ERR_NOT_CONVERGED) && phgmg__schur_undamped(N, h->T))
+      rc = PHGMG_ERR_NOT_STABLE;   /* an undamped mode: no H2 norm */
   }
   phgmg__free(alloc, A);
   if (rc == PHGMG_OK) rc = phgmg_jr_factor_create(&h->jr, sys, NULL, alloc);
