@@ -98,35 +98,5 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   return 0;
 }
 
-#ifndef PHGMG_LIBFUZZER
-#if defined(__GNUC__) || defined(__clang__)
-__attribute__((weak))
-#endif
-int main(int argc, char **argv) {
-  int k, nok = 0;
-  for (k = 1; k < argc; ++k) {
-    FILE *f = fopen(argv[k], "rb");
-    unsigned char *buf;
-    long n;
-    if (!f) { fprintf(stderr, "fuzz_npy_stream: cannot open %s\n", argv[k]); return 1; }
-    if (fseek(f, 0, SEEK_END) != 0 || (n = ftell(f)) < 0 || fseek(f, 0, SEEK_SET) != 0) {
-      fprintf(stderr, "fuzz_npy_stream: cannot size %s\n", argv[k]);
-      fclose(f);
-      return 1;
-    }
-    buf = (unsigned char *)malloc((size_t)n + 1);
-    if (!buf || fread(buf, 1, (size_t)n, f) != (size_t)n) {
-      fprintf(stderr, "fuzz_npy_stream: cannot read %s\n", argv[k]);
-      free(buf);
-      fclose(f);
-      return 1;
-    }
-    fclose(f);
-    LLVMFuzzerTestOneInput(buf, (size_t)n);
-    free(buf);
-    ++nok;
-  }
-  printf("fuzz_npy_stream: %d inputs ran without findings\n", nok);
-  return 0;
-}
-#endif
+#define FUZZ_NAME "fuzz_npy_stream"
+#include "fuzz_main.h"
