@@ -46,7 +46,7 @@ int main(int argc, char **argv) {
     else if (!strcmp(argv[i], "--rn") && i + 1 < argc) rn = atoi(argv[++i]);
     else { fprintf(stderr, "bad argument %s\n", argv[i]); return 2; }
   }
-  { const char *q = rs; char *end; while (*q && nr < 64) { rl[nr++] = (int)strtol(q, &end, 10); if (end == q) break; q = *end == ',' ? end + 1 : end; } }
+  nr = demo_parse_rlist(rs, rl, 64);
   if (nonlin) {
     msd_nl_opts mo;
     memset(&mo, 0, sizeof mo);

@@ -61,7 +61,7 @@ int main(int argc, char **argv) {
       second = !strcmp(argv[i], "steps") ? u_steps : !strcmp(argv[i], "mssteps") ? u_mssteps : demo_u_multisine;
     }
   }
-  { const char *q = rs; char *end; while (*q && nr < 64) { rl[nr++] = (int)strtol(q, &end, 10); if (end == q) break; q = *end == ',' ? end + 1 : end; } }
+  nr = demo_parse_rlist(rs, rl, 64);
   if (nonlin) {
     msd_nl_opts mo;
     memset(&mo, 0, sizeof mo);

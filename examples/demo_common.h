@@ -183,6 +183,20 @@ DEMO_FN int demo_parse_lambda(const char *arg, double *lambda) {
   return 0;
 }
 
+/* A comma-separated list of orders ("8,12,16") into rl (at most max);
+   returns how many were read (stops at the first non-number). */
+DEMO_FN int demo_parse_rlist(const char *arg, int *rl, int max) {
+  const char *q = arg;
+  char *end;
+  int n = 0;
+  while (*q && n < max) {
+    rl[n++] = (int)strtol(q, &end, 10);
+    if (end == q) break;
+    q = *end == ',' ? end + 1 : end;
+  }
+  return n;
+}
+
 /* The automatic-lambda study of one example and input: rows
    "r, GMG-POD e_red, GMG-QM-auto e_red, lambda chosen, e_lowerbound, Newton
    failures" (nr x 6, row-major) into <out>/<example>_<input>_lambda_auto.csv. */

@@ -118,6 +118,23 @@ static void bt_r(const study *S, int r, double *Ar, double *Br, double *Cr) {
   free(AT);
 }
 
+/* The pH model of method j at order r: PRBT (j = 5) or GMG-POD on the
+   snapshot POD (0), an input-independent basis (1-3) or the least-H2 basis (7). */
+static phgmg_result build_model(const study *S, int j, int r, phgmg_reduced **red) {
+  const int N = S->sys->N, m = S->sys->m;
+  phgmg_reduce_opts o;
+  if (j == 5) {
+    phgmg_prbt_opts po;
+    memset(&po, 0, sizeof po);
+    po.dt = 0.1; po.X = S->Xr; po.Y = S->Yr;
+    return phgmg_prbt(red, S->sys, r, &po, NULL, NULL, NULL);
+  }
+  memset(&o, 0, sizeof o);
+  o.method = PHGMG_METHOD_GMG_POD; o.r = r; o.dt = 0.1;
+  o.pod_basis = j == 0 ? S->pod : j == 7 ? S->h2[r] : S->bas[j - 1]; o.pod_cols = j == 7 ? r - m : RMAX;
+  return o.pod_basis ? phgmg_reduce(red, S->sys, S->X[0], N, 1001, &o, NULL, NULL) : PHGMG_ERR_INVALID_ARG;
+}
+
 /* One reduced model (method j, order r): its (A, B, C) and e_y on every input. */
 static void run_method(const study *S, int j, int r, double ey[NIN], double *Ar, double *Br, double *Cr) {
   const int N = S->sys->N, m = S->sys->m;
@@ -127,17 +144,8 @@ static void run_method(const study *S, int j, int r, double ey[NIN], double *Ar,
   int in;
   if (j == 4) {
     bt_r(S, r, Ar, Br, Cr);
-  } else if (j == 5 || j == 6) {
-    phgmg_prbt_opts po;
-    memset(&po, 0, sizeof po);
-    po.dt = 0.1; po.X = S->Xr; po.Y = S->Yr;
-    rc = phgmg_prbt(&red, S->sys, r, &po, NULL, NULL, NULL);
   } else {
-    phgmg_reduce_opts o;
-    memset(&o, 0, sizeof o);
-    o.method = PHGMG_METHOD_GMG_POD; o.r = r; o.dt = 0.1;
-    o.pod_basis = j == 0 ? S->pod : j == 7 ? S->h2[r] : S->bas[j - 1]; o.pod_cols = j == 7 ? r - m : RMAX;
-    rc = o.pod_basis ? phgmg_reduce(&red, S->sys, S->X[0], N, 1001, &o, NULL, NULL) : PHGMG_ERR_INVALID_ARG;
+    rc = build_model(S, j == 6 ? 5 : j, r, &red);
   }
   if (red && j == 6) {   /* PRBT's projection (T, W) without the pH form: W^T A T, W^T B, C T */
     double *Tm = (double *)malloc(sizeof(double) * N * r * 2), *Wm = Tm + (size_t)N * r, e[RMAX];
@@ -262,7 +270,7 @@ static void study_free(study *S) {
    largest energy-balance error |H_n - H_0 - S_n + D_n| / max H over 1000
    steps of the `mix` input with the step map. */
 static void structure_row(const study *S, int j, int r, FILE *f) {
-  const int N = S->sys->N, m = S->sys->m;
+  const int m = S->sys->m;
   static double H[1001], Su[1001], D[1001];
   double Rr[RMAX * RMAX], w[RMAX], xr0[RMAX] = {0}, e = 0.0, hmax = 0.0;
   phgmg_energy en;
@@ -270,18 +278,7 @@ static void structure_row(const study *S, int j, int r, FILE *f) {
   phgmg_result rc;
   input_ctx ic;
   int a, b;
-  if (j == 5) {
-    phgmg_prbt_opts po;
-    memset(&po, 0, sizeof po);
-    po.dt = 0.1; po.X = S->Xr; po.Y = S->Yr;
-    rc = phgmg_prbt(&red, S->sys, r, &po, NULL, NULL, NULL);
-  } else {
-    phgmg_reduce_opts o;
-    memset(&o, 0, sizeof o);
-    o.method = PHGMG_METHOD_GMG_POD; o.r = r; o.dt = 0.1;
-    o.pod_basis = j == 0 ? S->pod : j == 7 ? S->h2[r] : S->bas[j - 1]; o.pod_cols = j == 7 ? r - m : RMAX;
-    rc = o.pod_basis ? phgmg_reduce(&red, S->sys, S->X[0], N, 1001, &o, NULL, NULL) : PHGMG_ERR_INVALID_ARG;
-  }
+  rc = build_model(S, j, r, &red);
   if (rc != PHGMG_OK) { phgmg_reduced_destroy(red); return; }
   {
     const phgmg_rom *rom = phgmg_reduced_rom(red);

@@ -80,11 +80,9 @@ int main(int argc, char **argv) {
   if (msd_linear_build(&M, 50, NULL, NULL, NULL, PHGMG_DENSE) != 0) { fprintf(stderr, "model\n"); return 1; }
   if (gen) { /* --generalization: issue 15's study at the listed r */
     int rl[64], nrl = 0;
-    char *end;
-    const char *q = gen;
     phgmg_reduce_opts o;
     svgplot_fig *gf = svgplot_new("Linear chain: GMG-POD and GMG-QM (lambda validated by simulation) on inputs they were not trained on", 2);
-    while (*q && nrl < 64) { rl[nrl++] = (int)strtol(q, &end, 10); if (end == q) break; q = *end == ',' ? end + 1 : end; }
+    nrl = demo_parse_rlist(gen, rl, 64);
     memset(&o, 0, sizeof o);
     o.rn = rn; o.dt = dt;
     svgplot_size(gf, 1200, 480);

@@ -67,11 +67,10 @@ typedef struct nl_setup {
 /* --generalization: issue 15's study at the listed r */
 static int generalization_main(nl_setup *S, const char *gen) {
   int rl[64], nrl = 0;
-  char *end, path[512];
-  const char *q = gen;
+  char path[512];
   phgmg_reduce_opts o;
   svgplot_fig *gf = svgplot_new("Nonlinear chain: GMG-POD and GMG-QM (lambda validated by simulation) on inputs they were not trained on", 2);
-  while (*q && nrl < 64) { rl[nrl++] = (int)strtol(q, &end, 10); if (end == q) break; q = *end == ',' ? end + 1 : end; }
+  nrl = demo_parse_rlist(gen, rl, 64);
   memset(&o, 0, sizeof o);
   o.rn = S->rn; o.deim = 1; o.deim_tol = S->deim_tol; o.deim_allow_negative = 1;
   svgplot_size(gf, 1200, 480);
