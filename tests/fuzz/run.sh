@@ -20,7 +20,7 @@ set -u
 secs=${1:-60}
 case "$secs" in ''|*[!0-9]*) echo "usage: $0 [SECONDS]" >&2; exit 2 ;; esac
 cd "$(dirname "$0")/../.." || exit 2
-make -s phgmg.h || exit 2
+MAKEFLAGS= make -s phgmg.h || exit 2   # alone: not a job of a calling make -j
 out=build/fuzz
 mkdir -p "$out"
 
