@@ -868,7 +868,10 @@ PHGMG_DEF void phgmg_rom_stage_times(phgmg_real t, phgmg_real dt, phgmg_real tc[
    On failure (PHGMG_ERR_NOT_CONVERGED, _NANINF, _SINGULAR) x, y, energy are untouched.
    Newton: simplified (the LU of I - dt (A kron Jf) is kept across steps and
    renewed after a failure or when the contraction is slower than 1/2), started
-   from the extrapolated collocation polynomial of the last step. QUADRATIC
+   from the extrapolated collocation polynomial of the last step, at least one
+   update per step, until the stage residual (inf-norm, absolute: in the units
+   of x) is <= tol. For a model whose states are far from unit size (charges
+   of 1e-12 C, displacements in km) pass a tol scaled to them. QUADRATIC
    models are solved in mass-matrix form, E(x) x' = g(x) + E(x) Bh u with
    E = D^T G D: the stage values Phi_i = E(Y_i)^{-1} g(Y_i) are unknowns beside
    the stage increments, so an iteration needs products E(Y_i) Phi_i and solves
@@ -6835,7 +6838,10 @@ PHGMG__ONLINE phgmg_real phgmg__romstep_iterate(phgmg_rom_stepper *s, const phgm
   const int r = s->rom->r, n3 = 3 * r;
   phgmg_real res_prev = PHGMG__R(0);
   int i, a;
-  while (res > s->tol && *it < s->max_iter) {
+  /* at least one update (as the full-order stepper): tol is absolute, and a
+     model whose states are tiny (SI units, e.g. charges of 1e-12 C) would
+     otherwise accept the extrapolated guess unsolved */
+  while ((res > s->tol || *it == 0) && *it < s->max_iter) {
     for (i = 0; i < n3; ++i) L->dZ[i] = -L->Res[i];
     phgmg__r_lu_solve(n3, L->LU, L->piv, L->dZ);
     for (i = 0; i < n3; ++i) L->Z[i] += L->dZ[i];
