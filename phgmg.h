@@ -1004,7 +1004,9 @@ typedef struct phgmg_reduce_opts {
   double dt;           /* > 0: precompute the GL3 step map for this step
                           (LINEAR map with quadratic H only)                          */
   double degeneracy_tol; /* fail with PHGMG_ERR_DEGENERATE when the reciprocal
-                          condition of D^T G D at the snapshots is below this (0: 1e-12) */
+                          condition of D^T G D at the snapshots is below this (0: 1e-12);
+                          measured with D's port columns B_a scaled to unit length,
+                          so that the units of the states and of B do not matter */
   /* Optional cache for studies over many r: the leading left singular vectors
      (N x pod_cols, ld N, by descending singular value) of the matrix the
      method PODs -- GMG-POD/GMG-QM: the adjusted snapshots X - B B^+ X (from
@@ -1141,7 +1143,8 @@ typedef struct phgmg_reduce_info {
   int deim_modes;          /* DEIM points kept (nd)                          */
   int deim_negative;       /* number of negative DEIM weights               */
   double deim_sigma_ratio; /* sigma_{nd+1}/sigma_1 of the nonlinear snapshots (0 if all kept) */
-  double rcond_dgd;        /* smallest rcond of D^T G D seen (at x = 0 and the snapshots) */
+  double rcond_dgd;        /* smallest rcond of D^T G D seen (at x = 0 and the snapshots;
+                              port columns of D at unit length, see degeneracy_tol) */
   double rcond_jr;         /* rcond of J - R                                  */
   double pod_sigma_ratio;  /* sigma_{r'+1}/sigma_1 of the (adjusted) snapshots */
   double lambda;           /* GMG-QM: the ridge lambda used (fixed or chosen)  */
@@ -9241,6 +9244,20 @@ PHGMG__PRIV double phgmg__rcond_inplace(int n, double *E, int *ip, double *work)
   return phgmg_lu_rcond(n, E, n, ip, anorm, work, ip + n);
 }
 
+/* The degeneracy check measures D^T G D with unit port columns: rows and
+   columns a < m of E (r x r) scaled by 1 / ||B_a|| -- the same invertibility,
+   but a condition independent of the units of B (B scaled by s while G
+   scales by 1/s^2, as for states in other units, would otherwise move rcond
+   by s^2 and fail a well-posed model). */
+PHGMG__PRIV void phgmg__dgd_unit_ports(const phgmg_reduced *red, double *E) {
+  const int r = red->r, m = red->m, N = red->N;
+  int a, i;
+  for (a = 0; a < m; ++a) {
+    const double nb = phgmg_normf(N, 1, red->sys->B + (size_t)a * N, N), f = nb > 0.0 ? 1.0 / nb : 1.0;
+    for (i = 0; i < r; ++i) { E[a + (size_t)i * r] *= f; E[i + (size_t)a * r] *= f; }
+  }
+}
+
 /* Smallest rcond of D^T G D over the snapshots (QUADRATIC kind); with the
    automatic lambda, stops early at the first snapshot that would raise it.
    The snapshots' x2 = V1^T x_i come 64 at a time from one GEMM
@@ -9268,6 +9285,7 @@ PHGMG__PRIV phgmg_result phgmg__dgd_rcond_snapshots(phgmg__rctx *c, double stop_
       double rc_i;
       phgmg__eta_d(red, x2b + (size_t)i * ld2, NULL, Lp, NULL, red->rwork);
       phgmg__dgd_d(red, Lp, E, tmp);
+      phgmg__dgd_unit_ports(red, E);
       rc_i = phgmg__rcond_inplace(r, E, ip, wk);
       if (rc_i < *rmin) *rmin = rc_i;
       if (!(rc_i >= stop_below)) { j0 = c->ns; break; }
@@ -9282,9 +9300,20 @@ PHGMG__PRIV phgmg_result phgmg__dgd_rcond_snapshots(phgmg__rctx *c, double stop_
    the automatic lambda, an M that (nearly) degenerates it (rcond below
    lambda_rcond times its value at x = 0) moves to the next larger grid
    lambda (M -> 0 as lambda grows, and D^T G D -> G00). */
+PHGMG__PRIV double phgmg__dgd_rcond0(phgmg__rctx *c) {
+  phgmg_reduced *red = c->red;
+  const size_t rr = (size_t)red->r * red->r;
+  double *E = phgmg__dalloc(c->alloc, rr), rc0;
+  if (!E) return -1.0;
+  memcpy(E, red->G00, rr * sizeof(double));
+  phgmg__dgd_unit_ports(red, E);
+  rc0 = phgmg__rcond_of(red->r, E, c->alloc);
+  phgmg__free(c->alloc, E);
+  return rc0;
+}
 PHGMG__PRIV phgmg_result phgmg__check_degeneracy(phgmg__rctx *c) {
   phgmg_reduced *red = c->red;
-  const double rc0 = phgmg__rcond_of(red->r, red->G00, c->alloc);
+  const double rc0 = phgmg__dgd_rcond0(c);
   const double lrc = rc0 * (c->o->lambda_rcond == 0.0 ? 1e-6 : c->o->lambda_rcond);
   const int can_raise = c->gsel >= 0 && rc0 >= c->degtol;
   phgmg_result rc;

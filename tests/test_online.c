@@ -188,7 +188,14 @@ TEST(test_workspace_contract) {
    drifts (before: e_y 3.4e-3 MHz, 2.8 GHz; now 3.4e-4 both). */
 static double rlc_w0;
 static void rlc_u(double t, double *u, void *p) { (void)p; u[0] = sin(rlc_w0 * t); }
+static double rlc_rom_run_scaled(double C, double L, double sc, double *Yf, double *Yr, phgmg_result *rrc);
 static double rlc_rom_run(double C, double L, double *Yf, double *Yr) {
+  phgmg_result rc;
+  return rlc_rom_run_scaled(C, L, 1.0, Yf, Yr, &rc);
+}
+/* sc != 1: the states in other units, x' = sc x (J, R times sc^2, Q / sc^2,
+   B times sc): the same outputs. */
+static double rlc_rom_run_scaled(double C, double L, double sc, double *Yf, double *Yr, phgmg_result *rrc) {
   enum { n = 20, N = 2 * n, NS = 401 };
   static double J[N * N], R[N * N], Q[N * N], B[N], X[N * NS];
   double xr0[8] = {0}, dt;
@@ -206,6 +213,8 @@ static double rlc_rom_run(double C, double L, double *Yf, double *Yr) {
     R[f + f * N] = 50.0; Q[q + q * N] = 1.0 / C; Q[f + f * N] = 1.0 / L;
   }
   B[1] = 1.0;   /* a voltage source in series with the first inductor */
+  for (i = 0; i < N * N; ++i) { J[i] *= sc * sc; R[i] *= sc * sc; Q[i] /= sc * sc; }
+  B[1] *= sc;
   rlc_w0 = 0.3 / sqrt(L * C); dt = 6.283185307179586 / rlc_w0 / 100.0;
   memset(&s, 0, sizeof s);
   s.N = N; s.m = 1; s.J = J; s.R = R; s.Q = Q; s.B = B;
@@ -214,7 +223,8 @@ static double rlc_rom_run(double C, double L, double *Yf, double *Yr) {
   if (phgmg_simulate_inputs(&s, 1, &run, NULL, X, N, Yf, NULL, NULL) != PHGMG_OK) return NAN;
   memset(&o, 0, sizeof o);
   o.method = PHGMG_METHOD_GMG_POD; o.r = 8;
-  if (phgmg_reduce(&red, &s, X, N, NS, &o, NULL, NULL) != PHGMG_OK) return NAN;
+  *rrc = phgmg_reduce(&red, &s, X, N, NS, &o, NULL, NULL);
+  if (*rrc != PHGMG_OK) return NAN;
   rc = phgmg_reduced_simulate(red, xr0, 0.0, dt, NS - 1, rlc_u, NULL, 0.0, 20, NULL, Yr, NULL, NULL, NULL);
   phgmg_reduced_destroy(red);
   return rc == PHGMG_OK ? phgmg_rel_error(1, NS, Yf, 1, Yr, 1) : NAN;
@@ -229,10 +239,28 @@ TEST(test_rom_tiny_state_scale) {
   CHECK_LE(e1, 1e-3);
 }
 
+/* The non-degeneracy check of GMG does not depend on the units of the
+   states: the MHz ladder with charges and fluxes in units 1e-12 of the SI
+   ones (states ~6e3, B ~1e12) reduces to the same model (before: rcond of
+   D^T G D moved by 1e-24 with B's scale and the reduction failed with
+   PHGMG_ERR_DEGENERATE). */
+TEST(test_reduce_state_units) {
+  static double Yf1[401], Yr1[401], Yf2[401], Yr2[401];
+  phgmg_result rc1, rc2;
+  const double e1 = rlc_rom_run_scaled(1e-9, 1e-6, 1.0, Yf1, Yr1, &rc1);
+  const double e2 = rlc_rom_run_scaled(1e-9, 1e-6, 1e12, Yf2, Yr2, &rc2);
+  CHECK_RC(rc1, PHGMG_OK);
+  CHECK_RC(rc2, PHGMG_OK);
+  CHECK(e1 == e1 && e2 == e2);
+  CHECK_LE(phgmg_rel_error(1, 401, Yf1, 1, Yf2, 1), 1e-10);
+  CHECK_LE(phgmg_rel_error(1, 401, Yr1, 1, Yr2, 1), 1e-8);
+}
+
 SUITE(online) {
   RUN(test_oscillator_order6);
   RUN(test_linear_energy_balance);
   RUN(test_jacobian_fd_and_newton_failure);
   RUN(test_workspace_contract);
   RUN(test_rom_tiny_state_scale);
+  RUN(test_reduce_state_units);
 }
