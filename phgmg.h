@@ -558,8 +558,10 @@ PHGMG_DEF void phgmg_ph_sparse_destroy(phgmg_ph_sparse *sp);
    fixed step a precomputed step map is used unless opts.no_step_map.
    Details:
    - Newton iterates on Z_i = Y_i - x_n, always makes at least one update and
-     stops when ||Z - h (A x I) F(Z)||_inf <= tol (absolute), at most max_iter
-     updates. Jac = (J - R) Hess H(x_n), factored as gam/h I - Jac (real) and
+     stops when ||Z - h (A x I) F(Z)||_inf <= tol, at most max_iter updates.
+     An explicit opts.tol is absolute; the default (opts.tol = 0) is 1e-10
+     times max(1, ||x_n||_inf, ||Z||_inf), so that a model whose states are
+     large in its units (1e9) still converges (tests/test_online.c). Jac = (J - R) Hess H(x_n), factored as gam/h I - Jac (real) and
      (alp - i bet)/h I - Jac (complex): dense LU, banded LU with lower/upper
      bandwidth from the nonzero diagonals of J - R and Q (plus kb for a GENERAL
      Hessian), or the caller's shifted_* callbacks. Factors are reused across
@@ -610,7 +612,8 @@ PHGMG_DEF void phgmg_ph_sparse_destroy(phgmg_ph_sparse *sp);
 typedef void (*phgmg_input_fn)(double t, double *u, void *user);
 
 typedef struct phgmg_gl3_opts {
-  double tol;          /* Newton tolerance on the stage residual, inf-norm (0: 1e-10) */
+  double tol;          /* Newton tolerance on the stage residual, inf-norm (0: 1e-10,
+                          relative to states / stage increments above 1; see above) */
   int max_iter;        /* Newton iteration cap per step (0: 10)                      */
   int no_step_map;     /* 1: never use the precomputed linear step map               */
   double contraction;  /* refactor when the contraction rate exceeds this (0: 0.5)    */
@@ -825,6 +828,8 @@ typedef struct phgmg_rom_stepper {
   const phgmg_rom *rom;
   phgmg_real dt, tol;     /* step and Newton tolerance (inf-norm of the stage residual) */
   int max_iter;           /* Newton cap per step                                        */
+  int tol_rel;            /* 1: tol is the default, scaled by max(1, |x|_inf) each step */
+  phgmg_real tol_step;    /* internal: the tolerance of the current step                */
   int use_map;            /* 1 if the precomputed step map is used                      */
   int have_lu, have_prev; /* internal: factors valid / extrapolation data valid        */
   int stale_e;            /* internal (QUADRATIC): refactor E = D^T G D before the next step */
@@ -851,7 +856,8 @@ PHGMG_DEF size_t phgmg_rom_stepper_memsize_dt(const phgmg_rom *rom, phgmg_real d
    sizeof(phgmg_real) * (size_t)((rn) * (r) * (r) + (r) * (r) + (r) + 8))
 /* Set up a stepper in caller memory (mem must be aligned for phgmg_real and
    int; anything from malloc or a static phgmg_real array is). tol <= 0 gives
-   1e-10 (double) / 1e-5 (float); a tol that is NaN or infinite is
+   1e-10 (double) / 1e-5 (float) times max(1, |x|_inf, |Z|_inf) each step
+   (relative for large states, see phgmg_rom_step); a tol that is NaN or infinite is
    PHGMG_ERR_INVALID_ARG; max_iter <= 0 gives 10. PHGMG_ERR_WORKSPACE if
    mem_size < phgmg_rom_stepper_memsize_dt(rom, dt) (which equals
    phgmg_rom_stepper_memsize(rom) when dt is the model's own step, or the
@@ -869,9 +875,11 @@ PHGMG_DEF void phgmg_rom_stage_times(phgmg_real t, phgmg_real dt, phgmg_real tc[
    Newton: simplified (the LU of I - dt (A kron Jf) is kept across steps and
    renewed after a failure or when the contraction is slower than 1/2), started
    from the extrapolated collocation polynomial of the last step, at least one
-   update per step, until the stage residual (inf-norm, absolute: in the units
-   of x) is <= tol. For a model whose states are far from unit size (charges
-   of 1e-12 C, displacements in km) pass a tol scaled to them. QUADRATIC
+   update per step, until the stage residual (inf-norm) is <= tol: an explicit
+   tol is absolute (in the units of x), the default follows states and stage
+   increments larger than 1; for tiny states (charges of 1e-12 C) the forced
+   update solves a linear model exactly, a nonlinear one may want a smaller
+   explicit tol. QUADRATIC
    models are solved in mass-matrix form, E(x) x' = g(x) + E(x) Bh u with
    E = D^T G D: the stage values Phi_i = E(Y_i)^{-1} g(Y_i) are unknowns beside
    the stage increments, so an iteration needs products E(Y_i) Phi_i and solves
@@ -4893,7 +4901,7 @@ struct phgmg_gl3 {
   phgmg_ph_system sys;
   int N, m, mode, linear;
   double h, tol, contraction;
-  int max_iter;
+  int max_iter, tol_rel;   /* tol_rel: the default tol, scaled by max(1, |x|_inf) */
   double c[3], b[3], A[9], T[9], Ti[9], E[9], d[3];
   double gam, alp, bet;
   /* dense operators */
@@ -5309,6 +5317,7 @@ PHGMG_DEF phgmg_result phgmg_gl3_create(phgmg_gl3 **out, const phgmg_ph_system *
   s->m = sys->m;
   s->h = dt;
   s->tol = (opts && opts->tol > 0.0) ? opts->tol : 1e-10;
+  s->tol_rel = !(opts && opts->tol > 0.0);
   s->max_iter = (opts && opts->max_iter > 0) ? opts->max_iter : 10;
   s->contraction = (opts && opts->contraction > 0.0) ? opts->contraction : 0.5;
   s->flush = !(opts && opts->keep_tiny);
@@ -5719,11 +5728,16 @@ PHGMG__PRIV void phgmg__gl3_solve_cplx(phgmg_gl3 *s, double *r) {
 PHGMG__PRIV phgmg_result phgmg__gl3_newton(phgmg_gl3 *s, const double *x, int fresh,
                                            double *theta_max, double *res_out) {
   int N = s->N, it = 0, ndiv = 0, i;
-  double h = s->h, ih = 1.0 / s->h, res_prev = 0.0, theta = 0.0;
+  double h = s->h, ih = 1.0 / s->h, res_prev = 0.0, theta = 0.0, tol = s->tol;
   double *Z0 = s->Z, *Z1 = s->Z + N, *Z2 = s->Z + 2 * (size_t)N;
   double *W0 = s->W, *W1 = s->W + N, *W2 = s->W + 2 * (size_t)N;
   const double *T = s->T, *Ti = s->Ti, *A = s->A;
   *theta_max = 0.0;
+  if (s->tol_rel) {   /* the default tolerance follows states and stage increments larger than 1 */
+    double xm = 1.0;
+    for (i = 0; i < N; ++i) xm = PHGMG__MAX(xm, fabs(x[i]));
+    tol *= xm;
+  }
   for (i = 0; i < N; ++i) {
     double z0 = Z0[i], z1 = Z1[i], z2 = Z2[i];
     W0[i] = Ti[0] * z0 + Ti[1] * z1 + Ti[2] * z2;
@@ -5732,7 +5746,7 @@ PHGMG__PRIV phgmg_result phgmg__gl3_newton(phgmg_gl3 *s, const double *x, int fr
   }
   for (;;) {
     const double *F0 = s->F, *F1 = s->F + N, *F2 = s->F + 2 * (size_t)N;
-    double res = 0.0, chk = 0.0;
+    double res = 0.0, chk = 0.0, zm = 0.0;
     double *r1 = s->r1, *rc = s->rc;
     const double a00 = h * A[0], a01 = h * A[1], a02 = h * A[2], a10 = h * A[3], a11 = h * A[4],
                  a12 = h * A[5], a20 = h * A[6], a21 = h * A[7], a22 = h * A[8];
@@ -5746,6 +5760,7 @@ PHGMG__PRIV phgmg_result phgmg__gl3_newton(phgmg_gl3 *s, const double *x, int fr
       e1 = fabs(Z1[i] - PHGMG__FMA(a10, f0, PHGMG__FMA(a11, f1, a12 * f2)));
       e2 = fabs(Z2[i] - PHGMG__FMA(a20, f0, PHGMG__FMA(a21, f1, a22 * f2)));
       chk += (e0 + e1) + e2; /* NaN/Inf detection */
+      zm = PHGMG__MAX(zm, PHGMG__MAX(fabs(Z0[i]), PHGMG__MAX(fabs(Z1[i]), fabs(Z2[i]))));
       res = e0 > res ? e0 : res;
       res = e1 > res ? e1 : res;
       res = e2 > res ? e2 : res;
@@ -5757,7 +5772,7 @@ PHGMG__PRIV phgmg_result phgmg__gl3_newton(phgmg_gl3 *s, const double *x, int fr
       ndiv = theta >= 1.0 ? ndiv + 1 : 0;
     }
     *res_out = res;
-    if (it >= 1 && res <= s->tol) return PHGMG_OK;
+    if (it >= 1 && res <= (s->tol_rel ? PHGMG__MAX(tol, s->tol * zm) : tol)) return PHGMG_OK;
     if (it >= s->max_iter) return PHGMG_ERR_NOT_CONVERGED;
     if (it >= 1 && theta >= 1.0 && !fresh) return PHGMG_ERR_NOT_CONVERGED;
     if (ndiv >= 2) return PHGMG_ERR_NOT_CONVERGED;
@@ -6642,6 +6657,8 @@ PHGMG_DEF phgmg_result phgmg_rom_stepper_init(phgmg_rom_stepper *s, const phgmg_
 #else
   s->tol = tol > PHGMG__R(0) ? tol : PHGMG__R(1e-10);
 #endif
+  s->tol_rel = !(tol > PHGMG__R(0));
+  s->tol_step = s->tol;
   s->max_iter = max_iter > 0 ? max_iter : 10;
   s->use_map = use_map;
   s->have_lu = 0;
@@ -6835,6 +6852,15 @@ PHGMG__ONLINE phgmg_result phgmg__romstep_start(phgmg_rom_stepper *s, const phgm
 /* Simplified Newton on the stage system from the residual res; in
    mass-matrix form (mm) a slow contraction switches to exact stage values.
    Returns the final residual (negative after a failure, with *err). */
+/* The default tolerance (tol_rel) follows the stage increments too: tol
+   times max(1, |x|_inf, |Z|_inf). */
+PHGMG__ONLINE void phgmg__romstep_tol(phgmg_rom_stepper *s, const phgmg__romstep_mem *L) {
+  int i;
+  if (!s->tol_rel) return;
+  for (i = 0; i < 3 * s->rom->r; ++i)
+    if (PHGMG__RABS(L->Z[i]) * s->tol > s->tol_step) s->tol_step = PHGMG__RABS(L->Z[i]) * s->tol;
+}
+
 PHGMG__ONLINE phgmg_real phgmg__romstep_iterate(phgmg_rom_stepper *s, const phgmg__romstep_mem *L, const phgmg_real *x,
                                                const phgmg_real *u3, phgmg_real res, int *mm, int *exact, int *it,
                                                phgmg_real *theta_max, phgmg_result *err) {
@@ -6844,10 +6870,12 @@ PHGMG__ONLINE phgmg_real phgmg__romstep_iterate(phgmg_rom_stepper *s, const phgm
   /* at least one update (as the full-order stepper): tol is absolute, and a
      model whose states are tiny (SI units, e.g. charges of 1e-12 C) would
      otherwise accept the extrapolated guess unsolved */
-  while ((res > s->tol || *it == 0) && *it < s->max_iter) {
+  phgmg__romstep_tol(s, L);
+  while ((res > s->tol_step || *it == 0) && *it < s->max_iter) {
     for (i = 0; i < n3; ++i) L->dZ[i] = -L->Res[i];
     phgmg__r_lu_solve(n3, L->LU, L->piv, L->dZ);
     for (i = 0; i < n3; ++i) L->Z[i] += L->dZ[i];
+    phgmg__romstep_tol(s, L);
     if (*mm) /* dPhi_i = Jf dZ_i - Del_i */
       for (i = 0; i < 3; ++i) {
         phgmg__r_gemv(r, r, L->Jf, L->dZ + i * r, 1, L->Phi + i * r);
@@ -6858,7 +6886,7 @@ PHGMG__ONLINE phgmg_real phgmg__romstep_iterate(phgmg_rom_stepper *s, const phgm
     res_prev = res;
     res = phgmg__romstep_residual(s, L, x, u3, *mm, err);
     if (res < PHGMG__R(0)) break;
-    if (*mm && res > s->tol && res > PHGMG__R(0.25) * res_prev) {
+    if (*mm && res > s->tol_step && res > PHGMG__R(0.25) * res_prev) {
       /* slow: the frozen E is too far from E(Y_i) here. Exact stage values
          from this iterate on, and for the next steps. */
       *mm = 0; *exact = 1; s->exact_hold = 16;
@@ -6984,6 +7012,13 @@ PHGMG_DEF phgmg_result phgmg_rom_step(phgmg_rom_stepper *s, phgmg_real *x, const
   phgmg__romstep_layout(rom, s->use_map, s->ws, &L);
   if (s->use_map) return phgmg__rom_track(s, x, phgmg__romstep_map(s, &L, x, u3, y, energy));
   if (s->exact_hold > 0) { s->exact_hold--; exact = 1; }
+  s->tol_step = s->tol;
+  if (s->tol_rel) {   /* the default tolerance follows states larger than 1 (and, in
+                         phgmg__romstep_tol, stage increments) */
+    int a;
+    for (a = 0; a < r; ++a)
+      if (PHGMG__RABS(x[a]) * s->tol > s->tol_step) s->tol_step = PHGMG__RABS(x[a]) * s->tol;
+  }
   /* attempts: (1) the kept factors; (2) fresh factors at x; (3) QUADRATIC only:
      the same Newton with exact stage values F = phgmg_rom_rhs (a factorisation
      of E per stage) -- for when E varies too fast for frozen factors. */
@@ -6999,7 +7034,7 @@ PHGMG_DEF phgmg_result phgmg_rom_step(phgmg_rom_stepper *s, phgmg_real *x, const
       break;
     }
     res = phgmg__romstep_iterate(s, &L, x, u3, res, &mm, &exact, &it, &theta_max, &err);
-    if (res >= PHGMG__R(0) && res <= s->tol) {
+    if (res >= PHGMG__R(0) && res <= s->tol_step) {
       err = phgmg__romstep_accept(s, &L, x, u3, y, energy, mm, it, theta_max);
       if (err == PHGMG_OK) return phgmg__rom_track(s, x, PHGMG_OK);
       break;
