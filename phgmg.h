@@ -1044,7 +1044,10 @@ typedef struct phgmg_reduce_opts {
      the smallest held-out error summed over the folds (ties within a relative
      1e-6: the largest) fits M on all snapshots. Guard: while rcond(D^T G D)
      at some snapshot is below lambda_rcond times its value at x = 0 (or below
-     degeneracy_tol), the next larger grid lambda is used (info.lambda_raised).
+     degeneracy_tol), the next larger grid lambda is used (info.lambda_raised);
+     when even lambda_max does not make it regular (the grid is absolute, so
+     it can be small for states that are large in their units), M = 0: the
+     linear limit, info.lambda = HUGE_VAL (tests/test_online.c).
      Cost: lambda_folds SVDs of (ns - ns/folds) x p(p+1)/2 matrices, about
      50 ms at r - m = 18, ns = 1001. Errors: PHGMG_ERR_INVALID_ARG for
      lambda_auto not 0/1/2, bounds negative, NaN, Inf or lambda_min > lambda_max,
@@ -9368,6 +9371,18 @@ PHGMG__PRIV phgmg_result phgmg__check_degeneracy(phgmg__rctx *c) {
     rc = phgmg__qm_fit(red, c->ns, c->Tq, c->Tq + (size_t)c->ns * nc, c->lambda,
                        c->Tq + (size_t)c->ns * (nc + red->rn), c->alloc);
     if (rc != PHGMG_OK) return rc;
+  }
+  if (c->inf.rcond_dgd < c->degtol && can_raise && red->M) {
+    /* automatic lambda: not even the grid's largest lambda (absolute, so
+       small for states that are large in their units) keeps D^T G D
+       regular -- the linear limit M = 0, regular at every state because
+       G00 is (rc0 >= degtol) */
+    memset(red->M, 0, (size_t)red->rn * red->p * red->p * sizeof(double));
+    if (red->Ms) memset(red->Ms, 0, (size_t)red->rn * red->p * red->p * sizeof(double));
+    c->gsel = -1;
+    c->lambda = c->inf.lambda = HUGE_VAL;
+    c->inf.lambda_cv_err = 1.0;
+    c->inf.rcond_dgd = rc0;
   }
   return c->inf.rcond_dgd >= c->degtol ? PHGMG_OK : PHGMG_ERR_DEGENERATE;
 }
