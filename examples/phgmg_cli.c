@@ -85,8 +85,9 @@ static const char *const help_lines[] = {
   "                      same; default sin);  or a FILE.npy (see INPUT FILES; AMP is\n",
   "                      then not used)\n",
   "    --amp AMP         amplitude (default 0.1)\n",
-  "    --newton-tol T    Newton tolerance (stage residual, inf-norm) for nonlinear\n",
-  "                      models (default 1e-10)\n",
+  "    --newton-tol T    Newton tolerance (stage residual, inf-norm, absolute) for\n",
+  "                      nonlinear models (default: the library's, 1e-10 times\n",
+  "                      max(1, |x|, |stage increment|): follows large states)\n",
   "    --newton-iter K   Newton iteration cap per step (default 10)\n",
   "  --method M          gmg-pod: linear map phi(x) = [B, V] x, GMG reduction (paper 4.2.1)\n",
   "                      gmg-qm:  quadratic manifold phi(x) = [B, V1] x + V2 M (x2 kron x2)\n",
@@ -869,7 +870,7 @@ static int parse_reduce(int argc, char **argv, reduce_args *A) {
   int i, nseen = 0;
   memset(A, 0, sizeof *A);
   A->dt = 0.1; A->steps = 1000; A->amp = 0.1; A->rn = 0; A->lambda = 1e-3;
-  A->deim_tol = 1e-8; A->name = "rom"; A->newton_tol = 1e-10; A->newton_iter = 10;
+  A->deim_tol = 1e-8; A->name = "rom"; A->newton_tol = 0.0; A->newton_iter = 10;
   for (i = 2; i < argc; ++i) {
     const char *o = argv[i], *v;
 #define STR(opt, field) else if (!strcmp(o, opt)) { if (!(v = optval(argc, argv, &i))) return 2; A->field = v; }
@@ -1740,7 +1741,7 @@ static int load_model(const char *path, const char *opt, phgmg_rom *rom, void **
 
 static int cmd_simulate_rom(int argc, char **argv) {
   const char *model = NULL, *out = NULL, *states = NULL, *inspec = "sin";
-  double dt = 0.0, amp = 0.1, newton_tol = 1e-10, t0;
+  double dt = 0.0, amp = 0.1, newton_tol = 0.0, t0;   /* 0: the library's default */
   int steps = 1000, newton_iter = 10, have_dt = 0, i, a, n, status = 1;
   phgmg_rom rom;
   void *block = NULL, *mem = NULL;
