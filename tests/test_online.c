@@ -7,6 +7,7 @@
 #define PHGMG_IMPLEMENTATION
 #include "../phgmg.h"
 #include "harness.h"
+#include "../examples/msd_models.h"
 
 static double osc_err(double h, double T) {
   /* x' = K Qh x with K = [[0,1],[-1,0]], Qh = I: x = (cos t, -sin t) */
@@ -290,6 +291,67 @@ TEST(test_reduce_state_units) {
   }
 }
 
+/* A nonlinear chain with Toda springs phi(l) = e^l - 1 - l, written in
+   units x' = s x (J, R times s^2, Q / s^2, B times s, phi(l'/s) as the
+   exp-polynomial {-1, -1/s}, (1, 1/s)): GMG-POD with DEIM gives the same
+   outputs at s = 1e-6, 1, 1e6; GMG-QM with the automatic lambda succeeds
+   at every s and is never worse than 1.02x GMG-POD (its absolute lambda
+   grid makes it the linear limit at s = 1e6). */
+static void toda_u(double t, double *u, void *p) { (void)p; u[0] = 0.5 * sin(t); }
+static double toda_rom(double sc, phgmg_method meth, double *Yf, double *Yr, double *lambda) {
+  enum { NS = 301 };
+  msd_nonlinear M;
+  msd_nl_opts mo;
+  double poly[2], expo[2], xr0[10] = {0}, *X, e = NAN;
+  phgmg_run run;
+  phgmg_reduce_opts o;
+  phgmg_reduce_info info;
+  phgmg_reduced *red = NULL;
+  size_t i, len;
+  poly[0] = -1.0; poly[1] = -1.0 / sc; expo[0] = 1.0; expo[1] = 1.0 / sc;
+  memset(&mo, 0, sizeof mo);
+  mo.n = 50; mo.storage = PHGMG_BANDED; mo.k2 = -1.0;
+  if (msd_nonlinear_build(&M, &mo) != 0) return NAN;
+  len = (size_t)(2 * M.sys.kb + 1) * (size_t)M.sys.N;
+  for (i = 0; i < len; ++i) { M.J[i] *= sc * sc; M.R[i] *= sc * sc; M.Q[i] /= sc * sc; }
+  for (i = 0; i < (size_t)M.sys.N; ++i) M.B[i] *= sc;
+  M.sys.poly = poly; M.sys.poly_deg = 1; M.sys.nexp = 1; M.sys.expo = expo;
+  X = (double *)malloc(sizeof(double) * (size_t)M.sys.N * NS);
+  memset(&run, 0, sizeof run);
+  run.u = toda_u; run.dt = 0.1; run.nsteps = NS - 1;
+  memset(&o, 0, sizeof o);
+  o.method = meth; o.r = 10; o.rn = 6; o.deim = 1; o.deim_allow_negative = 1;
+  o.lambda_auto = meth == PHGMG_METHOD_GMG_QM; o.nrun = 1; o.runs = &run;
+  if (X && phgmg_simulate_inputs(&M.sys, 1, &run, NULL, X, M.sys.N, Yf, NULL, NULL) == PHGMG_OK &&
+      phgmg_reduce(&red, &M.sys, X, M.sys.N, NS, &o, &info, NULL) == PHGMG_OK &&
+      phgmg_reduced_simulate(red, xr0, 0.0, 0.1, NS - 1, toda_u, NULL, 0.0, 20, NULL, Yr, NULL, NULL, NULL) == PHGMG_OK) {
+    e = phgmg_rel_error(1, NS, Yf, 1, Yr, 1);
+    if (lambda) *lambda = info.lambda;
+  }
+  phgmg_reduced_destroy(red);
+  free(X);
+  msd_nonlinear_free(&M);
+  return e;
+}
+TEST(test_toda_state_units) {
+  static double Yf[3][301], Yr[3][301], Yq[301], Yfq[301];
+  static const double sc[3] = {1.0, 1e-6, 1e6};
+  double ep[3], lam = 0.0;
+  int k;
+  for (k = 0; k < 3; ++k) {
+    double eq;
+    ep[k] = toda_rom(sc[k], PHGMG_METHOD_GMG_POD, Yf[k], Yr[k], NULL);
+    CHECK(ep[k] == ep[k]);
+    eq = toda_rom(sc[k], PHGMG_METHOD_GMG_QM, Yfq, Yq, &lam);
+    CHECK(eq == eq);
+    CHECK_LE(eq, 1.02 * ep[k]);
+    if (k > 0) {
+      CHECK_LE(phgmg_rel_error(1, 301, Yf[0], 1, Yf[k], 1), 1e-6);
+      CHECK_LE(phgmg_rel_error(1, 301, Yr[0], 1, Yr[k], 1), 1e-6);
+    }
+  }
+}
+
 SUITE(online) {
   RUN(test_oscillator_order6);
   RUN(test_linear_energy_balance);
@@ -297,4 +359,5 @@ SUITE(online) {
   RUN(test_workspace_contract);
   RUN(test_rom_tiny_state_scale);
   RUN(test_reduce_state_units);
+  RUN(test_toda_state_units);
 }
