@@ -561,7 +561,8 @@ PHGMG_DEF void phgmg_ph_sparse_destroy(phgmg_ph_sparse *sp);
      stops when ||Z - h (A x I) F(Z)||_inf <= tol, at most max_iter updates.
      An explicit opts.tol is absolute; the default (opts.tol = 0) is 1e-10
      times max(1, ||x_n||_inf, ||Z||_inf), so that a model whose states are
-     large in its units (1e9) still converges (tests/test_online.c). Jac = (J - R) Hess H(x_n), factored as gam/h I - Jac (real) and
+     large in its units (1e9) still converges (tests/test_online.c).
+     Jac = (J - R) Hess H(x_n), factored as gam/h I - Jac (real) and
      (alp - i bet)/h I - Jac (complex): dense LU, banded LU with lower/upper
      bandwidth from the nonzero diagonals of J - R and Q (plus kb for a GENERAL
      Hessian), or the caller's shifted_* callbacks. Factors are reused across
@@ -828,7 +829,7 @@ typedef struct phgmg_rom_stepper {
   const phgmg_rom *rom;
   phgmg_real dt, tol;     /* step and Newton tolerance (inf-norm of the stage residual) */
   int max_iter;           /* Newton cap per step                                        */
-  int tol_rel;            /* 1: tol is the default, scaled by max(1, |x|_inf) each step */
+  int tol_rel;            /* 1: tol is the default, scaled by max(1, |x|_inf, |Z|_inf)  */
   phgmg_real tol_step;    /* internal: the tolerance of the current step                */
   int use_map;            /* 1 if the precomputed step map is used                      */
   int have_lu, have_prev; /* internal: factors valid / extrapolation data valid        */
@@ -4904,7 +4905,7 @@ struct phgmg_gl3 {
   phgmg_ph_system sys;
   int N, m, mode, linear;
   double h, tol, contraction;
-  int max_iter, tol_rel;   /* tol_rel: the default tol, scaled by max(1, |x|_inf) */
+  int max_iter, tol_rel;   /* tol_rel: the default tol, scaled by max(1, |x|_inf, |Z|_inf) */
   double c[3], b[3], A[9], T[9], Ti[9], E[9], d[3];
   double gam, alp, bet;
   /* dense operators */
@@ -6852,11 +6853,8 @@ PHGMG__ONLINE phgmg_result phgmg__romstep_start(phgmg_rom_stepper *s, const phgm
   return PHGMG_OK;
 }
 
-/* Simplified Newton on the stage system from the residual res; in
-   mass-matrix form (mm) a slow contraction switches to exact stage values.
-   Returns the final residual (negative after a failure, with *err). */
 /* The default tolerance (tol_rel) follows the stage increments too: tol
-   times max(1, |x|_inf, |Z|_inf). */
+   times max(1, |x|_inf, |Z|_inf) (phgmg_rom_step starts it from x). */
 PHGMG__ONLINE void phgmg__romstep_tol(phgmg_rom_stepper *s, const phgmg__romstep_mem *L) {
   int i;
   if (!s->tol_rel) return;
@@ -6864,13 +6862,16 @@ PHGMG__ONLINE void phgmg__romstep_tol(phgmg_rom_stepper *s, const phgmg__romstep
     if (PHGMG__RABS(L->Z[i]) * s->tol > s->tol_step) s->tol_step = PHGMG__RABS(L->Z[i]) * s->tol;
 }
 
+/* Simplified Newton on the stage system from the residual res; in
+   mass-matrix form (mm) a slow contraction switches to exact stage values.
+   Returns the final residual (negative after a failure, with *err). */
 PHGMG__ONLINE phgmg_real phgmg__romstep_iterate(phgmg_rom_stepper *s, const phgmg__romstep_mem *L, const phgmg_real *x,
                                                const phgmg_real *u3, phgmg_real res, int *mm, int *exact, int *it,
                                                phgmg_real *theta_max, phgmg_result *err) {
   const int r = s->rom->r, n3 = 3 * r;
   phgmg_real res_prev = PHGMG__R(0);
   int i, a;
-  /* at least one update (as the full-order stepper): tol is absolute, and a
+  /* at least one update (as the full-order stepper): tol has a floor, and a
      model whose states are tiny (SI units, e.g. charges of 1e-12 C) would
      otherwise accept the extrapolated guess unsolved */
   phgmg__romstep_tol(s, L);
