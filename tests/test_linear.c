@@ -275,23 +275,29 @@ TEST(test_prbt_zero_feedthrough_limit) {
   }
 }
 
+/* V (CH_N x k, k <= 18): orthonormal columns, orthogonal to the chain's B. */
+static void check_orthonormal_to_b(int k, const double *V) {
+  double G[18 * 18], BV[2 * 18];
+  int i, j;
+  phgmg_gemm('T', 'N', k, k, CH_N, 1.0, V, CH_N, V, CH_N, 0.0, G, k);
+  phgmg_gemm('T', 'N', 2, k, CH_N, 1.0, chB, CH_N, V, CH_N, 0.0, BV, 2);
+  for (j = 0; j < k; ++j)
+    for (i = 0; i < k; ++i) CHECK_LE(fabs(G[i + j * k] - (i == j ? 1.0 : 0.0)), 1e-12);
+  for (i = 0; i < 2 * k; ++i) CHECK_LE(fabs(BV[i]), 1e-12);
+}
+
 TEST(test_bases_orthonormal_to_b) {
   phgmg_ph_system s = chain2();
   static double V[CH_N * 18];
-  double G[18 * 18], BV[2 * 18];
   static volatile int kv = 18;   /* opaque: see ch_n */
-  int kind, k = kv, kk = 0, i, j;
+  int kind, k = kv, kk = 0;
   phgmg_basis_opts bo;
   memset(&bo, 0, sizeof bo);
   bo.nsteps = 300;
   for (kind = PHGMG_BASIS_FREQ; kind <= PHGMG_BASIS_BALANCED; ++kind) {
     CHECK_RC(phgmg_linear_basis(&s, (phgmg_basis_kind)kind, k, &bo, V, &kk, NULL), PHGMG_OK);
     CHECK(kk == k);
-    phgmg_gemm('T', 'N', k, k, CH_N, 1.0, V, CH_N, V, CH_N, 0.0, G, k);
-    phgmg_gemm('T', 'N', 2, k, CH_N, 1.0, chB, CH_N, V, CH_N, 0.0, BV, 2);
-    for (j = 0; j < k; ++j)
-      for (i = 0; i < k; ++i) CHECK_LE(fabs(G[i + j * k] - (i == j ? 1.0 : 0.0)), 1e-12);
-    for (i = 0; i < 2 * k; ++i) CHECK_LE(fabs(BV[i]), 1e-12);
+    check_orthonormal_to_b(k, V);
   }
   CHECK_RC(phgmg_linear_basis(&s, (phgmg_basis_kind)9, k, NULL, V, NULL, NULL), PHGMG_ERR_INVALID_ARG);
   CHECK_RC(phgmg_linear_basis(&s, PHGMG_BASIS_FREQ, CH_N, NULL, V, NULL, NULL), PHGMG_ERR_SIZE);
@@ -507,20 +513,16 @@ TEST(test_h2_basis) {
   enum { k = 10 };
   phgmg_ph_system s = chain2();
   static double V[CH_N * k], V0[CH_N * k];
-  double Gm[k * k], BV[2 * k], h2 = NAN, e0;
+  double h2 = NAN, e0;
   phgmg_basis_opts bo;
-  int i, j, kk = 0;
+  int kk = 0;
   CHECK_RC(phgmg_linear_basis(&s, PHGMG_BASIS_BALANCED, k, NULL, V0, NULL, NULL), PHGMG_OK);
   e0 = h2_direct(k, V0);
   memset(&bo, 0, sizeof bo);
   bo.maxit = 100; bo.h2_rel = &h2;
   CHECK_RC(phgmg_linear_basis(&s, PHGMG_BASIS_H2, k, &bo, V, &kk, NULL), PHGMG_OK);
   CHECK(kk == k);
-  phgmg_gemm('T', 'N', k, k, CH_N, 1.0, V, CH_N, V, CH_N, 0.0, Gm, k);
-  phgmg_gemm('T', 'N', 2, k, CH_N, 1.0, chB, CH_N, V, CH_N, 0.0, BV, 2);
-  for (j = 0; j < k; ++j)
-    for (i = 0; i < k; ++i) CHECK_LE(fabs(Gm[i + j * k] - (i == j ? 1.0 : 0.0)), 1e-12);
-  for (i = 0; i < 2 * k; ++i) CHECK_LE(fabs(BV[i]), 1e-12);
+  check_orthonormal_to_b(k, V);
   CHECK_LE(fabs(h2 - h2_direct(k, V)), 1e-6 * h2);
   CHECK(h2 < e0);
   memset(V0, 0, sizeof V0);   /* an infeasible start (V^T G V singular): the balanced start instead */
