@@ -177,23 +177,6 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   return 0;
 }
 
-#ifndef PHGMG_LIBFUZZER
-#if defined(__GNUC__) || defined(__clang__)
-__attribute__((weak))
-#endif
-int main(int argc, char **argv) {
-  int k, nok = 0;
-  for (k = 1; k < argc; ++k) {
-    FILE *f = fopen(argv[k], "rb");
-    unsigned char buf[256];
-    size_t n;
-    if (!f) { fprintf(stderr, "fuzz_cli: cannot open %s\n", argv[k]); return 1; }
-    n = fread(buf, 1, sizeof buf, f);
-    fclose(f);
-    LLVMFuzzerTestOneInput(buf, n);
-    ++nok;
-  }
-  printf("fuzz_cli: %d inputs ran without findings\n", nok);
-  return 0;
-}
-#endif
+#define FUZZ_NAME "fuzz_cli"
+#define FUZZ_MAX_INPUT 256   /* the replay reads at most this much of a corpus file */
+#include "fuzz_main.h"

@@ -1,7 +1,8 @@
 /* The stand-alone driver of a fuzz harness (built without libFuzzer, and by
    `sh tests/fuzz/run.sh 0` to replay a corpus): runs LLVMFuzzerTestOneInput
-   once on the whole of each file named on the command line. Define FUZZ_NAME
-   (the harness's name for messages) before including it, after the harness. */
+   once on each file named on the command line (the whole file, or its first
+   FUZZ_MAX_INPUT bytes when the harness defines that). Define FUZZ_NAME (the
+   harness's name for messages) before including it, after the harness. */
 #ifndef PHGMG_LIBFUZZER
 #if defined(__GNUC__) || defined(__clang__)
 __attribute__((weak))
@@ -26,6 +27,9 @@ int main(int argc, char **argv) {
       return 1;
     }
     fclose(f);
+#ifdef FUZZ_MAX_INPUT
+    if (n > FUZZ_MAX_INPUT) n = FUZZ_MAX_INPUT;
+#endif
     LLVMFuzzerTestOneInput(buf, (size_t)n);
     free(buf);
     ++nok;
