@@ -184,13 +184,19 @@ extern "C" {
   X(PHGMG_ERR_Q_NOT_PD,        -18, "Q is not positive definite (semidefinite for a nonlinear H)")                       \
   X(PHGMG_ERR_DTYPE,           -19, "unsupported .npy dtype (complex, object, string, ...)") \
   X(PHGMG_ERR_INEXACT,         -20, "integer beyond 2^53 in magnitude: not exact as a double") \
-  X(PHGMG_ERR_NOT_STABLE,      -21, "system not asymptotically stable (an undamped mode: eigenvalue on the imaginary axis)")
+  X(PHGMG_ERR_NOT_STABLE,      -21, "system not asymptotically stable (an undamped mode: eigenvalue on the imaginary axis)") \
+  X(PHGMG_ERR_OVERFLOW,        -22, "a result overflows the double range (values too large in their units: rescale the data)") \
+  X(PHGMG_ERR_TOL_UNREACHABLE, -23, "tolerance below what double precision can reach (relative tolerance < 1e-15)") \
+  X(PHGMG_ERR_NOT_STABILIZABLE, -24, "no stabilizing Riccati solution: (A, K) not stabilizable or (A, L) not detectable") \
+  X(PHGMG_ERR_STALE,           -25, "the system changed since the study was created (create the study again)") \
+  X(PHGMG_ERR_STRUCTURE,       -26, "model fails the structure check (Qh not positive definite, R not PSD, or a step map not of its dt)") \
+  X(PHGMG_ERR_STEP_MAP,        -27, "step map not stable in double precision at this dt (use a smaller dt)")
 
 typedef enum phgmg_result {
 #define PHGMG__X(name, val, str) name = val,
   PHGMG__RESULT_LIST(PHGMG__X)
 #undef PHGMG__X
-  PHGMG__RESULT_END_ = -22
+  PHGMG__RESULT_END_ = -28
 } phgmg_result;
 
 /* A stable, human-readable description of a result code (never NULL). */
@@ -1288,17 +1294,27 @@ typedef struct phgmg_validation {
    reduced model from rho(x0) with the online stepper (tol/max_iter <= 0:
    defaults 1e-10 for the full model, the stepper's default for the reduced
    one (1e-10 double, 1e-5 float) / 20), and fills *v. pass = 1 when the reduced run completes
-   without any failed Newton solve and e_y <= ey_max (ey_max <= 0: no limit
-   on e_y). Returns PHGMG_OK when the comparison was made (a failing reduced
-   model is a result, v->pass = 0, not an error); PHGMG_ERR_INVALID_ARG /
-   _SIZE for bad arguments (sys->N or m not the model's), the full model's
-   code if it fails, PHGMG_ERR_NOMEM. Cost: one full and one reduced run. */
+   without any failed Newton solve, every measure is finite and e_y <= ey_max
+   (ey_max <= 0: no limit on e_y). The error norms are sums of squares
+   scaled by a power of two when the plain sums would overflow or underflow,
+   so e_red, e_y and e_proj do not depend on the data's magnitude. Returns
+   PHGMG_OK when the comparison was made (a failing reduced model is a
+   result, v->pass = 0, not an error); PHGMG_ERR_INVALID_ARG / _SIZE for bad
+   arguments (run->nsteps < 1: nothing to compare; sys->N or m not the
+   model's), the full model's code if it fails, PHGMG_ERR_NOMEM;
+   PHGMG_ERR_NANINF when a Hamiltonian returns NaN at states below 1e100 in
+   magnitude, PHGMG_ERR_OVERFLOW when the states are so large that an energy
+   or a measure leaves the double range (e.g. |x| ~ 1e160: H ~ |x|^2). With
+   these two *v holds what could be measured and pass = 0. Cost: one full
+   and one reduced run. */
 PHGMG_DEF phgmg_result phgmg_reduced_validate(const phgmg_reduced *red, const phgmg_ph_system *sys,
                                               const phgmg_run *run, double tol, int max_iter, double ey_max,
                                               phgmg_validation *v, const phgmg_allocator *alloc);
 
 /* --- error measures (paper 5.1) --- */
-/* sqrt(sum_i ||A_i - B_i||^2 / sum_i ||A_i||^2) over ns columns of length n. */
+/* sqrt(sum_i ||A_i - B_i||^2 / sum_i ||A_i||^2) over ns columns of length n
+   (the sums scaled by a power of two when plain sums would overflow or
+   underflow; the same holds for phgmg_err_red / _proj / _lowerbound). */
 PHGMG_DEF double phgmg_rel_error(int n, int ns, const double *A, int lda, const double *B, int ldb);
 /* e_red: reduction error of a reduced trajectory XR (r x ns) against X. */
 PHGMG_DEF double phgmg_err_red(const phgmg_reduced *red, const double *X, int ldx, int ns,
@@ -10500,6 +10516,28 @@ PHGMG_DEF phgmg_result phgmg_reduced_simulate(const phgmg_reduced *red, const do
   return rc;
 }
 
+PHGMG__PRIV phgmg_result phgmg__err_map_rc(const phgmg_reduced *red, const double *X, int ldx, int ns,
+                                           const double *XR, int ldxr, int mode, double *e);
+
+/* phgmg_reduced_validate's measures all finite? PHGMG_OK if so; else
+   PHGMG_ERR_NANINF when a Hamiltonian value is NaN (full model Hf over nf
+   points, reduced H over nr) at states of ordinary size (the full model's
+   states X, N x nf, all below 1e100 in magnitude), PHGMG_ERR_OVERFLOW
+   otherwise: the states are so large that their energies (quadratic in the
+   states) or the error measures leave the double range. */
+PHGMG__PRIV phgmg_result phgmg__validate_finite(const phgmg_validation *v, const double *X, int N,
+                                                const double *Hf, int nf, const double *H, int nr) {
+  int j, nan = 0;
+  size_t q;
+  if (isfinite(v->e_red) && isfinite(v->e_y) && isfinite(v->e_proj) && isfinite(v->e_energy) &&
+      isfinite(v->e_energy_fom))
+    return PHGMG_OK;
+  for (j = 0; j < nf; ++j) nan |= Hf[j] != Hf[j];
+  for (j = 0; j < nr; ++j) nan |= H[j] != H[j];
+  for (q = 0; nan && q < (size_t)N * nf; ++q) if (!(fabs(X[q]) < 1e100)) nan = 0;
+  return nan ? PHGMG_ERR_NANINF : PHGMG_ERR_OVERFLOW;
+}
+
 PHGMG_DEF phgmg_result phgmg_reduced_validate(const phgmg_reduced *red, const phgmg_ph_system *sys,
                                               const phgmg_run *run, double tol, int max_iter, double ey_max,
                                               phgmg_validation *v, const phgmg_allocator *alloc) {
@@ -10513,7 +10551,8 @@ PHGMG_DEF phgmg_result phgmg_reduced_validate(const phgmg_reduced *red, const ph
   memset(v, 0, sizeof *v);
   v->first_failure = -1;
   if (!red || !sys || !run) return PHGMG_ERR_INVALID_ARG;
-  if (phgmg_runs_columns(1, run) < 0 || !(tol < 1.0) || ey_max != ey_max) return PHGMG_ERR_INVALID_ARG;
+  if (phgmg_runs_columns(1, run) < 0 || run->nsteps < 1 || !(tol < 1.0) || ey_max != ey_max)
+    return PHGMG_ERR_INVALID_ARG;
   N = red->N; m = red->m; r = red->r; ns = run->nsteps + 1;
   if (sys->N != N || sys->m != m) return PHGMG_ERR_SIZE;
   nb = (size_t)N * ns + (size_t)m * ns * 2 + (size_t)r * ns + (size_t)r + 6 * (size_t)ns + (size_t)N;
@@ -10538,38 +10577,67 @@ PHGMG_DEF phgmg_result phgmg_reduced_validate(const phgmg_reduced *red, const ph
   v->nsteps = run->nsteps;
   v->steps_done = v->rom_rc == PHGMG_OK ? run->nsteps : done;
   if (v->rom_rc != PHGMG_OK) v->first_failure = v->steps_done;
-  v->e_red = phgmg_err_red(red, X, N, v->steps_done + 1, XR, r);
+  rc = phgmg__err_map_rc(red, X, N, v->steps_done + 1, XR, r, 0, &v->e_red);
+  if (rc == PHGMG_OK) rc = phgmg__err_map_rc(red, X, N, ns, NULL, 0, 1, &v->e_proj);
+  if (rc != PHGMG_OK) { phgmg__free(alloc, buf); return rc; }
   v->e_y = phgmg_rel_error(m, v->steps_done + 1, Y, m, YR, m);
-  v->e_proj = phgmg_err_proj(red, X, N, ns);
-  if (v->e_red != v->e_red || v->e_proj != v->e_proj) { /* the error maps could not allocate (data are finite) */
-    phgmg__free(alloc, buf);
-    return PHGMG_ERR_NOMEM;
-  }
   for (j = 0; j < ns; ++j) {
     const double efj = fabs(Hf[j] - Hf[0] - Sf[j] + Df[j]);
-    if (efj > v->e_energy_fom) v->e_energy_fom = efj;
+    if (!(efj <= v->e_energy_fom)) v->e_energy_fom = efj;
     if (j <= v->steps_done) {
       const double erj = fabs(H[j] - H[0] - S[j] + D[j]);
       if (!(erj <= v->e_energy)) v->e_energy = erj;
     }
     for (k = 0; k < m; ++k) v->y_scale = PHGMG__MAX(v->y_scale, fabs(Y[k + (size_t)j * m]));
   }
-  v->pass = v->rom_rc == PHGMG_OK && v->stats.failures == 0 && (ey_max <= 0.0 || v->e_y <= ey_max);
+  rc = phgmg__validate_finite(v, X, N, Hf, ns, H, v->steps_done + 1);
+  v->pass = rc == PHGMG_OK && v->rom_rc == PHGMG_OK && v->stats.failures == 0 && (ey_max <= 0.0 || v->e_y <= ey_max);
   phgmg__free(alloc, buf);
-  return PHGMG_OK;
+  return rc;
 }
 
 /* --- error measures ------------------------------------------------------ */
+/* Scale of the error measures' second pass: 2^-e with amax 2^-e in [0.5, 1)
+   (exact: a power of two), 1 for amax 0, NaN or Inf. */
+PHGMG__PRIV double phgmg__pow2_scale(double amax) {
+  int e = 0;
+  if (!(amax > 0.0) || !(amax < HUGE_VAL)) return 1.0;
+  (void)frexp(amax, &e);
+  return ldexp(1.0, -e);
+}
+
+/* Do plain sums of squares num, den need the scaled second pass (an
+   overflow, or squares near the underflow threshold)? */
+#define PHGMG__SSQ_RESCALE(num, den) (!((den) > 1e-280 && (den) < 1e280 && (num) < 1e280))
+
+/* sqrt(num / den) of the error measures (den 0: 0 if num is 0, else Inf). */
+PHGMG__PRIV double phgmg__err_ratio(double num, double den) {
+  return den > 0.0 ? sqrt(num / den) : (num > 0.0 ? (double)INFINITY : 0.0);
+}
+
 PHGMG_DEF double phgmg_rel_error(int n, int ns, const double *A, int lda, const double *B, int ldb) {
-  double num = 0.0, den = 0.0;
+  double num = 0.0, den = 0.0, amax = 0.0, s;
   int i, j;
   for (j = 0; j < ns; ++j)
     for (i = 0; i < n; ++i) {
-      const double a = A[i + (size_t)j * lda], d = a - B[i + (size_t)j * ldb];
+      const double a = A[i + (size_t)j * lda], b = B[i + (size_t)j * ldb], d = a - b;
+      num += d * d;
+      den += a * a;
+      amax = PHGMG__MAX(amax, PHGMG__MAX(fabs(a), fabs(b)));
+    }
+  if (!PHGMG__SSQ_RESCALE(num, den) || num != num || den != den || !(amax > 0.0 && amax < HUGE_VAL))
+    return phgmg__err_ratio(num, den);
+  /* second pass on the data scaled by a power of two (exact): the ratio of
+     the sums does not depend on the data's magnitude */
+  s = phgmg__pow2_scale(amax);
+  num = den = 0.0;
+  for (j = 0; j < ns; ++j)
+    for (i = 0; i < n; ++i) {
+      const double a = s * A[i + (size_t)j * lda], d = a - s * B[i + (size_t)j * ldb];
       num += d * d;
       den += a * a;
     }
-  return den > 0.0 ? sqrt(num / den) : (num > 0.0 ? (double)INFINITY : 0.0);
+  return phgmg__err_ratio(num, den);
 }
 
 /* Columns per block of the error measures: GEMMs of N x 64 blocks, bounded
@@ -10632,36 +10700,70 @@ PHGMG__PRIV void phgmg__err_map_block(const phgmg_reduced *red, const double *X,
   }
 }
 
-/* sqrt(sum ||x_i - g(x_i)||^2 / sum ||x_i||^2) with g applied column-wise,
-   PHGMG__ERR_NB columns at a time (GEMM instead of per-column GEMV).
-   mode 0: g(x_i) = phi(XR_i); 1: phi(rho(x_i)); 2: orthogonal projection on
-   [B, V1, V2]. */
-PHGMG__PRIV double phgmg__err_map(const phgmg_reduced *red, const double *X, int ldx, int ns,
-                                  const double *XR, int ldxr, int mode) {
-  const int N = red->N, r = red->r, nbmax = PHGMG__MIN(ns, PHGMG__ERR_NB);
-  const phgmg_allocator *alloc = red->use_alloc ? &red->alloc : NULL;
-  double *Xt, *C, *Qb, num = 0.0, den = 0.0;
+/* The sums of phgmg__err_map over all blocks with the differences and
+   states scaled by s (s = 1: plain); *amax = the largest |x_i|, |g(x_i)|. */
+PHGMG__PRIV void phgmg__err_map_sums(const phgmg_reduced *red, const double *X, int ldx, int ns,
+                                     const double *XR, int ldxr, int mode, double s, double *Xt, double *C,
+                                     double *Qb, double *num, double *den, double *amax) {
+  const int N = red->N, nbmax = PHGMG__MIN(ns, PHGMG__ERR_NB);
+  double sn = 0.0, sd = 0.0, am = 0.0;
   int i, j0, k;
-  if (ns < 1) return 0.0;
-  Xt = phgmg__dalloc(alloc, (size_t)nbmax * ((size_t)N + (size_t)(r + red->rn) + 64));
-  if (!Xt) return (double)NAN;
-  C = Xt + (size_t)N * nbmax;
-  Qb = C + (size_t)(r + red->rn) * nbmax;
   for (j0 = 0; j0 < ns; j0 += nbmax) {
     const int nb = PHGMG__MIN(nbmax, ns - j0);
     const double *Xb = X + (size_t)j0 * ldx;
     phgmg__err_map_block(red, Xb, ldx, nb, XR ? XR + (size_t)j0 * ldxr : NULL, ldxr, mode, Xt, C, Qb);
     for (k = 0; k < nb; ++k) {
       const double *x = Xb + (size_t)k * ldx, *xt = Xt + (size_t)k * N;
-      for (i = 0; i < N; ++i) {
-        const double d = x[i] - xt[i];
-        num += d * d;
-        den += x[i] * x[i];
+      if (s == 1.0) {
+        for (i = 0; i < N; ++i) {
+          const double d = x[i] - xt[i];
+          sn += d * d;
+          sd += x[i] * x[i];
+          am = PHGMG__MAX(am, PHGMG__MAX(fabs(x[i]), fabs(xt[i])));
+        }
+      } else {
+        for (i = 0; i < N; ++i) {
+          const double xs = s * x[i], d = xs - s * xt[i];
+          sn += d * d;
+          sd += xs * xs;
+        }
       }
     }
   }
+  *num = sn; *den = sd; *amax = am;
+}
+
+/* sqrt(sum ||x_i - g(x_i)||^2 / sum ||x_i||^2) with g applied column-wise,
+   PHGMG__ERR_NB columns at a time (GEMM instead of per-column GEMV).
+   mode 0: g(x_i) = phi(XR_i); 1: phi(rho(x_i)); 2: orthogonal projection on
+   [B, V1, V2]. Plain sums of squares; when they overflow or come near the
+   underflow threshold, a second pass sums the values scaled by a power of
+   two (exact), so the measure does not depend on the data's magnitude.
+   *e = the measure; PHGMG_ERR_NOMEM (then *e = NaN) or PHGMG_OK. */
+PHGMG__PRIV phgmg_result phgmg__err_map_rc(const phgmg_reduced *red, const double *X, int ldx, int ns,
+                                           const double *XR, int ldxr, int mode, double *e) {
+  const int N = red->N, r = red->r, nbmax = PHGMG__MIN(ns, PHGMG__ERR_NB);
+  const phgmg_allocator *alloc = red->use_alloc ? &red->alloc : NULL;
+  double *Xt, *C, *Qb, num = 0.0, den = 0.0, amax = 0.0;
+  *e = 0.0;
+  if (ns < 1) return PHGMG_OK;
+  Xt = phgmg__dalloc(alloc, (size_t)nbmax * ((size_t)N + (size_t)(r + red->rn) + 64));
+  if (!Xt) { *e = (double)NAN; return PHGMG_ERR_NOMEM; }
+  C = Xt + (size_t)N * nbmax;
+  Qb = C + (size_t)(r + red->rn) * nbmax;
+  phgmg__err_map_sums(red, X, ldx, ns, XR, ldxr, mode, 1.0, Xt, C, Qb, &num, &den, &amax);
+  if (PHGMG__SSQ_RESCALE(num, den) && num == num && amax > 0.0 && amax < HUGE_VAL)
+    phgmg__err_map_sums(red, X, ldx, ns, XR, ldxr, mode, phgmg__pow2_scale(amax), Xt, C, Qb, &num, &den, &amax);
   phgmg__free(alloc, Xt);
-  return den > 0.0 ? sqrt(num / den) : 0.0;
+  *e = den > 0.0 ? sqrt(num / den) : 0.0;
+  return PHGMG_OK;
+}
+
+PHGMG__PRIV double phgmg__err_map(const phgmg_reduced *red, const double *X, int ldx, int ns,
+                                  const double *XR, int ldxr, int mode) {
+  double e;
+  (void)phgmg__err_map_rc(red, X, ldx, ns, XR, ldxr, mode, &e);
+  return e;
 }
 
 PHGMG_DEF double phgmg_err_red(const phgmg_reduced *red, const double *X, int ldx, int ns,

@@ -1,0 +1,141 @@
+/* Defects of the library's C API found by trying it as a new user and as an
+   attacker would (third sweep): one regression test per defect fixed, each
+   failing on the code before the fix. The command line's items are checked
+   in tests/test_cli.sh. */
+#define PHGMG_STATIC
+#define PHGMG_IMPLEMENTATION
+#include "../phgmg.h"
+#include "harness.h"
+#include <stdlib.h>
+
+/* Linear mass-spring-damper chain of paper 5.2 (n masses, N = 2n, one force
+   port at the first mass), x = (q1, p1, q2, p2, ...), dense. */
+typedef struct d3_model {
+  phgmg_ph_system sys;
+  double *J, *R, *Q, *B;
+} d3_model;
+static void d3_msd(d3_model *t, int n) {
+  const int N = 2 * n;
+  int i;
+  memset(t, 0, sizeof *t);
+  t->J = (double *)calloc((size_t)N * N, sizeof(double));
+  t->R = (double *)calloc((size_t)N * N, sizeof(double));
+  t->Q = (double *)calloc((size_t)N * N, sizeof(double));
+  t->B = (double *)calloc((size_t)N, sizeof(double));
+  for (i = 0; i < n; ++i) {
+    const int q = 2 * i, p = 2 * i + 1;
+    t->J[q + p * N] = 1; t->J[p + q * N] = -1;
+    t->R[p + p * N] = 0.5;
+    t->Q[p + p * N] = 1.0;
+    t->Q[q + q * N] = (i == 0 ? 1.0 : 2.0);
+    if (i + 1 < n) { t->Q[q + (q + 2) * N] = -1.0; t->Q[(q + 2) + q * N] = -1.0; }
+  }
+  t->B[1] = 1;
+  t->sys.N = N; t->sys.m = 1; t->sys.J = t->J; t->sys.R = t->R; t->sys.Q = t->Q; t->sys.B = t->B;
+}
+static void d3_free(d3_model *t) { free(t->J); free(t->R); free(t->Q); free(t->B); }
+static double d3_amp = 1.0;
+static void d3_u_sin(double t, double *u, void *user) { (void)user; u[0] = d3_amp * sin(t); }
+
+/* Snapshots of the chain driven by sin (amplitude 1) and a GMG-POD model of order r. */
+static phgmg_reduced *d3_reduce(d3_model *t, int n, int ns, int r, phgmg_method meth, double **Xo) {
+  const int N = 2 * n;
+  double *X = (double *)calloc((size_t)N * ns, sizeof(double)), *x0 = (double *)calloc((size_t)N, sizeof(double));
+  phgmg_reduce_opts o;
+  phgmg_reduced *red = NULL;
+  d3_msd(t, n);
+  d3_amp = 1.0;
+  CHECK_RC(phgmg_simulate(&t->sys, x0, 0.0, 0.1, ns - 1, d3_u_sin, NULL, NULL, X, NULL, NULL, NULL, NULL, NULL),
+           PHGMG_OK);
+  memset(&o, 0, sizeof o);
+  o.method = meth; o.r = r;
+  CHECK_RC(phgmg_reduce(&red, &t->sys, X, N, ns, &o, NULL, NULL), PHGMG_OK);
+  free(x0);
+  if (Xo) *Xo = X; else free(X);
+  return red;
+}
+
+/* The error norms do not depend on the data's magnitude (the chain is
+   linear and x0 = 0, so an input a times larger gives states and outputs a
+   times larger: e_red, e_y, e_proj are invariant; a = 2^k keeps every
+   product exact). At a = 2^-530 the plain squares underflow, at 2^510 their
+   sums overflow (the energy, one column's quadratic form, still does not);
+   at 2^530 the energy overflows: PHGMG_ERR_OVERFLOW, not "out of memory". */
+TEST(test_defect3_validate_scaled_norms) {
+  d3_model t;
+  phgmg_reduced *red = d3_reduce(&t, 10, 201, 4, PHGMG_METHOD_GMG_POD, NULL);
+  phgmg_run run;
+  phgmg_validation v1, v;
+  const int ex[3] = {-530, 510, 530};
+  int k;
+  memset(&run, 0, sizeof run);
+  run.u = d3_u_sin; run.dt = 0.1; run.nsteps = 200;
+  d3_amp = 1.0;
+  CHECK_RC(phgmg_reduced_validate(red, &t.sys, &run, 0.0, 0, 0.5, &v1, NULL), PHGMG_OK);
+  CHECK(v1.pass == 1 && v1.e_y > 0.0 && v1.e_red > 0.0);
+  for (k = 0; k < 3; ++k) {
+    d3_amp = ldexp(1.0, ex[k]);
+    CHECK_RC(phgmg_reduced_validate(red, &t.sys, &run, 0.0, 0, 0.5, &v, NULL),
+             (ex[k] == 530 ? PHGMG_ERR_OVERFLOW : PHGMG_OK));
+    CHECK_LE(fabs(v.e_red - v1.e_red), 1e-9 * v1.e_red);
+    CHECK_LE(fabs(v.e_y - v1.e_y), 1e-9 * v1.e_y);
+    CHECK_LE(fabs(v.e_proj - v1.e_proj), 1e-9 * v1.e_proj);
+    CHECK(v.pass == (ex[k] != 530));
+  }
+  /* the public measures directly: phgmg_rel_error of a and a (1 + 2^-3) is 2^-3 */
+  {
+    double A[3], B[3];
+    const double sc[3] = {1e-300, 1.0, 1e300};
+    for (k = 0; k < 3; ++k) {
+      A[0] = sc[k]; A[1] = -2.0 * sc[k]; A[2] = 0.5 * sc[k];
+      B[0] = A[0] * 1.125; B[1] = A[1] * 1.125; B[2] = A[2] * 1.125;
+      CHECK_LE(fabs(phgmg_rel_error(3, 1, A, 3, B, 3) - 0.125), 1e-15);
+    }
+  }
+  d3_amp = 1.0;
+  phgmg_reduced_destroy(red);
+  d3_free(&t);
+}
+
+/* A GENERAL nonlinear part whose H_nl is NaN (gradient and Hessian zero: the
+   dynamics stay the chain's) must not pass validation; nor may a run of zero
+   steps, which compares nothing. */
+static double d3_h_nan(const double *x, void *user) { (void)x; (void)user; return (double)NAN; }
+static int d3_nN;
+static void d3_g_zero(const double *x, double *g, void *user) { (void)x; (void)user; memset(g, 0, sizeof(double) * (size_t)d3_nN); }
+static void d3_h_zero(const double *x, double *Hs, void *user) {
+  (void)x; (void)user; memset(Hs, 0, sizeof(double) * (size_t)d3_nN * (size_t)d3_nN);
+}
+TEST(test_defect3_validate_nan_energy) {
+  d3_model t;
+  double *X;
+  phgmg_reduced *red = d3_reduce(&t, 5, 101, 4, PHGMG_METHOD_GMG_POD, &X);
+  phgmg_ph_system g = t.sys;
+  phgmg_reduced *rg = NULL;
+  phgmg_reduce_opts o;
+  phgmg_run run;
+  phgmg_validation v;
+  memset(&run, 0, sizeof run);
+  run.u = d3_u_sin; run.dt = 0.1; run.nsteps = 0;
+  CHECK_RC(phgmg_reduced_validate(red, &t.sys, &run, 0.0, 0, 0.5, &v, NULL), PHGMG_ERR_INVALID_ARG);
+  CHECK(v.pass == 0);
+  d3_nN = 10;
+  g.nl = PHGMG_NL_GENERAL; g.H_nl = d3_h_nan; g.grad_nl = d3_g_zero; g.hess_nl = d3_h_zero;
+  memset(&o, 0, sizeof o);
+  o.method = PHGMG_METHOD_GMG_POD; o.r = 4;
+  CHECK_RC(phgmg_reduce(&rg, &g, X, 10, 101, &o, NULL, NULL), PHGMG_OK);
+  run.nsteps = 50;
+  if (rg) {
+    CHECK_RC(phgmg_reduced_validate(rg, &g, &run, 0.0, 0, 0.5, &v, NULL), PHGMG_ERR_NANINF);
+    CHECK(v.pass == 0);
+  }
+  phgmg_reduced_destroy(rg);
+  phgmg_reduced_destroy(red);
+  free(X);
+  d3_free(&t);
+}
+
+SUITE(defects3) {
+  RUN(test_defect3_validate_scaled_norms);
+  RUN(test_defect3_validate_nan_energy);
+}
