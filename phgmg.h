@@ -1441,7 +1441,9 @@ PHGMG_DEF phgmg_result phgmg_nnls(int m, int n, const double *A, int lda, const 
    each training quantity (e.g. rows (snapshot i, reduced coordinate a) =
    phi_k'(l_k(x_i)) [V]_{idx_k, a}, optionally energy rows phi_k(l_k(x_i)));
    target (nrows) = the full sum, Gm sw. Finds w >= 0 with few non-zeros and
-   ||Gm w - target|| <= tol ||target|| (tol <= 0: 1e-6) by Lawson-Hanson
+   ||Gm w - target|| <= tol ||target|| (tol = 0: 1e-6; tol < 0, NaN or >= 1:
+   PHGMG_ERR_INVALID_ARG; 0 < tol < 1e-15, below the rounding level of a
+   relative residual: PHGMG_ERR_TOL_UNREACHABLE) by Lawson-Hanson
    stopped at tol: the candidate gradient from the Gram matrix Gm^T Gm (formed
    once: nrows nterms^2 flops, the dominant cost, 0.16 s at 20020 x 500),
    the passive least squares by Cholesky of the Gram block refined once with
@@ -1472,9 +1474,14 @@ PHGMG_DEF phgmg_result phgmg_nnls(int m, int n, const double *A, int lda, const 
    (also if W reaches 16 * PHGMG_ECSW_SCREEN_ADD terms). Memory nrows *
    |W| + O(nrows + nterms); on the paper's chain at N = 256 000 (128 000
    terms, 20 020 rows) 3 rounds, 28 points, about 2 s.
+   Scale: Gm or target whose largest |entry| is outside [2^-400, 2^400] are
+   scaled by powers of two (exact) in a copy (nrows nterms more memory), so
+   the points, the relative residual and the weights (scaled back) do not
+   depend on the data's magnitude; weights beyond the double range give
+   PHGMG_ERR_OVERFLOW.
    Errors: PHGMG_ERR_INVALID_ARG, PHGMG_ERR_SIZE, PHGMG_ERR_NANINF,
-   PHGMG_ERR_NOT_CONVERGED (tol not met: outputs hold the best found),
-   PHGMG_ERR_NOMEM. */
+   PHGMG_ERR_TOL_UNREACHABLE, PHGMG_ERR_NOT_CONVERGED (tol not met: outputs
+   hold the best found), PHGMG_ERR_OVERFLOW, PHGMG_ERR_NOMEM. */
 PHGMG_DEF phgmg_result phgmg_ecsw(int nterms, int nrows, const double *Gm, int ldg, const double *target,
                                   double tol, int *pts, double *w, int *nd_out, double *resid_out,
                                   const phgmg_allocator *alloc);
@@ -1906,6 +1913,15 @@ PHGMG_DEF const char *phgmg_result_string(phgmg_result r) {
 /* Private helpers are `static PHGMG__UNUSED` so that a build that does not use
    every one of them stays warning-free. */
 #define PHGMG__PRIV static PHGMG__UNUSED
+
+/* 2^-e with amax 2^-e in [0.5, 1): a scale that is exact (a power of two),
+   for data whose magnitude must not matter; 1 for amax 0, NaN or Inf. */
+PHGMG__PRIV double phgmg__pow2_scale(double amax) {
+  int e = 0;
+  if (!(amax > 0.0) || !(amax < HUGE_VAL)) return 1.0;
+  (void)frexp(amax, &e);
+  return ldexp(1.0, -e);
+}
 
 PHGMG__PRIV int phgmg__all_finite(const double *a, size_t n) {
   size_t i;
@@ -8081,17 +8097,14 @@ PHGMG__PRIV phgmg_result phgmg__ecsw_screened(const phgmg__ecsw_op *op, const do
   return rc;
 }
 
-PHGMG_DEF phgmg_result phgmg_ecsw(int nterms, int nrows, const double *Gm, int ldg, const double *target,
-                                  double tol, int *pts, double *w, int *nd_out, double *resid_out,
-                                  const phgmg_allocator *alloc) {
-  const int n = nterms, m = nrows;
+/* phgmg_ecsw on checked arguments (tol >= PHGMG__ECSW_TOL_MIN; Gm and target
+   within [2^-400, 2^400] in magnitude, so that the Gram matrix neither
+   overflows nor underflows). */
+PHGMG__PRIV phgmg_result phgmg__ecsw_run(int n, int m, const double *Gm, int ldg, const double *target, double tol,
+                                         int *pts, double *w, int *nd_out, double *resid_out,
+                                         const phgmg_allocator *alloc) {
   phgmg__ecsw_op op;
   double tn;
-  if (!Gm || !target || !pts || !w || !nd_out) return PHGMG_ERR_INVALID_ARG;
-  if (tol != tol) return PHGMG_ERR_INVALID_ARG;
-  if (n < 1 || m < 1 || ldg < m) return PHGMG_ERR_SIZE;
-  if (!phgmg__mat_finite(m, n, Gm, ldg) || !phgmg__all_finite(target, (size_t)m)) return PHGMG_ERR_NANINF;
-  if (tol <= 0.0) tol = 1e-6;
   if (n < PHGMG_ECSW_SCREEN_MIN)
     return phgmg__ecsw_gram(n, m, Gm, ldg, target, tol, NULL, pts, w, nd_out, resid_out, alloc);
   tn = phgmg_normf(m, 1, target, m);
@@ -8102,6 +8115,57 @@ PHGMG_DEF phgmg_result phgmg_ecsw(int nterms, int nrows, const double *Gm, int l
   op.grad = phgmg__ecsw_grad_dense; op.col = phgmg__ecsw_col_dense;
   op.n = n; op.m = m; op.A = Gm; op.lda = ldg;
   return phgmg__ecsw_screened(&op, target, tol, pts, w, nd_out, resid_out, alloc);
+}
+
+/* The smallest relative residual ECSW accepts as a tolerance: below it the
+   residual is not resolved by double precision (its rounding level). */
+#define PHGMG__ECSW_TOL_MIN 1e-15
+
+/* Largest |entry| of an m x n matrix (lda). */
+PHGMG__PRIV double phgmg__mat_amax(int m, int n, const double *A, int lda) {
+  double a = 0.0;
+  int i, j;
+  for (j = 0; j < n; ++j)
+    for (i = 0; i < m; ++i) a = PHGMG__MAX(a, fabs(A[i + (size_t)j * lda]));
+  return a;
+}
+
+PHGMG_DEF phgmg_result phgmg_ecsw(int nterms, int nrows, const double *Gm, int ldg, const double *target,
+                                  double tol, int *pts, double *w, int *nd_out, double *resid_out,
+                                  const phgmg_allocator *alloc) {
+  const int n = nterms, m = nrows;
+  const double lo = ldexp(1.0, -400), hi = ldexp(1.0, 400);
+  double ag, at, sg, st, *Gc;
+  int i, j, eg = 0, et = 0;
+  phgmg_result rc;
+  if (!Gm || !target || !pts || !w || !nd_out) return PHGMG_ERR_INVALID_ARG;
+  if (!(tol >= 0.0) || !(tol < 1.0)) return PHGMG_ERR_INVALID_ARG;
+  if (n < 1 || m < 1 || ldg < m) return PHGMG_ERR_SIZE;
+  if (!phgmg__mat_finite(m, n, Gm, ldg) || !phgmg__all_finite(target, (size_t)m)) return PHGMG_ERR_NANINF;
+  if (tol == 0.0) tol = 1e-6;
+  if (tol < PHGMG__ECSW_TOL_MIN) return PHGMG_ERR_TOL_UNREACHABLE;
+  ag = phgmg__mat_amax(m, n, Gm, ldg);
+  at = phgmg__mat_amax(m, 1, target, m);
+  sg = ag > 0.0 && (ag < lo || ag > hi) ? phgmg__pow2_scale(ag) : 1.0;
+  st = at > 0.0 && (at < lo || at > hi) ? phgmg__pow2_scale(at) : 1.0;
+  if (sg == 1.0 && st == 1.0) return phgmg__ecsw_run(n, m, Gm, ldg, target, tol, pts, w, nd_out, resid_out, alloc);
+  /* data far from 1 in magnitude: the same problem scaled by powers of two
+     (exact; the weights scale by sg / st), so that the result does not
+     depend on the data's magnitude */
+  Gc = phgmg__dalloc(alloc, (size_t)m * n + (size_t)m);
+  if (!Gc) return PHGMG_ERR_NOMEM;
+  for (j = 0; j < n; ++j)
+    for (i = 0; i < m; ++i) Gc[i + (size_t)j * m] = sg * Gm[i + (size_t)j * ldg];
+  for (i = 0; i < m; ++i) Gc[i + (size_t)m * n] = st * target[i];
+  rc = phgmg__ecsw_run(n, m, Gc, m, Gc + (size_t)m * n, tol, pts, w, nd_out, resid_out, alloc);
+  phgmg__free(alloc, Gc);
+  (void)frexp(sg, &eg);
+  (void)frexp(st, &et);
+  for (j = 0; (rc == PHGMG_OK || rc == PHGMG_ERR_NOT_CONVERGED) && j < *nd_out; ++j) {
+    w[j] = ldexp(w[j], eg - et);
+    if (!(w[j] > 0.0 && w[j] < HUGE_VAL)) rc = PHGMG_ERR_OVERFLOW; /* the weights leave the double range */
+  }
+  return rc;
 }
 
 /* ||F^T diag(a) Vt||_F (ns x r) for a (nterms); B: nterms x r, Y: ns x r scratch. */
@@ -8150,12 +8214,13 @@ PHGMG_DEF phgmg_result phgmg_ecsw_separable(int nterms, int ns, const double *F,
   int ks = 0, rank = 0, q, j, a, i, k, pass, nd = 0, mc;
   phgmg_result rc;
   if (!F || !Vt || !pts || !w || !nd_out) return PHGMG_ERR_INVALID_ARG;
-  if (tol != tol) return PHGMG_ERR_INVALID_ARG;
+  if (!(tol >= 0.0) || !(tol < 1.0)) return PHGMG_ERR_INVALID_ARG;
   if (nt < 1 || ns < 1 || r < 1 || ldf < nt || ldvt < nt) return PHGMG_ERR_SIZE;
   if (!phgmg__mat_finite(nt, ns, F, ldf) || !phgmg__mat_finite(nt, r, Vt, ldvt) ||
       (sw && !phgmg__all_finite(sw, (size_t)nt)))
     return PHGMG_ERR_NANINF;
-  if (tol <= 0.0) tol = 1e-6;
+  if (tol == 0.0) tol = 1e-6;
+  if (tol < PHGMG__ECSW_TOL_MIN) return PHGMG_ERR_TOL_UNREACHABLE;
   if (nt >= PHGMG_ECSW_SCREEN_MIN) return phgmg__ecsw_sep_screened(nt, ns, F, ldf, r, Vt, ldvt, sw, tol, pts, w,
                                                                    nd_out, resid_out, alloc);
   U = phgmg__dalloc(alloc, (size_t)nt * kk + (size_t)kk + 2 * (size_t)nt + (size_t)nt * r + (size_t)ns * r);
@@ -8182,7 +8247,7 @@ PHGMG_DEF phgmg_result phgmg_ecsw_separable(int nterms, int ns, const double *F,
         for (a = 0; a < r; ++a)
           Gc[j * r + a + (size_t)k * mc] = S[j] * U[k + (size_t)j * nt] * Vt[k + (size_t)a * ldvt];
     phgmg_gemv('N', mc, nt, 1.0, Gc, mc, dw + nt, 0.0, tc);
-    rc = phgmg_ecsw(nt, mc, Gc, mc, tc, 0.5 * tol, pts, w, &nd, NULL, alloc);
+    rc = phgmg_ecsw(nt, mc, Gc, mc, tc, PHGMG__MAX(0.5 * tol, PHGMG__ECSW_TOL_MIN), pts, w, &nd, NULL, alloc);
     phgmg__free(alloc, Gc);
     if (rc != PHGMG_OK && rc != PHGMG_ERR_NOT_CONVERGED) break;
     for (i = 0; i < nt; ++i) dw[i] = -dw[nt + i];
@@ -10597,15 +10662,6 @@ PHGMG_DEF phgmg_result phgmg_reduced_validate(const phgmg_reduced *red, const ph
 }
 
 /* --- error measures ------------------------------------------------------ */
-/* Scale of the error measures' second pass: 2^-e with amax 2^-e in [0.5, 1)
-   (exact: a power of two), 1 for amax 0, NaN or Inf. */
-PHGMG__PRIV double phgmg__pow2_scale(double amax) {
-  int e = 0;
-  if (!(amax > 0.0) || !(amax < HUGE_VAL)) return 1.0;
-  (void)frexp(amax, &e);
-  return ldexp(1.0, -e);
-}
-
 /* Do plain sums of squares num, den need the scaled second pass (an
    overflow, or squares near the underflow threshold)? */
 #define PHGMG__SSQ_RESCALE(num, den) (!((den) > 1e-280 && (den) < 1e280 && (num) < 1e280))

@@ -135,7 +135,62 @@ TEST(test_defect3_validate_nan_energy) {
   d3_free(&t);
 }
 
+/* ECSW is scale-invariant: exact data (target = Gm w0 with w0 >= 0 on 5 of
+   30 terms) times 1e-200 or 1e160 -- the Gram matrix of the scaled data
+   underflows or overflows -- give the points of the unscaled problem, the
+   same weights and a residual within tol; Gm alone scaled by 1e-200 gives
+   the weights times 1e200. A tolerance below the rounding level is refused
+   by its own code, a negative one as a bad argument. */
+TEST(test_defect3_ecsw_scale) {
+  enum { M = 40, NT = 30 };
+  static double G[M * NT], t[M], Gs[M * NT], ts[M], w[NT], ws[NT];
+  int pts[NT], pts2[NT], nd = 0, nd2 = 0, i, j, k;
+  double res = 1.0, res2 = 1.0;
+  const double sc[2] = {1e-200, 1e160};
+  const int sup[5] = {2, 7, 11, 19, 26};
+  for (i = 0; i < M * NT; ++i) G[i] = th_rand();
+  for (i = 0; i < M; ++i) {
+    t[i] = 0.0;
+    for (k = 0; k < 5; ++k) t[i] += (1.0 + 0.5 * k) * G[i + sup[k] * M];
+  }
+  CHECK_RC(phgmg_ecsw(NT, M, G, M, t, 1e-10, pts, w, &nd, &res, NULL), PHGMG_OK);
+  CHECK(nd >= 1 && res <= 1e-10);
+  for (k = 0; k < 2; ++k) {
+    for (i = 0; i < M * NT; ++i) Gs[i] = sc[k] * G[i];
+    for (i = 0; i < M; ++i) ts[i] = sc[k] * t[i];
+    nd2 = 0; res2 = 1.0;
+    CHECK_RC(phgmg_ecsw(NT, M, Gs, M, ts, 1e-10, pts2, ws, &nd2, &res2, NULL), PHGMG_OK);
+    CHECK(nd2 == nd && res2 <= 1e-10);
+    for (j = 0; j < nd && j < nd2; ++j) {
+      CHECK(pts2[j] == pts[j]);
+      CHECK_LE(fabs(ws[j] - w[j]), 1e-8 * w[j]);
+    }
+  }
+  for (i = 0; i < M * NT; ++i) Gs[i] = 1e-200 * G[i];
+  nd2 = 0;
+  CHECK_RC(phgmg_ecsw(NT, M, Gs, M, t, 1e-10, pts2, ws, &nd2, &res2, NULL), PHGMG_OK);
+  CHECK(nd2 == nd);
+  for (j = 0; j < nd && j < nd2; ++j) CHECK(pts2[j] == pts[j] && fabs(ws[j] * 1e-200 - w[j]) <= 1e-8 * w[j]);
+  CHECK_RC(phgmg_ecsw(NT, M, G, M, t, 1e-300, pts2, ws, &nd2, &res2, NULL), PHGMG_ERR_TOL_UNREACHABLE);
+  CHECK_RC(phgmg_ecsw(NT, M, G, M, t, -1e-6, pts2, ws, &nd2, &res2, NULL), PHGMG_ERR_INVALID_ARG);
+  CHECK(strstr(phgmg_result_string(PHGMG_ERR_TOL_UNREACHABLE), "tolerance") != NULL);
+  /* the separable form (the reduction's default hyper-reduction): gradients
+     F of 30 terms at 40 snapshots, scaled by 1e-170 -- the same points */
+  {
+    static double F[NT * M], Fs[NT * M], Vt[NT * 3];
+    for (i = 0; i < NT * 3; ++i) Vt[i] = th_rand();
+    for (i = 0; i < NT * M; ++i) { F[i] = th_rand(); Fs[i] = 1e-170 * F[i]; }
+    CHECK_RC(phgmg_ecsw_separable(NT, M, F, NT, 3, Vt, NT, NULL, 1e-6, pts, w, &nd, &res, NULL), PHGMG_OK);
+    CHECK_RC(phgmg_ecsw_separable(NT, M, Fs, NT, 3, Vt, NT, NULL, 1e-6, pts2, ws, &nd2, &res2, NULL), PHGMG_OK);
+    CHECK(nd2 == nd && res2 <= 1e-6);
+    for (j = 0; j < nd && j < nd2; ++j) CHECK(pts2[j] == pts[j] && fabs(ws[j] - w[j]) <= 1e-8 * w[j]);
+    CHECK_RC(phgmg_ecsw_separable(NT, M, F, NT, 3, Vt, NT, NULL, 1e-300, pts, w, &nd, &res, NULL),
+             PHGMG_ERR_TOL_UNREACHABLE);
+  }
+}
+
 SUITE(defects3) {
   RUN(test_defect3_validate_scaled_norms);
   RUN(test_defect3_validate_nan_energy);
+  RUN(test_defect3_ecsw_scale);
 }
