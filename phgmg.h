@@ -1002,7 +1002,9 @@ typedef struct phgmg_reduce_opts {
   int r;               /* reduced order (GMG: includes the m port coordinates), required */
   int rn;              /* GMG-QM lifting dimension r_n (0: 8)                        */
   double lambda;       /* GMG-QM ridge parameter, applied to the un-normalised sum
-                          over snapshots (0: 1e-3; < 0: exactly zero; ignored with
+                          over snapshots (0: 1e-3; < 0: exactly zero, the fit of M
+                          then being the minimum-norm least-squares solution, for
+                          any rank of its Kronecker matrix; ignored with
                           lambda_auto, below)                                         */
   int deim;            /* separable nonlinear part: 1 = structure-preserving DEIM,
                           0 = keep every term (exact, but O(n_terms) online)          */
@@ -8678,6 +8680,41 @@ PHGMG__PRIV int phgmg__lambda_grid(double lo, double hi, int pd, double *grid) {
   return n;
 }
 
+/* Minimum-norm least squares X = A^+ B (A m x n, B m x nrhs, X n x nrhs, ld
+   n) through the thin SVD A = U S V^T truncated at its numerical rank
+   (phgmg_svd): the limit of the ridge solution as lambda -> 0+, defined for
+   any rank. */
+PHGMG__PRIV phgmg_result phgmg__lstsq_minnorm(int m, int n, int nrhs, const double *A, int lda, const double *B,
+                                              int ldb, double *X, const phgmg_allocator *alloc) {
+  const int kmax = PHGMG__MIN(m, n);
+  double *U = phgmg__dalloc(alloc, (size_t)m * kmax + (size_t)n * kmax + (size_t)kmax + (size_t)kmax * nrhs);
+  double *V, *S, *C;
+  int k = 0, i, j;
+  phgmg_result rc;
+  if (!U) return PHGMG_ERR_NOMEM;
+  V = U + (size_t)m * kmax; S = V + (size_t)n * kmax; C = S + kmax;
+  rc = phgmg_svd(m, n, A, lda, kmax, S, U, m, V, n, &k, NULL, alloc);
+  if (rc == PHGMG_OK) {
+    if (k > 0) phgmg_gemm('T', 'N', k, nrhs, m, 1.0, U, m, B, ldb, 0.0, C, k);   /* U^T B */
+    for (j = 0; j < nrhs; ++j)
+      for (i = 0; i < k; ++i) C[i + (size_t)j * k] /= S[i];
+    if (k > 0) phgmg_gemm('N', 'N', n, nrhs, k, 1.0, V, n, C, k, 0.0, X, n);
+    else memset(X, 0, (size_t)n * nrhs * sizeof(double));
+  }
+  phgmg__free(alloc, U);
+  return rc;
+}
+
+/* Least squares of the manifold fits: phgmg_lstsq, and for lambda = 0 (the
+   caller's "exactly zero") on a rank-deficient or underdetermined matrix the
+   minimum-norm solution instead of PHGMG_ERR_RANK. X: ld n. */
+PHGMG__PRIV phgmg_result phgmg__lstsq_fit(int m, int n, int nrhs, const double *A, const double *B, double lambda,
+                                          double *X, const phgmg_allocator *alloc) {
+  phgmg_result rc = phgmg_lstsq(m, n, nrhs, A, m, B, m, lambda, X, n, alloc);
+  if (rc == PHGMG_ERR_RANK && lambda == 0.0) rc = phgmg__lstsq_minnorm(m, n, nrhs, A, m, B, m, X, alloc);
+  return rc;
+}
+
 /* M (and Ms = 2 M) of the quadratic manifold from the ridge problem over the
    p(p+1)/2 distinct Kronecker columns Kt (ns x nc) with right-hand sides Rqt
    (ns x rn); Mt (nc x rn) is scratch. red->M/Ms are allocated on first use. */
@@ -8686,7 +8723,7 @@ PHGMG__PRIV phgmg_result phgmg__qm_fit(phgmg_reduced *red, int ns, const double 
   const int p = red->p, rn = red->rn, nc = p * (p + 1) / 2;
   const double s2 = sqrt(2.0);
   int a, j, i, c;
-  phgmg_result rc = phgmg_lstsq(ns, nc, rn, Kt, ns, Rqt, ns, lambda, Mt, nc, alloc);
+  phgmg_result rc = phgmg__lstsq_fit(ns, nc, rn, Kt, Rqt, lambda, Mt, alloc);
   if (rc != PHGMG_OK) return rc;
   if (!red->M) red->M = phgmg__red_d(red, (size_t)rn * p * p);
   if (!red->Ms) red->Ms = phgmg__red_d(red, (size_t)rn * p * p);
@@ -9166,7 +9203,7 @@ PHGMG__PRIV phgmg_result phgmg__altmin_eval(int q, int ns, int p, int rn, const 
     for (a = 0; a < rn; ++a) Yt[i + (size_t)a * ns] = z[p + a];
   }
   if (alloc && alloc->alloc == phgmg__arena_alloc) ((phgmg__arena *)alloc->user)->used = 0;
-  rc = phgmg_lstsq(ns, nc, rn, Kt, ns, Yt, ns, lam, T, nc, alloc);
+  rc = phgmg__lstsq_fit(ns, nc, rn, Kt, Yt, lam, T, alloc);
   if (rc != PHGMG_OK) return rc;
   phgmg_gemm('N', 'N', ns, rn, nc, 1.0, Kt, ns, T, nc, 0.0, Yt, ns);   /* the fitted correction */
   for (i = 0; i < ns; ++i)

@@ -189,8 +189,58 @@ TEST(test_defect3_ecsw_scale) {
   }
 }
 
+/* lambda exactly zero (opts.lambda < 0): the unregularised quadratic fit is
+   the minimum-norm least-squares solution, also when its Kronecker matrix is
+   rank deficient or has fewer rows than columns, instead of "rank
+   deficient". The helper against the closed form A^+ B of a rank-2 matrix
+   A = Q1 diag(3, 1/2) Q2^T (Q1, Q2 orthonormal); the reduction on 21
+   snapshots at r = 8 (36 Kronecker columns for 21 rows). */
+TEST(test_defect3_lambda_zero) {
+  double A[6 * 4], Bm[6 * 2], X[4 * 2], Xe[4 * 2];
+  const double s6 = 1.0 / sqrt(6.0), q1[2][6] = {{1, 1, 1, 1, 1, 1}, {1, -1, 1, -1, 1, -1}};
+  const double q2[2][4] = {{0.5, 0.5, 0.5, 0.5}, {0.5, -0.5, -0.5, 0.5}}, sg[2] = {3.0, 0.5};
+  int i, j, k, c;
+  d3_model t;
+  double *Xs;
+  phgmg_reduced *red = NULL;
+  phgmg_reduce_opts o;
+  for (i = 0; i < 6; ++i)
+    for (j = 0; j < 4; ++j) {
+      A[i + 6 * j] = 0.0;
+      for (k = 0; k < 2; ++k) A[i + 6 * j] += q1[k][i] * s6 * sg[k] * q2[k][j];
+    }
+  for (i = 0; i < 12; ++i) Bm[i] = th_rand();
+  for (c = 0; c < 2; ++c)   /* Xe = Q2 diag(1/3, 2) Q1^T B */
+    for (j = 0; j < 4; ++j) {
+      Xe[j + 4 * c] = 0.0;
+      for (k = 0; k < 2; ++k) {
+        double d = 0.0;
+        for (i = 0; i < 6; ++i) d += q1[k][i] * s6 * Bm[i + 6 * c];
+        Xe[j + 4 * c] += q2[k][j] * d / sg[k];
+      }
+    }
+  CHECK_RC(phgmg_lstsq(6, 4, 2, A, 6, Bm, 6, 0.0, X, 4, NULL), PHGMG_ERR_RANK);   /* the plain solver's contract */
+  CHECK_RC(phgmg__lstsq_fit(6, 4, 2, A, Bm, 0.0, X, NULL), PHGMG_OK);
+  for (i = 0; i < 8; ++i) CHECK_LE(fabs(X[i] - Xe[i]), 1e-13);
+  memset(&o, 0, sizeof o);
+  d3_msd(&t, 10);
+  Xs = (double *)calloc((size_t)20 * 21, sizeof(double));
+  {
+    double x0[20] = {0};
+    CHECK_RC(phgmg_simulate(&t.sys, x0, 0.0, 0.1, 20, d3_u_sin, NULL, NULL, Xs, NULL, NULL, NULL, NULL, NULL),
+             PHGMG_OK);
+  }
+  o.method = PHGMG_METHOD_GMG_QM; o.r = 8; o.rn = 4; o.lambda = -1.0;
+  CHECK_RC(phgmg_reduce(&red, &t.sys, Xs, 20, 21, &o, NULL, NULL), PHGMG_OK);
+  if (red) CHECK_LE(phgmg_err_proj(red, Xs, 20, 21), 1e-6);
+  phgmg_reduced_destroy(red);
+  free(Xs);
+  d3_free(&t);
+}
+
 SUITE(defects3) {
   RUN(test_defect3_validate_scaled_norms);
   RUN(test_defect3_validate_nan_energy);
   RUN(test_defect3_ecsw_scale);
+  RUN(test_defect3_lambda_zero);
 }
