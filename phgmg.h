@@ -1019,7 +1019,11 @@ typedef struct phgmg_reduce_opts {
   double hyper_tol;    /* ECSW: relative residual of the reduced nonlinear gradient
                           over the training snapshots (0: 1e-6)                     */
   double dt;           /* > 0: precompute the GL3 step map for this step
-                          (LINEAR map with quadratic H only)                          */
+                          (LINEAR map with quadratic H only). Any step size: for
+                          h ||K Qh|| > 100 the map is formed without the factor h
+                          (no cancellation; it tends to -I as dt grows). The map
+                          of a dissipative model (Qh > 0, K + K^T <= 0) is checked
+                          not to grow in the energy norm (PHGMG_ERR_STEP_MAP)   */
   double degeneracy_tol; /* fail with PHGMG_ERR_DEGENERATE when the reciprocal
                           condition of D^T G D at the snapshots is below this (0: 1e-12);
                           measured with D's port columns B_a scaled to unit length,
@@ -8335,32 +8339,74 @@ PHGMG__PRIV phgmg_result phgmg__inv(int n, const double *A, double *Ainv, const 
   return rc;
 }
 
-/* The exact GL3 step map of x' = Jf x + Bh u (see phgmg_rom). */
+/* Below this h ||Jf||_1 the step map is formed as x+ = x + h sum b_i Jf Y_i;
+   above it in the form without h (see phgmg__step_map). */
+#define PHGMG__STEP_MAP_STIFF 100.0
+
+/* Is the step map Phi of a dissipative model (Qh positive definite, K + K^T
+   negative semidefinite up to 1e-12 ||K||_F) a contraction in the energy
+   norm, ||Qh^(1/2) Phi Qh^(-1/2)||_2 <= 1 + 1e-6, as the GL3 map of such a
+   model is (the energy does not grow without input)? PHGMG_OK also for a
+   model that is not dissipative in this sense (nothing to check);
+   PHGMG_ERR_STEP_MAP if the map grows. w: 5 r^2 + r doubles. */
+PHGMG__PRIV phgmg_result phgmg__step_map_check(int r, const double *K, const double *Qh, const double *Phi, double *w) {
+  double *E = w, *V = E + (size_t)r * r, *S = V + (size_t)r * r, *T = S + (size_t)r * r, *C = T + (size_t)r * r;
+  double *ev = C + (size_t)r * r, kn = phgmg_normf(r, r, K, r);
+  int i, j;
+  for (j = 0; j < r; ++j)
+    for (i = 0; i < r; ++i) E[i + (size_t)j * r] = 0.5 * (K[i + (size_t)j * r] + K[j + (size_t)i * r]);
+  if (phgmg_sym_eig(r, E, r, ev, NULL, r) != PHGMG_OK || ev[r - 1] > 1e-12 * kn) return PHGMG_OK;
+  memcpy(E, Qh, (size_t)r * r * sizeof(double));
+  if (phgmg_sym_eig(r, E, r, ev, V, r) != PHGMG_OK || !(ev[0] > 0.0)) return PHGMG_OK;
+  for (j = 0; j < r; ++j)   /* S = V diag(sqrt q), T = V diag(1/sqrt q) */
+    for (i = 0; i < r; ++i) {
+      S[i + (size_t)j * r] = V[i + (size_t)j * r] * sqrt(ev[j]);
+      T[i + (size_t)j * r] = V[i + (size_t)j * r] / sqrt(ev[j]);
+    }
+  /* C = S^T Phi T (orthogonally similar to Qh^(1/2) Phi Qh^(-1/2)), E = C^T C */
+  phgmg_gemm('N', 'N', r, r, r, 1.0, Phi, r, T, r, 0.0, E, r);
+  phgmg_gemm('T', 'N', r, r, r, 1.0, S, r, E, r, 0.0, C, r);
+  phgmg_gemm('T', 'N', r, r, r, 1.0, C, r, C, r, 0.0, E, r);
+  if (phgmg_sym_eig(r, E, r, ev, NULL, r) != PHGMG_OK) return PHGMG_ERR_STEP_MAP;
+  return ev[r - 1] <= (1.0 + 1e-6) * (1.0 + 1e-6) ? PHGMG_OK : PHGMG_ERR_STEP_MAP;
+}
+
+/* The exact GL3 step map of x' = Jf x + Bh u (see phgmg_rom): stage values
+   Y = (I - h A kron Jf)^{-1} (1 kron x + h (A kron Bh) u3) = SX x + SU u3 and
+   x+ = x + h sum_i b_i (Jf Y_i + Bh u_i). For h ||Jf|| large the sum cancels
+   (Y_i ~ x / (h ||Jf||): rounding of size eps h ||Jf|| ||x||, a map that can
+   grow by orders of magnitude), so there the stage relation
+   h (A kron I) F = Y - 1 kron x (F the stage derivatives) is used instead:
+   x+ = (1 - b^T A^{-1} 1) x + sum_i d_i Y_i, d = A^{-T} b, 1 - b^T A^{-1} 1 =
+   R(inf) = -1 for the 3-stage Gauss method -- no factor h, nothing cancels.
+   The map of a dissipative model is checked to be a contraction in the
+   energy norm (phgmg__step_map_check): PHGMG_ERR_STEP_MAP otherwise. */
 PHGMG__PRIV phgmg_result phgmg__step_map(phgmg_reduced *red, double h, const phgmg_allocator *alloc) {
   const int r = red->r, m = red->m, n3 = 3 * r, nc = r + 3 * m;
-  double c[3], b[3], A[9];
-  double *Jf = phgmg__dalloc(alloc, (size_t)r * r + (size_t)n3 * n3 + (size_t)n3 * nc);
+  double c[3], b[3], A[9], d[3], rinf = 1.0;
+  double *Jf = phgmg__dalloc(alloc, (size_t)r * r + (size_t)n3 * n3 + (size_t)n3 * nc + 5 * (size_t)r * r + (size_t)r);
   int *ip = phgmg__ialloc(alloc, (size_t)n3);
   double *M3, *RH;
   phgmg_result rc = PHGMG_ERR_NOMEM;
-  int i, j, a, bb;
+  int i, j, a, bb, stiff;
   if (!Jf || !ip) goto done;
   M3 = Jf + (size_t)r * r;
   RH = M3 + (size_t)n3 * n3;
   phgmg_gl3_coefficients(c, b, A);
   phgmg_gemm('N', 'N', r, r, r, 1.0, red->K, r, red->Qh, r, 0.0, Jf, r);
+  stiff = !(h * phgmg_norm1(r, r, Jf, r) <= PHGMG__STEP_MAP_STIFF);
   for (j = 0; j < 3; ++j)
     for (bb = 0; bb < r; ++bb)
       for (i = 0; i < 3; ++i)
         for (a = 0; a < r; ++a)
           M3[(i * r + a) + (size_t)(j * r + bb) * n3] = (i == j && a == bb ? 1.0 : 0.0) - h * A[i * 3 + j] * Jf[a + (size_t)bb * r];
-  /* RH = [h (A kron Jf)(1 kron I),  h (A kron Bh)] */
+  /* RH = [h (A kron Jf)(1 kron I),  h (A kron Bh)]; stiff: [1 kron I, h (A kron Bh)] */
   for (i = 0; i < 3; ++i) {
     for (bb = 0; bb < r; ++bb)
       for (a = 0; a < r; ++a) {
         double s = 0.0;
         for (j = 0; j < 3; ++j) s += A[i * 3 + j];
-        RH[(i * r + a) + (size_t)bb * n3] = h * s * Jf[a + (size_t)bb * r];
+        RH[(i * r + a) + (size_t)bb * n3] = stiff ? (a == bb ? 1.0 : 0.0) : h * s * Jf[a + (size_t)bb * r];
       }
     for (j = 0; j < 3; ++j)
       for (bb = 0; bb < m; ++bb)
@@ -8377,18 +8423,38 @@ PHGMG__PRIV phgmg_result phgmg__step_map(phgmg_reduced *red, double h, const phg
   red->Gam = phgmg__red_d(red, (size_t)r * 3 * m);
   if (!red->SX || !red->SU || !red->Phi || !red->Gam) goto done;
   for (bb = 0; bb < r; ++bb)
-    for (a = 0; a < n3; ++a) red->SX[a + (size_t)bb * n3] = RH[a + (size_t)bb * n3] + (a % r == bb ? 1.0 : 0.0);
+    for (a = 0; a < n3; ++a)
+      red->SX[a + (size_t)bb * n3] = RH[a + (size_t)bb * n3] + (!stiff && a % r == bb ? 1.0 : 0.0);
   for (bb = 0; bb < 3 * m; ++bb)
     for (a = 0; a < n3; ++a) red->SU[a + (size_t)bb * n3] = RH[a + (size_t)(r + bb) * n3];
-  /* Phi = I + h sum b_i Jf SX_i ; Gam = h sum b_i Jf SU_i + h [b_1 Bh, b_2 Bh, b_3 Bh] */
-  for (a = 0; a < r; ++a) red->Phi[a + (size_t)a * r] = 1.0;
-  for (i = 0; i < 3; ++i) {
-    phgmg_gemm('N', 'N', r, r, r, h * b[i], Jf, r, red->SX + i * r, n3, 1.0, red->Phi, r);
-    if (m > 0) phgmg_gemm('N', 'N', r, 3 * m, r, h * b[i], Jf, r, red->SU + i * r, n3, 1.0, red->Gam, r);
-    for (bb = 0; bb < m; ++bb)
-      for (a = 0; a < r; ++a) red->Gam[a + (size_t)(i * m + bb) * r] += h * b[i] * red->Bh[a + (size_t)bb * r];
+  if (stiff) {   /* d = A^{-T} b (the 3 x 3 system by its LU), R(inf) = 1 - d^T 1 */
+    double At[9];
+    int ip3[3];
+    for (i = 0; i < 3; ++i)
+      for (j = 0; j < 3; ++j) At[i + 3 * j] = A[j * 3 + i];   /* column-major A^T */
+    for (i = 0; i < 3; ++i) d[i] = b[i];
+    rc = phgmg_lu_factor(3, At, 3, ip3);
+    if (rc != PHGMG_OK) goto done;
+    phgmg_lu_solve('N', 3, At, 3, ip3, 1, d, 3);
+    for (i = 0; i < 3; ++i) rinf -= d[i];
+    for (a = 0; a < r; ++a) red->Phi[a + (size_t)a * r] = rinf;
+    for (i = 0; i < 3; ++i) {   /* Phi += d_i SX_i, Gam += d_i SU_i */
+      for (bb = 0; bb < r; ++bb)
+        for (a = 0; a < r; ++a) red->Phi[a + (size_t)bb * r] += d[i] * red->SX[i * r + a + (size_t)bb * n3];
+      for (bb = 0; bb < 3 * m; ++bb)
+        for (a = 0; a < r; ++a) red->Gam[a + (size_t)bb * r] += d[i] * red->SU[i * r + a + (size_t)bb * n3];
+    }
+  } else {
+    /* Phi = I + h sum b_i Jf SX_i ; Gam = h sum b_i Jf SU_i + h [b_1 Bh, b_2 Bh, b_3 Bh] */
+    for (a = 0; a < r; ++a) red->Phi[a + (size_t)a * r] = 1.0;
+    for (i = 0; i < 3; ++i) {
+      phgmg_gemm('N', 'N', r, r, r, h * b[i], Jf, r, red->SX + i * r, n3, 1.0, red->Phi, r);
+      if (m > 0) phgmg_gemm('N', 'N', r, 3 * m, r, h * b[i], Jf, r, red->SU + i * r, n3, 1.0, red->Gam, r);
+      for (bb = 0; bb < m; ++bb)
+        for (a = 0; a < r; ++a) red->Gam[a + (size_t)(i * m + bb) * r] += h * b[i] * red->Bh[a + (size_t)bb * r];
+    }
   }
-  rc = PHGMG_OK;
+  rc = phgmg__step_map_check(r, red->K, red->Qh, red->Phi, RH + (size_t)n3 * nc);
 done:
   phgmg__free(alloc, Jf);
   phgmg__free(alloc, ip);

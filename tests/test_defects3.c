@@ -238,9 +238,63 @@ TEST(test_defect3_lambda_zero) {
   d3_free(&t);
 }
 
+/* The exact GL3 step map of a dissipative model for a huge dt: the 3-stage
+   Gauss method is A-stable, its stability function R(z) (the (3,3) Pade
+   approximant of e^z) has |R(z)| <= 1 for Re z <= 0 and R(inf) = -1, so the
+   map contracts in the energy norm: H(Phi x) <= H(x), H = x^T Qh x / 2, and
+   tends to -I as dt -> inf (Jf = K Qh nonsingular). The old form
+   x + h sum b_i Jf Y_i cancelled: a map growing by 1e84 per step at dt =
+   1e100. A map that grows is refused (phgmg__step_map_check). */
+TEST(test_defect3_step_map_huge_dt) {
+  d3_model t;
+  double *X, x[6], y[6], Phi1[36], I6[36];
+  const double dts[3] = {1e15, 1e100, 1e300};
+  int k, a, b, it;
+  phgmg_reduced *red0 = d3_reduce(&t, 10, 301, 6, PHGMG_METHOD_GMG_POD, &X);
+  phgmg_reduce_opts o;
+  memset(&o, 0, sizeof o);
+  o.method = PHGMG_METHOD_GMG_POD; o.r = 6;
+  for (k = 0; k < 3; ++k) {
+    phgmg_reduced *red = NULL;
+    const phgmg_rom *rom;
+    double worst = 0.0, dev = 0.0;
+    o.dt = dts[k];
+    CHECK_RC(phgmg_reduce(&red, &t.sys, X, 20, 301, &o, NULL, NULL), PHGMG_OK);
+    if (!red) continue;
+    rom = phgmg_reduced_rom(red);
+    for (it = 0; it < 50; ++it) {   /* H(Phi x) / H(x) over random x */
+      double hx = 0.0, hy = 0.0;
+      for (a = 0; a < 6; ++a) x[a] = th_rand();
+      for (a = 0; a < 6; ++a) { y[a] = 0.0; for (b = 0; b < 6; ++b) y[a] += rom->Phi[a + 6 * b] * x[b]; }
+      for (a = 0; a < 6; ++a)
+        for (b = 0; b < 6; ++b) { hx += x[a] * rom->Qh[a + 6 * b] * x[b]; hy += y[a] * rom->Qh[a + 6 * b] * y[b]; }
+      worst = fmax(worst, hy / hx);
+    }
+    CHECK_LE(worst, 1.0 + 1e-9);
+    for (a = 0; a < 36; ++a) dev = fmax(dev, fabs(rom->Phi[a] + (a % 7 == 0 ? 1.0 : 0.0)));
+    CHECK_LE(dev, 1e-6);   /* Phi = R(h Jf) -> R(inf) I = -I */
+    phgmg_reduced_destroy(red);
+  }
+  /* the check: a map 1.1 I of the same (dissipative) model grows */
+  {
+    const phgmg_rom *r0 = phgmg_reduced_rom(red0);
+    double w[5 * 36 + 6], Kd[36], Qd[36];
+    for (a = 0; a < 36; ++a) {
+      Kd[a] = r0->K[a]; Qd[a] = r0->Qh[a];
+      Phi1[a] = a % 7 == 0 ? 1.1 : 0.0; I6[a] = a % 7 == 0 ? 0.999 : 0.0;
+    }
+    CHECK_RC(phgmg__step_map_check(6, Kd, Qd, Phi1, w), PHGMG_ERR_STEP_MAP);
+    CHECK_RC(phgmg__step_map_check(6, Kd, Qd, I6, w), PHGMG_OK);
+  }
+  phgmg_reduced_destroy(red0);
+  free(X);
+  d3_free(&t);
+}
+
 SUITE(defects3) {
   RUN(test_defect3_validate_scaled_norms);
   RUN(test_defect3_validate_nan_energy);
   RUN(test_defect3_ecsw_scale);
   RUN(test_defect3_lambda_zero);
+  RUN(test_defect3_step_map_huge_dt);
 }
