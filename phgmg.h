@@ -515,7 +515,7 @@ PHGMG_DEF phgmg_result phgmg_rcm(int N, int na, const phgmg_csc *const *A, int *
        phgmg_ph_sparse_create(&sp, N, m, &J, &R, &Q, B, NULL, &inf, NULL);
        phgmg_ph_system sys = *phgmg_ph_sparse_system(sp);
        sys.nl = PHGMG_NL_SEPARABLE; ... phi, poly ...;
-       phgmg_ph_sparse_sep_idx(sp, nsep, my_idx, &sys);   // remapped
+       phgmg_ph_sparse_sep_idx(sp, nsep, my_idx, NULL, &sys);   // remapped
        phgmg_ph_sparse_to_banded_order(sp, 1, x0_user, N, x0, N);
        phgmg_simulate(&sys, x0, ...X...);                 // internal order
        phgmg_ph_sparse_to_user_order(sp, nsteps + 1, X, N, X_user, N);
@@ -548,12 +548,15 @@ PHGMG_DEF phgmg_result phgmg_ph_sparse_sep_idx(phgmg_ph_sparse *sp, int nsep, co
                                                int *idx_out, phgmg_ph_system *sys);
 /* Y (N x ncols, ldy) = rows of X (N x ncols, ldx) moved from the user's to
    the internal ordering: Y[i] = X[perm[i]]; _to_user_order the inverse,
-   Y[perm[i]] = X[i]. Snapshot matrices, trajectories, lifted states. X and Y
-   must not overlap. O(N ncols). */
-PHGMG_DEF void phgmg_ph_sparse_to_banded_order(const phgmg_ph_sparse *sp, int ncols, const double *X,
-                                               int ldx, double *Y, int ldy);
-PHGMG_DEF void phgmg_ph_sparse_to_user_order(const phgmg_ph_sparse *sp, int ncols, const double *X,
-                                             int ldx, double *Y, int ldy);
+   Y[perm[i]] = X[i]. Snapshot matrices, trajectories, lifted states.
+   O(N ncols). In place when X == Y with ldx == ldy (one column of scratch
+   from the object's allocator); any other overlap of X and Y:
+   PHGMG_ERR_INVALID_ARG, Y untouched. Also _INVALID_ARG for NULL, _SIZE for
+   ncols < 0 or a leading dimension < N, _NOMEM. */
+PHGMG_DEF phgmg_result phgmg_ph_sparse_to_banded_order(const phgmg_ph_sparse *sp, int ncols, const double *X,
+                                                       int ldx, double *Y, int ldy);
+PHGMG_DEF phgmg_result phgmg_ph_sparse_to_user_order(const phgmg_ph_sparse *sp, int ncols, const double *X,
+                                                     int ldx, double *Y, int ldy);
 /* Frees the object and its arrays (NULL is fine). */
 PHGMG_DEF void phgmg_ph_sparse_destroy(phgmg_ph_sparse *sp);
 
@@ -1167,8 +1170,10 @@ typedef struct phgmg_reduce_info {
   int deim_modes;          /* DEIM points kept (nd)                          */
   int deim_negative;       /* number of negative DEIM weights               */
   double deim_sigma_ratio; /* sigma_{nd+1}/sigma_1 of the nonlinear snapshots (0 if all kept) */
-  double rcond_dgd;        /* smallest rcond of D^T G D seen (at x = 0 and the snapshots;
-                              port columns of D at unit length, see degeneracy_tol) */
+  double rcond_dgd;        /* GMG: smallest rcond of D^T G D seen (at x = 0 and the
+                              snapshots; port columns of D at unit length, see
+                              degeneracy_tol). SP1/SP2: rcond of V^T Vg, the matrix
+                              inverted for W (no D^T G D there)                   */
   double rcond_jr;         /* rcond of J - R                                  */
   double pod_sigma_ratio;  /* sigma_{r'+1}/sigma_1 of the (adjusted) snapshots */
   double lambda;           /* GMG-QM: the ridge lambda used (fixed or chosen)  */
@@ -1364,8 +1369,9 @@ typedef struct phgmg_study_opts {
                     <= min(N, ns) (fewer are kept if the snapshots have lower rank)   */
 } phgmg_study_opts;
 /* Cost: one thin SVD of N x ns per basis asked for plus O(N ns kmax).
-   PHGMG_ERR_INVALID_ARG (NULL), _SIZE (kmax < 1 or > min(N, ns), ldx < N),
-   _NANINF, _RANK (B), _NOMEM, a solve's code (G = (J - R)^{-1}). */
+   PHGMG_ERR_INVALID_ARG (NULL, a flag bit other than PHGMG_STUDY_*), _SIZE
+   (kmax < 1 or > min(N, ns), ldx < N), _NANINF, _RANK (B), _NOMEM, a
+   solve's code (G = (J - R)^{-1}). */
 PHGMG_DEF phgmg_result phgmg_study_create(phgmg_study **out, const phgmg_ph_system *sys, const double *X,
                                           int ldx, int ns, const phgmg_study_opts *so,
                                           const phgmg_allocator *alloc);
@@ -1384,7 +1390,11 @@ PHGMG_DEF const double *phgmg_study_basis(const phgmg_study *st, char which, int
    quantities from coordinates) applies to GMG-POD, GMG-QM with manifold 0,
    SP1 and SP2 on the study's own bases and r - m + rn (GMG) / r (SP) within
    its modes; other models are built exactly as phgmg_reduce builds them.
-   Not thread-safe on one study (the DEIM cache). */
+   Not thread-safe on one study (the DEIM cache). The system (sizes, J, R,
+   Q, B, a separable part's indices, weights and coefficients) must not
+   change after phgmg_study_create: a fingerprint taken there is compared
+   at every call (O(N^2) dense, O(kb N) banded), PHGMG_ERR_STALE if it
+   differs (the study's blocks would be those of the old system). */
 PHGMG_DEF phgmg_result phgmg_study_reduce(phgmg_study *st, const phgmg_reduce_opts *opts, phgmg_reduced **out,
                                           phgmg_reduce_info *info);
 /* Error measures over the study's snapshots: e_red of a reduced trajectory
@@ -1419,7 +1429,9 @@ PHGMG_DEF phgmg_result phgmg_deim(int nterms, int ns, const double *F, int ldf, 
 /* phgmg_deim with a choice of point selection: method PHGMG_DEIM_QDEIM or
    PHGMG_DEIM_GREEDY (else PHGMG_ERR_INVALID_ARG). Modes, weights and outputs
    as phgmg_deim; Q-DEIM points come in pivot order, greedy points in the
-   order chosen. PHGMG_ERR_SINGULAR if P^T U is singular. */
+   order chosen. PHGMG_ERR_SINGULAR if P^T U is singular. For both: tol = 0
+   gives 1e-8, kmax = 0 no cap; tol < 0, NaN or >= 1 and kmax < 0 give
+   PHGMG_ERR_INVALID_ARG. */
 PHGMG_DEF phgmg_result phgmg_deim_select(int nterms, int ns, const double *F, int ldf, const double *sw,
                                          double tol, int kmax, int method, int *pts, double *w,
                                          int *nd_out, int *nneg, double *sigma_ratio,
@@ -1542,6 +1554,7 @@ extern "C" {
    n x n (all ld = n). Sign iteration Z <- (Z/c + c Z^-1)/2, E <- (E/c + c
    Z^-1 E Z^-T)/2 from Z = A, E = F; X = E/2. *iters (may be NULL) = steps.
    PHGMG_ERR_SINGULAR (A singular, or not stable: the sign of A is not -I),
+   _INVALID_ARG (F not symmetric: ||F - F^T||_F > 1e-10 ||F||_F),
    _NOT_CONVERGED, _NANINF, _NOMEM. */
 PHGMG_DEF phgmg_result phgmg_lyap(int n, const double *A, const double *F, double *X, int *iters,
                                   const phgmg_allocator *alloc);
@@ -1550,7 +1563,9 @@ PHGMG_DEF phgmg_result phgmg_lyap(int n, const double *A, const double *F, doubl
    matrix H = [A, -K; -L, -A^T]: [W12; W22 + I] X = -[W11 + I; W21] by least
    squares, X symmetrised. H must have no eigenvalue on the imaginary axis
    (else PHGMG_ERR_NOT_CONVERGED or _SINGULAR, or -- close to the axis -- an
-   inaccurate X: check phgmg_care_residual). */
+   inaccurate X: check phgmg_care_residual). PHGMG_ERR_NOT_STABILIZABLE when
+   the stable invariant subspace of H is not a graph [I; X] (no stabilizing
+   solution: (A, K) not stabilizable or (A, L) not detectable). */
 PHGMG_DEF phgmg_result phgmg_care(int n, const double *A, const double *K, const double *L, double *X,
                                   int *iters, const phgmg_allocator *alloc);
 /* Relative residuals ||A X + X A^T + F||_F / (2 ||A||_F ||X||_F + ||F||_F) and
@@ -1658,11 +1673,16 @@ typedef enum phgmg_basis_kind {
   PHGMG_BASIS_H2 = 4        /* the GMG model of least H2 error (one order)     */
 } phgmg_basis_kind;
 
+/* Every field 0 takes its default; a negative count, a negative, NaN or
+   infinite wmin/wmax/dt, wmin >= wmax (both given, or one given beyond the
+   other's default) give PHGMG_ERR_INVALID_ARG, a V0 with NaN/Inf (H2)
+   PHGMG_ERR_NANINF. */
 typedef struct phgmg_basis_opts {
   int nw;             /* FREQ: frequencies (0: 60)                               */
   double wmin, wmax;  /* FREQ: grid ends (0: from the system: wmin = 1 /
                          (10 ||A^-1||_1), wmax = 2 ||A||_1, which bracket every
-                         eigenvalue modulus of A: |lambda| in [1/||A^-1||, ||A||]) */
+                         eigenvalue modulus of A: |lambda| in [1/||A^-1||, ||A||];
+                         each end separately)                                    */
   double dt;          /* IMPULSE: step (0: 0.1)                                   */
   int nsteps;         /* IMPULSE: steps (0: 1000)                                 */
   int maxit;          /* H2: L-BFGS iterations (0: 1000)                          */
@@ -1757,10 +1777,19 @@ PHGMG_DEF size_t phgmg_rom_serialized_size(const phgmg_rom *rom);
 /* Serialise into buf (cap bytes). *written = bytes used. PHGMG_ERR_WORKSPACE if cap is too small. */
 PHGMG_DEF phgmg_result phgmg_rom_serialize(const phgmg_rom *rom, void *buf, size_t cap, size_t *written);
 /* Bytes of memory phgmg_rom_deserialize needs to hold the model in buf
-   (the arrays are copied, so buf may be freed afterwards). */
+   (the arrays are copied, so buf may be freed afterwards; the count includes
+   (r + rn)^2 + 4 r + 4 reals of scratch for the structure check). */
 PHGMG_DEF phgmg_result phgmg_rom_deserialize_size(const void *buf, size_t len, size_t *need);
 /* Rebuild a model from buf into caller memory mem (>= the size above, aligned
-   for double); rom's views point into mem. */
+   for double); rom's views point into mem. A damaged file: PHGMG_ERR_FORMAT
+   (header, sizes, checksum, NaN/Inf). Then a structure check of the values,
+   since a checksum can be recomputed after an edit: Qh (QUADRATIC: with Q01,
+   Q11) positive definite up to sqrt(eps) ||Qh||, the dissipation -(K + K^T)/2
+   (QUADRATIC: of the G blocks) positive semidefinite to the same relative
+   level, and a step map that satisfies the GL3 stage equations of
+   x' = K Qh x + Bh u for the stored dt (within 48 (r + 1) eps of its terms'
+   size): PHGMG_ERR_STRUCTURE otherwise (details at phgmg__rom_physics).
+   No allocation; phgmg_rom_load returns the same codes. */
 PHGMG_DEF phgmg_result phgmg_rom_deserialize(const void *buf, size_t len, phgmg_rom *rom, void *mem,
                                              size_t mem_size);
 
@@ -4673,20 +4702,47 @@ PHGMG_DEF phgmg_result phgmg_ph_sparse_sep_idx(phgmg_ph_sparse *sp, int nsep, co
   return PHGMG_OK;
 }
 
-PHGMG_DEF void phgmg_ph_sparse_to_banded_order(const phgmg_ph_sparse *sp, int ncols, const double *X,
-                                               int ldx, double *Y, int ldy) {
-  int i, j;
-  if (!sp || !X || !Y) return;
-  for (j = 0; j < ncols; ++j)
-    for (i = 0; i < sp->sys.N; ++i) Y[i + (size_t)j * ldy] = X[sp->perm[i] + (size_t)j * ldx];
+#include <stdint.h> /* uintptr_t: the overlap test of the orderings' row moves */
+
+/* The two orderings' row moves: to_user = 0: Y[i] = X[perm[i]]; 1: Y[perm[i]]
+   = X[i]. In place (X == Y, ldx == ldy) through one column of scratch;
+   other overlaps are refused. */
+PHGMG__PRIV phgmg_result phgmg__sparse_reorder(const phgmg_ph_sparse *sp, int ncols, const double *X, int ldx,
+                                              double *Y, int ldy, int to_user) {
+  const double *xc;
+  double *tmp = NULL;
+  uintptr_t x0, x1, y0, y1;
+  int i, j, N;
+  if (!sp || !X || !Y) return PHGMG_ERR_INVALID_ARG;
+  N = sp->sys.N;
+  if (ncols < 0 || ldx < N || ldy < N) return PHGMG_ERR_SIZE;
+  if (ncols == 0) return PHGMG_OK;
+  x0 = (uintptr_t)(const void *)X; x1 = x0 + ((size_t)(ncols - 1) * ldx + (size_t)N) * sizeof(double);
+  y0 = (uintptr_t)(const void *)Y; y1 = y0 + ((size_t)(ncols - 1) * ldy + (size_t)N) * sizeof(double);
+  if (x0 < y1 && y0 < x1) {
+    if (x0 != y0 || ldx != ldy) return PHGMG_ERR_INVALID_ARG;
+    tmp = phgmg__dalloc(sp->alloc, (size_t)N);
+    if (!tmp) return PHGMG_ERR_NOMEM;
+  }
+  for (j = 0; j < ncols; ++j) {
+    double *yc = Y + (size_t)j * ldy;
+    xc = X + (size_t)j * ldx;
+    if (tmp) { memcpy(tmp, xc, (size_t)N * sizeof(double)); xc = tmp; }
+    if (to_user) for (i = 0; i < N; ++i) yc[sp->perm[i]] = xc[i];
+    else for (i = 0; i < N; ++i) yc[i] = xc[sp->perm[i]];
+  }
+  phgmg__free(sp->alloc, tmp);
+  return PHGMG_OK;
 }
 
-PHGMG_DEF void phgmg_ph_sparse_to_user_order(const phgmg_ph_sparse *sp, int ncols, const double *X,
-                                             int ldx, double *Y, int ldy) {
-  int i, j;
-  if (!sp || !X || !Y) return;
-  for (j = 0; j < ncols; ++j)
-    for (i = 0; i < sp->sys.N; ++i) Y[sp->perm[i] + (size_t)j * ldy] = X[i + (size_t)j * ldx];
+PHGMG_DEF phgmg_result phgmg_ph_sparse_to_banded_order(const phgmg_ph_sparse *sp, int ncols, const double *X,
+                                                       int ldx, double *Y, int ldy) {
+  return phgmg__sparse_reorder(sp, ncols, X, ldx, Y, ldy, 0);
+}
+
+PHGMG_DEF phgmg_result phgmg_ph_sparse_to_user_order(const phgmg_ph_sparse *sp, int ncols, const double *X,
+                                                     int ldx, double *Y, int ldy) {
+  return phgmg__sparse_reorder(sp, ncols, X, ldx, Y, ldy, 1);
 }
 
 /* >>gl3 (implementation) ================================================= */
@@ -7162,7 +7218,49 @@ struct phgmg_study {
   phgmg_input_fn pu;
   void *puser;
   double pt0, pdt, ptol;
+  uint64_t fp;             /* fingerprint of the system at create (phgmg__sys_fingerprint) */
 };
+
+/* FNV-1a style hash of n doubles' bit patterns into h. */
+PHGMG__PRIV uint64_t phgmg__hash_d(uint64_t h, const double *a, size_t n) {
+  size_t i;
+  if (!a) return (h ^ 0x9e3779b97f4a7c15ull) * 0x100000001b3ull;
+  for (i = 0; i < n; ++i) {
+    uint64_t w;
+    memcpy(&w, a + i, sizeof w);
+    h = (h ^ w) * 0x100000001b3ull;
+  }
+  return h;
+}
+
+/* A fingerprint of what a study precomputes from: the sizes and kinds, J,
+   R, Q (dense or banded), B, and a separable part's indices, weights and
+   coefficients (the callbacks themselves are not hashed). O(size of the
+   system): N^2 for dense storage, (2 kb + 1) N banded. */
+PHGMG__PRIV uint64_t phgmg__sys_fingerprint(const phgmg_ph_system *s) {
+  const size_t N = (size_t)s->N, nm = s->storage == PHGMG_BANDED ? (size_t)(2 * s->kb + 1) * N : N * N;
+  double hdr[7];
+  uint64_t h = 0xcbf29ce484222325ull;
+  int k;
+  hdr[0] = s->N; hdr[1] = s->m; hdr[2] = (double)s->storage; hdr[3] = s->kb; hdr[4] = (double)s->nl;
+  hdr[5] = s->nsep; hdr[6] = s->poly_deg + 64.0 * s->nexp + 4096.0 * s->phi_nfun;
+  h = phgmg__hash_d(h, hdr, 7);
+  h = phgmg__hash_d(h, s->J, nm);
+  h = phgmg__hash_d(h, s->R, nm);
+  h = phgmg__hash_d(h, s->Q, nm);
+  h = phgmg__hash_d(h, s->B, N * (size_t)s->m);
+  if (s->nl == PHGMG_NL_SEPARABLE && s->nsep > 0) {
+    const size_t nf = s->phi_nfun > 1 ? (size_t)s->phi_nfun : 1;
+    for (k = 0; s->sep_idx && k < s->nsep; ++k) {
+      const double v = s->sep_idx[k];
+      h = phgmg__hash_d(h, &v, 1);
+    }
+    h = phgmg__hash_d(h, s->sep_w, (size_t)s->nsep);
+    if (s->poly_deg > 0 && s->poly) h = phgmg__hash_d(h, s->poly, nf * (size_t)(s->poly_deg + 1));
+    if (s->nexp > 0) h = phgmg__hash_d(h, s->expo, nf * 2 * (size_t)s->nexp);
+  }
+  return h;
+}
 
 PHGMG__PRIV void *phgmg__red_alloc(phgmg_reduced *red, size_t bytes) {
   void *p;
@@ -7551,9 +7649,10 @@ PHGMG_DEF phgmg_result phgmg_deim_select(int nterms, int ns, const double *F, in
   phgmg_result rc;
   if (!F || !pts || !w || !nd_out) return PHGMG_ERR_INVALID_ARG;
   if (method != PHGMG_DEIM_QDEIM && method != PHGMG_DEIM_GREEDY) return PHGMG_ERR_INVALID_ARG;
+  if (!(tol >= 0.0 && tol < 1.0) || kmax < 0) return PHGMG_ERR_INVALID_ARG;
   if (nterms < 1 || ns < 1 || ldf < nterms) return PHGMG_ERR_SIZE;
   if (!phgmg__mat_finite(nterms, ns, F, ldf)) return PHGMG_ERR_NANINF; /* padding rows are not data */
-  if (tol <= 0.0) tol = 1e-8;
+  if (tol == 0.0) tol = 1e-8;
   kk = PHGMG__MIN(nterms, ns);
   if (kmax > 0) kk = PHGMG__MIN(kk, kmax + 1);
   U = phgmg__dalloc(alloc, (size_t)nterms * kk + (size_t)kk + (size_t)kk * nterms + (size_t)kk +
@@ -11063,6 +11162,7 @@ PHGMG_DEF phgmg_result phgmg_study_create(phgmg_study **out, const phgmg_ph_syst
   if (!out) return PHGMG_ERR_INVALID_ARG;
   *out = NULL;
   if (!sys || !X || !so) return PHGMG_ERR_INVALID_ARG;
+  if (so->what & ~(PHGMG_STUDY_GMG | PHGMG_STUDY_SP | PHGMG_STUDY_SP2)) return PHGMG_ERR_INVALID_ARG;
   what = so->what ? so->what : (PHGMG_STUDY_GMG | PHGMG_STUDY_SP);
   if (what & PHGMG_STUDY_SP2) what |= PHGMG_STUDY_SP;
   N = sys->N;
@@ -11075,6 +11175,7 @@ PHGMG_DEF phgmg_result phgmg_study_create(phgmg_study **out, const phgmg_ph_syst
   memset(st, 0, sizeof *st);
   if (alloc) { st->alloc = *alloc; st->use_alloc = 1; }
   st->sys = sys; st->X = X; st->ldx = ldx; st->ns = ns; st->N = N; st->m = sys->m;
+  st->fp = phgmg__sys_fingerprint(sys);
   st->xx = phgmg__sumsq(N, ns, X, ldx);
   st->QB = phgmg__dalloc(alloc, (size_t)N * sys->m + (size_t)sys->m * sys->m);
   T = phgmg__dalloc(alloc, (size_t)N * ns);
@@ -11129,6 +11230,7 @@ PHGMG_DEF phgmg_result phgmg_study_reduce(phgmg_study *st, const phgmg_reduce_op
   int deim;
   if (out) *out = NULL;
   if (!st || !opts || !out) return PHGMG_ERR_INVALID_ARG;
+  if (phgmg__sys_fingerprint(st->sys) != st->fp) return PHGMG_ERR_STALE;   /* the blocks would be stale */
   o = *opts;
   if ((o.method == PHGMG_METHOD_GMG_POD || o.method == PHGMG_METHOD_GMG_QM) && st->Ua && !o.pod_basis) {
     o.pod_basis = st->Ua; o.pod_cols = st->ka;
@@ -11300,6 +11402,18 @@ PHGMG__PRIV phgmg_result phgmg__sign_iter(int n, double *Z, double *E, int *iter
   return rc;
 }
 
+/* ||F - F^T||_F <= tol ||F||_F (F n x n)? */
+PHGMG__PRIV int phgmg__sym_within(int n, const double *F, double tol) {
+  double d = 0.0;
+  int i, j;
+  for (j = 0; j < n; ++j)
+    for (i = j + 1; i < n; ++i) {
+      const double e = F[i + (size_t)j * n] - F[j + (size_t)i * n];
+      d += 2.0 * e * e;
+    }
+  return sqrt(d) <= tol * phgmg_normf(n, n, F, n);
+}
+
 PHGMG_DEF phgmg_result phgmg_lyap(int n, const double *A, const double *F, double *X, int *iters,
                                   const phgmg_allocator *alloc) {
   const size_t nn = (size_t)n * n;
@@ -11310,6 +11424,7 @@ PHGMG_DEF phgmg_result phgmg_lyap(int n, const double *A, const double *F, doubl
   if (!A || !F || !X) return PHGMG_ERR_INVALID_ARG;
   if (n < 1) return PHGMG_ERR_SIZE;
   if (!phgmg__all_finite(A, nn) || !phgmg__all_finite(F, nn)) return PHGMG_ERR_NANINF;
+  if (!phgmg__sym_within(n, F, 1e-10)) return PHGMG_ERR_INVALID_ARG;
   Z = phgmg__dalloc(alloc, 2 * nn);
   if (!Z) return PHGMG_ERR_NOMEM;
   memcpy(Z, A, nn * sizeof(double));
@@ -11357,6 +11472,9 @@ PHGMG_DEF phgmg_result phgmg_care(int n, const double *A, const double *K, const
         Rh[(i + n) + (size_t)j * n2] = -H[(i + n) + (size_t)j * n2];                          /* -W21 */
       }
     rc = phgmg_lstsq(n2, n, n, M, n2, Rh, n2, 0.0, H, n, alloc);
+    /* [W12; W22 + I] rank deficient: the stable invariant subspace of H is
+       not a graph [I; X], i.e. no stabilizing solution exists */
+    if (rc == PHGMG_ERR_RANK) rc = PHGMG_ERR_NOT_STABILIZABLE;
   }
   if (rc == PHGMG_OK)
     for (j = 0; j < n; ++j)
@@ -12064,7 +12182,13 @@ PHGMG__PRIV phgmg_result phgmg__basis_snapshots(const phgmg_ph_system *sys, phgm
     if (!A || !ip || !X) { phgmg__free(alloc, A); phgmg__free(alloc, ip); phgmg__free(alloc, X); return PHGMG_ERR_NOMEM; }
     Z = A + (size_t)N * N; Bz = Z + 2 * (size_t)N * N;
     rc = phgmg_ph_abc(sys, A, NULL, alloc);
-    if (rc == PHGMG_OK && !(wmin > 0.0 && wmax > wmin)) rc = phgmg__freq_range(N, A, &wmin, &wmax, alloc);
+    if (rc == PHGMG_OK && !(wmin > 0.0 && wmax > 0.0)) {   /* the ends not given from the system */
+      double lo = 0.0, hi = 0.0;
+      rc = phgmg__freq_range(N, A, &lo, &hi, alloc);
+      if (!(wmin > 0.0)) wmin = lo;
+      if (!(wmax > 0.0)) wmax = hi;
+      if (rc == PHGMG_OK && !(wmin < wmax)) rc = PHGMG_ERR_INVALID_ARG;   /* one end given, beyond the other */
+    }
     for (j = 0; rc == PHGMG_OK && j < nw; ++j) {
       const double w = wmin * pow(wmax / wmin, nw > 1 ? (double)j / (nw - 1) : 0.0);
       for (i = 0; i < 2 * N * N; ++i) Z[i] = 0.0;
@@ -12640,6 +12764,14 @@ PHGMG__PRIV phgmg_result phgmg__basis_h2(const phgmg_ph_system *sys, int k, cons
   return rc;
 }
 
+/* phgmg_basis_opts within their documented ranges (0 = the default)? */
+PHGMG__PRIV int phgmg__basis_opts_ok(const phgmg_basis_opts *o) {
+  if (o->nw < 0 || o->nsteps < 0 || o->maxit < 0) return 0;
+  if (!(o->wmin >= 0.0 && o->wmin < HUGE_VAL) || !(o->wmax >= 0.0 && o->wmax < HUGE_VAL)) return 0;
+  if (o->wmin > 0.0 && o->wmax > 0.0 && !(o->wmin < o->wmax)) return 0;
+  return o->dt >= 0.0 && o->dt < HUGE_VAL;
+}
+
 PHGMG_DEF phgmg_result phgmg_linear_basis(const phgmg_ph_system *sys, phgmg_basis_kind kind, int k,
                                           const phgmg_basis_opts *opts, double *V, int *k_out,
                                           const phgmg_allocator *alloc) {
@@ -12648,12 +12780,13 @@ PHGMG_DEF phgmg_result phgmg_linear_basis(const phgmg_ph_system *sys, phgmg_basi
   phgmg_result rc;
   if (!sys || !V) return PHGMG_ERR_INVALID_ARG;
   if (kind < PHGMG_BASIS_FREQ || kind > PHGMG_BASIS_H2) return PHGMG_ERR_INVALID_ARG;
-  if (opts && opts->maxit < 0) return PHGMG_ERR_INVALID_ARG;
+  if (opts && !phgmg__basis_opts_ok(opts)) return PHGMG_ERR_INVALID_ARG;
   if (sys->nl != PHGMG_NL_NONE) return PHGMG_ERR_UNSUPPORTED;
   rc = phgmg_ph_validate(sys, 0.0, NULL, alloc);
   if (rc != PHGMG_OK) return rc;
   N = sys->N; m = sys->m;
   if (k < 1 || k > N - m) return PHGMG_ERR_SIZE;
+  if (kind == PHGMG_BASIS_H2 && opts && opts->V0 && !phgmg__mat_finite(N, k, opts->V0, N)) return PHGMG_ERR_NANINF;
   memset(V, 0, (size_t)N * k * sizeof(double));
   if (kind == PHGMG_BASIS_H2) {
     rc = phgmg__basis_h2(sys, k, opts, V, alloc);
@@ -13045,6 +13178,164 @@ PHGMG__ONLINE phgmg_result phgmg__rom_header(const unsigned char *b, size_t len,
   return PHGMG_OK;
 }
 
+/* ---- load-time structure check (phgmg_rom_deserialize) --------------------
+   A file's checksum shows it arrived intact, not that its values describe a
+   port-Hamiltonian model: a file rewritten with a fresh checksum could hold
+   K -> -K (energy created), Qh -> -Qh (H unbounded below) or another dt than
+   its step map's. On load, in phgmg_real and in the caller's memory:
+   - the energy is positive: Qh (QUADRATIC: [Qh Q01; Q01^T Q11]) + d I
+     positive definite (LDL^T pivots > 0), d = tol ||.||_1;
+   - dissipation is not negative: LINEAR R = -(K + K^T)/2, QUADRATIC the
+     negative symmetric part of [G00 G01; G10 G11] (sym(G) = -G R G^T for
+     G = (J - R)^{-1}) plus d I positive definite, same d;
+   - (J skew holds by construction: J = (K - K^T)/2 of the stored K;)
+   - a step map is the GL3 map of x' = K Qh x + Bh u for the stored dt:
+     each column s of [SX, SU] satisfies the stage equations
+     s_i = e_i - h sum_j A_ij Jf s_j (e_i: 1 kron I resp. h A kron Bh) and
+     [Phi, Gam] = base + h sum_i b_i Jf s_i, each residual within
+     tolm (1 + |out| + (1 + h ||A|| ||K|| ||Qh||) |s|) (|.|: max-norm).
+   tol = sqrt(eps), tolm = 48 (r + 1) eps, eps the unit roundoff of the values
+   (float scalars in the file or a float build: 1.2e-7, else 2.2e-16).
+   Failure: PHGMG_ERR_STRUCTURE. Work: (r + rn)^2 + 4 r + 4 reals. */
+PHGMG__ONLINE size_t phgmg__rom_phys_work(const phgmg_rom *rom) {
+  const size_t n2 = (size_t)rom->r + (size_t)(rom->kind == PHGMG_ROM_QUADRATIC ? rom->rn : 0);
+  return n2 * n2 + 4 * (size_t)rom->r + 4;
+}
+
+/* ||.||_1 of an n x n matrix. */
+PHGMG__ONLINE phgmg_real phgmg__r_norm1(int n, const phgmg_real *A) {
+  phgmg_real nm = PHGMG__R(0);
+  int i, j;
+  for (j = 0; j < n; ++j) {
+    phgmg_real c = PHGMG__R(0);
+    for (i = 0; i < n; ++i) c += PHGMG__RABS(A[i + (size_t)j * n]);
+    if (c > nm) nm = c;
+  }
+  return nm;
+}
+
+/* S (n x n, symmetric, overwritten) + tol ||S||_1 I positive definite?
+   LDL^T without pivoting: every pivot > 0. 1 if so (also for S = 0). */
+PHGMG__ONLINE int phgmg__r_psd_shifted(int n, phgmg_real *S, phgmg_real tol) {
+  const phgmg_real d = tol * phgmg__r_norm1(n, S);
+  int i, j, k;
+  if (d == PHGMG__R(0)) return 1;
+  for (i = 0; i < n; ++i) S[i + (size_t)i * n] += d;
+  for (j = 0; j < n; ++j) {   /* column j of L (unit) in S below the diagonal, D on it */
+    phgmg_real djj = S[j + (size_t)j * n];
+    for (k = 0; k < j; ++k) djj -= S[j + (size_t)k * n] * S[j + (size_t)k * n] * S[k + (size_t)k * n];
+    if (!(djj > PHGMG__R(0))) return 0;
+    S[j + (size_t)j * n] = djj;
+    for (i = j + 1; i < n; ++i) {
+      phgmg_real v = S[i + (size_t)j * n];
+      for (k = 0; k < j; ++k) v -= S[i + (size_t)k * n] * S[j + (size_t)k * n] * S[k + (size_t)k * n];
+      S[i + (size_t)j * n] = v / djj;
+    }
+  }
+  return 1;
+}
+
+/* Residuals of one step-map column: s (3r, the column of SX or SU), out (r,
+   the column of Phi or Gam), base (r) and stage right-hand sides e (3r);
+   v: 4r scratch. 1 if within the bound above. */
+PHGMG__ONLINE int phgmg__r_map_col(const phgmg_rom *rom, const phgmg_real *s, int lds, const phgmg_real *out,
+                                   const phgmg_real *e, const phgmg_real *base, double kq, double eps,
+                                   phgmg_real *v) {
+  const int r = rom->r;
+  const double h = (double)rom->dt, tolm = 48.0 * (r + 1) * eps, s15 = sqrt(15.0);
+  const double b[3] = {5.0 / 18.0, 4.0 / 9.0, 5.0 / 18.0};
+  const double A[9] = {5.0 / 36.0, 2.0 / 9.0 - s15 / 15.0, 5.0 / 36.0 - s15 / 30.0,
+                       5.0 / 36.0 + s15 / 24.0, 2.0 / 9.0, 5.0 / 36.0 - s15 / 24.0,
+                       5.0 / 36.0 + s15 / 30.0, 2.0 / 9.0 + s15 / 15.0, 5.0 / 36.0};
+  double smax = 0.0, omax = 0.0, bound;
+  int i, j, a;
+  for (i = 0; i < 3; ++i) {   /* v_i = K (Qh s_i) */
+    phgmg__r_gemv(r, r, rom->Qh, s + (size_t)i * r, 0, v + 3 * (size_t)r);
+    phgmg__r_gemv(r, r, rom->K, v + 3 * (size_t)r, 0, v + (size_t)i * r);
+    for (a = 0; a < r; ++a) smax = fmax(smax, fabs((double)s[a + (size_t)i * r]));
+  }
+  (void)lds;
+  for (a = 0; a < r; ++a) omax = fmax(omax, fabs((double)out[a]));
+  bound = tolm * (1.0 + omax + (1.0 + h * kq) * smax);   /* ||A||_inf < 1, sum b = 1 */
+  for (i = 0; i < 3; ++i)
+    for (a = 0; a < r; ++a) {
+      double res = (double)s[a + (size_t)i * r] - (double)e[a + (size_t)i * r];
+      for (j = 0; j < 3; ++j) res -= h * A[i * 3 + j] * (double)v[a + (size_t)j * r];
+      if (!(fabs(res) <= bound)) return 0;
+    }
+  for (a = 0; a < r; ++a) {
+    double res = (double)out[a] - (double)base[a];
+    for (i = 0; i < 3; ++i) res -= h * b[i] * (double)v[a + (size_t)i * r];
+    if (!(fabs(res) <= bound)) return 0;
+  }
+  return 1;
+}
+
+/* The step map's columns (see above); w: 4r + 4r scratch. */
+PHGMG__ONLINE int phgmg__rom_map_ok(const phgmg_rom *rom, double eps, phgmg_real *w) {
+  const int r = rom->r, m = rom->m, n3 = 3 * r;
+  const double h = (double)rom->dt, s15 = sqrt(15.0);
+  const double b[3] = {5.0 / 18.0, 4.0 / 9.0, 5.0 / 18.0};
+  const double A[9] = {5.0 / 36.0, 2.0 / 9.0 - s15 / 15.0, 5.0 / 36.0 - s15 / 30.0,
+                       5.0 / 36.0 + s15 / 24.0, 2.0 / 9.0, 5.0 / 36.0 - s15 / 24.0,
+                       5.0 / 36.0 + s15 / 30.0, 2.0 / 9.0 + s15 / 15.0, 5.0 / 36.0};
+  const double kq = (double)phgmg__r_norm1(r, rom->K) * (double)phgmg__r_norm1(r, rom->Qh);
+  phgmg_real *e = w, *base = e + n3, *v = base + r;   /* 3r + r + 4r: the caller gives (r + rn)^2 + 4r + 4 >= 8r */
+  int c, i, a, jj, bb;
+  for (c = 0; c < r; ++c) {   /* SX, Phi: e = 1 kron e_c, base = e_c */
+    for (i = 0; i < n3; ++i) e[i] = PHGMG__R(i % r == c ? 1 : 0);
+    for (a = 0; a < r; ++a) base[a] = PHGMG__R(a == c ? 1 : 0);
+    if (!phgmg__r_map_col(rom, rom->SX + (size_t)c * n3, n3, rom->Phi + (size_t)c * r, e, base, kq, eps, v)) return 0;
+  }
+  for (jj = 0; jj < 3; ++jj)   /* SU, Gam: column (jj, bb): e_i = h A_{i,jj} Bh_bb, base = h b_jj Bh_bb */
+    for (bb = 0; bb < m; ++bb) {
+      const int col = jj * m + bb;
+      for (i = 0; i < 3; ++i)
+        for (a = 0; a < r; ++a) e[a + (size_t)i * r] = (phgmg_real)(h * A[i * 3 + jj] * (double)rom->Bh[a + (size_t)bb * r]);
+      for (a = 0; a < r; ++a) base[a] = (phgmg_real)(h * b[jj] * (double)rom->Bh[a + (size_t)bb * r]);
+      if (!phgmg__r_map_col(rom, rom->SU + (size_t)col * n3, n3, rom->Gam + (size_t)col * r, e, base, kq, eps, v))
+        return 0;
+    }
+  return 1;
+}
+
+/* The load-time structure check (see above) of a model that passed
+   phgmg_rom_check; eps: the unit roundoff of the values (the larger of the
+   file's scalars' and phgmg_real's); w: phgmg__rom_phys_work(rom) reals. */
+PHGMG__ONLINE phgmg_result phgmg__rom_physics(const phgmg_rom *rom, double eps, phgmg_real *w) {
+  const int r = rom->r, quad = rom->kind == PHGMG_ROM_QUADRATIC, rn = quad ? rom->rn : 0, n2 = r + rn;
+  const phgmg_real tol = (phgmg_real)sqrt(eps);
+  int i, j;
+  /* energy: [Qh Q01; Q01^T Q11] */
+  for (j = 0; j < n2; ++j)
+    for (i = 0; i < n2; ++i) {
+      phgmg_real v;
+      if (i < r && j < r) v = rom->Qh[i + (size_t)j * r];
+      else if (i < r) v = rom->Q01[i + (size_t)(j - r) * r];
+      else if (j < r) v = rom->Q01[j + (size_t)(i - r) * r];
+      else v = rom->Q11[(i - r) + (size_t)(j - r) * rn];
+      w[i + (size_t)j * n2] = v;
+    }
+  if (!phgmg__r_psd_shifted(n2, w, tol)) return PHGMG_ERR_STRUCTURE;
+  if (rom->nd == 0 && phgmg__r_norm1(r, rom->Qh) == PHGMG__R(0)) return PHGMG_ERR_STRUCTURE; /* H = 0 */
+  /* dissipation: -(M + M^T)/2, M = K or the G blocks */
+  for (j = 0; j < n2; ++j)
+    for (i = 0; i < n2; ++i) {
+      phgmg_real a, b;
+      if (!quad) { a = rom->K[i + (size_t)j * r]; b = rom->K[j + (size_t)i * r]; }
+      else {
+#define PHGMG__GIJ(ii, jj) ((ii) < r ? ((jj) < r ? rom->G00[(ii) + (size_t)(jj) * r] : rom->G01[(ii) + (size_t)((jj) - r) * r]) \
+                                     : ((jj) < r ? rom->G10[((ii) - r) + (size_t)(jj) * rn] : rom->G11[((ii) - r) + (size_t)((jj) - r) * rn]))
+        a = PHGMG__GIJ(i, j); b = PHGMG__GIJ(j, i);
+#undef PHGMG__GIJ
+      }
+      w[i + (size_t)j * n2] = -PHGMG__R(0.5) * (a + b);
+    }
+  if (!phgmg__r_psd_shifted(n2, w, tol)) return PHGMG_ERR_STRUCTURE;
+  if (rom->Phi && (!rom->K || !phgmg__rom_map_ok(rom, eps, w))) return PHGMG_ERR_STRUCTURE;
+  return PHGMG_OK;
+}
+
 PHGMG_DEF phgmg_result phgmg_rom_deserialize_size(const void *buf, size_t len, size_t *need) {
   phgmg_rom tmp;
   size_t n = 0, ss = 0;
@@ -13052,7 +13343,7 @@ PHGMG_DEF phgmg_result phgmg_rom_deserialize_size(const void *buf, size_t len, s
   size_t nterm = 0;
   phgmg_result rc = phgmg__rom_header(PHGMG__CAST(const unsigned char *, buf), len, &tmp, &n, &ss, &mask, &nterm);
   if (rc != PHGMG_OK) return rc;
-  if (need) *need = n * sizeof(phgmg_real) + sizeof(phgmg_real) + nterm * sizeof(int);
+  if (need) *need = (n + phgmg__rom_phys_work(&tmp)) * sizeof(phgmg_real) + sizeof(phgmg_real) + nterm * sizeof(int);
   return PHGMG_OK;
 }
 
@@ -13062,13 +13353,14 @@ PHGMG_DEF phgmg_result phgmg_rom_deserialize(const void *buf, size_t len, phgmg_
   phgmg_rom tmp;
   size_t n = 0, ss = 0, o, k, nterm = 0;
   uint32_t mask = 0;
-  phgmg_real *dst = PHGMG__CAST(phgmg_real *, mem);
+  phgmg_real *dst = PHGMG__CAST(phgmg_real *, mem), *work;
   phgmg_result rc;
   int i;
   if (!rom || !mem) return PHGMG_ERR_INVALID_ARG;
   rc = phgmg__rom_header(b, len, &tmp, &n, &ss, &mask, &nterm);
   if (rc != PHGMG_OK) return rc;
-  if (mem_size < n * sizeof(phgmg_real) + sizeof(phgmg_real) + nterm * sizeof(int)) return PHGMG_ERR_WORKSPACE;
+  if (mem_size < (n + phgmg__rom_phys_work(&tmp)) * sizeof(phgmg_real) + sizeof(phgmg_real) + nterm * sizeof(int))
+    return PHGMG_ERR_WORKSPACE;
   o = phgmg__get32(b + 8) == 1u ? PHGMG__HDR_BYTES : PHGMG__HDR2_BYTES;
   if (((size_t)mem) % sizeof(phgmg_real) != 0) return PHGMG_ERR_INVALID_ARG;
   for (i = 0; i < PHGMG__NFIELDS; ++i) {
@@ -13080,7 +13372,9 @@ PHGMG_DEF phgmg_result phgmg_rom_deserialize(const void *buf, size_t len, phgmg_
     *phgmg__field_ptr(&tmp, i) = dst;
     dst += len_i;
   }
-  if (nterm) { /* the term indices follow the scalars in mem */
+  work = dst;                           /* the structure check's scratch */
+  dst += phgmg__rom_phys_work(&tmp);
+  if (nterm) { /* the term indices follow the scalars and the scratch in mem */
     int *ti = PHGMG__CAST(int *, PHGMG__CAST(void *, dst));
     for (k = 0; k < nterm; ++k, o += 4) {
       uint32_t v = phgmg__get32(b + o);
@@ -13094,6 +13388,8 @@ PHGMG_DEF phgmg_result phgmg_rom_deserialize(const void *buf, size_t len, phgmg_
   /* fields required by the kind must be present, others absent */
   if ((tmp.kind == PHGMG_ROM_QUADRATIC) != (tmp.Ms != NULL) || (tmp.nd == 0 && (tmp.P0 || tmp.w)))
     return PHGMG_ERR_FORMAT;
+  rc = phgmg__rom_physics(&tmp, ss == 4 ? 1.1920929e-07 : (double)PHGMG__REPS, work);
+  if (rc != PHGMG_OK) return rc;
   *rom = tmp;
   return PHGMG_OK;
 }

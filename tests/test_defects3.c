@@ -291,10 +291,245 @@ TEST(test_defect3_step_map_huge_dt) {
   d3_free(&t);
 }
 
+/* Option checks as strict as the other entry points': phgmg_linear_basis
+   refuses what it used to replace by defaults; phgmg_deim_select tol NaN /
+   >= 1 / < 0 and kmax < 0; phgmg_nnls leaves x alone when it refuses;
+   phgmg_study_create refuses unknown flag bits; phgmg_lyap a non-symmetric
+   right-hand side; phgmg_care on an unstabilizable pair says so. */
+TEST(test_defect3_argument_checks) {
+  d3_model t;
+  double *V, F[6 * 4], w[6], A2[4], K2[4], L2[4], X2[4], x[3], An[6];
+  int pts[6], nd, nneg, k, i;
+  double sig;
+  phgmg_basis_opts bo;
+  phgmg_study *st = NULL;
+  phgmg_study_opts so;
+  double *Xs;
+  phgmg_reduced *red = d3_reduce(&t, 5, 101, 4, PHGMG_METHOD_GMG_POD, &Xs);
+  V = (double *)calloc((size_t)10 * 4, sizeof(double));
+  CHECK_RC(phgmg_linear_basis(&t.sys, PHGMG_BASIS_FREQ, 4, NULL, V, &k, NULL), PHGMG_OK);
+  memset(&bo, 0, sizeof bo); bo.nw = -1;
+  CHECK_RC(phgmg_linear_basis(&t.sys, PHGMG_BASIS_FREQ, 4, &bo, V, &k, NULL), PHGMG_ERR_INVALID_ARG);
+  memset(&bo, 0, sizeof bo); bo.wmin = 10.0; bo.wmax = 1.0;
+  CHECK_RC(phgmg_linear_basis(&t.sys, PHGMG_BASIS_FREQ, 4, &bo, V, &k, NULL), PHGMG_ERR_INVALID_ARG);
+  memset(&bo, 0, sizeof bo); bo.wmin = (double)NAN;
+  CHECK_RC(phgmg_linear_basis(&t.sys, PHGMG_BASIS_FREQ, 4, &bo, V, &k, NULL), PHGMG_ERR_INVALID_ARG);
+  memset(&bo, 0, sizeof bo); bo.wmax = 1e9;   /* one end given: the other from the system */
+  CHECK_RC(phgmg_linear_basis(&t.sys, PHGMG_BASIS_FREQ, 4, &bo, V, &k, NULL), PHGMG_OK);
+  memset(&bo, 0, sizeof bo); bo.dt = -0.1;
+  CHECK_RC(phgmg_linear_basis(&t.sys, PHGMG_BASIS_IMPULSE, 4, &bo, V, &k, NULL), PHGMG_ERR_INVALID_ARG);
+  memset(&bo, 0, sizeof bo); bo.nsteps = -5;
+  CHECK_RC(phgmg_linear_basis(&t.sys, PHGMG_BASIS_IMPULSE, 4, &bo, V, &k, NULL), PHGMG_ERR_INVALID_ARG);
+  {
+    double *V0 = (double *)malloc(sizeof(double) * 40);
+    for (i = 0; i < 40; ++i) V0[i] = (double)NAN;
+    memset(&bo, 0, sizeof bo); bo.V0 = V0; bo.maxit = 3;
+    CHECK_RC(phgmg_linear_basis(&t.sys, PHGMG_BASIS_H2, 4, &bo, V, &k, NULL), PHGMG_ERR_NANINF);
+    free(V0);
+  }
+  /* DEIM selection */
+  for (i = 0; i < 24; ++i) F[i] = th_rand();
+  CHECK_RC(phgmg_deim_select(6, 4, F, 6, NULL, 1e-8, 0, PHGMG_DEIM_QDEIM, pts, w, &nd, &nneg, &sig, NULL), PHGMG_OK);
+  CHECK_RC(phgmg_deim_select(6, 4, F, 6, NULL, (double)NAN, 0, PHGMG_DEIM_QDEIM, pts, w, &nd, &nneg, &sig, NULL),
+           PHGMG_ERR_INVALID_ARG);
+  CHECK_RC(phgmg_deim_select(6, 4, F, 6, NULL, 1.0, 0, PHGMG_DEIM_QDEIM, pts, w, &nd, &nneg, &sig, NULL),
+           PHGMG_ERR_INVALID_ARG);
+  CHECK_RC(phgmg_deim_select(6, 4, F, 6, NULL, 1e-8, -1, PHGMG_DEIM_GREEDY, pts, w, &nd, &nneg, &sig, NULL),
+           PHGMG_ERR_INVALID_ARG);
+  /* NNLS: refused without writing x */
+  for (i = 0; i < 6; ++i) An[i] = th_rand();
+  x[0] = x[1] = x[2] = 7.0;
+  CHECK_RC(phgmg_nnls(2, 3, An, 2, w, (double)NAN, 0, x, NULL, NULL, NULL), PHGMG_ERR_INVALID_ARG);
+  CHECK_RC(phgmg_nnls(2, 3, An, 2, w, 1e-6, -1, x, NULL, NULL, NULL), PHGMG_ERR_INVALID_ARG);
+  CHECK(x[0] == 7.0 && x[1] == 7.0 && x[2] == 7.0);
+  /* study flags */
+  memset(&so, 0, sizeof so);
+  so.kmax = 4; so.what = PHGMG_STUDY_GMG | 64u;
+  CHECK_RC(phgmg_study_create(&st, &t.sys, Xs, 10, 101, &so, NULL), PHGMG_ERR_INVALID_ARG);
+  CHECK(st == NULL);
+  /* Lyapunov with F not symmetric; A = -I: X = F / 2 if F were symmetric */
+  A2[0] = -1; A2[1] = 0; A2[2] = 0; A2[3] = -1;
+  K2[0] = 1; K2[1] = 0.4; K2[2] = 0; K2[3] = 1;
+  CHECK_RC(phgmg_lyap(2, A2, K2, X2, NULL, NULL), PHGMG_ERR_INVALID_ARG);
+  K2[2] = 0.4;
+  CHECK_RC(phgmg_lyap(2, A2, K2, X2, NULL, NULL), PHGMG_OK);
+  CHECK_LE(fabs(X2[2] - 0.2), 1e-12);
+  /* Riccati with A = diag(1, -1) and K = diag(0, 1) (input only to the
+     stable mode), L = I: the unstable mode cannot be stabilized */
+  A2[0] = 1; A2[1] = 0; A2[2] = 0; A2[3] = -1;
+  K2[0] = 0; K2[1] = 0; K2[2] = 0; K2[3] = 1;
+  L2[0] = 1; L2[1] = 0; L2[2] = 0; L2[3] = 1;
+  CHECK_RC(phgmg_care(2, A2, K2, L2, X2, NULL, NULL), PHGMG_ERR_NOT_STABILIZABLE);
+  K2[0] = 1;   /* stabilizable: X = diag(1 + sqrt 2, sqrt 2 - 1) */
+  CHECK_RC(phgmg_care(2, A2, K2, L2, X2, NULL, NULL), PHGMG_OK);
+  CHECK_LE(fabs(X2[0] - (1.0 + sqrt(2.0))), 1e-10);
+  CHECK_LE(fabs(X2[3] - (sqrt(2.0) - 1.0)), 1e-10);
+  phgmg_reduced_destroy(red);
+  free(V); free(Xs);
+  d3_free(&t);
+}
+
+/* The orderings' row moves of a sparse model in place (X == Y) give what
+   they give into a separate array; a partial overlap is refused with Y
+   untouched. The model: 6 states whose coupling is the path 0-3-1-4-2-5 in
+   the user's numbering (bandwidth 3; reverse Cuthill-McKee reorders it to
+   bandwidth 1, so the permutation is not the identity). */
+TEST(test_defect3_sparse_order_in_place) {
+  enum { N = 6 };
+  const int path[N] = {0, 3, 1, 4, 2, 5};
+  double Jd[N * N] = {0}, Rd[N * N] = {0}, Qd[N * N] = {0}, B[N] = {1, 0, 0, 0, 0, 0};
+  int cp[3][N + 1], ri[3][N * N], k, i, j, c;
+  double va[3][N * N], X[N * 2], Yr[N * 2], Z[N * 2 + 1];
+  const double *D[3];
+  phgmg_csc M[3];
+  phgmg_ph_sparse *sp = NULL;
+  phgmg_ph_sparse_info inf;
+  for (k = 0; k + 1 < N; ++k) {
+    Jd[path[k] + N * path[k + 1]] = 1.0;
+    Jd[path[k + 1] + N * path[k]] = -1.0;
+  }
+  for (i = 0; i < N; ++i) { Rd[i + N * i] = 0.1; Qd[i + N * i] = 2.0; }
+  D[0] = Jd; D[1] = Rd; D[2] = Qd;
+  for (c = 0; c < 3; ++c) {   /* dense -> CSC */
+    int nz = 0;
+    for (j = 0; j < N; ++j) {
+      cp[c][j] = nz;
+      for (i = 0; i < N; ++i)
+        if (D[c][i + N * j] != 0.0) { ri[c][nz] = i; va[c][nz] = D[c][i + N * j]; ++nz; }
+    }
+    cp[c][N] = nz;
+    M[c].n_rows = M[c].n_cols = N; M[c].colptr = cp[c]; M[c].rowidx = ri[c]; M[c].values = va[c];
+  }
+  CHECK_RC(phgmg_ph_sparse_create(&sp, N, 1, &M[0], &M[1], &M[2], B, NULL, &inf, NULL), PHGMG_OK);
+  if (!sp) return;
+  CHECK(inf.permuted == 1);
+  for (i = 0; i < 2 * N; ++i) X[i] = (double)(i + 1);
+  for (k = 0; k < 2; ++k) {
+    CHECK_RC(k ? phgmg_ph_sparse_to_user_order(sp, 2, X, N, Yr, N) : phgmg_ph_sparse_to_banded_order(sp, 2, X, N, Yr, N),
+             PHGMG_OK);
+    memcpy(Z, X, sizeof X);
+    CHECK_RC(k ? phgmg_ph_sparse_to_user_order(sp, 2, Z, N, Z, N) : phgmg_ph_sparse_to_banded_order(sp, 2, Z, N, Z, N),
+             PHGMG_OK);
+    CHECK(memcmp(Z, Yr, sizeof Yr) == 0);
+    memcpy(Z, X, sizeof X); Z[2 * N] = -1.0;
+    CHECK_RC(k ? phgmg_ph_sparse_to_user_order(sp, 2, Z, N, Z + 1, N)
+               : phgmg_ph_sparse_to_banded_order(sp, 2, Z, N, Z + 1, N),
+             PHGMG_ERR_INVALID_ARG);
+    CHECK(memcmp(Z, X, sizeof X) == 0 && Z[2 * N] == -1.0);
+  }
+  for (j = 0; j < 2; ++j)   /* to_user undoes to_banded */
+    for (i = 0; i < N; ++i) CHECK(Yr[phgmg_ph_sparse_perm(sp)[i] + N * j] == X[i + N * j]);
+  CHECK_RC(phgmg_ph_sparse_to_banded_order(sp, -1, X, N, Yr, N), PHGMG_ERR_SIZE);
+  CHECK_RC(phgmg_ph_sparse_to_banded_order(NULL, 2, X, N, Yr, N), PHGMG_ERR_INVALID_ARG);
+  phgmg_ph_sparse_destroy(sp);
+}
+
+/* A study keeps blocks of the system it was created for: after Q changed,
+   phgmg_study_reduce says so instead of returning a model of the old Q
+   (restored, it reduces again, and gives phgmg_reduce's model). */
+TEST(test_defect3_study_stale) {
+  d3_model t;
+  double *Xs;
+  phgmg_reduced *red = d3_reduce(&t, 5, 101, 4, PHGMG_METHOD_GMG_POD, &Xs), *r2 = NULL;
+  phgmg_study *st = NULL;
+  phgmg_study_opts so;
+  phgmg_reduce_opts o;
+  memset(&so, 0, sizeof so);
+  so.kmax = 6;
+  CHECK_RC(phgmg_study_create(&st, &t.sys, Xs, 10, 101, &so, NULL), PHGMG_OK);
+  memset(&o, 0, sizeof o);
+  o.method = PHGMG_METHOD_GMG_POD; o.r = 4;
+  if (st) {
+    t.Q[0] = 1.5;   /* still positive definite */
+    CHECK_RC(phgmg_study_reduce(st, &o, &r2, NULL), PHGMG_ERR_STALE);
+    CHECK(r2 == NULL);
+    phgmg_reduced_destroy(r2); r2 = NULL;
+    t.Q[0] = 1.0;
+    CHECK_RC(phgmg_study_reduce(st, &o, &r2, NULL), PHGMG_OK);
+    if (r2) {
+      const phgmg_rom *a = phgmg_reduced_rom(red), *b = phgmg_reduced_rom(r2);
+      int i;
+      for (i = 0; i < 16; ++i) CHECK_LE(fabs(a->Qh[i] - b->Qh[i]), 1e-12 * (1.0 + fabs(a->Qh[i])));
+    }
+  }
+  phgmg_reduced_destroy(r2);
+  phgmg_study_destroy(st);
+  phgmg_reduced_destroy(red);
+  free(Xs);
+  d3_free(&t);
+}
+
+/* Loading checks the physics, not only the checksum: a model file written
+   again (fresh checksum) with K -> -K (energy created), Qh -> -Qh (H
+   unbounded below), dt 0.1 -> 1e300 or 0.2 (the step map no longer of its
+   dt) is refused with PHGMG_ERR_STRUCTURE; the genuine files (GMG-POD with
+   a step map, GMG-QM) load. */
+static phgmg_result d3_roundtrip(const phgmg_rom *rom) {
+  static unsigned char buf[1 << 16];
+  static double mem[1 << 14];
+  size_t wr = 0, need = 0;
+  phgmg_rom back;
+  phgmg_result rc = phgmg_rom_serialize(rom, buf, sizeof buf, &wr);
+  if (rc != PHGMG_OK) return rc;
+  rc = phgmg_rom_deserialize_size(buf, wr, &need);
+  if (rc != PHGMG_OK) return rc;
+  if (need > sizeof mem) return PHGMG_ERR_WORKSPACE;
+  return phgmg_rom_deserialize(buf, wr, &back, mem, need);
+}
+TEST(test_defect3_load_structure) {
+  d3_model t;
+  double *Xs;
+  phgmg_reduced *red = NULL, *rq = NULL;
+  phgmg_reduce_opts o;
+  phgmg_rom cp;
+  phgmg_real K2[36], Q2[36];
+  int i;
+  phgmg_reduced_destroy(d3_reduce(&t, 10, 201, 6, PHGMG_METHOD_GMG_POD, &Xs));   /* the snapshots */
+  memset(&o, 0, sizeof o);
+  o.method = PHGMG_METHOD_GMG_POD; o.r = 6; o.dt = 0.1;
+  CHECK_RC(phgmg_reduce(&red, &t.sys, Xs, 20, 201, &o, NULL, NULL), PHGMG_OK);
+  o.method = PHGMG_METHOD_GMG_QM; o.r = 6; o.rn = 4; o.dt = 0.0;
+  CHECK_RC(phgmg_reduce(&rq, &t.sys, Xs, 20, 201, &o, NULL, NULL), PHGMG_OK);
+  if (red && rq) {
+    const phgmg_rom *rom = phgmg_reduced_rom(red);
+    CHECK(rom->Phi != NULL);
+    CHECK_RC(d3_roundtrip(rom), PHGMG_OK);
+    CHECK_RC(d3_roundtrip(phgmg_reduced_rom(rq)), PHGMG_OK);
+    cp = *rom;
+    for (i = 0; i < 36; ++i) K2[i] = -rom->K[i];
+    cp.K = K2;
+    CHECK_RC(d3_roundtrip(&cp), PHGMG_ERR_STRUCTURE);
+    cp.Phi = cp.Gam = cp.SX = cp.SU = NULL; cp.dt = 0;   /* without the step map: R's check alone */
+    CHECK_RC(d3_roundtrip(&cp), PHGMG_ERR_STRUCTURE);
+    cp = *rom;
+    for (i = 0; i < 36; ++i) Q2[i] = -rom->Qh[i];
+    cp.Qh = Q2;
+    CHECK_RC(d3_roundtrip(&cp), PHGMG_ERR_STRUCTURE);
+    cp = *rom; cp.dt = 1e300;
+    CHECK_RC(d3_roundtrip(&cp), PHGMG_ERR_STRUCTURE);
+    cp.dt = 0.2;
+    CHECK_RC(d3_roundtrip(&cp), PHGMG_ERR_STRUCTURE);
+    {   /* GMG-QM: the G blocks' symmetric part turned positive */
+      const phgmg_rom *q = phgmg_reduced_rom(rq);
+      for (i = 0; i < 36; ++i) K2[i] = -q->G00[i];
+      cp = *q; cp.G00 = K2;
+      CHECK_RC(d3_roundtrip(&cp), PHGMG_ERR_STRUCTURE);
+    }
+  }
+  phgmg_reduced_destroy(red);
+  phgmg_reduced_destroy(rq);
+  free(Xs);
+  d3_free(&t);
+}
+
 SUITE(defects3) {
   RUN(test_defect3_validate_scaled_norms);
   RUN(test_defect3_validate_nan_energy);
   RUN(test_defect3_ecsw_scale);
   RUN(test_defect3_lambda_zero);
   RUN(test_defect3_step_map_huge_dt);
+  RUN(test_defect3_argument_checks);
+  RUN(test_defect3_sparse_order_in_place);
+  RUN(test_defect3_study_stale);
+  RUN(test_defect3_load_structure);
 }
