@@ -1784,11 +1784,13 @@ PHGMG_DEF phgmg_result phgmg_rom_deserialize_size(const void *buf, size_t len, s
    for double); rom's views point into mem. A damaged file: PHGMG_ERR_FORMAT
    (header, sizes, checksum, NaN/Inf). Then a structure check of the values,
    since a checksum can be recomputed after an edit: Qh (QUADRATIC: with Q01,
-   Q11) positive definite up to sqrt(eps) ||Qh||, the dissipation -(K + K^T)/2
+   Q11) positive definite up to 3.5e-4 ||Qh||_1 (sqrt of float's roundoff: a
+   model may have passed through float), the dissipation -(K + K^T)/2
    (QUADRATIC: of the G blocks) positive semidefinite to the same relative
    level, and a step map that satisfies the GL3 stage equations of
-   x' = K Qh x + Bh u for the stored dt (within 48 (r + 1) eps of its terms'
-   size): PHGMG_ERR_STRUCTURE otherwise (details at phgmg__rom_physics).
+   x' = K Qh x + Bh u for the stored dt (within 48 (r + 1) 1.2e-7 of its
+   terms' size): PHGMG_ERR_STRUCTURE otherwise (details at
+   phgmg__rom_physics).
    No allocation; phgmg_rom_load returns the same codes. */
 PHGMG_DEF phgmg_result phgmg_rom_deserialize(const void *buf, size_t len, phgmg_rom *rom, void *mem,
                                              size_t mem_size);
@@ -13194,8 +13196,9 @@ PHGMG__ONLINE phgmg_result phgmg__rom_header(const unsigned char *b, size_t len,
      s_i = e_i - h sum_j A_ij Jf s_j (e_i: 1 kron I resp. h A kron Bh) and
      [Phi, Gam] = base + h sum_i b_i Jf s_i, each residual within
      tolm (1 + |out| + (1 + h ||A|| ||K|| ||Qh||) |s|) (|.|: max-norm).
-   tol = sqrt(eps), tolm = 48 (r + 1) eps, eps the unit roundoff of the values
-   (float scalars in the file or a float build: 1.2e-7, else 2.2e-16).
+   tol = sqrt(eps), tolm = 48 (r + 1) eps with eps = 1.2e-7, float's unit
+   roundoff, for every file: a model may have been rounded to float on its
+   way (a float build, an f32 file) and saved again with 8-byte scalars.
    Failure: PHGMG_ERR_STRUCTURE. Work: (r + rn)^2 + 4 r + 4 reals. */
 PHGMG__ONLINE size_t phgmg__rom_phys_work(const phgmg_rom *rom) {
   const size_t n2 = (size_t)rom->r + (size_t)(rom->kind == PHGMG_ROM_QUADRATIC ? rom->rn : 0);
@@ -13388,7 +13391,7 @@ PHGMG_DEF phgmg_result phgmg_rom_deserialize(const void *buf, size_t len, phgmg_
   /* fields required by the kind must be present, others absent */
   if ((tmp.kind == PHGMG_ROM_QUADRATIC) != (tmp.Ms != NULL) || (tmp.nd == 0 && (tmp.P0 || tmp.w)))
     return PHGMG_ERR_FORMAT;
-  rc = phgmg__rom_physics(&tmp, ss == 4 ? 1.1920929e-07 : (double)PHGMG__REPS, work);
+  rc = phgmg__rom_physics(&tmp, 1.1920929e-07, work);   /* float's roundoff for every file (see there) */
   if (rc != PHGMG_OK) return rc;
   *rom = tmp;
   return PHGMG_OK;
