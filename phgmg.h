@@ -1023,7 +1023,7 @@ typedef struct phgmg_reduce_opts {
                           over the training snapshots (0: 1e-6)                     */
   double dt;           /* > 0: precompute the GL3 step map for this step
                           (LINEAR map with quadratic H only). Any step size: for
-                          h ||K Qh|| > 100 the map is formed without the factor h
+                          h ||K Qh|| > 1e6 the map is formed without the factor h
                           (no cancellation; it tends to -I as dt grows). The map
                           of a dissipative model (Qh > 0, K + K^T <= 0) is checked
                           not to grow in the energy norm (PHGMG_ERR_STEP_MAP)   */
@@ -8440,9 +8440,10 @@ PHGMG__PRIV phgmg_result phgmg__inv(int n, const double *A, double *Ainv, const 
   return rc;
 }
 
-/* Below this h ||Jf||_1 the step map is formed as x+ = x + h sum b_i Jf Y_i;
-   above it in the form without h (see phgmg__step_map). */
-#define PHGMG__STEP_MAP_STIFF 100.0
+/* Below this h ||Jf||_1 the step map is formed as x+ = x + h sum b_i Jf Y_i
+   (rounding about eps h ||Jf||: at most 2e-10 relative here); above it in
+   the form without h (see phgmg__step_map). */
+#define PHGMG__STEP_MAP_STIFF 1e6
 
 /* Is the step map Phi of a dissipative model (Qh positive definite, K + K^T
    negative semidefinite up to 1e-12 ||K||_F) a contraction in the energy
