@@ -184,13 +184,17 @@ extern "C" {
   X(PHGMG_ERR_Q_NOT_PD,        -18, "Q is not positive definite (semidefinite for a nonlinear H)")                       \
   X(PHGMG_ERR_DTYPE,           -19, "unsupported .npy dtype (complex, object, string, ...)") \
   X(PHGMG_ERR_INEXACT,         -20, "integer beyond 2^53 in magnitude: not exact as a double") \
-  X(PHGMG_ERR_NOT_STABLE,      -21, "system not asymptotically stable (an undamped mode: eigenvalue on the imaginary axis)")
+  X(PHGMG_ERR_NOT_STABLE,      -21, "system not asymptotically stable (an undamped mode: eigenvalue on the imaginary axis)") \
+  X(PHGMG_ERR_E_SINGULAR,      -22, "the mass matrix E is singular to working precision") \
+  X(PHGMG_ERR_EQ_NOT_SYMMETRIC, -23, "E^T Q is not symmetric (descriptor model)")          \
+  X(PHGMG_ERR_EQ_NOT_PD,       -24, "E^T Q is not positive definite (semidefinite for a nonlinear H)") \
+  X(PHGMG_ERR_E_COUPLED,       -25, "a row of E at a nonlinear coordinate is not a positive multiple of the unit row")
 
 typedef enum phgmg_result {
 #define PHGMG__X(name, val, str) name = val,
   PHGMG__RESULT_LIST(PHGMG__X)
 #undef PHGMG__X
-  PHGMG__RESULT_END_ = -22
+  PHGMG__RESULT_END_ = -26
 } phgmg_result;
 
 /* A stable, human-readable description of a result code (never NULL). */
@@ -392,6 +396,21 @@ typedef struct phgmg_ph_system {
   phgmg_result (*shifted_factor)(double sr, double si, const double *x_lin, void *user);
   void (*shifted_solve)(double sr, double si, double *rhs, void *user);
   void *shifted_user;      /* `user` argument of the two callbacks above      */
+  /* Descriptor form (NULL: E = I, the standard form above). With a mass
+     matrix E (N x N, the storage and kb of J, R, Q; nonsingular) the model is
+         E x' = (J - R) z(x) + B u,   y = B^T z(x),   E^T z(x) = grad H(x),
+     where the co-state z(x) = Q x + grad H_nl(x) is what phgmg_ph_gradient
+     returns and the Hamiltonian is
+         H(x) = 1/2 x^T E^T Q x + sum_k E(i_k, i_k) w_k phi_k(x[i_k]),
+     i_k = sep_idx[k] (phgmg_ph_hamiltonian). E^T Q must be symmetric positive
+     definite (semidefinite with a nonlinear part) and, for a separable part,
+     row i_k of E must be E(i_k, i_k) e_{i_k}^T with E(i_k, i_k) > 0 (the
+     nonlinear coordinates carry no mass coupling), so that E^T z is a
+     gradient. A GENERAL part and the shifted_* callbacks are not supported
+     with E (PHGMG_ERR_UNSUPPORTED). The stepper never forms E^{-1}: E enters
+     its Newton matrices (sigma E - (J - R) Hess) and stage residuals. See
+     DESCRIPTOR MODELS in the manual at the top for the reduction. */
+  const double *E;
 } phgmg_ph_system;
 
 /* Validation of a system. tol (<= 0: 1e-12) is relative to the matrix norms:
@@ -3444,6 +3463,36 @@ PHGMG__PRIV void phgmg__ph_mv(const phgmg_ph_system *s, const double *M, const d
   }
 }
 
+/* y = M^T x (overwrite) for a dense or banded system matrix. */
+PHGMG__PRIV void phgmg__ph_mtv(const phgmg_ph_system *s, const double *M, const double *x, double *y) {
+  int N = s->N, i, j;
+  for (j = 0; j < N; ++j) {
+    double acc = 0.0;
+    if (s->storage == PHGMG_BANDED) {
+      int kb = s->kb, i0 = PHGMG__MAX(0, j - kb), i1 = PHGMG__MIN(N - 1, j + kb);
+      const double *col = M + PHGMG__PHB(kb, 0, j);
+      for (i = i0; i <= i1; ++i) acc += col[i] * x[i];
+    } else {
+      const double *col = M + (size_t)j * (size_t)N;
+      for (i = 0; i < N; ++i) acc += col[i] * x[i];
+    }
+    y[j] = acc;
+  }
+}
+
+/* Y = E X ('N') or E^T X ('T') for an N x nc block (E NULL: the identity). */
+PHGMG__PRIV void phgmg__ph_e_apply(const phgmg_ph_system *s, char trans, int nc, const double *X, int ldx,
+                                   double *Y, int ldy) {
+  int c;
+  for (c = 0; c < nc; ++c) {
+    const double *x = X + (size_t)c * (size_t)ldx;
+    double *y = Y + (size_t)c * (size_t)ldy;
+    if (!s->E) memcpy(y, x, sizeof(double) * (size_t)s->N);
+    else if (trans == 'T') phgmg__ph_mtv(s, s->E, x, y);
+    else phgmg__ph_mv(s, s->E, x, y);
+  }
+}
+
 /* x^T M y without temporaries. */
 PHGMG__PRIV double phgmg__ph_quad(const phgmg_ph_system *s, const double *M, const double *x,
                                   const double *y) {
@@ -3554,6 +3603,7 @@ PHGMG__PRIV phgmg_result phgmg__ph_check(const phgmg_ph_system *s) {
   if (s->storage == PHGMG_BANDED && (s->kb < 0 || s->kb > s->N - 1)) return PHGMG_ERR_SIZE;
   if (!s->J || !s->R || !s->Q || !s->B) return PHGMG_ERR_INVALID_ARG;
   if ((s->shifted_factor == NULL) != (s->shifted_solve == NULL)) return PHGMG_ERR_INVALID_ARG;
+  if (s->E && (s->nl == PHGMG_NL_GENERAL || s->shifted_factor)) return PHGMG_ERR_UNSUPPORTED;
   switch (s->nl) {
     case PHGMG_NL_NONE: break;
     case PHGMG_NL_SEPARABLE:
@@ -3619,10 +3669,31 @@ PHGMG__PRIV void phgmg__ph_scratch_free(double *p, double *stackbuf) {
   if (p != stackbuf) phgmg__free(NULL, p);
 }
 
+/* Descriptor Hamiltonian 1/2 (E x)^T (Q x) + sum_k E_kk w_k phi_k(x_k) (NaN
+   when the scratch vectors cannot be had). */
+PHGMG__PRIV double phgmg__ph_hamiltonian_e(const phgmg_ph_system *sys, const double *x) {
+  double sb[2 * PHGMG__PH_STACK], *ex, H = 0.0;
+  int N = sys->N, k;
+  ex = N <= PHGMG__PH_STACK ? sb : phgmg__dalloc(NULL, 2 * (size_t)N);
+  if (!ex) return (double)NAN;
+  phgmg__ph_mv(sys, sys->E, x, ex);
+  phgmg__ph_mv(sys, sys->Q, x, ex + N);
+  for (k = 0; k < N; ++k) H += ex[k] * ex[N + k];
+  H *= 0.5;
+  if (ex != sb) phgmg__free(NULL, ex);
+  if (sys->nl == PHGMG_NL_SEPARABLE)
+    for (k = 0; k < sys->nsep; ++k) {
+      const int ix = sys->sep_idx[k];
+      H += phgmg__ph_at(sys, sys->E, ix, ix) * (sys->sep_w ? sys->sep_w[k] : 1.0) * phgmg__ph_phi(sys, k, x[ix], 0);
+    }
+  return H;
+}
+
 PHGMG_DEF double phgmg_ph_hamiltonian(const phgmg_ph_system *sys, const double *x) {
   double H;
   int k;
   PHGMG_ASSERT(sys && x);
+  if (sys->E) return phgmg__ph_hamiltonian_e(sys, x);
   H = 0.5 * phgmg__ph_quad(sys, sys->Q, x, x);
   if (sys->nl == PHGMG_NL_SEPARABLE) {
     for (k = 0; k < sys->nsep; ++k)
@@ -4238,6 +4309,91 @@ PHGMG__PRIV phgmg_result phgmg__ph_check_q_pd(const phgmg_ph_system *s, double t
   return rc;
 }
 
+/* ---- descriptor models (E != NULL) -----------------------------------------
+   A factorization of E by the J - R machinery (J := E, R := 0): dense LU or
+   band LU; phgmg_jr_solve then applies E^{-1} ('N') or E^{-T} ('T').
+   rcond_out (may be NULL): its reciprocal condition estimate. */
+PHGMG__PRIV phgmg_result phgmg__e_factor(const phgmg_ph_system *sys, phgmg_jr_factor **f, double *rcond_out,
+                                         const phgmg_allocator *alloc) {
+  phgmg_ph_system t;
+  const size_t len = sys->storage == PHGMG_BANDED ? (size_t)(2 * sys->kb + 1) * (size_t)sys->N
+                                                  : (size_t)sys->N * (size_t)sys->N;
+  double *zero = phgmg__dalloc(alloc, len);
+  phgmg_result rc;
+  *f = NULL;
+  if (!zero) return PHGMG_ERR_NOMEM;
+  memset(zero, 0, sizeof(double) * len);
+  memset(&t, 0, sizeof t);
+  t.N = sys->N; t.m = sys->m; t.storage = sys->storage; t.kb = sys->kb;
+  t.J = sys->E; t.R = zero; t.Q = sys->E; t.B = sys->B;
+  rc = phgmg_jr_factor_create(f, &t, rcond_out, alloc);
+  phgmg__free(alloc, zero);
+  return rc;
+}
+
+/* E^T Q into a system view t (only t.Q meaningful: dense N x N, or banded
+   with half-bandwidth min(2 kb, N - 1)); *buf owns the storage. */
+PHGMG__PRIV phgmg_result phgmg__etq_form(const phgmg_ph_system *sys, phgmg_ph_system *t, double **buf,
+                                         const phgmg_allocator *alloc) {
+  const int N = sys->N;
+  int i, j, k;
+  *t = *sys;
+  t->E = NULL;
+  if (sys->storage == PHGMG_DENSE) {
+    *buf = phgmg__dalloc(alloc, (size_t)N * (size_t)N);
+    if (!*buf) return PHGMG_ERR_NOMEM;
+    phgmg_gemm('T', 'N', N, N, N, 1.0, sys->E, N, sys->Q, N, 0.0, *buf, N);
+  } else {
+    const int kb = sys->kb, k2 = PHGMG__MIN(2 * kb, N - 1);
+    const size_t len = (size_t)(2 * k2 + 1) * (size_t)N;
+    *buf = phgmg__dalloc(alloc, len);
+    if (!*buf) return PHGMG_ERR_NOMEM;
+    memset(*buf, 0, sizeof(double) * len);
+    for (j = 0; j < N; ++j)   /* (E^T Q)(i, j) = sum_k E(k, i) Q(k, j) */
+      for (i = PHGMG__MAX(0, j - k2); i <= PHGMG__MIN(N - 1, j + k2); ++i) {
+        double acc = 0.0;
+        for (k = PHGMG__MAX(PHGMG__MAX(0, i - kb), j - kb); k <= PHGMG__MIN(PHGMG__MIN(N - 1, i + kb), j + kb); ++k)
+          acc += sys->E[PHGMG__PHB(kb, k, i)] * sys->Q[PHGMG__PHB(kb, k, j)];
+        (*buf)[PHGMG__PHB(k2, i, j)] = acc;
+      }
+    t->kb = k2;
+  }
+  t->Q = *buf;
+  return PHGMG_OK;
+}
+
+/* The descriptor checks of phgmg_ph_validate: E finite and nonsingular,
+   E^T Q symmetric and positive (semi)definite, separable coordinates free of
+   mass coupling. */
+PHGMG__PRIV phgmg_result phgmg__ph_validate_e(const phgmg_ph_system *sys, double tol, const phgmg_allocator *alloc) {
+  phgmg_ph_system t;
+  phgmg_jr_factor *f = NULL;
+  double *buf = NULL, rcond = 0.0, nrm, def;
+  int k, j;
+  phgmg_result rc;
+  if (!phgmg__ph_mat_finite(sys, sys->E)) return PHGMG_ERR_NANINF;
+  rc = phgmg__etq_form(sys, &t, &buf, alloc);
+  if (rc != PHGMG_OK) return rc;
+  phgmg__ph_sym_defect(&t, t.Q, -1.0, &nrm, &def);
+  if (def > tol * nrm) rc = PHGMG_ERR_EQ_NOT_SYMMETRIC;
+  if (rc == PHGMG_OK) {
+    rc = phgmg__ph_check_q_pd(&t, tol, alloc);
+    if (rc == PHGMG_ERR_Q_NOT_PD) rc = PHGMG_ERR_EQ_NOT_PD;
+  }
+  phgmg__free(alloc, buf);
+  for (k = 0; rc == PHGMG_OK && sys->nl == PHGMG_NL_SEPARABLE && k < sys->nsep; ++k) {
+    const int ix = sys->sep_idx[k];
+    if (!(phgmg__ph_at(sys, sys->E, ix, ix) > 0.0)) rc = PHGMG_ERR_E_COUPLED;
+    for (j = 0; j < sys->N && rc == PHGMG_OK; ++j)
+      if (j != ix && phgmg__ph_at(sys, sys->E, ix, j) != 0.0) rc = PHGMG_ERR_E_COUPLED;
+  }
+  if (rc != PHGMG_OK) return rc;
+  rc = phgmg__e_factor(sys, &f, &rcond, alloc);
+  phgmg_jr_factor_destroy(f);
+  if (rc == PHGMG_ERR_NOMEM) return rc;
+  return rc == PHGMG_OK && rcond > tol ? PHGMG_OK : PHGMG_ERR_E_SINGULAR;
+}
+
 PHGMG_DEF phgmg_result phgmg_ph_validate(const phgmg_ph_system *sys, double tol,
                                          double *rcond_out, const phgmg_allocator *alloc) {
   phgmg_result rc;
@@ -4264,12 +4420,18 @@ PHGMG_DEF phgmg_result phgmg_ph_validate(const phgmg_ph_system *sys, double tol,
   if (def > tol * nrm) return PHGMG_ERR_NOT_SKEW;
   phgmg__ph_sym_defect(sys, sys->R, -1.0, &nrm, &def);
   if (def > tol * nrm) return PHGMG_ERR_NOT_SYMMETRIC;
-  phgmg__ph_sym_defect(sys, sys->Q, -1.0, &nrm, &def);
-  if (def > tol * nrm) return PHGMG_ERR_Q_NOT_SYMMETRIC;
-  rc = phgmg__ph_check_psd(sys, tol, alloc);
-  if (rc != PHGMG_OK) return rc;
-  rc = phgmg__ph_check_q_pd(sys, tol, alloc);
-  if (rc != PHGMG_OK) return rc;
+  if (sys->E) {   /* descriptor: E^T Q takes the place of Q */
+    rc = phgmg__ph_check_psd(sys, tol, alloc);
+    if (rc == PHGMG_OK) rc = phgmg__ph_validate_e(sys, tol, alloc);
+    if (rc != PHGMG_OK) return rc;
+  } else {
+    phgmg__ph_sym_defect(sys, sys->Q, -1.0, &nrm, &def);
+    if (def > tol * nrm) return PHGMG_ERR_Q_NOT_SYMMETRIC;
+    rc = phgmg__ph_check_psd(sys, tol, alloc);
+    if (rc != PHGMG_OK) return rc;
+    rc = phgmg__ph_check_q_pd(sys, tol, alloc);
+    if (rc != PHGMG_OK) return rc;
+  }
   /* B full column rank: pivoted QR, |R(m-1,m-1)| > tol |R(0,0)| */
   {
     double *Bc = phgmg__dalloc(alloc, (size_t)N * (size_t)m);
@@ -4940,6 +5102,9 @@ struct phgmg_gl3 {
   /* tiny entries: flush threshold of this step, ||xend||_inf, 0 = keep_tiny */
   double ftau, xamax;
   int flush;
+  /* descriptor (sys.E set): E times the stage block (3N), E's diagonals (banded) */
+  double *EZ;
+  phgmg__dia de;
 };
 
 PHGMG_DEF void phgmg_gl3_destroy(phgmg_gl3 *s) {
@@ -4964,11 +5129,40 @@ PHGMG_DEF void phgmg_gl3_destroy(phgmg_gl3 *s) {
   phgmg__free(&al, s->xnew); phgmg__free(&al, s->r1buf); phgmg__free(&al, s->rcbuf);
   phgmg__free(&al, s->pk);
   phgmg__free(&al, s->tmp);
+  phgmg__free(&al, s->EZ);
+  phgmg__dia_free(&al, &s->de);
   phgmg__free(&al, s);
 }
 
 PHGMG_DEF const phgmg_gl3_stats *phgmg_gl3_get_stats(const phgmg_gl3 *s) {
   return s ? &s->st : NULL;
+}
+
+/* Descriptor, dense: K1 = gam/h E - Jac and K2 = (alp - i bet)/h E - Jac from
+   K1, K2 that hold sigma I - Jac. */
+PHGMG__PRIV void phgmg__gl3_dense_shift_e(const phgmg_gl3 *s, double *K1, double *K2) {
+  const int N = s->N;
+  const double sg = s->gam / s->h, sa = s->alp / s->h, sb = -s->bet / s->h;
+  const double *E = s->sys.E;
+  int i, j;
+  for (j = 0; j < N; ++j)
+    for (i = 0; i < N; ++i) {
+      const size_t e = (size_t)i + (size_t)j * (size_t)N;
+      const double d = i == j ? 1.0 : 0.0;
+      K1[e] += sg * (E[e] - d);
+      K2[2 * e] += sa * (E[e] - d);
+      K2[2 * e + 1] = sb * E[e];
+    }
+}
+
+/* Descriptor: EZ = E V for the three stage columns of V (N each). */
+PHGMG__PRIV void phgmg__gl3_e_times(const phgmg_gl3 *s, const double *V, double *EZ) {
+  int st;
+  if (s->sys.storage == PHGMG_DENSE) {
+    phgmg_gemm('N', 'N', s->N, 3, s->N, 1.0, s->sys.E, s->N, V, s->N, 0.0, EZ, s->N);
+    return;
+  }
+  for (st = 0; st < 3; ++st) phgmg__dia_mv(&s->de, V + (size_t)st * (size_t)s->N, EZ + (size_t)st * (size_t)s->N);
 }
 
 /* Precompute the exact one-step map of a dense linear system (see >>gl3). */
@@ -5021,6 +5215,7 @@ PHGMG__PRIV phgmg_result phgmg__gl3_build_map(phgmg_gl3 *s) {
         K2[2 * e + 1] = -s->bet / s->h;
       }
     }
+  if (sys->E) phgmg__gl3_dense_shift_e(s, K1, K2);
   rc = phgmg_lu_factor(N, K1, N, ip1);
   if (rc == PHGMG_OK) rc = phgmg_zlu_factor(N, K2, N, ip2);
   if (rc != PHGMG_OK) goto done;
@@ -5147,6 +5342,10 @@ PHGMG__PRIV phgmg_result phgmg__gl3_setup_newton(phgmg_gl3 *s) {
   s->tmp = phgmg__dalloc(&s->al, (size_t)N);
   if (!s->Z || !s->W || !s->Y || !s->F || !s->Zprev || !s->xend ||
       !s->tmp) return PHGMG_ERR_NOMEM;
+  if (sys->E) {
+    s->EZ = phgmg__dalloc(&s->al, N3);
+    if (!s->EZ) return PHGMG_ERR_NOMEM;
+  }
   if (sys->nl == PHGMG_NL_SEPARABLE) {
     s->dd = phgmg__dalloc(&s->al, (size_t)N);
     if (!s->dd) return PHGMG_ERR_NOMEM;
@@ -5265,6 +5464,14 @@ PHGMG__PRIV phgmg_result phgmg__gl3_setup_banded(phgmg_gl3 *s) {
       rc = phgmg__dia_build(&s->al, &s->dh, N, kb, NULL, NULL, 1, 1);
       s->hband = phgmg__dalloc(&s->al, (size_t)(2 * kb + 1) * (size_t)N);
       if (rc != PHGMG_OK || !s->hband) return PHGMG_ERR_NOMEM;
+    }
+    if (sys->E) { /* descriptor: the band of E joins that of (J - R) Hess */
+      rc = phgmg__dia_build(&s->al, &s->de, N, kb, sys->E, NULL, 1, 0);
+      if (rc != PHGMG_OK) return rc;
+      for (k = 0; k < s->de.nd; ++k) {
+        amin = PHGMG__MIN(amin, s->de.off[k] - bmin);
+        amax = PHGMG__MAX(amax, s->de.off[k] - bmax);
+      }
     }
     s->kl = PHGMG__MIN(N - 1, -(amin + bmin));
     s->ku = PHGMG__MIN(N - 1, amax + bmax);
@@ -5626,6 +5833,22 @@ PHGMG__PRIV void phgmg__gl3_solve_packed(const phgmg_gl3 *s, double *b, double *
 #undef PHGMG__GL3_FWD_ROW
 #undef PHGMG__GL3_BWD_ROW
 
+/* Descriptor, banded: AB1 += sg E, AB2 += (sa + i sb) E (band LU layout). */
+PHGMG__PRIV void phgmg__gl3_band_shift_e(phgmg_gl3 *s, double sg, double sa, double sb) {
+  const int n = s->N, kv = s->kl + s->ku, ld = s->ldab;
+  int d, i;
+  for (d = 0; d < s->de.nd; ++d) {
+    const int o = s->de.off[d], i0 = PHGMG__MAX(0, -o), i1 = PHGMG__MIN(n, n - o);
+    const double *vd = s->de.v + (size_t)d * (size_t)n;
+    for (i = i0; i < i1; ++i) {
+      const size_t e = (size_t)(kv - o) + (size_t)(i + o) * (size_t)ld;
+      s->AB1[e] += sg * vd[i];
+      s->AB2[2 * e] += sa * vd[i];
+      s->AB2[2 * e + 1] += sb * vd[i];
+    }
+  }
+}
+
 /* (Re)factor the shifted Newton matrices at x. */
 PHGMG__PRIV phgmg_result phgmg__gl3_factor(phgmg_gl3 *s, const double *x) {
   const phgmg_ph_system *sys = &s->sys;
@@ -5670,6 +5893,7 @@ PHGMG__PRIV phgmg_result phgmg__gl3_factor(phgmg_gl3 *s, const double *x) {
       s->K2[2 * d] += sa;
       s->K2[2 * d + 1] = sb;
     }
+    if (sys->E) phgmg__gl3_dense_shift_e(s, s->K1, s->K2);
     rc = phgmg_lu_factor(N, s->K1, N, s->ip1);
     if (rc == PHGMG_OK) rc = phgmg_zlu_factor(N, s->K2, N, s->ip2);
     return rc;
@@ -5688,11 +5912,15 @@ PHGMG__PRIV phgmg_result phgmg__gl3_factor(phgmg_gl3 *s, const double *x) {
       phgmg__dia_prod_band(&s->djr, &s->dh, NULL, -1.0, s->AB1, ld, kv);
     }
     for (e = 0; e < tot; ++e) { s->AB2[2 * e] = s->AB1[e]; s->AB2[2 * e + 1] = 0.0; }
-    for (j = 0; j < N; ++j) {
-      size_t d = (size_t)kv + (size_t)j * (size_t)ld;
-      s->AB1[d] += sg;
-      s->AB2[2 * d] += sa;
-      s->AB2[2 * d + 1] = sb;
+    if (sys->E) { /* descriptor: sigma E in place of sigma I */
+      phgmg__gl3_band_shift_e(s, sg, sa, sb);
+    } else {
+      for (j = 0; j < N; ++j) {
+        size_t d = (size_t)kv + (size_t)j * (size_t)ld;
+        s->AB1[d] += sg;
+        s->AB2[2 * d] += sa;
+        s->AB2[2 * d + 1] = sb;
+      }
     }
     if (!phgmg__all_finite(s->AB1, tot)) return PHGMG_ERR_NANINF;
     rc = phgmg__gb_factor(N, s->kl, s->ku, s->AB1, ld, s->ip1, s->dinv1, &s->ue1);
@@ -5757,12 +5985,18 @@ PHGMG__PRIV phgmg_result phgmg__gl3_newton(phgmg_gl3 *s, const double *x, int fr
     const double t00 = Ti[0], t01 = Ti[1], t02 = Ti[2], t10 = Ti[3], t11 = Ti[4], t12 = Ti[5],
                  t20 = Ti[6], t21 = Ti[7], t22 = Ti[8];
     const double gih = s->gam * ih, aih = s->alp * ih, bih = s->bet * ih;
+    /* descriptor: E Z and E W in place of Z and W (the same vectors without E) */
+    const double *M0 = Z0, *M1 = Z1, *M2 = Z2, *V0 = W0, *V1 = W1, *V2 = W2;
     phgmg__gl3_eval(s, x);
-    for (i = 0; i < N; ++i) { /* stage residual Z - h (A x I) F */
+    if (s->EZ) {
+      phgmg__gl3_e_times(s, s->Z, s->EZ);
+      M0 = s->EZ; M1 = s->EZ + N; M2 = s->EZ + 2 * (size_t)N;
+    }
+    for (i = 0; i < N; ++i) { /* stage residual (I x E) Z - h (A x I) F */
       double f0 = F0[i], f1 = F1[i], f2 = F2[i], e0, e1, e2;
-      e0 = fabs(Z0[i] - PHGMG__FMA(a00, f0, PHGMG__FMA(a01, f1, a02 * f2)));
-      e1 = fabs(Z1[i] - PHGMG__FMA(a10, f0, PHGMG__FMA(a11, f1, a12 * f2)));
-      e2 = fabs(Z2[i] - PHGMG__FMA(a20, f0, PHGMG__FMA(a21, f1, a22 * f2)));
+      e0 = fabs(M0[i] - PHGMG__FMA(a00, f0, PHGMG__FMA(a01, f1, a02 * f2)));
+      e1 = fabs(M1[i] - PHGMG__FMA(a10, f0, PHGMG__FMA(a11, f1, a12 * f2)));
+      e2 = fabs(M2[i] - PHGMG__FMA(a20, f0, PHGMG__FMA(a21, f1, a22 * f2)));
       chk += (e0 + e1) + e2; /* NaN/Inf detection */
       zm = PHGMG__MAX(zm, PHGMG__MAX(fabs(Z0[i]), PHGMG__MAX(fabs(Z1[i]), fabs(Z2[i]))));
       res = e0 > res ? e0 : res;
@@ -5780,8 +6014,12 @@ PHGMG__PRIV phgmg_result phgmg__gl3_newton(phgmg_gl3 *s, const double *x, int fr
     if (it >= s->max_iter) return PHGMG_ERR_NOT_CONVERGED;
     if (it >= 1 && theta >= 1.0 && !fresh) return PHGMG_ERR_NOT_CONVERGED;
     if (ndiv >= 2) return PHGMG_ERR_NOT_CONVERGED;
+    if (s->EZ) {
+      phgmg__gl3_e_times(s, s->W, s->EZ);
+      V0 = s->EZ; V1 = s->EZ + N; V2 = s->EZ + 2 * (size_t)N;
+    }
     for (i = 0; i < N; ++i) { /* Newton right-hand sides in the transformed variables */
-      double f0 = F0[i], f1 = F1[i], f2 = F2[i], w0 = W0[i], w1 = W1[i], w2 = W2[i];
+      double f0 = F0[i], f1 = F1[i], f2 = F2[i], w0 = V0[i], w1 = V1[i], w2 = V2[i];
       r1[i] = PHGMG__FMA(t00, f0, PHGMG__FMA(t01, f1, PHGMG__FMA(t02, f2, -gih * w0)));
       rc[2 * i] =
           PHGMG__FMA(t10, f0, PHGMG__FMA(t11, f1, PHGMG__FMA(t12, f2, -(aih * w1 + bih * w2))));
@@ -5927,8 +6165,12 @@ PHGMG_DEF phgmg_result phgmg_gl3_step(phgmg_gl3 *s, double t, double *x, phgmg_i
     const double *F0 = s->F, *F1 = s->F + N, *F2 = s->F + 2 * (size_t)N;
     double hb0 = s->h * s->b[0], hb1 = s->h * s->b[1], hb2 = s->h * s->b[2], chk = 0.0, am = 0.0;
     const double tau = s->ftau; /* the new state is flushed with this step's threshold */
+    const double *Z0 = s->Z, *Z1 = s->Z + N, *Z2 = s->Z + 2 * (size_t)N;
     for (i = 0; i < N; ++i) {
-      double v = x[i] + (hb0 * F0[i] + hb1 * F1[i] + hb2 * F2[i]), a = fabs(v);
+      /* descriptor: x + sum d_i Z_i (= x + h sum b_i E^{-1} F_i at the solution) */
+      double v = s->EZ ? x[i] + (s->d[0] * Z0[i] + s->d[1] * Z1[i] + s->d[2] * Z2[i])
+                       : x[i] + (hb0 * F0[i] + hb1 * F1[i] + hb2 * F2[i]),
+             a = fabs(v);
       s->xnew[i] = a < tau ? 0.0 : v;
       chk += v;
       am = a > am ? a : am;
@@ -8652,6 +8894,13 @@ typedef struct phgmg__rctx {
                               GMG-POD: phgmg_reduce redoes it with manifold = POD */
   phgmg_study *st;         /* phgmg_study_reduce: the study (else NULL)     */
   int sf;                  /* fast path on the study's basis: 1 GMG, 2 SP1, 3 SP2 (0: none) */
+  /* descriptor models (sys->E set; see DESCRIPTOR MODELS in the manual):
+     Bp = E^{-1} B, the port columns of the GMG basis (sys->B without E);
+     sepw = E(i_k, i_k) w_k, the separable weights of H (sys->sep_w without E);
+     ef = the factorization of E */
+  const double *Bp, *sepw;
+  double *Bp_own, *sepw_own;
+  phgmg_jr_factor *ef;
 } phgmg__rctx;
 
 PHGMG__PRIV void phgmg__rctx_free(phgmg__rctx *c) {
@@ -8661,7 +8910,40 @@ PHGMG__PRIV void phgmg__rctx_free(phgmg__rctx *c) {
   phgmg__free(c->alloc, c->Tq);
   phgmg__free(c->alloc, c->runcol);
   phgmg__free(c->alloc, c->V2h);
+  phgmg__free(c->alloc, c->Bp_own);
+  phgmg__free(c->alloc, c->sepw_own);
+  phgmg_jr_factor_destroy(c->ef);
   c->jr = NULL; c->Xa = c->lg = c->Tq = c->V2h = NULL; c->runcol = NULL;
+  c->Bp_own = c->sepw_own = NULL; c->ef = NULL;
+}
+
+/* Descriptor models: E factored, Bp = E^{-1} B, sepw = E(i_k, i_k) w_k; no
+   study fast path (its cached blocks assume E = I). Without E: Bp = B,
+   sepw = the system's weights. */
+PHGMG__PRIV phgmg_result phgmg__reduce_descriptor_setup(phgmg__rctx *c) {
+  const phgmg_ph_system *sys = c->sys;
+  const int N = sys->N, m = sys->m;
+  int k;
+  phgmg_result rc;
+  c->Bp = sys->B;
+  c->sepw = sys->sep_w;
+  if (!sys->E) return PHGMG_OK;
+  c->sf = 0;
+  rc = phgmg__e_factor(sys, &c->ef, NULL, c->alloc);
+  if (rc != PHGMG_OK) return rc;
+  c->Bp_own = phgmg__dalloc(c->alloc, (size_t)N * m);
+  if (!c->Bp_own) return PHGMG_ERR_NOMEM;
+  memcpy(c->Bp_own, sys->B, (size_t)N * m * sizeof(double));
+  phgmg_jr_solve(c->ef, 'N', m, c->Bp_own, N);
+  c->Bp = c->Bp_own;
+  if (sys->nl == PHGMG_NL_SEPARABLE && sys->nsep > 0) {
+    c->sepw_own = phgmg__dalloc(c->alloc, (size_t)sys->nsep);
+    if (!c->sepw_own) return PHGMG_ERR_NOMEM;
+    for (k = 0; k < sys->nsep; ++k)
+      c->sepw_own[k] = (sys->sep_w ? sys->sep_w[k] : 1.0) * phgmg__ph_at(sys, sys->E, sys->sep_idx[k], sys->sep_idx[k]);
+    c->sepw = c->sepw_own;
+  }
+  return phgmg__all_finite(c->Bp_own, (size_t)N * m) ? PHGMG_OK : PHGMG_ERR_NANINF;
 }
 
 PHGMG__PRIV int phgmg__is_gmg(int method) {
@@ -8837,7 +9119,7 @@ PHGMG__PRIV phgmg_result phgmg__stage_basis(phgmg__rctx *c) {
   red->QB = phgmg__red_d(red, (size_t)N * m);
   red->RB = phgmg__red_d(red, (size_t)m * m);
   if (!red->V0 || !red->QB || !red->RB) return PHGMG_ERR_NOMEM;
-  rc = phgmg__thin_qr(N, m, c->sys->B, red->QB, red->RB, c->alloc);
+  rc = phgmg__thin_qr(N, m, c->Bp, red->QB, red->RB, c->alloc);
   if (rc != PHGMG_OK) return rc;
   if (c->o->pod_basis && c->o->pod_cols < need) return PHGMG_ERR_SIZE;
   if (!phgmg__is_gmg(red->method)) {
@@ -8866,7 +9148,7 @@ PHGMG__PRIV phgmg_result phgmg__stage_basis(phgmg__rctx *c) {
     c->V2h = phgmg__dalloc(c->alloc, (size_t)N * red->rn);
     if (!c->V2h) { phgmg__free(c->alloc, tmp); return PHGMG_ERR_NOMEM; }
   }
-  memcpy(red->V0, c->sys->B, (size_t)N * m * sizeof(double));
+  memcpy(red->V0, c->Bp, (size_t)N * m * sizeof(double));
   if (!c->o->pod_basis && red->kind != PHGMG_ROM_QUADRATIC) { /* large: randomized, X - QB QB^T X implicit */
     rc = phgmg__basis_pod_implicit(c, tmp);
     if (rc != PHGMG_ERR_NOT_CONVERGED) { phgmg__free(c->alloc, tmp); return rc; }
@@ -9902,16 +10184,23 @@ PHGMG__PRIV phgmg_result phgmg__study_gmg_blocks(phgmg__rctx *c) {
 PHGMG__PRIV phgmg_result phgmg__stage_gmg_blocks(phgmg__rctx *c) {
   phgmg_reduced *red = c->red;
   const int N = red->N, m = red->m, r = red->r, rn = red->rn;
-  double *GV = NULL;
+  double *GV = NULL, *EV = NULL;
+  const double *L0 = red->V0, *L2 = red->V2;   /* left factors: [V0, V2], or E [V0, V2] */
   int j;
   phgmg_result rc = PHGMG_OK;
   if (c->sf != 1) {
     rc = phgmg_jr_factor_create(&c->jr, c->sys, NULL, c->alloc);
     if (rc != PHGMG_OK) return rc;
-    GV = phgmg__dalloc(c->alloc, (size_t)N * (r + rn));
+    GV = phgmg__dalloc(c->alloc, (size_t)N * (r + rn) * (c->sys->E ? 2 : 1));
     if (!GV) return PHGMG_ERR_NOMEM;
     memcpy(GV, red->V0, (size_t)N * r * sizeof(double));
     if (rn) memcpy(GV + (size_t)N * r, red->V2, (size_t)N * rn * sizeof(double));
+    if (c->sys->E) { /* descriptor: G_E = E^T G E, so the blocks are (E V)^T G (E V) */
+      EV = GV + (size_t)N * (r + rn);
+      phgmg__ph_e_apply(c->sys, 'N', r + rn, GV, N, EV, N);
+      memcpy(GV, EV, (size_t)N * (r + rn) * sizeof(double));
+      L0 = EV; L2 = EV + (size_t)N * r;
+    }
     phgmg_jr_solve(c->jr, 'N', r + rn, GV, N);           /* GV = G [V0, V2] */
   }
   red->G00 = phgmg__red_d(red, (size_t)r * r);
@@ -9928,12 +10217,12 @@ PHGMG__PRIV phgmg_result phgmg__stage_gmg_blocks(phgmg__rctx *c) {
   if (c->sf == 1) {
     phgmg__study_gmg_blocks(c);
   } else {
-    phgmg__atb(N, r, r, red->V0, GV, red->G00);
+    phgmg__atb(N, r, r, L0, GV, red->G00);
   }
   if (rn && c->sf != 1) {
-    phgmg__atb(N, r, rn, red->V0, GV + (size_t)N * r, red->G01);
-    phgmg__atb(N, rn, r, red->V2, GV, red->G10);
-    phgmg__atb(N, rn, rn, red->V2, GV + (size_t)N * r, red->G11);
+    phgmg__atb(N, r, rn, L0, GV + (size_t)N * r, red->G01);
+    phgmg__atb(N, rn, r, L2, GV, red->G10);
+    phgmg__atb(N, rn, rn, L2, GV + (size_t)N * r, red->G11);
   }
   phgmg__free(c->alloc, GV);
   for (j = 0; j < m; ++j) red->Bh[j + (size_t)j * r] = 1.0;
@@ -9944,6 +10233,20 @@ PHGMG__PRIV phgmg_result phgmg__stage_gmg_blocks(phgmg__rctx *c) {
   return phgmg__inv(r, red->G00, red->K, c->alloc);
 }
 
+/* Descriptor: X (N x nc, ld N) <- E^T X. */
+PHGMG__PRIV phgmg_result phgmg__e_transpose_block(const phgmg__rctx *c, int nc, double *X) {
+  const int N = c->sys->N;
+  double *t = phgmg__dalloc(c->alloc, (size_t)N);
+  int j;
+  if (!t) return PHGMG_ERR_NOMEM;
+  for (j = 0; j < nc; ++j) {
+    phgmg__ph_mtv(c->sys, c->sys->E, X + (size_t)j * N, t);
+    memcpy(X + (size_t)j * N, t, (size_t)N * sizeof(double));
+  }
+  phgmg__free(c->alloc, t);
+  return PHGMG_OK;
+}
+
 /* The test basis of SP1 (Q V) or SP2 (POD of the gradient snapshots) into Vg. */
 PHGMG__PRIV phgmg_result phgmg__sp_test_basis(phgmg__rctx *c, double *Vg) {
   phgmg_reduced *red = c->red;
@@ -9951,9 +10254,9 @@ PHGMG__PRIV phgmg_result phgmg__sp_test_basis(phgmg__rctx *c, double *Vg) {
   double *Fg, *S;
   int j, k = 0;
   phgmg_result rc;
-  if (red->method == PHGMG_METHOD_SP1) {
+  if (red->method == PHGMG_METHOD_SP1) {   /* Hess H V: Q V, or E^T Q V */
     phgmg_ph_apply(c->sys, 'Q', r, red->V0, N, Vg, N);
-    return PHGMG_OK;
+    return c->sys->E ? phgmg__e_transpose_block(c, r, Vg) : PHGMG_OK;
   }
   if (c->o->grad_basis) {
     if (c->o->grad_cols < r) return PHGMG_ERR_SIZE;
@@ -9964,7 +10267,8 @@ PHGMG__PRIV phgmg_result phgmg__sp_test_basis(phgmg__rctx *c, double *Vg) {
   if (!Fg) return PHGMG_ERR_NOMEM;
   S = Fg + (size_t)N * ns;
   for (j = 0; j < ns; ++j) phgmg_ph_gradient(c->sys, c->X + (size_t)j * c->ldx, Fg + (size_t)j * N);
-  rc = phgmg_pod(N, ns, Fg, N, r, 0.0, Vg, N, S, &k, c->alloc);
+  rc = c->sys->E ? phgmg__e_transpose_block(c, ns, Fg) : PHGMG_OK;   /* grad H = E^T z */
+  if (rc == PHGMG_OK) rc = phgmg_pod(N, ns, Fg, N, r, 0.0, Vg, N, S, &k, c->alloc);
   if (rc == PHGMG_OK && (k < r || !(S[r - 1] > phgmg__rank_floor(N, ns, Fg, N)))) rc = PHGMG_ERR_SIZE;
   phgmg__free(c->alloc, Fg);
   return rc;
@@ -9998,15 +10302,49 @@ PHGMG__PRIV phgmg_result phgmg__stage_sp_blocks(phgmg__rctx *c) {
   }
   if (rc == PHGMG_OK) memcpy(red->Ainv, Ainv, (size_t)r * r * sizeof(double));
   if (rc == PHGMG_OK) {
+    const double *Wz = red->W;   /* the test basis of the co-state: W, or E^{-T} W */
     phgmg_gemm('N', 'N', N, r, r, 1.0, Vg, N, Ainv, r, 0.0, red->W, N);
-    phgmg_ph_apply(c->sys, 'J', r, red->W, N, Vg, N);
-    phgmg_ph_apply(c->sys, 'R', r, red->W, N, T, N);
+    if (c->sys->E) {
+      double *Wt = phgmg__red_d(red, (size_t)N * r);
+      if (!Wt) { phgmg__free(c->alloc, Vg); return PHGMG_ERR_NOMEM; }
+      memcpy(Wt, red->W, (size_t)N * r * sizeof(double));
+      phgmg_jr_solve(c->ef, 'T', r, Wt, N);
+      Wz = Wt;
+    }
+    phgmg_ph_apply(c->sys, 'J', r, Wz, N, Vg, N);
+    phgmg_ph_apply(c->sys, 'R', r, Wz, N, T, N);
     for (i = 0; i < N * r; ++i) Vg[i] -= T[i];
-    phgmg__atb(N, r, r, red->W, Vg, red->K);
-    phgmg__atb(N, r, m, red->W, c->sys->B, red->Bh);
+    phgmg__atb(N, r, r, Wz, Vg, red->K);
+    phgmg__atb(N, r, m, Wz, c->sys->B, red->Bh);
   }
   phgmg__free(c->alloc, Vg);
   return rc;
+}
+
+/* Descriptor: Qh = (E V0)^T Q V0, Q01 = (E V0)^T Q V2, Q11 = (E V2)^T Q V2
+   (Hess H = E^T Q) from QV = Q [V0, V2]; Qh and Q11 symmetrised. */
+PHGMG__PRIV phgmg_result phgmg__quadratic_terms_e(phgmg__rctx *c, const double *QV) {
+  phgmg_reduced *red = c->red;
+  const int N = red->N, r = red->r, rn = red->rn;
+  double *EV = phgmg__dalloc(c->alloc, (size_t)N * (r + rn));
+  int i, j;
+  if (!EV) return PHGMG_ERR_NOMEM;
+  phgmg__ph_e_apply(c->sys, 'N', r, red->V0, N, EV, N);
+  if (rn) phgmg__ph_e_apply(c->sys, 'N', rn, red->V2, N, EV + (size_t)N * r, N);
+  phgmg__atb(N, r, r, EV, QV, red->Qh);
+  if (rn) {
+    phgmg__atb(N, r, rn, EV, QV + (size_t)N * r, red->Q01);
+    phgmg__atb(N, rn, rn, EV + (size_t)N * r, QV + (size_t)N * r, red->Q11);
+    for (j = 0; j < rn; ++j)
+      for (i = 0; i < j; ++i)
+        red->Q11[i + (size_t)j * rn] = red->Q11[j + (size_t)i * rn] =
+            0.5 * (red->Q11[i + (size_t)j * rn] + red->Q11[j + (size_t)i * rn]);
+  }
+  for (j = 0; j < r; ++j)
+    for (i = 0; i < j; ++i)
+      red->Qh[i + (size_t)j * r] = red->Qh[j + (size_t)i * r] = 0.5 * (red->Qh[i + (size_t)j * r] + red->Qh[j + (size_t)i * r]);
+  phgmg__free(c->alloc, EV);
+  return PHGMG_OK;
 }
 
 /* Stage 4a, quadratic part of H: Qh = V0^T Q V0 (exactly symmetric), and
@@ -10032,6 +10370,11 @@ PHGMG__PRIV phgmg_result phgmg__stage_quadratic_terms(phgmg__rctx *c) {
   } else {
     phgmg_ph_apply(c->sys, 'Q', r, red->V0, N, QV, N);
     if (rn) phgmg_ph_apply(c->sys, 'Q', rn, red->V2, N, QV + (size_t)N * r, N);
+    if (c->sys->E) { /* descriptor: Hess H = E^T Q, so Qh = (E V0)^T (Q V0) ... */
+      phgmg_result rc = phgmg__quadratic_terms_e(c, QV);
+      phgmg__free(c->alloc, QV);
+      return rc;
+    }
     phgmg__atb(N, r, r, red->V0, QV, red->Qh);
   }
   for (j = 0; j < r; ++j)
@@ -10084,7 +10427,7 @@ PHGMG__PRIV phgmg_result phgmg__hyper_ecsw_manifold(phgmg__rctx *c, const double
   }
   for (a = 0; a < (int)nrow; ++a) tg[a] = 0.0;
   for (k = 0; k < nt; ++k) {
-    const double sw = sys->sep_w ? sys->sep_w[live[k]] : 1.0;
+    const double sw = c->sepw ? c->sepw[live[k]] : 1.0;
     for (a = 0; a < (int)nrow; ++a) tg[a] += sw * Gm[a + (size_t)k * nrow];
   }
   rc = phgmg_ecsw(nt, (int)nrow, Gm, (int)nrow, tg, c->o->hyper_tol, pts, wt, nd, &c->inf.hyper_residual, c->alloc);
@@ -10111,7 +10454,7 @@ PHGMG__PRIV phgmg_result phgmg__hyper_ecsw(phgmg__rctx *c, const double *F, int 
   sw = Vt + (size_t)nl * r;
   for (a = 0; a < r; ++a)
     for (k = 0; k < nl; ++k) Vt[k + (size_t)a * nl] = red->V0[c->sys->sep_idx[live[k]] + (size_t)a * N];
-  for (k = 0; k < nl; ++k) sw[k] = c->sys->sep_w ? c->sys->sep_w[live[k]] : 1.0;
+  for (k = 0; k < nl; ++k) sw[k] = c->sepw ? c->sepw[live[k]] : 1.0;
   rc = phgmg_ecsw_separable(nl, c->ns, F, nl, r, Vt, nl, sw, c->o->hyper_tol, pts, wt, nd,
                             &c->inf.hyper_residual, c->alloc);
   for (k = 0; rc == PHGMG_OK && k < *nd; ++k) pts[k] = live[pts[k]];   /* ascending stays ascending */
@@ -10177,7 +10520,7 @@ PHGMG__PRIV phgmg_result phgmg__separable_points(phgmg__rctx *c, int *pts, doubl
     else if (ecsw)
       rc = phgmg__hyper_ecsw(c, F, nl, live, pts, wt, nd);
     else
-      rc = phgmg_deim_select(nt, ns, F, nt, sys->sep_w, o->deim_tol, o->deim_max,
+      rc = phgmg_deim_select(nt, ns, F, nt, c->sepw, o->deim_tol, o->deim_max,
                              o->hyper == PHGMG_HYPER_GREEDY ? PHGMG_DEIM_GREEDY : PHGMG_DEIM_QDEIM,
                              pts, wt, nd, &nneg, &c->inf.deim_sigma_ratio, c->alloc);
     phgmg__free(c->alloc, F);
@@ -10185,7 +10528,7 @@ PHGMG__PRIV phgmg_result phgmg__separable_points(phgmg__rctx *c, int *pts, doubl
     c->inf.hyper_method = o->hyper;
   } else {
     *nd = nt;
-    for (a = 0; a < nt; ++a) { pts[a] = a; wt[a] = sys->sep_w ? sys->sep_w[a] : 1.0; }
+    for (a = 0; a < nt; ++a) { pts[a] = a; wt[a] = c->sepw ? c->sepw[a] : 1.0; }
   }
   c->inf.deim_modes = *nd;      /* reported on PHGMG_ERR_NEGATIVE_WEIGHT too */
   c->inf.deim_negative = nneg;
@@ -10337,6 +10680,7 @@ PHGMG__PRIV phgmg_result phgmg__reduce_run(phgmg_reduced **out, const phgmg_ph_s
   c.degtol = opts->degeneracy_tol > 0.0 ? opts->degeneracy_tol : 1e-12;
   c.rfloor = phgmg__rank_floor(sys->N, ns, X, ldx);
   rc = phgmg__runs_layout(&c);
+  if (rc == PHGMG_OK) rc = phgmg__reduce_descriptor_setup(&c);
   if (rc == PHGMG_OK) rc = phgmg__reduce_new(&c);
   if (rc == PHGMG_OK && c.sf) { c.red->study = st; c.red->sbasis = c.sf; }
   if (rc == PHGMG_OK) { phgmg__progress(opts, "basis"); rc = phgmg__stage_basis(&c); }

@@ -12,6 +12,7 @@
 #include "test_core.c"
 #include "test_defects.c"
 #include "test_deploy.c"
+#include "test_descriptor.c"
 #include "test_errors.c"
 #include "test_general.c"
 #include "test_hyper.c"
