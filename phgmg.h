@@ -1271,7 +1271,10 @@ PHGMG_DEF void phgmg_reduced_lift(const phgmg_reduced *red, const double *xr, do
 PHGMG_DEF void phgmg_reduced_restrict(const phgmg_reduced *red, const double *x, double *xr);
 /* Jacobian of phi at xr: D (N x r, ldd). */
 PHGMG_DEF void phgmg_reduced_dphi(const phgmg_reduced *red, const double *xr, double *D, int ldd);
-/* The reduction map W(xr) (N x r, ldw) in full dimension (for checks; O(N r^2)). */
+/* The reduction map W(xr) (N x r, ldw >= N) in full dimension (for checks;
+   O(N r^2)), W^T Dphi = I. Descriptor model: W^T = (D^T G_E D)^{-1} D^T G_E,
+   G_E = E^T G E (the map of the equivalent standard form); the test basis of
+   the co-state equation is W_z = E^{-T} W (see DESCRIPTOR MODELS). */
 PHGMG_DEF phgmg_result phgmg_reduced_W(const phgmg_reduced *red, const double *xr, double *W, int ldw);
 
 /* Simulate the reduced model with the online GL3 stepper from xr0 over nsteps
@@ -10774,10 +10777,17 @@ PHGMG_DEF phgmg_result phgmg_reduced_W(const phgmg_reduced *red, const double *x
   if (!D) return PHGMG_ERR_NOMEM;
   GtD = D + (size_t)N * r; E = GtD + (size_t)N * r; Einv = E + (size_t)r * r;
   phgmg_reduced_dphi(red, xr, D, N);
-  memcpy(GtD, D, (size_t)N * r * sizeof(double));
+  if (red->sys->E) phgmg__ph_e_apply(red->sys, 'N', r, D, N, GtD, N);   /* descriptor: G_E = E^T G E */
+  else memcpy(GtD, D, (size_t)N * r * sizeof(double));
   rc = phgmg_jr_factor_create(&jr, red->sys, NULL, alloc);
   if (rc == PHGMG_OK) {
     phgmg_jr_solve(jr, 'T', r, GtD, N);                      /* G^T D */
+    if (red->sys->E) {                                       /* E^T G^T E D, column by column */
+      for (j = 0; j < r; ++j) {
+        phgmg__ph_mtv(red->sys, red->sys->E, GtD + (size_t)j * N, W + (size_t)j * ldw);
+        memcpy(GtD + (size_t)j * N, W + (size_t)j * ldw, (size_t)N * sizeof(double));
+      }
+    }
     phgmg__atb(N, r, r, GtD, D, E);                           /* (G^T D)^T D = D^T G D */
     rc = phgmg__inv(r, E, Einv, alloc);
     if (rc == PHGMG_OK)                                       /* W = G^T D E^{-T} */
@@ -11145,6 +11155,7 @@ PHGMG_DEF phgmg_result phgmg_study_create(phgmg_study **out, const phgmg_ph_syst
   phgmg_result rc;
   if (!out) return PHGMG_ERR_INVALID_ARG;
   *out = NULL;
+  if (sys && sys->E) return PHGMG_ERR_UNSUPPORTED; /* standard form only (see DESCRIPTOR MODELS) */
   if (!sys || !X || !so) return PHGMG_ERR_INVALID_ARG;
   what = so->what ? so->what : (PHGMG_STUDY_GMG | PHGMG_STUDY_SP);
   if (what & PHGMG_STUDY_SP2) what |= PHGMG_STUDY_SP;
@@ -11483,6 +11494,7 @@ PHGMG_DEF phgmg_result phgmg_ph_abc(const phgmg_ph_system *sys, double *A, doubl
   int N, m, i;
   double *I, *Qd, *T;
   if (!sys) return PHGMG_ERR_INVALID_ARG;
+  if (sys && sys->E) return PHGMG_ERR_UNSUPPORTED; /* standard form only (see DESCRIPTOR MODELS) */
   if (sys->nl != PHGMG_NL_NONE) return PHGMG_ERR_UNSUPPORTED;
   N = sys->N; m = sys->m;
   if (N < 1 || m < 1 || m > N) return PHGMG_ERR_SIZE;
@@ -11599,6 +11611,7 @@ PHGMG_DEF phgmg_result phgmg_bt(const phgmg_ph_system *sys, int r, double *Ar, d
   double *A, *C, *P, *O, *Tb, *Wb, *S;
   phgmg_result rc;
   if (!sys || !Ar || !Br || !Cr) return PHGMG_ERR_INVALID_ARG;
+  if (sys && sys->E) return PHGMG_ERR_UNSUPPORTED; /* standard form only (see DESCRIPTOR MODELS) */
   if (sys->nl != PHGMG_NL_NONE) return PHGMG_ERR_UNSUPPORTED;
   rc = phgmg_ph_validate(sys, 0.0, NULL, alloc);
   if (rc != PHGMG_OK) return rc;
@@ -12001,6 +12014,7 @@ PHGMG_DEF phgmg_result phgmg_prbt(phgmg_reduced **out, const phgmg_ph_system *sy
   phgmg_result rc;
   if (!out) return PHGMG_ERR_INVALID_ARG;
   *out = NULL;
+  if (sys && sys->E) return PHGMG_ERR_UNSUPPORTED; /* standard form only (see DESCRIPTOR MODELS) */
   if (!sys) return PHGMG_ERR_INVALID_ARG;
   if (sys->nl != PHGMG_NL_NONE) return PHGMG_ERR_UNSUPPORTED;
   if (opts && (opts->eps < 0.0 || opts->dt < 0.0 || !isfinite(opts->eps) || !isfinite(opts->dt) ||
@@ -12088,6 +12102,7 @@ PHGMG_DEF phgmg_result phgmg_prbt_riccati(const phgmg_ph_system *sys, double eps
   double *A, *C, CBn;
   phgmg_result rc;
   if (!sys || !X || !Y) return PHGMG_ERR_INVALID_ARG;
+  if (sys && sys->E) return PHGMG_ERR_UNSUPPORTED; /* standard form only (see DESCRIPTOR MODELS) */
   if (sys->nl != PHGMG_NL_NONE) return PHGMG_ERR_UNSUPPORTED;
   rc = phgmg_ph_validate(sys, 0.0, NULL, alloc);
   if (rc != PHGMG_OK) return rc;
@@ -12730,6 +12745,7 @@ PHGMG_DEF phgmg_result phgmg_linear_basis(const phgmg_ph_system *sys, phgmg_basi
   double *X = NULL;
   phgmg_result rc;
   if (!sys || !V) return PHGMG_ERR_INVALID_ARG;
+  if (sys && sys->E) return PHGMG_ERR_UNSUPPORTED; /* standard form only (see DESCRIPTOR MODELS) */
   if (kind < PHGMG_BASIS_FREQ || kind > PHGMG_BASIS_H2) return PHGMG_ERR_INVALID_ARG;
   if (opts && opts->maxit < 0) return PHGMG_ERR_INVALID_ARG;
   if (sys->nl != PHGMG_NL_NONE) return PHGMG_ERR_UNSUPPORTED;

@@ -363,6 +363,20 @@ static void check_rom_closed_forms(const dbar *b, const phgmg_reduced *red, int 
       dev = fmax(dev, fabs(s - (i == j ? 1.0 : 0.0)));
     }
   CHECK_LE(dev, 1e-8);
+  if (gmg) { /* phgmg_reduced_W: the x-space map W = E^T Wz */
+    double *W = (double *)malloc(sizeof(double) * (size_t)N * r), wn = 0.0;
+    CHECK_RC(phgmg_reduced_W(red, xr0, W, N), PHGMG_OK);
+    dev = 0.0;
+    for (j = 0; j < r; ++j)
+      for (i = 0; i < N; ++i) {
+        double s = 0.0;
+        for (k = 0; k < N; ++k) s += b->E[k + (size_t)i * N] * Wz[k + (size_t)j * N];
+        dev = fmax(dev, fabs(W[i + (size_t)j * N] - s));
+        wn = fmax(wn, fabs(s));
+      }
+    CHECK_LE(dev, 1e-8 * wn);
+    free(W);
+  }
   dev = 0.0;
   for (i = 0; i < r; ++i) /* K = Wz^T (J - R) Wz, Qh = D^T E^T Q D */
     for (j = 0; j < r; ++j) {
