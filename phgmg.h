@@ -79,7 +79,7 @@
             phgmg_ph_hamiltonian, phgmg_ph_gradient, phgmg_ph_rhs, phgmg_ph_output,
             phgmg_ph_apply (J, R or Q times a block), phgmg_jr_factor_create /
             phgmg_jr_solve / phgmg_jr_factor_destroy (apply (J-R)^{-1} or ^{-T}),
-            phgmg_ph_sparse_create / _system / _perm / _sep_idx / _to_banded_order /
+            phgmg_ph_sparse_create / _create_e (with E) / _system / _perm / _sep_idx / _to_banded_order /
             _to_user_order / _destroy (CSC input, reverse Cuthill-McKee, banded),
             phgmg_rcm (the ordering alone)
    gl3:     phgmg_gl3_coefficients, phgmg_gl3_create / _step / _get_stats / _destroy,
@@ -111,6 +111,60 @@
             phgmg_rom_deserialize, phgmg_rom_save, phgmg_rom_load, phgmg_rom_export_c
    npy:     phgmg_npy_parse, phgmg_npy_serialize, phgmg_npy_free, phgmg_npy_read,
             phgmg_npy_write
+
+   DESCRIPTOR MODELS (phgmg_ph_system.E) --------------------------------------
+   Finite-element and network models come as
+       E x' = (J - R) z(x) + B u,   y = B^T z(x),   E^T z(x) = grad H(x),
+   E nonsingular (a consistent mass matrix, dense or banded like J, R, Q).
+   phgmg takes z(x) = Q x + grad H_nl(x) (Q, the separable part as usual) and
+   H(x) = 1/2 x^T E^T Q x + sum_k E(i_k,i_k) w_k phi_k(x[i_k]); E^T Q must be
+   symmetric positive (semi)definite and E's rows at the nonlinear coordinates
+   unit rows times E(i_k,i_k) > 0, so that E^T z is the gradient of this H.
+   Energy: dH/dt = z^T E x' = -z^T R z + y^T u.
+   Simulation: Gauss-Legendre with the mass matrix -- stage equations
+   E (Y_i - x_n) = h sum_j a_ij f(Y_j), Newton matrices sigma E - (J - R) Hess,
+   x_{n+1} = x_n + sum_i d_i (Y_i - x_n), d = b^T A^{-1}; E^{-1} is never
+   formed. GL3 commutes with the linear change of variables x~ = E x, so this is
+   the same scheme as on the standard form, and the energy bookkeeping (stage
+   co-states z(Y_i)) keeps its meaning: H_n - H_0 = S_n - D_n to round-off for
+   a quadratic H.
+   Reduction. In x the model is a standard pH system,
+       x' = (J_E - R_E) grad H(x) + B_E u,  J_E = E^{-1} J E^{-T}, R_E =
+       E^{-1} R E^{-T}, B_E = E^{-1} B,  y = B_E^T grad H(x),
+   (J_E skew, R_E PSD: congruences), with G_E = (J_E - R_E)^{-1} = E^T G E,
+   G = (J - R)^{-1}. Every method is applied to this system without forming
+   it; only m solves with E (B_E) and products with E are needed:
+   - GMG (POD, QM, your manifold): phi(x) = [B_E, V] x (+ V2 eta), V from the
+     POD of X - B_E B_E^+ X. The GMG map W^T = (D^T G_E D)^{-1} D^T G_E gives
+       x' = (D^T G_E D)^{-1} grad Hr(x) + W^T B_E u,   Hr = H o phi,
+     with D^T G_E D = (E D)^T G (E D): the G-blocks are those of today with
+     E V0, E V2 in place of V0, V2 (solves with J - R only); the Q-blocks
+     V0^T E^T Q V0 = (E V0)^T (Q V0), ...; the separable weights become
+     E(i_k,i_k) w_k. W^T B_E = (D^T G_E D)^{-1} (E D)^T G B = [I; 0] because
+     E D's first m columns are B: the port structure and the output
+     yr = Bh^T grad Hr = B^T z(phi(xr)) (exact at the lifted state) are kept.
+     In terms of the descriptor equation this is the Petrov-Galerkin
+     projection with the co-state test basis W_z = E^{-T} W:
+       W_z^T E D xr' = W_z^T [(J - R) z(phi(xr)) + B u],   W_z^T E D = I,
+     so the reduced mass matrix is the identity and the reduced model is the
+     library's standard reduced form (phgmg_rom): export, binary files and the
+     allocation-free stepper are unchanged.
+   - SP1: V = POD of X, Hess H = E^T Q, W = E^T Q V (V^T E^T Q V)^{-1}; with
+     W_z = E^{-T} W = Q V (V^T E^T Q V)^{-1} (no solve): K = W_z^T (J - R) W_z,
+     Bh = W_z^T B, Qh = V^T E^T Q V; again W_z^T E V = I. SP2: the gradient
+     snapshots are grad H(x_j) = E^T z(x_j); W_z = E^{-T} W by r solves.
+   Why the reduced model is port-Hamiltonian: K = W_z^T (J - R) W_z (for GMG
+   this equals (D^T G_E D)^{-1} = W^T (J_E - R_E) W), so its symmetric part
+   -W_z^T R W_z is negative semidefinite and its skew part W_z^T J W_z skew;
+   Hr(xr) = H(phi(xr)) is its energy (Qh = D^T E^T Q D, positive definite when
+   E^T Q is and D has full rank), and dHr/dt = -grad Hr^T Rr grad Hr + yr^T u
+   with the same output structure. tests/test_descriptor.c checks each claim
+   against the reduction of the explicitly formed J_E, R_E, Q_E = E^T Q, B_E
+   and against the closed forms above.
+   Not for descriptor models (PHGMG_ERR_UNSUPPORTED): a GENERAL nonlinear part,
+   the shifted_* callbacks, the linear-systems toolbox (BT, PRBT, Gramian
+   bases, phgmg_ph_abc) and studies. Singular E (algebraic constraints),
+   feedthrough (P, S, N) and nonlinear dissipation are not supported.
 
    OFFLINE / ONLINE, MEMORY, ERRORS -------------------------------------------
    Offline functions (double) take a `const phgmg_allocator *` (NULL = default)
@@ -400,7 +454,7 @@ typedef struct phgmg_ph_system {
      matrix E (N x N, the storage and kb of J, R, Q; nonsingular) the model is
          E x' = (J - R) z(x) + B u,   y = B^T z(x),   E^T z(x) = grad H(x),
      where the co-state z(x) = Q x + grad H_nl(x) is what phgmg_ph_gradient
-     returns and the Hamiltonian is
+     returns (phgmg_ph_rhs gives E x' = (J - R) z + B u) and the Hamiltonian is
          H(x) = 1/2 x^T E^T Q x + sum_k E(i_k, i_k) w_k phi_k(x[i_k]),
      i_k = sep_idx[k] (phgmg_ph_hamiltonian). E^T Q must be symmetric positive
      definite (semidefinite with a nonlinear part) and, for a separable part,
@@ -540,12 +594,19 @@ typedef struct phgmg_ph_sparse_info {
   int kb_rcm;    /* half-bandwidth of the reverse Cuthill-McKee ordering    */
   int permuted;  /* 1: RCM order used, 0: the given order kept (perm = id)  */
   int wide;      /* 1: kb > N/4, banded costs about as much as dense or more */
-  long nnz;      /* stored entries of J, R, Q together                       */
+  long nnz;      /* stored entries of J, R, Q (and E) together              */
 } phgmg_ph_sparse_info;
 PHGMG_DEF phgmg_result phgmg_ph_sparse_create(phgmg_ph_sparse **out, int N, int m, const phgmg_csc *J,
                                               const phgmg_csc *R, const phgmg_csc *Q, const double *B,
                                               const phgmg_csc *Bcsc, phgmg_ph_sparse_info *info,
                                               const phgmg_allocator *alloc);
+/* The same for a descriptor model (phgmg_ph_system.E): E (N x N CSC, the
+   user's ordering) joins J, R, Q in the ordering and the band; E NULL is
+   phgmg_ph_sparse_create. info->nnz counts E's entries too. */
+PHGMG_DEF phgmg_result phgmg_ph_sparse_create_e(phgmg_ph_sparse **out, int N, int m, const phgmg_csc *J,
+                                                const phgmg_csc *R, const phgmg_csc *Q, const phgmg_csc *E,
+                                                const double *B, const phgmg_csc *Bcsc,
+                                                phgmg_ph_sparse_info *info, const phgmg_allocator *alloc);
 /* The banded, permuted system (valid until destroy; NULL for NULL). */
 PHGMG_DEF const phgmg_ph_system *phgmg_ph_sparse_system(const phgmg_ph_sparse *sp);
 /* The permutation (N): internal index i is user index perm[i]; NULL for NULL. */
@@ -4662,6 +4723,7 @@ struct phgmg_ph_sparse {
   const phgmg_allocator *alloc; /* &a or NULL */
   int *perm, *iperm, *sep;
   double *J, *R, *Q, *B;
+  double *E;   /* descriptor models (phgmg_ph_sparse_create_e), else NULL */
 };
 
 PHGMG_DEF void phgmg_ph_sparse_destroy(phgmg_ph_sparse *sp) {
@@ -4675,6 +4737,7 @@ PHGMG_DEF void phgmg_ph_sparse_destroy(phgmg_ph_sparse *sp) {
   phgmg__free(alloc, sp->R);
   phgmg__free(alloc, sp->Q);
   phgmg__free(alloc, sp->B);
+  phgmg__free(alloc, sp->E);
   phgmg__free(alloc, sp);
 }
 
@@ -4690,16 +4753,16 @@ PHGMG__PRIV void phgmg__csc_to_band(const phgmg_csc *A, const int *ip, int kb, d
 }
 
 /* Argument and data checks of phgmg_ph_sparse_create. */
-PHGMG__PRIV phgmg_result phgmg__ph_sparse_check(int N, int m, const phgmg_csc *const *A, const double *B,
+PHGMG__PRIV phgmg_result phgmg__ph_sparse_check(int N, int m, const phgmg_csc *const *A, int na, const double *B,
                                                 const phgmg_csc *Bcsc) {
   int a;
   phgmg_result rc;
   if (!A[0] || !A[1] || !A[2] || (!B && !Bcsc)) return PHGMG_ERR_INVALID_ARG;
   if (N < 1 || m < 1 || m > N) return PHGMG_ERR_SIZE;
-  for (a = 0; a < 3; ++a)
+  for (a = 0; a < na; ++a)
     if ((rc = phgmg__csc_check(A[a], N, N)) != PHGMG_OK) return rc;
   if (!B && (rc = phgmg__csc_check(Bcsc, N, m)) != PHGMG_OK) return rc;
-  for (a = 0; a < 3; ++a)
+  for (a = 0; a < na; ++a)
     if (!phgmg__all_finite(A[a]->values, (size_t)A[a]->colptr[N])) return PHGMG_ERR_NANINF;
   if (B ? !phgmg__all_finite(B, (size_t)N * (size_t)m)
         : !phgmg__all_finite(Bcsc->values, (size_t)Bcsc->colptr[m]))
@@ -4711,16 +4774,24 @@ PHGMG_DEF phgmg_result phgmg_ph_sparse_create(phgmg_ph_sparse **out, int N, int 
                                               const phgmg_csc *R, const phgmg_csc *Q, const double *B,
                                               const phgmg_csc *Bcsc, phgmg_ph_sparse_info *info,
                                               const phgmg_allocator *alloc) {
-  const phgmg_csc *A[3];
+  return phgmg_ph_sparse_create_e(out, N, m, J, R, Q, NULL, B, Bcsc, info, alloc);
+}
+
+PHGMG_DEF phgmg_result phgmg_ph_sparse_create_e(phgmg_ph_sparse **out, int N, int m, const phgmg_csc *J,
+                                                const phgmg_csc *R, const phgmg_csc *Q, const phgmg_csc *E,
+                                                const double *B, const phgmg_csc *Bcsc,
+                                                phgmg_ph_sparse_info *info, const phgmg_allocator *alloc) {
+  const phgmg_csc *A[4];
+  const int na = E ? 4 : 3;
   phgmg_ph_sparse *sp;
   phgmg_result rc;
   int a, i, j, kb_in = 0, kb_rcm = 0, kb;
   size_t len;
-  A[0] = J; A[1] = R; A[2] = Q;
+  A[0] = J; A[1] = R; A[2] = Q; A[3] = E;
   if (info) memset(info, 0, sizeof *info);
   if (!out) return PHGMG_ERR_INVALID_ARG;
   *out = NULL;
-  if ((rc = phgmg__ph_sparse_check(N, m, A, B, Bcsc)) != PHGMG_OK) return rc;
+  if ((rc = phgmg__ph_sparse_check(N, m, A, na, B, Bcsc)) != PHGMG_OK) return rc;
   sp = PHGMG__CAST(phgmg_ph_sparse *, phgmg__alloc(alloc, sizeof *sp));
   if (!sp) return PHGMG_ERR_NOMEM;
   memset(sp, 0, sizeof *sp);
@@ -4728,9 +4799,9 @@ PHGMG_DEF phgmg_result phgmg_ph_sparse_create(phgmg_ph_sparse **out, int N, int 
   sp->perm = phgmg__ialloc(alloc, (size_t)N);
   sp->iperm = phgmg__ialloc(alloc, (size_t)N);
   if (!sp->perm || !sp->iperm) { phgmg_ph_sparse_destroy(sp); return PHGMG_ERR_NOMEM; }
-  rc = phgmg_rcm(N, 3, A, sp->perm, &kb_rcm, alloc);
+  rc = phgmg_rcm(N, na, A, sp->perm, &kb_rcm, alloc);
   if (rc != PHGMG_OK) { phgmg_ph_sparse_destroy(sp); return rc; }
-  for (a = 0; a < 3; ++a) {
+  for (a = 0; a < na; ++a) {
     int k = phgmg__csc_bandwidth(A[a], NULL);
     if (k > kb_in) kb_in = k;
   }
@@ -4750,6 +4821,12 @@ PHGMG_DEF phgmg_result phgmg_ph_sparse_create(phgmg_ph_sparse **out, int N, int 
   phgmg__csc_to_band(J, sp->iperm, kb, sp->J);
   phgmg__csc_to_band(R, sp->iperm, kb, sp->R);
   phgmg__csc_to_band(Q, sp->iperm, kb, sp->Q);
+  if (E) {
+    sp->E = phgmg__dalloc(alloc, len);
+    if (!sp->E) { phgmg_ph_sparse_destroy(sp); return PHGMG_ERR_NOMEM; }
+    memset(sp->E, 0, sizeof(double) * len);
+    phgmg__csc_to_band(E, sp->iperm, kb, sp->E);
+  }
   if (B) {
     for (j = 0; j < m; ++j)
       for (i = 0; i < N; ++i) sp->B[i + (size_t)j * N] = B[sp->perm[i] + (size_t)j * N];
@@ -4765,6 +4842,7 @@ PHGMG_DEF phgmg_result phgmg_ph_sparse_create(phgmg_ph_sparse **out, int N, int 
   sp->sys.storage = PHGMG_BANDED;
   sp->sys.kb = kb;
   sp->sys.J = sp->J; sp->sys.R = sp->R; sp->sys.Q = sp->Q; sp->sys.B = sp->B;
+  sp->sys.E = sp->E;
   sp->sys.nl = PHGMG_NL_NONE;
   if (info) {
     info->kb = kb;
@@ -4772,7 +4850,7 @@ PHGMG_DEF phgmg_result phgmg_ph_sparse_create(phgmg_ph_sparse **out, int N, int 
     info->kb_rcm = kb_rcm;
     info->permuted = kb_rcm < kb_in;
     info->wide = 4 * (long)kb > (long)N;
-    info->nnz = (long)J->colptr[N] + (long)R->colptr[N] + (long)Q->colptr[N];
+    info->nnz = (long)J->colptr[N] + (long)R->colptr[N] + (long)Q->colptr[N] + (E ? (long)E->colptr[N] : 0L);
   }
   *out = sp;
   return PHGMG_OK;

@@ -285,6 +285,76 @@ TEST(test_descriptor_bad_input) {
   dbar_free(&b);
 }
 
+/* CSC of P^T A P for a dense N x N A (perm: new index i is old perm[i]). */
+typedef struct dcsc { phgmg_csc A; int *cp, *ri; double *v; } dcsc;
+static void dcsc_make(dcsc *c, int N, const double *A, const int *perm) {
+  int i, j, nz = 0;
+  c->cp = (int *)malloc(sizeof(int) * (size_t)(N + 1));
+  c->ri = (int *)malloc(sizeof(int) * (size_t)N * N);
+  c->v = (double *)malloc(sizeof(double) * (size_t)N * N);
+  c->cp[0] = 0;
+  for (j = 0; j < N; ++j) {
+    for (i = 0; i < N; ++i) {
+      double a = A[perm[i] + (size_t)perm[j] * N];
+      if (a != 0.0) { c->ri[nz] = i; c->v[nz++] = a; }
+    }
+    c->cp[j + 1] = nz;
+  }
+  c->A.n_rows = c->A.n_cols = N; c->A.colptr = c->cp; c->A.rowidx = c->ri; c->A.values = c->v;
+}
+static void dcsc_free(dcsc *c) { free(c->cp); free(c->ri); free(c->v); }
+
+/* The bar given as CSC in a scrambled ordering (phgmg_ph_sparse_create_e):
+   reverse Cuthill-McKee brings it back to a narrow band; the banded
+   simulation in the internal order, mapped back, equals the dense one. */
+TEST(test_descriptor_sparse_scrambled) {
+  dbar b;
+  const int n = 25, ns = 100;
+  const double dt = 0.05;
+  phgmg_ph_system sd, sp_sys;
+  phgmg_ph_sparse *sp = NULL;
+  phgmg_ph_sparse_info inf;
+  dcsc cE, cJ, cR, cQ;
+  double *Bp, *X, *XU, *XI, *Y, *Yi, emax = 0.0;
+  int N, perm[64], i, j, k;
+  dbar_make(&b, n);
+  N = b.N;
+  for (i = 0; i < N; ++i) perm[i] = i;
+  for (i = N - 1; i > 0; --i) { j = (int)((th_rand() + 1.0) * 0.5 * (i + 1)); if (j > i) j = i; k = perm[i]; perm[i] = perm[j]; perm[j] = k; }
+  dcsc_make(&cE, N, b.E, perm); dcsc_make(&cJ, N, b.J, perm); dcsc_make(&cR, N, b.R, perm); dcsc_make(&cQ, N, b.Q, perm);
+  Bp = (double *)malloc(sizeof(double) * (size_t)N * 2);
+  for (j = 0; j < 2; ++j) for (i = 0; i < N; ++i) Bp[i + (size_t)j * N] = b.B[perm[i] + (size_t)j * N];
+  X = (double *)calloc((size_t)N * (ns + 1), sizeof(double));
+  XU = (double *)calloc((size_t)N * (ns + 1), sizeof(double));
+  XI = (double *)calloc((size_t)N * (ns + 1), sizeof(double));
+  Y = (double *)calloc((size_t)2 * (ns + 1), sizeof(double));
+  Yi = (double *)calloc((size_t)2 * (ns + 1), sizeof(double));
+  CHECK_RC(phgmg_ph_sparse_create_e(&sp, N, 2, &cJ.A, &cR.A, &cQ.A, &cE.A, Bp, NULL, &inf, NULL), PHGMG_OK);
+  if (sp) {
+    phgmg_gl3_opts go;
+    memset(&go, 0, sizeof go);
+    go.tol = 1e-13;
+    sp_sys = *phgmg_ph_sparse_system(sp);
+    CHECK(sp_sys.E != NULL);
+    CHECK(inf.kb < N / 2);
+    CHECK_RC(phgmg_ph_validate(&sp_sys, 0.0, NULL, NULL), PHGMG_OK);
+    sd = dbar_system(&b, 0);
+    CHECK_RC(phgmg_simulate(&sd, X, 0.0, dt, ns, dbar_input, NULL, &go, X, Y, NULL, NULL, NULL, NULL), PHGMG_OK);
+    CHECK_RC(phgmg_simulate(&sp_sys, XI, 0.0, dt, ns, dbar_input, NULL, &go, XI, Yi, NULL, NULL, NULL, NULL), PHGMG_OK);
+    phgmg_ph_sparse_to_user_order(sp, ns + 1, XI, N, XU, N);   /* the scrambled user order */
+    for (k = 0; k <= ns; ++k)
+      for (i = 0; i < N; ++i) emax = fmax(emax, fabs(XU[i + (size_t)k * N] - X[perm[i] + (size_t)k * N]));
+    CHECK_LE(emax, 1e-10 * max_abs((size_t)N * (ns + 1), X));
+    emax = 0.0;
+    for (k = 0; k < 2 * (ns + 1); ++k) emax = fmax(emax, fabs(Y[k] - Yi[k]));
+    CHECK_LE(emax, 1e-10 * max_abs((size_t)2 * (ns + 1), Y));
+  }
+  phgmg_ph_sparse_destroy(sp);
+  dcsc_free(&cE); dcsc_free(&cJ); dcsc_free(&cR); dcsc_free(&cQ);
+  free(Bp); free(X); free(XU); free(XI); free(Y); free(Yi);
+  dbar_free(&b);
+}
+
 /* ---- reduced models ------------------------------------------------------------- */
 static double rel_err_y(int m, int ns, const double *Y, const double *Yr) {
   double a = 0.0, d = 0.0;
@@ -502,5 +572,6 @@ SUITE(descriptor) {
   RUN(test_descriptor_fom_nonlinear);
   RUN(test_descriptor_hamiltonian);
   RUN(test_descriptor_bad_input);
+  RUN(test_descriptor_sparse_scrambled);
   RUN(test_descriptor_reduce);
 }
