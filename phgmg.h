@@ -242,13 +242,14 @@ extern "C" {
   X(PHGMG_ERR_E_SINGULAR,      -22, "the mass matrix E is singular to working precision") \
   X(PHGMG_ERR_EQ_NOT_SYMMETRIC, -23, "E^T Q is not symmetric (descriptor model)")          \
   X(PHGMG_ERR_EQ_NOT_PD,       -24, "E^T Q is not positive definite (semidefinite for a nonlinear H)") \
-  X(PHGMG_ERR_E_COUPLED,       -25, "a row of E at a nonlinear coordinate is not a positive multiple of the unit row")
+  X(PHGMG_ERR_E_COUPLED,       -25, "a row of E at a nonlinear coordinate is not a positive multiple of the unit row") \
+  X(PHGMG_ERR_FEEDTHROUGH,     -26, "feedthrough: [[R, P], [P^T, S]] not symmetric positive semidefinite or N not skew")
 
 typedef enum phgmg_result {
 #define PHGMG__X(name, val, str) name = val,
   PHGMG__RESULT_LIST(PHGMG__X)
 #undef PHGMG__X
-  PHGMG__RESULT_END_ = -26
+  PHGMG__RESULT_END_ = -27
 } phgmg_result;
 
 /* A stable, human-readable description of a result code (never NULL). */
@@ -465,6 +466,15 @@ typedef struct phgmg_ph_system {
      its Newton matrices (sigma E - (J - R) Hess) and stage residuals. See
      DESCRIPTOR MODELS in the manual at the top for the reduction. */
   const double *E;
+  /* Feedthrough (each NULL = 0): P (N x m, ld N), S (m x m, symmetric), Nskew
+     (m x m, skew), column-major:
+         E x' = (J - R) z + (B - P) u,   y = (B + P)^T z + (S + Nskew) u,
+     with the dissipation block [[R, P], [P^T, S]] positive semidefinite, so
+     that dH/dt = y^T u - [z; u]^T [[R, P], [P^T, S]] [z; u] <= y^T u. The full
+     model (validation, stepper, outputs and energy of phgmg_simulate) takes
+     them; phgmg_ph_output gives (B + P)^T z only (it has no u). Reductions of
+     a model with feedthrough are not supported (PHGMG_ERR_UNSUPPORTED). */
+  const double *P, *S, *Nskew;
 } phgmg_ph_system;
 
 /* Validation of a system. tol (<= 0: 1e-12) is relative to the matrix norms:
@@ -3815,6 +3825,8 @@ PHGMG_DEF void phgmg_ph_rhs(const phgmg_ph_system *sys, const double *x, const d
     for (j = 0; j < sys->m; ++j) {
       const double *bj = sys->B + (size_t)j * (size_t)N;
       for (i = 0; i < N; ++i) f[i] += bj[i] * u[j];
+      if (sys->P)
+        for (i = 0; i < N; ++i) f[i] -= sys->P[(size_t)i + (size_t)j * (size_t)N] * u[j];
     }
   phgmg__free(NULL, tmp);
   phgmg__ph_scratch_free(g, sb);
@@ -3836,6 +3848,8 @@ PHGMG_DEF void phgmg_ph_output(const phgmg_ph_system *sys, const double *x, doub
     const double *bj = sys->B + (size_t)j * (size_t)N;
     double acc = 0.0;
     for (i = 0; i < N; ++i) acc += bj[i] * g[i];
+    if (sys->P)
+      for (i = 0; i < N; ++i) acc += sys->P[(size_t)i + (size_t)j * (size_t)N] * g[i];
     y[j] = acc;
   }
   phgmg__free(NULL, tmp);
@@ -4458,6 +4472,50 @@ PHGMG__PRIV phgmg_result phgmg__ph_validate_e(const phgmg_ph_system *sys, double
   return rc == PHGMG_OK && rcond > tol ? PHGMG_OK : PHGMG_ERR_E_SINGULAR;
 }
 
+/* Feedthrough: P, S, N finite, N skew, S symmetric and [[R, P], [P^T, S]]
+   positive semidefinite (smallest eigenvalue >= -tol times the largest
+   magnitude; dense eigenvalues of the (N + m) block, so banded models with
+   N > PHGMG__PH_PSD_DENSE_MAX are not checked: PHGMG_ERR_UNSUPPORTED). */
+PHGMG__PRIV phgmg_result phgmg__ph_validate_feedthrough(const phgmg_ph_system *sys, double tol,
+                                                        const phgmg_allocator *alloc) {
+  const int N = sys->N, m = sys->m, n = N + m;
+  double *A, *w, a = 0.0, d = 0.0;
+  int i, j;
+  phgmg_result rc;
+  if ((sys->P && !phgmg__all_finite(sys->P, (size_t)N * m)) || (sys->S && !phgmg__all_finite(sys->S, (size_t)m * m)) ||
+      (sys->Nskew && !phgmg__all_finite(sys->Nskew, (size_t)m * m)))
+    return PHGMG_ERR_NANINF;
+  for (j = 0; sys->Nskew && j < m; ++j)
+    for (i = 0; i < m; ++i) {
+      const double v = sys->Nskew[i + (size_t)j * m], e = v + sys->Nskew[j + (size_t)i * m];
+      a += v * v; d += e * e;
+    }
+  if (sqrt(d) > tol * sqrt(a)) return PHGMG_ERR_FEEDTHROUGH;
+  if (sys->storage == PHGMG_BANDED && N > PHGMG__PH_PSD_DENSE_MAX) return PHGMG_ERR_UNSUPPORTED;
+  A = phgmg__dalloc(alloc, (size_t)n * n);
+  w = phgmg__dalloc(alloc, (size_t)n);
+  if (!A || !w) { phgmg__free(alloc, A); phgmg__free(alloc, w); return PHGMG_ERR_NOMEM; }
+  for (j = 0; j < n; ++j)
+    for (i = 0; i < n; ++i) {
+      double v;
+      if (i < N && j < N) v = phgmg__ph_at(sys, sys->R, i, j);
+      else if (i < N) v = sys->P ? sys->P[i + (size_t)(j - N) * N] : 0.0;
+      else if (j < N) v = sys->P ? sys->P[j + (size_t)(i - N) * N] : 0.0;
+      else v = sys->S ? sys->S[(i - N) + (size_t)(j - N) * m] : 0.0;
+      A[i + (size_t)j * n] = v;
+    }
+  for (j = 0, a = d = 0.0; sys->S && j < m; ++j)   /* S symmetric */
+    for (i = 0; i < m; ++i) {
+      const double v = sys->S[i + (size_t)j * m], e = v - sys->S[j + (size_t)i * m];
+      a += v * v; d += e * e;
+    }
+  rc = sqrt(d) > tol * sqrt(a) ? PHGMG_ERR_FEEDTHROUGH : phgmg_sym_eig(n, A, n, w, NULL, 0);
+  if (rc == PHGMG_OK && w[0] < -tol * PHGMG__MAX(fabs(w[0]), fabs(w[n - 1]))) rc = PHGMG_ERR_FEEDTHROUGH;
+  phgmg__free(alloc, A);
+  phgmg__free(alloc, w);
+  return rc;
+}
+
 PHGMG_DEF phgmg_result phgmg_ph_validate(const phgmg_ph_system *sys, double tol,
                                          double *rcond_out, const phgmg_allocator *alloc) {
   phgmg_result rc;
@@ -4484,6 +4542,11 @@ PHGMG_DEF phgmg_result phgmg_ph_validate(const phgmg_ph_system *sys, double tol,
   if (def > tol * nrm) return PHGMG_ERR_NOT_SKEW;
   phgmg__ph_sym_defect(sys, sys->R, -1.0, &nrm, &def);
   if (def > tol * nrm) return PHGMG_ERR_NOT_SYMMETRIC;
+  if (sys->P || sys->S || sys->Nskew) {
+    rc = phgmg__ph_check_psd(sys, tol, alloc);
+    if (rc == PHGMG_OK) rc = phgmg__ph_validate_feedthrough(sys, tol, alloc);
+    if (rc != PHGMG_OK) return rc;
+  }
   if (sys->E) {   /* descriptor: E^T Q takes the place of Q */
     rc = phgmg__ph_check_psd(sys, tol, alloc);
     if (rc == PHGMG_OK) rc = phgmg__ph_validate_e(sys, tol, alloc);
@@ -5186,6 +5249,9 @@ struct phgmg_gl3 {
   /* descriptor (sys.E set): E times the stage block (3N), E's diagonals (banded) */
   double *EZ;
   phgmg__dia de;
+  /* feedthrough (sys.P set): sys.B of this copy is B - P (the input matrix of
+     the state equation), Bout = B + P that of the output (NULL: B) */
+  double *Bin, *Bout;
 };
 
 PHGMG_DEF void phgmg_gl3_destroy(phgmg_gl3 *s) {
@@ -5212,6 +5278,8 @@ PHGMG_DEF void phgmg_gl3_destroy(phgmg_gl3 *s) {
   phgmg__free(&al, s->tmp);
   phgmg__free(&al, s->EZ);
   phgmg__dia_free(&al, &s->de);
+  phgmg__free(&al, s->Bin);
+  phgmg__free(&al, s->Bout);
   phgmg__free(&al, s);
 }
 
@@ -5588,6 +5656,23 @@ PHGMG__PRIV phgmg_result phgmg__gl3_setup_buffers(phgmg_gl3 *s) {
   return PHGMG_OK;
 }
 
+/* Feedthrough P: the stepper's copy of the system takes B - P as its input
+   matrix (every right-hand side path and the step map then use it); B + P
+   is kept for the outputs of the energy bookkeeping. */
+PHGMG__PRIV phgmg_result phgmg__gl3_setup_feedthrough(phgmg_gl3 *s) {
+  const size_t n = (size_t)s->N * (size_t)s->m;
+  size_t i;
+  s->Bin = phgmg__dalloc(&s->al, n);
+  s->Bout = phgmg__dalloc(&s->al, n);
+  if (!s->Bin || !s->Bout) return PHGMG_ERR_NOMEM;
+  for (i = 0; i < n; ++i) {
+    s->Bin[i] = s->sys.B[i] - s->sys.P[i];
+    s->Bout[i] = s->sys.B[i] + s->sys.P[i];
+  }
+  s->sys.B = s->Bin;
+  return PHGMG_OK;
+}
+
 PHGMG_DEF phgmg_result phgmg_gl3_create(phgmg_gl3 **out, const phgmg_ph_system *sys, double dt,
                                         const phgmg_gl3_opts *opts, const phgmg_allocator *alloc) {
   phgmg_gl3 *s;
@@ -5615,6 +5700,10 @@ PHGMG_DEF phgmg_result phgmg_gl3_create(phgmg_gl3 **out, const phgmg_ph_system *
   s->flush = !(opts && opts->keep_tiny);
   s->ftau = s->flush ? PHGMG__DBL_MIN : 0.0;
   s->linear = sys->nl == PHGMG_NL_NONE;
+  if (sys->P && phgmg__gl3_setup_feedthrough(s) != PHGMG_OK) {
+    phgmg_gl3_destroy(s);
+    return PHGMG_ERR_NOMEM;
+  }
   phgmg__gl3_setup_method(s, opts);
   s->U = phgmg__dalloc(&s->al, 3 * (size_t)s->m);
   s->G = phgmg__dalloc(&s->al, 3 * (size_t)s->N);
@@ -6135,11 +6224,43 @@ PHGMG__PRIV phgmg_result phgmg__gl3_newton(phgmg_gl3 *s, const double *x, int fr
   }
 }
 
+/* The same with feedthrough: y_i = (B + P)^T z_i + (S + N) u_i supplied,
+   [z; u]^T [[R, P], [P^T, S]] [z; u] = z^T R z + 2 z^T P u + u^T S u dissipated. */
+PHGMG__PRIV void phgmg__gl3_energy_feedthrough(phgmg_gl3 *s, double energy_inc[2]) {
+  const phgmg_ph_system *sys = &s->sys;
+  const int N = s->N, m = s->m;
+  const double *Bo = s->Bout ? s->Bout : sys->B;
+  int st, k, l, i;
+  double sup = 0.0, dis = 0.0;
+  for (st = 0; st < 3; ++st) {
+    const double *g = s->G + (size_t)st * (size_t)N, *u = s->U + (size_t)st * (size_t)m;
+    double yu = 0.0, d = phgmg__ph_quad(sys, sys->R, g, g);
+    for (k = 0; k < m; ++k) {
+      double yk = 0.0, pk = 0.0;
+      for (i = 0; i < N; ++i) yk += Bo[(size_t)i + (size_t)k * (size_t)N] * g[i];
+      if (sys->P)
+        for (i = 0; i < N; ++i) pk += sys->P[(size_t)i + (size_t)k * (size_t)N] * g[i];
+      for (l = 0; l < m; ++l) {
+        const double sk = sys->S ? sys->S[k + (size_t)l * m] : 0.0, nk = sys->Nskew ? sys->Nskew[k + (size_t)l * m] : 0.0;
+        yk += (sk + nk) * u[l];
+        d += u[k] * sk * u[l];
+      }
+      yu += yk * u[k];
+      d += 2.0 * pk * u[k];
+    }
+    sup += s->b[st] * yu;
+    dis += s->b[st] * d;
+  }
+  energy_inc[0] = s->h * sup;
+  energy_inc[1] = s->h * dis;
+}
+
 /* Supplied and dissipated energy over a step from the stage gradients s->G. */
 PHGMG__PRIV void phgmg__gl3_energy(phgmg_gl3 *s, double energy_inc[2]) {
   const phgmg_ph_system *sys = &s->sys;
   int N = s->N, m = s->m, st, k, i;
   double sup = 0.0, dis = 0.0;
+  if (sys->P || sys->S || sys->Nskew) { phgmg__gl3_energy_feedthrough(s, energy_inc); return; }
   for (st = 0; st < 3; ++st) {
     const double *g = s->G + (size_t)st * (size_t)N, *u = s->U + (size_t)st * (size_t)m;
     double yu = 0.0;
@@ -6276,6 +6397,23 @@ PHGMG_DEF phgmg_result phgmg_gl3_step(phgmg_gl3 *s, double t, double *x, phgmg_i
   return PHGMG_OK;
 }
 
+/* Feedthrough part of the output: y += P^T z + (S + N) u(t) (u into tmp, m). */
+PHGMG__PRIV void phgmg__output_feedthrough(const phgmg_ph_system *sys, const double *z, double t, phgmg_input_fn uf,
+                                          void *uuser, double *tmp, double *y) {
+  const int N = sys->N, m = sys->m;
+  int k, l, i;
+  if (uf) uf(t, tmp, uuser);
+  else for (k = 0; k < m; ++k) tmp[k] = 0.0;
+  for (k = 0; k < m; ++k) {
+    double acc = 0.0;
+    if (sys->P)
+      for (i = 0; i < N; ++i) acc += sys->P[(size_t)i + (size_t)k * (size_t)N] * z[i];
+    for (l = 0; l < m; ++l)
+      acc += ((sys->S ? sys->S[k + (size_t)l * m] : 0.0) + (sys->Nskew ? sys->Nskew[k + (size_t)l * m] : 0.0)) * tmp[l];
+    y[k] += acc;
+  }
+}
+
 PHGMG_DEF phgmg_result phgmg_simulate(const phgmg_ph_system *sys, const double *x0, double t0,
                                       double dt, int nsteps, phgmg_input_fn uf, void *uuser,
                                       const phgmg_gl3_opts *opts, double *X, double *Y,
@@ -6309,6 +6447,8 @@ PHGMG_DEF phgmg_result phgmg_simulate(const phgmg_ph_system *sys, const double *
         for (i = 0; i < N; ++i) acc += bk[i] * g[i];
         Y[(size_t)k + (size_t)n * (size_t)m] = acc;
       }
+      if (sys->P || sys->S || sys->Nskew)
+        phgmg__output_feedthrough(sys, g, t0 + (double)n * dt, uf, uuser, tmp, Y + (size_t)n * (size_t)m);
     }
     if (energy) {
       energy->H[n] = phgmg_ph_hamiltonian(sys, x);
@@ -9062,6 +9202,7 @@ PHGMG__PRIV phgmg_result phgmg__reduce_check(const phgmg_ph_system *sys, const d
   if (o->hyper < PHGMG_HYPER_ECSW || o->hyper > PHGMG_HYPER_GREEDY) return PHGMG_ERR_INVALID_ARG;
   if (!(o->hyper_tol >= 0.0 && o->hyper_tol < 1.0)) return PHGMG_ERR_INVALID_ARG;
   if (o->deim && sys->nl == PHGMG_NL_GENERAL) return PHGMG_ERR_UNSUPPORTED;
+  if (sys->P || sys->S || sys->Nskew) return PHGMG_ERR_UNSUPPORTED;   /* feedthrough: full model only */
   if (!(o->deim_tol >= 0.0 && o->deim_tol < 1.0) || o->deim_max < 0) return PHGMG_ERR_INVALID_ARG;
   if (!(o->dt >= 0.0) || o->dt == HUGE_VAL) return PHGMG_ERR_INVALID_ARG;
   if (o->lambda != o->lambda || !(o->degeneracy_tol >= 0.0 && o->degeneracy_tol < 1.0)) return PHGMG_ERR_INVALID_ARG;
@@ -11233,7 +11374,7 @@ PHGMG_DEF phgmg_result phgmg_study_create(phgmg_study **out, const phgmg_ph_syst
   phgmg_result rc;
   if (!out) return PHGMG_ERR_INVALID_ARG;
   *out = NULL;
-  if (sys && sys->E) return PHGMG_ERR_UNSUPPORTED; /* standard form only (see DESCRIPTOR MODELS) */
+  if (sys && (sys->E || sys->P || sys->S || sys->Nskew)) return PHGMG_ERR_UNSUPPORTED; /* standard form only */
   if (!sys || !X || !so) return PHGMG_ERR_INVALID_ARG;
   what = so->what ? so->what : (PHGMG_STUDY_GMG | PHGMG_STUDY_SP);
   if (what & PHGMG_STUDY_SP2) what |= PHGMG_STUDY_SP;
@@ -11572,7 +11713,7 @@ PHGMG_DEF phgmg_result phgmg_ph_abc(const phgmg_ph_system *sys, double *A, doubl
   int N, m, i;
   double *I, *Qd, *T;
   if (!sys) return PHGMG_ERR_INVALID_ARG;
-  if (sys && sys->E) return PHGMG_ERR_UNSUPPORTED; /* standard form only (see DESCRIPTOR MODELS) */
+  if (sys && (sys->E || sys->P || sys->S || sys->Nskew)) return PHGMG_ERR_UNSUPPORTED; /* standard form only */
   if (sys->nl != PHGMG_NL_NONE) return PHGMG_ERR_UNSUPPORTED;
   N = sys->N; m = sys->m;
   if (N < 1 || m < 1 || m > N) return PHGMG_ERR_SIZE;
@@ -11689,7 +11830,7 @@ PHGMG_DEF phgmg_result phgmg_bt(const phgmg_ph_system *sys, int r, double *Ar, d
   double *A, *C, *P, *O, *Tb, *Wb, *S;
   phgmg_result rc;
   if (!sys || !Ar || !Br || !Cr) return PHGMG_ERR_INVALID_ARG;
-  if (sys && sys->E) return PHGMG_ERR_UNSUPPORTED; /* standard form only (see DESCRIPTOR MODELS) */
+  if (sys && (sys->E || sys->P || sys->S || sys->Nskew)) return PHGMG_ERR_UNSUPPORTED; /* standard form only */
   if (sys->nl != PHGMG_NL_NONE) return PHGMG_ERR_UNSUPPORTED;
   rc = phgmg_ph_validate(sys, 0.0, NULL, alloc);
   if (rc != PHGMG_OK) return rc;
@@ -12092,7 +12233,7 @@ PHGMG_DEF phgmg_result phgmg_prbt(phgmg_reduced **out, const phgmg_ph_system *sy
   phgmg_result rc;
   if (!out) return PHGMG_ERR_INVALID_ARG;
   *out = NULL;
-  if (sys && sys->E) return PHGMG_ERR_UNSUPPORTED; /* standard form only (see DESCRIPTOR MODELS) */
+  if (sys && (sys->E || sys->P || sys->S || sys->Nskew)) return PHGMG_ERR_UNSUPPORTED; /* standard form only */
   if (!sys) return PHGMG_ERR_INVALID_ARG;
   if (sys->nl != PHGMG_NL_NONE) return PHGMG_ERR_UNSUPPORTED;
   if (opts && (opts->eps < 0.0 || opts->dt < 0.0 || !isfinite(opts->eps) || !isfinite(opts->dt) ||
@@ -12180,7 +12321,7 @@ PHGMG_DEF phgmg_result phgmg_prbt_riccati(const phgmg_ph_system *sys, double eps
   double *A, *C, CBn;
   phgmg_result rc;
   if (!sys || !X || !Y) return PHGMG_ERR_INVALID_ARG;
-  if (sys && sys->E) return PHGMG_ERR_UNSUPPORTED; /* standard form only (see DESCRIPTOR MODELS) */
+  if (sys && (sys->E || sys->P || sys->S || sys->Nskew)) return PHGMG_ERR_UNSUPPORTED; /* standard form only */
   if (sys->nl != PHGMG_NL_NONE) return PHGMG_ERR_UNSUPPORTED;
   rc = phgmg_ph_validate(sys, 0.0, NULL, alloc);
   if (rc != PHGMG_OK) return rc;
@@ -12823,7 +12964,7 @@ PHGMG_DEF phgmg_result phgmg_linear_basis(const phgmg_ph_system *sys, phgmg_basi
   double *X = NULL;
   phgmg_result rc;
   if (!sys || !V) return PHGMG_ERR_INVALID_ARG;
-  if (sys && sys->E) return PHGMG_ERR_UNSUPPORTED; /* standard form only (see DESCRIPTOR MODELS) */
+  if (sys && (sys->E || sys->P || sys->S || sys->Nskew)) return PHGMG_ERR_UNSUPPORTED; /* standard form only */
   if (kind < PHGMG_BASIS_FREQ || kind > PHGMG_BASIS_H2) return PHGMG_ERR_INVALID_ARG;
   if (opts && opts->maxit < 0) return PHGMG_ERR_INVALID_ARG;
   if (sys->nl != PHGMG_NL_NONE) return PHGMG_ERR_UNSUPPORTED;

@@ -355,6 +355,84 @@ TEST(test_descriptor_sparse_scrambled) {
   dbar_free(&b);
 }
 
+/* Feedthrough P, S, N on the descriptor bar: P = R C (so P^T R^+ P = C^T R C),
+   S = C^T R C + 0.1 I, N skew. Against the independent forms: the states of
+   the model without feedthrough and input matrix B - P (bit for bit: the same
+   arithmetic), outputs (B + P)^T z + (S + N) u formed here, and the discrete
+   energy balance H_n - H_0 = S_n - D_n with supply y^T u and dissipation
+   [z; u]^T [[R, P], [P^T, S]] [z; u] to round-off (quadratic H). Bad blocks
+   get PHGMG_ERR_FEEDTHROUGH; a reduction PHGMG_ERR_UNSUPPORTED. */
+TEST(test_descriptor_feedthrough) {
+  dbar b;
+  const int n = 10, ns = 150;
+  const double dt = 0.05;
+  phgmg_ph_system sf, sb;
+  phgmg_energy en;
+  phgmg_reduce_opts o;
+  phgmg_reduced *red = (phgmg_reduced *)1;
+  double *C, *P, *Bm, *X, *Xb, *Y, z[64], u[2], S[4], Nk[4] = {0.0, -0.3, 0.3, 0.0}, Hn[151], Sn[151], Dn[151];
+  double emax = 0.0, hmax = 0.0, ymax = 0.0;
+  int N, i, j, k;
+  dbar_make(&b, n);
+  N = b.N;
+  C = (double *)malloc(sizeof(double) * (size_t)N * 2); P = (double *)calloc((size_t)N * 2, sizeof(double));
+  Bm = (double *)malloc(sizeof(double) * (size_t)N * 2);
+  X = (double *)calloc((size_t)N * (ns + 1), sizeof(double)); Xb = (double *)calloc((size_t)N * (ns + 1), sizeof(double));
+  Y = (double *)calloc((size_t)2 * (ns + 1), sizeof(double));
+  for (k = 0; k < N * 2; ++k) C[k] = 0.5 * th_rand();
+  for (j = 0; j < 2; ++j)
+    for (i = 0; i < N; ++i)
+      for (k = 0; k < N; ++k) P[i + (size_t)j * N] += b.R[i + (size_t)k * N] * C[k + (size_t)j * N];
+  for (j = 0; j < 2; ++j)
+    for (i = 0; i < 2; ++i) {
+      double acc = i == j ? 0.1 : 0.0;
+      for (k = 0; k < N; ++k) acc += C[k + (size_t)i * N] * P[k + (size_t)j * N];
+      S[i + 2 * j] = acc;
+    }
+  S[2] = S[1] = 0.5 * (S[1] + S[2]);
+  for (k = 0; k < N * 2; ++k) Bm[k] = b.B[k] - P[k];
+  sf = dbar_system(&b, 0); sf.P = P; sf.S = S; sf.Nskew = Nk;
+  sb = dbar_system(&b, 0); sb.B = Bm;
+  CHECK_RC(phgmg_ph_validate(&sf, 0.0, NULL, NULL), PHGMG_OK);
+  en.H = Hn; en.S = Sn; en.D = Dn;
+  CHECK_RC(phgmg_simulate(&sf, X, 0.0, dt, ns, dbar_input, NULL, NULL, X, Y, &en, NULL, NULL, NULL), PHGMG_OK);
+  CHECK_RC(phgmg_simulate(&sb, Xb, 0.0, dt, ns, dbar_input, NULL, NULL, Xb, NULL, NULL, NULL, NULL, NULL), PHGMG_OK);
+  CHECK(memcmp(X, Xb, sizeof(double) * (size_t)N * (ns + 1)) == 0);
+  for (k = 0; k <= ns; ++k) {
+    phgmg_ph_gradient(&sf, X + (size_t)k * N, z);
+    dbar_input(k * dt, u, NULL);
+    for (j = 0; j < 2; ++j) {
+      double y = 0.0;
+      for (i = 0; i < N; ++i) y += (b.B[i + (size_t)j * N] + P[i + (size_t)j * N]) * z[i];
+      y += (S[j] + Nk[j]) * u[0] + (S[j + 2] + Nk[j + 2]) * u[1];
+      emax = fmax(emax, fabs(y - Y[j + 2 * k]));
+      ymax = fmax(ymax, fabs(y));
+    }
+  }
+  CHECK(ymax > 0.0);
+  CHECK_LE(emax, 1e-13 * ymax);
+  for (k = 0, emax = 0.0; k <= ns; ++k) {
+    emax = fmax(emax, fabs(Hn[k] - Hn[0] - Sn[k] + Dn[k]));
+    hmax = fmax(hmax, fabs(Hn[k]));
+  }
+  CHECK(hmax > 0.0 && Dn[ns] > 0.0);
+  CHECK_LE(emax, 1e-12 * hmax);
+  memset(&o, 0, sizeof o);
+  o.method = PHGMG_METHOD_GMG_POD; o.r = 6;
+  CHECK_RC(phgmg_reduce(&red, &sf, X, N, ns + 1, &o, NULL, NULL), PHGMG_ERR_UNSUPPORTED);
+  CHECK(red == NULL);
+  S[0] = -S[0];   /* indefinite S */
+  CHECK_RC(phgmg_ph_validate(&sf, 0.0, NULL, NULL), PHGMG_ERR_FEEDTHROUGH);
+  S[0] = -S[0];
+  Nk[1] = 0.3;    /* N not skew */
+  CHECK_RC(phgmg_ph_validate(&sf, 0.0, NULL, NULL), PHGMG_ERR_FEEDTHROUGH);
+  Nk[1] = -0.3;
+  S[0] = 1e-3;    /* S below P^T R^+ P: the block is indefinite */
+  CHECK_RC(phgmg_ph_validate(&sf, 0.0, NULL, NULL), PHGMG_ERR_FEEDTHROUGH);
+  free(C); free(P); free(Bm); free(X); free(Xb); free(Y);
+  dbar_free(&b);
+}
+
 /* ---- reduced models ------------------------------------------------------------- */
 static double rel_err_y(int m, int ns, const double *Y, const double *Yr) {
   double a = 0.0, d = 0.0;
@@ -573,5 +651,6 @@ SUITE(descriptor) {
   RUN(test_descriptor_hamiltonian);
   RUN(test_descriptor_bad_input);
   RUN(test_descriptor_sparse_scrambled);
+  RUN(test_descriptor_feedthrough);
   RUN(test_descriptor_reduce);
 }
