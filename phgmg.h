@@ -163,8 +163,15 @@
    and against the closed forms above.
    Not for descriptor models (PHGMG_ERR_UNSUPPORTED): a GENERAL nonlinear part,
    the shifted_* callbacks, the linear-systems toolbox (BT, PRBT, Gramian
-   bases, phgmg_ph_abc) and studies. Singular E (algebraic constraints),
-   feedthrough (P, S, N) and nonlinear dissipation are not supported.
+   bases, phgmg_ph_abc) and studies. Singular E (algebraic constraints) and
+   nonlinear dissipation are not supported. Feedthrough (phgmg_ph_system.P,
+   S, Nskew: E x' = (J - R) z + (B - P) u, y = (B + P)^T z + (S + N) u) is
+   taken by the full model -- validation of [[R, P], [P^T, S]] >= 0 and N
+   skew (PHGMG_ERR_FEEDTHROUGH), the stepper, outputs, and the energy
+   balance with supply y^T u and dissipation [z; u]^T [[R, P], [P^T, S]]
+   [z; u] -- but not yet by the reductions (PHGMG_ERR_UNSUPPORTED): the
+   reduced model would need the reduced P = W_z^T P and S + N, fields the
+   phgmg_rom format does not have.
 
    OFFLINE / ONLINE, MEMORY, ERRORS -------------------------------------------
    Offline functions (double) take a `const phgmg_allocator *` (NULL = default)

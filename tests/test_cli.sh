@@ -508,6 +508,14 @@ np.save('E_neg.npy', -np.eye(N))
   run_err "E^T Q not symmetric" 1 "E^T Q is not symmetric" "$P" reduce $SYS --E E_nonsym.npy $SIM --method gmg-pod --r 12 --out oEn
   [ ! -e oEn ] && pass || bad "E^T Q not symmetric: output written"
   run_err "E^T Q not PD" 1 "E_neg.npy, model/Q.npy (--E, --Q)" "$P" reduce $SYS --E E_neg.npy $SIM --method gmg-pod --r 12 --out oEp
+  "$PY" -c "
+import numpy as np
+np.save('S_ok.npy', 0.1 * np.eye(1)); np.save('S_neg.npy', -0.1 * np.eye(1))
+" && pass || bad "feedthrough files"
+  run_err "feedthrough S not PSD" 1 "S_neg.npy (--P, --S, --N)" "$P" reduce $SYS --S S_neg.npy $SIM --method gmg-pod --r 12 --out oSn
+  [ ! -e oSn ] && pass || bad "feedthrough not PSD: output written"
+  run_err "feedthrough: reduction refused" 1 "do not take feedthrough" "$P" reduce $SYS --S S_ok.npy $SIM --method gmg-pod --r 12 --out oSo
+  [ ! -e oSo ] && pass || bad "feedthrough refused: output written"
   run_err "--E with --J-coo" 2 "--E-coo" "$P" reduce --J-coo J.npy --R-coo R.npy --Q-coo Q.npy --B model/B.npy --E E_id.npy $SIM --method gmg-pod --r 12 --out oEc
 fi
 
