@@ -79,7 +79,7 @@
             phgmg_ph_hamiltonian, phgmg_ph_gradient, phgmg_ph_rhs, phgmg_ph_output,
             phgmg_ph_apply (J, R or Q times a block), phgmg_jr_factor_create /
             phgmg_jr_solve / phgmg_jr_factor_destroy (apply (J-R)^{-1} or ^{-T}),
-            phgmg_ph_sparse_create / _system / _perm / _sep_idx / _to_banded_order /
+            phgmg_ph_sparse_create / _create_e (with E) / _system / _perm / _sep_idx / _to_banded_order /
             _to_user_order / _destroy (CSC input, reverse Cuthill-McKee, banded),
             phgmg_rcm (the ordering alone)
    gl3:     phgmg_gl3_coefficients, phgmg_gl3_create / _step / _get_stats / _destroy,
@@ -111,6 +111,67 @@
             phgmg_rom_deserialize, phgmg_rom_save, phgmg_rom_load, phgmg_rom_export_c
    npy:     phgmg_npy_parse, phgmg_npy_serialize, phgmg_npy_free, phgmg_npy_read,
             phgmg_npy_write
+
+   DESCRIPTOR MODELS (phgmg_ph_system.E) --------------------------------------
+   Finite-element and network models come as
+       E x' = (J - R) z(x) + B u,   y = B^T z(x),   E^T z(x) = grad H(x),
+   E nonsingular (a consistent mass matrix, dense or banded like J, R, Q).
+   phgmg takes z(x) = Q x + grad H_nl(x) (Q, the separable part as usual) and
+   H(x) = 1/2 x^T E^T Q x + sum_k E(i_k,i_k) w_k phi_k(x[i_k]); E^T Q must be
+   symmetric positive (semi)definite and E's rows at the nonlinear coordinates
+   unit rows times E(i_k,i_k) > 0, so that E^T z is the gradient of this H.
+   Energy: dH/dt = z^T E x' = -z^T R z + y^T u.
+   Simulation: Gauss-Legendre with the mass matrix -- stage equations
+   E (Y_i - x_n) = h sum_j a_ij f(Y_j), Newton matrices sigma E - (J - R) Hess,
+   x_{n+1} = x_n + sum_i d_i (Y_i - x_n), d = b^T A^{-1}; E^{-1} is never
+   formed. GL3 commutes with the linear change of variables x~ = E x, so this is
+   the same scheme as on the standard form, and the energy bookkeeping (stage
+   co-states z(Y_i)) keeps its meaning: H_n - H_0 = S_n - D_n to round-off for
+   a quadratic H.
+   Reduction. In x the model is a standard pH system,
+       x' = (J_E - R_E) grad H(x) + B_E u,  J_E = E^{-1} J E^{-T}, R_E =
+       E^{-1} R E^{-T}, B_E = E^{-1} B,  y = B_E^T grad H(x),
+   (J_E skew, R_E PSD: congruences), with G_E = (J_E - R_E)^{-1} = E^T G E,
+   G = (J - R)^{-1}. Every method is applied to this system without forming
+   it; only m solves with E (B_E) and products with E are needed:
+   - GMG (POD, QM, your manifold): phi(x) = [B_E, V] x (+ V2 eta), V from the
+     POD of X - B_E B_E^+ X. The GMG map W^T = (D^T G_E D)^{-1} D^T G_E gives
+       x' = (D^T G_E D)^{-1} grad Hr(x) + W^T B_E u,   Hr = H o phi,
+     with D^T G_E D = (E D)^T G (E D): the G-blocks are those of today with
+     E V0, E V2 in place of V0, V2 (solves with J - R only); the Q-blocks
+     V0^T E^T Q V0 = (E V0)^T (Q V0), ...; the separable weights become
+     E(i_k,i_k) w_k. W^T B_E = (D^T G_E D)^{-1} (E D)^T G B = [I; 0] because
+     E D's first m columns are B: the port structure and the output
+     yr = Bh^T grad Hr = B^T z(phi(xr)) (exact at the lifted state) are kept.
+     In terms of the descriptor equation this is the Petrov-Galerkin
+     projection with the co-state test basis W_z = E^{-T} W:
+       W_z^T E D xr' = W_z^T [(J - R) z(phi(xr)) + B u],   W_z^T E D = I,
+     so the reduced mass matrix is the identity and the reduced model is the
+     library's standard reduced form (phgmg_rom): export, binary files and the
+     allocation-free stepper are unchanged.
+   - SP1: V = POD of X, Hess H = E^T Q, W = E^T Q V (V^T E^T Q V)^{-1}; with
+     W_z = E^{-T} W = Q V (V^T E^T Q V)^{-1} (no solve): K = W_z^T (J - R) W_z,
+     Bh = W_z^T B, Qh = V^T E^T Q V; again W_z^T E V = I. SP2: the gradient
+     snapshots are grad H(x_j) = E^T z(x_j); W_z = E^{-T} W by r solves.
+   Why the reduced model is port-Hamiltonian: K = W_z^T (J - R) W_z (for GMG
+   this equals (D^T G_E D)^{-1} = W^T (J_E - R_E) W), so its symmetric part
+   -W_z^T R W_z is negative semidefinite and its skew part W_z^T J W_z skew;
+   Hr(xr) = H(phi(xr)) is its energy (Qh = D^T E^T Q D, positive definite when
+   E^T Q is and D has full rank), and dHr/dt = -grad Hr^T Rr grad Hr + yr^T u
+   with the same output structure. tests/test_descriptor.c checks each claim
+   against the reduction of the explicitly formed J_E, R_E, Q_E = E^T Q, B_E
+   and against the closed forms above.
+   Not for descriptor models (PHGMG_ERR_UNSUPPORTED): a GENERAL nonlinear part,
+   the shifted_* callbacks, the linear-systems toolbox (BT, PRBT, Gramian
+   bases, phgmg_ph_abc) and studies. Singular E (algebraic constraints) and
+   nonlinear dissipation are not supported. Feedthrough (phgmg_ph_system.P,
+   S, Nskew: E x' = (J - R) z + (B - P) u, y = (B + P)^T z + (S + N) u) is
+   taken by the full model -- validation of [[R, P], [P^T, S]] >= 0 and N
+   skew (PHGMG_ERR_FEEDTHROUGH), the stepper, outputs, and the energy
+   balance with supply y^T u and dissipation [z; u]^T [[R, P], [P^T, S]]
+   [z; u] -- but not yet by the reductions (PHGMG_ERR_UNSUPPORTED): the
+   reduced model would need the reduced P = W_z^T P and S + N, fields the
+   phgmg_rom format does not have.
 
    OFFLINE / ONLINE, MEMORY, ERRORS -------------------------------------------
    Offline functions (double) take a `const phgmg_allocator *` (NULL = default)
@@ -190,13 +251,18 @@ extern "C" {
   X(PHGMG_ERR_NOT_STABILIZABLE, -24, "no stabilizing Riccati solution: (A, K) not stabilizable or (A, L) not detectable") \
   X(PHGMG_ERR_STALE,           -25, "the system changed since the study was created (create the study again)") \
   X(PHGMG_ERR_STRUCTURE,       -26, "model fails the structure check (Qh not positive definite, R not PSD, or a step map not of its dt)") \
-  X(PHGMG_ERR_STEP_MAP,        -27, "step map not stable in double precision at this dt (use a smaller dt)")
+  X(PHGMG_ERR_STEP_MAP,        -27, "step map not stable in double precision at this dt (use a smaller dt)") \
+  X(PHGMG_ERR_E_SINGULAR,      -28, "the mass matrix E is singular to working precision") \
+  X(PHGMG_ERR_EQ_NOT_SYMMETRIC, -29, "E^T Q is not symmetric (descriptor model)")          \
+  X(PHGMG_ERR_EQ_NOT_PD,       -30, "E^T Q is not positive definite (semidefinite for a nonlinear H)") \
+  X(PHGMG_ERR_E_COUPLED,       -31, "a row of E at a nonlinear coordinate is not a positive multiple of the unit row") \
+  X(PHGMG_ERR_FEEDTHROUGH,     -32, "feedthrough: [[R, P], [P^T, S]] not symmetric positive semidefinite or N not skew")
 
 typedef enum phgmg_result {
 #define PHGMG__X(name, val, str) name = val,
   PHGMG__RESULT_LIST(PHGMG__X)
 #undef PHGMG__X
-  PHGMG__RESULT_END_ = -28
+  PHGMG__RESULT_END_ = -33
 } phgmg_result;
 
 /* A stable, human-readable description of a result code (never NULL). */
@@ -398,6 +464,30 @@ typedef struct phgmg_ph_system {
   phgmg_result (*shifted_factor)(double sr, double si, const double *x_lin, void *user);
   void (*shifted_solve)(double sr, double si, double *rhs, void *user);
   void *shifted_user;      /* `user` argument of the two callbacks above      */
+  /* Descriptor form (NULL: E = I, the standard form above). With a mass
+     matrix E (N x N, the storage and kb of J, R, Q; nonsingular) the model is
+         E x' = (J - R) z(x) + B u,   y = B^T z(x),   E^T z(x) = grad H(x),
+     where the co-state z(x) = Q x + grad H_nl(x) is what phgmg_ph_gradient
+     returns (phgmg_ph_rhs gives E x' = (J - R) z + B u) and the Hamiltonian is
+         H(x) = 1/2 x^T E^T Q x + sum_k E(i_k, i_k) w_k phi_k(x[i_k]),
+     i_k = sep_idx[k] (phgmg_ph_hamiltonian). E^T Q must be symmetric positive
+     definite (semidefinite with a nonlinear part) and, for a separable part,
+     row i_k of E must be E(i_k, i_k) e_{i_k}^T with E(i_k, i_k) > 0 (the
+     nonlinear coordinates carry no mass coupling), so that E^T z is a
+     gradient. A GENERAL part and the shifted_* callbacks are not supported
+     with E (PHGMG_ERR_UNSUPPORTED). The stepper never forms E^{-1}: E enters
+     its Newton matrices (sigma E - (J - R) Hess) and stage residuals. See
+     DESCRIPTOR MODELS in the manual at the top for the reduction. */
+  const double *E;
+  /* Feedthrough (each NULL = 0): P (N x m, ld N), S (m x m, symmetric), Nskew
+     (m x m, skew), column-major:
+         E x' = (J - R) z + (B - P) u,   y = (B + P)^T z + (S + Nskew) u,
+     with the dissipation block [[R, P], [P^T, S]] positive semidefinite, so
+     that dH/dt = y^T u - [z; u]^T [[R, P], [P^T, S]] [z; u] <= y^T u. The full
+     model (validation, stepper, outputs and energy of phgmg_simulate) takes
+     them; phgmg_ph_output gives (B + P)^T z only (it has no u). Reductions of
+     a model with feedthrough are not supported (PHGMG_ERR_UNSUPPORTED). */
+  const double *P, *S, *Nskew;
 } phgmg_ph_system;
 
 /* Validation of a system. tol (<= 0: 1e-12) is relative to the matrix norms:
@@ -527,12 +617,19 @@ typedef struct phgmg_ph_sparse_info {
   int kb_rcm;    /* half-bandwidth of the reverse Cuthill-McKee ordering    */
   int permuted;  /* 1: RCM order used, 0: the given order kept (perm = id)  */
   int wide;      /* 1: kb > N/4, banded costs about as much as dense or more */
-  long nnz;      /* stored entries of J, R, Q together                       */
+  long nnz;      /* stored entries of J, R, Q (and E) together              */
 } phgmg_ph_sparse_info;
 PHGMG_DEF phgmg_result phgmg_ph_sparse_create(phgmg_ph_sparse **out, int N, int m, const phgmg_csc *J,
                                               const phgmg_csc *R, const phgmg_csc *Q, const double *B,
                                               const phgmg_csc *Bcsc, phgmg_ph_sparse_info *info,
                                               const phgmg_allocator *alloc);
+/* The same for a descriptor model (phgmg_ph_system.E): E (N x N CSC, the
+   user's ordering) joins J, R, Q in the ordering and the band; E NULL is
+   phgmg_ph_sparse_create. info->nnz counts E's entries too. */
+PHGMG_DEF phgmg_result phgmg_ph_sparse_create_e(phgmg_ph_sparse **out, int N, int m, const phgmg_csc *J,
+                                                const phgmg_csc *R, const phgmg_csc *Q, const phgmg_csc *E,
+                                                const double *B, const phgmg_csc *Bcsc,
+                                                phgmg_ph_sparse_info *info, const phgmg_allocator *alloc);
 /* The banded, permuted system (valid until destroy; NULL for NULL). */
 PHGMG_DEF const phgmg_ph_system *phgmg_ph_sparse_system(const phgmg_ph_sparse *sp);
 /* The permutation (N): internal index i is user index perm[i]; NULL for NULL. */
@@ -1269,7 +1366,10 @@ PHGMG_DEF void phgmg_reduced_lift(const phgmg_reduced *red, const double *xr, do
 PHGMG_DEF void phgmg_reduced_restrict(const phgmg_reduced *red, const double *x, double *xr);
 /* Jacobian of phi at xr: D (N x r, ldd). */
 PHGMG_DEF void phgmg_reduced_dphi(const phgmg_reduced *red, const double *xr, double *D, int ldd);
-/* The reduction map W(xr) (N x r, ldw) in full dimension (for checks; O(N r^2)). */
+/* The reduction map W(xr) (N x r, ldw >= N) in full dimension (for checks;
+   O(N r^2)), W^T Dphi = I. Descriptor model: W^T = (D^T G_E D)^{-1} D^T G_E,
+   G_E = E^T G E (the map of the equivalent standard form); the test basis of
+   the co-state equation is W_z = E^{-T} W (see DESCRIPTOR MODELS). */
 PHGMG_DEF phgmg_result phgmg_reduced_W(const phgmg_reduced *red, const double *xr, double *W, int ldw);
 
 /* Simulate the reduced model with the online GL3 stepper from xr0 over nsteps
@@ -3513,6 +3613,36 @@ PHGMG__PRIV void phgmg__ph_mv(const phgmg_ph_system *s, const double *M, const d
   }
 }
 
+/* y = M^T x (overwrite) for a dense or banded system matrix. */
+PHGMG__PRIV void phgmg__ph_mtv(const phgmg_ph_system *s, const double *M, const double *x, double *y) {
+  int N = s->N, i, j;
+  for (j = 0; j < N; ++j) {
+    double acc = 0.0;
+    if (s->storage == PHGMG_BANDED) {
+      int kb = s->kb, i0 = PHGMG__MAX(0, j - kb), i1 = PHGMG__MIN(N - 1, j + kb);
+      const double *col = M + PHGMG__PHB(kb, 0, j);
+      for (i = i0; i <= i1; ++i) acc += col[i] * x[i];
+    } else {
+      const double *col = M + (size_t)j * (size_t)N;
+      for (i = 0; i < N; ++i) acc += col[i] * x[i];
+    }
+    y[j] = acc;
+  }
+}
+
+/* Y = E X ('N') or E^T X ('T') for an N x nc block (E NULL: the identity). */
+PHGMG__PRIV void phgmg__ph_e_apply(const phgmg_ph_system *s, char trans, int nc, const double *X, int ldx,
+                                   double *Y, int ldy) {
+  int c;
+  for (c = 0; c < nc; ++c) {
+    const double *x = X + (size_t)c * (size_t)ldx;
+    double *y = Y + (size_t)c * (size_t)ldy;
+    if (!s->E) memcpy(y, x, sizeof(double) * (size_t)s->N);
+    else if (trans == 'T') phgmg__ph_mtv(s, s->E, x, y);
+    else phgmg__ph_mv(s, s->E, x, y);
+  }
+}
+
 /* x^T M y without temporaries. */
 PHGMG__PRIV double phgmg__ph_quad(const phgmg_ph_system *s, const double *M, const double *x,
                                   const double *y) {
@@ -3623,6 +3753,7 @@ PHGMG__PRIV phgmg_result phgmg__ph_check(const phgmg_ph_system *s) {
   if (s->storage == PHGMG_BANDED && (s->kb < 0 || s->kb > s->N - 1)) return PHGMG_ERR_SIZE;
   if (!s->J || !s->R || !s->Q || !s->B) return PHGMG_ERR_INVALID_ARG;
   if ((s->shifted_factor == NULL) != (s->shifted_solve == NULL)) return PHGMG_ERR_INVALID_ARG;
+  if (s->E && (s->nl == PHGMG_NL_GENERAL || s->shifted_factor)) return PHGMG_ERR_UNSUPPORTED;
   switch (s->nl) {
     case PHGMG_NL_NONE: break;
     case PHGMG_NL_SEPARABLE:
@@ -3688,10 +3819,31 @@ PHGMG__PRIV void phgmg__ph_scratch_free(double *p, double *stackbuf) {
   if (p != stackbuf) phgmg__free(NULL, p);
 }
 
+/* Descriptor Hamiltonian 1/2 (E x)^T (Q x) + sum_k E_kk w_k phi_k(x_k) (NaN
+   when the scratch vectors cannot be had). */
+PHGMG__PRIV double phgmg__ph_hamiltonian_e(const phgmg_ph_system *sys, const double *x) {
+  double sb[2 * PHGMG__PH_STACK], *ex, H = 0.0;
+  int N = sys->N, k;
+  ex = N <= PHGMG__PH_STACK ? sb : phgmg__dalloc(NULL, 2 * (size_t)N);
+  if (!ex) return (double)NAN;
+  phgmg__ph_mv(sys, sys->E, x, ex);
+  phgmg__ph_mv(sys, sys->Q, x, ex + N);
+  for (k = 0; k < N; ++k) H += ex[k] * ex[N + k];
+  H *= 0.5;
+  if (ex != sb) phgmg__free(NULL, ex);
+  if (sys->nl == PHGMG_NL_SEPARABLE)
+    for (k = 0; k < sys->nsep; ++k) {
+      const int ix = sys->sep_idx[k];
+      H += phgmg__ph_at(sys, sys->E, ix, ix) * (sys->sep_w ? sys->sep_w[k] : 1.0) * phgmg__ph_phi(sys, k, x[ix], 0);
+    }
+  return H;
+}
+
 PHGMG_DEF double phgmg_ph_hamiltonian(const phgmg_ph_system *sys, const double *x) {
   double H;
   int k;
   PHGMG_ASSERT(sys && x);
+  if (sys->E) return phgmg__ph_hamiltonian_e(sys, x);
   H = 0.5 * phgmg__ph_quad(sys, sys->Q, x, x);
   if (sys->nl == PHGMG_NL_SEPARABLE) {
     for (k = 0; k < sys->nsep; ++k)
@@ -3749,6 +3901,8 @@ PHGMG_DEF void phgmg_ph_rhs(const phgmg_ph_system *sys, const double *x, const d
     for (j = 0; j < sys->m; ++j) {
       const double *bj = sys->B + (size_t)j * (size_t)N;
       for (i = 0; i < N; ++i) f[i] += bj[i] * u[j];
+      if (sys->P)
+        for (i = 0; i < N; ++i) f[i] -= sys->P[(size_t)i + (size_t)j * (size_t)N] * u[j];
     }
   phgmg__free(NULL, tmp);
   phgmg__ph_scratch_free(g, sb);
@@ -3770,6 +3924,8 @@ PHGMG_DEF void phgmg_ph_output(const phgmg_ph_system *sys, const double *x, doub
     const double *bj = sys->B + (size_t)j * (size_t)N;
     double acc = 0.0;
     for (i = 0; i < N; ++i) acc += bj[i] * g[i];
+    if (sys->P)
+      for (i = 0; i < N; ++i) acc += sys->P[(size_t)i + (size_t)j * (size_t)N] * g[i];
     y[j] = acc;
   }
   phgmg__free(NULL, tmp);
@@ -4307,6 +4463,135 @@ PHGMG__PRIV phgmg_result phgmg__ph_check_q_pd(const phgmg_ph_system *s, double t
   return rc;
 }
 
+/* ---- descriptor models (E != NULL) -----------------------------------------
+   A factorization of E by the J - R machinery (J := E, R := 0): dense LU or
+   band LU; phgmg_jr_solve then applies E^{-1} ('N') or E^{-T} ('T').
+   rcond_out (may be NULL): its reciprocal condition estimate. */
+PHGMG__PRIV phgmg_result phgmg__e_factor(const phgmg_ph_system *sys, phgmg_jr_factor **f, double *rcond_out,
+                                         const phgmg_allocator *alloc) {
+  phgmg_ph_system t;
+  const size_t len = sys->storage == PHGMG_BANDED ? (size_t)(2 * sys->kb + 1) * (size_t)sys->N
+                                                  : (size_t)sys->N * (size_t)sys->N;
+  double *zero = phgmg__dalloc(alloc, len);
+  phgmg_result rc;
+  *f = NULL;
+  if (!zero) return PHGMG_ERR_NOMEM;
+  memset(zero, 0, sizeof(double) * len);
+  memset(&t, 0, sizeof t);
+  t.N = sys->N; t.m = sys->m; t.storage = sys->storage; t.kb = sys->kb;
+  t.J = sys->E; t.R = zero; t.Q = sys->E; t.B = sys->B;
+  rc = phgmg_jr_factor_create(f, &t, rcond_out, alloc);
+  phgmg__free(alloc, zero);
+  return rc;
+}
+
+/* E^T Q into a system view t (only t.Q meaningful: dense N x N, or banded
+   with half-bandwidth min(2 kb, N - 1)); *buf owns the storage. */
+PHGMG__PRIV phgmg_result phgmg__etq_form(const phgmg_ph_system *sys, phgmg_ph_system *t, double **buf,
+                                         const phgmg_allocator *alloc) {
+  const int N = sys->N;
+  int i, j, k;
+  *t = *sys;
+  t->E = NULL;
+  if (sys->storage == PHGMG_DENSE) {
+    *buf = phgmg__dalloc(alloc, (size_t)N * (size_t)N);
+    if (!*buf) return PHGMG_ERR_NOMEM;
+    phgmg_gemm('T', 'N', N, N, N, 1.0, sys->E, N, sys->Q, N, 0.0, *buf, N);
+  } else {
+    const int kb = sys->kb, k2 = PHGMG__MIN(2 * kb, N - 1);
+    const size_t len = (size_t)(2 * k2 + 1) * (size_t)N;
+    *buf = phgmg__dalloc(alloc, len);
+    if (!*buf) return PHGMG_ERR_NOMEM;
+    memset(*buf, 0, sizeof(double) * len);
+    for (j = 0; j < N; ++j)   /* (E^T Q)(i, j) = sum_k E(k, i) Q(k, j) */
+      for (i = PHGMG__MAX(0, j - k2); i <= PHGMG__MIN(N - 1, j + k2); ++i) {
+        double acc = 0.0;
+        for (k = PHGMG__MAX(PHGMG__MAX(0, i - kb), j - kb); k <= PHGMG__MIN(PHGMG__MIN(N - 1, i + kb), j + kb); ++k)
+          acc += sys->E[PHGMG__PHB(kb, k, i)] * sys->Q[PHGMG__PHB(kb, k, j)];
+        (*buf)[PHGMG__PHB(k2, i, j)] = acc;
+      }
+    t->kb = k2;
+  }
+  t->Q = *buf;
+  return PHGMG_OK;
+}
+
+/* The descriptor checks of phgmg_ph_validate: E finite and nonsingular,
+   E^T Q symmetric and positive (semi)definite, separable coordinates free of
+   mass coupling. */
+PHGMG__PRIV phgmg_result phgmg__ph_validate_e(const phgmg_ph_system *sys, double tol, const phgmg_allocator *alloc) {
+  phgmg_ph_system t;
+  phgmg_jr_factor *f = NULL;
+  double *buf = NULL, rcond = 0.0, nrm, def;
+  int k, j;
+  phgmg_result rc;
+  if (!phgmg__ph_mat_finite(sys, sys->E)) return PHGMG_ERR_NANINF;
+  rc = phgmg__etq_form(sys, &t, &buf, alloc);
+  if (rc != PHGMG_OK) return rc;
+  phgmg__ph_sym_defect(&t, t.Q, -1.0, &nrm, &def);
+  if (def > tol * nrm) rc = PHGMG_ERR_EQ_NOT_SYMMETRIC;
+  if (rc == PHGMG_OK) {
+    rc = phgmg__ph_check_q_pd(&t, tol, alloc);
+    if (rc == PHGMG_ERR_Q_NOT_PD) rc = PHGMG_ERR_EQ_NOT_PD;
+  }
+  phgmg__free(alloc, buf);
+  for (k = 0; rc == PHGMG_OK && sys->nl == PHGMG_NL_SEPARABLE && k < sys->nsep; ++k) {
+    const int ix = sys->sep_idx[k];
+    if (!(phgmg__ph_at(sys, sys->E, ix, ix) > 0.0)) rc = PHGMG_ERR_E_COUPLED;
+    for (j = 0; j < sys->N && rc == PHGMG_OK; ++j)
+      if (j != ix && phgmg__ph_at(sys, sys->E, ix, j) != 0.0) rc = PHGMG_ERR_E_COUPLED;
+  }
+  if (rc != PHGMG_OK) return rc;
+  rc = phgmg__e_factor(sys, &f, &rcond, alloc);
+  phgmg_jr_factor_destroy(f);
+  if (rc == PHGMG_ERR_NOMEM) return rc;
+  return rc == PHGMG_OK && rcond > tol ? PHGMG_OK : PHGMG_ERR_E_SINGULAR;
+}
+
+/* Feedthrough: P, S, N finite, N skew, S symmetric and [[R, P], [P^T, S]]
+   positive semidefinite (smallest eigenvalue >= -tol times the largest
+   magnitude; dense eigenvalues of the (N + m) block, so banded models with
+   N > PHGMG__PH_PSD_DENSE_MAX are not checked: PHGMG_ERR_UNSUPPORTED). */
+PHGMG__PRIV phgmg_result phgmg__ph_validate_feedthrough(const phgmg_ph_system *sys, double tol,
+                                                        const phgmg_allocator *alloc) {
+  const int N = sys->N, m = sys->m, n = N + m;
+  double *A, *w, a = 0.0, d = 0.0;
+  int i, j;
+  phgmg_result rc;
+  if ((sys->P && !phgmg__all_finite(sys->P, (size_t)N * m)) || (sys->S && !phgmg__all_finite(sys->S, (size_t)m * m)) ||
+      (sys->Nskew && !phgmg__all_finite(sys->Nskew, (size_t)m * m)))
+    return PHGMG_ERR_NANINF;
+  for (j = 0; sys->Nskew && j < m; ++j)
+    for (i = 0; i < m; ++i) {
+      const double v = sys->Nskew[i + (size_t)j * m], e = v + sys->Nskew[j + (size_t)i * m];
+      a += v * v; d += e * e;
+    }
+  if (sqrt(d) > tol * sqrt(a)) return PHGMG_ERR_FEEDTHROUGH;
+  if (sys->storage == PHGMG_BANDED && N > PHGMG__PH_PSD_DENSE_MAX) return PHGMG_ERR_UNSUPPORTED;
+  A = phgmg__dalloc(alloc, (size_t)n * n);
+  w = phgmg__dalloc(alloc, (size_t)n);
+  if (!A || !w) { phgmg__free(alloc, A); phgmg__free(alloc, w); return PHGMG_ERR_NOMEM; }
+  for (j = 0; j < n; ++j)
+    for (i = 0; i < n; ++i) {
+      double v;
+      if (i < N && j < N) v = phgmg__ph_at(sys, sys->R, i, j);
+      else if (i < N) v = sys->P ? sys->P[i + (size_t)(j - N) * N] : 0.0;
+      else if (j < N) v = sys->P ? sys->P[j + (size_t)(i - N) * N] : 0.0;
+      else v = sys->S ? sys->S[(i - N) + (size_t)(j - N) * m] : 0.0;
+      A[i + (size_t)j * n] = v;
+    }
+  for (j = 0, a = d = 0.0; sys->S && j < m; ++j)   /* S symmetric */
+    for (i = 0; i < m; ++i) {
+      const double v = sys->S[i + (size_t)j * m], e = v - sys->S[j + (size_t)i * m];
+      a += v * v; d += e * e;
+    }
+  rc = sqrt(d) > tol * sqrt(a) ? PHGMG_ERR_FEEDTHROUGH : phgmg_sym_eig(n, A, n, w, NULL, 0);
+  if (rc == PHGMG_OK && w[0] < -tol * PHGMG__MAX(fabs(w[0]), fabs(w[n - 1]))) rc = PHGMG_ERR_FEEDTHROUGH;
+  phgmg__free(alloc, A);
+  phgmg__free(alloc, w);
+  return rc;
+}
+
 PHGMG_DEF phgmg_result phgmg_ph_validate(const phgmg_ph_system *sys, double tol,
                                          double *rcond_out, const phgmg_allocator *alloc) {
   phgmg_result rc;
@@ -4333,12 +4618,23 @@ PHGMG_DEF phgmg_result phgmg_ph_validate(const phgmg_ph_system *sys, double tol,
   if (def > tol * nrm) return PHGMG_ERR_NOT_SKEW;
   phgmg__ph_sym_defect(sys, sys->R, -1.0, &nrm, &def);
   if (def > tol * nrm) return PHGMG_ERR_NOT_SYMMETRIC;
-  phgmg__ph_sym_defect(sys, sys->Q, -1.0, &nrm, &def);
-  if (def > tol * nrm) return PHGMG_ERR_Q_NOT_SYMMETRIC;
-  rc = phgmg__ph_check_psd(sys, tol, alloc);
-  if (rc != PHGMG_OK) return rc;
-  rc = phgmg__ph_check_q_pd(sys, tol, alloc);
-  if (rc != PHGMG_OK) return rc;
+  if (sys->P || sys->S || sys->Nskew) {
+    rc = phgmg__ph_check_psd(sys, tol, alloc);
+    if (rc == PHGMG_OK) rc = phgmg__ph_validate_feedthrough(sys, tol, alloc);
+    if (rc != PHGMG_OK) return rc;
+  }
+  if (sys->E) {   /* descriptor: E^T Q takes the place of Q */
+    rc = phgmg__ph_check_psd(sys, tol, alloc);
+    if (rc == PHGMG_OK) rc = phgmg__ph_validate_e(sys, tol, alloc);
+    if (rc != PHGMG_OK) return rc;
+  } else {
+    phgmg__ph_sym_defect(sys, sys->Q, -1.0, &nrm, &def);
+    if (def > tol * nrm) return PHGMG_ERR_Q_NOT_SYMMETRIC;
+    rc = phgmg__ph_check_psd(sys, tol, alloc);
+    if (rc != PHGMG_OK) return rc;
+    rc = phgmg__ph_check_q_pd(sys, tol, alloc);
+    if (rc != PHGMG_OK) return rc;
+  }
   /* B full column rank: pivoted QR, |R(m-1,m-1)| > tol |R(0,0)| */
   {
     double *Bc = phgmg__dalloc(alloc, (size_t)N * (size_t)m);
@@ -4566,6 +4862,7 @@ struct phgmg_ph_sparse {
   const phgmg_allocator *alloc; /* &a or NULL */
   int *perm, *iperm, *sep;
   double *J, *R, *Q, *B;
+  double *E;   /* descriptor models (phgmg_ph_sparse_create_e), else NULL */
 };
 
 PHGMG_DEF void phgmg_ph_sparse_destroy(phgmg_ph_sparse *sp) {
@@ -4579,6 +4876,7 @@ PHGMG_DEF void phgmg_ph_sparse_destroy(phgmg_ph_sparse *sp) {
   phgmg__free(alloc, sp->R);
   phgmg__free(alloc, sp->Q);
   phgmg__free(alloc, sp->B);
+  phgmg__free(alloc, sp->E);
   phgmg__free(alloc, sp);
 }
 
@@ -4594,16 +4892,16 @@ PHGMG__PRIV void phgmg__csc_to_band(const phgmg_csc *A, const int *ip, int kb, d
 }
 
 /* Argument and data checks of phgmg_ph_sparse_create. */
-PHGMG__PRIV phgmg_result phgmg__ph_sparse_check(int N, int m, const phgmg_csc *const *A, const double *B,
+PHGMG__PRIV phgmg_result phgmg__ph_sparse_check(int N, int m, const phgmg_csc *const *A, int na, const double *B,
                                                 const phgmg_csc *Bcsc) {
   int a;
   phgmg_result rc;
   if (!A[0] || !A[1] || !A[2] || (!B && !Bcsc)) return PHGMG_ERR_INVALID_ARG;
   if (N < 1 || m < 1 || m > N) return PHGMG_ERR_SIZE;
-  for (a = 0; a < 3; ++a)
+  for (a = 0; a < na; ++a)
     if ((rc = phgmg__csc_check(A[a], N, N)) != PHGMG_OK) return rc;
   if (!B && (rc = phgmg__csc_check(Bcsc, N, m)) != PHGMG_OK) return rc;
-  for (a = 0; a < 3; ++a)
+  for (a = 0; a < na; ++a)
     if (!phgmg__all_finite(A[a]->values, (size_t)A[a]->colptr[N])) return PHGMG_ERR_NANINF;
   if (B ? !phgmg__all_finite(B, (size_t)N * (size_t)m)
         : !phgmg__all_finite(Bcsc->values, (size_t)Bcsc->colptr[m]))
@@ -4615,16 +4913,24 @@ PHGMG_DEF phgmg_result phgmg_ph_sparse_create(phgmg_ph_sparse **out, int N, int 
                                               const phgmg_csc *R, const phgmg_csc *Q, const double *B,
                                               const phgmg_csc *Bcsc, phgmg_ph_sparse_info *info,
                                               const phgmg_allocator *alloc) {
-  const phgmg_csc *A[3];
+  return phgmg_ph_sparse_create_e(out, N, m, J, R, Q, NULL, B, Bcsc, info, alloc);
+}
+
+PHGMG_DEF phgmg_result phgmg_ph_sparse_create_e(phgmg_ph_sparse **out, int N, int m, const phgmg_csc *J,
+                                                const phgmg_csc *R, const phgmg_csc *Q, const phgmg_csc *E,
+                                                const double *B, const phgmg_csc *Bcsc,
+                                                phgmg_ph_sparse_info *info, const phgmg_allocator *alloc) {
+  const phgmg_csc *A[4];
+  const int na = E ? 4 : 3;
   phgmg_ph_sparse *sp;
   phgmg_result rc;
   int a, i, j, kb_in = 0, kb_rcm = 0, kb;
   size_t len;
-  A[0] = J; A[1] = R; A[2] = Q;
+  A[0] = J; A[1] = R; A[2] = Q; A[3] = E;
   if (info) memset(info, 0, sizeof *info);
   if (!out) return PHGMG_ERR_INVALID_ARG;
   *out = NULL;
-  if ((rc = phgmg__ph_sparse_check(N, m, A, B, Bcsc)) != PHGMG_OK) return rc;
+  if ((rc = phgmg__ph_sparse_check(N, m, A, na, B, Bcsc)) != PHGMG_OK) return rc;
   sp = PHGMG__CAST(phgmg_ph_sparse *, phgmg__alloc(alloc, sizeof *sp));
   if (!sp) return PHGMG_ERR_NOMEM;
   memset(sp, 0, sizeof *sp);
@@ -4632,9 +4938,9 @@ PHGMG_DEF phgmg_result phgmg_ph_sparse_create(phgmg_ph_sparse **out, int N, int 
   sp->perm = phgmg__ialloc(alloc, (size_t)N);
   sp->iperm = phgmg__ialloc(alloc, (size_t)N);
   if (!sp->perm || !sp->iperm) { phgmg_ph_sparse_destroy(sp); return PHGMG_ERR_NOMEM; }
-  rc = phgmg_rcm(N, 3, A, sp->perm, &kb_rcm, alloc);
+  rc = phgmg_rcm(N, na, A, sp->perm, &kb_rcm, alloc);
   if (rc != PHGMG_OK) { phgmg_ph_sparse_destroy(sp); return rc; }
-  for (a = 0; a < 3; ++a) {
+  for (a = 0; a < na; ++a) {
     int k = phgmg__csc_bandwidth(A[a], NULL);
     if (k > kb_in) kb_in = k;
   }
@@ -4654,6 +4960,12 @@ PHGMG_DEF phgmg_result phgmg_ph_sparse_create(phgmg_ph_sparse **out, int N, int 
   phgmg__csc_to_band(J, sp->iperm, kb, sp->J);
   phgmg__csc_to_band(R, sp->iperm, kb, sp->R);
   phgmg__csc_to_band(Q, sp->iperm, kb, sp->Q);
+  if (E) {
+    sp->E = phgmg__dalloc(alloc, len);
+    if (!sp->E) { phgmg_ph_sparse_destroy(sp); return PHGMG_ERR_NOMEM; }
+    memset(sp->E, 0, sizeof(double) * len);
+    phgmg__csc_to_band(E, sp->iperm, kb, sp->E);
+  }
   if (B) {
     for (j = 0; j < m; ++j)
       for (i = 0; i < N; ++i) sp->B[i + (size_t)j * N] = B[sp->perm[i] + (size_t)j * N];
@@ -4669,6 +4981,7 @@ PHGMG_DEF phgmg_result phgmg_ph_sparse_create(phgmg_ph_sparse **out, int N, int 
   sp->sys.storage = PHGMG_BANDED;
   sp->sys.kb = kb;
   sp->sys.J = sp->J; sp->sys.R = sp->R; sp->sys.Q = sp->Q; sp->sys.B = sp->B;
+  sp->sys.E = sp->E;
   sp->sys.nl = PHGMG_NL_NONE;
   if (info) {
     info->kb = kb;
@@ -4676,7 +4989,7 @@ PHGMG_DEF phgmg_result phgmg_ph_sparse_create(phgmg_ph_sparse **out, int N, int 
     info->kb_rcm = kb_rcm;
     info->permuted = kb_rcm < kb_in;
     info->wide = 4 * (long)kb > (long)N;
-    info->nnz = (long)J->colptr[N] + (long)R->colptr[N] + (long)Q->colptr[N];
+    info->nnz = (long)J->colptr[N] + (long)R->colptr[N] + (long)Q->colptr[N] + (E ? (long)E->colptr[N] : 0L);
   }
   *out = sp;
   return PHGMG_OK;
@@ -5036,6 +5349,12 @@ struct phgmg_gl3 {
   /* tiny entries: flush threshold of this step, ||xend||_inf, 0 = keep_tiny */
   double ftau, xamax;
   int flush;
+  /* descriptor (sys.E set): E times the stage block (3N), E's diagonals (banded) */
+  double *EZ;
+  phgmg__dia de;
+  /* feedthrough (sys.P set): sys.B of this copy is B - P (the input matrix of
+     the state equation), Bout = B + P that of the output (NULL: B) */
+  double *Bin, *Bout;
 };
 
 PHGMG_DEF void phgmg_gl3_destroy(phgmg_gl3 *s) {
@@ -5060,11 +5379,42 @@ PHGMG_DEF void phgmg_gl3_destroy(phgmg_gl3 *s) {
   phgmg__free(&al, s->xnew); phgmg__free(&al, s->r1buf); phgmg__free(&al, s->rcbuf);
   phgmg__free(&al, s->pk);
   phgmg__free(&al, s->tmp);
+  phgmg__free(&al, s->EZ);
+  phgmg__dia_free(&al, &s->de);
+  phgmg__free(&al, s->Bin);
+  phgmg__free(&al, s->Bout);
   phgmg__free(&al, s);
 }
 
 PHGMG_DEF const phgmg_gl3_stats *phgmg_gl3_get_stats(const phgmg_gl3 *s) {
   return s ? &s->st : NULL;
+}
+
+/* Descriptor, dense: K1 = gam/h E - Jac and K2 = (alp - i bet)/h E - Jac from
+   K1, K2 that hold sigma I - Jac. */
+PHGMG__PRIV void phgmg__gl3_dense_shift_e(const phgmg_gl3 *s, double *K1, double *K2) {
+  const int N = s->N;
+  const double sg = s->gam / s->h, sa = s->alp / s->h, sb = -s->bet / s->h;
+  const double *E = s->sys.E;
+  int i, j;
+  for (j = 0; j < N; ++j)
+    for (i = 0; i < N; ++i) {
+      const size_t e = (size_t)i + (size_t)j * (size_t)N;
+      const double d = i == j ? 1.0 : 0.0;
+      K1[e] += sg * (E[e] - d);
+      K2[2 * e] += sa * (E[e] - d);
+      K2[2 * e + 1] = sb * E[e];
+    }
+}
+
+/* Descriptor: EZ = E V for the three stage columns of V (N each). */
+PHGMG__PRIV void phgmg__gl3_e_times(const phgmg_gl3 *s, const double *V, double *EZ) {
+  int st;
+  if (s->sys.storage == PHGMG_DENSE) {
+    phgmg_gemm('N', 'N', s->N, 3, s->N, 1.0, s->sys.E, s->N, V, s->N, 0.0, EZ, s->N);
+    return;
+  }
+  for (st = 0; st < 3; ++st) phgmg__dia_mv(&s->de, V + (size_t)st * (size_t)s->N, EZ + (size_t)st * (size_t)s->N);
 }
 
 /* Precompute the exact one-step map of a dense linear system (see >>gl3). */
@@ -5117,6 +5467,7 @@ PHGMG__PRIV phgmg_result phgmg__gl3_build_map(phgmg_gl3 *s) {
         K2[2 * e + 1] = -s->bet / s->h;
       }
     }
+  if (sys->E) phgmg__gl3_dense_shift_e(s, K1, K2);
   rc = phgmg_lu_factor(N, K1, N, ip1);
   if (rc == PHGMG_OK) rc = phgmg_zlu_factor(N, K2, N, ip2);
   if (rc != PHGMG_OK) goto done;
@@ -5243,6 +5594,10 @@ PHGMG__PRIV phgmg_result phgmg__gl3_setup_newton(phgmg_gl3 *s) {
   s->tmp = phgmg__dalloc(&s->al, (size_t)N);
   if (!s->Z || !s->W || !s->Y || !s->F || !s->Zprev || !s->xend ||
       !s->tmp) return PHGMG_ERR_NOMEM;
+  if (sys->E) {
+    s->EZ = phgmg__dalloc(&s->al, N3);
+    if (!s->EZ) return PHGMG_ERR_NOMEM;
+  }
   if (sys->nl == PHGMG_NL_SEPARABLE) {
     s->dd = phgmg__dalloc(&s->al, (size_t)N);
     if (!s->dd) return PHGMG_ERR_NOMEM;
@@ -5362,6 +5717,14 @@ PHGMG__PRIV phgmg_result phgmg__gl3_setup_banded(phgmg_gl3 *s) {
       s->hband = phgmg__dalloc(&s->al, (size_t)(2 * kb + 1) * (size_t)N);
       if (rc != PHGMG_OK || !s->hband) return PHGMG_ERR_NOMEM;
     }
+    if (sys->E) { /* descriptor: the band of E joins that of (J - R) Hess */
+      rc = phgmg__dia_build(&s->al, &s->de, N, kb, sys->E, NULL, 1, 0);
+      if (rc != PHGMG_OK) return rc;
+      for (k = 0; k < s->de.nd; ++k) {
+        amin = PHGMG__MIN(amin, s->de.off[k] - bmin);
+        amax = PHGMG__MAX(amax, s->de.off[k] - bmax);
+      }
+    }
     s->kl = PHGMG__MIN(N - 1, -(amin + bmin));
     s->ku = PHGMG__MIN(N - 1, amax + bmax);
     s->ldab = 2 * s->kl + s->ku + 1;
@@ -5396,6 +5759,23 @@ PHGMG__PRIV phgmg_result phgmg__gl3_setup_buffers(phgmg_gl3 *s) {
   return PHGMG_OK;
 }
 
+/* Feedthrough P: the stepper's copy of the system takes B - P as its input
+   matrix (every right-hand side path and the step map then use it); B + P
+   is kept for the outputs of the energy bookkeeping. */
+PHGMG__PRIV phgmg_result phgmg__gl3_setup_feedthrough(phgmg_gl3 *s) {
+  const size_t n = (size_t)s->N * (size_t)s->m;
+  size_t i;
+  s->Bin = phgmg__dalloc(&s->al, n);
+  s->Bout = phgmg__dalloc(&s->al, n);
+  if (!s->Bin || !s->Bout) return PHGMG_ERR_NOMEM;
+  for (i = 0; i < n; ++i) {
+    s->Bin[i] = s->sys.B[i] - s->sys.P[i];
+    s->Bout[i] = s->sys.B[i] + s->sys.P[i];
+  }
+  s->sys.B = s->Bin;
+  return PHGMG_OK;
+}
+
 PHGMG_DEF phgmg_result phgmg_gl3_create(phgmg_gl3 **out, const phgmg_ph_system *sys, double dt,
                                         const phgmg_gl3_opts *opts, const phgmg_allocator *alloc) {
   phgmg_gl3 *s;
@@ -5423,6 +5803,10 @@ PHGMG_DEF phgmg_result phgmg_gl3_create(phgmg_gl3 **out, const phgmg_ph_system *
   s->flush = !(opts && opts->keep_tiny);
   s->ftau = s->flush ? PHGMG__DBL_MIN : 0.0;
   s->linear = sys->nl == PHGMG_NL_NONE;
+  if (sys->P && phgmg__gl3_setup_feedthrough(s) != PHGMG_OK) {
+    phgmg_gl3_destroy(s);
+    return PHGMG_ERR_NOMEM;
+  }
   phgmg__gl3_setup_method(s, opts);
   s->U = phgmg__dalloc(&s->al, 3 * (size_t)s->m);
   s->G = phgmg__dalloc(&s->al, 3 * (size_t)s->N);
@@ -5722,6 +6106,22 @@ PHGMG__PRIV void phgmg__gl3_solve_packed(const phgmg_gl3 *s, double *b, double *
 #undef PHGMG__GL3_FWD_ROW
 #undef PHGMG__GL3_BWD_ROW
 
+/* Descriptor, banded: AB1 += sg E, AB2 += (sa + i sb) E (band LU layout). */
+PHGMG__PRIV void phgmg__gl3_band_shift_e(phgmg_gl3 *s, double sg, double sa, double sb) {
+  const int n = s->N, kv = s->kl + s->ku, ld = s->ldab;
+  int d, i;
+  for (d = 0; d < s->de.nd; ++d) {
+    const int o = s->de.off[d], i0 = PHGMG__MAX(0, -o), i1 = PHGMG__MIN(n, n - o);
+    const double *vd = s->de.v + (size_t)d * (size_t)n;
+    for (i = i0; i < i1; ++i) {
+      const size_t e = (size_t)(kv - o) + (size_t)(i + o) * (size_t)ld;
+      s->AB1[e] += sg * vd[i];
+      s->AB2[2 * e] += sa * vd[i];
+      s->AB2[2 * e + 1] += sb * vd[i];
+    }
+  }
+}
+
 /* (Re)factor the shifted Newton matrices at x. */
 PHGMG__PRIV phgmg_result phgmg__gl3_factor(phgmg_gl3 *s, const double *x) {
   const phgmg_ph_system *sys = &s->sys;
@@ -5766,6 +6166,7 @@ PHGMG__PRIV phgmg_result phgmg__gl3_factor(phgmg_gl3 *s, const double *x) {
       s->K2[2 * d] += sa;
       s->K2[2 * d + 1] = sb;
     }
+    if (sys->E) phgmg__gl3_dense_shift_e(s, s->K1, s->K2);
     rc = phgmg_lu_factor(N, s->K1, N, s->ip1);
     if (rc == PHGMG_OK) rc = phgmg_zlu_factor(N, s->K2, N, s->ip2);
     return rc;
@@ -5784,11 +6185,15 @@ PHGMG__PRIV phgmg_result phgmg__gl3_factor(phgmg_gl3 *s, const double *x) {
       phgmg__dia_prod_band(&s->djr, &s->dh, NULL, -1.0, s->AB1, ld, kv);
     }
     for (e = 0; e < tot; ++e) { s->AB2[2 * e] = s->AB1[e]; s->AB2[2 * e + 1] = 0.0; }
-    for (j = 0; j < N; ++j) {
-      size_t d = (size_t)kv + (size_t)j * (size_t)ld;
-      s->AB1[d] += sg;
-      s->AB2[2 * d] += sa;
-      s->AB2[2 * d + 1] = sb;
+    if (sys->E) { /* descriptor: sigma E in place of sigma I */
+      phgmg__gl3_band_shift_e(s, sg, sa, sb);
+    } else {
+      for (j = 0; j < N; ++j) {
+        size_t d = (size_t)kv + (size_t)j * (size_t)ld;
+        s->AB1[d] += sg;
+        s->AB2[2 * d] += sa;
+        s->AB2[2 * d + 1] = sb;
+      }
     }
     if (!phgmg__all_finite(s->AB1, tot)) return PHGMG_ERR_NANINF;
     rc = phgmg__gb_factor(N, s->kl, s->ku, s->AB1, ld, s->ip1, s->dinv1, &s->ue1);
@@ -5853,12 +6258,18 @@ PHGMG__PRIV phgmg_result phgmg__gl3_newton(phgmg_gl3 *s, const double *x, int fr
     const double t00 = Ti[0], t01 = Ti[1], t02 = Ti[2], t10 = Ti[3], t11 = Ti[4], t12 = Ti[5],
                  t20 = Ti[6], t21 = Ti[7], t22 = Ti[8];
     const double gih = s->gam * ih, aih = s->alp * ih, bih = s->bet * ih;
+    /* descriptor: E Z and E W in place of Z and W (the same vectors without E) */
+    const double *M0 = Z0, *M1 = Z1, *M2 = Z2, *V0 = W0, *V1 = W1, *V2 = W2;
     phgmg__gl3_eval(s, x);
-    for (i = 0; i < N; ++i) { /* stage residual Z - h (A x I) F */
+    if (s->EZ) {
+      phgmg__gl3_e_times(s, s->Z, s->EZ);
+      M0 = s->EZ; M1 = s->EZ + N; M2 = s->EZ + 2 * (size_t)N;
+    }
+    for (i = 0; i < N; ++i) { /* stage residual (I x E) Z - h (A x I) F */
       double f0 = F0[i], f1 = F1[i], f2 = F2[i], e0, e1, e2;
-      e0 = fabs(Z0[i] - PHGMG__FMA(a00, f0, PHGMG__FMA(a01, f1, a02 * f2)));
-      e1 = fabs(Z1[i] - PHGMG__FMA(a10, f0, PHGMG__FMA(a11, f1, a12 * f2)));
-      e2 = fabs(Z2[i] - PHGMG__FMA(a20, f0, PHGMG__FMA(a21, f1, a22 * f2)));
+      e0 = fabs(M0[i] - PHGMG__FMA(a00, f0, PHGMG__FMA(a01, f1, a02 * f2)));
+      e1 = fabs(M1[i] - PHGMG__FMA(a10, f0, PHGMG__FMA(a11, f1, a12 * f2)));
+      e2 = fabs(M2[i] - PHGMG__FMA(a20, f0, PHGMG__FMA(a21, f1, a22 * f2)));
       chk += (e0 + e1) + e2; /* NaN/Inf detection */
       zm = PHGMG__MAX(zm, PHGMG__MAX(fabs(Z0[i]), PHGMG__MAX(fabs(Z1[i]), fabs(Z2[i]))));
       res = e0 > res ? e0 : res;
@@ -5876,8 +6287,12 @@ PHGMG__PRIV phgmg_result phgmg__gl3_newton(phgmg_gl3 *s, const double *x, int fr
     if (it >= s->max_iter) return PHGMG_ERR_NOT_CONVERGED;
     if (it >= 1 && theta >= 1.0 && !fresh) return PHGMG_ERR_NOT_CONVERGED;
     if (ndiv >= 2) return PHGMG_ERR_NOT_CONVERGED;
+    if (s->EZ) {
+      phgmg__gl3_e_times(s, s->W, s->EZ);
+      V0 = s->EZ; V1 = s->EZ + N; V2 = s->EZ + 2 * (size_t)N;
+    }
     for (i = 0; i < N; ++i) { /* Newton right-hand sides in the transformed variables */
-      double f0 = F0[i], f1 = F1[i], f2 = F2[i], w0 = W0[i], w1 = W1[i], w2 = W2[i];
+      double f0 = F0[i], f1 = F1[i], f2 = F2[i], w0 = V0[i], w1 = V1[i], w2 = V2[i];
       r1[i] = PHGMG__FMA(t00, f0, PHGMG__FMA(t01, f1, PHGMG__FMA(t02, f2, -gih * w0)));
       rc[2 * i] =
           PHGMG__FMA(t10, f0, PHGMG__FMA(t11, f1, PHGMG__FMA(t12, f2, -(aih * w1 + bih * w2))));
@@ -5912,11 +6327,43 @@ PHGMG__PRIV phgmg_result phgmg__gl3_newton(phgmg_gl3 *s, const double *x, int fr
   }
 }
 
+/* The same with feedthrough: y_i = (B + P)^T z_i + (S + N) u_i supplied,
+   [z; u]^T [[R, P], [P^T, S]] [z; u] = z^T R z + 2 z^T P u + u^T S u dissipated. */
+PHGMG__PRIV void phgmg__gl3_energy_feedthrough(phgmg_gl3 *s, double energy_inc[2]) {
+  const phgmg_ph_system *sys = &s->sys;
+  const int N = s->N, m = s->m;
+  const double *Bo = s->Bout ? s->Bout : sys->B;
+  int st, k, l, i;
+  double sup = 0.0, dis = 0.0;
+  for (st = 0; st < 3; ++st) {
+    const double *g = s->G + (size_t)st * (size_t)N, *u = s->U + (size_t)st * (size_t)m;
+    double yu = 0.0, d = phgmg__ph_quad(sys, sys->R, g, g);
+    for (k = 0; k < m; ++k) {
+      double yk = 0.0, pk = 0.0;
+      for (i = 0; i < N; ++i) yk += Bo[(size_t)i + (size_t)k * (size_t)N] * g[i];
+      if (sys->P)
+        for (i = 0; i < N; ++i) pk += sys->P[(size_t)i + (size_t)k * (size_t)N] * g[i];
+      for (l = 0; l < m; ++l) {
+        const double sk = sys->S ? sys->S[k + (size_t)l * m] : 0.0, nk = sys->Nskew ? sys->Nskew[k + (size_t)l * m] : 0.0;
+        yk += (sk + nk) * u[l];
+        d += u[k] * sk * u[l];
+      }
+      yu += yk * u[k];
+      d += 2.0 * pk * u[k];
+    }
+    sup += s->b[st] * yu;
+    dis += s->b[st] * d;
+  }
+  energy_inc[0] = s->h * sup;
+  energy_inc[1] = s->h * dis;
+}
+
 /* Supplied and dissipated energy over a step from the stage gradients s->G. */
 PHGMG__PRIV void phgmg__gl3_energy(phgmg_gl3 *s, double energy_inc[2]) {
   const phgmg_ph_system *sys = &s->sys;
   int N = s->N, m = s->m, st, k, i;
   double sup = 0.0, dis = 0.0;
+  if (sys->P || sys->S || sys->Nskew) { phgmg__gl3_energy_feedthrough(s, energy_inc); return; }
   for (st = 0; st < 3; ++st) {
     const double *g = s->G + (size_t)st * (size_t)N, *u = s->U + (size_t)st * (size_t)m;
     double yu = 0.0;
@@ -6023,8 +6470,12 @@ PHGMG_DEF phgmg_result phgmg_gl3_step(phgmg_gl3 *s, double t, double *x, phgmg_i
     const double *F0 = s->F, *F1 = s->F + N, *F2 = s->F + 2 * (size_t)N;
     double hb0 = s->h * s->b[0], hb1 = s->h * s->b[1], hb2 = s->h * s->b[2], chk = 0.0, am = 0.0;
     const double tau = s->ftau; /* the new state is flushed with this step's threshold */
+    const double *Z0 = s->Z, *Z1 = s->Z + N, *Z2 = s->Z + 2 * (size_t)N;
     for (i = 0; i < N; ++i) {
-      double v = x[i] + (hb0 * F0[i] + hb1 * F1[i] + hb2 * F2[i]), a = fabs(v);
+      /* descriptor: x + sum d_i Z_i (= x + h sum b_i E^{-1} F_i at the solution) */
+      double v = s->EZ ? x[i] + (s->d[0] * Z0[i] + s->d[1] * Z1[i] + s->d[2] * Z2[i])
+                       : x[i] + (hb0 * F0[i] + hb1 * F1[i] + hb2 * F2[i]),
+             a = fabs(v);
       s->xnew[i] = a < tau ? 0.0 : v;
       chk += v;
       am = a > am ? a : am;
@@ -6047,6 +6498,23 @@ PHGMG_DEF phgmg_result phgmg_gl3_step(phgmg_gl3 *s, double t, double *x, phgmg_i
   s->st.steps++;
   if (res > s->st.max_residual) s->st.max_residual = res;
   return PHGMG_OK;
+}
+
+/* Feedthrough part of the output: y += P^T z + (S + N) u(t) (u into tmp, m). */
+PHGMG__PRIV void phgmg__output_feedthrough(const phgmg_ph_system *sys, const double *z, double t, phgmg_input_fn uf,
+                                          void *uuser, double *tmp, double *y) {
+  const int N = sys->N, m = sys->m;
+  int k, l, i;
+  if (uf) uf(t, tmp, uuser);
+  else for (k = 0; k < m; ++k) tmp[k] = 0.0;
+  for (k = 0; k < m; ++k) {
+    double acc = 0.0;
+    if (sys->P)
+      for (i = 0; i < N; ++i) acc += sys->P[(size_t)i + (size_t)k * (size_t)N] * z[i];
+    for (l = 0; l < m; ++l)
+      acc += ((sys->S ? sys->S[k + (size_t)l * m] : 0.0) + (sys->Nskew ? sys->Nskew[k + (size_t)l * m] : 0.0)) * tmp[l];
+    y[k] += acc;
+  }
 }
 
 PHGMG_DEF phgmg_result phgmg_simulate(const phgmg_ph_system *sys, const double *x0, double t0,
@@ -6082,6 +6550,8 @@ PHGMG_DEF phgmg_result phgmg_simulate(const phgmg_ph_system *sys, const double *
         for (i = 0; i < N; ++i) acc += bk[i] * g[i];
         Y[(size_t)k + (size_t)n * (size_t)m] = acc;
       }
+      if (sys->P || sys->S || sys->Nskew)
+        phgmg__output_feedthrough(sys, g, t0 + (double)n * dt, uf, uuser, tmp, Y + (size_t)n * (size_t)m);
     }
     if (energy) {
       energy->H[n] = phgmg_ph_hamiltonian(sys, x);
@@ -8938,6 +9408,13 @@ typedef struct phgmg__rctx {
                               GMG-POD: phgmg_reduce redoes it with manifold = POD */
   phgmg_study *st;         /* phgmg_study_reduce: the study (else NULL)     */
   int sf;                  /* fast path on the study's basis: 1 GMG, 2 SP1, 3 SP2 (0: none) */
+  /* descriptor models (sys->E set; see DESCRIPTOR MODELS in the manual):
+     Bp = E^{-1} B, the port columns of the GMG basis (sys->B without E);
+     sepw = E(i_k, i_k) w_k, the separable weights of H (sys->sep_w without E);
+     ef = the factorization of E */
+  const double *Bp, *sepw;
+  double *Bp_own, *sepw_own;
+  phgmg_jr_factor *ef;
 } phgmg__rctx;
 
 PHGMG__PRIV void phgmg__rctx_free(phgmg__rctx *c) {
@@ -8947,7 +9424,40 @@ PHGMG__PRIV void phgmg__rctx_free(phgmg__rctx *c) {
   phgmg__free(c->alloc, c->Tq);
   phgmg__free(c->alloc, c->runcol);
   phgmg__free(c->alloc, c->V2h);
+  phgmg__free(c->alloc, c->Bp_own);
+  phgmg__free(c->alloc, c->sepw_own);
+  phgmg_jr_factor_destroy(c->ef);
   c->jr = NULL; c->Xa = c->lg = c->Tq = c->V2h = NULL; c->runcol = NULL;
+  c->Bp_own = c->sepw_own = NULL; c->ef = NULL;
+}
+
+/* Descriptor models: E factored, Bp = E^{-1} B, sepw = E(i_k, i_k) w_k; no
+   study fast path (its cached blocks assume E = I). Without E: Bp = B,
+   sepw = the system's weights. */
+PHGMG__PRIV phgmg_result phgmg__reduce_descriptor_setup(phgmg__rctx *c) {
+  const phgmg_ph_system *sys = c->sys;
+  const int N = sys->N, m = sys->m;
+  int k;
+  phgmg_result rc;
+  c->Bp = sys->B;
+  c->sepw = sys->sep_w;
+  if (!sys->E) return PHGMG_OK;
+  c->sf = 0;
+  rc = phgmg__e_factor(sys, &c->ef, NULL, c->alloc);
+  if (rc != PHGMG_OK) return rc;
+  c->Bp_own = phgmg__dalloc(c->alloc, (size_t)N * m);
+  if (!c->Bp_own) return PHGMG_ERR_NOMEM;
+  memcpy(c->Bp_own, sys->B, (size_t)N * m * sizeof(double));
+  phgmg_jr_solve(c->ef, 'N', m, c->Bp_own, N);
+  c->Bp = c->Bp_own;
+  if (sys->nl == PHGMG_NL_SEPARABLE && sys->nsep > 0) {
+    c->sepw_own = phgmg__dalloc(c->alloc, (size_t)sys->nsep);
+    if (!c->sepw_own) return PHGMG_ERR_NOMEM;
+    for (k = 0; k < sys->nsep; ++k)
+      c->sepw_own[k] = (sys->sep_w ? sys->sep_w[k] : 1.0) * phgmg__ph_at(sys, sys->E, sys->sep_idx[k], sys->sep_idx[k]);
+    c->sepw = c->sepw_own;
+  }
+  return phgmg__all_finite(c->Bp_own, (size_t)N * m) ? PHGMG_OK : PHGMG_ERR_NANINF;
 }
 
 PHGMG__PRIV int phgmg__is_gmg(int method) {
@@ -8985,6 +9495,7 @@ PHGMG__PRIV phgmg_result phgmg__reduce_check(const phgmg_ph_system *sys, const d
   if (o->hyper < PHGMG_HYPER_ECSW || o->hyper > PHGMG_HYPER_GREEDY) return PHGMG_ERR_INVALID_ARG;
   if (!(o->hyper_tol >= 0.0 && o->hyper_tol < 1.0)) return PHGMG_ERR_INVALID_ARG;
   if (o->deim && sys->nl == PHGMG_NL_GENERAL) return PHGMG_ERR_UNSUPPORTED;
+  if (sys->P || sys->S || sys->Nskew) return PHGMG_ERR_UNSUPPORTED;   /* feedthrough: full model only */
   if (!(o->deim_tol >= 0.0 && o->deim_tol < 1.0) || o->deim_max < 0) return PHGMG_ERR_INVALID_ARG;
   if (!(o->dt >= 0.0) || o->dt == HUGE_VAL) return PHGMG_ERR_INVALID_ARG;
   if (o->lambda != o->lambda || !(o->degeneracy_tol >= 0.0 && o->degeneracy_tol < 1.0)) return PHGMG_ERR_INVALID_ARG;
@@ -9123,7 +9634,7 @@ PHGMG__PRIV phgmg_result phgmg__stage_basis(phgmg__rctx *c) {
   red->QB = phgmg__red_d(red, (size_t)N * m);
   red->RB = phgmg__red_d(red, (size_t)m * m);
   if (!red->V0 || !red->QB || !red->RB) return PHGMG_ERR_NOMEM;
-  rc = phgmg__thin_qr(N, m, c->sys->B, red->QB, red->RB, c->alloc);
+  rc = phgmg__thin_qr(N, m, c->Bp, red->QB, red->RB, c->alloc);
   if (rc != PHGMG_OK) return rc;
   if (c->o->pod_basis && c->o->pod_cols < need) return PHGMG_ERR_SIZE;
   if (!phgmg__is_gmg(red->method)) {
@@ -9152,7 +9663,7 @@ PHGMG__PRIV phgmg_result phgmg__stage_basis(phgmg__rctx *c) {
     c->V2h = phgmg__dalloc(c->alloc, (size_t)N * red->rn);
     if (!c->V2h) { phgmg__free(c->alloc, tmp); return PHGMG_ERR_NOMEM; }
   }
-  memcpy(red->V0, c->sys->B, (size_t)N * m * sizeof(double));
+  memcpy(red->V0, c->Bp, (size_t)N * m * sizeof(double));
   if (!c->o->pod_basis && red->kind != PHGMG_ROM_QUADRATIC) { /* large: randomized, X - QB QB^T X implicit */
     rc = phgmg__basis_pod_implicit(c, tmp);
     if (rc != PHGMG_ERR_NOT_CONVERGED) { phgmg__free(c->alloc, tmp); return rc; }
@@ -10188,16 +10699,23 @@ PHGMG__PRIV phgmg_result phgmg__study_gmg_blocks(phgmg__rctx *c) {
 PHGMG__PRIV phgmg_result phgmg__stage_gmg_blocks(phgmg__rctx *c) {
   phgmg_reduced *red = c->red;
   const int N = red->N, m = red->m, r = red->r, rn = red->rn;
-  double *GV = NULL;
+  double *GV = NULL, *EV = NULL;
+  const double *L0 = red->V0, *L2 = red->V2;   /* left factors: [V0, V2], or E [V0, V2] */
   int j;
   phgmg_result rc = PHGMG_OK;
   if (c->sf != 1) {
     rc = phgmg_jr_factor_create(&c->jr, c->sys, NULL, c->alloc);
     if (rc != PHGMG_OK) return rc;
-    GV = phgmg__dalloc(c->alloc, (size_t)N * (r + rn));
+    GV = phgmg__dalloc(c->alloc, (size_t)N * (r + rn) * (c->sys->E ? 2 : 1));
     if (!GV) return PHGMG_ERR_NOMEM;
     memcpy(GV, red->V0, (size_t)N * r * sizeof(double));
     if (rn) memcpy(GV + (size_t)N * r, red->V2, (size_t)N * rn * sizeof(double));
+    if (c->sys->E) { /* descriptor: G_E = E^T G E, so the blocks are (E V)^T G (E V) */
+      EV = GV + (size_t)N * (r + rn);
+      phgmg__ph_e_apply(c->sys, 'N', r + rn, GV, N, EV, N);
+      memcpy(GV, EV, (size_t)N * (r + rn) * sizeof(double));
+      L0 = EV; L2 = EV + (size_t)N * r;
+    }
     phgmg_jr_solve(c->jr, 'N', r + rn, GV, N);           /* GV = G [V0, V2] */
   }
   red->G00 = phgmg__red_d(red, (size_t)r * r);
@@ -10214,12 +10732,12 @@ PHGMG__PRIV phgmg_result phgmg__stage_gmg_blocks(phgmg__rctx *c) {
   if (c->sf == 1) {
     phgmg__study_gmg_blocks(c);
   } else {
-    phgmg__atb(N, r, r, red->V0, GV, red->G00);
+    phgmg__atb(N, r, r, L0, GV, red->G00);
   }
   if (rn && c->sf != 1) {
-    phgmg__atb(N, r, rn, red->V0, GV + (size_t)N * r, red->G01);
-    phgmg__atb(N, rn, r, red->V2, GV, red->G10);
-    phgmg__atb(N, rn, rn, red->V2, GV + (size_t)N * r, red->G11);
+    phgmg__atb(N, r, rn, L0, GV + (size_t)N * r, red->G01);
+    phgmg__atb(N, rn, r, L2, GV, red->G10);
+    phgmg__atb(N, rn, rn, L2, GV + (size_t)N * r, red->G11);
   }
   phgmg__free(c->alloc, GV);
   for (j = 0; j < m; ++j) red->Bh[j + (size_t)j * r] = 1.0;
@@ -10230,6 +10748,20 @@ PHGMG__PRIV phgmg_result phgmg__stage_gmg_blocks(phgmg__rctx *c) {
   return phgmg__inv(r, red->G00, red->K, c->alloc);
 }
 
+/* Descriptor: X (N x nc, ld N) <- E^T X. */
+PHGMG__PRIV phgmg_result phgmg__e_transpose_block(const phgmg__rctx *c, int nc, double *X) {
+  const int N = c->sys->N;
+  double *t = phgmg__dalloc(c->alloc, (size_t)N);
+  int j;
+  if (!t) return PHGMG_ERR_NOMEM;
+  for (j = 0; j < nc; ++j) {
+    phgmg__ph_mtv(c->sys, c->sys->E, X + (size_t)j * N, t);
+    memcpy(X + (size_t)j * N, t, (size_t)N * sizeof(double));
+  }
+  phgmg__free(c->alloc, t);
+  return PHGMG_OK;
+}
+
 /* The test basis of SP1 (Q V) or SP2 (POD of the gradient snapshots) into Vg. */
 PHGMG__PRIV phgmg_result phgmg__sp_test_basis(phgmg__rctx *c, double *Vg) {
   phgmg_reduced *red = c->red;
@@ -10237,9 +10769,9 @@ PHGMG__PRIV phgmg_result phgmg__sp_test_basis(phgmg__rctx *c, double *Vg) {
   double *Fg, *S;
   int j, k = 0;
   phgmg_result rc;
-  if (red->method == PHGMG_METHOD_SP1) {
+  if (red->method == PHGMG_METHOD_SP1) {   /* Hess H V: Q V, or E^T Q V */
     phgmg_ph_apply(c->sys, 'Q', r, red->V0, N, Vg, N);
-    return PHGMG_OK;
+    return c->sys->E ? phgmg__e_transpose_block(c, r, Vg) : PHGMG_OK;
   }
   if (c->o->grad_basis) {
     if (c->o->grad_cols < r) return PHGMG_ERR_SIZE;
@@ -10250,7 +10782,8 @@ PHGMG__PRIV phgmg_result phgmg__sp_test_basis(phgmg__rctx *c, double *Vg) {
   if (!Fg) return PHGMG_ERR_NOMEM;
   S = Fg + (size_t)N * ns;
   for (j = 0; j < ns; ++j) phgmg_ph_gradient(c->sys, c->X + (size_t)j * c->ldx, Fg + (size_t)j * N);
-  rc = phgmg_pod(N, ns, Fg, N, r, 0.0, Vg, N, S, &k, c->alloc);
+  rc = c->sys->E ? phgmg__e_transpose_block(c, ns, Fg) : PHGMG_OK;   /* grad H = E^T z */
+  if (rc == PHGMG_OK) rc = phgmg_pod(N, ns, Fg, N, r, 0.0, Vg, N, S, &k, c->alloc);
   if (rc == PHGMG_OK && (k < r || !(S[r - 1] > phgmg__rank_floor(N, ns, Fg, N)))) rc = PHGMG_ERR_SIZE;
   phgmg__free(c->alloc, Fg);
   return rc;
@@ -10284,15 +10817,49 @@ PHGMG__PRIV phgmg_result phgmg__stage_sp_blocks(phgmg__rctx *c) {
   }
   if (rc == PHGMG_OK) memcpy(red->Ainv, Ainv, (size_t)r * r * sizeof(double));
   if (rc == PHGMG_OK) {
+    const double *Wz = red->W;   /* the test basis of the co-state: W, or E^{-T} W */
     phgmg_gemm('N', 'N', N, r, r, 1.0, Vg, N, Ainv, r, 0.0, red->W, N);
-    phgmg_ph_apply(c->sys, 'J', r, red->W, N, Vg, N);
-    phgmg_ph_apply(c->sys, 'R', r, red->W, N, T, N);
+    if (c->sys->E) {
+      double *Wt = phgmg__red_d(red, (size_t)N * r);
+      if (!Wt) { phgmg__free(c->alloc, Vg); return PHGMG_ERR_NOMEM; }
+      memcpy(Wt, red->W, (size_t)N * r * sizeof(double));
+      phgmg_jr_solve(c->ef, 'T', r, Wt, N);
+      Wz = Wt;
+    }
+    phgmg_ph_apply(c->sys, 'J', r, Wz, N, Vg, N);
+    phgmg_ph_apply(c->sys, 'R', r, Wz, N, T, N);
     for (i = 0; i < N * r; ++i) Vg[i] -= T[i];
-    phgmg__atb(N, r, r, red->W, Vg, red->K);
-    phgmg__atb(N, r, m, red->W, c->sys->B, red->Bh);
+    phgmg__atb(N, r, r, Wz, Vg, red->K);
+    phgmg__atb(N, r, m, Wz, c->sys->B, red->Bh);
   }
   phgmg__free(c->alloc, Vg);
   return rc;
+}
+
+/* Descriptor: Qh = (E V0)^T Q V0, Q01 = (E V0)^T Q V2, Q11 = (E V2)^T Q V2
+   (Hess H = E^T Q) from QV = Q [V0, V2]; Qh and Q11 symmetrised. */
+PHGMG__PRIV phgmg_result phgmg__quadratic_terms_e(phgmg__rctx *c, const double *QV) {
+  phgmg_reduced *red = c->red;
+  const int N = red->N, r = red->r, rn = red->rn;
+  double *EV = phgmg__dalloc(c->alloc, (size_t)N * (r + rn));
+  int i, j;
+  if (!EV) return PHGMG_ERR_NOMEM;
+  phgmg__ph_e_apply(c->sys, 'N', r, red->V0, N, EV, N);
+  if (rn) phgmg__ph_e_apply(c->sys, 'N', rn, red->V2, N, EV + (size_t)N * r, N);
+  phgmg__atb(N, r, r, EV, QV, red->Qh);
+  if (rn) {
+    phgmg__atb(N, r, rn, EV, QV + (size_t)N * r, red->Q01);
+    phgmg__atb(N, rn, rn, EV + (size_t)N * r, QV + (size_t)N * r, red->Q11);
+    for (j = 0; j < rn; ++j)
+      for (i = 0; i < j; ++i)
+        red->Q11[i + (size_t)j * rn] = red->Q11[j + (size_t)i * rn] =
+            0.5 * (red->Q11[i + (size_t)j * rn] + red->Q11[j + (size_t)i * rn]);
+  }
+  for (j = 0; j < r; ++j)
+    for (i = 0; i < j; ++i)
+      red->Qh[i + (size_t)j * r] = red->Qh[j + (size_t)i * r] = 0.5 * (red->Qh[i + (size_t)j * r] + red->Qh[j + (size_t)i * r]);
+  phgmg__free(c->alloc, EV);
+  return PHGMG_OK;
 }
 
 /* Stage 4a, quadratic part of H: Qh = V0^T Q V0 (exactly symmetric), and
@@ -10318,6 +10885,11 @@ PHGMG__PRIV phgmg_result phgmg__stage_quadratic_terms(phgmg__rctx *c) {
   } else {
     phgmg_ph_apply(c->sys, 'Q', r, red->V0, N, QV, N);
     if (rn) phgmg_ph_apply(c->sys, 'Q', rn, red->V2, N, QV + (size_t)N * r, N);
+    if (c->sys->E) { /* descriptor: Hess H = E^T Q, so Qh = (E V0)^T (Q V0) ... */
+      phgmg_result rc = phgmg__quadratic_terms_e(c, QV);
+      phgmg__free(c->alloc, QV);
+      return rc;
+    }
     phgmg__atb(N, r, r, red->V0, QV, red->Qh);
   }
   for (j = 0; j < r; ++j)
@@ -10370,7 +10942,7 @@ PHGMG__PRIV phgmg_result phgmg__hyper_ecsw_manifold(phgmg__rctx *c, const double
   }
   for (a = 0; a < (int)nrow; ++a) tg[a] = 0.0;
   for (k = 0; k < nt; ++k) {
-    const double sw = sys->sep_w ? sys->sep_w[live[k]] : 1.0;
+    const double sw = c->sepw ? c->sepw[live[k]] : 1.0;
     for (a = 0; a < (int)nrow; ++a) tg[a] += sw * Gm[a + (size_t)k * nrow];
   }
   rc = phgmg_ecsw(nt, (int)nrow, Gm, (int)nrow, tg, c->o->hyper_tol, pts, wt, nd, &c->inf.hyper_residual, c->alloc);
@@ -10397,7 +10969,7 @@ PHGMG__PRIV phgmg_result phgmg__hyper_ecsw(phgmg__rctx *c, const double *F, int 
   sw = Vt + (size_t)nl * r;
   for (a = 0; a < r; ++a)
     for (k = 0; k < nl; ++k) Vt[k + (size_t)a * nl] = red->V0[c->sys->sep_idx[live[k]] + (size_t)a * N];
-  for (k = 0; k < nl; ++k) sw[k] = c->sys->sep_w ? c->sys->sep_w[live[k]] : 1.0;
+  for (k = 0; k < nl; ++k) sw[k] = c->sepw ? c->sepw[live[k]] : 1.0;
   rc = phgmg_ecsw_separable(nl, c->ns, F, nl, r, Vt, nl, sw, c->o->hyper_tol, pts, wt, nd,
                             &c->inf.hyper_residual, c->alloc);
   for (k = 0; rc == PHGMG_OK && k < *nd; ++k) pts[k] = live[pts[k]];   /* ascending stays ascending */
@@ -10463,7 +11035,7 @@ PHGMG__PRIV phgmg_result phgmg__separable_points(phgmg__rctx *c, int *pts, doubl
     else if (ecsw)
       rc = phgmg__hyper_ecsw(c, F, nl, live, pts, wt, nd);
     else
-      rc = phgmg_deim_select(nt, ns, F, nt, sys->sep_w, o->deim_tol, o->deim_max,
+      rc = phgmg_deim_select(nt, ns, F, nt, c->sepw, o->deim_tol, o->deim_max,
                              o->hyper == PHGMG_HYPER_GREEDY ? PHGMG_DEIM_GREEDY : PHGMG_DEIM_QDEIM,
                              pts, wt, nd, &nneg, &c->inf.deim_sigma_ratio, c->alloc);
     phgmg__free(c->alloc, F);
@@ -10471,7 +11043,7 @@ PHGMG__PRIV phgmg_result phgmg__separable_points(phgmg__rctx *c, int *pts, doubl
     c->inf.hyper_method = o->hyper;
   } else {
     *nd = nt;
-    for (a = 0; a < nt; ++a) { pts[a] = a; wt[a] = sys->sep_w ? sys->sep_w[a] : 1.0; }
+    for (a = 0; a < nt; ++a) { pts[a] = a; wt[a] = c->sepw ? c->sepw[a] : 1.0; }
   }
   c->inf.deim_modes = *nd;      /* reported on PHGMG_ERR_NEGATIVE_WEIGHT too */
   c->inf.deim_negative = nneg;
@@ -10623,6 +11195,7 @@ PHGMG__PRIV phgmg_result phgmg__reduce_run(phgmg_reduced **out, const phgmg_ph_s
   c.degtol = opts->degeneracy_tol > 0.0 ? opts->degeneracy_tol : 1e-12;
   c.rfloor = phgmg__rank_floor(sys->N, ns, X, ldx);
   rc = phgmg__runs_layout(&c);
+  if (rc == PHGMG_OK) rc = phgmg__reduce_descriptor_setup(&c);
   if (rc == PHGMG_OK) rc = phgmg__reduce_new(&c);
   if (rc == PHGMG_OK && c.sf) { c.red->study = st; c.red->sbasis = c.sf; }
   if (rc == PHGMG_OK) { phgmg__progress(opts, "basis"); rc = phgmg__stage_basis(&c); }
@@ -10716,10 +11289,17 @@ PHGMG_DEF phgmg_result phgmg_reduced_W(const phgmg_reduced *red, const double *x
   if (!D) return PHGMG_ERR_NOMEM;
   GtD = D + (size_t)N * r; E = GtD + (size_t)N * r; Einv = E + (size_t)r * r;
   phgmg_reduced_dphi(red, xr, D, N);
-  memcpy(GtD, D, (size_t)N * r * sizeof(double));
+  if (red->sys->E) phgmg__ph_e_apply(red->sys, 'N', r, D, N, GtD, N);   /* descriptor: G_E = E^T G E */
+  else memcpy(GtD, D, (size_t)N * r * sizeof(double));
   rc = phgmg_jr_factor_create(&jr, red->sys, NULL, alloc);
   if (rc == PHGMG_OK) {
     phgmg_jr_solve(jr, 'T', r, GtD, N);                      /* G^T D */
+    if (red->sys->E) {                                       /* E^T G^T E D, column by column */
+      for (j = 0; j < r; ++j) {
+        phgmg__ph_mtv(red->sys, red->sys->E, GtD + (size_t)j * N, W + (size_t)j * ldw);
+        memcpy(GtD + (size_t)j * N, W + (size_t)j * ldw, (size_t)N * sizeof(double));
+      }
+    }
     phgmg__atb(N, r, r, GtD, D, E);                           /* (G^T D)^T D = D^T G D */
     rc = phgmg__inv(r, E, Einv, alloc);
     if (rc == PHGMG_OK)                                       /* W = G^T D E^{-T} */
@@ -11164,6 +11744,7 @@ PHGMG_DEF phgmg_result phgmg_study_create(phgmg_study **out, const phgmg_ph_syst
   phgmg_result rc;
   if (!out) return PHGMG_ERR_INVALID_ARG;
   *out = NULL;
+  if (sys && (sys->E || sys->P || sys->S || sys->Nskew)) return PHGMG_ERR_UNSUPPORTED; /* standard form only */
   if (!sys || !X || !so) return PHGMG_ERR_INVALID_ARG;
   if (so->what & ~(PHGMG_STUDY_GMG | PHGMG_STUDY_SP | PHGMG_STUDY_SP2)) return PHGMG_ERR_INVALID_ARG;
   what = so->what ? so->what : (PHGMG_STUDY_GMG | PHGMG_STUDY_SP);
@@ -11521,6 +12102,7 @@ PHGMG_DEF phgmg_result phgmg_ph_abc(const phgmg_ph_system *sys, double *A, doubl
   int N, m, i;
   double *I, *Qd, *T;
   if (!sys) return PHGMG_ERR_INVALID_ARG;
+  if (sys && (sys->E || sys->P || sys->S || sys->Nskew)) return PHGMG_ERR_UNSUPPORTED; /* standard form only */
   if (sys->nl != PHGMG_NL_NONE) return PHGMG_ERR_UNSUPPORTED;
   N = sys->N; m = sys->m;
   if (N < 1 || m < 1 || m > N) return PHGMG_ERR_SIZE;
@@ -11637,6 +12219,7 @@ PHGMG_DEF phgmg_result phgmg_bt(const phgmg_ph_system *sys, int r, double *Ar, d
   double *A, *C, *P, *O, *Tb, *Wb, *S;
   phgmg_result rc;
   if (!sys || !Ar || !Br || !Cr) return PHGMG_ERR_INVALID_ARG;
+  if (sys && (sys->E || sys->P || sys->S || sys->Nskew)) return PHGMG_ERR_UNSUPPORTED; /* standard form only */
   if (sys->nl != PHGMG_NL_NONE) return PHGMG_ERR_UNSUPPORTED;
   rc = phgmg_ph_validate(sys, 0.0, NULL, alloc);
   if (rc != PHGMG_OK) return rc;
@@ -12039,6 +12622,7 @@ PHGMG_DEF phgmg_result phgmg_prbt(phgmg_reduced **out, const phgmg_ph_system *sy
   phgmg_result rc;
   if (!out) return PHGMG_ERR_INVALID_ARG;
   *out = NULL;
+  if (sys && (sys->E || sys->P || sys->S || sys->Nskew)) return PHGMG_ERR_UNSUPPORTED; /* standard form only */
   if (!sys) return PHGMG_ERR_INVALID_ARG;
   if (sys->nl != PHGMG_NL_NONE) return PHGMG_ERR_UNSUPPORTED;
   if (opts && (opts->eps < 0.0 || opts->dt < 0.0 || !isfinite(opts->eps) || !isfinite(opts->dt) ||
@@ -12126,6 +12710,7 @@ PHGMG_DEF phgmg_result phgmg_prbt_riccati(const phgmg_ph_system *sys, double eps
   double *A, *C, CBn;
   phgmg_result rc;
   if (!sys || !X || !Y) return PHGMG_ERR_INVALID_ARG;
+  if (sys && (sys->E || sys->P || sys->S || sys->Nskew)) return PHGMG_ERR_UNSUPPORTED; /* standard form only */
   if (sys->nl != PHGMG_NL_NONE) return PHGMG_ERR_UNSUPPORTED;
   rc = phgmg_ph_validate(sys, 0.0, NULL, alloc);
   if (rc != PHGMG_OK) return rc;
@@ -12782,6 +13367,7 @@ PHGMG_DEF phgmg_result phgmg_linear_basis(const phgmg_ph_system *sys, phgmg_basi
   double *X = NULL;
   phgmg_result rc;
   if (!sys || !V) return PHGMG_ERR_INVALID_ARG;
+  if (sys && (sys->E || sys->P || sys->S || sys->Nskew)) return PHGMG_ERR_UNSUPPORTED; /* standard form only */
   if (kind < PHGMG_BASIS_FREQ || kind > PHGMG_BASIS_H2) return PHGMG_ERR_INVALID_ARG;
   if (opts && !phgmg__basis_opts_ok(opts)) return PHGMG_ERR_INVALID_ARG;
   if (sys->nl != PHGMG_NL_NONE) return PHGMG_ERR_UNSUPPORTED;

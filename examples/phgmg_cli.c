@@ -67,6 +67,19 @@ static const char *const help_lines[] = {
   "  --J-coo SPEC, --R-coo SPEC, --Q-coo SPEC   instead of --J, --R, --Q: sparse\n",
   "                      matrices as coordinate triplets (all three together; N from\n",
   "                      --B); see SPARSE MATRICES.\n",
+  "  --E FILE, --E-coo SPEC   a mass matrix (N x N, nonsingular; dense with --J,\n",
+  "                      coordinate triplets with --J-coo): the descriptor model\n",
+  "                      E x' = (J - R) z + B u, y = B^T z, z = Q x (+ the nonlinear\n",
+  "                      gradient), energy H = x^T E^T Q x / 2 (+ sum E_kk phi_k).\n",
+  "                      E^T Q must be symmetric positive definite (semidefinite with\n",
+  "                      --poly), and rows of E at --poly-idx coordinates unit rows\n",
+  "                      times E_kk > 0. Methods gmg-pod, gmg-qm, sp1, sp2 (the\n",
+  "                      reduced model is an ordinary pH model: simulate-rom, export).\n",
+  "  --P FILE, --S FILE, --N FILE   feedthrough (N x m, m x m, m x m; each optional):\n",
+  "                      E x' = (J - R) z + (B - P) u, y = (B + P)^T z + (S + N) u, with\n",
+  "                      [[R, P], [P^T, S]] symmetric positive semidefinite and N skew.\n",
+  "                      Checked and simulated with the full model; the reductions do\n",
+  "                      not take feedthrough yet (an error names the files).\n",
   "  --X FILE            snapshot matrix N x ns (ns >= 2 states, one per column; a\n",
   "                      trajectory x(t_0), ..., x(t_n), normally starting at x = 0).\n",
   "                      Repeatable (up to 16): one training run per file, the runs'\n",
@@ -832,6 +845,8 @@ static int explain_validate(phgmg_result rc, const mat *J, const mat *R, const m
 typedef struct reduce_args {
   const char *J, *R, *B, *Q, *X, *poly, *poly_idx, *poly_w, *out, *name, *input, *method;
   const char *Jcoo, *Rcoo, *Qcoo; /* sparse J, R, Q as coordinate triplets */
+  const char *E, *Ecoo;            /* descriptor models: the mass matrix, dense or sparse */
+  const char *Pf, *Sf, *Nf;        /* feedthrough P, S, N */
   const char *expf, *potential, *hyper;
   double hyper_tol;
   int simulate, steps, r, rn, no_deim, deim_max, deim_neg, save_snap, have_dt_map, newton_iter;
@@ -893,7 +908,7 @@ static int parse_reduce(int argc, char **argv, reduce_args *A) {
     }
     if (repeated_opt(o, seen, &nseen)) return 2;
     STR("--J", J) STR("--R", R) STR("--B", B) STR("--Q", Q)
-    STR("--J-coo", Jcoo) STR("--R-coo", Rcoo) STR("--Q-coo", Qcoo)
+    STR("--J-coo", Jcoo) STR("--R-coo", Rcoo) STR("--Q-coo", Qcoo) STR("--E", E) STR("--E-coo", Ecoo) STR("--P", Pf) STR("--S", Sf) STR("--N", Nf)
     STR("--poly", poly) STR("--poly-idx", poly_idx) STR("--poly-w", poly_w)
     STR("--exp", expf) STR("--potential", potential) STR("--hyper", hyper)
     DBL("--hyper-tol", hyper_tol, 0.0)
@@ -934,6 +949,8 @@ static int parse_reduce(int argc, char **argv, reduce_args *A) {
 #undef INT
 #undef DBL
   }
+  if ((A->E && A->Jcoo) || (A->Ecoo && !A->Jcoo))
+    return usage_error("reduce: give E like J, R, Q: --E with --J/--R/--Q, --E-coo with --J-coo/--R-coo/--Q-coo");
   if ((A->J || A->R || A->Q) && (A->Jcoo || A->Rcoo || A->Qcoo))
     return usage_error("reduce: give J, R, Q either dense (--J, --R, --Q) or sparse (--J-coo, --R-coo, --Q-coo)");
   if (A->Jcoo || A->Rcoo || A->Qcoo) {
@@ -1072,7 +1089,9 @@ typedef struct reduce_state {
   int *idx;
   double *fpoly, *fexp, named[8]; /* the family's coefficients as phgmg_ph_system wants them */
   double *Xsim, *Ysim, *V0;
-  cli_csc cJ, cR, cQ;     /* sparse input (--J-coo ...) */
+  cli_csc cJ, cR, cQ, cE; /* sparse input (--J-coo ..., --E-coo) */
+  mat E;                  /* --E (dense) */
+  mat Pm, Sm, Nm;         /* --P, --S, --N */
   phgmg_ph_sparse *sp;    /* its banded, RCM-ordered system; NULL for dense input */
   double *Xperm, *Uord;   /* snapshots in the internal order; un-permuted output */
   cli_input in;
@@ -1167,12 +1186,12 @@ static int load_family(const reduce_args *A, reduce_state *S, phgmg_ph_system *s
 }
 
 static void reduce_cleanup(reduce_state *S) {
-  mat_free(&S->J); mat_free(&S->R); mat_free(&S->B); mat_free(&S->Q); mat_free(&S->X);
+  mat_free(&S->J); mat_free(&S->R); mat_free(&S->B); mat_free(&S->Q); mat_free(&S->E); mat_free(&S->Pm); mat_free(&S->Sm); mat_free(&S->Nm); mat_free(&S->X);
   mat_free(&S->poly); mat_free(&S->pidx); mat_free(&S->pw); mat_free(&S->ex); mat_free(&S->in.tab);
   { int k; for (k = 0; k < 16; ++k) { mat_free(&S->tin[k].tab); mat_free(&S->Xs[k]); mat_free(&S->xinp[k].tab); } }
   free(S->Xcat);
   free(S->idx); free(S->fpoly); free(S->fexp); free(S->Xsim); free(S->Ysim); free(S->V0);
-  cli_csc_free(&S->cJ); cli_csc_free(&S->cR); cli_csc_free(&S->cQ);
+  cli_csc_free(&S->cJ); cli_csc_free(&S->cR); cli_csc_free(&S->cQ); cli_csc_free(&S->cE);
   phgmg_ph_sparse_destroy(S->sp); free(S->Xperm); free(S->Uord);
   phgmg_reduced_destroy(S->red);
   stage_abort(&S->sg); /* after a failure: no output of this run stays */
@@ -1208,10 +1227,11 @@ static int load_sparse_system(const reduce_args *A, reduce_state *S, phgmg_ph_sy
     return fail("%s (--B): expected shape (N, m) with 1 <= m <= N, or (N,), got %s", A->B, shape_str(&S->B));
   m = S->B.cols;
   if (load_coo(&S->cJ, "--J-coo", A->Jcoo, N) || load_coo(&S->cR, "--R-coo", A->Rcoo, N) ||
-      load_coo(&S->cQ, "--Q-coo", A->Qcoo, N))
+      load_coo(&S->cQ, "--Q-coo", A->Qcoo, N) || (A->Ecoo && load_coo(&S->cE, "--E-coo", A->Ecoo, N)))
     return 1;
-  rc = phgmg_ph_sparse_create(&S->sp, N, m, &S->cJ.A, &S->cR.A, &S->cQ.A, S->B.a, NULL, &inf, NULL);
-  if (rc != PHGMG_OK) return fail("sparse J, R, Q: %s", phgmg_result_string(rc));
+  rc = phgmg_ph_sparse_create_e(&S->sp, N, m, &S->cJ.A, &S->cR.A, &S->cQ.A, A->Ecoo ? &S->cE.A : NULL, S->B.a,
+                                NULL, &inf, NULL);
+  if (rc != PHGMG_OK) return fail("sparse J, R, Q%s: %s", A->Ecoo ? ", E" : "", phgmg_result_string(rc));
   *sys = *phgmg_ph_sparse_system(S->sp);
   progress("sparse J, R, Q: N = %d, %ld stored entries; half-bandwidth %d (given order %d, reverse "
            "Cuthill-McKee %d)%s", N, inf.nnz, inf.kb, inf.kb_input, inf.kb_rcm,
@@ -1289,6 +1309,38 @@ static int load_snapshot_files(const reduce_args *A, reduce_state *S, int N, int
   return 0;
 }
 
+/* --P (N x m), --S, --N (m x m) into sys; with sparse input P's rows are
+   moved to the internal ordering. */
+static int load_feedthrough(const reduce_args *A, reduce_state *S, phgmg_ph_system *sys) {
+  const int N = sys->N, m = sys->m;
+  if (A->Pf) {
+    if (mat_load(&S->Pm, "--P", A->Pf)) return 1;
+    if (S->Pm.ndim == 0 || S->Pm.rows != N || S->Pm.cols != m)
+      return fail("%s (--P): expected shape (%d, %d) (N x m, like B), got %s", A->Pf, N, m, shape_str(&S->Pm));
+    if (S->sp) {
+      double *t = (double *)malloc(sizeof(double) * (size_t)N * m + 1);
+      if (!t) return fail("out of memory");
+      phgmg_ph_sparse_to_banded_order(S->sp, m, S->Pm.a, N, t, N);
+      memcpy(S->Pm.a, t, sizeof(double) * (size_t)N * m);
+      free(t);
+    }
+    sys->P = S->Pm.a;
+  }
+  if (A->Sf) {
+    if (mat_load(&S->Sm, "--S", A->Sf)) return 1;
+    if (S->Sm.rows * S->Sm.cols != m * m || (m > 1 && (S->Sm.rows != m || S->Sm.cols != m)))
+      return fail("%s (--S): expected shape (%d, %d) (m x m), got %s", A->Sf, m, m, shape_str(&S->Sm));
+    sys->S = S->Sm.a;
+  }
+  if (A->Nf) {
+    if (mat_load(&S->Nm, "--N", A->Nf)) return 1;
+    if (S->Nm.rows * S->Nm.cols != m * m || (m > 1 && (S->Nm.rows != m || S->Nm.cols != m)))
+      return fail("%s (--N): expected shape (%d, %d) (m x m), got %s", A->Nf, m, m, shape_str(&S->Nm));
+    sys->Nskew = S->Nm.a;
+  }
+  return 0;
+}
+
 /* The full model from the files: dense or sparse J, R, Q, B and the nonlinear
    part, checked (phgmg_ph_validate), into S->sys. */
 static int load_system(const reduce_args *A, reduce_state *S) {
@@ -1324,6 +1376,14 @@ static int load_system(const reduce_args *A, reduce_state *S) {
     sys.N = N; sys.m = m; sys.storage = PHGMG_DENSE;
     sys.J = S->J.a; sys.R = S->R.a; sys.Q = S->Q.a; sys.B = S->B.a;
     sys.nl = PHGMG_NL_NONE;
+    if (A->E) {
+      if (mat_load(&S->E, "--E", A->E)) return 1;
+      if (S->E.ndim != 2 || S->E.rows != N || S->E.cols != N)
+        return fail("%s (--E): E must be a square N x N matrix (N = %d from %s), got %s", A->E, N, A->J,
+                    shape_str(&S->E));
+      sys.E = S->E.a;
+      progress("E: %s (descriptor model)", A->E);
+    }
   }
   if (A->poly_idx) {
     int nt;
@@ -1358,7 +1418,23 @@ static int load_system(const reduce_args *A, reduce_state *S) {
              A->potential ? A->potential : "exp-polynomial", sys.poly_deg, sys.nexp,
              sys.phi_nfun > 1 ? " (one function per term)" : "");
   }
+  if (load_feedthrough(A, S, &sys)) return 1;
   rc = phgmg_ph_validate(&sys, 0.0, &rcond, NULL);
+  if (rc == PHGMG_ERR_FEEDTHROUGH || (rc == PHGMG_ERR_UNSUPPORTED && (sys.P || sys.S || sys.Nskew)))
+    return fail("%s%s%s%s%s (--P, --S, --N): %s", A->Pf ? A->Pf : "", A->Sf ? " " : "", A->Sf ? A->Sf : "",
+                A->Nf ? " " : "", A->Nf ? A->Nf : "", phgmg_result_string(rc));
+  if (rc != PHGMG_OK && sys.E) {
+    const char *ef = A->E ? A->E : A->Ecoo, *qf = A->Q ? A->Q : A->Qcoo;
+    switch (rc) {
+      case PHGMG_ERR_E_SINGULAR: return fail("%s (--E): %s", ef, phgmg_result_string(rc));
+      case PHGMG_ERR_EQ_NOT_SYMMETRIC:
+      case PHGMG_ERR_EQ_NOT_PD: return fail("%s, %s (--E, --Q): %s", ef, qf, phgmg_result_string(rc));
+      case PHGMG_ERR_E_COUPLED: return fail("%s, %s (--E, --poly-idx): %s", ef, A->poly_idx, phgmg_result_string(rc));
+      case PHGMG_ERR_UNSUPPORTED: return fail("%s (--E): %s (a descriptor model takes a separable nonlinear part only)", ef,
+                                              phgmg_result_string(rc));
+      default: break;
+    }
+  }
   if (rc != PHGMG_OK && S->sp)
     return fail("the sparse system (%s, %s, %s, %s) is not valid: %s%s", A->Jcoo, A->Rcoo, A->Qcoo, A->B,
                 phgmg_result_string(rc), rc == PHGMG_ERR_SINGULAR ? " (J - R singular)" : "");
@@ -1492,6 +1568,10 @@ static int run_reduction(const reduce_args *A, reduce_state *S, int method, cons
       case PHGMG_ERR_NEGATIVE_WEIGHT:
         return fail("reduction failed: %s (use --deim-allow-negative, a smaller --deim-tol, or --no-deim)",
                     phgmg_result_string(rc));
+      case PHGMG_ERR_UNSUPPORTED:
+        if (A->Pf || A->Sf || A->Nf)
+          return fail("reduction failed: the reductions do not take feedthrough (--P, --S, --N) yet");
+        return fail("reduction failed: %s", phgmg_result_string(rc));
       default:
         return fail("reduction failed: %s", phgmg_result_string(rc));
     }

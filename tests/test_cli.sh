@@ -491,5 +491,33 @@ run_err "lambda word" 2 "--lambda" "$P" reduce $SYS $QSIM --method gmg-qm --r 10
 run_err "train-input with --X" 2 "needs --simulate" "$P" reduce $SYS --X out/msd_snapshots.npy --train-input sin --method gmg-qm --r 10 --out q8
 run_err "train-input with --input" 2 "not both" "$P" reduce $SYS $QSIM --input sin --train-input const --method gmg-qm --r 10 --out q8
 
+# ---- descriptor models (--E): E = I gives the model without E; bad E named ----
+if [ "$HAVE_NP" = 1 ]; then
+  "$PY" -c "
+import numpy as np
+J = np.load('model/J.npy'); N = J.shape[0]
+np.save('E_id.npy', np.eye(N)); np.save('E_rect.npy', np.eye(N)[:, :N - 1])
+np.save('E_nonsym.npy', np.eye(N) + 0.1 * J)
+np.save('E_neg.npy', -np.eye(N))
+" && pass || bad "descriptor files"
+  run_ok "reduce --E identity" "$P" reduce $SYS --E E_id.npy $SIM --method gmg-pod --r 12 --out oE --name m --quiet
+  run_ok "simulate-rom --E identity" "$P" simulate-rom --model oE/m.phgmgrom $ROMSIM --out oE/y.npy --quiet
+  run_ok "--E identity == no E (1e-9)" "$REF" compare out/y_rom.npy oE/y.npy 1e-9
+  run_err "E not square" 1 "E_rect.npy (--E)" "$P" reduce $SYS --E E_rect.npy $SIM --method gmg-pod --r 12 --out oEr
+  [ ! -e oEr ] && pass || bad "E not square: output written"
+  run_err "E^T Q not symmetric" 1 "E^T Q is not symmetric" "$P" reduce $SYS --E E_nonsym.npy $SIM --method gmg-pod --r 12 --out oEn
+  [ ! -e oEn ] && pass || bad "E^T Q not symmetric: output written"
+  run_err "E^T Q not PD" 1 "E_neg.npy, model/Q.npy (--E, --Q)" "$P" reduce $SYS --E E_neg.npy $SIM --method gmg-pod --r 12 --out oEp
+  "$PY" -c "
+import numpy as np
+np.save('S_ok.npy', 0.1 * np.eye(1)); np.save('S_neg.npy', -0.1 * np.eye(1))
+" && pass || bad "feedthrough files"
+  run_err "feedthrough S not PSD" 1 "S_neg.npy (--P, --S, --N)" "$P" reduce $SYS --S S_neg.npy $SIM --method gmg-pod --r 12 --out oSn
+  [ ! -e oSn ] && pass || bad "feedthrough not PSD: output written"
+  run_err "feedthrough: reduction refused" 1 "do not take feedthrough" "$P" reduce $SYS --S S_ok.npy $SIM --method gmg-pod --r 12 --out oSo
+  [ ! -e oSo ] && pass || bad "feedthrough refused: output written"
+  run_err "--E with --J-coo" 2 "--E-coo" "$P" reduce --J-coo J.npy --R-coo R.npy --Q-coo Q.npy --B model/B.npy --E E_id.npy $SIM --method gmg-pod --r 12 --out oEc
+fi
+
 echo "test_cli: $npass passed, $nfail failed"
 [ "$nfail" -eq 0 ]
