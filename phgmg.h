@@ -1014,8 +1014,10 @@ typedef struct phgmg_reduce_opts {
      kept, the online width is rn = min(rw, (r-m)(r-m+1)/2). 0 (default): the
      paper's r_n = 8 for the hierarchical POD manifold (manifold = 0), wide
      for the greedy and alternating-minimization manifolds. Cost of wide:
-     offline one SVD of the N x ns residual (the greedy reuses its own) and
-     O((N + ns) rw (r-m)^2) for the compression; online (hyper-reduced, so
+     offline one SVD of the N x ns residual (the greedy with greedy_window
+     > 0 reuses its own; memory: N min(N, ns) doubles for its modes, as much
+     as the copy of the snapshots GMG-QM keeps) and O((N + ns) rw (r-m)^2)
+     for the compression; online (hyper-reduced, so
      independent of N) the quadratic terms cost O(rn (r-m)^2) per evaluation
      and the stepper's memory grows with rn r (PHGMG_ROM_STEPPER_MEMSIZE_MAX):
      at r - m = 20, rn <= 210, some 10^5 flops per right-hand side. */
@@ -1141,15 +1143,17 @@ typedef struct phgmg_reduce_opts {
   int newton_iter;         /* validation simulations: iteration cap (0: 20)      */
   /* GMG-QM manifold: 0 = the paper's hierarchical POD (V1 = leading POD modes);
      1 = greedy: V1 chosen column by column among the leading (r - m) + rn
-     POD modes of the adjusted snapshots, each time the mode whose
+     POD modes of the adjusted snapshots (rn: the cap, or 8 with a wide V2;
+     see greedy_window), each time the mode whose
      coordinates best predict the other candidates' by the quadratic ridge
      fit (Schwerdtner & Peherstorfer 2024; ridge lambda 1e-9 with lambda_auto,
-     else opts.lambda; every ceil(ns/400)-th snapshot); V2 = POD of what
-     [B, V1] leaves, as for 0. Cost: about (r - m)(r - m + rn) small
-     least-squares solves (0.1-0.5 s at r = 20).
+     else opts.lambda; every ceil(ns/400)-th snapshot); V2 = what [B, V1]
+     leaves: wide by default, else its POD as for 0 (see rn). Cost: about
+     (r - m)(r - m + rn) small least-squares solves (0.1-0.5 s at r = 20).
      2 = alternating minimization (PHGMG_MANIFOLD_ALTMIN; after Geelen,
      Balzano, Wright & Willcox 2023): V1, V2 rotated within the leading
-     2 (r - m + rn) POD modes of the adjusted snapshots, alternating the ridge
+     2 (r - m + rn) POD modes of the adjusted snapshots (rn: the cap, or 8
+     with a wide V2, which then replaces the sweeps' V2), alternating the ridge
      fit of M with an orthogonal Procrustes step (extrapolated while that
      helps), started from 0, each sweep kept only if the training objective
      sum ||x - phi(rho(x))||^2 + lam ||M||^2 decreases (so it ends at or below
@@ -8649,10 +8653,11 @@ PHGMG__PRIV void phgmg__eta_d(const phgmg_reduced *red, const double *x2, double
   const int p = red->p, rn = red->rn;
   int i;
   if (!red->eta) {
-    if (Dq) {
-      phgmg__lp_d(rn, p, red->Ms, x2, Dq);
-      if (q) phgmg_gemv('N', rn, p, 0.5, Dq, rn, x2, 0.0, q);
-    } else if (q) {
+    double Lb[64 * 64], *L = Dq ? Dq : Lb;
+    if (Dq || rn * p <= 64 * 64) {
+      phgmg__lp_d(rn, p, red->Ms, x2, L);
+      if (q) phgmg_gemv('N', rn, p, 0.5, L, rn, x2, 0.0, q);
+    } else if (q) {   /* a wide V2: q without the rn x p buffer */
       phgmg__q_rows(red, x2, 0, rn, q);
     }
     if (D2q) memcpy(D2q, red->Ms, (size_t)rn * p * p * sizeof(double));
@@ -10962,7 +10967,7 @@ PHGMG_DEF phgmg_result phgmg_reduce(phgmg_reduced **out, const phgmg_ph_system *
 
 PHGMG_DEF void phgmg_reduced_lift(const phgmg_reduced *red, const double *xr, double *x) {
   phgmg_gemv('N', red->N, red->r, 1.0, red->V0, red->N, xr, 0.0, x);
-  if (red->kind == PHGMG_ROM_QUADRATIC && red->eta) {   /* + V2 eta(x2); rn <= 64 for your eta */
+  if (red->kind == PHGMG_ROM_QUADRATIC && (red->eta || red->rn <= 64)) {   /* + V2 eta(x2); rn <= 64 for your eta */
     double q[64];
     phgmg__eta_d(red, xr + red->m, q, NULL, NULL, red->rwork);
     phgmg_gemv('N', red->N, red->rn, 1.0, red->V2, red->N, q, 1.0, x);
@@ -11002,7 +11007,7 @@ PHGMG_DEF void phgmg_reduced_dphi(const phgmg_reduced *red, const double *xr, do
     double Lp[64 * 64];
     const int p = red->p, rn = red->rn;
     int i0, nb;
-    if (red->eta) {   /* your eta: rn p <= 64 * 64 (phgmg_reduce) */
+    if (rn * p <= 64 * 64) {   /* your eta: always (phgmg_reduce) */
       phgmg__eta_d(red, xr + m, NULL, Lp, NULL, red->rwork);
       phgmg_gemm('N', 'N', N, p, rn, 1.0, red->V2, N, Lp, rn, 1.0, D + (size_t)m * ldd, ldd);
       return;
