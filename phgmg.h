@@ -1097,10 +1097,28 @@ enum {
   PHGMG_MANIFOLD_ALTMIN = 2  /* alternating minimization of V1, V2 and M           */
 };
 
+/* phgmg_reduce_opts.rn: V2 over the whole residual of the snapshots (see rn). */
+#define PHGMG_RN_WIDE (-1)
+
 typedef struct phgmg_reduce_opts {
   phgmg_method method; /* required                                                  */
   int r;               /* reduced order (GMG: includes the m port coordinates), required */
-  int rn;              /* GMG-QM lifting dimension r_n (0: 8)                        */
+  /* GMG-QM lifting dimension r_n, the width of V2. > 0: a cap -- V2 = the
+     leading rn POD modes of what [B, V1] leaves of the snapshots (the
+     paper's construction). PHGMG_RN_WIDE: V2 over the whole residual up to
+     its numerical rank rw (phgmg__qm_wide_v2), so the quadratic term may
+     correct in every direction the data has; only the part M can reach is
+     kept, the online width is rn = min(rw, (r-m)(r-m+1)/2). 0 (default): the
+     paper's r_n = 8 for the hierarchical POD manifold (manifold = 0), wide
+     for the greedy and alternating-minimization manifolds. Cost of wide:
+     offline one SVD of the N x ns residual (the greedy with greedy_window
+     > 0 reuses its own; memory: N min(N, ns) doubles for its modes, as much
+     as the copy of the snapshots GMG-QM keeps) and O((N + ns) rw (r-m)^2)
+     for the compression; online (hyper-reduced, so
+     independent of N) the quadratic terms cost O(rn (r-m)^2) per evaluation
+     and the stepper's memory grows with rn r (PHGMG_ROM_STEPPER_MEMSIZE_MAX):
+     at r - m = 20, rn <= 210, some 10^5 flops per right-hand side. */
+  int rn;
   double lambda;       /* GMG-QM ridge parameter, applied to the un-normalised sum
                           over snapshots (0: 1e-3; < 0: exactly zero, the fit of M
                           then being the minimum-norm least-squares solution, for
@@ -1222,15 +1240,17 @@ typedef struct phgmg_reduce_opts {
   int newton_iter;         /* validation simulations: iteration cap (0: 20)      */
   /* GMG-QM manifold: 0 = the paper's hierarchical POD (V1 = leading POD modes);
      1 = greedy: V1 chosen column by column among the leading (r - m) + rn
-     POD modes of the adjusted snapshots, each time the mode whose
+     POD modes of the adjusted snapshots (rn: the cap, or 8 with a wide V2;
+     see greedy_window), each time the mode whose
      coordinates best predict the other candidates' by the quadratic ridge
      fit (Schwerdtner & Peherstorfer 2024; ridge lambda 1e-9 with lambda_auto,
-     else opts.lambda; every ceil(ns/400)-th snapshot); V2 = POD of what
-     [B, V1] leaves, as for 0. Cost: about (r - m)(r - m + rn) small
-     least-squares solves (0.1-0.5 s at r = 20).
+     else opts.lambda; every ceil(ns/400)-th snapshot); V2 = what [B, V1]
+     leaves: wide by default, else its POD as for 0 (see rn). Cost: about
+     (r - m)(r - m + rn) small least-squares solves (0.1-0.5 s at r = 20).
      2 = alternating minimization (PHGMG_MANIFOLD_ALTMIN; after Geelen,
      Balzano, Wright & Willcox 2023): V1, V2 rotated within the leading
-     2 (r - m + rn) POD modes of the adjusted snapshots, alternating the ridge
+     2 (r - m + rn) POD modes of the adjusted snapshots (rn: the cap, or 8
+     with a wide V2, which then replaces the sweeps' V2), alternating the ridge
      fit of M with an orthogonal Procrustes step (extrapolated while that
      helps), started from 0, each sweep kept only if the training objective
      sum ||x - phi(rho(x))||^2 + lam ||M||^2 decreases (so it ends at or below
@@ -1244,6 +1264,19 @@ typedef struct phgmg_reduce_opts {
      (N-independent but for one POD), plus one GMG-POD build and its
      validation runs under lambda_auto = 1. */
   int manifold;
+  /* manifold = 1 with a wide V2 (rn = 0 or PHGMG_RN_WIDE): 0 (default) =
+     the candidates for V1 and their score as described under manifold (the
+     leading r - m + 8 POD modes); > 0 = the leading r - m + greedy_window
+     modes (up to the numerical rank), each scored by the ridge objective
+     (misfit + lam ||M||^2) over the other candidates not yet taken, by an
+     incremental QR of the features that keeps a wide window affordable. The
+     reference code of Schwerdtner & Peherstorfer uses 200, which transport
+     data need: there the modes V1 wants reach far down the spectrum
+     (bench/qm_pulse.c). Cost: about (r - m) greedy_window incremental updates
+     of O(nsub (r - m)^3 + nsub^2 (r - m)) (nsub <= 400 snapshots used), plus
+     one SVD of the adjusted snapshots: 3-10 s at r - m = 12-20, window 200,
+     N = 4096, ns = 1000 (two shared cores). */
+  int greedy_window;
   /* lambda_auto = 1 with lambda_train_only = 1: validate on the training runs
      alone (no probe runs): from the regression optimum up (one per decade),
      the first lambda whose model simulates every training run without Newton
@@ -9055,6 +9088,32 @@ PHGMG__PRIV void phgmg__restrict_block(const phgmg_reduced *red, int ns, const d
 }
 
 
+/* Rows i0 .. i0 + nb - 1 of the built-in q = M (x2 kron x2) (no buffer, any rn). */
+PHGMG__PRIV void phgmg__q_rows(const phgmg_reduced *red, const double *x2, int i0, int nb, double *q) {
+  const int p = red->p, rn = red->rn;
+  int i, a, j;
+  for (i = 0; i < nb; ++i) q[i] = 0.0;
+  for (a = 0; a < p; ++a)
+    for (j = 0; j < p; ++j) {
+      const double f = x2[a] * x2[j], *mc = red->M + (size_t)(a * p + j) * rn + i0;
+      for (i = 0; i < nb; ++i) q[i] += mc[i] * f;
+    }
+}
+
+/* Rows i0 .. i0 + nb - 1 of Lp = d q / d x2 (as phgmg__lp_d), ld nb. */
+PHGMG__PRIV void phgmg__lp_rows(const phgmg_reduced *red, const double *x2, int i0, int nb, double *L) {
+  const int p = red->p, rn = red->rn;
+  int i, j, k;
+  for (k = 0; k < p; ++k) {
+    double *l = L + (size_t)k * nb;
+    for (i = 0; i < nb; ++i) l[i] = 0.0;
+    for (j = 0; j < p; ++j) {
+      const double *ms = red->Ms + ((size_t)k * p + j) * rn + i0;
+      for (i = 0; i < nb; ++i) l[i] += ms[i] * x2[j];
+    }
+  }
+}
+
 /* eta and its derivatives at x2, in double: the built-in quadratic map
    (q = M (x2 kron x2) = L x2 / 2, Dq = L, D2q = Ms) or the caller's eta
    (GMG_MANIFOLD, in phgmg_real). Outputs may be NULL. rw: phgmg_real scratch
@@ -9065,8 +9124,12 @@ PHGMG__PRIV void phgmg__eta_d(const phgmg_reduced *red, const double *x2, double
   int i;
   if (!red->eta) {
     double Lb[64 * 64], *L = Dq ? Dq : Lb;
-    phgmg__lp_d(rn, p, red->Ms, x2, L);
-    if (q) phgmg_gemv('N', rn, p, 0.5, L, rn, x2, 0.0, q);
+    if (Dq || rn * p <= 64 * 64) {
+      phgmg__lp_d(rn, p, red->Ms, x2, L);
+      if (q) phgmg_gemv('N', rn, p, 0.5, L, rn, x2, 0.0, q);
+    } else if (q) {   /* a wide V2: q without the rn x p buffer */
+      phgmg__q_rows(red, x2, 0, rn, q);
+    }
     if (D2q) memcpy(D2q, red->Ms, (size_t)rn * p * p * sizeof(double));
   } else {
     phgmg_real *x2r = rw, *qr = x2r + p, *Dr = qr + rn, *D2r = Dr + (size_t)rn * p;
@@ -9415,6 +9478,10 @@ typedef struct phgmg__rctx {
   const double *Bp, *sepw;
   double *Bp_own, *sepw_own;
   phgmg_jr_factor *ef;
+  int wide;                /* GMG-QM: V2 over the whole residual (phgmg__qm_wide_v2) */
+  double *Uw, *Cw;         /* greedy wide: the complement's modes (N x kw) and
+                              coordinates (kw x ns; Cw lives in Uw's block)   */
+  int kw;
 } phgmg__rctx;
 
 PHGMG__PRIV void phgmg__rctx_free(phgmg__rctx *c) {
@@ -9427,6 +9494,8 @@ PHGMG__PRIV void phgmg__rctx_free(phgmg__rctx *c) {
   phgmg__free(c->alloc, c->Bp_own);
   phgmg__free(c->alloc, c->sepw_own);
   phgmg_jr_factor_destroy(c->ef);
+  phgmg__free(c->alloc, c->Uw);
+  c->Uw = c->Cw = NULL;
   c->jr = NULL; c->Xa = c->lg = c->Tq = c->V2h = NULL; c->runcol = NULL;
   c->Bp_own = c->sepw_own = NULL; c->ef = NULL;
 }
@@ -9491,6 +9560,7 @@ PHGMG__PRIV phgmg_result phgmg__reduce_check(const phgmg_ph_system *sys, const d
     return PHGMG_ERR_SIZE;
   }
   if (o->method == PHGMG_METHOD_GMG_MANIFOLD && (!o->eta || o->rn < 1)) return PHGMG_ERR_INVALID_ARG;
+  if (o->rn < PHGMG_RN_WIDE) return PHGMG_ERR_INVALID_ARG;
   if (o->deim != 0 && o->deim != 1) return PHGMG_ERR_INVALID_ARG;
   if (o->hyper < PHGMG_HYPER_ECSW || o->hyper > PHGMG_HYPER_GREEDY) return PHGMG_ERR_INVALID_ARG;
   if (!(o->hyper_tol >= 0.0 && o->hyper_tol < 1.0)) return PHGMG_ERR_INVALID_ARG;
@@ -9540,9 +9610,13 @@ PHGMG__PRIV phgmg_result phgmg__reduce_new(phgmg__rctx *c) {
                   ? PHGMG_ROM_QUADRATIC : PHGMG_ROM_LINEAR;
   red->p = phgmg__is_gmg(o->method) ? o->r - red->m : o->r;
   if (red->kind == PHGMG_ROM_QUADRATIC) {
-    red->rn = o->rn > 0 ? o->rn : 8;
-    /* the q/Lp buffers of lift/dphi hold up to 64 x 64 */
-    if (red->rn > red->N - red->r || red->rn > 64 || red->rn * red->p > 64 * 64) return PHGMG_ERR_SIZE;
+    c->wide = o->method == PHGMG_METHOD_GMG_QM &&
+              (o->rn == PHGMG_RN_WIDE || (o->rn == 0 && o->manifold != PHGMG_MANIFOLD_POD));
+    /* wide: the alternating minimization's search width; phgmg__qm_wide_v2 sets the final one */
+    red->rn = o->rn > 0 ? o->rn : (c->wide ? PHGMG__MIN(8, red->N - red->r) : 8);
+    if (red->rn < 1 || red->rn > red->N - red->r) return PHGMG_ERR_SIZE;
+    /* your eta's q/Dq go through buffers of up to 64 x 64 (lift, dphi) */
+    if (o->method == PHGMG_METHOD_GMG_MANIFOLD && (red->rn > 64 || red->rn * red->p > 64 * 64)) return PHGMG_ERR_SIZE;
   }
   if (o->method == PHGMG_METHOD_GMG_MANIFOLD) {
     const size_t p = (size_t)red->p, rn = (size_t)red->rn;
@@ -9593,7 +9667,7 @@ PHGMG__PRIV phgmg_result phgmg__basis_take(phgmg__rctx *c, const double *V1, con
    basis. */
 PHGMG__PRIV int phgmg__v2_from_basis(const phgmg__rctx *c) {
   const phgmg_reduced *red = c->red;
-  if (red->kind != PHGMG_ROM_QUADRATIC || c->o->pod_basis) return 0;
+  if (red->kind != PHGMG_ROM_QUADRATIC || c->o->pod_basis || c->wide) return 0;
   return red->method == PHGMG_METHOD_GMG_MANIFOLD ||
          (red->method == PHGMG_METHOD_GMG_QM && c->o->manifold == PHGMG_MANIFOLD_POD);
 }
@@ -10025,6 +10099,227 @@ PHGMG__PRIV phgmg_result phgmg__qm_altmin(phgmg__rctx *c) {
   return rc;
 }
 
+/* The p(p+1)/2 distinct Kronecker features of the columns of Z2 (p x ns, ld
+   ldz) as the rows of Kt (ns x nc, ld ldk): feature (a, j), a <= j, in the
+   order of phgmg__qm_problem, scaled by sqrt 2 off the diagonal. */
+PHGMG__PRIV void phgmg__qm_features(int p, int ns, const double *Z2, int ldz, double *Kt, int ldk) {
+  const double s2 = sqrt(2.0);
+  int i, a, j, cc;
+  for (i = 0; i < ns; ++i) {
+    const double *z = Z2 + (size_t)i * ldz;
+    for (a = 0, cc = 0; a < p; ++a)
+      for (j = a; j < p; ++j, ++cc) Kt[i + (size_t)cc * ldk] = (a == j ? 1.0 : s2) * z[a] * z[j];
+  }
+}
+
+/* Wide V2 (opts.rn = PHGMG_RN_WIDE; the default of the greedy and alternating
+   minimization manifolds). V2 spans the whole residual Xres = (I - [B, V1]
+   [B, V1]^+) X up to its numerical rank: kw orthonormal directions U (N x kw)
+   with coordinates C = U^T Xres (kw x ns), given (the greedy's complement) or
+   from the SVD of Xres (c->Xa on entry), modes above the rank floor. The
+   ridge fit M = C K (K^T K + lam I)^{-1} (K: ns x nc features of x2 = V1^T x,
+   nc = p(p+1)/2) lies in range(C K) for EVERY lam; when kw > nc, the thin QR
+   C K = P R (P: kw x nc, untruncated, so range(P) contains range(C K)) and
+   V2 = U P give the same phi for every lam with the online width
+   rn = min(kw, nc). Sets red->V2 and red->rn. Cost: the SVD of Xres (N ns kw),
+   C K (kw ns nc), U P (N kw nc). */
+PHGMG__PRIV phgmg_result phgmg__qm_wide_v2(phgmg__rctx *c, const double *Ug, const double *Cg, int kg) {
+  phgmg_reduced *red = c->red;
+  const int N = red->N, m = red->m, p = red->p, ns = c->ns, nc = p * (p + 1) / 2;
+  const int kmax = PHGMG__MIN(N, ns);
+  double *U = NULL, *C = NULL, *W = NULL, *S = NULL, *Z2, *Kt, *A, *tau, *V2;
+  const double *Uu = Ug, *Cu = Cg;
+  int kw = kg, i, j, rn;
+  phgmg_result rc = PHGMG_OK;
+  if (!Ug) {
+    U = phgmg__dalloc(c->alloc, (size_t)N * kmax + (size_t)ns * kmax + (size_t)kmax * ns + (size_t)kmax);
+    if (!U) return PHGMG_ERR_NOMEM;
+    W = U + (size_t)N * kmax; C = W + (size_t)ns * kmax; S = C + (size_t)kmax * ns;
+    rc = phgmg_svd(N, ns, c->Xa, N, kmax, S, U, N, W, ns, &kw, NULL, c->alloc);
+    while (rc == PHGMG_OK && kw > 0 && !(S[kw - 1] > c->rfloor)) --kw;
+    for (j = 0; rc == PHGMG_OK && j < ns; ++j)
+      for (i = 0; i < kw; ++i) C[i + (size_t)j * kw] = S[i] * W[j + (size_t)i * ns];
+    Uu = U; Cu = C;
+  }
+  if (rc == PHGMG_OK && kw < 1) rc = PHGMG_ERR_SIZE;   /* nothing left for the quadratic term */
+  if (rc != PHGMG_OK) { phgmg__free(c->alloc, U); return rc; }
+  rn = PHGMG__MIN(kw, nc);
+  Z2 = phgmg__dalloc(c->alloc, (size_t)p * ns + (size_t)ns * nc + (size_t)kw * nc + (size_t)nc);
+  V2 = phgmg__red_d(red, (size_t)N * rn);
+  if (!Z2 || !V2) { phgmg__free(c->alloc, U); phgmg__free(c->alloc, Z2); return PHGMG_ERR_NOMEM; }
+  Kt = Z2 + (size_t)p * ns; A = Kt + (size_t)ns * nc; tau = A + (size_t)kw * nc;
+  if (kw <= nc) {
+    memcpy(V2, Uu, (size_t)N * kw * sizeof(double));
+  } else {
+    phgmg_gemm('T', 'N', p, ns, N, 1.0, red->V0 + (size_t)N * m, N, c->X, c->ldx, 0.0, Z2, p);
+    phgmg__qm_features(p, ns, Z2, p, Kt, ns);
+    phgmg_gemm('N', 'N', kw, nc, ns, 1.0, Cu, kw, Kt, ns, 0.0, A, kw);   /* C K */
+    rc = phgmg_qr(kw, nc, A, kw, tau);
+    if (rc == PHGMG_OK) {
+      phgmg_qr_form_q(kw, nc, A, kw, tau, Kt);                          /* P (kw x nc) */
+      phgmg_gemm('N', 'N', N, nc, kw, 1.0, Uu, N, A, kw, 0.0, V2, N);
+    }
+  }
+  phgmg__free(c->alloc, Z2);
+  phgmg__free(c->alloc, U);
+  if (rc != PHGMG_OK) return rc;
+  red->V2 = V2;
+  red->rn = rn;
+  return PHGMG_OK;
+}
+
+/* The greedy manifold with a wide V2 (phgmg__qm_greedy_wide): the state of
+   the selection over the subsample (every st-th snapshot, nsub of them). */
+typedef struct phgmg__gw {
+  int q, nsub, L, nin;  /* modes, snapshots, augmented rows nsub + nc, features kept */
+  const double *Cs;     /* q x nsub POD coordinates of the subsample            */
+  double *G;            /* nsub x nsub Gram of the candidates not yet taken       */
+  double *Qin;          /* L x nc: orthonormal basis of the kept augmented features */
+  double *A, *GA, *t, *sv;
+  double sl, trG, tin;  /* sqrt(lam), trace G, trace(Qin1^T G Qin1)              */
+} phgmg__gw;
+
+/* The j + 1 features that candidate k adds to the j selected modes sel --
+   (k, sel_a) scaled by sqrt 2 and (k, k) -- as ridge-augmented columns
+   [K_new; sqrt(lam) I] (L rows; rows nsub + nin + a), orthonormalised against
+   Qin and among themselves (Gram-Schmidt, twice), into w->A. */
+PHGMG__PRIV void phgmg__gw_columns(phgmg__gw *w, const int *sel, int j, int k) {
+  const int q = w->q, nsub = w->nsub, L = w->L, nin = w->nin, lr = nsub + nin + j + 1;
+  int a, b, i, pass;
+  memset(w->A, 0, (size_t)L * (j + 1) * sizeof(double));
+  for (a = 0; a <= j; ++a) {
+    double *col = w->A + (size_t)a * L;
+    const int o = a < j ? sel[a] : k;
+    const double f = a < j ? sqrt(2.0) : 1.0;
+    for (i = 0; i < nsub; ++i) col[i] = f * w->Cs[k + (size_t)i * q] * w->Cs[o + (size_t)i * q];
+    col[nsub + nin + a] = w->sl;
+  }
+  for (pass = 0; pass < 2 && nin > 0; ++pass) {
+    phgmg_gemm('T', 'N', nin, j + 1, nsub + nin, 1.0, w->Qin, L, w->A, L, 0.0, w->t, nin);
+    phgmg_gemm('N', 'N', nsub + nin, j + 1, nin, -1.0, w->Qin, L, w->t, nin, 1.0, w->A, L);
+  }
+  for (a = 0; a <= j; ++a) {
+    double *ca = w->A + (size_t)a * L, nrm;
+    for (pass = 0; pass < 2; ++pass)
+      for (b = 0; b < a; ++b) {
+        const double *cb = w->A + (size_t)b * L, d = phgmg__dot(lr, cb, ca);
+        for (i = 0; i < lr; ++i) ca[i] -= d * cb[i];
+      }
+    nrm = sqrt(phgmg__dot(lr, ca, ca));   /* >= sqrt(lam) > 0 in exact arithmetic */
+    for (i = 0; i < lr; ++i) ca[i] = nrm > 0.0 ? ca[i] / nrm : 0.0;
+  }
+}
+
+/* The ridge objective min_T ||R - K T||^2 + lam ||T||^2 over the other
+   candidates R (every candidate but sel and k, as the Gram w->G - s s^T, s = the
+   candidate's coordinates) with the features K of sel + k: with [K; sqrt(lam)
+   I] = Q R, it is tr(R R^T) - ||Q1^T R||^2 (Q1: the first nsub rows), split
+   into the kept features' part (Qin) and the new ones' (w->A). */
+PHGMG__PRIV double phgmg__gw_error(phgmg__gw *w, const int *sel, int j, int k) {
+  const int q = w->q, nsub = w->nsub, L = w->L, nin = w->nin;
+  double e, ss, tq = 0.0, ps = 0.0;
+  int i, a;
+  phgmg__gw_columns(w, sel, j, k);
+  for (i = 0; i < nsub; ++i) w->sv[i] = w->Cs[k + (size_t)i * q];
+  ss = phgmg__dot(nsub, w->sv, w->sv);
+  e = w->trG - ss - w->tin;
+  if (nin > 0) {
+    phgmg_gemv('T', nsub, nin, 1.0, w->Qin, L, w->sv, 0.0, w->t);
+    e += phgmg__dot(nin, w->t, w->t);
+  }
+  phgmg_gemm('N', 'N', nsub, j + 1, nsub, 1.0, w->G, nsub, w->A, L, 0.0, w->GA, nsub);
+  for (a = 0; a <= j; ++a) {
+    const double *ca = w->A + (size_t)a * L, d = phgmg__dot(nsub, ca, w->sv);
+    tq += phgmg__dot(nsub, ca, w->GA + (size_t)a * nsub);
+    ps += d * d;
+  }
+  return e - tq + ps;
+}
+
+/* Keep candidate k: its features join Qin, its coordinates leave G. */
+PHGMG__PRIV void phgmg__gw_take(phgmg__gw *w, const int *sel, int j, int k) {
+  const int q = w->q, nsub = w->nsub, L = w->L;
+  int i, a;
+  phgmg__gw_columns(w, sel, j, k);
+  memcpy(w->Qin + (size_t)w->nin * L, w->A, (size_t)L * (j + 1) * sizeof(double));
+  w->nin += j + 1;
+  for (i = 0; i < nsub; ++i) w->sv[i] = w->Cs[k + (size_t)i * q];
+  w->trG -= phgmg__dot(nsub, w->sv, w->sv);
+  phgmg_gemm('N', 'T', nsub, nsub, 1, -1.0, w->sv, nsub, w->sv, nsub, 1.0, w->G, nsub);
+  phgmg_gemm('N', 'N', nsub, w->nin, nsub, 1.0, w->G, nsub, w->Qin, L, 0.0, w->GA, nsub);
+  for (w->tin = 0.0, a = 0; a < w->nin; ++a) w->tin += phgmg__dot(nsub, w->Qin + (size_t)a * L, w->GA + (size_t)a * nsub);
+}
+
+/* opts.manifold = 1 with a wide V2 (phgmg__qm_wide_v2) and greedy_window > 0:
+   V1 takes one POD mode of the adjusted snapshots at a time among the
+   qw = p + greedy_window leading ones, the one whose features (with those
+   already taken) leave the smallest ridge objective (misfit + lam ||T||^2;
+   phgmg__qm_greedy scores the misfit alone) over the other candidates not
+   yet taken (after Schwerdtner & Peherstorfer 2024). One SVD of Xa up to its
+   numerical rank q; each trial orthogonalises the j + 1 new feature columns
+   against the kept ones (incremental QR of the ridge-augmented feature
+   matrix) and needs one nsub x nsub x (j + 1) product: about qw p^2 (nsub^2
+   + nsub p^2) / 2 flops in all. Writes V1 into red->V0; all q - p modes not
+   taken and their coordinates stay in c->Uw, c->Cw for the wide V2. */
+PHGMG__PRIV phgmg_result phgmg__qm_greedy_wide(phgmg__rctx *c) {
+  phgmg_reduced *red = c->red;
+  const int N = red->N, m = red->m, p = red->p, ns = c->ns, nc = p * (p + 1) / 2, kmax = PHGMG__MIN(N, ns);
+  const int st = (ns + 399) / 400, nsub = (ns + st - 1) / st, L = nsub + nc;
+  double *U, *W, *S, *C, *Cs, *buf, best_err, e;
+  int *sel, *used, q = 0, qw = 0, i, j, k, best, kc;
+  phgmg__gw w;
+  phgmg_result rc;
+  U = phgmg__dalloc(c->alloc, (size_t)N * kmax + (size_t)ns * kmax + (size_t)kmax * ns + (size_t)kmax * nsub + kmax);
+  buf = phgmg__dalloc(c->alloc, (size_t)nsub * nsub + (size_t)L * nc + (size_t)L * p + (size_t)nsub * nc + (size_t)nc * p + nsub);
+  sel = phgmg__ialloc(c->alloc, (size_t)kmax + p);
+  if (!U || !buf || !sel) { phgmg__free(c->alloc, U); phgmg__free(c->alloc, buf); phgmg__free(c->alloc, sel); return PHGMG_ERR_NOMEM; }
+  W = U + (size_t)N * kmax; C = W + (size_t)ns * kmax; Cs = C + (size_t)kmax * ns; S = Cs + (size_t)kmax * nsub;
+  used = sel + p;
+  rc = phgmg_svd(N, ns, c->Xa, N, kmax, S, U, N, W, ns, &q, NULL, c->alloc);
+  while (rc == PHGMG_OK && q > 0 && !(S[q - 1] > c->rfloor)) --q;
+  if (rc == PHGMG_OK && q <= p) rc = PHGMG_ERR_SIZE;   /* r - m >= rank: nothing to choose or to lift */
+  if (rc == PHGMG_OK) {
+    for (j = 0; j < ns; ++j)
+      for (i = 0; i < q; ++i) C[i + (size_t)j * q] = S[i] * W[j + (size_t)i * ns];
+    for (j = 0; j < nsub; ++j) memcpy(Cs + (size_t)j * q, C + (size_t)j * st * q, (size_t)q * sizeof(double));
+    memset(&w, 0, sizeof w);
+    w.q = q; w.nsub = nsub; w.L = L; w.Cs = Cs; w.sl = sqrt(c->o->lambda_auto ? 1e-9 : (c->lambda > 0.0 ? c->lambda : 1e-12));
+    w.G = buf; w.Qin = w.G + (size_t)nsub * nsub; w.A = w.Qin + (size_t)L * nc; w.GA = w.A + (size_t)L * p;
+    w.t = w.GA + (size_t)nsub * nc; w.sv = w.t + (size_t)nc * p;
+    qw = PHGMG__MIN(q, p + c->o->greedy_window);
+    phgmg_gemm('T', 'N', nsub, nsub, qw, 1.0, Cs, q, Cs, q, 0.0, w.G, nsub);   /* the candidates' Gram */
+    for (i = 0; i < nsub; ++i) w.trG += w.G[i + (size_t)i * nsub];
+    for (k = 0; k < q; ++k) used[k] = 0;
+    for (j = 0; j < p; ++j) {
+      best = -1; best_err = HUGE_VAL;
+      for (k = 0; k < qw; ++k) {
+        if (used[k]) continue;
+        e = phgmg__gw_error(&w, sel, j, k);
+        if (e < best_err) { best_err = e; best = k; }
+      }
+      if (best < 0) { rc = PHGMG_ERR_NANINF; break; }
+      phgmg__gw_take(&w, sel, j, best);
+      sel[j] = best;
+      used[best] = 1;
+    }
+  }
+  if (rc == PHGMG_OK) {   /* V1; the complement's modes and coordinates, compacted in place */
+    for (j = 0; j < p; ++j) memcpy(red->V0 + (size_t)N * (m + j), U + (size_t)N * sel[j], (size_t)N * sizeof(double));
+    for (k = 0, kc = 0; k < q; ++k) {
+      if (used[k]) continue;
+      if (kc != k) memmove(U + (size_t)N * kc, U + (size_t)N * k, (size_t)N * sizeof(double));
+      for (j = 0; j < ns; ++j) W[kc + (size_t)j * (q - p)] = C[k + (size_t)j * q];
+      ++kc;
+    }
+    c->Uw = U; c->Cw = W; c->kw = q - p;
+    U = NULL;
+  }
+  phgmg__free(c->alloc, U);
+  phgmg__free(c->alloc, buf);
+  phgmg__free(c->alloc, sel);
+  return rc;
+}
+
 /* Stage 2, manifold (QUADRATIC kind): V2 = POD of the residual of [B, V1]
    (paper 4.2.2; V1 greedy with opts.manifold = 1), V1 and V2 by alternating
    minimization (opts.manifold = 2), or the caller's; then GMG-QM fits M (eq. least_square_reg,
@@ -10038,7 +10333,8 @@ PHGMG__PRIV phgmg_result phgmg__stage_manifold(phgmg__rctx *c) {
   red->V2 = phgmg__red_d(red, (size_t)N * rn);
   if (!red->V2) return PHGMG_ERR_NOMEM;
   if (c->o->manifold == PHGMG_MANIFOLD_GREEDY && red->method == PHGMG_METHOD_GMG_QM) {
-    rc = phgmg__qm_greedy(c);
+    /* a wide V2 with a greedy_window: the incremental selection; else today's */
+    rc = c->wide && c->o->greedy_window > 0 ? phgmg__qm_greedy_wide(c) : phgmg__qm_greedy(c);
     if (rc != PHGMG_OK) return rc;
   }
   if (c->o->manifold == PHGMG_MANIFOLD_ALTMIN && red->method == PHGMG_METHOD_GMG_QM) {
@@ -10049,7 +10345,11 @@ PHGMG__PRIV phgmg_result phgmg__stage_manifold(phgmg__rctx *c) {
     double *tmp = phgmg__dalloc(c->alloc, (size_t)p * ns + (size_t)rn);
     if (!tmp) return PHGMG_ERR_NOMEM;
     if (c->sf != 1) phgmg__orth_remove(N, p, red->V0 + (size_t)N * m, ns, c->Xa, N, tmp);
-    if (c->o->manifold == PHGMG_MANIFOLD_ALTMIN && red->method == PHGMG_METHOD_GMG_QM) {
+    if (c->wide) {
+      rc = phgmg__qm_wide_v2(c, c->Uw, c->Cw, c->kw);   /* the whole residual; sets rn */
+      phgmg__free(c->alloc, c->Uw);
+      c->Uw = c->Cw = NULL;
+    } else if (c->o->manifold == PHGMG_MANIFOLD_ALTMIN && red->method == PHGMG_METHOD_GMG_QM) {
       /* V2 from the alternating minimization */
     } else if (c->o->pod_basis && c->o->manifold == PHGMG_MANIFOLD_POD) {
       memcpy(red->V2, c->o->pod_basis + (size_t)N * p, (size_t)N * rn * sizeof(double));
@@ -10066,7 +10366,8 @@ PHGMG__PRIV phgmg_result phgmg__stage_manifold(phgmg__rctx *c) {
   if (rc == PHGMG_OK && c->ng > 0) rc = phgmg__qm_lambda_auto(c);
   if (rc == PHGMG_OK) {
     const int nc = p * (p + 1) / 2;
-    rc = phgmg__qm_fit(red, ns, c->Tq, c->Tq + (size_t)ns * nc, c->lambda, c->Tq + (size_t)ns * (nc + rn), c->alloc);
+    rc = phgmg__qm_fit(red, ns, c->Tq, c->Tq + (size_t)ns * nc, c->lambda, c->Tq + (size_t)ns * (nc + red->rn),
+                       c->alloc);   /* red->rn: the wide V2 may have changed it */
     c->inf.lambda = c->lambda;
   }
   if (c->gsel < 0) { phgmg__free(c->alloc, c->Tq); c->Tq = NULL; } /* no refit without the grid */
@@ -10264,11 +10565,12 @@ PHGMG__PRIV void phgmg__restrict_snapshots(const phgmg__rctx *c, double *XR) {
 PHGMG__PRIV phgmg_result phgmg__q_envelope(phgmg__rctx *c) {
   phgmg_reduced *red = c->red;
   const int r = red->r, m = red->m, rn = red->rn;
-  double *xr, q[64], qmax = 0.0;
+  double *xr, *q, qmax = 0.0;
   int j, i;
   red->qmax = phgmg__red_d(red, 1);
-  xr = phgmg__dalloc(c->alloc, (size_t)r * c->ns);
+  xr = phgmg__dalloc(c->alloc, (size_t)r * c->ns + (size_t)rn);
   if (!red->qmax || !xr) { phgmg__free(c->alloc, xr); return PHGMG_ERR_NOMEM; }
+  q = xr + (size_t)r * c->ns;
   phgmg__restrict_snapshots(c, xr);
   for (j = 0; j < c->ns; ++j) {
     double s2 = 0.0;
@@ -11158,7 +11460,8 @@ PHGMG__PRIV void phgmg__progress(const phgmg_reduce_opts *o, const char *phase) 
 PHGMG__PRIV int phgmg__study_fast(const phgmg_study *st, const phgmg_reduce_opts *o, int m) {
   if (!st) return 0;
   if ((o->method == PHGMG_METHOD_GMG_POD || (o->method == PHGMG_METHOD_GMG_QM && o->manifold == PHGMG_MANIFOLD_POD)) && st->Ua &&
-      o->pod_basis == st->Ua && o->r - m + (o->method == PHGMG_METHOD_GMG_QM ? (o->rn > 0 ? o->rn : 8) : 0) <= st->ka)
+      o->pod_basis == st->Ua && o->rn >= 0 &&
+      o->r - m + (o->method == PHGMG_METHOD_GMG_QM ? (o->rn > 0 ? o->rn : 8) : 0) <= st->ka)
     return 1;
   if (o->method == PHGMG_METHOD_SP1 && st->Up && st->Cq && o->pod_basis == st->Up && o->r <= st->kp) return 2;
   if (o->method == PHGMG_METHOD_SP2 && st->Up && st->Ug && o->pod_basis == st->Up && o->grad_basis == st->Ug &&
@@ -11237,10 +11540,18 @@ PHGMG_DEF phgmg_result phgmg_reduce(phgmg_reduced **out, const phgmg_ph_system *
 
 PHGMG_DEF void phgmg_reduced_lift(const phgmg_reduced *red, const double *xr, double *x) {
   phgmg_gemv('N', red->N, red->r, 1.0, red->V0, red->N, xr, 0.0, x);
-  if (red->kind == PHGMG_ROM_QUADRATIC) {   /* + V2 eta(x2) */
+  if (red->kind == PHGMG_ROM_QUADRATIC && (red->eta || red->rn <= 64)) {   /* + V2 eta(x2); rn <= 64 for your eta */
     double q[64];
     phgmg__eta_d(red, xr + red->m, q, NULL, NULL, red->rwork);
     phgmg_gemv('N', red->N, red->rn, 1.0, red->V2, red->N, q, 1.0, x);
+  } else if (red->kind == PHGMG_ROM_QUADRATIC) {   /* 64 rows of q at a time: any rn */
+    double q[64];
+    int i0;
+    for (i0 = 0; i0 < red->rn; i0 += 64) {
+      const int nb = PHGMG__MIN(64, red->rn - i0);
+      phgmg__q_rows(red, xr + red->m, i0, nb, q);
+      phgmg_gemv('N', red->N, nb, 1.0, red->V2 + (size_t)red->N * i0, red->N, q, 1.0, x);
+    }
   }
 }
 
@@ -11268,9 +11579,17 @@ PHGMG_DEF void phgmg_reduced_dphi(const phgmg_reduced *red, const double *xr, do
   if (red->kind == PHGMG_ROM_QUADRATIC) {
     double Lp[64 * 64];
     const int p = red->p, rn = red->rn;
-    if (rn * p > 64 * 64) return;
-    phgmg__eta_d(red, xr + m, NULL, Lp, NULL, red->rwork);
-    phgmg_gemm('N', 'N', N, p, rn, 1.0, red->V2, N, Lp, rn, 1.0, D + (size_t)m * ldd, ldd);
+    int i0, nb;
+    if (rn * p <= 64 * 64) {   /* your eta: always (phgmg_reduce) */
+      phgmg__eta_d(red, xr + m, NULL, Lp, NULL, red->rwork);
+      phgmg_gemm('N', 'N', N, p, rn, 1.0, red->V2, N, Lp, rn, 1.0, D + (size_t)m * ldd, ldd);
+      return;
+    }
+    for (i0 = 0; i0 < rn; i0 += nb) {   /* rows of Lp in blocks of <= 64 * 64 entries: any rn */
+      nb = PHGMG__MIN(rn - i0, PHGMG__MAX(1, 64 * 64 / p));
+      phgmg__lp_rows(red, xr + m, i0, nb, Lp);
+      phgmg_gemm('N', 'N', N, p, nb, 1.0, red->V2 + (size_t)N * i0, N, Lp, nb, 1.0, D + (size_t)m * ldd, ldd);
+    }
   }
 }
 
@@ -11522,7 +11841,7 @@ PHGMG__PRIV void phgmg__err_map_block(const phgmg_reduced *red, const double *X,
   /* Xt = phi(XR), as phgmg_reduced_lift */
   phgmg_gemm('N', 'N', N, nb, r, 1.0, red->V0, N, XR, ldxr, 0.0, Xt, N);
   if (red->kind == PHGMG_ROM_QUADRATIC) {
-    const int p = red->p, rq = PHGMG__MIN(rn, 64);
+    const int p = red->p, rq = rn;
     int a;
     for (k = 0; k < nb; ++k) {
       const double *x2 = XR + (size_t)k * ldxr + m;
@@ -11588,7 +11907,7 @@ PHGMG__PRIV phgmg_result phgmg__err_map_rc(const phgmg_reduced *red, const doubl
   double *Xt, *C, *Qb, num = 0.0, den = 0.0, amax = 0.0;
   *e = 0.0;
   if (ns < 1) return PHGMG_OK;
-  Xt = phgmg__dalloc(alloc, (size_t)nbmax * ((size_t)N + (size_t)(r + red->rn) + 64));
+  Xt = phgmg__dalloc(alloc, (size_t)nbmax * ((size_t)N + (size_t)(r + red->rn) + (size_t)red->rn));
   if (!Xt) { *e = (double)NAN; return PHGMG_ERR_NOMEM; }
   C = Xt + (size_t)N * nbmax;
   Qb = C + (size_t)(r + red->rn) * nbmax;

@@ -13,7 +13,8 @@
 #    each, appending `case,median_s,min_s,max_s,runs` lines to the CSV;
 # 3. if a CBLAS is installed, builds bench_linalg again with -DPHGMG_USE_CBLAS
 #    and records its cases with a `_cblas` suffix (one BLAS thread);
-# 3b. runs bench/hyper_study.c and bench/altmin_study.c (tables, no CSV cases);
+# 3b. runs bench/hyper_study.c, bench/altmin_study.c and bench/qm_pulse.c
+#     (tables, no CSV cases);
 # 4. builds the examples (`make examples`; if that fails, the two demo
 #    programs directly, without -Werror) and times the whole demo (the three
 #    runs `make demo` makes, with its arguments: linear, nonlinear, linear with
@@ -78,6 +79,14 @@ if $CC $CFLAGS -o "$BUILD/altmin_study" bench/altmin_study.c $LIBS; then
   for chain in linear nonlinear; do
     "./$BUILD/altmin_study" $chain --lambda 1e-9 --r 8,12,16,20
   done | tee "$BUILD/altmin_study.txt"
+fi
+
+# transport data: the greedy manifold with a wide V2 on an advecting pulse
+# against the greedy reference code's projection errors (table, not timing cases)
+echo
+echo "== qm_pulse"
+if $CC $CFLAGS -o "$BUILD/qm_pulse" bench/qm_pulse.c $LIBS; then
+  "./$BUILD/qm_pulse" --n 12,16,20 | tee "$BUILD/qm_pulse.txt"
 fi
 
 # CBLAS: the first of these libraries that links and runs a 1x1 dgemm

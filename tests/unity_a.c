@@ -21,6 +21,7 @@
 #include "test_linear.c"
 #include "test_npy.c"
 #include "test_online.c"
+#include "test_qm_wide.c"
 #include "test_sparse.c"
 #include "test_study.c"
 #include "test_subnormal.c"
