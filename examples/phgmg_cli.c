@@ -27,6 +27,7 @@
 #include <sys/stat.h>
 #include <sys/types.h>
 #include <time.h>
+#include <unistd.h>
 
 /* The manual, one string per line (C99 caps a single literal at 4095 bytes). */
 static const char *const help_lines[] = {
@@ -48,9 +49,11 @@ static const char *const help_lines[] = {
   "  phgmg validate <the options of reduce> [--test-input KIND]... [--test-amp A]\n",
   "               [--test-steps N] [--max-ey E]   (reduce, then run full and reduced\n",
   "               model on each test input: e_red, e_y, e_proj, energy, Newton, the\n",
-  "               first failing step; exit 1 if one fails or e_y > E, default 0.1;\n",
-  "               default test inputs: the training input(s); with --X the\n",
-  "               --X-input runs, else --test-input is required)\n",
+  "               first failing step; exit 1 if one fails or e_y > E (E > 0, default\n",
+  "               0.1); default test inputs: the training input(s); with --X the\n",
+  "               --X-input runs, else --test-input is required; each test runs\n",
+  "               the training run's length unless --test-steps; the outputs are\n",
+  "               written only when every test passes)\n",
   "  phgmg --help | --version\n",
   "\n",
   "THE MODEL\n",
@@ -185,8 +188,10 @@ static const char *const help_lines[] = {
   "                      x ~ V0 xr + V2 M kron(x2, x2), x2 = xr[m:]\n",
   "    NAME.json          sizes, method, options, diagnostics and the list of files\n",
   "  A run writes all of these or none: they are written under temporary names and\n",
-  "  renamed at the end; NAME_*.npy arrays of an earlier run with the same NAME that\n",
-  "  this run does not produce (another method) are removed.\n",
+  "  renamed at the end; the NAME_*.npy arrays that an earlier run listed in its\n",
+  "  NAME.json and this run does not produce (another method) are removed. A run\n",
+  "  never writes or removes one of its input files (compared as files, however\n",
+  "  spelled): an output that would be an input is refused before any work.\n",
   "  The reduced model (LINEAR kind) is x' = K grad H(x) + Bh u, y = Bh^T grad H(x),\n",
   "  H(x) = 1/2 x^T Qh x (+ sum_j w_j phi(P0_j x)); it is again port-Hamiltonian.\n",
   "\n",
@@ -503,7 +508,7 @@ static void input_fn(double t, double *u, void *user) {
 
 /* Set up the input from --input/--amp for m ports and step dt. Returns 0, or
    the exit status after a message (2: neither a kind nor an existing file). */
-static int input_setup(cli_input *in, const char *spec, double amp, int m, double dt) {
+static int input_setup(cli_input *in, const char *opt, const char *spec, double amp, int m, double dt) {
   struct stat st;
   const size_t l = strlen(spec);
   memset(in, 0, sizeof *in);
@@ -513,20 +518,20 @@ static int input_setup(cli_input *in, const char *spec, double amp, int m, doubl
   if (!strcmp(spec, "sin")) { in->kind = IN_SIN; return 0; }
   if (!strcmp(spec, "const")) { in->kind = IN_CONST; return 0; }
   if (stat(spec, &st) != 0 && (l < 4 || strcmp(spec + l - 4, ".npy") != 0))
-    return usage_error("--input '%s': expected sin, const or a FILE.npy, and there is no file '%s'", spec, spec);
-  if (mat_load(&in->tab, "--input", spec)) return 1;
+    return usage_error("%s '%s': expected sin, const or a FILE.npy, and there is no file '%s'", opt, spec, spec);
+  if (mat_load(&in->tab, opt, spec)) return 1;
   if (in->tab.ndim == 2 && !(m == 1 && in->tab.cols == 1)) {
     int k;
     if (in->tab.cols != 1 + m || in->tab.rows < 1) {
-      fail("%s (--input): expected a table of shape (K, %d) (times, then %d input%s), got %s",
-           spec, 1 + m, m, m > 1 ? "s" : "", shape_str(&in->tab));
+      fail("%s (%s): expected a table of shape (K, %d) (times, then %d input%s), got %s",
+           spec, opt, 1 + m, m, m > 1 ? "s" : "", shape_str(&in->tab));
       mat_free(&in->tab);
       return 1;
     }
     for (k = 1; k < in->tab.rows; ++k)
       if (!(in->tab.a[k] > in->tab.a[k - 1])) {
-        fail("%s (--input): the times in column 0 must increase strictly (row %d: %g after %g)",
-             spec, k, in->tab.a[k], in->tab.a[k - 1]);
+        fail("%s (%s): the times in column 0 must increase strictly (row %d: %g after %g)",
+             spec, opt, k, in->tab.a[k], in->tab.a[k - 1]);
         mat_free(&in->tab);
         return 1;
       }
@@ -534,9 +539,9 @@ static int input_setup(cli_input *in, const char *spec, double amp, int m, doubl
     return 0;
   }
   if (m != 1 || in->tab.rows * in->tab.cols < 1) {
-    fail("%s (--input): a vector of samples needs a model with one input (m = %d) and at least "
+    fail("%s (%s): a vector of samples needs a model with one input (m = %d) and at least "
          "one sample; for m > 1 give a table of shape (K, %d); got %s",
-         spec, m, 1 + m, shape_str(&in->tab));
+         spec, opt, m, 1 + m, shape_str(&in->tab));
     mat_free(&in->tab);
     return 1;
   }
@@ -552,24 +557,210 @@ static const char *input_desc(const cli_input *in, const char *spec) {
   return buf;
 }
 
+/* A warning on stderr, also with --quiet. */
+static void note(const char *fmt, ...) {
+  va_list ap;
+  fputs("phgmg: note: ", stderr);
+  va_start(ap, fmt);
+  vfprintf(stderr, fmt, ap);
+  va_end(ap);
+  fputc('\n', stderr);
+}
+
+/* Say so when an input file ends before a run of length t_end: past its last
+   time it is held at its last value. */
+static void input_covers(const cli_input *in, const char *spec, const char *opt, double t_end) {
+  double last;
+  if (in->kind == IN_TABLE) last = in->tab.a[in->tab.rows - 1];
+  else if (in->kind == IN_GRID) last = (double)(in->tab.rows * in->tab.cols - 1) * in->grid_dt;
+  else return;
+  if (last < t_end * (1.0 - 1e-12))
+    note("%s (%s) ends at t = %g, the run at t = %g: from t = %g on, the input is held at its last value",
+         spec, opt, last, t_end, last);
+}
+
 /* ---- files ---------------------------------------------------------------- */
-static int mkdir_p(const char *dir) {
-  char buf[4096];
-  size_t n = strlen(dir), i;
-  struct stat st;
-  if (n == 0 || n >= sizeof buf) return fail("%s (--out): bad directory name", dir);
-  memcpy(buf, dir, n + 1);
-  for (i = 1; i <= n; ++i) {
-    if (buf[i] == '/' || buf[i] == '\0') {
-      const char c = buf[i];
-      buf[i] = '\0';
-      if (mkdir(buf, 0777) != 0 && errno != EEXIST)
-        return fail("%s (--out): cannot create directory %s: %s", dir, buf, strerror(errno));
-      buf[i] = c;
+/* ---- file identity: a run never writes or removes one of its inputs ----------
+   Paths are compared by the file they name, not by their spelling: an existing
+   file by (st_dev, st_ino) (hard links, symbolic links, "./a" and "a" are one
+   file); a file not yet there by its directory's identity and its base name;
+   below a directory not yet there by the absolute path with "." and ".."
+   folded. */
+typedef struct file_id {
+  int kind;        /* 1 the file exists, 2 its directory exists, 3 neither */
+  dev_t dev;
+  ino_t ino;
+  char *s;         /* kind 2: the base name; kind 3: the folded absolute path */
+} file_id;
+
+/* The absolute path with "//", "." and ".." folded, into out (cap bytes). */
+static void path_fold(const char *path, char *out, size_t cap) {
+  char buf[8192];
+  size_t n = 0, k;
+  const char *p;
+  buf[0] = '\0';
+  if (path[0] != '/' && (!getcwd(buf, sizeof buf - 1) || strlen(buf) + strlen(path) + 2 >= sizeof buf)) buf[0] = '\0';
+  if (strlen(buf) + strlen(path) + 2 < sizeof buf) { strcat(buf, "/"); strcat(buf, path); }
+  out[0] = '\0';
+  for (p = buf; *p;) {
+    size_t l;
+    while (*p == '/') ++p;
+    l = strcspn(p, "/");
+    if (l == 0) break;
+    if (l == 1 && p[0] == '.') { p += l; continue; }
+    if (l == 2 && p[0] == '.' && p[1] == '.') {
+      for (k = n; k > 0 && out[k - 1] != '/'; --k) {}
+      n = k > 0 ? k - 1 : 0;
+      out[n] = '\0';
+      p += l;
+      continue;
     }
+    if (n + l + 2 >= cap) break;
+    out[n++] = '/';
+    memcpy(out + n, p, l);
+    n += l;
+    out[n] = '\0';
+    p += l;
   }
-  if (stat(dir, &st) != 0 || !S_ISDIR(st.st_mode)) return fail("%s (--out): not a directory", dir);
+  if (n == 0 && cap > 1) { out[0] = '/'; out[1] = '\0'; }
+}
+
+static void file_id_make(const char *path, file_id *f) {
+  struct stat st;
+  const char *sl = strrchr(path, '/');
+  const char *base = sl ? sl + 1 : path;
+  char dir[4096];
+  memset(f, 0, sizeof *f);
+  if (stat(path, &st) == 0) { f->kind = 1; f->dev = st.st_dev; f->ino = st.st_ino; return; }
+  if (sl && (size_t)(sl - path) >= sizeof dir) sl = NULL, base = "";
+  if (sl == path) strcpy(dir, "/");
+  else if (sl) { memcpy(dir, path, (size_t)(sl - path)); dir[sl - path] = '\0'; }
+  else strcpy(dir, ".");
+  if (*base && strcmp(base, ".") && strcmp(base, "..") && stat(dir, &st) == 0 && S_ISDIR(st.st_mode)) {
+    f->kind = 2; f->dev = st.st_dev; f->ino = st.st_ino;
+    f->s = (char *)malloc(strlen(base) + 1);
+    if (f->s) strcpy(f->s, base);
+    return;
+  }
+  f->kind = 3;
+  f->s = (char *)malloc(8192);
+  if (f->s) path_fold(path, f->s, 8192);
+}
+
+static int file_id_same(const file_id *a, const file_id *b) {
+  if (a->kind != b->kind) return 0;
+  if (a->kind == 3) return a->s && b->s && !strcmp(a->s, b->s);
+  if (a->dev != b->dev || a->ino != b->ino) return 0;
+  return a->kind == 1 || (a->s && b->s && !strcmp(a->s, b->s));
+}
+
+/* A list of paths with the options they came from (copies). */
+#define PATHS_MAX 160
+typedef struct pathset {
+  char *path[PATHS_MAX];
+  const char *opt[PATHS_MAX];
+  file_id id[PATHS_MAX];
+  int n;
+} pathset;
+
+static void paths_free(pathset *ps) {
+  int k;
+  for (k = 0; k < ps->n; ++k) { free(ps->path[k]); free(ps->id[k].s); }
+  ps->n = 0;
+}
+
+/* Add path (and, with tmp, the temporary name path.tmp a staged write uses). */
+static void paths_add(pathset *ps, const char *opt, const char *path, int tmp) {
+  int t;
+  for (t = 0; t <= tmp && ps->n < PATHS_MAX; ++t) {
+    const size_t l = strlen(path);
+    char *c = (char *)malloc(l + 5);
+    if (!c) return;
+    memcpy(c, path, l + 1);
+    if (t) memcpy(c + l, ".tmp", 5);
+    ps->path[ps->n] = c;
+    ps->opt[ps->n] = opt;
+    file_id_make(c, &ps->id[ps->n]);
+    ps->n++;
+  }
+}
+
+/* An input spec that may be a file: anything but the input kinds sin, const. */
+static void paths_add_input(pathset *ps, const char *opt, const char *spec) {
+  if (spec && strcmp(spec, "sin") && strcmp(spec, "const")) paths_add(ps, opt, spec, 0);
+}
+
+/* The index in ps of the file path names, -1 if none. */
+static int paths_find(const pathset *ps, const char *path) {
+  file_id f;
+  int k, hit = -1;
+  file_id_make(path, &f);
+  for (k = 0; k < ps->n && hit < 0; ++k)
+    if (file_id_same(&f, &ps->id[k])) hit = k;
+  free(f.s);
+  return hit;
+}
+
+/* The inputs of the running command: stage_path refuses to write one, the
+   removal of an earlier run's arrays skips them. */
+static const pathset *g_inputs = NULL;
+
+/* Up front: no output may be an input or another output of the same run.
+   Returns 0, or the usage status 2 after a message. */
+static int check_collisions(const char *cmd, const pathset *in, const pathset *out) {
+  int i, k;
+  for (i = 0; i < out->n; ++i) {
+    for (k = 0; k < in->n; ++k)
+      if (file_id_same(&out->id[i], &in->id[k]))
+        return usage_error("%s: the output %s (%s) is the input %s (%s): a run never overwrites its inputs; "
+                           "choose another output name", cmd, out->path[i], out->opt[i], in->path[k], in->opt[k]);
+    for (k = 0; k < i; ++k)
+      if (file_id_same(&out->id[i], &out->id[k]))
+        return usage_error("%s: %s (%s) and %s (%s) are the same file; give each output its own name", cmd,
+                           out->path[k], out->opt[k], out->path[i], out->opt[i]);
+  }
   return 0;
+}
+
+/* Up front: can files be created in dir (created first if missing, create = 1)?
+   0, or 1 after a message naming opt and path. */
+static int check_writable_dir(const char *dir, const char *opt, const char *path, int create) {
+  char buf[4096];
+  struct stat st;
+  size_t n = strlen(dir);
+  if (n == 0 || n >= sizeof buf) return fail("%s (%s): bad directory name", path, opt);
+  memcpy(buf, dir, n + 1);
+  for (;;) {
+    if (stat(buf, &st) == 0) {
+      if (!S_ISDIR(st.st_mode))
+        return fail("%s (%s): cannot write there: %s is not a directory", path, opt, buf);
+      if (access(buf, W_OK | X_OK) != 0)
+        return fail("%s (%s): cannot write in %s: %s", path, opt, buf, strerror(errno));
+      return 0;
+    }
+    if (errno != ENOENT) return fail("%s (%s): cannot use %s: %s", path, opt, buf, strerror(errno));
+    if (!create) return fail("%s (%s): cannot write: the directory %s does not exist", path, opt, buf);
+    if (!strcmp(buf, ".")) return fail("%s (%s): the working directory is gone", path, opt);
+    while (n > 1 && buf[n - 1] == '/') buf[--n] = '\0'; /* to the parent: drop the last component */
+    while (n > 0 && buf[n - 1] != '/') buf[--n] = '\0';
+    while (n > 1 && buf[n - 1] == '/') buf[--n] = '\0';
+    if (n == 0) { strcpy(buf, "."); n = 1; }
+  }
+}
+
+/* An output file path: its directory must exist and be writable, and the path
+   must not be a directory. 0, or 1 after a message. */
+static int check_out_file(const char *path, const char *opt) {
+  char dir[4096];
+  const char *sl = strrchr(path, '/');
+  struct stat st;
+  if (!*path) return fail("'' (%s): empty file name", opt);
+  if (stat(path, &st) == 0 && S_ISDIR(st.st_mode)) return fail("%s (%s): cannot write: is a directory", path, opt);
+  if (!sl) strcpy(dir, ".");
+  else if (sl == path) strcpy(dir, "/");
+  else if ((size_t)(sl - path) < sizeof dir) { memcpy(dir, path, (size_t)(sl - path)); dir[sl - path] = '\0'; }
+  else return fail("%s (%s): path too long", path, opt);
+  return check_writable_dir(dir, opt, path, 0);
 }
 
 /* All or none: every output of a run is written under a temporary name
@@ -581,22 +772,63 @@ static int mkdir_p(const char *dir) {
 typedef struct staged {
   char *fin[64], *tmp[64];
   int n;
+  char *made[32];  /* directories this run created (mkdir_p), removed again if empty after a failure */
+  int nmade;
 } staged;
 
-static void stage_abort(staged *sg) {
+static void stage_free(staged *sg, int remove_tmp) {
   int k;
   for (k = 0; k < sg->n; ++k) {
-    remove(sg->tmp[k]);
+    if (remove_tmp) remove(sg->tmp[k]);
     free(sg->fin[k]);
     free(sg->tmp[k]);
   }
   sg->n = 0;
+  for (k = sg->nmade - 1; k >= 0; --k) {
+    if (remove_tmp) rmdir(sg->made[k]); /* only if empty */
+    free(sg->made[k]);
+  }
+  sg->nmade = 0;
+}
+
+/* After a failure: the temporary files and the directories made go. */
+static void stage_abort(staged *sg) { stage_free(sg, 1); }
+
+/* Create dir and its missing parents (noted in sg). */
+static int mkdir_p(const char *dir, staged *sg) {
+  char buf[4096];
+  size_t n = strlen(dir), i;
+  struct stat st;
+  if (n == 0 || n >= sizeof buf) return fail("%s (--out): bad directory name", dir);
+  memcpy(buf, dir, n + 1);
+  for (i = 1; i <= n; ++i) {
+    if (buf[i] == '/' || buf[i] == '\0') {
+      const char c = buf[i];
+      buf[i] = '\0';
+      if (mkdir(buf, 0777) == 0) {
+        if (sg->nmade < 32 && (sg->made[sg->nmade] = (char *)malloc(i + 1)) != NULL) memcpy(sg->made[sg->nmade++], buf, i + 1);
+      } else if (errno != EEXIST) {
+        return fail("%s (--out): cannot create directory %s: %s", dir, buf, strerror(errno));
+      }
+      buf[i] = c;
+    }
+  }
+  if (stat(dir, &st) != 0 || !S_ISDIR(st.st_mode)) return fail("%s (--out): not a directory", dir);
+  return 0;
 }
 
 /* The path to write for the output `path` (NULL after a message). */
 static const char *stage_path(staged *sg, const char *path) {
   struct stat st;
   const size_t l = strlen(path);
+  if (g_inputs) { /* the last guard; the outputs were checked against the inputs up front */
+    char tmp[4096 + 260];
+    snprintf(tmp, sizeof tmp, "%s.tmp", path);
+    if (paths_find(g_inputs, path) >= 0 || paths_find(g_inputs, tmp) >= 0) {
+      fail("%s: not written: it is an input of this run", path);
+      return NULL;
+    }
+  }
   if (lstat(path, &st) == 0) {
     if (S_ISDIR(st.st_mode)) { fail("%s: cannot write: is a directory", path); return NULL; }
     if (!S_ISREG(st.st_mode)) return path;
@@ -622,10 +854,10 @@ static int stage_commit(staged *sg) {
   for (k = 0; k < sg->n; ++k)
     if (rename(sg->tmp[k], sg->fin[k]) != 0) {
       fail("%s: cannot rename %s into place: %s", sg->fin[k], sg->tmp[k], strerror(errno));
-      stage_abort(sg); /* removes the files not yet renamed, frees the names */
+      stage_free(sg, 1); /* removes the files not yet renamed, frees the names */
       return 1;
     }
-  stage_abort(sg); /* frees the names; the temporary files are gone */
+  stage_free(sg, 0); /* frees the names; the temporary files are gone, the directories stay */
   return 0;
 }
 
@@ -1103,7 +1335,12 @@ typedef struct reduce_state {
   cli_input xinp[16];     /* --X-input: the input of each --X run */
   phgmg_ph_system sys;    /* the full model as reduced (internal ordering for sparse input) */
   phgmg_reduced *red;
+  int method;
+  const double *Xd;       /* --X: the snapshots (internal ordering), ns columns */
+  int ns;
   staged sg; /* the outputs, renamed into place at the end */
+  outlist ol; /* the arrays written */
+  pathset pin, pout; /* the files read; the files the run may write */
 } reduce_state;
 
 /* A named potential (--potential) as exp-polynomial coefficients into S->named:
@@ -1195,24 +1432,61 @@ static void reduce_cleanup(reduce_state *S) {
   phgmg_ph_sparse_destroy(S->sp); free(S->Xperm); free(S->Uord);
   phgmg_reduced_destroy(S->red);
   stage_abort(&S->sg); /* after a failure: no output of this run stays */
+  g_inputs = NULL;
+  paths_free(&S->pin); paths_free(&S->pout);
 }
 
-/* Remove the arrays NAME_<field>.npy (regular files) of an earlier run in dir
-   that this run (list ol) did not write, e.g. after another method. */
-static void remove_stale(const char *dir, const char *name, const outlist *ol) {
-  static const char *const all[] = {"Bh", "Qh", "K", "G00", "G01", "G10", "G11", "Q01", "Q11", "Ms",
-                                    "P0", "P1", "w", "poly", "expo", "Phi", "Gam", "SX", "SU", "V0", "V2", "M",
-                                    "snapshots", "fom_y", NULL};
-  char path[4096 + 256], file[128];
+/* The fields NAME_<field>.npy a run may write. */
+static const char *const all_fields[] = {"Bh", "Qh", "K", "G00", "G01", "G10", "G11", "Q01", "Q11", "Ms",
+                                         "P0", "P1", "w", "poly", "expo", "Phi", "Gam", "SX", "SU", "V0", "V2",
+                                         "M", "snapshots", "fom_y", NULL};
+
+/* The arrays an earlier run recorded as its own in DIR/NAME.json ("arrays":
+   {"NAME_<field>.npy": [rows, cols], ...}), those of the form NAME_<field>.npy
+   with a known field only, into rec. Nothing when there is no such record. */
+static void read_record(const char *dir, const char *name, outlist *rec) {
+  char path[4096 + 256], *text, *p;
+  FILE *f;
+  long n;
+  memset(rec, 0, sizeof *rec);
+  snprintf(path, sizeof path, "%s/%s.json", dir, name);
+  if (!(f = fopen(path, "rb"))) return;
+  if (fseek(f, 0, SEEK_END) != 0 || (n = ftell(f)) <= 0 || n > (1L << 20) || fseek(f, 0, SEEK_SET) != 0 ||
+      !(text = (char *)malloc((size_t)n + 1))) { fclose(f); return; }
+  n = (long)fread(text, 1, (size_t)n, f);
+  fclose(f);
+  text[n] = '\0';
+  p = strstr(text, "\"arrays\": {");
+  while (p && rec->n < 48) {
+    char *q, *e;
+    int k;
+    p = strchr(p + 1, '"');
+    if (!p || !(e = strchr(p + 1, '"')) || strchr(p, '}') < p) break;
+    q = p + 1;
+    *e = '\0';
+    for (k = 0; all_fields[k]; ++k) {
+      char want[128];
+      snprintf(want, sizeof want, "%s_%s.npy", name, all_fields[k]);
+      if (!strcmp(q, want) && strlen(want) < sizeof rec->names[0]) { strcpy(rec->names[rec->n++], want); break; }
+    }
+    p = strchr(e + 1, ']');
+  }
+  free(text);
+}
+
+/* Remove the arrays an earlier run recorded (rec, read before this run's
+   record replaced it) that this run (ol) did not write, e.g. after another
+   method -- never an input of this run, only regular files. */
+static void remove_stale(const char *dir, const outlist *rec, const outlist *ol) {
+  char path[4096 + 256];
   struct stat st;
   int k, i, mine;
-  for (k = 0; all[k]; ++k) {
-    snprintf(file, sizeof file, "%s_%s.npy", name, all[k]);
-    for (i = 0, mine = 0; i < ol->n && !mine; ++i) mine = !strcmp(ol->names[i], file);
-    snprintf(path, sizeof path, "%s/%s", dir, file);
-    if (!mine && lstat(path, &st) == 0 && S_ISREG(st.st_mode)) {
-      if (remove(path) == 0) progress("removed %s (an array of an earlier run, not written by this one)", path);
-    }
+  for (k = 0; k < rec->n; ++k) {
+    for (i = 0, mine = 0; i < ol->n && !mine; ++i) mine = !strcmp(ol->names[i], rec->names[k]);
+    snprintf(path, sizeof path, "%s/%s", dir, rec->names[k]);
+    if (mine || (g_inputs && paths_find(g_inputs, path) >= 0)) continue;
+    if (lstat(path, &st) == 0 && S_ISREG(st.st_mode) && remove(path) == 0)
+      progress("removed %s (an array of an earlier run, not written by this one)", path);
   }
 }
 
@@ -1291,7 +1565,7 @@ static int load_snapshot_files(const reduce_args *A, reduce_state *S, int N, int
       const int c = k ? S->Xs[k].cols : S->X.cols;
       memset(&S->runs[k], 0, sizeof S->runs[k]);
       if (A->nxin) {
-        int e = input_setup(&S->xinp[k], A->xin[k], A->amp, m, A->dt);
+        int e = input_setup(&S->xinp[k], "--X-input", A->xin[k], A->amp, m, A->dt);
         if (e) return e;
         S->runs[k].u = input_fn; S->runs[k].user = &S->xinp[k];
         S->runs[k].x0 = X + col * (size_t)N;
@@ -1473,9 +1747,9 @@ static int simulate_training_runs(const reduce_args *A, reduce_state *S, const d
   double *x0;
   int done = 0;
   const int nrun = A->ntrain ? A->ntrain : 1;
-  if ((k = input_setup(&S->in, A->input, A->amp, m, A->dt)) != 0) return k;
+  if ((k = input_setup(&S->in, A->ntrain ? "--train-input" : "--input", A->input, A->amp, m, A->dt)) != 0) return k;
   for (i = 1; i < nrun; ++i)
-    if ((k = input_setup(&S->tin[i], A->train[i], A->amp, m, A->dt)) != 0) return k;
+    if ((k = input_setup(&S->tin[i], "--train-input", A->train[i], A->amp, m, A->dt)) != 0) return k;
   ns = nrun * (A->steps + 1);
   if (too_big(((double)N + (double)m) * (double)ns, "--simulate: the snapshots (N x (steps+1)) and outputs"))
     return 2;
@@ -1489,6 +1763,7 @@ static int simulate_training_runs(const reduce_args *A, reduce_state *S, const d
   for (i = 0; i < nrun; ++i) {   /* run i in columns i (steps + 1) ..; from x0 = 0 */
     cli_input *in = i ? &S->tin[i] : &S->in;
     const size_t c0 = (size_t)i * (size_t)(A->steps + 1);
+    input_covers(in, i ? A->train[i] : A->input, A->ntrain ? "--train-input" : "--input", A->steps * A->dt);
     progress("simulating the full model: %d steps of dt = %g, %s", A->steps, A->dt,
              input_desc(in, i ? A->train[i] : A->input));
     in->report = 1;
@@ -1604,7 +1879,7 @@ static int write_arrays(const reduce_args *A, reduce_state *S, const double *X, 
   rom_field fields[24];
   int i, k, nf;
   /* --- outputs --- */
-  if (mkdir_p(A->out)) return 1;
+  if (mkdir_p(A->out, &S->sg)) return 1;
   memset(ol, 0, sizeof *ol);
   nf = rom_fields(rom, fields);
   {
@@ -1747,7 +2022,6 @@ static int write_json(const reduce_args *A, reduce_state *S, int method, int ns,
 static int write_model_files(const reduce_args *A, reduce_state *S, int method, int ns, double t_sim, double t_red,
                              const phgmg_reduce_opts *o, const phgmg_reduce_info *info, const outlist *ol) {
   const phgmg_rom *rom = phgmg_reduced_rom(S->red);
-  const int N = S->sys.N;
   phgmg_result rc;
   char path[4096 + 256];
   const char *wp;
@@ -1759,38 +2033,104 @@ static int write_model_files(const reduce_args *A, reduce_state *S, int method, 
   if (!(wp = stage_path(&S->sg, path))) return 1;
   rc = phgmg_rom_export_c(rom, A->name, wp);
   if (rc != PHGMG_OK) return fail("%s: cannot write the C source: %s", path, phgmg_result_string(rc));
+  return write_json(A, S, method, ns, t_sim, t_red, o, info, ol);
+}
 
-  if (write_json(A, S, method, ns, t_sim, t_red, o, info, ol)) return 1;
+/* Every output of the run moves into place; then the arrays an earlier run
+   recorded and this one did not write are removed. */
+static int reduce_commit(const reduce_args *A, reduce_state *S) {
+  const phgmg_rom *rom = phgmg_reduced_rom(S->red);
+  outlist rec;
+  read_record(A->out, A->name, &rec); /* before this run's record replaces it */
   if (stage_commit(&S->sg)) return 1;
-  remove_stale(A->out, A->name, ol);
-
+  remove_stale(A->out, &rec, &S->ol);
   printf("wrote %s/%s.phgmgrom, %s/%s.c, %s/%s.json and %d arrays %s/%s_*.npy (%s, r = %d, m = %d, N = %d)\n",
-         A->out, A->name, A->out, A->name, A->out, A->name, ol->n, A->out, A->name, method_name(method), rom->r,
-         rom->m, N);
+         A->out, A->name, A->out, A->name, A->out, A->name, S->ol.n, A->out, A->name, method_name(S->method),
+         rom->r, rom->m, S->sys.N);
   return 0;
 }
 
-static int cmd_reduce_impl(const reduce_args *A, reduce_state *S) {
+/* The files a run reads (every file option; validate: also its test inputs)
+   and the files it may write (every output its options can produce, with the
+   temporary names of the staged writes) into S->pin, S->pout. */
+static void reduce_paths(const reduce_args *A, reduce_state *S, const char *const *tests, int nt) {
+  const char *const files[] = {A->J, A->R, A->B, A->Q, A->poly, A->poly_idx, A->poly_w, A->expf};
+  const char *const fopt[] = {"--J", "--R", "--B", "--Q", "--poly", "--poly-idx", "--poly-w", "--exp"};
+  const char *const coo[] = {A->Jcoo, A->Rcoo, A->Qcoo}, *const cooopt[] = {"--J-coo", "--R-coo", "--Q-coo"};
+  char path[4096 + 256];
+  int k;
+  for (k = 0; k < 8; ++k)
+    if (files[k]) paths_add(&S->pin, fopt[k], files[k], 0);
+  for (k = 0; k < 3; ++k) { /* FILE or rows,cols,vals */
+    const char *a = coo[k];
+    while (a) {
+      const char *c = strchr(a, ',');
+      const size_t l = c ? (size_t)(c - a) : strlen(a);
+      if (l < sizeof path) { memcpy(path, a, l); path[l] = '\0'; paths_add(&S->pin, cooopt[k], path, 0); }
+      a = c ? c + 1 : NULL;
+    }
+  }
+  for (k = 0; k < A->nx; ++k) paths_add(&S->pin, "--X", A->xs[k], 0);
+  for (k = 0; k < A->nxin; ++k) paths_add_input(&S->pin, "--X-input", A->xin[k]);
+  for (k = 0; k < A->ntrain; ++k) paths_add_input(&S->pin, "--train-input", A->train[k]);
+  if (!A->ntrain && A->simulate) paths_add_input(&S->pin, "--input", A->input);
+  for (k = 0; k < nt; ++k) paths_add_input(&S->pin, "--test-input", tests[k]);
+  snprintf(path, sizeof path, "%s/%s.phgmgrom", A->out, A->name); paths_add(&S->pout, "--out/--name", path, 1);
+  snprintf(path, sizeof path, "%s/%s.c", A->out, A->name); paths_add(&S->pout, "--out/--name", path, 1);
+  snprintf(path, sizeof path, "%s/%s.json", A->out, A->name); paths_add(&S->pout, "--out/--name", path, 1);
+  for (k = 0; all_fields[k]; ++k) {
+    if (!A->save_snap && (!strcmp(all_fields[k], "snapshots") || !strcmp(all_fields[k], "fom_y"))) continue;
+    snprintf(path, sizeof path, "%s/%s_%s.npy", A->out, A->name, all_fields[k]);
+    paths_add(&S->pout, "--out/--name", path, 1);
+  }
+}
+
+/* The method code of --method, or -1. */
+static int method_code(const char *m) {
+  if (!strcmp(m, "gmg-pod")) return PHGMG_METHOD_GMG_POD;
+  if (!strcmp(m, "gmg-qm")) return PHGMG_METHOD_GMG_QM;
+  if (!strcmp(m, "sp1")) return PHGMG_METHOD_SP1;
+  if (!strcmp(m, "sp2")) return PHGMG_METHOD_SP2;
+  return -1;
+}
+
+/* Everything that can be checked before any computation: the method, no
+   output an input or another output, the output directory usable, the files
+   read and the system valid, the sizes. */
+static int reduce_prepare(const reduce_args *A, reduce_state *S, const char *const *tests, int nt) {
+  int e;
+  if ((S->method = method_code(A->method)) < 0)
+    return usage_error("--method '%s': expected gmg-pod, gmg-qm, sp1 or sp2", A->method);
+  reduce_paths(A, S, tests, nt);
+  if ((e = check_collisions("reduce", &S->pin, &S->pout)) != 0) return e;
+  g_inputs = &S->pin;
+  if (check_writable_dir(A->out, "--out", A->out, 1)) return 1;
+  if ((e = load_system(A, S)) != 0) return e;
+  if ((e = check_sizes(A, S->method, S->sys.N, S->sys.m)) != 0) return e;
+  return A->X ? load_snapshot_files(A, S, S->sys.N, S->sys.m, &S->Xd, &S->ns) : 0;
+}
+
+/* The snapshots, the reduction and every output written under its temporary
+   name (reduce_commit moves them into place). */
+static int reduce_build(const reduce_args *A, reduce_state *S) {
   phgmg_reduce_opts o;
   phgmg_reduce_info info;
-  outlist ol;
   double t_sim = 0.0, t_red = 0.0;
-  const double *X = NULL;
-  int ns = 0, method, e;
+  const double *X = S->Xd;
+  int ns = S->ns, e;
   memset(&o, 0, sizeof o);
   memset(&info, 0, sizeof info);
-  if (!strcmp(A->method, "gmg-pod")) method = PHGMG_METHOD_GMG_POD;
-  else if (!strcmp(A->method, "gmg-qm")) method = PHGMG_METHOD_GMG_QM;
-  else if (!strcmp(A->method, "sp1")) method = PHGMG_METHOD_SP1;
-  else if (!strcmp(A->method, "sp2")) method = PHGMG_METHOD_SP2;
-  else return usage_error("--method '%s': expected gmg-pod, gmg-qm, sp1 or sp2", A->method);
-  if ((e = load_system(A, S)) != 0) return e;
-  if ((e = check_sizes(A, method, S->sys.N, S->sys.m)) != 0) return e;
-  e = A->X ? load_snapshot_files(A, S, S->sys.N, S->sys.m, &X, &ns) : simulate_training_runs(A, S, &X, &ns, &t_sim);
-  if (e) return e;
-  if ((e = run_reduction(A, S, method, X, ns, &o, &info, &t_red)) != 0) return e;
-  if ((e = write_arrays(A, S, X, ns, &ol)) != 0) return e;
-  return write_model_files(A, S, method, ns, t_sim, t_red, &o, &info, &ol);
+  if (!A->X && (e = simulate_training_runs(A, S, &X, &ns, &t_sim)) != 0) return e;
+  if ((e = run_reduction(A, S, S->method, X, ns, &o, &info, &t_red)) != 0) return e;
+  if ((e = write_arrays(A, S, X, ns, &S->ol)) != 0) return e;
+  return write_model_files(A, S, S->method, ns, t_sim, t_red, &o, &info, &S->ol);
+}
+
+static int cmd_reduce_impl(const reduce_args *A, reduce_state *S) {
+  int e;
+  if ((e = reduce_prepare(A, S, NULL, 0)) != 0) return e;
+  if ((e = reduce_build(A, S)) != 0) return e;
+  return reduce_commit(A, S);
 }
 
 static int cmd_reduce(int argc, char **argv) {
@@ -1834,8 +2174,11 @@ static int cmd_simulate_rom(int argc, char **argv) {
   staged sg;
   const char *seen[64], *wp;
   int nseen = 0;
+  pathset pin, pout; /* the files read; the files written */
   memset(&in, 0, sizeof in);
   memset(&sg, 0, sizeof sg);
+  memset(&pin, 0, sizeof pin);
+  memset(&pout, 0, sizeof pout);
   for (i = 2; i < argc; ++i) {
     const char *o = argv[i], *v;
     if (!strcmp(o, "--help") || !strcmp(o, "-h")) { print_help(); return 0; }
@@ -1857,14 +2200,23 @@ static int cmd_simulate_rom(int argc, char **argv) {
     else return usage_error("simulate-rom: unknown option '%s'", o);
   }
   if (!model || !out) return usage_error("simulate-rom: --model FILE and --out FILE are required");
-  if (load_model(model, "--model", &rom, &block)) return 1;
+  paths_add(&pin, "--model", model, 0);
+  paths_add_input(&pin, "--input", inspec);
+  paths_add(&pout, "--out", out, 1);
+  if (states) paths_add(&pout, "--states", states, 1);
+  if ((status = check_collisions("simulate-rom", &pin, &pout)) != 0) goto done;
+  status = 1;
+  if (check_out_file(out, "--out") || (states && check_out_file(states, "--states"))) goto done;
+  g_inputs = &pin;
+  if (load_model(model, "--model", &rom, &block)) goto done;
   if (!have_dt) dt = rom.Phi ? (double)rom.dt : 0.1;
   if (too_big(((double)rom.m + (states ? (double)rom.r : 0.0)) * ((double)steps + 1.0),
               "--steps: the outputs (m x (steps+1), states r x (steps+1))")) {
     status = 2;
     goto done;
   }
-  if ((status = input_setup(&in, inspec, amp, rom.m, dt)) != 0) goto done;
+  if ((status = input_setup(&in, "--input", inspec, amp, rom.m, dt)) != 0) goto done;
+  input_covers(&in, inspec, "--input", steps * dt);
   status = 1;
   msz = phgmg_rom_stepper_memsize_dt(&rom, (phgmg_real)dt);
   nreal = (size_t)rom.r + 4 * (size_t)rom.m + phgmg_rom_eval_work_size(&rom);
@@ -1921,6 +2273,8 @@ static int cmd_simulate_rom(int argc, char **argv) {
   status = 0;
 done:
   stage_abort(&sg);
+  g_inputs = NULL;
+  paths_free(&pin); paths_free(&pout);
   mat_free(&in.tab);
   free(mem); free(x); free(Y); free(XR); free(block);
   return status;
@@ -1967,69 +2321,161 @@ static int cmd_info(int argc, char **argv) {
    training envelope (outside) and with a quadratic correction above the
    training maximum (q-out), and the first failing step. Exit status 1 if any test fails (a Newton failure in the reduced run,
    or e_y above --max-ey, default 0.1); 0 if all pass; 2 bad usage. */
+/* validate's own options, taken out of the command line (the rest is
+   reduce's). Returns 0 or the usage status 2. */
+typedef struct validate_args {
+  const char *tests[16];
+  int nt, steps_t, have_amp;
+  double amp_t, max_ey;
+} validate_args;
+
+static int parse_validate(int argc, char **argv, validate_args *V, const char **reduce_argv, int *rargc) {
+  const char *seen[8];
+  int i, nseen = 0;
+  memset(V, 0, sizeof *V);
+  V->max_ey = 0.1;
+  *rargc = 0;
+  for (i = 0; i < argc; ++i) {
+    const char *o = argv[i], *v;
+    const int mine = i >= 2 && (!strcmp(o, "--test-input") || !strcmp(o, "--test-amp") ||
+                                !strcmp(o, "--test-steps") || !strcmp(o, "--max-ey"));
+    if (!mine) {
+      if (*rargc >= 255) return usage_error("validate: too many arguments");
+      reduce_argv[(*rargc)++] = o;
+      continue;
+    }
+    if (!(v = optval(argc, argv, &i))) return 2;
+    if (!strcmp(o, "--test-input")) {   /* repeatable: one test each */
+      if (V->nt >= 16) return usage_error("validate: at most 16 --test-input");
+      V->tests[V->nt++] = v;
+      continue;
+    }
+    if (repeated_opt(o, seen, &nseen)) return 2;
+    if (!strcmp(o, "--test-amp")) {
+      if (!parse_double(o, v, -HUGE_VAL, &V->amp_t)) return 2;
+      V->have_amp = 1;
+    } else if (!strcmp(o, "--test-steps")) {
+      if (!parse_int(o, v, 1, INT_MAX - 1, &V->steps_t)) return 2;
+      if (too_big((double)V->steps_t + 1.0, "--test-steps: the full model's trajectory (N x (steps+1)) alone"))
+        return 2; /* N >= 1: a first check before reading J */
+    } else { /* --max-ey */
+      if (!parse_double(o, v, 0.0, &V->max_ey)) return 2;
+      if (!(V->max_ey > 0.0)) return usage_error("--max-ey %s: the bound on e_y must be > 0", v);
+    }
+  }
+  reduce_argv[*rargc] = NULL;
+  return 0;
+}
+
+/* A test that could not be made: the reason in the user's terms. */
+static int validate_error(const char *spec, phgmg_result rc, const reduce_state *S, int nsteps) {
+  if (rc == PHGMG_ERR_NANINF)
+    return fail("validate: %s: the full model's run overflows or meets NaN (states beyond the double range; "
+                "try a smaller --test-amp)", spec);
+  if (rc == PHGMG_ERR_NOMEM) { /* the library's error norms gave NaN, or memory is short: tell which */
+    const phgmg_rom *rom = phgmg_reduced_rom(S->red);
+    void *p = malloc(sizeof(double) * ((size_t)S->sys.N + 2 * (size_t)S->sys.m + (size_t)rom->r + 8) *
+                     ((size_t)nsteps + 1));
+    free(p);
+    if (p)
+      return fail("validate: %s: the error norms overflow the double range (states of magnitude 1e154 or more: "
+                  "try a smaller --test-amp)", spec);
+  }
+  if (rc == PHGMG_ERR_NOT_CONVERGED)
+    return fail("validate: %s: the full model's run failed: %s (try a smaller --dt or more --newton-iter)", spec,
+                phgmg_result_string(rc));
+  return fail("validate: %s: %s", spec, phgmg_result_string(rc));
+}
+
+/* One test of validate: full and reduced model on input `spec` over nsteps
+   from x0 (NULL: 0); prints its line; 0 pass, 1 fail or error. */
+static int validate_one(const reduce_args *A, reduce_state *S, cli_input *in, const char *spec, int nsteps,
+                        const double *x0, double max_ey) {
+  const phgmg_ph_system sys = S->sys;   /* as reduced: any potential, sparse input in its internal order */
+  phgmg_run run;
+  phgmg_validation v;
+  phgmg_result rc;
+  memset(&run, 0, sizeof run);
+  run.u = input_fn; run.user = in; run.dt = A->dt; run.nsteps = nsteps; run.x0 = x0;
+  rc = phgmg_reduced_validate(S->red, &sys, &run, A->newton_tol, A->newton_iter, max_ey, &v, NULL);
+  if (rc != PHGMG_OK) return validate_error(spec, rc, S, nsteps);
+  printf("%-24s %10.3e %10.3e %10.3e %10.3e %10.3e %8.2f %8ld %8ld %8d  %s\n", spec, v.e_red, v.e_y, v.e_proj,
+         v.e_energy, v.e_energy_fom, v.stats.steps ? (double)v.stats.newton_iters / v.stats.steps : 0.0,
+         v.stats.outside_steps, v.stats.q_outside_steps, v.first_failure, v.pass ? "pass" : "FAIL");
+  if (v.first_failure >= 0) {
+    printf("  first failing step: %d (t = %g -> %g): %s\n", v.first_failure, v.first_failure * A->dt,
+           (v.first_failure + 1) * A->dt, phgmg_result_string(v.rom_rc));
+    return 1;
+  }
+  if (!(isfinite(v.e_y) && isfinite(v.e_red) && isfinite(v.e_proj))) {
+    printf("  the error norms overflow the double range (states too large; try a smaller --test-amp)\n");
+    return 1;
+  }
+  if (v.pass) return 0;
+  printf("  e_y %.3e above --max-ey %g\n", v.e_y, max_ey);
+  return 1;
+}
+
+/* ---- validate: reduce, then check the reduced model against the full one ----
+   phgmg validate <every option of reduce> [--test-input KIND]... [--test-amp A]
+                  [--test-steps N] [--max-ey E]
+   Builds the reduced model as reduce does, then runs full and reduced model on
+   each test input (KIND as --input; default: the training input(s), with --X
+   the --X-input runs from their first snapshot) with phgmg_reduced_validate
+   and prints e_red, e_y, e_proj, the energy error, Newton statistics
+   (iterations per step), the steps outside the training envelope (outside)
+   and with a quadratic correction above the training maximum (q-out), and
+   the first failing step. Each test runs --test-steps steps, default the
+   length of the training run. The outputs are written (as reduce writes
+   them) only when every test passes: a failing model never replaces the one
+   under --out. Exit status 1 if any test fails (a Newton failure in the
+   reduced run, or e_y above --max-ey, default 0.1); 0 if all pass; 2 bad
+   usage. Every option and test input is checked before any computation. */
 static int cmd_validate(int argc, char **argv) {
-  const char *tests[16], *reduce_argv[256];
-  double amp_t = -HUGE_VAL, max_ey = 0.1;
-  int nt = 0, rargc = 0, steps_t = 0, i, k, status = 0;
+  const char *reduce_argv[256];
+  validate_args V;
+  cli_input tin[16];
+  int steps[16], from_x[16];
+  int rargc = 0, i, k, status = 0, nt;
   reduce_args A;
   reduce_state S;
-  for (i = 0; i < argc; ++i) {
-    const char *v;
-    if (i >= 2 && !strcmp(argv[i], "--test-input")) {
-      if (!(v = optval(argc, argv, &i))) return 2;
-      if (nt >= 16) return usage_error("validate: at most 16 --test-input");
-      tests[nt++] = v;
-    } else if (i >= 2 && !strcmp(argv[i], "--test-amp")) {
-      if (!(v = optval(argc, argv, &i)) || !parse_double("--test-amp", v, -HUGE_VAL, &amp_t)) return 2;
-    } else if (i >= 2 && !strcmp(argv[i], "--test-steps")) {
-      if (!(v = optval(argc, argv, &i)) || !parse_int("--test-steps", v, 1, INT_MAX - 1, &steps_t)) return 2;
-    } else if (i >= 2 && !strcmp(argv[i], "--max-ey")) {
-      if (!(v = optval(argc, argv, &i)) || !parse_double("--max-ey", v, 0.0, &max_ey)) return 2;
-    } else {
-      if (rargc >= 255) return usage_error("validate: too many arguments");
-      reduce_argv[rargc++] = argv[i];
-    }
-  }
-  reduce_argv[rargc] = NULL;
+  if ((i = parse_validate(argc, argv, &V, reduce_argv, &rargc)) != 0) return i;
   if ((i = parse_reduce(rargc, (char **)reduce_argv, &A)) != 0) return i;
+  nt = V.nt;
+  memset(from_x, 0, sizeof from_x);
   if (nt == 0 && A.ntrain)   /* default: the training inputs */
-    for (i = 0; i < A.ntrain; ++i) tests[nt++] = A.train[i];
-  if (nt == 0 && A.nxin)     /* --X: the inputs of the snapshot runs */
-    for (i = 0; i < A.nxin; ++i) tests[nt++] = A.xin[i];
+    for (i = 0; i < A.ntrain; ++i) V.tests[nt++] = A.train[i];
+  if (nt == 0 && A.nxin)     /* --X: the inputs of the snapshot runs, from their first snapshot */
+    for (i = 0; i < A.nxin; ++i) { from_x[nt] = 1; V.tests[nt++] = A.xin[i]; }
   if (nt == 0 && !A.simulate)
     return usage_error("validate: with --X give --test-input (or --X-input): the inputs that made the snapshots are unknown");
-  if (nt == 0) tests[nt++] = A.input;
+  if (nt == 0) V.tests[nt++] = A.input;
   memset(&S, 0, sizeof S);
-  status = cmd_reduce_impl(&A, &S);
+  memset(tin, 0, sizeof tin);
+  status = reduce_prepare(&A, &S, V.tests, nt);
+  for (k = 0; k < nt && !status; ++k) { /* every test input and run length, up front */
+    /* the training run's length: --steps, or the --X run's (the first run's for a --test-input) */
+    const int run = from_x[k] ? k : 0;
+    steps[k] = V.steps_t ? V.steps_t : !A.X ? A.steps : (run ? S.Xs[run].cols : S.X.cols) - 1;
+    status = input_setup(&tin[k], "--test-input", V.tests[k], V.have_amp ? V.amp_t : A.amp, S.sys.m, A.dt);
+    if (!status) input_covers(&tin[k], V.tests[k], "--test-input", steps[k] * A.dt);
+    if (!status && too_big(((double)S.sys.N + 2.0 * S.sys.m + A.r + 8.0) * ((double)steps[k] + 1.0),
+                           "validate: a test run (the full model's states and outputs, N x (steps+1))"))
+      status = 2;
+  }
+  if (!status) status = reduce_build(&A, &S);
   if (status == 0) {
-    const phgmg_ph_system sys = S.sys;   /* as reduced: any potential, sparse input in its internal order */
     printf("%-24s %10s %10s %10s %10s %10s %8s %8s %8s %8s  %s\n", "test input", "e_red", "e_y", "e_proj", "e_energy",
            "(FOM)", "newton", "outside", "q-out", "fail@", "verdict");
-    for (k = 0; k < nt; ++k) {
-      cli_input in;
-      phgmg_run run;
-      phgmg_validation v;
-      phgmg_result rc;
-      if (input_setup(&in, tests[k], amp_t > -HUGE_VAL ? amp_t : A.amp, sys.m, A.dt)) { status = 1; break; }
-      memset(&run, 0, sizeof run);
-      run.u = input_fn; run.user = &in; run.dt = A.dt; run.nsteps = steps_t ? steps_t : A.steps;
-      rc = phgmg_reduced_validate(S.red, &sys, &run, A.newton_tol, A.newton_iter, max_ey, &v, NULL);
-      mat_free(&in.tab);
-      if (rc != PHGMG_OK) { status = fail("validate: %s: %s", tests[k], phgmg_result_string(rc)); break; }
-      printf("%-24s %10.3e %10.3e %10.3e %10.3e %10.3e %8.2f %8ld %8ld %8d  %s\n", tests[k], v.e_red, v.e_y, v.e_proj,
-             v.e_energy, v.e_energy_fom, v.stats.steps ? (double)v.stats.newton_iters / v.stats.steps : 0.0,
-             v.stats.outside_steps, v.stats.q_outside_steps, v.first_failure, v.pass ? "pass" : "FAIL");
-      if (!v.pass) {
-        status = 1;
-        if (v.first_failure >= 0)
-          printf("  first failing step: %d (t = %g -> %g): %s\n", v.first_failure, v.first_failure * A.dt,
-                 (v.first_failure + 1) * A.dt, phgmg_result_string(v.rom_rc));
-        else
-          printf("  e_y %.3e above --max-ey %g\n", v.e_y, max_ey);
-      }
-    }
+    for (k = 0; k < nt; ++k)
+      if (validate_one(&A, &S, &tin[k], V.tests[k], steps[k], from_x[k] ? S.runs[k].x0 : NULL, V.max_ey)) status = 1;
     printf("validate: %s\n", status ? "FAILED" : "passed");
+    if (status == 0) status = reduce_commit(&A, &S);
+    else
+      printf("validate: the model was not written: %s/%s.* is unchanged (the same options with `phgmg reduce` "
+             "write the failing model)\n", A.out, A.name);
   }
+  for (k = 0; k < 16; ++k) mat_free(&tin[k].tab);
   reduce_cleanup(&S);
   return status;
 }

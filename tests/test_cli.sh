@@ -519,5 +519,66 @@ np.save('S_ok.npy', 0.1 * np.eye(1)); np.save('S_neg.npy', -0.1 * np.eye(1))
   run_err "--E with --J-coo" 2 "--E-coo" "$P" reduce --J-coo J.npy --R-coo R.npy --Q-coo Q.npy --B model/B.npy --E E_id.npy $SIM --method gmg-pod --r 12 --out oEc
 fi
 
+# ---- 9. issue 25: a run never removes or overwrites its inputs; outputs checked up front ----
+# Files are compared by identity (device and inode), however they are spelled.
+sums() { cksum "$@" 2>/dev/null; }
+run_ok "S1 snapshots into ds" "$P" reduce $SYS $QSIM --method gmg-pod --r 10 --out ds --name rom --save-snapshots
+sums ds/rom_snapshots.npy >s1_before.txt
+run_ok "S1 reduce --X ds/rom_snapshots.npy into ds" "$P" reduce $SYS --X ds/rom_snapshots.npy --X-input sin \
+  --method gmg-pod --r 10 --out ds --name rom
+sums ds/rom_snapshots.npy >s1_after.txt
+cmp -s s1_before.txt s1_after.txt && pass || bad "S1: reduce removed or changed its input ds/rom_snapshots.npy"
+grep -F -q "removed ds/rom_snapshots.npy" "$T/err.txt" && bad "S1: reduce says it removed its input" || pass
+# the arrays an earlier run recorded and this one does not write still go (fom_y), not the input
+[ -e ds/rom_fom_y.npy ] && bad "S1: the earlier run's rom_fom_y.npy was not removed" || pass
+# a file the user put beside the outputs, never recorded by a run, stays
+mkdir -p du && cp out/msd_V0.npy du/rom_M.npy
+run_ok "S1 user file beside" "$P" reduce $SYS $QSIM --method gmg-pod --r 10 --out du --name rom
+[ -e du/rom_M.npy ] && pass || bad "S1: reduce removed du/rom_M.npy, a file no run recorded as its output"
+# outputs that would overwrite inputs: refused up front (exit 2), the inputs unchanged
+mkdir -p dp && cp nl/poly.npy dp/model_poly.npy && cp nl/idx.npy dp/idx.npy
+if [ "$HAVE_NP" = 1 ]; then "$PY" -c "import numpy as np; np.save('dp/model_w.npy', np.ones(20))"
+else cp nl/idx.npy dp/model_w.npy; fi
+sums dp/model_poly.npy dp/model_w.npy >s2_before.txt
+run_err "S1 --poly-w is an output" 2 "dp/model_w.npy (--poly-w)" "$P" reduce --J nl/J.npy --R nl/R.npy --B nl/B.npy \
+  --Q nl/Q.npy --poly dp/model_poly.npy --poly-idx dp/idx.npy --poly-w dp/model_w.npy --deim-allow-negative $QSIM \
+  --method gmg-pod --r 10 --out dp --name model
+grep -F -q "reducing" "$T/err.txt" && bad "S1: the collision was found after the reduction" || pass
+ln -s dp dp_link
+run_err "S1 --poly-w through a symbolic link" 2 "(--poly-w)" "$P" reduce --J nl/J.npy --R nl/R.npy --B nl/B.npy \
+  --Q nl/Q.npy --poly nl/poly.npy --poly-idx dp/idx.npy --poly-w ./dp_link/../dp/model_w.npy --deim-allow-negative \
+  $QSIM --method gmg-pod --r 10 --out dp --name model
+ln dp/model_poly.npy dp/hard.npy
+run_err "S1 a hard link to an output" 2 "dp/hard.npy (--poly)" "$P" reduce --J nl/J.npy --R nl/R.npy --B nl/B.npy \
+  --Q nl/Q.npy --poly dp/hard.npy --poly-idx dp/idx.npy --deim-allow-negative $QSIM --method gmg-pod --r 10 \
+  --out dp --name model
+sums dp/model_poly.npy dp/model_w.npy >s2_after.txt
+cmp -s s2_before.txt s2_after.txt && pass || bad "S1: a refused run changed dp/model_poly.npy or dp/model_w.npy"
+run_err "S1 --X is --save-snapshots' output" 2 "(--X)" "$P" reduce $SYS --X ds/rom_snapshots.npy --method gmg-pod \
+  --r 10 --out ds/. --name rom --save-snapshots
+# 4: simulate-rom's outputs: not the model, not each other
+cp out/msd.phgmgrom sm.phgmgrom
+sums sm.phgmgrom >s4_before.txt
+run_err "S4 --out is --model" 2 "(--model)" "$P" simulate-rom --model sm.phgmgrom --steps 10 --out ./sm.phgmgrom
+run_err "S4 --states is --model" 2 "(--model)" "$P" simulate-rom --model sm.phgmgrom --steps 10 --out y4.npy \
+  --states sm.phgmgrom
+sums sm.phgmgrom >s4_after.txt
+cmp -s s4_before.txt s4_after.txt && pass || bad "S4: simulate-rom overwrote its --model"
+run_err "S4 --out is --states" 2 "the same file" "$P" simulate-rom --model sm.phgmgrom --steps 10 --out y4.npy \
+  --states ./y4.npy
+run_err "S4 --out is the --input file" 2 "(--input)" "$P" simulate-rom --model sm.phgmgrom --steps 10 \
+  --input u.npy --out u.npy
+[ -e y4.npy ] && bad "S4: a refused run wrote y4.npy" || pass
+# 13: unusable outputs are found before any computation
+run_err "S13 --out below a file" 1 "garbage.npy/sub (--out)" "$P" reduce $SYS $SIM --method gmg-pod --r 12 \
+  --out garbage.npy/sub
+grep -F -q "simulating" "$T/err.txt" && bad "S13: --out below a file found after the computation" || pass
+run_err "S13 simulate-rom --out nodir/y.npy" 1 "nodir/y.npy (--out)" "$P" simulate-rom --model out/msd.phgmgrom \
+  --out nodir/y.npy
+grep -F -q "simulating" "$T/err.txt" && bad "S13: simulate-rom --out nodir/ found after the simulation" || pass
+run_err "S13 simulate-rom --states nodir/x.npy" 1 "nodir/x.npy (--states)" "$P" simulate-rom --model out/msd.phgmgrom \
+  --out y13.npy --states nodir/x.npy
+grep -F -q "simulating" "$T/err.txt" && bad "S13: simulate-rom --states nodir/ found after the simulation" || pass
+
 echo "test_cli: $npass passed, $nfail failed"
 [ "$nfail" -eq 0 ]

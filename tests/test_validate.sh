@@ -153,5 +153,55 @@ $P reduce --J small/J.npy --R small/R.npy --B small/B.npy --Q small/Q.npy --simu
    --method gmg-qm --r 4 --rn 8 --out sq2 > /dev/null 2>&1
 [ $? -eq 2 ] && pass || bad "N = 10, --rn 8 at r = 4: expected the usage error"
 
+# 8. issue 25: a failing validate leaves the deployed model alone; bounds and
+#    test inputs are checked before any computation.
+M8="--J m/J.npy --R m/R.npy --B m/B.npy --Q m/Q.npy --simulate --quiet"
+$P reduce $M8 --method gmg-pod --r 12 --out dep > /dev/null 2>&1 || bad "deploy a model"
+(cd dep && cksum rom.phgmgrom rom.c rom.json rom_*.npy) > dep_before.txt
+$P validate $M8 --method gmg-qm --r 8 --lambda 1e-12 --out dep --test-input const > v11.txt 2>&1
+rc=$?
+[ $rc -eq 1 ] && pass || bad "failing validate into dep: exit $rc (expected 1)"
+(cd dep && cksum rom.phgmgrom rom.c rom.json rom_*.npy) > dep_after.txt
+cmp -s dep_before.txt dep_after.txt && pass || bad "a failing validate replaced the deployed model in dep"
+ls dep | grep -q '\.tmp$' && bad "a failing validate left temporary files in dep" || pass
+grep -q "not written" v11.txt && pass || bad "a failing validate does not say that the model was not written"
+$P validate $M8 --method gmg-qm --r 8 --lambda 1e-12 --out newdir/sub --test-input const > /dev/null 2>&1
+[ -e newdir ] && bad "a failing validate left the directory it created" || pass
+# --max-ey must be a bound: 0 or negative refused; validate's options once each
+for bad_ey in 0 -1 0.0; do
+  $P validate $M8 --steps 50 --method gmg-pod --r 4 --out o12 --max-ey $bad_ey > v12.txt 2>&1
+  rc=$?
+  [ $rc -eq 2 ] && pass || bad "--max-ey $bad_ey: exit $rc (expected 2)"
+done
+for o in "--max-ey 0.5 --max-ey 1" "--test-amp 1 --test-amp 2" "--test-steps 10 --test-steps 20"; do
+  $P validate $M8 --steps 50 --method gmg-pod --r 4 --out o12 $o > v12.txt 2>&1
+  rc=$?
+  [ $rc -eq 2 ] && grep -q "given more than once" v12.txt && pass || bad "repeated '$o': exit $rc (expected 2)"
+done
+[ -e o12 ] && bad "refused validate runs wrote o12" || pass
+# a bad --test-input is found before the reduction and nothing is written
+$P validate --J m/J.npy --R m/R.npy --B m/B.npy --Q m/Q.npy --simulate --method gmg-pod --r 12 --out o13 \
+   --test-input sin --test-input square > v13.txt 2>&1
+rc=$?
+[ $rc -eq 2 ] && grep -q -- "--test-input 'square'" v13.txt && pass || bad "--test-input square: exit $rc (expected 2)"
+grep -q "simulating\|reducing" v13.txt && bad "--test-input square found after the computation" || pass
+$P validate --J m/J.npy --R m/R.npy --B m/B.npy --Q m/Q.npy --simulate --method gmg-pod --r 12 --out o13 \
+   --test-input m/J.npy > v13.txt 2>&1
+rc=$?
+[ $rc -eq 1 ] && grep -q "m/J.npy (--test-input)" v13.txt && pass || bad "--test-input m/J.npy: exit $rc, $(cat v13.txt)"
+grep -q "simulating\|reducing" v13.txt && bad "a bad --test-input file found after the computation" || pass
+[ -e o13 ] && bad "validate with a bad --test-input wrote o13" || pass
+# --test-steps beyond the 4 GiB cap: refused up front
+$P validate $M8 --method gmg-pod --r 12 --out o14 --test-steps 2000000000 > v14.txt 2>&1
+rc=$?
+[ $rc -eq 2 ] && grep -q "would need" v14.txt && pass || bad "--test-steps 2e9: exit $rc (expected 2, 'would need')"
+TO=; command -v timeout >/dev/null 2>&1 && TO="timeout 60"   # refused up front: instant; a regression must not hang
+$TO $P validate --J m/J.npy --R m/R.npy --B m/B.npy --Q m/Q.npy --simulate --method gmg-pod --r 12 --out o14 \
+   --test-steps 10000000 > v14.txt 2>&1
+rc=$?
+[ $rc -eq 2 ] && grep -q "would need" v14.txt && pass || bad "--test-steps 1e7 (N = 100): exit $rc (expected 2)"
+grep -q "simulating\|reducing" v14.txt && bad "--test-steps 1e7 refused only after the computation" || pass
+[ -e o14 ] && bad "a refused --test-steps wrote o14" || pass
+
 echo "test_validate: $npass passed, $nfail failed"
 [ $nfail -eq 0 ]
