@@ -114,9 +114,9 @@ static const char *const help_lines[] = {
   "  --r R               reduced order (required). For gmg-pod/gmg-qm it includes the m\n",
   "                      port coordinates, so m < R <= N; R - m (gmg) or R (sp1/sp2) must\n",
   "                      not exceed the rank of the (adjusted) snapshots.\n",
-  "  --rn K              gmg-qm lifting dimension r_n (default 8, or the largest that\n",
+  "  --rn K              gmg-qm only: lifting dimension r_n (default 8, or the largest that\n",
   "                      fits; K <= 64, K (R-m) <= 4096, R + K <= N)\n",
-  "  --lambda L          gmg-qm ridge parameter, on the un-normalised sum over the\n",
+  "  --lambda L          gmg-qm only: ridge parameter, on the un-normalised sum over the\n",
   "                      snapshots (0 = exactly zero; the paper's value is 1e-3). Or:\n",
   "    --lambda auto     the default: validated by simulation (the safe choice):\n",
   "                      the reduced model is simulated for candidate lambdas on\n",
@@ -146,9 +146,11 @@ static const char *const help_lines[] = {
   "                      (a (terms, 2) matrix with up to 8 terms is per term only beside\n",
   "                      a per-term --poly).\n",
   "  --potential NAME    a named potential instead of --poly/--exp: toda (e^s - 1 - s),\n",
-  "                      cosh:A ((cosh(A s) - 1)/A^2), morse:D:A (D (1 - e^{-A s})^2),\n",
-  "                      fpu:K3:K4 (K3 s^3/3 + K4 s^4/4). --poly, --exp or --potential\n",
-  "                      need --poly-idx.\n",
+  "                      cosh:A ((cosh(A s) - 1)/A^2, A != 0), morse:D:A (D (1 - e^{-A s})^2,\n",
+  "                      D > 0, A != 0), fpu:K3:K4 (K3 s^3/3 + K4 s^4/4, K4 > 0). --poly,\n",
+  "                      --exp or --potential need --poly-idx. An energy unbounded below\n",
+  "                      (a term w phi(s) -> -inf: a negative leading power >= 3 or\n",
+  "                      fastest exponential) is refused.\n",
   "  --poly-idx FILE     a vector of the 0-based state coordinates idx_k of the terms\n",
   "                      (each in [0, N); any integer dtype, e.g. np.arange, or float64).\n",
   "  --poly-w FILE       a vector of the term weights w_k (default all 1).\n",
@@ -157,9 +159,12 @@ static const char *const help_lines[] = {
   "  --hyper H           hyper-reduction of the nonlinear terms: ecsw (default; weights\n",
   "                      >= 0 by non-negative least squares), qdeim or greedy (the\n",
   "                      paper's structure-preserving DEIM; weights may be negative)\n",
-  "  --hyper-tol T       ecsw: relative training residual of the reduced gradient (1e-6)\n",
-  "  --deim-tol T        DEIM keeps the modes with sigma_k / sigma_1 > T (default 1e-8)\n",
-  "  --deim-max K        at most K DEIM points (default: no cap)\n",
+  "  --hyper-tol T       ecsw: relative training residual of the reduced gradient\n",
+  "                      (default 1e-6; 1e-14 <= T < 1)\n",
+  "  --deim-tol T        qdeim/greedy: keep the modes with sigma_k / sigma_1 > T\n",
+  "                      (default 1e-8; 0 <= T < 1)\n",
+  "  --deim-max K        qdeim/greedy: at most K DEIM points (default: no cap)\n",
+  "                      The options of the hyper-reduction need a nonlinear part.\n",
   "  --deim-allow-negative  accept negative DEIM weights (the reduced energy may then\n",
   "                      lose its lower bound); default: refuse with an error.\n",
   "  --dt-map DT         precompute the exact GL3 step map for step DT in the model\n",
@@ -419,6 +424,7 @@ static int mat_load(mat *m, const char *opt, const char *path) {
   size_t i, n;
   memset(m, 0, sizeof *m);
   m->path = path;
+  if (!*path) return usage_error("%s: empty file name", opt);
   if (is_dir(path, opt)) return 1;
   f = fopen(path, "rb");
   if (!f) return fail("%s (%s): cannot open: %s", path, opt, strerror(errno));
@@ -1108,13 +1114,98 @@ static const char *method_name(int m) {
 /* The value of option argv[*i] (advancing *i), or NULL after a usage message. */
 static const char *optval(int argc, char **argv, int *i) {
   if (*i + 1 >= argc) { usage_error("%s needs a value", argv[*i]); return NULL; }
+  if (!argv[*i + 1][0]) { usage_error("%s: empty value (a file name, a number or a word expected)", argv[*i]); return NULL; }
   return argv[++*i];
+}
+
+/* A named potential (--potential NAME[:P1[:P2]]) as exp-polynomial
+   coefficients into c (the polynomial c_0..c_deg, then the pairs (a_e, b_e)).
+   Returns 0, or 1 after a message: an unknown name, a field that is empty or
+   not a finite number, the wrong number of fields, a parameter out of range,
+   coefficients beyond the double range. */
+static int named_potential(const char *spec, double *c, int *deg, int *nexp) {
+  double p[2] = {1.0, 1.0};
+  int n = 0, k;
+  const char *colon = strchr(spec, ':');
+  const size_t len = colon ? (size_t)(colon - spec) : strlen(spec);
+  const char *what = "expected toda, cosh:A (A != 0), morse:D:A (D > 0, A != 0) or fpu:K3:K4 (K4 > 0)";
+  while (colon) { /* each field a whole finite number */
+    char *end;
+    if (n == 2) return usage_error("--potential '%s': too many fields; %s", spec, what);
+    errno = 0;
+    p[n] = strtod(colon + 1, &end);
+    if (end == colon + 1 || (*end && *end != ':') || errno == ERANGE || !isfinite(p[n]))
+      return usage_error("--potential '%s': field %d is %s; %s", spec, n + 1,
+                         end == colon + 1 ? "empty or not a number" : "not a finite double", what);
+    ++n;
+    colon = *end == ':' ? end : NULL;
+  }
+  memset(c, 0, 8 * sizeof(double));
+  if (len == 4 && !strncmp(spec, "toda", 4) && n == 0) {        /* e^s - 1 - s */
+    c[0] = -1.0; c[1] = -1.0; *deg = 1; *nexp = 1; c[2] = 1.0; c[3] = 1.0;
+  } else if (len == 4 && !strncmp(spec, "cosh", 4) && n <= 1 && p[0] != 0.0) { /* (cosh(a s) - 1)/a^2 */
+    c[0] = -1.0 / (p[0] * p[0]); *deg = 0; *nexp = 2;
+    c[1] = 0.5 / (p[0] * p[0]); c[2] = p[0]; c[3] = 0.5 / (p[0] * p[0]); c[4] = -p[0];
+  } else if (len == 5 && !strncmp(spec, "morse", 5) && n == 2 && p[0] > 0.0 && p[1] != 0.0) { /* D (1 - e^{-a s})^2 */
+    c[0] = p[0]; *deg = 0; *nexp = 2; c[1] = -2.0 * p[0]; c[2] = -p[1]; c[3] = p[0]; c[4] = -2.0 * p[1];
+  } else if (len == 3 && !strncmp(spec, "fpu", 3) && n == 2 && p[1] > 0.0) {  /* k3 s^3/3 + k4 s^4/4 */
+    c[3] = p[0] / 3.0; c[4] = p[1] / 4.0; *deg = 4; *nexp = 0;
+  } else {
+    return usage_error("--potential '%s': %s%s", spec, what,
+                       (len == 5 && !strncmp(spec, "morse", 5) && n == 2 && p[0] <= 0.0) ||
+                       (len == 3 && !strncmp(spec, "fpu", 3) && n == 2 && p[1] <= 0.0)
+                           ? " (else the energy is unbounded below)" : "");
+  }
+  for (k = 0; k < 8; ++k)
+    if (!isfinite(c[k]) || (c[k] != 0.0 && fabs(c[k]) < DBL_MIN))
+      return usage_error("--potential '%s': its coefficients leave the double range (%g); use parameters "
+                         "of moderate size", spec, c[k]);
+  return 0;
+}
+
+/* 1 if option o is among the seen ones. */
+static int given(const char *o, const char *const *seen, int nseen) {
+  int k;
+  for (k = 0; k < nseen; ++k)
+    if (!strcmp(seen[k], o)) return 1;
+  return 0;
+}
+
+/* The hyper-reduction options: each applies to a nonlinear part, and only
+   to the method that reads it. 0 or the usage status 2. */
+static int check_hyper_opts(const reduce_args *A, const char *const *seen, int nseen) {
+  static const char *const all[] = {"--hyper", "--hyper-tol", "--deim-tol", "--deim-max", "--no-deim",
+                                    "--deim-allow-negative", NULL};
+  const int ecsw = !A->hyper || !strcmp(A->hyper, "ecsw");
+  int k;
+  for (k = 0; all[k]; ++k)
+    if (given(all[k], seen, nseen) && !A->poly_idx)
+      return usage_error("reduce: %s applies to a nonlinear part (--poly, --exp or --potential with --poly-idx); "
+                         "this model has none", all[k]);
+  for (k = 0; k < 4; ++k)
+    if (A->no_deim && given(all[k], seen, nseen))
+      return usage_error("reduce: --no-deim keeps every nonlinear term: %s does not apply", all[k]);
+  if (given("--hyper-tol", seen, nseen)) {
+    if (!ecsw) return usage_error("--hyper-tol applies to --hyper ecsw (the tolerance of %s is --deim-tol)", A->hyper);
+    if (!(A->hyper_tol > 0.0 && A->hyper_tol < 1.0))
+      return usage_error("--hyper-tol %g: expected 0 < T < 1 (a relative residual)", A->hyper_tol);
+    if (A->hyper_tol < 1e-14)
+      return usage_error("--hyper-tol %g: below what double precision resolves in a relative residual (1e-14); "
+                         "for every term exactly, use --no-deim", A->hyper_tol);
+  }
+  if (ecsw && (given("--deim-tol", seen, nseen) || given("--deim-max", seen, nseen)))
+    return usage_error("reduce: --deim-tol and --deim-max apply to --hyper qdeim or greedy (ecsw's tolerance is "
+                       "--hyper-tol)");
+  if (!(A->deim_tol < 1.0))
+    return usage_error("--deim-tol %g: expected 0 <= T < 1 (DEIM keeps the modes with sigma_k / sigma_1 > T)",
+                       A->deim_tol);
+  return 0;
 }
 
 /* Returns 0, the usage status 2, or -1 after printing --help. */
 static int parse_reduce(int argc, char **argv, reduce_args *A) {
   const char *seen[64];
-  int i, nseen = 0;
+  int i, nseen = 0, e;
   memset(A, 0, sizeof *A);
   A->dt = 0.1; A->steps = 1000; A->amp = 0.1; A->rn = 0; A->lambda = 1e-3;
   A->deim_tol = 1e-8; A->name = "rom"; A->newton_tol = 0.0; A->newton_iter = 10;
@@ -1186,8 +1277,15 @@ static int parse_reduce(int argc, char **argv, reduce_args *A) {
   if ((A->J || A->R || A->Q) && (A->Jcoo || A->Rcoo || A->Qcoo))
     return usage_error("reduce: give J, R, Q either dense (--J, --R, --Q) or sparse (--J-coo, --R-coo, --Q-coo)");
   if (A->Jcoo || A->Rcoo || A->Qcoo) {
+    const char *const spec[3] = {A->Jcoo, A->Rcoo, A->Qcoo}, *const opt[3] = {"--J-coo", "--R-coo", "--Q-coo"};
     if (!A->Jcoo || !A->Rcoo || !A->Qcoo || !A->B)
       return usage_error("reduce: --J-coo, --R-coo, --Q-coo and --B are required together");
+    for (i = 0; i < 3; ++i) {
+      const char *c1 = strchr(spec[i], ','), *c2 = c1 ? strchr(c1 + 1, ',') : NULL;
+      if (c1 && (!c2 || strchr(c2 + 1, ',') || c1 == spec[i] || c2 == c1 + 1 || !c2[1]))
+        return usage_error("%s '%s': expected rows.npy,cols.npy,vals.npy (three non-empty names) or one (nnz, 3) "
+                           "FILE.npy", opt[i], spec[i]);
+    }
   } else if (!A->J || !A->R || !A->B || !A->Q) return usage_error("reduce: --J, --R, --B and --Q are required");
   if (!A->method) return usage_error("reduce: --method is required (gmg-pod, gmg-qm, sp1 or sp2)");
   if (!A->r) return usage_error("reduce: --r is required");
@@ -1197,9 +1295,14 @@ static int parse_reduce(int argc, char **argv, reduce_args *A) {
   if (!!(A->poly || A->expf || A->potential) != !!A->poly_idx)
     return usage_error("reduce: --poly/--exp/--potential and --poly-idx go together");
   if (A->poly_w && !A->poly_idx) return usage_error("reduce: --poly-w needs a nonlinear part (--poly-idx)");
+  if (A->potential) {
+    double c[8];
+    int d, ne;
+    if (named_potential(A->potential, c, &d, &ne)) return 2;
+  }
   if (A->hyper && strcmp(A->hyper, "ecsw") && strcmp(A->hyper, "qdeim") && strcmp(A->hyper, "greedy"))
     return usage_error("--hyper '%s': expected ecsw, qdeim or greedy", A->hyper);
-  if (!(A->hyper_tol < 1.0)) return usage_error("--hyper-tol must be < 1");
+  if ((e = check_hyper_opts(A, seen, nseen)) != 0) return e;
   if (name_problem(A->name)) return usage_error("--name '%s': %s", A->name, name_problem(A->name));
   if (A->ntrain && !A->simulate) return usage_error("reduce: --train-input needs --simulate");
   if (A->nxin && A->nxin != A->nx)
@@ -1208,8 +1311,8 @@ static int parse_reduce(int argc, char **argv, reduce_args *A) {
   if (A->ntrain && A->input)
     return usage_error("reduce: give the training input either by --input or by --train-input, not both");
   if (!A->input) A->input = A->ntrain ? A->train[0] : "sin";
-  if ((A->lambda_auto || A->manifold_s) && strcmp(A->method, "gmg-qm") != 0)
-    return usage_error("reduce: --lambda auto/cv and --manifold apply to --method gmg-qm only");
+  if ((A->have_lambda || A->manifold_s || A->rn) && strcmp(A->method, "gmg-qm") != 0)
+    return usage_error("reduce: --lambda, --rn and --manifold apply to --method gmg-qm only (not %s)", A->method);
   /* gmg-qm without --lambda: the validated choice (a fixed lambda can give a
      model whose Newton solve fails on inputs unlike the training run) */
   if (!A->have_lambda && !strcmp(A->method, "gmg-qm")) A->lambda_auto = 1;
@@ -1247,7 +1350,8 @@ static int load_coo(cli_csc *c, const char *opt, const char *spec, int N) {
   memset(c, 0, sizeof *c);
   if (strchr(spec, ',')) {
     const char *a = spec, *b = strchr(a, ','), *e = b ? strchr(b + 1, ',') : NULL;
-    if (!b || !e || strchr(e + 1, ',') || b - a >= 4096 || e - b - 1 >= 4096 || strlen(e + 1) >= 4096)
+    if (!b || !e || strchr(e + 1, ',') || b - a >= 4096 || e - b - 1 >= 4096 || strlen(e + 1) >= 4096 ||
+        b == a || e == b + 1 || !e[1])
       return usage_error("%s '%s': expected rows.npy,cols.npy,vals.npy or one (nnz, 3) FILE.npy", opt, spec);
     memcpy(buf[0], a, (size_t)(b - a)); buf[0][b - a] = '\0';
     memcpy(buf[1], b + 1, (size_t)(e - b - 1)); buf[1][e - b - 1] = '\0';
@@ -1343,32 +1447,43 @@ typedef struct reduce_state {
   pathset pin, pout; /* the files read; the files the run may write */
 } reduce_state;
 
-/* A named potential (--potential) as exp-polynomial coefficients into S->named:
-   returns the degree and the exponential count, -1 for an unknown name. */
-static int named_potential(const char *spec, double *c, int *deg, int *nexp) {
-  double p1 = 1.0, p2 = 1.0;
-  int n = 0;
-  const char *colon = strchr(spec, ':');
-  size_t len = colon ? (size_t)(colon - spec) : strlen(spec);
-  if (colon) {
-    char *end;
-    p1 = strtod(colon + 1, &end);
-    n = 1;
-    if (*end == ':') { p2 = strtod(end + 1, &end); n = 2; }
-    if (*end || !isfinite(p1) || !isfinite(p2)) return -1;
+/* Is w phi(s), phi(s) = sum_j c_j s^j + sum_e a_e exp(b_e s), bounded below
+   as s -> dir * inf (dir = +1 or -1)? The fastest-growing exponential decides
+   when there is one, else the polynomial's leading power of degree >= 3 (a
+   degree up to 2 is left to the quadratic energy). 1 bounded, 0 not. */
+static int phi_bounded(const double *c, int deg, const double *ex, int ne, double w, double dir) {
+  double bmax = 0.0, amax = 0.0;
+  int e, f, j;
+  for (e = 0; e < ne; ++e) { /* the largest rate dir * b > 0 with a nonzero net coefficient */
+    double a = 0.0;
+    const double rate = dir * ex[2 * e + 1];
+    if (!(rate > bmax)) continue;
+    for (f = 0; f < ne; ++f)
+      if (ex[2 * f + 1] == ex[2 * e + 1]) a += ex[2 * f];
+    if (a != 0.0) { bmax = rate; amax = a; }
   }
-  memset(c, 0, 8 * sizeof(double));
-  if (len == 4 && !strncmp(spec, "toda", 4) && n == 0) {        /* e^s - 1 - s */
-    c[0] = -1.0; c[1] = -1.0; *deg = 1; *nexp = 1; c[2] = 1.0; c[3] = 1.0;
-  } else if (len == 4 && !strncmp(spec, "cosh", 4) && n <= 1 && p1 != 0.0) { /* (cosh(a s) - 1)/a^2 */
-    c[0] = -1.0 / (p1 * p1); *deg = 0; *nexp = 2;
-    c[1] = 0.5 / (p1 * p1); c[2] = p1; c[3] = 0.5 / (p1 * p1); c[4] = -p1;
-  } else if (len == 5 && !strncmp(spec, "morse", 5) && n == 2 && p2 != 0.0) { /* D (1 - e^{-a s})^2 */
-    c[0] = p1; *deg = 0; *nexp = 2; c[1] = -2.0 * p1; c[2] = -p2; c[3] = p1; c[4] = -2.0 * p2;
-  } else if (len == 3 && !strncmp(spec, "fpu", 3) && n == 2) {  /* k3 s^3/3 + k4 s^4/4 */
-    c[3] = p1 / 3.0; c[4] = p2 / 4.0; *deg = 4; *nexp = 0;
-  } else {
-    return -1;
+  if (bmax > 0.0) return w * amax > 0.0;
+  for (j = deg; j >= 3; --j)
+    if (c[j] != 0.0) return w * c[j] * ((j % 2 && dir < 0.0) ? -1.0 : 1.0) > 0.0;
+  return 1;
+}
+
+/* Every term w_k phi_k of sys bounded below (both directions); 0, or 1 after
+   a message naming the source (--potential, --poly/--exp, --poly-w). */
+static int check_bounded_below(const reduce_args *A, const phgmg_ph_system *sys) {
+  int k, d;
+  for (k = 0; k < sys->nsep; ++k) {
+    const int f = sys->phi_nfun > 0 ? k : 0;
+    const double w = sys->sep_w ? sys->sep_w[k] : 1.0;
+    const double *c = sys->poly + (size_t)f * (sys->poly_deg + 1);
+    const double *ex = sys->nexp ? sys->expo + (size_t)f * 2 * sys->nexp : NULL;
+    if (w == 0.0) continue;
+    for (d = -1; d <= 1; d += 2)
+      if (!phi_bounded(c, sys->poly_deg, ex, sys->nexp, w, (double)d))
+        return fail("%s: term %d (weight %g): w phi(s) -> -inf as s -> %cinf, so the energy H is unbounded below "
+                    "and the model is not a passive port-Hamiltonian system (check the sign of the leading "
+                    "coefficient%s)", A->potential ? A->potential : A->poly ? A->poly : A->expf, k, w,
+                    d > 0 ? '+' : '-', A->poly_w ? " and of the weights in --poly-w" : "");
   }
   return 0;
 }
@@ -1379,8 +1494,7 @@ static int named_potential(const char *spec, double *c, int *deg, int *nexp) {
 static int load_family(const reduce_args *A, reduce_state *S, phgmg_ph_system *sys, int nt) {
   int deg = 0, ne = 0, per_p = 0, per_e = 0, t, j, k;
   if (A->potential) {
-    if (named_potential(A->potential, S->named, &deg, &ne))
-      return fail("--potential '%s': expected toda, cosh:A (A != 0), morse:D:A (A != 0) or fpu:K3:K4", A->potential);
+    named_potential(A->potential, S->named, &deg, &ne); /* checked by parse_reduce */
     sys->poly_deg = deg; sys->poly = S->named; sys->nexp = ne; sys->expo = S->named + deg + 1;
     return 0;
   }
@@ -1687,7 +1801,7 @@ static int load_system(const reduce_args *A, reduce_state *S) {
     if (S->sp && (rc = phgmg_ph_sparse_sep_idx(S->sp, nt, S->idx, NULL, &sys)) != PHGMG_OK)
       return fail("%s (--poly-idx): %s", A->poly_idx, phgmg_result_string(rc));
     sys.sep_w = A->poly_w ? S->pw.a : NULL;
-    if (load_family(A, S, &sys, nt)) return 1;
+    if (load_family(A, S, &sys, nt) || check_bounded_below(A, &sys)) return 1;
     progress("nonlinear part: %d terms, %s, polynomial degree %d, %d exponentials%s", nt,
              A->potential ? A->potential : "exp-polynomial", sys.poly_deg, sys.nexp,
              sys.phi_nfun > 1 ? " (one function per term)" : "");
@@ -2494,5 +2608,6 @@ int main(int argc, char **argv) {
   if (!strcmp(argv[1], "simulate-rom")) return cmd_simulate_rom(argc, argv);
   if (!strcmp(argv[1], "info")) return cmd_info(argc, argv);
   if (!strcmp(argv[1], "validate")) return cmd_validate(argc, argv);
-  return usage_error("unknown command '%s' (expected reduce, simulate-rom or info)", argv[1]);
+  return usage_error("unknown command '%s' (expected reduce, validate, simulate-rom, info, --help or --version)",
+                     argv[1]);
 }

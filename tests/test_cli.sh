@@ -434,7 +434,7 @@ f = np.load("toda/a/m_fom_y.npy").ravel()
 e = np.linalg.norm(f - y["a"]) / np.linalg.norm(f)
 assert e < 1e-2, f"Toda ROM e_y = {e}"
 PYEOF
-  run_err "potential unknown" 1 "--potential 'tode'" "$P" reduce $TSYS --potential tode $TRUN --out toda/f
+  run_err "potential unknown" 2 "--potential 'tode'" "$P" reduce $TSYS --potential tode $TRUN --out toda/f
   run_err "potential and poly" 2 "replaces --poly" "$P" reduce $TSYS --potential toda --poly toda/poly.npy $TRUN --out toda/f
   run_err "hyper unknown" 2 "expected ecsw, qdeim or greedy" "$P" reduce $TSYS --potential toda --hyper nnls $TRUN --out toda/f
 else
@@ -579,6 +579,56 @@ grep -F -q "simulating" "$T/err.txt" && bad "S13: simulate-rom --out nodir/ foun
 run_err "S13 simulate-rom --states nodir/x.npy" 1 "nodir/x.npy (--states)" "$P" simulate-rom --model out/msd.phgmgrom \
   --out y13.npy --states nodir/x.npy
 grep -F -q "simulating" "$T/err.txt" && bad "S13: simulate-rom --states nodir/ found after the simulation" || pass
+
+# ---- 10. issue 25: option values refused up front, messages naming the right option ----
+if [ "$HAVE_NP" = 1 ]; then
+  TS="--J toda/J.npy --R toda/R.npy --Q toda/Q.npy --B toda/B.npy --poly-idx toda/idx.npy"
+  TR="--simulate --dt 0.1 --steps 100 --method gmg-pod --r 16"
+  # 8: --potential fields: empty or not a number, energies unbounded below, coefficient overflow
+  for pot in "fpu::" "fpu:1:" "morse::1" "fpu:1:x" "cosh:1:2" "fpu:1:-1" "morse:-1:1" "fpu:1:0" "cosh:1e-200" \
+             "morse:1e308:1"; do
+    run_err "P8 --potential $pot refused" 2 "--potential '$pot'" "$P" reduce $TS --potential "$pot" $TR --out p8
+    grep -F -q "simulating" "$T/err.txt" && bad "P8: --potential $pot found after the simulation" || pass
+  done
+  grep -F -q "double range" "$T/err.txt" || bad "P8: morse:1e308:1 not reported as an overflow"
+  "$PY" -c "import numpy as np; np.save('toda/neg.npy', np.array([0, 0, 0, 0, -0.25])); np.save('toda/negw.npy', -np.ones(40))"
+  run_err "P8 --poly with a negative leading coefficient" 1 "unbounded below" "$P" reduce $TS --poly toda/neg.npy \
+    $TR --out p8
+  grep -F -q "simulating" "$T/err.txt" && bad "P8: the unbounded --poly found after the simulation" || pass
+  run_err "P8 --potential toda with negative --poly-w" 1 "unbounded below" "$P" reduce $TS --potential toda \
+    --poly-w toda/negw.npy $TR --out p8
+  run_ok "P8 --potential fpu:-1:1 (bounded)" "$P" reduce $TS --potential fpu:-1:1 --simulate --steps 300 \
+    --method gmg-pod --r 12 --out p8 --quiet
+  # 10: options that do not apply are refused, not ignored
+  run_err "P10 --deim-tol 1" 2 "--deim-tol 1" "$P" reduce $TS --potential toda --hyper qdeim --deim-tol 1 $TR --out p10
+  run_err "P10 --hyper-tol with qdeim" 2 "--hyper-tol applies to --hyper ecsw" "$P" reduce $TS --potential toda \
+    --hyper qdeim --hyper-tol 1e-3 $TR --out p10
+  run_err "P10 --deim-tol with ecsw" 2 "apply to --hyper qdeim or greedy" "$P" reduce $TS --potential toda \
+    --deim-tol 1e-6 $TR --out p10
+  run_err "P10 --hyper without a nonlinear part" 2 "--hyper applies to a nonlinear part" "$P" reduce $SYS $QSIM \
+    --method gmg-pod --r 10 --hyper ecsw --out p10
+  run_err "P10 --lambda with gmg-pod" 2 "apply to --method gmg-qm only" "$P" reduce $SYS $QSIM --method gmg-pod \
+    --r 10 --lambda 1e-3 --out p10
+  run_err "P10 --rn with sp1" 2 "apply to --method gmg-qm only" "$P" reduce $SYS $QSIM --method sp1 --r 10 --rn 4 \
+    --out p10
+  [ -e p10 ] && bad "P10: a refused run wrote p10" || pass
+  # 7: an ECSW tolerance below double precision
+  run_err "P7 --hyper-tol 1e-300" 2 "below what double precision resolves" "$P" reduce $TS --potential toda \
+    --hyper-tol 1e-300 $TR --out p7
+  run_err "P7 --hyper-tol 0" 2 "--hyper-tol 0" "$P" reduce $TS --potential toda --hyper-tol 0 $TR --out p7
+fi
+# 23: messages name the option the value came from; every command listed
+run_err "P23 --train-input file" 1 "nofile.npy (--train-input)" "$P" reduce $SYS $QSIM --train-input sin \
+  --train-input nofile.npy --method gmg-pod --r 10 --out p23
+run_err "P23 --X-input file" 1 "nofile.npy (--X-input)" "$P" reduce $SYS --X out/msd_snapshots.npy \
+  --X-input nofile.npy --method gmg-pod --r 10 --out p23
+run_err "P23 --X-input kind" 2 "--X-input 'square'" "$P" reduce $SYS --X out/msd_snapshots.npy --X-input square \
+  --method gmg-pod --r 10 --out p23
+run_err "P23 empty --J-coo" 2 "--J-coo: empty value" "$P" reduce --J-coo "" --R-coo a.npy --Q-coo b.npy \
+  --B model/B.npy $QSIM --method gmg-pod --r 10 --out p23
+run_err "P23 empty name in --R-coo" 2 "--R-coo 'r.npy,,v.npy'" "$P" reduce --J-coo a.npy --R-coo r.npy,,v.npy \
+  --Q-coo b.npy --B model/B.npy $QSIM --method gmg-pod --r 10 --out p23
+run_err "P23 unknown command lists validate" 2 "validate" "$P" frobnicate
 
 echo "test_cli: $npass passed, $nfail failed"
 [ "$nfail" -eq 0 ]

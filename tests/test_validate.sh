@@ -203,5 +203,14 @@ rc=$?
 grep -q "simulating\|reducing" v14.txt && bad "--test-steps 1e7 refused only after the computation" || pass
 [ -e o14 ] && bad "a refused --test-steps wrote o14" || pass
 
+# 6: huge test amplitudes: an overflow is reported as one (or the norms are
+#    computed without overflowing), never as "out of memory"
+$P validate $M8 --steps 100 --method gmg-pod --r 8 --out o6a --test-input sin --test-amp 1e160 > v6a.txt 2>&1
+rc=$?
+if grep -q "out of memory" v6a.txt; then bad "--test-amp 1e160 reported as out of memory"
+elif [ $rc -eq 1 ] && grep -q "overflow" v6a.txt; then pass
+elif [ $rc -eq 0 ] && grep -q "^sin  .* pass$" v6a.txt; then pass
+else bad "--test-amp 1e160: exit $rc: $(tail -n 2 v6a.txt)"; fi
+
 echo "test_validate: $npass passed, $nfail failed"
 [ $nfail -eq 0 ]
