@@ -90,16 +90,23 @@ static const char *const help_lines[] = {
   "  --X-input KIND      the input that made each --X run (one per --X, same order;\n",
   "                      KIND as --input, sampled with --dt = the snapshots' step):\n",
   "                      --lambda auto then simulates the runs from their first\n",
-  "                      snapshot, and validate tests them by default. Without it\n",
-  "                      the inputs are unknown: --lambda auto keeps M = 0.\n",
+  "                      snapshot, and validate tests them by default. Checked: the\n",
+  "                      full model simulated from a run's first snapshot with its\n",
+  "                      input must reproduce the next 5 snapshots (to 10 % of their\n",
+  "                      change), else the run is refused. Without --X-input the\n",
+  "                      inputs are unknown: --lambda auto is refused, and gmg-qm's\n",
+  "                      default keeps M = 0 (said so).\n",
   "  --simulate          instead of --X: simulate the full model from x0 = 0 with the\n",
   "                      3-stage Gauss-Legendre method (order 6) and use the steps+1\n",
   "                      states as snapshots. Options:\n",
   "    --dt DT           step (default 0.1)\n",
   "    --steps N         number of steps (default 1000), t in [0, N*DT]\n",
-  "    --input KIND      sin: u(t) = AMP sin(t);  const: u(t) = AMP  (every port the\n",
-  "                      same; default sin);  or a FILE.npy (see INPUT FILES; AMP is\n",
-  "                      then not used)\n",
+  "    --input KIND      sin (default): u(t) = AMP sin(t); with m > 1 ports each port\n",
+  "                      at its own frequency, u_a(t) = AMP sin((1 + a/m) t) for\n",
+  "                      a = 0..m-1, so that the ports are excited independently;\n",
+  "                      const: u(t) = AMP on every port (the same on all: pointed out\n",
+  "                      for m > 1, as for a table whose columns are equal); or a\n",
+  "                      FILE.npy (see INPUT FILES; AMP is then not used)\n",
   "    --amp AMP         amplitude (default 0.1)\n",
   "    --newton-tol T    Newton tolerance (stage residual, inf-norm, absolute) for\n",
   "                      nonlinear models (default: the library's, 1e-10 times\n",
@@ -170,7 +177,8 @@ static const char *const help_lines[] = {
   "  --dt-map DT         precompute the exact GL3 step map for step DT in the model\n",
   "                      (linear models with quadratic H; the online stepper then needs\n",
   "                      no Newton iteration at that step). Default: the --dt of\n",
-  "                      --simulate, none with --X; 0 = none.\n",
+  "                      --simulate, none with --X; 0 = none. A step map with spectral\n",
+  "                      radius above 1 (an amplifying step) is refused.\n",
   "  --out DIR           output directory, created if missing (required).\n",
   "  --name NAME         base name of the outputs and C identifier prefix (default rom;\n",
   "                      letters, digits and _, not starting with a digit; not a C/C++\n",
@@ -236,7 +244,8 @@ static const char *const help_lines[] = {
   "  --input FILE.npy:   either a 2-d table of shape (K, 1 + m): column 0 the times\n",
   "                      (strictly increasing), columns 1..m the inputs at those times;\n",
   "                      or, for m = 1, a vector of K samples u(k DT), k = 0..K-1.\n",
-  "                      u(t) is interpolated linearly, held constant outside.\n",
+  "                      u(t) is interpolated linearly, held constant outside (a\n",
+  "                      note says so when a run goes past the table's last time).\n",
   "  Written: format 1.0, '<f8', Fortran order (NumPy reads it as usual).\n",
   "\n",
   "EXAMPLES\n",
@@ -498,7 +507,9 @@ static void input_fn(double t, double *u, void *user) {
   cli_input *in = (cli_input *)user;
   int a;
   switch (in->kind) {
-    case IN_SIN: for (a = 0; a < in->m; ++a) u[a] = in->amp * sin(t); break;
+    case IN_SIN: /* port a: its own frequency 1 + a/m, so that the ports are excited independently */
+      for (a = 0; a < in->m; ++a) u[a] = in->amp * sin((1.0 + (double)a / in->m) * t);
+      break;
     case IN_CONST: for (a = 0; a < in->m; ++a) u[a] = in->amp; break;
     default: table_eval(in, t, u); break;
   }
@@ -557,7 +568,9 @@ static int input_setup(cli_input *in, const char *opt, const char *spec, double 
 
 static const char *input_desc(const cli_input *in, const char *spec) {
   static char buf[600];
-  if (in->kind == IN_SIN) snprintf(buf, sizeof buf, "u(t) = %g sin(t)", in->amp);
+  if (in->kind == IN_SIN && in->m > 1)
+    snprintf(buf, sizeof buf, "u_a(t) = %g sin((1 + a/%d) t) at port a = 0..%d", in->amp, in->m, in->m - 1);
+  else if (in->kind == IN_SIN) snprintf(buf, sizeof buf, "u(t) = %g sin(t)", in->amp);
   else if (in->kind == IN_CONST) snprintf(buf, sizeof buf, "u(t) = %g", in->amp);
   else snprintf(buf, sizeof buf, "u(t) from %s", spec);
   return buf;
@@ -583,6 +596,30 @@ static void input_covers(const cli_input *in, const char *spec, const char *opt,
   if (last < t_end * (1.0 - 1e-12))
     note("%s (%s) ends at t = %g, the run at t = %g: from t = %g on, the input is held at its last value",
          spec, opt, last, t_end, last);
+}
+
+/* 1 if the input drives every port with the same signal (m > 1): const, or
+   a table whose input columns are equal. */
+static int input_same_on_ports(const cli_input *in) {
+  int k, a;
+  if (in->m < 2) return 0;
+  if (in->kind == IN_CONST) return 1;
+  if (in->kind != IN_TABLE) return 0;
+  for (a = 2; a <= in->m; ++a)
+    for (k = 0; k < in->tab.rows; ++k)
+      if (in->tab.a[k + (size_t)a * in->tab.rows] != in->tab.a[k + (size_t)in->tab.rows]) return 0;
+  return 1;
+}
+
+/* Say so when no training run excites the m > 1 ports independently. */
+static void note_ports(const cli_input *const *ins, int n, int m) {
+  int k;
+  if (m < 2 || n < 1) return;
+  for (k = 0; k < n; ++k)
+    if (!input_same_on_ports(ins[k])) return;
+  note("every training run drives all %d ports with the same signal: the ports are not excited independently "
+       "(the snapshots cannot tell them apart; GMG may fail or the model may not follow other inputs). "
+       "Use the default sin (one frequency per port) or a table with a column per port", m);
 }
 
 /* ---- files ---------------------------------------------------------------- */
@@ -1316,6 +1353,9 @@ static int parse_reduce(int argc, char **argv, reduce_args *A) {
   /* gmg-qm without --lambda: the validated choice (a fixed lambda can give a
      model whose Newton solve fails on inputs unlike the training run) */
   if (!A->have_lambda && !strcmp(A->method, "gmg-qm")) A->lambda_auto = 1;
+  if (A->lambda_auto == 1 && A->have_lambda && A->X && !A->nxin)
+    return usage_error("reduce: --lambda auto with --X needs the inputs of the runs (--X-input, one per --X): it "
+                       "simulates them; or give a fixed --lambda, or --lambda cv");
   if (!A->have_dt_map) A->dt_map = A->simulate ? A->dt : 0.0;
   if (A->simulate && too_big((double)A->steps + 1.0, "--simulate --steps: the snapshots (N x (steps+1)) alone"))
     return 2; /* N >= 1: a first check before reading J */
@@ -1639,6 +1679,57 @@ static int write_user_field(const reduce_args *A, reduce_state *S, const char *f
   return write_field(A->out, A->name, field, S->Uord, N, cols, ol, &S->sg);
 }
 
+/* The first steps of each --X run must follow from its first snapshot and
+   its --X-input: the full model is simulated over up to X_CHECK_STEPS steps
+   and compared with the snapshots. The mismatch is measured relative to the
+   change of the snapshots over those steps; above X_CHECK_TOL (loose enough
+   for snapshots from another integrator of moderate accuracy, far below the
+   mismatch of another input or another step) the run is refused. */
+#define X_CHECK_STEPS 5
+#define X_CHECK_TOL 0.1
+static int check_x_inputs(const reduce_args *A, reduce_state *S, int N, int m) {
+  double *W = (double *)malloc(sizeof(double) * ((size_t)N + (size_t)m) * (X_CHECK_STEPS + 1));
+  phgmg_gl3_opts go;
+  int k, j, i, rc = 0;
+  if (!W) return fail("out of memory");
+  memset(&go, 0, sizeof go);
+  go.tol = A->newton_tol; go.max_iter = A->newton_iter;
+  for (k = 0; k < A->nx && !rc; ++k) {
+    const phgmg_run *run = &S->runs[k];
+    const int n = PHGMG__MIN(X_CHECK_STEPS, run->nsteps);
+    const double *X = run->x0;
+    double num = 0.0, den = 0.0, x0n = 0.0;
+    phgmg_result r = phgmg_simulate(&S->sys, X, 0.0, A->dt, n, input_fn, run->user, &go, W, W + (size_t)N * (n + 1),
+                                    NULL, NULL, NULL, NULL);
+    if (r != PHGMG_OK) {
+      rc = fail("%s (--X-input %s): the full model cannot be simulated from the run's first snapshot: %s",
+                A->xs[k], A->xin[k], phgmg_result_string(r));
+      break;
+    }
+    for (i = 0; i < N; ++i) x0n = PHGMG__MAX(x0n, fabs(X[i]));
+    for (j = 1; j <= n; ++j) {
+      double dn = 0.0, dd = 0.0;
+      for (i = 0; i < N; ++i) {
+        const double xs = X[i + (size_t)j * N];
+        dn = PHGMG__MAX(dn, fabs(W[i + (size_t)j * N] - xs));
+        dd = PHGMG__MAX(dd, fabs(xs - X[i]));
+      }
+      num = PHGMG__MAX(num, dn);
+      den = PHGMG__MAX(den, dd);
+    }
+    if (den == 0.0) den = x0n > 0.0 ? x0n : DBL_MIN;
+    progress("--X-input check: %s from its first snapshot with %s: %d steps reproduced to %.2g (relative to the "
+             "states' change)", A->xs[k], A->xin[k], n, num / den);
+    if (!(num <= X_CHECK_TOL * den))
+      rc = fail("%s (--X-input %s): the declared input does not reproduce the run: simulated from the first "
+                "snapshot with --dt %g, the next %d states differ from the snapshots by %.3g of their change "
+                "(limit %g). Give the input (and --dt) that made this run", A->xs[k], A->xin[k], A->dt, n,
+                num / den, X_CHECK_TOL);
+  }
+  free(W);
+  return rc;
+}
+
 /* The --X files (one run each) as one snapshot set in the internal ordering,
    with the runs' boundaries (and, with --X-input, their inputs) in S->runs. */
 static int load_snapshot_files(const reduce_args *A, reduce_state *S, int N, int m, const double **Xo, int *nso) {
@@ -1688,6 +1779,15 @@ static int load_snapshot_files(const reduce_args *A, reduce_state *S, int N, int
       col += (size_t)c;
     }
     S->nrun = A->nx;
+  }
+  if (A->nxin) {
+    const cli_input *ins[16];
+    for (k = 0; k < A->nx; ++k) {
+      ins[k] = &S->xinp[k];
+      input_covers(&S->xinp[k], A->xin[k], "--X-input", S->runs[k].nsteps * A->dt);
+    }
+    note_ports(ins, A->nx, m);
+    if ((k = check_x_inputs(A, S, N, m)) != 0) return k;
   }
   for (k = 0; k < A->nx; ++k)
     progress("snapshots: %s, %d states%s%s", A->xs[k], k ? S->Xs[k].cols : S->X.cols, A->nxin ? ", input " : "",
@@ -1864,6 +1964,11 @@ static int simulate_training_runs(const reduce_args *A, reduce_state *S, const d
   if ((k = input_setup(&S->in, A->ntrain ? "--train-input" : "--input", A->input, A->amp, m, A->dt)) != 0) return k;
   for (i = 1; i < nrun; ++i)
     if ((k = input_setup(&S->tin[i], "--train-input", A->train[i], A->amp, m, A->dt)) != 0) return k;
+  {
+    const cli_input *ins[16];
+    for (i = 0; i < nrun; ++i) ins[i] = i ? &S->tin[i] : &S->in;
+    note_ports(ins, nrun, m);
+  }
   ns = nrun * (A->steps + 1);
   if (too_big(((double)N + (double)m) * (double)ns, "--simulate: the snapshots (N x (steps+1)) and outputs"))
     return 2;
@@ -1909,6 +2014,40 @@ static int default_rn(int N, int r, int m) {
   int rn = PHGMG__MIN(8, N - r);
   if (r > m) rn = PHGMG__MIN(rn, 4096 / (r - m));
   return PHGMG__MAX(rn, 1);
+}
+
+/* The spectral radius of the step map Phi (r x r), from above:
+   ||Phi^k||_F^(1/k) for k = 2^30 by repeated squaring, normalised at every
+   square (no overflow). For a pH model the eigenvalues of modulus 1 are
+   semisimple, so the estimate exceeds the radius by at most a factor
+   cond^(1/k) ~ 1 + 1e-8. INFINITY if Phi holds NaN/Inf. */
+static double step_map_radius(const phgmg_rom *rom) {
+  const int r = rom->r;
+  double *A = (double *)malloc(sizeof(double) * 2 * (size_t)r * (size_t)r), *B, L = 0.0, s;
+  int it, i, j, k;
+  if (!A) return NAN;
+  B = A + (size_t)r * r;
+  for (i = 0; i < r * r; ++i) A[i] = (double)rom->Phi[i];
+  for (it = 0; it <= 30; ++it) {
+    double f = 0.0;
+    for (s = 0.0, i = 0; i < r * r; ++i) s = PHGMG__MAX(s, fabs(A[i])); /* scale first: no overflow in the norm */
+    if (!isfinite(s)) { free(A); return INFINITY; }
+    if (s == 0.0) { free(A); return 0.0; }
+    for (i = 0; i < r * r; ++i) { A[i] /= s; f += A[i] * A[i]; }
+    f = sqrt(f);
+    for (i = 0; i < r * r; ++i) A[i] /= f;   /* A = Phi^(2^it) / ||Phi^(2^it)||_F */
+    L += log(s * f) / ldexp(1.0, it);       /* L = log ||Phi^(2^it)||_F / 2^it */
+    if (it == 30) break;
+    for (j = 0; j < r; ++j) /* B = A A */
+      for (i = 0; i < r; ++i) {
+        double t = 0.0;
+        for (k = 0; k < r; ++k) t += A[i + (size_t)k * r] * A[k + (size_t)j * r];
+        B[i + (size_t)j * r] = t;
+      }
+    memcpy(A, B, sizeof(double) * (size_t)r * r);
+  }
+  free(A);
+  return exp(L);
 }
 
 /* phgmg_reduce with the options of the command line; reports what it did. */
@@ -1968,10 +2107,22 @@ static int run_reduction(const reduce_args *A, reduce_state *S, int method, cons
   rom = phgmg_reduced_rom(S->red);
   progress("  done in %.2f s: r = %d, m = %d%s; sigma_{r'+1}/sigma_1 = %.3g, rcond(D^T G D) = %.3g", *t_red, rom->r,
            rom->m, rom->nd ? "" : ", quadratic energy", info.pod_sigma_ratio, info.rcond_dgd);
-  if (method == PHGMG_METHOD_GMG_QM && (A->lambda_auto || A->manifold))
+  if (method == PHGMG_METHOD_GMG_QM && A->lambda_auto == 1 && A->X && !A->nxin)
+    note("gmg-qm with --X and no --X-input: the inputs of the runs are unknown, so no lambda can be validated "
+         "by simulation: M = 0 (the GMG-POD model on the same basis). Give --X-input for the validated "
+         "choice, or a fixed --lambda");
+  else if (method == PHGMG_METHOD_GMG_QM && (A->lambda_auto || A->manifold))
     progress("  manifold %s, lambda %s: %.3g%s", A->manifold_s ? A->manifold_s : "pod",
              A->lambda_auto == 1 ? "auto" : A->lambda_auto == 2 ? "cv" : "fixed", info.lambda,
              info.lambda == HUGE_VAL ? " (M = 0: no safe quadratic correction found)" : "");
+  if (rom->Phi) { /* the precomputed step map must not amplify: spectral radius <= 1 */
+    const double rho = step_map_radius(rom);
+    progress("  step map for dt = %g: spectral radius %.6g", A->dt_map, rho);
+    if (!(rho <= 1.0 + 1e-6))
+      return fail("--dt-map %g: the step map is unstable (spectral radius %.3g > 1), while the model never gains "
+                  "energy; use a smaller --dt-map (or --dt-map 0: none, the stepper then solves each step)",
+                  A->dt_map, rho);
+  }
   if (info.pod_randomized)
     progress("  POD: %s (a-posteriori check %.2g)", info.pod_randomized > 0 ? "randomized (large snapshot set)"
              : "exact SVD (the randomized POD failed its check)", info.pod_check);
@@ -2042,6 +2193,13 @@ static int write_arrays(const reduce_args *A, reduce_state *S, const double *X, 
   return 0;
 }
 
+/* The hyper-reduction of the run: ecsw, qdeim, greedy, or none (no nonlinear
+   part, or --no-deim: every term kept). */
+static const char *hyper_name(const reduce_args *A, const phgmg_reduce_opts *o) {
+  if (!A->poly_idx || !o->deim) return "none";
+  return o->hyper == PHGMG_HYPER_ECSW ? "ecsw" : o->hyper == PHGMG_HYPER_QDEIM ? "qdeim" : "greedy";
+}
+
 /* NAME.json: what was reduced, how, and where the outputs are. */
 static int write_json(const reduce_args *A, reduce_state *S, int method, int ns, double t_sim, double t_red,
                       const phgmg_reduce_opts *o, const phgmg_reduce_info *info, const outlist *ol) {
@@ -2101,23 +2259,51 @@ static int write_json(const reduce_args *A, reduce_state *S, int method, int ns,
     fprintf(jf, ", \"newton_iter\": %d, \"seconds\": ", A->newton_iter); json_num(jf, t_sim);
     fprintf(jf, "}");
   }
-  fprintf(jf, "},\n  \"options\": {\"rn\": %d, \"lambda\": ", o->rn);
-  if (A->lambda_auto) json_str(jf, A->lambda_auto == 1 ? "auto" : "cv");
-  else json_num(jf, A->lambda);
-  fprintf(jf, ", \"lambda_used\": ");
-  json_num(jf, info->lambda == HUGE_VAL ? -1.0 : info->lambda);
-  fprintf(jf, ", \"manifold\": ");
-  json_str(jf, A->manifold_s ? A->manifold_s : "pod");
-  fprintf(jf, ", \"training_runs\": %d", S->nrun);
-  fprintf(jf, ", \"deim\": %s, \"deim_tol\": ", o->deim ? "true" : "false");
-  json_num(jf, A->deim_tol);
-  fprintf(jf, ", \"deim_max\": %d, \"deim_allow_negative\": %s},\n", A->deim_max, A->deim_neg ? "true" : "false");
+  fprintf(jf, "},\n  \"options\": {");
+  if (method == PHGMG_METHOD_GMG_QM) { /* lambda, r_n and the manifold are gmg-qm's */
+    fprintf(jf, "\"rn\": %d, \"lambda\": ", o->rn);
+    if (A->lambda_auto) json_str(jf, A->lambda_auto == 1 ? "auto" : "cv");
+    else json_num(jf, A->lambda);
+    fprintf(jf, ", \"lambda_used\": ");
+    json_num(jf, info->lambda == HUGE_VAL ? -1.0 : info->lambda);
+    if (A->lambda_auto == 1 && A->X && !A->nxin)
+      fprintf(jf, ", \"lambda_note\": \"M = 0: the inputs of the --X runs are unknown (no --X-input)\"");
+    fprintf(jf, ", \"manifold\": ");
+    json_str(jf, A->manifold_s ? A->manifold_s : "pod");
+    fprintf(jf, ", ");
+  }
+  fprintf(jf, "\"training_runs\": %d", S->nrun);
+  fprintf(jf, ", \"hyper\": ");
+  json_str(jf, hyper_name(A, o));
+  if (o->deim && o->hyper == PHGMG_HYPER_ECSW) {
+    fprintf(jf, ", \"hyper_tol\": ");
+    json_num(jf, A->hyper_tol > 0.0 ? A->hyper_tol : 1e-6);
+  }
+  fprintf(jf, ", \"deim\": %s", o->deim && o->hyper != PHGMG_HYPER_ECSW ? "true" : "false");
+  if (o->deim && o->hyper != PHGMG_HYPER_ECSW) {
+    fprintf(jf, ", \"deim_tol\": ");
+    json_num(jf, A->deim_tol);
+    fprintf(jf, ", \"deim_max\": %d, \"deim_allow_negative\": %s", A->deim_max, A->deim_neg ? "true" : "false");
+  }
+  fprintf(jf, "},\n");
   fprintf(jf, "  \"info\": {\"pod_sigma_ratio\": ");
   json_num(jf, info->pod_sigma_ratio);
   fprintf(jf, ", \"rcond_jr\": "); json_num(jf, info->rcond_jr);
   fprintf(jf, ", \"rcond_dgd\": "); json_num(jf, info->rcond_dgd);
-  fprintf(jf, ", \"deim_modes\": %d, \"deim_negative\": %d, \"deim_sigma_ratio\": ", info->deim_modes, info->deim_negative);
-  json_num(jf, info->deim_sigma_ratio);
+  if (o->deim && A->poly_idx) { /* the hyper-reduction's result */
+    fprintf(jf, ", \"hyper\": {\"method\": ");
+    json_str(jf, hyper_name(A, o));
+    fprintf(jf, ", \"points\": %d, \"negative_weights\": %d, \"min_weight\": ", info->deim_modes, info->deim_negative);
+    json_num(jf, info->hyper_min_weight);
+    if (o->hyper == PHGMG_HYPER_ECSW) {
+      fprintf(jf, ", \"tol\": "); json_num(jf, A->hyper_tol > 0.0 ? A->hyper_tol : 1e-6);
+      fprintf(jf, ", \"residual\": "); json_num(jf, info->hyper_residual);
+    } else {
+      fprintf(jf, ", \"tol\": "); json_num(jf, A->deim_tol);
+      fprintf(jf, ", \"sigma_ratio\": "); json_num(jf, info->deim_sigma_ratio);
+    }
+    fprintf(jf, "}");
+  }
   fprintf(jf, ", \"reduce_seconds\": "); json_num(jf, t_red);
   fprintf(jf, "},\n  \"stepper_memsize_bytes\": %lu,\n", (unsigned long)phgmg_rom_stepper_memsize(rom));
   fprintf(jf, "  \"reconstruction\": \"%s\",\n",
