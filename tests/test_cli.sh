@@ -630,5 +630,13 @@ run_err "P23 empty name in --R-coo" 2 "--R-coo 'r.npy,,v.npy'" "$P" reduce --J-c
   --Q-coo b.npy --B model/B.npy $QSIM --method gmg-pod --r 10 --out p23
 run_err "P23 unknown command lists validate" 2 "validate" "$P" frobnicate
 
+# 26: the fuzz harness of the command line knows every command and option of
+#     --help (the lines calling Python name compare.py's options, not phgmg's)
+missing=
+for o in reduce validate simulate-rom info $("$P" --help | grep -v python3 | grep -o -- '--[a-zA-Z][a-zA-Z-]*' | sort -u); do
+  grep -F -q -- "\"$o\"" "$ROOT/tests/fuzz/fuzz_cli.c" || missing="$missing $o"
+done
+[ -z "$missing" ] && pass || bad "P26: tests/fuzz/fuzz_cli.c does not know:$missing"
+
 echo "test_cli: $npass passed, $nfail failed"
 [ "$nfail" -eq 0 ]
