@@ -1599,7 +1599,7 @@ static const char *const all_fields[] = {"Bh", "Qh", "K", "G00", "G01", "G10", "
    {"NAME_<field>.npy": [rows, cols], ...}), those of the form NAME_<field>.npy
    with a known field only, into rec. Nothing when there is no such record. */
 static void read_record(const char *dir, const char *name, outlist *rec) {
-  char path[4096 + 256], *text, *p;
+  char path[4096 + 256], *text, *p, *end;
   FILE *f;
   long n;
   memset(rec, 0, sizeof *rec);
@@ -1611,13 +1611,14 @@ static void read_record(const char *dir, const char *name, outlist *rec) {
   fclose(f);
   text[n] = '\0';
   p = strstr(text, "\"arrays\": {");
-  while (p && rec->n < 48) {
-    char *q, *e;
+  end = p ? strchr(p, '}') : NULL;
+  if (p) p = strchr(p, '{');
+  while (p && end && rec->n < 48) { /* "key": [rows, cols], ... up to the closing brace */
+    char *q = strchr(p, '"'), *e;
     int k;
-    p = strchr(p + 1, '"');
-    if (!p || !(e = strchr(p + 1, '"')) || strchr(p, '}') < p) break;
-    q = p + 1;
+    if (!q || q > end || !(e = strchr(q + 1, '"')) || e > end) break;
     *e = '\0';
+    ++q;
     for (k = 0; all_fields[k]; ++k) {
       char want[128];
       snprintf(want, sizeof want, "%s_%s.npy", name, all_fields[k]);
