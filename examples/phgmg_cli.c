@@ -2094,6 +2094,10 @@ static int run_reduction(const reduce_args *A, reduce_state *S, int method, cons
         return fail("reduction failed: %s (%s, or the port matrix %s)", phgmg_result_string(rc), src, A->B);
       case PHGMG_ERR_DEGENERATE:
         return fail("reduction failed: %s (try another --r, or for gmg-qm a larger --lambda)", phgmg_result_string(rc));
+      case PHGMG_ERR_STEP_MAP:
+        return fail("reduction failed: --dt-map %g: %s (or --dt-map 0: none)", A->dt_map, phgmg_result_string(rc));
+      case PHGMG_ERR_TOL_UNREACHABLE:
+        return fail("reduction failed: --hyper-tol %g: %s", A->hyper_tol, phgmg_result_string(rc));
       case PHGMG_ERR_NEGATIVE_WEIGHT:
         return fail("reduction failed: %s (use --deim-allow-negative, a smaller --deim-tol, or --no-deim)",
                     phgmg_result_string(rc));
@@ -2670,6 +2674,9 @@ static int parse_validate(int argc, char **argv, validate_args *V, const char **
 
 /* A test that could not be made: the reason in the user's terms. */
 static int validate_error(const char *spec, phgmg_result rc, const reduce_state *S, int nsteps) {
+  if (rc == PHGMG_ERR_OVERFLOW)
+    return fail("validate: %s: the states or the error norms overflow the double range (try a smaller "
+                "--test-amp)", spec);
   if (rc == PHGMG_ERR_NANINF)
     return fail("validate: %s: the full model's run overflows or meets NaN (states beyond the double range; "
                 "try a smaller --test-amp)", spec);
