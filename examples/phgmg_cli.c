@@ -2359,14 +2359,17 @@ static int reduce_commit(const reduce_args *A, reduce_state *S) {
    and the files it may write (every output its options can produce, with the
    temporary names of the staged writes) into S->pin, S->pout. */
 static void reduce_paths(const reduce_args *A, reduce_state *S, const char *const *tests, int nt) {
-  const char *const files[] = {A->J, A->R, A->B, A->Q, A->poly, A->poly_idx, A->poly_w, A->expf};
-  const char *const fopt[] = {"--J", "--R", "--B", "--Q", "--poly", "--poly-idx", "--poly-w", "--exp"};
-  const char *const coo[] = {A->Jcoo, A->Rcoo, A->Qcoo}, *const cooopt[] = {"--J-coo", "--R-coo", "--Q-coo"};
+  const char *const files[] = {A->J, A->R, A->B, A->Q, A->poly, A->poly_idx, A->poly_w, A->expf,
+                               A->E, A->Pf, A->Sf, A->Nf};
+  const char *const fopt[] = {"--J", "--R", "--B", "--Q", "--poly", "--poly-idx", "--poly-w", "--exp",
+                              "--E", "--P", "--S", "--N"};
+  const char *const coo[] = {A->Jcoo, A->Rcoo, A->Qcoo, A->Ecoo};
+  const char *const cooopt[] = {"--J-coo", "--R-coo", "--Q-coo", "--E-coo"};
   char path[4096 + 256];
   int k;
-  for (k = 0; k < 8; ++k)
+  for (k = 0; k < 12; ++k)
     if (files[k]) paths_add(&S->pin, fopt[k], files[k], 0);
-  for (k = 0; k < 3; ++k) { /* FILE or rows,cols,vals */
+  for (k = 0; k < 4; ++k) { /* FILE or rows,cols,vals */
     const char *a = coo[k];
     while (a) {
       const char *c = strchr(a, ',');
