@@ -27,6 +27,7 @@
 #include <sys/stat.h>
 #include <sys/types.h>
 #include <time.h>
+#include <unistd.h>
 
 /* The manual, one string per line (C99 caps a single literal at 4095 bytes). */
 static const char *const help_lines[] = {
@@ -48,9 +49,11 @@ static const char *const help_lines[] = {
   "  phgmg validate <the options of reduce> [--test-input KIND]... [--test-amp A]\n",
   "               [--test-steps N] [--max-ey E]   (reduce, then run full and reduced\n",
   "               model on each test input: e_red, e_y, e_proj, energy, Newton, the\n",
-  "               first failing step; exit 1 if one fails or e_y > E, default 0.1;\n",
-  "               default test inputs: the training input(s); with --X the\n",
-  "               --X-input runs, else --test-input is required)\n",
+  "               first failing step; exit 1 if one fails or e_y > E (E > 0, default\n",
+  "               0.1); default test inputs: the training input(s); with --X the\n",
+  "               --X-input runs, else --test-input is required; each test runs\n",
+  "               the training run's length unless --test-steps; the outputs are\n",
+  "               written only when every test passes)\n",
   "  phgmg --help | --version\n",
   "\n",
   "THE MODEL\n",
@@ -87,16 +90,23 @@ static const char *const help_lines[] = {
   "  --X-input KIND      the input that made each --X run (one per --X, same order;\n",
   "                      KIND as --input, sampled with --dt = the snapshots' step):\n",
   "                      --lambda auto then simulates the runs from their first\n",
-  "                      snapshot, and validate tests them by default. Without it\n",
-  "                      the inputs are unknown: --lambda auto keeps M = 0.\n",
+  "                      snapshot, and validate tests them by default. Checked: the\n",
+  "                      full model simulated from a run's first snapshot with its\n",
+  "                      input must reproduce the next 5 snapshots (to 10 % of their\n",
+  "                      change), else the run is refused. Without --X-input the\n",
+  "                      inputs are unknown: --lambda auto is refused, and gmg-qm's\n",
+  "                      default keeps M = 0 (said so).\n",
   "  --simulate          instead of --X: simulate the full model from x0 = 0 with the\n",
   "                      3-stage Gauss-Legendre method (order 6) and use the steps+1\n",
   "                      states as snapshots. Options:\n",
   "    --dt DT           step (default 0.1)\n",
   "    --steps N         number of steps (default 1000), t in [0, N*DT]\n",
-  "    --input KIND      sin: u(t) = AMP sin(t);  const: u(t) = AMP  (every port the\n",
-  "                      same; default sin);  or a FILE.npy (see INPUT FILES; AMP is\n",
-  "                      then not used)\n",
+  "    --input KIND      sin (default): u(t) = AMP sin(t); with m > 1 ports each port\n",
+  "                      at its own frequency, u_a(t) = AMP sin((1 + a/m) t) for\n",
+  "                      a = 0..m-1, so that the ports are excited independently;\n",
+  "                      const: u(t) = AMP on every port (the same on all: pointed out\n",
+  "                      for m > 1, as for a table whose columns are equal); or a\n",
+  "                      FILE.npy (see INPUT FILES; AMP is then not used)\n",
   "    --amp AMP         amplitude (default 0.1)\n",
   "    --newton-tol T    Newton tolerance (stage residual, inf-norm, absolute) for\n",
   "                      nonlinear models (default: the library's, 1e-10 times\n",
@@ -111,9 +121,9 @@ static const char *const help_lines[] = {
   "  --r R               reduced order (required). For gmg-pod/gmg-qm it includes the m\n",
   "                      port coordinates, so m < R <= N; R - m (gmg) or R (sp1/sp2) must\n",
   "                      not exceed the rank of the (adjusted) snapshots.\n",
-  "  --rn K              gmg-qm lifting dimension r_n (default 8, or the largest that\n",
+  "  --rn K              gmg-qm only: lifting dimension r_n (default 8, or the largest that\n",
   "                      fits; K <= 64, K (R-m) <= 4096, R + K <= N)\n",
-  "  --lambda L          gmg-qm ridge parameter, on the un-normalised sum over the\n",
+  "  --lambda L          gmg-qm only: ridge parameter, on the un-normalised sum over the\n",
   "                      snapshots (0 = exactly zero; the paper's value is 1e-3). Or:\n",
   "    --lambda auto     the default: validated by simulation (the safe choice):\n",
   "                      the reduced model is simulated for candidate lambdas on\n",
@@ -143,9 +153,11 @@ static const char *const help_lines[] = {
   "                      (a (terms, 2) matrix with up to 8 terms is per term only beside\n",
   "                      a per-term --poly).\n",
   "  --potential NAME    a named potential instead of --poly/--exp: toda (e^s - 1 - s),\n",
-  "                      cosh:A ((cosh(A s) - 1)/A^2), morse:D:A (D (1 - e^{-A s})^2),\n",
-  "                      fpu:K3:K4 (K3 s^3/3 + K4 s^4/4). --poly, --exp or --potential\n",
-  "                      need --poly-idx.\n",
+  "                      cosh:A ((cosh(A s) - 1)/A^2, A != 0), morse:D:A (D (1 - e^{-A s})^2,\n",
+  "                      D > 0, A != 0), fpu:K3:K4 (K3 s^3/3 + K4 s^4/4, K4 > 0). --poly,\n",
+  "                      --exp or --potential need --poly-idx. An energy unbounded below\n",
+  "                      (a term w phi(s) -> -inf: a negative leading power >= 3 or\n",
+  "                      fastest exponential) is refused.\n",
   "  --poly-idx FILE     a vector of the 0-based state coordinates idx_k of the terms\n",
   "                      (each in [0, N); any integer dtype, e.g. np.arange, or float64).\n",
   "  --poly-w FILE       a vector of the term weights w_k (default all 1).\n",
@@ -154,15 +166,19 @@ static const char *const help_lines[] = {
   "  --hyper H           hyper-reduction of the nonlinear terms: ecsw (default; weights\n",
   "                      >= 0 by non-negative least squares), qdeim or greedy (the\n",
   "                      paper's structure-preserving DEIM; weights may be negative)\n",
-  "  --hyper-tol T       ecsw: relative training residual of the reduced gradient (1e-6)\n",
-  "  --deim-tol T        DEIM keeps the modes with sigma_k / sigma_1 > T (default 1e-8)\n",
-  "  --deim-max K        at most K DEIM points (default: no cap)\n",
+  "  --hyper-tol T       ecsw: relative training residual of the reduced gradient\n",
+  "                      (default 1e-6; 1e-14 <= T < 1)\n",
+  "  --deim-tol T        qdeim/greedy: keep the modes with sigma_k / sigma_1 > T\n",
+  "                      (default 1e-8; 0 <= T < 1)\n",
+  "  --deim-max K        qdeim/greedy: at most K DEIM points (default: no cap)\n",
+  "                      The options of the hyper-reduction need a nonlinear part.\n",
   "  --deim-allow-negative  accept negative DEIM weights (the reduced energy may then\n",
   "                      lose its lower bound); default: refuse with an error.\n",
   "  --dt-map DT         precompute the exact GL3 step map for step DT in the model\n",
   "                      (linear models with quadratic H; the online stepper then needs\n",
   "                      no Newton iteration at that step). Default: the --dt of\n",
-  "                      --simulate, none with --X; 0 = none.\n",
+  "                      --simulate, none with --X; 0 = none. A step map with spectral\n",
+  "                      radius above 1 (an amplifying step) is refused.\n",
   "  --out DIR           output directory, created if missing (required).\n",
   "  --name NAME         base name of the outputs and C identifier prefix (default rom;\n",
   "                      letters, digits and _, not starting with a digit; not a C/C++\n",
@@ -185,8 +201,10 @@ static const char *const help_lines[] = {
   "                      x ~ V0 xr + V2 M kron(x2, x2), x2 = xr[m:]\n",
   "    NAME.json          sizes, method, options, diagnostics and the list of files\n",
   "  A run writes all of these or none: they are written under temporary names and\n",
-  "  renamed at the end; NAME_*.npy arrays of an earlier run with the same NAME that\n",
-  "  this run does not produce (another method) are removed.\n",
+  "  renamed at the end; the NAME_*.npy arrays that an earlier run listed in its\n",
+  "  NAME.json and this run does not produce (another method) are removed. A run\n",
+  "  never writes or removes one of its input files (compared as files, however\n",
+  "  spelled): an output that would be an input is refused before any work.\n",
   "  The reduced model (LINEAR kind) is x' = K grad H(x) + Bh u, y = Bh^T grad H(x),\n",
   "  H(x) = 1/2 x^T Qh x (+ sum_j w_j phi(P0_j x)); it is again port-Hamiltonian.\n",
   "\n",
@@ -226,7 +244,8 @@ static const char *const help_lines[] = {
   "  --input FILE.npy:   either a 2-d table of shape (K, 1 + m): column 0 the times\n",
   "                      (strictly increasing), columns 1..m the inputs at those times;\n",
   "                      or, for m = 1, a vector of K samples u(k DT), k = 0..K-1.\n",
-  "                      u(t) is interpolated linearly, held constant outside.\n",
+  "                      u(t) is interpolated linearly, held constant outside (a\n",
+  "                      note says so when a run goes past the table's last time).\n",
   "  Written: format 1.0, '<f8', Fortran order (NumPy reads it as usual).\n",
   "\n",
   "EXAMPLES\n",
@@ -414,6 +433,7 @@ static int mat_load(mat *m, const char *opt, const char *path) {
   size_t i, n;
   memset(m, 0, sizeof *m);
   m->path = path;
+  if (!*path) return usage_error("%s: empty file name", opt);
   if (is_dir(path, opt)) return 1;
   f = fopen(path, "rb");
   if (!f) return fail("%s (%s): cannot open: %s", path, opt, strerror(errno));
@@ -487,7 +507,9 @@ static void input_fn(double t, double *u, void *user) {
   cli_input *in = (cli_input *)user;
   int a;
   switch (in->kind) {
-    case IN_SIN: for (a = 0; a < in->m; ++a) u[a] = in->amp * sin(t); break;
+    case IN_SIN: /* port a: its own frequency 1 + a/m, so that the ports are excited independently */
+      for (a = 0; a < in->m; ++a) u[a] = in->amp * sin((1.0 + (double)a / in->m) * t);
+      break;
     case IN_CONST: for (a = 0; a < in->m; ++a) u[a] = in->amp; break;
     default: table_eval(in, t, u); break;
   }
@@ -503,7 +525,7 @@ static void input_fn(double t, double *u, void *user) {
 
 /* Set up the input from --input/--amp for m ports and step dt. Returns 0, or
    the exit status after a message (2: neither a kind nor an existing file). */
-static int input_setup(cli_input *in, const char *spec, double amp, int m, double dt) {
+static int input_setup(cli_input *in, const char *opt, const char *spec, double amp, int m, double dt) {
   struct stat st;
   const size_t l = strlen(spec);
   memset(in, 0, sizeof *in);
@@ -513,20 +535,20 @@ static int input_setup(cli_input *in, const char *spec, double amp, int m, doubl
   if (!strcmp(spec, "sin")) { in->kind = IN_SIN; return 0; }
   if (!strcmp(spec, "const")) { in->kind = IN_CONST; return 0; }
   if (stat(spec, &st) != 0 && (l < 4 || strcmp(spec + l - 4, ".npy") != 0))
-    return usage_error("--input '%s': expected sin, const or a FILE.npy, and there is no file '%s'", spec, spec);
-  if (mat_load(&in->tab, "--input", spec)) return 1;
+    return usage_error("%s '%s': expected sin, const or a FILE.npy, and there is no file '%s'", opt, spec, spec);
+  if (mat_load(&in->tab, opt, spec)) return 1;
   if (in->tab.ndim == 2 && !(m == 1 && in->tab.cols == 1)) {
     int k;
     if (in->tab.cols != 1 + m || in->tab.rows < 1) {
-      fail("%s (--input): expected a table of shape (K, %d) (times, then %d input%s), got %s",
-           spec, 1 + m, m, m > 1 ? "s" : "", shape_str(&in->tab));
+      fail("%s (%s): expected a table of shape (K, %d) (times, then %d input%s), got %s",
+           spec, opt, 1 + m, m, m > 1 ? "s" : "", shape_str(&in->tab));
       mat_free(&in->tab);
       return 1;
     }
     for (k = 1; k < in->tab.rows; ++k)
       if (!(in->tab.a[k] > in->tab.a[k - 1])) {
-        fail("%s (--input): the times in column 0 must increase strictly (row %d: %g after %g)",
-             spec, k, in->tab.a[k], in->tab.a[k - 1]);
+        fail("%s (%s): the times in column 0 must increase strictly (row %d: %g after %g)",
+             spec, opt, k, in->tab.a[k], in->tab.a[k - 1]);
         mat_free(&in->tab);
         return 1;
       }
@@ -534,9 +556,9 @@ static int input_setup(cli_input *in, const char *spec, double amp, int m, doubl
     return 0;
   }
   if (m != 1 || in->tab.rows * in->tab.cols < 1) {
-    fail("%s (--input): a vector of samples needs a model with one input (m = %d) and at least "
+    fail("%s (%s): a vector of samples needs a model with one input (m = %d) and at least "
          "one sample; for m > 1 give a table of shape (K, %d); got %s",
-         spec, m, 1 + m, shape_str(&in->tab));
+         spec, opt, m, 1 + m, shape_str(&in->tab));
     mat_free(&in->tab);
     return 1;
   }
@@ -546,30 +568,242 @@ static int input_setup(cli_input *in, const char *spec, double amp, int m, doubl
 
 static const char *input_desc(const cli_input *in, const char *spec) {
   static char buf[600];
-  if (in->kind == IN_SIN) snprintf(buf, sizeof buf, "u(t) = %g sin(t)", in->amp);
+  if (in->kind == IN_SIN && in->m > 1)
+    snprintf(buf, sizeof buf, "u_a(t) = %g sin((1 + a/%d) t) at port a = 0..%d", in->amp, in->m, in->m - 1);
+  else if (in->kind == IN_SIN) snprintf(buf, sizeof buf, "u(t) = %g sin(t)", in->amp);
   else if (in->kind == IN_CONST) snprintf(buf, sizeof buf, "u(t) = %g", in->amp);
   else snprintf(buf, sizeof buf, "u(t) from %s", spec);
   return buf;
 }
 
+/* A warning on stderr, also with --quiet. */
+static void note(const char *fmt, ...) {
+  va_list ap;
+  fputs("phgmg: note: ", stderr);
+  va_start(ap, fmt);
+  vfprintf(stderr, fmt, ap);
+  va_end(ap);
+  fputc('\n', stderr);
+}
+
+/* Say so when an input file ends before a run of length t_end: past its last
+   time it is held at its last value. */
+static void input_covers(const cli_input *in, const char *spec, const char *opt, double t_end) {
+  double last;
+  if (in->kind == IN_TABLE) last = in->tab.a[in->tab.rows - 1];
+  else if (in->kind == IN_GRID) last = (double)(in->tab.rows * in->tab.cols - 1) * in->grid_dt;
+  else return;
+  if (last < t_end * (1.0 - 1e-12))
+    note("%s (%s) ends at t = %g, the run at t = %g: from t = %g on, the input is held at its last value",
+         spec, opt, last, t_end, last);
+}
+
+/* 1 if the input drives every port with the same signal (m > 1): const, or
+   a table whose input columns are equal. */
+static int input_same_on_ports(const cli_input *in) {
+  int k, a;
+  if (in->m < 2) return 0;
+  if (in->kind == IN_CONST) return 1;
+  if (in->kind != IN_TABLE) return 0;
+  for (a = 2; a <= in->m; ++a)
+    for (k = 0; k < in->tab.rows; ++k)
+      if (in->tab.a[k + (size_t)a * in->tab.rows] != in->tab.a[k + (size_t)in->tab.rows]) return 0;
+  return 1;
+}
+
+/* Say so when no training run excites the m > 1 ports independently. */
+static void note_ports(const cli_input *const *ins, int n, int m) {
+  int k;
+  if (m < 2 || n < 1) return;
+  for (k = 0; k < n; ++k)
+    if (!input_same_on_ports(ins[k])) return;
+  note("every training run drives all %d ports with the same signal: the ports are not excited independently "
+       "(the snapshots cannot tell them apart; GMG may fail or the model may not follow other inputs). "
+       "Use the default sin (one frequency per port) or a table with a column per port", m);
+}
+
 /* ---- files ---------------------------------------------------------------- */
-static int mkdir_p(const char *dir) {
-  char buf[4096];
-  size_t n = strlen(dir), i;
-  struct stat st;
-  if (n == 0 || n >= sizeof buf) return fail("%s (--out): bad directory name", dir);
-  memcpy(buf, dir, n + 1);
-  for (i = 1; i <= n; ++i) {
-    if (buf[i] == '/' || buf[i] == '\0') {
-      const char c = buf[i];
-      buf[i] = '\0';
-      if (mkdir(buf, 0777) != 0 && errno != EEXIST)
-        return fail("%s (--out): cannot create directory %s: %s", dir, buf, strerror(errno));
-      buf[i] = c;
+/* ---- file identity: a run never writes or removes one of its inputs ----------
+   Paths are compared by the file they name, not by their spelling: an existing
+   file by (st_dev, st_ino) (hard links, symbolic links, "./a" and "a" are one
+   file); a file not yet there by its directory's identity and its base name;
+   below a directory not yet there by the absolute path with "." and ".."
+   folded. */
+typedef struct file_id {
+  int kind;        /* 1 the file exists, 2 its directory exists, 3 neither */
+  dev_t dev;
+  ino_t ino;
+  char *s;         /* kind 2: the base name; kind 3: the folded absolute path */
+} file_id;
+
+/* The absolute path with "//", "." and ".." folded, into out (cap bytes). */
+static void path_fold(const char *path, char *out, size_t cap) {
+  char buf[8192];
+  size_t n = 0, k;
+  const char *p;
+  buf[0] = '\0';
+  if (path[0] != '/' && (!getcwd(buf, sizeof buf - 1) || strlen(buf) + strlen(path) + 2 >= sizeof buf)) buf[0] = '\0';
+  if (strlen(buf) + strlen(path) + 2 < sizeof buf) { strcat(buf, "/"); strcat(buf, path); }
+  out[0] = '\0';
+  for (p = buf; *p;) {
+    size_t l;
+    while (*p == '/') ++p;
+    l = strcspn(p, "/");
+    if (l == 0) break;
+    if (l == 1 && p[0] == '.') { p += l; continue; }
+    if (l == 2 && p[0] == '.' && p[1] == '.') {
+      for (k = n; k > 0 && out[k - 1] != '/'; --k) {}
+      n = k > 0 ? k - 1 : 0;
+      out[n] = '\0';
+      p += l;
+      continue;
     }
+    if (n + l + 2 >= cap) break;
+    out[n++] = '/';
+    memcpy(out + n, p, l);
+    n += l;
+    out[n] = '\0';
+    p += l;
   }
-  if (stat(dir, &st) != 0 || !S_ISDIR(st.st_mode)) return fail("%s (--out): not a directory", dir);
+  if (n == 0 && cap > 1) { out[0] = '/'; out[1] = '\0'; }
+}
+
+static void file_id_make(const char *path, file_id *f) {
+  struct stat st;
+  const char *sl = strrchr(path, '/');
+  const char *base = sl ? sl + 1 : path;
+  char dir[4096];
+  memset(f, 0, sizeof *f);
+  if (stat(path, &st) == 0) { f->kind = 1; f->dev = st.st_dev; f->ino = st.st_ino; return; }
+  if (sl && (size_t)(sl - path) >= sizeof dir) sl = NULL, base = "";
+  if (sl == path) strcpy(dir, "/");
+  else if (sl) { memcpy(dir, path, (size_t)(sl - path)); dir[sl - path] = '\0'; }
+  else strcpy(dir, ".");
+  if (*base && strcmp(base, ".") && strcmp(base, "..") && stat(dir, &st) == 0 && S_ISDIR(st.st_mode)) {
+    f->kind = 2; f->dev = st.st_dev; f->ino = st.st_ino;
+    f->s = (char *)malloc(strlen(base) + 1);
+    if (f->s) strcpy(f->s, base);
+    return;
+  }
+  f->kind = 3;
+  f->s = (char *)malloc(8192);
+  if (f->s) path_fold(path, f->s, 8192);
+}
+
+static int file_id_same(const file_id *a, const file_id *b) {
+  if (a->kind != b->kind) return 0;
+  if (a->kind == 3) return a->s && b->s && !strcmp(a->s, b->s);
+  if (a->dev != b->dev || a->ino != b->ino) return 0;
+  return a->kind == 1 || (a->s && b->s && !strcmp(a->s, b->s));
+}
+
+/* A list of paths with the options they came from (copies). */
+#define PATHS_MAX 160
+typedef struct pathset {
+  char *path[PATHS_MAX];
+  const char *opt[PATHS_MAX];
+  file_id id[PATHS_MAX];
+  int n;
+} pathset;
+
+static void paths_free(pathset *ps) {
+  int k;
+  for (k = 0; k < ps->n; ++k) { free(ps->path[k]); free(ps->id[k].s); }
+  ps->n = 0;
+}
+
+/* Add path (and, with tmp, the temporary name path.tmp a staged write uses). */
+static void paths_add(pathset *ps, const char *opt, const char *path, int tmp) {
+  int t;
+  for (t = 0; t <= tmp && ps->n < PATHS_MAX; ++t) {
+    const size_t l = strlen(path);
+    char *c = (char *)malloc(l + 5);
+    if (!c) return;
+    memcpy(c, path, l + 1);
+    if (t) memcpy(c + l, ".tmp", 5);
+    ps->path[ps->n] = c;
+    ps->opt[ps->n] = opt;
+    file_id_make(c, &ps->id[ps->n]);
+    ps->n++;
+  }
+}
+
+/* An input spec that may be a file: anything but the input kinds sin, const. */
+static void paths_add_input(pathset *ps, const char *opt, const char *spec) {
+  if (spec && strcmp(spec, "sin") && strcmp(spec, "const")) paths_add(ps, opt, spec, 0);
+}
+
+/* The index in ps of the file path names, -1 if none. */
+static int paths_find(const pathset *ps, const char *path) {
+  file_id f;
+  int k, hit = -1;
+  file_id_make(path, &f);
+  for (k = 0; k < ps->n && hit < 0; ++k)
+    if (file_id_same(&f, &ps->id[k])) hit = k;
+  free(f.s);
+  return hit;
+}
+
+/* The inputs of the running command: stage_path refuses to write one, the
+   removal of an earlier run's arrays skips them. */
+static const pathset *g_inputs = NULL;
+
+/* Up front: no output may be an input or another output of the same run.
+   Returns 0, or the usage status 2 after a message. */
+static int check_collisions(const char *cmd, const pathset *in, const pathset *out) {
+  int i, k;
+  for (i = 0; i < out->n; ++i) {
+    for (k = 0; k < in->n; ++k)
+      if (file_id_same(&out->id[i], &in->id[k]))
+        return usage_error("%s: the output %s (%s) is the input %s (%s): a run never overwrites its inputs; "
+                           "choose another output name", cmd, out->path[i], out->opt[i], in->path[k], in->opt[k]);
+    for (k = 0; k < i; ++k)
+      if (file_id_same(&out->id[i], &out->id[k]))
+        return usage_error("%s: %s (%s) and %s (%s) are the same file; give each output its own name", cmd,
+                           out->path[k], out->opt[k], out->path[i], out->opt[i]);
+  }
   return 0;
+}
+
+/* Up front: can files be created in dir (created first if missing, create = 1)?
+   0, or 1 after a message naming opt and path. */
+static int check_writable_dir(const char *dir, const char *opt, const char *path, int create) {
+  char buf[4096];
+  struct stat st;
+  size_t n = strlen(dir);
+  if (n == 0 || n >= sizeof buf) return fail("%s (%s): bad directory name", path, opt);
+  memcpy(buf, dir, n + 1);
+  for (;;) {
+    if (stat(buf, &st) == 0) {
+      if (!S_ISDIR(st.st_mode))
+        return fail("%s (%s): cannot write there: %s is not a directory", path, opt, buf);
+      if (access(buf, W_OK | X_OK) != 0)
+        return fail("%s (%s): cannot write in %s: %s", path, opt, buf, strerror(errno));
+      return 0;
+    }
+    if (errno != ENOENT) return fail("%s (%s): cannot use %s: %s", path, opt, buf, strerror(errno));
+    if (!create) return fail("%s (%s): cannot write: the directory %s does not exist", path, opt, buf);
+    if (!strcmp(buf, ".")) return fail("%s (%s): the working directory is gone", path, opt);
+    while (n > 1 && buf[n - 1] == '/') buf[--n] = '\0'; /* to the parent: drop the last component */
+    while (n > 0 && buf[n - 1] != '/') buf[--n] = '\0';
+    while (n > 1 && buf[n - 1] == '/') buf[--n] = '\0';
+    if (n == 0) { strcpy(buf, "."); n = 1; }
+  }
+}
+
+/* An output file path: its directory must exist and be writable, and the path
+   must not be a directory. 0, or 1 after a message. */
+static int check_out_file(const char *path, const char *opt) {
+  char dir[4096];
+  const char *sl = strrchr(path, '/');
+  struct stat st;
+  if (!*path) return fail("'' (%s): empty file name", opt);
+  if (stat(path, &st) == 0 && S_ISDIR(st.st_mode)) return fail("%s (%s): cannot write: is a directory", path, opt);
+  if (!sl) strcpy(dir, ".");
+  else if (sl == path) strcpy(dir, "/");
+  else if ((size_t)(sl - path) < sizeof dir) { memcpy(dir, path, (size_t)(sl - path)); dir[sl - path] = '\0'; }
+  else return fail("%s (%s): path too long", path, opt);
+  return check_writable_dir(dir, opt, path, 0);
 }
 
 /* All or none: every output of a run is written under a temporary name
@@ -581,22 +815,63 @@ static int mkdir_p(const char *dir) {
 typedef struct staged {
   char *fin[64], *tmp[64];
   int n;
+  char *made[32];  /* directories this run created (mkdir_p), removed again if empty after a failure */
+  int nmade;
 } staged;
 
-static void stage_abort(staged *sg) {
+static void stage_free(staged *sg, int remove_tmp) {
   int k;
   for (k = 0; k < sg->n; ++k) {
-    remove(sg->tmp[k]);
+    if (remove_tmp) remove(sg->tmp[k]);
     free(sg->fin[k]);
     free(sg->tmp[k]);
   }
   sg->n = 0;
+  for (k = sg->nmade - 1; k >= 0; --k) {
+    if (remove_tmp) rmdir(sg->made[k]); /* only if empty */
+    free(sg->made[k]);
+  }
+  sg->nmade = 0;
+}
+
+/* After a failure: the temporary files and the directories made go. */
+static void stage_abort(staged *sg) { stage_free(sg, 1); }
+
+/* Create dir and its missing parents (noted in sg). */
+static int mkdir_p(const char *dir, staged *sg) {
+  char buf[4096];
+  size_t n = strlen(dir), i;
+  struct stat st;
+  if (n == 0 || n >= sizeof buf) return fail("%s (--out): bad directory name", dir);
+  memcpy(buf, dir, n + 1);
+  for (i = 1; i <= n; ++i) {
+    if (buf[i] == '/' || buf[i] == '\0') {
+      const char c = buf[i];
+      buf[i] = '\0';
+      if (mkdir(buf, 0777) == 0) {
+        if (sg->nmade < 32 && (sg->made[sg->nmade] = (char *)malloc(i + 1)) != NULL) memcpy(sg->made[sg->nmade++], buf, i + 1);
+      } else if (errno != EEXIST) {
+        return fail("%s (--out): cannot create directory %s: %s", dir, buf, strerror(errno));
+      }
+      buf[i] = c;
+    }
+  }
+  if (stat(dir, &st) != 0 || !S_ISDIR(st.st_mode)) return fail("%s (--out): not a directory", dir);
+  return 0;
 }
 
 /* The path to write for the output `path` (NULL after a message). */
 static const char *stage_path(staged *sg, const char *path) {
   struct stat st;
   const size_t l = strlen(path);
+  if (g_inputs) { /* the last guard; the outputs were checked against the inputs up front */
+    char tmp[4096 + 260];
+    snprintf(tmp, sizeof tmp, "%s.tmp", path);
+    if (paths_find(g_inputs, path) >= 0 || paths_find(g_inputs, tmp) >= 0) {
+      fail("%s: not written: it is an input of this run", path);
+      return NULL;
+    }
+  }
   if (lstat(path, &st) == 0) {
     if (S_ISDIR(st.st_mode)) { fail("%s: cannot write: is a directory", path); return NULL; }
     if (!S_ISREG(st.st_mode)) return path;
@@ -622,10 +897,10 @@ static int stage_commit(staged *sg) {
   for (k = 0; k < sg->n; ++k)
     if (rename(sg->tmp[k], sg->fin[k]) != 0) {
       fail("%s: cannot rename %s into place: %s", sg->fin[k], sg->tmp[k], strerror(errno));
-      stage_abort(sg); /* removes the files not yet renamed, frees the names */
+      stage_free(sg, 1); /* removes the files not yet renamed, frees the names */
       return 1;
     }
-  stage_abort(sg); /* frees the names; the temporary files are gone */
+  stage_free(sg, 0); /* frees the names; the temporary files are gone, the directories stay */
   return 0;
 }
 
@@ -876,13 +1151,98 @@ static const char *method_name(int m) {
 /* The value of option argv[*i] (advancing *i), or NULL after a usage message. */
 static const char *optval(int argc, char **argv, int *i) {
   if (*i + 1 >= argc) { usage_error("%s needs a value", argv[*i]); return NULL; }
+  if (!argv[*i + 1][0]) { usage_error("%s: empty value (a file name, a number or a word expected)", argv[*i]); return NULL; }
   return argv[++*i];
+}
+
+/* A named potential (--potential NAME[:P1[:P2]]) as exp-polynomial
+   coefficients into c (the polynomial c_0..c_deg, then the pairs (a_e, b_e)).
+   Returns 0, or 1 after a message: an unknown name, a field that is empty or
+   not a finite number, the wrong number of fields, a parameter out of range,
+   coefficients beyond the double range. */
+static int named_potential(const char *spec, double *c, int *deg, int *nexp) {
+  double p[2] = {1.0, 1.0};
+  int n = 0, k;
+  const char *colon = strchr(spec, ':');
+  const size_t len = colon ? (size_t)(colon - spec) : strlen(spec);
+  const char *what = "expected toda, cosh:A (A != 0), morse:D:A (D > 0, A != 0) or fpu:K3:K4 (K4 > 0)";
+  while (colon) { /* each field a whole finite number */
+    char *end;
+    if (n == 2) return usage_error("--potential '%s': too many fields; %s", spec, what);
+    errno = 0;
+    p[n] = strtod(colon + 1, &end);
+    if (end == colon + 1 || (*end && *end != ':') || errno == ERANGE || !isfinite(p[n]))
+      return usage_error("--potential '%s': field %d is %s; %s", spec, n + 1,
+                         end == colon + 1 ? "empty or not a number" : "not a finite double", what);
+    ++n;
+    colon = *end == ':' ? end : NULL;
+  }
+  memset(c, 0, 8 * sizeof(double));
+  if (len == 4 && !strncmp(spec, "toda", 4) && n == 0) {        /* e^s - 1 - s */
+    c[0] = -1.0; c[1] = -1.0; *deg = 1; *nexp = 1; c[2] = 1.0; c[3] = 1.0;
+  } else if (len == 4 && !strncmp(spec, "cosh", 4) && n <= 1 && p[0] != 0.0) { /* (cosh(a s) - 1)/a^2 */
+    c[0] = -1.0 / (p[0] * p[0]); *deg = 0; *nexp = 2;
+    c[1] = 0.5 / (p[0] * p[0]); c[2] = p[0]; c[3] = 0.5 / (p[0] * p[0]); c[4] = -p[0];
+  } else if (len == 5 && !strncmp(spec, "morse", 5) && n == 2 && p[0] > 0.0 && p[1] != 0.0) { /* D (1 - e^{-a s})^2 */
+    c[0] = p[0]; *deg = 0; *nexp = 2; c[1] = -2.0 * p[0]; c[2] = -p[1]; c[3] = p[0]; c[4] = -2.0 * p[1];
+  } else if (len == 3 && !strncmp(spec, "fpu", 3) && n == 2 && p[1] > 0.0) {  /* k3 s^3/3 + k4 s^4/4 */
+    c[3] = p[0] / 3.0; c[4] = p[1] / 4.0; *deg = 4; *nexp = 0;
+  } else {
+    return usage_error("--potential '%s': %s%s", spec, what,
+                       (len == 5 && !strncmp(spec, "morse", 5) && n == 2 && p[0] <= 0.0) ||
+                       (len == 3 && !strncmp(spec, "fpu", 3) && n == 2 && p[1] <= 0.0)
+                           ? " (else the energy is unbounded below)" : "");
+  }
+  for (k = 0; k < 8; ++k)
+    if (!isfinite(c[k]) || (c[k] != 0.0 && fabs(c[k]) < DBL_MIN))
+      return usage_error("--potential '%s': its coefficients leave the double range (%g); use parameters "
+                         "of moderate size", spec, c[k]);
+  return 0;
+}
+
+/* 1 if option o is among the seen ones. */
+static int given(const char *o, const char *const *seen, int nseen) {
+  int k;
+  for (k = 0; k < nseen; ++k)
+    if (!strcmp(seen[k], o)) return 1;
+  return 0;
+}
+
+/* The hyper-reduction options: each applies to a nonlinear part, and only
+   to the method that reads it. 0 or the usage status 2. */
+static int check_hyper_opts(const reduce_args *A, const char *const *seen, int nseen) {
+  static const char *const all[] = {"--hyper", "--hyper-tol", "--deim-tol", "--deim-max", "--no-deim",
+                                    "--deim-allow-negative", NULL};
+  const int ecsw = !A->hyper || !strcmp(A->hyper, "ecsw");
+  int k;
+  for (k = 0; all[k]; ++k)
+    if (given(all[k], seen, nseen) && !A->poly_idx)
+      return usage_error("reduce: %s applies to a nonlinear part (--poly, --exp or --potential with --poly-idx); "
+                         "this model has none", all[k]);
+  for (k = 0; k < 4; ++k)
+    if (A->no_deim && given(all[k], seen, nseen))
+      return usage_error("reduce: --no-deim keeps every nonlinear term: %s does not apply", all[k]);
+  if (given("--hyper-tol", seen, nseen)) {
+    if (!ecsw) return usage_error("--hyper-tol applies to --hyper ecsw (the tolerance of %s is --deim-tol)", A->hyper);
+    if (!(A->hyper_tol > 0.0 && A->hyper_tol < 1.0))
+      return usage_error("--hyper-tol %g: expected 0 < T < 1 (a relative residual)", A->hyper_tol);
+    if (A->hyper_tol < 1e-14)
+      return usage_error("--hyper-tol %g: below what double precision resolves in a relative residual (1e-14); "
+                         "for every term exactly, use --no-deim", A->hyper_tol);
+  }
+  if (ecsw && (given("--deim-tol", seen, nseen) || given("--deim-max", seen, nseen)))
+    return usage_error("reduce: --deim-tol and --deim-max apply to --hyper qdeim or greedy (ecsw's tolerance is "
+                       "--hyper-tol)");
+  if (!(A->deim_tol < 1.0))
+    return usage_error("--deim-tol %g: expected 0 <= T < 1 (DEIM keeps the modes with sigma_k / sigma_1 > T)",
+                       A->deim_tol);
+  return 0;
 }
 
 /* Returns 0, the usage status 2, or -1 after printing --help. */
 static int parse_reduce(int argc, char **argv, reduce_args *A) {
   const char *seen[64];
-  int i, nseen = 0;
+  int i, nseen = 0, e;
   memset(A, 0, sizeof *A);
   A->dt = 0.1; A->steps = 1000; A->amp = 0.1; A->rn = 0; A->lambda = 1e-3;
   A->deim_tol = 1e-8; A->name = "rom"; A->newton_tol = 0.0; A->newton_iter = 10;
@@ -954,8 +1314,15 @@ static int parse_reduce(int argc, char **argv, reduce_args *A) {
   if ((A->J || A->R || A->Q) && (A->Jcoo || A->Rcoo || A->Qcoo))
     return usage_error("reduce: give J, R, Q either dense (--J, --R, --Q) or sparse (--J-coo, --R-coo, --Q-coo)");
   if (A->Jcoo || A->Rcoo || A->Qcoo) {
+    const char *const spec[3] = {A->Jcoo, A->Rcoo, A->Qcoo}, *const opt[3] = {"--J-coo", "--R-coo", "--Q-coo"};
     if (!A->Jcoo || !A->Rcoo || !A->Qcoo || !A->B)
       return usage_error("reduce: --J-coo, --R-coo, --Q-coo and --B are required together");
+    for (i = 0; i < 3; ++i) {
+      const char *c1 = strchr(spec[i], ','), *c2 = c1 ? strchr(c1 + 1, ',') : NULL;
+      if (c1 && (!c2 || strchr(c2 + 1, ',') || c1 == spec[i] || c2 == c1 + 1 || !c2[1]))
+        return usage_error("%s '%s': expected rows.npy,cols.npy,vals.npy (three non-empty names) or one (nnz, 3) "
+                           "FILE.npy", opt[i], spec[i]);
+    }
   } else if (!A->J || !A->R || !A->B || !A->Q) return usage_error("reduce: --J, --R, --B and --Q are required");
   if (!A->method) return usage_error("reduce: --method is required (gmg-pod, gmg-qm, sp1 or sp2)");
   if (!A->r) return usage_error("reduce: --r is required");
@@ -965,9 +1332,14 @@ static int parse_reduce(int argc, char **argv, reduce_args *A) {
   if (!!(A->poly || A->expf || A->potential) != !!A->poly_idx)
     return usage_error("reduce: --poly/--exp/--potential and --poly-idx go together");
   if (A->poly_w && !A->poly_idx) return usage_error("reduce: --poly-w needs a nonlinear part (--poly-idx)");
+  if (A->potential) {
+    double c[8];
+    int d, ne;
+    if (named_potential(A->potential, c, &d, &ne)) return 2;
+  }
   if (A->hyper && strcmp(A->hyper, "ecsw") && strcmp(A->hyper, "qdeim") && strcmp(A->hyper, "greedy"))
     return usage_error("--hyper '%s': expected ecsw, qdeim or greedy", A->hyper);
-  if (!(A->hyper_tol < 1.0)) return usage_error("--hyper-tol must be < 1");
+  if ((e = check_hyper_opts(A, seen, nseen)) != 0) return e;
   if (name_problem(A->name)) return usage_error("--name '%s': %s", A->name, name_problem(A->name));
   if (A->ntrain && !A->simulate) return usage_error("reduce: --train-input needs --simulate");
   if (A->nxin && A->nxin != A->nx)
@@ -976,11 +1348,14 @@ static int parse_reduce(int argc, char **argv, reduce_args *A) {
   if (A->ntrain && A->input)
     return usage_error("reduce: give the training input either by --input or by --train-input, not both");
   if (!A->input) A->input = A->ntrain ? A->train[0] : "sin";
-  if ((A->lambda_auto || A->manifold_s) && strcmp(A->method, "gmg-qm") != 0)
-    return usage_error("reduce: --lambda auto/cv and --manifold apply to --method gmg-qm only");
+  if ((A->have_lambda || A->manifold_s || A->rn) && strcmp(A->method, "gmg-qm") != 0)
+    return usage_error("reduce: --lambda, --rn and --manifold apply to --method gmg-qm only (not %s)", A->method);
   /* gmg-qm without --lambda: the validated choice (a fixed lambda can give a
      model whose Newton solve fails on inputs unlike the training run) */
   if (!A->have_lambda && !strcmp(A->method, "gmg-qm")) A->lambda_auto = 1;
+  if (A->lambda_auto == 1 && A->have_lambda && A->X && !A->nxin)
+    return usage_error("reduce: --lambda auto with --X needs the inputs of the runs (--X-input, one per --X): it "
+                       "simulates them; or give a fixed --lambda, or --lambda cv");
   if (!A->have_dt_map) A->dt_map = A->simulate ? A->dt : 0.0;
   if (A->simulate && too_big((double)A->steps + 1.0, "--simulate --steps: the snapshots (N x (steps+1)) alone"))
     return 2; /* N >= 1: a first check before reading J */
@@ -1015,7 +1390,8 @@ static int load_coo(cli_csc *c, const char *opt, const char *spec, int N) {
   memset(c, 0, sizeof *c);
   if (strchr(spec, ',')) {
     const char *a = spec, *b = strchr(a, ','), *e = b ? strchr(b + 1, ',') : NULL;
-    if (!b || !e || strchr(e + 1, ',') || b - a >= 4096 || e - b - 1 >= 4096 || strlen(e + 1) >= 4096)
+    if (!b || !e || strchr(e + 1, ',') || b - a >= 4096 || e - b - 1 >= 4096 || strlen(e + 1) >= 4096 ||
+        b == a || e == b + 1 || !e[1])
       return usage_error("%s '%s': expected rows.npy,cols.npy,vals.npy or one (nnz, 3) FILE.npy", opt, spec);
     memcpy(buf[0], a, (size_t)(b - a)); buf[0][b - a] = '\0';
     memcpy(buf[1], b + 1, (size_t)(e - b - 1)); buf[1][e - b - 1] = '\0';
@@ -1103,35 +1479,51 @@ typedef struct reduce_state {
   cli_input xinp[16];     /* --X-input: the input of each --X run */
   phgmg_ph_system sys;    /* the full model as reduced (internal ordering for sparse input) */
   phgmg_reduced *red;
+  int method;
+  const double *Xd;       /* --X: the snapshots (internal ordering), ns columns */
+  int ns;
   staged sg; /* the outputs, renamed into place at the end */
+  outlist ol; /* the arrays written */
+  pathset pin, pout; /* the files read; the files the run may write */
 } reduce_state;
 
-/* A named potential (--potential) as exp-polynomial coefficients into S->named:
-   returns the degree and the exponential count, -1 for an unknown name. */
-static int named_potential(const char *spec, double *c, int *deg, int *nexp) {
-  double p1 = 1.0, p2 = 1.0;
-  int n = 0;
-  const char *colon = strchr(spec, ':');
-  size_t len = colon ? (size_t)(colon - spec) : strlen(spec);
-  if (colon) {
-    char *end;
-    p1 = strtod(colon + 1, &end);
-    n = 1;
-    if (*end == ':') { p2 = strtod(end + 1, &end); n = 2; }
-    if (*end || !isfinite(p1) || !isfinite(p2)) return -1;
+/* Is w phi(s), phi(s) = sum_j c_j s^j + sum_e a_e exp(b_e s), bounded below
+   as s -> dir * inf (dir = +1 or -1)? The fastest-growing exponential decides
+   when there is one, else the polynomial's leading power of degree >= 3 (a
+   degree up to 2 is left to the quadratic energy). 1 bounded, 0 not. */
+static int phi_bounded(const double *c, int deg, const double *ex, int ne, double w, double dir) {
+  double bmax = 0.0, amax = 0.0;
+  int e, f, j;
+  for (e = 0; e < ne; ++e) { /* the largest rate dir * b > 0 with a nonzero net coefficient */
+    double a = 0.0;
+    const double rate = dir * ex[2 * e + 1];
+    if (!(rate > bmax)) continue;
+    for (f = 0; f < ne; ++f)
+      if (ex[2 * f + 1] == ex[2 * e + 1]) a += ex[2 * f];
+    if (a != 0.0) { bmax = rate; amax = a; }
   }
-  memset(c, 0, 8 * sizeof(double));
-  if (len == 4 && !strncmp(spec, "toda", 4) && n == 0) {        /* e^s - 1 - s */
-    c[0] = -1.0; c[1] = -1.0; *deg = 1; *nexp = 1; c[2] = 1.0; c[3] = 1.0;
-  } else if (len == 4 && !strncmp(spec, "cosh", 4) && n <= 1 && p1 != 0.0) { /* (cosh(a s) - 1)/a^2 */
-    c[0] = -1.0 / (p1 * p1); *deg = 0; *nexp = 2;
-    c[1] = 0.5 / (p1 * p1); c[2] = p1; c[3] = 0.5 / (p1 * p1); c[4] = -p1;
-  } else if (len == 5 && !strncmp(spec, "morse", 5) && n == 2 && p2 != 0.0) { /* D (1 - e^{-a s})^2 */
-    c[0] = p1; *deg = 0; *nexp = 2; c[1] = -2.0 * p1; c[2] = -p2; c[3] = p1; c[4] = -2.0 * p2;
-  } else if (len == 3 && !strncmp(spec, "fpu", 3) && n == 2) {  /* k3 s^3/3 + k4 s^4/4 */
-    c[3] = p1 / 3.0; c[4] = p2 / 4.0; *deg = 4; *nexp = 0;
-  } else {
-    return -1;
+  if (bmax > 0.0) return w * amax > 0.0;
+  for (j = deg; j >= 3; --j)
+    if (c[j] != 0.0) return w * c[j] * ((j % 2 && dir < 0.0) ? -1.0 : 1.0) > 0.0;
+  return 1;
+}
+
+/* Every term w_k phi_k of sys bounded below (both directions); 0, or 1 after
+   a message naming the source (--potential, --poly/--exp, --poly-w). */
+static int check_bounded_below(const reduce_args *A, const phgmg_ph_system *sys) {
+  int k, d;
+  for (k = 0; k < sys->nsep; ++k) {
+    const int f = sys->phi_nfun > 0 ? k : 0;
+    const double w = sys->sep_w ? sys->sep_w[k] : 1.0;
+    const double *c = sys->poly + (size_t)f * (sys->poly_deg + 1);
+    const double *ex = sys->nexp ? sys->expo + (size_t)f * 2 * sys->nexp : NULL;
+    if (w == 0.0) continue;
+    for (d = -1; d <= 1; d += 2)
+      if (!phi_bounded(c, sys->poly_deg, ex, sys->nexp, w, (double)d))
+        return fail("%s: term %d (weight %g): w phi(s) -> -inf as s -> %cinf, so the energy H is unbounded below "
+                    "and the model is not a passive port-Hamiltonian system (check the sign of the leading "
+                    "coefficient%s)", A->potential ? A->potential : A->poly ? A->poly : A->expf, k, w,
+                    d > 0 ? '+' : '-', A->poly_w ? " and of the weights in --poly-w" : "");
   }
   return 0;
 }
@@ -1142,8 +1534,7 @@ static int named_potential(const char *spec, double *c, int *deg, int *nexp) {
 static int load_family(const reduce_args *A, reduce_state *S, phgmg_ph_system *sys, int nt) {
   int deg = 0, ne = 0, per_p = 0, per_e = 0, t, j, k;
   if (A->potential) {
-    if (named_potential(A->potential, S->named, &deg, &ne))
-      return fail("--potential '%s': expected toda, cosh:A (A != 0), morse:D:A (A != 0) or fpu:K3:K4", A->potential);
+    named_potential(A->potential, S->named, &deg, &ne); /* checked by parse_reduce */
     sys->poly_deg = deg; sys->poly = S->named; sys->nexp = ne; sys->expo = S->named + deg + 1;
     return 0;
   }
@@ -1195,24 +1586,62 @@ static void reduce_cleanup(reduce_state *S) {
   phgmg_ph_sparse_destroy(S->sp); free(S->Xperm); free(S->Uord);
   phgmg_reduced_destroy(S->red);
   stage_abort(&S->sg); /* after a failure: no output of this run stays */
+  g_inputs = NULL;
+  paths_free(&S->pin); paths_free(&S->pout);
 }
 
-/* Remove the arrays NAME_<field>.npy (regular files) of an earlier run in dir
-   that this run (list ol) did not write, e.g. after another method. */
-static void remove_stale(const char *dir, const char *name, const outlist *ol) {
-  static const char *const all[] = {"Bh", "Qh", "K", "G00", "G01", "G10", "G11", "Q01", "Q11", "Ms",
-                                    "P0", "P1", "w", "poly", "expo", "Phi", "Gam", "SX", "SU", "V0", "V2", "M",
-                                    "snapshots", "fom_y", NULL};
-  char path[4096 + 256], file[128];
+/* The fields NAME_<field>.npy a run may write. */
+static const char *const all_fields[] = {"Bh", "Qh", "K", "G00", "G01", "G10", "G11", "Q01", "Q11", "Ms",
+                                         "P0", "P1", "w", "poly", "expo", "Phi", "Gam", "SX", "SU", "V0", "V2",
+                                         "M", "snapshots", "fom_y", NULL};
+
+/* The arrays an earlier run recorded as its own in DIR/NAME.json ("arrays":
+   {"NAME_<field>.npy": [rows, cols], ...}), those of the form NAME_<field>.npy
+   with a known field only, into rec. Nothing when there is no such record. */
+static void read_record(const char *dir, const char *name, outlist *rec) {
+  char path[4096 + 256], *text, *p, *end;
+  FILE *f;
+  long n;
+  memset(rec, 0, sizeof *rec);
+  snprintf(path, sizeof path, "%s/%s.json", dir, name);
+  if (!(f = fopen(path, "rb"))) return;
+  if (fseek(f, 0, SEEK_END) != 0 || (n = ftell(f)) <= 0 || n > (1L << 20) || fseek(f, 0, SEEK_SET) != 0 ||
+      !(text = (char *)malloc((size_t)n + 1))) { fclose(f); return; }
+  n = (long)fread(text, 1, (size_t)n, f);
+  fclose(f);
+  text[n] = '\0';
+  p = strstr(text, "\"arrays\": {");
+  end = p ? strchr(p, '}') : NULL;
+  if (p) p = strchr(p, '{');
+  while (p && end && rec->n < 48) { /* "key": [rows, cols], ... up to the closing brace */
+    char *q = strchr(p, '"'), *e;
+    int k;
+    if (!q || q > end || !(e = strchr(q + 1, '"')) || e > end) break;
+    *e = '\0';
+    ++q;
+    for (k = 0; all_fields[k]; ++k) {
+      char want[128];
+      snprintf(want, sizeof want, "%s_%s.npy", name, all_fields[k]);
+      if (!strcmp(q, want) && strlen(want) < sizeof rec->names[0]) { strcpy(rec->names[rec->n++], want); break; }
+    }
+    p = strchr(e + 1, ']');
+  }
+  free(text);
+}
+
+/* Remove the arrays an earlier run recorded (rec, read before this run's
+   record replaced it) that this run (ol) did not write, e.g. after another
+   method -- never an input of this run, only regular files. */
+static void remove_stale(const char *dir, const outlist *rec, const outlist *ol) {
+  char path[4096 + 256];
   struct stat st;
   int k, i, mine;
-  for (k = 0; all[k]; ++k) {
-    snprintf(file, sizeof file, "%s_%s.npy", name, all[k]);
-    for (i = 0, mine = 0; i < ol->n && !mine; ++i) mine = !strcmp(ol->names[i], file);
-    snprintf(path, sizeof path, "%s/%s", dir, file);
-    if (!mine && lstat(path, &st) == 0 && S_ISREG(st.st_mode)) {
-      if (remove(path) == 0) progress("removed %s (an array of an earlier run, not written by this one)", path);
-    }
+  for (k = 0; k < rec->n; ++k) {
+    for (i = 0, mine = 0; i < ol->n && !mine; ++i) mine = !strcmp(ol->names[i], rec->names[k]);
+    snprintf(path, sizeof path, "%s/%s", dir, rec->names[k]);
+    if (mine || (g_inputs && paths_find(g_inputs, path) >= 0)) continue;
+    if (lstat(path, &st) == 0 && S_ISREG(st.st_mode) && remove(path) == 0)
+      progress("removed %s (an array of an earlier run, not written by this one)", path);
   }
 }
 
@@ -1249,6 +1678,57 @@ static int write_user_field(const reduce_args *A, reduce_state *S, const char *f
   if (!S->Uord) return fail("out of memory");
   phgmg_ph_sparse_to_user_order(S->sp, cols, M, N, S->Uord, N);
   return write_field(A->out, A->name, field, S->Uord, N, cols, ol, &S->sg);
+}
+
+/* The first steps of each --X run must follow from its first snapshot and
+   its --X-input: the full model is simulated over up to X_CHECK_STEPS steps
+   and compared with the snapshots. The mismatch is measured relative to the
+   change of the snapshots over those steps; above X_CHECK_TOL (loose enough
+   for snapshots from another integrator of moderate accuracy, far below the
+   mismatch of another input or another step) the run is refused. */
+#define X_CHECK_STEPS 5
+#define X_CHECK_TOL 0.1
+static int check_x_inputs(const reduce_args *A, reduce_state *S, int N, int m) {
+  double *W = (double *)malloc(sizeof(double) * ((size_t)N + (size_t)m) * (X_CHECK_STEPS + 1));
+  phgmg_gl3_opts go;
+  int k, j, i, rc = 0;
+  if (!W) return fail("out of memory");
+  memset(&go, 0, sizeof go);
+  go.tol = A->newton_tol; go.max_iter = A->newton_iter;
+  for (k = 0; k < A->nx && !rc; ++k) {
+    const phgmg_run *run = &S->runs[k];
+    const int n = PHGMG__MIN(X_CHECK_STEPS, run->nsteps);
+    const double *X = run->x0;
+    double num = 0.0, den = 0.0, x0n = 0.0;
+    phgmg_result r = phgmg_simulate(&S->sys, X, 0.0, A->dt, n, input_fn, run->user, &go, W, W + (size_t)N * (n + 1),
+                                    NULL, NULL, NULL, NULL);
+    if (r != PHGMG_OK) {
+      rc = fail("%s (--X-input %s): the full model cannot be simulated from the run's first snapshot: %s",
+                A->xs[k], A->xin[k], phgmg_result_string(r));
+      break;
+    }
+    for (i = 0; i < N; ++i) x0n = PHGMG__MAX(x0n, fabs(X[i]));
+    for (j = 1; j <= n; ++j) {
+      double dn = 0.0, dd = 0.0;
+      for (i = 0; i < N; ++i) {
+        const double xs = X[i + (size_t)j * N];
+        dn = PHGMG__MAX(dn, fabs(W[i + (size_t)j * N] - xs));
+        dd = PHGMG__MAX(dd, fabs(xs - X[i]));
+      }
+      num = PHGMG__MAX(num, dn);
+      den = PHGMG__MAX(den, dd);
+    }
+    if (den == 0.0) den = x0n > 0.0 ? x0n : DBL_MIN;
+    progress("--X-input check: %s from its first snapshot with %s: %d steps reproduced to %.2g (relative to the "
+             "states' change)", A->xs[k], A->xin[k], n, num / den);
+    if (!(num <= X_CHECK_TOL * den))
+      rc = fail("%s (--X-input %s): the declared input does not reproduce the run: simulated from the first "
+                "snapshot with --dt %g, the next %d states differ from the snapshots by %.3g of their change "
+                "(limit %g). Give the input (and --dt) that made this run", A->xs[k], A->xin[k], A->dt, n,
+                num / den, X_CHECK_TOL);
+  }
+  free(W);
+  return rc;
 }
 
 /* The --X files (one run each) as one snapshot set in the internal ordering,
@@ -1291,7 +1771,7 @@ static int load_snapshot_files(const reduce_args *A, reduce_state *S, int N, int
       const int c = k ? S->Xs[k].cols : S->X.cols;
       memset(&S->runs[k], 0, sizeof S->runs[k]);
       if (A->nxin) {
-        int e = input_setup(&S->xinp[k], A->xin[k], A->amp, m, A->dt);
+        int e = input_setup(&S->xinp[k], "--X-input", A->xin[k], A->amp, m, A->dt);
         if (e) return e;
         S->runs[k].u = input_fn; S->runs[k].user = &S->xinp[k];
         S->runs[k].x0 = X + col * (size_t)N;
@@ -1300,6 +1780,15 @@ static int load_snapshot_files(const reduce_args *A, reduce_state *S, int N, int
       col += (size_t)c;
     }
     S->nrun = A->nx;
+  }
+  if (A->nxin) {
+    const cli_input *ins[16];
+    for (k = 0; k < A->nx; ++k) {
+      ins[k] = &S->xinp[k];
+      input_covers(&S->xinp[k], A->xin[k], "--X-input", S->runs[k].nsteps * A->dt);
+    }
+    note_ports(ins, A->nx, m);
+    if ((k = check_x_inputs(A, S, N, m)) != 0) return k;
   }
   for (k = 0; k < A->nx; ++k)
     progress("snapshots: %s, %d states%s%s", A->xs[k], k ? S->Xs[k].cols : S->X.cols, A->nxin ? ", input " : "",
@@ -1413,7 +1902,7 @@ static int load_system(const reduce_args *A, reduce_state *S) {
     if (S->sp && (rc = phgmg_ph_sparse_sep_idx(S->sp, nt, S->idx, NULL, &sys)) != PHGMG_OK)
       return fail("%s (--poly-idx): %s", A->poly_idx, phgmg_result_string(rc));
     sys.sep_w = A->poly_w ? S->pw.a : NULL;
-    if (load_family(A, S, &sys, nt)) return 1;
+    if (load_family(A, S, &sys, nt) || check_bounded_below(A, &sys)) return 1;
     progress("nonlinear part: %d terms, %s, polynomial degree %d, %d exponentials%s", nt,
              A->potential ? A->potential : "exp-polynomial", sys.poly_deg, sys.nexp,
              sys.phi_nfun > 1 ? " (one function per term)" : "");
@@ -1473,9 +1962,14 @@ static int simulate_training_runs(const reduce_args *A, reduce_state *S, const d
   double *x0;
   int done = 0;
   const int nrun = A->ntrain ? A->ntrain : 1;
-  if ((k = input_setup(&S->in, A->input, A->amp, m, A->dt)) != 0) return k;
+  if ((k = input_setup(&S->in, A->ntrain ? "--train-input" : "--input", A->input, A->amp, m, A->dt)) != 0) return k;
   for (i = 1; i < nrun; ++i)
-    if ((k = input_setup(&S->tin[i], A->train[i], A->amp, m, A->dt)) != 0) return k;
+    if ((k = input_setup(&S->tin[i], "--train-input", A->train[i], A->amp, m, A->dt)) != 0) return k;
+  {
+    const cli_input *ins[16];
+    for (i = 0; i < nrun; ++i) ins[i] = i ? &S->tin[i] : &S->in;
+    note_ports(ins, nrun, m);
+  }
   ns = nrun * (A->steps + 1);
   if (too_big(((double)N + (double)m) * (double)ns, "--simulate: the snapshots (N x (steps+1)) and outputs"))
     return 2;
@@ -1489,6 +1983,7 @@ static int simulate_training_runs(const reduce_args *A, reduce_state *S, const d
   for (i = 0; i < nrun; ++i) {   /* run i in columns i (steps + 1) ..; from x0 = 0 */
     cli_input *in = i ? &S->tin[i] : &S->in;
     const size_t c0 = (size_t)i * (size_t)(A->steps + 1);
+    input_covers(in, i ? A->train[i] : A->input, A->ntrain ? "--train-input" : "--input", A->steps * A->dt);
     progress("simulating the full model: %d steps of dt = %g, %s", A->steps, A->dt,
              input_desc(in, i ? A->train[i] : A->input));
     in->report = 1;
@@ -1520,6 +2015,40 @@ static int default_rn(int N, int r, int m) {
   int rn = PHGMG__MIN(8, N - r);
   if (r > m) rn = PHGMG__MIN(rn, 4096 / (r - m));
   return PHGMG__MAX(rn, 1);
+}
+
+/* The spectral radius of the step map Phi (r x r), from above:
+   ||Phi^k||_F^(1/k) for k = 2^30 by repeated squaring, normalised at every
+   square (no overflow). For a pH model the eigenvalues of modulus 1 are
+   semisimple, so the estimate exceeds the radius by at most a factor
+   cond^(1/k) ~ 1 + 1e-8. INFINITY if Phi holds NaN/Inf. */
+static double step_map_radius(const phgmg_rom *rom) {
+  const int r = rom->r;
+  double *A = (double *)malloc(sizeof(double) * 2 * (size_t)r * (size_t)r), *B, L = 0.0, s;
+  int it, i, j, k;
+  if (!A) return NAN;
+  B = A + (size_t)r * r;
+  for (i = 0; i < r * r; ++i) A[i] = (double)rom->Phi[i];
+  for (it = 0; it <= 30; ++it) {
+    double f = 0.0;
+    for (s = 0.0, i = 0; i < r * r; ++i) s = PHGMG__MAX(s, fabs(A[i])); /* scale first: no overflow in the norm */
+    if (!isfinite(s)) { free(A); return INFINITY; }
+    if (s == 0.0) { free(A); return 0.0; }
+    for (i = 0; i < r * r; ++i) { A[i] /= s; f += A[i] * A[i]; }
+    f = sqrt(f);
+    for (i = 0; i < r * r; ++i) A[i] /= f;   /* A = Phi^(2^it) / ||Phi^(2^it)||_F */
+    L += log(s * f) / ldexp(1.0, it);       /* L = log ||Phi^(2^it)||_F / 2^it */
+    if (it == 30) break;
+    for (j = 0; j < r; ++j) /* B = A A */
+      for (i = 0; i < r; ++i) {
+        double t = 0.0;
+        for (k = 0; k < r; ++k) t += A[i + (size_t)k * r] * A[k + (size_t)j * r];
+        B[i + (size_t)j * r] = t;
+      }
+    memcpy(A, B, sizeof(double) * (size_t)r * r);
+  }
+  free(A);
+  return exp(L);
 }
 
 /* phgmg_reduce with the options of the command line; reports what it did. */
@@ -1565,6 +2094,10 @@ static int run_reduction(const reduce_args *A, reduce_state *S, int method, cons
         return fail("reduction failed: %s (%s, or the port matrix %s)", phgmg_result_string(rc), src, A->B);
       case PHGMG_ERR_DEGENERATE:
         return fail("reduction failed: %s (try another --r, or for gmg-qm a larger --lambda)", phgmg_result_string(rc));
+      case PHGMG_ERR_STEP_MAP:
+        return fail("reduction failed: --dt-map %g: %s (or --dt-map 0: none)", A->dt_map, phgmg_result_string(rc));
+      case PHGMG_ERR_TOL_UNREACHABLE:
+        return fail("reduction failed: --hyper-tol %g: %s", A->hyper_tol, phgmg_result_string(rc));
       case PHGMG_ERR_NEGATIVE_WEIGHT:
         return fail("reduction failed: %s (use --deim-allow-negative, a smaller --deim-tol, or --no-deim)",
                     phgmg_result_string(rc));
@@ -1579,10 +2112,22 @@ static int run_reduction(const reduce_args *A, reduce_state *S, int method, cons
   rom = phgmg_reduced_rom(S->red);
   progress("  done in %.2f s: r = %d, m = %d%s; sigma_{r'+1}/sigma_1 = %.3g, rcond(D^T G D) = %.3g", *t_red, rom->r,
            rom->m, rom->nd ? "" : ", quadratic energy", info.pod_sigma_ratio, info.rcond_dgd);
-  if (method == PHGMG_METHOD_GMG_QM && (A->lambda_auto || A->manifold))
+  if (method == PHGMG_METHOD_GMG_QM && A->lambda_auto == 1 && A->X && !A->nxin)
+    note("gmg-qm with --X and no --X-input: the inputs of the runs are unknown, so no lambda can be validated "
+         "by simulation: M = 0 (the GMG-POD model on the same basis). Give --X-input for the validated "
+         "choice, or a fixed --lambda");
+  else if (method == PHGMG_METHOD_GMG_QM && (A->lambda_auto || A->manifold))
     progress("  manifold %s, lambda %s: %.3g%s", A->manifold_s ? A->manifold_s : "pod",
              A->lambda_auto == 1 ? "auto" : A->lambda_auto == 2 ? "cv" : "fixed", info.lambda,
              info.lambda == HUGE_VAL ? " (M = 0: no safe quadratic correction found)" : "");
+  if (rom->Phi) { /* the precomputed step map must not amplify: spectral radius <= 1 */
+    const double rho = step_map_radius(rom);
+    progress("  step map for dt = %g: spectral radius %.6g", A->dt_map, rho);
+    if (!(rho <= 1.0 + 1e-6))
+      return fail("--dt-map %g: the step map is unstable (spectral radius %.3g > 1), while the model never gains "
+                  "energy; use a smaller --dt-map (or --dt-map 0: none, the stepper then solves each step)",
+                  A->dt_map, rho);
+  }
   if (info.pod_randomized)
     progress("  POD: %s (a-posteriori check %.2g)", info.pod_randomized > 0 ? "randomized (large snapshot set)"
              : "exact SVD (the randomized POD failed its check)", info.pod_check);
@@ -1604,7 +2149,7 @@ static int write_arrays(const reduce_args *A, reduce_state *S, const double *X, 
   rom_field fields[24];
   int i, k, nf;
   /* --- outputs --- */
-  if (mkdir_p(A->out)) return 1;
+  if (mkdir_p(A->out, &S->sg)) return 1;
   memset(ol, 0, sizeof *ol);
   nf = rom_fields(rom, fields);
   {
@@ -1651,6 +2196,13 @@ static int write_arrays(const reduce_args *A, reduce_state *S, const double *X, 
     if (write_field(A->out, A->name, "fom_y", Y, m, ns, ol, &S->sg)) return 1;
   }
   return 0;
+}
+
+/* The hyper-reduction of the run: ecsw, qdeim, greedy, or none (no nonlinear
+   part, or --no-deim: every term kept). */
+static const char *hyper_name(const reduce_args *A, const phgmg_reduce_opts *o) {
+  if (!A->poly_idx || !o->deim) return "none";
+  return o->hyper == PHGMG_HYPER_ECSW ? "ecsw" : o->hyper == PHGMG_HYPER_QDEIM ? "qdeim" : "greedy";
 }
 
 /* NAME.json: what was reduced, how, and where the outputs are. */
@@ -1712,23 +2264,51 @@ static int write_json(const reduce_args *A, reduce_state *S, int method, int ns,
     fprintf(jf, ", \"newton_iter\": %d, \"seconds\": ", A->newton_iter); json_num(jf, t_sim);
     fprintf(jf, "}");
   }
-  fprintf(jf, "},\n  \"options\": {\"rn\": %d, \"lambda\": ", o->rn);
-  if (A->lambda_auto) json_str(jf, A->lambda_auto == 1 ? "auto" : "cv");
-  else json_num(jf, A->lambda);
-  fprintf(jf, ", \"lambda_used\": ");
-  json_num(jf, info->lambda == HUGE_VAL ? -1.0 : info->lambda);
-  fprintf(jf, ", \"manifold\": ");
-  json_str(jf, A->manifold_s ? A->manifold_s : "pod");
-  fprintf(jf, ", \"training_runs\": %d", S->nrun);
-  fprintf(jf, ", \"deim\": %s, \"deim_tol\": ", o->deim ? "true" : "false");
-  json_num(jf, A->deim_tol);
-  fprintf(jf, ", \"deim_max\": %d, \"deim_allow_negative\": %s},\n", A->deim_max, A->deim_neg ? "true" : "false");
+  fprintf(jf, "},\n  \"options\": {");
+  if (method == PHGMG_METHOD_GMG_QM) { /* lambda, r_n and the manifold are gmg-qm's */
+    fprintf(jf, "\"rn\": %d, \"lambda\": ", o->rn);
+    if (A->lambda_auto) json_str(jf, A->lambda_auto == 1 ? "auto" : "cv");
+    else json_num(jf, A->lambda);
+    fprintf(jf, ", \"lambda_used\": ");
+    json_num(jf, info->lambda == HUGE_VAL ? -1.0 : info->lambda);
+    if (A->lambda_auto == 1 && A->X && !A->nxin)
+      fprintf(jf, ", \"lambda_note\": \"M = 0: the inputs of the --X runs are unknown (no --X-input)\"");
+    fprintf(jf, ", \"manifold\": ");
+    json_str(jf, A->manifold_s ? A->manifold_s : "pod");
+    fprintf(jf, ", ");
+  }
+  fprintf(jf, "\"training_runs\": %d", S->nrun);
+  fprintf(jf, ", \"hyper\": ");
+  json_str(jf, hyper_name(A, o));
+  if (o->deim && o->hyper == PHGMG_HYPER_ECSW) {
+    fprintf(jf, ", \"hyper_tol\": ");
+    json_num(jf, A->hyper_tol > 0.0 ? A->hyper_tol : 1e-6);
+  }
+  fprintf(jf, ", \"deim\": %s", o->deim && o->hyper != PHGMG_HYPER_ECSW ? "true" : "false");
+  if (o->deim && o->hyper != PHGMG_HYPER_ECSW) {
+    fprintf(jf, ", \"deim_tol\": ");
+    json_num(jf, A->deim_tol);
+    fprintf(jf, ", \"deim_max\": %d, \"deim_allow_negative\": %s", A->deim_max, A->deim_neg ? "true" : "false");
+  }
+  fprintf(jf, "},\n");
   fprintf(jf, "  \"info\": {\"pod_sigma_ratio\": ");
   json_num(jf, info->pod_sigma_ratio);
   fprintf(jf, ", \"rcond_jr\": "); json_num(jf, info->rcond_jr);
   fprintf(jf, ", \"rcond_dgd\": "); json_num(jf, info->rcond_dgd);
-  fprintf(jf, ", \"deim_modes\": %d, \"deim_negative\": %d, \"deim_sigma_ratio\": ", info->deim_modes, info->deim_negative);
-  json_num(jf, info->deim_sigma_ratio);
+  if (o->deim && A->poly_idx) { /* the hyper-reduction's result */
+    fprintf(jf, ", \"hyper\": {\"method\": ");
+    json_str(jf, hyper_name(A, o));
+    fprintf(jf, ", \"points\": %d, \"negative_weights\": %d, \"min_weight\": ", info->deim_modes, info->deim_negative);
+    json_num(jf, info->hyper_min_weight);
+    if (o->hyper == PHGMG_HYPER_ECSW) {
+      fprintf(jf, ", \"tol\": "); json_num(jf, A->hyper_tol > 0.0 ? A->hyper_tol : 1e-6);
+      fprintf(jf, ", \"residual\": "); json_num(jf, info->hyper_residual);
+    } else {
+      fprintf(jf, ", \"tol\": "); json_num(jf, A->deim_tol);
+      fprintf(jf, ", \"sigma_ratio\": "); json_num(jf, info->deim_sigma_ratio);
+    }
+    fprintf(jf, "}");
+  }
   fprintf(jf, ", \"reduce_seconds\": "); json_num(jf, t_red);
   fprintf(jf, "},\n  \"stepper_memsize_bytes\": %lu,\n", (unsigned long)phgmg_rom_stepper_memsize(rom));
   fprintf(jf, "  \"reconstruction\": \"%s\",\n",
@@ -1747,7 +2327,6 @@ static int write_json(const reduce_args *A, reduce_state *S, int method, int ns,
 static int write_model_files(const reduce_args *A, reduce_state *S, int method, int ns, double t_sim, double t_red,
                              const phgmg_reduce_opts *o, const phgmg_reduce_info *info, const outlist *ol) {
   const phgmg_rom *rom = phgmg_reduced_rom(S->red);
-  const int N = S->sys.N;
   phgmg_result rc;
   char path[4096 + 256];
   const char *wp;
@@ -1759,38 +2338,107 @@ static int write_model_files(const reduce_args *A, reduce_state *S, int method, 
   if (!(wp = stage_path(&S->sg, path))) return 1;
   rc = phgmg_rom_export_c(rom, A->name, wp);
   if (rc != PHGMG_OK) return fail("%s: cannot write the C source: %s", path, phgmg_result_string(rc));
+  return write_json(A, S, method, ns, t_sim, t_red, o, info, ol);
+}
 
-  if (write_json(A, S, method, ns, t_sim, t_red, o, info, ol)) return 1;
+/* Every output of the run moves into place; then the arrays an earlier run
+   recorded and this one did not write are removed. */
+static int reduce_commit(const reduce_args *A, reduce_state *S) {
+  const phgmg_rom *rom = phgmg_reduced_rom(S->red);
+  outlist rec;
+  read_record(A->out, A->name, &rec); /* before this run's record replaces it */
   if (stage_commit(&S->sg)) return 1;
-  remove_stale(A->out, A->name, ol);
-
+  remove_stale(A->out, &rec, &S->ol);
   printf("wrote %s/%s.phgmgrom, %s/%s.c, %s/%s.json and %d arrays %s/%s_*.npy (%s, r = %d, m = %d, N = %d)\n",
-         A->out, A->name, A->out, A->name, A->out, A->name, ol->n, A->out, A->name, method_name(method), rom->r,
-         rom->m, N);
+         A->out, A->name, A->out, A->name, A->out, A->name, S->ol.n, A->out, A->name, method_name(S->method),
+         rom->r, rom->m, S->sys.N);
   return 0;
 }
 
-static int cmd_reduce_impl(const reduce_args *A, reduce_state *S) {
+/* The files a run reads (every file option; validate: also its test inputs)
+   and the files it may write (every output its options can produce, with the
+   temporary names of the staged writes) into S->pin, S->pout. */
+static void reduce_paths(const reduce_args *A, reduce_state *S, const char *const *tests, int nt) {
+  const char *const files[] = {A->J, A->R, A->B, A->Q, A->poly, A->poly_idx, A->poly_w, A->expf,
+                               A->E, A->Pf, A->Sf, A->Nf};
+  const char *const fopt[] = {"--J", "--R", "--B", "--Q", "--poly", "--poly-idx", "--poly-w", "--exp",
+                              "--E", "--P", "--S", "--N"};
+  const char *const coo[] = {A->Jcoo, A->Rcoo, A->Qcoo, A->Ecoo};
+  const char *const cooopt[] = {"--J-coo", "--R-coo", "--Q-coo", "--E-coo"};
+  char path[4096 + 256];
+  int k;
+  for (k = 0; k < 12; ++k)
+    if (files[k]) paths_add(&S->pin, fopt[k], files[k], 0);
+  for (k = 0; k < 4; ++k) { /* FILE or rows,cols,vals */
+    const char *a = coo[k];
+    while (a) {
+      const char *c = strchr(a, ',');
+      const size_t l = c ? (size_t)(c - a) : strlen(a);
+      if (l < sizeof path) { memcpy(path, a, l); path[l] = '\0'; paths_add(&S->pin, cooopt[k], path, 0); }
+      a = c ? c + 1 : NULL;
+    }
+  }
+  for (k = 0; k < A->nx; ++k) paths_add(&S->pin, "--X", A->xs[k], 0);
+  for (k = 0; k < A->nxin; ++k) paths_add_input(&S->pin, "--X-input", A->xin[k]);
+  for (k = 0; k < A->ntrain; ++k) paths_add_input(&S->pin, "--train-input", A->train[k]);
+  if (!A->ntrain && A->simulate) paths_add_input(&S->pin, "--input", A->input);
+  for (k = 0; k < nt; ++k) paths_add_input(&S->pin, "--test-input", tests[k]);
+  snprintf(path, sizeof path, "%s/%s.phgmgrom", A->out, A->name); paths_add(&S->pout, "--out/--name", path, 1);
+  snprintf(path, sizeof path, "%s/%s.c", A->out, A->name); paths_add(&S->pout, "--out/--name", path, 1);
+  snprintf(path, sizeof path, "%s/%s.json", A->out, A->name); paths_add(&S->pout, "--out/--name", path, 1);
+  for (k = 0; all_fields[k]; ++k) {
+    if (!A->save_snap && (!strcmp(all_fields[k], "snapshots") || !strcmp(all_fields[k], "fom_y"))) continue;
+    snprintf(path, sizeof path, "%s/%s_%s.npy", A->out, A->name, all_fields[k]);
+    paths_add(&S->pout, "--out/--name", path, 1);
+  }
+}
+
+/* The method code of --method, or -1. */
+static int method_code(const char *m) {
+  if (!strcmp(m, "gmg-pod")) return PHGMG_METHOD_GMG_POD;
+  if (!strcmp(m, "gmg-qm")) return PHGMG_METHOD_GMG_QM;
+  if (!strcmp(m, "sp1")) return PHGMG_METHOD_SP1;
+  if (!strcmp(m, "sp2")) return PHGMG_METHOD_SP2;
+  return -1;
+}
+
+/* Everything that can be checked before any computation: the method, no
+   output an input or another output, the output directory usable, the files
+   read and the system valid, the sizes. */
+static int reduce_prepare(const reduce_args *A, reduce_state *S, const char *const *tests, int nt) {
+  int e;
+  if ((S->method = method_code(A->method)) < 0)
+    return usage_error("--method '%s': expected gmg-pod, gmg-qm, sp1 or sp2", A->method);
+  reduce_paths(A, S, tests, nt);
+  if ((e = check_collisions("reduce", &S->pin, &S->pout)) != 0) return e;
+  g_inputs = &S->pin;
+  if (check_writable_dir(A->out, "--out", A->out, 1)) return 1;
+  if ((e = load_system(A, S)) != 0) return e;
+  if ((e = check_sizes(A, S->method, S->sys.N, S->sys.m)) != 0) return e;
+  return A->X ? load_snapshot_files(A, S, S->sys.N, S->sys.m, &S->Xd, &S->ns) : 0;
+}
+
+/* The snapshots, the reduction and every output written under its temporary
+   name (reduce_commit moves them into place). */
+static int reduce_build(const reduce_args *A, reduce_state *S) {
   phgmg_reduce_opts o;
   phgmg_reduce_info info;
-  outlist ol;
   double t_sim = 0.0, t_red = 0.0;
-  const double *X = NULL;
-  int ns = 0, method, e;
+  const double *X = S->Xd;
+  int ns = S->ns, e;
   memset(&o, 0, sizeof o);
   memset(&info, 0, sizeof info);
-  if (!strcmp(A->method, "gmg-pod")) method = PHGMG_METHOD_GMG_POD;
-  else if (!strcmp(A->method, "gmg-qm")) method = PHGMG_METHOD_GMG_QM;
-  else if (!strcmp(A->method, "sp1")) method = PHGMG_METHOD_SP1;
-  else if (!strcmp(A->method, "sp2")) method = PHGMG_METHOD_SP2;
-  else return usage_error("--method '%s': expected gmg-pod, gmg-qm, sp1 or sp2", A->method);
-  if ((e = load_system(A, S)) != 0) return e;
-  if ((e = check_sizes(A, method, S->sys.N, S->sys.m)) != 0) return e;
-  e = A->X ? load_snapshot_files(A, S, S->sys.N, S->sys.m, &X, &ns) : simulate_training_runs(A, S, &X, &ns, &t_sim);
-  if (e) return e;
-  if ((e = run_reduction(A, S, method, X, ns, &o, &info, &t_red)) != 0) return e;
-  if ((e = write_arrays(A, S, X, ns, &ol)) != 0) return e;
-  return write_model_files(A, S, method, ns, t_sim, t_red, &o, &info, &ol);
+  if (!A->X && (e = simulate_training_runs(A, S, &X, &ns, &t_sim)) != 0) return e;
+  if ((e = run_reduction(A, S, S->method, X, ns, &o, &info, &t_red)) != 0) return e;
+  if ((e = write_arrays(A, S, X, ns, &S->ol)) != 0) return e;
+  return write_model_files(A, S, S->method, ns, t_sim, t_red, &o, &info, &S->ol);
+}
+
+static int cmd_reduce_impl(const reduce_args *A, reduce_state *S) {
+  int e;
+  if ((e = reduce_prepare(A, S, NULL, 0)) != 0) return e;
+  if ((e = reduce_build(A, S)) != 0) return e;
+  return reduce_commit(A, S);
 }
 
 static int cmd_reduce(int argc, char **argv) {
@@ -1834,8 +2482,11 @@ static int cmd_simulate_rom(int argc, char **argv) {
   staged sg;
   const char *seen[64], *wp;
   int nseen = 0;
+  pathset pin, pout; /* the files read; the files written */
   memset(&in, 0, sizeof in);
   memset(&sg, 0, sizeof sg);
+  memset(&pin, 0, sizeof pin);
+  memset(&pout, 0, sizeof pout);
   for (i = 2; i < argc; ++i) {
     const char *o = argv[i], *v;
     if (!strcmp(o, "--help") || !strcmp(o, "-h")) { print_help(); return 0; }
@@ -1857,14 +2508,23 @@ static int cmd_simulate_rom(int argc, char **argv) {
     else return usage_error("simulate-rom: unknown option '%s'", o);
   }
   if (!model || !out) return usage_error("simulate-rom: --model FILE and --out FILE are required");
-  if (load_model(model, "--model", &rom, &block)) return 1;
+  paths_add(&pin, "--model", model, 0);
+  paths_add_input(&pin, "--input", inspec);
+  paths_add(&pout, "--out", out, 1);
+  if (states) paths_add(&pout, "--states", states, 1);
+  if ((status = check_collisions("simulate-rom", &pin, &pout)) != 0) goto done;
+  status = 1;
+  if (check_out_file(out, "--out") || (states && check_out_file(states, "--states"))) goto done;
+  g_inputs = &pin;
+  if (load_model(model, "--model", &rom, &block)) goto done;
   if (!have_dt) dt = rom.Phi ? (double)rom.dt : 0.1;
   if (too_big(((double)rom.m + (states ? (double)rom.r : 0.0)) * ((double)steps + 1.0),
               "--steps: the outputs (m x (steps+1), states r x (steps+1))")) {
     status = 2;
     goto done;
   }
-  if ((status = input_setup(&in, inspec, amp, rom.m, dt)) != 0) goto done;
+  if ((status = input_setup(&in, "--input", inspec, amp, rom.m, dt)) != 0) goto done;
+  input_covers(&in, inspec, "--input", steps * dt);
   status = 1;
   msz = phgmg_rom_stepper_memsize_dt(&rom, (phgmg_real)dt);
   nreal = (size_t)rom.r + 4 * (size_t)rom.m + phgmg_rom_eval_work_size(&rom);
@@ -1921,6 +2581,8 @@ static int cmd_simulate_rom(int argc, char **argv) {
   status = 0;
 done:
   stage_abort(&sg);
+  g_inputs = NULL;
+  paths_free(&pin); paths_free(&pout);
   mat_free(&in.tab);
   free(mem); free(x); free(Y); free(XR); free(block);
   return status;
@@ -1967,69 +2629,164 @@ static int cmd_info(int argc, char **argv) {
    training envelope (outside) and with a quadratic correction above the
    training maximum (q-out), and the first failing step. Exit status 1 if any test fails (a Newton failure in the reduced run,
    or e_y above --max-ey, default 0.1); 0 if all pass; 2 bad usage. */
+/* validate's own options, taken out of the command line (the rest is
+   reduce's). Returns 0 or the usage status 2. */
+typedef struct validate_args {
+  const char *tests[16];
+  int nt, steps_t, have_amp;
+  double amp_t, max_ey;
+} validate_args;
+
+static int parse_validate(int argc, char **argv, validate_args *V, const char **reduce_argv, int *rargc) {
+  const char *seen[8];
+  int i, nseen = 0;
+  memset(V, 0, sizeof *V);
+  V->max_ey = 0.1;
+  *rargc = 0;
+  for (i = 0; i < argc; ++i) {
+    const char *o = argv[i], *v;
+    const int mine = i >= 2 && (!strcmp(o, "--test-input") || !strcmp(o, "--test-amp") ||
+                                !strcmp(o, "--test-steps") || !strcmp(o, "--max-ey"));
+    if (!mine) {
+      if (*rargc >= 255) return usage_error("validate: too many arguments");
+      reduce_argv[(*rargc)++] = o;
+      continue;
+    }
+    if (!(v = optval(argc, argv, &i))) return 2;
+    if (!strcmp(o, "--test-input")) {   /* repeatable: one test each */
+      if (V->nt >= 16) return usage_error("validate: at most 16 --test-input");
+      V->tests[V->nt++] = v;
+      continue;
+    }
+    if (repeated_opt(o, seen, &nseen)) return 2;
+    if (!strcmp(o, "--test-amp")) {
+      if (!parse_double(o, v, -HUGE_VAL, &V->amp_t)) return 2;
+      V->have_amp = 1;
+    } else if (!strcmp(o, "--test-steps")) {
+      if (!parse_int(o, v, 1, INT_MAX - 1, &V->steps_t)) return 2;
+      if (too_big((double)V->steps_t + 1.0, "--test-steps: the full model's trajectory (N x (steps+1)) alone"))
+        return 2; /* N >= 1: a first check before reading J */
+    } else { /* --max-ey */
+      if (!parse_double(o, v, 0.0, &V->max_ey)) return 2;
+      if (!(V->max_ey > 0.0)) return usage_error("--max-ey %s: the bound on e_y must be > 0", v);
+    }
+  }
+  reduce_argv[*rargc] = NULL;
+  return 0;
+}
+
+/* A test that could not be made: the reason in the user's terms. */
+static int validate_error(const char *spec, phgmg_result rc, const reduce_state *S, int nsteps) {
+  if (rc == PHGMG_ERR_OVERFLOW)
+    return fail("validate: %s: the states or the error norms overflow the double range (try a smaller "
+                "--test-amp)", spec);
+  if (rc == PHGMG_ERR_NANINF)
+    return fail("validate: %s: the full model's run overflows or meets NaN (states beyond the double range; "
+                "try a smaller --test-amp)", spec);
+  if (rc == PHGMG_ERR_NOMEM) { /* the library's error norms gave NaN, or memory is short: tell which */
+    const phgmg_rom *rom = phgmg_reduced_rom(S->red);
+    void *p = malloc(sizeof(double) * ((size_t)S->sys.N + 2 * (size_t)S->sys.m + (size_t)rom->r + 8) *
+                     ((size_t)nsteps + 1));
+    free(p);
+    if (p)
+      return fail("validate: %s: the error norms overflow the double range (states of magnitude 1e154 or more: "
+                  "try a smaller --test-amp)", spec);
+  }
+  if (rc == PHGMG_ERR_NOT_CONVERGED)
+    return fail("validate: %s: the full model's run failed: %s (try a smaller --dt or more --newton-iter)", spec,
+                phgmg_result_string(rc));
+  return fail("validate: %s: %s", spec, phgmg_result_string(rc));
+}
+
+/* One test of validate: full and reduced model on input `spec` over nsteps
+   from x0 (NULL: 0); prints its line; 0 pass, 1 fail or error. */
+static int validate_one(const reduce_args *A, reduce_state *S, cli_input *in, const char *spec, int nsteps,
+                        const double *x0, double max_ey) {
+  const phgmg_ph_system sys = S->sys;   /* as reduced: any potential, sparse input in its internal order */
+  phgmg_run run;
+  phgmg_validation v;
+  phgmg_result rc;
+  memset(&run, 0, sizeof run);
+  run.u = input_fn; run.user = in; run.dt = A->dt; run.nsteps = nsteps; run.x0 = x0;
+  rc = phgmg_reduced_validate(S->red, &sys, &run, A->newton_tol, A->newton_iter, max_ey, &v, NULL);
+  if (rc != PHGMG_OK) return validate_error(spec, rc, S, nsteps);
+  printf("%-24s %10.3e %10.3e %10.3e %10.3e %10.3e %8.2f %8ld %8ld %8d  %s\n", spec, v.e_red, v.e_y, v.e_proj,
+         v.e_energy, v.e_energy_fom, v.stats.steps ? (double)v.stats.newton_iters / v.stats.steps : 0.0,
+         v.stats.outside_steps, v.stats.q_outside_steps, v.first_failure, v.pass ? "pass" : "FAIL");
+  if (v.first_failure >= 0) {
+    printf("  first failing step: %d (t = %g -> %g): %s\n", v.first_failure, v.first_failure * A->dt,
+           (v.first_failure + 1) * A->dt, phgmg_result_string(v.rom_rc));
+    return 1;
+  }
+  if (!(isfinite(v.e_y) && isfinite(v.e_red) && isfinite(v.e_proj))) {
+    printf("  the error norms overflow the double range (states too large; try a smaller --test-amp)\n");
+    return 1;
+  }
+  if (v.pass) return 0;
+  printf("  e_y %.3e above --max-ey %g\n", v.e_y, max_ey);
+  return 1;
+}
+
+/* ---- validate: reduce, then check the reduced model against the full one ----
+   phgmg validate <every option of reduce> [--test-input KIND]... [--test-amp A]
+                  [--test-steps N] [--max-ey E]
+   Builds the reduced model as reduce does, then runs full and reduced model on
+   each test input (KIND as --input; default: the training input(s), with --X
+   the --X-input runs from their first snapshot) with phgmg_reduced_validate
+   and prints e_red, e_y, e_proj, the energy error, Newton statistics
+   (iterations per step), the steps outside the training envelope (outside)
+   and with a quadratic correction above the training maximum (q-out), and
+   the first failing step. Each test runs --test-steps steps, default the
+   length of the training run. The outputs are written (as reduce writes
+   them) only when every test passes: a failing model never replaces the one
+   under --out. Exit status 1 if any test fails (a Newton failure in the
+   reduced run, or e_y above --max-ey, default 0.1); 0 if all pass; 2 bad
+   usage. Every option and test input is checked before any computation. */
 static int cmd_validate(int argc, char **argv) {
-  const char *tests[16], *reduce_argv[256];
-  double amp_t = -HUGE_VAL, max_ey = 0.1;
-  int nt = 0, rargc = 0, steps_t = 0, i, k, status = 0;
+  const char *reduce_argv[256];
+  validate_args V;
+  cli_input tin[16];
+  int steps[16], from_x[16];
+  int rargc = 0, i, k, status = 0, nt;
   reduce_args A;
   reduce_state S;
-  for (i = 0; i < argc; ++i) {
-    const char *v;
-    if (i >= 2 && !strcmp(argv[i], "--test-input")) {
-      if (!(v = optval(argc, argv, &i))) return 2;
-      if (nt >= 16) return usage_error("validate: at most 16 --test-input");
-      tests[nt++] = v;
-    } else if (i >= 2 && !strcmp(argv[i], "--test-amp")) {
-      if (!(v = optval(argc, argv, &i)) || !parse_double("--test-amp", v, -HUGE_VAL, &amp_t)) return 2;
-    } else if (i >= 2 && !strcmp(argv[i], "--test-steps")) {
-      if (!(v = optval(argc, argv, &i)) || !parse_int("--test-steps", v, 1, INT_MAX - 1, &steps_t)) return 2;
-    } else if (i >= 2 && !strcmp(argv[i], "--max-ey")) {
-      if (!(v = optval(argc, argv, &i)) || !parse_double("--max-ey", v, 0.0, &max_ey)) return 2;
-    } else {
-      if (rargc >= 255) return usage_error("validate: too many arguments");
-      reduce_argv[rargc++] = argv[i];
-    }
-  }
-  reduce_argv[rargc] = NULL;
+  if ((i = parse_validate(argc, argv, &V, reduce_argv, &rargc)) != 0) return i;
   if ((i = parse_reduce(rargc, (char **)reduce_argv, &A)) != 0) return i;
+  nt = V.nt;
+  memset(from_x, 0, sizeof from_x);
   if (nt == 0 && A.ntrain)   /* default: the training inputs */
-    for (i = 0; i < A.ntrain; ++i) tests[nt++] = A.train[i];
-  if (nt == 0 && A.nxin)     /* --X: the inputs of the snapshot runs */
-    for (i = 0; i < A.nxin; ++i) tests[nt++] = A.xin[i];
+    for (i = 0; i < A.ntrain; ++i) V.tests[nt++] = A.train[i];
+  if (nt == 0 && A.nxin)     /* --X: the inputs of the snapshot runs, from their first snapshot */
+    for (i = 0; i < A.nxin; ++i) { from_x[nt] = 1; V.tests[nt++] = A.xin[i]; }
   if (nt == 0 && !A.simulate)
     return usage_error("validate: with --X give --test-input (or --X-input): the inputs that made the snapshots are unknown");
-  if (nt == 0) tests[nt++] = A.input;
+  if (nt == 0) V.tests[nt++] = A.input;
   memset(&S, 0, sizeof S);
-  status = cmd_reduce_impl(&A, &S);
+  memset(tin, 0, sizeof tin);
+  status = reduce_prepare(&A, &S, V.tests, nt);
+  for (k = 0; k < nt && !status; ++k) { /* every test input and run length, up front */
+    /* the training run's length: --steps, or the --X run's (the first run's for a --test-input) */
+    const int run = from_x[k] ? k : 0;
+    steps[k] = V.steps_t ? V.steps_t : !A.X ? A.steps : (run ? S.Xs[run].cols : S.X.cols) - 1;
+    status = input_setup(&tin[k], "--test-input", V.tests[k], V.have_amp ? V.amp_t : A.amp, S.sys.m, A.dt);
+    if (!status) input_covers(&tin[k], V.tests[k], "--test-input", steps[k] * A.dt);
+    if (!status && too_big(((double)S.sys.N + 2.0 * S.sys.m + A.r + 8.0) * ((double)steps[k] + 1.0),
+                           "validate: a test run (the full model's states and outputs, N x (steps+1))"))
+      status = 2;
+  }
+  if (!status) status = reduce_build(&A, &S);
   if (status == 0) {
-    const phgmg_ph_system sys = S.sys;   /* as reduced: any potential, sparse input in its internal order */
     printf("%-24s %10s %10s %10s %10s %10s %8s %8s %8s %8s  %s\n", "test input", "e_red", "e_y", "e_proj", "e_energy",
            "(FOM)", "newton", "outside", "q-out", "fail@", "verdict");
-    for (k = 0; k < nt; ++k) {
-      cli_input in;
-      phgmg_run run;
-      phgmg_validation v;
-      phgmg_result rc;
-      if (input_setup(&in, tests[k], amp_t > -HUGE_VAL ? amp_t : A.amp, sys.m, A.dt)) { status = 1; break; }
-      memset(&run, 0, sizeof run);
-      run.u = input_fn; run.user = &in; run.dt = A.dt; run.nsteps = steps_t ? steps_t : A.steps;
-      rc = phgmg_reduced_validate(S.red, &sys, &run, A.newton_tol, A.newton_iter, max_ey, &v, NULL);
-      mat_free(&in.tab);
-      if (rc != PHGMG_OK) { status = fail("validate: %s: %s", tests[k], phgmg_result_string(rc)); break; }
-      printf("%-24s %10.3e %10.3e %10.3e %10.3e %10.3e %8.2f %8ld %8ld %8d  %s\n", tests[k], v.e_red, v.e_y, v.e_proj,
-             v.e_energy, v.e_energy_fom, v.stats.steps ? (double)v.stats.newton_iters / v.stats.steps : 0.0,
-             v.stats.outside_steps, v.stats.q_outside_steps, v.first_failure, v.pass ? "pass" : "FAIL");
-      if (!v.pass) {
-        status = 1;
-        if (v.first_failure >= 0)
-          printf("  first failing step: %d (t = %g -> %g): %s\n", v.first_failure, v.first_failure * A.dt,
-                 (v.first_failure + 1) * A.dt, phgmg_result_string(v.rom_rc));
-        else
-          printf("  e_y %.3e above --max-ey %g\n", v.e_y, max_ey);
-      }
-    }
+    for (k = 0; k < nt; ++k)
+      if (validate_one(&A, &S, &tin[k], V.tests[k], steps[k], from_x[k] ? S.runs[k].x0 : NULL, V.max_ey)) status = 1;
     printf("validate: %s\n", status ? "FAILED" : "passed");
+    if (status == 0) status = reduce_commit(&A, &S);
+    else
+      printf("validate: the model was not written: %s/%s.* is unchanged (the same options with `phgmg reduce` "
+             "write the failing model)\n", A.out, A.name);
   }
+  for (k = 0; k < 16; ++k) mat_free(&tin[k].tab);
   reduce_cleanup(&S);
   return status;
 }
@@ -2048,5 +2805,6 @@ int main(int argc, char **argv) {
   if (!strcmp(argv[1], "simulate-rom")) return cmd_simulate_rom(argc, argv);
   if (!strcmp(argv[1], "info")) return cmd_info(argc, argv);
   if (!strcmp(argv[1], "validate")) return cmd_validate(argc, argv);
-  return usage_error("unknown command '%s' (expected reduce, simulate-rom or info)", argv[1]);
+  return usage_error("unknown command '%s' (expected reduce, validate, simulate-rom, info, --help or --version)",
+                     argv[1]);
 }

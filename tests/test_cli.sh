@@ -434,7 +434,7 @@ f = np.load("toda/a/m_fom_y.npy").ravel()
 e = np.linalg.norm(f - y["a"]) / np.linalg.norm(f)
 assert e < 1e-2, f"Toda ROM e_y = {e}"
 PYEOF
-  run_err "potential unknown" 1 "--potential 'tode'" "$P" reduce $TSYS --potential tode $TRUN --out toda/f
+  run_err "potential unknown" 2 "--potential 'tode'" "$P" reduce $TSYS --potential tode $TRUN --out toda/f
   run_err "potential and poly" 2 "replaces --poly" "$P" reduce $TSYS --potential toda --poly toda/poly.npy $TRUN --out toda/f
   run_err "hyper unknown" 2 "expected ecsw, qdeim or greedy" "$P" reduce $TSYS --potential toda --hyper nnls $TRUN --out toda/f
 else
@@ -518,6 +518,125 @@ np.save('S_ok.npy', 0.1 * np.eye(1)); np.save('S_neg.npy', -0.1 * np.eye(1))
   [ ! -e oSo ] && pass || bad "feedthrough refused: output written"
   run_err "--E with --J-coo" 2 "--E-coo" "$P" reduce --J-coo J.npy --R-coo R.npy --Q-coo Q.npy --B model/B.npy --E E_id.npy $SIM --method gmg-pod --r 12 --out oEc
 fi
+
+# ---- 9. issue 25: a run never removes or overwrites its inputs; outputs checked up front ----
+# Files are compared by identity (device and inode), however they are spelled.
+sums() { cksum "$@" 2>/dev/null; }
+run_ok "S1 snapshots into ds" "$P" reduce $SYS $QSIM --method gmg-pod --r 10 --out ds --name rom --save-snapshots
+sums ds/rom_snapshots.npy >s1_before.txt
+run_ok "S1 reduce --X ds/rom_snapshots.npy into ds" "$P" reduce $SYS --X ds/rom_snapshots.npy --X-input sin \
+  --method gmg-pod --r 10 --out ds --name rom
+sums ds/rom_snapshots.npy >s1_after.txt
+cmp -s s1_before.txt s1_after.txt && pass || bad "S1: reduce removed or changed its input ds/rom_snapshots.npy"
+grep -F -q "removed ds/rom_snapshots.npy" "$T/err.txt" && bad "S1: reduce says it removed its input" || pass
+# the arrays an earlier run recorded and this one does not write still go (fom_y), not the input
+[ -e ds/rom_fom_y.npy ] && bad "S1: the earlier run's rom_fom_y.npy was not removed" || pass
+# a file the user put beside the outputs, never recorded by a run, stays
+mkdir -p du && cp out/msd_V0.npy du/rom_M.npy
+run_ok "S1 user file beside" "$P" reduce $SYS $QSIM --method gmg-pod --r 10 --out du --name rom
+[ -e du/rom_M.npy ] && pass || bad "S1: reduce removed du/rom_M.npy, a file no run recorded as its output"
+# outputs that would overwrite inputs: refused up front (exit 2), the inputs unchanged
+mkdir -p dp && cp nl/poly.npy dp/model_poly.npy && cp nl/idx.npy dp/idx.npy
+if [ "$HAVE_NP" = 1 ]; then "$PY" -c "import numpy as np; np.save('dp/model_w.npy', np.ones(20))"
+else cp nl/idx.npy dp/model_w.npy; fi
+sums dp/model_poly.npy dp/model_w.npy >s2_before.txt
+run_err "S1 --poly-w is an output" 2 "dp/model_w.npy (--poly-w)" "$P" reduce --J nl/J.npy --R nl/R.npy --B nl/B.npy \
+  --Q nl/Q.npy --poly dp/model_poly.npy --poly-idx dp/idx.npy --poly-w dp/model_w.npy --deim-allow-negative $QSIM \
+  --method gmg-pod --r 10 --out dp --name model
+grep -F -q "reducing" "$T/err.txt" && bad "S1: the collision was found after the reduction" || pass
+ln -s dp dp_link
+run_err "S1 --poly-w through a symbolic link" 2 "(--poly-w)" "$P" reduce --J nl/J.npy --R nl/R.npy --B nl/B.npy \
+  --Q nl/Q.npy --poly nl/poly.npy --poly-idx dp/idx.npy --poly-w ./dp_link/../dp/model_w.npy --deim-allow-negative \
+  $QSIM --method gmg-pod --r 10 --out dp --name model
+ln dp/model_poly.npy dp/hard.npy
+run_err "S1 a hard link to an output" 2 "dp/hard.npy (--poly)" "$P" reduce --J nl/J.npy --R nl/R.npy --B nl/B.npy \
+  --Q nl/Q.npy --poly dp/hard.npy --poly-idx dp/idx.npy --deim-allow-negative $QSIM --method gmg-pod --r 10 \
+  --out dp --name model
+sums dp/model_poly.npy dp/model_w.npy >s2_after.txt
+cmp -s s2_before.txt s2_after.txt && pass || bad "S1: a refused run changed dp/model_poly.npy or dp/model_w.npy"
+run_err "S1 --X is --save-snapshots' output" 2 "(--X)" "$P" reduce $SYS --X ds/rom_snapshots.npy --method gmg-pod \
+  --r 10 --out ds/. --name rom --save-snapshots
+# 4: simulate-rom's outputs: not the model, not each other
+cp out/msd.phgmgrom sm.phgmgrom
+sums sm.phgmgrom >s4_before.txt
+run_err "S4 --out is --model" 2 "(--model)" "$P" simulate-rom --model sm.phgmgrom --steps 10 --out ./sm.phgmgrom
+run_err "S4 --states is --model" 2 "(--model)" "$P" simulate-rom --model sm.phgmgrom --steps 10 --out y4.npy \
+  --states sm.phgmgrom
+sums sm.phgmgrom >s4_after.txt
+cmp -s s4_before.txt s4_after.txt && pass || bad "S4: simulate-rom overwrote its --model"
+run_err "S4 --out is --states" 2 "the same file" "$P" simulate-rom --model sm.phgmgrom --steps 10 --out y4.npy \
+  --states ./y4.npy
+run_err "S4 --out is the --input file" 2 "(--input)" "$P" simulate-rom --model sm.phgmgrom --steps 10 \
+  --input u.npy --out u.npy
+[ -e y4.npy ] && bad "S4: a refused run wrote y4.npy" || pass
+# 13: unusable outputs are found before any computation
+run_err "S13 --out below a file" 1 "garbage.npy/sub (--out)" "$P" reduce $SYS $SIM --method gmg-pod --r 12 \
+  --out garbage.npy/sub
+grep -F -q "simulating" "$T/err.txt" && bad "S13: --out below a file found after the computation" || pass
+run_err "S13 simulate-rom --out nodir/y.npy" 1 "nodir/y.npy (--out)" "$P" simulate-rom --model out/msd.phgmgrom \
+  --out nodir/y.npy
+grep -F -q "simulating" "$T/err.txt" && bad "S13: simulate-rom --out nodir/ found after the simulation" || pass
+run_err "S13 simulate-rom --states nodir/x.npy" 1 "nodir/x.npy (--states)" "$P" simulate-rom --model out/msd.phgmgrom \
+  --out y13.npy --states nodir/x.npy
+grep -F -q "simulating" "$T/err.txt" && bad "S13: simulate-rom --states nodir/ found after the simulation" || pass
+
+# ---- 10. issue 25: option values refused up front, messages naming the right option ----
+if [ "$HAVE_NP" = 1 ]; then
+  TS="--J toda/J.npy --R toda/R.npy --Q toda/Q.npy --B toda/B.npy --poly-idx toda/idx.npy"
+  TR="--simulate --dt 0.1 --steps 100 --method gmg-pod --r 16"
+  # 8: --potential fields: empty or not a number, energies unbounded below, coefficient overflow
+  for pot in "fpu::" "fpu:1:" "morse::1" "fpu:1:x" "cosh:1:2" "fpu:1:-1" "morse:-1:1" "fpu:1:0" "cosh:1e-200" \
+             "morse:1e308:1"; do
+    run_err "P8 --potential $pot refused" 2 "--potential '$pot'" "$P" reduce $TS --potential "$pot" $TR --out p8
+    grep -F -q "simulating" "$T/err.txt" && bad "P8: --potential $pot found after the simulation" || pass
+  done
+  grep -F -q "double range" "$T/err.txt" || bad "P8: morse:1e308:1 not reported as an overflow"
+  "$PY" -c "import numpy as np; np.save('toda/neg.npy', np.array([0, 0, 0, 0, -0.25])); np.save('toda/negw.npy', -np.ones(40))"
+  run_err "P8 --poly with a negative leading coefficient" 1 "unbounded below" "$P" reduce $TS --poly toda/neg.npy \
+    $TR --out p8
+  grep -F -q "simulating" "$T/err.txt" && bad "P8: the unbounded --poly found after the simulation" || pass
+  run_err "P8 --potential toda with negative --poly-w" 1 "unbounded below" "$P" reduce $TS --potential toda \
+    --poly-w toda/negw.npy $TR --out p8
+  run_ok "P8 --potential fpu:-1:1 (bounded)" "$P" reduce $TS --potential fpu:-1:1 --simulate --steps 300 \
+    --method gmg-pod --r 12 --out p8 --quiet
+  # 10: options that do not apply are refused, not ignored
+  run_err "P10 --deim-tol 1" 2 "--deim-tol 1" "$P" reduce $TS --potential toda --hyper qdeim --deim-tol 1 $TR --out p10
+  run_err "P10 --hyper-tol with qdeim" 2 "--hyper-tol applies to --hyper ecsw" "$P" reduce $TS --potential toda \
+    --hyper qdeim --hyper-tol 1e-3 $TR --out p10
+  run_err "P10 --deim-tol with ecsw" 2 "apply to --hyper qdeim or greedy" "$P" reduce $TS --potential toda \
+    --deim-tol 1e-6 $TR --out p10
+  run_err "P10 --hyper without a nonlinear part" 2 "--hyper applies to a nonlinear part" "$P" reduce $SYS $QSIM \
+    --method gmg-pod --r 10 --hyper ecsw --out p10
+  run_err "P10 --lambda with gmg-pod" 2 "apply to --method gmg-qm only" "$P" reduce $SYS $QSIM --method gmg-pod \
+    --r 10 --lambda 1e-3 --out p10
+  run_err "P10 --rn with sp1" 2 "apply to --method gmg-qm only" "$P" reduce $SYS $QSIM --method sp1 --r 10 --rn 4 \
+    --out p10
+  [ -e p10 ] && bad "P10: a refused run wrote p10" || pass
+  # 7: an ECSW tolerance below double precision
+  run_err "P7 --hyper-tol 1e-300" 2 "below what double precision resolves" "$P" reduce $TS --potential toda \
+    --hyper-tol 1e-300 $TR --out p7
+  run_err "P7 --hyper-tol 0" 2 "--hyper-tol 0" "$P" reduce $TS --potential toda --hyper-tol 0 $TR --out p7
+fi
+# 23: messages name the option the value came from; every command listed
+run_err "P23 --train-input file" 1 "nofile.npy (--train-input)" "$P" reduce $SYS $QSIM --train-input sin \
+  --train-input nofile.npy --method gmg-pod --r 10 --out p23
+run_err "P23 --X-input file" 1 "nofile.npy (--X-input)" "$P" reduce $SYS --X out/msd_snapshots.npy \
+  --X-input nofile.npy --method gmg-pod --r 10 --out p23
+run_err "P23 --X-input kind" 2 "--X-input 'square'" "$P" reduce $SYS --X out/msd_snapshots.npy --X-input square \
+  --method gmg-pod --r 10 --out p23
+run_err "P23 empty --J-coo" 2 "--J-coo: empty value" "$P" reduce --J-coo "" --R-coo a.npy --Q-coo b.npy \
+  --B model/B.npy $QSIM --method gmg-pod --r 10 --out p23
+run_err "P23 empty name in --R-coo" 2 "--R-coo 'r.npy,,v.npy'" "$P" reduce --J-coo a.npy --R-coo r.npy,,v.npy \
+  --Q-coo b.npy --B model/B.npy $QSIM --method gmg-pod --r 10 --out p23
+run_err "P23 unknown command lists validate" 2 "validate" "$P" frobnicate
+
+# 26: the fuzz harness of the command line knows every command and option of
+#     --help (the lines calling Python name compare.py's options, not phgmg's)
+missing=
+for o in reduce validate simulate-rom info $("$P" --help | grep -v python3 | grep -o -- '--[a-zA-Z][a-zA-Z-]*' | sort -u); do
+  grep -F -q -- "\"$o\"" "$ROOT/tests/fuzz/fuzz_cli.c" || missing="$missing $o"
+done
+[ -z "$missing" ] && pass || bad "P26: tests/fuzz/fuzz_cli.c does not know:$missing"
 
 echo "test_cli: $npass passed, $nfail failed"
 [ "$nfail" -eq 0 ]

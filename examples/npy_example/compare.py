@@ -37,17 +37,23 @@ def rel(a, b):
 
 def exact_response(J, R, B, Q, t, kind, amp):
     """States X (N x nt) and outputs Y (m x nt) of x' = (J-R)Q x + B u, x(0) = 0,
-    u_j(t) = amp sin t or amp for every port j, by eigendecomposition."""
+    by eigendecomposition: u_a(t) = amp sin(w_a t), w_a = 1 + a/m at port
+    a = 0..m-1 (phgmg's sin; amp sin t for m = 1), or amp on every port."""
     A = (J - R) @ Q
     lam, V = np.linalg.eig(A)
-    c = np.linalg.solve(V, B @ np.ones(B.shape[1]))  # z' = lam z + c u(t)
+    m = B.shape[1]
     L, T = lam[:, None], t[None, :]
     eL = np.exp(L * T)
-    if kind == "sin":   # sin t = (e^{it} - e^{-it}) / 2i
-        zp = (np.exp(1j * T) - eL) / (1j - L)
-        zm = (np.exp(-1j * T) - eL) / (-1j - L)
-        Z = amp * c[:, None] * (zp - zm) / 2j
+    if kind == "sin":   # sin wt = (e^{iwt} - e^{-iwt}) / 2i
+        Z = 0
+        for a in range(m):
+            c = np.linalg.solve(V, B[:, a])  # z' = lam z + c u_a(t)
+            w = 1.0 + a / m
+            zp = (np.exp(1j * w * T) - eL) / (1j * w - L)
+            zm = (np.exp(-1j * w * T) - eL) / (-1j * w - L)
+            Z = Z + amp * c[:, None] * (zp - zm) / 2j
     elif kind == "const":
+        c = np.linalg.solve(V, B @ np.ones(m))
         Z = amp * c[:, None] * (eL - 1.0) / L
     else:
         raise ValueError(kind)

@@ -1,8 +1,10 @@
 /* Fuzz harness for the argument handling of the `phgmg` command line
    (examples/phgmg_cli.c, compiled in with its main renamed) on a tiny model
    (N = 4, m = 1) in a scratch directory. Each input byte picks one token
-   of a vocabulary (commands, every option, numbers good and bad, the scratch
-   model's files, a malformed and an integer .npy, a directory, output paths
+   of a vocabulary (every command and option -- reduce, validate,
+   simulate-rom, info --, numbers good and bad, potentials, hyper-reduction
+   and manifold names, the scratch model's files dense and as coordinate
+   triplets, a malformed and an integer .npy, a directory, output paths
    inside the scratch directory), at most 48 tokens; the resulting command
    line is run. Any exit status is fine (0, 1, 2); sanitizers, leaks and
    hangs are findings. Before each run the scratch directory is restored, so
@@ -30,7 +32,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
 static char g_dir[64];
 static int g_home = -1; /* the starting working directory */
-static char g_tok[96][128];
+static char g_tok[160][128];
 static int g_ntok;
 static unsigned char *g_rom;
 static size_t g_rom_len;
@@ -101,6 +103,21 @@ static void restore(void) {
   put_npy("B.npy", B4, 4, 1); put_npy("X.npy", X, 4, 8); put_npy("poly.npy", poly, 5, 1);
   put_npy("idx.npy", idx, 2, 1); put_npy("u.npy", X, 8, 1);
   put_bytes("idx_i8.npy", int_idx, sizeof int_idx - 1);
+  {   /* J, R, Q as (nnz, 3) coordinate triplets; one exponential pair (a, b) */
+    double C[3 * 16], e2[2] = {1.0, 1.0};
+    const double *const M[3] = {J4, R4, Q4};
+    const char *const nm[3] = {"Jc.npy", "Rc.npy", "Qc.npy"};
+    int t, i, j, n;
+    for (t = 0; t < 3; ++t) {
+      for (n = 0, j = 0; j < 4; ++j)
+        for (i = 0; i < 4; ++i)
+          if (M[t][i + 4 * j] != 0.0) { C[n] = i; C[n + 16] = j; C[n + 32] = M[t][i + 4 * j]; ++n; }
+      for (i = 0; i < n; ++i) { C[n + i] = C[16 + i]; }          /* compact the columns: (n, 3) */
+      for (i = 0; i < n; ++i) { C[2 * n + i] = C[32 + i]; }
+      put_npy(nm[t], C, n, 3);
+    }
+    put_npy("exp.npy", e2, 1, 2);
+  }
   put_bytes("garbage.npy", "not an npy file", 15);
   if (g_rom) put_bytes("m.phgmgrom", g_rom, g_rom_len);
   {
@@ -121,8 +138,17 @@ static void init(void) {
   static const char *const files[] = {"J.npy", "R.npy", "Q.npy", "B.npy", "X.npy", "poly.npy", "idx.npy",
                                       "idx_i8.npy", "u.npy", "garbage.npy", "m.phgmgrom", "adir", "o",
                                       "y.npy", "xr.npy", "nofile.npy", "o/m.phgmgrom", NULL};
+  /* appended after the first vocabulary, so that the seeds written for it
+     (bytes below its size) keep their meaning */
+  static const char *const words2[] = {
+    "validate", "--J-coo", "--R-coo", "--Q-coo", "--potential", "--exp", "--train-input", "--X-input",
+    "--manifold", "--hyper", "--hyper-tol", "--test-input", "--test-amp", "--test-steps", "--max-ey",
+    "toda", "fpu:1:1", "fpu::", "morse:1:2", "morse:-1:1", "cosh:1", "cosh:1e-200", "ecsw", "qdeim", "greedy",
+    "pod", "altmin", "auto", "cv", "1e-300", "1e160", "1e15", "rom", "--E", "--E-coo", "--P", "--S", "--N", NULL};
+  static const char *const files2[] = {"Jc.npy", "Rc.npy", "Qc.npy", "exp.npy", "o/rom.phgmgrom", "o/rom_V0.npy",
+                                       "o/rom.json", NULL};
   char *argv[24];
-  int k, argc = 0;
+  int k, fb, argc = 0;   /* fb: the token of files[0] */
   FILE *f;
   long n;
   char path[256];
@@ -130,19 +156,22 @@ static void init(void) {
   if (!mkdtemp(g_dir)) fz_die("mkdtemp");
   atexit(cleanup);
   for (k = 0; words[k]; ++k) strcpy(g_tok[g_ntok++], words[k]);
+  fb = g_ntok;
   for (k = 0; files[k]; ++k) snprintf(g_tok[g_ntok++], sizeof g_tok[0], "%s/%s", g_dir, files[k]);
+  for (k = 0; words2[k]; ++k) strcpy(g_tok[g_ntok++], words2[k]);
+  for (k = 0; files2[k]; ++k) snprintf(g_tok[g_ntok++], sizeof g_tok[0], "%s/%s", g_dir, files2[k]);
   /* the model file, made once by the CLI itself */
   restore();
   argv[argc++] = (char *)"phgmg"; argv[argc++] = (char *)"reduce";
-  argv[argc++] = (char *)"--J"; argv[argc++] = g_tok[g_ntok - 17];
-  argv[argc++] = (char *)"--R"; argv[argc++] = g_tok[g_ntok - 16];
-  argv[argc++] = (char *)"--Q"; argv[argc++] = g_tok[g_ntok - 15];
-  argv[argc++] = (char *)"--B"; argv[argc++] = g_tok[g_ntok - 14];
-  argv[argc++] = (char *)"--X"; argv[argc++] = g_tok[g_ntok - 13];
+  argv[argc++] = (char *)"--J"; argv[argc++] = g_tok[fb + 0];
+  argv[argc++] = (char *)"--R"; argv[argc++] = g_tok[fb + 1];
+  argv[argc++] = (char *)"--Q"; argv[argc++] = g_tok[fb + 2];
+  argv[argc++] = (char *)"--B"; argv[argc++] = g_tok[fb + 3];
+  argv[argc++] = (char *)"--X"; argv[argc++] = g_tok[fb + 4];
   argv[argc++] = (char *)"--dt-map"; argv[argc++] = (char *)"0.1";
   argv[argc++] = (char *)"--method"; argv[argc++] = (char *)"gmg-pod";
   argv[argc++] = (char *)"--r"; argv[argc++] = (char *)"3";
-  argv[argc++] = (char *)"--out"; argv[argc++] = g_tok[g_ntok - 5];
+  argv[argc++] = (char *)"--out"; argv[argc++] = g_tok[fb + 12];
   argv[argc++] = (char *)"--quiet";
   argv[argc] = NULL;
   if (chdir(g_dir) != 0) fz_die("chdir");
