@@ -36,7 +36,7 @@ int main(int argc, char **argv) {
   double *X, *Y, *XR, *YR, xr0[64] = {0};
   phgmg_run runs[2];
   phgmg_gl3_opts go;
-  if (argc < 2) { fprintf(stderr, "usage: %s linear|nonlinear [--lambda L|auto] [--r LIST] [--two]\n", argv[0]); return 2; }
+  if (argc < 2 || (strcmp(argv[1], "linear") && strcmp(argv[1], "nonlinear"))) { fprintf(stderr, "usage: %s linear|nonlinear [--lambda L|auto] [--r LIST] [--two]\n", argv[0]); return 2; }
   nonlin = !strcmp(argv[1], "nonlinear");
   for (i = 2; i < argc; ++i) {
     if (!strcmp(argv[i], "--lambda") && i + 1 < argc) { ++i; if (!strcmp(argv[i], "auto")) lauto = 1; else lambda = atof(argv[i]); }

@@ -50,7 +50,15 @@ int main(int argc, char **argv) {
     if (!strcmp(argv[a], "--no-exact")) { exact = 0; continue; }
     if (!strcmp(argv[a], "--q") && a + 1 < argc) { q = atoi(argv[++a]); continue; }
     if (!strcmp(argv[a], "--reduce")) { red = 1; continue; }
-    N = atoi(argv[a]);
+    {
+      char *end;
+      long v = strtol(argv[a], &end, 10);
+      if (end == argv[a] || *end || v < 200 || v > 100000000) {
+        fprintf(stderr, "usage: rsvd_study [--no-exact] [--q Q] [--reduce] N... (N >= 200)\n");
+        return strcmp(argv[a], "--help") ? 2 : 0;
+      }
+      N = (int)v;
+    }
     memset(&mo, 0, sizeof mo);
     mo.n = N / 2;
     mo.storage = PHGMG_BANDED;

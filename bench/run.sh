@@ -61,7 +61,7 @@ for prog in bench_linalg bench_fom bench_rom bench_linear bench_scale; do
     echo "run.sh: warning: $src does not build, skipped" >&2
     continue
   fi
-  "./$BUILD/$prog" "$CSV" || echo "run.sh: warning: $prog failed (exit $?)" >&2
+  "./$BUILD/$prog" --out "$CSV" || echo "run.sh: warning: $prog failed (exit $?)" >&2
 done
 
 # the hyper-reduction choices side by side (a table, not timing cases)
@@ -96,7 +96,7 @@ if [ -f bench/bench_linalg.c ]; then
     tmp="$BUILD/bench_cblas.csv"
     rm -f "$tmp"
     if $CC $CFLAGS -DPHGMG_USE_CBLAS -o "$BUILD/bench_linalg_cblas" bench/bench_linalg.c $cblas $LIBS &&
-       "./$BUILD/bench_linalg_cblas" "$tmp"; then
+       "./$BUILD/bench_linalg_cblas" --out "$tmp"; then
       awk -F, 'NR > 1 && NF == 5 { printf "%s_cblas,%s,%s,%s,%s\n", $1, $2, $3, $4, $5 }' "$tmp" >> "$CSV"
     else
       echo "run.sh: warning: the CBLAS build of bench_linalg failed" >&2

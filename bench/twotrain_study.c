@@ -49,7 +49,10 @@ int main(int argc, char **argv) {
   const phgmg_ph_system *sys;
   phgmg_run runs[2];
   phgmg_gl3_opts go;
-  if (argc < 2) return 2;
+  if (argc < 2 || (strcmp(argv[1], "linear") && strcmp(argv[1], "nonlinear"))) {
+    fprintf(stderr, "usage: %s linear|nonlinear [--r LIST] [--balance] [--second multisine|steps|mssteps]\n", argv[0]);
+    return argc >= 2 && (!strcmp(argv[1], "--help") || !strcmp(argv[1], "-h")) ? 0 : 2;
+  }
   for (k = 0; k < 64; ++k)
     for (i = 0; i < 2 * NHO; ++i) ey2[k][i / NHO][i % NHO] = NAN;
   nonlin = !strcmp(argv[1], "nonlinear");
@@ -59,7 +62,7 @@ int main(int argc, char **argv) {
     else if (!strcmp(argv[i], "--second") && i + 1 < argc) {
       ++i;
       second = !strcmp(argv[i], "steps") ? u_steps : !strcmp(argv[i], "mssteps") ? u_mssteps : demo_u_multisine;
-    }
+    } else { fprintf(stderr, "twotrain_study: unknown argument '%s'\n", argv[i]); return 2; }
   }
   nr = demo_parse_rlist(rs, rl, 64);
   if (nonlin) {
