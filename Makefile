@@ -5,6 +5,7 @@
 #   make examples  build the examples
 #   make embedded  cross-compile the controller example for Cortex-M4F
 #   make fuzz      short fuzzing run of every reader of outside data
+#   make docs-check  the docs against the code (part of make test)
 CC      ?= cc
 CXX     ?= c++
 WARN     = -Wall -Wextra -Werror -pedantic -Wshadow
@@ -16,7 +17,7 @@ LDLIBS   = -lm
 TESTSRC := $(wildcard tests/test_*.c)
 BUILD    = build
 
-.PHONY: test-hello test-build test-validate test-deploy all test test-plain test-asan compile-checks test-embedded-host test-npy test-cli test-demo test-fuzz-replay demo bench examples embedded fuzz clean
+.PHONY: docs-check test-hello test-build test-validate test-deploy all test test-plain test-asan compile-checks test-embedded-host test-npy test-cli test-demo test-fuzz-replay demo bench examples embedded fuzz clean
 
 all: phgmg.h examples
 
@@ -61,7 +62,7 @@ test: test-build
 test-lane-asan: test-asan
 test-lane-host: compile-checks test-embedded-host
 test-lane-demo: test-demo
-test-lane-tools: test-fuzz-replay test-npy test-cli test-validate test-hello
+test-lane-tools: test-fuzz-replay test-npy test-cli test-validate test-hello docs-check
 .PHONY: test-lane-asan test-lane-host test-lane-demo test-lane-tools
 
 # Everything make test compiles, built first on both cores (the compiles are
@@ -69,6 +70,12 @@ test-lane-tools: test-fuzz-replay test-npy test-cli test-validate test-hello
 test-build: tests/suites.inc
 	$(MAKE) -j2 $(BUILD)/test_run $(BUILD)/test_run_asan $(EXAMPLES) $(BUILD)/npy_tool \
 	  $(BUILD)/export_model_d $(BUILD)/export_model_f
+
+# The documentation against the code: every public function in the manual's
+# index, every CLI option in --help, README's first C block compiles and runs,
+# no tracked file named '-...', no issue numbers in README.md, phgmg.h, Makefile.
+docs-check: $(BUILD)/phgmg
+	/usr/bin/python3 tests/docs_check.py $(BUILD)/phgmg
 
 # The quick start of README.md (examples/hello.c): reduce and step a model.
 test-hello: $(BUILD)/hello

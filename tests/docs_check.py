@@ -1,0 +1,128 @@
+#!/usr/bin/python3
+"""docs-check: the user-facing documentation still matches the code.
+
+Usage: /usr/bin/python3 tests/docs_check.py [PHGMG_BINARY]   (from the repository root)
+
+Fails (exit 1, one line per finding) when
+  - a public function (a PHGMG_DEF declaration in the header's declaration
+    half) is missing from the INDEX section of the manual at the top of
+    phgmg.h, or the index names a function that is not declared;
+  - `phgmg --help` (build/phgmg by default) does not name an option that
+    examples/phgmg_cli.c's parser accepts;
+  - the first C block of README.md does not compile (C99, warnings as errors)
+    or does not run with exit status 0;
+  - a tracked file name starts with '-';
+  - README.md, phgmg.h or the Makefile mention an issue number, a "session",
+    or a document outside the repository (NUMERICS, STYLE.md).
+"""
+import os, re, subprocess, sys
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+CC = os.environ.get("CC", "cc")
+problems = []
+
+
+def read(path):
+    with open(os.path.join(ROOT, path), encoding="utf-8") as f:
+        return f.read()
+
+
+def check_index(header):
+    lines = header.split("\n")
+    impl = next(i for i, l in enumerate(lines) if l.startswith("#ifdef PHGMG_IMPLEMENTATION"))
+    declared = set()
+    for l in lines[:impl]:
+        m = re.match(r"PHGMG_DEF\b.*?\b(phgmg_[A-Za-z0-9_]+)\s*\(", l)
+        if m:
+            declared.add(m.group(1))
+    top = header[: header.index("*/")]
+    if "INDEX OF PUBLIC FUNCTIONS" not in top:
+        problems.append("phgmg.h: the manual has no INDEX OF PUBLIC FUNCTIONS section")
+        return
+    index = top[top.index("INDEX OF PUBLIC FUNCTIONS"):]
+    named = set(re.findall(r"\bphgmg_[A-Za-z0-9_]+", index))
+    for f in sorted(declared - named):
+        problems.append("phgmg.h: public function %s is missing from the manual's index" % f)
+    for f in sorted(named - declared):
+        problems.append("phgmg.h: the manual's index names %s, which is not a public function" % f)
+    print("docs-check: %d public functions, all in the manual's index" % len(declared)
+          if declared <= named else "docs-check: index incomplete")
+
+
+def check_help(binary):
+    src = read("examples/phgmg_cli.c")
+    opts = set(re.findall(r'(?:strcmp\([^,()]+,\s*|\b(?:STR|INT|DBL)\()"(--[A-Za-z][A-Za-z0-9-]*)"', src))
+    if len(opts) < 20:
+        problems.append("examples/phgmg_cli.c: found only %d parsed options; has the parser changed?" % len(opts))
+    try:
+        out = subprocess.run([binary, "--help"], capture_output=True, text=True, timeout=30)
+    except OSError as e:
+        problems.append("%s --help: %s" % (binary, e))
+        return
+    if out.returncode != 0:
+        problems.append("%s --help exits with %d" % (binary, out.returncode))
+    text = out.stdout
+    for o in sorted(opts):
+        if not re.search(r"(?<![A-Za-z0-9-])" + re.escape(o) + r"(?![A-Za-z0-9-])", text):
+            problems.append("phgmg --help does not name the option %s that the CLI parses" % o)
+    print("docs-check: %d options parsed by the CLI, checked against --help" % len(opts))
+
+
+def check_readme_program(readme):
+    m = re.search(r"```c\n(.*?)```", readme, re.S)
+    if not m:
+        problems.append("README.md: no C block")
+        return
+    d = os.path.join(ROOT, "build", "docs")
+    os.makedirs(d, exist_ok=True)
+    src, exe = os.path.join(d, "readme_quickstart.c"), os.path.join(d, "readme_quickstart")
+    with open(src, "w", encoding="utf-8") as f:
+        f.write(m.group(1))
+    cmd = [CC, "-std=c99", "-Wall", "-Wextra", "-Werror", "-pedantic", "-Wshadow", "-O0",
+           "-I", ROOT, "-o", exe, src, "-lm"]
+    r = subprocess.run(cmd, capture_output=True, text=True)
+    if r.returncode != 0:
+        problems.append("README.md: the first C block does not compile:\n" + r.stderr[-2000:])
+        return
+    r = subprocess.run([exe], capture_output=True, text=True, timeout=120)
+    if r.returncode != 0:
+        problems.append("README.md: the first C block exits with %d: %s" % (r.returncode, r.stdout + r.stderr))
+        return
+    print("docs-check: README's first C block compiles and runs: " + r.stdout.strip())
+
+
+def check_file_names():
+    try:
+        r = subprocess.run(["git", "-C", ROOT, "ls-files", "-z"], capture_output=True, text=True, check=True)
+        names = [n for n in r.stdout.split("\0") if n]
+    except (OSError, subprocess.CalledProcessError):
+        names = [os.path.relpath(os.path.join(dp, f), ROOT) for dp, _, fs in os.walk(ROOT) if ".git" not in dp for f in fs]
+    for n in names:
+        if any(part.startswith("-") for part in n.split("/")):
+            problems.append("tracked file whose name starts with '-': %s" % n)
+
+
+def check_words():
+    pat = re.compile(r"\bissues?\s*#?\d+|\bsessions?\b|NUMERICS|STYLE\.md", re.I)
+    for path in ("README.md", "phgmg.h", "Makefile"):
+        for no, line in enumerate(read(path).split("\n"), 1):
+            m = pat.search(line)
+            if m:
+                problems.append("%s:%d: user-facing text mentions '%s'" % (path, no, m.group(0)))
+
+
+def main():
+    binary = sys.argv[1] if len(sys.argv) > 1 else os.path.join(ROOT, "build", "phgmg")
+    check_index(read("phgmg.h"))
+    check_help(binary)
+    check_readme_program(read("README.md"))
+    check_file_names()
+    check_words()
+    for p in problems:
+        print("docs-check: FAIL: " + p)
+    print("docs-check: %s" % ("passed" if not problems else "%d problem(s)" % len(problems)))
+    return 1 if problems else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
