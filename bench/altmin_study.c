@@ -1,4 +1,4 @@
-/* altmin_study.c -- the GMG-QM manifold constructions side by side (issue 15):
+/* altmin_study.c -- the GMG-QM manifold constructions side by side:
    hierarchical POD (the paper's), greedy linear part, alternating minimization.
    Trained on u = 0.1 sin t (1000 steps of dt = 0.1; with --two also on the
    multisine 0.05 (sin 0.5t + sin 1.5t + sin 3t)), for each r: the training

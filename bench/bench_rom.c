@@ -1,4 +1,4 @@
-/* bench_rom — offline and online timings of the reduced models (issue 7).
+/* bench_rom — offline and online timings of the reduced models.
 
    Models: the paper's linear MSD (50 masses, N = 100, dense) and the nonlinear
    MSD chain (banded, N = 1000 and N = 4000), u = 0.1 sin t, dt = 0.1, 1000
@@ -266,7 +266,7 @@ static int deim_fn(void *vc, int phase) {
   return phgmg_deim(nt, NS, c->F, nt, NULL, 1e-8, 0, c->pts, c->w, &c->nd, &c->nneg, NULL, NULL) == PHGMG_OK ? 0 : -1;
 }
 
-/* Hyper-reduction with non-negative weights (issue 14) on the N = 1000 chain:
+/* Hyper-reduction with non-negative weights on the N = 1000 chain:
    GMG-POD basis V0 = [B, 19 POD modes of the adjusted snapshots] (r = 20);
    training rows (snapshot i, coordinate a) = phi'(l_k(x_i)) V0[idx_k, a]
    (ns r = 20020 rows, one column per term). sep = 0: phgmg_ecsw on the

@@ -1,4 +1,4 @@
-/* bench_scale — the offline reduction at large N (issue 18).
+/* bench_scale — the offline reduction at large N.
 
    Case (appended to the CSV of --out as `case,median_s,min_s,max_s,runs`):
      offline_gmgpod_N256000   the paper's nonlinear chain (examples/msd_models.h:

@@ -1,5 +1,5 @@
 /* rsvd_study — randomized POD (phgmg_pod_randomized) against the exact
-   phgmg_pod on snapshots of the paper's nonlinear MSD chain (issue 18).
+   phgmg_pod on snapshots of the paper's nonlinear MSD chain.
 
    For each N given: the chain with N/2 masses (banded), u = 0.1 sin t,
    dt = 0.1, 1000 steps from x0 = 0 (1001 snapshots, Newton tol 1e-8); then

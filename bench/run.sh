@@ -71,7 +71,7 @@ if $CC $CFLAGS -o "$BUILD/hyper_study" bench/hyper_study.c $LIBS; then
   "./$BUILD/hyper_study" | tee "$BUILD/hyper_study.txt"
 fi
 
-# the GMG-QM manifold constructions side by side (issue 15; tables, not timing cases)
+# the GMG-QM manifold constructions side by side (tables, not timing cases)
 echo
 echo "== altmin_study"
 if $CC $CFLAGS -o "$BUILD/altmin_study" bench/altmin_study.c $LIBS; then

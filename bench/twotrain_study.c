@@ -1,6 +1,6 @@
 /* twotrain_study.c -- why two training runs (0.1 sin t + the multisine
    0.05 (sin 0.5t + sin 1.5t + sin 3t)) can be worse than one (0.1 sin t) on
-   held-out inputs at small r (issue 15). For GMG-POD on the chosen chain, with
+   held-out inputs at small r. For GMG-POD on the chosen chain, with
    every nonlinear term (deim 0) and with ECSW hyper-reduction (deim 1), per
    held-out input (0.1, 0.1 sin 2t, chirp, random pwc): e_proj of the held-out
    trajectory onto the model's basis (what the basis can represent at all)

@@ -78,7 +78,7 @@ int main(int argc, char **argv) {
   nr = (rmax - rmin) / rstep + 1;
   demo_mkdir(out);
   if (msd_linear_build(&M, 50, NULL, NULL, NULL, PHGMG_DENSE) != 0) { fprintf(stderr, "model\n"); return 1; }
-  if (gen) { /* --generalization: issue 15's study at the listed r */
+  if (gen) { /* --generalization: the deployment study at the listed r */
     int rl[64], nrl = 0;
     phgmg_reduce_opts o;
     svgplot_fig *gf = svgplot_new("Linear chain: GMG-POD and GMG-QM (lambda validated by simulation) on inputs they were not trained on", 2);

@@ -64,7 +64,7 @@ typedef struct nl_setup {
   double mass, lambda_fixed, deim_tol, dt;
 } nl_setup;
 
-/* --generalization: issue 15's study at the listed r */
+/* --generalization: the deployment study at the listed r */
 static int generalization_main(nl_setup *S, const char *gen) {
   int rl[64], nrl = 0;
   char path[512];
