@@ -197,6 +197,8 @@
      PHGMG_METHOD_PRBT         positive-real balanced truncation (phgmg_prbt only).
 
    3.2 phgmg_reduce_opts
+   phgmg_reduce_opts_default fills a struct with these defaults (the library
+   applies them in that one place; the command line starts from them too).
      field              default (zero)       meaning
      method             (required)           one of 3.1
      r                  (required)           reduced order
@@ -643,15 +645,16 @@
            phgmg_rom_stepper_init, phgmg_rom_stepper_reset,
            phgmg_rom_stage_times, phgmg_rom_step
    reduce: phgmg_pod, phgmg_pod_randomized, phgmg_adjust_snapshots,
-           phgmg_runs_columns, phgmg_simulate_inputs, phgmg_reduce,
-           phgmg_reduced_destroy, phgmg_reduced_rom, phgmg_reduced_N,
-           phgmg_reduced_lift, phgmg_reduced_restrict, phgmg_reduced_dphi,
-           phgmg_reduced_W, phgmg_reduced_simulate, phgmg_reduced_validate,
-           phgmg_rel_error, phgmg_err_red, phgmg_err_proj,
-           phgmg_err_lowerbound, phgmg_err_energy, phgmg_study_create,
-           phgmg_study_destroy, phgmg_study_basis, phgmg_study_reduce,
-           phgmg_study_errors, phgmg_pod_hierarchical, phgmg_deim,
-           phgmg_deim_select, phgmg_nnls, phgmg_ecsw, phgmg_ecsw_separable
+           phgmg_runs_columns, phgmg_simulate_inputs,
+           phgmg_reduce_opts_default, phgmg_reduce, phgmg_reduced_destroy,
+           phgmg_reduced_rom, phgmg_reduced_N, phgmg_reduced_lift,
+           phgmg_reduced_restrict, phgmg_reduced_dphi, phgmg_reduced_W,
+           phgmg_reduced_simulate, phgmg_reduced_validate, phgmg_rel_error,
+           phgmg_err_red, phgmg_err_proj, phgmg_err_lowerbound,
+           phgmg_err_energy, phgmg_study_create, phgmg_study_destroy,
+           phgmg_study_basis, phgmg_study_reduce, phgmg_study_errors,
+           phgmg_pod_hierarchical, phgmg_deim, phgmg_deim_select, phgmg_nnls,
+           phgmg_ecsw, phgmg_ecsw_separable
    linear: phgmg_lyap, phgmg_care, phgmg_lyap_residual, phgmg_care_residual,
            phgmg_ph_abc, phgmg_bt, phgmg_prbt_riccati, phgmg_prbt,
            phgmg_linear_basis, phgmg_ss_transfer, phgmg_reduced_abc,
@@ -661,7 +664,7 @@
            phgmg_rom_load, phgmg_rom_export_c
    npy:    phgmg_npy_parse, phgmg_npy_serialize, phgmg_npy_free,
            phgmg_npy_read, phgmg_npy_write
-   (110 functions; also the macros PHGMG_ROM_STEPPER_MEMSIZE_MAX and _MAX_CB.)
+   (111 functions; also the macros PHGMG_ROM_STEPPER_MEMSIZE_MAX and _MAX_CB.)
 */
 #ifndef PHGMG_H_INCLUDED
 #define PHGMG_H_INCLUDED
@@ -1642,6 +1645,14 @@ typedef struct phgmg_reduce_opts {
   void (*progress)(const char *phase, void *user);
   void *progress_user;
 } phgmg_reduce_opts;
+
+/* The defaults of phgmg_reduce_opts (the table in manual 3.2): *o is zeroed
+   and every field whose zero stands for a default gets that default. A zeroed
+   struct and this one reduce identically (with method and r set); use it to
+   show or start from the defaults. Left 0: method and r (required),
+   lambda_blocks (min(ns, 100): needs the snapshots), newton_tol (the
+   steppers' own defaults), the optional pointers and flags. */
+PHGMG_DEF void phgmg_reduce_opts_default(phgmg_reduce_opts *o);
 
 typedef struct phgmg_reduce_info {
   int deim_modes;          /* DEIM points kept (nd)                          */
@@ -9376,7 +9387,8 @@ PHGMG__PRIV phgmg_result phgmg__qm_fit(phgmg_reduced *red, int ns, const double 
 typedef struct phgmg__rctx {
   phgmg_reduced *red;
   const phgmg_ph_system *sys;
-  const phgmg_reduce_opts *o;
+  phgmg_reduce_opts ro;    /* the caller's options with the defaults applied */
+  const phgmg_reduce_opts *o; /* &ro */
   const double *X;
   int ldx, ns;
   const phgmg_allocator *alloc;
@@ -9417,7 +9429,7 @@ PHGMG__PRIV phgmg_result phgmg__deploy_check(const phgmg_reduce_opts *o, int ns)
   if (o->nrun < 0 || (o->nrun > 0 && !o->runs) || o->nrun > PHGMG__NVAL_MAX - 3) return PHGMG_ERR_INVALID_ARG;
   if (o->nrun > 0 && phgmg_runs_columns(o->nrun, o->runs) < 0) return PHGMG_ERR_INVALID_ARG;
   if (o->nrun > 0 && phgmg_runs_columns(o->nrun, o->runs) != ns) return PHGMG_ERR_SIZE;
-  if (!(o->lambda_tolerance == 0.0 || (o->lambda_tolerance >= 1.0 && o->lambda_tolerance < HUGE_VAL)))
+  if (!(o->lambda_tolerance >= 1.0 && o->lambda_tolerance < HUGE_VAL))
     return PHGMG_ERR_INVALID_ARG;
   if (!(o->newton_tol >= 0.0 && o->newton_tol < 1.0) || o->newton_iter < 0) return PHGMG_ERR_INVALID_ARG;
   if (o->manifold < PHGMG_MANIFOLD_POD || o->manifold > PHGMG_MANIFOLD_ALTMIN) return PHGMG_ERR_INVALID_ARG;
@@ -9425,8 +9437,35 @@ PHGMG__PRIV phgmg_result phgmg__deploy_check(const phgmg_reduce_opts *o, int ns)
   return PHGMG_OK;
 }
 
-/* Options and sizes; nothing allocated. X_checked: X is known finite (a
-   study checked it). */
+/* The one place where the defaults of phgmg_reduce_opts are applied (manual
+   3.2): every field left 0 takes its default; ns > 0 also resolves
+   lambda_blocks. Invalid values are kept for phgmg__reduce_check to refuse.
+   GMG_MANIFOLD has no default r_n (the caller's eta fixes it); newton_tol
+   stays 0 (the steppers' defaults). Idempotent. */
+PHGMG__PRIV void phgmg__reduce_opts_resolve(phgmg_reduce_opts *o, int ns) {
+  if (o->rn == 0 && o->method != PHGMG_METHOD_GMG_MANIFOLD) o->rn = 8;
+  if (o->lambda == 0.0) o->lambda = 1e-3;
+  if (o->deim_tol == 0.0) o->deim_tol = 1e-8;
+  if (o->hyper_tol == 0.0) o->hyper_tol = 1e-6;
+  if (o->degeneracy_tol == 0.0) o->degeneracy_tol = 1e-12;
+  if (o->lambda_min == 0.0) o->lambda_min = 1e-14;
+  if (o->lambda_max == 0.0) o->lambda_max = 1.0;
+  if (o->lambda_per_decade == 0) o->lambda_per_decade = 4;
+  if (o->lambda_folds == 0) o->lambda_folds = 5;
+  if (o->lambda_blocks == 0 && ns > 0) o->lambda_blocks = PHGMG__MIN(ns, 100);
+  if (o->lambda_rcond == 0.0) o->lambda_rcond = 1e-6;
+  if (o->lambda_tolerance == 0.0) o->lambda_tolerance = 1.02;
+  if (o->newton_iter == 0) o->newton_iter = 20;
+}
+
+PHGMG_DEF void phgmg_reduce_opts_default(phgmg_reduce_opts *o) {
+  if (!o) return;
+  memset(o, 0, sizeof *o);
+  phgmg__reduce_opts_resolve(o, 0);
+}
+
+/* Options (resolved by phgmg__reduce_opts_resolve) and sizes; nothing
+   allocated. X_checked: X is known finite (a study checked it). */
 PHGMG__PRIV phgmg_result phgmg__reduce_check(const phgmg_ph_system *sys, const double *X, int ldx, int ns,
                                              const phgmg_reduce_opts *o, int X_checked) {
   const int N = sys->N, m = sys->m, r = o->r;
@@ -9448,14 +9487,11 @@ PHGMG__PRIV phgmg_result phgmg__reduce_check(const phgmg_ph_system *sys, const d
   if (sys->nl == PHGMG_NL_SEPARABLE && sys->poly_deg > 32) return PHGMG_ERR_SIZE;
   if (!X_checked && !phgmg__mat_finite(N, ns, X, ldx)) return PHGMG_ERR_NANINF; /* padding rows are not data */
   if (o->lambda_auto) {
-    const double lo = o->lambda_min == 0.0 ? 1e-14 : o->lambda_min;
-    const double hi = o->lambda_max == 0.0 ? 1.0 : o->lambda_max;
-    const int nf = o->lambda_folds == 0 ? 5 : o->lambda_folds;
-    const int nb = o->lambda_blocks == 0 ? PHGMG__MIN(ns, 100) : o->lambda_blocks;
+    const int nf = o->lambda_folds, nb = o->lambda_blocks;
     if ((o->lambda_auto != 1 && o->lambda_auto != 2) || o->lambda_per_decade < 0 || nf < 2 || nb < 0)
       return PHGMG_ERR_INVALID_ARG;
     if (!(o->lambda_rcond >= 0.0 && o->lambda_rcond <= 1.0)) return PHGMG_ERR_INVALID_ARG;
-    if (phgmg__lambda_grid(lo, hi, o->lambda_per_decade == 0 ? 4 : o->lambda_per_decade, NULL) < 1)
+    if (phgmg__lambda_grid(o->lambda_min, o->lambda_max, o->lambda_per_decade, NULL) < 1)
       return PHGMG_ERR_INVALID_ARG;
     if (nb < nf || nb > ns) return PHGMG_ERR_SIZE;
   }
@@ -9486,7 +9522,7 @@ PHGMG__PRIV phgmg_result phgmg__reduce_new(phgmg__rctx *c) {
                   ? PHGMG_ROM_QUADRATIC : PHGMG_ROM_LINEAR;
   red->p = phgmg__is_gmg(o->method) ? o->r - red->m : o->r;
   if (red->kind == PHGMG_ROM_QUADRATIC) {
-    red->rn = o->rn > 0 ? o->rn : 8;
+    red->rn = o->rn;
     /* the q/Lp buffers of lift/dphi hold up to 64 x 64 */
     if (red->rn > red->N - red->r || red->rn > 64 || red->rn * red->p > 64 * 64) return PHGMG_ERR_SIZE;
   }
@@ -9675,15 +9711,14 @@ PHGMG__PRIV phgmg_result phgmg__qm_lambda_auto(phgmg__rctx *c) {
   const phgmg_reduce_opts *o = c->o;
   const int ns = c->ns, p = c->red->p, rn = c->red->rn, nc = p * (p + 1) / 2, ng = c->ng;
   const int byrun = o->nrun >= 2 && c->runcol;   /* leave one run out */
-  const int nfold = byrun ? o->nrun : (o->lambda_folds == 0 ? 5 : o->lambda_folds);
-  const int nblk = o->lambda_blocks == 0 ? PHGMG__MIN(ns, 100) : o->lambda_blocks;
+  const int nfold = byrun ? o->nrun : o->lambda_folds;
+  const int nblk = o->lambda_blocks;
   double best, *lg;
   int g;
   phgmg_result rc;
   lg = c->lg = phgmg__dalloc(c->alloc, 2 * (size_t)ng);
   if (!lg) return PHGMG_ERR_NOMEM;
-  phgmg__lambda_grid(o->lambda_min == 0.0 ? 1e-14 : o->lambda_min, o->lambda_max == 0.0 ? 1.0 : o->lambda_max,
-                     o->lambda_per_decade == 0 ? 4 : o->lambda_per_decade, lg);
+  phgmg__lambda_grid(o->lambda_min, o->lambda_max, o->lambda_per_decade, lg);
   if (c->sf == 1 && !byrun && c->st->cv && c->st->cv_p == p && c->st->cv_rn == rn && c->st->cv_ng == ng &&
       c->st->cv_nf == nfold && c->st->cv_nb == nblk && c->st->cv_lo == lg[0] && c->st->cv_hi == lg[ng - 1]) {
     memcpy(lg + ng, c->st->cv, (size_t)ng * sizeof(double));   /* the study's: same problem, same basis */
@@ -10096,7 +10131,7 @@ PHGMG__PRIV double phgmg__dgd_rcond0(phgmg__rctx *c) {
 PHGMG__PRIV phgmg_result phgmg__check_degeneracy(phgmg__rctx *c) {
   phgmg_reduced *red = c->red;
   const double rc0 = phgmg__dgd_rcond0(c);
-  const double lrc = rc0 * (c->o->lambda_rcond == 0.0 ? 1e-6 : c->o->lambda_rcond);
+  const double lrc = rc0 * c->o->lambda_rcond;
   const int can_raise = c->gsel >= 0 && rc0 >= c->degtol;
   phgmg_result rc;
   if (rc0 < 0.0) return PHGMG_ERR_NOMEM;
@@ -10437,7 +10472,7 @@ PHGMG__PRIV phgmg_result phgmg__vset_build(phgmg__rctx *c, phgmg__vset *v) {
   }
   memset(&go, 0, sizeof go);
   go.tol = c->o->newton_tol > 0.0 ? c->o->newton_tol : 1e-10;
-  go.max_iter = c->o->newton_iter > 0 ? c->o->newton_iter : 20;
+  go.max_iter = c->o->newton_iter;
   if (c->o->lambda_train_only) { v->nv = nrun; return phgmg__vset_dedupe(c, v); }
   if (phgmg__study_probes(c, v, level, zero, off, &go, 0)) return phgmg__vset_dedupe(c, v);
   for (k = nrun; k < nrun + 3; ++k) {
@@ -10465,7 +10500,7 @@ PHGMG__PRIV phgmg_result phgmg__vset_build(phgmg__rctx *c, phgmg__vset *v) {
 PHGMG__PRIV phgmg_result phgmg__vset_eval(phgmg__rctx *c, phgmg__vset *v, int *ok, double tolr) {
   const int m = c->sys->m;
   const double tol = c->o->newton_tol;   /* 0: the stepper's default (1e-10 double, 1e-5 float) */
-  const int it = c->o->newton_iter > 0 ? c->o->newton_iter : 20;
+  const int it = c->o->newton_iter;
   int i, k, j;
   *ok = 1;
   for (k = 0; k < v->nv; ++k) v->ey[k] = HUGE_VAL;
@@ -10540,14 +10575,14 @@ PHGMG__PRIV phgmg_result phgmg__altmin_reference(phgmg__rctx *c, phgmg__vset *v,
 }
 
 /* opts.lambda_auto = 1 (after publish): validation by simulation, see the
-   comment at phgmg_reduce_opts.runs. Candidates from lambda_max down, one
+   manual 4.2. Candidates from lambda_max down, one
    per decade, to the regression optimum; stops after two inadmissible
    candidates in a row (the error grows as lambda falls). */
 PHGMG__PRIV phgmg_result phgmg__stage_lambda_validate(phgmg__rctx *c) {
   phgmg_reduced *red = c->red;
   const phgmg_reduce_opts *o = c->o;
-  const int pd = o->lambda_per_decade == 0 ? 4 : o->lambda_per_decade;
-  const double tolr = o->lambda_tolerance > 0.0 ? o->lambda_tolerance : 1.02;
+  const int pd = o->lambda_per_decade;
+  const double tolr = o->lambda_tolerance;
   const size_t n = (size_t)red->rn * red->p * red->p;
   phgmg__vset *v;
   phgmg_real *ms;
@@ -11043,7 +11078,7 @@ PHGMG__PRIV void phgmg__progress(const phgmg_reduce_opts *o, const char *phase) 
 PHGMG__PRIV int phgmg__study_fast(const phgmg_study *st, const phgmg_reduce_opts *o, int m) {
   if (!st) return 0;
   if ((o->method == PHGMG_METHOD_GMG_POD || (o->method == PHGMG_METHOD_GMG_QM && o->manifold == PHGMG_MANIFOLD_POD)) && st->Ua &&
-      o->pod_basis == st->Ua && o->r - m + (o->method == PHGMG_METHOD_GMG_QM ? (o->rn > 0 ? o->rn : 8) : 0) <= st->ka)
+      o->pod_basis == st->Ua && o->r - m + (o->method == PHGMG_METHOD_GMG_QM ? o->rn : 0) <= st->ka)
     return 1;
   if (o->method == PHGMG_METHOD_SP1 && st->Up && st->Cq && o->pod_basis == st->Up && o->r <= st->kp) return 2;
   if (o->method == PHGMG_METHOD_SP2 && st->Up && st->Ug && o->pod_basis == st->Up && o->grad_basis == st->Ug &&
@@ -11062,22 +11097,22 @@ PHGMG__PRIV phgmg_result phgmg__reduce_run(phgmg_reduced **out, const phgmg_ph_s
   *out = NULL;
   if (!sys || !X || !opts) return PHGMG_ERR_INVALID_ARG;
   memset(&c, 0, sizeof c);
-  c.sys = sys; c.o = opts; c.X = X; c.ldx = ldx; c.ns = ns; c.alloc = alloc; c.gsel = -1;
+  c.ro = *opts;
+  phgmg__reduce_opts_resolve(&c.ro, ns);
+  c.sys = sys; c.o = &c.ro; c.X = X; c.ldx = ldx; c.ns = ns; c.alloc = alloc; c.gsel = -1;
   c.st = st;
-  c.sf = phgmg__study_fast(st, opts, sys->m);
   c.inf.hyper_method = -1;
-  rc = phgmg__reduce_check(sys, X, ldx, ns, opts, st != NULL);
+  rc = phgmg__reduce_check(sys, X, ldx, ns, c.o, st != NULL);
+  if (rc == PHGMG_OK) c.sf = phgmg__study_fast(st, c.o, sys->m);
   if (rc == PHGMG_OK) rc = phgmg_ph_validate(sys, 0.0, &c.inf.rcond_jr, alloc);
   if (rc != PHGMG_OK) {
     if (info) *info = c.inf;
     return rc;
   }
-  c.lambda = opts->lambda == 0.0 ? 1e-3 : (opts->lambda < 0.0 ? 0.0 : opts->lambda);
-  if (opts->lambda_auto && opts->method == PHGMG_METHOD_GMG_QM)
-    c.ng = phgmg__lambda_grid(opts->lambda_min == 0.0 ? 1e-14 : opts->lambda_min,
-                              opts->lambda_max == 0.0 ? 1.0 : opts->lambda_max,
-                              opts->lambda_per_decade == 0 ? 4 : opts->lambda_per_decade, NULL);
-  c.degtol = opts->degeneracy_tol > 0.0 ? opts->degeneracy_tol : 1e-12;
+  c.lambda = c.o->lambda < 0.0 ? 0.0 : c.o->lambda;   /* < 0: exactly zero */
+  if (c.o->lambda_auto && c.o->method == PHGMG_METHOD_GMG_QM)
+    c.ng = phgmg__lambda_grid(c.o->lambda_min, c.o->lambda_max, c.o->lambda_per_decade, NULL);
+  c.degtol = c.o->degeneracy_tol;
   c.rfloor = phgmg__rank_floor(sys->N, ns, X, ldx);
   rc = phgmg__runs_layout(&c);
   if (rc == PHGMG_OK) rc = phgmg__reduce_new(&c);
@@ -11692,6 +11727,7 @@ PHGMG_DEF phgmg_result phgmg_study_reduce(phgmg_study *st, const phgmg_reduce_op
   if (!st || !opts || !out) return PHGMG_ERR_INVALID_ARG;
   if (phgmg__sys_fingerprint(st->sys) != st->fp) return PHGMG_ERR_STALE;   /* the blocks would be stale */
   o = *opts;
+  phgmg__reduce_opts_resolve(&o, st->ns);
   if ((o.method == PHGMG_METHOD_GMG_POD || o.method == PHGMG_METHOD_GMG_QM) && st->Ua && !o.pod_basis) {
     o.pod_basis = st->Ua; o.pod_cols = st->ka;
   }
@@ -14567,6 +14603,8 @@ PHGMG_DEF phgmg_result phgmg_npy_write(const char *path, const double *A, int ro
             depends on the units of B; Q need only be semidefinite when H
             has a nonlinear part; new result code PHGMG_ERR_NOT_STABLE and
             Q's own codes; tiny entries flushed in the steppers' own vectors.
+          - New: phgmg_reduce_opts_default, the defaults of phgmg_reduce_opts
+            as one query; the library applies them in one place.
           - The manual at the top of this file.
    0.1.0  (2026-11-21) first version: GL3 full-order stepper with energy
           bookkeeping; POD, GMG-POD, GMG-QM, SP1, SP2, structure-preserving

@@ -24,6 +24,16 @@ DEMO_FN double demo_now(void) {
   return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
+/* The automatic lambda's settings as the library's defaults give them
+   (phgmg_reduce_opts_default), then tail and a newline. */
+DEMO_FN void demo_print_lambda_defaults(const char *tail) {
+  phgmg_reduce_opts d;
+  phgmg_reduce_opts_default(&d);
+  printf("(library defaults: grid %g..%g at %d per decade, %d-fold validation over contiguous\n"
+         "blocks of snapshots, conditioning guard %g)%s\n",
+         d.lambda_min, d.lambda_max, d.lambda_per_decade, d.lambda_folds, d.lambda_rcond, tail);
+}
+
 DEMO_FN void demo_die(const char *what, phgmg_result rc) {
   fprintf(stderr, "error: %s: %s\n", what, phgmg_result_string(rc));
   exit(1);

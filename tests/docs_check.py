@@ -11,6 +11,9 @@ Fails (exit 1, one line per finding) when
     examples/phgmg_cli.c's parser accepts;
   - the first C block of README.md does not compile (C99, warnings as errors)
     or does not run with exit status 0;
+  - phgmg_reduce_opts_default() disagrees with the defaults in the manual's
+    table (3.2) or with the defaults `phgmg --help` states for --rn,
+    --deim-tol and --hyper-tol;
   - a tracked file name starts with '-';
   - README.md, phgmg.h or the Makefile mention an issue number, a "session",
     or a document outside the repository (NUMERICS, STYLE.md).
@@ -91,6 +94,76 @@ def check_readme_program(readme):
     print("docs-check: README's first C block compiles and runs: " + r.stdout.strip())
 
 
+DEFAULTS_C = r"""
+#define PHGMG_IMPLEMENTATION
+#include "phgmg.h"
+#include <stdio.h>
+int main(void) {
+  phgmg_reduce_opts o;
+  phgmg_reduce_opts_default(&o);
+#define I(f) printf(#f " %d\n", (int)o.f);
+#define D(f) printf(#f " %.17g\n", o.f);
+  I(rn) D(lambda) I(deim) I(hyper) D(hyper_tol) D(deim_tol) I(deim_max) I(deim_allow_negative) D(dt)
+  D(degeneracy_tol) I(lambda_auto) D(lambda_min) D(lambda_max) I(lambda_per_decade) I(lambda_folds)
+  D(lambda_rcond) D(lambda_tolerance) I(newton_iter) I(manifold) I(lambda_train_only)
+  return 0;
+}
+"""
+# names the manual's table uses for a default that is an enum or a phrase
+WORDS = {"PHGMG_HYPER_ECSW": 0.0, "PHGMG_MANIFOLD_POD": 0.0, "no": 0.0}
+
+
+def check_defaults(header, binary):
+    d = os.path.join(ROOT, "build", "docs")
+    os.makedirs(d, exist_ok=True)
+    src, exe = os.path.join(d, "opts_defaults.c"), os.path.join(d, "opts_defaults")
+    with open(src, "w", encoding="utf-8") as f:
+        f.write(DEFAULTS_C)
+    r = subprocess.run([CC, "-std=c99", "-O0", "-I", ROOT, "-o", exe, src, "-lm"], capture_output=True, text=True)
+    if r.returncode != 0:
+        problems.append("phgmg_reduce_opts_default: the query program does not compile:\n" + r.stderr[-1500:])
+        return
+    got = {}
+    for line in subprocess.run([exe], capture_output=True, text=True).stdout.split("\n"):
+        if line.strip():
+            k, v = line.split()
+            got[k] = float(v)
+    top = header[: header.index("*/")]
+    a = top.find("3.2 phgmg_reduce_opts")
+    b = top.find("3.3 ", a)
+    table = {}
+    for line in top[a:b].split("\n"):
+        m = re.match(r"     ([a-z_]+)\s+(\S+)", line)
+        if m:
+            table[m.group(1)] = m.group(2)
+    for k, v in sorted(got.items()):
+        if k not in table:
+            problems.append("manual 3.2: no row for phgmg_reduce_opts.%s (default %g)" % (k, v))
+            continue
+        t = table[k]
+        try:
+            tv = WORDS[t] if t in WORDS else float(t)
+        except ValueError:
+            problems.append("manual 3.2: %s's default '%s' is not a value" % (k, t))
+            continue
+        if tv != v:
+            problems.append("manual 3.2 says %s = %s, phgmg_reduce_opts_default gives %.17g" % (k, t, v))
+    try:
+        text = subprocess.run([binary, "--help"], capture_output=True, text=True, timeout=30).stdout
+    except OSError:
+        text = ""
+    for opt, field, pat in (("--rn", "rn", r"--rn K .*?\(default (\S+?)[,)]"),
+                            ("--deim-tol", "deim_tol", r"--deim-tol T .*?\(default (\S+?)\)"),
+                            ("--hyper-tol", "hyper_tol", r"--hyper-tol T .*?\((\S+?)\)")):
+        m = re.search(pat, text, re.S)
+        if not m:
+            problems.append("phgmg --help: no default stated for %s" % opt)
+        elif float(m.group(1)) != got.get(field):
+            problems.append("phgmg --help says %s defaults to %s, the library's default is %.17g"
+                            % (opt, m.group(1), got.get(field)))
+    print("docs-check: %d defaults of phgmg_reduce_opts agree with the manual's table and --help" % len(got))
+
+
 def check_file_names():
     try:
         r = subprocess.run(["git", "-C", ROOT, "ls-files", "-z"], capture_output=True, text=True, check=True)
@@ -116,6 +189,7 @@ def main():
     check_index(read("phgmg.h"))
     check_help(binary)
     check_readme_program(read("README.md"))
+    check_defaults(read("phgmg.h"), binary)
     check_file_names()
     check_words()
     for p in problems:
