@@ -13,7 +13,7 @@
 #    each, appending `case,median_s,min_s,max_s,runs` lines to the CSV;
 # 3. if a CBLAS is installed, builds bench_linalg again with -DPHGMG_USE_CBLAS
 #    and records its cases with a `_cblas` suffix (one BLAS thread);
-# 3b. runs bench/hyper_study.c and bench/altmin_study.c (tables, no CSV cases);
+# 3b. runs bench/studies/hyper_study.c and bench/studies/altmin_study.c (tables, no CSV cases);
 # 4. builds the examples (`make examples`; if that fails, the two demo
 #    programs directly, without -Werror) and times the whole demo (the three
 #    runs `make demo` makes, with its arguments: linear, nonlinear, linear with
@@ -67,14 +67,14 @@ done
 # the hyper-reduction choices side by side (a table, not timing cases)
 echo
 echo "== hyper_study"
-if $CC $CFLAGS -o "$BUILD/hyper_study" bench/hyper_study.c $LIBS; then
+if $CC $CFLAGS -o "$BUILD/hyper_study" bench/studies/hyper_study.c $LIBS; then
   "./$BUILD/hyper_study" | tee "$BUILD/hyper_study.txt"
 fi
 
 # the GMG-QM manifold constructions side by side (tables, not timing cases)
 echo
 echo "== altmin_study"
-if $CC $CFLAGS -o "$BUILD/altmin_study" bench/altmin_study.c $LIBS; then
+if $CC $CFLAGS -o "$BUILD/altmin_study" bench/studies/altmin_study.c $LIBS; then
   for chain in linear nonlinear; do
     "./$BUILD/altmin_study" $chain --lambda 1e-9 --r 8,12,16,20
   done | tee "$BUILD/altmin_study.txt"

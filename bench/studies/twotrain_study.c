@@ -13,9 +13,9 @@
 #include <stdlib.h>
 #include <string.h>
 #define PHGMG_IMPLEMENTATION
-#include "../phgmg.h"
-#include "../examples/msd_models.h"
-#include "../examples/demo_common.h"
+#include "../../phgmg.h"
+#include "../../examples/msd_models.h"
+#include "../../examples/demo_common.h"
 
 /* the inputs of make demo's generalization study (examples/demo_common.h),
    and two more candidates for the second training run */

@@ -9,16 +9,16 @@
    GMG-POD (M = 0) on the same r for reference.
    QM-alt* = altmin fell back to the POD manifold (lambda auto, not better than GMG-POD).
    Usage: altmin_study linear|nonlinear [--lambda L|auto] [--train-only] [--r 8,10,...] [--rn 8] [--two]
-   Build: make build/altmin_study (or cc -O2 -march=native bench/altmin_study.c -lm). */
+   Build: cc -O2 -march=native -o build/altmin_study bench/studies/altmin_study.c -lm. */
 #define _POSIX_C_SOURCE 199309L
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
 #define PHGMG_IMPLEMENTATION
-#include "../phgmg.h"
-#include "../examples/msd_models.h"
-#include "../examples/demo_common.h"
+#include "../../phgmg.h"
+#include "../../examples/msd_models.h"
+#include "../../examples/demo_common.h"
 
 /* the inputs of make demo's generalization study (examples/demo_common.h) */
 #define NIN 5

@@ -11,12 +11,12 @@
    whole phgmg_reduce (GMG-POD, r = 20, deim = 1 with the default ECSW
    hyper-reduction); build with -DPHGMG_POD_RANDOMIZED_MIN=50000000 to see it
    with the randomized POD inside.
-     cc -std=c99 -O2 -march=native bench/rsvd_study.c -lm
+     cc -std=c99 -O2 -march=native bench/studies/rsvd_study.c -lm
      ./a.out [--no-exact] [--q 2] 4000 16000 64000                          */
 #define _POSIX_C_SOURCE 199309L
 #define PHGMG_IMPLEMENTATION
-#include "../phgmg.h"
-#include "../examples/msd_models.h"
+#include "../../phgmg.h"
+#include "../../examples/msd_models.h"
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
