@@ -465,7 +465,9 @@
      PHGMG_ERR_NOT_SYMMETRIC (-9)   R not symmetric
      PHGMG_ERR_NOT_PSD (-10)        R not positive semidefinite
      PHGMG_ERR_RANK (-11)           B not of full column rank; a rank-deficient
-                                    least-squares problem
+                                    least-squares problem (phgmg_lstsq; GMG-QM
+                                    with lambda < 0 takes the minimum-norm
+                                    solution instead)
      PHGMG_ERR_DEGENERATE (-12)     GMG non-degeneracy fails: rcond(D^T G D)
                                     below degeneracy_tol at xr = 0 or (GMG-QM)
                                     at a snapshot; SP1/SP2 likewise
@@ -484,6 +486,24 @@
      PHGMG_ERR_INEXACT (-20)        a 64-bit integer beyond 2^53 in a .npy
      PHGMG_ERR_NOT_STABLE (-21)     an undamped mode (eigenvalue of (J - R) Q
                                     on the imaginary axis): no Gramians
+     PHGMG_ERR_OVERFLOW (-22)       a result beyond the double range (e.g. an
+                                    energy of states ~1e160 in
+                                    phgmg_reduced_validate; the error norms
+                                    themselves are scaled), ECSW weights out
+                                    of range after scaling back
+     PHGMG_ERR_TOL_UNREACHABLE (-23) a relative tolerance below 1e-15 (ECSW,
+                                    hence hyper_tol)
+     PHGMG_ERR_NOT_STABILIZABLE (-24) no stabilizing Riccati solution
+                                    (phgmg_care)
+     PHGMG_ERR_STALE (-25)          the system changed after
+                                    phgmg_study_create (phgmg_study_reduce)
+     PHGMG_ERR_STRUCTURE (-26)      an intact model file that is not a pH model
+                                    of its kind (Qh not positive definite,
+                                    dissipation not PSD, a step map not of its
+                                    dt): phgmg_rom_deserialize / _load
+     PHGMG_ERR_STEP_MAP (-27)       the step map of a dissipative model would
+                                    grow in the energy norm (phgmg_reduce with
+                                    opts.dt)
    The declaration of each function lists the codes it returns and when.
 
 
@@ -14603,6 +14623,9 @@ PHGMG_DEF phgmg_result phgmg_npy_write(const char *path, const double *A, int ro
             depends on the units of B; Q need only be semidefinite when H
             has a nonlinear part; new result code PHGMG_ERR_NOT_STABLE and
             Q's own codes; tiny entries flushed in the steppers' own vectors.
+          - New result codes PHGMG_ERR_OVERFLOW, _TOL_UNREACHABLE,
+            _NOT_STABILIZABLE, _STALE, _STRUCTURE (a load-time structure check
+            of model files) and _STEP_MAP.
           - New: phgmg_reduce_opts_default, the defaults of phgmg_reduce_opts
             as one query; the library applies them in one place.
           - The manual at the top of this file.
