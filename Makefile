@@ -5,6 +5,7 @@
 #   make examples  build the examples
 #   make embedded  cross-compile the controller example for Cortex-M4F
 #   make fuzz      short fuzzing run of every reader of outside data
+#   make docs-check  the docs against the code (part of make test)
 CC      ?= cc
 CXX     ?= c++
 WARN     = -Wall -Wextra -Werror -pedantic -Wshadow
@@ -16,7 +17,7 @@ LDLIBS   = -lm
 TESTSRC := $(wildcard tests/test_*.c)
 BUILD    = build
 
-.PHONY: test-build test-validate test-deploy all test test-plain test-asan compile-checks test-embedded-host test-npy test-cli test-demo test-fuzz-replay demo bench examples embedded fuzz clean
+.PHONY: docs-check test-hello test-build test-validate test-deploy all test test-plain test-asan compile-checks test-embedded-host test-npy test-cli test-demo test-fuzz-replay demo bench examples embedded fuzz clean
 
 all: phgmg.h examples
 
@@ -61,7 +62,7 @@ test: test-build
 test-lane-asan: test-asan
 test-lane-host: compile-checks test-embedded-host
 test-lane-demo: test-demo
-test-lane-tools: test-fuzz-replay test-npy test-cli test-validate
+test-lane-tools: test-fuzz-replay test-npy test-cli test-validate test-hello docs-check
 .PHONY: test-lane-asan test-lane-host test-lane-demo test-lane-tools
 
 # Everything make test compiles, built first on both cores (the compiles are
@@ -70,11 +71,21 @@ test-build: tests/suites.inc
 	$(MAKE) -j2 $(BUILD)/test_run $(BUILD)/test_run_asan $(EXAMPLES) $(BUILD)/npy_tool \
 	  $(BUILD)/export_model_d $(BUILD)/export_model_f
 
+# The documentation against the code: every public function in the manual's
+# index, every CLI option in --help, README's first C block compiles and runs,
+# no tracked file named '-...', no issue numbers in README.md, phgmg.h, Makefile.
+docs-check: $(BUILD)/phgmg
+	/usr/bin/python3 tests/docs_check.py $(BUILD)/phgmg
+
+# The quick start of README.md (examples/hello.c): reduce and step a model.
+test-hello: $(BUILD)/hello
+	./$(BUILD)/hello
+
 # `phgmg validate` and the deployment checks (tests/test_validate.sh, a few seconds).
 test-validate: $(BUILD)/phgmg
 	sh tests/test_validate.sh $(BUILD)/phgmg
 
-# Issue 15's acceptance at every r = 6..20 on both chains (GMG-QM with the
+# The deployment study at every r = 6..20 on both chains (GMG-QM with the
 # validated lambda on five inputs, one and two training runs; the training-only
 # validated model against GMG-POD); minutes, not part of make test.
 test-deploy: $(EXAMPLES)
@@ -149,7 +160,7 @@ compile-checks: phgmg.h
 	  clang -std=c99 $(WARN) -Wdouble-promotion -DPHGMG_REAL_FLOAT -c $(BUILD)/cc/impl.c -o $(BUILD)/cc/a.o; fi
 	@echo "compile checks passed"
 
-EXAMPLES = $(BUILD)/msd_linear $(BUILD)/msd_nonlinear $(BUILD)/morse_chain $(BUILD)/phgmg $(BUILD)/linear_bases
+EXAMPLES = $(BUILD)/hello $(BUILD)/msd_linear $(BUILD)/msd_nonlinear $(BUILD)/morse_chain $(BUILD)/phgmg $(BUILD)/linear_bases
 EXHDRS   = examples/msd_models.h examples/morse_models.h examples/demo_common.h examples/svgplot.h
 
 examples: $(EXAMPLES)
@@ -167,7 +178,7 @@ $(BUILD)/%: examples/%.c phgmg.h $(EXHDRS)
 	$(CC) $(OPTFLAGS) -o $@ $< $(LDLIBS)
 
 # Reproduce Section 5 of the paper: tables on the terminal, CSVs and SVG figures in results/;
-# then the non-polynomial Morse-chain example (issue 13) and its acceptance checks.
+# then the non-polynomial Morse-chain example and its acceptance checks.
 demo: $(EXAMPLES)
 	@mkdir -p results
 	@start=$$(date +%s.%N); \

@@ -1,7 +1,8 @@
-/* phgmg.h — structure-preserving model order reduction of port-Hamiltonian
-   systems by generalized manifold Galerkin (GMG) reduction.
+/* phgmg.h -- structure-preserving model order reduction of port-Hamiltonian
+   systems by generalized manifold Galerkin (GMG) reduction. Version 0.2.0.
    Single-file C99 library (also compiles as C++), no dependencies beyond libc
-   and libm. MIT license at the end of the file.
+   and libm. The revision history and the MIT license are at the end of the
+   file.
 
    Method: Glas & Mu, "Structure-Preserving Generalized Manifold Galerkin
    Reduction for Port-Hamiltonian Systems". A pH system
@@ -10,109 +11,118 @@
    manifold) and the GMG reduction map W(xr) = F_G(Dphi(xr))^T, G = (J-R)^{-1};
    the reduced model is again a pH system, with the same output structure.
 
-   QUICK START ----------------------------------------------------------------
-       #define PHGMG_IMPLEMENTATION      // in exactly one .c file
+   MANUAL ======================================================================
+     0. Quick start
+     1. Concepts and model forms
+     2. The offline pipeline
+     3. Methods and options (with every default)
+     4. Deployment: validation, choosing lambda, online indicators
+     5. The online path and firmware
+     6. The command line
+     7. Errors
+     8. Numerical notes: what the paper leaves open and what phgmg decided
+     9. Configuration macros
+    10. Index of public functions
+   The header has two halves, declarations and implementation, each cut into
+   sections marked >>config, >>result, >>memory, >>linalg, >>ph, >>gl3,
+   >>online, >>pod / >>reduce, >>linear, >>export, >>npy (grep for them; the
+   same order in both halves). The comment at each declaration states its
+   contract: what it computes, units and layouts, result codes.
+
+
+   0. QUICK START ---------------------------------------------------------------
+   In exactly one .c file:
+       #define PHGMG_IMPLEMENTATION
        #include "phgmg.h"
+   elsewhere include "phgmg.h" plainly (or use PHGMG_STATIC for a private copy).
+   Link with -lm. A complete program is examples/hello.c (also the quick start
+   of README.md); in outline:
 
-       phgmg_ph_system sys = {0};        // N, m, J, R, Q, B (column-major)
-       ... fill sys ...
-       phgmg_simulate(&sys, x0, 0.0, dt, nsteps, u_fn, NULL, NULL, X, Y, NULL, NULL, NULL, NULL);
-       phgmg_reduce_opts o = {0};  o.method = PHGMG_METHOD_GMG_POD;  o.r = 12;  o.dt = dt;
-       phgmg_reduced *red;  phgmg_reduce(&red, &sys, X, N, nsteps + 1, &o, NULL, NULL);
+       phgmg_ph_system sys;  memset(&sys, 0, sizeof sys);  // zero: defaults
+       sys.N = N; sys.m = 1; sys.J = J; sys.R = R; sys.Q = Q; sys.B = B;
+       phgmg_simulate(&sys, x0, 0.0, dt, nsteps, u_fn, NULL, NULL, X, Y,
+                      NULL, NULL, NULL, NULL);             // snapshots X
+       phgmg_reduce_opts o;  memset(&o, 0, sizeof o);
+       o.method = PHGMG_METHOD_GMG_POD;  o.r = 10;  o.dt = dt;
+       phgmg_reduced *red;
+       phgmg_reduce(&red, &sys, X, N, nsteps + 1, &o, NULL, NULL);
        // online, allocation-free, float or double:
-       const phgmg_rom *rom = phgmg_reduced_rom(red);
-       phgmg_rom_stepper st;  static double mem[4096];
-       phgmg_rom_stepper_init(&st, rom, dt, 0, 0, mem, sizeof mem);
+       phgmg_rom_stepper st;  static double mem[8192];
+       phgmg_rom_stepper_init(&st, phgmg_reduced_rom(red), dt, 0, 0, mem, sizeof mem);
        phgmg_rom_step(&st, xr, u3, y, NULL);      // u3 = u at the 3 stage times
-       phgmg_rom_export_c(rom, "my_model", "my_model.h");  // for firmware
+       phgmg_rom_export_c(phgmg_reduced_rom(red), "plant", "plant.h");  // firmware
 
-   CONTENTS (grep for the >>markers; same order in both halves) ---------------
-     >>config   configuration macros, version, scalar type
-     >>result   phgmg_result codes and phgmg_result_string
-     >>memory   allocator hooks, matrix views
-     >>linalg   dense kernels: GEMM, LU (real, complex), QR, QRCP, least squares,
-                thin SVD (QRCP + one-sided Jacobi), symmetric eigenvalues
-     >>ph       full-order pH systems: dense/banded storage, separable or general
-                nonlinear Hamiltonians, validation, J-R factorization
-     >>gl3      3-stage Gauss-Legendre (order 6) + simplified Newton, energy bookkeeping
-     >>online   reduced models (phgmg_rom), evaluation, allocation-free GL3 stepper
-     >>pod, >>reduce, >>deim, >>errors   POD, GMG-POD, GMG-QM, SP1, SP2, DEIM, error measures
-     >>linear   linear pH systems: Lyapunov/Riccati (sign function), balanced truncation,
-                positive-real BT in pH form, input-independent GMG bases, H-inf/H2
-     >>export   C-source and binary export/import of reduced models
-     >>npy      NumPy .npy read/write
 
-   CONFIGURATION MACROS (define before including) ------------------------------
-     PHGMG_IMPLEMENTATION  compile the implementation in this translation unit
-     PHGMG_STATIC          all functions static (private copy per translation unit)
-     PHGMG_DEF             storage class of the public functions (default extern)
-     PHGMG_REAL_FLOAT      online scalar phgmg_real = float (default double);
-                           the offline half stays double
-     PHGMG_NO_OFFLINE      compile only the online half (+ export/import in memory):
-                           needs libm only, no heap, no stdio
-     PHGMG_NO_STDIO        no file functions (.npy files, model files, C export)
-     PHGMG_NPY_MAX_HEADER  longest accepted .npy header in bytes (default 1 MiB)
-     PHGMG_MALLOC(sz,u) / PHGMG_FREE(p,u)   default allocator (both or neither)
-     PHGMG_ASSERT(x)       internal invariant checks (default assert)
-     PHGMG_USE_CBLAS       use cblas_dgemm/cblas_dgemv (optional speed-up)
-     PHGMG_USE_OPENMP      with -fopenmp: phgmg_gemm runs its row blocks in
-                           parallel (off by default; same results; OMP_NUM_THREADS)
-     PHGMG_POD_RANDOMIZED_MIN  phgmg_pod with tol <= 0 switches to the randomized
-                           POD when N*ns >= this (default 0: never; see phgmg_pod)
-     PHGMG_POD_OVERSAMPLE, PHGMG_POD_POWER_ITERS, PHGMG_POD_SEED  its parameters
-                           (20, 2, a fixed seed)
-     PHGMG_POD_AUTO_MIN    phgmg_reduce takes the randomized POD (checked, exact
-                           fallback) when N*ns >= this (default 2e7; <= 0: never)
-     PHGMG_POD_CHECK_TOL   its acceptance: backward error <= this * sigma_1 (1e-10)
-     PHGMG_ECSW_SCREEN_MIN phgmg_ecsw(_separable) screen candidates from this many
-                           terms on (default 4096; no n x n Gram matrix)
-     PHGMG_ECSW_SCREEN_ADD candidates added per screening round (default 64)
-     PHGMG_ECSW_SCREEN_ROUNDS  cap on screening rounds (default 200)
+   1. CONCEPTS AND MODEL FORMS --------------------------------------------------
+   1.1 The full model (phgmg_ph_system, >>ph)
+       x' = (J - R) grad H(x) + B u(t),   y = B^T grad H(x),
+       H(x) = 1/2 x^T Q x + H_nl(x),
+   J skew-symmetric, R symmetric positive semidefinite, Q symmetric positive
+   definite (only semidefinite when H_nl is present: the nonlinear part may
+   carry the convexity, e.g. a Toda chain), B (N x m) of full column rank,
+   J - R regular. All matrices are column-major. Storage:
+     DENSE   J, R, Q N x N (ld N);
+     BANDED  J, R, Q with a common half-bandwidth kb, (2kb+1) x N;
+     sparse  J, R, Q as CSC in any ordering: phgmg_ph_sparse_create reorders
+             the states by reverse Cuthill-McKee into a band and gives the
+             banded system; snapshots and full-dimension results are mapped
+             with phgmg_ph_sparse_to_banded_order / _to_user_order.
+   The nonlinear part H_nl (field nl):
+     PHGMG_NL_NONE       quadratic H;
+     PHGMG_NL_SEPARABLE  H_nl(x) = sum_k w_k phi_k(x[idx_k]) (nsep terms),
+                         phi_k either from the built-in exp-polynomial family
+                         phi(s) = sum_j c_j s^j + sum_e a_e exp(b_e s)
+                         (degree <= 32, at most 8 exponentials; one function
+                         for all terms or one per term; covers polynomial/FPU,
+                         Toda, cosh, Morse), or from callbacks phi/dphi/ddphi;
+     PHGMG_NL_GENERAL    H_nl, its gradient and Hessian by callbacks.
+   phgmg_ph_validate checks all of this (section 7 lists the codes); every
+   reduction calls it first. A model may bring its own solver for the shifted
+   Newton matrices of the GL3 stepper (shifted_factor / shifted_solve).
 
-   FUNCTIONS (one line each; full comments at the declarations) ---------------
-   core:    phgmg_result_string
-   linalg:  phgmg_gemm, phgmg_gemv, phgmg_lu_factor, phgmg_lu_solve, phgmg_lu_rcond,
-            phgmg_norm1, phgmg_normf, phgmg_zlu_factor, phgmg_zlu_solve, phgmg_qr,
-            phgmg_qrcp, phgmg_qr_form_q, phgmg_qr_apply, phgmg_lstsq (plain/ridge),
-            phgmg_svd (thin, rank-revealing), phgmg_sym_eig
-   ph:      phgmg_ph_validate (skew J, symmetric PSD R, symmetric PD Q, rank B, cond(J-R), NaN),
-            phgmg_ph_hamiltonian, phgmg_ph_gradient, phgmg_ph_rhs, phgmg_ph_output,
-            phgmg_ph_apply (J, R or Q times a block), phgmg_jr_factor_create /
-            phgmg_jr_solve / phgmg_jr_factor_destroy (apply (J-R)^{-1} or ^{-T}),
-            phgmg_ph_sparse_create / _create_e (with E) / _system / _perm / _sep_idx / _to_banded_order /
-            _to_user_order / _destroy (CSC input, reverse Cuthill-McKee, banded),
-            phgmg_rcm (the ordering alone)
-   gl3:     phgmg_gl3_coefficients, phgmg_gl3_create / _step / _get_stats / _destroy,
-            phgmg_simulate (trajectory, outputs, energy H/S/D, stats)
-   online:  phgmg_rom_check, phgmg_rom_eval_work_size, phgmg_rom_hamiltonian,
-            phgmg_rom_gradient, phgmg_rom_rhs, phgmg_rom_output, phgmg_rom_structure
-            (J and R at a state), phgmg_rom_hessian, phgmg_rom_jacobian (analytic),
-            phgmg_rom_stepper_memsize,
-            PHGMG_ROM_STEPPER_MEMSIZE_MAX, phgmg_rom_stepper_init, phgmg_rom_stepper_reset,
-            phgmg_rom_stage_times, phgmg_rom_step
-   reduce:  phgmg_pod, phgmg_pod_randomized, phgmg_adjust_snapshots, phgmg_pod_hierarchical, phgmg_deim,
-            phgmg_deim_select (Q-DEIM / greedy), phgmg_nnls, phgmg_ecsw,
-            phgmg_ecsw_separable (non-negative empirical quadrature),
-            phgmg_runs_columns, phgmg_simulate_inputs (several training runs),
-            phgmg_reduce (pipeline of named stages; every Hamiltonian kind --
-            quadratic, separable exp-polynomial or callbacks, GENERAL -- with
-            GMG-POD, GMG-QM, your own manifold eta (GMG_MANIFOLD), SP1, SP2;
-            hyper-reduction opts.hyper: ECSW w >= 0 by default, Q-DEIM, greedy;
-            GMG-QM lambda fixed or validated by simulation: opts.lambda_auto),
-            phgmg_reduced_destroy, phgmg_reduced_rom, phgmg_reduced_N,
-            phgmg_reduced_lift (phi), phgmg_reduced_restrict (rho), phgmg_reduced_dphi,
-            phgmg_reduced_W, phgmg_reduced_simulate, phgmg_reduced_validate
-   errors:  phgmg_rel_error, phgmg_err_red, phgmg_err_proj, phgmg_err_lowerbound,
-            phgmg_err_energy
-   linear:  phgmg_lyap, phgmg_care, phgmg_lyap_residual, phgmg_care_residual, phgmg_ph_abc,
-            phgmg_bt, phgmg_prbt, phgmg_prbt_riccati, phgmg_linear_basis, phgmg_ss_transfer, phgmg_reduced_abc,
-            phgmg_ss_error
-   export:  phgmg_rom_serialized_size, phgmg_rom_serialize, phgmg_rom_deserialize_size,
-            phgmg_rom_deserialize, phgmg_rom_save, phgmg_rom_load, phgmg_rom_export_c
-   npy:     phgmg_npy_parse, phgmg_npy_serialize, phgmg_npy_free, phgmg_npy_read,
-            phgmg_npy_write
+   1.2 Snapshots and runs
+   A snapshot matrix X is N x ns (column-major, ld >= N), one state per column,
+   normally a trajectory x(t_0), ..., x(t_n) from phgmg_simulate (ns = n + 1).
+   Several training runs lie one after the other; phgmg_run describes one run
+   (input, x0, t0, dt, nsteps), phgmg_simulate_inputs makes the snapshot set,
+   phgmg_runs_columns counts its columns, and phgmg_reduce_opts.runs tells the
+   reduction where the runs are and how they were made.
 
-   DESCRIPTOR MODELS (phgmg_ph_system.E) --------------------------------------
+   1.3 The reduced model
+   phgmg_reduce returns a phgmg_reduced: the online model (phgmg_rom, below)
+   together with its offline data (bases, double copies). The reduced model is
+       xr' = (Jr(xr) - Rr(xr)) grad Hr(xr) + Br u,   yr = Br^T grad Hr(xr),
+   Jr skew, Rr symmetric positive semidefinite, with Br = [I; 0] for the GMG
+   methods (the first m reduced coordinates are the port coordinates).
+   phgmg_reduced_lift is phi (reduced -> full state), phgmg_reduced_restrict
+   is the point reduction rho (rho(phi(xr)) = xr), phgmg_reduced_dphi its
+   Jacobian, phgmg_reduced_W the reduction map. The online model phgmg_rom is a
+   set of non-owning const views of small precomputed blocks (V0^T G V0, ...),
+   so evaluating and stepping it never touches N-dimensional data (except a
+   GENERAL nonlinear part, see 3.4).
+
+   1.4 Error measures (phgmg_err_*, paper Section 5.1)
+     e_red        sqrt(sum_i ||x_i - phi(xr_i)||^2 / sum_i ||x_i||^2), reduced
+                  trajectory against the full one (phgmg_err_red);
+     e_y          the same relative measure for the outputs (phgmg_rel_error);
+     e_proj       sqrt(sum ||x_i - phi(rho(x_i))||^2 / sum ||x_i||^2): how well
+                  the manifold represents the snapshots (phgmg_err_proj);
+     e_lowerbound the orthogonal projection error onto span[B, V1, V2] of a
+                  quadratic manifold (phgmg_err_lowerbound);
+     e_energy(t_n) = |H_n - H_0 - S_n + D_n|, with the supplied (S) and
+                  dissipated (D) energy summed by the stepper's own stage
+                  quadrature (phgmg_energy, phgmg_err_energy).
+
+   1.5 Offline and online
+   The offline half (simulation, reduction, studies, linear methods, .npy,
+   files) works in double, takes a `const phgmg_allocator *` (NULL: malloc/free
+   or PHGMG_MALLOC/PHGMG_FREE) and frees everything on every error path. The
+   online half (phgmg_rom_*) works in phgmg_real (double, or float with
+   PHGMG_REAL_FLOAT), never allocates, uses no globals, no stdio and no VLAs;
+   its cost does not depend on N. Instances are independent.
+
+
+   1.6 Descriptor models and feedthrough (phgmg_ph_system.E, P, S, Nskew)
    Finite-element and network models come as
        E x' = (J - R) z(x) + B u,   y = B^T z(x),   E^T z(x) = grad H(x),
    E nonsingular (a consistent mass matrix, dense or banded like J, R, Q).
@@ -173,23 +183,592 @@
    reduced model would need the reduced P = W_z^T P and S + N, fields the
    phgmg_rom format does not have.
 
-   OFFLINE / ONLINE, MEMORY, ERRORS -------------------------------------------
-   Offline functions (double) take a `const phgmg_allocator *` (NULL = default)
-   and free everything on every error path. The online half (phgmg_rom_*) never
-   allocates: ask phgmg_rom_stepper_memsize (or use the compile-time bound
-   PHGMG_ROM_STEPPER_MEMSIZE_MAX), hand over the memory, step; instances are
-   independent. Its cost does not depend on N. Every data-dependent failure is
-   a negative phgmg_result; on failure the caller's inputs (and the state of a
-   stepper) are unchanged. The library never prints, exits or aborts.
+   2. THE OFFLINE PIPELINE ------------------------------------------------------
+   2.1 Simulate. phgmg_simulate (or a phgmg_gl3 object: _create / _step /
+   _get_stats / _destroy) integrates the full model with the 3-stage
+   Gauss-Legendre method (order 6, symplectic, exact energy balance for a
+   quadratic H). Inputs are evaluated at the stage times t + c_i dt. Linear
+   dense models with N <= PHGMG_GL3_STEP_MAP_MAX_N use a precomputed step map;
+   otherwise simplified Newton on the transformed stage system (one real and one
+   complex N x N factorization, reused across steps). Optional outputs: the
+   trajectory, the outputs, the energy bookkeeping, statistics; on a failure the
+   steps done so far are kept.
+
+   2.2 Reduce. phgmg_reduce(&red, &sys, X, ldx, ns, &opts, &info, alloc) runs
+   named stages, each a function of its own:
+     basis      POD of the snapshots (GMG: of the adjusted snapshots
+                X - B B^+ X, giving V0 = [B, V1]); exact thin SVD, or for
+                large N*ns the randomized POD with an a-posteriori check and
+                exact fallback (info.pod_randomized, info.pod_check; GMG-POD
+                then applies X - B B^+ X without copying X);
+     manifold   GMG-QM: V2 = the next r_n POD modes (hierarchical POD) and
+                the ridge fit of M; GMG_MANIFOLD: V2 and your eta;
+     blocks     GMG: V0^T G V0, V0^T G V2, ... and the non-degeneracy check
+                of D^T G D at xr = 0 and at every snapshot; SP1/SP2: W;
+     terms      quadratic blocks; a separable part by hyper-reduction (or
+                every term kept); a GENERAL part by callback;
+     step map   LINEAR model with quadratic H and opts.dt > 0;
+     selection  GMG-QM with opts.lambda_auto: the choice of lambda (section 4).
+   opts.progress reports the stages ("basis", "manifold", "blocks",
+   "hamiltonian", "hyper-reduction", "finish", "done"); the library never
+   prints. info (may be NULL) receives the diagnostics (phgmg_reduce_info).
+
+   2.3 Studies over many orders. phgmg_study_create computes, once for the
+   largest basis, the PODs, the snapshots' reduced coordinates, the residual
+   tails and the G- and Q-blocks; phgmg_study_reduce then builds the same model
+   as phgmg_reduce in O(K ns r) instead of O(N ns r), phgmg_study_errors the
+   error measures in reduced coordinates, phgmg_study_basis hands the bases to
+   your own calls (opts.pod_basis). X must stay unchanged while a study lives.
+
+   2.4 Building blocks. The stages' kernels are public: phgmg_pod,
+   phgmg_pod_randomized, phgmg_adjust_snapshots, phgmg_pod_hierarchical,
+   phgmg_deim, phgmg_deim_select, phgmg_nnls, phgmg_ecsw, phgmg_ecsw_separable,
+   and the dense kernels of >>linalg (GEMM, LU, QR, pivoted QR, least squares,
+   thin SVD, symmetric eigenvalues).
+
+   2.5 Linear systems (>>linear, quadratic H, dense up to a few thousand
+   states): Lyapunov and Riccati equations by the matrix sign function
+   (phgmg_lyap, phgmg_care and their residuals), balanced truncation as a
+   reference (phgmg_bt, plain Ar, Br, Cr), positive-real balanced truncation in
+   pH form (phgmg_prbt, a phgmg_reduced of method PRBT), input-independent GMG
+   bases (phgmg_linear_basis: frequency samples, impulse responses, balanced,
+   least H2 error; pass them as opts.pod_basis), transfer functions and
+   H-infinity / H2 errors (phgmg_ph_abc, phgmg_ss_transfer, phgmg_reduced_abc,
+   phgmg_ss_error). A system with an undamped mode has no Gramians: BT, PRBT
+   and the BALANCED / H2 bases then return PHGMG_ERR_NOT_STABLE.
+
+
+   3. METHODS AND OPTIONS -------------------------------------------------------
+   Every option struct is "zero means default": memset it to 0 and set what you
+   need. The tables give each field's default (the value a zero field takes).
+
+   3.1 Methods (phgmg_reduce_opts.method)
+     PHGMG_METHOD_GMG_POD      phi = [B, V1] xr, V1 from the POD of the
+                               adjusted snapshots; GMG reduction. r includes
+                               the m port coordinates (m < r <= N).
+     PHGMG_METHOD_GMG_QM       quadratic manifold phi = [B, V1] xr +
+                               V2 M (x2 kron x2), x2 = xr[m..r-1]; V2 the next
+                               r_n modes, M a ridge fit with parameter lambda.
+     PHGMG_METHOD_GMG_MANIFOLD your manifold phi = [B, V1] xr + V2 eta(x2),
+                               eta and its first and second derivatives by a
+                               callback (opts.eta); GMG-QM is the case
+                               eta = M (x2 kron x2), GMG-POD the case r_n = 0.
+     PHGMG_METHOD_SP1          baseline: phi = V xr (POD of X), W = QV(V^TQV)^-1.
+     PHGMG_METHOD_SP2          baseline: W from a POD of the gradient snapshots.
+     PHGMG_METHOD_PRBT         positive-real balanced truncation (phgmg_prbt only).
+
+   3.2 phgmg_reduce_opts
+   phgmg_reduce_opts_default fills a struct with these defaults (the library
+   applies them in that one place; the command line starts from them too).
+     field              default (zero)       meaning
+     method             (required)           one of 3.1
+     r                  (required)           reduced order
+     rn                 8                    GMG-QM lifting dimension r_n with
+                                             the POD manifold; with greedy or
+                                             altmin, 0 resolves to
+                                             PHGMG_RN_WIDE (V2 as wide as the
+                                             data); > 0: a cap; GMG_MANIFOLD:
+                                             required, <= 64
+     lambda             1e-3 (the paper's)   GMG-QM ridge parameter on the
+                                             un-normalised sum over snapshots;
+                                             < 0: exactly zero; not used with
+                                             lambda_auto
+     deim               0                    1: hyper-reduce a separable part
+                                             (the method is `hyper`); 0: keep
+                                             every term (exact, O(terms) online)
+     hyper              PHGMG_HYPER_ECSW     ECSW (weights >= 0), QDEIM or
+                                             GREEDY (structure-preserving DEIM)
+     hyper_tol          1e-6                 ECSW: relative training residual
+                                             of the reduced nonlinear gradient
+     deim_tol           1e-8                 DEIM modes: sigma_k/sigma_1 > tol
+     deim_max           no cap               cap on DEIM modes
+     deim_allow_negative 0                   1: accept negative DEIM weights
+     dt                 0 (no step map)      > 0: precompute the GL3 step map
+                                             of a LINEAR model for this step
+     degeneracy_tol     1e-12                least reciprocal condition of
+                                             D^T G D (port columns at unit
+                                             length) before _ERR_DEGENERATE
+     pod_basis/pod_cols NULL (computed)      cached POD basis (studies)
+     grad_basis/grad_cols NULL (computed)    SP2: cached gradient POD basis
+     deim_pts/deim_w/deim_count NULL         cached DEIM result
+     lambda_auto        0 (fixed lambda)     1: validated by simulation
+                                             (section 4.2); 2: regression only
+     lambda_min         1e-14                smallest lambda of the grid
+     lambda_max         1                    largest lambda of the grid
+     lambda_per_decade  4                    grid points per decade (1..100)
+     lambda_folds       5                    lambda_auto = 2: folds (>= 2)
+     lambda_blocks      min(ns, 100)         lambda_auto = 2: time blocks
+     lambda_rcond       1e-6                 conditioning guard, relative to
+                                             rcond(D^T G D) at xr = 0
+     eta/eta_user       NULL                 GMG_MANIFOLD: the manifold map
+     nrun/runs          0/NULL (one run of   the training runs that made X
+                        unknown input)
+     lambda_tolerance   1.02                 admissible e_y ratio to the
+                                             linear limit (lambda_auto = 1)
+     newton_tol         1e-10 (full), the    validation simulations
+                        stepper's (reduced)
+     newton_iter        20                   validation simulations
+     manifold           PHGMG_MANIFOLD_POD   GMG-QM construction (3.3)
+     lambda_train_only  0                    1: validate on the training runs
+                                             alone (4.2)
+     progress/_user     NULL                 stage callback (2.2)
+   Bad values (NaN, out of range, unknown enums) give PHGMG_ERR_INVALID_ARG;
+   sizes that do not fit the model or the snapshots' rank give PHGMG_ERR_SIZE.
+
+   3.3 GMG-QM manifold constructions (opts.manifold)
+     PHGMG_MANIFOLD_POD     the paper's hierarchical POD: V1 the leading POD
+                            modes of the adjusted snapshots, V2 the next r_n.
+     PHGMG_MANIFOLD_GREEDY  V1 chosen column by column among the leading
+                            (r - m) + r_n POD modes: each time the mode whose
+                            coordinates best predict the other candidates' by
+                            the quadratic ridge fit (after Schwerdtner &
+                            Peherstorfer 2024; ridge 1e-9 under lambda_auto,
+                            else opts.lambda; every ceil(ns/400)-th snapshot);
+                            V2 the POD of what [B, V1] leaves. About (r - m)
+                            (r - m + r_n) small least-squares solves.
+     PHGMG_MANIFOLD_ALTMIN  alternating minimization (after Geelen, Balzano,
+                            Wright & Willcox 2023): V1, V2 rotated within the
+                            leading 2 (r - m + r_n) POD modes, alternating the
+                            ridge fit of M with an orthogonal Procrustes step;
+                            a sweep is kept only if the training objective
+                            sum ||x - phi(rho(x))||^2 + lam ||M||^2 decreases,
+                            so it never ends above the POD manifold
+                            (info.manifold_obj0 -> manifold_obj, at most 100
+                            sweeps). Under lambda_auto = 1 GMG-POD joins the
+                            validation as a second reference, and when no
+                            lambda beats both the model of MANIFOLD_POD is
+                            returned (info.manifold_fallback = 1).
+   In every construction B stays in the span and [B, V1, V2] is orthonormal,
+   so Br = [I; 0] and the GMG reduction is unchanged.
+
+   3.4 Hyper-reduction (opts.deim = 1, opts.hyper)
+   A separable energy sum_k w_k phi(l_k) is replaced by sum_j w'_j phi(l_pj)
+   over a few kept terms. Because the reduced energy itself is approximated
+   (not its gradient), the reduced gradient is an exact gradient and the model
+   stays pH.
+     PHGMG_HYPER_ECSW   (default) empirical quadrature: weights w' >= 0 by
+                        non-negative least squares on the reduced gradient
+                        over the training snapshots (phgmg_ecsw_separable),
+                        relative residual <= hyper_tol. Non-negative weights
+                        keep a convex, bounded-below sum convex and bounded
+                        below; the terms at rest in every snapshot are skipped.
+     PHGMG_HYPER_QDEIM  the paper's structure-preserving DEIM with Q-DEIM
+                        points (pivoted QR); weights w' = (P^T U)^{-T} U^T w
+                        may be negative (refused unless deim_allow_negative).
+     PHGMG_HYPER_GREEDY the same with greedy DEIM points.
+   Online cost O(points); info.hyper_* and info.deim_* report the result.
+   A GENERAL nonlinear part cannot be hyper-reduced (PHGMG_ERR_UNSUPPORTED):
+   its reduced model evaluates H_nl in full dimension through
+   phgmg_rom.ham_cb (info.online_full_dim = 1; not exportable).
+
+   3.5 Other option structs
+     phgmg_gl3_opts     tol 1e-10 (times max(1, |x|_inf, |Z|_inf); an explicit
+                        tol is absolute), max_iter 10, contraction 0.5
+                        (refactor above), no_step_map 0, keep_tiny 0.
+     phgmg_study_opts   what = PHGMG_STUDY_GMG | PHGMG_STUDY_SP, kmax required.
+     phgmg_prbt_opts    eps 0 (exact zero feedthrough; > 0: regularised
+                        D = eps ||CB|| I), dt 0 (no step map), X/Y NULL.
+     phgmg_basis_opts   nw 60, wmin/wmax from the system (1/(10 ||A^-1||_1),
+                        2 ||A||_1), dt 0.1, nsteps 1000, maxit 1000, V0 NULL
+                        (the balanced basis), h2_rel NULL.
+     rom stepper        tol 1e-10 double / 1e-5 float (times max(1, |x|_inf,
+                        |Z|_inf)), max_iter 10 (phgmg_rom_stepper_init).
+
+
+   4. DEPLOYMENT: VALIDATION, CHOOSING LAMBDA, ONLINE INDICATORS ----------------
+   4.1 Training runs. Train on inputs that cover the levels (static content)
+   and the frequency band the model will see; several runs go into one snapshot
+   set (phgmg_simulate_inputs) and opts.nrun / opts.runs.
+
+   4.2 GMG-QM's ridge parameter. A fixed lambda (opts.lambda, the paper's 1e-3
+   when zero) is what the paper does; on small reduced coordinates it shrinks M
+   to almost zero, and a very small lambda can bend the manifold so much that
+   the reduced model fails on inputs unlike the training one.
+     lambda_auto = 1 (recommended; needs opts.runs): validation by simulation.
+       The reduction simulates the finished reduced model, for candidate
+       lambdas, on every training run (reference: the snapshots' outputs) and
+       on three probe runs it was not fitted to -- the full model driven from
+       runs[0].x0 by a constant at the RMS level of runs[0].u (per port), by
+       runs[0].u played 1.5x faster and by the square wave RMS * sign(u(t))
+       -- and compares each run's e_y with the linear limit M = 0 (GMG-POD on
+       the same basis). Candidates: lambda_max, then one per decade down to
+       the regression optimum of lambda_auto = 2; the descent stops after two
+       inadmissible candidates in a row, and a candidate's evaluation at its
+       first inadmissible run. Admissible: no simulation fails, at most 4
+       Newton iterations per step on average, and every run's e_y at most
+       lambda_tolerance (1.02) times the linear limit's. Kept: the largest
+       admissible lambda with at least half of the best admissible gain (sum
+       of log ratios); none: M = 0 (info.lambda = HUGE_VAL). Without runs
+       nothing can be simulated and M = 0. Runs with the same x0 and the same
+       inputs at every stage time are simulated once. Cost: three full-model
+       probe runs plus (nrun + 3) reduced runs per candidate, 4-8 candidates.
+       info.lambda_candidates, info.lambda_val_ratio report it.
+     lambda_train_only = 1 (with lambda_auto = 1): no probe runs; from the
+       regression optimum up, the first lambda whose model simulates every
+       training run without Newton trouble and within lambda_tolerance of the
+       linear limit: the most accurate model on the training inputs; it does
+       not guard against unlike inputs.
+     lambda_auto = 2: regression only. The snapshots are cut into
+       lambda_blocks contiguous blocks in time, block j to fold j mod
+       lambda_folds (with several runs: one run per fold). For each fold, M is
+       fitted on the other snapshots for every lambda of the grid lambda_min *
+       10^(g / lambda_per_decade) <= lambda_max (one thin SVD of the training
+       rows, then a small product per lambda) and predicts the held-out
+       quadratic correction V2^T x. The lambda with the smallest held-out error
+       summed over the folds (ties within 1e-6 relative: the larger) fits M on
+       all snapshots. Guard: while rcond(D^T G D) at some snapshot is below
+       lambda_rcond times its value at xr = 0, the next larger lambda is taken
+       (info.lambda_raised); if even lambda_max does not help, M = 0. This
+       choice measures the regression, not the reduced model, and picks very
+       small lambdas that overfit (see 8.6).
+   Before version 0.2.0, lambda_auto = 1 meant what is now lambda_auto = 2.
+
+   4.3 The check before shipping. phgmg_reduced_validate(red, &sys, &run, tol,
+   max_iter, ey_max, &v, alloc) simulates full and reduced model on one run and
+   fills phgmg_validation: e_red, e_y, e_proj, e_energy (and the full model's),
+   Newton statistics, the first failing step, pass (completed, no Newton
+   failure, e_y <= ey_max). A failing reduced model is a result (pass = 0), not
+   an error. The command line's `phgmg validate` does the same for a list of
+   test inputs and exits 1 when one fails.
+
+   4.4 Online indicators. Every reduced model carries a training envelope
+   (env_lo, env_hi: the range of the training snapshots' reduced coordinates,
+   widened by 10 % of each width plus 2 % of the largest) and, for a quadratic
+   manifold, q_max (1.2 times the largest quadratic correction seen in
+   training). phgmg_rom_step counts stats.outside_steps (steps ending outside
+   the envelope), stats.q_outside_steps (correction above q_max),
+   stats.consec_failures and stats.max_consec_failures. The envelope marks
+   unfamiliar states, not error; a growing q count is the warning sign of a
+   quadratic manifold used outside its training.
+
+
+   5. THE ONLINE PATH AND FIRMWARE ----------------------------------------------
+   5.1 Stepping. phgmg_rom_stepper_memsize(rom) (or the compile-time bound
+   PHGMG_ROM_STEPPER_MEMSIZE_MAX(r, m, rn, nd), _MAX_CB with callbacks) gives
+   the bytes; phgmg_rom_stepper_init places the stepper in caller memory;
+   phgmg_rom_step advances xr in place, with u3 = u at the three stage times
+   (phgmg_rom_stage_times), and returns the output and optionally the energy
+   increments. A LINEAR model with a quadratic H stepped at its own dt uses the
+   exact step map (a matrix-vector product); otherwise GL3 with simplified
+   Newton on the 3r stage system, bounded by max_iter: a failure is a result
+   code, never a hang, and leaves x, y and the energy untouched; the stepper
+   stays usable. Quadratic-manifold models are stepped in mass-matrix form
+   (8.5). phgmg_rom_stepper_memsize_dt sizes a stepper for another dt;
+   phgmg_rom_stepper_reset forgets the extrapolation history.
+   Evaluators for your own integrator: phgmg_rom_hamiltonian, _gradient, _rhs,
+   _output, _structure (Jr, Rr at a state), _hessian, _jacobian (analytic),
+   with phgmg_rom_eval_work_size reals of workspace.
+
+   5.2 Shipping a model. phgmg_rom_export_c writes C source (static const
+   arrays and a `static const phgmg_rom`), to be compiled after phgmg.h into
+   firmware; values round-trip exactly. phgmg_rom_serialize / _save write a
+   versioned, checksummed little-endian binary (format version 2; version 1
+   files still load); phgmg_rom_deserialize / _load read it into caller
+   memory, checking magic, version, sizes, checksum and values; a file written
+   by a double build loads into a float build and vice versa. Models that call
+   back into user code cannot be serialised; the C export references the
+   firmware's <name>_phi / <name>_eta instead (a GENERAL model: not at all).
+
+   5.3 Firmware builds. PHGMG_NO_OFFLINE compiles only the online half and the
+   in-memory (de)serialisation: libm only, no heap, no stdio. PHGMG_REAL_FLOAT
+   makes the online scalar float. examples/controller/ steps an exported model
+   on a Cortex-M4F (make embedded).
+
+
+   6. THE COMMAND LINE -----------------------------------------------------------
+   examples/phgmg_cli.c is a complete reducer on top of this header
+   (`make build/phgmg`, or cc -std=c99 -O2 examples/phgmg_cli.c -o phgmg -lm):
+     phgmg reduce       J, R, Q, B (or sparse triplets) as .npy, snapshots
+                        (--X) or --simulate, --method, --r, ... --out DIR:
+                        writes NAME.phgmgrom, NAME.c, NAME.json and the
+                        reduced operators as NAME_*.npy;
+     phgmg simulate-rom run a model file on an input, outputs (and states) as
+                        .npy;
+     phgmg validate     reduce, then test full against reduced model on each
+                        --test-input (exit 1 if one fails);
+     phgmg info         describe a model file.
+   `phgmg --help` lists every option with its default, the file formats and
+   examples. The reduction does not depend on the units of the states; GMG-QM's
+   lambda grid and the POD itself do (with ports of very different scale,
+   scale the inputs and check each port's e_y with validate).
+
+
+   7. ERRORS ---------------------------------------------------------------------
+   Every data-dependent failure is a negative phgmg_result (0 is success);
+   phgmg_result_string gives a stable text. The library never prints, exits or
+   aborts (PHGMG_ASSERT guards only contract violations of void helpers, e.g.
+   a NULL factorization handed to phgmg_jr_solve). For every failing call:
+   - the caller's inputs are never modified (systems, snapshots, options,
+     models, file images, the state of a failed step);
+   - objects returned through **out are NULL; nothing allocated stays
+     allocated (each single allocation failure included);
+   - caller-provided output arrays hold unspecified values, except where a
+     declaration says otherwise (phgmg_simulate and phgmg_reduced_simulate
+     keep the steps done);
+   - stateful objects stay usable (a stepper after a failed step).
+   The codes:
+     PHGMG_OK (0)                   success
+     PHGMG_ERR_INVALID_ARG (-1)     a NULL pointer, an unknown enum, missing
+                                    callbacks, dt not positive and finite, a
+                                    bad option (3.2), misaligned memory
+     PHGMG_ERR_SIZE (-2)            dimensions out of range; snapshots whose
+                                    numerical rank is below what the method
+                                    needs (r - m modes for GMG, r_n more for
+                                    GMG-QM, r for SP1/SP2)
+     PHGMG_ERR_WORKSPACE (-3)       caller memory smaller than the size query
+     PHGMG_ERR_NOMEM (-4)           the allocator returned NULL (offline only;
+                                    the error measures return NaN instead)
+     PHGMG_ERR_SINGULAR (-5)        J - R singular or too ill-conditioned; an
+                                    exactly zero pivot; D^T G D singular at a
+                                    state of a quadratic-manifold model
+     PHGMG_ERR_NANINF (-6)          NaN or Inf in the data, the input, the
+                                    state, or produced by a step
+     PHGMG_ERR_NOT_CONVERGED (-7)   a Newton step (also after one retry with
+                                    fresh factors), a Jacobi sweep limit, an
+                                    iteration cap
+     PHGMG_ERR_NOT_SKEW (-8)        ||J + J^T|| > tol ||J||
+     PHGMG_ERR_NOT_SYMMETRIC (-9)   R not symmetric
+     PHGMG_ERR_NOT_PSD (-10)        R not positive semidefinite
+     PHGMG_ERR_RANK (-11)           B not of full column rank; a rank-deficient
+                                    least-squares problem (phgmg_lstsq; GMG-QM
+                                    with lambda < 0 takes the minimum-norm
+                                    solution instead)
+     PHGMG_ERR_DEGENERATE (-12)     GMG non-degeneracy fails: rcond(D^T G D)
+                                    below degeneracy_tol at xr = 0 or (GMG-QM)
+                                    at a snapshot; SP1/SP2 likewise
+                                    (info->rcond_dgd says how close)
+     PHGMG_ERR_NEGATIVE_WEIGHT (-13) DEIM gave a negative weight and
+                                    deim_allow_negative is 0
+     PHGMG_ERR_FORMAT (-14)         a malformed model image or .npy file
+     PHGMG_ERR_IO (-15)             a file cannot be opened, read or written
+                                    (an existing path is never removed)
+     PHGMG_ERR_UNSUPPORTED (-16)    e.g. DEIM of a GENERAL part, serialising a
+                                    model with callbacks
+     PHGMG_ERR_Q_NOT_SYMMETRIC (-17) Q not symmetric
+     PHGMG_ERR_Q_NOT_PD (-18)       Q not positive definite (semidefinite with
+                                    a nonlinear part)
+     PHGMG_ERR_DTYPE (-19)          an unsupported .npy dtype
+     PHGMG_ERR_INEXACT (-20)        a 64-bit integer beyond 2^53 in a .npy
+     PHGMG_ERR_NOT_STABLE (-21)     an undamped mode (eigenvalue of (J - R) Q
+                                    on the imaginary axis): no Gramians
+     PHGMG_ERR_OVERFLOW (-22)       a result beyond the double range (e.g. an
+                                    energy of states ~1e160 in
+                                    phgmg_reduced_validate; the error norms
+                                    themselves are scaled), ECSW weights out
+                                    of range after scaling back
+     PHGMG_ERR_TOL_UNREACHABLE (-23) a relative tolerance below 1e-15 (ECSW,
+                                    hence hyper_tol)
+     PHGMG_ERR_NOT_STABILIZABLE (-24) no stabilizing Riccati solution
+                                    (phgmg_care)
+     PHGMG_ERR_STALE (-25)          the system changed after
+                                    phgmg_study_create (phgmg_study_reduce)
+     PHGMG_ERR_STRUCTURE (-26)      an intact model file that is not a pH model
+                                    of its kind (Qh not positive definite,
+                                    dissipation not PSD, a step map not of its
+                                    dt): phgmg_rom_deserialize / _load
+     PHGMG_ERR_STEP_MAP (-27)       the step map of a dissipative model would
+                                    grow in the energy norm (phgmg_reduce with
+                                    opts.dt)
+     PHGMG_ERR_E_SINGULAR (-28)     the mass matrix E is singular to working
+                                    precision (descriptor models, 1.6)
+     PHGMG_ERR_EQ_NOT_SYMMETRIC (-29) E^T Q not symmetric (descriptor models)
+     PHGMG_ERR_EQ_NOT_PD (-30)      E^T Q not positive definite (semidefinite
+                                    with a nonlinear part)
+     PHGMG_ERR_E_COUPLED (-31)      a row of E at a nonlinear coordinate is not
+                                    a positive multiple of the unit row
+     PHGMG_ERR_FEEDTHROUGH (-32)    [[R, P], [P^T, S]] not symmetric PSD, or N
+                                    not skew
+   The declaration of each function lists the codes it returns and when.
+
+
+   8. NUMERICAL NOTES: WHAT THE PAPER LEAVES OPEN AND WHAT PHGMG DECIDED -----------
+   8.1 Time integration. Gauss-Legendre with three stages; its coefficients
+   come from their closed forms (phgmg_gl3_coefficients), not from decimals.
+   The 3N stage system is solved in the eigenbasis of A^{-1} (one real and one
+   complex N x N system per simplified-Newton iteration), factors reused while
+   the iteration contracts, the guess extrapolated from the last step's
+   collocation polynomial. A linear model with fixed step is a linear map,
+   precomputed once. Newton stops when the inf-norm of the stage residual is
+   <= tol after at least one update (full and reduced steppers alike). An
+   explicit tol is absolute, in the units of the state; the default (1e-10,
+   1e-5 in float) is multiplied by max(1, |x|_inf, |Z|_inf), so a model whose
+   states are large in its units still converges, and a small-state model is
+   never accepted on the unsolved extrapolated guess.
+
+   8.2 Energy balance. The supplied energy h sum b_i y_i^T u_i and the
+   dissipated energy h sum b_i gradH(Y_i)^T R gradH(Y_i) are summed at the
+   stage values with the inputs the stepper used. For a quadratic H the
+   balance H(x+) - H(x) = supplied - dissipated then holds to round-off; a
+   trapezoidal rule on the time grid would measure the quadrature instead.
+
+   8.3 Dense kernels. The thin SVD of a tall, numerically rank-deficient
+   snapshot matrix is a QR with column pivoting truncated at the numerical rank
+   followed by one-sided Jacobi on the small triangular factor; the Gram-matrix
+   route would lose the small singular values that DEIM's 1e-8 truncation
+   needs. The randomized POD is offered for large N only where the small
+   values do not matter, and checked a posteriori.
+
+   8.4 Structure and orderings. Every reduction is equivariant under a
+   permutation of the states: reordering a model (e.g. into a band) changes the
+   full-dimension vectors, not the reduced model. Models bring their structure
+   (banded storage, a sparse reordering, or their own shifted solves).
+
+   8.5 Quadratic manifold. The Jacobian of phi is affine in x2, so
+   D^T G D, the reduced gradient of a quadratic H and the hyper-reduction rows
+   are small polynomials in x2 whose coefficients (V0^T G V0, V0^T G V2,
+   V2^T G V2, ...) are computed offline: the online cost is independent of N,
+   and the Newton Jacobian is analytic. The ridge problem for M has equal
+   columns (i, j) and (j, i) in the paper's full Kronecker form; its ridge
+   solution is symmetric, so phgmg solves the same problem over the p(p+1)/2
+   distinct columns and expands (same minimiser). lambda is applied to the
+   un-normalised sum over the snapshots, as in the paper. The reduced stepper
+   treats the stage values E(Y_i)^{-1} gradH(Y_i), E = D^T G D, as unknowns
+   beside the stage increments (mass-matrix form): an iteration needs only
+   products with E and solves with factors of E kept from an earlier state;
+   E is refactored every 8 steps and after a step needing more than one
+   iteration, and a slowly contracting step is redone with exact stage
+   values (stats.exact_steps, stats.e_refreshes). The converged stages are
+   those of the ordinary GL3 method.
+
+   8.6 Choosing lambda. Held-out time blocks of the training trajectory
+   measure the regression: they pick lambda around 1e-12 ... 1e-14, and the
+   reduced model is excellent on the training input and fails (large e_y or a
+   Newton failure) on a constant, a faster sine or a chirp. Hence
+   lambda_auto = 1 validates by simulating the reduced model on data it was
+   not fitted to, with GMG-POD's linear limit as the safe fallback (4.2).
+   The grid is absolute: for reduced coordinates far from unit size, set
+   lambda_min / lambda_max to the scale of the quadratic features (|z|^4).
+
+   8.7 Hyper-reduction. Approximating the gradient (plain DEIM) breaks the
+   pH structure; approximating the energy keeps it. The paper's weights
+   (P^T U)^{-T} U^T 1 depend on the points and can be negative (on the
+   paper's nonlinear chain driven by u = 0.1 both Q-DEIM and greedy points
+   give one), which can make the reduced energy unbounded below. phgmg therefore
+   defaults to non-negative weights by empirical quadrature and refuses
+   negative DEIM weights unless asked. DEIM's mode count is the relative
+   criterion sigma_k / sigma_1 > deim_tol.
+
+   8.8 Readings of the paper. (a) SP2's reduction matrix as printed is
+   dimensionally inconsistent; phgmg takes W = V_grad (V_POD^T V_grad)^{-1}
+   (so W^T V_POD = I) and the pH form xr' = W^T (J - R) W gradHr + W^T B u,
+   Hr(xr) = H(V_POD xr), yr = (W^T B)^T gradHr. (b) SP1: V = V_POD,
+   W = QV(V^TQV)^{-1}, Q the Hessian of the quadratic part; its point
+   reduction is rho(x) = W^T x. (c) The reduced initial state is rho(x0).
+   (d) The paper's nonlinear example: mass 1 in the Hamiltonian (the explicit
+   decomposition's Q = blockdiag(Q0, I)) and damping 0.3, reduced and
+   measured in the coordinates l_i = xi_i - xi_{i+1}, stored interleaved so
+   that the Newton matrices are banded; its lambda is max(0.2 e_proj(r),
+   10^-2.5), e_proj of the linear GMG map at the same r. These choices are
+   the examples' (examples/msd_models.h), not the library's.
+
+   8.9 Non-degeneracy. GMG needs det(D^T G D) != 0. phgmg estimates the
+   reciprocal condition number with the port columns of D scaled to unit
+   length, so the result does not depend on the units of B or of the states,
+   at xr = 0 and (GMG-QM) at every snapshot. Examples: R = 0 makes G skew, so
+   every odd r fails.
+
+   8.10 Tiny numbers and the floating-point environment. The decaying tail of
+   a wave through a chain at rest passes through the subnormal range, where
+   some processors compute about 100x slower. The steppers set entries of
+   their own vectors below max(DBL_MIN, PHGMG_GL3_FLUSH_REL |x|_inf) to zero
+   (phgmg_gl3_opts.keep_tiny = 1 turns it off); the library never reads or
+   changes the floating-point environment (rounding mode, FTZ/DAZ).
+
+   8.11 Linear systems. For a linear model GMG-POD is a Petrov-Galerkin
+   projection with the test space G^T V, V = orth([B, Vbar]); its model depends
+   on the basis alone, which is why bases from Gramians or frequency samples
+   (and the basis of least H2 error) keep the structure and can beat a
+   single-trajectory POD by orders of magnitude off the training input. Zero
+   feedthrough makes the positive-real Riccati equations singular; phgmg
+   solves the exact limit (the constraint X B = C^T eliminated in the frame
+   [B, ker C]) instead of regularising, so the pH model is the balanced
+   projection itself (details at phgmg_prbt).
+
+
+   9. CONFIGURATION MACROS (define before including) -----------------------------
+     PHGMG_IMPLEMENTATION  compile the implementation in this translation unit
+     PHGMG_STATIC          all functions static (private copy per translation unit)
+     PHGMG_DEF             storage class of the public functions (default extern)
+     PHGMG_REAL_FLOAT      online scalar phgmg_real = float (default double);
+                           the offline half stays double
+     PHGMG_NO_OFFLINE      compile only the online half (+ export/import in memory):
+                           needs libm only, no heap, no stdio
+     PHGMG_NO_STDIO        no file functions (.npy files, model files, C export)
+     PHGMG_NPY_MAX_HEADER  longest accepted .npy header in bytes (default 1 MiB)
+     PHGMG_MALLOC(sz,u) / PHGMG_FREE(p,u)   default allocator (both or neither)
+     PHGMG_ASSERT(x)       internal invariant checks (default assert)
+     PHGMG_USE_CBLAS       use cblas_dgemm/cblas_dgemv (optional speed-up)
+     PHGMG_USE_OPENMP      with -fopenmp: phgmg_gemm runs its row blocks in
+                           parallel (off by default; same results; OMP_NUM_THREADS)
+     PHGMG_GL3_STEP_MAP_MAX_N  largest dense linear model that gets a step map
+                           in the full-order stepper (default 1000)
+     PHGMG_GL3_FLUSH_REL   relative flush threshold of tiny entries (1e-60)
+     PHGMG_POD_RANDOMIZED_MIN  phgmg_pod with tol <= 0 switches to the randomized
+                           POD when N*ns >= this (default 0: never; see phgmg_pod)
+     PHGMG_POD_OVERSAMPLE, PHGMG_POD_POWER_ITERS, PHGMG_POD_SEED  its parameters
+                           (20, 2, a fixed seed)
+     PHGMG_POD_AUTO_MIN    phgmg_reduce takes the randomized POD (checked, exact
+                           fallback) when N*ns >= this (default 2e7; <= 0: never)
+     PHGMG_POD_CHECK_TOL   its acceptance: backward error <= this * sigma_1 (1e-10)
+     PHGMG_ECSW_SCREEN_MIN phgmg_ecsw(_separable) screen candidates from this many
+                           terms on (default 4096; no n x n Gram matrix)
+     PHGMG_ECSW_SCREEN_ADD candidates added per screening round (default 64)
+     PHGMG_ECSW_SCREEN_ROUNDS  cap on screening rounds (default 200)
+
+
+   10. INDEX OF PUBLIC FUNCTIONS -------------------------------------------------
+   Every public function, by header section (full contract at the declaration).
+   result: phgmg_result_string
+   linalg: phgmg_gemm, phgmg_gemv, phgmg_lu_factor, phgmg_lu_solve,
+           phgmg_lu_rcond, phgmg_norm1, phgmg_normf, phgmg_zlu_factor,
+           phgmg_zlu_solve, phgmg_qr, phgmg_qrcp, phgmg_qr_form_q,
+           phgmg_qr_apply, phgmg_lstsq, phgmg_svd, phgmg_sym_eig
+   ph:     phgmg_ph_validate, phgmg_ph_hamiltonian, phgmg_ph_gradient,
+           phgmg_ph_rhs, phgmg_ph_output, phgmg_ph_apply,
+           phgmg_jr_factor_create, phgmg_jr_solve, phgmg_jr_factor_destroy,
+           phgmg_rcm, phgmg_ph_sparse_create, phgmg_ph_sparse_create_e,
+           phgmg_ph_sparse_system,
+           phgmg_ph_sparse_perm, phgmg_ph_sparse_sep_idx,
+           phgmg_ph_sparse_to_banded_order, phgmg_ph_sparse_to_user_order,
+           phgmg_ph_sparse_destroy, phgmg_gl3_create, phgmg_gl3_destroy,
+           phgmg_gl3_step, phgmg_gl3_get_stats, phgmg_simulate,
+           phgmg_gl3_coefficients
+   online: phgmg_rom_check, phgmg_rom_eval_work_size, phgmg_rom_hamiltonian,
+           phgmg_rom_gradient, phgmg_rom_rhs, phgmg_rom_output,
+           phgmg_rom_structure, phgmg_rom_hessian, phgmg_rom_jacobian,
+           phgmg_rom_stepper_memsize, phgmg_rom_stepper_memsize_dt,
+           phgmg_rom_stepper_init, phgmg_rom_stepper_reset,
+           phgmg_rom_stage_times, phgmg_rom_step
+   reduce: phgmg_pod, phgmg_pod_randomized, phgmg_adjust_snapshots,
+           phgmg_runs_columns, phgmg_simulate_inputs,
+           phgmg_reduce_opts_default, phgmg_reduce, phgmg_reduced_destroy,
+           phgmg_reduced_rom, phgmg_reduced_N, phgmg_reduced_lift,
+           phgmg_reduced_restrict, phgmg_reduced_dphi, phgmg_reduced_W,
+           phgmg_reduced_simulate, phgmg_reduced_validate, phgmg_rel_error,
+           phgmg_err_red, phgmg_err_proj, phgmg_err_lowerbound,
+           phgmg_err_energy, phgmg_study_create, phgmg_study_destroy,
+           phgmg_study_basis, phgmg_study_reduce, phgmg_study_errors,
+           phgmg_pod_hierarchical, phgmg_deim, phgmg_deim_select, phgmg_nnls,
+           phgmg_ecsw, phgmg_ecsw_separable
+   linear: phgmg_lyap, phgmg_care, phgmg_lyap_residual, phgmg_care_residual,
+           phgmg_ph_abc, phgmg_bt, phgmg_prbt_riccati, phgmg_prbt,
+           phgmg_linear_basis, phgmg_ss_transfer, phgmg_reduced_abc,
+           phgmg_ss_error
+   export: phgmg_rom_serialized_size, phgmg_rom_serialize,
+           phgmg_rom_deserialize_size, phgmg_rom_deserialize, phgmg_rom_save,
+           phgmg_rom_load, phgmg_rom_export_c
+   npy:    phgmg_npy_parse, phgmg_npy_serialize, phgmg_npy_free,
+           phgmg_npy_read, phgmg_npy_write
+   (112 functions; also the macros PHGMG_ROM_STEPPER_MEMSIZE_MAX and _MAX_CB.)
 */
 #ifndef PHGMG_H_INCLUDED
 #define PHGMG_H_INCLUDED
 
 /* >>config ================================================================ */
 #define PHGMG_VERSION_MAJOR 0
-#define PHGMG_VERSION_MINOR 1
+#define PHGMG_VERSION_MINOR 2
 #define PHGMG_VERSION_PATCH 0
-#define PHGMG_VERSION_STRING "0.1.0"
+#define PHGMG_VERSION_STRING "0.2.0"
 
 #include <stddef.h>
 
@@ -590,7 +1169,7 @@ PHGMG_DEF phgmg_result phgmg_rcm(int N, int na, const phgmg_csc *const *A, int *
    phgmg_rcm, also for Bcsc), _NANINF (a stored value or an entry of B not
    finite), _NOMEM. *out is NULL on failure.
 
-   Orderings. Every reduction is permutation-equivariant (NUMERICS 3): reduce
+   Orderings. Every reduction is permutation-equivariant (manual 8.4): reduce
    the internal system with snapshots in the internal ordering
    (phgmg_ph_sparse_to_banded_order on the user's snapshot matrix, or simulate
    the internal system). The reduced model (phgmg_reduced_rom) is then the
@@ -808,7 +1387,7 @@ typedef enum phgmg_method {
   PHGMG_METHOD_GMG_POD = 1, /* phi = [B, Vbar] x, GMG reduction (paper 4.2.1)         */
   PHGMG_METHOD_GMG_QM = 2,  /* quadratic manifold, GMG reduction (paper 4.2.2)        */
   PHGMG_METHOD_SP1 = 3,     /* SP1-POD: phi = V_POD x, W = QV(V^TQV)^-1 (eq. 5.3)     */
-  PHGMG_METHOD_SP2 = 4,     /* SP2-POD: W = V_gradH (V_POD^T V_gradH)^-1 (NUMERICS 6.3) */
+  PHGMG_METHOD_SP2 = 4,     /* SP2-POD: W = V_gradH (V_POD^T V_gradH)^-1 (manual 8.8) */
   PHGMG_METHOD_GMG_MANIFOLD = 5, /* your own manifold phi = [B, V1] x + V2 eta(x2), GMG reduction */
   PHGMG_METHOD_PRBT = 6     /* positive-real balanced truncation, pH form (phgmg_prbt, >>linear) */
 } phgmg_method;
@@ -1161,30 +1740,14 @@ typedef struct phgmg_reduce_opts {
   const int *deim_pts;
   const double *deim_w;
   int deim_count;
-  /* GMG-QM automatic lambda (all zero = off: the paper's fixed lambda above).
-     lambda_auto = 1 (recommended): validation by simulation of the reduced
-     model, see opts.runs below; it starts from the regression choice of
-     lambda_auto = 2 and moves towards the linear limit.
-     lambda_auto = 2 (regression only; picks lambda ~ 1e-12 on one trajectory,
-     which overfits -- NUMERICS 8.2): the snapshots are cut into lambda_blocks contiguous
-     blocks in time, block j going to validation fold j mod lambda_folds. For
-     each fold, M is fitted on the other snapshots for every lambda of the grid
-     lambda_min * 10^(g / lambda_per_decade) <= lambda_max (one thin SVD of
-     the training rows, then a small product per lambda) and predicts the
-     quadratic correction V2^T x of the held-out snapshots. The lambda with
-     the smallest held-out error summed over the folds (ties within a relative
-     1e-6: the largest) fits M on all snapshots. Guard: while rcond(D^T G D)
-     at some snapshot is below lambda_rcond times its value at x = 0 (or below
-     degeneracy_tol), the next larger grid lambda is used (info.lambda_raised);
-     when even lambda_max does not make it regular (the grid is absolute, so
-     it can be small for states that are large in their units), M = 0: the
-     linear limit, info.lambda = HUGE_VAL (tests/test_online.c).
-     Cost: lambda_folds SVDs of (ns - ns/folds) x p(p+1)/2 matrices, about
-     50 ms at r - m = 18, ns = 1001. Errors: PHGMG_ERR_INVALID_ARG for
-     lambda_auto not 0/1/2, bounds negative, NaN, Inf or lambda_min > lambda_max,
-     lambda_per_decade outside 1..100, lambda_folds < 2, lambda_blocks < 0,
-     lambda_rcond outside [0, 1], a grid of more than 1000 points;
-     PHGMG_ERR_SIZE for lambda_blocks < lambda_folds or > ns. Off: ignored. */
+  /* GMG-QM automatic lambda (manual 4.2; all zero = off: the fixed lambda
+     above). 1: validated by simulating the reduced model on opts.runs and
+     three probe inputs (M = 0 without runs); 2: regression validation on
+     held-out time blocks. PHGMG_ERR_INVALID_ARG for lambda_auto not 0/1/2,
+     bounds negative, NaN, Inf or lambda_min > lambda_max, lambda_per_decade
+     outside 1..100, lambda_folds < 2, lambda_blocks < 0, lambda_rcond outside
+     [0, 1], a grid of more than 1000 points; PHGMG_ERR_SIZE for lambda_blocks
+     < lambda_folds or > ns. info.lambda = HUGE_VAL when M = 0 was chosen. */
   int lambda_auto;
   double lambda_min;     /* smallest grid lambda, > 0 (0: 1e-14)                 */
   double lambda_max;     /* largest grid lambda (0: 1)                           */
@@ -1193,44 +1756,18 @@ typedef struct phgmg_reduce_opts {
   int lambda_blocks;     /* contiguous blocks, lambda_folds..ns (0: min(ns, 100)) */
   double lambda_rcond;   /* conditioning guard, relative to rcond(D^T G D) at x = 0,
                             in [0, 1] (0: 1e-6)                                  */
-  /* PHGMG_METHOD_GMG_MANIFOLD (required there, ignored otherwise): your own
-     manifold phi(x) = B x1 + V1 x2 + V2 eta(x2), x = (x1, x2), with eta:
-     R^p -> R^rn (p = r - m, rn = opts.rn >= 1) and its first and second
-     derivatives by this callback (see phgmg_eta_fn). This is the paper's
-     general embedding phi = B x1 + Vbar eta~(x2) with Vbar = [V1, V2] and
-     eta~(x2) = (x2, eta(x2)): the identity part keeps the point reduction
-     rho(x) = ([B, V1]^+ x) a left inverse of phi. V1, V2 come from the
-     hierarchical POD (as for GMG-QM) or from opts.pod_basis (checked to be
-     orthonormal and orthogonal to B: PHGMG_ERR_RANK otherwise). The reduced
-     model calls eta online (phgmg_rom.eta_cb); its online cost stays
-     independent of N (the same G- and Q-blocks as GMG-QM). GMG-QM is the
-     built-in case eta(x2) = M (x2 kron x2). */
+  /* PHGMG_METHOD_GMG_MANIFOLD (required there, ignored otherwise): the map
+     eta: R^p -> R^rn of phi(x) = B x1 + V1 x2 + V2 eta(x2) (p = r - m,
+     rn = opts.rn >= 1) and its derivatives (phgmg_eta_fn; manual 3.1). V1, V2
+     from the hierarchical POD or opts.pod_basis (orthonormal and orthogonal
+     to B, else PHGMG_ERR_RANK). The reduced model calls eta online. */
   phgmg_eta_fn eta;
   void *eta_user;
   /* The runs that made X (nrun >= 1, columns as phgmg_simulate_inputs lays
-     them out; sum of nsteps + 1 must equal ns: PHGMG_ERR_SIZE otherwise).
-     0/NULL: X is one run of unknown input. With runs, the regression
-     validation of lambda_auto = 2 leaves one run out (for nrun >= 2), and
-     lambda_auto = 1 validates by simulation (NUMERICS 8.2): the finished
-     reduced model is simulated, for candidate lambdas, on every training run
-     (reference: the snapshots' outputs) and on three probe runs it was not
-     fitted to -- the full model driven from runs[0].x0 by a constant at the
-     RMS level of runs[0].u (per port), by runs[0].u played 1.5x faster and by
-     the square wave RMS * sign(runs[0].u(t)) -- and each run's output error
-     e_y is compared with the linear limit M = 0 (GMG-POD on the same basis).
-     Candidates: lambda_max, then one per decade (lambda_per_decade grid
-     steps) down to the regression optimum; the descent stops after two
-     inadmissible candidates in a row. Admissible: no simulation fails, at
-     most 4 Newton iterations per step on average (the predicted-trouble
-     guard), and every run's e_y at most lambda_tolerance times the linear
-     limit's. Kept: the largest admissible lambda with at least half of the
-     best admissible gain (sum of log ratios); none: M = 0 (info.lambda =
-     HUGE_VAL). Without runs, lambda_auto = 1 cannot simulate and keeps M = 0.
-     Cost: three full-model probe runs plus (nrun + 3) reduced runs per
-     candidate (runs with the same x0 and bit-identical inputs at every
-     stage time are simulated once; a candidate's evaluation stops at its
-     first inadmissible run), 4-8 candidates: 0.3-0.5 s on the paper's linear chain and 1-2.5 s
-     on its nonlinear chain (N = 1000, DEIM) at r = 20, 1000 steps. */
+     them out; the sum of nsteps + 1 must equal ns, else PHGMG_ERR_SIZE).
+     0/NULL: X is one run of unknown input. Used by lambda_auto (manual 4.2):
+     1 simulates every training run and three probe runs made from runs[0];
+     2 leaves one run out per fold (nrun >= 2). */
   int nrun;
   const phgmg_run *runs;
   double lambda_tolerance; /* admissible ratio to the linear limit (0: 1.02) */
@@ -1238,31 +1775,11 @@ typedef struct phgmg_reduce_opts {
                               the full model; the stepper's default for the reduced
                               one, 1e-10 double / 1e-5 float)                     */
   int newton_iter;         /* validation simulations: iteration cap (0: 20)      */
-  /* GMG-QM manifold: 0 = the paper's hierarchical POD (V1 = leading POD modes);
-     1 = greedy: V1 chosen column by column among the leading (r - m) + rn
-     POD modes of the adjusted snapshots (rn: the cap, or 8 with a wide V2;
-     see greedy_window), each time the mode whose
-     coordinates best predict the other candidates' by the quadratic ridge
-     fit (Schwerdtner & Peherstorfer 2024; ridge lambda 1e-9 with lambda_auto,
-     else opts.lambda; every ceil(ns/400)-th snapshot); V2 = what [B, V1]
-     leaves: wide by default, else its POD as for 0 (see rn). Cost: about
-     (r - m)(r - m + rn) small least-squares solves (0.1-0.5 s at r = 20).
-     2 = alternating minimization (PHGMG_MANIFOLD_ALTMIN; after Geelen,
-     Balzano, Wright & Willcox 2023): V1, V2 rotated within the leading
-     2 (r - m + rn) POD modes of the adjusted snapshots (rn: the cap, or 8
-     with a wide V2, which then replaces the sweeps' V2), alternating the ridge
-     fit of M with an orthogonal Procrustes step (extrapolated while that
-     helps), started from 0, each sweep kept only if the training objective
-     sum ||x - phi(rho(x))||^2 + lam ||M||^2 decreases (so it ends at or below
-     the hierarchical POD's; info.manifold_obj0/obj; lam as for 1); at most
-     100 sweeps. B stays in the span, [B, V1, V2] orthonormal.
-     With lambda_auto = 1 the linear limit M = 0 on the altmin basis is not
-     GMG-POD, so the validation also simulates GMG-POD and admits a lambda
-     only if the model beats both; with none admissible and the altmin linear
-     limit worse than GMG-POD, the model of manifold = 0 is returned
-     (info.manifold_fallback = 1). Cost: 0.05-2.5 s for the sweeps at r = 8-20
-     (N-independent but for one POD), plus one GMG-POD build and its
-     validation runs under lambda_auto = 1. */
+  /* GMG-QM manifold construction (manual 3.3): PHGMG_MANIFOLD_POD (0, the
+     paper's hierarchical POD), _GREEDY (1, greedy linear part), _ALTMIN (2,
+     alternating minimization; falls back to the POD manifold under
+     lambda_auto = 1 when it beats neither reference: info.manifold_fallback).
+     Greedy and altmin take a wide V2 by default (see rn). */
   int manifold;
   /* manifold = 1 with a wide V2 (rn = 0 or PHGMG_RN_WIDE): 0 (default) =
      the candidates for V1 and their score as described under manifold (the
@@ -1277,13 +1794,9 @@ typedef struct phgmg_reduce_opts {
      one SVD of the adjusted snapshots: 3-10 s at r - m = 12-20, window 200,
      N = 4096, ns = 1000 (two shared cores). */
   int greedy_window;
-  /* lambda_auto = 1 with lambda_train_only = 1: validate on the training runs
-     alone (no probe runs): from the regression optimum up (one per decade),
-     the first lambda whose model simulates every training run without Newton
-     trouble and with e_y at most lambda_tolerance times the linear limit's --
-     the most accurate model on the training inputs, in practice. Use it with several training
-     runs, or to measure the manifold's best case; it does not guard against
-     inputs unlike the training ones. */
+  /* With lambda_auto = 1: 1 = validate on the training runs alone, no probe
+     runs (manual 4.2): the most accurate model on the training inputs; no
+     guard against unlike inputs. */
   int lambda_train_only;
   /* Optional progress report for long reductions (NULL: none; the library
      itself never prints): phgmg_reduce calls progress(phase, progress_user)
@@ -1295,6 +1808,14 @@ typedef struct phgmg_reduce_opts {
   void (*progress)(const char *phase, void *user);
   void *progress_user;
 } phgmg_reduce_opts;
+
+/* The defaults of phgmg_reduce_opts (the table in manual 3.2): *o is zeroed
+   and every field whose zero stands for a default gets that default. A zeroed
+   struct and this one reduce identically (with method and r set); use it to
+   show or start from the defaults. Left 0: method and r (required),
+   lambda_blocks (min(ns, 100): needs the snapshots), newton_tol (the
+   steppers' own defaults), the optional pointers and flags. */
+PHGMG_DEF void phgmg_reduce_opts_default(phgmg_reduce_opts *o);
 
 typedef struct phgmg_reduce_info {
   int deim_modes;          /* DEIM points kept (nd)                          */
@@ -1349,36 +1870,16 @@ typedef struct phgmg_reduce_info {
 typedef struct phgmg_reduced phgmg_reduced;
 
 /* Build a reduced model of `sys` from snapshots X (N x ns, ldx). The system must
-   validate (phgmg_ph_validate). The pipeline (each stage a function of its own,
-   phgmg__stage_*): basis (POD; [B, V1] for GMG) -> manifold (GMG-QM: V2 and the
-   ridge fit of M; GMG_MANIFOLD: V2 and your eta) -> reduction blocks (GMG: the
-   G-blocks V0^T G V0 ... and the non-degeneracy check; SP1/SP2: W) ->
-   Hamiltonian terms (quadratic blocks; a separable part by DEIM or every term;
-   a GENERAL part) -> GL3 step map (LINEAR map, quadratic H, opts.dt > 0).
-   Every kind of Hamiltonian reduces with every method:
-   - quadratic, and separable with the built-in exp-polynomial family: the
-     online cost is independent of N, the model exports (C and binary);
-   - separable with callbacks: the online model calls the system's phi/dphi/
-     ddphi through phgmg_rom.phi_cb (O(nd) per evaluation; the C export names
-     the function `<name>_phi` for the firmware to supply; no binary export);
-   - GENERAL (H_nl, grad, Hessian by callbacks): the reduced gradient
-     Dphi^T grad H_nl(phi(x)) and Hessian are evaluated in FULL dimension
-     through phgmg_rom.ham_cb -- O(N) per gradient, O(N^2 r) (dense) or
-     O(N kb r) (banded) per Hessian, info.online_full_dim = 1; the reduced
-     object must outlive the model and is not thread-safe in evaluation; not
-     exportable (PHGMG_ERR_UNSUPPORTED); DEIM does not apply (opts.deim = 1
-     gives PHGMG_ERR_UNSUPPORTED).
-   POD of the basis: the exact SVD (phgmg_pod), except for large snapshot sets
-   (N*ns >= PHGMG_POD_AUTO_MIN, default 2e7, and 4 (r' + 20) <= min(N, ns) for
-   the r' modes wanted): phgmg_pod_randomized (2 power iterations, 20 extra
-   columns), then the a-posteriori check ||X W - V diag(S)||_F <= 1e-10 S_1
-   (PHGMG_POD_CHECK_TOL; W: its right singular vectors, X^T V = W diag(S) by
-   construction, so the modes are the exact POD of a matrix within that
-   distance of X); if it fails, the exact SVD. info.pod_randomized and
-   info.pod_check say which. GMG-POD then works on X - B B^+ X implicitly,
-   without its N x ns copy (GMG-QM/GMG_MANIFOLD keep the copy: their
-   manifold stage needs it, and take the exact POD there). The paper's demo models
-   (N <= 4000) stay on the exact path, bit for bit.
+   validate (phgmg_ph_validate). The stages and the model kinds are described in
+   the manual (2.2, 3.1-3.4): every Hamiltonian kind reduces with every method;
+   a GENERAL part makes the online model evaluate in full dimension
+   (info.online_full_dim = 1, not exportable, the reduced object must outlive
+   the model and is not thread-safe in evaluation); separable callbacks make it
+   call back (phgmg_rom.phi_cb; no binary export). For N*ns >=
+   PHGMG_POD_AUTO_MIN the basis comes from the randomized POD, accepted when
+   ||X W - V diag(S)||_F <= PHGMG_POD_CHECK_TOL S_1 and otherwise replaced by
+   the exact SVD (info.pod_randomized, info.pod_check); smaller problems take
+   the exact path bit for bit.
    Errors: PHGMG_ERR_INVALID_ARG (NULL, bad options: method, deim not 0/1,
    deim_tol NaN or outside [0, 1), dt NaN/Inf/negative, lambda NaN,
    GMG_MANIFOLD without eta or rn), PHGMG_ERR_SIZE (r <= m for GMG, r > rank of
@@ -9452,7 +9953,8 @@ PHGMG__PRIV phgmg_result phgmg__qm_fit(phgmg_reduced *red, int ns, const double 
 typedef struct phgmg__rctx {
   phgmg_reduced *red;
   const phgmg_ph_system *sys;
-  const phgmg_reduce_opts *o;
+  phgmg_reduce_opts ro;    /* the caller's options with the defaults applied */
+  const phgmg_reduce_opts *o; /* &ro */
   const double *X;
   int ldx, ns;
   const phgmg_allocator *alloc;
@@ -9539,7 +10041,7 @@ PHGMG__PRIV phgmg_result phgmg__deploy_check(const phgmg_reduce_opts *o, int ns)
   if (o->nrun < 0 || (o->nrun > 0 && !o->runs) || o->nrun > PHGMG__NVAL_MAX - 3) return PHGMG_ERR_INVALID_ARG;
   if (o->nrun > 0 && phgmg_runs_columns(o->nrun, o->runs) < 0) return PHGMG_ERR_INVALID_ARG;
   if (o->nrun > 0 && phgmg_runs_columns(o->nrun, o->runs) != ns) return PHGMG_ERR_SIZE;
-  if (!(o->lambda_tolerance == 0.0 || (o->lambda_tolerance >= 1.0 && o->lambda_tolerance < HUGE_VAL)))
+  if (!(o->lambda_tolerance >= 1.0 && o->lambda_tolerance < HUGE_VAL))
     return PHGMG_ERR_INVALID_ARG;
   if (!(o->newton_tol >= 0.0 && o->newton_tol < 1.0) || o->newton_iter < 0) return PHGMG_ERR_INVALID_ARG;
   if (o->manifold < PHGMG_MANIFOLD_POD || o->manifold > PHGMG_MANIFOLD_ALTMIN) return PHGMG_ERR_INVALID_ARG;
@@ -9547,8 +10049,38 @@ PHGMG__PRIV phgmg_result phgmg__deploy_check(const phgmg_reduce_opts *o, int ns)
   return PHGMG_OK;
 }
 
-/* Options and sizes; nothing allocated. X_checked: X is known finite (a
-   study checked it). */
+/* The one place where the defaults of phgmg_reduce_opts are applied (manual
+   3.2): every field left 0 takes its default; ns > 0 also resolves
+   lambda_blocks. Invalid values are kept for phgmg__reduce_check to refuse.
+   GMG_MANIFOLD has no default r_n (the caller's eta fixes it); newton_tol
+   stays 0 (the steppers' defaults). Idempotent. */
+PHGMG__PRIV void phgmg__reduce_opts_resolve(phgmg_reduce_opts *o, int ns) {
+  /* rn = 0: the paper's r_n = 8 with the hierarchical POD manifold, V2 as wide
+     as the data (PHGMG_RN_WIDE) with the greedy and altmin manifolds */
+  if (o->rn == 0 && o->method != PHGMG_METHOD_GMG_MANIFOLD)
+    o->rn = (o->method == PHGMG_METHOD_GMG_QM && o->manifold != PHGMG_MANIFOLD_POD) ? PHGMG_RN_WIDE : 8;
+  if (o->lambda == 0.0) o->lambda = 1e-3;
+  if (o->deim_tol == 0.0) o->deim_tol = 1e-8;
+  if (o->hyper_tol == 0.0) o->hyper_tol = 1e-6;
+  if (o->degeneracy_tol == 0.0) o->degeneracy_tol = 1e-12;
+  if (o->lambda_min == 0.0) o->lambda_min = 1e-14;
+  if (o->lambda_max == 0.0) o->lambda_max = 1.0;
+  if (o->lambda_per_decade == 0) o->lambda_per_decade = 4;
+  if (o->lambda_folds == 0) o->lambda_folds = 5;
+  if (o->lambda_blocks == 0 && ns > 0) o->lambda_blocks = PHGMG__MIN(ns, 100);
+  if (o->lambda_rcond == 0.0) o->lambda_rcond = 1e-6;
+  if (o->lambda_tolerance == 0.0) o->lambda_tolerance = 1.02;
+  if (o->newton_iter == 0) o->newton_iter = 20;
+}
+
+PHGMG_DEF void phgmg_reduce_opts_default(phgmg_reduce_opts *o) {
+  if (!o) return;
+  memset(o, 0, sizeof *o);
+  phgmg__reduce_opts_resolve(o, 0);
+}
+
+/* Options (resolved by phgmg__reduce_opts_resolve) and sizes; nothing
+   allocated. X_checked: X is known finite (a study checked it). */
 PHGMG__PRIV phgmg_result phgmg__reduce_check(const phgmg_ph_system *sys, const double *X, int ldx, int ns,
                                              const phgmg_reduce_opts *o, int X_checked) {
   const int N = sys->N, m = sys->m, r = o->r;
@@ -9572,14 +10104,11 @@ PHGMG__PRIV phgmg_result phgmg__reduce_check(const phgmg_ph_system *sys, const d
   if (sys->nl == PHGMG_NL_SEPARABLE && sys->poly_deg > 32) return PHGMG_ERR_SIZE;
   if (!X_checked && !phgmg__mat_finite(N, ns, X, ldx)) return PHGMG_ERR_NANINF; /* padding rows are not data */
   if (o->lambda_auto) {
-    const double lo = o->lambda_min == 0.0 ? 1e-14 : o->lambda_min;
-    const double hi = o->lambda_max == 0.0 ? 1.0 : o->lambda_max;
-    const int nf = o->lambda_folds == 0 ? 5 : o->lambda_folds;
-    const int nb = o->lambda_blocks == 0 ? PHGMG__MIN(ns, 100) : o->lambda_blocks;
+    const int nf = o->lambda_folds, nb = o->lambda_blocks;
     if ((o->lambda_auto != 1 && o->lambda_auto != 2) || o->lambda_per_decade < 0 || nf < 2 || nb < 0)
       return PHGMG_ERR_INVALID_ARG;
     if (!(o->lambda_rcond >= 0.0 && o->lambda_rcond <= 1.0)) return PHGMG_ERR_INVALID_ARG;
-    if (phgmg__lambda_grid(lo, hi, o->lambda_per_decade == 0 ? 4 : o->lambda_per_decade, NULL) < 1)
+    if (phgmg__lambda_grid(o->lambda_min, o->lambda_max, o->lambda_per_decade, NULL) < 1)
       return PHGMG_ERR_INVALID_ARG;
     if (nb < nf || nb > ns) return PHGMG_ERR_SIZE;
   }
@@ -9803,15 +10332,14 @@ PHGMG__PRIV phgmg_result phgmg__qm_lambda_auto(phgmg__rctx *c) {
   const phgmg_reduce_opts *o = c->o;
   const int ns = c->ns, p = c->red->p, rn = c->red->rn, nc = p * (p + 1) / 2, ng = c->ng;
   const int byrun = o->nrun >= 2 && c->runcol;   /* leave one run out */
-  const int nfold = byrun ? o->nrun : (o->lambda_folds == 0 ? 5 : o->lambda_folds);
-  const int nblk = o->lambda_blocks == 0 ? PHGMG__MIN(ns, 100) : o->lambda_blocks;
+  const int nfold = byrun ? o->nrun : o->lambda_folds;
+  const int nblk = o->lambda_blocks;
   double best, *lg;
   int g;
   phgmg_result rc;
   lg = c->lg = phgmg__dalloc(c->alloc, 2 * (size_t)ng);
   if (!lg) return PHGMG_ERR_NOMEM;
-  phgmg__lambda_grid(o->lambda_min == 0.0 ? 1e-14 : o->lambda_min, o->lambda_max == 0.0 ? 1.0 : o->lambda_max,
-                     o->lambda_per_decade == 0 ? 4 : o->lambda_per_decade, lg);
+  phgmg__lambda_grid(o->lambda_min, o->lambda_max, o->lambda_per_decade, lg);
   if (c->sf == 1 && !byrun && c->st->cv && c->st->cv_p == p && c->st->cv_rn == rn && c->st->cv_ng == ng &&
       c->st->cv_nf == nfold && c->st->cv_nb == nblk && c->st->cv_lo == lg[0] && c->st->cv_hi == lg[ng - 1]) {
     memcpy(lg + ng, c->st->cv, (size_t)ng * sizeof(double));   /* the study's: same problem, same basis */
@@ -10451,7 +10979,7 @@ PHGMG__PRIV double phgmg__dgd_rcond0(phgmg__rctx *c) {
 PHGMG__PRIV phgmg_result phgmg__check_degeneracy(phgmg__rctx *c) {
   phgmg_reduced *red = c->red;
   const double rc0 = phgmg__dgd_rcond0(c);
-  const double lrc = rc0 * (c->o->lambda_rcond == 0.0 ? 1e-6 : c->o->lambda_rcond);
+  const double lrc = rc0 * c->o->lambda_rcond;
   const int can_raise = c->gsel >= 0 && rc0 >= c->degtol;
   phgmg_result rc;
   if (rc0 < 0.0) return PHGMG_ERR_NOMEM;
@@ -10793,7 +11321,7 @@ PHGMG__PRIV phgmg_result phgmg__vset_build(phgmg__rctx *c, phgmg__vset *v) {
   }
   memset(&go, 0, sizeof go);
   go.tol = c->o->newton_tol > 0.0 ? c->o->newton_tol : 1e-10;
-  go.max_iter = c->o->newton_iter > 0 ? c->o->newton_iter : 20;
+  go.max_iter = c->o->newton_iter;
   if (c->o->lambda_train_only) { v->nv = nrun; return phgmg__vset_dedupe(c, v); }
   if (phgmg__study_probes(c, v, level, zero, off, &go, 0)) return phgmg__vset_dedupe(c, v);
   for (k = nrun; k < nrun + 3; ++k) {
@@ -10821,7 +11349,7 @@ PHGMG__PRIV phgmg_result phgmg__vset_build(phgmg__rctx *c, phgmg__vset *v) {
 PHGMG__PRIV phgmg_result phgmg__vset_eval(phgmg__rctx *c, phgmg__vset *v, int *ok, double tolr) {
   const int m = c->sys->m;
   const double tol = c->o->newton_tol;   /* 0: the stepper's default (1e-10 double, 1e-5 float) */
-  const int it = c->o->newton_iter > 0 ? c->o->newton_iter : 20;
+  const int it = c->o->newton_iter;
   int i, k, j;
   *ok = 1;
   for (k = 0; k < v->nv; ++k) v->ey[k] = HUGE_VAL;
@@ -10896,14 +11424,14 @@ PHGMG__PRIV phgmg_result phgmg__altmin_reference(phgmg__rctx *c, phgmg__vset *v,
 }
 
 /* opts.lambda_auto = 1 (after publish): validation by simulation, see the
-   comment at phgmg_reduce_opts.runs. Candidates from lambda_max down, one
+   manual 4.2. Candidates from lambda_max down, one
    per decade, to the regression optimum; stops after two inadmissible
    candidates in a row (the error grows as lambda falls). */
 PHGMG__PRIV phgmg_result phgmg__stage_lambda_validate(phgmg__rctx *c) {
   phgmg_reduced *red = c->red;
   const phgmg_reduce_opts *o = c->o;
-  const int pd = o->lambda_per_decade == 0 ? 4 : o->lambda_per_decade;
-  const double tolr = o->lambda_tolerance > 0.0 ? o->lambda_tolerance : 1.02;
+  const int pd = o->lambda_per_decade;
+  const double tolr = o->lambda_tolerance;
   const size_t n = (size_t)red->rn * red->p * red->p;
   phgmg__vset *v;
   phgmg_real *ms;
@@ -11091,7 +11619,7 @@ PHGMG__PRIV phgmg_result phgmg__sp_test_basis(phgmg__rctx *c, double *Vg) {
   return rc;
 }
 
-/* Stage 3b, SP1/SP2 blocks (NUMERICS 6.3-6.4): W = Vg (V^T Vg)^{-1},
+/* Stage 3b, SP1/SP2 blocks (manual 8.8): W = Vg (V^T Vg)^{-1},
    K = W^T (J - R) W, Bh = W^T B. */
 PHGMG__PRIV phgmg_result phgmg__stage_sp_blocks(phgmg__rctx *c) {
   phgmg_reduced *red = c->red;
@@ -11480,22 +12008,22 @@ PHGMG__PRIV phgmg_result phgmg__reduce_run(phgmg_reduced **out, const phgmg_ph_s
   *out = NULL;
   if (!sys || !X || !opts) return PHGMG_ERR_INVALID_ARG;
   memset(&c, 0, sizeof c);
-  c.sys = sys; c.o = opts; c.X = X; c.ldx = ldx; c.ns = ns; c.alloc = alloc; c.gsel = -1;
+  c.ro = *opts;
+  phgmg__reduce_opts_resolve(&c.ro, ns);
+  c.sys = sys; c.o = &c.ro; c.X = X; c.ldx = ldx; c.ns = ns; c.alloc = alloc; c.gsel = -1;
   c.st = st;
-  c.sf = phgmg__study_fast(st, opts, sys->m);
   c.inf.hyper_method = -1;
-  rc = phgmg__reduce_check(sys, X, ldx, ns, opts, st != NULL);
+  rc = phgmg__reduce_check(sys, X, ldx, ns, c.o, st != NULL);
+  if (rc == PHGMG_OK) c.sf = phgmg__study_fast(st, c.o, sys->m);
   if (rc == PHGMG_OK) rc = phgmg_ph_validate(sys, 0.0, &c.inf.rcond_jr, alloc);
   if (rc != PHGMG_OK) {
     if (info) *info = c.inf;
     return rc;
   }
-  c.lambda = opts->lambda == 0.0 ? 1e-3 : (opts->lambda < 0.0 ? 0.0 : opts->lambda);
-  if (opts->lambda_auto && opts->method == PHGMG_METHOD_GMG_QM)
-    c.ng = phgmg__lambda_grid(opts->lambda_min == 0.0 ? 1e-14 : opts->lambda_min,
-                              opts->lambda_max == 0.0 ? 1.0 : opts->lambda_max,
-                              opts->lambda_per_decade == 0 ? 4 : opts->lambda_per_decade, NULL);
-  c.degtol = opts->degeneracy_tol > 0.0 ? opts->degeneracy_tol : 1e-12;
+  c.lambda = c.o->lambda < 0.0 ? 0.0 : c.o->lambda;   /* < 0: exactly zero */
+  if (c.o->lambda_auto && c.o->method == PHGMG_METHOD_GMG_QM)
+    c.ng = phgmg__lambda_grid(c.o->lambda_min, c.o->lambda_max, c.o->lambda_per_decade, NULL);
+  c.degtol = c.o->degeneracy_tol;
   c.rfloor = phgmg__rank_floor(sys->N, ns, X, ldx);
   rc = phgmg__runs_layout(&c);
   if (rc == PHGMG_OK) rc = phgmg__reduce_descriptor_setup(&c);
@@ -12135,6 +12663,7 @@ PHGMG_DEF phgmg_result phgmg_study_reduce(phgmg_study *st, const phgmg_reduce_op
   if (!st || !opts || !out) return PHGMG_ERR_INVALID_ARG;
   if (phgmg__sys_fingerprint(st->sys) != st->fp) return PHGMG_ERR_STALE;   /* the blocks would be stale */
   o = *opts;
+  phgmg__reduce_opts_resolve(&o, st->ns);
   if ((o.method == PHGMG_METHOD_GMG_POD || o.method == PHGMG_METHOD_GMG_QM) && st->Ua && !o.pod_basis) {
     o.pod_basis = st->Ua; o.pod_cols = st->ka;
   }
@@ -14981,6 +15510,51 @@ PHGMG_DEF phgmg_result phgmg_npy_write(const char *path, const double *A, int ro
 #endif /* PHGMG_NO_OFFLINE */
 #endif /* PHGMG_IMPLEMENTATION_DONE */
 #endif /* PHGMG_IMPLEMENTATION */
+
+/*
+   REVISION HISTORY
+   0.2.0  (2026-11-25)
+          - Meaning changed: phgmg_reduce_opts.lambda_auto = 1 now chooses
+            GMG-QM's ridge parameter by simulating the reduced model on the
+            training runs (opts.runs) and three probe inputs against the
+            linear limit M = 0, and keeps M = 0 when nothing is safe or no
+            runs are given. In 0.1.0 lambda_auto = 1 was the regression
+            validation on held-out time blocks of the snapshots; that choice
+            is now lambda_auto = 2.
+          - New: training runs (phgmg_run, phgmg_simulate_inputs,
+            phgmg_runs_columns), phgmg_reduced_validate, the training envelope
+            and quadratic-correction indicators of the online stepper,
+            lambda_train_only, GMG-QM manifold constructions (greedy,
+            alternating minimization).
+          - New: Hamiltonians beyond polynomials (exp-polynomial family,
+            callbacks, GENERAL), your own manifold (PHGMG_METHOD_GMG_MANIFOLD),
+            binary model format version 2.
+          - New: hyper-reduction with non-negative weights (ECSW) as the
+            default of opts.deim = 1 (opts.hyper; the paper's DEIM as
+            PHGMG_HYPER_QDEIM / _GREEDY), phgmg_deim_select, phgmg_nnls,
+            phgmg_ecsw, phgmg_ecsw_separable.
+          - New: linear systems (Lyapunov, Riccati, balanced truncation,
+            positive-real BT in pH form, input-independent bases, H-infinity
+            and H2 errors), sparse input (phgmg_ph_sparse_*, phgmg_rcm),
+            randomized POD and its automatic use for large snapshot sets,
+            studies over many orders (phgmg_study_*), optional OpenMP GEMM.
+          - Changed: the default Newton tolerance follows the size of the
+            states (1e-10 times max(1, |x|, |Z|)) and every step makes at
+            least one Newton update; the non-degeneracy check no longer
+            depends on the units of B; Q need only be semidefinite when H
+            has a nonlinear part; new result code PHGMG_ERR_NOT_STABLE and
+            Q's own codes; tiny entries flushed in the steppers' own vectors.
+          - New result codes PHGMG_ERR_OVERFLOW, _TOL_UNREACHABLE,
+            _NOT_STABILIZABLE, _STALE, _STRUCTURE (a load-time structure check
+            of model files) and _STEP_MAP.
+          - New: phgmg_reduce_opts_default, the defaults of phgmg_reduce_opts
+            as one query; the library applies them in one place.
+          - The manual at the top of this file.
+   0.1.0  (2026-11-21) first version: GL3 full-order stepper with energy
+          bookkeeping; POD, GMG-POD, GMG-QM, SP1, SP2, structure-preserving
+          DEIM and the paper's error measures; allocation-free online stepper
+          in float or double; C-source and binary export; .npy files.
+*/
 
 /*
 ------------------------------------------------------------------------------

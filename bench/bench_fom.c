@@ -21,6 +21,7 @@
 #define PHGMG_IMPLEMENTATION
 #include "../phgmg.h"
 #include "../examples/msd_models.h"
+#include "bench_args.h"
 #include <stdio.h>
 #include <time.h>
 
@@ -191,10 +192,13 @@ int main(int argc, char **argv) {
   FILE *csv = NULL;
   int fail = 0, k;
   static const int sizes[4] = {1000, 2000, 4000, 8000};
-  if (argc > 1) {
-    csv = fopen(argv[1], "a");
-    if (!csv) { perror(argv[1]); return 1; }
-    if (ftell(csv) == 0) fprintf(csv, "case,median_s,min_s,max_s,runs\n");
+  {
+    const char *out;
+    int rc = bench_args(argc, argv, "bench_fom", "Full-order GL3 simulations of the paper's chains (1000 steps).", &out,
+                        NULL, NULL);
+    if (rc) return rc == 1 ? 0 : 2;
+    csv = bench_open_csv("bench_fom", out, &rc);
+    if (rc) return 1;
   }
   { /* linear MSD, N = 100: m_i = 2, k_i = 1, c_i = 1 */
     msd_linear M;

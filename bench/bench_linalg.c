@@ -6,13 +6,14 @@
    the line after them shows the largest relative error of the 40 singular
    values of the randomized against the exact POD. Each case runs once to
    warm up, then RUNS times; prints median/min/max seconds and GFLOP/s, and
-   appends `case,median_s,min_s,max_s,runs` lines to the CSV file argv[1] (if
-   given; a header line is written when the file is empty).
-     cc -std=c99 -O2 -march=native bench/bench_linalg.c -lm && ./a.out out.csv  */
+   appends `case,median_s,min_s,max_s,runs` lines to the CSV file given
+   with --out (a header line is written when the file is empty).
+     cc -std=c99 -O2 -march=native bench/bench_linalg.c -lm && ./a.out --out out.csv  */
 #define _POSIX_C_SOURCE 199309L
 #define PHGMG_IMPLEMENTATION
 #include "../phgmg.h"
 #include "../examples/msd_models.h"
+#include "bench_args.h"
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -57,11 +58,12 @@ int main(int argc, char **argv) {
   FILE *csv = NULL;
   double t[RUNS];
   int r, i;
-  if (argc > 1) {
-    csv = fopen(argv[1], "a");
-    if (!csv) { fprintf(stderr, "bench_linalg: cannot open %s\n", argv[1]); return 1; }
-    fseek(csv, 0, SEEK_END);
-    if (ftell(csv) == 0) fprintf(csv, "case,median_s,min_s,max_s,runs\n");
+  {
+    const char *out;
+    int rc = bench_args(argc, argv, "bench_linalg", "Dense kernel timings (LU, SVD, GEMM, POD).", &out, NULL, NULL);
+    if (rc) return rc == 1 ? 0 : 2;
+    csv = bench_open_csv("bench_linalg", out, &rc);
+    if (rc) return 1;
   }
 #ifdef PHGMG_USE_CBLAS
   printf("(PHGMG_USE_CBLAS: products through cblas)\n");

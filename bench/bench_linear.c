@@ -10,13 +10,14 @@
                       Schur form of A once, then 20 L-BFGS steps of O(N^2 r) each
                       (measured: Schur 9.7 s, 60 ms a step, shared machine)
    Prints the relative residuals (Lyapunov; both Riccati equations) and
-   appends `case,median_s,min_s,max_s,runs` to the CSV argv[1] (if given).
+   appends `case,median_s,min_s,max_s,runs` to the CSV given with --out.
    BENCH_LINEAR_RUNS (default 1) runs per case; no warm-up (each run is seconds).
-     cc -std=c99 -O2 -march=native bench/bench_linear.c -lm && ./a.out out.csv  */
+     cc -std=c99 -O2 -march=native bench/bench_linear.c -lm && ./a.out --out out.csv  */
 #define _POSIX_C_SOURCE 199309L
 #define PHGMG_IMPLEMENTATION
 #include "../phgmg.h"
 #include "../examples/msd_models.h"
+#include "bench_args.h"
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -48,9 +49,12 @@ int main(int argc, char **argv) {
   FILE *csv = NULL;
   phgmg_result rc;
   if (runs < 1 || runs > 16) runs = 1;
-  if (argc > 1) {
-    csv = fopen(argv[1], "a");
-    if (!csv) { fprintf(stderr, "bench_linear: cannot open %s\n", argv[1]); return 1; }
+  {
+    const char *out;
+    int arc = bench_args(argc, argv, "bench_linear", "Lyapunov, PRBT and least-H2 basis at N = 1000.", &out, NULL, NULL);
+    if (arc) { free(mv); return arc == 1 ? 0 : 2; }
+    csv = bench_open_csv("bench_linear", out, &arc);
+    if (arc) { free(mv); return 1; }
   }
   for (i = 0; i < n; ++i) mv[i] = 4.0;
   if (msd_linear_build(&M, n, mv, mv, NULL, PHGMG_DENSE) != 0) return 1;

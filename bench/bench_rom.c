@@ -1,4 +1,4 @@
-/* bench_rom — offline and online timings of the reduced models (issue 7).
+/* bench_rom — offline and online timings of the reduced models.
 
    Models: the paper's linear MSD (50 masses, N = 100, dense) and the nonlinear
    MSD chain (banded, N = 1000 and N = 4000), u = 0.1 sin t, dt = 0.1, 1000
@@ -29,16 +29,17 @@
    Linear kinds: sp1, gmgpod (both with the precomputed step map), gmgqm;
    nonlinear: gmgpod_deim, sp2_deim, gmgqm_deim.
 
-   Appends `case,median_s,min_s,max_s,runs` to the CSV file argv[1] (header if
+   Appends `case,median_s,min_s,max_s,runs` to the CSV file of --out (header if
    the file is empty) and prints a table: microseconds per step, Newton
    iterations per step, DEIM points, the flop count per step of the algorithm
    as implemented (see rom_flops), the rate it implies, the output error e_y
    against the full-order model, and the speed-up over it.
-     cc -std=c99 -O2 -march=native bench/bench_rom.c -lm && ./a.out out.csv */
+     cc -std=c99 -O2 -march=native bench/bench_rom.c -lm && ./a.out --out out.csv */
 #define _POSIX_C_SOURCE 199309L
 #define PHGMG_IMPLEMENTATION
 #include "../phgmg.h"
 #include "../examples/msd_models.h"
+#include "bench_args.h"
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -265,7 +266,7 @@ static int deim_fn(void *vc, int phase) {
   return phgmg_deim(nt, NS, c->F, nt, NULL, 1e-8, 0, c->pts, c->w, &c->nd, &c->nneg, NULL, NULL) == PHGMG_OK ? 0 : -1;
 }
 
-/* Hyper-reduction with non-negative weights (issue 14) on the N = 1000 chain:
+/* Hyper-reduction with non-negative weights on the N = 1000 chain:
    GMG-POD basis V0 = [B, 19 POD modes of the adjusted snapshots] (r = 20);
    training rows (snapshot i, coordinate a) = phi'(l_k(x_i)) V0[idx_k, a]
    (ns r = 20020 rows, one column per term). sep = 0: phgmg_ecsw on the
@@ -763,11 +764,14 @@ int main(int argc, char **argv) {
   model_data lin, nl1, nl4;
   int i, k;
   g_only = getenv("BENCH_ROM_ONLY");
-  if (argc > 1) {
-    g_csv = fopen(argv[1], "a");
-    if (!g_csv) { fprintf(stderr, "bench_rom: cannot open %s\n", argv[1]); return 1; }
-    fseek(g_csv, 0, SEEK_END);
-    if (ftell(g_csv) == 0) fprintf(g_csv, "case,median_s,min_s,max_s,runs\n");
+  {
+    const char *out;
+    int rc = bench_args(argc, argv, "bench_rom",
+                        "Offline and online timings of the reduced models (BENCH_ROM_ONLY=case runs one case).", &out,
+                        NULL, NULL);
+    if (rc) return rc == 1 ? 0 : 2;
+    g_csv = bench_open_csv("bench_rom", out, &rc);
+    if (rc) return 1;
   }
   for (i = 0; i < NSTEPS; ++i) {
     phgmg_real tc[3];

@@ -1,6 +1,6 @@
-/* bench_scale — the offline reduction at large N (issue 18).
+/* bench_scale — the offline reduction at large N.
 
-   Case (appended to the CSV argv[1] as `case,median_s,min_s,max_s,runs`):
+   Case (appended to the CSV of --out as `case,median_s,min_s,max_s,runs`):
      offline_gmgpod_N256000   the paper's nonlinear chain (examples/msd_models.h:
                               quartic springs, banded storage, N = 256 000 =
                               128 000 masses), 1001 snapshots (1000 steps of
@@ -23,6 +23,7 @@
 #define PHGMG_IMPLEMENTATION
 #include "../phgmg.h"
 #include "../examples/msd_models.h"
+#include "bench_args.h"
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -77,13 +78,17 @@ int main(int argc, char **argv) {
   phgmg_gl3_opts go;
   phgmg_reduce_opts o;
   phgmg_reduce_info info;
-  const char *csv = argc > 1 && argv[1][0] ? argv[1] : NULL, *cache = getenv("BENCH_SCALE_SNAP");
-  const int N = argc > 2 ? atoi(argv[2]) : 256000;
-  int runs = argc > 3 ? atoi(argv[3]) : 3, i;
+  static const char *const extra[] = {"--n", "--runs", NULL};
+  const char *csv, *cache = getenv("BENCH_SCALE_SNAP"), *val[2] = {NULL, NULL};
+  const int arc = bench_args(argc, argv, "bench_scale", "The whole phgmg_reduce at large N (default N = 256000, 3 runs).",
+                             &csv, extra, val);
+  const int N = val[0] ? atoi(val[0]) : 256000;
+  int runs = val[1] ? atoi(val[1]) : 3, i;
   double *X, *x0, t[16], w[16], t0, c0;
   char name[64];
   phgmg_result rc;
-  if (N < 200 || N % 2 || runs < 1) { fprintf(stderr, "usage: bench_scale [out.csv] [N even >= 200] [runs]\n"); return 2; }
+  if (arc) return arc == 1 ? 0 : 2;
+  if (N < 200 || N % 2 || runs < 1) { fprintf(stderr, "usage: bench_scale [--out FILE] [--n N even >= 200] [--runs R]\n"); return 2; }
   if (runs > 16) runs = 16;
   snprintf(name, sizeof name, "offline_gmgpod_N%d", N);
   memset(&mo, 0, sizeof mo);
@@ -131,10 +136,9 @@ int main(int argc, char **argv) {
   printf("%-28s CPU median %.3f s (min %.3f, max %.3f), wall median %.3f s, %d runs; target 15 s\n", name,
          t[runs / 2], t[0], t[runs - 1], w[runs / 2], runs);
   if (csv) {
-    FILE *f = fopen(csv, "a");
-    if (!f) { fprintf(stderr, "bench_scale: cannot open %s\n", csv); return 1; }
-    fseek(f, 0, SEEK_END);
-    if (ftell(f) == 0) fprintf(f, "case,median_s,min_s,max_s,runs\n");
+    int err;
+    FILE *f = bench_open_csv("bench_scale", csv, &err);
+    if (!f) return 1;
     fprintf(f, "%s,%.9f,%.9f,%.9f,%d\n", name, t[runs / 2], t[0], t[runs - 1], runs);
     fclose(f);
   }

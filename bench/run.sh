@@ -13,8 +13,8 @@
 #    each, appending `case,median_s,min_s,max_s,runs` lines to the CSV;
 # 3. if a CBLAS is installed, builds bench_linalg again with -DPHGMG_USE_CBLAS
 #    and records its cases with a `_cblas` suffix (one BLAS thread);
-# 3b. runs bench/hyper_study.c, bench/altmin_study.c and bench/qm_pulse.c
-#     (tables, no CSV cases);
+# 3b. runs bench/studies/hyper_study.c, bench/studies/altmin_study.c and
+#     bench/qm_pulse.c (tables, no CSV cases);
 # 4. builds the examples (`make examples`; if that fails, the two demo
 #    programs directly, without -Werror) and times the whole demo (the three
 #    runs `make demo` makes, with its arguments: linear, nonlinear, linear with
@@ -62,20 +62,20 @@ for prog in bench_linalg bench_fom bench_rom bench_linear bench_scale; do
     echo "run.sh: warning: $src does not build, skipped" >&2
     continue
   fi
-  "./$BUILD/$prog" "$CSV" || echo "run.sh: warning: $prog failed (exit $?)" >&2
+  "./$BUILD/$prog" --out "$CSV" || echo "run.sh: warning: $prog failed (exit $?)" >&2
 done
 
 # the hyper-reduction choices side by side (a table, not timing cases)
 echo
 echo "== hyper_study"
-if $CC $CFLAGS -o "$BUILD/hyper_study" bench/hyper_study.c $LIBS; then
+if $CC $CFLAGS -o "$BUILD/hyper_study" bench/studies/hyper_study.c $LIBS; then
   "./$BUILD/hyper_study" | tee "$BUILD/hyper_study.txt"
 fi
 
-# the GMG-QM manifold constructions side by side (issue 15; tables, not timing cases)
+# the GMG-QM manifold constructions side by side (tables, not timing cases)
 echo
 echo "== altmin_study"
-if $CC $CFLAGS -o "$BUILD/altmin_study" bench/altmin_study.c $LIBS; then
+if $CC $CFLAGS -o "$BUILD/altmin_study" bench/studies/altmin_study.c $LIBS; then
   for chain in linear nonlinear; do
     "./$BUILD/altmin_study" $chain --lambda 1e-9 --r 8,12,16,20
   done | tee "$BUILD/altmin_study.txt"
@@ -105,7 +105,7 @@ if [ -f bench/bench_linalg.c ]; then
     tmp="$BUILD/bench_cblas.csv"
     rm -f "$tmp"
     if $CC $CFLAGS -DPHGMG_USE_CBLAS -o "$BUILD/bench_linalg_cblas" bench/bench_linalg.c $cblas $LIBS &&
-       "./$BUILD/bench_linalg_cblas" "$tmp"; then
+       "./$BUILD/bench_linalg_cblas" --out "$tmp"; then
       awk -F, 'NR > 1 && NF == 5 { printf "%s_cblas,%s,%s,%s,%s\n", $1, $2, $3, $4, $5 }' "$tmp" >> "$CSV"
     else
       echo "run.sh: warning: the CBLAS build of bench_linalg failed" >&2

@@ -24,6 +24,16 @@ DEMO_FN double demo_now(void) {
   return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
+/* The automatic lambda's settings as the library's defaults give them
+   (phgmg_reduce_opts_default), then tail and a newline. */
+DEMO_FN void demo_print_lambda_defaults(const char *tail) {
+  phgmg_reduce_opts d;
+  phgmg_reduce_opts_default(&d);
+  printf("(library defaults: grid %g..%g at %d per decade, %d-fold validation over contiguous\n"
+         "blocks of snapshots, conditioning guard %g)%s\n",
+         d.lambda_min, d.lambda_max, d.lambda_per_decade, d.lambda_folds, d.lambda_rcond, tail);
+}
+
 DEMO_FN void demo_die(const char *what, phgmg_result rc) {
   fprintf(stderr, "error: %s: %s\n", what, phgmg_result_string(rc));
   exit(1);
@@ -75,7 +85,7 @@ DEMO_FN demo_rom_result demo_run_rom(const demo_cache *cache, const phgmg_ph_sys
   YR = (double *)malloc(sizeof(double) * (size_t)m * ns);
   xr0 = (double *)malloc(sizeof(double) * (size_t)r);
   if (!XR || !YR || !xr0) { fprintf(stderr, "out of memory\n"); exit(1); }
-  phgmg_reduced_restrict(red, X, xr0);     /* rho(x0) (NUMERICS 6.7) */
+  phgmg_reduced_restrict(red, X, xr0);     /* rho(x0) (phgmg.h manual 8.8) */
   t0 = demo_now();
   res.rc = phgmg_reduced_simulate(red, xr0, 0.0, dt, nsteps, uf, NULL, newton_tol, newton_it, XR, YR,
                                   energy, &res.stats, NULL);
@@ -354,7 +364,7 @@ DEMO_FN void demo_tables_and_panels(const char *out, const char *example, const 
   }
   free(col);
 }
-/* ---- generalization study (issue 15): train on one run (u = 0.1 sin t) or
+/* ---- generalization study: train on one run (u = 0.1 sin t) or
    two (plus a multisine), test on five inputs ---------------------------- */
 DEMO_FN void demo_u_sin2(double t, double *u, void *p) { (void)p; u[0] = 0.1 * sin(2.0 * t); }
 DEMO_FN void demo_u_chirp(double t, double *u, void *p) { (void)p; u[0] = 0.1 * sin(0.2 * t + 0.01 * t * t); }

@@ -190,7 +190,7 @@ static void run_method(const study *S, int j, int r, double ey[NIN], double *Ar,
    L-BFGS steps per basis column for r >= 12 (the acceptance range; 1320 at r
    = 12, 2280 at r = 20 on the paper's chain; --h2-iters N: N steps), 300 below
    (phgmg_linear_basis, kind H2). With 1000 steps for every order the paper's
-   chain met issue 16's 10x target in 40-42 of 45 cases, with 80 per column
+   chain met the 10x target in 40-42 of 45 cases, with 80 per column
    in 44. (Starting from
    the order r - 1 optimum plus one balanced column was tried: at the same
    iteration count it ended 2-3x higher in H2 error on the paper's chain.) */

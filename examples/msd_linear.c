@@ -40,10 +40,9 @@ static const phgmg_method meth_id[NMETH] = {PHGMG_METHOD_SP1, PHGMG_METHOD_GMG_P
 static int lambda_auto_study(msd_linear *M, const char *out, int rmin, int rmax, int rstep, int rn,
                              int nsteps, double dt) {
   const int N = M->sys.N;
-  printf("Linear MSD, N = %d, %d steps of dt = %g; r = %d..%d; GMG-QM r_n = %d, lambda automatic\n"
-         "(library defaults: grid 1e-14..1 at 4 per decade, 5-fold validation over 100 contiguous\n"
-         "blocks of snapshots, conditioning guard 1e-6)\n",
+  printf("Linear MSD, N = %d, %d steps of dt = %g; r = %d..%d; GMG-QM r_n = %d, lambda automatic\n",
          N, nsteps, dt, rmin, rmax, rn);
+  demo_print_lambda_defaults("");
   {
     phgmg_reduce_opts o;
     memset(&o, 0, sizeof o);
@@ -78,7 +77,7 @@ int main(int argc, char **argv) {
   nr = (rmax - rmin) / rstep + 1;
   demo_mkdir(out);
   if (msd_linear_build(&M, 50, NULL, NULL, NULL, PHGMG_DENSE) != 0) { fprintf(stderr, "model\n"); return 1; }
-  if (gen) { /* --generalization: issue 15's study at the listed r */
+  if (gen) { /* --generalization: the deployment study at the listed r */
     int rl[64], nrl = 0;
     phgmg_reduce_opts o;
     svgplot_fig *gf = svgplot_new("Linear chain: GMG-POD and GMG-QM (lambda validated by simulation) on inputs they were not trained on", 2);

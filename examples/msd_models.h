@@ -99,7 +99,7 @@ MSD_FN int msd_linear_build(msd_linear *M, int n_masses, const double *m, const 
      Jhat = T J T^T = [0 Tt; -Tt^T 0],  Rhat = diag(0, gamma I),  Bhat = T B = e_{v_1},
      Hhat = 1/2 k1 sum l_i^2 + 1/2 mass sum v_i^2 + sum k2 l_i^4 / 4,
    (Tt: 1 on the diagonal, -1 above it). The quadratic part is Qhat =
-   diag(k1 I, mass I) (NUMERICS 6.1: mass 1 by default, as the paper's Q; the
+   diag(k1 I, mass I) (phgmg.h manual 8.8: mass 1 by default, as the paper's Q; the
    paper's text writes the kinetic term as 1/2 m x_{n+i}^2, so `mass` scales it
    the same way). The quartic is the separable part in polynomial form,
    poly = {0, 0, 0, 0, k2/4}, one term per l_i.

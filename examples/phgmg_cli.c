@@ -1243,9 +1243,11 @@ static int check_hyper_opts(const reduce_args *A, const char *const *seen, int n
 static int parse_reduce(int argc, char **argv, reduce_args *A) {
   const char *seen[64];
   int i, nseen = 0, e;
+  phgmg_reduce_opts def;   /* the library's defaults of the options it shares */
+  phgmg_reduce_opts_default(&def);
   memset(A, 0, sizeof *A);
-  A->dt = 0.1; A->steps = 1000; A->amp = 0.1; A->rn = 0; A->lambda = 1e-3;
-  A->deim_tol = 1e-8; A->name = "rom"; A->newton_tol = 0.0; A->newton_iter = 10;
+  A->dt = 0.1; A->steps = 1000; A->amp = 0.1; A->rn = 0; A->lambda = def.lambda;
+  A->deim_tol = def.deim_tol; A->name = "rom"; A->newton_tol = 0.0; A->newton_iter = 10;
   for (i = 2; i < argc; ++i) {
     const char *o = argv[i], *v;
 #define STR(opt, field) else if (!strcmp(o, opt)) { if (!(v = optval(argc, argv, &i))) return 2; A->field = v; }
@@ -2012,7 +2014,10 @@ static int simulate_training_runs(const reduce_args *A, reduce_state *S, const d
 
 /* gmg-qm's r_n without --rn: 8, or what fits (r + r_n <= N, r_n (r - m) <= 4096). */
 static int default_rn(int N, int r, int m) {
-  int rn = PHGMG__MIN(8, N - r);
+  phgmg_reduce_opts def;
+  int rn;
+  phgmg_reduce_opts_default(&def);
+  rn = PHGMG__MIN(def.rn, N - r);
   if (r > m) rn = PHGMG__MIN(rn, 4096 / (r - m));
   return PHGMG__MAX(rn, 1);
 }
@@ -2061,7 +2066,7 @@ static int run_reduction(const reduce_args *A, reduce_state *S, int method, cons
   const phgmg_rom *rom;
   double t0;
   /* --- reduce --- */
-  memset(&o, 0, sizeof o);
+  phgmg_reduce_opts_default(&o);
   o.method = (phgmg_method)method;
   o.r = A->r;
   o.rn = A->rn ? A->rn : default_rn(N, A->r, S->sys.m);
@@ -2069,7 +2074,7 @@ static int run_reduction(const reduce_args *A, reduce_state *S, int method, cons
   o.deim = A->poly_idx && !A->no_deim;
   o.hyper = !A->hyper || !strcmp(A->hyper, "ecsw") ? PHGMG_HYPER_ECSW
             : !strcmp(A->hyper, "qdeim") ? PHGMG_HYPER_QDEIM : PHGMG_HYPER_GREEDY;
-  o.hyper_tol = A->hyper_tol;
+  if (A->hyper_tol > 0.0) o.hyper_tol = A->hyper_tol;
   o.deim_tol = A->deim_tol > 0.0 ? A->deim_tol : 1e-300;
   o.deim_max = A->deim_max;
   o.deim_allow_negative = A->deim_neg;

@@ -22,6 +22,7 @@
 #include "test_npy.c"
 #include "test_online.c"
 #include "test_qm_wide.c"
+#include "test_options.c"
 #include "test_sparse.c"
 #include "test_study.c"
 #include "test_subnormal.c"

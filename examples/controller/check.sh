@@ -6,7 +6,7 @@
 #  2. controller.c, built with PHGMG_NO_OFFLINE around each exported C file,
 #     prints exactly the in-memory reference outputs (same scalar type);
 #  3. float against double: relative output error over 1000 steps, asserted
-#     <= 1e-4 for the linear models and the Morse chain (mo_*, issue 13),
+#     <= 1e-4 for the linear models and the Morse chain (mo_*),
 #     reported for the paper's nonlinear chain.
 # usage: check.sh BUILD_DIR [--fast]
 set -eu

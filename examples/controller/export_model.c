@@ -103,7 +103,7 @@ int main(int argc, char **argv) {
   bad |= do_model(argv[1], "nl_gmgpod", &M.sys, X, ns, PHGMG_METHOD_GMG_POD, 1, 0);
   bad |= do_model(argv[1], "nl_gmgqm", &M.sys, X, ns, PHGMG_METHOD_GMG_QM, 1, 5e-3);
   free(X); free(x0);
-  /* Morse chain (issue 13): exp-polynomial separable part, training input
+  /* Morse chain: exp-polynomial separable part, training input
      u = 0.1 sin t, Newton tol 1e-10 as in examples/morse_chain.c; GMG-QM with
      that example's lambda rule max(0.2 e_proj(16), 10^-2.5) = 10^-2.5 */
   memset(&co, 0, sizeof co);

@@ -1,6 +1,6 @@
 /* twotrain_study.c -- why two training runs (0.1 sin t + the multisine
    0.05 (sin 0.5t + sin 1.5t + sin 3t)) can be worse than one (0.1 sin t) on
-   held-out inputs at small r (issue 15). For GMG-POD on the chosen chain, with
+   held-out inputs at small r. For GMG-POD on the chosen chain, with
    every nonlinear term (deim 0) and with ECSW hyper-reduction (deim 1), per
    held-out input (0.1, 0.1 sin 2t, chirp, random pwc): e_proj of the held-out
    trajectory onto the model's basis (what the basis can represent at all)
@@ -13,9 +13,9 @@
 #include <stdlib.h>
 #include <string.h>
 #define PHGMG_IMPLEMENTATION
-#include "../phgmg.h"
-#include "../examples/msd_models.h"
-#include "../examples/demo_common.h"
+#include "../../phgmg.h"
+#include "../../examples/msd_models.h"
+#include "../../examples/demo_common.h"
 
 /* the inputs of make demo's generalization study (examples/demo_common.h),
    and two more candidates for the second training run */
@@ -49,7 +49,10 @@ int main(int argc, char **argv) {
   const phgmg_ph_system *sys;
   phgmg_run runs[2];
   phgmg_gl3_opts go;
-  if (argc < 2) return 2;
+  if (argc < 2 || (strcmp(argv[1], "linear") && strcmp(argv[1], "nonlinear"))) {
+    fprintf(stderr, "usage: %s linear|nonlinear [--r LIST] [--balance] [--second multisine|steps|mssteps]\n", argv[0]);
+    return argc >= 2 && (!strcmp(argv[1], "--help") || !strcmp(argv[1], "-h")) ? 0 : 2;
+  }
   for (k = 0; k < 64; ++k)
     for (i = 0; i < 2 * NHO; ++i) ey2[k][i / NHO][i % NHO] = NAN;
   nonlin = !strcmp(argv[1], "nonlinear");
@@ -59,7 +62,7 @@ int main(int argc, char **argv) {
     else if (!strcmp(argv[i], "--second") && i + 1 < argc) {
       ++i;
       second = !strcmp(argv[i], "steps") ? u_steps : !strcmp(argv[i], "mssteps") ? u_mssteps : demo_u_multisine;
-    }
+    } else { fprintf(stderr, "twotrain_study: unknown argument '%s'\n", argv[i]); return 2; }
   }
   nr = demo_parse_rlist(rs, rl, 64);
   if (nonlin) {

@@ -1,4 +1,4 @@
-/* altmin_study.c -- the GMG-QM manifold constructions side by side (issue 15):
+/* altmin_study.c -- the GMG-QM manifold constructions side by side:
    hierarchical POD (the paper's), greedy linear part, alternating minimization.
    Trained on u = 0.1 sin t (1000 steps of dt = 0.1; with --two also on the
    multisine 0.05 (sin 0.5t + sin 1.5t + sin 3t)), for each r: the training
@@ -9,16 +9,16 @@
    GMG-POD (M = 0) on the same r for reference.
    QM-alt* = altmin fell back to the POD manifold (lambda auto, not better than GMG-POD).
    Usage: altmin_study linear|nonlinear [--lambda L|auto] [--train-only] [--r 8,10,...] [--rn 8] [--two]
-   Build: make build/altmin_study (or cc -O2 -march=native bench/altmin_study.c -lm). */
+   Build: cc -O2 -march=native -o build/altmin_study bench/studies/altmin_study.c -lm. */
 #define _POSIX_C_SOURCE 199309L
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
 #define PHGMG_IMPLEMENTATION
-#include "../phgmg.h"
-#include "../examples/msd_models.h"
-#include "../examples/demo_common.h"
+#include "../../phgmg.h"
+#include "../../examples/msd_models.h"
+#include "../../examples/demo_common.h"
 
 /* the inputs of make demo's generalization study (examples/demo_common.h) */
 #define NIN 5
@@ -36,7 +36,7 @@ int main(int argc, char **argv) {
   double *X, *Y, *XR, *YR, xr0[64] = {0};
   phgmg_run runs[2];
   phgmg_gl3_opts go;
-  if (argc < 2) { fprintf(stderr, "usage: %s linear|nonlinear [--lambda L|auto] [--r LIST] [--two]\n", argv[0]); return 2; }
+  if (argc < 2 || (strcmp(argv[1], "linear") && strcmp(argv[1], "nonlinear"))) { fprintf(stderr, "usage: %s linear|nonlinear [--lambda L|auto] [--r LIST] [--two]\n", argv[0]); return 2; }
   nonlin = !strcmp(argv[1], "nonlinear");
   for (i = 2; i < argc; ++i) {
     if (!strcmp(argv[i], "--lambda") && i + 1 < argc) { ++i; if (!strcmp(argv[i], "auto")) lauto = 1; else lambda = atof(argv[i]); }

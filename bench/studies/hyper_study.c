@@ -5,11 +5,11 @@
    training inputs (u = 0.1 and u = 0.1 sin t). Prints points, negative
    weights, smallest weight, ECSW training residual, e_red, e_y (on the
    training input) and the CPU time of the whole phgmg_reduce.
-   Build and run: cc -std=c99 -O2 -march=native -o build/hyper_study bench/hyper_study.c -lm
+   Build and run: cc -std=c99 -O2 -march=native -o build/hyper_study bench/studies/hyper_study.c -lm
    && ./build/hyper_study   (also run by make bench) */
 #define PHGMG_IMPLEMENTATION
-#include "../phgmg.h"
-#include "../examples/msd_models.h"
+#include "../../phgmg.h"
+#include "../../examples/msd_models.h"
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>

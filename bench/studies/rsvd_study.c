@@ -1,5 +1,5 @@
 /* rsvd_study — randomized POD (phgmg_pod_randomized) against the exact
-   phgmg_pod on snapshots of the paper's nonlinear MSD chain (issue 18).
+   phgmg_pod on snapshots of the paper's nonlinear MSD chain.
 
    For each N given: the chain with N/2 masses (banded), u = 0.1 sin t,
    dt = 0.1, 1000 steps from x0 = 0 (1001 snapshots, Newton tol 1e-8); then
@@ -11,12 +11,12 @@
    whole phgmg_reduce (GMG-POD, r = 20, deim = 1 with the default ECSW
    hyper-reduction); build with -DPHGMG_POD_RANDOMIZED_MIN=50000000 to see it
    with the randomized POD inside.
-     cc -std=c99 -O2 -march=native bench/rsvd_study.c -lm
+     cc -std=c99 -O2 -march=native bench/studies/rsvd_study.c -lm
      ./a.out [--no-exact] [--q 2] 4000 16000 64000                          */
 #define _POSIX_C_SOURCE 199309L
 #define PHGMG_IMPLEMENTATION
-#include "../phgmg.h"
-#include "../examples/msd_models.h"
+#include "../../phgmg.h"
+#include "../../examples/msd_models.h"
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -50,7 +50,15 @@ int main(int argc, char **argv) {
     if (!strcmp(argv[a], "--no-exact")) { exact = 0; continue; }
     if (!strcmp(argv[a], "--q") && a + 1 < argc) { q = atoi(argv[++a]); continue; }
     if (!strcmp(argv[a], "--reduce")) { red = 1; continue; }
-    N = atoi(argv[a]);
+    {
+      char *end;
+      long v = strtol(argv[a], &end, 10);
+      if (end == argv[a] || *end || v < 200 || v > 100000000) {
+        fprintf(stderr, "usage: rsvd_study [--no-exact] [--q Q] [--reduce] N... (N >= 200)\n");
+        return strcmp(argv[a], "--help") ? 2 : 0;
+      }
+      N = (int)v;
+    }
     memset(&mo, 0, sizeof mo);
     mo.n = N / 2;
     mo.storage = PHGMG_BANDED;

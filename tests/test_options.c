@@ -1,0 +1,122 @@
+/* The defaults of phgmg_reduce_opts in one place: a struct from
+   phgmg_reduce_opts_default gives bit for bit the same reduced model as a
+   zeroed one, for every method and the automatic lambda (both kinds), and
+   an explicit non-default value does change the model (so the comparison is
+   not vacuous). The values themselves are compared with the manual's table
+   and the command line's --help by tests/docs_check.py. Models: the paper's
+   chains (examples/msd_models.h), small. */
+#include <stdlib.h>
+#define PHGMG_STATIC
+#define PHGMG_IMPLEMENTATION
+#include "../phgmg.h"
+#include "harness.h"
+#include "../examples/msd_models.h"
+
+enum { OPT_STEPS = 200 };
+
+/* The serialized reduced model of (sys, X) under opts (NULL on failure);
+   *len its size, *lam the lambda used. */
+static unsigned char *opt_model(const phgmg_ph_system *sys, const double *X, const phgmg_reduce_opts *o,
+                                size_t *len, double *lam) {
+  phgmg_reduced *red = NULL;
+  phgmg_reduce_info info;
+  unsigned char *buf = NULL;
+  if (phgmg_reduce(&red, sys, X, sys->N, OPT_STEPS + 1, o, &info, NULL) == PHGMG_OK) {
+    const phgmg_rom *rom = phgmg_reduced_rom(red);
+    *len = phgmg_rom_serialized_size(rom);
+    *lam = info.lambda;
+    buf = (unsigned char *)malloc(*len);
+    if (buf && phgmg_rom_serialize(rom, buf, *len, len) != PHGMG_OK) { free(buf); buf = NULL; }
+  }
+  phgmg_reduced_destroy(red);
+  return buf;
+}
+
+/* Reduces with a zeroed struct and with the defaults, each completed by
+   set(); returns 1 when both succeed and the models are identical. */
+static int opt_same(const phgmg_ph_system *sys, const double *X, void (*set)(phgmg_reduce_opts *, const phgmg_run *),
+                    const phgmg_run *run) {
+  phgmg_reduce_opts z, d;
+  unsigned char *a, *b;
+  size_t la = 0, lb = 0;
+  double ka = 0, kb = 0;
+  int same;
+  memset(&z, 0, sizeof z);
+  phgmg_reduce_opts_default(&d);
+  set(&z, run); set(&d, run);
+  a = opt_model(sys, X, &z, &la, &ka);
+  b = opt_model(sys, X, &d, &lb, &kb);
+  same = a && b && la == lb && !memcmp(a, b, la) && (ka == kb || (ka != ka && kb != kb));
+  free(a); free(b);
+  return same;
+}
+
+static void set_pod(phgmg_reduce_opts *o, const phgmg_run *r) { (void)r; o->method = PHGMG_METHOD_GMG_POD; o->r = 8; o->dt = 0.1; }
+static void set_qm(phgmg_reduce_opts *o, const phgmg_run *r) { (void)r; o->method = PHGMG_METHOD_GMG_QM; o->r = 8; }
+static void set_qm_cv(phgmg_reduce_opts *o, const phgmg_run *r) { set_qm(o, r); o->lambda_auto = 2; }
+static void set_qm_auto(phgmg_reduce_opts *o, const phgmg_run *r) {
+  set_qm(o, r); o->lambda_auto = 1; o->nrun = 1; o->runs = r;
+}
+static void set_sp1(phgmg_reduce_opts *o, const phgmg_run *r) { (void)r; o->method = PHGMG_METHOD_SP1; o->r = 8; }
+static void set_pod_ecsw(phgmg_reduce_opts *o, const phgmg_run *r) { (void)r; o->method = PHGMG_METHOD_GMG_POD; o->r = 8; o->deim = 1; }
+static void set_sp2_qdeim(phgmg_reduce_opts *o, const phgmg_run *r) {
+  (void)r; o->method = PHGMG_METHOD_SP2; o->r = 8; o->deim = 1; o->hyper = PHGMG_HYPER_QDEIM; o->deim_allow_negative = 1;
+}
+static void set_qm_other(phgmg_reduce_opts *o, const phgmg_run *r) { set_qm(o, r); o->lambda = 1e-9; }
+
+TEST(test_reduce_opts_default_same_model) {
+  msd_linear L;
+  msd_nonlinear M;
+  msd_nl_opts mo;
+  phgmg_gl3_opts go;
+  phgmg_run run;
+  phgmg_reduce_opts d, z;
+  double *X = NULL, *XN = NULL;
+  CHECK(msd_linear_build(&L, 20, NULL, NULL, NULL, PHGMG_DENSE) == 0);
+  memset(&mo, 0, sizeof mo);
+  mo.n = 20; mo.storage = PHGMG_BANDED;
+  CHECK(msd_nonlinear_build(&M, &mo) == 0);
+  memset(&run, 0, sizeof run);
+  run.u = msd_input_sin; run.dt = 0.1; run.nsteps = OPT_STEPS;
+  memset(&go, 0, sizeof go);
+  go.tol = 1e-10;
+  X = (double *)malloc(sizeof(double) * L.sys.N * (OPT_STEPS + 1));
+  XN = (double *)malloc(sizeof(double) * M.sys.N * (OPT_STEPS + 1));
+  CHECK(X && XN);
+  if (X && XN) {
+    CHECK_RC(phgmg_simulate_inputs(&L.sys, 1, &run, &go, X, L.sys.N, NULL, NULL, NULL), PHGMG_OK);
+    CHECK_RC(phgmg_simulate_inputs(&M.sys, 1, &run, &go, XN, M.sys.N, NULL, NULL, NULL), PHGMG_OK);
+    CHECK(opt_same(&L.sys, X, set_pod, &run));
+    CHECK(opt_same(&L.sys, X, set_qm, &run));
+    CHECK(opt_same(&L.sys, X, set_qm_cv, &run));
+    CHECK(opt_same(&L.sys, X, set_qm_auto, &run));
+    CHECK(opt_same(&L.sys, X, set_sp1, &run));
+    CHECK(opt_same(&M.sys, XN, set_pod_ecsw, &run));
+    CHECK(opt_same(&M.sys, XN, set_sp2_qdeim, &run));
+    { /* negative control: a lambda other than the default is another model */
+      unsigned char *a, *b;
+      size_t la = 0, lb = 0;
+      double ka, kb;
+      phgmg_reduce_opts_default(&d); set_qm(&d, &run);
+      memset(&z, 0, sizeof z); set_qm_other(&z, &run);
+      a = opt_model(&L.sys, X, &d, &la, &ka);
+      b = opt_model(&L.sys, X, &z, &lb, &kb);
+      CHECK(a && b && ka != kb && (la != lb || memcmp(a, b, la) != 0));
+      free(a); free(b);
+    }
+  }
+  /* the query is idempotent and leaves the required fields to the caller */
+  phgmg_reduce_opts_default(&d);
+  z = d;
+  phgmg_reduce_opts_default(&z);
+  CHECK(!memcmp(&d, &z, sizeof d));
+  CHECK(d.method == 0 && d.r == 0 && d.lambda_blocks == 0 && d.newton_tol == 0.0 && !d.runs && !d.eta);
+  phgmg_reduce_opts_default(NULL);
+  free(X); free(XN);
+  msd_linear_free(&L);
+  msd_nonlinear_free(&M);
+}
+
+SUITE(options) {
+  RUN(test_reduce_opts_default_same_model);
+}
