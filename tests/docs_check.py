@@ -153,8 +153,8 @@ def check_defaults(header, binary):
     except OSError:
         text = ""
     for opt, field, pat in (("--rn", "rn", r"--rn K .*?\(default (\S+?)[,)]"),
-                            ("--deim-tol", "deim_tol", r"--deim-tol T .*?\(default (\S+?)\)"),
-                            ("--hyper-tol", "hyper_tol", r"--hyper-tol T .*?\((\S+?)\)")):
+                            ("--deim-tol", "deim_tol", r"--deim-tol T .*?\(default (\S+?)[;,)]"),
+                            ("--hyper-tol", "hyper_tol", r"--hyper-tol T .*?\(default (\S+?)[;,)]")):
         m = re.search(pat, text, re.S)
         if not m:
             problems.append("phgmg --help: no default stated for %s" % opt)
