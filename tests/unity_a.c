@@ -22,5 +22,6 @@
 #include "test_npy.c"
 #include "test_online.c"
 #include "test_sparse.c"
+#include "test_sparse_lu.c"
 #include "test_study.c"
 #include "test_subnormal.c"
