@@ -6050,17 +6050,14 @@ PHGMG_DEF phgmg_result phgmg_ph_sparse_create_e(phgmg_ph_sparse **out, int N, in
    and Q, as the band stepper computes them. */
 PHGMG__PRIV void phgmg__ph_sparse_stage_bw(const phgmg_ph_sparse *sp, int *kl, int *ku) {
   const int N = sp->sys.N, kb = sp->sys.kb;
-  int o, i, amin = 0, amax = 0, bmin = 0, bmax = 0;
-  for (o = -kb; o <= kb; ++o) {
-    int nzjr = 0, nzq = 0;
-    for (i = PHGMG__MAX(0, -o); i < PHGMG__MIN(N, N - o); ++i) {
-      size_t k = PHGMG__PHB(kb, i, i + o);
-      nzjr |= sp->J[k] - sp->R[k] != 0.0;
-      nzq |= sp->Q[k] != 0.0;
+  int i, j, amin = 0, amax = 0, bmin = 0, bmax = 0;
+  for (j = 0; j < N; ++j) /* column by column: contiguous in band storage */
+    for (i = PHGMG__MAX(0, j - kb); i <= PHGMG__MIN(N - 1, j + kb); ++i) {
+      size_t k = PHGMG__PHB(kb, i, j);
+      int o = j - i;
+      if (sp->J[k] - sp->R[k] != 0.0) { amin = PHGMG__MIN(amin, o); amax = PHGMG__MAX(amax, o); }
+      if (sp->Q[k] != 0.0) { bmin = PHGMG__MIN(bmin, o); bmax = PHGMG__MAX(bmax, o); }
     }
-    if (nzjr) { amin = PHGMG__MIN(amin, o); amax = PHGMG__MAX(amax, o); }
-    if (nzq) { bmin = PHGMG__MIN(bmin, o); bmax = PHGMG__MAX(bmax, o); }
-  }
   *kl = PHGMG__MIN(N - 1, -(amin + bmin));
   *ku = PHGMG__MIN(N - 1, amax + bmax);
 }
@@ -6835,6 +6832,26 @@ PHGMG__PRIV phgmg_result phgmg__gl3_setup_sparse(phgmg_gl3 *s) {
 
 PHGMG__PRIV phgmg_result phgmg__gl3_setup_band_lu(phgmg_gl3 *s);
 
+/* Sparse mode: Q's diagonal as the one-diagonal form when Q is diagonal (the
+   fused gradient path), else no diagonal form (Q x through the CSC copy);
+   the band's diagonals are not scanned. */
+PHGMG__PRIV phgmg_result phgmg__gl3_sparse_qdiag(phgmg_gl3 *s) {
+  const phgmg__spsym *S = s->sps;
+  int j, p, diag = 1;
+  for (j = 0; j < s->N && diag; ++j)
+    for (p = S->q_p[j]; p < S->q_p[j + 1]; ++p) diag &= S->q_i[p] == j;
+  s->dq.n = s->N;
+  s->dq.nd = 0;
+  if (!diag) return PHGMG_OK;
+  s->dq.off = phgmg__ialloc(&s->al, 1);
+  s->dq.v = phgmg__dalloc(&s->al, (size_t)s->N);
+  if (!s->dq.off || !s->dq.v) return PHGMG_ERR_NOMEM;
+  s->dq.off[0] = 0;
+  for (j = 0; j < s->N; ++j) s->dq.v[j] = S->q_p[j + 1] > S->q_p[j] ? S->q_x[S->q_p[j]] : 0.0;
+  s->dq.nd = 1;
+  return PHGMG_OK;
+}
+
 /* Banded storage: diagonals of J - R and Q, the CSR forms, and the
    workspaces of the stage solver. */
 PHGMG__PRIV phgmg_result phgmg__gl3_setup_banded(phgmg_gl3 *s) {
@@ -6842,8 +6859,12 @@ PHGMG__PRIV phgmg_result phgmg__gl3_setup_banded(phgmg_gl3 *s) {
   const int N = s->N;
   phgmg_result rc;
   int kb = sys->kb;
-  rc = phgmg__dia_build(&s->al, &s->djr, N, kb, sys->J, sys->R, 0, 0);
-  if (rc == PHGMG_OK) rc = phgmg__dia_build(&s->al, &s->dq, N, kb, sys->Q, NULL, 1, 0);
+  if (s->mode == PHGMG__GL3_SPARSE) {
+    rc = phgmg__gl3_sparse_qdiag(s);
+  } else {
+    rc = phgmg__dia_build(&s->al, &s->djr, N, kb, sys->J, sys->R, 0, 0);
+    if (rc == PHGMG_OK) rc = phgmg__dia_build(&s->al, &s->dq, N, kb, sys->Q, NULL, 1, 0);
+  }
   if (rc != PHGMG_OK) return rc;
   rc = phgmg__gl3_csr(s);
   if (rc != PHGMG_OK) return rc;
@@ -7301,7 +7322,10 @@ PHGMG__PRIV phgmg_result phgmg__gl3_sparse_fallback(phgmg_gl3 *s) {
   phgmg__spnum_free(&s->al, &s->spf1);
   phgmg__spnum_free(&s->al, &s->spf2);
   s->mode = PHGMG__GL3_BANDED;
-  rc = phgmg__gl3_setup_band_lu(s);
+  phgmg__dia_free(&s->al, &s->dq);
+  rc = phgmg__dia_build(&s->al, &s->djr, s->N, s->sys.kb, s->sys.J, s->sys.R, 0, 0);
+  if (rc == PHGMG_OK) rc = phgmg__dia_build(&s->al, &s->dq, s->N, s->sys.kb, s->sys.Q, NULL, 1, 0);
+  if (rc == PHGMG_OK) rc = phgmg__gl3_setup_band_lu(s);
   if (rc != PHGMG_OK) return rc;
   phgmg__free(&s->al, s->r1buf);
   phgmg__free(&s->al, s->rcbuf);
