@@ -33,7 +33,9 @@
      >>linalg   dense kernels: GEMM, LU (real, complex), QR, QRCP, least squares,
                 thin SVD (QRCP + one-sided Jacobi), symmetric eigenvalues
      >>ph       full-order pH systems: dense/banded storage, separable or general
-                nonlinear Hamiltonians, validation, J-R factorization
+                nonlinear Hamiltonians, validation, J-R factorization, sparse input
+     >>sparse   (inside >>ph) sparse LU of the GL3 stage matrices of sparse input:
+                nested dissection, elimination tree, supernodal multifrontal LU
      >>gl3      3-stage Gauss-Legendre (order 6) + simplified Newton, energy bookkeeping
      >>online   reduced models (phgmg_rom), evaluation, allocation-free GL3 stepper
      >>pod, >>reduce, >>deim, >>errors   POD, GMG-POD, GMG-QM, SP1, SP2, DEIM, error measures
@@ -756,7 +758,8 @@ PHGMG_DEF phgmg_result phgmg_ph_sparse_set_solver(phgmg_ph_sparse *sp, int solve
      Jac = (J - R) Hess H(x_n), factored as gam/h I - Jac (real) and
      (alp - i bet)/h I - Jac (complex): dense LU, banded LU with lower/upper
      bandwidth from the nonzero diagonals of J - R and Q (plus kb for a GENERAL
-     Hessian), or the caller's shifted_* callbacks. Factors are reused across
+     Hessian), the sparse LU of a phgmg_ph_sparse model that chose it
+     (>>sparse), or the caller's shifted_* callbacks. Factors are reused across
      steps; the next step refactors when the largest contraction rate
      res_{k+1}/res_k of a step exceeded opts.contraction. With factors from an
      earlier state a rising residual aborts at once and the step is retried
