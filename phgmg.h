@@ -7325,6 +7325,7 @@ PHGMG__PRIV phgmg_result phgmg__gl3_sparse_fallback(phgmg_gl3 *s) {
   phgmg__spnum_free(&s->al, &s->spf1);
   phgmg__spnum_free(&s->al, &s->spf2);
   s->mode = PHGMG__GL3_BANDED;
+  s->sps = NULL; /* from here exactly the band stepper */
   phgmg__dia_free(&s->al, &s->dq);
   rc = phgmg__dia_build(&s->al, &s->djr, s->N, s->sys.kb, s->sys.J, s->sys.R, 0, 0);
   if (rc == PHGMG_OK) rc = phgmg__dia_build(&s->al, &s->dq, s->N, s->sys.kb, s->sys.Q, NULL, 1, 0);
