@@ -172,6 +172,7 @@ $(BUILD)/phgmg: examples/phgmg_cli.c phgmg.h
 
 test-cli: $(BUILD)/phgmg
 	sh tests/test_cli.sh $(BUILD)/phgmg
+	sh tests/test_simulate.sh $(BUILD)/phgmg
 
 $(BUILD)/%: examples/%.c phgmg.h $(EXHDRS)
 	@mkdir -p $(BUILD)

@@ -238,6 +238,18 @@
    and the BALANCED / H2 bases then return PHGMG_ERR_NOT_STABLE.
 
 
+   2.6 Sparse models (>>ph, >>sparse). phgmg_ph_sparse_create takes J, R, Q
+   (and E) as compressed sparse columns in any ordering, reorders them by
+   reverse Cuthill-McKee into band storage and, for meshes (a wide band),
+   also analyses a sparse LU of the GL3 stage matrices: nested dissection of
+   the symmetrised pattern, elimination tree, relaxed supernodes, a
+   multifrontal LU with dense fronts, static pivoting on the fill-reducing
+   order, each factorization checked (a tiny pivot or growth above
+   PHGMG_SPARSE_GROWTH switches that stepper to the band LU with partial
+   pivoting). The cheaper of band and sparse LU by predicted entries and
+   flops is used; phgmg_ph_sparse_info reports the choice and
+   phgmg_ph_sparse_set_solver forces one. Descriptor models keep the band LU.
+
    3. METHODS AND OPTIONS -------------------------------------------------------
    Every option struct is "zero means default": memset it to 0 and set what you
    need. The tables give each field's default (the value a zero field takes).
@@ -730,7 +742,8 @@
            phgmg_ph_sparse_system,
            phgmg_ph_sparse_perm, phgmg_ph_sparse_sep_idx,
            phgmg_ph_sparse_to_banded_order, phgmg_ph_sparse_to_user_order,
-           phgmg_ph_sparse_destroy, phgmg_gl3_create, phgmg_gl3_destroy,
+           phgmg_ph_sparse_destroy, phgmg_ph_sparse_set_solver,
+           phgmg_gl3_create, phgmg_gl3_destroy,
            phgmg_gl3_step, phgmg_gl3_get_stats, phgmg_simulate,
            phgmg_gl3_coefficients
    online: phgmg_rom_check, phgmg_rom_eval_work_size, phgmg_rom_hamiltonian,
@@ -759,7 +772,7 @@
            phgmg_rom_load, phgmg_rom_export_c
    npy:    phgmg_npy_parse, phgmg_npy_serialize, phgmg_npy_free,
            phgmg_npy_read, phgmg_npy_write
-   (112 functions; also the macros PHGMG_ROM_STEPPER_MEMSIZE_MAX and _MAX_CB.)
+   (113 functions; also the macros PHGMG_ROM_STEPPER_MEMSIZE_MAX and _MAX_CB.)
 */
 #ifndef PHGMG_H_INCLUDED
 #define PHGMG_H_INCLUDED
@@ -996,6 +1009,8 @@ typedef enum phgmg_nl_kind {
    nsep terms) return phi_k(s), phi_k'(s), phi_k''(s). */
 typedef double (*phgmg_phi_fn)(int k, double s, void *user);
 
+typedef struct phgmg_ph_sparse phgmg_ph_sparse; /* sparse input, below */
+
 typedef struct phgmg_ph_system {
   int N, m;
   phgmg_storage storage;   /* DENSE (default) or BANDED                      */
@@ -1067,6 +1082,11 @@ typedef struct phgmg_ph_system {
      them; phgmg_ph_output gives (B + P)^T z only (it has no u). Reductions of
      a model with feedthrough are not supported (PHGMG_ERR_UNSUPPORTED). */
   const double *P, *S, *Nskew;
+  /* Set by phgmg_ph_sparse_system (NULL otherwise): the sparse model this
+     banded system comes from. The GL3 stepper then solves its stage systems
+     with the sparse LU when phgmg_ph_sparse chose it (see >>sparse) and J,
+     R, Q are still the object's matrices. */
+  const phgmg_ph_sparse *sparse;
 } phgmg_ph_system;
 
 /* Validation of a system. tol (<= 0: 1e-12) is relative to the matrix norms:
@@ -1189,7 +1209,6 @@ PHGMG_DEF phgmg_result phgmg_rcm(int N, int na, const phgmg_csc *const *A, int *
        phgmg_simulate(&sys, x0, ...X...);                 // internal order
        phgmg_ph_sparse_to_user_order(sp, nsteps + 1, X, N, X_user, N);
        phgmg_ph_sparse_destroy(sp);                       // after sys's last use */
-typedef struct phgmg_ph_sparse phgmg_ph_sparse;
 typedef struct phgmg_ph_sparse_info {
   int kb;        /* half-bandwidth of the stored (internal) ordering        */
   int kb_input;  /* half-bandwidth of the given ordering                    */
@@ -1197,6 +1216,15 @@ typedef struct phgmg_ph_sparse_info {
   int permuted;  /* 1: RCM order used, 0: the given order kept (perm = id)  */
   int wide;      /* 1: kb > N/4, banded costs about as much as dense or more */
   long nnz;      /* stored entries of J, R, Q (and E) together              */
+  /* The solver of the GL3 stage systems (see >>sparse): */
+  int solver;         /* PHGMG_SOLVER_BAND or PHGMG_SOLVER_SPARSE_LU           */
+  int kl, ku;         /* lower/upper bandwidth of the stage matrix             */
+  double lu_band;     /* predicted entries of one band factor, N (2kl + ku + 1) */
+  double lu_sparse;   /* entries of one sparse factor (0: not analysed)        */
+  double flops_band;  /* predicted flops of one real band factorization        */
+  double flops_sparse;/* of one real sparse factorization (0: not analysed)    */
+  int supernodes;     /* supernodes of the sparse factor (0: not analysed)     */
+  int front_max;      /* largest dense front (order)                           */
 } phgmg_ph_sparse_info;
 PHGMG_DEF phgmg_result phgmg_ph_sparse_create(phgmg_ph_sparse **out, int N, int m, const phgmg_csc *J,
                                               const phgmg_csc *R, const phgmg_csc *Q, const double *B,
@@ -1236,6 +1264,76 @@ PHGMG_DEF phgmg_result phgmg_ph_sparse_to_user_order(const phgmg_ph_sparse *sp, 
 /* Frees the object and its arrays (NULL is fine). */
 PHGMG_DEF void phgmg_ph_sparse_destroy(phgmg_ph_sparse *sp);
 
+/* >>sparse ---------------------------------------------------------------
+   The GL3 stepper solves, per Newton iteration, one real and one complex
+   system with the stage matrices K(sigma) = sigma I + M, M = -(J - R)(Q + D)
+   (D: the Hessian diagonal of a SEPARABLE nonlinear part, 0 for a linear
+   model), sigma = gamma/h and (alpha - i beta)/h. In band storage these
+   factor in O(N kl (kl + ku)) and solve in O(N (kl + ku)) with kl, ku ~ 2 kb:
+   right for chains, slow for 2-D and 3-D meshes (a 40 x 40 lattice has kb ~
+   80, a 16^3 one ~ 400). phgmg_ph_sparse_create therefore predicts both
+   costs and picks the cheaper solver (PHGMG_SOLVER_AUTO):
+   - Band: kept without analysis when kb <= PHGMG_SPARSE_MIN_KB (chains).
+   - Sparse LU, own code in this file, in four steps:
+     1. Ordering: nested dissection of the graph of M + M^T (the pattern of
+        M is that of (J - R) Q + (J - R) + I; it is symmetric when J - R and
+        Q have symmetric patterns only if their product's is, so the graph is
+        symmetrised). Each part is split by one level of a breadth-first
+        search from a pseudo-peripheral node (George-Liu), the level where
+        half of the part is reached, thinned to the nodes with a neighbour in
+        the next level (still a separator); halves first, separator last,
+        parts of <= 48 nodes as they come, unconnected parts one by one.
+     2. Symbolic analysis: elimination tree (Liu, path compression),
+        postorder, column counts from the row subtrees (O(nnz(L))),
+        supernodes: fundamental ones, plus a child joined to its only-child
+        parent while the block has <= 16 columns and the padded zeros stay
+        below a fifth of its entries. The factor of the symmetric pattern
+        needs the same structure for L and U^T.
+     3. Numeric factorization, multifrontal: per supernode (postorder) a
+        dense front (its columns and rows) is assembled from K and the
+        children's update matrices (a stack), its columns are eliminated
+        with the diagonal pivots (dense LU on the panel, a triangular solve
+        for U's block, one GEMM for the update matrix), L/U panels stored.
+     4. Solve: forward and backward substitution supernode by supernode.
+     Pivoting is static: the pivots are the diagonal of the fill-reducing
+     order. This is safe here because K = sigma I + M with Re sigma > 0 is
+     dominated by its shift for the step sizes GL3 is used with, but not
+     guaranteed; so each factorization checks itself: a pivot below
+     PHGMG_SPARSE_PIVTOL max|K| is replaced by that value, and when any was
+     replaced or the largest factor entry exceeds PHGMG_SPARSE_GROWTH
+     max|K|, the stepper drops the sparse factors and uses the band LU with
+     partial pivoting for the rest of its life (as before this solver).
+   Prediction: the band factor has N (2kl + ku + 1) entries and about
+   2 N kl (kl + ku) flops (kl, ku of the stage matrix's pattern); the sparse
+   one the entries and flops of its supernodes. The stepper reuses factors
+   across steps (a linear model factors once), so the solve cost decides:
+   sparse when its factor has fewer than half the band's entries (a solve
+   through a supernodal factor costs about twice a band solve per entry)
+   and its factorization takes fewer flops. The analysis itself costs about
+   one factorization's memory traffic. phgmg_ph_sparse_set_solver forces a
+   choice (tests, comparisons). The choice and both predictions are in
+   phgmg_ph_sparse_info. The sparse solver serves the GL3 stepper of a
+   system with nl NONE or SEPARABLE; a GENERAL Hessian (banded by its
+   callback) and a descriptor model (E) keep the band LU
+   (phgmg_ph_sparse_set_solver: PHGMG_ERR_UNSUPPORTED for the sparse LU). Other solves with J - R (phgmg_jr_factor,
+   the validation) stay banded. */
+#ifndef PHGMG_SPARSE_MIN_KB
+#define PHGMG_SPARSE_MIN_KB 8      /* band without analysis up to this kb       */
+#endif
+#ifndef PHGMG_SPARSE_PIVTOL
+#define PHGMG_SPARSE_PIVTOL 1e-8   /* static pivot threshold, relative to max|K| */
+#endif
+#ifndef PHGMG_SPARSE_GROWTH
+#define PHGMG_SPARSE_GROWTH 1e8    /* largest factor entry / max|K| accepted     */
+#endif
+enum { PHGMG_SOLVER_AUTO = 0, PHGMG_SOLVER_BAND = 1, PHGMG_SOLVER_SPARSE_LU = 2 };
+/* Force the stage-matrix solver of steppers created from now on:
+   PHGMG_SOLVER_BAND, _SPARSE_LU (runs the analysis if not done) or _AUTO
+   (the prediction). info (may be NULL) is refreshed. PHGMG_ERR_INVALID_ARG
+   (NULL sp, unknown solver), _NOMEM. */
+PHGMG_DEF phgmg_result phgmg_ph_sparse_set_solver(phgmg_ph_sparse *sp, int solver,
+                                                  phgmg_ph_sparse_info *info);
+
 /* >>gl3 =================================================================== */
 /* 3-stage Gauss-Legendre (order 6), simplified Newton on the transformed stage
    system (one real and one complex N x N solve per iteration), factorization
@@ -1250,7 +1348,8 @@ PHGMG_DEF void phgmg_ph_sparse_destroy(phgmg_ph_sparse *sp);
      Jac = (J - R) Hess H(x_n), factored as gam/h I - Jac (real) and
      (alp - i bet)/h I - Jac (complex): dense LU, banded LU with lower/upper
      bandwidth from the nonzero diagonals of J - R and Q (plus kb for a GENERAL
-     Hessian), or the caller's shifted_* callbacks. Factors are reused across
+     Hessian), the sparse LU of a phgmg_ph_sparse model that chose it
+     (>>sparse), or the caller's shifted_* callbacks. Factors are reused across
      steps; the next step refactors when the largest contraction rate
      res_{k+1}/res_k of a step exceeded opts.contraction. With factors from an
      earlier state a rising residual aborts at once and the step is retried
@@ -4124,9 +4223,12 @@ PHGMG__PRIV double phgmg__ph_at(const phgmg_ph_system *s, const double *M, int i
 }
 
 /* y = M x (overwrite) for a dense or banded system matrix. */
+PHGMG__PRIV int phgmg__ph_sparse_mv(const phgmg_ph_system *s, const double *M, const double *x,
+                                     double *y);
 PHGMG__PRIV void phgmg__ph_mv(const phgmg_ph_system *s, const double *M, const double *x,
                               double *y) {
   int N = s->N, i, j;
+  if (s->sparse && phgmg__ph_sparse_mv(s, M, x, y)) return;
   for (i = 0; i < N; ++i) y[i] = 0.0;
   if (s->storage == PHGMG_BANDED) {
     int kb = s->kb;
@@ -5203,6 +5305,964 @@ PHGMG_DEF phgmg_result phgmg_ph_validate(const phgmg_ph_system *sys, double tol,
   return PHGMG_OK;
 }
 
+/* >>sparse (implementation) ============================================== */
+/* Sparse direct solver of the GL3 stage matrices K = sigma I + M,
+   M = -(J - R)(Q + D) (see >>sparse above): nested dissection on the
+   symmetrised pattern, elimination tree, supernodes, multifrontal LU with
+   dense fronts and the diagonal pivots of the ordering (static pivoting). */
+
+/* Nested dissection workspace: the graph (CSR, symmetric, no diagonal) and
+   the per-node arrays shared by the recursion. */
+typedef struct phgmg__nd {
+  int n;
+  const int *ap, *ai;
+  int *lab, *lev, *queue, *order;
+  int nout, nlab;
+  unsigned long long *bits; /* PHGMG__ND_LEAF^2 bits: a part's elimination graph */
+  int *mate, *vis, stamp;   /* separator refinement (matching, marks)          */
+} phgmg__nd;
+
+/* Breadth-first search from root over the nodes labelled lab: levels into
+   nd->lev, nodes in BFS order into queue[0..*cnt); returns the number of
+   levels. */
+PHGMG__PRIV int phgmg__nd_bfs(phgmg__nd *d, int root, int lab, int *cnt) {
+  int head = 0, tail = 0, nl = 0, p;
+  d->queue[tail++] = root;
+  d->lev[root] = 0;
+  d->lab[root] = -2 - lab; /* visited mark, restored below */
+  while (head < tail) {
+    int v = d->queue[head++];
+    if (d->lev[v] + 1 > nl) nl = d->lev[v] + 1;
+    for (p = d->ap[v]; p < d->ap[v + 1]; ++p) {
+      int w = d->ai[p];
+      if (d->lab[w] != lab) continue;
+      d->lab[w] = -2 - lab;
+      d->lev[w] = d->lev[v] + 1;
+      d->queue[tail++] = w;
+    }
+  }
+  for (p = 0; p < tail; ++p) d->lab[d->queue[p]] = lab;
+  *cnt = tail;
+  return nl;
+}
+
+/* Degree of v within the nodes labelled lab. */
+PHGMG__PRIV int phgmg__nd_deg(const phgmg__nd *d, int v, int lab) {
+  int p, k = 0;
+  for (p = d->ap[v]; p < d->ap[v + 1]; ++p) k += d->lab[d->ai[p]] == lab;
+  return k;
+}
+
+#define PHGMG__ND_LEAF 256 /* parts this small: minimum degree */
+
+PHGMG__PRIV int phgmg__popcount64(unsigned long long x) {
+  x = x - ((x >> 1) & 0x5555555555555555ULL);
+  x = (x & 0x3333333333333333ULL) + ((x >> 2) & 0x3333333333333333ULL);
+  x = (x + (x >> 4)) & 0x0F0F0F0F0F0F0F0FULL;
+  return (int)((x * 0x0101010101010101ULL) >> 56);
+}
+
+/* Minimum degree order of a small part (cnt <= PHGMG__ND_LEAF nodes, all
+   labelled lab), exact, on its elimination graph as a bit matrix (degrees
+   within the part; ties: the earlier node). */
+PHGMG__PRIV void phgmg__nd_leaf(phgmg__nd *d, const int *list, int cnt, int lab) {
+  enum { WD = PHGMG__ND_LEAF / 64 };
+  unsigned long long *adj = d->bits, alive[WD];
+  int i, p, k, w, nw = (cnt + 63) / 64;
+  for (i = 0; i < cnt; ++i) d->lev[list[i]] = i; /* local index */
+  for (i = 0; i < cnt * WD; ++i) adj[i] = 0;
+  for (w = 0; w < WD; ++w) alive[w] = 0;
+  for (i = 0; i < cnt; ++i) {
+    int v = list[i];
+    alive[i / 64] |= 1ULL << (i % 64);
+    for (p = d->ap[v]; p < d->ap[v + 1]; ++p) {
+      int u = d->ai[p];
+      if (d->lab[u] != lab) continue;
+      u = d->lev[u];
+      if (u != i) adj[i * WD + u / 64] |= 1ULL << (u % 64);
+    }
+  }
+  for (k = 0; k < cnt; ++k) {
+    int best = -1, bdeg = 0;
+    for (i = 0; i < cnt; ++i) {
+      int g = 0;
+      if (!(alive[i / 64] >> (i % 64) & 1ULL)) continue;
+      for (w = 0; w < nw; ++w) g += phgmg__popcount64(adj[i * WD + w]);
+      if (best < 0 || g < bdeg) { best = i; bdeg = g; }
+    }
+    alive[best / 64] &= ~(1ULL << (best % 64));
+    for (i = 0; i < cnt; ++i) { /* neighbours of best: a clique, best removed */
+      if (!(adj[best * WD + i / 64] >> (i % 64) & 1ULL)) continue;
+      for (w = 0; w < nw; ++w) adj[i * WD + w] |= adj[best * WD + w];
+      adj[i * WD + i / 64] &= ~(1ULL << (i % 64));
+      adj[i * WD + best / 64] &= ~(1ULL << (best % 64));
+    }
+    d->order[d->nout++] = list[best];
+    d->lab[list[best]] = -1;
+  }
+}
+
+/* Augmenting path from x (level ly - 1) into level ly (Kuhn). */
+PHGMG__PRIV int phgmg__nd_aug(phgmg__nd *d, int x, int lab, int ly) {
+  int p;
+  for (p = d->ap[x]; p < d->ap[x + 1]; ++p) {
+    int y = d->ai[p];
+    if (d->lab[y] != lab || d->lev[y] != ly || d->vis[y] == d->stamp) continue;
+    d->vis[y] = d->stamp;
+    if (d->mate[y] < 0 || phgmg__nd_aug(d, d->mate[y], lab, ly)) {
+      d->mate[y] = x;
+      d->mate[x] = y;
+      return 1;
+    }
+  }
+  return 0;
+}
+
+/* Minimum vertex cover of the bipartite graph between BFS levels L and L+1
+   (the first cnt entries of queue, labelled lab): maximum matching by
+   augmenting paths, then Koenig's construction; cover nodes get vis = -1. */
+PHGMG__PRIV void phgmg__nd_cover(phgmg__nd *d, int cnt, int lab, int L) {
+  int i, p, head = 0, tail = 0, *q = d->queue + cnt; /* queue has room for n: BFS of cnt used */
+  for (i = 0; i < cnt; ++i) {
+    int x = d->queue[i];
+    if (d->lev[x] != L) continue;
+    ++d->stamp;
+    phgmg__nd_aug(d, x, lab, L + 1);
+  }
+  ++d->stamp; /* Z: reachable from unmatched X by alternating paths */
+  for (i = 0; i < cnt; ++i) {
+    int x = d->queue[i];
+    if (d->lev[x] == L && d->mate[x] < 0) { d->vis[x] = d->stamp; q[tail++] = x; }
+  }
+  while (head < tail) {
+    int x = q[head++];
+    for (p = d->ap[x]; p < d->ap[x + 1]; ++p) {
+      int y = d->ai[p], x2;
+      if (d->lab[y] != lab || d->lev[y] != L + 1 || d->vis[y] == d->stamp) continue;
+      d->vis[y] = d->stamp;
+      x2 = d->mate[y];
+      if (x2 >= 0 && d->vis[x2] != d->stamp) { d->vis[x2] = d->stamp; q[tail++] = x2; }
+    }
+  }
+  for (i = 0; i < cnt; ++i) { /* cover: (X \ Z) + (Y & Z) */
+    int v = d->queue[i], lv = d->lev[v], z = d->vis[v] == d->stamp;
+    if ((lv == L && !z) || (lv == L + 1 && z)) d->vis[v] = -1;
+    if (lv == L || lv == L + 1) d->mate[v] = -1;
+  }
+}
+
+/* Order the nodes list[0..cnt) (all labelled lab): split by the middle level
+   of a breadth-first search from a pseudo-peripheral node, the two halves
+   first (recursively), the separator last. Unconnected parts one after the
+   other (a loop, so that many small components do not deepen the recursion). */
+PHGMG__PRIV void phgmg__nd_rec(phgmg__nd *d, int *list, int cnt, int lab) {
+  for (;;) {
+    int root, nl, reach, i, it, half, sep_lev, na = 0, nb = 0, ns = 0, la, lb, ls;
+    if (cnt <= PHGMG__ND_LEAF) {
+      phgmg__nd_leaf(d, list, cnt, lab);
+      return;
+    }
+    root = list[0];
+    nl = phgmg__nd_bfs(d, root, lab, &reach);
+    if (reach < cnt) { /* not connected: the component of root, then the rest */
+      int *tmp = d->queue, la2 = ++d->nlab, lb2 = ++d->nlab, r = reach;
+      for (i = 0; i < reach; ++i) d->lab[tmp[i]] = la2;
+      for (i = 0; i < cnt; ++i)
+        if (d->lab[list[i]] != la2) { d->lab[list[i]] = lb2; tmp[r++] = list[i]; }
+      for (i = 0; i < cnt; ++i) list[i] = tmp[i];
+      phgmg__nd_rec(d, list, reach, la2);
+      list += reach;
+      cnt -= reach;
+      lab = lb2;
+      continue;
+    }
+    for (it = 0; it < 6; ++it) { /* pseudo-peripheral node (George-Liu) */
+      int best = -1, bdeg = 0, k, nl2, r2;
+      for (k = reach - 1; k >= 0 && d->lev[d->queue[k]] == nl - 1; --k) {
+        int g = phgmg__nd_deg(d, d->queue[k], lab);
+        if (best < 0 || g < bdeg) { best = d->queue[k]; bdeg = g; }
+      }
+      nl2 = phgmg__nd_bfs(d, best, lab, &r2);
+      if (nl2 <= nl) { nl = phgmg__nd_bfs(d, root, lab, &reach); break; }
+      root = best;
+      nl = nl2;
+    }
+    if (nl < 3) { /* too compact to split by levels */
+      for (i = 0; i < cnt; ++i) { d->order[d->nout++] = list[i]; d->lab[list[i]] = -1; }
+      return;
+    }
+    /* the separator: a minimum vertex cover of the edges between the level
+       where the count reaches half (X) and the next (Y) */
+    half = 0;
+    sep_lev = 0;
+    for (i = 0; i < cnt; ++i) {
+      sep_lev = d->lev[d->queue[i]];
+      if (++half >= cnt / 2) break;
+    }
+    if (sep_lev < 1) sep_lev = 1;
+    if (sep_lev > nl - 2) sep_lev = nl - 2;
+    la = ++d->nlab;
+    lb = ++d->nlab;
+    ls = ++d->nlab;
+    phgmg__nd_cover(d, cnt, lab, sep_lev);
+    for (i = 0; i < cnt; ++i) {
+      int v = d->queue[i], lv = d->lev[v];
+      if (lv < sep_lev) d->lab[v] = la;
+      else if (lv > sep_lev + 1) d->lab[v] = lb;
+      else if (d->vis[v] == -1) d->lab[v] = ls; /* in the cover */
+      else d->lab[v] = lv == sep_lev ? la : lb;
+    }
+    for (i = 0; i < cnt; ++i) d->vis[d->queue[i]] = 0;
+    { /* list: part a, part b, separator */
+      int *q = d->queue;
+      for (i = 0; i < cnt; ++i) q[i] = list[i];
+      for (i = 0; i < cnt; ++i) if (d->lab[q[i]] == la) list[na++] = q[i];
+      for (i = 0; i < cnt; ++i) if (d->lab[q[i]] == lb) list[na + nb++] = q[i];
+      for (i = 0; i < cnt; ++i) if (d->lab[q[i]] == ls) list[na + nb + ns++] = q[i];
+    }
+    phgmg__nd_rec(d, list, na, la);
+    phgmg__nd_rec(d, list + na, nb, lb);
+    for (i = 0; i < ns; ++i) { d->order[d->nout++] = list[na + nb + i]; d->lab[list[na + nb + i]] = -1; }
+    return;
+  }
+}
+
+/* Nested dissection order of a symmetric graph (CSR without diagonal):
+   order[k] = node eliminated k-th. */
+PHGMG__PRIV phgmg_result phgmg__nd_order(int n, const int *ap, const int *ai, int *order,
+                                         const phgmg_allocator *al) {
+  phgmg__nd d;
+  int *list, i;
+  d.n = n; d.ap = ap; d.ai = ai; d.order = order; d.nout = 0; d.nlab = 0;
+  d.lab = phgmg__ialloc(al, (size_t)n);
+  d.lev = phgmg__ialloc(al, (size_t)n);
+  d.queue = phgmg__ialloc(al, 2 * (size_t)n);
+  list = phgmg__ialloc(al, (size_t)n);
+  d.bits = PHGMG__CAST(unsigned long long *,
+                       phgmg__alloc(al, sizeof(unsigned long long) * PHGMG__ND_LEAF * (PHGMG__ND_LEAF / 64)));
+  d.mate = phgmg__ialloc(al, (size_t)n);
+  d.vis = phgmg__ialloc(al, (size_t)n);
+  d.stamp = 0;
+  if (!d.lab || !d.lev || !d.queue || !list || !d.bits || !d.mate || !d.vis) {
+    phgmg__free(al, d.lab); phgmg__free(al, d.lev); phgmg__free(al, d.queue); phgmg__free(al, list);
+    phgmg__free(al, d.bits); phgmg__free(al, d.mate); phgmg__free(al, d.vis);
+    return PHGMG_ERR_NOMEM;
+  }
+  for (i = 0; i < n; ++i) { d.mate[i] = -1; d.vis[i] = 0; }
+  for (i = 0; i < n; ++i) { d.lab[i] = 0; list[i] = i; d.lev[i] = 0; }
+  phgmg__nd_rec(&d, list, n, 0);
+  phgmg__free(al, d.bits); phgmg__free(al, d.mate); phgmg__free(al, d.vis);
+  phgmg__free(al, d.lab); phgmg__free(al, d.lev); phgmg__free(al, d.queue); phgmg__free(al, list);
+  return d.nout == n ? PHGMG_OK : PHGMG_ERR_INVALID_ARG;
+}
+
+/* Elimination tree of the symmetric pattern (CSR, any order of neighbours)
+   in the order given by iperm (new index of node v: iperm[v]); parent in the
+   new numbering, -1 for a root (Liu's algorithm, path compression). */
+PHGMG__PRIV void phgmg__etree(int n, const int *ap, const int *ai, const int *perm, const int *iperm,
+                              int *parent, int *anc) {
+  int k, p;
+  for (k = 0; k < n; ++k) {
+    int v = perm[k];
+    parent[k] = -1;
+    anc[k] = -1;
+    for (p = ap[v]; p < ap[v + 1]; ++p) {
+      int r = iperm[ai[p]];
+      if (r >= k) continue;
+      while (anc[r] != -1 && anc[r] != k) { int t = anc[r]; anc[r] = k; r = t; }
+      if (anc[r] == -1) { anc[r] = k; parent[r] = k; }
+    }
+  }
+}
+
+/* Postorder of a forest: post[k] = node visited k-th (children before parents). */
+PHGMG__PRIV void phgmg__postorder(int n, const int *parent, int *post, int *head, int *next, int *stack) {
+  int j, k = 0;
+  for (j = 0; j < n; ++j) head[j] = -1;
+  for (j = n - 1; j >= 0; --j)
+    if (parent[j] >= 0) { next[j] = head[parent[j]]; head[parent[j]] = j; }
+  for (j = 0; j < n; ++j) {
+    int top = 0;
+    if (parent[j] != -1) continue;
+    stack[0] = j;
+    while (top >= 0) {
+      int p = stack[top], c = head[p];
+      if (c == -1) { --top; post[k++] = p; }
+      else { head[p] = next[c]; stack[++top] = c; }
+    }
+  }
+}
+
+/* The symbolic analysis (owned by phgmg_ph_sparse, shared by its steppers). */
+typedef struct phgmg__spsym {
+  int n;
+  int *jr_p, *jr_i; double *jr_x; /* J - R, CSC, internal order        */
+  int *q_p, *q_i; double *q_x;    /* Q, CSC, internal order            */
+  int *k_p, *k_i;                 /* pattern of M plus the diagonal    */
+  int *perm;                      /* fill position k: internal perm[k] */
+  int nsup;
+  int *sfirst, *sparent, *scp, *sch, *srp, *srow; /* sch[scp[s]..scp[s+1]): children, last first */
+  size_t *lptr;                   /* factor offsets (scalars)          */
+  int *amp, *ami;                 /* assembly: entries of supernode s  */
+  size_t *amd;                    /*   and their offsets in its front  */
+  size_t front_max, stack_max, nnz_lu;
+  double flops;
+} phgmg__spsym;
+
+PHGMG__PRIV void phgmg__spsym_free(const phgmg_allocator *al, phgmg__spsym *S) {
+  if (!S) return;
+  phgmg__free(al, S->jr_p); phgmg__free(al, S->jr_i); phgmg__free(al, S->jr_x);
+  phgmg__free(al, S->q_p); phgmg__free(al, S->q_i); phgmg__free(al, S->q_x);
+  phgmg__free(al, S->k_p); phgmg__free(al, S->k_i); phgmg__free(al, S->perm);
+  phgmg__free(al, S->sfirst); phgmg__free(al, S->sparent); phgmg__free(al, S->scp); phgmg__free(al, S->sch);
+  phgmg__free(al, S->srp); phgmg__free(al, S->srow); phgmg__free(al, S->lptr);
+  phgmg__free(al, S->amp); phgmg__free(al, S->ami); phgmg__free(al, S->amd);
+  phgmg__free(al, S);
+}
+
+/* Sort n ints increasingly (heapsort: no libc qsort, O(n log n)). */
+PHGMG__PRIV void phgmg__isort(int *a, size_t n) {
+  size_t i, end;
+  if (n < 2) return;
+  for (i = n / 2; i-- > 0;) {
+    size_t r = i;
+    for (;;) {
+      size_t c = 2 * r + 1;
+      int t;
+      if (c >= n) break;
+      if (c + 1 < n && a[c + 1] > a[c]) ++c;
+      if (a[r] >= a[c]) break;
+      t = a[r]; a[r] = a[c]; a[c] = t; r = c;
+    }
+  }
+  for (end = n - 1; end > 0; --end) {
+    size_t r = 0;
+    int t = a[0]; a[0] = a[end]; a[end] = t;
+    for (;;) {
+      size_t c = 2 * r + 1;
+      if (c >= end) break;
+      if (c + 1 < end && a[c + 1] > a[c]) ++c;
+      if (a[r] >= a[c]) break;
+      t = a[r]; a[r] = a[c]; a[c] = t; r = c;
+    }
+  }
+}
+
+/* CSC of M1 - M2 (M2 may be NULL) from band storage (kb), the nonzero
+   entries only. */
+PHGMG__PRIV phgmg_result phgmg__band_to_csc(int n, int kb, const double *M1, const double *M2, int **pp,
+                                            int **pi, double **px, const phgmg_allocator *al) {
+  int j, i, pass;
+  size_t nz = 0;
+  *pp = phgmg__ialloc(al, (size_t)n + 1);
+  if (!*pp) return PHGMG_ERR_NOMEM;
+  for (pass = 0; pass < 2; ++pass) {
+    nz = 0;
+    for (j = 0; j < n; ++j) {
+      if (pass) (*pp)[j] = (int)nz;
+      for (i = PHGMG__MAX(0, j - kb); i <= PHGMG__MIN(n - 1, j + kb); ++i) {
+        size_t k = PHGMG__PHB(kb, i, j);
+        double v = M1[k] - (M2 ? M2[k] : 0.0);
+        if (v == 0.0) continue;
+        if (pass) { (*pi)[nz] = i; (*px)[nz] = v; }
+        ++nz;
+      }
+    }
+    if (!pass) {
+      *pi = phgmg__ialloc(al, nz + 1);
+      *px = phgmg__dalloc(al, nz + 1);
+      if (!*pi || !*px) return PHGMG_ERR_NOMEM;
+    }
+  }
+  (*pp)[n] = (int)nz;
+  return PHGMG_OK;
+}
+
+/* Pattern of M = (J - R) Q plus (J - R) plus the diagonal, CSC, sorted rows. */
+PHGMG__PRIV phgmg_result phgmg__spsym_kpattern(phgmg__spsym *S, const phgmg_allocator *al) {
+  int n = S->n, j, p, q, nz = 0, pass;
+  int *mark = phgmg__ialloc(al, (size_t)n);
+  if (!mark) return PHGMG_ERR_NOMEM;
+  S->k_p = phgmg__ialloc(al, (size_t)n + 1);
+  if (!S->k_p) { phgmg__free(al, mark); return PHGMG_ERR_NOMEM; }
+  for (pass = 0; pass < 2; ++pass) {
+    for (j = 0; j < n; ++j) mark[j] = -1;
+    nz = 0;
+    for (j = 0; j < n; ++j) {
+      int start = nz;
+      if (pass) S->k_p[j] = nz;
+#define PHGMG__KP_ADD(r) do { int r_ = (r); if (mark[r_] != j) { mark[r_] = j; if (pass) S->k_i[nz] = r_; ++nz; } } while (0)
+      PHGMG__KP_ADD(j);
+      for (p = S->jr_p[j]; p < S->jr_p[j + 1]; ++p) PHGMG__KP_ADD(S->jr_i[p]);
+      for (q = S->q_p[j]; q < S->q_p[j + 1]; ++q) {
+        int k = S->q_i[q];
+        for (p = S->jr_p[k]; p < S->jr_p[k + 1]; ++p) PHGMG__KP_ADD(S->jr_i[p]);
+      }
+#undef PHGMG__KP_ADD
+      if (pass) phgmg__isort(S->k_i + start, (size_t)(nz - start));
+    }
+    if (!pass) {
+      S->k_i = phgmg__ialloc(al, (size_t)nz);
+      if (!S->k_i) { phgmg__free(al, mark); return PHGMG_ERR_NOMEM; }
+    }
+  }
+  S->k_p[n] = nz;
+  phgmg__free(al, mark);
+  return PHGMG_OK;
+}
+
+/* Symmetrised adjacency (CSR, no diagonal) of the pattern of K. */
+PHGMG__PRIV phgmg_result phgmg__spsym_graph(const phgmg__spsym *S, int **gp, int **gi,
+                                            const phgmg_allocator *al) {
+  int n = S->n, j, p, *cnt = phgmg__ialloc(al, (size_t)n + 1), *mark = phgmg__ialloc(al, (size_t)n);
+  size_t nz = 0;
+  *gp = NULL; *gi = NULL;
+  if (!cnt || !mark) { phgmg__free(al, cnt); phgmg__free(al, mark); return PHGMG_ERR_NOMEM; }
+  for (j = 0; j <= n; ++j) cnt[j] = 0;
+  for (j = 0; j < n; ++j)
+    for (p = S->k_p[j]; p < S->k_p[j + 1]; ++p)
+      if (S->k_i[p] != j) { cnt[S->k_i[p]]++; cnt[j]++; }
+  *gp = phgmg__ialloc(al, (size_t)n + 1);
+  for (j = 0; j < n; ++j) nz += (size_t)cnt[j];
+  *gi = phgmg__ialloc(al, nz + 1);
+  if (!*gp || !*gi) { phgmg__free(al, cnt); phgmg__free(al, mark); return PHGMG_ERR_NOMEM; }
+  (*gp)[0] = 0;
+  for (j = 0; j < n; ++j) { (*gp)[j + 1] = (*gp)[j] + cnt[j]; cnt[j] = (*gp)[j]; }
+  for (j = 0; j < n; ++j)
+    for (p = S->k_p[j]; p < S->k_p[j + 1]; ++p) {
+      int r = S->k_i[p];
+      if (r == j) continue;
+      (*gi)[cnt[r]++] = j;
+      (*gi)[cnt[j]++] = r;
+    }
+  /* remove duplicates (an entry present in both triangles) */
+  for (j = 0; j < n; ++j) mark[j] = -1;
+  nz = 0;
+  for (j = 0; j < n; ++j) {
+    int s = (*gp)[j], e = (*gp)[j + 1];
+    (*gp)[j] = (int)nz;
+    for (p = s; p < e; ++p) {
+      int r = (*gi)[p];
+      if (mark[r] == j) continue;
+      mark[r] = j;
+      (*gi)[nz++] = r;
+    }
+  }
+  (*gp)[n] = (int)nz;
+  phgmg__free(al, cnt);
+  phgmg__free(al, mark);
+  return PHGMG_OK;
+}
+
+/* Column counts of L (off-diagonal) from the row subtrees, O(nnz(L)). */
+PHGMG__PRIV void phgmg__colcounts(int n, const int *ap, const int *ai, const int *perm, const int *iperm,
+                                  const int *parent, int *cnt, int *mark) {
+  int i, p;
+  for (i = 0; i < n; ++i) { cnt[i] = 0; mark[i] = -1; }
+  for (i = 0; i < n; ++i) {
+    int v = perm[i];
+    mark[i] = i;
+    for (p = ap[v]; p < ap[v + 1]; ++p) {
+      int k = iperm[ai[p]];
+      if (k >= i) continue;
+      while (mark[k] != i) { cnt[k]++; mark[k] = i; k = parent[k]; }
+    }
+  }
+}
+
+/* Relaxed supernodes: column j joins j+1's... built from the front: a chain
+   j -> parent j+1 joins when j is the only child of j+1 and the counts nest
+   (fundamental), or when the merged block stays small (at most
+   PHGMG__SP_RELAX columns and extra zeros below a fifth of its entries). */
+#define PHGMG__SP_RELAX 16
+
+/* Supernode partition, tree and row structures (fill order). */
+PHGMG__PRIV phgmg_result phgmg__spsym_supernodes(phgmg__spsym *S, const int *ap, const int *ai,
+                                                 const int *iperm, const int *parent, const int *cnt,
+                                                 const phgmg_allocator *al) {
+  int n = S->n, j, s, p, ns = 0;
+  int *nch = phgmg__ialloc(al, (size_t)n), *sof = phgmg__ialloc(al, (size_t)n);
+  int *mark = phgmg__ialloc(al, (size_t)n);
+  size_t cap = 0, nz = 0, zeros = 0;
+  phgmg_result rc = PHGMG_OK;
+  S->sfirst = phgmg__ialloc(al, (size_t)n + 1);
+  if (!nch || !sof || !mark || !S->sfirst) { rc = PHGMG_ERR_NOMEM; goto done; }
+  for (j = 0; j < n; ++j) nch[j] = 0;
+  for (j = 0; j < n; ++j) if (parent[j] >= 0) nch[parent[j]]++;
+  for (j = 0; j < n; ++j) {
+    int join = 0;
+    if (j > 0 && parent[j - 1] == j && nch[j] == 1) {
+      int f = S->sfirst[ns - 1], nc = j - f;  /* current supernode f..j-1 */
+      if (cnt[j - 1] == cnt[j] + 1) join = 1;  /* fundamental */
+      else if (nc + 1 <= PHGMG__SP_RELAX) {
+        /* extra zeros: columns f..j-1 padded to the structure of j */
+        size_t extra = (size_t)nc * (size_t)(cnt[j] + 1 > cnt[j - 1] ? cnt[j] + 1 - cnt[j - 1] : 0);
+        size_t tot = (size_t)(nc + 1) * (size_t)(cnt[j] + 1 + nc);
+        join = 5 * (zeros + extra) < tot;
+        if (join) zeros += extra;
+      }
+    }
+    if (!join) { S->sfirst[ns++] = j; zeros = 0; }
+    sof[j] = ns - 1;
+  }
+  S->sfirst[ns] = n;
+  S->nsup = ns;
+  S->sparent = phgmg__ialloc(al, (size_t)ns);
+  S->scp = phgmg__ialloc(al, (size_t)ns + 1);
+  S->sch = phgmg__ialloc(al, (size_t)ns + 1);
+  S->srp = phgmg__ialloc(al, (size_t)ns + 1);
+  S->lptr = PHGMG__CAST(size_t *, phgmg__alloc(al, sizeof(size_t) * ((size_t)ns + 1)));
+  if (!S->sparent || !S->scp || !S->sch || !S->srp || !S->lptr) { rc = PHGMG_ERR_NOMEM; goto done; }
+  for (s = 0; s < ns; ++s) {
+    int l = S->sfirst[s + 1] - 1;
+    S->sparent[s] = parent[l] >= 0 ? sof[parent[l]] : -1;
+    for (j = S->sfirst[s]; j <= l; ++j) cap += (size_t)cnt[j];
+  }
+  for (s = 0; s <= ns; ++s) S->scp[s] = 0;
+  for (s = 0; s < ns; ++s) if (S->sparent[s] >= 0) S->scp[S->sparent[s] + 1]++;
+  for (s = 0; s < ns; ++s) S->scp[s + 1] += S->scp[s];
+  for (s = 0; s < ns; ++s) mark[s] = S->scp[s];
+  for (s = ns - 1; s >= 0; --s) if (S->sparent[s] >= 0) S->sch[mark[S->sparent[s]]++] = s;
+  S->srow = phgmg__ialloc(al, cap + 1);
+  if (!S->srow) { rc = PHGMG_ERR_NOMEM; goto done; }
+  /* rows of s: the entries below its block of its own columns and of its
+     children's structures (children come first in the postorder) */
+  for (j = 0; j < n; ++j) mark[j] = -1;
+  {
+    int *clist = nch; /* reuse: children lists by head/next over supernodes */
+    int *head = sof;  /* sof no longer needed after sparent */
+    for (s = 0; s < ns; ++s) head[s] = -1;
+    for (s = ns - 1; s >= 0; --s)
+      if (S->sparent[s] >= 0) { clist[s] = head[S->sparent[s]]; head[S->sparent[s]] = s; }
+    for (s = 0; s < ns; ++s) {
+      int f = S->sfirst[s], l = S->sfirst[s + 1] - 1, c;
+      size_t start = nz;
+      S->srp[s] = (int)nz;
+      for (j = f; j <= l; ++j) {
+        int v = S->perm[j];
+        for (p = ap[v]; p < ap[v + 1]; ++p) {
+          int r = iperm[ai[p]];
+          if (r > l && mark[r] != s) { mark[r] = s; S->srow[nz++] = r; }
+        }
+      }
+      for (c = head[s]; c != -1; c = clist[c]) {
+        int q;
+        for (q = S->srp[c]; q < S->srp[c + 1]; ++q) {
+          int r = S->srow[q];
+          if (r > l && mark[r] != s) { mark[r] = s; S->srow[nz++] = r; }
+        }
+      }
+      phgmg__isort(S->srow + start, nz - start);
+      S->srp[s + 1] = (int)nz;
+    }
+  }
+  S->srp[ns] = (int)nz;
+  /* factor offsets, front and stack sizes (push/pop in postorder), flops */
+  {
+    size_t off = 0, stack = 0, smax = 0, fmax = 0;
+    double fl = 0.0;
+    for (s = 0; s < ns; ++s) {
+      size_t nc = (size_t)(S->sfirst[s + 1] - S->sfirst[s]), nr = (size_t)(S->srp[s + 1] - S->srp[s]);
+      size_t nf = nc + nr;
+      int c;
+      S->lptr[s] = off;
+      off += nc * nf + nc * nr;
+      if (nf * nf > fmax) fmax = nf * nf;
+      fl += (double)nc * (double)nc * (double)nf + 2.0 * (double)nc * (double)nr * (double)(nr + nc);
+      for (c = S->scp[s]; c < S->scp[s + 1]; ++c) {
+        size_t cn = (size_t)(S->srp[S->sch[c] + 1] - S->srp[S->sch[c]]);
+        stack -= cn * cn;
+      }
+      stack += nr * nr;
+      if (stack > smax) smax = stack;
+    }
+    S->lptr[ns] = off;
+    S->nnz_lu = off;
+    S->front_max = fmax;
+    S->stack_max = smax;
+    S->flops = fl;
+  }
+done:
+  phgmg__free(al, nch); phgmg__free(al, sof); phgmg__free(al, mark);
+  return rc;
+}
+
+/* Assembly map: each entry of K goes to the front of the supernode of
+   min(row, column) (fill order), at its (row, column) position there. */
+PHGMG__PRIV phgmg_result phgmg__spsym_assembly(phgmg__spsym *S, const int *iperm, const phgmg_allocator *al) {
+  int n = S->n, ns = S->nsup, j, p, s;
+  int nz = S->k_p[n];
+  int *sof = phgmg__ialloc(al, (size_t)n), *pos = phgmg__ialloc(al, (size_t)n), *fill;
+  S->amp = phgmg__ialloc(al, (size_t)ns + 1);
+  S->ami = phgmg__ialloc(al, (size_t)nz);
+  S->amd = PHGMG__CAST(size_t *, phgmg__alloc(al, sizeof(size_t) * (size_t)nz));
+  fill = phgmg__ialloc(al, (size_t)ns + 1);
+  if (!sof || !pos || !S->amp || !S->ami || !S->amd || !fill) {
+    phgmg__free(al, sof); phgmg__free(al, pos); phgmg__free(al, fill);
+    return PHGMG_ERR_NOMEM;
+  }
+  for (s = 0; s < ns; ++s)
+    for (j = S->sfirst[s]; j < S->sfirst[s + 1]; ++j) sof[j] = s;
+  for (s = 0; s <= ns; ++s) S->amp[s] = 0;
+  for (j = 0; j < n; ++j)
+    for (p = S->k_p[j]; p < S->k_p[j + 1]; ++p) {
+      int a = iperm[S->k_i[p]], b = iperm[j];
+      S->amp[sof[a < b ? a : b] + 1]++;
+    }
+  for (s = 0; s < ns; ++s) S->amp[s + 1] += S->amp[s];
+  for (s = 0; s < ns; ++s) fill[s] = S->amp[s];
+  for (j = 0; j < n; ++j)
+    for (p = S->k_p[j]; p < S->k_p[j + 1]; ++p) {
+      int a = iperm[S->k_i[p]], b = iperm[j];
+      S->ami[fill[sof[a < b ? a : b]]++] = p;
+    }
+  for (s = 0; s < ns; ++s) {
+    int f = S->sfirst[s], nc = S->sfirst[s + 1] - f, q, nf = nc + S->srp[s + 1] - S->srp[s];
+    for (q = 0; q < nc; ++q) pos[f + q] = q;
+    for (q = S->srp[s]; q < S->srp[s + 1]; ++q) pos[S->srow[q]] = nc + q - S->srp[s];
+    for (q = S->amp[s]; q < S->amp[s + 1]; ++q) {
+      int e = S->ami[q], col = -1, a, b;
+      /* column of entry e: binary search in k_p */
+      int lo = 0, hi = n;
+      while (hi - lo > 1) { int mid = (lo + hi) / 2; if (S->k_p[mid] <= e) lo = mid; else hi = mid; }
+      col = lo;
+      a = iperm[S->k_i[e]];
+      b = iperm[col];
+      S->amd[q] = (size_t)pos[a] + (size_t)pos[b] * (size_t)nf;
+    }
+  }
+  phgmg__free(al, sof); phgmg__free(al, pos); phgmg__free(al, fill);
+  return PHGMG_OK;
+}
+
+/* Symbolic analysis of the stage matrices of a system in band storage
+   (J, R, Q with half-bandwidth kb). */
+PHGMG__PRIV phgmg_result phgmg__spsym_create(phgmg__spsym **out, int n, int kb, const double *J,
+                                             const double *R, const double *Q, const phgmg_allocator *al) {
+  phgmg__spsym *S = PHGMG__CAST(phgmg__spsym *, phgmg__alloc(al, sizeof(phgmg__spsym)));
+  int *gp = NULL, *gi = NULL, *order = NULL, *iord = NULL, *parent = NULL, *w1 = NULL, *w2 = NULL,
+      *w3 = NULL, *post = NULL, i;
+  phgmg_result rc;
+  *out = NULL;
+  if (!S) return PHGMG_ERR_NOMEM;
+  memset(S, 0, sizeof *S);
+  S->n = n;
+  rc = phgmg__band_to_csc(n, kb, J, R, &S->jr_p, &S->jr_i, &S->jr_x, al);
+  if (rc == PHGMG_OK) rc = phgmg__band_to_csc(n, kb, Q, NULL, &S->q_p, &S->q_i, &S->q_x, al);
+  if (rc == PHGMG_OK) rc = phgmg__spsym_kpattern(S, al);
+  if (rc == PHGMG_OK) rc = phgmg__spsym_graph(S, &gp, &gi, al);
+  if (rc != PHGMG_OK) goto done;
+  order = phgmg__ialloc(al, (size_t)n);
+  iord = phgmg__ialloc(al, (size_t)n);
+  parent = phgmg__ialloc(al, (size_t)n);
+  post = phgmg__ialloc(al, (size_t)n);
+  w1 = phgmg__ialloc(al, (size_t)n);
+  w2 = phgmg__ialloc(al, (size_t)n);
+  w3 = phgmg__ialloc(al, (size_t)n);
+  S->perm = phgmg__ialloc(al, (size_t)n);
+  if (!order || !iord || !parent || !post || !w1 || !w2 || !w3 || !S->perm) { rc = PHGMG_ERR_NOMEM; goto done; }
+  rc = phgmg__nd_order(n, gp, gi, order, al);
+  if (rc != PHGMG_OK) goto done;
+  for (i = 0; i < n; ++i) iord[order[i]] = i;
+  phgmg__etree(n, gp, gi, order, iord, parent, w1);
+  phgmg__postorder(n, parent, post, w1, w2, w3);
+  for (i = 0; i < n; ++i) S->perm[i] = order[post[i]];
+  for (i = 0; i < n; ++i) iord[S->perm[i]] = i;
+  phgmg__etree(n, gp, gi, S->perm, iord, parent, w1);
+  phgmg__colcounts(n, gp, gi, S->perm, iord, parent, w2, w1);
+  rc = phgmg__spsym_supernodes(S, gp, gi, iord, parent, w2, al);
+  if (rc == PHGMG_OK) rc = phgmg__spsym_assembly(S, iord, al);
+done:
+  phgmg__free(al, gp); phgmg__free(al, gi); phgmg__free(al, order); phgmg__free(al, iord);
+  phgmg__free(al, parent); phgmg__free(al, post); phgmg__free(al, w1); phgmg__free(al, w2);
+  phgmg__free(al, w3);
+  if (rc != PHGMG_OK) { phgmg__spsym_free(al, S); return rc; }
+  *out = S;
+  return PHGMG_OK;
+}
+
+/* Numeric factors of one stage matrix (real, or complex: interleaved pairs). */
+typedef struct phgmg__spnum {
+  int cplx, nstatic;   /* nstatic: pivots replaced (see >>sparse) */
+  double *X, *front, *stack, *y, *t;
+  int *pos;
+  double growth;
+} phgmg__spnum;
+
+PHGMG__PRIV void phgmg__spnum_free(const phgmg_allocator *al, phgmg__spnum *F) {
+  phgmg__free(al, F->X); phgmg__free(al, F->front); phgmg__free(al, F->stack);
+  phgmg__free(al, F->y); phgmg__free(al, F->pos); phgmg__free(al, F->t);
+  F->X = F->front = F->stack = F->y = F->t = NULL;
+  F->pos = NULL;
+}
+
+PHGMG__PRIV phgmg_result phgmg__spnum_alloc(const phgmg_allocator *al, const phgmg__spsym *S, int cplx,
+                                            phgmg__spnum *F) {
+  size_t w = cplx ? 2 : 1;
+  memset(F, 0, sizeof *F);
+  F->cplx = cplx;
+  F->X = phgmg__dalloc(al, w * S->nnz_lu + 1);
+  F->front = phgmg__dalloc(al, w * S->front_max + 1);
+  F->stack = phgmg__dalloc(al, w * S->stack_max + 1);
+  F->y = phgmg__dalloc(al, w * (size_t)S->n);
+  F->pos = phgmg__ialloc(al, (size_t)S->n);
+  F->t = phgmg__dalloc(al, w * (size_t)S->n);
+  if (!F->X || !F->front || !F->stack || !F->y || !F->pos || !F->t) { phgmg__spnum_free(al, F); return PHGMG_ERR_NOMEM; }
+  return PHGMG_OK;
+}
+
+/* y -= t x for complex t = tr + i ti, interleaved x, y (n entries). */
+PHGMG__PRIV void phgmg__sp_zaxpy(int n, double tr, double ti, const double *x, double *y) {
+  int i = 0;
+#if defined(PHGMG__VEC4) && (defined(__clang__) || defined(__GNUC__))
+  {
+    const phgmg__v4 vr = {tr, tr, tr, tr}, vi = {-ti, ti, -ti, ti};
+    for (; i + 2 <= n; i += 2) {
+      phgmg__v4 xv, yv, xs;
+      memcpy(&xv, x + 2 * i, sizeof xv);
+      memcpy(&yv, y + 2 * i, sizeof yv);
+#ifdef __clang__
+      xs = __builtin_shufflevector(xv, xv, 1, 0, 3, 2);
+#else
+      {
+        typedef long long phgmg__v4i __attribute__((vector_size(32)));
+        const phgmg__v4i sw = {1, 0, 3, 2};
+        xs = __builtin_shuffle(xv, sw);
+      }
+#endif
+      yv -= vr * xv + vi * xs;
+      memcpy(y + 2 * i, &yv, sizeof yv);
+    }
+  }
+#endif
+  for (; i < n; ++i) {
+    double xr = x[2 * i], xi = x[2 * i + 1];
+    y[2 * i] -= tr * xr - ti * xi;
+    y[2 * i + 1] -= tr * xi + ti * xr;
+  }
+}
+
+/* Dense partial LU of a front (nf x nf, ld nf), the first nc pivots on the
+   diagonal; a pivot below tiny in magnitude is replaced by tiny (same sign)
+   and counted. Real. */
+PHGMG__PRIV int phgmg__front_lu(int nf, int nc, double *F, double tiny) {
+  int k, i, j, nr = nf - nc, nrep = 0;
+  for (k = 0; k < nc; ++k) {
+    double *ck = F + (size_t)k * (size_t)nf, p = ck[k], inv;
+    if (!(fabs(p) >= tiny)) { p = p < 0.0 ? -tiny : tiny; ck[k] = p; ++nrep; }
+    inv = 1.0 / p;
+    for (i = k + 1; i < nf; ++i) ck[i] *= inv;
+    for (j = k + 1; j < nc; ++j) {
+      double *cj = F + (size_t)j * (size_t)nf, f = cj[k];
+      if (f != 0.0) phgmg__axpy(nf - k - 1, -f, ck + k + 1, cj + k + 1);
+    }
+  }
+  if (nr > 0) {
+    double *F12 = F + (size_t)nc * (size_t)nf;
+    phgmg__trsm_llu(nc, nr, F, nf, F12, nf);
+    phgmg_gemm('N', 'N', nr, nr, nc, -1.0, F + nc, nf, F12, nf, 1.0, F12 + nc, nf);
+  }
+  return nrep;
+}
+
+/* The same for complex fronts (pairs). */
+PHGMG__PRIV int phgmg__front_zlu(int nf, int nc, double *F, double tiny) {
+  int k, i, j, nrep = 0;
+  size_t ld = 2 * (size_t)nf;
+  for (k = 0; k < nc; ++k) {
+    double *ck = F + (size_t)k * ld, pr = ck[2 * k], pi = ck[2 * k + 1], mag = hypot(pr, pi), ir, ii, d;
+    if (!(mag >= tiny)) {
+      if (mag > 0.0) { pr *= tiny / mag; pi *= tiny / mag; } else { pr = tiny; pi = 0.0; }
+      ck[2 * k] = pr; ck[2 * k + 1] = pi; ++nrep;
+    }
+    d = pr * pr + pi * pi;
+    ir = pr / d; ii = -pi / d;
+    for (i = k + 1; i < nf; ++i) {
+      double a = ck[2 * i], b = ck[2 * i + 1];
+      ck[2 * i] = a * ir - b * ii;
+      ck[2 * i + 1] = a * ii + b * ir;
+    }
+    for (j = k + 1; j < nc; ++j) {
+      double *cj = F + (size_t)j * ld, fr = cj[2 * k], fi = cj[2 * k + 1];
+      if (fr == 0.0 && fi == 0.0) continue;
+      phgmg__sp_zaxpy(nf - k - 1, fr, fi, ck + 2 * (k + 1), cj + 2 * (k + 1));
+    }
+  }
+  if (nf > nc) { /* U12 = L11^{-1} F12, F22 -= L21 U12 */
+    double *F12 = F + (size_t)nc * ld;
+    phgmg__ztrsm_llu(nc, nf - nc, F, nf, F12, nf);
+    phgmg__zgemm_acc(nf - nc, nf - nc, nc, -1.0, F + 2 * nc, nf, F12, nf, F12 + 2 * nc, nf);
+  }
+  return nrep;
+}
+
+/* Numeric factorization of K = shift I + M (M values in S's k pattern, shift
+   = sr + i si for complex factors). tiny: the static-pivot threshold relative
+   to max |K|. Fills
+   F->X; F->nstatic counts replaced pivots; F->growth = max |factor entry| /
+   max |K entry|. */
+PHGMG__PRIV void phgmg__sp_factor(const phgmg__spsym *S, phgmg__spnum *F, const double *Mx, double sr,
+                                  double si, double tiny) {
+  const int ns = S->nsup, w = F->cplx ? 2 : 1;
+  int s, q;
+  size_t top = 0;
+  double kmax = 0.0, fmax = 0.0;
+  F->nstatic = 0;
+  for (q = 0; q < S->k_p[S->n]; ++q) kmax = PHGMG__MAX(kmax, fabs(Mx[q]));
+  kmax = PHGMG__MAX(kmax, hypot(sr, si));
+  tiny *= kmax;
+  for (s = 0; s < ns; ++s) {
+    int f = S->sfirst[s], nc = S->sfirst[s + 1] - f, nr = S->srp[s + 1] - S->srp[s], nf = nc + nr, i, j;
+    const int *rows = S->srow + S->srp[s];
+    double *Fr = F->front;
+    size_t len = (size_t)w * (size_t)nf * (size_t)nf, e;
+    for (e = 0; e < len; ++e) Fr[e] = 0.0;
+    for (q = S->amp[s]; q < S->amp[s + 1]; ++q) Fr[(size_t)w * S->amd[q]] += Mx[S->ami[q]];
+    for (j = 0; j < nc; ++j) {
+      size_t d = (size_t)w * ((size_t)j * (size_t)nf + (size_t)j);
+      Fr[d] += sr;
+      if (w == 2) Fr[d + 1] += si;
+    }
+    /* extend-add of the children's update matrices (top of the stack) */
+    for (j = 0; j < nc; ++j) F->pos[f + j] = j;
+    for (j = 0; j < nr; ++j) F->pos[rows[j]] = nc + j;
+    for (q = S->scp[s]; q < S->scp[s + 1]; ++q) {
+      int t = S->sch[q], cn = S->srp[t + 1] - S->srp[t], a, b;
+      const int *cr = S->srow + S->srp[t];
+      const double *U;
+      top -= (size_t)w * (size_t)cn * (size_t)cn;
+      U = F->stack + top;
+      for (b = 0; b < cn; ++b) {
+        size_t cb = (size_t)F->pos[cr[b]] * (size_t)nf;
+        const double *ub = U + (size_t)w * (size_t)b * (size_t)cn;
+        if (w == 1)
+          for (a = 0; a < cn; ++a) Fr[cb + (size_t)F->pos[cr[a]]] += ub[a];
+        else
+          for (a = 0; a < cn; ++a) {
+            size_t o = 2 * (cb + (size_t)F->pos[cr[a]]);
+            Fr[o] += ub[2 * a];
+            Fr[o + 1] += ub[2 * a + 1];
+          }
+      }
+    }
+    F->nstatic += w == 1 ? phgmg__front_lu(nf, nc, Fr, tiny) : phgmg__front_zlu(nf, nc, Fr, tiny);
+    /* store the panel (nf x nc) and U12 (nc x nr); push F22 */
+    {
+      double *L = F->X + (size_t)w * S->lptr[s], *Up = L + (size_t)w * (size_t)nf * (size_t)nc;
+      size_t pl = (size_t)w * (size_t)nf * (size_t)nc;
+      memcpy(L, Fr, sizeof(double) * pl);
+      for (e = 0; e < pl; ++e) fmax = PHGMG__MAX(fmax, fabs(L[e]));
+      for (j = 0; j < nr; ++j) {
+        const double *src = Fr + (size_t)w * (size_t)(nc + j) * (size_t)nf;
+        for (i = 0; i < w * nc; ++i) { Up[(size_t)j * (size_t)(w * nc) + (size_t)i] = src[i]; fmax = PHGMG__MAX(fmax, fabs(src[i])); }
+        memcpy(F->stack + top + (size_t)w * (size_t)j * (size_t)nr, src + w * nc, sizeof(double) * (size_t)(w * nr));
+      }
+      top += (size_t)w * (size_t)nr * (size_t)nr;
+    }
+  }
+  F->growth = kmax > 0.0 ? fmax / kmax : 0.0;
+}
+
+/* x <- K^{-1} x (x internal order; real N or complex 2N interleaved):
+   per supernode the dense triangular block, its off-diagonal block through a
+   contiguous buffer (one scatter or gather per supernode). */
+PHGMG__PRIV void phgmg__sp_solve(const phgmg__spsym *S, const phgmg__spnum *F, double *x) {
+  const int n = S->n, ns = S->nsup, w = F->cplx ? 2 : 1;
+  int s, i, j, k;
+  double *y = F->y, *t = F->t;
+  for (i = 0; i < n; ++i) {
+    y[w * i] = x[w * S->perm[i]];
+    if (w == 2) y[2 * i + 1] = x[2 * S->perm[i] + 1];
+  }
+  for (s = 0; s < ns; ++s) { /* forward: L, unit diagonal */
+    int f = S->sfirst[s], nc = S->sfirst[s + 1] - f, nr = S->srp[s + 1] - S->srp[s], nf = nc + nr;
+    const int *rows = S->srow + S->srp[s];
+    const double *L = F->X + (size_t)w * S->lptr[s];
+    double *yf = y + (size_t)w * (size_t)f;
+    for (i = 0; i < w * nr; ++i) t[i] = 0.0;
+    for (k = 0; k < nc; ++k) {
+      const double *lk = L + (size_t)w * (size_t)k * (size_t)nf;
+      if (w == 1) {
+        double v = yf[k];
+        if (v == 0.0) continue;
+        phgmg__axpy(nc - k - 1, -v, lk + k + 1, yf + k + 1);
+        phgmg__axpy(nr, v, lk + nc, t);
+      } else {
+        double vr = yf[2 * k], vi = yf[2 * k + 1];
+        if (vr == 0.0 && vi == 0.0) continue;
+        phgmg__sp_zaxpy(nc - k - 1, vr, vi, lk + 2 * (k + 1), yf + 2 * (k + 1));
+        phgmg__sp_zaxpy(nr, -vr, -vi, lk + 2 * nc, t);
+      }
+    }
+    if (w == 1) for (i = 0; i < nr; ++i) y[rows[i]] -= t[i];
+    else for (i = 0; i < nr; ++i) { y[2 * rows[i]] -= t[2 * i]; y[2 * rows[i] + 1] -= t[2 * i + 1]; }
+  }
+  for (s = ns - 1; s >= 0; --s) { /* backward: U */
+    int f = S->sfirst[s], nc = S->sfirst[s + 1] - f, nr = S->srp[s + 1] - S->srp[s], nf = nc + nr;
+    const int *rows = S->srow + S->srp[s];
+    const double *L = F->X + (size_t)w * S->lptr[s], *Up = L + (size_t)w * (size_t)nf * (size_t)nc;
+    double *yf = y + (size_t)w * (size_t)f;
+    if (w == 1) {
+      for (j = 0; j < nr; ++j) {
+        double v = y[rows[j]];
+        if (v != 0.0) phgmg__axpy(nc, -v, Up + (size_t)j * (size_t)nc, yf);
+      }
+      for (k = nc - 1; k >= 0; --k) {
+        const double *lk = L + (size_t)k * (size_t)nf;
+        double v = yf[k] / lk[k];
+        yf[k] = v;
+        if (v != 0.0) phgmg__axpy(k, -v, lk, yf);
+      }
+    } else {
+      for (j = 0; j < nr; ++j) {
+        double vr = y[2 * rows[j]], vi = y[2 * rows[j] + 1];
+        if (vr != 0.0 || vi != 0.0) phgmg__sp_zaxpy(nc, vr, vi, Up + 2 * (size_t)j * (size_t)nc, yf);
+      }
+      for (k = nc - 1; k >= 0; --k) {
+        const double *lk = L + 2 * (size_t)k * (size_t)nf;
+        double ar = yf[2 * k], ai = yf[2 * k + 1], pr = lk[2 * k], pi = lk[2 * k + 1];
+        double d = pr * pr + pi * pi, vr = (ar * pr + ai * pi) / d, vi = (ai * pr - ar * pi) / d;
+        yf[2 * k] = vr;
+        yf[2 * k + 1] = vi;
+        if (vr != 0.0 || vi != 0.0) phgmg__sp_zaxpy(k, vr, vi, lk, yf);
+      }
+    }
+  }
+  for (i = 0; i < n; ++i) {
+    x[w * S->perm[i]] = y[w * i];
+    if (w == 2) x[2 * S->perm[i] + 1] = y[2 * i + 1];
+  }
+}
+
+/* Values of M = -(J - R)(Q + diag(dd)) (dd may be NULL) in the k pattern,
+   with a dense scratch w (n). */
+PHGMG__PRIV void phgmg__sp_stage_values(const phgmg__spsym *S, const double *dd, double *Mx, double *w) {
+  int n = S->n, j, p, q;
+  for (j = 0; j < n; ++j) w[j] = 0.0;
+  for (j = 0; j < n; ++j) {
+    double dj = dd ? dd[j] : 0.0;
+    for (q = S->q_p[j]; q < S->q_p[j + 1]; ++q) {
+      int k = S->q_i[q];
+      double v = S->q_x[q];
+      for (p = S->jr_p[k]; p < S->jr_p[k + 1]; ++p) w[S->jr_i[p]] -= S->jr_x[p] * v;
+    }
+    if (dj != 0.0)
+      for (p = S->jr_p[j]; p < S->jr_p[j + 1]; ++p) w[S->jr_i[p]] -= S->jr_x[p] * dj;
+    for (p = S->k_p[j]; p < S->k_p[j + 1]; ++p) { Mx[p] = w[S->k_i[p]]; w[S->k_i[p]] = 0.0; }
+  }
+}
+
+/* y = Q x (internal order, CSC). */
+PHGMG__PRIV void phgmg__sp_qmv(const phgmg__spsym *S, const double *x, double *y) {
+  int n = S->n, j, p;
+  for (j = 0; j < n; ++j) y[j] = 0.0;
+  for (j = 0; j < n; ++j) {
+    double xj = x[j];
+    if (xj == 0.0) continue;
+    for (p = S->q_p[j]; p < S->q_p[j + 1]; ++p) y[S->q_i[p]] += S->q_x[p] * xj;
+  }
+}
+
 /* ---- sparse input: CSC checks, reverse Cuthill-McKee, banded conversion ---- */
 
 /* Structure of an nr x nc CSC matrix (see phgmg_csc). */
@@ -5397,6 +6457,9 @@ struct phgmg_ph_sparse {
   int *perm, *iperm, *sep;
   double *J, *R, *Q, *B;
   double *E;   /* descriptor models (phgmg_ph_sparse_create_e), else NULL */
+  phgmg__spsym *sym;            /* sparse LU analysis (NULL: not done) */
+  int use_lu;                   /* 1: steppers use the sparse LU       */
+  phgmg_ph_sparse_info inf;
 };
 
 PHGMG_DEF void phgmg_ph_sparse_destroy(phgmg_ph_sparse *sp) {
@@ -5411,6 +6474,7 @@ PHGMG_DEF void phgmg_ph_sparse_destroy(phgmg_ph_sparse *sp) {
   phgmg__free(alloc, sp->Q);
   phgmg__free(alloc, sp->B);
   phgmg__free(alloc, sp->E);
+  phgmg__spsym_free(alloc, sp->sym);
   phgmg__free(alloc, sp);
 }
 
@@ -5517,16 +6581,88 @@ PHGMG_DEF phgmg_result phgmg_ph_sparse_create_e(phgmg_ph_sparse **out, int N, in
   sp->sys.J = sp->J; sp->sys.R = sp->R; sp->sys.Q = sp->Q; sp->sys.B = sp->B;
   sp->sys.E = sp->E;
   sp->sys.nl = PHGMG_NL_NONE;
-  if (info) {
-    info->kb = kb;
-    info->kb_input = kb_in;
-    info->kb_rcm = kb_rcm;
-    info->permuted = kb_rcm < kb_in;
-    info->wide = 4 * (long)kb > (long)N;
-    info->nnz = (long)J->colptr[N] + (long)R->colptr[N] + (long)Q->colptr[N] + (E ? (long)E->colptr[N] : 0L);
-  }
+  sp->sys.sparse = sp;
+  sp->inf.kb = kb;
+  sp->inf.kb_input = kb_in;
+  sp->inf.kb_rcm = kb_rcm;
+  sp->inf.permuted = kb_rcm < kb_in;
+  sp->inf.wide = 4 * (long)kb > (long)N;
+  sp->inf.nnz = (long)J->colptr[N] + (long)R->colptr[N] + (long)Q->colptr[N] + (E ? (long)E->colptr[N] : 0L);
+  rc = phgmg_ph_sparse_set_solver(sp, PHGMG_SOLVER_AUTO, info);
+  if (rc != PHGMG_OK) { phgmg_ph_sparse_destroy(sp); return rc; }
   *out = sp;
   return PHGMG_OK;
+}
+
+/* Stage-matrix bandwidths (lower, upper) from the nonzero diagonals of J - R
+   and Q, as the band stepper computes them. */
+PHGMG__PRIV void phgmg__ph_sparse_stage_bw(const phgmg_ph_sparse *sp, int *kl, int *ku) {
+  const int N = sp->sys.N, kb = sp->sys.kb;
+  int i, j, amin = 0, amax = 0, bmin = 0, bmax = 0;
+  for (j = 0; j < N; ++j) /* column by column: contiguous in band storage */
+    for (i = PHGMG__MAX(0, j - kb); i <= PHGMG__MIN(N - 1, j + kb); ++i) {
+      size_t k = PHGMG__PHB(kb, i, j);
+      int o = j - i;
+      if (sp->J[k] - sp->R[k] != 0.0) { amin = PHGMG__MIN(amin, o); amax = PHGMG__MAX(amax, o); }
+      if (sp->Q[k] != 0.0) { bmin = PHGMG__MIN(bmin, o); bmax = PHGMG__MAX(bmax, o); }
+    }
+  *kl = PHGMG__MIN(N - 1, -(amin + bmin));
+  *ku = PHGMG__MIN(N - 1, amax + bmax);
+}
+
+PHGMG_DEF phgmg_result phgmg_ph_sparse_set_solver(phgmg_ph_sparse *sp, int solver,
+                                                  phgmg_ph_sparse_info *info) {
+  phgmg_ph_sparse_info *f;
+  const int N = sp ? sp->sys.N : 0;
+  phgmg_result rc;
+  if (!sp || solver < PHGMG_SOLVER_AUTO || solver > PHGMG_SOLVER_SPARSE_LU) return PHGMG_ERR_INVALID_ARG;
+  f = &sp->inf;
+  phgmg__ph_sparse_stage_bw(sp, &f->kl, &f->ku);
+  f->lu_band = (double)N * (double)(2 * f->kl + f->ku + 1);
+  f->flops_band = 2.0 * (double)N * (double)f->kl * (double)(f->kl + f->ku + 1);
+  if (sp->E && solver == PHGMG_SOLVER_SPARSE_LU) return PHGMG_ERR_UNSUPPORTED; /* stage matrix sigma E - ... */
+  if (!sp->E && !sp->sym && (solver == PHGMG_SOLVER_SPARSE_LU ||
+                   (solver == PHGMG_SOLVER_AUTO && sp->sys.kb > PHGMG_SPARSE_MIN_KB))) {
+    rc = phgmg__spsym_create(&sp->sym, N, sp->sys.kb, sp->J, sp->R, sp->Q, sp->alloc);
+    if (rc != PHGMG_OK) return rc;
+  }
+  if (sp->sym) {
+    f->lu_sparse = (double)sp->sym->nnz_lu;
+    f->flops_sparse = sp->sym->flops;
+    f->supernodes = sp->sym->nsup;
+    { size_t fm = 0; while ((fm + 1) * (fm + 1) <= sp->sym->front_max) ++fm; f->front_max = (int)fm; }
+  }
+  if (solver == PHGMG_SOLVER_AUTO)
+    sp->use_lu = sp->sym && 2.0 * f->lu_sparse < f->lu_band && f->flops_sparse < f->flops_band;
+  else
+    sp->use_lu = solver == PHGMG_SOLVER_SPARSE_LU;
+  if (!sp->use_lu && sp->sym) { /* not used: give the memory back */
+    phgmg__spsym_free(sp->alloc, sp->sym);
+    sp->sym = NULL;
+  }
+  f->solver = sp->use_lu ? PHGMG_SOLVER_SPARSE_LU : PHGMG_SOLVER_BAND;
+  if (info) *info = *f;
+  return PHGMG_OK;
+}
+
+/* y = M x through the compressed copy when the analysis has one (Q of the
+   object's own system); 0: not handled (band product). */
+PHGMG__PRIV int phgmg__ph_sparse_mv(const phgmg_ph_system *s, const double *M, const double *x,
+                                     double *y) {
+  const phgmg_ph_sparse *sp = s->sparse;
+  if (!sp->sym || M != sp->Q || s->N != sp->sys.N || s->kb != sp->sys.kb) return 0;
+  phgmg__sp_qmv(sp->sym, x, y);
+  return 1;
+}
+
+/* The sparse analysis a stepper may use for sys (NULL: band). */
+PHGMG__PRIV const phgmg__spsym *phgmg__ph_sparse_lu(const phgmg_ph_system *sys) {
+  const phgmg_ph_sparse *sp = sys->sparse;
+  if (!sp || !sp->use_lu || !sp->sym || sys->E || sys->storage != PHGMG_BANDED || sys->N != sp->sys.N ||
+      sys->kb != sp->sys.kb || sys->J != sp->J || sys->R != sp->R || sys->Q != sp->Q ||
+      sys->nl == PHGMG_NL_GENERAL)
+    return NULL;
+  return sp->sym;
 }
 
 PHGMG_DEF const phgmg_ph_system *phgmg_ph_sparse_system(const phgmg_ph_sparse *sp) {
@@ -5841,7 +6977,8 @@ PHGMG__PRIV void phgmg__dia_prod_band(const phgmg__dia *A, const phgmg__dia *B, 
   }
 }
 
-enum { PHGMG__GL3_DENSE = 0, PHGMG__GL3_BANDED = 1, PHGMG__GL3_CALLBACK = 2, PHGMG__GL3_MAP = 3 };
+enum { PHGMG__GL3_DENSE = 0, PHGMG__GL3_BANDED = 1, PHGMG__GL3_CALLBACK = 2, PHGMG__GL3_MAP = 3,
+       PHGMG__GL3_SPARSE = 4 };
 
 struct phgmg_gl3 {
   phgmg_allocator al;
@@ -5877,6 +7014,11 @@ struct phgmg_gl3 {
   double *r1buf, *rcbuf, *r1, *rc;
   /* packed row-wise factors for the pivot-free banded solve (see below) */
   double *pk;
+  /* sparse LU of the stage matrices (see >>sparse): the analysis (owned by
+     the phgmg_ph_sparse), the real and complex factors, M's values */
+  const phgmg__spsym *sps;
+  phgmg__spnum spf1, spf2;
+  double *spM, *spw;
   int have_prev, need_factor;
   double tend;
   phgmg_gl3_stats st;
@@ -5912,6 +7054,8 @@ PHGMG_DEF void phgmg_gl3_destroy(phgmg_gl3 *s) {
   phgmg__free(&al, s->Zprev); phgmg__free(&al, s->xend);
   phgmg__free(&al, s->xnew); phgmg__free(&al, s->r1buf); phgmg__free(&al, s->rcbuf);
   phgmg__free(&al, s->pk);
+  phgmg__spnum_free(&al, &s->spf1); phgmg__spnum_free(&al, &s->spf2);
+  phgmg__free(&al, s->spM); phgmg__free(&al, s->spw);
   phgmg__free(&al, s->tmp);
   phgmg__free(&al, s->EZ);
   phgmg__dia_free(&al, &s->de);
@@ -6084,6 +7228,8 @@ PHGMG__PRIV void phgmg__gl3_setup_method(phgmg_gl3 *s, const phgmg_gl3_opts *opt
     s->mode = PHGMG__GL3_MAP;
   else if (sys->shifted_factor)
     s->mode = PHGMG__GL3_CALLBACK;
+  else if ((s->sps = phgmg__ph_sparse_lu(sys)) != NULL)
+    s->mode = PHGMG__GL3_SPARSE;
   else
     s->mode = sys->storage == PHGMG_DENSE ? PHGMG__GL3_DENSE : PHGMG__GL3_BANDED;
 
@@ -6222,20 +7368,65 @@ PHGMG__PRIV phgmg_result phgmg__gl3_csr(phgmg_gl3 *s) {
   return PHGMG_OK;
 }
 
-/* Banded storage: diagonals of J - R and Q, the CSR forms, and the band LU
-   workspaces (bandwidths from the nonzero diagonals). */
+/* The sparse LU's factors and the values of M (see >>sparse). */
+PHGMG__PRIV phgmg_result phgmg__gl3_setup_sparse(phgmg_gl3 *s) {
+  phgmg_result rc = phgmg__spnum_alloc(&s->al, s->sps, 0, &s->spf1);
+  if (rc == PHGMG_OK) rc = phgmg__spnum_alloc(&s->al, s->sps, 1, &s->spf2);
+  if (rc != PHGMG_OK) return rc;
+  s->spM = phgmg__dalloc(&s->al, (size_t)s->sps->k_p[s->N] + 1);
+  s->spw = phgmg__dalloc(&s->al, (size_t)s->N);
+  return s->spM && s->spw ? PHGMG_OK : PHGMG_ERR_NOMEM;
+}
+
+PHGMG__PRIV phgmg_result phgmg__gl3_setup_band_lu(phgmg_gl3 *s);
+
+/* Sparse mode: Q's diagonal as the one-diagonal form when Q is diagonal (the
+   fused gradient path), else no diagonal form (Q x through the CSC copy);
+   the band's diagonals are not scanned. */
+PHGMG__PRIV phgmg_result phgmg__gl3_sparse_qdiag(phgmg_gl3 *s) {
+  const phgmg__spsym *S = s->sps;
+  int j, p, diag = 1;
+  for (j = 0; j < s->N && diag; ++j)
+    for (p = S->q_p[j]; p < S->q_p[j + 1]; ++p) diag &= S->q_i[p] == j;
+  s->dq.n = s->N;
+  s->dq.nd = 0;
+  if (!diag) return PHGMG_OK;
+  s->dq.off = phgmg__ialloc(&s->al, 1);
+  s->dq.v = phgmg__dalloc(&s->al, (size_t)s->N);
+  if (!s->dq.off || !s->dq.v) return PHGMG_ERR_NOMEM;
+  s->dq.off[0] = 0;
+  for (j = 0; j < s->N; ++j) s->dq.v[j] = S->q_p[j + 1] > S->q_p[j] ? S->q_x[S->q_p[j]] : 0.0;
+  s->dq.nd = 1;
+  return PHGMG_OK;
+}
+
+/* Banded storage: diagonals of J - R and Q, the CSR forms, and the
+   workspaces of the stage solver. */
 PHGMG__PRIV phgmg_result phgmg__gl3_setup_banded(phgmg_gl3 *s) {
   const phgmg_ph_system *sys = &s->sys;
   const int N = s->N;
-  int k;
   phgmg_result rc;
-  int kb = sys->kb, amin = 0, amax = 0, bmin = 0, bmax = 0;
-  rc = phgmg__dia_build(&s->al, &s->djr, N, kb, sys->J, sys->R, 0, 0);
-  if (rc == PHGMG_OK) rc = phgmg__dia_build(&s->al, &s->dq, N, kb, sys->Q, NULL, 1, 0);
+  int kb = sys->kb;
+  if (s->mode == PHGMG__GL3_SPARSE) {
+    rc = phgmg__gl3_sparse_qdiag(s);
+  } else {
+    rc = phgmg__dia_build(&s->al, &s->djr, N, kb, sys->J, sys->R, 0, 0);
+    if (rc == PHGMG_OK) rc = phgmg__dia_build(&s->al, &s->dq, N, kb, sys->Q, NULL, 1, 0);
+  }
   if (rc != PHGMG_OK) return rc;
   rc = phgmg__gl3_csr(s);
   if (rc != PHGMG_OK) return rc;
-  if (s->mode == PHGMG__GL3_BANDED) {
+  if (s->mode == PHGMG__GL3_SPARSE) return phgmg__gl3_setup_sparse(s);
+  return s->mode == PHGMG__GL3_BANDED ? phgmg__gl3_setup_band_lu(s) : PHGMG_OK;
+}
+
+/* The band LU workspaces (bandwidths from the nonzero diagonals). */
+PHGMG__PRIV phgmg_result phgmg__gl3_setup_band_lu(phgmg_gl3 *s) {
+  const phgmg_ph_system *sys = &s->sys;
+  const int N = s->N;
+  int k, kb = sys->kb, amin = 0, amax = 0, bmin = 0, bmax = 0;
+  phgmg_result rc;
+  {
     for (k = 0; k < s->djr.nd; ++k) {
       amin = PHGMG__MIN(amin, s->djr.off[k]);
       amax = PHGMG__MAX(amax, s->djr.off[k]);
@@ -6501,6 +7692,9 @@ PHGMG__PRIV void phgmg__gl3_eval(phgmg_gl3 *s, const double *x) {
       double *g = s->G + (size_t)st * (size_t)N;
       for (i = 0; i < N; ++i) g[i] = qd[i] * (x[i] + z[i]);
     }
+  } else if (s->sps) {
+    for (st = 0; st < 3; ++st)
+      phgmg__sp_qmv(s->sps, s->Y + (size_t)st * (size_t)N, s->G + (size_t)st * (size_t)N);
   } else {
     for (st = 0; st < 3; ++st)
       phgmg__dia_mv(&s->dq, s->Y + (size_t)st * (size_t)N, s->G + (size_t)st * (size_t)N);
@@ -6657,6 +7851,37 @@ PHGMG__PRIV void phgmg__gl3_band_shift_e(phgmg_gl3 *s, double sg, double sa, dou
 }
 
 /* (Re)factor the shifted Newton matrices at x. */
+/* Sparse LU of both stage matrices (see >>sparse); PHGMG_ERR_SINGULAR when
+   a static pivot was replaced or the factors grew beyond PHGMG_SPARSE_GROWTH. */
+PHGMG__PRIV phgmg_result phgmg__gl3_sparse_factor(phgmg_gl3 *s, double sg, double sa, double sb) {
+  const phgmg__spsym *S = s->sps;
+  phgmg__sp_stage_values(S, s->sys.nl == PHGMG_NL_SEPARABLE ? s->dd : NULL, s->spM, s->spw);
+  if (!phgmg__all_finite(s->spM, (size_t)S->k_p[s->N])) return PHGMG_ERR_NANINF;
+  phgmg__sp_factor(S, &s->spf1, s->spM, sg, 0.0, PHGMG_SPARSE_PIVTOL);
+  if (s->spf1.nstatic || !(s->spf1.growth <= PHGMG_SPARSE_GROWTH)) return PHGMG_ERR_SINGULAR;
+  phgmg__sp_factor(S, &s->spf2, s->spM, sa, sb, PHGMG_SPARSE_PIVTOL);
+  if (s->spf2.nstatic || !(s->spf2.growth <= PHGMG_SPARSE_GROWTH)) return PHGMG_ERR_SINGULAR;
+  return PHGMG_OK;
+}
+
+/* Give up the sparse factors for the band LU with partial pivoting. */
+PHGMG__PRIV phgmg_result phgmg__gl3_sparse_fallback(phgmg_gl3 *s) {
+  phgmg_result rc;
+  phgmg__spnum_free(&s->al, &s->spf1);
+  phgmg__spnum_free(&s->al, &s->spf2);
+  s->mode = PHGMG__GL3_BANDED;
+  s->sps = NULL; /* from here exactly the band stepper */
+  phgmg__dia_free(&s->al, &s->dq);
+  rc = phgmg__dia_build(&s->al, &s->djr, s->N, s->sys.kb, s->sys.J, s->sys.R, 0, 0);
+  if (rc == PHGMG_OK) rc = phgmg__dia_build(&s->al, &s->dq, s->N, s->sys.kb, s->sys.Q, NULL, 1, 0);
+  if (rc == PHGMG_OK) rc = phgmg__gl3_setup_band_lu(s);
+  if (rc != PHGMG_OK) return rc;
+  phgmg__free(&s->al, s->r1buf);
+  phgmg__free(&s->al, s->rcbuf);
+  s->r1buf = s->rcbuf = NULL;
+  return phgmg__gl3_setup_buffers(s);
+}
+
 PHGMG__PRIV phgmg_result phgmg__gl3_factor(phgmg_gl3 *s, const double *x) {
   const phgmg_ph_system *sys = &s->sys;
   int N = s->N, i, j, k;
@@ -6674,6 +7899,12 @@ PHGMG__PRIV phgmg_result phgmg__gl3_factor(phgmg_gl3 *s, const double *x) {
     rc = sys->shifted_factor(sg, 0.0, x, sys->shifted_user);
     if (rc == PHGMG_OK) rc = sys->shifted_factor(sa, sb, x, sys->shifted_user);
     return rc;
+  }
+  if (s->mode == PHGMG__GL3_SPARSE) {
+    rc = phgmg__gl3_sparse_factor(s, sg, sa, sb);
+    if (rc != PHGMG_ERR_SINGULAR) return rc;
+    rc = phgmg__gl3_sparse_fallback(s); /* static pivots not good enough: band LU */
+    if (rc != PHGMG_OK) return rc;
   }
   if (s->mode == PHGMG__GL3_DENSE) {
     size_t NN = (size_t)N * (size_t)N, e;
@@ -6745,7 +7976,9 @@ PHGMG__PRIV phgmg_result phgmg__gl3_factor(phgmg_gl3 *s, const double *x) {
 
 /* Solve with the real (K1) and the complex (K2) shifted matrix. */
 PHGMG__PRIV void phgmg__gl3_solve_real(phgmg_gl3 *s, double *r) {
-  if (s->mode == PHGMG__GL3_DENSE)
+  if (s->mode == PHGMG__GL3_SPARSE)
+    phgmg__sp_solve(s->sps, &s->spf1, r);
+  else if (s->mode == PHGMG__GL3_DENSE)
     phgmg_lu_solve('N', s->N, s->K1, s->N, s->ip1, 1, r, s->N);
   else if (s->mode == PHGMG__GL3_BANDED)
     phgmg__gb_solve('N', s->N, s->kl, s->ku, s->ue1, s->AB1, s->ldab, s->ip1, s->dinv1, r);
@@ -6753,7 +7986,9 @@ PHGMG__PRIV void phgmg__gl3_solve_real(phgmg_gl3 *s, double *r) {
     s->sys.shifted_solve(s->gam / s->h, 0.0, r, s->sys.shifted_user);
 }
 PHGMG__PRIV void phgmg__gl3_solve_cplx(phgmg_gl3 *s, double *r) {
-  if (s->mode == PHGMG__GL3_DENSE)
+  if (s->mode == PHGMG__GL3_SPARSE)
+    phgmg__sp_solve(s->sps, &s->spf2, r);
+  else if (s->mode == PHGMG__GL3_DENSE)
     phgmg_zlu_solve(s->N, s->K2, s->N, s->ip2, 1, r, s->N);
   else if (s->mode == PHGMG__GL3_BANDED)
     phgmg__zgb_solve(s->N, s->kl, s->ku, s->ue2, s->AB2, s->ldab, s->ip2, s->dinv2, r);

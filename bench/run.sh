@@ -11,6 +11,8 @@
 #    the snapshots; about 2 minutes and 5 GB of memory) into
 #    build/ (a missing or broken source is skipped with a warning) and runs
 #    each, appending `case,median_s,min_s,max_s,runs` lines to the CSV;
+# 2b. bench/bench_sparse.sh: `phgmg simulate` on scrambled 2-D/3-D lattices
+#    against the same GL3 steps in SciPy + SuperLU (ratio cases; a few minutes);
 # 3. if a CBLAS is installed, builds bench_linalg again with -DPHGMG_USE_CBLAS
 #    and records its cases with a `_cblas` suffix (one BLAS thread);
 # 3b. runs bench/studies/hyper_study.c, bench/studies/altmin_study.c and
@@ -64,6 +66,13 @@ for prog in bench_linalg bench_fom bench_rom bench_linear bench_scale; do
   fi
   "./$BUILD/$prog" --out "$CSV" || echo "run.sh: warning: $prog failed (exit $?)" >&2
 done
+
+# sparse lattices: phgmg simulate against SciPy + SuperLU (bench/bench_sparse.sh)
+echo
+echo "== bench_sparse"
+if make "$BUILD/phgmg" >/dev/null; then
+  sh bench/bench_sparse.sh "$BUILD/phgmg" "$CSV" || echo "run.sh: warning: bench_sparse failed" >&2
+fi
 
 # the hyper-reduction choices side by side (a table, not timing cases)
 echo

@@ -43,6 +43,8 @@ static const char *const help_lines[] = {
   "               [--manifold pod|greedy|altmin] [--train-input KIND]...\n",
   "               [--poly coeffs.npy --poly-idx idx.npy [--poly-w w.npy]] [DEIM options]\n",
   "               --out DIR [--name rom] [--dt-map DT] [--save-snapshots] [--quiet]\n",
+  "  phgmg simulate <the model options of reduce> --out y.npy [--states x.npy]\n",
+  "               [--dt 0.1] [--steps 1000] [--input sin] [--amp 0.1] [--quiet]\n",
   "  phgmg simulate-rom --model DIR/NAME.phgmgrom --out y.npy [--states xr.npy]\n",
   "               [--dt DT] [--steps 1000] [--input sin] [--amp 0.1] [--quiet]\n",
   "  phgmg info MODEL.phgmgrom\n",
@@ -207,6 +209,19 @@ static const char *const help_lines[] = {
   "  spelled): an output that would be an input is refused before any work.\n",
   "  The reduced model (LINEAR kind) is x' = K grad H(x) + Bh u, y = Bh^T grad H(x),\n",
   "  H(x) = 1/2 x^T Qh x (+ sum_j w_j phi(P0_j x)); it is again port-Hamiltonian.\n",
+  "\n",
+  "COMMAND simulate\n",
+  "  Runs the full model (the model options of reduce: --J/--R/--Q or the -coo\n",
+  "  forms, --B, the nonlinear part) from x = 0 with the GL3 stepper and writes its\n",
+  "  output y, an m x (steps+1) matrix (column n = y(n*DT)).\n",
+  "  --out FILE          output .npy (required; never one of the input files)\n",
+  "  --states FILE       also the states (N x (steps+1), the given ordering of the\n",
+  "                      coordinates); written together with --out: both or neither\n",
+  "  --dt DT, --steps N, --input KIND, --amp AMP, --newton-tol T, --newton-iter K:\n",
+  "                      as for reduce --simulate\n",
+  "  Sparse input: the log names the solver of the stage systems (band LU, or the\n",
+  "  sparse LU for 2-D/3-D meshes; see phgmg.h >>sparse).\n",
+  "  --quiet             no progress lines\n",
   "\n",
   "COMMAND simulate-rom\n",
   "  Runs a reduced model from xr = 0 with the online GL3 stepper and writes its\n",
@@ -1647,6 +1662,19 @@ static void remove_stale(const char *dir, const outlist *rec, const outlist *ol)
   }
 }
 
+/* The GL3 stage-matrix solver phgmg_ph_sparse_create chose, for the log. */
+static const char *sparse_solver_desc(const phgmg_ph_sparse_info *inf) {
+  static char buf[256];
+  if (inf->solver == PHGMG_SOLVER_SPARSE_LU)
+    snprintf(buf, sizeof buf, "sparse LU (nested dissection, %d supernodes, %.3g factor entries vs %.3g banded)",
+             inf->supernodes, inf->lu_sparse, inf->lu_band);
+  else if (inf->lu_sparse > 0.0)
+    snprintf(buf, sizeof buf, "band LU (%.3g factor entries; sparse LU would need %.3g)", inf->lu_band, inf->lu_sparse);
+  else
+    snprintf(buf, sizeof buf, "band LU (%.3g factor entries)", inf->lu_band);
+  return buf;
+}
+
 /* The sparse system (--J-coo, --R-coo, --Q-coo, --B) into S->sp and sys. */
 static int load_sparse_system(const reduce_args *A, reduce_state *S, phgmg_ph_system *sys) {
   phgmg_ph_sparse_info inf;
@@ -1667,6 +1695,7 @@ static int load_sparse_system(const reduce_args *A, reduce_state *S, phgmg_ph_sy
   progress("sparse J, R, Q: N = %d, %ld stored entries; half-bandwidth %d (given order %d, reverse "
            "Cuthill-McKee %d)%s", N, inf.nnz, inf.kb, inf.kb_input, inf.kb_rcm,
            inf.wide ? "; wide band (kb > N/4): dense .npy input would be as fast" : "");
+  progress("  stage solver: %s", sparse_solver_desc(&inf));
   return 0;
 }
 
@@ -2593,6 +2622,140 @@ done:
   return status;
 }
 
+/* ---- simulate (full model) ----------------------------------------------------- */
+/* Is path the same file as the model or input file in (a comma list of up to
+   three files for a triplet SPEC)? */
+static int sim_same_file(const char *path, const char *in) {
+  struct stat a, b;
+  char buf[4096];
+  const char *p = in;
+  if (!in || stat(path, &a) != 0) return 0;
+  while (p && *p) {
+    const char *c = strchr(p, ',');
+    size_t l = c ? (size_t)(c - p) : strlen(p);
+    if (l < sizeof buf) {
+      memcpy(buf, p, l);
+      buf[l] = 0;
+      if (stat(buf, &b) == 0 && a.st_dev == b.st_dev && a.st_ino == b.st_ino) return 1;
+    }
+    p = c ? c + 1 : NULL;
+  }
+  return 0;
+}
+
+/* The options of `simulate`: the model options of reduce, --dt, --steps,
+   --input, --amp, --newton-tol, --newton-iter, --out, --states, --quiet.
+   Returns 0, the usage status 2, or -1 after --help. */
+static int parse_simulate(int argc, char **argv, reduce_args *A, const char **states) {
+  const char *seen[64], *ins[12];
+  int i, k, nseen = 0;
+  memset(A, 0, sizeof *A);
+  A->dt = 0.1; A->steps = 1000; A->amp = 0.1; A->newton_iter = 10; A->input = "sin";
+  *states = NULL;
+  for (i = 2; i < argc; ++i) {
+    const char *o = argv[i], *v;
+    if (!strcmp(o, "--help") || !strcmp(o, "-h")) { print_help(); return -1; }
+    if (repeated_opt(o, seen, &nseen)) return 2;
+#define STR(opt, field) else if (!strcmp(o, opt)) { if (!(v = optval(argc, argv, &i))) return 2; A->field = v; }
+    if (!strcmp(o, "--quiet")) g_quiet = 1;
+    STR("--J", J) STR("--R", R) STR("--B", B) STR("--Q", Q)
+    STR("--J-coo", Jcoo) STR("--R-coo", Rcoo) STR("--Q-coo", Qcoo)
+    STR("--poly", poly) STR("--poly-idx", poly_idx) STR("--poly-w", poly_w)
+    STR("--exp", expf) STR("--potential", potential) STR("--input", input) STR("--out", out)
+#undef STR
+    else if (!strcmp(o, "--states")) { if (!(*states = optval(argc, argv, &i))) return 2; }
+    else if (!strcmp(o, "--dt")) {
+      if (!(v = optval(argc, argv, &i)) || !parse_double(o, v, 0.0, &A->dt)) return 2;
+      if (!(A->dt > 0.0)) return usage_error("--dt must be > 0");
+    }
+    else if (!strcmp(o, "--steps")) { if (!(v = optval(argc, argv, &i)) || !parse_int(o, v, 1, INT_MAX - 1, &A->steps)) return 2; }
+    else if (!strcmp(o, "--newton-iter")) { if (!(v = optval(argc, argv, &i)) || !parse_int(o, v, 1, 1000, &A->newton_iter)) return 2; }
+    else if (!strcmp(o, "--amp")) { if (!(v = optval(argc, argv, &i)) || !parse_double(o, v, -HUGE_VAL, &A->amp)) return 2; }
+    else if (!strcmp(o, "--newton-tol")) { if (!(v = optval(argc, argv, &i)) || !parse_double(o, v, 0.0, &A->newton_tol)) return 2; }
+    else return usage_error("simulate: unknown option '%s'", o);
+  }
+  if ((A->J || A->R || A->Q) && (A->Jcoo || A->Rcoo || A->Qcoo))
+    return usage_error("simulate: give J, R, Q either dense (--J, --R, --Q) or sparse (--J-coo, --R-coo, --Q-coo)");
+  if (A->Jcoo || A->Rcoo || A->Qcoo) {
+    if (!A->Jcoo || !A->Rcoo || !A->Qcoo || !A->B)
+      return usage_error("simulate: --J-coo, --R-coo, --Q-coo and --B are required together");
+  } else if (!A->J || !A->R || !A->B || !A->Q) return usage_error("simulate: --J, --R, --B and --Q are required");
+  if (!A->out) return usage_error("simulate: --out FILE is required");
+  if (A->potential && (A->poly || A->expf)) return usage_error("simulate: --potential replaces --poly and --exp");
+  if (!!(A->poly || A->expf || A->potential) != !!A->poly_idx)
+    return usage_error("simulate: --poly/--exp/--potential and --poly-idx go together");
+  if (A->poly_w && !A->poly_idx) return usage_error("simulate: --poly-w needs a nonlinear part (--poly-idx)");
+  if (*states && !strcmp(*states, A->out)) return usage_error("simulate: --out and --states name the same file");
+  ins[0] = A->J; ins[1] = A->R; ins[2] = A->B; ins[3] = A->Q; ins[4] = A->Jcoo; ins[5] = A->Rcoo;
+  ins[6] = A->Qcoo; ins[7] = A->poly; ins[8] = A->poly_idx; ins[9] = A->poly_w; ins[10] = A->expf;
+  ins[11] = A->input;
+  for (k = 0; k < 12; ++k)
+    if (sim_same_file(A->out, ins[k]) || (*states && sim_same_file(*states, ins[k])))
+      return usage_error("simulate: the output %s is one of the input files (%s): not overwritten",
+                         sim_same_file(A->out, ins[k]) ? A->out : *states, ins[k]);
+  return 0;
+}
+
+/* phgmg simulate: the full model from x0 = 0 with the GL3 stepper; writes y
+   (m x (steps+1)) and, with --states, x (N x (steps+1), the user's ordering). */
+static int cmd_simulate(int argc, char **argv) {
+  reduce_args A;
+  reduce_state S;
+  const char *states, *wp;
+  phgmg_gl3_opts go;
+  phgmg_gl3_stats st;
+  phgmg_result rc;
+  double *x0 = NULL, *X = NULL, *XU = NULL, *Y = NULL, t0;
+  int status, N, m, done = 0;
+  if ((status = parse_simulate(argc, argv, &A, &states)) != 0) return status < 0 ? 0 : status;
+  memset(&S, 0, sizeof S);
+  status = 1;
+  if (load_system(&A, &S)) goto out;
+  N = S.sys.N;
+  m = S.sys.m;
+  if (too_big(((double)m + (states ? 2.0 * (double)N : 0.0)) * ((double)A.steps + 1.0),
+              "--steps: the outputs (m x (steps+1), states N x (steps+1))")) {
+    status = 2;
+    goto out;
+  }
+  if ((status = input_setup(&S.in, A.input, A.amp, m, A.dt)) != 0) goto out;
+  status = 1;
+  x0 = (double *)calloc((size_t)N, sizeof(double));
+  Y = (double *)malloc(sizeof(double) * (size_t)m * ((size_t)A.steps + 1));
+  if (states) X = (double *)malloc(sizeof(double) * (size_t)N * ((size_t)A.steps + 1));
+  if (!x0 || !Y || (states && !X)) { fail("out of memory for %d steps", A.steps); goto out; }
+  memset(&go, 0, sizeof go);
+  go.tol = A.newton_tol;
+  go.max_iter = A.newton_iter;
+  progress("simulating the full model: %d steps of dt = %g, %s", A.steps, A.dt, input_desc(&S.in, A.input));
+  S.in.report = 1;
+  S.in.t_end = A.steps * A.dt;
+  S.in.wall0 = S.in.wall_last = t0 = now_s();
+  rc = phgmg_simulate(&S.sys, x0, 0.0, A.dt, A.steps, input_fn, &S.in, &go, X, Y, NULL, &st, &done, NULL);
+  S.in.report = 0;
+  if (rc != PHGMG_OK) {
+    fail("full-order simulation failed at step %d of %d (t = %g): %s%s", done + 1, A.steps, done * A.dt,
+         phgmg_result_string(rc), rc == PHGMG_ERR_NOT_CONVERGED ? " (try a smaller --dt or more --newton-iter)" : "");
+    goto out;
+  }
+  progress("  done in %.3f s (%ld Newton iterations, %ld factorizations)", now_s() - t0, st.newton_iters,
+           st.factorizations);
+  if (X && S.sp) { /* states back into the user's ordering */
+    XU = (double *)malloc(sizeof(double) * (size_t)N * ((size_t)A.steps + 1));
+    if (!XU) { fail("out of memory"); goto out; }
+    phgmg_ph_sparse_to_user_order(S.sp, A.steps + 1, X, N, XU, N);
+  }
+  if (!(wp = stage_path(&S.sg, A.out)) || write_npy(wp, Y, m, A.steps + 1, 2)) goto out;
+  if (states && (!(wp = stage_path(&S.sg, states)) || write_npy(wp, XU ? XU : X, N, A.steps + 1, 2))) goto out;
+  if (stage_commit(&S.sg)) goto out;
+  printf("wrote %s (%d x %d)%s%s\n", A.out, m, A.steps + 1, states ? " and " : "", states ? states : "");
+  status = 0;
+out:
+  free(x0); free(X); free(XU); free(Y);
+  reduce_cleanup(&S);
+  return status;
+}
+
 /* ---- info --------------------------------------------------------------------- */
 static int cmd_info(int argc, char **argv) {
   phgmg_rom rom;
@@ -2808,6 +2971,7 @@ int main(int argc, char **argv) {
   if (!strcmp(argv[1], "--version")) { printf("phgmg %s\n", PHGMG_VERSION_STRING); return 0; }
   if (!strcmp(argv[1], "reduce")) return cmd_reduce(argc, argv);
   if (!strcmp(argv[1], "simulate-rom")) return cmd_simulate_rom(argc, argv);
+  if (!strcmp(argv[1], "simulate")) return cmd_simulate(argc, argv);
   if (!strcmp(argv[1], "info")) return cmd_info(argc, argv);
   if (!strcmp(argv[1], "validate")) return cmd_validate(argc, argv);
   return usage_error("unknown command '%s' (expected reduce, validate, simulate-rom, info, --help or --version)",

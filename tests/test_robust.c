@@ -26,6 +26,8 @@ static void *rb_malloc(size_t n) { void *p = rb_sys_malloc(n); if (p) g_default_
 static void rb_free(void *p) { if (p) { g_default_live--; free(p); } }
 #define PHGMG_MALLOC(sz, user) ((void)(user), rb_malloc(sz))
 #define PHGMG_FREE(p, user) ((void)(user), rb_free(p))
+/* every sparse LU factorization counts as too much growth: the band fallback */
+#define PHGMG_SPARSE_GROWTH 0.5
 #define PHGMG_STATIC
 #define PHGMG_IMPLEMENTATION
 #include "../phgmg.h"
@@ -1589,7 +1591,64 @@ TEST(test_oom_kernels_and_readers) {
 /* Everything allocated through the default allocator was freed. */
 TEST(test_default_allocator_balanced) { CHECK(g_default_live == 0); }
 
+/* The sparse LU's fallback: with PHGMG_SPARSE_GROWTH = 0.5 (above) every
+   sparse factorization is rejected, the stepper switches to the band LU with
+   partial pivoting and gives the band run's states bit for bit (a 2-D
+   lattice, 7 x 7 masses, (q, p) per mass, in a shuffled order; without the
+   fallback the sparse LU's states differ in the last bits). */
+static void rb_fb_u(double t, double *u, void *user) { (void)user; u[0] = 0.1 * sin(t); }
+TEST(test_sparse_lu_fallback) {
+  enum { NX = 7, NN = NX * NX, N = 2 * NN };
+  static double Jd[N * N], Rd[N * N], Qd[N * N], B[N], Y[2][41], X[2][N * 41];
+  static int cp[3][N + 1], ri[3][N * N];
+  static double vv[3][N * N];
+  int sc[N], i, j, a, k, run;
+  phgmg_csc M[3];
+  for (i = 0; i < N; ++i) sc[i] = (7 * i + 3) % N; /* a fixed shuffle (7 and N coprime) */
+  memset(Jd, 0, sizeof Jd); memset(Rd, 0, sizeof Rd); memset(Qd, 0, sizeof Qd); memset(B, 0, sizeof B);
+  for (k = 0; k < NN; ++k) {
+    int q = sc[2 * k], p = sc[2 * k + 1], nb[2], nn = 0;
+    if (k % NX + 1 < NX) nb[nn++] = k + 1;
+    if (k + NX < NN) nb[nn++] = k + NX;
+    Jd[q + p * N] = 1.0; Jd[p + q * N] = -1.0; Rd[p + p * N] = 0.05; Qd[p + p * N] = 1.0;
+    Qd[q + q * N] += 0.1;
+    for (i = 0; i < nn; ++i) {
+      int q2 = sc[2 * nb[i]];
+      Qd[q + q2 * N] -= 1.0; Qd[q2 + q * N] -= 1.0; Qd[q + q * N] += 1.0; Qd[q2 + q2 * N] += 1.0;
+    }
+  }
+  B[sc[1]] = 1.0;
+  for (a = 0; a < 3; ++a) {
+    const double *D = a == 0 ? Jd : a == 1 ? Rd : Qd;
+    int nz = 0;
+    for (j = 0; j < N; ++j) {
+      cp[a][j] = nz;
+      for (i = 0; i < N; ++i) if (D[i + j * N] != 0.0) { ri[a][nz] = i; vv[a][nz] = D[i + j * N]; ++nz; }
+    }
+    cp[a][N] = nz;
+    M[a].n_rows = M[a].n_cols = N; M[a].colptr = cp[a]; M[a].rowidx = ri[a]; M[a].values = vv[a];
+  }
+  for (run = 0; run < 2; ++run) {
+    phgmg_ph_sparse *sp = NULL;
+    phgmg_ph_sparse_info inf;
+    phgmg_gl3_stats st;
+    double x0[N];
+    memset(x0, 0, sizeof x0);
+    CHECK_RC(phgmg_ph_sparse_create(&sp, N, 1, &M[0], &M[1], &M[2], B, NULL, &inf, NULL), PHGMG_OK);
+    CHECK_RC(phgmg_ph_sparse_set_solver(sp, run ? PHGMG_SOLVER_BAND : PHGMG_SOLVER_SPARSE_LU, &inf), PHGMG_OK);
+    CHECK_RC(phgmg_simulate(phgmg_ph_sparse_system(sp), x0, 0.0, 0.1, 40, rb_fb_u, NULL, NULL, X[run], Y[run], NULL,
+                            &st, NULL, NULL), PHGMG_OK);
+    CHECK(st.factorizations == 1);
+    phgmg_ph_sparse_destroy(sp);
+  }
+  for (i = 0, k = 0; i < N * 41; ++i) k += X[0][i] != X[1][i];
+  CHECK(k == 0);
+  for (i = 0; i <= 40; ++i) CHECK_LE(fabs(Y[0][i] - Y[1][i]), 1e-14 * fabs(Y[1][40]));
+  CHECK(Y[1][40] != 0.0);
+}
+
 SUITE(robust) {
+  RUN(test_sparse_lu_fallback);
   RUN(test_dims_reduce);
   RUN(test_dims_validate);
   RUN(test_dims_simulate);

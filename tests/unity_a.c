@@ -24,5 +24,6 @@
 #include "test_qm_wide.c"
 #include "test_options.c"
 #include "test_sparse.c"
+#include "test_sparse_lu.c"
 #include "test_study.c"
 #include "test_subnormal.c"
