@@ -2647,7 +2647,7 @@ static int sim_same_file(const char *path, const char *in) {
    --input, --amp, --newton-tol, --newton-iter, --out, --states, --quiet.
    Returns 0, the usage status 2, or -1 after --help. */
 static int parse_simulate(int argc, char **argv, reduce_args *A, const char **states) {
-  const char *seen[64], *ins[12];
+  const char *seen[64], *ins[17];
   int i, k, nseen = 0;
   memset(A, 0, sizeof *A);
   A->dt = 0.1; A->steps = 1000; A->amp = 0.1; A->newton_iter = 10; A->input = "sin";
@@ -2660,6 +2660,7 @@ static int parse_simulate(int argc, char **argv, reduce_args *A, const char **st
     if (!strcmp(o, "--quiet")) g_quiet = 1;
     STR("--J", J) STR("--R", R) STR("--B", B) STR("--Q", Q)
     STR("--J-coo", Jcoo) STR("--R-coo", Rcoo) STR("--Q-coo", Qcoo)
+    STR("--E", E) STR("--E-coo", Ecoo) STR("--P", Pf) STR("--S", Sf) STR("--N", Nf)
     STR("--poly", poly) STR("--poly-idx", poly_idx) STR("--poly-w", poly_w)
     STR("--exp", expf) STR("--potential", potential) STR("--input", input) STR("--out", out)
 #undef STR
@@ -2688,8 +2689,8 @@ static int parse_simulate(int argc, char **argv, reduce_args *A, const char **st
   if (*states && !strcmp(*states, A->out)) return usage_error("simulate: --out and --states name the same file");
   ins[0] = A->J; ins[1] = A->R; ins[2] = A->B; ins[3] = A->Q; ins[4] = A->Jcoo; ins[5] = A->Rcoo;
   ins[6] = A->Qcoo; ins[7] = A->poly; ins[8] = A->poly_idx; ins[9] = A->poly_w; ins[10] = A->expf;
-  ins[11] = A->input;
-  for (k = 0; k < 12; ++k)
+  ins[11] = A->input; ins[12] = A->E; ins[13] = A->Ecoo; ins[14] = A->Pf; ins[15] = A->Sf; ins[16] = A->Nf;
+  for (k = 0; k < 17; ++k)
     if (sim_same_file(A->out, ins[k]) || (*states && sim_same_file(*states, ins[k])))
       return usage_error("simulate: the output %s is one of the input files (%s): not overwritten",
                          sim_same_file(A->out, ins[k]) ? A->out : *states, ins[k]);
@@ -2718,7 +2719,7 @@ static int cmd_simulate(int argc, char **argv) {
     status = 2;
     goto out;
   }
-  if ((status = input_setup(&S.in, A.input, A.amp, m, A.dt)) != 0) goto out;
+  if ((status = input_setup(&S.in, "--input", A.input, A.amp, m, A.dt)) != 0) goto out;
   status = 1;
   x0 = (double *)calloc((size_t)N, sizeof(double));
   Y = (double *)malloc(sizeof(double) * (size_t)m * ((size_t)A.steps + 1));
