@@ -2144,8 +2144,13 @@ static int run_reduction(const reduce_args *A, reduce_state *S, int method, cons
     }
   }
   rom = phgmg_reduced_rom(S->red);
-  progress("  done in %.2f s: r = %d, m = %d%s; sigma_{r'+1}/sigma_1 = %.3g, rcond(D^T G D) = %.3g", *t_red, rom->r,
-           rom->m, rom->nd ? "" : ", quadratic energy", info.pod_sigma_ratio, info.rcond_dgd);
+  /* GMG reports rcond(D^T G D); SP1/SP2 have no D^T G D (their rcond_dgd is V^T Vg's) */
+  if (method == PHGMG_METHOD_SP1 || method == PHGMG_METHOD_SP2)
+    progress("  done in %.2f s: r = %d, m = %d%s; sigma_{r+1}/sigma_1 = %.3g", *t_red, rom->r, rom->m,
+             rom->nd ? "" : ", quadratic energy", info.pod_sigma_ratio);
+  else
+    progress("  done in %.2f s: r = %d, m = %d%s; sigma_{r'+1}/sigma_1 = %.3g, rcond(D^T G D) = %.3g", *t_red,
+             rom->r, rom->m, rom->nd ? "" : ", quadratic energy", info.pod_sigma_ratio, info.rcond_dgd);
   if (method == PHGMG_METHOD_GMG_QM && A->lambda_auto == 1 && A->X && !A->nxin)
     note("gmg-qm with --X and no --X-input: the inputs of the runs are unknown, so no lambda can be validated "
          "by simulation: M = 0 (the GMG-POD model on the same basis). Give --X-input for the validated "
@@ -2328,7 +2333,9 @@ static int write_json(const reduce_args *A, reduce_state *S, int method, int ns,
   fprintf(jf, "  \"info\": {\"pod_sigma_ratio\": ");
   json_num(jf, info->pod_sigma_ratio);
   fprintf(jf, ", \"rcond_jr\": "); json_num(jf, info->rcond_jr);
-  fprintf(jf, ", \"rcond_dgd\": "); json_num(jf, info->rcond_dgd);
+  if (o->method != PHGMG_METHOD_SP1 && o->method != PHGMG_METHOD_SP2) { /* GMG only */
+    fprintf(jf, ", \"rcond_dgd\": "); json_num(jf, info->rcond_dgd);
+  }
   if (o->deim && A->poly_idx) { /* the hyper-reduction's result */
     fprintf(jf, ", \"hyper\": {\"method\": ");
     json_str(jf, hyper_name(A, o));

@@ -118,6 +118,12 @@ for meth in gmg-qm sp1; do
   run_ok "$meth r=12 CLI == library (1e-12)" "$REF" compare ref_$meth.npy o_$meth/y.npy 1e-12
 done
 [ -s o_gmg-qm/m_V2.npy ] && [ -s o_gmg-qm/m_M.npy ] && [ -s o_gmg-qm/m_Ms.npy ] || bad "gmg-qm arrays missing"
+# SP1/SP2 have no D^T G D: their log and record name no GMG diagnostic
+run_ok "reduce sp2 (log)" "$P" reduce $SYS $SIM --method sp2 --r 12 --out o_sp2 --name m
+if grep -F -q "D^T G D" "$T/err.txt" "$T/out.txt"; then bad "sp2 progress prints a GMG diagnostic (rcond(D^T G D))"; else pass; fi
+if grep -F -q "rcond_dgd" o_sp2/m.json o_sp1/m.json; then bad "sp1/sp2 record carries rcond_dgd"; else pass; fi
+run_ok "reduce gmg-pod (log)" "$P" reduce $SYS $SIM --method gmg-pod --r 12 --out o_gp --name m
+grep -F -q "rcond(D^T G D)" "$T/err.txt" "$T/out.txt" && pass || bad "gmg-pod progress lacks rcond(D^T G D)"
 
 # negative control: a different reduced order must not pass the comparison
 run_ok "reduce r=11" "$P" reduce $SYS $SIM --method gmg-pod --r 11 --out o11 --name m --quiet
