@@ -6,7 +6,7 @@
   - nonlinear: GMG-POD's e_y below SP2-POD's at every r;
   - nonlinear, r = 16: every ROM's max energy error within 10x of the FOM's.
 Issue 15 (replaces issue 5's "automatic lambda 1.5x below GMG-POD", which
-measured an overfitted lambda; NUMERICS 8.2), see the comments below:
+measured an overfitted lambda; manual section 8.6), see the comments below:
 <ex>_<sin|const>_lambda_auto.csv and <ex>_generalization.csv, each when present.
 usage: check_claims.py RESULTS_DIR [--full] ; --full: the issue-15 CSVs must
 cover every r = 6..20. Exit status 1 if a claim fails."""

@@ -132,7 +132,7 @@ static void check_structure(const phgmg_ph_system *sys, const double *X, int ns,
       CHECK_LE(maxabs(r * r, Jref), 1e-10);
     }
     /* reduced rhs against W^T ((J - R) grad H(phi(x)) + B u) in full dimension;
-       SP2 replaces grad H by its oblique projection W V^T grad H (NUMERICS 6.3) */
+       SP2 replaces grad H by its oblique projection W V^T grad H (manual section 8) */
     CHECK_RC(phgmg_rom_rhs(rom, xr, &u, fr, work), PHGMG_OK);
     phgmg_reduced_lift(red, xr, xf);
     if (meth == PHGMG_METHOD_SP2) {
