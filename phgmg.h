@@ -1903,7 +1903,11 @@ typedef struct phgmg_reduce_opts {
      "manifold", "blocks" (reduced operators), "hamiltonian" (quadratic terms),
      "hyper-reduction" (the separable part: gradient snapshots and DEIM/ECSW),
      "finish" (general term, step map, validation), and "done" at the end of
-     a successful reduction. Called from the calling thread only. */
+     a successful reduction. GMG-QM with lambda_auto = 1 adds "lambda:
+     validation runs" (their set-up), "lambda: full-model probe run" before
+     each full-model simulation of a probe input, and "lambda: candidate"
+     before each lambda simulated (as many as info.lambda_candidates). Called
+     from the calling thread only. */
   void (*progress)(const char *phase, void *user);
   void *progress_user;
 } phgmg_reduce_opts;
@@ -12508,6 +12512,11 @@ PHGMG__PRIV int phgmg__study_probes(phgmg__rctx *c, phgmg__vset *v, const double
   return 1;
 }
 
+/* opts.progress, when set (the library never prints). */
+PHGMG__PRIV void phgmg__progress(const phgmg_reduce_opts *o, const char *phase) {
+  if (o->progress) o->progress(phase, o->progress_user);
+}
+
 PHGMG__PRIV phgmg_result phgmg__vset_build(phgmg__rctx *c, phgmg__vset *v) {
   const phgmg_ph_system *sys = c->sys;
   const phgmg_run *run = c->o->runs;
@@ -12566,6 +12575,7 @@ PHGMG__PRIV phgmg_result phgmg__vset_build(phgmg__rctx *c, phgmg__vset *v) {
     v->u[k] = phgmg__probe_u; v->user[k] = p; v->x0[k] = run[0].x0 ? run[0].x0 : zero;
     v->t0[k] = run[0].t0; v->dt[k] = run[0].dt; v->nsteps[k] = run[0].nsteps; v->Yref[k] = v->buf + off;
     off += (size_t)m * (run[0].nsteps + 1);
+    phgmg__progress(c->o, "lambda: full-model probe run");
     rc = phgmg_simulate(sys, v->x0[k], v->t0[k], v->dt[k], v->nsteps[k], v->u[k], v->user[k], &go, NULL,
                         v->Yref[k], NULL, NULL, NULL, c->alloc);
     if (rc == PHGMG_ERR_NOMEM) return rc;
@@ -12684,6 +12694,7 @@ PHGMG__PRIV phgmg_result phgmg__stage_lambda_validate(phgmg__rctx *c) {
   v = PHGMG__CAST(phgmg__vset *, phgmg__alloc(c->alloc, sizeof(phgmg__vset)));
   if (!v) return PHGMG_ERR_NOMEM;
   memset(v, 0, sizeof *v);
+  phgmg__progress(o, "lambda: validation runs");
   rc = phgmg__vset_build(c, v);
   if (rc == PHGMG_OK) rc = phgmg__qm_set(c, -1, ms);
   if (rc == PHGMG_OK) rc = phgmg__vset_eval(c, v, &ok, 0.0);
@@ -12692,6 +12703,7 @@ PHGMG__PRIV phgmg_result phgmg__stage_lambda_validate(phgmg__rctx *c) {
   /* training runs alone: up from the regression optimum, the first admissible */
   for (g = c->gsel; rc == PHGMG_OK && o->lambda_train_only && g < c->ng; g += pd) {
     double worst = 0.0;
+    phgmg__progress(o, "lambda: candidate");
     rc = phgmg__qm_set(c, g, ms);
     if (rc == PHGMG_OK) rc = phgmg__vset_eval(c, v, &ok, tolr);
     if (rc != PHGMG_OK) break;
@@ -12702,6 +12714,7 @@ PHGMG__PRIV phgmg_result phgmg__stage_lambda_validate(phgmg__rctx *c) {
   for (g = c->ng - 1; rc == PHGMG_OK && !o->lambda_train_only && g >= c->gsel;
        g = (g - pd >= c->gsel || g == c->gsel) ? g - pd : c->gsel) {
     double score = 0.0, worst = 0.0;
+    phgmg__progress(o, "lambda: candidate");
     rc = phgmg__qm_set(c, g, ms);
     if (rc == PHGMG_OK) rc = phgmg__vset_eval(c, v, &ok, tolr);
     if (rc != PHGMG_OK) break;
@@ -13214,9 +13227,6 @@ PHGMG__PRIV phgmg_result phgmg__reduce_fallback_pod(phgmg_reduced **out, const p
 }
 
 /* opts->progress, if set (see phgmg_reduce_opts). */
-PHGMG__PRIV void phgmg__progress(const phgmg_reduce_opts *o, const char *phase) {
-  if (o->progress) o->progress(phase, o->progress_user);
-}
 
 /* Which fast path of a study applies to opts (0: none): the study's own
    bases, orders within its modes (phgmg_study_reduce). */

@@ -138,6 +138,47 @@ TEST(test_lambda_auto_without_runs_is_linear_limit) {
    Newton failure and e_y within 1.2x of GMG-POD's on inputs it never saw
    (a constant, 0.1 sin 2t, a step sequence), where the regression choice
    (lambda_auto = 2) is worse than 1.2x on the constant -- so the check can fail. */
+/* Progress of the validated lambda: one "lambda: candidate" call per
+   candidate counted in info.lambda_candidates, and the probe runs announced
+   (three probe inputs per training run unless the full model fails on one). */
+typedef struct { int cand, probe, val, done; } progress_count;
+static void count_phase(const char *phase, void *user) {
+  progress_count *pc = (progress_count *)user;
+  if (!strcmp(phase, "lambda: candidate")) pc->cand++;
+  else if (!strcmp(phase, "lambda: full-model probe run")) pc->probe++;
+  else if (!strcmp(phase, "lambda: validation runs")) pc->val++;
+  else if (!strcmp(phase, "done")) pc->done++;
+}
+TEST(test_lambda_auto_progress) {
+  msd_linear M;
+  enum { NS = 301 };
+  double *X;
+  phgmg_run run;
+  phgmg_reduce_info info;
+  phgmg_reduce_opts o;
+  phgmg_reduced *red = NULL;
+  progress_count pc = {0, 0, 0, 0};
+  CHECK(msd_linear_build(&M, 30, NULL, NULL, NULL, PHGMG_DENSE) == 0);
+  X = sim(&M.sys, msd_input_sin, NS - 1, NULL);
+  CHECK(X != NULL);
+  memset(&run, 0, sizeof run);
+  run.u = msd_input_sin; run.dt = 0.1; run.nsteps = NS - 1;
+  memset(&o, 0, sizeof o);
+  o.method = PHGMG_METHOD_GMG_QM; o.r = 8; o.rn = 4; o.lambda_auto = 1; o.nrun = 1; o.runs = &run;
+  o.progress = count_phase; o.progress_user = &pc;
+  if (X) {
+    CHECK_RC(phgmg_reduce(&red, &M.sys, X, M.sys.N, NS, &o, &info, NULL), PHGMG_OK);
+    CHECK(info.lambda_candidates >= 1);
+    CHECK(pc.cand == info.lambda_candidates);
+    CHECK(pc.val == 1);
+    CHECK(pc.probe == 3);
+    CHECK(pc.done == 1);
+  }
+  phgmg_reduced_destroy(red);
+  free(X);
+  msd_linear_free(&M);
+}
+
 TEST(test_lambda_auto_generalizes) {
   msd_linear M;
   enum { NS = 601, NT = 3 };
@@ -564,6 +605,7 @@ TEST(test_deploy_oom) {
 }
 
 SUITE(deploy) {
+  RUN(test_lambda_auto_progress);
   RUN(test_deploy_oom);
   RUN(test_simulate_inputs_layout);
   RUN(test_deploy_options);
