@@ -15850,6 +15850,13 @@ PHGMG__ONLINE phgmg_result phgmg__rom_header(const unsigned char *b, size_t len,
       n += k;
     }
   if (n > (len / ss)) return PHGMG_ERR_FORMAT;
+  {   /* the load-time structure check's scratch ((r + rn)^2 + ...) is bounded by
+         the matrices a valid model holds (r x r blocks, and rn x rn blocks when
+         quadratic): a small file declaring large sizes without them is refused
+         here, before anyone sizes a buffer from it */
+    const size_t n2 = (size_t)rom->r + (size_t)(rom->kind == PHGMG_ROM_QUADRATIC ? rom->rn : 0);
+    if (n2 * n2 > 4 * n + 4) return PHGMG_ERR_FORMAT;
+  }
   total = hdr + n * ss + 4 * nterm + 4;
   if (total != len) return PHGMG_ERR_FORMAT;
   if (phgmg__get32(b + total - 4) != phgmg__fnv1a(b, total - 4)) return PHGMG_ERR_FORMAT;
