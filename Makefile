@@ -36,11 +36,11 @@ TESTOBJ_ASAN = $(patsubst tests/%.c,$(BUILD)/obj_asan/%.o,$(TEST_UNITS))
 $(BUILD)/obj/unity_%.o $(BUILD)/obj_asan/unity_%.o: $(filter-out $(TEST_SOLO),$(TESTSRC)) \
   examples/msd_models.h tests/sepfun_models.h
 
-$(BUILD)/obj/%.o: tests/%.c phgmg.h tests/harness.h tests/suites.inc
+$(BUILD)/obj/%.o: tests/%.c phgmg.h tests/harness.h tests/fixture_msd.h tests/suites.inc
 	@mkdir -p $(BUILD)/obj
 	$(CC) $(CFLAGS_T) -c -o $@ $<
 
-$(BUILD)/obj_asan/%.o: tests/%.c phgmg.h tests/harness.h tests/suites.inc
+$(BUILD)/obj_asan/%.o: tests/%.c phgmg.h tests/harness.h tests/fixture_msd.h tests/suites.inc
 	@mkdir -p $(BUILD)/obj_asan
 	$(CC) $(CFLAGS_T) -O1 $(SANFLAGS) -c -o $@ $<
 

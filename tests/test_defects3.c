@@ -8,42 +8,17 @@
 #include "harness.h"
 #include <stdlib.h>
 
-/* Linear mass-spring-damper chain of paper 5.2 (n masses, N = 2n, one force
-   port at the first mass), x = (q1, p1, q2, p2, ...), dense. */
-typedef struct d3_model {
-  phgmg_ph_system sys;
-  double *J, *R, *Q, *B;
-} d3_model;
-static void d3_msd(d3_model *t, int n) {
-  const int N = 2 * n;
-  int i;
-  memset(t, 0, sizeof *t);
-  t->J = (double *)calloc((size_t)N * N, sizeof(double));
-  t->R = (double *)calloc((size_t)N * N, sizeof(double));
-  t->Q = (double *)calloc((size_t)N * N, sizeof(double));
-  t->B = (double *)calloc((size_t)N, sizeof(double));
-  for (i = 0; i < n; ++i) {
-    const int q = 2 * i, p = 2 * i + 1;
-    t->J[q + p * N] = 1; t->J[p + q * N] = -1;
-    t->R[p + p * N] = 0.5;
-    t->Q[p + p * N] = 1.0;
-    t->Q[q + q * N] = (i == 0 ? 1.0 : 2.0);
-    if (i + 1 < n) { t->Q[q + (q + 2) * N] = -1.0; t->Q[(q + 2) + q * N] = -1.0; }
-  }
-  t->B[1] = 1;
-  t->sys.N = N; t->sys.m = 1; t->sys.J = t->J; t->sys.R = t->R; t->sys.Q = t->Q; t->sys.B = t->B;
-}
-static void d3_free(d3_model *t) { free(t->J); free(t->R); free(t->Q); free(t->B); }
+#include "fixture_msd.h"
 static double d3_amp = 1.0;
 static void d3_u_sin(double t, double *u, void *user) { (void)user; u[0] = d3_amp * sin(t); }
 
 /* Snapshots of the chain driven by sin (amplitude 1) and a GMG-POD model of order r. */
-static phgmg_reduced *d3_reduce(d3_model *t, int n, int ns, int r, phgmg_method meth, double **Xo) {
+static phgmg_reduced *d3_reduce(dmodel *t, int n, int ns, int r, phgmg_method meth, double **Xo) {
   const int N = 2 * n;
   double *X = (double *)calloc((size_t)N * ns, sizeof(double)), *x0 = (double *)calloc((size_t)N, sizeof(double));
   phgmg_reduce_opts o;
   phgmg_reduced *red = NULL;
-  d3_msd(t, n);
+  dmodel_msd(t, n);
   d3_amp = 1.0;
   CHECK_RC(phgmg_simulate(&t->sys, x0, 0.0, 0.1, ns - 1, d3_u_sin, NULL, NULL, X, NULL, NULL, NULL, NULL, NULL),
            PHGMG_OK);
@@ -62,7 +37,7 @@ static phgmg_reduced *d3_reduce(d3_model *t, int n, int ns, int r, phgmg_method 
    sums overflow (the energy, one column's quadratic form, still does not);
    at 2^530 the energy overflows: PHGMG_ERR_OVERFLOW, not "out of memory". */
 TEST(test_defect3_validate_scaled_norms) {
-  d3_model t;
+  dmodel t;
   phgmg_reduced *red = d3_reduce(&t, 10, 201, 4, PHGMG_METHOD_GMG_POD, NULL);
   phgmg_run run;
   phgmg_validation v1, v;
@@ -94,7 +69,7 @@ TEST(test_defect3_validate_scaled_norms) {
   }
   d3_amp = 1.0;
   phgmg_reduced_destroy(red);
-  d3_free(&t);
+  dmodel_free(&t);
 }
 
 /* A GENERAL nonlinear part whose H_nl is NaN (gradient and Hessian zero: the
@@ -107,7 +82,7 @@ static void d3_h_zero(const double *x, double *Hs, void *user) {
   (void)x; (void)user; memset(Hs, 0, sizeof(double) * (size_t)d3_nN * (size_t)d3_nN);
 }
 TEST(test_defect3_validate_nan_energy) {
-  d3_model t;
+  dmodel t;
   double *X;
   phgmg_reduced *red = d3_reduce(&t, 5, 101, 4, PHGMG_METHOD_GMG_POD, &X);
   phgmg_ph_system g = t.sys;
@@ -132,7 +107,7 @@ TEST(test_defect3_validate_nan_energy) {
   phgmg_reduced_destroy(rg);
   phgmg_reduced_destroy(red);
   free(X);
-  d3_free(&t);
+  dmodel_free(&t);
 }
 
 /* ECSW is scale-invariant: exact data (target = Gm w0 with w0 >= 0 on 5 of
@@ -200,7 +175,7 @@ TEST(test_defect3_lambda_zero) {
   const double s6 = 1.0 / sqrt(6.0), q1[2][6] = {{1, 1, 1, 1, 1, 1}, {1, -1, 1, -1, 1, -1}};
   const double q2[2][4] = {{0.5, 0.5, 0.5, 0.5}, {0.5, -0.5, -0.5, 0.5}}, sg[2] = {3.0, 0.5};
   int i, j, k, c;
-  d3_model t;
+  dmodel t;
   double *Xs;
   phgmg_reduced *red = NULL;
   phgmg_reduce_opts o;
@@ -223,7 +198,7 @@ TEST(test_defect3_lambda_zero) {
   CHECK_RC(phgmg__lstsq_fit(6, 4, 2, A, Bm, 0.0, X, NULL), PHGMG_OK);
   for (i = 0; i < 8; ++i) CHECK_LE(fabs(X[i] - Xe[i]), 1e-13);
   memset(&o, 0, sizeof o);
-  d3_msd(&t, 10);
+  dmodel_msd(&t, 10);
   Xs = (double *)calloc((size_t)20 * 21, sizeof(double));
   {
     double x0[20] = {0};
@@ -235,7 +210,7 @@ TEST(test_defect3_lambda_zero) {
   if (red) CHECK_LE(phgmg_err_proj(red, Xs, 20, 21), 1e-6);
   phgmg_reduced_destroy(red);
   free(Xs);
-  d3_free(&t);
+  dmodel_free(&t);
 }
 
 /* The exact GL3 step map of a dissipative model for a huge dt: the 3-stage
@@ -246,7 +221,7 @@ TEST(test_defect3_lambda_zero) {
    x + h sum b_i Jf Y_i cancelled: a map growing by 1e84 per step at dt =
    1e100. A map that grows is refused (phgmg__step_map_check). */
 TEST(test_defect3_step_map_huge_dt) {
-  d3_model t;
+  dmodel t;
   double *X, x[6], y[6], Phi1[36], I6[36];
   const double dts[3] = {1e15, 1e100, 1e300};
   int k, a, b, it;
@@ -288,7 +263,7 @@ TEST(test_defect3_step_map_huge_dt) {
   }
   phgmg_reduced_destroy(red0);
   free(X);
-  d3_free(&t);
+  dmodel_free(&t);
 }
 
 /* Option checks as strict as the other entry points': phgmg_linear_basis
@@ -297,7 +272,7 @@ TEST(test_defect3_step_map_huge_dt) {
    phgmg_study_create refuses unknown flag bits; phgmg_lyap a non-symmetric
    right-hand side; phgmg_care on an unstabilizable pair says so. */
 TEST(test_defect3_argument_checks) {
-  d3_model t;
+  dmodel t;
   double *V, F[6 * 4], w[6], A2[4], K2[4], L2[4], X2[4], x[3], An[6];
   int pts[6], nd, nneg, k, i;
   double sig;
@@ -366,7 +341,7 @@ TEST(test_defect3_argument_checks) {
   CHECK_LE(fabs(X2[3] - (sqrt(2.0) - 1.0)), 1e-10);
   phgmg_reduced_destroy(red);
   free(V); free(Xs);
-  d3_free(&t);
+  dmodel_free(&t);
 }
 
 /* The orderings' row moves of a sparse model in place (X == Y) give what
@@ -428,7 +403,7 @@ TEST(test_defect3_sparse_order_in_place) {
    phgmg_study_reduce says so instead of returning a model of the old Q
    (restored, it reduces again, and gives phgmg_reduce's model). */
 TEST(test_defect3_study_stale) {
-  d3_model t;
+  dmodel t;
   double *Xs;
   phgmg_reduced *red = d3_reduce(&t, 5, 101, 4, PHGMG_METHOD_GMG_POD, &Xs), *r2 = NULL;
   phgmg_study *st = NULL;
@@ -456,7 +431,7 @@ TEST(test_defect3_study_stale) {
   phgmg_study_destroy(st);
   phgmg_reduced_destroy(red);
   free(Xs);
-  d3_free(&t);
+  dmodel_free(&t);
 }
 
 /* Loading checks the physics, not only the checksum: a model file written
@@ -477,7 +452,7 @@ static phgmg_result d3_roundtrip(const phgmg_rom *rom) {
   return phgmg_rom_deserialize(buf, wr, &back, mem, need);
 }
 TEST(test_defect3_load_structure) {
-  d3_model t;
+  dmodel t;
   double *Xs;
   phgmg_reduced *red = NULL, *rq = NULL;
   phgmg_reduce_opts o;
@@ -519,7 +494,7 @@ TEST(test_defect3_load_structure) {
   phgmg_reduced_destroy(red);
   phgmg_reduced_destroy(rq);
   free(Xs);
-  d3_free(&t);
+  dmodel_free(&t);
 }
 
 SUITE(defects3) {
