@@ -9,7 +9,7 @@
 CC      ?= cc
 CXX     ?= c++
 WARN     = -Wall -Wextra -Werror -pedantic -Wshadow
-CFLAGS_T = -std=c99 $(WARN) -O2 -g
+CFLAGS_T = -std=c99 $(WARN) -O2 -g1
 SANFLAGS = -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=all
 OPTFLAGS = -std=c99 $(WARN) -O2 -march=native
 LDLIBS   = -lm

@@ -285,9 +285,10 @@
                                              un-normalised sum over snapshots;
                                              < 0: exactly zero; not used with
                                              lambda_auto
-     deim               0                    1: hyper-reduce a separable part
+     hyper_reduce       0                    1: hyper-reduce a separable part
                                              (the method is `hyper`); 0: keep
                                              every term (exact, O(terms) online)
+     deim               0                    the former name of hyper_reduce
      hyper              PHGMG_HYPER_ECSW     ECSW (weights >= 0), QDEIM or
                                              GREEDY (structure-preserving DEIM)
      hyper_tol          1e-6                 ECSW: relative training residual
@@ -353,7 +354,7 @@
    In every construction B stays in the span and [B, V1, V2] is orthonormal,
    so Br = [I; 0] and the GMG reduction is unchanged.
 
-   3.4 Hyper-reduction (opts.deim = 1, opts.hyper)
+   3.4 Hyper-reduction (opts.hyper_reduce = 1, opts.hyper)
    A separable energy sum_k w_k phi(l_k) is replaced by sum_j w'_j phi(l_pj)
    over a few kept terms. Because the reduced energy itself is approximated
    (not its gradient), the reduced gradient is an exact gradient and the model
@@ -1737,11 +1738,13 @@ PHGMG_DEF phgmg_result phgmg_pod_randomized(int N, int ns, const double *X, int 
 PHGMG_DEF phgmg_result phgmg_adjust_snapshots(int N, int m, const double *B, int ns, const double *X,
                                               int ldx, double *Xa, int ldxa, const phgmg_allocator *alloc);
 
-/* Hyper-reduction of a separable part (phgmg_reduce_opts.hyper, with deim = 1). */
+/* Hyper-reduction of a separable part (phgmg_reduce_opts.hyper, with
+   hyper_reduce = 1). */
 typedef enum phgmg_hyper {
   PHGMG_HYPER_ECSW = 0,   /* default: w >= 0 by NNLS fit of the reduced gradient (ECSW) */
   PHGMG_HYPER_QDEIM = 1,  /* structure-preserving DEIM, Q-DEIM points (the paper's)     */
-  PHGMG_HYPER_GREEDY = 2  /* structure-preserving DEIM, greedy DEIM points             */
+  PHGMG_HYPER_GREEDY = 2, /* structure-preserving DEIM, greedy DEIM points             */
+  PHGMG_HYPER_COUNT       /* number of kinds (not a kind)                              */
 } phgmg_hyper;
 
 /* One run of the full model: input u (NULL: u = 0) from x0 (NULL: 0) at t0,
@@ -1769,11 +1772,12 @@ PHGMG_DEF phgmg_result phgmg_simulate_inputs(const phgmg_ph_system *sys, int nru
                                              const phgmg_allocator *alloc);
 
 /* GMG-QM manifold constructions (phgmg_reduce_opts.manifold). */
-enum {
+typedef enum phgmg_manifold {
   PHGMG_MANIFOLD_POD = 0,    /* the paper's hierarchical POD                       */
   PHGMG_MANIFOLD_GREEDY = 1, /* greedy linear part (Schwerdtner & Peherstorfer 2024) */
-  PHGMG_MANIFOLD_ALTMIN = 2  /* alternating minimization of V1, V2 and M           */
-};
+  PHGMG_MANIFOLD_ALTMIN = 2, /* alternating minimization of V1, V2 and M           */
+  PHGMG_MANIFOLD_COUNT       /* number of constructions (not one)                  */
+} phgmg_manifold;
 
 /* phgmg_reduce_opts.rn: V2 over the whole residual of the snapshots (see rn). */
 #define PHGMG_RN_WIDE (-1)
@@ -1802,12 +1806,15 @@ typedef struct phgmg_reduce_opts {
                           then being the minimum-norm least-squares solution, for
                           any rank of its Kronecker matrix; ignored with
                           lambda_auto, below)                                         */
-  int deim;            /* separable nonlinear part: 1 = structure-preserving DEIM,
-                          0 = keep every term (exact, but O(n_terms) online)          */
+  int hyper_reduce;    /* separable nonlinear part: 1 = hyper-reduce it (the kind in
+                          hyper below), 0 = keep every term (exact, but O(n_terms)
+                          online)                                                     */
+  int deim;            /* the former name of hyper_reduce (either set to 1 turns
+                          hyper-reduction on); kept for 0.x, to be removed in 1.0     */
   double deim_tol;     /* DEIM modes: sigma_k / sigma_1 > deim_tol (0: 1e-8)          */
   int deim_max;        /* cap on DEIM modes (0: no cap)                               */
   int deim_allow_negative; /* 1: accept negative DEIM weights (reported in info)      */
-  int hyper;           /* with deim = 1, the hyper-reduction (phgmg_hyper):
+  phgmg_hyper hyper;   /* with hyper_reduce = 1, the hyper-reduction (phgmg_hyper):
                           0 / PHGMG_HYPER_ECSW: empirical quadrature with weights >= 0
                           by non-negative least squares (default; never a negative
                           weight); PHGMG_HYPER_QDEIM / _GREEDY: the paper's
@@ -1879,7 +1886,7 @@ typedef struct phgmg_reduce_opts {
      alternating minimization; falls back to the POD manifold under
      lambda_auto = 1 when it beats neither reference: info.manifold_fallback).
      Greedy and altmin take a wide V2 by default (see rn). */
-  int manifold;
+  phgmg_manifold manifold;
   /* manifold = 1 with a wide V2 (rn = 0 or PHGMG_RN_WIDE): 0 (default) =
      the candidates for V1 and their score as described under manifold (the
      leading r - m + 8 POD modes); > 0 = the leading r - m + greedy_window
@@ -1944,7 +1951,7 @@ typedef struct phgmg_reduce_info {
                               be exported. 0: online cost independent of N. */
   int online_callbacks;    /* 1: the reduced model calls back into user code
                               (separable functions, eta or a GENERAL part)     */
-  int hyper_method;        /* phgmg_hyper used (with deim = 1), -1 without    */
+  int hyper_method;        /* phgmg_hyper used (hyper_reduce = 1), -1 without */
   double hyper_min_weight; /* smallest weight of the kept terms                */
   double hyper_residual;   /* ECSW: relative training residual of the reduced
                               nonlinear gradient; 0 for DEIM                   */
@@ -2121,7 +2128,7 @@ PHGMG_DEF const double *phgmg_study_basis(const phgmg_study *st, char which, int
 /* phgmg_reduce(out, sys, X, ldx, ns, opts', info, alloc) of the study's
    system and snapshots, with opts' = opts plus the study's bases where
    opts leaves pod_basis / grad_basis NULL (GMG-POD, GMG-QM, SP1, SP2), and
-   with opts.deim = 1, hyper QDEIM or GREEDY and no deim_pts: the study's
+   with opts.hyper_reduce = 1, hyper QDEIM or GREEDY and no deim_pts: the study's
    DEIM points (computed at the first such call, reused while deim_tol,
    deim_max and the point selection are the same). The fast path (snapshot
    quantities from coordinates) applies to GMG-POD, GMG-QM with manifold 0,
@@ -11283,7 +11290,7 @@ PHGMG__PRIV phgmg_result phgmg__deploy_check(const phgmg_reduce_opts *o, int ns)
   if (!(o->lambda_tolerance >= 1.0 && o->lambda_tolerance < HUGE_VAL))
     return PHGMG_ERR_INVALID_ARG;
   if (!(o->newton_tol >= 0.0 && o->newton_tol < 1.0) || o->newton_iter < 0) return PHGMG_ERR_INVALID_ARG;
-  if (o->manifold < PHGMG_MANIFOLD_POD || o->manifold > PHGMG_MANIFOLD_ALTMIN) return PHGMG_ERR_INVALID_ARG;
+  if ((int)o->manifold < 0 || (int)o->manifold >= (int)PHGMG_MANIFOLD_COUNT) return PHGMG_ERR_INVALID_ARG;
   if (o->lambda_train_only != 0 && o->lambda_train_only != 1) return PHGMG_ERR_INVALID_ARG;
   return PHGMG_OK;
 }
@@ -11310,6 +11317,8 @@ PHGMG__PRIV void phgmg__reduce_opts_resolve(phgmg_reduce_opts *o, int ns) {
   if (o->lambda_rcond == 0.0) o->lambda_rcond = 1e-6;
   if (o->lambda_tolerance == 0.0) o->lambda_tolerance = 1.02;
   if (o->newton_iter == 0) o->newton_iter = 20;
+  if (o->deim == 1 && o->hyper_reduce == 0) o->hyper_reduce = 1;   /* the former name */
+  if (o->hyper_reduce == 1 && o->deim == 0) o->deim = 1;
 }
 
 PHGMG_DEF void phgmg_reduce_opts_default(phgmg_reduce_opts *o) {
@@ -11332,10 +11341,10 @@ PHGMG__PRIV phgmg_result phgmg__reduce_check(const phgmg_ph_system *sys, const d
   }
   if (o->method == PHGMG_METHOD_GMG_MANIFOLD && (!o->eta || o->rn < 1)) return PHGMG_ERR_INVALID_ARG;
   if (o->rn < PHGMG_RN_WIDE) return PHGMG_ERR_INVALID_ARG;
-  if (o->deim != 0 && o->deim != 1) return PHGMG_ERR_INVALID_ARG;
-  if (o->hyper < PHGMG_HYPER_ECSW || o->hyper > PHGMG_HYPER_GREEDY) return PHGMG_ERR_INVALID_ARG;
+  if ((o->hyper_reduce != 0 && o->hyper_reduce != 1) || (o->deim != 0 && o->deim != 1)) return PHGMG_ERR_INVALID_ARG;
+  if ((int)o->hyper < 0 || (int)o->hyper >= (int)PHGMG_HYPER_COUNT) return PHGMG_ERR_INVALID_ARG;
   if (!(o->hyper_tol >= 0.0 && o->hyper_tol < 1.0)) return PHGMG_ERR_INVALID_ARG;
-  if (o->deim && sys->nl == PHGMG_NL_GENERAL) return PHGMG_ERR_UNSUPPORTED;
+  if (o->hyper_reduce && sys->nl == PHGMG_NL_GENERAL) return PHGMG_ERR_UNSUPPORTED;
   if (sys->P || sys->S || sys->Nskew) return PHGMG_ERR_UNSUPPORTED;   /* feedthrough: full model only */
   if (!(o->deim_tol >= 0.0 && o->deim_tol < 1.0) || o->deim_max < 0) return PHGMG_ERR_INVALID_ARG;
   if (!(o->dt >= 0.0) || o->dt == HUGE_VAL) return PHGMG_ERR_INVALID_ARG;
@@ -13090,7 +13099,7 @@ PHGMG__PRIV phgmg_result phgmg__separable_points(phgmg__rctx *c, int *pts, doubl
   const int nt = sys->nsep, ns = c->ns;
   int a, nneg = 0;
   phgmg_result rc = PHGMG_OK;
-  if (o->deim && o->deim_pts && o->deim_w) {
+  if (o->hyper_reduce && o->deim_pts && o->deim_w) {
     if (o->deim_count < 1 || o->deim_count > nt) return PHGMG_ERR_SIZE;
     *nd = o->deim_count;
     for (a = 0; a < *nd; ++a) {
@@ -13100,7 +13109,7 @@ PHGMG__PRIV phgmg_result phgmg__separable_points(phgmg__rctx *c, int *pts, doubl
       if (wt[a] < 0.0) ++nneg;
     }
     if (!phgmg__all_finite(wt, (size_t)*nd)) return PHGMG_ERR_NANINF;
-  } else if (o->deim) {
+  } else if (o->hyper_reduce) {
     const int ecsw = o->hyper == PHGMG_HYPER_ECSW, quad = c->red->kind == PHGMG_ROM_QUADRATIC;
     double *F = NULL;
     int *live = NULL, nl = 0;
@@ -13879,7 +13888,7 @@ PHGMG__PRIV int phgmg__study_deim(phgmg_study *st, const phgmg_reduce_opts *o) {
   double *F;
   int a, i;
   phgmg_result rc;
-  if (o->deim != 1 || o->deim_pts || sys->nl != PHGMG_NL_SEPARABLE || nt < 1 ||
+  if (o->hyper_reduce != 1 || o->deim_pts || sys->nl != PHGMG_NL_SEPARABLE || nt < 1 ||
       (o->hyper != PHGMG_HYPER_QDEIM && o->hyper != PHGMG_HYPER_GREEDY) || !(o->deim_tol >= 0.0 && o->deim_tol < 1.0))
     return 0;
   if (st->deim_have && st->deim_tol == o->deim_tol && st->deim_max == o->deim_max && st->deim_method == meth) return 1;

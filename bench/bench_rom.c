@@ -424,7 +424,7 @@ static phgmg_reduced *build(const model_data *md, phgmg_method meth, int r, doub
   phgmg_result rc;
   memset(&o, 0, sizeof o);
   o.method = meth; o.r = r; o.rn = RN; o.lambda = lambda;
-  o.deim = 1; o.deim_tol = 1e-8; o.deim_allow_negative = 1;
+  o.hyper_reduce = 1; o.deim_tol = 1e-8; o.deim_allow_negative = 1;
   if (with_map) o.dt = DT;
   rc = phgmg_reduce(&red, md->sys, md->X, md->sys->N, NS, &o, NULL, NULL);
   if (rc != PHGMG_OK) die("phgmg_reduce", rc);
@@ -644,7 +644,7 @@ static void bench_offline_reduce(const model_data *lin, const model_data *nl1, d
       rc.sys = md->sys; rc.X = md->X;
       rc.o.method = oc[i].m; rc.o.r = 20; rc.o.rn = RN;
       rc.o.lambda = oc[i].lin ? 1e-3 : lam20;
-      rc.o.deim = 1; rc.o.deim_tol = 1e-8; rc.o.deim_allow_negative = 1;
+      rc.o.hyper_reduce = 1; rc.o.deim_tol = 1e-8; rc.o.deim_allow_negative = 1;
       if (oc[i].map) rc.o.dt = DT;
       T = bench(oc[i].name, RUNS_OFF, reduce_fn, &rc);
       snprintf(extra, sizeof extra, "whole phgmg_reduce, N = %d%s", md->sys->N,

@@ -166,7 +166,7 @@ static rom_row rom_run(const morse_chain *M, const traj *train, const traj *test
   row.rc = phgmg_reduce(&red, &M->sys, train->X, N, ns, o, &info, NULL);
   row.t_offline = demo_now() - t0;
   if (row.rc == PHGMG_OK) {
-    row.ndeim = o->deim ? info.deim_modes : M->n;
+    row.ndeim = o->hyper_reduce ? info.deim_modes : M->n;
     row.e_proj = phgmg_err_proj(red, train->X, N, ns);
     phgmg_reduced_restrict(red, train->X, xr0); /* rho(x0), x0 = 0 for both inputs */
     t0 = demo_now();
@@ -277,7 +277,7 @@ static void study(const morse_chain *M, const traj *train, const traj *test, con
         rom_row *w = &rows[(k * NMETH + j) * 2 + d];
         phgmg_reduce_opts o;
         memset(&o, 0, sizeof o);
-        o.method = meth_id[j]; o.r = rs[k]; o.rn = rn; o.deim = d; o.deim_tol = deim_tol;
+        o.method = meth_id[j]; o.r = rs[k]; o.rn = rn; o.hyper_reduce = d; o.deim_tol = deim_tol;
         o.deim_allow_negative = 1;
         if (meth_id[j] == PHGMG_METHOD_GMG_QM) o.lambda = fmax(0.2 * proj_pod, pow(10.0, -2.5));
         demo_cache_use(cache, &o);

@@ -163,8 +163,9 @@ static const char *const help_lines[] = {
   "  --poly-idx FILE     a vector of the 0-based state coordinates idx_k of the terms\n",
   "                      (each in [0, N); any integer dtype, e.g. np.arange, or float64).\n",
   "  --poly-w FILE       a vector of the term weights w_k (default all 1).\n",
-  "  --no-deim           keep every nonlinear term online (exact, cost O(terms)).\n",
-  "                      Default: structure-preserving DEIM picks a few of them.\n",
+  "  --no-hyper          keep every nonlinear term online (exact, cost O(terms));\n",
+  "                      --no-deim is the former name. Default: the hyper-reduction\n",
+  "                      (--hyper) keeps a few weighted terms.\n",
   "  --hyper H           hyper-reduction of the nonlinear terms: ecsw (default; weights\n",
   "                      >= 0 by non-negative least squares), qdeim or greedy (the\n",
   "                      paper's structure-preserving DEIM; weights may be negative)\n",
@@ -1227,7 +1228,7 @@ static int given(const char *o, const char *const *seen, int nseen) {
    to the method that reads it. 0 or the usage status 2. */
 static int check_hyper_opts(const reduce_args *A, const char *const *seen, int nseen) {
   static const char *const all[] = {"--hyper", "--hyper-tol", "--deim-tol", "--deim-max", "--no-deim",
-                                    "--deim-allow-negative", NULL};
+                                    "--no-hyper", "--deim-allow-negative", NULL};
   const int ecsw = !A->hyper || !strcmp(A->hyper, "ecsw");
   int k;
   for (k = 0; all[k]; ++k)
@@ -1236,14 +1237,14 @@ static int check_hyper_opts(const reduce_args *A, const char *const *seen, int n
                          "this model has none", all[k]);
   for (k = 0; k < 4; ++k)
     if (A->no_deim && given(all[k], seen, nseen))
-      return usage_error("reduce: --no-deim keeps every nonlinear term: %s does not apply", all[k]);
+      return usage_error("reduce: --no-hyper keeps every nonlinear term: %s does not apply", all[k]);
   if (given("--hyper-tol", seen, nseen)) {
     if (!ecsw) return usage_error("--hyper-tol applies to --hyper ecsw (the tolerance of %s is --deim-tol)", A->hyper);
     if (!(A->hyper_tol > 0.0 && A->hyper_tol < 1.0))
       return usage_error("--hyper-tol %g: expected 0 < T < 1 (a relative residual)", A->hyper_tol);
     if (A->hyper_tol < 1e-14)
       return usage_error("--hyper-tol %g: below what double precision resolves in a relative residual (1e-14); "
-                         "for every term exactly, use --no-deim", A->hyper_tol);
+                         "for every term exactly, use --no-hyper", A->hyper_tol);
   }
   if (ecsw && (given("--deim-tol", seen, nseen) || given("--deim-max", seen, nseen)))
     return usage_error("reduce: --deim-tol and --deim-max apply to --hyper qdeim or greedy (ecsw's tolerance is "
@@ -1317,7 +1318,7 @@ static int parse_reduce(int argc, char **argv, reduce_args *A) {
       A->have_dt_map = 1;
     }
     else if (!strcmp(o, "--simulate")) A->simulate = 1;
-    else if (!strcmp(o, "--no-deim")) A->no_deim = 1;
+    else if (!strcmp(o, "--no-deim") || !strcmp(o, "--no-hyper")) A->no_deim = 1;
     else if (!strcmp(o, "--deim-allow-negative")) A->deim_neg = 1;
     else if (!strcmp(o, "--save-snapshots")) A->save_snap = 1;
     else if (!strcmp(o, "--quiet")) g_quiet = 1;
@@ -2100,7 +2101,7 @@ static int run_reduction(const reduce_args *A, reduce_state *S, int method, cons
   o.r = A->r;
   o.rn = A->rn ? A->rn : default_rn(N, A->r, S->sys.m);
   o.lambda = A->lambda > 0.0 ? A->lambda : -1.0; /* 0 on the command line = exactly zero */
-  o.deim = A->poly_idx && !A->no_deim;
+  o.hyper_reduce = A->poly_idx && !A->no_deim;
   o.hyper = !A->hyper || !strcmp(A->hyper, "ecsw") ? PHGMG_HYPER_ECSW
             : !strcmp(A->hyper, "qdeim") ? PHGMG_HYPER_QDEIM : PHGMG_HYPER_GREEDY;
   if (A->hyper_tol > 0.0) o.hyper_tol = A->hyper_tol;
@@ -2133,7 +2134,7 @@ static int run_reduction(const reduce_args *A, reduce_state *S, int method, cons
       case PHGMG_ERR_TOL_UNREACHABLE:
         return fail("reduction failed: --hyper-tol %g: %s", A->hyper_tol, phgmg_result_string(rc));
       case PHGMG_ERR_NEGATIVE_WEIGHT:
-        return fail("reduction failed: %s (use --deim-allow-negative, a smaller --deim-tol, or --no-deim)",
+        return fail("reduction failed: %s (use --deim-allow-negative, a smaller --deim-tol, or --no-hyper)",
                     phgmg_result_string(rc));
       case PHGMG_ERR_UNSUPPORTED:
         if (A->Pf || A->Sf || A->Nf)
@@ -2170,7 +2171,7 @@ static int run_reduction(const reduce_args *A, reduce_state *S, int method, cons
   if (info.pod_randomized)
     progress("  POD: %s (a-posteriori check %.2g)", info.pod_randomized > 0 ? "randomized (large snapshot set)"
              : "exact SVD (the randomized POD failed its check)", info.pod_check);
-  if (rom->nd && o.deim)
+  if (rom->nd && o.hyper_reduce)
     progress("  hyper-reduction %s: %d points, %d negative weights, smallest weight %.3g, training residual %.2g",
              A->hyper ? A->hyper : "ecsw", info.deim_modes, info.deim_negative, info.hyper_min_weight,
              info.hyper_residual);
@@ -2240,7 +2241,7 @@ static int write_arrays(const reduce_args *A, reduce_state *S, const double *X, 
 /* The hyper-reduction of the run: ecsw, qdeim, greedy, or none (no nonlinear
    part, or --no-deim: every term kept). */
 static const char *hyper_name(const reduce_args *A, const phgmg_reduce_opts *o) {
-  if (!A->poly_idx || !o->deim) return "none";
+  if (!A->poly_idx || !o->hyper_reduce) return "none";
   return o->hyper == PHGMG_HYPER_ECSW ? "ecsw" : o->hyper == PHGMG_HYPER_QDEIM ? "qdeim" : "greedy";
 }
 
@@ -2319,12 +2320,12 @@ static int write_json(const reduce_args *A, reduce_state *S, int method, int ns,
   fprintf(jf, "\"training_runs\": %d", S->nrun);
   fprintf(jf, ", \"hyper\": ");
   json_str(jf, hyper_name(A, o));
-  if (o->deim && o->hyper == PHGMG_HYPER_ECSW) {
+  if (o->hyper_reduce && o->hyper == PHGMG_HYPER_ECSW) {
     fprintf(jf, ", \"hyper_tol\": ");
     json_num(jf, A->hyper_tol > 0.0 ? A->hyper_tol : 1e-6);
   }
-  fprintf(jf, ", \"deim\": %s", o->deim && o->hyper != PHGMG_HYPER_ECSW ? "true" : "false");
-  if (o->deim && o->hyper != PHGMG_HYPER_ECSW) {
+  fprintf(jf, ", \"deim\": %s", o->hyper_reduce && o->hyper != PHGMG_HYPER_ECSW ? "true" : "false");
+  if (o->hyper_reduce && o->hyper != PHGMG_HYPER_ECSW) {
     fprintf(jf, ", \"deim_tol\": ");
     json_num(jf, A->deim_tol);
     fprintf(jf, ", \"deim_max\": %d, \"deim_allow_negative\": %s", A->deim_max, A->deim_neg ? "true" : "false");
@@ -2336,7 +2337,7 @@ static int write_json(const reduce_args *A, reduce_state *S, int method, int ns,
   if (o->method != PHGMG_METHOD_SP1 && o->method != PHGMG_METHOD_SP2) { /* GMG only */
     fprintf(jf, ", \"rcond_dgd\": "); json_num(jf, info->rcond_dgd);
   }
-  if (o->deim && A->poly_idx) { /* the hyper-reduction's result */
+  if (o->hyper_reduce && A->poly_idx) { /* the hyper-reduction's result */
     fprintf(jf, ", \"hyper\": {\"method\": ");
     json_str(jf, hyper_name(A, o));
     fprintf(jf, ", \"points\": %d, \"negative_weights\": %d, \"min_weight\": ", info->deim_modes, info->deim_negative);

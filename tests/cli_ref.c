@@ -101,7 +101,7 @@ static int ref(int nonlinear, phgmg_method meth, int r, int n, const char *out) 
     if (msd_nonlinear_build(&MN, &mo) != 0) return die("msd_nonlinear_build", PHGMG_ERR_INVALID_ARG);
     sys = &MN.sys;
     go.tol = 1e-8; go.max_iter = 20;
-    o.deim = 1; o.deim_tol = 1e-8; o.deim_allow_negative = 1;
+    o.hyper_reduce = 1; o.deim_tol = 1e-8; o.deim_allow_negative = 1;
     o.lambda = 1e-3;
   } else {
     if (msd_linear_build(&ML, 50, NULL, NULL, NULL, PHGMG_DENSE) != 0)

@@ -103,7 +103,7 @@ int main(void) {
   phgmg_reduce_opts_default(&o);
 #define I(f) printf(#f " %d\n", (int)o.f);
 #define D(f) printf(#f " %.17g\n", o.f);
-  I(rn) D(lambda) I(deim) I(hyper) D(hyper_tol) D(deim_tol) I(deim_max) I(deim_allow_negative) D(dt)
+  I(rn) D(lambda) I(hyper_reduce) I(deim) I(hyper) D(hyper_tol) D(deim_tol) I(deim_max) I(deim_allow_negative) D(dt)
   D(degeneracy_tol) I(lambda_auto) D(lambda_min) D(lambda_max) I(lambda_per_decade) I(lambda_folds)
   D(lambda_rcond) D(lambda_tolerance) I(newton_iter) I(manifold) I(lambda_train_only)
   return 0;

@@ -92,7 +92,7 @@ static double te_compare(int n_masses, int ns, int ld, int r, int *count) {
     ro.method = (phgmg_method)meth;
     ro.r = r;
     ro.rn = 4;
-    ro.deim = 1;
+    ro.hyper_reduce = 1;
     ro.deim_allow_negative = 1;
     if (phgmg_reduce(&red, &M.sys, X0, N, ns, &ro, NULL, NULL) != PHGMG_OK) { worst = 1.0; free(XR); break; }
     memset(xr0, 0, sizeof xr0);

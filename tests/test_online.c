@@ -320,7 +320,7 @@ static double toda_rom(double sc, phgmg_method meth, double *Yf, double *Yr, dou
   memset(&run, 0, sizeof run);
   run.u = toda_u; run.dt = 0.1; run.nsteps = NS - 1;
   memset(&o, 0, sizeof o);
-  o.method = meth; o.r = 10; o.rn = 6; o.deim = 1; o.deim_allow_negative = 1;
+  o.method = meth; o.r = 10; o.rn = 6; o.hyper_reduce = 1; o.deim_allow_negative = 1;
   o.lambda_auto = meth == PHGMG_METHOD_GMG_QM; o.nrun = 1; o.runs = &run;
   if (X && phgmg_simulate_inputs(&M.sys, 1, &run, NULL, X, M.sys.N, Yf, NULL, NULL) == PHGMG_OK &&
       phgmg_reduce(&red, &M.sys, X, M.sys.N, NS, &o, &info, NULL) == PHGMG_OK &&

@@ -58,9 +58,9 @@ static void set_qm_auto(phgmg_reduce_opts *o, const phgmg_run *r) {
   set_qm(o, r); o->lambda_auto = 1; o->nrun = 1; o->runs = r;
 }
 static void set_sp1(phgmg_reduce_opts *o, const phgmg_run *r) { (void)r; o->method = PHGMG_METHOD_SP1; o->r = 8; }
-static void set_pod_ecsw(phgmg_reduce_opts *o, const phgmg_run *r) { (void)r; o->method = PHGMG_METHOD_GMG_POD; o->r = 8; o->deim = 1; }
+static void set_pod_ecsw(phgmg_reduce_opts *o, const phgmg_run *r) { (void)r; o->method = PHGMG_METHOD_GMG_POD; o->r = 8; o->hyper_reduce = 1; }
 static void set_sp2_qdeim(phgmg_reduce_opts *o, const phgmg_run *r) {
-  (void)r; o->method = PHGMG_METHOD_SP2; o->r = 8; o->deim = 1; o->hyper = PHGMG_HYPER_QDEIM; o->deim_allow_negative = 1;
+  (void)r; o->method = PHGMG_METHOD_SP2; o->r = 8; o->hyper_reduce = 1; o->hyper = PHGMG_HYPER_QDEIM; o->deim_allow_negative = 1;
 }
 static void set_qm_other(phgmg_reduce_opts *o, const phgmg_run *r) { set_qm(o, r); o->lambda = 1e-9; }
 
@@ -117,6 +117,57 @@ TEST(test_reduce_opts_default_same_model) {
   msd_nonlinear_free(&M);
 }
 
+/* hyper_reduce and its former name deim select the same hyper-reduction;
+   neither on keeps every term (another model: the negative control); values
+   outside the enums (hyper_reduce 2, PHGMG_HYPER_COUNT, PHGMG_MANIFOLD_COUNT)
+   are refused. */
+static void set_pod_former(phgmg_reduce_opts *o, const phgmg_run *r) { set_pod_ecsw(o, r); o->hyper_reduce = 0; o->deim = 1; }
+static void set_pod_both(phgmg_reduce_opts *o, const phgmg_run *r) { set_pod_ecsw(o, r); o->deim = 1; }
+TEST(test_reduce_opts_hyper_reduce_former_name) {
+  msd_nonlinear M;
+  msd_nl_opts mo;
+  phgmg_gl3_opts go;
+  phgmg_run run;
+  phgmg_reduce_opts a, b;
+  phgmg_reduced *red = NULL;
+  unsigned char *ma, *mb, *mc;
+  size_t la = 0, lb = 0, lc = 0;
+  double ka, kb, kc;
+  double *X;
+  memset(&mo, 0, sizeof mo);
+  mo.n = 20; mo.storage = PHGMG_BANDED;
+  CHECK(msd_nonlinear_build(&M, &mo) == 0);
+  memset(&run, 0, sizeof run);
+  run.u = msd_input_sin; run.dt = 0.1; run.nsteps = OPT_STEPS;
+  memset(&go, 0, sizeof go);
+  go.tol = 1e-10;
+  X = (double *)malloc(sizeof(double) * M.sys.N * (OPT_STEPS + 1));
+  CHECK(X != NULL);
+  if (X) {
+    CHECK_RC(phgmg_simulate_inputs(&M.sys, 1, &run, &go, X, M.sys.N, NULL, NULL, NULL), PHGMG_OK);
+    memset(&a, 0, sizeof a); set_pod_ecsw(&a, &run);
+    memset(&b, 0, sizeof b); set_pod_former(&b, &run);
+    ma = opt_model(&M.sys, X, &a, &la, &ka);
+    mb = opt_model(&M.sys, X, &b, &lb, &kb);
+    CHECK(ma && mb && la == lb && !memcmp(ma, mb, la));
+    CHECK(opt_same(&M.sys, X, set_pod_both, &run));
+    b.deim = 0;   /* neither: every term kept, a larger model */
+    mc = opt_model(&M.sys, X, &b, &lc, &kc);
+    CHECK(mc && lc != la);
+    free(ma); free(mb); free(mc);
+    a.hyper_reduce = 2;
+    CHECK_RC(phgmg_reduce(&red, &M.sys, X, M.sys.N, OPT_STEPS + 1, &a, NULL, NULL), PHGMG_ERR_INVALID_ARG);
+    a.hyper_reduce = 1; a.hyper = PHGMG_HYPER_COUNT;
+    CHECK_RC(phgmg_reduce(&red, &M.sys, X, M.sys.N, OPT_STEPS + 1, &a, NULL, NULL), PHGMG_ERR_INVALID_ARG);
+    a.hyper = PHGMG_HYPER_ECSW; a.method = PHGMG_METHOD_GMG_QM; a.manifold = PHGMG_MANIFOLD_COUNT;
+    CHECK_RC(phgmg_reduce(&red, &M.sys, X, M.sys.N, OPT_STEPS + 1, &a, NULL, NULL), PHGMG_ERR_INVALID_ARG);
+    CHECK(red == NULL);
+  }
+  free(X);
+  msd_nonlinear_free(&M);
+}
+
 SUITE(options) {
   RUN(test_reduce_opts_default_same_model);
+  RUN(test_reduce_opts_hyper_reduce_former_name);
 }

@@ -173,7 +173,7 @@ static void check_derivatives(const phgmg_ph_system *sys, const double *X, int n
   double xr[32], xp[32], f1[32], f2[32], Jf[1024], Hs[1024], work[8192];
   int s, a, b;
   memset(&o, 0, sizeof o);
-  o.method = meth; o.r = r; o.rn = 8; o.lambda = 1e-3; o.deim = deim; o.deim_allow_negative = 1;
+  o.method = meth; o.r = r; o.rn = 8; o.lambda = 1e-3; o.hyper_reduce = deim; o.deim_allow_negative = 1;
   CHECK_RC(phgmg_reduce(&red, sys, X, N, ns, &o, NULL, NULL), PHGMG_OK);
   if (!red) return;
   rom = phgmg_reduced_rom(red);
@@ -297,7 +297,7 @@ TEST(test_qm_stepper_matches_reference_gl3) {
     phgmg_rom_stepper st;
     int n, a;
     memset(&o, 0, sizeof o);
-    o.method = PHGMG_METHOD_GMG_QM; o.r = pass ? 16 : 8; o.rn = 8; o.lambda = 1e-6; o.deim = pass;
+    o.method = PHGMG_METHOD_GMG_QM; o.r = pass ? 16 : 8; o.rn = 8; o.lambda = 1e-6; o.hyper_reduce = pass;
     o.deim_allow_negative = 1;
     CHECK_RC(phgmg_reduce(&red, &t.sys, X, t.sys.N, 301, &o, NULL, NULL), PHGMG_OK);
     if (!red) continue;
@@ -411,7 +411,7 @@ TEST(test_online_never_allocates) {
     long calls;
     int n, i;
     memset(&o, 0, sizeof o);
-    o.method = meths[k]; o.r = 12; o.deim = 1; o.deim_allow_negative = 1; o.lambda = 1e-3;
+    o.method = meths[k]; o.r = 12; o.hyper_reduce = 1; o.deim_allow_negative = 1; o.lambda = 1e-3;
     CHECK_RC(phgmg_reduce(&red, &t.sys, X, t.sys.N, 301, &o, NULL, NULL), PHGMG_OK);
     if (!red) continue;
     CHECK(phgmg_rom_stepper_memsize(phgmg_reduced_rom(red)) <= sizeof mem);

@@ -869,7 +869,7 @@ TEST(test_deim_negative_weight) {
     for (i = n; i < N; ++i) X[i + j * N] = th_rand();
   }
   /* the default hyper-reduction (ECSW) keeps every weight >= 0 here */
-  o = ropts(PHGMG_METHOD_GMG_POD, 2); o.deim = 1;
+  o = ropts(PHGMG_METHOD_GMG_POD, 2); o.hyper_reduce = 1;
   memset(&info, 0, sizeof info);
   CHECK_RC(phgmg_reduce(&red, &M.sys, X, N, ns, &o, &info, NULL), PHGMG_OK);
   CHECK(info.hyper_method == PHGMG_HYPER_ECSW && info.deim_negative == 0 && info.hyper_min_weight > 0.0);
@@ -888,15 +888,15 @@ TEST(test_deim_negative_weight) {
   }
   phgmg_reduced_destroy(red);
   /* GMG-QM and SP2 see the same gradient snapshots */
-  o = ropts(PHGMG_METHOD_GMG_QM, 2); o.rn = 1; o.deim = 1; o.hyper = PHGMG_HYPER_QDEIM;
+  o = ropts(PHGMG_METHOD_GMG_QM, 2); o.rn = 1; o.hyper_reduce = 1; o.hyper = PHGMG_HYPER_QDEIM;
   EXPECT(reduce_g(&M.sys, X, N, ns, &o, &info), PHGMG_ERR_NEGATIVE_WEIGHT);
-  o = ropts(PHGMG_METHOD_SP2, 3); o.deim = 1; o.hyper = PHGMG_HYPER_QDEIM;
+  o = ropts(PHGMG_METHOD_SP2, 3); o.hyper_reduce = 1; o.hyper = PHGMG_HYPER_QDEIM;
   EXPECT(reduce_g(&M.sys, X, N, ns, &o, &info), PHGMG_ERR_NEGATIVE_WEIGHT);
   /* a cached DEIM result (opts.deim_pts/deim_w) is checked the same way */
   {
     int cpts[2] = {0, 2};
     double cw[2] = {1.5, -0.2};
-    o = ropts(PHGMG_METHOD_GMG_POD, 2); o.deim = 1;
+    o = ropts(PHGMG_METHOD_GMG_POD, 2); o.hyper_reduce = 1;
     o.deim_pts = cpts; o.deim_w = cw; o.deim_count = 2;
     guard(cpts, sizeof cpts); guard(cw, sizeof cw);
     EXPECT(reduce_g(&M.sys, X, N, ns, &o, &info), PHGMG_ERR_NEGATIVE_WEIGHT);
@@ -1250,7 +1250,7 @@ TEST(test_rom_images) {
                                              {PHGMG_METHOD_GMG_POD, PHGMG_METHOD_GMG_QM, PHGMG_METHOD_SP2}};
       phgmg_reduce_opts o = ropts(meth[pass][k], 3);
       phgmg_reduced *red = NULL;
-      o.dt = 0.1; o.deim = pass && k < 2; o.deim_allow_negative = 1;
+      o.dt = 0.1; o.hyper_reduce = pass && k < 2; o.deim_allow_negative = 1;
       CHECK_RC(phgmg_reduce(&red, s, X, N, ns, &o, NULL, NULL), PHGMG_OK);
       if (red) check_image(phgmg_reduced_rom(red), names[pass][k], dir);
       if (red && pass == 0 && k == 0) CHECK(phgmg_reduced_rom(red)->Phi != NULL);
@@ -1465,13 +1465,13 @@ TEST(test_oom_reduce) {
     memset(&c, 0, sizeof c);
     c.sys = k < 3 ? &L.sys : &M.sys; c.X = k < 3 ? XL : XM; c.N = c.sys->N; c.ns = ns;
     c.o = ropts(meth[k], 4);
-    c.o.dt = 0.1; c.o.deim = k >= 3 && k < 6; c.o.deim_allow_negative = 1;
+    c.o.dt = 0.1; c.o.hyper_reduce = k >= 3 && k < 6; c.o.deim_allow_negative = 1;
     CHECK(oom_sweep(name[k], op_reduce, undo_reduce, &c) > 5);
   }
   /* the reduced model's own evaluations that allocate */
   memset(&c, 0, sizeof c);
   c.sys = &M.sys; c.X = XM; c.N = 12; c.ns = ns;
-  c.o = ropts(PHGMG_METHOD_GMG_QM, 4); c.o.deim = 1; c.o.deim_allow_negative = 1;
+  c.o = ropts(PHGMG_METHOD_GMG_QM, 4); c.o.hyper_reduce = 1; c.o.deim_allow_negative = 1;
   CHECK_RC(phgmg_reduce(&c.red, &M.sys, XM, 12, ns, &c.o, NULL, &g_fa_alloc), PHGMG_OK);
   if (c.red) {
     c.out = (double *)malloc(sizeof(double) * 12 * 4);

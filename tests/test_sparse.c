@@ -350,7 +350,7 @@ TEST(test_sparse_chain_reduce) {
     o.r = 8;
     o.rn = 4;
     o.lambda = 1e-6;
-    o.deim = k == 1;
+    o.hyper_reduce = k == 1;
     o.deim_allow_negative = 1;
     CHECK_RC(reduce_errors(&c.D.sys, Xd, Yd, ns, &o, &ed, &eyd), PHGMG_OK);
     CHECK_RC(reduce_errors(&c.sys, Xs, Yd, ns, &o, &es, &eys), PHGMG_OK);

@@ -184,7 +184,7 @@ TEST(test_study_nonlinear) {
     phgmg_reduce_opts o;
     memset(&o, 0, sizeof o);
     o.method = meth[j]; o.r = 8; o.rn = 4; o.lambda = 1e-4;
-    o.deim = 1; o.hyper = PHGMG_HYPER_QDEIM; o.deim_tol = 1e-8; o.deim_allow_negative = 1;
+    o.hyper_reduce = 1; o.hyper = PHGMG_HYPER_QDEIM; o.deim_tol = 1e-8; o.deim_allow_negative = 1;
     ts_case(st, &M.sys, X, ns, o, dt, nsteps, 1);
   }
   phgmg_study_destroy(st);
