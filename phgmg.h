@@ -754,11 +754,12 @@
            phgmg_rom_stepper_init, phgmg_rom_stepper_reset,
            phgmg_rom_stage_times, phgmg_rom_step
    reduce: phgmg_pod, phgmg_pod_randomized, phgmg_adjust_snapshots,
-           phgmg_runs_columns, phgmg_simulate_inputs,
+           phgmg_runs_columns, phgmg_simulate_inputs, phgmg_simulate_run,
            phgmg_reduce_opts_default, phgmg_reduce, phgmg_reduced_destroy,
            phgmg_reduced_rom, phgmg_reduced_N, phgmg_reduced_lift,
            phgmg_reduced_restrict, phgmg_reduced_dphi, phgmg_reduced_W,
-           phgmg_reduced_simulate, phgmg_reduced_validate, phgmg_rel_error,
+           phgmg_reduced_simulate, phgmg_reduced_simulate_run,
+           phgmg_reduced_validate, phgmg_rel_error,
            phgmg_err_red, phgmg_err_proj, phgmg_err_lowerbound,
            phgmg_err_energy, phgmg_study_create, phgmg_study_destroy,
            phgmg_study_basis, phgmg_study_reduce, phgmg_study_errors,
@@ -767,7 +768,7 @@
    linear: phgmg_lyap, phgmg_care, phgmg_lyap_residual, phgmg_care_residual,
            phgmg_ph_abc, phgmg_bt, phgmg_prbt_riccati, phgmg_prbt,
            phgmg_linear_basis, phgmg_ss_transfer, phgmg_reduced_abc,
-           phgmg_ss_error
+           phgmg_ss_error, phgmg_ss_compare
    export: phgmg_rom_serialized_size, phgmg_rom_serialize,
            phgmg_rom_deserialize_size, phgmg_rom_deserialize, phgmg_rom_save,
            phgmg_rom_load, phgmg_rom_export_c
@@ -1760,6 +1761,26 @@ typedef struct phgmg_run {
   int nsteps;
 } phgmg_run;
 
+/* Where a simulation puts its results (each pointer may be NULL): X the
+   N x (nsteps + 1) states (ld N; r x (nsteps + 1) for a reduced model), Y the
+   m x (nsteps + 1) outputs (ld m), energy the bookkeeping of phgmg_simulate;
+   steps_done (written) how many steps succeeded. stats: one of the two,
+   matching the model simulated (the other is ignored). */
+typedef struct phgmg_sim_out {
+  double *X, *Y;
+  const phgmg_energy *energy;
+  phgmg_gl3_stats *stats;       /* phgmg_simulate_run                    */
+  phgmg_rom_stats *rom_stats;   /* phgmg_reduced_simulate_run            */
+  int steps_done;
+} phgmg_sim_out;
+
+/* phgmg_simulate with the run described by a phgmg_run (u, user, x0 (NULL:
+   0), t0, dt, nsteps) and the outputs gathered in out (may be NULL: only the
+   result code). Same results and codes as phgmg_simulate. */
+PHGMG_DEF phgmg_result phgmg_simulate_run(const phgmg_ph_system *sys, const phgmg_run *run,
+                                          const phgmg_gl3_opts *opts, phgmg_sim_out *out,
+                                          const phgmg_allocator *alloc);
+
 /* Columns of a snapshot set of nrun runs: sum of (nsteps + 1); -1 for a bad
    run (nsteps < 0, dt not positive and finite). */
 PHGMG_DEF int phgmg_runs_columns(int nrun, const phgmg_run *runs);
@@ -2027,6 +2048,11 @@ PHGMG_DEF phgmg_result phgmg_reduced_simulate(const phgmg_reduced *red, const do
                                               double tol, int max_iter, double *XR, double *Y,
                                               const phgmg_energy *energy, phgmg_rom_stats *stats,
                                               const phgmg_allocator *alloc);
+/* The same with the run in a phgmg_run (run->x0: the reduced initial state
+   xr0, r values; NULL: 0) and the outputs in out (out->X receives XR,
+   out->rom_stats the stepper's totals; may be NULL). tol, max_iter as above. */
+PHGMG_DEF phgmg_result phgmg_reduced_simulate_run(const phgmg_reduced *red, const phgmg_run *run, double tol,
+                                                  int max_iter, phgmg_sim_out *out, const phgmg_allocator *alloc);
 
 /* --- a check before shipping --- */
 typedef struct phgmg_validation {
@@ -2481,6 +2507,21 @@ PHGMG_DEF phgmg_result phgmg_ss_error(int n1, const double *A1, const double *B1
                                       int m, int p, int nw, double wmin, double wmax, double *hinf,
                                       double *hinf_ref, double *h2, double *h2_ref,
                                       const phgmg_allocator *alloc);
+/* A state-space model x' = A x + B u, y = C x (A n x n, B n x m, C p x n,
+   column-major, ld = rows) and the error measures of phgmg_ss_error. */
+typedef struct phgmg_ss {
+  int n, m, p;
+  const double *A, *B, *C;
+} phgmg_ss;
+typedef struct phgmg_ss_errors {
+  double hinf, hinf_ref; /* sampled H-infinity norm of G1 - G2 and of G1 */
+  double h2, h2_ref;     /* H2 norm of G1 - G2 and of G1                 */
+} phgmg_ss_errors;
+/* phgmg_ss_error for two models given as phgmg_ss (PHGMG_ERR_SIZE when their
+   m or p differ) on nw log-spaced frequencies in [wmin, wmax]; err (written
+   on success) receives all four measures. */
+PHGMG_DEF phgmg_result phgmg_ss_compare(const phgmg_ss *g1, const phgmg_ss *g2, int nw, double wmin, double wmax,
+                                        phgmg_ss_errors *err, const phgmg_allocator *alloc);
 
 #ifdef __cplusplus
 }
@@ -8297,6 +8338,26 @@ PHGMG__PRIV void phgmg__output_feedthrough(const phgmg_ph_system *sys, const dou
   }
 }
 
+PHGMG_DEF phgmg_result phgmg_simulate_run(const phgmg_ph_system *sys, const phgmg_run *run,
+                                          const phgmg_gl3_opts *opts, phgmg_sim_out *out,
+                                          const phgmg_allocator *alloc) {
+  phgmg_sim_out none;
+  double *z = NULL;
+  phgmg_result rc;
+  if (!run || !sys) return PHGMG_ERR_INVALID_ARG;
+  if (!out) { memset(&none, 0, sizeof none); out = &none; }
+  out->steps_done = 0;
+  if (!run->x0 && sys->N > 0) {   /* x0 = 0 */
+    z = phgmg__dalloc(alloc, (size_t)sys->N);
+    if (!z) return PHGMG_ERR_NOMEM;
+    memset(z, 0, sizeof(double) * (size_t)sys->N);
+  }
+  rc = phgmg_simulate(sys, run->x0 ? run->x0 : z, run->t0, run->dt, run->nsteps, run->u, run->user, opts, out->X,
+                      out->Y, out->energy, out->stats, &out->steps_done, alloc);
+  phgmg__free(alloc, z);
+  return rc;
+}
+
 PHGMG_DEF phgmg_result phgmg_simulate(const phgmg_ph_system *sys, const double *x0, double t0,
                                       double dt, int nsteps, phgmg_input_fn uf, void *uuser,
                                       const phgmg_gl3_opts *opts, double *X, double *Y,
@@ -13411,6 +13472,30 @@ PHGMG_DEF phgmg_result phgmg_reduced_W(const phgmg_reduced *red, const double *x
   return rc;
 }
 
+PHGMG_DEF phgmg_result phgmg_reduced_simulate_run(const phgmg_reduced *red, const phgmg_run *run, double tol,
+                                                  int max_iter, phgmg_sim_out *out, const phgmg_allocator *alloc) {
+  phgmg_sim_out none;
+  phgmg_rom_stats st;
+  phgmg_result rc;
+  if (!run) return PHGMG_ERR_INVALID_ARG;
+  if (!out) { memset(&none, 0, sizeof none); out = &none; }
+  memset(&st, 0, sizeof st);
+  if (!run->x0 && red) {   /* xr0 = 0 */
+    double *z = phgmg__dalloc(alloc, (size_t)phgmg_reduced_rom(red)->r);
+    if (!z) return PHGMG_ERR_NOMEM;
+    memset(z, 0, sizeof(double) * (size_t)phgmg_reduced_rom(red)->r);
+    rc = phgmg_reduced_simulate(red, z, run->t0, run->dt, run->nsteps, run->u, run->user, tol, max_iter, out->X,
+                                out->Y, out->energy, &st, alloc);
+    phgmg__free(alloc, z);
+  } else {
+    rc = phgmg_reduced_simulate(red, run->x0, run->t0, run->dt, run->nsteps, run->u, run->user, tol, max_iter,
+                                out->X, out->Y, out->energy, &st, alloc);
+  }
+  out->steps_done = (int)st.steps;   /* the successful steps */
+  if (out->rom_stats) *out->rom_stats = st;
+  return rc;
+}
+
 PHGMG_DEF phgmg_result phgmg_reduced_simulate(const phgmg_reduced *red, const double *xr0, double t0,
                                               double dt, int nsteps, phgmg_input_fn uf, void *uuser,
                                               double tol, int max_iter, double *XR, double *Y,
@@ -15576,6 +15661,18 @@ PHGMG__PRIV double phgmg__zsigma_max(int p, int m, const double *E) {
     }
   if (phgmg_sym_eig(2 * m, H, 2 * m, w, NULL, 0) != PHGMG_OK) return (double)NAN;
   return sqrt(w[2 * m - 1] > 0.0 ? w[2 * m - 1] : 0.0);
+}
+
+PHGMG_DEF phgmg_result phgmg_ss_compare(const phgmg_ss *g1, const phgmg_ss *g2, int nw, double wmin, double wmax,
+                                        phgmg_ss_errors *err, const phgmg_allocator *alloc) {
+  phgmg_ss_errors e;
+  phgmg_result rc;
+  if (!g1 || !g2 || !err) return PHGMG_ERR_INVALID_ARG;
+  if (g1->m != g2->m || g1->p != g2->p) return PHGMG_ERR_SIZE;
+  rc = phgmg_ss_error(g1->n, g1->A, g1->B, g1->C, g2->n, g2->A, g2->B, g2->C, g1->m, g1->p, nw, wmin, wmax,
+                      &e.hinf, &e.hinf_ref, &e.h2, &e.h2_ref, alloc);
+  if (rc == PHGMG_OK) *err = e;
+  return rc;
 }
 
 PHGMG_DEF phgmg_result phgmg_ss_error(int n1, const double *A1, const double *B1, const double *C1,

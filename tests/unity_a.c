@@ -9,6 +9,7 @@
    A test file missing from every unit fails the link (tests/suites.inc
    declares its suite). */
 #define _POSIX_C_SOURCE 200809L /* test_defects, test_npy */
+#include "test_api_structs.c"
 #include "test_core.c"
 #include "test_defects.c"
 #include "test_defects3.c"
