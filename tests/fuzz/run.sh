@@ -77,7 +77,15 @@ if [ $have_libfuzzer = 1 ]; then
     files=$(find "$out/corpus_$t" -type f | wc -l)
     if [ $rc -ne 0 ]; then
       echo "fuzz: $t: FINDING (exit $rc) after ${runs:-?} runs; see $log and $out/crash-$t-*"
+      # what failed (the harness's invariant, the sanitizer's report) and the
+      # input itself, so that a finding on another machine can be replayed
+      grep -m 5 -e 'invariant violated' -e 'ERROR:' -e 'runtime error' -e 'SUMMARY' "$log"
       tail -n 40 "$log"
+      for c in "$out"/crash-"$t"-*; do
+        [ -f "$c" ] || continue
+        echo "fuzz: $t: input $c (base64, replay: base64 -d > f; $bin f):"
+        base64 "$c" | head -c 12000; echo
+      done
       exit 1
     fi
     if [ "$secs" = 0 ]; then echo "fuzz: $t: ${runs:-?} corpus inputs replayed, ${cov:-cov: ?}, no finding"
