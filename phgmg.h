@@ -999,12 +999,15 @@ PHGMG_DEF phgmg_result phgmg_sym_eig(int n, double *A, int lda, double *w, doubl
 extern "C" {
 #endif
 
-typedef enum phgmg_storage { PHGMG_DENSE = 0, PHGMG_BANDED = 1 } phgmg_storage;
+/* Every enumerated choice ends in a _COUNT: one more than its largest value
+   (not a choice itself), for range checks and tables. */
+typedef enum phgmg_storage { PHGMG_DENSE = 0, PHGMG_BANDED = 1, PHGMG_STORAGE_COUNT } phgmg_storage;
 
 typedef enum phgmg_nl_kind {
   PHGMG_NL_NONE = 0,      /* quadratic Hamiltonian only                          */
   PHGMG_NL_SEPARABLE = 1, /* H_nl(x) = sum_k w_k phi_k(x[idx_k])  (DEIM needs this) */
-  PHGMG_NL_GENERAL = 2    /* H_nl, grad and Hessian by callbacks                 */
+  PHGMG_NL_GENERAL = 2,   /* H_nl, grad and Hessian by callbacks                 */
+  PHGMG_NL_COUNT
 } phgmg_nl_kind;
 
 /* Scalar callbacks of a separable nonlinear part: for term k (0-based, over the
@@ -1483,14 +1486,15 @@ PHGMG_DEF void phgmg_gl3_coefficients(double c[3], double b[3], double A[9]);
 extern "C" {
 #endif
 
-typedef enum phgmg_rom_kind { PHGMG_ROM_LINEAR = 1, PHGMG_ROM_QUADRATIC = 2 } phgmg_rom_kind;
+typedef enum phgmg_rom_kind { PHGMG_ROM_LINEAR = 1, PHGMG_ROM_QUADRATIC = 2, PHGMG_ROM_KIND_COUNT } phgmg_rom_kind;
 typedef enum phgmg_method {
   PHGMG_METHOD_GMG_POD = 1, /* phi = [B, Vbar] x, GMG reduction (paper 4.2.1)         */
   PHGMG_METHOD_GMG_QM = 2,  /* quadratic manifold, GMG reduction (paper 4.2.2)        */
   PHGMG_METHOD_SP1 = 3,     /* SP1-POD: phi = V_POD x, W = QV(V^TQV)^-1 (eq. 5.3)     */
   PHGMG_METHOD_SP2 = 4,     /* SP2-POD: W = V_gradH (V_POD^T V_gradH)^-1 (manual 8.8) */
   PHGMG_METHOD_GMG_MANIFOLD = 5, /* your own manifold phi = [B, V1] x + V2 eta(x2), GMG reduction */
-  PHGMG_METHOD_PRBT = 6     /* positive-real balanced truncation, pH form (phgmg_prbt, >>linear) */
+  PHGMG_METHOD_PRBT = 6,    /* positive-real balanced truncation, pH form (phgmg_prbt, >>linear) */
+  PHGMG_METHOD_COUNT
 } phgmg_method;
 
 /* A manifold map eta: R^p -> R^rn (p = r - m) and its derivatives at x2:
@@ -1745,7 +1749,7 @@ typedef enum phgmg_hyper {
   PHGMG_HYPER_ECSW = 0,   /* default: w >= 0 by NNLS fit of the reduced gradient (ECSW) */
   PHGMG_HYPER_QDEIM = 1,  /* structure-preserving DEIM, Q-DEIM points (the paper's)     */
   PHGMG_HYPER_GREEDY = 2, /* structure-preserving DEIM, greedy DEIM points             */
-  PHGMG_HYPER_COUNT       /* number of kinds (not a kind)                              */
+  PHGMG_HYPER_COUNT
 } phgmg_hyper;
 
 /* One run of the full model: input u (NULL: u = 0) from x0 (NULL: 0) at t0,
@@ -1797,7 +1801,7 @@ typedef enum phgmg_manifold {
   PHGMG_MANIFOLD_POD = 0,    /* the paper's hierarchical POD                       */
   PHGMG_MANIFOLD_GREEDY = 1, /* greedy linear part (Schwerdtner & Peherstorfer 2024) */
   PHGMG_MANIFOLD_ALTMIN = 2, /* alternating minimization of V1, V2 and M           */
-  PHGMG_MANIFOLD_COUNT       /* number of constructions (not one)                  */
+  PHGMG_MANIFOLD_COUNT
 } phgmg_manifold;
 
 /* phgmg_reduce_opts.rn: V2 over the whole residual of the snapshots (see rn). */
@@ -2440,7 +2444,8 @@ typedef enum phgmg_basis_kind {
   PHGMG_BASIS_FREQ = 1,     /* Re, Im of (i w I - A)^{-1} B, w log-spaced      */
   PHGMG_BASIS_IMPULSE = 2,  /* x(t) = e^{At} B sampled by GL3 steps            */
   PHGMG_BASIS_BALANCED = 3, /* balanced right basis T of phgmg_bt, in order    */
-  PHGMG_BASIS_H2 = 4        /* the GMG model of least H2 error (one order)     */
+  PHGMG_BASIS_H2 = 4,       /* the GMG model of least H2 error (one order)     */
+  PHGMG_BASIS_COUNT
 } phgmg_basis_kind;
 
 /* Every field 0 takes its default; a negative count, a negative, NaN or
