@@ -5656,6 +5656,16 @@ typedef struct phgmg__spsym {
   int *jr_p, *jr_i; double *jr_x; /* J - R, CSC, internal order        */
   int *q_p, *q_i; double *q_x;    /* Q, CSC, internal order            */
   int *k_p, *k_i;                 /* pattern of M plus the diagonal    */
+  /* The factored matrix (order nf, pattern f_p/f_i in its own numbering:
+     internal index fidx[c] for column c): K itself (na = 0, f_p = k_p), or
+     the Schur complement of the condensed block (see >>sparse). */
+  int nf, na;
+  int *f_p, *f_i, *f_d;           /* pattern; f_d[c]: diagonal entry   */
+  int *fidx, *bpos;               /* bpos[v]: f index, or -1 - a index */
+  int *aidx;                      /* condensed states (internal index) */
+  int *ad_k;                      /* Mx index of K(a, a)               */
+  int *ca_p, *ca_i, *ca_k;        /* column a of K: rows, Mx indices   */
+  int *ra_p, *ra_i, *ra_k;        /* row a of K: columns, Mx indices   */
   int *perm;                      /* fill position k: internal perm[k] */
   int nsup;
   int *sfirst, *sparent, *scp, *sch, *srp, *srow; /* sch[scp[s]..scp[s+1]): children, last first */
@@ -5670,7 +5680,12 @@ PHGMG__PRIV void phgmg__spsym_free(const phgmg_allocator *al, phgmg__spsym *S) {
   if (!S) return;
   phgmg__free(al, S->jr_p); phgmg__free(al, S->jr_i); phgmg__free(al, S->jr_x);
   phgmg__free(al, S->q_p); phgmg__free(al, S->q_i); phgmg__free(al, S->q_x);
+  if (S->f_p != S->k_p) { phgmg__free(al, S->f_p); phgmg__free(al, S->f_i); }
   phgmg__free(al, S->k_p); phgmg__free(al, S->k_i); phgmg__free(al, S->perm);
+  phgmg__free(al, S->f_d); phgmg__free(al, S->fidx); phgmg__free(al, S->bpos);
+  phgmg__free(al, S->aidx); phgmg__free(al, S->ad_k);
+  phgmg__free(al, S->ca_p); phgmg__free(al, S->ca_i); phgmg__free(al, S->ca_k);
+  phgmg__free(al, S->ra_p); phgmg__free(al, S->ra_i); phgmg__free(al, S->ra_k);
   phgmg__free(al, S->sfirst); phgmg__free(al, S->sparent); phgmg__free(al, S->scp); phgmg__free(al, S->sch);
   phgmg__free(al, S->srp); phgmg__free(al, S->srow); phgmg__free(al, S->lptr);
   phgmg__free(al, S->amp); phgmg__free(al, S->ami); phgmg__free(al, S->amd);
@@ -5768,17 +5783,17 @@ PHGMG__PRIV phgmg_result phgmg__spsym_kpattern(phgmg__spsym *S, const phgmg_allo
   return PHGMG_OK;
 }
 
-/* Symmetrised adjacency (CSR, no diagonal) of the pattern of K. */
-PHGMG__PRIV phgmg_result phgmg__spsym_graph(const phgmg__spsym *S, int **gp, int **gi,
+/* Symmetrised adjacency (CSR, no diagonal) of an n x n CSC pattern. */
+PHGMG__PRIV phgmg_result phgmg__spsym_graph(int n, const int *kp, const int *ki, int **gp, int **gi,
                                             const phgmg_allocator *al) {
-  int n = S->n, j, p, *cnt = phgmg__ialloc(al, (size_t)n + 1), *mark = phgmg__ialloc(al, (size_t)n);
+  int j, p, *cnt = phgmg__ialloc(al, (size_t)n + 1), *mark = phgmg__ialloc(al, (size_t)n);
   size_t nz = 0;
   *gp = NULL; *gi = NULL;
   if (!cnt || !mark) { phgmg__free(al, cnt); phgmg__free(al, mark); return PHGMG_ERR_NOMEM; }
   for (j = 0; j <= n; ++j) cnt[j] = 0;
   for (j = 0; j < n; ++j)
-    for (p = S->k_p[j]; p < S->k_p[j + 1]; ++p)
-      if (S->k_i[p] != j) { cnt[S->k_i[p]]++; cnt[j]++; }
+    for (p = kp[j]; p < kp[j + 1]; ++p)
+      if (ki[p] != j) { cnt[ki[p]]++; cnt[j]++; }
   *gp = phgmg__ialloc(al, (size_t)n + 1);
   for (j = 0; j < n; ++j) nz += (size_t)cnt[j];
   *gi = phgmg__ialloc(al, nz + 1);
@@ -5786,8 +5801,8 @@ PHGMG__PRIV phgmg_result phgmg__spsym_graph(const phgmg__spsym *S, int **gp, int
   (*gp)[0] = 0;
   for (j = 0; j < n; ++j) { (*gp)[j + 1] = (*gp)[j] + cnt[j]; cnt[j] = (*gp)[j]; }
   for (j = 0; j < n; ++j)
-    for (p = S->k_p[j]; p < S->k_p[j + 1]; ++p) {
-      int r = S->k_i[p];
+    for (p = kp[j]; p < kp[j + 1]; ++p) {
+      int r = ki[p];
       if (r == j) continue;
       (*gi)[cnt[r]++] = j;
       (*gi)[cnt[j]++] = r;
@@ -5837,7 +5852,7 @@ PHGMG__PRIV void phgmg__colcounts(int n, const int *ap, const int *ai, const int
 PHGMG__PRIV phgmg_result phgmg__spsym_supernodes(phgmg__spsym *S, const int *ap, const int *ai,
                                                  const int *iperm, const int *parent, const int *cnt,
                                                  const phgmg_allocator *al) {
-  int n = S->n, j, s, p, ns = 0;
+  int n = S->nf, j, s, p, ns = 0;
   int *nch = phgmg__ialloc(al, (size_t)n), *sof = phgmg__ialloc(al, (size_t)n);
   int *mark = phgmg__ialloc(al, (size_t)n);
   size_t cap = 0, nz = 0, zeros = 0;
@@ -5947,8 +5962,8 @@ done:
 /* Assembly map: each entry of K goes to the front of the supernode of
    min(row, column) (fill order), at its (row, column) position there. */
 PHGMG__PRIV phgmg_result phgmg__spsym_assembly(phgmg__spsym *S, const int *iperm, const phgmg_allocator *al) {
-  int n = S->n, ns = S->nsup, j, p, s;
-  int nz = S->k_p[n];
+  int n = S->nf, ns = S->nsup, j, p, s;
+  int nz = S->f_p[n];
   int *sof = phgmg__ialloc(al, (size_t)n), *pos = phgmg__ialloc(al, (size_t)n), *fill;
   S->amp = phgmg__ialloc(al, (size_t)ns + 1);
   S->ami = phgmg__ialloc(al, (size_t)nz);
@@ -5962,15 +5977,15 @@ PHGMG__PRIV phgmg_result phgmg__spsym_assembly(phgmg__spsym *S, const int *iperm
     for (j = S->sfirst[s]; j < S->sfirst[s + 1]; ++j) sof[j] = s;
   for (s = 0; s <= ns; ++s) S->amp[s] = 0;
   for (j = 0; j < n; ++j)
-    for (p = S->k_p[j]; p < S->k_p[j + 1]; ++p) {
-      int a = iperm[S->k_i[p]], b = iperm[j];
+    for (p = S->f_p[j]; p < S->f_p[j + 1]; ++p) {
+      int a = iperm[S->f_i[p]], b = iperm[j];
       S->amp[sof[a < b ? a : b] + 1]++;
     }
   for (s = 0; s < ns; ++s) S->amp[s + 1] += S->amp[s];
   for (s = 0; s < ns; ++s) fill[s] = S->amp[s];
   for (j = 0; j < n; ++j)
-    for (p = S->k_p[j]; p < S->k_p[j + 1]; ++p) {
-      int a = iperm[S->k_i[p]], b = iperm[j];
+    for (p = S->f_p[j]; p < S->f_p[j + 1]; ++p) {
+      int a = iperm[S->f_i[p]], b = iperm[j];
       S->ami[fill[sof[a < b ? a : b]]++] = p;
     }
   for (s = 0; s < ns; ++s) {
@@ -5981,9 +5996,9 @@ PHGMG__PRIV phgmg_result phgmg__spsym_assembly(phgmg__spsym *S, const int *iperm
       int e = S->ami[q], col = -1, a, b;
       /* column of entry e: binary search in k_p */
       int lo = 0, hi = n;
-      while (hi - lo > 1) { int mid = (lo + hi) / 2; if (S->k_p[mid] <= e) lo = mid; else hi = mid; }
+      while (hi - lo > 1) { int mid = (lo + hi) / 2; if (S->f_p[mid] <= e) lo = mid; else hi = mid; }
       col = lo;
-      a = iperm[S->k_i[e]];
+      a = iperm[S->f_i[e]];
       b = iperm[col];
       S->amd[q] = (size_t)pos[a] + (size_t)pos[b] * (size_t)nf;
     }
@@ -5992,13 +6007,142 @@ PHGMG__PRIV phgmg_result phgmg__spsym_assembly(phgmg__spsym *S, const int *iperm
   return PHGMG_OK;
 }
 
+/* States condensed first (see >>sparse): an independent set of the graph
+   of K (no two joined, so K's block on them is diagonal), taken greedily in
+   breadth-first order (on a bipartite graph, such as positions and momenta
+   of a mechanical model, one whole side), only states of degree at most
+   PHGMG__SP_CONDENSE_DEG. Sets na, aidx, bpos, fidx, nf. */
+#define PHGMG__SP_CONDENSE_DEG 32
+PHGMG__PRIV phgmg_result phgmg__sp_condense_select(phgmg__spsym *S, const int *gp, const int *gi,
+                                                   const phgmg_allocator *al) {
+  int n = S->n, v, head = 0, tail = 0, r, p;
+  int *q = phgmg__ialloc(al, (size_t)n), *st = phgmg__ialloc(al, (size_t)n);
+  phgmg_result rc = PHGMG_ERR_NOMEM;
+  S->na = 0; S->nf = 0;
+  S->aidx = phgmg__ialloc(al, (size_t)n + 1);
+  S->fidx = phgmg__ialloc(al, (size_t)n + 1);
+  S->bpos = phgmg__ialloc(al, (size_t)n + 1);
+  if (!q || !st || !S->aidx || !S->fidx || !S->bpos) goto done;
+  for (v = 0; v < n; ++v) st[v] = 0; /* 0 unseen, 1 queued, 2 chosen, 3 blocked */
+  for (r = 0; r < n; ++r) {
+    if (st[r]) continue;
+    st[r] = 1; q[tail++] = r;
+    while (head < tail) {
+      int u = q[head++], free_ = gp[u + 1] - gp[u] <= PHGMG__SP_CONDENSE_DEG;
+      for (p = gp[u]; p < gp[u + 1] && free_; ++p) if (st[gi[p]] == 2) free_ = 0;
+      st[u] = free_ ? 2 : 3;
+      for (p = gp[u]; p < gp[u + 1]; ++p) if (!st[gi[p]]) { st[gi[p]] = 1; q[tail++] = gi[p]; }
+    }
+  }
+  for (v = 0; v < n; ++v) {
+    if (st[v] == 2) { S->bpos[v] = -1 - S->na; S->aidx[S->na++] = v; }
+    else { S->bpos[v] = S->nf; S->fidx[S->nf++] = v; }
+  }
+  rc = PHGMG_OK;
+done:
+  phgmg__free(al, q); phgmg__free(al, st);
+  return rc;
+}
+
+/* The condensed block's couplings (column a and row a of K outside the
+   diagonal, K(a, a)) and the pattern of the Schur complement
+   K_bb - K_ba K_aa^{-1} K_ab (f_p/f_i, sorted columns). */
+PHGMG__PRIV phgmg_result phgmg__sp_condense_pattern(phgmg__spsym *S, const phgmg_allocator *al) {
+  const int n = S->n, na = S->na, nf = S->nf;
+  int t, j, p, q, pass, nz = 0, *mark = phgmg__ialloc(al, (size_t)n + 1);
+  S->ad_k = phgmg__ialloc(al, (size_t)na + 1);
+  S->ca_p = phgmg__ialloc(al, (size_t)na + 1);
+  S->ra_p = phgmg__ialloc(al, (size_t)na + 1);
+  S->f_p = phgmg__ialloc(al, (size_t)nf + 1);
+  if (!mark || !S->ad_k || !S->ca_p || !S->ra_p || !S->f_p) { phgmg__free(al, mark); return PHGMG_ERR_NOMEM; }
+  for (t = 0; t <= na; ++t) { S->ca_p[t] = 0; S->ra_p[t] = 0; }
+  for (j = 0; j < n; ++j)
+    for (p = S->k_p[j]; p < S->k_p[j + 1]; ++p) {
+      int r = S->k_i[p];
+      if (r == j) { if (S->bpos[j] < 0) S->ad_k[-1 - S->bpos[j]] = p; }
+      else if (S->bpos[j] < 0) S->ca_p[-S->bpos[j]]++;   /* column a */
+      else if (S->bpos[r] < 0) S->ra_p[-S->bpos[r]]++;   /* row a    */
+    }
+  for (t = 0; t < na; ++t) { S->ca_p[t + 1] += S->ca_p[t]; S->ra_p[t + 1] += S->ra_p[t]; }
+  S->ca_i = phgmg__ialloc(al, (size_t)S->ca_p[na] + 1);
+  S->ca_k = phgmg__ialloc(al, (size_t)S->ca_p[na] + 1);
+  S->ra_i = phgmg__ialloc(al, (size_t)S->ra_p[na] + 1);
+  S->ra_k = phgmg__ialloc(al, (size_t)S->ra_p[na] + 1);
+  if (!S->ca_i || !S->ca_k || !S->ra_i || !S->ra_k) { phgmg__free(al, mark); return PHGMG_ERR_NOMEM; }
+  for (t = 0; t < na; ++t) mark[t] = S->ra_p[t];
+  for (j = 0; j < n; ++j)
+    for (p = S->k_p[j]; p < S->k_p[j + 1]; ++p) {
+      int r = S->k_i[p];
+      if (r != j && S->bpos[j] >= 0 && S->bpos[r] < 0) {
+        t = -1 - S->bpos[r];
+        S->ra_i[mark[t]] = j; S->ra_k[mark[t]++] = p;
+      }
+    }
+  for (t = 0; t < na; ++t) {
+    int v = S->aidx[t], e = S->ca_p[t];
+    for (p = S->k_p[v]; p < S->k_p[v + 1]; ++p)
+      if (S->k_i[p] != v) { S->ca_i[e] = S->k_i[p]; S->ca_k[e++] = p; }
+  }
+  for (pass = 0; pass < 2; ++pass) {
+    for (j = 0; j < nf; ++j) mark[j] = -1;
+    nz = 0;
+    for (j = 0; j < nf; ++j) {
+      int v = S->fidx[j], start = nz;
+      if (pass) S->f_p[j] = nz;
+#define PHGMG__SC_ADD(b) do { int b_ = (b); if (mark[b_] != j) { mark[b_] = j; if (pass) S->f_i[nz] = b_; ++nz; } } while (0)
+      for (p = S->k_p[v]; p < S->k_p[v + 1]; ++p) {
+        int r = S->k_i[p];
+        if (S->bpos[r] >= 0) PHGMG__SC_ADD(S->bpos[r]);
+        else for (t = -1 - S->bpos[r], q = S->ca_p[t]; q < S->ca_p[t + 1]; ++q) PHGMG__SC_ADD(S->bpos[S->ca_i[q]]);
+      }
+#undef PHGMG__SC_ADD
+      if (pass) phgmg__isort(S->f_i + start, (size_t)(nz - start));
+    }
+    if (!pass) {
+      S->f_i = phgmg__ialloc(al, (size_t)nz + 1);
+      if (!S->f_i) { phgmg__free(al, mark); return PHGMG_ERR_NOMEM; }
+    }
+  }
+  S->f_p[nf] = nz;
+  phgmg__free(al, mark);
+  return PHGMG_OK;
+}
+
+/* Fill-reducing order of a graph: nested dissection, postordered by its
+   elimination tree; returns the predicted entries of L (off-diagonal) in
+   *lnz. parent, w1..w3: n ints of scratch. */
+PHGMG__PRIV phgmg_result phgmg__sp_order(int n, const int *gp, const int *gi, int *perm, double *lnz,
+                                         int *iord, int *parent, int *w1, int *w2, int *w3,
+                                         const phgmg_allocator *al) {
+  int i, *order = phgmg__ialloc(al, (size_t)n + 1);
+  phgmg_result rc;
+  if (!order) return PHGMG_ERR_NOMEM;
+  rc = phgmg__nd_order(n, gp, gi, order, al);
+  if (rc == PHGMG_OK) {
+    for (i = 0; i < n; ++i) iord[order[i]] = i;
+    phgmg__etree(n, gp, gi, order, iord, parent, w1);
+    phgmg__postorder(n, parent, w3, w1, w2, perm);
+    for (i = 0; i < n; ++i) perm[i] = order[w3[i]];
+    for (i = 0; i < n; ++i) iord[perm[i]] = i;
+    phgmg__etree(n, gp, gi, perm, iord, parent, w1);
+    phgmg__colcounts(n, gp, gi, perm, iord, parent, w2, w1);
+    *lnz = 0.0;
+    for (i = 0; i < n; ++i) *lnz += (double)w2[i];
+  }
+  phgmg__free(al, order);
+  return rc;
+}
+
 /* Symbolic analysis of the stage matrices of a system in band storage
-   (J, R, Q with half-bandwidth kb). */
+   (J, R, Q with half-bandwidth kb): K itself, or the Schur complement after
+   condensing an independent set of states, whichever predicts the smaller
+   factor (condensation: its couplings, twice, plus the diagonal). */
 PHGMG__PRIV phgmg_result phgmg__spsym_create(phgmg__spsym **out, int n, int kb, const double *J,
                                              const double *R, const double *Q, const phgmg_allocator *al) {
   phgmg__spsym *S = PHGMG__CAST(phgmg__spsym *, phgmg__alloc(al, sizeof(phgmg__spsym)));
-  int *gp = NULL, *gi = NULL, *order = NULL, *iord = NULL, *parent = NULL, *w1 = NULL, *w2 = NULL,
-      *w3 = NULL, *post = NULL, i;
+  int *gp = NULL, *gi = NULL, *hp = NULL, *hi = NULL, *iord = NULL, *parent = NULL, *w1 = NULL,
+      *w2 = NULL, *w3 = NULL, *perm2 = NULL, i;
+  double lnz = 0.0, lnz2 = 0.0;
   phgmg_result rc;
   *out = NULL;
   if (!S) return PHGMG_ERR_NOMEM;
@@ -6007,32 +6151,54 @@ PHGMG__PRIV phgmg_result phgmg__spsym_create(phgmg__spsym **out, int n, int kb, 
   rc = phgmg__band_to_csc(n, kb, J, R, &S->jr_p, &S->jr_i, &S->jr_x, al);
   if (rc == PHGMG_OK) rc = phgmg__band_to_csc(n, kb, Q, NULL, &S->q_p, &S->q_i, &S->q_x, al);
   if (rc == PHGMG_OK) rc = phgmg__spsym_kpattern(S, al);
-  if (rc == PHGMG_OK) rc = phgmg__spsym_graph(S, &gp, &gi, al);
+  if (rc == PHGMG_OK) rc = phgmg__spsym_graph(n, S->k_p, S->k_i, &gp, &gi, al);
   if (rc != PHGMG_OK) goto done;
-  order = phgmg__ialloc(al, (size_t)n);
   iord = phgmg__ialloc(al, (size_t)n);
   parent = phgmg__ialloc(al, (size_t)n);
-  post = phgmg__ialloc(al, (size_t)n);
   w1 = phgmg__ialloc(al, (size_t)n);
   w2 = phgmg__ialloc(al, (size_t)n);
   w3 = phgmg__ialloc(al, (size_t)n);
   S->perm = phgmg__ialloc(al, (size_t)n);
-  if (!order || !iord || !parent || !post || !w1 || !w2 || !w3 || !S->perm) { rc = PHGMG_ERR_NOMEM; goto done; }
-  rc = phgmg__nd_order(n, gp, gi, order, al);
+  perm2 = phgmg__ialloc(al, (size_t)n);
+  if (!iord || !parent || !w1 || !w2 || !w3 || !S->perm || !perm2) { rc = PHGMG_ERR_NOMEM; goto done; }
+  rc = phgmg__sp_order(n, gp, gi, S->perm, &lnz, iord, parent, w1, w2, w3, al);
+  if (rc == PHGMG_OK) rc = phgmg__sp_condense_select(S, gp, gi, al);
+  if (rc == PHGMG_OK && S->na > 0) {
+    rc = phgmg__sp_condense_pattern(S, al);
+    if (rc == PHGMG_OK) rc = phgmg__spsym_graph(S->nf, S->f_p, S->f_i, &hp, &hi, al);
+    if (rc == PHGMG_OK) rc = phgmg__sp_order(S->nf, hp, hi, perm2, &lnz2, iord, parent, w1, w2, w3, al);
+    lnz2 += 0.5 * ((double)S->ca_p[S->na] + (double)S->ra_p[S->na]);
+  }
   if (rc != PHGMG_OK) goto done;
-  for (i = 0; i < n; ++i) iord[order[i]] = i;
-  phgmg__etree(n, gp, gi, order, iord, parent, w1);
-  phgmg__postorder(n, parent, post, w1, w2, w3);
-  for (i = 0; i < n; ++i) S->perm[i] = order[post[i]];
-  for (i = 0; i < n; ++i) iord[S->perm[i]] = i;
-  phgmg__etree(n, gp, gi, S->perm, iord, parent, w1);
-  phgmg__colcounts(n, gp, gi, S->perm, iord, parent, w2, w1);
+  if (S->na > 0 && lnz2 < lnz) { /* condensed: analyse the Schur complement */
+    int *t = S->perm; S->perm = perm2; perm2 = t;
+    phgmg__free(al, gp); phgmg__free(al, gi);
+    gp = hp; gi = hi; hp = hi = NULL;
+  } else { /* K itself */
+    S->na = 0; S->nf = n;
+    for (i = 0; i < n; ++i) { S->fidx[i] = i; S->bpos[i] = i; }
+    if (S->f_p) { phgmg__free(al, S->f_p); phgmg__free(al, S->f_i); }
+    S->f_p = S->k_p; S->f_i = S->k_i;
+  }
+  S->f_d = phgmg__ialloc(al, (size_t)S->nf + 1);
+  if (!S->f_d) { rc = PHGMG_ERR_NOMEM; goto done; }
+  for (i = 0; i < S->nf; ++i) {
+    int p;
+    for (p = S->f_p[i]; p < S->f_p[i + 1]; ++p) if (S->f_i[p] == i) S->f_d[i] = p;
+  }
+  for (i = 0; i < S->nf; ++i) iord[S->perm[i]] = i;
+  phgmg__etree(S->nf, gp, gi, S->perm, iord, parent, w1);
+  phgmg__colcounts(S->nf, gp, gi, S->perm, iord, parent, w2, w1);
   rc = phgmg__spsym_supernodes(S, gp, gi, iord, parent, w2, al);
   if (rc == PHGMG_OK) rc = phgmg__spsym_assembly(S, iord, al);
+  if (rc == PHGMG_OK) {
+    for (i = 0; i < S->nf; ++i) S->perm[i] = S->fidx[S->perm[i]]; /* solves: internal index */
+    S->nnz_lu += (size_t)(S->ca_p && S->na ? S->ca_p[S->na] + S->ra_p[S->na] + S->na : 0);
+  }
 done:
-  phgmg__free(al, gp); phgmg__free(al, gi); phgmg__free(al, order); phgmg__free(al, iord);
-  phgmg__free(al, parent); phgmg__free(al, post); phgmg__free(al, w1); phgmg__free(al, w2);
-  phgmg__free(al, w3);
+  phgmg__free(al, gp); phgmg__free(al, gi); phgmg__free(al, hp); phgmg__free(al, hi);
+  phgmg__free(al, iord); phgmg__free(al, parent); phgmg__free(al, w1); phgmg__free(al, w2);
+  phgmg__free(al, w3); phgmg__free(al, perm2);
   if (rc != PHGMG_OK) { phgmg__spsym_free(al, S); return rc; }
   *out = S;
   return PHGMG_OK;
@@ -6042,6 +6208,8 @@ done:
 typedef struct phgmg__spnum {
   int cplx, nstatic;   /* nstatic: pivots replaced (see >>sparse) */
   double *X, *front, *stack, *y, *t;
+  double *Fx;          /* values of the factored matrix (f pattern)        */
+  double *dinv, *cax, *rax; /* condensed block: 1 / K(a, a), its couplings */
   int *pos;
   double growth;
 } phgmg__spnum;
@@ -6049,7 +6217,9 @@ typedef struct phgmg__spnum {
 PHGMG__PRIV void phgmg__spnum_free(const phgmg_allocator *al, phgmg__spnum *F) {
   phgmg__free(al, F->X); phgmg__free(al, F->front); phgmg__free(al, F->stack);
   phgmg__free(al, F->y); phgmg__free(al, F->pos); phgmg__free(al, F->t);
+  phgmg__free(al, F->Fx); phgmg__free(al, F->dinv); phgmg__free(al, F->cax); phgmg__free(al, F->rax);
   F->X = F->front = F->stack = F->y = F->t = NULL;
+  F->Fx = F->dinv = F->cax = F->rax = NULL;
   F->pos = NULL;
 }
 
@@ -6061,10 +6231,18 @@ PHGMG__PRIV phgmg_result phgmg__spnum_alloc(const phgmg_allocator *al, const phg
   F->X = phgmg__dalloc(al, w * S->nnz_lu + 1);
   F->front = phgmg__dalloc(al, w * S->front_max + 1);
   F->stack = phgmg__dalloc(al, w * S->stack_max + 1);
-  F->y = phgmg__dalloc(al, w * (size_t)S->n);
+  F->y = phgmg__dalloc(al, 2 * w * (size_t)S->n); /* y, then the solves' scratch */
   F->pos = phgmg__ialloc(al, (size_t)S->n);
   F->t = phgmg__dalloc(al, w * (size_t)S->n);
-  if (!F->X || !F->front || !F->stack || !F->y || !F->pos || !F->t) { phgmg__spnum_free(al, F); return PHGMG_ERR_NOMEM; }
+  F->Fx = phgmg__dalloc(al, w * (size_t)S->f_p[S->nf] + 1);
+  F->dinv = phgmg__dalloc(al, w * (size_t)S->na + 1);
+  F->cax = phgmg__dalloc(al, S->na ? (size_t)S->ca_p[S->na] + 1 : 1);
+  F->rax = phgmg__dalloc(al, S->na ? (size_t)S->ra_p[S->na] + 1 : 1);
+  if (!F->X || !F->front || !F->stack || !F->y || !F->pos || !F->t || !F->Fx || !F->dinv || !F->cax || !F->rax) {
+    phgmg__spnum_free(al, F);
+    return PHGMG_ERR_NOMEM;
+  }
+  { size_t i; for (i = 0; i < w * (size_t)S->n; ++i) F->t[i] = 0.0; }
   return PHGMG_OK;
 }
 
@@ -6153,9 +6331,54 @@ PHGMG__PRIV int phgmg__front_zlu(int nf, int nc, double *F, double tiny) {
   return nrep;
 }
 
+/* Values of the factored matrix into F->Fx: K = shift I + M itself, or the
+   Schur complement K_bb - K_ba K_aa^{-1} K_ab (F->dinv = 1 / K(a, a), the
+   couplings copied for the solves). A pivot K(a, a) below tiny is counted in
+   F->nstatic. Returns the largest |K_ba(:, a) / K(a, a)|. */
+PHGMG__PRIV double phgmg__sp_fvalues(const phgmg__spsym *S, phgmg__spnum *F, const double *Mx, double sr,
+                                     double si, double tiny) {
+  const int nf = S->nf, w = F->cplx ? 2 : 1;
+  int t, c, p, q;
+  double *x = F->t, lmax = 0.0;
+  for (t = 0; t < S->na; ++t) {
+    double dr = Mx[S->ad_k[t]] + sr, di = w == 2 ? si : 0.0, m = hypot(dr, di), d2, cm = 0.0;
+    if (!(m >= tiny)) ++F->nstatic;
+    d2 = dr * dr + di * di;
+    F->dinv[w * t] = dr / d2;
+    if (w == 2) F->dinv[2 * t + 1] = -di / d2;
+    for (q = S->ca_p[t]; q < S->ca_p[t + 1]; ++q) { F->cax[q] = Mx[S->ca_k[q]]; cm = PHGMG__MAX(cm, fabs(F->cax[q])); }
+    for (q = S->ra_p[t]; q < S->ra_p[t + 1]; ++q) F->rax[q] = Mx[S->ra_k[q]];
+    lmax = PHGMG__MAX(lmax, cm / m);
+  }
+  for (c = 0; c < nf; ++c) {
+    int v = S->fidx[c];
+    for (p = S->k_p[v]; p < S->k_p[v + 1]; ++p) {
+      int b = S->bpos[S->k_i[p]];
+      if (b >= 0) { x[w * b] += Mx[p]; continue; }
+      t = -1 - b;
+      { /* x_b -= K_ba(:, a) K(a, a)^{-1} K(a, c) */
+        double gr = Mx[p] * F->dinv[w * t], gi = w == 2 ? Mx[p] * F->dinv[2 * t + 1] : 0.0;
+        for (q = S->ca_p[t]; q < S->ca_p[t + 1]; ++q) {
+          int r = S->bpos[S->ca_i[q]];
+          x[w * r] -= F->cax[q] * gr;
+          if (w == 2) x[2 * r + 1] -= F->cax[q] * gi;
+        }
+      }
+    }
+    x[w * c] += sr;
+    if (w == 2) x[2 * c + 1] += si;
+    for (p = S->f_p[c]; p < S->f_p[c + 1]; ++p) {
+      int r = S->f_i[p];
+      F->Fx[w * p] = x[w * r]; x[w * r] = 0.0;
+      if (w == 2) { F->Fx[2 * p + 1] = x[2 * r + 1]; x[2 * r + 1] = 0.0; }
+    }
+  }
+  return lmax;
+}
+
 /* Numeric factorization of K = shift I + M (M values in S's k pattern, shift
-   = sr + i si for complex factors). tiny: the static-pivot threshold relative
-   to max |K|. Fills
+   = sr + i si for complex factors), of its Schur complement when S condenses
+   a block. tiny: the static-pivot threshold relative to max |K|. Fills
    F->X; F->nstatic counts replaced pivots; F->growth = max |factor entry| /
    max |K entry|. */
 PHGMG__PRIV void phgmg__sp_factor(const phgmg__spsym *S, phgmg__spnum *F, const double *Mx, double sr,
@@ -6168,18 +6391,20 @@ PHGMG__PRIV void phgmg__sp_factor(const phgmg__spsym *S, phgmg__spnum *F, const 
   for (q = 0; q < S->k_p[S->n]; ++q) kmax = PHGMG__MAX(kmax, fabs(Mx[q]));
   kmax = PHGMG__MAX(kmax, hypot(sr, si));
   tiny *= kmax;
+  fmax = phgmg__sp_fvalues(S, F, Mx, sr, si, tiny);
   for (s = 0; s < ns; ++s) {
     int f = S->sfirst[s], nc = S->sfirst[s + 1] - f, nr = S->srp[s + 1] - S->srp[s], nf = nc + nr, i, j;
     const int *rows = S->srow + S->srp[s];
     double *Fr = F->front;
     size_t len = (size_t)w * (size_t)nf * (size_t)nf, e;
     for (e = 0; e < len; ++e) Fr[e] = 0.0;
-    for (q = S->amp[s]; q < S->amp[s + 1]; ++q) Fr[(size_t)w * S->amd[q]] += Mx[S->ami[q]];
-    for (j = 0; j < nc; ++j) {
-      size_t d = (size_t)w * ((size_t)j * (size_t)nf + (size_t)j);
-      Fr[d] += sr;
-      if (w == 2) Fr[d + 1] += si;
-    }
+    if (w == 1)
+      for (q = S->amp[s]; q < S->amp[s + 1]; ++q) Fr[S->amd[q]] += F->Fx[S->ami[q]];
+    else
+      for (q = S->amp[s]; q < S->amp[s + 1]; ++q) {
+        Fr[2 * S->amd[q]] += F->Fx[2 * (size_t)S->ami[q]];
+        Fr[2 * S->amd[q] + 1] += F->Fx[2 * (size_t)S->ami[q] + 1];
+      }
     /* extend-add of the children's update matrices (top of the stack) */
     for (j = 0; j < nc; ++j) F->pos[f + j] = j;
     for (j = 0; j < nr; ++j) F->pos[rows[j]] = nc + j;
@@ -6223,10 +6448,10 @@ PHGMG__PRIV void phgmg__sp_factor(const phgmg__spsym *S, phgmg__spnum *F, const 
 /* x <- K^{-1} x (x internal order; real N or complex 2N interleaved):
    per supernode the dense triangular block, its off-diagonal block through a
    contiguous buffer (one scatter or gather per supernode). */
-PHGMG__PRIV void phgmg__sp_solve(const phgmg__spsym *S, const phgmg__spnum *F, double *x) {
-  const int n = S->n, ns = S->nsup, w = F->cplx ? 2 : 1;
+PHGMG__PRIV void phgmg__sp_solve_f(const phgmg__spsym *S, const phgmg__spnum *F, double *x) {
+  const int n = S->nf, ns = S->nsup, w = F->cplx ? 2 : 1;
   int s, i, j, k;
-  double *y = F->y, *t = F->t;
+  double *y = F->y, *t = F->y + (size_t)w * (size_t)n;
   for (i = 0; i < n; ++i) {
     y[w * i] = x[w * S->perm[i]];
     if (w == 2) y[2 * i + 1] = x[2 * S->perm[i] + 1];
@@ -6288,6 +6513,47 @@ PHGMG__PRIV void phgmg__sp_solve(const phgmg__spsym *S, const phgmg__spnum *F, d
   for (i = 0; i < n; ++i) {
     x[w * S->perm[i]] = y[w * i];
     if (w == 2) x[2 * S->perm[i] + 1] = y[2 * i + 1];
+  }
+}
+
+/* x <- K^{-1} x: with a condensed block, u_a = x_a / K(a, a), x_b -= K_ba u_a,
+   the Schur complement's solve, x_a = u_a - K_ab x_b / K(a, a). */
+PHGMG__PRIV void phgmg__sp_solve(const phgmg__spsym *S, const phgmg__spnum *F, double *x) {
+  int t, q;
+  if (F->cplx) {
+    for (t = 0; t < S->na; ++t) {
+      int v = S->aidx[t];
+      double ar = x[2 * v], ai = x[2 * v + 1], dr = F->dinv[2 * t], di = F->dinv[2 * t + 1];
+      double ur = ar * dr - ai * di, ui = ar * di + ai * dr;
+      x[2 * v] = ur; x[2 * v + 1] = ui;
+      for (q = S->ca_p[t]; q < S->ca_p[t + 1]; ++q) {
+        int r = S->ca_i[q];
+        x[2 * r] -= F->cax[q] * ur; x[2 * r + 1] -= F->cax[q] * ui;
+      }
+    }
+    phgmg__sp_solve_f(S, F, x);
+    for (t = 0; t < S->na; ++t) {
+      int v = S->aidx[t];
+      double sr = 0.0, si = 0.0, dr = F->dinv[2 * t], di = F->dinv[2 * t + 1];
+      for (q = S->ra_p[t]; q < S->ra_p[t + 1]; ++q) {
+        int c = S->ra_i[q];
+        sr += F->rax[q] * x[2 * c]; si += F->rax[q] * x[2 * c + 1];
+      }
+      x[2 * v] -= sr * dr - si * di; x[2 * v + 1] -= sr * di + si * dr;
+    }
+  } else {
+    for (t = 0; t < S->na; ++t) {
+      int v = S->aidx[t];
+      double u = x[v] * F->dinv[t];
+      x[v] = u;
+      for (q = S->ca_p[t]; q < S->ca_p[t + 1]; ++q) x[S->ca_i[q]] -= F->cax[q] * u;
+    }
+    phgmg__sp_solve_f(S, F, x);
+    for (t = 0; t < S->na; ++t) {
+      double sm = 0.0;
+      for (q = S->ra_p[t]; q < S->ra_p[t + 1]; ++q) sm += F->rax[q] * x[S->ra_i[q]];
+      x[S->aidx[t]] -= sm * F->dinv[t];
+    }
   }
 }
 
