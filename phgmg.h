@@ -1230,6 +1230,7 @@ typedef struct phgmg_ph_sparse_info {
   double flops_sparse;/* of one real sparse factorization (0: not analysed)    */
   int supernodes;     /* supernodes of the sparse factor (0: not analysed)     */
   int front_max;      /* largest dense front (order)                           */
+  int condensed;      /* states eliminated first by block elimination (>>sparse) */
 } phgmg_ph_sparse_info;
 PHGMG_DEF phgmg_result phgmg_ph_sparse_create(phgmg_ph_sparse **out, int N, int m, const phgmg_csc *J,
                                               const phgmg_csc *R, const phgmg_csc *Q, const double *B,
@@ -6136,9 +6137,11 @@ PHGMG__PRIV phgmg_result phgmg__sp_order(int n, const int *gp, const int *gi, in
 /* Symbolic analysis of the stage matrices of a system in band storage
    (J, R, Q with half-bandwidth kb): K itself, or the Schur complement after
    condensing an independent set of states, whichever predicts the smaller
-   factor (condensation: its couplings, twice, plus the diagonal). */
+   factor (condensation: its couplings, twice, plus the diagonal).
+   condense: -1 that choice, 0 never, 1 whenever a state can be condensed. */
 PHGMG__PRIV phgmg_result phgmg__spsym_create(phgmg__spsym **out, int n, int kb, const double *J,
-                                             const double *R, const double *Q, const phgmg_allocator *al) {
+                                             const double *R, const double *Q, int condense,
+                                             const phgmg_allocator *al) {
   phgmg__spsym *S = PHGMG__CAST(phgmg__spsym *, phgmg__alloc(al, sizeof(phgmg__spsym)));
   int *gp = NULL, *gi = NULL, *hp = NULL, *hi = NULL, *iord = NULL, *parent = NULL, *w1 = NULL,
       *w2 = NULL, *w3 = NULL, *perm2 = NULL, i;
@@ -6163,14 +6166,14 @@ PHGMG__PRIV phgmg_result phgmg__spsym_create(phgmg__spsym **out, int n, int kb, 
   if (!iord || !parent || !w1 || !w2 || !w3 || !S->perm || !perm2) { rc = PHGMG_ERR_NOMEM; goto done; }
   rc = phgmg__sp_order(n, gp, gi, S->perm, &lnz, iord, parent, w1, w2, w3, al);
   if (rc == PHGMG_OK) rc = phgmg__sp_condense_select(S, gp, gi, al);
-  if (rc == PHGMG_OK && S->na > 0) {
+  if (rc == PHGMG_OK && S->na > 0 && condense) {
     rc = phgmg__sp_condense_pattern(S, al);
     if (rc == PHGMG_OK) rc = phgmg__spsym_graph(S->nf, S->f_p, S->f_i, &hp, &hi, al);
     if (rc == PHGMG_OK) rc = phgmg__sp_order(S->nf, hp, hi, perm2, &lnz2, iord, parent, w1, w2, w3, al);
-    lnz2 += 0.5 * ((double)S->ca_p[S->na] + (double)S->ra_p[S->na]);
+    if (rc == PHGMG_OK) lnz2 += 0.5 * ((double)S->ca_p[S->na] + (double)S->ra_p[S->na]);
   }
   if (rc != PHGMG_OK) goto done;
-  if (S->na > 0 && lnz2 < lnz) { /* condensed: analyse the Schur complement */
+  if (S->na > 0 && condense && (lnz2 < lnz || condense > 0)) { /* condensed: the Schur complement */
     int *t = S->perm; S->perm = perm2; perm2 = t;
     phgmg__free(al, gp); phgmg__free(al, gi);
     gp = hp; gi = hi; hp = hi = NULL;
@@ -6946,13 +6949,14 @@ PHGMG_DEF phgmg_result phgmg_ph_sparse_set_solver(phgmg_ph_sparse *sp, int solve
   if (sp->E && solver == PHGMG_SOLVER_SPARSE_LU) return PHGMG_ERR_UNSUPPORTED; /* stage matrix sigma E - ... */
   if (!sp->E && !sp->sym && (solver == PHGMG_SOLVER_SPARSE_LU ||
                    (solver == PHGMG_SOLVER_AUTO && sp->sys.kb > PHGMG_SPARSE_MIN_KB))) {
-    rc = phgmg__spsym_create(&sp->sym, N, sp->sys.kb, sp->J, sp->R, sp->Q, sp->alloc);
+    rc = phgmg__spsym_create(&sp->sym, N, sp->sys.kb, sp->J, sp->R, sp->Q, -1, sp->alloc);
     if (rc != PHGMG_OK) return rc;
   }
   if (sp->sym) {
     f->lu_sparse = (double)sp->sym->nnz_lu;
     f->flops_sparse = sp->sym->flops;
     f->supernodes = sp->sym->nsup;
+    f->condensed = sp->sym->na;
     { size_t fm = 0; while ((fm + 1) * (fm + 1) <= sp->sym->front_max) ++fm; f->front_max = (int)fm; }
   }
   if (solver == PHGMG_SOLVER_AUTO)

@@ -1667,8 +1667,8 @@ static void remove_stale(const char *dir, const outlist *rec, const outlist *ol)
 static const char *sparse_solver_desc(const phgmg_ph_sparse_info *inf) {
   static char buf[256];
   if (inf->solver == PHGMG_SOLVER_SPARSE_LU)
-    snprintf(buf, sizeof buf, "sparse LU (nested dissection, %d supernodes, %.3g factor entries vs %.3g banded)",
-             inf->supernodes, inf->lu_sparse, inf->lu_band);
+    snprintf(buf, sizeof buf, "sparse LU (%d states condensed, nested dissection, %d supernodes, %.3g factor "
+             "entries vs %.3g banded)", inf->condensed, inf->supernodes, inf->lu_sparse, inf->lu_band);
   else if (inf->lu_sparse > 0.0)
     snprintf(buf, sizeof buf, "band LU (%.3g factor entries; sparse LU would need %.3g)", inf->lu_band, inf->lu_sparse);
   else

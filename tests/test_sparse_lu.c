@@ -227,9 +227,149 @@ TEST(test_sparse_lu_alloc_failures) {
   slu_lat_free(&L);
 }
 
+/* A random sparse port-Hamiltonian model (not bipartite: J and Q have
+   triangles), N states, in the slu_lat container (no masses). */
+static void slu_random_build(slu_lat *L, int N) {
+  int i, j, k;
+  double *D[3];
+  memset(L, 0, sizeof *L);
+  L->N = N;
+  for (k = 0; k < 3; ++k) D[k] = (double *)calloc((size_t)N * N, sizeof(double));
+  for (j = 0; j < N; ++j) {
+    D[2][j + (size_t)j * N] = 2.0 + th_rand();
+    if (j % 3 == 0) D[1][j + (size_t)j * N] = 0.2 + 0.1 * th_rand();
+    for (i = 0; i < j; ++i) {
+      double r = 0.5 * (th_rand() + 1.0);
+      if (r < 0.06) { double a = th_rand(); D[0][i + (size_t)j * N] = a; D[0][j + (size_t)i * N] = -a; }
+      else if (r < 0.09) { double a = 0.3 * th_rand(); D[2][i + (size_t)j * N] = a; D[2][j + (size_t)i * N] = a; }
+    }
+  }
+  for (k = 0; k < 3; ++k) { slu_to_csc(L, k, D[k]); free(D[k]); }
+  L->B = (double *)calloc((size_t)N, sizeof(double));
+  L->B[0] = 1.0;
+}
+
+/* Dense Gaussian elimination with partial pivoting of the real form
+   [Ar -Ai; Ai Ar] [xr; xi] = [br; bi] (n complex unknowns): the independent
+   reference for the sparse solves. A (2n x 2n) and b (2n) are overwritten. */
+static void slu_dense_solve(int n2, double *A, double *b) {
+  int k, i, j;
+  for (k = 0; k < n2; ++k) {
+    int p = k;
+    for (i = k + 1; i < n2; ++i) if (fabs(A[i + (size_t)k * n2]) > fabs(A[p + (size_t)k * n2])) p = i;
+    for (j = 0; j < n2; ++j) { double t = A[k + (size_t)j * n2]; A[k + (size_t)j * n2] = A[p + (size_t)j * n2]; A[p + (size_t)j * n2] = t; }
+    { double t = b[k]; b[k] = b[p]; b[p] = t; }
+    for (i = k + 1; i < n2; ++i) {
+      double f = A[i + (size_t)k * n2] / A[k + (size_t)k * n2];
+      if (f == 0.0) continue;
+      for (j = k; j < n2; ++j) A[i + (size_t)j * n2] -= f * A[k + (size_t)j * n2];
+      b[i] -= f * b[k];
+    }
+  }
+  for (k = n2 - 1; k >= 0; --k) {
+    double sm = b[k];
+    for (j = k + 1; j < n2; ++j) sm -= A[k + (size_t)j * n2] * b[j];
+    b[k] = sm / A[k + (size_t)k * n2];
+  }
+}
+
+/* The sparse solve of K = sigma I - (J - R)(Q + diag(dd)) (internal order)
+   against the dense solve, condensed (condense = 1) and not (0), real and
+   complex shift; returns the relative difference of the solutions. */
+static double slu_solve_check(const slu_lat *L, int condense, double sr, double si, int with_dd, int *na) {
+  const int N = L->N, N2 = 2 * N;
+  phgmg_ph_sparse *sp = NULL;
+  phgmg__spsym *S = NULL;
+  phgmg__spnum F;
+  double *Ju = (double *)calloc((size_t)N * N * 3, sizeof(double)), *A = (double *)calloc((size_t)N2 * N2, sizeof(double));
+  double *Mx, *w = (double *)malloc(sizeof(double) * (size_t)N), *dd = (double *)malloc(sizeof(double) * (size_t)N);
+  double *x = (double *)malloc(sizeof(double) * (size_t)N2), *b = (double *)malloc(sizeof(double) * (size_t)N2), err = 1.0;
+  int i, j, k, a, cp = si != 0.0;
+  *na = -1;
+  for (a = 0; a < 3; ++a)
+    for (j = 0; j < N; ++j)
+      for (k = L->M[a].colptr[j]; k < L->M[a].colptr[j + 1]; ++k)
+        Ju[(size_t)a * N * N + L->M[a].rowidx[k] + (size_t)j * N] = L->M[a].values[k];
+  for (i = 0; i < N; ++i) dd[i] = with_dd ? 0.5 + 0.5 * th_rand() : 0.0;
+  if (phgmg_ph_sparse_create(&sp, N, 1, &L->M[0], &L->M[1], &L->M[2], L->B, NULL, NULL, NULL) != PHGMG_OK ||
+      phgmg__spsym_create(&S, N, sp->sys.kb, sp->J, sp->R, sp->Q, condense, NULL) != PHGMG_OK ||
+      phgmg__spnum_alloc(NULL, S, cp, &F) != PHGMG_OK)
+    goto done;
+  *na = S->na;
+  Mx = (double *)malloc(sizeof(double) * (size_t)S->k_p[N] + 1);
+  phgmg__sp_stage_values(S, with_dd ? dd : NULL, Mx, w);
+  phgmg__sp_factor(S, &F, Mx, sr, si, PHGMG_SPARSE_PIVTOL);
+  free(Mx);
+  /* dense K in the internal order: K(i, j) = sigma delta - sum_k (J - R)(pi, pk) (Q(pk, pj) + dd_j delta_kj) */
+  for (i = 0; i < N; ++i)
+    for (j = 0; j < N; ++j) {
+      int pi = sp->perm[i], pj = sp->perm[j];
+      double v = i == j ? sr : 0.0;
+      for (k = 0; k < N; ++k) {
+        int pk = sp->perm[k];
+        double jr = Ju[pi + (size_t)pk * N] - Ju[(size_t)N * N + pi + (size_t)pk * N];
+        double q = Ju[(size_t)2 * N * N + pk + (size_t)pj * N] + (k == j ? dd[j] : 0.0);
+        v -= jr * q;
+      }
+      A[i + (size_t)j * N2] = v; A[i + N + (size_t)(j + N) * N2] = v;
+      if (i == j) { A[i + (size_t)(j + N) * N2] = -si; A[i + N + (size_t)j * N2] = si; }
+    }
+  for (i = 0; i < N2; ++i) b[i] = cp || i < N ? th_rand() : 0.0;
+  for (i = 0; i < N; ++i) { x[cp ? 2 * i : i] = b[i]; if (cp) x[2 * i + 1] = b[N + i]; }
+  phgmg__sp_solve(S, &F, x);
+  slu_dense_solve(N2, A, b);
+  {
+    double d = 0.0, m = 0.0;
+    for (i = 0; i < N; ++i) {
+      d = PHGMG__MAX(d, fabs(x[cp ? 2 * i : i] - b[i]));
+      if (cp) d = PHGMG__MAX(d, fabs(x[2 * i + 1] - b[N + i]));
+      m = PHGMG__MAX(m, PHGMG__MAX(fabs(b[i]), fabs(b[N + i])));
+    }
+    err = d / m;
+  }
+  phgmg__spnum_free(NULL, &F);
+done:
+  phgmg__spsym_free(NULL, S);
+  phgmg_ph_sparse_destroy(sp);
+  free(Ju); free(A); free(w); free(dd); free(x); free(b);
+  return err;
+}
+
+/* Condensing an independent set first (Schur complement of a diagonal
+   block): every solve equals the dense solve, real and complex shifts, with
+   and without the Hessian diagonal; a mass-spring lattice condenses one
+   whole side (its graph is bipartite), a random model part of its states. */
+TEST(test_sparse_lu_condense) {
+  slu_lat L;
+  int m, c, z, h, na;
+  for (m = 0; m < 2; ++m) {
+    if (m == 0) slu_lat_build(&L, 5, 6, 1, 0);
+    else slu_random_build(&L, 50);
+    for (c = 0; c < 2; ++c)
+      for (z = 0; z < 2; ++z)
+        for (h = 0; h < 2; ++h) {
+          CHECK_LE(slu_solve_check(&L, c, 3.7, z ? 1.9 : 0.0, h, &na), 1e-12);
+          if (c == 0) CHECK(na == 0);
+          else if (m == 0) CHECK(na == L.nn);
+          else CHECK(na > 0 && na < L.N / 2);
+        }
+    slu_lat_free(&L);
+  }
+  { /* the automatic choice condenses the lattice (smaller factor) */
+    phgmg_ph_sparse *sp = NULL;
+    phgmg_ph_sparse_info inf;
+    slu_lat_build(&L, 16, 16, 1, 0);
+    CHECK_RC(phgmg_ph_sparse_create(&sp, L.N, 1, &L.M[0], &L.M[1], &L.M[2], L.B, NULL, &inf, NULL), PHGMG_OK);
+    CHECK(inf.solver == PHGMG_SOLVER_SPARSE_LU && inf.condensed == L.nn);
+    phgmg_ph_sparse_destroy(sp);
+    slu_lat_free(&L);
+  }
+}
+
 SUITE(sparse_lu) {
   RUN(test_sparse_lu_lattices);
   RUN(test_sparse_lu_components);
   RUN(test_sparse_lu_choice);
   RUN(test_sparse_lu_alloc_failures);
+  RUN(test_sparse_lu_condense);
 }
