@@ -8633,23 +8633,22 @@ PHGMG_DEF phgmg_result phgmg_simulate_run(const phgmg_ph_system *sys, const phgm
   return rc;
 }
 
-PHGMG_DEF phgmg_result phgmg_simulate(const phgmg_ph_system *sys, const double *x0, double t0,
-                                      double dt, int nsteps, phgmg_input_fn uf, void *uuser,
-                                      const phgmg_gl3_opts *opts, double *X, double *Y,
-                                      const phgmg_energy *energy, phgmg_gl3_stats *stats,
-                                      int *steps_done, const phgmg_allocator *alloc) {
-  phgmg_gl3 *s = NULL;
-  phgmg_result rc;
+/* One run of nsteps steps from x0 at t0 on the stepper s (of sys, its step
+   dt): the loop of phgmg_simulate. The run starts afresh (no extrapolation
+   from an earlier run); the factors s holds are reused (a linear model
+   factors once for all the runs of one stepper; a nonlinear one refactors
+   by its contraction rule). stats: this run's (s's totals keep counting). */
+PHGMG__PRIV phgmg_result phgmg__simulate_on(phgmg_gl3 *s, const phgmg_ph_system *sys, const double *x0,
+                                            double t0, double dt, int nsteps, phgmg_input_fn uf, void *uuser,
+                                            double *X, double *Y, const phgmg_energy *energy,
+                                            phgmg_gl3_stats *stats, int *steps_done,
+                                            const phgmg_allocator *alloc) {
+  phgmg_result rc = PHGMG_OK;
   double *x = NULL, *g = NULL, *tmp = NULL;
-  int N, m, n, i, k, done = 0;
-  if (steps_done) *steps_done = 0;
-  if (stats) memset(stats, 0, sizeof *stats);
-  if (!sys || !x0 || nsteps < 0) return PHGMG_ERR_INVALID_ARG;
-  if (energy && (!energy->H || !energy->S || !energy->D)) return PHGMG_ERR_INVALID_ARG;
-  rc = phgmg_gl3_create(&s, sys, dt, opts, alloc);
-  if (rc != PHGMG_OK) return rc;
-  N = sys->N;
-  m = sys->m;
+  int N = sys->N, m = sys->m, n, i, k, done = 0;
+  phgmg_gl3_stats tot = s->st;
+  memset(&s->st, 0, sizeof s->st);
+  s->have_prev = 0;
   x = phgmg__dalloc(alloc, (size_t)N);
   g = phgmg__dalloc(alloc, (size_t)N);
   tmp = phgmg__dalloc(alloc, (size_t)N);
@@ -8687,10 +8686,31 @@ PHGMG_DEF phgmg_result phgmg_simulate(const phgmg_ph_system *sys, const double *
   }
 done:
   if (stats) *stats = s->st;
+  tot.steps += s->st.steps; tot.newton_iters += s->st.newton_iters;
+  tot.factorizations += s->st.factorizations; tot.rhs_evals += s->st.rhs_evals;
+  tot.failures += s->st.failures; tot.max_residual = PHGMG__MAX(tot.max_residual, s->st.max_residual);
+  s->st = tot;
   if (steps_done) *steps_done = done;
   phgmg__free(alloc, x);
   phgmg__free(alloc, g);
   phgmg__free(alloc, tmp);
+  return rc;
+}
+
+PHGMG_DEF phgmg_result phgmg_simulate(const phgmg_ph_system *sys, const double *x0, double t0,
+                                      double dt, int nsteps, phgmg_input_fn uf, void *uuser,
+                                      const phgmg_gl3_opts *opts, double *X, double *Y,
+                                      const phgmg_energy *energy, phgmg_gl3_stats *stats,
+                                      int *steps_done, const phgmg_allocator *alloc) {
+  phgmg_gl3 *s = NULL;
+  phgmg_result rc;
+  if (steps_done) *steps_done = 0;
+  if (stats) memset(stats, 0, sizeof *stats);
+  if (!sys || !x0 || nsteps < 0) return PHGMG_ERR_INVALID_ARG;
+  if (energy && (!energy->H || !energy->S || !energy->D)) return PHGMG_ERR_INVALID_ARG;
+  rc = phgmg_gl3_create(&s, sys, dt, opts, alloc);
+  if (rc != PHGMG_OK) return rc;
+  rc = phgmg__simulate_on(s, sys, x0, t0, dt, nsteps, uf, uuser, X, Y, energy, stats, steps_done, alloc);
   phgmg_gl3_destroy(s);
   return rc;
 }
@@ -12614,8 +12634,9 @@ PHGMG_DEF int phgmg_runs_columns(int nrun, const phgmg_run *runs) {
 PHGMG_DEF phgmg_result phgmg_simulate_inputs(const phgmg_ph_system *sys, int nrun, const phgmg_run *runs,
                                              const phgmg_gl3_opts *go, double *X, int ldx, double *Y, int *col,
                                              const phgmg_allocator *alloc) {
-  double *z, *T = NULL;
+  double *z, *T = NULL, sdt = 0.0;
   int k, c0 = 0, nmax = 0, N;
+  phgmg_gl3 *s = NULL; /* one stepper while dt stays: its factors serve every run */
   phgmg_result rc = PHGMG_OK;
   if (!sys || !runs || !X) return PHGMG_ERR_INVALID_ARG;
   if (phgmg_runs_columns(nrun, runs) < 0) return PHGMG_ERR_INVALID_ARG;
@@ -12631,14 +12652,22 @@ PHGMG_DEF phgmg_result phgmg_simulate_inputs(const phgmg_ph_system *sys, int nru
     double *dst = T ? T : X + (size_t)c0 * ldx;
     int j;
     if (col) col[k] = c0;
-    rc = phgmg_simulate(sys, q->x0 ? q->x0 : z, q->t0, q->dt, q->nsteps, q->u, q->user, go, dst,
-                        Y ? Y + (size_t)c0 * sys->m : NULL, NULL, NULL, NULL, alloc);
+    if (!s || q->dt != sdt) {
+      phgmg_gl3_destroy(s);
+      s = NULL;
+      rc = phgmg_gl3_create(&s, sys, q->dt, go, alloc);
+      if (rc != PHGMG_OK) break;
+      sdt = q->dt;
+    }
+    rc = phgmg__simulate_on(s, sys, q->x0 ? q->x0 : z, q->t0, q->dt, q->nsteps, q->u, q->user, dst,
+                            Y ? Y + (size_t)c0 * sys->m : NULL, NULL, NULL, NULL, alloc);
     if (T)
       for (j = 0; j <= q->nsteps; ++j)
         memcpy(X + (size_t)(c0 + j) * ldx, T + (size_t)j * N, (size_t)N * sizeof(double));
     c0 += q->nsteps + 1;
   }
   if (col && rc == PHGMG_OK) col[nrun] = c0;
+  phgmg_gl3_destroy(s);
   phgmg__free(alloc, T);
   phgmg__free(alloc, z);
   return rc;
@@ -12913,18 +12942,24 @@ PHGMG__PRIV phgmg_result phgmg__vset_build(phgmg__rctx *c, phgmg__vset *v) {
   go.max_iter = c->o->newton_iter;
   if (c->o->lambda_train_only) { v->nv = nrun; return phgmg__vset_dedupe(c, v); }
   if (phgmg__study_probes(c, v, level, zero, off, &go, 0)) return phgmg__vset_dedupe(c, v);
-  for (k = nrun; k < nrun + 3; ++k) {
-    phgmg__probe *p = v->probe + (k - nrun);
-    phgmg_result rc;
-    p->run = run; p->level = level; p->mode = k - nrun; p->m = m;
-    v->u[k] = phgmg__probe_u; v->user[k] = p; v->x0[k] = run[0].x0 ? run[0].x0 : zero;
-    v->t0[k] = run[0].t0; v->dt[k] = run[0].dt; v->nsteps[k] = run[0].nsteps; v->Yref[k] = v->buf + off;
-    off += (size_t)m * (run[0].nsteps + 1);
-    phgmg__progress(c->o, "lambda: full-model probe run");
-    rc = phgmg_simulate(sys, v->x0[k], v->t0[k], v->dt[k], v->nsteps[k], v->u[k], v->user[k], &go, NULL,
-                        v->Yref[k], NULL, NULL, NULL, c->alloc);
+  {
+    phgmg_gl3 *s = NULL; /* one stepper (and its factors) for the three probes */
+    phgmg_result rc = phgmg_gl3_create(&s, sys, run[0].dt, &go, c->alloc);
     if (rc == PHGMG_ERR_NOMEM) return rc;
-    if (rc != PHGMG_OK) { v->nv = k; break; }   /* the full model itself fails: no probe */
+    if (rc != PHGMG_OK) v->nv = nrun;   /* the full model itself fails: no probe */
+    for (k = nrun; k < v->nv; ++k) {
+      phgmg__probe *p = v->probe + (k - nrun);
+      p->run = run; p->level = level; p->mode = k - nrun; p->m = m;
+      v->u[k] = phgmg__probe_u; v->user[k] = p; v->x0[k] = run[0].x0 ? run[0].x0 : zero;
+      v->t0[k] = run[0].t0; v->dt[k] = run[0].dt; v->nsteps[k] = run[0].nsteps; v->Yref[k] = v->buf + off;
+      off += (size_t)m * (run[0].nsteps + 1);
+      phgmg__progress(c->o, "lambda: full-model probe run");
+      rc = phgmg__simulate_on(s, sys, v->x0[k], v->t0[k], v->dt[k], v->nsteps[k], v->u[k], v->user[k], NULL,
+                              v->Yref[k], NULL, NULL, NULL, c->alloc);
+      if (rc == PHGMG_ERR_NOMEM) { phgmg_gl3_destroy(s); return rc; }
+      if (rc != PHGMG_OK) { v->nv = k; break; }   /* the full model itself fails: no probe */
+    }
+    phgmg_gl3_destroy(s);
   }
   phgmg__study_probes(c, v, level, zero, 0, &go, 1);
   return phgmg__vset_dedupe(c, v);

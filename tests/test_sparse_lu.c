@@ -366,10 +366,109 @@ TEST(test_sparse_lu_condense) {
   }
 }
 
+static double max_abs_x(const double *x, size_t n) {
+  double m = 0.0;
+  size_t i;
+  for (i = 0; i < n; ++i) m = PHGMG__MAX(m, fabs(x[i]));
+  return m;
+}
+
+/* Counting shifted solver (dense LU of sigma I - (J - R) Q) for the reuse test. */
+typedef struct slu_cb {
+  int N;
+  const double *JR, *Q;   /* dense, J - R and Q */
+  double *K1, *K2;
+  int *ip1, *ip2;
+  long nfactor;
+} slu_cb;
+static phgmg_result slu_cb_factor(double sr, double si, const double *x, void *user) {
+  slu_cb *c = (slu_cb *)user;
+  int N = c->N, i, j, k;
+  (void)x;
+  c->nfactor++;
+  for (j = 0; j < N; ++j)
+    for (i = 0; i < N; ++i) {
+      double v = i == j ? sr : 0.0;
+      for (k = 0; k < N; ++k) v -= c->JR[i + (size_t)k * N] * c->Q[k + (size_t)j * N];
+      if (si == 0.0) c->K1[i + (size_t)j * N] = v;
+      else { c->K2[2 * (i + (size_t)j * N)] = v; c->K2[2 * (i + (size_t)j * N) + 1] = i == j ? si : 0.0; }
+    }
+  return si == 0.0 ? phgmg_lu_factor(N, c->K1, N, c->ip1) : phgmg_zlu_factor(N, c->K2, N, c->ip2);
+}
+static void slu_cb_solve(double sr, double si, double *rhs, void *user) {
+  slu_cb *c = (slu_cb *)user;
+  (void)sr;
+  if (si == 0.0) phgmg_lu_solve('N', c->N, c->K1, c->N, c->ip1, 1, rhs, c->N);
+  else phgmg_zlu_solve(c->N, c->K2, c->N, c->ip2, 1, rhs, c->N);
+}
+
+/* The runs of phgmg_simulate_inputs share one stepper while dt stays the
+   same: a linear model is factored once (one real and one complex
+   factorization) for three runs, again when dt changes; the trajectories
+   equal those of separate phgmg_simulate calls bit for bit. */
+TEST(test_sparse_lu_reuse_runs) {
+  slu_lat L;
+  slu_cb cb;
+  phgmg_ph_system sys;
+  phgmg_gl3_opts o;
+  phgmg_run runs[3];
+  double *D, *JR, *X, *Xs, x0[40], z[40], amp[3] = {1.0, 0.5, 2.0};
+  int N, i, j, a, k, c0;
+  slu_lat_build(&L, 4, 5, 1, 0);
+  N = L.N;
+  CHECK(N == 40);
+  D = (double *)calloc((size_t)3 * N * N, sizeof(double)); /* dense J, R, Q */
+  JR = (double *)malloc(sizeof(double) * (size_t)N * N);
+  for (a = 0; a < 3; ++a)
+    for (j = 0; j < N; ++j)
+      for (k = L.M[a].colptr[j]; k < L.M[a].colptr[j + 1]; ++k)
+        D[(size_t)a * N * N + L.M[a].rowidx[k] + (size_t)j * N] = L.M[a].values[k];
+  for (i = 0; i < N * N; ++i) JR[i] = D[i] - D[(size_t)N * N + i];
+  memset(&cb, 0, sizeof cb);
+  cb.N = N; cb.JR = JR; cb.Q = D + (size_t)2 * N * N;
+  cb.K1 = (double *)malloc(sizeof(double) * (size_t)N * N);
+  cb.K2 = (double *)malloc(2 * sizeof(double) * (size_t)N * N);
+  cb.ip1 = (int *)malloc(sizeof(int) * (size_t)N);
+  cb.ip2 = (int *)malloc(sizeof(int) * (size_t)N);
+  memset(&sys, 0, sizeof sys);
+  sys.N = N; sys.m = 1; sys.storage = PHGMG_DENSE;
+  sys.J = D; sys.R = D + (size_t)N * N; sys.Q = cb.Q; sys.B = L.B;
+  sys.shifted_factor = slu_cb_factor; sys.shifted_solve = slu_cb_solve; sys.shifted_user = &cb;
+  memset(&o, 0, sizeof o);
+  o.no_step_map = 1;
+  for (i = 0; i < N; ++i) { x0[i] = 0.01 * (i % 7); z[i] = 0.0; }
+  memset(runs, 0, sizeof runs);
+  for (k = 0; k < 3; ++k) {
+    runs[k].x0 = k == 1 ? x0 : NULL; runs[k].t0 = 0.5 * k; runs[k].dt = 0.1;
+    runs[k].nsteps = 30 + 5 * k; runs[k].u = slu_u; runs[k].user = &amp[k];
+  }
+  X = (double *)malloc(sizeof(double) * (size_t)N * 120);
+  Xs = (double *)malloc(sizeof(double) * (size_t)N * 120);
+  CHECK_RC(phgmg_simulate_inputs(&sys, 3, runs, &o, X, N, NULL, NULL, NULL), PHGMG_OK);
+  CHECK(cb.nfactor == 2);
+  for (k = 0, c0 = 0; k < 3; ++k) { /* separately: each call factors */
+    long before = cb.nfactor;
+    CHECK_RC(phgmg_simulate(&sys, runs[k].x0 ? runs[k].x0 : z, runs[k].t0, runs[k].dt, runs[k].nsteps, slu_u,
+                            &amp[k], &o, Xs + (size_t)c0 * N, NULL, NULL, NULL, NULL, NULL), PHGMG_OK);
+    CHECK(cb.nfactor == before + 2);
+    c0 += runs[k].nsteps + 1;
+  }
+  CHECK(c0 == 108);
+  CHECK(memcmp(X, Xs, sizeof(double) * (size_t)N * (size_t)c0) == 0);
+  CHECK(max_abs_x(X + (size_t)N * 31, (size_t)N * 77) > 1e-3);
+  cb.nfactor = 0;
+  runs[2].dt = 0.05; /* a new dt: a new stepper */
+  CHECK_RC(phgmg_simulate_inputs(&sys, 3, runs, &o, X, N, NULL, NULL, NULL), PHGMG_OK);
+  CHECK(cb.nfactor == 4);
+  free(D); free(JR); free(X); free(Xs); free(cb.K1); free(cb.K2); free(cb.ip1); free(cb.ip2);
+  slu_lat_free(&L);
+}
+
 SUITE(sparse_lu) {
   RUN(test_sparse_lu_lattices);
   RUN(test_sparse_lu_components);
   RUN(test_sparse_lu_choice);
   RUN(test_sparse_lu_alloc_failures);
   RUN(test_sparse_lu_condense);
+  RUN(test_sparse_lu_reuse_runs);
 }
