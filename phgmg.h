@@ -6190,14 +6190,14 @@ PHGMG__PRIV phgmg_result phgmg__spsym_create(phgmg__spsym **out, int n, int kb, 
   if (!iord || !parent || !w1 || !w2 || !w3 || !S->perm || !perm2) { rc = PHGMG_ERR_NOMEM; goto done; }
   rc = phgmg__sp_order(n, gp, gi, S->perm, &lnz, iord, parent, w1, w2, w3, al);
   if (rc == PHGMG_OK) rc = phgmg__sp_condense_select(S, gp, gi, al);
-  if (rc == PHGMG_OK && S->na > 0 && condense) {
+  if (rc == PHGMG_OK && S->na > 0 && S->nf > 0 && condense) {
     rc = phgmg__sp_condense_pattern(S, al);
     if (rc == PHGMG_OK) rc = phgmg__spsym_graph(S->nf, S->f_p, S->f_i, &hp, &hi, al);
     if (rc == PHGMG_OK) rc = phgmg__sp_order(S->nf, hp, hi, perm2, &lnz2, iord, parent, w1, w2, w3, al);
     if (rc == PHGMG_OK) lnz2 += 0.5 * ((double)S->ca_p[S->na] + (double)S->ra_p[S->na]);
   }
   if (rc != PHGMG_OK) goto done;
-  if (S->na > 0 && condense && (lnz2 < lnz || condense > 0)) { /* condensed: the Schur complement */
+  if (S->na > 0 && S->nf > 0 && condense && (lnz2 < lnz || condense > 0)) { /* condensed: the Schur complement */
     int *t = S->perm; S->perm = perm2; perm2 = t;
     phgmg__free(al, gp); phgmg__free(al, gi);
     gp = hp; gi = hi; hp = hi = NULL;

@@ -355,6 +355,21 @@ TEST(test_sparse_lu_condense) {
         }
     slu_lat_free(&L);
   }
+  { /* no couplings at all (M diagonal): nothing left to factor if every
+       state were condensed, so none is */
+    double *D[3];
+    int k, i;
+    memset(&L, 0, sizeof L);
+    L.N = 6;
+    for (k = 0; k < 3; ++k) D[k] = (double *)calloc(36, sizeof(double));
+    for (i = 0; i < 6; ++i) { D[1][i * 7] = 0.1 * (i % 2); D[2][i * 7] = 1.0 + i; }
+    for (k = 0; k < 3; ++k) { slu_to_csc(&L, k, D[k]); free(D[k]); }
+    L.B = (double *)calloc(6, sizeof(double));
+    L.B[0] = 1.0;
+    CHECK_LE(slu_solve_check(&L, 1, 3.7, 1.9, 1, &na), 1e-14);
+    CHECK(na == 0);
+    slu_lat_free(&L);
+  }
   { /* the automatic choice condenses the lattice (smaller factor) */
     phgmg_ph_sparse *sp = NULL;
     phgmg_ph_sparse_info inf;
