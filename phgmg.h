@@ -354,6 +354,16 @@
                             validation as a second reference, and when no
                             lambda beats both the model of MANIFOLD_POD is
                             returned (info.manifold_fallback = 1).
+                            With a wide V2 and opts.greedy_window > 0 it
+                            starts from the greedy manifold instead (V1 the
+                            greedy choice, the search space V1 and its
+                            complement's leading modes): its objective
+                            measures V2 at width 8, where the hierarchical
+                            POD start is a local minimum far above what a
+                            wide V2 allows on transport data (advecting pulse,
+                            n = 20: POD manifold 1.4e-1, altmin from it
+                            1.4e-1, from the greedy start 8.7e-4; sweeps
+                            improve n = 12 from 3.01e-2 to 2.91e-2).
    In every construction B stays in the span and [B, V1, V2] is orthonormal,
    so Br = [I; 0] and the GMG reduction is unchanged.
 
@@ -1986,7 +1996,8 @@ typedef struct phgmg_reduce_opts {
      (bench/qm_pulse.c). Cost: about (r - m) greedy_window incremental updates
      of O(nsub (r - m)^3 + nsub^2 (r - m)) (nsub <= 400 snapshots used), plus
      one SVD of the adjusted snapshots: 3-10 s at r - m = 12-20, window 200,
-     N = 4096, ns = 1000 (two shared cores). */
+     N = 4096, ns = 1000 (two shared cores). manifold = 2 with a wide V2: the
+     alternating minimization starts from this greedy manifold (manual 3.3). */
   int greedy_window;
   /* With lambda_auto = 1: 1 = validate on the training runs alone, no probe
      runs (manual 4.2): the most accurate model on the training inputs; no
@@ -12018,7 +12029,12 @@ PHGMG__PRIV phgmg_result phgmg__qm_altmin(phgmg__rctx *c) {
   w.Qb = w.Qn + (size_t)q * k; w.A = w.Qb + (size_t)q * k; w.U = w.A + (size_t)q * k; w.V = w.U + (size_t)q * k;
   w.sv = w.V + (size_t)k * k; w.W = w.sv + k; w.Wn = w.W + (size_t)k * ns; w.Wb = w.Wn + (size_t)k * ns;
   w.Kt = w.Wb + (size_t)k * ns; w.Yt = w.Kt + (size_t)ns * nc; w.T = w.Yt + (size_t)ns * rn;
-  if (c->o->pod_basis) memcpy(U, c->o->pod_basis, (size_t)N * q * sizeof(double));
+  if (c->Uw) {   /* warm start (greedy_window): U = [the greedy V1, the leading modes of its complement] */
+    q = PHGMG__MIN(q, p + c->kw);
+    if (q < k) rc = PHGMG_ERR_SIZE;
+    memcpy(U, red->V0 + (size_t)N * m, (size_t)N * p * sizeof(double));
+    if (q > p) memcpy(U + (size_t)N * p, c->Uw, (size_t)N * (q - p) * sizeof(double));
+  } else if (c->o->pod_basis) memcpy(U, c->o->pod_basis, (size_t)N * q * sizeof(double));
   else {
     rc = phgmg_pod(N, ns, c->Xa, N, q, 0.0, U, N, NULL, &kk, c->alloc);
     if (rc == PHGMG_OK && kk < k) rc = PHGMG_ERR_SIZE;
@@ -12290,7 +12306,13 @@ PHGMG__PRIV phgmg_result phgmg__stage_manifold(phgmg__rctx *c) {
     if (rc != PHGMG_OK) return rc;
   }
   if (c->o->manifold == PHGMG_MANIFOLD_ALTMIN && red->method == PHGMG_METHOD_GMG_QM) {
-    rc = phgmg__qm_altmin(c);   /* V1 and V2 */
+    /* a wide V2 with a greedy_window: started from the greedy manifold */
+    if (c->wide && c->o->greedy_window > 0) rc = phgmg__qm_greedy_wide(c);
+    if (rc == PHGMG_OK) rc = phgmg__qm_altmin(c);   /* V1 and V2 */
+    if (rc == PHGMG_OK && c->Uw && c->inf.manifold_sweeps > 0) {   /* V1 moved: its complement anew */
+      phgmg__free(c->alloc, c->Uw);
+      c->Uw = c->Cw = NULL; c->kw = 0;
+    }
     if (rc != PHGMG_OK) return rc;
   }
   {
