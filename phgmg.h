@@ -2027,7 +2027,7 @@ typedef struct phgmg_reduce_opts {
 } phgmg_reduce_opts;
 
 /* phgmg_reduce_opts.ref */
-enum { PHGMG_REF_NONE = 0, PHGMG_REF_MEAN = 1, PHGMG_REF_GIVEN = 2 };
+typedef enum phgmg_ref { PHGMG_REF_NONE = 0, PHGMG_REF_MEAN = 1, PHGMG_REF_GIVEN = 2, PHGMG_REF_COUNT } phgmg_ref;
 
 /* The defaults of phgmg_reduce_opts (the table in manual 3.2): *o is zeroed
    and every field whose zero stands for a default gets that default. A zeroed
@@ -11477,7 +11477,7 @@ PHGMG__PRIV phgmg_result phgmg__deploy_check(const phgmg_reduce_opts *o, int ns)
   if (!(o->newton_tol >= 0.0 && o->newton_tol < 1.0) || o->newton_iter < 0) return PHGMG_ERR_INVALID_ARG;
   if ((int)o->manifold < 0 || (int)o->manifold >= (int)PHGMG_MANIFOLD_COUNT) return PHGMG_ERR_INVALID_ARG;
   if (o->lambda_train_only != 0 && o->lambda_train_only != 1) return PHGMG_ERR_INVALID_ARG;
-  if (o->ref < PHGMG_REF_NONE || o->ref > PHGMG_REF_GIVEN || (o->ref == PHGMG_REF_GIVEN && !o->ref_x))
+  if (o->ref < 0 || o->ref >= (int)PHGMG_REF_COUNT || (o->ref == PHGMG_REF_GIVEN && !o->ref_x))
     return PHGMG_ERR_INVALID_ARG;
   return PHGMG_OK;
 }
