@@ -160,7 +160,7 @@ compile-checks: phgmg.h
 	  clang -std=c99 $(WARN) -Wdouble-promotion -DPHGMG_REAL_FLOAT -c $(BUILD)/cc/impl.c -o $(BUILD)/cc/a.o; fi
 	@echo "compile checks passed"
 
-EXAMPLES = $(BUILD)/hello $(BUILD)/msd_linear $(BUILD)/msd_nonlinear $(BUILD)/morse_chain $(BUILD)/phgmg $(BUILD)/linear_bases $(BUILD)/fe_bar
+EXAMPLES = $(BUILD)/hello $(BUILD)/msd_linear $(BUILD)/msd_nonlinear $(BUILD)/morse_chain $(BUILD)/phgmg $(BUILD)/linear_bases $(BUILD)/fe_bar $(BUILD)/transport_line
 EXHDRS   = examples/msd_models.h examples/morse_models.h examples/demo_common.h examples/svgplot.h
 
 examples: $(EXAMPLES)
@@ -179,7 +179,7 @@ $(BUILD)/%: examples/%.c phgmg.h $(EXHDRS)
 	$(CC) $(OPTFLAGS) -o $@ $< $(LDLIBS)
 
 # Reproduce Section 5 of the paper: tables on the terminal, CSVs and SVG figures in results/;
-# then the non-polynomial Morse-chain example and its acceptance checks.
+# then the non-polynomial Morse-chain example, the transport example and their checks.
 demo: $(EXAMPLES)
 	@mkdir -p results
 	@start=$$(date +%s.%N); \
@@ -187,10 +187,11 @@ demo: $(EXAMPLES)
 	./$(BUILD)/msd_linear --lambda auto --rmin 8 --rmax 14 --rstep 6 --out results && \
 	./$(BUILD)/msd_linear --generalization 8,12,16 --out results && \
 	./$(BUILD)/morse_chain --out results && ./$(BUILD)/linear_bases --out results && \
-	./$(BUILD)/fe_bar --n 200 --out results && \
+	./$(BUILD)/fe_bar --n 200 --out results && ./$(BUILD)/transport_line --rmax 12 --out results && \
 	end=$$(date +%s.%N) && awk -v a=$$start -v b=$$end 'BEGIN { printf "make demo: total wall time %.2f s\n", b - a }' && \
 	/usr/bin/python3 tests/check_claims.py results && /usr/bin/python3 tests/check_morse.py results && \
-	/usr/bin/python3 tests/check_linear.py results && /usr/bin/python3 tests/check_fe_bar.py results
+	/usr/bin/python3 tests/check_linear.py results && /usr/bin/python3 tests/check_fe_bar.py results && \
+	/usr/bin/python3 tests/check_transport.py results
 
 # Short fuzzing run of every reader of outside data (.npy in memory and
 # streamed from a file and a pipe, binary model files) and of the CLI's

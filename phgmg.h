@@ -327,6 +327,9 @@
      lambda_train_only  0                    1: validate on the training runs
                                              alone (4.2)
      progress/_user     NULL                 stage callback (2.2)
+     ref / ref_x        PHGMG_REF_NONE       affine reference state (3.6):
+                                             _MEAN the snapshots' mean,
+                                             _GIVEN the vector ref_x
    Bad values (NaN, out of range, unknown enums) give PHGMG_ERR_INVALID_ARG;
    sizes that do not fit the model or the snapshots' rank give PHGMG_ERR_SIZE.
 
@@ -353,6 +356,16 @@
                             validation as a second reference, and when no
                             lambda beats both the model of MANIFOLD_POD is
                             returned (info.manifold_fallback = 1).
+                            With a wide V2 and opts.greedy_window > 0 it
+                            starts from the greedy manifold instead (V1 the
+                            greedy choice, the search space V1 and its
+                            complement's leading modes): its objective
+                            measures V2 at width 8, where the hierarchical
+                            POD start is a local minimum far above what a
+                            wide V2 allows on transport data (advecting pulse,
+                            n = 20: POD manifold 1.4e-1, altmin from it
+                            1.4e-1, from the greedy start 8.7e-4; sweeps
+                            improve n = 12 from 3.01e-2 to 2.91e-2).
    In every construction B stays in the span and [B, V1, V2] is orthonormal,
    so Br = [I; 0] and the GMG reduction is unchanged.
 
@@ -388,6 +401,54 @@
                         (the balanced basis), h2_rel NULL.
      rom stepper        tol 1e-10 double / 1e-5 float (times max(1, |x|_inf,
                         |Z|_inf)), max_iter 10 (phgmg_rom_stepper_init).
+
+   3.6 Affine reference state (opts.ref, opts.ref_x)
+   Data that do not vary around 0 -- a pulse travelling through a domain, a
+   state oscillating about a loaded equilibrium -- are represented far
+   better by an affine manifold
+       phi(x) = xbar + B x1 + V1 x2 + V2 eta(x2),   x = (x1, x2),
+   with a reference state xbar (PHGMG_REF_MEAN: the mean of the snapshots;
+   PHGMG_REF_GIVEN: your vector). Every basis and manifold (POD, hierarchical,
+   greedy, alternating minimization; SP1/SP2's POD) is fitted to the
+   snapshots minus xbar; the point reduction is rho(x) = rho_0(x - xbar) with
+   rho_0 the map without reference state. On the advecting pulse of
+   bench/qm_pulse.c the greedy manifold's training error at n = 20 drops from
+   8.7e-4 to 1.5e-7 (examples/README.md).
+   Why the reduced model is still port-Hamiltonian. xbar is constant, so
+   Dphi(x) = V0 + V2 [0, Deta(x2)] (V0 = [B, V1]) does not depend on it: the
+   GMG reduction map W = F_G(Dphi)^T, W^T Dphi = I, the structure
+   K(x) = (Dphi^T G Dphi)^{-1} (Jr its skew part, Rr = -sym K >= 0) and the
+   port matrix W^T B = [I; 0] are those without reference state. Only the
+   energy changes: the reduced Hamiltonian is Hr(x) = H(phi(x)), for
+   H = 1/2 z^T Hq z + sum_k w_k phi_k(z[i_k]) (Hq = Q, E^T Q for a descriptor
+   model)
+       Hr(x) = 1/2 phi0^T Hq phi0 + x^T g0 + q^T g2 + h0
+               + sum_k w_k phi_k(P0_k x + P1_k q + xbar[i_k]),
+   phi0 = V0 x + V2 q, q = eta(x2), g0 = V0^T Hq xbar, g2 = V2^T Hq xbar,
+   h0 = 1/2 xbar^T Hq xbar: a constant vector g0 in the gradient, g2 added
+   to the curvature term (Deta^T (V2^T grad H)), offsets xbar[i_k] in the
+   separable arguments (phgmg_rom.ref_g, ref_s). grad Hr = Dphi^T grad H(phi)
+   holds as before, so dHr/dt = -grad Hr^T Rr grad Hr + yr^T u, and the
+   output yr = Bh^T grad Hr = B^T grad H(phi(x)) is the full model's output at
+   the lifted state (the first m columns of Dphi are B).
+   A linear phi with a quadratic H: xbar is moved within the affine space
+   xbar + span V0 to xbar - V0 Qh^{-1} g0, the same model in coordinates
+   shifted by Qh^{-1} g0, which makes g0 = 0: the reduced model is then the
+   model without reference state (step map included) plus the constant h0
+   and the shifted lift.
+   The initial state. A full state x0 enters as xr0 = rho(x0), the rule of
+   every method; the full state 0 (a run from rest) is xr_rest = rho(0)
+   (phgmg_rom.xr_rest, also in the model file and the C export), whose lift
+   phi(xr_rest) is not 0 in general: the gap is the manifold's error at 0,
+   small when the rest state is among the training snapshots (then it is part
+   of the training projection error), and the energy starts at
+   Hr(xr_rest) ~ 0. An exact shift (xr0 with phi(xr0) = 0) does not exist
+   in general: 0 need not lie on the manifold. Start a deployed model from
+   xr_rest, not from xr = 0 (which is the state xbar).
+   Costs: one N x ns copy of the centred snapshots offline; online r + rn + 1
+   more coefficients and O(r + rn) flops per gradient. Not with a study's
+   cached basis (phgmg_study_reduce then takes the general path).
+   tests/test_qm_ref.c checks each claim against full-dimension computations.
 
 
    4. DEPLOYMENT: VALIDATION, CHOOSING LAMBDA, ONLINE INDICATORS ----------------
@@ -1603,6 +1664,18 @@ typedef struct phgmg_rom {
      snapshots; steps whose correction is larger are counted in
      phgmg_rom_stats.q_outside_steps (0 for M = 0). */
   const phgmg_real *q_max;
+  /* Affine reference state xbar (optional, NULL = none; manual 3.6):
+     phi(x) = xbar + V0 x (+ V2 q). The energy H(phi(x)) then gains the terms
+     x^T g0 + q^T g2 + h0 of the quadratic part, the separable terms their
+     arguments' offsets xbar at the kept coordinates, and the full state 0 is
+     represented by the reduced state xr_rest = rho(0):
+       ref_g   r + rn + 1 values [g0; g2; h0]: g0 = V0^T Q xbar (r), g2 = V2^T Q
+               xbar (rn, QUADRATIC), h0 = 1/2 xbar^T Q xbar (descriptor
+               models: E^T Q for Q); g0 = 0 with a step map;
+       ref_s   nd values: xbar at the kept coordinates (s_j += ref_s[j]);
+       xr_rest r values: the reduced state of the full state 0 (the initial
+               state of a run from rest). */
+  const phgmg_real *ref_g, *ref_s, *xr_rest;
 } phgmg_rom;
 
 /* Checks a model's sizes and pointers for consistency (not its values). */
@@ -1948,7 +2021,8 @@ typedef struct phgmg_reduce_opts {
      (bench/qm_pulse.c). Cost: about (r - m) greedy_window incremental updates
      of O(nsub (r - m)^3 + nsub^2 (r - m)) (nsub <= 400 snapshots used), plus
      one SVD of the adjusted snapshots: 3-10 s at r - m = 12-20, window 200,
-     N = 4096, ns = 1000 (two shared cores). */
+     N = 4096, ns = 1000 (two shared cores). manifold = 2 with a wide V2: the
+     alternating minimization starts from this greedy manifold (manual 3.3). */
   int greedy_window;
   /* With lambda_auto = 1: 1 = validate on the training runs alone, no probe
      runs (manual 4.2): the most accurate model on the training inputs; no
@@ -1967,7 +2041,18 @@ typedef struct phgmg_reduce_opts {
      from the calling thread only. */
   void (*progress)(const char *phase, void *user);
   void *progress_user;
+  /* Affine reference state xbar (manual 3.6): phi(x) = xbar + [B, V1] x
+     (+ V2 eta(x2)), every basis and manifold fitted to the snapshots minus
+     xbar. PHGMG_REF_NONE (0, default): none; PHGMG_REF_MEAN: the mean of the
+     snapshots; PHGMG_REF_GIVEN: ref_x (N values, finite). Any method of
+     phgmg_reduce; not on a study's cached basis (the study fast path is
+     then off). The reduced state of the full state 0 is phgmg_rom.xr_rest. */
+  int ref;
+  const double *ref_x;
 } phgmg_reduce_opts;
+
+/* phgmg_reduce_opts.ref */
+typedef enum phgmg_ref { PHGMG_REF_NONE = 0, PHGMG_REF_MEAN = 1, PHGMG_REF_GIVEN = 2, PHGMG_REF_COUNT } phgmg_ref;
 
 /* The defaults of phgmg_reduce_opts (the table in manual 3.2): *o is zeroed
    and every field whose zero stands for a default gets that default. A zeroed
@@ -8947,6 +9032,12 @@ PHGMG_DEF phgmg_result phgmg_rom_check(const phgmg_rom *rom) {
   }
   if (rom->Phi && (!rom->Gam || !rom->SX || !rom->SU || !(rom->dt > PHGMG__R(0))))
     return PHGMG_ERR_INVALID_ARG;
+  if (rom->ref_s && rom->nd < 1) return PHGMG_ERR_INVALID_ARG;
+  if (rom->Phi && rom->ref_g) { /* the step map is of x' = K Qh x + Bh u: no constant gradient */
+    int i;
+    for (i = 0; i < rom->r; ++i)
+      if (rom->ref_g[i] != PHGMG__R(0)) return PHGMG_ERR_INVALID_ARG;
+  }
   return PHGMG_OK;
 }
 
@@ -9016,6 +9107,8 @@ PHGMG__ONLINE void phgmg__rom_prep(const phgmg_rom *rom, const phgmg_real *x, co
   if (nd > 0) {
     phgmg__r_gemv(nd, r, rom->P0, x, 0, w->c);
     if (rom->kind == PHGMG_ROM_QUADRATIC) phgmg__r_gemv(nd, rn, rom->P1, w->q, 1, w->c);
+    if (rom->ref_s)
+      for (i = 0; i < nd; ++i) w->c[i] += rom->ref_s[i];
   }
 }
 
@@ -9035,6 +9128,12 @@ PHGMG_DEF phgmg_real phgmg_rom_hamiltonian(const phgmg_rom *rom, const phgmg_rea
   }
   for (j = 0; j < r; ++j) h += x[j] * w.tmp[j];
   h *= PHGMG__R(0.5);
+  if (rom->ref_g) { /* + x^T g0 + q^T g2 + h0 (reference state) */
+    const int nq = rom->kind == PHGMG_ROM_QUADRATIC ? rn : 0;
+    for (j = 0; j < r; ++j) h += x[j] * rom->ref_g[j];
+    for (j = 0; j < nq; ++j) h += w.q[j] * rom->ref_g[r + j];
+    h += rom->ref_g[r + nq];
+  }
   for (j = 0; j < rom->nd; ++j) {
     phgmg_real d[3];
     phgmg__r_phi(rom, j, w.c[j], d);
@@ -9060,6 +9159,8 @@ PHGMG__ONLINE void phgmg__rom_grad(const phgmg_rom *rom, const phgmg_real *x, ph
     w->d[j] = rom->w[j] * d[1];
   }
   phgmg__r_gemv(r, r, rom->Qh, x, 0, g);
+  if (rom->ref_g)
+    for (j = 0; j < r; ++j) g[j] += rom->ref_g[j];
   if (rom->ham_cb) {
     rom->ham_cb(x, NULL, w->hg, NULL, rom->ham_user);
     for (j = 0; j < r; ++j) g[j] += w->hg[j];
@@ -9067,8 +9168,10 @@ PHGMG__ONLINE void phgmg__rom_grad(const phgmg_rom *rom, const phgmg_real *x, ph
   if (nd > 0) phgmg__r_gemvt(nd, r, rom->P0, w->d, 1, g);
   if (rom->kind == PHGMG_ROM_QUADRATIC) {
     phgmg__r_gemv(r, rn, rom->Q01, w->q, 1, g);
-    phgmg__r_gemvt(r, rn, rom->Q01, x, 0, w->a1); /* a1 = Q01^T x + Q11 q + P1^T d */
+    phgmg__r_gemvt(r, rn, rom->Q01, x, 0, w->a1); /* a1 = Q01^T x + Q11 q (+ g2) + P1^T d */
     phgmg__r_gemv(rn, rn, rom->Q11, w->q, 1, w->a1);
+    if (rom->ref_g)
+      for (j = 0; j < rn; ++j) w->a1[j] += rom->ref_g[r + j];
     if (nd > 0) phgmg__r_gemvt(nd, rn, rom->P1, w->d, 1, w->a1);
     phgmg__r_gemvt(rn, p, w->Lp, w->a1, 1, g + m); /* g2 += Lp^T a1 */
   }
@@ -9825,6 +9928,9 @@ struct phgmg_reduced {
   double *Ainv;        /* SP1/SP2: (V^T Vg)^{-1}, r x r (W = Vg Ainv)          */
   const phgmg_study *study; /* the study that built it on its cached basis (else NULL) */
   int sbasis;          /* with study: 1 GMG ([B, Ua_1..p(+rn)]), 2 SP1, 3 SP2 (Up_1..r) */
+  /* affine reference state (opts.ref; NULL: none): xbar (N), xbr = rho_lin(xbar)
+     (r; rho(x) = rho_lin(x) - xbr), the online terms (phgmg_rom.ref_g/ref_s/xr_rest) */
+  double *xbar, *xbr, *refg, *refs, *xrest;
 };
 
 /* A study (phgmg_study_create): what every reduction of one snapshot set
@@ -11210,6 +11316,7 @@ PHGMG__PRIV void phgmg__restrict_block(const phgmg_reduced *red, int ns, const d
   int i, j, k;
   if (red->method == PHGMG_METHOD_SP1 || red->method == PHGMG_METHOD_SP2 || red->method == PHGMG_METHOD_PRBT) {
     phgmg_gemm('T', 'N', r, ns, N, 1.0, red->W, N, X, ldx, 0.0, XR, r);
+    for (k = 0; red->xbr && k < ns; ++k) phgmg__axpy(r, -1.0, red->xbr, XR + (size_t)k * r);
     return;
   }
   phgmg_gemm('T', 'N', m, ns, N, 1.0, red->QB, N, X, ldx, 0.0, XR, r);
@@ -11221,6 +11328,7 @@ PHGMG__PRIV void phgmg__restrict_block(const phgmg_reduced *red, int ns, const d
       for (j = i + 1; j < m; ++j) sm -= red->RB[i + j * m] * xr[j];
       xr[i] = sm / red->RB[i + i * m];
     }
+    if (red->xbr) phgmg__axpy(r, -1.0, red->xbr, xr);
   }
 }
 
@@ -11377,6 +11485,9 @@ PHGMG__PRIV phgmg_result phgmg__publish(phgmg_reduced *red) {
   PHGMG__PUB(poly, nf * (size_t)(o->poly_deg + 1)); PHGMG__PUB(expo, nf * 2 * (size_t)red->nexp);
   PHGMG__PUB(Phi, r * r); PHGMG__PUB(Gam, r * 3 * m); PHGMG__PUB(SX, 3 * r * r); PHGMG__PUB(SU, 3 * r * 3 * m);
 #undef PHGMG__PUB
+  if (rc == PHGMG_OK) rc = phgmg__to_real(red, red->refg, r + (red->kind == PHGMG_ROM_QUADRATIC ? rn : 0) + 1, &o->ref_g);
+  if (rc == PHGMG_OK) rc = phgmg__to_real(red, red->refs, nd, &o->ref_s);
+  if (rc == PHGMG_OK) rc = phgmg__to_real(red, red->xrest, r, &o->xr_rest);
   o->dt = red->Phi ? (phgmg_real)red->map_dt : (phgmg_real)0;
   if (nd > 0 && !red->poly && !red->expo) {   /* callbacks: they need the full-model term index */
     o->phi_cb = phgmg__phi_tramp; o->phi_user = red; o->term = red->term;
@@ -11620,6 +11731,12 @@ typedef struct phgmg__rctx {
   double *Uw, *Cw;         /* greedy wide: the complement's modes (N x kw) and
                               coordinates (kw x ns; Cw lives in Uw's block)   */
   int kw;
+  /* opts.ref: X above is then Xc, the snapshots minus xbar (what the bases and
+     the manifold are fitted to); Xf / ldxf are always the caller's states
+     (gradients, outputs, rho of a state, the validation runs' x0) */
+  const double *Xf;
+  int ldxf;
+  double *Xc;
 } phgmg__rctx;
 
 PHGMG__PRIV void phgmg__rctx_free(phgmg__rctx *c) {
@@ -11634,6 +11751,8 @@ PHGMG__PRIV void phgmg__rctx_free(phgmg__rctx *c) {
   phgmg_jr_factor_destroy(c->ef);
   phgmg__free(c->alloc, c->Uw);
   c->Uw = c->Cw = NULL;
+  phgmg__free(c->alloc, c->Xc);
+  c->Xc = NULL;
   c->jr = NULL; c->Xa = c->lg = c->Tq = c->V2h = NULL; c->runcol = NULL;
   c->Bp_own = c->sepw_own = NULL; c->ef = NULL;
 }
@@ -11682,6 +11801,8 @@ PHGMG__PRIV phgmg_result phgmg__deploy_check(const phgmg_reduce_opts *o, int ns)
   if (!(o->newton_tol >= 0.0 && o->newton_tol < 1.0) || o->newton_iter < 0) return PHGMG_ERR_INVALID_ARG;
   if ((int)o->manifold < 0 || (int)o->manifold >= (int)PHGMG_MANIFOLD_COUNT) return PHGMG_ERR_INVALID_ARG;
   if (o->lambda_train_only != 0 && o->lambda_train_only != 1) return PHGMG_ERR_INVALID_ARG;
+  if (o->ref < 0 || o->ref >= (int)PHGMG_REF_COUNT || (o->ref == PHGMG_REF_GIVEN && !o->ref_x))
+    return PHGMG_ERR_INVALID_ARG;
   return PHGMG_OK;
 }
 
@@ -12232,7 +12353,12 @@ PHGMG__PRIV phgmg_result phgmg__qm_altmin(phgmg__rctx *c) {
   w.Qb = w.Qn + (size_t)q * k; w.A = w.Qb + (size_t)q * k; w.U = w.A + (size_t)q * k; w.V = w.U + (size_t)q * k;
   w.sv = w.V + (size_t)k * k; w.W = w.sv + k; w.Wn = w.W + (size_t)k * ns; w.Wb = w.Wn + (size_t)k * ns;
   w.Kt = w.Wb + (size_t)k * ns; w.Yt = w.Kt + (size_t)ns * nc; w.T = w.Yt + (size_t)ns * rn;
-  if (c->o->pod_basis) memcpy(U, c->o->pod_basis, (size_t)N * q * sizeof(double));
+  if (c->Uw) {   /* warm start (greedy_window): U = [the greedy V1, the leading modes of its complement] */
+    q = PHGMG__MIN(q, p + c->kw);
+    if (q < k) rc = PHGMG_ERR_SIZE;
+    memcpy(U, red->V0 + (size_t)N * m, (size_t)N * p * sizeof(double));
+    if (q > p) memcpy(U + (size_t)N * p, c->Uw, (size_t)N * (q - p) * sizeof(double));
+  } else if (c->o->pod_basis) memcpy(U, c->o->pod_basis, (size_t)N * q * sizeof(double));
   else {
     rc = phgmg_pod(N, ns, c->Xa, N, q, 0.0, U, N, NULL, &kk, c->alloc);
     if (rc == PHGMG_OK && kk < k) rc = PHGMG_ERR_SIZE;
@@ -12504,7 +12630,13 @@ PHGMG__PRIV phgmg_result phgmg__stage_manifold(phgmg__rctx *c) {
     if (rc != PHGMG_OK) return rc;
   }
   if (c->o->manifold == PHGMG_MANIFOLD_ALTMIN && red->method == PHGMG_METHOD_GMG_QM) {
-    rc = phgmg__qm_altmin(c);   /* V1 and V2 */
+    /* a wide V2 with a greedy_window: started from the greedy manifold */
+    if (c->wide && c->o->greedy_window > 0) rc = phgmg__qm_greedy_wide(c);
+    if (rc == PHGMG_OK) rc = phgmg__qm_altmin(c);   /* V1 and V2 */
+    if (rc == PHGMG_OK && c->Uw && c->inf.manifold_sweeps > 0) {   /* V1 moved: its complement anew */
+      phgmg__free(c->alloc, c->Uw);
+      c->Uw = c->Cw = NULL; c->kw = 0;
+    }
     if (rc != PHGMG_OK) return rc;
   }
   {
@@ -12731,7 +12863,7 @@ PHGMG__PRIV void phgmg__restrict_snapshots(const phgmg__rctx *c, double *XR) {
     const int ld = c->sf == 2 ? st->kp : st->kg;
     phgmg_gemm('T', 'N', r, ns, r, 1.0, red->Ainv, r, Cv, ld, 0.0, XR, r);
   } else {
-    phgmg__restrict_block(red, ns, c->X, c->ldx, XR);
+    phgmg__restrict_block(red, ns, c->Xf, c->ldxf, XR);
   }
 }
 
@@ -12945,18 +13077,18 @@ PHGMG__PRIV phgmg_result phgmg__vset_build(phgmg__rctx *c, phgmg__vset *v) {
     const phgmg_allocator *sa = c->st->use_alloc ? &c->st->alloc : NULL;
     c->st->Yt = phgmg__dalloc(sa, (size_t)m * c->ns);
     for (j = 0; c->st->Yt && j < c->ns; ++j) {
-      phgmg_ph_gradient(sys, c->X + (size_t)j * c->ldx, g);
+      phgmg_ph_gradient(sys, c->Xf + (size_t)j * c->ldxf, g);
       phgmg_gemv('T', N, m, 1.0, sys->B, N, g, 0.0, c->st->Yt + (size_t)j * m);
     }
   }
   for (k = 0, off = 0; k < nrun; ++k) {   /* training runs: y = B^T grad H(x_j) */
-    v->u[k] = run[k].u; v->user[k] = run[k].user; v->x0[k] = c->X + (size_t)c->runcol[k] * c->ldx;
+    v->u[k] = run[k].u; v->user[k] = run[k].user; v->x0[k] = c->Xf + (size_t)c->runcol[k] * c->ldxf;
     v->t0[k] = run[k].t0; v->dt[k] = run[k].dt; v->nsteps[k] = run[k].nsteps; v->Yref[k] = v->buf + off;
     if (c->st && c->st->Yt) {
       memcpy(v->Yref[k], c->st->Yt + (size_t)c->runcol[k] * m, (size_t)m * (run[k].nsteps + 1) * sizeof(double));
     } else {
       for (j = 0; j <= run[k].nsteps; ++j) {
-        phgmg_ph_gradient(sys, c->X + (size_t)(c->runcol[k] + j) * c->ldx, g);
+        phgmg_ph_gradient(sys, c->Xf + (size_t)(c->runcol[k] + j) * c->ldxf, g);
         phgmg_gemv('T', N, m, 1.0, sys->B, N, g, 0.0, v->Yref[k] + (size_t)j * m);
       }
     }
@@ -13067,7 +13199,7 @@ PHGMG__PRIV phgmg_result phgmg__altmin_reference(phgmg__rctx *c, phgmg__vset *v,
   phgmg_result rc;
   o.method = PHGMG_METHOD_GMG_POD; o.lambda_auto = 0; o.manifold = PHGMG_MANIFOLD_POD; o.nrun = 0; o.runs = NULL;
   o.dt = 0.0;
-  rc = phgmg_reduce(&pod, c->sys, c->X, c->ldx, c->ns, &o, NULL, c->alloc);
+  rc = phgmg_reduce(&pod, c->sys, c->Xf, c->ldxf, c->ns, &o, NULL, c->alloc);
   if (rc == PHGMG_ERR_NOMEM) return rc;
   if (rc != PHGMG_OK) return PHGMG_OK;   /* no GMG-POD to compare with: the linear limit alone */
   c->red = pod;
@@ -13273,7 +13405,7 @@ PHGMG__PRIV phgmg_result phgmg__sp_test_basis(phgmg__rctx *c, double *Vg) {
   Fg = phgmg__dalloc(c->alloc, (size_t)N * ns + (size_t)r);
   if (!Fg) return PHGMG_ERR_NOMEM;
   S = Fg + (size_t)N * ns;
-  for (j = 0; j < ns; ++j) phgmg_ph_gradient(c->sys, c->X + (size_t)j * c->ldx, Fg + (size_t)j * N);
+  for (j = 0; j < ns; ++j) phgmg_ph_gradient(c->sys, c->Xf + (size_t)j * c->ldxf, Fg + (size_t)j * N);
   rc = c->sys->E ? phgmg__e_transpose_block(c, ns, Fg) : PHGMG_OK;   /* grad H = E^T z */
   if (rc == PHGMG_OK) rc = phgmg_pod(N, ns, Fg, N, r, 0.0, Vg, N, S, &k, c->alloc);
   if (rc == PHGMG_OK && (k < r || !(S[r - 1] > phgmg__rank_floor(N, ns, Fg, N)))) rc = PHGMG_ERR_SIZE;
@@ -13413,10 +13545,10 @@ PHGMG__PRIV phgmg_result phgmg__hyper_ecsw_manifold(phgmg__rctx *c, const double
   phgmg_result rc;
   if (!Gm) return PHGMG_ERR_NOMEM;
   tg = Gm + nrow * nt; XR = tg + nrow; Dq = XR + nrow;
-  if ((double)c->ldx * stride <= 2147483647.0)   /* rho of the used snapshots */
-    phgmg__restrict_block(red, nsu, c->X, c->ldx * stride, XR);
+  if ((double)c->ldxf * stride <= 2147483647.0)   /* rho of the used snapshots */
+    phgmg__restrict_block(red, nsu, c->Xf, c->ldxf * stride, XR);
   else
-    for (u = 0; u < nsu; ++u) phgmg_reduced_restrict(red, c->X + (size_t)u * stride * c->ldx, XR + (size_t)u * r);
+    for (u = 0; u < nsu; ++u) phgmg_reduced_restrict(red, c->Xf + (size_t)u * stride * c->ldxf, XR + (size_t)u * r);
   for (u = 0; u < nsu; ++u) {
     i = u * stride;
     phgmg__eta_d(red, XR + (size_t)u * r + m, NULL, Dq, NULL, red->rwork);
@@ -13482,7 +13614,7 @@ PHGMG__PRIV phgmg_result phgmg__separable_gradients(phgmg__rctx *c, int compact,
   if (!live) return PHGMG_ERR_NOMEM;
   for (a = 0; a < nt; ++a) live[a] = !compact || phgmg__ph_phi(sys, a, 0.0, 1) != 0.0;
   for (i = 0; compact && i < ns; ++i) {
-    const double *x = c->X + (size_t)i * c->ldx;
+    const double *x = c->Xf + (size_t)i * c->ldxf;
     for (a = 0; a < nt; ++a) live[a] |= x[sys->sep_idx[a]] != 0.0;
   }
   for (a = 0; a < nt; ++a) if (live[a]) live[nl++] = a;   /* in place: nl <= a */
@@ -13490,7 +13622,7 @@ PHGMG__PRIV phgmg_result phgmg__separable_gradients(phgmg__rctx *c, int compact,
   if (!F) { phgmg__free(c->alloc, live); return PHGMG_ERR_NOMEM; }
   for (i = 0; i < ns; ++i)
     for (a = 0; a < nl; ++a)
-      F[a + (size_t)i * nl] = phgmg__ph_phi(sys, live[a], c->X[sys->sep_idx[live[a]] + (size_t)i * c->ldx], 1);
+      F[a + (size_t)i * nl] = phgmg__ph_phi(sys, live[a], c->Xf[sys->sep_idx[live[a]] + (size_t)i * c->ldxf], 1);
   *Fo = F; *liveo = live; *nlo = nl;
   return PHGMG_OK;
 }
@@ -13601,7 +13733,12 @@ PHGMG__PRIV phgmg_result phgmg__stage_separable_terms(phgmg__rctx *c) {
       for (a = 0; a < r; ++a) red->P0[j + (size_t)a * nd] = red->V0[cj + (size_t)a * N];
       for (a = 0; a < rn; ++a) red->P1[j + (size_t)a * nd] = red->V2[cj + (size_t)a * N];
     }
-    rc = phgmg__separable_functions(red, pts);
+    if (red->xbar && nd > 0) {   /* the kept terms' argument offsets */
+      red->refs = phgmg__red_d(red, (size_t)nd);
+      for (j = 0; red->refs && j < nd; ++j) red->refs[j] = red->xbar[red->coord[j]];
+      if (!red->refs) rc = PHGMG_ERR_NOMEM;
+    }
+    if (rc == PHGMG_OK) rc = phgmg__separable_functions(red, pts);
   }
   phgmg__free(c->alloc, pts);
   phgmg__free(c->alloc, wt);
@@ -13623,6 +13760,88 @@ PHGMG__PRIV phgmg_result phgmg__stage_general_term(phgmg__rctx *c) {
   return red->gwork ? PHGMG_OK : PHGMG_ERR_NOMEM;
 }
 
+/* Reference state (opts.ref), first part: xbar (the snapshots' mean or the
+   caller's vector) and the centred snapshots Xc = X - xbar 1^T, which the
+   basis and manifold stages fit (c->X becomes Xc; c->Xf stays X). */
+PHGMG__PRIV phgmg_result phgmg__stage_reference(phgmg__rctx *c) {
+  phgmg_reduced *red = c->red;
+  const int N = red->N, ns = c->ns;
+  int i, j;
+  if (c->o->ref == PHGMG_REF_NONE) return PHGMG_OK;
+  red->xbar = phgmg__red_d(red, (size_t)N);
+  c->Xc = phgmg__dalloc(c->alloc, (size_t)N * ns);
+  if (!red->xbar || !c->Xc) return PHGMG_ERR_NOMEM;
+  if (c->o->ref == PHGMG_REF_GIVEN) {
+    memcpy(red->xbar, c->o->ref_x, (size_t)N * sizeof(double));
+    if (!phgmg__all_finite(red->xbar, (size_t)N)) return PHGMG_ERR_NANINF;
+  } else {   /* the mean, summed in order (the snapshots are finite) */
+    memset(red->xbar, 0, (size_t)N * sizeof(double));
+    for (j = 0; j < ns; ++j) phgmg__axpy(N, 1.0, c->Xf + (size_t)j * c->ldxf, red->xbar);
+    for (i = 0; i < N; ++i) red->xbar[i] /= (double)ns;
+  }
+  for (j = 0; j < ns; ++j) {
+    const double *x = c->Xf + (size_t)j * c->ldxf;
+    double *y = c->Xc + (size_t)j * N;
+    for (i = 0; i < N; ++i) y[i] = x[i] - red->xbar[i];
+  }
+  c->X = c->Xc;   /* red->xbr: phgmg__stage_reference_terms, once the basis is final */
+  c->ldx = N;
+  c->rfloor = phgmg__rank_floor(N, ns, c->Xc, N);   /* the rank of what the bases are fitted to */
+  return PHGMG_OK;
+}
+
+/* Reference state, second part (after the quadratic terms; manual 3.6). With
+   Hq = Q (E^T Q for a descriptor model) and v = Hq xbar:
+     g0 = V0^T v, g2 = V2^T v, h0 = xbar^T v / 2, xr_rest = rho(0).
+   A linear phi and a quadratic H: xbar is first moved within the affine
+   space xbar + span V0 to xbar - V0 Qh^{-1} V0^T Hq xbar, which makes g0 = 0
+   (the same model in shifted coordinates: the step map applies as is). */
+PHGMG__PRIV void phgmg__ref_hq(const phgmg__rctx *c, const double *x, double *v, double *t) {
+  phgmg_ph_apply(c->sys, 'Q', 1, x, c->sys->N, t, c->sys->N);
+  phgmg__ph_e_apply(c->sys, 'T', 1, t, c->sys->N, v, c->sys->N);
+}
+
+PHGMG__PRIV phgmg_result phgmg__stage_reference_terms(phgmg__rctx *c) {
+  phgmg_reduced *red = c->red;
+  const int N = red->N, r = red->r, rn = red->kind == PHGMG_ROM_QUADRATIC ? red->rn : 0;
+  double *v, *t, *A, *a, *xbr, h0 = 0.0;
+  int *piv, i;
+  phgmg_result rc = PHGMG_OK;
+  if (!red->xbar) return PHGMG_OK;
+  v = phgmg__dalloc(c->alloc, 2 * (size_t)N + (size_t)r * r + (size_t)r);
+  piv = phgmg__ialloc(c->alloc, (size_t)r);
+  red->refg = phgmg__red_d(red, (size_t)r + rn + 1);
+  red->xrest = phgmg__red_d(red, (size_t)r);
+  xbr = phgmg__red_d(red, (size_t)r);
+  if (!v || !piv || !red->refg || !red->xrest || !xbr) rc = PHGMG_ERR_NOMEM;
+  if (rc == PHGMG_OK) {
+    t = v + N; A = t + N; a = A + (size_t)r * r;
+    phgmg__ref_hq(c, red->xbar, v, t);
+    phgmg_gemv('T', N, r, 1.0, red->V0, N, v, 0.0, red->refg);   /* g0 */
+    if (red->kind == PHGMG_ROM_LINEAR && c->sys->nl == PHGMG_NL_NONE) {   /* shift: g0 = 0 */
+      memcpy(A, red->Qh, (size_t)r * r * sizeof(double));
+      memcpy(a, red->refg, (size_t)r * sizeof(double));
+      if (phgmg_lu_factor(r, A, r, piv) == PHGMG_OK) {
+        phgmg_lu_solve('N', r, A, r, piv, 1, a, r);
+        phgmg_gemv('N', N, r, -1.0, red->V0, N, a, 1.0, red->xbar);
+        phgmg__ref_hq(c, red->xbar, v, t);
+        memset(red->refg, 0, (size_t)r * sizeof(double));
+      }
+    }
+    if (rn) phgmg_gemv('T', N, rn, 1.0, red->V2, N, v, 0.0, red->refg + r);   /* g2 */
+    for (i = 0; i < N; ++i) h0 += red->xbar[i] * v[i];
+    red->refg[r + rn] = 0.5 * h0;
+    red->xbr = NULL;                      /* rho without the shift, at xbar */
+    phgmg_reduced_restrict(red, red->xbar, xbr);
+    red->xbr = xbr;
+    for (i = 0; i < r; ++i) red->xrest[i] = -xbr[i];   /* rho(0) */
+    if (!phgmg__all_finite(red->refg, (size_t)r + rn + 1) || !phgmg__all_finite(xbr, (size_t)r)) rc = PHGMG_ERR_NANINF;
+  }
+  phgmg__free(c->alloc, v);
+  phgmg__free(c->alloc, piv);
+  return rc;
+}
+
 /* manifold = ALTMIN under lambda_auto = 1 without a model as good as GMG-POD
    (phgmg__altmin_reference): the same reduction with the hierarchical POD
    manifold; info keeps the altmin objective and sets manifold_fallback. */
@@ -13633,7 +13852,7 @@ PHGMG__PRIV phgmg_result phgmg__reduce_fallback_pod(phgmg_reduced **out, const p
   phgmg_result rc;
   phgmg_reduced_destroy(c->red);
   o.manifold = PHGMG_MANIFOLD_POD;
-  rc = phgmg_reduce(out, c->sys, c->X, c->ldx, c->ns, &o, &inf, c->alloc);
+  rc = phgmg_reduce(out, c->sys, c->Xf, c->ldxf, c->ns, &o, &inf, c->alloc);
   inf.manifold_obj0 = c->inf.manifold_obj0; inf.manifold_obj = c->inf.manifold_obj;
   inf.manifold_sweeps = c->inf.manifold_sweeps; inf.manifold_fallback = 1;
   if (info) *info = inf;
@@ -13670,10 +13889,11 @@ PHGMG__PRIV phgmg_result phgmg__reduce_run(phgmg_reduced **out, const phgmg_ph_s
   c.ro = *opts;
   phgmg__reduce_opts_resolve(&c.ro, ns);
   c.sys = sys; c.o = &c.ro; c.X = X; c.ldx = ldx; c.ns = ns; c.alloc = alloc; c.gsel = -1;
+  c.Xf = X; c.ldxf = ldx;
   c.st = st;
   c.inf.hyper_method = -1;
   rc = phgmg__reduce_check(sys, X, ldx, ns, c.o, st != NULL);
-  if (rc == PHGMG_OK) c.sf = phgmg__study_fast(st, c.o, sys->m);
+  if (rc == PHGMG_OK) c.sf = c.o->ref ? 0 : phgmg__study_fast(st, c.o, sys->m);
   if (rc == PHGMG_OK) rc = phgmg_ph_validate(sys, 0.0, &c.inf.rcond_jr, alloc);
   if (rc != PHGMG_OK) {
     if (info) *info = c.inf;
@@ -13688,13 +13908,15 @@ PHGMG__PRIV phgmg_result phgmg__reduce_run(phgmg_reduced **out, const phgmg_ph_s
   if (rc == PHGMG_OK) rc = phgmg__reduce_descriptor_setup(&c);
   if (rc == PHGMG_OK) rc = phgmg__reduce_new(&c);
   if (rc == PHGMG_OK && c.sf) { c.red->study = st; c.red->sbasis = c.sf; }
-  if (rc == PHGMG_OK) { phgmg__progress(opts, "basis"); rc = phgmg__stage_basis(&c); }
+  if (rc == PHGMG_OK) { phgmg__progress(opts, "basis"); rc = phgmg__stage_reference(&c); }
+  if (rc == PHGMG_OK) rc = phgmg__stage_basis(&c);
   if (rc == PHGMG_OK) { phgmg__progress(opts, "manifold"); rc = phgmg__stage_manifold(&c); }
   if (rc == PHGMG_OK) {
     phgmg__progress(opts, "blocks");
     rc = phgmg__is_gmg(opts->method) ? phgmg__stage_gmg_blocks(&c) : phgmg__stage_sp_blocks(&c);
   }
   if (rc == PHGMG_OK) { phgmg__progress(opts, "hamiltonian"); rc = phgmg__stage_quadratic_terms(&c); }
+  if (rc == PHGMG_OK) rc = phgmg__stage_reference_terms(&c);
   if (rc == PHGMG_OK) { phgmg__progress(opts, "hyper-reduction"); rc = phgmg__stage_separable_terms(&c); }
   if (rc == PHGMG_OK) { phgmg__progress(opts, "finish"); rc = phgmg__stage_general_term(&c); }
   if (rc == PHGMG_OK && opts->dt > 0.0 && c.red->kind == PHGMG_ROM_LINEAR && c.red->nd == 0 &&
@@ -13740,6 +13962,7 @@ PHGMG_DEF void phgmg_reduced_lift(const phgmg_reduced *red, const double *xr, do
       phgmg_gemv('N', red->N, nb, 1.0, red->V2 + (size_t)red->N * i0, red->N, q, 1.0, x);
     }
   }
+  if (red->xbar) phgmg__axpy(red->N, 1.0, red->xbar, x);
 }
 
 PHGMG_DEF void phgmg_reduced_restrict(const phgmg_reduced *red, const double *x, double *xr) {
@@ -13757,6 +13980,7 @@ PHGMG_DEF void phgmg_reduced_restrict(const phgmg_reduced *red, const double *x,
     }
     phgmg_gemv('T', N, r - m, 1.0, red->V0 + (size_t)N * m, N, x, 0.0, xr + m);
   }
+  if (red->xbr) phgmg__axpy(r, -1.0, red->xbr, xr);
 }
 
 PHGMG_DEF void phgmg_reduced_dphi(const phgmg_reduced *red, const double *xr, double *D, int ldd) {
@@ -14024,6 +14248,7 @@ PHGMG__PRIV void phgmg__err_map_block(const phgmg_reduced *red, const double *X,
   int i, j, k;
   if (mode == 2) { /* x - (I - P_{V2})(I - P_{V1})(I - P_{QB}) x, as in orth_remove */
     for (k = 0; k < nb; ++k) memcpy(Xt + (size_t)k * N, X + (size_t)k * ldx, (size_t)N * sizeof(double));
+    for (k = 0; red->xbar && k < nb; ++k) phgmg__axpy(N, -1.0, red->xbar, Xt + (size_t)k * N);
     phgmg__orth_remove(N, m, red->QB, nb, Xt, N, C);
     phgmg__orth_remove(N, r - m, red->V0 + (size_t)N * m, nb, Xt, N, C);
     phgmg__orth_remove(N, rn, red->V2, nb, Xt, N, C);
@@ -14046,6 +14271,7 @@ PHGMG__PRIV void phgmg__err_map_block(const phgmg_reduced *red, const double *X,
       }
       phgmg_gemm('T', 'N', r - m, nb, N, 1.0, red->V0 + (size_t)N * m, N, X, ldx, 0.0, C + m, r);
     }
+    for (k = 0; red->xbr && k < nb; ++k) phgmg__axpy(r, -1.0, red->xbr, C + (size_t)k * r);
     XR = C;
     ldxr = r;
   }
@@ -14069,6 +14295,7 @@ PHGMG__PRIV void phgmg__err_map_block(const phgmg_reduced *red, const double *X,
     }
     phgmg_gemm('N', 'N', N, nb, rq, 1.0, red->V2, N, Qb, rq, 1.0, Xt, N);
   }
+  for (k = 0; red->xbar && k < nb; ++k) phgmg__axpy(N, 1.0, red->xbar, Xt + (size_t)k * N);
 }
 
 /* The sums of phgmg__err_map over all blocks with the differences and
@@ -16086,7 +16313,9 @@ PHGMG_DEF phgmg_result phgmg_ss_error(int n1, const double *A1, const double *B1
 #include <stdint.h>
 
 /* The arrays of a phgmg_rom in file order, with their sizes. */
-#define PHGMG__NFIELDS 22
+#define PHGMG__NFIELDS 29
+/* Bits 22-25 are reserved (no field; a file that sets them is refused). */
+#define PHGMG__FIELDS_RESERVED (15u << 22)
 typedef struct phgmg__field { size_t off; const char *name; } phgmg__field;
 static const phgmg__field phgmg__fields[PHGMG__NFIELDS] = {
   {offsetof(phgmg_rom, Bh), "Bh"},   {offsetof(phgmg_rom, Qh), "Qh"},   {offsetof(phgmg_rom, K), "K"},
@@ -16097,12 +16326,16 @@ static const phgmg__field phgmg__fields[PHGMG__NFIELDS] = {
   {offsetof(phgmg_rom, Gam), "Gam"}, {offsetof(phgmg_rom, SX), "SX"},   {offsetof(phgmg_rom, SU), "SU"},
   {offsetof(phgmg_rom, expo), "expo"},
   {offsetof(phgmg_rom, env_lo), "env_lo"}, {offsetof(phgmg_rom, env_hi), "env_hi"},
-  {offsetof(phgmg_rom, q_max), "q_max"}};
+  {offsetof(phgmg_rom, q_max), "q_max"},
+  {0, NULL}, {0, NULL}, {0, NULL}, {0, NULL},
+  {offsetof(phgmg_rom, ref_g), "ref_g"}, {offsetof(phgmg_rom, ref_s), "ref_s"},
+  {offsetof(phgmg_rom, xr_rest), "xr_rest"}};
 
 PHGMG__ONLINE const phgmg_real **phgmg__field_ptr(phgmg_rom *rom, int i) {
   return PHGMG__CAST(const phgmg_real **, PHGMG__CAST(void *, PHGMG__CAST(char *, PHGMG__CAST(void *, rom)) + phgmg__fields[i].off));
 }
 PHGMG__ONLINE const phgmg_real *phgmg__field_get(const phgmg_rom *rom, int i) {
+  if (!phgmg__fields[i].name) return NULL;
   return *PHGMG__CAST(const phgmg_real *const *, PHGMG__CAST(const void *, PHGMG__CAST(const char *, PHGMG__CAST(const void *, rom)) + phgmg__fields[i].off));
 }
 /* Number of scalars of field i (0 if the field does not apply). */
@@ -16130,7 +16363,11 @@ PHGMG__ONLINE size_t phgmg__field_len(const phgmg_rom *rom, int i) {
     case 17: return 3 * r * 3 * m;
     case 18: return nd ? nf * 2 * (size_t)rom->nexp : 0;
     case 19: case 20: return r;   /* env_lo, env_hi */
-    default: return 1;            /* q_max */
+    case 21: return 1;            /* q_max */
+    case 26: return r + (rom->kind == PHGMG_ROM_QUADRATIC ? rn : 0) + 1;   /* ref_g */
+    case 27: return nd;           /* ref_s */
+    case 28: return r;            /* xr_rest */
+    default: return 0;            /* reserved */
   }
 }
 
@@ -16289,7 +16526,8 @@ PHGMG__ONLINE phgmg_result phgmg__rom_header(const unsigned char *b, size_t len,
     rom->dt = (phgmg_real)dt;
   }
   /* version 1: every field but expo (bit 18, which needs the version-2 header) */
-  if ((mask >> PHGMG__NFIELDS) || (ver == 1u && (mask & (1u << 18)))) return PHGMG_ERR_FORMAT;
+  if ((mask >> PHGMG__NFIELDS) || (mask & PHGMG__FIELDS_RESERVED) || (ver == 1u && (mask & (1u << 18))))
+    return PHGMG_ERR_FORMAT;
   if (rom->m > rom->r) return PHGMG_ERR_FORMAT;
   if ((rom->nphi > 1 && rom->nphi != rom->nd) || (nterm != 0 && nterm != (size_t)rom->nd))
     return PHGMG_ERR_FORMAT;
@@ -16505,7 +16743,7 @@ PHGMG_DEF phgmg_result phgmg_rom_deserialize(const void *buf, size_t len, phgmg_
   if (((size_t)mem) % sizeof(phgmg_real) != 0) return PHGMG_ERR_INVALID_ARG;
   for (i = 0; i < PHGMG__NFIELDS; ++i) {
     const size_t len_i = phgmg__field_len(&tmp, i);
-    if (!(mask & (1u << i))) { *phgmg__field_ptr(&tmp, i) = NULL; continue; }
+    if (!(mask & (1u << i))) { if (phgmg__fields[i].name) *phgmg__field_ptr(&tmp, i) = NULL; continue; }
     for (k = 0; k < len_i; ++k, o += ss)
       dst[k] = ss == 8 ? (phgmg_real)phgmg__get_f64(b + o) : (phgmg_real)phgmg__get_f32(b + o);
     if (!phgmg__r_finite(dst, (int)len_i)) return PHGMG_ERR_FORMAT;
@@ -16656,8 +16894,9 @@ PHGMG_DEF phgmg_result phgmg_rom_export_c(const phgmg_rom *rom, const char *name
   if (rom->eta_cb) ok &= fprintf(f, " %s_eta, NULL,", name) > 0;
   else ok &= fprintf(f, " 0, NULL,") > 0;
   ok &= fprintf(f, " 0, NULL") > 0;
-  for (i = 19; i < 22; ++i) { /* env_lo, env_hi, q_max */
-    if (phgmg__field_get(rom, i)) ok &= fprintf(f, ", %s_%s", name, phgmg__fields[i].name) > 0;
+  for (i = 19; i < PHGMG__NFIELDS; ++i) { /* env_lo, env_hi, q_max, ref_g, ref_s, xr_rest */
+    if (!phgmg__fields[i].name) continue;
+    if (phgmg__field_get(rom, i) && phgmg__field_len(rom, i) > 0) ok &= fprintf(f, ", %s_%s", name, phgmg__fields[i].name) > 0;
     else ok &= fprintf(f, ", NULL") > 0;
   }
   ok &= fprintf(f, "\n};\n") > 0;

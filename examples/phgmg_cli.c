@@ -124,7 +124,16 @@ static const char *const help_lines[] = {
   "                      port coordinates, so m < R <= N; R - m (gmg) or R (sp1/sp2) must\n",
   "                      not exceed the rank of the (adjusted) snapshots.\n",
   "  --rn K              gmg-qm only: lifting dimension r_n (default 8, or the largest that\n",
-  "                      fits; K <= 64, K (R-m) <= 4096, R + K <= N)\n",
+  "                      fits; K <= 4096, R + K <= N). Or:\n",
+  "    --rn wide         V2 over the whole residual of the snapshots (up to its numerical\n",
+  "                      rank and (R-m)(R-m+1)/2): what the greedy and altmin manifolds\n",
+  "                      need on transport data; offline one SVD of the residual\n",
+  "  --ref KIND          affine reference state xbar: none (default) or mean (the mean of\n",
+  "                      the snapshots); the model is phi(x) = xbar + [B, V1] x (+ V2 q),\n",
+  "                      bases and manifold fitted to the snapshots minus xbar. Every\n",
+  "                      method. A run from rest starts at the model's xr_rest = rho(0)\n",
+  "                      (simulate-rom does). Pays off for data not centred at 0\n",
+  "                      (travelling pulses, states about a loaded equilibrium).\n",
   "  --lambda L          gmg-qm only: ridge parameter, on the un-normalised sum over the\n",
   "                      snapshots (0 = exactly zero; the paper's value is 1e-3). Or:\n",
   "    --lambda auto     the default: validated by simulation (the safe choice):\n",
@@ -225,8 +234,9 @@ static const char *const help_lines[] = {
   "  --quiet             no progress lines\n",
   "\n",
   "COMMAND simulate-rom\n",
-  "  Runs a reduced model from xr = 0 with the online GL3 stepper and writes its\n",
-  "  output y, an m x (steps+1) matrix (column n = y(n*DT)).\n",
+  "  Runs a reduced model from rest (the full state 0: xr = 0, or the model's\n",
+  "  xr_rest = rho(0) when it has a reference state, see --ref) with the online GL3\n",
+  "  stepper and writes its output y, an m x (steps+1) matrix (column n = y(n*DT)).\n",
   "  --model FILE        a .phgmgrom file written by reduce (required)\n",
   "  --out FILE          output .npy (required)\n",
   "  --states FILE       also write the reduced states (r x (steps+1)); written together\n",
@@ -1146,6 +1156,7 @@ typedef struct reduce_args {
   int lambda_auto;              /* --lambda auto (1) / cv (2) */
   int manifold;                 /* --manifold pod (0) / greedy (1) / altmin (2) */
   const char *manifold_s;
+  int ref;                      /* --ref none (0) / mean (PHGMG_REF_MEAN) */
   const char *train[16];        /* --train-input KIND, repeatable */
   int ntrain;
   const char *xs[16];           /* --X FILE, repeatable: one run each (X = xs[0]) */
@@ -1291,7 +1302,7 @@ static int parse_reduce(int argc, char **argv, reduce_args *A) {
     STR("--exp", expf) STR("--potential", potential) STR("--hyper", hyper)
     DBL("--hyper-tol", hyper_tol, 0.0)
     STR("--out", out) STR("--name", name) STR("--input", input) STR("--method", method)
-    INT("--steps", steps, 1, INT_MAX - 1) INT("--r", r, 1, INT_MAX) INT("--rn", rn, 1, 64)
+    INT("--steps", steps, 1, INT_MAX - 1) INT("--r", r, 1, INT_MAX) 
     INT("--deim-max", deim_max, 1, INT_MAX) INT("--newton-iter", newton_iter, 1, 1000)
     DBL("--amp", amp, -HUGE_VAL) DBL("--deim-tol", deim_tol, 0.0) DBL("--newton-tol", newton_tol, 0.0)
     else if (!strcmp(o, "--dt")) {
@@ -1304,6 +1315,17 @@ static int parse_reduce(int argc, char **argv, reduce_args *A) {
       else if (!strcmp(v, "cv")) A->lambda_auto = 2;
       else if (!parse_double(o, v, 0.0, &A->lambda)) return 2;
       A->have_lambda = 1;
+    }
+    else if (!strcmp(o, "--rn")) {
+      if (!(v = optval(argc, argv, &i))) return 2;
+      if (!strcmp(v, "wide")) A->rn = PHGMG_RN_WIDE;
+      else if (!parse_int(o, v, 1, 4096, &A->rn)) return 2;
+    }
+    else if (!strcmp(o, "--ref")) {
+      if (!(v = optval(argc, argv, &i))) return 2;
+      if (!strcmp(v, "none")) A->ref = PHGMG_REF_NONE;
+      else if (!strcmp(v, "mean")) A->ref = PHGMG_REF_MEAN;
+      else return usage_error("--ref '%s': expected none or mean", v);
     }
     else if (!strcmp(o, "--manifold")) {
       if (!(v = optval(argc, argv, &i))) return 2;
@@ -1971,8 +1993,8 @@ static int check_sizes(const reduce_args *A, int method, int N, int m) {
   if (method == PHGMG_METHOD_GMG_POD || method == PHGMG_METHOD_GMG_QM) {
     if (A->r <= m || A->r > N)
       return usage_error("--r %d: %s needs m < r <= N (m = %d ports from %s, N = %d)", A->r, A->method, m, A->B, N);
-    if (method == PHGMG_METHOD_GMG_QM && A->rn && (A->rn > N - A->r || A->rn * (A->r - m) > 4096))
-      return usage_error("--rn %d: gmg-qm needs r + r_n <= N (= %d) and r_n (r - m) <= 4096", A->rn, N);
+    if (method == PHGMG_METHOD_GMG_QM && A->rn > 0 && A->rn > N - A->r)
+      return usage_error("--rn %d: gmg-qm needs r + r_n <= N (= %d)", A->rn, N);
     if (method == PHGMG_METHOD_GMG_QM && A->r >= N)
       return usage_error("--r %d: gmg-qm needs r < N (= %d): room for at least one quadratic mode", A->r, N);
   } else if (A->r > N) {
@@ -2111,6 +2133,7 @@ static int run_reduction(const reduce_args *A, reduce_state *S, int method, cons
   o.dt = A->dt_map;
   o.lambda_auto = A->lambda_auto;
   o.manifold = A->manifold;
+  o.ref = A->ref;
   if (S->nrun > 0) { o.nrun = S->nrun; o.runs = S->runs; } /* --simulate: the runs are known */
   if (A->lambda_auto == 1) { o.newton_tol = A->newton_tol; o.newton_iter = A->newton_iter; }
   memset(&info, 0, sizeof info);
@@ -2581,7 +2604,7 @@ static int cmd_simulate_rom(int argc, char **argv) {
   progress("simulating %s (r = %d, m = %d%s): %d steps of dt = %g%s, %s", model, rom.r, rom.m,
            rom.kind == PHGMG_ROM_QUADRATIC ? ", quadratic manifold" : "", steps, dt,
            st.use_map ? " (precomputed step map)" : "", input_desc(&in, inspec));
-  for (a = 0; a < rom.r; ++a) x[a] = (phgmg_real)0;
+  for (a = 0; a < rom.r; ++a) x[a] = rom.xr_rest ? rom.xr_rest[a] : (phgmg_real)0;   /* from rest: rho(0) */
   /* the same sequence of operations as phgmg_reduced_simulate */
 #define RECORD(nn) do { \
     if (XR) for (a = 0; a < rom.r; ++a) XR[a + (size_t)(nn) * rom.r] = (double)x[a]; \

@@ -23,6 +23,7 @@
 #include "test_npy.c"
 #include "test_online.c"
 #include "test_qm_wide.c"
+#include "test_qm_ref.c"
 #include "test_options.c"
 #include "test_sparse.c"
 #include "test_sparse_lu.c"

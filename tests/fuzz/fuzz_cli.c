@@ -147,6 +147,7 @@ static void init(void) {
     "pod", "altmin", "auto", "cv", "1e-300", "1e160", "1e15", "rom", "--E", "--E-coo", "--P", "--S", "--N", "--no-hyper", NULL};
   static const char *const files2[] = {"Jc.npy", "Rc.npy", "Qc.npy", "exp.npy", "o/rom.phgmgrom", "o/rom_V0.npy",
                                        "o/rom.json", NULL};
+  static const char *const words3[] = {"--ref", "mean", "none", "wide", NULL};   /* after files2: seeds keep their meaning */
   char *argv[24];
   int k, fb, argc = 0;   /* fb: the token of files[0] */
   FILE *f;
@@ -160,6 +161,7 @@ static void init(void) {
   for (k = 0; files[k]; ++k) snprintf(g_tok[g_ntok++], sizeof g_tok[0], "%s/%s", g_dir, files[k]);
   for (k = 0; words2[k]; ++k) strcpy(g_tok[g_ntok++], words2[k]);
   for (k = 0; files2[k]; ++k) snprintf(g_tok[g_ntok++], sizeof g_tok[0], "%s/%s", g_dir, files2[k]);
+  for (k = 0; words3[k]; ++k) strcpy(g_tok[g_ntok++], words3[k]);
   /* the model file, made once by the CLI itself */
   restore();
   argv[argc++] = (char *)"phgmg"; argv[argc++] = (char *)"reduce";
