@@ -850,13 +850,14 @@ extern "C" {
   X(PHGMG_ERR_EQ_NOT_SYMMETRIC, -29, "E^T Q is not symmetric (descriptor model)")          \
   X(PHGMG_ERR_EQ_NOT_PD,       -30, "E^T Q is not positive definite (semidefinite for a nonlinear H)") \
   X(PHGMG_ERR_E_COUPLED,       -31, "a row of E at a nonlinear coordinate is not a positive multiple of the unit row") \
-  X(PHGMG_ERR_FEEDTHROUGH,     -32, "feedthrough: [[R, P], [P^T, S]] not symmetric positive semidefinite or N not skew")
+  X(PHGMG_ERR_FEEDTHROUGH,     -32, "feedthrough: [[R, P], [P^T, S]] not symmetric positive semidefinite or N not skew") \
+  X(PHGMG_ERR_DAMPER,          -33, "a damper generates energy (s rho(s) < 0 for some s)")
 
 typedef enum phgmg_result {
 #define PHGMG__X(name, val, str) name = val,
   PHGMG__RESULT_LIST(PHGMG__X)
 #undef PHGMG__X
-  PHGMG__RESULT_END_ = -33
+  PHGMG__RESULT_END_ = -34
 } phgmg_result;
 
 /* A stable, human-readable description of a result code (never NULL). */
@@ -1084,6 +1085,28 @@ typedef struct phgmg_ph_system {
      them; phgmg_ph_output gives (B + P)^T z only (it has no u). Reductions of
      a model with feedthrough are not supported (PHGMG_ERR_UNSUPPORTED). */
   const double *P, *S, *Nskew;
+  /* Nonlinear dissipation (ndamp = 0: none): ndamp dampers, damper k acting
+     on s_k = c_k^T z, c_k = e_i - e_j (i = damp_i[k], j = damp_j[k]; damp_j
+     NULL or damp_j[k] < 0: c_k = e_i), with the force law rho_k:
+         E x' = (J - R) z - sum_k c_k rho_k(c_k^T z) + (B - P) u,
+     so that dH/dt = y^T u - (the dissipation of R, P, S) - sum_k s_k rho_k(s_k).
+     rho_k is either the odd polynomial
+         rho_k(s) = sum_{d=1}^{damp_deg} a_d s^d,  a = damp_poly + t (damp_deg + 1),
+     t = 0 (damp_nfun 0 or 1: one law for all) or t = k (damp_nfun == ndamp),
+     a_0 and every even a_d zero and every odd a_d >= 0 (e.g. a linear plus
+     cubic damper c1 s + c3 s^3: damp_deg = 3, {0, c1, 0, c3}), checked --
+     PHGMG_ERR_DAMPER otherwise -- or the callback damp_fn(k, s, d, user)
+     filling d[0] = rho_k(s), d[1] = rho_k'(s) (used when damp_poly is NULL;
+     s rho_k(s) >= 0 is checked wherever it is evaluated: PHGMG_ERR_DAMPER).
+     damp_deg <= 15. Banded storage: |i - j| <= kb. Not with the shifted_*
+     callbacks (PHGMG_ERR_UNSUPPORTED). Reduction: GMG-POD, SP1, SP2 (manual
+     1.7). */
+  int ndamp;
+  const int *damp_i, *damp_j;
+  int damp_deg, damp_nfun;
+  const double *damp_poly;
+  void (*damp_fn)(int k, double s, double d[2], void *user);
+  void *damp_user;
   /* Set by phgmg_ph_sparse_system (NULL otherwise): the sparse model this
      banded system comes from. The GL3 stepper then solves its stage systems
      with the sparse LU when phgmg_ph_sparse chose it (see >>sparse) and J,
@@ -1121,7 +1144,9 @@ PHGMG_DEF phgmg_result phgmg_ph_validate(const phgmg_ph_system *sys, double tol,
    and from the default allocator above; if that fails the result is NaN. */
 PHGMG_DEF double phgmg_ph_hamiltonian(const phgmg_ph_system *sys, const double *x);
 PHGMG_DEF void phgmg_ph_gradient(const phgmg_ph_system *sys, const double *x, double *g);
-/* f = (J - R) grad H(x) + B u  (u may be NULL = 0). */
+/* f = (J - R) grad H(x) + B u  (u may be NULL = 0); with feedthrough and
+   dampers (E x' =) (J - R) z - sum_k c_k rho_k(c_k^T z) + (B - P) u (all NaN
+   when a callback damper generates energy). */
 PHGMG_DEF void phgmg_ph_rhs(const phgmg_ph_system *sys, const double *x, const double *u, double *f);
 /* y (m) = B^T grad H(x). */
 PHGMG_DEF void phgmg_ph_output(const phgmg_ph_system *sys, const double *x, double *y);
@@ -4432,6 +4457,74 @@ PHGMG__PRIV void phgmg__ph_phi3(const phgmg_ph_system *s, int k, double x, doubl
   d[2] = s->ddphi(k, x, s->user);
 }
 
+/* >>dampers: nonlinear dissipation sum_k c_k rho_k(c_k^T z), c_k = e_i - e_j. */
+#define PHGMG__DAMP_DEG_MAX 15
+PHGMG__PRIV int phgmg__damp_j(const phgmg_ph_system *s, int k) {
+  return s->damp_j ? s->damp_j[k] : -1;
+}
+/* s_k = c_k^T z */
+PHGMG__PRIV double phgmg__damp_s(const phgmg_ph_system *s, int k, const double *z) {
+  const int j = phgmg__damp_j(s, k);
+  return j >= 0 ? z[s->damp_i[k]] - z[j] : z[s->damp_i[k]];
+}
+/* d[0] = rho_k(v), d[1] = rho_k'(v). */
+PHGMG__PRIV void phgmg__damp_law(const phgmg_ph_system *s, int k, double v, double d[2]) {
+  const double *a;
+  int e;
+  if (!s->damp_poly) { s->damp_fn(k, v, d, s->damp_user); return; }
+  a = s->damp_poly + (s->damp_nfun > 1 ? (size_t)k * (size_t)(s->damp_deg + 1) : 0);
+  d[0] = a[s->damp_deg];
+  d[1] = (double)s->damp_deg * a[s->damp_deg];
+  for (e = s->damp_deg - 1; e >= 1; --e) {
+    d[0] = d[0] * v + a[e];
+    d[1] = d[1] * v + (double)e * a[e];
+  }
+  d[0] *= v;
+}
+/* f += alpha sum_k c_k rho_k(c_k^T z); returns sum_k s_k rho_k(s_k), or -1
+   when a callback damper generates energy (s rho(s) < 0) or gives NaN. */
+PHGMG__PRIV double phgmg__damp_apply(const phgmg_ph_system *s, const double *z, double alpha, double *f) {
+  double dis = 0.0, d[2];
+  int k;
+  for (k = 0; k < s->ndamp; ++k) {
+    const double v = phgmg__damp_s(s, k, z);
+    const int j = phgmg__damp_j(s, k);
+    phgmg__damp_law(s, k, v, d);
+    if (!(v * d[0] >= 0.0)) return -1.0;
+    dis += v * d[0];
+    if (f) {
+      f[s->damp_i[k]] += alpha * d[0];
+      if (j >= 0) f[j] -= alpha * d[0];
+    }
+  }
+  return dis;
+}
+/* Damper data: sizes, indices, finite coefficients, a dissipative odd
+   polynomial (PHGMG_ERR_DAMPER for a_0 != 0, an even a_d != 0 or an odd
+   a_d < 0). */
+PHGMG__PRIV phgmg_result phgmg__ph_check_dampers(const phgmg_ph_system *s) {
+  int k, e, nf;
+  if (s->ndamp < 0) return PHGMG_ERR_SIZE;
+  if (!s->damp_i || (!s->damp_poly && !s->damp_fn)) return PHGMG_ERR_INVALID_ARG;
+  if (s->shifted_factor) return PHGMG_ERR_UNSUPPORTED;
+  for (k = 0; k < s->ndamp; ++k) {
+    const int i = s->damp_i[k], j = phgmg__damp_j(s, k);
+    if (i < 0 || i >= s->N || j >= s->N || i == j) return PHGMG_ERR_SIZE;
+    if (s->storage == PHGMG_BANDED && j >= 0 && (i > j ? i - j : j - i) > s->kb) return PHGMG_ERR_SIZE;
+  }
+  if (!s->damp_poly) return PHGMG_OK;
+  if (s->damp_deg < 1 || s->damp_deg > PHGMG__DAMP_DEG_MAX) return PHGMG_ERR_SIZE;
+  if (s->damp_nfun < 0 || (s->damp_nfun > 1 && s->damp_nfun != s->ndamp)) return PHGMG_ERR_SIZE;
+  nf = s->damp_nfun > 1 ? s->damp_nfun : 1;
+  if (!phgmg__all_finite(s->damp_poly, (size_t)nf * (size_t)(s->damp_deg + 1))) return PHGMG_ERR_NANINF;
+  for (k = 0; k < nf; ++k)
+    for (e = 0; e <= s->damp_deg; ++e) {
+      const double a = s->damp_poly[(size_t)k * (size_t)(s->damp_deg + 1) + (size_t)e];
+      if ((e % 2 == 0 && a != 0.0) || a < 0.0) return PHGMG_ERR_DAMPER;
+    }
+  return PHGMG_OK;
+}
+
 /* Structural checks shared by every entry point (no O(N^2) work). */
 PHGMG__PRIV phgmg_result phgmg__ph_check(const phgmg_ph_system *s) {
   int k;
@@ -4465,7 +4558,7 @@ PHGMG__PRIV phgmg_result phgmg__ph_check(const phgmg_ph_system *s) {
       break;
     default: return PHGMG_ERR_INVALID_ARG;
   }
-  return PHGMG_OK;
+  return s->ndamp ? phgmg__ph_check_dampers(s) : PHGMG_OK;
 }
 
 /* Finiteness of the valid entries of a dense or banded system matrix. */
@@ -4592,6 +4685,8 @@ PHGMG_DEF void phgmg_ph_rhs(const phgmg_ph_system *sys, const double *x, const d
       if (sys->P)
         for (i = 0; i < N; ++i) f[i] -= sys->P[(size_t)i + (size_t)j * (size_t)N] * u[j];
     }
+  if (sys->ndamp && phgmg__damp_apply(sys, g, -1.0, f) < 0.0)
+    for (i = 0; i < N; ++i) f[i] = (double)NAN;
   phgmg__free(NULL, tmp);
   phgmg__ph_scratch_free(g, sb);
 }
@@ -5280,6 +5375,49 @@ PHGMG__PRIV phgmg_result phgmg__ph_validate_feedthrough(const phgmg_ph_system *s
   return rc;
 }
 
+/* The linearisation of the dampers at z = 0, L = sum_k rho_k'(0) c_k c_k^T,
+   added to a copy of R: *Rl (dense N x N or band (2kb+1) x N, caller frees).
+   PHGMG_ERR_DAMPER if some rho_k'(0) < 0 (a callback law). */
+PHGMG__PRIV phgmg_result phgmg__damp_r_lin(const phgmg_ph_system *sys, double **Rl, const phgmg_allocator *alloc) {
+  const int N = sys->N;
+  const size_t n = sys->storage == PHGMG_DENSE ? (size_t)N * N : (size_t)(2 * sys->kb + 1) * N;
+  double *R = phgmg__dalloc(alloc, n), d[2];
+  int k;
+  *Rl = R;
+  if (!R) return PHGMG_ERR_NOMEM;
+  memcpy(R, sys->R, n * sizeof(double));
+  for (k = 0; k < sys->ndamp; ++k) {
+    const int i = sys->damp_i[k], j = phgmg__damp_j(sys, k);
+    phgmg__damp_law(sys, k, 0.0, d);
+    if (!(d[1] >= 0.0) || d[1] == HUGE_VAL) return d[1] != d[1] ? PHGMG_ERR_NANINF : PHGMG_ERR_DAMPER;
+#define PHGMG__RL(a, b) R[sys->storage == PHGMG_DENSE ? (size_t)(a) + (size_t)(b) * N : PHGMG__PHB(sys->kb, a, b)]
+    PHGMG__RL(i, i) += d[1];
+    if (j >= 0) {
+      PHGMG__RL(j, j) += d[1];
+      PHGMG__RL(i, j) -= d[1];
+      PHGMG__RL(j, i) -= d[1];
+    }
+#undef PHGMG__RL
+  }
+  return PHGMG_OK;
+}
+
+/* phgmg_jr_factor_create of J - R, or with dampers of J - R - L. */
+PHGMG__PRIV phgmg_result phgmg__damp_jr_factor(phgmg_jr_factor **f, const phgmg_ph_system *sys, double *rcond,
+                                               const phgmg_allocator *alloc) {
+  phgmg_ph_system lin;
+  double *Rl = NULL;
+  phgmg_result rc;
+  if (!sys->ndamp) return phgmg_jr_factor_create(f, sys, rcond, alloc);
+  rc = phgmg__damp_r_lin(sys, &Rl, alloc);
+  lin = *sys;
+  lin.R = Rl;
+  lin.ndamp = 0;
+  if (rc == PHGMG_OK) rc = phgmg_jr_factor_create(f, &lin, rcond, alloc);
+  phgmg__free(alloc, Rl);
+  return rc;
+}
+
 PHGMG_DEF phgmg_result phgmg_ph_validate(const phgmg_ph_system *sys, double tol,
                                          double *rcond_out, const phgmg_allocator *alloc) {
   phgmg_result rc;
@@ -5343,11 +5481,11 @@ PHGMG_DEF phgmg_result phgmg_ph_validate(const phgmg_ph_system *sys, double tol,
     phgmg__free(alloc, jpvt);
     if (rc != PHGMG_OK) return rc;
   }
-  /* J - R invertible */
+  /* J - R invertible (with dampers: J - R - L, L their linearisation at 0) */
   {
     phgmg_jr_factor *f = NULL;
     double rcond = 0.0;
-    rc = phgmg_jr_factor_create(&f, sys, &rcond, alloc);
+    rc = phgmg__damp_jr_factor(&f, sys, &rcond, alloc);
     if (rc == PHGMG_ERR_NOMEM) return rc;
     if (rc != PHGMG_OK) rcond = 0.0;
     phgmg_jr_factor_destroy(f);
@@ -7083,6 +7221,12 @@ struct phgmg_gl3 {
   /* feedthrough (sys.P set): sys.B of this copy is B - P (the input matrix of
      the state equation), Bout = B + P that of the output (NULL: B) */
   double *Bin, *Bout;
+  /* dampers (sys.ndamp > 0): the co-state at the factorization point (N),
+     banded: the damper linearisation sum rho'(s_k) c_k c_k^T by diagonals
+     (offsets -ddm_w .. ddm_w), a callback damper that generated energy */
+  double *dz;
+  phgmg__dia ddm;
+  int ddm_w, damp_bad;
 };
 
 PHGMG_DEF void phgmg_gl3_destroy(phgmg_gl3 *s) {
@@ -7113,6 +7257,8 @@ PHGMG_DEF void phgmg_gl3_destroy(phgmg_gl3 *s) {
   phgmg__dia_free(&al, &s->de);
   phgmg__free(&al, s->Bin);
   phgmg__free(&al, s->Bout);
+  phgmg__free(&al, s->dz);
+  phgmg__dia_free(&al, &s->ddm);
   phgmg__free(&al, s);
 }
 
@@ -7280,7 +7426,7 @@ PHGMG__PRIV void phgmg__gl3_setup_method(phgmg_gl3 *s, const phgmg_gl3_opts *opt
     s->mode = PHGMG__GL3_MAP;
   else if (sys->shifted_factor)
     s->mode = PHGMG__GL3_CALLBACK;
-  else if ((s->sps = phgmg__ph_sparse_lu(sys)) != NULL)
+  else if (!sys->ndamp && (s->sps = phgmg__ph_sparse_lu(sys)) != NULL)
     s->mode = PHGMG__GL3_SPARSE;
   else
     s->mode = sys->storage == PHGMG_DENSE ? PHGMG__GL3_DENSE : PHGMG__GL3_BANDED;
@@ -7329,6 +7475,10 @@ PHGMG__PRIV phgmg_result phgmg__gl3_setup_newton(phgmg_gl3 *s) {
   if (sys->E) {
     s->EZ = phgmg__dalloc(&s->al, N3);
     if (!s->EZ) return PHGMG_ERR_NOMEM;
+  }
+  if (sys->ndamp) {
+    s->dz = phgmg__dalloc(&s->al, (size_t)N);
+    if (!s->dz) return PHGMG_ERR_NOMEM;
   }
   if (sys->nl == PHGMG_NL_SEPARABLE) {
     s->dd = phgmg__dalloc(&s->al, (size_t)N);
@@ -7472,6 +7622,26 @@ PHGMG__PRIV phgmg_result phgmg__gl3_setup_banded(phgmg_gl3 *s) {
   return s->mode == PHGMG__GL3_BANDED ? phgmg__gl3_setup_band_lu(s) : PHGMG_OK;
 }
 
+/* Banded with dampers: the diagonals -w .. w (w = largest |i - j|) of the
+   damper linearisation, refilled at every factorization. */
+PHGMG__PRIV phgmg_result phgmg__gl3_setup_ddm(phgmg_gl3 *s) {
+  const phgmg_ph_system *sys = &s->sys;
+  int k, w = 0;
+  phgmg__dia_free(&s->al, &s->ddm);
+  for (k = 0; k < sys->ndamp; ++k) {
+    const int j = phgmg__damp_j(sys, k), i = sys->damp_i[k];
+    if (j >= 0) w = PHGMG__MAX(w, i > j ? i - j : j - i);
+  }
+  s->ddm_w = w;
+  s->ddm.n = s->N;
+  s->ddm.nd = 2 * w + 1;
+  s->ddm.off = phgmg__ialloc(&s->al, (size_t)(2 * w + 1));
+  s->ddm.v = phgmg__dalloc(&s->al, (size_t)(2 * w + 1) * (size_t)s->N);
+  if (!s->ddm.off || !s->ddm.v) return PHGMG_ERR_NOMEM;
+  for (k = 0; k <= 2 * w; ++k) s->ddm.off[k] = k - w;
+  return PHGMG_OK;
+}
+
 /* The band LU workspaces (bandwidths from the nonzero diagonals). */
 PHGMG__PRIV phgmg_result phgmg__gl3_setup_band_lu(phgmg_gl3 *s) {
   const phgmg_ph_system *sys = &s->sys;
@@ -7493,6 +7663,12 @@ PHGMG__PRIV phgmg_result phgmg__gl3_setup_band_lu(phgmg_gl3 *s) {
       rc = phgmg__dia_build(&s->al, &s->dh, N, kb, NULL, NULL, 1, 1);
       s->hband = phgmg__dalloc(&s->al, (size_t)(2 * kb + 1) * (size_t)N);
       if (rc != PHGMG_OK || !s->hband) return PHGMG_ERR_NOMEM;
+    }
+    if (sys->ndamp) { /* dampers: their linearisation joins J - R */
+      rc = phgmg__gl3_setup_ddm(s);
+      if (rc != PHGMG_OK) return rc;
+      amin = PHGMG__MIN(amin, -s->ddm_w);
+      amax = PHGMG__MAX(amax, s->ddm_w);
     }
     if (sys->E) { /* descriptor: the band of E joins that of (J - R) Hess */
       rc = phgmg__dia_build(&s->al, &s->de, N, kb, sys->E, NULL, 1, 0);
@@ -7579,7 +7755,7 @@ PHGMG_DEF phgmg_result phgmg_gl3_create(phgmg_gl3 **out, const phgmg_ph_system *
   s->contraction = (opts && opts->contraction > 0.0) ? opts->contraction : 0.5;
   s->flush = !(opts && opts->keep_tiny);
   s->ftau = s->flush ? PHGMG__DBL_MIN : 0.0;
-  s->linear = sys->nl == PHGMG_NL_NONE;
+  s->linear = sys->nl == PHGMG_NL_NONE && sys->ndamp == 0;
   if (sys->P && phgmg__gl3_setup_feedthrough(s) != PHGMG_OK) {
     phgmg_gl3_destroy(s);
     return PHGMG_ERR_NOMEM;
@@ -7719,7 +7895,7 @@ PHGMG__PRIV void phgmg__gl3_grad_nl(phgmg_gl3 *s, const double *x, int st) {
   }
 }
 
-PHGMG__PRIV void phgmg__gl3_eval(phgmg_gl3 *s, const double *x) {
+PHGMG__PRIV void phgmg__gl3_eval_jr(phgmg_gl3 *s, const double *x) {
   const phgmg_ph_system *sys = &s->sys;
   int N = s->N, m = s->m, st, i, k;
   int qdiag = sys->storage == PHGMG_BANDED && s->dq.nd == 1;
@@ -7771,6 +7947,18 @@ PHGMG__PRIV void phgmg__gl3_eval(phgmg_gl3 *s, const double *x) {
   }
   phgmg_gemm('N', 'N', N, 3, N, 1.0, s->JR, N, s->G, N, 1.0, s->F, N);
   s->st.rhs_evals += 3;
+}
+
+/* Stage gradients G_i and right-hand sides F_i, with the dampers' forces
+   -sum_k c_k rho_k(c_k^T G_i) (s->damp_bad: a callback damper generated
+   energy). */
+PHGMG__PRIV void phgmg__gl3_eval(phgmg_gl3 *s, const double *x) {
+  int st;
+  phgmg__gl3_eval_jr(s, x);
+  if (!s->sys.ndamp) return;
+  for (st = 0; st < 3; ++st)
+    if (phgmg__damp_apply(&s->sys, s->G + (size_t)st * (size_t)s->N, -1.0, s->F + (size_t)st * (size_t)s->N) < 0.0)
+      s->damp_bad = 1;
 }
 
 /* Both band factorizations without row interchanges: the factors are repacked
@@ -7902,6 +8090,53 @@ PHGMG__PRIV void phgmg__gl3_band_shift_e(phgmg_gl3 *s, double sg, double sa, dou
   }
 }
 
+/* Dense: K1 (= -Jac) += sum_k a_k c_k (c_k^T Hess), Hess = Q + diag(dd)
+   (SEPARABLE) or s->Hs (GENERAL, formed by the caller). One damper at a
+   time, rows i and j. */
+PHGMG__PRIV void phgmg__gl3_damp_jac_dense(phgmg_gl3 *s, const double *x) {
+  const phgmg_ph_system *sys = &s->sys;
+  const int N = s->N;
+  const double *H = sys->nl == PHGMG_NL_GENERAL ? s->Hs : sys->Q;
+  int k, c;
+  phgmg__ph_grad(sys, x, s->dz, s->tmp);   /* the co-state z(x) */
+  for (k = 0; k < sys->ndamp; ++k) {
+    const int i = sys->damp_i[k], j = phgmg__damp_j(sys, k);
+    double d[2], v;
+    phgmg__damp_law(sys, k, phgmg__damp_s(sys, k, s->dz), d);
+    if (d[1] == 0.0) continue;
+    for (c = 0; c < N; ++c) {
+      v = H[(size_t)i + (size_t)c * N] - (j >= 0 ? H[(size_t)j + (size_t)c * N] : 0.0);
+      if (sys->nl == PHGMG_NL_SEPARABLE && c == i) v += s->dd[i];
+      if (sys->nl == PHGMG_NL_SEPARABLE && c == j) v -= s->dd[j];
+      s->K1[(size_t)i + (size_t)c * N] += d[1] * v;
+      if (j >= 0) s->K1[(size_t)j + (size_t)c * N] -= d[1] * v;
+    }
+  }
+}
+
+/* Banded: the diagonals of sum_k a_k c_k c_k^T into s->ddm, and
+   AB1 (= -Jac) += ddm Hess (Hess = dq + diag(dd), or dq + dh). */
+PHGMG__PRIV void phgmg__gl3_damp_jac_band(phgmg_gl3 *s, const double *x) {
+  const phgmg_ph_system *sys = &s->sys;
+  const int N = s->N, w = s->ddm_w, kv = s->kl + s->ku;
+  int k;
+  memset(s->ddm.v, 0, sizeof(double) * (size_t)(2 * w + 1) * (size_t)N);
+  phgmg__ph_grad(sys, x, s->dz, s->tmp);
+  for (k = 0; k < sys->ndamp; ++k) {
+    const int i = sys->damp_i[k], j = phgmg__damp_j(sys, k);
+    double d[2];
+    phgmg__damp_law(sys, k, phgmg__damp_s(sys, k, s->dz), d);
+    s->ddm.v[(size_t)w * N + (size_t)i] += d[1];      /* (i, i): offset 0 */
+    if (j < 0) continue;
+    s->ddm.v[(size_t)w * N + (size_t)j] += d[1];
+    s->ddm.v[(size_t)(j - i + w) * N + (size_t)i] -= d[1];   /* (i, j) */
+    s->ddm.v[(size_t)(i - j + w) * N + (size_t)j] -= d[1];   /* (j, i) */
+  }
+  phgmg__dia_prod_band(&s->ddm, &s->dq, NULL, 1.0, s->AB1, s->ldab, kv);
+  if (sys->nl == PHGMG_NL_SEPARABLE) phgmg__dia_prod_band(&s->ddm, NULL, s->dd, 1.0, s->AB1, s->ldab, kv);
+  else if (sys->nl == PHGMG_NL_GENERAL) phgmg__dia_prod_band(&s->ddm, &s->dh, NULL, 1.0, s->AB1, s->ldab, kv);
+}
+
 /* (Re)factor the shifted Newton matrices at x. */
 /* Sparse LU of both stage matrices (see >>sparse); PHGMG_ERR_SINGULAR when
    a static pivot was replaced or the factors grew beyond PHGMG_SPARSE_GROWTH. */
@@ -7976,6 +8211,7 @@ PHGMG__PRIV phgmg_result phgmg__gl3_factor(phgmg_gl3 *s, const double *x) {
           for (i = 0; i < N; ++i) kc[i] -= jc[i] * dj;
         }
     }
+    if (sys->ndamp) phgmg__gl3_damp_jac_dense(s, x);
     for (e = 0; e < NN; ++e) { s->K2[2 * e] = s->K1[e]; s->K2[2 * e + 1] = 0.0; }
     for (i = 0; i < N; ++i) {
       size_t d = (size_t)i * (size_t)(N + 1);
@@ -8001,6 +8237,7 @@ PHGMG__PRIV phgmg_result phgmg__gl3_factor(phgmg_gl3 *s, const double *x) {
       phgmg__dia_refill(&s->dh, sys->kb, s->hband);
       phgmg__dia_prod_band(&s->djr, &s->dh, NULL, -1.0, s->AB1, ld, kv);
     }
+    if (sys->ndamp) phgmg__gl3_damp_jac_band(s, x);
     for (e = 0; e < tot; ++e) { s->AB2[2 * e] = s->AB1[e]; s->AB2[2 * e + 1] = 0.0; }
     if (sys->E) { /* descriptor: sigma E in place of sigma I */
       phgmg__gl3_band_shift_e(s, sg, sa, sb);
@@ -8082,6 +8319,7 @@ PHGMG__PRIV phgmg_result phgmg__gl3_newton(phgmg_gl3 *s, const double *x, int fr
     /* descriptor: E Z and E W in place of Z and W (the same vectors without E) */
     const double *M0 = Z0, *M1 = Z1, *M2 = Z2, *V0 = W0, *V1 = W1, *V2 = W2;
     phgmg__gl3_eval(s, x);
+    if (s->damp_bad) { s->damp_bad = 0; return PHGMG_ERR_DAMPER; }
     if (s->EZ) {
       phgmg__gl3_e_times(s, s->Z, s->EZ);
       M0 = s->EZ; M1 = s->EZ + N; M2 = s->EZ + 2 * (size_t)N;
@@ -8179,12 +8417,22 @@ PHGMG__PRIV void phgmg__gl3_energy_feedthrough(phgmg_gl3 *s, double energy_inc[2
   energy_inc[1] = s->h * dis;
 }
 
+/* Dampers: h sum_i b_i sum_k s_k rho_k(s_k) at the stage co-states, added
+   to the dissipated energy. */
+PHGMG__PRIV void phgmg__gl3_energy_damp(phgmg_gl3 *s, double energy_inc[2]) {
+  double dis = 0.0;
+  int st;
+  if (!s->sys.ndamp) return;
+  for (st = 0; st < 3; ++st) dis += s->b[st] * phgmg__damp_apply(&s->sys, s->G + (size_t)st * (size_t)s->N, 0.0, NULL);
+  energy_inc[1] += s->h * dis;
+}
+
 /* Supplied and dissipated energy over a step from the stage gradients s->G. */
 PHGMG__PRIV void phgmg__gl3_energy(phgmg_gl3 *s, double energy_inc[2]) {
   const phgmg_ph_system *sys = &s->sys;
   int N = s->N, m = s->m, st, k, i;
   double sup = 0.0, dis = 0.0;
-  if (sys->P || sys->S || sys->Nskew) { phgmg__gl3_energy_feedthrough(s, energy_inc); return; }
+  if (sys->P || sys->S || sys->Nskew) { phgmg__gl3_energy_feedthrough(s, energy_inc); phgmg__gl3_energy_damp(s, energy_inc); return; }
   for (st = 0; st < 3; ++st) {
     const double *g = s->G + (size_t)st * (size_t)N, *u = s->U + (size_t)st * (size_t)m;
     double yu = 0.0;
@@ -8199,6 +8447,7 @@ PHGMG__PRIV void phgmg__gl3_energy(phgmg_gl3 *s, double energy_inc[2]) {
   }
   energy_inc[0] = s->h * sup;
   energy_inc[1] = s->h * dis;
+  phgmg__gl3_energy_damp(s, energy_inc);
 }
 
 PHGMG__PRIV phgmg_result phgmg__gl3_step_map(phgmg_gl3 *s, const double *x, double energy_inc[2]) {
@@ -11407,6 +11656,7 @@ PHGMG__PRIV phgmg_result phgmg__reduce_check(const phgmg_ph_system *sys, const d
   if (!(o->hyper_tol >= 0.0 && o->hyper_tol < 1.0)) return PHGMG_ERR_INVALID_ARG;
   if (o->hyper_reduce && sys->nl == PHGMG_NL_GENERAL) return PHGMG_ERR_UNSUPPORTED;
   if (sys->P || sys->S || sys->Nskew) return PHGMG_ERR_UNSUPPORTED;   /* feedthrough: full model only */
+  if (sys->ndamp) return PHGMG_ERR_UNSUPPORTED;   /* dampers: full model only */
   if (!(o->deim_tol >= 0.0 && o->deim_tol < 1.0) || o->deim_max < 0) return PHGMG_ERR_INVALID_ARG;
   if (!(o->dt >= 0.0) || o->dt == HUGE_VAL) return PHGMG_ERR_INVALID_ARG;
   if (o->lambda != o->lambda || !(o->degeneracy_tol >= 0.0 && o->degeneracy_tol < 1.0)) return PHGMG_ERR_INVALID_ARG;

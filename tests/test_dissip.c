@@ -1,0 +1,248 @@
+/* Nonlinear dissipation (phgmg_ph_system.ndamp: dampers c_k rho_k(c_k^T z)):
+   the full-order stepper's discrete energy balance with the dampers' term,
+   dense against banded storage, linear dampers against the same model with
+   their c1 c c^T added to R (the linear path: the step map), the result
+   codes of dampers that generate energy, and the reduced models (GMG-POD,
+   SP1): their dampers W_z^T c_k, the structure of the reduced dissipation,
+   their energy balance and linear dampers against the linear-R reduction. */
+#define PHGMG_STATIC
+#define PHGMG_IMPLEMENTATION
+#include "../phgmg.h"
+#include "harness.h"
+#include <stdlib.h>
+
+/* ---- model ---------------------------------------------------------------------- */
+/* A chain of n masses (m_k = 1 + k/n) and springs (k_k = 1, fixed at the
+   left), x = (q, p): q the spring elongations, p the momenta, Q = diag(K, M^-1)
+   (K = diag(k)), J couples elongation k with momenta k and k+1 (dq_k/dt =
+   v_k - v_{k+1}, dp_k/dt = f_k - f_{k-1}), small linear damping R = 0.01 on
+   every velocity, one force port at the last mass. Dampers: on the velocity
+   of every third mass (s = v_k), and between masses 1 and 2 (s = v_1 - v_2). */
+typedef struct dpm {
+  int n, N, nd;
+  double *J, *R, *Q, *B;
+  int di[64], dj[64];
+} dpm;
+
+static void dpm_make(dpm *c, int n) {
+  const int N = 2 * n;
+  int k;
+  memset(c, 0, sizeof *c);
+  c->n = n; c->N = N;
+  c->J = (double *)calloc((size_t)N * N, sizeof(double));
+  c->R = (double *)calloc((size_t)N * N, sizeof(double));
+  c->Q = (double *)calloc((size_t)N * N, sizeof(double));
+  c->B = (double *)calloc((size_t)N, sizeof(double));
+  for (k = 0; k < n; ++k) {
+    c->Q[k + (size_t)k * N] = 1.0;
+    c->Q[n + k + (size_t)(n + k) * N] = 1.0 / (1.0 + (double)k / n);
+    c->R[n + k + (size_t)(n + k) * N] = 0.01;
+    /* dq_k = v_{k-1} - v_k (spring k between mass k-1 and k; spring 0 to the wall) */
+    c->J[k + (size_t)(n + k) * N] = -1.0;
+    c->J[n + k + (size_t)k * N] = 1.0;
+    if (k > 0) {
+      c->J[k + (size_t)(n + k - 1) * N] = 1.0;
+      c->J[n + k - 1 + (size_t)k * N] = -1.0;
+    }
+  }
+  c->B[N - 1] = 1.0;
+  for (k = 0; k < n; k += 3) { c->di[c->nd] = n + k; c->dj[c->nd] = -1; c->nd++; }
+  c->di[c->nd] = n + 1; c->dj[c->nd] = n + 2; c->nd++;
+}
+
+static void dpm_free(dpm *c) { free(c->J); free(c->R); free(c->Q); free(c->B); }
+
+static double dpm_law[4] = {0.0, 0.2, 0.0, 3.0}; /* rho(s) = 0.2 s + 3 s^3 */
+
+static phgmg_ph_system dpm_system(const dpm *c, const double *law, int deg) {
+  phgmg_ph_system s;
+  memset(&s, 0, sizeof s);
+  s.N = c->N; s.m = 1; s.J = c->J; s.R = c->R; s.Q = c->Q; s.B = c->B;
+  if (law) {
+    s.ndamp = c->nd; s.damp_i = c->di; s.damp_j = c->dj;
+    s.damp_deg = deg; s.damp_poly = law;
+  }
+  return s;
+}
+
+static const double dp_zero[256];
+
+static void dpm_input(double t, double *u, void *user) {
+  (void)user;
+  u[0] = 2.0 * sin(1.3 * t) * (t < 8.0 ? 1.0 : 0.0);
+}
+
+/* band storage of a dense N x N matrix, half-bandwidth kb */
+static double *dp_band(int N, int kb, const double *A) {
+  double *b = (double *)calloc((size_t)(2 * kb + 1) * N, sizeof(double));
+  int i, j;
+  for (j = 0; j < N; ++j)
+    for (i = (j - kb > 0 ? j - kb : 0); i <= (j + kb < N - 1 ? j + kb : N - 1); ++i)
+      b[(kb + i - j) + (size_t)j * (2 * kb + 1)] = A[i + (size_t)j * N];
+  return b;
+}
+
+static double dp_maxdiff(size_t n, const double *a, const double *b) {
+  double m = 0.0;
+  size_t i;
+  for (i = 0; i < n; ++i) m = fabs(a[i] - b[i]) > m ? fabs(a[i] - b[i]) : m;
+  return m;
+}
+
+static double dp_maxabs(size_t n, const double *a) {
+  double m = 0.0;
+  size_t i;
+  for (i = 0; i < n; ++i) m = fabs(a[i]) > m ? fabs(a[i]) : m;
+  return m;
+}
+
+/* Full model: the energy balance H_n - H_0 = S_n - D_n (D with the dampers'
+   stage quadrature) to round-off for this quadratic H, and the dampers do
+   dissipate (D well above that of R alone); dense and banded storage give
+   the same trajectory (two different Newton matrices, same stages). */
+TEST(test_dissip_fom_energy) {
+  dpm c;
+  const int n = 12, ns = 400;
+  const double dt = 0.05;
+  phgmg_ph_system s, sb, s0;
+  double *X, *Xb, *X0, *H, *S, *D, *H0, *S0, *D0, *Jb, *Rb, *Qb, e = 0.0, hmax = 0.0;
+  phgmg_energy en, en0;
+  int i;
+  dpm_make(&c, n);
+  X = (double *)malloc(sizeof(double) * (size_t)c.N * (ns + 1));
+  Xb = (double *)malloc(sizeof(double) * (size_t)c.N * (ns + 1));
+  X0 = (double *)malloc(sizeof(double) * (size_t)c.N * (ns + 1));
+  H = (double *)malloc(sizeof(double) * 6 * (ns + 1));
+  S = H + (ns + 1); D = S + (ns + 1); H0 = D + (ns + 1); S0 = H0 + (ns + 1); D0 = S0 + (ns + 1);
+  en.H = H; en.S = S; en.D = D;
+  en0.H = H0; en0.S = S0; en0.D = D0;
+  s = dpm_system(&c, dpm_law, 3);
+  s0 = dpm_system(&c, NULL, 0);
+  CHECK_RC(phgmg_ph_validate(&s, 0.0, NULL, NULL), PHGMG_OK);
+  CHECK_RC(phgmg_simulate(&s, dp_zero, 0.0, dt, ns, dpm_input, NULL, NULL, X, NULL, &en, NULL, NULL, NULL), PHGMG_OK);
+  CHECK_RC(phgmg_simulate(&s0, dp_zero, 0.0, dt, ns, dpm_input, NULL, NULL, X0, NULL, &en0, NULL, NULL, NULL), PHGMG_OK);
+  for (i = 0; i <= ns; ++i) {
+    e = fabs(H[i] - H[0] - S[i] + D[i]) > e ? fabs(H[i] - H[0] - S[i] + D[i]) : e;
+    hmax = H[i] > hmax ? H[i] : hmax;
+  }
+  CHECK_LE(e, 1e-11 * hmax);
+  CHECK(D[ns] > 2.0 * D0[ns]);   /* the dampers take out energy */
+  CHECK(D[ns] > 0.0);
+  /* banded storage, half-bandwidth n + 1 covers J's coupling (n) and the pair damper */
+  Jb = dp_band(c.N, n + 1, c.J); Rb = dp_band(c.N, n + 1, c.R); Qb = dp_band(c.N, n + 1, c.Q);
+  sb = s; sb.storage = PHGMG_BANDED; sb.kb = n + 1; sb.J = Jb; sb.R = Rb; sb.Q = Qb;
+  CHECK_RC(phgmg_simulate(&sb, dp_zero, 0.0, dt, ns, dpm_input, NULL, NULL, Xb, NULL, NULL, NULL, NULL, NULL), PHGMG_OK);
+  CHECK_LE(dp_maxdiff((size_t)c.N * (ns + 1), X, Xb), 1e-9 * dp_maxabs((size_t)c.N * (ns + 1), X));
+  free(Jb); free(Rb); free(Qb);
+  free(X); free(Xb); free(X0); free(H);
+  dpm_free(&c);
+}
+
+/* Linear dampers (rho = c1 s) are the linear model with R + sum c1 c c^T:
+   that one runs on the precomputed step map, the damper model on Newton. */
+TEST(test_dissip_fom_linear_damper) {
+  dpm c;
+  const int n = 10, ns = 200;
+  const double dt = 0.05, law[2] = {0.0, 0.7};
+  phgmg_ph_system s, sl;
+  double *X, *Xl, *R2;
+  int k;
+  dpm_make(&c, n);
+  X = (double *)malloc(sizeof(double) * (size_t)c.N * (ns + 1));
+  Xl = (double *)malloc(sizeof(double) * (size_t)c.N * (ns + 1));
+  R2 = (double *)malloc(sizeof(double) * (size_t)c.N * c.N);
+  memcpy(R2, c.R, sizeof(double) * (size_t)c.N * c.N);
+  for (k = 0; k < c.nd; ++k) {
+    const int i = c.di[k], j = c.dj[k];
+    R2[i + (size_t)i * c.N] += law[1];
+    if (j >= 0) {
+      R2[j + (size_t)j * c.N] += law[1];
+      R2[i + (size_t)j * c.N] -= law[1];
+      R2[j + (size_t)i * c.N] -= law[1];
+    }
+  }
+  s = dpm_system(&c, law, 1);
+  sl = dpm_system(&c, NULL, 0);
+  sl.R = R2;
+  CHECK_RC(phgmg_simulate(&s, dp_zero, 0.0, dt, ns, dpm_input, NULL, NULL, X, NULL, NULL, NULL, NULL, NULL), PHGMG_OK);
+  CHECK_RC(phgmg_simulate(&sl, dp_zero, 0.0, dt, ns, dpm_input, NULL, NULL, Xl, NULL, NULL, NULL, NULL, NULL), PHGMG_OK);
+  CHECK_LE(dp_maxdiff((size_t)c.N * (ns + 1), X, Xl), 1e-9 * dp_maxabs((size_t)c.N * (ns + 1), Xl));
+  free(X); free(Xl); free(R2);
+  dpm_free(&c);
+}
+
+static void dp_bad_law(int k, double s, double d[2], void *user) {
+  (void)k; (void)user;
+  d[0] = s > 0.5 ? -s : s;   /* generates energy above s = 0.5 */
+  d[1] = s > 0.5 ? -1.0 : 1.0;
+}
+
+static void dp_tanh_law(int k, double s, double d[2], void *user) {
+  (void)k; (void)user;
+  d[0] = 0.5 * tanh(4.0 * s);
+  d[1] = 2.0 / (cosh(4.0 * s) * cosh(4.0 * s));
+}
+
+/* Dampers that generate energy, and bad damper data, get named codes. */
+TEST(test_dissip_bad_input) {
+  dpm c;
+  const double neg[4] = {0.0, -0.1, 0.0, 1.0}, neg3[4] = {0.0, 0.1, 0.0, -1.0}, a0[2] = {0.1, 1.0},
+               even[3] = {0.0, 1.0, 1.0}, nan1[2] = {0.0, (double)NAN};
+  phgmg_ph_system s;
+  phgmg_gl3 *g = NULL;
+  double x[64], *X;
+  int di_bad[64], k, done = -1;
+  dpm_make(&c, 8);
+  X = (double *)malloc(sizeof(double) * (size_t)c.N * 401);
+  s = dpm_system(&c, neg, 3);
+  CHECK_RC(phgmg_ph_validate(&s, 0.0, NULL, NULL), PHGMG_ERR_DAMPER);
+  CHECK_RC(phgmg_gl3_create(&g, &s, 0.1, NULL, NULL), PHGMG_ERR_DAMPER);
+  CHECK(g == NULL);
+  s = dpm_system(&c, neg3, 3);
+  CHECK_RC(phgmg_ph_validate(&s, 0.0, NULL, NULL), PHGMG_ERR_DAMPER);
+  s = dpm_system(&c, a0, 1);
+  CHECK_RC(phgmg_ph_validate(&s, 0.0, NULL, NULL), PHGMG_ERR_DAMPER);
+  s = dpm_system(&c, even, 2);
+  CHECK_RC(phgmg_ph_validate(&s, 0.0, NULL, NULL), PHGMG_ERR_DAMPER);
+  s = dpm_system(&c, nan1, 1);
+  CHECK_RC(phgmg_ph_validate(&s, 0.0, NULL, NULL), PHGMG_ERR_NANINF);
+  s = dpm_system(&c, dpm_law, 16);
+  CHECK_RC(phgmg_ph_validate(&s, 0.0, NULL, NULL), PHGMG_ERR_SIZE);
+  for (k = 0; k < c.nd; ++k) di_bad[k] = c.di[k];
+  di_bad[0] = c.N;
+  s = dpm_system(&c, dpm_law, 3);
+  s.damp_i = di_bad;
+  CHECK_RC(phgmg_ph_validate(&s, 0.0, NULL, NULL), PHGMG_ERR_SIZE);
+  di_bad[0] = c.dj[c.nd - 1];
+  s.damp_i = c.di; s.damp_j = NULL;   /* fine: single-coordinate dampers */
+  CHECK_RC(phgmg_ph_validate(&s, 0.0, NULL, NULL), PHGMG_OK);
+  s.damp_j = c.dj; s.damp_i = di_bad; /* damper 0 now from i to i: no direction */
+  di_bad[0] = c.dj[0] < 0 ? c.di[0] : c.dj[0];
+  {
+    int dj2[64];
+    for (k = 0; k < c.nd; ++k) dj2[k] = c.dj[k];
+    dj2[0] = di_bad[0];
+    s.damp_j = dj2;
+    CHECK_RC(phgmg_ph_validate(&s, 0.0, NULL, NULL), PHGMG_ERR_SIZE);
+  }
+  s = dpm_system(&c, dpm_law, 3);
+  s.damp_poly = NULL;
+  CHECK_RC(phgmg_ph_validate(&s, 0.0, NULL, NULL), PHGMG_ERR_INVALID_ARG);
+  /* a callback damper that generates energy at large speeds: the step that
+     reaches it fails with PHGMG_ERR_DAMPER, the steps before are kept */
+  s.damp_fn = dp_bad_law;
+  CHECK_RC(phgmg_ph_validate(&s, 0.0, NULL, NULL), PHGMG_OK);
+  for (k = 0; k < c.N; ++k) x[k] = 0.0;
+  CHECK_RC(phgmg_simulate(&s, x, 0.0, 0.05, 400, dpm_input, NULL, NULL, X, NULL, NULL, NULL, &done, NULL), PHGMG_ERR_DAMPER);
+  CHECK(done > 0 && done < 400);
+  s.damp_fn = dp_tanh_law;   /* smooth friction: dissipative */
+  CHECK_RC(phgmg_simulate(&s, x, 0.0, 0.05, 400, dpm_input, NULL, NULL, X, NULL, NULL, NULL, &done, NULL), PHGMG_OK);
+  free(X);
+  dpm_free(&c);
+}
+
+SUITE(dissip) {
+  RUN(test_dissip_fom_energy);
+  RUN(test_dissip_fom_linear_damper);
+  RUN(test_dissip_bad_input);
+}
