@@ -1599,6 +1599,19 @@ typedef struct phgmg_rom {
      snapshots; steps whose correction is larger are counted in
      phgmg_rom_stats.q_outside_steps (0 for M = 0). */
   const phgmg_real *q_max;
+  /* nonlinear dissipation (LINEAR kind; ndamp = 0: none): ndamp reduced
+     dampers, f = K g - sum_j dw_j Cd_j rho_j(Cd_j^T g) + Bh u, g = grad H(x),
+     with dw_j >= 0 and rho_j(s) = sum_{d=1}^{damp_deg} a_d s^d (odd, a_d >= 0;
+     a = dpoly + t (damp_deg + 1), t = 0 (damp_nphi 0 or 1) or j (damp_nphi ==
+     ndamp)), or damp_cb(dterm[j], s, d, damp_user): d = rho, rho' of the
+     full-model damper dterm[j] (not exportable). Manual 1.7. */
+  int ndamp, damp_deg, damp_nphi;
+  const phgmg_real *Cd;     /* r x ndamp: the reduced damper directions W_z^T c_k */
+  const phgmg_real *dw;     /* ndamp weights (NULL: all 1)                         */
+  const phgmg_real *dpoly;  /* (damp_nphi or 1) x (damp_deg + 1), constant term first */
+  void (*damp_cb)(int term, phgmg_real s, phgmg_real d[2], void *user);
+  const int *dterm;         /* ndamp: full-model damper of each kept one (NULL: j) */
+  void *damp_user;
 } phgmg_rom;
 
 /* Checks a model's sizes and pointers for consistency (not its values). */
@@ -8867,7 +8880,64 @@ PHGMG_DEF phgmg_result phgmg_rom_check(const phgmg_rom *rom) {
   }
   if (rom->Phi && (!rom->Gam || !rom->SX || !rom->SU || !(rom->dt > PHGMG__R(0))))
     return PHGMG_ERR_INVALID_ARG;
+  if (rom->ndamp < 0 || rom->ndamp > (1 << 24)) return PHGMG_ERR_SIZE;
+  if (rom->ndamp > 0) {
+    if (rom->kind != PHGMG_ROM_LINEAR || !rom->Cd || (!rom->dpoly && !rom->damp_cb)) return PHGMG_ERR_INVALID_ARG;
+    if (!rom->damp_cb && (rom->damp_deg < 1 || rom->damp_deg > 15)) return PHGMG_ERR_SIZE;
+    if (rom->damp_nphi < 0 || (rom->damp_nphi > 1 && rom->damp_nphi != rom->ndamp)) return PHGMG_ERR_SIZE;
+  }
   return PHGMG_OK;
+}
+
+/* d = rho_j, rho_j' of reduced damper j at s. */
+PHGMG__ONLINE void phgmg__r_damp_law(const phgmg_rom *rom, int j, phgmg_real s, phgmg_real d[2]) {
+  const phgmg_real *a;
+  int e;
+  if (rom->damp_cb) { rom->damp_cb(rom->dterm ? rom->dterm[j] : j, s, d, rom->damp_user); return; }
+  a = rom->dpoly + (rom->damp_nphi > 1 ? (size_t)j * (size_t)(rom->damp_deg + 1) : 0);
+  d[0] = a[rom->damp_deg];
+  d[1] = (phgmg_real)rom->damp_deg * a[rom->damp_deg];
+  for (e = rom->damp_deg - 1; e >= 1; --e) {
+    d[0] = d[0] * s + a[e];
+    d[1] = d[1] * s + (phgmg_real)e * a[e];
+  }
+  d[0] *= s;
+}
+
+/* f -= sum_j dw_j Cd_j rho_j(Cd_j^T g); 1 if a callback damper generated
+   energy (s rho(s) < 0), else 0. */
+PHGMG__ONLINE int phgmg__rom_damp(const phgmg_rom *rom, const phgmg_real *g, phgmg_real *f) {
+  const int r = rom->r;
+  int j, a, bad = 0;
+  for (j = 0; j < rom->ndamp; ++j) {
+    const phgmg_real *cj = rom->Cd + (size_t)j * r;
+    phgmg_real sj = PHGMG__R(0), d[2], c;
+    for (a = 0; a < r; ++a) sj += cj[a] * g[a];
+    phgmg__r_damp_law(rom, j, sj, d);
+    if (sj * d[0] < PHGMG__R(0)) bad = 1;
+    c = (rom->dw ? rom->dw[j] : PHGMG__R(1)) * d[0];
+    for (a = 0; a < r; ++a) f[a] -= c * cj[a];
+  }
+  return bad;
+}
+
+/* Jf -= sum_j dw_j rho_j'(s_j) Cd_j (Cd_j^T Hs), s_j = Cd_j^T g (Hs symmetric);
+   t: r scratch reals. */
+PHGMG__ONLINE void phgmg__rom_damp_jac(const phgmg_rom *rom, const phgmg_real *g, const phgmg_real *Hs,
+                                       phgmg_real *Jf, phgmg_real *t) {
+  const int r = rom->r;
+  int j, a, b;
+  for (j = 0; j < rom->ndamp; ++j) {
+    const phgmg_real *cj = rom->Cd + (size_t)j * r;
+    phgmg_real sj = PHGMG__R(0), d[2], c;
+    for (a = 0; a < r; ++a) sj += cj[a] * g[a];
+    phgmg__r_damp_law(rom, j, sj, d);
+    c = (rom->dw ? rom->dw[j] : PHGMG__R(1)) * d[1];
+    if (c == PHGMG__R(0)) continue;
+    phgmg__r_gemv(r, r, Hs, cj, 0, t);
+    for (b = 0; b < r; ++b)
+      for (a = 0; a < r; ++a) Jf[a + (size_t)b * r] -= c * cj[a] * t[b];
+  }
 }
 
 /* Evaluation work: one layout function used by the size query and by every
@@ -9029,6 +9099,7 @@ PHGMG__ONLINE phgmg_result phgmg__rom_rhs(const phgmg_rom *rom, const phgmg_real
   phgmg__rom_grad(rom, x, w->g, w);
   if (rom->kind == PHGMG_ROM_LINEAR) {
     phgmg__r_gemv(r, r, rom->K, w->g, 0, f);
+    if (rom->ndamp && phgmg__rom_damp(rom, w->g, f)) return PHGMG_ERR_DAMPER;
   } else {
     int i;
     phgmg__rom_dgd(rom, w);
@@ -9160,6 +9231,7 @@ PHGMG__ONLINE phgmg_result phgmg__rom_jac(const phgmg_rom *rom, const phgmg_real
     phgmg_real *Hs = w->E;
     phgmg__rom_hess(rom, x, Hs, w);
     for (b = 0; b < r; ++b) phgmg__r_gemv(r, r, rom->K, Hs + (size_t)b * r, 0, Jf + (size_t)b * r);
+    if (rom->ndamp) phgmg__rom_damp_jac(rom, w->g, Hs, Jf, w->xp);
     return PHGMG_OK;
   }
   phgmg__rom_hess(rom, x, Jf, w); /* Jf = H; w->g, w->Lp at x */
@@ -9247,7 +9319,7 @@ PHGMG__ONLINE size_t phgmg__romstep_layout(const phgmg_rom *rom, int map_only, v
 
 /* Does stepping with dt use the model's precomputed step map? */
 PHGMG__ONLINE int phgmg__rom_uses_map(const phgmg_rom *rom, phgmg_real dt) {
-  return rom->Phi != NULL && rom->kind == PHGMG_ROM_LINEAR && rom->nd == 0 &&
+  return rom->Phi != NULL && rom->kind == PHGMG_ROM_LINEAR && rom->nd == 0 && rom->ndamp == 0 &&
          PHGMG__RABS(rom->dt - dt) <= PHGMG__R(8) * PHGMG__REPS * dt;
 }
 
@@ -9745,6 +9817,11 @@ struct phgmg_reduced {
   double *Ainv;        /* SP1/SP2: (V^T Vg)^{-1}, r x r (W = Vg Ainv)          */
   const phgmg_study *study; /* the study that built it on its cached basis (else NULL) */
   int sbasis;          /* with study: 1 GMG ([B, Ua_1..p(+rn)]), 2 SP1, 3 SP2 (Up_1..r) */
+  /* reduced dampers (manual 1.7): Cd r x ndamp, weights, laws (ndamp rows
+     with one law per damper, else 1), full-model index of each kept damper */
+  int ndamp;
+  double *Cd, *dw, *dpoly;
+  int *dterm;
 };
 
 /* A study (phgmg_study_create): what every reduction of one snapshot set
@@ -11276,6 +11353,38 @@ PHGMG__PRIV phgmg_result phgmg__to_real(phgmg_reduced *red, const double *src, s
   return PHGMG_OK;
 }
 
+/* Reduced damper law by the full model's callback. */
+PHGMG__PRIV void phgmg__damp_tramp(int term, phgmg_real s, phgmg_real d[2], void *user) {
+  const phgmg_reduced *red = PHGMG__CAST(const phgmg_reduced *, user);
+  double dd[2];
+  phgmg__damp_law(red->sys, term, (double)s, dd);
+  d[0] = (phgmg_real)dd[0];
+  d[1] = (phgmg_real)dd[1];
+}
+
+/* The online dampers: Cd, weights, and the laws (the full model's
+   polynomials, one row per kept damper when they differ, or its callback). */
+PHGMG__PRIV phgmg_result phgmg__publish_dampers(phgmg_reduced *red) {
+  const phgmg_ph_system *sys = red->sys;
+  phgmg_rom *o = &red->rom;
+  const size_t r = (size_t)red->r, nd = (size_t)red->ndamp, nc = (size_t)sys->damp_deg + 1;
+  phgmg_result rc;
+  size_t k;
+  o->ndamp = red->ndamp;
+  rc = phgmg__to_real(red, red->Cd, r * nd, &o->Cd);
+  if (rc == PHGMG_OK) rc = phgmg__to_real(red, red->dw, nd, &o->dw);
+  if (rc != PHGMG_OK) return rc;
+  o->dterm = red->dterm;
+  if (!sys->damp_poly) { o->damp_cb = phgmg__damp_tramp; o->damp_user = red; return PHGMG_OK; }
+  o->damp_deg = sys->damp_deg;
+  o->damp_nphi = sys->damp_nfun > 1 ? red->ndamp : 1;
+  red->dpoly = phgmg__red_d(red, (size_t)o->damp_nphi * nc);
+  if (!red->dpoly) return PHGMG_ERR_NOMEM;
+  for (k = 0; k < (size_t)o->damp_nphi; ++k)
+    memcpy(red->dpoly + k * nc, sys->damp_poly + (sys->damp_nfun > 1 ? (size_t)red->dterm[k] * nc : 0), nc * sizeof(double));
+  return phgmg__to_real(red, red->dpoly, (size_t)o->damp_nphi * nc, &o->dpoly);
+}
+
 /* The online model: phgmg_real copies of the blocks, and the callbacks
    through which it evaluates what has no fixed coefficients (separable
    functions given by callbacks, the caller's eta, a GENERAL part). */
@@ -11303,7 +11412,7 @@ PHGMG__PRIV phgmg_result phgmg__publish(phgmg_reduced *red) {
   }
   if (red->eta) { o->eta_cb = red->eta; o->eta_user = red->eta_user; }
   if (red->gwork) { o->ham_cb = phgmg__ham_general; o->ham_user = red; }
-  return rc;
+  return rc == PHGMG_OK && red->ndamp ? phgmg__publish_dampers(red) : rc;
 }
 
 /* GMG-QM ridge validation (phgmg_reduce_opts.lambda_auto). The rows of K
@@ -11656,7 +11765,9 @@ PHGMG__PRIV phgmg_result phgmg__reduce_check(const phgmg_ph_system *sys, const d
   if (!(o->hyper_tol >= 0.0 && o->hyper_tol < 1.0)) return PHGMG_ERR_INVALID_ARG;
   if (o->hyper_reduce && sys->nl == PHGMG_NL_GENERAL) return PHGMG_ERR_UNSUPPORTED;
   if (sys->P || sys->S || sys->Nskew) return PHGMG_ERR_UNSUPPORTED;   /* feedthrough: full model only */
-  if (sys->ndamp) return PHGMG_ERR_UNSUPPORTED;   /* dampers: full model only */
+  if (sys->ndamp && o->method != PHGMG_METHOD_GMG_POD && o->method != PHGMG_METHOD_SP1 &&
+      o->method != PHGMG_METHOD_SP2)
+    return PHGMG_ERR_UNSUPPORTED;   /* dampers: linear maps only (manual 1.7) */
   if (!(o->deim_tol >= 0.0 && o->deim_tol < 1.0) || o->deim_max < 0) return PHGMG_ERR_INVALID_ARG;
   if (!(o->dt >= 0.0) || o->dt == HUGE_VAL) return PHGMG_ERR_INVALID_ARG;
   if (o->lambda != o->lambda || !(o->degeneracy_tol >= 0.0 && o->degeneracy_tol < 1.0)) return PHGMG_ERR_INVALID_ARG;
@@ -13094,6 +13205,96 @@ PHGMG__PRIV phgmg_result phgmg__study_gmg_blocks(phgmg__rctx *c) {
   return PHGMG_OK;
 }
 
+/* >>dampers (reduction, manual 1.7). The reduced dampers of the co-state test
+   basis Wz (N x r): Cd(:, k) = Wz^T c_k = Wz(i_k, :) - Wz(j_k, :). GMG
+   (add_lin = 1): K, built from G = (J - R - L)^{-1}, becomes Wz^T (J - R) Wz
+   = K + sum_k rho_k'(0) Cd_k Cd_k^T. Then, with opts.deim, the dampers are
+   hyper-reduced by ECSW (weights >= 0) on the training forces
+   rho_k(c_k^T z(x_j)). */
+PHGMG__PRIV phgmg_result phgmg__dampers_hyper(phgmg__rctx *c);
+PHGMG__PRIV phgmg_result phgmg__stage_dampers(phgmg__rctx *c, const double *Wz, int add_lin) {
+  phgmg_reduced *red = c->red;
+  const phgmg_ph_system *sys = c->sys;
+  const int N = red->N, r = red->r, nd = sys->ndamp;
+  int k, a, b;
+  red->ndamp = nd;
+  red->Cd = phgmg__red_d(red, (size_t)r * nd);
+  red->dw = phgmg__red_d(red, (size_t)nd);
+  red->dterm = PHGMG__CAST(int *, phgmg__red_alloc(red, (size_t)nd * sizeof(int)));
+  if (!red->Cd || !red->dw || !red->dterm) return PHGMG_ERR_NOMEM;
+  for (k = 0; k < nd; ++k) {
+    const int i = sys->damp_i[k], j = phgmg__damp_j(sys, k);
+    double *ck = red->Cd + (size_t)k * r, d[2];
+    for (a = 0; a < r; ++a) ck[a] = Wz[i + (size_t)a * N] - (j >= 0 ? Wz[j + (size_t)a * N] : 0.0);
+    red->dw[k] = 1.0;
+    red->dterm[k] = k;
+    if (!add_lin) continue;
+    phgmg__damp_law(sys, k, 0.0, d);
+    for (b = 0; b < r; ++b)
+      for (a = 0; a < r; ++a) red->K[a + (size_t)b * r] += d[1] * ck[a] * ck[b];
+  }
+  if (!phgmg__all_finite(red->Cd, (size_t)r * nd)) return PHGMG_ERR_NANINF;
+  return c->o->deim ? phgmg__dampers_hyper(c) : PHGMG_OK;
+}
+
+/* GMG: Wz = G^T (E V0) K^T (Wz^T = K (E V0)^T G), then the reduced dampers. */
+PHGMG__PRIV phgmg_result phgmg__gmg_dampers(phgmg__rctx *c) {
+  phgmg_reduced *red = c->red;
+  const int N = red->N, r = red->r;
+  double *Y = phgmg__dalloc(c->alloc, 2 * (size_t)N * r), *Wz;
+  phgmg_result rc;
+  if (!Y) return PHGMG_ERR_NOMEM;
+  Wz = Y + (size_t)N * r;
+  if (c->sys->E) phgmg__ph_e_apply(c->sys, 'N', r, red->V0, N, Y, N);
+  else memcpy(Y, red->V0, (size_t)N * r * sizeof(double));
+  phgmg_jr_solve(c->jr, 'T', r, Y, N);
+  phgmg_gemm('N', 'T', N, r, r, 1.0, Y, N, red->K, r, 0.0, Wz, N);
+  rc = phgmg__stage_dampers(c, Wz, 1);
+  phgmg__free(c->alloc, Y);
+  return rc;
+}
+
+/* ECSW over the dampers: F(k, j) = rho_k(c_k^T z(x_j)) (PHGMG_ERR_DAMPER if
+   a callback law generates energy there), rows Cd_k; the kept dampers and
+   their weights replace the full set. */
+PHGMG__PRIV phgmg_result phgmg__dampers_hyper(phgmg__rctx *c) {
+  phgmg_reduced *red = c->red;
+  const phgmg_ph_system *sys = c->sys;
+  const int N = red->N, r = red->r, nd = sys->ndamp, ns = c->ns;
+  double *F = phgmg__dalloc(c->alloc, (size_t)nd * ns + (size_t)nd * r + (size_t)N + (size_t)nd);
+  double *Vt, *z, *w, resid = 0.0, d[2];
+  int *pts = phgmg__ialloc(c->alloc, (size_t)nd), j, k, a, nk = 0;
+  phgmg_result rc = PHGMG_OK;
+  if (!F || !pts) { phgmg__free(c->alloc, F); phgmg__free(c->alloc, pts); return PHGMG_ERR_NOMEM; }
+  Vt = F + (size_t)nd * ns; z = Vt + (size_t)nd * r; w = z + N;
+  for (j = 0; j < ns && rc == PHGMG_OK; ++j) {
+    phgmg_ph_gradient(sys, c->X + (size_t)j * c->ldx, z);
+    for (k = 0; k < nd; ++k) {
+      const double v = phgmg__damp_s(sys, k, z);
+      phgmg__damp_law(sys, k, v, d);
+      if (!(v * d[0] >= 0.0)) { rc = d[0] != d[0] ? PHGMG_ERR_NANINF : PHGMG_ERR_DAMPER; break; }
+      F[k + (size_t)j * nd] = d[0];
+    }
+  }
+  for (k = 0; k < nd; ++k)
+    for (a = 0; a < r; ++a) Vt[k + (size_t)a * nd] = red->Cd[a + (size_t)k * r];
+  if (rc == PHGMG_OK)
+    rc = phgmg_ecsw_separable(nd, ns, F, nd, r, Vt, nd, NULL, c->o->hyper_tol, pts, w, &nk, &resid, c->alloc);
+  if (rc == PHGMG_OK) {   /* compact in place: kept dampers first (pts ascending or not, k <= pts[k] is not assumed) */
+    double *C2 = Vt;      /* reuse: r x nk */
+    for (k = 0; k < nk; ++k) {
+      memcpy(C2 + (size_t)k * r, red->Cd + (size_t)pts[k] * r, (size_t)r * sizeof(double));
+      red->dterm[k] = pts[k];
+    }
+    memcpy(red->Cd, C2, (size_t)nk * r * sizeof(double));
+    for (k = 0; k < nk; ++k) red->dw[k] = w[k];
+    red->ndamp = nk;
+  }
+  phgmg__free(c->alloc, F);
+  phgmg__free(c->alloc, pts);
+  return rc;
+}
+
 PHGMG__PRIV phgmg_result phgmg__stage_gmg_blocks(phgmg__rctx *c) {
   phgmg_reduced *red = c->red;
   const int N = red->N, m = red->m, r = red->r, rn = red->rn;
@@ -13102,7 +13303,7 @@ PHGMG__PRIV phgmg_result phgmg__stage_gmg_blocks(phgmg__rctx *c) {
   int j;
   phgmg_result rc = PHGMG_OK;
   if (c->sf != 1) {
-    rc = phgmg_jr_factor_create(&c->jr, c->sys, NULL, c->alloc);
+    rc = phgmg__damp_jr_factor(&c->jr, c->sys, NULL, c->alloc);   /* G = (J - R (- L))^{-1} */
     if (rc != PHGMG_OK) return rc;
     GV = phgmg__dalloc(c->alloc, (size_t)N * (r + rn) * (c->sys->E ? 2 : 1));
     if (!GV) return PHGMG_ERR_NOMEM;
@@ -13143,7 +13344,8 @@ PHGMG__PRIV phgmg_result phgmg__stage_gmg_blocks(phgmg__rctx *c) {
   if (rc != PHGMG_OK || red->kind != PHGMG_ROM_LINEAR) return rc;
   red->K = phgmg__red_d(red, (size_t)r * r);
   if (!red->K) return PHGMG_ERR_NOMEM;
-  return phgmg__inv(r, red->G00, red->K, c->alloc);
+  rc = phgmg__inv(r, red->G00, red->K, c->alloc);
+  return (rc == PHGMG_OK && c->sys->ndamp) ? phgmg__gmg_dampers(c) : rc;
 }
 
 /* Descriptor: X (N x nc, ld N) <- E^T X. */
@@ -13229,6 +13431,7 @@ PHGMG__PRIV phgmg_result phgmg__stage_sp_blocks(phgmg__rctx *c) {
     for (i = 0; i < N * r; ++i) Vg[i] -= T[i];
     phgmg__atb(N, r, r, Wz, Vg, red->K);
     phgmg__atb(N, r, m, Wz, c->sys->B, red->Bh);
+    if (c->sys->ndamp) rc = phgmg__stage_dampers(c, Wz, 0);
   }
   phgmg__free(c->alloc, Vg);
   return rc;
@@ -13579,7 +13782,7 @@ PHGMG__PRIV phgmg_result phgmg__reduce_run(phgmg_reduced **out, const phgmg_ph_s
   c.st = st;
   c.inf.hyper_method = -1;
   rc = phgmg__reduce_check(sys, X, ldx, ns, c.o, st != NULL);
-  if (rc == PHGMG_OK) c.sf = phgmg__study_fast(st, c.o, sys->m);
+  if (rc == PHGMG_OK) c.sf = sys->ndamp ? 0 : phgmg__study_fast(st, c.o, sys->m);
   if (rc == PHGMG_OK) rc = phgmg_ph_validate(sys, 0.0, &c.inf.rcond_jr, alloc);
   if (rc != PHGMG_OK) {
     if (info) *info = c.inf;
@@ -13604,7 +13807,7 @@ PHGMG__PRIV phgmg_result phgmg__reduce_run(phgmg_reduced **out, const phgmg_ph_s
   if (rc == PHGMG_OK) { phgmg__progress(opts, "hyper-reduction"); rc = phgmg__stage_separable_terms(&c); }
   if (rc == PHGMG_OK) { phgmg__progress(opts, "finish"); rc = phgmg__stage_general_term(&c); }
   if (rc == PHGMG_OK && opts->dt > 0.0 && c.red->kind == PHGMG_ROM_LINEAR && c.red->nd == 0 &&
-      sys->nl != PHGMG_NL_GENERAL) {
+      sys->nl != PHGMG_NL_GENERAL && c.red->ndamp == 0) {
     c.red->map_dt = opts->dt;
     rc = phgmg__step_map(c.red, opts->dt, alloc);
   }
@@ -13703,7 +13906,7 @@ PHGMG_DEF phgmg_result phgmg_reduced_W(const phgmg_reduced *red, const double *x
   phgmg_reduced_dphi(red, xr, D, N);
   if (red->sys->E) phgmg__ph_e_apply(red->sys, 'N', r, D, N, GtD, N);   /* descriptor: G_E = E^T G E */
   else memcpy(GtD, D, (size_t)N * r * sizeof(double));
-  rc = phgmg_jr_factor_create(&jr, red->sys, NULL, alloc);
+  rc = phgmg__damp_jr_factor(&jr, red->sys, NULL, alloc);   /* dampers: G = (J - R - L)^{-1} */
   if (rc == PHGMG_OK) {
     phgmg_jr_solve(jr, 'T', r, GtD, N);                      /* G^T D */
     if (red->sys->E) {                                       /* E^T G^T E D, column by column */
@@ -16108,7 +16311,7 @@ PHGMG_DEF phgmg_result phgmg_rom_serialize(const phgmg_rom *rom, void *buf, size
   int i;
   phgmg_result rc = phgmg_rom_check(rom);
   if (rc != PHGMG_OK) return rc;
-  if (rom->phi_cb || rom->eta_cb || rom->ham_cb) return PHGMG_ERR_UNSUPPORTED;
+  if (rom->phi_cb || rom->eta_cb || rom->ham_cb || rom->ndamp) return PHGMG_ERR_UNSUPPORTED;
   if (!buf) return PHGMG_ERR_INVALID_ARG;
   need = phgmg_rom_serialized_size(rom);
   if (cap < need) return PHGMG_ERR_WORKSPACE;
@@ -16501,7 +16704,7 @@ PHGMG_DEF phgmg_result phgmg_rom_export_c(const phgmg_rom *rom, const char *name
   size_t k;
   phgmg_result rc = phgmg_rom_check(rom);
   if (rc != PHGMG_OK) return rc;
-  if (rom->ham_cb) return PHGMG_ERR_UNSUPPORTED;
+  if (rom->ham_cb || rom->ndamp) return PHGMG_ERR_UNSUPPORTED;
   if (!name || !path) return PHGMG_ERR_INVALID_ARG;
   f = fopen(path, "w");
   if (!f) return PHGMG_ERR_IO;

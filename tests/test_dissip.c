@@ -21,8 +21,10 @@
 typedef struct dpm {
   int n, N, nd;
   double *J, *R, *Q, *B;
-  int di[64], dj[64];
+  int di[128], dj[128];
 } dpm;
+
+static int dpm_stride = 3;   /* a damper on every dpm_stride-th mass */
 
 static void dpm_make(dpm *c, int n) {
   const int N = 2 * n;
@@ -46,7 +48,7 @@ static void dpm_make(dpm *c, int n) {
     }
   }
   c->B[N - 1] = 1.0;
-  for (k = 0; k < n; k += 3) { c->di[c->nd] = n + k; c->dj[c->nd] = -1; c->nd++; }
+  for (k = 0; k < n; k += dpm_stride) { c->di[c->nd] = n + k; c->dj[c->nd] = -1; c->nd++; }
   c->di[c->nd] = n + 1; c->dj[c->nd] = n + 2; c->nd++;
 }
 
@@ -241,8 +243,220 @@ TEST(test_dissip_bad_input) {
   dpm_free(&c);
 }
 
+
+/* ---- reduction ------------------------------------------------------------------- */
+static double dp_rel(int n, const double *a, const double *b) {
+  double num = 0.0, den = 0.0;
+  int i;
+  for (i = 0; i < n; ++i) { num += (a[i] - b[i]) * (a[i] - b[i]); den += b[i] * b[i]; }
+  return sqrt(num / den);
+}
+
+/* The reduced dampers are W_z^T c_k with W_z = W from phgmg_reduced_W (E = I),
+   the reduced dissipation is non-negative at sampled states (every damper
+   s rho(s) >= 0, and -g^T f >= 0 at u = 0), Rr = -(K + K^T)/2 is PSD, the
+   online stepper's energy balance holds to round-off (quadratic H), and the
+   reduced output follows the full one (e_y small, much smaller than that of
+   the same reduction without the dampers). */
+static void dp_check_reduced(const dpm *c, const phgmg_ph_system *s, const phgmg_reduced *red, const double *Y,
+                             int ns, double dt, double ey_max) {
+  const phgmg_rom *rom = phgmg_reduced_rom(red);
+  const int N = c->N, r = rom->r;
+  double *W = (double *)malloc(sizeof(double) * (size_t)N * r), xr[64], g[64], f[64], work[4096], Rr[64 * 64],
+         Jr[64 * 64], ev[64], cmax = 0.0, dmax = 0.0;
+  double *YR = (double *)malloc(sizeof(double) * (ns + 1)), *EH = (double *)malloc(sizeof(double) * 3 * (ns + 1));
+  phgmg_energy en;
+  int k, a, t, ok = 1;
+  CHECK(rom->ndamp == c->nd);
+  CHECK_RC(phgmg_reduced_W(red, xr, W, N), PHGMG_OK);
+  for (k = 0; k < rom->ndamp; ++k)
+    for (a = 0; a < r; ++a) {
+      const double v = W[c->di[k] + (size_t)a * N] - (c->dj[k] >= 0 ? W[c->dj[k] + (size_t)a * N] : 0.0);
+      cmax = fabs(v) > cmax ? fabs(v) : cmax;
+      dmax = fabs(v - rom->Cd[a + (size_t)k * r]) > dmax ? fabs(v - rom->Cd[a + (size_t)k * r]) : dmax;
+    }
+  CHECK_LE(dmax, 1e-10 * cmax);
+  for (t = 0; t < 200; ++t) {   /* sampled states: dissipation >= 0 */
+    double gf = 0.0, gg = 0.0;
+    for (a = 0; a < r; ++a) xr[a] = 3.0 * th_rand();
+    phgmg_rom_gradient(rom, xr, g, work);
+    CHECK_RC(phgmg_rom_rhs(rom, xr, NULL, f, work), PHGMG_OK);
+    for (a = 0; a < r; ++a) { gf += g[a] * f[a]; gg += g[a] * g[a]; }
+    if (!(gf <= 1e-12 * gg)) ok = 0;
+    for (k = 0; k < rom->ndamp; ++k) {
+      double sk = 0.0, d[2];
+      for (a = 0; a < r; ++a) sk += rom->Cd[a + (size_t)k * r] * g[a];
+      phgmg__r_damp_law(rom, k, sk, d);
+      if (!(sk * d[0] >= 0.0) || !(rom->dw[k] >= 0.0)) ok = 0;
+    }
+  }
+  CHECK(ok);
+  CHECK_RC(phgmg_rom_structure(rom, xr, Jr, Rr, work), PHGMG_OK);
+  CHECK_RC(phgmg_sym_eig(r, Rr, r, ev, NULL, 0), PHGMG_OK);
+  CHECK(ev[0] >= -1e-12 * fabs(ev[r - 1]));
+  /* reduced run on the training input: energy balance and output error */
+  for (a = 0; a < r; ++a) xr[a] = 0.0;
+  en.H = EH; en.S = EH + ns + 1; en.D = EH + 2 * (ns + 1);
+  CHECK_RC(phgmg_reduced_simulate(red, xr, 0.0, dt, ns, dpm_input, NULL, 1e-13, 20, NULL, YR, &en, NULL, NULL), PHGMG_OK);
+  {
+    double e = 0.0, hm = 0.0;
+    for (t = 0; t <= ns; ++t) {
+      e = fabs(EH[t] - EH[0] - en.S[t] + en.D[t]) > e ? fabs(EH[t] - EH[0] - en.S[t] + en.D[t]) : e;
+      hm = EH[t] > hm ? EH[t] : hm;
+    }
+    CHECK_LE(e, 1e-11 * hm);
+    CHECK(en.D[ns] > 0.0);
+  }
+  CHECK_LE(dp_rel(ns + 1, YR, Y), ey_max);
+  (void)s;
+  free(W); free(YR); free(EH);
+}
+
+TEST(test_dissip_reduce) {
+  dpm c;
+  const int n = 30, ns = 600, rs[2] = {22, 38};
+  const double eys[2] = {1e-2, 1e-5};
+  const double dt = 0.05;
+  const int methods[2] = {PHGMG_METHOD_GMG_POD, PHGMG_METHOD_SP1};
+  phgmg_ph_system s, s0;
+  double *X, *Y;
+  int mi;
+  dpm_make(&c, n);
+  X = (double *)malloc(sizeof(double) * (size_t)c.N * (ns + 1));
+  Y = (double *)malloc(sizeof(double) * (ns + 1));
+  s = dpm_system(&c, dpm_law, 3);
+  s0 = dpm_system(&c, NULL, 0);
+  CHECK_RC(phgmg_simulate(&s, dp_zero, 0.0, dt, ns, dpm_input, NULL, NULL, X, Y, NULL, NULL, NULL, NULL), PHGMG_OK);
+  for (mi = 0; mi < 4; ++mi) {
+    const int r = rs[mi / 2];
+    phgmg_reduce_opts o;
+    phgmg_reduced *red = NULL, *red0 = NULL;
+    double *YR0 = (double *)malloc(sizeof(double) * (ns + 1)), xr[64] = {0};
+    memset(&o, 0, sizeof o);
+    o.method = methods[mi % 2]; o.r = r;
+    CHECK_RC(phgmg_reduce(&red, &s, X, c.N, ns + 1, &o, NULL, NULL), PHGMG_OK);
+    if (red) dp_check_reduced(&c, &s, red, Y, ns, dt, eys[mi / 2]);
+    /* without the dampers the reduced model misses them by far */
+    CHECK_RC(phgmg_reduce(&red0, &s0, X, c.N, ns + 1, &o, NULL, NULL), PHGMG_OK);
+    CHECK_RC(phgmg_reduced_simulate(red0, xr, 0.0, dt, ns, dpm_input, NULL, 0.0, 0, NULL, YR0, NULL, NULL, NULL), PHGMG_OK);
+    CHECK(dp_rel(ns + 1, YR0, Y) > 0.1);
+    phgmg_reduced_destroy(red);
+    phgmg_reduced_destroy(red0);
+    free(YR0);
+  }
+  {   /* GMG-QM: not supported with dampers */
+    phgmg_reduce_opts o;
+    phgmg_reduced *red = NULL;
+    memset(&o, 0, sizeof o);
+    o.method = PHGMG_METHOD_GMG_QM; o.r = 14;
+    CHECK_RC(phgmg_reduce(&red, &s, X, c.N, ns + 1, &o, NULL, NULL), PHGMG_ERR_UNSUPPORTED);
+    CHECK(red == NULL);
+  }
+  free(X); free(Y);
+  dpm_free(&c);
+}
+
+/* Linear dampers: the reduced model equals (to round-off) the reduction of
+   the linear model with R + sum c1 c c^T on the same snapshots -- GMG-POD
+   (whose G is then the same) and SP1. */
+TEST(test_dissip_reduce_linear_damper) {
+  dpm c;
+  const int n = 20, ns = 300, r = 10;
+  const double dt = 0.05, law[2] = {0.0, 0.4};
+  const int methods[2] = {PHGMG_METHOD_GMG_POD, PHGMG_METHOD_SP1};
+  phgmg_ph_system s, sl;
+  double *X, *R2, work[4096];
+  int k, mi, t, a;
+  dpm_make(&c, n);
+  X = (double *)malloc(sizeof(double) * (size_t)c.N * (ns + 1));
+  R2 = (double *)malloc(sizeof(double) * (size_t)c.N * c.N);
+  memcpy(R2, c.R, sizeof(double) * (size_t)c.N * c.N);
+  for (k = 0; k < c.nd; ++k) {
+    const int i = c.di[k], j = c.dj[k];
+    R2[i + (size_t)i * c.N] += law[1];
+    if (j >= 0) {
+      R2[j + (size_t)j * c.N] += law[1];
+      R2[i + (size_t)j * c.N] -= law[1];
+      R2[j + (size_t)i * c.N] -= law[1];
+    }
+  }
+  s = dpm_system(&c, law, 1);
+  sl = dpm_system(&c, NULL, 0);
+  sl.R = R2;
+  CHECK_RC(phgmg_simulate(&sl, dp_zero, 0.0, dt, ns, dpm_input, NULL, NULL, X, NULL, NULL, NULL, NULL, NULL), PHGMG_OK);
+  for (mi = 0; mi < 2; ++mi) {
+    phgmg_reduce_opts o;
+    phgmg_reduced *rd = NULL, *rl = NULL;
+    double dm = 0.0, fm = 0.0;
+    memset(&o, 0, sizeof o);
+    o.method = methods[mi]; o.r = r;
+    CHECK_RC(phgmg_reduce(&rd, &s, X, c.N, ns + 1, &o, NULL, NULL), PHGMG_OK);
+    CHECK_RC(phgmg_reduce(&rl, &sl, X, c.N, ns + 1, &o, NULL, NULL), PHGMG_OK);
+    if (rd && rl)
+      for (t = 0; t < 50; ++t) {
+        double xr[64], fd[64], fl[64], u = th_rand();
+        for (a = 0; a < r; ++a) xr[a] = th_rand();
+        CHECK_RC(phgmg_rom_rhs(phgmg_reduced_rom(rd), xr, &u, fd, work), PHGMG_OK);
+        CHECK_RC(phgmg_rom_rhs(phgmg_reduced_rom(rl), xr, &u, fl, work), PHGMG_OK);
+        for (a = 0; a < r; ++a) {
+          dm = fabs(fd[a] - fl[a]) > dm ? fabs(fd[a] - fl[a]) : dm;
+          fm = fabs(fl[a]) > fm ? fabs(fl[a]) : fm;
+        }
+      }
+    CHECK_LE(dm, 1e-11 * fm);
+    phgmg_reduced_destroy(rd);
+    phgmg_reduced_destroy(rl);
+  }
+  free(X); free(R2);
+  dpm_free(&c);
+}
+
+/* Hyper-reduced dampers (opts.deim = 1, ECSW): a damper on every mass, a
+   few kept with weights >= 0, the reduced model still dissipative, its
+   energy balance exact, its output close to the full one. */
+TEST(test_dissip_reduce_hyper) {
+  dpm c;
+  const int n = 30, ns = 600, r = 22;
+  const double dt = 0.05;
+  phgmg_ph_system s;
+  phgmg_reduce_opts o;
+  phgmg_reduced *red = NULL, *rh = NULL;
+  double *X, *Y, *YR, xr[64] = {0}, ey, eyh;
+  int k;
+  dpm_stride = 1;
+  dpm_make(&c, n);
+  dpm_stride = 3;
+  X = (double *)malloc(sizeof(double) * (size_t)c.N * (ns + 1));
+  Y = (double *)malloc(sizeof(double) * (ns + 1));
+  YR = (double *)malloc(sizeof(double) * (ns + 1));
+  s = dpm_system(&c, dpm_law, 3);
+  CHECK_RC(phgmg_simulate(&s, dp_zero, 0.0, dt, ns, dpm_input, NULL, NULL, X, Y, NULL, NULL, NULL, NULL), PHGMG_OK);
+  memset(&o, 0, sizeof o);
+  o.method = PHGMG_METHOD_GMG_POD; o.r = r;
+  CHECK_RC(phgmg_reduce(&red, &s, X, c.N, ns + 1, &o, NULL, NULL), PHGMG_OK);
+  o.deim = 1;
+  CHECK_RC(phgmg_reduce(&rh, &s, X, c.N, ns + 1, &o, NULL, NULL), PHGMG_OK);
+  if (red && rh) {
+    const phgmg_rom *rom = phgmg_reduced_rom(rh);
+    CHECK(rom->ndamp >= 1 && rom->ndamp < c.nd);
+    for (k = 0; k < rom->ndamp; ++k) CHECK(rom->dw[k] >= 0.0);
+    CHECK_RC(phgmg_reduced_simulate(red, xr, 0.0, dt, ns, dpm_input, NULL, 0.0, 0, NULL, YR, NULL, NULL, NULL), PHGMG_OK);
+    ey = dp_rel(ns + 1, YR, Y);
+    CHECK_RC(phgmg_reduced_simulate(rh, xr, 0.0, dt, ns, dpm_input, NULL, 0.0, 0, NULL, YR, NULL, NULL, NULL), PHGMG_OK);
+    eyh = dp_rel(ns + 1, YR, Y);
+    CHECK_LE(eyh, 2.0 * ey + 1e-3);
+  }
+  phgmg_reduced_destroy(red);
+  phgmg_reduced_destroy(rh);
+  free(X); free(Y); free(YR);
+  dpm_free(&c);
+}
+
 SUITE(dissip) {
   RUN(test_dissip_fom_energy);
   RUN(test_dissip_fom_linear_damper);
   RUN(test_dissip_bad_input);
+  RUN(test_dissip_reduce);
+  RUN(test_dissip_reduce_linear_damper);
+  RUN(test_dissip_reduce_hyper);
 }
