@@ -173,8 +173,8 @@
    and against the closed forms above.
    Not for descriptor models (PHGMG_ERR_UNSUPPORTED): a GENERAL nonlinear part,
    the shifted_* callbacks, the linear-systems toolbox (BT, PRBT, Gramian
-   bases, phgmg_ph_abc) and studies. Singular E (algebraic constraints) and
-   nonlinear dissipation are not supported. Feedthrough (phgmg_ph_system.P,
+   bases, phgmg_ph_abc) and studies. Singular E (algebraic constraints) is
+   not supported; nonlinear dissipation is the subject of 1.7. Feedthrough (phgmg_ph_system.P,
    S, Nskew: E x' = (J - R) z + (B - P) u, y = (B + P)^T z + (S + N) u) is
    taken by the full model -- validation of [[R, P], [P^T, S]] >= 0 and N
    skew (PHGMG_ERR_FEEDTHROUGH), the stepper, outputs, and the energy
@@ -182,6 +182,77 @@
    [z; u] -- but not yet by the reductions (PHGMG_ERR_UNSUPPORTED): the
    reduced model would need the reduced P = W_z^T P and S + N, fields the
    phgmg_rom format does not have.
+
+   1.7 Nonlinear dissipation (phgmg_ph_system.ndamp, damp_*)
+   Dampers r(z) = sum_k c_k rho_k(c_k^T z), c_k = e_i - e_j (a damper between
+   two co-state components, e.g. two velocities) or e_i (one component):
+       E x' = (J - R) z - r(z) + B u,   y = B^T z,
+       dH/dt = z^T E x' = -z^T R z - sum_k s_k rho_k(s_k) + y^T u,  s_k = c_k^T z.
+   The model dissipates iff s rho_k(s) >= 0 for every s. Laws: an odd
+   polynomial sum_d a_d s^d with every a_d >= 0 (a linear plus cubic damper
+   c1 s + c3 s^3 is damp_deg = 3, damp_poly = {0, c1, 0, c3}), checked when
+   the model is validated; or a callback (smooth friction a tanh(b s), ...),
+   whose sign is checked wherever it is evaluated. A law that generates
+   energy (c1 < 0, c3 < 0, an even or constant term, a callback with
+   s rho(s) < 0) is PHGMG_ERR_DAMPER. Example: a chain with cubic dampers on
+   the velocities v_k = p_k / m_k (state index n + k): ndamp = n, damp_i[k]
+   = n + k, damp_j = NULL, damp_deg = 3, damp_poly = {0, 0.2, 0, 3}
+   (tests/test_dissip.c).
+   Full model. GL3 with the dampers in the stage right-hand sides
+   F_i = (J - R) z_i - r(z_i) + B u_i, z_i = z(Y_i); the simplified-Newton
+   matrices take the slopes rho_k' at the factorization point,
+   sigma E - (J - R - sum_k rho_k'(s_k) c_k c_k^T) Hess (dense or banded;
+   the sparse stage LU and the linear step map are not used with dampers).
+   Discrete energy balance: GL3 is the collocation method of the cubic p with
+   p(t_n) = x_n, E p'(t_n + c_i h) = F_i. For a quadratic H,
+   H(p(t))' = z(p)^T E p' is a polynomial of degree 5, integrated exactly by
+   the three-point Gauss rule, so
+       H(x_{n+1}) - H(x_n) = h sum_i b_i z_i^T F_i
+                           = h sum_i b_i (y_i^T u_i - z_i^T R z_i - sum_k s_ik rho_k(s_ik)),
+   s_ik = c_k^T z_i: the balance H_n - H_0 = S_n - D_n holds to round-off and
+   the Newton tolerance whatever rho is, where D sums the dampers' stage
+   quadrature h sum_i b_i s_ik rho_k(s_ik) with that of R (phgmg_energy.D,
+   energy_inc[1]). For a non-quadratic H it holds up to the error of the
+   Gauss rule on H(p(t))'.
+   Reduction (GMG-POD, SP1, SP2; GMG-QM and your manifold are
+   PHGMG_ERR_UNSUPPORTED). With the co-state test basis W_z of 1.6 (E = I:
+   W_z = W) the reduced model replaces the co-state by z^ = W_z grad Hr(xr):
+       xr' = W_z^T (J - R) z^ - W_z^T r(z^) + Bh u
+           = K grad Hr - sum_k Cd_k rho_k(Cd_k^T grad Hr) + Bh u,
+       Cd_k = W_z^T c_k  (phgmg_rom.Cd, r x ndamp),   K = W_z^T (J - R) W_z,
+   so dHr/dt = -z^^T R z^ - sum_k s^_k rho_k(s^_k) + yr^T u with
+   s^_k = c_k^T z^ = Cd_k^T grad Hr: the reduced dampers are the full ones
+   evaluated at the reduced co-state, each dissipative for every argument,
+   and the reduced model is again port-Hamiltonian with the same laws. The
+   reduced stepper is GL3 again: the discrete balance above holds for it with
+   Hr (to round-off for a quadratic Hr, e.g. GMG-POD or SP1 of a quadratic
+   H). Which W: SP1/SP2 as in 1.6. GMG needs a regular G; it takes
+   G = (J - R - L)^{-1}, L = sum_k rho_k'(0) c_k c_k^T (rho_k'(0) >= 0 for a
+   dissipative law), the linearisation of the dampers at rest: any regular G
+   gives W^T D = I and Bh = [I; 0]; this one makes linear dampers
+   (rho = c1 s) reproduce exactly the GMG-POD model of the linear system with
+   R + L, and keeps G regular when all the damping is in the dampers. Then
+   W_z^T = (D^T G_E D)^{-1} (E D)^T G and the stored K = (D^T G_E D)^{-1} +
+   sum_k rho_k'(0) Cd_k Cd_k^T = W_z^T (J - R) W_z (offline: r transposed
+   solves with J - R - L and O(N r^2) work).
+   Online cost and hyper-reduction. Each evaluation costs O(ndamp r): free of
+   N, but every damper is kept, so a model with a damper at every node has an
+   O(N) online cost. opts.deim = 1 hyper-reduces the dampers by empirical
+   quadrature (phgmg_ecsw_separable, tolerance hyper_tol; always ECSW,
+   whatever opts.hyper says): weights dw_k >= 0 on a subset of the dampers
+   such that sum_k dw_k Cd_k rho_k(s_k) matches sum_k Cd_k rho_k(s_k) on the
+   training forces, s_k = c_k^T z(x_j) at the snapshots. Non-negative weights
+   keep every kept term dissipative, so the hyper-reduced model is
+   port-Hamiltonian too.
+   Not (yet) for damper models: model files and C export
+   (PHGMG_ERR_UNSUPPORTED; the reduced model lives in memory), the step map,
+   the studies' fast path (phgmg_study_reduce computes the blocks afresh).
+   tests/test_dissip.c checks each claim: the full balance to 1e-11 H (and
+   that it fails without the dampers' term), dense = banded stepper, linear
+   dampers = the linear model with R + L (full and reduced, GMG-POD and SP1),
+   Cd against phgmg_reduced_W, sampled s rho(s) >= 0 and g^T f <= 0 of the
+   reduced model, the reduced balance, the output error falling with r, and
+   the codes of energy-generating dampers.
 
    2. THE OFFLINE PIPELINE ------------------------------------------------------
    2.1 Simulate. phgmg_simulate (or a phgmg_gl3 object: _create / _step /
@@ -591,6 +662,11 @@
                                     a positive multiple of the unit row
      PHGMG_ERR_FEEDTHROUGH (-32)    [[R, P], [P^T, S]] not symmetric PSD, or N
                                     not skew
+     PHGMG_ERR_DAMPER (-33)         a damper that generates energy: a
+                                    polynomial law with a constant or even
+                                    term or a negative coefficient, or a
+                                    callback law with s rho(s) < 0 where it
+                                    was evaluated (1.7)
    The declaration of each function lists the codes it returns and when.
 
 
@@ -1439,7 +1515,8 @@ typedef struct phgmg_gl3_stats {
 
 /* Energy bookkeeping of one run, per grid point n = 0..nsteps:
    H[n] = H(x_n), S[n] = supplied energy up to t_n (h sum b_i y_i^T u_i),
-   D[n] = dissipated energy up to t_n (h sum b_i gradH(Y_i)^T R gradH(Y_i)),
+   D[n] = dissipated energy up to t_n (h sum b_i gradH(Y_i)^T R gradH(Y_i),
+   plus the dampers' h sum b_i sum_k s_k rho_k(s_k), manual 1.7),
    so e_energy(t_n) = |H[n] - H[0] - S[n] + D[n]| (paper eq.
    def_energy_conserve_error, stage quadrature). */
 typedef struct phgmg_energy {
