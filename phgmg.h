@@ -244,9 +244,10 @@
    training forces, s_k = c_k^T z(x_j) at the snapshots. Non-negative weights
    keep every kept term dissipative, so the hyper-reduced model is
    port-Hamiltonian too.
-   Not (yet) for damper models: model files and C export
-   (PHGMG_ERR_UNSUPPORTED; the reduced model lives in memory), the step map,
-   the studies' fast path (phgmg_study_reduce computes the blocks afresh).
+   Not for damper models: model files and C export of a model
+   with callback laws (PHGMG_ERR_UNSUPPORTED; polynomial laws are saved,
+   format version 3, and exported), the step map, the studies' fast path
+   (phgmg_study_reduce computes the blocks afresh).
    tests/test_dissip.c checks each claim: the full balance to 1e-11 H (and
    that it fails without the dampers' term), dense = banded stepper, linear
    dampers = the linear model with R + L (full and reduced, GMG-POD and SP1),
@@ -546,12 +547,15 @@
    5.2 Shipping a model. phgmg_rom_export_c writes C source (static const
    arrays and a `static const phgmg_rom`), to be compiled after phgmg.h into
    firmware; values round-trip exactly. phgmg_rom_serialize / _save write a
-   versioned, checksummed little-endian binary (format version 2; version 1
-   files still load); phgmg_rom_deserialize / _load read it into caller
+   versioned, checksummed little-endian binary (format version 3 for a model
+   with dampers, 2 for one with several separable functions, else 1; all
+   three load); phgmg_rom_deserialize / _load read it into caller
    memory, checking magic, version, sizes, checksum and values; a file written
    by a double build loads into a float build and vice versa. Models that call
    back into user code cannot be serialised; the C export references the
-   firmware's <name>_phi / <name>_eta instead (a GENERAL model: not at all).
+   firmware's <name>_phi / <name>_eta instead (a GENERAL model, callback
+   dampers: not at all). A loaded model with dampers must have weights >= 0
+   and dissipative laws (PHGMG_ERR_STRUCTURE otherwise).
 
    5.3 Firmware builds. PHGMG_NO_OFFLINE compiles only the online half and the
    in-memory (de)serialisation: libm only, no heap, no stdio. PHGMG_REAL_FLOAT
@@ -2670,7 +2674,7 @@ extern "C" {
 /* Format version 2 adds the exp-polynomial data (nexp, nphi, expo, per-term
    poly) and the term indices; a model without them is still written as
    version 1, and both versions load. */
-#define PHGMG_ROM_FORMAT_VERSION 2u
+#define PHGMG_ROM_FORMAT_VERSION 3u
 
 /* Bytes phgmg_rom_serialize writes for this model. */
 PHGMG_DEF size_t phgmg_rom_serialized_size(const phgmg_rom *rom);
@@ -16272,7 +16276,7 @@ PHGMG_DEF phgmg_result phgmg_ss_error(int n1, const double *A1, const double *B1
 #include <stdint.h>
 
 /* The arrays of a phgmg_rom in file order, with their sizes. */
-#define PHGMG__NFIELDS 22
+#define PHGMG__NFIELDS 25
 typedef struct phgmg__field { size_t off; const char *name; } phgmg__field;
 static const phgmg__field phgmg__fields[PHGMG__NFIELDS] = {
   {offsetof(phgmg_rom, Bh), "Bh"},   {offsetof(phgmg_rom, Qh), "Qh"},   {offsetof(phgmg_rom, K), "K"},
@@ -16283,7 +16287,8 @@ static const phgmg__field phgmg__fields[PHGMG__NFIELDS] = {
   {offsetof(phgmg_rom, Gam), "Gam"}, {offsetof(phgmg_rom, SX), "SX"},   {offsetof(phgmg_rom, SU), "SU"},
   {offsetof(phgmg_rom, expo), "expo"},
   {offsetof(phgmg_rom, env_lo), "env_lo"}, {offsetof(phgmg_rom, env_hi), "env_hi"},
-  {offsetof(phgmg_rom, q_max), "q_max"}};
+  {offsetof(phgmg_rom, q_max), "q_max"},
+  {offsetof(phgmg_rom, Cd), "Cd"}, {offsetof(phgmg_rom, dw), "dw"}, {offsetof(phgmg_rom, dpoly), "dpoly"}};
 
 PHGMG__ONLINE const phgmg_real **phgmg__field_ptr(phgmg_rom *rom, int i) {
   return PHGMG__CAST(const phgmg_real **, PHGMG__CAST(void *, PHGMG__CAST(char *, PHGMG__CAST(void *, rom)) + phgmg__fields[i].off));
@@ -16316,7 +16321,10 @@ PHGMG__ONLINE size_t phgmg__field_len(const phgmg_rom *rom, int i) {
     case 17: return 3 * r * 3 * m;
     case 18: return nd ? nf * 2 * (size_t)rom->nexp : 0;
     case 19: case 20: return r;   /* env_lo, env_hi */
-    default: return 1;            /* q_max */
+    case 21: return 1;            /* q_max */
+    case 22: return r * (size_t)rom->ndamp;   /* Cd */
+    case 23: return (size_t)rom->ndamp;       /* dw */
+    default: return rom->ndamp ? (size_t)(rom->damp_nphi > 1 ? rom->damp_nphi : 1) * ((size_t)rom->damp_deg + 1) : 0;
   }
 }
 
@@ -16326,8 +16334,12 @@ PHGMG__ONLINE size_t phgmg__field_len(const phgmg_rom *rom, int i) {
    q_max, bits 19-21, may sit in either version); nterm (0 or nd) uint32 term
    indices after the scalars. */
 #define PHGMG__HDR2_BYTES (PHGMG__HDR_BYTES + 12)
+/* Version 3 (written only for a model with dampers): the version-2 header,
+   then ndamp, damp_deg, damp_nphi; the fields Cd, dw, dpoly (bits 22-24). */
+#define PHGMG__HDR3_BYTES (PHGMG__HDR2_BYTES + 12)
+PHGMG__ONLINE int phgmg__rom_v3(const phgmg_rom *rom) { return rom->ndamp > 0; }
 PHGMG__ONLINE int phgmg__rom_v2(const phgmg_rom *rom) {
-  return rom->nd > 0 && (rom->nexp > 0 || rom->nphi > 1 || rom->term);
+  return (rom->nd > 0 && (rom->nexp > 0 || rom->nphi > 1 || rom->term)) || phgmg__rom_v3(rom);
 }
 PHGMG__ONLINE size_t phgmg__rom_nterm(const phgmg_rom *rom) {
   return phgmg__rom_v2(rom) && rom->term ? (size_t)rom->nd : 0;
@@ -16378,7 +16390,8 @@ PHGMG_DEF size_t phgmg_rom_serialized_size(const phgmg_rom *rom) {
   for (i = 0; i < PHGMG__NFIELDS; ++i)
     if (phgmg__field_get(rom, i)) n += phgmg__field_len(rom, i);
   if (!phgmg__rom_v2(rom)) return PHGMG__HDR_BYTES + n * sizeof(phgmg_real) + 4;
-  return PHGMG__HDR2_BYTES + n * sizeof(phgmg_real) + 4 * phgmg__rom_nterm(rom) + 4;
+  return (phgmg__rom_v3(rom) ? PHGMG__HDR3_BYTES : PHGMG__HDR2_BYTES) + n * sizeof(phgmg_real) +
+         4 * phgmg__rom_nterm(rom) + 4;
 }
 
 PHGMG_DEF phgmg_result phgmg_rom_serialize(const phgmg_rom *rom, void *buf, size_t cap, size_t *written) {
@@ -16388,14 +16401,14 @@ PHGMG_DEF phgmg_result phgmg_rom_serialize(const phgmg_rom *rom, void *buf, size
   int i;
   phgmg_result rc = phgmg_rom_check(rom);
   if (rc != PHGMG_OK) return rc;
-  if (rom->phi_cb || rom->eta_cb || rom->ham_cb || rom->ndamp) return PHGMG_ERR_UNSUPPORTED;
+  if (rom->phi_cb || rom->eta_cb || rom->ham_cb || rom->damp_cb) return PHGMG_ERR_UNSUPPORTED;
   if (!buf) return PHGMG_ERR_INVALID_ARG;
   need = phgmg_rom_serialized_size(rom);
   if (cap < need) return PHGMG_ERR_WORKSPACE;
   for (i = 0; i < PHGMG__NFIELDS; ++i)
     if (phgmg__field_get(rom, i)) mask |= 1u << i;
   memcpy(b, "PHGMGROM", 8);
-  phgmg__put32(b + 8, phgmg__rom_v2(rom) ? PHGMG_ROM_FORMAT_VERSION : 1u);
+  phgmg__put32(b + 8, phgmg__rom_v3(rom) ? 3u : phgmg__rom_v2(rom) ? 2u : 1u);
   phgmg__put32(b + 12, (uint32_t)sizeof(phgmg_real));
   phgmg__put32(b + 16, (uint32_t)rom->kind);
   phgmg__put32(b + 20, (uint32_t)rom->method);
@@ -16412,6 +16425,12 @@ PHGMG_DEF phgmg_result phgmg_rom_serialize(const phgmg_rom *rom, void *buf, size
     phgmg__put32(b + o + 4, (uint32_t)rom->nphi);
     phgmg__put32(b + o + 8, (uint32_t)phgmg__rom_nterm(rom));
     o = PHGMG__HDR2_BYTES;
+  }
+  if (phgmg__rom_v3(rom)) {
+    phgmg__put32(b + o, (uint32_t)rom->ndamp);
+    phgmg__put32(b + o + 4, (uint32_t)rom->damp_deg);
+    phgmg__put32(b + o + 8, (uint32_t)rom->damp_nphi);
+    o = PHGMG__HDR3_BYTES;
   }
   for (i = 0; i < PHGMG__NFIELDS; ++i) {
     const phgmg_real *a = phgmg__field_get(rom, i);
@@ -16443,11 +16462,21 @@ PHGMG__ONLINE phgmg_result phgmg__rom_header(const unsigned char *b, size_t len,
   if (len < PHGMG__HDR_BYTES + 4 || memcmp(b, "PHGMGROM", 8) != 0) return PHGMG_ERR_FORMAT;
   ver = phgmg__get32(b + 8);
   ss = phgmg__get32(b + 12);
-  if ((ver != 1u && ver != PHGMG_ROM_FORMAT_VERSION) || (ss != 4 && ss != 8)) return PHGMG_ERR_FORMAT;
+  if ((ver != 1u && ver != 2u && ver != 3u) || (ss != 4 && ss != 8)) return PHGMG_ERR_FORMAT;
   memset(rom, 0, sizeof *rom);
-  if (ver == 2u) {
+  if (ver == 3u) {
+    if (len < PHGMG__HDR3_BYTES + 4) return PHGMG_ERR_FORMAT;
+    if (phgmg__get32(b + 68) < 1u || phgmg__get32(b + 68) > (1u << 24) || phgmg__get32(b + 72) < 1u ||
+        phgmg__get32(b + 72) > 15u || phgmg__get32(b + 76) > (1u << 24))
+      return PHGMG_ERR_FORMAT;
+    rom->ndamp = (int)phgmg__get32(b + 68);
+    rom->damp_deg = (int)phgmg__get32(b + 72);
+    rom->damp_nphi = (int)phgmg__get32(b + 76);
+    if (rom->damp_nphi > 1 && rom->damp_nphi != rom->ndamp) return PHGMG_ERR_FORMAT;
+  }
+  if (ver >= 2u) {
     if (len < PHGMG__HDR2_BYTES + 4) return PHGMG_ERR_FORMAT;
-    hdr = PHGMG__HDR2_BYTES;
+    hdr = ver == 3u ? PHGMG__HDR3_BYTES : PHGMG__HDR2_BYTES;
     if (phgmg__get32(b + 56) > 8u || phgmg__get32(b + 60) > (1u << 24) || phgmg__get32(b + 64) > (1u << 24))
       return PHGMG_ERR_FORMAT;
     rom->nexp = (int)phgmg__get32(b + 56);
@@ -16476,6 +16505,8 @@ PHGMG__ONLINE phgmg_result phgmg__rom_header(const unsigned char *b, size_t len,
   }
   /* version 1: every field but expo (bit 18, which needs the version-2 header) */
   if ((mask >> PHGMG__NFIELDS) || (ver == 1u && (mask & (1u << 18)))) return PHGMG_ERR_FORMAT;
+  /* dampers (bits 22-24) exactly in version 3, all three */
+  if ((ver == 3u) != ((mask & (7u << 22)) == (7u << 22)) || (ver != 3u && (mask & (7u << 22)))) return PHGMG_ERR_FORMAT;
   if (rom->m > rom->r) return PHGMG_ERR_FORMAT;
   if ((rom->nphi > 1 && rom->nphi != rom->nd) || (nterm != 0 && nterm != (size_t)rom->nd))
     return PHGMG_ERR_FORMAT;
@@ -16628,6 +16659,22 @@ PHGMG__ONLINE int phgmg__rom_map_ok(const phgmg_rom *rom, double eps, phgmg_real
 /* The load-time structure check (see above) of a model that passed
    phgmg_rom_check; eps: the unit roundoff of the values (the larger of the
    file's scalars' and phgmg_real's); w: phgmg__rom_phys_work(rom) reals. */
+/* Dampers of a loaded model dissipate: weights >= 0, every law an odd
+   polynomial with coefficients >= 0 (manual 1.7). */
+PHGMG__ONLINE phgmg_result phgmg__rom_damp_ok(const phgmg_rom *rom) {
+  const int nf = rom->damp_nphi > 1 ? rom->damp_nphi : 1;
+  int j, e;
+  if (!rom->dpoly || !rom->dw) return PHGMG_ERR_STRUCTURE;
+  for (j = 0; j < rom->ndamp; ++j)
+    if (!(rom->dw[j] >= PHGMG__R(0))) return PHGMG_ERR_STRUCTURE;
+  for (j = 0; j < nf; ++j)
+    for (e = 0; e <= rom->damp_deg; ++e) {
+      const phgmg_real a = rom->dpoly[(size_t)j * (size_t)(rom->damp_deg + 1) + (size_t)e];
+      if ((e % 2 == 0 && a != PHGMG__R(0)) || a < PHGMG__R(0)) return PHGMG_ERR_STRUCTURE;
+    }
+  return PHGMG_OK;
+}
+
 PHGMG__ONLINE phgmg_result phgmg__rom_physics(const phgmg_rom *rom, double eps, phgmg_real *w) {
   const int r = rom->r, quad = rom->kind == PHGMG_ROM_QUADRATIC, rn = quad ? rom->rn : 0, n2 = r + rn;
   const phgmg_real tol = (phgmg_real)sqrt(eps);
@@ -16659,7 +16706,7 @@ PHGMG__ONLINE phgmg_result phgmg__rom_physics(const phgmg_rom *rom, double eps, 
     }
   if (!phgmg__r_psd_shifted(n2, w, tol)) return PHGMG_ERR_STRUCTURE;
   if (rom->Phi && (!rom->K || !phgmg__rom_map_ok(rom, eps, w))) return PHGMG_ERR_STRUCTURE;
-  return PHGMG_OK;
+  return rom->ndamp ? phgmg__rom_damp_ok(rom) : PHGMG_OK;
 }
 
 PHGMG_DEF phgmg_result phgmg_rom_deserialize_size(const void *buf, size_t len, size_t *need) {
@@ -16687,7 +16734,7 @@ PHGMG_DEF phgmg_result phgmg_rom_deserialize(const void *buf, size_t len, phgmg_
   if (rc != PHGMG_OK) return rc;
   if (mem_size < (n + phgmg__rom_phys_work(&tmp)) * sizeof(phgmg_real) + sizeof(phgmg_real) + nterm * sizeof(int))
     return PHGMG_ERR_WORKSPACE;
-  o = phgmg__get32(b + 8) == 1u ? PHGMG__HDR_BYTES : PHGMG__HDR2_BYTES;
+  o = phgmg__get32(b + 8) == 1u ? PHGMG__HDR_BYTES : phgmg__get32(b + 8) == 2u ? PHGMG__HDR2_BYTES : PHGMG__HDR3_BYTES;
   if (((size_t)mem) % sizeof(phgmg_real) != 0) return PHGMG_ERR_INVALID_ARG;
   for (i = 0; i < PHGMG__NFIELDS; ++i) {
     const size_t len_i = phgmg__field_len(&tmp, i);
@@ -16781,7 +16828,7 @@ PHGMG_DEF phgmg_result phgmg_rom_export_c(const phgmg_rom *rom, const char *name
   size_t k;
   phgmg_result rc = phgmg_rom_check(rom);
   if (rc != PHGMG_OK) return rc;
-  if (rom->ham_cb || rom->ndamp) return PHGMG_ERR_UNSUPPORTED;
+  if (rom->ham_cb || rom->damp_cb) return PHGMG_ERR_UNSUPPORTED;
   if (!name || !path) return PHGMG_ERR_INVALID_ARG;
   f = fopen(path, "w");
   if (!f) return PHGMG_ERR_IO;
@@ -16846,6 +16893,13 @@ PHGMG_DEF phgmg_result phgmg_rom_export_c(const phgmg_rom *rom, const char *name
     if (phgmg__field_get(rom, i)) ok &= fprintf(f, ", %s_%s", name, phgmg__fields[i].name) > 0;
     else ok &= fprintf(f, ", NULL") > 0;
   }
+  /* dampers: ndamp, damp_deg, damp_nphi, Cd, dw, dpoly (damp_cb, dterm, damp_user: 0) */
+  ok &= fprintf(f, ",\n  %d, %d, %d", rom->ndamp, rom->damp_deg, rom->damp_nphi) > 0;
+  for (i = 22; i < 25; ++i) {
+    if (phgmg__field_get(rom, i) && phgmg__field_len(rom, i) > 0) ok &= fprintf(f, ", %s_%s", name, phgmg__fields[i].name) > 0;
+    else ok &= fprintf(f, ", NULL") > 0;
+  }
+  ok &= fprintf(f, ", 0, NULL, NULL") > 0;
   ok &= fprintf(f, "\n};\n") > 0;
   if (fclose(f) != 0) ok = 0;
   return ok ? PHGMG_OK : PHGMG_ERR_IO;

@@ -452,6 +452,77 @@ TEST(test_dissip_reduce_hyper) {
   dpm_free(&c);
 }
 
+/* Model files: a damper model round-trips (format version 3) and steps to
+   the same bits; a file whose damper law was rewritten to generate energy
+   (checksum recomputed) is refused with PHGMG_ERR_STRUCTURE; callback
+   dampers cannot be saved. */
+TEST(test_dissip_rom_file) {
+  dpm c;
+  const int n = 12, ns = 200, r = 8;
+  const double dt = 0.05;
+  phgmg_ph_system s;
+  phgmg_reduce_opts o;
+  phgmg_reduced *red = NULL;
+  double *X;
+  dpm_make(&c, n);
+  X = (double *)malloc(sizeof(double) * (size_t)c.N * (ns + 1));
+  s = dpm_system(&c, dpm_law, 3);
+  CHECK_RC(phgmg_simulate(&s, dp_zero, 0.0, dt, ns, dpm_input, NULL, NULL, X, NULL, NULL, NULL, NULL, NULL), PHGMG_OK);
+  memset(&o, 0, sizeof o);
+  o.method = PHGMG_METHOD_SP1; o.r = r;
+  CHECK_RC(phgmg_reduce(&red, &s, X, c.N, ns + 1, &o, NULL, NULL), PHGMG_OK);
+  if (red) {
+    const phgmg_rom *rom = phgmg_reduced_rom(red);
+    size_t sz = phgmg_rom_serialized_size(rom), w = 0, need = 0;
+    unsigned char *buf = (unsigned char *)malloc(sz);
+    double *mem = NULL, mem1[4096], mem2[4096], x1[16] = {0}, x2[16] = {0}, u3[3];
+    phgmg_rom lr;
+    phgmg_rom_stepper s1, s2;
+    int t, a, same = 1;
+    CHECK_RC(phgmg_rom_serialize(rom, buf, sz, &w), PHGMG_OK);
+    CHECK(w == sz);
+    CHECK(buf[8] == 3);
+    CHECK_RC(phgmg_rom_deserialize_size(buf, w, &need), PHGMG_OK);
+    mem = (double *)malloc(need);
+    CHECK_RC(phgmg_rom_deserialize(buf, w, &lr, mem, need), PHGMG_OK);
+    CHECK(lr.ndamp == rom->ndamp && lr.damp_deg == 3);
+    CHECK_RC(phgmg_rom_stepper_init(&s1, rom, dt, 0.0, 0, mem1, sizeof mem1), PHGMG_OK);
+    CHECK_RC(phgmg_rom_stepper_init(&s2, &lr, dt, 0.0, 0, mem2, sizeof mem2), PHGMG_OK);
+    for (t = 0; t < 100; ++t) {
+      u3[0] = u3[1] = u3[2] = sin(0.1 * t);
+      CHECK_RC(phgmg_rom_step(&s1, x1, u3, NULL, NULL), PHGMG_OK);
+      CHECK_RC(phgmg_rom_step(&s2, x2, u3, NULL, NULL), PHGMG_OK);
+      for (a = 0; a < r; ++a) if (x1[a] != x2[a]) same = 0;
+    }
+    CHECK(same);
+    {   /* the cubic coefficient made negative, checksum fixed: refused */
+      const size_t o3 = w - 4 - 8 * 1;   /* dpoly is the last field: a_3 its last scalar */
+      double v;
+      uint32_t h;
+      memcpy(&v, buf + o3, 8);
+      CHECK(v == 3.0);
+      v = -3.0;
+      memcpy(buf + o3, &v, 8);
+      h = phgmg__fnv1a(buf, w - 4);
+      phgmg__put32(buf + w - 4, h);
+      CHECK_RC(phgmg_rom_deserialize(buf, w, &lr, mem, need), PHGMG_ERR_STRUCTURE);
+    }
+    free(buf);
+    free(mem);
+  }
+  phgmg_reduced_destroy(red);
+  s.damp_poly = NULL; s.damp_fn = dp_tanh_law;
+  red = NULL;
+  CHECK_RC(phgmg_reduce(&red, &s, X, c.N, ns + 1, &o, NULL, NULL), PHGMG_OK);
+  if (red) {
+    unsigned char b2[64];
+    CHECK_RC(phgmg_rom_serialize(phgmg_reduced_rom(red), b2, sizeof b2, NULL), PHGMG_ERR_UNSUPPORTED);
+  }
+  phgmg_reduced_destroy(red);
+  free(X);
+  dpm_free(&c);
+}
+
 SUITE(dissip) {
   RUN(test_dissip_fom_energy);
   RUN(test_dissip_fom_linear_damper);
@@ -459,4 +530,5 @@ SUITE(dissip) {
   RUN(test_dissip_reduce);
   RUN(test_dissip_reduce_linear_damper);
   RUN(test_dissip_reduce_hyper);
+  RUN(test_dissip_rom_file);
 }
