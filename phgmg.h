@@ -575,6 +575,11 @@
      phgmg validate     reduce, then test full against reduced model on each
                         --test-input (exit 1 if one fails);
      phgmg info         describe a model file.
+   Model options shared by reduce, validate and simulate include the mass
+   matrix (--E, --E-coo), feedthrough (--P, --S, --N) and nonlinear dampers:
+   --dampers FILE, a (k, 4) array of rows (i, j, c1, c3), a damper on
+   s = z_i - z_j (j = -1: s = z_i) with force c1 s + c3 s^3 (1.7); e.g. cubic
+   dampers on the velocities of a chain (tests/test_cli.sh builds one).
    `phgmg --help` lists every option with its default, the file formats and
    examples. The reduction does not depend on the units of the states; GMG-QM's
    lambda grid and the POD itself do (with ports of very different scale,
