@@ -237,7 +237,7 @@
    solves with J - R - L and O(N r^2) work).
    Online cost and hyper-reduction. Each evaluation costs O(ndamp r): free of
    N, but every damper is kept, so a model with a damper at every node has an
-   O(N) online cost. opts.deim = 1 hyper-reduces the dampers by empirical
+   O(N) online cost. opts.hyper_reduce = 1 hyper-reduces the dampers by empirical
    quadrature (phgmg_ecsw_separable, tolerance hyper_tol; always ECSW,
    whatever opts.hyper says): weights dw_k >= 0 on a subset of the dampers
    such that sum_k dw_k Cd_k rho_k(s_k) matches sum_k Cd_k rho_k(s_k) on the
@@ -13294,7 +13294,7 @@ PHGMG__PRIV phgmg_result phgmg__study_gmg_blocks(phgmg__rctx *c) {
 /* >>dampers (reduction, manual 1.7). The reduced dampers of the co-state test
    basis Wz (N x r): Cd(:, k) = Wz^T c_k = Wz(i_k, :) - Wz(j_k, :). GMG
    (add_lin = 1): K, built from G = (J - R - L)^{-1}, becomes Wz^T (J - R) Wz
-   = K + sum_k rho_k'(0) Cd_k Cd_k^T. Then, with opts.deim, the dampers are
+   = K + sum_k rho_k'(0) Cd_k Cd_k^T. Then, with opts.hyper_reduce, the dampers are
    hyper-reduced by ECSW (weights >= 0) on the training forces
    rho_k(c_k^T z(x_j)). */
 PHGMG__PRIV phgmg_result phgmg__dampers_hyper(phgmg__rctx *c);
@@ -13320,7 +13320,7 @@ PHGMG__PRIV phgmg_result phgmg__stage_dampers(phgmg__rctx *c, const double *Wz, 
       for (a = 0; a < r; ++a) red->K[a + (size_t)b * r] += d[1] * ck[a] * ck[b];
   }
   if (!phgmg__all_finite(red->Cd, (size_t)r * nd)) return PHGMG_ERR_NANINF;
-  return c->o->deim ? phgmg__dampers_hyper(c) : PHGMG_OK;
+  return c->o->hyper_reduce ? phgmg__dampers_hyper(c) : PHGMG_OK;
 }
 
 /* GMG: Wz = G^T (E V0) K^T (Wz^T = K (E V0)^T G), then the reduced dampers. */

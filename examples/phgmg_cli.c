@@ -91,7 +91,7 @@ static const char *const help_lines[] = {
   "                      c1 s + c3 s^3, c1, c3 >= 0 (a damper that generates energy is\n",
   "                      refused): E x' = (J - R) z - sum_k c_k (c1 s_k + c3 s_k^3) + B u.\n",
   "                      Methods gmg-pod, sp1, sp2; the reduced model keeps the dampers\n",
-  "                      (W_z^T c_k), hyper-reduced to a weighted subset unless --no-deim.\n",
+  "                      (W_z^T c_k), hyper-reduced to a weighted subset unless --no-hyper.\n",
   "  --X FILE            snapshot matrix N x ns (ns >= 2 states, one per column; a\n",
   "                      trajectory x(t_0), ..., x(t_n), normally starting at x = 0).\n",
   "                      Repeatable (up to 16): one training run per file, the runs'\n",

@@ -411,7 +411,7 @@ TEST(test_dissip_reduce_linear_damper) {
   dpm_free(&c);
 }
 
-/* Hyper-reduced dampers (opts.deim = 1, ECSW): a damper on every mass, a
+/* Hyper-reduced dampers (opts.hyper_reduce = 1, ECSW): a damper on every mass, a
    few kept with weights >= 0, the reduced model still dissipative, its
    energy balance exact, its output close to the full one. */
 TEST(test_dissip_reduce_hyper) {
@@ -434,7 +434,7 @@ TEST(test_dissip_reduce_hyper) {
   memset(&o, 0, sizeof o);
   o.method = PHGMG_METHOD_GMG_POD; o.r = r;
   CHECK_RC(phgmg_reduce(&red, &s, X, c.N, ns + 1, &o, NULL, NULL), PHGMG_OK);
-  o.deim = 1;
+  o.hyper_reduce = 1;
   CHECK_RC(phgmg_reduce(&rh, &s, X, c.N, ns + 1, &o, NULL, NULL), PHGMG_OK);
   if (red && rh) {
     const phgmg_rom *rom = phgmg_reduced_rom(rh);
