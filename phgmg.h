@@ -210,7 +210,9 @@
        H(x_{n+1}) - H(x_n) = h sum_i b_i z_i^T F_i
                            = h sum_i b_i (y_i^T u_i - z_i^T R z_i - sum_k s_ik rho_k(s_ik)),
    s_ik = c_k^T z_i: the balance H_n - H_0 = S_n - D_n holds to round-off and
-   the Newton tolerance whatever rho is, where D sums the dampers' stage
+   the Newton tolerance whatever rho is (with E the stage residuals enter
+   x_{n+1} through d = b^T A^{-1}, entries up to about 10: a tolerance of
+   1e-13 gives 1e-12 over hundreds of steps, the default 1e-10 about 1e-9), where D sums the dampers' stage
    quadrature h sum_i b_i s_ik rho_k(s_ik) with that of R (phgmg_energy.D,
    energy_inc[1]). For a non-quadratic H it holds up to the error of the
    Gauss rule on H(p(t))'.
@@ -249,7 +251,8 @@
    format version 3, and exported), the step map, the studies' fast path
    (phgmg_study_reduce computes the blocks afresh).
    tests/test_dissip.c checks each claim: the full balance to 1e-11 H (and
-   that it fails without the dampers' term), dense = banded stepper, linear
+   that it fails without the dampers' term; with a coupled mass matrix too),
+   dense = banded stepper, linear
    dampers = the linear model with R + L (full and reduced, GMG-POD and SP1),
    Cd against phgmg_reduced_W, sampled s rho(s) >= 0 and g^T f <= 0 of the
    reduced model, the reduced balance, the output error falling with r, and
