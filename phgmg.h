@@ -179,9 +179,20 @@
    taken by the full model -- validation of [[R, P], [P^T, S]] >= 0 and N
    skew (PHGMG_ERR_FEEDTHROUGH), the stepper, outputs, and the energy
    balance with supply y^T u and dissipation [z; u]^T [[R, P], [P^T, S]]
-   [z; u] -- but not yet by the reductions (PHGMG_ERR_UNSUPPORTED): the
-   reduced model would need the reduced P = W_z^T P and S + N, fields the
-   phgmg_rom format does not have.
+   [z; u] -- and by GMG-POD, SP1 and SP2 (GMG-QM and your manifold:
+   PHGMG_ERR_UNSUPPORTED). The reduced model, with z^ = W_z grad Hr as the
+   co-state (1.7), is
+       xr' = K grad Hr + (Bh - Ph) u,  y = (Bh + Ph)^T grad Hr + (S + N) u,
+       Ph = W_z^T P,  Bh = W_z^T B,  phgmg_rom.PD = [Ph; S + N],
+   its dissipation block [[Rr, Ph], [Ph^T, S]] = diag(W_z, I)^T [[R, P],
+   [P^T, S]] diag(W_z, I) (Rr = W_z^T R W_z = -sym K) is positive
+   semidefinite by congruence, and dHr/dt = yr^T u - [g; u]^T [[Rr, Ph],
+   [Ph^T, S]] [g; u], g = grad Hr; the online stepper sums this dissipation
+   and the supply yr^T u at its stages (the balance as in 1.7). The online
+   output functions have no u: phgmg_rom_output and the stepper's y give
+   (Bh + Ph)^T grad Hr, the caller adds (S + N) u(t) (phgmg_reduced_simulate
+   and the command line do). Model files (format version 3, field PD) check
+   the block on load (PHGMG_ERR_STRUCTURE); no step map with feedthrough.
 
    1.7 Nonlinear dissipation (phgmg_ph_system.ndamp, damp_*)
    Dampers r(z) = sum_k c_k rho_k(c_k^T z), c_k = e_i - e_j (a damper between
@@ -1701,6 +1712,13 @@ typedef struct phgmg_rom {
   void (*damp_cb)(int term, phgmg_real s, phgmg_real d[2], void *user);
   const int *dterm;         /* ndamp: full-model damper of each kept one (NULL: j) */
   void *damp_user;
+  /* feedthrough (NULL: none; LINEAR kind): PD = [Ph; Dh], Ph = W_z^T P
+     (r x m), then Dh = S + N (m x m):  x' = ... + (Bh - Ph) u,
+     y = (Bh + Ph)^T grad H + Dh u, dissipation block [[-sym K, Ph],
+     [Ph^T, sym Dh]] positive semidefinite (manual 1.6). phgmg_rom_output and
+     the stepper's y give (Bh + Ph)^T grad H: they have no u, add Dh u(t)
+     yourself (phgmg_reduced_simulate does). */
+  const phgmg_real *PD;
 } phgmg_rom;
 
 /* Checks a model's sizes and pointers for consistency (not its values). */
@@ -8970,6 +8988,7 @@ PHGMG_DEF phgmg_result phgmg_rom_check(const phgmg_rom *rom) {
   if (rom->Phi && (!rom->Gam || !rom->SX || !rom->SU || !(rom->dt > PHGMG__R(0))))
     return PHGMG_ERR_INVALID_ARG;
   if (rom->ndamp < 0 || rom->ndamp > (1 << 24)) return PHGMG_ERR_SIZE;
+  if (rom->PD && rom->kind != PHGMG_ROM_LINEAR) return PHGMG_ERR_INVALID_ARG;
   if (rom->ndamp > 0) {
     if (rom->kind != PHGMG_ROM_LINEAR || !rom->Cd || (!rom->dpoly && !rom->damp_cb)) return PHGMG_ERR_INVALID_ARG;
     if (!rom->damp_cb && (rom->damp_deg < 1 || rom->damp_deg > 15)) return PHGMG_ERR_SIZE;
@@ -9164,6 +9183,7 @@ PHGMG_DEF void phgmg_rom_output(const phgmg_rom *rom, const phgmg_real *x, phgmg
   phgmg__romw_layout(rom, work, &w);
   phgmg__rom_grad(rom, x, w.g, &w);
   phgmg__r_gemvt(rom->r, rom->m, rom->Bh, w.g, 0, y);
+  if (rom->PD) phgmg__r_gemvt(rom->r, rom->m, rom->PD, w.g, 1, y);   /* + Ph^T g */
 }
 
 /* E = D^T G D = G00 + G01 L + L^T (G10 + G11 L), L = [0, Lp] (QUADRATIC; Lp current). */
@@ -9197,6 +9217,11 @@ PHGMG__ONLINE phgmg_result phgmg__rom_rhs(const phgmg_rom *rom, const phgmg_real
     phgmg__r_lu_solve(r, w->E, w->piv, f);
   }
   if (u && rom->m > 0) phgmg__r_gemv(r, rom->m, rom->Bh, u, 1, f);
+  if (u && rom->m > 0 && rom->PD) {   /* feedthrough: (Bh - Ph) u */
+    int a, k;
+    for (k = 0; k < rom->m; ++k)
+      for (a = 0; a < r; ++a) f[a] -= rom->PD[a + (size_t)k * r] * u[k];
+  }
   return PHGMG_OK;
 }
 
@@ -9408,7 +9433,7 @@ PHGMG__ONLINE size_t phgmg__romstep_layout(const phgmg_rom *rom, int map_only, v
 
 /* Does stepping with dt use the model's precomputed step map? */
 PHGMG__ONLINE int phgmg__rom_uses_map(const phgmg_rom *rom, phgmg_real dt) {
-  return rom->Phi != NULL && rom->kind == PHGMG_ROM_LINEAR && rom->nd == 0 && rom->ndamp == 0 &&
+  return rom->Phi != NULL && rom->kind == PHGMG_ROM_LINEAR && rom->nd == 0 && rom->ndamp == 0 && !rom->PD &&
          PHGMG__RABS(rom->dt - dt) <= PHGMG__R(8) * PHGMG__REPS * dt;
 }
 
@@ -9720,6 +9745,21 @@ PHGMG__ONLINE phgmg_real phgmg__romstep_iterate(phgmg_rom_stepper *s, const phgm
   return res;
 }
 
+/* Feedthrough at a stage: g^T Ph u + u^T Dh u (= u^T S u, N skew); t: m reals. */
+PHGMG__ONLINE phgmg_real phgmg__rom_feed_energy(const phgmg_rom *rom, const phgmg_real *g, const phgmg_real *u,
+                                                phgmg_real *t) {
+  const int r = rom->r, m = rom->m;
+  const phgmg_real *Dh = rom->PD + (size_t)r * m;
+  phgmg_real v = PHGMG__R(0);
+  int a, b;
+  phgmg__r_gemvt(r, m, rom->PD, g, 0, t);
+  for (a = 0; a < m; ++a) {
+    v += t[a] * u[a];
+    for (b = 0; b < m; ++b) v += u[a] * Dh[a + (size_t)b * m] * u[b];
+  }
+  return v;
+}
+
 /* A converged step: the stage values of the last correction, the new state,
    the energy over the step, the extrapolation data, when to refactor. */
 PHGMG__ONLINE phgmg_result phgmg__romstep_accept(phgmg_rom_stepper *s, const phgmg__romstep_mem *L, phgmg_real *x,
@@ -9757,6 +9797,11 @@ PHGMG__ONLINE phgmg_result phgmg__romstep_accept(phgmg_rom_stepper *s, const phg
       if (u3 && m > 0) {
         phgmg__r_gemvt(r, m, rom->Bh, gi, 0, L->Y);
         for (a = 0; a < m; ++a) { si += L->Y[a] * u3[i * m + a]; di += L->Y[a] * u3[i * m + a]; }
+        if (rom->PD) {   /* feedthrough: g^T Ph u + u^T S u, supplied and dissipated */
+          const phgmg_real pu = phgmg__rom_feed_energy(rom, gi, u3 + i * m, L->Y);
+          si += pu;
+          di += pu;
+        }
       }
       sup += L->b[i] * si;
       dis += L->b[i] * di;
@@ -9911,6 +9956,7 @@ struct phgmg_reduced {
   int ndamp;
   double *Cd, *dw, *dpoly;
   int *dterm;
+  double *PD;          /* feedthrough: [W_z^T P; S + N], (r + m) x m (phgmg_rom.PD) */
 };
 
 /* A study (phgmg_study_create): what every reduction of one snapshot set
@@ -11501,6 +11547,7 @@ PHGMG__PRIV phgmg_result phgmg__publish(phgmg_reduced *red) {
   }
   if (red->eta) { o->eta_cb = red->eta; o->eta_user = red->eta_user; }
   if (red->gwork) { o->ham_cb = phgmg__ham_general; o->ham_user = red; }
+  if (rc == PHGMG_OK) rc = phgmg__to_real(red, red->PD, (size_t)(r + m) * m, &o->PD);
   return rc == PHGMG_OK && red->ndamp ? phgmg__publish_dampers(red) : rc;
 }
 
@@ -11853,10 +11900,9 @@ PHGMG__PRIV phgmg_result phgmg__reduce_check(const phgmg_ph_system *sys, const d
   if ((int)o->hyper < 0 || (int)o->hyper >= (int)PHGMG_HYPER_COUNT) return PHGMG_ERR_INVALID_ARG;
   if (!(o->hyper_tol >= 0.0 && o->hyper_tol < 1.0)) return PHGMG_ERR_INVALID_ARG;
   if (o->hyper_reduce && sys->nl == PHGMG_NL_GENERAL) return PHGMG_ERR_UNSUPPORTED;
-  if (sys->P || sys->S || sys->Nskew) return PHGMG_ERR_UNSUPPORTED;   /* feedthrough: full model only */
-  if (sys->ndamp && o->method != PHGMG_METHOD_GMG_POD && o->method != PHGMG_METHOD_SP1 &&
+  if ((sys->P || sys->S || sys->Nskew || sys->ndamp) && o->method != PHGMG_METHOD_GMG_POD && o->method != PHGMG_METHOD_SP1 &&
       o->method != PHGMG_METHOD_SP2)
-    return PHGMG_ERR_UNSUPPORTED;   /* dampers: linear maps only (manual 1.7) */
+    return PHGMG_ERR_UNSUPPORTED;   /* dampers, feedthrough: linear maps only (manual 1.6, 1.7) */
   if (!(o->deim_tol >= 0.0 && o->deim_tol < 1.0) || o->deim_max < 0) return PHGMG_ERR_INVALID_ARG;
   if (!(o->dt >= 0.0) || o->dt == HUGE_VAL) return PHGMG_ERR_INVALID_ARG;
   if (o->lambda != o->lambda || !(o->degeneracy_tol >= 0.0 && o->degeneracy_tol < 1.0)) return PHGMG_ERR_INVALID_ARG;
@@ -13326,7 +13372,32 @@ PHGMG__PRIV phgmg_result phgmg__stage_dampers(phgmg__rctx *c, const double *Wz, 
   return c->o->hyper_reduce ? phgmg__dampers_hyper(c) : PHGMG_OK;
 }
 
-/* GMG: Wz = G^T (E V0) K^T (Wz^T = K (E V0)^T G), then the reduced dampers. */
+PHGMG__PRIV int phgmg__has_feed(const phgmg_ph_system *sys) { return sys->P || sys->S || sys->Nskew; }
+
+/* Feedthrough (manual 1.6): PD = [W_z^T P; S + N]. */
+PHGMG__PRIV phgmg_result phgmg__stage_feedthrough(phgmg__rctx *c, const double *Wz) {
+  phgmg_reduced *red = c->red;
+  const phgmg_ph_system *sys = c->sys;
+  const int N = red->N, r = red->r, m = red->m;
+  int a, b;
+  red->PD = phgmg__red_d(red, (size_t)(r + m) * m);
+  if (!red->PD) return PHGMG_ERR_NOMEM;
+  if (sys->P) {
+    double *t = phgmg__dalloc(c->alloc, (size_t)r * m);
+    if (!t) return PHGMG_ERR_NOMEM;
+    phgmg__atb(N, r, m, Wz, sys->P, t);
+    memcpy(red->PD, t, (size_t)r * m * sizeof(double));
+    phgmg__free(c->alloc, t);
+  }
+  for (b = 0; b < m; ++b)
+    for (a = 0; a < m; ++a)
+      red->PD[(size_t)r * m + a + (size_t)b * m] = (sys->S ? sys->S[a + (size_t)b * m] : 0.0) +
+                                                   (sys->Nskew ? sys->Nskew[a + (size_t)b * m] : 0.0);
+  return phgmg__all_finite(red->PD, (size_t)(r + m) * m) ? PHGMG_OK : PHGMG_ERR_NANINF;
+}
+
+/* GMG: Wz = G^T (E V0) K^T (Wz^T = K (E V0)^T G), then the reduced dampers
+   and the feedthrough. */
 PHGMG__PRIV phgmg_result phgmg__gmg_dampers(phgmg__rctx *c) {
   phgmg_reduced *red = c->red;
   const int N = red->N, r = red->r;
@@ -13338,7 +13409,8 @@ PHGMG__PRIV phgmg_result phgmg__gmg_dampers(phgmg__rctx *c) {
   else memcpy(Y, red->V0, (size_t)N * r * sizeof(double));
   phgmg_jr_solve(c->jr, 'T', r, Y, N);
   phgmg_gemm('N', 'T', N, r, r, 1.0, Y, N, red->K, r, 0.0, Wz, N);
-  rc = phgmg__stage_dampers(c, Wz, 1);
+  rc = c->sys->ndamp ? phgmg__stage_dampers(c, Wz, 1) : PHGMG_OK;
+  if (rc == PHGMG_OK && phgmg__has_feed(c->sys)) rc = phgmg__stage_feedthrough(c, Wz);
   phgmg__free(c->alloc, Y);
   return rc;
 }
@@ -13434,7 +13506,7 @@ PHGMG__PRIV phgmg_result phgmg__stage_gmg_blocks(phgmg__rctx *c) {
   red->K = phgmg__red_d(red, (size_t)r * r);
   if (!red->K) return PHGMG_ERR_NOMEM;
   rc = phgmg__inv(r, red->G00, red->K, c->alloc);
-  return (rc == PHGMG_OK && c->sys->ndamp) ? phgmg__gmg_dampers(c) : rc;
+  return (rc == PHGMG_OK && (c->sys->ndamp || phgmg__has_feed(c->sys))) ? phgmg__gmg_dampers(c) : rc;
 }
 
 /* Descriptor: X (N x nc, ld N) <- E^T X. */
@@ -13521,6 +13593,7 @@ PHGMG__PRIV phgmg_result phgmg__stage_sp_blocks(phgmg__rctx *c) {
     phgmg__atb(N, r, r, Wz, Vg, red->K);
     phgmg__atb(N, r, m, Wz, c->sys->B, red->Bh);
     if (c->sys->ndamp) rc = phgmg__stage_dampers(c, Wz, 0);
+    if (rc == PHGMG_OK && phgmg__has_feed(c->sys)) rc = phgmg__stage_feedthrough(c, Wz);
   }
   phgmg__free(c->alloc, Vg);
   return rc;
@@ -13896,7 +13969,7 @@ PHGMG__PRIV phgmg_result phgmg__reduce_run(phgmg_reduced **out, const phgmg_ph_s
   if (rc == PHGMG_OK) { phgmg__progress(opts, "hyper-reduction"); rc = phgmg__stage_separable_terms(&c); }
   if (rc == PHGMG_OK) { phgmg__progress(opts, "finish"); rc = phgmg__stage_general_term(&c); }
   if (rc == PHGMG_OK && opts->dt > 0.0 && c.red->kind == PHGMG_ROM_LINEAR && c.red->nd == 0 &&
-      sys->nl != PHGMG_NL_GENERAL && c.red->ndamp == 0) {
+      sys->nl != PHGMG_NL_GENERAL && c.red->ndamp == 0 && !c.red->PD) {
     c.red->map_dt = opts->dt;
     rc = phgmg__step_map(c.red, opts->dt, alloc);
   }
@@ -14038,6 +14111,16 @@ PHGMG_DEF phgmg_result phgmg_reduced_simulate_run(const phgmg_reduced *red, cons
   return rc;
 }
 
+/* y += Dh u(t) (feedthrough of a reduced model; ubuf: m doubles). */
+PHGMG__PRIV void phgmg__feed_out(const phgmg_rom *rom, double t, phgmg_input_fn uf, void *uuser, double *ubuf,
+                                 double *y) {
+  const int r = rom->r, m = rom->m;
+  int a, b;
+  uf(t, ubuf, uuser);
+  for (a = 0; a < m; ++a)
+    for (b = 0; b < m; ++b) y[a] += (double)rom->PD[(size_t)r * m + a + (size_t)b * m] * ubuf[b];
+}
+
 PHGMG_DEF phgmg_result phgmg_reduced_simulate(const phgmg_reduced *red, const double *xr0, double t0,
                                               double dt, int nsteps, phgmg_input_fn uf, void *uuser,
                                               double tol, int max_iter, double *XR, double *Y,
@@ -14066,7 +14149,8 @@ PHGMG_DEF phgmg_result phgmg_reduced_simulate(const phgmg_reduced *red, const do
   for (a = 0; a < r; ++a) x[a] = (phgmg_real)xr0[a];
 #define PHGMG__REC(nn) do { \
     if (XR) for (a = 0; a < r; ++a) XR[a + (size_t)(nn) * r] = (double)x[a]; \
-    if (Y) { phgmg_rom_output(rom, x, y, ework); for (a = 0; a < m; ++a) Y[a + (size_t)(nn) * m] = (double)y[a]; } \
+    if (Y) { phgmg_rom_output(rom, x, y, ework); for (a = 0; a < m; ++a) Y[a + (size_t)(nn) * m] = (double)y[a]; \
+             if (rom->PD && uf) phgmg__feed_out(rom, t0 + (nn) * dt, uf, uuser, ubuf, Y + (size_t)(nn) * m); } \
     if (energy) { energy->H[nn] = (double)phgmg_rom_hamiltonian(rom, x, ework); energy->S[nn] = S; energy->D[nn] = D; } \
   } while (0)
   PHGMG__REC(0);
@@ -16284,7 +16368,7 @@ PHGMG_DEF phgmg_result phgmg_ss_error(int n1, const double *A1, const double *B1
 #include <stdint.h>
 
 /* The arrays of a phgmg_rom in file order, with their sizes. */
-#define PHGMG__NFIELDS 25
+#define PHGMG__NFIELDS 26
 typedef struct phgmg__field { size_t off; const char *name; } phgmg__field;
 static const phgmg__field phgmg__fields[PHGMG__NFIELDS] = {
   {offsetof(phgmg_rom, Bh), "Bh"},   {offsetof(phgmg_rom, Qh), "Qh"},   {offsetof(phgmg_rom, K), "K"},
@@ -16296,7 +16380,8 @@ static const phgmg__field phgmg__fields[PHGMG__NFIELDS] = {
   {offsetof(phgmg_rom, expo), "expo"},
   {offsetof(phgmg_rom, env_lo), "env_lo"}, {offsetof(phgmg_rom, env_hi), "env_hi"},
   {offsetof(phgmg_rom, q_max), "q_max"},
-  {offsetof(phgmg_rom, Cd), "Cd"}, {offsetof(phgmg_rom, dw), "dw"}, {offsetof(phgmg_rom, dpoly), "dpoly"}};
+  {offsetof(phgmg_rom, Cd), "Cd"}, {offsetof(phgmg_rom, dw), "dw"}, {offsetof(phgmg_rom, dpoly), "dpoly"},
+  {offsetof(phgmg_rom, PD), "PD"}};
 
 PHGMG__ONLINE const phgmg_real **phgmg__field_ptr(phgmg_rom *rom, int i) {
   return PHGMG__CAST(const phgmg_real **, PHGMG__CAST(void *, PHGMG__CAST(char *, PHGMG__CAST(void *, rom)) + phgmg__fields[i].off));
@@ -16332,7 +16417,8 @@ PHGMG__ONLINE size_t phgmg__field_len(const phgmg_rom *rom, int i) {
     case 21: return 1;            /* q_max */
     case 22: return r * (size_t)rom->ndamp;   /* Cd */
     case 23: return (size_t)rom->ndamp;       /* dw */
-    default: return rom->ndamp ? (size_t)(rom->damp_nphi > 1 ? rom->damp_nphi : 1) * ((size_t)rom->damp_deg + 1) : 0;
+    case 24: return rom->ndamp ? (size_t)(rom->damp_nphi > 1 ? rom->damp_nphi : 1) * ((size_t)rom->damp_deg + 1) : 0;
+    default: return (r + m) * m;              /* PD */
   }
 }
 
@@ -16342,10 +16428,11 @@ PHGMG__ONLINE size_t phgmg__field_len(const phgmg_rom *rom, int i) {
    q_max, bits 19-21, may sit in either version); nterm (0 or nd) uint32 term
    indices after the scalars. */
 #define PHGMG__HDR2_BYTES (PHGMG__HDR_BYTES + 12)
-/* Version 3 (written only for a model with dampers): the version-2 header,
-   then ndamp, damp_deg, damp_nphi; the fields Cd, dw, dpoly (bits 22-24). */
+/* Version 3 (written only for a model with dampers or feedthrough): the
+   version-2 header, then ndamp, damp_deg, damp_nphi (0 without dampers);
+   the fields Cd, dw, dpoly (bits 22-24, with dampers) and PD (bit 25). */
 #define PHGMG__HDR3_BYTES (PHGMG__HDR2_BYTES + 12)
-PHGMG__ONLINE int phgmg__rom_v3(const phgmg_rom *rom) { return rom->ndamp > 0; }
+PHGMG__ONLINE int phgmg__rom_v3(const phgmg_rom *rom) { return rom->ndamp > 0 || rom->PD; }
 PHGMG__ONLINE int phgmg__rom_v2(const phgmg_rom *rom) {
   return (rom->nd > 0 && (rom->nexp > 0 || rom->nphi > 1 || rom->term)) || phgmg__rom_v3(rom);
 }
@@ -16474,8 +16561,8 @@ PHGMG__ONLINE phgmg_result phgmg__rom_header(const unsigned char *b, size_t len,
   memset(rom, 0, sizeof *rom);
   if (ver == 3u) {
     if (len < PHGMG__HDR3_BYTES + 4) return PHGMG_ERR_FORMAT;
-    if (phgmg__get32(b + 68) < 1u || phgmg__get32(b + 68) > (1u << 24) || phgmg__get32(b + 72) < 1u ||
-        phgmg__get32(b + 72) > 15u || phgmg__get32(b + 76) > (1u << 24))
+    if (phgmg__get32(b + 68) > (1u << 24) || phgmg__get32(b + 72) > 15u || phgmg__get32(b + 76) > (1u << 24) ||
+        (phgmg__get32(b + 68) > 0u) != (phgmg__get32(b + 72) > 0u))
       return PHGMG_ERR_FORMAT;
     rom->ndamp = (int)phgmg__get32(b + 68);
     rom->damp_deg = (int)phgmg__get32(b + 72);
@@ -16513,8 +16600,11 @@ PHGMG__ONLINE phgmg_result phgmg__rom_header(const unsigned char *b, size_t len,
   }
   /* version 1: every field but expo (bit 18, which needs the version-2 header) */
   if ((mask >> PHGMG__NFIELDS) || (ver == 1u && (mask & (1u << 18)))) return PHGMG_ERR_FORMAT;
-  /* dampers (bits 22-24) exactly in version 3, all three */
-  if ((ver == 3u) != ((mask & (7u << 22)) == (7u << 22)) || (ver != 3u && (mask & (7u << 22)))) return PHGMG_ERR_FORMAT;
+  /* dampers (bits 22-24, all three) exactly when the version-3 header has
+     ndamp > 0; feedthrough (bit 25) only in version 3; version 3 has one */
+  if ((rom->ndamp > 0) != ((mask & (7u << 22)) == (7u << 22)) || (rom->ndamp == 0 && (mask & (7u << 22))) ||
+      (ver != 3u && (mask & (1u << 25))) || (ver == 3u && rom->ndamp == 0 && !(mask & (1u << 25))))
+    return PHGMG_ERR_FORMAT;
   if (rom->m > rom->r) return PHGMG_ERR_FORMAT;
   if ((rom->nphi > 1 && rom->nphi != rom->nd) || (nterm != 0 && nterm != (size_t)rom->nd))
     return PHGMG_ERR_FORMAT;
@@ -16562,9 +16652,10 @@ PHGMG__ONLINE phgmg_result phgmg__rom_header(const unsigned char *b, size_t len,
    roundoff, for every file: a model may have been rounded to float on its
    way (a float build, an f32 file) and saved again with 8-byte scalars.
    Failure: PHGMG_ERR_STRUCTURE. Work: (r + rn)^2 + 4 r + 4 reals. */
-PHGMG__ONLINE size_t phgmg__rom_phys_work(const phgmg_rom *rom) {
+PHGMG__ONLINE size_t phgmg__rom_phys_work(const phgmg_rom *rom, uint32_t mask) {
   const size_t n2 = (size_t)rom->r + (size_t)(rom->kind == PHGMG_ROM_QUADRATIC ? rom->rn : 0);
-  return n2 * n2 + 4 * (size_t)rom->r + 4;
+  const size_t nf = (mask & (1u << 25)) ? (size_t)rom->r + (size_t)rom->m : 0;   /* feedthrough block */
+  return (nf > n2 ? nf * nf : n2 * n2) + 4 * (size_t)rom->r + 4;
 }
 
 /* ||.||_1 of an n x n matrix. */
@@ -16667,6 +16758,24 @@ PHGMG__ONLINE int phgmg__rom_map_ok(const phgmg_rom *rom, double eps, phgmg_real
 /* The load-time structure check (see above) of a model that passed
    phgmg_rom_check; eps: the unit roundoff of the values (the larger of the
    file's scalars' and phgmg_real's); w: phgmg__rom_phys_work(rom) reals. */
+/* Feedthrough of a loaded model: [[-sym K, Ph], [Ph^T, sym Dh]] + d I
+   positive definite (d as for the dissipation above); w: (r + m)^2 reals. */
+PHGMG__ONLINE int phgmg__rom_feed_ok(const phgmg_rom *rom, phgmg_real tol, phgmg_real *w) {
+  const int r = rom->r, m = rom->m, n = r + m;
+  const phgmg_real *Dh = rom->PD + (size_t)r * m;
+  int i, j;
+  for (j = 0; j < n; ++j)
+    for (i = 0; i < n; ++i) {
+      phgmg_real v;
+      if (i < r && j < r) v = -PHGMG__R(0.5) * (rom->K[i + (size_t)j * r] + rom->K[j + (size_t)i * r]);
+      else if (i < r) v = rom->PD[i + (size_t)(j - r) * r];
+      else if (j < r) v = rom->PD[j + (size_t)(i - r) * r];
+      else v = PHGMG__R(0.5) * (Dh[(i - r) + (size_t)(j - r) * m] + Dh[(j - r) + (size_t)(i - r) * m]);
+      w[i + (size_t)j * n] = v;
+    }
+  return phgmg__r_psd_shifted(n, w, tol);
+}
+
 /* Dampers of a loaded model dissipate: weights >= 0, every law an odd
    polynomial with coefficients >= 0 (manual 1.7). */
 PHGMG__ONLINE phgmg_result phgmg__rom_damp_ok(const phgmg_rom *rom) {
@@ -16714,6 +16823,7 @@ PHGMG__ONLINE phgmg_result phgmg__rom_physics(const phgmg_rom *rom, double eps, 
     }
   if (!phgmg__r_psd_shifted(n2, w, tol)) return PHGMG_ERR_STRUCTURE;
   if (rom->Phi && (!rom->K || !phgmg__rom_map_ok(rom, eps, w))) return PHGMG_ERR_STRUCTURE;
+  if (rom->PD && !phgmg__rom_feed_ok(rom, tol, w)) return PHGMG_ERR_STRUCTURE;
   return rom->ndamp ? phgmg__rom_damp_ok(rom) : PHGMG_OK;
 }
 
@@ -16724,7 +16834,7 @@ PHGMG_DEF phgmg_result phgmg_rom_deserialize_size(const void *buf, size_t len, s
   size_t nterm = 0;
   phgmg_result rc = phgmg__rom_header(PHGMG__CAST(const unsigned char *, buf), len, &tmp, &n, &ss, &mask, &nterm);
   if (rc != PHGMG_OK) return rc;
-  if (need) *need = (n + phgmg__rom_phys_work(&tmp)) * sizeof(phgmg_real) + sizeof(phgmg_real) + nterm * sizeof(int);
+  if (need) *need = (n + phgmg__rom_phys_work(&tmp, mask)) * sizeof(phgmg_real) + sizeof(phgmg_real) + nterm * sizeof(int);
   return PHGMG_OK;
 }
 
@@ -16740,7 +16850,7 @@ PHGMG_DEF phgmg_result phgmg_rom_deserialize(const void *buf, size_t len, phgmg_
   if (!rom || !mem) return PHGMG_ERR_INVALID_ARG;
   rc = phgmg__rom_header(b, len, &tmp, &n, &ss, &mask, &nterm);
   if (rc != PHGMG_OK) return rc;
-  if (mem_size < (n + phgmg__rom_phys_work(&tmp)) * sizeof(phgmg_real) + sizeof(phgmg_real) + nterm * sizeof(int))
+  if (mem_size < (n + phgmg__rom_phys_work(&tmp, mask)) * sizeof(phgmg_real) + sizeof(phgmg_real) + nterm * sizeof(int))
     return PHGMG_ERR_WORKSPACE;
   o = phgmg__get32(b + 8) == 1u ? PHGMG__HDR_BYTES : phgmg__get32(b + 8) == 2u ? PHGMG__HDR2_BYTES : PHGMG__HDR3_BYTES;
   if (((size_t)mem) % sizeof(phgmg_real) != 0) return PHGMG_ERR_INVALID_ARG;
@@ -16754,7 +16864,7 @@ PHGMG_DEF phgmg_result phgmg_rom_deserialize(const void *buf, size_t len, phgmg_
     dst += len_i;
   }
   work = dst;                           /* the structure check's scratch */
-  dst += phgmg__rom_phys_work(&tmp);
+  dst += phgmg__rom_phys_work(&tmp, mask);
   if (nterm) { /* the term indices follow the scalars and the scratch in mem */
     int *ti = PHGMG__CAST(int *, PHGMG__CAST(void *, dst));
     for (k = 0; k < nterm; ++k, o += 4) {
@@ -16908,6 +17018,7 @@ PHGMG_DEF phgmg_result phgmg_rom_export_c(const phgmg_rom *rom, const char *name
     else ok &= fprintf(f, ", NULL") > 0;
   }
   ok &= fprintf(f, ", 0, NULL, NULL") > 0;
+  if (rom->PD) ok &= fprintf(f, ",\n  %s_PD", name) > 0;   /* feedthrough */
   ok &= fprintf(f, "\n};\n") > 0;
   if (fclose(f) != 0) ok = 0;
   return ok ? PHGMG_OK : PHGMG_ERR_IO;

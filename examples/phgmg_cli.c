@@ -83,8 +83,8 @@ static const char *const help_lines[] = {
   "  --P FILE, --S FILE, --N FILE   feedthrough (N x m, m x m, m x m; each optional):\n",
   "                      E x' = (J - R) z + (B - P) u, y = (B + P)^T z + (S + N) u, with\n",
   "                      [[R, P], [P^T, S]] symmetric positive semidefinite and N skew.\n",
-  "                      Checked and simulated with the full model; the reductions do\n",
-  "                      not take feedthrough yet (an error names the files).\n",
+  "                      Kept by gmg-pod, sp1, sp2 (reduced P = W_z^T P, S + N; not by\n",
+  "                      gmg-qm: an error names the files); simulate-rom adds (S + N) u.\n",
   "  --dampers FILE      nonlinear dampers, a (k, 4) array with rows (i, j, c1, c3):\n",
   "                      a damper on s = z_i - z_j (j = -1: s = z_i; 0-based states,\n",
   "                      z = Q x the co-state, e.g. a velocity) with the force\n",
@@ -2201,7 +2201,9 @@ static int run_reduction(const reduce_args *A, reduce_state *S, int method, cons
                     phgmg_result_string(rc));
       case PHGMG_ERR_UNSUPPORTED:
         if (A->Pf || A->Sf || A->Nf)
-          return fail("reduction failed: the reductions do not take feedthrough (--P, --S, --N) yet");
+          return fail("reduction failed: gmg-qm does not take feedthrough (--P, --S, --N); use gmg-pod, sp1 or sp2");
+        if (A->dampf)
+          return fail("reduction failed: gmg-qm does not take --dampers (%s); use gmg-pod, sp1 or sp2", A->dampf);
         return fail("reduction failed: %s", phgmg_result_string(rc));
       default:
         return fail("reduction failed: %s", phgmg_result_string(rc));
@@ -2572,6 +2574,16 @@ static int load_model(const char *path, const char *opt, phgmg_rom *rom, void **
   return 0;
 }
 
+/* Feedthrough of a reduced model: y += (S + N) u(t) (rom->PD's last m x m block). */
+static void rom_feed_out(const phgmg_rom *rom, double t, cli_input *in, double *y) {
+  double ub[64];
+  int a, b;
+  if (rom->m > 64) return;
+  input_fn(t, ub, in);
+  for (a = 0; a < rom->m; ++a)
+    for (b = 0; b < rom->m; ++b) y[a] += (double)rom->PD[(size_t)rom->r * rom->m + a + (size_t)b * rom->m] * ub[b];
+}
+
 static int cmd_simulate_rom(int argc, char **argv) {
   const char *model = NULL, *out = NULL, *states = NULL, *inspec = "sin";
   double dt = 0.0, amp = 0.1, newton_tol = 0.0, t0;   /* 0: the library's default */
@@ -2650,6 +2662,7 @@ static int cmd_simulate_rom(int argc, char **argv) {
     if (XR) for (a = 0; a < rom.r; ++a) XR[a + (size_t)(nn) * rom.r] = (double)x[a]; \
     phgmg_rom_output(&rom, x, y, ework); \
     for (a = 0; a < rom.m; ++a) Y[a + (size_t)(nn) * rom.m] = (double)y[a]; \
+    if (rom.PD) rom_feed_out(&rom, (double)(nn) * dt, &in, Y + (size_t)(nn) * rom.m); \
   } while (0)
   RECORD(0);
   t0 = wall_last = now_s();

@@ -520,8 +520,12 @@ np.save('S_ok.npy', 0.1 * np.eye(1)); np.save('S_neg.npy', -0.1 * np.eye(1))
 " && pass || bad "feedthrough files"
   run_err "feedthrough S not PSD" 1 "S_neg.npy (--P, --S, --N)" "$P" reduce $SYS --S S_neg.npy $SIM --method gmg-pod --r 12 --out oSn
   [ ! -e oSn ] && pass || bad "feedthrough not PSD: output written"
-  run_err "feedthrough: reduction refused" 1 "do not take feedthrough" "$P" reduce $SYS --S S_ok.npy $SIM --method gmg-pod --r 12 --out oSo
+  run_err "feedthrough: gmg-qm refused" 1 "gmg-qm does not take feedthrough" "$P" reduce $SYS --S S_ok.npy $SIM --method gmg-qm --r 12 --out oSo
   [ ! -e oSo ] && pass || bad "feedthrough refused: output written"
+  run_ok "reduce --S (gmg-pod)" "$P" reduce $SYS --S S_ok.npy $SIM --method gmg-pod --r 12 --out oSf --name m --quiet
+  run_ok "simulate-rom with feedthrough" "$P" simulate-rom --model oSf/m.phgmgrom $ROMSIM --out oSf/y.npy --quiet
+  run_ok "simulate --S" "$P" simulate $SYS --S S_ok.npy $ROMSIM --out ySf.npy --quiet
+  run_ok "feedthrough ROM follows the full model (1e-2)" "$REF" compare ySf.npy oSf/y.npy 1e-2
   run_err "--E with --J-coo" 2 "--E-coo" "$P" reduce --J-coo J.npy --R-coo R.npy --Q-coo Q.npy --B model/B.npy --E E_id.npy $SIM --method gmg-pod --r 12 --out oEc
 fi
 

@@ -608,6 +608,101 @@ TEST(test_dissip_descriptor) {
   dpm_free(&c);
 }
 
+/* Feedthrough kept by the reductions (with dampers): Ph = W_z^T P against
+   phgmg_reduced_W, Dh = S, the reduced balance with supply y^T u and the
+   dissipation [g; u]^T [[Rr, Ph], [Ph^T, S]] [g; u], the output (with
+   (S + N) u added) against the full model's, files (a tampered Ph that
+   breaks the PSD block is refused), GMG-QM refused. */
+TEST(test_dissip_feedthrough) {
+  dpm c;
+  const int n = 30, ns = 600, rs[2] = {22, 38};
+  const double dt = 0.05, eys[2] = {5e-2, 1e-5}, Sv = 0.02;
+  const int methods[2] = {PHGMG_METHOD_GMG_POD, PHGMG_METHOD_SP1};
+  phgmg_ph_system s;
+  double *X, *Y, *P, *W, *YR, *EH, xr[64] = {0};
+  phgmg_energy en;
+  int mi, a, t, N;
+  dpm_make(&c, n);
+  N = c.N;
+  X = (double *)malloc(sizeof(double) * (size_t)N * (ns + 1));
+  W = (double *)malloc(sizeof(double) * (size_t)N * 64);
+  Y = (double *)malloc(sizeof(double) * (ns + 1));
+  YR = (double *)malloc(sizeof(double) * (ns + 1));
+  EH = (double *)malloc(sizeof(double) * 3 * (ns + 1));
+  P = (double *)calloc((size_t)N, sizeof(double));
+  P[N - 1] = 0.01;   /* [[0.01, 0.01], [0.01, 0.02]] on (v_last, u): PSD */
+  P[N - 2] = -0.002;
+  en.H = EH; en.S = EH + ns + 1; en.D = EH + 2 * (ns + 1);
+  s = dpm_system(&c, dpm_law, 3);
+  s.P = P; s.S = &Sv;
+  CHECK_RC(phgmg_ph_validate(&s, 0.0, NULL, NULL), PHGMG_OK);
+  CHECK_RC(phgmg_simulate(&s, dp_zero, 0.0, dt, ns, dpm_input, NULL, NULL, X, Y, NULL, NULL, NULL, NULL), PHGMG_OK);
+  for (mi = 0; mi < 4; ++mi) {
+    phgmg_reduce_opts o;
+    phgmg_reduced *red = NULL;
+    const int r = rs[mi / 2];
+    memset(&o, 0, sizeof o);
+    o.method = methods[mi % 2]; o.r = r;
+    CHECK_RC(phgmg_reduce(&red, &s, X, N, ns + 1, &o, NULL, NULL), PHGMG_OK);
+    if (red) {
+      const phgmg_rom *rom = phgmg_reduced_rom(red);
+      double dm = 0.0, pm = 0.0, e = 0.0, hm = 0.0;
+      CHECK(rom->PD != NULL);
+      CHECK_RC(phgmg_reduced_W(red, xr, W, N), PHGMG_OK);
+      for (a = 0; a < r; ++a) {
+        double v = 0.0;
+        int i;
+        for (i = 0; i < N; ++i) v += W[i + (size_t)a * N] * P[i];
+        dm = fabs(v - rom->PD[a]) > dm ? fabs(v - rom->PD[a]) : dm;
+        pm = fabs(v) > pm ? fabs(v) : pm;
+      }
+      CHECK_LE(dm, 1e-10 * pm);
+      CHECK(rom->PD[r] == Sv);
+      CHECK_RC(phgmg_reduced_simulate(red, xr, 0.0, dt, ns, dpm_input, NULL, 1e-13, 20, NULL, YR, &en, NULL, NULL), PHGMG_OK);
+      for (t = 0; t <= ns; ++t) {
+        e = fabs(EH[t] - EH[0] - en.S[t] + en.D[t]) > e ? fabs(EH[t] - EH[0] - en.S[t] + en.D[t]) : e;
+        hm = EH[t] > hm ? EH[t] : hm;
+      }
+      CHECK_LE(e, 1e-11 * hm);
+      CHECK_LE(dp_rel(ns + 1, YR, Y), eys[mi / 2]);
+      if (mi == 0) {   /* file round trip; a Ph that breaks the PSD block is refused */
+        size_t sz = phgmg_rom_serialized_size(rom), w = 0, need = 0;
+        unsigned char *buf = (unsigned char *)malloc(sz);
+        double *mem;
+        phgmg_rom lr;
+        CHECK_RC(phgmg_rom_serialize(rom, buf, sz, &w), PHGMG_OK);
+        CHECK_RC(phgmg_rom_deserialize_size(buf, w, &need), PHGMG_OK);
+        mem = (double *)malloc(need);
+        CHECK_RC(phgmg_rom_deserialize(buf, w, &lr, mem, need), PHGMG_OK);
+        CHECK(lr.PD && lr.PD[0] == rom->PD[0] && lr.PD[r] == Sv);
+        {   /* PD is the last field: (r + 1) scalars before the checksum; Ph[0] *= 1e6 */
+          const size_t o0 = w - 4 - 8 * (size_t)(r + 1);
+          double v;
+          memcpy(&v, buf + o0, 8);
+          CHECK(v == rom->PD[0]);
+          v = (v == 0.0 ? 1.0 : v) * 1e6;
+          memcpy(buf + o0, &v, 8);
+          phgmg__put32(buf + w - 4, phgmg__fnv1a(buf, w - 4));
+          CHECK_RC(phgmg_rom_deserialize(buf, w, &lr, mem, need), PHGMG_ERR_STRUCTURE);
+        }
+        free(buf);
+        free(mem);
+      }
+    }
+    phgmg_reduced_destroy(red);
+  }
+  {
+    phgmg_reduce_opts o;
+    phgmg_reduced *red = NULL;
+    s.ndamp = 0;
+    memset(&o, 0, sizeof o);
+    o.method = PHGMG_METHOD_GMG_QM; o.r = 14;
+    CHECK_RC(phgmg_reduce(&red, &s, X, N, ns + 1, &o, NULL, NULL), PHGMG_ERR_UNSUPPORTED);
+  }
+  free(X); free(W); free(Y); free(YR); free(EH); free(P);
+  dpm_free(&c);
+}
+
 SUITE(dissip) {
   RUN(test_dissip_fom_energy);
   RUN(test_dissip_fom_linear_damper);
@@ -617,4 +712,5 @@ SUITE(dissip) {
   RUN(test_dissip_reduce_hyper);
   RUN(test_dissip_rom_file);
   RUN(test_dissip_descriptor);
+  RUN(test_dissip_feedthrough);
 }
