@@ -17019,6 +17019,7 @@ PHGMG_DEF phgmg_result phgmg_rom_export_c(const phgmg_rom *rom, const char *name
   }
   ok &= fprintf(f, ", 0, NULL, NULL") > 0;
   if (rom->PD) ok &= fprintf(f, ",\n  %s_PD", name) > 0;   /* feedthrough */
+  else ok &= fprintf(f, ", NULL") > 0;
   ok &= fprintf(f, "\n};\n") > 0;
   if (fclose(f) != 0) ok = 0;
   return ok ? PHGMG_OK : PHGMG_ERR_IO;
