@@ -173,15 +173,101 @@
    and against the closed forms above.
    Not for descriptor models (PHGMG_ERR_UNSUPPORTED): a GENERAL nonlinear part,
    the shifted_* callbacks, the linear-systems toolbox (BT, PRBT, Gramian
-   bases, phgmg_ph_abc) and studies. Singular E (algebraic constraints) and
-   nonlinear dissipation are not supported. Feedthrough (phgmg_ph_system.P,
+   bases, phgmg_ph_abc) and studies. Singular E (algebraic constraints) is
+   not supported; nonlinear dissipation is the subject of 1.7. Feedthrough (phgmg_ph_system.P,
    S, Nskew: E x' = (J - R) z + (B - P) u, y = (B + P)^T z + (S + N) u) is
    taken by the full model -- validation of [[R, P], [P^T, S]] >= 0 and N
    skew (PHGMG_ERR_FEEDTHROUGH), the stepper, outputs, and the energy
    balance with supply y^T u and dissipation [z; u]^T [[R, P], [P^T, S]]
-   [z; u] -- but not yet by the reductions (PHGMG_ERR_UNSUPPORTED): the
-   reduced model would need the reduced P = W_z^T P and S + N, fields the
-   phgmg_rom format does not have.
+   [z; u] -- and by GMG-POD, SP1 and SP2 (GMG-QM and your manifold:
+   PHGMG_ERR_UNSUPPORTED). The reduced model, with z^ = W_z grad Hr as the
+   co-state (1.7), is
+       xr' = K grad Hr + (Bh - Ph) u,  y = (Bh + Ph)^T grad Hr + (S + N) u,
+       Ph = W_z^T P,  Bh = W_z^T B,  phgmg_rom.PD = [Ph; S + N],
+   its dissipation block [[Rr, Ph], [Ph^T, S]] = diag(W_z, I)^T [[R, P],
+   [P^T, S]] diag(W_z, I) (Rr = W_z^T R W_z = -sym K) is positive
+   semidefinite by congruence, and dHr/dt = yr^T u - [g; u]^T [[Rr, Ph],
+   [Ph^T, S]] [g; u], g = grad Hr; the online stepper sums this dissipation
+   and the supply yr^T u at its stages (the balance as in 1.7). The online
+   output functions have no u: phgmg_rom_output and the stepper's y give
+   (Bh + Ph)^T grad Hr, the caller adds (S + N) u(t) (phgmg_reduced_simulate
+   and the command line do). Model files (format version 3, field PD) check
+   the block on load (PHGMG_ERR_STRUCTURE); no step map with feedthrough.
+
+   1.7 Nonlinear dissipation (phgmg_ph_system.ndamp, damp_*)
+   Dampers r(z) = sum_k c_k rho_k(c_k^T z), c_k = e_i - e_j (a damper between
+   two co-state components, e.g. two velocities) or e_i (one component):
+       E x' = (J - R) z - r(z) + B u,   y = B^T z,
+       dH/dt = z^T E x' = -z^T R z - sum_k s_k rho_k(s_k) + y^T u,  s_k = c_k^T z.
+   The model dissipates iff s rho_k(s) >= 0 for every s. Laws: an odd
+   polynomial sum_d a_d s^d with every a_d >= 0 (a linear plus cubic damper
+   c1 s + c3 s^3 is damp_deg = 3, damp_poly = {0, c1, 0, c3}), checked when
+   the model is validated; or a callback (smooth friction a tanh(b s), ...),
+   whose sign is checked wherever it is evaluated. A law that generates
+   energy (c1 < 0, c3 < 0, an even or constant term, a callback with
+   s rho(s) < 0) is PHGMG_ERR_DAMPER. Example: a chain with cubic dampers on
+   the velocities v_k = p_k / m_k (state index n + k): ndamp = n, damp_i[k]
+   = n + k, damp_j = NULL, damp_deg = 3, damp_poly = {0, 0.2, 0, 3}
+   (tests/test_dissip.c).
+   Full model. GL3 with the dampers in the stage right-hand sides
+   F_i = (J - R) z_i - r(z_i) + B u_i, z_i = z(Y_i); the simplified-Newton
+   matrices take the slopes rho_k' at the factorization point,
+   sigma E - (J - R - sum_k rho_k'(s_k) c_k c_k^T) Hess (dense or banded;
+   the sparse stage LU and the linear step map are not used with dampers).
+   Discrete energy balance: GL3 is the collocation method of the cubic p with
+   p(t_n) = x_n, E p'(t_n + c_i h) = F_i. For a quadratic H,
+   H(p(t))' = z(p)^T E p' is a polynomial of degree 5, integrated exactly by
+   the three-point Gauss rule, so
+       H(x_{n+1}) - H(x_n) = h sum_i b_i z_i^T F_i
+                           = h sum_i b_i (y_i^T u_i - z_i^T R z_i - sum_k s_ik rho_k(s_ik)),
+   s_ik = c_k^T z_i: the balance H_n - H_0 = S_n - D_n holds to round-off and
+   the Newton tolerance whatever rho is (with E the stage residuals enter
+   x_{n+1} through d = b^T A^{-1}, entries up to about 10: a tolerance of
+   1e-13 gives 1e-12 over hundreds of steps, the default 1e-10 about 1e-9), where D sums the dampers' stage
+   quadrature h sum_i b_i s_ik rho_k(s_ik) with that of R (phgmg_energy.D,
+   energy_inc[1]). For a non-quadratic H it holds up to the error of the
+   Gauss rule on H(p(t))'.
+   Reduction (GMG-POD, SP1, SP2; GMG-QM and your manifold are
+   PHGMG_ERR_UNSUPPORTED). With the co-state test basis W_z of 1.6 (E = I:
+   W_z = W) the reduced model replaces the co-state by z^ = W_z grad Hr(xr):
+       xr' = W_z^T (J - R) z^ - W_z^T r(z^) + Bh u
+           = K grad Hr - sum_k Cd_k rho_k(Cd_k^T grad Hr) + Bh u,
+       Cd_k = W_z^T c_k  (phgmg_rom.Cd, r x ndamp),   K = W_z^T (J - R) W_z,
+   so dHr/dt = -z^^T R z^ - sum_k s^_k rho_k(s^_k) + yr^T u with
+   s^_k = c_k^T z^ = Cd_k^T grad Hr: the reduced dampers are the full ones
+   evaluated at the reduced co-state, each dissipative for every argument,
+   and the reduced model is again port-Hamiltonian with the same laws. The
+   reduced stepper is GL3 again: the discrete balance above holds for it with
+   Hr (to round-off for a quadratic Hr, e.g. GMG-POD or SP1 of a quadratic
+   H). Which W: SP1/SP2 as in 1.6. GMG needs a regular G; it takes
+   G = (J - R - L)^{-1}, L = sum_k rho_k'(0) c_k c_k^T (rho_k'(0) >= 0 for a
+   dissipative law), the linearisation of the dampers at rest: any regular G
+   gives W^T D = I and Bh = [I; 0]; this one makes linear dampers
+   (rho = c1 s) reproduce exactly the GMG-POD model of the linear system with
+   R + L, and keeps G regular when all the damping is in the dampers. Then
+   W_z^T = (D^T G_E D)^{-1} (E D)^T G and the stored K = (D^T G_E D)^{-1} +
+   sum_k rho_k'(0) Cd_k Cd_k^T = W_z^T (J - R) W_z (offline: r transposed
+   solves with J - R - L and O(N r^2) work).
+   Online cost and hyper-reduction. Each evaluation costs O(ndamp r): free of
+   N, but every damper is kept, so a model with a damper at every node has an
+   O(N) online cost. opts.hyper_reduce = 1 hyper-reduces the dampers by empirical
+   quadrature (phgmg_ecsw_separable, tolerance hyper_tol; always ECSW,
+   whatever opts.hyper says): weights dw_k >= 0 on a subset of the dampers
+   such that sum_k dw_k Cd_k rho_k(s_k) matches sum_k Cd_k rho_k(s_k) on the
+   training forces, s_k = c_k^T z(x_j) at the snapshots. Non-negative weights
+   keep every kept term dissipative, so the hyper-reduced model is
+   port-Hamiltonian too.
+   Not for damper models: model files and C export of a model
+   with callback laws (PHGMG_ERR_UNSUPPORTED; polynomial laws are saved,
+   format version 3, and exported), the step map, the studies' fast path
+   (phgmg_study_reduce computes the blocks afresh).
+   tests/test_dissip.c checks each claim: the full balance to 1e-11 H (and
+   that it fails without the dampers' term; with a coupled mass matrix too),
+   dense = banded stepper, linear
+   dampers = the linear model with R + L (full and reduced, GMG-POD and SP1),
+   Cd against phgmg_reduced_W, sampled s rho(s) >= 0 and g^T f <= 0 of the
+   reduced model, the reduced balance, the output error falling with r, and
+   the codes of energy-generating dampers.
 
    2. THE OFFLINE PIPELINE ------------------------------------------------------
    2.1 Simulate. phgmg_simulate (or a phgmg_gl3 object: _create / _step /
@@ -538,12 +624,15 @@
    5.2 Shipping a model. phgmg_rom_export_c writes C source (static const
    arrays and a `static const phgmg_rom`), to be compiled after phgmg.h into
    firmware; values round-trip exactly. phgmg_rom_serialize / _save write a
-   versioned, checksummed little-endian binary (format version 2; version 1
-   files still load); phgmg_rom_deserialize / _load read it into caller
+   versioned, checksummed little-endian binary (format version 3 for a model
+   with dampers, 2 for one with several separable functions, else 1; all
+   three load); phgmg_rom_deserialize / _load read it into caller
    memory, checking magic, version, sizes, checksum and values; a file written
    by a double build loads into a float build and vice versa. Models that call
    back into user code cannot be serialised; the C export references the
-   firmware's <name>_phi / <name>_eta instead (a GENERAL model: not at all).
+   firmware's <name>_phi / <name>_eta instead (a GENERAL model, callback
+   dampers: not at all). A loaded model with dampers must have weights >= 0
+   and dissipative laws (PHGMG_ERR_STRUCTURE otherwise).
 
    5.3 Firmware builds. PHGMG_NO_OFFLINE compiles only the online half and the
    in-memory (de)serialisation: libm only, no heap, no stdio. PHGMG_REAL_FLOAT
@@ -563,6 +652,11 @@
      phgmg validate     reduce, then test full against reduced model on each
                         --test-input (exit 1 if one fails);
      phgmg info         describe a model file.
+   Model options shared by reduce, validate and simulate include the mass
+   matrix (--E, --E-coo), feedthrough (--P, --S, --N) and nonlinear dampers:
+   --dampers FILE, a (k, 4) array of rows (i, j, c1, c3), a damper on
+   s = z_i - z_j (j = -1: s = z_i) with force c1 s + c3 s^3 (1.7); e.g. cubic
+   dampers on the velocities of a chain (tests/test_cli.sh builds one).
    `phgmg --help` lists every option with its default, the file formats and
    examples. The reduction does not depend on the units of the states; GMG-QM's
    lambda grid and the POD itself do (with ports of very different scale,
@@ -654,6 +748,11 @@
                                     a positive multiple of the unit row
      PHGMG_ERR_FEEDTHROUGH (-32)    [[R, P], [P^T, S]] not symmetric PSD, or N
                                     not skew
+     PHGMG_ERR_DAMPER (-33)         a damper that generates energy: a
+                                    polynomial law with a constant or even
+                                    term or a negative coefficient, or a
+                                    callback law with s rho(s) < 0 where it
+                                    was evaluated (1.7)
    The declaration of each function lists the codes it returns and when.
 
 
@@ -913,13 +1012,14 @@ extern "C" {
   X(PHGMG_ERR_EQ_NOT_SYMMETRIC, -29, "E^T Q is not symmetric (descriptor model)")          \
   X(PHGMG_ERR_EQ_NOT_PD,       -30, "E^T Q is not positive definite (semidefinite for a nonlinear H)") \
   X(PHGMG_ERR_E_COUPLED,       -31, "a row of E at a nonlinear coordinate is not a positive multiple of the unit row") \
-  X(PHGMG_ERR_FEEDTHROUGH,     -32, "feedthrough: [[R, P], [P^T, S]] not symmetric positive semidefinite or N not skew")
+  X(PHGMG_ERR_FEEDTHROUGH,     -32, "feedthrough: [[R, P], [P^T, S]] not symmetric positive semidefinite or N not skew") \
+  X(PHGMG_ERR_DAMPER,          -33, "a damper generates energy (s rho(s) < 0 for some s)")
 
 typedef enum phgmg_result {
 #define PHGMG__X(name, val, str) name = val,
   PHGMG__RESULT_LIST(PHGMG__X)
 #undef PHGMG__X
-  PHGMG__RESULT_END_ = -33
+  PHGMG__RESULT_END_ = -34
 } phgmg_result;
 
 /* A stable, human-readable description of a result code (never NULL). */
@@ -1150,6 +1250,28 @@ typedef struct phgmg_ph_system {
      them; phgmg_ph_output gives (B + P)^T z only (it has no u). Reductions of
      a model with feedthrough are not supported (PHGMG_ERR_UNSUPPORTED). */
   const double *P, *S, *Nskew;
+  /* Nonlinear dissipation (ndamp = 0: none): ndamp dampers, damper k acting
+     on s_k = c_k^T z, c_k = e_i - e_j (i = damp_i[k], j = damp_j[k]; damp_j
+     NULL or damp_j[k] < 0: c_k = e_i), with the force law rho_k:
+         E x' = (J - R) z - sum_k c_k rho_k(c_k^T z) + (B - P) u,
+     so that dH/dt = y^T u - (the dissipation of R, P, S) - sum_k s_k rho_k(s_k).
+     rho_k is either the odd polynomial
+         rho_k(s) = sum_{d=1}^{damp_deg} a_d s^d,  a = damp_poly + t (damp_deg + 1),
+     t = 0 (damp_nfun 0 or 1: one law for all) or t = k (damp_nfun == ndamp),
+     a_0 and every even a_d zero and every odd a_d >= 0 (e.g. a linear plus
+     cubic damper c1 s + c3 s^3: damp_deg = 3, {0, c1, 0, c3}), checked --
+     PHGMG_ERR_DAMPER otherwise -- or the callback damp_fn(k, s, d, user)
+     filling d[0] = rho_k(s), d[1] = rho_k'(s) (used when damp_poly is NULL;
+     s rho_k(s) >= 0 is checked wherever it is evaluated: PHGMG_ERR_DAMPER).
+     damp_deg <= 15. Banded storage: |i - j| <= kb. Not with the shifted_*
+     callbacks (PHGMG_ERR_UNSUPPORTED). Reduction: GMG-POD, SP1, SP2 (manual
+     1.7). */
+  int ndamp;
+  const int *damp_i, *damp_j;
+  int damp_deg, damp_nfun;
+  const double *damp_poly;
+  void (*damp_fn)(int k, double s, double d[2], void *user);
+  void *damp_user;
   /* Set by phgmg_ph_sparse_system (NULL otherwise): the sparse model this
      banded system comes from. The GL3 stepper then solves its stage systems
      with the sparse LU when phgmg_ph_sparse chose it (see >>sparse) and J,
@@ -1187,7 +1309,9 @@ PHGMG_DEF phgmg_result phgmg_ph_validate(const phgmg_ph_system *sys, double tol,
    and from the default allocator above; if that fails the result is NaN. */
 PHGMG_DEF double phgmg_ph_hamiltonian(const phgmg_ph_system *sys, const double *x);
 PHGMG_DEF void phgmg_ph_gradient(const phgmg_ph_system *sys, const double *x, double *g);
-/* f = (J - R) grad H(x) + B u  (u may be NULL = 0). */
+/* f = (J - R) grad H(x) + B u  (u may be NULL = 0); with feedthrough and
+   dampers (E x' =) (J - R) z - sum_k c_k rho_k(c_k^T z) + (B - P) u (all NaN
+   when a callback damper generates energy). */
 PHGMG_DEF void phgmg_ph_rhs(const phgmg_ph_system *sys, const double *x, const double *u, double *f);
 /* y (m) = B^T grad H(x). */
 PHGMG_DEF void phgmg_ph_output(const phgmg_ph_system *sys, const double *x, double *y);
@@ -1503,7 +1627,8 @@ typedef struct phgmg_gl3_stats {
 
 /* Energy bookkeeping of one run, per grid point n = 0..nsteps:
    H[n] = H(x_n), S[n] = supplied energy up to t_n (h sum b_i y_i^T u_i),
-   D[n] = dissipated energy up to t_n (h sum b_i gradH(Y_i)^T R gradH(Y_i)),
+   D[n] = dissipated energy up to t_n (h sum b_i gradH(Y_i)^T R gradH(Y_i),
+   plus the dampers' h sum b_i sum_k s_k rho_k(s_k), manual 1.7),
    so e_energy(t_n) = |H[n] - H[0] - S[n] + D[n]| (paper eq.
    def_energy_conserve_error, stage quadrature). */
 typedef struct phgmg_energy {
@@ -1676,6 +1801,26 @@ typedef struct phgmg_rom {
        xr_rest r values: the reduced state of the full state 0 (the initial
                state of a run from rest). */
   const phgmg_real *ref_g, *ref_s, *xr_rest;
+  /* nonlinear dissipation (LINEAR kind; ndamp = 0: none): ndamp reduced
+     dampers, f = K g - sum_j dw_j Cd_j rho_j(Cd_j^T g) + Bh u, g = grad H(x),
+     with dw_j >= 0 and rho_j(s) = sum_{d=1}^{damp_deg} a_d s^d (odd, a_d >= 0;
+     a = dpoly + t (damp_deg + 1), t = 0 (damp_nphi 0 or 1) or j (damp_nphi ==
+     ndamp)), or damp_cb(dterm[j], s, d, damp_user): d = rho, rho' of the
+     full-model damper dterm[j] (not exportable). Manual 1.7. */
+  int ndamp, damp_deg, damp_nphi;
+  const phgmg_real *Cd;     /* r x ndamp: the reduced damper directions W_z^T c_k */
+  const phgmg_real *dw;     /* ndamp weights (NULL: all 1)                         */
+  const phgmg_real *dpoly;  /* (damp_nphi or 1) x (damp_deg + 1), constant term first */
+  void (*damp_cb)(int term, phgmg_real s, phgmg_real d[2], void *user);
+  const int *dterm;         /* ndamp: full-model damper of each kept one (NULL: j) */
+  void *damp_user;
+  /* feedthrough (NULL: none; LINEAR kind): PD = [Ph; Dh], Ph = W_z^T P
+     (r x m), then Dh = S + N (m x m):  x' = ... + (Bh - Ph) u,
+     y = (Bh + Ph)^T grad H + Dh u, dissipation block [[-sym K, Ph],
+     [Ph^T, sym Dh]] positive semidefinite (manual 1.6). phgmg_rom_output and
+     the stepper's y give (Bh + Ph)^T grad H: they have no u, add Dh u(t)
+     yourself (phgmg_reduced_simulate does). */
+  const phgmg_real *PD;
 } phgmg_rom;
 
 /* Checks a model's sizes and pointers for consistency (not its values). */
@@ -2670,7 +2815,7 @@ extern "C" {
 /* Format version 2 adds the exp-polynomial data (nexp, nphi, expo, per-term
    poly) and the term indices; a model without them is still written as
    version 1, and both versions load. */
-#define PHGMG_ROM_FORMAT_VERSION 2u
+#define PHGMG_ROM_FORMAT_VERSION 3u
 
 /* Bytes phgmg_rom_serialize writes for this model. */
 PHGMG_DEF size_t phgmg_rom_serialized_size(const phgmg_rom *rom);
@@ -4547,6 +4692,74 @@ PHGMG__PRIV void phgmg__ph_phi3(const phgmg_ph_system *s, int k, double x, doubl
   d[2] = s->ddphi(k, x, s->user);
 }
 
+/* >>dampers: nonlinear dissipation sum_k c_k rho_k(c_k^T z), c_k = e_i - e_j. */
+#define PHGMG__DAMP_DEG_MAX 15
+PHGMG__PRIV int phgmg__damp_j(const phgmg_ph_system *s, int k) {
+  return s->damp_j ? s->damp_j[k] : -1;
+}
+/* s_k = c_k^T z */
+PHGMG__PRIV double phgmg__damp_s(const phgmg_ph_system *s, int k, const double *z) {
+  const int j = phgmg__damp_j(s, k);
+  return j >= 0 ? z[s->damp_i[k]] - z[j] : z[s->damp_i[k]];
+}
+/* d[0] = rho_k(v), d[1] = rho_k'(v). */
+PHGMG__PRIV void phgmg__damp_law(const phgmg_ph_system *s, int k, double v, double d[2]) {
+  const double *a;
+  int e;
+  if (!s->damp_poly) { s->damp_fn(k, v, d, s->damp_user); return; }
+  a = s->damp_poly + (s->damp_nfun > 1 ? (size_t)k * (size_t)(s->damp_deg + 1) : 0);
+  d[0] = a[s->damp_deg];
+  d[1] = (double)s->damp_deg * a[s->damp_deg];
+  for (e = s->damp_deg - 1; e >= 1; --e) {
+    d[0] = d[0] * v + a[e];
+    d[1] = d[1] * v + (double)e * a[e];
+  }
+  d[0] *= v;
+}
+/* f += alpha sum_k c_k rho_k(c_k^T z); returns sum_k s_k rho_k(s_k), or -1
+   when a callback damper generates energy (s rho(s) < 0) or gives NaN. */
+PHGMG__PRIV double phgmg__damp_apply(const phgmg_ph_system *s, const double *z, double alpha, double *f) {
+  double dis = 0.0, d[2];
+  int k;
+  for (k = 0; k < s->ndamp; ++k) {
+    const double v = phgmg__damp_s(s, k, z);
+    const int j = phgmg__damp_j(s, k);
+    phgmg__damp_law(s, k, v, d);
+    if (!(v * d[0] >= 0.0)) return -1.0;
+    dis += v * d[0];
+    if (f) {
+      f[s->damp_i[k]] += alpha * d[0];
+      if (j >= 0) f[j] -= alpha * d[0];
+    }
+  }
+  return dis;
+}
+/* Damper data: sizes, indices, finite coefficients, a dissipative odd
+   polynomial (PHGMG_ERR_DAMPER for a_0 != 0, an even a_d != 0 or an odd
+   a_d < 0). */
+PHGMG__PRIV phgmg_result phgmg__ph_check_dampers(const phgmg_ph_system *s) {
+  int k, e, nf;
+  if (s->ndamp < 0) return PHGMG_ERR_SIZE;
+  if (!s->damp_i || (!s->damp_poly && !s->damp_fn)) return PHGMG_ERR_INVALID_ARG;
+  if (s->shifted_factor) return PHGMG_ERR_UNSUPPORTED;
+  for (k = 0; k < s->ndamp; ++k) {
+    const int i = s->damp_i[k], j = phgmg__damp_j(s, k);
+    if (i < 0 || i >= s->N || j >= s->N || i == j) return PHGMG_ERR_SIZE;
+    if (s->storage == PHGMG_BANDED && j >= 0 && (i > j ? i - j : j - i) > s->kb) return PHGMG_ERR_SIZE;
+  }
+  if (!s->damp_poly) return PHGMG_OK;
+  if (s->damp_deg < 1 || s->damp_deg > PHGMG__DAMP_DEG_MAX) return PHGMG_ERR_SIZE;
+  if (s->damp_nfun < 0 || (s->damp_nfun > 1 && s->damp_nfun != s->ndamp)) return PHGMG_ERR_SIZE;
+  nf = s->damp_nfun > 1 ? s->damp_nfun : 1;
+  if (!phgmg__all_finite(s->damp_poly, (size_t)nf * (size_t)(s->damp_deg + 1))) return PHGMG_ERR_NANINF;
+  for (k = 0; k < nf; ++k)
+    for (e = 0; e <= s->damp_deg; ++e) {
+      const double a = s->damp_poly[(size_t)k * (size_t)(s->damp_deg + 1) + (size_t)e];
+      if ((e % 2 == 0 && a != 0.0) || a < 0.0) return PHGMG_ERR_DAMPER;
+    }
+  return PHGMG_OK;
+}
+
 /* Structural checks shared by every entry point (no O(N^2) work). */
 PHGMG__PRIV phgmg_result phgmg__ph_check(const phgmg_ph_system *s) {
   int k;
@@ -4580,7 +4793,7 @@ PHGMG__PRIV phgmg_result phgmg__ph_check(const phgmg_ph_system *s) {
       break;
     default: return PHGMG_ERR_INVALID_ARG;
   }
-  return PHGMG_OK;
+  return s->ndamp ? phgmg__ph_check_dampers(s) : PHGMG_OK;
 }
 
 /* Finiteness of the valid entries of a dense or banded system matrix. */
@@ -4707,6 +4920,8 @@ PHGMG_DEF void phgmg_ph_rhs(const phgmg_ph_system *sys, const double *x, const d
       if (sys->P)
         for (i = 0; i < N; ++i) f[i] -= sys->P[(size_t)i + (size_t)j * (size_t)N] * u[j];
     }
+  if (sys->ndamp && phgmg__damp_apply(sys, g, -1.0, f) < 0.0)
+    for (i = 0; i < N; ++i) f[i] = (double)NAN;
   phgmg__free(NULL, tmp);
   phgmg__ph_scratch_free(g, sb);
 }
@@ -5395,6 +5610,49 @@ PHGMG__PRIV phgmg_result phgmg__ph_validate_feedthrough(const phgmg_ph_system *s
   return rc;
 }
 
+/* The linearisation of the dampers at z = 0, L = sum_k rho_k'(0) c_k c_k^T,
+   added to a copy of R: *Rl (dense N x N or band (2kb+1) x N, caller frees).
+   PHGMG_ERR_DAMPER if some rho_k'(0) < 0 (a callback law). */
+PHGMG__PRIV phgmg_result phgmg__damp_r_lin(const phgmg_ph_system *sys, double **Rl, const phgmg_allocator *alloc) {
+  const int N = sys->N;
+  const size_t n = sys->storage == PHGMG_DENSE ? (size_t)N * N : (size_t)(2 * sys->kb + 1) * N;
+  double *R = phgmg__dalloc(alloc, n), d[2];
+  int k;
+  *Rl = R;
+  if (!R) return PHGMG_ERR_NOMEM;
+  memcpy(R, sys->R, n * sizeof(double));
+  for (k = 0; k < sys->ndamp; ++k) {
+    const int i = sys->damp_i[k], j = phgmg__damp_j(sys, k);
+    phgmg__damp_law(sys, k, 0.0, d);
+    if (!(d[1] >= 0.0) || d[1] == HUGE_VAL) return d[1] != d[1] ? PHGMG_ERR_NANINF : PHGMG_ERR_DAMPER;
+#define PHGMG__RL(a, b) R[sys->storage == PHGMG_DENSE ? (size_t)(a) + (size_t)(b) * N : PHGMG__PHB(sys->kb, a, b)]
+    PHGMG__RL(i, i) += d[1];
+    if (j >= 0) {
+      PHGMG__RL(j, j) += d[1];
+      PHGMG__RL(i, j) -= d[1];
+      PHGMG__RL(j, i) -= d[1];
+    }
+#undef PHGMG__RL
+  }
+  return PHGMG_OK;
+}
+
+/* phgmg_jr_factor_create of J - R, or with dampers of J - R - L. */
+PHGMG__PRIV phgmg_result phgmg__damp_jr_factor(phgmg_jr_factor **f, const phgmg_ph_system *sys, double *rcond,
+                                               const phgmg_allocator *alloc) {
+  phgmg_ph_system lin;
+  double *Rl = NULL;
+  phgmg_result rc;
+  if (!sys->ndamp) return phgmg_jr_factor_create(f, sys, rcond, alloc);
+  rc = phgmg__damp_r_lin(sys, &Rl, alloc);
+  lin = *sys;
+  lin.R = Rl;
+  lin.ndamp = 0;
+  if (rc == PHGMG_OK) rc = phgmg_jr_factor_create(f, &lin, rcond, alloc);
+  phgmg__free(alloc, Rl);
+  return rc;
+}
+
 PHGMG_DEF phgmg_result phgmg_ph_validate(const phgmg_ph_system *sys, double tol,
                                          double *rcond_out, const phgmg_allocator *alloc) {
   phgmg_result rc;
@@ -5458,11 +5716,11 @@ PHGMG_DEF phgmg_result phgmg_ph_validate(const phgmg_ph_system *sys, double tol,
     phgmg__free(alloc, jpvt);
     if (rc != PHGMG_OK) return rc;
   }
-  /* J - R invertible */
+  /* J - R invertible (with dampers: J - R - L, L their linearisation at 0) */
   {
     phgmg_jr_factor *f = NULL;
     double rcond = 0.0;
-    rc = phgmg_jr_factor_create(&f, sys, &rcond, alloc);
+    rc = phgmg__damp_jr_factor(&f, sys, &rcond, alloc);
     if (rc == PHGMG_ERR_NOMEM) return rc;
     if (rc != PHGMG_OK) rcond = 0.0;
     phgmg_jr_factor_destroy(f);
@@ -7477,6 +7735,12 @@ struct phgmg_gl3 {
   /* feedthrough (sys.P set): sys.B of this copy is B - P (the input matrix of
      the state equation), Bout = B + P that of the output (NULL: B) */
   double *Bin, *Bout;
+  /* dampers (sys.ndamp > 0): the co-state at the factorization point (N),
+     banded: the damper linearisation sum rho'(s_k) c_k c_k^T by diagonals
+     (offsets -ddm_w .. ddm_w), a callback damper that generated energy */
+  double *dz;
+  phgmg__dia ddm;
+  int ddm_w, damp_bad;
 };
 
 PHGMG_DEF void phgmg_gl3_destroy(phgmg_gl3 *s) {
@@ -7507,6 +7771,8 @@ PHGMG_DEF void phgmg_gl3_destroy(phgmg_gl3 *s) {
   phgmg__dia_free(&al, &s->de);
   phgmg__free(&al, s->Bin);
   phgmg__free(&al, s->Bout);
+  phgmg__free(&al, s->dz);
+  phgmg__dia_free(&al, &s->ddm);
   phgmg__free(&al, s);
 }
 
@@ -7674,7 +7940,7 @@ PHGMG__PRIV void phgmg__gl3_setup_method(phgmg_gl3 *s, const phgmg_gl3_opts *opt
     s->mode = PHGMG__GL3_MAP;
   else if (sys->shifted_factor)
     s->mode = PHGMG__GL3_CALLBACK;
-  else if ((s->sps = phgmg__ph_sparse_lu(sys)) != NULL)
+  else if (!sys->ndamp && (s->sps = phgmg__ph_sparse_lu(sys)) != NULL)
     s->mode = PHGMG__GL3_SPARSE;
   else
     s->mode = sys->storage == PHGMG_DENSE ? PHGMG__GL3_DENSE : PHGMG__GL3_BANDED;
@@ -7723,6 +7989,10 @@ PHGMG__PRIV phgmg_result phgmg__gl3_setup_newton(phgmg_gl3 *s) {
   if (sys->E) {
     s->EZ = phgmg__dalloc(&s->al, N3);
     if (!s->EZ) return PHGMG_ERR_NOMEM;
+  }
+  if (sys->ndamp) {
+    s->dz = phgmg__dalloc(&s->al, (size_t)N);
+    if (!s->dz) return PHGMG_ERR_NOMEM;
   }
   if (sys->nl == PHGMG_NL_SEPARABLE) {
     s->dd = phgmg__dalloc(&s->al, (size_t)N);
@@ -7866,6 +8136,26 @@ PHGMG__PRIV phgmg_result phgmg__gl3_setup_banded(phgmg_gl3 *s) {
   return s->mode == PHGMG__GL3_BANDED ? phgmg__gl3_setup_band_lu(s) : PHGMG_OK;
 }
 
+/* Banded with dampers: the diagonals -w .. w (w = largest |i - j|) of the
+   damper linearisation, refilled at every factorization. */
+PHGMG__PRIV phgmg_result phgmg__gl3_setup_ddm(phgmg_gl3 *s) {
+  const phgmg_ph_system *sys = &s->sys;
+  int k, w = 0;
+  phgmg__dia_free(&s->al, &s->ddm);
+  for (k = 0; k < sys->ndamp; ++k) {
+    const int j = phgmg__damp_j(sys, k), i = sys->damp_i[k];
+    if (j >= 0) w = PHGMG__MAX(w, i > j ? i - j : j - i);
+  }
+  s->ddm_w = w;
+  s->ddm.n = s->N;
+  s->ddm.nd = 2 * w + 1;
+  s->ddm.off = phgmg__ialloc(&s->al, (size_t)(2 * w + 1));
+  s->ddm.v = phgmg__dalloc(&s->al, (size_t)(2 * w + 1) * (size_t)s->N);
+  if (!s->ddm.off || !s->ddm.v) return PHGMG_ERR_NOMEM;
+  for (k = 0; k <= 2 * w; ++k) s->ddm.off[k] = k - w;
+  return PHGMG_OK;
+}
+
 /* The band LU workspaces (bandwidths from the nonzero diagonals). */
 PHGMG__PRIV phgmg_result phgmg__gl3_setup_band_lu(phgmg_gl3 *s) {
   const phgmg_ph_system *sys = &s->sys;
@@ -7887,6 +8177,12 @@ PHGMG__PRIV phgmg_result phgmg__gl3_setup_band_lu(phgmg_gl3 *s) {
       rc = phgmg__dia_build(&s->al, &s->dh, N, kb, NULL, NULL, 1, 1);
       s->hband = phgmg__dalloc(&s->al, (size_t)(2 * kb + 1) * (size_t)N);
       if (rc != PHGMG_OK || !s->hband) return PHGMG_ERR_NOMEM;
+    }
+    if (sys->ndamp) { /* dampers: their linearisation joins J - R */
+      rc = phgmg__gl3_setup_ddm(s);
+      if (rc != PHGMG_OK) return rc;
+      amin = PHGMG__MIN(amin, -s->ddm_w);
+      amax = PHGMG__MAX(amax, s->ddm_w);
     }
     if (sys->E) { /* descriptor: the band of E joins that of (J - R) Hess */
       rc = phgmg__dia_build(&s->al, &s->de, N, kb, sys->E, NULL, 1, 0);
@@ -7973,7 +8269,7 @@ PHGMG_DEF phgmg_result phgmg_gl3_create(phgmg_gl3 **out, const phgmg_ph_system *
   s->contraction = (opts && opts->contraction > 0.0) ? opts->contraction : 0.5;
   s->flush = !(opts && opts->keep_tiny);
   s->ftau = s->flush ? PHGMG__DBL_MIN : 0.0;
-  s->linear = sys->nl == PHGMG_NL_NONE;
+  s->linear = sys->nl == PHGMG_NL_NONE && sys->ndamp == 0;
   if (sys->P && phgmg__gl3_setup_feedthrough(s) != PHGMG_OK) {
     phgmg_gl3_destroy(s);
     return PHGMG_ERR_NOMEM;
@@ -8113,7 +8409,7 @@ PHGMG__PRIV void phgmg__gl3_grad_nl(phgmg_gl3 *s, const double *x, int st) {
   }
 }
 
-PHGMG__PRIV void phgmg__gl3_eval(phgmg_gl3 *s, const double *x) {
+PHGMG__PRIV void phgmg__gl3_eval_jr(phgmg_gl3 *s, const double *x) {
   const phgmg_ph_system *sys = &s->sys;
   int N = s->N, m = s->m, st, i, k;
   int qdiag = sys->storage == PHGMG_BANDED && s->dq.nd == 1;
@@ -8165,6 +8461,18 @@ PHGMG__PRIV void phgmg__gl3_eval(phgmg_gl3 *s, const double *x) {
   }
   phgmg_gemm('N', 'N', N, 3, N, 1.0, s->JR, N, s->G, N, 1.0, s->F, N);
   s->st.rhs_evals += 3;
+}
+
+/* Stage gradients G_i and right-hand sides F_i, with the dampers' forces
+   -sum_k c_k rho_k(c_k^T G_i) (s->damp_bad: a callback damper generated
+   energy). */
+PHGMG__PRIV void phgmg__gl3_eval(phgmg_gl3 *s, const double *x) {
+  int st;
+  phgmg__gl3_eval_jr(s, x);
+  if (!s->sys.ndamp) return;
+  for (st = 0; st < 3; ++st)
+    if (phgmg__damp_apply(&s->sys, s->G + (size_t)st * (size_t)s->N, -1.0, s->F + (size_t)st * (size_t)s->N) < 0.0)
+      s->damp_bad = 1;
 }
 
 /* Both band factorizations without row interchanges: the factors are repacked
@@ -8296,6 +8604,53 @@ PHGMG__PRIV void phgmg__gl3_band_shift_e(phgmg_gl3 *s, double sg, double sa, dou
   }
 }
 
+/* Dense: K1 (= -Jac) += sum_k a_k c_k (c_k^T Hess), Hess = Q + diag(dd)
+   (SEPARABLE) or s->Hs (GENERAL, formed by the caller). One damper at a
+   time, rows i and j. */
+PHGMG__PRIV void phgmg__gl3_damp_jac_dense(phgmg_gl3 *s, const double *x) {
+  const phgmg_ph_system *sys = &s->sys;
+  const int N = s->N;
+  const double *H = sys->nl == PHGMG_NL_GENERAL ? s->Hs : sys->Q;
+  int k, c;
+  phgmg__ph_grad(sys, x, s->dz, s->tmp);   /* the co-state z(x) */
+  for (k = 0; k < sys->ndamp; ++k) {
+    const int i = sys->damp_i[k], j = phgmg__damp_j(sys, k);
+    double d[2], v;
+    phgmg__damp_law(sys, k, phgmg__damp_s(sys, k, s->dz), d);
+    if (d[1] == 0.0) continue;
+    for (c = 0; c < N; ++c) {
+      v = H[(size_t)i + (size_t)c * N] - (j >= 0 ? H[(size_t)j + (size_t)c * N] : 0.0);
+      if (sys->nl == PHGMG_NL_SEPARABLE && c == i) v += s->dd[i];
+      if (sys->nl == PHGMG_NL_SEPARABLE && c == j) v -= s->dd[j];
+      s->K1[(size_t)i + (size_t)c * N] += d[1] * v;
+      if (j >= 0) s->K1[(size_t)j + (size_t)c * N] -= d[1] * v;
+    }
+  }
+}
+
+/* Banded: the diagonals of sum_k a_k c_k c_k^T into s->ddm, and
+   AB1 (= -Jac) += ddm Hess (Hess = dq + diag(dd), or dq + dh). */
+PHGMG__PRIV void phgmg__gl3_damp_jac_band(phgmg_gl3 *s, const double *x) {
+  const phgmg_ph_system *sys = &s->sys;
+  const int N = s->N, w = s->ddm_w, kv = s->kl + s->ku;
+  int k;
+  memset(s->ddm.v, 0, sizeof(double) * (size_t)(2 * w + 1) * (size_t)N);
+  phgmg__ph_grad(sys, x, s->dz, s->tmp);
+  for (k = 0; k < sys->ndamp; ++k) {
+    const int i = sys->damp_i[k], j = phgmg__damp_j(sys, k);
+    double d[2];
+    phgmg__damp_law(sys, k, phgmg__damp_s(sys, k, s->dz), d);
+    s->ddm.v[(size_t)w * N + (size_t)i] += d[1];      /* (i, i): offset 0 */
+    if (j < 0) continue;
+    s->ddm.v[(size_t)w * N + (size_t)j] += d[1];
+    s->ddm.v[(size_t)(j - i + w) * N + (size_t)i] -= d[1];   /* (i, j) */
+    s->ddm.v[(size_t)(i - j + w) * N + (size_t)j] -= d[1];   /* (j, i) */
+  }
+  phgmg__dia_prod_band(&s->ddm, &s->dq, NULL, 1.0, s->AB1, s->ldab, kv);
+  if (sys->nl == PHGMG_NL_SEPARABLE) phgmg__dia_prod_band(&s->ddm, NULL, s->dd, 1.0, s->AB1, s->ldab, kv);
+  else if (sys->nl == PHGMG_NL_GENERAL) phgmg__dia_prod_band(&s->ddm, &s->dh, NULL, 1.0, s->AB1, s->ldab, kv);
+}
+
 /* (Re)factor the shifted Newton matrices at x. */
 /* Sparse LU of both stage matrices (see >>sparse); PHGMG_ERR_SINGULAR when
    a static pivot was replaced or the factors grew beyond PHGMG_SPARSE_GROWTH. */
@@ -8370,6 +8725,7 @@ PHGMG__PRIV phgmg_result phgmg__gl3_factor(phgmg_gl3 *s, const double *x) {
           for (i = 0; i < N; ++i) kc[i] -= jc[i] * dj;
         }
     }
+    if (sys->ndamp) phgmg__gl3_damp_jac_dense(s, x);
     for (e = 0; e < NN; ++e) { s->K2[2 * e] = s->K1[e]; s->K2[2 * e + 1] = 0.0; }
     for (i = 0; i < N; ++i) {
       size_t d = (size_t)i * (size_t)(N + 1);
@@ -8395,6 +8751,7 @@ PHGMG__PRIV phgmg_result phgmg__gl3_factor(phgmg_gl3 *s, const double *x) {
       phgmg__dia_refill(&s->dh, sys->kb, s->hband);
       phgmg__dia_prod_band(&s->djr, &s->dh, NULL, -1.0, s->AB1, ld, kv);
     }
+    if (sys->ndamp) phgmg__gl3_damp_jac_band(s, x);
     for (e = 0; e < tot; ++e) { s->AB2[2 * e] = s->AB1[e]; s->AB2[2 * e + 1] = 0.0; }
     if (sys->E) { /* descriptor: sigma E in place of sigma I */
       phgmg__gl3_band_shift_e(s, sg, sa, sb);
@@ -8476,6 +8833,7 @@ PHGMG__PRIV phgmg_result phgmg__gl3_newton(phgmg_gl3 *s, const double *x, int fr
     /* descriptor: E Z and E W in place of Z and W (the same vectors without E) */
     const double *M0 = Z0, *M1 = Z1, *M2 = Z2, *V0 = W0, *V1 = W1, *V2 = W2;
     phgmg__gl3_eval(s, x);
+    if (s->damp_bad) { s->damp_bad = 0; return PHGMG_ERR_DAMPER; }
     if (s->EZ) {
       phgmg__gl3_e_times(s, s->Z, s->EZ);
       M0 = s->EZ; M1 = s->EZ + N; M2 = s->EZ + 2 * (size_t)N;
@@ -8573,12 +8931,22 @@ PHGMG__PRIV void phgmg__gl3_energy_feedthrough(phgmg_gl3 *s, double energy_inc[2
   energy_inc[1] = s->h * dis;
 }
 
+/* Dampers: h sum_i b_i sum_k s_k rho_k(s_k) at the stage co-states, added
+   to the dissipated energy. */
+PHGMG__PRIV void phgmg__gl3_energy_damp(phgmg_gl3 *s, double energy_inc[2]) {
+  double dis = 0.0;
+  int st;
+  if (!s->sys.ndamp) return;
+  for (st = 0; st < 3; ++st) dis += s->b[st] * phgmg__damp_apply(&s->sys, s->G + (size_t)st * (size_t)s->N, 0.0, NULL);
+  energy_inc[1] += s->h * dis;
+}
+
 /* Supplied and dissipated energy over a step from the stage gradients s->G. */
 PHGMG__PRIV void phgmg__gl3_energy(phgmg_gl3 *s, double energy_inc[2]) {
   const phgmg_ph_system *sys = &s->sys;
   int N = s->N, m = s->m, st, k, i;
   double sup = 0.0, dis = 0.0;
-  if (sys->P || sys->S || sys->Nskew) { phgmg__gl3_energy_feedthrough(s, energy_inc); return; }
+  if (sys->P || sys->S || sys->Nskew) { phgmg__gl3_energy_feedthrough(s, energy_inc); phgmg__gl3_energy_damp(s, energy_inc); return; }
   for (st = 0; st < 3; ++st) {
     const double *g = s->G + (size_t)st * (size_t)N, *u = s->U + (size_t)st * (size_t)m;
     double yu = 0.0;
@@ -8593,6 +8961,7 @@ PHGMG__PRIV void phgmg__gl3_energy(phgmg_gl3 *s, double energy_inc[2]) {
   }
   energy_inc[0] = s->h * sup;
   energy_inc[1] = s->h * dis;
+  phgmg__gl3_energy_damp(s, energy_inc);
 }
 
 PHGMG__PRIV phgmg_result phgmg__gl3_step_map(phgmg_gl3 *s, const double *x, double energy_inc[2]) {
@@ -9038,7 +9407,65 @@ PHGMG_DEF phgmg_result phgmg_rom_check(const phgmg_rom *rom) {
     for (i = 0; i < rom->r; ++i)
       if (rom->ref_g[i] != PHGMG__R(0)) return PHGMG_ERR_INVALID_ARG;
   }
+  if (rom->ndamp < 0 || rom->ndamp > (1 << 24)) return PHGMG_ERR_SIZE;
+  if (rom->PD && rom->kind != PHGMG_ROM_LINEAR) return PHGMG_ERR_INVALID_ARG;
+  if (rom->ndamp > 0) {
+    if (rom->kind != PHGMG_ROM_LINEAR || !rom->Cd || (!rom->dpoly && !rom->damp_cb)) return PHGMG_ERR_INVALID_ARG;
+    if (!rom->damp_cb && (rom->damp_deg < 1 || rom->damp_deg > 15)) return PHGMG_ERR_SIZE;
+    if (rom->damp_nphi < 0 || (rom->damp_nphi > 1 && rom->damp_nphi != rom->ndamp)) return PHGMG_ERR_SIZE;
+  }
   return PHGMG_OK;
+}
+
+/* d = rho_j, rho_j' of reduced damper j at s. */
+PHGMG__ONLINE void phgmg__r_damp_law(const phgmg_rom *rom, int j, phgmg_real s, phgmg_real d[2]) {
+  const phgmg_real *a;
+  int e;
+  if (rom->damp_cb) { rom->damp_cb(rom->dterm ? rom->dterm[j] : j, s, d, rom->damp_user); return; }
+  a = rom->dpoly + (rom->damp_nphi > 1 ? (size_t)j * (size_t)(rom->damp_deg + 1) : 0);
+  d[0] = a[rom->damp_deg];
+  d[1] = (phgmg_real)rom->damp_deg * a[rom->damp_deg];
+  for (e = rom->damp_deg - 1; e >= 1; --e) {
+    d[0] = d[0] * s + a[e];
+    d[1] = d[1] * s + (phgmg_real)e * a[e];
+  }
+  d[0] *= s;
+}
+
+/* f -= sum_j dw_j Cd_j rho_j(Cd_j^T g); 1 if a callback damper generated
+   energy (s rho(s) < 0), else 0. */
+PHGMG__ONLINE int phgmg__rom_damp(const phgmg_rom *rom, const phgmg_real *g, phgmg_real *f) {
+  const int r = rom->r;
+  int j, a, bad = 0;
+  for (j = 0; j < rom->ndamp; ++j) {
+    const phgmg_real *cj = rom->Cd + (size_t)j * r;
+    phgmg_real sj = PHGMG__R(0), d[2], c;
+    for (a = 0; a < r; ++a) sj += cj[a] * g[a];
+    phgmg__r_damp_law(rom, j, sj, d);
+    if (sj * d[0] < PHGMG__R(0)) bad = 1;
+    c = (rom->dw ? rom->dw[j] : PHGMG__R(1)) * d[0];
+    for (a = 0; a < r; ++a) f[a] -= c * cj[a];
+  }
+  return bad;
+}
+
+/* Jf -= sum_j dw_j rho_j'(s_j) Cd_j (Cd_j^T Hs), s_j = Cd_j^T g (Hs symmetric);
+   t: r scratch reals. */
+PHGMG__ONLINE void phgmg__rom_damp_jac(const phgmg_rom *rom, const phgmg_real *g, const phgmg_real *Hs,
+                                       phgmg_real *Jf, phgmg_real *t) {
+  const int r = rom->r;
+  int j, a, b;
+  for (j = 0; j < rom->ndamp; ++j) {
+    const phgmg_real *cj = rom->Cd + (size_t)j * r;
+    phgmg_real sj = PHGMG__R(0), d[2], c;
+    for (a = 0; a < r; ++a) sj += cj[a] * g[a];
+    phgmg__r_damp_law(rom, j, sj, d);
+    c = (rom->dw ? rom->dw[j] : PHGMG__R(1)) * d[1];
+    if (c == PHGMG__R(0)) continue;
+    phgmg__r_gemv(r, r, Hs, cj, 0, t);
+    for (b = 0; b < r; ++b)
+      for (a = 0; a < r; ++a) Jf[a + (size_t)b * r] -= c * cj[a] * t[b];
+  }
 }
 
 /* Evaluation work: one layout function used by the size query and by every
@@ -9188,6 +9615,7 @@ PHGMG_DEF void phgmg_rom_output(const phgmg_rom *rom, const phgmg_real *x, phgmg
   phgmg__romw_layout(rom, work, &w);
   phgmg__rom_grad(rom, x, w.g, &w);
   phgmg__r_gemvt(rom->r, rom->m, rom->Bh, w.g, 0, y);
+  if (rom->PD) phgmg__r_gemvt(rom->r, rom->m, rom->PD, w.g, 1, y);   /* + Ph^T g */
 }
 
 /* E = D^T G D = G00 + G01 L + L^T (G10 + G11 L), L = [0, Lp] (QUADRATIC; Lp current). */
@@ -9212,6 +9640,7 @@ PHGMG__ONLINE phgmg_result phgmg__rom_rhs(const phgmg_rom *rom, const phgmg_real
   phgmg__rom_grad(rom, x, w->g, w);
   if (rom->kind == PHGMG_ROM_LINEAR) {
     phgmg__r_gemv(r, r, rom->K, w->g, 0, f);
+    if (rom->ndamp && phgmg__rom_damp(rom, w->g, f)) return PHGMG_ERR_DAMPER;
   } else {
     int i;
     phgmg__rom_dgd(rom, w);
@@ -9220,6 +9649,11 @@ PHGMG__ONLINE phgmg_result phgmg__rom_rhs(const phgmg_rom *rom, const phgmg_real
     phgmg__r_lu_solve(r, w->E, w->piv, f);
   }
   if (u && rom->m > 0) phgmg__r_gemv(r, rom->m, rom->Bh, u, 1, f);
+  if (u && rom->m > 0 && rom->PD) {   /* feedthrough: (Bh - Ph) u */
+    int a, k;
+    for (k = 0; k < rom->m; ++k)
+      for (a = 0; a < r; ++a) f[a] -= rom->PD[a + (size_t)k * r] * u[k];
+  }
   return PHGMG_OK;
 }
 
@@ -9343,6 +9777,7 @@ PHGMG__ONLINE phgmg_result phgmg__rom_jac(const phgmg_rom *rom, const phgmg_real
     phgmg_real *Hs = w->E;
     phgmg__rom_hess(rom, x, Hs, w);
     for (b = 0; b < r; ++b) phgmg__r_gemv(r, r, rom->K, Hs + (size_t)b * r, 0, Jf + (size_t)b * r);
+    if (rom->ndamp) phgmg__rom_damp_jac(rom, w->g, Hs, Jf, w->xp);
     return PHGMG_OK;
   }
   phgmg__rom_hess(rom, x, Jf, w); /* Jf = H; w->g, w->Lp at x */
@@ -9430,7 +9865,7 @@ PHGMG__ONLINE size_t phgmg__romstep_layout(const phgmg_rom *rom, int map_only, v
 
 /* Does stepping with dt use the model's precomputed step map? */
 PHGMG__ONLINE int phgmg__rom_uses_map(const phgmg_rom *rom, phgmg_real dt) {
-  return rom->Phi != NULL && rom->kind == PHGMG_ROM_LINEAR && rom->nd == 0 &&
+  return rom->Phi != NULL && rom->kind == PHGMG_ROM_LINEAR && rom->nd == 0 && rom->ndamp == 0 && !rom->PD &&
          PHGMG__RABS(rom->dt - dt) <= PHGMG__R(8) * PHGMG__REPS * dt;
 }
 
@@ -9742,6 +10177,21 @@ PHGMG__ONLINE phgmg_real phgmg__romstep_iterate(phgmg_rom_stepper *s, const phgm
   return res;
 }
 
+/* Feedthrough at a stage: g^T Ph u + u^T Dh u (= u^T S u, N skew); t: m reals. */
+PHGMG__ONLINE phgmg_real phgmg__rom_feed_energy(const phgmg_rom *rom, const phgmg_real *g, const phgmg_real *u,
+                                                phgmg_real *t) {
+  const int r = rom->r, m = rom->m;
+  const phgmg_real *Dh = rom->PD + (size_t)r * m;
+  phgmg_real v = PHGMG__R(0);
+  int a, b;
+  phgmg__r_gemvt(r, m, rom->PD, g, 0, t);
+  for (a = 0; a < m; ++a) {
+    v += t[a] * u[a];
+    for (b = 0; b < m; ++b) v += u[a] * Dh[a + (size_t)b * m] * u[b];
+  }
+  return v;
+}
+
 /* A converged step: the stage values of the last correction, the new state,
    the energy over the step, the extrapolation data, when to refactor. */
 PHGMG__ONLINE phgmg_result phgmg__romstep_accept(phgmg_rom_stepper *s, const phgmg__romstep_mem *L, phgmg_real *x,
@@ -9779,6 +10229,11 @@ PHGMG__ONLINE phgmg_result phgmg__romstep_accept(phgmg_rom_stepper *s, const phg
       if (u3 && m > 0) {
         phgmg__r_gemvt(r, m, rom->Bh, gi, 0, L->Y);
         for (a = 0; a < m; ++a) { si += L->Y[a] * u3[i * m + a]; di += L->Y[a] * u3[i * m + a]; }
+        if (rom->PD) {   /* feedthrough: g^T Ph u + u^T S u, supplied and dissipated */
+          const phgmg_real pu = phgmg__rom_feed_energy(rom, gi, u3 + i * m, L->Y);
+          si += pu;
+          di += pu;
+        }
       }
       sup += L->b[i] * si;
       dis += L->b[i] * di;
@@ -9931,6 +10386,12 @@ struct phgmg_reduced {
   /* affine reference state (opts.ref; NULL: none): xbar (N), xbr = rho_lin(xbar)
      (r; rho(x) = rho_lin(x) - xbr), the online terms (phgmg_rom.ref_g/ref_s/xr_rest) */
   double *xbar, *xbr, *refg, *refs, *xrest;
+  /* reduced dampers (manual 1.7): Cd r x ndamp, weights, laws (ndamp rows
+     with one law per damper, else 1), full-model index of each kept damper */
+  int ndamp;
+  double *Cd, *dw, *dpoly;
+  int *dterm;
+  double *PD;          /* feedthrough: [W_z^T P; S + N], (r + m) x m (phgmg_rom.PD) */
 };
 
 /* A study (phgmg_study_create): what every reduction of one snapshot set
@@ -11464,6 +11925,38 @@ PHGMG__PRIV phgmg_result phgmg__to_real(phgmg_reduced *red, const double *src, s
   return PHGMG_OK;
 }
 
+/* Reduced damper law by the full model's callback. */
+PHGMG__PRIV void phgmg__damp_tramp(int term, phgmg_real s, phgmg_real d[2], void *user) {
+  const phgmg_reduced *red = PHGMG__CAST(const phgmg_reduced *, user);
+  double dd[2];
+  phgmg__damp_law(red->sys, term, (double)s, dd);
+  d[0] = (phgmg_real)dd[0];
+  d[1] = (phgmg_real)dd[1];
+}
+
+/* The online dampers: Cd, weights, and the laws (the full model's
+   polynomials, one row per kept damper when they differ, or its callback). */
+PHGMG__PRIV phgmg_result phgmg__publish_dampers(phgmg_reduced *red) {
+  const phgmg_ph_system *sys = red->sys;
+  phgmg_rom *o = &red->rom;
+  const size_t r = (size_t)red->r, nd = (size_t)red->ndamp, nc = (size_t)sys->damp_deg + 1;
+  phgmg_result rc;
+  size_t k;
+  o->ndamp = red->ndamp;
+  rc = phgmg__to_real(red, red->Cd, r * nd, &o->Cd);
+  if (rc == PHGMG_OK) rc = phgmg__to_real(red, red->dw, nd, &o->dw);
+  if (rc != PHGMG_OK) return rc;
+  o->dterm = red->dterm;
+  if (!sys->damp_poly) { o->damp_cb = phgmg__damp_tramp; o->damp_user = red; return PHGMG_OK; }
+  o->damp_deg = sys->damp_deg;
+  o->damp_nphi = sys->damp_nfun > 1 ? red->ndamp : 1;
+  red->dpoly = phgmg__red_d(red, (size_t)o->damp_nphi * nc);
+  if (!red->dpoly) return PHGMG_ERR_NOMEM;
+  for (k = 0; k < (size_t)o->damp_nphi; ++k)
+    memcpy(red->dpoly + k * nc, sys->damp_poly + (sys->damp_nfun > 1 ? (size_t)red->dterm[k] * nc : 0), nc * sizeof(double));
+  return phgmg__to_real(red, red->dpoly, (size_t)o->damp_nphi * nc, &o->dpoly);
+}
+
 /* The online model: phgmg_real copies of the blocks, and the callbacks
    through which it evaluates what has no fixed coefficients (separable
    functions given by callbacks, the caller's eta, a GENERAL part). */
@@ -11494,7 +11987,8 @@ PHGMG__PRIV phgmg_result phgmg__publish(phgmg_reduced *red) {
   }
   if (red->eta) { o->eta_cb = red->eta; o->eta_user = red->eta_user; }
   if (red->gwork) { o->ham_cb = phgmg__ham_general; o->ham_user = red; }
-  return rc;
+  if (rc == PHGMG_OK) rc = phgmg__to_real(red, red->PD, (size_t)(r + m) * m, &o->PD);
+  return rc == PHGMG_OK && red->ndamp ? phgmg__publish_dampers(red) : rc;
 }
 
 /* GMG-QM ridge validation (phgmg_reduce_opts.lambda_auto). The rows of K
@@ -11856,7 +12350,11 @@ PHGMG__PRIV phgmg_result phgmg__reduce_check(const phgmg_ph_system *sys, const d
   if ((int)o->hyper < 0 || (int)o->hyper >= (int)PHGMG_HYPER_COUNT) return PHGMG_ERR_INVALID_ARG;
   if (!(o->hyper_tol >= 0.0 && o->hyper_tol < 1.0)) return PHGMG_ERR_INVALID_ARG;
   if (o->hyper_reduce && sys->nl == PHGMG_NL_GENERAL) return PHGMG_ERR_UNSUPPORTED;
-  if (sys->P || sys->S || sys->Nskew) return PHGMG_ERR_UNSUPPORTED;   /* feedthrough: full model only */
+  if ((sys->P || sys->S || sys->Nskew || sys->ndamp) && o->method != PHGMG_METHOD_GMG_POD && o->method != PHGMG_METHOD_SP1 &&
+      o->method != PHGMG_METHOD_SP2)
+    return PHGMG_ERR_UNSUPPORTED;   /* dampers, feedthrough: linear maps only (manual 1.6, 1.7) */
+  if ((sys->P || sys->S || sys->Nskew || sys->ndamp) && o->ref != PHGMG_REF_NONE)
+    return PHGMG_ERR_UNSUPPORTED;   /* a reference state with dampers or feedthrough: not derived */
   if (!(o->deim_tol >= 0.0 && o->deim_tol < 1.0) || o->deim_max < 0) return PHGMG_ERR_INVALID_ARG;
   if (!(o->dt >= 0.0) || o->dt == HUGE_VAL) return PHGMG_ERR_INVALID_ARG;
   if (o->lambda != o->lambda || !(o->degeneracy_tol >= 0.0 && o->degeneracy_tol < 1.0)) return PHGMG_ERR_INVALID_ARG;
@@ -13320,6 +13818,122 @@ PHGMG__PRIV phgmg_result phgmg__study_gmg_blocks(phgmg__rctx *c) {
   return PHGMG_OK;
 }
 
+/* >>dampers (reduction, manual 1.7). The reduced dampers of the co-state test
+   basis Wz (N x r): Cd(:, k) = Wz^T c_k = Wz(i_k, :) - Wz(j_k, :). GMG
+   (add_lin = 1): K, built from G = (J - R - L)^{-1}, becomes Wz^T (J - R) Wz
+   = K + sum_k rho_k'(0) Cd_k Cd_k^T. Then, with opts.hyper_reduce, the dampers are
+   hyper-reduced by ECSW (weights >= 0) on the training forces
+   rho_k(c_k^T z(x_j)). */
+PHGMG__PRIV phgmg_result phgmg__dampers_hyper(phgmg__rctx *c);
+PHGMG__PRIV phgmg_result phgmg__stage_dampers(phgmg__rctx *c, const double *Wz, int add_lin) {
+  phgmg_reduced *red = c->red;
+  const phgmg_ph_system *sys = c->sys;
+  const int N = red->N, r = red->r, nd = sys->ndamp;
+  int k, a, b;
+  red->ndamp = nd;
+  red->Cd = phgmg__red_d(red, (size_t)r * nd);
+  red->dw = phgmg__red_d(red, (size_t)nd);
+  red->dterm = PHGMG__CAST(int *, phgmg__red_alloc(red, (size_t)nd * sizeof(int)));
+  if (!red->Cd || !red->dw || !red->dterm) return PHGMG_ERR_NOMEM;
+  for (k = 0; k < nd; ++k) {
+    const int i = sys->damp_i[k], j = phgmg__damp_j(sys, k);
+    double *ck = red->Cd + (size_t)k * r, d[2];
+    for (a = 0; a < r; ++a) ck[a] = Wz[i + (size_t)a * N] - (j >= 0 ? Wz[j + (size_t)a * N] : 0.0);
+    red->dw[k] = 1.0;
+    red->dterm[k] = k;
+    if (!add_lin) continue;
+    phgmg__damp_law(sys, k, 0.0, d);
+    for (b = 0; b < r; ++b)
+      for (a = 0; a < r; ++a) red->K[a + (size_t)b * r] += d[1] * ck[a] * ck[b];
+  }
+  if (!phgmg__all_finite(red->Cd, (size_t)r * nd)) return PHGMG_ERR_NANINF;
+  return c->o->hyper_reduce ? phgmg__dampers_hyper(c) : PHGMG_OK;
+}
+
+PHGMG__PRIV int phgmg__has_feed(const phgmg_ph_system *sys) { return sys->P || sys->S || sys->Nskew; }
+
+/* Feedthrough (manual 1.6): PD = [W_z^T P; S + N]. */
+PHGMG__PRIV phgmg_result phgmg__stage_feedthrough(phgmg__rctx *c, const double *Wz) {
+  phgmg_reduced *red = c->red;
+  const phgmg_ph_system *sys = c->sys;
+  const int N = red->N, r = red->r, m = red->m;
+  int a, b;
+  red->PD = phgmg__red_d(red, (size_t)(r + m) * m);
+  if (!red->PD) return PHGMG_ERR_NOMEM;
+  if (sys->P) {
+    double *t = phgmg__dalloc(c->alloc, (size_t)r * m);
+    if (!t) return PHGMG_ERR_NOMEM;
+    phgmg__atb(N, r, m, Wz, sys->P, t);
+    memcpy(red->PD, t, (size_t)r * m * sizeof(double));
+    phgmg__free(c->alloc, t);
+  }
+  for (b = 0; b < m; ++b)
+    for (a = 0; a < m; ++a)
+      red->PD[(size_t)r * m + a + (size_t)b * m] = (sys->S ? sys->S[a + (size_t)b * m] : 0.0) +
+                                                   (sys->Nskew ? sys->Nskew[a + (size_t)b * m] : 0.0);
+  return phgmg__all_finite(red->PD, (size_t)(r + m) * m) ? PHGMG_OK : PHGMG_ERR_NANINF;
+}
+
+/* GMG: Wz = G^T (E V0) K^T (Wz^T = K (E V0)^T G), then the reduced dampers
+   and the feedthrough. */
+PHGMG__PRIV phgmg_result phgmg__gmg_dampers(phgmg__rctx *c) {
+  phgmg_reduced *red = c->red;
+  const int N = red->N, r = red->r;
+  double *Y = phgmg__dalloc(c->alloc, 2 * (size_t)N * r), *Wz;
+  phgmg_result rc;
+  if (!Y) return PHGMG_ERR_NOMEM;
+  Wz = Y + (size_t)N * r;
+  if (c->sys->E) phgmg__ph_e_apply(c->sys, 'N', r, red->V0, N, Y, N);
+  else memcpy(Y, red->V0, (size_t)N * r * sizeof(double));
+  phgmg_jr_solve(c->jr, 'T', r, Y, N);
+  phgmg_gemm('N', 'T', N, r, r, 1.0, Y, N, red->K, r, 0.0, Wz, N);
+  rc = c->sys->ndamp ? phgmg__stage_dampers(c, Wz, 1) : PHGMG_OK;
+  if (rc == PHGMG_OK && phgmg__has_feed(c->sys)) rc = phgmg__stage_feedthrough(c, Wz);
+  phgmg__free(c->alloc, Y);
+  return rc;
+}
+
+/* ECSW over the dampers: F(k, j) = rho_k(c_k^T z(x_j)) (PHGMG_ERR_DAMPER if
+   a callback law generates energy there), rows Cd_k; the kept dampers and
+   their weights replace the full set. */
+PHGMG__PRIV phgmg_result phgmg__dampers_hyper(phgmg__rctx *c) {
+  phgmg_reduced *red = c->red;
+  const phgmg_ph_system *sys = c->sys;
+  const int N = red->N, r = red->r, nd = sys->ndamp, ns = c->ns;
+  double *F = phgmg__dalloc(c->alloc, (size_t)nd * ns + (size_t)nd * r + (size_t)N + (size_t)nd);
+  double *Vt, *z, *w, resid = 0.0, d[2];
+  int *pts = phgmg__ialloc(c->alloc, (size_t)nd), j, k, a, nk = 0;
+  phgmg_result rc = PHGMG_OK;
+  if (!F || !pts) { phgmg__free(c->alloc, F); phgmg__free(c->alloc, pts); return PHGMG_ERR_NOMEM; }
+  Vt = F + (size_t)nd * ns; z = Vt + (size_t)nd * r; w = z + N;
+  for (j = 0; j < ns && rc == PHGMG_OK; ++j) {
+    phgmg_ph_gradient(sys, c->X + (size_t)j * c->ldx, z);
+    for (k = 0; k < nd; ++k) {
+      const double v = phgmg__damp_s(sys, k, z);
+      phgmg__damp_law(sys, k, v, d);
+      if (!(v * d[0] >= 0.0)) { rc = d[0] != d[0] ? PHGMG_ERR_NANINF : PHGMG_ERR_DAMPER; break; }
+      F[k + (size_t)j * nd] = d[0];
+    }
+  }
+  for (k = 0; k < nd; ++k)
+    for (a = 0; a < r; ++a) Vt[k + (size_t)a * nd] = red->Cd[a + (size_t)k * r];
+  if (rc == PHGMG_OK)
+    rc = phgmg_ecsw_separable(nd, ns, F, nd, r, Vt, nd, NULL, c->o->hyper_tol, pts, w, &nk, &resid, c->alloc);
+  if (rc == PHGMG_OK) {   /* compact in place: kept dampers first (pts ascending or not, k <= pts[k] is not assumed) */
+    double *C2 = Vt;      /* reuse: r x nk */
+    for (k = 0; k < nk; ++k) {
+      memcpy(C2 + (size_t)k * r, red->Cd + (size_t)pts[k] * r, (size_t)r * sizeof(double));
+      red->dterm[k] = pts[k];
+    }
+    memcpy(red->Cd, C2, (size_t)nk * r * sizeof(double));
+    for (k = 0; k < nk; ++k) red->dw[k] = w[k];
+    red->ndamp = nk;
+  }
+  phgmg__free(c->alloc, F);
+  phgmg__free(c->alloc, pts);
+  return rc;
+}
+
 PHGMG__PRIV phgmg_result phgmg__stage_gmg_blocks(phgmg__rctx *c) {
   phgmg_reduced *red = c->red;
   const int N = red->N, m = red->m, r = red->r, rn = red->rn;
@@ -13328,7 +13942,7 @@ PHGMG__PRIV phgmg_result phgmg__stage_gmg_blocks(phgmg__rctx *c) {
   int j;
   phgmg_result rc = PHGMG_OK;
   if (c->sf != 1) {
-    rc = phgmg_jr_factor_create(&c->jr, c->sys, NULL, c->alloc);
+    rc = phgmg__damp_jr_factor(&c->jr, c->sys, NULL, c->alloc);   /* G = (J - R (- L))^{-1} */
     if (rc != PHGMG_OK) return rc;
     GV = phgmg__dalloc(c->alloc, (size_t)N * (r + rn) * (c->sys->E ? 2 : 1));
     if (!GV) return PHGMG_ERR_NOMEM;
@@ -13369,7 +13983,8 @@ PHGMG__PRIV phgmg_result phgmg__stage_gmg_blocks(phgmg__rctx *c) {
   if (rc != PHGMG_OK || red->kind != PHGMG_ROM_LINEAR) return rc;
   red->K = phgmg__red_d(red, (size_t)r * r);
   if (!red->K) return PHGMG_ERR_NOMEM;
-  return phgmg__inv(r, red->G00, red->K, c->alloc);
+  rc = phgmg__inv(r, red->G00, red->K, c->alloc);
+  return (rc == PHGMG_OK && (c->sys->ndamp || phgmg__has_feed(c->sys))) ? phgmg__gmg_dampers(c) : rc;
 }
 
 /* Descriptor: X (N x nc, ld N) <- E^T X. */
@@ -13455,6 +14070,8 @@ PHGMG__PRIV phgmg_result phgmg__stage_sp_blocks(phgmg__rctx *c) {
     for (i = 0; i < N * r; ++i) Vg[i] -= T[i];
     phgmg__atb(N, r, r, Wz, Vg, red->K);
     phgmg__atb(N, r, m, Wz, c->sys->B, red->Bh);
+    if (c->sys->ndamp) rc = phgmg__stage_dampers(c, Wz, 0);
+    if (rc == PHGMG_OK && phgmg__has_feed(c->sys)) rc = phgmg__stage_feedthrough(c, Wz);
   }
   phgmg__free(c->alloc, Vg);
   return rc;
@@ -13893,7 +14510,7 @@ PHGMG__PRIV phgmg_result phgmg__reduce_run(phgmg_reduced **out, const phgmg_ph_s
   c.st = st;
   c.inf.hyper_method = -1;
   rc = phgmg__reduce_check(sys, X, ldx, ns, c.o, st != NULL);
-  if (rc == PHGMG_OK) c.sf = c.o->ref ? 0 : phgmg__study_fast(st, c.o, sys->m);
+  if (rc == PHGMG_OK) c.sf = (c.o->ref || sys->ndamp) ? 0 : phgmg__study_fast(st, c.o, sys->m);
   if (rc == PHGMG_OK) rc = phgmg_ph_validate(sys, 0.0, &c.inf.rcond_jr, alloc);
   if (rc != PHGMG_OK) {
     if (info) *info = c.inf;
@@ -13920,7 +14537,7 @@ PHGMG__PRIV phgmg_result phgmg__reduce_run(phgmg_reduced **out, const phgmg_ph_s
   if (rc == PHGMG_OK) { phgmg__progress(opts, "hyper-reduction"); rc = phgmg__stage_separable_terms(&c); }
   if (rc == PHGMG_OK) { phgmg__progress(opts, "finish"); rc = phgmg__stage_general_term(&c); }
   if (rc == PHGMG_OK && opts->dt > 0.0 && c.red->kind == PHGMG_ROM_LINEAR && c.red->nd == 0 &&
-      sys->nl != PHGMG_NL_GENERAL) {
+      sys->nl != PHGMG_NL_GENERAL && c.red->ndamp == 0 && !c.red->PD) {
     c.red->map_dt = opts->dt;
     rc = phgmg__step_map(c.red, opts->dt, alloc);
   }
@@ -14021,7 +14638,7 @@ PHGMG_DEF phgmg_result phgmg_reduced_W(const phgmg_reduced *red, const double *x
   phgmg_reduced_dphi(red, xr, D, N);
   if (red->sys->E) phgmg__ph_e_apply(red->sys, 'N', r, D, N, GtD, N);   /* descriptor: G_E = E^T G E */
   else memcpy(GtD, D, (size_t)N * r * sizeof(double));
-  rc = phgmg_jr_factor_create(&jr, red->sys, NULL, alloc);
+  rc = phgmg__damp_jr_factor(&jr, red->sys, NULL, alloc);   /* dampers: G = (J - R - L)^{-1} */
   if (rc == PHGMG_OK) {
     phgmg_jr_solve(jr, 'T', r, GtD, N);                      /* G^T D */
     if (red->sys->E) {                                       /* E^T G^T E D, column by column */
@@ -14064,6 +14681,16 @@ PHGMG_DEF phgmg_result phgmg_reduced_simulate_run(const phgmg_reduced *red, cons
   return rc;
 }
 
+/* y += Dh u(t) (feedthrough of a reduced model; ubuf: m doubles). */
+PHGMG__PRIV void phgmg__feed_out(const phgmg_rom *rom, double t, phgmg_input_fn uf, void *uuser, double *ubuf,
+                                 double *y) {
+  const int r = rom->r, m = rom->m;
+  int a, b;
+  uf(t, ubuf, uuser);
+  for (a = 0; a < m; ++a)
+    for (b = 0; b < m; ++b) y[a] += (double)rom->PD[(size_t)r * m + a + (size_t)b * m] * ubuf[b];
+}
+
 PHGMG_DEF phgmg_result phgmg_reduced_simulate(const phgmg_reduced *red, const double *xr0, double t0,
                                               double dt, int nsteps, phgmg_input_fn uf, void *uuser,
                                               double tol, int max_iter, double *XR, double *Y,
@@ -14092,7 +14719,8 @@ PHGMG_DEF phgmg_result phgmg_reduced_simulate(const phgmg_reduced *red, const do
   for (a = 0; a < r; ++a) x[a] = (phgmg_real)xr0[a];
 #define PHGMG__REC(nn) do { \
     if (XR) for (a = 0; a < r; ++a) XR[a + (size_t)(nn) * r] = (double)x[a]; \
-    if (Y) { phgmg_rom_output(rom, x, y, ework); for (a = 0; a < m; ++a) Y[a + (size_t)(nn) * m] = (double)y[a]; } \
+    if (Y) { phgmg_rom_output(rom, x, y, ework); for (a = 0; a < m; ++a) Y[a + (size_t)(nn) * m] = (double)y[a]; \
+             if (rom->PD && uf) phgmg__feed_out(rom, t0 + (nn) * dt, uf, uuser, ubuf, Y + (size_t)(nn) * m); } \
     if (energy) { energy->H[nn] = (double)phgmg_rom_hamiltonian(rom, x, ework); energy->S[nn] = S; energy->D[nn] = D; } \
   } while (0)
   PHGMG__REC(0);
@@ -16314,8 +16942,6 @@ PHGMG_DEF phgmg_result phgmg_ss_error(int n1, const double *A1, const double *B1
 
 /* The arrays of a phgmg_rom in file order, with their sizes. */
 #define PHGMG__NFIELDS 29
-/* Bits 22-25 are reserved (no field; a file that sets them is refused). */
-#define PHGMG__FIELDS_RESERVED (15u << 22)
 typedef struct phgmg__field { size_t off; const char *name; } phgmg__field;
 static const phgmg__field phgmg__fields[PHGMG__NFIELDS] = {
   {offsetof(phgmg_rom, Bh), "Bh"},   {offsetof(phgmg_rom, Qh), "Qh"},   {offsetof(phgmg_rom, K), "K"},
@@ -16327,7 +16953,8 @@ static const phgmg__field phgmg__fields[PHGMG__NFIELDS] = {
   {offsetof(phgmg_rom, expo), "expo"},
   {offsetof(phgmg_rom, env_lo), "env_lo"}, {offsetof(phgmg_rom, env_hi), "env_hi"},
   {offsetof(phgmg_rom, q_max), "q_max"},
-  {0, NULL}, {0, NULL}, {0, NULL}, {0, NULL},
+  {offsetof(phgmg_rom, Cd), "Cd"}, {offsetof(phgmg_rom, dw), "dw"}, {offsetof(phgmg_rom, dpoly), "dpoly"},
+  {offsetof(phgmg_rom, PD), "PD"},
   {offsetof(phgmg_rom, ref_g), "ref_g"}, {offsetof(phgmg_rom, ref_s), "ref_s"},
   {offsetof(phgmg_rom, xr_rest), "xr_rest"}};
 
@@ -16364,10 +16991,14 @@ PHGMG__ONLINE size_t phgmg__field_len(const phgmg_rom *rom, int i) {
     case 18: return nd ? nf * 2 * (size_t)rom->nexp : 0;
     case 19: case 20: return r;   /* env_lo, env_hi */
     case 21: return 1;            /* q_max */
+    case 22: return r * (size_t)rom->ndamp;   /* Cd */
+    case 23: return (size_t)rom->ndamp;       /* dw */
+    case 24: return rom->ndamp ? (size_t)(rom->damp_nphi > 1 ? rom->damp_nphi : 1) * ((size_t)rom->damp_deg + 1) : 0;
+    case 25: return (r + m) * m;              /* PD */
     case 26: return r + (rom->kind == PHGMG_ROM_QUADRATIC ? rn : 0) + 1;   /* ref_g */
     case 27: return nd;           /* ref_s */
     case 28: return r;            /* xr_rest */
-    default: return 0;            /* reserved */
+    default: return 0;
   }
 }
 
@@ -16377,8 +17008,13 @@ PHGMG__ONLINE size_t phgmg__field_len(const phgmg_rom *rom, int i) {
    q_max, bits 19-21, may sit in either version); nterm (0 or nd) uint32 term
    indices after the scalars. */
 #define PHGMG__HDR2_BYTES (PHGMG__HDR_BYTES + 12)
+/* Version 3 (written only for a model with dampers or feedthrough): the
+   version-2 header, then ndamp, damp_deg, damp_nphi (0 without dampers);
+   the fields Cd, dw, dpoly (bits 22-24, with dampers) and PD (bit 25). */
+#define PHGMG__HDR3_BYTES (PHGMG__HDR2_BYTES + 12)
+PHGMG__ONLINE int phgmg__rom_v3(const phgmg_rom *rom) { return rom->ndamp > 0 || rom->PD; }
 PHGMG__ONLINE int phgmg__rom_v2(const phgmg_rom *rom) {
-  return rom->nd > 0 && (rom->nexp > 0 || rom->nphi > 1 || rom->term);
+  return (rom->nd > 0 && (rom->nexp > 0 || rom->nphi > 1 || rom->term)) || phgmg__rom_v3(rom);
 }
 PHGMG__ONLINE size_t phgmg__rom_nterm(const phgmg_rom *rom) {
   return phgmg__rom_v2(rom) && rom->term ? (size_t)rom->nd : 0;
@@ -16429,7 +17065,8 @@ PHGMG_DEF size_t phgmg_rom_serialized_size(const phgmg_rom *rom) {
   for (i = 0; i < PHGMG__NFIELDS; ++i)
     if (phgmg__field_get(rom, i)) n += phgmg__field_len(rom, i);
   if (!phgmg__rom_v2(rom)) return PHGMG__HDR_BYTES + n * sizeof(phgmg_real) + 4;
-  return PHGMG__HDR2_BYTES + n * sizeof(phgmg_real) + 4 * phgmg__rom_nterm(rom) + 4;
+  return (phgmg__rom_v3(rom) ? PHGMG__HDR3_BYTES : PHGMG__HDR2_BYTES) + n * sizeof(phgmg_real) +
+         4 * phgmg__rom_nterm(rom) + 4;
 }
 
 PHGMG_DEF phgmg_result phgmg_rom_serialize(const phgmg_rom *rom, void *buf, size_t cap, size_t *written) {
@@ -16439,14 +17076,14 @@ PHGMG_DEF phgmg_result phgmg_rom_serialize(const phgmg_rom *rom, void *buf, size
   int i;
   phgmg_result rc = phgmg_rom_check(rom);
   if (rc != PHGMG_OK) return rc;
-  if (rom->phi_cb || rom->eta_cb || rom->ham_cb) return PHGMG_ERR_UNSUPPORTED;
+  if (rom->phi_cb || rom->eta_cb || rom->ham_cb || rom->damp_cb) return PHGMG_ERR_UNSUPPORTED;
   if (!buf) return PHGMG_ERR_INVALID_ARG;
   need = phgmg_rom_serialized_size(rom);
   if (cap < need) return PHGMG_ERR_WORKSPACE;
   for (i = 0; i < PHGMG__NFIELDS; ++i)
     if (phgmg__field_get(rom, i)) mask |= 1u << i;
   memcpy(b, "PHGMGROM", 8);
-  phgmg__put32(b + 8, phgmg__rom_v2(rom) ? PHGMG_ROM_FORMAT_VERSION : 1u);
+  phgmg__put32(b + 8, phgmg__rom_v3(rom) ? 3u : phgmg__rom_v2(rom) ? 2u : 1u);
   phgmg__put32(b + 12, (uint32_t)sizeof(phgmg_real));
   phgmg__put32(b + 16, (uint32_t)rom->kind);
   phgmg__put32(b + 20, (uint32_t)rom->method);
@@ -16463,6 +17100,12 @@ PHGMG_DEF phgmg_result phgmg_rom_serialize(const phgmg_rom *rom, void *buf, size
     phgmg__put32(b + o + 4, (uint32_t)rom->nphi);
     phgmg__put32(b + o + 8, (uint32_t)phgmg__rom_nterm(rom));
     o = PHGMG__HDR2_BYTES;
+  }
+  if (phgmg__rom_v3(rom)) {
+    phgmg__put32(b + o, (uint32_t)rom->ndamp);
+    phgmg__put32(b + o + 4, (uint32_t)rom->damp_deg);
+    phgmg__put32(b + o + 8, (uint32_t)rom->damp_nphi);
+    o = PHGMG__HDR3_BYTES;
   }
   for (i = 0; i < PHGMG__NFIELDS; ++i) {
     const phgmg_real *a = phgmg__field_get(rom, i);
@@ -16494,11 +17137,21 @@ PHGMG__ONLINE phgmg_result phgmg__rom_header(const unsigned char *b, size_t len,
   if (len < PHGMG__HDR_BYTES + 4 || memcmp(b, "PHGMGROM", 8) != 0) return PHGMG_ERR_FORMAT;
   ver = phgmg__get32(b + 8);
   ss = phgmg__get32(b + 12);
-  if ((ver != 1u && ver != PHGMG_ROM_FORMAT_VERSION) || (ss != 4 && ss != 8)) return PHGMG_ERR_FORMAT;
+  if ((ver != 1u && ver != 2u && ver != 3u) || (ss != 4 && ss != 8)) return PHGMG_ERR_FORMAT;
   memset(rom, 0, sizeof *rom);
-  if (ver == 2u) {
+  if (ver == 3u) {
+    if (len < PHGMG__HDR3_BYTES + 4) return PHGMG_ERR_FORMAT;
+    if (phgmg__get32(b + 68) > (1u << 24) || phgmg__get32(b + 72) > 15u || phgmg__get32(b + 76) > (1u << 24) ||
+        (phgmg__get32(b + 68) > 0u) != (phgmg__get32(b + 72) > 0u))
+      return PHGMG_ERR_FORMAT;
+    rom->ndamp = (int)phgmg__get32(b + 68);
+    rom->damp_deg = (int)phgmg__get32(b + 72);
+    rom->damp_nphi = (int)phgmg__get32(b + 76);
+    if (rom->damp_nphi > 1 && rom->damp_nphi != rom->ndamp) return PHGMG_ERR_FORMAT;
+  }
+  if (ver >= 2u) {
     if (len < PHGMG__HDR2_BYTES + 4) return PHGMG_ERR_FORMAT;
-    hdr = PHGMG__HDR2_BYTES;
+    hdr = ver == 3u ? PHGMG__HDR3_BYTES : PHGMG__HDR2_BYTES;
     if (phgmg__get32(b + 56) > 8u || phgmg__get32(b + 60) > (1u << 24) || phgmg__get32(b + 64) > (1u << 24))
       return PHGMG_ERR_FORMAT;
     rom->nexp = (int)phgmg__get32(b + 56);
@@ -16526,7 +17179,11 @@ PHGMG__ONLINE phgmg_result phgmg__rom_header(const unsigned char *b, size_t len,
     rom->dt = (phgmg_real)dt;
   }
   /* version 1: every field but expo (bit 18, which needs the version-2 header) */
-  if ((mask >> PHGMG__NFIELDS) || (mask & PHGMG__FIELDS_RESERVED) || (ver == 1u && (mask & (1u << 18))))
+  if ((mask >> PHGMG__NFIELDS) || (ver == 1u && (mask & (1u << 18)))) return PHGMG_ERR_FORMAT;
+  /* dampers (bits 22-24, all three) exactly when the version-3 header has
+     ndamp > 0; feedthrough (bit 25) only in version 3; version 3 has one */
+  if ((rom->ndamp > 0) != ((mask & (7u << 22)) == (7u << 22)) || (rom->ndamp == 0 && (mask & (7u << 22))) ||
+      (ver != 3u && (mask & (1u << 25))) || (ver == 3u && rom->ndamp == 0 && !(mask & (1u << 25))))
     return PHGMG_ERR_FORMAT;
   if (rom->m > rom->r) return PHGMG_ERR_FORMAT;
   if ((rom->nphi > 1 && rom->nphi != rom->nd) || (nterm != 0 && nterm != (size_t)rom->nd))
@@ -16575,9 +17232,10 @@ PHGMG__ONLINE phgmg_result phgmg__rom_header(const unsigned char *b, size_t len,
    roundoff, for every file: a model may have been rounded to float on its
    way (a float build, an f32 file) and saved again with 8-byte scalars.
    Failure: PHGMG_ERR_STRUCTURE. Work: (r + rn)^2 + 4 r + 4 reals. */
-PHGMG__ONLINE size_t phgmg__rom_phys_work(const phgmg_rom *rom) {
+PHGMG__ONLINE size_t phgmg__rom_phys_work(const phgmg_rom *rom, uint32_t mask) {
   const size_t n2 = (size_t)rom->r + (size_t)(rom->kind == PHGMG_ROM_QUADRATIC ? rom->rn : 0);
-  return n2 * n2 + 4 * (size_t)rom->r + 4;
+  const size_t nf = (mask & (1u << 25)) ? (size_t)rom->r + (size_t)rom->m : 0;   /* feedthrough block */
+  return (nf > n2 ? nf * nf : n2 * n2) + 4 * (size_t)rom->r + 4;
 }
 
 /* ||.||_1 of an n x n matrix. */
@@ -16680,6 +17338,40 @@ PHGMG__ONLINE int phgmg__rom_map_ok(const phgmg_rom *rom, double eps, phgmg_real
 /* The load-time structure check (see above) of a model that passed
    phgmg_rom_check; eps: the unit roundoff of the values (the larger of the
    file's scalars' and phgmg_real's); w: phgmg__rom_phys_work(rom) reals. */
+/* Feedthrough of a loaded model: [[-sym K, Ph], [Ph^T, sym Dh]] + d I
+   positive definite (d as for the dissipation above); w: (r + m)^2 reals. */
+PHGMG__ONLINE int phgmg__rom_feed_ok(const phgmg_rom *rom, phgmg_real tol, phgmg_real *w) {
+  const int r = rom->r, m = rom->m, n = r + m;
+  const phgmg_real *Dh = rom->PD + (size_t)r * m;
+  int i, j;
+  for (j = 0; j < n; ++j)
+    for (i = 0; i < n; ++i) {
+      phgmg_real v;
+      if (i < r && j < r) v = -PHGMG__R(0.5) * (rom->K[i + (size_t)j * r] + rom->K[j + (size_t)i * r]);
+      else if (i < r) v = rom->PD[i + (size_t)(j - r) * r];
+      else if (j < r) v = rom->PD[j + (size_t)(i - r) * r];
+      else v = PHGMG__R(0.5) * (Dh[(i - r) + (size_t)(j - r) * m] + Dh[(j - r) + (size_t)(i - r) * m]);
+      w[i + (size_t)j * n] = v;
+    }
+  return phgmg__r_psd_shifted(n, w, tol);
+}
+
+/* Dampers of a loaded model dissipate: weights >= 0, every law an odd
+   polynomial with coefficients >= 0 (manual 1.7). */
+PHGMG__ONLINE phgmg_result phgmg__rom_damp_ok(const phgmg_rom *rom) {
+  const int nf = rom->damp_nphi > 1 ? rom->damp_nphi : 1;
+  int j, e;
+  if (!rom->dpoly || !rom->dw) return PHGMG_ERR_STRUCTURE;
+  for (j = 0; j < rom->ndamp; ++j)
+    if (!(rom->dw[j] >= PHGMG__R(0))) return PHGMG_ERR_STRUCTURE;
+  for (j = 0; j < nf; ++j)
+    for (e = 0; e <= rom->damp_deg; ++e) {
+      const phgmg_real a = rom->dpoly[(size_t)j * (size_t)(rom->damp_deg + 1) + (size_t)e];
+      if ((e % 2 == 0 && a != PHGMG__R(0)) || a < PHGMG__R(0)) return PHGMG_ERR_STRUCTURE;
+    }
+  return PHGMG_OK;
+}
+
 PHGMG__ONLINE phgmg_result phgmg__rom_physics(const phgmg_rom *rom, double eps, phgmg_real *w) {
   const int r = rom->r, quad = rom->kind == PHGMG_ROM_QUADRATIC, rn = quad ? rom->rn : 0, n2 = r + rn;
   const phgmg_real tol = (phgmg_real)sqrt(eps);
@@ -16711,7 +17403,8 @@ PHGMG__ONLINE phgmg_result phgmg__rom_physics(const phgmg_rom *rom, double eps, 
     }
   if (!phgmg__r_psd_shifted(n2, w, tol)) return PHGMG_ERR_STRUCTURE;
   if (rom->Phi && (!rom->K || !phgmg__rom_map_ok(rom, eps, w))) return PHGMG_ERR_STRUCTURE;
-  return PHGMG_OK;
+  if (rom->PD && !phgmg__rom_feed_ok(rom, tol, w)) return PHGMG_ERR_STRUCTURE;
+  return rom->ndamp ? phgmg__rom_damp_ok(rom) : PHGMG_OK;
 }
 
 PHGMG_DEF phgmg_result phgmg_rom_deserialize_size(const void *buf, size_t len, size_t *need) {
@@ -16721,7 +17414,7 @@ PHGMG_DEF phgmg_result phgmg_rom_deserialize_size(const void *buf, size_t len, s
   size_t nterm = 0;
   phgmg_result rc = phgmg__rom_header(PHGMG__CAST(const unsigned char *, buf), len, &tmp, &n, &ss, &mask, &nterm);
   if (rc != PHGMG_OK) return rc;
-  if (need) *need = (n + phgmg__rom_phys_work(&tmp)) * sizeof(phgmg_real) + sizeof(phgmg_real) + nterm * sizeof(int);
+  if (need) *need = (n + phgmg__rom_phys_work(&tmp, mask)) * sizeof(phgmg_real) + sizeof(phgmg_real) + nterm * sizeof(int);
   return PHGMG_OK;
 }
 
@@ -16737,9 +17430,9 @@ PHGMG_DEF phgmg_result phgmg_rom_deserialize(const void *buf, size_t len, phgmg_
   if (!rom || !mem) return PHGMG_ERR_INVALID_ARG;
   rc = phgmg__rom_header(b, len, &tmp, &n, &ss, &mask, &nterm);
   if (rc != PHGMG_OK) return rc;
-  if (mem_size < (n + phgmg__rom_phys_work(&tmp)) * sizeof(phgmg_real) + sizeof(phgmg_real) + nterm * sizeof(int))
+  if (mem_size < (n + phgmg__rom_phys_work(&tmp, mask)) * sizeof(phgmg_real) + sizeof(phgmg_real) + nterm * sizeof(int))
     return PHGMG_ERR_WORKSPACE;
-  o = phgmg__get32(b + 8) == 1u ? PHGMG__HDR_BYTES : PHGMG__HDR2_BYTES;
+  o = phgmg__get32(b + 8) == 1u ? PHGMG__HDR_BYTES : phgmg__get32(b + 8) == 2u ? PHGMG__HDR2_BYTES : PHGMG__HDR3_BYTES;
   if (((size_t)mem) % sizeof(phgmg_real) != 0) return PHGMG_ERR_INVALID_ARG;
   for (i = 0; i < PHGMG__NFIELDS; ++i) {
     const size_t len_i = phgmg__field_len(&tmp, i);
@@ -16751,7 +17444,7 @@ PHGMG_DEF phgmg_result phgmg_rom_deserialize(const void *buf, size_t len, phgmg_
     dst += len_i;
   }
   work = dst;                           /* the structure check's scratch */
-  dst += phgmg__rom_phys_work(&tmp);
+  dst += phgmg__rom_phys_work(&tmp, mask);
   if (nterm) { /* the term indices follow the scalars and the scratch in mem */
     int *ti = PHGMG__CAST(int *, PHGMG__CAST(void *, dst));
     for (k = 0; k < nterm; ++k, o += 4) {
@@ -16833,7 +17526,7 @@ PHGMG_DEF phgmg_result phgmg_rom_export_c(const phgmg_rom *rom, const char *name
   size_t k;
   phgmg_result rc = phgmg_rom_check(rom);
   if (rc != PHGMG_OK) return rc;
-  if (rom->ham_cb) return PHGMG_ERR_UNSUPPORTED;
+  if (rom->ham_cb || rom->damp_cb) return PHGMG_ERR_UNSUPPORTED;
   if (!name || !path) return PHGMG_ERR_INVALID_ARG;
   f = fopen(path, "w");
   if (!f) return PHGMG_ERR_IO;
@@ -16899,6 +17592,15 @@ PHGMG_DEF phgmg_result phgmg_rom_export_c(const phgmg_rom *rom, const char *name
     if (phgmg__field_get(rom, i) && phgmg__field_len(rom, i) > 0) ok &= fprintf(f, ", %s_%s", name, phgmg__fields[i].name) > 0;
     else ok &= fprintf(f, ", NULL") > 0;
   }
+  /* dampers: ndamp, damp_deg, damp_nphi, Cd, dw, dpoly (damp_cb, dterm, damp_user: 0) */
+  ok &= fprintf(f, ",\n  %d, %d, %d", rom->ndamp, rom->damp_deg, rom->damp_nphi) > 0;
+  for (i = 22; i < 25; ++i) {
+    if (phgmg__field_get(rom, i) && phgmg__field_len(rom, i) > 0) ok &= fprintf(f, ", %s_%s", name, phgmg__fields[i].name) > 0;
+    else ok &= fprintf(f, ", NULL") > 0;
+  }
+  ok &= fprintf(f, ", 0, NULL, NULL") > 0;
+  if (rom->PD) ok &= fprintf(f, ",\n  %s_PD", name) > 0;   /* feedthrough */
+  else ok &= fprintf(f, ", NULL") > 0;
   ok &= fprintf(f, "\n};\n") > 0;
   if (fclose(f) != 0) ok = 0;
   return ok ? PHGMG_OK : PHGMG_ERR_IO;

@@ -83,8 +83,15 @@ static const char *const help_lines[] = {
   "  --P FILE, --S FILE, --N FILE   feedthrough (N x m, m x m, m x m; each optional):\n",
   "                      E x' = (J - R) z + (B - P) u, y = (B + P)^T z + (S + N) u, with\n",
   "                      [[R, P], [P^T, S]] symmetric positive semidefinite and N skew.\n",
-  "                      Checked and simulated with the full model; the reductions do\n",
-  "                      not take feedthrough yet (an error names the files).\n",
+  "                      Kept by gmg-pod, sp1, sp2 (reduced P = W_z^T P, S + N; not by\n",
+  "                      gmg-qm: an error names the files); simulate-rom adds (S + N) u.\n",
+  "  --dampers FILE      nonlinear dampers, a (k, 4) array with rows (i, j, c1, c3):\n",
+  "                      a damper on s = z_i - z_j (j = -1: s = z_i; 0-based states,\n",
+  "                      z = Q x the co-state, e.g. a velocity) with the force\n",
+  "                      c1 s + c3 s^3, c1, c3 >= 0 (a damper that generates energy is\n",
+  "                      refused): E x' = (J - R) z - sum_k c_k (c1 s_k + c3 s_k^3) + B u.\n",
+  "                      Methods gmg-pod, sp1, sp2; the reduced model keeps the dampers\n",
+  "                      (W_z^T c_k), hyper-reduced to a weighted subset unless --no-hyper.\n",
   "  --X FILE            snapshot matrix N x ns (ns >= 2 states, one per column; a\n",
   "                      trajectory x(t_0), ..., x(t_n), normally starting at x = 0).\n",
   "                      Repeatable (up to 16): one training run per file, the runs'\n",
@@ -1148,6 +1155,7 @@ typedef struct reduce_args {
   const char *Jcoo, *Rcoo, *Qcoo; /* sparse J, R, Q as coordinate triplets */
   const char *E, *Ecoo;            /* descriptor models: the mass matrix, dense or sparse */
   const char *Pf, *Sf, *Nf;        /* feedthrough P, S, N */
+  const char *dampf;               /* --dampers: nonlinear dampers (k x 4: i, j, c1, c3) */
   const char *expf, *potential, *hyper;
   double hyper_tol;
   int simulate, steps, r, rn, no_deim, deim_max, deim_neg, save_snap, have_dt_map, newton_iter;
@@ -1298,6 +1306,7 @@ static int parse_reduce(int argc, char **argv, reduce_args *A) {
     if (repeated_opt(o, seen, &nseen)) return 2;
     STR("--J", J) STR("--R", R) STR("--B", B) STR("--Q", Q)
     STR("--J-coo", Jcoo) STR("--R-coo", Rcoo) STR("--Q-coo", Qcoo) STR("--E", E) STR("--E-coo", Ecoo) STR("--P", Pf) STR("--S", Sf) STR("--N", Nf)
+    STR("--dampers", dampf)
     STR("--poly", poly) STR("--poly-idx", poly_idx) STR("--poly-w", poly_w)
     STR("--exp", expf) STR("--potential", potential) STR("--hyper", hyper)
     DBL("--hyper-tol", hyper_tol, 0.0)
@@ -1508,6 +1517,9 @@ typedef struct reduce_state {
   cli_csc cJ, cR, cQ, cE; /* sparse input (--J-coo ..., --E-coo) */
   mat E;                  /* --E (dense) */
   mat Pm, Sm, Nm;         /* --P, --S, --N */
+  mat Dm;                 /* --dampers */
+  int *di, *dj;           /* the dampers' state indices (internal ordering) */
+  double *dlaw;           /* their laws: k x 4 coefficients {0, c1, 0, c3} */
   phgmg_ph_sparse *sp;    /* its banded, RCM-ordered system; NULL for dense input */
   double *Xperm, *Uord;   /* snapshots in the internal order; un-permuted output */
   cli_input in;
@@ -1617,7 +1629,8 @@ static int load_family(const reduce_args *A, reduce_state *S, phgmg_ph_system *s
 }
 
 static void reduce_cleanup(reduce_state *S) {
-  mat_free(&S->J); mat_free(&S->R); mat_free(&S->B); mat_free(&S->Q); mat_free(&S->E); mat_free(&S->Pm); mat_free(&S->Sm); mat_free(&S->Nm); mat_free(&S->X);
+  mat_free(&S->J); mat_free(&S->R); mat_free(&S->B); mat_free(&S->Q); mat_free(&S->E); mat_free(&S->Pm); mat_free(&S->Sm); mat_free(&S->Nm); mat_free(&S->Dm);
+  free(S->di); free(S->dj); free(S->dlaw); mat_free(&S->X);
   mat_free(&S->poly); mat_free(&S->pidx); mat_free(&S->pw); mat_free(&S->ex); mat_free(&S->in.tab);
   { int k; for (k = 0; k < 16; ++k) { mat_free(&S->tin[k].tab); mat_free(&S->Xs[k]); mat_free(&S->xinp[k].tab); } }
   free(S->Xcat);
@@ -1884,6 +1897,53 @@ static int load_feedthrough(const reduce_args *A, reduce_state *S, phgmg_ph_syst
   return 0;
 }
 
+/* A state index of the user's ordering in the internal one (sparse input:
+   the RCM reordering, found by mapping the unit vector). */
+static int cli_internal_index(const reduce_state *S, int N, int i, double *e, double *t) {
+  int k;
+  if (!S->sp) return i;
+  for (k = 0; k < N; ++k) e[k] = k == i ? 1.0 : 0.0;
+  phgmg_ph_sparse_to_banded_order(S->sp, 1, e, N, t, N);
+  for (k = 0; k < N; ++k) if (t[k] != 0.0) return k;
+  return -1;
+}
+
+/* --dampers FILE: k x 4 (or 4 values for one damper), rows (i, j, c1, c3):
+   a damper on s = z_i - z_j (j = -1: s = z_i), force c1 s + c3 s^3,
+   0-based state indices (of the files' ordering). */
+static int load_dampers(const reduce_args *A, reduce_state *S, phgmg_ph_system *sys) {
+  const int N = sys->N;
+  double *e, *t;
+  int k, nd;
+  if (!A->dampf) return 0;
+  if (mat_load(&S->Dm, "--dampers", A->dampf)) return 1;
+  nd = S->Dm.rows * S->Dm.cols == 4 ? 1 : S->Dm.rows;
+  if (S->Dm.rows * S->Dm.cols != 4 * nd || (nd > 1 && S->Dm.cols != 4) || nd < 1)
+    return fail("%s (--dampers): expected shape (k, 4), rows (i, j, c1, c3), got %s", A->dampf, shape_str(&S->Dm));
+  S->di = (int *)malloc(sizeof(int) * (size_t)nd);
+  S->dj = (int *)malloc(sizeof(int) * (size_t)nd);
+  S->dlaw = (double *)malloc(sizeof(double) * 4 * (size_t)nd);
+  e = (double *)malloc(sizeof(double) * 2 * (size_t)N);
+  if (!S->di || !S->dj || !S->dlaw || !e) { free(e); return fail("out of memory"); }
+  t = e + N;
+  for (k = 0; k < nd; ++k) {
+    const double *row = S->Dm.a, vi = row[k], vj = row[k + nd], c1 = row[k + 2 * nd], c3 = row[k + 3 * nd];
+    if (!(vi >= 0.0 && vi < N && vi == floor(vi)) || !(vj >= -1.0 && vj < N && vj == floor(vj)) || vi == vj) {
+      free(e);
+      return fail("%s (--dampers): row %d: i = %g, j = %g; expected integer states in [0, %d), j = -1 for one state, i != j",
+                  A->dampf, k, vi, vj, N);
+    }
+    S->di[k] = cli_internal_index(S, N, (int)vi, e, t);
+    S->dj[k] = vj < 0.0 ? -1 : cli_internal_index(S, N, (int)vj, e, t);
+    S->dlaw[4 * k] = 0.0; S->dlaw[4 * k + 1] = c1; S->dlaw[4 * k + 2] = 0.0; S->dlaw[4 * k + 3] = c3;
+  }
+  free(e);
+  sys->ndamp = nd; sys->damp_i = S->di; sys->damp_j = S->dj;
+  sys->damp_deg = 3; sys->damp_nfun = nd; sys->damp_poly = S->dlaw;
+  progress("dampers: %s, %d (force c1 s + c3 s^3)", A->dampf, nd);
+  return 0;
+}
+
 /* The full model from the files: dense or sparse J, R, Q, B and the nonlinear
    part, checked (phgmg_ph_validate), into S->sys. */
 static int load_system(const reduce_args *A, reduce_state *S) {
@@ -1961,8 +2021,11 @@ static int load_system(const reduce_args *A, reduce_state *S) {
              A->potential ? A->potential : "exp-polynomial", sys.poly_deg, sys.nexp,
              sys.phi_nfun > 1 ? " (one function per term)" : "");
   }
-  if (load_feedthrough(A, S, &sys)) return 1;
+  if (load_feedthrough(A, S, &sys) || load_dampers(A, S, &sys)) return 1;
   rc = phgmg_ph_validate(&sys, 0.0, &rcond, NULL);
+  if (sys.ndamp && (rc == PHGMG_ERR_DAMPER || rc == PHGMG_ERR_SIZE || rc == PHGMG_ERR_NANINF))
+    return fail("%s (--dampers): %s%s", A->dampf, phgmg_result_string(rc),
+                rc == PHGMG_ERR_DAMPER ? " (c1 and c3 must be >= 0)" : rc == PHGMG_ERR_SIZE ? " (banded storage: |i - j| beyond the band)" : "");
   if (rc == PHGMG_ERR_FEEDTHROUGH || (rc == PHGMG_ERR_UNSUPPORTED && (sys.P || sys.S || sys.Nskew)))
     return fail("%s%s%s%s%s (--P, --S, --N): %s", A->Pf ? A->Pf : "", A->Sf ? " " : "", A->Sf ? A->Sf : "",
                 A->Nf ? " " : "", A->Nf ? A->Nf : "", phgmg_result_string(rc));
@@ -2161,7 +2224,9 @@ static int run_reduction(const reduce_args *A, reduce_state *S, int method, cons
                     phgmg_result_string(rc));
       case PHGMG_ERR_UNSUPPORTED:
         if (A->Pf || A->Sf || A->Nf)
-          return fail("reduction failed: the reductions do not take feedthrough (--P, --S, --N) yet");
+          return fail("reduction failed: gmg-qm does not take feedthrough (--P, --S, --N); use gmg-pod, sp1 or sp2");
+        if (A->dampf)
+          return fail("reduction failed: gmg-qm does not take --dampers (%s); use gmg-pod, sp1 or sp2", A->dampf);
         return fail("reduction failed: %s", phgmg_result_string(rc));
       default:
         return fail("reduction failed: %s", phgmg_result_string(rc));
@@ -2532,6 +2597,16 @@ static int load_model(const char *path, const char *opt, phgmg_rom *rom, void **
   return 0;
 }
 
+/* Feedthrough of a reduced model: y += (S + N) u(t) (rom->PD's last m x m block). */
+static void rom_feed_out(const phgmg_rom *rom, double t, cli_input *in, double *y) {
+  double ub[64];
+  int a, b;
+  if (rom->m > 64) return;
+  input_fn(t, ub, in);
+  for (a = 0; a < rom->m; ++a)
+    for (b = 0; b < rom->m; ++b) y[a] += (double)rom->PD[(size_t)rom->r * rom->m + a + (size_t)b * rom->m] * ub[b];
+}
+
 static int cmd_simulate_rom(int argc, char **argv) {
   const char *model = NULL, *out = NULL, *states = NULL, *inspec = "sin";
   double dt = 0.0, amp = 0.1, newton_tol = 0.0, t0;   /* 0: the library's default */
@@ -2610,6 +2685,7 @@ static int cmd_simulate_rom(int argc, char **argv) {
     if (XR) for (a = 0; a < rom.r; ++a) XR[a + (size_t)(nn) * rom.r] = (double)x[a]; \
     phgmg_rom_output(&rom, x, y, ework); \
     for (a = 0; a < rom.m; ++a) Y[a + (size_t)(nn) * rom.m] = (double)y[a]; \
+    if (rom.PD) rom_feed_out(&rom, (double)(nn) * dt, &in, Y + (size_t)(nn) * rom.m); \
   } while (0)
   RECORD(0);
   t0 = wall_last = now_s();
@@ -2691,7 +2767,7 @@ static int parse_simulate(int argc, char **argv, reduce_args *A, const char **st
     if (!strcmp(o, "--quiet")) g_quiet = 1;
     STR("--J", J) STR("--R", R) STR("--B", B) STR("--Q", Q)
     STR("--J-coo", Jcoo) STR("--R-coo", Rcoo) STR("--Q-coo", Qcoo)
-    STR("--E", E) STR("--E-coo", Ecoo) STR("--P", Pf) STR("--S", Sf) STR("--N", Nf)
+    STR("--E", E) STR("--E-coo", Ecoo) STR("--P", Pf) STR("--S", Sf) STR("--N", Nf) STR("--dampers", dampf)
     STR("--poly", poly) STR("--poly-idx", poly_idx) STR("--poly-w", poly_w)
     STR("--exp", expf) STR("--potential", potential) STR("--input", input) STR("--out", out)
 #undef STR

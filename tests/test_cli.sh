@@ -529,9 +529,45 @@ np.save('S_ok.npy', 0.1 * np.eye(1)); np.save('S_neg.npy', -0.1 * np.eye(1))
 " && pass || bad "feedthrough files"
   run_err "feedthrough S not PSD" 1 "S_neg.npy (--P, --S, --N)" "$P" reduce $SYS --S S_neg.npy $SIM --method gmg-pod --r 12 --out oSn
   [ ! -e oSn ] && pass || bad "feedthrough not PSD: output written"
-  run_err "feedthrough: reduction refused" 1 "do not take feedthrough" "$P" reduce $SYS --S S_ok.npy $SIM --method gmg-pod --r 12 --out oSo
+  run_err "feedthrough: gmg-qm refused" 1 "gmg-qm does not take feedthrough" "$P" reduce $SYS --S S_ok.npy $SIM --method gmg-qm --r 12 --out oSo
   [ ! -e oSo ] && pass || bad "feedthrough refused: output written"
+  run_ok "reduce --S (gmg-pod)" "$P" reduce $SYS --S S_ok.npy $SIM --method gmg-pod --r 12 --out oSf --name m --quiet
+  run_ok "simulate-rom with feedthrough" "$P" simulate-rom --model oSf/m.phgmgrom $ROMSIM --out oSf/y.npy --quiet
+  run_ok "simulate --S" "$P" simulate $SYS --S S_ok.npy $ROMSIM --out ySf.npy --quiet
+  run_ok "feedthrough ROM follows the full model (1e-2)" "$REF" compare ySf.npy oSf/y.npy 1e-2
   run_err "--E with --J-coo" 2 "--E-coo" "$P" reduce --J-coo J.npy --R-coo R.npy --Q-coo Q.npy --B model/B.npy --E E_id.npy $SIM --method gmg-pod --r 12 --out oEc
+fi
+
+# ---- nonlinear dampers (--dampers): linear dampers == R + c1 c c^T; energy-generating refused ----
+if [ "$HAVE_NP" = 1 ]; then
+  "$PY" -c "
+import numpy as np
+R = np.load('model/R.npy'); N = R.shape[0]
+D = np.array([[N - 1, -1, 0.05, 0.0], [N - 3, N - 5, 0.02, 0.0]])
+np.save('d_lin.npy', D)
+R2 = R.copy()
+for i, j, c1, c3 in D:
+    i = int(i); j = int(j)
+    c = np.zeros(N); c[i] = 1.0
+    if j >= 0: c[j] = -1.0
+    R2 += c1 * np.outer(c, c)
+np.save('R_damp.npy', R2)
+Dc = D.copy(); Dc[:, 3] = 5.0; np.save('d_cub.npy', Dc)
+Dn = D.copy(); Dn[0, 2] = -0.05; np.save('d_neg.npy', Dn)
+np.save('d_bad.npy', np.array([[N, -1, 0.1, 0.0]]))
+" && pass || bad "damper files"
+  DSIM="--dt 0.1 --steps 300 --input sin --amp 0.5 --quiet"
+  run_ok "simulate --dampers linear" "$P" simulate $SYS --dampers d_lin.npy $DSIM --out yd.npy
+  run_ok "simulate R + c1 c c^T" "$P" simulate --J model/J.npy --R R_damp.npy --B model/B.npy --Q model/Q.npy $DSIM --out yr.npy
+  run_ok "linear dampers == R + c1 c c^T (1e-9)" "$REF" compare yr.npy yd.npy 1e-9
+  run_ok "reduce --dampers cubic" "$P" reduce $SYS --dampers d_cub.npy --simulate $DSIM --method gmg-pod --r 12 --out oD --name m
+  run_ok "simulate-rom of a damper model" "$P" simulate-rom --model oD/m.phgmgrom $DSIM --out oD/y.npy
+  run_ok "simulate --dampers cubic" "$P" simulate $SYS --dampers d_cub.npy $DSIM --out yc.npy
+  run_ok "damper ROM follows the full model (1e-2)" "$REF" compare yc.npy oD/y.npy 1e-2
+  run_err "damper that generates energy" 1 "d_neg.npy (--dampers)" "$P" reduce $SYS --dampers d_neg.npy --simulate $DSIM --method gmg-pod --r 12 --out oDn
+  [ ! -e oDn ] && pass || bad "energy-generating damper: output written"
+  run_err "damper index out of range" 1 "d_bad.npy (--dampers)" "$P" simulate $SYS --dampers d_bad.npy $DSIM --out ydb.npy
+  [ ! -e ydb.npy ] && pass || bad "bad damper index: output written"
 fi
 
 # ---- 9. issue 25: a run never removes or overwrites its inputs; outputs checked up front ----

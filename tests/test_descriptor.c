@@ -361,7 +361,7 @@ TEST(test_descriptor_sparse_scrambled) {
    arithmetic), outputs (B + P)^T z + (S + N) u formed here, and the discrete
    energy balance H_n - H_0 = S_n - D_n with supply y^T u and dissipation
    [z; u]^T [[R, P], [P^T, S]] [z; u] to round-off (quadratic H). Bad blocks
-   get PHGMG_ERR_FEEDTHROUGH; a reduction PHGMG_ERR_UNSUPPORTED. */
+   get PHGMG_ERR_FEEDTHROUGH; GMG-QM PHGMG_ERR_UNSUPPORTED, GMG-POD keeps it (more in tests/test_dissip.c). */
 TEST(test_descriptor_feedthrough) {
   dbar b;
   const int n = 10, ns = 150;
@@ -418,9 +418,14 @@ TEST(test_descriptor_feedthrough) {
   CHECK(hmax > 0.0 && Dn[ns] > 0.0);
   CHECK_LE(emax, 1e-12 * hmax);
   memset(&o, 0, sizeof o);
-  o.method = PHGMG_METHOD_GMG_POD; o.r = 6;
+  o.method = PHGMG_METHOD_GMG_QM; o.r = 6;   /* feedthrough: linear maps only (tests/test_dissip.c) */
   CHECK_RC(phgmg_reduce(&red, &sf, X, N, ns + 1, &o, NULL, NULL), PHGMG_ERR_UNSUPPORTED);
   CHECK(red == NULL);
+  o.method = PHGMG_METHOD_GMG_POD;
+  CHECK_RC(phgmg_reduce(&red, &sf, X, N, ns + 1, &o, NULL, NULL), PHGMG_OK);
+  CHECK(red && phgmg_reduced_rom(red)->PD != NULL);
+  phgmg_reduced_destroy(red);
+  red = NULL;
   S[0] = -S[0];   /* indefinite S */
   CHECK_RC(phgmg_ph_validate(&sf, 0.0, NULL, NULL), PHGMG_ERR_FEEDTHROUGH);
   S[0] = -S[0];

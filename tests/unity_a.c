@@ -15,6 +15,7 @@
 #include "test_defects3.c"
 #include "test_deploy.c"
 #include "test_descriptor.c"
+#include "test_dissip.c"
 #include "test_errors.c"
 #include "test_general.c"
 #include "test_hyper.c"

@@ -144,7 +144,7 @@ static void init(void) {
     "validate", "--J-coo", "--R-coo", "--Q-coo", "--potential", "--exp", "--train-input", "--X-input",
     "--manifold", "--hyper", "--hyper-tol", "--test-input", "--test-amp", "--test-steps", "--max-ey",
     "toda", "fpu:1:1", "fpu::", "morse:1:2", "morse:-1:1", "cosh:1", "cosh:1e-200", "ecsw", "qdeim", "greedy",
-    "pod", "altmin", "auto", "cv", "1e-300", "1e160", "1e15", "rom", "--E", "--E-coo", "--P", "--S", "--N", "--no-hyper", NULL};
+    "pod", "altmin", "auto", "cv", "1e-300", "1e160", "1e15", "rom", "--E", "--E-coo", "--P", "--S", "--N", "--dampers", "--no-hyper", NULL};
   static const char *const files2[] = {"Jc.npy", "Rc.npy", "Qc.npy", "exp.npy", "o/rom.phgmgrom", "o/rom_V0.npy",
                                        "o/rom.json", NULL};
   static const char *const words3[] = {"--ref", "mean", "none", "wide", NULL};   /* after files2: seeds keep their meaning */
