@@ -17587,8 +17587,8 @@ PHGMG_DEF phgmg_result phgmg_rom_export_c(const phgmg_rom *rom, const char *name
   if (rom->eta_cb) ok &= fprintf(f, " %s_eta, NULL,", name) > 0;
   else ok &= fprintf(f, " 0, NULL,") > 0;
   ok &= fprintf(f, " 0, NULL") > 0;
-  for (i = 19; i < PHGMG__NFIELDS; ++i) { /* env_lo, env_hi, q_max, ref_g, ref_s, xr_rest */
-    if (!phgmg__fields[i].name) continue;
+  for (i = 19; i < PHGMG__NFIELDS; ++i) { /* env_lo, env_hi, q_max, ref_g, ref_s, xr_rest (member order) */
+    if (i >= 22 && i <= 25) continue;   /* the dampers and PD follow their counts below */
     if (phgmg__field_get(rom, i) && phgmg__field_len(rom, i) > 0) ok &= fprintf(f, ", %s_%s", name, phgmg__fields[i].name) > 0;
     else ok &= fprintf(f, ", NULL") > 0;
   }

@@ -1,4 +1,5 @@
-/* Exported C source of exp-polynomial, phi_cb and eta_cb reduced models (issue 13).
+/* Exported C source of exp-polynomial, phi_cb and eta_cb reduced models, and of a
+   linear model with dampers, feedthrough and a reference state.
    Without MODEL_HEADER: build three hand-made models (tests/sepfun_models.h), write
    them with phgmg_rom_export_c into DIR and their reference outputs into
    DIR/<name>.ref. With -DMODEL_HEADER="<name>.h" -DMODEL_NAME=<name> (and
@@ -45,6 +46,39 @@ static int print_outputs(const phgmg_rom *rom, FILE *f) {
   return 0;
 }
 
+#ifndef MODEL_HEADER
+/* A LINEAR model with every optional block that follows the separable part in
+   phgmg_rom: nonlinear dampers (Cd, dw, dpoly), feedthrough (PD) and an
+   affine reference state (ref_g, xr_rest); r = SF_R, m = SF_M. K = J - I
+   (J skew), Qh = I + 0.1 ones, dampers rho(s) = 0.2 s + 1.5 s^3 (weights 1,
+   0.5), PD = [Ph; I + N] with Ph = 0.1, N skew. */
+static phgmg_real lx_Bh[SF_R * SF_M], lx_Qh[SF_R * SF_R], lx_K[SF_R * SF_R], lx_Cd[SF_R * 2],
+    lx_dw[2] = {1.0f, 0.5f}, lx_dpoly[4] = {0.0f, 0.2f, 0.0f, 1.5f}, lx_PD[(SF_R + SF_M) * SF_M],
+    lx_refg[SF_R + 1], lx_rest[SF_R];
+static phgmg_rom lx_build(void) {
+  phgmg_rom r;
+  int i, j;
+  memset(&r, 0, sizeof r);
+  for (i = 0; i < SF_R; ++i)
+    for (j = 0; j < SF_R; ++j) {
+      lx_Qh[i + j * SF_R] = (phgmg_real)((i == j ? 1.0 : 0.0) + 0.1);
+      lx_K[i + j * SF_R] = (phgmg_real)((i == j ? -1.0 : 0.0) + (i < j ? 0.3 * (j - i) : i > j ? -0.3 * (i - j) : 0.0));
+    }
+  for (i = 0; i < SF_R * SF_M; ++i) lx_Bh[i] = (phgmg_real)(i % SF_R == i / SF_R ? 1.0 : 0.0);
+  for (i = 0; i < SF_R * 2; ++i) lx_Cd[i] = (phgmg_real)(i % SF_R == 2 + i / SF_R ? 1.0 : i % SF_R == 1 ? -0.5 : 0.0);
+  for (i = 0; i < SF_R * SF_M; ++i) lx_PD[i] = (phgmg_real)0.1;
+  lx_PD[SF_R * SF_M + 0] = 1.0f; lx_PD[SF_R * SF_M + 1] = 0.2f;   /* S + N, column-major m x m */
+  lx_PD[SF_R * SF_M + 2] = -0.2f; lx_PD[SF_R * SF_M + 3] = 1.0f;
+  for (i = 0; i < SF_R; ++i) { lx_refg[i] = (phgmg_real)(0.05 * (i + 1)); lx_rest[i] = (phgmg_real)(-0.01 * i); }
+  lx_refg[SF_R] = 0.125f;
+  r.kind = PHGMG_ROM_LINEAR; r.method = PHGMG_METHOD_GMG_POD; r.r = SF_R; r.m = SF_M;
+  r.Bh = lx_Bh; r.Qh = lx_Qh; r.K = lx_K;
+  r.ndamp = 2; r.damp_deg = 3; r.damp_nphi = 1; r.Cd = lx_Cd; r.dw = lx_dw; r.dpoly = lx_dpoly;
+  r.PD = lx_PD; r.ref_g = lx_refg; r.xr_rest = lx_rest;
+  return r;
+}
+#endif
+
 int main(int argc, char **argv) {
 #ifdef MODEL_HEADER
   (void)argc; (void)argv;
@@ -79,6 +113,15 @@ int main(int argc, char **argv) {
   if (!(f = fopen(path, "w"))) return 1;
   rc |= print_outputs(&cb, f);
   fclose(f);
+  { /* the blocks after the separable part, in their member order */
+    const phgmg_rom lx = lx_build();
+    snprintf(path, sizeof path, "%s/sfx_lin.h", argv[1]);
+    if (phgmg_rom_export_c(&lx, "sfx_lin", path) != PHGMG_OK) return 1;
+    snprintf(path, sizeof path, "%s/sfx_lin.ref", argv[1]);
+    if (!(f = fopen(path, "w"))) return 1;
+    rc |= print_outputs(&lx, f);
+    fclose(f);
+  }
   return rc;
 #endif
 }

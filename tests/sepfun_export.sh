@@ -1,5 +1,6 @@
 #!/bin/sh
-# Exported C source of an exp-polynomial model, a phi_cb and an eta_cb model (issue 13):
+# Exported C source of an exp-polynomial model, a phi_cb and an eta_cb model, and a
+# linear model with dampers, feedthrough and a reference state:
 # compiled with PHGMG_NO_OFFLINE as C99 and as C++, they must print exactly the
 # in-memory reference outputs. usage: sepfun_export.sh BUILD_DIR
 set -eu
@@ -11,7 +12,7 @@ mkdir -p "$D"
 W="-Wall -Wextra -Werror"
 $CC -std=c99 $W -pedantic -O2 -o "$D/gen" tests/sepfun_export.c -lm
 "$D/gen" "$D"
-for m in sfx_poly sfx_cb sfx_eta; do
+for m in sfx_poly sfx_cb sfx_eta sfx_lin; do
   $CC -std=c99 $W -pedantic -O2 -DPHGMG_NO_OFFLINE -DMODEL_HEADER="\"$m.h\"" -DMODEL_NAME=$m -I"$D" \
       -o "$D/use_$m" tests/sepfun_export.c -lm
   "$D/use_$m" > "$D/$m.out"
@@ -21,4 +22,4 @@ for m in sfx_poly sfx_cb sfx_eta; do
   "$D/usexx_$m" > "$D/$m.outxx"
   cmp -s "$D/$m.outxx" "$D/$m.ref" || { echo "FAIL: exported C model $m (C++) does not reproduce the in-memory outputs"; exit 1; }
 done
-echo "ok    sepfun export: exp-polynomial, phi_cb and eta_cb models exported as C reproduce the in-memory outputs (C99, C++)"
+echo "ok    sepfun export: exp-polynomial, phi_cb, eta_cb and linear damper/feedthrough/reference-state models exported as C reproduce the in-memory outputs (C99, C++)"
