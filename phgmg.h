@@ -25,8 +25,9 @@
     10. Index of public functions
    The header has two halves, declarations and implementation, each cut into
    sections marked >>config, >>result, >>memory, >>linalg, >>ph, >>gl3,
-   >>online, >>pod / >>reduce, >>linear, >>export, >>npy (grep for them; the
-   same order in both halves). The comment at each declaration states its
+   >>online, >>pod, >>hyper, >>reduce, >>deploy, >>errors, >>study, >>linear,
+   >>export, >>npy (grep for them; the same order in both halves, the
+   implementation's >>reduce opening with the reduced object the others use). The comment at each declaration states its
    contract: what it computes, units and layouts, result codes.
 
 
@@ -1929,7 +1930,7 @@ PHGMG_DEF phgmg_result phgmg_rom_step(phgmg_rom_stepper *s, phgmg_real *x, const
 }
 #endif
 
-/* >>pod / >>reduce / >>deim / >>errors ====================================== */
+/* >>pod =================================================================== */
 /* Offline reduction (double). A user gives a pH system and a snapshot matrix
    X (N x ns, ns = n_t + 1 columns) and gets a reduced model that is again a
    pH system (see >>online), plus the error measures of the paper (5.1). */
@@ -1986,6 +1987,129 @@ PHGMG_DEF phgmg_result phgmg_pod_randomized(int N, int ns, const double *X, int 
 PHGMG_DEF phgmg_result phgmg_adjust_snapshots(int N, int m, const double *B, int ns, const double *X,
                                               int ldx, double *Xa, int ldxa, const phgmg_allocator *alloc);
 
+/* Hierarchical POD of paper 4.2.2: V1 = POD_p(X - BB^+X), V2 = POD_rn of the
+   residual (I - [B,V1][B,V1]^+) X. V1: N x p, V2: N x rn. */
+PHGMG_DEF phgmg_result phgmg_pod_hierarchical(int N, int m, const double *B, int ns, const double *X,
+                                              int ldx, int p, int rn, double *V1, double *V2,
+                                              const phgmg_allocator *alloc);
+
+/* >>hyper ================================================================= */
+/* Hyper-reduction: points and weights that stand for a separable sum of
+   terms (DEIM, ECSW) and the solvers behind them. */
+
+/* Structure-preserving DEIM for a separable sum: F (nterms x ns) holds the
+   snapshots of the nonlinear gradient terms phi_k'(x_idx_k). Modes: sigma_k >
+   tol sigma_1 (capped by kmax if > 0). Points by Q-DEIM (pivoted QR of U^T).
+   Weights w = (P^T U)^{-T} U^T sw (sw = the terms' own weights, NULL = 1), so
+   sum_k sw_k phi_k ~ sum_j w_j phi_{pts_j}. pts, w: room for nterms entries.
+   *nd_out = points chosen, *nneg = negative weights. */
+PHGMG_DEF phgmg_result phgmg_deim(int nterms, int ns, const double *F, int ldf, const double *sw,
+                                  double tol, int kmax, int *pts, double *w, int *nd_out,
+                                  int *nneg, double *sigma_ratio, const phgmg_allocator *alloc);
+
+/* DEIM point selection (phgmg_deim_select). */
+#define PHGMG_DEIM_QDEIM 0  /* pivoted QR of U^T (Drmac-Gugercin; phgmg_deim's choice) */
+#define PHGMG_DEIM_GREEDY 1 /* greedy DEIM (Chaturantabut-Sorensen): point l = argmax
+                               |u_l - U_{<l} (P^T U_{<l})^{-1} P^T u_l| (first index on ties) */
+/* phgmg_deim with a choice of point selection: method PHGMG_DEIM_QDEIM or
+   PHGMG_DEIM_GREEDY (else PHGMG_ERR_INVALID_ARG). Modes, weights and outputs
+   as phgmg_deim; Q-DEIM points come in pivot order, greedy points in the
+   order chosen. PHGMG_ERR_SINGULAR if P^T U is singular. For both: tol = 0
+   gives 1e-8, kmax = 0 no cap; tol < 0, NaN or >= 1 and kmax < 0 give
+   PHGMG_ERR_INVALID_ARG. */
+PHGMG_DEF phgmg_result phgmg_deim_select(int nterms, int ns, const double *F, int ldf, const double *sw,
+                                         double tol, int kmax, int method, int *pts, double *w,
+                                         int *nd_out, int *nneg, double *sigma_ratio,
+                                         const phgmg_allocator *alloc);
+
+/* Non-negative least squares: min ||A x - b||_2 subject to x >= 0 (A m x n, lda).
+   Lawson-Hanson active set on the rows compressed by one Householder QR when
+   m > n (on A itself if that QR is not finite); each passive-set least
+   squares by a fresh QR (k p^2 flops, k = min(m, n), p passive indices; for
+   large problems see phgmg_ecsw's Gram form). Stops early once ||A x - b|| <=
+   tol ||b|| (tol <= 0: solve to optimality: no free index with gradient
+   [A^T (b - A x)]_j > 10 max(m,n) eps ||A||_F ||b||). max_iter (<= 0: 3n)
+   caps the iterations (one per index added or dropped). Outputs: x (n),
+   resid = ||A x - b|| (may be NULL), nnz_out = entries of x > 0 (may be NULL).
+   Errors: PHGMG_ERR_INVALID_ARG (NULL A, b, x), PHGMG_ERR_SIZE, PHGMG_ERR_NANINF,
+   PHGMG_ERR_NOT_CONVERGED (cap reached; x, resid, nnz hold the feasible
+   iterate), PHGMG_ERR_NOMEM. */
+PHGMG_DEF phgmg_result phgmg_nnls(int m, int n, const double *A, int lda, const double *b, double tol,
+                                  int max_iter, double *x, double *resid, int *nnz_out,
+                                  const phgmg_allocator *alloc);
+
+/* Empirical quadrature with non-negative weights (ECSW, Farhat et al.;
+   empirical cubature, Hernandez et al.) for a separable sum sum_k sw_k phi_k.
+   Gm (nrows x nterms, ldg): column k = what term k contributes at weight 1 to
+   each training quantity (e.g. rows (snapshot i, reduced coordinate a) =
+   phi_k'(l_k(x_i)) [V]_{idx_k, a}, optionally energy rows phi_k(l_k(x_i)));
+   target (nrows) = the full sum, Gm sw. Finds w >= 0 with few non-zeros and
+   ||Gm w - target|| <= tol ||target|| (tol = 0: 1e-6; tol < 0, NaN or >= 1:
+   PHGMG_ERR_INVALID_ARG; 0 < tol < 1e-15, below the rounding level of a
+   relative residual: PHGMG_ERR_TOL_UNREACHABLE) by Lawson-Hanson
+   stopped at tol: the candidate gradient from the Gram matrix Gm^T Gm (formed
+   once: nrows nterms^2 flops, the dominant cost, 0.16 s at 20020 x 500),
+   the passive least squares by Cholesky of the Gram block refined once with
+   the true residual, the residual itself from Gm (so the 1e-6 default is
+   met where the Gram form alone stalls near 1e-5), and a claim of
+   optimality checked with the true gradient Gm^T r. When the original
+   weights are >= 0 they are an exact solution, so tol is reachable up to
+   rounding; the points come out in Lawson-Hanson's greedy order of largest
+   gradient, typically fewer than DEIM's at a comparable accuracy.
+   Outputs: pts[0..nd-1] kept terms ascending, w[0..nd-1] their weights (> 0),
+   both with room for nterms; *nd_out = nd; *resid_out (may be NULL) =
+   ||Gm w - target|| / ||target|| (0 when target = 0, then nd = 0).
+   With w >= 0 and convex phi_k the reduced sum sum_j w_j phi(l_{pts_j}(x))
+   is convex in the reduced coordinates for any linear map x -> l, and bounded
+   below whenever each phi_k is; negative DEIM weights give no such guarantee.
+   Only Gm^T Gm, Gm^T target and ||target|| matter: rows compressed by any
+   orthogonal map (Gm' = Q^T Gm, target' = Q^T target) give the same weights
+   at less cost; phgmg_ecsw_separable does this for terms linear in the
+   reduced coordinates.
+   Many terms (nterms >= PHGMG_ECSW_SCREEN_MIN, default 4096): the n x n Gram
+   matrix is never formed. Screening: the full gradient Gm^T (target - Gm w)
+   (one pass over Gm) picks the PHGMG_ECSW_SCREEN_ADD (64) terms with the
+   largest positive gradient into a working set W, the method above solves
+   the problem restricted to W (all rows: its residual is the true one), and
+   this repeats until tol is met or no term outside W has a positive
+   gradient (w then optimal over all terms, as above). Same guarantees:
+   w > 0 on the kept terms, residual <= tol or PHGMG_ERR_NOT_CONVERGED
+   (also if W reaches 16 * PHGMG_ECSW_SCREEN_ADD terms). Memory nrows *
+   |W| + O(nrows + nterms); on the paper's chain at N = 256 000 (128 000
+   terms, 20 020 rows) 3 rounds, 28 points, about 2 s.
+   Scale: Gm or target whose largest |entry| is outside [2^-400, 2^400] are
+   scaled by powers of two (exact) in a copy (nrows nterms more memory), so
+   the points, the relative residual and the weights (scaled back) do not
+   depend on the data's magnitude; weights beyond the double range give
+   PHGMG_ERR_OVERFLOW.
+   Errors: PHGMG_ERR_INVALID_ARG, PHGMG_ERR_SIZE, PHGMG_ERR_NANINF,
+   PHGMG_ERR_TOL_UNREACHABLE, PHGMG_ERR_NOT_CONVERGED (tol not met: outputs
+   hold the best found), PHGMG_ERR_OVERFLOW, PHGMG_ERR_NOMEM. */
+PHGMG_DEF phgmg_result phgmg_ecsw(int nterms, int nrows, const double *Gm, int ldg, const double *target,
+                                  double tol, int *pts, double *w, int *nd_out, double *resid_out,
+                                  const phgmg_allocator *alloc);
+
+/* phgmg_ecsw for the common case of terms l_k linear in the reduced
+   coordinates (GMG-POD, SP1, SP2: l_k = row of the basis), without forming
+   the ns r x nterms training matrix. F (nterms x ns, ldf) = phi_k'(l_k(x_i))
+   as for phgmg_deim; Vt (nterms x r, ldvt): row k = d l_k / d(reduced
+   coordinates) (e.g. V[idx_k, :]); sw: the terms' weights (NULL = 1). The
+   training rows (i, a) = F[k, i] Vt[k, a], target = sum_k sw_k (...). Uses
+   F = U S W^T: the rows (j, a) = S_j U[k, j] Vt[k, a] for the modes sigma_j >
+   1e-3 tol sigma_1 have (up to that truncation) the same Gram matrix, so
+   phgmg_ecsw runs on q r rows instead of ns r; the residual
+   ||F^T diag(w - sw) Vt||_F / ||F^T diag(sw) Vt||_F is then computed on the
+   full rows, and if it misses tol the fit is redone with every mode.
+   From PHGMG_ECSW_SCREEN_MIN terms on: no SVD of F; the screening of
+   phgmg_ecsw on the full ns r rows, applied as F^T diag(.) Vt products
+   (gradient: one GEMM with F, 2 nterms ns r flops per round; only the
+   working set's columns are formed).
+   Outputs, tol and errors as phgmg_ecsw (resid_out: on the full rows). */
+PHGMG_DEF phgmg_result phgmg_ecsw_separable(int nterms, int ns, const double *F, int ldf, int r,
+                                            const double *Vt, int ldvt, const double *sw, double tol,
+                                            int *pts, double *w, int *nd_out, double *resid_out,
+                                            const phgmg_allocator *alloc);
+
 /* Hyper-reduction of a separable part (phgmg_reduce_opts.hyper, with
    hyper_reduce = 1). */
 typedef enum phgmg_hyper {
@@ -1994,6 +2118,10 @@ typedef enum phgmg_hyper {
   PHGMG_HYPER_GREEDY = 2, /* structure-preserving DEIM, greedy DEIM points             */
   PHGMG_HYPER_COUNT
 } phgmg_hyper;
+
+/* >>reduce ================================================================ */
+/* The reduction: runs and snapshot sets, the options, phgmg_reduce and the
+   reduced object. */
 
 /* One run of the full model: input u (NULL: u = 0) from x0 (NULL: 0) at t0,
    nsteps steps of dt. A snapshot set of several runs keeps them one after
@@ -2313,6 +2441,7 @@ PHGMG_DEF phgmg_result phgmg_reduced_simulate(const phgmg_reduced *red, const do
 PHGMG_DEF phgmg_result phgmg_reduced_simulate_run(const phgmg_reduced *red, const phgmg_run *run, double tol,
                                                   int max_iter, phgmg_sim_out *out, const phgmg_allocator *alloc);
 
+/* >>deploy ================================================================ */
 /* --- a check before shipping --- */
 typedef struct phgmg_validation {
   double e_red;        /* reduction error of the reduced trajectory (over the steps done) */
@@ -2351,6 +2480,7 @@ PHGMG_DEF phgmg_result phgmg_reduced_validate(const phgmg_reduced *red, const ph
                                               const phgmg_run *run, double tol, int max_iter, double ey_max,
                                               phgmg_validation *v, const phgmg_allocator *alloc);
 
+/* >>errors ================================================================ */
 /* --- error measures (paper 5.1) --- */
 /* sqrt(sum_i ||A_i - B_i||^2 / sum_i ||A_i||^2) over ns columns of length n
    (the sums scaled by a power of two when plain sums would overflow or
@@ -2367,6 +2497,7 @@ PHGMG_DEF double phgmg_err_lowerbound(const phgmg_reduced *red, const double *X,
 /* e_energy(t_n) = |H[n] - H[0] - S[n] + D[n]| for n = 0..nsteps into e. */
 PHGMG_DEF void phgmg_err_energy(const phgmg_energy *energy, int nsteps, double *e);
 
+/* >>study ================================================================= */
 /* --- studies over many reduced orders of one snapshot set ---------------
    phgmg_reduce alone redoes, for every call, work that grows with N ns r:
    the POD, the snapshots' coordinates, the envelope and non-degeneracy
@@ -2434,125 +2565,6 @@ PHGMG_DEF phgmg_result phgmg_study_reduce(phgmg_study *st, const phgmg_reduce_op
    (NULL st or red), _SIZE (red not of the study's N, m), _NOMEM. */
 PHGMG_DEF phgmg_result phgmg_study_errors(const phgmg_study *st, const phgmg_reduced *red, const double *XR,
                                           int ldxr, double *e_red, double *e_proj, double *e_lower);
-
-/* Hierarchical POD of paper 4.2.2: V1 = POD_p(X - BB^+X), V2 = POD_rn of the
-   residual (I - [B,V1][B,V1]^+) X. V1: N x p, V2: N x rn. */
-PHGMG_DEF phgmg_result phgmg_pod_hierarchical(int N, int m, const double *B, int ns, const double *X,
-                                              int ldx, int p, int rn, double *V1, double *V2,
-                                              const phgmg_allocator *alloc);
-
-/* Structure-preserving DEIM for a separable sum: F (nterms x ns) holds the
-   snapshots of the nonlinear gradient terms phi_k'(x_idx_k). Modes: sigma_k >
-   tol sigma_1 (capped by kmax if > 0). Points by Q-DEIM (pivoted QR of U^T).
-   Weights w = (P^T U)^{-T} U^T sw (sw = the terms' own weights, NULL = 1), so
-   sum_k sw_k phi_k ~ sum_j w_j phi_{pts_j}. pts, w: room for nterms entries.
-   *nd_out = points chosen, *nneg = negative weights. */
-PHGMG_DEF phgmg_result phgmg_deim(int nterms, int ns, const double *F, int ldf, const double *sw,
-                                  double tol, int kmax, int *pts, double *w, int *nd_out,
-                                  int *nneg, double *sigma_ratio, const phgmg_allocator *alloc);
-
-/* DEIM point selection (phgmg_deim_select). */
-#define PHGMG_DEIM_QDEIM 0  /* pivoted QR of U^T (Drmac-Gugercin; phgmg_deim's choice) */
-#define PHGMG_DEIM_GREEDY 1 /* greedy DEIM (Chaturantabut-Sorensen): point l = argmax
-                               |u_l - U_{<l} (P^T U_{<l})^{-1} P^T u_l| (first index on ties) */
-/* phgmg_deim with a choice of point selection: method PHGMG_DEIM_QDEIM or
-   PHGMG_DEIM_GREEDY (else PHGMG_ERR_INVALID_ARG). Modes, weights and outputs
-   as phgmg_deim; Q-DEIM points come in pivot order, greedy points in the
-   order chosen. PHGMG_ERR_SINGULAR if P^T U is singular. For both: tol = 0
-   gives 1e-8, kmax = 0 no cap; tol < 0, NaN or >= 1 and kmax < 0 give
-   PHGMG_ERR_INVALID_ARG. */
-PHGMG_DEF phgmg_result phgmg_deim_select(int nterms, int ns, const double *F, int ldf, const double *sw,
-                                         double tol, int kmax, int method, int *pts, double *w,
-                                         int *nd_out, int *nneg, double *sigma_ratio,
-                                         const phgmg_allocator *alloc);
-
-/* Non-negative least squares: min ||A x - b||_2 subject to x >= 0 (A m x n, lda).
-   Lawson-Hanson active set on the rows compressed by one Householder QR when
-   m > n (on A itself if that QR is not finite); each passive-set least
-   squares by a fresh QR (k p^2 flops, k = min(m, n), p passive indices; for
-   large problems see phgmg_ecsw's Gram form). Stops early once ||A x - b|| <=
-   tol ||b|| (tol <= 0: solve to optimality: no free index with gradient
-   [A^T (b - A x)]_j > 10 max(m,n) eps ||A||_F ||b||). max_iter (<= 0: 3n)
-   caps the iterations (one per index added or dropped). Outputs: x (n),
-   resid = ||A x - b|| (may be NULL), nnz_out = entries of x > 0 (may be NULL).
-   Errors: PHGMG_ERR_INVALID_ARG (NULL A, b, x), PHGMG_ERR_SIZE, PHGMG_ERR_NANINF,
-   PHGMG_ERR_NOT_CONVERGED (cap reached; x, resid, nnz hold the feasible
-   iterate), PHGMG_ERR_NOMEM. */
-PHGMG_DEF phgmg_result phgmg_nnls(int m, int n, const double *A, int lda, const double *b, double tol,
-                                  int max_iter, double *x, double *resid, int *nnz_out,
-                                  const phgmg_allocator *alloc);
-
-/* Empirical quadrature with non-negative weights (ECSW, Farhat et al.;
-   empirical cubature, Hernandez et al.) for a separable sum sum_k sw_k phi_k.
-   Gm (nrows x nterms, ldg): column k = what term k contributes at weight 1 to
-   each training quantity (e.g. rows (snapshot i, reduced coordinate a) =
-   phi_k'(l_k(x_i)) [V]_{idx_k, a}, optionally energy rows phi_k(l_k(x_i)));
-   target (nrows) = the full sum, Gm sw. Finds w >= 0 with few non-zeros and
-   ||Gm w - target|| <= tol ||target|| (tol = 0: 1e-6; tol < 0, NaN or >= 1:
-   PHGMG_ERR_INVALID_ARG; 0 < tol < 1e-15, below the rounding level of a
-   relative residual: PHGMG_ERR_TOL_UNREACHABLE) by Lawson-Hanson
-   stopped at tol: the candidate gradient from the Gram matrix Gm^T Gm (formed
-   once: nrows nterms^2 flops, the dominant cost, 0.16 s at 20020 x 500),
-   the passive least squares by Cholesky of the Gram block refined once with
-   the true residual, the residual itself from Gm (so the 1e-6 default is
-   met where the Gram form alone stalls near 1e-5), and a claim of
-   optimality checked with the true gradient Gm^T r. When the original
-   weights are >= 0 they are an exact solution, so tol is reachable up to
-   rounding; the points come out in Lawson-Hanson's greedy order of largest
-   gradient, typically fewer than DEIM's at a comparable accuracy.
-   Outputs: pts[0..nd-1] kept terms ascending, w[0..nd-1] their weights (> 0),
-   both with room for nterms; *nd_out = nd; *resid_out (may be NULL) =
-   ||Gm w - target|| / ||target|| (0 when target = 0, then nd = 0).
-   With w >= 0 and convex phi_k the reduced sum sum_j w_j phi(l_{pts_j}(x))
-   is convex in the reduced coordinates for any linear map x -> l, and bounded
-   below whenever each phi_k is; negative DEIM weights give no such guarantee.
-   Only Gm^T Gm, Gm^T target and ||target|| matter: rows compressed by any
-   orthogonal map (Gm' = Q^T Gm, target' = Q^T target) give the same weights
-   at less cost; phgmg_ecsw_separable does this for terms linear in the
-   reduced coordinates.
-   Many terms (nterms >= PHGMG_ECSW_SCREEN_MIN, default 4096): the n x n Gram
-   matrix is never formed. Screening: the full gradient Gm^T (target - Gm w)
-   (one pass over Gm) picks the PHGMG_ECSW_SCREEN_ADD (64) terms with the
-   largest positive gradient into a working set W, the method above solves
-   the problem restricted to W (all rows: its residual is the true one), and
-   this repeats until tol is met or no term outside W has a positive
-   gradient (w then optimal over all terms, as above). Same guarantees:
-   w > 0 on the kept terms, residual <= tol or PHGMG_ERR_NOT_CONVERGED
-   (also if W reaches 16 * PHGMG_ECSW_SCREEN_ADD terms). Memory nrows *
-   |W| + O(nrows + nterms); on the paper's chain at N = 256 000 (128 000
-   terms, 20 020 rows) 3 rounds, 28 points, about 2 s.
-   Scale: Gm or target whose largest |entry| is outside [2^-400, 2^400] are
-   scaled by powers of two (exact) in a copy (nrows nterms more memory), so
-   the points, the relative residual and the weights (scaled back) do not
-   depend on the data's magnitude; weights beyond the double range give
-   PHGMG_ERR_OVERFLOW.
-   Errors: PHGMG_ERR_INVALID_ARG, PHGMG_ERR_SIZE, PHGMG_ERR_NANINF,
-   PHGMG_ERR_TOL_UNREACHABLE, PHGMG_ERR_NOT_CONVERGED (tol not met: outputs
-   hold the best found), PHGMG_ERR_OVERFLOW, PHGMG_ERR_NOMEM. */
-PHGMG_DEF phgmg_result phgmg_ecsw(int nterms, int nrows, const double *Gm, int ldg, const double *target,
-                                  double tol, int *pts, double *w, int *nd_out, double *resid_out,
-                                  const phgmg_allocator *alloc);
-
-/* phgmg_ecsw for the common case of terms l_k linear in the reduced
-   coordinates (GMG-POD, SP1, SP2: l_k = row of the basis), without forming
-   the ns r x nterms training matrix. F (nterms x ns, ldf) = phi_k'(l_k(x_i))
-   as for phgmg_deim; Vt (nterms x r, ldvt): row k = d l_k / d(reduced
-   coordinates) (e.g. V[idx_k, :]); sw: the terms' weights (NULL = 1). The
-   training rows (i, a) = F[k, i] Vt[k, a], target = sum_k sw_k (...). Uses
-   F = U S W^T: the rows (j, a) = S_j U[k, j] Vt[k, a] for the modes sigma_j >
-   1e-3 tol sigma_1 have (up to that truncation) the same Gram matrix, so
-   phgmg_ecsw runs on q r rows instead of ns r; the residual
-   ||F^T diag(w - sw) Vt||_F / ||F^T diag(sw) Vt||_F is then computed on the
-   full rows, and if it misses tol the fit is redone with every mode.
-   From PHGMG_ECSW_SCREEN_MIN terms on: no SVD of F; the screening of
-   phgmg_ecsw on the full ns r rows, applied as F^T diag(.) Vt products
-   (gradient: one GEMM with F, 2 nterms ns r flops per round; only the
-   working set's columns are formed).
-   Outputs, tol and errors as phgmg_ecsw (resid_out: on the full rows). */
-PHGMG_DEF phgmg_result phgmg_ecsw_separable(int nterms, int ns, const double *F, int ldf, int r,
-                                            const double *Vt, int ldvt, const double *sw, double tol,
-                                            int *pts, double *w, int *nd_out, double *resid_out,
-                                            const phgmg_allocator *alloc);
 
 #ifdef __cplusplus
 }
@@ -10349,7 +10361,7 @@ PHGMG_DEF phgmg_result phgmg_rom_step(phgmg_rom_stepper *s, phgmg_real *x, const
 }
 
 #ifndef PHGMG_NO_OFFLINE
-/* >>pod / >>reduce (implementation) ======================================= */
+/* >>reduce (implementation): the reduced object =========================== */
 
 /* A small owner list: every array of a phgmg_reduced is allocated through it,
    so destroy (and every error path) frees exactly what was allocated. */
@@ -10498,6 +10510,7 @@ PHGMG_DEF void phgmg_reduced_destroy(phgmg_reduced *red) {
 PHGMG_DEF const phgmg_rom *phgmg_reduced_rom(const phgmg_reduced *red) { return red ? &red->rom : NULL; }
 PHGMG_DEF int phgmg_reduced_N(const phgmg_reduced *red) { return red ? red->N : 0; }
 
+/* >>pod (implementation) ================================================== */
 /* C (m x n) = A^T B with A: k x m, B: k x n (column-major, tight). */
 PHGMG__PRIV void phgmg__atb(int k, int m, int n, const double *A, const double *B, double *C) {
   phgmg_gemm('T', 'N', m, n, k, 1.0, A, k, B, k, 0.0, C, m);
@@ -10812,6 +10825,7 @@ PHGMG_DEF phgmg_result phgmg_pod_hierarchical(int N, int m, const double *B, int
   return rc;
 }
 
+/* >>hyper (implementation) ================================================ */
 PHGMG_DEF phgmg_result phgmg_deim(int nterms, int ns, const double *F, int ldf, const double *sw,
                                   double tol, int kmax, int *pts, double *w, int *nd_out,
                                   int *nneg, double *sigma_ratio, const phgmg_allocator *alloc) {
@@ -11578,6 +11592,7 @@ PHGMG_DEF phgmg_result phgmg_ecsw_separable(int nterms, int ns, const double *F,
   return rc;
 }
 
+/* >>reduce (implementation): manifold, GMG blocks, Hamiltonian terms, stepper  */
 /* Lp (rn x p) = [sum_j Ms(:, k*p + j) x2_j]_k in double. */
 PHGMG__PRIV void phgmg__lp_d(int rn, int p, const double *Ms, const double *x2, double *Lp) {
   int i, j, k;
@@ -14657,6 +14672,7 @@ PHGMG_DEF phgmg_result phgmg_reduced_W(const phgmg_reduced *red, const double *x
   return rc;
 }
 
+/* >>deploy (implementation) =============================================== */
 PHGMG_DEF phgmg_result phgmg_reduced_simulate_run(const phgmg_reduced *red, const phgmg_run *run, double tol,
                                                   int max_iter, phgmg_sim_out *out, const phgmg_allocator *alloc) {
   phgmg_sim_out none;
@@ -14833,6 +14849,7 @@ PHGMG_DEF phgmg_result phgmg_reduced_validate(const phgmg_reduced *red, const ph
    overflow, or squares near the underflow threshold)? */
 #define PHGMG__SSQ_RESCALE(num, den) (!((den) > 1e-280 && (den) < 1e280 && (num) < 1e280))
 
+/* >>errors (implementation) =============================================== */
 /* sqrt(num / den) of the error measures (den 0: 0 if num is 0, else Inf). */
 PHGMG__PRIV double phgmg__err_ratio(double num, double den) {
   return den > 0.0 ? sqrt(num / den) : (num > 0.0 ? (double)INFINITY : 0.0);
@@ -15008,7 +15025,7 @@ PHGMG_DEF void phgmg_err_energy(const phgmg_energy *energy, int nsteps, double *
   for (n = 0; n <= nsteps; ++n) e[n] = fabs(energy->H[n] - energy->H[0] - energy->S[n] + energy->D[n]);
 }
 
-/* --- studies (phgmg_study_*) ------------------------------------------- */
+/* >>study (implementation) ================================================ */
 PHGMG_DEF void phgmg_study_destroy(phgmg_study *st) {
   phgmg_allocator a;
   const phgmg_allocator *al;

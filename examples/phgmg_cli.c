@@ -1275,9 +1275,10 @@ static int check_hyper_opts(const reduce_args *A, const char *const *seen, int n
 }
 
 /* Returns 0, the usage status 2, or -1 after printing --help. */
+static int check_reduce_args(reduce_args *A, const char *const *seen, int nseen);
 static int parse_reduce(int argc, char **argv, reduce_args *A) {
   const char *seen[64];
-  int i, nseen = 0, e;
+  int i, nseen = 0;
   phgmg_reduce_opts def;   /* the library's defaults of the options it shares */
   phgmg_reduce_opts_default(&def);
   memset(A, 0, sizeof *A);
@@ -1358,6 +1359,15 @@ static int parse_reduce(int argc, char **argv, reduce_args *A) {
 #undef INT
 #undef DBL
   }
+  return check_reduce_args(A, seen, nseen);
+}
+
+/* The checks of reduce's arguments as a whole (after parsing): required and
+   exclusive options, the model's files, the nonlinear part, the training
+   inputs; resolves the CLI's own defaults (input, gmg-qm's lambda, dt-map).
+   0, or the usage status 2. */
+static int check_reduce_args(reduce_args *A, const char *const *seen, int nseen) {
+  int i, e;
   if ((A->E && A->Jcoo) || (A->Ecoo && !A->Jcoo))
     return usage_error("reduce: give E like J, R, Q: --E with --J/--R/--Q, --E-coo with --J-coo/--R-coo/--Q-coo");
   if ((A->J || A->R || A->Q) && (A->Jcoo || A->Rcoo || A->Qcoo))
@@ -2334,6 +2344,70 @@ static const char *hyper_name(const reduce_args *A, const phgmg_reduce_opts *o) 
 }
 
 /* NAME.json: what was reduced, how, and where the outputs are. */
+/* The json record's "snapshots" object (opened after "system"). */
+static void json_snapshots(FILE *jf, const reduce_args *A, int ns, double t_sim) {
+  int i;
+  fprintf(jf, "},\n  \"snapshots\": {\"count\": %d, ", ns);
+  if (A->X) {
+    fprintf(jf, "\"file\": "); json_str(jf, A->X);
+    if (A->nx > 1 || A->nxin) {
+      fprintf(jf, ", \"files\": [");
+      for (i = 0; i < A->nx; ++i) { if (i) fprintf(jf, ", "); json_str(jf, A->xs[i]); }
+      fprintf(jf, "]");
+    }
+    if (A->nxin) {
+      fprintf(jf, ", \"inputs\": [");
+      for (i = 0; i < A->nxin; ++i) { if (i) fprintf(jf, ", "); json_str(jf, A->xin[i]); }
+      fprintf(jf, "], \"dt\": "); json_num(jf, A->dt);
+    }
+  }
+  else {
+    fprintf(jf, "\"simulate\": {\"dt\": "); json_num(jf, A->dt);
+    fprintf(jf, ", \"steps\": %d, \"input\": ", A->steps); json_str(jf, A->input);
+    if (A->ntrain) {
+      fprintf(jf, ", \"train_inputs\": [");
+      for (i = 0; i < A->ntrain; ++i) { if (i) fprintf(jf, ", "); json_str(jf, A->train[i]); }
+      fprintf(jf, "]");
+    }
+    fprintf(jf, ", \"amp\": "); json_num(jf, A->amp);
+    fprintf(jf, ", \"newton_tol\": "); json_num(jf, A->newton_tol);
+    fprintf(jf, ", \"newton_iter\": %d, \"seconds\": ", A->newton_iter); json_num(jf, t_sim);
+    fprintf(jf, "}");
+  }
+}
+
+/* The json record's "options" object. */
+static void json_options(FILE *jf, const reduce_args *A, const reduce_state *S, int method,
+                         const phgmg_reduce_opts *o, const phgmg_reduce_info *info) {
+  fprintf(jf, "},\n  \"options\": {");
+  if (method == PHGMG_METHOD_GMG_QM) { /* lambda, r_n and the manifold are gmg-qm's */
+    fprintf(jf, "\"rn\": %d, \"lambda\": ", o->rn);
+    if (A->lambda_auto) json_str(jf, A->lambda_auto == 1 ? "auto" : "cv");
+    else json_num(jf, A->lambda);
+    fprintf(jf, ", \"lambda_used\": ");
+    json_num(jf, info->lambda == HUGE_VAL ? -1.0 : info->lambda);
+    if (A->lambda_auto == 1 && A->X && !A->nxin)
+      fprintf(jf, ", \"lambda_note\": \"M = 0: the inputs of the --X runs are unknown (no --X-input)\"");
+    fprintf(jf, ", \"manifold\": ");
+    json_str(jf, A->manifold_s ? A->manifold_s : "pod");
+    fprintf(jf, ", ");
+  }
+  fprintf(jf, "\"training_runs\": %d", S->nrun);
+  fprintf(jf, ", \"hyper\": ");
+  json_str(jf, hyper_name(A, o));
+  if (o->hyper_reduce && o->hyper == PHGMG_HYPER_ECSW) {
+    fprintf(jf, ", \"hyper_tol\": ");
+    json_num(jf, A->hyper_tol > 0.0 ? A->hyper_tol : 1e-6);
+  }
+  fprintf(jf, ", \"deim\": %s", o->hyper_reduce && o->hyper != PHGMG_HYPER_ECSW ? "true" : "false");
+  if (o->hyper_reduce && o->hyper != PHGMG_HYPER_ECSW) {
+    fprintf(jf, ", \"deim_tol\": ");
+    json_num(jf, A->deim_tol);
+    fprintf(jf, ", \"deim_max\": %d, \"deim_allow_negative\": %s", A->deim_max, A->deim_neg ? "true" : "false");
+  }
+  fprintf(jf, "},\n");
+}
+
 static int write_json(const reduce_args *A, reduce_state *S, int method, int ns, double t_sim, double t_red,
                       const phgmg_reduce_opts *o, const phgmg_reduce_info *info, const outlist *ol) {
   const phgmg_rom *rom = phgmg_reduced_rom(S->red);
@@ -2365,60 +2439,8 @@ static int write_json(const reduce_args *A, reduce_state *S, int method, int ns,
     fprintf(jf, ", \"poly_idx\": "); json_str(jf, A->poly_idx);
     if (A->poly_w) { fprintf(jf, ", \"poly_w\": "); json_str(jf, A->poly_w); }
   }
-  fprintf(jf, "},\n  \"snapshots\": {\"count\": %d, ", ns);
-  if (A->X) {
-    fprintf(jf, "\"file\": "); json_str(jf, A->X);
-    if (A->nx > 1 || A->nxin) {
-      fprintf(jf, ", \"files\": [");
-      for (i = 0; i < A->nx; ++i) { if (i) fprintf(jf, ", "); json_str(jf, A->xs[i]); }
-      fprintf(jf, "]");
-    }
-    if (A->nxin) {
-      fprintf(jf, ", \"inputs\": [");
-      for (i = 0; i < A->nxin; ++i) { if (i) fprintf(jf, ", "); json_str(jf, A->xin[i]); }
-      fprintf(jf, "], \"dt\": "); json_num(jf, A->dt);
-    }
-  }
-  else {
-    fprintf(jf, "\"simulate\": {\"dt\": "); json_num(jf, A->dt);
-    fprintf(jf, ", \"steps\": %d, \"input\": ", A->steps); json_str(jf, A->input);
-    if (A->ntrain) {
-      fprintf(jf, ", \"train_inputs\": [");
-      for (i = 0; i < A->ntrain; ++i) { if (i) fprintf(jf, ", "); json_str(jf, A->train[i]); }
-      fprintf(jf, "]");
-    }
-    fprintf(jf, ", \"amp\": "); json_num(jf, A->amp);
-    fprintf(jf, ", \"newton_tol\": "); json_num(jf, A->newton_tol);
-    fprintf(jf, ", \"newton_iter\": %d, \"seconds\": ", A->newton_iter); json_num(jf, t_sim);
-    fprintf(jf, "}");
-  }
-  fprintf(jf, "},\n  \"options\": {");
-  if (method == PHGMG_METHOD_GMG_QM) { /* lambda, r_n and the manifold are gmg-qm's */
-    fprintf(jf, "\"rn\": %d, \"lambda\": ", o->rn);
-    if (A->lambda_auto) json_str(jf, A->lambda_auto == 1 ? "auto" : "cv");
-    else json_num(jf, A->lambda);
-    fprintf(jf, ", \"lambda_used\": ");
-    json_num(jf, info->lambda == HUGE_VAL ? -1.0 : info->lambda);
-    if (A->lambda_auto == 1 && A->X && !A->nxin)
-      fprintf(jf, ", \"lambda_note\": \"M = 0: the inputs of the --X runs are unknown (no --X-input)\"");
-    fprintf(jf, ", \"manifold\": ");
-    json_str(jf, A->manifold_s ? A->manifold_s : "pod");
-    fprintf(jf, ", ");
-  }
-  fprintf(jf, "\"training_runs\": %d", S->nrun);
-  fprintf(jf, ", \"hyper\": ");
-  json_str(jf, hyper_name(A, o));
-  if (o->hyper_reduce && o->hyper == PHGMG_HYPER_ECSW) {
-    fprintf(jf, ", \"hyper_tol\": ");
-    json_num(jf, A->hyper_tol > 0.0 ? A->hyper_tol : 1e-6);
-  }
-  fprintf(jf, ", \"deim\": %s", o->hyper_reduce && o->hyper != PHGMG_HYPER_ECSW ? "true" : "false");
-  if (o->hyper_reduce && o->hyper != PHGMG_HYPER_ECSW) {
-    fprintf(jf, ", \"deim_tol\": ");
-    json_num(jf, A->deim_tol);
-    fprintf(jf, ", \"deim_max\": %d, \"deim_allow_negative\": %s", A->deim_max, A->deim_neg ? "true" : "false");
-  }
-  fprintf(jf, "},\n");
+  json_snapshots(jf, A, ns, t_sim);
+  json_options(jf, A, S, method, o, info);
   fprintf(jf, "  \"info\": {\"pod_sigma_ratio\": ");
   json_num(jf, info->pod_sigma_ratio);
   fprintf(jf, ", \"rcond_jr\": "); json_num(jf, info->rcond_jr);
@@ -2607,10 +2629,49 @@ static void rom_feed_out(const phgmg_rom *rom, double t, cli_input *in, double *
     for (b = 0; b < rom->m; ++b) y[a] += (double)rom->PD[(size_t)rom->r * rom->m + a + (size_t)b * rom->m] * ub[b];
 }
 
+/* simulate-rom's options (0 / NULL: not given). */
+typedef struct simrom_args {
+  const char *model, *out, *states, *inspec;
+  double dt, amp, newton_tol;   /* newton_tol 0: the library's default */
+  int steps, newton_iter, have_dt;
+} simrom_args;
+
+/* Parses simulate-rom's options into P: 0, -1 after --help, or the usage
+   status 2. */
+static int parse_simulate_rom(int argc, char **argv, simrom_args *P) {
+  const char *seen[64];
+  int nseen = 0, i;
+  memset(P, 0, sizeof *P);
+  P->inspec = "sin"; P->amp = 0.1; P->steps = 1000; P->newton_iter = 10;
+  for (i = 2; i < argc; ++i) {
+    const char *o = argv[i], *v;
+    if (!strcmp(o, "--help") || !strcmp(o, "-h")) { print_help(); return -1; }
+    if (repeated_opt(o, seen, &nseen)) return 2;
+    else if (!strcmp(o, "--model")) { if (!(P->model = optval(argc, argv, &i))) return 2; }
+    else if (!strcmp(o, "--out")) { if (!(P->out = optval(argc, argv, &i))) return 2; }
+    else if (!strcmp(o, "--states")) { if (!(P->states = optval(argc, argv, &i))) return 2; }
+    else if (!strcmp(o, "--input")) { if (!(P->inspec = optval(argc, argv, &i))) return 2; }
+    else if (!strcmp(o, "--dt")) {
+      if (!(v = optval(argc, argv, &i)) || !parse_double(o, v, 0.0, &P->dt)) return 2;
+      if (!(P->dt > 0.0)) return usage_error("--dt must be > 0");
+      P->have_dt = 1;
+    }
+    else if (!strcmp(o, "--amp")) { if (!(v = optval(argc, argv, &i)) || !parse_double(o, v, -HUGE_VAL, &P->amp)) return 2; }
+    else if (!strcmp(o, "--newton-tol")) { if (!(v = optval(argc, argv, &i)) || !parse_double(o, v, 0.0, &P->newton_tol)) return 2; }
+    else if (!strcmp(o, "--steps")) { if (!(v = optval(argc, argv, &i)) || !parse_int(o, v, 1, INT_MAX - 1, &P->steps)) return 2; }
+    else if (!strcmp(o, "--newton-iter")) { if (!(v = optval(argc, argv, &i)) || !parse_int(o, v, 1, 1000, &P->newton_iter)) return 2; }
+    else if (!strcmp(o, "--quiet")) g_quiet = 1;
+    else return usage_error("simulate-rom: unknown option '%s'", o);
+  }
+  if (!P->model || !P->out) return usage_error("simulate-rom: --model FILE and --out FILE are required");
+  return 0;
+}
+
 static int cmd_simulate_rom(int argc, char **argv) {
-  const char *model = NULL, *out = NULL, *states = NULL, *inspec = "sin";
-  double dt = 0.0, amp = 0.1, newton_tol = 0.0, t0;   /* 0: the library's default */
-  int steps = 1000, newton_iter = 10, have_dt = 0, i, a, n, status = 1;
+  simrom_args P;
+  const char *model, *out, *states, *inspec;
+  double dt, amp, newton_tol, t0;
+  int steps, newton_iter, have_dt, a, n, status = parse_simulate_rom(argc, argv, &P);
   phgmg_rom rom;
   void *block = NULL, *mem = NULL;
   phgmg_real *x = NULL, *u3, *y, *ework;
@@ -2620,34 +2681,17 @@ static int cmd_simulate_rom(int argc, char **argv) {
   cli_input in;
   size_t msz, nreal;
   staged sg;
-  const char *seen[64], *wp;
-  int nseen = 0;
+  const char *wp;
   pathset pin, pout; /* the files read; the files written */
+  if (status != 0) return status < 0 ? 0 : status;
+  model = P.model; out = P.out; states = P.states; inspec = P.inspec;
+  dt = P.dt; amp = P.amp; newton_tol = P.newton_tol;
+  steps = P.steps; newton_iter = P.newton_iter; have_dt = P.have_dt;
+  status = 1;
   memset(&in, 0, sizeof in);
   memset(&sg, 0, sizeof sg);
   memset(&pin, 0, sizeof pin);
   memset(&pout, 0, sizeof pout);
-  for (i = 2; i < argc; ++i) {
-    const char *o = argv[i], *v;
-    if (!strcmp(o, "--help") || !strcmp(o, "-h")) { print_help(); return 0; }
-    if (repeated_opt(o, seen, &nseen)) return 2;
-    else if (!strcmp(o, "--model")) { if (!(model = optval(argc, argv, &i))) return 2; }
-    else if (!strcmp(o, "--out")) { if (!(out = optval(argc, argv, &i))) return 2; }
-    else if (!strcmp(o, "--states")) { if (!(states = optval(argc, argv, &i))) return 2; }
-    else if (!strcmp(o, "--input")) { if (!(inspec = optval(argc, argv, &i))) return 2; }
-    else if (!strcmp(o, "--dt")) {
-      if (!(v = optval(argc, argv, &i)) || !parse_double(o, v, 0.0, &dt)) return 2;
-      if (!(dt > 0.0)) return usage_error("--dt must be > 0");
-      have_dt = 1;
-    }
-    else if (!strcmp(o, "--amp")) { if (!(v = optval(argc, argv, &i)) || !parse_double(o, v, -HUGE_VAL, &amp)) return 2; }
-    else if (!strcmp(o, "--newton-tol")) { if (!(v = optval(argc, argv, &i)) || !parse_double(o, v, 0.0, &newton_tol)) return 2; }
-    else if (!strcmp(o, "--steps")) { if (!(v = optval(argc, argv, &i)) || !parse_int(o, v, 1, INT_MAX - 1, &steps)) return 2; }
-    else if (!strcmp(o, "--newton-iter")) { if (!(v = optval(argc, argv, &i)) || !parse_int(o, v, 1, 1000, &newton_iter)) return 2; }
-    else if (!strcmp(o, "--quiet")) g_quiet = 1;
-    else return usage_error("simulate-rom: unknown option '%s'", o);
-  }
-  if (!model || !out) return usage_error("simulate-rom: --model FILE and --out FILE are required");
   paths_add(&pin, "--model", model, 0);
   paths_add_input(&pin, "--input", inspec);
   paths_add(&pout, "--out", out, 1);
