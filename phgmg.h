@@ -1,5 +1,5 @@
 /* phgmg.h -- structure-preserving model order reduction of port-Hamiltonian
-   systems by generalized manifold Galerkin (GMG) reduction. Version 0.2.0.
+   systems by generalized manifold Galerkin (GMG) reduction. Version 0.3.0.
    Single-file C99 library (also compiles as C++), no dependencies beyond libc
    and libm. The revision history and the MIT license are at the end of the
    file.
@@ -944,9 +944,9 @@
 
 /* >>config ================================================================ */
 #define PHGMG_VERSION_MAJOR 0
-#define PHGMG_VERSION_MINOR 2
+#define PHGMG_VERSION_MINOR 3
 #define PHGMG_VERSION_PATCH 0
-#define PHGMG_VERSION_STRING "0.2.0"
+#define PHGMG_VERSION_STRING "0.3.0"
 
 #include <stddef.h>
 
@@ -18173,6 +18173,27 @@ PHGMG_DEF phgmg_result phgmg_npy_write(const char *path, const double *A, int ro
 
 /*
    REVISION HISTORY
+   0.3.0  (2026-11-26)
+          - New: nonlinear dissipation (phgmg_ph_system dampers c_k rho_k(c_k^T z),
+            PHGMG_ERR_DAMPER), kept by GMG-POD, SP1 and SP2 (reduced dampers,
+            ECSW hyper-reduction); feedthrough P, S, N kept by the same
+            reductions (phgmg_rom.PD); binary model format version 3 for
+            models with either (other models keep versions 1 and 2).
+          - New: an affine reference state (opts.ref, phgmg_ref: none, the
+            snapshot mean, or a given vector; phgmg_rom.ref_g, ref_s, xr_rest);
+            alternating minimization starts from the greedy manifold when V2
+            is wide and greedy_window > 0.
+          - New: sparse direct solves condense an independent set of states
+            first; one stepper (and its factors) serves consecutive runs.
+          - New: phgmg_simulate_run, phgmg_reduced_simulate_run (phgmg_sim_out)
+            and phgmg_ss_compare (phgmg_ss, phgmg_ss_errors), struct forms of
+            the long-argument drivers.
+          - Renamed: phgmg_reduce_opts.deim is now hyper_reduce (deim still
+            works and is resolved to it; to be removed in 1.0); the CLI's
+            --no-deim is now --no-hyper (the old name still works).
+          - Changed: the enumerated choices are typed enums ending in a
+            _COUNT (phgmg_manifold, phgmg_hyper, phgmg_ref and the others);
+            phgmg_reduce_opts.manifold and .hyper have those types.
    0.2.0  (2026-11-25)
           - Meaning changed: phgmg_reduce_opts.lambda_auto = 1 now chooses
             GMG-QM's ridge parameter by simulating the reduced model on the
