@@ -9,7 +9,7 @@
 CC      ?= cc
 CXX     ?= c++
 WARN     = -Wall -Wextra -Werror -pedantic -Wshadow
-CFLAGS_T = -std=c99 $(WARN) -O2 -g1
+CFLAGS_T = -std=c99 $(WARN) -O1 -g1
 SANFLAGS = -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=all
 OPTFLAGS = -std=c99 $(WARN) -O2 -march=native
 LDLIBS   = -lm
@@ -108,10 +108,10 @@ test-demo: demo
 # binary and C-source exports reproduce the in-memory outputs exactly, float vs double.
 $(BUILD)/export_model_d: examples/controller/export_model.c examples/controller/controller_run.h phgmg.h examples/msd_models.h examples/morse_models.h
 	@mkdir -p $(BUILD)
-	$(CC) -std=c99 $(WARN) -O2 -o $@ $< $(LDLIBS)
+	$(CC) -std=c99 $(WARN) -O1 -o $@ $< $(LDLIBS)
 $(BUILD)/export_model_f: examples/controller/export_model.c examples/controller/controller_run.h phgmg.h examples/msd_models.h examples/morse_models.h
 	@mkdir -p $(BUILD)
-	$(CC) -std=c99 $(WARN) -Wdouble-promotion -DPHGMG_REAL_FLOAT -O2 -o $@ $< $(LDLIBS)
+	$(CC) -std=c99 $(WARN) -Wdouble-promotion -DPHGMG_REAL_FLOAT -O1 -o $@ $< $(LDLIBS)
 test-embedded-host: $(BUILD)/export_model_d $(BUILD)/export_model_f
 	sh examples/controller/check.sh $(BUILD)
 	sh tests/sepfun_export.sh $(BUILD)
@@ -125,7 +125,7 @@ embedded: $(BUILD)/export_model_d $(BUILD)/export_model_f
 # .npy round trips against real NumPy (Debian python3-numpy, /usr/bin/python3).
 $(BUILD)/npy_tool: tests/npy_tool.c phgmg.h
 	@mkdir -p $(BUILD)
-	$(CC) -std=c99 $(WARN) -O2 -o $@ $< $(LDLIBS)
+	$(CC) -std=c99 $(WARN) -O1 -o $@ $< $(LDLIBS)
 test-npy: $(BUILD)/npy_tool
 	/usr/bin/python3 tests/test_npy_numpy.py $(BUILD)/npy_tool
 
@@ -135,7 +135,8 @@ test-plain: $(BUILD)/test_run
 test-asan: $(BUILD)/test_run_asan
 	ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1 ./$(BUILD)/test_run_asan
 
-# The header as users build it: C99, C11, C++, float online scalar, PHGMG_STATIC
+# The header as users build it (syntax and warnings: -fsyntax-only; the two-unit
+# PHGMG_STATIC build is compiled and linked): C99, C11, C++, float online scalar, PHGMG_STATIC
 # in two translation units, declarations only, offline half compiled out.
 compile-checks: phgmg.h
 	@mkdir -p $(BUILD)/cc
@@ -144,20 +145,20 @@ compile-checks: phgmg.h
 	@printf '#include "../../phgmg.h"\nint decl_only(void){return (int)PHGMG_OK;}\n' > $(BUILD)/cc/decl.c
 	@printf '#define PHGMG_STATIC\n#define PHGMG_IMPLEMENTATION\n#include "../../phgmg.h"\nint tu2(void){return (int)PHGMG_OK;}\n' > $(BUILD)/cc/s2.c
 	@printf '#define PHGMG_STATIC\n#define PHGMG_IMPLEMENTATION\n#include "../../phgmg.h"\nint tu2(void);\nint main(void){return tu2();}\n' > $(BUILD)/cc/s1.c
-	$(CC) -std=c99 $(WARN) -Wdouble-promotion -c $(BUILD)/cc/impl.c -o $(BUILD)/cc/a.o
-	$(CC) -std=c11 $(WARN) -Wdouble-promotion -c $(BUILD)/cc/impl.c -o $(BUILD)/cc/a.o
-	$(CC) -std=c99 $(WARN) -Wdouble-promotion -DPHGMG_REAL_FLOAT -c $(BUILD)/cc/impl.c -o $(BUILD)/cc/a.o
-	$(CC) -std=c99 $(WARN) -Wdouble-promotion -DPHGMG_REAL_FLOAT -DPHGMG_NO_OFFLINE -c $(BUILD)/cc/impl.c -o $(BUILD)/cc/a.o
-	$(CC) -std=c99 $(WARN) -DPHGMG_NO_OFFLINE -c $(BUILD)/cc/impl.c -o $(BUILD)/cc/a.o
-	$(CXX) -std=c++11 -Wall -Wextra -Werror -c $(BUILD)/cc/impl.cpp -o $(BUILD)/cc/a.o
-	$(CXX) -std=c++11 -Wall -Wextra -Werror -DPHGMG_REAL_FLOAT -c $(BUILD)/cc/impl.cpp -o $(BUILD)/cc/a.o
-	$(CC) -std=c99 $(WARN) -c $(BUILD)/cc/decl.c -o $(BUILD)/cc/a.o
+	$(CC) -std=c99 $(WARN) -Wdouble-promotion -fsyntax-only $(BUILD)/cc/impl.c
+	$(CC) -std=c11 $(WARN) -Wdouble-promotion -fsyntax-only $(BUILD)/cc/impl.c
+	$(CC) -std=c99 $(WARN) -Wdouble-promotion -DPHGMG_REAL_FLOAT -fsyntax-only $(BUILD)/cc/impl.c
+	$(CC) -std=c99 $(WARN) -Wdouble-promotion -DPHGMG_REAL_FLOAT -DPHGMG_NO_OFFLINE -fsyntax-only $(BUILD)/cc/impl.c
+	$(CC) -std=c99 $(WARN) -DPHGMG_NO_OFFLINE -fsyntax-only $(BUILD)/cc/impl.c
+	$(CXX) -std=c++11 -Wall -Wextra -Werror -fsyntax-only $(BUILD)/cc/impl.cpp
+	$(CXX) -std=c++11 -Wall -Wextra -Werror -DPHGMG_REAL_FLOAT -fsyntax-only $(BUILD)/cc/impl.cpp
+	$(CC) -std=c99 $(WARN) -fsyntax-only $(BUILD)/cc/decl.c
 	$(CC) -std=c99 $(WARN) $(BUILD)/cc/s1.c $(BUILD)/cc/s2.c -o $(BUILD)/cc/static2 $(LDLIBS)
 	if printf 'int main(void){return 0;}\n' | $(CC) -fopenmp -x c - -o $(BUILD)/cc/omp >/dev/null 2>&1; then \
-	  $(CC) -std=c99 $(WARN) -fopenmp -DPHGMG_USE_OPENMP -c $(BUILD)/cc/impl.c -o $(BUILD)/cc/a.o && \
-	  $(CXX) -std=c++11 -Wall -Wextra -Werror -fopenmp -DPHGMG_USE_OPENMP -c $(BUILD)/cc/impl.cpp -o $(BUILD)/cc/a.o; fi
-	if command -v clang >/dev/null 2>&1; then clang -std=c99 $(WARN) -Wdouble-promotion -c $(BUILD)/cc/impl.c -o $(BUILD)/cc/a.o && \
-	  clang -std=c99 $(WARN) -Wdouble-promotion -DPHGMG_REAL_FLOAT -c $(BUILD)/cc/impl.c -o $(BUILD)/cc/a.o; fi
+	  $(CC) -std=c99 $(WARN) -fopenmp -DPHGMG_USE_OPENMP -fsyntax-only $(BUILD)/cc/impl.c && \
+	  $(CXX) -std=c++11 -Wall -Wextra -Werror -fopenmp -DPHGMG_USE_OPENMP -fsyntax-only $(BUILD)/cc/impl.cpp; fi
+	if command -v clang >/dev/null 2>&1; then clang -std=c99 $(WARN) -Wdouble-promotion -fsyntax-only $(BUILD)/cc/impl.c && \
+	  clang -std=c99 $(WARN) -Wdouble-promotion -DPHGMG_REAL_FLOAT -fsyntax-only $(BUILD)/cc/impl.c; fi
 	@echo "compile checks passed"
 
 EXAMPLES = $(BUILD)/hello $(BUILD)/msd_linear $(BUILD)/msd_nonlinear $(BUILD)/morse_chain $(BUILD)/phgmg $(BUILD)/linear_bases $(BUILD)/fe_bar $(BUILD)/transport_line
