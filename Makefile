@@ -50,20 +50,14 @@ $(BUILD)/test_run: $(TESTOBJ)
 $(BUILD)/test_run_asan: $(TESTOBJ_ASAN)
 	$(CC) $(CFLAGS_T) -O1 $(SANFLAGS) -o $@ $(TESTOBJ_ASAN) $(LDLIBS)
 
-# After the compiles, the single-core stages run in two lanes on both cores
-# (each lane's output is printed whole when it ends -- GNU make 4's
-# --output-sync, left out by older makes; a failure stops make test).
+# After the compiles, the single-core stages run as independent jobs on both
+# cores, the longest first (each job's output is printed whole when it ends --
+# GNU make 4's --output-sync, left out by older makes; a failure stops make test).
 SYNC = $(if $(filter output-sync,$(.FEATURES)),--output-sync=target,)
 test: test-build
-	$(MAKE) test-plain
-	$(MAKE) -j2 $(SYNC) test-lane-asan test-lane-host
-	$(MAKE) -j2 $(SYNC) test-lane-demo test-lane-tools
+	$(MAKE) -j2 $(SYNC) test-asan test-cli test-fuzz-replay test-embedded-host test-demo compile-checks \
+	  test-validate test-plain test-npy test-hello docs-check
 
-test-lane-asan: test-asan
-test-lane-host: compile-checks test-embedded-host
-test-lane-demo: test-demo
-test-lane-tools: test-fuzz-replay test-npy test-cli test-validate test-hello docs-check
-.PHONY: test-lane-asan test-lane-host test-lane-demo test-lane-tools
 
 # Everything make test compiles, built first on both cores (the compiles are
 # most of its time); the runs below then go one after the other.
