@@ -17098,7 +17098,7 @@ PHGMG_DEF phgmg_result phgmg_rom_serialize(const phgmg_rom *rom, void *buf, size
   need = phgmg_rom_serialized_size(rom);
   if (cap < need) return PHGMG_ERR_WORKSPACE;
   for (i = 0; i < PHGMG__NFIELDS; ++i)
-    if (phgmg__field_get(rom, i)) mask |= 1u << i;
+    if (phgmg__field_get(rom, i) && phgmg__field_len(rom, i) > 0) mask |= 1u << i;
   memcpy(b, "PHGMGROM", 8);
   phgmg__put32(b + 8, phgmg__rom_v3(rom) ? 3u : phgmg__rom_v2(rom) ? 2u : 1u);
   phgmg__put32(b + 12, (uint32_t)sizeof(phgmg_real));
@@ -17205,10 +17205,14 @@ PHGMG__ONLINE phgmg_result phgmg__rom_header(const unsigned char *b, size_t len,
   if (rom->m > rom->r) return PHGMG_ERR_FORMAT;
   if ((rom->nphi > 1 && rom->nphi != rom->nd) || (nterm != 0 && nterm != (size_t)rom->nd))
     return PHGMG_ERR_FORMAT;
+  /* only the form the writer produces, so that a loaded model saves to the
+     same bytes: version 2 exactly when the model needs it (phgmg__rom_v2),
+     and no field of length 0 (the writer leaves those out) */
+  if (ver == 2u && !(rom->nd > 0 && (rom->nexp > 0 || rom->nphi > 1 || nterm > 0))) return PHGMG_ERR_FORMAT;
   for (i = 0; i < PHGMG__NFIELDS; ++i)
     if (mask & (1u << i)) {
       size_t k = phgmg__field_len(rom, i);
-      if (k > ((size_t)1 << 28)) return PHGMG_ERR_FORMAT;
+      if (k == 0 || k > ((size_t)1 << 28)) return PHGMG_ERR_FORMAT;
       n += k;
     }
   if (n > (len / ss)) return PHGMG_ERR_FORMAT;
