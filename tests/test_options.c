@@ -51,6 +51,26 @@ static int opt_same(const phgmg_ph_system *sys, const double *X, void (*set)(phg
   return same;
 }
 
+/* The run the tests train on (sin input, dt 0.1, OPT_STEPS steps) and its
+   snapshots of sys (NULL when the allocation or the simulation fails). */
+static double *opt_snapshots(const phgmg_ph_system *sys, phgmg_run *run) {
+  phgmg_gl3_opts go;
+  double *X = (double *)malloc(sizeof(double) * sys->N * (OPT_STEPS + 1));
+  memset(run, 0, sizeof *run);
+  run->u = msd_input_sin; run->dt = 0.1; run->nsteps = OPT_STEPS;
+  memset(&go, 0, sizeof go);
+  go.tol = 1e-10;
+  if (X && phgmg_simulate_inputs(sys, 1, run, &go, X, sys->N, NULL, NULL, NULL) != PHGMG_OK) { free(X); X = NULL; }
+  return X;
+}
+/* The nonlinear chain of 20 masses, banded. */
+static int opt_nl_build(msd_nonlinear *M) {
+  msd_nl_opts mo;
+  memset(&mo, 0, sizeof mo);
+  mo.n = 20; mo.storage = PHGMG_BANDED;
+  return msd_nonlinear_build(M, &mo);
+}
+
 static void set_pod(phgmg_reduce_opts *o, const phgmg_run *r) { (void)r; o->method = PHGMG_METHOD_GMG_POD; o->r = 8; o->dt = 0.1; }
 static void set_qm(phgmg_reduce_opts *o, const phgmg_run *r) { (void)r; o->method = PHGMG_METHOD_GMG_QM; o->r = 8; }
 static void set_qm_cv(phgmg_reduce_opts *o, const phgmg_run *r) { set_qm(o, r); o->lambda_auto = 2; }
@@ -67,25 +87,15 @@ static void set_qm_other(phgmg_reduce_opts *o, const phgmg_run *r) { set_qm(o, r
 TEST(test_reduce_opts_default_same_model) {
   msd_linear L;
   msd_nonlinear M;
-  msd_nl_opts mo;
-  phgmg_gl3_opts go;
   phgmg_run run;
   phgmg_reduce_opts d, z;
   double *X = NULL, *XN = NULL;
   CHECK(msd_linear_build(&L, 20, NULL, NULL, NULL, PHGMG_DENSE) == 0);
-  memset(&mo, 0, sizeof mo);
-  mo.n = 20; mo.storage = PHGMG_BANDED;
-  CHECK(msd_nonlinear_build(&M, &mo) == 0);
-  memset(&run, 0, sizeof run);
-  run.u = msd_input_sin; run.dt = 0.1; run.nsteps = OPT_STEPS;
-  memset(&go, 0, sizeof go);
-  go.tol = 1e-10;
-  X = (double *)malloc(sizeof(double) * L.sys.N * (OPT_STEPS + 1));
-  XN = (double *)malloc(sizeof(double) * M.sys.N * (OPT_STEPS + 1));
+  CHECK(opt_nl_build(&M) == 0);
+  X = opt_snapshots(&L.sys, &run);
+  XN = opt_snapshots(&M.sys, &run);
   CHECK(X && XN);
   if (X && XN) {
-    CHECK_RC(phgmg_simulate_inputs(&L.sys, 1, &run, &go, X, L.sys.N, NULL, NULL, NULL), PHGMG_OK);
-    CHECK_RC(phgmg_simulate_inputs(&M.sys, 1, &run, &go, XN, M.sys.N, NULL, NULL, NULL), PHGMG_OK);
     CHECK(opt_same(&L.sys, X, set_pod, &run));
     CHECK(opt_same(&L.sys, X, set_qm, &run));
     CHECK(opt_same(&L.sys, X, set_qm_cv, &run));
@@ -125,8 +135,6 @@ static void set_pod_former(phgmg_reduce_opts *o, const phgmg_run *r) { set_pod_e
 static void set_pod_both(phgmg_reduce_opts *o, const phgmg_run *r) { set_pod_ecsw(o, r); o->deim = 1; }
 TEST(test_reduce_opts_hyper_reduce_former_name) {
   msd_nonlinear M;
-  msd_nl_opts mo;
-  phgmg_gl3_opts go;
   phgmg_run run;
   phgmg_reduce_opts a, b;
   phgmg_reduced *red = NULL;
@@ -134,17 +142,10 @@ TEST(test_reduce_opts_hyper_reduce_former_name) {
   size_t la = 0, lb = 0, lc = 0;
   double ka, kb, kc;
   double *X;
-  memset(&mo, 0, sizeof mo);
-  mo.n = 20; mo.storage = PHGMG_BANDED;
-  CHECK(msd_nonlinear_build(&M, &mo) == 0);
-  memset(&run, 0, sizeof run);
-  run.u = msd_input_sin; run.dt = 0.1; run.nsteps = OPT_STEPS;
-  memset(&go, 0, sizeof go);
-  go.tol = 1e-10;
-  X = (double *)malloc(sizeof(double) * M.sys.N * (OPT_STEPS + 1));
+  CHECK(opt_nl_build(&M) == 0);
+  X = opt_snapshots(&M.sys, &run);
   CHECK(X != NULL);
   if (X) {
-    CHECK_RC(phgmg_simulate_inputs(&M.sys, 1, &run, &go, X, M.sys.N, NULL, NULL, NULL), PHGMG_OK);
     memset(&a, 0, sizeof a); set_pod_ecsw(&a, &run);
     memset(&b, 0, sizeof b); set_pod_former(&b, &run);
     ma = opt_model(&M.sys, X, &a, &la, &ka);
