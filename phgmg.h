@@ -174,8 +174,8 @@
    and against the closed forms above.
    Not for descriptor models (PHGMG_ERR_UNSUPPORTED): a GENERAL nonlinear part,
    the shifted_* callbacks, the linear-systems toolbox (BT, PRBT, Gramian
-   bases, phgmg_ph_abc) and studies. Singular E (algebraic constraints) is
-   not supported; nonlinear dissipation is the subject of 1.7. Feedthrough (phgmg_ph_system.P,
+   bases, phgmg_ph_abc) and studies. Singular E (algebraic constraints of
+   index one) is the subject of 1.8, nonlinear dissipation of 1.7. Feedthrough (phgmg_ph_system.P,
    S, Nskew: E x' = (J - R) z + (B - P) u, y = (B + P)^T z + (S + N) u) is
    taken by the full model -- validation of [[R, P], [P^T, S]] >= 0 and N
    skew (PHGMG_ERR_FEEDTHROUGH), the stepper, outputs, and the energy
@@ -269,6 +269,72 @@
    Cd against phgmg_reduced_W, sampled s rho(s) >= 0 and g^T f <= 0 of the
    reduced model, the reduced balance, the output error falling with r, and
    the codes of energy-generating dampers.
+
+   1.8 Algebraic constraints: singular E of index one (phgmg_dae_*)
+   Circuit and network tools write Kirchhoff constraints, finite-element
+   codes massless nodes, as equations without a time derivative: E has k
+   zero rows (the algebraic equations, row set a) and k zero columns (the
+   algebraic variables, column set c; often a = c). phgmg takes this form
+   (the kernel of E spanned by coordinates, in any ordering) and no other
+   singular E (PHGMG_ERR_E_SINGULAR). With d the other rows and columns,
+   E_dd nonsingular, L = J - R, G = B - P, F = B + P, z = Q x + grad H_nl:
+       E_dd x_d' = L_dd z_d + L_da z_a + G_d u,     (differential)
+             0   = L_ad z_d + L_aa z_a + G_a u,     (algebraic)
+       z_a = Q_ad x_d + Q_ac x_c.
+   E^T Q symmetric with E[:, c] = 0 forces Q_dc = 0 (the kept co-states do not
+   depend on x_c: checked, PHGMG_ERR_EQ_NOT_SYMMETRIC); a separable term or
+   a damper on an algebraic line is not supported. Index. The pencil
+   s E - L Q is regular of index one exactly when L_aa and Q_ac are
+   nonsingular (rcond > tol): then the algebraic equation fixes z_a, and z_a
+   fixes x_c. Otherwise phgmg evaluates det(s E - L Q) at two unrelated s:
+   nonzero at one of them means a regular pencil of index two or more
+   (PHGMG_ERR_INDEX: e.g. a massless undamped node, whose constraint acts on
+   positions), zero at both a singular pencil (PHGMG_ERR_PENCIL: the model
+   does not determine its solution).
+   Condensation. Eliminating z_a = -L_aa^{-1} (L_ad z_d + G_a u) gives a
+   port-Hamiltonian ODE in x_d with nonsingular E_dd, co-state z_d and
+       L' = L_dd - L_da L_aa^{-1} L_ad,   G' = G_d - L_da L_aa^{-1} G_a,
+       F' = F_d - L_ad^T L_aa^{-T} F_a,   (S + N)' = S + N - F_a^T L_aa^{-1} G_a,
+   read as J' = skew L', R' = -sym L', B' = (G' + F')/2, P' = (F' - G')/2,
+   S' = sym (S + N)', N' = skew (S + N)'. Why it is port-Hamiltonian: the
+   system matrix K = [[L, G], [-F^T, -(S + N)]] maps (z, u) to (E x', -y) and
+   has the symmetric part -[[R, P], [P^T, S]] <= 0; the condensed K' is its
+   Schur complement on the block L_aa, and for any w, with v = (w, z_a)
+   completed by the algebraic equation, K v = (K' w, 0), so w^T K' w =
+   v^T K v <= 0: the condensed dissipation block is positive semidefinite,
+   and at consistent states it dissipates exactly what the full one does.
+   The Hamiltonian H(x) = 1/2 x^T E^T Q x + ... does not depend on x_c
+   (E^T Q x_c-columns vanish), so H restricted to x_d is the condensed
+   model's energy and the outputs are the same. A port on an algebraic row
+   becomes feedthrough (a resistor between the port and the constraint:
+   S' > 0); a constraint away from the ports changes J and R only.
+   phgmg_dae_create builds the condensed model (dense or banded like the
+   input; the update is confined to the neighbours of the algebraic lines),
+   phgmg_dae_lift recovers the algebraic variables (x_c = Q_ac^{-1} (z_a -
+   Q_ad x_d)), phgmg_dae_restrict takes x_d.
+   Simulation (phgmg_simulate; the command line's simulate and reduce
+   --simulate): the scheme is Gauss-Legendre collocation of the DAE itself,
+   its stage equations enforce the constraints at the stages, and the
+   algebraic variables at t_{n+1} are taken from the constraints at
+   t_{n+1} (the collocation polynomial's end value of an algebraic variable
+   is not consistent: the Gauss methods' stability function is -1 at
+   infinity). That is the same as GL3 on the condensed ODE followed by the
+   lift, which is how it is computed: consistent states at every step (x0's
+   algebraic part is replaced by the consistent one), the discrete energy
+   balance of 1.7 (exact for a quadratic H: the lift changes only x_c, on
+   which H does not depend). Reduction: reduce the condensed model,
+   phgmg_dae_system(d), with snapshots restricted to x_d (phgmg_reduce of the
+   full model is PHGMG_ERR_UNSUPPORTED; the command line does this by
+   itself). The reduced model is a port-Hamiltonian ODE with the same
+   outputs; every method takes it (GMG needs B' of full rank: a port that
+   acts only through a constraint leaves B' = 0 there; SP1 and SP2 do not
+   need it). tests/test_dae.c checks each claim: the condensed matrices of a
+   three-state circuit against their closed forms, the simulation against
+   an independent collocation of the DAE (its 3N stage system with the
+   singular E solved directly), the constraints at every step, the energy
+   balance, dense = banded, the dissipation block's eigenvalues, the reduced
+   models' structure and balance, and the codes of index two, a singular
+   pencil, E singular in another form and Q_dc != 0.
 
    2. THE OFFLINE PIPELINE ------------------------------------------------------
    2.1 Simulate. phgmg_simulate (or a phgmg_gl3 object: _create / _step /
@@ -741,7 +807,8 @@
                                     grow in the energy norm (phgmg_reduce with
                                     opts.dt)
      PHGMG_ERR_E_SINGULAR (-28)     the mass matrix E is singular to working
-                                    precision (descriptor models, 1.6)
+                                    precision and not of the algebraic form
+                                    of 1.8 (k zero rows, k zero columns)
      PHGMG_ERR_EQ_NOT_SYMMETRIC (-29) E^T Q not symmetric (descriptor models)
      PHGMG_ERR_EQ_NOT_PD (-30)      E^T Q not positive definite (semidefinite
                                     with a nonlinear part)
@@ -754,6 +821,11 @@
                                     term or a negative coefficient, or a
                                     callback law with s rho(s) < 0 where it
                                     was evaluated (1.7)
+     PHGMG_ERR_PENCIL (-34)         singular E whose pencil s E - (J - R) Q is
+                                    singular for every s (1.8)
+     PHGMG_ERR_INDEX (-35)          singular E of index two or higher: the
+                                    algebraic co-states are not determined by
+                                    the algebraic equations (1.8)
    The declaration of each function lists the codes it returns and when.
 
 
@@ -902,7 +974,8 @@
    ph:     phgmg_ph_validate, phgmg_ph_hamiltonian, phgmg_ph_gradient,
            phgmg_ph_rhs, phgmg_ph_output, phgmg_ph_apply,
            phgmg_jr_factor_create, phgmg_jr_solve, phgmg_jr_factor_destroy,
-           phgmg_rcm, phgmg_ph_sparse_create, phgmg_ph_sparse_create_e,
+           phgmg_dae_create, phgmg_dae_system, phgmg_dae_nalg,
+           phgmg_dae_restrict, phgmg_dae_lift, phgmg_dae_destroy, phgmg_rcm, phgmg_ph_sparse_create, phgmg_ph_sparse_create_e,
            phgmg_ph_sparse_system,
            phgmg_ph_sparse_perm, phgmg_ph_sparse_sep_idx,
            phgmg_ph_sparse_to_banded_order, phgmg_ph_sparse_to_user_order,
@@ -937,7 +1010,7 @@
            phgmg_rom_load, phgmg_rom_export_c
    npy:    phgmg_npy_parse, phgmg_npy_serialize, phgmg_npy_free,
            phgmg_npy_read, phgmg_npy_write
-   (113 functions; also the macros PHGMG_ROM_STEPPER_MEMSIZE_MAX and _MAX_CB.)
+   (119 functions; also the macros PHGMG_ROM_STEPPER_MEMSIZE_MAX and _MAX_CB.)
 */
 #ifndef PHGMG_H_INCLUDED
 #define PHGMG_H_INCLUDED
@@ -1014,13 +1087,15 @@ extern "C" {
   X(PHGMG_ERR_EQ_NOT_PD,       -30, "E^T Q is not positive definite (semidefinite for a nonlinear H)") \
   X(PHGMG_ERR_E_COUPLED,       -31, "a row of E at a nonlinear coordinate is not a positive multiple of the unit row") \
   X(PHGMG_ERR_FEEDTHROUGH,     -32, "feedthrough: [[R, P], [P^T, S]] not symmetric positive semidefinite or N not skew") \
-  X(PHGMG_ERR_DAMPER,          -33, "a damper generates energy (s rho(s) < 0 for some s)")
+  X(PHGMG_ERR_DAMPER,          -33, "a damper generates energy (s rho(s) < 0 for some s)") \
+  X(PHGMG_ERR_PENCIL,          -34, "the pencil (E, (J - R) Q) is singular: the model does not determine its solution") \
+  X(PHGMG_ERR_INDEX,           -35, "the descriptor model has index two or higher (index one is supported)")
 
 typedef enum phgmg_result {
 #define PHGMG__X(name, val, str) name = val,
   PHGMG__RESULT_LIST(PHGMG__X)
 #undef PHGMG__X
-  PHGMG__RESULT_END_ = -34
+  PHGMG__RESULT_END_ = -36
 } phgmg_result;
 
 /* A stable, human-readable description of a result code (never NULL). */
@@ -1228,7 +1303,9 @@ typedef struct phgmg_ph_system {
   void (*shifted_solve)(double sr, double si, double *rhs, void *user);
   void *shifted_user;      /* `user` argument of the two callbacks above      */
   /* Descriptor form (NULL: E = I, the standard form above). With a mass
-     matrix E (N x N, the storage and kb of J, R, Q; nonsingular) the model is
+     matrix E (N x N, the storage and kb of J, R, Q; nonsingular, or with k
+     zero rows and k zero columns: algebraic constraints of index one, manual
+     1.8) the model is
          E x' = (J - R) z(x) + B u,   y = B^T z(x),   E^T z(x) = grad H(x),
      where the co-state z(x) = Q x + grad H_nl(x) is what phgmg_ph_gradient
      returns (phgmg_ph_rhs gives E x' = (J - R) z + B u) and the Hamiltonian is
@@ -1303,6 +1380,36 @@ typedef struct phgmg_ph_system {
    The system is never modified. */
 PHGMG_DEF phgmg_result phgmg_ph_validate(const phgmg_ph_system *sys, double tol,
                                          double *rcond_out, const phgmg_allocator *alloc);
+
+/* Index-one descriptor models (manual 1.8): E with k zero rows (algebraic
+   equations) and k zero columns (algebraic variables). phgmg_dae_create
+   checks the index (PHGMG_ERR_INDEX for index >= 2, PHGMG_ERR_PENCIL for a
+   singular pencil, PHGMG_ERR_E_SINGULAR when E is singular but not of this
+   form, PHGMG_ERR_EQ_NOT_SYMMETRIC when the kept co-states depend on the
+   algebraic variables, PHGMG_ERR_UNSUPPORTED for a separable coordinate or a
+   damper on an algebraic line or k > 8192) and builds the condensed model: a
+   port-Hamiltonian ODE in the n = N - k differential coordinates, with the
+   same outputs, Hamiltonian and dissipation (phgmg_dae_system; feedthrough P,
+   S, Nskew where a constraint touches a port), which it validates
+   (phgmg_ph_validate's codes). Validate the full model with
+   phgmg_ph_validate first (it runs this check too). With k = 0 the
+   condensed model is the model itself. phgmg_simulate takes index-one models
+   directly; to reduce one, reduce phgmg_dae_system(d) with snapshots
+   restricted by phgmg_dae_restrict. The object keeps pointers into sys
+   (the nonlinear part's functions and weights): sys must outlive it. */
+typedef struct phgmg_dae phgmg_dae;
+PHGMG_DEF phgmg_result phgmg_dae_create(phgmg_dae **out, const phgmg_ph_system *sys, double tol,
+                                        const phgmg_allocator *alloc);
+/* The condensed model (valid while d lives); k = phgmg_dae_nalg(d). */
+PHGMG_DEF const phgmg_ph_system *phgmg_dae_system(const phgmg_dae *d);
+PHGMG_DEF int phgmg_dae_nalg(const phgmg_dae *d);
+/* xi (n) = the differential coordinates of x (N), in their order in x. */
+PHGMG_DEF void phgmg_dae_restrict(const phgmg_dae *d, const double *x, double *xi);
+/* x (N) = the consistent state with differential part xi at input u (m; NULL
+   = 0): the algebraic variables solve the constraints. Uses d's scratch
+   memory: one thread per object. */
+PHGMG_DEF void phgmg_dae_lift(phgmg_dae *d, const double *xi, const double *u, double *x);
+PHGMG_DEF void phgmg_dae_destroy(phgmg_dae *d);
 
 /* Hamiltonian, its gradient and the output at a state. These evaluators do
    not take an allocator: where they need a scratch vector of N doubles
@@ -5546,6 +5653,9 @@ PHGMG__PRIV phgmg_result phgmg__etq_form(const phgmg_ph_system *sys, phgmg_ph_sy
   return PHGMG_OK;
 }
 
+PHGMG__PRIV int phgmg__e_algebraic(const phgmg_ph_system *s, const phgmg_allocator *alloc);
+PHGMG__PRIV phgmg_result phgmg__dae_validate(const phgmg_ph_system *sys, double tol, const phgmg_allocator *alloc);
+
 /* The descriptor checks of phgmg_ph_validate: E finite and nonsingular,
    E^T Q symmetric and positive (semi)definite, separable coordinates free of
    mass coupling. */
@@ -5556,6 +5666,9 @@ PHGMG__PRIV phgmg_result phgmg__ph_validate_e(const phgmg_ph_system *sys, double
   int k, j;
   phgmg_result rc;
   if (!phgmg__ph_mat_finite(sys, sys->E)) return PHGMG_ERR_NANINF;
+  k = phgmg__e_algebraic(sys, alloc);   /* zero rows or columns: index one? (1.8) */
+  if (k < 0) return PHGMG_ERR_NOMEM;
+  if (k > 0) return phgmg__dae_validate(sys, tol, alloc);
   rc = phgmg__etq_form(sys, &t, &buf, alloc);
   if (rc != PHGMG_OK) return rc;
   phgmg__ph_sym_defect(&t, t.Q, -1.0, &nrm, &def);
@@ -5665,8 +5778,11 @@ PHGMG__PRIV phgmg_result phgmg__damp_jr_factor(phgmg_jr_factor **f, const phgmg_
   return rc;
 }
 
-PHGMG_DEF phgmg_result phgmg_ph_validate(const phgmg_ph_system *sys, double tol,
-                                         double *rcond_out, const phgmg_allocator *alloc) {
+/* phgmg_ph_validate; check_rank = 0 skips the rank test of B (the condensed
+   model of an index-one model may have B' = 0 where a port acts through a
+   constraint only, 1.8). */
+PHGMG__PRIV phgmg_result phgmg__ph_validate(const phgmg_ph_system *sys, double tol, double *rcond_out,
+                                            const phgmg_allocator *alloc, int check_rank) {
   phgmg_result rc;
   double nrm, def;
   int N, m;
@@ -5709,7 +5825,7 @@ PHGMG_DEF phgmg_result phgmg_ph_validate(const phgmg_ph_system *sys, double tol,
     if (rc != PHGMG_OK) return rc;
   }
   /* B full column rank: pivoted QR, |R(m-1,m-1)| > tol |R(0,0)| */
-  {
+  if (check_rank) {
     double *Bc = phgmg__dalloc(alloc, (size_t)N * (size_t)m);
     double *tau = phgmg__dalloc(alloc, (size_t)m), *work = phgmg__dalloc(alloc, 2 * (size_t)m);
     int *jpvt = phgmg__ialloc(alloc, (size_t)m);
@@ -5740,6 +5856,563 @@ PHGMG_DEF phgmg_result phgmg_ph_validate(const phgmg_ph_system *sys, double tol,
     if (!(rcond > tol)) return PHGMG_ERR_SINGULAR;
   }
   return PHGMG_OK;
+}
+
+PHGMG_DEF phgmg_result phgmg_ph_validate(const phgmg_ph_system *sys, double tol,
+                                         double *rcond_out, const phgmg_allocator *alloc) {
+  return phgmg__ph_validate(sys, tol, rcond_out, alloc, 1);
+}
+
+/* >>dae (implementation) ================================================== */
+/* Index-one descriptor models (manual 1.8): E with k zero rows (the
+   algebraic equations, row set ra) and k zero columns (the algebraic
+   variables, column set ca); the rest (rows rn, columns cn) condensed into a
+   port-Hamiltonian ODE by eliminating the algebraic co-states z[ra]. */
+struct phgmg_dae {
+  phgmg_ph_system sys;          /* the condensed model (n = N - k states)           */
+  phgmg_allocator al;           /* a copy of the caller's allocator (or zeros)       */
+  int N, n, k, m;
+  int *rpos, *cpos;             /* N: position of row / column i in rn / cn, or -1   */
+  int *ra, *ca;                 /* k: the algebraic rows / columns                   */
+  int *sep_idx, *damp_i, *damp_j;
+  double *mats;                 /* J', R', Q', E' of the condensed model              */
+  double *Bc, *Pc, *Sc, *Nc;    /* B', P' (n x m), S', N' (m x m)                     */
+  double *L22, *Q22;            /* LU factors of L[ra, ra], Q[ra, ca] (k x k)          */
+  int *p22, *q22;
+  int nd, nq;                   /* lift: L[ra, dcol] (k x nd), Q[ra, qcol] (k x nq)    */
+  int *dcol, *qcol;             /* positions in rn / cn                               */
+  double *D, *Qa, *Ga;          /* and (B - P)[ra, :] (k x m)                          */
+  double *work;                 /* n + 2 k + m                                        */
+};
+
+#define PHGMG__DAE_KMAX 8192
+
+/* Row range [a, b] of the stored entries of column (or row) i. */
+PHGMG__PRIV void phgmg__ph_span(const phgmg_ph_system *s, int i, int *a, int *b) {
+  *a = s->storage == PHGMG_BANDED ? PHGMG__MAX(0, i - s->kb) : 0;
+  *b = s->storage == PHGMG_BANDED ? PHGMG__MIN(s->N - 1, i + s->kb) : s->N - 1;
+}
+
+/* Zero rows (zr[i] = 1) and zero columns (zc[j] = 1) of E, and their counts. */
+PHGMG__PRIV void phgmg__e_zero_lines(const phgmg_ph_system *s, int *zr, int *zc, int *kr, int *kc) {
+  int i, j, a, b;
+  for (i = 0; i < s->N; ++i) zr[i] = zc[i] = 1;
+  for (j = 0; j < s->N; ++j) {
+    phgmg__ph_span(s, j, &a, &b);
+    for (i = a; i <= b; ++i)
+      if (phgmg__ph_at(s, s->E, i, j) != 0.0) zr[i] = zc[j] = 0;
+  }
+  for (i = 0, *kr = *kc = 0; i < s->N; ++i) { *kr += zr[i]; *kc += zc[i]; }
+}
+
+/* 1 if E has a zero row or a zero column (an algebraic model), 0 if not,
+   -1 if the scratch memory cannot be had. */
+PHGMG__PRIV int phgmg__e_algebraic(const phgmg_ph_system *s, const phgmg_allocator *alloc) {
+  int *z, kr, kc;
+  if (!s->E) return 0;
+  z = phgmg__ialloc(alloc, 2 * (size_t)s->N);
+  if (!z) return -1;
+  phgmg__e_zero_lines(s, z, z + s->N, &kr, &kc);
+  phgmg__free(alloc, z);
+  return kr + kc > 0;
+}
+
+/* The index maps from the zero lines: rpos/cpos, ra/ca. PHGMG_ERR_E_SINGULAR
+   when the counts differ (the kernel of E is not spanned by coordinates). */
+PHGMG__PRIV phgmg_result phgmg__dae_split(phgmg_dae *d, const phgmg_ph_system *s) {
+  int *zr = d->rpos, *zc = d->cpos, kr, kc, i, a = 0, b = 0, c = 0, e = 0;
+  phgmg__e_zero_lines(s, zr, zc, &kr, &kc);
+  if (kr != kc) return PHGMG_ERR_E_SINGULAR;
+  if (kr > PHGMG__DAE_KMAX) return PHGMG_ERR_UNSUPPORTED;
+  d->k = kr; d->n = s->N - kr;
+  d->ra = phgmg__ialloc(&d->al, 2 * (size_t)kr);
+  if (!d->ra) return PHGMG_ERR_NOMEM;
+  d->ca = d->ra + kr;
+  for (i = 0; i < s->N; ++i) {
+    if (zr[i]) { d->ra[a++] = i; zr[i] = -1; } else zr[i] = b++;
+    if (zc[i]) { d->ca[c++] = i; zc[i] = -1; } else zc[i] = e++;
+  }
+  return PHGMG_OK;
+}
+
+PHGMG__PRIV double phgmg__ph_l(const phgmg_ph_system *s, int i, int j) {
+  return phgmg__ph_at(s, s->J, i, j) - phgmg__ph_at(s, s->R, i, j);
+}
+
+/* det(sigma E - (J - R) Q) for one sigma: its reciprocal condition number
+   (dense, or banded with half-bandwidth min(2 kb, N - 1)). */
+PHGMG__PRIV phgmg_result phgmg__pencil_rcond(const phgmg_ph_system *s, double sigma, double *rcond,
+                                             const phgmg_allocator *alloc) {
+  const int N = s->N, kb2 = s->storage == PHGMG_BANDED ? PHGMG__MIN(2 * s->kb, N - 1) : N - 1;
+  const size_t len = s->storage == PHGMG_BANDED ? (size_t)(2 * kb2 + 1) * (size_t)N : (size_t)N * (size_t)N;
+  double *M = phgmg__dalloc(alloc, len), *zero = phgmg__dalloc(alloc, len);
+  phgmg_ph_system t;
+  phgmg_jr_factor *f = NULL;
+  phgmg_result rc;
+  int i, j, l, a, b;
+  *rcond = 0.0;
+  if (!M || !zero) { phgmg__free(alloc, M); phgmg__free(alloc, zero); return PHGMG_ERR_NOMEM; }
+  memset(zero, 0, len * sizeof(double));
+  memset(M, 0, len * sizeof(double));
+  for (j = 0; j < N; ++j) {
+    const int i0 = PHGMG__MAX(0, j - kb2), i1 = PHGMG__MIN(N - 1, j + kb2);
+    for (i = i0; i <= i1; ++i) {
+      double acc = sigma * phgmg__ph_at(s, s->E, i, j);
+      phgmg__ph_span(s, i, &a, &b);
+      for (l = a; l <= b; ++l) acc -= phgmg__ph_l(s, i, l) * phgmg__ph_at(s, s->Q, l, j);
+      M[s->storage == PHGMG_BANDED ? PHGMG__PHB(kb2, i, j) : (size_t)i + (size_t)j * (size_t)N] = acc;
+    }
+  }
+  memset(&t, 0, sizeof t);
+  t.N = N; t.m = s->m; t.storage = s->storage; t.kb = kb2; t.B = s->B;
+  t.J = M; t.R = zero; t.Q = M;
+  rc = phgmg_jr_factor_create(&f, &t, rcond, alloc);
+  phgmg_jr_factor_destroy(f);
+  phgmg__free(alloc, M);
+  phgmg__free(alloc, zero);
+  if (rc != PHGMG_OK && rc != PHGMG_ERR_NOMEM) { *rcond = 0.0; rc = PHGMG_OK; }
+  return rc;
+}
+
+/* Why L[ra, ra] Q[ra, ca] is singular: a singular pencil (det(sigma E -
+   (J - R) Q) = 0 at two unrelated sigma) or a regular one of index >= 2. */
+PHGMG__PRIV phgmg_result phgmg__dae_classify(const phgmg_ph_system *s, double tol, const phgmg_allocator *alloc) {
+  double ne = 0.0, nl = 0.0, nq = 0.0, r1 = 0.0, r2 = 0.0;
+  int i, j, a, b;
+  phgmg_result rc;
+  for (j = 0; j < s->N; ++j) {
+    phgmg__ph_span(s, j, &a, &b);
+    for (i = a; i <= b; ++i) {
+      ne = PHGMG__MAX(ne, fabs(phgmg__ph_at(s, s->E, i, j)));
+      nl = PHGMG__MAX(nl, fabs(phgmg__ph_l(s, i, j)));
+      nq = PHGMG__MAX(nq, fabs(phgmg__ph_at(s, s->Q, i, j)));
+    }
+  }
+  rc = phgmg__pencil_rcond(s, 0.6180339887498949 * nl * nq / ne, &r1, alloc);
+  if (rc == PHGMG_OK) rc = phgmg__pencil_rcond(s, -1.7320508075688772 * nl * nq / ne, &r2, alloc);
+  if (rc != PHGMG_OK) return rc;
+  return r1 > tol || r2 > tol ? PHGMG_ERR_INDEX : PHGMG_ERR_PENCIL;
+}
+
+/* LU of the k x k block M[ra, cols] of L (cols = ra) or Q (cols = ca), and
+   whether it is regular (rcond > tol). */
+PHGMG__PRIV phgmg_result phgmg__dae_block(const phgmg_ph_system *s, const double *Mq, const int *ra,
+                                          const int *cols, int k, double *A, int *piv, double tol,
+                                          double *work, int *iwork) {
+  int i, j;
+  for (j = 0; j < k; ++j)
+    for (i = 0; i < k; ++i)
+      A[i + (size_t)j * k] = Mq ? phgmg__ph_at(s, Mq, ra[i], cols[j]) : phgmg__ph_l(s, ra[i], cols[j]);
+  {
+    const double an = phgmg_norm1(k, k, A, k);
+    if (phgmg_lu_factor(k, A, k, piv) != PHGMG_OK) return PHGMG_ERR_INDEX;
+    return phgmg_lu_rcond(k, A, k, piv, an, work, iwork) > tol ? PHGMG_OK : PHGMG_ERR_INDEX;
+  }
+}
+
+/* Index one: L[ra, ra] and Q[ra, ca] regular; else the pencil's class. */
+PHGMG__PRIV phgmg_result phgmg__dae_index(phgmg_dae *d, const phgmg_ph_system *s, double tol) {
+  const int k = d->k;
+  double *w = phgmg__dalloc(&d->al, 2 * (size_t)k);
+  int *iw = phgmg__ialloc(&d->al, (size_t)k);
+  phgmg_result rc = PHGMG_ERR_NOMEM;
+  d->L22 = phgmg__dalloc(&d->al, 2 * (size_t)k * (size_t)k);
+  d->p22 = phgmg__ialloc(&d->al, 2 * (size_t)k);
+  if (w && iw && d->L22 && d->p22) {
+    d->Q22 = d->L22 + (size_t)k * k;
+    d->q22 = d->p22 + k;
+    rc = phgmg__dae_block(s, NULL, d->ra, d->ra, k, d->L22, d->p22, tol, w, iw);
+    if (rc == PHGMG_OK) rc = phgmg__dae_block(s, s->Q, d->ra, d->ca, k, d->Q22, d->q22, tol, w, iw);
+    if (rc == PHGMG_ERR_INDEX) rc = phgmg__dae_classify(s, tol, &d->al);
+  }
+  phgmg__free(&d->al, w);
+  phgmg__free(&d->al, iw);
+  return rc;
+}
+
+/* The rows of L[rn, ra] and the columns of L[ra, rn] that hold entries: the
+   support of the elimination's update (original indices, ascending). */
+PHGMG__PRIV phgmg_result phgmg__dae_support(phgmg_dae *d, const phgmg_ph_system *s, int **ri, int *nri,
+                                            int **cj, int *ncj) {
+  int *mr = phgmg__ialloc(&d->al, 2 * (size_t)s->N), q, i, a, b;
+  *ri = *cj = NULL; *nri = *ncj = 0;
+  if (!mr) return PHGMG_ERR_NOMEM;
+  memset(mr, 0, 2 * (size_t)s->N * sizeof(int));
+  for (q = 0; q < d->k; ++q) {
+    phgmg__ph_span(s, d->ra[q], &a, &b);
+    for (i = a; i <= b; ++i) {
+      if (d->rpos[i] >= 0 && phgmg__ph_l(s, i, d->ra[q]) != 0.0) mr[i] = 1;
+      if (d->rpos[i] >= 0 && phgmg__ph_l(s, d->ra[q], i) != 0.0) mr[s->N + i] = 1;
+    }
+  }
+  for (i = 0; i < s->N; ++i) { *nri += mr[i]; *ncj += mr[s->N + i]; }
+  *ri = phgmg__ialloc(&d->al, (size_t)*nri + (size_t)*ncj + 1);
+  if (*ri) {
+    *cj = *ri + *nri;
+    for (i = 0, a = b = 0; i < s->N; ++i) {
+      if (mr[i]) (*ri)[a++] = i;
+      if (mr[s->N + i]) (*cj)[b++] = i;
+    }
+  }
+  phgmg__free(&d->al, mr);
+  return *ri ? PHGMG_OK : PHGMG_ERR_NOMEM;
+}
+
+/* The elimination of z[ra]: U = L[ri, ra] L22^{-1} L[ra, cj] (nri x ncj),
+   and the ports G' = G[rn] - L[rn, ra] L22^{-1} G[ra], F' = F[rn] - L[ra, rn]^T
+   L22^{-T} F[ra], (S + N)' = S + N - F[ra]^T L22^{-1} G[ra] (G = B - P,
+   F = B + P), into d->Bc (G'), d->Pc (F'), d->Sc ((S + N)'). Keeps
+   D = L[ra, cj] and Ga = G[ra] for the lift. */
+PHGMG__PRIV phgmg_result phgmg__dae_eliminate(phgmg_dae *d, const phgmg_ph_system *s, const int *ri, int nri,
+                                              const int *cj, int ncj, double **Uo) {
+  const int k = d->k, m = d->m, N = s->N, n = d->n;
+  double *C = phgmg__dalloc(&d->al, (size_t)nri * k + 1), *W = phgmg__dalloc(&d->al, (size_t)k * ncj + 1);
+  double *Fa = phgmg__dalloc(&d->al, 2 * (size_t)k * m), *U = phgmg__dalloc(&d->al, (size_t)nri * ncj + 1);
+  int i, j, q;
+  *Uo = U;
+  d->D = phgmg__dalloc(&d->al, (size_t)k * ncj + 1);
+  d->Ga = phgmg__dalloc(&d->al, (size_t)k * m);
+  if (!C || !W || !Fa || !U || !d->D || !d->Ga) {
+    phgmg__free(&d->al, C); phgmg__free(&d->al, W); phgmg__free(&d->al, Fa);
+    return PHGMG_ERR_NOMEM;
+  }
+  for (q = 0; q < k; ++q) {
+    for (i = 0; i < nri; ++i) C[i + (size_t)q * nri] = phgmg__ph_l(s, ri[i], d->ra[q]);
+    for (j = 0; j < ncj; ++j) d->D[q + (size_t)j * k] = phgmg__ph_l(s, d->ra[q], cj[j]);
+    for (j = 0; j < m; ++j) {
+      const double b = s->B[d->ra[q] + (size_t)j * N], p = s->P ? s->P[d->ra[q] + (size_t)j * N] : 0.0;
+      d->Ga[q + (size_t)j * k] = b - p;
+      Fa[q + (size_t)j * k] = b + p;
+    }
+  }
+  memcpy(W, d->D, (size_t)k * ncj * sizeof(double));
+  if (ncj) phgmg_lu_solve('N', k, d->L22, k, d->p22, ncj, W, k);
+  if (nri && ncj) phgmg_gemm('N', 'N', nri, ncj, k, 1.0, C, nri, W, k, 0.0, U, nri);
+  for (j = 0; j < m; ++j)   /* G'[rn] and F'[rn] before the update */
+    for (i = 0; i < N; ++i)
+      if (d->rpos[i] >= 0) {
+        const double b = s->B[i + (size_t)j * N], p = s->P ? s->P[i + (size_t)j * N] : 0.0;
+        d->Bc[d->rpos[i] + (size_t)j * n] = b - p;
+        d->Pc[d->rpos[i] + (size_t)j * n] = b + p;
+      }
+  memcpy(Fa + (size_t)k * m, d->Ga, (size_t)k * m * sizeof(double)); /* X1 = L22^{-1} Ga */
+  phgmg_lu_solve('N', k, d->L22, k, d->p22, m, Fa + (size_t)k * m, k);
+  for (j = 0; j < m; ++j) {
+    for (i = 0; i < nri; ++i) {
+      double acc = 0.0;
+      for (q = 0; q < k; ++q) acc += C[i + (size_t)q * nri] * Fa[(size_t)k * m + q + (size_t)j * k];
+      d->Bc[d->rpos[ri[i]] + (size_t)j * n] -= acc;
+    }
+    for (i = 0; i < m; ++i) {   /* (S + N)' = S + N - Fa^T X1 */
+      double acc = (s->S ? s->S[i + (size_t)j * m] : 0.0) + (s->Nskew ? s->Nskew[i + (size_t)j * m] : 0.0);
+      for (q = 0; q < k; ++q) acc -= Fa[q + (size_t)i * k] * Fa[(size_t)k * m + q + (size_t)j * k];
+      d->Sc[i + (size_t)j * m] = acc;
+    }
+  }
+  phgmg_lu_solve('T', k, d->L22, k, d->p22, m, Fa, k);   /* X2 = L22^{-T} Fa */
+  for (j = 0; j < m; ++j)
+    for (i = 0; i < ncj; ++i) {
+      double acc = 0.0;
+      for (q = 0; q < k; ++q) acc += d->D[q + (size_t)i * k] * Fa[q + (size_t)j * k];
+      d->Pc[d->rpos[cj[i]] + (size_t)j * n] -= acc;
+    }
+  phgmg__free(&d->al, C); phgmg__free(&d->al, W); phgmg__free(&d->al, Fa);
+  return PHGMG_OK;
+}
+
+/* G', F', (S + N)' into the pH ports: B' = (G' + F')/2, P' = (F' - G')/2,
+   S' and N' the symmetric and skew parts; a block that is exactly zero is
+   left out (NULL), so a constraint away from the ports adds no feedthrough. */
+PHGMG__PRIV void phgmg__dae_ports(phgmg_dae *d) {
+  const int n = d->n, m = d->m;
+  size_t i, len = (size_t)n * m;
+  int a, b, anyp = 0, anys = 0, anyn = 0;
+  for (i = 0; i < len; ++i) {
+    const double g = d->Bc[i], f = d->Pc[i];
+    d->Bc[i] = 0.5 * (g + f);
+    d->Pc[i] = 0.5 * (f - g);
+    anyp |= d->Pc[i] != 0.0;
+  }
+  for (b = 0; b < m; ++b)
+    for (a = 0; a <= b; ++a) {
+      const double x = d->Sc[a + (size_t)b * m], y = d->Sc[b + (size_t)a * m];
+      d->Sc[a + (size_t)b * m] = d->Sc[b + (size_t)a * m] = 0.5 * (x + y);
+      d->Nc[a + (size_t)b * m] = 0.5 * (x - y);
+      d->Nc[b + (size_t)a * m] = -0.5 * (x - y);
+      anys |= x + y != 0.0;
+      anyn |= x - y != 0.0;
+    }
+  d->sys.B = d->Bc;
+  d->sys.P = anyp ? d->Pc : NULL;
+  d->sys.S = anys ? d->Sc : NULL;
+  d->sys.Nskew = anyn ? d->Nc : NULL;
+}
+
+/* Half-bandwidth of the condensed matrices (banded storage). */
+PHGMG__PRIV int phgmg__dae_band(const phgmg_dae *d, const phgmg_ph_system *s, const int *ri, int nri, const int *cj,
+                                int ncj, const double *U) {
+  int kb = 0, i, j, a, b;
+  for (j = 0; j < s->N; ++j) {
+    phgmg__ph_span(s, j, &a, &b);
+    for (i = a; i <= b; ++i) {
+      const int ir = d->rpos[i];
+      if (ir < 0) continue;
+      if (d->rpos[j] >= 0 && phgmg__ph_l(s, i, j) != 0.0) kb = PHGMG__MAX(kb, abs(ir - d->rpos[j]));
+      if (d->cpos[j] >= 0 && (phgmg__ph_at(s, s->Q, i, j) != 0.0 || phgmg__ph_at(s, s->E, i, j) != 0.0))
+        kb = PHGMG__MAX(kb, abs(ir - d->cpos[j]));
+    }
+  }
+  for (j = 0; j < ncj; ++j)
+    for (i = 0; i < nri; ++i)
+      if (U[i + (size_t)j * nri] != 0.0) kb = PHGMG__MAX(kb, abs(d->rpos[ri[i]] - d->rpos[cj[j]]));
+  return PHGMG__MIN(kb, d->n - 1);
+}
+
+/* J', R', Q', E' of the condensed model: the kept blocks of J, R, Q, E and
+   J' = J - (U - U^T)/2, R' = R + (U + U^T)/2 (so J' - R' = L' = L - U). */
+PHGMG__PRIV phgmg_result phgmg__dae_assemble(phgmg_dae *d, const phgmg_ph_system *s, const int *ri, int nri,
+                                             const int *cj, int ncj, const double *U) {
+  const int n = d->n, kb = s->storage == PHGMG_BANDED ? phgmg__dae_band(d, s, ri, nri, cj, ncj, U) : n - 1;
+  const size_t len = s->storage == PHGMG_BANDED ? (size_t)(2 * kb + 1) * n : (size_t)n * n;
+  double *Jc, *Rc, *Qc, *Ec;
+  int i, j, a, b;
+#define PHGMG__DX(i, j) (s->storage == PHGMG_BANDED ? PHGMG__PHB(kb, i, j) : (size_t)(i) + (size_t)(j) * (size_t)n)
+  d->mats = phgmg__dalloc(&d->al, 4 * len);
+  if (!d->mats) return PHGMG_ERR_NOMEM;
+  memset(d->mats, 0, 4 * len * sizeof(double));
+  Jc = d->mats; Rc = Jc + len; Qc = Rc + len; Ec = Qc + len;
+  for (j = 0; j < s->N; ++j) {
+    phgmg__ph_span(s, j, &a, &b);
+    for (i = a; i <= b; ++i) {
+      const int ir = d->rpos[i], jr = d->rpos[j], jc = d->cpos[j];
+      if (ir < 0) continue;
+      if (jr >= 0) { Jc[PHGMG__DX(ir, jr)] = phgmg__ph_at(s, s->J, i, j); Rc[PHGMG__DX(ir, jr)] = phgmg__ph_at(s, s->R, i, j); }
+      if (jc >= 0) { Qc[PHGMG__DX(ir, jc)] = phgmg__ph_at(s, s->Q, i, j); Ec[PHGMG__DX(ir, jc)] = phgmg__ph_at(s, s->E, i, j); }
+    }
+  }
+  for (j = 0; j < ncj; ++j)
+    for (i = 0; i < nri; ++i) {
+      const double u = 0.5 * U[i + (size_t)j * nri];
+      const int p = d->rpos[ri[i]], q = d->rpos[cj[j]];
+      Jc[PHGMG__DX(p, q)] -= u; Jc[PHGMG__DX(q, p)] += u;
+      Rc[PHGMG__DX(p, q)] += u; Rc[PHGMG__DX(q, p)] += u;
+    }
+#undef PHGMG__DX
+  d->sys.storage = s->storage;
+  d->sys.kb = s->storage == PHGMG_BANDED ? kb : 0;
+  d->sys.J = Jc; d->sys.R = Rc; d->sys.Q = Qc; d->sys.E = Ec;
+  return PHGMG_OK;
+}
+
+/* Q[rn, ca] = 0 (E^T Q symmetric with E[:, ca] = 0 implies it: the kept
+   co-states do not depend on the algebraic variables), and Q[ra, cn] kept
+   for the lift. */
+PHGMG__PRIV phgmg_result phgmg__dae_qmaps(phgmg_dae *d, const phgmg_ph_system *s, double tol) {
+  const int k = d->k;
+  int *mark = phgmg__ialloc(&d->al, (size_t)s->N), i, j, q, a, b;
+  double qmax = 0.0, off = 0.0;
+  if (!mark) return PHGMG_ERR_NOMEM;
+  memset(mark, 0, (size_t)s->N * sizeof(int));
+  for (j = 0; j < s->N; ++j) {
+    phgmg__ph_span(s, j, &a, &b);
+    for (i = a; i <= b; ++i) {
+      const double v = fabs(phgmg__ph_at(s, s->Q, i, j));
+      qmax = PHGMG__MAX(qmax, v);
+      if (d->rpos[i] >= 0 && d->cpos[j] < 0) off = PHGMG__MAX(off, v);
+      if (d->rpos[i] < 0 && d->cpos[j] >= 0 && v != 0.0) mark[j] = 1;
+    }
+  }
+  if (off > tol * qmax) { phgmg__free(&d->al, mark); return PHGMG_ERR_EQ_NOT_SYMMETRIC; }
+  for (j = 0, d->nq = 0; j < s->N; ++j) d->nq += mark[j];
+  d->qcol = phgmg__ialloc(&d->al, (size_t)d->nq + 1);
+  d->Qa = phgmg__dalloc(&d->al, (size_t)k * d->nq + 1);
+  if (d->qcol && d->Qa)
+    for (j = 0, a = 0; j < s->N; ++j)
+      if (mark[j]) {
+        for (q = 0; q < k; ++q) d->Qa[q + (size_t)a * k] = phgmg__ph_at(s, s->Q, d->ra[q], j);
+        d->qcol[a++] = d->cpos[j];
+      }
+  phgmg__free(&d->al, mark);
+  return d->qcol && d->Qa ? PHGMG_OK : PHGMG_ERR_NOMEM;
+}
+
+/* The nonlinear part and the dampers in condensed coordinates: a separable
+   coordinate i must keep its row and column at one position (rpos = cpos),
+   a damper must act on kept co-states (PHGMG_ERR_UNSUPPORTED otherwise). */
+PHGMG__PRIV phgmg_result phgmg__dae_nonlinear(phgmg_dae *d, const phgmg_ph_system *s) {
+  int t;
+  if (s->nl == PHGMG_NL_SEPARABLE && s->nsep > 0) {
+    d->sep_idx = phgmg__ialloc(&d->al, (size_t)s->nsep);
+    if (!d->sep_idx) return PHGMG_ERR_NOMEM;
+    for (t = 0; t < s->nsep; ++t) {
+      const int i = s->sep_idx[t];
+      if (d->cpos[i] < 0 || d->rpos[i] != d->cpos[i]) return PHGMG_ERR_UNSUPPORTED;
+      d->sep_idx[t] = d->cpos[i];
+    }
+    d->sys.sep_idx = d->sep_idx;
+  }
+  if (s->ndamp > 0) {
+    d->damp_i = phgmg__ialloc(&d->al, 2 * (size_t)s->ndamp);
+    if (!d->damp_i) return PHGMG_ERR_NOMEM;
+    d->damp_j = d->damp_i + s->ndamp;
+    for (t = 0; t < s->ndamp; ++t) {
+      const int i = s->damp_i[t], j = s->damp_j ? s->damp_j[t] : -1;
+      if (d->rpos[i] < 0 || (j >= 0 && d->rpos[j] < 0)) return PHGMG_ERR_UNSUPPORTED;
+      d->damp_i[t] = d->rpos[i];
+      d->damp_j[t] = j >= 0 ? d->rpos[j] : -1;
+    }
+    d->sys.damp_i = d->damp_i;
+    d->sys.damp_j = d->damp_j;
+  }
+  return PHGMG_OK;
+}
+
+/* The condensation proper, after the split and the index check. */
+PHGMG__PRIV phgmg_result phgmg__dae_condense(phgmg_dae *d, const phgmg_ph_system *s, double tol) {
+  int *ri = NULL, *cj = NULL, nri = 0, ncj = 0, i;
+  double *U = NULL;
+  phgmg_result rc;
+  const size_t nm = (size_t)d->n * d->m, mm = (size_t)d->m * d->m;
+  d->Bc = phgmg__dalloc(&d->al, 2 * nm + 2 * mm);
+  if (!d->Bc) return PHGMG_ERR_NOMEM;
+  d->Pc = d->Bc + nm; d->Sc = d->Pc + nm; d->Nc = d->Sc + mm;
+  rc = phgmg__dae_qmaps(d, s, tol);
+  if (rc == PHGMG_OK) rc = phgmg__dae_support(d, s, &ri, &nri, &cj, &ncj);
+  if (rc == PHGMG_OK) rc = phgmg__dae_eliminate(d, s, ri, nri, cj, ncj, &U);
+  if (rc == PHGMG_OK) rc = phgmg__dae_assemble(d, s, ri, nri, cj, ncj, U);
+  if (rc == PHGMG_OK) {
+    phgmg__dae_ports(d);
+    d->nd = ncj;
+    d->dcol = phgmg__ialloc(&d->al, (size_t)ncj + 1);
+    if (!d->dcol) rc = PHGMG_ERR_NOMEM;
+    for (i = 0; rc == PHGMG_OK && i < ncj; ++i) d->dcol[i] = d->rpos[cj[i]];
+  }
+  phgmg__free(&d->al, ri);
+  phgmg__free(&d->al, U);
+  return rc;
+}
+
+PHGMG_DEF void phgmg_dae_destroy(phgmg_dae *d) {
+  phgmg_allocator al;
+  if (!d) return;
+  al = d->al;
+  phgmg__free(&al, d->rpos); phgmg__free(&al, d->ra); phgmg__free(&al, d->sep_idx);
+  phgmg__free(&al, d->damp_i); phgmg__free(&al, d->mats); phgmg__free(&al, d->Bc);
+  phgmg__free(&al, d->L22); phgmg__free(&al, d->p22); phgmg__free(&al, d->dcol);
+  phgmg__free(&al, d->qcol); phgmg__free(&al, d->D); phgmg__free(&al, d->Qa);
+  phgmg__free(&al, d->Ga); phgmg__free(&al, d->work);
+  phgmg__free(&al, d);
+}
+
+PHGMG_DEF phgmg_result phgmg_dae_create(phgmg_dae **out, const phgmg_ph_system *sys, double tol,
+                                        const phgmg_allocator *alloc) {
+  phgmg_dae *d;
+  phgmg_result rc;
+  if (!out) return PHGMG_ERR_INVALID_ARG;
+  *out = NULL;
+  rc = phgmg__ph_check(sys);
+  if (rc != PHGMG_OK) return rc;
+  if (!sys->E) return PHGMG_ERR_INVALID_ARG;
+  if (!(tol > 0.0)) tol = 1e-12;
+  if (!phgmg__ph_mat_finite(sys, sys->E) || !phgmg__ph_mat_finite(sys, sys->J) ||
+      !phgmg__ph_mat_finite(sys, sys->R) || !phgmg__ph_mat_finite(sys, sys->Q) ||
+      !phgmg__all_finite(sys->B, (size_t)sys->N * (size_t)sys->m))
+    return PHGMG_ERR_NANINF;
+  d = PHGMG__CAST(phgmg_dae *, phgmg__alloc(alloc, sizeof *d));
+  if (!d) return PHGMG_ERR_NOMEM;
+  memset(d, 0, sizeof *d);
+  if (alloc) d->al = *alloc;
+  d->N = sys->N; d->m = sys->m;
+  d->sys = *sys;
+  d->sys.sparse = NULL;
+  d->rpos = phgmg__ialloc(&d->al, 2 * (size_t)sys->N);
+  rc = d->rpos ? PHGMG_OK : PHGMG_ERR_NOMEM;
+  if (rc == PHGMG_OK) { d->cpos = d->rpos + sys->N; rc = phgmg__dae_split(d, sys); }
+  if (rc == PHGMG_OK && d->k > 0) {
+    d->sys.N = d->n;
+    rc = d->n > 0 && d->m <= d->n ? phgmg__dae_index(d, sys, tol) : PHGMG_ERR_SIZE;
+    if (rc == PHGMG_OK) rc = phgmg__dae_condense(d, sys, tol);
+    if (rc == PHGMG_OK) rc = phgmg__dae_nonlinear(d, sys);
+  }
+  if (rc == PHGMG_OK) rc = phgmg__ph_validate(&d->sys, tol, NULL, &d->al, d->k == 0);
+  if (rc == PHGMG_OK) {
+    d->work = phgmg__dalloc(&d->al, (size_t)d->n + 2 * (size_t)d->k + (size_t)d->m + 1);
+    if (!d->work) rc = PHGMG_ERR_NOMEM;
+  }
+  if (rc != PHGMG_OK) { phgmg_dae_destroy(d); return rc; }
+  *out = d;
+  return PHGMG_OK;
+}
+
+PHGMG_DEF const phgmg_ph_system *phgmg_dae_system(const phgmg_dae *d) { return d ? &d->sys : NULL; }
+PHGMG_DEF int phgmg_dae_nalg(const phgmg_dae *d) { return d ? d->k : 0; }
+
+PHGMG_DEF void phgmg_dae_restrict(const phgmg_dae *d, const double *x, double *xi) {
+  int i;
+  for (i = 0; i < d->N; ++i)
+    if (d->cpos[i] >= 0) xi[d->cpos[i]] = x[i];
+}
+
+PHGMG_DEF void phgmg_dae_lift(phgmg_dae *d, const double *xi, const double *u, double *x) {
+  const int n = d->n, k = d->k, m = d->m;
+  double *z = d->work, *t = z + n, *r = t + k;
+  int i, q;
+  for (i = 0; i < d->N; ++i)
+    if (d->cpos[i] >= 0) x[i] = xi[d->cpos[i]];
+  if (k == 0) return;
+  phgmg__ph_grad(&d->sys, xi, z, NULL);
+  for (q = 0; q < k; ++q) {   /* t = L[ra, rn] z1 + G[ra] u */
+    double acc = 0.0;
+    for (i = 0; i < d->nd; ++i) acc += d->D[q + (size_t)i * k] * z[d->dcol[i]];
+    for (i = 0; u && i < m; ++i) acc += d->Ga[q + (size_t)i * k] * u[i];
+    t[q] = acc;
+  }
+  phgmg_lu_solve('N', k, d->L22, k, d->p22, 1, t, k);   /* z2 = -t */
+  for (q = 0; q < k; ++q) {
+    double acc = -t[q];
+    for (i = 0; i < d->nq; ++i) acc -= d->Qa[q + (size_t)i * k] * xi[d->qcol[i]];
+    r[q] = acc;
+  }
+  phgmg_lu_solve('N', k, d->Q22, k, d->q22, 1, r, k);
+  for (q = 0; q < k; ++q) x[d->ca[q]] = r[q];
+}
+
+/* phgmg_ph_validate of a model with algebraic rows or columns of E. */
+PHGMG__PRIV phgmg_result phgmg__dae_validate(const phgmg_ph_system *sys, double tol, const phgmg_allocator *alloc) {
+  phgmg_dae *d = NULL;
+  phgmg_result rc = phgmg_dae_create(&d, sys, tol, alloc);
+  phgmg_dae_destroy(d);
+  return rc;
+}
+
+/* phgmg_simulate of an index-one model: the condensed model from the
+   differential part of x0, its states lifted with u(t_n). */
+PHGMG__PRIV phgmg_result phgmg__simulate_dae(const phgmg_ph_system *sys, const double *x0, double t0, double dt,
+                                             int nsteps, phgmg_input_fn uf, void *uuser,
+                                             const phgmg_gl3_opts *opts, double *X, double *Y,
+                                             const phgmg_energy *energy, phgmg_gl3_stats *stats,
+                                             int *steps_done, const phgmg_allocator *alloc) {
+  phgmg_dae *d = NULL;
+  double *xi = NULL, *u = NULL;
+  int done = 0, j;
+  phgmg_result rc = phgmg_dae_create(&d, sys, 0.0, alloc);
+  if (rc != PHGMG_OK) return rc;
+  xi = phgmg__dalloc(alloc, (size_t)d->n * (X ? (size_t)nsteps + 1 : 1));
+  u = phgmg__dalloc(alloc, (size_t)d->m);
+  if (!xi || !u) rc = PHGMG_ERR_NOMEM;
+  if (rc == PHGMG_OK) {
+    phgmg_dae_restrict(d, x0, xi);
+    rc = phgmg_simulate(&d->sys, xi, t0, dt, nsteps, uf, uuser, opts, X ? xi : NULL, Y, energy, stats, &done, alloc);
+    for (j = 0; X && j <= done && j <= nsteps; ++j) {
+      if (uf) uf(t0 + (double)j * dt, u, uuser);
+      phgmg_dae_lift(d, xi + (size_t)j * d->n, uf ? u : NULL, X + (size_t)j * d->N);
+    }
+  }
+  if (steps_done) *steps_done = done;
+  phgmg__free(alloc, xi);
+  phgmg__free(alloc, u);
+  phgmg_dae_destroy(d);
+  return rc;
 }
 
 /* >>sparse (implementation) ============================================== */
@@ -8264,6 +8937,7 @@ PHGMG_DEF phgmg_result phgmg_gl3_create(phgmg_gl3 **out, const phgmg_ph_system *
   rc = phgmg__ph_check(sys);
   if (rc != PHGMG_OK) return rc;
   if (!(dt > 0.0) || dt == HUGE_VAL) return PHGMG_ERR_INVALID_ARG;
+  if (sys->E && phgmg__e_algebraic(sys, alloc) != 0) return PHGMG_ERR_UNSUPPORTED;   /* step the condensed model (1.8) */
   if (opts && (opts->max_iter < 0 || opts->tol < 0.0 || opts->contraction < 0.0 ||
                opts->tol != opts->tol || opts->contraction != opts->contraction))
     return PHGMG_ERR_INVALID_ARG;
@@ -9208,6 +9882,8 @@ PHGMG_DEF phgmg_result phgmg_simulate(const phgmg_ph_system *sys, const double *
   if (stats) memset(stats, 0, sizeof *stats);
   if (!sys || !x0 || nsteps < 0) return PHGMG_ERR_INVALID_ARG;
   if (energy && (!energy->H || !energy->S || !energy->D)) return PHGMG_ERR_INVALID_ARG;
+  if (sys->E && phgmg__e_algebraic(sys, alloc) != 0)   /* index one (1.8), or no memory */
+    return phgmg__simulate_dae(sys, x0, t0, dt, nsteps, uf, uuser, opts, X, Y, energy, stats, steps_done, alloc);
   rc = phgmg_gl3_create(&s, sys, dt, opts, alloc);
   if (rc != PHGMG_OK) return rc;
   rc = phgmg__simulate_on(s, sys, x0, t0, dt, nsteps, uf, uuser, X, Y, energy, stats, steps_done, alloc);
@@ -14527,6 +15203,8 @@ PHGMG__PRIV phgmg_result phgmg__reduce_run(phgmg_reduced **out, const phgmg_ph_s
   rc = phgmg__reduce_check(sys, X, ldx, ns, c.o, st != NULL);
   if (rc == PHGMG_OK) c.sf = (c.o->ref || sys->ndamp) ? 0 : phgmg__study_fast(st, c.o, sys->m);
   if (rc == PHGMG_OK) rc = phgmg_ph_validate(sys, 0.0, &c.inf.rcond_jr, alloc);
+  if (rc == PHGMG_OK && sys->E && phgmg__e_algebraic(sys, alloc) != 0)   /* reduce the condensed model (1.8) */
+    rc = PHGMG_ERR_UNSUPPORTED;
   if (rc != PHGMG_OK) {
     if (info) *info = c.inf;
     return rc;

@@ -267,10 +267,13 @@ TEST(test_descriptor_bad_input) {
   memcpy(E2, b.E, sizeof(double) * (size_t)N * N);
   for (i = 0; i < N * N; ++i) if (i % N >= b.n && i / N >= b.n) E2[i] = -E2[i];
   CHECK_RC(phgmg_ph_validate(&s, 0.0, NULL, NULL), PHGMG_ERR_EQ_NOT_PD);
-  /* singular E (E^T Q semidefinite is allowed with a nonlinear part) */
+  /* singular E without zero rows or columns (E^T Q semidefinite is allowed
+     with a nonlinear part; a zero row and column would be an index-one model,
+     tests/test_dae.c): the last two masses' block c [[1, 1], [1, 1]] */
   s = dbar_system(&b, 1);
   memcpy(E2, b.E, sizeof(double) * (size_t)N * N);
-  for (i = 0; i < N; ++i) E2[N - 1 + (size_t)i * N] = E2[i + (size_t)(N - 1) * N] = 0.0;
+  for (i = 0; i < N; ++i) E2[N - 1 + (size_t)i * N] = E2[i + (size_t)(N - 1) * N] = E2[N - 2 + (size_t)i * N] = E2[i + (size_t)(N - 2) * N] = 0.0;
+  E2[N - 2 + (size_t)(N - 2) * N] = E2[N - 1 + (size_t)(N - 2) * N] = E2[N - 2 + (size_t)(N - 1) * N] = E2[N - 1 + (size_t)(N - 1) * N] = 0.01;
   s.E = E2;
   CHECK_RC(phgmg_ph_validate(&s, 0.0, NULL, NULL), PHGMG_ERR_E_SINGULAR);
   /* a separable term on a mass-coupled coordinate */

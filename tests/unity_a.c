@@ -11,6 +11,7 @@
 #define _POSIX_C_SOURCE 200809L /* test_defects, test_npy */
 #include "test_api_structs.c"
 #include "test_core.c"
+#include "test_dae.c"
 #include "test_defects.c"
 #include "test_defects3.c"
 #include "test_deploy.c"
