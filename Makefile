@@ -17,7 +17,7 @@ LDLIBS   = -lm
 TESTSRC := $(wildcard tests/test_*.c)
 BUILD    = build
 
-.PHONY: docs-check test-hello test-build test-validate test-deploy all test test-plain test-asan compile-checks test-embedded-host test-npy test-cli test-demo test-fuzz-replay demo bench examples embedded fuzz clean
+.PHONY: check-descriptor docs-check test-hello test-build test-validate test-deploy all test test-plain test-asan compile-checks test-embedded-host test-npy test-cli test-demo test-fuzz-replay demo bench examples embedded fuzz clean
 
 all: phgmg.h examples
 
@@ -168,6 +168,12 @@ $(BUILD)/phgmg: examples/phgmg_cli.c phgmg.h
 test-cli: $(BUILD)/phgmg
 	sh tests/test_cli.sh $(BUILD)/phgmg
 	sh tests/test_simulate.sh $(BUILD)/phgmg
+	/usr/bin/python3 tests/check_dae_bar.py $(BUILD)/phgmg 100 $(BUILD)/dae_bar
+
+# The descriptor bar (N = 800, consistent mass, feedthrough, scrambled order)
+# and its index-one variant through the command line against SciPy.
+check-descriptor: $(BUILD)/phgmg
+	/usr/bin/python3 tests/check_dae_bar.py $(BUILD)/phgmg 400 $(BUILD)/dae_bar400
 
 $(BUILD)/%: examples/%.c phgmg.h $(EXHDRS)
 	@mkdir -p $(BUILD)

@@ -975,7 +975,8 @@
            phgmg_ph_rhs, phgmg_ph_output, phgmg_ph_apply,
            phgmg_jr_factor_create, phgmg_jr_solve, phgmg_jr_factor_destroy,
            phgmg_dae_create, phgmg_dae_system, phgmg_dae_nalg,
-           phgmg_dae_restrict, phgmg_dae_lift, phgmg_dae_destroy, phgmg_rcm, phgmg_ph_sparse_create, phgmg_ph_sparse_create_e,
+           phgmg_dae_restrict, phgmg_dae_embed, phgmg_dae_lift,
+           phgmg_dae_destroy, phgmg_rcm, phgmg_ph_sparse_create, phgmg_ph_sparse_create_e,
            phgmg_ph_sparse_system,
            phgmg_ph_sparse_perm, phgmg_ph_sparse_sep_idx,
            phgmg_ph_sparse_to_banded_order, phgmg_ph_sparse_to_user_order,
@@ -1010,7 +1011,7 @@
            phgmg_rom_load, phgmg_rom_export_c
    npy:    phgmg_npy_parse, phgmg_npy_serialize, phgmg_npy_free,
            phgmg_npy_read, phgmg_npy_write
-   (119 functions; also the macros PHGMG_ROM_STEPPER_MEMSIZE_MAX and _MAX_CB.)
+   (120 functions; also the macros PHGMG_ROM_STEPPER_MEMSIZE_MAX and _MAX_CB.)
 */
 #ifndef PHGMG_H_INCLUDED
 #define PHGMG_H_INCLUDED
@@ -1405,6 +1406,9 @@ PHGMG_DEF const phgmg_ph_system *phgmg_dae_system(const phgmg_dae *d);
 PHGMG_DEF int phgmg_dae_nalg(const phgmg_dae *d);
 /* xi (n) = the differential coordinates of x (N), in their order in x. */
 PHGMG_DEF void phgmg_dae_restrict(const phgmg_dae *d, const double *x, double *xi);
+/* x (N) = xi at the differential coordinates, 0 at the algebraic ones (for
+   a basis, whose algebraic rows follow from the constraints). */
+PHGMG_DEF void phgmg_dae_embed(const phgmg_dae *d, const double *xi, double *x);
 /* x (N) = the consistent state with differential part xi at input u (m; NULL
    = 0): the algebraic variables solve the constraints. Uses d's scratch
    memory: one thread per object. */
@@ -6351,6 +6355,11 @@ PHGMG_DEF void phgmg_dae_restrict(const phgmg_dae *d, const double *x, double *x
   int i;
   for (i = 0; i < d->N; ++i)
     if (d->cpos[i] >= 0) xi[d->cpos[i]] = x[i];
+}
+
+PHGMG_DEF void phgmg_dae_embed(const phgmg_dae *d, const double *xi, double *x) {
+  int i;
+  for (i = 0; i < d->N; ++i) x[i] = d->cpos[i] >= 0 ? xi[d->cpos[i]] : 0.0;
 }
 
 PHGMG_DEF void phgmg_dae_lift(phgmg_dae *d, const double *xi, const double *u, double *x) {

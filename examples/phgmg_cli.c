@@ -72,7 +72,7 @@ static const char *const help_lines[] = {
   "  --J-coo SPEC, --R-coo SPEC, --Q-coo SPEC   instead of --J, --R, --Q: sparse\n",
   "                      matrices as coordinate triplets (all three together; N from\n",
   "                      --B); see SPARSE MATRICES.\n",
-  "  --E FILE, --E-coo SPEC   a mass matrix (N x N, nonsingular; dense with --J,\n",
+  "  --E FILE, --E-coo SPEC   a mass matrix (N x N; dense with --J,\n",
   "                      coordinate triplets with --J-coo): the descriptor model\n",
   "                      E x' = (J - R) z + B u, y = B^T z, z = Q x (+ the nonlinear\n",
   "                      gradient), energy H = x^T E^T Q x / 2 (+ sum E_kk phi_k).\n",
@@ -80,6 +80,15 @@ static const char *const help_lines[] = {
   "                      --poly), and rows of E at --poly-idx coordinates unit rows\n",
   "                      times E_kk > 0. Methods gmg-pod, gmg-qm, sp1, sp2 (the\n",
   "                      reduced model is an ordinary pH model: simulate-rom, export).\n",
+  "                      Algebraic constraints: k zero rows and k zero columns of E\n",
+  "                      (equations without a derivative, e.g. a massless node or a\n",
+  "                      Kirchhoff law) are taken when they determine their variables\n",
+  "                      (index one; index two or more, or a singular pencil, is an\n",
+  "                      error naming the files): the model is condensed to its\n",
+  "                      differential states (a port on a constraint becomes\n",
+  "                      feedthrough), simulated with consistent states and reduced;\n",
+  "                      written states are full (basis rows of the algebraic\n",
+  "                      variables zero).\n",
   "  --P FILE, --S FILE, --N FILE   feedthrough (N x m, m x m, m x m; each optional):\n",
   "                      E x' = (J - R) z + (B - P) u, y = (B + P)^T z + (S + N) u, with\n",
   "                      [[R, P], [P^T, S]] symmetric positive semidefinite and N skew.\n",
@@ -1539,7 +1548,12 @@ typedef struct reduce_state {
   mat Xs[16];             /* --X files 2..16 (the first is X) */
   double *Xcat;           /* several --X: their columns one after the other */
   cli_input xinp[16];     /* --X-input: the input of each --X run */
-  phgmg_ph_system sys;    /* the full model as reduced (internal ordering for sparse input) */
+  phgmg_ph_system sys;    /* the model as reduced (internal ordering for sparse input; an
+                             index-one model's condensed ODE) */
+  phgmg_ph_system full;   /* the full model (= sys unless E has algebraic lines) */
+  phgmg_dae *dae;         /* an index-one model's condensation, else NULL */
+  const double *Xgiven;   /* --X of an index-one model: the given states (internal order) */
+  double *Xres;           /* ... and their differential part */
   phgmg_reduced *red;
   int method;
   const double *Xd;       /* --X: the snapshots (internal ordering), ns columns */
@@ -1647,6 +1661,7 @@ static void reduce_cleanup(reduce_state *S) {
   free(S->idx); free(S->fpoly); free(S->fexp); free(S->Xsim); free(S->Ysim); free(S->V0);
   cli_csc_free(&S->cJ); cli_csc_free(&S->cR); cli_csc_free(&S->cQ); cli_csc_free(&S->cE);
   phgmg_ph_sparse_destroy(S->sp); free(S->Xperm); free(S->Uord);
+  phgmg_dae_destroy(S->dae); free(S->Xres);
   phgmg_reduced_destroy(S->red);
   stage_abort(&S->sg); /* after a failure: no output of this run stays */
   g_inputs = NULL;
@@ -1745,9 +1760,35 @@ static int load_sparse_system(const reduce_args *A, reduce_state *S, phgmg_ph_sy
   return 0;
 }
 
+/* An index-one model's n x cols array in the full coordinates (N x cols, into
+   *buf): snapshots as consistent states (lifted with the runs' inputs, or
+   the given --X states), bases with zero rows at the algebraic variables
+   (they follow from the constraints, not from the basis). */
+static const double *full_rows(reduce_state *S, const double *M, int cols, int lift, double **buf) {
+  const int N = S->full.N, n = S->sys.N;
+  double *u = NULL;
+  int j, r = 0, j0 = 0;
+  if (lift && S->Xgiven) return S->Xgiven;
+  *buf = (double *)calloc((size_t)N * (size_t)cols + 1, sizeof(double));
+  u = (double *)calloc((size_t)S->sys.m, sizeof(double));
+  if (!*buf || !u) { free(u); return NULL; }
+  for (j = 0; j < cols; ++j) {
+    double *x = *buf + (size_t)j * N;
+    if (lift) {   /* column j of run r: t = (j - j0) dt */
+      while (r + 1 < S->nrun && j - j0 > S->runs[r].nsteps) { j0 += S->runs[r].nsteps + 1; ++r; }
+      if (S->runs[r].u) S->runs[r].u((j - j0) * S->runs[r].dt, u, S->runs[r].user);
+      phgmg_dae_lift(S->dae, M + (size_t)j * n, u, x);
+    } else {
+      phgmg_dae_embed(S->dae, M + (size_t)j * n, x);
+    }
+  }
+  free(u);
+  return *buf;
+}
+
 /* write_field of an N x cols full-dimension array, in the user's ordering. */
-static int write_user_field(const reduce_args *A, reduce_state *S, const char *field, const double *M, int cols,
-                            outlist *ol) {
+static int write_user_field_full(const reduce_args *A, reduce_state *S, const char *field, const double *M, int cols,
+                                 outlist *ol) {
   const int N = S->sp ? phgmg_ph_sparse_system(S->sp)->N : 0;
   if (!S->sp) return write_field(A->out, A->name, field, M, S->J.rows, cols, ol, &S->sg);
   free(S->Uord);
@@ -1755,6 +1796,19 @@ static int write_user_field(const reduce_args *A, reduce_state *S, const char *f
   if (!S->Uord) return fail("out of memory");
   phgmg_ph_sparse_to_user_order(S->sp, cols, M, N, S->Uord, N);
   return write_field(A->out, A->name, field, S->Uord, N, cols, ol, &S->sg);
+}
+
+static int write_user_field(const reduce_args *A, reduce_state *S, const char *field, const double *M, int cols,
+                            outlist *ol) {
+  double *ex = NULL;
+  if (S->dae) {
+    int st;
+    if (!(M = full_rows(S, M, cols, !strcmp(field, "snapshots"), &ex))) { free(ex); return fail("out of memory"); }
+    st = write_user_field_full(A, S, field, M, cols, ol);
+    free(ex);
+    return st;
+  }
+  return write_user_field_full(A, S, field, M, cols, ol);
 }
 
 /* The first steps of each --X run must follow from its first snapshot and
@@ -1814,6 +1868,8 @@ static int load_snapshot_files(const reduce_args *A, reduce_state *S, int N, int
   double *X;
   size_t col = 0;
   int k, ns = 0;
+  const int n = N;   /* the states reduced: an index-one model's differential part */
+  N = S->dae ? S->full.N : N;
   for (k = 0; k < A->nx; ++k) {
     mat *F = k ? &S->Xs[k] : &S->X;
     if (mat_load(F, "--X", A->xs[k])) return 1;
@@ -1839,6 +1895,14 @@ static int load_snapshot_files(const reduce_args *A, reduce_state *S, int N, int
     phgmg_ph_sparse_to_banded_order(S->sp, ns, X, N, S->Xperm, N);
     X = S->Xperm;
   }
+  if (S->dae) {   /* the given states are kept for --save-snapshots */
+    S->Xgiven = X;
+    S->Xres = (double *)malloc(sizeof(double) * (size_t)n * (size_t)ns + 1);
+    if (!S->Xres) return fail("out of memory");
+    for (k = 0; k < ns; ++k) phgmg_dae_restrict(S->dae, X + (size_t)k * N, S->Xres + (size_t)k * n);
+    X = S->Xres;
+  }
+  N = n;
   /* Run boundaries: with the inputs known (--X-input) every use (--lambda auto
      simulates the runs from their first snapshot); without, only the folds of
      --lambda cv (a run with an unknown input must not be simulated as u = 0). */
@@ -1956,6 +2020,7 @@ static int load_dampers(const reduce_args *A, reduce_state *S, phgmg_ph_system *
 
 /* The full model from the files: dense or sparse J, R, Q, B and the nonlinear
    part, checked (phgmg_ph_validate), into S->sys. */
+static int condense_algebraic(reduce_state *S);
 static int load_system(const reduce_args *A, reduce_state *S) {
   phgmg_ph_system sys;
   phgmg_result rc;
@@ -2046,8 +2111,13 @@ static int load_system(const reduce_args *A, reduce_state *S) {
       case PHGMG_ERR_EQ_NOT_SYMMETRIC:
       case PHGMG_ERR_EQ_NOT_PD: return fail("%s, %s (--E, --Q): %s", ef, qf, phgmg_result_string(rc));
       case PHGMG_ERR_E_COUPLED: return fail("%s, %s (--E, --poly-idx): %s", ef, A->poly_idx, phgmg_result_string(rc));
-      case PHGMG_ERR_UNSUPPORTED: return fail("%s (--E): %s (a descriptor model takes a separable nonlinear part only)", ef,
-                                              phgmg_result_string(rc));
+      case PHGMG_ERR_UNSUPPORTED: return fail("%s (--E): %s (a descriptor model takes a separable nonlinear part only; "
+                                              "with algebraic lines of E, none on them)", ef, phgmg_result_string(rc));
+      case PHGMG_ERR_INDEX:
+      case PHGMG_ERR_PENCIL:
+        return fail("%s, %s, %s, %s (--E, --J, --R, --Q): %s: the zero rows and columns of E are algebraic "
+                    "equations and variables, and the equations must determine the variables (index one)", ef,
+                    A->J ? A->J : A->Jcoo, A->R ? A->R : A->Rcoo, qf, phgmg_result_string(rc));
       default: break;
     }
   }
@@ -2056,7 +2126,25 @@ static int load_system(const reduce_args *A, reduce_state *S) {
                 phgmg_result_string(rc), rc == PHGMG_ERR_SINGULAR ? " (J - R singular)" : "");
   if (rc != PHGMG_OK) return explain_validate(rc, &S->J, &S->R, &S->B, &S->Q, rcond);
   progress("system: N = %d, m = %d, valid port-Hamiltonian (rcond(J - R) = %.3g)", N, m, rcond);
-  S->sys = sys;
+  S->sys = S->full = sys;
+  return sys.E ? condense_algebraic(S) : 0;
+}
+
+/* An index-one model (E with zero rows and columns): S->sys becomes its
+   condensed ODE in the differential coordinates, which is what is simulated
+   for training and reduced; states written out are lifted back. */
+static int condense_algebraic(reduce_state *S) {
+  phgmg_result rc = phgmg_dae_create(&S->dae, &S->full, 0.0, NULL);
+  if (rc != PHGMG_OK) return fail("the algebraic part of the descriptor model: %s", phgmg_result_string(rc));
+  if (phgmg_dae_nalg(S->dae) == 0) {
+    phgmg_dae_destroy(S->dae);
+    S->dae = NULL;
+    return 0;
+  }
+  S->sys = *phgmg_dae_system(S->dae);
+  progress("algebraic constraints: %d zero rows and columns of E (index one); condensed to N = %d differential "
+           "states%s", phgmg_dae_nalg(S->dae), S->sys.N,
+           S->sys.P || S->sys.S ? " with feedthrough (a port on a constraint)" : "");
 
   return 0;
 }
@@ -2863,8 +2951,8 @@ static int cmd_simulate(int argc, char **argv) {
   memset(&S, 0, sizeof S);
   status = 1;
   if (load_system(&A, &S)) goto out;
-  N = S.sys.N;
-  m = S.sys.m;
+  N = S.full.N;   /* an index-one model: phgmg_simulate gives consistent full states */
+  m = S.full.m;
   if (too_big(((double)m + (states ? 2.0 * (double)N : 0.0)) * ((double)A.steps + 1.0),
               "--steps: the outputs (m x (steps+1), states N x (steps+1))")) {
     status = 2;
@@ -2883,7 +2971,7 @@ static int cmd_simulate(int argc, char **argv) {
   S.in.report = 1;
   S.in.t_end = A.steps * A.dt;
   S.in.wall0 = S.in.wall_last = t0 = now_s();
-  rc = phgmg_simulate(&S.sys, x0, 0.0, A.dt, A.steps, input_fn, &S.in, &go, X, Y, NULL, &st, &done, NULL);
+  rc = phgmg_simulate(&S.full, x0, 0.0, A.dt, A.steps, input_fn, &S.in, &go, X, Y, NULL, &st, &done, NULL);
   S.in.report = 0;
   if (rc != PHGMG_OK) {
     fail("full-order simulation failed at step %d of %d (t = %g): %s%s", done + 1, A.steps, done * A.dt,
