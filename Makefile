@@ -155,7 +155,7 @@ compile-checks: phgmg.h
 	  clang -std=c99 $(WARN) -Wdouble-promotion -DPHGMG_REAL_FLOAT -fsyntax-only $(BUILD)/cc/impl.c; fi
 	@echo "compile checks passed"
 
-EXAMPLES = $(BUILD)/hello $(BUILD)/msd_linear $(BUILD)/msd_nonlinear $(BUILD)/morse_chain $(BUILD)/phgmg $(BUILD)/linear_bases $(BUILD)/fe_bar $(BUILD)/transport_line
+EXAMPLES = $(BUILD)/hello $(BUILD)/msd_linear $(BUILD)/msd_nonlinear $(BUILD)/morse_chain $(BUILD)/phgmg $(BUILD)/linear_bases $(BUILD)/fe_bar $(BUILD)/transport_line $(BUILD)/circuit_dae $(BUILD)/damped_chain
 EXHDRS   = examples/msd_models.h examples/morse_models.h examples/demo_common.h examples/svgplot.h
 
 examples: $(EXAMPLES)
@@ -189,10 +189,12 @@ demo: $(EXAMPLES)
 	./$(BUILD)/msd_linear --generalization 8,12,16 --out results && \
 	./$(BUILD)/morse_chain --out results && ./$(BUILD)/linear_bases --out results && \
 	./$(BUILD)/fe_bar --n 200 --out results && ./$(BUILD)/transport_line --rmax 12 --out results && \
+	./$(BUILD)/circuit_dae --out results && ./$(BUILD)/damped_chain --out results && \
 	end=$$(date +%s.%N) && awk -v a=$$start -v b=$$end 'BEGIN { printf "make demo: total wall time %.2f s\n", b - a }' && \
 	/usr/bin/python3 tests/check_claims.py results && /usr/bin/python3 tests/check_morse.py results && \
 	/usr/bin/python3 tests/check_linear.py results && /usr/bin/python3 tests/check_fe_bar.py results && \
-	/usr/bin/python3 tests/check_transport.py results
+	/usr/bin/python3 tests/check_transport.py results && /usr/bin/python3 tests/check_circuit.py results && \
+	/usr/bin/python3 tests/check_damped.py results
 
 # Short fuzzing run of every reader of outside data (.npy in memory and
 # streamed from a file and a pipe, binary model files) and of the CLI's
