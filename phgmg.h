@@ -11048,6 +11048,29 @@ PHGMG_DEF phgmg_result phgmg_rom_step(phgmg_rom_stepper *s, phgmg_real *x, const
 #ifndef PHGMG_NO_OFFLINE
 /* >>reduce (implementation): the reduced object =========================== */
 
+/* The methods, described once: what the pipeline and the checks ask of a
+   method is read from this table (a new method is a row here and its stage
+   functions). */
+typedef struct phgmg__method_row {
+  int by_reduce;     /* built by phgmg_reduce (PRBT: by phgmg_prbt, >>linear)         */
+  int gmg;           /* GMG reduction: phi = [B, V1] x (+ V2 eta), W from G = (J - R)^-1 */
+  int quadratic;     /* a manifold term: reduced model of kind QUADRATIC              */
+  int test_w;        /* a stored test basis W (point reduction xr = W^T x)           */
+  int extras;        /* takes feedthrough and dampers (linear maps, manual 1.6, 1.7) */
+} phgmg__method_row;
+static const phgmg__method_row phgmg__methods[PHGMG_METHOD_COUNT] = {
+  {0, 0, 0, 0, 0},   /* 0: not a method */
+  {1, 1, 0, 0, 1},   /* GMG_POD      */
+  {1, 1, 1, 0, 0},   /* GMG_QM       */
+  {1, 0, 0, 1, 1},   /* SP1          */
+  {1, 0, 0, 1, 1},   /* SP2          */
+  {1, 1, 1, 0, 0},   /* GMG_MANIFOLD */
+  {0, 0, 0, 1, 0},   /* PRBT         */
+};
+PHGMG__PRIV const phgmg__method_row *phgmg__method(int method) {
+  return phgmg__methods + (method > 0 && method < (int)PHGMG_METHOD_COUNT ? method : 0);
+}
+
 /* A small owner list: every array of a phgmg_reduced is allocated through it,
    so destroy (and every error path) frees exactly what was allocated. */
 #define PHGMG__MAXBUF 56
@@ -12475,7 +12498,7 @@ done:
 PHGMG__PRIV void phgmg__restrict_block(const phgmg_reduced *red, int ns, const double *X, int ldx, double *XR) {
   const int N = red->N, m = red->m, r = red->r;
   int i, j, k;
-  if (red->method == PHGMG_METHOD_SP1 || red->method == PHGMG_METHOD_SP2 || red->method == PHGMG_METHOD_PRBT) {
+  if (phgmg__method(red->method)->test_w) {
     phgmg_gemm('T', 'N', r, ns, N, 1.0, red->W, N, X, ldx, 0.0, XR, r);
     for (k = 0; red->xbr && k < ns; ++k) phgmg__axpy(r, -1.0, red->xbr, XR + (size_t)k * r);
     return;
@@ -12980,9 +13003,7 @@ PHGMG__PRIV phgmg_result phgmg__reduce_descriptor_setup(phgmg__rctx *c) {
   return phgmg__all_finite(c->Bp_own, (size_t)N * m) ? PHGMG_OK : PHGMG_ERR_NANINF;
 }
 
-PHGMG__PRIV int phgmg__is_gmg(int method) {
-  return method == PHGMG_METHOD_GMG_POD || method == PHGMG_METHOD_GMG_QM || method == PHGMG_METHOD_GMG_MANIFOLD;
-}
+PHGMG__PRIV int phgmg__is_gmg(int method) { return phgmg__method(method)->gmg; }
 
 /* The deployment options (runs, validation, manifold). */
 #define PHGMG__NVAL_MAX 67 /* training runs + 3 probes */
@@ -13038,7 +13059,7 @@ PHGMG__PRIV phgmg_result phgmg__reduce_check(const phgmg_ph_system *sys, const d
                                              const phgmg_reduce_opts *o, int X_checked) {
   const int N = sys->N, m = sys->m, r = o->r;
   if (N < 1 || m < 1 || ns < 1 || ldx < N) return PHGMG_ERR_SIZE;
-  if (o->method < PHGMG_METHOD_GMG_POD || o->method > PHGMG_METHOD_GMG_MANIFOLD) return PHGMG_ERR_INVALID_ARG;
+  if (!phgmg__method(o->method)->by_reduce) return PHGMG_ERR_INVALID_ARG;
   if (phgmg__is_gmg(o->method)) {
     if (r <= m || r > N) return PHGMG_ERR_SIZE;
   } else if (r < 1 || r > N || r > ns) {
@@ -13050,8 +13071,7 @@ PHGMG__PRIV phgmg_result phgmg__reduce_check(const phgmg_ph_system *sys, const d
   if ((int)o->hyper < 0 || (int)o->hyper >= (int)PHGMG_HYPER_COUNT) return PHGMG_ERR_INVALID_ARG;
   if (!(o->hyper_tol >= 0.0 && o->hyper_tol < 1.0)) return PHGMG_ERR_INVALID_ARG;
   if (o->hyper_reduce && sys->nl == PHGMG_NL_GENERAL) return PHGMG_ERR_UNSUPPORTED;
-  if ((sys->P || sys->S || sys->Nskew || sys->ndamp) && o->method != PHGMG_METHOD_GMG_POD && o->method != PHGMG_METHOD_SP1 &&
-      o->method != PHGMG_METHOD_SP2)
+  if ((sys->P || sys->S || sys->Nskew || sys->ndamp) && !phgmg__method(o->method)->extras)
     return PHGMG_ERR_UNSUPPORTED;   /* dampers, feedthrough: linear maps only (manual 1.6, 1.7) */
   if ((sys->P || sys->S || sys->Nskew || sys->ndamp) && o->ref != PHGMG_REF_NONE)
     return PHGMG_ERR_UNSUPPORTED;   /* a reference state with dampers or feedthrough: not derived */
@@ -13092,8 +13112,7 @@ PHGMG__PRIV phgmg_result phgmg__reduce_new(phgmg__rctx *c) {
   c->red = red;
   if (c->alloc) { red->alloc = *c->alloc; red->use_alloc = 1; }
   red->N = c->sys->N; red->m = c->sys->m; red->r = o->r; red->method = o->method; red->sys = c->sys;
-  red->kind = (o->method == PHGMG_METHOD_GMG_QM || o->method == PHGMG_METHOD_GMG_MANIFOLD)
-                  ? PHGMG_ROM_QUADRATIC : PHGMG_ROM_LINEAR;
+  red->kind = phgmg__method(o->method)->quadratic ? PHGMG_ROM_QUADRATIC : PHGMG_ROM_LINEAR;
   red->p = phgmg__is_gmg(o->method) ? o->r - red->m : o->r;
   if (red->kind == PHGMG_ROM_QUADRATIC) {
     c->wide = o->method == PHGMG_METHOD_GMG_QM &&
@@ -15286,7 +15305,7 @@ PHGMG_DEF void phgmg_reduced_lift(const phgmg_reduced *red, const double *xr, do
 
 PHGMG_DEF void phgmg_reduced_restrict(const phgmg_reduced *red, const double *x, double *xr) {
   const int N = red->N, m = red->m, r = red->r;
-  if (red->method == PHGMG_METHOD_SP1 || red->method == PHGMG_METHOD_SP2 || red->method == PHGMG_METHOD_PRBT) {
+  if (phgmg__method(red->method)->test_w) {
     phgmg_gemv('T', N, r, 1.0, red->W, N, x, 0.0, xr);
   } else {
     /* [B, V1]^+ x = [RB^{-1} QB^T x; V1^T x]  (V1 is orthogonal to B) */
@@ -15330,7 +15349,7 @@ PHGMG_DEF phgmg_result phgmg_reduced_W(const phgmg_reduced *red, const double *x
   double *D, *GtD, *E, *Einv;
   phgmg_result rc;
   int j;
-  if (red->method == PHGMG_METHOD_SP1 || red->method == PHGMG_METHOD_SP2 || red->method == PHGMG_METHOD_PRBT) {
+  if (phgmg__method(red->method)->test_w) {
     for (j = 0; j < r; ++j) memcpy(W + (size_t)j * ldw, red->W + (size_t)j * N, (size_t)N * sizeof(double));
     return PHGMG_OK;
   }
