@@ -15212,6 +15212,73 @@ PHGMG__PRIV int phgmg__study_fast(const phgmg_study *st, const phgmg_reduce_opts
   return 0;
 }
 
+/* Building one reduced model: the pipeline's stages in the paper's order
+   (basis -> manifold -> GMG blocks -> Hamiltonian terms -> stepper), then
+   the object published for use. */
+PHGMG__PRIV phgmg_result phgmg__reduce_build(phgmg__rctx *c) {
+  const phgmg_reduce_opts *opts = c->o;
+  const phgmg_ph_system *sys = c->sys;
+  phgmg_result rc = phgmg__reduce_new(c);
+  if (rc == PHGMG_OK && c->sf) { c->red->study = c->st; c->red->sbasis = c->sf; }
+  if (rc == PHGMG_OK) { phgmg__progress(opts, "basis"); rc = phgmg__stage_reference(c); }
+  if (rc == PHGMG_OK) rc = phgmg__stage_basis(c);
+  if (rc == PHGMG_OK) { phgmg__progress(opts, "manifold"); rc = phgmg__stage_manifold(c); }
+  if (rc == PHGMG_OK) {
+    phgmg__progress(opts, "blocks");
+    rc = phgmg__is_gmg(opts->method) ? phgmg__stage_gmg_blocks(c) : phgmg__stage_sp_blocks(c);
+  }
+  if (rc == PHGMG_OK) { phgmg__progress(opts, "hamiltonian"); rc = phgmg__stage_quadratic_terms(c); }
+  if (rc == PHGMG_OK) rc = phgmg__stage_reference_terms(c);
+  if (rc == PHGMG_OK) { phgmg__progress(opts, "hyper-reduction"); rc = phgmg__stage_separable_terms(c); }
+  if (rc == PHGMG_OK) { phgmg__progress(opts, "finish"); rc = phgmg__stage_general_term(c); }
+  if (rc == PHGMG_OK && opts->dt > 0.0 && c->red->kind == PHGMG_ROM_LINEAR && c->red->nd == 0 &&
+      sys->nl != PHGMG_NL_GENERAL && c->red->ndamp == 0 && !c->red->PD) {
+    c->red->map_dt = opts->dt;
+    rc = phgmg__step_map(c->red, opts->dt, c->alloc);
+  }
+  return rc == PHGMG_OK ? phgmg__publish(c->red) : rc;
+}
+
+/* Selecting among the models the options allow, after one was built: the
+   validated lambda of GMG-QM (each candidate's M refitted on the built
+   blocks and simulated; >>deploy), the online bounds of the chosen model, and
+   the fallback to GMG-POD when no candidate is safe (c->fallback_pod, acted
+   on by the caller). */
+PHGMG__PRIV phgmg_result phgmg__reduce_select(phgmg__rctx *c) {
+  phgmg_result rc = phgmg__stage_lambda_validate(c);
+  if (rc == PHGMG_OK) rc = phgmg__stage_envelope(c);
+  if (rc == PHGMG_OK) c->inf.online_callbacks = c->red->rom.phi_cb || c->red->rom.eta_cb || c->red->rom.ham_cb;
+  return rc;
+}
+
+/* The options resolved and checked, the model validated, the context set. */
+PHGMG__PRIV phgmg_result phgmg__reduce_setup(phgmg__rctx *c, const phgmg_ph_system *sys, const double *X, int ldx,
+                                             int ns, const phgmg_reduce_opts *opts, const phgmg_allocator *alloc,
+                                             phgmg_study *st) {
+  phgmg_result rc;
+  memset(c, 0, sizeof *c);
+  c->ro = *opts;
+  phgmg__reduce_opts_resolve(&c->ro, ns);
+  c->sys = sys; c->o = &c->ro; c->X = X; c->ldx = ldx; c->ns = ns; c->alloc = alloc; c->gsel = -1;
+  c->Xf = X; c->ldxf = ldx;
+  c->st = st;
+  c->inf.hyper_method = -1;
+  rc = phgmg__reduce_check(sys, X, ldx, ns, c->o, st != NULL);
+  if (rc == PHGMG_OK) c->sf = (c->o->ref || sys->ndamp) ? 0 : phgmg__study_fast(st, c->o, sys->m);
+  if (rc == PHGMG_OK) rc = phgmg_ph_validate(sys, 0.0, &c->inf.rcond_jr, alloc);
+  if (rc == PHGMG_OK && sys->E && phgmg__e_algebraic(sys, alloc) != 0)   /* reduce the condensed model (1.8) */
+    rc = PHGMG_ERR_UNSUPPORTED;
+  if (rc != PHGMG_OK) return rc;
+  c->lambda = c->o->lambda < 0.0 ? 0.0 : c->o->lambda;   /* < 0: exactly zero */
+  if (c->o->lambda_auto && c->o->method == PHGMG_METHOD_GMG_QM)
+    c->ng = phgmg__lambda_grid(c->o->lambda_min, c->o->lambda_max, c->o->lambda_per_decade, NULL);
+  c->degtol = c->o->degeneracy_tol;
+  c->rfloor = phgmg__rank_floor(sys->N, ns, X, ldx);
+  rc = phgmg__runs_layout(c);
+  return rc == PHGMG_OK ? phgmg__reduce_descriptor_setup(c) : rc;
+}
+
+/* phgmg_reduce: set up, build one model, select (lambda, fallback). */
 PHGMG__PRIV phgmg_result phgmg__reduce_run(phgmg_reduced **out, const phgmg_ph_system *sys, const double *X,
                                            int ldx, int ns, const phgmg_reduce_opts *opts,
                                            phgmg_reduce_info *info, const phgmg_allocator *alloc,
@@ -15221,52 +15288,9 @@ PHGMG__PRIV phgmg_result phgmg__reduce_run(phgmg_reduced **out, const phgmg_ph_s
   if (!out) return PHGMG_ERR_INVALID_ARG;
   *out = NULL;
   if (!sys || !X || !opts) return PHGMG_ERR_INVALID_ARG;
-  memset(&c, 0, sizeof c);
-  c.ro = *opts;
-  phgmg__reduce_opts_resolve(&c.ro, ns);
-  c.sys = sys; c.o = &c.ro; c.X = X; c.ldx = ldx; c.ns = ns; c.alloc = alloc; c.gsel = -1;
-  c.Xf = X; c.ldxf = ldx;
-  c.st = st;
-  c.inf.hyper_method = -1;
-  rc = phgmg__reduce_check(sys, X, ldx, ns, c.o, st != NULL);
-  if (rc == PHGMG_OK) c.sf = (c.o->ref || sys->ndamp) ? 0 : phgmg__study_fast(st, c.o, sys->m);
-  if (rc == PHGMG_OK) rc = phgmg_ph_validate(sys, 0.0, &c.inf.rcond_jr, alloc);
-  if (rc == PHGMG_OK && sys->E && phgmg__e_algebraic(sys, alloc) != 0)   /* reduce the condensed model (1.8) */
-    rc = PHGMG_ERR_UNSUPPORTED;
-  if (rc != PHGMG_OK) {
-    if (info) *info = c.inf;
-    return rc;
-  }
-  c.lambda = c.o->lambda < 0.0 ? 0.0 : c.o->lambda;   /* < 0: exactly zero */
-  if (c.o->lambda_auto && c.o->method == PHGMG_METHOD_GMG_QM)
-    c.ng = phgmg__lambda_grid(c.o->lambda_min, c.o->lambda_max, c.o->lambda_per_decade, NULL);
-  c.degtol = c.o->degeneracy_tol;
-  c.rfloor = phgmg__rank_floor(sys->N, ns, X, ldx);
-  rc = phgmg__runs_layout(&c);
-  if (rc == PHGMG_OK) rc = phgmg__reduce_descriptor_setup(&c);
-  if (rc == PHGMG_OK) rc = phgmg__reduce_new(&c);
-  if (rc == PHGMG_OK && c.sf) { c.red->study = st; c.red->sbasis = c.sf; }
-  if (rc == PHGMG_OK) { phgmg__progress(opts, "basis"); rc = phgmg__stage_reference(&c); }
-  if (rc == PHGMG_OK) rc = phgmg__stage_basis(&c);
-  if (rc == PHGMG_OK) { phgmg__progress(opts, "manifold"); rc = phgmg__stage_manifold(&c); }
-  if (rc == PHGMG_OK) {
-    phgmg__progress(opts, "blocks");
-    rc = phgmg__is_gmg(opts->method) ? phgmg__stage_gmg_blocks(&c) : phgmg__stage_sp_blocks(&c);
-  }
-  if (rc == PHGMG_OK) { phgmg__progress(opts, "hamiltonian"); rc = phgmg__stage_quadratic_terms(&c); }
-  if (rc == PHGMG_OK) rc = phgmg__stage_reference_terms(&c);
-  if (rc == PHGMG_OK) { phgmg__progress(opts, "hyper-reduction"); rc = phgmg__stage_separable_terms(&c); }
-  if (rc == PHGMG_OK) { phgmg__progress(opts, "finish"); rc = phgmg__stage_general_term(&c); }
-  if (rc == PHGMG_OK && opts->dt > 0.0 && c.red->kind == PHGMG_ROM_LINEAR && c.red->nd == 0 &&
-      sys->nl != PHGMG_NL_GENERAL && c.red->ndamp == 0 && !c.red->PD) {
-    c.red->map_dt = opts->dt;
-    rc = phgmg__step_map(c.red, opts->dt, alloc);
-  }
-  if (rc == PHGMG_OK) rc = phgmg__publish(c.red);
-  if (rc == PHGMG_OK) rc = phgmg__stage_lambda_validate(&c);
-  if (rc == PHGMG_OK) rc = phgmg__stage_envelope(&c);
-  if (rc == PHGMG_OK)
-    c.inf.online_callbacks = c.red->rom.phi_cb || c.red->rom.eta_cb || c.red->rom.ham_cb;
+  rc = phgmg__reduce_setup(&c, sys, X, ldx, ns, opts, alloc, st);
+  if (rc == PHGMG_OK) rc = phgmg__reduce_build(&c);
+  if (rc == PHGMG_OK) rc = phgmg__reduce_select(&c);
   phgmg__rctx_free(&c);
   if (rc == PHGMG_OK && c.fallback_pod) return phgmg__reduce_fallback_pod(out, &c, info);
   if (info) *info = c.inf;
