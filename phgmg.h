@@ -1394,9 +1394,11 @@ PHGMG_DEF phgmg_result phgmg_ph_validate(const phgmg_ph_system *sys, double tol,
    S, Nskew where a constraint touches a port), which it validates
    (phgmg_ph_validate's codes). Validate the full model with
    phgmg_ph_validate first (it runs this check too). With k = 0 the
-   condensed model is the model itself. phgmg_simulate takes index-one models
-   directly; to reduce one, reduce phgmg_dae_system(d) with snapshots
-   restricted by phgmg_dae_restrict. The object keeps pointers into sys
+   condensed model is the model itself. phgmg_simulate and
+   phgmg_simulate_run take index-one models directly (consistent states);
+   the stepper object (phgmg_gl3_create), phgmg_simulate_inputs and
+   phgmg_reduce return PHGMG_ERR_UNSUPPORTED for them: give them
+   phgmg_dae_system(d), with snapshots restricted by phgmg_dae_restrict. The object keeps pointers into sys
    (the nonlinear part's functions and weights): sys must outlive it. */
 typedef struct phgmg_dae phgmg_dae;
 PHGMG_DEF phgmg_result phgmg_dae_create(phgmg_dae **out, const phgmg_ph_system *sys, double tol,
