@@ -1388,7 +1388,8 @@ PHGMG_DEF phgmg_result phgmg_ph_validate(const phgmg_ph_system *sys, double tol,
    singular pencil, PHGMG_ERR_E_SINGULAR when E is singular but not of this
    form, PHGMG_ERR_EQ_NOT_SYMMETRIC when the kept co-states depend on the
    algebraic variables, PHGMG_ERR_UNSUPPORTED for a separable coordinate or a
-   damper on an algebraic line or k > 8192) and builds the condensed model: a
+   damper on an algebraic line, k > 4096, or an elimination whose dense
+   blocks would exceed 1e8 doubles) and builds the condensed model: a
    port-Hamiltonian ODE in the n = N - k differential coordinates, with the
    same outputs, Hamiltonian and dissipation (phgmg_dae_system; feedthrough P,
    S, Nskew where a constraint touches a port), which it validates
@@ -5891,7 +5892,11 @@ struct phgmg_dae {
   double *work;                 /* n + 2 k + m                                        */
 };
 
-#define PHGMG__DAE_KMAX 8192
+/* Size limits of the elimination, which is dense in the algebraic lines:
+   k algebraic lines, and the blocks of the update (rows x k, k x columns,
+   rows x columns) in doubles. */
+#define PHGMG__DAE_KMAX 4096
+#define PHGMG__DAE_BLOCK_MAX 1e8
 
 /* Row range [a, b] of the stored entries of column (or row) i. */
 PHGMG__PRIV void phgmg__ph_span(const phgmg_ph_system *s, int i, int *a, int *b) {
@@ -6072,9 +6077,14 @@ PHGMG__PRIV phgmg_result phgmg__dae_support(phgmg_dae *d, const phgmg_ph_system 
 PHGMG__PRIV phgmg_result phgmg__dae_eliminate(phgmg_dae *d, const phgmg_ph_system *s, const int *ri, int nri,
                                               const int *cj, int ncj, double **Uo) {
   const int k = d->k, m = d->m, N = s->N, n = d->n;
-  double *C = phgmg__dalloc(&d->al, (size_t)nri * k + 1), *W = phgmg__dalloc(&d->al, (size_t)k * ncj + 1);
-  double *Fa = phgmg__dalloc(&d->al, 2 * (size_t)k * m), *U = phgmg__dalloc(&d->al, (size_t)nri * ncj + 1);
+  double *C, *W, *Fa, *U;
   int i, j, q;
+  *Uo = NULL;
+  if ((double)nri * k > PHGMG__DAE_BLOCK_MAX || (double)ncj * k > PHGMG__DAE_BLOCK_MAX ||
+      (double)nri * ncj > PHGMG__DAE_BLOCK_MAX)
+    return PHGMG_ERR_UNSUPPORTED;
+  C = phgmg__dalloc(&d->al, (size_t)nri * k + 1); W = phgmg__dalloc(&d->al, (size_t)k * ncj + 1);
+  Fa = phgmg__dalloc(&d->al, 2 * (size_t)k * m); U = phgmg__dalloc(&d->al, (size_t)nri * ncj + 1);
   *Uo = U;
   d->D = phgmg__dalloc(&d->al, (size_t)k * ncj + 1);
   d->Ga = phgmg__dalloc(&d->al, (size_t)k * m);
