@@ -509,10 +509,40 @@ TEST(test_dae_bar_reduce) {
   dae_model_free(&d);
 }
 
+/* More algebraic lines than the dense elimination takes (k > 4096): an RLC
+   ladder in nodal form (examples/circuit_dae.c) with 10000 sections, half of
+   its nodes without capacitor: PHGMG_ERR_UNSUPPORTED up front, no memory
+   beyond the index maps. */
+TEST(test_dae_too_many_constraints) {
+  const int n = 10000, N = 2 * n + 1;
+  double *E = (double *)calloc((size_t)3 * N, sizeof(double)), *J = (double *)calloc((size_t)3 * N, sizeof(double));
+  double *R = (double *)calloc((size_t)3 * N, sizeof(double)), *Q = (double *)calloc((size_t)3 * N, sizeof(double));
+  double *B = (double *)calloc((size_t)N, sizeof(double));
+  phgmg_ph_system s;
+  phgmg_dae *dae = NULL;
+  int j;
+#define DAE_B(M, a, b) M[(size_t)(1 + (a) - (b)) + (size_t)(b) * 3]
+  for (j = 0; j <= n; ++j) { DAE_B(E, 2 * j, 2 * j) = j % 2 ? 0.0 : 1.0; DAE_B(R, 2 * j, 2 * j) = j % 2 ? 1.0 : 0.0; }
+  for (j = 1; j <= n; ++j) {
+    DAE_B(E, 2 * j - 1, 2 * j - 1) = 1.0;
+    DAE_B(J, 2 * j - 1, 2 * j - 2) = 1.0; DAE_B(J, 2 * j - 2, 2 * j - 1) = -1.0;
+    DAE_B(J, 2 * j - 1, 2 * j) = -1.0; DAE_B(J, 2 * j, 2 * j - 1) = 1.0;
+  }
+  for (j = 0; j < N; ++j) DAE_B(Q, j, j) = 1.0;
+#undef DAE_B
+  B[0] = 1.0;
+  memset(&s, 0, sizeof s);
+  s.N = N; s.m = 1; s.storage = PHGMG_BANDED; s.kb = 1; s.E = E; s.J = J; s.R = R; s.Q = Q; s.B = B;
+  CHECK_RC(phgmg_dae_create(&dae, &s, 0.0, NULL), PHGMG_ERR_UNSUPPORTED);
+  CHECK(dae == NULL);
+  free(E); free(J); free(R); free(Q); free(B);
+}
+
 SUITE(dae) {
   RUN(test_dae_circuit_closed_form);
   RUN(test_dae_circuit_simulate);
   RUN(test_dae_bad_input);
   RUN(test_dae_bar_simulate);
   RUN(test_dae_bar_reduce);
+  RUN(test_dae_too_many_constraints);
 }
