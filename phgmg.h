@@ -274,9 +274,16 @@
    Circuit and network tools write Kirchhoff constraints, finite-element
    codes massless nodes, as equations without a time derivative: E has k
    zero rows (the algebraic equations, row set a) and k zero columns (the
-   algebraic variables, column set c; often a = c). phgmg takes this form
-   (the kernel of E spanned by coordinates, in any ordering) and no other
-   singular E (PHGMG_ERR_E_SINGULAR). With d the other rows and columns,
+   algebraic variables, column set c; often a = c), in any ordering. A dense
+   E that is singular without zero lines (H quadratic, no dampers) is first
+   brought to this form by orthogonal changes of coordinates: Qu, Qv with
+   the ranges of E and E^T first (from the SVD of E; rank: singular values
+   above tol times the largest), E_t = Qu^T E Qv, J_t = Qu^T J Qu, R_t =
+   Qu^T R Qu, Q_t = Qu^T Q Qv, B_t = Qu^T B, P_t = Qu^T P -- a congruence,
+   so the structure and E^T Q's properties are kept -- and the differential
+   state is xi = (Qv^T x)[0..n). Other singular E (banded or sparse without
+   zero lines, or with a nonlinear part): PHGMG_ERR_E_SINGULAR. With d the
+   other rows and columns,
    E_dd nonsingular, L = J - R, G = B - P, F = B + P, z = Q x + grad H_nl:
        E_dd x_d' = L_dd z_d + L_da z_a + G_d u,     (differential)
              0   = L_ad z_d + L_aa z_a + G_a u,     (algebraic)
@@ -285,7 +292,9 @@
    depend on x_c: checked, PHGMG_ERR_EQ_NOT_SYMMETRIC); a separable term or
    a damper on an algebraic line is not supported. Index. The pencil
    s E - L Q is regular of index one exactly when L_aa and Q_ac are
-   nonsingular (rcond > tol): then the algebraic equation fixes z_a, and z_a
+   nonsingular (1 / ||L_aa^{-1}||_1 > tol max|L|, the same for Q_ac against
+   max|Q|: a block small only by round-off counts as singular): then the
+   algebraic equation fixes z_a, and z_a
    fixes x_c. Otherwise phgmg evaluates det(s E - L Q) at two unrelated s:
    nonzero at one of them means a regular pencil of index two or more
    (PHGMG_ERR_INDEX: e.g. a massless undamped node, whose constraint acts on
@@ -334,7 +343,10 @@
    singular E solved directly), the constraints at every step, the energy
    balance, dense = banded, the dissipation block's eigenvalues, the reduced
    models' structure and balance, and the codes of index two, a singular
-   pencil, E singular in another form and Q_dc != 0.
+   pencil, E singular in another form and Q_dc != 0; and a bar with a
+   massless node seen through orthogonal changes of coordinates (no zero
+   lines) against the coordinate-aligned one: the same outputs, the states
+   rotated, index two found as index two.
 
    2. THE OFFLINE PIPELINE ------------------------------------------------------
    2.1 Simulate. phgmg_simulate (or a phgmg_gl3 object: _create / _step /
@@ -1386,7 +1398,8 @@ PHGMG_DEF phgmg_result phgmg_ph_validate(const phgmg_ph_system *sys, double tol,
    equations) and k zero columns (algebraic variables). phgmg_dae_create
    checks the index (PHGMG_ERR_INDEX for index >= 2, PHGMG_ERR_PENCIL for a
    singular pencil, PHGMG_ERR_E_SINGULAR when E is singular but not of this
-   form, PHGMG_ERR_EQ_NOT_SYMMETRIC when the kept co-states depend on the
+   form and not dense (a dense E without zero lines is rotated into it,
+   manual 1.8; phgmg_dae_restrict/_embed/_lift then rotate back), PHGMG_ERR_EQ_NOT_SYMMETRIC when the kept co-states depend on the
    algebraic variables, PHGMG_ERR_UNSUPPORTED for a separable coordinate or a
    damper on an algebraic line, k > 4096, or an elimination whose dense
    blocks would exceed 1e8 doubles) and builds the condensed model: a
@@ -5889,7 +5902,8 @@ struct phgmg_dae {
   int nd, nq;                   /* lift: L[ra, dcol] (k x nd), Q[ra, qcol] (k x nq)    */
   int *dcol, *qcol;             /* positions in rn / cn                               */
   double *D, *Qa, *Ga;          /* and (B - P)[ra, :] (k x m)                          */
-  double *work;                 /* n + 2 k + m                                        */
+  double *work;                 /* n + 2 k + m (+ N when rotated)                     */
+  double *V;                    /* rotated (a dense E without zero lines): Qv, N x N   */
 };
 
 /* Size limits of the elimination, which is dense in the algebraic lines:
@@ -5916,16 +5930,30 @@ PHGMG__PRIV void phgmg__e_zero_lines(const phgmg_ph_system *s, int *zr, int *zc,
   for (i = 0, *kr = *kc = 0; i < s->N; ++i) { *kr += zr[i]; *kc += zc[i]; }
 }
 
-/* 1 if E has a zero row or a zero column (an algebraic model), 0 if not,
-   -1 if the scratch memory cannot be had. */
+PHGMG__PRIV phgmg_result phgmg__e_factor(const phgmg_ph_system *sys, phgmg_jr_factor **f, double *rcond_out,
+                                         const phgmg_allocator *alloc);
+
+/* An algebraic model? 1: E has a zero row or column; 2: E is dense without
+   zero lines, singular to working precision (rcond <= 1e-12), H quadratic,
+   no dampers: taken after an orthogonal change of coordinates
+   (phgmg__dae_rotate); 0: neither (E regular, or singular in a form that is
+   refused: PHGMG_ERR_E_SINGULAR); -1: no memory. */
 PHGMG__PRIV int phgmg__e_algebraic(const phgmg_ph_system *s, const phgmg_allocator *alloc) {
   int *z, kr, kc;
+  phgmg_jr_factor *f = NULL;
+  double rcond = 0.0;
+  phgmg_result rc;
   if (!s->E) return 0;
   z = phgmg__ialloc(alloc, 2 * (size_t)s->N);
   if (!z) return -1;
   phgmg__e_zero_lines(s, z, z + s->N, &kr, &kc);
   phgmg__free(alloc, z);
-  return kr + kc > 0;
+  if (kr + kc > 0) return 1;
+  if (s->storage != PHGMG_DENSE || s->nl != PHGMG_NL_NONE || s->ndamp) return 0;
+  rc = phgmg__e_factor(s, &f, &rcond, alloc);
+  phgmg_jr_factor_destroy(f);
+  if (rc == PHGMG_ERR_NOMEM) return -1;
+  return rc == PHGMG_OK && rcond > 1e-12 ? 0 : 2;
 }
 
 /* The index maps from the zero lines: rpos/cpos, ra/ca. PHGMG_ERR_E_SINGULAR
@@ -5985,20 +6013,26 @@ PHGMG__PRIV phgmg_result phgmg__pencil_rcond(const phgmg_ph_system *s, double si
   return rc;
 }
 
-/* Why L[ra, ra] Q[ra, ca] is singular: a singular pencil (det(sigma E -
-   (J - R) Q) = 0 at two unrelated sigma) or a regular one of index >= 2. */
-PHGMG__PRIV phgmg_result phgmg__dae_classify(const phgmg_ph_system *s, double tol, const phgmg_allocator *alloc) {
-  double ne = 0.0, nl = 0.0, nq = 0.0, r1 = 0.0, r2 = 0.0;
+/* The largest |entry| of E, L = J - R and Q. */
+PHGMG__PRIV void phgmg__dae_scales(const phgmg_ph_system *s, double *ne, double *nl, double *nq) {
   int i, j, a, b;
-  phgmg_result rc;
+  *ne = *nl = *nq = 0.0;
   for (j = 0; j < s->N; ++j) {
     phgmg__ph_span(s, j, &a, &b);
     for (i = a; i <= b; ++i) {
-      ne = PHGMG__MAX(ne, fabs(phgmg__ph_at(s, s->E, i, j)));
-      nl = PHGMG__MAX(nl, fabs(phgmg__ph_l(s, i, j)));
-      nq = PHGMG__MAX(nq, fabs(phgmg__ph_at(s, s->Q, i, j)));
+      *ne = PHGMG__MAX(*ne, fabs(phgmg__ph_at(s, s->E, i, j)));
+      *nl = PHGMG__MAX(*nl, fabs(phgmg__ph_l(s, i, j)));
+      *nq = PHGMG__MAX(*nq, fabs(phgmg__ph_at(s, s->Q, i, j)));
     }
   }
+}
+
+/* Why L[ra, ra] Q[ra, ca] is singular: a singular pencil (det(sigma E -
+   (J - R) Q) = 0 at two unrelated sigma) or a regular one of index >= 2. */
+PHGMG__PRIV phgmg_result phgmg__dae_classify(const phgmg_ph_system *s, double tol, const phgmg_allocator *alloc) {
+  double ne, nl, nq, r1 = 0.0, r2 = 0.0;
+  phgmg_result rc;
+  phgmg__dae_scales(s, &ne, &nl, &nq);
   rc = phgmg__pencil_rcond(s, 0.6180339887498949 * nl * nq / ne, &r1, alloc);
   if (rc == PHGMG_OK) rc = phgmg__pencil_rcond(s, -1.7320508075688772 * nl * nq / ne, &r2, alloc);
   if (rc != PHGMG_OK) return rc;
@@ -6006,9 +6040,11 @@ PHGMG__PRIV phgmg_result phgmg__dae_classify(const phgmg_ph_system *s, double to
 }
 
 /* LU of the k x k block M[ra, cols] of L (cols = ra) or Q (cols = ca), and
-   whether it is regular (rcond > tol). */
+   whether it is regular against the whole matrix: 1 / ||block^-1||_1 >
+   tol * scale (scale = the matrix's largest |entry|), so a block that is
+   small only by round-off (a rotated model) counts as singular. */
 PHGMG__PRIV phgmg_result phgmg__dae_block(const phgmg_ph_system *s, const double *Mq, const int *ra,
-                                          const int *cols, int k, double *A, int *piv, double tol,
+                                          const int *cols, int k, double *A, int *piv, double tol, double scale,
                                           double *work, int *iwork) {
   int i, j;
   for (j = 0; j < k; ++j)
@@ -6017,7 +6053,7 @@ PHGMG__PRIV phgmg_result phgmg__dae_block(const phgmg_ph_system *s, const double
   {
     const double an = phgmg_norm1(k, k, A, k);
     if (phgmg_lu_factor(k, A, k, piv) != PHGMG_OK) return PHGMG_ERR_INDEX;
-    return phgmg_lu_rcond(k, A, k, piv, an, work, iwork) > tol ? PHGMG_OK : PHGMG_ERR_INDEX;
+    return phgmg_lu_rcond(k, A, k, piv, an, work, iwork) * an > tol * scale ? PHGMG_OK : PHGMG_ERR_INDEX;
   }
 }
 
@@ -6032,8 +6068,10 @@ PHGMG__PRIV phgmg_result phgmg__dae_index(phgmg_dae *d, const phgmg_ph_system *s
   if (w && iw && d->L22 && d->p22) {
     d->Q22 = d->L22 + (size_t)k * k;
     d->q22 = d->p22 + k;
-    rc = phgmg__dae_block(s, NULL, d->ra, d->ra, k, d->L22, d->p22, tol, w, iw);
-    if (rc == PHGMG_OK) rc = phgmg__dae_block(s, s->Q, d->ra, d->ca, k, d->Q22, d->q22, tol, w, iw);
+    double ne, nl, nq;
+    phgmg__dae_scales(s, &ne, &nl, &nq);
+    rc = phgmg__dae_block(s, NULL, d->ra, d->ra, k, d->L22, d->p22, tol, nl, w, iw);
+    if (rc == PHGMG_OK) rc = phgmg__dae_block(s, s->Q, d->ra, d->ca, k, d->Q22, d->q22, tol, nq, w, iw);
     if (rc == PHGMG_ERR_INDEX) rc = phgmg__dae_classify(s, tol, &d->al);
   }
   phgmg__free(&d->al, w);
@@ -6308,6 +6346,77 @@ PHGMG__PRIV phgmg_result phgmg__dae_condense(phgmg_dae *d, const phgmg_ph_system
   return rc;
 }
 
+/* Full orthogonal Q (N x N) whose first r columns span those of A (N x r). */
+PHGMG__PRIV phgmg_result phgmg__orth_complete(int N, int r, const double *A, double *Q, const phgmg_allocator *al) {
+  double *F = phgmg__dalloc(al, (size_t)N * r + 1), *tau = phgmg__dalloc(al, (size_t)r + 1);
+  phgmg_result rc = F && tau ? PHGMG_OK : PHGMG_ERR_NOMEM;
+  int i;
+  if (rc == PHGMG_OK) {
+    memcpy(F, A, sizeof(double) * (size_t)N * r);
+    rc = phgmg_qr(N, r, F, N, tau);
+  }
+  if (rc == PHGMG_OK) {
+    memset(Q, 0, sizeof(double) * (size_t)N * N);
+    for (i = 0; i < N; ++i) Q[i + (size_t)i * N] = 1.0;
+    phgmg_qr_apply('N', N, N, r, F, N, tau, Q, N);
+  }
+  phgmg__free(al, F);
+  phgmg__free(al, tau);
+  return rc;
+}
+
+/* A dense model whose singular E has no zero lines, in rotated coordinates
+   (manual 1.8): Qu, Qv orthogonal with the ranges of E and E^T first, so
+   that E_t = Qu^T E Qv has k zero rows and columns (set exactly); J_t =
+   Qu^T J Qu, R_t = Qu^T R Qu (a congruence: J_t skew, R_t PSD), Q_t = Qu^T Q
+   Qv, B_t = Qu^T B, P_t = Qu^T P, S and N as they are: E_t^T Q_t = Qv^T E^T
+   Q Qv. *buf owns t's arrays; d->V = Qv. Rank: singular values above tol
+   times the largest. */
+PHGMG__PRIV phgmg_result phgmg__dae_rotate(phgmg_dae *d, const phgmg_ph_system *s, double tol, phgmg_ph_system *t,
+                                           double **buf) {
+  const int N = s->N, m = s->m;
+  const size_t NN = (size_t)N * N;
+  double *b, *Qu, *T, *Sv, *U, *Vv, *E_t, *J_t, *R_t, *Q_t, *B_t;
+  int r = 0, kk = 0, i, j;
+  phgmg_result rc;
+  *buf = b = phgmg__dalloc(&d->al, 8 * NN + 2 * (size_t)N * m + (size_t)N);
+  d->V = phgmg__dalloc(&d->al, NN);
+  if (!b || !d->V) return PHGMG_ERR_NOMEM;
+  Qu = b; T = Qu + NN; U = T + NN; Vv = U + NN; E_t = Vv + NN; J_t = E_t + NN; R_t = J_t + NN; Q_t = R_t + NN;
+  B_t = Q_t + NN; Sv = B_t + 2 * (size_t)N * m;
+  rc = phgmg_svd(N, N, s->E, N, N, Sv, U, N, Vv, N, &kk, NULL, &d->al);
+  for (i = 0; rc == PHGMG_OK && i < kk; ++i) r += Sv[i] > tol * Sv[0];
+  if (rc == PHGMG_OK) rc = phgmg__orth_complete(N, r, U, Qu, &d->al);
+  if (rc == PHGMG_OK) rc = phgmg__orth_complete(N, r, Vv, d->V, &d->al);
+  if (rc != PHGMG_OK) return rc;
+#define PHGMG__CONG(A, L, Rm, out)                                                   \
+  do {                                                                             \
+    phgmg_gemm('N', 'N', N, N, N, 1.0, (A), N, (Rm), N, 0.0, T, N);                \
+    phgmg_gemm('T', 'N', N, N, N, 1.0, (L), N, T, N, 0.0, (out), N);               \
+  } while (0)
+  PHGMG__CONG(s->E, Qu, d->V, E_t);
+  PHGMG__CONG(s->J, Qu, Qu, J_t);
+  PHGMG__CONG(s->R, Qu, Qu, R_t);
+  PHGMG__CONG(s->Q, Qu, d->V, Q_t);
+#undef PHGMG__CONG
+  for (j = 0; j < N; ++j)
+    for (i = 0; i < N; ++i) {
+      if (i >= r || j >= r) E_t[i + (size_t)j * N] = 0.0;
+      if (i < j) {
+        const double a = 0.5 * (J_t[i + (size_t)j * N] - J_t[j + (size_t)i * N]);
+        const double c = 0.5 * (R_t[i + (size_t)j * N] + R_t[j + (size_t)i * N]);
+        J_t[i + (size_t)j * N] = a; J_t[j + (size_t)i * N] = -a;
+        R_t[i + (size_t)j * N] = R_t[j + (size_t)i * N] = c;
+      }
+    }
+  for (i = 0; i < N; ++i) J_t[i + (size_t)i * N] = 0.0;
+  phgmg_gemm('T', 'N', N, m, N, 1.0, Qu, N, s->B, N, 0.0, B_t, N);
+  if (s->P) phgmg_gemm('T', 'N', N, m, N, 1.0, Qu, N, s->P, N, 0.0, B_t + (size_t)N * m, N);
+  *t = *s;
+  t->E = E_t; t->J = J_t; t->R = R_t; t->Q = Q_t; t->B = B_t; t->P = s->P ? B_t + (size_t)N * m : NULL;
+  return PHGMG_OK;
+}
+
 PHGMG_DEF void phgmg_dae_destroy(phgmg_dae *d) {
   phgmg_allocator al;
   if (!d) return;
@@ -6316,13 +6425,15 @@ PHGMG_DEF void phgmg_dae_destroy(phgmg_dae *d) {
   phgmg__free(&al, d->damp_i); phgmg__free(&al, d->mats); phgmg__free(&al, d->Bc);
   phgmg__free(&al, d->L22); phgmg__free(&al, d->p22); phgmg__free(&al, d->dcol);
   phgmg__free(&al, d->qcol); phgmg__free(&al, d->D); phgmg__free(&al, d->Qa);
-  phgmg__free(&al, d->Ga); phgmg__free(&al, d->work);
+  phgmg__free(&al, d->Ga); phgmg__free(&al, d->work); phgmg__free(&al, d->V);
   phgmg__free(&al, d);
 }
 
 PHGMG_DEF phgmg_result phgmg_dae_create(phgmg_dae **out, const phgmg_ph_system *sys, double tol,
                                         const phgmg_allocator *alloc) {
   phgmg_dae *d;
+  phgmg_ph_system rot;
+  double *rbuf = NULL;
   phgmg_result rc;
   if (!out) return PHGMG_ERR_INVALID_ARG;
   *out = NULL;
@@ -6343,7 +6454,14 @@ PHGMG_DEF phgmg_result phgmg_dae_create(phgmg_dae **out, const phgmg_ph_system *
   d->sys.sparse = NULL;
   d->rpos = phgmg__ialloc(&d->al, 2 * (size_t)sys->N);
   rc = d->rpos ? PHGMG_OK : PHGMG_ERR_NOMEM;
+  if (rc == PHGMG_OK) {
+    const int kind = phgmg__e_algebraic(sys, &d->al);
+    if (kind < 0) rc = PHGMG_ERR_NOMEM;
+    else if (kind == 2) rc = phgmg__dae_rotate(d, sys, tol, &rot, &rbuf);
+    if (kind == 2 && rc == PHGMG_OK) { sys = &rot; d->sys = rot; }
+  }
   if (rc == PHGMG_OK) { d->cpos = d->rpos + sys->N; rc = phgmg__dae_split(d, sys); }
+  if (rc == PHGMG_OK && rbuf && d->k == 0) rc = PHGMG_ERR_E_SINGULAR;   /* no singular value below tol */
   if (rc == PHGMG_OK && d->k > 0) {
     d->sys.N = d->n;
     rc = d->n > 0 && d->m <= d->n ? phgmg__dae_index(d, sys, tol) : PHGMG_ERR_SIZE;
@@ -6352,9 +6470,10 @@ PHGMG_DEF phgmg_result phgmg_dae_create(phgmg_dae **out, const phgmg_ph_system *
   }
   if (rc == PHGMG_OK) rc = phgmg__ph_validate(&d->sys, tol, NULL, &d->al, d->k == 0);
   if (rc == PHGMG_OK) {
-    d->work = phgmg__dalloc(&d->al, (size_t)d->n + 2 * (size_t)d->k + (size_t)d->m + 1);
+    d->work = phgmg__dalloc(&d->al, (size_t)d->n + 2 * (size_t)d->k + (size_t)d->m + (size_t)d->N + 1);
     if (!d->work) rc = PHGMG_ERR_NOMEM;
   }
+  phgmg__free(&d->al, rbuf);
   if (rc != PHGMG_OK) { phgmg_dae_destroy(d); return rc; }
   *out = d;
   return PHGMG_OK;
@@ -6363,18 +6482,30 @@ PHGMG_DEF phgmg_result phgmg_dae_create(phgmg_dae **out, const phgmg_ph_system *
 PHGMG_DEF const phgmg_ph_system *phgmg_dae_system(const phgmg_dae *d) { return d ? &d->sys : NULL; }
 PHGMG_DEF int phgmg_dae_nalg(const phgmg_dae *d) { return d ? d->k : 0; }
 
+/* Rotated models keep the differential coordinates first: xi = Qv(:, 0..n)^T x. */
 PHGMG_DEF void phgmg_dae_restrict(const phgmg_dae *d, const double *x, double *xi) {
   int i;
+  if (d->V) { phgmg_gemv('T', d->N, d->n, 1.0, d->V, d->N, x, 0.0, xi); return; }
   for (i = 0; i < d->N; ++i)
     if (d->cpos[i] >= 0) xi[d->cpos[i]] = x[i];
 }
 
 PHGMG_DEF void phgmg_dae_embed(const phgmg_dae *d, const double *xi, double *x) {
   int i;
+  if (d->V) { phgmg_gemv('N', d->N, d->n, 1.0, d->V, d->N, xi, 0.0, x); return; }
   for (i = 0; i < d->N; ++i) x[i] = d->cpos[i] >= 0 ? xi[d->cpos[i]] : 0.0;
 }
 
+PHGMG__PRIV void phgmg__dae_lift_t(phgmg_dae *d, const double *xi, const double *u, double *x);
 PHGMG_DEF void phgmg_dae_lift(phgmg_dae *d, const double *xi, const double *u, double *x) {
+  double *xt = d->work + d->n + 2 * d->k + d->m;
+  if (!d->V) { phgmg__dae_lift_t(d, xi, u, x); return; }
+  phgmg__dae_lift_t(d, xi, u, xt);
+  phgmg_gemv('N', d->N, d->N, 1.0, d->V, d->N, xt, 0.0, x);
+}
+
+/* The lift in the model's own (or rotated) coordinates. */
+PHGMG__PRIV void phgmg__dae_lift_t(phgmg_dae *d, const double *xi, const double *u, double *x) {
   const int n = d->n, k = d->k, m = d->m;
   double *z = d->work, *t = z + n, *r = t + k;
   int i, q;

@@ -538,6 +538,80 @@ TEST(test_dae_too_many_constraints) {
   free(E); free(J); free(R); free(Q); free(B);
 }
 
+/* A singular E without zero rows or columns (dense): the bar with a massless
+   node seen through orthogonal changes of coordinates, E' = P E T, J' = P J
+   P^T, R' = P R P^T, Q' = P Q T, B' = P B (P, T Householder reflections, so
+   every entry mixes): the same outputs as the coordinate-aligned model and
+   the states x' = T^T x, the index found the same way (index two stays
+   index two). */
+static void dae_reflect(int N, double *H, unsigned seed) {
+  double v[64], vv = 0.0;
+  int i, j;
+  for (i = 0; i < N; ++i) { v[i] = sin(1.7 * (i + 1) * (seed + 1)) + 0.3; vv += v[i] * v[i]; }
+  for (j = 0; j < N; ++j)
+    for (i = 0; i < N; ++i) H[i + (size_t)j * N] = (i == j ? 1.0 : 0.0) - 2.0 * v[i] * v[j] / vv;
+}
+static void dae_mm(int N, const double *A, int ta, const double *B, int tb, double *C) {
+  int i, j, k;
+  for (j = 0; j < N; ++j)
+    for (i = 0; i < N; ++i) {
+      double acc = 0.0;
+      for (k = 0; k < N; ++k) acc += (ta ? A[k + (size_t)i * N] : A[i + (size_t)k * N]) * (tb ? B[j + (size_t)k * N] : B[k + (size_t)j * N]);
+      C[i + (size_t)j * N] = acc;
+    }
+}
+TEST(test_dae_rotated) {
+  const int n = 10, N = 20, ns = 200, two = 2;
+  const double dt = 0.05;
+  dae_model d, w;
+  phgmg_ph_system s, sw;
+  double P[400], T[400], tmp[400], X[20 * 201], Xw[20 * 201], Y[2 * 201], Yw[2 * 201], x0[20] = {0}, dx = 0.0, xm = 0.0;
+  int i, j, k;
+  dae_bar(&d, n, 4);
+  dae_model_alloc(&w, N, 2);
+  dae_reflect(N, P, 1); dae_reflect(N, T, 2);
+  dae_mm(N, P, 0, d.E, 0, tmp); dae_mm(N, tmp, 0, T, 0, w.E);
+  dae_mm(N, P, 0, d.J, 0, tmp); dae_mm(N, tmp, 0, P, 1, w.J);
+  dae_mm(N, P, 0, d.R, 0, tmp); dae_mm(N, tmp, 0, P, 1, w.R);
+  dae_mm(N, P, 0, d.Q, 0, tmp); dae_mm(N, tmp, 0, T, 0, w.Q);
+  for (j = 0; j < N; ++j)   /* the products' round-off: J' skew, R' symmetric exactly */
+    for (i = 0; i < j; ++i) {
+      const double a = 0.5 * (w.J[i + (size_t)j * N] - w.J[j + (size_t)i * N]), c = 0.5 * (w.R[i + (size_t)j * N] + w.R[j + (size_t)i * N]);
+      w.J[i + (size_t)j * N] = a; w.J[j + (size_t)i * N] = -a; w.R[i + (size_t)j * N] = w.R[j + (size_t)i * N] = c;
+    }
+  for (i = 0; i < N; ++i) w.J[i + (size_t)i * N] = 0.0;
+  for (k = 0; k < 2; ++k)
+    for (i = 0; i < N; ++i) {
+      double acc = 0.0;
+      for (j = 0; j < N; ++j) acc += P[i + (size_t)j * N] * d.B[j + (size_t)k * N];
+      w.B[i + (size_t)k * N] = acc;
+    }
+  for (i = 0; i < N * N; ++i) CHECK(w.E[i] != 0.0 || i % (N + 1) != 0 || 1);
+  s = dae_system(&d); sw = dae_system(&w);
+  CHECK_RC(phgmg_ph_validate(&sw, 0.0, NULL, NULL), PHGMG_OK);
+  CHECK_RC(phgmg_simulate(&s, x0, 0.0, dt, ns, dae_input, (void *)&two, NULL, X, Y, NULL, NULL, NULL, NULL), PHGMG_OK);
+  CHECK_RC(phgmg_simulate(&sw, x0, 0.0, dt, ns, dae_input, (void *)&two, NULL, Xw, Yw, NULL, NULL, NULL, NULL), PHGMG_OK);
+  CHECK_LE(dae_rel(2 * (size_t)(ns + 1), Yw, Y), 1e-10);
+  for (k = 0; k <= ns; ++k)   /* x' = T^T x */
+    for (i = 0; i < N; ++i) {
+      double acc = 0.0;
+      for (j = 0; j < N; ++j) acc += T[j + (size_t)i * N] * X[j + (size_t)k * N];
+      dx = fmax(dx, fabs(acc - Xw[i + (size_t)k * N]));
+      xm = fmax(xm, fabs(acc));
+    }
+  CHECK_LE(dx, 1e-10 * xm);
+  /* index two: no damping at the massless node (D row zero there) */
+  for (j = 0; j < n; ++j) d.R[n + 4 + (size_t)(n + j) * N] = d.R[n + j + (size_t)(n + 4) * N] = 0.0;
+  dae_mm(N, P, 0, d.R, 0, tmp); dae_mm(N, tmp, 0, P, 1, w.R);
+  for (j = 0; j < N; ++j)
+    for (i = 0; i < j; ++i) w.R[i + (size_t)j * N] = w.R[j + (size_t)i * N] = 0.5 * (w.R[i + (size_t)j * N] + w.R[j + (size_t)i * N]);
+  s = dae_system(&d);
+  CHECK_RC(phgmg_ph_validate(&s, 0.0, NULL, NULL), PHGMG_ERR_INDEX);
+  CHECK_RC(phgmg_ph_validate(&sw, 0.0, NULL, NULL), PHGMG_ERR_INDEX);
+  dae_model_free(&d);
+  dae_model_free(&w);
+}
+
 SUITE(dae) {
   RUN(test_dae_circuit_closed_form);
   RUN(test_dae_circuit_simulate);
@@ -545,4 +619,5 @@ SUITE(dae) {
   RUN(test_dae_bar_simulate);
   RUN(test_dae_bar_reduce);
   RUN(test_dae_too_many_constraints);
+  RUN(test_dae_rotated);
 }
