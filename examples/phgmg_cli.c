@@ -82,7 +82,8 @@ static const char *const help_lines[] = {
   "                      reduced model is an ordinary pH model: simulate-rom, export).\n",
   "                      Algebraic constraints: k zero rows and k zero columns of E\n",
   "                      (equations without a derivative, e.g. a massless node or a\n",
-  "                      Kirchhoff law) are taken when they determine their variables\n",
+  "                      Kirchhoff law; a dense singular E is rotated into this form)\n",
+  "                      are taken when they determine their variables\n",
   "                      (index one; index two or more, or a singular pencil, is an\n",
   "                      error naming the files): the model is condensed to its\n",
   "                      differential states (a port on a constraint becomes\n",
@@ -2142,8 +2143,8 @@ static int condense_algebraic(reduce_state *S) {
     return 0;
   }
   S->sys = *phgmg_dae_system(S->dae);
-  progress("algebraic constraints: %d zero rows and columns of E (index one); condensed to N = %d differential "
-           "states%s", phgmg_dae_nalg(S->dae), S->sys.N,
+  progress("algebraic constraints: E singular, %d algebraic equations and variables (index one); condensed to "
+           "N = %d differential states%s", phgmg_dae_nalg(S->dae), S->sys.N,
            S->sys.P || S->sys.S ? " with feedthrough (a port on a constraint)" : "");
 
   return 0;
