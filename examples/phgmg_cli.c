@@ -145,8 +145,10 @@ static const char *const help_lines[] = {
   "    --rn wide         V2 over the whole residual of the snapshots (up to its numerical\n",
   "                      rank and (R-m)(R-m+1)/2): what the greedy and altmin manifolds\n",
   "                      need on transport data; offline one SVD of the residual\n",
-  "  --ref KIND          affine reference state xbar: none (default) or mean (the mean of\n",
-  "                      the snapshots); the model is phi(x) = xbar + [B, V1] x (+ V2 q),\n",
+  "  --ref KIND|FILE     affine reference state xbar: none (default), mean (the mean of\n",
+  "                      the snapshots) or a .npy file of N values (your state, e.g. an\n",
+  "                      equilibrium; read, never written); the model is\n",
+  "                      phi(x) = xbar + [B, V1] x (+ V2 q),\n",
   "                      bases and manifold fitted to the snapshots minus xbar. Every\n",
   "                      method. A run from rest starts at the model's xr_rest = rho(0)\n",
   "                      (simulate-rom does). Pays off for data not centred at 0\n",
@@ -167,6 +169,11 @@ static const char *const help_lines[] = {
   "                      quadratic fit), altmin (alternating minimization of V1, V2\n",
   "                      and M over the snapshots, started from pod; B stays in the\n",
   "                      span). Representation error: altmin <= pod on the snapshots.\n",
+  "  --greedy-window W   with --manifold greedy or altmin and --rn wide: V1 is chosen\n",
+  "                      among the leading R - m + W POD modes, each scored by the ridge\n",
+  "                      fit of the other candidates (default: the leading R - m + 8,\n",
+  "                      scored by the misfit). Transport data (travelling pulses) need\n",
+  "                      a wide window, e.g. 200; offline cost grows with W (seconds).\n",
   "  --train-input KIND  with --simulate, instead of --input: one training run per\n",
   "                      --train-input (repeatable, up to 16; KIND as --input), each\n",
   "                      from x0 = 0 with the same --dt, --steps and --amp; the\n",
@@ -1174,7 +1181,9 @@ typedef struct reduce_args {
   int lambda_auto;              /* --lambda auto (1) / cv (2) */
   int manifold;                 /* --manifold pod (0) / greedy (1) / altmin (2) */
   const char *manifold_s;
-  int ref;                      /* --ref none (0) / mean (PHGMG_REF_MEAN) */
+  int ref;                      /* --ref none (0) / mean (PHGMG_REF_MEAN) / FILE (PHGMG_REF_GIVEN) */
+  const char *ref_file;         /* --ref FILE: the reference state, N values */
+  int greedy_window;            /* --greedy-window W (0: the library's default) */
   const char *train[16];        /* --train-input KIND, repeatable */
   int ntrain;
   const char *xs[16];           /* --X FILE, repeatable: one run each (X = xs[0]) */
@@ -1345,7 +1354,16 @@ static int parse_reduce(int argc, char **argv, reduce_args *A) {
       if (!(v = optval(argc, argv, &i))) return 2;
       if (!strcmp(v, "none")) A->ref = PHGMG_REF_NONE;
       else if (!strcmp(v, "mean")) A->ref = PHGMG_REF_MEAN;
-      else return usage_error("--ref '%s': expected none or mean", v);
+      else if (!*v) return usage_error("--ref: expected none, mean or a .npy file, got an empty name");
+      else {
+        FILE *f = fopen(v, "rb");
+        if (!f) return usage_error("--ref '%s': expected none, mean or a .npy file (cannot open: %s)", v, strerror(errno));
+        fclose(f);
+        A->ref = PHGMG_REF_GIVEN; A->ref_file = v;
+      }
+    }
+    else if (!strcmp(o, "--greedy-window")) {
+      if (!(v = optval(argc, argv, &i)) || !parse_int(o, v, 1, 100000, &A->greedy_window)) return 2;
     }
     else if (!strcmp(o, "--manifold")) {
       if (!(v = optval(argc, argv, &i))) return 2;
@@ -1419,6 +1437,11 @@ static int check_reduce_args(reduce_args *A, const char *const *seen, int nseen)
   if (!A->input) A->input = A->ntrain ? A->train[0] : "sin";
   if ((A->have_lambda || A->manifold_s || A->rn) && strcmp(A->method, "gmg-qm") != 0)
     return usage_error("reduce: --lambda, --rn and --manifold apply to --method gmg-qm only (not %s)", A->method);
+  if (A->greedy_window && (A->manifold != PHGMG_MANIFOLD_GREEDY && A->manifold != PHGMG_MANIFOLD_ALTMIN))
+    return usage_error("reduce: --greedy-window applies to --method gmg-qm with --manifold greedy or altmin");
+  if (A->greedy_window && A->rn != PHGMG_RN_WIDE)
+    return usage_error("reduce: --greedy-window needs --rn wide (the candidates are scored against the whole "
+                       "residual)");
   /* gmg-qm without --lambda: the validated choice (a fixed lambda can give a
      model whose Newton solve fails on inputs unlike the training run) */
   if (!A->have_lambda && !strcmp(A->method, "gmg-qm")) A->lambda_auto = 1;
@@ -1537,6 +1560,7 @@ typedef struct reduce_state {
   cli_csc cJ, cR, cQ, cE; /* sparse input (--J-coo ..., --E-coo) */
   mat E;                  /* --E (dense) */
   mat Pm, Sm, Nm;         /* --P, --S, --N */
+  mat refm;               /* --ref FILE (internal ordering) */
   mat Dm;                 /* --dampers */
   int *di, *dj;           /* the dampers' state indices (internal ordering) */
   double *dlaw;           /* their laws: k x 4 coefficients {0, c1, 0, c3} */
@@ -1654,7 +1678,7 @@ static int load_family(const reduce_args *A, reduce_state *S, phgmg_ph_system *s
 }
 
 static void reduce_cleanup(reduce_state *S) {
-  mat_free(&S->J); mat_free(&S->R); mat_free(&S->B); mat_free(&S->Q); mat_free(&S->E); mat_free(&S->Pm); mat_free(&S->Sm); mat_free(&S->Nm); mat_free(&S->Dm);
+  mat_free(&S->J); mat_free(&S->R); mat_free(&S->B); mat_free(&S->Q); mat_free(&S->E); mat_free(&S->Pm); mat_free(&S->Sm); mat_free(&S->Nm); mat_free(&S->Dm); mat_free(&S->refm);
   free(S->di); free(S->dj); free(S->dlaw); mat_free(&S->X);
   mat_free(&S->poly); mat_free(&S->pidx); mat_free(&S->pw); mat_free(&S->ex); mat_free(&S->in.tab);
   { int k; for (k = 0; k < 16; ++k) { mat_free(&S->tin[k].tab); mat_free(&S->Xs[k]); mat_free(&S->xinp[k].tab); } }
@@ -1972,6 +1996,24 @@ static int load_feedthrough(const reduce_args *A, reduce_state *S, phgmg_ph_syst
   return 0;
 }
 
+/* --ref FILE: the reference state xbar, N values (shape (N,) or (N, 1)), in
+   the files' ordering (sparse input: mapped to the internal one). */
+static int load_ref(const reduce_args *A, reduce_state *S, int N) {
+  if (!A->ref_file) return 0;
+  if (mat_load(&S->refm, "--ref", A->ref_file)) return 1;
+  if (S->refm.ndim == 0 || S->refm.rows != N || S->refm.cols != 1)
+    return fail("%s (--ref): expected shape (%d,) or (%d, 1) (one value per state), got %s", A->ref_file, N, N,
+                shape_str(&S->refm));
+  if (S->sp) {
+    double *t = (double *)malloc(sizeof(double) * (size_t)N + 1);
+    if (!t) return fail("out of memory");
+    phgmg_ph_sparse_to_banded_order(S->sp, 1, S->refm.a, N, t, N);
+    memcpy(S->refm.a, t, sizeof(double) * (size_t)N);
+    free(t);
+  }
+  return 0;
+}
+
 /* A state index of the user's ordering in the internal one (sparse input:
    the RCM reordering, found by mapping the unit vector). */
 static int cli_internal_index(const reduce_state *S, int N, int i, double *e, double *t) {
@@ -2097,7 +2139,7 @@ static int load_system(const reduce_args *A, reduce_state *S) {
              A->potential ? A->potential : "exp-polynomial", sys.poly_deg, sys.nexp,
              sys.phi_nfun > 1 ? " (one function per term)" : "");
   }
-  if (load_feedthrough(A, S, &sys) || load_dampers(A, S, &sys)) return 1;
+  if (load_feedthrough(A, S, &sys) || load_dampers(A, S, &sys) || load_ref(A, S, sys.N)) return 1;
   rc = phgmg_ph_validate(&sys, 0.0, &rcond, NULL);
   if (sys.ndamp && (rc == PHGMG_ERR_DAMPER || rc == PHGMG_ERR_SIZE || rc == PHGMG_ERR_NANINF))
     return fail("%s (--dampers): %s%s", A->dampf, phgmg_result_string(rc),
@@ -2296,6 +2338,8 @@ static int run_reduction(const reduce_args *A, reduce_state *S, int method, cons
   o.lambda_auto = A->lambda_auto;
   o.manifold = A->manifold;
   o.ref = A->ref;
+  o.ref_x = A->ref == PHGMG_REF_GIVEN ? S->refm.a : NULL;
+  o.greedy_window = A->greedy_window;
   if (S->nrun > 0) { o.nrun = S->nrun; o.runs = S->runs; } /* --simulate: the runs are known */
   if (A->lambda_auto == 1) { o.newton_tol = A->newton_tol; o.newton_iter = A->newton_iter; }
   memset(&info, 0, sizeof info);
@@ -2479,9 +2523,12 @@ static void json_options(FILE *jf, const reduce_args *A, const reduce_state *S, 
       fprintf(jf, ", \"lambda_note\": \"M = 0: the inputs of the --X runs are unknown (no --X-input)\"");
     fprintf(jf, ", \"manifold\": ");
     json_str(jf, A->manifold_s ? A->manifold_s : "pod");
+    if (A->greedy_window) fprintf(jf, ", \"greedy_window\": %d", A->greedy_window);
     fprintf(jf, ", ");
   }
   fprintf(jf, "\"training_runs\": %d", S->nrun);
+  fprintf(jf, ", \"ref\": ");
+  json_str(jf, A->ref == PHGMG_REF_MEAN ? "mean" : A->ref == PHGMG_REF_GIVEN ? A->ref_file : "none");
   fprintf(jf, ", \"hyper\": ");
   json_str(jf, hyper_name(A, o));
   if (o->hyper_reduce && o->hyper == PHGMG_HYPER_ECSW) {
@@ -2620,6 +2667,7 @@ static void reduce_paths(const reduce_args *A, reduce_state *S, const char *cons
     }
   }
   for (k = 0; k < A->nx; ++k) paths_add(&S->pin, "--X", A->xs[k], 0);
+  if (A->ref_file) paths_add(&S->pin, "--ref", A->ref_file, 0);
   for (k = 0; k < A->nxin; ++k) paths_add_input(&S->pin, "--X-input", A->xin[k]);
   for (k = 0; k < A->ntrain; ++k) paths_add_input(&S->pin, "--train-input", A->train[k]);
   if (!A->ntrain && A->simulate) paths_add_input(&S->pin, "--input", A->input);

@@ -65,7 +65,7 @@ fi
 # ---- 1. help and usage --------------------------------------------------------
 run_ok "help" "$P" --help
 for o in --J --R --B --Q --X --simulate --dt --steps --input --amp --newton-tol --newton-iter --method \
-         gmg-pod gmg-qm sp1 sp2 --r --rn wide --ref --lambda --poly --poly-idx --poly-w --no-deim --deim-tol --deim-max \
+         gmg-pod gmg-qm sp1 sp2 --r --rn wide --ref --greedy-window --lambda --poly --poly-idx --poly-w --no-deim --deim-tol --deim-max \
          --deim-allow-negative --dt-map --out --name --save-snapshots --quiet simulate-rom --model --states \
          .phgmgrom _V0.npy .json "EXIT STATUS" EXAMPLES --J-coo --R-coo --Q-coo "SPARSE MATRICES" tocoo; do
   grep -F -q -- "$o" "$T/out.txt" || bad "--help does not explain $o"
@@ -125,6 +125,42 @@ run_ok "reduce gmg-qm --ref mean --rn wide" "$P" reduce $SYS $SIM --method gmg-q
 run_ok "simulate-rom --ref mean" "$P" simulate-rom --model o_ref/m.phgmgrom $ROMSIM --out o_ref/y.npy --quiet
 run_ok "--ref mean model against the full model (1e-2)" "$REF" compare o_ref/m_fom_y.npy o_ref/y.npy 1e-2
 run_err "--ref bad" 2 "--ref" "$P" reduce $SYS $SIM --method gmg-pod --r 12 --ref median --out o_bad --name m
+# --ref FILE: the snapshots' mean written by NumPy gives the model of --ref mean
+# (same output to 1e-8: only the mean's rounding differs); the file is an input
+# (an output of that name is refused, the file stays as it was); its shape is
+# checked against N
+if [ "$HAVE_NP" = 1 ]; then
+  mkdir -p o_rf
+  "$PY" -c "import numpy as np; X = np.load('o_ref/m_snapshots.npy'); np.save('o_rf/xbar.npy', X.mean(axis=1))"
+  run_ok "reduce --ref FILE" "$P" reduce $SYS $SIM --method gmg-qm --lambda 1e-3 --r 12 --rn wide \
+    --manifold greedy --ref o_rf/xbar.npy --out o_rf --name m --quiet
+  grep -F -q '"ref": "o_rf/xbar.npy"' o_rf/m.json || bad "json does not name the --ref file"
+  grep -F -q '"ref": "mean"' o_ref/m.json || bad "json does not say --ref mean"
+  run_ok "simulate-rom --ref FILE" "$P" simulate-rom --model o_rf/m.phgmgrom $ROMSIM --out o_rf/y.npy --quiet
+  run_ok "--ref FILE (the mean) == --ref mean (1e-8)" "$REF" compare o_ref/y.npy o_rf/y.npy 1e-8
+  run_err "--ref FILE against the zero reference (negative control)" 1 "" "$REF" compare o_gmg-qm/y.npy o_rf/y.npy 1e-8
+  cp o_rf/xbar.npy o_rf/m_V0.npy && cp o_rf/xbar.npy o_rf/keep.npy
+  run_err "--ref FILE is an output" 2 "never overwrites its inputs" "$P" reduce $SYS $SIM --method gmg-pod --r 12 \
+    --ref o_rf/m_V0.npy --out o_rf --name m --quiet
+  cmp -s o_rf/m_V0.npy o_rf/keep.npy || bad "--ref FILE was overwritten"
+  "$PY" -c "import numpy as np; np.save('o_rf/short.npy', np.zeros(99)); np.save('o_rf/nan.npy', np.full(100, np.nan))"
+  run_err "--ref wrong shape" 1 "o_rf/short.npy (--ref): expected shape (100,)" "$P" reduce $SYS $SIM \
+    --method gmg-pod --r 12 --ref o_rf/short.npy --out o_bad --name m
+  run_err "--ref NaN" 1 "o_rf/nan.npy (--ref): NaN" "$P" reduce $SYS $SIM --method gmg-pod --r 12 \
+    --ref o_rf/nan.npy --out o_bad --name m
+fi
+run_err "--ref missing file" 2 "--ref 'no_such.npy'" "$P" reduce $SYS $SIM --method gmg-pod --r 12 \
+  --ref no_such.npy --out o_bad --name m
+# --greedy-window: recorded in the json; only with gmg-qm, --manifold greedy or altmin, --rn wide
+run_ok "reduce --greedy-window" "$P" reduce $SYS $SIM --method gmg-qm --lambda 1e-3 --r 12 --rn wide \
+  --manifold greedy --greedy-window 40 --out o_gw --name m --quiet
+grep -F -q '"greedy_window": 40' o_gw/m.json || bad "json does not record --greedy-window"
+run_err "--greedy-window without --rn wide" 2 "needs --rn wide" "$P" reduce $SYS $SIM --method gmg-qm \
+  --lambda 1e-3 --r 12 --manifold greedy --greedy-window 40 --out o_bad --name m
+run_err "--greedy-window with the pod manifold" 2 "--manifold greedy or altmin" "$P" reduce $SYS $SIM \
+  --method gmg-qm --lambda 1e-3 --r 12 --rn wide --greedy-window 40 --out o_bad --name m
+run_err "--greedy-window 0" 2 "--greedy-window" "$P" reduce $SYS $SIM --method gmg-qm --lambda 1e-3 --r 12 \
+  --rn wide --manifold greedy --greedy-window 0 --out o_bad --name m
 run_err "--rn 0" 2 "--rn" "$P" reduce $SYS $SIM --method gmg-qm --r 12 --rn 0 --out o_bad --name m
 [ -s o_gmg-qm/m_V2.npy ] && [ -s o_gmg-qm/m_M.npy ] && [ -s o_gmg-qm/m_Ms.npy ] || bad "gmg-qm arrays missing"
 # SP1/SP2 have no D^T G D: their log and record name no GMG diagnostic
