@@ -510,27 +510,54 @@
                             V2 the POD of what [B, V1] leaves. About (r - m)
                             (r - m + r_n) small least-squares solves.
      PHGMG_MANIFOLD_ALTMIN  alternating minimization (after Geelen, Balzano,
-                            Wright & Willcox 2023): V1, V2 rotated within the
-                            leading 2 (r - m + r_n) POD modes, alternating the
-                            ridge fit of M with an orthogonal Procrustes step;
-                            a sweep is kept only if the training objective
-                            sum ||x - phi(rho(x))||^2 + lam ||M||^2 decreases,
-                            so it never ends above the POD manifold
-                            (info.manifold_obj0 -> manifold_obj, at most 100
-                            sweeps). Under lambda_auto = 1 GMG-POD joins the
+                            Wright & Willcox 2023) of the training objective
+                            sum ||x - phi(rho(x))||^2 + lam ||M||^2 (lam:
+                            1e-9 under lambda_auto, else opts.lambda). It
+                            keeps only what lowers the objective, so it never
+                            ends above its start (info.manifold_obj0 ->
+                            manifold_obj). With V2 of width r_n: V1, V2
+                            rotated within the leading 2 (r - m + r_n) POD
+                            modes, alternating the ridge fit of M with an
+                            orthogonal Procrustes step (at most 100 sweeps).
+                            With a wide V2 (its default): V2 is everything
+                            V1 leaves, so for each V1 the best M is one ridge
+                            fit and the objective is a function f(V1) alone.
+                            The two blocks then alternate as: fit M for the
+                            current V1; move V1 along the gradient of the
+                            misfit with that M held fixed (which is the
+                            gradient of f, because M is optimal), on the
+                            orthonormal matrices within the numerical rank
+                            of the adjusted snapshots (at most 256 modes),
+                            step length by Barzilai-Borwein with a
+                            non-monotone backtracking, the best V1 kept (at
+                            most 200 steps). Why not the Procrustes step
+                            here: the reduced state is the linear projection
+                            V1^T x, so a rotation that fits the latent values
+                            of the last sweep changes those values too; on
+                            transport data it did not lower the objective
+                            once. Why it helps: the POD modes V1 starts from
+                            are the best linear space, not the best base for
+                            a quadratic correction; the gradient turns V1
+                            towards directions whose products predict the
+                            rest. Advecting pulse of bench/qm_pulse.c (n = 12,
+                            16, 20, lam = 1e-12): from the hierarchical POD
+                            manifold's 3.4e-1, 2.1e-1, 1.2e-1 it reaches
+                            1.7e-2, 3.0e-3, 1.9e-3 (the greedy manifold:
+                            2.8e-2, 3.1e-3, 7.3e-4; the previous Procrustes
+                            form with a wide V2: 1.0e-1, 4.1e-2, 1.2e-1),
+                            10-30 s per reduction (N = 4096, 1000 snapshots).
+                            Below the POD manifold's span floor it cannot
+                            go; how far above it stops is set by the
+                            non-convex objective (a local minimum near the
+                            start) and the step budget, which binds on the
+                            pulse. With opts.greedy_window > 0 it starts from
+                            the greedy manifold (V1 the greedy choice, the
+                            search space V1 and its complement's leading
+                            modes) and improves it by 8-30 % there.
+                            Under lambda_auto = 1 GMG-POD joins the
                             validation as a second reference, and when no
                             lambda beats both the model of MANIFOLD_POD is
                             returned (info.manifold_fallback = 1).
-                            With a wide V2 and opts.greedy_window > 0 it
-                            starts from the greedy manifold instead (V1 the
-                            greedy choice, the search space V1 and its
-                            complement's leading modes): its objective
-                            measures V2 at width 8, where the hierarchical
-                            POD start is a local minimum far above what a
-                            wide V2 allows on transport data (advecting pulse,
-                            n = 20: POD manifold 1.4e-1, altmin from it
-                            1.4e-1, from the greedy start 8.7e-4; sweeps
-                            improve n = 12 from 3.01e-2 to 2.91e-2).
    In every construction B stays in the span and [B, V1, V2] is orthonormal,
    so Br = [I; 0] and the GMG reduction is unchanged.
 
@@ -578,7 +605,7 @@
    snapshots minus xbar; the point reduction is rho(x) = rho_0(x - xbar) with
    rho_0 the map without reference state. On the advecting pulse of
    bench/qm_pulse.c the greedy manifold's training error at n = 20 drops from
-   8.7e-4 to 1.5e-7 (examples/README.md).
+   7.3e-4 to 7.7e-8 (lam = 1e-12; examples/README.md).
    Why the reduced model is still port-Hamiltonian. xbar is constant, so
    Dphi(x) = V0 + V2 [0, Deta(x2)] (V0 = [B, V1]) does not depend on it: the
    GMG reduction map W = F_G(Dphi)^T, W^T Dphi = I, the structure
@@ -2495,8 +2522,9 @@ typedef struct phgmg_reduce_info {
                               model to the linear limit over the validation runs */
   /* manifold = PHGMG_MANIFOLD_ALTMIN: the objective sum_i ||x_i - phi(rho(x_i))||^2
      + lam ||M||^2 over the snapshots (lam: the ridge parameter of the sweeps) at
-     the start (the hierarchical POD) and at the end, and the sweeps kept; the
-     final M is then refitted with the lambda in force (fixed or automatic). */
+     the start (the hierarchical POD, or the greedy manifold) and at the end,
+     and the sweeps kept (with a wide V2: the descent steps taken); the final
+     M is then refitted with the lambda in force (fixed or automatic). */
   double manifold_obj0, manifold_obj;
   int manifold_sweeps;
   /* 1: altmin under lambda_auto = 1 gave no model at least as good as GMG-POD
@@ -13676,77 +13704,276 @@ PHGMG__PRIV phgmg_result phgmg__altmin_sweep(phgmg__altmin_ws *w, double *f, int
   return PHGMG_OK;
 }
 
+/* The search space of the alternating minimization (phgmg__qm_altmin): q
+   orthonormal modes U (N x q, room for qmax) of the adjusted snapshots, in
+   which V1 and V2 are rotated. Warm start (the greedy's, c->Uw): [V1, the
+   leading modes of its complement]; opts.pod_basis: its leading columns;
+   else the leading POD modes of Xa, with a wide V2 only those above the
+   rank floor (the numerical rank). Sets *q <= qmax. */
+PHGMG__PRIV phgmg_result phgmg__altmin_space(phgmg__rctx *c, int qmax, double *U, int *q) {
+  phgmg_reduced *red = c->red;
+  const int N = red->N, m = red->m, p = red->p, ns = c->ns;
+  double *sv;
+  int kk = 0;
+  phgmg_result rc;
+  *q = qmax;
+  if (c->Uw) {
+    *q = PHGMG__MIN(qmax, p + c->kw);
+    memcpy(U, red->V0 + (size_t)N * m, (size_t)N * p * sizeof(double));
+    if (*q > p) memcpy(U + (size_t)N * p, c->Uw, (size_t)N * (*q - p) * sizeof(double));
+    return PHGMG_OK;
+  }
+  if (c->o->pod_basis) {
+    memcpy(U, c->o->pod_basis, (size_t)N * qmax * sizeof(double));
+    return PHGMG_OK;
+  }
+  sv = phgmg__dalloc(c->alloc, (size_t)qmax);
+  if (!sv) return PHGMG_ERR_NOMEM;
+  rc = phgmg_pod(N, ns, c->Xa, N, qmax, 0.0, U, N, sv, &kk, c->alloc);
+  while (rc == PHGMG_OK && c->wide && kk > 0 && !(sv[kk - 1] > c->rfloor)) --kk;
+  phgmg__free(c->alloc, sv);
+  *q = kk;   /* the numerical rank may cut the candidates */
+  return rc;
+}
+
+PHGMG__PRIV void phgmg__qm_features(int p, int ns, const double *Z2, int ldz, double *Kt, int ldk);
+
+/* The alternating minimization with a wide V2 (phgmg__altmin_wide): V2 is
+   all of span U that V1 = U Q1 leaves, so the objective depends on Q1
+   (q x p, orthonormal) alone:
+     f(Q1) = min_T ||E||_F^2 + lam ||T||_F^2,  E = R - (K T)^T,
+     R = (I - Q1 Q1^T) S,  K = the features of Z = Q1^T S (ns x nc).
+   The ridge fit T (nc x q) is the minimization over M for the current V1;
+   by the envelope theorem the gradient in Q1 is that of ||E||^2 with T held
+   fixed: -2 (E Z^T + S L^T), L (p x ns) = the chain rule of the features
+   through Gam = T E (the first term of the Q1-derivative of R vanishes
+   because Q1^T E = 0), projected on the tangent space (I - Q1 Q1^T). */
+typedef struct phgmg__awide {
+  int q, ns, p, nc;
+  double lam;
+  const double *S;                          /* q x ns coordinates            */
+  double *Z, *Kt, *Rt, *T, *E, *Gam, *L;    /* p x ns, ns x nc, ns x q, nc x q,
+                                               q x ns, nc x ns, p x ns      */
+  double *Pu, *Pv, *Psv;                    /* polar scratch: q x p, p x p, p */
+  phgmg_allocator al;                       /* the scratch arena            */
+} phgmg__awide;
+
+/* f(Q1) into *f and, with g != NULL, its tangent gradient g (q x p). */
+PHGMG__PRIV phgmg_result phgmg__awide_eval(phgmg__awide *w, const double *Q1, double *f, double *g) {
+  const int q = w->q, ns = w->ns, p = w->p, nc = w->nc;
+  const double s2 = sqrt(2.0);
+  double sum = 0.0;
+  int i, a, b, cc;
+  phgmg_result rc;
+  phgmg_gemm('T', 'N', p, ns, q, 1.0, Q1, q, w->S, q, 0.0, w->Z, p);
+  phgmg__qm_features(p, ns, w->Z, p, w->Kt, ns);
+  memcpy(w->E, w->S, (size_t)q * ns * sizeof(double));
+  phgmg_gemm('N', 'N', q, ns, p, -1.0, Q1, q, w->Z, p, 1.0, w->E, q);   /* R */
+  for (i = 0; i < ns; ++i)
+    for (a = 0; a < q; ++a) w->Rt[i + (size_t)a * ns] = w->E[a + (size_t)i * q];
+  if (w->al.alloc == phgmg__arena_alloc) ((phgmg__arena *)w->al.user)->used = 0;
+  rc = phgmg__lstsq_fit(ns, nc, q, w->Kt, w->Rt, w->lam, w->T, &w->al);
+  if (rc != PHGMG_OK) return rc;
+  phgmg_gemm('T', 'T', q, ns, nc, -1.0, w->T, nc, w->Kt, ns, 1.0, w->E, q);   /* E = R - (K T)^T */
+  sum = phgmg__sumsq(q, ns, w->E, q) + w->lam * phgmg__sumsq(nc, q, w->T, nc);
+  *f = sum;
+  if (!(sum <= HUGE_VAL)) return PHGMG_ERR_NANINF;
+  if (!g) return PHGMG_OK;
+  phgmg_gemm('N', 'N', nc, ns, q, 1.0, w->T, nc, w->E, q, 0.0, w->Gam, nc);
+  memset(w->L, 0, (size_t)p * ns * sizeof(double));
+  for (i = 0; i < ns; ++i) {
+    const double *z = w->Z + (size_t)i * p, *gm = w->Gam + (size_t)i * nc;
+    double *l = w->L + (size_t)i * p;
+    for (a = 0, cc = 0; a < p; ++a)
+      for (b = a; b < p; ++b, ++cc) {
+        if (a == b) l[a] += 2.0 * gm[cc] * z[a];
+        else { l[a] += s2 * gm[cc] * z[b]; l[b] += s2 * gm[cc] * z[a]; }
+      }
+  }
+  phgmg_gemm('N', 'T', q, p, ns, -2.0, w->E, q, w->Z, p, 0.0, g, q);
+  phgmg_gemm('N', 'T', q, p, ns, -2.0, w->S, q, w->L, p, 1.0, g, q);
+  phgmg_gemm('T', 'N', p, p, q, 1.0, Q1, q, g, q, 0.0, w->Pv, p);    /* tangent: g - Q1 (Q1^T g) */
+  phgmg_gemm('N', 'N', q, p, p, -1.0, Q1, q, w->Pv, p, 1.0, g, q);
+  return PHGMG_OK;
+}
+
+/* The descent in Q1 (opts.manifold = ALTMIN with a wide V2): from Q1 = the
+   first p coordinates (the start of phgmg__qm_altmin), steps
+   Q1 <- polar(Q1 - t g) along the tangent gradient g, with the
+   Barzilai-Borwein step t (the plain gradient step converges slowly here)
+   safeguarded by a non-monotone backtracking: t is halved until f falls
+   below the largest of the last PHGMG__AW_MEM values by 1e-4 t ||g||^2 (at
+   most 40 halvings). The best Q1 seen is returned, so the result is never
+   worse than the start. Stops after PHGMG__AW_STEPS steps, when no step is
+   accepted, or when the best f has gained less than 1e-6 of itself over
+   PHGMG__AW_MEM steps. Q1 (q x p) in/out; *f0, *f the objective at the
+   start and at the end. */
+#define PHGMG__AW_STEPS 200
+#define PHGMG__AW_MEM 8
+PHGMG__PRIV phgmg_result phgmg__altmin_wide(phgmg__awide *w, double *Q1, double *f0, double *f, int *steps,
+                                            const phgmg_allocator *alloc) {
+  const int q = w->q, p = w->p, qp = q * p;
+  double *g, *gn, *Qn, *sd, *Qc, t, gg, fn, fc, sy, ss, fref, hist[PHGMG__AW_MEM], fbest_old = HUGE_VAL;
+  int it, h, i;
+  phgmg_result rc;
+  g = phgmg__dalloc(alloc, 5 * (size_t)qp);
+  if (!g) return PHGMG_ERR_NOMEM;
+  gn = g + qp; Qn = gn + qp; sd = Qn + qp; Qc = sd + qp;
+  *steps = 0;
+  memcpy(Qc, Q1, (size_t)qp * sizeof(double));
+  rc = phgmg__awide_eval(w, Qc, &fc, g);
+  *f0 = *f = fc;
+  for (i = 0; i < PHGMG__AW_MEM; ++i) hist[i] = fc;
+  gg = phgmg__dot(qp, g, g);
+  t = gg > 0.0 ? 0.5 / sqrt(gg) : 0.0;
+  for (it = 0; rc == PHGMG_OK && it < PHGMG__AW_STEPS && gg > 0.0; ++it) {
+    for (i = 1, fref = hist[0]; i < PHGMG__AW_MEM; ++i) fref = PHGMG__MAX(fref, hist[i]);
+    for (h = 0, fn = HUGE_VAL; h < 40; ++h, t *= 0.5) {
+      for (i = 0; i < qp; ++i) sd[i] = Qc[i] - t * g[i];
+      rc = phgmg__polar(q, p, sd, w->Pu, w->Pv, w->Psv, Qn, &w->al);
+      if (rc == PHGMG_OK) rc = phgmg__awide_eval(w, Qn, &fn, gn);
+      if (rc == PHGMG_ERR_NOMEM) break;
+      if (rc == PHGMG_OK && fn <= fref - 1e-4 * t * gg) break;
+      rc = PHGMG_OK;
+      fn = HUGE_VAL;
+    }
+    if (rc != PHGMG_OK || !(fn < HUGE_VAL)) break;
+    for (i = 0, sy = ss = 0.0; i < qp; ++i) {
+      const double di = Qn[i] - Qc[i], yi = gn[i] - g[i];
+      sy += di * yi; ss += di * di;
+    }
+    memcpy(Qc, Qn, (size_t)qp * sizeof(double));
+    memcpy(g, gn, (size_t)qp * sizeof(double));
+    fc = fn;
+    gg = phgmg__dot(qp, g, g);
+    hist[it % PHGMG__AW_MEM] = fc;
+    ++*steps;
+    if (fc < *f) { *f = fc; memcpy(Q1, Qc, (size_t)qp * sizeof(double)); }
+    if (it % PHGMG__AW_MEM == PHGMG__AW_MEM - 1) {
+      if (*f > fbest_old * (1.0 - 1e-6)) break;
+      fbest_old = *f;
+    }
+    t = sy != 0.0 ? fabs(ss / sy) : 2.0 * t;   /* Barzilai-Borwein */
+  }
+  phgmg__free(alloc, g);
+  return rc == PHGMG_ERR_NOMEM ? rc : PHGMG_OK;   /* a failed fit or step: the best Q1 so far */
+}
+
 /* opts.manifold = PHGMG_MANIFOLD_ALTMIN: alternating minimization of the
    linear and quadratic parts (after Geelen, Balzano, Wright & Willcox 2023).
-   In the coordinates S = U^T Xa of the q = min(2 (p + rn), rank) leading POD
-   modes U of the adjusted snapshots Xa = X - B B^+ X, with V1 = U Q1,
+   In the coordinates S = U^T Xa of q orthonormal modes U of the adjusted
+   snapshots Xa = X - B B^+ X (phgmg__altmin_space), with V1 = U Q1,
    V2 = U Q2 and Q = [Q1, Q2] orthonormal (so [B, V1, V2] stays orthonormal
    and B in the span, as the hierarchical POD has it), the objective is
    sum_i ||x_i - phi(rho(x_i))||^2 + lam ||M||^2 (lam as phgmg__qm_greedy).
-   Start: Q = the leading p + rn coordinates (the hierarchical POD). Each
-   sweep (phgmg__altmin_sweep) moves Q by the orthogonal Procrustes step and
-   refits M; a sweep is kept only if the objective decreases, so it never
-   increases. Stop: no decrease, a relative decrease below 1e-5, or 100
-   sweeps. Writes V1 into red->V0 and V2 into red->V2. */
+   V2 of width rn: U = the q = min(2 (p + rn), rank) leading POD modes.
+   A wide V2: U = every mode above the rank floor (at most PHGMG__ALTMIN_QMAX)
+   and Q square (V2 = all of span U that V1 leaves), so that the objective
+   is the one of the wide model that phgmg__qm_wide_v2 then builds.
+   Start: Q = the leading p + rn coordinates (the hierarchical POD, or the
+   greedy manifold as warm start). Each sweep (phgmg__altmin_sweep) moves Q by
+   the orthogonal Procrustes step and refits M; a sweep is kept only if the
+   objective decreases, so it never increases. Stop: no decrease, a relative
+   decrease below 1e-5, or 100 sweeps. Writes V1 into red->V0 and (V2 of
+   width rn) V2 into red->V2. */
+#define PHGMG__ALTMIN_QMAX 256
+/* phgmg__qm_altmin with a wide V2: the descent of phgmg__altmin_wide in the
+   q modes U; writes V1 = U Q1 into red->V0 (V2 follows from its complement). */
+PHGMG__PRIV phgmg_result phgmg__qm_altmin_wide(phgmg__rctx *c, const double *U, int q) {
+  phgmg_reduced *red = c->red;
+  const int N = red->N, m = red->m, p = red->p, ns = c->ns, nc = p * (p + 1) / 2;
+  const size_t nar = (size_t)(ns + nc) * (nc + q) + (size_t)nc + 16 * (size_t)(q + p) * p + 4096;
+  const size_t nw = (size_t)q * ns * 2 + (size_t)p * ns * 2 + (size_t)ns * nc + (size_t)ns * q + (size_t)nc * q +
+                    (size_t)nc * ns + (size_t)q * p * 2 + (size_t)p * p + (size_t)p;
+  double *blk, *S, *Q1, f0 = 0.0, f = 0.0, outside;
+  int i, steps = 0;
+  phgmg__awide w;
+  phgmg__arena ar;
+  phgmg_result rc;
+  blk = phgmg__dalloc(c->alloc, nw + nar);
+  if (!blk) return PHGMG_ERR_NOMEM;
+  memset(&w, 0, sizeof w);
+  S = blk; w.Z = S + (size_t)q * ns; w.Kt = w.Z + (size_t)p * ns; w.Rt = w.Kt + (size_t)ns * nc;
+  w.T = w.Rt + (size_t)ns * q; w.E = w.T + (size_t)nc * q; w.Gam = w.E + (size_t)q * ns; w.L = w.Gam + (size_t)nc * ns;
+  w.Pu = w.L + (size_t)p * ns; Q1 = w.Pu + (size_t)q * p; w.Pv = Q1 + (size_t)q * p; w.Psv = w.Pv + (size_t)p * p;
+  ar.base = (unsigned char *)(blk + nw); ar.cap = nar * sizeof(double); ar.used = 0; ar.up = c->alloc;
+  w.al.alloc = phgmg__arena_alloc; w.al.free = phgmg__arena_free; w.al.user = &ar;
+  w.q = q; w.ns = ns; w.p = p; w.nc = nc; w.S = S;
+  w.lam = c->o->lambda_auto ? 1e-9 : c->lambda;
+  phgmg_gemm('T', 'N', q, ns, N, 1.0, U, N, c->Xa, N, 0.0, S, q);
+  outside = PHGMG__MAX(phgmg__sumsq(N, ns, c->Xa, N) - phgmg__sumsq(q, ns, S, q), 0.0);
+  for (i = 0; i < q * p; ++i) Q1[i] = (i % q) == (i / q) ? 1.0 : 0.0;
+  rc = phgmg__altmin_wide(&w, Q1, &f0, &f, &steps, c->alloc);
+  if (rc == PHGMG_OK) {
+    c->inf.manifold_obj0 = f0 + outside;
+    c->inf.manifold_obj = f + outside;
+    c->inf.manifold_sweeps = steps;
+    phgmg_gemm('N', 'N', N, p, q, 1.0, U, N, Q1, q, 0.0, red->V0 + (size_t)N * m, N);
+  }
+  phgmg__free(c->alloc, blk);
+  return rc;
+}
+
 PHGMG__PRIV phgmg_result phgmg__qm_altmin(phgmg__rctx *c) {
   phgmg_reduced *red = c->red;
-  const int N = red->N, m = red->m, p = red->p, rn = red->rn, ns = c->ns, k = p + rn, nc = p * (p + 1) / 2;
+  const int N = red->N, m = red->m, p = red->p, ns = c->ns, nc = p * (p + 1) / 2;
   const int navail = c->o->pod_basis ? c->o->pod_cols : PHGMG__MIN(N, ns) - 1;
-  double *U, *S, f = HUGE_VAL, f0, tot = 0.0, outside;
-  int it, kk = 0, i, q = PHGMG__MIN(2 * k, navail), moved = 0;
+  const int qmax = PHGMG__MIN(c->wide ? PHGMG__ALTMIN_QMAX : 2 * (p + red->rn), navail);
+  double *U, *S, *blk, f = HUGE_VAL, f0, tot = 0.0, outside;
+  int it, i, q = 0, k, rs, moved = 0;
   phgmg__altmin_ws w;
   phgmg__arena ar;
   size_t nar;
-  phgmg_result rc = PHGMG_OK;
-  if (q < k) return PHGMG_ERR_SIZE;
-  /* arena: phgmg_lstsq's [K; sqrt(lam) I], [Y; 0] and tau, and room for the q x k SVDs */
-  nar = (size_t)(ns + nc) * (nc + rn) + (size_t)nc + 16 * (size_t)(q + k) * k + 4096;
-  U = phgmg__dalloc(c->alloc, (size_t)N * q + (size_t)q * ns * 2 + (size_t)q * k * 5 + (size_t)k * (k + 1) +
-                                  (size_t)k * ns * 3 + (size_t)ns * (nc + rn) + (size_t)nc * rn + nar);
+  phgmg_result rc;
+  if (qmax < p + (c->wide ? 1 : red->rn)) return PHGMG_ERR_SIZE;
+  U = phgmg__dalloc(c->alloc, (size_t)N * qmax);
   if (!U) return PHGMG_ERR_NOMEM;
+  rc = phgmg__altmin_space(c, qmax, U, &q);
+  rs = c->wide ? q - p : red->rn;   /* V2's width in the search */
+  k = p + rs;
+  if (rc == PHGMG_OK && (rs < 1 || q < k)) rc = PHGMG_ERR_SIZE;
+  if (rc != PHGMG_OK) { phgmg__free(c->alloc, U); return rc; }
+  if (c->wide) {
+    rc = phgmg__qm_altmin_wide(c, U, q);
+    phgmg__free(c->alloc, U);
+    return rc;
+  }
+  /* arena: phgmg_lstsq's [K; sqrt(lam) I], [Y; 0] and tau, and room for the q x k SVDs */
+  nar = (size_t)(ns + nc) * (nc + rs) + (size_t)nc + 16 * (size_t)(q + k) * k + 4096;
+  blk = phgmg__dalloc(c->alloc, (size_t)q * ns * 2 + (size_t)q * k * 5 + (size_t)k * (k + 1) + (size_t)k * ns * 3 +
+                                    (size_t)ns * (nc + rs) + (size_t)nc * rs + nar);
+  if (!blk) { phgmg__free(c->alloc, U); return PHGMG_ERR_NOMEM; }
   memset(&w, 0, sizeof w);
-  ar.base = (unsigned char *)(U + (size_t)N * q + (size_t)q * ns * 2 + (size_t)q * k * 5 + (size_t)k * (k + 1) +
-                              (size_t)k * ns * 3 + (size_t)ns * (nc + rn) + (size_t)nc * rn);
+  ar.base = (unsigned char *)(blk + (size_t)q * ns * 2 + (size_t)q * k * 5 + (size_t)k * (k + 1) + (size_t)k * ns * 3 +
+                              (size_t)ns * (nc + rs) + (size_t)nc * rs);
   ar.cap = nar * sizeof(double); ar.used = 0; ar.up = c->alloc;
   w.al.alloc = phgmg__arena_alloc; w.al.free = phgmg__arena_free; w.al.user = &ar;
-  S = U + (size_t)N * q; w.R = S + (size_t)q * ns; w.Q = w.R + (size_t)q * ns; w.Qn = w.Q + (size_t)q * k;
+  S = blk; w.R = S + (size_t)q * ns; w.Q = w.R + (size_t)q * ns; w.Qn = w.Q + (size_t)q * k;
   w.Qb = w.Qn + (size_t)q * k; w.A = w.Qb + (size_t)q * k; w.U = w.A + (size_t)q * k; w.V = w.U + (size_t)q * k;
   w.sv = w.V + (size_t)k * k; w.W = w.sv + k; w.Wn = w.W + (size_t)k * ns; w.Wb = w.Wn + (size_t)k * ns;
-  w.Kt = w.Wb + (size_t)k * ns; w.Yt = w.Kt + (size_t)ns * nc; w.T = w.Yt + (size_t)ns * rn;
-  if (c->Uw) {   /* warm start (greedy_window): U = [the greedy V1, the leading modes of its complement] */
-    q = PHGMG__MIN(q, p + c->kw);
-    if (q < k) rc = PHGMG_ERR_SIZE;
-    memcpy(U, red->V0 + (size_t)N * m, (size_t)N * p * sizeof(double));
-    if (q > p) memcpy(U + (size_t)N * p, c->Uw, (size_t)N * (q - p) * sizeof(double));
-  } else if (c->o->pod_basis) memcpy(U, c->o->pod_basis, (size_t)N * q * sizeof(double));
-  else {
-    rc = phgmg_pod(N, ns, c->Xa, N, q, 0.0, U, N, NULL, &kk, c->alloc);
-    if (rc == PHGMG_OK && kk < k) rc = PHGMG_ERR_SIZE;
-    q = kk;   /* the numerical rank may cut the candidates */
-  }
-  w.q = q; w.ns = ns; w.p = p; w.rn = rn; w.k = k; w.S = S;
+  w.Kt = w.Wb + (size_t)k * ns; w.Yt = w.Kt + (size_t)ns * nc; w.T = w.Yt + (size_t)ns * rs;
+  w.q = q; w.ns = ns; w.p = p; w.rn = rs; w.k = k; w.S = S;
   w.lam = c->o->lambda_auto ? 1e-9 : c->lambda;
-  if (rc == PHGMG_OK) {
-    phgmg_gemm('T', 'N', q, ns, N, 1.0, U, N, c->Xa, N, 0.0, S, q);
-    tot = phgmg__sumsq(N, ns, c->Xa, N) - phgmg__sumsq(q, ns, S, q);
-    outside = PHGMG__MAX(tot, 0.0);                    /* what no Q in span U can represent */
-    for (i = 0; i < q * k; ++i) w.Q[i] = (i % q) == (i / q) ? 1.0 : 0.0;
-    rc = phgmg__altmin_eval(q, ns, p, rn, S, w.Q, w.lam, w.Kt, w.Yt, w.T, w.W, w.R, &f, &w.al);
-    if (rc == PHGMG_OK) c->inf.manifold_obj0 = c->inf.manifold_obj = f + outside;
-    for (it = 0; rc == PHGMG_OK && it < 100; ++it) {
-      f0 = f;
-      rc = phgmg__altmin_sweep(&w, &f, &moved);
-      if (rc != PHGMG_OK || !moved) break;
-      c->inf.manifold_sweeps = it + 1;
-      c->inf.manifold_obj = f + outside;
-      if (f > f0 * (1.0 - 1e-5)) break;
-    }
-    if (rc != PHGMG_ERR_NOMEM) rc = PHGMG_OK;   /* no fit or no unique step: the last Q (at worst the POD) */
+  phgmg_gemm('T', 'N', q, ns, N, 1.0, U, N, c->Xa, N, 0.0, S, q);
+  tot = phgmg__sumsq(N, ns, c->Xa, N) - phgmg__sumsq(q, ns, S, q);
+  outside = PHGMG__MAX(tot, 0.0);                    /* what no Q in span U can represent */
+  for (i = 0; i < q * k; ++i) w.Q[i] = (i % q) == (i / q) ? 1.0 : 0.0;
+  rc = phgmg__altmin_eval(q, ns, p, rs, S, w.Q, w.lam, w.Kt, w.Yt, w.T, w.W, w.R, &f, &w.al);
+  if (rc == PHGMG_OK) c->inf.manifold_obj0 = c->inf.manifold_obj = f + outside;
+  for (it = 0; rc == PHGMG_OK && it < 100; ++it) {
+    f0 = f;
+    rc = phgmg__altmin_sweep(&w, &f, &moved);
+    if (rc != PHGMG_OK || !moved) break;
+    c->inf.manifold_sweeps = it + 1;
+    c->inf.manifold_obj = f + outside;
+    if (f > f0 * (1.0 - 1e-5)) break;
   }
-  if (rc == PHGMG_OK) {   /* V1 = U Q1, V2 = U Q2 */
+  if (rc != PHGMG_ERR_NOMEM) rc = PHGMG_OK;   /* no fit or no unique step: the last Q (at worst the start) */
+  if (rc == PHGMG_OK) {   /* V1 = U Q1, V2 = U Q2 (a wide V2 is built afterwards from V1's complement) */
     phgmg_gemm('N', 'N', N, p, q, 1.0, U, N, w.Q, q, 0.0, red->V0 + (size_t)N * m, N);
-    phgmg_gemm('N', 'N', N, rn, q, 1.0, U, N, w.Q + (size_t)q * p, q, 0.0, red->V2, N);
+    if (!c->wide) phgmg_gemm('N', 'N', N, red->rn, q, 1.0, U, N, w.Q + (size_t)q * p, q, 0.0, red->V2, N);
   }
+  phgmg__free(c->alloc, blk);
   phgmg__free(c->alloc, U);
   return rc;
 }

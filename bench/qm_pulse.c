@@ -93,14 +93,15 @@ int main(int argc, char **argv) {
   sys.J = J; sys.R = R; sys.Q = Q; sys.B = B;
   printf("advecting Gaussian pulse, N = %d, %d training snapshots, lambda %g, V2 %s, reference state %s\n", NX, ns,
          lambda, rn == PHGMG_RN_WIDE ? "wide (whole residual)" : "capped", xref ? "the mean" : "none");
-  printf("%-8s %4s %5s %12s %12s %8s %9s\n", "manifold", "n", "rn", "e_proj", "reference", "ratio", "reduce_s");
+  printf("%-8s %4s %5s %12s %12s %8s %10s %6s %9s\n", "manifold", "n", "rn", "e_proj", "reference", "ratio", "span_floor",
+         "sweeps", "reduce_s");
   for (mf = mlo; mf <= mhi; ++mf)
     for (k = 0; k < nn; ++k) {
       phgmg_reduce_opts o;
       phgmg_reduce_info inf;
       phgmg_reduced *red = NULL;
       phgmg_result rc;
-      double t0, t1, e, rv = 0.0;
+      double t0, t1, e, lb, rv = 0.0;
       int a;
       memset(&o, 0, sizeof o);
       o.method = PHGMG_METHOD_GMG_QM; o.r = nl[k] + 1; o.rn = rn; o.lambda = lambda; o.manifold = mf;
@@ -112,11 +113,14 @@ int main(int argc, char **argv) {
       t1 = now();
       if (rc != PHGMG_OK) { printf("%-8s %4d  failed: %s\n", names[mf], nl[k], phgmg_result_string(rc)); continue; }
       e = phgmg_err_proj(red, X, NX, ns);
+      lb = phgmg_err_lowerbound(red, X, NX, ns);
       for (a = 0; a < 9; ++a) if ((int)(xref ? refm : ref0)[a][0] == nl[k]) rv = (xref ? refm : ref0)[a][1];
       if (rv > 0.0)
-        printf("%-8s %4d %5d %12.3e %12.3e %8.2f %9.2f\n", names[mf], nl[k], phgmg_reduced_rom(red)->rn, e, rv, e / rv, t1 - t0);
+        printf("%-8s %4d %5d %12.3e %12.3e %8.2f %10.3e %6d %9.2f\n", names[mf], nl[k], phgmg_reduced_rom(red)->rn, e, rv,
+               e / rv, lb, inf.manifold_sweeps, t1 - t0);
       else
-        printf("%-8s %4d %5d %12.3e %12s %8s %9.2f\n", names[mf], nl[k], phgmg_reduced_rom(red)->rn, e, "-", "-", t1 - t0);
+        printf("%-8s %4d %5d %12.3e %12s %8s %10.3e %6d %9.2f\n", names[mf], nl[k], phgmg_reduced_rom(red)->rn, e, "-", "-",
+               lb, inf.manifold_sweeps, t1 - t0);
       phgmg_reduced_destroy(red);
     }
   free(X); free(J);

@@ -212,12 +212,13 @@ TEST(test_qm_greedy_window_matches_direct) {
   phgmg_reduced_destroy(red);
 }
 
-/* manifold = ALTMIN with a greedy_window starts from the greedy manifold
-   (V1 the greedy choice, the search space its complement's leading modes) and
-   keeps only sweeps that lower its objective: on an advecting pulse (where the
-   hierarchical POD manifold is far from what the data allow) it ends at least
-   as good as the greedy manifold -- the same model when no sweep is kept --
-   and far below the POD manifold; started from the POD manifold it is not. */
+/* manifold = ALTMIN with a wide V2 descends in V1 with V2 = all that V1
+   leaves (manual 3.3); it keeps the best V1 seen, so its objective never
+   ends above its start. On an advecting pulse (where the hierarchical POD
+   manifold is far from what the data allow): started from the POD manifold
+   it closes most of the gap to the greedy manifold by itself, and started
+   from the greedy manifold (greedy_window > 0) it ends at least as good as
+   that -- the same model when no step is kept. */
 #define QP_N 400
 #define QP_NS 200
 TEST(test_qm_altmin_greedy_start) {
@@ -246,16 +247,52 @@ TEST(test_qm_altmin_greedy_start) {
     o.greedy_window = k >= 2 ? 40 : 0;
     CHECK_RC(phgmg_reduce(&red, &sys, X, QP_N, QP_NS, &o, &inf, NULL), PHGMG_OK);
     e[k] = red ? phgmg_err_proj(red, X, QP_N, QP_NS) : 1.0;
-    if (k == 3) {
-      CHECK(inf.manifold_obj <= inf.manifold_obj0);
-      sweeps = inf.manifold_sweeps;
-    }
+    if (k == 1 || k == 3) CHECK(inf.manifold_obj <= inf.manifold_obj0);
+    if (k == 1) CHECK(inf.manifold_sweeps > 0);
+    if (k == 3) sweeps = inf.manifold_sweeps;
     phgmg_reduced_destroy(red);
   }
-  CHECK(e[1] > 0.2 * e[0]);           /* from the POD manifold: stays near it */
-  CHECK_LE(e[3], 0.05 * e[0]);        /* from the greedy manifold: the gap closed */
+  CHECK_LE(e[2], 0.05 * e[0]);        /* the greedy manifold: far below the POD manifold */
+  CHECK_LE(e[1], 0.01 * e[0]);        /* from the POD manifold: most of the gap closed (measured 1e-4 x) */
+  CHECK_LE(e[1], e[2]);               /* ... and below the greedy manifold (measured 0.008 x) */
   if (sweeps == 0) CHECK(e[3] == e[2]);
-  else CHECK_LE(e[3], 1.5 * e[2]);
+  else CHECK_LE(e[3], e[2]);
+}
+
+/* The gradient of the wide alternating minimization's objective
+   (phgmg__awide_eval: the ridge fit eliminated, envelope theorem) against
+   central differences of f along tangent directions D = (I - Q1 Q1^T) Y:
+   d/ds f(orth(Q1 + s D)) at s = 0 is <g, D> (the polar retraction agrees with
+   Q1 + s D to second order). Random coordinates S, lam = 1e-3 (a smooth f). */
+TEST(test_qm_altmin_wide_gradient) {
+  enum { q = 14, ns = 60, p = 4, nc = p * (p + 1) / 2 };
+  static double S[q * ns], Q1[q * p], g[q * p], D[q * p], Qs[q * p], Pu[q * p], Pv[p * p], Psv[p], t[p * p];
+  static double Z[p * ns], Kt[ns * nc], Rt[ns * q], T[nc * q], E[q * ns], Gam[nc * ns], L[p * ns];
+  phgmg__awide w;
+  double f, fp, fm, dd;
+  int i, trial;
+  for (i = 0; i < q * ns; ++i) S[i] = th_rand() * (1.0 + (i % q));
+  for (i = 0; i < q * p; ++i) D[i] = th_rand();
+  CHECK_RC(phgmg__polar(q, p, D, Pu, Pv, Psv, Q1, NULL), PHGMG_OK);
+  memset(&w, 0, sizeof w);
+  w.q = q; w.ns = ns; w.p = p; w.nc = nc; w.lam = 1e-3; w.S = S;
+  w.Z = Z; w.Kt = Kt; w.Rt = Rt; w.T = T; w.E = E; w.Gam = Gam; w.L = L; w.Pu = Pu; w.Pv = Pv; w.Psv = Psv;
+  CHECK_RC(phgmg__awide_eval(&w, Q1, &f, g), PHGMG_OK);
+  for (trial = 0; trial < 3; ++trial) {
+    const double h = 1e-5;
+    for (i = 0; i < q * p; ++i) D[i] = th_rand();
+    phgmg_gemm('T', 'N', p, p, q, 1.0, Q1, q, D, q, 0.0, t, p);
+    phgmg_gemm('N', 'N', q, p, p, -1.0, Q1, q, t, p, 1.0, D, q);
+    dd = phgmg__dot(q * p, g, D);
+    for (i = 0; i < q * p; ++i) Qs[i] = Q1[i] + h * D[i];
+    CHECK_RC(phgmg__polar(q, p, Qs, Pu, Pv, Psv, Qs, NULL), PHGMG_OK);
+    CHECK_RC(phgmg__awide_eval(&w, Qs, &fp, NULL), PHGMG_OK);
+    for (i = 0; i < q * p; ++i) Qs[i] = Q1[i] - h * D[i];
+    CHECK_RC(phgmg__polar(q, p, Qs, Pu, Pv, Psv, Qs, NULL), PHGMG_OK);
+    CHECK_RC(phgmg__awide_eval(&w, Qs, &fm, NULL), PHGMG_OK);
+    CHECK_LE(fabs((fp - fm) / (2.0 * h) - dd), 1e-6 * fabs(dd) + 1e-9 * f);
+    CHECK(fabs(dd) > 1e-3 * f);   /* a direction along which f does change */
+  }
 }
 
 TEST(test_qm_wide_bad_rn) {
@@ -275,4 +312,5 @@ SUITE(qm_wide) {
   RUN(test_qm_greedy_window_matches_direct);
   RUN(test_qm_wide_bad_rn);
   RUN(test_qm_altmin_greedy_start);
+  RUN(test_qm_altmin_wide_gradient);
 }
