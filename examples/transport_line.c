@@ -18,24 +18,29 @@
      rs = 0.2 (series loss), n = 300 (N = 600), banded storage (half-bandwidth
      1: the interleaved states couple only neighbours).
    Inputs (current at node 1): training u(t) = exp(-((t - 0.15)/0.04)^2), one
-     pulse of 0.04 time units = 12 cells; test (unseen) u(t) = 0.7
-     exp(-((t - 0.1)/0.03)^2) - 0.5 exp(-((t - 0.45)/0.06)^2). t in (0, 1.4],
+     pulse of 0.04 time units = 12 cells; delayed: the same pulse 0.2 later
+     (its states are the training states delayed: on the training manifold);
+     test (unseen) u(t) = 0.7 exp(-((t - 0.1)/0.03)^2) - 0.5
+     exp(-((t - 0.45)/0.06)^2) (other widths, heights and signs: states off
+     the training manifold). t in (0, 1.4],
      dt = 0.004 (350 steps), from rest: the pulse crosses the line in one time
      unit and leaves through the termination.
    Methods, r = 6..30 step 6 (r includes the port coordinate):
      GMG-POD; GMG-QM with the hierarchical POD manifold (r_n = 8, the
-     paper's), the greedy manifold (wide V2) and alternating minimization
-     (wide V2), each with lambda validated by simulation (lambda_auto = 1,
+     paper's), the greedy manifold (wide V2, candidates the leading
+     r - 1 + 100 POD modes) and alternating minimization (wide V2, from the
+     POD manifold), each with lambda validated by simulation (lambda_auto = 1,
      the training run and three probes; M = 0 when no lambda is safe:
      reported as lambda = inf); and the hierarchical POD manifold with the
      snapshots' mean as affine reference state (manual 3.6).
    Measured: e_proj (training snapshots), e_red and e_y (training run), e_y
-     on the test input, the largest energy-balance error of the reduced
+     on the delayed pulse and on the test input, the largest energy-balance error of the reduced
      training run relative to the energy scale, the lambda kept.
    Output: <out>/transport_errors.csv and a table on the terminal;
    tests/check_transport.py checks what examples/README.md claims from it.
-   make demo runs r = 6, 12 (a few seconds); the table in examples/README.md
-   is of r = 6..30 (about a minute: V2 grows to 248 columns).
+   make demo runs r = 6, 12 (about 6 s); the table in examples/README.md
+   is of r = 6..30 (about two minutes: V2 grows to 248 columns, the
+   alternating minimization takes 200 descent steps at each r).
    Options: --n N (cells, 300), --rmin/--rmax/--rstep (6, 30, 6), --out DIR. */
 #define _POSIX_C_SOURCE 200809L
 #include <stdio.h>
@@ -49,10 +54,16 @@
 #define TL_DT 0.004
 #define TL_STEPS 350
 #define TL_RS 0.2
+#define TL_WINDOW 100 /* the greedy manifold's candidates: the leading r - 1 + 100 POD modes */
 
 static void u_train(double t, double *u, void *user) {
   (void)user;
   u[0] = exp(-((t - 0.15) / 0.04) * ((t - 0.15) / 0.04));
+}
+/* the training pulse 0.2 time units later: its states are the training
+   states delayed, on the training manifold */
+static void u_delay(double t, double *u, void *user) {
+  u_train(t - 0.2, u, user);
 }
 static void u_test(double t, double *u, void *user) {
   (void)user;
@@ -97,7 +108,7 @@ static int line_build(line *L, int n) {
 /* one row of the study */
 typedef struct row {
   int r, rc;
-  double e_proj, e_red, e_y, e_y_test, energy, lambda;
+  double e_proj, e_red, e_y, e_y_delay, e_y_test, energy, lambda;
   int rn;
 } row;
 
@@ -137,6 +148,7 @@ static row study_one(const line *L, int meth, int r, const double *X, const doub
     o.manifold = meth == 1 || meth == 4 ? PHGMG_MANIFOLD_POD : meth == 3 ? PHGMG_MANIFOLD_ALTMIN : PHGMG_MANIFOLD_GREEDY;
     o.lambda_auto = 1; o.nrun = 1; o.runs = &run;
     if (meth == 4) o.ref = PHGMG_REF_MEAN;
+    if (meth == 2) o.greedy_window = TL_WINDOW;
   }
   w.rc = phgmg_reduce(&red, &L->sys, X, N, ns, &o, &inf, NULL);
   if (w.rc != PHGMG_OK) return w;
@@ -150,7 +162,10 @@ static row study_one(const line *L, int meth, int r, const double *X, const doub
     w.e_red = phgmg_err_red(red, X, N, ns, XR, r);
     w.e_y = phgmg_rel_error(1, ns, Y, 1, Yr, 1);
     w.energy = energy_rel(&en, ns);
-    w.rc = phgmg_reduced_simulate(red, xr0, 0.0, TL_DT, TL_STEPS, u_test, NULL, 0.0, 20, NULL, Yr, NULL, NULL, NULL);
+    w.rc = phgmg_reduced_simulate(red, xr0, 0.0, TL_DT, TL_STEPS, u_delay, NULL, 0.0, 20, NULL, Yr, NULL, NULL, NULL);
+    if (w.rc == PHGMG_OK) w.e_y_delay = phgmg_rel_error(1, ns, Yt + ns, 1, Yr, 1);
+    if (w.rc == PHGMG_OK)
+      w.rc = phgmg_reduced_simulate(red, xr0, 0.0, TL_DT, TL_STEPS, u_test, NULL, 0.0, 20, NULL, Yr, NULL, NULL, NULL);
     if (w.rc == PHGMG_OK) w.e_y_test = phgmg_rel_error(1, ns, Yt, 1, Yr, 1);
   }
   phgmg_reduced_destroy(red);
@@ -183,21 +198,23 @@ int main(int argc, char **argv) {
   if (line_build(&L, n)) return 1;
   nr = (rmax - rmin) / rstep + 1;
   X = (double *)malloc(sizeof(double) * (size_t)L.N * (TL_STEPS + 1));
-  Y = (double *)malloc(sizeof(double) * 4 * (TL_STEPS + 1));
+  Y = (double *)malloc(sizeof(double) * 5 * (TL_STEPS + 1));
   XR = (double *)malloc(sizeof(double) * 64 * (TL_STEPS + 1));
   work = (double *)malloc(sizeof(double) * (64 + 4 * (TL_STEPS + 1)));
   x0 = (double *)calloc((size_t)L.N, sizeof(double));
   rows = (row *)calloc((size_t)nr * NM, sizeof(row));
   if (!X || !Y || !XR || !work || !x0 || !rows) return 1;
-  Yt = Y + (TL_STEPS + 1); Yr = Yt + (TL_STEPS + 1);
+  Yt = Y + (TL_STEPS + 1); Yr = Yt + 2 * (TL_STEPS + 1);   /* Yt: the test, then the delayed pulse */
   if (phgmg_simulate(&L.sys, x0, 0.0, TL_DT, TL_STEPS, u_train, NULL, NULL, X, Y, NULL, NULL, NULL, NULL) != PHGMG_OK ||
-      phgmg_simulate(&L.sys, x0, 0.0, TL_DT, TL_STEPS, u_test, NULL, NULL, NULL, Yt, NULL, NULL, NULL, NULL) != PHGMG_OK) {
+      phgmg_simulate(&L.sys, x0, 0.0, TL_DT, TL_STEPS, u_test, NULL, NULL, NULL, Yt, NULL, NULL, NULL, NULL) != PHGMG_OK ||
+      phgmg_simulate(&L.sys, x0, 0.0, TL_DT, TL_STEPS, u_delay, NULL, NULL, NULL, Yt + TL_STEPS + 1, NULL, NULL, NULL,
+                     NULL) != PHGMG_OK) {
     fprintf(stderr, "transport_line: the full model failed\n");
     return 1;
   }
   printf("transmission line, N = %d, %d steps of %g, pulse through the line and out (matched end)\n", L.N, TL_STEPS, TL_DT);
-  printf("%-19s %3s %4s %10s %10s %10s %10s %9s %9s\n", "method", "r", "rn", "e_proj", "e_red", "e_y", "e_y_test",
-         "energy", "lambda");
+  printf("%-19s %3s %4s %10s %10s %10s %10s %10s %9s %9s\n", "method", "r", "rn", "e_proj", "e_red", "e_y", "e_y_delay",
+         "e_y_test", "energy", "lambda");
   for (m = 0; m < NM; ++m)
     for (i = 0; i < nr; ++i) {
       row *w;
@@ -207,18 +224,18 @@ int main(int argc, char **argv) {
       if (w->rc != PHGMG_OK)
         printf("%-19s %3d  failed: %s\n", mname[m], r, phgmg_result_string((phgmg_result)w->rc));
       else
-        printf("%-19s %3d %4d %10.3e %10.3e %10.3e %10.3e %9.1e %9.1e\n", mname[m], r, w->rn, w->e_proj, w->e_red,
-               w->e_y, w->e_y_test, w->energy, w->lambda);
+        printf("%-19s %3d %4d %10.3e %10.3e %10.3e %10.3e %10.3e %9.1e %9.1e\n", mname[m], r, w->rn, w->e_proj, w->e_red,
+               w->e_y, w->e_y_delay, w->e_y_test, w->energy, w->lambda);
     }
   snprintf(path, sizeof path, "%s/transport_errors.csv", out);
   f = fopen(path, "w");
   if (!f) { fprintf(stderr, "transport_line: cannot write %s\n", path); return 1; }
-  fprintf(f, "method,r,rn,rc,e_proj,e_red,e_y,e_y_test,energy,lambda\n");
+  fprintf(f, "method,r,rn,rc,e_proj,e_red,e_y,e_y_delay,e_y_test,energy,lambda\n");
   for (m = 0; m < NM; ++m)
     for (i = 0; i < nr; ++i) {
       const row *w = &rows[m * nr + i];
-      fprintf(f, "%s,%d,%d,%d,%.6e,%.6e,%.6e,%.6e,%.6e,%.6e\n", mname[m], w->r, w->rn, w->rc, w->e_proj, w->e_red,
-              w->e_y, w->e_y_test, w->energy, w->lambda);
+      fprintf(f, "%s,%d,%d,%d,%.6e,%.6e,%.6e,%.6e,%.6e,%.6e,%.6e\n", mname[m], w->r, w->rn, w->rc, w->e_proj, w->e_red,
+              w->e_y, w->e_y_delay, w->e_y_test, w->energy, w->lambda);
     }
   fclose(f);
   printf("wrote %s\n", path);
