@@ -1280,7 +1280,11 @@ extern "C" {
 
 /* Every enumerated choice ends in a _COUNT: one more than its largest value
    (not a choice itself), for range checks and tables. */
-typedef enum phgmg_storage { PHGMG_DENSE = 0, PHGMG_BANDED = 1, PHGMG_STORAGE_COUNT } phgmg_storage;
+/* PHGMG_SPARSE: only the system of a phgmg_ph_sparse object that chose the
+   sparse LU (phgmg_ph_sparse_system): J, R, Q are then the value arrays of the
+   object's compressed (CSC) copies, not arrays a caller can index. */
+typedef enum phgmg_storage { PHGMG_DENSE = 0, PHGMG_BANDED = 1, PHGMG_SPARSE = 2,
+                             PHGMG_STORAGE_COUNT } phgmg_storage;
 
 typedef enum phgmg_nl_kind {
   PHGMG_NL_NONE = 0,      /* quadratic Hamiltonian only                          */
@@ -1573,6 +1577,8 @@ typedef struct phgmg_ph_sparse_info {
   int supernodes;     /* supernodes of the sparse factor (0: not analysed)     */
   int front_max;      /* largest dense front (order)                           */
   int condensed;      /* states eliminated first by block elimination (>>sparse) */
+  int band_copy;      /* 1: the object holds band copies of J, R, Q (band solver) */
+  double bytes;       /* memory the object holds now (its arrays, the analysis)   */
 } phgmg_ph_sparse_info;
 PHGMG_DEF phgmg_result phgmg_ph_sparse_create(phgmg_ph_sparse **out, int N, int m, const phgmg_csc *J,
                                               const phgmg_csc *R, const phgmg_csc *Q, const double *B,
@@ -4691,8 +4697,24 @@ PHGMG_DEF phgmg_result phgmg_sym_eig(int n, double *A, int lda, double *w, doubl
    shifted band Cholesky instead of a dense eigenvalue computation. */
 #define PHGMG__PH_PSD_DENSE_MAX 2000
 
-/* Element (i,j) of J, R or Q (0 outside the band). */
+PHGMG__PRIV int phgmg__ph_csc_of(const phgmg_ph_system *s, const double *M, const int **cp, const int **ci,
+                                 const double **cx);
+PHGMG__PRIV phgmg_result phgmg__ph_sparse_own_band(const phgmg_ph_system *s, int a1, int a2, phgmg_ph_system *t,
+                                                  double **bands, int **perm, const phgmg_allocator *al);
+PHGMG__PRIV void phgmg__ph_own_band_free(phgmg_ph_system *t, double **bands, int *perm, const phgmg_allocator *al);
+
+/* Element (i,j) of J, R or Q (0 outside the band or the pattern). */
 PHGMG__PRIV double phgmg__ph_at(const phgmg_ph_system *s, const double *M, int i, int j) {
+  const int *cp, *ci;
+  const double *cx;
+  if (phgmg__ph_csc_of(s, M, &cp, &ci, &cx)) { /* binary search in column j */
+    int lo = cp[j], hi = cp[j + 1];
+    while (lo < hi) {
+      int mid = lo + (hi - lo) / 2;
+      if (ci[mid] < i) lo = mid + 1; else hi = mid;
+    }
+    return lo < cp[j + 1] && ci[lo] == i ? cx[lo] : 0.0;
+  }
   if (s->storage == PHGMG_BANDED) {
     int d = i - j;
     if (d > s->kb || d < -s->kb) return 0.0;
@@ -4731,6 +4753,16 @@ PHGMG__PRIV void phgmg__ph_mv(const phgmg_ph_system *s, const double *M, const d
 /* y = M^T x (overwrite) for a dense or banded system matrix. */
 PHGMG__PRIV void phgmg__ph_mtv(const phgmg_ph_system *s, const double *M, const double *x, double *y) {
   int N = s->N, i, j;
+  const int *cp, *ci;
+  const double *cx;
+  if (phgmg__ph_csc_of(s, M, &cp, &ci, &cx)) {
+    for (j = 0; j < N; ++j) {
+      double acc = 0.0;
+      for (i = cp[j]; i < cp[j + 1]; ++i) acc += cx[i] * x[ci[i]];
+      y[j] = acc;
+    }
+    return;
+  }
   for (j = 0; j < N; ++j) {
     double acc = 0.0;
     if (s->storage == PHGMG_BANDED) {
@@ -4763,6 +4795,16 @@ PHGMG__PRIV double phgmg__ph_quad(const phgmg_ph_system *s, const double *M, con
                                   const double *y) {
   int N = s->N, i, j;
   double acc = 0.0;
+  const int *cp, *ci;
+  const double *cx;
+  if (phgmg__ph_csc_of(s, M, &cp, &ci, &cx)) {
+    for (j = 0; j < N; ++j) {
+      double t = 0.0;
+      for (i = cp[j]; i < cp[j + 1]; ++i) t += x[ci[i]] * cx[i];
+      acc += t * y[j];
+    }
+    return acc;
+  }
   for (j = 0; j < N; ++j) {
     double t = 0.0;
     if (s->storage == PHGMG_BANDED) {
@@ -4927,13 +4969,17 @@ PHGMG__PRIV phgmg_result phgmg__ph_check_dampers(const phgmg_ph_system *s) {
   return PHGMG_OK;
 }
 
+PHGMG__PRIV phgmg_result phgmg__ph_check_sparse(const phgmg_ph_system *s);
+
 /* Structural checks shared by every entry point (no O(N^2) work). */
 PHGMG__PRIV phgmg_result phgmg__ph_check(const phgmg_ph_system *s) {
   int k;
   if (!s) return PHGMG_ERR_INVALID_ARG;
   if (s->N <= 0 || s->m <= 0 || s->m > s->N) return PHGMG_ERR_SIZE;
-  if (s->storage != PHGMG_DENSE && s->storage != PHGMG_BANDED) return PHGMG_ERR_INVALID_ARG;
+  if (s->storage != PHGMG_DENSE && s->storage != PHGMG_BANDED && s->storage != PHGMG_SPARSE)
+    return PHGMG_ERR_INVALID_ARG;
   if (s->storage == PHGMG_BANDED && (s->kb < 0 || s->kb > s->N - 1)) return PHGMG_ERR_SIZE;
+  if (s->storage == PHGMG_SPARSE && phgmg__ph_check_sparse(s) != PHGMG_OK) return phgmg__ph_check_sparse(s);
   if (!s->J || !s->R || !s->Q || !s->B) return PHGMG_ERR_INVALID_ARG;
   if ((s->shifted_factor == NULL) != (s->shifted_solve == NULL)) return PHGMG_ERR_INVALID_ARG;
   if (s->E && (s->nl == PHGMG_NL_GENERAL || s->shifted_factor)) return PHGMG_ERR_UNSUPPORTED;
@@ -4966,6 +5012,9 @@ PHGMG__PRIV phgmg_result phgmg__ph_check(const phgmg_ph_system *s) {
 /* Finiteness of the valid entries of a dense or banded system matrix. */
 PHGMG__PRIV int phgmg__ph_mat_finite(const phgmg_ph_system *s, const double *M) {
   int N = s->N, j;
+  const int *cp, *ci;
+  const double *cx;
+  if (phgmg__ph_csc_of(s, M, &cp, &ci, &cx)) return phgmg__all_finite(cx, (size_t)cp[N]);
   if (s->storage == PHGMG_DENSE) return phgmg__all_finite(M, (size_t)N * (size_t)N);
   for (j = 0; j < N; ++j) {
     int i0 = PHGMG__MAX(0, j - s->kb), i1 = PHGMG__MIN(N - 1, j + s->kb);
@@ -5070,8 +5119,13 @@ PHGMG_DEF void phgmg_ph_rhs(const phgmg_ph_system *sys, const double *x, const d
   /* f -= R g, column by column (no second scratch vector) */
   for (j = 0; j < N; ++j) {
     double gj = g[j];
+    const int *cp, *ci;
+    const double *cx;
     if (gj == 0.0) continue;
-    if (sys->storage == PHGMG_BANDED) {
+    if (phgmg__ph_csc_of(sys, sys->R, &cp, &ci, &cx)) {
+      int p;
+      for (p = cp[j]; p < cp[j + 1]; ++p) f[ci[p]] -= cx[p] * gj;
+    } else if (sys->storage == PHGMG_BANDED) {
       int kb = sys->kb, i0 = PHGMG__MAX(0, j - kb), i1 = PHGMG__MIN(N - 1, j + kb);
       const double *col = sys->R + PHGMG__PHB(kb, 0, j);
       for (i = i0; i <= i1; ++i) f[i] -= col[i] * gj;
@@ -5387,6 +5441,20 @@ PHGMG__PRIV double phgmg__gbf_inv_norm1(const phgmg__gbf *f, double *work, int *
 PHGMG__PRIV double phgmg__ph_jr_norm1(const phgmg_ph_system *s) {
   int N = s->N, i, j;
   double best = 0.0;
+  const int *jp, *ji, *rp, *ri;
+  const double *jx, *rx;
+  if (phgmg__ph_csc_of(s, s->J, &jp, &ji, &jx) && phgmg__ph_csc_of(s, s->R, &rp, &ri, &rx)) {
+    for (j = 0; j < N; ++j) { /* the two sorted columns merged */
+      int p = jp[j], q = rp[j];
+      double acc = 0.0;
+      while (p < jp[j + 1] || q < rp[j + 1]) {
+        int a = p < jp[j + 1] ? ji[p] : N, b = q < rp[j + 1] ? ri[q] : N, r = PHGMG__MIN(a, b);
+        acc += fabs((a == r ? jx[p++] : 0.0) - (b == r ? rx[q++] : 0.0));
+      }
+      if (acc > best) best = acc;
+    }
+    return best;
+  }
   for (j = 0; j < N; ++j) {
     double acc = 0.0;
     int i0 = 0, i1 = N - 1;
@@ -5408,7 +5476,9 @@ struct phgmg_jr_factor {
   phgmg_storage storage;
   double *LU; /* dense */
   int *ipiv;
-  phgmg__gbf gb; /* banded */
+  phgmg__gbf gb; /* banded; SPARSE systems: in J - R's own RCM order, */
+  int *perm;     /* position i holds index perm[i] (NULL: none)       */
+  double *w;     /* N, the permuted right-hand side                   */
 };
 
 PHGMG_DEF void phgmg_jr_factor_destroy(phgmg_jr_factor *f) {
@@ -5418,6 +5488,8 @@ PHGMG_DEF void phgmg_jr_factor_destroy(phgmg_jr_factor *f) {
   phgmg__free(&al, f->LU);
   phgmg__free(&al, f->ipiv);
   phgmg__gbf_free(&al, &f->gb);
+  phgmg__free(&al, f->perm);
+  phgmg__free(&al, f->w);
   phgmg__free(&al, f);
 }
 
@@ -5447,6 +5519,8 @@ PHGMG__PRIV double phgmg__jr_rcond(const phgmg_jr_factor *f, const phgmg_ph_syst
 PHGMG_DEF phgmg_result phgmg_jr_factor_create(phgmg_jr_factor **out, const phgmg_ph_system *sys,
                                               double *rcond_out, const phgmg_allocator *alloc) {
   phgmg_jr_factor *f;
+  phgmg_ph_system t;
+  double *bands[2] = {NULL, NULL};
   phgmg_result rc;
   int N, i, j;
   if (!out) return PHGMG_ERR_INVALID_ARG;
@@ -5472,6 +5546,15 @@ PHGMG_DEF phgmg_result phgmg_jr_factor_create(phgmg_jr_factor **out, const phgmg
         f->LU[k] = sys->J[k] - sys->R[k];
       }
     rc = phgmg_lu_factor(N, f->LU, N, f->ipiv);
+  } else if (sys->storage == PHGMG_SPARSE) { /* J - R in band storage, its own RCM order */
+    rc = phgmg__ph_sparse_own_band(sys, 0, 1, &t, bands, &f->perm, alloc);
+    f->w = phgmg__dalloc(alloc, (size_t)N);
+    if (rc == PHGMG_OK && !f->w) rc = PHGMG_ERR_NOMEM;
+    if (rc == PHGMG_OK) rc = phgmg__gbf_jr(alloc, &t, &f->gb);
+    if (rc == PHGMG_OK && rcond_out) *rcond_out = phgmg__jr_rcond(f, &t);
+    phgmg__ph_own_band_free(&t, bands, NULL, alloc);
+    if (rc == PHGMG_OK && rcond_out && *rcond_out < 0.0) rc = PHGMG_ERR_NOMEM;
+    if (rc == PHGMG_OK) { *out = f; return PHGMG_OK; }
   } else {
     rc = phgmg__gbf_jr(alloc, sys, &f->gb);
   }
@@ -5497,7 +5580,14 @@ PHGMG_DEF void phgmg_jr_solve(const phgmg_jr_factor *f, char trans, int nrhs, do
     phgmg_lu_solve(trans, f->N, f->LU, f->N, f->ipiv, nrhs, X, ldx);
     return;
   }
-  for (c = 0; c < nrhs; ++c) phgmg__gbf_solve(&f->gb, trans, X + (size_t)c * (size_t)ldx);
+  for (c = 0; c < nrhs; ++c) {
+    double *x = X + (size_t)c * (size_t)ldx;
+    int i;
+    if (!f->perm) { phgmg__gbf_solve(&f->gb, trans, x); continue; }
+    for (i = 0; i < f->N; ++i) f->w[i] = x[f->perm[i]];
+    phgmg__gbf_solve(&f->gb, trans, f->w);
+    for (i = 0; i < f->N; ++i) x[f->perm[i]] = f->w[i];
+  }
 }
 
 /* ---- validation ------------------------------------------------------------- */
@@ -5506,6 +5596,20 @@ PHGMG__PRIV void phgmg__ph_sym_defect(const phgmg_ph_system *s, const double *M,
                                       double *norm, double *defect) {
   int N = s->N, i, j;
   double a = 0.0, d = 0.0;
+  const int *cp, *ci;
+  const double *cx;
+  if (phgmg__ph_csc_of(s, M, &cp, &ci, &cx)) { /* stored (i,j); (j,i) counted here too when not stored */
+    for (j = 0; j < N; ++j)
+      for (i = cp[j]; i < cp[j + 1]; ++i) {
+        double mij = cx[i], mji = phgmg__ph_at(s, M, j, ci[i]), e = mij + sign * mji;
+        a += mij * mij;
+        d += e * e;
+        if (mji == 0.0) d += mij * mij;
+      }
+    *norm = sqrt(a);
+    *defect = sqrt(d);
+    return;
+  }
   for (j = 0; j < N; ++j) {
     int i0 = 0, i1 = N - 1;
     if (s->storage == PHGMG_BANDED) {
@@ -5555,6 +5659,15 @@ PHGMG__PRIV phgmg_result phgmg__ph_check_psd(const phgmg_ph_system *s, double to
                                              const phgmg_allocator *al) {
   int N = s->N, i, j, diag = 1;
   double dmax = 0.0, dmin = HUGE_VAL;
+  if (s->storage == PHGMG_SPARSE) { /* R alone in band storage, in its own RCM order */
+    phgmg_ph_system t;
+    double *bands[2];
+    int *perm = NULL;
+    phgmg_result rc = phgmg__ph_sparse_own_band(s, 1, -1, &t, bands, &perm, al);
+    if (rc == PHGMG_OK) rc = phgmg__ph_check_psd(&t, tol, al);
+    phgmg__ph_own_band_free(&t, bands, perm, al);
+    return rc;
+  }
   for (j = 0; j < N && diag; ++j) {
     int i0 = 0, i1 = N - 1;
     if (s->storage == PHGMG_BANDED) {
@@ -5613,6 +5726,15 @@ PHGMG__PRIV phgmg_result phgmg__ph_check_q_pd(const phgmg_ph_system *s, double t
   int i, j, diag = 1;
   double *L, shift = 0.0;
   phgmg_result rc = PHGMG_OK;
+  if (s->storage == PHGMG_SPARSE) { /* Q alone in band storage, in its own RCM order */
+    phgmg_ph_system t;
+    double *bands[2];
+    int *perm = NULL;
+    rc = phgmg__ph_sparse_own_band(s, 2, -1, &t, bands, &perm, al);
+    if (rc == PHGMG_OK) rc = phgmg__ph_check_q_pd(&t, tol, al);
+    phgmg__ph_own_band_free(&t, bands, perm, al);
+    return rc;
+  }
   for (j = 0; j < N && diag; ++j)
     for (i = PHGMG__MAX(0, j - kb); i <= PHGMG__MIN(N - 1, j + kb); ++i)
       if (i != j && phgmg__ph_at(s, s->Q, i, j) != 0.0) { diag = 0; break; }
@@ -7371,13 +7493,11 @@ PHGMG__PRIV phgmg_result phgmg__sp_order(int n, const int *gp, const int *gi, in
    condensing an independent set of states, whichever predicts the smaller
    factor (condensation: its couplings, twice, plus the diagonal).
    condense: -1 that choice, 0 never, 1 whenever a state can be condensed. */
+PHGMG__PRIV phgmg_result phgmg__spsym_analyse(phgmg__spsym *S, int condense, const phgmg_allocator *al);
 PHGMG__PRIV phgmg_result phgmg__spsym_create(phgmg__spsym **out, int n, int kb, const double *J,
                                              const double *R, const double *Q, int condense,
                                              const phgmg_allocator *al) {
   phgmg__spsym *S = PHGMG__CAST(phgmg__spsym *, phgmg__alloc(al, sizeof(phgmg__spsym)));
-  int *gp = NULL, *gi = NULL, *hp = NULL, *hi = NULL, *iord = NULL, *parent = NULL, *w1 = NULL,
-      *w2 = NULL, *w3 = NULL, *perm2 = NULL, i;
-  double lnz = 0.0, lnz2 = 0.0;
   phgmg_result rc;
   *out = NULL;
   if (!S) return PHGMG_ERR_NOMEM;
@@ -7385,7 +7505,20 @@ PHGMG__PRIV phgmg_result phgmg__spsym_create(phgmg__spsym **out, int n, int kb, 
   S->n = n;
   rc = phgmg__band_to_csc(n, kb, J, R, &S->jr_p, &S->jr_i, &S->jr_x, al);
   if (rc == PHGMG_OK) rc = phgmg__band_to_csc(n, kb, Q, NULL, &S->q_p, &S->q_i, &S->q_x, al);
-  if (rc == PHGMG_OK) rc = phgmg__spsym_kpattern(S, al);
+  if (rc == PHGMG_OK) rc = phgmg__spsym_analyse(S, condense, al);
+  if (rc != PHGMG_OK) { phgmg__spsym_free(al, S); return rc; }
+  *out = S;
+  return PHGMG_OK;
+}
+
+/* Steps 0-2 of the analysis (see >>sparse) of S with its J - R and Q set;
+   on failure the caller frees S. */
+PHGMG__PRIV phgmg_result phgmg__spsym_analyse(phgmg__spsym *S, int condense, const phgmg_allocator *al) {
+  const int n = S->n;
+  int *gp = NULL, *gi = NULL, *hp = NULL, *hi = NULL, *iord = NULL, *parent = NULL, *w1 = NULL,
+      *w2 = NULL, *w3 = NULL, *perm2 = NULL, i;
+  double lnz = 0.0, lnz2 = 0.0;
+  phgmg_result rc = phgmg__spsym_kpattern(S, al);
   if (rc == PHGMG_OK) rc = phgmg__spsym_graph(n, S->k_p, S->k_i, &gp, &gi, al);
   if (rc != PHGMG_OK) goto done;
   iord = phgmg__ialloc(al, (size_t)n);
@@ -7434,9 +7567,20 @@ done:
   phgmg__free(al, gp); phgmg__free(al, gi); phgmg__free(al, hp); phgmg__free(al, hi);
   phgmg__free(al, iord); phgmg__free(al, parent); phgmg__free(al, w1); phgmg__free(al, w2);
   phgmg__free(al, w3); phgmg__free(al, perm2);
-  if (rc != PHGMG_OK) { phgmg__spsym_free(al, S); return rc; }
-  *out = S;
-  return PHGMG_OK;
+  return rc;
+}
+
+/* Memory of an analysis (bytes). */
+PHGMG__PRIV double phgmg__spsym_bytes(const phgmg__spsym *S) {
+  const double n = (double)S->n, nf = (double)S->nf, na = (double)S->na, I = (double)sizeof(int);
+  double b = (2.0 * n + 2.0) * I + (double)(S->jr_p[S->n] + S->q_p[S->n]) * (I + sizeof(double));
+  b += (double)S->k_p[S->n] * I + (n + 1.0) * I;
+  if (S->f_p != S->k_p) b += (double)S->f_p[S->nf] * I + (nf + 1.0) * I;
+  b += (4.0 * n + nf + 3.0 * na) * I;
+  if (S->na) b += 2.0 * (double)(S->ca_p[S->na] + S->ra_p[S->na]) * I;
+  b += (double)S->nsup * (6.0 * I + sizeof(size_t)) + (double)(S->srp ? S->srp[S->nsup] : 0) * I;
+  if (S->amp) b += (double)S->amp[S->nsup] * (I + sizeof(size_t));
+  return b;
 }
 
 /* Numeric factors of one stage matrix (real, or complex: interleaved pairs). */
@@ -8025,13 +8169,63 @@ struct phgmg_ph_sparse {
   int *perm, *iperm, *sep;
   double *J, *R, *Q, *B;
   double *E;   /* descriptor models (phgmg_ph_sparse_create_e), else NULL */
+  int *cp[3], *ci[3];           /* J, R, Q as CSC in the internal order */
+  double *cx[3];                /*   (rows sorted; nnz + 1 values each) */
   phgmg__spsym *sym;            /* sparse LU analysis (NULL: not done) */
   int use_lu;                   /* 1: steppers use the sparse LU       */
   phgmg_ph_sparse_info inf;
 };
 
+/* The analysis of sp's stage matrices from its CSC copies (J - R merged,
+   zero values dropped, as from band storage); condense as phgmg__spsym_create. */
+PHGMG__PRIV phgmg_result phgmg__spsym_create_sp(phgmg__spsym **out, const phgmg_ph_sparse *sp, int condense) {
+  const phgmg_allocator *al = sp->alloc;
+  const int n = sp->sys.N;
+  phgmg__spsym *S = PHGMG__CAST(phgmg__spsym *, phgmg__alloc(al, sizeof(phgmg__spsym)));
+  phgmg_result rc = PHGMG_OK;
+  int j, p, q, pass;
+  *out = NULL;
+  if (!S) return PHGMG_ERR_NOMEM;
+  memset(S, 0, sizeof *S);
+  S->n = n;
+  S->jr_p = phgmg__ialloc(al, (size_t)n + 1);
+  S->q_p = phgmg__ialloc(al, (size_t)n + 1);
+  if (!S->jr_p || !S->q_p) rc = PHGMG_ERR_NOMEM;
+  for (pass = 0; pass < 2 && rc == PHGMG_OK; ++pass) { /* count, then fill */
+    int nz = 0, nq = 0;
+    for (j = 0; j < n; ++j) {
+      S->jr_p[j] = nz; S->q_p[j] = nq;
+      p = sp->cp[0][j]; q = sp->cp[1][j];
+      while (p < sp->cp[0][j + 1] || q < sp->cp[1][j + 1]) {
+        int ip = p < sp->cp[0][j + 1] ? sp->ci[0][p] : n, iq = q < sp->cp[1][j + 1] ? sp->ci[1][q] : n;
+        int i = PHGMG__MIN(ip, iq);
+        double v = (ip == i ? sp->cx[0][p++] : 0.0) - (iq == i ? sp->cx[1][q++] : 0.0);
+        if (v == 0.0) continue;
+        if (pass) { S->jr_i[nz] = i; S->jr_x[nz] = v; }
+        ++nz;
+      }
+      for (p = sp->cp[2][j]; p < sp->cp[2][j + 1]; ++p) {
+        if (sp->cx[2][p] == 0.0) continue;
+        if (pass) { S->q_i[nq] = sp->ci[2][p]; S->q_x[nq] = sp->cx[2][p]; }
+        ++nq;
+      }
+    }
+    S->jr_p[n] = nz; S->q_p[n] = nq;
+    if (!pass) {
+      S->jr_i = phgmg__ialloc(al, (size_t)nz + 1); S->jr_x = phgmg__dalloc(al, (size_t)nz + 1);
+      S->q_i = phgmg__ialloc(al, (size_t)nq + 1); S->q_x = phgmg__dalloc(al, (size_t)nq + 1);
+      if (!S->jr_i || !S->jr_x || !S->q_i || !S->q_x) rc = PHGMG_ERR_NOMEM;
+    }
+  }
+  if (rc == PHGMG_OK) rc = phgmg__spsym_analyse(S, condense, al);
+  if (rc != PHGMG_OK) { phgmg__spsym_free(al, S); return rc; }
+  *out = S;
+  return PHGMG_OK;
+}
+
 PHGMG_DEF void phgmg_ph_sparse_destroy(phgmg_ph_sparse *sp) {
   const phgmg_allocator *alloc;
+  int a;
   if (!sp) return;
   alloc = sp->alloc;
   phgmg__free(alloc, sp->perm);
@@ -8042,6 +8236,9 @@ PHGMG_DEF void phgmg_ph_sparse_destroy(phgmg_ph_sparse *sp) {
   phgmg__free(alloc, sp->Q);
   phgmg__free(alloc, sp->B);
   phgmg__free(alloc, sp->E);
+  for (a = 0; a < 3; ++a) {
+    phgmg__free(alloc, sp->cp[a]); phgmg__free(alloc, sp->ci[a]); phgmg__free(alloc, sp->cx[a]);
+  }
   phgmg__spsym_free(alloc, sp->sym);
   phgmg__free(alloc, sp);
 }
@@ -8055,6 +8252,38 @@ PHGMG__PRIV void phgmg__csc_to_band(const phgmg_csc *A, const int *ip, int kb, d
       int r = ip[A->rowidx[p]], c = ip[j];
       band[(size_t)(kb + r - c) + (size_t)c * ld] = A->values[p];
     }
+}
+
+/* CSC of P A P^T (ip: the inverse permutation, new index of each old one),
+   rows sorted in each column; nnz + 1 values (a distinct array also when
+   A has no entry). */
+PHGMG__PRIV phgmg_result phgmg__csc_permuted(const phgmg_csc *A, const int *ip, int **pp, int **pi, double **px,
+                                            const phgmg_allocator *al) {
+  const int n = A->n_cols;
+  const size_t nz = (size_t)A->colptr[n];
+  int j, p, *cnt;
+  *pp = phgmg__ialloc(al, (size_t)n + 1);
+  *pi = phgmg__ialloc(al, nz + 1);
+  *px = phgmg__dalloc(al, nz + 1);
+  cnt = phgmg__ialloc(al, (size_t)n + 1);
+  if (!*pp || !*pi || !*px || !cnt) { phgmg__free(al, cnt); return PHGMG_ERR_NOMEM; }
+  for (j = 0; j <= n; ++j) cnt[j] = 0;
+  for (j = 0; j < n; ++j) cnt[ip[j] + 1] = A->colptr[j + 1] - A->colptr[j];
+  for (j = 0; j < n; ++j) cnt[j + 1] += cnt[j];
+  memcpy(*pp, cnt, sizeof(int) * ((size_t)n + 1));
+  for (j = 0; j < n; ++j) {
+    int c = ip[j], q = cnt[c], k;
+    for (p = A->colptr[j]; p < A->colptr[j + 1]; ++p, ++q) { (*pi)[q] = ip[A->rowidx[p]]; (*px)[q] = A->values[p]; }
+    for (k = cnt[c] + 1; k < q; ++k) { /* insertion sort by row (columns are short) */
+      int r = (*pi)[k], t = k;
+      double v = (*px)[k];
+      while (t > cnt[c] && (*pi)[t - 1] > r) { (*pi)[t] = (*pi)[t - 1]; (*px)[t] = (*px)[t - 1]; --t; }
+      (*pi)[t] = r; (*px)[t] = v;
+    }
+  }
+  (*px)[nz] = 0.0;
+  phgmg__free(al, cnt);
+  return PHGMG_OK;
 }
 
 /* Argument and data checks of phgmg_ph_sparse_create. */
@@ -8091,7 +8320,6 @@ PHGMG_DEF phgmg_result phgmg_ph_sparse_create_e(phgmg_ph_sparse **out, int N, in
   phgmg_ph_sparse *sp;
   phgmg_result rc;
   int a, i, j, kb_in = 0, kb_rcm = 0, kb;
-  size_t len;
   A[0] = J; A[1] = R; A[2] = Q; A[3] = E;
   if (info) memset(info, 0, sizeof *info);
   if (!out) return PHGMG_ERR_INVALID_ARG;
@@ -8114,22 +8342,14 @@ PHGMG_DEF phgmg_result phgmg_ph_sparse_create_e(phgmg_ph_sparse **out, int N, in
     for (i = 0; i < N; ++i) sp->perm[i] = i;
   kb = kb_rcm < kb_in ? kb_rcm : kb_in;
   for (i = 0; i < N; ++i) sp->iperm[sp->perm[i]] = i;
-  len = (size_t)(2 * kb + 1) * (size_t)N;
-  sp->J = phgmg__dalloc(alloc, len);
-  sp->R = phgmg__dalloc(alloc, len);
-  sp->Q = phgmg__dalloc(alloc, len);
+  for (a = 0; a < 3 && rc == PHGMG_OK; ++a) /* J, R, Q in the internal order: no band copy yet */
+    rc = phgmg__csc_permuted(A[a], sp->iperm, &sp->cp[a], &sp->ci[a], &sp->cx[a], alloc);
   sp->B = phgmg__dalloc(alloc, (size_t)N * (size_t)m);
-  if (!sp->J || !sp->R || !sp->Q || !sp->B) { phgmg_ph_sparse_destroy(sp); return PHGMG_ERR_NOMEM; }
-  memset(sp->J, 0, sizeof(double) * len);
-  memset(sp->R, 0, sizeof(double) * len);
-  memset(sp->Q, 0, sizeof(double) * len);
-  phgmg__csc_to_band(J, sp->iperm, kb, sp->J);
-  phgmg__csc_to_band(R, sp->iperm, kb, sp->R);
-  phgmg__csc_to_band(Q, sp->iperm, kb, sp->Q);
-  if (E) {
-    sp->E = phgmg__dalloc(alloc, len);
+  if (rc != PHGMG_OK || !sp->B) { phgmg_ph_sparse_destroy(sp); return rc != PHGMG_OK ? rc : PHGMG_ERR_NOMEM; }
+  if (E) { /* descriptor models keep the band solver: E in band storage */
+    sp->E = phgmg__dalloc(alloc, (size_t)(2 * kb + 1) * (size_t)N);
     if (!sp->E) { phgmg_ph_sparse_destroy(sp); return PHGMG_ERR_NOMEM; }
-    memset(sp->E, 0, sizeof(double) * len);
+    memset(sp->E, 0, sizeof(double) * (size_t)(2 * kb + 1) * (size_t)N);
     phgmg__csc_to_band(E, sp->iperm, kb, sp->E);
   }
   if (B) {
@@ -8144,9 +8364,8 @@ PHGMG_DEF phgmg_result phgmg_ph_sparse_create_e(phgmg_ph_sparse **out, int N, in
   }
   sp->sys.N = N;
   sp->sys.m = m;
-  sp->sys.storage = PHGMG_BANDED;
   sp->sys.kb = kb;
-  sp->sys.J = sp->J; sp->sys.R = sp->R; sp->sys.Q = sp->Q; sp->sys.B = sp->B;
+  sp->sys.B = sp->B;
   sp->sys.E = sp->E;
   sp->sys.nl = PHGMG_NL_NONE;
   sp->sys.sparse = sp;
@@ -8163,19 +8382,64 @@ PHGMG_DEF phgmg_result phgmg_ph_sparse_create_e(phgmg_ph_sparse **out, int N, in
 }
 
 /* Stage-matrix bandwidths (lower, upper) from the nonzero diagonals of J - R
-   and Q, as the band stepper computes them. */
+   and Q, as the band stepper computes them (from the CSC copies). */
 PHGMG__PRIV void phgmg__ph_sparse_stage_bw(const phgmg_ph_sparse *sp, int *kl, int *ku) {
-  const int N = sp->sys.N, kb = sp->sys.kb;
-  int i, j, amin = 0, amax = 0, bmin = 0, bmax = 0;
-  for (j = 0; j < N; ++j) /* column by column: contiguous in band storage */
-    for (i = PHGMG__MAX(0, j - kb); i <= PHGMG__MIN(N - 1, j + kb); ++i) {
-      size_t k = PHGMG__PHB(kb, i, j);
-      int o = j - i;
-      if (sp->J[k] - sp->R[k] != 0.0) { amin = PHGMG__MIN(amin, o); amax = PHGMG__MAX(amax, o); }
-      if (sp->Q[k] != 0.0) { bmin = PHGMG__MIN(bmin, o); bmax = PHGMG__MAX(bmax, o); }
+  const int N = sp->sys.N;
+  int j, p, q, amin = 0, amax = 0, bmin = 0, bmax = 0;
+  for (j = 0; j < N; ++j) {
+    p = sp->cp[0][j]; q = sp->cp[1][j];
+    while (p < sp->cp[0][j + 1] || q < sp->cp[1][j + 1]) { /* J - R, merged */
+      int ip = p < sp->cp[0][j + 1] ? sp->ci[0][p] : N, iq = q < sp->cp[1][j + 1] ? sp->ci[1][q] : N;
+      int i = PHGMG__MIN(ip, iq), o = j - i;
+      double v = (ip == i ? sp->cx[0][p++] : 0.0) - (iq == i ? sp->cx[1][q++] : 0.0);
+      if (v != 0.0) { amin = PHGMG__MIN(amin, o); amax = PHGMG__MAX(amax, o); }
     }
+    for (p = sp->cp[2][j]; p < sp->cp[2][j + 1]; ++p)
+      if (sp->cx[2][p] != 0.0) { bmin = PHGMG__MIN(bmin, j - sp->ci[2][p]); bmax = PHGMG__MAX(bmax, j - sp->ci[2][p]); }
+  }
   *kl = PHGMG__MIN(N - 1, -(amin + bmin));
   *ku = PHGMG__MIN(N - 1, amax + bmax);
+}
+
+/* Band copies of J, R, Q (the band solver's storage) from the CSC copies;
+   drop = 1 frees them. */
+PHGMG__PRIV phgmg_result phgmg__ph_sparse_band(phgmg_ph_sparse *sp, int drop) {
+  const int N = sp->sys.N, kb = sp->sys.kb;
+  const size_t len = (size_t)(2 * kb + 1) * (size_t)N;
+  double **dst[3];
+  int a, j, p;
+  dst[0] = &sp->J; dst[1] = &sp->R; dst[2] = &sp->Q;
+  for (a = 0; a < 3; ++a) {
+    if (drop) { phgmg__free(sp->alloc, *dst[a]); *dst[a] = NULL; continue; }
+    if (*dst[a]) continue;
+    *dst[a] = phgmg__dalloc(sp->alloc, len);
+    if (!*dst[a]) return PHGMG_ERR_NOMEM;
+    memset(*dst[a], 0, sizeof(double) * len);
+    for (j = 0; j < N; ++j)
+      for (p = sp->cp[a][j]; p < sp->cp[a][j + 1]; ++p) (*dst[a])[PHGMG__PHB(kb, sp->ci[a][p], j)] = sp->cx[a][p];
+  }
+  return PHGMG_OK;
+}
+
+/* The object's system in the storage of the chosen solver: SPARSE (the CSC
+   copies; band copies freed) for the sparse LU, else BANDED (band copies
+   made before), and info's memory figures. */
+PHGMG__PRIV void phgmg__ph_sparse_storage(phgmg_ph_sparse *sp) {
+  phgmg_ph_sparse_info *f = &sp->inf;
+  double b;
+  int a;
+  if (sp->use_lu) phgmg__ph_sparse_band(sp, 1);
+  sp->sys.storage = sp->use_lu ? PHGMG_SPARSE : PHGMG_BANDED;
+  sp->sys.J = sp->use_lu ? sp->cx[0] : sp->J;
+  sp->sys.R = sp->use_lu ? sp->cx[1] : sp->R;
+  sp->sys.Q = sp->use_lu ? sp->cx[2] : sp->Q;
+  f->band_copy = sp->J != NULL;
+  b = (double)sizeof(double) * (double)sp->sys.N * (double)sp->sys.m + 2.0 * sizeof(int) * (double)sp->sys.N;
+  for (a = 0; a < 3; ++a) b += (double)(sizeof(int) + sizeof(double)) * (double)sp->cp[a][sp->sys.N];
+  if (sp->J) b += 3.0 * sizeof(double) * (double)(2 * sp->sys.kb + 1) * (double)sp->sys.N;
+  if (sp->E) b += sizeof(double) * (double)(2 * sp->sys.kb + 1) * (double)sp->sys.N;
+  if (sp->sym) b += phgmg__spsym_bytes(sp->sym);
+  f->bytes = b;
 }
 
 PHGMG_DEF phgmg_result phgmg_ph_sparse_set_solver(phgmg_ph_sparse *sp, int solver,
@@ -8183,6 +8447,7 @@ PHGMG_DEF phgmg_result phgmg_ph_sparse_set_solver(phgmg_ph_sparse *sp, int solve
   phgmg_ph_sparse_info *f;
   const int N = sp ? sp->sys.N : 0;
   phgmg_result rc;
+  int use;
   if (!sp || solver < PHGMG_SOLVER_AUTO || solver > PHGMG_SOLVER_SPARSE_LU) return PHGMG_ERR_INVALID_ARG;
   f = &sp->inf;
   phgmg__ph_sparse_stage_bw(sp, &f->kl, &f->ku);
@@ -8191,7 +8456,7 @@ PHGMG_DEF phgmg_result phgmg_ph_sparse_set_solver(phgmg_ph_sparse *sp, int solve
   if (sp->E && solver == PHGMG_SOLVER_SPARSE_LU) return PHGMG_ERR_UNSUPPORTED; /* stage matrix sigma E - ... */
   if (!sp->E && !sp->sym && (solver == PHGMG_SOLVER_SPARSE_LU ||
                    (solver == PHGMG_SOLVER_AUTO && sp->sys.kb > PHGMG_SPARSE_MIN_KB))) {
-    rc = phgmg__spsym_create(&sp->sym, N, sp->sys.kb, sp->J, sp->R, sp->Q, -1, sp->alloc);
+    rc = phgmg__spsym_create_sp(&sp->sym, sp, -1);
     if (rc != PHGMG_OK) return rc;
   }
   if (sp->sym) {
@@ -8202,36 +8467,126 @@ PHGMG_DEF phgmg_result phgmg_ph_sparse_set_solver(phgmg_ph_sparse *sp, int solve
     { size_t fm = 0; while ((fm + 1) * (fm + 1) <= sp->sym->front_max) ++fm; f->front_max = (int)fm; }
   }
   if (solver == PHGMG_SOLVER_AUTO)
-    sp->use_lu = sp->sym && 2.0 * f->lu_sparse < f->lu_band && f->flops_sparse < f->flops_band;
+    use = sp->sym && 2.0 * f->lu_sparse < f->lu_band && f->flops_sparse < f->flops_band;
   else
-    sp->use_lu = solver == PHGMG_SOLVER_SPARSE_LU;
+    use = solver == PHGMG_SOLVER_SPARSE_LU;
+  /* the band solver needs band copies: made first, nothing changes on failure */
+  if (!use && (rc = phgmg__ph_sparse_band(sp, 0)) != PHGMG_OK) return rc;
+  sp->use_lu = use;
   if (!sp->use_lu && sp->sym) { /* not used: give the memory back */
     phgmg__spsym_free(sp->alloc, sp->sym);
     sp->sym = NULL;
   }
   f->solver = sp->use_lu ? PHGMG_SOLVER_SPARSE_LU : PHGMG_SOLVER_BAND;
+  phgmg__ph_sparse_storage(sp);
   if (info) *info = *f;
   return PHGMG_OK;
 }
 
-/* y = M x through the compressed copy when the analysis has one (Q of the
-   object's own system); 0: not handled (band product). */
+/* The CSC copy behind M (J, R or Q of a SPARSE system): 1 and its arrays,
+   0 if M is none of them. */
+PHGMG__PRIV int phgmg__ph_csc_of(const phgmg_ph_system *s, const double *M, const int **cp, const int **ci,
+                                 const double **cx) {
+  const phgmg_ph_sparse *sp = s->sparse;
+  int a;
+  if (s->storage != PHGMG_SPARSE || !sp) return 0;
+  for (a = 0; a < 3; ++a)
+    if (M == sp->cx[a]) { *cp = sp->cp[a]; *ci = sp->ci[a]; *cx = sp->cx[a]; return 1; }
+  return 0;
+}
+
+/* y = M x through the CSC copy of a SPARSE system; 0: not handled. */
 PHGMG__PRIV int phgmg__ph_sparse_mv(const phgmg_ph_system *s, const double *M, const double *x,
                                      double *y) {
-  const phgmg_ph_sparse *sp = s->sparse;
-  if (!sp->sym || M != sp->Q || s->N != sp->sys.N || s->kb != sp->sys.kb) return 0;
-  phgmg__sp_qmv(sp->sym, x, y);
+  const int *cp, *ci;
+  const double *cx;
+  int j, p;
+  if (!phgmg__ph_csc_of(s, M, &cp, &ci, &cx)) return 0;
+  for (j = 0; j < s->N; ++j) y[j] = 0.0;
+  for (j = 0; j < s->N; ++j) {
+    double xj = x[j];
+    if (xj == 0.0) continue;
+    for (p = cp[j]; p < cp[j + 1]; ++p) y[ci[p]] += cx[p] * xj;
+  }
   return 1;
 }
 
 /* The sparse analysis a stepper may use for sys (NULL: band). */
 PHGMG__PRIV const phgmg__spsym *phgmg__ph_sparse_lu(const phgmg_ph_system *sys) {
   const phgmg_ph_sparse *sp = sys->sparse;
-  if (!sp || !sp->use_lu || !sp->sym || sys->E || sys->storage != PHGMG_BANDED || sys->N != sp->sys.N ||
-      sys->kb != sp->sys.kb || sys->J != sp->J || sys->R != sp->R || sys->Q != sp->Q ||
-      sys->nl == PHGMG_NL_GENERAL)
+  if (!sp || !sp->use_lu || !sp->sym || sys->E || sys->storage != PHGMG_SPARSE || sys->N != sp->sys.N ||
+      sys->J != sp->cx[0] || sys->R != sp->cx[1] || sys->Q != sp->cx[2] || sys->nl == PHGMG_NL_GENERAL)
     return NULL;
   return sp->sym;
+}
+
+/* phgmg__ph_check's part for SPARSE storage: the object's own matrices, and
+   only what the sparse path serves (see phgmg_ph_sparse_system). */
+PHGMG__PRIV phgmg_result phgmg__ph_check_sparse(const phgmg_ph_system *s) {
+  const phgmg_ph_sparse *sp = s->sparse;
+  if (!sp || s->N != sp->sys.N || s->J != sp->cx[0] || s->R != sp->cx[1] || s->Q != sp->cx[2])
+    return PHGMG_ERR_INVALID_ARG;
+  if (s->E || s->ndamp || s->P || s->S || s->Nskew || s->nl == PHGMG_NL_GENERAL || s->shifted_factor)
+    return PHGMG_ERR_UNSUPPORTED;
+  return PHGMG_OK;
+}
+
+/* A BANDED system t holding matrix a1 (0 J, 1 R, 2 Q) of the SPARSE system
+   s, and a2 (-1: none) too, in the reverse Cuthill-McKee order of their own
+   pattern (perm: position i holds index perm[i]): the band solves and checks
+   of one or two matrices need only their own bandwidth (J - R of a
+   mass-spring model pairs each position with its momentum: kb = 1), not the
+   model's. t's other matrices point at a1's band. */
+PHGMG__PRIV phgmg_result phgmg__ph_sparse_own_band(const phgmg_ph_system *s, int a1, int a2, phgmg_ph_system *t,
+                                                  double **bands, int **perm, const phgmg_allocator *al) {
+  const phgmg_ph_sparse *sp = s->sparse;
+  const int N = s->N, na = a2 >= 0 ? 2 : 1;
+  phgmg_csc A[2];
+  const phgmg_csc *Ap[2];
+  const double **slot[3];
+  int k, j, p, kb = 0, *ip;
+  phgmg_result rc;
+  *t = *s;
+  t->storage = PHGMG_BANDED;
+  t->sparse = NULL;
+  t->J = t->R = t->Q = NULL;
+  bands[0] = bands[1] = NULL;
+  *perm = phgmg__ialloc(al, (size_t)N);
+  ip = phgmg__ialloc(al, (size_t)N);
+  if (!*perm || !ip) { phgmg__free(al, ip); return PHGMG_ERR_NOMEM; }
+  for (k = 0; k < na; ++k) {
+    int a = k ? a2 : a1;
+    A[k].n_rows = A[k].n_cols = N;
+    A[k].colptr = sp->cp[a]; A[k].rowidx = sp->ci[a]; A[k].values = sp->cx[a];
+    Ap[k] = &A[k];
+  }
+  rc = phgmg_rcm(N, na, Ap, *perm, &kb, al);
+  slot[0] = &t->J; slot[1] = &t->R; slot[2] = &t->Q;
+  for (k = 0; k < na && rc == PHGMG_OK; ++k) {
+    int a = k ? a2 : a1;
+    const size_t len = (size_t)(2 * kb + 1) * (size_t)N;
+    double *b = phgmg__dalloc(al, len);
+    if (!b) { rc = PHGMG_ERR_NOMEM; break; }
+    bands[k] = b;
+    memset(b, 0, sizeof(double) * len);
+    if (!k) for (j = 0; j < N; ++j) ip[(*perm)[j]] = j;
+    for (j = 0; j < N; ++j)
+      for (p = sp->cp[a][j]; p < sp->cp[a][j + 1]; ++p) b[PHGMG__PHB(kb, ip[sp->ci[a][p]], ip[j])] = sp->cx[a][p];
+    *slot[a] = b;
+    if (!k) t->J = t->R = t->Q = b, *slot[a] = b;
+  }
+  t->kb = kb;
+  phgmg__free(al, ip);
+  return rc;
+}
+
+/* Frees what phgmg__ph_sparse_own_band allocated (perm may be NULL: kept). */
+PHGMG__PRIV void phgmg__ph_own_band_free(phgmg_ph_system *t, double **bands, int *perm, const phgmg_allocator *al) {
+  phgmg__free(al, bands[0]);
+  phgmg__free(al, bands[1]);
+  bands[0] = bands[1] = NULL;
+  t->J = t->R = t->Q = NULL;
+  phgmg__free(al, perm);
 }
 
 PHGMG_DEF const phgmg_ph_system *phgmg_ph_sparse_system(const phgmg_ph_sparse *sp) {
@@ -8907,11 +9262,16 @@ PHGMG__PRIV phgmg_result phgmg__gl3_setup_dense(phgmg_gl3 *s) {
 }
 
 /* Banded storage: CSR of J - R and of B for the right-hand side. */
+PHGMG__PRIV phgmg_result phgmg__gl3_csr_sparse(phgmg_gl3 *s);
 PHGMG__PRIV phgmg_result phgmg__gl3_csr(phgmg_gl3 *s) {
   const phgmg_ph_system *sys = &s->sys;
   const int N = s->N, m = s->m, kb = sys->kb;
   size_t nnz = 0;
   int r, c;
+  if (sys->storage == PHGMG_SPARSE) {
+    phgmg_result rc = phgmg__gl3_csr_sparse(s);
+    if (rc != PHGMG_OK) return rc;
+  } else {
   for (r = 0; r < N; ++r)
     for (c = PHGMG__MAX(0, r - kb); c <= PHGMG__MIN(N - 1, r + kb); ++c)
       if (sys->J[PHGMG__PHB(kb, r, c)] - sys->R[PHGMG__PHB(kb, r, c)] != 0.0) ++nnz;
@@ -8928,6 +9288,7 @@ PHGMG__PRIV phgmg_result phgmg__gl3_csr(phgmg_gl3 *s) {
     }
   }
   s->jr_ptr[N] = (int)nnz;
+  }
   nnz = 0;
   for (c = 0; c < m; ++c)
     for (r = 0; r < N; ++r)
@@ -8946,6 +9307,31 @@ PHGMG__PRIV phgmg_result phgmg__gl3_csr(phgmg_gl3 *s) {
       s->b_val[s->nbnz] = v;
       s->nbnz++;
     }
+  return PHGMG_OK;
+}
+
+/* SPARSE storage: the CSR of J - R is the transpose of the analysis's CSC
+   (the same entries, columns increasing in each row, as from band storage). */
+PHGMG__PRIV phgmg_result phgmg__gl3_csr_sparse(phgmg_gl3 *s) {
+  const phgmg__spsym *S = s->sps ? s->sps : phgmg__ph_sparse_lu(&s->sys);
+  const int N = s->N;
+  const size_t nnz = S ? (size_t)S->jr_p[N] : 0;
+  int j, p;
+  if (!S) return PHGMG_ERR_UNSUPPORTED;
+  s->jr_ptr = phgmg__ialloc(&s->al, (size_t)N + 1);
+  s->jr_col = phgmg__ialloc(&s->al, nnz + 1);
+  s->jr_val = phgmg__dalloc(&s->al, nnz + 1);
+  if (!s->jr_ptr || !s->jr_col || !s->jr_val) return PHGMG_ERR_NOMEM;
+  for (j = 0; j <= N; ++j) s->jr_ptr[j] = 0;
+  for (p = 0; p < (int)nnz; ++p) s->jr_ptr[S->jr_i[p] + 1]++;
+  for (j = 0; j < N; ++j) s->jr_ptr[j + 1] += s->jr_ptr[j];
+  for (j = 0; j < N; ++j) /* columns in order: each row's columns increase */
+    for (p = S->jr_p[j]; p < S->jr_p[j + 1]; ++p) {
+      int q = s->jr_ptr[S->jr_i[p]]++;
+      s->jr_col[q] = j; s->jr_val[q] = S->jr_x[p];
+    }
+  for (j = N; j > 0; --j) s->jr_ptr[j] = s->jr_ptr[j - 1];
+  s->jr_ptr[0] = 0;
   return PHGMG_OK;
 }
 
@@ -9278,7 +9664,7 @@ PHGMG__PRIV void phgmg__gl3_grad_nl(phgmg_gl3 *s, const double *x, int st) {
 PHGMG__PRIV void phgmg__gl3_eval_jr(phgmg_gl3 *s, const double *x) {
   const phgmg_ph_system *sys = &s->sys;
   int N = s->N, m = s->m, st, i, k;
-  int qdiag = sys->storage == PHGMG_BANDED && s->dq.nd == 1;
+  int qdiag = sys->storage != PHGMG_DENSE && s->dq.nd == 1;
   int need_y = !qdiag || sys->nl == PHGMG_NL_GENERAL;
   if (need_y)
     for (st = 0; st < 3; ++st) {
@@ -9309,7 +9695,7 @@ PHGMG__PRIV void phgmg__gl3_eval_jr(phgmg_gl3 *s, const double *x) {
   }
   if (sys->nl != PHGMG_NL_NONE)
     for (st = 0; st < 3; ++st) phgmg__gl3_grad_nl(s, x, st);
-  if (sys->storage == PHGMG_BANDED) {
+  if (sys->storage != PHGMG_DENSE) {
     phgmg__gl3_rhs_csr(s);
     return;
   }
@@ -9531,6 +9917,28 @@ PHGMG__PRIV phgmg_result phgmg__gl3_sparse_factor(phgmg_gl3 *s, double sg, doubl
   return PHGMG_OK;
 }
 
+/* SPARSE storage: the diagonals of J - R and Q through band copies made
+   here (the system has none) and freed after. */
+PHGMG__PRIV phgmg_result phgmg__gl3_sparse_dia(phgmg_gl3 *s) {
+  const phgmg_ph_sparse *sp = s->sys.sparse;
+  const int N = s->N, kb = s->sys.kb;
+  const size_t len = (size_t)(2 * kb + 1) * (size_t)N;
+  double *b[3];
+  int a, j, p;
+  phgmg_result rc = PHGMG_OK;
+  for (a = 0; a < 3; ++a) {
+    b[a] = phgmg__dalloc(&s->al, len);
+    if (!b[a]) { rc = PHGMG_ERR_NOMEM; continue; }
+    memset(b[a], 0, sizeof(double) * len);
+    for (j = 0; j < N; ++j)
+      for (p = sp->cp[a][j]; p < sp->cp[a][j + 1]; ++p) b[a][PHGMG__PHB(kb, sp->ci[a][p], j)] = sp->cx[a][p];
+  }
+  if (rc == PHGMG_OK) rc = phgmg__dia_build(&s->al, &s->djr, N, kb, b[0], b[1], 0, 0);
+  if (rc == PHGMG_OK) rc = phgmg__dia_build(&s->al, &s->dq, N, kb, b[2], NULL, 1, 0);
+  for (a = 0; a < 3; ++a) phgmg__free(&s->al, b[a]);
+  return rc;
+}
+
 /* Give up the sparse factors for the band LU with partial pivoting. */
 PHGMG__PRIV phgmg_result phgmg__gl3_sparse_fallback(phgmg_gl3 *s) {
   phgmg_result rc;
@@ -9539,8 +9947,12 @@ PHGMG__PRIV phgmg_result phgmg__gl3_sparse_fallback(phgmg_gl3 *s) {
   s->mode = PHGMG__GL3_BANDED;
   s->sps = NULL; /* from here exactly the band stepper */
   phgmg__dia_free(&s->al, &s->dq);
-  rc = phgmg__dia_build(&s->al, &s->djr, s->N, s->sys.kb, s->sys.J, s->sys.R, 0, 0);
-  if (rc == PHGMG_OK) rc = phgmg__dia_build(&s->al, &s->dq, s->N, s->sys.kb, s->sys.Q, NULL, 1, 0);
+  if (s->sys.storage == PHGMG_SPARSE) {
+    rc = phgmg__gl3_sparse_dia(s);
+  } else {
+    rc = phgmg__dia_build(&s->al, &s->djr, s->N, s->sys.kb, s->sys.J, s->sys.R, 0, 0);
+    if (rc == PHGMG_OK) rc = phgmg__dia_build(&s->al, &s->dq, s->N, s->sys.kb, s->sys.Q, NULL, 1, 0);
+  }
   if (rc == PHGMG_OK) rc = phgmg__gl3_setup_band_lu(s);
   if (rc != PHGMG_OK) return rc;
   phgmg__free(&s->al, s->r1buf);
@@ -11345,9 +11757,23 @@ PHGMG__PRIV uint64_t phgmg__sys_fingerprint(const phgmg_ph_system *s) {
   hdr[0] = s->N; hdr[1] = s->m; hdr[2] = (double)s->storage; hdr[3] = s->kb; hdr[4] = (double)s->nl;
   hdr[5] = s->nsep; hdr[6] = s->poly_deg + 64.0 * s->nexp + 4096.0 * s->phi_nfun;
   h = phgmg__hash_d(h, hdr, 7);
-  h = phgmg__hash_d(h, s->J, nm);
-  h = phgmg__hash_d(h, s->R, nm);
-  h = phgmg__hash_d(h, s->Q, nm);
+  if (s->storage == PHGMG_SPARSE) { /* the CSC copies: values, then the patterns */
+    const int *cp, *ci;
+    const double *cx;
+    const double *M[3];
+    size_t q;
+    M[0] = s->J; M[1] = s->R; M[2] = s->Q;
+    for (k = 0; k < 3; ++k)
+      if (phgmg__ph_csc_of(s, M[k], &cp, &ci, &cx)) {
+        h = phgmg__hash_d(h, cx, (size_t)cp[N]);
+        for (q = 0; q < (size_t)cp[N]; ++q) { const double v = ci[q]; h = phgmg__hash_d(h, &v, 1); }
+        for (q = 0; q <= N; ++q) { const double v = cp[q]; h = phgmg__hash_d(h, &v, 1); }
+      }
+  } else {
+    h = phgmg__hash_d(h, s->J, nm);
+    h = phgmg__hash_d(h, s->R, nm);
+    h = phgmg__hash_d(h, s->Q, nm);
+  }
   h = phgmg__hash_d(h, s->B, N * (size_t)s->m);
   if (s->nl == PHGMG_NL_SEPARABLE && s->nsep > 0) {
     const size_t nf = s->phi_nfun > 1 ? (size_t)s->phi_nfun : 1;

@@ -292,7 +292,7 @@ static double slu_solve_check(const slu_lat *L, int condense, double sr, double 
         Ju[(size_t)a * N * N + L->M[a].rowidx[k] + (size_t)j * N] = L->M[a].values[k];
   for (i = 0; i < N; ++i) dd[i] = with_dd ? 0.5 + 0.5 * th_rand() : 0.0;
   if (phgmg_ph_sparse_create(&sp, N, 1, &L->M[0], &L->M[1], &L->M[2], L->B, NULL, NULL, NULL) != PHGMG_OK ||
-      phgmg__spsym_create(&S, N, sp->sys.kb, sp->J, sp->R, sp->Q, condense, NULL) != PHGMG_OK ||
+      phgmg__spsym_create_sp(&S, sp, condense) != PHGMG_OK ||
       phgmg__spnum_alloc(NULL, S, cp, &F) != PHGMG_OK)
     goto done;
   *na = S->na;
