@@ -5655,19 +5655,13 @@ PHGMG__PRIV int phgmg__ph_band_chol_pd(const phgmg_ph_system *s, const double *R
 }
 
 /* R positive semidefinite within tol (see the declaration). */
+PHGMG__PRIV phgmg_result phgmg__ph_check_sparse_pd(const phgmg_ph_system *s, int a, double tol,
+                                                   const phgmg_allocator *al);
 PHGMG__PRIV phgmg_result phgmg__ph_check_psd(const phgmg_ph_system *s, double tol,
                                              const phgmg_allocator *al) {
   int N = s->N, i, j, diag = 1;
   double dmax = 0.0, dmin = HUGE_VAL;
-  if (s->storage == PHGMG_SPARSE) { /* R alone in band storage, in its own RCM order */
-    phgmg_ph_system t;
-    double *bands[2];
-    int *perm = NULL;
-    phgmg_result rc = phgmg__ph_sparse_own_band(s, 1, -1, &t, bands, &perm, al);
-    if (rc == PHGMG_OK) rc = phgmg__ph_check_psd(&t, tol, al);
-    phgmg__ph_own_band_free(&t, bands, perm, al);
-    return rc;
-  }
+  if (s->storage == PHGMG_SPARSE) return phgmg__ph_check_sparse_pd(s, 1, tol, al);
   for (j = 0; j < N && diag; ++j) {
     int i0 = 0, i1 = N - 1;
     if (s->storage == PHGMG_BANDED) {
@@ -5726,15 +5720,7 @@ PHGMG__PRIV phgmg_result phgmg__ph_check_q_pd(const phgmg_ph_system *s, double t
   int i, j, diag = 1;
   double *L, shift = 0.0;
   phgmg_result rc = PHGMG_OK;
-  if (s->storage == PHGMG_SPARSE) { /* Q alone in band storage, in its own RCM order */
-    phgmg_ph_system t;
-    double *bands[2];
-    int *perm = NULL;
-    rc = phgmg__ph_sparse_own_band(s, 2, -1, &t, bands, &perm, al);
-    if (rc == PHGMG_OK) rc = phgmg__ph_check_q_pd(&t, tol, al);
-    phgmg__ph_own_band_free(&t, bands, perm, al);
-    return rc;
-  }
+  if (s->storage == PHGMG_SPARSE) return phgmg__ph_check_sparse_pd(s, 2, tol, al);
   for (j = 0; j < N && diag; ++j)
     for (i = PHGMG__MAX(0, j - kb); i <= PHGMG__MIN(N - 1, j + kb); ++i)
       if (i != j && phgmg__ph_at(s, s->Q, i, j) != 0.0) { diag = 0; break; }
@@ -5767,6 +5753,54 @@ PHGMG__PRIV phgmg_result phgmg__ph_check_q_pd(const phgmg_ph_system *s, double t
     else Li[i] = sqrt(d);
   }
   phgmg__free(al, L);
+  return rc;
+}
+
+PHGMG__PRIV int phgmg__sp_pd(int n, const int *cp, const int *ci, const double *cx, double shift,
+                             const phgmg_allocator *al);
+
+/* The R (a = 1) or Q (a = 2) check of a SPARSE system, with the decisions of
+   the band checks above: a diagonal matrix by its diagonal; R of N <= the
+   dense limit by its eigenvalues; else R + tol ||R||_1 I, Q (+ tol ||Q||_1 I
+   with a nonlinear part) positive definite by the sparse LU's pivots
+   (phgmg__sp_pd), and when that cannot decide, by the band Cholesky of the
+   matrix alone in its own reverse Cuthill-McKee order. */
+PHGMG__PRIV phgmg_result phgmg__ph_check_sparse_pd(const phgmg_ph_system *s, int a, double tol,
+                                                   const phgmg_allocator *al) {
+  const int N = s->N;
+  const int *cp, *ci;
+  const double *cx;
+  double n1 = 0.0, dmax = 0.0, dmin = HUGE_VAL, shift;
+  int j, p, diag = 1, r = 2;
+  phgmg_result rc;
+  if (!phgmg__ph_csc_of(s, a == 1 ? s->R : s->Q, &cp, &ci, &cx)) return PHGMG_ERR_INVALID_ARG;
+  for (j = 0; j < N; ++j) {
+    double cs = 0.0, d = 0.0;
+    for (p = cp[j]; p < cp[j + 1]; ++p) {
+      cs += fabs(cx[p]);
+      if (ci[p] == j) d = cx[p]; else if (cx[p] != 0.0) diag = 0;
+    }
+    n1 = PHGMG__MAX(n1, cs);
+    dmax = PHGMG__MAX(dmax, fabs(d));
+    dmin = PHGMG__MIN(dmin, d);
+  }
+  shift = a == 1 ? tol * n1 : s->nl != PHGMG_NL_NONE ? PHGMG__MAX(tol * n1, 1e-300) : 0.0;
+  if (diag) {
+    if (a == 1) return dmin >= -tol * dmax ? PHGMG_OK : PHGMG_ERR_NOT_PSD;
+    return dmin + shift > 0.0 ? PHGMG_OK : PHGMG_ERR_Q_NOT_PD;
+  }
+  if (a == 1 && n1 == 0.0) return PHGMG_OK;
+  if (a == 2 || N > PHGMG__PH_PSD_DENSE_MAX) r = phgmg__sp_pd(N, cp, ci, cx, shift, al);
+  if (r < 0) return PHGMG_ERR_NOMEM;
+  if (r < 2) return r ? PHGMG_OK : a == 1 ? PHGMG_ERR_NOT_PSD : PHGMG_ERR_Q_NOT_PD;
+  { /* the band checks on the matrix alone, in its own RCM order */
+    phgmg_ph_system t;
+    double *bands[2];
+    int *perm = NULL;
+    rc = phgmg__ph_sparse_own_band(s, a, -1, &t, bands, &perm, al);
+    if (rc == PHGMG_OK) rc = a == 1 ? phgmg__ph_check_psd(&t, tol, al) : phgmg__ph_check_q_pd(&t, tol, al);
+    phgmg__ph_own_band_free(&t, bands, perm, al);
+  }
   return rc;
 }
 
@@ -6867,6 +6901,40 @@ PHGMG__PRIV void phgmg__nd_cover(phgmg__nd *d, int cnt, int lab, int L) {
    of a breadth-first search from a pseudo-peripheral node, the two halves
    first (recursively), the separator last. Unconnected parts one after the
    other (a loop, so that many small components do not deepen the recursion). */
+PHGMG__PRIV void phgmg__nd_rec(phgmg__nd *d, int *list, int cnt, int lab);
+
+/* A part that is not connected: its components found in one pass (each by a
+   search from the first node of the list not yet reached, in search order;
+   O(part), where splitting off one component at a time cost O(part) per
+   component -- quadratic for the many isolated states of a diagonal block),
+   a rest of at most PHGMG__ND_LEAF nodes kept as one leaf in list order,
+   then each ordered in turn. */
+PHGMG__PRIV void phgmg__nd_components(phgmg__nd *d, int *list, int cnt, int lab) {
+  int *base = d->queue, r = 0, i, k, s;
+  for (i = 0; i < cnt && r < cnt; ++i) {
+    int v = list[i], c, lc;
+    if (d->lab[v] != lab) continue;
+    lc = ++d->nlab;
+    if (r > 0 && cnt - r <= PHGMG__ND_LEAF) { /* the rest, as it comes */
+      for (k = i; k < cnt; ++k)
+        if (d->lab[list[k]] == lab) { d->lab[list[k]] = lc; base[r++] = list[k]; }
+      break;
+    }
+    d->queue = base + r;
+    phgmg__nd_bfs(d, v, lab, &c);
+    d->queue = base;
+    for (k = 0; k < c; ++k) d->lab[base[r + k]] = lc;
+    r += c;
+  }
+  for (i = 0; i < cnt; ++i) list[i] = base[i];
+  for (s = 0; s < cnt;) { /* the segments, each with its own label */
+    int e = s + 1, lc = d->lab[list[s]];
+    while (e < cnt && d->lab[list[e]] == lc) ++e;
+    phgmg__nd_rec(d, list + s, e - s, lc);
+    s = e;
+  }
+}
+
 PHGMG__PRIV void phgmg__nd_rec(phgmg__nd *d, int *list, int cnt, int lab) {
   for (;;) {
     int root, nl, reach, i, it, half, sep_lev, na = 0, nb = 0, ns = 0, la, lb, ls;
@@ -6876,17 +6944,9 @@ PHGMG__PRIV void phgmg__nd_rec(phgmg__nd *d, int *list, int cnt, int lab) {
     }
     root = list[0];
     nl = phgmg__nd_bfs(d, root, lab, &reach);
-    if (reach < cnt) { /* not connected: the component of root, then the rest */
-      int *tmp = d->queue, la2 = ++d->nlab, lb2 = ++d->nlab, r = reach;
-      for (i = 0; i < reach; ++i) d->lab[tmp[i]] = la2;
-      for (i = 0; i < cnt; ++i)
-        if (d->lab[list[i]] != la2) { d->lab[list[i]] = lb2; tmp[r++] = list[i]; }
-      for (i = 0; i < cnt; ++i) list[i] = tmp[i];
-      phgmg__nd_rec(d, list, reach, la2);
-      list += reach;
-      cnt -= reach;
-      lab = lb2;
-      continue;
+    if (reach < cnt) { /* not connected: each component (roots in list order), a rest of <= leaf nodes as one */
+      phgmg__nd_components(d, list, cnt, lab);
+      return;
     }
     for (it = 0; it < 6; ++it) { /* pseudo-peripheral node (George-Liu) */
       int best = -1, bdeg = 0, k, nl2, r2;
@@ -7973,6 +8033,56 @@ PHGMG__PRIV void phgmg__sp_qmv(const phgmg__spsym *S, const double *x, double *y
     if (xj == 0.0) continue;
     for (p = S->q_p[j]; p < S->q_p[j + 1]; ++p) y[S->q_i[p]] += S->q_x[p] * xj;
   }
+}
+
+/* Is the symmetric n x n CSC matrix A + shift I positive definite? Through
+   the sparse LU of >>sparse (the stage matrix of J - R = -I, Q = A, sigma =
+   shift): without row exchanges the LU pivots of a symmetric matrix are the
+   D of its L D L^T, all positive exactly when it is definite (Sylvester),
+   and for a definite matrix the elimination is stable. 1 yes, 0 no, 2
+   undecided (a pivot replaced or large growth: the caller's band Cholesky
+   decides), -1 out of memory. Memory: the sparse factor, not a band. */
+PHGMG__PRIV int phgmg__sp_pd(int n, const int *cp, const int *ci, const double *cx, double shift,
+                             const phgmg_allocator *al) {
+  phgmg__spsym *S = PHGMG__CAST(phgmg__spsym *, phgmg__alloc(al, sizeof(phgmg__spsym)));
+  phgmg__spnum F;
+  double *Mx = NULL, *w = NULL;
+  int j, p, t, nq = 0, ok = -1;
+  memset(&F, 0, sizeof F);
+  if (!S) return -1;
+  memset(S, 0, sizeof *S);
+  S->n = n;
+  S->jr_p = phgmg__ialloc(al, (size_t)n + 1); S->jr_i = phgmg__ialloc(al, (size_t)n + 1);
+  S->jr_x = phgmg__dalloc(al, (size_t)n + 1); S->q_p = phgmg__ialloc(al, (size_t)n + 1);
+  S->q_i = phgmg__ialloc(al, (size_t)cp[n] + 1); S->q_x = phgmg__dalloc(al, (size_t)cp[n] + 1);
+  if (!S->jr_p || !S->jr_i || !S->jr_x || !S->q_p || !S->q_i || !S->q_x) goto done;
+  for (j = 0; j < n; ++j) {
+    S->jr_p[j] = j; S->jr_i[j] = j; S->jr_x[j] = -1.0; S->q_p[j] = nq;
+    for (p = cp[j]; p < cp[j + 1]; ++p)
+      if (cx[p] != 0.0) { S->q_i[nq] = ci[p]; S->q_x[nq] = cx[p]; ++nq; }
+  }
+  S->jr_p[n] = n; S->q_p[n] = nq;
+  if (phgmg__spsym_analyse(S, -1, al) != PHGMG_OK) goto done;
+  Mx = phgmg__dalloc(al, (size_t)S->k_p[n] + 1);
+  w = phgmg__dalloc(al, (size_t)n);
+  if (!Mx || !w || phgmg__spnum_alloc(al, S, 0, &F) != PHGMG_OK) goto done;
+  phgmg__sp_stage_values(S, NULL, Mx, w);   /* M = -(J - R) Q = A */
+  phgmg__sp_factor(S, &F, Mx, shift, 0.0, PHGMG_SPARSE_PIVTOL);
+  ok = F.nstatic || !(F.growth <= PHGMG_SPARSE_GROWTH) ? 2 : 1;
+  for (t = 0; t < S->na && ok == 1; ++t)    /* condensed block: its diagonal */
+    if (!(Mx[S->ad_k[t]] + shift > 0.0)) ok = 0;
+  for (t = 0; t < S->nsup && ok == 1; ++t) { /* the pivots of each front */
+    const int nc = S->sfirst[t + 1] - S->sfirst[t], nf = nc + S->srp[t + 1] - S->srp[t];
+    const double *L = F.X + S->lptr[t];
+    for (j = 0; j < nc; ++j)
+      if (!(L[(size_t)j * (size_t)nf + (size_t)j] > 0.0)) { ok = 0; break; }
+  }
+done:
+  phgmg__spnum_free(al, &F);
+  phgmg__free(al, Mx);
+  phgmg__free(al, w);
+  phgmg__spsym_free(al, S);
+  return ok;
 }
 
 /* ---- sparse input: CSC checks, reverse Cuthill-McKee, banded conversion ---- */
