@@ -479,6 +479,158 @@ TEST(test_sparse_lu_reuse_runs) {
   slu_lat_free(&L);
 }
 
+/* ---- SPARSE storage: no band copy ---------------------------------------------------- */
+/* An allocator that counts the bytes it holds (a size header per block). */
+typedef struct slu_count { double live, peak; } slu_count;
+static void *slu_count_alloc(size_t n, void *user) {
+  slu_count *c = (slu_count *)user;
+  double *p = (double *)malloc(n + sizeof(double));
+  if (!p) return NULL;
+  p[0] = (double)n;
+  c->live += (double)n;
+  if (c->live > c->peak) c->peak = c->live;
+  return p + 1;
+}
+static void slu_count_free(void *ptr, void *user) {
+  double *p = (double *)ptr;
+  if (!p) return;
+  ((slu_count *)user)->live -= p[-1];
+  free(p - 1);
+}
+
+TEST(test_sparse_storage_no_band) {
+  /* The object of a lattice that chose the sparse LU holds its matrices as
+     CSC and no band copy: the bytes it holds, counted by its allocator, stay
+     below one band matrix ((2 kb + 1) N doubles; the band path held three);
+     the band solver makes the copies, the sparse one frees them again. */
+  slu_lat L;
+  slu_count cnt = {0.0, 0.0};
+  phgmg_allocator al;
+  phgmg_ph_sparse *sp = NULL;
+  phgmg_ph_sparse_info inf;
+  double band1;
+  al.alloc = slu_count_alloc; al.free = slu_count_free; al.user = &cnt;
+  slu_lat_build(&L, 24, 24, 1, 0);
+  CHECK_RC(phgmg_ph_sparse_create(&sp, L.N, 1, &L.M[0], &L.M[1], &L.M[2], L.B, NULL, &inf, &al), PHGMG_OK);
+  band1 = 8.0 * (2.0 * inf.kb + 1.0) * L.N;
+  CHECK(inf.solver == PHGMG_SOLVER_SPARSE_LU && inf.band_copy == 0);
+  CHECK(phgmg_ph_sparse_system(sp)->storage == PHGMG_SPARSE);
+  CHECK_LE(cnt.live, band1);
+  CHECK_LE(cnt.peak, band1);                 /* not even for a while */
+  CHECK(inf.bytes > 0.5 * cnt.live && inf.bytes < 1.5 * cnt.live); /* the report: what it holds */
+  CHECK_RC(phgmg_ph_sparse_set_solver(sp, PHGMG_SOLVER_BAND, &inf), PHGMG_OK);
+  CHECK(inf.band_copy == 1 && phgmg_ph_sparse_system(sp)->storage == PHGMG_BANDED);
+  CHECK(cnt.live >= 3.0 * band1);
+  CHECK(inf.bytes > 0.5 * cnt.live && inf.bytes < 1.5 * cnt.live);
+  CHECK_RC(phgmg_ph_sparse_set_solver(sp, PHGMG_SOLVER_AUTO, &inf), PHGMG_OK);
+  CHECK(inf.band_copy == 0 && phgmg_ph_sparse_system(sp)->storage == PHGMG_SPARSE);
+  CHECK_LE(cnt.live, band1);
+  phgmg_ph_sparse_destroy(sp);
+  CHECK(cnt.live == 0.0);
+  slu_lat_free(&L);
+}
+
+TEST(test_sparse_storage_equals_band) {
+  /* The same lattice with SPARSE storage (sparse LU) and with BANDED storage
+     (band LU with partial pivoting, an independent solver): validation,
+     J - R solves, trajectories and a GMG-POD reduction agree to 1e-10. */
+  slu_lat L;
+  phgmg_ph_sparse *sp[2] = {NULL, NULL};
+  phgmg_ph_sparse_info inf;
+  const int ns = 201;
+  double *X[2], *Y[2], *YR[2], rc_v[2], *x0, *b, *x, *r1, *r2, res = 0.0, bn = 0.0;
+  int run, i;
+  slu_lat_build(&L, 12, 12, 1, 0);
+  x0 = (double *)calloc((size_t)L.N, sizeof(double));
+  b = (double *)malloc(sizeof(double) * (size_t)L.N); x = (double *)malloc(sizeof(double) * (size_t)L.N);
+  r1 = (double *)malloc(sizeof(double) * (size_t)L.N); r2 = (double *)malloc(sizeof(double) * (size_t)L.N);
+  for (run = 0; run < 2; ++run) {
+    phgmg_reduce_opts o;
+    phgmg_reduced *red = NULL;
+    const phgmg_ph_system *sys;
+    phgmg_jr_factor *f = NULL;
+    double xr0[16];
+    X[run] = (double *)malloc(sizeof(double) * (size_t)L.N * ns);
+    Y[run] = (double *)malloc(sizeof(double) * ns);
+    YR[run] = (double *)malloc(sizeof(double) * ns);
+    CHECK_RC(phgmg_ph_sparse_create(&sp[run], L.N, 1, &L.M[0], &L.M[1], &L.M[2], L.B, NULL, &inf, NULL), PHGMG_OK);
+    if (run) CHECK_RC(phgmg_ph_sparse_set_solver(sp[run], PHGMG_SOLVER_BAND, &inf), PHGMG_OK);
+    sys = phgmg_ph_sparse_system(sp[run]);
+    CHECK(sys->storage == (run ? PHGMG_BANDED : PHGMG_SPARSE));
+    CHECK_RC(phgmg_ph_validate(sys, 0.0, &rc_v[run], NULL), PHGMG_OK);
+    /* (J - R) x = b by the factor, checked by the products J x - R x */
+    CHECK_RC(phgmg_jr_factor_create(&f, sys, NULL, NULL), PHGMG_OK);
+    for (i = 0; i < L.N; ++i) { b[i] = th_rand(); x[i] = b[i]; }
+    if (f) phgmg_jr_solve(f, 'N', 1, x, L.N);
+    phgmg_ph_apply(sys, 'J', 1, x, L.N, r1, L.N);
+    phgmg_ph_apply(sys, 'R', 1, x, L.N, r2, L.N);
+    for (i = 0; i < L.N; ++i) { res = fmax(res, fabs(r1[i] - r2[i] - b[i])); bn = fmax(bn, fabs(b[i])); }
+    phgmg_jr_factor_destroy(f);
+    CHECK_RC(phgmg_simulate(sys, x0, 0.0, 0.1, ns - 1, slu_u, NULL, NULL, X[run], Y[run], NULL, NULL, NULL, NULL),
+             PHGMG_OK);
+    phgmg_reduce_opts_default(&o);
+    o.method = PHGMG_METHOD_GMG_POD;
+    o.r = 12;
+    CHECK_RC(phgmg_reduce(&red, sys, X[run], L.N, ns, &o, NULL, NULL), PHGMG_OK);
+    if (red) {
+      phgmg_reduced_restrict(red, x0, xr0);
+      CHECK_RC(phgmg_reduced_simulate(red, xr0, 0.0, 0.1, ns - 1, slu_u, NULL, 1e-12, 30, NULL, YR[run], NULL, NULL,
+                                      NULL), PHGMG_OK);
+    }
+    phgmg_reduced_destroy(red);
+  }
+  CHECK_LE(res, 1e-12 * bn);
+  CHECK(rc_v[0] > 0.1 && rc_v[1] > 0.1); /* J - R is well conditioned here (block diagonal, R small) */
+  CHECK_LE(slu_rel(L.N * ns, X[0], X[1]), 1e-10);
+  CHECK_LE(slu_rel(ns, Y[0], Y[1]), 1e-10);
+  CHECK_LE(slu_rel(ns, YR[0], YR[1]), 1e-10);
+  CHECK(fabs(Y[1][ns - 1]) > 0.0);
+  for (run = 0; run < 2; ++run) { phgmg_ph_sparse_destroy(sp[run]); free(X[run]); free(Y[run]); free(YR[run]); }
+  free(x0); free(b); free(x); free(r1); free(r2);
+  slu_lat_free(&L);
+}
+
+TEST(test_sparse_storage_checks) {
+  /* Definiteness through the sparse LU's pivots (phgmg__sp_pd) against closed
+     forms: the 1-D Laplacian tridiag(-1, 2, -1) of order n has eigenvalues
+     2 - 2 cos(k pi / (n + 1)), so A + c I is definite exactly for c > -lambda_1;
+     then validation of a SPARSE system with a Q that has a negative diagonal
+     entry (e^T Q e < 0: not definite), and the refusals of the SPARSE kind. */
+  const int n = 200;
+  const double pi = 3.14159265358979323846, l1 = 2.0 - 2.0 * cos(pi / (n + 1)), l2 = 2.0 - 2.0 * cos(2.0 * pi / (n + 1));
+  int *cp = (int *)malloc(sizeof(int) * (n + 1)), *ci = (int *)malloc(sizeof(int) * 3 * n), j, nz = 0;
+  double *cx = (double *)malloc(sizeof(double) * 3 * n);
+  slu_lat L;
+  phgmg_ph_sparse *sp = NULL;
+  phgmg_ph_system sys;
+  for (j = 0; j < n; ++j) {
+    cp[j] = nz;
+    if (j > 0) { ci[nz] = j - 1; cx[nz++] = -1.0; }
+    ci[nz] = j; cx[nz++] = 2.0;
+    if (j + 1 < n) { ci[nz] = j + 1; cx[nz++] = -1.0; }
+  }
+  cp[n] = nz;
+  CHECK(phgmg__sp_pd(n, cp, ci, cx, 0.0, NULL) == 1);
+  CHECK(phgmg__sp_pd(n, cp, ci, cx, -0.5 * l1, NULL) == 1);
+  CHECK(phgmg__sp_pd(n, cp, ci, cx, -0.5 * (l1 + l2), NULL) == 0);
+  CHECK(phgmg__sp_pd(n, cp, ci, cx, -3.0, NULL) != 1); /* 0, or 2: undecided (large growth) */
+  free(cp); free(ci); free(cx);
+  slu_lat_build(&L, 14, 14, 1, 0);
+  for (j = L.M[2].colptr[L.sc[0]]; j < L.M[2].colptr[L.sc[0] + 1]; ++j)
+    if (L.M[2].rowidx[j] == L.sc[0]) L.v[2][j] = -1.0; /* Q(q_0, q_0) < 0 */
+  CHECK_RC(phgmg_ph_sparse_create(&sp, L.N, 1, &L.M[0], &L.M[1], &L.M[2], L.B, NULL, NULL, NULL), PHGMG_OK);
+  sys = *phgmg_ph_sparse_system(sp);
+  CHECK(sys.storage == PHGMG_SPARSE);
+  CHECK_RC(phgmg_ph_validate(&sys, 0.0, NULL, NULL), PHGMG_ERR_Q_NOT_PD);
+  sys.nl = PHGMG_NL_GENERAL;  /* the band Hessian of a GENERAL part: the band solver's storage */
+  CHECK_RC(phgmg_ph_validate(&sys, 0.0, NULL, NULL), PHGMG_ERR_UNSUPPORTED);
+  sys = *phgmg_ph_sparse_system(sp);
+  sys.Q = sys.J;               /* not the object's own matrices */
+  CHECK_RC(phgmg_ph_validate(&sys, 0.0, NULL, NULL), PHGMG_ERR_INVALID_ARG);
+  phgmg_ph_sparse_destroy(sp);
+  slu_lat_free(&L);
+}
+
 SUITE(sparse_lu) {
   RUN(test_sparse_lu_lattices);
   RUN(test_sparse_lu_components);
@@ -486,4 +638,7 @@ SUITE(sparse_lu) {
   RUN(test_sparse_lu_alloc_failures);
   RUN(test_sparse_lu_condense);
   RUN(test_sparse_lu_reuse_runs);
+  RUN(test_sparse_storage_no_band);
+  RUN(test_sparse_storage_equals_band);
+  RUN(test_sparse_storage_checks);
 }
