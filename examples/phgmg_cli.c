@@ -345,10 +345,20 @@ static void progress(const char *fmt, ...) {
 }
 
 /* phgmg_reduce_opts.progress: one line per reduction phase, with the time
-   since the reduction started (user: its start time, now_s()). Set for long
-   reductions only (N * ns >= 1e7, e.g. N >= 10 000 with 1001 snapshots). */
+   since the reduction started, the lambda candidates and full-model probe
+   runs numbered. Every phase of a long reduction (N * ns >= 1e7, e.g.
+   N >= 10 000 with 1001 snapshots); of others, the phases that start after
+   the reduction has run a second (a short reduction stays quiet). */
+typedef struct phase_log { double t0; int all, ncand, nprobe; } phase_log;
 static void reduce_phase(const char *phase, void *user) {
-  if (strcmp(phase, "done") != 0) progress("  ... %s (%.1f s)", phase, now_s() - *(const double *)user);
+  phase_log *pl = (phase_log *)user;
+  const double t = now_s() - pl->t0;
+  int k = 0;
+  if (strcmp(phase, "lambda: candidate") == 0) k = ++pl->ncand;
+  if (strcmp(phase, "lambda: full-model probe run") == 0) k = ++pl->nprobe;
+  if (strcmp(phase, "done") == 0 || (!pl->all && t < 1.0)) return;
+  if (k) progress("  ... %s %d (%.1f s)", phase, k, t);
+  else progress("  ... %s (%.1f s)", phase, t);
 }
 
 /* Error on stderr; returns the exit status 1 for `return fail(...)`. */
@@ -2324,6 +2334,7 @@ static int run_reduction(const reduce_args *A, reduce_state *S, int method, cons
   phgmg_result rc;
   const phgmg_rom *rom;
   double t0;
+  phase_log plog;
   /* --- reduce --- */
   phgmg_reduce_opts_default(&o);
   o.method = (phgmg_method)method;
@@ -2348,7 +2359,8 @@ static int run_reduction(const reduce_args *A, reduce_state *S, int method, cons
   memset(&info, 0, sizeof info);
   progress("reducing: %s, r = %d%s", A->method, A->r, method == PHGMG_METHOD_GMG_QM ? " (quadratic manifold)" : "");
   t0 = now_s();
-  if (!g_quiet && (double)N * (double)ns >= 1e7) { o.progress = reduce_phase; o.progress_user = &t0; }
+  plog.t0 = t0; plog.all = (double)N * (double)ns >= 1e7; plog.ncand = plog.nprobe = 0;
+  if (!g_quiet) { o.progress = reduce_phase; o.progress_user = &plog; }
   rc = phgmg_reduce(&S->red, &S->sys, X, N, ns, &o, &info, NULL);
   *t_red = now_s() - t0;
   if (rc != PHGMG_OK) {
