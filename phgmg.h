@@ -1301,7 +1301,7 @@ typedef struct phgmg_ph_sparse phgmg_ph_sparse; /* sparse input, below */
 
 typedef struct phgmg_ph_system {
   int N, m;
-  phgmg_storage storage;   /* DENSE (default) or BANDED                      */
+  phgmg_storage storage;   /* DENSE (default), BANDED (or SPARSE: below)     */
   int kb;                  /* half-bandwidth for BANDED                      */
   const double *J, *R, *Q; /* dense N x N or banded (2kb+1) x N              */
   const double *B;         /* N x m, ld = N                                   */
@@ -1395,9 +1395,10 @@ typedef struct phgmg_ph_system {
   void (*damp_fn)(int k, double s, double d[2], void *user);
   void *damp_user;
   /* Set by phgmg_ph_sparse_system (NULL otherwise): the sparse model this
-     banded system comes from. The GL3 stepper then solves its stage systems
-     with the sparse LU when phgmg_ph_sparse chose it (see >>sparse) and J,
-     R, Q are still the object's matrices. */
+     system comes from. When the object chose the sparse LU (see >>sparse)
+     the storage is SPARSE: J, R, Q are the object's compressed copies (not
+     for indexing; the library reads them through sparse) and the GL3 stepper
+     solves its stage systems with the sparse LU; else BANDED. */
   const phgmg_ph_sparse *sparse;
 } phgmg_ph_system;
 
@@ -1523,13 +1524,22 @@ PHGMG_DEF phgmg_result phgmg_rcm(int N, int na, const phgmg_csc *const *A, int *
    dense (N x m, ld N) or, if B is NULL, as the N x m CSC matrix Bcsc; it
    computes phgmg_rcm of J, R, Q, keeps the better of that order and the given
    one (smaller half-bandwidth; a tie keeps the given order), and stores
-   P^T J P, P^T R P, P^T Q P in band storage (>>ph above) with that
-   half-bandwidth kb and P^T B dense, where P is the permutation: state entry
-   i of the banded ("internal") ordering is entry perm[i] of the user's.
-   phgmg_ph_sparse_system gives the ready phgmg_ph_system (BANDED, nl = NONE):
-   copy it to add a nonlinear part. Nothing is densified: O(N kb + nnz) memory,
-   the GL3 stepper, phgmg_jr_factor, phgmg_ph_validate cost O(N kb^2), solves
-   O(N kb). Call phgmg_ph_validate on the system for the structural checks
+   P^T J P, P^T R P, P^T Q P as CSC matrices with that half-bandwidth kb and
+   P^T B dense, where P is the permutation: state entry i of the internal
+   ("banded") ordering is entry perm[i] of the user's. It then picks the
+   stage-matrix solver (>>sparse). With the band LU it also stores J, R, Q
+   in band storage (>>ph above); with the sparse LU it does not: memory
+   O(nnz + the sparse factor), never O(N kb) (info.band_copy, info.bytes).
+   phgmg_ph_sparse_system gives the ready phgmg_ph_system (nl = NONE;
+   storage BANDED or SPARSE by that choice): copy it to add a SEPARABLE
+   nonlinear part. A SPARSE system serves validation, simulation and every
+   reduction method; it refuses (PHGMG_ERR_UNSUPPORTED) a GENERAL nonlinear
+   part, dampers, feedthrough, E and the shifted-solve callbacks, which need
+   band storage: call phgmg_ph_sparse_set_solver(sp, PHGMG_SOLVER_BAND, ..)
+   first (a copy made before that call no longer matches the object: copy
+   again). Nothing is densified. Banded: the GL3 stepper, phgmg_jr_factor,
+   phgmg_ph_validate cost O(N kb^2), solves O(N kb). Sparse: see >>sparse.
+   Call phgmg_ph_validate on the system for the structural checks
    (skew J, symmetric PSD R, ...: the usual codes; a nonsymmetric pattern is
    fine, the band covers the symmetrized pattern). info (may be NULL): the
    half-bandwidths, and wide = 1 when kb > N/4: the banded path then costs
@@ -1691,8 +1701,31 @@ PHGMG_DEF void phgmg_ph_sparse_destroy(phgmg_ph_sparse *sp);
    phgmg_ph_sparse_info. The sparse solver serves the GL3 stepper of a
    system with nl NONE or SEPARABLE; a GENERAL Hessian (banded by its
    callback) and a descriptor model (E) keep the band LU
-   (phgmg_ph_sparse_set_solver: PHGMG_ERR_UNSUPPORTED for the sparse LU). Other solves with J - R (phgmg_jr_factor,
-   the validation) stay banded. */
+   (phgmg_ph_sparse_set_solver: PHGMG_ERR_UNSUPPORTED for the sparse LU).
+   Memory. With the sparse LU the system is SPARSE: J, R, Q stay in the
+   object's CSC copies and no band copy is made (a band of a 2-D lattice of
+   317 x 317 masses, kb = 634, would take 3 (2 kb + 1) N doubles = 6.1 GB;
+   its CSC copies take 11 MB). The other operations then need no band of
+   the whole model either:
+   - products with J, R, Q (right-hand sides, Hamiltonian, the reduced
+     operators V^T M W of every method) go through the CSC copies;
+   - phgmg_jr_factor (G = (J - R)^{-1} in GMG, rcond in the validation)
+     factors J - R in band storage in the reverse Cuthill-McKee order of J - R
+     alone: its bandwidth, not the model's (a mass-spring model's J - R pairs
+     each position with its momentum: bandwidth 1);
+   - the definiteness of Q (and of R + tol ||R||_1 I, semidefiniteness of
+     R, for N above the dense-eigenvalue limit) is read from the pivots of
+     the sparse LU of that matrix (static pivots, no exchanges): for a
+     symmetric matrix they are the D of its L D L^T, all positive exactly
+     when it is definite (Sylvester's law of inertia), and the elimination
+     of a definite matrix needs no pivoting to be stable. When a pivot had
+     to be replaced or the growth check fails, the band Cholesky of that
+     matrix alone (in its own reverse Cuthill-McKee order) decides, as before;
+   - a stepper whose static pivots fail falls back to the band LU with band
+     copies made inside the stepper (the O(N kb) memory is then spent).
+   Measured on a 2-D lattice with N = 200 978 (bench/bench_sparse.sh),
+   `phgmg reduce --simulate --steps 200 --method gmg-pod --r 20` peaks at
+   about twice the snapshot matrix. */
 #ifndef PHGMG_SPARSE_MIN_KB
 #define PHGMG_SPARSE_MIN_KB 8      /* band without analysis up to this kb       */
 #endif
@@ -1705,8 +1738,12 @@ PHGMG_DEF void phgmg_ph_sparse_destroy(phgmg_ph_sparse *sp);
 enum { PHGMG_SOLVER_AUTO = 0, PHGMG_SOLVER_BAND = 1, PHGMG_SOLVER_SPARSE_LU = 2 };
 /* Force the stage-matrix solver of steppers created from now on:
    PHGMG_SOLVER_BAND, _SPARSE_LU (runs the analysis if not done) or _AUTO
-   (the prediction). info (may be NULL) is refreshed. PHGMG_ERR_INVALID_ARG
-   (NULL sp, unknown solver), _NOMEM. */
+   (the prediction). The object's system follows: BANDED with band copies of
+   J, R, Q made here for the band LU, SPARSE with them freed for the sparse
+   LU; a copy of phgmg_ph_sparse_system made before the call no longer
+   matches (copy it again). info (may be NULL) is refreshed.
+   PHGMG_ERR_INVALID_ARG (NULL sp, unknown solver), _NOMEM (the object is
+   unchanged). */
 PHGMG_DEF phgmg_result phgmg_ph_sparse_set_solver(phgmg_ph_sparse *sp, int solver,
                                                   phgmg_ph_sparse_info *info);
 

@@ -9,6 +9,14 @@
 #   sim2d_N7200    60 x 60 masses, 1000 steps
 #   sim3d_N8192    16 x 16 x 16 masses, 1000 steps
 #   sim2d_N100352  224 x 224 masses, 100 steps
+# and, phgmg alone (SPARSE_RUNS runs each, median, min, max into the CSV):
+#   reduce2d_N200978_gmgpod  317 x 317 masses: `phgmg reduce --simulate --steps 200
+#                  --method gmg-pod --r 20` (the whole process: simulation, reduction,
+#                  files); with /usr/bin/time its peak memory is printed against
+#                  the snapshot matrix (N x 201 doubles)
+#   desc_febar_N10000  the finite-element bar of bench/fe_bar.py (5000 elements,
+#                  consistent mass matrix: a descriptor model, --E-coo), `phgmg
+#                  simulate --dt 0.05 --steps 1000 --input sin --amp 1`
 # Each case runs phgmg and SciPy in turn, SPARSE_RUNS times (default 3):
 # phgmg's time is the whole process (reading the .npy files, ordering, analysis,
 # validation, factorization, steps, writing y); SciPy's the stepping as
@@ -69,3 +77,48 @@ import numpy as np
 a, b = np.load('$W/y.npy'), np.load('$W/ys.npy')
 print('  $name: max |y_phgmg - y_scipy| / max |y_scipy| = %.2e' % (np.abs(a - b).max() / np.abs(b).max()))"
 done
+
+# phgmg alone: name, SPARSE_RUNS timed runs of the command "$@" (stderr into $W/log)
+alone() {
+  name=$1; shift
+  : > "$W/tp"
+  i=0
+  while [ $i -lt "$RUNS" ]; do
+    t0=$(date +%s.%N)
+    "$@" 2> "$W/log" >/dev/null || { echo "bench_sparse: $name failed: $(tail -n 2 "$W/log")" >&2; return 1; }
+    t1=$(date +%s.%N)
+    tp=$(awk -v a="$t0" -v b="$t1" 'BEGIN { printf "%.6f", b - a }')
+    echo "$tp" >> "$W/tp"
+    echo "  $name run $((i + 1)): phgmg $tp s"
+    i=$((i + 1))
+  done
+  stats "$name" < "$W/tp"
+}
+
+name=reduce2d_N200978_gmgpod
+case " ${SPARSE_CASES:-$name} " in *" $name "*)
+  if "$PY" "$ROOT/bench/lattice.py" "$W/$name" 317 317 1 >/dev/null; then
+    L="$W/$name"
+    set -- "$P" reduce --J-coo "$L/J.npy" --R-coo "$L/R.npy" --Q-coo "$L/Q.npy" --B "$L/B.npy" \
+      --simulate --steps 200 --method gmg-pod --r 20 --out "$W/rom"
+    if alone "$name" "$@"; then
+      grep 'stage solver' "$W/log" | sed 's/^phgmg: */  /'
+      if [ -x /usr/bin/time ]; then
+        /usr/bin/time -f '%M' -o "$W/rss" "$@" 2>/dev/null >/dev/null &&
+          awk -v kb="$(tail -n 1 "$W/rss")" 'BEGIN { s = 200978 * 201 * 8 / 1024;
+            printf "  %s: peak memory %.0f MiB, %.2f x the snapshot matrix (%.0f MiB)\n", "'"$name"'", kb / 1024, kb / s, s / 1024 }'
+      fi
+    fi
+    rm -rf "$L" "$W/rom"
+  fi ;;
+esac
+
+name=desc_febar_N10000
+case " ${SPARSE_CASES:-$name} " in *" $name "*)
+  if "$PY" "$ROOT/bench/fe_bar.py" "$W/$name" 5000 >/dev/null; then
+    L="$W/$name"
+    alone "$name" "$P" simulate --J-coo "$L/J.npy" --R-coo "$L/R.npy" --Q-coo "$L/Q.npy" --E-coo "$L/E.npy" \
+      --B "$L/B.npy" --dt 0.05 --steps 1000 --input sin --amp 1 --out "$W/y.npy" &&
+      grep 'stage solver' "$W/log" | sed 's/^phgmg: */  /'
+  fi ;;
+esac
