@@ -12,7 +12,9 @@
 #    build/ (a missing or broken source is skipped with a warning) and runs
 #    each, appending `case,median_s,min_s,max_s,runs` lines to the CSV;
 # 2b. bench/bench_sparse.sh: `phgmg simulate` on scrambled 2-D/3-D lattices
-#    against the same GL3 steps in SciPy + SuperLU (ratio cases; a few minutes);
+#    against the same GL3 steps in SciPy + SuperLU (ratio cases), a GMG-POD
+#    reduction of a 2-D lattice with N = 200 978 (time, and peak memory against
+#    the snapshot matrix) and a descriptor finite-element bar (a few minutes);
 # 3. if a CBLAS is installed, builds bench_linalg again with -DPHGMG_USE_CBLAS
 #    and records its cases with a `_cblas` suffix (one BLAS thread);
 # 3b. runs bench/studies/hyper_study.c, bench/studies/altmin_study.c and
