@@ -5010,13 +5010,14 @@ PHGMG__PRIV phgmg_result phgmg__ph_check_sparse(const phgmg_ph_system *s);
 
 /* Structural checks shared by every entry point (no O(N^2) work). */
 PHGMG__PRIV phgmg_result phgmg__ph_check(const phgmg_ph_system *s) {
+  phgmg_result rc;
   int k;
   if (!s) return PHGMG_ERR_INVALID_ARG;
   if (s->N <= 0 || s->m <= 0 || s->m > s->N) return PHGMG_ERR_SIZE;
   if (s->storage != PHGMG_DENSE && s->storage != PHGMG_BANDED && s->storage != PHGMG_SPARSE)
     return PHGMG_ERR_INVALID_ARG;
   if (s->storage == PHGMG_BANDED && (s->kb < 0 || s->kb > s->N - 1)) return PHGMG_ERR_SIZE;
-  if (s->storage == PHGMG_SPARSE && phgmg__ph_check_sparse(s) != PHGMG_OK) return phgmg__ph_check_sparse(s);
+  if (s->storage == PHGMG_SPARSE && (rc = phgmg__ph_check_sparse(s)) != PHGMG_OK) return rc;
   if (!s->J || !s->R || !s->Q || !s->B) return PHGMG_ERR_INVALID_ARG;
   if ((s->shifted_factor == NULL) != (s->shifted_solve == NULL)) return PHGMG_ERR_INVALID_ARG;
   if (s->E && (s->nl == PHGMG_NL_GENERAL || s->shifted_factor)) return PHGMG_ERR_UNSUPPORTED;
