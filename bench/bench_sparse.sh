@@ -12,8 +12,8 @@
 # and, phgmg alone (SPARSE_RUNS runs each, median, min, max into the CSV):
 #   reduce2d_N200978_gmgpod  317 x 317 masses: `phgmg reduce --simulate --steps 200
 #                  --method gmg-pod --r 20` (the whole process: simulation, reduction,
-#                  files); with /usr/bin/time its peak memory is printed against
-#                  the snapshot matrix (N x 201 doubles)
+#                  files); with /usr/bin/time (each run under it) the last run's
+#                  peak memory is printed against the snapshot matrix (N x 201 doubles)
 #   desc_febar_N10000  the finite-element bar of bench/fe_bar.py (5000 elements,
 #                  consistent mass matrix: a descriptor model, --E-coo), `phgmg
 #                  simulate --dt 0.05 --steps 1000 --input sin --amp 1`
@@ -101,13 +101,12 @@ case " ${SPARSE_CASES:-$name} " in *" $name "*)
     L="$W/$name"
     set -- "$P" reduce --J-coo "$L/J.npy" --R-coo "$L/R.npy" --Q-coo "$L/Q.npy" --B "$L/B.npy" \
       --simulate --steps 200 --method gmg-pod --r 20 --out "$W/rom"
+    : > "$W/rss"
+    [ -x /usr/bin/time ] && set -- /usr/bin/time -f '%M' -o "$W/rss" "$@" # peak memory of each run
     if alone "$name" "$@"; then
       grep 'stage solver' "$W/log" | sed 's/^phgmg: */  /'
-      if [ -x /usr/bin/time ]; then
-        /usr/bin/time -f '%M' -o "$W/rss" "$@" 2>/dev/null >/dev/null &&
-          awk -v kb="$(tail -n 1 "$W/rss")" 'BEGIN { s = 200978 * 201 * 8 / 1024;
-            printf "  %s: peak memory %.0f MiB, %.2f x the snapshot matrix (%.0f MiB)\n", "'"$name"'", kb / 1024, kb / s, s / 1024 }'
-      fi
+      [ -s "$W/rss" ] && awk -v kb="$(tail -n 1 "$W/rss")" 'BEGIN { s = 200978 * 201 * 8 / 1024;
+        printf "  %s: peak memory %.0f MiB, %.2f x the snapshot matrix (%.0f MiB)\n", "'"$name"'", kb / 1024, kb / s, s / 1024 }'
     fi
     rm -rf "$L" "$W/rom"
   fi ;;
