@@ -1,5 +1,5 @@
 /* phgmg.h -- structure-preserving model order reduction of port-Hamiltonian
-   systems by generalized manifold Galerkin (GMG) reduction. Version 0.3.0.
+   systems by generalized manifold Galerkin (GMG) reduction. Version 0.4.0.
    Single-file C99 library (also compiles as C++), no dependencies beyond libc
    and libm. The revision history and the MIT license are at the end of the
    file.
@@ -1057,9 +1057,9 @@
 
 /* >>config ================================================================ */
 #define PHGMG_VERSION_MAJOR 0
-#define PHGMG_VERSION_MINOR 3
+#define PHGMG_VERSION_MINOR 4
 #define PHGMG_VERSION_PATCH 0
-#define PHGMG_VERSION_STRING "0.3.0"
+#define PHGMG_VERSION_STRING "0.4.0"
 
 #include <stddef.h>
 
@@ -19851,6 +19851,25 @@ PHGMG_DEF phgmg_result phgmg_npy_write(const char *path, const double *A, int ro
 
 /*
    REVISION HISTORY
+   0.4.0  (2026-11-26)
+          - New: algebraic constraints of index one: a singular E with zero
+            rows and columns (or a dense singular E, rotated into that form)
+            is checked (PHGMG_ERR_INDEX, PHGMG_ERR_PENCIL), simulated with
+            consistent states by phgmg_simulate and condensed into a
+            port-Hamiltonian ODE (phgmg_dae_create and friends), which every
+            method reduces; the command line does it by itself.
+          - New: PHGMG_SPARSE storage: a sparse model whose solver is the
+            sparse LU keeps J, R, Q only as compressed copies (no band copy;
+            phgmg_ph_sparse_info.band_copy, .bytes). Such a system refuses a
+            GENERAL part, dampers, feedthrough and the shifted-solve
+            callbacks (PHGMG_ERR_UNSUPPORTED): choose the band solver for
+            them (phgmg_ph_sparse_set_solver); PHGMG_STORAGE_COUNT is 3.
+          - Changed: alternating minimization with a wide V2 is a descent in
+            V1 with M eliminated by its ridge fit (replaces the rotation
+            sweeps); the CLI takes --ref FILE and --greedy-window.
+          - Changed: phgmg_gl3_create, phgmg_simulate_inputs and phgmg_reduce
+            refuse an index-one model (PHGMG_ERR_UNSUPPORTED): give them the
+            condensed model.
    0.3.0  (2026-11-26)
           - New: nonlinear dissipation (phgmg_ph_system dampers c_k rho_k(c_k^T z),
             PHGMG_ERR_DAMPER), kept by GMG-POD, SP1 and SP2 (reduced dampers,
