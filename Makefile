@@ -54,15 +54,18 @@ $(BUILD)/test_run_asan: $(TESTOBJ_ASAN)
 # cores, the longest first (each job's output is printed whole when it ends --
 # GNU make 4's --output-sync, left out by older makes; a failure stops make test).
 SYNC = $(if $(filter output-sync,$(.FEATURES)),--output-sync=target,)
+# The unit suites run once, under ASan + UBSan at -O1 with the warning flags
+# (the plain runner, `make test-plain`, runs the same tests without the
+# sanitizers; it is the quick one during development).
 test: test-build
 	$(MAKE) -j2 $(SYNC) test-asan test-cli test-fuzz-replay test-embedded-host test-demo compile-checks \
-	  test-validate test-plain test-npy test-hello docs-check
+	  test-validate test-npy test-hello docs-check
 
 
 # Everything make test compiles, built first on both cores (the compiles are
 # most of its time); the runs below then go one after the other.
 test-build: tests/suites.inc
-	$(MAKE) -j2 $(BUILD)/test_run $(BUILD)/test_run_asan $(EXAMPLES) $(BUILD)/npy_tool \
+	$(MAKE) -j2 $(BUILD)/test_run_asan $(EXAMPLES) $(BUILD)/npy_tool \
 	  $(BUILD)/export_model_d $(BUILD)/export_model_f
 
 # The documentation against the code: every public function in the manual's

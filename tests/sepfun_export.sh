@@ -10,14 +10,14 @@ CXX=${CXX:-c++}
 D="$B/sepfun_export"
 mkdir -p "$D"
 W="-Wall -Wextra -Werror"
-$CC -std=c99 $W -pedantic -O2 -o "$D/gen" tests/sepfun_export.c -lm
+$CC -std=c99 $W -pedantic -O1 -o "$D/gen" tests/sepfun_export.c -lm
 "$D/gen" "$D"
 for m in sfx_poly sfx_cb sfx_eta sfx_lin; do
-  $CC -std=c99 $W -pedantic -O2 -DPHGMG_NO_OFFLINE -DMODEL_HEADER="\"$m.h\"" -DMODEL_NAME=$m -I"$D" \
+  $CC -std=c99 $W -pedantic -O1 -DPHGMG_NO_OFFLINE -DMODEL_HEADER="\"$m.h\"" -DMODEL_NAME=$m -I"$D" \
       -o "$D/use_$m" tests/sepfun_export.c -lm
   "$D/use_$m" > "$D/$m.out"
   cmp -s "$D/$m.out" "$D/$m.ref" || { echo "FAIL: exported C model $m does not reproduce the in-memory outputs"; exit 1; }
-  $CXX -std=c++11 $W -O2 -DPHGMG_NO_OFFLINE -DMODEL_HEADER="\"$m.h\"" -DMODEL_NAME=$m -I"$D" \
+  $CXX -std=c++11 $W -O1 -DPHGMG_NO_OFFLINE -DMODEL_HEADER="\"$m.h\"" -DMODEL_NAME=$m -I"$D" \
       -x c++ -o "$D/usexx_$m" tests/sepfun_export.c -lm
   "$D/usexx_$m" > "$D/$m.outxx"
   cmp -s "$D/$m.outxx" "$D/$m.ref" || { echo "FAIL: exported C model $m (C++) does not reproduce the in-memory outputs"; exit 1; }

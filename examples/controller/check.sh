@@ -14,7 +14,7 @@ B=${1:-build}
 FAST=${2:-}
 CC=${CC:-cc}
 MODELS="lin_sp1 lin_gmgpod lin_gmgqm nl_sp2 nl_gmgpod nl_gmgqm mo_sp2 mo_gmgpod mo_gmgqm"
-W="-std=c99 -Wall -Wextra -Werror -pedantic -O2"
+W="-std=c99 -Wall -Wextra -Werror -pedantic -O1"
 for t in d f; do
   mkdir -p "$B/emb_$t"
   "$B/export_model_$t" "$B/emb_$t" $FAST > "$B/emb_$t/export.log"
