@@ -9,6 +9,7 @@
 #include <stdio.h>
 #include <math.h>
 #include <string.h>
+#include <stdlib.h>
 
 extern int th_cur_failed;    /* checks failed in the current test */
 extern const char *th_filter;
@@ -43,6 +44,17 @@ static inline unsigned long long *th_rand_state(void) {
   return &s;
 }
 static inline void th_rand_reset(void) { *th_rand_state() = 0x9E3779B97F4A7C15ULL; }
+/* Band storage (half-bandwidth kb, (2 kb + 1) x N, the library's layout) of a
+   dense N x N matrix; calloc'ed, the caller frees. */
+static inline double *th_band(int N, int kb, const double *A) {
+  double *b = (double *)calloc((size_t)(2 * kb + 1) * (size_t)N, sizeof(double));
+  int i, j;
+  for (j = 0; b && j < N; ++j)
+    for (i = (j - kb > 0 ? j - kb : 0); i <= (j + kb < N - 1 ? j + kb : N - 1); ++i)
+      b[(kb + i - j) + (size_t)j * (size_t)(2 * kb + 1)] = A[i + (size_t)j * N];
+  return b;
+}
+
 static inline double th_rand(void) {
   unsigned long long *p = th_rand_state(), s = *p;
   s ^= s >> 12; s ^= s << 25; s ^= s >> 27;

@@ -342,14 +342,6 @@ static void dae_bar(dae_model *d, int n, int im) {
   free(K); free(M);
 }
 
-static double *dae_to_band(int N, int kb, const double *A) {
-  double *b = (double *)calloc((size_t)(2 * kb + 1) * N, sizeof(double));
-  int i, j;
-  for (j = 0; j < N; ++j)
-    for (i = j - kb; i <= j + kb; ++i)
-      if (i >= 0 && i < N) b[(kb + i - j) + (size_t)j * (2 * kb + 1)] = A[i + (size_t)j * N];
-  return b;
-}
 
 static const double dae_quartic[5] = {0.0, 0.0, 0.0, 0.0, 0.5};
 
@@ -374,7 +366,7 @@ TEST(test_dae_bar_simulate) {
   dae_reference(&d, dt, ns, Xr, Yr);
   CHECK_LE(dae_rel((size_t)N * (ns + 1), X, Xr), 1e-11);
   CHECK_LE(dae_rel(2 * (size_t)(ns + 1), Y, Yr), 1e-11);
-  Eb = dae_to_band(N, kb, d.E); Jb = dae_to_band(N, kb, d.J); Rb = dae_to_band(N, kb, d.R); Qb = dae_to_band(N, kb, d.Q);
+  Eb = th_band(N, kb, d.E); Jb = th_band(N, kb, d.J); Rb = th_band(N, kb, d.R); Qb = th_band(N, kb, d.Q);
   sb = s;
   sb.storage = PHGMG_BANDED; sb.kb = kb; sb.E = Eb; sb.J = Jb; sb.R = Rb; sb.Q = Qb;
   for (k = 0; k < n; ++k) idx[k] = k;

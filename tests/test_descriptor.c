@@ -127,15 +127,6 @@ static void dbar_input(double t, double *u, void *user) {
   u[1] = 0.5 * sin(0.7 * t) * t * exp(-0.3 * t);
 }
 
-/* Band storage (kb) of a dense N x N matrix. */
-static double *to_band(int N, int kb, const double *A) {
-  double *b = (double *)calloc((size_t)(2 * kb + 1) * N, sizeof(double));
-  int i, j;
-  for (j = 0; j < N; ++j)
-    for (i = j - kb; i <= j + kb; ++i)
-      if (i >= 0 && i < N) b[(kb + i - j) + (size_t)j * (2 * kb + 1)] = A[i + (size_t)j * N];
-  return b;
-}
 
 static double max_abs(size_t n, const double *a) {
   double m = 0.0;
@@ -217,7 +208,7 @@ static void check_fom_vs_standard(int nonlinear) {
   /* the same model through Newton (no step map) and in band storage (kb = n) */
   go.no_step_map = 1;
   CHECK_RC(phgmg_simulate(&sd, Xn, 0.0, dt, ns, dbar_input, NULL, &go, Xn, NULL, NULL, NULL, NULL, NULL), PHGMG_OK);
-  Eb = to_band(N, n, b.E); Jb = to_band(N, n, b.J); Rb = to_band(N, n, b.R); Qb = to_band(N, n, b.Q);
+  Eb = th_band(N, n, b.E); Jb = th_band(N, n, b.J); Rb = th_band(N, n, b.R); Qb = th_band(N, n, b.Q);
   sb = sd; sb.storage = PHGMG_BANDED; sb.kb = n; sb.E = Eb; sb.J = Jb; sb.R = Rb; sb.Q = Qb;
   CHECK_RC(phgmg_ph_validate(&sb, 0.0, NULL, NULL), PHGMG_OK);
   CHECK_RC(phgmg_simulate(&sb, Xb, 0.0, dt, ns, dbar_input, NULL, &go, Xb, NULL, NULL, NULL, NULL, NULL), PHGMG_OK);

@@ -74,15 +74,6 @@ static void dpm_input(double t, double *u, void *user) {
   u[0] = 2.0 * sin(1.3 * t) * (t < 8.0 ? 1.0 : 0.0);
 }
 
-/* band storage of a dense N x N matrix, half-bandwidth kb */
-static double *dp_band(int N, int kb, const double *A) {
-  double *b = (double *)calloc((size_t)(2 * kb + 1) * N, sizeof(double));
-  int i, j;
-  for (j = 0; j < N; ++j)
-    for (i = (j - kb > 0 ? j - kb : 0); i <= (j + kb < N - 1 ? j + kb : N - 1); ++i)
-      b[(kb + i - j) + (size_t)j * (2 * kb + 1)] = A[i + (size_t)j * N];
-  return b;
-}
 
 static double dp_maxdiff(size_t n, const double *a, const double *b) {
   double m = 0.0;
@@ -131,7 +122,7 @@ TEST(test_dissip_fom_energy) {
   CHECK(D[ns] > 2.0 * D0[ns]);   /* the dampers take out energy */
   CHECK(D[ns] > 0.0);
   /* banded storage, half-bandwidth n + 1 covers J's coupling (n) and the pair damper */
-  Jb = dp_band(c.N, n + 1, c.J); Rb = dp_band(c.N, n + 1, c.R); Qb = dp_band(c.N, n + 1, c.Q);
+  Jb = th_band(c.N, n + 1, c.J); Rb = th_band(c.N, n + 1, c.R); Qb = th_band(c.N, n + 1, c.Q);
   sb = s; sb.storage = PHGMG_BANDED; sb.kb = n + 1; sb.J = Jb; sb.R = Rb; sb.Q = Qb;
   CHECK_RC(phgmg_simulate(&sb, dp_zero, 0.0, dt, ns, dpm_input, NULL, NULL, Xb, NULL, NULL, NULL, NULL, NULL), PHGMG_OK);
   CHECK_LE(dp_maxdiff((size_t)c.N * (ns + 1), X, Xb), 1e-9 * dp_maxabs((size_t)c.N * (ns + 1), X));
@@ -590,7 +581,7 @@ TEST(test_dissip_descriptor) {
     hm = EH[t] > hm ? EH[t] : hm;
   }
   CHECK_LE(e, 1e-11 * hm);
-  Jb = dp_band(N, n + 1, c.J); Rb = dp_band(N, n + 1, c.R); Qb = dp_band(N, n + 1, Q2); Eb = dp_band(N, n + 1, E);
+  Jb = th_band(N, n + 1, c.J); Rb = th_band(N, n + 1, c.R); Qb = th_band(N, n + 1, Q2); Eb = th_band(N, n + 1, E);
   sb = s; sb.storage = PHGMG_BANDED; sb.kb = n + 1; sb.J = Jb; sb.R = Rb; sb.Q = Qb; sb.E = Eb;
   CHECK_RC(phgmg_simulate(&sb, dp_zero, 0.0, dt, ns, dpm_input, NULL, &go, Xb, NULL, NULL, NULL, NULL, NULL), PHGMG_OK);
   CHECK_LE(dp_maxdiff((size_t)N * (ns + 1), X, Xb), 1e-9 * dp_maxabs((size_t)N * (ns + 1), X));
