@@ -14773,6 +14773,33 @@ PHGMG__PRIV phgmg_result phgmg__qm_greedy_wide(phgmg__rctx *c) {
   return rc;
 }
 
+/* The manifolds' constructions of V1 (and V2 where the construction makes
+   it), described once: opts.manifold indexes this table for GMG-QM. */
+PHGMG__PRIV phgmg_result phgmg__v1_pod(phgmg__rctx *c) { (void)c; return PHGMG_OK; }   /* V1 = POD modes */
+PHGMG__PRIV phgmg_result phgmg__v1_greedy(phgmg__rctx *c) {
+  /* a wide V2 with a greedy_window: the incremental selection; else the classic one */
+  return c->wide && c->o->greedy_window > 0 ? phgmg__qm_greedy_wide(c) : phgmg__qm_greedy(c);
+}
+PHGMG__PRIV phgmg_result phgmg__v1_altmin(phgmg__rctx *c) {
+  /* a wide V2 with a greedy_window: started from the greedy manifold */
+  phgmg_result rc = c->wide && c->o->greedy_window > 0 ? phgmg__qm_greedy_wide(c) : PHGMG_OK;
+  if (rc == PHGMG_OK) rc = phgmg__qm_altmin(c);   /* V1 and V2 */
+  if (rc == PHGMG_OK && c->Uw && c->inf.manifold_sweeps > 0) {   /* V1 moved: its complement anew */
+    phgmg__free(c->alloc, c->Uw);
+    c->Uw = c->Cw = NULL; c->kw = 0;
+  }
+  return rc;
+}
+typedef struct phgmg__manifold_row {
+  phgmg_result (*v1)(phgmg__rctx *c);   /* V1 (run after the basis stage)                */
+  int makes_v2;                         /* the construction leaves V2 too (unless wide)   */
+} phgmg__manifold_row;
+static const phgmg__manifold_row phgmg__manifolds[PHGMG_MANIFOLD_COUNT] = {
+  {phgmg__v1_pod, 0},     /* POD: the paper's hierarchical manifold */
+  {phgmg__v1_greedy, 0},  /* GREEDY                                  */
+  {phgmg__v1_altmin, 1},  /* ALTMIN                                  */
+};
+
 /* Stage 2, manifold (QUADRATIC kind): V2 = POD of the residual of [B, V1]
    (paper 4.2.2; V1 greedy with opts.manifold = 1), V1 and V2 by alternating
    minimization (opts.manifold = 2), or the caller's; then GMG-QM fits M (eq. least_square_reg,
@@ -14780,26 +14807,13 @@ PHGMG__PRIV phgmg_result phgmg__qm_greedy_wide(phgmg__rctx *c) {
 PHGMG__PRIV phgmg_result phgmg__stage_manifold(phgmg__rctx *c) {
   phgmg_reduced *red = c->red;
   const int N = red->N, m = red->m, p = red->p, rn = red->rn, ns = c->ns;
+  const phgmg__manifold_row *mf = red->method == PHGMG_METHOD_GMG_QM ? &phgmg__manifolds[c->o->manifold] : NULL;
   phgmg_result rc = PHGMG_OK;
   int k = 0;
   if (red->kind != PHGMG_ROM_QUADRATIC) return PHGMG_OK;
   red->V2 = phgmg__red_d(red, (size_t)N * rn);
   if (!red->V2) return PHGMG_ERR_NOMEM;
-  if (c->o->manifold == PHGMG_MANIFOLD_GREEDY && red->method == PHGMG_METHOD_GMG_QM) {
-    /* a wide V2 with a greedy_window: the incremental selection; else today's */
-    rc = c->wide && c->o->greedy_window > 0 ? phgmg__qm_greedy_wide(c) : phgmg__qm_greedy(c);
-    if (rc != PHGMG_OK) return rc;
-  }
-  if (c->o->manifold == PHGMG_MANIFOLD_ALTMIN && red->method == PHGMG_METHOD_GMG_QM) {
-    /* a wide V2 with a greedy_window: started from the greedy manifold */
-    if (c->wide && c->o->greedy_window > 0) rc = phgmg__qm_greedy_wide(c);
-    if (rc == PHGMG_OK) rc = phgmg__qm_altmin(c);   /* V1 and V2 */
-    if (rc == PHGMG_OK && c->Uw && c->inf.manifold_sweeps > 0) {   /* V1 moved: its complement anew */
-      phgmg__free(c->alloc, c->Uw);
-      c->Uw = c->Cw = NULL; c->kw = 0;
-    }
-    if (rc != PHGMG_OK) return rc;
-  }
+  if (mf && (rc = mf->v1(c)) != PHGMG_OK) return rc;
   {
     double *tmp = phgmg__dalloc(c->alloc, (size_t)p * ns + (size_t)rn);
     if (!tmp) return PHGMG_ERR_NOMEM;
@@ -14808,8 +14822,8 @@ PHGMG__PRIV phgmg_result phgmg__stage_manifold(phgmg__rctx *c) {
       rc = phgmg__qm_wide_v2(c, c->Uw, c->Cw, c->kw);   /* the whole residual; sets rn */
       phgmg__free(c->alloc, c->Uw);
       c->Uw = c->Cw = NULL;
-    } else if (c->o->manifold == PHGMG_MANIFOLD_ALTMIN && red->method == PHGMG_METHOD_GMG_QM) {
-      /* V2 from the alternating minimization */
+    } else if (mf && mf->makes_v2) {
+      /* V2 from the construction */
     } else if (c->o->pod_basis && c->o->manifold == PHGMG_MANIFOLD_POD) {
       memcpy(red->V2, c->o->pod_basis + (size_t)N * p, (size_t)N * rn * sizeof(double));
     } else if (c->v2ok && phgmg__v2_from_basis(c)) { /* the same SVD's next modes */
