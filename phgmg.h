@@ -24,8 +24,8 @@
      9. Configuration macros
     10. Index of public functions
    The header has two halves, declarations and implementation, each cut into
-   sections marked >>config, >>result, >>memory, >>linalg, >>ph, >>gl3,
-   >>online, >>pod, >>hyper, >>reduce, >>deploy, >>errors, >>study, >>linear,
+   sections marked >>config, >>result, >>memory, >>linalg, >>ph, >>dae,
+   >>sparse, >>gl3, >>online, >>pod, >>hyper, >>reduce, >>deploy, >>errors, >>study, >>linear,
    >>export, >>npy (grep for them; the same order in both halves, the
    implementation's >>reduce opening with the reduced object the others use). The comment at each declaration states its
    contract: what it computes, units and layouts, result codes.
@@ -1426,7 +1426,8 @@ typedef struct phgmg_ph_system {
 PHGMG_DEF phgmg_result phgmg_ph_validate(const phgmg_ph_system *sys, double tol,
                                          double *rcond_out, const phgmg_allocator *alloc);
 
-/* Index-one descriptor models (manual 1.8): E with k zero rows (algebraic
+/* >>dae ------------------------------------------------------------------
+   Index-one descriptor models (manual 1.8): E with k zero rows (algebraic
    equations) and k zero columns (algebraic variables). phgmg_dae_create
    checks the index (PHGMG_ERR_INDEX for index >= 2, PHGMG_ERR_PENCIL for a
    singular pencil, PHGMG_ERR_E_SINGULAR when E is singular but not of this
