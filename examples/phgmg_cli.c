@@ -2200,7 +2200,8 @@ static int condense_algebraic(reduce_state *S) {
   S->sys = *phgmg_dae_system(S->dae);
   progress("algebraic constraints: E singular, %d algebraic equations and variables (index one); condensed to "
            "N = %d differential states%s", phgmg_dae_nalg(S->dae), S->sys.N,
-           S->sys.P || S->sys.S ? " with feedthrough (a port on a constraint)" : "");
+           (S->sys.P || S->sys.S) && !(S->full.P || S->full.S || S->full.Nskew)
+               ? " with feedthrough (a port on a constraint)" : "");
 
   return 0;
 }
