@@ -11803,6 +11803,11 @@ PHGMG__PRIV const phgmg__method_row *phgmg__method(int method) {
   return phgmg__methods + (method > 0 && method < (int)PHGMG_METHOD_COUNT ? method : 0);
 }
 
+/* Where a reduction takes its snapshot coordinates and blocks from when it
+   runs on a study's cached bases (phgmg_study_reduce): none (computed from
+   the data), the GMG basis [B, Ua], or SP1's / SP2's Up. */
+enum { PHGMG__SF_NONE = 0, PHGMG__SF_GMG = 1, PHGMG__SF_SP1 = 2, PHGMG__SF_SP2 = 3 };
+
 /* A small owner list: every array of a phgmg_reduced is allocated through it,
    so destroy (and every error path) frees exactly what was allocated. */
 #define PHGMG__MAXBUF 56
@@ -11834,7 +11839,7 @@ struct phgmg_reduced {
   double *qmax;        /* 1: phgmg_rom.q_max (QUADRATIC)                       */
   double *Ainv;        /* SP1/SP2: (V^T Vg)^{-1}, r x r (W = Vg Ainv)          */
   const phgmg_study *study; /* the study that built it on its cached basis (else NULL) */
-  int sbasis;          /* with study: 1 GMG ([B, Ua_1..p(+rn)]), 2 SP1, 3 SP2 (Up_1..r) */
+  int sbasis;          /* with study: PHGMG__SF_GMG ([B, Ua_1..p(+rn)]), _SP1, _SP2 (Up_1..r) */
   /* affine reference state (opts.ref; NULL: none): xbar (N), xbr = rho_lin(xbar)
      (r; rho(x) = rho_lin(x) - xbr), the online terms (phgmg_rom.ref_g/ref_s/xr_rest) */
   double *xbar, *xbr, *refg, *refs, *xrest;
@@ -13682,7 +13687,7 @@ typedef struct phgmg__rctx {
   int fallback_pod;        /* altmin under lambda_auto = 1 found no model as good as
                               GMG-POD: phgmg_reduce redoes it with manifold = POD */
   phgmg_study *st;         /* phgmg_study_reduce: the study (else NULL)     */
-  int sf;                  /* fast path on the study's basis: 1 GMG, 2 SP1, 3 SP2 (0: none) */
+  int sf;                  /* fast path on the study's basis: PHGMG__SF_* */
   /* descriptor models (sys->E set; see DESCRIPTOR MODELS in the manual):
      Bp = E^{-1} B, the port columns of the GMG basis (sys->B without E);
      sepw = E(i_k, i_k) w_k, the separable weights of H (sys->sep_w without E);
@@ -13731,7 +13736,7 @@ PHGMG__PRIV phgmg_result phgmg__reduce_descriptor_setup(phgmg__rctx *c) {
   c->Bp = sys->B;
   c->sepw = sys->sep_w;
   if (!sys->E) return PHGMG_OK;
-  c->sf = 0;
+  c->sf = PHGMG__SF_NONE;
   rc = phgmg__e_factor(sys, &c->ef, NULL, c->alloc);
   if (rc != PHGMG_OK) return rc;
   c->Bp_own = phgmg__dalloc(c->alloc, (size_t)N * m);
@@ -13975,7 +13980,7 @@ PHGMG__PRIV phgmg_result phgmg__stage_basis(phgmg__rctx *c) {
     phgmg__free(c->alloc, S);
     return rc;
   }
-  if (c->sf == 1) { /* the study's basis: Xa is not needed (its coordinates are cached) */
+  if (c->sf == PHGMG__SF_GMG) { /* the study's basis: Xa is not needed (its coordinates are cached) */
     memcpy(red->V0, c->sys->B, (size_t)N * m * sizeof(double));
     memcpy(red->V0 + (size_t)N * m, c->o->pod_basis, (size_t)N * p * sizeof(double));
     return PHGMG_OK;
@@ -14028,7 +14033,7 @@ PHGMG__PRIV phgmg_result phgmg__qm_problem(phgmg__rctx *c) {
   c->Tq = phgmg__dalloc(c->alloc, (size_t)ns * nc + (size_t)ns * rn + (size_t)nc * rn);
   if (!Z2 || !c->Tq) { phgmg__free(c->alloc, Z2); return PHGMG_ERR_NOMEM; }
   Rq = Z2 + (size_t)p * ns; Kt = c->Tq; Rqt = Kt + (size_t)ns * nc;
-  if (c->sf == 1) { /* V1^T X = Ua_1..p^T Xa, V2^T Xa = Ua_p+1..p+rn^T Xa (coordinates) */
+  if (c->sf == PHGMG__SF_GMG) { /* V1^T X = Ua_1..p^T Xa, V2^T Xa = Ua_p+1..p+rn^T Xa (coordinates) */
     const int ka = c->st->ka;
     for (i = 0; i < ns; ++i) {
       memcpy(Z2 + (size_t)i * p, c->st->Ca + (size_t)i * ka, (size_t)p * sizeof(double));
@@ -14062,14 +14067,14 @@ PHGMG__PRIV phgmg_result phgmg__qm_lambda_auto(phgmg__rctx *c) {
   lg = c->lg = phgmg__dalloc(c->alloc, 2 * (size_t)ng);
   if (!lg) return PHGMG_ERR_NOMEM;
   phgmg__lambda_grid(o->lambda_min, o->lambda_max, o->lambda_per_decade, lg);
-  if (c->sf == 1 && !byrun && c->st->cv && c->st->cv_p == p && c->st->cv_rn == rn && c->st->cv_ng == ng &&
+  if (c->sf == PHGMG__SF_GMG && !byrun && c->st->cv && c->st->cv_p == p && c->st->cv_rn == rn && c->st->cv_ng == ng &&
       c->st->cv_nf == nfold && c->st->cv_nb == nblk && c->st->cv_lo == lg[0] && c->st->cv_hi == lg[ng - 1]) {
     memcpy(lg + ng, c->st->cv, (size_t)ng * sizeof(double));   /* the study's: same problem, same basis */
   } else {
     rc = phgmg__ridge_cv_runs(ns, nc, rn, c->Tq, ns, c->Tq + (size_t)ns * nc, ns, ng, lg, nfold, nblk,
                               byrun ? c->runcol : NULL, lg + ng, c->alloc);
     if (rc != PHGMG_OK) return rc;
-    if (c->sf == 1 && !byrun) {
+    if (c->sf == PHGMG__SF_GMG && !byrun) {
       const phgmg_allocator *sa = c->st->use_alloc ? &c->st->alloc : NULL;
       phgmg__free(sa, c->st->cv);
       c->st->cv = phgmg__dalloc(sa, (size_t)ng);
@@ -14818,7 +14823,7 @@ PHGMG__PRIV phgmg_result phgmg__stage_manifold(phgmg__rctx *c) {
   {
     double *tmp = phgmg__dalloc(c->alloc, (size_t)p * ns + (size_t)rn);
     if (!tmp) return PHGMG_ERR_NOMEM;
-    if (c->sf != 1) phgmg__orth_remove(N, p, red->V0 + (size_t)N * m, ns, c->Xa, N, tmp);
+    if (c->sf != PHGMG__SF_GMG) phgmg__orth_remove(N, p, red->V0 + (size_t)N * m, ns, c->Xa, N, tmp);
     if (c->wide) {
       rc = phgmg__qm_wide_v2(c, c->Uw, c->Cw, c->kw);   /* the whole residual; sets rn */
       phgmg__free(c->alloc, c->Uw);
@@ -14886,7 +14891,7 @@ PHGMG__PRIV phgmg_result phgmg__dgd_rcond_snapshots(phgmg__rctx *c, double stop_
   for (j0 = 0; j0 < c->ns; j0 += nbmax) {
     const int nb = PHGMG__MIN(nbmax, c->ns - j0);
     const double *x2b = X2;
-    if (c->sf == 1) {
+    if (c->sf == PHGMG__SF_GMG) {
       x2b = c->st->Ca + (size_t)j0 * c->st->ka;
       ld2 = c->st->ka;
     } else {
@@ -15023,7 +15028,7 @@ PHGMG__PRIV void phgmg__restrict_snapshots(const phgmg__rctx *c, double *XR) {
   const phgmg_study *st = c->st;
   const int r = red->r, m = red->m, ns = c->ns;
   int i, j, k;
-  if (c->sf == 1) {
+  if (c->sf == PHGMG__SF_GMG) {
     for (k = 0; k < ns; ++k) {
       double *xr = XR + (size_t)k * r;
       memcpy(xr, st->CB + (size_t)k * m, (size_t)m * sizeof(double));
@@ -15034,9 +15039,9 @@ PHGMG__PRIV void phgmg__restrict_snapshots(const phgmg__rctx *c, double *XR) {
       }
       memcpy(xr + m, st->Ca + (size_t)k * st->ka, (size_t)(r - m) * sizeof(double));
     }
-  } else if (c->sf == 2 || c->sf == 3) {
-    const double *Cv = c->sf == 2 ? st->Cq : st->Cg;
-    const int ld = c->sf == 2 ? st->kp : st->kg;
+  } else if (c->sf == PHGMG__SF_SP1 || c->sf == PHGMG__SF_SP2) {
+    const double *Cv = c->sf == PHGMG__SF_SP1 ? st->Cq : st->Cg;
+    const int ld = c->sf == PHGMG__SF_SP1 ? st->kp : st->kg;
     phgmg_gemm('T', 'N', r, ns, r, 1.0, red->Ainv, r, Cv, ld, 0.0, XR, r);
   } else {
     phgmg__restrict_block(red, ns, c->Xf, c->ldxf, XR);
@@ -15619,7 +15624,7 @@ PHGMG__PRIV phgmg_result phgmg__stage_gmg_blocks(phgmg__rctx *c) {
   const double *L0 = red->V0, *L2 = red->V2;   /* left factors: [V0, V2], or E [V0, V2] */
   int j;
   phgmg_result rc = PHGMG_OK;
-  if (c->sf != 1) {
+  if (c->sf != PHGMG__SF_GMG) {
     rc = phgmg__damp_jr_factor(&c->jr, c->sys, NULL, c->alloc);   /* G = (J - R (- L))^{-1} */
     if (rc != PHGMG_OK) return rc;
     GV = phgmg__dalloc(c->alloc, (size_t)N * (r + rn) * (c->sys->E ? 2 : 1));
@@ -15645,12 +15650,12 @@ PHGMG__PRIV phgmg_result phgmg__stage_gmg_blocks(phgmg__rctx *c) {
     phgmg__free(c->alloc, GV);
     return PHGMG_ERR_NOMEM;
   }
-  if (c->sf == 1) {
+  if (c->sf == PHGMG__SF_GMG) {
     phgmg__study_gmg_blocks(c);
   } else {
     phgmg__atb(N, r, r, L0, GV, red->G00);
   }
-  if (rn && c->sf != 1) {
+  if (rn && c->sf != PHGMG__SF_GMG) {
     phgmg__atb(N, r, rn, L0, GV + (size_t)N * r, red->G01);
     phgmg__atb(N, rn, r, L2, GV, red->G10);
     phgmg__atb(N, rn, rn, L2, GV + (size_t)N * r, red->G11);
@@ -15794,7 +15799,7 @@ PHGMG__PRIV phgmg_result phgmg__stage_quadratic_terms(phgmg__rctx *c) {
     red->Q11 = phgmg__red_d(red, (size_t)rn * rn);
   }
   if (!QV || !red->Qh || (rn && (!red->Q01 || !red->Q11))) { phgmg__free(c->alloc, QV); return PHGMG_ERR_NOMEM; }
-  if (c->sf == 1) { /* sub-blocks of the study's [B, Ua]^T Q [B, Ua] */
+  if (c->sf == PHGMG__SF_GMG) { /* sub-blocks of the study's [B, Ua]^T Q [B, Ua] */
     const int nf = red->m + c->st->ka;
     phgmg__subblock(r, r, c->st->Qf, nf, 0, 0, red->Qh);
     if (rn) {
@@ -15815,7 +15820,7 @@ PHGMG__PRIV phgmg_result phgmg__stage_quadratic_terms(phgmg__rctx *c) {
     for (i = 0; i < j; ++i)
       red->Qh[i + (size_t)j * r] = red->Qh[j + (size_t)i * r] =
           0.5 * (red->Qh[i + (size_t)j * r] + red->Qh[j + (size_t)i * r]);
-  if (rn && c->sf != 1) {
+  if (rn && c->sf != PHGMG__SF_GMG) {
     phgmg__atb(N, r, rn, red->V0, QV + (size_t)N * r, red->Q01);
     phgmg__atb(N, rn, rn, red->V2, QV + (size_t)N * r, red->Q11);
   }
@@ -16159,16 +16164,16 @@ PHGMG__PRIV phgmg_result phgmg__reduce_fallback_pod(phgmg_reduced **out, const p
 /* Which fast path of a study applies to opts (0: none): the study's own
    bases, orders within its modes (phgmg_study_reduce). */
 PHGMG__PRIV int phgmg__study_fast(const phgmg_study *st, const phgmg_reduce_opts *o, int m) {
-  if (!st) return 0;
+  if (!st) return PHGMG__SF_NONE;
   if ((o->method == PHGMG_METHOD_GMG_POD || (o->method == PHGMG_METHOD_GMG_QM && o->manifold == PHGMG_MANIFOLD_POD)) && st->Ua &&
       o->pod_basis == st->Ua && o->rn >= 0 &&
       o->r - m + (o->method == PHGMG_METHOD_GMG_QM ? (o->rn > 0 ? o->rn : 8) : 0) <= st->ka)
-    return 1;
-  if (o->method == PHGMG_METHOD_SP1 && st->Up && st->Cq && o->pod_basis == st->Up && o->r <= st->kp) return 2;
+    return PHGMG__SF_GMG;
+  if (o->method == PHGMG_METHOD_SP1 && st->Up && st->Cq && o->pod_basis == st->Up && o->r <= st->kp) return PHGMG__SF_SP1;
   if (o->method == PHGMG_METHOD_SP2 && st->Up && st->Ug && o->pod_basis == st->Up && o->grad_basis == st->Ug &&
       o->r <= st->kp && o->r <= st->kg)
-    return 3;
-  return 0;
+    return PHGMG__SF_SP2;
+  return PHGMG__SF_NONE;
 }
 
 /* Building one reduced model: the pipeline's stages in the paper's order
@@ -16223,7 +16228,7 @@ PHGMG__PRIV phgmg_result phgmg__reduce_setup(phgmg__rctx *c, const phgmg_ph_syst
   c->st = st;
   c->inf.hyper_method = -1;
   rc = phgmg__reduce_check(sys, X, ldx, ns, c->o, st != NULL);
-  if (rc == PHGMG_OK) c->sf = (c->o->ref || sys->ndamp) ? 0 : phgmg__study_fast(st, c->o, sys->m);
+  if (rc == PHGMG_OK) c->sf = (c->o->ref || sys->ndamp) ? PHGMG__SF_NONE : phgmg__study_fast(st, c->o, sys->m);
   if (rc == PHGMG_OK) rc = phgmg_ph_validate(sys, 0.0, &c->inf.rcond_jr, alloc);
   if (rc == PHGMG_OK && sys->E && phgmg__e_algebraic(sys, alloc) != 0)   /* reduce the condensed model (1.8) */
     rc = PHGMG_ERR_UNSUPPORTED;
@@ -16973,7 +16978,7 @@ PHGMG__PRIV int phgmg__study_err_sums(const phgmg_study *st, const phgmg_reduced
                                       double s[2]) {
   const int r = red->r, ns = st->ns;
   int i, a, b;
-  if (red->sbasis == 1) {
+  if (red->sbasis == PHGMG__SF_GMG) {
     const phgmg_allocator *alloc = red->use_alloc ? &red->alloc : NULL;
     const int nbmax = PHGMG__ERR_NB, p = red->p, rn = red->rn;
     double *w = phgmg__dalloc(alloc, (size_t)nbmax * ((size_t)p * p + 2 * (size_t)rn) + 1);
@@ -16986,8 +16991,8 @@ PHGMG__PRIV int phgmg__study_err_sums(const phgmg_study *st, const phgmg_reduced
     return 1;
   }
   {
-    const double *Cv = red->sbasis == 2 ? st->Cq : st->Cg;
-    const int ld = red->sbasis == 2 ? st->kp : st->kg, kp = st->kp;
+    const double *Cv = red->sbasis == PHGMG__SF_SP1 ? st->Cq : st->Cg;
+    const int ld = red->sbasis == PHGMG__SF_SP1 ? st->kp : st->kg, kp = st->kp;
     s[0] = s[1] = st->Tp[r];
     for (i = 0; i < ns; ++i) {
       const double *cp = st->Cp + (size_t)i * kp, *cv = Cv + (size_t)i * ld;
@@ -17007,7 +17012,7 @@ PHGMG_DEF phgmg_result phgmg_study_errors(const phgmg_study *st, const phgmg_red
   double s[2];
   if (!st || !red) return PHGMG_ERR_INVALID_ARG;
   if (red->N != st->N || red->m != st->m || (XR && ldxr < red->r)) return PHGMG_ERR_SIZE;
-  if (red->study != st || red->sbasis == 0 || red->rn > 64) {
+  if (red->study != st || red->sbasis == PHGMG__SF_NONE || red->rn > 64) {
     if (e_red) *e_red = XR ? phgmg_err_red(red, st->X, st->ldx, st->ns, XR, ldxr) : (double)NAN;
     if (e_proj) *e_proj = phgmg_err_proj(red, st->X, st->ldx, st->ns);
     if (e_lower) *e_lower = phgmg_err_lowerbound(red, st->X, st->ldx, st->ns);
