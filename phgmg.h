@@ -14023,9 +14023,32 @@ PHGMG__PRIV phgmg_result phgmg__stage_basis(phgmg__rctx *c) {
    equivalent problem over the p(p+1)/2 distinct columns (off-diagonal ones
    scaled by sqrt 2, unknown t = sqrt 2 M(:,(a,j))) has the same minimiser
    with 4x fewer flops. c->Tq = [Kt (ns x nc), Rqt (ns x rn), Mt (nc x rn)]. */
+/* The snapshot coordinates the quadratic fit and the checks read, from one
+   provider: the V1 coordinates V1^T X (p rows) and the V2 coordinates
+   V2^T Xa (rn rows) of snapshots j0 .. j0+nb-1, taken from the study's
+   cache (phgmg_study_reduce on its GMG basis: columns of Ca) or computed
+   into buf (p x nb, resp. rn x nb). Returns the block; *ld its leading
+   dimension. */
+PHGMG__PRIV const double *phgmg__snap_v1(const phgmg__rctx *c, int j0, int nb, double *buf, int *ld) {
+  const phgmg_reduced *red = c->red;
+  const int N = red->N, m = red->m, p = red->p;
+  if (c->sf == PHGMG__SF_GMG) { *ld = c->st->ka; return c->st->Ca + (size_t)j0 * c->st->ka; }
+  phgmg_gemm('T', 'N', p, nb, N, 1.0, red->V0 + (size_t)N * m, N, c->X + (size_t)j0 * c->ldx, c->ldx, 0.0, buf, p);
+  *ld = p;
+  return buf;
+}
+PHGMG__PRIV const double *phgmg__snap_v2(const phgmg__rctx *c, int j0, int nb, double *buf, int *ld) {
+  const phgmg_reduced *red = c->red;
+  const int N = red->N, rn = red->rn;
+  if (c->sf == PHGMG__SF_GMG) { *ld = c->st->ka; return c->st->Ca + (size_t)j0 * c->st->ka + red->p; }
+  phgmg_gemm('T', 'N', rn, nb, N, 1.0, red->V2, N, c->Xa + (size_t)j0 * N, N, 0.0, buf, rn);
+  *ld = rn;
+  return buf;
+}
+
 PHGMG__PRIV phgmg_result phgmg__qm_problem(phgmg__rctx *c) {
   phgmg_reduced *red = c->red;
-  const int N = red->N, m = red->m, p = red->p, rn = red->rn, ns = c->ns, nc = p * (p + 1) / 2;
+  const int p = red->p, rn = red->rn, ns = c->ns, nc = p * (p + 1) / 2;
   const double s2 = sqrt(2.0);
   double *Z2, *Rq, *Kt, *Rqt;
   int i, a, j, cc;
@@ -14033,21 +14056,15 @@ PHGMG__PRIV phgmg_result phgmg__qm_problem(phgmg__rctx *c) {
   c->Tq = phgmg__dalloc(c->alloc, (size_t)ns * nc + (size_t)ns * rn + (size_t)nc * rn);
   if (!Z2 || !c->Tq) { phgmg__free(c->alloc, Z2); return PHGMG_ERR_NOMEM; }
   Rq = Z2 + (size_t)p * ns; Kt = c->Tq; Rqt = Kt + (size_t)ns * nc;
-  if (c->sf == PHGMG__SF_GMG) { /* V1^T X = Ua_1..p^T Xa, V2^T Xa = Ua_p+1..p+rn^T Xa (coordinates) */
-    const int ka = c->st->ka;
+  {
+    int l1, l2;
+    const double *z2 = phgmg__snap_v1(c, 0, ns, Z2, &l1), *rq = phgmg__snap_v2(c, 0, ns, Rq, &l2);
     for (i = 0; i < ns; ++i) {
-      memcpy(Z2 + (size_t)i * p, c->st->Ca + (size_t)i * ka, (size_t)p * sizeof(double));
-      memcpy(Rq + (size_t)i * rn, c->st->Ca + (size_t)i * ka + p, (size_t)rn * sizeof(double));
+      for (a = 0, cc = 0; a < p; ++a)
+        for (j = a; j < p; ++j, ++cc)
+          Kt[i + (size_t)cc * ns] = (a == j ? 1.0 : s2) * z2[a + (size_t)i * l1] * z2[j + (size_t)i * l1];
+      for (a = 0; a < rn; ++a) Rqt[i + (size_t)a * ns] = rq[a + (size_t)i * l2];
     }
-  } else {
-    phgmg_gemm('T', 'N', p, ns, N, 1.0, red->V0 + (size_t)N * m, N, c->X, c->ldx, 0.0, Z2, p);
-    phgmg_gemm('T', 'N', rn, ns, N, 1.0, red->V2, N, c->Xa, N, 0.0, Rq, rn);
-  }
-  for (i = 0; i < ns; ++i) {
-    for (a = 0, cc = 0; a < p; ++a)
-      for (j = a; j < p; ++j, ++cc)
-        Kt[i + (size_t)cc * ns] = (a == j ? 1.0 : s2) * Z2[a + (size_t)i * p] * Z2[j + (size_t)i * p];
-    for (a = 0; a < rn; ++a) Rqt[i + (size_t)a * ns] = Rq[a + (size_t)i * rn];
   }
   phgmg__free(c->alloc, Z2);
   return PHGMG_OK;
@@ -14881,7 +14898,7 @@ PHGMG__PRIV void phgmg__dgd_unit_ports(const phgmg_reduced *red, double *E) {
    workspace. */
 PHGMG__PRIV phgmg_result phgmg__dgd_rcond_snapshots(phgmg__rctx *c, double stop_below, double *rmin) {
   phgmg_reduced *red = c->red;
-  const int N = red->N, m = red->m, p = red->p, rn = red->rn, r = red->r, nbmax = 64;
+  const int p = red->p, rn = red->rn, r = red->r, nbmax = 64;
   double *Lp, *E, *tmp, *X2, *wk;
   int *ip, i, j0, ld2 = p;
   Lp = phgmg__dalloc(c->alloc, (size_t)rn * p + (size_t)r * r + (size_t)rn * r + (size_t)p * nbmax + 2 * (size_t)r);
@@ -14890,13 +14907,7 @@ PHGMG__PRIV phgmg_result phgmg__dgd_rcond_snapshots(phgmg__rctx *c, double stop_
   E = Lp + (size_t)rn * p; tmp = E + (size_t)r * r; X2 = tmp + (size_t)rn * r; wk = X2 + (size_t)p * nbmax;
   for (j0 = 0; j0 < c->ns; j0 += nbmax) {
     const int nb = PHGMG__MIN(nbmax, c->ns - j0);
-    const double *x2b = X2;
-    if (c->sf == PHGMG__SF_GMG) {
-      x2b = c->st->Ca + (size_t)j0 * c->st->ka;
-      ld2 = c->st->ka;
-    } else {
-      phgmg_gemm('T', 'N', p, nb, N, 1.0, red->V0 + (size_t)N * m, N, c->X + (size_t)j0 * c->ldx, c->ldx, 0.0, X2, p);
-    }
+    const double *x2b = phgmg__snap_v1(c, j0, nb, X2, &ld2);
     for (i = 0; i < nb; ++i) {
       double rc_i;
       phgmg__eta_d(red, x2b + (size_t)i * ld2, NULL, Lp, NULL, red->rwork);
