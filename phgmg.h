@@ -6207,14 +6207,13 @@ PHGMG__PRIV phgmg_result phgmg__pencil_rcond(const phgmg_ph_system *s, double si
                                              const phgmg_allocator *alloc) {
   const int N = s->N, kb2 = s->storage == PHGMG_BANDED ? PHGMG__MIN(2 * s->kb, N - 1) : N - 1;
   const size_t len = s->storage == PHGMG_BANDED ? (size_t)(2 * kb2 + 1) * (size_t)N : (size_t)N * (size_t)N;
-  double *M = phgmg__dalloc(alloc, len), *zero = phgmg__dalloc(alloc, len);
+  double *M = phgmg__dalloc(alloc, len);
   phgmg_ph_system t;
   phgmg_jr_factor *f = NULL;
   phgmg_result rc;
   int i, j, l, a, b;
   *rcond = 0.0;
-  if (!M || !zero) { phgmg__free(alloc, M); phgmg__free(alloc, zero); return PHGMG_ERR_NOMEM; }
-  memset(zero, 0, len * sizeof(double));
+  if (!M) return PHGMG_ERR_NOMEM;
   memset(M, 0, len * sizeof(double));
   for (j = 0; j < N; ++j) {
     const int i0 = PHGMG__MAX(0, j - kb2), i1 = PHGMG__MIN(N - 1, j + kb2);
@@ -6225,13 +6224,12 @@ PHGMG__PRIV phgmg_result phgmg__pencil_rcond(const phgmg_ph_system *s, double si
       M[s->storage == PHGMG_BANDED ? PHGMG__PHB(kb2, i, j) : (size_t)i + (size_t)j * (size_t)N] = acc;
     }
   }
-  memset(&t, 0, sizeof t);
-  t.N = N; t.m = s->m; t.storage = s->storage; t.kb = kb2; t.B = s->B;
-  t.J = M; t.R = zero; t.Q = M;
-  rc = phgmg_jr_factor_create(&f, &t, rcond, alloc);
+  t = *s;   /* the factorization of a mass matrix, with M in its place */
+  t.kb = s->storage == PHGMG_BANDED ? kb2 : 0;
+  t.E = M;
+  rc = phgmg__e_factor(&t, &f, rcond, alloc);
   phgmg_jr_factor_destroy(f);
   phgmg__free(alloc, M);
-  phgmg__free(alloc, zero);
   if (rc != PHGMG_OK && rc != PHGMG_ERR_NOMEM) { *rcond = 0.0; rc = PHGMG_OK; }
   return rc;
 }
