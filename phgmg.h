@@ -389,7 +389,15 @@
    phgmg_pod_randomized, phgmg_adjust_snapshots, phgmg_pod_hierarchical,
    phgmg_deim, phgmg_deim_select, phgmg_nnls, phgmg_ecsw, phgmg_ecsw_separable,
    and the dense kernels of >>linalg (GEMM, LU, QR, pivoted QR, least squares,
-   thin SVD, symmetric eigenvalues).
+   thin SVD, symmetric eigenvalues). Argument lists. These kernels take
+   their operands positionally in the LAPACK manner -- sizes, then each
+   matrix as a pointer and its leading dimension, outputs last, the
+   allocator at the end -- and some have ten or more arguments; the drivers
+   a program calls with a model offer a struct form instead: phgmg_run with
+   phgmg_simulate_run and phgmg_reduced_simulate_run (for phgmg_simulate and
+   phgmg_reduced_simulate), phgmg_ss with phgmg_ss_compare (for
+   phgmg_ss_error), phgmg_ph_sparse_desc with phgmg_ph_sparse_create_desc
+   (for phgmg_ph_sparse_create and _create_e).
 
    2.5 Linear systems (>>linear, quadratic H, dense up to a few thousand
    states): Lyapunov and Riccati equations by the matrix sign function
@@ -404,7 +412,8 @@
 
 
    2.6 Sparse models (>>ph, >>sparse). phgmg_ph_sparse_create takes J, R, Q
-   (and E) as compressed sparse columns in any ordering, reorders them by
+   (and E; or all of them in one phgmg_ph_sparse_desc:
+   phgmg_ph_sparse_create_desc) as compressed sparse columns in any ordering, reorders them by
    reverse Cuthill-McKee into band storage and, for meshes (a wide band),
    also analyses a sparse LU of the GL3 stage matrices: block elimination
    of an independent set of states first (a mass-spring model's positions:
@@ -1016,6 +1025,7 @@
            phgmg_dae_create, phgmg_dae_system, phgmg_dae_nalg,
            phgmg_dae_restrict, phgmg_dae_embed, phgmg_dae_lift,
            phgmg_dae_destroy, phgmg_rcm, phgmg_ph_sparse_create, phgmg_ph_sparse_create_e,
+           phgmg_ph_sparse_create_desc,
            phgmg_ph_sparse_system,
            phgmg_ph_sparse_perm, phgmg_ph_sparse_sep_idx,
            phgmg_ph_sparse_to_banded_order, phgmg_ph_sparse_to_user_order,
@@ -1602,6 +1612,20 @@ PHGMG_DEF phgmg_result phgmg_ph_sparse_create_e(phgmg_ph_sparse **out, int N, in
                                                 const phgmg_csc *R, const phgmg_csc *Q, const phgmg_csc *E,
                                                 const double *B, const phgmg_csc *Bcsc,
                                                 phgmg_ph_sparse_info *info, const phgmg_allocator *alloc);
+/* The same from one description (no positional argument list to get wrong):
+   J, R, Q required; E optional (E.colptr NULL: E = I); B dense (N x m, ld N)
+   or, if B is NULL, the CSC matrix Bcsc. Equivalent to
+   phgmg_ph_sparse_create_e(out, d->N, d->m, &d->J, &d->R, &d->Q, E or NULL,
+   d->B, B ? NULL : &d->Bcsc, info, alloc); PHGMG_ERR_INVALID_ARG for NULL d. */
+typedef struct phgmg_ph_sparse_desc {
+  int N, m;
+  phgmg_csc J, R, Q;  /* N x N, the user's ordering                        */
+  phgmg_csc E;        /* descriptor models; zeroed (colptr NULL): E = I      */
+  const double *B;    /* N x m dense, ld N; NULL: Bcsc                       */
+  phgmg_csc Bcsc;     /* N x m CSC, used when B is NULL                      */
+} phgmg_ph_sparse_desc;
+PHGMG_DEF phgmg_result phgmg_ph_sparse_create_desc(phgmg_ph_sparse **out, const phgmg_ph_sparse_desc *d,
+                                                   phgmg_ph_sparse_info *info, const phgmg_allocator *alloc);
 /* The banded, permuted system (valid until destroy; NULL for NULL). */
 PHGMG_DEF const phgmg_ph_system *phgmg_ph_sparse_system(const phgmg_ph_sparse *sp);
 /* The permutation (N): internal index i is user index perm[i]; NULL for NULL. */
@@ -8456,6 +8480,17 @@ PHGMG_DEF phgmg_result phgmg_ph_sparse_create(phgmg_ph_sparse **out, int N, int 
                                               const phgmg_csc *Bcsc, phgmg_ph_sparse_info *info,
                                               const phgmg_allocator *alloc) {
   return phgmg_ph_sparse_create_e(out, N, m, J, R, Q, NULL, B, Bcsc, info, alloc);
+}
+
+PHGMG_DEF phgmg_result phgmg_ph_sparse_create_desc(phgmg_ph_sparse **out, const phgmg_ph_sparse_desc *d,
+                                                   phgmg_ph_sparse_info *info, const phgmg_allocator *alloc) {
+  if (!d) {
+    if (info) memset(info, 0, sizeof *info);
+    if (out) *out = NULL;
+    return PHGMG_ERR_INVALID_ARG;
+  }
+  return phgmg_ph_sparse_create_e(out, d->N, d->m, &d->J, &d->R, &d->Q, d->E.colptr ? &d->E : NULL,
+                                  d->B, d->B ? NULL : &d->Bcsc, info, alloc);
 }
 
 PHGMG_DEF phgmg_result phgmg_ph_sparse_create_e(phgmg_ph_sparse **out, int N, int m, const phgmg_csc *J,

@@ -343,6 +343,32 @@ TEST(test_descriptor_sparse_scrambled) {
     for (k = 0; k < 2 * (ns + 1); ++k) emax = fmax(emax, fabs(Y[k] - Yi[k]));
     CHECK_LE(emax, 1e-10 * max_abs((size_t)2 * (ns + 1), Y));
   }
+  /* The description form builds the same object: the same ordering and the
+     same trajectory bit for bit; without E it is the plain phgmg_ph_sparse_create. */
+  if (sp) {
+    phgmg_ph_sparse_desc d;
+    phgmg_ph_sparse *sq = (phgmg_ph_sparse *)1, *sr = NULL;
+    phgmg_ph_sparse_info inq;
+    memset(&d, 0, sizeof d);
+    d.N = N; d.m = 2; d.J = cJ.A; d.R = cR.A; d.Q = cQ.A; d.E = cE.A; d.B = Bp;
+    CHECK_RC(phgmg_ph_sparse_create_desc(NULL, &d, &inq, NULL), PHGMG_ERR_INVALID_ARG);
+    CHECK_RC(phgmg_ph_sparse_create_desc(&sq, NULL, &inq, NULL), PHGMG_ERR_INVALID_ARG);
+    CHECK(sq == NULL);
+    CHECK_RC(phgmg_ph_sparse_create_desc(&sq, &d, &inq, NULL), PHGMG_OK);
+    if (sq) {
+      phgmg_ph_system s2 = *phgmg_ph_sparse_system(sq);
+      CHECK(memcmp(phgmg_ph_sparse_perm(sq), phgmg_ph_sparse_perm(sp), sizeof(int) * (size_t)N) == 0);
+      CHECK(inq.kb == inf.kb && inq.nnz == inf.nnz && s2.E != NULL);
+      CHECK_RC(phgmg_simulate(&s2, X, 0.0, dt, ns, dbar_input, NULL, NULL, X, Y, NULL, NULL, NULL, NULL), PHGMG_OK);
+      CHECK_RC(phgmg_simulate(&sp_sys, XU, 0.0, dt, ns, dbar_input, NULL, NULL, XU, Yi, NULL, NULL, NULL, NULL), PHGMG_OK);
+      CHECK(memcmp(X, XU, sizeof(double) * (size_t)N * (ns + 1)) == 0);
+    }
+    memset(&d.E, 0, sizeof d.E);
+    CHECK_RC(phgmg_ph_sparse_create_desc(&sr, &d, &inq, NULL), PHGMG_OK);
+    CHECK(sr != NULL && phgmg_ph_sparse_system(sr)->E == NULL);
+    phgmg_ph_sparse_destroy(sq);
+    phgmg_ph_sparse_destroy(sr);
+  }
   phgmg_ph_sparse_destroy(sp);
   dcsc_free(&cE); dcsc_free(&cJ); dcsc_free(&cR); dcsc_free(&cQ);
   free(Bp); free(X); free(XU); free(XI); free(Y); free(Yi);
