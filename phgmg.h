@@ -15661,28 +15661,42 @@ PHGMG__PRIV phgmg_result phgmg__dampers_hyper(phgmg__rctx *c) {
   return rc;
 }
 
+/* The G-blocks computed: r + rn solves with J - R (- L) (the factor stays in
+   c->jr for the dampers and feedthrough), G00 = L0^T G [V0] and, with V2,
+   G01, G10, G11; L = [V0, V2], or E [V0, V2] for a descriptor model. */
+PHGMG__PRIV phgmg_result phgmg__gmg_blocks_solve(phgmg__rctx *c) {
+  phgmg_reduced *red = c->red;
+  const int N = red->N, r = red->r, rn = red->rn;
+  double *GV, *EV;
+  const double *L0 = red->V0, *L2 = red->V2;   /* left factors: [V0, V2], or E [V0, V2] */
+  phgmg_result rc = phgmg__damp_jr_factor(&c->jr, c->sys, NULL, c->alloc);   /* G = (J - R (- L))^{-1} */
+  if (rc != PHGMG_OK) return rc;
+  GV = phgmg__dalloc(c->alloc, (size_t)N * (r + rn) * (c->sys->E ? 2 : 1));
+  if (!GV) return PHGMG_ERR_NOMEM;
+  memcpy(GV, red->V0, (size_t)N * r * sizeof(double));
+  if (rn) memcpy(GV + (size_t)N * r, red->V2, (size_t)N * rn * sizeof(double));
+  if (c->sys->E) { /* descriptor: G_E = E^T G E, so the blocks are (E V)^T G (E V) */
+    EV = GV + (size_t)N * (r + rn);
+    phgmg__ph_e_apply(c->sys, 'N', r + rn, GV, N, EV, N);
+    memcpy(GV, EV, (size_t)N * (r + rn) * sizeof(double));
+    L0 = EV; L2 = EV + (size_t)N * r;
+  }
+  phgmg_jr_solve(c->jr, 'N', r + rn, GV, N);           /* GV = G [V0, V2] */
+  phgmg__atb(N, r, r, L0, GV, red->G00);
+  if (rn) {
+    phgmg__atb(N, r, rn, L0, GV + (size_t)N * r, red->G01);
+    phgmg__atb(N, rn, r, L2, GV, red->G10);
+    phgmg__atb(N, rn, rn, L2, GV + (size_t)N * r, red->G11);
+  }
+  phgmg__free(c->alloc, GV);
+  return PHGMG_OK;
+}
+
 PHGMG__PRIV phgmg_result phgmg__stage_gmg_blocks(phgmg__rctx *c) {
   phgmg_reduced *red = c->red;
-  const int N = red->N, m = red->m, r = red->r, rn = red->rn;
-  double *GV = NULL, *EV = NULL;
-  const double *L0 = red->V0, *L2 = red->V2;   /* left factors: [V0, V2], or E [V0, V2] */
+  const int m = red->m, r = red->r, rn = red->rn;
   int j;
-  phgmg_result rc = PHGMG_OK;
-  if (c->sf != PHGMG__SF_GMG) {
-    rc = phgmg__damp_jr_factor(&c->jr, c->sys, NULL, c->alloc);   /* G = (J - R (- L))^{-1} */
-    if (rc != PHGMG_OK) return rc;
-    GV = phgmg__dalloc(c->alloc, (size_t)N * (r + rn) * (c->sys->E ? 2 : 1));
-    if (!GV) return PHGMG_ERR_NOMEM;
-    memcpy(GV, red->V0, (size_t)N * r * sizeof(double));
-    if (rn) memcpy(GV + (size_t)N * r, red->V2, (size_t)N * rn * sizeof(double));
-    if (c->sys->E) { /* descriptor: G_E = E^T G E, so the blocks are (E V)^T G (E V) */
-      EV = GV + (size_t)N * (r + rn);
-      phgmg__ph_e_apply(c->sys, 'N', r + rn, GV, N, EV, N);
-      memcpy(GV, EV, (size_t)N * (r + rn) * sizeof(double));
-      L0 = EV; L2 = EV + (size_t)N * r;
-    }
-    phgmg_jr_solve(c->jr, 'N', r + rn, GV, N);           /* GV = G [V0, V2] */
-  }
+  phgmg_result rc;
   red->G00 = phgmg__red_d(red, (size_t)r * r);
   red->Bh = phgmg__red_d(red, (size_t)r * m);
   if (rn) {
@@ -15690,21 +15704,9 @@ PHGMG__PRIV phgmg_result phgmg__stage_gmg_blocks(phgmg__rctx *c) {
     red->G10 = phgmg__red_d(red, (size_t)rn * r);
     red->G11 = phgmg__red_d(red, (size_t)rn * rn);
   }
-  if (!red->G00 || !red->Bh || (rn && (!red->G01 || !red->G10 || !red->G11))) {
-    phgmg__free(c->alloc, GV);
-    return PHGMG_ERR_NOMEM;
-  }
-  if (c->sf == PHGMG__SF_GMG) {
-    phgmg__study_gmg_blocks(c);
-  } else {
-    phgmg__atb(N, r, r, L0, GV, red->G00);
-  }
-  if (rn && c->sf != PHGMG__SF_GMG) {
-    phgmg__atb(N, r, rn, L0, GV + (size_t)N * r, red->G01);
-    phgmg__atb(N, rn, r, L2, GV, red->G10);
-    phgmg__atb(N, rn, rn, L2, GV + (size_t)N * r, red->G11);
-  }
-  phgmg__free(c->alloc, GV);
+  if (!red->G00 || !red->Bh || (rn && (!red->G01 || !red->G10 || !red->G11))) return PHGMG_ERR_NOMEM;
+  rc = c->sf == PHGMG__SF_GMG ? phgmg__study_gmg_blocks(c) : phgmg__gmg_blocks_solve(c);
+  if (rc != PHGMG_OK) return rc;
   for (j = 0; j < m; ++j) red->Bh[j + (size_t)j * r] = 1.0;
   rc = phgmg__check_degeneracy(c);
   if (rc != PHGMG_OK || red->kind != PHGMG_ROM_LINEAR) return rc;
@@ -15804,72 +15806,68 @@ PHGMG__PRIV phgmg_result phgmg__stage_sp_blocks(phgmg__rctx *c) {
   return rc;
 }
 
-/* Descriptor: Qh = (E V0)^T Q V0, Q01 = (E V0)^T Q V2, Q11 = (E V2)^T Q V2
-   (Hess H = E^T Q) from QV = Q [V0, V2]; Qh and Q11 symmetrised. */
-PHGMG__PRIV phgmg_result phgmg__quadratic_terms_e(phgmg__rctx *c, const double *QV) {
+/* A (n x n) <- (A + A^T) / 2, exactly symmetric. */
+PHGMG__PRIV void phgmg__symmetrize(int n, double *A) {
+  int i, j;
+  for (j = 0; j < n; ++j)
+    for (i = 0; i < j; ++i)
+      A[i + (size_t)j * n] = A[j + (size_t)i * n] = 0.5 * (A[i + (size_t)j * n] + A[j + (size_t)i * n]);
+}
+
+/* The Q-blocks computed: Qh = L0^T Q V0, Q01 = L0^T Q V2, Q11 = L2^T Q V2
+   with L = [V0, V2], or E [V0, V2] for a descriptor model (Hess H = E^T Q). */
+PHGMG__PRIV phgmg_result phgmg__quadratic_terms_apply(phgmg__rctx *c) {
   phgmg_reduced *red = c->red;
   const int N = red->N, r = red->r, rn = red->rn;
-  double *EV = phgmg__dalloc(c->alloc, (size_t)N * (r + rn));
-  int i, j;
-  if (!EV) return PHGMG_ERR_NOMEM;
-  phgmg__ph_e_apply(c->sys, 'N', r, red->V0, N, EV, N);
-  if (rn) phgmg__ph_e_apply(c->sys, 'N', rn, red->V2, N, EV + (size_t)N * r, N);
-  phgmg__atb(N, r, r, EV, QV, red->Qh);
-  if (rn) {
-    phgmg__atb(N, r, rn, EV, QV + (size_t)N * r, red->Q01);
-    phgmg__atb(N, rn, rn, EV + (size_t)N * r, QV + (size_t)N * r, red->Q11);
-    for (j = 0; j < rn; ++j)
-      for (i = 0; i < j; ++i)
-        red->Q11[i + (size_t)j * rn] = red->Q11[j + (size_t)i * rn] =
-            0.5 * (red->Q11[i + (size_t)j * rn] + red->Q11[j + (size_t)i * rn]);
+  double *QV = phgmg__dalloc(c->alloc, (size_t)N * (r + rn) * (c->sys->E ? 2 : 1));
+  const double *L0 = red->V0, *L2 = red->V2;
+  if (!QV) return PHGMG_ERR_NOMEM;
+  phgmg_ph_apply(c->sys, 'Q', r, red->V0, N, QV, N);
+  if (rn) phgmg_ph_apply(c->sys, 'Q', rn, red->V2, N, QV + (size_t)N * r, N);
+  if (c->sys->E) {
+    double *EV = QV + (size_t)N * (r + rn);
+    phgmg__ph_e_apply(c->sys, 'N', r, red->V0, N, EV, N);
+    if (rn) phgmg__ph_e_apply(c->sys, 'N', rn, red->V2, N, EV + (size_t)N * r, N);
+    L0 = EV; L2 = EV + (size_t)N * r;
   }
-  for (j = 0; j < r; ++j)
-    for (i = 0; i < j; ++i)
-      red->Qh[i + (size_t)j * r] = red->Qh[j + (size_t)i * r] = 0.5 * (red->Qh[i + (size_t)j * r] + red->Qh[j + (size_t)i * r]);
-  phgmg__free(c->alloc, EV);
+  phgmg__atb(N, r, r, L0, QV, red->Qh);
+  if (rn) {
+    phgmg__atb(N, r, rn, L0, QV + (size_t)N * r, red->Q01);
+    phgmg__atb(N, rn, rn, L2, QV + (size_t)N * r, red->Q11);
+    if (c->sys->E) phgmg__symmetrize(rn, red->Q11);
+  }
+  phgmg__free(c->alloc, QV);
+  return PHGMG_OK;
+}
+
+/* The study's Q-blocks: sub-blocks of its [B, Ua]^T Q [B, Ua]. */
+PHGMG__PRIV phgmg_result phgmg__study_quadratic_terms(phgmg__rctx *c) {
+  phgmg_reduced *red = c->red;
+  const int r = red->r, rn = red->rn, nf = red->m + c->st->ka;
+  phgmg__subblock(r, r, c->st->Qf, nf, 0, 0, red->Qh);
+  if (rn) {
+    phgmg__subblock(r, rn, c->st->Qf, nf, 0, r, red->Q01);
+    phgmg__subblock(rn, rn, c->st->Qf, nf, r, r, red->Q11);
+  }
   return PHGMG_OK;
 }
 
 /* Stage 4a, quadratic part of H: Qh = V0^T Q V0 (exactly symmetric), and
-   the V2 blocks Q01 = V0^T Q V2, Q11 = V2^T Q V2. */
+   the V2 blocks Q01 = V0^T Q V2, Q11 = V2^T Q V2 -- from the study's cached
+   blocks or computed. */
 PHGMG__PRIV phgmg_result phgmg__stage_quadratic_terms(phgmg__rctx *c) {
   phgmg_reduced *red = c->red;
-  const int N = red->N, r = red->r, rn = red->rn;
-  double *QV = phgmg__dalloc(c->alloc, (size_t)N * (r + rn));
-  int i, j;
+  const int r = red->r, rn = red->rn;
+  phgmg_result rc;
   red->Qh = phgmg__red_d(red, (size_t)r * r);
   if (rn) {
     red->Q01 = phgmg__red_d(red, (size_t)r * rn);
     red->Q11 = phgmg__red_d(red, (size_t)rn * rn);
   }
-  if (!QV || !red->Qh || (rn && (!red->Q01 || !red->Q11))) { phgmg__free(c->alloc, QV); return PHGMG_ERR_NOMEM; }
-  if (c->sf == PHGMG__SF_GMG) { /* sub-blocks of the study's [B, Ua]^T Q [B, Ua] */
-    const int nf = red->m + c->st->ka;
-    phgmg__subblock(r, r, c->st->Qf, nf, 0, 0, red->Qh);
-    if (rn) {
-      phgmg__subblock(r, rn, c->st->Qf, nf, 0, r, red->Q01);
-      phgmg__subblock(rn, rn, c->st->Qf, nf, r, r, red->Q11);
-    }
-  } else {
-    phgmg_ph_apply(c->sys, 'Q', r, red->V0, N, QV, N);
-    if (rn) phgmg_ph_apply(c->sys, 'Q', rn, red->V2, N, QV + (size_t)N * r, N);
-    if (c->sys->E) { /* descriptor: Hess H = E^T Q, so Qh = (E V0)^T (Q V0) ... */
-      phgmg_result rc = phgmg__quadratic_terms_e(c, QV);
-      phgmg__free(c->alloc, QV);
-      return rc;
-    }
-    phgmg__atb(N, r, r, red->V0, QV, red->Qh);
-  }
-  for (j = 0; j < r; ++j)
-    for (i = 0; i < j; ++i)
-      red->Qh[i + (size_t)j * r] = red->Qh[j + (size_t)i * r] =
-          0.5 * (red->Qh[i + (size_t)j * r] + red->Qh[j + (size_t)i * r]);
-  if (rn && c->sf != PHGMG__SF_GMG) {
-    phgmg__atb(N, r, rn, red->V0, QV + (size_t)N * r, red->Q01);
-    phgmg__atb(N, rn, rn, red->V2, QV + (size_t)N * r, red->Q11);
-  }
-  phgmg__free(c->alloc, QV);
-  return PHGMG_OK;
+  if (!red->Qh || (rn && (!red->Q01 || !red->Q11))) return PHGMG_ERR_NOMEM;
+  rc = c->sf == PHGMG__SF_GMG ? phgmg__study_quadratic_terms(c) : phgmg__quadratic_terms_apply(c);
+  if (rc == PHGMG_OK) phgmg__symmetrize(r, red->Qh);
+  return rc;
 }
 
 /* ECSW for GMG-QM / GMG_MANIFOLD: rows (i, a) of the training matrix are
