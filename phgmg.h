@@ -890,6 +890,25 @@
    1e-5 in float) is multiplied by max(1, |x|_inf, |Z|_inf), so a model whose
    states are large in its units still converges, and a small-state model is
    never accepted on the unsolved extrapolated guess.
+   The full model's stepper (phgmg_gl3) in detail:
+   - Newton iterates on Z_i = Y_i - x_n, always makes at least one update and
+     stops when ||Z - h (A x I) F(Z)||_inf <= tol, at most max_iter updates.
+     An explicit opts.tol is absolute; the default (opts.tol = 0) is 1e-10
+     times max(1, ||x_n||_inf, ||Z||_inf), so that a model whose states are
+     large in its units (1e9) still converges (tests/test_online.c).
+     Jac = (J - R) Hess H(x_n), factored as gam/h I - Jac (real) and
+     (alp - i bet)/h I - Jac (complex): dense LU, banded LU with lower/upper
+     bandwidth from the nonzero diagonals of J - R and Q (plus kb for a GENERAL
+     Hessian), the sparse LU of a phgmg_ph_sparse model that chose it
+     (8.12), or the caller's shifted_* callbacks. Factors are reused across
+     steps; the next step refactors when the largest contraction rate
+     res_{k+1}/res_k of a step exceeded opts.contraction. With factors from an
+     earlier state a rising residual aborts at once and the step is retried
+     once with fresh factors; with fresh factors two successive rises or
+     max_iter give PHGMG_ERR_NOT_CONVERGED.
+   - The starting guess extrapolates the previous step's collocation polynomial
+     when the call continues the previous one (same x as it returned, t = its
+     end time), else Z = 0.
 
    8.2 Energy balance. The supplied energy h sum b_i y_i^T u_i and the
    dissipated energy h sum b_i gradH(Y_i)^T R gradH(Y_i) are summed at the
@@ -943,6 +962,35 @@
    defaults to non-negative weights by empirical quadrature and refuses
    negative DEIM weights unless asked. DEIM's mode count is the relative
    criterion sigma_k / sigma_1 > deim_tol.
+   Empirical quadrature (phgmg_ecsw) is Lawson-Hanson's active-set method
+   for non-negative least squares, stopped at the tolerance: the candidate
+   gradient from the Gram matrix Gm^T Gm (formed once: nrows nterms^2
+   flops, the dominant cost, 0.16 s at 20020 x 500),
+   the passive least squares by Cholesky of the Gram block refined once with
+   the true residual, the residual itself from Gm (so the 1e-6 default is
+   met where the Gram form alone stalls near 1e-5), and a claim of
+   optimality checked with the true gradient Gm^T r. When the original
+   weights are >= 0 they are an exact solution, so tol is reachable up to
+   rounding; the points come out in Lawson-Hanson's greedy order of largest
+   gradient, typically fewer than DEIM's at a comparable accuracy.
+   With w >= 0 and convex phi_k the reduced sum sum_j w_j phi(l_{pts_j}(x))
+   is convex in the reduced coordinates for any linear map x -> l, and bounded
+   below whenever each phi_k is; negative DEIM weights give no such guarantee.
+   Only Gm^T Gm, Gm^T target and ||target|| matter: rows compressed by any
+   orthogonal map (Gm' = Q^T Gm, target' = Q^T target) give the same weights
+   at less cost; phgmg_ecsw_separable does this for terms linear in the
+   reduced coordinates.
+   Many terms (nterms >= PHGMG_ECSW_SCREEN_MIN, default 4096): the n x n Gram
+   matrix is never formed. Screening: the full gradient Gm^T (target - Gm w)
+   (one pass over Gm) picks the PHGMG_ECSW_SCREEN_ADD (64) terms with the
+   largest positive gradient into a working set W, the method above solves
+   the problem restricted to W (all rows: its residual is the true one), and
+   this repeats until tol is met or no term outside W has a positive
+   gradient (w then optimal over all terms, as above). Same guarantees:
+   w > 0 on the kept terms, residual <= tol or PHGMG_ERR_NOT_CONVERGED
+   (also if W reaches 16 * PHGMG_ECSW_SCREEN_ADD terms). Memory nrows *
+   |W| + O(nrows + nterms); on the paper's chain at N = 256 000 (128 000
+   terms, 20 020 rows) 3 rounds, 28 points, about 2 s.
 
    8.8 Readings of the paper. (a) SP2's reduction matrix as printed is
    dimensionally inconsistent; phgmg takes W = V_grad (V_POD^T V_grad)^{-1}
@@ -969,6 +1017,26 @@
    their own vectors below max(DBL_MIN, PHGMG_GL3_FLUSH_REL |x|_inf) to zero
    (phgmg_gl3_opts.keep_tiny = 1 turns it off); the library never reads or
    changes the floating-point environment (rounding mode, FTZ/DAZ).
+   In the full model's stepper:
+   - a chain started at rest carries a wave whose tail decays
+     through the subnormal range (|v| < DBL_MIN), where some processors compute
+     ~100x slower, and a polynomial nonlinearity underflows long before that
+     (y^3 for |y| < 3e-103). The stepper therefore sets to zero, in its own
+     vectors, every entry below tau = max(DBL_MIN, PHGMG_GL3_FLUSH_REL ||x||_inf)
+     (x: the state at the start of the step; with the step map: the new
+     state relative to itself, and the map matrices relative to their largest
+     entry, once at create): the new state, the converged
+     stages kept for the next guess, and in the pivot-free banded solve the
+     tail the substitutions carry beyond the support of the right-hand side
+     (the sweeps stop after kl resp. ku zero rows, which also skips the O(N)
+     work where the chain is still at rest); the other solves (dense,
+     pivoting banded, callbacks) have their results flushed. On the paper's
+     nonlinear chain from rest no instruction sees a subnormal operand after
+     the second step (the first has no scale yet). An entry 1e-60 below the
+     largest changes nothing at any Newton tolerance: the trajectory agrees
+     with opts.keep_tiny = 1 (no flushing) to rounding (tests/test_subnormal.c).
+     The floating-point environment (rounding mode, MXCSR/FTZ/DAZ) is neither
+     read nor changed.
 
    8.11 Linear systems. For a linear model GMG-POD is a Petrov-Galerkin
    projection with the test space G^T V, V = orth([B, Vbar]); its model depends
@@ -978,7 +1046,143 @@
    feedthrough makes the positive-real Riccati equations singular; phgmg
    solves the exact limit (the constraint X B = C^T eliminated in the frame
    [B, ker C]) instead of regularising, so the pH model is the balanced
-   projection itself (details at phgmg_prbt).
+   projection itself.
+   Positive-real balanced truncation (phgmg_prbt) in detail. Gramians: the
+   minimal solutions X (Q-eq) and Y (P-eq) of the positive-real lemma.
+   Default (opts->eps = 0): the exact limit. The lemma with D = 0 reads
+   A^T X + X A <= 0, X B = C^T. In the frame T = [B, Nc] (Nc: ker C) the
+   constraint fixes T^T X T = diag(C B, Z), and the Schur complement is a
+   regular positive-real Riccati equation for Z (size N - m) with feedthrough
+   S = 2 B^T Q R Q B (must be positive definite: every port damped). Its
+   Popov function still vanishes at w = 0 on chains driven by forces (G(0) =
+   0), so its Hamiltonian has Jordan pairs at 0: the solution is taken from
+   the stable eigenvectors plus the cluster's eigenvectors (two shifted sign
+   iteration and the kernel of the Hamiltonian, see phgmg__care_cluster). Then
+   X B = C^T holds to round-off, Sigma_r Br = Cr^T, and the pH form is
+   Qh = Sigma_r, Jh = skew(Ar Sigma_r^-1), Rh = Sigma_r^-1 F F^T Sigma_r^-1 / 2
+   with F = Tr^T Lf and -(A^T X + X A) = Lf Lf^T (rank m, in factored form
+   from the deflated equation: PSD by construction; clipping the round-off
+   negative eigenvalues of -sym(Ar Sigma_r^-1) instead cost 1e-6 in e_y once
+   sigma_r ~ 1e-8), Bh = Br, output Bh^T Qh x = Cr x: the balanced projection
+   itself, without an output change. Cost: one sign iteration of size
+   2(N - m) per equation, as the regularised path.
+   Measured (examples/linear_bases.c, e_y worst unseen input, PRBT / BT):
+   two-port chain r = 12/16/20: 1.7e-3/9.1e-5/2.0e-5 vs 6.5e-4/5.7e-5/1.3e-5;
+   paper's chain r = 12/16/20: 1.3e-4/1.2e-6/6.1e-9 vs 3.4e-5/5.0e-7/1.7e-9.
+   If S is not positive definite (or C B not symmetric), or opts->eps > 0:
+   the regularised lemma with D = d I, d = eps ||C B||_F (eps 1e-10 in the
+   fallback), S = 2 d I:
+     Q-eq  A^T X + X A + (X B - C^T) S^-1 (X B - C^T)^T = 0,
+     P-eq  A Y + Y A^T + (Y C^T - B) S^-1 (Y C^T - B)^T = 0,
+   stabilizing solutions by phgmg_care; pH form Qh = Sigma_r, Jh = skew(Ar
+   Sigma_r^-1), Rh = Sigma_r^-1 F S^-1 F^T Sigma_r^-1 / 2 with F = Sigma_r Br
+   - Cr^T (PSD by construction), Bh = Br, output Bh^T Qh x. Its cost: the
+   model drops D = d I and replaces the output Cr by Br^T Sigma_r; both
+   differences are O(sqrt(eps)) relative (||X B - C^T|| / ||C||: 8e-3, 8e-4,
+   8e-5 at eps = 1e-6, 1e-8, 1e-10 on the two-port chain), which is why the
+   regularised PRBT levels off near 1e-5 (e_y) while BT keeps falling;
+   much smaller eps makes the Hamiltonian too ill-conditioned for the sign
+   function (at 1e-11 it loses the minimal solution: a positive-real
+   singular value > 1, returned as PHGMG_ERR_NOT_CONVERGED).
+
+   8.12 The sparse direct solver (>>sparse).
+   The GL3 stepper solves, per Newton iteration, one real and one complex
+   system with the stage matrices K(sigma) = sigma I + M, M = -(J - R)(Q + D)
+   (D: the Hessian diagonal of a SEPARABLE nonlinear part, 0 for a linear
+   model), sigma = gamma/h and (alpha - i beta)/h. In band storage these
+   factor in O(N kl (kl + ku)) and solve in O(N (kl + ku)) with kl, ku ~ 2 kb:
+   right for chains, slow for 2-D and 3-D meshes (a 40 x 40 lattice has kb ~
+   80, a 16^3 one ~ 400). phgmg_ph_sparse_create therefore predicts both
+   costs and picks the cheaper solver (PHGMG_SOLVER_AUTO):
+   - Band: kept without analysis when kb <= PHGMG_SPARSE_MIN_KB (chains).
+   - Sparse LU, own code in this file, in five steps:
+     0. Condensation (block elimination): a set A of states no two of which
+        are joined in the graph of M + M^T makes K_AA diagonal, so with B
+        the other states
+           K = [K_AA K_AB; K_BA K_BB],  S = K_BB - K_BA K_AA^{-1} K_AB,
+           K x = r:  u = K_AA^{-1} r_A,  S x_B = r_B - K_BA u,
+                     x_A = u - K_AA^{-1} K_AB x_B,
+        and only S (order |B|) goes through steps 1-4. S's pattern is that
+        of K_BB plus the product pattern of K_BA K_AB, computed from the
+        unsymmetric pattern of K: for a mass-spring model x = (q, p) the
+        position rows hold one entry (dq/dt = p / m), so condensing the
+        positions leaves S with the pattern of the stiffness matrix (the
+        symmetrised graph would have joined every two neighbours of a
+        mass). A is chosen greedily in breadth-first order among the states
+        of degree <= 32 (on a bipartite graph, as positions and momenta
+        are, one whole side); the condensed analysis is kept when its
+        predicted factor (entries of L of S, plus those of K_BA and K_AB)
+        is smaller than K's own. A pivot K(a, a) is checked like the
+        others (below). Lattices: the factor shrinks 2.8-3.3x (2-D 40 x 40
+        1.59e5 -> 5.6e4 entries; 3-D 16^3 1.95e6 -> 6.0e5).
+     1. Ordering: nested dissection of the graph of M + M^T (the pattern of
+        M is that of (J - R) Q + (J - R) + I; it is symmetric when J - R and
+        Q have symmetric patterns only if their product's is, so the graph is
+        symmetrised). Each part is split by one level of a breadth-first
+        search from a pseudo-peripheral node (George-Liu), the level where
+        half of the part is reached, thinned to the nodes with a neighbour in
+        the next level (still a separator); halves first, separator last,
+        parts of <= 48 nodes as they come, unconnected parts one by one.
+     2. Symbolic analysis: elimination tree (Liu, path compression),
+        postorder, column counts from the row subtrees (O(nnz(L))),
+        supernodes: fundamental ones, plus a child joined to its only-child
+        parent while the block has <= 16 columns and the padded zeros stay
+        below a fifth of its entries. The factor of the symmetric pattern
+        needs the same structure for L and U^T.
+     3. Numeric factorization, multifrontal: per supernode (postorder) a
+        dense front (its columns and rows) is assembled from K and the
+        children's update matrices (a stack), its columns are eliminated
+        with the diagonal pivots (dense LU on the panel, a triangular solve
+        for U's block, one GEMM for the update matrix), L/U panels stored.
+     4. Solve: forward and backward substitution supernode by supernode.
+     Pivoting is static: the pivots are the diagonal of the fill-reducing
+     order. This is safe here because K = sigma I + M with Re sigma > 0 is
+     dominated by its shift for the step sizes GL3 is used with, but not
+     guaranteed; so each factorization checks itself: a pivot below
+     PHGMG_SPARSE_PIVTOL max|K| is replaced by that value, and when any was
+     replaced or the largest factor entry exceeds PHGMG_SPARSE_GROWTH
+     max|K|, the stepper drops the sparse factors and uses the band LU with
+     partial pivoting for the rest of its life.
+   Factors are kept across steps and, in phgmg_simulate_inputs (runs of
+   one dt) and the automatic lambda's three full-model probe runs, across
+   runs: one stepper serves them all (a linear model factors once).
+   Prediction: the band factor has N (2kl + ku + 1) entries and about
+   2 N kl (kl + ku) flops (kl, ku of the stage matrix's pattern); the sparse
+   one the entries and flops of its supernodes. The stepper reuses factors
+   across steps (a linear model factors once), so the solve cost decides:
+   sparse when its factor has fewer than half the band's entries (a solve
+   through a supernodal factor costs about twice a band solve per entry)
+   and its factorization takes fewer flops. The analysis itself costs about
+   one factorization's memory traffic. phgmg_ph_sparse_set_solver forces a
+   choice (tests, comparisons). The choice and both predictions are in
+   phgmg_ph_sparse_info. The sparse solver serves the GL3 stepper of a
+   system with nl NONE or SEPARABLE; a GENERAL Hessian (banded by its
+   callback) and a descriptor model (E) keep the band LU
+   (phgmg_ph_sparse_set_solver: PHGMG_ERR_UNSUPPORTED for the sparse LU).
+   Memory. With the sparse LU the system is SPARSE: J, R, Q stay in the
+   object's CSC copies and no band copy is made (a band of a 2-D lattice of
+   317 x 317 masses, kb = 634, would take 3 (2 kb + 1) N doubles = 6.1 GB;
+   its CSC copies take 11 MB). The other operations then need no band of
+   the whole model either:
+   - products with J, R, Q (right-hand sides, Hamiltonian, the reduced
+     operators V^T M W of every method) go through the CSC copies;
+   - phgmg_jr_factor (G = (J - R)^{-1} in GMG, rcond in the validation)
+     factors J - R in band storage in the reverse Cuthill-McKee order of J - R
+     alone: its bandwidth, not the model's (a mass-spring model's J - R pairs
+     each position with its momentum: bandwidth 1);
+   - the definiteness of Q (and of R + tol ||R||_1 I, semidefiniteness of
+     R, for N above the dense-eigenvalue limit) is read from the pivots of
+     the sparse LU of that matrix (static pivots, no exchanges): for a
+     symmetric matrix they are the D of its L D L^T, all positive exactly
+     when it is definite (Sylvester's law of inertia), and the elimination
+     of a definite matrix needs no pivoting to be stable. When a pivot had
+     to be replaced or the growth check fails, the band Cholesky of that
+     matrix alone (in its own reverse Cuthill-McKee order) decides;
+   - a stepper whose static pivots fail falls back to the band LU with band
+     copies made inside the stepper (the O(N kb) memory is then spent).
+   Measured on a 2-D lattice with N = 200 978 (bench/bench_sparse.sh),
+   `phgmg reduce --simulate --steps 200 --method gmg-pod --r 20` peaks at
+   about twice the snapshot matrix.
 
 
    9. CONFIGURATION MACROS (define before including) -----------------------------
@@ -1405,7 +1609,7 @@ typedef struct phgmg_ph_system {
   void (*damp_fn)(int k, double s, double d[2], void *user);
   void *damp_user;
   /* Set by phgmg_ph_sparse_system (NULL otherwise): the sparse model this
-     system comes from. When the object chose the sparse LU (see >>sparse)
+     system comes from. When the object chose the sparse LU (manual 8.12)
      the storage is SPARSE: J, R, Q are the object's compressed copies (not
      for indexing; the library reads them through sparse) and the GL3 stepper
      solves its stage systems with the sparse LU; else BANDED. */
@@ -1549,7 +1753,7 @@ PHGMG_DEF phgmg_result phgmg_rcm(int N, int na, const phgmg_csc *const *A, int *
    band storage: call phgmg_ph_sparse_set_solver(sp, PHGMG_SOLVER_BAND, ..)
    first (a copy made before that call no longer matches the object: copy
    again). Nothing is densified. Banded: the GL3 stepper, phgmg_jr_factor,
-   phgmg_ph_validate cost O(N kb^2), solves O(N kb). Sparse: see >>sparse.
+   phgmg_ph_validate cost O(N kb^2), solves O(N kb). Sparse: manual 8.12.
    Call phgmg_ph_validate on the system for the structural checks
    (skew J, symmetric PSD R, ...: the usual codes; a nonsymmetric pattern is
    fine, the band covers the symmetrized pattern). info (may be NULL): the
@@ -1588,7 +1792,7 @@ typedef struct phgmg_ph_sparse_info {
   int permuted;  /* 1: RCM order used, 0: the given order kept (perm = id)  */
   int wide;      /* 1: kb > N/4, banded costs about as much as dense or more */
   long nnz;      /* stored entries of J, R, Q (and E) together              */
-  /* The solver of the GL3 stage systems (see >>sparse): */
+  /* The solver of the GL3 stage systems (manual 8.12): */
   int solver;         /* PHGMG_SOLVER_BAND or PHGMG_SOLVER_SPARSE_LU           */
   int kl, ku;         /* lower/upper bandwidth of the stage matrix             */
   double lu_band;     /* predicted entries of one band factor, N (2kl + ku + 1) */
@@ -1597,7 +1801,7 @@ typedef struct phgmg_ph_sparse_info {
   double flops_sparse;/* of one real sparse factorization (0: not analysed)    */
   int supernodes;     /* supernodes of the sparse factor (0: not analysed)     */
   int front_max;      /* largest dense front (order)                           */
-  int condensed;      /* states eliminated first by block elimination (>>sparse) */
+  int condensed;      /* states eliminated first by block elimination (manual 8.12) */
   int band_copy;      /* 1: the object holds band copies of J, R, Q (band solver) */
   double bytes;       /* memory the object holds now (its arrays, the analysis)   */
 } phgmg_ph_sparse_info;
@@ -1654,103 +1858,12 @@ PHGMG_DEF phgmg_result phgmg_ph_sparse_to_user_order(const phgmg_ph_sparse *sp, 
 PHGMG_DEF void phgmg_ph_sparse_destroy(phgmg_ph_sparse *sp);
 
 /* >>sparse ---------------------------------------------------------------
-   The GL3 stepper solves, per Newton iteration, one real and one complex
-   system with the stage matrices K(sigma) = sigma I + M, M = -(J - R)(Q + D)
-   (D: the Hessian diagonal of a SEPARABLE nonlinear part, 0 for a linear
-   model), sigma = gamma/h and (alpha - i beta)/h. In band storage these
-   factor in O(N kl (kl + ku)) and solve in O(N (kl + ku)) with kl, ku ~ 2 kb:
-   right for chains, slow for 2-D and 3-D meshes (a 40 x 40 lattice has kb ~
-   80, a 16^3 one ~ 400). phgmg_ph_sparse_create therefore predicts both
-   costs and picks the cheaper solver (PHGMG_SOLVER_AUTO):
-   - Band: kept without analysis when kb <= PHGMG_SPARSE_MIN_KB (chains).
-   - Sparse LU, own code in this file, in five steps:
-     0. Condensation (block elimination): a set A of states no two of which
-        are joined in the graph of M + M^T makes K_AA diagonal, so with B
-        the other states
-           K = [K_AA K_AB; K_BA K_BB],  S = K_BB - K_BA K_AA^{-1} K_AB,
-           K x = r:  u = K_AA^{-1} r_A,  S x_B = r_B - K_BA u,
-                     x_A = u - K_AA^{-1} K_AB x_B,
-        and only S (order |B|) goes through steps 1-4. S's pattern is that
-        of K_BB plus the product pattern of K_BA K_AB, computed from the
-        unsymmetric pattern of K: for a mass-spring model x = (q, p) the
-        position rows hold one entry (dq/dt = p / m), so condensing the
-        positions leaves S with the pattern of the stiffness matrix (the
-        symmetrised graph would have joined every two neighbours of a
-        mass). A is chosen greedily in breadth-first order among the states
-        of degree <= 32 (on a bipartite graph, as positions and momenta
-        are, one whole side); the condensed analysis is kept when its
-        predicted factor (entries of L of S, plus those of K_BA and K_AB)
-        is smaller than K's own. A pivot K(a, a) is checked like the
-        others (below). Lattices: the factor shrinks 2.8-3.3x (2-D 40 x 40
-        1.59e5 -> 5.6e4 entries; 3-D 16^3 1.95e6 -> 6.0e5).
-     1. Ordering: nested dissection of the graph of M + M^T (the pattern of
-        M is that of (J - R) Q + (J - R) + I; it is symmetric when J - R and
-        Q have symmetric patterns only if their product's is, so the graph is
-        symmetrised). Each part is split by one level of a breadth-first
-        search from a pseudo-peripheral node (George-Liu), the level where
-        half of the part is reached, thinned to the nodes with a neighbour in
-        the next level (still a separator); halves first, separator last,
-        parts of <= 48 nodes as they come, unconnected parts one by one.
-     2. Symbolic analysis: elimination tree (Liu, path compression),
-        postorder, column counts from the row subtrees (O(nnz(L))),
-        supernodes: fundamental ones, plus a child joined to its only-child
-        parent while the block has <= 16 columns and the padded zeros stay
-        below a fifth of its entries. The factor of the symmetric pattern
-        needs the same structure for L and U^T.
-     3. Numeric factorization, multifrontal: per supernode (postorder) a
-        dense front (its columns and rows) is assembled from K and the
-        children's update matrices (a stack), its columns are eliminated
-        with the diagonal pivots (dense LU on the panel, a triangular solve
-        for U's block, one GEMM for the update matrix), L/U panels stored.
-     4. Solve: forward and backward substitution supernode by supernode.
-     Pivoting is static: the pivots are the diagonal of the fill-reducing
-     order. This is safe here because K = sigma I + M with Re sigma > 0 is
-     dominated by its shift for the step sizes GL3 is used with, but not
-     guaranteed; so each factorization checks itself: a pivot below
-     PHGMG_SPARSE_PIVTOL max|K| is replaced by that value, and when any was
-     replaced or the largest factor entry exceeds PHGMG_SPARSE_GROWTH
-     max|K|, the stepper drops the sparse factors and uses the band LU with
-     partial pivoting for the rest of its life (as before this solver).
-   Factors are kept across steps and, in phgmg_simulate_inputs (runs of
-   one dt) and the automatic lambda's three full-model probe runs, across
-   runs: one stepper serves them all (a linear model factors once).
-   Prediction: the band factor has N (2kl + ku + 1) entries and about
-   2 N kl (kl + ku) flops (kl, ku of the stage matrix's pattern); the sparse
-   one the entries and flops of its supernodes. The stepper reuses factors
-   across steps (a linear model factors once), so the solve cost decides:
-   sparse when its factor has fewer than half the band's entries (a solve
-   through a supernodal factor costs about twice a band solve per entry)
-   and its factorization takes fewer flops. The analysis itself costs about
-   one factorization's memory traffic. phgmg_ph_sparse_set_solver forces a
-   choice (tests, comparisons). The choice and both predictions are in
-   phgmg_ph_sparse_info. The sparse solver serves the GL3 stepper of a
-   system with nl NONE or SEPARABLE; a GENERAL Hessian (banded by its
-   callback) and a descriptor model (E) keep the band LU
-   (phgmg_ph_sparse_set_solver: PHGMG_ERR_UNSUPPORTED for the sparse LU).
-   Memory. With the sparse LU the system is SPARSE: J, R, Q stay in the
-   object's CSC copies and no band copy is made (a band of a 2-D lattice of
-   317 x 317 masses, kb = 634, would take 3 (2 kb + 1) N doubles = 6.1 GB;
-   its CSC copies take 11 MB). The other operations then need no band of
-   the whole model either:
-   - products with J, R, Q (right-hand sides, Hamiltonian, the reduced
-     operators V^T M W of every method) go through the CSC copies;
-   - phgmg_jr_factor (G = (J - R)^{-1} in GMG, rcond in the validation)
-     factors J - R in band storage in the reverse Cuthill-McKee order of J - R
-     alone: its bandwidth, not the model's (a mass-spring model's J - R pairs
-     each position with its momentum: bandwidth 1);
-   - the definiteness of Q (and of R + tol ||R||_1 I, semidefiniteness of
-     R, for N above the dense-eigenvalue limit) is read from the pivots of
-     the sparse LU of that matrix (static pivots, no exchanges): for a
-     symmetric matrix they are the D of its L D L^T, all positive exactly
-     when it is definite (Sylvester's law of inertia), and the elimination
-     of a definite matrix needs no pivoting to be stable. When a pivot had
-     to be replaced or the growth check fails, the band Cholesky of that
-     matrix alone (in its own reverse Cuthill-McKee order) decides, as before;
-   - a stepper whose static pivots fail falls back to the band LU with band
-     copies made inside the stepper (the O(N kb) memory is then spent).
-   Measured on a 2-D lattice with N = 200 978 (bench/bench_sparse.sh),
-   `phgmg reduce --simulate --steps 200 --method gmg-pod --r 20` peaks at
-   about twice the snapshot matrix. */
+   The stage-matrix solver of a phgmg_ph_sparse model: the band LU, or the
+   library's own sparse LU (condensation, nested dissection, supernodal
+   multifrontal factorization with checked static pivots), chosen by
+   predicted cost (PHGMG_SOLVER_AUTO) when the model is created. How to use
+   it: manual 2.6; how it works, when it falls back to the band LU and what
+   memory it needs: manual 8.12. */
 #ifndef PHGMG_SPARSE_MIN_KB
 #define PHGMG_SPARSE_MIN_KB 8      /* band without analysis up to this kb       */
 #endif
@@ -1773,29 +1886,13 @@ PHGMG_DEF phgmg_result phgmg_ph_sparse_set_solver(phgmg_ph_sparse *sp, int solve
                                                   phgmg_ph_sparse_info *info);
 
 /* >>gl3 =================================================================== */
-/* 3-stage Gauss-Legendre (order 6), simplified Newton on the transformed stage
-   system (one real and one complex N x N solve per iteration), factorization
-   reuse, extrapolated starting guess. For linear systems (nl == NONE) with a
-   fixed step a precomputed step map is used unless opts.no_step_map.
-   Details:
-   - Newton iterates on Z_i = Y_i - x_n, always makes at least one update and
-     stops when ||Z - h (A x I) F(Z)||_inf <= tol, at most max_iter updates.
-     An explicit opts.tol is absolute; the default (opts.tol = 0) is 1e-10
-     times max(1, ||x_n||_inf, ||Z||_inf), so that a model whose states are
-     large in its units (1e9) still converges (tests/test_online.c).
-     Jac = (J - R) Hess H(x_n), factored as gam/h I - Jac (real) and
-     (alp - i bet)/h I - Jac (complex): dense LU, banded LU with lower/upper
-     bandwidth from the nonzero diagonals of J - R and Q (plus kb for a GENERAL
-     Hessian), the sparse LU of a phgmg_ph_sparse model that chose it
-     (>>sparse), or the caller's shifted_* callbacks. Factors are reused across
-     steps; the next step refactors when the largest contraction rate
-     res_{k+1}/res_k of a step exceeded opts.contraction. With factors from an
-     earlier state a rising residual aborts at once and the step is retried
-     once with fresh factors; with fresh factors two successive rises or
-     max_iter give PHGMG_ERR_NOT_CONVERGED.
-   - The starting guess extrapolates the previous step's collocation polynomial
-     when the call continues the previous one (same x as it returned, t = its
-     end time), else Z = 0.
+/* 3-stage Gauss-Legendre (order 6) for the full model: simplified Newton on
+   the transformed stage system, factors reused across steps, a precomputed
+   step map for linear models with a fixed step (unless opts.no_step_map).
+   How the iteration, the starting guess and the flushing of tiny entries
+   work: manual 8.1 and 8.10.
+   - Tolerance: an explicit opts.tol is absolute (units of the state); the
+     default (opts.tol = 0) is 1e-10 times max(1, ||x_n||_inf, ||Z||_inf).
    - Step map: nl == NONE, DENSE storage and N <= PHGMG_GL3_STEP_MAP_MAX_N
      (default 1000; 4 N^2 + 12 N m doubles, O(N^3) at create): x+ = Phi x +
      Gam [u_1; u_2; u_3] and the stage gradients by similar maps. A linear
@@ -1805,30 +1902,13 @@ PHGMG_DEF phgmg_result phgmg_ph_sparse_set_solver(phgmg_ph_sparse *sp, int solve
      factorizations counts (real + complex) factorization pairs, failures counts
      Newton attempts that failed (including ones a retry rescued) and steps that
      returned an error.
-   - Tiny entries: a chain started at rest carries a wave whose tail decays
-     through the subnormal range (|v| < DBL_MIN), where some processors compute
-     ~100x slower, and a polynomial nonlinearity underflows long before that
-     (y^3 for |y| < 3e-103). The stepper therefore sets to zero, in its own
-     vectors, every entry below tau = max(DBL_MIN, PHGMG_GL3_FLUSH_REL ||x||_inf)
-     (x: the state at the start of the step; with the step map: the new
-     state relative to itself, and the map matrices relative to their largest
-     entry, once at create): the new state, the converged
-     stages kept for the next guess, and in the pivot-free banded solve the
-     tail the substitutions carry beyond the support of the right-hand side
-     (the sweeps stop after kl resp. ku zero rows, which also skips the O(N)
-     work where the chain is still at rest); the other solves (dense,
-     pivoting banded, callbacks) have their results flushed. On the paper's
-     nonlinear chain from rest no instruction sees a subnormal operand after
-     the second step (the first has no scale yet). An entry 1e-60 below the
-     largest changes nothing at any Newton tolerance: the trajectory agrees
-     with opts.keep_tiny = 1 (no flushing) to rounding (tests/test_subnormal.c).
-     The floating-point environment (rounding mode, MXCSR/FTZ/DAZ) is neither
-     read nor changed. */
+   - The floating-point environment (rounding mode, MXCSR/FTZ/DAZ) is
+     neither read nor changed. */
 #ifndef PHGMG_GL3_STEP_MAP_MAX_N
 #define PHGMG_GL3_STEP_MAP_MAX_N 1000
 #endif
 #ifndef PHGMG_GL3_FLUSH_REL
-#define PHGMG_GL3_FLUSH_REL 1e-60 /* relative flush threshold (see Tiny entries) */
+#define PHGMG_GL3_FLUSH_REL 1e-60 /* relative flush threshold (manual 8.10)     */
 #endif
 
 /* u(t) into u[m]. */
@@ -1840,7 +1920,7 @@ typedef struct phgmg_gl3_opts {
   int max_iter;        /* Newton iteration cap per step (0: 10)                      */
   int no_step_map;     /* 1: never use the precomputed linear step map               */
   double contraction;  /* refactor when the contraction rate exceeds this (0: 0.5)    */
-  int keep_tiny;       /* 1: never flush tiny entries (see Tiny entries above)       */
+  int keep_tiny;       /* 1: never flush tiny entries (manual 8.10)                 */
 } phgmg_gl3_opts;
 
 typedef struct phgmg_gl3_stats {
@@ -2268,37 +2348,14 @@ PHGMG_DEF phgmg_result phgmg_nnls(int m, int n, const double *A, int lda, const 
    target (nrows) = the full sum, Gm sw. Finds w >= 0 with few non-zeros and
    ||Gm w - target|| <= tol ||target|| (tol = 0: 1e-6; tol < 0, NaN or >= 1:
    PHGMG_ERR_INVALID_ARG; 0 < tol < 1e-15, below the rounding level of a
-   relative residual: PHGMG_ERR_TOL_UNREACHABLE) by Lawson-Hanson
-   stopped at tol: the candidate gradient from the Gram matrix Gm^T Gm (formed
-   once: nrows nterms^2 flops, the dominant cost, 0.16 s at 20020 x 500),
-   the passive least squares by Cholesky of the Gram block refined once with
-   the true residual, the residual itself from Gm (so the 1e-6 default is
-   met where the Gram form alone stalls near 1e-5), and a claim of
-   optimality checked with the true gradient Gm^T r. When the original
-   weights are >= 0 they are an exact solution, so tol is reachable up to
-   rounding; the points come out in Lawson-Hanson's greedy order of largest
-   gradient, typically fewer than DEIM's at a comparable accuracy.
+   relative residual: PHGMG_ERR_TOL_UNREACHABLE) by non-negative least
+   squares (Lawson-Hanson) stopped at tol; with nterms >=
+   PHGMG_ECSW_SCREEN_MIN (4096) the Gram matrix is never formed (screening
+   in rounds of PHGMG_ECSW_SCREEN_ADD terms). The algorithm and its
+   guarantees: manual 8.7.
    Outputs: pts[0..nd-1] kept terms ascending, w[0..nd-1] their weights (> 0),
    both with room for nterms; *nd_out = nd; *resid_out (may be NULL) =
    ||Gm w - target|| / ||target|| (0 when target = 0, then nd = 0).
-   With w >= 0 and convex phi_k the reduced sum sum_j w_j phi(l_{pts_j}(x))
-   is convex in the reduced coordinates for any linear map x -> l, and bounded
-   below whenever each phi_k is; negative DEIM weights give no such guarantee.
-   Only Gm^T Gm, Gm^T target and ||target|| matter: rows compressed by any
-   orthogonal map (Gm' = Q^T Gm, target' = Q^T target) give the same weights
-   at less cost; phgmg_ecsw_separable does this for terms linear in the
-   reduced coordinates.
-   Many terms (nterms >= PHGMG_ECSW_SCREEN_MIN, default 4096): the n x n Gram
-   matrix is never formed. Screening: the full gradient Gm^T (target - Gm w)
-   (one pass over Gm) picks the PHGMG_ECSW_SCREEN_ADD (64) terms with the
-   largest positive gradient into a working set W, the method above solves
-   the problem restricted to W (all rows: its residual is the true one), and
-   this repeats until tol is met or no term outside W has a positive
-   gradient (w then optimal over all terms, as above). Same guarantees:
-   w > 0 on the kept terms, residual <= tol or PHGMG_ERR_NOT_CONVERGED
-   (also if W reaches 16 * PHGMG_ECSW_SCREEN_ADD terms). Memory nrows *
-   |W| + O(nrows + nterms); on the paper's chain at N = 256 000 (128 000
-   terms, 20 020 rows) 3 rounds, 28 points, about 2 s.
    Scale: Gm or target whose largest |entry| is outside [2^-400, 2^400] are
    scaled by powers of two (exact) in a copy (nrows nterms more memory), so
    the points, the relative residual and the weights (scaled back) do not
@@ -2866,7 +2923,7 @@ PHGMG_DEF phgmg_result phgmg_bt(const phgmg_ph_system *sys, int r, double *Ar, d
 
 typedef struct phgmg_prbt_opts {
   double eps; /* 0: zero feedthrough handled exactly (see phgmg_prbt); > 0: regularisation
-                 D = eps ||C B||_F I (the previous default was 1e-10) */
+                 D = eps ||C B||_F I                                              */
   double dt;  /* > 0: precompute the GL3 step map of the reduced model for this step   */
   /* Optional cache for studies over many r: the two Riccati solutions from
      phgmg_prbt_riccati with the same eps (N x N each; both or neither). */
@@ -2882,42 +2939,13 @@ PHGMG_DEF phgmg_result phgmg_prbt_riccati(const phgmg_ph_system *sys, double eps
 /* Positive-real balanced truncation with a pH reduced model (method
    PHGMG_METHOD_PRBT, kind LINEAR). Gramians: the minimal solutions X (Q-eq)
    and Y (P-eq) of the positive-real lemma. A pH system has zero feedthrough,
-   where the lemma's Riccati equations are singular.
-   Default (opts->eps = 0): the exact limit. The lemma with D = 0 reads
-   A^T X + X A <= 0, X B = C^T. In the frame T = [B, Nc] (Nc: ker C) the
-   constraint fixes T^T X T = diag(C B, Z), and the Schur complement is a
-   regular positive-real Riccati equation for Z (size N - m) with feedthrough
-   S = 2 B^T Q R Q B (must be positive definite: every port damped). Its
-   Popov function still vanishes at w = 0 on chains driven by forces (G(0) =
-   0), so its Hamiltonian has Jordan pairs at 0: the solution is taken from
-   the stable eigenvectors plus the cluster's eigenvectors (two shifted sign
-   iteration and the kernel of the Hamiltonian, see phgmg__care_cluster). Then
-   X B = C^T holds to round-off, Sigma_r Br = Cr^T, and the pH form is
-   Qh = Sigma_r, Jh = skew(Ar Sigma_r^-1), Rh = Sigma_r^-1 F F^T Sigma_r^-1 / 2
-   with F = Tr^T Lf and -(A^T X + X A) = Lf Lf^T (rank m, in factored form
-   from the deflated equation: PSD by construction; clipping the round-off
-   negative eigenvalues of -sym(Ar Sigma_r^-1) instead cost 1e-6 in e_y once
-   sigma_r ~ 1e-8), Bh = Br, output Bh^T Qh x = Cr x: the balanced projection
-   itself, without an output change. Cost: one sign iteration of size
-   2(N - m) per equation, as the regularised path.
-   Measured (examples/linear_bases.c, e_y worst unseen input, PRBT / BT):
-   two-port chain r = 12/16/20: 1.7e-3/9.1e-5/2.0e-5 vs 6.5e-4/5.7e-5/1.3e-5;
-   paper's chain r = 12/16/20: 1.3e-4/1.2e-6/6.1e-9 vs 3.4e-5/5.0e-7/1.7e-9.
-   If S is not positive definite (or C B not symmetric), or opts->eps > 0:
-   the regularised lemma with D = d I, d = eps ||C B||_F (eps 1e-10 in the
-   fallback), S = 2 d I:
-     Q-eq  A^T X + X A + (X B - C^T) S^-1 (X B - C^T)^T = 0,
-     P-eq  A Y + Y A^T + (Y C^T - B) S^-1 (Y C^T - B)^T = 0,
-   stabilizing solutions by phgmg_care; pH form Qh = Sigma_r, Jh = skew(Ar
-   Sigma_r^-1), Rh = Sigma_r^-1 F S^-1 F^T Sigma_r^-1 / 2 with F = Sigma_r Br
-   - Cr^T (PSD by construction), Bh = Br, output Bh^T Qh x. Its cost: the
-   model drops D = d I and replaces the output Cr by Br^T Sigma_r; both
-   differences are O(sqrt(eps)) relative (||X B - C^T|| / ||C||: 8e-3, 8e-4,
-   8e-5 at eps = 1e-6, 1e-8, 1e-10 on the two-port chain), which is why the
-   regularised PRBT levels off near 1e-5 (e_y) while BT keeps falling;
-   much smaller eps makes the Hamiltonian too ill-conditioned for the sign
-   function (at 1e-11 it loses the minimal solution: a positive-real
-   singular value > 1, returned as PHGMG_ERR_NOT_CONVERGED).
+   where the lemma's Riccati equations are singular. opts->eps = 0
+   (default): their exact limit (the constraint X B = C^T eliminated; needs
+   every port damped); otherwise, or when that limit does not exist, the
+   regularised lemma with D = eps ||C B||_F I (eps 1e-10 in the fallback).
+   Reduced model: Qh = Sigma_r, Jh = skew(Ar Sigma_r^-1), Rh >= 0 by
+   construction, Bh = Br. The derivation, its accuracy and the cost of
+   regularising: manual 8.11.
    Lift: x = T xr (phgmg_reduced_lift); restrict: xr = W^T x. prsv (may be
    NULL): the first r positive-real singular values; info_xb (may be NULL):
    ||X B - C^T||_F / ||C||_F. The system must outlive the model. Errors:
@@ -6814,7 +6842,7 @@ PHGMG__PRIV phgmg_result phgmg__simulate_dae(const phgmg_ph_system *sys, const d
 
 /* >>sparse (implementation) ============================================== */
 /* Sparse direct solver of the GL3 stage matrices K = sigma I + M,
-   M = -(J - R)(Q + D) (see >>sparse above): nested dissection on the
+   M = -(J - R)(Q + D) (manual 8.12): nested dissection on the
    symmetrised pattern, elimination tree, supernodes, multifrontal LU with
    dense fronts and the diagonal pivots of the ordering (static pivoting). */
 
@@ -7134,7 +7162,7 @@ typedef struct phgmg__spsym {
   int *k_p, *k_i;                 /* pattern of M plus the diagonal    */
   /* The factored matrix (order nf, pattern f_p/f_i in its own numbering:
      internal index fidx[c] for column c): K itself (na = 0, f_p = k_p), or
-     the Schur complement of the condensed block (see >>sparse). */
+     the Schur complement of the condensed block (manual 8.12). */
   int nf, na;
   int *f_p, *f_i, *f_d;           /* pattern; f_d[c]: diagonal entry   */
   int *fidx, *bpos;               /* bpos[v]: f index, or -1 - a index */
@@ -7483,7 +7511,7 @@ PHGMG__PRIV phgmg_result phgmg__spsym_assembly(phgmg__spsym *S, const int *iperm
   return PHGMG_OK;
 }
 
-/* States condensed first (see >>sparse): an independent set of the graph
+/* States condensed first (manual 8.12): an independent set of the graph
    of K (no two joined, so K's block on them is diagonal), taken greedily in
    breadth-first order (on a bipartite graph, such as positions and momenta
    of a mechanical model, one whole side), only states of degree at most
@@ -7632,7 +7660,7 @@ PHGMG__PRIV phgmg_result phgmg__spsym_create(phgmg__spsym **out, int n, int kb, 
   return PHGMG_OK;
 }
 
-/* Steps 0-2 of the analysis (see >>sparse) of S with its J - R and Q set;
+/* Steps 0-2 of the analysis (manual 8.12) of S with its J - R and Q set;
    on failure the caller frees S. */
 PHGMG__PRIV phgmg_result phgmg__spsym_analyse(phgmg__spsym *S, int condense, const phgmg_allocator *al) {
   const int n = S->n;
@@ -7706,7 +7734,7 @@ PHGMG__PRIV double phgmg__spsym_bytes(const phgmg__spsym *S) {
 
 /* Numeric factors of one stage matrix (real, or complex: interleaved pairs). */
 typedef struct phgmg__spnum {
-  int cplx, nstatic;   /* nstatic: pivots replaced (see >>sparse) */
+  int cplx, nstatic;   /* nstatic: pivots replaced (manual 8.12) */
   double *X, *front, *stack, *y, *t;
   double *Fx;          /* values of the factored matrix (f pattern)        */
   double *dinv, *cax, *rax; /* condensed block: 1 / K(a, a), its couplings */
@@ -8840,7 +8868,7 @@ PHGMG_DEF phgmg_result phgmg_ph_sparse_to_user_order(const phgmg_ph_sparse *sp, 
 
 
 /* Set entries with |v_i| < tau to zero (tau >= DBL_MIN: no subnormal is left;
-   see Tiny entries in >>gl3). Four at a time: GCC -O2 vectorises this form
+   see manual 8.10). Four at a time: GCC -O2 vectorises this form
    (0.06 ns per entry on the bench machine, 4x the plain loop). */
 PHGMG__PRIV void phgmg__flush_tiny(double *v, size_t n, double tau) {
   size_t i;
@@ -9120,7 +9148,7 @@ struct phgmg_gl3 {
   double *r1buf, *rcbuf, *r1, *rc;
   /* packed row-wise factors for the pivot-free banded solve (see below) */
   double *pk;
-  /* sparse LU of the stage matrices (see >>sparse): the analysis (owned by
+  /* sparse LU of the stage matrices (manual 8.12): the analysis (owned by
      the phgmg_ph_sparse), the real and complex factors, M's values */
   const phgmg__spsym *sps;
   phgmg__spnum spf1, spf2;
@@ -9517,7 +9545,7 @@ PHGMG__PRIV phgmg_result phgmg__gl3_csr_sparse(phgmg_gl3 *s) {
   return PHGMG_OK;
 }
 
-/* The sparse LU's factors and the values of M (see >>sparse). */
+/* The sparse LU's factors and the values of M (manual 8.12). */
 PHGMG__PRIV phgmg_result phgmg__gl3_setup_sparse(phgmg_gl3 *s) {
   phgmg_result rc = phgmg__spnum_alloc(&s->al, s->sps, 0, &s->spf1);
   if (rc == PHGMG_OK) rc = phgmg__spnum_alloc(&s->al, s->sps, 1, &s->spf2);
@@ -10086,7 +10114,7 @@ PHGMG__PRIV void phgmg__gl3_damp_jac_band(phgmg_gl3 *s, const double *x) {
 }
 
 /* (Re)factor the shifted Newton matrices at x. */
-/* Sparse LU of both stage matrices (see >>sparse); PHGMG_ERR_SINGULAR when
+/* Sparse LU of both stage matrices (manual 8.12); PHGMG_ERR_SINGULAR when
    a static pivot was replaced or the factors grew beyond PHGMG_SPARSE_GROWTH. */
 PHGMG__PRIV phgmg_result phgmg__gl3_sparse_factor(phgmg_gl3 *s, double sg, double sa, double sb) {
   const phgmg__spsym *S = s->sps;
