@@ -2457,154 +2457,100 @@ typedef enum phgmg_manifold {
 /* phgmg_reduce_opts.rn: V2 over the whole residual of the snapshots (see rn). */
 #define PHGMG_RN_WIDE (-1)
 
-typedef struct phgmg_reduce_opts {
-  phgmg_method method; /* required                                                  */
-  int r;               /* reduced order (GMG: includes the m port coordinates), required */
-  /* GMG-QM lifting dimension r_n, the width of V2. > 0: a cap -- V2 = the
-     leading rn POD modes of what [B, V1] leaves of the snapshots (the
-     paper's construction). PHGMG_RN_WIDE: V2 over the whole residual up to
-     its numerical rank rw (phgmg__qm_wide_v2), so the quadratic term may
-     correct in every direction the data has; only the part M can reach is
-     kept, the online width is rn = min(rw, (r-m)(r-m+1)/2). 0 (default): the
-     paper's r_n = 8 for the hierarchical POD manifold (manifold = 0), wide
-     for the greedy and alternating-minimization manifolds. Cost of wide:
-     offline one SVD of the N x ns residual (the greedy with greedy_window
-     > 0 reuses its own; memory: N min(N, ns) doubles for its modes, as much
-     as the copy of the snapshots GMG-QM keeps) and O((N + ns) rw (r-m)^2)
-     for the compression; online (hyper-reduced, so
-     independent of N) the quadratic terms cost O(rn (r-m)^2) per evaluation
-     and the stepper's memory grows with rn r (PHGMG_ROM_STEPPER_MEMSIZE_MAX):
-     at r - m = 20, rn <= 210, some 10^5 flops per right-hand side. */
-  int rn;
-  double lambda;       /* GMG-QM ridge parameter, applied to the un-normalised sum
-                          over snapshots (0: 1e-3; < 0: exactly zero, the fit of M
-                          then being the minimum-norm least-squares solution, for
-                          any rank of its Kronecker matrix; ignored with
-                          lambda_auto, below)                                         */
-  int hyper_reduce;    /* separable nonlinear part: 1 = hyper-reduce it (the kind in
-                          hyper below), 0 = keep every term (exact, but O(n_terms)
-                          online)                                                     */
-  int deim;            /* the former name of hyper_reduce (either set to 1 turns
-                          hyper-reduction on); kept for 0.x, to be removed in 1.0     */
-  double deim_tol;     /* DEIM modes: sigma_k / sigma_1 > deim_tol (0: 1e-8)          */
-  int deim_max;        /* cap on DEIM modes (0: no cap)                               */
-  int deim_allow_negative; /* 1: accept negative DEIM weights (reported in info)      */
-  phgmg_hyper hyper;   /* with hyper_reduce = 1, the hyper-reduction (phgmg_hyper):
-                          0 / PHGMG_HYPER_ECSW: empirical quadrature with weights >= 0
-                          by non-negative least squares (default; never a negative
-                          weight); PHGMG_HYPER_QDEIM / _GREEDY: the paper's
-                          structure-preserving DEIM with Q-DEIM or greedy points    */
-  double hyper_tol;    /* ECSW: relative residual of the reduced nonlinear gradient
-                          over the training snapshots (0: 1e-6)                     */
-  double dt;           /* > 0: precompute the GL3 step map for this step
-                          (LINEAR map with quadratic H only). Any step size: for
-                          h ||K Qh|| > 1e6 the map is formed without the factor h
-                          (no cancellation; it tends to -I as dt grows). The map
-                          of a dissipative model (Qh > 0, K + K^T <= 0) is checked
-                          not to grow in the energy norm (PHGMG_ERR_STEP_MAP)   */
-  double degeneracy_tol; /* fail with PHGMG_ERR_DEGENERATE when the reciprocal
-                          condition of D^T G D at the snapshots is below this (0: 1e-12);
-                          measured with D's port columns B_a scaled to unit length,
-                          so that the units of the states and of B do not matter */
-  /* Optional cache for studies over many r: the leading left singular vectors
-     (N x pod_cols, ld N, by descending singular value) of the matrix the
-     method PODs -- GMG-POD/GMG-QM: the adjusted snapshots X - B B^+ X (from
-     phgmg_adjust_snapshots + phgmg_pod); SP1/SP2: X itself. GMG-QM takes V1
-     from its first r-m columns and V2 from the next r_n (the POD of the
-     residual of V1 is exactly that tail). NULL: computed here. */
-  const double *pod_basis;
+/* phgmg_reduce_opts.ref: the affine reference state (manual 3.6). */
+typedef enum phgmg_ref { PHGMG_REF_NONE = 0, PHGMG_REF_MEAN = 1, PHGMG_REF_GIVEN = 2, PHGMG_REF_COUNT } phgmg_ref;
+
+/* phgmg_select_opts.lambda_mode: how GMG-QM's ridge parameter is chosen
+   (manual 4.2). */
+typedef enum phgmg_lambda_mode {
+  PHGMG_LAMBDA_FIXED = 0,      /* default: qm.lambda as given                           */
+  PHGMG_LAMBDA_VALIDATED = 1,  /* by simulating the reduced model (opts.runs, probes)    */
+  PHGMG_LAMBDA_REGRESSION = 2, /* by held-out regression error on time blocks           */
+  PHGMG_LAMBDA_MODE_COUNT
+} phgmg_lambda_mode;
+
+/* The quadratic manifold of GMG-QM and GMG_MANIFOLD (manual 3.1, 3.3). */
+typedef struct phgmg_qm_opts {
+  int rn;          /* width r_n of V2: > 0 a cap, PHGMG_RN_WIDE the numerical rank of
+                      the residual (manual 3.3); 0: 8 with the POD manifold, wide with
+                      GREEDY / ALTMIN; GMG_MANIFOLD: required, 1..64. < -1: _INVALID_ARG */
+  double lambda;   /* ridge parameter of the fit of M, on the un-normalised sum over
+                      snapshots (0: 1e-3; < 0: exactly zero, minimum-norm fit; NaN:
+                      _INVALID_ARG). Unused unless select.lambda_mode is FIXED */
+  phgmg_manifold manifold; /* construction (manual 3.3; 0: PHGMG_MANIFOLD_POD)         */
+  int greedy_window;       /* GREEDY / ALTMIN with a wide V2: candidate modes beyond
+                              r - m (0: the construction's own 8 and score; > 0: this
+                              many, ridge-scored; manual 3.3)                          */
+  phgmg_eta_fn eta;        /* GMG_MANIFOLD (required there): the map eta and its
+                              derivatives (manual 3.1); called online                  */
+  void *eta_user;          /* passed to eta                                            */
+} phgmg_qm_opts;
+
+/* Choosing GMG-QM's lambda and validating the model (manual 4.2). Used only
+   with lambda_mode != PHGMG_LAMBDA_FIXED (newton_tol, newton_iter: by every
+   validation simulation). Bad values: PHGMG_ERR_INVALID_ARG, except blocks <
+   folds or > ns: PHGMG_ERR_SIZE. */
+typedef struct phgmg_select_opts {
+  phgmg_lambda_mode lambda_mode; /* 0: PHGMG_LAMBDA_FIXED                                */
+  double lambda_min;   /* smallest grid lambda, > 0, finite (0: 1e-14)                   */
+  double lambda_max;   /* largest grid lambda, >= lambda_min (0: 1); grid <= 1000 points  */
+  int per_decade;      /* grid points per decade, 1..100 (0: 4)                          */
+  int folds;           /* REGRESSION: folds, >= 2 (0: 5)                                 */
+  int blocks;          /* REGRESSION: contiguous time blocks, folds..ns (0: min(ns, 100))*/
+  double rcond;        /* conditioning guard, relative to rcond(D^T G D) at x = 0, in
+                          [0, 1] (0: 1e-6)                                               */
+  double tolerance;    /* VALIDATED: admissible e_y ratio to the linear limit (0: 1.02)  */
+  int train_only;      /* VALIDATED: 1 = training runs only, no probe runs (0: probes)   */
+  double newton_tol;   /* validation simulations' Newton tolerance (0: 1e-10 full model,
+                          the stepper's default for the reduced one)                     */
+  int newton_iter;     /* validation simulations' iteration cap (0: 20)                  */
+} phgmg_select_opts;
+
+/* Hyper-reduction of a separable part (manual 3.4). */
+typedef struct phgmg_hyper_opts {
+  int on;              /* 1: hyper-reduce the separable part; 0: keep every term (exact,
+                          O(terms) online). Else _INVALID_ARG; GENERAL part: _UNSUPPORTED */
+  phgmg_hyper kind;    /* with on = 1 (0: PHGMG_HYPER_ECSW)                              */
+  double tol;          /* ECSW: relative training residual of the reduced gradient,
+                          [0, 1) (0: 1e-6)                                               */
+  double deim_tol;     /* DEIM modes kept: sigma_k / sigma_1 > deim_tol, [0, 1) (0: 1e-8) */
+  int deim_max;        /* cap on DEIM modes, >= 0 (0: no cap)                            */
+  int allow_negative;  /* DEIM: 1 = accept negative weights (counted in info)            */
+} phgmg_hyper_opts;
+
+/* Results of earlier work reused by a reduction (studies over r; manual 2.3).
+   NULL: computed here. Each must come from the same snapshots. */
+typedef struct phgmg_reduce_cache {
+  const double *pod_basis;  /* N x pod_cols, ld N: leading left singular vectors of
+                               the matrix the method PODs (manual 2.3)                   */
   int pod_cols;
-  const double *grad_basis; /* SP2: same for the gradient snapshots (NULL: computed) */
+  const double *grad_basis; /* SP2: the same for the gradient snapshots                 */
   int grad_cols;
-  /* Optional DEIM result from phgmg_deim on the same snapshots (it does not
-     depend on r or the method): term indices and weights. NULL: computed. */
-  const int *deim_pts;
+  const int *deim_pts;      /* phgmg_deim's points and weights on these snapshots       */
   const double *deim_w;
   int deim_count;
-  /* GMG-QM automatic lambda (manual 4.2; all zero = off: the fixed lambda
-     above). 1: validated by simulating the reduced model on opts.runs and
-     three probe inputs (M = 0 without runs); 2: regression validation on
-     held-out time blocks. PHGMG_ERR_INVALID_ARG for lambda_auto not 0/1/2,
-     bounds negative, NaN, Inf or lambda_min > lambda_max, lambda_per_decade
-     outside 1..100, lambda_folds < 2, lambda_blocks < 0, lambda_rcond outside
-     [0, 1], a grid of more than 1000 points; PHGMG_ERR_SIZE for lambda_blocks
-     < lambda_folds or > ns. info.lambda = HUGE_VAL when M = 0 was chosen. */
-  int lambda_auto;
-  double lambda_min;     /* smallest grid lambda, > 0 (0: 1e-14)                 */
-  double lambda_max;     /* largest grid lambda (0: 1)                           */
-  int lambda_per_decade; /* grid points per decade, 1..100 (0: 4)                */
-  int lambda_folds;      /* validation folds, >= 2 (0: 5)                        */
-  int lambda_blocks;     /* contiguous blocks, lambda_folds..ns (0: min(ns, 100)) */
-  double lambda_rcond;   /* conditioning guard, relative to rcond(D^T G D) at x = 0,
-                            in [0, 1] (0: 1e-6)                                  */
-  /* PHGMG_METHOD_GMG_MANIFOLD (required there, ignored otherwise): the map
-     eta: R^p -> R^rn of phi(x) = B x1 + V1 x2 + V2 eta(x2) (p = r - m,
-     rn = opts.rn >= 1) and its derivatives (phgmg_eta_fn; manual 3.1). V1, V2
-     from the hierarchical POD or opts.pod_basis (orthonormal and orthogonal
-     to B, else PHGMG_ERR_RANK). The reduced model calls eta online. */
-  phgmg_eta_fn eta;
-  void *eta_user;
-  /* The runs that made X (nrun >= 1, columns as phgmg_simulate_inputs lays
-     them out; the sum of nsteps + 1 must equal ns, else PHGMG_ERR_SIZE).
-     0/NULL: X is one run of unknown input. Used by lambda_auto (manual 4.2):
-     1 simulates every training run and three probe runs made from runs[0];
-     2 leaves one run out per fold (nrun >= 2). */
-  int nrun;
-  const phgmg_run *runs;
-  double lambda_tolerance; /* admissible ratio to the linear limit (0: 1.02) */
-  double newton_tol;       /* validation simulations: Newton tolerance (0: 1e-10 for
-                              the full model; the stepper's default for the reduced
-                              one, 1e-10 double / 1e-5 float)                     */
-  int newton_iter;         /* validation simulations: iteration cap (0: 20)      */
-  /* GMG-QM manifold construction (manual 3.3): PHGMG_MANIFOLD_POD (0, the
-     paper's hierarchical POD), _GREEDY (1, greedy linear part), _ALTMIN (2,
-     alternating minimization; falls back to the POD manifold under
-     lambda_auto = 1 when it beats neither reference: info.manifold_fallback).
-     Greedy and altmin take a wide V2 by default (see rn). */
-  phgmg_manifold manifold;
-  /* manifold = 1 with a wide V2 (rn = 0 or PHGMG_RN_WIDE): 0 (default) =
-     the candidates for V1 and their score as described under manifold (the
-     leading r - m + 8 POD modes); > 0 = the leading r - m + greedy_window
-     modes (up to the numerical rank), each scored by the ridge objective
-     (misfit + lam ||M||^2) over the other candidates not yet taken, by an
-     incremental QR of the features that keeps a wide window affordable. The
-     reference code of Schwerdtner & Peherstorfer uses 200, which transport
-     data need: there the modes V1 wants reach far down the spectrum
-     (bench/qm_pulse.c). Cost: about (r - m) greedy_window incremental updates
-     of O(nsub (r - m)^3 + nsub^2 (r - m)) (nsub <= 400 snapshots used), plus
-     one SVD of the adjusted snapshots: 3-10 s at r - m = 12-20, window 200,
-     N = 4096, ns = 1000 (two shared cores). manifold = 2 with a wide V2: the
-     alternating minimization starts from this greedy manifold (manual 3.3). */
-  int greedy_window;
-  /* With lambda_auto = 1: 1 = validate on the training runs alone, no probe
-     runs (manual 4.2): the most accurate model on the training inputs; no
-     guard against unlike inputs. */
-  int lambda_train_only;
-  /* Optional progress report for long reductions (NULL: none; the library
-     itself never prints): phgmg_reduce calls progress(phase, progress_user)
-     as each stage starts, phase one of "basis" (snapshot adjustment and POD),
-     "manifold", "blocks" (reduced operators), "hamiltonian" (quadratic terms),
-     "hyper-reduction" (the separable part: gradient snapshots and DEIM/ECSW),
-     "finish" (general term, step map, validation), and "done" at the end of
-     a successful reduction. GMG-QM with lambda_auto = 1 adds "lambda:
-     validation runs" (their set-up), "lambda: full-model probe run" before
-     each full-model simulation of a probe input, and "lambda: candidate"
-     before each lambda simulated (as many as info.lambda_candidates). Called
-     from the calling thread only. */
-  void (*progress)(const char *phase, void *user);
-  void *progress_user;
-  /* Affine reference state xbar (manual 3.6): phi(x) = xbar + [B, V1] x
-     (+ V2 eta(x2)), every basis and manifold fitted to the snapshots minus
-     xbar. PHGMG_REF_NONE (0, default): none; PHGMG_REF_MEAN: the mean of the
-     snapshots; PHGMG_REF_GIVEN: ref_x (N values, finite). Any method of
-     phgmg_reduce; not on a study's cached basis (the study fast path is
-     then off). The reduced state of the full state 0 is phgmg_rom.xr_rest. */
-  int ref;
-  const double *ref_x;
-} phgmg_reduce_opts;
+} phgmg_reduce_cache;
 
-/* phgmg_reduce_opts.ref */
-typedef enum phgmg_ref { PHGMG_REF_NONE = 0, PHGMG_REF_MEAN = 1, PHGMG_REF_GIVEN = 2, PHGMG_REF_COUNT } phgmg_ref;
+typedef struct phgmg_reduce_opts {
+  phgmg_method method;   /* required (manual 3.1)                                         */
+  int r;                 /* reduced order, required (GMG: m < r <= N, including the m
+                            port coordinates; SP: 1..min(N, ns)), else PHGMG_ERR_SIZE     */
+  double dt;             /* > 0: precompute the GL3 step map for this step (LINEAR map,
+                            quadratic H; manual 2.2); 0: none; < 0, NaN, Inf: _INVALID_ARG */
+  double degeneracy_tol; /* least rcond of D^T G D at the snapshots (port columns at unit
+                            length), in [0, 1) (0: 1e-12); below: PHGMG_ERR_DEGENERATE   */
+  int nrun;              /* the runs that made X (manual 4.1; columns as
+                            phgmg_simulate_inputs, summing to ns, else _SIZE). 0/NULL:  */
+  const phgmg_run *runs; /* X is one run of unknown input                                 */
+  phgmg_ref ref;         /* affine reference state (manual 3.6; 0: PHGMG_REF_NONE)        */
+  const double *ref_x;   /* PHGMG_REF_GIVEN: the N values, finite                         */
+  void (*progress)(const char *phase, void *user); /* stage callback (manual 2.2; NULL) */
+  void *progress_user;
+  phgmg_qm_opts qm;         /* GMG-QM / GMG_MANIFOLD                                      */
+  phgmg_select_opts select; /* choosing lambda (GMG-QM)                                  */
+  phgmg_hyper_opts hyper; /* a separable part                                        */
+  phgmg_reduce_cache cache; /* reuse across reductions                                   */
+} phgmg_reduce_opts;
 
 /* The defaults of phgmg_reduce_opts (the table in manual 3.2): *o is zeroed
    and every field whose zero stands for a default gets that default. A zeroed
@@ -13823,11 +13769,11 @@ PHGMG__PRIV phgmg_result phgmg__deploy_check(const phgmg_reduce_opts *o, int ns)
   if (o->nrun < 0 || (o->nrun > 0 && !o->runs) || o->nrun > PHGMG__NVAL_MAX - 3) return PHGMG_ERR_INVALID_ARG;
   if (o->nrun > 0 && phgmg_runs_columns(o->nrun, o->runs) < 0) return PHGMG_ERR_INVALID_ARG;
   if (o->nrun > 0 && phgmg_runs_columns(o->nrun, o->runs) != ns) return PHGMG_ERR_SIZE;
-  if (!(o->lambda_tolerance >= 1.0 && o->lambda_tolerance < HUGE_VAL))
+  if (!(o->select.tolerance >= 1.0 && o->select.tolerance < HUGE_VAL))
     return PHGMG_ERR_INVALID_ARG;
-  if (!(o->newton_tol >= 0.0 && o->newton_tol < 1.0) || o->newton_iter < 0) return PHGMG_ERR_INVALID_ARG;
-  if ((int)o->manifold < 0 || (int)o->manifold >= (int)PHGMG_MANIFOLD_COUNT) return PHGMG_ERR_INVALID_ARG;
-  if (o->lambda_train_only != 0 && o->lambda_train_only != 1) return PHGMG_ERR_INVALID_ARG;
+  if (!(o->select.newton_tol >= 0.0 && o->select.newton_tol < 1.0) || o->select.newton_iter < 0) return PHGMG_ERR_INVALID_ARG;
+  if ((int)o->qm.manifold < 0 || (int)o->qm.manifold >= (int)PHGMG_MANIFOLD_COUNT) return PHGMG_ERR_INVALID_ARG;
+  if (o->select.train_only != 0 && o->select.train_only != 1) return PHGMG_ERR_INVALID_ARG;
   if (o->ref < 0 || o->ref >= (int)PHGMG_REF_COUNT || (o->ref == PHGMG_REF_GIVEN && !o->ref_x))
     return PHGMG_ERR_INVALID_ARG;
   return PHGMG_OK;
@@ -13835,28 +13781,26 @@ PHGMG__PRIV phgmg_result phgmg__deploy_check(const phgmg_reduce_opts *o, int ns)
 
 /* The one place where the defaults of phgmg_reduce_opts are applied (manual
    3.2): every field left 0 takes its default; ns > 0 also resolves
-   lambda_blocks. Invalid values are kept for phgmg__reduce_check to refuse.
-   GMG_MANIFOLD has no default r_n (the caller's eta fixes it); newton_tol
+   select.blocks. Invalid values are kept for phgmg__reduce_check to refuse.
+   GMG_MANIFOLD has no default r_n (the caller's eta fixes it); select.newton_tol
    stays 0 (the steppers' defaults). Idempotent. */
 PHGMG__PRIV void phgmg__reduce_opts_resolve(phgmg_reduce_opts *o, int ns) {
   /* rn = 0: the paper's r_n = 8 with the hierarchical POD manifold, V2 as wide
      as the data (PHGMG_RN_WIDE) with the greedy and altmin manifolds */
-  if (o->rn == 0 && o->method != PHGMG_METHOD_GMG_MANIFOLD)
-    o->rn = (o->method == PHGMG_METHOD_GMG_QM && o->manifold != PHGMG_MANIFOLD_POD) ? PHGMG_RN_WIDE : 8;
-  if (o->lambda == 0.0) o->lambda = 1e-3;
-  if (o->deim_tol == 0.0) o->deim_tol = 1e-8;
-  if (o->hyper_tol == 0.0) o->hyper_tol = 1e-6;
+  if (o->qm.rn == 0 && o->method != PHGMG_METHOD_GMG_MANIFOLD)
+    o->qm.rn = (o->method == PHGMG_METHOD_GMG_QM && o->qm.manifold != PHGMG_MANIFOLD_POD) ? PHGMG_RN_WIDE : 8;
+  if (o->qm.lambda == 0.0) o->qm.lambda = 1e-3;
+  if (o->hyper.deim_tol == 0.0) o->hyper.deim_tol = 1e-8;
+  if (o->hyper.tol == 0.0) o->hyper.tol = 1e-6;
   if (o->degeneracy_tol == 0.0) o->degeneracy_tol = 1e-12;
-  if (o->lambda_min == 0.0) o->lambda_min = 1e-14;
-  if (o->lambda_max == 0.0) o->lambda_max = 1.0;
-  if (o->lambda_per_decade == 0) o->lambda_per_decade = 4;
-  if (o->lambda_folds == 0) o->lambda_folds = 5;
-  if (o->lambda_blocks == 0 && ns > 0) o->lambda_blocks = PHGMG__MIN(ns, 100);
-  if (o->lambda_rcond == 0.0) o->lambda_rcond = 1e-6;
-  if (o->lambda_tolerance == 0.0) o->lambda_tolerance = 1.02;
-  if (o->newton_iter == 0) o->newton_iter = 20;
-  if (o->deim == 1 && o->hyper_reduce == 0) o->hyper_reduce = 1;   /* the former name */
-  if (o->hyper_reduce == 1 && o->deim == 0) o->deim = 1;
+  if (o->select.lambda_min == 0.0) o->select.lambda_min = 1e-14;
+  if (o->select.lambda_max == 0.0) o->select.lambda_max = 1.0;
+  if (o->select.per_decade == 0) o->select.per_decade = 4;
+  if (o->select.folds == 0) o->select.folds = 5;
+  if (o->select.blocks == 0 && ns > 0) o->select.blocks = PHGMG__MIN(ns, 100);
+  if (o->select.rcond == 0.0) o->select.rcond = 1e-6;
+  if (o->select.tolerance == 0.0) o->select.tolerance = 1.02;
+  if (o->select.newton_iter == 0) o->select.newton_iter = 20;
 }
 
 PHGMG_DEF void phgmg_reduce_opts_default(phgmg_reduce_opts *o) {
@@ -13877,27 +13821,27 @@ PHGMG__PRIV phgmg_result phgmg__reduce_check(const phgmg_ph_system *sys, const d
   } else if (r < 1 || r > N || r > ns) {
     return PHGMG_ERR_SIZE;
   }
-  if (o->method == PHGMG_METHOD_GMG_MANIFOLD && (!o->eta || o->rn < 1)) return PHGMG_ERR_INVALID_ARG;
-  if (o->rn < PHGMG_RN_WIDE) return PHGMG_ERR_INVALID_ARG;
-  if ((o->hyper_reduce != 0 && o->hyper_reduce != 1) || (o->deim != 0 && o->deim != 1)) return PHGMG_ERR_INVALID_ARG;
-  if ((int)o->hyper < 0 || (int)o->hyper >= (int)PHGMG_HYPER_COUNT) return PHGMG_ERR_INVALID_ARG;
-  if (!(o->hyper_tol >= 0.0 && o->hyper_tol < 1.0)) return PHGMG_ERR_INVALID_ARG;
-  if (o->hyper_reduce && sys->nl == PHGMG_NL_GENERAL) return PHGMG_ERR_UNSUPPORTED;
+  if (o->method == PHGMG_METHOD_GMG_MANIFOLD && (!o->qm.eta || o->qm.rn < 1)) return PHGMG_ERR_INVALID_ARG;
+  if (o->qm.rn < PHGMG_RN_WIDE) return PHGMG_ERR_INVALID_ARG;
+  if (o->hyper.on != 0 && o->hyper.on != 1) return PHGMG_ERR_INVALID_ARG;
+  if ((int)o->hyper.kind < 0 || (int)o->hyper.kind >= (int)PHGMG_HYPER_COUNT) return PHGMG_ERR_INVALID_ARG;
+  if (!(o->hyper.tol >= 0.0 && o->hyper.tol < 1.0)) return PHGMG_ERR_INVALID_ARG;
+  if (o->hyper.on && sys->nl == PHGMG_NL_GENERAL) return PHGMG_ERR_UNSUPPORTED;
   if ((sys->P || sys->S || sys->Nskew || sys->ndamp) && !phgmg__method(o->method)->extras)
     return PHGMG_ERR_UNSUPPORTED;   /* dampers, feedthrough: linear maps only (manual 1.6, 1.7) */
   if ((sys->P || sys->S || sys->Nskew || sys->ndamp) && o->ref != PHGMG_REF_NONE)
     return PHGMG_ERR_UNSUPPORTED;   /* a reference state with dampers or feedthrough: not derived */
-  if (!(o->deim_tol >= 0.0 && o->deim_tol < 1.0) || o->deim_max < 0) return PHGMG_ERR_INVALID_ARG;
+  if (!(o->hyper.deim_tol >= 0.0 && o->hyper.deim_tol < 1.0) || o->hyper.deim_max < 0) return PHGMG_ERR_INVALID_ARG;
   if (!(o->dt >= 0.0) || o->dt == HUGE_VAL) return PHGMG_ERR_INVALID_ARG;
-  if (o->lambda != o->lambda || !(o->degeneracy_tol >= 0.0 && o->degeneracy_tol < 1.0)) return PHGMG_ERR_INVALID_ARG;
+  if (o->qm.lambda != o->qm.lambda || !(o->degeneracy_tol >= 0.0 && o->degeneracy_tol < 1.0)) return PHGMG_ERR_INVALID_ARG;
   if (sys->nl == PHGMG_NL_SEPARABLE && sys->poly_deg > 32) return PHGMG_ERR_SIZE;
   if (!X_checked && !phgmg__mat_finite(N, ns, X, ldx)) return PHGMG_ERR_NANINF; /* padding rows are not data */
-  if (o->lambda_auto) {
-    const int nf = o->lambda_folds, nb = o->lambda_blocks;
-    if ((o->lambda_auto != 1 && o->lambda_auto != 2) || o->lambda_per_decade < 0 || nf < 2 || nb < 0)
+  if (o->select.lambda_mode != PHGMG_LAMBDA_FIXED) {
+    const int nf = o->select.folds, nb = o->select.blocks;
+    if ((int)o->select.lambda_mode < 0 || (int)o->select.lambda_mode >= (int)PHGMG_LAMBDA_MODE_COUNT || o->select.per_decade < 0 || nf < 2 || nb < 0)
       return PHGMG_ERR_INVALID_ARG;
-    if (!(o->lambda_rcond >= 0.0 && o->lambda_rcond <= 1.0)) return PHGMG_ERR_INVALID_ARG;
-    if (phgmg__lambda_grid(o->lambda_min, o->lambda_max, o->lambda_per_decade, NULL) < 1)
+    if (!(o->select.rcond >= 0.0 && o->select.rcond <= 1.0)) return PHGMG_ERR_INVALID_ARG;
+    if (phgmg__lambda_grid(o->select.lambda_min, o->select.lambda_max, o->select.per_decade, NULL) < 1)
       return PHGMG_ERR_INVALID_ARG;
     if (nb < nf || nb > ns) return PHGMG_ERR_SIZE;
   }
@@ -13928,17 +13872,17 @@ PHGMG__PRIV phgmg_result phgmg__reduce_new(phgmg__rctx *c) {
   red->p = phgmg__is_gmg(o->method) ? o->r - red->m : o->r;
   if (red->kind == PHGMG_ROM_QUADRATIC) {
     c->wide = o->method == PHGMG_METHOD_GMG_QM &&
-              (o->rn == PHGMG_RN_WIDE || (o->rn == 0 && o->manifold != PHGMG_MANIFOLD_POD));
+              (o->qm.rn == PHGMG_RN_WIDE || (o->qm.rn == 0 && o->qm.manifold != PHGMG_MANIFOLD_POD));
     /* wide: the alternating minimization's search width; phgmg__qm_wide_v2 sets the final one */
-    red->rn = o->rn > 0 ? o->rn : (c->wide ? PHGMG__MIN(8, red->N - red->r) : 8);
+    red->rn = o->qm.rn > 0 ? o->qm.rn : (c->wide ? PHGMG__MIN(8, red->N - red->r) : 8);
     if (red->rn < 1 || red->rn > red->N - red->r) return PHGMG_ERR_SIZE;
     /* your eta's q/Dq go through buffers of up to 64 x 64 (lift, dphi) */
     if (o->method == PHGMG_METHOD_GMG_MANIFOLD && (red->rn > 64 || red->rn * red->p > 64 * 64)) return PHGMG_ERR_SIZE;
   }
   if (o->method == PHGMG_METHOD_GMG_MANIFOLD) {
     const size_t p = (size_t)red->p, rn = (size_t)red->rn;
-    red->eta = o->eta;
-    red->eta_user = o->eta_user;
+    red->eta = o->qm.eta;
+    red->eta_user = o->qm.eta_user;
     red->rwork = PHGMG__CAST(phgmg_real *, phgmg__red_alloc(red, (p + rn * (1 + p + p * p)) * sizeof(phgmg_real)));
     if (!red->rwork) return PHGMG_ERR_NOMEM;
   }
@@ -13984,9 +13928,9 @@ PHGMG__PRIV phgmg_result phgmg__basis_take(phgmg__rctx *c, const double *V1, con
    basis. */
 PHGMG__PRIV int phgmg__v2_from_basis(const phgmg__rctx *c) {
   const phgmg_reduced *red = c->red;
-  if (red->kind != PHGMG_ROM_QUADRATIC || c->o->pod_basis || c->wide) return 0;
+  if (red->kind != PHGMG_ROM_QUADRATIC || c->o->cache.pod_basis || c->wide) return 0;
   return red->method == PHGMG_METHOD_GMG_MANIFOLD ||
-         (red->method == PHGMG_METHOD_GMG_QM && c->o->manifold == PHGMG_MANIFOLD_POD);
+         (red->method == PHGMG_METHOD_GMG_QM && c->o->qm.manifold == PHGMG_MANIFOLD_POD);
 }
 
 /* GMG with a linear basis (no manifold stage that needs the adjusted
@@ -14027,10 +13971,10 @@ PHGMG__PRIV phgmg_result phgmg__stage_basis(phgmg__rctx *c) {
   if (!red->V0 || !red->QB || !red->RB) return PHGMG_ERR_NOMEM;
   rc = phgmg__thin_qr(N, m, c->Bp, red->QB, red->RB, c->alloc);
   if (rc != PHGMG_OK) return rc;
-  if (c->o->pod_basis && c->o->pod_cols < need) return PHGMG_ERR_SIZE;
+  if (c->o->cache.pod_basis && c->o->cache.pod_cols < need) return PHGMG_ERR_SIZE;
   if (!phgmg__is_gmg(red->method)) {
-    if (c->o->pod_basis) {
-      memcpy(red->V0, c->o->pod_basis, (size_t)N * p * sizeof(double));
+    if (c->o->cache.pod_basis) {
+      memcpy(red->V0, c->o->cache.pod_basis, (size_t)N * p * sizeof(double));
       return PHGMG_OK;
     }
     S = phgmg__dalloc(c->alloc, (size_t)p);
@@ -14043,7 +13987,7 @@ PHGMG__PRIV phgmg_result phgmg__stage_basis(phgmg__rctx *c) {
   }
   if (c->sf == PHGMG__SF_GMG) { /* the study's basis: Xa is not needed (its coordinates are cached) */
     memcpy(red->V0, c->sys->B, (size_t)N * m * sizeof(double));
-    memcpy(red->V0 + (size_t)N * m, c->o->pod_basis, (size_t)N * p * sizeof(double));
+    memcpy(red->V0 + (size_t)N * m, c->o->cache.pod_basis, (size_t)N * p * sizeof(double));
     return PHGMG_OK;
   }
   kk = phgmg__v2_from_basis(c) ? p + red->rn + 1 : p + 1;
@@ -14055,7 +13999,7 @@ PHGMG__PRIV phgmg_result phgmg__stage_basis(phgmg__rctx *c) {
     if (!c->V2h) { phgmg__free(c->alloc, tmp); return PHGMG_ERR_NOMEM; }
   }
   memcpy(red->V0, c->Bp, (size_t)N * m * sizeof(double));
-  if (!c->o->pod_basis && red->kind != PHGMG_ROM_QUADRATIC) { /* large: randomized, X - QB QB^T X implicit */
+  if (!c->o->cache.pod_basis && red->kind != PHGMG_ROM_QUADRATIC) { /* large: randomized, X - QB QB^T X implicit */
     rc = phgmg__basis_pod_implicit(c, tmp);
     if (rc != PHGMG_ERR_NOT_CONVERGED) { phgmg__free(c->alloc, tmp); return rc; }
     rc = PHGMG_OK;
@@ -14064,10 +14008,10 @@ PHGMG__PRIV phgmg_result phgmg__stage_basis(phgmg__rctx *c) {
   if (!c->Xa) { phgmg__free(c->alloc, tmp); return PHGMG_ERR_NOMEM; }
   for (j = 0; j < ns; ++j) memcpy(c->Xa + (size_t)j * N, c->X + (size_t)j * c->ldx, (size_t)N * sizeof(double));
   phgmg__orth_remove(N, m, red->QB, ns, c->Xa, N, tmp);
-  if (c->o->pod_basis) {
-    memcpy(red->V0 + (size_t)N * m, c->o->pod_basis, (size_t)N * p * sizeof(double));
+  if (c->o->cache.pod_basis) {
+    memcpy(red->V0 + (size_t)N * m, c->o->cache.pod_basis, (size_t)N * p * sizeof(double));
     if (red->method == PHGMG_METHOD_GMG_MANIFOLD)
-      rc = phgmg__check_given_basis(red, c->o->pod_basis, need, c->alloc);
+      rc = phgmg__check_given_basis(red, c->o->cache.pod_basis, need, c->alloc);
   } else {
     double *V1 = tmp + (size_t)PHGMG__MAX(m, 1) * ns;
     S = V1 + (size_t)N * (p + red->rn + 1);
@@ -14137,14 +14081,14 @@ PHGMG__PRIV phgmg_result phgmg__qm_lambda_auto(phgmg__rctx *c) {
   const phgmg_reduce_opts *o = c->o;
   const int ns = c->ns, p = c->red->p, rn = c->red->rn, nc = p * (p + 1) / 2, ng = c->ng;
   const int byrun = o->nrun >= 2 && c->runcol;   /* leave one run out */
-  const int nfold = byrun ? o->nrun : o->lambda_folds;
-  const int nblk = o->lambda_blocks;
+  const int nfold = byrun ? o->nrun : o->select.folds;
+  const int nblk = o->select.blocks;
   double best, *lg;
   int g;
   phgmg_result rc;
   lg = c->lg = phgmg__dalloc(c->alloc, 2 * (size_t)ng);
   if (!lg) return PHGMG_ERR_NOMEM;
-  phgmg__lambda_grid(o->lambda_min, o->lambda_max, o->lambda_per_decade, lg);
+  phgmg__lambda_grid(o->select.lambda_min, o->select.lambda_max, o->select.per_decade, lg);
   if (c->sf == PHGMG__SF_GMG && !byrun && c->st->cv && c->st->cv_p == p && c->st->cv_rn == rn && c->st->cv_ng == ng &&
       c->st->cv_nf == nfold && c->st->cv_nb == nblk && c->st->cv_lo == lg[0] && c->st->cv_hi == lg[ng - 1]) {
     memcpy(lg + ng, c->st->cv, (size_t)ng * sizeof(double));   /* the study's: same problem, same basis */
@@ -14184,9 +14128,9 @@ PHGMG__PRIV phgmg_result phgmg__qm_greedy(phgmg__rctx *c) {
   phgmg_reduced *red = c->red;
   const int N = red->N, m = red->m, p = red->p, rn = red->rn, ns = c->ns;
   const int st = (ns + 399) / 400, nsub = (ns + st - 1) / st;
-  const int navail = c->o->pod_basis ? c->o->pod_cols : PHGMG__MIN(N, ns) - 1;
+  const int navail = c->o->cache.pod_basis ? c->o->cache.pod_cols : PHGMG__MIN(N, ns) - 1;
   const int q = PHGMG__MIN(p + rn, navail);
-  const double lam = c->o->lambda_auto ? 1e-9 : (c->lambda > 0.0 ? c->lambda : 1e-12);
+  const double lam = c->o->select.lambda_mode != PHGMG_LAMBDA_FIXED ? 1e-9 : (c->lambda > 0.0 ? c->lambda : 1e-12);
   double *U, *S, *Kt, *Rt, *T, best_err;
   int *sel, *used, j, k, a, b, i, cc, best, nc, nr, kk = 0;
   phgmg_result rc = PHGMG_OK;
@@ -14197,7 +14141,7 @@ PHGMG__PRIV phgmg_result phgmg__qm_greedy(phgmg__rctx *c) {
   if (!U || !Kt || !sel) { phgmg__free(c->alloc, U); phgmg__free(c->alloc, Kt); phgmg__free(c->alloc, sel); return PHGMG_ERR_NOMEM; }
   S = U + (size_t)N * q; Rt = Kt + (size_t)nsub * (p * (p + 1) / 2); T = Rt + (size_t)nsub * q;
   used = sel + q;
-  if (c->o->pod_basis) memcpy(U, c->o->pod_basis, (size_t)N * q * sizeof(double));
+  if (c->o->cache.pod_basis) memcpy(U, c->o->cache.pod_basis, (size_t)N * q * sizeof(double));
   else {
     rc = phgmg_pod(N, ns, c->Xa, N, q, 0.0, U, N, S, &kk, c->alloc);
     if (rc == PHGMG_OK && kk < q) rc = PHGMG_ERR_SIZE;
@@ -14381,8 +14325,8 @@ PHGMG__PRIV phgmg_result phgmg__altmin_space(phgmg__rctx *c, int qmax, double *U
     if (*q > p) memcpy(U + (size_t)N * p, c->Uw, (size_t)N * (*q - p) * sizeof(double));
     return PHGMG_OK;
   }
-  if (c->o->pod_basis) {
-    memcpy(U, c->o->pod_basis, (size_t)N * qmax * sizeof(double));
+  if (c->o->cache.pod_basis) {
+    memcpy(U, c->o->cache.pod_basis, (size_t)N * qmax * sizeof(double));
     return PHGMG_OK;
   }
   sv = phgmg__dalloc(c->alloc, (size_t)qmax);
@@ -14557,7 +14501,7 @@ PHGMG__PRIV phgmg_result phgmg__qm_altmin_wide(phgmg__rctx *c, const double *U, 
   ar.base = (unsigned char *)(blk + nw); ar.cap = nar * sizeof(double); ar.used = 0; ar.up = c->alloc;
   w.al.alloc = phgmg__arena_alloc; w.al.free = phgmg__arena_free; w.al.user = &ar;
   w.q = q; w.ns = ns; w.p = p; w.nc = nc; w.S = S;
-  w.lam = c->o->lambda_auto ? 1e-9 : c->lambda;
+  w.lam = c->o->select.lambda_mode != PHGMG_LAMBDA_FIXED ? 1e-9 : c->lambda;
   phgmg_gemm('T', 'N', q, ns, N, 1.0, U, N, c->Xa, N, 0.0, S, q);
   outside = PHGMG__MAX(phgmg__sumsq(N, ns, c->Xa, N) - phgmg__sumsq(q, ns, S, q), 0.0);
   for (i = 0; i < q * p; ++i) Q1[i] = (i % q) == (i / q) ? 1.0 : 0.0;
@@ -14575,7 +14519,7 @@ PHGMG__PRIV phgmg_result phgmg__qm_altmin_wide(phgmg__rctx *c, const double *U, 
 PHGMG__PRIV phgmg_result phgmg__qm_altmin(phgmg__rctx *c) {
   phgmg_reduced *red = c->red;
   const int N = red->N, m = red->m, p = red->p, ns = c->ns, nc = p * (p + 1) / 2;
-  const int navail = c->o->pod_basis ? c->o->pod_cols : PHGMG__MIN(N, ns) - 1;
+  const int navail = c->o->cache.pod_basis ? c->o->cache.pod_cols : PHGMG__MIN(N, ns) - 1;
   const int qmax = PHGMG__MIN(c->wide ? PHGMG__ALTMIN_QMAX : 2 * (p + red->rn), navail);
   double *U, *S, *blk, f = HUGE_VAL, f0, tot = 0.0, outside;
   int it, i, q = 0, k, rs, moved = 0;
@@ -14611,7 +14555,7 @@ PHGMG__PRIV phgmg_result phgmg__qm_altmin(phgmg__rctx *c) {
   w.sv = w.V + (size_t)k * k; w.W = w.sv + k; w.Wn = w.W + (size_t)k * ns; w.Wb = w.Wn + (size_t)k * ns;
   w.Kt = w.Wb + (size_t)k * ns; w.Yt = w.Kt + (size_t)ns * nc; w.T = w.Yt + (size_t)ns * rs;
   w.q = q; w.ns = ns; w.p = p; w.rn = rs; w.k = k; w.S = S;
-  w.lam = c->o->lambda_auto ? 1e-9 : c->lambda;
+  w.lam = c->o->select.lambda_mode != PHGMG_LAMBDA_FIXED ? 1e-9 : c->lambda;
   phgmg_gemm('T', 'N', q, ns, N, 1.0, U, N, c->Xa, N, 0.0, S, q);
   tot = phgmg__sumsq(N, ns, c->Xa, N) - phgmg__sumsq(q, ns, S, q);
   outside = PHGMG__MAX(tot, 0.0);                    /* what no Q in span U can represent */
@@ -14820,10 +14764,10 @@ PHGMG__PRIV phgmg_result phgmg__qm_greedy_wide(phgmg__rctx *c) {
       for (i = 0; i < q; ++i) C[i + (size_t)j * q] = S[i] * W[j + (size_t)i * ns];
     for (j = 0; j < nsub; ++j) memcpy(Cs + (size_t)j * q, C + (size_t)j * st * q, (size_t)q * sizeof(double));
     memset(&w, 0, sizeof w);
-    w.q = q; w.nsub = nsub; w.L = L; w.Cs = Cs; w.sl = sqrt(c->o->lambda_auto ? 1e-9 : (c->lambda > 0.0 ? c->lambda : 1e-12));
+    w.q = q; w.nsub = nsub; w.L = L; w.Cs = Cs; w.sl = sqrt(c->o->select.lambda_mode != PHGMG_LAMBDA_FIXED ? 1e-9 : (c->lambda > 0.0 ? c->lambda : 1e-12));
     w.G = buf; w.Qin = w.G + (size_t)nsub * nsub; w.A = w.Qin + (size_t)L * nc; w.GA = w.A + (size_t)L * p;
     w.t = w.GA + (size_t)nsub * nc; w.sv = w.t + (size_t)nc * p;
-    qw = PHGMG__MIN(q, p + c->o->greedy_window);
+    qw = PHGMG__MIN(q, p + c->o->qm.greedy_window);
     phgmg_gemm('T', 'N', nsub, nsub, qw, 1.0, Cs, q, Cs, q, 0.0, w.G, nsub);   /* the candidates' Gram */
     for (i = 0; i < nsub; ++i) w.trG += w.G[i + (size_t)i * nsub];
     for (k = 0; k < q; ++k) used[k] = 0;
@@ -14862,11 +14806,11 @@ PHGMG__PRIV phgmg_result phgmg__qm_greedy_wide(phgmg__rctx *c) {
 PHGMG__PRIV phgmg_result phgmg__v1_pod(phgmg__rctx *c) { (void)c; return PHGMG_OK; }   /* V1 = POD modes */
 PHGMG__PRIV phgmg_result phgmg__v1_greedy(phgmg__rctx *c) {
   /* a wide V2 with a greedy_window: the incremental selection; else the classic one */
-  return c->wide && c->o->greedy_window > 0 ? phgmg__qm_greedy_wide(c) : phgmg__qm_greedy(c);
+  return c->wide && c->o->qm.greedy_window > 0 ? phgmg__qm_greedy_wide(c) : phgmg__qm_greedy(c);
 }
 PHGMG__PRIV phgmg_result phgmg__v1_altmin(phgmg__rctx *c) {
   /* a wide V2 with a greedy_window: started from the greedy manifold */
-  phgmg_result rc = c->wide && c->o->greedy_window > 0 ? phgmg__qm_greedy_wide(c) : PHGMG_OK;
+  phgmg_result rc = c->wide && c->o->qm.greedy_window > 0 ? phgmg__qm_greedy_wide(c) : PHGMG_OK;
   if (rc == PHGMG_OK) rc = phgmg__qm_altmin(c);   /* V1 and V2 */
   if (rc == PHGMG_OK && c->Uw && c->inf.manifold_sweeps > 0) {   /* V1 moved: its complement anew */
     phgmg__free(c->alloc, c->Uw);
@@ -14891,7 +14835,7 @@ static const phgmg__manifold_row phgmg__manifolds[PHGMG_MANIFOLD_COUNT] = {
 PHGMG__PRIV phgmg_result phgmg__stage_manifold(phgmg__rctx *c) {
   phgmg_reduced *red = c->red;
   const int N = red->N, m = red->m, p = red->p, rn = red->rn, ns = c->ns;
-  const phgmg__manifold_row *mf = red->method == PHGMG_METHOD_GMG_QM ? &phgmg__manifolds[c->o->manifold] : NULL;
+  const phgmg__manifold_row *mf = red->method == PHGMG_METHOD_GMG_QM ? &phgmg__manifolds[c->o->qm.manifold] : NULL;
   phgmg_result rc = PHGMG_OK;
   int k = 0;
   if (red->kind != PHGMG_ROM_QUADRATIC) return PHGMG_OK;
@@ -14908,8 +14852,8 @@ PHGMG__PRIV phgmg_result phgmg__stage_manifold(phgmg__rctx *c) {
       c->Uw = c->Cw = NULL;
     } else if (mf && mf->makes_v2) {
       /* V2 from the construction */
-    } else if (c->o->pod_basis && c->o->manifold == PHGMG_MANIFOLD_POD) {
-      memcpy(red->V2, c->o->pod_basis + (size_t)N * p, (size_t)N * rn * sizeof(double));
+    } else if (c->o->cache.pod_basis && c->o->qm.manifold == PHGMG_MANIFOLD_POD) {
+      memcpy(red->V2, c->o->cache.pod_basis + (size_t)N * p, (size_t)N * rn * sizeof(double));
     } else if (c->v2ok && phgmg__v2_from_basis(c)) { /* the same SVD's next modes */
       memcpy(red->V2, c->V2h, (size_t)N * rn * sizeof(double));
     } else {
@@ -15002,7 +14946,7 @@ PHGMG__PRIV double phgmg__dgd_rcond0(phgmg__rctx *c) {
 PHGMG__PRIV phgmg_result phgmg__check_degeneracy(phgmg__rctx *c) {
   phgmg_reduced *red = c->red;
   const double rc0 = phgmg__dgd_rcond0(c);
-  const double lrc = rc0 * c->o->lambda_rcond;
+  const double lrc = rc0 * c->o->select.rcond;
   const int can_raise = c->gsel >= 0 && rc0 >= c->degtol;
   phgmg_result rc;
   if (rc0 < 0.0) return PHGMG_ERR_NOMEM;
@@ -15357,9 +15301,9 @@ PHGMG__PRIV phgmg_result phgmg__vset_build(phgmg__rctx *c, phgmg__vset *v) {
     level[a] = sqrt(s2 / (run[0].nsteps + 1));
   }
   memset(&go, 0, sizeof go);
-  go.tol = c->o->newton_tol > 0.0 ? c->o->newton_tol : 1e-10;
-  go.max_iter = c->o->newton_iter;
-  if (c->o->lambda_train_only) { v->nv = nrun; return phgmg__vset_dedupe(c, v); }
+  go.tol = c->o->select.newton_tol > 0.0 ? c->o->select.newton_tol : 1e-10;
+  go.max_iter = c->o->select.newton_iter;
+  if (c->o->select.train_only) { v->nv = nrun; return phgmg__vset_dedupe(c, v); }
   if (phgmg__study_probes(c, v, level, zero, off, &go, 0)) return phgmg__vset_dedupe(c, v);
   {
     phgmg_gl3 *s = NULL; /* one stepper (and its factors) for the three probes */
@@ -15392,8 +15336,8 @@ PHGMG__PRIV phgmg_result phgmg__vset_build(phgmg__rctx *c, phgmg__vset *v) {
    tolr): the remaining e_y are not needed (left HUGE_VAL). */
 PHGMG__PRIV phgmg_result phgmg__vset_eval(phgmg__rctx *c, phgmg__vset *v, int *ok, double tolr) {
   const int m = c->sys->m;
-  const double tol = c->o->newton_tol;   /* 0: the stepper's default (1e-10 double, 1e-5 float) */
-  const int it = c->o->newton_iter;
+  const double tol = c->o->select.newton_tol;   /* 0: the stepper's default (1e-10 double, 1e-5 float) */
+  const int it = c->o->select.newton_iter;
   int i, k, j;
   *ok = 1;
   for (k = 0; k < v->nv; ++k) v->ey[k] = HUGE_VAL;
@@ -15450,7 +15394,7 @@ PHGMG__PRIV phgmg_result phgmg__altmin_reference(phgmg__rctx *c, phgmg__vset *v,
   phgmg_reduced *pod = NULL, *keep = c->red;
   int k, ok = 0;
   phgmg_result rc;
-  o.method = PHGMG_METHOD_GMG_POD; o.lambda_auto = 0; o.manifold = PHGMG_MANIFOLD_POD; o.nrun = 0; o.runs = NULL;
+  o.method = PHGMG_METHOD_GMG_POD; o.select.lambda_mode = PHGMG_LAMBDA_FIXED; o.qm.manifold = PHGMG_MANIFOLD_POD; o.nrun = 0; o.runs = NULL;
   o.dt = 0.0;
   rc = phgmg_reduce(&pod, c->sys, c->Xf, c->ldxf, c->ns, &o, NULL, c->alloc);
   if (rc == PHGMG_ERR_NOMEM) return rc;
@@ -15474,15 +15418,15 @@ PHGMG__PRIV phgmg_result phgmg__altmin_reference(phgmg__rctx *c, phgmg__vset *v,
 PHGMG__PRIV phgmg_result phgmg__stage_lambda_validate(phgmg__rctx *c) {
   phgmg_reduced *red = c->red;
   const phgmg_reduce_opts *o = c->o;
-  const int pd = o->lambda_per_decade;
-  const double tolr = o->lambda_tolerance;
+  const int pd = o->select.per_decade;
+  const double tolr = o->select.tolerance;
   const size_t n = (size_t)red->rn * red->p * red->p;
   phgmg__vset *v;
   phgmg_real *ms;
   double best_score = 0.0, best_ratio = 1.0, cand_score[64], cand_worst[64];
   int best = -1, g, bad = 0, ok, k, ncand = 0, cand_g[64], cand_ok[64];
   phgmg_result rc;
-  if (red->method != PHGMG_METHOD_GMG_QM || o->lambda_auto != 1 || c->gsel < 0) return PHGMG_OK;
+  if (red->method != PHGMG_METHOD_GMG_QM || o->select.lambda_mode != PHGMG_LAMBDA_VALIDATED || c->gsel < 0) return PHGMG_OK;
   ms = PHGMG__CAST(phgmg_real *, phgmg__red_alloc(red, (n ? n : 1) * sizeof(phgmg_real)));
   if (!ms) return PHGMG_ERR_NOMEM;
   red->rom.Ms = ms;
@@ -15498,9 +15442,9 @@ PHGMG__PRIV phgmg_result phgmg__stage_lambda_validate(phgmg__rctx *c) {
   if (rc == PHGMG_OK) rc = phgmg__qm_set(c, -1, ms);
   if (rc == PHGMG_OK) rc = phgmg__vset_eval(c, v, &ok, 0.0);
   for (k = 0; k < v->nv && rc == PHGMG_OK; ++k) v->base[k] = v->ey[k] < HUGE_VAL ? v->ey[k] : 1.0;
-  if (rc == PHGMG_OK && o->manifold == PHGMG_MANIFOLD_ALTMIN) rc = phgmg__altmin_reference(c, v, ok, tolr);
+  if (rc == PHGMG_OK && o->qm.manifold == PHGMG_MANIFOLD_ALTMIN) rc = phgmg__altmin_reference(c, v, ok, tolr);
   /* training runs alone: up from the regression optimum, the first admissible */
-  for (g = c->gsel; rc == PHGMG_OK && o->lambda_train_only && g < c->ng; g += pd) {
+  for (g = c->gsel; rc == PHGMG_OK && o->select.train_only && g < c->ng; g += pd) {
     double worst = 0.0;
     phgmg__progress(o, "lambda: candidate");
     rc = phgmg__qm_set(c, g, ms);
@@ -15510,7 +15454,7 @@ PHGMG__PRIV phgmg_result phgmg__stage_lambda_validate(phgmg__rctx *c) {
     for (k = 0; k < v->nv && ok; ++k) worst = PHGMG__MAX(worst, (v->ey[k] + 1e-14) / (v->base[k] + 1e-14));
     if (ok && worst <= tolr) { best = g; best_ratio = worst; break; }
   }
-  for (g = c->ng - 1; rc == PHGMG_OK && !o->lambda_train_only && g >= c->gsel;
+  for (g = c->ng - 1; rc == PHGMG_OK && !o->select.train_only && g >= c->gsel;
        g = (g - pd >= c->gsel || g == c->gsel) ? g - pd : c->gsel) {
     double score = 0.0, worst = 0.0;
     phgmg__progress(o, "lambda: candidate");
@@ -15531,7 +15475,7 @@ PHGMG__PRIV phgmg_result phgmg__stage_lambda_validate(phgmg__rctx *c) {
   }
   /* the largest admissible lambda with at least half the best gain (a
      safety margin towards the linear limit) */
-  for (k = 0; k < ncand && best >= 0 && !o->lambda_train_only; ++k)
+  for (k = 0; k < ncand && best >= 0 && !o->select.train_only; ++k)
     if (cand_ok[k] && cand_score[k] <= 0.5 * best_score) {
       best = cand_g[k]; best_ratio = cand_worst[k];
       break;
@@ -15602,7 +15546,7 @@ PHGMG__PRIV phgmg_result phgmg__stage_dampers(phgmg__rctx *c, const double *Wz, 
       for (a = 0; a < r; ++a) red->K[a + (size_t)b * r] += d[1] * ck[a] * ck[b];
   }
   if (!phgmg__all_finite(red->Cd, (size_t)r * nd)) return PHGMG_ERR_NANINF;
-  return c->o->hyper_reduce ? phgmg__dampers_hyper(c) : PHGMG_OK;
+  return c->o->hyper.on ? phgmg__dampers_hyper(c) : PHGMG_OK;
 }
 
 PHGMG__PRIV int phgmg__has_feed(const phgmg_ph_system *sys) { return sys->P || sys->S || sys->Nskew; }
@@ -15673,7 +15617,7 @@ PHGMG__PRIV phgmg_result phgmg__dampers_hyper(phgmg__rctx *c) {
   for (k = 0; k < nd; ++k)
     for (a = 0; a < r; ++a) Vt[k + (size_t)a * nd] = red->Cd[a + (size_t)k * r];
   if (rc == PHGMG_OK)
-    rc = phgmg_ecsw_separable(nd, ns, F, nd, r, Vt, nd, NULL, c->o->hyper_tol, pts, w, &nk, &resid, c->alloc);
+    rc = phgmg_ecsw_separable(nd, ns, F, nd, r, Vt, nd, NULL, c->o->hyper.tol, pts, w, &nk, &resid, c->alloc);
   if (rc == PHGMG_OK) {   /* compact in place: kept dampers first (pts ascending or not, k <= pts[k] is not assumed) */
     double *C2 = Vt;      /* reuse: r x nk */
     for (k = 0; k < nk; ++k) {
@@ -15769,9 +15713,9 @@ PHGMG__PRIV phgmg_result phgmg__sp_test_basis(phgmg__rctx *c, double *Vg) {
     phgmg_ph_apply(c->sys, 'Q', r, red->V0, N, Vg, N);
     return c->sys->E ? phgmg__e_transpose_block(c, r, Vg) : PHGMG_OK;
   }
-  if (c->o->grad_basis) {
-    if (c->o->grad_cols < r) return PHGMG_ERR_SIZE;
-    memcpy(Vg, c->o->grad_basis, (size_t)N * r * sizeof(double));
+  if (c->o->cache.grad_basis) {
+    if (c->o->cache.grad_cols < r) return PHGMG_ERR_SIZE;
+    memcpy(Vg, c->o->cache.grad_basis, (size_t)N * r * sizeof(double));
     return PHGMG_OK;
   }
   Fg = phgmg__dalloc(c->alloc, (size_t)N * ns + (size_t)r);
@@ -15939,7 +15883,7 @@ PHGMG__PRIV phgmg_result phgmg__hyper_ecsw_manifold(phgmg__rctx *c, const double
     const double sw = c->sepw ? c->sepw[live[k]] : 1.0;
     for (a = 0; a < (int)nrow; ++a) tg[a] += sw * Gm[a + (size_t)k * nrow];
   }
-  rc = phgmg_ecsw(nt, (int)nrow, Gm, (int)nrow, tg, c->o->hyper_tol, pts, wt, nd, &c->inf.hyper_residual, c->alloc);
+  rc = phgmg_ecsw(nt, (int)nrow, Gm, (int)nrow, tg, c->o->hyper.tol, pts, wt, nd, &c->inf.hyper_residual, c->alloc);
   for (k = 0; rc == PHGMG_OK && k < *nd; ++k) pts[k] = live[pts[k]];   /* ascending stays ascending */
   phgmg__free(c->alloc, Gm);
   return rc;
@@ -15964,7 +15908,7 @@ PHGMG__PRIV phgmg_result phgmg__hyper_ecsw(phgmg__rctx *c, const double *F, int 
   for (a = 0; a < r; ++a)
     for (k = 0; k < nl; ++k) Vt[k + (size_t)a * nl] = red->V0[c->sys->sep_idx[live[k]] + (size_t)a * N];
   for (k = 0; k < nl; ++k) sw[k] = c->sepw ? c->sepw[live[k]] : 1.0;
-  rc = phgmg_ecsw_separable(nl, c->ns, F, nl, r, Vt, nl, sw, c->o->hyper_tol, pts, wt, nd,
+  rc = phgmg_ecsw_separable(nl, c->ns, F, nl, r, Vt, nl, sw, c->o->hyper.tol, pts, wt, nd,
                             &c->inf.hyper_residual, c->alloc);
   for (k = 0; rc == PHGMG_OK && k < *nd; ++k) pts[k] = live[pts[k]];   /* ascending stays ascending */
   phgmg__free(c->alloc, Vt);
@@ -16006,18 +15950,18 @@ PHGMG__PRIV phgmg_result phgmg__separable_points(phgmg__rctx *c, int *pts, doubl
   const int nt = sys->nsep, ns = c->ns;
   int a, nneg = 0;
   phgmg_result rc = PHGMG_OK;
-  if (o->hyper_reduce && o->deim_pts && o->deim_w) {
-    if (o->deim_count < 1 || o->deim_count > nt) return PHGMG_ERR_SIZE;
-    *nd = o->deim_count;
+  if (o->hyper.on && o->cache.deim_pts && o->cache.deim_w) {
+    if (o->cache.deim_count < 1 || o->cache.deim_count > nt) return PHGMG_ERR_SIZE;
+    *nd = o->cache.deim_count;
     for (a = 0; a < *nd; ++a) {
-      if (o->deim_pts[a] < 0 || o->deim_pts[a] >= nt) return PHGMG_ERR_INVALID_ARG;
-      pts[a] = o->deim_pts[a];
-      wt[a] = o->deim_w[a];
+      if (o->cache.deim_pts[a] < 0 || o->cache.deim_pts[a] >= nt) return PHGMG_ERR_INVALID_ARG;
+      pts[a] = o->cache.deim_pts[a];
+      wt[a] = o->cache.deim_w[a];
       if (wt[a] < 0.0) ++nneg;
     }
     if (!phgmg__all_finite(wt, (size_t)*nd)) return PHGMG_ERR_NANINF;
-  } else if (o->hyper_reduce) {
-    const int ecsw = o->hyper == PHGMG_HYPER_ECSW, quad = c->red->kind == PHGMG_ROM_QUADRATIC;
+  } else if (o->hyper.on) {
+    const int ecsw = o->hyper.kind == PHGMG_HYPER_ECSW, quad = c->red->kind == PHGMG_ROM_QUADRATIC;
     double *F = NULL;
     int *live = NULL, nl = 0;
     rc = phgmg__separable_gradients(c, ecsw, &F, &live, &nl);
@@ -16029,12 +15973,12 @@ PHGMG__PRIV phgmg_result phgmg__separable_points(phgmg__rctx *c, int *pts, doubl
     else if (ecsw)
       rc = phgmg__hyper_ecsw(c, F, nl, live, pts, wt, nd);
     else
-      rc = phgmg_deim_select(nt, ns, F, nt, c->sepw, o->deim_tol, o->deim_max,
-                             o->hyper == PHGMG_HYPER_GREEDY ? PHGMG_DEIM_GREEDY : PHGMG_DEIM_QDEIM,
+      rc = phgmg_deim_select(nt, ns, F, nt, c->sepw, o->hyper.deim_tol, o->hyper.deim_max,
+                             o->hyper.kind == PHGMG_HYPER_GREEDY ? PHGMG_DEIM_GREEDY : PHGMG_DEIM_QDEIM,
                              pts, wt, nd, &nneg, &c->inf.deim_sigma_ratio, c->alloc);
     phgmg__free(c->alloc, F);
     phgmg__free(c->alloc, live);
-    c->inf.hyper_method = o->hyper;
+    c->inf.hyper_method = o->hyper.kind;
   } else {
     *nd = nt;
     for (a = 0; a < nt; ++a) { pts[a] = a; wt[a] = c->sepw ? c->sepw[a] : 1.0; }
@@ -16045,7 +15989,7 @@ PHGMG__PRIV phgmg_result phgmg__separable_points(phgmg__rctx *c, int *pts, doubl
     c->inf.hyper_min_weight = wt[0];
     for (a = 1; a < *nd; ++a) c->inf.hyper_min_weight = PHGMG__MIN(c->inf.hyper_min_weight, wt[a]);
   }
-  if (rc == PHGMG_OK && nneg > 0 && !o->deim_allow_negative) rc = PHGMG_ERR_NEGATIVE_WEIGHT;
+  if (rc == PHGMG_OK && nneg > 0 && !o->hyper.allow_negative) rc = PHGMG_ERR_NEGATIVE_WEIGHT;
   return rc;
 }
 
@@ -16221,7 +16165,7 @@ PHGMG__PRIV phgmg_result phgmg__reduce_fallback_pod(phgmg_reduced **out, const p
   phgmg_reduce_info inf;
   phgmg_result rc;
   phgmg_reduced_destroy(c->red);
-  o.manifold = PHGMG_MANIFOLD_POD;
+  o.qm.manifold = PHGMG_MANIFOLD_POD;
   rc = phgmg_reduce(out, c->sys, c->Xf, c->ldxf, c->ns, &o, &inf, c->alloc);
   inf.manifold_obj0 = c->inf.manifold_obj0; inf.manifold_obj = c->inf.manifold_obj;
   inf.manifold_sweeps = c->inf.manifold_sweeps; inf.manifold_fallback = 1;
@@ -16235,12 +16179,12 @@ PHGMG__PRIV phgmg_result phgmg__reduce_fallback_pod(phgmg_reduced **out, const p
    bases, orders within its modes (phgmg_study_reduce). */
 PHGMG__PRIV int phgmg__study_fast(const phgmg_study *st, const phgmg_reduce_opts *o, int m) {
   if (!st) return PHGMG__SF_NONE;
-  if ((o->method == PHGMG_METHOD_GMG_POD || (o->method == PHGMG_METHOD_GMG_QM && o->manifold == PHGMG_MANIFOLD_POD)) && st->Ua &&
-      o->pod_basis == st->Ua && o->rn >= 0 &&
-      o->r - m + (o->method == PHGMG_METHOD_GMG_QM ? (o->rn > 0 ? o->rn : 8) : 0) <= st->ka)
+  if ((o->method == PHGMG_METHOD_GMG_POD || (o->method == PHGMG_METHOD_GMG_QM && o->qm.manifold == PHGMG_MANIFOLD_POD)) && st->Ua &&
+      o->cache.pod_basis == st->Ua && o->qm.rn >= 0 &&
+      o->r - m + (o->method == PHGMG_METHOD_GMG_QM ? (o->qm.rn > 0 ? o->qm.rn : 8) : 0) <= st->ka)
     return PHGMG__SF_GMG;
-  if (o->method == PHGMG_METHOD_SP1 && st->Up && st->Cq && o->pod_basis == st->Up && o->r <= st->kp) return PHGMG__SF_SP1;
-  if (o->method == PHGMG_METHOD_SP2 && st->Up && st->Ug && o->pod_basis == st->Up && o->grad_basis == st->Ug &&
+  if (o->method == PHGMG_METHOD_SP1 && st->Up && st->Cq && o->cache.pod_basis == st->Up && o->r <= st->kp) return PHGMG__SF_SP1;
+  if (o->method == PHGMG_METHOD_SP2 && st->Up && st->Ug && o->cache.pod_basis == st->Up && o->cache.grad_basis == st->Ug &&
       o->r <= st->kp && o->r <= st->kg)
     return PHGMG__SF_SP2;
   return PHGMG__SF_NONE;
@@ -16303,9 +16247,9 @@ PHGMG__PRIV phgmg_result phgmg__reduce_setup(phgmg__rctx *c, const phgmg_ph_syst
   if (rc == PHGMG_OK && sys->E && phgmg__e_algebraic(sys, alloc) != 0)   /* reduce the condensed model (1.8) */
     rc = PHGMG_ERR_UNSUPPORTED;
   if (rc != PHGMG_OK) return rc;
-  c->lambda = c->o->lambda < 0.0 ? 0.0 : c->o->lambda;   /* < 0: exactly zero */
-  if (c->o->lambda_auto && c->o->method == PHGMG_METHOD_GMG_QM)
-    c->ng = phgmg__lambda_grid(c->o->lambda_min, c->o->lambda_max, c->o->lambda_per_decade, NULL);
+  c->lambda = c->o->qm.lambda < 0.0 ? 0.0 : c->o->qm.lambda;   /* < 0: exactly zero */
+  if (c->o->select.lambda_mode != PHGMG_LAMBDA_FIXED && c->o->method == PHGMG_METHOD_GMG_QM)
+    c->ng = phgmg__lambda_grid(c->o->select.lambda_min, c->o->select.lambda_max, c->o->select.per_decade, NULL);
   c->degtol = c->o->degeneracy_tol;
   c->rfloor = phgmg__rank_floor(sys->N, ns, X, ldx);
   rc = phgmg__runs_layout(c);
@@ -16949,14 +16893,14 @@ PHGMG__PRIV int phgmg__study_deim(phgmg_study *st, const phgmg_reduce_opts *o) {
   const phgmg_ph_system *sys = st->sys;
   const phgmg_allocator *alloc = st->use_alloc ? &st->alloc : NULL;
   const int nt = sys->nsep, ns = st->ns;
-  const int meth = o->hyper == PHGMG_HYPER_GREEDY ? PHGMG_DEIM_GREEDY : PHGMG_DEIM_QDEIM;
+  const int meth = o->hyper.kind == PHGMG_HYPER_GREEDY ? PHGMG_DEIM_GREEDY : PHGMG_DEIM_QDEIM;
   double *F;
   int a, i;
   phgmg_result rc;
-  if (o->hyper_reduce != 1 || o->deim_pts || sys->nl != PHGMG_NL_SEPARABLE || nt < 1 ||
-      (o->hyper != PHGMG_HYPER_QDEIM && o->hyper != PHGMG_HYPER_GREEDY) || !(o->deim_tol >= 0.0 && o->deim_tol < 1.0))
+  if (o->hyper.on != 1 || o->cache.deim_pts || sys->nl != PHGMG_NL_SEPARABLE || nt < 1 ||
+      (o->hyper.kind != PHGMG_HYPER_QDEIM && o->hyper.kind != PHGMG_HYPER_GREEDY) || !(o->hyper.deim_tol >= 0.0 && o->hyper.deim_tol < 1.0))
     return 0;
-  if (st->deim_have && st->deim_tol == o->deim_tol && st->deim_max == o->deim_max && st->deim_method == meth) return 1;
+  if (st->deim_have && st->deim_tol == o->hyper.deim_tol && st->deim_max == o->hyper.deim_max && st->deim_method == meth) return 1;
   st->deim_have = 0;
   if (!st->deim_pts) st->deim_pts = phgmg__ialloc(alloc, (size_t)nt);
   if (!st->deim_w) st->deim_w = phgmg__dalloc(alloc, (size_t)nt);
@@ -16965,11 +16909,11 @@ PHGMG__PRIV int phgmg__study_deim(phgmg_study *st, const phgmg_reduce_opts *o) {
   for (i = 0; i < ns; ++i)
     for (a = 0; a < nt; ++a)
       F[a + (size_t)i * nt] = phgmg__ph_phi(sys, a, st->X[sys->sep_idx[a] + (size_t)i * st->ldx], 1);
-  rc = phgmg_deim_select(nt, ns, F, nt, sys->sep_w, o->deim_tol, o->deim_max, meth, st->deim_pts, st->deim_w,
+  rc = phgmg_deim_select(nt, ns, F, nt, sys->sep_w, o->hyper.deim_tol, o->hyper.deim_max, meth, st->deim_pts, st->deim_w,
                          &st->deim_nd, &st->deim_nneg, &st->deim_sigma, alloc);
   phgmg__free(alloc, F);
   if (rc != PHGMG_OK) return 0;
-  st->deim_have = 1; st->deim_tol = o->deim_tol; st->deim_max = o->deim_max; st->deim_method = meth;
+  st->deim_have = 1; st->deim_tol = o->hyper.deim_tol; st->deim_max = o->hyper.deim_max; st->deim_method = meth;
   return 1;
 }
 
@@ -16983,17 +16927,17 @@ PHGMG_DEF phgmg_result phgmg_study_reduce(phgmg_study *st, const phgmg_reduce_op
   if (phgmg__sys_fingerprint(st->sys) != st->fp) return PHGMG_ERR_STALE;   /* the blocks would be stale */
   o = *opts;
   phgmg__reduce_opts_resolve(&o, st->ns);
-  if ((o.method == PHGMG_METHOD_GMG_POD || o.method == PHGMG_METHOD_GMG_QM) && st->Ua && !o.pod_basis) {
-    o.pod_basis = st->Ua; o.pod_cols = st->ka;
+  if ((o.method == PHGMG_METHOD_GMG_POD || o.method == PHGMG_METHOD_GMG_QM) && st->Ua && !o.cache.pod_basis) {
+    o.cache.pod_basis = st->Ua; o.cache.pod_cols = st->ka;
   }
-  if ((o.method == PHGMG_METHOD_SP1 || o.method == PHGMG_METHOD_SP2) && st->Up && !o.pod_basis) {
-    o.pod_basis = st->Up; o.pod_cols = st->kp;
+  if ((o.method == PHGMG_METHOD_SP1 || o.method == PHGMG_METHOD_SP2) && st->Up && !o.cache.pod_basis) {
+    o.cache.pod_basis = st->Up; o.cache.pod_cols = st->kp;
   }
-  if (o.method == PHGMG_METHOD_SP2 && st->Ug && !o.grad_basis) { o.grad_basis = st->Ug; o.grad_cols = st->kg; }
+  if (o.method == PHGMG_METHOD_SP2 && st->Ug && !o.cache.grad_basis) { o.cache.grad_basis = st->Ug; o.cache.grad_cols = st->kg; }
   deim = phgmg__study_deim(st, &o);
-  if (deim) { o.deim_pts = st->deim_pts; o.deim_w = st->deim_w; o.deim_count = st->deim_nd; }
+  if (deim) { o.cache.deim_pts = st->deim_pts; o.cache.deim_w = st->deim_w; o.cache.deim_count = st->deim_nd; }
   rc = phgmg__reduce_run(out, st->sys, st->X, st->ldx, st->ns, &o, info, st->use_alloc ? &st->alloc : NULL, st);
-  if (info && deim) { info->deim_sigma_ratio = st->deim_sigma; info->hyper_method = o.hyper; }
+  if (info && deim) { info->deim_sigma_ratio = st->deim_sigma; info->hyper_method = o.hyper.kind; }
   return rc;
 }
 
