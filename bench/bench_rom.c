@@ -423,8 +423,8 @@ static phgmg_reduced *build(const model_data *md, phgmg_method meth, int r, doub
   phgmg_reduced *red = NULL;
   phgmg_result rc;
   memset(&o, 0, sizeof o);
-  o.method = meth; o.r = r; o.rn = RN; o.lambda = lambda;
-  o.hyper_reduce = 1; o.deim_tol = 1e-8; o.deim_allow_negative = 1;
+  o.method = meth; o.r = r; o.qm.rn = RN; o.qm.lambda = lambda;
+  o.hyper.on = 1; o.hyper.deim_tol = 1e-8; o.hyper.allow_negative = 1;
   if (with_map) o.dt = DT;
   rc = phgmg_reduce(&red, md->sys, md->X, md->sys->N, NS, &o, NULL, NULL);
   if (rc != PHGMG_OK) die("phgmg_reduce", rc);
@@ -642,9 +642,9 @@ static void bench_offline_reduce(const model_data *lin, const model_data *nl1, d
       const model_data *md = oc[i].lin ? lin : nl1;
       memset(&rc, 0, sizeof rc);
       rc.sys = md->sys; rc.X = md->X;
-      rc.o.method = oc[i].m; rc.o.r = 20; rc.o.rn = RN;
-      rc.o.lambda = oc[i].lin ? 1e-3 : lam20;
-      rc.o.hyper_reduce = 1; rc.o.deim_tol = 1e-8; rc.o.deim_allow_negative = 1;
+      rc.o.method = oc[i].m; rc.o.r = 20; rc.o.qm.rn = RN;
+      rc.o.qm.lambda = oc[i].lin ? 1e-3 : lam20;
+      rc.o.hyper.on = 1; rc.o.hyper.deim_tol = 1e-8; rc.o.hyper.allow_negative = 1;
       if (oc[i].map) rc.o.dt = DT;
       T = bench(oc[i].name, RUNS_OFF, reduce_fn, &rc);
       snprintf(extra, sizeof extra, "whole phgmg_reduce, N = %d%s", md->sys->N,

@@ -113,7 +113,7 @@ int main(int argc, char **argv) {
   memset(&o, 0, sizeof o);
   o.method = PHGMG_METHOD_GMG_POD;
   o.r = 20;
-  o.hyper_reduce = 1; /* hyper = 0: ECSW, hyper_tol 0: 1e-6 */
+  o.hyper.on = 1; /* hyper = 0: ECSW, hyper_tol 0: 1e-6 */
   if (getenv("BENCH_SCALE_PROGRESS")) o.progress = progress;
   for (i = 0; i < runs; ++i) {
     phgmg_reduced *red = NULL;

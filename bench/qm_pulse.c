@@ -104,9 +104,9 @@ int main(int argc, char **argv) {
       double t0, t1, e, lb, rv = 0.0;
       int a;
       memset(&o, 0, sizeof o);
-      o.method = PHGMG_METHOD_GMG_QM; o.r = nl[k] + 1; o.rn = rn; o.lambda = lambda; o.manifold = mf;
+      o.method = PHGMG_METHOD_GMG_QM; o.r = nl[k] + 1; o.qm.rn = rn; o.qm.lambda = lambda; o.qm.manifold = mf;
       o.degeneracy_tol = 1e-300;   /* a projection study: no simulation follows */
-      o.greedy_window = window;
+      o.qm.greedy_window = window;
       o.ref = xref;
       t0 = now();
       rc = phgmg_reduce(&red, &sys, X, NX, ns, &o, &inf, NULL);

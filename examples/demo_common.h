@@ -31,7 +31,7 @@ DEMO_FN void demo_print_lambda_defaults(const char *tail) {
   phgmg_reduce_opts_default(&d);
   printf("(library defaults: grid %g..%g at %d per decade, %d-fold validation over contiguous\n"
          "blocks of snapshots, conditioning guard %g)%s\n",
-         d.lambda_min, d.lambda_max, d.lambda_per_decade, d.lambda_folds, d.lambda_rcond, tail);
+         d.select.lambda_min, d.select.lambda_max, d.select.per_decade, d.select.folds, d.select.rcond, tail);
 }
 
 DEMO_FN void demo_die(const char *what, phgmg_result rc) {
@@ -149,12 +149,12 @@ DEMO_FN void demo_cache_build(demo_cache *c, const phgmg_ph_system *sys, const d
 }
 DEMO_FN void demo_cache_free(demo_cache *c) { phgmg_study_destroy(c->st); free(c->deim_pts); free(c->deim_w); }
 DEMO_FN void demo_cache_use(const demo_cache *c, phgmg_reduce_opts *o) {
-  o->deim_pts = c->deim_pts; o->deim_w = c->deim_w; o->deim_count = c->deim_count;
+  o->cache.deim_pts = c->deim_pts; o->cache.deim_w = c->deim_w; o->cache.deim_count = c->deim_count;
   if (o->method == PHGMG_METHOD_GMG_POD || o->method == PHGMG_METHOD_GMG_QM) {
-    o->pod_basis = c->adj; o->pod_cols = c->adj_cols;
+    o->cache.pod_basis = c->adj; o->cache.pod_cols = c->adj_cols;
   } else {
-    o->pod_basis = c->plain; o->pod_cols = c->plain_cols;
-    o->grad_basis = c->grad; o->grad_cols = c->grad_cols;
+    o->cache.pod_basis = c->plain; o->cache.pod_cols = c->plain_cols;
+    o->cache.grad_basis = c->grad; o->cache.grad_cols = c->grad_cols;
   }
 }
 
@@ -249,8 +249,8 @@ DEMO_FN void demo_lambda_auto_row(const phgmg_ph_system *sys, const double *X, c
     int g, pick;
     for (g = 0; g < 2; ++g) {
       o = *base;
-      o.method = PHGMG_METHOD_GMG_QM; o.lambda_auto = 1; o.lambda_train_only = 1; o.manifold = g;
-      o.nrun = 1; o.runs = &run; o.newton_tol = newton_tol; o.newton_iter = newton_it;
+      o.method = PHGMG_METHOD_GMG_QM; o.select.lambda_mode = PHGMG_LAMBDA_VALIDATED; o.select.train_only = 1; o.qm.manifold = g;
+      o.nrun = 1; o.runs = &run; o.select.newton_tol = newton_tol; o.select.newton_iter = newton_it;
       demo_cache_use(cache, &o);
       rm[g] = demo_run_rom(cache, sys, X, Y, nsteps, dt, uf, &o, newton_tol, newton_it, NULL);
     }
@@ -262,14 +262,14 @@ DEMO_FN void demo_lambda_auto_row(const phgmg_ph_system *sys, const double *X, c
   }
   row[6] = res.e_red; row[7] = res.info.lambda < HUGE_VAL ? res.info.lambda : NAN; row[8] = demo_newton_failures(&res);
   o = *base;
-  o.method = PHGMG_METHOD_GMG_POD; o.lambda_auto = 0;
+  o.method = PHGMG_METHOD_GMG_POD; o.select.lambda_mode = PHGMG_LAMBDA_FIXED;
   demo_cache_use(cache, &o);
   res = demo_run_rom(cache, sys, X, Y, nsteps, dt, uf, &o, newton_tol, newton_it, NULL);
   if (res.rc != PHGMG_OK) fprintf(stderr, "  [GMG-POD r=%d: %s]\n", o.r, phgmg_result_string(res.rc));
   row[0] = o.r; row[1] = res.e_red;
   o = *base;
-  o.method = PHGMG_METHOD_GMG_QM; o.lambda_auto = 1;
-  o.nrun = 1; o.runs = &run; o.newton_tol = newton_tol; o.newton_iter = newton_it;
+  o.method = PHGMG_METHOD_GMG_QM; o.select.lambda_mode = PHGMG_LAMBDA_VALIDATED;
+  o.nrun = 1; o.runs = &run; o.select.newton_tol = newton_tol; o.select.newton_iter = newton_it;
   demo_cache_use(cache, &o);
   res = demo_run_rom(cache, sys, X, Y, nsteps, dt, uf, &o, newton_tol, newton_it, NULL);
   if (res.rc != PHGMG_OK) fprintf(stderr, "  [GMG-QM r=%d: %s]\n", o.r, phgmg_result_string(res.rc));
@@ -313,8 +313,8 @@ DEMO_FN void demo_lambda_auto_study(const phgmg_ph_system *sys, const char *out,
     memset(&go, 0, sizeof go); go.tol = newton_tol; go.max_iter = newton_it;
     rc = phgmg_simulate(sys, x0, 0.0, dt, nsteps, inf[in], NULL, &go, X, Y, NULL, NULL, NULL, NULL);
     if (rc != PHGMG_OK) demo_die("full-order simulation", rc);
-    demo_cache_build_what(&cache, sys, X, ns, rmax + base->rn + 1, PHGMG_STUDY_GMG); /* GMG-POD, GMG-QM only */
-    if (base->deim) demo_cache_deim(&cache, sys, X, ns, base->deim_tol);
+    demo_cache_build_what(&cache, sys, X, ns, rmax + base->qm.rn + 1, PHGMG_STUDY_GMG); /* GMG-POD, GMG-QM only */
+    if (base->hyper.on && base->hyper.kind != PHGMG_HYPER_ECSW) demo_cache_deim(&cache, sys, X, ns, base->hyper.deim_tol);
     demo_lambda_auto_header(in ? "0.1" : "0.1 sin t");
     for (k = 0; k < nr; ++k) {
       phgmg_reduce_opts o = *base;
@@ -430,7 +430,7 @@ DEMO_FN void demo_generalization_study(const phgmg_ph_system *sys, const char *o
         double *row = rows + (size_t)nrow++ * DEMO_GEN_COLS, fails = 0;
         o.r = rlist[k];
         o.method = me == 1 ? PHGMG_METHOD_GMG_POD : PHGMG_METHOD_GMG_QM;
-        o.lambda_auto = me == 2; o.nrun = tr; o.runs = runs; o.newton_tol = tol; o.newton_iter = it;
+        o.select.lambda_mode = me == 2; o.nrun = tr; o.runs = runs; o.select.newton_tol = tol; o.select.newton_iter = it;
         row[0] = o.r; row[1] = tr; row[2] = me; row[10] = NAN;
         rc = phgmg_reduce(&red, sys, X, N, tr * ns, &o, &info, NULL);
         if (rc != PHGMG_OK) { fprintf(stderr, "  [%s r=%d: %s]\n", example, o.r, phgmg_result_string(rc)); for (i = 3; i < 10; ++i) row[i] = NAN; continue; }

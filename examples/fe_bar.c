@@ -129,7 +129,7 @@ static void fb_method(const phgmg_ph_system *sys, const double *X, const double 
   o.method = meth; o.r = r;
   memset(&run, 0, sizeof run);
   run.u = fb_train; run.dt = fb_dt; run.nsteps = FB_STEPS;
-  if (meth == PHGMG_METHOD_GMG_QM) { o.lambda_auto = 1; o.nrun = 1; o.runs = &run; }   /* lambda validated */
+  if (meth == PHGMG_METHOD_GMG_QM) { o.select.lambda_mode = PHGMG_LAMBDA_VALIDATED; o.nrun = 1; o.runs = &run; }   /* lambda validated */
   rc = phgmg_reduce(&red, sys, X, sys->N, FB_STEPS + 1, &o, &info, NULL);
   if (rc != PHGMG_OK) { printf("  reduce failed: %s\n", phgmg_result_string(rc)); return; }
   if (meth == PHGMG_METHOD_GMG_QM && info.lambda == HUGE_VAL)

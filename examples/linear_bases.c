@@ -131,8 +131,8 @@ static phgmg_result build_model(const study *S, int j, int r, phgmg_reduced **re
   }
   memset(&o, 0, sizeof o);
   o.method = PHGMG_METHOD_GMG_POD; o.r = r; o.dt = 0.1;
-  o.pod_basis = j == 0 ? S->pod : j == 7 ? S->h2[r] : S->bas[j - 1]; o.pod_cols = j == 7 ? r - m : RMAX;
-  return o.pod_basis ? phgmg_reduce(red, S->sys, S->X[0], N, 1001, &o, NULL, NULL) : PHGMG_ERR_INVALID_ARG;
+  o.cache.pod_basis = j == 0 ? S->pod : j == 7 ? S->h2[r] : S->bas[j - 1]; o.cache.pod_cols = j == 7 ? r - m : RMAX;
+  return o.cache.pod_basis ? phgmg_reduce(red, S->sys, S->X[0], N, 1001, &o, NULL, NULL) : PHGMG_ERR_INVALID_ARG;
 }
 
 /* One reduced model (method j, order r): its (A, B, C) and e_y on every input. */

@@ -159,14 +159,14 @@ static rom_row rom_run(const morse_chain *M, const traj *train, const traj *test
   phgmg_result rc;
   memset(&row, 0, sizeof row);
   row.e_red = row.e_y = row.e_red_test = row.e_y_test = row.e_proj = row.energy = row.energy_test = NAN;
-  row.lambda = o->method == PHGMG_METHOD_GMG_QM ? o->lambda : NAN;
+  row.lambda = o->method == PHGMG_METHOD_GMG_QM ? o->qm.lambda : NAN;
   if (!XR || !YR || !REH || !work || !xr0) { fprintf(stderr, "out of memory\n"); exit(1); }
   t0 = demo_now();
   memset(&info, 0, sizeof info);
   row.rc = phgmg_reduce(&red, &M->sys, train->X, N, ns, o, &info, NULL);
   row.t_offline = demo_now() - t0;
   if (row.rc == PHGMG_OK) {
-    row.ndeim = o->hyper_reduce ? info.deim_modes : M->n;
+    row.ndeim = o->hyper.on ? info.deim_modes : M->n;
     row.e_proj = phgmg_err_proj(red, train->X, N, ns);
     phgmg_reduced_restrict(red, train->X, xr0); /* rho(x0), x0 = 0 for both inputs */
     t0 = demo_now();
@@ -277,9 +277,9 @@ static void study(const morse_chain *M, const traj *train, const traj *test, con
         rom_row *w = &rows[(k * NMETH + j) * 2 + d];
         phgmg_reduce_opts o;
         memset(&o, 0, sizeof o);
-        o.method = meth_id[j]; o.r = rs[k]; o.rn = rn; o.hyper_reduce = d; o.deim_tol = deim_tol;
-        o.deim_allow_negative = 1;
-        if (meth_id[j] == PHGMG_METHOD_GMG_QM) o.lambda = fmax(0.2 * proj_pod, pow(10.0, -2.5));
+        o.method = meth_id[j]; o.r = rs[k]; o.qm.rn = rn; o.hyper.on = d; o.hyper.deim_tol = deim_tol;
+        o.hyper.allow_negative = 1;
+        if (meth_id[j] == PHGMG_METHOD_GMG_QM) o.qm.lambda = fmax(0.2 * proj_pod, pow(10.0, -2.5));
         demo_cache_use(cache, &o);
         *w = rom_run(M, train, d || all_test ? test : NULL, &o);
         if (meth_id[j] == PHGMG_METHOD_GMG_POD) proj_pod = w->e_proj;

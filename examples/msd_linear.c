@@ -46,7 +46,7 @@ static int lambda_auto_study(msd_linear *M, const char *out, int rmin, int rmax,
   {
     phgmg_reduce_opts o;
     memset(&o, 0, sizeof o);
-    o.rn = rn; o.dt = dt;
+    o.qm.rn = rn; o.dt = dt;
     demo_lambda_auto_study(&M->sys, out, "linear", rmin, rmax, rstep, &o, 1e-10, 10, nsteps, dt);
   }
   return 0;
@@ -83,7 +83,7 @@ int main(int argc, char **argv) {
     svgplot_fig *gf = svgplot_new("Linear chain: GMG-POD and GMG-QM (lambda validated by simulation) on inputs they were not trained on", 2);
     nrl = demo_parse_rlist(gen, rl, 64);
     memset(&o, 0, sizeof o);
-    o.rn = rn; o.dt = dt;
+    o.qm.rn = rn; o.dt = dt;
     svgplot_size(gf, 1200, 480);
     demo_generalization_study(&M.sys, out, "linear", rl, nrl, &o, 1e-10, 10, nsteps, dt, gf, 0);
     snprintf(path, sizeof path, "%s/fig_generalization_linear.svg", out);
@@ -131,7 +131,7 @@ int main(int argc, char **argv) {
         phgmg_reduce_opts o;
         demo_rom_result res;
         memset(&o, 0, sizeof o);
-        o.method = meth_id[j]; o.r = r; o.rn = rn; o.lambda = lambda; o.dt = dt;
+        o.method = meth_id[j]; o.r = r; o.qm.rn = rn; o.qm.lambda = lambda; o.dt = dt;
         demo_cache_use(&cache, &o);
         res = demo_run_rom(&cache, &M.sys, X, Y, nsteps, dt, inf[in], &o, 1e-10, 10, NULL);
         if (res.rc != PHGMG_OK) fprintf(stderr, "  [%s r=%d: %s]\n", meth_name[j], r, phgmg_result_string(res.rc));

@@ -53,7 +53,7 @@ static int lambda_auto_study(msd_nonlinear *M, const char *out, int rmin, int rm
   {
     phgmg_reduce_opts o;
     memset(&o, 0, sizeof o);
-    o.rn = rn; o.hyper_reduce = 1; o.deim_tol = deim_tol; o.deim_allow_negative = 1;
+    o.qm.rn = rn; o.hyper.on = 1; o.hyper.deim_tol = deim_tol; o.hyper.allow_negative = 1;
     demo_lambda_auto_study(&M->sys, out, "nonlinear", rmin, rmax, rstep, &o, 1e-8, 20, nsteps, dt);
   }
   return 0;
@@ -75,7 +75,7 @@ static int generalization_main(nl_setup *S, const char *gen) {
   svgplot_fig *gf = svgplot_new("Nonlinear chain: GMG-POD and GMG-QM (lambda validated by simulation) on inputs they were not trained on", 2);
   nrl = demo_parse_rlist(gen, rl, 64);
   memset(&o, 0, sizeof o);
-  o.rn = S->rn; o.hyper_reduce = 1; o.deim_tol = S->deim_tol; o.deim_allow_negative = 1;
+  o.qm.rn = S->rn; o.hyper.on = 1; o.hyper.deim_tol = S->deim_tol; o.hyper.allow_negative = 1;
   svgplot_size(gf, 1200, 480);
   demo_generalization_study(&S->M.sys, S->out, "nonlinear", rl, nrl, &o, 1e-8, 20, S->nsteps, S->dt, gf, 0);
   snprintf(path, sizeof path, "%s/fig_generalization_nonlinear.svg", S->out);
@@ -107,10 +107,10 @@ static void paper_order(nl_setup *S, demo_cache *cache, const double *X, const d
     phgmg_energy ren;
     double *REH = NULL;
     memset(&o, 0, sizeof o);
-    o.method = meth_id[j]; o.r = r; o.rn = S->rn; o.hyper_reduce = 1; o.deim_tol = S->deim_tol; o.deim_allow_negative = 1;
+    o.method = meth_id[j]; o.r = r; o.qm.rn = S->rn; o.hyper.on = 1; o.hyper.deim_tol = S->deim_tol; o.hyper.allow_negative = 1;
     if (meth_id[j] == PHGMG_METHOD_GMG_QM) {
       if (!(lam > 0)) lam = fmax(0.2 * T->tproj[k * 4 + 1], pow(10.0, -2.5));
-      o.lambda = lam;
+      o.qm.lambda = lam;
     }
     demo_cache_use(cache, &o);
     if (r == S->renergy) {

@@ -1311,8 +1311,8 @@ static int parse_reduce(int argc, char **argv, reduce_args *A) {
   phgmg_reduce_opts def;   /* the library's defaults of the options it shares */
   phgmg_reduce_opts_default(&def);
   memset(A, 0, sizeof *A);
-  A->dt = 0.1; A->steps = 1000; A->amp = 0.1; A->rn = 0; A->lambda = def.lambda;
-  A->deim_tol = def.deim_tol; A->name = "rom"; A->newton_tol = 0.0; A->newton_iter = 10;
+  A->dt = 0.1; A->steps = 1000; A->amp = 0.1; A->rn = 0; A->lambda = def.qm.lambda;
+  A->deim_tol = def.hyper.deim_tol; A->name = "rom"; A->newton_tol = 0.0; A->newton_iter = 10;
   for (i = 2; i < argc; ++i) {
     const char *o = argv[i], *v;
 #define STR(opt, field) else if (!strcmp(o, opt)) { if (!(v = optval(argc, argv, &i))) return 2; A->field = v; }
@@ -2287,7 +2287,7 @@ static int default_rn(int N, int r, int m) {
   phgmg_reduce_opts def;
   int rn;
   phgmg_reduce_opts_default(&def);
-  rn = PHGMG__MIN(def.rn, N - r);
+  rn = PHGMG__MIN(def.qm.rn, N - r);
   if (r > m) rn = PHGMG__MIN(rn, 4096 / (r - m));
   return PHGMG__MAX(rn, 1);
 }
@@ -2340,23 +2340,23 @@ static int run_reduction(const reduce_args *A, reduce_state *S, int method, cons
   phgmg_reduce_opts_default(&o);
   o.method = (phgmg_method)method;
   o.r = A->r;
-  o.rn = A->rn ? A->rn : default_rn(N, A->r, S->sys.m);
-  o.lambda = A->lambda > 0.0 ? A->lambda : -1.0; /* 0 on the command line = exactly zero */
-  o.hyper_reduce = A->poly_idx && !A->no_deim;
-  o.hyper = !A->hyper || !strcmp(A->hyper, "ecsw") ? PHGMG_HYPER_ECSW
-            : !strcmp(A->hyper, "qdeim") ? PHGMG_HYPER_QDEIM : PHGMG_HYPER_GREEDY;
-  if (A->hyper_tol > 0.0) o.hyper_tol = A->hyper_tol;
-  o.deim_tol = A->deim_tol > 0.0 ? A->deim_tol : 1e-300;
-  o.deim_max = A->deim_max;
-  o.deim_allow_negative = A->deim_neg;
+  o.qm.rn = A->rn ? A->rn : default_rn(N, A->r, S->sys.m);
+  o.qm.lambda = A->lambda > 0.0 ? A->lambda : -1.0; /* 0 on the command line = exactly zero */
+  o.hyper.on = A->poly_idx && !A->no_deim;
+  o.hyper.kind = !A->hyper || !strcmp(A->hyper, "ecsw") ? PHGMG_HYPER_ECSW
+                 : !strcmp(A->hyper, "qdeim") ? PHGMG_HYPER_QDEIM : PHGMG_HYPER_GREEDY;
+  if (A->hyper_tol > 0.0) o.hyper.tol = A->hyper_tol;
+  o.hyper.deim_tol = A->deim_tol > 0.0 ? A->deim_tol : 1e-300;
+  o.hyper.deim_max = A->deim_max;
+  o.hyper.allow_negative = A->deim_neg;
   o.dt = A->dt_map;
-  o.lambda_auto = A->lambda_auto;
-  o.manifold = A->manifold;
+  o.select.lambda_mode = A->lambda_auto;
+  o.qm.manifold = A->manifold;
   o.ref = A->ref;
   o.ref_x = A->ref == PHGMG_REF_GIVEN ? S->refm.a : NULL;
-  o.greedy_window = A->greedy_window;
+  o.qm.greedy_window = A->greedy_window;
   if (S->nrun > 0) { o.nrun = S->nrun; o.runs = S->runs; } /* --simulate: the runs are known */
-  if (A->lambda_auto == 1) { o.newton_tol = A->newton_tol; o.newton_iter = A->newton_iter; }
+  if (A->lambda_auto == 1) { o.select.newton_tol = A->newton_tol; o.select.newton_iter = A->newton_iter; }
   memset(&info, 0, sizeof info);
   progress("reducing: %s, r = %d%s", A->method, A->r, method == PHGMG_METHOD_GMG_QM ? " (quadratic manifold)" : "");
   t0 = now_s();
@@ -2418,7 +2418,7 @@ static int run_reduction(const reduce_args *A, reduce_state *S, int method, cons
   if (info.pod_randomized)
     progress("  POD: %s (a-posteriori check %.2g)", info.pod_randomized > 0 ? "randomized (large snapshot set)"
              : "exact SVD (the randomized POD failed its check)", info.pod_check);
-  if (rom->nd && o.hyper_reduce)
+  if (rom->nd && o.hyper.on)
     progress("  hyper-reduction %s: %d points, %d negative weights, smallest weight %.3g, training residual %.2g",
              A->hyper ? A->hyper : "ecsw", info.deim_modes, info.deim_negative, info.hyper_min_weight,
              info.hyper_residual);
@@ -2488,8 +2488,8 @@ static int write_arrays(const reduce_args *A, reduce_state *S, const double *X, 
 /* The hyper-reduction of the run: ecsw, qdeim, greedy, or none (no nonlinear
    part, or --no-deim: every term kept). */
 static const char *hyper_name(const reduce_args *A, const phgmg_reduce_opts *o) {
-  if (!A->poly_idx || !o->hyper_reduce) return "none";
-  return o->hyper == PHGMG_HYPER_ECSW ? "ecsw" : o->hyper == PHGMG_HYPER_QDEIM ? "qdeim" : "greedy";
+  if (!A->poly_idx || !o->hyper.on) return "none";
+  return o->hyper.kind == PHGMG_HYPER_ECSW ? "ecsw" : o->hyper.kind == PHGMG_HYPER_QDEIM ? "qdeim" : "greedy";
 }
 
 /* NAME.json: what was reduced, how, and where the outputs are. */
@@ -2530,7 +2530,7 @@ static void json_options(FILE *jf, const reduce_args *A, const reduce_state *S, 
                          const phgmg_reduce_opts *o, const phgmg_reduce_info *info) {
   fprintf(jf, "},\n  \"options\": {");
   if (method == PHGMG_METHOD_GMG_QM) { /* lambda, r_n and the manifold are gmg-qm's */
-    fprintf(jf, "\"rn\": %d, \"lambda\": ", o->rn);
+    fprintf(jf, "\"rn\": %d, \"lambda\": ", o->qm.rn);
     if (A->lambda_auto) json_str(jf, A->lambda_auto == 1 ? "auto" : "cv");
     else json_num(jf, A->lambda);
     fprintf(jf, ", \"lambda_used\": ");
@@ -2547,12 +2547,12 @@ static void json_options(FILE *jf, const reduce_args *A, const reduce_state *S, 
   json_str(jf, A->ref == PHGMG_REF_MEAN ? "mean" : A->ref == PHGMG_REF_GIVEN ? A->ref_file : "none");
   fprintf(jf, ", \"hyper\": ");
   json_str(jf, hyper_name(A, o));
-  if (o->hyper_reduce && o->hyper == PHGMG_HYPER_ECSW) {
+  if (o->hyper.on && o->hyper.kind == PHGMG_HYPER_ECSW) {
     fprintf(jf, ", \"hyper_tol\": ");
     json_num(jf, A->hyper_tol > 0.0 ? A->hyper_tol : 1e-6);
   }
-  fprintf(jf, ", \"deim\": %s", o->hyper_reduce && o->hyper != PHGMG_HYPER_ECSW ? "true" : "false");
-  if (o->hyper_reduce && o->hyper != PHGMG_HYPER_ECSW) {
+  fprintf(jf, ", \"deim\": %s", o->hyper.on && o->hyper.kind != PHGMG_HYPER_ECSW ? "true" : "false");
+  if (o->hyper.on && o->hyper.kind != PHGMG_HYPER_ECSW) {
     fprintf(jf, ", \"deim_tol\": ");
     json_num(jf, A->deim_tol);
     fprintf(jf, ", \"deim_max\": %d, \"deim_allow_negative\": %s", A->deim_max, A->deim_neg ? "true" : "false");
@@ -2599,12 +2599,12 @@ static int write_json(const reduce_args *A, reduce_state *S, int method, int ns,
   if (o->method != PHGMG_METHOD_SP1 && o->method != PHGMG_METHOD_SP2) { /* GMG only */
     fprintf(jf, ", \"rcond_dgd\": "); json_num(jf, info->rcond_dgd);
   }
-  if (o->hyper_reduce && A->poly_idx) { /* the hyper-reduction's result */
+  if (o->hyper.on && A->poly_idx) { /* the hyper-reduction's result */
     fprintf(jf, ", \"hyper\": {\"method\": ");
     json_str(jf, hyper_name(A, o));
     fprintf(jf, ", \"points\": %d, \"negative_weights\": %d, \"min_weight\": ", info->deim_modes, info->deim_negative);
     json_num(jf, info->hyper_min_weight);
-    if (o->hyper == PHGMG_HYPER_ECSW) {
+    if (o->hyper.kind == PHGMG_HYPER_ECSW) {
       fprintf(jf, ", \"tol\": "); json_num(jf, A->hyper_tol > 0.0 ? A->hyper_tol : 1e-6);
       fprintf(jf, ", \"residual\": "); json_num(jf, info->hyper_residual);
     } else {

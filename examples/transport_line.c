@@ -145,10 +145,10 @@ static row study_one(const line *L, int meth, int r, const double *X, const doub
   o.r = r;
   o.method = meth == 0 ? PHGMG_METHOD_GMG_POD : PHGMG_METHOD_GMG_QM;
   if (meth > 0) {
-    o.manifold = meth == 1 || meth == 4 ? PHGMG_MANIFOLD_POD : meth == 3 ? PHGMG_MANIFOLD_ALTMIN : PHGMG_MANIFOLD_GREEDY;
-    o.lambda_auto = 1; o.nrun = 1; o.runs = &run;
+    o.qm.manifold = meth == 1 || meth == 4 ? PHGMG_MANIFOLD_POD : meth == 3 ? PHGMG_MANIFOLD_ALTMIN : PHGMG_MANIFOLD_GREEDY;
+    o.select.lambda_mode = PHGMG_LAMBDA_VALIDATED; o.nrun = 1; o.runs = &run;
     if (meth == 4) o.ref = PHGMG_REF_MEAN;
-    if (meth == 2) o.greedy_window = TL_WINDOW;
+    if (meth == 2) o.qm.greedy_window = TL_WINDOW;
   }
   w.rc = phgmg_reduce(&red, &L->sys, X, N, ns, &o, &inf, NULL);
   if (w.rc != PHGMG_OK) return w;

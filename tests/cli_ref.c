@@ -93,7 +93,7 @@ static int ref(int nonlinear, phgmg_method meth, int r, int n, const char *out) 
   int st;
   memset(&go, 0, sizeof go);
   memset(&o, 0, sizeof o);
-  o.method = meth; o.r = r; o.rn = rn;
+  o.method = meth; o.r = r; o.qm.rn = rn;
   if (nonlinear) {
     msd_nl_opts mo;
     memset(&mo, 0, sizeof mo);
@@ -101,14 +101,14 @@ static int ref(int nonlinear, phgmg_method meth, int r, int n, const char *out) 
     if (msd_nonlinear_build(&MN, &mo) != 0) return die("msd_nonlinear_build", PHGMG_ERR_INVALID_ARG);
     sys = &MN.sys;
     go.tol = 1e-8; go.max_iter = 20;
-    o.hyper_reduce = 1; o.deim_tol = 1e-8; o.deim_allow_negative = 1;
-    o.lambda = 1e-3;
+    o.hyper.on = 1; o.hyper.deim_tol = 1e-8; o.hyper.allow_negative = 1;
+    o.qm.lambda = 1e-3;
   } else {
     if (msd_linear_build(&ML, 50, NULL, NULL, NULL, PHGMG_DENSE) != 0)
       return die("msd_linear_build", PHGMG_ERR_INVALID_ARG);
     sys = &ML.sys;
     go.tol = 1e-10; go.max_iter = 10;
-    o.lambda = 1e-3; o.dt = dt;
+    o.qm.lambda = 1e-3; o.dt = dt;
   }
   X = (double *)malloc(sizeof(double) * (size_t)sys->N * ns);
   x0 = (double *)calloc((size_t)sys->N, sizeof(double));

@@ -331,9 +331,9 @@ TEST(test_defect_reduce_options) {
   CHECK_RC(phgmg_reduce(&red, &t.sys, X, N, ns, NULL, NULL, NULL), PHGMG_ERR_INVALID_ARG);
   CHECK(red == NULL);
   /* 9: NaN deim_tol, NaN / Inf / negative dt */
-  o.deim_tol = (double)NAN;
+  o.hyper.deim_tol = (double)NAN;
   CHECK_RC(phgmg_reduce(&red, &t.sys, X, N, ns, &o, NULL, NULL), PHGMG_ERR_INVALID_ARG);
-  o.deim_tol = 0.0; o.dt = (double)NAN;
+  o.hyper.deim_tol = 0.0; o.dt = (double)NAN;
   CHECK_RC(phgmg_reduce(&red, &t.sys, X, N, ns, &o, NULL, NULL), PHGMG_ERR_INVALID_ARG);
   o.dt = (double)INFINITY;
   CHECK_RC(phgmg_reduce(&red, &t.sys, X, N, ns, &o, NULL, NULL), PHGMG_ERR_INVALID_ARG);

@@ -205,7 +205,7 @@ TEST(test_defect3_lambda_zero) {
     CHECK_RC(phgmg_simulate(&t.sys, x0, 0.0, 0.1, 20, d3_u_sin, NULL, NULL, Xs, NULL, NULL, NULL, NULL, NULL),
              PHGMG_OK);
   }
-  o.method = PHGMG_METHOD_GMG_QM; o.r = 8; o.rn = 4; o.lambda = -1.0;
+  o.method = PHGMG_METHOD_GMG_QM; o.r = 8; o.qm.rn = 4; o.qm.lambda = -1.0;
   CHECK_RC(phgmg_reduce(&red, &t.sys, Xs, 20, 21, &o, NULL, NULL), PHGMG_OK);
   if (red) CHECK_LE(phgmg_err_proj(red, Xs, 20, 21), 1e-6);
   phgmg_reduced_destroy(red);
@@ -463,7 +463,7 @@ TEST(test_defect3_load_structure) {
   memset(&o, 0, sizeof o);
   o.method = PHGMG_METHOD_GMG_POD; o.r = 6; o.dt = 0.1;
   CHECK_RC(phgmg_reduce(&red, &t.sys, Xs, 20, 201, &o, NULL, NULL), PHGMG_OK);
-  o.method = PHGMG_METHOD_GMG_QM; o.r = 6; o.rn = 4; o.dt = 0.0;
+  o.method = PHGMG_METHOD_GMG_QM; o.r = 6; o.qm.rn = 4; o.dt = 0.0;
   CHECK_RC(phgmg_reduce(&rq, &t.sys, Xs, 20, 201, &o, NULL, NULL), PHGMG_OK);
   if (red && rq) {
     const phgmg_rom *rom = phgmg_reduced_rom(red);

@@ -76,19 +76,19 @@ TEST(test_deploy_options) {
   memset(&run, 0, sizeof run);
   run.u = msd_input_sin; run.dt = 0.1; run.nsteps = ns - 1;
   memset(&b, 0, sizeof b);
-  b.method = PHGMG_METHOD_GMG_QM; b.r = 5; b.rn = 3; b.nrun = 1; b.runs = &run;
+  b.method = PHGMG_METHOD_GMG_QM; b.r = 5; b.qm.rn = 3; b.nrun = 1; b.runs = &run;
 #define BAD(field, val, code) do { o = b; o.field = (val); \
     CHECK_RC(phgmg_reduce(&red, &M.sys, X, M.sys.N, ns, &o, NULL, NULL), code); CHECK(red == NULL); } while (0)
   BAD(nrun, -1, PHGMG_ERR_INVALID_ARG);
   BAD(runs, NULL, PHGMG_ERR_INVALID_ARG);
-  BAD(lambda_tolerance, 0.5, PHGMG_ERR_INVALID_ARG);
-  BAD(lambda_tolerance, (double)NAN, PHGMG_ERR_INVALID_ARG);
-  BAD(newton_tol, -1.0, PHGMG_ERR_INVALID_ARG);
-  BAD(newton_iter, -1, PHGMG_ERR_INVALID_ARG);
-  BAD(manifold, 3, PHGMG_ERR_INVALID_ARG);
-  BAD(manifold, -1, PHGMG_ERR_INVALID_ARG);
-  BAD(lambda_train_only, 2, PHGMG_ERR_INVALID_ARG);
-  BAD(lambda_auto, 3, PHGMG_ERR_INVALID_ARG);
+  BAD(select.tolerance, 0.5, PHGMG_ERR_INVALID_ARG);
+  BAD(select.tolerance, (double)NAN, PHGMG_ERR_INVALID_ARG);
+  BAD(select.newton_tol, -1.0, PHGMG_ERR_INVALID_ARG);
+  BAD(select.newton_iter, -1, PHGMG_ERR_INVALID_ARG);
+  BAD(qm.manifold, 3, PHGMG_ERR_INVALID_ARG);
+  BAD(qm.manifold, -1, PHGMG_ERR_INVALID_ARG);
+  BAD(select.train_only, 2, PHGMG_ERR_INVALID_ARG);
+  BAD(select.lambda_mode, 3, PHGMG_ERR_INVALID_ARG);
 #undef BAD
   {
     phgmg_run two[2];
@@ -117,7 +117,7 @@ TEST(test_lambda_auto_without_runs_is_linear_limit) {
   CHECK(X != NULL);
   if (!X) { msd_linear_free(&M); return; }
   memset(&o, 0, sizeof o);
-  o.method = PHGMG_METHOD_GMG_QM; o.r = r; o.rn = 4; o.lambda_auto = 1;
+  o.method = PHGMG_METHOD_GMG_QM; o.r = r; o.qm.rn = 4; o.select.lambda_mode = PHGMG_LAMBDA_VALIDATED;
   CHECK_RC(phgmg_reduce(&qm, &M.sys, X, M.sys.N, ns, &o, &info, NULL), PHGMG_OK);
   CHECK(info.lambda == HUGE_VAL && info.lambda_candidates == 0);
   memset(&o, 0, sizeof o);
@@ -164,7 +164,7 @@ TEST(test_lambda_auto_progress) {
   memset(&run, 0, sizeof run);
   run.u = msd_input_sin; run.dt = 0.1; run.nsteps = NS - 1;
   memset(&o, 0, sizeof o);
-  o.method = PHGMG_METHOD_GMG_QM; o.r = 8; o.rn = 4; o.lambda_auto = 1; o.nrun = 1; o.runs = &run;
+  o.method = PHGMG_METHOD_GMG_QM; o.r = 8; o.qm.rn = 4; o.select.lambda_mode = PHGMG_LAMBDA_VALIDATED; o.nrun = 1; o.runs = &run;
   o.progress = count_phase; o.progress_user = &pc;
   if (X) {
     CHECK_RC(phgmg_reduce(&red, &M.sys, X, M.sys.N, NS, &o, &info, NULL), PHGMG_OK);
@@ -198,8 +198,8 @@ TEST(test_lambda_auto_generalizes) {
     phgmg_reduce_opts o;
     phgmg_reduced *red = NULL;
     memset(&o, 0, sizeof o);
-    o.method = v ? PHGMG_METHOD_GMG_QM : PHGMG_METHOD_GMG_POD; o.r = r; o.rn = 8;
-    o.lambda_auto = v; o.nrun = 1; o.runs = &run;
+    o.method = v ? PHGMG_METHOD_GMG_QM : PHGMG_METHOD_GMG_POD; o.r = r; o.qm.rn = 8;
+    o.select.lambda_mode = v; o.nrun = 1; o.runs = &run;
     CHECK_RC(phgmg_reduce(&red, &M.sys, X, M.sys.N, NS, &o, &info, NULL), PHGMG_OK);
     if (!red) continue;
     if (v == 1) {
@@ -270,14 +270,14 @@ static double ra_expected(const phgmg_ph_system *sys, const double *X, int ns, i
   ra_eval(red, ns, u, Yref, base, &ok);
   phgmg_reduced_destroy(red);
   for (k = 0; k < 4; ++k) if (!(base[k] < HUGE_VAL)) base[k] = 1.0;
-  o.method = PHGMG_METHOD_GMG_QM; o.rn = 8; o.lambda_auto = 2; o.nrun = 1; o.runs = run;
+  o.method = PHGMG_METHOD_GMG_QM; o.qm.rn = 8; o.select.lambda_mode = PHGMG_LAMBDA_REGRESSION; o.nrun = 1; o.runs = run;
   if (phgmg_reduce(&red, sys, X, sys->N, ns, &o, &info, NULL) != PHGMG_OK) return NAN;
   phgmg_reduced_destroy(red);
   lam_reg = info.lambda;
   gsel = (int)floor(pd * log10(lam_reg / lo) + 0.5);
   for (g = ng - 1; g >= gsel; g = (g - pd >= gsel || g == gsel) ? g - pd : gsel) {
     double score = 0.0, worst = 0.0;
-    o.lambda_auto = 0; o.lambda = lo * pow(10.0, (double)g / pd);
+    o.select.lambda_mode = PHGMG_LAMBDA_FIXED; o.qm.lambda = lo * pow(10.0, (double)g / pd);
     if (phgmg_reduce(&red, sys, X, sys->N, ns, &o, NULL, NULL) != PHGMG_OK) return NAN;
     ra_eval(red, ns, u, Yref, ey, &ok);
     phgmg_reduced_destroy(red);
@@ -325,7 +325,7 @@ TEST(test_lambda_auto_rule_recomputed) {
     r = rs[j];
     want = ra_expected(&M.sys, X, NS, r, &run, Yref, u, &ncand);
     memset(&o, 0, sizeof o);
-    o.method = PHGMG_METHOD_GMG_QM; o.r = r; o.rn = 8; o.lambda_auto = 1; o.nrun = 1; o.runs = &run;
+    o.method = PHGMG_METHOD_GMG_QM; o.r = r; o.qm.rn = 8; o.select.lambda_mode = PHGMG_LAMBDA_VALIDATED; o.nrun = 1; o.runs = &run;
     CHECK_RC(phgmg_reduce(&red, &M.sys, X, M.sys.N, NS, &o, &info, NULL), PHGMG_OK);
     phgmg_reduced_destroy(red);
     CHECK(!isnan(want));
@@ -360,7 +360,7 @@ TEST(test_validate_and_indicator) {
   memset(&o, 0, sizeof o);
   o.method = PHGMG_METHOD_GMG_POD; o.r = 12;
   CHECK_RC(phgmg_reduce(&pod, &M.sys, X, M.sys.N, NS, &o, NULL, NULL), PHGMG_OK);
-  o.method = PHGMG_METHOD_GMG_QM; o.r = 8; o.rn = 8; o.lambda = 1e-12;
+  o.method = PHGMG_METHOD_GMG_QM; o.r = 8; o.qm.rn = 8; o.qm.lambda = 1e-12;
   CHECK_RC(phgmg_reduce(&qm, &M.sys, X, M.sys.N, NS, &o, NULL, NULL), PHGMG_OK);
   if (pod && qm) {
     CHECK(phgmg_reduced_rom(pod)->env_lo != NULL && phgmg_reduced_rom(pod)->env_hi != NULL);
@@ -450,7 +450,7 @@ TEST(test_greedy_manifold_picks_pod_modes) {
   CHECK_RC(phgmg_adjust_snapshots(100, 1, M.sys.B, NS, X, 100, Xa, 100, NULL), PHGMG_OK);
   CHECK_RC(phgmg_pod(100, NS, Xa, 100, Q, 0.0, U, 100, NULL, &k, NULL), PHGMG_OK);
   memset(&o, 0, sizeof o);
-  o.method = PHGMG_METHOD_GMG_QM; o.r = P + 1; o.rn = RN; o.manifold = 1; o.lambda = 1e-9;
+  o.method = PHGMG_METHOD_GMG_QM; o.r = P + 1; o.qm.rn = RN; o.qm.manifold = 1; o.qm.lambda = 1e-9;
   CHECK_RC(phgmg_reduce(&red, &M.sys, X, 100, NS, &o, NULL, NULL), PHGMG_OK);
   if (red) {
     phgmg_reduced_dphi(red, xr0, D, 100);   /* Dphi(0) = V0 = [B, V1] */
@@ -500,10 +500,10 @@ TEST(test_altmin_manifold) {
   if (!X) { msd_linear_free(&M); return; }
   nx = sumsq(N, NS, X);
   memset(&o, 0, sizeof o);
-  o.method = PHGMG_METHOD_GMG_QM; o.r = R; o.rn = RN; o.lambda = -1.0;   /* exactly 0 */
-  o.manifold = PHGMG_MANIFOLD_POD;
+  o.method = PHGMG_METHOD_GMG_QM; o.r = R; o.qm.rn = RN; o.qm.lambda = -1.0;   /* exactly 0 */
+  o.qm.manifold = PHGMG_MANIFOLD_POD;
   CHECK_RC(phgmg_reduce(&pod, &M.sys, X, N, NS, &o, &ip, NULL), PHGMG_OK);
-  o.manifold = PHGMG_MANIFOLD_ALTMIN;
+  o.qm.manifold = PHGMG_MANIFOLD_ALTMIN;
   CHECK_RC(phgmg_reduce(&alt, &M.sys, X, N, NS, &o, &ia, NULL), PHGMG_OK);
   if (pod && alt) {
     e_pod = phgmg_err_proj(pod, X, N, NS);
@@ -578,10 +578,10 @@ TEST(test_deploy_oom) {
   al.alloc = tc_alloc; al.free = tc_free; al.user = &c;
   for (pass = 0; pass < 4; ++pass) {   /* manifold POD, greedy, altmin (fixed lambda, lambda_auto = 1) */
     memset(&o, 0, sizeof o);
-    o.method = PHGMG_METHOD_GMG_QM; o.r = 5; o.rn = 3; o.lambda_auto = 1; o.nrun = 1; o.runs = &run;
-    o.manifold = pass < 3 ? pass : PHGMG_MANIFOLD_ALTMIN; o.lambda_train_only = pass == 1;
-    if (pass == 2) { o.r = 4; o.rn = 2; o.lambda_auto = 0; }
-    if (pass == 3) { o.r = 3; o.rn = 1; }   /* with the GMG-POD reference and the fallback: small */
+    o.method = PHGMG_METHOD_GMG_QM; o.r = 5; o.qm.rn = 3; o.select.lambda_mode = PHGMG_LAMBDA_VALIDATED; o.nrun = 1; o.runs = &run;
+    o.qm.manifold = pass < 3 ? pass : PHGMG_MANIFOLD_ALTMIN; o.select.train_only = pass == 1;
+    if (pass == 2) { o.r = 4; o.qm.rn = 2; o.select.lambda_mode = PHGMG_LAMBDA_FIXED; }
+    if (pass == 3) { o.r = 3; o.qm.rn = 1; }   /* with the GMG-POD reference and the fallback: small */
     memset(&c, 0, sizeof c);
     CHECK_RC(phgmg_reduce(&red, &M.sys, X, M.sys.N, ns, &o, NULL, &al), PHGMG_OK);
     if (red) CHECK_RC(phgmg_reduced_validate(red, &M.sys, &run, 0, 0, 0, &v, &al), PHGMG_OK);

@@ -450,7 +450,7 @@ TEST(test_dissip_reduce_hyper) {
   memset(&o, 0, sizeof o);
   o.method = PHGMG_METHOD_GMG_POD; o.r = r;
   CHECK_RC(phgmg_reduce(&red, &s, X, c.N, ns + 1, &o, NULL, NULL), PHGMG_OK);
-  o.hyper_reduce = 1;
+  o.hyper.on = 1;
   CHECK_RC(phgmg_reduce(&rh, &s, X, c.N, ns + 1, &o, NULL, NULL), PHGMG_OK);
   if (red && rh) {
     const phgmg_rom *rom = phgmg_reduced_rom(rh);

@@ -91,9 +91,9 @@ static double te_compare(int n_masses, int ns, int ld, int r, int *count) {
     memset(&ro, 0, sizeof ro);
     ro.method = (phgmg_method)meth;
     ro.r = r;
-    ro.rn = 4;
-    ro.hyper_reduce = 1;
-    ro.deim_allow_negative = 1;
+    ro.qm.rn = 4;
+    ro.hyper.on = 1;
+    ro.hyper.allow_negative = 1;
     if (phgmg_reduce(&red, &M.sys, X0, N, ns, &ro, NULL, NULL) != PHGMG_OK) { worst = 1.0; free(XR); break; }
     memset(xr0, 0, sizeof xr0);
     if (phgmg_reduced_simulate(red, xr0, 0.0, 0.1, ns - 1, msd_input_sin, NULL, 1e-10, 20, XR, NULL, NULL,

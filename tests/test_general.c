@@ -109,7 +109,7 @@ TEST(test_callbacks_equal_polynomial) {
         phgmg_reduce_info i1, i2;
         double e1[2], e2[2];
         memset(&o, 0, sizeof o);
-        o.method = meths[a]; o.r = rs[b]; o.rn = 8; o.hyper_reduce = d; o.deim_allow_negative = 1;
+        o.method = meths[a]; o.r = rs[b]; o.qm.rn = 8; o.hyper.on = d; o.hyper.allow_negative = 1;
         CHECK_RC(g_errors(&t.sys, &f, &o, e1, &i1), PHGMG_OK);
         CHECK_RC(g_errors(&cb, &f, &o, e2, &i2), PHGMG_OK);
         CHECK(i2.online_callbacks == 1 && i1.online_callbacks == 0 && i2.online_full_dim == 0);
@@ -137,7 +137,7 @@ TEST(test_general_equals_separable) {
       phgmg_reduce_info i1, i2;
       double e1[2], e2[2];
       memset(&o, 0, sizeof o);
-      o.method = meths[a]; o.r = rs[b]; o.rn = 8;
+      o.method = meths[a]; o.r = rs[b]; o.qm.rn = 8;
       CHECK_RC(g_errors(&t.sys, &f, &o, e1, &i1), PHGMG_OK);
       CHECK_RC(g_errors(&gs, &f, &o, e2, &i2), PHGMG_OK);
       CHECK(i2.online_full_dim == 1 && i2.online_callbacks == 1);
@@ -149,10 +149,10 @@ TEST(test_general_equals_separable) {
     phgmg_reduced *red = NULL;
     static unsigned char buf[4096];
     memset(&o, 0, sizeof o);
-    o.method = PHGMG_METHOD_GMG_POD; o.r = 8; o.hyper_reduce = 1;
+    o.method = PHGMG_METHOD_GMG_POD; o.r = 8; o.hyper.on = 1;
     CHECK_RC(phgmg_reduce(&red, &gs, f.X, gs.N, GNS, &o, NULL, NULL), PHGMG_ERR_UNSUPPORTED);
     CHECK(red == NULL);
-    o.hyper_reduce = 0;
+    o.hyper.on = 0;
     CHECK_RC(phgmg_reduce(&red, &gs, f.X, gs.N, GNS, &o, NULL, NULL), PHGMG_OK);
     if (red) {
       size_t need = 0;
@@ -198,12 +198,12 @@ TEST(test_eta_reproduces_qm_and_cubic_structure) {
   g_model(&t);
   CHECK(g_fom(&t.sys, &f));
   memset(&o, 0, sizeof o);
-  o.method = PHGMG_METHOD_GMG_QM; o.r = r; o.rn = 6;
+  o.method = PHGMG_METHOD_GMG_QM; o.r = r; o.qm.rn = 6;
   CHECK_RC(g_errors(&t.sys, &f, &o, e1, NULL), PHGMG_OK);
   CHECK_RC(phgmg_reduce(&qm, &t.sys, f.X, t.sys.N, GNS, &o, NULL, NULL), PHGMG_OK);
   if (!qm) return;
   ec.Ms = phgmg_reduced_rom(qm)->Ms; ec.p = r - 1; ec.rn = 6; ec.cub = 0.0;
-  o.method = PHGMG_METHOD_GMG_MANIFOLD; o.eta = eta_fn; o.eta_user = &ec;
+  o.method = PHGMG_METHOD_GMG_MANIFOLD; o.qm.eta = eta_fn; o.qm.eta_user = &ec;
   CHECK_RC(g_errors(&t.sys, &f, &o, e2, NULL), PHGMG_OK);
   CHECK_LE(g_rel(e1[0], e2[0]), 1e-10);
   CHECK_LE(g_rel(e1[1], e2[1]), 1e-10);
@@ -292,7 +292,7 @@ TEST(test_toda_builtin_equals_callbacks) {
       phgmg_reduce_opts o;
       phgmg_reduced *r1 = NULL, *r2 = NULL;
       memset(&o, 0, sizeof o);
-      o.method = meths[a]; o.r = 12; o.rn = 6; o.hyper_reduce = d; o.deim_allow_negative = 1;
+      o.method = meths[a]; o.r = 12; o.qm.rn = 6; o.hyper.on = d; o.hyper.allow_negative = 1;
       CHECK_RC(phgmg_reduce(&r1, &t.sys, f.X, t.sys.N, GNS, &o, NULL, NULL), PHGMG_OK);
       CHECK_RC(phgmg_reduce(&r2, &cb, f.X, cb.N, GNS, &o, NULL, NULL), PHGMG_OK);
       if (r1 && r2) {
@@ -344,7 +344,7 @@ TEST(test_default_hyper_nonnegative) {
         phgmg_reduced *red = NULL;
         double xr0[20];
         memset(&o, 0, sizeof o);
-        o.method = meths[a]; o.r = 12; o.hyper_reduce = d;
+        o.method = meths[a]; o.r = 12; o.hyper.on = d;
         CHECK_RC(phgmg_reduce(&red, &t.sys, X, t.sys.N, GNS, &o, &info, NULL), PHGMG_OK);
         if (!red) continue;
         if (d) {

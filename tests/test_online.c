@@ -232,7 +232,7 @@ static double rlc_rom(const phgmg_ph_system *s, const phgmg_run *run, phgmg_meth
   phgmg_reduced *red = NULL;
   phgmg_result rc;
   memset(&o, 0, sizeof o);
-  o.method = meth; o.r = 10; o.rn = 6; o.lambda_auto = lambda_auto; o.nrun = 1; o.runs = run;
+  o.method = meth; o.r = 10; o.qm.rn = 6; o.select.lambda_mode = lambda_auto; o.nrun = 1; o.runs = run;
   *rrc = phgmg_reduce(&red, s, rlc_X, RLC_N, RLC_NS, &o, &info, NULL);
   if (*rrc != PHGMG_OK) return NAN;
   if (lambda) *lambda = info.lambda;
@@ -320,8 +320,8 @@ static double toda_rom(double sc, phgmg_method meth, double *Yf, double *Yr, dou
   memset(&run, 0, sizeof run);
   run.u = toda_u; run.dt = 0.1; run.nsteps = NS - 1;
   memset(&o, 0, sizeof o);
-  o.method = meth; o.r = 10; o.rn = 6; o.hyper_reduce = 1; o.deim_allow_negative = 1;
-  o.lambda_auto = meth == PHGMG_METHOD_GMG_QM; o.nrun = 1; o.runs = &run;
+  o.method = meth; o.r = 10; o.qm.rn = 6; o.hyper.on = 1; o.hyper.allow_negative = 1;
+  o.select.lambda_mode = meth == PHGMG_METHOD_GMG_QM; o.nrun = 1; o.runs = &run;
   if (X && phgmg_simulate_inputs(&M.sys, 1, &run, NULL, X, M.sys.N, Yf, NULL, NULL) == PHGMG_OK &&
       phgmg_reduce(&red, &M.sys, X, M.sys.N, NS, &o, &info, NULL) == PHGMG_OK &&
       phgmg_reduced_simulate(red, xr0, 0.0, 0.1, NS - 1, toda_u, NULL, 0.0, 20, NULL, Yr, NULL, NULL, NULL) == PHGMG_OK) {

@@ -73,16 +73,16 @@ static int opt_nl_build(msd_nonlinear *M) {
 
 static void set_pod(phgmg_reduce_opts *o, const phgmg_run *r) { (void)r; o->method = PHGMG_METHOD_GMG_POD; o->r = 8; o->dt = 0.1; }
 static void set_qm(phgmg_reduce_opts *o, const phgmg_run *r) { (void)r; o->method = PHGMG_METHOD_GMG_QM; o->r = 8; }
-static void set_qm_cv(phgmg_reduce_opts *o, const phgmg_run *r) { set_qm(o, r); o->lambda_auto = 2; }
+static void set_qm_cv(phgmg_reduce_opts *o, const phgmg_run *r) { set_qm(o, r); o->select.lambda_mode = PHGMG_LAMBDA_REGRESSION; }
 static void set_qm_auto(phgmg_reduce_opts *o, const phgmg_run *r) {
-  set_qm(o, r); o->lambda_auto = 1; o->nrun = 1; o->runs = r;
+  set_qm(o, r); o->select.lambda_mode = PHGMG_LAMBDA_VALIDATED; o->nrun = 1; o->runs = r;
 }
 static void set_sp1(phgmg_reduce_opts *o, const phgmg_run *r) { (void)r; o->method = PHGMG_METHOD_SP1; o->r = 8; }
-static void set_pod_ecsw(phgmg_reduce_opts *o, const phgmg_run *r) { (void)r; o->method = PHGMG_METHOD_GMG_POD; o->r = 8; o->hyper_reduce = 1; }
+static void set_pod_ecsw(phgmg_reduce_opts *o, const phgmg_run *r) { (void)r; o->method = PHGMG_METHOD_GMG_POD; o->r = 8; o->hyper.on = 1; }
 static void set_sp2_qdeim(phgmg_reduce_opts *o, const phgmg_run *r) {
-  (void)r; o->method = PHGMG_METHOD_SP2; o->r = 8; o->hyper_reduce = 1; o->hyper = PHGMG_HYPER_QDEIM; o->deim_allow_negative = 1;
+  (void)r; o->method = PHGMG_METHOD_SP2; o->r = 8; o->hyper.on = 1; o->hyper.kind = PHGMG_HYPER_QDEIM; o->hyper.allow_negative = 1;
 }
-static void set_qm_other(phgmg_reduce_opts *o, const phgmg_run *r) { set_qm(o, r); o->lambda = 1e-9; }
+static void set_qm_other(phgmg_reduce_opts *o, const phgmg_run *r) { set_qm(o, r); o->qm.lambda = 1e-9; }
 
 TEST(test_reduce_opts_default_same_model) {
   msd_linear L;
@@ -120,20 +120,19 @@ TEST(test_reduce_opts_default_same_model) {
   z = d;
   phgmg_reduce_opts_default(&z);
   CHECK(!memcmp(&d, &z, sizeof d));
-  CHECK(d.method == 0 && d.r == 0 && d.lambda_blocks == 0 && d.newton_tol == 0.0 && !d.runs && !d.eta);
+  CHECK(d.method == 0 && d.r == 0 && d.select.blocks == 0 && d.select.newton_tol == 0.0 && !d.runs && !d.qm.eta);
   phgmg_reduce_opts_default(NULL);
   free(X); free(XN);
   msd_linear_free(&L);
   msd_nonlinear_free(&M);
 }
 
-/* hyper_reduce and its former name deim select the same hyper-reduction;
-   neither on keeps every term (another model: the negative control); values
-   outside the enums (hyper_reduce 2, PHGMG_HYPER_COUNT, PHGMG_MANIFOLD_COUNT)
-   are refused. */
-static void set_pod_former(phgmg_reduce_opts *o, const phgmg_run *r) { set_pod_ecsw(o, r); o->hyper_reduce = 0; o->deim = 1; }
-static void set_pod_both(phgmg_reduce_opts *o, const phgmg_run *r) { set_pod_ecsw(o, r); o->deim = 1; }
-TEST(test_reduce_opts_hyper_reduce_former_name) {
+/* hyper.on = 1 hyper-reduces; hyper.on = 0 keeps every term (another, larger
+   model: the negative control); a struct with every other field left zero
+   and one from phgmg_reduce_opts_default give the same model; values outside
+   the enums and flags (hyper.on 2, PHGMG_HYPER_COUNT, PHGMG_MANIFOLD_COUNT,
+   PHGMG_LAMBDA_MODE_COUNT, PHGMG_REF_COUNT) are refused. */
+TEST(test_reduce_opts_hyper_on_and_enums) {
   msd_nonlinear M;
   phgmg_run run;
   phgmg_reduce_opts a, b;
@@ -147,20 +146,23 @@ TEST(test_reduce_opts_hyper_reduce_former_name) {
   CHECK(X != NULL);
   if (X) {
     memset(&a, 0, sizeof a); set_pod_ecsw(&a, &run);
-    memset(&b, 0, sizeof b); set_pod_former(&b, &run);
+    phgmg_reduce_opts_default(&b); set_pod_ecsw(&b, &run);
     ma = opt_model(&M.sys, X, &a, &la, &ka);
     mb = opt_model(&M.sys, X, &b, &lb, &kb);
     CHECK(ma && mb && la == lb && !memcmp(ma, mb, la));
-    CHECK(opt_same(&M.sys, X, set_pod_both, &run));
-    b.deim = 0;   /* neither: every term kept, a larger model */
+    b.hyper.on = 0;   /* every term kept, a larger model */
     mc = opt_model(&M.sys, X, &b, &lc, &kc);
     CHECK(mc && lc != la);
     free(ma); free(mb); free(mc);
-    a.hyper_reduce = 2;
+    a.hyper.on = 2;
     CHECK_RC(phgmg_reduce(&red, &M.sys, X, M.sys.N, OPT_STEPS + 1, &a, NULL, NULL), PHGMG_ERR_INVALID_ARG);
-    a.hyper_reduce = 1; a.hyper = PHGMG_HYPER_COUNT;
+    a.hyper.on = 1; a.hyper.kind = PHGMG_HYPER_COUNT;
     CHECK_RC(phgmg_reduce(&red, &M.sys, X, M.sys.N, OPT_STEPS + 1, &a, NULL, NULL), PHGMG_ERR_INVALID_ARG);
-    a.hyper = PHGMG_HYPER_ECSW; a.method = PHGMG_METHOD_GMG_QM; a.manifold = PHGMG_MANIFOLD_COUNT;
+    a.hyper.kind = PHGMG_HYPER_ECSW; a.method = PHGMG_METHOD_GMG_QM; a.qm.manifold = PHGMG_MANIFOLD_COUNT;
+    CHECK_RC(phgmg_reduce(&red, &M.sys, X, M.sys.N, OPT_STEPS + 1, &a, NULL, NULL), PHGMG_ERR_INVALID_ARG);
+    a.qm.manifold = PHGMG_MANIFOLD_POD; a.select.lambda_mode = PHGMG_LAMBDA_MODE_COUNT;
+    CHECK_RC(phgmg_reduce(&red, &M.sys, X, M.sys.N, OPT_STEPS + 1, &a, NULL, NULL), PHGMG_ERR_INVALID_ARG);
+    a.select.lambda_mode = PHGMG_LAMBDA_FIXED; a.ref = PHGMG_REF_COUNT;
     CHECK_RC(phgmg_reduce(&red, &M.sys, X, M.sys.N, OPT_STEPS + 1, &a, NULL, NULL), PHGMG_ERR_INVALID_ARG);
     CHECK(red == NULL);
   }
@@ -170,5 +172,5 @@ TEST(test_reduce_opts_hyper_reduce_former_name) {
 
 SUITE(options) {
   RUN(test_reduce_opts_default_same_model);
-  RUN(test_reduce_opts_hyper_reduce_former_name);
+  RUN(test_reduce_opts_hyper_on_and_enums);
 }

@@ -71,8 +71,8 @@ TEST(test_qm_ref_exact_affine_manifold) {
       phgmg_reduced *red = NULL;
       double e;
       memset(&o, 0, sizeof o);
-      o.method = PHGMG_METHOD_GMG_QM; o.r = 1 + QR_P; o.manifold = mf; o.lambda = 1e-12;
-      o.rn = PHGMG_RN_WIDE;
+      o.method = PHGMG_METHOD_GMG_QM; o.r = 1 + QR_P; o.qm.manifold = mf; o.qm.lambda = 1e-12;
+      o.qm.rn = PHGMG_RN_WIDE;
       if (withref) { o.ref = PHGMG_REF_GIVEN; o.ref_x = d.c; }
       CHECK_RC(phgmg_reduce(&red, &d.sys, d.X, QR_N, QR_NS, &o, NULL, NULL), PHGMG_OK);
       if (!red) continue;
@@ -115,7 +115,7 @@ static phgmg_reduced *qc_reduce(const qc_model *q, int method, int r, double dt)
   phgmg_reduce_opts o;
   phgmg_reduced *red = NULL;
   memset(&o, 0, sizeof o);
-  o.method = method; o.r = r; o.rn = 4; o.lambda = 1e-3; o.ref = PHGMG_REF_MEAN; o.dt = dt;
+  o.method = method; o.r = r; o.qm.rn = 4; o.qm.lambda = 1e-3; o.ref = PHGMG_REF_MEAN; o.dt = dt;
   CHECK_RC(phgmg_reduce(&red, &q->t.sys, q->X, QC_N, QC_NS, &o, NULL, NULL), PHGMG_OK);
   return red;
 }
@@ -327,7 +327,7 @@ TEST(test_qm_ref_bad_input) {
   double xb[QC_N] = {0};
   qc_build(&q, 0);
   memset(&o, 0, sizeof o);
-  o.method = PHGMG_METHOD_GMG_QM; o.r = 5; o.rn = 3;
+  o.method = PHGMG_METHOD_GMG_QM; o.r = 5; o.qm.rn = 3;
   o.ref = 3;
   CHECK_RC(phgmg_reduce(&red, &q.t.sys, q.X, QC_N, QC_NS, &o, NULL, NULL), PHGMG_ERR_INVALID_ARG);
   o.ref = PHGMG_REF_GIVEN;

@@ -57,8 +57,8 @@ static phgmg_reduced *qw_reduce(const qw_data *d, int manifold, int rn, int wind
   phgmg_reduced *red = NULL;
   phgmg_result rc;
   memset(&o, 0, sizeof o);
-  o.method = PHGMG_METHOD_GMG_QM; o.r = 1 + QW_P; o.rn = rn; o.manifold = manifold; o.lambda = 1e-12;
-  o.greedy_window = window;
+  o.method = PHGMG_METHOD_GMG_QM; o.r = 1 + QW_P; o.qm.rn = rn; o.qm.manifold = manifold; o.qm.lambda = 1e-12;
+  o.qm.greedy_window = window;
   rc = phgmg_reduce(&red, &d->sys, d->X, QW_N, QW_NS, &o, NULL, NULL);
   CHECK_RC(rc, PHGMG_OK);
   return rc == PHGMG_OK ? red : NULL;
@@ -200,8 +200,8 @@ TEST(test_qm_greedy_window_matches_direct) {
   memset(&sys, 0, sizeof sys);
   sys.N = GB_N; sys.m = 1; sys.storage = PHGMG_BANDED; sys.kb = 0; sys.J = J; sys.R = Rm; sys.Q = Qm; sys.B = B;
   memset(&o, 0, sizeof o);
-  o.method = PHGMG_METHOD_GMG_QM; o.r = 1 + GB_P; o.manifold = PHGMG_MANIFOLD_GREEDY; o.lambda = lam;
-  o.greedy_window = GB_W; o.degeneracy_tol = 1e-300;
+  o.method = PHGMG_METHOD_GMG_QM; o.r = 1 + GB_P; o.qm.manifold = PHGMG_MANIFOLD_GREEDY; o.qm.lambda = lam;
+  o.qm.greedy_window = GB_W; o.degeneracy_tol = 1e-300;
   CHECK_RC(phgmg_reduce(&red, &sys, X, GB_N, GB_NS, &o, NULL, NULL), PHGMG_OK);
   if (!red) return;
   for (j = 0; j < GB_P; ++j) {   /* V1's column j is +-U(:, sel_j) */
@@ -242,9 +242,9 @@ TEST(test_qm_altmin_greedy_start) {
     phgmg_reduce_info inf;
     phgmg_reduced *red = NULL;
     memset(&o, 0, sizeof o);
-    o.method = PHGMG_METHOD_GMG_QM; o.r = 10; o.rn = PHGMG_RN_WIDE; o.lambda = 1e-9; o.degeneracy_tol = 1e-300;
-    o.manifold = k == 0 ? PHGMG_MANIFOLD_POD : k == 2 ? PHGMG_MANIFOLD_GREEDY : PHGMG_MANIFOLD_ALTMIN;
-    o.greedy_window = k >= 2 ? 40 : 0;
+    o.method = PHGMG_METHOD_GMG_QM; o.r = 10; o.qm.rn = PHGMG_RN_WIDE; o.qm.lambda = 1e-9; o.degeneracy_tol = 1e-300;
+    o.qm.manifold = k == 0 ? PHGMG_MANIFOLD_POD : k == 2 ? PHGMG_MANIFOLD_GREEDY : PHGMG_MANIFOLD_ALTMIN;
+    o.qm.greedy_window = k >= 2 ? 40 : 0;
     CHECK_RC(phgmg_reduce(&red, &sys, X, QP_N, QP_NS, &o, &inf, NULL), PHGMG_OK);
     e[k] = red ? phgmg_err_proj(red, X, QP_N, QP_NS) : 1.0;
     if (k == 1 || k == 3) CHECK(inf.manifold_obj <= inf.manifold_obj0);
@@ -301,7 +301,7 @@ TEST(test_qm_wide_bad_rn) {
   phgmg_reduced *red = NULL;
   qw_build(&d);
   memset(&o, 0, sizeof o);
-  o.method = PHGMG_METHOD_GMG_QM; o.r = 1 + QW_P; o.rn = -2;
+  o.method = PHGMG_METHOD_GMG_QM; o.r = 1 + QW_P; o.qm.rn = -2;
   CHECK_RC(phgmg_reduce(&red, &d.sys, d.X, QW_N, QW_NS, &o, NULL, NULL), PHGMG_ERR_INVALID_ARG);
   CHECK(red == NULL);
 }

@@ -95,7 +95,7 @@ static void check_structure(const phgmg_ph_system *sys, const double *X, int ns,
   double xr[32], fr[32], fref[32], Jr[1024], Rr[1024], Jref[1024], ev[32], work[8192], u = 0.07;
   int s, i, j;
   memset(&o, 0, sizeof o);
-  o.method = meth; o.r = r; o.rn = 8; o.lambda = 1e-3;
+  o.method = meth; o.r = r; o.qm.rn = 8; o.qm.lambda = 1e-3;
   CHECK_RC(phgmg_reduce(&red, sys, X, N, ns, &o, &info, NULL), PHGMG_OK);
   if (!red) goto done;
   rom = phgmg_reduced_rom(red);
@@ -173,7 +173,7 @@ static void check_derivatives(const phgmg_ph_system *sys, const double *X, int n
   double xr[32], xp[32], f1[32], f2[32], Jf[1024], Hs[1024], work[8192];
   int s, a, b;
   memset(&o, 0, sizeof o);
-  o.method = meth; o.r = r; o.rn = 8; o.lambda = 1e-3; o.hyper_reduce = deim; o.deim_allow_negative = 1;
+  o.method = meth; o.r = r; o.qm.rn = 8; o.qm.lambda = 1e-3; o.hyper.on = deim; o.hyper.allow_negative = 1;
   CHECK_RC(phgmg_reduce(&red, sys, X, N, ns, &o, NULL, NULL), PHGMG_OK);
   if (!red) return;
   rom = phgmg_reduced_rom(red);
@@ -297,8 +297,8 @@ TEST(test_qm_stepper_matches_reference_gl3) {
     phgmg_rom_stepper st;
     int n, a;
     memset(&o, 0, sizeof o);
-    o.method = PHGMG_METHOD_GMG_QM; o.r = pass ? 16 : 8; o.rn = 8; o.lambda = 1e-6; o.hyper_reduce = pass;
-    o.deim_allow_negative = 1;
+    o.method = PHGMG_METHOD_GMG_QM; o.r = pass ? 16 : 8; o.qm.rn = 8; o.qm.lambda = 1e-6; o.hyper.on = pass;
+    o.hyper.allow_negative = 1;
     CHECK_RC(phgmg_reduce(&red, &t.sys, X, t.sys.N, 301, &o, NULL, NULL), PHGMG_OK);
     if (!red) continue;
     rom = phgmg_reduced_rom(red);
@@ -411,7 +411,7 @@ TEST(test_online_never_allocates) {
     long calls;
     int n, i;
     memset(&o, 0, sizeof o);
-    o.method = meths[k]; o.r = 12; o.hyper_reduce = 1; o.deim_allow_negative = 1; o.lambda = 1e-3;
+    o.method = meths[k]; o.r = 12; o.hyper.on = 1; o.hyper.allow_negative = 1; o.qm.lambda = 1e-3;
     CHECK_RC(phgmg_reduce(&red, &t.sys, X, t.sys.N, 301, &o, NULL, NULL), PHGMG_OK);
     if (!red) continue;
     CHECK(phgmg_rom_stepper_memsize(phgmg_reduced_rom(red)) <= sizeof mem);
@@ -545,7 +545,7 @@ TEST(test_lambda_auto_exact_manifold) {
     double xf[64], xl[64];
     int g, on_grid = 0;
     memset(&o, 0, sizeof o);
-    o.method = PHGMG_METHOD_GMG_QM; o.r = r; o.rn = RN; o.lambda_auto = pass == 0 ? 2 : 0;
+    o.method = PHGMG_METHOD_GMG_QM; o.r = r; o.qm.rn = RN; o.select.lambda_mode = pass == 0 ? 2 : 0;
     CHECK_RC(phgmg_reduce(&red, &t.sys, X, N, NSN, &o, &info, NULL), PHGMG_OK);
     if (!red) break;
     if (pass == 0) {
@@ -597,7 +597,7 @@ TEST(test_qm_v2_is_hierarchical_pod) {
   CHECK(X != NULL);
   if (!X) { tmodel_free(&t); return; }
   memset(&o, 0, sizeof o);
-  o.method = PHGMG_METHOD_GMG_QM; o.r = r; o.rn = rn;
+  o.method = PHGMG_METHOD_GMG_QM; o.r = r; o.qm.rn = rn;
   CHECK_RC(phgmg_reduce(&red, &t.sys, X, N, ns, &o, NULL, NULL), PHGMG_OK);
   Xa = (double *)malloc(sizeof(double) * (size_t)N * ns);
   U = (double *)malloc(sizeof(double) * (size_t)N * (rn + 1));
@@ -646,16 +646,16 @@ TEST(test_lambda_auto_linear_msd) {
   CHECK(X != NULL);
   if (!X) { tmodel_free(&t); return; }
   memset(&o, 0, sizeof o);
-  o.method = PHGMG_METHOD_GMG_QM; o.r = r; o.rn = 8; o.lambda_auto = 2; o.lambda_rcond = 1e-300; /* no guard */
+  o.method = PHGMG_METHOD_GMG_QM; o.r = r; o.qm.rn = 8; o.select.lambda_mode = PHGMG_LAMBDA_REGRESSION; o.select.rcond = 1e-300; /* no guard */
   CHECK_RC(phgmg_reduce(&red, &t.sys, X, t.sys.N, ns, &o, &info, NULL), PHGMG_OK);
   if (red) { ep_auto = phgmg_err_proj(red, X, t.sys.N, ns); phgmg_reduced_destroy(red); red = NULL; }
   CHECK(info.lambda_raised == 0);
   CHECK(info.lambda >= 1e-14 * (1 - 1e-12) && info.lambda <= 1.0);
   CHECK_LE(fabs(4.0 * log10(info.lambda / 1e-14) - floor(4.0 * log10(info.lambda / 1e-14) + 0.5)), 1e-9);
-  o.lambda_min = o.lambda_max = 1e-14;
+  o.select.lambda_min = o.select.lambda_max = 1e-14;
   CHECK_RC(phgmg_reduce(&red, &t.sys, X, t.sys.N, ns, &o, &ilo, NULL), PHGMG_OK);
   phgmg_reduced_destroy(red); red = NULL;
-  o.lambda_min = o.lambda_max = 1.0;
+  o.select.lambda_min = o.select.lambda_max = 1.0;
   CHECK_RC(phgmg_reduce(&red, &t.sys, X, t.sys.N, ns, &o, &ihi, NULL), PHGMG_OK);
   phgmg_reduced_destroy(red); red = NULL;
   CHECK(ilo.lambda_grid == 1 && ihi.lambda_grid == 1 && ilo.lambda == 1e-14 && ihi.lambda == 1.0);
@@ -667,7 +667,7 @@ TEST(test_lambda_auto_linear_msd) {
      grows with lambda, so a smaller lambda projects the snapshots better */
   CHECK(info.lambda < 1e-3);
   memset(&o, 0, sizeof o);
-  o.method = PHGMG_METHOD_GMG_QM; o.r = r; o.rn = 8;
+  o.method = PHGMG_METHOD_GMG_QM; o.r = r; o.qm.rn = 8;
   CHECK_RC(phgmg_reduce(&red, &t.sys, X, t.sys.N, ns, &o, NULL, NULL), PHGMG_OK);
   if (red) { ep_paper = phgmg_err_proj(red, X, t.sys.N, ns); phgmg_reduced_destroy(red); red = NULL; }
   CHECK_LE(ep_auto, ep_paper);
@@ -677,7 +677,7 @@ TEST(test_lambda_auto_linear_msd) {
   o.method = PHGMG_METHOD_GMG_POD; o.r = r;
   CHECK_RC(phgmg_reduce(&red, &t.sys, X, t.sys.N, ns, &o, &ipod, NULL), PHGMG_OK);
   phgmg_reduced_destroy(red); red = NULL;
-  o.method = PHGMG_METHOD_GMG_QM; o.rn = 8; o.lambda_auto = 2; o.lambda_rcond = 0.5;
+  o.method = PHGMG_METHOD_GMG_QM; o.qm.rn = 8; o.select.lambda_mode = PHGMG_LAMBDA_REGRESSION; o.select.rcond = 0.5;
   CHECK_RC(phgmg_reduce(&red, &t.sys, X, t.sys.N, ns, &o, &ig, NULL), PHGMG_OK);
   phgmg_reduced_destroy(red); red = NULL;
   CHECK(ig.lambda_raised > 0);
@@ -715,36 +715,36 @@ TEST(test_lambda_auto_options_and_oom) {
   CHECK(X != NULL);
   if (!X) { tmodel_free(&t); return; }
   memset(&b, 0, sizeof b);
-  b.method = PHGMG_METHOD_GMG_QM; b.r = 5; b.rn = 3; b.lambda_auto = 2;
+  b.method = PHGMG_METHOD_GMG_QM; b.r = 5; b.qm.rn = 3; b.select.lambda_mode = PHGMG_LAMBDA_REGRESSION;
 #define BAD(field, val, code) do { o = b; o.field = (val); \
     CHECK_RC(phgmg_reduce(&red, &t.sys, X, t.sys.N, ns, &o, NULL, NULL), code); CHECK(red == NULL); } while (0)
-  BAD(lambda_auto, 3, PHGMG_ERR_INVALID_ARG);
-  BAD(lambda_auto, -1, PHGMG_ERR_INVALID_ARG);
-  BAD(lambda_min, -1e-6, PHGMG_ERR_INVALID_ARG);
-  BAD(lambda_min, (double)NAN, PHGMG_ERR_INVALID_ARG);
-  BAD(lambda_min, 2.0, PHGMG_ERR_INVALID_ARG);          /* above lambda_max = 1 */
-  BAD(lambda_max, (double)INFINITY, PHGMG_ERR_INVALID_ARG);
-  BAD(lambda_max, -1.0, PHGMG_ERR_INVALID_ARG);
-  BAD(lambda_per_decade, -1, PHGMG_ERR_INVALID_ARG);
-  BAD(lambda_per_decade, 101, PHGMG_ERR_INVALID_ARG);
-  BAD(lambda_folds, 1, PHGMG_ERR_INVALID_ARG);
-  BAD(lambda_folds, -2, PHGMG_ERR_INVALID_ARG);
-  BAD(lambda_blocks, -1, PHGMG_ERR_INVALID_ARG);
-  BAD(lambda_rcond, -0.5, PHGMG_ERR_INVALID_ARG);
-  BAD(lambda_rcond, 1.5, PHGMG_ERR_INVALID_ARG);
-  BAD(lambda_rcond, (double)NAN, PHGMG_ERR_INVALID_ARG);
-  o = b; o.lambda_min = 1e-300; o.lambda_per_decade = 100;  /* 30000 points */
+  BAD(select.lambda_mode, 3, PHGMG_ERR_INVALID_ARG);
+  BAD(select.lambda_mode, -1, PHGMG_ERR_INVALID_ARG);
+  BAD(select.lambda_min, -1e-6, PHGMG_ERR_INVALID_ARG);
+  BAD(select.lambda_min, (double)NAN, PHGMG_ERR_INVALID_ARG);
+  BAD(select.lambda_min, 2.0, PHGMG_ERR_INVALID_ARG);          /* above lambda_max = 1 */
+  BAD(select.lambda_max, (double)INFINITY, PHGMG_ERR_INVALID_ARG);
+  BAD(select.lambda_max, -1.0, PHGMG_ERR_INVALID_ARG);
+  BAD(select.per_decade, -1, PHGMG_ERR_INVALID_ARG);
+  BAD(select.per_decade, 101, PHGMG_ERR_INVALID_ARG);
+  BAD(select.folds, 1, PHGMG_ERR_INVALID_ARG);
+  BAD(select.folds, -2, PHGMG_ERR_INVALID_ARG);
+  BAD(select.blocks, -1, PHGMG_ERR_INVALID_ARG);
+  BAD(select.rcond, -0.5, PHGMG_ERR_INVALID_ARG);
+  BAD(select.rcond, 1.5, PHGMG_ERR_INVALID_ARG);
+  BAD(select.rcond, (double)NAN, PHGMG_ERR_INVALID_ARG);
+  o = b; o.select.lambda_min = 1e-300; o.select.per_decade = 100;  /* 30000 points */
   CHECK_RC(phgmg_reduce(&red, &t.sys, X, t.sys.N, ns, &o, NULL, NULL), PHGMG_ERR_INVALID_ARG);
-  BAD(lambda_blocks, 4, PHGMG_ERR_SIZE);                   /* fewer blocks than the 5 folds */
-  BAD(lambda_blocks, ns + 1, PHGMG_ERR_SIZE);
-  BAD(lambda_folds, ns + 1, PHGMG_ERR_SIZE);
+  BAD(select.blocks, 4, PHGMG_ERR_SIZE);                   /* fewer blocks than the 5 folds */
+  BAD(select.blocks, ns + 1, PHGMG_ERR_SIZE);
+  BAD(select.folds, ns + 1, PHGMG_ERR_SIZE);
   /* the options are ignored when lambda_auto is off */
-  o = b; o.lambda_auto = 0; o.lambda_min = -1.0; o.lambda_folds = 1;
+  o = b; o.select.lambda_mode = PHGMG_LAMBDA_FIXED; o.select.lambda_min = -1.0; o.select.folds = 1;
   CHECK_RC(phgmg_reduce(&red, &t.sys, X, t.sys.N, ns, &o, NULL, NULL), PHGMG_OK);
   phgmg_reduced_destroy(red); red = NULL;
 #undef BAD
   /* allocation failures (with a guard that raises lambda, so the refit path runs) */
-  o = b; o.lambda_rcond = 0.5;
+  o = b; o.select.rcond = 0.5;
   memset(&c, 0, sizeof c);
   al.alloc = tc_alloc; al.free = tc_free; al.user = &c;
   CHECK_RC(phgmg_reduce(&red, &t.sys, X, t.sys.N, ns, &o, &info, &al), PHGMG_OK);

@@ -76,11 +76,11 @@ static int sys_same(const phgmg_ph_system *a, const phgmg_ph_system *b) {
            RB_NE(a, b, shifted_solve) || RB_NE(a, b, shifted_user));
 }
 static int opts_same(const phgmg_reduce_opts *a, const phgmg_reduce_opts *b) {
-  return !(RB_NE(a, b, method) || RB_NE(a, b, r) || RB_NE(a, b, rn) || RB_NE(a, b, lambda) || RB_NE(a, b, deim) ||
-           RB_NE(a, b, deim_tol) || RB_NE(a, b, deim_max) || RB_NE(a, b, deim_allow_negative) || RB_NE(a, b, dt) ||
-           RB_NE(a, b, degeneracy_tol) || RB_NE(a, b, pod_basis) || RB_NE(a, b, pod_cols) ||
-           RB_NE(a, b, grad_basis) || RB_NE(a, b, grad_cols) || RB_NE(a, b, deim_pts) || RB_NE(a, b, deim_w) ||
-           RB_NE(a, b, deim_count));
+  return !(RB_NE(a, b, method) || RB_NE(a, b, r) || RB_NE(a, b, qm.rn) || RB_NE(a, b, qm.lambda) || RB_NE(a, b, hyper.on) ||
+           RB_NE(a, b, hyper.deim_tol) || RB_NE(a, b, hyper.deim_max) || RB_NE(a, b, hyper.allow_negative) || RB_NE(a, b, dt) ||
+           RB_NE(a, b, degeneracy_tol) || RB_NE(a, b, cache.pod_basis) || RB_NE(a, b, cache.pod_cols) ||
+           RB_NE(a, b, cache.grad_basis) || RB_NE(a, b, cache.grad_cols) || RB_NE(a, b, cache.deim_pts) || RB_NE(a, b, cache.deim_w) ||
+           RB_NE(a, b, cache.deim_count));
 }
 #undef RB_NE
 static void guard_opts(const phgmg_reduce_opts *o) { rb_optp = o; rb_opt = *o; }
@@ -223,7 +223,7 @@ static void hsys_free(hsys *h) { free(h->J); free(h->R); free(h->Q); free(h->B);
 static phgmg_reduce_opts ropts(phgmg_method meth, int r) {
   phgmg_reduce_opts o;
   memset(&o, 0, sizeof o);
-  o.method = meth; o.r = r; o.rn = 2;
+  o.method = meth; o.r = r; o.qm.rn = 2;
   return o;
 }
 
@@ -275,9 +275,9 @@ TEST(test_dims_reduce) {
   o.r = N + 1; EXPECT(reduce_g(&M.sys, X, N, ns, &o, NULL), PHGMG_ERR_SIZE);
   o = ropts(PHGMG_METHOD_GMG_QM, 1);
   EXPECT(reduce_g(&M.sys, X, N, ns, &o, NULL), PHGMG_ERR_SIZE);
-  o.r = 4; o.rn = N - 3;   /* r + rn > N */
+  o.r = 4; o.qm.rn = N - 3;   /* r + rn > N */
   EXPECT(reduce_g(&M.sys, X, N, ns, &o, NULL), PHGMG_ERR_SIZE);
-  o.rn = 65;               /* beyond the online buffers */
+  o.qm.rn = 65;               /* beyond the online buffers */
   EXPECT(reduce_g(&M.sys, X, N, ns, &o, NULL), PHGMG_ERR_SIZE);
   /* SP methods: 1 <= r <= min(N, ns) */
   o = ropts(PHGMG_METHOD_SP1, 0);
@@ -289,9 +289,9 @@ TEST(test_dims_reduce) {
   /* a cached POD basis with too few columns */
   {
     double *V = rand_mat(N, 3, 1.0);
-    o = ropts(PHGMG_METHOD_GMG_POD, 5); o.pod_basis = V; o.pod_cols = 3; /* needs r - m = 4 */
+    o = ropts(PHGMG_METHOD_GMG_POD, 5); o.cache.pod_basis = V; o.cache.pod_cols = 3; /* needs r - m = 4 */
     EXPECT(reduce_g(&M.sys, X, N, ns, &o, NULL), PHGMG_ERR_SIZE);
-    o = ropts(PHGMG_METHOD_SP1, 4); o.pod_basis = V; o.pod_cols = 3;
+    o = ropts(PHGMG_METHOD_SP1, 4); o.cache.pod_basis = V; o.cache.pod_cols = 3;
     EXPECT(reduce_g(&M.sys, X, N, ns, &o, NULL), PHGMG_ERR_SIZE);
     free(V);
   }
@@ -747,7 +747,7 @@ TEST(test_gmg_degenerate) {
   CHECK_LE(info.rcond_dgd, 1e-12);
   o.r = 5;
   EXPECT(reduce_g(&h.sys, X, N, ns, &o, &info), PHGMG_ERR_DEGENERATE);
-  o = ropts(PHGMG_METHOD_GMG_QM, 3); o.rn = 2;
+  o = ropts(PHGMG_METHOD_GMG_QM, 3); o.qm.rn = 2;
   EXPECT(reduce_g(&h.sys, X, N, ns, &o, &info), PHGMG_ERR_DEGENERATE);
   /* even r: a generic skew matrix is invertible */
   o = ropts(PHGMG_METHOD_GMG_POD, 4);
@@ -819,9 +819,9 @@ TEST(test_snapshot_rank) {
   EXPECT(reduce_g(&M.sys, X, N, ns, &o, NULL), PHGMG_OK);
   o.r = 5;                        EXPECT(reduce_g(&M.sys, X, N, ns, &o, NULL), PHGMG_ERR_SIZE);
   /* GMG-QM: V1 takes r - m = 2 of the 3 directions, V2 needs rn from the rest */
-  o = ropts(PHGMG_METHOD_GMG_QM, 3); o.rn = 1;
+  o = ropts(PHGMG_METHOD_GMG_QM, 3); o.qm.rn = 1;
   EXPECT(reduce_g(&M.sys, X, N, ns, &o, NULL), PHGMG_OK);
-  o.rn = 2;                       EXPECT(reduce_g(&M.sys, X, N, ns, &o, NULL), PHGMG_ERR_SIZE);
+  o.qm.rn = 2;                       EXPECT(reduce_g(&M.sys, X, N, ns, &o, NULL), PHGMG_ERR_SIZE);
   /* snapshots along B only: the adjusted snapshots vanish */
   memset(Z, 0, sizeof Z);
   for (j = 0; j < ns; ++j) Z[1 + j * N] = 1.0 + j;
@@ -869,17 +869,17 @@ TEST(test_deim_negative_weight) {
     for (i = n; i < N; ++i) X[i + j * N] = th_rand();
   }
   /* the default hyper-reduction (ECSW) keeps every weight >= 0 here */
-  o = ropts(PHGMG_METHOD_GMG_POD, 2); o.hyper_reduce = 1;
+  o = ropts(PHGMG_METHOD_GMG_POD, 2); o.hyper.on = 1;
   memset(&info, 0, sizeof info);
   CHECK_RC(phgmg_reduce(&red, &M.sys, X, N, ns, &o, &info, NULL), PHGMG_OK);
   CHECK(info.hyper_method == PHGMG_HYPER_ECSW && info.deim_negative == 0 && info.hyper_min_weight > 0.0);
   CHECK(info.hyper_residual <= 1e-6);
   phgmg_reduced_destroy(red); red = NULL;
   /* the paper's DEIM gives one negative weight */
-  o.hyper = PHGMG_HYPER_QDEIM;
+  o.hyper.kind = PHGMG_HYPER_QDEIM;
   EXPECT(reduce_g(&M.sys, X, N, ns, &o, &info), PHGMG_ERR_NEGATIVE_WEIGHT);
   CHECK(info.deim_negative == 1 && info.deim_modes == 1);
-  o.deim_allow_negative = 1;
+  o.hyper.allow_negative = 1;
   CHECK_RC(phgmg_reduce(&red, &M.sys, X, N, ns, &o, &info, NULL), PHGMG_OK);
   if (red) {
     const phgmg_rom *rom = phgmg_reduced_rom(red);
@@ -888,16 +888,16 @@ TEST(test_deim_negative_weight) {
   }
   phgmg_reduced_destroy(red);
   /* GMG-QM and SP2 see the same gradient snapshots */
-  o = ropts(PHGMG_METHOD_GMG_QM, 2); o.rn = 1; o.hyper_reduce = 1; o.hyper = PHGMG_HYPER_QDEIM;
+  o = ropts(PHGMG_METHOD_GMG_QM, 2); o.qm.rn = 1; o.hyper.on = 1; o.hyper.kind = PHGMG_HYPER_QDEIM;
   EXPECT(reduce_g(&M.sys, X, N, ns, &o, &info), PHGMG_ERR_NEGATIVE_WEIGHT);
-  o = ropts(PHGMG_METHOD_SP2, 3); o.hyper_reduce = 1; o.hyper = PHGMG_HYPER_QDEIM;
+  o = ropts(PHGMG_METHOD_SP2, 3); o.hyper.on = 1; o.hyper.kind = PHGMG_HYPER_QDEIM;
   EXPECT(reduce_g(&M.sys, X, N, ns, &o, &info), PHGMG_ERR_NEGATIVE_WEIGHT);
   /* a cached DEIM result (opts.deim_pts/deim_w) is checked the same way */
   {
     int cpts[2] = {0, 2};
     double cw[2] = {1.5, -0.2};
-    o = ropts(PHGMG_METHOD_GMG_POD, 2); o.hyper_reduce = 1;
-    o.deim_pts = cpts; o.deim_w = cw; o.deim_count = 2;
+    o = ropts(PHGMG_METHOD_GMG_POD, 2); o.hyper.on = 1;
+    o.cache.deim_pts = cpts; o.cache.deim_w = cw; o.cache.deim_count = 2;
     guard(cpts, sizeof cpts); guard(cw, sizeof cw);
     EXPECT(reduce_g(&M.sys, X, N, ns, &o, &info), PHGMG_ERR_NEGATIVE_WEIGHT);
     CHECK(info.deim_negative == 1 && info.deim_modes == 2);
@@ -905,9 +905,9 @@ TEST(test_deim_negative_weight) {
     EXPECT(reduce_g(&M.sys, X, N, ns, &o, &info), PHGMG_ERR_NANINF);
     cw[1] = 0.2; cpts[1] = 3;   /* only 3 terms */
     EXPECT(reduce_g(&M.sys, X, N, ns, &o, &info), PHGMG_ERR_INVALID_ARG);
-    cpts[1] = 2; o.deim_count = 4;
+    cpts[1] = 2; o.cache.deim_count = 4;
     EXPECT(reduce_g(&M.sys, X, N, ns, &o, &info), PHGMG_ERR_SIZE);
-    o.deim_count = 2;
+    o.cache.deim_count = 2;
     EXPECT(reduce_g(&M.sys, X, N, ns, &o, &info), PHGMG_OK);
   }
   /* without DEIM every term is kept with its own weight: no failure */
@@ -1250,7 +1250,7 @@ TEST(test_rom_images) {
                                              {PHGMG_METHOD_GMG_POD, PHGMG_METHOD_GMG_QM, PHGMG_METHOD_SP2}};
       phgmg_reduce_opts o = ropts(meth[pass][k], 3);
       phgmg_reduced *red = NULL;
-      o.dt = 0.1; o.hyper_reduce = pass && k < 2; o.deim_allow_negative = 1;
+      o.dt = 0.1; o.hyper.on = pass && k < 2; o.hyper.allow_negative = 1;
       CHECK_RC(phgmg_reduce(&red, s, X, N, ns, &o, NULL, NULL), PHGMG_OK);
       if (red) check_image(phgmg_reduced_rom(red), names[pass][k], dir);
       if (red && pass == 0 && k == 0) CHECK(phgmg_reduced_rom(red)->Phi != NULL);
@@ -1465,13 +1465,13 @@ TEST(test_oom_reduce) {
     memset(&c, 0, sizeof c);
     c.sys = k < 3 ? &L.sys : &M.sys; c.X = k < 3 ? XL : XM; c.N = c.sys->N; c.ns = ns;
     c.o = ropts(meth[k], 4);
-    c.o.dt = 0.1; c.o.hyper_reduce = k >= 3 && k < 6; c.o.deim_allow_negative = 1;
+    c.o.dt = 0.1; c.o.hyper.on = k >= 3 && k < 6; c.o.hyper.allow_negative = 1;
     CHECK(oom_sweep(name[k], op_reduce, undo_reduce, &c) > 5);
   }
   /* the reduced model's own evaluations that allocate */
   memset(&c, 0, sizeof c);
   c.sys = &M.sys; c.X = XM; c.N = 12; c.ns = ns;
-  c.o = ropts(PHGMG_METHOD_GMG_QM, 4); c.o.hyper_reduce = 1; c.o.deim_allow_negative = 1;
+  c.o = ropts(PHGMG_METHOD_GMG_QM, 4); c.o.hyper.on = 1; c.o.hyper.allow_negative = 1;
   CHECK_RC(phgmg_reduce(&c.red, &M.sys, XM, 12, ns, &c.o, NULL, &g_fa_alloc), PHGMG_OK);
   if (c.red) {
     c.out = (double *)malloc(sizeof(double) * 12 * 4);

@@ -215,7 +215,7 @@ TEST(test_reduce_pod_randomized_and_fallback) {
     memset(&o, 0, sizeof o);
     o.method = PHGMG_METHOD_GMG_POD;
     o.r = r;
-    o.hyper_reduce = 0;
+    o.hyper.on = 0;
     memset(&info, 0, sizeof info);
     CHECK_RC(phgmg_reduce(&red, &M.sys, X, N, ns, &o, &info, NULL), PHGMG_OK);
     if (!red) break;
@@ -268,7 +268,7 @@ TEST(test_reduce_ecsw_skips_resting_terms) {
   memset(&o, 0, sizeof o);
   o.method = PHGMG_METHOD_GMG_POD;
   o.r = r;
-  o.hyper_reduce = 1;   /* ECSW, the default hyper-reduction */
+  o.hyper.on = 1;   /* ECSW, the default hyper-reduction */
   memset(&info, 0, sizeof info);
   if (X) CHECK_RC(phgmg_reduce(&red, &sys, X, N, ns, &o, &info, NULL), PHGMG_OK);
   if (red) {
@@ -318,8 +318,8 @@ TEST(test_reduce_ecsw_qm_skips_resting_terms) {
     memset(&o, 0, sizeof o);
     o.method = PHGMG_METHOD_GMG_QM;
     o.r = 8;
-    o.rn = 4;
-    o.hyper_reduce = 1;
+    o.qm.rn = 4;
+    o.hyper.on = 1;
     CHECK_RC(phgmg_reduce(&red[v], &sys[v], X, N, ns, &o, NULL, NULL), PHGMG_OK);
   }
   if (red[0] && red[1]) {

@@ -348,10 +348,10 @@ TEST(test_sparse_chain_reduce) {
     memset(&o, 0, sizeof o);
     o.method = meth[k];
     o.r = 8;
-    o.rn = 4;
-    o.lambda = 1e-6;
-    o.hyper_reduce = k == 1;
-    o.deim_allow_negative = 1;
+    o.qm.rn = 4;
+    o.qm.lambda = 1e-6;
+    o.hyper.on = k == 1;
+    o.hyper.allow_negative = 1;
     CHECK_RC(reduce_errors(&c.D.sys, Xd, Yd, ns, &o, &ed, &eyd), PHGMG_OK);
     CHECK_RC(reduce_errors(&c.sys, Xs, Yd, ns, &o, &es, &eys), PHGMG_OK);
     CHECK(ed > 0 && ed < 1 && eyd > 0 && eyd < 1);

@@ -73,10 +73,10 @@ static void ts_case(phgmg_study *st, const phgmg_ph_system *sys, const double *X
   phgmg_result rc;
   rc = phgmg_study_reduce(st, &o, &a, NULL);
   CHECK_RC(rc, PHGMG_OK);
-  if (o.method == PHGMG_METHOD_GMG_POD || o.method == PHGMG_METHOD_GMG_QM) ob.pod_basis = phgmg_study_basis(st, 'a', &cols);
-  else ob.pod_basis = phgmg_study_basis(st, 'p', &cols);
-  ob.pod_cols = cols;
-  if (o.method == PHGMG_METHOD_SP2) { ob.grad_basis = phgmg_study_basis(st, 'g', &cols); ob.grad_cols = cols; }
+  if (o.method == PHGMG_METHOD_GMG_POD || o.method == PHGMG_METHOD_GMG_QM) ob.cache.pod_basis = phgmg_study_basis(st, 'a', &cols);
+  else ob.cache.pod_basis = phgmg_study_basis(st, 'p', &cols);
+  ob.cache.pod_cols = cols;
+  if (o.method == PHGMG_METHOD_SP2) { ob.cache.grad_basis = phgmg_study_basis(st, 'g', &cols); ob.cache.grad_cols = cols; }
   rc = phgmg_reduce(&b, sys, X, N, ns, &ob, NULL, NULL);
   CHECK_RC(rc, PHGMG_OK);
   if (!a || !b) { phgmg_reduced_destroy(a); phgmg_reduced_destroy(b); return; }
@@ -131,21 +131,21 @@ TEST(test_study_linear) {
       static const phgmg_method meth[3] = {PHGMG_METHOD_GMG_POD, PHGMG_METHOD_GMG_QM, PHGMG_METHOD_SP1};
       phgmg_reduce_opts o;
       memset(&o, 0, sizeof o);
-      o.method = meth[j]; o.r = r; o.rn = 4; o.lambda = 1e-6;
+      o.method = meth[j]; o.r = r; o.qm.rn = 4; o.qm.lambda = 1e-6;
       ts_case(st, &M.sys, X, ns, o, dt, nsteps, 1);
     }
   }
   { /* greedy linear part: the study supplies the basis, the model is built as phgmg_reduce builds it */
     phgmg_reduce_opts o;
     memset(&o, 0, sizeof o);
-    o.method = PHGMG_METHOD_GMG_QM; o.r = 7; o.rn = 4; o.lambda = 1e-6; o.manifold = 1;
+    o.method = PHGMG_METHOD_GMG_QM; o.r = 7; o.qm.rn = 4; o.qm.lambda = 1e-6; o.qm.manifold = 1;
     ts_case(st, &M.sys, X, ns, o, dt, nsteps, 0);
   }
   { /* orders beyond the study's modes: not the fast path, and an error (r - m + rn > kmax) */
     phgmg_reduce_opts o;
     phgmg_reduced *red = (phgmg_reduced *)1;
     memset(&o, 0, sizeof o);
-    o.method = PHGMG_METHOD_GMG_QM; o.r = 16; o.rn = 4;
+    o.method = PHGMG_METHOD_GMG_QM; o.r = 16; o.qm.rn = 4;
     CHECK_RC(phgmg_study_reduce(st, &o, &red, NULL), PHGMG_ERR_SIZE);
     CHECK(red == NULL);
   }
@@ -183,8 +183,8 @@ TEST(test_study_nonlinear) {
     static const phgmg_method meth[3] = {PHGMG_METHOD_SP2, PHGMG_METHOD_GMG_POD, PHGMG_METHOD_GMG_QM};
     phgmg_reduce_opts o;
     memset(&o, 0, sizeof o);
-    o.method = meth[j]; o.r = 8; o.rn = 4; o.lambda = 1e-4;
-    o.hyper_reduce = 1; o.hyper = PHGMG_HYPER_QDEIM; o.deim_tol = 1e-8; o.deim_allow_negative = 1;
+    o.method = meth[j]; o.r = 8; o.qm.rn = 4; o.qm.lambda = 1e-4;
+    o.hyper.on = 1; o.hyper.kind = PHGMG_HYPER_QDEIM; o.hyper.deim_tol = 1e-8; o.hyper.allow_negative = 1;
     ts_case(st, &M.sys, X, ns, o, dt, nsteps, 1);
   }
   phgmg_study_destroy(st);

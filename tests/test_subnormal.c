@@ -233,7 +233,7 @@ static int ts_run_all(void) {
     memset(&o, 0, sizeof o);
     o.method = (phgmg_method)meth;
     o.r = 6;
-    o.rn = 4;
+    o.qm.rn = 4;
     if (phgmg_reduce(&red, &M.sys, X, N, NS, &o, NULL, NULL) != PHGMG_OK) { bad = 1; break; }
     memset(x, 0, sizeof x);
     if (phgmg_rom_stepper_init(&st, phgmg_reduced_rom(red), 0.1, 1e-8, 20, mem, sizeof mem) != PHGMG_OK)
@@ -312,7 +312,7 @@ TEST(test_rom_step_flushes_subnormal) {
     memset(&o, 0, sizeof o);
     o.method = (phgmg_method)meth;
     o.r = 6;
-    o.rn = 4;
+    o.qm.rn = 4;
     CHECK_RC(phgmg_reduce(&red, &M.sys, X, N, NS, &o, NULL, NULL), PHGMG_OK);
     if (!red) continue;
     for (a = 0; a < 6; ++a) x[a] = (a % 2 ? -0.25 : 0.5) * DBL_MIN; /* subnormal */

@@ -89,9 +89,9 @@ int main(int argc, char **argv) {
       double t0, tred, ered = NAN, eytr = NAN, eyo = 0, fails = 0, eproj, elb;
       memset(&o, 0, sizeof o);
       o.method = me < 0 ? PHGMG_METHOD_GMG_POD : PHGMG_METHOD_GMG_QM;
-      o.r = rl[k]; o.rn = rn; o.manifold = me < 0 ? 0 : me; o.lambda = lambda;
-      o.lambda_auto = me >= 0 && lauto; o.lambda_train_only = tonly; o.nrun = ntr; o.runs = runs; o.newton_tol = tol; o.newton_iter = 20;
-      if (nonlin) { o.hyper_reduce = 1; o.deim_tol = 1e-8; o.deim_allow_negative = 1; }
+      o.r = rl[k]; o.qm.rn = rn; o.qm.manifold = me < 0 ? 0 : me; o.qm.lambda = lambda;
+      o.select.lambda_mode = me >= 0 && lauto; o.select.train_only = tonly; o.nrun = ntr; o.runs = runs; o.select.newton_tol = tol; o.select.newton_iter = 20;
+      if (nonlin) { o.hyper.on = 1; o.hyper.deim_tol = 1e-8; o.hyper.allow_negative = 1; }
       t0 = demo_now();
       rc = phgmg_reduce(&red, sys, X, N, ntr * ns, &o, &info, NULL);
       tred = demo_now() - t0;

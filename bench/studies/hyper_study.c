@@ -50,8 +50,8 @@ int main(void) {
         double tt;
         phgmg_result rc;
         memset(&o, 0, sizeof o);
-        o.method = (phgmg_method)meth; o.r = r; o.hyper_reduce = h > 0; o.deim_allow_negative = 1;
-        o.hyper = h == 1 ? PHGMG_HYPER_ECSW : h == 2 ? PHGMG_HYPER_QDEIM : PHGMG_HYPER_GREEDY;
+        o.method = (phgmg_method)meth; o.r = r; o.hyper.on = h > 0; o.hyper.allow_negative = 1;
+        o.hyper.kind = h == 1 ? PHGMG_HYPER_ECSW : h == 2 ? PHGMG_HYPER_QDEIM : PHGMG_HYPER_GREEDY;
         t0 = clock();
         rc = phgmg_reduce(&red, &M.sys, X, N, ns, &o, &info, NULL);
         tt = (double)(clock() - t0) / CLOCKS_PER_SEC;

@@ -102,7 +102,7 @@ int main(int argc, char **argv) {
       phgmg_reduce_opts o;
       phgmg_reduced *rd = NULL;
       memset(&o, 0, sizeof o);
-      o.method = PHGMG_METHOD_GMG_POD; o.r = 20; o.hyper_reduce = 1;
+      o.method = PHGMG_METHOD_GMG_POD; o.r = 20; o.hyper.on = 1;
       t0 = now_wall();
       rc = phgmg_reduce(&rd, &M.sys, X, N, NS, &o, NULL, NULL);
       printf("  phgmg_reduce GMG-POD r 20 deim: %s, %.2f s (PHGMG_POD_RANDOMIZED_MIN %.0f)\n",

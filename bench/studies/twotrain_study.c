@@ -108,10 +108,10 @@ int main(int argc, char **argv) {
         phgmg_reduced *red = NULL;
         phgmg_result rc;
         memset(&o, 0, sizeof o);
-        o.method = PHGMG_METHOD_GMG_POD; o.r = rl[k]; o.hyper_reduce = nonlin && dm; o.deim_tol = 1e-8; o.deim_allow_negative = 1;
+        o.method = PHGMG_METHOD_GMG_POD; o.r = rl[k]; o.hyper.on = nonlin && dm; o.hyper.deim_tol = 1e-8; o.hyper.allow_negative = 1;
         rc = phgmg_reduce(&red, sys, X, N, tr * ns, &o, &info, NULL);
         if (rc != PHGMG_OK) { printf("%3d %4d reduce: %s\n", o.r, tr, phgmg_result_string(rc)); continue; }
-        printf("%3d %4d %4d", o.r, tr, o.hyper_reduce);
+        printf("%3d %4d %4d", o.r, tr, o.hyper.on);
         for (i = 0; i < NHO; ++i) {
           const double *Xi = X + (size_t)(2 + i) * N * ns;
           double ey;

@@ -41,7 +41,7 @@ static int do_model(const char *dir, const char *name, const phgmg_ph_system *sy
   void *block = NULL;
   int bad = 0;
   memset(&o, 0, sizeof o);
-  o.method = meth; o.r = 16; o.rn = 8; o.lambda = lambda; o.hyper_reduce = deim; o.deim_allow_negative = 1;
+  o.method = meth; o.r = 16; o.qm.rn = 8; o.qm.lambda = lambda; o.hyper.on = deim; o.hyper.allow_negative = 1;
   o.dt = 0.1;
   rc = phgmg_reduce(&red, sys, X, sys->N, ns, &o, NULL, NULL);
   if (rc != PHGMG_OK) { fprintf(stderr, "%s: reduce: %s\n", name, phgmg_result_string(rc)); return 1; }
