@@ -2310,9 +2310,12 @@ PHGMG_DEF phgmg_result phgmg_deim(int nterms, int ns, const double *F, int ldf, 
                                   int *nneg, double *sigma_ratio, const phgmg_allocator *alloc);
 
 /* DEIM point selection (phgmg_deim_select). */
-#define PHGMG_DEIM_QDEIM 0  /* pivoted QR of U^T (Drmac-Gugercin; phgmg_deim's choice) */
-#define PHGMG_DEIM_GREEDY 1 /* greedy DEIM (Chaturantabut-Sorensen): point l = argmax
-                               |u_l - U_{<l} (P^T U_{<l})^{-1} P^T u_l| (first index on ties) */
+typedef enum phgmg_deim_method {
+  PHGMG_DEIM_QDEIM = 0,  /* pivoted QR of U^T (Drmac-Gugercin; phgmg_deim's choice) */
+  PHGMG_DEIM_GREEDY = 1, /* greedy DEIM (Chaturantabut-Sorensen): point l = argmax
+                            |u_l - U_{<l} (P^T U_{<l})^{-1} P^T u_l| (first index on ties) */
+  PHGMG_DEIM_METHOD_COUNT
+} phgmg_deim_method;
 /* phgmg_deim with a choice of point selection: method PHGMG_DEIM_QDEIM or
    PHGMG_DEIM_GREEDY (else PHGMG_ERR_INVALID_ARG). Modes, weights and outputs
    as phgmg_deim; Q-DEIM points come in pivot order, greedy points in the
@@ -2320,7 +2323,7 @@ PHGMG_DEF phgmg_result phgmg_deim(int nterms, int ns, const double *F, int ldf, 
    gives 1e-8, kmax = 0 no cap; tol < 0, NaN or >= 1 and kmax < 0 give
    PHGMG_ERR_INVALID_ARG. */
 PHGMG_DEF phgmg_result phgmg_deim_select(int nterms, int ns, const double *F, int ldf, const double *sw,
-                                         double tol, int kmax, int method, int *pts, double *w,
+                                         double tol, int kmax, phgmg_deim_method method, int *pts, double *w,
                                          int *nd_out, int *nneg, double *sigma_ratio,
                                          const phgmg_allocator *alloc);
 
@@ -12329,7 +12332,7 @@ PHGMG__PRIV phgmg_result phgmg__deim_greedy(int n, int keep, const double *U, in
 }
 
 PHGMG_DEF phgmg_result phgmg_deim_select(int nterms, int ns, const double *F, int ldf, const double *sw,
-                                         double tol, int kmax, int method, int *pts, double *w,
+                                         double tol, int kmax, phgmg_deim_method method, int *pts, double *w,
                                          int *nd_out, int *nneg, double *sigma_ratio,
                                          const phgmg_allocator *alloc) {
   double *U, *S, *Ut, *tau, *work, *PU;
@@ -12337,7 +12340,7 @@ PHGMG_DEF phgmg_result phgmg_deim_select(int nterms, int ns, const double *F, in
   int k = 0, kk, rank = 0, i, j, neg = 0;
   phgmg_result rc;
   if (!F || !pts || !w || !nd_out) return PHGMG_ERR_INVALID_ARG;
-  if (method != PHGMG_DEIM_QDEIM && method != PHGMG_DEIM_GREEDY) return PHGMG_ERR_INVALID_ARG;
+  if ((int)method < 0 || (int)method >= (int)PHGMG_DEIM_METHOD_COUNT) return PHGMG_ERR_INVALID_ARG;
   if (!(tol >= 0.0 && tol < 1.0) || kmax < 0) return PHGMG_ERR_INVALID_ARG;
   if (nterms < 1 || ns < 1 || ldf < nterms) return PHGMG_ERR_SIZE;
   if (!phgmg__mat_finite(nterms, ns, F, ldf)) return PHGMG_ERR_NANINF; /* padding rows are not data */
@@ -16893,14 +16896,14 @@ PHGMG__PRIV int phgmg__study_deim(phgmg_study *st, const phgmg_reduce_opts *o) {
   const phgmg_ph_system *sys = st->sys;
   const phgmg_allocator *alloc = st->use_alloc ? &st->alloc : NULL;
   const int nt = sys->nsep, ns = st->ns;
-  const int meth = o->hyper.kind == PHGMG_HYPER_GREEDY ? PHGMG_DEIM_GREEDY : PHGMG_DEIM_QDEIM;
+  const phgmg_deim_method meth = o->hyper.kind == PHGMG_HYPER_GREEDY ? PHGMG_DEIM_GREEDY : PHGMG_DEIM_QDEIM;
   double *F;
   int a, i;
   phgmg_result rc;
   if (o->hyper.on != 1 || o->cache.deim_pts || sys->nl != PHGMG_NL_SEPARABLE || nt < 1 ||
       (o->hyper.kind != PHGMG_HYPER_QDEIM && o->hyper.kind != PHGMG_HYPER_GREEDY) || !(o->hyper.deim_tol >= 0.0 && o->hyper.deim_tol < 1.0))
     return 0;
-  if (st->deim_have && st->deim_tol == o->hyper.deim_tol && st->deim_max == o->hyper.deim_max && st->deim_method == meth) return 1;
+  if (st->deim_have && st->deim_tol == o->hyper.deim_tol && st->deim_max == o->hyper.deim_max && st->deim_method == (int)meth) return 1;
   st->deim_have = 0;
   if (!st->deim_pts) st->deim_pts = phgmg__ialloc(alloc, (size_t)nt);
   if (!st->deim_w) st->deim_w = phgmg__dalloc(alloc, (size_t)nt);
@@ -16913,7 +16916,7 @@ PHGMG__PRIV int phgmg__study_deim(phgmg_study *st, const phgmg_reduce_opts *o) {
                          &st->deim_nd, &st->deim_nneg, &st->deim_sigma, alloc);
   phgmg__free(alloc, F);
   if (rc != PHGMG_OK) return 0;
-  st->deim_have = 1; st->deim_tol = o->hyper.deim_tol; st->deim_max = o->hyper.deim_max; st->deim_method = meth;
+  st->deim_have = 1; st->deim_tol = o->hyper.deim_tol; st->deim_max = o->hyper.deim_max; st->deim_method = (int)meth;
   return 1;
 }
 
