@@ -1,5 +1,5 @@
 /* phgmg.h -- structure-preserving model order reduction of port-Hamiltonian
-   systems by generalized manifold Galerkin (GMG) reduction. Version 0.4.0.
+   systems by generalized manifold Galerkin (GMG) reduction. Version 0.5.0.
    Single-file C99 library (also compiles as C++), no dependencies beyond libc
    and libm. The revision history and the MIT license are at the end of the
    file.
@@ -251,9 +251,9 @@
    solves with J - R - L and O(N r^2) work).
    Online cost and hyper-reduction. Each evaluation costs O(ndamp r): free of
    N, but every damper is kept, so a model with a damper at every node has an
-   O(N) online cost. opts.hyper_reduce = 1 hyper-reduces the dampers by empirical
-   quadrature (phgmg_ecsw_separable, tolerance hyper_tol; always ECSW,
-   whatever opts.hyper says): weights dw_k >= 0 on a subset of the dampers
+   O(N) online cost. opts.hyper.on = 1 hyper-reduces the dampers by empirical
+   quadrature (phgmg_ecsw_separable, tolerance hyper.tol; always ECSW,
+   whatever hyper.kind says): weights dw_k >= 0 on a subset of the dampers
    such that sum_k dw_k Cd_k rho_k(s_k) matches sum_k Cd_k rho_k(s_k) on the
    training forces, s_k = c_k^T z(x_j) at the snapshots. Non-negative weights
    keep every kept term dissipative, so the hyper-reduced model is
@@ -372,18 +372,50 @@
                 of D^T G D at xr = 0 and at every snapshot; SP1/SP2: W;
      terms      quadratic blocks; a separable part by hyper-reduction (or
                 every term kept); a GENERAL part by callback;
-     step map   LINEAR model with quadratic H and opts.dt > 0;
-     selection  GMG-QM with opts.lambda_auto: the choice of lambda (section 4).
-   opts.progress reports the stages ("basis", "manifold", "blocks",
-   "hamiltonian", "hyper-reduction", "finish", "done"); the library never
-   prints. info (may be NULL) receives the diagnostics (phgmg_reduce_info).
+     step map   LINEAR model with quadratic H and opts.dt > 0, for any
+                step size: when h ||K Qh|| > 1e6 the map is formed without
+                the factor h (no cancellation; it tends to -I as dt grows);
+                the map of a dissipative model (Qh > 0, K + K^T <= 0) is
+                checked not to grow in the energy norm (PHGMG_ERR_STEP_MAP);
+     selection  GMG-QM with opts.select.lambda_mode: the choice of lambda
+                (section 4).
+   Progress. The library never prints; opts.progress (NULL: none) is called
+   as progress(phase, opts.progress_user), from the calling thread only, as
+   each stage starts: "basis" (snapshot adjustment and POD), "manifold",
+   "blocks" (the reduced operators), "hamiltonian" (quadratic terms),
+   "hyper-reduction" (the separable part: its gradient snapshots and
+   DEIM/ECSW), "finish" (general term, step map, validation), and "done"
+   after a successful reduction. GMG-QM with select.lambda_mode =
+   PHGMG_LAMBDA_VALIDATED adds "lambda: validation runs" (their set-up),
+   "lambda: full-model probe run" before each full-model simulation of a
+   probe input and "lambda: candidate" before each lambda simulated (as many
+   as info.lambda_candidates). info (may be NULL) receives the diagnostics
+   (phgmg_reduce_info).
 
    2.3 Studies over many orders. phgmg_study_create computes, once for the
    largest basis, the PODs, the snapshots' reduced coordinates, the residual
    tails and the G- and Q-blocks; phgmg_study_reduce then builds the same model
    as phgmg_reduce in O(K ns r) instead of O(N ns r), phgmg_study_errors the
    error measures in reduced coordinates, phgmg_study_basis hands the bases to
-   your own calls (opts.pod_basis). X must stay unchanged while a study lives.
+   your own calls (opts.cache). X must stay unchanged while a study lives.
+   What opts.cache holds (NULL: computed by the reduction; each from the same
+   snapshots X):
+     pod_basis, pod_cols    the leading left singular vectors (N x pod_cols,
+                            ld N, by descending singular value) of the matrix
+                            the method PODs: for GMG-POD and GMG-QM the
+                            adjusted snapshots X - B B^+ X
+                            (phgmg_adjust_snapshots, then phgmg_pod), for SP1
+                            and SP2 X itself. GMG-QM takes V1 from the first
+                            r - m columns and V2 from the next r_n (the POD of
+                            what V1 leaves is exactly that tail), so one basis
+                            serves every r. GMG_MANIFOLD: [V1, V2] must be
+                            orthonormal and orthogonal to B (else
+                            PHGMG_ERR_RANK).
+     grad_basis, grad_cols  SP2: the same for the gradient snapshots.
+     deim_pts, deim_w,      points and weights of phgmg_deim on these
+     deim_count             snapshots (they depend on neither r nor the
+                            method); with hyper.on = 1 they are used as given,
+                            whatever hyper.kind says.
 
    2.4 Building blocks. The stages' kernels are public: phgmg_pod,
    phgmg_pod_randomized, phgmg_adjust_snapshots, phgmg_pod_hierarchical,
@@ -405,7 +437,7 @@
    reference (phgmg_bt, plain Ar, Br, Cr), positive-real balanced truncation in
    pH form (phgmg_prbt, a phgmg_reduced of method PRBT), input-independent GMG
    bases (phgmg_linear_basis: frequency samples, impulse responses, balanced,
-   least H2 error; pass them as opts.pod_basis), transfer functions and
+   least H2 error; pass them as opts.cache.pod_basis), transfer functions and
    H-infinity / H2 errors (phgmg_ph_abc, phgmg_ss_transfer, phgmg_reduced_abc,
    phgmg_ss_error). A system with an undamped mode has no Gramians: BT, PRBT
    and the BALANCED / H2 bases then return PHGMG_ERR_NOT_STABLE.
@@ -439,7 +471,7 @@
                                r_n modes, M a ridge fit with parameter lambda.
      PHGMG_METHOD_GMG_MANIFOLD your manifold phi = [B, V1] xr + V2 eta(x2),
                                eta and its first and second derivatives by a
-                               callback (opts.eta); GMG-QM is the case
+                               callback (opts.qm.eta); GMG-QM is the case
                                eta = M (x2 kron x2), GMG-POD the case r_n = 0.
      PHGMG_METHOD_SP1          baseline: phi = V xr (POD of X), W = QV(V^TQV)^-1.
      PHGMG_METHOD_SP2          baseline: W from a POD of the gradient snapshots.
@@ -448,80 +480,98 @@
    3.2 phgmg_reduce_opts
    phgmg_reduce_opts_default fills a struct with these defaults (the library
    applies them in that one place; the command line starts from them too).
-     field              default (zero)       meaning
-     method             (required)           one of 3.1
-     r                  (required)           reduced order
-     rn                 8                    GMG-QM lifting dimension r_n with
-                                             the POD manifold; with greedy or
-                                             altmin, 0 resolves to
-                                             PHGMG_RN_WIDE (V2 as wide as the
-                                             data); > 0: a cap; GMG_MANIFOLD:
-                                             required, <= 64
-     lambda             1e-3 (the paper's)   GMG-QM ridge parameter on the
-                                             un-normalised sum over snapshots;
-                                             < 0: exactly zero; not used with
-                                             lambda_auto
-     hyper_reduce       0                    1: hyper-reduce a separable part
-                                             (the method is `hyper`); 0: keep
-                                             every term (exact, O(terms) online)
-     deim               0                    the former name of hyper_reduce
-     hyper              PHGMG_HYPER_ECSW     ECSW (weights >= 0), QDEIM or
-                                             GREEDY (structure-preserving DEIM)
-     hyper_tol          1e-6                 ECSW: relative training residual
-                                             of the reduced nonlinear gradient
-     deim_tol           1e-8                 DEIM modes: sigma_k/sigma_1 > tol
-     deim_max           no cap               cap on DEIM modes
-     deim_allow_negative 0                   1: accept negative DEIM weights
-     dt                 0 (no step map)      > 0: precompute the GL3 step map
-                                             of a LINEAR model for this step
-     degeneracy_tol     1e-12                least reciprocal condition of
-                                             D^T G D (port columns at unit
-                                             length) before _ERR_DEGENERATE
-     pod_basis/pod_cols NULL (computed)      cached POD basis (studies)
-     grad_basis/grad_cols NULL (computed)    SP2: cached gradient POD basis
-     deim_pts/deim_w/deim_count NULL         cached DEIM result
-     lambda_auto        0 (fixed lambda)     1: validated by simulation
-                                             (section 4.2); 2: regression only
-     lambda_min         1e-14                smallest lambda of the grid
-     lambda_max         1                    largest lambda of the grid
-     lambda_per_decade  4                    grid points per decade (1..100)
-     lambda_folds       5                    lambda_auto = 2: folds (>= 2)
-     lambda_blocks      min(ns, 100)         lambda_auto = 2: time blocks
-     lambda_rcond       1e-6                 conditioning guard, relative to
-                                             rcond(D^T G D) at xr = 0
-     eta/eta_user       NULL                 GMG_MANIFOLD: the manifold map
-     nrun/runs          0/NULL (one run of   the training runs that made X
-                        unknown input)
-     lambda_tolerance   1.02                 admissible e_y ratio to the
-                                             linear limit (lambda_auto = 1)
-     newton_tol         1e-10 (full), the    validation simulations
-                        stepper's (reduced)
-     newton_iter        20                   validation simulations
-     manifold           PHGMG_MANIFOLD_POD   GMG-QM construction (3.3)
-     lambda_train_only  0                    1: validate on the training runs
-                                             alone (4.2)
-     progress/_user     NULL                 stage callback (2.2)
-     ref / ref_x        PHGMG_REF_NONE       affine reference state (3.6):
-                                             _MEAN the snapshots' mean,
-                                             _GIVEN the vector ref_x
+   The options of one concern are grouped in a sub-struct: qm (the manifold
+   of GMG-QM and GMG_MANIFOLD), select (choosing lambda, 4.2), hyper (a
+   separable part, 3.4), cache (results reused across reductions, 2.3).
+     field                default (zero)       meaning
+     method               (required)           one of 3.1
+     r                    (required)           reduced order (GMG: includes
+                                               the m port coordinates)
+     dt                   0 (no step map)      > 0: precompute the GL3 step
+                                               map of a LINEAR model (2.2)
+     degeneracy_tol       1e-12                least reciprocal condition of
+                                               D^T G D before _ERR_DEGENERATE
+                                               (below the table)
+     nrun/runs            0/NULL (one run of   the training runs that made X
+                          unknown input)       (4.1)
+     ref / ref_x          PHGMG_REF_NONE       affine reference state (3.6):
+                                               _MEAN the snapshots' mean,
+                                               _GIVEN the vector ref_x
+     progress/_user       NULL                 stage callback (2.2)
+   qm (phgmg_qm_opts)
+     qm.rn                8                    GMG-QM lifting dimension r_n
+                                               with the POD manifold; with
+                                               greedy or altmin, 0 resolves
+                                               to PHGMG_RN_WIDE (3.3); > 0: a
+                                               cap; GMG_MANIFOLD: required,
+                                               <= 64
+     qm.lambda            1e-3 (the paper's)   ridge parameter on the
+                                               un-normalised sum over
+                                               snapshots; < 0: exactly zero;
+                                               used with lambda_mode FIXED
+     qm.manifold          PHGMG_MANIFOLD_POD   GMG-QM construction (3.3)
+     qm.greedy_window     0                    greedy / altmin with a wide
+                                               V2: candidate modes (3.3)
+     qm.eta/eta_user      NULL                 GMG_MANIFOLD: the manifold map
+   select (phgmg_select_opts; only with lambda_mode other than FIXED)
+     select.lambda_mode   PHGMG_LAMBDA_FIXED   _VALIDATED: by simulation
+                                               (4.2); _REGRESSION: held-out
+                                               regression error only
+     select.lambda_min    1e-14                smallest lambda of the grid
+     select.lambda_max    1                    largest lambda of the grid
+     select.per_decade    4                    grid points per decade (1..100)
+     select.folds         5                    _REGRESSION: folds (>= 2)
+     select.blocks        min(ns, 100)         _REGRESSION: time blocks
+     select.rcond         1e-6                 conditioning guard, relative to
+                                               rcond(D^T G D) at xr = 0
+     select.tolerance     1.02                 _VALIDATED: admissible e_y
+                                               ratio to the linear limit
+     select.train_only    0                    1: validate on the training
+                                               runs alone (4.2)
+     select.newton_tol    1e-10 (full), the    validation simulations
+                          stepper's (reduced)
+     select.newton_iter   20                   validation simulations
+   hyper (phgmg_hyper_opts)
+     hyper.on             0                    1: hyper-reduce a separable
+                                               part (the method is hyper.kind);
+                                               0: keep every term (exact,
+                                               O(terms) online)
+     hyper.kind           PHGMG_HYPER_ECSW     ECSW (weights >= 0), QDEIM or
+                                               GREEDY (structure-preserving
+                                               DEIM)
+     hyper.tol            1e-6                 ECSW: relative training
+                                               residual of the reduced
+                                               nonlinear gradient
+     hyper.deim_tol       1e-8                 DEIM modes: sigma_k/sigma_1 > tol
+     hyper.deim_max       no cap               cap on DEIM modes
+     hyper.allow_negative 0                    1: accept negative DEIM weights
+   cache (phgmg_reduce_cache; 2.3)
+     cache.pod_basis/_cols NULL (computed)     cached POD basis
+     cache.grad_basis/_cols NULL (computed)    SP2: cached gradient POD basis
+     cache.deim_pts/_w/_count NULL             cached DEIM result
    Bad values (NaN, out of range, unknown enums) give PHGMG_ERR_INVALID_ARG;
    sizes that do not fit the model or the snapshots' rank give PHGMG_ERR_SIZE.
+   degeneracy_tol is compared with rcond(D^T G D) computed with D's port
+   columns B_a scaled to unit length, so that the units of the states and of
+   B do not change the verdict. Only method and r are required; every other
+   field may stay zero.
 
-   3.3 GMG-QM manifold constructions (opts.manifold)
+   3.3 GMG-QM manifold constructions (opts.qm)
      PHGMG_MANIFOLD_POD     the paper's hierarchical POD: V1 the leading POD
                             modes of the adjusted snapshots, V2 the next r_n.
      PHGMG_MANIFOLD_GREEDY  V1 chosen column by column among the leading
                             (r - m) + r_n POD modes: each time the mode whose
                             coordinates best predict the other candidates' by
                             the quadratic ridge fit (after Schwerdtner &
-                            Peherstorfer 2024; ridge 1e-9 under lambda_auto,
-                            else opts.lambda; every ceil(ns/400)-th snapshot);
+                            Peherstorfer 2024; ridge 1e-9 when lambda is
+                            chosen (select.lambda_mode not FIXED), else
+                            qm.lambda; every ceil(ns/400)-th snapshot);
                             V2 the POD of what [B, V1] leaves. About (r - m)
                             (r - m + r_n) small least-squares solves.
      PHGMG_MANIFOLD_ALTMIN  alternating minimization (after Geelen, Balzano,
                             Wright & Willcox 2023) of the training objective
                             sum ||x - phi(rho(x))||^2 + lam ||M||^2 (lam:
-                            1e-9 under lambda_auto, else opts.lambda). It
+                            1e-9 when lambda is chosen, else qm.lambda). It
                             keeps only what lowers the objective, so it never
                             ends above its start (info.manifold_obj0 ->
                             manifold_obj). With V2 of width r_n: V1, V2
@@ -559,18 +609,56 @@
                             go; how far above it stops is set by the
                             non-convex objective (a local minimum near the
                             start) and the step budget, which binds on the
-                            pulse. With opts.greedy_window > 0 it starts from
+                            pulse. With qm.greedy_window > 0 it starts from
                             the greedy manifold (V1 the greedy choice, the
                             search space V1 and its complement's leading
                             modes) and improves it by 8-30 % there.
-                            Under lambda_auto = 1 GMG-POD joins the
+                            Under PHGMG_LAMBDA_VALIDATED GMG-POD joins the
                             validation as a second reference, and when no
                             lambda beats both the model of MANIFOLD_POD is
                             returned (info.manifold_fallback = 1).
    In every construction B stays in the span and [B, V1, V2] is orthonormal,
    so Br = [I; 0] and the GMG reduction is unchanged.
+   The width of V2 (qm.rn). A cap rn > 0 takes as V2 the leading rn POD
+   modes of what [B, V1] leaves of the snapshots (the paper's construction).
+   PHGMG_RN_WIDE takes V2 over that whole residual up to its numerical rank
+   rw, so that the quadratic term may correct in every direction the data
+   has; only the part M can reach is kept, and the online width is
+   rn = min(rw, (r - m)(r - m + 1)/2). Zero means 8 with the POD manifold and
+   wide with the greedy and altmin manifolds. What wide costs: offline one
+   SVD of the N x ns residual (the greedy construction with greedy_window > 0
+   reuses its own), whose modes take N min(N, ns) doubles (as much as the
+   copy of the snapshots GMG-QM keeps), and O((N + ns) rw (r - m)^2) for the
+   compression; online, hyper-reduced and so independent of N, the
+   quadratic terms cost O(rn (r - m)^2) per evaluation and the stepper's
+   memory grows with rn r (PHGMG_ROM_STEPPER_MEMSIZE_MAX): at r - m = 20,
+   rn <= 210, some 10^5 flops per right-hand side.
+   The greedy window (qm.greedy_window; greedy or altmin with a wide V2).
+   Zero keeps the candidates and the score described under
+   PHGMG_MANIFOLD_GREEDY (the leading r - m + 8 POD modes). A window w > 0
+   takes the leading r - m + w modes (up to the numerical rank) and scores
+   each by the ridge objective (misfit + lam ||M||^2) over the other
+   candidates not yet taken, with an incremental QR of the features that
+   keeps a wide window affordable. The reference code of Schwerdtner &
+   Peherstorfer uses 200, and transport data need that much: there the
+   modes V1 wants lie far down the spectrum (bench/qm_pulse.c). Cost: about
+   (r - m) w incremental updates of O(nsub (r - m)^3 + nsub^2 (r - m)) (at
+   most nsub = 400 snapshots are used) plus one SVD of the adjusted
+   snapshots: 3-10 s at r - m = 12-20, w = 200, N = 4096, ns = 1000 (two
+   shared cores). With PHGMG_MANIFOLD_ALTMIN and a wide V2 the alternating
+   minimization starts from this greedy manifold.
+   The ridge parameter (qm.lambda, with select.lambda_mode FIXED): applied
+   to the un-normalised sum over the snapshots; a negative value means
+   exactly zero, and the fit of M is then the minimum-norm least-squares
+   solution whatever the rank of its Kronecker matrix.
+   Your own manifold (PHGMG_METHOD_GMG_MANIFOLD): qm.eta is the map
+   eta: R^p -> R^rn of phi(x) = B x1 + V1 x2 + V2 eta(x2) (p = r - m,
+   rn = qm.rn >= 1, required) with its first and second derivatives
+   (phgmg_eta_fn, 3.1), qm.eta_user its argument. V1 and V2 come from the
+   hierarchical POD or from opts.cache.pod_basis (2.3); the reduced model
+   calls eta online.
 
-   3.4 Hyper-reduction (opts.hyper_reduce = 1, opts.hyper)
+   3.4 Hyper-reduction (opts.hyper: on = 1, kind)
    A separable energy sum_k w_k phi(l_k) is replaced by sum_j w'_j phi(l_pj)
    over a few kept terms. Because the reduced energy itself is approximated
    (not its gradient), the reduced gradient is an exact gradient and the model
@@ -578,14 +666,16 @@
      PHGMG_HYPER_ECSW   (default) empirical quadrature: weights w' >= 0 by
                         non-negative least squares on the reduced gradient
                         over the training snapshots (phgmg_ecsw_separable),
-                        relative residual <= hyper_tol. Non-negative weights
+                        relative residual <= hyper.tol. Non-negative weights
                         keep a convex, bounded-below sum convex and bounded
                         below; the terms at rest in every snapshot are skipped.
      PHGMG_HYPER_QDEIM  the paper's structure-preserving DEIM with Q-DEIM
                         points (pivoted QR); weights w' = (P^T U)^{-T} U^T w
-                        may be negative (refused unless deim_allow_negative).
+                        may be negative (refused unless hyper.allow_negative).
      PHGMG_HYPER_GREEDY the same with greedy DEIM points.
-   Online cost O(points); info.hyper_* and info.deim_* report the result.
+   DEIM keeps the modes with sigma_k / sigma_1 > hyper.deim_tol, at most
+   hyper.deim_max of them. Online cost O(points); info.hyper_* and info.deim_*
+   report the result.
    A GENERAL nonlinear part cannot be hyper-reduced (PHGMG_ERR_UNSUPPORTED):
    its reduced model evaluates H_nl in full dimension through
    phgmg_rom.ham_cb (info.online_full_dim = 1; not exportable).
@@ -608,11 +698,13 @@
    state oscillating about a loaded equilibrium -- are represented far
    better by an affine manifold
        phi(x) = xbar + B x1 + V1 x2 + V2 eta(x2),   x = (x1, x2),
-   with a reference state xbar (PHGMG_REF_MEAN: the mean of the snapshots;
-   PHGMG_REF_GIVEN: your vector). Every basis and manifold (POD, hierarchical,
-   greedy, alternating minimization; SP1/SP2's POD) is fitted to the
-   snapshots minus xbar; the point reduction is rho(x) = rho_0(x - xbar) with
-   rho_0 the map without reference state. On the advecting pulse of
+   with a reference state xbar (opts.ref = PHGMG_REF_MEAN: the mean of the
+   snapshots; PHGMG_REF_GIVEN: your vector opts.ref_x, N finite values;
+   PHGMG_REF_NONE, the default: none), for any method of phgmg_reduce (not
+   with dampers or a feedthrough: PHGMG_ERR_UNSUPPORTED). Every basis and
+   manifold (POD, hierarchical, greedy, alternating minimization; SP1/SP2's
+   POD) is fitted to the snapshots minus xbar; the point reduction is
+   rho(x) = rho_0(x - xbar) with rho_0 the map without reference state. On the advecting pulse of
    bench/qm_pulse.c the greedy manifold's training error at n = 20 drops from
    7.3e-4 to 7.7e-8 (lam = 1e-12; examples/README.md).
    Why the reduced model is still port-Hamiltonian. xbar is constant, so
@@ -655,13 +747,23 @@
    4. DEPLOYMENT: VALIDATION, CHOOSING LAMBDA, ONLINE INDICATORS ----------------
    4.1 Training runs. Train on inputs that cover the levels (static content)
    and the frequency band the model will see; several runs go into one snapshot
-   set (phgmg_simulate_inputs) and opts.nrun / opts.runs.
+   set (phgmg_simulate_inputs) and opts.nrun / opts.runs tell the reduction
+   how they were made: nrun >= 1 runs whose columns lie one after the other
+   as phgmg_simulate_inputs lays them out (the sum of nsteps + 1 must be ns,
+   else PHGMG_ERR_SIZE); 0 / NULL: X is one run of an unknown input. The
+   runs are what lambda validation simulates (PHGMG_LAMBDA_VALIDATED: every
+   training run and three probe runs made from runs[0]) and cuts into folds
+   (PHGMG_LAMBDA_REGRESSION: one run per fold when nrun >= 2).
 
-   4.2 GMG-QM's ridge parameter. A fixed lambda (opts.lambda, the paper's 1e-3
-   when zero) is what the paper does; on small reduced coordinates it shrinks M
-   to almost zero, and a very small lambda can bend the manifold so much that
-   the reduced model fails on inputs unlike the training one.
-     lambda_auto = 1 (recommended; needs opts.runs): validation by simulation.
+   4.2 GMG-QM's ridge parameter (opts.select). A fixed lambda
+   (select.lambda_mode = PHGMG_LAMBDA_FIXED, the default: opts.qm.lambda, the
+   paper's 1e-3 when zero) is what the paper does; on small reduced
+   coordinates it shrinks M to almost zero, and a very small lambda can bend
+   the manifold so much that the reduced model fails on inputs unlike the
+   training one. The other modes choose lambda from a grid, and the other
+   fields of opts.select are read only then.
+     PHGMG_LAMBDA_VALIDATED (recommended; needs opts.runs): validation by
+       simulation.
        The reduction simulates the finished reduced model, for candidate
        lambdas, on every training run (reference: the snapshots' outputs) and
        on three probe runs it was not fitted to -- the full model driven from
@@ -669,36 +771,46 @@
        runs[0].u played 1.5x faster and by the square wave RMS * sign(u(t))
        -- and compares each run's e_y with the linear limit M = 0 (GMG-POD on
        the same basis). Candidates: lambda_max, then one per decade down to
-       the regression optimum of lambda_auto = 2; the descent stops after two
-       inadmissible candidates in a row, and a candidate's evaluation at its
-       first inadmissible run. Admissible: no simulation fails, at most 4
+       the regression optimum of PHGMG_LAMBDA_REGRESSION; the descent stops
+       after two inadmissible candidates in a row, and a candidate's
+       evaluation at its first inadmissible run. Admissible: no simulation fails, at most 4
        Newton iterations per step on average, and every run's e_y at most
-       lambda_tolerance (1.02) times the linear limit's. Kept: the largest
+       select.tolerance (1.02) times the linear limit's. Kept: the largest
        admissible lambda with at least half of the best admissible gain (sum
        of log ratios); none: M = 0 (info.lambda = HUGE_VAL). Without runs
        nothing can be simulated and M = 0. Runs with the same x0 and the same
        inputs at every stage time are simulated once. Cost: three full-model
        probe runs plus (nrun + 3) reduced runs per candidate, 4-8 candidates.
+       The validation simulations use select.newton_tol (0: 1e-10 for the
+       full model, the stepper's default for the reduced one: 1e-10 double,
+       1e-5 float) and select.newton_iter (0: 20).
        info.lambda_candidates, info.lambda_val_ratio report it.
-     lambda_train_only = 1 (with lambda_auto = 1): no probe runs; from the
-       regression optimum up, the first lambda whose model simulates every
-       training run without Newton trouble and within lambda_tolerance of the
-       linear limit: the most accurate model on the training inputs; it does
-       not guard against unlike inputs.
-     lambda_auto = 2: regression only. The snapshots are cut into
-       lambda_blocks contiguous blocks in time, block j to fold j mod
-       lambda_folds (with several runs: one run per fold). For each fold, M is
-       fitted on the other snapshots for every lambda of the grid lambda_min *
-       10^(g / lambda_per_decade) <= lambda_max (one thin SVD of the training
-       rows, then a small product per lambda) and predicts the held-out
+     select.train_only = 1 (with PHGMG_LAMBDA_VALIDATED): no probe runs; from
+       the regression optimum up, the first lambda whose model simulates
+       every training run without Newton trouble and within select.tolerance
+       of the linear limit: the most accurate model on the training inputs;
+       it does not guard against unlike inputs.
+     PHGMG_LAMBDA_REGRESSION: regression only. The snapshots are cut into
+       select.blocks contiguous blocks in time, block j to fold j mod
+       select.folds (with several runs: one run per fold). For each fold, M is
+       fitted on the other snapshots for every lambda of the grid
+       select.lambda_min * 10^(g / select.per_decade) <= select.lambda_max
+       (one thin SVD of the training rows, then a small product per lambda)
+       and predicts the held-out
        quadratic correction V2^T x. The lambda with the smallest held-out error
        summed over the folds (ties within 1e-6 relative: the larger) fits M on
        all snapshots. Guard: while rcond(D^T G D) at some snapshot is below
-       lambda_rcond times its value at xr = 0, the next larger lambda is taken
-       (info.lambda_raised); if even lambda_max does not help, M = 0. This
-       choice measures the regression, not the reduced model, and picks very
-       small lambdas that overfit (see 8.6).
-   Before version 0.2.0, lambda_auto = 1 meant what is now lambda_auto = 2.
+       select.rcond times its value at xr = 0, the next larger lambda is taken
+       (info.lambda_raised); if even select.lambda_max does not help, M = 0.
+       This choice measures the regression, not the reduced model, and picks
+       very small lambdas that overfit (see 8.6).
+   When M = 0 is chosen, info.lambda = HUGE_VAL. Result codes (checked only
+   when lambda_mode is not FIXED): PHGMG_ERR_INVALID_ARG for a lambda_mode
+   outside the enum, lambda_min or lambda_max negative, NaN or infinite or
+   lambda_min > lambda_max, per_decade outside 1..100, folds < 2, blocks < 0,
+   rcond outside [0, 1], a grid of more than 1000 points; PHGMG_ERR_SIZE for
+   blocks < folds or blocks > ns. Before version 0.2.0 the value 1 meant what
+   is now PHGMG_LAMBDA_REGRESSION.
 
    4.3 The check before shipping. phgmg_reduced_validate(red, &sys, &run, tol,
    max_iter, ey_max, &v, alloc) simulates full and reduced model on one run and
@@ -823,7 +935,7 @@
                                     at a snapshot; SP1/SP2 likewise
                                     (info->rcond_dgd says how close)
      PHGMG_ERR_NEGATIVE_WEIGHT (-13) DEIM gave a negative weight and
-                                    deim_allow_negative is 0
+                                    hyper.allow_negative is 0
      PHGMG_ERR_FORMAT (-14)         a malformed model image or .npy file
      PHGMG_ERR_IO (-15)             a file cannot be opened, read or written
                                     (an existing path is never removed)
@@ -842,7 +954,7 @@
                                     themselves are scaled), ECSW weights out
                                     of range after scaling back
      PHGMG_ERR_TOL_UNREACHABLE (-23) a relative tolerance below 1e-15 (ECSW,
-                                    hence hyper_tol)
+                                    hence hyper.tol)
      PHGMG_ERR_NOT_STABILIZABLE (-24) no stabilizing Riccati solution
                                     (phgmg_care)
      PHGMG_ERR_STALE (-25)          the system changed after
@@ -949,10 +1061,11 @@
    measure the regression: they pick lambda around 1e-12 ... 1e-14, and the
    reduced model is excellent on the training input and fails (large e_y or a
    Newton failure) on a constant, a faster sine or a chirp. Hence
-   lambda_auto = 1 validates by simulating the reduced model on data it was
-   not fitted to, with GMG-POD's linear limit as the safe fallback (4.2).
-   The grid is absolute: for reduced coordinates far from unit size, set
-   lambda_min / lambda_max to the scale of the quadratic features (|z|^4).
+   PHGMG_LAMBDA_VALIDATED validates by simulating the reduced model on data
+   it was not fitted to, with GMG-POD's linear limit as the safe fallback
+   (4.2). The grid is absolute: for reduced coordinates far from unit size,
+   set select.lambda_min / lambda_max to the scale of the quadratic features
+   (|z|^4).
 
    8.7 Hyper-reduction. Approximating the gradient (plain DEIM) breaks the
    pH structure; approximating the energy keeps it. The paper's weights
@@ -961,7 +1074,7 @@
    give one), which can make the reduced energy unbounded below. phgmg therefore
    defaults to non-negative weights by empirical quadrature and refuses
    negative DEIM weights unless asked. DEIM's mode count is the relative
-   criterion sigma_k / sigma_1 > deim_tol.
+   criterion sigma_k / sigma_1 > hyper.deim_tol.
    Empirical quadrature (phgmg_ecsw) is Lawson-Hanson's active-set method
    for non-negative least squares, stopped at the tolerance: the candidate
    gradient from the Gram matrix Gm^T Gm (formed once: nrows nterms^2
@@ -1271,9 +1384,9 @@
 
 /* >>config ================================================================ */
 #define PHGMG_VERSION_MAJOR 0
-#define PHGMG_VERSION_MINOR 4
+#define PHGMG_VERSION_MINOR 5
 #define PHGMG_VERSION_PATCH 0
-#define PHGMG_VERSION_STRING "0.4.0"
+#define PHGMG_VERSION_STRING "0.5.0"
 
 #include <stddef.h>
 
@@ -2014,7 +2127,7 @@ typedef enum phgmg_method {
 /* A manifold map eta: R^p -> R^rn (p = r - m) and its derivatives at x2:
    q = eta(x2) (rn), Dq = d eta / d x2 (rn x p, column-major), D2q (rn x p*p):
    D2q(:, k*p + j) = d^2 eta / dx2_k dx2_j. Any output may be NULL (not needed
-   by the caller). Used by phgmg_reduce_opts.eta and phgmg_rom.eta_cb. */
+   by the caller). Used by phgmg_reduce_opts.qm.eta and phgmg_rom.eta_cb. */
 typedef void (*phgmg_eta_fn)(const phgmg_real *x2, phgmg_real *q, phgmg_real *Dq, phgmg_real *D2q, void *user);
 
 #define PHGMG_ROM_MAGIC 0x50484731u /* "PHG1" */
@@ -2392,8 +2505,7 @@ PHGMG_DEF phgmg_result phgmg_ecsw_separable(int nterms, int ns, const double *F,
                                             int *pts, double *w, int *nd_out, double *resid_out,
                                             const phgmg_allocator *alloc);
 
-/* Hyper-reduction of a separable part (phgmg_reduce_opts.hyper, with
-   hyper_reduce = 1). */
+/* Hyper-reduction of a separable part (phgmg_hyper_opts.kind, with on = 1). */
 typedef enum phgmg_hyper {
   PHGMG_HYPER_ECSW = 0,   /* default: w >= 0 by NNLS fit of the reduced gradient (ECSW) */
   PHGMG_HYPER_QDEIM = 1,  /* structure-preserving DEIM, Q-DEIM points (the paper's)     */
@@ -2449,7 +2561,7 @@ PHGMG_DEF phgmg_result phgmg_simulate_inputs(const phgmg_ph_system *sys, int nru
                                              const phgmg_gl3_opts *go, double *X, int ldx, double *Y, int *col,
                                              const phgmg_allocator *alloc);
 
-/* GMG-QM manifold constructions (phgmg_reduce_opts.manifold). */
+/* GMG-QM manifold constructions (phgmg_qm_opts.manifold; manual 3.3). */
 typedef enum phgmg_manifold {
   PHGMG_MANIFOLD_POD = 0,    /* the paper's hierarchical POD                       */
   PHGMG_MANIFOLD_GREEDY = 1, /* greedy linear part (Schwerdtner & Peherstorfer 2024) */
@@ -2457,7 +2569,7 @@ typedef enum phgmg_manifold {
   PHGMG_MANIFOLD_COUNT
 } phgmg_manifold;
 
-/* phgmg_reduce_opts.rn: V2 over the whole residual of the snapshots (see rn). */
+/* phgmg_qm_opts.rn: V2 over the whole residual of the snapshots (manual 3.3). */
 #define PHGMG_RN_WIDE (-1)
 
 /* phgmg_reduce_opts.ref: the affine reference state (manual 3.6). */
@@ -2474,63 +2586,67 @@ typedef enum phgmg_lambda_mode {
 
 /* The quadratic manifold of GMG-QM and GMG_MANIFOLD (manual 3.1, 3.3). */
 typedef struct phgmg_qm_opts {
-  int rn;          /* width r_n of V2: > 0 a cap, PHGMG_RN_WIDE the numerical rank of
-                      the residual (manual 3.3); 0: 8 with the POD manifold, wide with
-                      GREEDY / ALTMIN; GMG_MANIFOLD: required, 1..64. < -1: _INVALID_ARG */
-  double lambda;   /* ridge parameter of the fit of M, on the un-normalised sum over
-                      snapshots (0: 1e-3; < 0: exactly zero, minimum-norm fit; NaN:
-                      _INVALID_ARG). Unused unless select.lambda_mode is FIXED */
-  phgmg_manifold manifold; /* construction (manual 3.3; 0: PHGMG_MANIFOLD_POD)         */
+  int rn;          /* width r_n of V2: > 0 a cap, PHGMG_RN_WIDE the numerical rank of the
+                      residual; 0: 8 with the POD manifold, wide with GREEDY / ALTMIN;
+                      GMG_MANIFOLD: required (< 1: _INVALID_ARG). < -1: _INVALID_ARG;
+                      wider than N - r (GMG_MANIFOLD: 64): _SIZE                         */
+  double lambda;   /* ridge parameter of the fit of M, > 0 (0: 1e-3; < 0: exactly zero,
+                      minimum-norm fit; NaN: _INVALID_ARG); read when select.lambda_mode
+                      is PHGMG_LAMBDA_FIXED                                              */
+  phgmg_manifold manifold; /* the construction (0: PHGMG_MANIFOLD_POD; outside the enum:
+                              _INVALID_ARG)                                             */
   int greedy_window;       /* GREEDY / ALTMIN with a wide V2: candidate modes beyond
-                              r - m (0: the construction's own 8 and score; > 0: this
-                              many, ridge-scored; manual 3.3)                          */
-  phgmg_eta_fn eta;        /* GMG_MANIFOLD (required there): the map eta and its
-                              derivatives (manual 3.1); called online                  */
+                              r - m (<= 0: 8, with the construction's own score)         */
+  phgmg_eta_fn eta;        /* GMG_MANIFOLD (required there, else _INVALID_ARG): eta and
+                              its derivatives; called online                           */
   void *eta_user;          /* passed to eta                                            */
 } phgmg_qm_opts;
 
-/* Choosing GMG-QM's lambda and validating the model (manual 4.2). Used only
-   with lambda_mode != PHGMG_LAMBDA_FIXED (newton_tol, newton_iter: by every
-   validation simulation). Bad values: PHGMG_ERR_INVALID_ARG, except blocks <
-   folds or > ns: PHGMG_ERR_SIZE. */
+/* Choosing GMG-QM's lambda (manual 4.2). lambda_min .. blocks and rcond are
+   read, and checked, only when lambda_mode is not PHGMG_LAMBDA_FIXED; bad
+   values give PHGMG_ERR_INVALID_ARG, except blocks < folds or > ns:
+   PHGMG_ERR_SIZE. */
 typedef struct phgmg_select_opts {
-  phgmg_lambda_mode lambda_mode; /* 0: PHGMG_LAMBDA_FIXED                                */
+  phgmg_lambda_mode lambda_mode; /* 0: PHGMG_LAMBDA_FIXED                              */
   double lambda_min;   /* smallest grid lambda, > 0, finite (0: 1e-14)                   */
-  double lambda_max;   /* largest grid lambda, >= lambda_min (0: 1); grid <= 1000 points  */
+  double lambda_max;   /* largest grid lambda, >= lambda_min, finite (0: 1); at most
+                          1000 grid points                                               */
   int per_decade;      /* grid points per decade, 1..100 (0: 4)                          */
   int folds;           /* REGRESSION: folds, >= 2 (0: 5)                                 */
   int blocks;          /* REGRESSION: contiguous time blocks, folds..ns (0: min(ns, 100))*/
   double rcond;        /* conditioning guard, relative to rcond(D^T G D) at x = 0, in
                           [0, 1] (0: 1e-6)                                               */
-  double tolerance;    /* VALIDATED: admissible e_y ratio to the linear limit (0: 1.02)  */
-  int train_only;      /* VALIDATED: 1 = training runs only, no probe runs (0: probes)   */
-  double newton_tol;   /* validation simulations' Newton tolerance (0: 1e-10 full model,
-                          the stepper's default for the reduced one)                     */
-  int newton_iter;     /* validation simulations' iteration cap (0: 20)                  */
+  double tolerance;    /* VALIDATED: admissible e_y ratio to the linear limit, >= 1 and
+                          finite (0: 1.02)                                               */
+  int train_only;      /* VALIDATED: 1 = training runs only, no probe runs; 0 or 1      */
+  double newton_tol;   /* validation simulations' Newton tolerance, [0, 1) (0: 1e-10 for
+                          the full model, the stepper's default for the reduced one)     */
+  int newton_iter;     /* validation simulations' iteration cap, >= 0 (0: 20)            */
 } phgmg_select_opts;
 
-/* Hyper-reduction of a separable part (manual 3.4). */
+/* Hyper-reduction of a separable part, and of dampers (manual 3.4, 1.7). */
 typedef struct phgmg_hyper_opts {
-  int on;              /* 1: hyper-reduce the separable part; 0: keep every term (exact,
-                          O(terms) online). Else _INVALID_ARG; GENERAL part: _UNSUPPORTED */
-  phgmg_hyper kind;    /* with on = 1 (0: PHGMG_HYPER_ECSW)                              */
+  int on;              /* 1: hyper-reduce; 0: keep every term (exact, O(terms) online);
+                          else _INVALID_ARG; with a GENERAL part: _UNSUPPORTED           */
+  phgmg_hyper kind;    /* with on = 1 (0: PHGMG_HYPER_ECSW; outside the enum: _INVALID_ARG) */
   double tol;          /* ECSW: relative training residual of the reduced gradient,
                           [0, 1) (0: 1e-6)                                               */
   double deim_tol;     /* DEIM modes kept: sigma_k / sigma_1 > deim_tol, [0, 1) (0: 1e-8) */
   int deim_max;        /* cap on DEIM modes, >= 0 (0: no cap)                            */
-  int allow_negative;  /* DEIM: 1 = accept negative weights (counted in info)            */
+  int allow_negative;  /* DEIM: 1 = accept negative weights (info.deim_negative); 0:
+                          a negative weight gives PHGMG_ERR_NEGATIVE_WEIGHT              */
 } phgmg_hyper_opts;
 
-/* Results of earlier work reused by a reduction (studies over r; manual 2.3).
-   NULL: computed here. Each must come from the same snapshots. */
+/* Results of earlier work reused by a reduction (manual 2.3), each from the
+   same snapshots X; NULL: computed by the reduction. */
 typedef struct phgmg_reduce_cache {
   const double *pod_basis;  /* N x pod_cols, ld N: leading left singular vectors of
-                               the matrix the method PODs (manual 2.3)                   */
+                               the matrix the method PODs                               */
   int pod_cols;
-  const double *grad_basis; /* SP2: the same for the gradient snapshots                 */
+  const double *grad_basis; /* SP2: the same for the gradient snapshots (N x grad_cols) */
   int grad_cols;
-  const int *deim_pts;      /* phgmg_deim's points and weights on these snapshots       */
-  const double *deim_w;
+  const int *deim_pts;      /* phgmg_deim's points and weights (deim_count of each);   */
+  const double *deim_w;     /* used as given when hyper.on = 1                          */
   int deim_count;
 } phgmg_reduce_cache;
 
@@ -2542,24 +2658,24 @@ typedef struct phgmg_reduce_opts {
                             quadratic H; manual 2.2); 0: none; < 0, NaN, Inf: _INVALID_ARG */
   double degeneracy_tol; /* least rcond of D^T G D at the snapshots (port columns at unit
                             length), in [0, 1) (0: 1e-12); below: PHGMG_ERR_DEGENERATE   */
-  int nrun;              /* the runs that made X (manual 4.1; columns as
-                            phgmg_simulate_inputs, summing to ns, else _SIZE). 0/NULL:  */
-  const phgmg_run *runs; /* X is one run of unknown input                                 */
+  int nrun;              /* runs[0..nrun-1] (nrun <= 64): the runs that made X, laid   */
+  const phgmg_run *runs; /* out as by phgmg_simulate_inputs (manual 4.1; columns summing
+                            to ns, else _SIZE). 0/NULL: X is one run of an unknown input */
   phgmg_ref ref;         /* affine reference state (manual 3.6; 0: PHGMG_REF_NONE)        */
-  const double *ref_x;   /* PHGMG_REF_GIVEN: the N values, finite                         */
+  const double *ref_x;   /* PHGMG_REF_GIVEN: the N values, finite (NULL: _INVALID_ARG)    */
   void (*progress)(const char *phase, void *user); /* stage callback (manual 2.2; NULL) */
   void *progress_user;
-  phgmg_qm_opts qm;         /* GMG-QM / GMG_MANIFOLD                                      */
-  phgmg_select_opts select; /* choosing lambda (GMG-QM)                                  */
-  phgmg_hyper_opts hyper; /* a separable part                                        */
-  phgmg_reduce_cache cache; /* reuse across reductions                                   */
+  phgmg_qm_opts qm;         /* GMG-QM / GMG_MANIFOLD: the manifold                       */
+  phgmg_select_opts select; /* GMG-QM: choosing lambda                                   */
+  phgmg_hyper_opts hyper;   /* a separable part (and dampers)                            */
+  phgmg_reduce_cache cache; /* reuse across reductions (studies)                         */
 } phgmg_reduce_opts;
 
 /* The defaults of phgmg_reduce_opts (the table in manual 3.2): *o is zeroed
    and every field whose zero stands for a default gets that default. A zeroed
    struct and this one reduce identically (with method and r set); use it to
    show or start from the defaults. Left 0: method and r (required),
-   lambda_blocks (min(ns, 100): needs the snapshots), newton_tol (the
+   select.blocks (min(ns, 100): needs the snapshots), select.newton_tol (the
    steppers' own defaults), the optional pointers and flags. */
 PHGMG_DEF void phgmg_reduce_opts_default(phgmg_reduce_opts *o);
 
@@ -2574,12 +2690,12 @@ typedef struct phgmg_reduce_info {
   double rcond_jr;         /* rcond of J - R                                  */
   double pod_sigma_ratio;  /* sigma_{r'+1}/sigma_1 of the (adjusted) snapshots */
   double lambda;           /* GMG-QM: the ridge lambda used (fixed or chosen)  */
-  double lambda_cv_err;    /* lambda_auto: held-out relative error of the quadratic
+  double lambda_cv_err;    /* lambda chosen: held-out relative error of the quadratic
                               correction at that lambda, sum ||V2^T x - M(z kron z)||^2
                               / sum ||V2^T x||^2 over the blocks (1 = no better than
-                              M = 0); 0 without lambda_auto                      */
-  int lambda_grid;         /* lambda_auto: grid points tried (0 without)       */
-  int lambda_raised;       /* lambda_auto: grid steps above the validated optimum
+                              M = 0); 0 with a fixed lambda                    */
+  int lambda_grid;         /* lambda chosen: grid points tried (0 without)     */
+  int lambda_raised;       /* lambda chosen: grid steps above the validated optimum
                               taken because of the non-degeneracy check         */
   int online_full_dim;     /* 1: the reduced model evaluates a GENERAL nonlinear part
                               in full dimension -- O(N) per gradient, O(N^2 r)
@@ -2587,23 +2703,23 @@ typedef struct phgmg_reduce_info {
                               be exported. 0: online cost independent of N. */
   int online_callbacks;    /* 1: the reduced model calls back into user code
                               (separable functions, eta or a GENERAL part)     */
-  int hyper_method;        /* phgmg_hyper used (hyper_reduce = 1), -1 without */
+  int hyper_method;        /* phgmg_hyper used (hyper.on = 1), -1 without     */
   double hyper_min_weight; /* smallest weight of the kept terms                */
   double hyper_residual;   /* ECSW: relative training residual of the reduced
                               nonlinear gradient; 0 for DEIM                   */
-  int lambda_candidates;   /* lambda_auto = 1: candidate lambdas simulated     */
-  double lambda_val_ratio; /* lambda_auto = 1: largest e_y ratio of the chosen
+  int lambda_candidates;   /* VALIDATED: candidate lambdas simulated           */
+  double lambda_val_ratio; /* VALIDATED: largest e_y ratio of the chosen
                               model to the linear limit over the validation runs */
-  /* manifold = PHGMG_MANIFOLD_ALTMIN: the objective sum_i ||x_i - phi(rho(x_i))||^2
+  /* qm.manifold = PHGMG_MANIFOLD_ALTMIN: the objective sum_i ||x_i - phi(rho(x_i))||^2
      + lam ||M||^2 over the snapshots (lam: the ridge parameter of the sweeps) at
      the start (the hierarchical POD, or the greedy manifold) and at the end,
      and the sweeps kept (with a wide V2: the descent steps taken); the final
      M is then refitted with the lambda in force (fixed or automatic). */
   double manifold_obj0, manifold_obj;
   int manifold_sweeps;
-  /* 1: altmin under lambda_auto = 1 gave no model at least as good as GMG-POD
-     on every validation run (within lambda_tolerance), so the returned model
-     is the one of manifold = PHGMG_MANIFOLD_POD (same options otherwise) */
+  /* 1: altmin under PHGMG_LAMBDA_VALIDATED gave no model at least as good as GMG-POD
+     on every validation run (within select.tolerance), so the returned model
+     is the one of qm.manifold = PHGMG_MANIFOLD_POD (same options otherwise) */
   int manifold_fallback;
   int pod_randomized;      /* the basis POD: 0 exact SVD; 1 randomized (large
                               N*ns, see phgmg_reduce: it passed its check);
@@ -2627,9 +2743,9 @@ typedef struct phgmg_reduced phgmg_reduced;
    ||X W - V diag(S)||_F <= PHGMG_POD_CHECK_TOL S_1 and otherwise replaced by
    the exact SVD (info.pod_randomized, info.pod_check); smaller problems take
    the exact path bit for bit.
-   Errors: PHGMG_ERR_INVALID_ARG (NULL, bad options: method, deim not 0/1,
-   deim_tol NaN or outside [0, 1), dt NaN/Inf/negative, lambda NaN,
-   GMG_MANIFOLD without eta or rn), PHGMG_ERR_SIZE (r <= m for GMG, r > rank of
+   Errors: PHGMG_ERR_INVALID_ARG (NULL, bad options: method, hyper.on not
+   0/1, hyper.deim_tol NaN or outside [0, 1), dt NaN/Inf/negative, qm.lambda
+   NaN, GMG_MANIFOLD without qm.eta or qm.rn; manual 3.2), PHGMG_ERR_SIZE (r <= m for GMG, r > rank of
    the snapshots, polynomial degree > 32, ...), PHGMG_ERR_RANK, _DEGENERATE,
    _NEGATIVE_WEIGHT, _NANINF, _NOMEM, _UNSUPPORTED. *out is NULL on every
    failure (when out itself is not NULL). info may be NULL. */
@@ -2741,7 +2857,7 @@ PHGMG_DEF void phgmg_err_energy(const phgmg_energy *energy, int nsteps, double *
    modes, from ||R_K||_F^2 plus sums of squared coordinates: no
    cancellation), [B, Ua]^T G [B, Ua] and [B, Ua]^T Q [B, Ua], and the DEIM
    points (at their first use). phgmg_study_reduce then builds the same
-   model as phgmg_reduce with opts.pod_basis (and grad_basis) set to the
+   model as phgmg_reduce with opts.cache.pod_basis (and grad_basis) set to the
    study's bases, taking every snapshot quantity from the coordinates
    (O(K ns r) per model instead of O(N ns r)), and phgmg_study_errors
    evaluates e_red, e_proj, e_lowerbound in reduced coordinates (the bases
@@ -2765,19 +2881,19 @@ PHGMG_DEF phgmg_result phgmg_study_create(phgmg_study **out, const phgmg_ph_syst
                                           int ldx, int ns, const phgmg_study_opts *so,
                                           const phgmg_allocator *alloc);
 PHGMG_DEF void phgmg_study_destroy(phgmg_study *st);
-/* A study's basis, for phgmg_reduce_opts.pod_basis / grad_basis of your own
+/* A study's basis, for phgmg_reduce_opts.cache.pod_basis / grad_basis of your own
    calls: which = 'a' (POD of the adjusted snapshots: GMG), 'p' (POD of X:
    SP1/SP2), 'g' (POD of the gradient snapshots: SP2). N x *cols, ld N,
    valid until destroy; NULL (and *cols = 0) if the study has none. */
 PHGMG_DEF const double *phgmg_study_basis(const phgmg_study *st, char which, int *cols);
 /* phgmg_reduce(out, sys, X, ldx, ns, opts', info, alloc) of the study's
    system and snapshots, with opts' = opts plus the study's bases where
-   opts leaves pod_basis / grad_basis NULL (GMG-POD, GMG-QM, SP1, SP2), and
-   with opts.hyper_reduce = 1, hyper QDEIM or GREEDY and no deim_pts: the study's
-   DEIM points (computed at the first such call, reused while deim_tol,
-   deim_max and the point selection are the same). The fast path (snapshot
-   quantities from coordinates) applies to GMG-POD, GMG-QM with manifold 0,
-   SP1 and SP2 on the study's own bases and r - m + rn (GMG) / r (SP) within
+   opts leaves cache.pod_basis / grad_basis NULL (GMG-POD, GMG-QM, SP1, SP2),
+   and with opts.hyper.on = 1, hyper.kind QDEIM or GREEDY and no
+   cache.deim_pts: the study's DEIM points (computed at the first such call,
+   reused while hyper.deim_tol, hyper.deim_max and the point selection are
+   the same). The fast path (snapshot quantities from coordinates) applies
+   to GMG-POD, GMG-QM with qm.manifold = PHGMG_MANIFOLD_POD, SP1 and SP2 on the study's own bases and r - m + rn (GMG) / r (SP) within
    its modes; other models are built exactly as phgmg_reduce builds them.
    Not thread-safe on one study (the DEIM cache). The system (sizes, J, R,
    Q, B, a separable part's indices, weights and coefficients) must not
@@ -2811,7 +2927,7 @@ PHGMG_DEF phgmg_result phgmg_study_errors(const phgmg_study *st, const phgmg_red
    check the residual with phgmg_lyap_residual / phgmg_care_residual), balanced
    truncation (square-root method) as reference, positive-real balanced
    truncation (PRBT) returning a pH reduced model, input-independent bases for
-   GMG-POD (pass them through phgmg_reduce_opts.pod_basis; kind H2: the GMG
+   GMG-POD (pass them through phgmg_reduce_opts.cache.pod_basis; kind H2: the GMG
    model of least H2 error, by L-BFGS), transfer functions
    and H-infinity / H2 errors. Cost O(n^3) per sign step (15-17 steps on the
    mass-spring-damper chains; tests/test_linear.c, bench/bench_linear.c). */
@@ -2935,7 +3051,7 @@ typedef struct phgmg_basis_opts {
 /* An input-independent basis V (N x k, ld N) for GMG: orthonormal and
    orthogonal to B, ordered (FREQ, IMPULSE: POD of the snapshots after
    removing their B-component; BALANCED: Gram-Schmidt of [B, T] in order,
-   B's part dropped). Pass it as opts.pod_basis / pod_cols = k to
+   B's part dropped). Pass it as opts.cache.pod_basis / pod_cols = k to
    phgmg_reduce (GMG-POD takes its first r - m columns). opts may be NULL.
    *k_out (may be NULL) = columns filled (fewer if the snapshots have lower
    rank; the rest is zero).
@@ -11883,11 +11999,11 @@ struct phgmg_study {
   double deim_tol, deim_sigma;
   int *deim_pts;
   double *deim_w;
-  /* lambda_auto = 1 validation data (first use): the snapshots' outputs
+  /* PHGMG_LAMBDA_VALIDATED validation data (first use): the snapshots' outputs
      B^T grad H(x_j) (m x ns), and the probe runs' full-model outputs for
      one runs[0] (key: its input, x0 (copy), t0, dt, steps; Newton settings) */
   double *Yt, *Yp, *px0;
-  double *cv;              /* lambda_auto regression errors on the grid (first use; key below) */
+  double *cv;              /* lambda-selection regression errors on the grid (first use; key below) */
   int cv_p, cv_rn, cv_ng, cv_nf, cv_nb;
   double cv_lo, cv_hi;
   int pnv, pn, pit, phave;
@@ -13475,7 +13591,7 @@ PHGMG__PRIV phgmg_result phgmg__publish(phgmg_reduced *red) {
   return rc == PHGMG_OK && red->ndamp ? phgmg__publish_dampers(red) : rc;
 }
 
-/* GMG-QM ridge validation (phgmg_reduce_opts.lambda_auto). The rows of K
+/* GMG-QM ridge validation (phgmg_select_opts.lambda_mode). The rows of K
    (ns x nc, the distinct Kronecker columns of the reduced snapshots) and Y
    (ns x rn, their V2 coordinates) are cut into nblk contiguous blocks (in
    time), block j going to fold j mod nfold. For each fold, one thin SVD
@@ -13694,7 +13810,7 @@ typedef struct phgmg__rctx {
   int v2ok;                /* V2h holds rn modes above the rank floor       */
   phgmg_jr_factor *jr;     /* factorization of J - R (GMG)                 */
   int *runcol;             /* opts.runs: nrun + 1 column offsets (NULL: one run) */
-  int fallback_pod;        /* altmin under lambda_auto = 1 found no model as good as
+  int fallback_pod;        /* altmin under PHGMG_LAMBDA_VALIDATED found no model as good as
                               GMG-POD: phgmg_reduce redoes it with manifold = POD */
   phgmg_study *st;         /* phgmg_study_reduce: the study (else NULL)     */
   int sf;                  /* fast path on the study's basis: PHGMG__SF_* */
@@ -13774,10 +13890,11 @@ PHGMG__PRIV phgmg_result phgmg__deploy_check(const phgmg_reduce_opts *o, int ns)
   if (o->nrun > 0 && phgmg_runs_columns(o->nrun, o->runs) != ns) return PHGMG_ERR_SIZE;
   if (!(o->select.tolerance >= 1.0 && o->select.tolerance < HUGE_VAL))
     return PHGMG_ERR_INVALID_ARG;
-  if (!(o->select.newton_tol >= 0.0 && o->select.newton_tol < 1.0) || o->select.newton_iter < 0) return PHGMG_ERR_INVALID_ARG;
+  if (!(o->select.newton_tol >= 0.0 && o->select.newton_tol < 1.0) || o->select.newton_iter < 0)
+    return PHGMG_ERR_INVALID_ARG;
   if ((int)o->qm.manifold < 0 || (int)o->qm.manifold >= (int)PHGMG_MANIFOLD_COUNT) return PHGMG_ERR_INVALID_ARG;
   if (o->select.train_only != 0 && o->select.train_only != 1) return PHGMG_ERR_INVALID_ARG;
-  if (o->ref < 0 || o->ref >= (int)PHGMG_REF_COUNT || (o->ref == PHGMG_REF_GIVEN && !o->ref_x))
+  if ((int)o->ref < 0 || (int)o->ref >= (int)PHGMG_REF_COUNT || (o->ref == PHGMG_REF_GIVEN && !o->ref_x))
     return PHGMG_ERR_INVALID_ARG;
   return PHGMG_OK;
 }
@@ -13841,7 +13958,8 @@ PHGMG__PRIV phgmg_result phgmg__reduce_check(const phgmg_ph_system *sys, const d
   if (!X_checked && !phgmg__mat_finite(N, ns, X, ldx)) return PHGMG_ERR_NANINF; /* padding rows are not data */
   if (o->select.lambda_mode != PHGMG_LAMBDA_FIXED) {
     const int nf = o->select.folds, nb = o->select.blocks;
-    if ((int)o->select.lambda_mode < 0 || (int)o->select.lambda_mode >= (int)PHGMG_LAMBDA_MODE_COUNT || o->select.per_decade < 0 || nf < 2 || nb < 0)
+    if ((int)o->select.lambda_mode < 0 || (int)o->select.lambda_mode >= (int)PHGMG_LAMBDA_MODE_COUNT ||
+        o->select.per_decade < 0 || nf < 2 || nb < 0)
       return PHGMG_ERR_INVALID_ARG;
     if (!(o->select.rcond >= 0.0 && o->select.rcond <= 1.0)) return PHGMG_ERR_INVALID_ARG;
     if (phgmg__lambda_grid(o->select.lambda_min, o->select.lambda_max, o->select.per_decade, NULL) < 1)
@@ -13892,7 +14010,7 @@ PHGMG__PRIV phgmg_result phgmg__reduce_new(phgmg__rctx *c) {
   return PHGMG_OK;
 }
 
-/* A caller's basis (GMG: [V1, V2] from opts.pod_basis) must be orthonormal
+/* A caller's basis (GMG: [V1, V2] from opts.cache.pod_basis) must be orthonormal
    and orthogonal to B; the hierarchical POD gives that by construction. */
 PHGMG__PRIV phgmg_result phgmg__check_given_basis(const phgmg_reduced *red, const double *V, int k,
                                                    const phgmg_allocator *alloc) {
@@ -13960,7 +14078,7 @@ PHGMG__PRIV phgmg_result phgmg__basis_pod_implicit(phgmg__rctx *c, double *tmp) 
 
 /* Stage 1, basis. GMG: V0 = [B, V1], V1 = POD of the adjusted snapshots
    X - B B^+ X (c->Xa keeps them, for the manifold stage). SP1/SP2: V0 =
-   V_POD of X. opts.pod_basis replaces the POD. */
+   V_POD of X. opts.cache.pod_basis replaces the POD. */
 PHGMG__PRIV phgmg_result phgmg__stage_basis(phgmg__rctx *c) {
   phgmg_reduced *red = c->red;
   const int N = red->N, m = red->m, p = red->p, ns = c->ns;
@@ -14078,7 +14196,8 @@ PHGMG__PRIV phgmg_result phgmg__qm_problem(phgmg__rctx *c) {
   return PHGMG_OK;
 }
 
-/* opts.lambda_auto: validation over contiguous blocks of snapshots picks the
+/* A chosen lambda (PHGMG_LAMBDA_REGRESSION, and the starting point of
+   _VALIDATED): validation over contiguous blocks of snapshots picks the
    grid lambda (ties within 1e-6 relative: the largest). */
 PHGMG__PRIV phgmg_result phgmg__qm_lambda_auto(phgmg__rctx *c) {
   const phgmg_reduce_opts *o = c->o;
@@ -14119,12 +14238,12 @@ PHGMG__PRIV phgmg_result phgmg__qm_lambda_auto(phgmg__rctx *c) {
   return PHGMG_OK;
 }
 
-/* opts.manifold = 1, greedy linear part (Schwerdtner & Peherstorfer 2024):
+/* opts.qm.manifold = 1, greedy linear part (Schwerdtner & Peherstorfer 2024):
    among the q = min(p + rn, available) leading POD modes U of the adjusted
    snapshots, V1 takes one mode at a time -- the one whose reduced
    coordinates z (with those already taken) best predict the remaining
    modes' coordinates by the quadratic ridge fit M (z kron z) (ridge lambda
-   1e-9 under lambda_auto, whose lambda is not known yet; else opts.lambda). Works in the
+   1e-9 when lambda is chosen, whose lambda is not known yet; else opts.qm.lambda). Works in the
    q POD coordinates S = U^T Xa of every k-th snapshot (k = ceil(ns / 400)),
    so a trial costs one small least-squares solve. Writes V1 into red->V0. */
 PHGMG__PRIV phgmg_result phgmg__qm_greedy(phgmg__rctx *c) {
@@ -14214,7 +14333,7 @@ PHGMG__PRIV void phgmg__arena_free(void *p, void *u) {
   phgmg__free(a->up, p);
 }
 
-/* opts.manifold = PHGMG_MANIFOLD_ALTMIN, one evaluation in the q POD
+/* opts.qm.manifold = PHGMG_MANIFOLD_ALTMIN, one evaluation in the q POD
    coordinates S (q x ns) of the adjusted snapshots, for the orthonormal
    Q = [Q1, Q2] (q x (p + rn)): Z = Q1^T S, the ridge fit T (nc x rn) of
    Q2^T S over the distinct Kronecker columns Kt of Z (as phgmg__qm_problem),
@@ -14312,7 +14431,7 @@ PHGMG__PRIV phgmg_result phgmg__altmin_sweep(phgmg__altmin_ws *w, double *f, int
 /* The search space of the alternating minimization (phgmg__qm_altmin): q
    orthonormal modes U (N x q, room for qmax) of the adjusted snapshots, in
    which V1 and V2 are rotated. Warm start (the greedy's, c->Uw): [V1, the
-   leading modes of its complement]; opts.pod_basis: its leading columns;
+   leading modes of its complement]; opts.cache.pod_basis: its leading columns;
    else the leading POD modes of Xa, with a wide V2 only those above the
    rank floor (the numerical rank). Sets *q <= qmax. */
 PHGMG__PRIV phgmg_result phgmg__altmin_space(phgmg__rctx *c, int qmax, double *U, int *q) {
@@ -14402,7 +14521,7 @@ PHGMG__PRIV phgmg_result phgmg__awide_eval(phgmg__awide *w, const double *Q1, do
   return PHGMG_OK;
 }
 
-/* The descent in Q1 (opts.manifold = ALTMIN with a wide V2): from Q1 = the
+/* The descent in Q1 (opts.qm.manifold = ALTMIN with a wide V2): from Q1 = the
    first p coordinates (the start of phgmg__qm_altmin), steps
    Q1 <- polar(Q1 - t g) along the tangent gradient g, with the
    Barzilai-Borwein step t (the plain gradient step converges slowly here)
@@ -14464,7 +14583,7 @@ PHGMG__PRIV phgmg_result phgmg__altmin_wide(phgmg__awide *w, double *Q1, double 
   return rc == PHGMG_ERR_NOMEM ? rc : PHGMG_OK;   /* a failed fit or step: the best Q1 so far */
 }
 
-/* opts.manifold = PHGMG_MANIFOLD_ALTMIN: alternating minimization of the
+/* opts.qm.manifold = PHGMG_MANIFOLD_ALTMIN: alternating minimization of the
    linear and quadratic parts (after Geelen, Balzano, Wright & Willcox 2023).
    In the coordinates S = U^T Xa of q orthonormal modes U of the adjusted
    snapshots Xa = X - B B^+ X (phgmg__altmin_space), with V1 = U Q1,
@@ -14596,7 +14715,7 @@ PHGMG__PRIV void phgmg__qm_features(int p, int ns, const double *Z2, int ldz, do
   }
 }
 
-/* Wide V2 (opts.rn = PHGMG_RN_WIDE; the default of the greedy and alternating
+/* Wide V2 (opts.qm.rn = PHGMG_RN_WIDE; the default of the greedy and alternating
    minimization manifolds). V2 spans the whole residual Xres = (I - [B, V1]
    [B, V1]^+) X up to its numerical rank: kw orthonormal directions U (N x kw)
    with coordinates C = U^T Xres (kw x ns), given (the greedy's complement) or
@@ -14734,9 +14853,9 @@ PHGMG__PRIV void phgmg__gw_take(phgmg__gw *w, const int *sel, int j, int k) {
   for (w->tin = 0.0, a = 0; a < w->nin; ++a) w->tin += phgmg__dot(nsub, w->Qin + (size_t)a * L, w->GA + (size_t)a * nsub);
 }
 
-/* opts.manifold = 1 with a wide V2 (phgmg__qm_wide_v2) and greedy_window > 0:
+/* opts.qm.manifold = 1 with a wide V2 (phgmg__qm_wide_v2) and qm.greedy_window > 0:
    V1 takes one POD mode of the adjusted snapshots at a time among the
-   qw = p + greedy_window leading ones, the one whose features (with those
+   qw = p + qm.greedy_window leading ones, the one whose features (with those
    already taken) leave the smallest ridge objective (misfit + lam ||T||^2;
    phgmg__qm_greedy scores the misfit alone) over the other candidates not
    yet taken (after Schwerdtner & Peherstorfer 2024). One SVD of Xa up to its
@@ -14767,7 +14886,8 @@ PHGMG__PRIV phgmg_result phgmg__qm_greedy_wide(phgmg__rctx *c) {
       for (i = 0; i < q; ++i) C[i + (size_t)j * q] = S[i] * W[j + (size_t)i * ns];
     for (j = 0; j < nsub; ++j) memcpy(Cs + (size_t)j * q, C + (size_t)j * st * q, (size_t)q * sizeof(double));
     memset(&w, 0, sizeof w);
-    w.q = q; w.nsub = nsub; w.L = L; w.Cs = Cs; w.sl = sqrt(c->o->select.lambda_mode != PHGMG_LAMBDA_FIXED ? 1e-9 : (c->lambda > 0.0 ? c->lambda : 1e-12));
+    w.q = q; w.nsub = nsub; w.L = L; w.Cs = Cs;
+    w.sl = sqrt(c->o->select.lambda_mode != PHGMG_LAMBDA_FIXED ? 1e-9 : (c->lambda > 0.0 ? c->lambda : 1e-12));
     w.G = buf; w.Qin = w.G + (size_t)nsub * nsub; w.A = w.Qin + (size_t)L * nc; w.GA = w.A + (size_t)L * p;
     w.t = w.GA + (size_t)nsub * nc; w.sv = w.t + (size_t)nc * p;
     qw = PHGMG__MIN(q, p + c->o->qm.greedy_window);
@@ -14805,7 +14925,7 @@ PHGMG__PRIV phgmg_result phgmg__qm_greedy_wide(phgmg__rctx *c) {
 }
 
 /* The manifolds' constructions of V1 (and V2 where the construction makes
-   it), described once: opts.manifold indexes this table for GMG-QM. */
+   it), described once: opts.qm.manifold indexes this table for GMG-QM. */
 PHGMG__PRIV phgmg_result phgmg__v1_pod(phgmg__rctx *c) { (void)c; return PHGMG_OK; }   /* V1 = POD modes */
 PHGMG__PRIV phgmg_result phgmg__v1_greedy(phgmg__rctx *c) {
   /* a wide V2 with a greedy_window: the incremental selection; else the classic one */
@@ -14832,8 +14952,8 @@ static const phgmg__manifold_row phgmg__manifolds[PHGMG_MANIFOLD_COUNT] = {
 };
 
 /* Stage 2, manifold (QUADRATIC kind): V2 = POD of the residual of [B, V1]
-   (paper 4.2.2; V1 greedy with opts.manifold = 1), V1 and V2 by alternating
-   minimization (opts.manifold = 2), or the caller's; then GMG-QM fits M (eq. least_square_reg,
+   (paper 4.2.2; V1 greedy with opts.qm.manifold = 1), V1 and V2 by alternating
+   minimization (opts.qm.manifold = 2), or the caller's; then GMG-QM fits M (eq. least_square_reg,
    lambda fixed or by validation); GMG_MANIFOLD takes the caller's eta. */
 PHGMG__PRIV phgmg_result phgmg__stage_manifold(phgmg__rctx *c) {
   phgmg_reduced *red = c->red;
@@ -14933,7 +15053,7 @@ PHGMG__PRIV phgmg_result phgmg__dgd_rcond_snapshots(phgmg__rctx *c, double stop_
 
 /* Non-degeneracy of D^T G D at x = 0 and (QUADRATIC) at every snapshot. With
    the automatic lambda, an M that (nearly) degenerates it (rcond below
-   lambda_rcond times its value at x = 0) moves to the next larger grid
+   select.rcond times its value at x = 0) moves to the next larger grid
    lambda (M -> 0 as lambda grows, and D^T G D -> G00). */
 PHGMG__PRIV double phgmg__dgd_rcond0(phgmg__rctx *c) {
   phgmg_reduced *red = c->red;
@@ -15384,7 +15504,7 @@ PHGMG__PRIV phgmg_result phgmg__qm_set(phgmg__rctx *c, int g, phgmg_real *ms) {
   return PHGMG_OK;
 }
 
-/* The validation reference of an altmin manifold (lambda_auto = 1): its own
+/* The validation reference of an altmin manifold (PHGMG_LAMBDA_VALIDATED): its own
    linear limit M = 0 is not GMG-POD (V1 is not the POD basis), so GMG-POD
    itself (phgmg_reduce with the same options, method GMG_POD) is simulated on
    the validation runs too and the reference becomes the smaller of the two
@@ -15397,7 +15517,8 @@ PHGMG__PRIV phgmg_result phgmg__altmin_reference(phgmg__rctx *c, phgmg__vset *v,
   phgmg_reduced *pod = NULL, *keep = c->red;
   int k, ok = 0;
   phgmg_result rc;
-  o.method = PHGMG_METHOD_GMG_POD; o.select.lambda_mode = PHGMG_LAMBDA_FIXED; o.qm.manifold = PHGMG_MANIFOLD_POD; o.nrun = 0; o.runs = NULL;
+  o.method = PHGMG_METHOD_GMG_POD; o.select.lambda_mode = PHGMG_LAMBDA_FIXED; o.qm.manifold = PHGMG_MANIFOLD_POD;
+  o.nrun = 0; o.runs = NULL;
   o.dt = 0.0;
   rc = phgmg_reduce(&pod, c->sys, c->Xf, c->ldxf, c->ns, &o, NULL, c->alloc);
   if (rc == PHGMG_ERR_NOMEM) return rc;
@@ -15414,8 +15535,8 @@ PHGMG__PRIV phgmg_result phgmg__altmin_reference(phgmg__rctx *c, phgmg__vset *v,
   return PHGMG_OK;
 }
 
-/* opts.lambda_auto = 1 (after publish): validation by simulation, see the
-   manual 4.2. Candidates from lambda_max down, one
+/* PHGMG_LAMBDA_VALIDATED (after publish): validation by simulation, see the
+   manual 4.2. Candidates from select.lambda_max down, one
    per decade, to the regression optimum; stops after two inadmissible
    candidates in a row (the error grows as lambda falls). */
 PHGMG__PRIV phgmg_result phgmg__stage_lambda_validate(phgmg__rctx *c) {
@@ -15523,7 +15644,7 @@ PHGMG__PRIV phgmg_result phgmg__study_gmg_blocks(phgmg__rctx *c) {
 /* >>dampers (reduction, manual 1.7). The reduced dampers of the co-state test
    basis Wz (N x r): Cd(:, k) = Wz^T c_k = Wz(i_k, :) - Wz(j_k, :). GMG
    (add_lin = 1): K, built from G = (J - R - L)^{-1}, becomes Wz^T (J - R) Wz
-   = K + sum_k rho_k'(0) Cd_k Cd_k^T. Then, with opts.hyper_reduce, the dampers are
+   = K + sum_k rho_k'(0) Cd_k Cd_k^T. Then, with opts.hyper.on, the dampers are
    hyper-reduced by ECSW (weights >= 0) on the training forces
    rho_k(c_k^T z(x_j)). */
 PHGMG__PRIV phgmg_result phgmg__dampers_hyper(phgmg__rctx *c);
@@ -15892,9 +16013,9 @@ PHGMG__PRIV phgmg_result phgmg__hyper_ecsw_manifold(phgmg__rctx *c, const double
   return rc;
 }
 
-/* Hyper-reduction by empirical quadrature (ECSW, opts.hyper = 0): terms and
+/* Hyper-reduction by empirical quadrature (hyper.kind = PHGMG_HYPER_ECSW): terms and
    weights w >= 0 that reproduce the reduced gradient of the nonlinear part
-   over the training snapshots to hyper_tol (phgmg_ecsw). With w >= 0 and a
+   over the training snapshots to hyper.tol (phgmg_ecsw). With w >= 0 and a
    convex phi the reduced Hamiltonian stays convex and bounded below. Here
    for a linear-kind model, on the terms live[0..nl) (F: nl x ns, their
    gradients at the snapshots); pts come back as full term indices. */
@@ -15944,7 +16065,7 @@ PHGMG__PRIV phgmg_result phgmg__separable_gradients(phgmg__rctx *c, int compact,
   return PHGMG_OK;
 }
 
-/* Points and weights of the separable sum: the caller's (opts.deim_pts),
+/* Points and weights of the separable sum: the caller's (opts.cache.deim_pts),
    structure-preserving DEIM on the snapshots of the terms' gradients, or
    every term with its own weight. pts/wt have room for nsep entries. */
 PHGMG__PRIV phgmg_result phgmg__separable_points(phgmg__rctx *c, int *pts, double *wt, int *nd) {
@@ -16159,7 +16280,7 @@ PHGMG__PRIV phgmg_result phgmg__stage_reference_terms(phgmg__rctx *c) {
   return rc;
 }
 
-/* manifold = ALTMIN under lambda_auto = 1 without a model as good as GMG-POD
+/* manifold = ALTMIN under PHGMG_LAMBDA_VALIDATED without a model as good as GMG-POD
    (phgmg__altmin_reference): the same reduction with the hierarchical POD
    manifold; info keeps the altmin objective and sets manifold_fallback. */
 PHGMG__PRIV phgmg_result phgmg__reduce_fallback_pod(phgmg_reduced **out, const phgmg__rctx *c,
@@ -16245,7 +16366,7 @@ PHGMG__PRIV phgmg_result phgmg__reduce_setup(phgmg__rctx *c, const phgmg_ph_syst
   c->st = st;
   c->inf.hyper_method = -1;
   rc = phgmg__reduce_check(sys, X, ldx, ns, c->o, st != NULL);
-  if (rc == PHGMG_OK) c->sf = (c->o->ref || sys->ndamp) ? PHGMG__SF_NONE : phgmg__study_fast(st, c->o, sys->m);
+  if (rc == PHGMG_OK) c->sf = (c->o->ref != PHGMG_REF_NONE || sys->ndamp) ? PHGMG__SF_NONE : phgmg__study_fast(st, c->o, sys->m);
   if (rc == PHGMG_OK) rc = phgmg_ph_validate(sys, 0.0, &c->inf.rcond_jr, alloc);
   if (rc == PHGMG_OK && sys->E && phgmg__e_algebraic(sys, alloc) != 0)   /* reduce the condensed model (1.8) */
     rc = PHGMG_ERR_UNSUPPORTED;
@@ -19888,6 +20009,40 @@ PHGMG_DEF phgmg_result phgmg_npy_write(const char *path, const double *A, int ro
 
 /*
    REVISION HISTORY
+   0.5.0  (2026-11-26)
+          - Changed (breaking): the options of phgmg_reduce_opts are grouped
+            in sub-structs, qm (phgmg_qm_opts), select (phgmg_select_opts),
+            hyper (phgmg_hyper_opts) and cache (phgmg_reduce_cache); every
+            moved field has a new name, so code using an old one no longer
+            compiles (nothing changes meaning silently). Old name -> new name:
+              rn -> qm.rn            lambda -> qm.lambda
+              manifold -> qm.manifold            eta -> qm.eta
+              greedy_window -> qm.greedy_window  eta_user -> qm.eta_user
+              lambda_auto -> select.lambda_mode  lambda_min -> select.lambda_min
+              lambda_max -> select.lambda_max    lambda_rcond -> select.rcond
+              lambda_per_decade -> select.per_decade
+              lambda_folds -> select.folds       lambda_blocks -> select.blocks
+              lambda_tolerance -> select.tolerance
+              lambda_train_only -> select.train_only
+              newton_tol -> select.newton_tol    newton_iter -> select.newton_iter
+              hyper_reduce -> hyper.on           hyper -> hyper.kind
+              hyper_tol -> hyper.tol             deim_tol -> hyper.deim_tol
+              deim_max -> hyper.deim_max
+              deim_allow_negative -> hyper.allow_negative
+              pod_basis -> cache.pod_basis       pod_cols -> cache.pod_cols
+              grad_basis -> cache.grad_basis     grad_cols -> cache.grad_cols
+              deim_pts -> cache.deim_pts         deim_w -> cache.deim_w
+              deim_count -> cache.deim_count
+            Unchanged: method, r, dt, degeneracy_tol, nrun, runs, ref, ref_x,
+            progress, progress_user. Zero still means the default everywhere,
+            and the models are the same bit for bit.
+          - Changed: lambda_auto (0, 1, 2) is select.lambda_mode of the enum
+            phgmg_lambda_mode (PHGMG_LAMBDA_FIXED, _VALIDATED, _REGRESSION,
+            _MODE_COUNT), same values; opts.ref has the type phgmg_ref;
+            phgmg_deim_select's method is of the enum phgmg_deim_method
+            (PHGMG_DEIM_QDEIM, _GREEDY, _METHOD_COUNT; same values).
+          - Removed: phgmg_reduce_opts.deim, the former name of hyper_reduce
+            (now hyper.on). The CLI's options keep their names.
    0.4.0  (2026-11-26)
           - New: algebraic constraints of index one: a singular E with zero
             rows and columns (or a dense singular E, rotated into that form)

@@ -181,7 +181,7 @@ DEMO_FN void demo_write_csv(const char *path, const char *header, int nrows, int
 DEMO_FN void demo_mkdir(const char *dir) { mkdir(dir, 0777); }
 
 /* --lambda L|auto: a number (fixed GMG-QM ridge parameter) or "auto"
-   (phgmg_reduce_opts.lambda_auto with the default grid and folds). Returns
+   (phgmg_reduce_opts.select.lambda_mode with the default grid and folds). Returns
    1 for auto, 0 for a number (stored in *lambda), -1 for anything else. */
 DEMO_FN int demo_parse_lambda(const char *arg, double *lambda) {
   char *end;
@@ -284,7 +284,7 @@ DEMO_FN void demo_lambda_auto_row(const phgmg_ph_system *sys, const double *X, c
 DEMO_FN void demo_lambda_auto_header(const char *input) {
   printf("\nu = %s  (e_red; QM-auto: lambda_auto = 1, validated by simulation on the training run and probe runs;\n"
          "QM-best: lambda validated on the training run alone, hierarchical POD or greedy linear part\n"
-         "(opts.manifold = 1, marked g), whichever has the smaller training e_red;\n"
+         "(opts.qm.manifold = 1, marked g), whichever has the smaller training e_red;\n"
          "lambda nan = the linear limit M = 0; "
          "+ = raised by the conditioning guard)\n  %3s  %-10s %-10s %-7s %-11s %-10s %-7s %-4s %-10s %-7s %-9s %s\n",
          input, "r", "GMG-POD", "QM-auto", "ratio", "lambda", "lowerbnd", "QM/lb", "fail", "QM-best", "ratio",

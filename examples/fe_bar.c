@@ -18,7 +18,7 @@
    Training: one run, u_a(t) = sin((1 + a/2) t), dt = 0.05, 1000 steps. Test:
    u_a(t) = 0.5 sin(0.7 t) + 0.5 cos((1.3 + a/3) t), 1000 steps (not trained
    on). Methods: GMG-POD, GMG-QM (lambda validated by simulation,
-   lambda_auto = 1), SP1, SP2 at r = 8, 14, 20; e_y is the relative output
+   PHGMG_LAMBDA_VALIDATED), SP1, SP2 at r = 8, 14, 20; e_y is the relative output
    error of the reduced model (phgmg_reduced_validate).
    Output: a table, and DIR/fe_bar.csv (method, r, e_y train, e_y test).
    Usage: fe_bar [--n N] [--out DIR]     (defaults: n = 400 (N = 800), results) */

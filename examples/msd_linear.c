@@ -20,7 +20,7 @@
      --lambda auto                  the automatic-lambda study instead: GMG-POD
                                     and GMG-QM with lambda chosen by validation on
                                     held-out blocks of snapshots
-                                    (phgmg_reduce_opts.lambda_auto); prints the
+                                    (phgmg_reduce_opts.select.lambda_mode); prints the
                                     chosen lambda and writes only
                                     results/linear_<sin|const>_lambda_auto.csv
                                     (r,GMG-POD,GMG-QM-auto,lambda,lowerbound,

@@ -22,7 +22,7 @@
      --lambda L       fixed GMG-QM ridge parameter (default: the rule above)
      --lambda auto    the automatic-lambda study instead: GMG-POD and GMG-QM
                       with lambda chosen by validation on held-out blocks of
-                      snapshots (phgmg_reduce_opts.lambda_auto); writes only
+                      snapshots (phgmg_reduce_opts.select.lambda_mode); writes only
                       results/nonlinear_<sin|const>_lambda_auto.csv
                       (r,GMG-POD,GMG-QM-auto,lambda,lowerbound,newton_failures)
      --deim-tol T     DEIM tolerance (default 1e-8)

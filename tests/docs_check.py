@@ -14,6 +14,8 @@ Fails (exit 1, one line per finding) when
   - phgmg_reduce_opts_default() disagrees with the defaults in the manual's
     table (3.2) or with the defaults `phgmg --help` states for --rn,
     --deim-tol and --hyper-tol;
+  - a renamed option of the newest revision history entry's table
+    (old -> new) compiles under its old name, or not under its new one;
   - a tracked file name starts with '-';
   - README.md, phgmg.h or the Makefile mention an issue number, a "session",
     or a document outside the repository (the notes files by name).
@@ -103,14 +105,15 @@ int main(void) {
   phgmg_reduce_opts_default(&o);
 #define I(f) printf(#f " %d\n", (int)o.f);
 #define D(f) printf(#f " %.17g\n", o.f);
-  I(rn) D(lambda) I(hyper_reduce) I(deim) I(hyper) D(hyper_tol) D(deim_tol) I(deim_max) I(deim_allow_negative) D(dt)
-  D(degeneracy_tol) I(lambda_auto) D(lambda_min) D(lambda_max) I(lambda_per_decade) I(lambda_folds)
-  D(lambda_rcond) D(lambda_tolerance) I(newton_iter) I(manifold) I(lambda_train_only)
+  D(dt) D(degeneracy_tol) I(qm.rn) D(qm.lambda) I(qm.manifold) I(qm.greedy_window)
+  I(select.lambda_mode) D(select.lambda_min) D(select.lambda_max) I(select.per_decade) I(select.folds)
+  D(select.rcond) D(select.tolerance) I(select.train_only) I(select.newton_iter)
+  I(hyper.on) I(hyper.kind) D(hyper.tol) D(hyper.deim_tol) I(hyper.deim_max) I(hyper.allow_negative)
   return 0;
 }
 """
 # names the manual's table uses for a default that is an enum or a phrase
-WORDS = {"PHGMG_HYPER_ECSW": 0.0, "PHGMG_MANIFOLD_POD": 0.0, "no": 0.0}
+WORDS = {"PHGMG_HYPER_ECSW": 0.0, "PHGMG_MANIFOLD_POD": 0.0, "PHGMG_LAMBDA_FIXED": 0.0, "no": 0.0}
 
 
 def check_defaults(header, binary):
@@ -133,7 +136,7 @@ def check_defaults(header, binary):
     b = top.find("3.3 ", a)
     table = {}
     for line in top[a:b].split("\n"):
-        m = re.match(r"     ([a-z_]+)\s+(\S+)", line)
+        m = re.match(r"     ([a-z_.]+)\s+(\S+)", line)
         if m:
             table[m.group(1)] = m.group(2)
     for k, v in sorted(got.items()):
@@ -152,9 +155,9 @@ def check_defaults(header, binary):
         text = subprocess.run([binary, "--help"], capture_output=True, text=True, timeout=30).stdout
     except OSError:
         text = ""
-    for opt, field, pat in (("--rn", "rn", r"--rn K .*?\(default (\S+?)[,)]"),
-                            ("--deim-tol", "deim_tol", r"--deim-tol T .*?\(default (\S+?)[;,)]"),
-                            ("--hyper-tol", "hyper_tol", r"--hyper-tol T .*?\(default (\S+?)[;,)]")):
+    for opt, field, pat in (("--rn", "qm.rn", r"--rn K .*?\(default (\S+?)[,)]"),
+                            ("--deim-tol", "hyper.deim_tol", r"--deim-tol T .*?\(default (\S+?)[;,)]"),
+                            ("--hyper-tol", "hyper.tol", r"--hyper-tol T .*?\(default (\S+?)[;,)]")):
         m = re.search(pat, text, re.S)
         if not m:
             problems.append("phgmg --help: no default stated for %s" % opt)
@@ -162,6 +165,50 @@ def check_defaults(header, binary):
             problems.append("phgmg --help says %s defaults to %s, the library's default is %.17g"
                             % (opt, m.group(1), got.get(field)))
     print("docs-check: %d defaults of phgmg_reduce_opts agree with the manual's table and --help" % len(got))
+
+
+RENAME_C = r"""
+#include "phgmg.h"
+void f(phgmg_reduce_opts *o);
+void f(phgmg_reduce_opts *o) {
+%s
+}
+"""
+
+
+def check_renames(header):
+    """The revision history's table of renamed options (old -> new): every
+    new name compiles, every old one does not (no silent change of meaning)."""
+    a = header.find("   REVISION HISTORY")
+    m = re.search(r"Old name -> new name:\n(.*?)\n\s+Unchanged:", header[a:], re.S)
+    if a < 0 or not m:
+        problems.append("phgmg.h: no table 'Old name -> new name:' in the newest revision history entry")
+        return
+    pairs = re.findall(r"\b([a-z_]+) -> ([a-z_]+\.[a-z_]+)\b", m.group(1))
+    if len(pairs) < 20:
+        problems.append("phgmg.h: the rename table has only %d entries" % len(pairs))
+        return
+    d = os.path.join(ROOT, "build", "docs")
+    os.makedirs(d, exist_ok=True)
+
+    def compile_lines(name, lines):
+        src = os.path.join(d, name)
+        with open(src, "w", encoding="utf-8") as f:
+            f.write(RENAME_C % "\n".join(lines))
+        r = subprocess.run([CC, "-std=c99", "-fsyntax-only", "-I", ROOT, src], capture_output=True, text=True)
+        bad = set(int(n) for n in re.findall(r"%s:(\d+):\d+: error" % re.escape(src), r.stderr))
+        first = RENAME_C.split("\n").index("%s") + 1
+        return r, [first + k in bad for k in range(len(lines))]
+
+    r, errs = compile_lines("renames_new.c", ["  (void)sizeof(o->%s);" % new for _, new in pairs])
+    if r.returncode != 0:
+        problems.append("phgmg.h: new option names of the rename table do not compile:\n" + r.stderr[-1500:])
+    # (int) makes a struct-valued old name (hyper) an error too
+    r, errs = compile_lines("renames_old.c", ["  (void)sizeof((int)o->%s);" % old for old, _ in pairs])
+    for (old, new), e in zip(pairs, errs):
+        if not e:
+            problems.append("phgmg_reduce_opts.%s still compiles (renamed to %s)" % (old, new))
+    print("docs-check: %d renamed options: the new names compile, the old ones do not" % len(pairs))
 
 
 def check_file_names():
@@ -190,6 +237,7 @@ def main():
     check_help(binary)
     check_readme_program(read("README.md"))
     check_defaults(read("phgmg.h"), binary)
+    check_renames(read("phgmg.h"))
     check_file_names()
     check_words()
     for p in problems:

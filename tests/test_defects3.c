@@ -164,7 +164,7 @@ TEST(test_defect3_ecsw_scale) {
   }
 }
 
-/* lambda exactly zero (opts.lambda < 0): the unregularised quadratic fit is
+/* lambda exactly zero (opts.qm.lambda < 0): the unregularised quadratic fit is
    the minimum-norm least-squares solution, also when its Kronecker matrix is
    rank deficient or has fewer rows than columns, instead of "rank
    deficient". The helper against the closed form A^+ B of a rank-2 matrix

@@ -1,6 +1,6 @@
 /* Deployment (issue 15): several training runs in one snapshot set
    (phgmg_simulate_inputs), the automatic lambda validated by simulation
-   (opts.lambda_auto = 1), phgmg_reduced_validate, the stepper's
+   (opts.select.lambda_mode = PHGMG_LAMBDA_VALIDATED), phgmg_reduced_validate, the stepper's
    training-envelope indicator and consecutive-failure counters, the greedy
    linear part of the quadratic manifold. Model: the paper's linear MSD
    (examples/msd_models.h). */
@@ -469,7 +469,7 @@ TEST(test_greedy_manifold_picks_pod_modes) {
   msd_linear_free(&M);
 }
 
-/* Alternating minimization (opts.manifold = PHGMG_MANIFOLD_ALTMIN), with the
+/* Alternating minimization (opts.qm.manifold = PHGMG_MANIFOLD_ALTMIN), with the
    exact least-squares fit (lambda = 0 both in the sweeps and in the final fit):
    - it starts from the hierarchical POD: info.manifold_obj0 equals the POD
      manifold's training error sum ||x - phi(rho(x))||^2, measured here by

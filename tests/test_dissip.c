@@ -427,7 +427,7 @@ TEST(test_dissip_reduce_linear_damper) {
   dpm_free(&c);
 }
 
-/* Hyper-reduced dampers (opts.hyper_reduce = 1, ECSW): a damper on every mass, a
+/* Hyper-reduced dampers (opts.hyper.on = 1, ECSW): a damper on every mass, a
    few kept with weights >= 0, the reduced model still dissipative, its
    energy balance exact, its output close to the full one. */
 TEST(test_dissip_reduce_hyper) {

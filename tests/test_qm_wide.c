@@ -1,4 +1,4 @@
-/* Quadratic manifolds with a wide V2 (opts.rn = PHGMG_RN_WIDE, the default of
+/* Quadratic manifolds with a wide V2 (opts.qm.rn = PHGMG_RN_WIDE, the default of
    the greedy and alternating-minimization manifolds), on snapshots that lie
    exactly on a quadratic manifold whose quadratic part spans 78 directions
    (more than the 64 an older cap allowed): every construction with a wide V2

@@ -433,7 +433,7 @@ TEST(test_online_never_allocates) {
   tmodel_free(&t);
 }
 
-/* ---- automatic ridge parameter of GMG-QM (opts.lambda_auto) -------------- */
+/* ---- automatic ridge parameter of GMG-QM (opts.select) ------------------- */
 
 /* The multi-lambda validation of phgmg__ridge_cv (one SVD per fold) against
    the definition computed another way: for every fold (block j of nblk

@@ -892,7 +892,7 @@ TEST(test_deim_negative_weight) {
   EXPECT(reduce_g(&M.sys, X, N, ns, &o, &info), PHGMG_ERR_NEGATIVE_WEIGHT);
   o = ropts(PHGMG_METHOD_SP2, 3); o.hyper.on = 1; o.hyper.kind = PHGMG_HYPER_QDEIM;
   EXPECT(reduce_g(&M.sys, X, N, ns, &o, &info), PHGMG_ERR_NEGATIVE_WEIGHT);
-  /* a cached DEIM result (opts.deim_pts/deim_w) is checked the same way */
+  /* a cached DEIM result (opts.cache.deim_pts/deim_w) is checked the same way */
   {
     int cpts[2] = {0, 2};
     double cw[2] = {1.5, -0.2};

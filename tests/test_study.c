@@ -1,5 +1,5 @@
 /* phgmg_study: one study over many r against separate phgmg_reduce calls.
-   The reference is phgmg_reduce with opts.pod_basis / grad_basis set to the
+   The reference is phgmg_reduce with opts.cache.pod_basis / grad_basis set to the
    study's bases (phgmg_study_basis), i.e. the pipeline that recomputes every
    snapshot quantity in full dimension, and the error measures phgmg_err_*,
    which lift every snapshot to N dimensions (an independent computation of
