@@ -2688,7 +2688,9 @@ typedef struct phgmg_reduce_info {
                               degeneracy_tol). SP1/SP2: rcond of V^T Vg, the matrix
                               inverted for W (no D^T G D there)                   */
   double rcond_jr;         /* rcond of J - R                                  */
-  double pod_sigma_ratio;  /* sigma_{r'+1}/sigma_1 of the (adjusted) snapshots */
+  double pod_sigma_ratio;  /* sigma_{r'+1}/sigma_1 of what the method PODs (GMG:
+                              the adjusted snapshots, r' = r - m; SP1/SP2: X,
+                              r' = r); 0 if no further mode or a given basis */
   double lambda;           /* GMG-QM: the ridge lambda used (fixed or chosen)  */
   double lambda_cv_err;    /* lambda chosen: held-out relative error of the quadratic
                               correction at that lambda, sum ||V2^T x - M(z kron z)||^2
@@ -11929,6 +11931,19 @@ PHGMG__PRIV const phgmg__method_row *phgmg__method(int method) {
   return phgmg__methods + (method > 0 && method < (int)PHGMG_METHOD_COUNT ? method : 0);
 }
 
+/* The hyper-reduction kinds (opts.hyper.kind, manual 3.4), described once:
+   empirical quadrature with weights >= 0, or the paper's structure-preserving
+   DEIM with its point selection (a new kind is a row here). */
+typedef struct phgmg__hyper_row {
+  int quadrature;                /* 1: ECSW (phgmg_ecsw_separable); 0: DEIM    */
+  phgmg_deim_method points;      /* DEIM's point selection (phgmg_deim_select) */
+} phgmg__hyper_row;
+static const phgmg__hyper_row phgmg__hypers[PHGMG_HYPER_COUNT] = {
+  {1, PHGMG_DEIM_QDEIM},   /* ECSW (points unused) */
+  {0, PHGMG_DEIM_QDEIM},   /* QDEIM                */
+  {0, PHGMG_DEIM_GREEDY},  /* GREEDY               */
+};
+
 /* Where a reduction takes its snapshot coordinates and blocks from when it
    runs on a study's cached bases (phgmg_study_reduce): none (computed from
    the data), the GMG basis [B, Ua], or SP1's / SP2's Up. */
@@ -14098,11 +14113,17 @@ PHGMG__PRIV phgmg_result phgmg__stage_basis(phgmg__rctx *c) {
       memcpy(red->V0, c->o->cache.pod_basis, (size_t)N * p * sizeof(double));
       return PHGMG_OK;
     }
-    S = phgmg__dalloc(c->alloc, (size_t)p);
+    /* one mode more than kept when the data have it: sigma_{r+1} for info */
+    kk = PHGMG__MIN(p + 1, PHGMG__MIN(N, ns));
+    S = phgmg__dalloc(c->alloc, (size_t)kk + (size_t)N * kk);
     if (!S) return PHGMG_ERR_NOMEM;
-    rc = phgmg__pod_auto(N, ns, c->X, c->ldx, p, red->V0, N, S, &k, &c->inf.pod_randomized, &c->inf.pod_check,
+    rc = phgmg__pod_auto(N, ns, c->X, c->ldx, kk, S + kk, N, S, &k, &c->inf.pod_randomized, &c->inf.pod_check,
                          c->alloc);
     if (rc == PHGMG_OK && (k < p || !(S[p - 1] > c->rfloor))) rc = PHGMG_ERR_SIZE;
+    if (rc == PHGMG_OK) {
+      memcpy(red->V0, S + kk, (size_t)N * p * sizeof(double));
+      c->inf.pod_sigma_ratio = (k > p && S[0] > 0.0) ? S[p] / S[0] : 0.0;
+    }
     phgmg__free(c->alloc, S);
     return rc;
   }
@@ -16085,7 +16106,8 @@ PHGMG__PRIV phgmg_result phgmg__separable_points(phgmg__rctx *c, int *pts, doubl
     }
     if (!phgmg__all_finite(wt, (size_t)*nd)) return PHGMG_ERR_NANINF;
   } else if (o->hyper.on) {
-    const int ecsw = o->hyper.kind == PHGMG_HYPER_ECSW, quad = c->red->kind == PHGMG_ROM_QUADRATIC;
+    const phgmg__hyper_row *hk = &phgmg__hypers[o->hyper.kind];
+    const int ecsw = hk->quadrature, quad = c->red->kind == PHGMG_ROM_QUADRATIC;
     double *F = NULL;
     int *live = NULL, nl = 0;
     rc = phgmg__separable_gradients(c, ecsw, &F, &live, &nl);
@@ -16098,7 +16120,7 @@ PHGMG__PRIV phgmg_result phgmg__separable_points(phgmg__rctx *c, int *pts, doubl
       rc = phgmg__hyper_ecsw(c, F, nl, live, pts, wt, nd);
     else
       rc = phgmg_deim_select(nt, ns, F, nt, c->sepw, o->hyper.deim_tol, o->hyper.deim_max,
-                             o->hyper.kind == PHGMG_HYPER_GREEDY ? PHGMG_DEIM_GREEDY : PHGMG_DEIM_QDEIM,
+                             hk->points,
                              pts, wt, nd, &nneg, &c->inf.deim_sigma_ratio, c->alloc);
     phgmg__free(c->alloc, F);
     phgmg__free(c->alloc, live);
@@ -17017,13 +17039,15 @@ PHGMG__PRIV int phgmg__study_deim(phgmg_study *st, const phgmg_reduce_opts *o) {
   const phgmg_ph_system *sys = st->sys;
   const phgmg_allocator *alloc = st->use_alloc ? &st->alloc : NULL;
   const int nt = sys->nsep, ns = st->ns;
-  const phgmg_deim_method meth = o->hyper.kind == PHGMG_HYPER_GREEDY ? PHGMG_DEIM_GREEDY : PHGMG_DEIM_QDEIM;
+  phgmg_deim_method meth;
   double *F;
   int a, i;
   phgmg_result rc;
   if (o->hyper.on != 1 || o->cache.deim_pts || sys->nl != PHGMG_NL_SEPARABLE || nt < 1 ||
-      (o->hyper.kind != PHGMG_HYPER_QDEIM && o->hyper.kind != PHGMG_HYPER_GREEDY) || !(o->hyper.deim_tol >= 0.0 && o->hyper.deim_tol < 1.0))
+      (int)o->hyper.kind < 0 || (int)o->hyper.kind >= (int)PHGMG_HYPER_COUNT ||
+      phgmg__hypers[o->hyper.kind].quadrature || !(o->hyper.deim_tol >= 0.0 && o->hyper.deim_tol < 1.0))
     return 0;
+  meth = phgmg__hypers[o->hyper.kind].points;
   if (st->deim_have && st->deim_tol == o->hyper.deim_tol && st->deim_max == o->hyper.deim_max && st->deim_method == (int)meth) return 1;
   st->deim_have = 0;
   if (!st->deim_pts) st->deim_pts = phgmg__ialloc(alloc, (size_t)nt);

@@ -2650,12 +2650,15 @@ static int write_model_files(const reduce_args *A, reduce_state *S, int method, 
 static int reduce_commit(const reduce_args *A, reduce_state *S) {
   const phgmg_rom *rom = phgmg_reduced_rom(S->red);
   outlist rec;
+  char nfull[64] = "";
   read_record(A->out, A->name, &rec); /* before this run's record replaces it */
   if (stage_commit(&S->sg)) return 1;
   remove_stale(A->out, &rec, &S->ol);
-  printf("wrote %s/%s.phgmgrom, %s/%s.c, %s/%s.json and %d arrays %s/%s_*.npy (%s, r = %d, m = %d, N = %d)\n",
+  if (S->dae) /* the arrays are full-size; the reduction ran on the differential states */
+    snprintf(nfull, sizeof nfull, ", of which %d differential", S->sys.N);
+  printf("wrote %s/%s.phgmgrom, %s/%s.c, %s/%s.json and %d arrays %s/%s_*.npy (%s, r = %d, m = %d, N = %d%s)\n",
          A->out, A->name, A->out, A->name, A->out, A->name, S->ol.n, A->out, A->name, method_name(S->method),
-         rom->r, rom->m, S->sys.N);
+         rom->r, rom->m, S->full.N, nfull);
   return 0;
 }
 

@@ -588,6 +588,9 @@ print(N, np.count_nonzero(R[N - 1, :]))
 " >dae_info.txt && pass || bad "algebraic files"
   run_ok "simulate: index one" "$P" simulate $SYS --E E_alg.npy $ROMSIM --out yA.npy --states xA.npy --quiet
   run_ok "reduce: index one" "$P" reduce $SYS --E E_alg.npy $SIM --method sp1 --r 10 --out oA --name m --save-snapshots --quiet
+  nA=$(cut -d' ' -f1 dae_info.txt)
+  grep -q "N = $nA, of which $((nA - 1)) differential)" "$T/out.txt" && pass \
+    || bad "reduce: index one: the closing line does not give the full N = $nA ($(tail -n 1 "$T/out.txt"))"
   run_ok "simulate-rom: index one" "$P" simulate-rom --model oA/m.phgmgrom $ROMSIM --out oA/y.npy --quiet
   run_ok "index-one ROM follows the full model (5e-2)" "$REF" compare yA.npy oA/y.npy 5e-2
   "$PY" -c "

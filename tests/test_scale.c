@@ -338,10 +338,49 @@ TEST(test_reduce_ecsw_qm_skips_resting_terms) {
   msd_nonlinear_free(&M);
 }
 
+
+/* info.pod_sigma_ratio of SP1 and SP2 is sigma_{r+1}/sigma_1 of the snapshot
+   matrix X itself, against the square roots of the eigenvalues of X X^T (a
+   symmetric eigensolver, not the SVD the reduction uses). */
+TEST(test_reduce_sp_sigma_ratio) {
+  msd_nonlinear M;
+  phgmg_reduce_opts o;
+  phgmg_reduce_info info;
+  phgmg_reduced *red = NULL;
+  const int ns = 101, r = 5;
+  double *X = sc_chain_run(&M, 30, ns), *G = NULL, w[64];
+  int N = M.sys.N, i, j, k, pass;
+  CHECK(X != NULL && N <= 64);
+  if (X) G = (double *)calloc((size_t)N * N, sizeof(double));
+  for (j = 0; G && j < N; ++j)
+    for (i = 0; i < N; ++i)
+      for (k = 0; k < ns; ++k) G[i + (size_t)j * N] += X[i + (size_t)k * N] * X[j + (size_t)k * N];
+  if (G) {
+    CHECK_RC(phgmg_sym_eig(N, G, N, w, NULL, N), PHGMG_OK);
+    for (i = 1; i < N; ++i) /* descending */
+      for (j = i; j > 0 && w[j] > w[j - 1]; --j) { double t = w[j]; w[j] = w[j - 1]; w[j - 1] = t; }
+  }
+  for (pass = 0; G && pass < 2; ++pass) {
+    const double want = sqrt(w[r] / w[0]);
+    memset(&o, 0, sizeof o);
+    o.method = pass ? PHGMG_METHOD_SP2 : PHGMG_METHOD_SP1;
+    o.r = r;
+    memset(&info, 0, sizeof info);
+    CHECK_RC(phgmg_reduce(&red, &M.sys, X, N, ns, &o, &info, NULL), PHGMG_OK);
+    CHECK(want > 1e-6);
+    CHECK_LE(fabs(info.pod_sigma_ratio - want), 1e-6 * want);
+    phgmg_reduced_destroy(red);
+    red = NULL;
+  }
+  free(G); free(X);
+  msd_nonlinear_free(&M);
+}
+
 SUITE(scale) {
   RUN(test_reduce_ecsw_skips_resting_terms);
   RUN(test_reduce_ecsw_qm_skips_resting_terms);
   RUN(test_ecsw_screened_separable);
   RUN(test_ecsw_screened_optimal);
   RUN(test_reduce_pod_randomized_and_fallback);
+  RUN(test_reduce_sp_sigma_ratio);
 }
