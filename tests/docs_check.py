@@ -17,6 +17,9 @@ Fails (exit 1, one line per finding) when
   - a renamed option of the newest revision history entry's table
     (old -> new) compiles under its old name, or not under its new one;
   - a tracked file name starts with '-';
+  - the private functions declared in phgmg.h's >>linalg (prototypes) are not
+    exactly those defined in >>linalg (implementation), with the same
+    signatures, in the same order;
   - README.md, phgmg.h or the Makefile mention an issue number, a "session",
     or a document outside the repository (the notes files by name).
 """
@@ -222,6 +225,42 @@ def check_file_names():
             problems.append("tracked file whose name starts with '-': %s" % n)
 
 
+def linalg_signatures(text):
+    """The PHGMG__PRIV signatures (whitespace normalised) at file level in text."""
+    sigs, depth, cur = [], 0, None
+    for l in text.split("\n"):
+        if cur is not None:
+            cur += " " + l
+        elif depth == 0 and l.startswith("PHGMG__PRIV "):
+            cur = l
+        if cur is not None and re.search(r"[;{]\s*$", cur):
+            sigs.append(" ".join(re.sub(r"\s*[;{]\s*$", "", cur).split()))
+            cur = None
+        if not l.startswith("#"):
+            depth += l.count("{") - l.count("}")
+    return sigs
+
+
+def check_linalg_prototypes(header):
+    a = header.find("/* >>linalg (prototypes)")
+    b = header.find("/* >>", a + 1)
+    c = header.find("/* >>linalg (implementation)")
+    if a < 0 or b < 0 or c < 0:
+        problems.append("phgmg.h: no >>linalg (prototypes) or >>linalg (implementation) section")
+        return
+    d = header.find("#endif /* PHGMG_IMPLEMENTATION_DONE */", c)
+    proto, defs = linalg_signatures(header[a:b]), linalg_signatures(header[c:d])
+    if proto != defs:
+        extra = [p for p in proto if p not in defs]
+        missing = [p for p in defs if p not in proto]
+        what = ("stale: %s; missing: %s" % (extra or "none", missing or "none")
+                if extra or missing else "another order")
+        problems.append("phgmg.h: >>linalg (prototypes) does not match the private functions "
+                        "defined in >>linalg (implementation): %s" % what)
+    else:
+        print("docs-check: %d prototypes of >>linalg, as defined and in order" % len(proto))
+
+
 def check_words():
     pat = re.compile(r"\bissues?\s*#?\d+|\bsessions?\b|NUMER[I]CS|STYLE\.md", re.I)
     for path in ("README.md", "phgmg.h", "Makefile"):
@@ -239,6 +278,7 @@ def main():
     check_defaults(read("phgmg.h"), binary)
     check_renames(read("phgmg.h"))
     check_file_names()
+    check_linalg_prototypes(read("phgmg.h"))
     check_words()
     for p in problems:
         print("docs-check: FAIL: " + p)
