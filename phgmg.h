@@ -30,7 +30,12 @@
    same order in both halves: the implementation declares the kernels' private
    helpers in >>linalg (prototypes) after >>memory, and its >>reduce opens with
    the reduced object the others use). The comment at each declaration states
-   its contract: what it computes, units and layouts, result codes.
+   its contract: what it computes, units and layouts, result codes. The
+   reduction methods, the GMG-QM manifold constructions and the
+   hyper-reduction kinds are each described once, in a table the pipeline
+   reads (phgmg__methods, phgmg__manifolds, phgmg__hypers in the
+   implementation's >>reduce): a new one is a row there and its stage
+   functions.
 
 
    0. QUICK START ---------------------------------------------------------------
