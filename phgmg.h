@@ -20133,6 +20133,12 @@ PHGMG_DEF phgmg_result phgmg_sym_eig(int n, double *A, int lda, double *w, doubl
             (PHGMG_DEIM_QDEIM, _GREEDY, _METHOD_COUNT; same values).
           - Removed: phgmg_reduce_opts.deim, the former name of hyper_reduce
             (now hyper.on). The CLI's options keep their names.
+          - New: phgmg_ph_sparse_create_desc, the sparse constructor from
+            one phgmg_ph_sparse_desc (J, R, Q, optional E, dense or CSC B).
+          - Fixed: SP1 and SP2 report info.pod_sigma_ratio (was 0).
+          - Changed: the header's layout: the dense kernels (>>linalg) follow
+            the domain sections in both halves; long design notes moved from
+            declaration comments into the manual (8.1, 8.7, 8.10-8.12).
    0.4.0  (2026-11-26)
           - New: algebraic constraints of index one: a singular E with zero
             rows and columns (or a dense singular E, rotated into that form)
