@@ -12609,8 +12609,9 @@ PHGMG__PRIV phgmg_result phgmg__reduce_new(phgmg__rctx *c) {
   if (red->kind == PHGMG_ROM_QUADRATIC) {
     c->wide = o->method == PHGMG_METHOD_GMG_QM &&
               (o->qm.rn == PHGMG_RN_WIDE || (o->qm.rn == 0 && o->qm.manifold != PHGMG_MANIFOLD_POD));
-    /* wide: the alternating minimization's search width; phgmg__qm_wide_v2 sets the final one */
-    red->rn = o->qm.rn > 0 ? o->qm.rn : (c->wide ? PHGMG__MIN(8, red->N - red->r) : 8);
+    /* resolved rn: a cap > 0, or PHGMG_RN_WIDE: then 8 is the alternating
+       minimization's search width; phgmg__qm_wide_v2 sets the final one */
+    red->rn = o->qm.rn > 0 ? o->qm.rn : PHGMG__MIN(8, red->N - red->r);
     if (red->rn < 1 || red->rn > red->N - red->r) return PHGMG_ERR_SIZE;
     /* your eta's q/Dq go through buffers of up to 64 x 64 (lift, dphi) */
     if (o->method == PHGMG_METHOD_GMG_MANIFOLD && (red->rn > 64 || red->rn * red->p > 64 * 64)) return PHGMG_ERR_SIZE;
@@ -14921,13 +14922,13 @@ PHGMG__PRIV phgmg_result phgmg__reduce_fallback_pod(phgmg_reduced **out, const p
 
 /* opts->progress, if set (see phgmg_reduce_opts). */
 
-/* Which fast path of a study applies to opts (0: none): the study's own
+/* Which fast path of a study applies to opts (resolved; 0: none): the study's own
    bases, orders within its modes (phgmg_study_reduce). */
 PHGMG__PRIV int phgmg__study_fast(const phgmg_study *st, const phgmg_reduce_opts *o, int m) {
   if (!st) return PHGMG__SF_NONE;
   if ((o->method == PHGMG_METHOD_GMG_POD || (o->method == PHGMG_METHOD_GMG_QM && o->qm.manifold == PHGMG_MANIFOLD_POD)) && st->Ua &&
       o->cache.pod_basis == st->Ua && o->qm.rn >= 0 &&
-      o->r - m + (o->method == PHGMG_METHOD_GMG_QM ? (o->qm.rn > 0 ? o->qm.rn : 8) : 0) <= st->ka)
+      o->r - m + (o->method == PHGMG_METHOD_GMG_QM ? o->qm.rn : 0) <= st->ka)
     return PHGMG__SF_GMG;
   if (o->method == PHGMG_METHOD_SP1 && st->Up && st->Cq && o->cache.pod_basis == st->Up && o->r <= st->kp) return PHGMG__SF_SP1;
   if (o->method == PHGMG_METHOD_SP2 && st->Up && st->Ug && o->cache.pod_basis == st->Up && o->cache.grad_basis == st->Ug &&
