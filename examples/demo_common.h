@@ -228,7 +228,8 @@ DEMO_FN double demo_newton_failures(const demo_rom_result *res) {
 }
 
 /* One row of the automatic-lambda study at order `base->r`: GMG-POD and
-   GMG-QM with lambda_auto (both with the other settings of `base`), the row
+   GMG-QM with lambda validated by simulation (select.lambda_mode; both
+   with the other settings of `base`), the row
    "r, GMG-POD e_red, GMG-QM-auto e_red, lambda, e_lowerbound, Newton
    failures" into row[6], and one line on the terminal. */
 DEMO_FN void demo_lambda_auto_row(const phgmg_ph_system *sys, const double *X, const double *Y, int nsteps,
@@ -282,7 +283,7 @@ DEMO_FN void demo_lambda_auto_row(const phgmg_ph_system *sys, const double *X, c
 }
 
 DEMO_FN void demo_lambda_auto_header(const char *input) {
-  printf("\nu = %s  (e_red; QM-auto: lambda_auto = 1, validated by simulation on the training run and probe runs;\n"
+  printf("\nu = %s  (e_red; QM-auto: lambda validated by simulation on the training run and probe runs;\n"
          "QM-best: lambda validated on the training run alone, hierarchical POD or greedy linear part\n"
          "(opts.qm.manifold = 1, marked g), whichever has the smaller training e_red;\n"
          "lambda nan = the linear limit M = 0; "

@@ -29,8 +29,9 @@
      GMG-POD; GMG-QM with the hierarchical POD manifold (r_n = 8, the
      paper's), the greedy manifold (wide V2, candidates the leading
      r - 1 + 100 POD modes) and alternating minimization (wide V2, from the
-     POD manifold), each with lambda validated by simulation (lambda_auto = 1,
-     the training run and three probes; M = 0 when no lambda is safe:
+     POD manifold), each with lambda validated by simulation
+     (select.lambda_mode = PHGMG_LAMBDA_VALIDATED: the training run and
+     three probes; M = 0 when no lambda is safe:
      reported as lambda = inf); and the hierarchical POD manifold with the
      snapshots' mean as affine reference state (manual 3.6).
    Measured: e_proj (training snapshots), e_red and e_y (training run), e_y
