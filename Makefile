@@ -65,7 +65,7 @@ test: test-build
 # Everything make test compiles, built first on both cores (the compiles are
 # most of its time); the runs below then go one after the other.
 test-build: tests/suites.inc
-	$(MAKE) -j2 $(BUILD)/test_run_asan $(EXAMPLES) $(BUILD)/npy_tool \
+	$(MAKE) -j2 $(BUILD)/test_run_asan $(EXAMPLES) $(BUILD)/phgmg-float $(BUILD)/npy_tool \
 	  $(BUILD)/export_model_d $(BUILD)/export_model_f
 
 # The documentation against the code: every public function in the manual's
@@ -161,15 +161,22 @@ compile-checks: phgmg.h
 EXAMPLES = $(BUILD)/hello $(BUILD)/msd_linear $(BUILD)/msd_nonlinear $(BUILD)/morse_chain $(BUILD)/phgmg $(BUILD)/linear_bases $(BUILD)/fe_bar $(BUILD)/transport_line $(BUILD)/circuit_dae $(BUILD)/damped_chain
 EXHDRS   = examples/msd_models.h examples/morse_models.h examples/demo_common.h examples/svgplot.h
 
-examples: $(EXAMPLES)
+examples: $(EXAMPLES) $(BUILD)/phgmg-float
 
 # the command-line reducer (examples/phgmg_cli.c) is installed as build/phgmg
 $(BUILD)/phgmg: examples/phgmg_cli.c phgmg.h
 	@mkdir -p $(BUILD)
 	$(CC) $(OPTFLAGS) -o $@ $< $(LDLIBS)
 
-test-cli: $(BUILD)/phgmg
-	sh tests/test_cli.sh $(BUILD)/phgmg
+# The command line in a float build: the offline work stays double, the
+# reduced model, simulate-rom and the exported C source are float (for
+# float firmware).
+$(BUILD)/phgmg-float: examples/phgmg_cli.c phgmg.h
+	@mkdir -p $(BUILD)
+	$(CC) $(OPTFLAGS) -Wdouble-promotion -DPHGMG_REAL_FLOAT -o $@ $< $(LDLIBS)
+
+test-cli: $(BUILD)/phgmg $(BUILD)/phgmg-float
+	sh tests/test_cli.sh $(BUILD)/phgmg $(BUILD)/phgmg-float
 	sh tests/test_simulate.sh $(BUILD)/phgmg
 	/usr/bin/python3 tests/check_dae_bar.py $(BUILD)/phgmg 100 $(BUILD)/dae_bar
 

@@ -486,7 +486,11 @@
 
    3.2 phgmg_reduce_opts
    phgmg_reduce_opts_default fills a struct with these defaults (the library
-   applies them in that one place; the command line starts from them too).
+   applies them in that one place). The command line starts from them, with
+   three choices of its own stated in its --help: --lambda auto (lambda
+   validated by simulation: select.lambda_mode = PHGMG_LAMBDA_VALIDATED) for
+   gmg-qm, --rn 8 with every manifold (a wide V2 only with --rn wide), and
+   --lambda 0 meaning exactly zero (qm.lambda < 0).
    The options of one concern are grouped in a sub-struct: qm (the manifold
    of GMG-QM and GMG_MANIFOLD), select (choosing lambda, 4.2), hyper (a
    separable part, 3.4), cache (results reused across reductions, 2.3).
@@ -661,7 +665,8 @@
    Your own manifold (PHGMG_METHOD_GMG_MANIFOLD): qm.eta is the map
    eta: R^p -> R^rn of phi(x) = B x1 + V1 x2 + V2 eta(x2) (p = r - m,
    rn = qm.rn >= 1, required) with its first and second derivatives
-   (phgmg_eta_fn, 3.1), qm.eta_user its argument. V1 and V2 come from the
+   (phgmg_eta_fn, declared in >>online with the layouts of q, Dq and
+   D2q), qm.eta_user its argument. V1 and V2 come from the
    hierarchical POD or from opts.cache.pod_basis (2.3); the reduced model
    calls eta online.
 
@@ -755,7 +760,7 @@
    4.1 Training runs. Train on inputs that cover the levels (static content)
    and the frequency band the model will see; several runs go into one snapshot
    set (phgmg_simulate_inputs) and opts.nrun / opts.runs tell the reduction
-   how they were made: nrun >= 1 runs whose columns lie one after the other
+   how they were made: 1 <= nrun <= 64 runs whose columns lie one after the other
    as phgmg_simulate_inputs lays them out (the sum of nsteps + 1 must be ns,
    else PHGMG_ERR_SIZE); 0 / NULL: X is one run of an unknown input. The
    runs are what lambda validation simulates (PHGMG_LAMBDA_VALIDATED: every
@@ -843,8 +848,10 @@
    PHGMG_ROM_STEPPER_MEMSIZE_MAX(r, m, rn, nd), _MAX_CB with callbacks) gives
    the bytes; phgmg_rom_stepper_init places the stepper in caller memory;
    phgmg_rom_step advances xr in place, with u3 = u at the three stage times
-   (phgmg_rom_stage_times), and returns the output and optionally the energy
-   increments. A LINEAR model with a quadratic H stepped at its own dt uses the
+   (phgmg_rom_stage_times), stage-major: u3[i*m + a] is input a at stage
+   time i (3m values), and returns the output and optionally the energy
+   increments. The memory must be aligned for phgmg_real and int (malloc,
+   or a static phgmg_real or double array). A LINEAR model with a quadratic H stepped at its own dt uses the
    exact step map (a matrix-vector product); otherwise GL3 with simplified
    Newton on the 3r stage system, bounded by max_iter: a failure is a result
    code, never a hang, and leaves x, y and the energy untouched; the stepper
@@ -857,16 +864,25 @@
 
    5.2 Shipping a model. phgmg_rom_export_c writes C source (static const
    arrays and a `static const phgmg_rom`), to be compiled after phgmg.h into
-   firmware; values round-trip exactly. phgmg_rom_serialize / _save write a
+   firmware; values round-trip exactly. The source is for the scalar type of
+   the build that wrote it (phgmg_real; an #error guards a mismatch). For
+   float firmware, export from a float build: the offline half always
+   computes in double, so a program compiled with PHGMG_REAL_FLOAT builds
+   the reduced model as the double build does (only a lambda validated by
+   simulation sees the float reduced model) and stores it rounded to float;
+   such a program can also phgmg_rom_load a model file a double build saved
+   and export that. The command line has a float build for this
+   (make build/phgmg-float). phgmg_rom_serialize / _save write a
    versioned, checksummed little-endian binary (format version 3 for a model
-   with dampers, 2 for one with several separable functions, else 1; all
-   three load); phgmg_rom_deserialize / _load read it into caller
+   with dampers or feedthrough, 2 for one with several separable functions,
+   else 1; all three load); phgmg_rom_deserialize / _load read it into caller
    memory, checking magic, version, sizes, checksum and values; a file written
    by a double build loads into a float build and vice versa. Models that call
    back into user code cannot be serialised; the C export references the
    firmware's <name>_phi / <name>_eta instead (a GENERAL model, callback
    dampers: not at all). A loaded model with dampers must have weights >= 0
-   and dissipative laws (PHGMG_ERR_STRUCTURE otherwise).
+   and dissipative laws, one with feedthrough a positive semidefinite
+   dissipation block (PHGMG_ERR_STRUCTURE otherwise).
 
    5.3 Firmware builds. PHGMG_NO_OFFLINE compiles only the online half and the
    in-memory (de)serialisation: libm only, no heap, no stdio. PHGMG_REAL_FLOAT
@@ -1334,6 +1350,17 @@
                            terms on (default 4096; no n x n Gram matrix)
      PHGMG_ECSW_SCREEN_ADD candidates added per screening round (default 64)
      PHGMG_ECSW_SCREEN_ROUNDS  cap on screening rounds (default 200)
+     PHGMG_SPARSE_MIN_KB   sparse models keep the band LU without analysis up to
+                           this half-bandwidth (default 8; manual 8.12)
+     PHGMG_SPARSE_PIVTOL   the sparse LU's static pivot threshold, relative to
+                           max|K| (default 1e-8)
+     PHGMG_SPARSE_GROWTH   largest factor entry / max|K| the sparse LU accepts
+                           before the stepper falls back to the band LU (1e8)
+     PHGMG_GEMM_MC, PHGMG_GEMM_KC  the dense GEMM's cache blocks (64, a
+                           multiple of 8, and 256; the packed block, MC*KC
+                           doubles, lives on the stack: 128 KiB by default)
+     PHGMG_NO_VECTOR_EXT   the plain C GEMM micro-kernel instead of the
+                           GCC/Clang vector extensions it uses on AVX targets
 
 
    10. INDEX OF PUBLIC FUNCTIONS -------------------------------------------------
@@ -1384,7 +1411,7 @@
            phgmg_lu_rcond, phgmg_norm1, phgmg_normf, phgmg_zlu_factor,
            phgmg_zlu_solve, phgmg_qr, phgmg_qrcp, phgmg_qr_form_q,
            phgmg_qr_apply, phgmg_lstsq, phgmg_svd, phgmg_sym_eig
-   (120 functions; also the macros PHGMG_ROM_STEPPER_MEMSIZE_MAX and _MAX_CB.)
+   (124 functions; also the macros PHGMG_ROM_STEPPER_MEMSIZE_MAX and _MAX_CB.)
 */
 #ifndef PHGMG_H_INCLUDED
 #define PHGMG_H_INCLUDED
@@ -1591,7 +1618,7 @@ typedef struct phgmg_ph_system {
      gradient. A GENERAL part and the shifted_* callbacks are not supported
      with E (PHGMG_ERR_UNSUPPORTED). The stepper never forms E^{-1}: E enters
      its Newton matrices (sigma E - (J - R) Hess) and stage residuals. See
-     DESCRIPTOR MODELS in the manual at the top for the reduction. */
+     manual 1.6 for the reduction. */
   const double *E;
   /* Feedthrough (each NULL = 0): P (N x m, ld N), S (m x m, symmetric), Nskew
      (m x m, skew), column-major:
@@ -1599,8 +1626,9 @@ typedef struct phgmg_ph_system {
      with the dissipation block [[R, P], [P^T, S]] positive semidefinite, so
      that dH/dt = y^T u - [z; u]^T [[R, P], [P^T, S]] [z; u] <= y^T u. The full
      model (validation, stepper, outputs and energy of phgmg_simulate) takes
-     them; phgmg_ph_output gives (B + P)^T z only (it has no u). Reductions of
-     a model with feedthrough are not supported (PHGMG_ERR_UNSUPPORTED). */
+     them; phgmg_ph_output gives (B + P)^T z only (it has no u). GMG-POD,
+     SP1 and SP2 keep the feedthrough (manual 1.6); GMG-QM and your own
+     manifold give PHGMG_ERR_UNSUPPORTED. */
   const double *P, *S, *Nskew;
   /* Nonlinear dissipation (ndamp = 0: none): ndamp dampers, damper k acting
      on s_k = c_k^T z, c_k = e_i - e_j (i = damp_i[k], j = damp_j[k]; damp_j
@@ -2583,7 +2611,8 @@ typedef struct phgmg_reduce_opts {
 PHGMG_DEF void phgmg_reduce_opts_default(phgmg_reduce_opts *o);
 
 typedef struct phgmg_reduce_info {
-  int deim_modes;          /* DEIM points kept (nd)                          */
+  int deim_modes;          /* terms kept by the hyper-reduction (nd), ECSW or
+                              DEIM; every term without hyper.on             */
   int deim_negative;       /* number of negative DEIM weights               */
   double deim_sigma_ratio; /* sigma_{nd+1}/sigma_1 of the nonlinear snapshots (0 if all kept) */
   double rcond_dgd;        /* GMG: smallest rcond of D^T G D seen (at x = 0 and the
@@ -2671,7 +2700,7 @@ PHGMG_DEF void phgmg_reduced_dphi(const phgmg_reduced *red, const double *xr, do
 /* The reduction map W(xr) (N x r, ldw >= N) in full dimension (for checks;
    O(N r^2)), W^T Dphi = I. Descriptor model: W^T = (D^T G_E D)^{-1} D^T G_E,
    G_E = E^T G E (the map of the equivalent standard form); the test basis of
-   the co-state equation is W_z = E^{-T} W (see DESCRIPTOR MODELS). */
+   the co-state equation is W_z = E^{-T} W (manual 1.6). */
 PHGMG_DEF phgmg_result phgmg_reduced_W(const phgmg_reduced *red, const double *xr, double *W, int ldw);
 
 /* Simulate the reduced model with the online GL3 stepper from xr0 over nsteps
@@ -3045,9 +3074,10 @@ PHGMG_DEF phgmg_result phgmg_ss_compare(const phgmg_ss *g1, const phgmg_ss *g2, 
 extern "C" {
 #endif
 
-/* Format version 2 adds the exp-polynomial data (nexp, nphi, expo, per-term
-   poly) and the term indices; a model without them is still written as
-   version 1, and both versions load. */
+/* Format versions: 1 the base model; 2 adds the exp-polynomial data (nexp,
+   nphi, expo, per-term poly) and the term indices; 3 adds dampers and
+   feedthrough (PD). A model is written in the lowest version that holds it,
+   and all three load. */
 #define PHGMG_ROM_FORMAT_VERSION 3u
 
 /* Bytes phgmg_rom_serialize writes for this model. */
@@ -12429,7 +12459,7 @@ typedef struct phgmg__rctx {
                               GMG-POD: phgmg_reduce redoes it with manifold = POD */
   phgmg_study *st;         /* phgmg_study_reduce: the study (else NULL)     */
   int sf;                  /* fast path on the study's basis: PHGMG__SF_* */
-  /* descriptor models (sys->E set; see DESCRIPTOR MODELS in the manual):
+  /* descriptor models (sys->E set; manual 1.6):
      Bp = E^{-1} B, the port columns of the GMG basis (sys->B without E);
      sepw = E(i_k, i_k) w_k, the separable weights of H (sys->sep_w without E);
      ef = the factorization of E */

@@ -6,7 +6,10 @@ Usage: /usr/bin/python3 tests/docs_check.py [PHGMG_BINARY]   (from the repositor
 Fails (exit 1, one line per finding) when
   - a public function (a PHGMG_DEF declaration in the header's declaration
     half) is missing from the INDEX section of the manual at the top of
-    phgmg.h, or the index names a function that is not declared;
+    phgmg.h, or the index names a function that is not declared, or its
+    count of functions is not the number declared;
+  - a configuration macro the header lets the user define (an #ifndef
+    default or a defined() switch) is not listed in the manual's section 9;
   - `phgmg --help` (build/phgmg by default) does not name an option that
     examples/phgmg_cli.c's parser accepts;
   - the first C block of README.md does not compile (C99, warnings as errors)
@@ -53,6 +56,17 @@ def check_index(header):
         problems.append("phgmg.h: public function %s is missing from the manual's index" % f)
     for f in sorted(named - declared):
         problems.append("phgmg.h: the manual's index names %s, which is not a public function" % f)
+    sec9 = top[top.find("9. CONFIGURATION MACROS"):top.find("10. INDEX")]
+    overridable = set(re.findall(r"#ifndef (PHGMG_[A-Z0-9_]+)\s*\n\s*#\s*define \1\b", header))
+    overridable |= set(re.findall(r"defined\((PHGMG_[A-Z0-9]+(?:_[A-Z0-9]+)*)\)", header))
+    overridable -= {"PHGMG_H_INCLUDED", "PHGMG_IMPLEMENTATION_DONE"}
+    for mac in sorted(overridable - set(re.findall(r"PHGMG_[A-Z0-9_]+", sec9))):
+        if not mac.startswith("PHGMG__"):
+            problems.append("phgmg.h: the configuration macro %s is not in the manual's section 9" % mac)
+    count = re.search(r"\((\d+) functions;", index)
+    if not count or int(count.group(1)) != len(declared):
+        problems.append("phgmg.h: the manual's index says (%s functions; ...), the header declares %d"
+                        % (count.group(1) if count else "no count", len(declared)))
     print("docs-check: %d public functions, all in the manual's index" % len(declared)
           if declared <= named else "docs-check: index incomplete")
 

@@ -1,7 +1,7 @@
 #!/bin/sh
 # test_cli.sh — tests of the `phgmg` command-line reducer (examples/phgmg_cli.c).
 #
-# Usage: sh tests/test_cli.sh build/phgmg      (from the repository root)
+# Usage: sh tests/test_cli.sh build/phgmg [build/phgmg-float]   (from the repository root)
 #
 # 1. --help explains every option; bad usage exits 2.
 # 2. The worked example's model (examples/npy_example/make_model.py, NumPy) is
@@ -27,6 +27,8 @@
 set -u
 P=${1:-build/phgmg}
 case "$P" in /*) ;; *) P="$PWD/$P" ;; esac
+PF=${2:-}   # optional: the command line built with -DPHGMG_REAL_FLOAT
+case "$PF" in /*|"") ;; *) PF="$PWD/$PF" ;; esac
 CC=${CC:-cc}
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
 PY=/usr/bin/python3
@@ -263,6 +265,54 @@ if $CC -std=c99 -O0 -DCLI_REF_ROM_C="\"$T/out/msd.c\"" -DCLI_REF_ROM_NAME=msd -o
   run_ok "exported C model == model file" "$REF" compare out/y_rom.npy y_c.npy 1e-12
 else
   bad "the exported C source out/msd.c does not compile: $(head -n 5 "$T/cc.txt")"
+fi
+
+# ---- 4b. float firmware source: the command line built with PHGMG_REAL_FLOAT ------
+# (its offline work is double; the reduced model and its C export are float).
+# The exported source compiles in a float PHGMG_NO_OFFLINE build and follows
+# the double model (out/y_rom.npy) to the float stepper's accuracy.
+if [ -n "$PF" ]; then
+  run_ok "float CLI: reduce gmg-pod" "$PF" reduce $SYS $SIM --method gmg-pod --r 12 --out outf --name msdf --quiet
+  grep -F -q 'exported for phgmg_real = float' outf/msdf.c && pass || bad "the float CLI did not export float source"
+  cat >fw_float.c <<FWEOF
+#define PHGMG_REAL_FLOAT
+#define PHGMG_NO_OFFLINE
+#define PHGMG_IMPLEMENTATION
+#include "phgmg.h"
+#include <math.h>
+#include <stdio.h>
+#include "$T/outf/msdf.c"
+int main(void) {
+  static double mem[1 << 14];
+  phgmg_rom_stepper st;
+  phgmg_real x[16] = {0}, u3[3], tc[3], y[1];
+  int n, i;
+  if (phgmg_rom_stepper_init(&st, &msdf, (phgmg_real)0.1, 0, 0, mem, sizeof mem) != PHGMG_OK) return 1;
+  printf("%.9g\\n", 0.0);
+  for (n = 0; n < 1000; ++n) {
+    phgmg_rom_stage_times((phgmg_real)(0.1 * n), (phgmg_real)0.1, tc);
+    for (i = 0; i < 3; ++i) u3[i] = (phgmg_real)(0.1 * sin((double)tc[i]));
+    if (phgmg_rom_step(&st, x, u3, y, NULL) != PHGMG_OK) return 1;
+    printf("%.9g\\n", (double)y[0]);
+  }
+  return 0;
+}
+FWEOF
+  if $CC -std=c99 -Wall -Wextra -Werror -pedantic -Wdouble-promotion -I"$ROOT" -o fw_float fw_float.c -lm 2>"$T/cc.txt"; then
+    pass
+    run_ok "float firmware runs" sh -c "./fw_float > y_f.txt"
+    if [ "$HAVE_NP" = 1 ]; then
+      "$PY" -c "
+import numpy as np
+yd = np.load('out/y_rom.npy').ravel(); yf = np.loadtxt('y_f.txt')
+assert yd.shape == yf.shape, (yd.shape, yf.shape)
+e = np.linalg.norm(yf - yd) / np.linalg.norm(yd)
+assert e <= 1e-5, e   # float rounding: about 2e-7 on this model; 1e-5 is the float stepper's tolerance
+" && pass || bad "float firmware output does not follow the double model"
+    fi
+  else
+    bad "the float export outf/msdf.c does not compile as float firmware: $(head -n 5 "$T/cc.txt")"
+  fi
 fi
 
 if [ "$HAVE_NP" = 1 ]; then
