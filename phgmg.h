@@ -4596,9 +4596,19 @@ PHGMG__PRIV phgmg_result phgmg__ph_check_sparse_pd(const phgmg_ph_system *s, int
    A factorization of E by the J - R machinery (J := E, R := 0): dense LU or
    band LU; phgmg_jr_solve then applies E^{-1} ('N') or E^{-T} ('T').
    rcond_out (may be NULL): its reciprocal condition estimate. */
+PHGMG__PRIV phgmg_result phgmg__ph_sparse_eq_band(const phgmg_ph_system *s, phgmg_ph_system *t, double **bufs,
+                                                 const phgmg_allocator *al);
 PHGMG__PRIV phgmg_result phgmg__e_factor(const phgmg_ph_system *sys, phgmg_jr_factor **f, double *rcond_out,
                                          const phgmg_allocator *alloc) {
   phgmg_ph_system t;
+  if (sys->storage == PHGMG_SPARSE) { /* the band LU of E's band copy, made here and freed */
+    double *bufs[2];
+    phgmg_result rc = phgmg__ph_sparse_eq_band(sys, &t, bufs, alloc);
+    *f = NULL;
+    if (rc == PHGMG_OK) rc = phgmg__e_factor(&t, f, rcond_out, alloc);
+    phgmg__free(alloc, bufs[0]); phgmg__free(alloc, bufs[1]);
+    return rc;
+  }
   const size_t len = sys->storage == PHGMG_BANDED ? (size_t)(2 * sys->kb + 1) * (size_t)sys->N
                                                   : (size_t)sys->N * (size_t)sys->N;
   double *zero = phgmg__dalloc(alloc, len);
@@ -4658,6 +4668,13 @@ PHGMG__PRIV phgmg_result phgmg__ph_validate_e(const phgmg_ph_system *sys, double
   int k, j;
   phgmg_result rc;
   if (!phgmg__ph_mat_finite(sys, sys->E)) return PHGMG_ERR_NANINF;
+  if (sys->storage == PHGMG_SPARSE) { /* on band copies of E and Q, made here and freed */
+    double *bufs[2];
+    rc = phgmg__ph_sparse_eq_band(sys, &t, bufs, alloc);
+    if (rc == PHGMG_OK) rc = phgmg__ph_validate_e(&t, tol, alloc);
+    phgmg__free(alloc, bufs[0]); phgmg__free(alloc, bufs[1]);
+    return rc;
+  }
   k = phgmg__e_algebraic(sys, alloc);   /* zero rows or columns: index one? (1.8) */
   if (k < 0) return PHGMG_ERR_NOMEM;
   if (k > 0) return phgmg__dae_validate(sys, tol, alloc);
@@ -4893,8 +4910,14 @@ PHGMG__PRIV void phgmg__ph_span(const phgmg_ph_system *s, int i, int *a, int *b)
 /* Zero rows (zr[i] = 1) and zero columns (zc[j] = 1) of E, and their counts. */
 PHGMG__PRIV void phgmg__e_zero_lines(const phgmg_ph_system *s, int *zr, int *zc, int *kr, int *kc) {
   int i, j, a, b;
+  const int *cp, *ci;
+  const double *cx;
   for (i = 0; i < s->N; ++i) zr[i] = zc[i] = 1;
-  for (j = 0; j < s->N; ++j) {
+  if (phgmg__ph_csc_of(s, s->E, &cp, &ci, &cx)) /* SPARSE: E's CSC copy */
+    for (j = 0; j < s->N; ++j)
+      for (a = cp[j]; a < cp[j + 1]; ++a)
+        if (cx[a] != 0.0) zr[ci[a]] = zc[j] = 0;
+  for (j = 0; j < s->N && s->storage != PHGMG_SPARSE; ++j) {
     phgmg__ph_span(s, j, &a, &b);
     for (i = a; i <= b; ++i)
       if (phgmg__ph_at(s, s->E, i, j) != 0.0) zr[i] = zc[j] = 0;
@@ -5857,6 +5880,9 @@ typedef struct phgmg__spsym {
   int *jr_p, *jr_i; double *jr_x; /* J - R, CSC, internal order        */
   int *q_p, *q_i; double *q_x;    /* Q, CSC, internal order            */
   int *k_p, *k_i;                 /* pattern of M plus the diagonal    */
+  const int *e_p, *e_i;           /* E (descriptor; not owned), NULL   */
+  const double *e_x;
+  double *kex, emax;              /* E's values in the k pattern, max  */
   /* The factored matrix (order nf, pattern f_p/f_i in its own numbering:
      internal index fidx[c] for column c): K itself (na = 0, f_p = k_p), or
      the Schur complement of the condensed block (manual 8.12). */
@@ -5881,6 +5907,7 @@ PHGMG__PRIV void phgmg__spsym_free(const phgmg_allocator *al, phgmg__spsym *S) {
   if (!S) return;
   phgmg__free(al, S->jr_p); phgmg__free(al, S->jr_i); phgmg__free(al, S->jr_x);
   phgmg__free(al, S->q_p); phgmg__free(al, S->q_i); phgmg__free(al, S->q_x);
+  phgmg__free(al, S->kex);
   if (S->f_p != S->k_p) { phgmg__free(al, S->f_p); phgmg__free(al, S->f_i); }
   phgmg__free(al, S->k_p); phgmg__free(al, S->k_i); phgmg__free(al, S->perm);
   phgmg__free(al, S->f_d); phgmg__free(al, S->fidx); phgmg__free(al, S->bpos);
@@ -5951,7 +5978,8 @@ PHGMG__PRIV phgmg_result phgmg__band_to_csc(int n, int kb, const double *M1, con
   return PHGMG_OK;
 }
 
-/* Pattern of M = (J - R) Q plus (J - R) plus the diagonal, CSC, sorted rows. */
+/* Pattern of M = (J - R) Q plus (J - R) plus the diagonal (and E's pattern
+   for a descriptor model), CSC, sorted rows. */
 PHGMG__PRIV phgmg_result phgmg__spsym_kpattern(phgmg__spsym *S, const phgmg_allocator *al) {
   int n = S->n, j, p, q, nz = 0, pass;
   int *mark = phgmg__ialloc(al, (size_t)n);
@@ -5967,6 +5995,7 @@ PHGMG__PRIV phgmg_result phgmg__spsym_kpattern(phgmg__spsym *S, const phgmg_allo
 #define PHGMG__KP_ADD(r) do { int r_ = (r); if (mark[r_] != j) { mark[r_] = j; if (pass) S->k_i[nz] = r_; ++nz; } } while (0)
       PHGMG__KP_ADD(j);
       for (p = S->jr_p[j]; p < S->jr_p[j + 1]; ++p) PHGMG__KP_ADD(S->jr_i[p]);
+      if (S->e_p) for (p = S->e_p[j]; p < S->e_p[j + 1]; ++p) PHGMG__KP_ADD(S->e_i[p]);
       for (q = S->q_p[j]; q < S->q_p[j + 1]; ++q) {
         int k = S->q_i[q];
         for (p = S->jr_p[k]; p < S->jr_p[k + 1]; ++p) PHGMG__KP_ADD(S->jr_i[p]);
@@ -5981,6 +6010,25 @@ PHGMG__PRIV phgmg_result phgmg__spsym_kpattern(phgmg__spsym *S, const phgmg_allo
   }
   S->k_p[n] = nz;
   phgmg__free(al, mark);
+  return PHGMG_OK;
+}
+
+/* Descriptor: E's values scattered into the k pattern (S->kex), their
+   largest magnitude (S->emax). */
+PHGMG__PRIV phgmg_result phgmg__spsym_kex(phgmg__spsym *S, const phgmg_allocator *al) {
+  int j, p, q;
+  S->kex = phgmg__dalloc(al, (size_t)S->k_p[S->n] + 1);
+  if (!S->kex) return PHGMG_ERR_NOMEM;
+  S->emax = 0.0;
+  for (j = 0; j < S->n; ++j) {
+    q = S->k_p[j];
+    for (p = q; p < S->k_p[j + 1]; ++p) S->kex[p] = 0.0;
+    for (p = S->e_p[j]; p < S->e_p[j + 1]; ++p) { /* both columns sorted */
+      while (S->k_i[q] < S->e_i[p]) ++q;
+      S->kex[q] += S->e_x[p];
+      S->emax = PHGMG__MAX(S->emax, fabs(S->e_x[p]));
+    }
+  }
   return PHGMG_OK;
 }
 
@@ -6225,6 +6273,9 @@ PHGMG__PRIV phgmg_result phgmg__sp_condense_select(phgmg__spsym *S, const int *g
   S->bpos = phgmg__ialloc(al, (size_t)n + 1);
   if (!q || !st || !S->aidx || !S->fidx || !S->bpos) goto done;
   for (v = 0; v < n; ++v) st[v] = 0; /* 0 unseen, 1 queued, 2 chosen, 3 blocked */
+  for (v = 0; S->e_p && v < n; ++v) /* E couples v to another state: not condensed (real couplings) */
+    for (p = S->e_p[v]; p < S->e_p[v + 1]; ++p)
+      if (S->e_i[p] != v && S->e_x[p] != 0.0) { st[v] = st[S->e_i[p]] = 4; }
   for (r = 0; r < n; ++r) {
     if (st[r]) continue;
     st[r] = 1; q[tail++] = r;
@@ -6365,6 +6416,7 @@ PHGMG__PRIV phgmg_result phgmg__spsym_analyse(phgmg__spsym *S, int condense, con
       *w2 = NULL, *w3 = NULL, *perm2 = NULL, i;
   double lnz = 0.0, lnz2 = 0.0;
   phgmg_result rc = phgmg__spsym_kpattern(S, al);
+  if (rc == PHGMG_OK && S->e_p) rc = phgmg__spsym_kex(S, al);
   if (rc == PHGMG_OK) rc = phgmg__spsym_graph(n, S->k_p, S->k_i, &gp, &gi, al);
   if (rc != PHGMG_OK) goto done;
   iord = phgmg__ialloc(al, (size_t)n);
@@ -6556,7 +6608,8 @@ PHGMG__PRIV int phgmg__front_zlu(int nf, int nc, double *F, double tiny) {
   return nrep;
 }
 
-/* Values of the factored matrix into F->Fx: K = shift I + M itself, or the
+/* Values of the factored matrix into F->Fx: K = shift I + M (shift E + M for
+   a descriptor model: S->kex) itself, or the
    Schur complement K_bb - K_ba K_aa^{-1} K_ab (F->dinv = 1 / K(a, a), the
    couplings copied for the solves). A pivot K(a, a) below tiny is counted in
    F->nstatic. Returns the largest |K_ba(:, a) / K(a, a)|. */
@@ -6565,8 +6618,9 @@ PHGMG__PRIV double phgmg__sp_fvalues(const phgmg__spsym *S, phgmg__spnum *F, con
   const int nf = S->nf, w = F->cplx ? 2 : 1;
   int t, c, p, q;
   double *x = F->t, lmax = 0.0;
-  for (t = 0; t < S->na; ++t) {
-    double dr = Mx[S->ad_k[t]] + sr, di = w == 2 ? si : 0.0, m = hypot(dr, di), d2, cm = 0.0;
+  for (t = 0; t < S->na; ++t) { /* (a descriptor's E is diagonal in the condensed rows and columns) */
+    const double e = S->kex ? S->kex[S->ad_k[t]] : 1.0;
+    double dr = Mx[S->ad_k[t]] + sr * e, di = w == 2 ? si * e : 0.0, m = hypot(dr, di), d2, cm = 0.0;
     if (!(m >= tiny)) ++F->nstatic;
     d2 = dr * dr + di * di;
     F->dinv[w * t] = dr / d2;
@@ -6579,7 +6633,11 @@ PHGMG__PRIV double phgmg__sp_fvalues(const phgmg__spsym *S, phgmg__spnum *F, con
     int v = S->fidx[c];
     for (p = S->k_p[v]; p < S->k_p[v + 1]; ++p) {
       int b = S->bpos[S->k_i[p]];
-      if (b >= 0) { x[w * b] += Mx[p]; continue; }
+      if (b >= 0) {
+        x[w * b] += Mx[p] + (S->kex ? sr * S->kex[p] : 0.0);
+        if (w == 2 && S->kex) x[w * b + 1] += si * S->kex[p];
+        continue;
+      }
       t = -1 - b;
       { /* x_b -= K_ba(:, a) K(a, a)^{-1} K(a, c) */
         double gr = Mx[p] * F->dinv[w * t], gi = w == 2 ? Mx[p] * F->dinv[2 * t + 1] : 0.0;
@@ -6590,8 +6648,7 @@ PHGMG__PRIV double phgmg__sp_fvalues(const phgmg__spsym *S, phgmg__spnum *F, con
         }
       }
     }
-    x[w * c] += sr;
-    if (w == 2) x[2 * c + 1] += si;
+    if (!S->kex) { x[w * c] += sr; if (w == 2) x[2 * c + 1] += si; } /* shift sigma I */
     for (p = S->f_p[c]; p < S->f_p[c + 1]; ++p) {
       int r = S->f_i[p];
       F->Fx[w * p] = x[w * r]; x[w * r] = 0.0;
@@ -6614,7 +6671,7 @@ PHGMG__PRIV void phgmg__sp_factor(const phgmg__spsym *S, phgmg__spnum *F, const 
   double kmax = 0.0, fmax = 0.0;
   F->nstatic = 0;
   for (q = 0; q < S->k_p[S->n]; ++q) kmax = PHGMG__MAX(kmax, fabs(Mx[q]));
-  kmax = PHGMG__MAX(kmax, hypot(sr, si));
+  kmax = PHGMG__MAX(kmax, hypot(sr, si) * (S->kex ? S->emax : 1.0));
   tiny *= kmax;
   fmax = phgmg__sp_fvalues(S, F, Mx, sr, si, tiny);
   for (s = 0; s < ns; ++s) {
@@ -7064,9 +7121,9 @@ struct phgmg_ph_sparse {
   const phgmg_allocator *alloc; /* &a or NULL */
   int *perm, *iperm, *sep;
   double *J, *R, *Q, *B;
-  double *E;   /* descriptor models (phgmg_ph_sparse_create_e), else NULL */
-  int *cp[3], *ci[3];           /* J, R, Q as CSC in the internal order */
-  double *cx[3];                /*   (rows sorted; nnz + 1 values each) */
+  double *E;   /* descriptor models: E's band copy (band LU only), else NULL */
+  int *cp[4], *ci[4];           /* J, R, Q (and E) as CSC in the internal order */
+  double *cx[4];                /*   (rows sorted; nnz + 1 values each; E: NULL without) */
   phgmg__spsym *sym;            /* sparse LU analysis (NULL: not done) */
   int use_lu;                   /* 1: steppers use the sparse LU       */
   phgmg_ph_sparse_info inf;
@@ -7084,6 +7141,7 @@ PHGMG__PRIV phgmg_result phgmg__spsym_create_sp(phgmg__spsym **out, const phgmg_
   if (!S) return PHGMG_ERR_NOMEM;
   memset(S, 0, sizeof *S);
   S->n = n;
+  S->e_p = sp->cp[3]; S->e_i = sp->ci[3]; S->e_x = sp->cx[3]; /* descriptor: NULL without E */
   S->jr_p = phgmg__ialloc(al, (size_t)n + 1);
   S->q_p = phgmg__ialloc(al, (size_t)n + 1);
   if (!S->jr_p || !S->q_p) rc = PHGMG_ERR_NOMEM;
@@ -7132,22 +7190,11 @@ PHGMG_DEF void phgmg_ph_sparse_destroy(phgmg_ph_sparse *sp) {
   phgmg__free(alloc, sp->Q);
   phgmg__free(alloc, sp->B);
   phgmg__free(alloc, sp->E);
-  for (a = 0; a < 3; ++a) {
+  for (a = 0; a < 4; ++a) {
     phgmg__free(alloc, sp->cp[a]); phgmg__free(alloc, sp->ci[a]); phgmg__free(alloc, sp->cx[a]);
   }
   phgmg__spsym_free(alloc, sp->sym);
   phgmg__free(alloc, sp);
-}
-
-/* Scatter an N x N CSC matrix into band storage (kb) of the permuted order. */
-PHGMG__PRIV void phgmg__csc_to_band(const phgmg_csc *A, const int *ip, int kb, double *band) {
-  int j, p;
-  const size_t ld = (size_t)(2 * kb + 1);
-  for (j = 0; j < A->n_cols; ++j)
-    for (p = A->colptr[j]; p < A->colptr[j + 1]; ++p) {
-      int r = ip[A->rowidx[p]], c = ip[j];
-      band[(size_t)(kb + r - c) + (size_t)c * ld] = A->values[p];
-    }
 }
 
 /* CSC of P A P^T (ip: the inverse permutation, new index of each old one),
@@ -7249,16 +7296,10 @@ PHGMG_DEF phgmg_result phgmg_ph_sparse_create_e(phgmg_ph_sparse **out, int N, in
     for (i = 0; i < N; ++i) sp->perm[i] = i;
   kb = kb_rcm < kb_in ? kb_rcm : kb_in;
   for (i = 0; i < N; ++i) sp->iperm[sp->perm[i]] = i;
-  for (a = 0; a < 3 && rc == PHGMG_OK; ++a) /* J, R, Q in the internal order: no band copy yet */
+  for (a = 0; a < na && rc == PHGMG_OK; ++a) /* J, R, Q (E) in the internal order: no band copy yet */
     rc = phgmg__csc_permuted(A[a], sp->iperm, &sp->cp[a], &sp->ci[a], &sp->cx[a], alloc);
   sp->B = phgmg__dalloc(alloc, (size_t)N * (size_t)m);
   if (rc != PHGMG_OK || !sp->B) { phgmg_ph_sparse_destroy(sp); return rc != PHGMG_OK ? rc : PHGMG_ERR_NOMEM; }
-  if (E) { /* descriptor models keep the band solver: E in band storage */
-    sp->E = phgmg__dalloc(alloc, (size_t)(2 * kb + 1) * (size_t)N);
-    if (!sp->E) { phgmg_ph_sparse_destroy(sp); return PHGMG_ERR_NOMEM; }
-    memset(sp->E, 0, sizeof(double) * (size_t)(2 * kb + 1) * (size_t)N);
-    phgmg__csc_to_band(E, sp->iperm, kb, sp->E);
-  }
   if (B) {
     for (j = 0; j < m; ++j)
       for (i = 0; i < N; ++i) sp->B[i + (size_t)j * N] = B[sp->perm[i] + (size_t)j * N];
@@ -7273,7 +7314,6 @@ PHGMG_DEF phgmg_result phgmg_ph_sparse_create_e(phgmg_ph_sparse **out, int N, in
   sp->sys.m = m;
   sp->sys.kb = kb;
   sp->sys.B = sp->B;
-  sp->sys.E = sp->E;
   sp->sys.nl = PHGMG_NL_NONE;
   sp->sys.sparse = sp;
   sp->inf.kb = kb;
@@ -7308,15 +7348,15 @@ PHGMG__PRIV void phgmg__ph_sparse_stage_bw(const phgmg_ph_sparse *sp, int *kl, i
   *ku = PHGMG__MIN(N - 1, amax + bmax);
 }
 
-/* Band copies of J, R, Q (the band solver's storage) from the CSC copies;
+/* Band copies of J, R, Q (and E) (the band solver's storage) from the CSC copies;
    drop = 1 frees them. */
 PHGMG__PRIV phgmg_result phgmg__ph_sparse_band(phgmg_ph_sparse *sp, int drop) {
   const int N = sp->sys.N, kb = sp->sys.kb;
   const size_t len = (size_t)(2 * kb + 1) * (size_t)N;
-  double **dst[3];
+  double **dst[4];
   int a, j, p;
-  dst[0] = &sp->J; dst[1] = &sp->R; dst[2] = &sp->Q;
-  for (a = 0; a < 3; ++a) {
+  dst[0] = &sp->J; dst[1] = &sp->R; dst[2] = &sp->Q; dst[3] = &sp->E;
+  for (a = 0; a < (sp->cp[3] ? 4 : 3); ++a) {
     if (drop) { phgmg__free(sp->alloc, *dst[a]); *dst[a] = NULL; continue; }
     if (*dst[a]) continue;
     *dst[a] = phgmg__dalloc(sp->alloc, len);
@@ -7340,13 +7380,35 @@ PHGMG__PRIV void phgmg__ph_sparse_storage(phgmg_ph_sparse *sp) {
   sp->sys.J = sp->use_lu ? sp->cx[0] : sp->J;
   sp->sys.R = sp->use_lu ? sp->cx[1] : sp->R;
   sp->sys.Q = sp->use_lu ? sp->cx[2] : sp->Q;
+  sp->sys.E = !sp->cp[3] ? NULL : sp->use_lu ? sp->cx[3] : sp->E;
   f->band_copy = sp->J != NULL;
   b = (double)sizeof(double) * (double)sp->sys.N * (double)sp->sys.m + 2.0 * sizeof(int) * (double)sp->sys.N;
-  for (a = 0; a < 3; ++a) b += (double)(sizeof(int) + sizeof(double)) * (double)sp->cp[a][sp->sys.N];
+  for (a = 0; a < 4; ++a)
+    if (sp->cp[a]) b += (double)(sizeof(int) + sizeof(double)) * (double)sp->cp[a][sp->sys.N];
   if (sp->J) b += 3.0 * sizeof(double) * (double)(2 * sp->sys.kb + 1) * (double)sp->sys.N;
   if (sp->E) b += sizeof(double) * (double)(2 * sp->sys.kb + 1) * (double)sp->sys.N;
   if (sp->sym) b += phgmg__spsym_bytes(sp->sym);
   f->bytes = b;
+}
+
+/* 1: no E, or every row and column of E holds a nonzero (no algebraic
+   equation); 0: E has a zero row or column; -1: no memory. */
+PHGMG__PRIV int phgmg__ph_sparse_e_regular(const phgmg_ph_sparse *sp) {
+  const int N = sp->sys.N;
+  int i, j, p, ok = 1, *hit;
+  if (!sp->cp[3]) return 1;
+  hit = phgmg__ialloc(sp->alloc, (size_t)N);
+  if (!hit) return -1;
+  for (i = 0; i < N; ++i) hit[i] = 0;
+  for (j = 0; j < N; ++j) {
+    int col = 0;
+    for (p = sp->cp[3][j]; p < sp->cp[3][j + 1]; ++p)
+      if (sp->cx[3][p] != 0.0) { col = 1; hit[sp->ci[3][p]] = 1; }
+    ok &= col;
+  }
+  for (i = 0; i < N; ++i) ok &= hit[i];
+  phgmg__free(sp->alloc, hit);
+  return ok;
 }
 
 PHGMG_DEF phgmg_result phgmg_ph_sparse_set_solver(phgmg_ph_sparse *sp, int solver,
@@ -7360,8 +7422,12 @@ PHGMG_DEF phgmg_result phgmg_ph_sparse_set_solver(phgmg_ph_sparse *sp, int solve
   phgmg__ph_sparse_stage_bw(sp, &f->kl, &f->ku);
   f->lu_band = (double)N * (double)(2 * f->kl + f->ku + 1);
   f->flops_band = 2.0 * (double)N * (double)f->kl * (double)(f->kl + f->ku + 1);
-  if (sp->E && solver == PHGMG_SOLVER_SPARSE_LU) return PHGMG_ERR_UNSUPPORTED; /* stage matrix sigma E - ... */
-  if (!sp->E && !sp->sym && (solver == PHGMG_SOLVER_SPARSE_LU ||
+  if ((use = phgmg__ph_sparse_e_regular(sp)) < 0) return PHGMG_ERR_NOMEM;
+  if (!use) { /* E with zero lines (index one, manual 1.8): the band path condenses them */
+    if (solver == PHGMG_SOLVER_SPARSE_LU) return PHGMG_ERR_UNSUPPORTED;
+    solver = PHGMG_SOLVER_BAND;
+  }
+  if (!sp->sym && solver != PHGMG_SOLVER_BAND && (solver == PHGMG_SOLVER_SPARSE_LU ||
                    (solver == PHGMG_SOLVER_AUTO && sp->sys.kb > PHGMG_SPARSE_MIN_KB))) {
     rc = phgmg__spsym_create_sp(&sp->sym, sp, -1);
     if (rc != PHGMG_OK) return rc;
@@ -7397,8 +7463,8 @@ PHGMG__PRIV int phgmg__ph_csc_of(const phgmg_ph_system *s, const double *M, cons
   const phgmg_ph_sparse *sp = s->sparse;
   int a;
   if (s->storage != PHGMG_SPARSE || !sp) return 0;
-  for (a = 0; a < 3; ++a)
-    if (M == sp->cx[a]) { *cp = sp->cp[a]; *ci = sp->ci[a]; *cx = sp->cx[a]; return 1; }
+  for (a = 0; a < 4; ++a)
+    if (M && M == sp->cx[a]) { *cp = sp->cp[a]; *ci = sp->ci[a]; *cx = sp->cx[a]; return 1; }
   return 0;
 }
 
@@ -7421,7 +7487,7 @@ PHGMG__PRIV int phgmg__ph_sparse_mv(const phgmg_ph_system *s, const double *M, c
 /* The sparse analysis a stepper may use for sys (NULL: band). */
 PHGMG__PRIV const phgmg__spsym *phgmg__ph_sparse_lu(const phgmg_ph_system *sys) {
   const phgmg_ph_sparse *sp = sys->sparse;
-  if (!sp || !sp->use_lu || !sp->sym || sys->E || sys->storage != PHGMG_SPARSE || sys->N != sp->sys.N ||
+  if (!sp || !sp->use_lu || !sp->sym || sys->E != sp->cx[3] || sys->storage != PHGMG_SPARSE || sys->N != sp->sys.N ||
       sys->J != sp->cx[0] || sys->R != sp->cx[1] || sys->Q != sp->cx[2] || sys->nl == PHGMG_NL_GENERAL)
     return NULL;
   return sp->sym;
@@ -7431,9 +7497,10 @@ PHGMG__PRIV const phgmg__spsym *phgmg__ph_sparse_lu(const phgmg_ph_system *sys) 
    only what the sparse path serves (see phgmg_ph_sparse_system). */
 PHGMG__PRIV phgmg_result phgmg__ph_check_sparse(const phgmg_ph_system *s) {
   const phgmg_ph_sparse *sp = s->sparse;
-  if (!sp || s->N != sp->sys.N || s->J != sp->cx[0] || s->R != sp->cx[1] || s->Q != sp->cx[2])
+  if (!sp || s->N != sp->sys.N || s->J != sp->cx[0] || s->R != sp->cx[1] || s->Q != sp->cx[2] ||
+      s->E != sp->cx[3])
     return PHGMG_ERR_INVALID_ARG;
-  if (s->E || s->ndamp || s->P || s->S || s->Nskew || s->nl == PHGMG_NL_GENERAL || s->shifted_factor)
+  if (s->ndamp || s->P || s->S || s->Nskew || s->nl == PHGMG_NL_GENERAL || s->shifted_factor)
     return PHGMG_ERR_UNSUPPORTED;
   return PHGMG_OK;
 }
@@ -7485,6 +7552,32 @@ PHGMG__PRIV phgmg_result phgmg__ph_sparse_own_band(const phgmg_ph_system *s, int
   t->kb = kb;
   phgmg__free(al, ip);
   return rc;
+}
+
+/* A BANDED view t of the SPARSE descriptor system s (the object's order and
+   half-bandwidth) with band copies of Q and E in bufs[0], bufs[1] (J and R
+   point at Q's copy: for the checks and factors of E and E^T Q only). */
+PHGMG__PRIV phgmg_result phgmg__ph_sparse_eq_band(const phgmg_ph_system *s, phgmg_ph_system *t, double **bufs,
+                                                 const phgmg_allocator *al) {
+  const phgmg_ph_sparse *sp = s->sparse;
+  const int N = s->N, kb = sp->sys.kb;
+  const size_t len = (size_t)(2 * kb + 1) * (size_t)N;
+  int k, j, p;
+  *t = *s;
+  bufs[0] = bufs[1] = NULL;
+  for (k = 0; k < 2; ++k) {
+    const int a = k ? 3 : 2;
+    if (!(bufs[k] = phgmg__dalloc(al, len))) return PHGMG_ERR_NOMEM;
+    memset(bufs[k], 0, sizeof(double) * len);
+    for (j = 0; j < N; ++j)
+      for (p = sp->cp[a][j]; p < sp->cp[a][j + 1]; ++p) bufs[k][PHGMG__PHB(kb, sp->ci[a][p], j)] = sp->cx[a][p];
+  }
+  t->storage = PHGMG_BANDED;
+  t->sparse = NULL;
+  t->kb = kb;
+  t->J = t->R = t->Q = bufs[0];
+  t->E = bufs[1];
+  return PHGMG_OK;
 }
 
 /* Frees what phgmg__ph_sparse_own_band allocated (perm may be NULL: kept). */
@@ -7931,6 +8024,10 @@ PHGMG__PRIV void phgmg__gl3_e_times(const phgmg_gl3 *s, const double *V, double 
     phgmg_gemm('N', 'N', s->N, 3, s->N, 1.0, s->sys.E, s->N, V, s->N, 0.0, EZ, s->N);
     return;
   }
+  if (s->sys.storage == PHGMG_SPARSE) { /* E's CSC copy */
+    for (st = 0; st < 3; ++st) phgmg__ph_mv(&s->sys, s->sys.E, V + (size_t)st * (size_t)s->N, EZ + (size_t)st * (size_t)s->N);
+    return;
+  }
   for (st = 0; st < 3; ++st) phgmg__dia_mv(&s->de, V + (size_t)st * (size_t)s->N, EZ + (size_t)st * (size_t)s->N);
 }
 
@@ -8343,7 +8440,8 @@ PHGMG__PRIV phgmg_result phgmg__gl3_setup_band_lu(phgmg_gl3 *s) {
       amax = PHGMG__MAX(amax, s->ddm_w);
     }
     if (sys->E) { /* descriptor: the band of E joins that of (J - R) Hess */
-      rc = phgmg__dia_build(&s->al, &s->de, N, kb, sys->E, NULL, 1, 0);
+      rc = sys->storage == PHGMG_SPARSE ? PHGMG_OK /* built by phgmg__gl3_sparse_dia */
+                                        : phgmg__dia_build(&s->al, &s->de, N, kb, sys->E, NULL, 1, 0);
       if (rc != PHGMG_OK) return rc;
       for (k = 0; k < s->de.nd; ++k) {
         amin = PHGMG__MIN(amin, s->de.off[k] - bmin);
@@ -8824,16 +8922,16 @@ PHGMG__PRIV phgmg_result phgmg__gl3_sparse_factor(phgmg_gl3 *s, double sg, doubl
   return PHGMG_OK;
 }
 
-/* SPARSE storage: the diagonals of J - R and Q through band copies made
+/* SPARSE storage: the diagonals of J - R and Q (and E) through band copies made
    here (the system has none) and freed after. */
 PHGMG__PRIV phgmg_result phgmg__gl3_sparse_dia(phgmg_gl3 *s) {
   const phgmg_ph_sparse *sp = s->sys.sparse;
   const int N = s->N, kb = s->sys.kb;
   const size_t len = (size_t)(2 * kb + 1) * (size_t)N;
-  double *b[3];
+  double *b[4] = {NULL, NULL, NULL, NULL};
   int a, j, p;
   phgmg_result rc = PHGMG_OK;
-  for (a = 0; a < 3; ++a) {
+  for (a = 0; a < (sp->cp[3] ? 4 : 3); ++a) {
     b[a] = phgmg__dalloc(&s->al, len);
     if (!b[a]) { rc = PHGMG_ERR_NOMEM; continue; }
     memset(b[a], 0, sizeof(double) * len);
@@ -8842,7 +8940,8 @@ PHGMG__PRIV phgmg_result phgmg__gl3_sparse_dia(phgmg_gl3 *s) {
   }
   if (rc == PHGMG_OK) rc = phgmg__dia_build(&s->al, &s->djr, N, kb, b[0], b[1], 0, 0);
   if (rc == PHGMG_OK) rc = phgmg__dia_build(&s->al, &s->dq, N, kb, b[2], NULL, 1, 0);
-  for (a = 0; a < 3; ++a) phgmg__free(&s->al, b[a]);
+  if (rc == PHGMG_OK && b[3]) rc = phgmg__dia_build(&s->al, &s->de, N, kb, b[3], NULL, 1, 0);
+  for (a = 0; a < 4; ++a) phgmg__free(&s->al, b[a]);
   return rc;
 }
 

@@ -631,6 +631,167 @@ TEST(test_sparse_storage_checks) {
   slu_lat_free(&L);
 }
 
+/* ---- descriptor models: sigma E + M on the sparse LU ------------------------------- */
+/* A consistent-mass-like E = blockdiag(I on the positions, Mc on the
+   momenta) of an nx x ny lattice built by slu_lat_build: Mc(n, n) = 1,
+   Mc(n, k) = 0.1 for neighbours (diagonally dominant: SPD), scrambled with
+   the lattice's states. E^T Q = blockdiag(K, Mc) is symmetric. */
+typedef struct slu_mass { int *cp, *ri; double *v; phgmg_csc E; } slu_mass;
+static void slu_mass_build(slu_mass *m, const slu_lat *L, int nx, int ny) {
+  const int N = L->N;
+  int n, x, y, i, j, nz = 0;
+  double *D = (double *)calloc((size_t)N * N, sizeof(double));
+  for (y = 0; y < ny; ++y)
+    for (x = 0; x < nx; ++x) {
+      int nb[2], nbn = 0;
+      n = x + nx * y;
+      if (x + 1 < nx) nb[nbn++] = n + 1;
+      if (y + 1 < ny) nb[nbn++] = n + nx;
+      D[(size_t)L->sc[2 * n] * (N + 1)] = 1.0;
+      D[(size_t)L->sc[2 * n + 1] * (N + 1)] = 1.0;
+      for (i = 0; i < nbn; ++i) {
+        D[L->sc[2 * n + 1] + (size_t)L->sc[2 * nb[i] + 1] * N] = 0.1;
+        D[L->sc[2 * nb[i] + 1] + (size_t)L->sc[2 * n + 1] * N] = 0.1;
+      }
+    }
+  m->cp = (int *)malloc(sizeof(int) * (size_t)(N + 1));
+  for (j = 0; j < N * N; ++j) nz += D[j] != 0.0;
+  m->ri = (int *)malloc(sizeof(int) * (size_t)nz);
+  m->v = (double *)malloc(sizeof(double) * (size_t)nz);
+  for (j = 0, nz = 0; j < N; ++j) {
+    m->cp[j] = nz;
+    for (i = 0; i < N; ++i)
+      if (D[i + (size_t)j * N] != 0.0) { m->ri[nz] = i; m->v[nz++] = D[i + (size_t)j * N]; }
+  }
+  m->cp[N] = nz;
+  m->E.n_rows = m->E.n_cols = N;
+  m->E.colptr = m->cp; m->E.rowidx = m->ri; m->E.values = m->v;
+  free(D);
+}
+static void slu_mass_free(slu_mass *m) { free(m->cp); free(m->ri); free(m->v); }
+
+TEST(test_sparse_lu_descriptor) {
+  /* A 2-D lattice with a coupled mass matrix E simulated with the sparse LU
+     of sigma E + M (forced; the old code refused it) and with the band LU
+     with partial pivoting (an independent solver of the same stage systems):
+     validation, trajectories, outputs, the energy bookkeeping and a GMG-POD
+     reduction agree to 1e-10, linear and with the cosh potential on the
+     positions (refactorizations); the discrete energy balance
+     H_n - H_0 = S_n - D_n holds to round-off (quadratic H, Gauss
+     collocation). */
+  static const double expo[4] = {0.5, 1.0, 0.5, -1.0}, poly[1] = {-1.0};
+  const int nx = 12, ny = 12, ns = 151;
+  slu_lat L;
+  slu_mass M;
+  double *X[2], *Y[2], *YR[2], *H[2], *S[2], *D[2], *x0, amp = 400.0, bal = 0.0, hm = 0.0;
+  int run, nl, k, *idx;
+  slu_lat_build(&L, nx, ny, 1, 0);
+  slu_mass_build(&M, &L, nx, ny);
+  x0 = (double *)calloc((size_t)L.N, sizeof(double));
+  idx = (int *)malloc(sizeof(int) * (size_t)L.nn);
+  for (nl = 0; nl < 2; ++nl) {
+    for (run = 0; run < 2; ++run) {
+      phgmg_ph_sparse *sp = NULL;
+      phgmg_ph_sparse_info inf;
+      phgmg_ph_system sys;
+      phgmg_energy en;
+      X[run] = (double *)malloc(sizeof(double) * (size_t)L.N * ns);
+      Y[run] = (double *)malloc(sizeof(double) * ns); YR[run] = (double *)calloc((size_t)ns, sizeof(double));
+      H[run] = (double *)malloc(sizeof(double) * ns); S[run] = (double *)malloc(sizeof(double) * ns);
+      D[run] = (double *)malloc(sizeof(double) * ns);
+      en.H = H[run]; en.S = S[run]; en.D = D[run];
+      CHECK_RC(phgmg_ph_sparse_create_e(&sp, L.N, 1, &L.M[0], &L.M[1], &L.M[2], &M.E, L.B, NULL, &inf, NULL), PHGMG_OK);
+      CHECK_RC(phgmg_ph_sparse_set_solver(sp, run ? PHGMG_SOLVER_BAND : PHGMG_SOLVER_SPARSE_LU, &inf), PHGMG_OK);
+      CHECK(inf.solver == (run ? PHGMG_SOLVER_BAND : PHGMG_SOLVER_SPARSE_LU));
+      sys = *phgmg_ph_sparse_system(sp);
+      CHECK(sys.E != NULL && sys.storage == (run ? PHGMG_BANDED : PHGMG_SPARSE));
+      CHECK_RC(phgmg_ph_validate(&sys, 0.0, NULL, NULL), PHGMG_OK);
+      if (nl) {
+        for (k = 0; k < L.nn; ++k) idx[k] = L.sc[2 * k];
+        sys.nl = PHGMG_NL_SEPARABLE;
+        sys.poly_deg = 0; sys.poly = poly; sys.nexp = 2; sys.expo = expo;
+        CHECK_RC(phgmg_ph_sparse_sep_idx(sp, L.nn, idx, NULL, &sys), PHGMG_OK);
+      }
+      CHECK_RC(phgmg_simulate(&sys, x0, 0.0, 0.1, ns - 1, slu_u, nl ? &amp : NULL, NULL, X[run], Y[run], &en, NULL,
+                              NULL, NULL), PHGMG_OK);
+      if (!nl) {
+        phgmg_reduce_opts o;
+        phgmg_reduced *red = NULL;
+        double xr0[16];
+        phgmg_reduce_opts_default(&o);
+        o.method = PHGMG_METHOD_GMG_POD;
+        o.r = 12;
+        CHECK_RC(phgmg_reduce(&red, &sys, X[run], L.N, ns, &o, NULL, NULL), PHGMG_OK);
+        if (red) {
+          phgmg_reduced_restrict(red, x0, xr0);
+          CHECK_RC(phgmg_reduced_simulate(red, xr0, 0.0, 0.1, ns - 1, slu_u, NULL, 1e-12, 30, NULL, YR[run], NULL,
+                                          NULL, NULL), PHGMG_OK);
+        }
+        phgmg_reduced_destroy(red);
+        for (k = 0; k < ns; ++k) { /* quadratic H: the discrete balance is exact up to round-off */
+          bal = fmax(bal, fabs(H[run][k] - H[run][0] - (S[run][k] - D[run][k])));
+          hm = fmax(hm, fabs(H[run][k]));
+        }
+      }
+      phgmg_ph_sparse_destroy(sp);
+    }
+    CHECK_LE(slu_rel(L.N * ns, X[0], X[1]), 1e-10);
+    CHECK_LE(slu_rel(ns, Y[0], Y[1]), 1e-10);
+    CHECK_LE(slu_rel(ns, H[0], H[1]), 1e-10);
+    CHECK_LE(slu_rel(ns, D[0], D[1]), 1e-10);
+    CHECK_LE(slu_rel(ns, YR[0], YR[1]), 1e-10);
+    CHECK(fabs(Y[1][ns - 1]) > 0.0 && H[1][ns - 1] > 0.0);
+    for (run = 0; run < 2; ++run) { free(X[run]); free(Y[run]); free(YR[run]); free(H[run]); free(S[run]); free(D[run]); }
+  }
+  CHECK(hm > 0.0);
+  CHECK_LE(bal, 1e-10 * hm);
+  free(x0); free(idx);
+  slu_mass_free(&M);
+  slu_lat_free(&L);
+}
+
+TEST(test_sparse_lu_descriptor_choice) {
+  /* A 24 x 24 lattice with a mass matrix: the sparse LU is predicted cheaper
+     and chosen (the old code kept the band LU), the object holds no band
+     copy (its bytes stay below one band matrix of (2 kb + 1) N doubles) and
+     the band solver makes the copies of J, R, Q and E; an E with a zero row
+     and column (an algebraic equation) keeps the band path, forcing the
+     sparse LU is refused. */
+  slu_lat L;
+  slu_mass M;
+  slu_count cnt = {0.0, 0.0};
+  phgmg_allocator al;
+  phgmg_ph_sparse *sp = NULL;
+  phgmg_ph_sparse_info inf;
+  double band1, keep;
+  int p;
+  al.alloc = slu_count_alloc; al.free = slu_count_free; al.user = &cnt;
+  slu_lat_build(&L, 24, 24, 1, 0);
+  slu_mass_build(&M, &L, 24, 24);
+  CHECK_RC(phgmg_ph_sparse_create_e(&sp, L.N, 1, &L.M[0], &L.M[1], &L.M[2], &M.E, L.B, NULL, &inf, &al), PHGMG_OK);
+  band1 = 8.0 * (2.0 * inf.kb + 1.0) * L.N;
+  CHECK(inf.solver == PHGMG_SOLVER_SPARSE_LU && inf.band_copy == 0);
+  CHECK(2.0 * inf.lu_sparse < inf.lu_band && inf.flops_sparse < inf.flops_band);
+  CHECK(phgmg_ph_sparse_system(sp)->storage == PHGMG_SPARSE && phgmg_ph_sparse_system(sp)->E != NULL);
+  CHECK_LE(cnt.live, band1);
+  CHECK_LE(cnt.peak, band1);
+  CHECK_RC(phgmg_ph_sparse_set_solver(sp, PHGMG_SOLVER_BAND, &inf), PHGMG_OK);
+  CHECK(inf.band_copy == 1 && phgmg_ph_sparse_system(sp)->storage == PHGMG_BANDED);
+  CHECK(cnt.live >= 4.0 * band1);
+  phgmg_ph_sparse_destroy(sp);
+  CHECK(cnt.live == 0.0);
+  keep = M.v[M.cp[1] - 1];
+  for (p = M.cp[0]; p < M.cp[1]; ++p) M.v[p] = 0.0; /* state 0: zero column and (E symmetric: its only entry) row */
+  sp = NULL;
+  CHECK_RC(phgmg_ph_sparse_create_e(&sp, L.N, 1, &L.M[0], &L.M[1], &L.M[2], &M.E, L.B, NULL, &inf, NULL), PHGMG_OK);
+  CHECK(inf.solver == PHGMG_SOLVER_BAND);
+  CHECK_RC(phgmg_ph_sparse_set_solver(sp, PHGMG_SOLVER_SPARSE_LU, &inf), PHGMG_ERR_UNSUPPORTED);
+  phgmg_ph_sparse_destroy(sp);
+  (void)keep;
+  slu_mass_free(&M);
+  slu_lat_free(&L);
+}
+
 SUITE(sparse_lu) {
   RUN(test_sparse_lu_lattices);
   RUN(test_sparse_lu_components);
@@ -641,4 +802,6 @@ SUITE(sparse_lu) {
   RUN(test_sparse_storage_no_band);
   RUN(test_sparse_storage_equals_band);
   RUN(test_sparse_storage_checks);
+  RUN(test_sparse_lu_descriptor);
+  RUN(test_sparse_lu_descriptor_choice);
 }
