@@ -463,7 +463,10 @@
    PHGMG_SPARSE_GROWTH switches that stepper to the band LU with partial
    pivoting). The cheaper of band and sparse LU by predicted entries and
    flops is used; phgmg_ph_sparse_info reports the choice and
-   phgmg_ph_sparse_set_solver forces one. Descriptor models keep the band LU.
+   phgmg_ph_sparse_set_solver forces one. Descriptor models (E, a mass
+   matrix) take the same choice: their stage matrices sigma E + M are
+   analysed with E's pattern joined (manual 8.12); an E with a zero row or
+   column (index one, 1.8) keeps the band LU.
 
    3. METHODS AND OPTIONS -------------------------------------------------------
    Every option struct is "zero means default": memset it to 0 and set what you
@@ -1293,8 +1296,21 @@
    choice (tests, comparisons). The choice and both predictions are in
    phgmg_ph_sparse_info. The sparse solver serves the GL3 stepper of a
    system with nl NONE or SEPARABLE; a GENERAL Hessian (banded by its
-   callback) and a descriptor model (E) keep the band LU
-   (phgmg_ph_sparse_set_solver: PHGMG_ERR_UNSUPPORTED for the sparse LU).
+   callback) keeps the band LU.
+   Descriptor models. With a mass matrix E the stage matrices are
+   K(sigma) = sigma E + M (E in place of I). The analysis uses the pattern
+   of M, of the identity and of E; the numeric assembly adds sigma times
+   E's values (kept in the pattern of K) where the plain model adds sigma
+   on the diagonal, for the real and the complex shift alike. Condensation
+   needs K_AA diagonal and, so that the couplings K_AB, K_BA stay real for
+   the complex shift, takes only states whose row and column of E hold
+   nothing but the diagonal (a mass-spring model with E = blockdiag(I, Mc):
+   the positions, as without E); a state that E couples to another is never
+   condensed. Static pivots are checked and fall back to the band LU as
+   above. An E with a zero row or column (the index-one path of 1.8, which
+   condenses the algebraic lines in band or dense storage) keeps the band
+   LU (forcing the sparse LU: PHGMG_ERR_UNSUPPORTED). Measured
+   (bench/bench_desc.c): BENCH_DESC_FIGURE
    Memory. With the sparse LU the system is SPARSE: J, R, Q stay in the
    object's CSC copies and no band copy is made (a band of a 2-D lattice of
    317 x 317 masses, kb = 634, would take 3 (2 kb + 1) N doubles = 6.1 GB;
@@ -1315,7 +1331,14 @@
      to be replaced or the growth check fails, the band Cholesky of that
      matrix alone (in its own reverse Cuthill-McKee order) decides;
    - a stepper whose static pivots fail falls back to the band LU with band
-     copies made inside the stepper (the O(N kb) memory is then spent).
+     copies made inside the stepper (the O(N kb) memory is then spent);
+   - a descriptor model's E is a fourth CSC copy (sys.E points at its
+     values): products with E and E^T (the stepper's E Z, the Hamiltonian,
+     the reductions' E V and E^T G) go through it; the checks of
+     phgmg_ph_validate (E^T Q symmetric and definite, E nonsingular) and
+     the factor of E a reduction of a descriptor model keeps (B' = E^{-1} B)
+     work on band copies of E (and Q) made for that call and freed after:
+     O(N kb) memory while they run, none held by the object.
    Measured on a 2-D lattice with N = 200 978 (bench/bench_sparse.sh),
    `phgmg reduce --simulate --steps 200 --method gmg-pod --r 20` peaks at
    about twice the snapshot matrix.
@@ -5444,7 +5467,7 @@ PHGMG_DEF phgmg_result phgmg_dae_create(phgmg_dae **out, const phgmg_ph_system *
   if (alloc) d->al = *alloc;
   d->N = sys->N; d->m = sys->m;
   d->sys = *sys;
-  d->sys.sparse = NULL;
+  if (sys->storage != PHGMG_SPARSE) d->sys.sparse = NULL; /* SPARSE: E regular (k = 0), the object's system */
   d->rpos = phgmg__ialloc(&d->al, 2 * (size_t)sys->N);
   rc = d->rpos ? PHGMG_OK : PHGMG_ERR_NOMEM;
   if (rc == PHGMG_OK) {

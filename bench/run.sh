@@ -8,7 +8,10 @@
 #    bench/bench_linear.c (lyap_N1000, prbt_N1000_r20, h2basis_N1000_r20_20it: about a minute and a half),
 #    bench/bench_scale.c (offline_gmgpod_N256000: the whole reduction of the
 #    nonlinear chain at N = 256 000, 3 runs after a ~30 s full-order run for
-#    the snapshots; about 2 minutes and 5 GB of memory) into
+#    the snapshots; about 2 minutes and 5 GB of memory),
+#    bench/bench_desc.c (desc2d_N10082_band / _sparse: a 2-D lattice with a
+#    mass matrix, 1000 steps with the band LU and with the sparse LU, 3
+#    paired runs; about a minute) into
 #    build/ (a missing or broken source is skipped with a warning) and runs
 #    each, appending `case,median_s,min_s,max_s,runs` lines to the CSV;
 # 2b. bench/bench_sparse.sh: `phgmg simulate` on scrambled 2-D/3-D lattices
@@ -54,7 +57,7 @@ echo "$machine" > "$BUILD/bench_machine.txt"
 make phgmg.h >/dev/null || { echo "run.sh: cannot build phgmg.h" >&2; exit 1; }
 echo "case,median_s,min_s,max_s,runs" > "$CSV"
 
-for prog in bench_linalg bench_fom bench_rom bench_linear bench_scale; do
+for prog in bench_linalg bench_fom bench_rom bench_linear bench_scale bench_desc; do
   src=bench/$prog.c
   if [ ! -f "$src" ]; then
     echo "run.sh: warning: $src is missing, skipped" >&2
