@@ -674,7 +674,8 @@ TEST(test_sparse_lu_descriptor) {
   /* A 2-D lattice with a coupled mass matrix E simulated with the sparse LU
      of sigma E + M (forced; the old code refused it) and with the band LU
      with partial pivoting (an independent solver of the same stage systems):
-     validation, trajectories, outputs, the energy bookkeeping and a GMG-POD
+     validation (and phgmg_dae_create: no algebraic line), trajectories,
+     outputs, the energy bookkeeping and a GMG-POD
      reduction agree to 1e-10, linear and with the cosh potential on the
      positions (refactorizations); the discrete energy balance
      H_n - H_0 = S_n - D_n holds to round-off (quadratic H, Gauss
@@ -706,6 +707,12 @@ TEST(test_sparse_lu_descriptor) {
       sys = *phgmg_ph_sparse_system(sp);
       CHECK(sys.E != NULL && sys.storage == (run ? PHGMG_BANDED : PHGMG_SPARSE));
       CHECK_RC(phgmg_ph_validate(&sys, 0.0, NULL, NULL), PHGMG_OK);
+      if (!nl) { /* no algebraic lines: the index-one path has nothing to condense (as the CLI asks) */
+        phgmg_dae *dae = NULL;
+        CHECK_RC(phgmg_dae_create(&dae, &sys, 0.0, NULL), PHGMG_OK);
+        CHECK(dae && phgmg_dae_nalg(dae) == 0);
+        phgmg_dae_destroy(dae);
+      }
       if (nl) {
         for (k = 0; k < L.nn; ++k) idx[k] = L.sc[2 * k];
         sys.nl = PHGMG_NL_SEPARABLE;
