@@ -1872,7 +1872,7 @@ typedef struct phgmg_ph_sparse_info {
   int supernodes;     /* supernodes of the sparse factor (0: not analysed)     */
   int front_max;      /* largest dense front (order)                           */
   int condensed;      /* states eliminated first by block elimination (manual 8.12) */
-  int band_copy;      /* 1: the object holds band copies of J, R, Q (band solver) */
+  int band_copy;      /* 1: the object holds band copies of J, R, Q (and E) (band solver) */
   double bytes;       /* memory the object holds now (its arrays, the analysis)   */
 } phgmg_ph_sparse_info;
 PHGMG_DEF phgmg_result phgmg_ph_sparse_create(phgmg_ph_sparse **out, int N, int m, const phgmg_csc *J,
@@ -7355,7 +7355,7 @@ PHGMG_DEF phgmg_result phgmg_ph_sparse_create_e(phgmg_ph_sparse **out, int N, in
 }
 
 /* Stage-matrix bandwidths (lower, upper) from the nonzero diagonals of J - R
-   and Q, as the band stepper computes them (from the CSC copies). */
+   and Q (and E), as the band stepper computes them (from the CSC copies). */
 PHGMG__PRIV void phgmg__ph_sparse_stage_bw(const phgmg_ph_sparse *sp, int *kl, int *ku) {
   const int N = sp->sys.N;
   int j, p, q, amin = 0, amax = 0, bmin = 0, bmax = 0;
@@ -7370,6 +7370,13 @@ PHGMG__PRIV void phgmg__ph_sparse_stage_bw(const phgmg_ph_sparse *sp, int *kl, i
     for (p = sp->cp[2][j]; p < sp->cp[2][j + 1]; ++p)
       if (sp->cx[2][p] != 0.0) { bmin = PHGMG__MIN(bmin, j - sp->ci[2][p]); bmax = PHGMG__MAX(bmax, j - sp->ci[2][p]); }
   }
+  if (sp->cp[3]) { amin = PHGMG__MIN(amin, -bmin); amax = PHGMG__MAX(amax, -bmax); } /* E's main diagonal */
+  for (j = 0; sp->cp[3] && j < N; ++j) /* descriptor: E's band joins that of (J - R) Q */
+    for (p = sp->cp[3][j]; p < sp->cp[3][j + 1]; ++p)
+      if (sp->cx[3][p] != 0.0) {
+        amin = PHGMG__MIN(amin, j - sp->ci[3][p] - bmin);
+        amax = PHGMG__MAX(amax, j - sp->ci[3][p] - bmax);
+      }
   *kl = PHGMG__MIN(N - 1, -(amin + bmin));
   *ku = PHGMG__MIN(N - 1, amax + bmax);
 }
