@@ -20298,6 +20298,12 @@ PHGMG_DEF phgmg_result phgmg_sym_eig(int n, double *A, int lda, double *w, doubl
             (now hyper.on). The CLI's options keep their names.
           - New: phgmg_ph_sparse_create_desc, the sparse constructor from
             one phgmg_ph_sparse_desc (J, R, Q, optional E, dense or CSC B).
+          - New: descriptor models (a mass matrix E) take the sparse LU of
+            sigma E + M when it is predicted cheaper, as models without E do
+            (E kept as a compressed copy, no band copies; an E with zero
+            lines keeps the band LU); phgmg_dae_create accepts such a model.
+          - New: make build/phgmg-float, the command line with a float
+            reduced model (C source for float firmware).
           - Fixed: SP1 and SP2 report info.pod_sigma_ratio (was 0).
           - Changed: the header's layout: the dense kernels (>>linalg) follow
             the domain sections in both halves; long design notes moved from
