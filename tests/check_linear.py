@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Checks results/linear_bases_e_y.csv from `make demo` (issue 16).
+"""Checks results/linear_bases_e_y.csv from `make demo`.
 Hard checks (exit 1 on failure): every (system, r = 4..20 with r > m, input,
 method) row present with a finite e_y; six inputs, the first the training one; every pH model of the two-port
 chain (results/linear_bases_structure.csv: GMG on each basis incl. GMG-H2, PRBT, r = 4..20)

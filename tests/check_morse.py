@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Checks the acceptance items of the Morse-chain example (issue 13, "a new
+"""Checks the acceptance items of the Morse-chain example ("a new
 example") on results/morse_errors.csv written by examples/morse_chain.c:
   - every reduced model was built and simulated (rc 0, finite errors) for
     every r = 6..20 step 2, every method (SP1-POD, SP2-POD, GMG-POD, GMG-QM),

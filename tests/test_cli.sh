@@ -376,7 +376,7 @@ np.save('J_3d.npy', np.zeros((2, 2, 2)))
   run_err "input times" 1 "u_dec.npy" "$P" simulate-rom --model out/msd.phgmgrom --input u_dec.npy --out y.npy
   run_err "complex npy names its dtype" 1 "cplx.npy (--J): dtype '<c16' is not supported" "$P" reduce \
     --J cplx.npy --R model/R.npy --B model/B.npy --Q model/Q.npy $SIM --method gmg-pod --r 12 --out e
-  # issue 13: NumPy's default int64 index array (np.arange) and an int32 one load
+  # NumPy's default int64 index array (np.arange) and an int32 one load
   run_ok "reduce --poly-idx int64" "$P" reduce --J nl/J.npy --R nl/R.npy --B nl/B.npy --Q nl/Q.npy --poly nl/poly.npy \
     --poly-idx idx64.npy --deim-allow-negative $SIM --newton-tol 1e-8 --newton-iter 20 --method gmg-pod --r 10 \
     --out onli --name nlm --quiet
@@ -427,7 +427,7 @@ run_err "model file malformed" 1 "garbage.npy (--model)" "$P" simulate-rom --mod
 run_err "simulate-rom unwritable" 1 "nodir/y.npy" "$P" simulate-rom --model out/msd.phgmgrom --out nodir/y.npy
 run_err "out is a file" 1 "garbage.npy (--out)" "$P" reduce $J_ $R_ $B_ $Q_ $SIM --method gmg-pod --r 12 --out garbage.npy
 
-# ---- 6. issue 19: defects found by testing as a new user and as an attacker ---------
+# ---- 6. defects found by testing as a new user and as an attacker ---------
 # 1: a model with a step map (dt 0.1) stepped with another dt
 run_ok "D1 simulate-rom --dt 0.05 on a dt-0.1 step-map model" "$P" simulate-rom --model out/msd.phgmgrom --dt 0.05 \
   --steps 200 --out y_d1.npy --quiet
@@ -491,7 +491,7 @@ run_ok "D13 help" "$P" --help
 grep -F -q "/usr/bin/python3 examples/npy_example/make_model.py" "$T/out.txt" || bad "D13: --help examples do not use /usr/bin/python3"
 grep -E -q "^  python3 " "$T/out.txt" && bad "D13: --help still calls plain python3" || pass
 
-# ---- 7. issue 13: the exp-polynomial family on the command line -------------------
+# ---- 7. the exp-polynomial family on the command line -------------------
 # A Toda chain (phi(s) = e^s - 1 - s on every spring, Q = blockdiag(0, I)):
 # --potential toda, the same coefficients by --poly/--exp (shared), and one
 # row per term give identical reduced outputs; --potential morse:D:A equals
@@ -542,7 +542,7 @@ else
   echo "test_cli: section 7 skipped (no NumPy for $PY)"
 fi
 
-# ---- 8. issue 15: --lambda auto|cv, --manifold, --train-input ----------------------
+# ---- 8. --lambda auto|cv, --manifold, --train-input ----------------------
 # --manifold altmin: the training representation error sum ||x - phi(rho(x))||^2
 # (computed here with NumPy from the written V0, V2, M and the snapshots, the
 # ridge lambda 1e-10 for both, negligible here) is at most the hierarchical POD's; --train-input
@@ -689,7 +689,7 @@ np.save('d_bad.npy', np.array([[N, -1, 0.1, 0.0]]))
   [ ! -e ydb.npy ] && pass || bad "bad damper index: output written"
 fi
 
-# ---- 9. issue 25: a run never removes or overwrites its inputs; outputs checked up front ----
+# ---- 9. a run never removes or overwrites its inputs; outputs checked up front ----
 # Files are compared by identity (device and inode), however they are spelled.
 sums() { cksum "$@" 2>/dev/null; }
 run_ok "S1 snapshots into ds" "$P" reduce $SYS $QSIM --method gmg-pod --r 10 --out ds --name rom --save-snapshots
@@ -750,7 +750,7 @@ run_err "S13 simulate-rom --states nodir/x.npy" 1 "nodir/x.npy (--states)" "$P" 
   --out y13.npy --states nodir/x.npy
 grep -F -q "simulating" "$T/err.txt" && bad "S13: simulate-rom --states nodir/ found after the simulation" || pass
 
-# ---- 10. issue 25: option values refused up front, messages naming the right option ----
+# ---- 10. option values refused up front, messages naming the right option ----
 if [ "$HAVE_NP" = 1 ]; then
   TS="--J toda/J.npy --R toda/R.npy --Q toda/Q.npy --B toda/B.npy --poly-idx toda/idx.npy"
   TR="--simulate --dt 0.1 --steps 100 --method gmg-pod --r 16"

@@ -1,4 +1,4 @@
-/* Issue 19 (defects found by testing as a new user and as an attacker):
+/* Defects found by testing as a new user and as an attacker:
    one regression test per defect fixed in the library. Each fails on the code
    before the fix. The CLI's defects are checked in tests/test_cli.sh. */
 #define _POSIX_C_SOURCE 200809L /* mkdtemp, symlink, pipe, lstat */
@@ -78,9 +78,9 @@ TEST(test_defect_q_checks) {
   dmodel_free(&t);
 }
 
-/* Defect 1: a model with a step map for dt = 0.1, simulated with dt = 0.05
-   (needs the Newton workspace, not the step-map one). Defect 9 (stepper
-   part): tol = +Inf / NaN is refused. */
+/* A model with a step map for dt = 0.1, simulated with dt = 0.05
+   (needs the Newton workspace, not the step-map one); the stepper refuses
+   tol = +Inf / NaN. */
 TEST(test_defect_other_dt) {
   dmodel t;
   const int n = 10, N = 20, ns = 201;
@@ -123,7 +123,7 @@ TEST(test_defect_other_dt) {
   dmodel_free(&t);
 }
 
-/* Defect 3: POD (and the SVD under it) do not depend on the magnitude of the
+/* POD (and the SVD under it) do not depend on the magnitude of the
    data: X c for c = 1e-300 ... 1e200 gives the basis of X and c times its
    singular values (before the fix: wrong bases at 1e-170 .. 1e-220,
    PHGMG_ERR_NOT_CONVERGED at 1e-150 and >= 1e160). */
@@ -215,7 +215,7 @@ static phgmg_result d_parse3(const unsigned char *buf, size_t len, double *vals,
   return rc;
 }
 
-/* Issue 13: integer and bool dtypes read exactly, both byte orders, through
+/* Integer and bool dtypes read exactly, both byte orders, through
    parse, a file and a pipe; int64 beyond 2^53: PHGMG_ERR_INEXACT; complex:
    PHGMG_ERR_DTYPE. */
 TEST(test_defect_npy_int_dtypes) {
@@ -260,7 +260,7 @@ TEST(test_defect_npy_int_dtypes) {
                     v, &r, &c), PHGMG_ERR_DTYPE);
 }
 
-/* Defect 10: 128 bytes through a pipe claiming shape (200000, 200000):
+/* 128 bytes through a pipe claiming shape (200000, 200000):
    PHGMG_ERR_FORMAT without a 320 GB allocation (before: the buffer was sized
    from the header, "out of memory"). */
 TEST(test_defect_npy_pipe_growth) {
@@ -286,7 +286,7 @@ TEST(test_defect_npy_pipe_growth) {
   CHECK_LE((double)cnt.biggest, 65536.0 * 2);
 }
 
-/* Defect 2: a failed write through a symbolic link (to /dev/full, where every
+/* A failed write through a symbolic link (to /dev/full, where every
    write fails) leaves the link alone; before, remove(path) deleted it. */
 TEST(test_defect_npy_write_keeps_link) {
   char dir[64], link_path[96];

@@ -1,4 +1,4 @@
-/* Deployment (issue 15): several training runs in one snapshot set
+/* Deployment: several training runs in one snapshot set
    (phgmg_simulate_inputs), the automatic lambda validated by simulation
    (opts.select.lambda_mode = PHGMG_LAMBDA_VALIDATED), phgmg_reduced_validate, the stepper's
    training-envelope indicator and consecutive-failure counters, the greedy

@@ -1,4 +1,4 @@
-/* Issue 13, "Any Hamiltonian, any manifold": the general paths of
+/* "Any Hamiltonian, any manifold": the general paths of
    phgmg_reduce against the existing, independently checked ones.
    - A separable part given by callbacks that compute the paper's quartic
      gives the same reduced models as its polynomial form (every method, with
@@ -314,7 +314,7 @@ TEST(test_toda_builtin_equals_callbacks) {
     }
 }
 
-/* Issue 14: deim = 1 with every other option zero (ECSW) keeps every weight
+/* hyper.on = 1 with every other option zero (ECSW) keeps every weight
    > 0 on the paper's chain driven by u = 0.1 (where Q-DEIM's weights are not
    all positive on the full-size chain) and on the Toda chain, fits the
    training gradient to its tolerance, and is as accurate as keeping every

@@ -1,4 +1,4 @@
-/* Hyper-reduction kernels (issue 14): phgmg_nnls, phgmg_deim_select (greedy
+/* Hyper-reduction kernels: phgmg_nnls, phgmg_deim_select (greedy
    DEIM), phgmg_ecsw. Expected values come from independent computations in
    this file: brute force over all active sets (NNLS), the KKT conditions, a
    plain greedy DEIM written from its definition, and the quadrature's

@@ -211,7 +211,7 @@ TEST(test_npy_parse_malformed) {
     npyt_expect_fail(buf, len, PHGMG_ERR_FORMAT, (int)t); /* index into bad[] */
   }
   {
-    /* unsupported dtypes (issue 19): PHGMG_ERR_DTYPE */
+    /* unsupported dtypes: PHGMG_ERR_DTYPE */
     static const char *dt[] = {"'<f2'", "'<c16'", "'<c8'", "'=f8'", "'f8'", "'<f16'", "'|f8'",
                                "'|i2'", "'<i3'", "'<b2'", "'<U5'", "'|S3'", "'|O'", "'<M8'",
                                "'<m8'", "'|V8'", "''", "[('a', '<f8')]"};

@@ -9,7 +9,7 @@ order; 0-d, 1-d, 2-d, 1x1 and empty shapes; NaN/Inf/-0/subnormals), has
 npy_tool read each one and write it back (Fortran or C order, float64 or
 float32), and checks with NumPy that the values round trip exactly and that
 the written header is what was asked for. Integer and bool arrays (int8 ...
-int64, uint8 ... uint64, both byte orders, bool; issue 13) must read back as
+int64, uint8 ... uint64, both byte orders, bool) must read back as
 exactly the same values in float64, also through a pipe; NumPy's default
 int64 index array (np.arange) included. Files NumPy writes but phgmg does
 not support (complex, float16, int64 beyond 2^53, 3-d, structured,

@@ -1,4 +1,4 @@
-/* Reduction (issue 4 acceptance): at states along a trajectory, every reduced
+/* Reduction: at states along a trajectory, every reduced
    model is a pH system (J skew, R PSD), the GMG models have Bh = [I; 0] and
    W(x)^T Dphi(x) = I, and the reduced right-hand side equals
    W(x)^T ((J - R) grad H(phi(x)) + B u) evaluated in full dimension — an

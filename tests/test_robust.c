@@ -1,4 +1,4 @@
-/* Bad input and faults (issue 8). Every case asserts the exact result code
+/* Bad input and faults. Every case asserts the exact result code
    and that the caller's data is unchanged (memcmp against a copy taken before
    the call): wrong or zero dimensions, NaN/Inf in every input and in the
    state, non-physical J, R, Q, B, J - R singular, the GMG non-degeneracy
@@ -763,8 +763,8 @@ TEST(test_gmg_degenerate) {
   EXPECT(reduce_g(&h.sys, X, N, ns, &o, &info), PHGMG_OK);
   CHECK(info.rcond_dgd > 1e-6);
   /* SP1: W = Q V (V^T Q V)^{-1} needs V^T Q V invertible, which a positive
-     definite Q guarantees; a singular Q is refused up front by the validation
-     (issue 19, defect 5), whatever r */
+     definite Q guarantees; a singular Q is refused up front by the validation,
+     whatever r */
   h.Q[9 + 9 * N] = 0.0;
   o = ropts(PHGMG_METHOD_SP1, N);
   EXPECT(reduce_g(&h.sys, X, N, ns, &o, &info), PHGMG_ERR_Q_NOT_PD);

@@ -1,4 +1,4 @@
-/* Randomized POD (issue 18, "a million states"): phgmg_pod_randomized against
+/* Randomized POD ("a million states"): phgmg_pod_randomized against
    snapshots of the paper's nonlinear chain (exact phgmg_pod as reference),
    closed-form spectra (X = U diag(sigma) W^T with U, W orthonormal) and against
    the exact phgmg_pod; subspace angles; determinism (same seed = same bits);

@@ -1,4 +1,4 @@
-/* The large-N paths of the reduction (issue 18), exercised at moderate sizes
+/* The large-N paths of the reduction, exercised at moderate sizes
    with their thresholds lowered in this file:
    - ECSW with candidate screening (phgmg_ecsw / phgmg_ecsw_separable for many
      terms): w > 0, the residual recomputed here from the explicit training

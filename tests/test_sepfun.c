@@ -1,4 +1,4 @@
-/* Separable functions beyond a shared polynomial (issue 13): the built-in
+/* Separable functions beyond a shared polynomial: the built-in
    exp-polynomial family of the full model and of reduced models against the same
    functions given as callbacks (closed forms), the manifold callback eta_cb
    against the built-in quadratic map and against direct N-dimensional formulas

@@ -1,5 +1,5 @@
 #!/bin/sh
-# test_validate.sh — `phgmg validate` (examples/phgmg_cli.c, issue 15): reduce,
+# test_validate.sh — `phgmg validate` (examples/phgmg_cli.c): reduce,
 # then check the reduced model against the full one on test inputs.
 #
 # Usage: sh tests/test_validate.sh build/phgmg      (from the repository root)
@@ -55,7 +55,7 @@ step=$(sed -n 's/.*first failing step: \([0-9]*\) .*/\1/p' v3.txt | head -1)
 if [ -n "$step" ] && [ "$step" -ge 1 ] && [ "$step" -le 999 ]; then pass; else bad "no first failing step reported (got '$step')"; cat v3.txt; fi
 grep -q "^sin  .* pass$" v3.txt && pass || bad "the training input should pass (v3)"
 
-# 2b. the same reduction with the validated lambda (--lambda auto, issue 15)
+# 2b. the same reduction with the validated lambda (--lambda auto)
 #     passes where lambda = 1e-12 failed: u = 0.1 and u = 0.1 sin 2t; also with
 #     the altmin manifold
 for man in pod altmin; do
@@ -153,7 +153,7 @@ $P reduce --J small/J.npy --R small/R.npy --B small/B.npy --Q small/Q.npy --simu
    --method gmg-qm --r 4 --rn 8 --out sq2 > /dev/null 2>&1
 [ $? -eq 2 ] && pass || bad "N = 10, --rn 8 at r = 4: expected the usage error"
 
-# 8. issue 25: a failing validate leaves the deployed model alone; bounds and
+# 8. a failing validate leaves the deployed model alone; bounds and
 #    test inputs are checked before any computation.
 M8="--J m/J.npy --R m/R.npy --B m/B.npy --Q m/Q.npy --simulate --quiet"
 $P reduce $M8 --method gmg-pod --r 12 --out dep > /dev/null 2>&1 || bad "deploy a model"
@@ -212,7 +212,7 @@ elif [ $rc -eq 1 ] && grep -q "overflow" v6a.txt; then pass
 elif [ $rc -eq 0 ] && grep -q "^sin  .* pass$" v6a.txt; then pass
 else bad "--test-amp 1e160: exit $rc: $(tail -n 2 v6a.txt)"; fi
 
-# 9. issue 25: inputs and records.
+# 9. inputs and records.
 # 5: a symmetric two-port chain (ports on the first and the last mass): with
 #    the same signal on both ports the states never leave the symmetric half
 #    and GMG's non-degeneracy check fails at every r; the default sin drives

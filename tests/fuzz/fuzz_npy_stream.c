@@ -4,7 +4,7 @@
    they fit the pipe's buffer). The three must return the same result code
    and, on success, the same shape and the same bits; on failure the outputs
    stay untouched. Nothing else than PHGMG_OK / _FORMAT / _DTYPE / _INEXACT /
-   _NOMEM may come back (issue 19: a pipe's buffer grows with the data that
+   _NOMEM may come back (a pipe's buffer grows with the data that
    actually arrives, so a short stream claiming a huge shape is _FORMAT).
 
    libFuzzer (clang):

@@ -49,8 +49,8 @@ put("bad_hlen.npy", good[:8] + b"\xff\xff" + good[10:])
 put("bad_int64.npy", npy(np.arange(6, dtype="<i8")))
 put("bad_3d.npy", npy(np.zeros((1, 2, 1))))
 put("bad_notuple.npy", good.replace(b"(2, 3)", b"(6)   "))
-# integer and bool dtypes (issue 13), refused ones, and a short stream that
-# claims a huge shape (issue 19, defect 10: a pipe's buffer must grow with
+# integer and bool dtypes, refused ones, and a short stream that
+# claims a huge shape (a pipe's buffer must grow with
 # the data; fuzz_npy_stream.c reads these from a file and a pipe too)
 for dt in ["<i1", "|u1", "<i2", ">i2", "<u2", "<i4", ">u4", "<i8", ">i8", "<u8"]:
     name = dt.replace("<", "l").replace(">", "b").replace("|", "n")
