@@ -7381,22 +7381,30 @@ PHGMG__PRIV void phgmg__ph_sparse_stage_bw(const phgmg_ph_sparse *sp, int *kl, i
   *ku = PHGMG__MIN(N - 1, amax + bmax);
 }
 
+/* A new band copy (the object's order and half-bandwidth) of the object's
+   CSC copy a (0 J, 1 R, 2 Q, 3 E); NULL when out of memory. */
+PHGMG__PRIV double *phgmg__sparse_band_copy(const phgmg_ph_sparse *sp, int a, const phgmg_allocator *al) {
+  const int N = sp->sys.N, kb = sp->sys.kb;
+  const size_t len = (size_t)(2 * kb + 1) * (size_t)N;
+  double *b = phgmg__dalloc(al, len);
+  int j, p;
+  if (!b) return NULL;
+  memset(b, 0, sizeof(double) * len);
+  for (j = 0; j < N; ++j)
+    for (p = sp->cp[a][j]; p < sp->cp[a][j + 1]; ++p) b[PHGMG__PHB(kb, sp->ci[a][p], j)] = sp->cx[a][p];
+  return b;
+}
+
 /* Band copies of J, R, Q (and E) (the band solver's storage) from the CSC copies;
    drop = 1 frees them. */
 PHGMG__PRIV phgmg_result phgmg__ph_sparse_band(phgmg_ph_sparse *sp, int drop) {
-  const int N = sp->sys.N, kb = sp->sys.kb;
-  const size_t len = (size_t)(2 * kb + 1) * (size_t)N;
   double **dst[4];
-  int a, j, p;
+  int a;
   dst[0] = &sp->J; dst[1] = &sp->R; dst[2] = &sp->Q; dst[3] = &sp->E;
   for (a = 0; a < (sp->cp[3] ? 4 : 3); ++a) {
     if (drop) { phgmg__free(sp->alloc, *dst[a]); *dst[a] = NULL; continue; }
     if (*dst[a]) continue;
-    *dst[a] = phgmg__dalloc(sp->alloc, len);
-    if (!*dst[a]) return PHGMG_ERR_NOMEM;
-    memset(*dst[a], 0, sizeof(double) * len);
-    for (j = 0; j < N; ++j)
-      for (p = sp->cp[a][j]; p < sp->cp[a][j + 1]; ++p) (*dst[a])[PHGMG__PHB(kb, sp->ci[a][p], j)] = sp->cx[a][p];
+    if (!(*dst[a] = phgmg__sparse_band_copy(sp, a, sp->alloc))) return PHGMG_ERR_NOMEM;
   }
   return PHGMG_OK;
 }
@@ -7427,21 +7435,15 @@ PHGMG__PRIV void phgmg__ph_sparse_storage(phgmg_ph_sparse *sp) {
 /* 1: no E, or every row and column of E holds a nonzero (no algebraic
    equation); 0: E has a zero row or column; -1: no memory. */
 PHGMG__PRIV int phgmg__ph_sparse_e_regular(const phgmg_ph_sparse *sp) {
-  const int N = sp->sys.N;
-  int i, j, p, ok = 1, *hit;
+  phgmg_ph_system v = sp->sys; /* a SPARSE view: phgmg__e_zero_lines reads E's CSC copy */
+  int *z, kr, kc;
   if (!sp->cp[3]) return 1;
-  hit = phgmg__ialloc(sp->alloc, (size_t)N);
-  if (!hit) return -1;
-  for (i = 0; i < N; ++i) hit[i] = 0;
-  for (j = 0; j < N; ++j) {
-    int col = 0;
-    for (p = sp->cp[3][j]; p < sp->cp[3][j + 1]; ++p)
-      if (sp->cx[3][p] != 0.0) { col = 1; hit[sp->ci[3][p]] = 1; }
-    ok &= col;
-  }
-  for (i = 0; i < N; ++i) ok &= hit[i];
-  phgmg__free(sp->alloc, hit);
-  return ok;
+  z = phgmg__ialloc(sp->alloc, 2 * (size_t)v.N);
+  if (!z) return -1;
+  v.storage = PHGMG_SPARSE; v.sparse = sp; v.E = sp->cx[3];
+  phgmg__e_zero_lines(&v, z, z + v.N, &kr, &kc);
+  phgmg__free(sp->alloc, z);
+  return kr == 0 && kc == 0;
 }
 
 PHGMG_DEF phgmg_result phgmg_ph_sparse_set_solver(phgmg_ph_sparse *sp, int solver,
@@ -7489,7 +7491,7 @@ PHGMG_DEF phgmg_result phgmg_ph_sparse_set_solver(phgmg_ph_sparse *sp, int solve
   return PHGMG_OK;
 }
 
-/* The CSC copy behind M (J, R or Q of a SPARSE system): 1 and its arrays,
+/* The CSC copy behind M (J, R, Q or E of a SPARSE system): 1 and its arrays,
    0 if M is none of them. */
 PHGMG__PRIV int phgmg__ph_csc_of(const phgmg_ph_system *s, const double *M, const int **cp, const int **ci,
                                  const double **cx) {
@@ -7593,21 +7595,13 @@ PHGMG__PRIV phgmg_result phgmg__ph_sparse_own_band(const phgmg_ph_system *s, int
 PHGMG__PRIV phgmg_result phgmg__ph_sparse_eq_band(const phgmg_ph_system *s, phgmg_ph_system *t, double **bufs,
                                                  const phgmg_allocator *al) {
   const phgmg_ph_sparse *sp = s->sparse;
-  const int N = s->N, kb = sp->sys.kb;
-  const size_t len = (size_t)(2 * kb + 1) * (size_t)N;
-  int k, j, p;
   *t = *s;
   bufs[0] = bufs[1] = NULL;
-  for (k = 0; k < 2; ++k) {
-    const int a = k ? 3 : 2;
-    if (!(bufs[k] = phgmg__dalloc(al, len))) return PHGMG_ERR_NOMEM;
-    memset(bufs[k], 0, sizeof(double) * len);
-    for (j = 0; j < N; ++j)
-      for (p = sp->cp[a][j]; p < sp->cp[a][j + 1]; ++p) bufs[k][PHGMG__PHB(kb, sp->ci[a][p], j)] = sp->cx[a][p];
-  }
+  if (!(bufs[0] = phgmg__sparse_band_copy(sp, 2, al)) || !(bufs[1] = phgmg__sparse_band_copy(sp, 3, al)))
+    return PHGMG_ERR_NOMEM;
   t->storage = PHGMG_BANDED;
   t->sparse = NULL;
-  t->kb = kb;
+  t->kb = sp->sys.kb;
   t->J = t->R = t->Q = bufs[0];
   t->E = bufs[1];
   return PHGMG_OK;
@@ -8960,17 +8954,11 @@ PHGMG__PRIV phgmg_result phgmg__gl3_sparse_factor(phgmg_gl3 *s, double sg, doubl
 PHGMG__PRIV phgmg_result phgmg__gl3_sparse_dia(phgmg_gl3 *s) {
   const phgmg_ph_sparse *sp = s->sys.sparse;
   const int N = s->N, kb = s->sys.kb;
-  const size_t len = (size_t)(2 * kb + 1) * (size_t)N;
   double *b[4] = {NULL, NULL, NULL, NULL};
-  int a, j, p;
+  int a;
   phgmg_result rc = PHGMG_OK;
-  for (a = 0; a < (sp->cp[3] ? 4 : 3); ++a) {
-    b[a] = phgmg__dalloc(&s->al, len);
-    if (!b[a]) { rc = PHGMG_ERR_NOMEM; continue; }
-    memset(b[a], 0, sizeof(double) * len);
-    for (j = 0; j < N; ++j)
-      for (p = sp->cp[a][j]; p < sp->cp[a][j + 1]; ++p) b[a][PHGMG__PHB(kb, sp->ci[a][p], j)] = sp->cx[a][p];
-  }
+  for (a = 0; a < (sp->cp[3] ? 4 : 3); ++a)
+    if (!(b[a] = phgmg__sparse_band_copy(sp, a, &s->al))) rc = PHGMG_ERR_NOMEM;
   if (rc == PHGMG_OK) rc = phgmg__dia_build(&s->al, &s->djr, N, kb, b[0], b[1], 0, 0);
   if (rc == PHGMG_OK) rc = phgmg__dia_build(&s->al, &s->dq, N, kb, b[2], NULL, 1, 0);
   if (rc == PHGMG_OK && b[3]) rc = phgmg__dia_build(&s->al, &s->de, N, kb, b[3], NULL, 1, 0);
