@@ -26,7 +26,8 @@
    The header has two halves, declarations and implementation, each cut into
    sections marked >>config, >>result, >>memory, >>ph, >>dae, >>sparse, >>gl3,
    >>online, >>pod, >>hyper, >>reduce, >>deploy, >>errors, >>study, >>linear,
-   >>export, >>npy and, last, >>linalg, the dense kernels (grep for them; the
+   >>export, >>npy, >>mpi (only with PHGMG_MPI) and, last, >>linalg, the
+   dense kernels (grep for them; the
    same order in both halves: the implementation declares the kernels' private
    helpers in >>linalg (prototypes) after >>memory, and its >>reduce opens with
    the reduced object the others use). The comment at each declaration states
@@ -467,6 +468,71 @@
    matrix) take the same choice: their stage matrices sigma E + M are
    analysed with E's pattern joined (manual 8.12); an E with a zero row or
    column (index one, 1.8) keeps the band LU.
+
+   2.7 Distributed offline phase (>>mpi; define PHGMG_MPI before the include,
+   compile with mpicc; the section includes <mpi.h> and needs nothing else).
+   For models whose state, operators and snapshots are distributed by rows
+   over MPI ranks, as PETSc, hypre, Tpetra or MFEM keep them: every rank
+   passes its own contiguous block of rows as plain column-major arrays and
+   CSR (64-bit global indices, phgmg_gidx), and gets the small reduced
+   quantities replicated and identical on every rank.
+     phgmg_mpi_ctx_create   the layout: communicator, global N, this rank's
+                            rows [row0, row0 + nloc) (uneven or empty blocks;
+                            checked to tile [0, N) in rank order)
+     phgmg_mpi_tsqr         X = Q R: local Householder QR, the ranks' small
+                            R factors gathered (one allgather of ns^2 doubles
+                            each) and factored again on every rank
+     phgmg_mpi_pod          POD by TSQR and the SVD of R; values identical
+                            on every rank, V this rank's rows
+     phgmg_mpi_pod_stream_* the same from column batches (incremental SVD at
+                            rank kmax, with a stated error bound): the N x ns
+                            snapshot matrix never exists, on one rank too
+     phgmg_mpi_deim_greedy  greedy DEIM points as global indices, ties to the
+                            lower global index: the same for every partition
+     phgmg_mpi_op_*         a row-distributed CSR operator: the halo exchange
+                            plan built once, A X, V^T A V (replicated)
+     phgmg_mpi_atb          A^T B of two row-distributed blocks (replicated)
+     phgmg_mpi_gmg_pod_linear  GMG-POD of a linear model x' = (J - R) Q x +
+                            B u (Q as an operator, B's rows, J - R through a
+                            collective solve callback: the user's KSP, MUMPS
+                            or AMG): K, Qh, Bh of the serial phgmg_reduce
+     phgmg_mpi_agree        one result for all ranks
+   Why TSQR and not the Gram matrix X^T X (the method of snapshots): the
+   Gram matrix squares the condition number, so singular values below
+   sqrt(eps) sigma_1 ~ 1e-8 sigma_1 are lost and the basis of the modes near
+   there depends on the partition through rounding. On a snapshot matrix with
+   singular values 1 ... 1e-13 (tests/mpi/test_mpi.c), V^T A V with r = 14
+   modes (sigma_r / sigma_1 = 2e-5) from the Gram basis is off by 6e-10 to
+   6e-9 relative, from TSQR by 2e-14 to 6e-14, and the TSQR values match
+   the exact ones to 4e-16 sigma_1; the results at 2, 3 and 4 ranks
+   differ from one rank's by less than 1e-13.
+   Errors are collective: every function agrees on its result over the
+   ranks (phgmg_mpi_agree: the most negative code), so an error found on
+   one rank only -- a bad argument, a failed solve, no memory -- returns the
+   same code on every rank and never leaves a rank waiting in a collective.
+   Identical on every rank: the small factors are computed by every rank
+   from the same gathered data (the same binary: bitwise the same result),
+   and sums over the ranks are a reduction to rank 0 and a broadcast, not an
+   allreduce whose rounding may differ between ranks.
+   Relation to the serial pipeline. phgmg_mpi_gmg_pod_linear computes the
+   quantities of the serial GMG-POD (2.2; linear model, quadratic H, no E,
+   dampers or feedthrough) in the same order: QB from the QR of B (the same
+   rank test), the POD of X - QB QB^T X, V0 = [B, V1], G00 = V0^T (J - R)^{-1}
+   V0 by r solves, the same non-degeneracy test (reciprocal condition of
+   G00 with B's columns scaled, >= 1e-12), K = G00^{-1}, Qh = V0^T Q V0
+   symmetrised, Bh = [I; 0]. The serial object (phgmg_reduced) keeps
+   N-dimensional data (V0, the snapshots), so the distributed function
+   returns the blocks instead; a phgmg_rom of kind PHGMG_ROM_LINEAR with
+   them is the online model (phgmg_rom_check, the stepper, export and
+   files work unchanged). Agreement with the serial phgmg_reduce: K and Qh
+   within 1.5e-15 relative at 1-4 ranks (after the sign of each POD mode,
+   which the SVD leaves free). Cost: per POD, one allgather of ns^2 doubles
+   per rank and a replicated QR of a (size ns) x ns matrix (fine to a few
+   hundred ranks; a reduction tree would remove the size factor); per DEIM
+   point one broadcast of k doubles and one reduction of a (value, index)
+   pair; per operator product one exchange with the neighbouring ranks.
+   Not yet distributed: GMG-QM, SP1/SP2, ECSW, nonlinear Hamiltonians,
+   dampers, descriptor models, the command line.
 
    3. METHODS AND OPTIONS -------------------------------------------------------
    Every option struct is "zero means default": memset it to 0 and set what you
@@ -1356,6 +1422,8 @@
      PHGMG_NO_OFFLINE      compile only the online half (+ export/import in memory):
                            needs libm only, no heap, no stdio
      PHGMG_NO_STDIO        no file functions (.npy files, model files, C export)
+     PHGMG_MPI             compile the distributed section >>mpi (includes
+                           <mpi.h>; build with mpicc; manual 2.7)
      PHGMG_NPY_MAX_HEADER  longest accepted .npy header in bytes (default 1 MiB)
      PHGMG_MALLOC(sz,u) / PHGMG_FREE(p,u)   default allocator (both or neither)
      PHGMG_ASSERT(x)       internal invariant checks (default assert)
@@ -1433,11 +1501,19 @@
            phgmg_rom_load, phgmg_rom_export_c
    npy:    phgmg_npy_parse, phgmg_npy_serialize, phgmg_npy_free,
            phgmg_npy_read, phgmg_npy_write
+   mpi:    (with PHGMG_MPI) phgmg_mpi_agree, phgmg_mpi_ctx_create,
+           phgmg_mpi_ctx_destroy, phgmg_mpi_atb, phgmg_mpi_tsqr, phgmg_mpi_pod,
+           phgmg_mpi_pod_stream_begin, phgmg_mpi_pod_stream_add,
+           phgmg_mpi_pod_stream_end, phgmg_mpi_pod_stream_destroy,
+           phgmg_mpi_deim_greedy, phgmg_mpi_op_create, phgmg_mpi_op_destroy,
+           phgmg_mpi_op_info, phgmg_mpi_op_apply, phgmg_mpi_op_project,
+           phgmg_mpi_gmg_pod_linear
    linalg: phgmg_gemm, phgmg_gemv, phgmg_lu_factor, phgmg_lu_solve,
            phgmg_lu_rcond, phgmg_norm1, phgmg_normf, phgmg_zlu_factor,
            phgmg_zlu_solve, phgmg_qr, phgmg_qrcp, phgmg_qr_form_q,
            phgmg_qr_apply, phgmg_lstsq, phgmg_svd, phgmg_sym_eig
-   (124 functions; also the macros PHGMG_ROM_STEPPER_MEMSIZE_MAX and _MAX_CB.)
+   (141 functions; 17 of them only with PHGMG_MPI; also the macros
+   PHGMG_ROM_STEPPER_MEMSIZE_MAX and _MAX_CB.)
 */
 #ifndef PHGMG_H_INCLUDED
 #define PHGMG_H_INCLUDED
@@ -3330,7 +3406,8 @@ PHGMG_DEF phgmg_result phgmg_mpi_pod(const phgmg_mpi_ctx *ctx, int ns, const dou
    basis are exactly those of a matrix within the sum, over the
    truncations, of sqrt(sum of the squares of the values dropped) of the
    true snapshot matrix in the Frobenius norm (phgmg_mpi_pod_stream_end
-   reports that bound). Memory: 2 nloc (kmax +
+   reports that bound; values below the SVD's rank threshold, eps times
+   the norm of the small matrix, count as zero). Memory: 2 nloc (kmax +
    nb) doubles for a block of nb columns. begin: *st (NULL on failure);
    add: nb >= 1 columns Xb (nloc x nb, ldx); end: V (nloc x k, ldv), S (k,
    may be NULL), *k_out = k, *discarded (may be NULL) = the bound above;
