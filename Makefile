@@ -72,7 +72,8 @@ test-build: tests/suites.inc
 # at 1, 2, 3 and 4 ranks (4: one rank owns no rows; more ranks than cores),
 # each run's results compared with the one-rank run's; the section's compile
 # checks (C99, float online scalar, C++). Skipped, with a message, without
-# mpicc and mpirun (Debian: openmpi-bin libopenmpi-dev). A few seconds.
+# mpicc and mpirun (Debian: openmpi-bin libopenmpi-dev). A deadlock fails
+# after 120 s (timeout). Half a minute, most of it compiling.
 MPICC  ?= mpicc
 MPICXX ?= mpicxx
 MPIRUN  = mpirun --oversubscribe $$(if [ "$$(id -u)" = 0 ]; then echo --allow-run-as-root; fi)
@@ -87,7 +88,7 @@ test-mpi:
 	if command -v $(MPICXX) >/dev/null 2>&1; then $(MPICXX) -std=c++11 -Wall -Wextra -Werror -fsyntax-only $(BUILD)/mpi/impl.cpp; fi && \
 	$(MPICC) $(CFLAGS_T) -o $(BUILD)/test_mpi tests/mpi/test_mpi.c $(LDLIBS) && \
 	$(MPICC) -std=c99 $(WARN) -O1 -o $(BUILD)/mpi_pod examples/mpi_pod.c $(LDLIBS) && \
-	for p in 1 2 3 4; do $(MPIRUN) -np $$p ./$(BUILD)/test_mpi $(BUILD)/mpi || exit 1; done && \
+	for p in 1 2 3 4; do timeout 120 $(MPIRUN) -np $$p ./$(BUILD)/test_mpi $(BUILD)/mpi || exit 1; done && \
 	$(MPIRUN) -np 3 ./$(BUILD)/mpi_pod --N 3000 > $(BUILD)/mpi/example.txt && echo "test-mpi: examples/mpi_pod.c runs at 3 ranks"
 
 # The documentation against the code: every public function in the manual's

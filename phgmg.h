@@ -19164,6 +19164,57 @@ PHGMG_DEF phgmg_result phgmg_mpi_atb(const phgmg_mpi_ctx *ctx, int ka, int kb, c
   return PHGMG_OK;
 }
 
+/* Local QR of X (n x ns, n >= 1) into W (n x ns, ld n: the explicit Q in
+   the first kq = min(n, ns) columns) and Rl (ns x ns, ld ns, zero below the
+   diagonal and below row kq). Tall blocks go by a flat tree: chunks of
+   about PHGMG__MPI_CHUNK rows (at least ns) factored each in cache, their
+   R factors stacked and factored again, each chunk's Q times its block of
+   the second Q (the unblocked Householder QR of the whole block would
+   stream it from memory once per column). */
+#define PHGMG__MPI_CHUNK 4096
+PHGMG__PRIV phgmg_result phgmg__mpi_local_qr(int n, int ns, const double *X, int ldx, double *W, double *Rl,
+                                             const phgmg_allocator *al) {
+  const int nc = n / PHGMG__MAX(PHGMG__MPI_CHUNK, ns), kq = PHGMG__MIN(n, ns), ms = PHGMG__MAX(nc, 1) * ns;
+  const int cmax = n / PHGMG__MAX(nc, 1) + 1;
+  double *S2 = phgmg__dalloc(al, (size_t)ms * ns + 2 * (size_t)ns + (nc > 1 ? (size_t)cmax * ns : 0));
+  double *tau, *work, *T;
+  int i, j, c;
+  phgmg_result rc = S2 ? PHGMG_OK : PHGMG_ERR_NOMEM;
+  if (rc != PHGMG_OK) return rc;
+  tau = S2 + (size_t)ms * ns; work = tau + ns; T = work + ns;
+  for (j = 0; j < ns; ++j) memcpy(W + (size_t)j * n, X + (size_t)j * ldx, (size_t)n * sizeof(double));
+  memset(Rl, 0, (size_t)ns * ns * sizeof(double));
+  if (nc <= 1) {
+    rc = phgmg_qr(n, ns, W, n, tau);
+    for (j = 0; j < ns && rc == PHGMG_OK; ++j)
+      for (i = 0; i <= j && i < kq; ++i) Rl[i + (size_t)j * ns] = W[i + (size_t)j * n];
+    if (rc == PHGMG_OK) phgmg_qr_form_q(n, kq, W, n, tau, work);
+    phgmg__free(al, S2);
+    return rc;
+  }
+  memset(S2, 0, (size_t)ms * ns * sizeof(double));
+  for (c = 0; c < nc && rc == PHGMG_OK; ++c) {   /* chunk c: rows r0 .. r0 + nb - 1 (nb >= ns) */
+    const int r0 = (int)((long long)n * c / nc), nb = (int)((long long)n * (c + 1) / nc) - r0;
+    rc = phgmg_qr(nb, ns, W + r0, n, tau);
+    for (j = 0; j < ns && rc == PHGMG_OK; ++j)
+      for (i = 0; i <= j; ++i) S2[c * ns + i + (size_t)j * ms] = W[r0 + i + (size_t)j * n];
+    if (rc == PHGMG_OK) phgmg_qr_form_q(nb, ns, W + r0, n, tau, work);
+  }
+  if (rc == PHGMG_OK) rc = phgmg_qr(ms, ns, S2, ms, tau);
+  if (rc == PHGMG_OK) {
+    for (j = 0; j < ns; ++j)
+      for (i = 0; i <= j; ++i) Rl[i + (size_t)j * ns] = S2[i + (size_t)j * ms];
+    phgmg_qr_form_q(ms, ns, S2, ms, tau, work);
+    for (c = 0; c < nc; ++c) {
+      const int r0 = (int)((long long)n * c / nc), nb = (int)((long long)n * (c + 1) / nc) - r0;
+      phgmg_gemm('N', 'N', nb, ns, ns, 1.0, W + r0, n, S2 + (size_t)c * ns, ms, 0.0, T, nb);
+      for (j = 0; j < ns; ++j) memcpy(W + r0 + (size_t)j * n, T + (size_t)j * nb, (size_t)nb * sizeof(double));
+    }
+  }
+  phgmg__free(al, S2);
+  return rc;
+}
+
 /* The TSQR kernel. W (nloc x ns, ld max(1, nloc)) receives X's local
    Householder QR with its explicit Q in the first kq = min(nloc, ns)
    columns; R (ns x ns) the global triangular factor (diagonal >= 0); Q2
@@ -19171,19 +19222,13 @@ PHGMG_DEF phgmg_result phgmg_mpi_atb(const phgmg_mpi_ctx *ctx, int ka, int kb, c
    used): X = W(:, 0:kq) Q2(0:kq, :) R. ws: (size + 2) ns^2 + 3 ns doubles. */
 PHGMG__PRIV phgmg_result phgmg__mpi_tsqr_core(const phgmg_mpi_ctx *ctx, int ns, const double *X, int ldx, double *W,
                                               double *R, double *Q2, double *ws) {
-  const int n = ctx->nloc, kq = PHGMG__MIN(n, ns), P = ctx->size, ldw = PHGMG__MAX(1, n), ms = P * ns;
+  const int n = ctx->nloc, P = ctx->size, ms = P * ns;
   double *Rl = ws, *Sg = Rl + (size_t)ns * ns, *S = Sg + (size_t)ms * ns, *tau = S + (size_t)ms * ns;
   double *work = tau + ns;
   phgmg_result rc = PHGMG_OK;
   int i, j, q;
-  for (j = 0; j < ns && n > 0; ++j) memcpy(W + (size_t)j * ldw, X + (size_t)j * ldx, (size_t)n * sizeof(double));
-  if (n > 0) rc = phgmg_qr(n, ns, W, ldw, tau);
   memset(Rl, 0, (size_t)ns * ns * sizeof(double));
-  if (rc == PHGMG_OK) {
-    for (j = 0; j < ns; ++j)
-      for (i = 0; i <= j && i < kq; ++i) Rl[i + (size_t)j * ns] = W[i + (size_t)j * ldw];
-    if (kq > 0) phgmg_qr_form_q(n, kq, W, ldw, tau, work);
-  }
+  if (n > 0) rc = phgmg__mpi_local_qr(n, ns, X, ldx, W, Rl, &ctx->al);
   rc = phgmg__mpi_agree(ctx, rc);
   if (rc != PHGMG_OK) return rc;
   MPI_Allgather(Rl, ns * ns, MPI_DOUBLE, Sg, ns * ns, MPI_DOUBLE, ctx->comm);

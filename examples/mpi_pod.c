@@ -3,7 +3,7 @@
    VecGetArray, MatGetRow and VecGetOwnershipRange give), no PETSc here.
 
      mpicc -std=c99 -O2 -o build/mpi_pod examples/mpi_pod.c -lm
-     mpirun -np 2 build/mpi_pod [--N 100000] [--ns 40] [--weak] [--batch 10]
+     mpirun -np 2 build/mpi_pod [--N 100000] [--ns 40] [--weak] [--batch 10] [--serial]
 
    The "solver" is a 1-D diffusion chain x' = -A x on N points whose
    snapshots are known in closed form (sine modes with decaying amplitudes),
@@ -19,7 +19,8 @@
         (phgmg_mpi_op_create, from a MatGetRow-like callback) and projects
         it, Ar = V^T A V, replicated on every rank,
    and prints the times of each step. --weak: N rows per rank (weak
-   scaling) instead of N in total (strong scaling). */
+   scaling) instead of N in total (strong scaling). --serial (one rank):
+   also the time of the serial phgmg_pod on the same snapshots. */
 #define PHGMG_MPI
 #define PHGMG_IMPLEMENTATION
 #include "../phgmg.h"
@@ -53,8 +54,8 @@ static void snapshot(long long N, long long row0, int nloc, int j, double *x) {
 
 int main(int argc, char **argv) {
   long long N = 100000, row0, *rp, *col;
-  int ns = 40, batch = 10, weak = 0, rank, size, nloc, i, j, k = 0, kst = 0, kmax = 12, ld;
-  double *X, *V, *Vs, *val, S[64], Ss[64], Ar[144], disc = 0.0, t[6];
+  int ns = 40, batch = 10, weak = 0, serial = 0, rank, size, nloc, i, j, k = 0, kst = 0, kmax = 12, ld;
+  double *X, *V, *Vs, *val, S[64], Ss[64], Ar[144], disc = 0.0, t[8];
   phgmg_mpi_ctx *ctx = NULL;
   phgmg_mpi_pod_stream *st = NULL;
   phgmg_mpi_op *A = NULL;
@@ -68,6 +69,7 @@ int main(int argc, char **argv) {
     else if (!strcmp(argv[i], "--ns") && i + 1 < argc) ns = atoi(argv[++i]);
     else if (!strcmp(argv[i], "--batch") && i + 1 < argc) batch = atoi(argv[++i]);
     else if (!strcmp(argv[i], "--weak")) weak = 1;
+    else if (!strcmp(argv[i], "--serial")) serial = 1;
   }
   if (ns < kmax || ns > 64 || batch < 1 || N < 2 * kmax) {
     if (rank == 0) fprintf(stderr, "mpi_pod: need 12 <= --ns <= 64, --batch >= 1, --N >= 24\n");
@@ -110,6 +112,11 @@ int main(int argc, char **argv) {
   if (rc == PHGMG_OK) rc = phgmg_mpi_op_create(&A, ctx, rp, col, val);
   if (rc == PHGMG_OK) rc = phgmg_mpi_op_project(A, k, V, ld, Ar, k);
   MPI_Barrier(MPI_COMM_WORLD); t[4] = MPI_Wtime();
+  if (serial && size == 1 && rc == PHGMG_OK) {   /* the serial POD of the same snapshots, for comparison */
+    int ks = 0;
+    rc = phgmg_pod(nloc, ns, X, ld, kmax, 0.0, Vs, ld, Ss, &ks, NULL);
+  }
+  t[5] = MPI_Wtime();
   if (rank == 0) {
     if (rc != PHGMG_OK) fprintf(stderr, "mpi_pod: %s\n", phgmg_result_string(rc));
     else {
@@ -121,6 +128,7 @@ int main(int argc, char **argv) {
       printf("\nV^T A V: diagonal %.6e %.6e %.6e ...\n", Ar[0], Ar[1 + k], Ar[2 + 2 * k]);
       printf("time [s]: POD (TSQR) %.3f, streamed POD %.3f, DEIM %.3f, operator plan + V^T A V %.3f\n",
              t[1] - t[0], t[2] - t[1], t[3] - t[2], t[4] - t[3]);
+      if (serial && size == 1) printf("time [s]: serial phgmg_pod %.3f\n", t[5] - t[4]);
     }
   }
   phgmg_mpi_op_destroy(A);
