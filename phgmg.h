@@ -3336,7 +3336,7 @@ typedef long long phgmg_gidx;
    0 .. N - 1, in rank order; blocks may be uneven or empty. Read the fields,
    do not change them (phgmg_mpi_ctx_create fills them). */
 typedef struct phgmg_mpi_ctx {
-  MPI_Comm comm;        /* the caller's communicator (not duplicated: keep it alive) */
+  MPI_Comm comm;        /* a duplicate of the caller's communicator (own message space) */
   int rank, size;       /* this rank, number of ranks                              */
   phgmg_gidx N;         /* global number of rows                                   */
   phgmg_gidx row0;      /* first row owned by this rank                            */
@@ -3355,10 +3355,12 @@ PHGMG_DEF phgmg_result phgmg_mpi_agree(MPI_Comm comm, phgmg_result rc);
    at 0, each next rank where the previous one ends, the last ends at N);
    otherwise PHGMG_ERR_SIZE on every rank. N < 1, nloc < 0, row0 < 0 or a
    NULL ctx on any rank: PHGMG_ERR_INVALID_ARG (or _SIZE) on every rank.
-   *ctx = NULL on failure. Free with phgmg_mpi_ctx_destroy. */
+   *ctx = NULL on failure. The context works on a duplicate of comm
+   (MPI_Comm_dup), so its messages never meet the caller's. Free with
+   phgmg_mpi_ctx_destroy. */
 PHGMG_DEF phgmg_result phgmg_mpi_ctx_create(phgmg_mpi_ctx **ctx, MPI_Comm comm, phgmg_gidx N, phgmg_gidx row0,
                                             int nloc, const phgmg_allocator *alloc);
-/* Not collective. NULL is a no-op. */
+/* Collective (frees the duplicated communicator). NULL is a no-op. */
 PHGMG_DEF void phgmg_mpi_ctx_destroy(phgmg_mpi_ctx *ctx);
 
 /* C (ka x kb, ldc) = A^T B summed over the ranks: A (nloc x ka, lda) and B
@@ -19117,7 +19119,8 @@ PHGMG_DEF phgmg_result phgmg_mpi_ctx_create(phgmg_mpi_ctx **ctx, MPI_Comm comm, 
     return rc;
   }
   memset(c, 0, sizeof *c);
-  c->comm = comm; c->rank = rank; c->size = size; c->N = N; c->row0 = row0; c->nloc = nloc;
+  MPI_Comm_dup(comm, &c->comm);
+  c->rank = rank; c->size = size; c->N = N; c->row0 = row0; c->nloc = nloc;
   if (alloc) c->al = *alloc;
   for (q = 0; q < size; ++q) all[q] = all[3 * q];   /* compact into the offsets (q <= 3q) */
   all[size] = N;
@@ -19130,6 +19133,7 @@ PHGMG_DEF void phgmg_mpi_ctx_destroy(phgmg_mpi_ctx *ctx) {
   phgmg_allocator al;
   if (!ctx) return;
   al = ctx->al;
+  MPI_Comm_free(&ctx->comm);
   phgmg__free(&al, ctx->starts);
   phgmg__free(&al, ctx);
 }
