@@ -526,6 +526,72 @@ static void test_gmg(void) {
   phgmg_mpi_ctx_destroy(c);
 }
 
+/* ---- errors on one rank ------------------------------------------------------------ */
+/* A bad input on one rank only (NaN, a bad size or leading dimension, a
+   rank-deficient B): the same code on every rank, never a hang. */
+static void test_errors(void) {
+  const int N = 300, ns = 8, bad = size_ > 1 ? 1 : 0;
+  phgmg_mpi_ctx *c = make_ctx(N);
+  const int ld = c->nloc > 0 ? c->nloc : 1, nb = c->nloc > 0 ? 1 : 0;   /* the bad rank owns rows */
+  double *X = (double *)malloc(sizeof(double) * (size_t)ld * ns), *V = (double *)malloc(sizeof(double) * (size_t)ld * ns);
+  double S[8], C[64], K[16], Qh[16], Bh[4];
+  long long pts[8];
+  phgmg_mpi_pod_stream *st = NULL;
+  phgmg_mpi_op *op = NULL;
+  phgmg_mpi_linear_model md;
+  phgmg_result rc;
+  int i, k = 0;
+  rng_ = 5;
+  for (i = 0; i < ld * ns; ++i) X[i] = urand();
+  if (rank_ == bad && nb) X[0] = NAN;
+  rc = phgmg_mpi_pod(c, ns, X, ld, 4, 0.0, V, ld, S, &k);
+  CHECK(rc == PHGMG_ERR_NANINF && same_everywhere(rc), "pod, NaN on one rank: %d", rc);
+  rc = phgmg_mpi_deim_greedy(c, 4, X, ld, NULL, pts, NULL);
+  CHECK(rc == PHGMG_ERR_NANINF && same_everywhere(rc), "deim, NaN on one rank: %d", rc);
+  CHECK(phgmg_mpi_pod_stream_begin(&st, c, 4, 0.0) == PHGMG_OK, "stream begin");
+  rc = phgmg_mpi_pod_stream_add(st, ns, X, ld);
+  CHECK(rc == PHGMG_ERR_NANINF && same_everywhere(rc), "stream, NaN on one rank: %d", rc);
+  phgmg_mpi_pod_stream_destroy(st);
+  X[0] = 0.25;
+  rc = phgmg_mpi_pod(c, ns, X, ld, rank_ == bad ? ns + 1 : 4, 0.0, V, ld, S, &k);
+  CHECK(rc == PHGMG_ERR_SIZE && same_everywhere(rc), "pod, kmax > ns on one rank: %d", rc);
+  rc = phgmg_mpi_atb(c, ns, ns, X, rank_ == bad ? 0 : ld, X, ld, C, ns);
+  CHECK(rc == PHGMG_ERR_SIZE && same_everywhere(rc), "atb, bad ld on one rank: %d", rc);
+  rc = phgmg_mpi_deim_greedy(c, 4, X, ld, NULL, rank_ == bad ? NULL : pts, NULL);
+  CHECK(rc == PHGMG_ERR_INVALID_ARG && same_everywhere(rc), "deim, NULL output on one rank: %d", rc);
+  /* the identity as an operator (empty rows on the bad rank would be fine) */
+  {
+    long long *rpi = (long long *)malloc(sizeof(long long) * ((size_t)c->nloc + 1)), *ci = (long long *)malloc(sizeof(long long) * (size_t)ld);
+    double *vi = (double *)malloc(sizeof(double) * (size_t)ld);
+    rpi[0] = 0;
+    for (i = 0; i < c->nloc; ++i) { rpi[i + 1] = i + 1; ci[i] = c->row0 + i; vi[i] = 1.0; }
+    CHECK(phgmg_mpi_op_create(&op, c, rpi, ci, vi) == PHGMG_OK, "identity op");
+    rc = phgmg_mpi_op_apply(op, 2, X, ld, V, rank_ == bad ? 0 : ld);
+    CHECK(rc == PHGMG_ERR_SIZE && same_everywhere(rc), "apply, bad ld on one rank: %d", rc);
+    if (rank_ == bad && nb) vi[0] = INFINITY;
+    phgmg_mpi_op_destroy(op); op = NULL;
+    rc = phgmg_mpi_op_create(&op, c, rpi, ci, vi);
+    CHECK(rc == PHGMG_ERR_NANINF && op == NULL && same_everywhere(rc), "op, Inf on one rank: %d", rc);
+    vi[0] = 1.0;
+    CHECK(phgmg_mpi_op_create(&op, c, rpi, ci, vi) == PHGMG_OK, "identity op");
+    /* B = 0: rank deficient (every rank sees the same R factor) */
+    {
+      double *Bz = (double *)calloc((size_t)ld, sizeof(double));
+      md.Q = op; md.m = 1; md.B = Bz; md.ldb = ld; md.solve = solve_cb; md.solve_user = NULL;
+      rc = phgmg_mpi_gmg_pod_linear(c, &md, ns, X, ld, 3, K, Qh, Bh, NULL, NULL, ld);
+      CHECK(rc == PHGMG_ERR_RANK && same_everywhere(rc), "gmg, B = 0: %d", rc);
+      md.B = rank_ == bad ? NULL : Bz;
+      rc = phgmg_mpi_gmg_pod_linear(c, &md, ns, X, ld, 3, K, Qh, Bh, NULL, NULL, ld);
+      CHECK((nb == 0 || rc == PHGMG_ERR_INVALID_ARG) && same_everywhere(rc), "gmg, NULL B on one rank: %d", rc);
+      free(Bz);
+    }
+    phgmg_mpi_op_destroy(op);
+    free(rpi); free(ci); free(vi);
+  }
+  free(X); free(V);
+  phgmg_mpi_ctx_destroy(c);
+}
+
 /* ---- across runs ----------------------------------------------------------------------- */
 static void compare_runs(const char *dir) {
   char path[1024];
@@ -566,6 +632,7 @@ int main(int argc, char **argv) {
   test_op();
   test_deim();
   test_gmg();
+  test_errors();
   compare_runs(argc > 1 ? argv[1] : NULL);
   MPI_Allreduce(&fails_, &total, 1, MPI_INT, MPI_SUM, MPI_COMM_WORLD);
   if (rank_ == 0) printf("test_mpi: P = %d: %s (%d failed checks, %.2f s)\n", size_, total ? "FAILED" : "passed", total, MPI_Wtime() - t0);
