@@ -177,6 +177,43 @@ static void test_tsqr_tall(void) {
   phgmg_mpi_ctx_destroy(c);
 }
 
+/* Blocks shorter than the number of columns (N = 45, 40 columns: every
+   rank at P > 1 owns fewer rows than that): Q R = X, Q^T Q = I, and the
+   POD's values and vectors equal the serial phgmg_pod's. */
+static void test_pod_short_blocks(void) {
+  const int N = 45, ns = 40;
+  double *X = (double *)malloc(sizeof(double) * N * ns), *Xl, *Q, *Qf, *QR = (double *)malloc(sizeof(double) * N * ns);
+  double R[1600], G[1600], S[40], Ss[40], *Vs = (double *)malloc(sizeof(double) * N * ns), *V, *Vf, e = 0.0, es = 0.0, ev = 0.0;
+  phgmg_mpi_ctx *c = make_ctx(N);
+  int i, j, k = 0, ks = 0, ld = c->nloc > 0 ? c->nloc : 1;
+  rng_ = 31;
+  for (j = 0; j < ns; ++j) for (i = 0; i < N; ++i) X[i + (size_t)j * N] = urand() * pow(10.0, -0.2 * j);
+  Xl = own_rows(c, ns, X);
+  Q = (double *)malloc(sizeof(double) * (size_t)ld * ns);
+  V = (double *)malloc(sizeof(double) * (size_t)ld * ns);
+  CHECK(phgmg_mpi_tsqr(c, ns, Xl, ld, Q, ld, R, ns) == PHGMG_OK, "tsqr short");
+  Qf = gather_rows(c, ns, Q);
+  phgmg_gemm('N', 'N', N, ns, ns, 1.0, Qf, N, R, ns, 0.0, QR, N);
+  for (i = 0; i < N * ns; ++i) e = fmax(e, fabs(QR[i] - X[i]));
+  phgmg_gemm('T', 'N', ns, ns, N, 1.0, Qf, N, Qf, N, 0.0, G, ns);
+  for (j = 0; j < ns; ++j) for (i = 0; i < ns; ++i) e = fmax(e, fabs(G[i + j * ns] - (i == j)));
+  CHECK(e <= 1e-13, "short blocks TSQR: max |QR - X|, |Q^T Q - I| = %.2e", e);
+  CHECK(phgmg_mpi_pod(c, ns, Xl, ld, 10, 0.0, V, ld, S, &k) == PHGMG_OK && k == 10, "pod short");
+  CHECK(phgmg_pod(N, ns, X, N, 10, 0.0, Vs, N, Ss, &ks, NULL) == PHGMG_OK && ks == 10, "serial pod short");
+  Vf = gather_rows(c, 10, V);
+  for (j = 0; j < 10; ++j) {
+    double d = 0.0;
+    es = fmax(es, fabs(S[j] - Ss[j]) / Ss[0]);
+    for (i = 0; i < N; ++i) d += Vf[i + (size_t)j * N] * Vs[i + (size_t)j * N];
+    for (i = 0; i < N; ++i) ev = fmax(ev, fabs(Vf[i + (size_t)j * N] - (d < 0 ? -1.0 : 1.0) * Vs[i + (size_t)j * N]));
+  }
+  CHECK(es <= 1e-14 && ev <= 1e-12, "short blocks POD against serial: values %.2e, vectors %.2e", es, ev);
+  if (rank_ == 0) printf("  short blocks (nloc < ns): TSQR %.2e, POD values %.2e, vectors %.2e\n", e, es, ev);
+  put(S, 10);
+  free(X); free(Xl); free(Q); free(Qf); free(QR); free(Vs); free(V); free(Vf);
+  phgmg_mpi_ctx_destroy(c);
+}
+
 /* ---- the sparse operator ----------------------------------------------------------- */
 /* Row i: 4 + (i mod 7)/10 on the diagonal, -1 beside it, and a long-range
    entry (i * 37 + 11) mod N (other ranks, not only neighbours). */
@@ -629,6 +666,7 @@ int main(int argc, char **argv) {
   test_ctx();
   test_pod();
   test_tsqr_tall();
+  test_pod_short_blocks();
   test_op();
   test_deim();
   test_gmg();
