@@ -3316,7 +3316,8 @@ PHGMG_DEF phgmg_result phgmg_npy_write(const char *path, const double *A, int ro
    context's communicator and agree on their result: an error found on one
    rank (a bad argument, a failed callback, no memory) is returned on every
    rank with the same code (the most negative code over the ranks), never a
-   deadlock. */
+   deadlock. (A NULL context or object cannot agree: the call returns
+   PHGMG_ERR_INVALID_ARG on that rank alone.) */
 #if defined(PHGMG_MPI) && !defined(PHGMG_NO_OFFLINE)
 #if defined(__cplusplus) && !defined(OMPI_SKIP_MPICXX)
 #define OMPI_SKIP_MPICXX 1 /* the C interface only (MPI-3 dropped the C++ one) */
@@ -3353,8 +3354,9 @@ PHGMG_DEF phgmg_result phgmg_mpi_agree(MPI_Comm comm, phgmg_result rc);
 /* Collective: the context of N global rows, this rank owning rows row0 ..
    row0 + nloc - 1. The blocks must tile [0, N) in rank order (rank 0 starts
    at 0, each next rank where the previous one ends, the last ends at N);
-   otherwise PHGMG_ERR_SIZE on every rank. N < 1, nloc < 0, row0 < 0 or a
-   NULL ctx on any rank: PHGMG_ERR_INVALID_ARG (or _SIZE) on every rank.
+   otherwise PHGMG_ERR_SIZE on every rank. A NULL ctx on any rank gives
+   PHGMG_ERR_INVALID_ARG, N < 1, nloc < 0, row0 < 0 or a block beyond N
+   PHGMG_ERR_SIZE, on every rank.
    *ctx = NULL on failure. The context works on a duplicate of comm
    (MPI_Comm_dup), so its messages never meet the caller's. Free with
    phgmg_mpi_ctx_destroy. */
@@ -3371,7 +3373,9 @@ PHGMG_DEF phgmg_result phgmg_mpi_atb(const phgmg_mpi_ctx *ctx, int ka, int kb, c
                                      const double *B, int ldb, double *C, int ldc);
 
 /* TSQR: X = Q R for a row-distributed X (nloc x ns, ldx; N >= ns not
-   required). Each rank factors its block by Householder QR, the small
+   required). Each rank factors its block by Householder QR (a block of
+   8192 rows or more in chunks of about 4096, each factored in cache and
+   combined the same way), the small
    triangular factors of all ranks are gathered (one MPI_Allgather of
    size ns^2 per rank), stacked and factored again on every rank (the same
    computation on the same data: R is identical on every rank), and this
@@ -3379,8 +3383,8 @@ PHGMG_DEF phgmg_result phgmg_mpi_atb(const phgmg_mpi_ctx *ctx, int ka, int kb, c
    Q (nloc x ns, ldq) may be NULL (R only); R: ns x ns, ldr, upper
    triangular. Backward stable: Q is orthonormal to working precision and
    R carries the singular values down to eps times the largest (a Gram
-   matrix X^T X loses those below sqrt(eps)). Memory: nloc ns + (size + 2)
-   ns^2 doubles. */
+   matrix X^T X loses those below sqrt(eps)). Memory: about nloc ns +
+   (2 size + 3 + nloc / 4096) ns^2 doubles. */
 PHGMG_DEF phgmg_result phgmg_mpi_tsqr(const phgmg_mpi_ctx *ctx, int ns, const double *X, int ldx, double *Q,
                                       int ldq, double *R, int ldr);
 
