@@ -526,7 +526,8 @@
    them is the online model (phgmg_rom_check, the stepper, export and
    files work unchanged). Agreement with the serial phgmg_reduce: K and Qh
    within 1.5e-15 relative at 1-4 ranks (after the sign of each POD mode,
-   which the SVD leaves free). Cost: per POD, one allgather of ns^2 doubles
+   which the SVD leaves free), the reduced outputs over 200 steps within
+   1e-15. Cost: per POD, one allgather of ns^2 doubles
    per rank and a replicated QR of a (size ns) x ns matrix (fine to a few
    hundred ranks; a reduction tree would remove the size factor); per DEIM
    point one broadcast of k doubles and one reduction of a (value, index)

@@ -477,7 +477,8 @@ static phgmg_result solve_cb(char trans, int nrhs, double *X, int ldx, void *use
 static void u_sin(double t, double *u, void *user) { (void)user; u[0] = sin(t) + 0.5 * sin(2.7 * t); }
 
 /* K, Qh, Bh of the distributed GMG-POD equal the serial phgmg_reduce's (after
-   the sign of each POD mode) on the mass-spring-damper chain; a solve failing
+   the sign of each POD mode) on the mass-spring-damper chain, and the online
+   model made of them steps to the serial model's outputs; a solve failing
    on one rank only gives the same code on every rank. */
 static void test_gmg(void) {
   const int n = 100, N = 200, ns = 201, r = 10, m = 1;
@@ -545,11 +546,25 @@ static void test_gmg(void) {
   if (rank_ == 0) printf(", Qh %.2e, sigma_r/sigma_1 %.1e\n", e, S[r - m - 1] / S[0]);
   for (i = 0; i < r * m; ++i) CHECK(Bh[i] == rom->Bh[i], "Bh");
   put(K, r * r); put(Qh, r * r);
-  {   /* the blocks make a valid online model */
+  {   /* the blocks make a valid online model whose outputs are the serial model's */
     phgmg_rom ro;
+    static double m1[16384], m2[16384];
+    phgmg_rom_stepper s1, s2;
+    double x1[10] = {0}, x2[10] = {0}, u3[3], tc[3], y1 = 0.0, y2 = 0.0, ey = 0.0, sy = 0.0;
+    int st;
     memset(&ro, 0, sizeof ro);
     ro.kind = PHGMG_ROM_LINEAR; ro.method = PHGMG_METHOD_GMG_POD; ro.r = r; ro.m = m; ro.Bh = Bh; ro.Qh = Qh; ro.K = K;
     CHECK(phgmg_rom_check(&ro) == PHGMG_OK, "rom check");
+    CHECK(phgmg_rom_stepper_init(&s1, &ro, 0.1, 0.0, 0, m1, sizeof m1) == PHGMG_OK &&
+              phgmg_rom_stepper_init(&s2, rom, 0.1, 0.0, 0, m2, sizeof m2) == PHGMG_OK, "steppers");
+    for (st = 0; st < 200; ++st) {
+      phgmg_rom_stage_times(0.1 * st, 0.1, tc);
+      for (i = 0; i < 3; ++i) u_sin(tc[i], u3 + i, NULL);
+      CHECK(phgmg_rom_step(&s1, x1, u3, &y1, NULL) == PHGMG_OK && phgmg_rom_step(&s2, x2, u3, &y2, NULL) == PHGMG_OK, "step");
+      ey = fmax(ey, fabs(y1 - y2)); sy = fmax(sy, fabs(y2));
+    }
+    CHECK(ey <= 1e-10 * sy, "reduced outputs against the serial model's: %.2e", ey / sy);
+    if (rank_ == 0) printf("  gmg-pod: reduced outputs (200 steps) against the serial model's %.2e\n", ey / sy);
   }
   /* the solve fails on one rank only */
   sv.fail_rank = size_ > 1 ? 1 : 0;
