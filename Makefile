@@ -87,7 +87,7 @@ test-mpi:
 	$(MPICC) -std=c99 $(WARN) -DPHGMG_NO_OFFLINE -fsyntax-only $(BUILD)/mpi/impl.c && \
 	if command -v $(MPICXX) >/dev/null 2>&1; then $(MPICXX) -std=c++11 -Wall -Wextra -Werror -fsyntax-only $(BUILD)/mpi/impl.cpp; fi && \
 	$(MPICC) $(CFLAGS_T) -o $(BUILD)/test_mpi tests/mpi/test_mpi.c $(LDLIBS) && \
-	$(MPICC) -std=c99 $(WARN) -O1 -o $(BUILD)/mpi_pod examples/mpi_pod.c $(LDLIBS) && \
+	$(MPICC) -std=c99 $(WARN) -O0 -o $(BUILD)/mpi_pod examples/mpi_pod.c $(LDLIBS) && \
 	for p in 1 2 3 4; do timeout 120 $(MPIRUN) -np $$p ./$(BUILD)/test_mpi $(BUILD)/mpi || exit 1; done && \
 	$(MPIRUN) -np 3 ./$(BUILD)/mpi_pod --N 3000 > $(BUILD)/mpi/example.txt && echo "test-mpi: examples/mpi_pod.c runs at 3 ranks"
 
