@@ -17,7 +17,7 @@ LDLIBS   = -lm
 TESTSRC := $(wildcard tests/test_*.c)
 BUILD    = build
 
-.PHONY: check-descriptor docs-check test-hello test-build test-validate test-deploy all test test-plain test-asan compile-checks test-embedded-host test-npy test-cli test-demo test-fuzz-replay demo bench examples embedded fuzz clean
+.PHONY: test-mpi check-descriptor docs-check test-hello test-build test-validate test-deploy all test test-plain test-asan compile-checks test-embedded-host test-npy test-cli test-demo test-fuzz-replay demo bench examples embedded fuzz clean
 
 all: phgmg.h examples
 
@@ -59,7 +59,7 @@ SYNC = $(if $(filter output-sync,$(.FEATURES)),--output-sync=target,)
 # sanitizers; it is the quick one during development).
 test: test-build
 	$(MAKE) -j2 $(SYNC) test-asan test-cli test-fuzz-replay test-embedded-host test-demo compile-checks \
-	  test-validate test-npy test-hello docs-check
+	  test-validate test-npy test-hello docs-check test-mpi
 
 
 # Everything make test compiles, built first on both cores (the compiles are
@@ -67,6 +67,29 @@ test: test-build
 test-build: tests/suites.inc
 	$(MAKE) -j2 $(BUILD)/test_run_asan $(EXAMPLES) $(BUILD)/phgmg-float $(BUILD)/npy_tool \
 	  $(BUILD)/export_model_d $(BUILD)/export_model_f
+
+# The distributed layer (PHGMG_MPI; tests/mpi/test_mpi.c, examples/mpi_pod.c)
+# at 1, 2, 3 and 4 ranks (4: one rank owns no rows; more ranks than cores),
+# each run's results compared with the one-rank run's; the section's compile
+# checks (C99, float online scalar, C++). Skipped, with a message, without
+# mpicc and mpirun (Debian: openmpi-bin libopenmpi-dev). A deadlock fails
+# after 120 s (timeout). Half a minute, most of it compiling.
+MPICC  ?= mpicc
+MPICXX ?= mpicxx
+MPIRUN  = mpirun --oversubscribe $$(if [ "$$(id -u)" = 0 ]; then echo --allow-run-as-root; fi)
+test-mpi:
+	@if ! command -v $(MPICC) >/dev/null 2>&1 || ! command -v mpirun >/dev/null 2>&1; then \
+	  echo "test-mpi: skipped (no $(MPICC) or mpirun; Debian packages openmpi-bin libopenmpi-dev)"; exit 0; fi; \
+	mkdir -p $(BUILD)/mpi && rm -f $(BUILD)/mpi/res_*.bin && \
+	printf '#define PHGMG_MPI\n#define PHGMG_IMPLEMENTATION\n#include "../../phgmg.h"\nint main(void){return 0;}\n' > $(BUILD)/mpi/impl.c && \
+	cp $(BUILD)/mpi/impl.c $(BUILD)/mpi/impl.cpp && \
+	$(MPICC) -std=c99 $(WARN) -Wdouble-promotion -DPHGMG_REAL_FLOAT -fsyntax-only $(BUILD)/mpi/impl.c && \
+	$(MPICC) -std=c99 $(WARN) -DPHGMG_NO_OFFLINE -fsyntax-only $(BUILD)/mpi/impl.c && \
+	if command -v $(MPICXX) >/dev/null 2>&1; then $(MPICXX) -std=c++11 -Wall -Wextra -Werror -fsyntax-only $(BUILD)/mpi/impl.cpp; fi && \
+	$(MPICC) $(CFLAGS_T) -o $(BUILD)/test_mpi tests/mpi/test_mpi.c $(LDLIBS) && \
+	$(MPICC) -std=c99 $(WARN) -O0 -o $(BUILD)/mpi_pod examples/mpi_pod.c $(LDLIBS) && \
+	for p in 1 2 3 4; do timeout 120 $(MPIRUN) -np $$p ./$(BUILD)/test_mpi $(BUILD)/mpi || exit 1; done && \
+	$(MPIRUN) -np 3 ./$(BUILD)/mpi_pod --N 3000 > $(BUILD)/mpi/example.txt && echo "test-mpi: examples/mpi_pod.c runs at 3 ranks"
 
 # The documentation against the code: every public function in the manual's
 # index, every CLI option in --help, README's first C block compiles and runs,

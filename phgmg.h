@@ -26,7 +26,8 @@
    The header has two halves, declarations and implementation, each cut into
    sections marked >>config, >>result, >>memory, >>ph, >>dae, >>sparse, >>gl3,
    >>online, >>pod, >>hyper, >>reduce, >>deploy, >>errors, >>study, >>linear,
-   >>export, >>npy and, last, >>linalg, the dense kernels (grep for them; the
+   >>export, >>npy, >>mpi (only with PHGMG_MPI) and, last, >>linalg, the
+   dense kernels (grep for them; the
    same order in both halves: the implementation declares the kernels' private
    helpers in >>linalg (prototypes) after >>memory, and its >>reduce opens with
    the reduced object the others use). The comment at each declaration states
@@ -467,6 +468,72 @@
    matrix) take the same choice: their stage matrices sigma E + M are
    analysed with E's pattern joined (manual 8.12); an E with a zero row or
    column (index one, 1.8) keeps the band LU.
+
+   2.7 Distributed offline phase (>>mpi; define PHGMG_MPI before the include,
+   compile with mpicc; the section includes <mpi.h> and needs nothing else).
+   For models whose state, operators and snapshots are distributed by rows
+   over MPI ranks, as PETSc, hypre, Tpetra or MFEM keep them: every rank
+   passes its own contiguous block of rows as plain column-major arrays and
+   CSR (64-bit global indices, phgmg_gidx), and gets the small reduced
+   quantities replicated and identical on every rank.
+     phgmg_mpi_ctx_create   the layout: communicator, global N, this rank's
+                            rows [row0, row0 + nloc) (uneven or empty blocks;
+                            checked to tile [0, N) in rank order)
+     phgmg_mpi_tsqr         X = Q R: local Householder QR, the ranks' small
+                            R factors gathered (one allgather of ns^2 doubles
+                            each) and factored again on every rank
+     phgmg_mpi_pod          POD by TSQR and the SVD of R; values identical
+                            on every rank, V this rank's rows
+     phgmg_mpi_pod_stream_* the same from column batches (incremental SVD at
+                            rank kmax, with a stated error bound): the N x ns
+                            snapshot matrix never exists, on one rank too
+     phgmg_mpi_deim_greedy  greedy DEIM points as global indices, ties to the
+                            lower global index: the same for every partition
+     phgmg_mpi_op_*         a row-distributed CSR operator: the halo exchange
+                            plan built once, A X, V^T A V (replicated)
+     phgmg_mpi_atb          A^T B of two row-distributed blocks (replicated)
+     phgmg_mpi_gmg_pod_linear  GMG-POD of a linear model x' = (J - R) Q x +
+                            B u (Q as an operator, B's rows, J - R through a
+                            collective solve callback: the user's KSP, MUMPS
+                            or AMG): K, Qh, Bh of the serial phgmg_reduce
+     phgmg_mpi_agree        one result for all ranks
+   Why TSQR and not the Gram matrix X^T X (the method of snapshots): the
+   Gram matrix squares the condition number, so singular values below
+   sqrt(eps) sigma_1 ~ 1e-8 sigma_1 are lost and the basis of the modes near
+   there depends on the partition through rounding. On a snapshot matrix with
+   singular values 1 ... 1e-13 (tests/mpi/test_mpi.c), V^T A V with r = 14
+   modes (sigma_r / sigma_1 = 2e-5) from the Gram basis is off by 6e-10 to
+   6e-9 relative, from TSQR by 2e-14 to 6e-14, and the TSQR values match
+   the exact ones to 4e-16 sigma_1; the results at 2, 3 and 4 ranks
+   differ from one rank's by less than 1e-13.
+   Errors are collective: every function agrees on its result over the
+   ranks (phgmg_mpi_agree: the most negative code), so an error found on
+   one rank only -- a bad argument, a failed solve, no memory -- returns the
+   same code on every rank and never leaves a rank waiting in a collective.
+   Identical on every rank: the small factors are computed by every rank
+   from the same gathered data (the same binary: bitwise the same result),
+   and sums over the ranks are a reduction to rank 0 and a broadcast, not an
+   allreduce whose rounding may differ between ranks.
+   Relation to the serial pipeline. phgmg_mpi_gmg_pod_linear computes the
+   quantities of the serial GMG-POD (2.2; linear model, quadratic H, no E,
+   dampers or feedthrough) in the same order: QB from the QR of B (the same
+   rank test), the POD of X - QB QB^T X, V0 = [B, V1], G00 = V0^T (J - R)^{-1}
+   V0 by r solves, the same non-degeneracy test (reciprocal condition of
+   G00 with B's columns scaled, >= 1e-12), K = G00^{-1}, Qh = V0^T Q V0
+   symmetrised, Bh = [I; 0]. The serial object (phgmg_reduced) keeps
+   N-dimensional data (V0, the snapshots), so the distributed function
+   returns the blocks instead; a phgmg_rom of kind PHGMG_ROM_LINEAR with
+   them is the online model (phgmg_rom_check, the stepper, export and
+   files work unchanged). Agreement with the serial phgmg_reduce: K and Qh
+   within 1.5e-15 relative at 1-4 ranks (after the sign of each POD mode,
+   which the SVD leaves free), the reduced outputs over 200 steps within
+   1e-15. Cost: per POD, one allgather of ns^2 doubles
+   per rank and a replicated QR of a (size ns) x ns matrix (fine to a few
+   hundred ranks; a reduction tree would remove the size factor); per DEIM
+   point one broadcast of k doubles and one reduction of a (value, index)
+   pair; per operator product one exchange with the neighbouring ranks.
+   Not yet distributed: GMG-QM, SP1/SP2, ECSW, nonlinear Hamiltonians,
+   dampers, descriptor models, the command line.
 
    3. METHODS AND OPTIONS -------------------------------------------------------
    Every option struct is "zero means default": memset it to 0 and set what you
@@ -1356,6 +1423,8 @@
      PHGMG_NO_OFFLINE      compile only the online half (+ export/import in memory):
                            needs libm only, no heap, no stdio
      PHGMG_NO_STDIO        no file functions (.npy files, model files, C export)
+     PHGMG_MPI             compile the distributed section >>mpi (includes
+                           <mpi.h>; build with mpicc; manual 2.7)
      PHGMG_NPY_MAX_HEADER  longest accepted .npy header in bytes (default 1 MiB)
      PHGMG_MALLOC(sz,u) / PHGMG_FREE(p,u)   default allocator (both or neither)
      PHGMG_ASSERT(x)       internal invariant checks (default assert)
@@ -1433,11 +1502,19 @@
            phgmg_rom_load, phgmg_rom_export_c
    npy:    phgmg_npy_parse, phgmg_npy_serialize, phgmg_npy_free,
            phgmg_npy_read, phgmg_npy_write
+   mpi:    (with PHGMG_MPI) phgmg_mpi_agree, phgmg_mpi_ctx_create,
+           phgmg_mpi_ctx_destroy, phgmg_mpi_atb, phgmg_mpi_tsqr, phgmg_mpi_pod,
+           phgmg_mpi_pod_stream_begin, phgmg_mpi_pod_stream_add,
+           phgmg_mpi_pod_stream_end, phgmg_mpi_pod_stream_destroy,
+           phgmg_mpi_deim_greedy, phgmg_mpi_op_create, phgmg_mpi_op_destroy,
+           phgmg_mpi_op_info, phgmg_mpi_op_apply, phgmg_mpi_op_project,
+           phgmg_mpi_gmg_pod_linear
    linalg: phgmg_gemm, phgmg_gemv, phgmg_lu_factor, phgmg_lu_solve,
            phgmg_lu_rcond, phgmg_norm1, phgmg_normf, phgmg_zlu_factor,
            phgmg_zlu_solve, phgmg_qr, phgmg_qrcp, phgmg_qr_form_q,
            phgmg_qr_apply, phgmg_lstsq, phgmg_svd, phgmg_sym_eig
-   (124 functions; also the macros PHGMG_ROM_STEPPER_MEMSIZE_MAX and _MAX_CB.)
+   (141 functions; 17 of them only with PHGMG_MPI; also the macros
+   PHGMG_ROM_STEPPER_MEMSIZE_MAX and _MAX_CB.)
 */
 #ifndef PHGMG_H_INCLUDED
 #define PHGMG_H_INCLUDED
@@ -3228,6 +3305,210 @@ PHGMG_DEF phgmg_result phgmg_npy_write(const char *path, const double *A, int ro
 }
 #endif
 #endif /* PHGMG_NO_OFFLINE */
+
+/* >>mpi =================================================================== */
+/* The distributed offline phase (manual 2.7): compiled only when PHGMG_MPI
+   is defined before the include, which then includes <mpi.h> (and nothing
+   else); without it this section is empty. Every rank owns a contiguous
+   block of rows of the state, of the snapshots and of the operators (the
+   layout of PETSc, hypre, Tpetra, MFEM); the reduced quantities (singular
+   values, small projected blocks, DEIM points) come out replicated and
+   identical on every rank. All functions here are collective over the
+   context's communicator and agree on their result: an error found on one
+   rank (a bad argument, a failed callback, no memory) is returned on every
+   rank with the same code (the most negative code over the ranks), never a
+   deadlock. (A NULL context or object cannot agree: the call returns
+   PHGMG_ERR_INVALID_ARG on that rank alone.) */
+#if defined(PHGMG_MPI) && !defined(PHGMG_NO_OFFLINE)
+#if defined(__cplusplus) && !defined(OMPI_SKIP_MPICXX)
+#define OMPI_SKIP_MPICXX 1 /* the C interface only (MPI-3 dropped the C++ one) */
+#endif
+#if defined(__cplusplus) && !defined(MPICH_SKIP_MPICXX)
+#define MPICH_SKIP_MPICXX 1
+#endif
+#include <mpi.h>
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Global (64-bit) row and column indices. */
+typedef long long phgmg_gidx;
+
+/* The row distribution: rank q owns the rows [starts[q], starts[q + 1]) of
+   0 .. N - 1, in rank order; blocks may be uneven or empty. Read the fields,
+   do not change them (phgmg_mpi_ctx_create fills them). */
+typedef struct phgmg_mpi_ctx {
+  MPI_Comm comm;        /* a duplicate of the caller's communicator (own message space) */
+  int rank, size;       /* this rank, number of ranks                              */
+  phgmg_gidx N;         /* global number of rows                                   */
+  phgmg_gidx row0;      /* first row owned by this rank                            */
+  int nloc;             /* rows owned by this rank (may be 0)                      */
+  phgmg_gidx *starts;   /* size + 1 offsets: rank q owns [starts[q], starts[q+1])  */
+  phgmg_allocator al;   /* a copy of the allocator given (zero: malloc/free)       */
+} phgmg_mpi_ctx;
+
+/* Agree on a result: every rank passes its own rc and gets back the most
+   negative of them (PHGMG_OK only if every rank passed PHGMG_OK). One
+   MPI_Allreduce. For the user's callbacks and drivers. */
+PHGMG_DEF phgmg_result phgmg_mpi_agree(MPI_Comm comm, phgmg_result rc);
+
+/* Collective: the context of N global rows, this rank owning rows row0 ..
+   row0 + nloc - 1. The blocks must tile [0, N) in rank order (rank 0 starts
+   at 0, each next rank where the previous one ends, the last ends at N);
+   otherwise PHGMG_ERR_SIZE on every rank. A NULL ctx on any rank gives
+   PHGMG_ERR_INVALID_ARG, N < 1, nloc < 0, row0 < 0 or a block beyond N
+   PHGMG_ERR_SIZE, on every rank.
+   *ctx = NULL on failure. The context works on a duplicate of comm
+   (MPI_Comm_dup), so its messages never meet the caller's. Free with
+   phgmg_mpi_ctx_destroy. */
+PHGMG_DEF phgmg_result phgmg_mpi_ctx_create(phgmg_mpi_ctx **ctx, MPI_Comm comm, phgmg_gidx N, phgmg_gidx row0,
+                                            int nloc, const phgmg_allocator *alloc);
+/* Collective (frees the duplicated communicator). NULL is a no-op. */
+PHGMG_DEF void phgmg_mpi_ctx_destroy(phgmg_mpi_ctx *ctx);
+
+/* C (ka x kb, ldc) = A^T B summed over the ranks: A (nloc x ka, lda) and B
+   (nloc x kb, ldb) are this rank's row blocks. The result is identical on
+   every rank (a reduction to rank 0 and a broadcast, not an allreduce whose
+   rounding could differ between ranks). */
+PHGMG_DEF phgmg_result phgmg_mpi_atb(const phgmg_mpi_ctx *ctx, int ka, int kb, const double *A, int lda,
+                                     const double *B, int ldb, double *C, int ldc);
+
+/* TSQR: X = Q R for a row-distributed X (nloc x ns, ldx; N >= ns not
+   required). Each rank factors its block by Householder QR (a block of
+   8192 rows or more in chunks of about 4096, each factored in cache and
+   combined the same way), the small
+   triangular factors of all ranks are gathered (one MPI_Allgather of
+   size ns^2 per rank), stacked and factored again on every rank (the same
+   computation on the same data: R is identical on every rank), and this
+   rank's block of Q is its local Q times its block of the second factor's Q.
+   Q (nloc x ns, ldq) may be NULL (R only); R: ns x ns, ldr, upper
+   triangular. Backward stable: Q is orthonormal to working precision and
+   R carries the singular values down to eps times the largest (a Gram
+   matrix X^T X loses those below sqrt(eps)). Memory: about nloc ns +
+   (2 size + 3 + nloc / 4096) ns^2 doubles. */
+PHGMG_DEF phgmg_result phgmg_mpi_tsqr(const phgmg_mpi_ctx *ctx, int ns, const double *X, int ldx, double *Q,
+                                      int ldq, double *R, int ldr);
+
+/* Distributed POD: the leading left singular vectors of the row-distributed
+   X (nloc x ns per rank), as phgmg_pod: kmax modes, or with tol > 0 only
+   those with sigma_k > tol sigma_1 (and never beyond the numerical rank).
+   By TSQR (phgmg_mpi_tsqr) and the SVD of the ns x ns factor R = U S W^T,
+   replicated: V = Q U(:, 0:k). V: this rank's rows (nloc x kmax, ldv); S
+   (kmax, may be NULL) and *k_out identical on every rank. kmax must not
+   exceed min(N, ns) (PHGMG_ERR_SIZE). Signs of the columns are those of the
+   SVD (compare bases up to the sign of each column). */
+PHGMG_DEF phgmg_result phgmg_mpi_pod(const phgmg_mpi_ctx *ctx, int ns, const double *X, int ldx, int kmax,
+                                     double tol, double *V, int ldv, double *S, int *k_out);
+
+/* Streaming POD of snapshots that arrive in column blocks (larger than
+   memory: the N x ns matrix never exists). An incremental SVD (Brand 2006)
+   kept at rank kmax: with the current basis V (N x k) and values S, a new
+   block Xb is split into C = V^T Xb and the residual Xb - V C (twice, for
+   orthogonality), the residual factored by TSQR into Qb Rb, and the small
+   matrix [[diag(S), C], [0, Rb]] decomposed (replicated); V, S are
+   updated and truncated to the kmax leading modes (and to sigma_k > tol
+   sigma_1 with tol > 0). Error statement: with no truncation (kmax >= the
+   number of columns seen) the result is the POD of all the columns; each
+   truncation discards the values it drops, and the final values and
+   basis are exactly those of a matrix within the sum, over the
+   truncations, of sqrt(sum of the squares of the values dropped) of the
+   true snapshot matrix in the Frobenius norm (phgmg_mpi_pod_stream_end
+   reports that bound; values below the SVD's rank threshold, eps times
+   the norm of the small matrix, count as zero). Memory: 2 nloc (kmax +
+   nb) doubles for a block of nb columns. begin: *st (NULL on failure);
+   add: nb >= 1 columns Xb (nloc x nb, ldx); end: V (nloc x k, ldv), S (k,
+   may be NULL), *k_out = k, *discarded (may be NULL) = the bound above;
+   the stream stays valid (add more and end again). All collective. */
+typedef struct phgmg_mpi_pod_stream phgmg_mpi_pod_stream;
+PHGMG_DEF phgmg_result phgmg_mpi_pod_stream_begin(phgmg_mpi_pod_stream **st, const phgmg_mpi_ctx *ctx, int kmax,
+                                                  double tol);
+PHGMG_DEF phgmg_result phgmg_mpi_pod_stream_add(phgmg_mpi_pod_stream *st, int nb, const double *Xb, int ldx);
+PHGMG_DEF phgmg_result phgmg_mpi_pod_stream_end(phgmg_mpi_pod_stream *st, double *V, int ldv, double *S,
+                                                int *k_out, double *discarded);
+/* Not collective. NULL is a no-op. */
+PHGMG_DEF void phgmg_mpi_pod_stream_destroy(phgmg_mpi_pod_stream *st);
+
+/* Greedy DEIM points (Chaturantabut-Sorensen, as PHGMG_DEIM_GREEDY) of a
+   row-distributed basis U (nloc x k, ldu): point l = the global row of
+   largest |u_l - U_{<l} (P^T U_{<l})^{-1} P^T u_l|, found by a maximum
+   reduction whose ties go to the lower GLOBAL index, so the points do not
+   depend on the partition. pts (k, replicated): global row indices in the
+   order chosen. w (k, may be NULL): the structure-preserving DEIM weights
+   w = (P^T U)^{-T} U^T sw (sw: this rank's nloc term weights, NULL = 1).
+   Costs per point: one broadcast of a row of U (k doubles) and one
+   reduction of a (value, index) pair. PHGMG_ERR_SINGULAR if P^T U is
+   singular (U rank deficient), PHGMG_ERR_SIZE if k > N. */
+PHGMG_DEF phgmg_result phgmg_mpi_deim_greedy(const phgmg_mpi_ctx *ctx, int k, const double *U, int ldu,
+                                             const double *sw, phgmg_gidx *pts, double *w);
+
+/* A row-distributed sparse operator: this rank's rows of a global N x N
+   matrix as CSR (rowptr: nloc + 1 entries from 0, col: global column
+   indices in [0, N), val), what PETSc MPIAIJ (MatGetRow), hypre ParCSR
+   and Tpetra export. phgmg_mpi_op_create copies it and builds the halo
+   exchange plan once: the columns owned by other ranks are requested from
+   their owners (one MPI_Alltoall of counts and one MPI_Alltoallv of
+   indices); each product then exchanges only those values with the
+   neighbouring ranks (MPI_Isend/MPI_Irecv). A column index out of range or
+   a NaN/Inf value on any rank: PHGMG_ERR_SIZE / _NANINF on every rank. The
+   context must outlive the operator. */
+typedef struct phgmg_mpi_op phgmg_mpi_op;
+PHGMG_DEF phgmg_result phgmg_mpi_op_create(phgmg_mpi_op **op, const phgmg_mpi_ctx *ctx, const phgmg_gidx *rowptr,
+                                           const phgmg_gidx *col, const double *val);
+/* Not collective. NULL is a no-op. */
+PHGMG_DEF void phgmg_mpi_op_destroy(phgmg_mpi_op *op);
+/* The plan: *nhalo = values received per column of a product, *nneighbours
+   = ranks exchanged with (either may be NULL). Not collective. */
+PHGMG_DEF void phgmg_mpi_op_info(const phgmg_mpi_op *op, int *nhalo, int *nneighbours);
+/* Y = A X for k columns (X, Y: this rank's rows, nloc x k; Y must not
+   overlap X). Collective. */
+PHGMG_DEF phgmg_result phgmg_mpi_op_apply(const phgmg_mpi_op *op, int k, const double *X, int ldx, double *Y,
+                                          int ldy);
+/* Ar (k x k, ldar) = V^T A V, replicated (phgmg_mpi_op_apply and
+   phgmg_mpi_atb). Collective. */
+PHGMG_DEF phgmg_result phgmg_mpi_op_project(const phgmg_mpi_op *op, int k, const double *V, int ldv, double *Ar,
+                                            int ldar);
+
+/* A collective solve with J - R (the user's distributed solver: PETSc KSP,
+   MUMPS, hypre, ...): X (nloc x nrhs, ldx, this rank's rows) is overwritten
+   by (J - R)^{-1} X (trans 'N') or (J - R)^{-T} X ('T'). Every rank calls it
+   together; its results are agreed (phgmg_mpi_agree). */
+typedef phgmg_result (*phgmg_mpi_solve_fn)(char trans, int nrhs, double *X, int ldx, void *user);
+
+/* A linear port-Hamiltonian model distributed by rows: x' = (J - R) Q x + B u,
+   y = B^T Q x. Q as a distributed operator, B this rank's rows (nloc x m,
+   ld ldb), J - R through its solve. */
+typedef struct phgmg_mpi_linear_model {
+  const phgmg_mpi_op *Q;
+  int m;
+  const double *B;
+  int ldb;
+  phgmg_mpi_solve_fn solve;
+  void *solve_user;
+} phgmg_mpi_linear_model;
+
+/* Distributed GMG-POD of a linear model (the serial phgmg_reduce with
+   PHGMG_METHOD_GMG_POD, manual 2.7): V0 = [B, V1], V1 the r - m leading POD
+   modes of the adjusted snapshots X - QB QB^T X (QB from the TSQR of B),
+   G00 = V0^T (J - R)^{-1} V0 (r solves), K = G00^{-1}, Qh = V0^T Q V0
+   (symmetrised), Bh = [I; 0]: the reduced model xr' = K Qh xr + Bh u,
+   yr = Bh^T Qh xr, Jr = (K - K^T)/2, Rr = -(K + K^T)/2. X: this rank's rows
+   of the snapshots (nloc x ns, ldx). Outputs, identical on every rank: K,
+   Qh (r x r), Bh (r x m); S (r - m, may be NULL) the POD's singular
+   values; V0 (nloc x r, ldv0, may be NULL) this rank's rows of the basis.
+   A phgmg_rom of kind PHGMG_ROM_LINEAR with these r, m, Bh, Qh, K (as
+   phgmg_real) is the online model: stepper, export and files as usual.
+   PHGMG_ERR_RANK (B rank deficient), _SIZE (r - m beyond the snapshots'
+   numerical rank, or r > N), _DEGENERATE (reciprocal condition of G00,
+   with B's columns scaled to unit length, below 1e-12), and the solve's
+   codes. */
+PHGMG_DEF phgmg_result phgmg_mpi_gmg_pod_linear(const phgmg_mpi_ctx *ctx, const phgmg_mpi_linear_model *model,
+                                                int ns, const double *X, int ldx, int r, double *K, double *Qh,
+                                                double *Bh, double *S, double *V0, int ldv0);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* PHGMG_MPI && !PHGMG_NO_OFFLINE */
 
 /* >>linalg ================================================================ */
 /* Dense linear algebra on column-major double matrices (offline half).
@@ -18779,6 +19060,854 @@ PHGMG_DEF phgmg_result phgmg_npy_write(const char *path, const double *A, int ro
 }
 #endif /* PHGMG_NO_STDIO */
 #endif /* PHGMG_NO_OFFLINE */
+
+/* >>mpi (implementation) ================================================= */
+#if defined(PHGMG_MPI) && !defined(PHGMG_NO_OFFLINE)
+#define PHGMG__MPI_TAG 7907
+#define PHGMG__GIDX_MAX 9223372036854775807LL
+
+PHGMG_DEF phgmg_result phgmg_mpi_agree(MPI_Comm comm, phgmg_result rc) {
+  int v = (int)rc, out = (int)rc;
+  MPI_Allreduce(&v, &out, 1, MPI_INT, MPI_MIN, comm);
+  return (phgmg_result)out;
+}
+
+/* rc agreed over the context's ranks (ctx not NULL). */
+PHGMG__PRIV phgmg_result phgmg__mpi_agree(const phgmg_mpi_ctx *ctx, phgmg_result rc) {
+  return phgmg_mpi_agree(ctx->comm, rc);
+}
+
+/* The ld of a local block: at least one, at least nloc. */
+PHGMG__PRIV int phgmg__mpi_ld_ok(const phgmg_mpi_ctx *ctx, int ld) { return ld >= PHGMG__MAX(1, ctx->nloc); }
+
+/* The rank owning global row g (0 <= g < N): the last q with starts[q] <= g
+   (empty blocks before it start at the same offset and are skipped). */
+PHGMG__PRIV int phgmg__mpi_owner(const phgmg_mpi_ctx *ctx, phgmg_gidx g) {
+  int lo = 0, hi = ctx->size - 1;
+  while (lo < hi) {
+    const int mid = lo + (hi - lo + 1) / 2;
+    if (ctx->starts[mid] <= g) lo = mid; else hi = mid - 1;
+  }
+  return lo;
+}
+
+PHGMG_DEF phgmg_result phgmg_mpi_ctx_create(phgmg_mpi_ctx **ctx, MPI_Comm comm, phgmg_gidx N, phgmg_gidx row0,
+                                            int nloc, const phgmg_allocator *alloc) {
+  phgmg_gidx mine[3], *all = NULL;
+  phgmg_mpi_ctx *c = NULL;
+  int size = 0, rank = 0, q;
+  phgmg_result rc = PHGMG_OK;
+  MPI_Comm_size(comm, &size);
+  MPI_Comm_rank(comm, &rank);
+  if (ctx) *ctx = NULL;
+  if (!ctx) rc = PHGMG_ERR_INVALID_ARG;
+  else if (N < 1 || nloc < 0 || row0 < 0 || row0 > N - nloc) rc = PHGMG_ERR_SIZE;
+  if (rc == PHGMG_OK) {
+    c = PHGMG__CAST(phgmg_mpi_ctx *, phgmg__alloc(alloc, sizeof *c));
+    all = PHGMG__CAST(phgmg_gidx *, phgmg__alloc(alloc, (size_t)(3 * size + 1) * sizeof(phgmg_gidx)));
+    if (!c || !all) rc = PHGMG_ERR_NOMEM;
+  }
+  rc = phgmg_mpi_agree(comm, rc);
+  if (rc == PHGMG_OK) {
+    mine[0] = row0; mine[1] = nloc; mine[2] = N;
+    MPI_Allgather(mine, 3, MPI_LONG_LONG, all, 3, MPI_LONG_LONG, comm);
+    /* every rank checks the same gathered layout: the verdict agrees */
+    for (q = 0; q < size && rc == PHGMG_OK; ++q) {
+      const phgmg_gidx start = q ? all[3 * (q - 1)] + all[3 * (q - 1) + 1] : 0;
+      if (all[3 * q + 2] != N || all[3 * q] != start) rc = PHGMG_ERR_SIZE;
+    }
+    if (rc == PHGMG_OK && all[3 * (size - 1)] + all[3 * (size - 1) + 1] != N) rc = PHGMG_ERR_SIZE;
+  }
+  if (rc != PHGMG_OK) {
+    phgmg__free(alloc, c);
+    phgmg__free(alloc, all);
+    return rc;
+  }
+  memset(c, 0, sizeof *c);
+  MPI_Comm_dup(comm, &c->comm);
+  c->rank = rank; c->size = size; c->N = N; c->row0 = row0; c->nloc = nloc;
+  if (alloc) c->al = *alloc;
+  for (q = 0; q < size; ++q) all[q] = all[3 * q];   /* compact into the offsets (q <= 3q) */
+  all[size] = N;
+  c->starts = all;
+  *ctx = c;
+  return PHGMG_OK;
+}
+
+PHGMG_DEF void phgmg_mpi_ctx_destroy(phgmg_mpi_ctx *ctx) {
+  phgmg_allocator al;
+  if (!ctx) return;
+  al = ctx->al;
+  MPI_Comm_free(&ctx->comm);
+  phgmg__free(&al, ctx->starts);
+  phgmg__free(&al, ctx);
+}
+
+/* out (n) = the sum over the ranks of in (n), identical on every rank: a
+   reduction to rank 0 and a broadcast (an allreduce may round differently
+   on different ranks). */
+PHGMG__PRIV void phgmg__mpi_sum(const phgmg_mpi_ctx *ctx, int n, const double *in, double *out) {
+  MPI_Reduce(in, out, n, MPI_DOUBLE, MPI_SUM, 0, ctx->comm);
+  MPI_Bcast(out, n, MPI_DOUBLE, 0, ctx->comm);
+}
+
+PHGMG_DEF phgmg_result phgmg_mpi_atb(const phgmg_mpi_ctx *ctx, int ka, int kb, const double *A, int lda,
+                                     const double *B, int ldb, double *C, int ldc) {
+  const phgmg_allocator *al;
+  double *loc = NULL;
+  phgmg_result rc = PHGMG_OK;
+  int j;
+  if (!ctx) return PHGMG_ERR_INVALID_ARG;
+  al = &ctx->al;
+  if (ka < 0 || kb < 0 || !phgmg__mpi_ld_ok(ctx, lda) || !phgmg__mpi_ld_ok(ctx, ldb) || ldc < PHGMG__MAX(1, ka))
+    rc = PHGMG_ERR_SIZE;
+  else if (!C || (ctx->nloc > 0 && ka > 0 && kb > 0 && (!A || !B))) rc = PHGMG_ERR_INVALID_ARG;
+  else if (!(loc = phgmg__dalloc(al, 2 * (size_t)ka * kb))) rc = PHGMG_ERR_NOMEM;
+  rc = phgmg__mpi_agree(ctx, rc);
+  if (rc != PHGMG_OK || ka == 0 || kb == 0) { phgmg__free(al, loc); return rc; }
+  if (ctx->nloc > 0) phgmg_gemm('T', 'N', ka, kb, ctx->nloc, 1.0, A, lda, B, ldb, 0.0, loc, ka);
+  else memset(loc, 0, (size_t)ka * kb * sizeof(double));
+  phgmg__mpi_sum(ctx, ka * kb, loc, loc + (size_t)ka * kb);
+  for (j = 0; j < kb; ++j) memcpy(C + (size_t)j * ldc, loc + (size_t)ka * kb + (size_t)j * ka, (size_t)ka * sizeof(double));
+  phgmg__free(al, loc);
+  return PHGMG_OK;
+}
+
+/* Local QR of X (n x ns, n >= 1) into W (n x ns, ld n: the explicit Q in
+   the first kq = min(n, ns) columns) and Rl (ns x ns, ld ns, zero below the
+   diagonal and below row kq). Tall blocks go by a flat tree: chunks of
+   about PHGMG__MPI_CHUNK rows (at least ns) factored each in cache, their
+   R factors stacked and factored again, each chunk's Q times its block of
+   the second Q (the unblocked Householder QR of the whole block would
+   stream it from memory once per column). */
+#define PHGMG__MPI_CHUNK 4096
+PHGMG__PRIV phgmg_result phgmg__mpi_local_qr(int n, int ns, const double *X, int ldx, double *W, double *Rl,
+                                             const phgmg_allocator *al) {
+  const int nc = n / PHGMG__MAX(PHGMG__MPI_CHUNK, ns), kq = PHGMG__MIN(n, ns), ms = PHGMG__MAX(nc, 1) * ns;
+  const int cmax = n / PHGMG__MAX(nc, 1) + 1;
+  double *S2 = phgmg__dalloc(al, (size_t)ms * ns + 2 * (size_t)ns + (nc > 1 ? (size_t)cmax * ns : 0));
+  double *tau, *work, *T;
+  int i, j, c;
+  phgmg_result rc = S2 ? PHGMG_OK : PHGMG_ERR_NOMEM;
+  if (rc != PHGMG_OK) return rc;
+  tau = S2 + (size_t)ms * ns; work = tau + ns; T = work + ns;
+  for (j = 0; j < ns; ++j) memcpy(W + (size_t)j * n, X + (size_t)j * ldx, (size_t)n * sizeof(double));
+  memset(Rl, 0, (size_t)ns * ns * sizeof(double));
+  if (nc <= 1) {
+    rc = phgmg_qr(n, ns, W, n, tau);
+    for (j = 0; j < ns && rc == PHGMG_OK; ++j)
+      for (i = 0; i <= j && i < kq; ++i) Rl[i + (size_t)j * ns] = W[i + (size_t)j * n];
+    if (rc == PHGMG_OK) phgmg_qr_form_q(n, kq, W, n, tau, work);
+    phgmg__free(al, S2);
+    return rc;
+  }
+  memset(S2, 0, (size_t)ms * ns * sizeof(double));
+  for (c = 0; c < nc && rc == PHGMG_OK; ++c) {   /* chunk c: rows r0 .. r0 + nb - 1 (nb >= ns) */
+    const int r0 = (int)((long long)n * c / nc), nb = (int)((long long)n * (c + 1) / nc) - r0;
+    rc = phgmg_qr(nb, ns, W + r0, n, tau);
+    for (j = 0; j < ns && rc == PHGMG_OK; ++j)
+      for (i = 0; i <= j; ++i) S2[c * ns + i + (size_t)j * ms] = W[r0 + i + (size_t)j * n];
+    if (rc == PHGMG_OK) phgmg_qr_form_q(nb, ns, W + r0, n, tau, work);
+  }
+  if (rc == PHGMG_OK) rc = phgmg_qr(ms, ns, S2, ms, tau);
+  if (rc == PHGMG_OK) {
+    for (j = 0; j < ns; ++j)
+      for (i = 0; i <= j; ++i) Rl[i + (size_t)j * ns] = S2[i + (size_t)j * ms];
+    phgmg_qr_form_q(ms, ns, S2, ms, tau, work);
+    for (c = 0; c < nc; ++c) {
+      const int r0 = (int)((long long)n * c / nc), nb = (int)((long long)n * (c + 1) / nc) - r0;
+      phgmg_gemm('N', 'N', nb, ns, ns, 1.0, W + r0, n, S2 + (size_t)c * ns, ms, 0.0, T, nb);
+      for (j = 0; j < ns; ++j) memcpy(W + r0 + (size_t)j * n, T + (size_t)j * nb, (size_t)nb * sizeof(double));
+    }
+  }
+  phgmg__free(al, S2);
+  return rc;
+}
+
+/* The TSQR kernel. W (nloc x ns, ld max(1, nloc)) receives X's local
+   Householder QR with its explicit Q in the first kq = min(nloc, ns)
+   columns; R (ns x ns) the global triangular factor (diagonal >= 0); Q2
+   (ns x ns) this rank's block of the stacked factors' Q (rows 0..kq-1 are
+   used): X = W(:, 0:kq) Q2(0:kq, :) R. ws: (size + 2) ns^2 + 3 ns doubles. */
+PHGMG__PRIV phgmg_result phgmg__mpi_tsqr_core(const phgmg_mpi_ctx *ctx, int ns, const double *X, int ldx, double *W,
+                                              double *R, double *Q2, double *ws) {
+  const int n = ctx->nloc, P = ctx->size, ms = P * ns;
+  double *Rl = ws, *Sg = Rl + (size_t)ns * ns, *S = Sg + (size_t)ms * ns, *tau = S + (size_t)ms * ns;
+  double *work = tau + ns;
+  phgmg_result rc = PHGMG_OK;
+  int i, j, q;
+  memset(Rl, 0, (size_t)ns * ns * sizeof(double));
+  if (n > 0) rc = phgmg__mpi_local_qr(n, ns, X, ldx, W, Rl, &ctx->al);
+  rc = phgmg__mpi_agree(ctx, rc);
+  if (rc != PHGMG_OK) return rc;
+  MPI_Allgather(Rl, ns * ns, MPI_DOUBLE, Sg, ns * ns, MPI_DOUBLE, ctx->comm);
+  for (q = 0; q < P; ++q)   /* stack the R factors: rows q ns .. q ns + ns - 1 */
+    for (j = 0; j < ns; ++j)
+      memcpy(S + (size_t)q * ns + (size_t)j * ms, Sg + (size_t)q * ns * ns + (size_t)j * ns, (size_t)ns * sizeof(double));
+  rc = phgmg_qr(ms, ns, S, ms, tau);   /* the same data on every rank: the same R */
+  if (rc != PHGMG_OK) return rc;
+  for (j = 0; j < ns; ++j)
+    for (i = 0; i < ns; ++i) R[i + (size_t)j * ns] = i <= j ? S[i + (size_t)j * ms] : 0.0;
+  phgmg_qr_form_q(ms, ns, S, ms, tau, work);
+  for (j = 0; j < ns; ++j)
+    memcpy(Q2 + (size_t)j * ns, S + (size_t)ctx->rank * ns + (size_t)j * ms, (size_t)ns * sizeof(double));
+  for (i = 0; i < ns; ++i)   /* sign convention: R(i, i) >= 0 */
+    if (R[i + (size_t)i * ns] < 0.0) {
+      for (j = i; j < ns; ++j) R[i + (size_t)j * ns] = -R[i + (size_t)j * ns];
+      for (j = 0; j < ns; ++j) Q2[j + (size_t)i * ns] = -Q2[j + (size_t)i * ns];
+    }
+  return PHGMG_OK;
+}
+
+/* Doubles of workspace for phgmg__mpi_tsqr_core (and W). */
+PHGMG__PRIV size_t phgmg__mpi_tsqr_ws(const phgmg_mpi_ctx *ctx, int ns) {
+  return ((size_t)ctx->size + 1) * ns * ns + (size_t)ctx->size * ns * ns + 3 * (size_t)ns;
+}
+
+PHGMG_DEF phgmg_result phgmg_mpi_tsqr(const phgmg_mpi_ctx *ctx, int ns, const double *X, int ldx, double *Q,
+                                      int ldq, double *R, int ldr) {
+  const phgmg_allocator *al;
+  double *W = NULL, *Rs, *Q2;
+  phgmg_result rc = PHGMG_OK;
+  int n, j;
+  if (!ctx) return PHGMG_ERR_INVALID_ARG;
+  al = &ctx->al; n = ctx->nloc;
+  if (ns < 1 || !phgmg__mpi_ld_ok(ctx, ldx) || (Q && !phgmg__mpi_ld_ok(ctx, ldq)) || ldr < ns) rc = PHGMG_ERR_SIZE;
+  else if (!R || (n > 0 && !X)) rc = PHGMG_ERR_INVALID_ARG;
+  else if (!(W = phgmg__dalloc(al, (size_t)PHGMG__MAX(1, n) * ns + 2 * (size_t)ns * ns + phgmg__mpi_tsqr_ws(ctx, ns))))
+    rc = PHGMG_ERR_NOMEM;
+  rc = phgmg__mpi_agree(ctx, rc);
+  if (rc != PHGMG_OK) { phgmg__free(al, W); return rc; }
+  Rs = W + (size_t)PHGMG__MAX(1, n) * ns; Q2 = Rs + (size_t)ns * ns;
+  rc = phgmg__mpi_tsqr_core(ctx, ns, X, ldx, W, Rs, Q2, Q2 + (size_t)ns * ns);
+  if (rc == PHGMG_OK) {
+    for (j = 0; j < ns; ++j) memcpy(R + (size_t)j * ldr, Rs + (size_t)j * ns, (size_t)ns * sizeof(double));
+    if (Q && n > 0) phgmg_gemm('N', 'N', n, ns, PHGMG__MIN(n, ns), 1.0, W, n, Q2, ns, 0.0, Q, ldq);
+  }
+  phgmg__free(al, W);
+  return rc;
+}
+
+/* V (nloc x k) = W(:, 0:kq) Q2(0:kq, :) U(:, 0:k): the left singular vectors
+   from the TSQR factors and R's singular vectors U (ns x k). T: kq x k. */
+PHGMG__PRIV void phgmg__mpi_tsqr_vectors(const phgmg_mpi_ctx *ctx, int ns, const double *W, const double *Q2,
+                                         const double *U, int k, double *T, double *V, int ldv) {
+  const int n = ctx->nloc, kq = PHGMG__MIN(n, ns);
+  if (n == 0 || k == 0) return;
+  phgmg_gemm('N', 'N', kq, k, ns, 1.0, Q2, ns, U, ns, 0.0, T, kq);
+  phgmg_gemm('N', 'N', n, k, kq, 1.0, W, n, T, kq, 0.0, V, ldv);
+}
+
+PHGMG_DEF phgmg_result phgmg_mpi_pod(const phgmg_mpi_ctx *ctx, int ns, const double *X, int ldx, int kmax,
+                                     double tol, double *V, int ldv, double *S, int *k_out) {
+  const phgmg_allocator *al;
+  double *W = NULL, *R, *Q2, *U, *s, *T, *ws;
+  phgmg_result rc = PHGMG_OK;
+  int n, k = 0, rank = 0, i;
+  if (!ctx) return PHGMG_ERR_INVALID_ARG;
+  al = &ctx->al; n = ctx->nloc;
+  if (ns < 1 || kmax < 1 || (phgmg_gidx)kmax > ctx->N || kmax > ns || !phgmg__mpi_ld_ok(ctx, ldx) ||
+      !phgmg__mpi_ld_ok(ctx, ldv))
+    rc = PHGMG_ERR_SIZE;
+  else if (!V || !k_out || (n > 0 && !X) || tol != tol) rc = PHGMG_ERR_INVALID_ARG;
+  else if (!(W = phgmg__dalloc(al, (size_t)PHGMG__MAX(1, n) * ns + 2 * (size_t)ns * ns + (size_t)ns * kmax +
+                                       (size_t)kmax + (size_t)ns * kmax + phgmg__mpi_tsqr_ws(ctx, ns))))
+    rc = PHGMG_ERR_NOMEM;
+  rc = phgmg__mpi_agree(ctx, rc);
+  if (rc != PHGMG_OK) { phgmg__free(al, W); return rc; }
+  R = W + (size_t)PHGMG__MAX(1, n) * ns; Q2 = R + (size_t)ns * ns; U = Q2 + (size_t)ns * ns;
+  s = U + (size_t)ns * kmax; T = s + kmax; ws = T + (size_t)ns * kmax;
+  rc = phgmg__mpi_tsqr_core(ctx, ns, X, ldx, W, R, Q2, ws);
+  /* the same R on every rank: the same SVD, no communication */
+  if (rc == PHGMG_OK) rc = phgmg_svd(ns, ns, R, ns, kmax, s, U, ns, NULL, 1, &k, &rank, al);
+  if (rc == PHGMG_OK) {
+    if (tol > 0.0)
+      for (i = 0; i < k; ++i)
+        if (!(s[i] > tol * s[0])) { k = i; break; }
+    phgmg__mpi_tsqr_vectors(ctx, ns, W, Q2, U, k, T, V, ldv);
+    for (i = 0; i < k && S; ++i) S[i] = s[i];
+    *k_out = k;
+  }
+  phgmg__free(al, W);
+  return rc;
+}
+
+/* ---- streaming POD ---------------------------------------------------------- */
+struct phgmg_mpi_pod_stream {
+  const phgmg_mpi_ctx *ctx;
+  int kmax, k;
+  double tol, discarded;
+  double *V, *S;   /* nloc x kmax (ld max(1, nloc)), kmax */
+};
+
+PHGMG_DEF phgmg_result phgmg_mpi_pod_stream_begin(phgmg_mpi_pod_stream **st, const phgmg_mpi_ctx *ctx, int kmax,
+                                                  double tol) {
+  phgmg_mpi_pod_stream *s = NULL;
+  phgmg_result rc = PHGMG_OK;
+  if (!ctx) return PHGMG_ERR_INVALID_ARG;
+  if (st) *st = NULL;
+  if (!st || tol != tol || tol < 0.0 || tol >= 1.0) rc = PHGMG_ERR_INVALID_ARG;
+  else if (kmax < 1 || (phgmg_gidx)kmax > ctx->N) rc = PHGMG_ERR_SIZE;
+  else if (!(s = PHGMG__CAST(phgmg_mpi_pod_stream *, phgmg__alloc(&ctx->al, sizeof *s)))) rc = PHGMG_ERR_NOMEM;
+  else if (!(s->V = phgmg__dalloc(&ctx->al, (size_t)PHGMG__MAX(1, ctx->nloc) * kmax + (size_t)kmax))) {
+    phgmg__free(&ctx->al, s);
+    s = NULL;
+    rc = PHGMG_ERR_NOMEM;
+  }
+  rc = phgmg__mpi_agree(ctx, rc);
+  if (rc != PHGMG_OK) {
+    if (s) { phgmg__free(&ctx->al, s->V); phgmg__free(&ctx->al, s); }
+    return rc;
+  }
+  s->ctx = ctx; s->kmax = kmax; s->k = 0; s->tol = tol; s->discarded = 0.0;
+  s->S = s->V + (size_t)PHGMG__MAX(1, ctx->nloc) * kmax;
+  *st = s;
+  return PHGMG_OK;
+}
+
+/* Res (nloc x nb) -= V C with C = V^T Res, twice; Cs (k x nb) = the sum of
+   both coefficient blocks, Ct: k x nb scratch. */
+PHGMG__PRIV phgmg_result phgmg__mpi_stream_project(const phgmg_mpi_pod_stream *s, int nb, double *Res, double *Cs,
+                                                   double *Ct) {
+  const int n = s->ctx->nloc, ld = PHGMG__MAX(1, n), k = s->k;
+  int pass, i;
+  phgmg_result rc = PHGMG_OK;
+  memset(Cs, 0, (size_t)k * nb * sizeof(double));
+  for (pass = 0; pass < 2 && rc == PHGMG_OK && k > 0; ++pass) {
+    rc = phgmg_mpi_atb(s->ctx, k, nb, s->V, ld, Res, ld, Ct, k);
+    if (rc != PHGMG_OK) break;
+    if (n > 0) phgmg_gemm('N', 'N', n, nb, k, -1.0, s->V, ld, Ct, k, 1.0, Res, ld);
+    for (i = 0; i < k * nb; ++i) Cs[i] += Ct[i];
+  }
+  return rc;
+}
+
+/* The new basis and values from the SVD of M = [[diag(S), C], [0, Rb]]
+   (K2 x K2, K2 = k + nb): V <- [V, Qb] Um(:, 0:knew), truncated to kmax and
+   tol; the dropped values into s->discarded. sv, Um: K2, K2 x K2; Vn: nloc x kmax. */
+PHGMG__PRIV phgmg_result phgmg__mpi_stream_update(phgmg_mpi_pod_stream *s, int nb, const double *M, const double *Qb,
+                                                  double *sv, double *Um, double *Vn) {
+  const int n = s->ctx->nloc, ld = PHGMG__MAX(1, n), k = s->k, K2 = k + nb;
+  int kk = 0, rank = 0, knew, i;
+  double drop = 0.0;
+  phgmg_result rc = phgmg_svd(K2, K2, M, K2, K2, sv, Um, K2, NULL, 1, &kk, &rank, &s->ctx->al);
+  if (rc != PHGMG_OK) return rc;
+  knew = PHGMG__MIN(kk, s->kmax);
+  if (s->tol > 0.0)
+    for (i = 0; i < knew; ++i)
+      if (!(sv[i] > s->tol * sv[0])) { knew = i; break; }
+  for (i = knew; i < kk; ++i) drop += sv[i] * sv[i];
+  s->discarded += sqrt(drop);
+  if (n > 0 && knew > 0) {
+    if (k > 0) phgmg_gemm('N', 'N', n, knew, k, 1.0, s->V, ld, Um, K2, 0.0, Vn, ld);
+    phgmg_gemm('N', 'N', n, knew, nb, 1.0, Qb, ld, Um + k, K2, k > 0 ? 1.0 : 0.0, Vn, ld);
+    memcpy(s->V, Vn, (size_t)ld * knew * sizeof(double));
+  }
+  for (i = 0; i < knew; ++i) s->S[i] = sv[i];
+  s->k = knew;
+  return PHGMG_OK;
+}
+
+PHGMG_DEF phgmg_result phgmg_mpi_pod_stream_add(phgmg_mpi_pod_stream *st, int nb, const double *Xb, int ldx) {
+  const phgmg_mpi_ctx *ctx;
+  const phgmg_allocator *al;
+  double *Res = NULL, *W, *Cs, *Ct, *Rb, *Q2, *M, *sv, *Um, *Vn, *ws;
+  phgmg_result rc = PHGMG_OK;
+  int n, ld, k, K2, i, j;
+  if (!st) return PHGMG_ERR_INVALID_ARG;
+  ctx = st->ctx; al = &ctx->al; n = ctx->nloc; ld = PHGMG__MAX(1, n); k = st->k; K2 = k + nb;
+  if (nb < 1 || !phgmg__mpi_ld_ok(ctx, ldx)) rc = PHGMG_ERR_SIZE;
+  else if (n > 0 && !Xb) rc = PHGMG_ERR_INVALID_ARG;
+  else if (!(Res = phgmg__dalloc(al, 2 * (size_t)ld * nb + 2 * (size_t)k * nb + 2 * (size_t)nb * nb +
+                                         (size_t)K2 * K2 * 2 + (size_t)K2 + (size_t)ld * st->kmax +
+                                         phgmg__mpi_tsqr_ws(ctx, nb))))
+    rc = PHGMG_ERR_NOMEM;
+  rc = phgmg__mpi_agree(ctx, rc);
+  if (rc != PHGMG_OK) { phgmg__free(al, Res); return rc; }
+  W = Res + (size_t)ld * nb; Cs = W + (size_t)ld * nb; Ct = Cs + (size_t)k * nb; Rb = Ct + (size_t)k * nb;
+  Q2 = Rb + (size_t)nb * nb; M = Q2 + (size_t)nb * nb; Um = M + (size_t)K2 * K2; sv = Um + (size_t)K2 * K2;
+  Vn = sv + K2; ws = Vn + (size_t)ld * st->kmax;
+  for (j = 0; j < nb && n > 0; ++j) memcpy(Res + (size_t)j * ld, Xb + (size_t)j * ldx, (size_t)n * sizeof(double));
+  rc = phgmg__mpi_stream_project(st, nb, Res, Cs, Ct);
+  if (rc == PHGMG_OK) rc = phgmg__mpi_tsqr_core(ctx, nb, Res, ld, W, Rb, Q2, ws);
+  if (rc == PHGMG_OK) {
+    if (n > 0) phgmg_gemm('N', 'N', n, nb, PHGMG__MIN(n, nb), 1.0, W, ld, Q2, nb, 0.0, Res, ld);   /* Qb */
+    memset(M, 0, (size_t)K2 * K2 * sizeof(double));
+    for (i = 0; i < k; ++i) M[i + (size_t)i * K2] = st->S[i];
+    for (j = 0; j < nb; ++j) {
+      for (i = 0; i < k; ++i) M[i + (size_t)(k + j) * K2] = Cs[i + (size_t)j * k];
+      for (i = 0; i <= j; ++i) M[k + i + (size_t)(k + j) * K2] = Rb[i + (size_t)j * nb];
+    }
+    rc = phgmg__mpi_stream_update(st, nb, M, Res, sv, Um, Vn);
+  }
+  phgmg__free(al, Res);
+  return rc;
+}
+
+PHGMG_DEF phgmg_result phgmg_mpi_pod_stream_end(phgmg_mpi_pod_stream *st, double *V, int ldv, double *S,
+                                                int *k_out, double *discarded) {
+  int j, n;
+  if (!st || !V || !k_out) return PHGMG_ERR_INVALID_ARG;
+  n = st->ctx->nloc;
+  if (!phgmg__mpi_ld_ok(st->ctx, ldv)) return PHGMG_ERR_SIZE;
+  for (j = 0; j < st->k && n > 0; ++j)
+    memcpy(V + (size_t)j * ldv, st->V + (size_t)j * n, (size_t)n * sizeof(double));
+  for (j = 0; j < st->k && S; ++j) S[j] = st->S[j];
+  *k_out = st->k;
+  if (discarded) *discarded = st->discarded;
+  return PHGMG_OK;
+}
+
+PHGMG_DEF void phgmg_mpi_pod_stream_destroy(phgmg_mpi_pod_stream *st) {
+  const phgmg_allocator *al;
+  if (!st) return;
+  al = &st->ctx->al;
+  phgmg__free(al, st->V);
+  phgmg__free(al, st);
+}
+
+/* ---- DEIM -------------------------------------------------------------------- */
+/* (value, global index) pairs, maximum with ties to the lower index. */
+typedef struct phgmg__mpi_vi {
+  double v;
+  phgmg_gidx i;
+} phgmg__mpi_vi;
+PHGMG__PRIV void phgmg__mpi_maxloc_fn(void *in, void *inout, int *len, MPI_Datatype *dt) {
+  const phgmg__mpi_vi *a = PHGMG__CAST(const phgmg__mpi_vi *, in);
+  phgmg__mpi_vi *b = PHGMG__CAST(phgmg__mpi_vi *, inout);
+  int j;
+  (void)dt;
+  for (j = 0; j < *len; ++j)
+    if (a[j].v > b[j].v || (a[j].v == b[j].v && a[j].i < b[j].i)) b[j] = a[j];
+}
+
+/* The global row of largest |r| (r: this rank's nloc entries), ties to the
+   lower global index. *vmax its value (-1 if N = 0). */
+PHGMG__PRIV phgmg_gidx phgmg__mpi_argmax(const phgmg_mpi_ctx *ctx, const double *r, MPI_Datatype t, MPI_Op op,
+                                         double *vmax) {
+  phgmg__mpi_vi loc, glob;
+  int i;
+  loc.v = -1.0; loc.i = PHGMG__GIDX_MAX;
+  for (i = 0; i < ctx->nloc; ++i)
+    if (fabs(r[i]) > loc.v) { loc.v = fabs(r[i]); loc.i = ctx->row0 + i; }
+  MPI_Allreduce(&loc, &glob, 1, t, op, ctx->comm);
+  *vmax = glob.v;
+  return glob.i;
+}
+
+/* Point l of greedy DEIM: c = (P^T U_{<l})^{-1} P^T u_l from Pr (rows of U
+   at the points, k x k), the residual into res, its argmax into pts[l] and
+   that row of U (broadcast by its owner) into Pr. */
+PHGMG__PRIV phgmg_result phgmg__mpi_deim_point(const phgmg_mpi_ctx *ctx, int k, const double *U, int ldu, int l,
+                                               phgmg_gidx *pts, double *Pr, double *res, double *LU, int *ipiv,
+                                               MPI_Datatype t, MPI_Op op) {
+  double *c = LU + (size_t)k * k, vmax;
+  int i, j, a, owner;
+  for (i = 0; i < ctx->nloc; ++i) res[i] = U[i + (size_t)l * ldu];
+  if (l > 0) {
+    for (j = 0; j < l; ++j) {
+      for (i = 0; i < l; ++i) LU[i + (size_t)j * l] = Pr[i + (size_t)j * k];
+      c[j] = Pr[j + (size_t)l * k];
+    }
+    if (phgmg_lu_factor(l, LU, l, ipiv) != PHGMG_OK) return PHGMG_ERR_SINGULAR;   /* same data everywhere */
+    phgmg_lu_solve('N', l, LU, l, ipiv, 1, c, l);
+    for (j = 0; j < l; ++j)
+      for (i = 0; i < ctx->nloc; ++i) res[i] -= U[i + (size_t)j * ldu] * c[j];
+  }
+  pts[l] = phgmg__mpi_argmax(ctx, res, t, op, &vmax);
+  if (!(vmax > 0.0) || pts[l] < 0 || pts[l] >= ctx->N) return PHGMG_ERR_SINGULAR;
+  for (j = 0; j < l; ++j)
+    if (pts[j] == pts[l]) return PHGMG_ERR_SINGULAR;
+  owner = phgmg__mpi_owner(ctx, pts[l]);
+  if (owner == ctx->rank)
+    for (a = 0; a < k; ++a) c[a] = U[(pts[l] - ctx->row0) + (size_t)a * ldu];
+  MPI_Bcast(c, k, MPI_DOUBLE, owner, ctx->comm);
+  for (a = 0; a < k; ++a) Pr[l + (size_t)a * k] = c[a];
+  return PHGMG_OK;
+}
+
+/* DEIM weights: Pr^T w = U^T sw. buf: nloc + k doubles. */
+PHGMG__PRIV phgmg_result phgmg__mpi_deim_weights(const phgmg_mpi_ctx *ctx, int k, const double *U, int ldu,
+                                                 const double *sw, const double *Pr, double *LU, int *ipiv,
+                                                 double *buf, double *w) {
+  const int n = ctx->nloc;
+  int i;
+  phgmg_result rc;
+  for (i = 0; i < n; ++i) buf[i] = sw ? sw[i] : 1.0;
+  rc = phgmg_mpi_atb(ctx, k, 1, U, ldu, buf, PHGMG__MAX(1, n), w, k);
+  if (rc != PHGMG_OK) return rc;
+  memcpy(LU, Pr, (size_t)k * k * sizeof(double));
+  if (phgmg_lu_factor(k, LU, k, ipiv) != PHGMG_OK) return PHGMG_ERR_SINGULAR;
+  phgmg_lu_solve('T', k, LU, k, ipiv, 1, w, k);
+  return phgmg__all_finite(w, (size_t)k) ? PHGMG_OK : PHGMG_ERR_SINGULAR;
+}
+
+PHGMG_DEF phgmg_result phgmg_mpi_deim_greedy(const phgmg_mpi_ctx *ctx, int k, const double *U, int ldu,
+                                             const double *sw, phgmg_gidx *pts, double *w) {
+  const phgmg_allocator *al;
+  double *Pr = NULL, *res, *LU;
+  int *ipiv = NULL, l, n;
+  MPI_Datatype t;
+  MPI_Op op;
+  phgmg_result rc = PHGMG_OK;
+  if (!ctx) return PHGMG_ERR_INVALID_ARG;
+  al = &ctx->al; n = ctx->nloc;
+  if (k < 1 || (phgmg_gidx)k > ctx->N || !phgmg__mpi_ld_ok(ctx, ldu)) rc = PHGMG_ERR_SIZE;
+  else if (!pts || (n > 0 && !U)) rc = PHGMG_ERR_INVALID_ARG;
+  else if (n > 0 && !phgmg__mat_finite(n, k, U, ldu)) rc = PHGMG_ERR_NANINF;
+  else {
+    Pr = phgmg__dalloc(al, 2 * (size_t)k * k + (size_t)k + (size_t)n + (size_t)k);
+    ipiv = phgmg__ialloc(al, (size_t)k);
+    if (!Pr || !ipiv) rc = PHGMG_ERR_NOMEM;
+  }
+  rc = phgmg__mpi_agree(ctx, rc);
+  if (rc != PHGMG_OK) { phgmg__free(al, Pr); phgmg__free(al, ipiv); return rc; }
+  LU = Pr + (size_t)k * k; res = LU + (size_t)k * k + k;
+  MPI_Type_contiguous((int)sizeof(phgmg__mpi_vi), MPI_BYTE, &t);
+  MPI_Type_commit(&t);
+  MPI_Op_create(phgmg__mpi_maxloc_fn, 1, &op);
+  for (l = 0; l < k && rc == PHGMG_OK; ++l) rc = phgmg__mpi_deim_point(ctx, k, U, ldu, l, pts, Pr, res, LU, ipiv, t, op);
+  if (rc == PHGMG_OK && w) rc = phgmg__mpi_deim_weights(ctx, k, U, ldu, sw, Pr, LU, ipiv, res, w);
+  MPI_Op_free(&op);
+  MPI_Type_free(&t);
+  phgmg__free(al, Pr);
+  phgmg__free(al, ipiv);
+  return rc;
+}
+
+/* ---- distributed sparse operator ------------------------------------------------ */
+struct phgmg_mpi_op {
+  const phgmg_mpi_ctx *ctx;
+  int nhalo;              /* columns owned elsewhere, sorted by global index   */
+  size_t *rp;             /* nloc + 1 row offsets                             */
+  int *cl;                /* local columns: < nloc own, nloc + h halo entry h */
+  double *va;
+  int nrecv, nsend;       /* neighbours received from / sent to               */
+  int *rrank, *roff;      /* halo entries [roff[q], roff[q+1]) from rrank[q]  */
+  int *srank, *soff, *sidx; /* own rows sidx[soff[q] .. soff[q+1]) to srank[q] */
+};
+
+PHGMG__PRIV int phgmg__mpi_gidx_cmp(const void *a, const void *b) {
+  const phgmg_gidx x = *PHGMG__CAST(const phgmg_gidx *, a), y = *PHGMG__CAST(const phgmg_gidx *, b);
+  return (x > y) - (x < y);
+}
+
+PHGMG_DEF void phgmg_mpi_op_destroy(phgmg_mpi_op *op) {
+  const phgmg_allocator *al;
+  if (!op) return;
+  al = &op->ctx->al;
+  phgmg__free(al, op->rp); phgmg__free(al, op->cl); phgmg__free(al, op->va);
+  phgmg__free(al, op->rrank); phgmg__free(al, op->srank); phgmg__free(al, op->sidx);
+  phgmg__free(al, op);
+}
+
+PHGMG_DEF void phgmg_mpi_op_info(const phgmg_mpi_op *op, int *nhalo, int *nneighbours) {
+  if (nhalo) *nhalo = op ? op->nhalo : 0;
+  if (nneighbours) *nneighbours = op ? PHGMG__MAX(op->nrecv, op->nsend) : 0;
+}
+
+/* Checks this rank's CSR and copies it into op (columns still global, in
+   hg: nnz entries); the sorted distinct halo columns into hg[0 .. nhalo). */
+PHGMG__PRIV phgmg_result phgmg__mpi_op_copy(phgmg_mpi_op *op, const phgmg_gidx *rowptr, const phgmg_gidx *col,
+                                            const double *val, phgmg_gidx *hg) {
+  const phgmg_mpi_ctx *ctx = op->ctx;
+  const int n = ctx->nloc;
+  const size_t nnz = (size_t)rowptr[n];
+  size_t e, nh = 0;
+  int i;
+  for (i = 0; i < n; ++i) {
+    op->rp[i] = (size_t)rowptr[i];
+    if (rowptr[i + 1] < rowptr[i]) return PHGMG_ERR_SIZE;
+  }
+  op->rp[n] = nnz;
+  for (e = 0; e < nnz; ++e) {
+    const phgmg_gidx g = col[e];
+    if (g < 0 || g >= ctx->N) return PHGMG_ERR_SIZE;
+    if (!(val[e] - val[e] == 0.0)) return PHGMG_ERR_NANINF;
+    op->va[e] = val[e];
+    if (g < ctx->row0 || g >= ctx->row0 + n) hg[nh++] = g;
+  }
+  if (nh > 1) qsort(hg, nh, sizeof *hg, phgmg__mpi_gidx_cmp);
+  op->nhalo = 0;
+  for (e = 0; e < nh; ++e)
+    if (e == 0 || hg[e] != hg[e - 1]) hg[op->nhalo++] = hg[e];
+  for (e = 0; e < nnz; ++e) {   /* local column numbers */
+    const phgmg_gidx g = col[e];
+    if (g >= ctx->row0 && g < ctx->row0 + n) op->cl[e] = (int)(g - ctx->row0);
+    else {
+      const phgmg_gidx *f = PHGMG__CAST(const phgmg_gidx *, bsearch(&g, hg, (size_t)op->nhalo, sizeof *hg,
+                                                                    phgmg__mpi_gidx_cmp));
+      op->cl[e] = n + (int)(f - hg);
+    }
+  }
+  return PHGMG_OK;
+}
+
+/* The neighbour lists from the counts of entries received from (cr) and
+   sent to (cs) each rank; sg (sum cs) the global rows requested from us. */
+PHGMG__PRIV phgmg_result phgmg__mpi_op_lists(phgmg_mpi_op *op, const int *cr, const int *cs, const phgmg_gidx *sg) {
+  const phgmg_mpi_ctx *ctx = op->ctx;
+  const phgmg_allocator *al = &ctx->al;
+  int q, nr = 0, ns = 0, tot = 0, i;
+  for (q = 0; q < ctx->size; ++q) { nr += cr[q] > 0; ns += cs[q] > 0; tot += cs[q]; }
+  op->rrank = phgmg__ialloc(al, 2 * (size_t)nr + 1);
+  op->srank = phgmg__ialloc(al, 2 * (size_t)ns + 1);
+  op->sidx = phgmg__ialloc(al, (size_t)tot);
+  if (!op->rrank || !op->srank || !op->sidx) return PHGMG_ERR_NOMEM;
+  op->roff = op->rrank + nr; op->soff = op->srank + ns;
+  op->roff[0] = op->soff[0] = 0;
+  for (q = 0; q < ctx->size; ++q) {
+    if (cr[q] > 0) { op->rrank[op->nrecv] = q; op->roff[op->nrecv + 1] = op->roff[op->nrecv] + cr[q]; op->nrecv++; }
+    if (cs[q] > 0) { op->srank[op->nsend] = q; op->soff[op->nsend + 1] = op->soff[op->nsend] + cs[q]; op->nsend++; }
+  }
+  for (i = 0; i < tot; ++i) {
+    if (sg[i] < ctx->row0 || sg[i] >= ctx->row0 + ctx->nloc) return PHGMG_ERR_SIZE;
+    op->sidx[i] = (int)(sg[i] - ctx->row0);
+  }
+  return PHGMG_OK;
+}
+
+/* The halo plan: who owns each halo column (cr), what each rank wants from
+   us (one Alltoall of counts, one Alltoallv of global indices). hg: the
+   sorted halo columns. */
+PHGMG__PRIV phgmg_result phgmg__mpi_op_plan(phgmg_mpi_op *op, const phgmg_gidx *hg) {
+  const phgmg_mpi_ctx *ctx = op->ctx;
+  const phgmg_allocator *al = &ctx->al;
+  const int P = ctx->size;
+  int *cr = phgmg__ialloc(al, 4 * (size_t)P), *cs, *dr, *ds, q, h, tot = 0;
+  phgmg_gidx *sg = NULL;
+  phgmg_result rc = cr ? PHGMG_OK : PHGMG_ERR_NOMEM;
+  rc = phgmg__mpi_agree(ctx, rc);
+  if (rc != PHGMG_OK) { phgmg__free(al, cr); return rc; }
+  cs = cr + P; dr = cs + P; ds = dr + P;
+  for (q = 0; q < P; ++q) cr[q] = 0;
+  for (h = 0; h < op->nhalo; ++h) cr[phgmg__mpi_owner(ctx, hg[h])]++;
+  MPI_Alltoall(cr, 1, MPI_INT, cs, 1, MPI_INT, ctx->comm);
+  for (q = 0; q < P; ++q) { dr[q] = q ? dr[q - 1] + cr[q - 1] : 0; ds[q] = tot; tot += cs[q]; }
+  sg = PHGMG__CAST(phgmg_gidx *, phgmg__alloc(al, (size_t)PHGMG__MAX(tot, 1) * sizeof(phgmg_gidx)));
+  rc = phgmg__mpi_agree(ctx, sg ? PHGMG_OK : PHGMG_ERR_NOMEM);
+  if (rc == PHGMG_OK) {
+    MPI_Alltoallv(hg, cr, dr, MPI_LONG_LONG, sg, cs, ds, MPI_LONG_LONG, ctx->comm);
+    rc = phgmg__mpi_agree(ctx, phgmg__mpi_op_lists(op, cr, cs, sg));
+  }
+  phgmg__free(al, sg);
+  phgmg__free(al, cr);
+  return rc;
+}
+
+PHGMG_DEF phgmg_result phgmg_mpi_op_create(phgmg_mpi_op **op, const phgmg_mpi_ctx *ctx, const phgmg_gidx *rowptr,
+                                           const phgmg_gidx *col, const double *val) {
+  const phgmg_allocator *al;
+  phgmg_mpi_op *o = NULL;
+  phgmg_gidx *hg = NULL, nnz = 0;
+  phgmg_result rc = PHGMG_OK;
+  if (!ctx) return PHGMG_ERR_INVALID_ARG;
+  al = &ctx->al;
+  if (op) *op = NULL;
+  if (!op || !rowptr) rc = PHGMG_ERR_INVALID_ARG;
+  else if (rowptr[0] != 0 || (nnz = rowptr[ctx->nloc]) < 0 || nnz > 2147483647LL) rc = PHGMG_ERR_SIZE;
+  else if (nnz > 0 && (!col || !val)) rc = PHGMG_ERR_INVALID_ARG;
+  else if (!(o = PHGMG__CAST(phgmg_mpi_op *, phgmg__alloc(al, sizeof *o)))) rc = PHGMG_ERR_NOMEM;
+  if (o) {
+    memset(o, 0, sizeof *o);
+    o->ctx = ctx;
+    o->rp = PHGMG__CAST(size_t *, phgmg__alloc(al, ((size_t)ctx->nloc + 1) * sizeof(size_t)));
+    o->cl = phgmg__ialloc(al, (size_t)nnz);
+    o->va = phgmg__dalloc(al, (size_t)nnz);
+    hg = PHGMG__CAST(phgmg_gidx *, phgmg__alloc(al, (size_t)PHGMG__MAX(nnz, 1) * sizeof(phgmg_gidx)));
+    rc = (o->rp && o->cl && o->va && hg) ? phgmg__mpi_op_copy(o, rowptr, col, val, hg) : PHGMG_ERR_NOMEM;
+  }
+  rc = phgmg__mpi_agree(ctx, rc);
+  if (rc == PHGMG_OK) rc = phgmg__mpi_op_plan(o, hg);
+  phgmg__free(al, hg);
+  if (rc != PHGMG_OK) { phgmg_mpi_op_destroy(o); return rc; }
+  *op = o;
+  return PHGMG_OK;
+}
+
+/* The halo values H (nhalo x k) of X (nloc x k) from the neighbours. buf:
+   k (soff[nsend] + nhalo) doubles; req: nrecv + nsend requests. */
+PHGMG__PRIV void phgmg__mpi_op_exchange(const phgmg_mpi_op *op, int k, const double *X, int ldx, double *H,
+                                        double *buf, MPI_Request *req) {
+  const int nh = op->nhalo;
+  double *sb = buf, *rb = buf + (size_t)k * op->soff[op->nsend];
+  int q, j, i;
+  for (q = 0; q < op->nrecv; ++q) {
+    const int c = op->roff[q + 1] - op->roff[q];
+    MPI_Irecv(rb + (size_t)k * op->roff[q], c * k, MPI_DOUBLE, op->rrank[q], PHGMG__MPI_TAG, op->ctx->comm, req + q);
+  }
+  for (q = 0; q < op->nsend; ++q) {
+    const int c = op->soff[q + 1] - op->soff[q];
+    double *b = sb + (size_t)k * op->soff[q];
+    for (j = 0; j < k; ++j)
+      for (i = 0; i < c; ++i) b[i + (size_t)j * c] = X[op->sidx[op->soff[q] + i] + (size_t)j * ldx];
+    MPI_Isend(b, c * k, MPI_DOUBLE, op->srank[q], PHGMG__MPI_TAG, op->ctx->comm, req + op->nrecv + q);
+  }
+  MPI_Waitall(op->nrecv + op->nsend, req, MPI_STATUSES_IGNORE);
+  for (q = 0; q < op->nrecv; ++q) {
+    const int c = op->roff[q + 1] - op->roff[q];
+    const double *b = rb + (size_t)k * op->roff[q];
+    for (j = 0; j < k; ++j)
+      for (i = 0; i < c; ++i) H[op->roff[q] + i + (size_t)j * nh] = b[i + (size_t)j * c];
+  }
+}
+
+PHGMG_DEF phgmg_result phgmg_mpi_op_apply(const phgmg_mpi_op *op, int k, const double *X, int ldx, double *Y,
+                                          int ldy) {
+  const phgmg_mpi_ctx *ctx;
+  const phgmg_allocator *al;
+  double *H = NULL;
+  MPI_Request *req = NULL;
+  phgmg_result rc = PHGMG_OK;
+  int n, i, j;
+  size_t e;
+  if (!op) return PHGMG_ERR_INVALID_ARG;
+  ctx = op->ctx; al = &ctx->al; n = ctx->nloc;
+  if (k < 0 || !phgmg__mpi_ld_ok(ctx, ldx) || !phgmg__mpi_ld_ok(ctx, ldy)) rc = PHGMG_ERR_SIZE;
+  else if (n > 0 && k > 0 && (!X || !Y)) rc = PHGMG_ERR_INVALID_ARG;
+  else {
+    H = phgmg__dalloc(al, (size_t)k * (2 * (size_t)op->nhalo + (size_t)op->soff[op->nsend]));
+    req = PHGMG__CAST(MPI_Request *, phgmg__alloc(al, (size_t)(op->nrecv + op->nsend + 1) * sizeof(MPI_Request)));
+    if (!H || !req) rc = PHGMG_ERR_NOMEM;
+  }
+  rc = phgmg__mpi_agree(ctx, rc);
+  if (rc == PHGMG_OK && k > 0) {
+    phgmg__mpi_op_exchange(op, k, X, ldx, H, H + (size_t)k * op->nhalo, req);
+    for (j = 0; j < k; ++j)
+      for (i = 0; i < n; ++i) {
+        double s = 0.0;
+        for (e = op->rp[i]; e < op->rp[i + 1]; ++e) {
+          const int c = op->cl[e];
+          s += op->va[e] * (c < n ? X[c + (size_t)j * ldx] : H[(c - n) + (size_t)j * op->nhalo]);
+        }
+        Y[i + (size_t)j * ldy] = s;
+      }
+  }
+  phgmg__free(al, H);
+  phgmg__free(al, req);
+  return rc;
+}
+
+PHGMG_DEF phgmg_result phgmg_mpi_op_project(const phgmg_mpi_op *op, int k, const double *V, int ldv, double *Ar,
+                                            int ldar) {
+  const phgmg_allocator *al;
+  double *W = NULL;
+  int ld;
+  phgmg_result rc = PHGMG_OK;
+  if (!op) return PHGMG_ERR_INVALID_ARG;
+  al = &op->ctx->al; ld = PHGMG__MAX(1, op->ctx->nloc);
+  if (k < 1 || ldar < k) rc = PHGMG_ERR_SIZE;
+  else if (!Ar) rc = PHGMG_ERR_INVALID_ARG;
+  else if (!(W = phgmg__dalloc(al, (size_t)ld * k))) rc = PHGMG_ERR_NOMEM;
+  rc = phgmg__mpi_agree(op->ctx, rc);
+  if (rc == PHGMG_OK) rc = phgmg_mpi_op_apply(op, k, V, ldv, W, ld);
+  if (rc == PHGMG_OK) rc = phgmg_mpi_atb(op->ctx, k, k, V, ldv, W, ld, Ar, ldar);
+  phgmg__free(al, W);
+  return rc;
+}
+
+/* ---- distributed GMG-POD of a linear model -------------------------------------- */
+/* V0 (ld max(1, nloc)) = [B, V1]: QB = TSQR(B) (rank checked as the serial
+   reduction does), V1 = the p leading POD modes of X - QB QB^T X; S (p). */
+PHGMG__PRIV phgmg_result phgmg__mpi_gmg_basis(const phgmg_mpi_ctx *ctx, const phgmg_mpi_linear_model *md, int ns,
+                                              const double *X, int ldx, int p, double *V0, double *S) {
+  const int n = ctx->nloc, ld = PHGMG__MAX(1, n), m = md->m;
+  const int kk = (int)PHGMG__MIN((phgmg_gidx)PHGMG__MIN(p + 1, ns), ctx->N);
+  double *QB = phgmg__dalloc(&ctx->al, (size_t)ld * m + (size_t)m * m + (size_t)m * ns + (size_t)ld * ns +
+                                           (size_t)ld * kk + (size_t)kk);
+  double *RB, *C, *Xa, *V1, *s, rmax = 0.0;
+  int j, k = 0;
+  phgmg_result rc = phgmg__mpi_agree(ctx, QB ? PHGMG_OK : PHGMG_ERR_NOMEM);
+  if (rc != PHGMG_OK) { phgmg__free(&ctx->al, QB); return rc; }
+  RB = QB + (size_t)ld * m; C = RB + (size_t)m * m; Xa = C + (size_t)m * ns; V1 = Xa + (size_t)ld * ns;
+  s = V1 + (size_t)ld * kk;
+  rc = phgmg_mpi_tsqr(ctx, m, md->B, md->ldb, QB, ld, RB, m);
+  for (j = 0; j < m && rc == PHGMG_OK; ++j) rmax = PHGMG__MAX(rmax, fabs(RB[j + j * m]));
+  for (j = 0; j < m && rc == PHGMG_OK; ++j)
+    if (!(fabs(RB[j + j * m]) > 1e3 * PHGMG__EPS * (double)ctx->N * rmax)) rc = PHGMG_ERR_RANK;
+  if (rc == PHGMG_OK) rc = phgmg_mpi_atb(ctx, m, ns, QB, ld, X, ldx, C, m);   /* C = QB^T X */
+  if (rc == PHGMG_OK) {
+    for (j = 0; j < ns && n > 0; ++j) memcpy(Xa + (size_t)j * ld, X + (size_t)j * ldx, (size_t)n * sizeof(double));
+    if (n > 0) phgmg_gemm('N', 'N', n, ns, m, -1.0, QB, ld, C, m, 1.0, Xa, ld);
+    rc = phgmg_mpi_pod(ctx, ns, Xa, ld, kk, 0.0, V1, ld, s, &k);
+  }
+  if (rc == PHGMG_OK && k < p) rc = PHGMG_ERR_SIZE;   /* r - m beyond the numerical rank */
+  if (rc == PHGMG_OK) {
+    for (j = 0; j < m && n > 0; ++j) memcpy(V0 + (size_t)j * ld, md->B + (size_t)j * md->ldb, (size_t)n * sizeof(double));
+    if (n > 0) memcpy(V0 + (size_t)m * ld, V1, (size_t)ld * p * sizeof(double));
+    memcpy(S, s, (size_t)p * sizeof(double));
+  }
+  phgmg__free(&ctx->al, QB);
+  return rc;
+}
+
+/* K = G00^{-1} after the non-degeneracy check of G00 with B's columns scaled
+   to unit length (norms bn, m). work: 3 r^2 + 2 r doubles. */
+PHGMG__PRIV phgmg_result phgmg__mpi_gmg_invert(int r, int m, const double *G00, const double *bn, double *K,
+                                               double *work, int *iwork, const phgmg_allocator *al) {
+  double *Gs = work, *rw = Gs + (size_t)r * r;
+  int i, j;
+  for (j = 0; j < r; ++j)
+    for (i = 0; i < r; ++i)
+      Gs[i + (size_t)j * r] = G00[i + (size_t)j * r] / ((i < m ? bn[i] : 1.0) * (j < m ? bn[j] : 1.0));
+  {
+    const double a1 = phgmg_norm1(r, r, Gs, r);
+    if (phgmg_lu_factor(r, Gs, r, iwork) != PHGMG_OK) return PHGMG_ERR_DEGENERATE;
+    if (!(phgmg_lu_rcond(r, Gs, r, iwork, a1, rw, iwork + r) >= 1e-12)) return PHGMG_ERR_DEGENERATE;
+  }
+  return phgmg__inv(r, G00, K, al);
+}
+
+PHGMG_DEF phgmg_result phgmg_mpi_gmg_pod_linear(const phgmg_mpi_ctx *ctx, const phgmg_mpi_linear_model *model,
+                                                int ns, const double *X, int ldx, int r, double *K, double *Qh,
+                                                double *Bh, double *S, double *V0, int ldv0) {
+  const phgmg_allocator *al;
+  double *Vb = NULL, *GV, *G00, *s, *bn, *work;
+  int *iwork = NULL, n, ld, m, p, i, j;
+  phgmg_result rc = PHGMG_OK;
+  if (!ctx) return PHGMG_ERR_INVALID_ARG;
+  al = &ctx->al; n = ctx->nloc; ld = PHGMG__MAX(1, n);
+  if (!model || !model->Q || !model->solve || !K || !Qh || !Bh || (n > 0 && (!X || !model->B)) ||
+      model->Q->ctx != ctx)
+    rc = PHGMG_ERR_INVALID_ARG;
+  else if ((m = model->m) < 1 || r <= m || (phgmg_gidx)r > ctx->N || ns < 1 || r - m > ns ||
+           !phgmg__mpi_ld_ok(ctx, model->ldb) || !phgmg__mpi_ld_ok(ctx, ldx) || (V0 && !phgmg__mpi_ld_ok(ctx, ldv0)))
+    rc = PHGMG_ERR_SIZE;
+  else {
+    Vb = phgmg__dalloc(al, 2 * (size_t)ld * r + 4 * (size_t)r * r + 3 * (size_t)r + (size_t)m * m);
+    iwork = phgmg__ialloc(al, 2 * (size_t)r);
+    if (!Vb || !iwork) rc = PHGMG_ERR_NOMEM;
+  }
+  rc = phgmg__mpi_agree(ctx, rc);
+  if (rc != PHGMG_OK) { phgmg__free(al, Vb); phgmg__free(al, iwork); return rc; }
+  m = model->m; p = r - m;
+  GV = Vb + (size_t)ld * r; G00 = GV + (size_t)ld * r; s = G00 + (size_t)r * r; bn = s + r;
+  work = bn + (size_t)m * m;
+  rc = phgmg__mpi_gmg_basis(ctx, model, ns, X, ldx, p, Vb, s);
+  if (rc == PHGMG_OK) {   /* GV = (J - R)^{-1} V0 by the user's solve */
+    memcpy(GV, Vb, (size_t)ld * r * sizeof(double));
+    rc = phgmg__mpi_agree(ctx, model->solve('N', r, GV, ld, model->solve_user));
+  }
+  if (rc == PHGMG_OK) rc = phgmg_mpi_atb(ctx, r, r, Vb, ld, GV, ld, G00, r);
+  if (rc == PHGMG_OK) rc = phgmg_mpi_atb(ctx, m, m, Vb, ld, Vb, ld, bn, m);
+  if (rc == PHGMG_OK) {
+    for (j = 0; j < m; ++j) bn[j] = sqrt(bn[j + (size_t)j * m]);   /* j <= j m: in place */
+    rc = phgmg__mpi_gmg_invert(r, m, G00, bn, K, work, iwork, al);   /* replicated data: replicated verdict */
+  }
+  if (rc == PHGMG_OK) rc = phgmg_mpi_op_project(model->Q, r, Vb, ld, Qh, r);
+  if (rc == PHGMG_OK) {
+    phgmg__symmetrize(r, Qh);
+    for (j = 0; j < m; ++j)
+      for (i = 0; i < r; ++i) Bh[i + (size_t)j * r] = i == j ? 1.0 : 0.0;
+    for (i = 0; i < p && S; ++i) S[i] = s[i];
+    for (j = 0; j < r && V0 && n > 0; ++j) memcpy(V0 + (size_t)j * ldv0, Vb + (size_t)j * ld, (size_t)n * sizeof(double));
+  }
+  phgmg__free(al, Vb);
+  phgmg__free(al, iwork);
+  return rc;
+}
+
+#endif /* PHGMG_MPI && !PHGMG_NO_OFFLINE */
 
 /* >>linalg (implementation) ============================================== */
 #ifndef PHGMG_NO_OFFLINE
