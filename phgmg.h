@@ -264,7 +264,9 @@
    such that sum_k dw_k Cd_k rho_k(s_k) matches sum_k Cd_k rho_k(s_k) on the
    training forces, s_k = c_k^T z(x_j) at the snapshots. Non-negative weights
    keep every kept term dissipative, so the hyper-reduced model is
-   port-Hamiltonian too.
+   port-Hamiltonian too. (The command line does not set it for dampers: its
+   reduced models keep every damper; its hyper-reduction options apply to
+   the separable terms.)
    Not for damper models: model files and C export of a model
    with callback laws (PHGMG_ERR_UNSUPPORTED; polynomial laws are saved,
    format version 3, and exported), the step map, the studies' fast path

@@ -90,7 +90,8 @@ static const char *const help_lines[] = {
   "                      (index one; index two or more, or a singular pencil, is an\n",
   "                      error naming the files): the model is condensed to its\n",
   "                      differential states (a port on a constraint becomes\n",
-  "                      feedthrough), simulated with consistent states and reduced;\n",
+  "                      feedthrough, which gmg-qm and --ref do not take: gmg-pod,\n",
+  "                      sp1, sp2 without --ref), simulated with consistent states and reduced;\n",
   "                      written states are full (basis rows of the algebraic\n",
   "                      variables zero).\n",
   "  --P FILE, --S FILE, --N FILE   feedthrough (N x m, m x m, m x m; each optional):\n",
@@ -103,8 +104,9 @@ static const char *const help_lines[] = {
   "                      z = Q x the co-state, e.g. a velocity) with the force\n",
   "                      c1 s + c3 s^3, c1, c3 >= 0 (a damper that generates energy is\n",
   "                      refused): E x' = (J - R) z - sum_k c_k (c1 s_k + c3 s_k^3) + B u.\n",
-  "                      Methods gmg-pod, sp1, sp2; the reduced model keeps the dampers\n",
-  "                      (W_z^T c_k), hyper-reduced to a weighted subset unless --no-hyper.\n",
+  "                      Methods gmg-pod, sp1, sp2 (without --ref); the reduced model\n",
+  "                      keeps every damper (W_z^T c_k; online cost O(k r)): the\n",
+  "                      hyper-reduction options apply to the --poly terms only.\n",
   "  --X FILE            snapshot matrix N x ns (ns >= 2 states, one per column; a\n",
   "                      trajectory x(t_0), ..., x(t_n), normally starting at x = 0).\n",
   "                      Repeatable (up to 16): one training run per file, the runs'\n",
@@ -426,11 +428,28 @@ static int parse_double(const char *opt, const char *s, double lo, double *out) 
     return 0;
   }
   if (errno || end == s || *end || !isfinite(v) || v < lo) {
-    usage_error("%s: expected a finite number >= %g, got '%s'", opt, lo, s);
+    if (lo == -HUGE_VAL) usage_error("%s: expected a finite number, got '%s'", opt, s);
+    else usage_error("%s: expected a finite number >= %g, got '%s'", opt, lo, s);
     return 0;
   }
   *out = v;
   return 1;
+}
+
+/* A value the reduced model's scalar type holds: the float build's online
+   path (simulate-rom, the step map) is float, so 0 or a normal float. 0, or
+   1 after a usage message. */
+static int real_bad(const char *opt, const char *s, double v) {
+#ifdef PHGMG_REAL_FLOAT
+  if (v != 0.0 && !(fabs(v) >= (double)FLT_MIN && fabs(v) <= (double)FLT_MAX)) {
+    usage_error("%s: '%s' is not representable in float, the scalar type of this build's reduced model (0 or "
+                "%g <= |x| <= %g)", opt, s, (double)FLT_MIN, (double)FLT_MAX);
+    return 1;
+  }
+#else
+  (void)opt; (void)s; (void)v;
+#endif
+  return 0;
 }
 
 /* Each option once: 1 (after a usage message) if o was seen before in this
@@ -1101,6 +1120,18 @@ static const char *num_str(double v, char *buf) {
   snprintf(buf, 32, "%.17g", v);
   return buf;
 }
+/* v as the shortest %.6g..%.9g that reads back exactly as the scalar type of
+   the build (float: 0.1f is "0.1", not 0.10000000149011612). */
+static const char *real_str(phgmg_real v, char *buf) {
+  int prec;
+  if (sizeof(phgmg_real) == sizeof(double)) return num_str((double)v, buf);
+  for (prec = 6; prec < 9; ++prec) {
+    snprintf(buf, 32, "%.*g", prec, (double)v);
+    if ((phgmg_real)strtod(buf, NULL) == v) return buf;
+  }
+  snprintf(buf, 32, "%.9g", (double)v);
+  return buf;
+}
 /* A JSON number; null for NaN/Inf. */
 static void json_num(FILE *f, double v) {
   char buf[32];
@@ -1386,7 +1417,8 @@ static int check_hyper_opts(const reduce_args *A, const char *const *seen, int n
   for (k = 0; all[k]; ++k)
     if (given(all[k], seen, nseen) && !A->poly_idx)
       return usage_error("reduce: %s applies to a nonlinear part (--poly, --exp or --potential with --poly-idx); "
-                         "this model has none", all[k]);
+                         "this model has none%s", all[k],
+                         A->dampf ? " (the dampers of --dampers are not hyper-reduced: every damper is kept)" : "");
   for (k = 0; k < 4; ++k)
     if (A->no_deim && given(all[k], seen, nseen))
       return usage_error("reduce: --no-hyper keeps every nonlinear term: %s does not apply", all[k]);
@@ -1485,7 +1517,7 @@ static int parse_reduce(int argc, char **argv, reduce_args *A) {
       else return usage_error("--manifold '%s': expected pod, greedy or altmin", v);
     }
     else if (!strcmp(o, "--dt-map")) {
-      if (!(v = optval(argc, argv, &i)) || !parse_double(o, v, 0.0, &A->dt_map)) return 2;
+      if (!(v = optval(argc, argv, &i)) || !parse_double(o, v, 0.0, &A->dt_map) || real_bad(o, v, A->dt_map)) return 2;
       A->have_dt_map = 1;
     }
     else if (!strcmp(o, "--simulate")) A->simulate = 1;
@@ -2185,6 +2217,40 @@ static int load_dampers(const reduce_args *A, reduce_state *S, phgmg_ph_system *
   return 0;
 }
 
+/* Which condition of the feedthrough failed (rc: phgmg_ph_validate's code),
+   naming the files given: N not skew, S not symmetric or not positive
+   semidefinite, or P too large for R and S. 1 after the message. */
+static int explain_feedthrough(const reduce_args *A, const reduce_state *S, phgmg_result rc) {
+  char files[3 * 4096 + 8] = "", opts[32] = "", why[256];
+  const char *const fl[3] = {A->Pf, A->Sf, A->Nf}, *const ol[3] = {"--P", "--S", "--N"};
+  const int m = S->B.cols;
+  int k;
+  for (k = 0; k < 3; ++k)
+    if (fl[k]) {
+      snprintf(files + strlen(files), sizeof files - strlen(files), "%s%s", files[0] ? ", " : "", fl[k]);
+      snprintf(opts + strlen(opts), sizeof opts - strlen(opts), "%s%s", opts[0] ? ", " : "", ol[k]);
+    }
+  if (rc != PHGMG_ERR_FEEDTHROUGH) return fail("%s (%s): %s", files, opts, phgmg_result_string(rc));
+  if (A->Nf && sym_defect(S->Nm.a, m, 1.0) > 1e-12)
+    snprintf(why, sizeof why, "N is not skew-symmetric (||N + N^T||_F / ||N||_F = %.3g)", sym_defect(S->Nm.a, m, 1.0));
+  else if (A->Sf && sym_defect(S->Sm.a, m, -1.0) > 1e-12)
+    snprintf(why, sizeof why, "S is not symmetric (||S - S^T||_F / ||S||_F = %.3g)", sym_defect(S->Sm.a, m, -1.0));
+  else {
+    double w[64], c[64 * 64];
+    int i;
+    if (A->Sf && m <= 64) {
+      for (i = 0; i < m * m; ++i) c[i] = S->Sm.a[i];
+      if (phgmg_sym_eig(m, c, m, w, NULL, 0) == PHGMG_OK && w[0] < -1e-12 * PHGMG__MAX(fabs(w[0]), fabs(w[m - 1]))) {
+        snprintf(why, sizeof why, "S is not positive semidefinite (smallest eigenvalue %.3g)", w[0]);
+        return fail("%s (%s): the feedthrough is not valid: %s", files, opts, why);
+      }
+    }
+    snprintf(why, sizeof why, "[[R, P], [P^T, S]] is not positive semidefinite: P is too large for the "
+             "dissipation R and S (a port's P needs damping R where P acts and S on the port)");
+  }
+  return fail("%s (%s): the feedthrough is not valid: %s", files, opts, why);
+}
+
 /* The full model from the files: dense or sparse J, R, Q, B and the nonlinear
    part, checked (phgmg_ph_validate), into S->sys. */
 static int condense_algebraic(reduce_state *S);
@@ -2269,8 +2335,7 @@ static int load_system(const reduce_args *A, reduce_state *S) {
     return fail("%s (--dampers): %s%s", A->dampf, phgmg_result_string(rc),
                 rc == PHGMG_ERR_DAMPER ? " (c1 and c3 must be >= 0)" : rc == PHGMG_ERR_SIZE ? " (banded storage: |i - j| beyond the band)" : "");
   if (rc == PHGMG_ERR_FEEDTHROUGH || (rc == PHGMG_ERR_UNSUPPORTED && (sys.P || sys.S || sys.Nskew)))
-    return fail("%s%s%s%s%s (--P, --S, --N): %s", A->Pf ? A->Pf : "", A->Sf ? " " : "", A->Sf ? A->Sf : "",
-                A->Nf ? " " : "", A->Nf ? A->Nf : "", phgmg_result_string(rc));
+    return explain_feedthrough(A, S, rc);
   if (rc != PHGMG_OK && sys.E) {
     const char *ef = A->E ? A->E : A->Ecoo, *qf = A->Q ? A->Q : A->Qcoo;
     switch (rc) {
@@ -2309,6 +2374,13 @@ static int condense_algebraic(reduce_state *S) {
     return 0;
   }
   S->sys = *phgmg_dae_system(S->dae);
+  if (S->refm.a) { /* --ref FILE holds full states: its differential part (rotated like the snapshots) */
+    double *t = (double *)malloc(sizeof(double) * (size_t)S->sys.N + 1);
+    if (!t) return fail("out of memory");
+    phgmg_dae_restrict(S->dae, S->refm.a, t);
+    memcpy(S->refm.a, t, sizeof(double) * (size_t)S->sys.N);
+    free(t);
+  }
   progress("algebraic constraints: E singular, %d algebraic equations and variables (index one); condensed to "
            "N = %d differential states%s", phgmg_dae_nalg(S->dae), S->sys.N,
            (S->sys.P || S->sys.S) && !(S->full.P || S->full.S || S->full.Nskew)
@@ -2345,6 +2417,30 @@ static int check_dt_scale(const reduce_args *A, const reduce_state *S) {
                 "beyond what a double resolves (1/eps = %.3g): the stage equations lose the mass term, and the "
                 "output is round-off, flushed to zero or NaN; use --dt <= %.3g", A->dt, A->dt * scale, 1.0 / scale,
                 DT_SCALE_MAX, DT_SCALE_MAX / scale);
+  return 0;
+}
+
+/* What the reduction does not take, explained up front: feedthrough or
+   dampers with gmg-qm or with a reference state (--ref). The feedthrough may
+   be the user's (--P, --S, --N) or come from a port on an algebraic line of
+   E (the condensed model's). 0, or 1 after a message. */
+static int check_extras(const reduce_args *A, const reduce_state *S) {
+  const phgmg_ph_system *c = &S->sys;
+  const int feed = c->P || c->S || c->Nskew, mine = A->Pf || A->Sf || A->Nf;
+  char what[4096 + 160];
+  if (!feed && !c->ndamp) return 0;
+  if (feed && !mine)
+    snprintf(what, sizeof what, "feedthrough from a port on an algebraic line of E (%s: the condensed model "
+             "carries (S + N) u)", A->E ? A->E : A->Ecoo);
+  else if (feed)
+    snprintf(what, sizeof what, "feedthrough (--P, --S, --N)");
+  else
+    snprintf(what, sizeof what, "dampers (--dampers %s)", A->dampf);
+  if (S->method == PHGMG_METHOD_GMG_QM)
+    return fail("gmg-qm does not take %s; use gmg-pod, sp1 or sp2%s", what, A->ref ? " (without --ref)" : "");
+  if (A->ref != PHGMG_REF_NONE)
+    return fail("--ref %s does not go with %s: the reference state's terms are not derived for them; use "
+                "--ref none", A->ref == PHGMG_REF_MEAN ? "mean" : A->ref_file, what);
   return 0;
 }
 
@@ -2524,10 +2620,7 @@ static int run_reduction(const reduce_args *A, reduce_state *S, int method, cons
         return fail("reduction failed: %s (use --deim-allow-negative, a smaller --deim-tol, or --no-hyper)",
                     phgmg_result_string(rc));
       case PHGMG_ERR_UNSUPPORTED:
-        if (A->Pf || A->Sf || A->Nf)
-          return fail("reduction failed: gmg-qm does not take feedthrough (--P, --S, --N); use gmg-pod, sp1 or sp2");
-        if (A->dampf)
-          return fail("reduction failed: gmg-qm does not take --dampers (%s); use gmg-pod, sp1 or sp2", A->dampf);
+        if (check_extras(A, S)) return 1;   /* feedthrough or dampers with gmg-qm or --ref */
         return fail("reduction failed: %s", phgmg_result_string(rc));
       default:
         return fail("reduction failed: %s", phgmg_result_string(rc));
@@ -2726,6 +2819,13 @@ static int write_json(const reduce_args *A, reduce_state *S, int method, int ns,
   json_str(jf, A->J ? A->J : A->Jcoo); fprintf(jf, ", \"R\": "); json_str(jf, A->R ? A->R : A->Rcoo);
   fprintf(jf, ", \"B\": "); json_str(jf, A->B); fprintf(jf, ", \"Q\": "); json_str(jf, A->Q ? A->Q : A->Qcoo);
   if (S->sp) fprintf(jf, ", \"sparse\": true, \"kb\": %d", S->sys.kb);
+  { /* the descriptor, feedthrough and damper files: a model rebuilt from this record is this model */
+    const char *const v[5] = {A->E ? A->E : A->Ecoo, A->Pf, A->Sf, A->Nf, A->dampf};
+    const char *const key[5] = {"E", "P", "S", "N", "dampers"};
+    int k;
+    for (k = 0; k < 5; ++k)
+      if (v[k]) { fprintf(jf, ", \"%s\": ", key[k]); json_str(jf, v[k]); }
+  }
   if (A->poly_idx) {
     if (A->poly) { fprintf(jf, ", \"poly\": "); json_str(jf, A->poly); }
     if (A->expf) { fprintf(jf, ", \"exp\": "); json_str(jf, A->expf); }
@@ -2879,6 +2979,7 @@ static int reduce_prepare(const reduce_args *A, reduce_state *S, const char *con
     return 1;
   if ((e = load_system(A, S)) != 0) return e;
   if ((A->simulate || A->nxin || nt) && check_dt_scale(A, S)) return 1;
+  if (check_extras(A, S)) return 1;
   if ((e = check_sizes(A, S->method, S->sys.N, S->sys.m)) != 0) return e;
   return A->X ? load_snapshot_files(A, S, S->sys.N, S->sys.m, &S->Xd, &S->ns) : 0;
 }
@@ -2965,12 +3066,12 @@ static int parse_simulate_rom(int argc, char **argv, simrom_args *P) {
     else if (!strcmp(o, "--states")) { if (!(P->states = optval(argc, argv, &i))) return 2; }
     else if (!strcmp(o, "--input")) { if (!(P->inspec = optval(argc, argv, &i))) return 2; }
     else if (!strcmp(o, "--dt")) {
-      if (!(v = optval(argc, argv, &i)) || !parse_double(o, v, 0.0, &P->dt)) return 2;
+      if (!(v = optval(argc, argv, &i)) || !parse_double(o, v, 0.0, &P->dt) || real_bad(o, v, P->dt)) return 2;
       if (!(P->dt > 0.0)) return usage_error("--dt must be > 0");
       P->have_dt = 1;
     }
-    else if (!strcmp(o, "--amp")) { if (!(v = optval(argc, argv, &i)) || !parse_double(o, v, -HUGE_VAL, &P->amp)) return 2; }
-    else if (!strcmp(o, "--newton-tol")) { if (!(v = optval(argc, argv, &i)) || !parse_double(o, v, 0.0, &P->newton_tol)) return 2; }
+    else if (!strcmp(o, "--amp")) { if (!(v = optval(argc, argv, &i)) || !parse_double(o, v, -HUGE_VAL, &P->amp) || real_bad(o, v, P->amp)) return 2; }
+    else if (!strcmp(o, "--newton-tol")) { if (!(v = optval(argc, argv, &i)) || !parse_double(o, v, 0.0, &P->newton_tol) || real_bad(o, v, P->newton_tol)) return 2; }
     else if (!strcmp(o, "--steps")) { if (!(v = optval(argc, argv, &i)) || !parse_int(o, v, 1, INT_MAX - 1, &P->steps)) return 2; }
     else if (!strcmp(o, "--newton-iter")) { if (!(v = optval(argc, argv, &i)) || !parse_int(o, v, 1, 1000, &P->newton_iter)) return 2; }
     else if (!strcmp(o, "--quiet")) g_quiet = 1;
@@ -3210,8 +3311,17 @@ static int cmd_info(int argc, char **argv) {
                      rom.nphi > 1 ? ", one function per term" : "");
   if (rom.Phi) {
     char buf[32];
-    printf(", step map for dt = %s", num_str((double)rom.dt, buf));
+    printf(", step map for dt = %s", real_str(rom.dt, buf));
   }
+  if (rom.ndamp) printf(", %d nonlinear dampers (force law degree %d)", rom.ndamp, rom.damp_deg);
+  if (rom.PD) printf(", feedthrough (S + N, %d x %d)", rom.m, rom.m);
+  if (rom.PD)
+    printf("\nfeedthrough: the output y of phgmg_rom_step and phgmg_rom_output leaves out (S + N) u; firmware "
+           "adds (S + N) u(t) itself, S + N the last %d x %d block of the model's PD = [Ph; S + N] "
+           "(simulate-rom does)", rom.m, rom.m);
+  if (rom.ndamp)
+    printf("\ndampers: the model keeps all %d (each evaluation of the reduced forces costs O(%d r)); "
+           "phgmg_rom_step applies them", rom.ndamp, rom.ndamp);
   printf("\nstepper memory: %lu bytes", (unsigned long)phgmg_rom_stepper_memsize(&rom));
   if (rom.Phi) { /* the step map serves its own dt only; another dt needs the Newton workspace */
     const phgmg_real other = rom.dt * (phgmg_real)2;
@@ -3400,7 +3510,8 @@ static int cmd_validate(int argc, char **argv) {
 
 int main(int argc, char **argv) {
   if (argc < 2) {
-    fputs("usage: phgmg reduce ... | phgmg simulate-rom ... | phgmg info MODEL | phgmg validate ... | phgmg --help\n", stderr);
+    fputs("usage: phgmg reduce ... | phgmg validate ... | phgmg simulate ... | phgmg simulate-rom ... | phgmg info MODEL"
+          " | phgmg --help | phgmg --version\n", stderr);
     return 2;
   }
   if (!strcmp(argv[1], "--help") || !strcmp(argv[1], "-h") || !strcmp(argv[1], "help")) {
@@ -3413,6 +3524,6 @@ int main(int argc, char **argv) {
   if (!strcmp(argv[1], "simulate")) return cmd_simulate(argc, argv);
   if (!strcmp(argv[1], "info")) return cmd_info(argc, argv);
   if (!strcmp(argv[1], "validate")) return cmd_validate(argc, argv);
-  return usage_error("unknown command '%s' (expected reduce, validate, simulate-rom, info, --help or --version)",
+  return usage_error("unknown command '%s' (expected reduce, validate, simulate, simulate-rom, info, --help or --version)",
                      argv[1]);
 }

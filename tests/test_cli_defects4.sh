@@ -142,5 +142,73 @@ done
 run_err "reduce --simulate --dt 1e300" 1 "--dt" "$P" reduce $SYS --simulate --dt 1e300 --steps 20 --method gmg-pod --r 4 --out o9
 run_ok "simulate --dt 10 (a large but resolved step)" "$P" simulate $SYS --dt 10 $RUN --out y9.npy
 
+# ---- 4. --ref FILE of an index-one model = --ref mean when it holds the states' mean ----
+# the massless mass's momentum moved to the front (the algebraic variable is not last)
+"$PY" - <<'EOF' || bad "scrambled index-one files"
+import numpy as np
+p = np.array([9, 0, 5, 1, 6, 2, 7, 3, 8, 4])
+for nm in ['J', 'R', 'Q', 'E_alg']:
+    A = np.load(nm + '.npy'); np.save('s' + nm + '.npy', A[np.ix_(p, p)])
+np.save('sB.npy', np.load('B.npy')[p])
+EOF
+SSYS="--J sJ.npy --R sR.npy --Q sQ.npy --B sB.npy --E sE_alg.npy"
+run_ok "simulate: scrambled index one" "$P" simulate $SSYS --steps 40 --out ys.npy --states xs.npy --quiet
+"$PY" -c "import numpy as np; np.save('xbar.npy', np.load('xs.npy').mean(axis=1))" || bad "mean of the states"
+run_ok "reduce --ref mean (index one)" "$P" reduce $SSYS --simulate --steps 40 --method gmg-pod --r 4 --ref mean --out rm --quiet
+run_ok "reduce --ref FILE (index one)" "$P" reduce $SSYS --simulate --steps 40 --method gmg-pod --r 4 --ref xbar.npy --out rf --quiet
+"$PY" - <<'EOF' && pass || bad "--ref FILE of an index-one model differs from --ref mean"
+import numpy as np
+for f in ['K', 'Qh', 'V0']:
+    a = np.load('rm/rom_%s.npy' % f); b = np.load('rf/rom_%s.npy' % f)
+    e = np.abs(a - b).max() / np.abs(a).max()
+    assert e <= 1e-10, (f, e)
+EOF
+
+# ---- 11, 12. what gmg-qm and --ref do not take, named ------------------------------
+run_err "--ref with --S" 1 "--ref mean does not go with feedthrough" "$P" reduce $SYS --method gmg-pod --ref mean --S S.npy $SIM --r 4 --out o11 --quiet
+grep -q "gmg-qm" err.txt && bad "--ref with --S: the message blames gmg-qm" || pass
+run_err "--ref with --dampers" 1 "--ref mean does not go with dampers" "$P" reduce $SYS --method sp1 --ref mean --dampers d.npy $SIM --r 4 --out o11 --quiet
+"$PY" -c "
+import numpy as np
+E = np.eye(10); E[5, 5] = 0.0; np.save('E_port.npy', E)   # mass 1, the port's, massless
+" || bad "E_port"
+run_err "gmg-qm, a port on an algebraic line" 1 "algebraic line of E" "$P" reduce $SYS --E E_port.npy --method gmg-qm $SIM --r 4 --out o12 --quiet
+run_err "--ref, a port on an algebraic line" 1 "algebraic line of E" "$P" reduce $SYS --E E_port.npy --method sp1 --ref mean $SIM --r 4 --out o12 --quiet
+"$P" --help >help.txt
+grep -q "feedthrough, which gmg-qm and --ref do not take" help.txt && pass || bad "--help: no caveat for gmg-qm on a port at a constraint"
+
+# ---- 21. --help does not promise the hyper-reduction of dampers ----------------------
+grep -q "hyper-reduced to a weighted subset" help.txt && bad "--help promises hyper-reduced dampers" || pass
+grep -q "keeps every damper" help.txt && pass || bad "--help: dampers kept whole not said"
+
+# ---- 22. info of a model with dampers and feedthrough; 25. NAME.json names every file ----
+run_ok "reduce with E, S, dampers" "$P" reduce $SYS --E E_mass.npy --S S.npy --dampers d.npy $SIM --method gmg-pod --r 4 --out o22 --quiet
+run_ok "info (dampers, feedthrough)" "$P" info o22/rom.phgmgrom
+grep -q "2 nonlinear dampers" out.txt && pass || bad "info does not say dampers: $(head -n 1 out.txt)"
+grep -q "leaves out (S + N) u" out.txt && pass || bad "info does not say what the output leaves out: $(cat out.txt)"
+"$PY" - <<'EOF' && pass || bad "NAME.json does not record E, S, dampers"
+import json
+s = json.load(open('o22/rom.json'))['system']
+assert s.get('E') == 'E_mass.npy' and s.get('S') == 'S.npy' and s.get('dampers') == 'd.npy', s
+EOF
+
+# ---- 23. usage; 27. feedthrough refusals; 28. --amp nan ------------------------------
+run_err "no arguments" 2 "phgmg simulate ..." "$P"
+run_err "--S not PSD" 1 "S is not positive semidefinite" "$P" simulate $SYS --S S_neg.npy $RUN --out y10.npy
+grep -q "error:  " err.txt && bad "--S not PSD: a stray blank in the message" || pass
+run_err "--N not skew" 1 "N is not skew-symmetric" "$P" simulate $SYS --N N_sym.npy $RUN --out y10.npy
+run_err "--P too large" 1 "P is too large" "$P" simulate $SYS --P P_big.npy $RUN --out y10.npy
+run_err "--amp nan" 2 "expected a finite number, got 'nan'" "$P" simulate $SYS --amp nan $RUN --out y10.npy
+
+# ---- 17. the float build: values float cannot hold; info's dt ------------------------
+if [ -n "$PF" ] && [ -x "$PF" ]; then
+  run_ok "float: reduce" "$PF" reduce $SYS $SIM --method gmg-pod --r 4 --out of --quiet
+  for dt in 1e-300 1e39; do
+    run_err "float: simulate-rom --dt $dt" 2 "not representable in float" "$PF" simulate-rom --model of/rom.phgmgrom --dt $dt --steps 5 --out yf.npy
+  done
+  run_ok "float: info" "$PF" info of/rom.phgmgrom
+  grep -q "step map for dt = 0\.1\$" out.txt && pass || bad "float: info prints dt as $(grep -o 'dt = [0-9.e+-]*' out.txt)"
+fi
+
 echo "test_cli_defects4: $npass passed, $nfail failed"
 [ "$nfail" -eq 0 ]
