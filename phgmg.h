@@ -5433,6 +5433,12 @@ PHGMG__PRIV phgmg_result phgmg__dae_rotate(phgmg_dae *d, const phgmg_ph_system *
   for (i = 0; i < N; ++i) J_t[i + (size_t)i * N] = 0.0;
   phgmg_gemm('T', 'N', N, m, N, 1.0, Qu, N, s->B, N, 0.0, B_t, N);
   if (s->P) phgmg_gemm('T', 'N', N, m, N, 1.0, Qu, N, s->P, N, 0.0, B_t + (size_t)N * m, N);
+  for (j = 0; j < (s->P ? 2 : 1) * m; ++j) {   /* the algebraic rows: a port away from the constraints keeps */
+    double nb = 0.0;                            /* no feedthrough (entries at the rotation's round-off are 0) */
+    for (i = 0; i < N; ++i) nb += B_t[i + (size_t)j * N] * B_t[i + (size_t)j * N];
+    for (i = r; i < N; ++i)
+      if (fabs(B_t[i + (size_t)j * N]) <= 4.0 * N * PHGMG__EPS * sqrt(nb)) B_t[i + (size_t)j * N] = 0.0;
+  }
   *t = *s;
   t->E = E_t; t->J = J_t; t->R = R_t; t->Q = Q_t; t->B = B_t; t->P = s->P ? B_t + (size_t)N * m : NULL;
   return PHGMG_OK;
