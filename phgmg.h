@@ -289,7 +289,10 @@
    the ranges of E and E^T first (from the SVD of E; rank: singular values
    above tol times the largest), E_t = Qu^T E Qv, J_t = Qu^T J Qu, R_t =
    Qu^T R Qu, Q_t = Qu^T Q Qv, B_t = Qu^T B, P_t = Qu^T P -- a congruence,
-   so the structure and E^T Q's properties are kept -- and the differential
+   so the structure and E^T Q's properties are kept; entries of B_t and P_t
+   in the algebraic rows at the rotation's round-off (4 N eps times their
+   column's norm) are set to zero, so a port that acts on no constraint
+   gives no feedthrough -- and the differential
    state is xi = (Qv^T x)[0..n). Other singular E (banded or sparse without
    zero lines, or with a nonlinear part): PHGMG_ERR_E_SINGULAR. With d the
    other rows and columns,
