@@ -232,6 +232,7 @@ if [ -n "$PF" ] && [ -x "$PF" ]; then
   done
   run_ok "float: info" "$PF" info of/rom.phgmgrom
   grep -q "step map for dt = 0\.1\$" out.txt && pass || bad "float: info prints dt as $(grep -o 'dt = [0-9.e+-]*' out.txt)"
+  "$PY" -c "import json; d = json.load(open('of/rom.json'))['dt_map']; assert d == 0.1, d" && pass || bad "float: NAME.json's dt_map is not 0.1"
 fi
 
 echo "test_cli_defects4: $npass passed, $nfail failed"
