@@ -204,6 +204,7 @@ grep -q "feedthrough, which gmg-qm and --ref do not take" help.txt && pass || ba
 # ---- 21. --help does not promise the hyper-reduction of dampers ----------------------
 grep -q "hyper-reduced to a weighted subset" help.txt && bad "--help promises hyper-reduced dampers" || pass
 grep -q "keeps every damper" help.txt && pass || bad "--help: dampers kept whole not said"
+run_err "--no-hyper with dampers only" 2 "dampers of --dampers are not hyper-reduced" "$P" reduce $SYS --dampers d.npy --no-hyper $SIM --method gmg-pod --r 4 --out o21
 
 # ---- 22. info of a model with dampers and feedthrough; 25. NAME.json names every file ----
 run_ok "reduce with E, S, dampers" "$P" reduce $SYS --E E_mass.npy --S S.npy --dampers d.npy $SIM --method gmg-pod --r 4 --out o22 --quiet
