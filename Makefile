@@ -200,6 +200,7 @@ $(BUILD)/phgmg-float: examples/phgmg_cli.c phgmg.h
 
 test-cli: $(BUILD)/phgmg $(BUILD)/phgmg-float
 	sh tests/test_cli.sh $(BUILD)/phgmg $(BUILD)/phgmg-float
+	sh tests/test_cli_defects4.sh $(BUILD)/phgmg $(BUILD)/phgmg-float
 	sh tests/test_simulate.sh $(BUILD)/phgmg
 	/usr/bin/python3 tests/check_dae_bar.py $(BUILD)/phgmg 100 $(BUILD)/dae_bar
 

@@ -265,7 +265,9 @@
    such that sum_k dw_k Cd_k rho_k(s_k) matches sum_k Cd_k rho_k(s_k) on the
    training forces, s_k = c_k^T z(x_j) at the snapshots. Non-negative weights
    keep every kept term dissipative, so the hyper-reduced model is
-   port-Hamiltonian too.
+   port-Hamiltonian too. (The command line does not set it for dampers: its
+   reduced models keep every damper; its hyper-reduction options apply to
+   the separable terms.)
    Not for damper models: model files and C export of a model
    with callback laws (PHGMG_ERR_UNSUPPORTED; polynomial laws are saved,
    format version 3, and exported), the step map, the studies' fast path
@@ -288,7 +290,10 @@
    the ranges of E and E^T first (from the SVD of E; rank: singular values
    above tol times the largest), E_t = Qu^T E Qv, J_t = Qu^T J Qu, R_t =
    Qu^T R Qu, Q_t = Qu^T Q Qv, B_t = Qu^T B, P_t = Qu^T P -- a congruence,
-   so the structure and E^T Q's properties are kept -- and the differential
+   so the structure and E^T Q's properties are kept; entries of B_t and P_t
+   in the algebraic rows at the rotation's round-off (4 N eps times their
+   column's norm) are set to zero, so a port that acts on no constraint
+   gives no feedthrough -- and the differential
    state is xi = (Qv^T x)[0..n). Other singular E (banded or sparse without
    zero lines, or with a nonlinear part): PHGMG_ERR_E_SINGULAR. With d the
    other rows and columns,
@@ -5712,6 +5717,12 @@ PHGMG__PRIV phgmg_result phgmg__dae_rotate(phgmg_dae *d, const phgmg_ph_system *
   for (i = 0; i < N; ++i) J_t[i + (size_t)i * N] = 0.0;
   phgmg_gemm('T', 'N', N, m, N, 1.0, Qu, N, s->B, N, 0.0, B_t, N);
   if (s->P) phgmg_gemm('T', 'N', N, m, N, 1.0, Qu, N, s->P, N, 0.0, B_t + (size_t)N * m, N);
+  for (j = 0; j < (s->P ? 2 : 1) * m; ++j) {   /* the algebraic rows: a port away from the constraints keeps */
+    double nb = 0.0;                            /* no feedthrough (entries at the rotation's round-off are 0) */
+    for (i = 0; i < N; ++i) nb += B_t[i + (size_t)j * N] * B_t[i + (size_t)j * N];
+    for (i = r; i < N; ++i)
+      if (fabs(B_t[i + (size_t)j * N]) <= 4.0 * N * PHGMG__EPS * sqrt(nb)) B_t[i + (size_t)j * N] = 0.0;
+  }
   *t = *s;
   t->E = E_t; t->J = J_t; t->R = R_t; t->Q = Q_t; t->B = B_t; t->P = s->P ? B_t + (size_t)N * m : NULL;
   return PHGMG_OK;

@@ -17,10 +17,12 @@
 #define PHGMG_IMPLEMENTATION
 #include "../phgmg.h"
 #include <errno.h>
+#include <fcntl.h>
 #include <float.h>
 #include <limits.h>
 #include <math.h>
 #include <stdarg.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -88,7 +90,8 @@ static const char *const help_lines[] = {
   "                      (index one; index two or more, or a singular pencil, is an\n",
   "                      error naming the files): the model is condensed to its\n",
   "                      differential states (a port on a constraint becomes\n",
-  "                      feedthrough), simulated with consistent states and reduced;\n",
+  "                      feedthrough, which gmg-qm and --ref do not take: gmg-pod,\n",
+  "                      sp1, sp2 without --ref), simulated with consistent states and reduced;\n",
   "                      written states are full (basis rows of the algebraic\n",
   "                      variables zero).\n",
   "  --P FILE, --S FILE, --N FILE   feedthrough (N x m, m x m, m x m; each optional):\n",
@@ -101,8 +104,9 @@ static const char *const help_lines[] = {
   "                      z = Q x the co-state, e.g. a velocity) with the force\n",
   "                      c1 s + c3 s^3, c1, c3 >= 0 (a damper that generates energy is\n",
   "                      refused): E x' = (J - R) z - sum_k c_k (c1 s_k + c3 s_k^3) + B u.\n",
-  "                      Methods gmg-pod, sp1, sp2; the reduced model keeps the dampers\n",
-  "                      (W_z^T c_k), hyper-reduced to a weighted subset unless --no-hyper.\n",
+  "                      Methods gmg-pod, sp1, sp2 (without --ref); the reduced model\n",
+  "                      keeps every damper (W_z^T c_k; online cost O(k r)): the\n",
+  "                      hyper-reduction options apply to the --poly terms only.\n",
   "  --X FILE            snapshot matrix N x ns (ns >= 2 states, one per column; a\n",
   "                      trajectory x(t_0), ..., x(t_n), normally starting at x = 0).\n",
   "                      Repeatable (up to 16): one training run per file, the runs'\n",
@@ -216,7 +220,9 @@ static const char *const help_lines[] = {
   "                      no Newton iteration at that step). Default: the --dt of\n",
   "                      --simulate, none with --X; 0 = none. A step map with spectral\n",
   "                      radius above 1 (an amplifying step) is refused.\n",
-  "  --out DIR           output directory, created if missing (required).\n",
+  "  --out DIR           output directory (required); created if missing, before\n",
+  "                      any work (and removed again if the run fails); a file is\n",
+  "                      created and removed there first to see that it is writable.\n",
   "  --name NAME         base name of the outputs and C identifier prefix (default rom;\n",
   "                      letters, digits and _, not starting with a digit; not a C/C++\n",
   "                      keyword, not starting with phgmg or _, not a name of the C\n",
@@ -242,8 +248,10 @@ static const char *const help_lines[] = {
   "  A run writes all of these or none: they are written under temporary names and\n",
   "  renamed at the end; the NAME_*.npy arrays that an earlier run listed in its\n",
   "  NAME.json and this run does not produce (another method) are removed. A run\n",
-  "  never writes or removes one of its input files (compared as files, however\n",
-  "  spelled): an output that would be an input is refused before any work.\n",
+  "  never writes or removes one of its input files -- every file option: the\n",
+  "  model's (also --E, --P, --S, --N, --dampers), --X, --ref FILE, input files --\n",
+  "  compared as files (however spelled or linked): an output that would be an\n",
+  "  input is refused before any work (status 2).\n",
   "  The reduced model (LINEAR kind) is x' = K grad H(x) + Bh u, y = Bh^T grad H(x),\n",
   "  H(x) = 1/2 x^T Qh x (+ sum_j w_j phi(P0_j x)); it is again port-Hamiltonian.\n",
   "\n",
@@ -254,6 +262,13 @@ static const char *const help_lines[] = {
   "  --out FILE          output .npy (required; never one of the input files)\n",
   "  --states FILE       also the states (N x (steps+1), the given ordering of the\n",
   "                      coordinates); written together with --out: both or neither\n",
+  "  Before the run: --out and --states must be other files than every input and\n",
+  "  than each other (compared as files, however spelled or linked: status 2), and\n",
+  "  their directories must exist and take a new file. E goes with J, R, Q: --E with\n",
+  "  --J/--R/--Q, --E-coo with --J-coo/--R-coo/--Q-coo. A step beyond what a double\n",
+  "  resolves, dt max|J - R| max|Q| / max|E| > 1/eps = 4.5e15 (the stage equations\n",
+  "  lose the mass term; the output would be round-off, zero or NaN), is refused\n",
+  "  (also by reduce --simulate and validate).\n",
   "  --dt DT, --steps N, --input KIND, --amp AMP, --newton-tol T, --newton-iter K:\n",
   "                      as for reduce --simulate\n",
   "  Sparse input: the log names the solver of the stage systems (band LU, or the\n",
@@ -413,11 +428,28 @@ static int parse_double(const char *opt, const char *s, double lo, double *out) 
     return 0;
   }
   if (errno || end == s || *end || !isfinite(v) || v < lo) {
-    usage_error("%s: expected a finite number >= %g, got '%s'", opt, lo, s);
+    if (lo == -HUGE_VAL) usage_error("%s: expected a finite number, got '%s'", opt, s);
+    else usage_error("%s: expected a finite number >= %g, got '%s'", opt, lo, s);
     return 0;
   }
   *out = v;
   return 1;
+}
+
+/* A value the reduced model's scalar type holds: the float build's online
+   path (simulate-rom, the step map) is float, so 0 or a normal float. 0, or
+   1 after a usage message. */
+static int real_bad(const char *opt, const char *s, double v) {
+#ifdef PHGMG_REAL_FLOAT
+  if (v != 0.0 && !(fabs(v) >= (double)FLT_MIN && fabs(v) <= (double)FLT_MAX)) {
+    usage_error("%s: '%s' is not representable in float, the scalar type of this build's reduced model (0 or "
+                "%g <= |x| <= %g)", opt, s, (double)FLT_MIN, (double)FLT_MAX);
+    return 1;
+  }
+#else
+  (void)opt; (void)s; (void)v;
+#endif
+  return 0;
 }
 
 /* Each option once: 1 (after a usage message) if o was seen before in this
@@ -731,6 +763,31 @@ static void path_fold(const char *path, char *out, size_t cap) {
   if (n == 0 && cap > 1) { out[0] = '/'; out[1] = '\0'; }
 }
 
+static void file_id_make(const char *path, file_id *f);
+
+/* A symbolic link whose target does not exist yet: its target (relative to
+   the link's directory), into out; 0 if path is not such a link. */
+static int dangling_target(const char *path, char *out, size_t cap) {
+  struct stat st;
+  char t[4096];
+  const char *sl = strrchr(path, '/');
+  ssize_t n;
+  if (lstat(path, &st) != 0 || !S_ISLNK(st.st_mode) || stat(path, &st) == 0) return 0;
+  n = readlink(path, t, sizeof t - 1);
+  if (n <= 0) return 0;
+  t[n] = '\0';
+  if (t[0] == '/' || !sl) snprintf(out, cap, "%s", t);
+  else snprintf(out, cap, "%.*s/%s", (int)(sl - path), path, t);
+  return 1;
+}
+
+/* file_id_make, following up to 16 dangling links to the file they will create. */
+static void file_id_follow(const char *path, file_id *f, int depth) {
+  char t[8192];
+  if (depth < 16 && dangling_target(path, t, sizeof t)) file_id_follow(t, f, depth + 1);
+  else file_id_make(path, f);
+}
+
 static void file_id_make(const char *path, file_id *f) {
   struct stat st;
   const char *sl = strrchr(path, '/');
@@ -786,7 +843,7 @@ static void paths_add(pathset *ps, const char *opt, const char *path, int tmp) {
     if (t) memcpy(c + l, ".tmp", 5);
     ps->path[ps->n] = c;
     ps->opt[ps->n] = opt;
-    file_id_make(c, &ps->id[ps->n]);
+    file_id_follow(c, &ps->id[ps->n], 0);
     ps->n++;
   }
 }
@@ -800,7 +857,7 @@ static void paths_add_input(pathset *ps, const char *opt, const char *spec) {
 static int paths_find(const pathset *ps, const char *path) {
   file_id f;
   int k, hit = -1;
-  file_id_make(path, &f);
+  file_id_follow(path, &f, 0);
   for (k = 0; k < ps->n && hit < 0; ++k)
     if (file_id_same(&f, &ps->id[k])) hit = k;
   free(f.s);
@@ -818,8 +875,8 @@ static int check_collisions(const char *cmd, const pathset *in, const pathset *o
   for (i = 0; i < out->n; ++i) {
     for (k = 0; k < in->n; ++k)
       if (file_id_same(&out->id[i], &in->id[k]))
-        return usage_error("%s: the output %s (%s) is the input %s (%s): a run never overwrites its inputs; "
-                           "choose another output name", cmd, out->path[i], out->opt[i], in->path[k], in->opt[k]);
+        return usage_error("%s: the output %s (%s) is one of the input files, %s (%s): a run never overwrites "
+                           "its inputs; choose another output name", cmd, out->path[i], out->opt[i], in->path[k], in->opt[k]);
     for (k = 0; k < i; ++k)
       if (file_id_same(&out->id[i], &out->id[k]))
         return usage_error("%s: %s (%s) and %s (%s) are the same file; give each output its own name", cmd,
@@ -828,20 +885,36 @@ static int check_collisions(const char *cmd, const pathset *in, const pathset *o
   return 0;
 }
 
-/* Up front: can files be created in dir (created first if missing, create = 1)?
-   0, or 1 after a message naming opt and path. */
+/* Can a file be created in the existing directory dir? Tried, not asked
+   (access() says yes to root where nothing can be written, e.g. /proc): a
+   probe file of a name no one uses is created and removed again. 0, or
+   errno. */
+static int probe_dir(const char *dir) {
+  char p[4096 + 64];
+  int k, fd;
+  for (k = 0; k < 100; ++k) {
+    snprintf(p, sizeof p, "%s/.phgmg-probe-%ld-%d", dir, (long)getpid(), k);
+    fd = open(p, O_WRONLY | O_CREAT | O_EXCL, 0600);
+    if (fd >= 0) { close(fd); unlink(p); return 0; }
+    if (errno != EEXIST) return errno;
+  }
+  return EEXIST;
+}
+
+/* Up front: can files be created in dir (its missing parents permitting,
+   create = 1)? 0, or 1 after a message naming opt and path. */
 static int check_writable_dir(const char *dir, const char *opt, const char *path, int create) {
   char buf[4096];
   struct stat st;
   size_t n = strlen(dir);
+  int e;
   if (n == 0 || n >= sizeof buf) return fail("%s (%s): bad directory name", path, opt);
   memcpy(buf, dir, n + 1);
   for (;;) {
     if (stat(buf, &st) == 0) {
       if (!S_ISDIR(st.st_mode))
         return fail("%s (%s): cannot write there: %s is not a directory", path, opt, buf);
-      if (access(buf, W_OK | X_OK) != 0)
-        return fail("%s (%s): cannot write in %s: %s", path, opt, buf, strerror(errno));
+      if ((e = probe_dir(buf)) != 0) return fail("%s (%s): cannot write in %s: %s", path, opt, buf, strerror(e));
       return 0;
     }
     if (errno != ENOENT) return fail("%s (%s): cannot use %s: %s", path, opt, buf, strerror(errno));
@@ -973,8 +1046,9 @@ typedef struct outlist {
   int rows[48], cols[48], n;
 } outlist;
 
-static int write_npy(const char *path, const double *A, int rows, int cols, int ndim) {
-  phgmg_result rc = phgmg_npy_write(path, A, rows, cols, rows > 0 ? rows : 1, ndim, 0u);
+/* Write to wp (the staged name) the output shown to the user as path. */
+static int write_npy(const char *path, const char *wp, const double *A, int rows, int cols, int ndim) {
+  phgmg_result rc = phgmg_npy_write(wp, A, rows, cols, rows > 0 ? rows : 1, ndim, 0u);
   if (rc != PHGMG_OK) return fail("%s: cannot write: %s (%s)", path, phgmg_result_string(rc), strerror(errno));
   return 0;
 }
@@ -984,7 +1058,7 @@ static int write_field(const char *dir, const char *name, const char *field, con
   char path[4096 + 256];
   const char *wp;
   snprintf(path, sizeof path, "%s/%s_%s.npy", dir, name, field);
-  if (!(wp = stage_path(sg, path)) || write_npy(wp, A, rows, cols, 2)) return 1;
+  if (!(wp = stage_path(sg, path)) || write_npy(path, wp, A, rows, cols, 2)) return 1;
   if (ol->n < 48) {
     snprintf(ol->names[ol->n], sizeof ol->names[0], "%s_%s.npy", name, field);
     ol->rows[ol->n] = rows; ol->cols[ol->n] = cols; ol->n++;
@@ -1044,6 +1118,18 @@ static const char *num_str(double v, char *buf) {
     if (strtod(buf, NULL) == v) return buf;
   }
   snprintf(buf, 32, "%.17g", v);
+  return buf;
+}
+/* v as the shortest %.6g..%.9g that reads back exactly as the scalar type of
+   the build (float: 0.1f is "0.1", not 0.10000000149011612). */
+static const char *real_str(phgmg_real v, char *buf) {
+  int prec;
+  if (sizeof(phgmg_real) == sizeof(double)) return num_str((double)v, buf);
+  for (prec = 6; prec < 9; ++prec) {
+    snprintf(buf, 32, "%.*g", prec, (double)v);
+    if ((phgmg_real)strtod(buf, NULL) == v) return buf;
+  }
+  snprintf(buf, 32, "%.9g", (double)v);
   return buf;
 }
 /* A JSON number; null for NaN/Inf. */
@@ -1205,6 +1291,52 @@ typedef struct reduce_args {
   int nxin;
 } reduce_args;
 
+/* ---- the input files of reduce, validate and simulate: ONE list -----------
+   Every option whose value names a file the run reads is here (the
+   repeatable --X, --X-input, --train-input in input_lists). The parsers take
+   these options from this table, and register_inputs registers every file
+   they name, so that no output (--out's arrays, --states, the clean-up of an
+   earlier run's arrays) can be one of them. kind: a file; a coordinate SPEC
+   (one file or rows,cols,vals); an input KIND (sin, const or a file). */
+enum { OPTF_FILE = 0, OPTF_COO = 1, OPTF_KIND = 2 };
+enum { OPTF_SIMULATE = 1, OPTF_SPECIAL = 2 };  /* taken by simulate too; parsed by its own code (--ref) */
+typedef struct input_opt { const char *opt; size_t off; int kind, flags; } input_opt;
+#define IOPT(o, f, k, fl) {o, offsetof(reduce_args, f), k, fl}
+static const input_opt input_opts[] = {
+  IOPT("--J", J, OPTF_FILE, OPTF_SIMULATE), IOPT("--R", R, OPTF_FILE, OPTF_SIMULATE),
+  IOPT("--B", B, OPTF_FILE, OPTF_SIMULATE), IOPT("--Q", Q, OPTF_FILE, OPTF_SIMULATE),
+  IOPT("--J-coo", Jcoo, OPTF_COO, OPTF_SIMULATE), IOPT("--R-coo", Rcoo, OPTF_COO, OPTF_SIMULATE),
+  IOPT("--Q-coo", Qcoo, OPTF_COO, OPTF_SIMULATE), IOPT("--E", E, OPTF_FILE, OPTF_SIMULATE),
+  IOPT("--E-coo", Ecoo, OPTF_COO, OPTF_SIMULATE), IOPT("--P", Pf, OPTF_FILE, OPTF_SIMULATE),
+  IOPT("--S", Sf, OPTF_FILE, OPTF_SIMULATE), IOPT("--N", Nf, OPTF_FILE, OPTF_SIMULATE),
+  IOPT("--dampers", dampf, OPTF_FILE, OPTF_SIMULATE), IOPT("--poly", poly, OPTF_FILE, OPTF_SIMULATE),
+  IOPT("--poly-idx", poly_idx, OPTF_FILE, OPTF_SIMULATE), IOPT("--poly-w", poly_w, OPTF_FILE, OPTF_SIMULATE),
+  IOPT("--exp", expf, OPTF_FILE, OPTF_SIMULATE), IOPT("--input", input, OPTF_KIND, OPTF_SIMULATE),
+  IOPT("--ref", ref_file, OPTF_FILE, OPTF_SPECIAL),
+  {NULL, 0, 0, 0}};
+#undef IOPT
+/* The repeatable ones: up to 16 values each, their count in cnt. */
+typedef struct input_list { const char *opt; size_t off, cnt; int kind; } input_list;
+static const input_list input_lists[] = {
+  {"--X", offsetof(reduce_args, xs), offsetof(reduce_args, nx), OPTF_FILE},
+  {"--X-input", offsetof(reduce_args, xin), offsetof(reduce_args, nxin), OPTF_KIND},
+  {"--train-input", offsetof(reduce_args, train), offsetof(reduce_args, ntrain), OPTF_KIND},
+  {NULL, 0, 0, 0}};
+
+/* The field of input_opts[k] in A. */
+static const char **input_field(reduce_args *A, int k) { return (const char **)(void *)((char *)A + input_opts[k].off); }
+
+/* The index in input_opts of option o that the parser takes by the table
+   (simulate: only those marked OPTF_SIMULATE), or -1. */
+static int input_opt_find(const char *o, int simulate) {
+  int k;
+  for (k = 0; input_opts[k].opt; ++k)
+    if (!strcmp(input_opts[k].opt, o) && !(input_opts[k].flags & OPTF_SPECIAL) &&
+        (!simulate || (input_opts[k].flags & OPTF_SIMULATE)))
+      return k;
+  return -1;
+}
+
 static const char *method_name(int m) {
   switch (m) {
     case PHGMG_METHOD_GMG_POD: return "gmg-pod";
@@ -1285,7 +1417,8 @@ static int check_hyper_opts(const reduce_args *A, const char *const *seen, int n
   for (k = 0; all[k]; ++k)
     if (given(all[k], seen, nseen) && !A->poly_idx)
       return usage_error("reduce: %s applies to a nonlinear part (--poly, --exp or --potential with --poly-idx); "
-                         "this model has none", all[k]);
+                         "this model has none%s", all[k],
+                         A->dampf ? " (the dampers of --dampers are not hyper-reduced: every damper is kept)" : "");
   for (k = 0; k < 4; ++k)
     if (A->no_deim && given(all[k], seen, nseen))
       return usage_error("reduce: --no-hyper keeps every nonlinear term: %s does not apply", all[k]);
@@ -1310,7 +1443,7 @@ static int check_hyper_opts(const reduce_args *A, const char *const *seen, int n
 static int check_reduce_args(reduce_args *A, const char *const *seen, int nseen);
 static int parse_reduce(int argc, char **argv, reduce_args *A) {
   const char *seen[64];
-  int i, nseen = 0;
+  int i, k, nseen = 0;
   phgmg_reduce_opts def;   /* the library's defaults of the options it shares */
   phgmg_reduce_opts_default(&def);
   memset(A, 0, sizeof *A);
@@ -1337,13 +1470,10 @@ static int parse_reduce(int argc, char **argv, reduce_args *A) {
       continue;
     }
     if (repeated_opt(o, seen, &nseen)) return 2;
-    STR("--J", J) STR("--R", R) STR("--B", B) STR("--Q", Q)
-    STR("--J-coo", Jcoo) STR("--R-coo", Rcoo) STR("--Q-coo", Qcoo) STR("--E", E) STR("--E-coo", Ecoo) STR("--P", Pf) STR("--S", Sf) STR("--N", Nf)
-    STR("--dampers", dampf)
-    STR("--poly", poly) STR("--poly-idx", poly_idx) STR("--poly-w", poly_w)
-    STR("--exp", expf) STR("--potential", potential) STR("--hyper", hyper)
+    else if ((k = input_opt_find(o, 0)) >= 0) { if (!(v = optval(argc, argv, &i))) return 2; *input_field(A, k) = v; }
+    STR("--potential", potential) STR("--hyper", hyper)
     DBL("--hyper-tol", hyper_tol, 0.0)
-    STR("--out", out) STR("--name", name) STR("--input", input) STR("--method", method)
+    STR("--out", out) STR("--name", name) STR("--method", method)
     INT("--steps", steps, 1, INT_MAX - 1) INT("--r", r, 1, INT_MAX) 
     INT("--deim-max", deim_max, 1, INT_MAX) INT("--newton-iter", newton_iter, 1, 1000)
     DBL("--amp", amp, -HUGE_VAL) DBL("--deim-tol", deim_tol, 0.0) DBL("--newton-tol", newton_tol, 0.0)
@@ -1387,7 +1517,7 @@ static int parse_reduce(int argc, char **argv, reduce_args *A) {
       else return usage_error("--manifold '%s': expected pod, greedy or altmin", v);
     }
     else if (!strcmp(o, "--dt-map")) {
-      if (!(v = optval(argc, argv, &i)) || !parse_double(o, v, 0.0, &A->dt_map)) return 2;
+      if (!(v = optval(argc, argv, &i)) || !parse_double(o, v, 0.0, &A->dt_map) || real_bad(o, v, A->dt_map)) return 2;
       A->have_dt_map = 1;
     }
     else if (!strcmp(o, "--simulate")) A->simulate = 1;
@@ -1407,36 +1537,46 @@ static int parse_reduce(int argc, char **argv, reduce_args *A) {
    exclusive options, the model's files, the nonlinear part, the training
    inputs; resolves the CLI's own defaults (input, gmg-qm's lambda, dt-map).
    0, or the usage status 2. */
-static int check_reduce_args(reduce_args *A, const char *const *seen, int nseen) {
-  int i, e;
+/* The model's options as a whole, for reduce, validate and simulate (cmd):
+   dense or sparse J, R, Q and E in the same form, the triplet SPECs, the
+   nonlinear part's options together. 0, or the usage status 2. */
+static int check_model_opts(const char *cmd, const reduce_args *A) {
+  int i;
   if ((A->E && A->Jcoo) || (A->Ecoo && !A->Jcoo))
-    return usage_error("reduce: give E like J, R, Q: --E with --J/--R/--Q, --E-coo with --J-coo/--R-coo/--Q-coo");
+    return usage_error("%s: give E like J, R, Q: --E with --J/--R/--Q, --E-coo with --J-coo/--R-coo/--Q-coo", cmd);
   if ((A->J || A->R || A->Q) && (A->Jcoo || A->Rcoo || A->Qcoo))
-    return usage_error("reduce: give J, R, Q either dense (--J, --R, --Q) or sparse (--J-coo, --R-coo, --Q-coo)");
+    return usage_error("%s: give J, R, Q either dense (--J, --R, --Q) or sparse (--J-coo, --R-coo, --Q-coo)", cmd);
   if (A->Jcoo || A->Rcoo || A->Qcoo) {
-    const char *const spec[3] = {A->Jcoo, A->Rcoo, A->Qcoo}, *const opt[3] = {"--J-coo", "--R-coo", "--Q-coo"};
+    const char *const spec[4] = {A->Jcoo, A->Rcoo, A->Qcoo, A->Ecoo};
+    const char *const opt[4] = {"--J-coo", "--R-coo", "--Q-coo", "--E-coo"};
     if (!A->Jcoo || !A->Rcoo || !A->Qcoo || !A->B)
-      return usage_error("reduce: --J-coo, --R-coo, --Q-coo and --B are required together");
-    for (i = 0; i < 3; ++i) {
-      const char *c1 = strchr(spec[i], ','), *c2 = c1 ? strchr(c1 + 1, ',') : NULL;
+      return usage_error("%s: --J-coo, --R-coo, --Q-coo and --B are required together", cmd);
+    for (i = 0; i < 4; ++i) {
+      const char *c1 = spec[i] ? strchr(spec[i], ',') : NULL, *c2 = c1 ? strchr(c1 + 1, ',') : NULL;
       if (c1 && (!c2 || strchr(c2 + 1, ',') || c1 == spec[i] || c2 == c1 + 1 || !c2[1]))
         return usage_error("%s '%s': expected rows.npy,cols.npy,vals.npy (three non-empty names) or one (nnz, 3) "
                            "FILE.npy", opt[i], spec[i]);
     }
-  } else if (!A->J || !A->R || !A->B || !A->Q) return usage_error("reduce: --J, --R, --B and --Q are required");
-  if (!A->method) return usage_error("reduce: --method is required (gmg-pod, gmg-qm, sp1 or sp2)");
-  if (!A->r) return usage_error("reduce: --r is required");
-  if (!A->out) return usage_error("reduce: --out DIR is required");
-  if (!!A->X == !!A->simulate) return usage_error("reduce: give exactly one of --X FILE and --simulate");
-  if (A->potential && (A->poly || A->expf)) return usage_error("reduce: --potential replaces --poly and --exp");
+  } else if (!A->J || !A->R || !A->B || !A->Q) return usage_error("%s: --J, --R, --B and --Q are required", cmd);
+  if (A->potential && (A->poly || A->expf)) return usage_error("%s: --potential replaces --poly and --exp", cmd);
   if (!!(A->poly || A->expf || A->potential) != !!A->poly_idx)
-    return usage_error("reduce: --poly/--exp/--potential and --poly-idx go together");
-  if (A->poly_w && !A->poly_idx) return usage_error("reduce: --poly-w needs a nonlinear part (--poly-idx)");
+    return usage_error("%s: --poly/--exp/--potential and --poly-idx go together", cmd);
+  if (A->poly_w && !A->poly_idx) return usage_error("%s: --poly-w needs a nonlinear part (--poly-idx)", cmd);
   if (A->potential) {
     double c[8];
     int d, ne;
     if (named_potential(A->potential, c, &d, &ne)) return 2;
   }
+  return 0;
+}
+
+static int check_reduce_args(reduce_args *A, const char *const *seen, int nseen) {
+  int e;
+  if ((e = check_model_opts("reduce", A)) != 0) return e;
+  if (!A->method) return usage_error("reduce: --method is required (gmg-pod, gmg-qm, sp1 or sp2)");
+  if (!A->r) return usage_error("reduce: --r is required");
+  if (!A->out) return usage_error("reduce: --out DIR is required");
+  if (!!A->X == !!A->simulate) return usage_error("reduce: give exactly one of --X FILE and --simulate");
   if (A->hyper && strcmp(A->hyper, "ecsw") && strcmp(A->hyper, "qdeim") && strcmp(A->hyper, "greedy"))
     return usage_error("--hyper '%s': expected ecsw, qdeim or greedy", A->hyper);
   if ((e = check_hyper_opts(A, seen, nseen)) != 0) return e;
@@ -2077,6 +2217,40 @@ static int load_dampers(const reduce_args *A, reduce_state *S, phgmg_ph_system *
   return 0;
 }
 
+/* Which condition of the feedthrough failed (rc: phgmg_ph_validate's code),
+   naming the files given: N not skew, S not symmetric or not positive
+   semidefinite, or P too large for R and S. 1 after the message. */
+static int explain_feedthrough(const reduce_args *A, const reduce_state *S, phgmg_result rc) {
+  char files[3 * 4096 + 8] = "", opts[32] = "", why[256];
+  const char *const fl[3] = {A->Pf, A->Sf, A->Nf}, *const ol[3] = {"--P", "--S", "--N"};
+  const int m = S->B.cols;
+  int k;
+  for (k = 0; k < 3; ++k)
+    if (fl[k]) {
+      snprintf(files + strlen(files), sizeof files - strlen(files), "%s%s", files[0] ? ", " : "", fl[k]);
+      snprintf(opts + strlen(opts), sizeof opts - strlen(opts), "%s%s", opts[0] ? ", " : "", ol[k]);
+    }
+  if (rc != PHGMG_ERR_FEEDTHROUGH) return fail("%s (%s): %s", files, opts, phgmg_result_string(rc));
+  if (A->Nf && sym_defect(S->Nm.a, m, 1.0) > 1e-12)
+    snprintf(why, sizeof why, "N is not skew-symmetric (||N + N^T||_F / ||N||_F = %.3g)", sym_defect(S->Nm.a, m, 1.0));
+  else if (A->Sf && sym_defect(S->Sm.a, m, -1.0) > 1e-12)
+    snprintf(why, sizeof why, "S is not symmetric (||S - S^T||_F / ||S||_F = %.3g)", sym_defect(S->Sm.a, m, -1.0));
+  else {
+    double w[64], c[64 * 64];
+    int i;
+    if (A->Sf && m <= 64) {
+      for (i = 0; i < m * m; ++i) c[i] = S->Sm.a[i];
+      if (phgmg_sym_eig(m, c, m, w, NULL, 0) == PHGMG_OK && w[0] < -1e-12 * PHGMG__MAX(fabs(w[0]), fabs(w[m - 1]))) {
+        snprintf(why, sizeof why, "S is not positive semidefinite (smallest eigenvalue %.3g)", w[0]);
+        return fail("%s (%s): the feedthrough is not valid: %s", files, opts, why);
+      }
+    }
+    snprintf(why, sizeof why, "[[R, P], [P^T, S]] is not positive semidefinite: P is too large for the "
+             "dissipation R and S (a port's P needs damping R where P acts and S on the port)");
+  }
+  return fail("%s (%s): the feedthrough is not valid: %s", files, opts, why);
+}
+
 /* The full model from the files: dense or sparse J, R, Q, B and the nonlinear
    part, checked (phgmg_ph_validate), into S->sys. */
 static int condense_algebraic(reduce_state *S);
@@ -2161,8 +2335,7 @@ static int load_system(const reduce_args *A, reduce_state *S) {
     return fail("%s (--dampers): %s%s", A->dampf, phgmg_result_string(rc),
                 rc == PHGMG_ERR_DAMPER ? " (c1 and c3 must be >= 0)" : rc == PHGMG_ERR_SIZE ? " (banded storage: |i - j| beyond the band)" : "");
   if (rc == PHGMG_ERR_FEEDTHROUGH || (rc == PHGMG_ERR_UNSUPPORTED && (sys.P || sys.S || sys.Nskew)))
-    return fail("%s%s%s%s%s (--P, --S, --N): %s", A->Pf ? A->Pf : "", A->Sf ? " " : "", A->Sf ? A->Sf : "",
-                A->Nf ? " " : "", A->Nf ? A->Nf : "", phgmg_result_string(rc));
+    return explain_feedthrough(A, S, rc);
   if (rc != PHGMG_OK && sys.E) {
     const char *ef = A->E ? A->E : A->Ecoo, *qf = A->Q ? A->Q : A->Qcoo;
     switch (rc) {
@@ -2201,11 +2374,73 @@ static int condense_algebraic(reduce_state *S) {
     return 0;
   }
   S->sys = *phgmg_dae_system(S->dae);
+  if (S->refm.a) { /* --ref FILE holds full states: its differential part (rotated like the snapshots) */
+    double *t = (double *)malloc(sizeof(double) * (size_t)S->sys.N + 1);
+    if (!t) return fail("out of memory");
+    phgmg_dae_restrict(S->dae, S->refm.a, t);
+    memcpy(S->refm.a, t, sizeof(double) * (size_t)S->sys.N);
+    free(t);
+  }
   progress("algebraic constraints: E singular, %d algebraic equations and variables (index one); condensed to "
            "N = %d differential states%s", phgmg_dae_nalg(S->dae), S->sys.N,
            (S->sys.P || S->sys.S) && !(S->full.P || S->full.S || S->full.Nskew)
                ? " with feedthrough (a port on a constraint)" : "");
 
+  return 0;
+}
+
+/* The largest |entry| of a loaded dense matrix or of a sparse one's values. */
+static double max_abs_entry(const mat *M, const cli_csc *C) {
+  double v = 0.0;
+  size_t k, n = M->a ? (size_t)M->rows * (size_t)M->cols : C->cp ? (size_t)C->cp[C->A.n_cols] : 0;
+  const double *a = M->a ? M->a : C->v;
+  for (k = 0; k < n; ++k) v = PHGMG__MAX(v, fabs(a[k]));
+  return v;
+}
+
+/* The step against the model's time scale, before a full-model run. GL3's
+   stage matrices are sigma E - (J - R) Q with sigma ~ 1/dt: beyond
+   dt max|J - R| max|Q| / max|E| = 1/eps the mass term is below round-off
+   (the step resolves nothing; further on the stage equations leave the
+   double range and the output is flushed to zero or NaN), and the times
+   t = n dt must stay in the double range. 0, or 1 after a message. */
+#define DT_SCALE_MAX (1.0 / DBL_EPSILON)
+static int check_dt_scale(const reduce_args *A, const reduce_state *S) {
+  const double jr = PHGMG__MAX(max_abs_entry(&S->J, &S->cJ), max_abs_entry(&S->R, &S->cR));
+  const double q = max_abs_entry(&S->Q, &S->cQ);
+  const double e = (A->E || A->Ecoo) ? max_abs_entry(&S->E, &S->cE) : 1.0;
+  const double scale = e > 0.0 ? jr * q / e : 0.0;
+  if (!((double)A->steps * A->dt < DBL_MAX / 4.0))
+    return fail("--dt %g with --steps %d: the times t = n dt leave the double range", A->dt, A->steps);
+  if (scale > 0.0 && !(A->dt <= DT_SCALE_MAX / scale))
+    return fail("--dt %g: the step is %.3g times the model's time scale 1 / (max|J - R| max|Q| / max|E|) = %.3g, "
+                "beyond what a double resolves (1/eps = %.3g): the stage equations lose the mass term, and the "
+                "output is round-off, flushed to zero or NaN; use --dt <= %.3g", A->dt, A->dt * scale, 1.0 / scale,
+                DT_SCALE_MAX, DT_SCALE_MAX / scale);
+  return 0;
+}
+
+/* What the reduction does not take, explained up front: feedthrough or
+   dampers with gmg-qm or with a reference state (--ref). The feedthrough may
+   be the user's (--P, --S, --N) or come from a port on an algebraic line of
+   E (the condensed model's). 0, or 1 after a message. */
+static int check_extras(const reduce_args *A, const reduce_state *S) {
+  const phgmg_ph_system *c = &S->sys;
+  const int feed = c->P || c->S || c->Nskew, mine = A->Pf || A->Sf || A->Nf;
+  char what[4096 + 160];
+  if (!feed && !c->ndamp) return 0;
+  if (feed && !mine)
+    snprintf(what, sizeof what, "feedthrough from a port on an algebraic line of E (%s: the condensed model "
+             "carries (S + N) u)", A->E ? A->E : A->Ecoo);
+  else if (feed)
+    snprintf(what, sizeof what, "feedthrough (--P, --S, --N)");
+  else
+    snprintf(what, sizeof what, "dampers (--dampers %s)", A->dampf);
+  if (S->method == PHGMG_METHOD_GMG_QM)
+    return fail("gmg-qm does not take %s; use gmg-pod, sp1 or sp2%s", what, A->ref ? " (without --ref)" : "");
+  if (A->ref != PHGMG_REF_NONE)
+    return fail("--ref %s does not go with %s: the reference state's terms are not derived for them; use "
+                "--ref none", A->ref == PHGMG_REF_MEAN ? "mean" : A->ref_file, what);
   return 0;
 }
 
@@ -2385,10 +2620,7 @@ static int run_reduction(const reduce_args *A, reduce_state *S, int method, cons
         return fail("reduction failed: %s (use --deim-allow-negative, a smaller --deim-tol, or --no-hyper)",
                     phgmg_result_string(rc));
       case PHGMG_ERR_UNSUPPORTED:
-        if (A->Pf || A->Sf || A->Nf)
-          return fail("reduction failed: gmg-qm does not take feedthrough (--P, --S, --N); use gmg-pod, sp1 or sp2");
-        if (A->dampf)
-          return fail("reduction failed: gmg-qm does not take --dampers (%s); use gmg-pod, sp1 or sp2", A->dampf);
+        if (check_extras(A, S)) return 1;   /* feedthrough or dampers with gmg-qm or --ref */
         return fail("reduction failed: %s", phgmg_result_string(rc));
       default:
         return fail("reduction failed: %s", phgmg_result_string(rc));
@@ -2582,11 +2814,19 @@ static int write_json(const reduce_args *A, reduce_state *S, int method, int ns,
   fprintf(jf, "  \"N\": %d, \"m\": %d, \"r\": %d, \"rn\": %d, \"nd\": %d, \"poly_deg\": %d,\n", N, m, rom->r,
           rom->rn, rom->nd, rom->nd ? rom->poly_deg : 0);
   fprintf(jf, "  \"dt_map\": ");
-  json_num(jf, rom->Phi ? (double)rom->dt : 0.0);
+  if (rom->Phi) { char buf[32]; fputs(isfinite((double)rom->dt) ? real_str(rom->dt, buf) : "null", jf); }   /* float: "0.1" */
+  else fputs("0", jf);
   fprintf(jf, ",\n  \"system\": {\"J\": ");
   json_str(jf, A->J ? A->J : A->Jcoo); fprintf(jf, ", \"R\": "); json_str(jf, A->R ? A->R : A->Rcoo);
   fprintf(jf, ", \"B\": "); json_str(jf, A->B); fprintf(jf, ", \"Q\": "); json_str(jf, A->Q ? A->Q : A->Qcoo);
   if (S->sp) fprintf(jf, ", \"sparse\": true, \"kb\": %d", S->sys.kb);
+  { /* the descriptor, feedthrough and damper files: a model rebuilt from this record is this model */
+    const char *const v[5] = {A->E ? A->E : A->Ecoo, A->Pf, A->Sf, A->Nf, A->dampf};
+    const char *const key[5] = {"E", "P", "S", "N", "dampers"};
+    int k;
+    for (k = 0; k < 5; ++k)
+      if (v[k]) { fprintf(jf, ", \"%s\": ", key[k]); json_str(jf, v[k]); }
+  }
   if (A->poly_idx) {
     if (A->poly) { fprintf(jf, ", \"poly\": "); json_str(jf, A->poly); }
     if (A->expf) { fprintf(jf, ", \"exp\": "); json_str(jf, A->expf); }
@@ -2665,35 +2905,46 @@ static int reduce_commit(const reduce_args *A, reduce_state *S) {
   return 0;
 }
 
-/* The files a run reads (every file option; validate: also its test inputs)
-   and the files it may write (every output its options can produce, with the
-   temporary names of the staged writes) into S->pin, S->pout. */
+/* A coordinate SPEC's files (FILE or rows,cols,vals) into ps. */
+static void paths_add_coo(pathset *ps, const char *opt, const char *spec) {
+  char path[4096];
+  const char *a = spec;
+  while (a) {
+    const char *c = strchr(a, ',');
+    const size_t l = c ? (size_t)(c - a) : strlen(a);
+    if (l < sizeof path) { memcpy(path, a, l); path[l] = '\0'; paths_add(ps, opt, path, 0); }
+    a = c ? c + 1 : NULL;
+  }
+}
+
+/* Every file a run reads -- each option of input_opts and input_lists that
+   was given, and validate's test inputs -- into ps. */
+static void register_inputs(const reduce_args *A, pathset *ps, const char *const *tests, int nt) {
+  int k, i;
+  for (k = 0; input_opts[k].opt; ++k) {
+    const char *v = *input_field((reduce_args *)A, k);
+    if (!v) continue;
+    if (input_opts[k].kind == OPTF_COO) paths_add_coo(ps, input_opts[k].opt, v);
+    else if (input_opts[k].kind == OPTF_KIND) paths_add_input(ps, input_opts[k].opt, v);
+    else paths_add(ps, input_opts[k].opt, v, 0);
+  }
+  for (k = 0; input_lists[k].opt; ++k) {
+    const char *const *vals = (const char *const *)(const void *)((const char *)A + input_lists[k].off);
+    const int n = *(const int *)(const void *)((const char *)A + input_lists[k].cnt);
+    for (i = 0; i < n; ++i)
+      if (input_lists[k].kind == OPTF_KIND) paths_add_input(ps, input_lists[k].opt, vals[i]);
+      else paths_add(ps, input_lists[k].opt, vals[i], 0);
+  }
+  for (k = 0; k < nt; ++k) paths_add_input(ps, "--test-input", tests[k]);
+}
+
+/* The files a run reads (register_inputs) and the files it may write (every
+   output its options can produce, with the temporary names of the staged
+   writes) into S->pin, S->pout. */
 static void reduce_paths(const reduce_args *A, reduce_state *S, const char *const *tests, int nt) {
-  const char *const files[] = {A->J, A->R, A->B, A->Q, A->poly, A->poly_idx, A->poly_w, A->expf,
-                               A->E, A->Pf, A->Sf, A->Nf};
-  const char *const fopt[] = {"--J", "--R", "--B", "--Q", "--poly", "--poly-idx", "--poly-w", "--exp",
-                              "--E", "--P", "--S", "--N"};
-  const char *const coo[] = {A->Jcoo, A->Rcoo, A->Qcoo, A->Ecoo};
-  const char *const cooopt[] = {"--J-coo", "--R-coo", "--Q-coo", "--E-coo"};
   char path[4096 + 256];
   int k;
-  for (k = 0; k < 12; ++k)
-    if (files[k]) paths_add(&S->pin, fopt[k], files[k], 0);
-  for (k = 0; k < 4; ++k) { /* FILE or rows,cols,vals */
-    const char *a = coo[k];
-    while (a) {
-      const char *c = strchr(a, ',');
-      const size_t l = c ? (size_t)(c - a) : strlen(a);
-      if (l < sizeof path) { memcpy(path, a, l); path[l] = '\0'; paths_add(&S->pin, cooopt[k], path, 0); }
-      a = c ? c + 1 : NULL;
-    }
-  }
-  for (k = 0; k < A->nx; ++k) paths_add(&S->pin, "--X", A->xs[k], 0);
-  if (A->ref_file) paths_add(&S->pin, "--ref", A->ref_file, 0);
-  for (k = 0; k < A->nxin; ++k) paths_add_input(&S->pin, "--X-input", A->xin[k]);
-  for (k = 0; k < A->ntrain; ++k) paths_add_input(&S->pin, "--train-input", A->train[k]);
-  if (!A->ntrain && A->simulate) paths_add_input(&S->pin, "--input", A->input);
-  for (k = 0; k < nt; ++k) paths_add_input(&S->pin, "--test-input", tests[k]);
+  register_inputs(A, &S->pin, tests, nt);
   snprintf(path, sizeof path, "%s/%s.phgmgrom", A->out, A->name); paths_add(&S->pout, "--out/--name", path, 1);
   snprintf(path, sizeof path, "%s/%s.c", A->out, A->name); paths_add(&S->pout, "--out/--name", path, 1);
   snprintf(path, sizeof path, "%s/%s.json", A->out, A->name); paths_add(&S->pout, "--out/--name", path, 1);
@@ -2723,8 +2974,13 @@ static int reduce_prepare(const reduce_args *A, reduce_state *S, const char *con
   reduce_paths(A, S, tests, nt);
   if ((e = check_collisions("reduce", &S->pin, &S->pout)) != 0) return e;
   g_inputs = &S->pin;
-  if (check_writable_dir(A->out, "--out", A->out, 1)) return 1;
+  /* the directory made now (removed again if the run fails) and a file tried in it */
+  if (check_writable_dir(A->out, "--out", A->out, 1) || mkdir_p(A->out, &S->sg) ||
+      check_writable_dir(A->out, "--out", A->out, 0))
+    return 1;
   if ((e = load_system(A, S)) != 0) return e;
+  if ((A->simulate || A->nxin || nt) && check_dt_scale(A, S)) return 1;
+  if (check_extras(A, S)) return 1;
   if ((e = check_sizes(A, S->method, S->sys.N, S->sys.m)) != 0) return e;
   return A->X ? load_snapshot_files(A, S, S->sys.N, S->sys.m, &S->Xd, &S->ns) : 0;
 }
@@ -2811,12 +3067,12 @@ static int parse_simulate_rom(int argc, char **argv, simrom_args *P) {
     else if (!strcmp(o, "--states")) { if (!(P->states = optval(argc, argv, &i))) return 2; }
     else if (!strcmp(o, "--input")) { if (!(P->inspec = optval(argc, argv, &i))) return 2; }
     else if (!strcmp(o, "--dt")) {
-      if (!(v = optval(argc, argv, &i)) || !parse_double(o, v, 0.0, &P->dt)) return 2;
+      if (!(v = optval(argc, argv, &i)) || !parse_double(o, v, 0.0, &P->dt) || real_bad(o, v, P->dt)) return 2;
       if (!(P->dt > 0.0)) return usage_error("--dt must be > 0");
       P->have_dt = 1;
     }
-    else if (!strcmp(o, "--amp")) { if (!(v = optval(argc, argv, &i)) || !parse_double(o, v, -HUGE_VAL, &P->amp)) return 2; }
-    else if (!strcmp(o, "--newton-tol")) { if (!(v = optval(argc, argv, &i)) || !parse_double(o, v, 0.0, &P->newton_tol)) return 2; }
+    else if (!strcmp(o, "--amp")) { if (!(v = optval(argc, argv, &i)) || !parse_double(o, v, -HUGE_VAL, &P->amp) || real_bad(o, v, P->amp)) return 2; }
+    else if (!strcmp(o, "--newton-tol")) { if (!(v = optval(argc, argv, &i)) || !parse_double(o, v, 0.0, &P->newton_tol) || real_bad(o, v, P->newton_tol)) return 2; }
     else if (!strcmp(o, "--steps")) { if (!(v = optval(argc, argv, &i)) || !parse_int(o, v, 1, INT_MAX - 1, &P->steps)) return 2; }
     else if (!strcmp(o, "--newton-iter")) { if (!(v = optval(argc, argv, &i)) || !parse_int(o, v, 1, 1000, &P->newton_iter)) return 2; }
     else if (!strcmp(o, "--quiet")) g_quiet = 1;
@@ -2918,8 +3174,8 @@ static int cmd_simulate_rom(int argc, char **argv) {
   progress("  done in %.3f s (%ld Newton iterations, %ld factorizations)", now_s() - t0, st.stats.newton_iters,
            st.stats.factorizations);
   /* both outputs or neither */
-  if (!(wp = stage_path(&sg, out)) || write_npy(wp, Y, rom.m, steps + 1, 2)) goto done;
-  if (states && (!(wp = stage_path(&sg, states)) || write_npy(wp, XR, rom.r, steps + 1, 2))) goto done;
+  if (!(wp = stage_path(&sg, out)) || write_npy(out, wp, Y, rom.m, steps + 1, 2)) goto done;
+  if (states && (!(wp = stage_path(&sg, states)) || write_npy(states, wp, XR, rom.r, steps + 1, 2))) goto done;
   if (stage_commit(&sg)) goto done;
   printf("wrote %s (%d x %d)%s%s\n", out, rom.m, steps + 1, states ? " and " : "", states ? states : "");
   status = 0;
@@ -2933,31 +3189,11 @@ done:
 }
 
 /* ---- simulate (full model) ----------------------------------------------------- */
-/* Is path the same file as the model or input file in (a comma list of up to
-   three files for a triplet SPEC)? */
-static int sim_same_file(const char *path, const char *in) {
-  struct stat a, b;
-  char buf[4096];
-  const char *p = in;
-  if (!in || stat(path, &a) != 0) return 0;
-  while (p && *p) {
-    const char *c = strchr(p, ',');
-    size_t l = c ? (size_t)(c - p) : strlen(p);
-    if (l < sizeof buf) {
-      memcpy(buf, p, l);
-      buf[l] = 0;
-      if (stat(buf, &b) == 0 && a.st_dev == b.st_dev && a.st_ino == b.st_ino) return 1;
-    }
-    p = c ? c + 1 : NULL;
-  }
-  return 0;
-}
-
 /* The options of `simulate`: the model options of reduce, --dt, --steps,
    --input, --amp, --newton-tol, --newton-iter, --out, --states, --quiet.
    Returns 0, the usage status 2, or -1 after --help. */
 static int parse_simulate(int argc, char **argv, reduce_args *A, const char **states) {
-  const char *seen[64], *ins[17];
+  const char *seen[64];
   int i, k, nseen = 0;
   memset(A, 0, sizeof *A);
   A->dt = 0.1; A->steps = 1000; A->amp = 0.1; A->newton_iter = 10; A->input = "sin";
@@ -2968,11 +3204,8 @@ static int parse_simulate(int argc, char **argv, reduce_args *A, const char **st
     if (repeated_opt(o, seen, &nseen)) return 2;
 #define STR(opt, field) else if (!strcmp(o, opt)) { if (!(v = optval(argc, argv, &i))) return 2; A->field = v; }
     if (!strcmp(o, "--quiet")) g_quiet = 1;
-    STR("--J", J) STR("--R", R) STR("--B", B) STR("--Q", Q)
-    STR("--J-coo", Jcoo) STR("--R-coo", Rcoo) STR("--Q-coo", Qcoo)
-    STR("--E", E) STR("--E-coo", Ecoo) STR("--P", Pf) STR("--S", Sf) STR("--N", Nf) STR("--dampers", dampf)
-    STR("--poly", poly) STR("--poly-idx", poly_idx) STR("--poly-w", poly_w)
-    STR("--exp", expf) STR("--potential", potential) STR("--input", input) STR("--out", out)
+    else if ((k = input_opt_find(o, 1)) >= 0) { if (!(v = optval(argc, argv, &i))) return 2; *input_field(A, k) = v; }
+    STR("--potential", potential) STR("--out", out)
 #undef STR
     else if (!strcmp(o, "--states")) { if (!(*states = optval(argc, argv, &i))) return 2; }
     else if (!strcmp(o, "--dt")) {
@@ -2985,26 +3218,22 @@ static int parse_simulate(int argc, char **argv, reduce_args *A, const char **st
     else if (!strcmp(o, "--newton-tol")) { if (!(v = optval(argc, argv, &i)) || !parse_double(o, v, 0.0, &A->newton_tol)) return 2; }
     else return usage_error("simulate: unknown option '%s'", o);
   }
-  if ((A->J || A->R || A->Q) && (A->Jcoo || A->Rcoo || A->Qcoo))
-    return usage_error("simulate: give J, R, Q either dense (--J, --R, --Q) or sparse (--J-coo, --R-coo, --Q-coo)");
-  if (A->Jcoo || A->Rcoo || A->Qcoo) {
-    if (!A->Jcoo || !A->Rcoo || !A->Qcoo || !A->B)
-      return usage_error("simulate: --J-coo, --R-coo, --Q-coo and --B are required together");
-  } else if (!A->J || !A->R || !A->B || !A->Q) return usage_error("simulate: --J, --R, --B and --Q are required");
+  if ((k = check_model_opts("simulate", A)) != 0) return k;
   if (!A->out) return usage_error("simulate: --out FILE is required");
-  if (A->potential && (A->poly || A->expf)) return usage_error("simulate: --potential replaces --poly and --exp");
-  if (!!(A->poly || A->expf || A->potential) != !!A->poly_idx)
-    return usage_error("simulate: --poly/--exp/--potential and --poly-idx go together");
-  if (A->poly_w && !A->poly_idx) return usage_error("simulate: --poly-w needs a nonlinear part (--poly-idx)");
-  if (*states && !strcmp(*states, A->out)) return usage_error("simulate: --out and --states name the same file");
-  ins[0] = A->J; ins[1] = A->R; ins[2] = A->B; ins[3] = A->Q; ins[4] = A->Jcoo; ins[5] = A->Rcoo;
-  ins[6] = A->Qcoo; ins[7] = A->poly; ins[8] = A->poly_idx; ins[9] = A->poly_w; ins[10] = A->expf;
-  ins[11] = A->input; ins[12] = A->E; ins[13] = A->Ecoo; ins[14] = A->Pf; ins[15] = A->Sf; ins[16] = A->Nf;
-  for (k = 0; k < 17; ++k)
-    if (sim_same_file(A->out, ins[k]) || (*states && sim_same_file(*states, ins[k])))
-      return usage_error("simulate: the output %s is one of the input files (%s): not overwritten",
-                         sim_same_file(A->out, ins[k]) ? A->out : *states, ins[k]);
   return 0;
+}
+
+/* simulate's outputs, before any work: neither --out nor --states is an
+   input or the other output (compared as files), and each can be written.
+   0, the usage status 2, or 1 after a message. */
+static int simulate_outputs_ok(const reduce_args *A, reduce_state *S, const char *states) {
+  int e;
+  register_inputs(A, &S->pin, NULL, 0);
+  paths_add(&S->pout, "--out", A->out, 1);
+  if (states) paths_add(&S->pout, "--states", states, 1);
+  if ((e = check_collisions("simulate", &S->pin, &S->pout)) != 0) return e;
+  g_inputs = &S->pin;
+  return check_out_file(A->out, "--out") || (states && check_out_file(states, "--states"));
 }
 
 /* phgmg simulate: the full model from x0 = 0 with the GL3 stepper; writes y
@@ -3020,8 +3249,9 @@ static int cmd_simulate(int argc, char **argv) {
   int status, N, m, done = 0;
   if ((status = parse_simulate(argc, argv, &A, &states)) != 0) return status < 0 ? 0 : status;
   memset(&S, 0, sizeof S);
+  if ((status = simulate_outputs_ok(&A, &S, states)) != 0) goto out;
   status = 1;
-  if (load_system(&A, &S)) goto out;
+  if (load_system(&A, &S) || check_dt_scale(&A, &S)) goto out;
   N = S.full.N;   /* an index-one model: phgmg_simulate gives consistent full states */
   m = S.full.m;
   if (too_big(((double)m + (states ? 2.0 * (double)N : 0.0)) * ((double)A.steps + 1.0),
@@ -3056,8 +3286,8 @@ static int cmd_simulate(int argc, char **argv) {
     if (!XU) { fail("out of memory"); goto out; }
     phgmg_ph_sparse_to_user_order(S.sp, A.steps + 1, X, N, XU, N);
   }
-  if (!(wp = stage_path(&S.sg, A.out)) || write_npy(wp, Y, m, A.steps + 1, 2)) goto out;
-  if (states && (!(wp = stage_path(&S.sg, states)) || write_npy(wp, XU ? XU : X, N, A.steps + 1, 2))) goto out;
+  if (!(wp = stage_path(&S.sg, A.out)) || write_npy(A.out, wp, Y, m, A.steps + 1, 2)) goto out;
+  if (states && (!(wp = stage_path(&S.sg, states)) || write_npy(states, wp, XU ? XU : X, N, A.steps + 1, 2))) goto out;
   if (stage_commit(&S.sg)) goto out;
   printf("wrote %s (%d x %d)%s%s\n", A.out, m, A.steps + 1, states ? " and " : "", states ? states : "");
   status = 0;
@@ -3082,8 +3312,17 @@ static int cmd_info(int argc, char **argv) {
                      rom.nphi > 1 ? ", one function per term" : "");
   if (rom.Phi) {
     char buf[32];
-    printf(", step map for dt = %s", num_str((double)rom.dt, buf));
+    printf(", step map for dt = %s", real_str(rom.dt, buf));
   }
+  if (rom.ndamp) printf(", %d nonlinear dampers (force law degree %d)", rom.ndamp, rom.damp_deg);
+  if (rom.PD) printf(", feedthrough (S + N, %d x %d)", rom.m, rom.m);
+  if (rom.PD)
+    printf("\nfeedthrough: the output y of phgmg_rom_step and phgmg_rom_output leaves out (S + N) u; firmware "
+           "adds (S + N) u(t) itself, S + N the last %d x %d block of the model's PD = [Ph; S + N] "
+           "(simulate-rom does)", rom.m, rom.m);
+  if (rom.ndamp)
+    printf("\ndampers: the model keeps all %d (each evaluation of the reduced forces costs O(%d r)); "
+           "phgmg_rom_step applies them", rom.ndamp, rom.ndamp);
   printf("\nstepper memory: %lu bytes", (unsigned long)phgmg_rom_stepper_memsize(&rom));
   if (rom.Phi) { /* the step map serves its own dt only; another dt needs the Newton workspace */
     const phgmg_real other = rom.dt * (phgmg_real)2;
@@ -3272,7 +3511,8 @@ static int cmd_validate(int argc, char **argv) {
 
 int main(int argc, char **argv) {
   if (argc < 2) {
-    fputs("usage: phgmg reduce ... | phgmg simulate-rom ... | phgmg info MODEL | phgmg validate ... | phgmg --help\n", stderr);
+    fputs("usage: phgmg reduce ... | phgmg validate ... | phgmg simulate ... | phgmg simulate-rom ... | phgmg info MODEL"
+          " | phgmg --help | phgmg --version\n", stderr);
     return 2;
   }
   if (!strcmp(argv[1], "--help") || !strcmp(argv[1], "-h") || !strcmp(argv[1], "help")) {
@@ -3285,6 +3525,6 @@ int main(int argc, char **argv) {
   if (!strcmp(argv[1], "simulate")) return cmd_simulate(argc, argv);
   if (!strcmp(argv[1], "info")) return cmd_info(argc, argv);
   if (!strcmp(argv[1], "validate")) return cmd_validate(argc, argv);
-  return usage_error("unknown command '%s' (expected reduce, validate, simulate-rom, info, --help or --version)",
+  return usage_error("unknown command '%s' (expected reduce, validate, simulate, simulate-rom, info, --help or --version)",
                      argv[1]);
 }

@@ -613,7 +613,7 @@ np.save('E_neg.npy', -np.eye(N))
 import numpy as np
 np.save('S_ok.npy', 0.1 * np.eye(1)); np.save('S_neg.npy', -0.1 * np.eye(1))
 " && pass || bad "feedthrough files"
-  run_err "feedthrough S not PSD" 1 "S_neg.npy (--P, --S, --N)" "$P" reduce $SYS --S S_neg.npy $SIM --method gmg-pod --r 12 --out oSn
+  run_err "feedthrough S not PSD" 1 "S_neg.npy (--S): the feedthrough is not valid: S is not positive semidefinite" "$P" reduce $SYS --S S_neg.npy $SIM --method gmg-pod --r 12 --out oSn
   [ ! -e oSn ] && pass || bad "feedthrough not PSD: output written"
   run_err "feedthrough: gmg-qm refused" 1 "gmg-qm does not take feedthrough" "$P" reduce $SYS --S S_ok.npy $SIM --method gmg-qm --r 12 --out oSo
   [ ! -e oSo ] && pass || bad "feedthrough refused: output written"

@@ -31,3 +31,4 @@
 #include "test_sparse_lu.c"
 #include "test_study.c"
 #include "test_subnormal.c"
+#include "test_dae_ports.c"

@@ -6,8 +6,14 @@
    and manifold names, the scratch model's files dense and as coordinate
    triplets, a malformed and an integer .npy, a directory, output paths
    inside the scratch directory), at most 48 tokens; the resulting command
-   line is run. Any exit status is fine (0, 1, 2); sanitizers, leaks and
-   hangs are findings. Before each run the scratch directory is restored, so
+   line is run; the vocabulary also has simulate and the descriptor,
+   feedthrough, damper and reference files (a mass matrix, an index-one E,
+   E as triplets, P, S, N, dampers, a reference state, a link to the
+   damper file). File mode (an input starting with 0xFF): byte 1 picks one
+   of those files, the rest of the input is its content, and a fixed
+   simulate or reduce that reads it runs -- the files' content fuzzed. Any
+   exit status is fine (0, 1, 2); sanitizers, leaks, hangs, and a run that
+   changes or removes a file named as one of its inputs are findings. Before each run the scratch directory is restored, so
    a run never sees what an earlier one wrote. The command runs with the
    scratch directory (/tmp/phgmg_fuzz_cli_XXXXXX, removed at exit) as its
    working directory, so whatever it writes -- also under a relative name
@@ -118,6 +124,21 @@ static void restore(void) {
     }
     put_npy("exp.npy", e2, 1, 2);
   }
+  {   /* the descriptor, feedthrough, damper and reference files: a mass matrix
+         (p1, p2 coupled), the same with p2 massless (index one), E as triplets,
+         P, S, N, two dampers, a reference state; ln_d.npy a link to d.npy */
+    static const double E4[16] = {1, 0, 0, 0, 0, 1, 0, 0.1, 0, 0, 1, 0, 0, 0.1, 0, 1};
+    static const double Ea[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 0};
+    static const double Ec[12] = {0, 1, 2, 3, 0, 1, 2, 3, 1, 1, 1, 1};
+    static const double P4[4] = {0, 0.1, 0, 0}, S1[1] = {0.2}, N1[1] = {0};
+    static const double D[8] = {1, 3, -1, 1, 0.1, 0.05, 1, 0.5}, ref[4] = {0.1, 0, 0.1, 0};
+    char path[256];
+    put_npy("E.npy", E4, 4, 4); put_npy("E_alg.npy", Ea, 4, 4); put_npy("Ec.npy", Ec, 4, 3);
+    put_npy("P.npy", P4, 4, 1); put_npy("S.npy", S1, 1, 1); put_npy("N.npy", N1, 1, 1);
+    put_npy("d.npy", D, 2, 4); put_npy("ref.npy", ref, 4, 1);
+    snprintf(path, sizeof path, "%s/ln_d.npy", g_dir);
+    if (symlink("d.npy", path) != 0) fz_die("symlink");
+  }
   put_bytes("garbage.npy", "not an npy file", 15);
   if (g_rom) put_bytes("m.phgmgrom", g_rom, g_rom_len);
   {
@@ -148,6 +169,9 @@ static void init(void) {
   static const char *const files2[] = {"Jc.npy", "Rc.npy", "Qc.npy", "exp.npy", "o/rom.phgmgrom", "o/rom_V0.npy",
                                        "o/rom.json", NULL};
   static const char *const words3[] = {"--ref", "mean", "none", "wide", "--greedy-window", NULL};   /* after files2: seeds keep their meaning */
+  static const char *const words4[] = {"simulate", "1e300", "1e308", NULL};   /* after words3 */
+  static const char *const files4[] = {"E.npy", "E_alg.npy", "Ec.npy", "P.npy", "S.npy", "N.npy", "d.npy", "ref.npy",
+                                       "ln_d.npy", NULL};
   char *argv[24];
   int k, fb, argc = 0;   /* fb: the token of files[0] */
   FILE *f;
@@ -162,6 +186,8 @@ static void init(void) {
   for (k = 0; words2[k]; ++k) strcpy(g_tok[g_ntok++], words2[k]);
   for (k = 0; files2[k]; ++k) snprintf(g_tok[g_ntok++], sizeof g_tok[0], "%s/%s", g_dir, files2[k]);
   for (k = 0; words3[k]; ++k) strcpy(g_tok[g_ntok++], words3[k]);
+  for (k = 0; words4[k]; ++k) strcpy(g_tok[g_ntok++], words4[k]);
+  for (k = 0; files4[k]; ++k) snprintf(g_tok[g_ntok++], sizeof g_tok[0], "%s/%s", g_dir, files4[k]);
   /* the model file, made once by the CLI itself */
   restore();
   argv[argc++] = (char *)"phgmg"; argv[argc++] = (char *)"reduce";
@@ -189,25 +215,120 @@ static void init(void) {
   fclose(f);
 }
 
+/* The invariant checked after every run: no file the command line names as
+   an input (the value after an input option: input_opts, input_lists,
+   --model, --test-input) is changed or removed by the run. */
+#define SNAP_MAX 24
+typedef struct snap { const char *path; unsigned char *b; long n; } snap;
+
+static int is_input_opt(const char *o) {
+  int k;
+  if (input_opt_find(o, 0) >= 0 || !strcmp(o, "--ref") || !strcmp(o, "--model") || !strcmp(o, "--test-input")) return 1;
+  for (k = 0; input_lists[k].opt; ++k)
+    if (!strcmp(o, input_lists[k].opt)) return 1;
+  return 0;
+}
+
+/* The bytes of a regular file (up to 1 MB), -1 if there is none. */
+static long read_all(const char *path, unsigned char **b) {
+  struct stat st;
+  FILE *f;
+  long n;
+  *b = NULL;
+  if (stat(path, &st) != 0 || !S_ISREG(st.st_mode) || st.st_size > (1L << 20)) return -1;
+  if (!(f = fopen(path, "rb"))) return -1;
+  n = (long)st.st_size;
+  *b = (unsigned char *)malloc((size_t)n + 1);
+  if (!*b || (long)fread(*b, 1, (size_t)n, f) != n) { fclose(f); free(*b); *b = NULL; return -1; }
+  fclose(f);
+  return n;
+}
+
+static int snap_inputs(int argc, char **argv, snap *sn) {
+  int i, n = 0;
+  for (i = 1; i + 1 < argc && n < SNAP_MAX; ++i)
+    if (is_input_opt(argv[i]) && (sn[n].n = read_all(argv[i + 1], &sn[n].b)) >= 0) sn[n++].path = argv[i + 1];
+  return n;
+}
+
+static void check_inputs(snap *sn, int n) {
+  int k;
+  for (k = 0; k < n; ++k) {
+    unsigned char *now;
+    const long m = read_all(sn[k].path, &now);
+    if (m != sn[k].n || (m > 0 && memcmp(now, sn[k].b, (size_t)m) != 0)) {
+      fprintf(stderr, "fuzz_cli: invariant violated: the input %s was changed or removed by the run\n", sn[k].path);
+      abort();
+    }
+    free(now);
+    free(sn[k].b);
+  }
+}
+
+/* File mode (an input starting with 0xFF): byte 1 picks one of the files
+   below, the rest of the input is its new content, and the command line
+   that reads it runs -- the content of the descriptor, feedthrough, damper
+   and reference files fuzzed. */
+static int file_mode_argv(const uint8_t *data, size_t size, char **argv) {
+  static const char *const target[] = {"d.npy", "E.npy", "Ec.npy", "P.npy", "S.npy", "N.npy", "ref.npy", "E.npy",
+                                       "d.npy"};
+  static const char *const extra[] = {"--dampers", "--E", "--E-coo", "--P", "--S", "--N", "--ref", "--E", "--dampers"};
+  const int k = data[1] % 9, red = k >= 6;
+  static char file[256], jc[256], rc[256], qc[256], cj[256], cr[256], cq[256], cb[256], cx[256], co[256];
+  int argc = 0;
+  snprintf(file, sizeof file, "%s/%s", g_dir, target[k]);
+  put_bytes(target[k], data + 2, size - 2);
+  snprintf(cj, sizeof cj, "%s/J.npy", g_dir); snprintf(cr, sizeof cr, "%s/R.npy", g_dir);
+  snprintf(cq, sizeof cq, "%s/Q.npy", g_dir); snprintf(cb, sizeof cb, "%s/B.npy", g_dir);
+  snprintf(jc, sizeof jc, "%s/Jc.npy", g_dir); snprintf(rc, sizeof rc, "%s/Rc.npy", g_dir);
+  snprintf(qc, sizeof qc, "%s/Qc.npy", g_dir); snprintf(cx, sizeof cx, "%s/X.npy", g_dir);
+  snprintf(co, sizeof co, "%s/o", g_dir);
+  argv[argc++] = (char *)"phgmg";
+  argv[argc++] = (char *)(red ? "reduce" : "simulate");
+  argv[argc++] = (char *)(k == 2 ? "--J-coo" : "--J"); argv[argc++] = k == 2 ? jc : cj;
+  argv[argc++] = (char *)(k == 2 ? "--R-coo" : "--R"); argv[argc++] = k == 2 ? rc : cr;
+  argv[argc++] = (char *)(k == 2 ? "--Q-coo" : "--Q"); argv[argc++] = k == 2 ? qc : cq;
+  argv[argc++] = (char *)"--B"; argv[argc++] = cb;
+  argv[argc++] = (char *)extra[k]; argv[argc++] = file;
+  if (red) {
+    argv[argc++] = (char *)(k == 8 ? "--simulate" : "--X");
+    if (k != 8) argv[argc++] = cx;
+    argv[argc++] = (char *)"--method"; argv[argc++] = (char *)(k == 7 ? "sp1" : "gmg-pod");
+    argv[argc++] = (char *)"--r"; argv[argc++] = (char *)"3";
+  }
+  argv[argc++] = (char *)"--steps"; argv[argc++] = (char *)"3";
+  argv[argc++] = (char *)"--out"; argv[argc++] = red ? co : (char *)"y.npy";
+  if (!red) { argv[argc++] = (char *)"--states"; argv[argc++] = (char *)"x.npy"; }
+  argv[argc] = NULL;
+  return argc;
+}
+
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
   char *argv[50];
-  int argc = 0;
+  snap sn[SNAP_MAX];
+  int argc = 0, nsn;
   size_t i;
   if (g_home < 0 && (g_home = open(".", O_RDONLY)) < 0) fz_die("cannot open the working directory");
   if (!g_dir[0]) init();
   restore();
-  argv[argc++] = (char *)"phgmg";
-  for (i = 0; i < size && argc < 49; ++i) argv[argc++] = g_tok[data[i] % g_ntok];
-  argv[argc] = NULL;
+  if (size >= 2 && data[0] == 0xFF) {
+    argc = file_mode_argv(data, size, argv);
+  } else {
+    argv[argc++] = (char *)"phgmg";
+    for (i = 0; i < size && argc < 49; ++i) argv[argc++] = g_tok[data[i] % g_ntok];
+    argv[argc] = NULL;
+  }
   g_quiet = 0;
   fflush(stdout);
   if (chdir(g_dir) != 0) fz_die("chdir");
+  nsn = snap_inputs(argc, argv, sn);
   (void)phgmg_cli_main(argc, argv);
+  check_inputs(sn, nsn);
   if (fchdir(g_home) != 0) fz_die("fchdir");
   fflush(stdout);
   return 0;
 }
 
 #define FUZZ_NAME "fuzz_cli"
-#define FUZZ_MAX_INPUT 256   /* the replay reads at most this much of a corpus file */
+#define FUZZ_MAX_INPUT 1024   /* the replay reads at most this much of a corpus file (file mode: a .npy) */
 #include "fuzz_main.h"
