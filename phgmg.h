@@ -1686,7 +1686,8 @@ typedef struct phgmg_ph_system {
   const phgmg_ph_sparse *sparse;
 } phgmg_ph_system;
 
-/* Validation of a system. tol (<= 0: 1e-12) is relative to the matrix norms:
+/* Validation of a system. tol (<= 0: 1e-12; NaN or +Inf:
+   PHGMG_ERR_INVALID_ARG) is relative to the matrix norms:
    ||J + J^T|| <= tol ||J||, ||R - R^T|| <= tol ||R||, ||Q - Q^T|| <= tol ||Q||
    (Frobenius), lambda_min(R) >= -tol ||R||_2, B full column rank (pivoted QR:
    |R_mm| > tol |R_11|), 1/cond_1(J - R) > tol (rcond_out, may be NULL, receives
@@ -1730,22 +1731,31 @@ PHGMG_DEF phgmg_result phgmg_ph_validate(const phgmg_ph_system *sys, double tol,
    the stepper object (phgmg_gl3_create), phgmg_simulate_inputs and
    phgmg_reduce return PHGMG_ERR_UNSUPPORTED for them: give them
    phgmg_dae_system(d), with snapshots restricted by phgmg_dae_restrict. The object keeps pointers into sys
-   (the nonlinear part's functions and weights): sys must outlive it. */
+   (the nonlinear part's functions and weights): sys must outlive it. tol is
+   the relative tolerance of phgmg_ph_validate (0 = 1e-12); a negative, NaN
+   or infinite tol is PHGMG_ERR_INVALID_ARG, as are NULL out, sys or E. */
 typedef struct phgmg_dae phgmg_dae;
 PHGMG_DEF phgmg_result phgmg_dae_create(phgmg_dae **out, const phgmg_ph_system *sys, double tol,
                                         const phgmg_allocator *alloc);
 /* The condensed model (valid while d lives); k = phgmg_dae_nalg(d). */
 PHGMG_DEF const phgmg_ph_system *phgmg_dae_system(const phgmg_dae *d);
 PHGMG_DEF int phgmg_dae_nalg(const phgmg_dae *d);
+/* The three maps between full (N) and differential (n) states return
+   PHGMG_ERR_INVALID_ARG for a NULL object or vector, output untouched. They
+   work in place: xi == x (the same start address) is allowed, the input is
+   first copied to the object's scratch memory (no allocation), so in-place
+   calls on one object must come from one thread; any other overlap of the
+   input and the output (or of u and x) is PHGMG_ERR_INVALID_ARG, output
+   untouched. */
 /* xi (n) = the differential coordinates of x (N), in their order in x. */
-PHGMG_DEF void phgmg_dae_restrict(const phgmg_dae *d, const double *x, double *xi);
+PHGMG_DEF phgmg_result phgmg_dae_restrict(const phgmg_dae *d, const double *x, double *xi);
 /* x (N) = xi at the differential coordinates, 0 at the algebraic ones (for
    a basis, whose algebraic rows follow from the constraints). */
-PHGMG_DEF void phgmg_dae_embed(const phgmg_dae *d, const double *xi, double *x);
+PHGMG_DEF phgmg_result phgmg_dae_embed(const phgmg_dae *d, const double *xi, double *x);
 /* x (N) = the consistent state with differential part xi at input u (m; NULL
    = 0): the algebraic variables solve the constraints. Uses d's scratch
    memory: one thread per object. */
-PHGMG_DEF void phgmg_dae_lift(phgmg_dae *d, const double *xi, const double *u, double *x);
+PHGMG_DEF phgmg_result phgmg_dae_lift(phgmg_dae *d, const double *xi, const double *u, double *x);
 PHGMG_DEF void phgmg_dae_destroy(phgmg_dae *d);
 
 /* Hamiltonian, its gradient and the output at a state. These evaluators do
@@ -4895,6 +4905,8 @@ PHGMG__PRIV phgmg_result phgmg__ph_validate(const phgmg_ph_system *sys, double t
 
 PHGMG_DEF phgmg_result phgmg_ph_validate(const phgmg_ph_system *sys, double tol,
                                          double *rcond_out, const phgmg_allocator *alloc) {
+  if (rcond_out) *rcond_out = 0.0;
+  if (tol != tol || tol == HUGE_VAL) return PHGMG_ERR_INVALID_ARG;   /* NaN, +Inf */
   return phgmg__ph_validate(sys, tol, rcond_out, alloc, 1);
 }
 
@@ -4917,7 +4929,8 @@ struct phgmg_dae {
   int nd, nq;                   /* lift: L[ra, dcol] (k x nd), Q[ra, qcol] (k x nq)    */
   int *dcol, *qcol;             /* positions in rn / cn                               */
   double *D, *Qa, *Ga;          /* and (B - P)[ra, :] (k x m)                          */
-  double *work;                 /* n + 2 k + m (+ N when rotated)                     */
+  double *work;                 /* n + 2 k + m, N (rotated lift), 1, alias            */
+  double *alias;                /* N: the input of an in-place restrict/embed/lift    */
   double *V;                    /* rotated (a dense E without zero lines): Qv, N x N   */
 };
 
@@ -5458,8 +5471,8 @@ PHGMG_DEF phgmg_result phgmg_dae_create(phgmg_dae **out, const phgmg_ph_system *
   *out = NULL;
   rc = phgmg__ph_check(sys);
   if (rc != PHGMG_OK) return rc;
-  if (!sys->E) return PHGMG_ERR_INVALID_ARG;
-  if (!(tol > 0.0)) tol = 1e-12;
+  if (!sys->E || !(tol >= 0.0 && tol < HUGE_VAL)) return PHGMG_ERR_INVALID_ARG;
+  if (tol == 0.0) tol = 1e-12;
   if (!phgmg__ph_mat_finite(sys, sys->E) || !phgmg__ph_mat_finite(sys, sys->J) ||
       !phgmg__ph_mat_finite(sys, sys->R) || !phgmg__ph_mat_finite(sys, sys->Q) ||
       !phgmg__all_finite(sys->B, (size_t)sys->N * (size_t)sys->m))
@@ -5489,8 +5502,9 @@ PHGMG_DEF phgmg_result phgmg_dae_create(phgmg_dae **out, const phgmg_ph_system *
   }
   if (rc == PHGMG_OK) rc = phgmg__ph_validate(&d->sys, tol, NULL, &d->al, d->k == 0);
   if (rc == PHGMG_OK) {
-    d->work = phgmg__dalloc(&d->al, (size_t)d->n + 2 * (size_t)d->k + (size_t)d->m + (size_t)d->N + 1);
+    d->work = phgmg__dalloc(&d->al, (size_t)d->n + 2 * (size_t)d->k + (size_t)d->m + 2 * (size_t)d->N + 1);
     if (!d->work) rc = PHGMG_ERR_NOMEM;
+    else d->alias = d->work + d->n + 2 * d->k + d->m + d->N + 1;
   }
   phgmg__free(&d->al, rbuf);
   if (rc != PHGMG_OK) { phgmg_dae_destroy(d); return rc; }
@@ -5501,26 +5515,60 @@ PHGMG_DEF phgmg_result phgmg_dae_create(phgmg_dae **out, const phgmg_ph_system *
 PHGMG_DEF const phgmg_ph_system *phgmg_dae_system(const phgmg_dae *d) { return d ? &d->sys : NULL; }
 PHGMG_DEF int phgmg_dae_nalg(const phgmg_dae *d) { return d ? d->k : 0; }
 
-/* Rotated models keep the differential coordinates first: xi = Qv(:, 0..n)^T x. */
-PHGMG_DEF void phgmg_dae_restrict(const phgmg_dae *d, const double *x, double *xi) {
-  int i;
-  if (d->V) { phgmg_gemv('T', d->N, d->n, 1.0, d->V, d->N, x, 0.0, xi); return; }
-  for (i = 0; i < d->N; ++i)
-    if (d->cpos[i] >= 0) xi[d->cpos[i]] = x[i];
+#include <stdint.h> /* uintptr_t: the overlap test of the in-place maps */
+
+/* How the vector a (na doubles) meets b (nb doubles): 0 apart, 1 the same
+   start (in place), 2 any other overlap. */
+PHGMG__PRIV int phgmg__dae_overlap(const double *a, size_t na, const double *b, size_t nb) {
+  const uintptr_t a0 = (uintptr_t)(const void *)a, b0 = (uintptr_t)(const void *)b;
+  if (a0 == b0) return 1;
+  return a0 < b0 + nb * sizeof(double) && b0 < a0 + na * sizeof(double) ? 2 : 0;
 }
 
-PHGMG_DEF void phgmg_dae_embed(const phgmg_dae *d, const double *xi, double *x) {
+/* The input of a map from in (nin doubles) to out (nout): in itself, its
+   copy in d's scratch when out == in, NULL for any other overlap. */
+PHGMG__PRIV const double *phgmg__dae_input(const phgmg_dae *d, const double *in, size_t nin, const double *out,
+                                           size_t nout) {
+  const int o = phgmg__dae_overlap(in, nin, out, nout);
+  if (o == 2) return NULL;
+  if (o == 1) { memcpy(d->alias, in, nin * sizeof(double)); return d->alias; }
+  return in;
+}
+
+/* Rotated models keep the differential coordinates first: xi = Qv(:, 0..n)^T x. */
+PHGMG_DEF phgmg_result phgmg_dae_restrict(const phgmg_dae *d, const double *x, double *xi) {
   int i;
-  if (d->V) { phgmg_gemv('N', d->N, d->n, 1.0, d->V, d->N, xi, 0.0, x); return; }
+  if (!d || !x || !xi) return PHGMG_ERR_INVALID_ARG;
+  x = phgmg__dae_input(d, x, (size_t)d->N, xi, (size_t)d->n);
+  if (!x) return PHGMG_ERR_INVALID_ARG;
+  if (d->V) { phgmg_gemv('T', d->N, d->n, 1.0, d->V, d->N, x, 0.0, xi); return PHGMG_OK; }
+  for (i = 0; i < d->N; ++i)
+    if (d->cpos[i] >= 0) xi[d->cpos[i]] = x[i];
+  return PHGMG_OK;
+}
+
+PHGMG_DEF phgmg_result phgmg_dae_embed(const phgmg_dae *d, const double *xi, double *x) {
+  int i;
+  if (!d || !xi || !x) return PHGMG_ERR_INVALID_ARG;
+  xi = phgmg__dae_input(d, xi, (size_t)d->n, x, (size_t)d->N);
+  if (!xi) return PHGMG_ERR_INVALID_ARG;
+  if (d->V) { phgmg_gemv('N', d->N, d->n, 1.0, d->V, d->N, xi, 0.0, x); return PHGMG_OK; }
   for (i = 0; i < d->N; ++i) x[i] = d->cpos[i] >= 0 ? xi[d->cpos[i]] : 0.0;
+  return PHGMG_OK;
 }
 
 PHGMG__PRIV void phgmg__dae_lift_t(phgmg_dae *d, const double *xi, const double *u, double *x);
-PHGMG_DEF void phgmg_dae_lift(phgmg_dae *d, const double *xi, const double *u, double *x) {
-  double *xt = d->work + d->n + 2 * d->k + d->m;
-  if (!d->V) { phgmg__dae_lift_t(d, xi, u, x); return; }
+PHGMG_DEF phgmg_result phgmg_dae_lift(phgmg_dae *d, const double *xi, const double *u, double *x) {
+  double *xt;
+  if (!d || !xi || !x) return PHGMG_ERR_INVALID_ARG;
+  if (u && phgmg__dae_overlap(u, (size_t)d->m, x, (size_t)d->N)) return PHGMG_ERR_INVALID_ARG;
+  xi = phgmg__dae_input(d, xi, (size_t)d->n, x, (size_t)d->N);
+  if (!xi) return PHGMG_ERR_INVALID_ARG;
+  if (!d->V) { phgmg__dae_lift_t(d, xi, u, x); return PHGMG_OK; }
+  xt = d->work + d->n + 2 * d->k + d->m;
   phgmg__dae_lift_t(d, xi, u, xt);
   phgmg_gemv('N', d->N, d->N, 1.0, d->V, d->N, xt, 0.0, x);
+  return PHGMG_OK;
 }
 
 /* The lift in the model's own (or rotated) coordinates. */
