@@ -200,7 +200,7 @@
    output functions have no u: phgmg_rom_output and the stepper's y give
    (Bh + Ph)^T grad Hr, the caller adds (S + N) u(t) (phgmg_reduced_simulate
    and the command line do). Model files (format version 3, field PD) check
-   the block on load (PHGMG_ERR_STRUCTURE); no step map with feedthrough.
+   the block on load (PHGMG_ERR_FEEDTHROUGH); no step map with feedthrough.
 
    1.7 Nonlinear dissipation (phgmg_ph_system.ndamp, damp_*)
    Dampers r(z) = sum_k c_k rho_k(c_k^T z), c_k = e_i - e_j (a damper between
@@ -884,8 +884,10 @@
    back into user code cannot be serialised; the C export references the
    firmware's <name>_phi / <name>_eta instead (a GENERAL model, callback
    dampers: not at all). A loaded model with dampers must have weights >= 0
-   and dissipative laws, one with feedthrough a positive semidefinite
-   dissipation block (PHGMG_ERR_STRUCTURE otherwise).
+   and dissipative laws (PHGMG_ERR_DAMPER otherwise), one with feedthrough a
+   positive semidefinite dissipation block (PHGMG_ERR_FEEDTHROUGH), and the
+   training envelope, q_max and the rest state xr_rest must be in range
+   (PHGMG_ERR_STRUCTURE; the criteria at phgmg_rom_deserialize).
 
    5.3 Firmware builds. PHGMG_NO_OFFLINE compiles only the online half and the
    in-memory (de)serialisation: libm only, no heap, no stdio. PHGMG_REAL_FLOAT
@@ -988,7 +990,9 @@
      PHGMG_ERR_STRUCTURE (-26)      an intact model file that is not a pH model
                                     of its kind (Qh not positive definite,
                                     dissipation not PSD, a step map not of its
-                                    dt): phgmg_rom_deserialize / _load
+                                    dt, the rest state or the training
+                                    envelope out of range):
+                                    phgmg_rom_deserialize / _load
      PHGMG_ERR_STEP_MAP (-27)       the step map of a dissipative model would
                                     grow in the energy norm (phgmg_reduce with
                                     opts.dt)
@@ -1507,7 +1511,7 @@ extern "C" {
   X(PHGMG_ERR_TOL_UNREACHABLE, -23, "tolerance below what double precision can reach (relative tolerance < 1e-15)") \
   X(PHGMG_ERR_NOT_STABILIZABLE, -24, "no stabilizing Riccati solution: (A, K) not stabilizable or (A, L) not detectable") \
   X(PHGMG_ERR_STALE,           -25, "the system changed since the study was created (create the study again)") \
-  X(PHGMG_ERR_STRUCTURE,       -26, "model fails the structure check (Qh not positive definite, R not PSD, or a step map not of its dt)") \
+  X(PHGMG_ERR_STRUCTURE,       -26, "model fails the structure check (Qh not positive definite, R not PSD, a step map not of its dt, or the rest state or training envelope out of range)") \
   X(PHGMG_ERR_STEP_MAP,        -27, "step map not stable in double precision at this dt (use a smaller dt)") \
   X(PHGMG_ERR_E_SINGULAR,      -28, "the mass matrix E is singular to working precision") \
   X(PHGMG_ERR_EQ_NOT_SYMMETRIC, -29, "E^T Q is not symmetric (descriptor model)")          \
@@ -3134,7 +3138,18 @@ PHGMG_DEF phgmg_result phgmg_rom_deserialize_size(const void *buf, size_t len, s
    level, and a step map that satisfies the GL3 stage equations of
    x' = K Qh x + Bh u for the stored dt (within 48 (r + 1) 1.2e-7 of its
    terms' size): PHGMG_ERR_STRUCTURE otherwise (details at
-   phgmg__rom_physics).
+   phgmg__rom_physics). Dampers: weights >= 0, laws odd with coefficients
+   >= 0 (PHGMG_ERR_DAMPER); feedthrough: the dissipation block
+   [[-sym K, Ph], [Ph^T, sym Dh]] positive semidefinite to the level above
+   (PHGMG_ERR_FEEDTHROUGH). The fields that place a run
+   (PHGMG_ERR_STRUCTURE): the training envelope has both bounds or neither,
+   env_lo <= env_hi; q_max >= 0; the rest state xr_rest is 0 without a
+   reference state (rho(0) = 0), else of finite energy, and within what the
+   working precision resolves against the training range: max |xr_rest| <=
+   S / eps (eps = 1.2e-7 in a float build, 2.2e-16 in double; S the largest
+   of the envelope's widths and bounds), since a run from rest moves over
+   the training range and, from a state further away, every such move would
+   be below the state's rounding unit.
    No allocation; phgmg_rom_load returns the same codes. */
 PHGMG_DEF phgmg_result phgmg_rom_deserialize(const void *buf, size_t len, phgmg_rom *rom, void *mem,
                                              size_t mem_size);
@@ -17907,7 +17922,9 @@ PHGMG__ONLINE phgmg_result phgmg__rom_header(const unsigned char *b, size_t len,
    tol = sqrt(eps), tolm = 48 (r + 1) eps with eps = 1.2e-7, float's unit
    roundoff, for every file: a model may have been rounded to float on its
    way (a float build, an f32 file) and saved again with 8-byte scalars.
-   Failure: PHGMG_ERR_STRUCTURE. Work: (r + rn)^2 + 4 r + 4 reals. */
+   Failure: PHGMG_ERR_STRUCTURE (dampers: _DAMPER, feedthrough: _FEEDTHROUGH;
+   then the placement fields, phgmg__rom_placement_ok). Work: (r + rn)^2 +
+   4 r + 4 reals. */
 PHGMG__ONLINE size_t phgmg__rom_phys_work(const phgmg_rom *rom, uint32_t mask) {
   const size_t n2 = (size_t)rom->r + (size_t)(rom->kind == PHGMG_ROM_QUADRATIC ? rom->rn : 0);
   const size_t nf = (mask & (1u << 25)) ? (size_t)rom->r + (size_t)rom->m : 0;   /* feedthrough block */
@@ -18039,12 +18056,42 @@ PHGMG__ONLINE phgmg_result phgmg__rom_damp_ok(const phgmg_rom *rom) {
   int j, e;
   if (!rom->dpoly || !rom->dw) return PHGMG_ERR_STRUCTURE;
   for (j = 0; j < rom->ndamp; ++j)
-    if (!(rom->dw[j] >= PHGMG__R(0))) return PHGMG_ERR_STRUCTURE;
+    if (!(rom->dw[j] >= PHGMG__R(0))) return PHGMG_ERR_DAMPER;
   for (j = 0; j < nf; ++j)
     for (e = 0; e <= rom->damp_deg; ++e) {
       const phgmg_real a = rom->dpoly[(size_t)j * (size_t)(rom->damp_deg + 1) + (size_t)e];
-      if ((e % 2 == 0 && a != PHGMG__R(0)) || a < PHGMG__R(0)) return PHGMG_ERR_STRUCTURE;
+      if ((e % 2 == 0 && a != PHGMG__R(0)) || a < PHGMG__R(0)) return PHGMG_ERR_DAMPER;
     }
+  return PHGMG_OK;
+}
+
+/* The fields that place a run rather than shape the dynamics: the training
+   envelope (both bounds or neither, env_lo <= env_hi), q_max >= 0, and the
+   rest state xr_rest = rho(0): 0 without a reference state (rho(0) = 0
+   then); with one, finite energy 1/2 xr^T Qh xr, and with an envelope, a
+   rest state that the working precision resolves against the training
+   range: max |xr_rest| eps_real <= S, S the largest of the envelope's widths
+   and bounds (a run from rest moves over the training range; from a state
+   more than S / eps_real away every such move is below its rounding unit). */
+PHGMG__ONLINE phgmg_result phgmg__rom_placement_ok(const phgmg_rom *rom) {
+  const int r = rom->r;
+  const double eps_real = PHGMG_REAL_IS_FLOAT ? 1.1920929e-07 : 2.220446049250313e-16;
+  double scale = 0.0, xmax = 0.0, e = 0.0;
+  int a, b;
+  if ((rom->env_lo == NULL) != (rom->env_hi == NULL)) return PHGMG_ERR_STRUCTURE;
+  for (a = 0; rom->env_lo && a < r; ++a) {
+    const double lo = (double)rom->env_lo[a], hi = (double)rom->env_hi[a];
+    if (!(lo <= hi)) return PHGMG_ERR_STRUCTURE;
+    scale = fmax(scale, fmax(hi - lo, fmax(fabs(lo), fabs(hi))));
+  }
+  if (rom->q_max && !(rom->q_max[0] >= PHGMG__R(0))) return PHGMG_ERR_STRUCTURE;
+  if (!rom->xr_rest) return PHGMG_OK;
+  for (a = 0; a < r; ++a) xmax = fmax(xmax, fabs((double)rom->xr_rest[a]));
+  if (!rom->ref_g) return xmax == 0.0 ? PHGMG_OK : PHGMG_ERR_STRUCTURE;
+  for (b = 0; b < r; ++b)
+    for (a = 0; a < r; ++a) e += (double)rom->xr_rest[a] * (double)rom->Qh[a + (size_t)b * r] * (double)rom->xr_rest[b];
+  if (!(fabs(e) < HUGE_VAL)) return PHGMG_ERR_STRUCTURE;
+  if (rom->env_lo && !(xmax * eps_real <= scale)) return PHGMG_ERR_STRUCTURE;
   return PHGMG_OK;
 }
 
@@ -18079,8 +18126,12 @@ PHGMG__ONLINE phgmg_result phgmg__rom_physics(const phgmg_rom *rom, double eps, 
     }
   if (!phgmg__r_psd_shifted(n2, w, tol)) return PHGMG_ERR_STRUCTURE;
   if (rom->Phi && (!rom->K || !phgmg__rom_map_ok(rom, eps, w))) return PHGMG_ERR_STRUCTURE;
-  if (rom->PD && !phgmg__rom_feed_ok(rom, tol, w)) return PHGMG_ERR_STRUCTURE;
-  return rom->ndamp ? phgmg__rom_damp_ok(rom) : PHGMG_OK;
+  if (rom->PD && !phgmg__rom_feed_ok(rom, tol, w)) return PHGMG_ERR_FEEDTHROUGH;
+  if (rom->ndamp) {
+    const phgmg_result rc = phgmg__rom_damp_ok(rom);
+    if (rc != PHGMG_OK) return rc;
+  }
+  return phgmg__rom_placement_ok(rom);
 }
 
 PHGMG_DEF phgmg_result phgmg_rom_deserialize_size(const void *buf, size_t len, size_t *need) {

@@ -2774,7 +2774,9 @@ static int load_model(const char *path, const char *opt, phgmg_rom *rom, void **
   fclose(f);
   rc = phgmg_rom_load(path, rom, block, NULL);
   if (rc != PHGMG_OK)
-    return fail("%s (%s): not a usable phgmg model file: %s", path, opt, phgmg_result_string(rc));
+    return fail("%s (%s): not a usable phgmg model file: %s%s", path, opt, phgmg_result_string(rc),
+                rc == PHGMG_ERR_DAMPER ? " (the file's damper weights or laws)"
+                : rc == PHGMG_ERR_FEEDTHROUGH ? " (the file's feedthrough block)" : "");
   return 0;
 }
 

@@ -9,6 +9,8 @@
 #include "harness.h"
 #include <stdlib.h>
 
+#include "fixture_msd.h"
+
 /* The three-state circuit with its algebraic node first: x = (x3, x1, x2),
    E = diag(0, 1, 1), Q = I, J couples x1-x2 and x2-x3, R = diag(r3, 0, 0),
    the port at x1. The constraint 0 = -x2 - r3 x3 gives x3 = -x2 / r3. */
@@ -168,7 +170,115 @@ TEST(test_defect4_dae_tolerance) {
   CHECK_RC(phgmg_ph_validate(&s, -1.0, NULL, NULL), PHGMG_OK);
 }
 
+/* ---- model files tampered with, the checksum recomputed by the writer ---- */
+static void d4_u_sin(double t, double *u, void *user) { (void)user; u[0] = sin(t); }
+
+/* Serialise rom (the writer computes the checksum) and load it back. */
+static phgmg_result d4_roundtrip(const phgmg_rom *rom) {
+  static unsigned char buf[1 << 16];
+  static double mem[1 << 14];
+  size_t wr = 0, need = 0;
+  phgmg_rom back;
+  phgmg_result rc = phgmg_rom_serialize(rom, buf, sizeof buf, &wr);
+  if (rc != PHGMG_OK) return rc;
+  rc = phgmg_rom_deserialize_size(buf, wr, &need);
+  if (rc != PHGMG_OK) return rc;
+  if (need > sizeof mem) return PHGMG_ERR_WORKSPACE;
+  return phgmg_rom_deserialize(buf, wr, &back, mem, need);
+}
+
+/* GMG-POD models (r = 6) of the 10-mass chain driven by sin, with the
+   snapshot mean as reference state (ref = 1) or without. */
+static phgmg_reduced *d4_chain_rom(dmodel *t, int ref) {
+  const int N = 20, ns = 201;
+  double *X = (double *)calloc((size_t)N * ns, sizeof(double)), x0[20] = {0};
+  phgmg_reduce_opts o;
+  phgmg_reduced *red = NULL;
+  dmodel_msd(t, 10);
+  CHECK_RC(phgmg_simulate(&t->sys, x0, 0.0, 0.1, ns - 1, d4_u_sin, NULL, NULL, X, NULL, NULL, NULL, NULL, NULL),
+           PHGMG_OK);
+  memset(&o, 0, sizeof o);
+  o.method = PHGMG_METHOD_GMG_POD; o.r = 6;
+  o.ref = ref ? PHGMG_REF_MEAN : PHGMG_REF_NONE;
+  CHECK_RC(phgmg_reduce(&red, &t->sys, X, N, ns, &o, NULL, NULL), PHGMG_OK);
+  free(X);
+  return red;
+}
+
+/* The fields that place a run are checked on load: a rest state of 1e30
+   (beyond what the working precision resolves against the training range),
+   an inverted training envelope, one bound of the envelope without the
+   other, and a nonzero rest state in a model without reference state (rho(0)
+   = 0 there) are refused with PHGMG_ERR_STRUCTURE; the genuine files load,
+   and a rest state moved within the training range still loads. */
+TEST(test_defect4_load_placement) {
+  dmodel t1, t2;
+  phgmg_reduced *red = d4_chain_rom(&t1, 1), *r0 = d4_chain_rom(&t2, 0);
+  if (red && r0) {
+    const phgmg_rom *rom = phgmg_reduced_rom(red), *rom0 = phgmg_reduced_rom(r0);
+    phgmg_rom cp;
+    phgmg_real xr[6];
+    int a, wide = 0;
+    CHECK(rom->xr_rest && rom->ref_g && rom->env_lo && rom->env_hi && !rom0->xr_rest && rom0->env_lo);
+    CHECK_RC(d4_roundtrip(rom), PHGMG_OK);
+    CHECK_RC(d4_roundtrip(rom0), PHGMG_OK);
+    for (a = 0; a < 6; ++a) xr[a] = rom->xr_rest[a];
+    cp = *rom; cp.xr_rest = xr;
+    xr[0] = rom->env_hi[0];   /* still inside the training range */
+    CHECK_RC(d4_roundtrip(&cp), PHGMG_OK);
+    xr[0] = (phgmg_real)1e30;
+    CHECK_RC(d4_roundtrip(&cp), PHGMG_ERR_STRUCTURE);
+    cp = *rom; cp.env_lo = rom->env_hi; cp.env_hi = rom->env_lo;   /* inverted */
+    for (a = 0; a < 6; ++a) wide |= rom->env_hi[a] > rom->env_lo[a];
+    CHECK(wide);
+    CHECK_RC(d4_roundtrip(&cp), PHGMG_ERR_STRUCTURE);
+    cp = *rom; cp.env_hi = NULL;
+    CHECK_RC(d4_roundtrip(&cp), PHGMG_ERR_STRUCTURE);
+    for (a = 0; a < 6; ++a) xr[a] = (phgmg_real)0;
+    cp = *rom0; cp.xr_rest = xr;   /* zero: rho(0) of a model without reference */
+    CHECK_RC(d4_roundtrip(&cp), PHGMG_OK);
+    xr[2] = (phgmg_real)0.5;
+    CHECK_RC(d4_roundtrip(&cp), PHGMG_ERR_STRUCTURE);
+  }
+  phgmg_reduced_destroy(red);
+  phgmg_reduced_destroy(r0);
+  dmodel_free(&t1);
+  dmodel_free(&t2);
+}
+
+/* A loaded model's damper and feedthrough blocks are refused with the codes
+   that name them: a negative damper weight or a law with a negative or even
+   coefficient: PHGMG_ERR_DAMPER; a feedthrough block that is not positive
+   semidefinite: PHGMG_ERR_FEEDTHROUGH (not the structure check's code,
+   whose text names Qh, R and the step map). The valid blocks load. */
+TEST(test_defect4_load_damper_feedthrough) {
+  dmodel t;
+  phgmg_reduced *red = d4_chain_rom(&t, 0);
+  if (red) {
+    const phgmg_rom *rom = phgmg_reduced_rom(red);
+    phgmg_rom cp;
+    phgmg_real Cd[6] = {1, 0, 0, 0, 0, 0}, dw[1] = {2}, dpoly[4] = {0, 1, 0, 3}, PD[7] = {0, 0, 0, 0, 0, 0, 1};
+    cp = *rom;
+    cp.ndamp = 1; cp.damp_deg = 3; cp.damp_nphi = 1; cp.Cd = Cd; cp.dw = dw; cp.dpoly = dpoly;
+    CHECK_RC(d4_roundtrip(&cp), PHGMG_OK);
+    dw[0] = (phgmg_real)-2;
+    CHECK_RC(d4_roundtrip(&cp), PHGMG_ERR_DAMPER);
+    dw[0] = (phgmg_real)2; dpoly[3] = (phgmg_real)-3;
+    CHECK_RC(d4_roundtrip(&cp), PHGMG_ERR_DAMPER);
+    dpoly[3] = (phgmg_real)3; dpoly[2] = (phgmg_real)1;
+    CHECK_RC(d4_roundtrip(&cp), PHGMG_ERR_DAMPER);
+    cp = *rom; cp.PD = PD;
+    CHECK_RC(d4_roundtrip(&cp), PHGMG_OK);
+    PD[6] = (phgmg_real)-1;   /* S < 0 */
+    CHECK_RC(d4_roundtrip(&cp), PHGMG_ERR_FEEDTHROUGH);
+  }
+  phgmg_reduced_destroy(red);
+  dmodel_free(&t);
+}
+
 SUITE(defects4) {
+  RUN(test_defect4_load_placement);
+  RUN(test_defect4_load_damper_feedthrough);
   RUN(test_defect4_dae_maps_in_place);
   RUN(test_defect4_dae_maps_null);
   RUN(test_defect4_dae_tolerance);
