@@ -199,7 +199,9 @@
    and the supply yr^T u at its stages (the balance as in 1.7). The online
    output functions have no u: phgmg_rom_output and the stepper's y give
    (Bh + Ph)^T grad Hr, the caller adds (S + N) u(t) (phgmg_reduced_simulate
-   and the command line do). Model files (format version 3, field PD) check
+   and the command line do); phgmg_rom_output_u(rom, x, u, y, work) gives the
+   whole output at input u, the call for firmware (the C export of such a
+   model says so in its header comment). Model files (format version 3, field PD) check
    the block on load (PHGMG_ERR_FEEDTHROUGH); no step map with feedthrough.
 
    1.7 Nonlinear dissipation (phgmg_ph_system.ndamp, damp_*)
@@ -1412,7 +1414,7 @@
            phgmg_gl3_coefficients
    online: phgmg_rom_check, phgmg_rom_eval_work_size, phgmg_rom_hamiltonian,
            phgmg_rom_gradient, phgmg_rom_rhs, phgmg_rom_output,
-           phgmg_rom_structure, phgmg_rom_hessian, phgmg_rom_jacobian,
+           phgmg_rom_output_u, phgmg_rom_structure, phgmg_rom_hessian, phgmg_rom_jacobian,
            phgmg_rom_stepper_memsize, phgmg_rom_stepper_memsize_dt,
            phgmg_rom_stepper_init, phgmg_rom_stepper_reset,
            phgmg_rom_stage_times, phgmg_rom_step
@@ -1441,7 +1443,7 @@
            phgmg_lu_rcond, phgmg_norm1, phgmg_normf, phgmg_zlu_factor,
            phgmg_zlu_solve, phgmg_qr, phgmg_qrcp, phgmg_qr_form_q,
            phgmg_qr_apply, phgmg_lstsq, phgmg_svd, phgmg_sym_eig
-   (124 functions; also the macros PHGMG_ROM_STEPPER_MEMSIZE_MAX and _MAX_CB.)
+   (125 functions; also the macros PHGMG_ROM_STEPPER_MEMSIZE_MAX and _MAX_CB.)
 */
 #ifndef PHGMG_H_INCLUDED
 #define PHGMG_H_INCLUDED
@@ -1719,8 +1721,8 @@ PHGMG_DEF phgmg_result phgmg_ph_validate(const phgmg_ph_system *sys, double tol,
    Index-one descriptor models (manual 1.8): E with k zero rows (algebraic
    equations) and k zero columns (algebraic variables). phgmg_dae_create
    checks the index (PHGMG_ERR_INDEX for index >= 2, PHGMG_ERR_PENCIL for a
-   singular pencil, PHGMG_ERR_E_SINGULAR when E is singular but not of this
-   form and not dense (a dense E without zero lines is rotated into it,
+   singular pencil, PHGMG_ERR_E_SINGULAR when E = 0 (every row and column
+   zero: no differential state) or E is singular but not of this form and not dense (a dense E without zero lines is rotated into it,
    manual 1.8; phgmg_dae_restrict/_embed/_lift then rotate back), PHGMG_ERR_EQ_NOT_SYMMETRIC when the kept co-states depend on the
    algebraic variables, PHGMG_ERR_UNSUPPORTED for a separable coordinate or a
    damper on an algebraic line, k > 4096, or an elimination whose dense
@@ -2205,8 +2207,9 @@ typedef struct phgmg_rom {
      (r x m), then Dh = S + N (m x m):  x' = ... + (Bh - Ph) u,
      y = (Bh + Ph)^T grad H + Dh u, dissipation block [[-sym K, Ph],
      [Ph^T, sym Dh]] positive semidefinite (manual 1.6). phgmg_rom_output and
-     the stepper's y give (Bh + Ph)^T grad H: they have no u, add Dh u(t)
-     yourself (phgmg_reduced_simulate does). */
+     the stepper's y give (Bh + Ph)^T grad H: they have no u; the whole output
+     at input u is phgmg_rom_output_u (or add Dh u(t) yourself, as
+     phgmg_reduced_simulate does). */
   const phgmg_real *PD;
 } phgmg_rom;
 
@@ -2220,8 +2223,15 @@ PHGMG_DEF void phgmg_rom_gradient(const phgmg_rom *rom, const phgmg_real *x, phg
 /* f = K(x) grad H(x) + Bh u (u may be NULL). PHGMG_ERR_SINGULAR if D^T G D is singular at x. */
 PHGMG_DEF phgmg_result phgmg_rom_rhs(const phgmg_rom *rom, const phgmg_real *x, const phgmg_real *u,
                                      phgmg_real *f, phgmg_real *work);
-/* y = Bh^T grad H(x). */
+/* y = Bh^T grad H(x) (with feedthrough (Bh + Ph)^T grad H(x): without the
+   Dh u term, which needs the input; use phgmg_rom_output_u). */
 PHGMG_DEF void phgmg_rom_output(const phgmg_rom *rom, const phgmg_real *x, phgmg_real *y, phgmg_real *work);
+/* The output at input u (m values; NULL = 0): y = (Bh + Ph)^T grad H(x) +
+   Dh u, the model's whole output also when it has feedthrough (PD); equal to
+   phgmg_rom_output without feedthrough. The call for firmware that deploys a
+   model with feedthrough: the stepper's y leaves out Dh u(t_{n+1}). */
+PHGMG_DEF void phgmg_rom_output_u(const phgmg_rom *rom, const phgmg_real *x, const phgmg_real *u, phgmg_real *y,
+                                  phgmg_real *work);
 /* The reduced structure matrices at x: Jr = (K - K^T)/2 (skew), Rr = -(K + K^T)/2 (sym PSD), r x r. */
 PHGMG_DEF phgmg_result phgmg_rom_structure(const phgmg_rom *rom, const phgmg_real *x, phgmg_real *Jr,
                                            phgmg_real *Rr, phgmg_real *work);
@@ -5511,7 +5521,8 @@ PHGMG_DEF phgmg_result phgmg_dae_create(phgmg_dae **out, const phgmg_ph_system *
   if (rc == PHGMG_OK && rbuf && d->k == 0) rc = PHGMG_ERR_E_SINGULAR;   /* no singular value below tol */
   if (rc == PHGMG_OK && d->k > 0) {
     d->sys.N = d->n;
-    rc = d->n > 0 && d->m <= d->n ? phgmg__dae_index(d, sys, tol) : PHGMG_ERR_SIZE;
+    rc = d->n == 0 ? PHGMG_ERR_E_SINGULAR   /* E = 0: no differential state */
+         : d->m <= d->n ? phgmg__dae_index(d, sys, tol) : PHGMG_ERR_SIZE;
     if (rc == PHGMG_OK) rc = phgmg__dae_condense(d, sys, tol);
     if (rc == PHGMG_OK) rc = phgmg__dae_nonlinear(d, sys);
   }
@@ -9986,6 +9997,19 @@ PHGMG_DEF void phgmg_rom_output(const phgmg_rom *rom, const phgmg_real *x, phgmg
   phgmg__rom_grad(rom, x, w.g, &w);
   phgmg__r_gemvt(rom->r, rom->m, rom->Bh, w.g, 0, y);
   if (rom->PD) phgmg__r_gemvt(rom->r, rom->m, rom->PD, w.g, 1, y);   /* + Ph^T g */
+}
+
+PHGMG_DEF void phgmg_rom_output_u(const phgmg_rom *rom, const phgmg_real *x, const phgmg_real *u, phgmg_real *y,
+                                  phgmg_real *work) {
+  const int r = rom->r, m = rom->m;
+  int a, b;
+  phgmg_rom_output(rom, x, y, work);
+  if (!rom->PD || !u) return;
+  for (a = 0; a < m; ++a) {   /* + Dh u, Dh (m x m) after Ph (r x m) in PD */
+    phgmg_real acc = y[a];
+    for (b = 0; b < m; ++b) acc += rom->PD[(size_t)r * (size_t)m + (size_t)a + (size_t)b * (size_t)m] * u[b];
+    y[a] = acc;
+  }
 }
 
 /* E = D^T G D = G00 + G01 L + L^T (G10 + G11 L), L = [0, Lp] (QUADRATIC; Lp current). */
@@ -18261,6 +18285,12 @@ PHGMG_DEF phgmg_result phgmg_rom_export_c(const phgmg_rom *rom, const char *name
                    "   kind %d, method %d, r = %d, m = %d, r_n = %d, DEIM points = %d.\n"
                    "   Include after phgmg.h; build with the same scalar type. */\n",
                 PHGMG_VERSION_STRING, rom->kind, rom->method, rom->r, rom->m, rom->rn, rom->nd) > 0;
+  if (rom->PD)
+    ok &= fprintf(f, "/* FEEDTHROUGH: this model's output is y = (Bh + Ph)^T grad H(x) + Dh u, Dh = S + N\n"
+                     "   (%s_PD: Ph, then Dh). phgmg_rom_step's y and phgmg_rom_output leave out the\n"
+                     "   Dh u term; compute the output with the input of the same time:\n"
+                     "     phgmg_rom_output_u(&%s, x, u, y, work);   (work: phgmg_rom_eval_work_size)\n"
+                     "   or add Dh u to the stepper's y yourself. */\n", name, name) > 0;
   ok &= fprintf(f, "#if PHGMG_REAL_IS_FLOAT != %d\n#error \"%s was exported for phgmg_real = %s\"\n#endif\n",
                 PHGMG_REAL_IS_FLOAT, name, PHGMG_REAL_IS_FLOAT ? "float" : "double") > 0;
   for (i = 0; i < PHGMG__NFIELDS; ++i) {

@@ -3,11 +3,15 @@
    with and re-checksummed, and result codes that name the real cause. Each
    test failed on the code before the corresponding change. The command
    line's messages are checked in tests/test_lib_msgs4.sh. */
+#ifndef _POSIX_C_SOURCE
+#define _POSIX_C_SOURCE 200809L /* mkstemp */
+#endif
 #define PHGMG_STATIC
 #define PHGMG_IMPLEMENTATION
 #include "../phgmg.h"
 #include "harness.h"
 #include <stdlib.h>
+#include <unistd.h>
 
 #include "fixture_msd.h"
 
@@ -276,7 +280,65 @@ TEST(test_defect4_load_damper_feedthrough) {
   dmodel_free(&t);
 }
 
+/* Does the file at path contain needle? */
+static int d4_file_has(const char *path, const char *needle) {
+  static char text[1 << 16];
+  FILE *f = fopen(path, "r");
+  size_t n;
+  if (!f) return 0;
+  n = fread(text, 1, sizeof text - 1, f);
+  fclose(f);
+  text[n] = 0;
+  return strstr(text, needle) != NULL;
+}
+
+/* Feedthrough in deployed models: phgmg_rom_output_u adds Dh u to
+   phgmg_rom_output's (Bh + Ph)^T grad H (Dh = 2.5 here: the difference is
+   2.5 u, also through the stepper's state), equals phgmg_rom_output without
+   feedthrough or with u = NULL; the C export of a model with feedthrough
+   says in its header comment that the stepper's y leaves out Dh u and names
+   phgmg_rom_output_u; without feedthrough it does not. */
+TEST(test_defect4_output_feedthrough) {
+  dmodel t;
+  phgmg_reduced *red = d4_chain_rom(&t, 0);
+  if (red) {
+    const phgmg_rom *rom = phgmg_reduced_rom(red);
+    phgmg_rom cp = *rom;
+    phgmg_real PD[7] = {0, 0, 0, 0, 0, 0, (phgmg_real)2.5}, x[6], y0[1], yu[1], yn[1], u[1] = {(phgmg_real)0.75};
+    phgmg_real work[4096];
+    char path[64];
+    int a, fd;
+    CHECK(phgmg_rom_eval_work_size(rom) <= 4096);
+    for (a = 0; a < 6; ++a) x[a] = (phgmg_real)(0.1 * (a + 1));
+    cp.Phi = cp.Gam = cp.SX = cp.SU = NULL; cp.dt = 0;
+    cp.PD = PD;
+    phgmg_rom_output(&cp, x, y0, work);
+    phgmg_rom_output_u(&cp, x, u, yu, work);
+    phgmg_rom_output_u(&cp, x, NULL, yn, work);
+    CHECK(yn[0] == y0[0]);
+    CHECK_LE(fabs((double)(yu[0] - y0[0]) - 2.5 * 0.75), 1e-6 * (1.0 + fabs((double)y0[0])));
+    phgmg_rom_output(rom, x, y0, work);
+    phgmg_rom_output_u(rom, x, u, yu, work);
+    CHECK(yu[0] == y0[0]);
+    strcpy(path, "/tmp/phgmg_d4_XXXXXX");
+    fd = mkstemp(path);
+    CHECK(fd >= 0);
+    if (fd >= 0) {
+      close(fd);
+      CHECK_RC(phgmg_rom_export_c(&cp, "ft", path), PHGMG_OK);
+      CHECK(d4_file_has(path, "phgmg_rom_output_u(&ft, x, u, y, work)"));
+      CHECK(d4_file_has(path, "leave out the\n   Dh u term") || d4_file_has(path, "leave out the"));
+      CHECK_RC(phgmg_rom_export_c(rom, "nf", path), PHGMG_OK);
+      CHECK(!d4_file_has(path, "phgmg_rom_output_u") && d4_file_has(path, "static const phgmg_rom nf"));
+      remove(path);
+    }
+  }
+  phgmg_reduced_destroy(red);
+  dmodel_free(&t);
+}
+
 SUITE(defects4) {
+  RUN(test_defect4_output_feedthrough);
   RUN(test_defect4_load_placement);
   RUN(test_defect4_load_damper_feedthrough);
   RUN(test_defect4_dae_maps_in_place);
