@@ -4928,11 +4928,28 @@ PHGMG__PRIV phgmg_result phgmg__ph_validate(const phgmg_ph_system *sys, double t
   return PHGMG_OK;
 }
 
+/* A singular E that is neither dense nor of the zero-line form makes E^T Q
+   singular too; the cause to report is E (taken dense only). */
+PHGMG__PRIV phgmg_result phgmg__ph_e_cause(const phgmg_ph_system *sys, phgmg_result rc,
+                                          const phgmg_allocator *alloc) {
+  phgmg_jr_factor *f = NULL;
+  double rcond = 0.0;
+  phgmg_result fr;
+  if ((rc != PHGMG_ERR_EQ_NOT_PD && rc != PHGMG_ERR_EQ_NOT_SYMMETRIC) || !sys->E || sys->storage == PHGMG_DENSE ||
+      phgmg__e_algebraic(sys, alloc) != 0)
+    return rc;
+  fr = phgmg__e_factor(sys, &f, &rcond, alloc);
+  phgmg_jr_factor_destroy(f);
+  return fr == PHGMG_ERR_NOMEM || (fr == PHGMG_OK && rcond > 1e-12) ? rc : PHGMG_ERR_E_SINGULAR;
+}
+
 PHGMG_DEF phgmg_result phgmg_ph_validate(const phgmg_ph_system *sys, double tol,
                                          double *rcond_out, const phgmg_allocator *alloc) {
+  phgmg_result rc;
   if (rcond_out) *rcond_out = 0.0;
   if (tol != tol || tol == HUGE_VAL) return PHGMG_ERR_INVALID_ARG;   /* NaN, +Inf */
-  return phgmg__ph_validate(sys, tol, rcond_out, alloc, 1);
+  rc = phgmg__ph_validate(sys, tol, rcond_out, alloc, 1);
+  return phgmg__ph_e_cause(sys, rc, alloc);
 }
 
 /* >>dae (implementation) ================================================== */
