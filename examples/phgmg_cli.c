@@ -2077,6 +2077,67 @@ static int load_dampers(const reduce_args *A, reduce_state *S, phgmg_ph_system *
   return 0;
 }
 
+static int e_zero_lines(const reduce_state *S, int N, int *zr, int *zc, int *dk, int *dl);
+
+/* A failed validation whose cause is the dampers (1: reported): a damper
+   on an algebraic line of E, or J - R - L singular (L the dampers'
+   linearisation at 0) while J - R alone is not. */
+static int explain_dampers(const reduce_args *A, const reduce_state *S, const phgmg_ph_system *sys,
+                           phgmg_result rc) {
+  int zr = 0, zc = 0, dk = -1, dl = -1;
+  if (rc == PHGMG_ERR_SINGULAR) {
+    phgmg_ph_system t = *sys;
+    double rc0 = 0.0;
+    t.ndamp = 0;
+    if (phgmg_ph_validate(&t, 0.0, &rc0, NULL) != PHGMG_OK) return 0;
+    fail("%s (--dampers): J - R minus the dampers' linear part at 0 (their c1 terms) is singular to working "
+         "precision (J - R alone: rcond %.3g): a damper's c1 is out of scale with the model", A->dampf, rc0);
+    return 1;
+  }
+  if (rc != PHGMG_ERR_UNSUPPORTED || !sys->E) return 0;
+  e_zero_lines(S, sys->N, &zr, &zc, &dk, &dl);
+  if (dk < 0) return 0;
+  fail("%s (--dampers): row %d: the damper acts on state %d, an algebraic line of E (a zero row or column of "
+       "%s): dampers must act on differential states only", A->dampf, dk, dl, A->E ? A->E : A->Ecoo);
+  return 1;
+}
+
+/* rz[i] = 1 for a zero row i, cz[j] = 1 for a zero column j of the given E
+   (--E or --E-coo, the files' order). */
+static void e_zero_masks(const reduce_state *S, int N, char *rz, char *cz) {
+  int i, j;
+  memset(rz, 1, (size_t)N); memset(cz, 1, (size_t)N);
+  if (S->E.a) {
+    for (j = 0; j < N; ++j)
+      for (i = 0; i < N; ++i)
+        if (S->E.a[i + (size_t)j * N] != 0.0) rz[i] = cz[j] = 0;
+  } else if (S->cE.A.colptr) {
+    for (j = 0; j < N; ++j)
+      for (i = S->cE.A.colptr[j]; i < S->cE.A.colptr[j + 1]; ++i)
+        if (S->cE.A.values[i] != 0.0) rz[S->cE.A.rowidx[i]] = cz[j] = 0;
+  }
+}
+
+/* Zero rows (*zr) and zero columns (*zc) of the given E; returns the smaller
+   count. With dampers, *dk = the first damper (row of --dampers) with a state
+   on a zero line of E, *dl = that state (-1: none). */
+static int e_zero_lines(const reduce_state *S, int N, int *zr, int *zc, int *dk, int *dl) {
+  char *rz = (char *)malloc((size_t)N), *cz = (char *)malloc((size_t)N);
+  int i, k;
+  *zr = *zc = 0;
+  if (dk) *dk = *dl = -1;
+  if (!rz || !cz) { free(rz); free(cz); return 0; }
+  e_zero_masks(S, N, rz, cz);
+  for (i = 0; i < N; ++i) { *zr += rz[i]; *zc += cz[i]; }
+  for (k = 0; dk && S->Dm.a && *dk < 0 && k < S->Dm.rows * S->Dm.cols / 4; ++k) {
+    const int nd = S->Dm.rows * S->Dm.cols / 4, vi = (int)S->Dm.a[k], vj = (int)S->Dm.a[k + nd];
+    if (rz[vi] || cz[vi]) { *dk = k; *dl = vi; }
+    else if (vj >= 0 && (rz[vj] || cz[vj])) { *dk = k; *dl = vj; }
+  }
+  free(rz); free(cz);
+  return *zr < *zc ? *zr : *zc;
+}
+
 /* The full model from the files: dense or sparse J, R, Q, B and the nonlinear
    part, checked (phgmg_ph_validate), into S->sys. */
 static int condense_algebraic(reduce_state *S);
@@ -2157,6 +2218,7 @@ static int load_system(const reduce_args *A, reduce_state *S) {
   }
   if (load_feedthrough(A, S, &sys) || load_dampers(A, S, &sys) || load_ref(A, S, sys.N)) return 1;
   rc = phgmg_ph_validate(&sys, 0.0, &rcond, NULL);
+  if (sys.ndamp && rc != PHGMG_OK && explain_dampers(A, S, &sys, rc)) return 1;
   if (sys.ndamp && (rc == PHGMG_ERR_DAMPER || rc == PHGMG_ERR_SIZE || rc == PHGMG_ERR_NANINF))
     return fail("%s (--dampers): %s%s", A->dampf, phgmg_result_string(rc),
                 rc == PHGMG_ERR_DAMPER ? " (c1 and c3 must be >= 0)" : rc == PHGMG_ERR_SIZE ? " (banded storage: |i - j| beyond the band)" : "");
@@ -2165,8 +2227,15 @@ static int load_system(const reduce_args *A, reduce_state *S) {
                 A->Nf ? " " : "", A->Nf ? A->Nf : "", phgmg_result_string(rc));
   if (rc != PHGMG_OK && sys.E) {
     const char *ef = A->E ? A->E : A->Ecoo, *qf = A->Q ? A->Q : A->Qcoo;
+    int zr = 0, zc = 0;
     switch (rc) {
-      case PHGMG_ERR_E_SINGULAR: return fail("%s (--E): %s", ef, phgmg_result_string(rc));
+      case PHGMG_ERR_E_SINGULAR:
+        return fail("%s (%s): %s%s", ef, A->E ? "--E" : "--E-coo", phgmg_result_string(rc),
+                    e_zero_lines(S, sys.N, &zr, &zc, NULL, NULL) == sys.N ? " (every row and column of E is zero: no "
+                                                                  "differential state)"
+                    : A->Ecoo && zr + zc == 0 ? " (a singular E without zero rows and columns is taken in dense "
+                                                "form only: give it as --E)"
+                    : zr != zc ? " (its zero rows and zero columns differ in number)" : "");
       case PHGMG_ERR_EQ_NOT_SYMMETRIC:
       case PHGMG_ERR_EQ_NOT_PD: return fail("%s, %s (--E, --Q): %s", ef, qf, phgmg_result_string(rc));
       case PHGMG_ERR_E_COUPLED: return fail("%s, %s (--E, --poly-idx): %s", ef, A->poly_idx, phgmg_result_string(rc));
@@ -2174,9 +2243,12 @@ static int load_system(const reduce_args *A, reduce_state *S) {
                                               "with algebraic lines of E, none on them)", ef, phgmg_result_string(rc));
       case PHGMG_ERR_INDEX:
       case PHGMG_ERR_PENCIL:
-        return fail("%s, %s, %s, %s (--E, --J, --R, --Q): %s: the zero rows and columns of E are algebraic "
-                    "equations and variables, and the equations must determine the variables (index one)", ef,
-                    A->J ? A->J : A->Jcoo, A->R ? A->R : A->Rcoo, qf, phgmg_result_string(rc));
+        return fail("%s, %s, %s, %s (--E, --J, --R, --Q): %s: %s, and the equations must determine the variables "
+                    "(index one)", ef, A->J ? A->J : A->Jcoo, A->R ? A->R : A->Rcoo, qf, phgmg_result_string(rc),
+                    e_zero_lines(S, sys.N, &zr, &zc, NULL, NULL) > 0
+                        ? "the zero rows and columns of E are algebraic equations and variables"
+                        : "E is singular without zero rows or columns: the directions of its null spaces (left: "
+                          "equations, right: variables) are algebraic");
       default: break;
     }
   }
