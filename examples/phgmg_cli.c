@@ -2281,17 +2281,30 @@ static int condense_algebraic(reduce_state *S) {
   return 0;
 }
 
-/* Sizes that phgmg_reduce would refuse, explained up front. */
-static int check_sizes(const reduce_args *A, int method, int N, int m) {
+/* 1 if the n values of a are all zero. */
+static int all_zero(const double *a, size_t n) {
+  size_t i;
+  for (i = 0; i < n; ++i)
+    if (a[i] != 0.0) return 0;
+  return 1;
+}
+
+/* Sizes that phgmg_reduce would refuse, explained up front. N: the states
+   reduced (an index-one model's differential states: k algebraic ones
+   left out of its N + k). */
+static int check_sizes(const reduce_args *A, int method, int N, int m, int k) {
+  char nd[128];
+  if (k > 0) snprintf(nd, sizeof nd, "%d differential states (the model's %d states less %d algebraic)", N, N + k, k);
+  else snprintf(nd, sizeof nd, "%d", N);
   if (method == PHGMG_METHOD_GMG_POD || method == PHGMG_METHOD_GMG_QM) {
     if (A->r <= m || A->r > N)
-      return usage_error("--r %d: %s needs m < r <= N (m = %d ports from %s, N = %d)", A->r, A->method, m, A->B, N);
+      return usage_error("--r %d: %s needs m < r <= N (m = %d ports from %s, N = %s)", A->r, A->method, m, A->B, nd);
     if (method == PHGMG_METHOD_GMG_QM && A->rn > 0 && A->rn > N - A->r)
-      return usage_error("--rn %d: gmg-qm needs r + r_n <= N (= %d)", A->rn, N);
+      return usage_error("--rn %d: gmg-qm needs r + r_n <= N (N = %s)", A->rn, nd);
     if (method == PHGMG_METHOD_GMG_QM && A->r >= N)
-      return usage_error("--r %d: gmg-qm needs r < N (= %d): room for at least one quadratic mode", A->r, N);
+      return usage_error("--r %d: gmg-qm needs r < N (N = %s): room for at least one quadratic mode", A->r, nd);
   } else if (A->r > N) {
-    return usage_error("--r %d: needs r <= N = %d", A->r, N);
+    return usage_error("--r %d: needs r <= N = %s", A->r, nd);
   }
 
   return 0;
@@ -2446,6 +2459,13 @@ static int run_reduction(const reduce_args *A, reduce_state *S, int method, cons
         return fail("reduction failed: %s: r = %d%s exceeds the rank of %s (%d snapshots of size %d)",
                     phgmg_result_string(rc), A->r, method == PHGMG_METHOD_GMG_QM ? " plus r_n" : "", src, ns, N);
       case PHGMG_ERR_RANK:
+        if (S->dae && all_zero(S->sys.B, (size_t)S->sys.N * (size_t)S->sys.m))
+          return fail("reduction failed: %s: every port of %s acts through an algebraic constraint, so the "
+                      "condensed model's port matrix B is zero (the ports act only through its feedthrough terms) "
+                      "and the reduction has no port direction to keep", phgmg_result_string(rc), A->B);
+        if (method == PHGMG_METHOD_GMG_QM && A->have_lambda && !A->lambda_auto && A->lambda > 0.0 && A->lambda < 1e-8)
+          return fail("reduction failed: %s: --lambda %g, the ridge parameter of the quadratic fit, is too small "
+                      "to regularise it (give a larger --lambda, or leave it out)", phgmg_result_string(rc), A->lambda);
         return fail("reduction failed: %s (%s, or the port matrix %s)", phgmg_result_string(rc), src, A->B);
       case PHGMG_ERR_DEGENERATE:
         return fail("reduction failed: %s (try another --r, or for gmg-qm a larger --lambda)", phgmg_result_string(rc));
@@ -2797,7 +2817,7 @@ static int reduce_prepare(const reduce_args *A, reduce_state *S, const char *con
   g_inputs = &S->pin;
   if (check_writable_dir(A->out, "--out", A->out, 1)) return 1;
   if ((e = load_system(A, S)) != 0) return e;
-  if ((e = check_sizes(A, S->method, S->sys.N, S->sys.m)) != 0) return e;
+  if ((e = check_sizes(A, S->method, S->sys.N, S->sys.m, S->dae ? phgmg_dae_nalg(S->dae) : 0)) != 0) return e;
   return A->X ? load_snapshot_files(A, S, S->sys.N, S->sys.m, &S->Xd, &S->ns) : 0;
 }
 
