@@ -2463,9 +2463,10 @@ static int run_reduction(const reduce_args *A, reduce_state *S, int method, cons
           return fail("reduction failed: %s: every port of %s acts through an algebraic constraint, so the "
                       "condensed model's port matrix B is zero (the ports act only through its feedthrough terms) "
                       "and the reduction has no port direction to keep", phgmg_result_string(rc), A->B);
-        if (method == PHGMG_METHOD_GMG_QM && A->have_lambda && !A->lambda_auto && A->lambda > 0.0 && A->lambda < 1e-8)
+        if (method == PHGMG_METHOD_GMG_QM && A->have_lambda && !A->lambda_auto && A->lambda > 0.0)
           return fail("reduction failed: %s: --lambda %g, the ridge parameter of the quadratic fit, is too small "
-                      "to regularise it (give a larger --lambda, or leave it out)", phgmg_result_string(rc), A->lambda);
+                      "to regularise it against the scale of the quadratic features (give a larger --lambda, "
+                      "or leave it out)", phgmg_result_string(rc), A->lambda);
         return fail("reduction failed: %s (%s, or the port matrix %s)", phgmg_result_string(rc), src, A->B);
       case PHGMG_ERR_DEGENERATE:
         return fail("reduction failed: %s (try another --r, or for gmg-qm a larger --lambda)", phgmg_result_string(rc));
