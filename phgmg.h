@@ -329,7 +329,9 @@
    phgmg_dae_create builds the condensed model (dense or banded like the
    input; the update is confined to the neighbours of the algebraic lines),
    phgmg_dae_lift recovers the algebraic variables (x_c = Q_ac^{-1} (z_a -
-   Q_ad x_d)), phgmg_dae_restrict takes x_d.
+   Q_ad x_d)), phgmg_dae_restrict takes x_d; the three maps work in place
+   (x == xi), refuse other overlaps and a NULL object (PHGMG_ERR_INVALID_ARG).
+   E = 0 (no differential state) is PHGMG_ERR_E_SINGULAR.
    Simulation (phgmg_simulate; the command line's simulate and reduce
    --simulate): the scheme is Gauss-Legendre collocation of the DAE itself,
    its stage equations enforce the constraints at the stages, and the
@@ -3159,7 +3161,10 @@ PHGMG_DEF phgmg_result phgmg_rom_deserialize_size(const void *buf, size_t len, s
    S / eps (eps = 1.2e-7 in a float build, 2.2e-16 in double; S the largest
    of the envelope's widths and bounds), since a run from rest moves over
    the training range and, from a state further away, every such move would
-   be below the state's rounding unit.
+   be below the state's rounding unit. The remaining fields are free by
+   construction and checked for NaN/Inf only: port and damper directions
+   (Bh, Cd), the DEIM and manifold terms (P0, P1, w, Ms), the reference
+   offsets (ref_g, ref_s).
    No allocation; phgmg_rom_load returns the same codes. */
 PHGMG_DEF phgmg_result phgmg_rom_deserialize(const void *buf, size_t len, phgmg_rom *rom, void *mem,
                                              size_t mem_size);
