@@ -2235,6 +2235,9 @@ static int load_system(const reduce_args *A, reduce_state *S) {
                                                                   "differential state)"
                     : A->Ecoo && zr + zc == 0 ? " (a singular E without zero rows and columns is taken in dense "
                                                 "form only: give it as --E)"
+                    : zr + zc == 0 && (sys.ndamp || sys.nl != PHGMG_NL_NONE)
+                        ? " (a singular E without zero rows and columns is taken with a quadratic energy and no "
+                          "dampers only)"
                     : zr != zc ? " (its zero rows and zero columns differ in number)" : "");
       case PHGMG_ERR_EQ_NOT_SYMMETRIC:
       case PHGMG_ERR_EQ_NOT_PD: return fail("%s, %s (--E, --Q): %s", ef, qf, phgmg_result_string(rc));

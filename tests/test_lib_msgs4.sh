@@ -9,7 +9,7 @@
 # with an algebraic node, a rotated chain whose E has no zero line) and
 # checks the exit status and that the error names the option, file and
 # cause: E = 0 (dense and sparse), a singular --E-coo without zero lines
-# (taken dense only), index two of an E without zero lines, a damper whose
+# (taken dense only) or with a damper, index two of an E without zero lines, a damper whose
 # c1 makes J - R - L singular, a damper on an algebraic line, r beyond the
 # differential states of an index-one model, every port acting through a
 # constraint (condensed B = 0), --lambda too small for the quadratic fit,
@@ -80,6 +80,7 @@ sy = lambda A: (A + A.T) / 2
 Ew, Jw, Rw, Rw2, Qw = P @ E @ T, sk(P @ J @ P.T), sy(P @ R @ P.T), sy(P @ R2 @ P.T), P @ Q @ T
 for k, v in dict(Ew=Ew, Jw=Jw, Rw=Rw, Rw2=Rw2, Qw=Qw, Bw=P @ B).items(): np.save(k + ".npy", v)
 for k, v in dict(Ew=Ew, Jw=Jw, Rw=Rw, Qw=Qw).items(): np.save(k + "c.npy", coo(v))
+np.save("d_w.npy", np.array([[1, 4, 0.2, 0.1]]))
 PYEOF
 
 # expect STATUS PATTERN... -- run phgmg with the remaining arguments; the
@@ -110,6 +111,9 @@ expect 1 "E0c.npy (--E-coo)" "every row and column of E is zero" -- \
 expect 0 -- $SIM --J Jw.npy --R Rw.npy --Q Qw.npy --B Bw.npy --E Ew.npy
 expect 1 "Ewc.npy (--E-coo)" "singular E without zero rows and columns is taken in dense form only" -- \
   $SIM --J-coo Jwc.npy --R-coo Rwc.npy --Q-coo Qwc.npy --B Bw.npy --E-coo Ewc.npy
+# with a damper that E is not taken (quadratic energy, no dampers): said so
+expect 1 "Ew.npy (--E)" "taken with a quadratic energy and no dampers only" -- \
+  $SIM --J Jw.npy --R Rw.npy --Q Qw.npy --B Bw.npy --E Ew.npy --dampers d_w.npy
 # index two of that E: no zero lines to blame
 expect 1 "index two" "E is singular without zero rows or columns" -- \
   $SIM --J Jw.npy --R Rw2.npy --Q Qw.npy --B Bw.npy --E Ew.npy
