@@ -2102,6 +2102,41 @@ static int explain_dampers(const reduce_args *A, const reduce_state *S, const ph
   return 1;
 }
 
+/* A failed validation of a descriptor model explained in terms of E (1:
+   reported, 0: not a cause this explains). */
+static int explain_descriptor(const reduce_args *A, const reduce_state *S, const phgmg_ph_system *sys,
+                              phgmg_result rc) {
+  const char *ef = A->E ? A->E : A->Ecoo, *qf = A->Q ? A->Q : A->Qcoo;
+  int zr = 0, zc = 0;
+  switch (rc) {
+    case PHGMG_ERR_E_SINGULAR:
+      return fail("%s (%s): %s%s", ef, A->E ? "--E" : "--E-coo", phgmg_result_string(rc),
+                  e_zero_lines(S, sys->N, &zr, &zc, NULL, NULL) == sys->N
+                      ? " (every row and column of E is zero: no differential state)"
+                  : A->Ecoo && zr + zc == 0 ? " (a singular E without zero rows and columns is taken in dense "
+                                              "form only: give it as --E)"
+                  : zr + zc == 0 && (sys->ndamp || sys->nl != PHGMG_NL_NONE)
+                      ? " (a singular E without zero rows and columns is taken with a quadratic energy and no "
+                        "dampers only)"
+                  : zr != zc ? " (its zero rows and zero columns differ in number)" : "");
+    case PHGMG_ERR_EQ_NOT_SYMMETRIC:
+    case PHGMG_ERR_EQ_NOT_PD: return fail("%s, %s (--E, --Q): %s", ef, qf, phgmg_result_string(rc));
+    case PHGMG_ERR_E_COUPLED: return fail("%s, %s (--E, --poly-idx): %s", ef, A->poly_idx, phgmg_result_string(rc));
+    case PHGMG_ERR_UNSUPPORTED: return fail("%s (--E): %s (a descriptor model takes a separable nonlinear part only; "
+                                            "with algebraic lines of E, none on them)", ef, phgmg_result_string(rc));
+    case PHGMG_ERR_INDEX:
+    case PHGMG_ERR_PENCIL:
+      return fail("%s, %s, %s, %s (--E, --J, --R, --Q): %s: %s, and the equations must determine the variables "
+                  "(index one)", ef, A->J ? A->J : A->Jcoo, A->R ? A->R : A->Rcoo, qf, phgmg_result_string(rc),
+                  e_zero_lines(S, sys->N, &zr, &zc, NULL, NULL) > 0
+                      ? "the zero rows and columns of E are algebraic equations and variables"
+                      : "E is singular without zero rows or columns: the directions of its null spaces (left: "
+                        "equations, right: variables) are algebraic");
+    default: break;
+  }
+  return 0;
+}
+
 /* rz[i] = 1 for a zero row i, cz[j] = 1 for a zero column j of the given E
    (--E or --E-coo, the files' order). */
 static void e_zero_masks(const reduce_state *S, int N, char *rz, char *cz) {
@@ -2225,36 +2260,7 @@ static int load_system(const reduce_args *A, reduce_state *S) {
   if (rc == PHGMG_ERR_FEEDTHROUGH || (rc == PHGMG_ERR_UNSUPPORTED && (sys.P || sys.S || sys.Nskew)))
     return fail("%s%s%s%s%s (--P, --S, --N): %s", A->Pf ? A->Pf : "", A->Sf ? " " : "", A->Sf ? A->Sf : "",
                 A->Nf ? " " : "", A->Nf ? A->Nf : "", phgmg_result_string(rc));
-  if (rc != PHGMG_OK && sys.E) {
-    const char *ef = A->E ? A->E : A->Ecoo, *qf = A->Q ? A->Q : A->Qcoo;
-    int zr = 0, zc = 0;
-    switch (rc) {
-      case PHGMG_ERR_E_SINGULAR:
-        return fail("%s (%s): %s%s", ef, A->E ? "--E" : "--E-coo", phgmg_result_string(rc),
-                    e_zero_lines(S, sys.N, &zr, &zc, NULL, NULL) == sys.N ? " (every row and column of E is zero: no "
-                                                                  "differential state)"
-                    : A->Ecoo && zr + zc == 0 ? " (a singular E without zero rows and columns is taken in dense "
-                                                "form only: give it as --E)"
-                    : zr + zc == 0 && (sys.ndamp || sys.nl != PHGMG_NL_NONE)
-                        ? " (a singular E without zero rows and columns is taken with a quadratic energy and no "
-                          "dampers only)"
-                    : zr != zc ? " (its zero rows and zero columns differ in number)" : "");
-      case PHGMG_ERR_EQ_NOT_SYMMETRIC:
-      case PHGMG_ERR_EQ_NOT_PD: return fail("%s, %s (--E, --Q): %s", ef, qf, phgmg_result_string(rc));
-      case PHGMG_ERR_E_COUPLED: return fail("%s, %s (--E, --poly-idx): %s", ef, A->poly_idx, phgmg_result_string(rc));
-      case PHGMG_ERR_UNSUPPORTED: return fail("%s (--E): %s (a descriptor model takes a separable nonlinear part only; "
-                                              "with algebraic lines of E, none on them)", ef, phgmg_result_string(rc));
-      case PHGMG_ERR_INDEX:
-      case PHGMG_ERR_PENCIL:
-        return fail("%s, %s, %s, %s (--E, --J, --R, --Q): %s: %s, and the equations must determine the variables "
-                    "(index one)", ef, A->J ? A->J : A->Jcoo, A->R ? A->R : A->Rcoo, qf, phgmg_result_string(rc),
-                    e_zero_lines(S, sys.N, &zr, &zc, NULL, NULL) > 0
-                        ? "the zero rows and columns of E are algebraic equations and variables"
-                        : "E is singular without zero rows or columns: the directions of its null spaces (left: "
-                          "equations, right: variables) are algebraic");
-      default: break;
-    }
-  }
+  if (rc != PHGMG_OK && sys.E && explain_descriptor(A, S, &sys, rc)) return 1;
   if (rc != PHGMG_OK && S->sp)
     return fail("the sparse system (%s, %s, %s, %s) is not valid: %s%s", A->Jcoo, A->Rcoo, A->Qcoo, A->B,
                 phgmg_result_string(rc), rc == PHGMG_ERR_SINGULAR ? " (J - R singular)" : "");
@@ -2290,6 +2296,22 @@ static int all_zero(const double *a, size_t n) {
   for (i = 0; i < n; ++i)
     if (a[i] != 0.0) return 0;
   return 1;
+}
+
+/* phgmg_reduce's PHGMG_ERR_RANK explained: every port through a constraint
+   (an index-one model's condensed B = 0), a --lambda too small for the
+   quadratic fit, else the snapshots (src) or B. */
+static int explain_rank(const reduce_args *A, const reduce_state *S, int method, const char *src) {
+  const char *what = phgmg_result_string(PHGMG_ERR_RANK);
+  if (S->dae && all_zero(S->sys.B, (size_t)S->sys.N * (size_t)S->sys.m))
+    return fail("reduction failed: %s: every port of %s acts through an algebraic constraint, so the condensed "
+                "model's port matrix B is zero (the ports act only through its feedthrough terms) and the "
+                "reduction has no port direction to keep", what, A->B);
+  if (method == PHGMG_METHOD_GMG_QM && A->have_lambda && !A->lambda_auto && A->lambda > 0.0)
+    return fail("reduction failed: %s: --lambda %g, the ridge parameter of the quadratic fit, is too small to "
+                "regularise it against the scale of the quadratic features (give a larger --lambda, or leave "
+                "it out)", what, A->lambda);
+  return fail("reduction failed: %s (%s, or the port matrix %s)", what, src, A->B);
 }
 
 /* Sizes that phgmg_reduce would refuse, explained up front. N: the states
@@ -2461,16 +2483,7 @@ static int run_reduction(const reduce_args *A, reduce_state *S, int method, cons
       case PHGMG_ERR_SIZE:
         return fail("reduction failed: %s: r = %d%s exceeds the rank of %s (%d snapshots of size %d)",
                     phgmg_result_string(rc), A->r, method == PHGMG_METHOD_GMG_QM ? " plus r_n" : "", src, ns, N);
-      case PHGMG_ERR_RANK:
-        if (S->dae && all_zero(S->sys.B, (size_t)S->sys.N * (size_t)S->sys.m))
-          return fail("reduction failed: %s: every port of %s acts through an algebraic constraint, so the "
-                      "condensed model's port matrix B is zero (the ports act only through its feedthrough terms) "
-                      "and the reduction has no port direction to keep", phgmg_result_string(rc), A->B);
-        if (method == PHGMG_METHOD_GMG_QM && A->have_lambda && !A->lambda_auto && A->lambda > 0.0)
-          return fail("reduction failed: %s: --lambda %g, the ridge parameter of the quadratic fit, is too small "
-                      "to regularise it against the scale of the quadratic features (give a larger --lambda, "
-                      "or leave it out)", phgmg_result_string(rc), A->lambda);
-        return fail("reduction failed: %s (%s, or the port matrix %s)", phgmg_result_string(rc), src, A->B);
+      case PHGMG_ERR_RANK: return explain_rank(A, S, method, src);
       case PHGMG_ERR_DEGENERATE:
         return fail("reduction failed: %s (try another --r, or for gmg-qm a larger --lambda)", phgmg_result_string(rc));
       case PHGMG_ERR_STEP_MAP:
