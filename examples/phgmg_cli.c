@@ -2481,8 +2481,9 @@ static int run_reduction(const reduce_args *A, reduce_state *S, int method, cons
     const char *src = A->X ? A->X : "the simulated snapshots";
     switch (rc) {
       case PHGMG_ERR_SIZE:
-        return fail("reduction failed: %s: r = %d%s exceeds the rank of %s (%d snapshots of size %d)",
-                    phgmg_result_string(rc), A->r, method == PHGMG_METHOD_GMG_QM ? " plus r_n" : "", src, ns, N);
+        return fail("reduction failed: %s: r = %d%s exceeds the rank of %s (%d snapshots of size %d%s)",
+                    phgmg_result_string(rc), A->r, method == PHGMG_METHOD_GMG_QM ? " plus r_n" : "", src, ns, N,
+                    S->dae ? ": the differential states" : "");
       case PHGMG_ERR_RANK: return explain_rank(A, S, method, src);
       case PHGMG_ERR_DEGENERATE:
         return fail("reduction failed: %s (try another --r, or for gmg-qm a larger --lambda)", phgmg_result_string(rc));

@@ -129,6 +129,8 @@ grep -q "(--P, --S, --N)" err.txt && bad "a damper on an algebraic line blamed o
 # index-one sizes: the differential count and the model's
 expect 2 "N = 19 differential states" "20 states less 1 algebraic" -- \
   reduce --J J.npy --R R.npy --Q Q.npy --B B.npy --E E5.npy --method gmg-pod --r 20 --simulate --out o
+expect 1 "snapshots of size 19: the differential states" -- \
+  reduce --J J.npy --R R.npy --Q Q.npy --B B.npy --E E5.npy --method gmg-pod --r 10 --simulate --steps 5 --out o4
 # every port through a constraint: the condensed B is zero
 expect 1 "every port of cB.npy acts through an algebraic constraint" "port matrix B is zero" -- \
   reduce --J cJ.npy --R cR.npy --Q cQ.npy --B cB.npy --E cE.npy --method sp1 --r 1 --simulate --out o2
