@@ -1715,6 +1715,9 @@ typedef struct phgmg_ph_system {
    failure is returned: PHGMG_ERR_INVALID_ARG (NULL pointers, missing
    callbacks) / _SIZE / _NANINF / _NOT_SKEW / _NOT_SYMMETRIC (R) /
    _Q_NOT_SYMMETRIC / _NOT_PSD (R) / _Q_NOT_PD / _RANK / _SINGULAR, or _NOMEM.
+   Descriptor models (E set) add the codes of manual 1.8; a singular E that
+   is neither dense nor of the zero-line form is PHGMG_ERR_E_SINGULAR, also
+   where E^T Q's checks would fail first (its cause is E).
    The system is never modified. */
 PHGMG_DEF phgmg_result phgmg_ph_validate(const phgmg_ph_system *sys, double tol,
                                          double *rcond_out, const phgmg_allocator *alloc);
