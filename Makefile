@@ -202,6 +202,7 @@ test-cli: $(BUILD)/phgmg $(BUILD)/phgmg-float
 	sh tests/test_cli.sh $(BUILD)/phgmg $(BUILD)/phgmg-float
 	sh tests/test_cli_defects4.sh $(BUILD)/phgmg $(BUILD)/phgmg-float
 	sh tests/test_simulate.sh $(BUILD)/phgmg
+	sh tests/test_lib_msgs4.sh $(BUILD)/phgmg
 	/usr/bin/python3 tests/check_dae_bar.py $(BUILD)/phgmg 100 $(BUILD)/dae_bar
 
 # The descriptor bar (N = 800, consistent mass, feedthrough, scrambled order)

@@ -200,8 +200,10 @@
    and the supply yr^T u at its stages (the balance as in 1.7). The online
    output functions have no u: phgmg_rom_output and the stepper's y give
    (Bh + Ph)^T grad Hr, the caller adds (S + N) u(t) (phgmg_reduced_simulate
-   and the command line do). Model files (format version 3, field PD) check
-   the block on load (PHGMG_ERR_STRUCTURE); no step map with feedthrough.
+   and the command line do); phgmg_rom_output_u(rom, x, u, y, work) gives the
+   whole output at input u, the call for firmware (the C export of such a
+   model says so in its header comment). Model files (format version 3, field PD) check
+   the block on load (PHGMG_ERR_FEEDTHROUGH); no step map with feedthrough.
 
    1.7 Nonlinear dissipation (phgmg_ph_system.ndamp, damp_*)
    Dampers r(z) = sum_k c_k rho_k(c_k^T z), c_k = e_i - e_j (a damper between
@@ -333,7 +335,9 @@
    phgmg_dae_create builds the condensed model (dense or banded like the
    input; the update is confined to the neighbours of the algebraic lines),
    phgmg_dae_lift recovers the algebraic variables (x_c = Q_ac^{-1} (z_a -
-   Q_ad x_d)), phgmg_dae_restrict takes x_d.
+   Q_ad x_d)), phgmg_dae_restrict takes x_d; the three maps work in place
+   (x == xi), refuse other overlaps and a NULL object (PHGMG_ERR_INVALID_ARG).
+   E = 0 (no differential state) is PHGMG_ERR_E_SINGULAR.
    Simulation (phgmg_simulate; the command line's simulate and reduce
    --simulate): the scheme is Gauss-Legendre collocation of the DAE itself,
    its stage equations enforce the constraints at the stages, and the
@@ -956,8 +960,10 @@
    back into user code cannot be serialised; the C export references the
    firmware's <name>_phi / <name>_eta instead (a GENERAL model, callback
    dampers: not at all). A loaded model with dampers must have weights >= 0
-   and dissipative laws, one with feedthrough a positive semidefinite
-   dissipation block (PHGMG_ERR_STRUCTURE otherwise).
+   and dissipative laws (PHGMG_ERR_DAMPER otherwise), one with feedthrough a
+   positive semidefinite dissipation block (PHGMG_ERR_FEEDTHROUGH), and the
+   training envelope, q_max and the rest state xr_rest must be in range
+   (PHGMG_ERR_STRUCTURE; the criteria at phgmg_rom_deserialize).
 
    5.3 Firmware builds. PHGMG_NO_OFFLINE compiles only the online half and the
    in-memory (de)serialisation: libm only, no heap, no stdio. PHGMG_REAL_FLOAT
@@ -1060,7 +1066,9 @@
      PHGMG_ERR_STRUCTURE (-26)      an intact model file that is not a pH model
                                     of its kind (Qh not positive definite,
                                     dissipation not PSD, a step map not of its
-                                    dt): phgmg_rom_deserialize / _load
+                                    dt, the rest state or the training
+                                    envelope out of range):
+                                    phgmg_rom_deserialize / _load
      PHGMG_ERR_STEP_MAP (-27)       the step map of a dissipative model would
                                     grow in the energy norm (phgmg_reduce with
                                     opts.dt)
@@ -1482,7 +1490,7 @@
            phgmg_gl3_coefficients
    online: phgmg_rom_check, phgmg_rom_eval_work_size, phgmg_rom_hamiltonian,
            phgmg_rom_gradient, phgmg_rom_rhs, phgmg_rom_output,
-           phgmg_rom_structure, phgmg_rom_hessian, phgmg_rom_jacobian,
+           phgmg_rom_output_u, phgmg_rom_structure, phgmg_rom_hessian, phgmg_rom_jacobian,
            phgmg_rom_stepper_memsize, phgmg_rom_stepper_memsize_dt,
            phgmg_rom_stepper_init, phgmg_rom_stepper_reset,
            phgmg_rom_stage_times, phgmg_rom_step
@@ -1518,7 +1526,7 @@
            phgmg_lu_rcond, phgmg_norm1, phgmg_normf, phgmg_zlu_factor,
            phgmg_zlu_solve, phgmg_qr, phgmg_qrcp, phgmg_qr_form_q,
            phgmg_qr_apply, phgmg_lstsq, phgmg_svd, phgmg_sym_eig
-   (141 functions; 17 of them only with PHGMG_MPI; also the macros
+   (142 functions; 17 of them only with PHGMG_MPI; also the macros
    PHGMG_ROM_STEPPER_MEMSIZE_MAX and _MAX_CB.)
 */
 #ifndef PHGMG_H_INCLUDED
@@ -1589,7 +1597,7 @@ extern "C" {
   X(PHGMG_ERR_TOL_UNREACHABLE, -23, "tolerance below what double precision can reach (relative tolerance < 1e-15)") \
   X(PHGMG_ERR_NOT_STABILIZABLE, -24, "no stabilizing Riccati solution: (A, K) not stabilizable or (A, L) not detectable") \
   X(PHGMG_ERR_STALE,           -25, "the system changed since the study was created (create the study again)") \
-  X(PHGMG_ERR_STRUCTURE,       -26, "model fails the structure check (Qh not positive definite, R not PSD, or a step map not of its dt)") \
+  X(PHGMG_ERR_STRUCTURE,       -26, "model fails the structure check (Qh not positive definite, R not PSD, a step map not of its dt, or the rest state or training envelope out of range)") \
   X(PHGMG_ERR_STEP_MAP,        -27, "step map not stable in double precision at this dt (use a smaller dt)") \
   X(PHGMG_ERR_E_SINGULAR,      -28, "the mass matrix E is singular to working precision") \
   X(PHGMG_ERR_EQ_NOT_SYMMETRIC, -29, "E^T Q is not symmetric (descriptor model)")          \
@@ -1768,7 +1776,8 @@ typedef struct phgmg_ph_system {
   const phgmg_ph_sparse *sparse;
 } phgmg_ph_system;
 
-/* Validation of a system. tol (<= 0: 1e-12) is relative to the matrix norms:
+/* Validation of a system. tol (<= 0: 1e-12; NaN or +Inf:
+   PHGMG_ERR_INVALID_ARG) is relative to the matrix norms:
    ||J + J^T|| <= tol ||J||, ||R - R^T|| <= tol ||R||, ||Q - Q^T|| <= tol ||Q||
    (Frobenius), lambda_min(R) >= -tol ||R||_2, B full column rank (pivoted QR:
    |R_mm| > tol |R_11|), 1/cond_1(J - R) > tol (rcond_out, may be NULL, receives
@@ -1788,6 +1797,9 @@ typedef struct phgmg_ph_system {
    failure is returned: PHGMG_ERR_INVALID_ARG (NULL pointers, missing
    callbacks) / _SIZE / _NANINF / _NOT_SKEW / _NOT_SYMMETRIC (R) /
    _Q_NOT_SYMMETRIC / _NOT_PSD (R) / _Q_NOT_PD / _RANK / _SINGULAR, or _NOMEM.
+   Descriptor models (E set) add the codes of manual 1.8; a singular E that
+   is neither dense nor of the zero-line form is PHGMG_ERR_E_SINGULAR, also
+   where E^T Q's checks would fail first (its cause is E).
    The system is never modified. */
 PHGMG_DEF phgmg_result phgmg_ph_validate(const phgmg_ph_system *sys, double tol,
                                          double *rcond_out, const phgmg_allocator *alloc);
@@ -1796,8 +1808,8 @@ PHGMG_DEF phgmg_result phgmg_ph_validate(const phgmg_ph_system *sys, double tol,
    Index-one descriptor models (manual 1.8): E with k zero rows (algebraic
    equations) and k zero columns (algebraic variables). phgmg_dae_create
    checks the index (PHGMG_ERR_INDEX for index >= 2, PHGMG_ERR_PENCIL for a
-   singular pencil, PHGMG_ERR_E_SINGULAR when E is singular but not of this
-   form and not dense (a dense E without zero lines is rotated into it,
+   singular pencil, PHGMG_ERR_E_SINGULAR when E = 0 (every row and column
+   zero: no differential state) or E is singular but not of this form and not dense (a dense E without zero lines is rotated into it,
    manual 1.8; phgmg_dae_restrict/_embed/_lift then rotate back), PHGMG_ERR_EQ_NOT_SYMMETRIC when the kept co-states depend on the
    algebraic variables, PHGMG_ERR_UNSUPPORTED for a separable coordinate or a
    damper on an algebraic line, k > 4096, or an elimination whose dense
@@ -1812,22 +1824,31 @@ PHGMG_DEF phgmg_result phgmg_ph_validate(const phgmg_ph_system *sys, double tol,
    the stepper object (phgmg_gl3_create), phgmg_simulate_inputs and
    phgmg_reduce return PHGMG_ERR_UNSUPPORTED for them: give them
    phgmg_dae_system(d), with snapshots restricted by phgmg_dae_restrict. The object keeps pointers into sys
-   (the nonlinear part's functions and weights): sys must outlive it. */
+   (the nonlinear part's functions and weights): sys must outlive it. tol is
+   the relative tolerance of phgmg_ph_validate (0 = 1e-12); a negative, NaN
+   or infinite tol is PHGMG_ERR_INVALID_ARG, as are NULL out, sys or E. */
 typedef struct phgmg_dae phgmg_dae;
 PHGMG_DEF phgmg_result phgmg_dae_create(phgmg_dae **out, const phgmg_ph_system *sys, double tol,
                                         const phgmg_allocator *alloc);
 /* The condensed model (valid while d lives); k = phgmg_dae_nalg(d). */
 PHGMG_DEF const phgmg_ph_system *phgmg_dae_system(const phgmg_dae *d);
 PHGMG_DEF int phgmg_dae_nalg(const phgmg_dae *d);
+/* The three maps between full (N) and differential (n) states return
+   PHGMG_ERR_INVALID_ARG for a NULL object or vector, output untouched. They
+   work in place: xi == x (the same start address) is allowed, the input is
+   first copied to the object's scratch memory (no allocation), so in-place
+   calls on one object must come from one thread; any other overlap of the
+   input and the output (or of u and x) is PHGMG_ERR_INVALID_ARG, output
+   untouched. */
 /* xi (n) = the differential coordinates of x (N), in their order in x. */
-PHGMG_DEF void phgmg_dae_restrict(const phgmg_dae *d, const double *x, double *xi);
+PHGMG_DEF phgmg_result phgmg_dae_restrict(const phgmg_dae *d, const double *x, double *xi);
 /* x (N) = xi at the differential coordinates, 0 at the algebraic ones (for
    a basis, whose algebraic rows follow from the constraints). */
-PHGMG_DEF void phgmg_dae_embed(const phgmg_dae *d, const double *xi, double *x);
+PHGMG_DEF phgmg_result phgmg_dae_embed(const phgmg_dae *d, const double *xi, double *x);
 /* x (N) = the consistent state with differential part xi at input u (m; NULL
    = 0): the algebraic variables solve the constraints. Uses d's scratch
    memory: one thread per object. */
-PHGMG_DEF void phgmg_dae_lift(phgmg_dae *d, const double *xi, const double *u, double *x);
+PHGMG_DEF phgmg_result phgmg_dae_lift(phgmg_dae *d, const double *xi, const double *u, double *x);
 PHGMG_DEF void phgmg_dae_destroy(phgmg_dae *d);
 
 /* Hamiltonian, its gradient and the output at a state. These evaluators do
@@ -2273,8 +2294,9 @@ typedef struct phgmg_rom {
      (r x m), then Dh = S + N (m x m):  x' = ... + (Bh - Ph) u,
      y = (Bh + Ph)^T grad H + Dh u, dissipation block [[-sym K, Ph],
      [Ph^T, sym Dh]] positive semidefinite (manual 1.6). phgmg_rom_output and
-     the stepper's y give (Bh + Ph)^T grad H: they have no u, add Dh u(t)
-     yourself (phgmg_reduced_simulate does). */
+     the stepper's y give (Bh + Ph)^T grad H: they have no u; the whole output
+     at input u is phgmg_rom_output_u (or add Dh u(t) yourself, as
+     phgmg_reduced_simulate does). */
   const phgmg_real *PD;
 } phgmg_rom;
 
@@ -2288,8 +2310,15 @@ PHGMG_DEF void phgmg_rom_gradient(const phgmg_rom *rom, const phgmg_real *x, phg
 /* f = K(x) grad H(x) + Bh u (u may be NULL). PHGMG_ERR_SINGULAR if D^T G D is singular at x. */
 PHGMG_DEF phgmg_result phgmg_rom_rhs(const phgmg_rom *rom, const phgmg_real *x, const phgmg_real *u,
                                      phgmg_real *f, phgmg_real *work);
-/* y = Bh^T grad H(x). */
+/* y = Bh^T grad H(x) (with feedthrough (Bh + Ph)^T grad H(x): without the
+   Dh u term, which needs the input; use phgmg_rom_output_u). */
 PHGMG_DEF void phgmg_rom_output(const phgmg_rom *rom, const phgmg_real *x, phgmg_real *y, phgmg_real *work);
+/* The output at input u (m values; NULL = 0): y = (Bh + Ph)^T grad H(x) +
+   Dh u, the model's whole output also when it has feedthrough (PD); equal to
+   phgmg_rom_output without feedthrough. The call for firmware that deploys a
+   model with feedthrough: the stepper's y leaves out Dh u(t_{n+1}). */
+PHGMG_DEF void phgmg_rom_output_u(const phgmg_rom *rom, const phgmg_real *x, const phgmg_real *u, phgmg_real *y,
+                                  phgmg_real *work);
 /* The reduced structure matrices at x: Jr = (K - K^T)/2 (skew), Rr = -(K + K^T)/2 (sym PSD), r x r. */
 PHGMG_DEF phgmg_result phgmg_rom_structure(const phgmg_rom *rom, const phgmg_real *x, phgmg_real *Jr,
                                            phgmg_real *Rr, phgmg_real *work);
@@ -3206,7 +3235,21 @@ PHGMG_DEF phgmg_result phgmg_rom_deserialize_size(const void *buf, size_t len, s
    level, and a step map that satisfies the GL3 stage equations of
    x' = K Qh x + Bh u for the stored dt (within 48 (r + 1) 1.2e-7 of its
    terms' size): PHGMG_ERR_STRUCTURE otherwise (details at
-   phgmg__rom_physics).
+   phgmg__rom_physics). Dampers: weights >= 0, laws odd with coefficients
+   >= 0 (PHGMG_ERR_DAMPER); feedthrough: the dissipation block
+   [[-sym K, Ph], [Ph^T, sym Dh]] positive semidefinite to the level above
+   (PHGMG_ERR_FEEDTHROUGH). The fields that place a run
+   (PHGMG_ERR_STRUCTURE): the training envelope has both bounds or neither,
+   env_lo <= env_hi; q_max >= 0; the rest state xr_rest is 0 without a
+   reference state (rho(0) = 0), else of finite energy, and within what the
+   working precision resolves against the training range: max |xr_rest| <=
+   S / eps (eps = 1.2e-7 in a float build, 2.2e-16 in double; S the largest
+   of the envelope's widths and bounds), since a run from rest moves over
+   the training range and, from a state further away, every such move would
+   be below the state's rounding unit. The remaining fields are free by
+   construction and checked for NaN/Inf only: port and damper directions
+   (Bh, Cd), the DEIM and manifold terms (P0, P1, w, Ms), the reference
+   offsets (ref_g, ref_s).
    No allocation; phgmg_rom_load returns the same codes. */
 PHGMG_DEF phgmg_result phgmg_rom_deserialize(const void *buf, size_t len, phgmg_rom *rom, void *mem,
                                              size_t mem_size);
@@ -5179,9 +5222,28 @@ PHGMG__PRIV phgmg_result phgmg__ph_validate(const phgmg_ph_system *sys, double t
   return PHGMG_OK;
 }
 
+/* A singular E that is neither dense nor of the zero-line form makes E^T Q
+   singular too; the cause to report is E (taken dense only). */
+PHGMG__PRIV phgmg_result phgmg__ph_e_cause(const phgmg_ph_system *sys, phgmg_result rc,
+                                          const phgmg_allocator *alloc) {
+  phgmg_jr_factor *f = NULL;
+  double rcond = 0.0;
+  phgmg_result fr;
+  if ((rc != PHGMG_ERR_EQ_NOT_PD && rc != PHGMG_ERR_EQ_NOT_SYMMETRIC) || !sys->E || sys->storage == PHGMG_DENSE ||
+      phgmg__e_algebraic(sys, alloc) != 0)
+    return rc;
+  fr = phgmg__e_factor(sys, &f, &rcond, alloc);
+  phgmg_jr_factor_destroy(f);
+  return fr == PHGMG_ERR_NOMEM || (fr == PHGMG_OK && rcond > 1e-12) ? rc : PHGMG_ERR_E_SINGULAR;
+}
+
 PHGMG_DEF phgmg_result phgmg_ph_validate(const phgmg_ph_system *sys, double tol,
                                          double *rcond_out, const phgmg_allocator *alloc) {
-  return phgmg__ph_validate(sys, tol, rcond_out, alloc, 1);
+  phgmg_result rc;
+  if (rcond_out) *rcond_out = 0.0;
+  if (tol != tol || tol == HUGE_VAL) return PHGMG_ERR_INVALID_ARG;   /* NaN, +Inf */
+  rc = phgmg__ph_validate(sys, tol, rcond_out, alloc, 1);
+  return phgmg__ph_e_cause(sys, rc, alloc);
 }
 
 /* >>dae (implementation) ================================================== */
@@ -5203,7 +5265,8 @@ struct phgmg_dae {
   int nd, nq;                   /* lift: L[ra, dcol] (k x nd), Q[ra, qcol] (k x nq)    */
   int *dcol, *qcol;             /* positions in rn / cn                               */
   double *D, *Qa, *Ga;          /* and (B - P)[ra, :] (k x m)                          */
-  double *work;                 /* n + 2 k + m (+ N when rotated)                     */
+  double *work;                 /* n + 2 k + m, N (rotated lift), 1, alias            */
+  double *alias;                /* N: the input of an in-place restrict/embed/lift    */
   double *V;                    /* rotated (a dense E without zero lines): Qv, N x N   */
 };
 
@@ -5750,8 +5813,8 @@ PHGMG_DEF phgmg_result phgmg_dae_create(phgmg_dae **out, const phgmg_ph_system *
   *out = NULL;
   rc = phgmg__ph_check(sys);
   if (rc != PHGMG_OK) return rc;
-  if (!sys->E) return PHGMG_ERR_INVALID_ARG;
-  if (!(tol > 0.0)) tol = 1e-12;
+  if (!sys->E || !(tol >= 0.0 && tol < HUGE_VAL)) return PHGMG_ERR_INVALID_ARG;
+  if (tol == 0.0) tol = 1e-12;
   if (!phgmg__ph_mat_finite(sys, sys->E) || !phgmg__ph_mat_finite(sys, sys->J) ||
       !phgmg__ph_mat_finite(sys, sys->R) || !phgmg__ph_mat_finite(sys, sys->Q) ||
       !phgmg__all_finite(sys->B, (size_t)sys->N * (size_t)sys->m))
@@ -5775,14 +5838,16 @@ PHGMG_DEF phgmg_result phgmg_dae_create(phgmg_dae **out, const phgmg_ph_system *
   if (rc == PHGMG_OK && rbuf && d->k == 0) rc = PHGMG_ERR_E_SINGULAR;   /* no singular value below tol */
   if (rc == PHGMG_OK && d->k > 0) {
     d->sys.N = d->n;
-    rc = d->n > 0 && d->m <= d->n ? phgmg__dae_index(d, sys, tol) : PHGMG_ERR_SIZE;
+    rc = d->n == 0 ? PHGMG_ERR_E_SINGULAR   /* E = 0: no differential state */
+         : d->m <= d->n ? phgmg__dae_index(d, sys, tol) : PHGMG_ERR_SIZE;
     if (rc == PHGMG_OK) rc = phgmg__dae_condense(d, sys, tol);
     if (rc == PHGMG_OK) rc = phgmg__dae_nonlinear(d, sys);
   }
   if (rc == PHGMG_OK) rc = phgmg__ph_validate(&d->sys, tol, NULL, &d->al, d->k == 0);
   if (rc == PHGMG_OK) {
-    d->work = phgmg__dalloc(&d->al, (size_t)d->n + 2 * (size_t)d->k + (size_t)d->m + (size_t)d->N + 1);
+    d->work = phgmg__dalloc(&d->al, (size_t)d->n + 2 * (size_t)d->k + (size_t)d->m + 2 * (size_t)d->N + 1);
     if (!d->work) rc = PHGMG_ERR_NOMEM;
+    else d->alias = d->work + d->n + 2 * d->k + d->m + d->N + 1;
   }
   phgmg__free(&d->al, rbuf);
   if (rc != PHGMG_OK) { phgmg_dae_destroy(d); return rc; }
@@ -5793,26 +5858,60 @@ PHGMG_DEF phgmg_result phgmg_dae_create(phgmg_dae **out, const phgmg_ph_system *
 PHGMG_DEF const phgmg_ph_system *phgmg_dae_system(const phgmg_dae *d) { return d ? &d->sys : NULL; }
 PHGMG_DEF int phgmg_dae_nalg(const phgmg_dae *d) { return d ? d->k : 0; }
 
-/* Rotated models keep the differential coordinates first: xi = Qv(:, 0..n)^T x. */
-PHGMG_DEF void phgmg_dae_restrict(const phgmg_dae *d, const double *x, double *xi) {
-  int i;
-  if (d->V) { phgmg_gemv('T', d->N, d->n, 1.0, d->V, d->N, x, 0.0, xi); return; }
-  for (i = 0; i < d->N; ++i)
-    if (d->cpos[i] >= 0) xi[d->cpos[i]] = x[i];
+#include <stdint.h> /* uintptr_t: the overlap test of the in-place maps */
+
+/* How the vector a (na doubles) meets b (nb doubles): 0 apart, 1 the same
+   start (in place), 2 any other overlap. */
+PHGMG__PRIV int phgmg__dae_overlap(const double *a, size_t na, const double *b, size_t nb) {
+  const uintptr_t a0 = (uintptr_t)(const void *)a, b0 = (uintptr_t)(const void *)b;
+  if (a0 == b0) return 1;
+  return a0 < b0 + nb * sizeof(double) && b0 < a0 + na * sizeof(double) ? 2 : 0;
 }
 
-PHGMG_DEF void phgmg_dae_embed(const phgmg_dae *d, const double *xi, double *x) {
+/* The input of a map from in (nin doubles) to out (nout): in itself, its
+   copy in d's scratch when out == in, NULL for any other overlap. */
+PHGMG__PRIV const double *phgmg__dae_input(const phgmg_dae *d, const double *in, size_t nin, const double *out,
+                                           size_t nout) {
+  const int o = phgmg__dae_overlap(in, nin, out, nout);
+  if (o == 2) return NULL;
+  if (o == 1) { memcpy(d->alias, in, nin * sizeof(double)); return d->alias; }
+  return in;
+}
+
+/* Rotated models keep the differential coordinates first: xi = Qv(:, 0..n)^T x. */
+PHGMG_DEF phgmg_result phgmg_dae_restrict(const phgmg_dae *d, const double *x, double *xi) {
   int i;
-  if (d->V) { phgmg_gemv('N', d->N, d->n, 1.0, d->V, d->N, xi, 0.0, x); return; }
+  if (!d || !x || !xi) return PHGMG_ERR_INVALID_ARG;
+  x = phgmg__dae_input(d, x, (size_t)d->N, xi, (size_t)d->n);
+  if (!x) return PHGMG_ERR_INVALID_ARG;
+  if (d->V) { phgmg_gemv('T', d->N, d->n, 1.0, d->V, d->N, x, 0.0, xi); return PHGMG_OK; }
+  for (i = 0; i < d->N; ++i)
+    if (d->cpos[i] >= 0) xi[d->cpos[i]] = x[i];
+  return PHGMG_OK;
+}
+
+PHGMG_DEF phgmg_result phgmg_dae_embed(const phgmg_dae *d, const double *xi, double *x) {
+  int i;
+  if (!d || !xi || !x) return PHGMG_ERR_INVALID_ARG;
+  xi = phgmg__dae_input(d, xi, (size_t)d->n, x, (size_t)d->N);
+  if (!xi) return PHGMG_ERR_INVALID_ARG;
+  if (d->V) { phgmg_gemv('N', d->N, d->n, 1.0, d->V, d->N, xi, 0.0, x); return PHGMG_OK; }
   for (i = 0; i < d->N; ++i) x[i] = d->cpos[i] >= 0 ? xi[d->cpos[i]] : 0.0;
+  return PHGMG_OK;
 }
 
 PHGMG__PRIV void phgmg__dae_lift_t(phgmg_dae *d, const double *xi, const double *u, double *x);
-PHGMG_DEF void phgmg_dae_lift(phgmg_dae *d, const double *xi, const double *u, double *x) {
-  double *xt = d->work + d->n + 2 * d->k + d->m;
-  if (!d->V) { phgmg__dae_lift_t(d, xi, u, x); return; }
+PHGMG_DEF phgmg_result phgmg_dae_lift(phgmg_dae *d, const double *xi, const double *u, double *x) {
+  double *xt;
+  if (!d || !xi || !x) return PHGMG_ERR_INVALID_ARG;
+  if (u && phgmg__dae_overlap(u, (size_t)d->m, x, (size_t)d->N)) return PHGMG_ERR_INVALID_ARG;
+  xi = phgmg__dae_input(d, xi, (size_t)d->n, x, (size_t)d->N);
+  if (!xi) return PHGMG_ERR_INVALID_ARG;
+  if (!d->V) { phgmg__dae_lift_t(d, xi, u, x); return PHGMG_OK; }
+  xt = d->work + d->n + 2 * d->k + d->m;
   phgmg__dae_lift_t(d, xi, u, xt);
   phgmg_gemv('N', d->N, d->N, 1.0, d->V, d->N, xt, 0.0, x);
+  return PHGMG_OK;
 }
 
 /* The lift in the model's own (or rotated) coordinates. */
@@ -10215,6 +10314,19 @@ PHGMG_DEF void phgmg_rom_output(const phgmg_rom *rom, const phgmg_real *x, phgmg
   phgmg__rom_grad(rom, x, w.g, &w);
   phgmg__r_gemvt(rom->r, rom->m, rom->Bh, w.g, 0, y);
   if (rom->PD) phgmg__r_gemvt(rom->r, rom->m, rom->PD, w.g, 1, y);   /* + Ph^T g */
+}
+
+PHGMG_DEF void phgmg_rom_output_u(const phgmg_rom *rom, const phgmg_real *x, const phgmg_real *u, phgmg_real *y,
+                                  phgmg_real *work) {
+  const int r = rom->r, m = rom->m;
+  int a, b;
+  phgmg_rom_output(rom, x, y, work);
+  if (!rom->PD || !u) return;
+  for (a = 0; a < m; ++a) {   /* + Dh u, Dh (m x m) after Ph (r x m) in PD */
+    phgmg_real acc = y[a];
+    for (b = 0; b < m; ++b) acc += rom->PD[(size_t)r * (size_t)m + (size_t)a + (size_t)b * (size_t)m] * u[b];
+    y[a] = acc;
+  }
 }
 
 /* E = D^T G D = G00 + G01 L + L^T (G10 + G11 L), L = [0, Lp] (QUADRATIC; Lp current). */
@@ -18151,7 +18263,9 @@ PHGMG__ONLINE phgmg_result phgmg__rom_header(const unsigned char *b, size_t len,
    tol = sqrt(eps), tolm = 48 (r + 1) eps with eps = 1.2e-7, float's unit
    roundoff, for every file: a model may have been rounded to float on its
    way (a float build, an f32 file) and saved again with 8-byte scalars.
-   Failure: PHGMG_ERR_STRUCTURE. Work: (r + rn)^2 + 4 r + 4 reals. */
+   Failure: PHGMG_ERR_STRUCTURE (dampers: _DAMPER, feedthrough: _FEEDTHROUGH;
+   then the placement fields, phgmg__rom_placement_ok). Work: (r + rn)^2 +
+   4 r + 4 reals. */
 PHGMG__ONLINE size_t phgmg__rom_phys_work(const phgmg_rom *rom, uint32_t mask) {
   const size_t n2 = (size_t)rom->r + (size_t)(rom->kind == PHGMG_ROM_QUADRATIC ? rom->rn : 0);
   const size_t nf = (mask & (1u << 25)) ? (size_t)rom->r + (size_t)rom->m : 0;   /* feedthrough block */
@@ -18283,12 +18397,42 @@ PHGMG__ONLINE phgmg_result phgmg__rom_damp_ok(const phgmg_rom *rom) {
   int j, e;
   if (!rom->dpoly || !rom->dw) return PHGMG_ERR_STRUCTURE;
   for (j = 0; j < rom->ndamp; ++j)
-    if (!(rom->dw[j] >= PHGMG__R(0))) return PHGMG_ERR_STRUCTURE;
+    if (!(rom->dw[j] >= PHGMG__R(0))) return PHGMG_ERR_DAMPER;
   for (j = 0; j < nf; ++j)
     for (e = 0; e <= rom->damp_deg; ++e) {
       const phgmg_real a = rom->dpoly[(size_t)j * (size_t)(rom->damp_deg + 1) + (size_t)e];
-      if ((e % 2 == 0 && a != PHGMG__R(0)) || a < PHGMG__R(0)) return PHGMG_ERR_STRUCTURE;
+      if ((e % 2 == 0 && a != PHGMG__R(0)) || a < PHGMG__R(0)) return PHGMG_ERR_DAMPER;
     }
+  return PHGMG_OK;
+}
+
+/* The fields that place a run rather than shape the dynamics: the training
+   envelope (both bounds or neither, env_lo <= env_hi), q_max >= 0, and the
+   rest state xr_rest = rho(0): 0 without a reference state (rho(0) = 0
+   then); with one, finite energy 1/2 xr^T Qh xr, and with an envelope, a
+   rest state that the working precision resolves against the training
+   range: max |xr_rest| eps_real <= S, S the largest of the envelope's widths
+   and bounds (a run from rest moves over the training range; from a state
+   more than S / eps_real away every such move is below its rounding unit). */
+PHGMG__ONLINE phgmg_result phgmg__rom_placement_ok(const phgmg_rom *rom) {
+  const int r = rom->r;
+  const double eps_real = PHGMG_REAL_IS_FLOAT ? 1.1920929e-07 : 2.220446049250313e-16;
+  double scale = 0.0, xmax = 0.0, e = 0.0;
+  int a, b;
+  if ((rom->env_lo == NULL) != (rom->env_hi == NULL)) return PHGMG_ERR_STRUCTURE;
+  for (a = 0; rom->env_lo && a < r; ++a) {
+    const double lo = (double)rom->env_lo[a], hi = (double)rom->env_hi[a];
+    if (!(lo <= hi)) return PHGMG_ERR_STRUCTURE;
+    scale = fmax(scale, fmax(hi - lo, fmax(fabs(lo), fabs(hi))));
+  }
+  if (rom->q_max && !(rom->q_max[0] >= PHGMG__R(0))) return PHGMG_ERR_STRUCTURE;
+  if (!rom->xr_rest) return PHGMG_OK;
+  for (a = 0; a < r; ++a) xmax = fmax(xmax, fabs((double)rom->xr_rest[a]));
+  if (!rom->ref_g) return xmax == 0.0 ? PHGMG_OK : PHGMG_ERR_STRUCTURE;
+  for (b = 0; b < r; ++b)
+    for (a = 0; a < r; ++a) e += (double)rom->xr_rest[a] * (double)rom->Qh[a + (size_t)b * r] * (double)rom->xr_rest[b];
+  if (!(fabs(e) < HUGE_VAL)) return PHGMG_ERR_STRUCTURE;
+  if (rom->env_lo && !(xmax * eps_real <= scale)) return PHGMG_ERR_STRUCTURE;
   return PHGMG_OK;
 }
 
@@ -18323,8 +18467,12 @@ PHGMG__ONLINE phgmg_result phgmg__rom_physics(const phgmg_rom *rom, double eps, 
     }
   if (!phgmg__r_psd_shifted(n2, w, tol)) return PHGMG_ERR_STRUCTURE;
   if (rom->Phi && (!rom->K || !phgmg__rom_map_ok(rom, eps, w))) return PHGMG_ERR_STRUCTURE;
-  if (rom->PD && !phgmg__rom_feed_ok(rom, tol, w)) return PHGMG_ERR_STRUCTURE;
-  return rom->ndamp ? phgmg__rom_damp_ok(rom) : PHGMG_OK;
+  if (rom->PD && !phgmg__rom_feed_ok(rom, tol, w)) return PHGMG_ERR_FEEDTHROUGH;
+  if (rom->ndamp) {
+    const phgmg_result rc = phgmg__rom_damp_ok(rom);
+    if (rc != PHGMG_OK) return rc;
+  }
+  return phgmg__rom_placement_ok(rom);
 }
 
 PHGMG_DEF phgmg_result phgmg_rom_deserialize_size(const void *buf, size_t len, size_t *need) {
@@ -18454,6 +18602,12 @@ PHGMG_DEF phgmg_result phgmg_rom_export_c(const phgmg_rom *rom, const char *name
                    "   kind %d, method %d, r = %d, m = %d, r_n = %d, DEIM points = %d.\n"
                    "   Include after phgmg.h; build with the same scalar type. */\n",
                 PHGMG_VERSION_STRING, rom->kind, rom->method, rom->r, rom->m, rom->rn, rom->nd) > 0;
+  if (rom->PD)
+    ok &= fprintf(f, "/* FEEDTHROUGH: this model's output is y = (Bh + Ph)^T grad H(x) + Dh u, Dh = S + N\n"
+                     "   (%s_PD: Ph, then Dh). phgmg_rom_step's y and phgmg_rom_output leave out the\n"
+                     "   Dh u term; compute the output with the input of the same time:\n"
+                     "     phgmg_rom_output_u(&%s, x, u, y, work);   (work: phgmg_rom_eval_work_size)\n"
+                     "   or add Dh u to the stepper's y yourself. */\n", name, name) > 0;
   ok &= fprintf(f, "#if PHGMG_REAL_IS_FLOAT != %d\n#error \"%s was exported for phgmg_real = %s\"\n#endif\n",
                 PHGMG_REAL_IS_FLOAT, name, PHGMG_REAL_IS_FLOAT ? "float" : "double") > 0;
   for (i = 0; i < PHGMG__NFIELDS; ++i) {

@@ -2249,6 +2249,100 @@ static int explain_feedthrough(const reduce_args *A, const reduce_state *S, phgm
              "dissipation R and S (a port's P needs damping R where P acts and S on the port)");
   }
   return fail("%s (%s): the feedthrough is not valid: %s", files, opts, why);
+static int e_zero_lines(const reduce_state *S, int N, int *zr, int *zc, int *dk, int *dl);
+
+/* A failed validation whose cause is the dampers (1: reported): a damper
+   on an algebraic line of E, or J - R - L singular (L the dampers'
+   linearisation at 0) while J - R alone is not. */
+static int explain_dampers(const reduce_args *A, const reduce_state *S, const phgmg_ph_system *sys,
+                           phgmg_result rc) {
+  int zr = 0, zc = 0, dk = -1, dl = -1;
+  if (rc == PHGMG_ERR_SINGULAR) {
+    phgmg_ph_system t = *sys;
+    double rc0 = 0.0;
+    t.ndamp = 0;
+    if (phgmg_ph_validate(&t, 0.0, &rc0, NULL) != PHGMG_OK) return 0;
+    fail("%s (--dampers): J - R minus the dampers' linear part at 0 (their c1 terms) is singular to working "
+         "precision (J - R alone: rcond %.3g): a damper's c1 is out of scale with the model", A->dampf, rc0);
+    return 1;
+  }
+  if (rc != PHGMG_ERR_UNSUPPORTED || !sys->E) return 0;
+  e_zero_lines(S, sys->N, &zr, &zc, &dk, &dl);
+  if (dk < 0) return 0;
+  fail("%s (--dampers): row %d: the damper acts on state %d, an algebraic line of E (a zero row or column of "
+       "%s): dampers must act on differential states only", A->dampf, dk, dl, A->E ? A->E : A->Ecoo);
+  return 1;
+}
+
+/* A failed validation of a descriptor model explained in terms of E (1:
+   reported, 0: not a cause this explains). */
+static int explain_descriptor(const reduce_args *A, const reduce_state *S, const phgmg_ph_system *sys,
+                              phgmg_result rc) {
+  const char *ef = A->E ? A->E : A->Ecoo, *qf = A->Q ? A->Q : A->Qcoo;
+  int zr = 0, zc = 0;
+  switch (rc) {
+    case PHGMG_ERR_E_SINGULAR:
+      return fail("%s (%s): %s%s", ef, A->E ? "--E" : "--E-coo", phgmg_result_string(rc),
+                  e_zero_lines(S, sys->N, &zr, &zc, NULL, NULL) == sys->N
+                      ? " (every row and column of E is zero: no differential state)"
+                  : A->Ecoo && zr + zc == 0 ? " (a singular E without zero rows and columns is taken in dense "
+                                              "form only: give it as --E)"
+                  : zr + zc == 0 && (sys->ndamp || sys->nl != PHGMG_NL_NONE)
+                      ? " (a singular E without zero rows and columns is taken with a quadratic energy and no "
+                        "dampers only)"
+                  : zr != zc ? " (its zero rows and zero columns differ in number)" : "");
+    case PHGMG_ERR_EQ_NOT_SYMMETRIC:
+    case PHGMG_ERR_EQ_NOT_PD: return fail("%s, %s (--E, --Q): %s", ef, qf, phgmg_result_string(rc));
+    case PHGMG_ERR_E_COUPLED: return fail("%s, %s (--E, --poly-idx): %s", ef, A->poly_idx, phgmg_result_string(rc));
+    case PHGMG_ERR_UNSUPPORTED: return fail("%s (--E): %s (a descriptor model takes a separable nonlinear part only; "
+                                            "with algebraic lines of E, none on them)", ef, phgmg_result_string(rc));
+    case PHGMG_ERR_INDEX:
+    case PHGMG_ERR_PENCIL:
+      return fail("%s, %s, %s, %s (--E, --J, --R, --Q): %s: %s, and the equations must determine the variables "
+                  "(index one)", ef, A->J ? A->J : A->Jcoo, A->R ? A->R : A->Rcoo, qf, phgmg_result_string(rc),
+                  e_zero_lines(S, sys->N, &zr, &zc, NULL, NULL) > 0
+                      ? "the zero rows and columns of E are algebraic equations and variables"
+                      : "E is singular without zero rows or columns: the directions of its null spaces (left: "
+                        "equations, right: variables) are algebraic");
+    default: break;
+  }
+  return 0;
+}
+
+/* rz[i] = 1 for a zero row i, cz[j] = 1 for a zero column j of the given E
+   (--E or --E-coo, the files' order). */
+static void e_zero_masks(const reduce_state *S, int N, char *rz, char *cz) {
+  int i, j;
+  memset(rz, 1, (size_t)N); memset(cz, 1, (size_t)N);
+  if (S->E.a) {
+    for (j = 0; j < N; ++j)
+      for (i = 0; i < N; ++i)
+        if (S->E.a[i + (size_t)j * N] != 0.0) rz[i] = cz[j] = 0;
+  } else if (S->cE.A.colptr) {
+    for (j = 0; j < N; ++j)
+      for (i = S->cE.A.colptr[j]; i < S->cE.A.colptr[j + 1]; ++i)
+        if (S->cE.A.values[i] != 0.0) rz[S->cE.A.rowidx[i]] = cz[j] = 0;
+  }
+}
+
+/* Zero rows (*zr) and zero columns (*zc) of the given E; returns the smaller
+   count. With dampers, *dk = the first damper (row of --dampers) with a state
+   on a zero line of E, *dl = that state (-1: none). */
+static int e_zero_lines(const reduce_state *S, int N, int *zr, int *zc, int *dk, int *dl) {
+  char *rz = (char *)malloc((size_t)N), *cz = (char *)malloc((size_t)N);
+  int i, k;
+  *zr = *zc = 0;
+  if (dk) *dk = *dl = -1;
+  if (!rz || !cz) { free(rz); free(cz); return 0; }
+  e_zero_masks(S, N, rz, cz);
+  for (i = 0; i < N; ++i) { *zr += rz[i]; *zc += cz[i]; }
+  for (k = 0; dk && S->Dm.a && *dk < 0 && k < S->Dm.rows * S->Dm.cols / 4; ++k) {
+    const int nd = S->Dm.rows * S->Dm.cols / 4, vi = (int)S->Dm.a[k], vj = (int)S->Dm.a[k + nd];
+    if (rz[vi] || cz[vi]) { *dk = k; *dl = vi; }
+    else if (vj >= 0 && (rz[vj] || cz[vj])) { *dk = k; *dl = vj; }
+  }
+  free(rz); free(cz);
+  return *zr < *zc ? *zr : *zc;
 }
 
 /* The full model from the files: dense or sparse J, R, Q, B and the nonlinear
@@ -2331,28 +2425,13 @@ static int load_system(const reduce_args *A, reduce_state *S) {
   }
   if (load_feedthrough(A, S, &sys) || load_dampers(A, S, &sys) || load_ref(A, S, sys.N)) return 1;
   rc = phgmg_ph_validate(&sys, 0.0, &rcond, NULL);
+  if (sys.ndamp && rc != PHGMG_OK && explain_dampers(A, S, &sys, rc)) return 1;
   if (sys.ndamp && (rc == PHGMG_ERR_DAMPER || rc == PHGMG_ERR_SIZE || rc == PHGMG_ERR_NANINF))
     return fail("%s (--dampers): %s%s", A->dampf, phgmg_result_string(rc),
                 rc == PHGMG_ERR_DAMPER ? " (c1 and c3 must be >= 0)" : rc == PHGMG_ERR_SIZE ? " (banded storage: |i - j| beyond the band)" : "");
   if (rc == PHGMG_ERR_FEEDTHROUGH || (rc == PHGMG_ERR_UNSUPPORTED && (sys.P || sys.S || sys.Nskew)))
     return explain_feedthrough(A, S, rc);
-  if (rc != PHGMG_OK && sys.E) {
-    const char *ef = A->E ? A->E : A->Ecoo, *qf = A->Q ? A->Q : A->Qcoo;
-    switch (rc) {
-      case PHGMG_ERR_E_SINGULAR: return fail("%s (--E): %s", ef, phgmg_result_string(rc));
-      case PHGMG_ERR_EQ_NOT_SYMMETRIC:
-      case PHGMG_ERR_EQ_NOT_PD: return fail("%s, %s (--E, --Q): %s", ef, qf, phgmg_result_string(rc));
-      case PHGMG_ERR_E_COUPLED: return fail("%s, %s (--E, --poly-idx): %s", ef, A->poly_idx, phgmg_result_string(rc));
-      case PHGMG_ERR_UNSUPPORTED: return fail("%s (--E): %s (a descriptor model takes a separable nonlinear part only; "
-                                              "with algebraic lines of E, none on them)", ef, phgmg_result_string(rc));
-      case PHGMG_ERR_INDEX:
-      case PHGMG_ERR_PENCIL:
-        return fail("%s, %s, %s, %s (--E, --J, --R, --Q): %s: the zero rows and columns of E are algebraic "
-                    "equations and variables, and the equations must determine the variables (index one)", ef,
-                    A->J ? A->J : A->Jcoo, A->R ? A->R : A->Rcoo, qf, phgmg_result_string(rc));
-      default: break;
-    }
-  }
+  if (rc != PHGMG_OK && sys.E && explain_descriptor(A, S, &sys, rc)) return 1;
   if (rc != PHGMG_OK && S->sp)
     return fail("the sparse system (%s, %s, %s, %s) is not valid: %s%s", A->Jcoo, A->Rcoo, A->Qcoo, A->B,
                 phgmg_result_string(rc), rc == PHGMG_ERR_SINGULAR ? " (J - R singular)" : "");
@@ -2444,17 +2523,46 @@ static int check_extras(const reduce_args *A, const reduce_state *S) {
   return 0;
 }
 
-/* Sizes that phgmg_reduce would refuse, explained up front. */
-static int check_sizes(const reduce_args *A, int method, int N, int m) {
+/* 1 if the n values of a are all zero. */
+static int all_zero(const double *a, size_t n) {
+  size_t i;
+  for (i = 0; i < n; ++i)
+    if (a[i] != 0.0) return 0;
+  return 1;
+}
+
+/* phgmg_reduce's PHGMG_ERR_RANK explained: every port through a constraint
+   (an index-one model's condensed B = 0), a --lambda too small for the
+   quadratic fit, else the snapshots (src) or B. */
+static int explain_rank(const reduce_args *A, const reduce_state *S, int method, const char *src) {
+  const char *what = phgmg_result_string(PHGMG_ERR_RANK);
+  if (S->dae && all_zero(S->sys.B, (size_t)S->sys.N * (size_t)S->sys.m))
+    return fail("reduction failed: %s: every port of %s acts through an algebraic constraint, so the condensed "
+                "model's port matrix B is zero (the ports act only through its feedthrough terms) and the "
+                "reduction has no port direction to keep", what, A->B);
+  if (method == PHGMG_METHOD_GMG_QM && A->have_lambda && !A->lambda_auto && A->lambda > 0.0)
+    return fail("reduction failed: %s: --lambda %g, the ridge parameter of the quadratic fit, is too small to "
+                "regularise it against the scale of the quadratic features (give a larger --lambda, or leave "
+                "it out)", what, A->lambda);
+  return fail("reduction failed: %s (%s, or the port matrix %s)", what, src, A->B);
+}
+
+/* Sizes that phgmg_reduce would refuse, explained up front. N: the states
+   reduced (an index-one model's differential states: k algebraic ones
+   left out of its N + k). */
+static int check_sizes(const reduce_args *A, int method, int N, int m, int k) {
+  char nd[128];
+  if (k > 0) snprintf(nd, sizeof nd, "%d differential states (the model's %d states less %d algebraic)", N, N + k, k);
+  else snprintf(nd, sizeof nd, "%d", N);
   if (method == PHGMG_METHOD_GMG_POD || method == PHGMG_METHOD_GMG_QM) {
     if (A->r <= m || A->r > N)
-      return usage_error("--r %d: %s needs m < r <= N (m = %d ports from %s, N = %d)", A->r, A->method, m, A->B, N);
+      return usage_error("--r %d: %s needs m < r <= N (m = %d ports from %s, N = %s)", A->r, A->method, m, A->B, nd);
     if (method == PHGMG_METHOD_GMG_QM && A->rn > 0 && A->rn > N - A->r)
-      return usage_error("--rn %d: gmg-qm needs r + r_n <= N (= %d)", A->rn, N);
+      return usage_error("--rn %d: gmg-qm needs r + r_n <= N (N = %s)", A->rn, nd);
     if (method == PHGMG_METHOD_GMG_QM && A->r >= N)
-      return usage_error("--r %d: gmg-qm needs r < N (= %d): room for at least one quadratic mode", A->r, N);
+      return usage_error("--r %d: gmg-qm needs r < N (N = %s): room for at least one quadratic mode", A->r, nd);
   } else if (A->r > N) {
-    return usage_error("--r %d: needs r <= N = %d", A->r, N);
+    return usage_error("--r %d: needs r <= N = %s", A->r, nd);
   }
 
   return 0;
@@ -2606,10 +2714,10 @@ static int run_reduction(const reduce_args *A, reduce_state *S, int method, cons
     const char *src = A->X ? A->X : "the simulated snapshots";
     switch (rc) {
       case PHGMG_ERR_SIZE:
-        return fail("reduction failed: %s: r = %d%s exceeds the rank of %s (%d snapshots of size %d)",
-                    phgmg_result_string(rc), A->r, method == PHGMG_METHOD_GMG_QM ? " plus r_n" : "", src, ns, N);
-      case PHGMG_ERR_RANK:
-        return fail("reduction failed: %s (%s, or the port matrix %s)", phgmg_result_string(rc), src, A->B);
+        return fail("reduction failed: %s: r = %d%s exceeds the rank of %s (%d snapshots of size %d%s)",
+                    phgmg_result_string(rc), A->r, method == PHGMG_METHOD_GMG_QM ? " plus r_n" : "", src, ns, N,
+                    S->dae ? ": the differential states" : "");
+      case PHGMG_ERR_RANK: return explain_rank(A, S, method, src);
       case PHGMG_ERR_DEGENERATE:
         return fail("reduction failed: %s (try another --r, or for gmg-qm a larger --lambda)", phgmg_result_string(rc));
       case PHGMG_ERR_STEP_MAP:
@@ -2981,7 +3089,7 @@ static int reduce_prepare(const reduce_args *A, reduce_state *S, const char *con
   if ((e = load_system(A, S)) != 0) return e;
   if ((A->simulate || A->nxin || nt) && check_dt_scale(A, S)) return 1;
   if (check_extras(A, S)) return 1;
-  if ((e = check_sizes(A, S->method, S->sys.N, S->sys.m)) != 0) return e;
+  if ((e = check_sizes(A, S->method, S->sys.N, S->sys.m, S->dae ? phgmg_dae_nalg(S->dae) : 0)) != 0) return e;
   return A->X ? load_snapshot_files(A, S, S->sys.N, S->sys.m, &S->Xd, &S->ns) : 0;
 }
 
@@ -3030,7 +3138,9 @@ static int load_model(const char *path, const char *opt, phgmg_rom *rom, void **
   fclose(f);
   rc = phgmg_rom_load(path, rom, block, NULL);
   if (rc != PHGMG_OK)
-    return fail("%s (%s): not a usable phgmg model file: %s", path, opt, phgmg_result_string(rc));
+    return fail("%s (%s): not a usable phgmg model file: %s%s", path, opt, phgmg_result_string(rc),
+                rc == PHGMG_ERR_DAMPER ? " (the file's damper weights or laws)"
+                : rc == PHGMG_ERR_FEEDTHROUGH ? " (the file's feedthrough block)" : "");
   return 0;
 }
 

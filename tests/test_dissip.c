@@ -470,7 +470,7 @@ TEST(test_dissip_reduce_hyper) {
 
 /* Model files: a damper model round-trips (format version 3) and steps to
    the same bits; a file whose damper law was rewritten to generate energy
-   (checksum recomputed) is refused with PHGMG_ERR_STRUCTURE; callback
+   (checksum recomputed) is refused with PHGMG_ERR_DAMPER; callback
    dampers cannot be saved. */
 TEST(test_dissip_rom_file) {
   dpm c;
@@ -521,7 +521,7 @@ TEST(test_dissip_rom_file) {
       memcpy(buf + o3, &v, 8);
       h = phgmg__fnv1a(buf, w - 4);
       phgmg__put32(buf + w - 4, h);
-      CHECK_RC(phgmg_rom_deserialize(buf, w, &lr, mem, need), PHGMG_ERR_STRUCTURE);
+      CHECK_RC(phgmg_rom_deserialize(buf, w, &lr, mem, need), PHGMG_ERR_DAMPER);
     }
     free(buf);
     free(mem);
@@ -674,7 +674,7 @@ TEST(test_dissip_feedthrough) {
           v = (v == 0.0 ? 1.0 : v) * 1e6;
           memcpy(buf + o0, &v, 8);
           phgmg__put32(buf + w - 4, phgmg__fnv1a(buf, w - 4));
-          CHECK_RC(phgmg_rom_deserialize(buf, w, &lr, mem, need), PHGMG_ERR_STRUCTURE);
+          CHECK_RC(phgmg_rom_deserialize(buf, w, &lr, mem, need), PHGMG_ERR_FEEDTHROUGH);
         }
         free(buf);
         free(mem);

@@ -3,8 +3,8 @@
    for the online path on whatever it accepts. For each input:
    - the size query and the loader must agree, and only PHGMG_ERR_FORMAT (or
      PHGMG_ERR_WORKSPACE when the model does not fit the harness's static
-     memory; from the loader also PHGMG_ERR_STRUCTURE, the load-time physics
-     check of an intact file) may come back on failure, with the output model
+     memory; from the loader also PHGMG_ERR_STRUCTURE, _DAMPER or
+     _FEEDTHROUGH, the load-time physics check of an intact file) may come back on failure, with the output model
      untouched;
    - a loaded model must pass phgmg_rom_check, serialise back to the same
      bytes when the file's scalar size is the build's, and reload identically;
@@ -148,7 +148,8 @@ static void fz_one(const uint8_t *data, size_t size) {
   fuzz_check(rc == PHGMG_ERR_WORKSPACE && memcmp(&rom, &keep, sizeof rom) == 0, "too small memory not reported");
   rc = phgmg_rom_deserialize(data, size, &rom, model, need);
   if (rc != PHGMG_OK) {
-    fuzz_check(rc == PHGMG_ERR_FORMAT || rc == PHGMG_ERR_STRUCTURE, "loader: unexpected result");
+    fuzz_check(rc == PHGMG_ERR_FORMAT || rc == PHGMG_ERR_STRUCTURE || rc == PHGMG_ERR_DAMPER ||
+               rc == PHGMG_ERR_FEEDTHROUGH, "loader: unexpected result");
     fuzz_check(memcmp(&rom, &keep, sizeof rom) == 0, "model changed on failure");
     free(model);
     return;
