@@ -2249,6 +2249,8 @@ static int explain_feedthrough(const reduce_args *A, const reduce_state *S, phgm
              "dissipation R and S (a port's P needs damping R where P acts and S on the port)");
   }
   return fail("%s (%s): the feedthrough is not valid: %s", files, opts, why);
+}
+
 static int e_zero_lines(const reduce_state *S, int N, int *zr, int *zc, int *dk, int *dl);
 
 /* A failed validation whose cause is the dampers (1: reported): a damper
