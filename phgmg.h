@@ -3076,6 +3076,136 @@ PHGMG_DEF phgmg_result phgmg_ss_compare(const phgmg_ss *g1, const phgmg_ss *g2, 
 #endif
 #endif /* PHGMG_NO_OFFLINE */
 
+/* >>lowrank =============================================================== */
+/* Low-rank Gramians and balanced truncation of large sparse linear pH models
+   (a phgmg_ph_sparse object: quadratic H, any E of full rank), where the
+   dense solvers of >>linear (O(N^3)) cannot go. With A = (J - R) Q and E
+   the mass matrix (or I), the model E x' = A x + B u, y = B^T Q x has the
+   Gramians
+       A P E^T + E P A^T + B B^T = 0,   A^T O E + E^T O A + C^T C = 0,
+   C = B^T Q. Because E^T Q is symmetric, O = Q Y Q where Y solves the first
+   equation for the dual model J -> -J (A' = (-J - R) Q = Q^{-1} A^T Q
+   formally; no inverse is formed): both Gramians come from the same solver
+   of A P E^T + E P A^T + B B^T = 0, P ~ Z Z^T with Z of low rank. Manual
+   2.7 (use) and 8.13 (the algorithms). Vectors are in the object's internal
+   ordering (phgmg_ph_sparse_to_banded_order / _to_user_order). */
+#ifndef PHGMG_NO_OFFLINE
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Shifted sparse solves (A + p E) X = F with the model's pencil (dual = 1:
+   the dual model's, A = (-J - R) Q), for real and complex shifts p, on ONE
+   symbolic analysis of the sparse LU of >>sparse (ordering, elimination
+   tree, supernodes, assembly map; made here, whatever solver the object's
+   stepper uses), whose complex numeric factorization serves a complex p
+   (the unknowns interleaved re/im in one complex front per supernode: half
+   the memory and a quarter of the flops of the real 2 x 2 embedding
+   [[Re, -Im], [Im, Re]], which would need the analysis of a doubled
+   pattern). The numeric factors of the last `keep` shifts (0: 2) are kept:
+   a repeated shift is solved without refactoring. Pivots are static (the
+   fill-reducing order's diagonal, manual 8.12), checked per factorization.
+   Errors: PHGMG_ERR_INVALID_ARG (NULL, keep < 0), _UNSUPPORTED (an E with
+   a zero row or column: index one, manual 1.8), _NOMEM. *out NULL on
+   failure. sp must outlive the object. */
+typedef struct phgmg_shifted phgmg_shifted;
+PHGMG_DEF phgmg_result phgmg_shifted_create(phgmg_shifted **out, const phgmg_ph_sparse *sp, int dual, int keep,
+                                            const phgmg_allocator *alloc);
+/* X = (A + p E)^{-1} F, p = pr + i pi. pi == 0: F and X real, N x nrhs (ld
+   ldf, ldx >= N); pi != 0: F and X complex, interleaved (re, im) pairs, N x
+   nrhs with ld in complex entries (column j at 2 j ld doubles). X == F
+   (same ld) solves in place. Errors: PHGMG_ERR_INVALID_ARG (NULL, a shift
+   not finite, nrhs < 0, ld < N), _NANINF (F not finite), _SINGULAR (a static
+   pivot below PHGMG_SPARSE_PIVTOL max|K| or growth above
+   PHGMG_SPARSE_GROWTH: this shift needs row exchanges the LU does not make;
+   X unspecified, the object stays usable), _NOMEM. */
+PHGMG_DEF phgmg_result phgmg_shifted_solve(phgmg_shifted *s, double pr, double pi, int nrhs, const double *F,
+                                           int ldf, double *X, int ldx);
+/* Y = A X (which 'A') or E X ('E'; E = I without a mass matrix), real N x
+   nrhs (ldx, ldy >= N), with the pencil's sparse copies. */
+PHGMG_DEF void phgmg_shifted_apply(const phgmg_shifted *s, char which, int nrhs, const double *X, int ldx,
+                                   double *Y, int ldy);
+/* Numeric factorizations made so far (a repeated shift that was kept does
+   not count again). */
+PHGMG_DEF int phgmg_shifted_factorizations(const phgmg_shifted *s);
+/* Frees the object (NULL is fine). */
+PHGMG_DEF void phgmg_shifted_destroy(phgmg_shifted *s);
+
+/* Options of the low-rank ADI (zero: default). */
+typedef struct phgmg_lradi_opts {
+  double tol;        /* stop when ||W^T W||_2 <= tol ||B^T B||_2 (0: 1e-10)        */
+  int maxit;         /* ADI steps, a complex pair counting two (0: 500)            */
+  int shift_blocks;  /* projection shifts: Ritz values on the last this many
+                        ADI blocks (0: 6)                                          */
+  double trunc;      /* compression: singular values of Z below trunc sigma_1
+                        dropped (0: 1e-12; < 0: no compression)                    */
+  void (*progress)(const char *phase, void *user); /* NULL: none (manual 2.7)      */
+  void *progress_user;
+} phgmg_lradi_opts;
+
+/* What a low-rank ADI run did. */
+typedef struct phgmg_lradi_info {
+  int iters;        /* ADI steps (a complex pair counts two)                    */
+  int cols;         /* columns of Z before compression                          */
+  int rank;         /* columns after compression (= *k)                         */
+  int shift_sets;   /* projection-shift computations                            */
+  int factorizations; /* numeric factorizations of the shifted matrices         */
+  double res;       /* ||W^T W||_2 / ||B^T B||_2 at the stop: the relative
+                       residual ||A Z Z^T E^T + E Z Z^T A^T + B B^T||_2 / ||B^T B||_2 */
+} phgmg_lradi_info;
+
+/* Low-rank ADI for A P E^T + E P A^T + B B^T = 0 with the pencil of s
+   (dual 0: the controllability Gramian; dual 1 with C = B^T Q: O = Q Z Z^T
+   Q, see above), B real N x m (ldb >= N). P ~ Z Z^T, *Z (N x *k, ld N)
+   allocated with alloc (free it with phgmg_lowrank_free). Steps: V = (A +
+   p E)^{-1} W, W <- W - 2 Re(p) E V (W_0 = B: the residual is W W^T), a
+   complex-conjugate pair in one complex solve with the real-arithmetic
+   update (Benner, Kuerschner, Saak), projection shifts, stop on ||W^T W||_2
+   <= tol ||B^T B||_2, then column compression (manual 8.13). info (may be
+   NULL) receives the counts and the residual. opts may be NULL. Errors:
+   PHGMG_ERR_INVALID_ARG (NULL, m < 1, ldb < N, negative tol/maxit/
+   shift_blocks), _NANINF (B), _NOT_STABLE (no Ritz value of the pencil in
+   the open left half-plane: no shift), _NOT_CONVERGED (maxit reached; info
+   then holds the residual reached, *Z NULL), the codes of
+   phgmg_shifted_solve, _NOMEM. */
+PHGMG_DEF phgmg_result phgmg_lradi(phgmg_shifted *s, int m, const double *B, int ldb, const phgmg_lradi_opts *opts,
+                                   double **Z, int *k, phgmg_lradi_info *info, const phgmg_allocator *alloc);
+/* Frees a factor from phgmg_lradi (NULL is fine). */
+PHGMG_DEF void phgmg_lowrank_free(double *Z, const phgmg_allocator *alloc);
+
+/* What low-rank balanced truncation did. */
+typedef struct phgmg_lrbt_info {
+  phgmg_lradi_info ctrl, obs; /* the two ADI runs (obs = ctrl when J = 0: one run) */
+  int nhsv;                   /* Hankel singular values computed (the rank of Z_o^T E Z_c) */
+  double bound;               /* 2 sum_{i > r} sigma_i over the computed ones (approximate) */
+  double hsv_tail;            /* sigma_{r+1} (0 if not computed)                    */
+} phgmg_lrbt_info;
+
+/* Low-rank square-root balanced truncation of a sparse linear pH model: the
+   factors Z_c, Z_o = Q Z_y by phgmg_lradi (one run when J = 0: the dual
+   model is the model), the SVD Z_o^T E Z_c = U S V^T (the Hankel singular
+   values S), T = Z_c V_r S_r^{-1/2}, W = Z_o U_r S_r^{-1/2} (W^T E T = I),
+   Ar = W^T A T (r x r), Br = W^T B (r x m), Cr = B^T Q T (m x r): the
+   reduced model xr' = Ar xr + Br u, y = Cr xr (Er = I), like phgmg_bt's.
+   hsv (may be NULL): the first r Hankel singular values; T, W (N x r,
+   internal order, may be NULL). info (may be NULL): the ADI runs, the count
+   of computed Hankel singular values and the H-infinity bound 2 sum of the
+   truncated ones -- of the computed ones only, so approximate: the factors
+   are of low rank and the values beyond their rank (below the ADI
+   tolerance's level) are not in it. Errors: PHGMG_ERR_INVALID_ARG (NULL
+   sp/Ar/Br/Cr), _SIZE (r outside 1..N), _RANK (fewer than r Hankel singular
+   values computed), the codes of phgmg_shifted_create and phgmg_lradi,
+   _NOMEM. Call phgmg_ph_validate on phgmg_ph_sparse_system(sp) first for
+   the structure (skew J, R >= 0, Q > 0 or E^T Q > 0). */
+PHGMG_DEF phgmg_result phgmg_lrbt(const phgmg_ph_sparse *sp, int r, const phgmg_lradi_opts *opts, double *Ar,
+                                  double *Br, double *Cr, double *hsv, double *T, double *W, phgmg_lrbt_info *info,
+                                  const phgmg_allocator *alloc);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* PHGMG_NO_OFFLINE */
+
 /* >>export ================================================================ */
 /* A reduced model leaves the workstation in two forms:
    - C source: static const arrays of phgmg_real plus a `static const phgmg_rom`
@@ -7155,9 +7285,12 @@ struct phgmg_ph_sparse {
   phgmg_ph_sparse_info inf;
 };
 
-/* The analysis of sp's stage matrices from its CSC copies (J - R merged,
-   zero values dropped, as from band storage); condense as phgmg__spsym_create. */
-PHGMG__PRIV phgmg_result phgmg__spsym_create_sp(phgmg__spsym **out, const phgmg_ph_sparse *sp, int condense) {
+/* The analysis of sp's stage matrices from its CSC copies (js J - R merged,
+   zero values dropped, as from band storage); condense as phgmg__spsym_create.
+   js = 1: the model; js = -1: its dual with J -> -J (the observability
+   equation of the low-rank solvers, >>lowrank). */
+PHGMG__PRIV phgmg_result phgmg__spsym_create_js(phgmg__spsym **out, const phgmg_ph_sparse *sp, int condense,
+                                                double js) {
   const phgmg_allocator *al = sp->alloc;
   const int n = sp->sys.N;
   phgmg__spsym *S = PHGMG__CAST(phgmg__spsym *, phgmg__alloc(al, sizeof(phgmg__spsym)));
@@ -7179,7 +7312,7 @@ PHGMG__PRIV phgmg_result phgmg__spsym_create_sp(phgmg__spsym **out, const phgmg_
       while (p < sp->cp[0][j + 1] || q < sp->cp[1][j + 1]) {
         int ip = p < sp->cp[0][j + 1] ? sp->ci[0][p] : n, iq = q < sp->cp[1][j + 1] ? sp->ci[1][q] : n;
         int i = PHGMG__MIN(ip, iq);
-        double v = (ip == i ? sp->cx[0][p++] : 0.0) - (iq == i ? sp->cx[1][q++] : 0.0);
+        double v = (ip == i ? js * sp->cx[0][p++] : 0.0) - (iq == i ? sp->cx[1][q++] : 0.0);
         if (v == 0.0) continue;
         if (pass) { S->jr_i[nz] = i; S->jr_x[nz] = v; }
         ++nz;
@@ -7201,6 +7334,9 @@ PHGMG__PRIV phgmg_result phgmg__spsym_create_sp(phgmg__spsym **out, const phgmg_
   if (rc != PHGMG_OK) { phgmg__spsym_free(al, S); return rc; }
   *out = S;
   return PHGMG_OK;
+}
+PHGMG__PRIV phgmg_result phgmg__spsym_create_sp(phgmg__spsym **out, const phgmg_ph_sparse *sp, int condense) {
+  return phgmg__spsym_create_js(out, sp, condense, 1.0);
 }
 
 PHGMG_DEF void phgmg_ph_sparse_destroy(phgmg_ph_sparse *sp) {
@@ -17557,6 +17693,532 @@ PHGMG_DEF phgmg_result phgmg_ss_error(int n1, const double *A1, const double *B1
     if (hinf_ref) *hinf_ref = hr;
   }
   phgmg__free(alloc, G1);
+  return rc;
+}
+#endif /* PHGMG_NO_OFFLINE */
+
+/* >>lowrank (implementation) ============================================= */
+#ifndef PHGMG_NO_OFFLINE
+/* One kept numeric factorization of K(sigma) = sigma E + M (M = -A), sigma =
+   -p: (A + p E) = -K(-p). */
+typedef struct phgmg__shf {
+  double sr, si;
+  long used;      /* last use (the object's clock); 0: empty */
+  int valid;
+  phgmg__spnum F;
+} phgmg__shf;
+
+struct phgmg_shifted {
+  phgmg_allocator a;
+  const phgmg_allocator *alloc;
+  phgmg__spsym *S; /* the analysis: J - R (dual: -J - R), Q, E        */
+  double *Mx;      /* M = -A in the pattern of K                       */
+  double *w;       /* N doubles of scratch (products)                  */
+  int N, keep, nfact;
+  long clock;
+  phgmg__shf *f;   /* keep entries                                     */
+};
+
+PHGMG_DEF void phgmg_shifted_destroy(phgmg_shifted *s) {
+  const phgmg_allocator *al;
+  int i;
+  if (!s) return;
+  al = s->alloc;
+  for (i = 0; s->f && i < s->keep; ++i) phgmg__spnum_free(al, &s->f[i].F);
+  phgmg__free(al, s->f);
+  phgmg__free(al, s->Mx);
+  phgmg__free(al, s->w);
+  phgmg__spsym_free(al, s->S);
+  phgmg__free(al, s);
+}
+
+PHGMG_DEF phgmg_result phgmg_shifted_create(phgmg_shifted **out, const phgmg_ph_sparse *sp, int dual, int keep,
+                                            const phgmg_allocator *alloc) {
+  phgmg_shifted *s;
+  phgmg_result rc;
+  int e;
+  if (!out) return PHGMG_ERR_INVALID_ARG;
+  *out = NULL;
+  if (!sp || keep < 0) return PHGMG_ERR_INVALID_ARG;
+  if ((e = phgmg__ph_sparse_e_regular(sp)) < 0) return PHGMG_ERR_NOMEM;
+  if (!e) return PHGMG_ERR_UNSUPPORTED;
+  s = PHGMG__CAST(phgmg_shifted *, phgmg__alloc(alloc, sizeof *s));
+  if (!s) return PHGMG_ERR_NOMEM;
+  memset(s, 0, sizeof *s);
+  if (alloc) { s->a = *alloc; s->alloc = &s->a; }
+  s->N = sp->sys.N;
+  s->keep = keep ? keep : 2;
+  rc = phgmg__spsym_create_js(&s->S, sp, -1, dual ? -1.0 : 1.0);
+  if (rc == PHGMG_OK) {
+    s->Mx = phgmg__dalloc(s->alloc, (size_t)s->S->k_p[s->N] + 1);
+    s->w = phgmg__dalloc(s->alloc, (size_t)s->N);
+    s->f = PHGMG__CAST(phgmg__shf *, phgmg__alloc(s->alloc, sizeof(phgmg__shf) * (size_t)s->keep));
+    if (!s->Mx || !s->w || !s->f) rc = PHGMG_ERR_NOMEM;
+  }
+  if (rc != PHGMG_OK) { phgmg_shifted_destroy(s); return rc; }
+  memset(s->f, 0, sizeof(phgmg__shf) * (size_t)s->keep);
+  phgmg__sp_stage_values(s->S, NULL, s->Mx, s->w); /* M = -(J - R) Q */
+  *out = s;
+  return PHGMG_OK;
+}
+
+/* The factors of K(sigma), sigma = sr + i si: a kept one, or the least
+   recently used entry refactored. */
+PHGMG__PRIV phgmg_result phgmg__shifted_factor(phgmg_shifted *s, double sr, double si, const phgmg__spnum **out) {
+  const int cplx = si != 0.0;
+  int i, lru = 0;
+  phgmg__shf *e;
+  for (i = 0; i < s->keep; ++i)
+    if (s->f[i].valid && s->f[i].sr == sr && s->f[i].si == si) {
+      s->f[i].used = ++s->clock;
+      *out = &s->f[i].F;
+      return PHGMG_OK;
+    }
+  for (i = 1; i < s->keep; ++i)
+    if (s->f[i].used < s->f[lru].used) lru = i;
+  e = &s->f[lru];
+  e->valid = 0;
+  e->used = 0;
+  if (e->F.X && e->F.cplx != cplx) phgmg__spnum_free(s->alloc, &e->F);
+  if (!e->F.X && phgmg__spnum_alloc(s->alloc, s->S, cplx, &e->F) != PHGMG_OK) return PHGMG_ERR_NOMEM;
+  phgmg__sp_factor(s->S, &e->F, s->Mx, sr, si, PHGMG_SPARSE_PIVTOL);
+  ++s->nfact;
+  if (e->F.nstatic || !(e->F.growth <= PHGMG_SPARSE_GROWTH)) return PHGMG_ERR_SINGULAR;
+  e->sr = sr; e->si = si; e->valid = 1; e->used = ++s->clock;
+  *out = &e->F;
+  return PHGMG_OK;
+}
+
+PHGMG_DEF phgmg_result phgmg_shifted_solve(phgmg_shifted *s, double pr, double pi, int nrhs, const double *F,
+                                           int ldf, double *X, int ldx) {
+  const phgmg__spnum *K;
+  phgmg_result rc;
+  int j, w = pi != 0.0 ? 2 : 1;
+  size_t i, len;
+  if (!s || !F || !X || nrhs < 0 || ldf < s->N || ldx < s->N || !isfinite(pr) || !isfinite(pi))
+    return PHGMG_ERR_INVALID_ARG;
+  len = (size_t)w * (size_t)s->N;
+  for (j = 0; j < nrhs; ++j)
+    if (!phgmg__all_finite(F + (size_t)w * (size_t)j * (size_t)ldf, len)) return PHGMG_ERR_NANINF;
+  if (nrhs == 0) return PHGMG_OK;
+  if ((rc = phgmg__shifted_factor(s, -pr, -pi, &K)) != PHGMG_OK) return rc;
+  for (j = 0; j < nrhs; ++j) { /* (A + p E) x = f  <=>  K(-p) x = -f */
+    const double *f = F + (size_t)w * (size_t)j * (size_t)ldf;
+    double *x = X + (size_t)w * (size_t)j * (size_t)ldx;
+    if (x != f) memmove(x, f, sizeof(double) * len);
+    phgmg__sp_solve(s->S, K, x);
+    for (i = 0; i < len; ++i) x[i] = -x[i];
+  }
+  return PHGMG_OK;
+}
+
+/* y = E x (x when the model has no mass matrix); S's pencil. */
+PHGMG__PRIV void phgmg__lr_emul(const phgmg__spsym *S, const double *x, double *y) {
+  int j, p;
+  if (!S->e_p) { memcpy(y, x, sizeof(double) * (size_t)S->n); return; }
+  for (j = 0; j < S->n; ++j) y[j] = 0.0;
+  for (j = 0; j < S->n; ++j)
+    for (p = S->e_p[j]; p < S->e_p[j + 1]; ++p) y[S->e_i[p]] += S->e_x[p] * x[j];
+}
+
+/* y = A x = (J - R) Q x (the dual: (-J - R) Q x); w: n doubles. */
+PHGMG__PRIV void phgmg__lr_amul(const phgmg__spsym *S, const double *x, double *y, double *w) {
+  int j, p;
+  phgmg__sp_qmv(S, x, w);
+  for (j = 0; j < S->n; ++j) y[j] = 0.0;
+  for (j = 0; j < S->n; ++j) {
+    const double v = w[j];
+    if (v == 0.0) continue;
+    for (p = S->jr_p[j]; p < S->jr_p[j + 1]; ++p) y[S->jr_i[p]] += S->jr_x[p] * v;
+  }
+}
+
+PHGMG_DEF void phgmg_shifted_apply(const phgmg_shifted *s, char which, int nrhs, const double *X, int ldx,
+                                   double *Y, int ldy) {
+  int j;
+  PHGMG_ASSERT(s && X && Y && (which == 'A' || which == 'E'));
+  for (j = 0; j < nrhs; ++j) {
+    const double *x = X + (size_t)j * (size_t)ldx;
+    double *y = Y + (size_t)j * (size_t)ldy;
+    if (which == 'A') phgmg__lr_amul(s->S, x, y, s->w);
+    else phgmg__lr_emul(s->S, x, y);
+  }
+}
+
+PHGMG_DEF int phgmg_shifted_factorizations(const phgmg_shifted *s) { return s ? s->nfact : 0; }
+
+PHGMG_DEF void phgmg_lowrank_free(double *Z, const phgmg_allocator *alloc) { phgmg__free(alloc, Z); }
+
+/* State of one LR-ADI run. */
+typedef struct phgmg__lradi {
+  phgmg_shifted *s;
+  const phgmg_allocator *al;
+  int N, m, kz, cap, nblk, bcap;
+  double *Z;          /* N x cap, kz columns filled                       */
+  int *bstart;        /* first column of block b (nblk blocks)            */
+  double *W, *V, *Y;  /* residual factor N x m; V 2N x m; Y N x m         */
+  double *sh;         /* shifts (re, im), one per conjugate pair (im > 0) */
+  int nsh, jsh;
+} phgmg__lradi;
+
+/* Room for `add` more columns of Z (and one more block). */
+PHGMG__PRIV phgmg_result phgmg__lr_grow(phgmg__lradi *st, int add) {
+  if (st->kz + add > st->cap) {
+    int cap = PHGMG__MAX(2 * st->cap, st->kz + add);
+    double *z = phgmg__dalloc(st->al, (size_t)st->N * (size_t)cap);
+    if (!z) return PHGMG_ERR_NOMEM;
+    if (st->kz) memcpy(z, st->Z, sizeof(double) * (size_t)st->N * (size_t)st->kz);
+    phgmg__free(st->al, st->Z);
+    st->Z = z;
+    st->cap = cap;
+  }
+  if (st->nblk + 1 > st->bcap) {
+    int bcap = 2 * st->bcap + 8, *b = phgmg__ialloc(st->al, (size_t)bcap);
+    if (!b) return PHGMG_ERR_NOMEM;
+    if (st->nblk) memcpy(b, st->bstart, sizeof(int) * (size_t)st->nblk);
+    phgmg__free(st->al, st->bstart);
+    st->bstart = b;
+    st->bcap = bcap;
+  }
+  st->bstart[st->nblk++] = st->kz;
+  return PHGMG_OK;
+}
+
+/* Eigenvalues of the pencil (Ap, Ep) (order k, ld k; Ap overwritten by
+   Ep^{-1} Ap) into ev (k complex pairs); 0 or a result code. */
+PHGMG__PRIV phgmg_result phgmg__lr_pencil_eig(int k, double *Ap, double *Ep, double *ev, const phgmg_allocator *al) {
+  int *ip = phgmg__ialloc(al, (size_t)k), i;
+  double *T = phgmg__dalloc(al, 4 * (size_t)k * (size_t)k + 3 * (size_t)k);
+  phgmg_result rc = PHGMG_ERR_NOMEM;
+  if (ip && T) {
+    rc = phgmg_lu_factor(k, Ep, k, ip);
+    if (rc == PHGMG_OK) {
+      phgmg_lu_solve('N', k, Ep, k, ip, k, Ap, k);
+      rc = phgmg__zschur(k, Ap, k, T, T + 2 * (size_t)k * (size_t)k, T + 4 * (size_t)k * (size_t)k);
+    }
+    if (rc == PHGMG_OK)
+      for (i = 0; i < k; ++i) { ev[2 * i] = T[2 * (i + (size_t)i * k)]; ev[2 * i + 1] = T[2 * (i + (size_t)i * k) + 1]; }
+  }
+  phgmg__free(al, ip);
+  phgmg__free(al, T);
+  return rc;
+}
+
+/* The stable ones of k eigenvalues ev as shifts: imaginary parts below
+   1e-8 |lambda| dropped (real shifts), one member (im > 0) of each pair;
+   sorted by modulus when a pair is among them, else by value (most negative
+   first). Returns their number (written to sh). */
+PHGMG__PRIV int phgmg__lr_pick_shifts(int k, const double *ev, double *sh) {
+  int i, j, n = 0, cplx = 0;
+  for (i = 0; i < k; ++i) {
+    double re = ev[2 * i], im = ev[2 * i + 1];
+    if (!(re < 0.0) || !isfinite(im)) continue;
+    if (fabs(im) <= 1e-8 * hypot(re, im)) im = 0.0;
+    if (im < 0.0) continue;
+    cplx |= im > 0.0;
+    sh[2 * n] = re; sh[2 * n + 1] = im; ++n;
+  }
+  for (i = 1; i < n; ++i) { /* insertion sort */
+    double re = sh[2 * i], im = sh[2 * i + 1], key = cplx ? hypot(re, im) : re;
+    for (j = i - 1; j >= 0; --j) {
+      double kj = cplx ? hypot(sh[2 * j], sh[2 * j + 1]) : sh[2 * j];
+      if (kj <= key) break;
+      sh[2 * j + 2] = sh[2 * j]; sh[2 * j + 3] = sh[2 * j + 1];
+    }
+    sh[2 * j + 2] = re; sh[2 * j + 3] = im;
+  }
+  return n;
+}
+
+/* Projection shifts: the Ritz values of the pencil (A, E) on span(Y) (N x
+   L, ld N): an orthonormal basis U by pivoted QR (columns with |R_jj| <=
+   1e-12 |R_00| dropped), Ap = U^T A U, Ep = U^T E U, their eigenvalues, the
+   stable ones as shifts. st->nsh = 0 when none is stable. */
+PHGMG__PRIV phgmg_result phgmg__lr_shifts(phgmg__lradi *st, const double *Y, int L) {
+  const int N = st->N;
+  const phgmg_allocator *al = st->al;
+  double *U = phgmg__dalloc(al, 2 * (size_t)N * (size_t)L), *AU = U + (size_t)N * (size_t)L;
+  double *sm = phgmg__dalloc(al, 2 * (size_t)L * (size_t)L + 6 * (size_t)L + 2);
+  int *jp = phgmg__ialloc(al, (size_t)L), k = 0, j;
+  phgmg_result rc = PHGMG_ERR_NOMEM;
+  double *Ap = sm, *Ep = sm + (size_t)L * L, *tau = Ep + (size_t)L * L, *wk = tau + L, *ev = wk + 2 * L;
+  st->nsh = 0; st->jsh = 0;
+  if (!U || !sm || !jp) goto done;
+  memcpy(U, Y, sizeof(double) * (size_t)N * (size_t)L);
+  if ((rc = phgmg_qrcp(N, L, U, N, tau, jp, wk)) != PHGMG_OK) goto done;
+  while (k < L && fabs(U[k + (size_t)k * N]) > 1e-12 * fabs(U[0])) ++k;
+  if (k == 0) goto done;
+  phgmg_qr_form_q(N, k, U, N, tau, wk);
+  for (j = 0; j < k; ++j) phgmg__lr_amul(st->s->S, U + (size_t)j * N, AU + (size_t)j * N, st->s->w);
+  phgmg_gemm('T', 'N', k, k, N, 1.0, U, N, AU, N, 0.0, Ap, k);
+  for (j = 0; j < k; ++j) phgmg__lr_emul(st->s->S, U + (size_t)j * N, AU + (size_t)j * N);
+  phgmg_gemm('T', 'N', k, k, N, 1.0, U, N, AU, N, 0.0, Ep, k);
+  rc = phgmg__lr_pencil_eig(k, Ap, Ep, ev, al);
+  if (rc == PHGMG_ERR_SINGULAR || rc == PHGMG_ERR_NOT_CONVERGED) { rc = PHGMG_OK; goto done; } /* no shifts */
+  if (rc != PHGMG_OK) goto done;
+  phgmg__free(al, st->sh);
+  st->sh = phgmg__dalloc(al, 2 * (size_t)k);
+  if (!st->sh) { rc = PHGMG_ERR_NOMEM; goto done; }
+  st->nsh = phgmg__lr_pick_shifts(k, ev, st->sh);
+done:
+  phgmg__free(al, U); phgmg__free(al, sm); phgmg__free(al, jp);
+  return rc;
+}
+
+/* One ADI step with shift p = pr + i pi (pi > 0: the pair p, conj(p)):
+   V = (A + p E)^{-1} W; real p: W <- W - 2 pr E V, Z += sqrt(-2 pr) V;
+   pair: with g = sqrt(-4 pr), d = pr / pi, Y = Re V + d Im V:
+   W <- W + g^2 E Y, Z += [g Y, g sqrt(d^2 + 1) Im V]. */
+PHGMG__PRIV phgmg_result phgmg__lr_step(phgmg__lradi *st, double pr, double pi) {
+  const int N = st->N, m = st->m;
+  const size_t Nm = (size_t)N * (size_t)m;
+  phgmg_result rc;
+  size_t i;
+  int j;
+  if ((rc = phgmg__lr_grow(st, pi != 0.0 ? 2 * m : m)) != PHGMG_OK) return rc;
+  if (pi == 0.0) {
+    const double g = sqrt(-2.0 * pr);
+    double *z = st->Z + (size_t)N * (size_t)st->kz;
+    if ((rc = phgmg_shifted_solve(st->s, pr, 0.0, m, st->W, N, z, N)) != PHGMG_OK) return rc;
+    for (j = 0; j < m; ++j) phgmg__lr_emul(st->s->S, z + (size_t)j * N, st->Y + (size_t)j * N);
+    for (i = 0; i < Nm; ++i) { st->W[i] -= 2.0 * pr * st->Y[i]; z[i] *= g; }
+    st->kz += m;
+  } else {
+    const double g = sqrt(-4.0 * pr), d = pr / pi, gi = g * sqrt(d * d + 1.0);
+    double *z = st->Z + (size_t)N * (size_t)st->kz, *zi = z + Nm;
+    for (i = 0; i < Nm; ++i) { st->V[2 * i] = st->W[i]; st->V[2 * i + 1] = 0.0; }
+    if ((rc = phgmg_shifted_solve(st->s, pr, pi, m, st->V, N, st->V, N)) != PHGMG_OK) return rc;
+    for (i = 0; i < Nm; ++i) { z[i] = st->V[2 * i] + d * st->V[2 * i + 1]; zi[i] = gi * st->V[2 * i + 1]; }
+    for (j = 0; j < m; ++j) phgmg__lr_emul(st->s->S, z + (size_t)j * N, st->Y + (size_t)j * N);
+    for (i = 0; i < Nm; ++i) { st->W[i] += g * g * st->Y[i]; z[i] *= g; }
+    st->kz += 2 * m;
+  }
+  return PHGMG_OK;
+}
+
+/* ||X^T X||_2 of X (N x m): the largest eigenvalue of the Gram matrix. */
+PHGMG__PRIV double phgmg__lr_gram2(int N, int m, const double *X, const phgmg_allocator *al) {
+  double *G = phgmg__dalloc(al, (size_t)m * (size_t)m + (size_t)m), v = (double)NAN;
+  if (!G) return v;
+  phgmg_gemm('T', 'N', m, m, N, 1.0, X, N, X, N, 0.0, G, m);
+  if (phgmg_sym_eig(m, G, m, G + (size_t)m * m, NULL, m) == PHGMG_OK) v = G[(size_t)m * m + (size_t)m - 1];
+  phgmg__free(al, G);
+  return v;
+}
+
+/* Column compression of Z (N x kz): Z <- U_k S_k from its thin SVD, the
+   singular values above trunc sigma_1. */
+PHGMG__PRIV phgmg_result phgmg__lr_compress(phgmg__lradi *st, double trunc) {
+  const int N = st->N, kz = st->kz;
+  double *U = phgmg__dalloc(st->al, (size_t)N * (size_t)kz + 1), *S = phgmg__dalloc(st->al, (size_t)kz + 1);
+  int k = 0, j;
+  phgmg_result rc = PHGMG_ERR_NOMEM;
+  size_t i;
+  if (U && S) rc = phgmg_svd(N, kz, st->Z, N, kz, S, U, N, NULL, 1, &k, NULL, st->al);
+  if (rc == PHGMG_OK) {
+    while (k > 1 && !(S[k - 1] > trunc * S[0])) --k;
+    for (j = 0; j < k; ++j)
+      for (i = 0; i < (size_t)N; ++i) U[i + (size_t)j * N] *= S[j];
+    phgmg__free(st->al, st->Z);
+    st->Z = U; U = NULL;
+    st->kz = st->cap = k;
+  }
+  phgmg__free(st->al, U);
+  phgmg__free(st->al, S);
+  return rc;
+}
+
+PHGMG__PRIV void phgmg__lr_progress(const phgmg_lradi_opts *o, const char *phase) {
+  if (o && o->progress) o->progress(phase, o->progress_user);
+}
+
+/* The ADI iteration of phgmg_lradi on st (W = B set); *res the residual. */
+PHGMG__PRIV phgmg_result phgmg__lr_iterate(phgmg__lradi *st, const phgmg_lradi_opts *o, double tol, int maxit,
+                                           int nblocks, double bnorm, phgmg_lradi_info *inf) {
+  phgmg_result rc = phgmg__lr_shifts(st, st->W, st->m);
+  double *sh0 = NULL;
+  int ns0 = 0;
+  inf->shift_sets = 1;
+  if (rc != PHGMG_OK) return rc;
+  if (st->nsh == 0) return PHGMG_ERR_NOT_STABLE;
+  inf->res = phgmg__lr_gram2(st->N, st->m, st->W, st->al) / bnorm;
+  while (!(inf->res <= tol)) {
+    double pr, pi;
+    if (inf->iters >= maxit) return PHGMG_ERR_NOT_CONVERGED;
+    if (st->jsh == st->nsh) { /* new projection shifts, or the last set again */
+      int b0 = PHGMG__MAX(0, st->nblk - nblocks), c0 = st->bstart[b0];
+      ns0 = st->nsh;
+      sh0 = phgmg__dalloc(st->al, 2 * (size_t)ns0);
+      if (!sh0) return PHGMG_ERR_NOMEM;
+      memcpy(sh0, st->sh, sizeof(double) * 2 * (size_t)ns0);
+      phgmg__lr_progress(o, "lradi: shifts");
+      rc = phgmg__lr_shifts(st, st->Z + (size_t)st->N * (size_t)c0, st->kz - c0);
+      ++inf->shift_sets;
+      if (rc == PHGMG_OK && st->nsh == 0) { phgmg__free(st->al, st->sh); st->sh = sh0; st->nsh = ns0; sh0 = NULL; }
+      phgmg__free(st->al, sh0);
+      sh0 = NULL;
+      if (rc != PHGMG_OK) return rc;
+    }
+    pr = st->sh[2 * st->jsh]; pi = st->sh[2 * st->jsh + 1];
+    ++st->jsh;
+    if ((rc = phgmg__lr_step(st, pr, pi)) != PHGMG_OK) return rc;
+    inf->iters += pi != 0.0 ? 2 : 1;
+    inf->res = phgmg__lr_gram2(st->N, st->m, st->W, st->al) / bnorm;
+    if (inf->res != inf->res) return PHGMG_ERR_NOMEM;
+  }
+  return PHGMG_OK;
+}
+
+PHGMG_DEF phgmg_result phgmg_lradi(phgmg_shifted *s, int m, const double *B, int ldb, const phgmg_lradi_opts *opts,
+                                   double **Z, int *k, phgmg_lradi_info *info, const phgmg_allocator *alloc) {
+  phgmg_lradi_info inf;
+  phgmg__lradi st;
+  phgmg_result rc = PHGMG_OK;
+  double tol = 1e-10, trunc = 1e-12, bnorm;
+  int maxit = 500, nblocks = 6, j, nf0;
+  memset(&inf, 0, sizeof inf);
+  if (info) *info = inf;
+  if (Z) *Z = NULL;
+  if (k) *k = 0;
+  if (!s || !B || !Z || !k || m < 1 || ldb < s->N) return PHGMG_ERR_INVALID_ARG;
+  if (opts) {
+    if (!(opts->tol >= 0.0 && opts->tol < 1.0) || opts->maxit < 0 || opts->shift_blocks < 0 ||
+        !(opts->trunc < 1.0))
+      return PHGMG_ERR_INVALID_ARG;
+    if (opts->tol > 0.0) tol = opts->tol;
+    if (opts->maxit > 0) maxit = opts->maxit;
+    if (opts->shift_blocks > 0) nblocks = opts->shift_blocks;
+    if (opts->trunc != 0.0) trunc = opts->trunc;
+  }
+  for (j = 0; j < m; ++j)
+    if (!phgmg__all_finite(B + (size_t)j * (size_t)ldb, (size_t)s->N)) return PHGMG_ERR_NANINF;
+  memset(&st, 0, sizeof st);
+  nf0 = s->nfact;
+  st.s = s; st.al = alloc; st.N = s->N; st.m = m;
+  st.W = phgmg__dalloc(alloc, 4 * (size_t)s->N * (size_t)m);
+  if (!st.W) return PHGMG_ERR_NOMEM;
+  st.Y = st.W + (size_t)s->N * (size_t)m;
+  st.V = st.Y + (size_t)s->N * (size_t)m;
+  for (j = 0; j < m; ++j) memcpy(st.W + (size_t)j * s->N, B + (size_t)j * ldb, sizeof(double) * (size_t)s->N);
+  bnorm = phgmg__lr_gram2(s->N, m, st.W, alloc);
+  if (bnorm != bnorm) rc = PHGMG_ERR_NOMEM;
+  else if (!(bnorm > 0.0)) rc = PHGMG_ERR_RANK; /* B = 0: P = 0, nothing to factor */
+  if (rc == PHGMG_OK) rc = phgmg__lr_iterate(&st, opts, tol, maxit, nblocks, bnorm, &inf);
+  inf.cols = st.kz;
+  if (rc == PHGMG_OK && trunc > 0.0 && st.kz > 0) rc = phgmg__lr_compress(&st, trunc);
+  inf.rank = st.kz;
+  inf.factorizations = s->nfact - nf0;
+  if (info) *info = inf;
+  phgmg__free(alloc, st.W); phgmg__free(alloc, st.sh); phgmg__free(alloc, st.bstart);
+  if (rc != PHGMG_OK || st.kz == 0) {
+    phgmg__free(alloc, st.Z);
+    if (info) info->rank = 0;
+    return rc != PHGMG_OK ? rc : PHGMG_ERR_RANK;
+  }
+  *Z = st.Z;
+  *k = st.kz;
+  return PHGMG_OK;
+}
+
+/* The two Gramian factors of phgmg_lrbt: Zc (kc columns) and Zo = Q Zy
+   (ko columns), with the ADI runs' info. */
+PHGMG__PRIV phgmg_result phgmg__lrbt_factors(const phgmg_ph_sparse *sp, const phgmg_lradi_opts *opts,
+                                             phgmg_shifted *sc, double **Zc, int *kc, double **Zo, int *ko,
+                                             phgmg_lrbt_info *inf, const phgmg_allocator *al) {
+  const int N = sp->sys.N, m = sp->sys.m;
+  phgmg_shifted *sd = NULL;
+  double *Zy = NULL;
+  int j, jzero = 1;
+  phgmg_result rc;
+  phgmg__lr_progress(opts, "controllability Gramian");
+  rc = phgmg_lradi(sc, m, sp->sys.B, N, opts, Zc, kc, &inf->ctrl, al);
+  if (rc != PHGMG_OK) return rc;
+  for (j = 0; j < sp->cp[0][N] && jzero; ++j) jzero = sp->cx[0][j] == 0.0;
+  if (jzero) { /* the dual model is the model: Zy = Zc */
+    inf->obs = inf->ctrl;
+    *ko = *kc;
+    Zy = *Zc;
+  } else {
+    phgmg__lr_progress(opts, "observability Gramian");
+    rc = phgmg_shifted_create(&sd, sp, 1, 0, al);
+    if (rc == PHGMG_OK) rc = phgmg_lradi(sd, m, sp->sys.B, N, opts, &Zy, ko, &inf->obs, al);
+    phgmg_shifted_destroy(sd);
+    if (rc != PHGMG_OK) return rc;
+  }
+  *Zo = phgmg__dalloc(al, (size_t)N * (size_t)*ko);
+  if (*Zo)
+    for (j = 0; j < *ko; ++j) phgmg__sp_qmv(sc->S, Zy + (size_t)j * N, *Zo + (size_t)j * N);
+  if (Zy != *Zc) phgmg__free(al, Zy);
+  return *Zo ? PHGMG_OK : PHGMG_ERR_NOMEM;
+}
+
+/* The balancing of phgmg_lrbt from the factors: SVD of Zo^T E Zc, the
+   bases T, W (N x r each, into TW), the reduced matrices, the values. */
+PHGMG__PRIV phgmg_result phgmg__lrbt_balance(const phgmg_ph_sparse *sp, phgmg_shifted *sc, int r, const double *Zc,
+                                             int kc, const double *Zo, int ko, double *TW, double *Ar, double *Br,
+                                             double *Cr, double *hsv, phgmg_lrbt_info *inf,
+                                             const phgmg_allocator *al) {
+  const int N = sp->sys.N, m = sp->sys.m, kmin = PHGMG__MIN(kc, ko);
+  double *EZ = phgmg__dalloc(al, (size_t)N * (size_t)PHGMG__MAX(kc, r));
+  double *M = phgmg__dalloc(al, (size_t)ko * (size_t)kc + (size_t)kmin * (size_t)(ko + kc + 1));
+  double *U = M + (size_t)ko * kc, *V = U + (size_t)ko * kmin, *S = V + (size_t)kc * kmin, *T = TW, *W = TW + (size_t)N * r;
+  int k = 0, i, j;
+  phgmg_result rc = PHGMG_ERR_NOMEM;
+  if (!EZ || !M) goto done;
+  for (j = 0; j < kc; ++j) phgmg__lr_emul(sc->S, Zc + (size_t)j * N, EZ + (size_t)j * N);
+  phgmg_gemm('T', 'N', ko, kc, N, 1.0, Zo, N, EZ, N, 0.0, M, ko);
+  rc = phgmg_svd(ko, kc, M, ko, kmin, S, U, ko, V, kc, &k, NULL, al);
+  if (rc != PHGMG_OK) goto done;
+  inf->nhsv = k;
+  if (k < r) { rc = PHGMG_ERR_RANK; goto done; }
+  for (j = 0; j < r; ++j) { /* T = Zc V_r S_r^{-1/2}, W = Zo U_r S_r^{-1/2} */
+    const double sc1 = 1.0 / sqrt(S[j]);
+    for (i = 0; i < kc; ++i) V[i + (size_t)j * kc] *= sc1;
+    for (i = 0; i < ko; ++i) U[i + (size_t)j * ko] *= sc1;
+    if (hsv) hsv[j] = S[j];
+  }
+  phgmg_gemm('N', 'N', N, r, kc, 1.0, Zc, N, V, kc, 0.0, T, N);
+  phgmg_gemm('N', 'N', N, r, ko, 1.0, Zo, N, U, ko, 0.0, W, N);
+  for (j = 0; j < r; ++j) phgmg__lr_amul(sc->S, T + (size_t)j * N, EZ + (size_t)j * N, sc->w);
+  phgmg_gemm('T', 'N', r, r, N, 1.0, W, N, EZ, N, 0.0, Ar, r);
+  phgmg_gemm('T', 'N', r, m, N, 1.0, W, N, sp->sys.B, N, 0.0, Br, r);
+  for (j = 0; j < r; ++j) phgmg__sp_qmv(sc->S, T + (size_t)j * N, EZ + (size_t)j * N);
+  phgmg_gemm('T', 'N', m, r, N, 1.0, sp->sys.B, N, EZ, N, 0.0, Cr, m);
+  inf->bound = 0.0;
+  for (j = r; j < k; ++j) inf->bound += 2.0 * S[j];
+  inf->hsv_tail = k > r ? S[r] : 0.0;
+done:
+  phgmg__free(al, EZ);
+  phgmg__free(al, M);
+  return rc;
+}
+
+PHGMG_DEF phgmg_result phgmg_lrbt(const phgmg_ph_sparse *sp, int r, const phgmg_lradi_opts *opts, double *Ar,
+                                  double *Br, double *Cr, double *hsv, double *T, double *W, phgmg_lrbt_info *info,
+                                  const phgmg_allocator *alloc) {
+  phgmg_lrbt_info inf;
+  phgmg_shifted *sc = NULL;
+  double *Zc = NULL, *Zo = NULL, *TW = NULL;
+  int kc = 0, ko = 0, N;
+  phgmg_result rc;
+  memset(&inf, 0, sizeof inf);
+  if (info) *info = inf;
+  if (!sp || !Ar || !Br || !Cr) return PHGMG_ERR_INVALID_ARG;
+  N = sp->sys.N;
+  if (r < 1 || r > N) return PHGMG_ERR_SIZE;
+  rc = phgmg_shifted_create(&sc, sp, 0, 0, alloc);
+  if (rc == PHGMG_OK) rc = phgmg__lrbt_factors(sp, opts, sc, &Zc, &kc, &Zo, &ko, &inf, alloc);
+  if (rc == PHGMG_OK) {
+    phgmg__lr_progress(opts, "balancing");
+    TW = phgmg__dalloc(alloc, 2 * (size_t)N * (size_t)r);
+    rc = TW ? phgmg__lrbt_balance(sp, sc, r, Zc, kc, Zo, ko, TW, Ar, Br, Cr, hsv, &inf, alloc) : PHGMG_ERR_NOMEM;
+  }
+  if (rc == PHGMG_OK && T) memcpy(T, TW, sizeof(double) * (size_t)N * (size_t)r);
+  if (rc == PHGMG_OK && W) memcpy(W, TW + (size_t)N * (size_t)r, sizeof(double) * (size_t)N * (size_t)r);
+  if (rc == PHGMG_OK) phgmg__lr_progress(opts, "done");
+  phgmg__free(alloc, TW); phgmg__free(alloc, Zc); phgmg__free(alloc, Zo);
+  phgmg_shifted_destroy(sc);
+  if (info) *info = inf;
   return rc;
 }
 #endif /* PHGMG_NO_OFFLINE */
