@@ -26,7 +26,7 @@
    The header has two halves, declarations and implementation, each cut into
    sections marked >>config, >>result, >>memory, >>ph, >>dae, >>sparse, >>gl3,
    >>online, >>pod, >>hyper, >>reduce, >>deploy, >>errors, >>study, >>linear,
-   >>export, >>npy and, last, >>linalg, the dense kernels (grep for them; the
+   >>lowrank, >>export, >>npy and, last, >>linalg, the dense kernels (grep for them; the
    same order in both halves: the implementation declares the kernels' private
    helpers in >>linalg (prototypes) after >>memory, and its >>reduce opens with
    the reduced object the others use). The comment at each declaration states
@@ -447,7 +447,8 @@
    least H2 error; pass them as opts.cache.pod_basis), transfer functions and
    H-infinity / H2 errors (phgmg_ph_abc, phgmg_ss_transfer, phgmg_reduced_abc,
    phgmg_ss_error). A system with an undamped mode has no Gramians: BT, PRBT
-   and the BALANCED / H2 bases then return PHGMG_ERR_NOT_STABLE.
+   and the BALANCED / H2 bases then return PHGMG_ERR_NOT_STABLE. Larger
+   sparse models: 2.7.
 
 
    2.6 Sparse models (>>ph, >>sparse). phgmg_ph_sparse_create takes J, R, Q
@@ -467,6 +468,43 @@
    matrix) take the same choice: their stage matrices sigma E + M are
    analysed with E's pattern joined (manual 8.12); an E with a zero row or
    column (index one, 1.8) keeps the band LU.
+
+   2.7 Large sparse linear models (>>lowrank). For a phgmg_ph_sparse model
+   with quadratic H (E x' = (J - R) Q x + B u, y = B^T Q x; E = I or a mass
+   matrix of full rank) the Gramians are computed in low-rank factored form
+   and balanced truncation runs without any N x N matrix:
+     phgmg_shifted_create / _solve / _apply / _factorizations / _destroy
+         solves (A + p E) X = F, A = (J - R) Q, for real and complex shifts
+         p on one symbolic analysis of the sparse LU (>>sparse), keeping the
+         numeric factors of the last few shifts; dual = 1 gives the pencil
+         of the dual model (J -> -J), whose Gramian is the observability
+         one (O = Q P_dual Q, 8.13);
+     phgmg_lradi (+ phgmg_lowrank_free)
+         the low-rank ADI for A P E^T + E P A^T + B B^T = 0: P ~ Z Z^T,
+         projection shifts, residual-factor stop ||W^T W||_2 <= tol ||B^T
+         B||_2 (tol 1e-10), column compression; phgmg_lradi_info reports
+         steps, columns, rank, residual, factorizations;
+     phgmg_lrbt
+         low-rank square-root BT: Ar, Br, Cr (Er = I) like phgmg_bt, the
+         Hankel singular values and the H-infinity bound 2 sum_{i > r}
+         sigma_i -- over the computed values only, so approximate (the tail
+         beyond the factors' rank is below the ADI tolerance's level).
+   Vectors (B, Z, T, W, F, X) are in the object's internal ordering.
+   phgmg_lradi_opts.progress (NULL: none) is called as progress(phase, user)
+   like phgmg_reduce's (2.2): "lradi: shifts" before each new set of
+   projection shifts; phgmg_lrbt also calls "controllability Gramian",
+   "observability Gramian" (not when J = 0: the dual model is the model and
+   one ADI run serves both), "balancing" and "done".
+
+       phgmg_ph_sparse *sp;  phgmg_lrbt_info inf;
+       phgmg_ph_sparse_create(&sp, N, m, &J, &R, &Q, B, NULL, NULL, NULL);
+       phgmg_lrbt(sp, 20, NULL, Ar, Br, Cr, hsv, NULL, NULL, &inf, NULL);
+       // inf.ctrl.res, inf.ctrl.rank, inf.nhsv, inf.bound
+
+   The reduced model (Ar, Br, Cr) is a plain state-space model (as
+   phgmg_bt's), not a pH model. Not yet: index-one E (zero rows/columns:
+   PHGMG_ERR_UNSUPPORTED), feedthrough, nonlinear parts. Algorithms and
+   measured times: 8.13.
 
    3. METHODS AND OPTIONS -------------------------------------------------------
    Every option struct is "zero means default": memset it to 0 and set what you
@@ -1346,6 +1384,66 @@
    `phgmg reduce --simulate --steps 200 --method gmg-pod --r 20` peaks at
    about twice the snapshot matrix.
 
+   8.13 Low-rank Gramians (>>lowrank).
+   Shifted solves. (A + p E) = -K(-p) with the stepper's stage matrix K(sigma)
+   = sigma E + M, M = -(J - R) Q (8.12), so the sparse LU's analysis (the
+   condensation, nested dissection, supernodes, assembly map: made once per
+   phgmg_shifted object) serves every shift; a complex shift uses the LU's
+   complex numeric factorization on that same analysis (interleaved re/im
+   fronts). The alternative, the real 2 x 2 embedding [[Re, -Im], [Im, Re]]
+   per unknown, would need an analysis of the doubled pattern (4x the
+   entries of the pattern), and its factor holds 4 real entries per complex
+   entry (2x the memory of the complex factor) and costs 2x the flops (a
+   dense front of order n: n^3/3 complex multiply-adds, 8/3 n^3 real flops,
+   against (2n)^3/3 real multiply-adds, 16/3 n^3 flops): rejected. The
+   pivots are static, as in the stepper (8.12); a factorization with a
+   replaced pivot or growth above PHGMG_SPARSE_GROWTH is refused
+   (PHGMG_ERR_SINGULAR) rather than used. (For Re p < 0, Q K(-p) = -p Q E -
+   Q (J - R) Q has the positive-definite Hermitian part -Re(p) E^T Q + Q R Q;
+   no refusal has been seen on the models of the tests and the bench.) The
+   numeric factors of the last `keep`
+   shifts stay; a shift is matched exactly (the projection shifts rarely
+   repeat; an ADI cycle that finds no new stable Ritz value reuses its last
+   set, and those solves are served from the kept factors).
+   Observability. C = B^T Q and E^T Q = Q E (a pH descriptor model) give
+   A^T (Q Y Q) E + E^T (Q Y Q) A + C^T C = Q (A' Y E^T + E Y A'^T + B B^T) Q
+   with A' = (-J - R) Q = ((J - R)^T) Q: the observability Gramian is O =
+   Q Y Q with Y the controllability Gramian of the dual model J -> -J. So
+   one solver (of A P E^T + E P A^T + B B^T = 0, non-transposed solves
+   only) serves both, Z_o = Q Z_y, and no Q^{-1} is formed; when J = 0 (the
+   heat equation) the dual is the model and one ADI run gives both.
+   LR-ADI (Benner, Kuerschner, Saak; as pyMOR's lradi). W_0 = B; per shift
+   p_k: V = (A + p_k E)^{-1} W, W <- W - 2 Re(p_k) E V, Z <- [Z, sqrt(-2
+   p_k) V] (real p_k); a pair p, conj(p) takes one complex solve and, with
+   g = sqrt(-4 Re p), d = Re p / Im p, Y = Re V + d Im V: W <- W + g^2 E Y,
+   Z <- [Z, g Y, g sqrt(d^2 + 1) Im V] (real arithmetic, two steps). Then
+   A Z Z^T E^T + E Z Z^T A^T + B B^T = W W^T exactly (in exact arithmetic),
+   so ||W^T W||_2 / ||B^T B||_2 is the relative residual in the 2-norm at no
+   extra cost (the tests recompute it densely: it agrees to 4 digits).
+   Shifts: the Ritz values of the pencil on span(B) to start, then on the
+   span of the last shift_blocks (6) ADI blocks whenever the current set is
+   used up: an orthonormal basis U by pivoted QR, the eigenvalues of (U^T E
+   U)^{-1} U^T A U by the complex Schur form (phgmg__zschur, the QR
+   algorithm on the Hessenberg form), those with Re < 0, imaginary parts
+   below 1e-8 |lambda| dropped, one member of each conjugate pair, sorted
+   by modulus (by value when all are real). Stop: residual <= tol (1e-10) or
+   maxit steps (PHGMG_ERR_NOT_CONVERGED). Compression at the end: Z <- U_k
+   S_k from the thin SVD (phgmg_svd), singular values above trunc = 1e-12
+   sigma_1 (the Gramian changes by at most 1e-24 of its norm).
+   Balanced truncation: Z_o^T E Z_c = U S V^T, T = Z_c V_r S_r^{-1/2}, W =
+   Z_o U_r S_r^{-1/2}, so W^T E T = I and the reduced model is Ar = W^T A T,
+   Br = W^T B, Cr = B^T Q T (Er = I). The Hankel singular values beyond the
+   rank of the product are not computed, hence the bound 2 sum_{i > r}
+   sigma_i over the computed ones is approximate (it misses values at the
+   level of the ADI residual).
+   Checked (tests/test_lowrank.c): a 10 x 10 lattice (N = 200, complex
+   shifts): Z Z^T and Q Z_y Z_y^T Q within 1e-11 (relative, Frobenius) of
+   phgmg_lyap's dense Gramians, reported and recomputed residual 4.6e-12,
+   Hankel singular values within 2e-12 sigma_1 of phgmg_bt's; the reduced
+   model's sampled H-infinity error 1.5e-2 below the bound 0.17 (r = 8); the
+   same lattice with a consistent-mass-like E against the dense E^{-1}
+   model.
+
 
    9. CONFIGURATION MACROS (define before including) -----------------------------
      PHGMG_IMPLEMENTATION  compile the implementation in this translation unit
@@ -1428,6 +1526,9 @@
            phgmg_ph_abc, phgmg_bt, phgmg_prbt_riccati, phgmg_prbt,
            phgmg_linear_basis, phgmg_ss_transfer, phgmg_reduced_abc,
            phgmg_ss_error, phgmg_ss_compare
+   lowrank: phgmg_shifted_create, phgmg_shifted_solve, phgmg_shifted_apply,
+           phgmg_shifted_factorizations, phgmg_shifted_destroy, phgmg_lradi,
+           phgmg_lowrank_free, phgmg_lrbt
    export: phgmg_rom_serialized_size, phgmg_rom_serialize,
            phgmg_rom_deserialize_size, phgmg_rom_deserialize, phgmg_rom_save,
            phgmg_rom_load, phgmg_rom_export_c
@@ -1437,7 +1538,7 @@
            phgmg_lu_rcond, phgmg_norm1, phgmg_normf, phgmg_zlu_factor,
            phgmg_zlu_solve, phgmg_qr, phgmg_qrcp, phgmg_qr_form_q,
            phgmg_qr_apply, phgmg_lstsq, phgmg_svd, phgmg_sym_eig
-   (124 functions; also the macros PHGMG_ROM_STEPPER_MEMSIZE_MAX and _MAX_CB.)
+   (132 functions; also the macros PHGMG_ROM_STEPPER_MEMSIZE_MAX and _MAX_CB.)
 */
 #ifndef PHGMG_H_INCLUDED
 #define PHGMG_H_INCLUDED
@@ -3100,9 +3201,9 @@ extern "C" {
    tree, supernodes, assembly map; made here, whatever solver the object's
    stepper uses), whose complex numeric factorization serves a complex p
    (the unknowns interleaved re/im in one complex front per supernode: half
-   the memory and a quarter of the flops of the real 2 x 2 embedding
-   [[Re, -Im], [Im, Re]], which would need the analysis of a doubled
-   pattern). The numeric factors of the last `keep` shifts (0: 2) are kept:
+   the memory and half the flops of the real 2 x 2 embedding [[Re, -Im],
+   [Im, Re]], which would also need the analysis of a doubled pattern; manual
+   8.13). The numeric factors of the last `keep` shifts (0: 2) are kept:
    a repeated shift is solved without refactoring. Pivots are static (the
    fill-reducing order's diagonal, manual 8.12), checked per factorization.
    Errors: PHGMG_ERR_INVALID_ARG (NULL, keep < 0), _UNSUPPORTED (an E with
