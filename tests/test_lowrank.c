@@ -365,8 +365,83 @@ TEST(test_lowrank_shifted_solve) {
   lr_free(&M);
 }
 
+/* Progress phases seen (a bit per phase name) and calls. */
+static int lr_phase_bits, lr_phase_calls;
+static void lr_progress(const char *phase, void *user) {
+  static const char *const names[] = {"lradi: shifts", "controllability Gramian", "observability Gramian",
+                                      "balancing", "done"};
+  int i;
+  (void)user;
+  ++lr_phase_calls;
+  for (i = 0; i < 5; ++i)
+    if (!strcmp(phase, names[i])) lr_phase_bits |= 1 << i;
+}
+
+/* Argument checks and refusals: bad options, the iteration cap (residual
+   reported, no factor), a zero B, orders out of range or beyond the
+   computed Hankel singular values, an E with a zero row and column (index
+   one), the progress phases. */
+TEST(test_lowrank_arguments) {
+  lr_model M;
+  phgmg_ph_sparse *sp, *sp1 = NULL;
+  phgmg_shifted *s = NULL;
+  phgmg_lradi_opts o;
+  phgmg_lradi_info inf;
+  phgmg_lrbt_info binf;
+  double *Z = NULL, *B0, Ar[64 * 64], Br[128], Cr[128];
+  const double *B;
+  int N, k = 7;
+  lr_lattice(&M, 4, 0);
+  N = M.N;
+  sp = lr_sparse(&M);
+  B = phgmg_ph_sparse_system(sp)->B;
+  CHECK_RC(phgmg_shifted_create(&s, sp, 0, 0, NULL), PHGMG_OK);
+  memset(&o, 0, sizeof o);
+  CHECK_RC(phgmg_lradi(NULL, 2, B, N, NULL, &Z, &k, NULL, NULL), PHGMG_ERR_INVALID_ARG);
+  CHECK_RC(phgmg_lradi(s, 0, B, N, NULL, &Z, &k, NULL, NULL), PHGMG_ERR_INVALID_ARG);
+  CHECK_RC(phgmg_lradi(s, 2, B, N - 1, NULL, &Z, &k, NULL, NULL), PHGMG_ERR_INVALID_ARG);
+  o.tol = 1.0;
+  CHECK_RC(phgmg_lradi(s, 2, B, N, &o, &Z, &k, NULL, NULL), PHGMG_ERR_INVALID_ARG);
+  o.tol = 0.0; o.maxit = -1;
+  CHECK_RC(phgmg_lradi(s, 2, B, N, &o, &Z, &k, NULL, NULL), PHGMG_ERR_INVALID_ARG);
+  o.maxit = 3;
+  CHECK_RC(phgmg_lradi(s, 2, B, N, &o, &Z, &k, &inf, NULL), PHGMG_ERR_NOT_CONVERGED);
+  CHECK(Z == NULL && k == 0 && inf.iters >= 3 && inf.res > 1e-10 && inf.res < 1.0 && inf.rank == 0);
+  B0 = (double *)calloc((size_t)N * 2, sizeof(double));
+  CHECK_RC(phgmg_lradi(s, 2, B0, N, NULL, &Z, &k, NULL, NULL), PHGMG_ERR_RANK);
+  B0[0] = NAN;
+  CHECK_RC(phgmg_lradi(s, 2, B0, N, NULL, &Z, &k, NULL, NULL), PHGMG_ERR_NANINF);
+  CHECK(Z == NULL);
+  /* the progress phases of a whole low-rank BT */
+  memset(&o, 0, sizeof o);
+  o.progress = lr_progress;
+  lr_phase_bits = lr_phase_calls = 0;
+  CHECK_RC(phgmg_lrbt(sp, 4, &o, Ar, Br, Cr, NULL, NULL, NULL, &binf, NULL), PHGMG_OK);
+  CHECK(lr_phase_bits == 31 && lr_phase_calls >= 6);
+  CHECK_RC(phgmg_lrbt(sp, 0, NULL, Ar, Br, Cr, NULL, NULL, NULL, NULL, NULL), PHGMG_ERR_SIZE);
+  CHECK_RC(phgmg_lrbt(sp, N + 1, NULL, Ar, Br, Cr, NULL, NULL, NULL, NULL, NULL), PHGMG_ERR_SIZE);
+  CHECK_RC(phgmg_lrbt(sp, binf.nhsv + 1, NULL, Ar, Br, Cr, NULL, NULL, NULL, &binf, NULL), PHGMG_ERR_RANK);
+  CHECK_RC(phgmg_lrbt(NULL, 4, NULL, Ar, Br, Cr, NULL, NULL, NULL, NULL, NULL), PHGMG_ERR_INVALID_ARG);
+  { /* an E with a zero row and column: refused */
+    lr_model M1 = M;
+    M1.E = (double *)calloc((size_t)N * N, sizeof(double));
+    for (k = 0; k < N - 1; ++k) M1.E[k + (size_t)k * N] = 1.0;
+    sp1 = lr_sparse(&M1);
+    free(M1.E);
+  }
+  phgmg_shifted_destroy(s);
+  s = NULL;
+  CHECK_RC(phgmg_shifted_create(&s, sp1, 0, 0, NULL), PHGMG_ERR_UNSUPPORTED);
+  CHECK(s == NULL);
+  CHECK_RC(phgmg_lrbt(sp1, 4, NULL, Ar, Br, Cr, NULL, NULL, NULL, NULL, NULL), PHGMG_ERR_UNSUPPORTED);
+  phgmg_ph_sparse_destroy(sp); phgmg_ph_sparse_destroy(sp1);
+  free(B0);
+  lr_free(&M);
+}
+
 SUITE(lowrank) {
   RUN(test_lowrank_shifted_solve);
   RUN(test_lowrank_lradi_lattice);
   RUN(test_lowrank_mass_matrix);
+  RUN(test_lowrank_arguments);
 }
