@@ -479,6 +479,12 @@
          numeric factors of the last few shifts; dual = 1 gives the pencil
          of the dual model (J -> -J), whose Gramian is the observability
          one (O = Q P_dual Q, 8.13);
+     phgmg_shifted_transfer, phgmg_shifted_hinf
+         the transfer function G(i w) = B^T Q (i w E - A)^{-1} B through
+         those solves (one complex factorization per frequency, on the same
+         analysis), and the sampled H-infinity error of a reduced model
+         against the sparse one on phgmg_ss_error's frequency grid: the
+         frequency response at scale;
      phgmg_lradi (+ phgmg_lowrank_free)
          the low-rank ADI for A P E^T + E P A^T + B B^T = 0: P ~ Z Z^T,
          projection shifts, residual-factor stop ||W^T W||_2 <= tol ||B^T
@@ -1539,6 +1545,7 @@
            phgmg_linear_basis, phgmg_ss_transfer, phgmg_reduced_abc,
            phgmg_ss_error, phgmg_ss_compare
    lowrank: phgmg_shifted_create, phgmg_shifted_solve, phgmg_shifted_apply,
+           phgmg_shifted_transfer, phgmg_shifted_hinf,
            phgmg_shifted_factorizations, phgmg_shifted_destroy, phgmg_lradi,
            phgmg_lowrank_free, phgmg_lrbt
    export: phgmg_rom_serialized_size, phgmg_rom_serialize,
@@ -1550,7 +1557,7 @@
            phgmg_lu_rcond, phgmg_norm1, phgmg_normf, phgmg_zlu_factor,
            phgmg_zlu_solve, phgmg_qr, phgmg_qrcp, phgmg_qr_form_q,
            phgmg_qr_apply, phgmg_lstsq, phgmg_svd, phgmg_sym_eig
-   (132 functions; also the macros PHGMG_ROM_STEPPER_MEMSIZE_MAX and _MAX_CB.)
+   (134 functions; also the macros PHGMG_ROM_STEPPER_MEMSIZE_MAX and _MAX_CB.)
 */
 #ifndef PHGMG_H_INCLUDED
 #define PHGMG_H_INCLUDED
@@ -3238,6 +3245,29 @@ PHGMG_DEF phgmg_result phgmg_shifted_solve(phgmg_shifted *s, double pr, double p
    nrhs (ldx, ldy >= N), with the pencil's sparse copies. */
 PHGMG_DEF void phgmg_shifted_apply(const phgmg_shifted *s, char which, int nrhs, const double *X, int ldx,
                                    double *Y, int ldy);
+/* Transfer function G(i w) = B^T Q (i w E - A)^{-1} B of the object's model
+   (dual 1: of the dual model), B the model's (internal order, m ports):
+   m x m complex, interleaved (re, im), column-major, into G (2 m^2
+   doubles). One complex factorization of i w E - A on the object's analysis
+   (kept like a shift's: p = -i w), m solves; w = 0: a real one, which the
+   static pivots refuse (PHGMG_ERR_SINGULAR) when A has zero diagonal
+   entries where the LU condenses states (a mass-spring model's positions),
+   as they refuse |w| below about PHGMG_SPARSE_PIVTOL max|A| there. Errors:
+   PHGMG_ERR_INVALID_ARG (NULL, w not finite), the codes of
+   phgmg_shifted_solve, _NOMEM. */
+PHGMG_DEF phgmg_result phgmg_shifted_transfer(phgmg_shifted *s, double w, double *G);
+/* Sampled H-infinity norms through those solves (frequency response at
+   scale, no dense N x N matrix): hinf = max over nw log-spaced w in [wmin,
+   wmax] (the grid of phgmg_ss_error) of sigma_max(G(i w) - Gr(i w)), Gr the
+   reduced state-space model (Ar r x r, Br r x m, Cr m x r; Er = I, e.g. from
+   phgmg_lrbt); hinf_ref the same of G alone. Either output may be NULL;
+   Ar/Br/Cr may be NULL together (r = 0): hinf_ref only. Cost: nw complex
+   factorizations. Errors: PHGMG_ERR_INVALID_ARG (NULL s, only some of
+   Ar/Br/Cr), _SIZE (r < 0, m > 16, nw < 1, wmin <= 0, wmax < wmin), the codes
+   of phgmg_shifted_transfer and phgmg_ss_transfer, _NOMEM. */
+PHGMG_DEF phgmg_result phgmg_shifted_hinf(phgmg_shifted *s, int r, const double *Ar, const double *Br,
+                                          const double *Cr, int nw, double wmin, double wmax, double *hinf,
+                                          double *hinf_ref);
 /* Numeric factorizations made so far (a repeated shift that was kept does
    not count again). */
 PHGMG_DEF int phgmg_shifted_factorizations(const phgmg_shifted *s);
@@ -17824,6 +17854,7 @@ typedef struct phgmg__shf {
 struct phgmg_shifted {
   phgmg_allocator a;
   const phgmg_allocator *alloc;
+  const phgmg_ph_sparse *sp;
   phgmg__spsym *S; /* the analysis: J - R (dual: -J - R), Q, E        */
   double *Mx;      /* M = -A in the pattern of K                       */
   double *w;       /* N doubles of scratch (products)                  */
@@ -17860,6 +17891,7 @@ PHGMG_DEF phgmg_result phgmg_shifted_create(phgmg_shifted **out, const phgmg_ph_
   memset(s, 0, sizeof *s);
   if (alloc) { s->a = *alloc; s->alloc = &s->a; }
   s->N = sp->sys.N;
+  s->sp = sp;
   s->keep = keep ? keep : 2;
   rc = phgmg__spsym_create_js(&s->S, sp, -1, dual ? -1.0 : 1.0);
   if (rc == PHGMG_OK) {
@@ -17959,6 +17991,63 @@ PHGMG_DEF void phgmg_shifted_apply(const phgmg_shifted *s, char which, int nrhs,
 }
 
 PHGMG_DEF int phgmg_shifted_factorizations(const phgmg_shifted *s) { return s ? s->nfact : 0; }
+
+PHGMG_DEF phgmg_result phgmg_shifted_transfer(phgmg_shifted *s, double w, double *G) {
+  const int N = s ? s->N : 0, m = s ? s->sp->sys.m : 0;
+  const double *B = s ? s->sp->sys.B : NULL;
+  double *X, *col;
+  phgmg_result rc;
+  int a, b, i, part;
+  if (!s || !G || !isfinite(w)) return PHGMG_ERR_INVALID_ARG;
+  X = phgmg__dalloc(s->alloc, 3 * (size_t)N * (size_t)m);
+  if (!X) return PHGMG_ERR_NOMEM;
+  col = X + 2 * (size_t)N * (size_t)m;
+  if (w != 0.0) { /* (A - i w E) X = B */
+    for (i = 0; i < N * m; ++i) { X[2 * i] = B[i]; X[2 * i + 1] = 0.0; }
+    rc = phgmg_shifted_solve(s, 0.0, -w, m, X, N, X, N);
+  } else {
+    rc = phgmg_shifted_solve(s, 0.0, 0.0, m, B, N, X, N);
+  }
+  for (b = 0; b < m && rc == PHGMG_OK; ++b)
+    for (part = 0; part < 2; ++part) { /* G = C (i w E - A)^{-1} B = -B^T Q X: real, imaginary part */
+      if (w == 0.0 && part == 1) {
+        for (a = 0; a < m; ++a) G[2 * (a + (size_t)b * m) + 1] = 0.0;
+        continue;
+      }
+      if (w != 0.0) for (i = 0; i < N; ++i) col[i] = X[2 * (i + (size_t)b * N) + part];
+      else memcpy(col, X + (size_t)b * N, sizeof(double) * (size_t)N);
+      phgmg__sp_qmv(s->S, col, s->w);
+      for (a = 0; a < m; ++a) G[2 * (a + (size_t)b * m) + part] = -phgmg__dot(N, B + (size_t)a * N, s->w);
+    }
+  phgmg__free(s->alloc, X);
+  return rc;
+}
+
+PHGMG_DEF phgmg_result phgmg_shifted_hinf(phgmg_shifted *s, int r, const double *Ar, const double *Br,
+                                          const double *Cr, int nw, double wmin, double wmax, double *hinf,
+                                          double *hinf_ref) {
+  const int m = s ? s->sp->sys.m : 0, red = Ar != NULL;
+  double G[2 * 16 * 16], Gr[2 * 16 * 16], hi = 0.0, hr = 0.0;
+  phgmg_result rc = PHGMG_OK;
+  int j, i;
+  if (!s || (Br != NULL) != red || (Cr != NULL) != red) return PHGMG_ERR_INVALID_ARG;
+  if (r < 0 || (red && r < 1) || m > 16 || nw < 1 || !(wmin > 0.0) || !(wmax >= wmin)) return PHGMG_ERR_SIZE;
+  for (j = 0; j < nw && rc == PHGMG_OK; ++j) {
+    const double w = wmin * pow(wmax / wmin, nw > 1 ? (double)j / (nw - 1) : 0.0);
+    rc = phgmg_shifted_transfer(s, w, G);
+    if (rc == PHGMG_OK && red) rc = phgmg_ss_transfer(r, m, m, Ar, Br, Cr, w, Gr, s->alloc);
+    if (rc != PHGMG_OK) break;
+    hr = PHGMG__MAX(hr, phgmg__zsigma_max(m, m, G));
+    if (!red) continue;
+    for (i = 0; i < 2 * m * m; ++i) Gr[i] = G[i] - Gr[i];
+    hi = PHGMG__MAX(hi, phgmg__zsigma_max(m, m, Gr));
+  }
+  if (rc == PHGMG_OK) {
+    if (hinf) *hinf = hi;
+    if (hinf_ref) *hinf_ref = hr;
+  }
+  return rc;
+}
 
 PHGMG_DEF void phgmg_lowrank_free(double *Z, const phgmg_allocator *alloc) { phgmg__free(alloc, Z); }
 

@@ -14,10 +14,14 @@
    --r (default 20) with the default options (tol 1e-10). Prints the wall and
    CPU time of each, the ADI steps, the factors' columns and ranks, the
    residuals, the numeric factorizations, the first Hankel singular values
-   and the bound 2 sum_{i > r} sigma_i / sigma_1.
+   and the bound 2 sum_{i > r} sigma_i / sigma_1; then (--nw, default 20,
+   0: skip) the sampled H-infinity error of the reduced model on --nw
+   log-spaced frequencies in [1e-2, 1e2] through the sparse model's shifted
+   solves (phgmg_shifted_hinf: one complex factorization per frequency),
+   relative to the sampled norm of G, against the bound.
 
      cc -std=c99 -O2 -march=native bench/bench_lowrank.c -o build/bench_lowrank -lm
-     ./build/bench_lowrank --model heat --n 100 [--r 20] [--out bench/results.csv]
+     ./build/bench_lowrank --model heat --n 100 [--r 20] [--nw 20] [--out bench/results.csv]
      ./build/bench_lowrank --model heat --n 317
      ./build/bench_lowrank --model lattice --n 71 */
 #define _POSIX_C_SOURCE 199309L
@@ -92,24 +96,26 @@ static int bl_model(int lattice, int n, bl_csc *J, bl_csc *R, bl_csc *Q, double 
 }
 
 int main(int argc, char **argv) {
-  static const char *const extra[] = {"--model", "--n", "--r", NULL};
-  const char *vals[3] = {NULL, NULL, NULL}, *outname;
+  static const char *const extra[] = {"--model", "--n", "--r", "--nw", NULL};
+  const char *vals[4] = {NULL, NULL, NULL, NULL}, *outname;
   bl_csc J, R, Q;
   double *B, *Ar, *Br, *Cr, *hsv, t0, t1, t2, c0, c1, c2;
   phgmg_ph_sparse *sp = NULL;
   phgmg_ph_sparse_info si;
   phgmg_lrbt_info inf;
   phgmg_result rc;
-  int lattice, n, r, N, i, err = 0;
+  int lattice, n, r, N, i, nw, err = 0;
   FILE *csv;
   i = bench_args(argc, argv, "bench_lowrank", "Low-rank BT of a 2-D heat model or a 2-D mass-spring-damper lattice.\n"
-                 "  --model heat|lattice (heat)  --n grid side (100)  --r order (20)", &outname, extra, vals);
+                 "  --model heat|lattice (heat)  --n grid side (100)  --r order (20)\n"
+                 "  --nw frequencies of the sampled H-infinity error (20; 0: none)", &outname, extra, vals);
   if (i) return i == 1 ? 0 : 2;
   lattice = vals[0] && !strcmp(vals[0], "lattice");
   if (vals[0] && !lattice && strcmp(vals[0], "heat")) { fprintf(stderr, "bench_lowrank: --model heat|lattice\n"); return 2; }
   n = vals[1] ? atoi(vals[1]) : 100;
   r = vals[2] ? atoi(vals[2]) : 20;
-  if (n < 4 || r < 1) { fprintf(stderr, "bench_lowrank: --n >= 4, --r >= 1\n"); return 2; }
+  nw = vals[3] ? atoi(vals[3]) : 20;
+  if (n < 4 || r < 1 || nw < 0) { fprintf(stderr, "bench_lowrank: --n >= 4, --r >= 1, --nw >= 0\n"); return 2; }
   csv = bench_open_csv("bench_lowrank", outname, &err);
   if (err) return 1;
   N = bl_model(lattice, n, &J, &R, &Q, &B);
@@ -131,6 +137,19 @@ int main(int argc, char **argv) {
          lattice ? "" : " (J = 0: the same run)");
   printf("  Hankel singular values computed %d; sigma_1 %.6e, sigma_r %.3e, sigma_r+1 %.3e; bound 2 sum_{i>r} / sigma_1 = %.2e\n",
          inf.nhsv, hsv[0], hsv[r - 1], inf.hsv_tail, inf.bound / hsv[0]);
+  if (nw > 0) {
+    phgmg_shifted *s = NULL;
+    double hinf = 0.0, href = 0.0;
+    t0 = bl_now(); c0 = (double)clock() / CLOCKS_PER_SEC;
+    rc = phgmg_shifted_create(&s, sp, 0, 1, NULL);
+    if (rc == PHGMG_OK) rc = phgmg_shifted_hinf(s, r, Ar, Br, Cr, nw, 1e-2, 1e2, &hinf, &href);
+    t1 = bl_now(); c1 = (double)clock() / CLOCKS_PER_SEC;
+    phgmg_shifted_destroy(s);
+    if (rc != PHGMG_OK) { fprintf(stderr, "bench_lowrank: sampled error: %s\n", phgmg_result_string(rc)); return 1; }
+    printf("  sampled H-infinity error on %d frequencies in [1e-2, 1e2]: %.3e (relative to the sampled ||G|| %.3e: %.2e), "
+           "bound %.3e: %s; %.2f s wall, %.2f s CPU\n", nw, hinf, href, hinf / href, inf.bound,
+           hinf <= inf.bound ? "within" : "ABOVE", t1 - t0, c1 - c0);
+  }
   if (csv) {
     fprintf(csv, "lrbt_%s_N%d_r%d,%.6f,%.6f,%.6f,1\n", lattice ? "lattice" : "heat", N, r, t2 - t1, t2 - t1, t2 - t1);
     fclose(csv);

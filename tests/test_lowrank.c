@@ -183,14 +183,24 @@ static void lr_dense_gramians(const lr_model *M, double *A, double *Bp, double *
 }
 
 /* The reduced model's sampled H-infinity error against the full (E^{-1})
-   model's, by dense complex solves (phgmg_ss_error), on nw frequencies. */
-static double lr_hinf(const lr_model *M, int r, const double *Ar, const double *Br, const double *Cr, int nw) {
+   model's, by dense complex solves (phgmg_ss_error), on nw frequencies in
+   [1e-2, 1e2]; the same through the sparse model's shifted solves
+   (phgmg_shifted_hinf) must agree, error and norm. */
+static double lr_hinf(const lr_model *M, phgmg_ph_sparse *sp, int r, const double *Ar, const double *Br,
+                      const double *Cr, int nw) {
   const int N = M->N;
   double *A = (double *)malloc(sizeof(double) * (size_t)N * N), *Bp = (double *)malloc(sizeof(double) * (size_t)N * 2);
-  double *C = (double *)malloc(sizeof(double) * (size_t)N * 2), hinf = 0.0;
+  double *C = (double *)malloc(sizeof(double) * (size_t)N * 2), hinf = 0.0, href = 0.0, hs = 0.0, hsr = 0.0;
+  phgmg_shifted *s = NULL;
   lr_dense_abc(M, A, Bp, C);
-  CHECK_RC(phgmg_ss_error(N, A, Bp, C, r, Ar, Br, Cr, 2, 2, nw, 1e-2, 1e2, &hinf, NULL, NULL, NULL, NULL),
+  CHECK_RC(phgmg_ss_error(N, A, Bp, C, r, Ar, Br, Cr, 2, 2, nw, 1e-2, 1e2, &hinf, &href, NULL, NULL, NULL),
            PHGMG_OK);
+  CHECK_RC(phgmg_shifted_create(&s, sp, 0, 0, NULL), PHGMG_OK);
+  CHECK_RC(phgmg_shifted_hinf(s, r, Ar, Br, Cr, nw, 1e-2, 1e2, &hs, &hsr), PHGMG_OK);
+  CHECK_LE(fabs(hs - hinf), 1e-9 * href);
+  CHECK_LE(fabs(hsr - href), 1e-10 * href);
+  CHECK(phgmg_shifted_factorizations(s) == nw);
+  phgmg_shifted_destroy(s);
   free(A); free(Bp); free(C);
   return hinf;
 }
@@ -236,7 +246,7 @@ TEST(test_lowrank_lradi_lattice) {
   CHECK_RC(phgmg_lrbt(sp, r, NULL, Ar, Br, Cr, hsv, NULL, NULL, &binf, NULL), PHGMG_OK);
   for (i = 0; i < r; ++i) CHECK_LE(fabs(hsv[i] - hsvd[i]), 1e-8 * hsvd[0]);
   CHECK(binf.nhsv > r && binf.bound > 0.0 && binf.hsv_tail <= hsv[r - 1]);
-  hinf = lr_hinf(&M, r, Ar, Br, Cr, 12);
+  hinf = lr_hinf(&M, sp, r, Ar, Br, Cr, 12);
   CHECK(hinf > 0.0);
   CHECK_LE(hinf, binf.bound);
   phgmg_lowrank_free(Z, NULL); phgmg_lowrank_free(Zy, NULL);
@@ -248,7 +258,8 @@ TEST(test_lowrank_lradi_lattice) {
 /* A mass matrix E: LR-ADI's Z Z^T and low-rank BT's Hankel singular values
    against the dense Gramians of the equivalent model (E^{-1} A, E^{-1} B,
    B^T Q), the residual with E recomputed here, the reduced model's sampled
-   H-infinity error against the full model's below the bound. */
+   H-infinity error against the full model's below the bound (sampled by
+   dense solves and by the sparse model's shifted solves). */
 TEST(test_lowrank_mass_matrix) {
   enum { r = 6 };
   lr_model M;
@@ -283,7 +294,7 @@ TEST(test_lowrank_mass_matrix) {
   lr_dense_hsv(N, P, O, hsvd, r);
   CHECK_RC(phgmg_lrbt(sp, r, NULL, Ar, Br, Cr, hsv, NULL, NULL, &binf, NULL), PHGMG_OK);
   for (i = 0; i < r; ++i) CHECK_LE(fabs(hsv[i] - hsvd[i]), 1e-8 * hsvd[0]);
-  res = lr_hinf(&M, r, Ar, Br, Cr, 24);
+  res = lr_hinf(&M, sp, r, Ar, Br, Cr, 24);
   CHECK(res > 0.0);
   CHECK_LE(res, binf.bound);
   phgmg_lowrank_free(Z, NULL);
@@ -294,7 +305,8 @@ TEST(test_lowrank_mass_matrix) {
 
 /* Shifted solves (A + p E) X = F on the model with a mass matrix: a complex
    and a real shift against dense solves done here (user order, permuted),
-   a repeated shift served by the kept factors, bad arguments refused. */
+   a repeated shift served by the kept factors, bad arguments refused; the
+   transfer function through them against dense solves. */
 TEST(test_lowrank_shifted_solve) {
   lr_model M;
   phgmg_ph_sparse *sp;
@@ -360,6 +372,33 @@ TEST(test_lowrank_shifted_solve) {
   F[3] = NAN;
   CHECK_RC(phgmg_shifted_solve(s, pr, pi, 1, F, N, X, N), PHGMG_ERR_NANINF);
   CHECK_RC(phgmg_shifted_create(NULL, sp, 0, 0, NULL), PHGMG_ERR_INVALID_ARG);
+  { /* the transfer function at w = 0.7 and 2.3 against dense solves: G = B^T Q (i w E - A)^{-1} B */
+    double G[8], w = 0.7;
+    int t;
+    for (t = 0; t < 2; ++t, w = 2.3) {
+      double gd[8] = {0}, e2 = 0.0, n2 = 0.0, *Bz = (double *)malloc(sizeof(double) * 4 * (size_t)N);
+      int a, b;
+      for (i = 0; i < N * N; ++i) { Kz[2 * i] = -A0[i]; Kz[2 * i + 1] = w * M.E[i]; }
+      for (i = 0; i < 2 * N; ++i) { Bz[2 * i] = M.B[i]; Bz[2 * i + 1] = 0.0; }
+      CHECK_RC(phgmg_zlu_factor(N, Kz, N, ip), PHGMG_OK);
+      phgmg_zlu_solve(N, Kz, N, ip, 2, Bz, N);
+      for (a = 0; a < 2; ++a)
+        for (b = 0; b < 2; ++b)
+          for (i = 0; i < N; ++i) { /* C = B^T Q: row a */
+            double c = 0.0;
+            for (j = 0; j < N; ++j) c += M.B[j + (size_t)a * N] * M.Q[j + (size_t)i * N];
+            gd[2 * (a + 2 * b)] += c * Bz[2 * (i + (size_t)b * N)];
+            gd[2 * (a + 2 * b) + 1] += c * Bz[2 * (i + (size_t)b * N) + 1];
+          }
+      CHECK_RC(phgmg_shifted_transfer(s, w, G), PHGMG_OK);
+      for (i = 0; i < 8; ++i) { e2 += (G[i] - gd[i]) * (G[i] - gd[i]); n2 += gd[i] * gd[i]; }
+      CHECK_LE(sqrt(e2 / n2), 1e-12);
+      free(Bz);
+    }
+    CHECK_RC(phgmg_shifted_transfer(s, NAN, G), PHGMG_ERR_INVALID_ARG);
+    CHECK_RC(phgmg_shifted_hinf(s, 0, NULL, NULL, NULL, 0, 1.0, 2.0, NULL, NULL), PHGMG_ERR_SIZE);
+    CHECK_RC(phgmg_shifted_hinf(s, 2, G, NULL, NULL, 1, 1.0, 2.0, NULL, NULL), PHGMG_ERR_INVALID_ARG);
+  }
   phgmg_shifted_destroy(s); phgmg_ph_sparse_destroy(sp);
   free(Kz); free(F); free(X); free(Fu); free(ip); free(A0); free(B0); free(C0);
   lr_free(&M);
