@@ -205,6 +205,58 @@ static double lr_hinf(const lr_model *M, phgmg_ph_sparse *sp, int r, const doubl
   return hinf;
 }
 
+/* pH-preserving low-rank balancing of the model against the dense Gramian
+   P: the values sqrt(eig(P E^T Q)) (EQ = E^T Q dense), the structure (Jr
+   skew exactly, Rr symmetric positive semidefinite, Qr diagonal positive),
+   the reduced model passive on sampled frequencies; returns its sampled
+   H-infinity error relative to the model's norm. */
+static double lr_check_phbt(const lr_model *M, phgmg_ph_sparse *sp, const double *P, const double *EQ, int r) {
+  const int N = M->N;
+  double *Jr = (double *)malloc(sizeof(double) * (size_t)r * r), *Rr = (double *)malloc(sizeof(double) * (size_t)r * r);
+  double *Qr = (double *)malloc(sizeof(double) * (size_t)r * r), *Br = (double *)malloc(sizeof(double) * (size_t)r * 2);
+  double *Ar = (double *)malloc(sizeof(double) * (size_t)r * r), *Cr = (double *)malloc(sizeof(double) * (size_t)r * 2);
+  double *sg = (double *)malloc(sizeof(double) * (size_t)r), *sd = (double *)malloc(sizeof(double) * (size_t)r);
+  double *w = (double *)malloc(sizeof(double) * (size_t)r), *T = (double *)malloc(sizeof(double) * (size_t)r * r);
+  double hinf = 0.0, href = 0.0, rmax = 0.0;
+  phgmg_shifted *s = NULL;
+  phgmg_lrbt_info inf;
+  int i, j;
+  CHECK_RC(phgmg_lrphbt(sp, r, NULL, Jr, Rr, Qr, Br, sg, NULL, &inf, NULL), PHGMG_OK);
+  lr_dense_hsv(N, P, EQ, sd, r);
+  for (i = 0; i < r; ++i) CHECK_LE(fabs(sg[i] - sd[i]), 1e-8 * sd[0]);
+  for (j = 0; j < r; ++j)
+    for (i = 0; i < r; ++i) {
+      CHECK(Jr[i + (size_t)j * r] == -Jr[j + (size_t)i * r]);
+      CHECK(Rr[i + (size_t)j * r] == Rr[j + (size_t)i * r]);
+      CHECK(i == j ? Qr[i + (size_t)j * r] > 0.0 : Qr[i + (size_t)j * r] == 0.0);
+      rmax = PHGMG__MAX(rmax, fabs(Rr[i + (size_t)j * r]));
+    }
+  memcpy(T, Rr, sizeof(double) * (size_t)r * r);
+  CHECK_RC(phgmg_sym_eig(r, T, r, w, NULL, r), PHGMG_OK);
+  CHECK(w[0] >= -1e-13 * rmax && w[r - 1] > 0.0);
+  for (i = 0; i < r * r; ++i) T[i] = Jr[i] - Rr[i];
+  phgmg_gemm('N', 'N', r, r, r, 1.0, T, r, Qr, r, 0.0, Ar, r);             /* A = (Jr - Rr) Qr */
+  phgmg_gemm('T', 'N', 2, r, r, 1.0, Br, r, Qr, r, 0.0, Cr, 2);            /* C = Br^T Qr      */
+  for (j = 0; j < 9; ++j) { /* passive: G_r(i w) + G_r(i w)^H positive semidefinite */
+    double G[8], H[16], e[4];
+    int a, b;
+    CHECK_RC(phgmg_ss_transfer(r, 2, 2, Ar, Br, Cr, pow(10.0, -2.0 + 0.5 * j), G, NULL), PHGMG_OK);
+    for (a = 0; a < 2; ++a)
+      for (b = 0; b < 2; ++b) { /* H = [[Re, -Im], [Im, Re]] of G + G^H */
+        const double re = G[2 * (a + 2 * b)] + G[2 * (b + 2 * a)], im = G[2 * (a + 2 * b) + 1] - G[2 * (b + 2 * a) + 1];
+        H[a + 4 * b] = H[(a + 2) + 4 * (b + 2)] = re;
+        H[(a + 2) + 4 * b] = im; H[a + 4 * (b + 2)] = -im;
+      }
+    CHECK_RC(phgmg_sym_eig(4, H, 4, e, NULL, 4), PHGMG_OK);
+    CHECK(e[0] >= -1e-12 * fabs(e[3]));
+  }
+  CHECK_RC(phgmg_shifted_create(&s, sp, 0, 1, NULL), PHGMG_OK);
+  CHECK_RC(phgmg_shifted_hinf(s, r, Ar, Br, Cr, 12, 1e-2, 1e2, &hinf, &href), PHGMG_OK);
+  phgmg_shifted_destroy(s);
+  free(Jr); free(Rr); free(Qr); free(Br); free(Ar); free(Cr); free(sg); free(sd); free(w); free(T);
+  return hinf / href;
+}
+
 /* LR-ADI on the lattice (complex shifts): Z Z^T against the dense Gramian,
    the reported residual against the residual of Z Z^T computed here, the
    observability factor of the dual model (O = Q Zy Zy^T Q); low-rank BT:
@@ -249,6 +301,12 @@ TEST(test_lowrank_lradi_lattice) {
   hinf = lr_hinf(&M, sp, r, Ar, Br, Cr, 12);
   CHECK(hinf > 0.0);
   CHECK_LE(hinf, binf.bound);
+  /* pH-preserving balancing: the values sqrt(eig(P Q)), the structure,
+     passivity, an error that falls with the order */
+  {
+    const double e4 = lr_check_phbt(&M, sp, P, M.Q, 4), e12 = lr_check_phbt(&M, sp, P, M.Q, 12);
+    CHECK(e12 < e4);
+  }
   phgmg_lowrank_free(Z, NULL); phgmg_lowrank_free(Zy, NULL);
   phgmg_shifted_destroy(s); phgmg_shifted_destroy(sd); phgmg_ph_sparse_destroy(sp);
   free(A); free(Bp); free(C); free(P); free(O); free(T); free(Plr); free(Olr);
@@ -259,7 +317,8 @@ TEST(test_lowrank_lradi_lattice) {
    against the dense Gramians of the equivalent model (E^{-1} A, E^{-1} B,
    B^T Q), the residual with E recomputed here, the reduced model's sampled
    H-infinity error against the full model's below the bound (sampled by
-   dense solves and by the sparse model's shifted solves). */
+   dense solves and by the sparse model's shifted solves); the pH-preserving
+   balancing against E^T Q. */
 TEST(test_lowrank_mass_matrix) {
   enum { r = 6 };
   lr_model M;
@@ -297,6 +356,12 @@ TEST(test_lowrank_mass_matrix) {
   res = lr_hinf(&M, sp, r, Ar, Br, Cr, 24);
   CHECK(res > 0.0);
   CHECK_LE(res, binf.bound);
+  { /* pH-preserving balancing against E^T Q */
+    double *EQ = (double *)malloc(sizeof(double) * (size_t)N * N);
+    phgmg_gemm('T', 'N', N, N, N, 1.0, M.E, N, M.Q, N, 0.0, EQ, N);
+    lr_check_phbt(&M, sp, P, EQ, r);
+    free(EQ);
+  }
   phgmg_lowrank_free(Z, NULL);
   phgmg_shifted_destroy(s); phgmg_ph_sparse_destroy(sp);
   free(A); free(Bp); free(C); free(P); free(O); free(Plr); free(A0); free(C0);
