@@ -3260,7 +3260,8 @@ PHGMG_DEF phgmg_result phgmg_shifted_create(phgmg_shifted **out, const phgmg_ph_
    ldf, ldx >= N); pi != 0: F and X complex, interleaved (re, im) pairs, N x
    nrhs with ld in complex entries (column j at 2 j ld doubles). X == F
    (same ld) solves in place. Errors: PHGMG_ERR_INVALID_ARG (NULL, a shift
-   not finite, nrhs < 0, ld < N), _NANINF (F not finite), _SINGULAR (a static
+   not finite, nrhs < 0, ld < N, X == F with ldx != ldf), _NANINF (F not
+   finite), _SINGULAR (a static
    pivot below PHGMG_SPARSE_PIVTOL max|K| or growth above
    PHGMG_SPARSE_GROWTH: this shift needs row exchanges the LU does not make;
    X unspecified, the object stays usable), _NOMEM. */
@@ -3331,8 +3332,8 @@ typedef struct phgmg_lradi_info {
    update (Benner, Kuerschner, Saak), projection shifts, stop on ||W^T W||_2
    <= tol ||B^T B||_2, then column compression (manual 8.13). info (may be
    NULL) receives the counts and the residual. opts may be NULL. Errors:
-   PHGMG_ERR_INVALID_ARG (NULL, m < 1, ldb < N, negative tol/maxit/
-   shift_blocks), _NANINF (B), _NOT_STABLE (no Ritz value of the pencil in
+   PHGMG_ERR_INVALID_ARG (NULL, m < 1, ldb < N, tol outside [0, 1), negative
+   maxit/shift_blocks, trunc >= 1 or NaN), _NANINF (B), _RANK (B = 0), _NOT_STABLE (no Ritz value of the pencil in
    the open left half-plane: no shift), _NOT_CONVERGED (maxit reached; info
    then holds the residual reached, *Z NULL), the codes of
    phgmg_shifted_solve, _NOMEM. */
@@ -17989,7 +17990,8 @@ PHGMG_DEF phgmg_result phgmg_shifted_solve(phgmg_shifted *s, double pr, double p
   phgmg_result rc;
   int j, w = pi != 0.0 ? 2 : 1;
   size_t i, len;
-  if (!s || !F || !X || nrhs < 0 || ldf < s->N || ldx < s->N || !isfinite(pr) || !isfinite(pi))
+  if (!s || !F || !X || nrhs < 0 || ldf < s->N || ldx < s->N || !isfinite(pr) || !isfinite(pi) ||
+      (X == F && ldx != ldf))
     return PHGMG_ERR_INVALID_ARG;
   len = (size_t)w * (size_t)s->N;
   for (j = 0; j < nrhs; ++j)

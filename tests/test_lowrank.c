@@ -434,6 +434,7 @@ TEST(test_lowrank_shifted_solve) {
   }
   CHECK_RC(phgmg_shifted_solve(s, NAN, 0.0, 1, F, N, X, N), PHGMG_ERR_INVALID_ARG);
   CHECK_RC(phgmg_shifted_solve(s, pr, 0.0, 1, F, N - 1, X, N), PHGMG_ERR_INVALID_ARG);
+  CHECK_RC(phgmg_shifted_solve(s, pr, 0.0, 1, F, N + 1, F, N), PHGMG_ERR_INVALID_ARG); /* in place, other ld */
   F[3] = NAN;
   CHECK_RC(phgmg_shifted_solve(s, pr, pi, 1, F, N, X, N), PHGMG_ERR_NANINF);
   CHECK_RC(phgmg_shifted_create(NULL, sp, 0, 0, NULL), PHGMG_ERR_INVALID_ARG);
