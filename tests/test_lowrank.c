@@ -270,7 +270,7 @@ TEST(test_lowrank_lradi_lattice) {
   phgmg_lradi_info inf, infd;
   double *A, *Bp, *C, *P, *O, *Z = NULL, *Zy = NULL, *Plr, *Olr, *T, res;
   int N, k = 0, ky = 0, i;
-  lr_lattice(&M, 9, 0);
+  lr_lattice(&M, 8, 0);
   N = M.N;
   A = (double *)malloc(sizeof(double) * (size_t)N * N); Bp = (double *)malloc(sizeof(double) * (size_t)N * 2);
   C = (double *)malloc(sizeof(double) * (size_t)N * 2); P = (double *)malloc(sizeof(double) * (size_t)N * N);
