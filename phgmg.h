@@ -26,8 +26,8 @@
    The header has two halves, declarations and implementation, each cut into
    sections marked >>config, >>result, >>memory, >>ph, >>dae, >>sparse, >>gl3,
    >>online, >>pod, >>hyper, >>reduce, >>deploy, >>errors, >>study, >>linear,
-   >>export, >>npy, >>mpi (only with PHGMG_MPI) and, last, >>linalg, the
-   dense kernels (grep for them; the
+   >>lowrank, >>export, >>npy, >>mpi (only with PHGMG_MPI) and, last,
+   >>linalg, the dense kernels (grep for them; the
    same order in both halves: the implementation declares the kernels' private
    helpers in >>linalg (prototypes) after >>memory, and its >>reduce opens with
    the reduced object the others use). The comment at each declaration states
@@ -457,7 +457,8 @@
    least H2 error; pass them as opts.cache.pod_basis), transfer functions and
    H-infinity / H2 errors (phgmg_ph_abc, phgmg_ss_transfer, phgmg_reduced_abc,
    phgmg_ss_error). A system with an undamped mode has no Gramians: BT, PRBT
-   and the BALANCED / H2 bases then return PHGMG_ERR_NOT_STABLE.
+   and the BALANCED / H2 bases then return PHGMG_ERR_NOT_STABLE. Larger
+   sparse models: 2.8.
 
 
    2.6 Sparse models (>>ph, >>sparse). phgmg_ph_sparse_create takes J, R, Q
@@ -543,6 +544,54 @@
    pair; per operator product one exchange with the neighbouring ranks.
    Not yet distributed: GMG-QM, SP1/SP2, ECSW, nonlinear Hamiltonians,
    dampers, descriptor models, the command line.
+   2.8 Large sparse linear models (>>lowrank). For a phgmg_ph_sparse model
+   with quadratic H (E x' = (J - R) Q x + B u, y = B^T Q x; E = I or a mass
+   matrix of full rank) the Gramians are computed in low-rank factored form
+   and balanced truncation runs without any N x N matrix:
+     phgmg_shifted_create / _solve / _apply / _factorizations / _destroy
+         solves (A + p E) X = F, A = (J - R) Q, for real and complex shifts
+         p on one symbolic analysis of the sparse LU (>>sparse), keeping the
+         numeric factors of the last few shifts; dual = 1 gives the pencil
+         of the dual model (J -> -J), whose Gramian is the observability
+         one (O = Q P_dual Q, 8.13);
+     phgmg_shifted_transfer, phgmg_shifted_hinf
+         the transfer function G(i w) = B^T Q (i w E - A)^{-1} B through
+         those solves (one complex factorization per frequency, on the same
+         analysis), and the sampled H-infinity error of a reduced model
+         against the sparse one on phgmg_ss_error's frequency grid: the
+         frequency response at scale;
+     phgmg_lradi (+ phgmg_lowrank_free)
+         the low-rank ADI for A P E^T + E P A^T + B B^T = 0: P ~ Z Z^T,
+         projection shifts, residual-factor stop ||W^T W||_2 <= tol ||B^T
+         B||_2 (tol 1e-10), column compression; phgmg_lradi_info reports
+         steps, columns, rank, residual, factorizations;
+     phgmg_lrbt
+         low-rank square-root BT: Ar, Br, Cr (Er = I) like phgmg_bt, the
+         Hankel singular values and the H-infinity bound 2 sum_{i > r}
+         sigma_i -- over the computed values only, so approximate (the tail
+         beyond the factors' rank is below the ADI tolerance's level).
+   Vectors (B, Z, T, W, F, X) are in the object's internal ordering.
+   phgmg_lradi_opts.progress (NULL: none) is called as progress(phase, user)
+   like phgmg_reduce's (2.2): "lradi: shifts" before each new set of
+   projection shifts; phgmg_lrbt also calls "controllability Gramian",
+   "observability Gramian" (not when J = 0: the dual model is the model and
+   one ADI run serves both), "balancing" and "done".
+
+       phgmg_ph_sparse *sp;  phgmg_lrbt_info inf;
+       phgmg_ph_sparse_create(&sp, N, m, &J, &R, &Q, B, NULL, NULL, NULL);
+       phgmg_lrbt(sp, 20, NULL, Ar, Br, Cr, hsv, NULL, NULL, &inf, NULL);
+       // inf.ctrl.res, inf.ctrl.rank, inf.nhsv, inf.bound
+
+     phgmg_lrphbt
+         pH-preserving low-rank balancing with one Lyapunov equation: the
+         controllability factor balanced against the energy matrix E^T Q,
+         Galerkin projection in the energy inner product: Jr skew, Rr >= 0,
+         Qr > 0 diagonal (Er = I) by construction, through sparse products
+         (never Q^{-1}); less accurate than BT at the same order (8.13).
+   The reduced model of phgmg_lrbt (Ar, Br, Cr) is a plain state-space
+   model (as phgmg_bt's), not a pH model. Not yet: index-one E (zero rows/columns:
+   PHGMG_ERR_UNSUPPORTED), feedthrough, nonlinear parts. Algorithms and
+   measured times: 8.13.
 
    3. METHODS AND OPTIONS -------------------------------------------------------
    Every option struct is "zero means default": memset it to 0 and set what you
@@ -1426,6 +1475,98 @@
    `phgmg reduce --simulate --steps 200 --method gmg-pod --r 20` peaks at
    about twice the snapshot matrix.
 
+   8.13 Low-rank Gramians (>>lowrank).
+   Shifted solves. (A + p E) = -K(-p) with the stepper's stage matrix K(sigma)
+   = sigma E + M, M = -(J - R) Q (8.12), so the sparse LU's analysis (the
+   condensation, nested dissection, supernodes, assembly map: made once per
+   phgmg_shifted object) serves every shift; a complex shift uses the LU's
+   complex numeric factorization on that same analysis (interleaved re/im
+   fronts). The alternative, the real 2 x 2 embedding [[Re, -Im], [Im, Re]]
+   per unknown, would need an analysis of the doubled pattern (4x the
+   entries of the pattern), and its factor holds 4 real entries per complex
+   entry (2x the memory of the complex factor) and costs 2x the flops (a
+   dense front of order n: n^3/3 complex multiply-adds, 8/3 n^3 real flops,
+   against (2n)^3/3 real multiply-adds, 16/3 n^3 flops): rejected. The
+   pivots are static, as in the stepper (8.12); a factorization with a
+   replaced pivot or growth above PHGMG_SPARSE_GROWTH is refused
+   (PHGMG_ERR_SINGULAR) rather than used. (For Re p < 0, Q K(-p) = -p Q E -
+   Q (J - R) Q has the positive-definite Hermitian part -Re(p) E^T Q + Q R Q;
+   no refusal has been seen on the models of the tests and the bench.) The
+   numeric factors of the last `keep`
+   shifts stay; a shift is matched exactly (the projection shifts rarely
+   repeat; an ADI cycle that finds no new stable Ritz value reuses its last
+   set, and those solves are served from the kept factors).
+   Observability. C = B^T Q and E^T Q = Q E (a pH descriptor model) give
+   A^T (Q Y Q) E + E^T (Q Y Q) A + C^T C = Q (A' Y E^T + E Y A'^T + B B^T) Q
+   with A' = (-J - R) Q = ((J - R)^T) Q: the observability Gramian is O =
+   Q Y Q with Y the controllability Gramian of the dual model J -> -J. So
+   one solver (of A P E^T + E P A^T + B B^T = 0, non-transposed solves
+   only) serves both, Z_o = Q Z_y, and no Q^{-1} is formed; when J = 0 (the
+   heat equation) the dual is the model and one ADI run gives both.
+   LR-ADI (Benner, Kuerschner, Saak; as pyMOR's lradi). W_0 = B; per shift
+   p_k: V = (A + p_k E)^{-1} W, W <- W - 2 Re(p_k) E V, Z <- [Z, sqrt(-2
+   p_k) V] (real p_k); a pair p, conj(p) takes one complex solve and, with
+   g = sqrt(-4 Re p), d = Re p / Im p, Y = Re V + d Im V: W <- W + g^2 E Y,
+   Z <- [Z, g Y, g sqrt(d^2 + 1) Im V] (real arithmetic, two steps). Then
+   A Z Z^T E^T + E Z Z^T A^T + B B^T = W W^T exactly (in exact arithmetic),
+   so ||W^T W||_2 / ||B^T B||_2 is the relative residual in the 2-norm at no
+   extra cost (the tests recompute it densely: it agrees to 4 digits).
+   Shifts: the Ritz values of the pencil on span(B) to start, then on the
+   span of the last shift_blocks (6) ADI blocks whenever the current set is
+   used up: an orthonormal basis U by pivoted QR, the eigenvalues of (U^T E
+   U)^{-1} U^T A U by the complex Schur form (phgmg__zschur, the QR
+   algorithm on the Hessenberg form), those with Re < 0, imaginary parts
+   below 1e-8 |lambda| dropped, one member of each conjugate pair, sorted
+   by modulus (by value when all are real). Stop: residual <= tol (1e-10) or
+   maxit steps (PHGMG_ERR_NOT_CONVERGED). Compression at the end: Z <- U_k
+   S_k from the thin SVD (phgmg_svd), singular values above trunc = 1e-12
+   sigma_1 (the Gramian changes by at most 1e-24 of its norm).
+   Balanced truncation: Z_o^T E Z_c = U S V^T, T = Z_c V_r S_r^{-1/2}, W =
+   Z_o U_r S_r^{-1/2}, so W^T E T = I and the reduced model is Ar = W^T A T,
+   Br = W^T B, Cr = B^T Q T (Er = I). The Hankel singular values beyond the
+   rank of the product are not computed, hence the bound 2 sum_{i > r}
+   sigma_i over the computed ones is approximate (it misses values at the
+   level of the ADI residual).
+   pH-preserving balancing (phgmg_lrphbt). One equation: P ~ Z_c Z_c^T, and
+   the Hamiltonian's energy matrix E^T Q (known, sparse) in place of the
+   observability Gramian: sigma_i = sqrt(eig(P E^T Q)) from the small
+   symmetric eigenproblem Z_c^T E^T Q Z_c = Y diag(sigma^2) Y^T; T = Z_c Y_r
+   Sigma_r^{-1/2} and the Petrov-Galerkin projection with test space Q T:
+   T^T Q E T = Sigma_r (Q E = E^T Q), Jr = skew(T^T Q J Q T), Rr = sym(T^T
+   Q R Q T), Br = T^T Q B; in xi = Sigma_r xr the model has Qr =
+   Sigma_r^{-1} and Er = I. Structure by construction: Jr is skew-symmetrised
+   (exact), Rr a congruence of R (positive semidefinite up to round-off),
+   Qr diagonal positive; the model is passive. The values sigma carry no
+   H-infinity bound, and the error is larger than BT's: on the 8 x 8
+   lattice of the tests 0.38 / 0.12 of the sampled norm at r = 4 / 12,
+   where BT has 0.044 at r = 8. Choosing the Hamiltonian that
+   minimises an error bound (the other half of the pH balancing
+   literature) is not done.
+   Checked (tests/test_lowrank.c): an 8 x 8 mass-spring-damper lattice (N =
+   128, complex shifts): Z Z^T and Q Z_y Z_y^T Q within 1.5e-10 (relative,
+   Frobenius) of phgmg_lyap's dense Gramians, the residual reported and
+   recomputed densely equal to 5 digits (9.657e-11), Hankel singular values
+   within 3e-12 sigma_1 of the dense Gramians' sqrt(eig(P O)), the reduced
+   model's sampled H-infinity error 3.4e-2 below the bound 0.32 (r = 8),
+   and phgmg_shifted_hinf equal to phgmg_ss_error's dense sampling; the 7 x
+   7 lattice with a consistent-mass-like E (N = 98) against the dense E^{-1}
+   model: Gramian 1.2e-11, values 3e-12 sigma_1, error 9.8e-2 below 0.65
+   (r = 6).
+   Measured (bench/bench_lowrank.c, Intel Xeon under KVM, one core, CPU
+   time, phgmg_lrbt to r = 20 with the defaults): 2-D heat model (J = 0, R
+   the 5-point Dirichlet Laplacian, Q = I, the left and bottom edges as
+   ports): N = 10 000: 0.6 s, 42 ADI steps, factor rank 76, residual
+   5.0e-12; N = 100 489 (317 x 317): 10.7 s, 50 steps, rank 97, residual
+   9.2e-11, 470 MB peak, bound 2 sum_{i>20} sigma_i / sigma_1 = 4.7e-4.
+   2-D lattice (K = Laplacian + 0.01 I, D = 0.5 I + 0.01 K, collocated
+   corner ports): N = 10 082: 4.4 s, 87 steps (complex pairs) per Gramian,
+   ranks 170 / 170; N = 100 352 (224 x 224): 91 - 96 s, 87 steps, ranks
+   170 / 170, residual 5.5e-11, 1.28 GB peak, bound 9.5e-5. The sampled
+   H-infinity error of the r = 20 models (phgmg_shifted_hinf, 20
+   frequencies in [1e-2, 1e2]) is within the bound: heat N = 100 489:
+   1.3e-2 against 5.4e-2 (11.8 s CPU), lattice N = 100 352: 9.6e-6 against
+   5.3e-5 (24 s CPU).
+
 
    9. CONFIGURATION MACROS (define before including) -----------------------------
      PHGMG_IMPLEMENTATION  compile the implementation in this translation unit
@@ -1510,6 +1651,10 @@
            phgmg_ph_abc, phgmg_bt, phgmg_prbt_riccati, phgmg_prbt,
            phgmg_linear_basis, phgmg_ss_transfer, phgmg_reduced_abc,
            phgmg_ss_error, phgmg_ss_compare
+   lowrank: phgmg_shifted_create, phgmg_shifted_solve, phgmg_shifted_apply,
+           phgmg_shifted_transfer, phgmg_shifted_hinf,
+           phgmg_shifted_factorizations, phgmg_shifted_destroy, phgmg_lradi,
+           phgmg_lowrank_free, phgmg_lrbt, phgmg_lrphbt
    export: phgmg_rom_serialized_size, phgmg_rom_serialize,
            phgmg_rom_deserialize_size, phgmg_rom_deserialize, phgmg_rom_save,
            phgmg_rom_load, phgmg_rom_export_c
@@ -1526,7 +1671,7 @@
            phgmg_lu_rcond, phgmg_norm1, phgmg_normf, phgmg_zlu_factor,
            phgmg_zlu_solve, phgmg_qr, phgmg_qrcp, phgmg_qr_form_q,
            phgmg_qr_apply, phgmg_lstsq, phgmg_svd, phgmg_sym_eig
-   (142 functions; 17 of them only with PHGMG_MPI; also the macros
+   (153 functions; 17 of them only with PHGMG_MPI; also the macros
    PHGMG_ROM_STEPPER_MEMSIZE_MAX and _MAX_CB.)
 */
 #ifndef PHGMG_H_INCLUDED
@@ -3181,6 +3326,184 @@ typedef struct phgmg_ss_errors {
    on success) receives all four measures. */
 PHGMG_DEF phgmg_result phgmg_ss_compare(const phgmg_ss *g1, const phgmg_ss *g2, int nw, double wmin, double wmax,
                                         phgmg_ss_errors *err, const phgmg_allocator *alloc);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* PHGMG_NO_OFFLINE */
+
+/* >>lowrank =============================================================== */
+/* Low-rank Gramians and balanced truncation of large sparse linear pH models
+   (a phgmg_ph_sparse object: quadratic H, any E of full rank), where the
+   dense solvers of >>linear (O(N^3)) cannot go. With A = (J - R) Q and E
+   the mass matrix (or I), the model E x' = A x + B u, y = B^T Q x has the
+   Gramians
+       A P E^T + E P A^T + B B^T = 0,   A^T O E + E^T O A + C^T C = 0,
+   C = B^T Q. Because E^T Q is symmetric, O = Q Y Q where Y solves the first
+   equation for the dual model J -> -J (A' = (-J - R) Q = Q^{-1} A^T Q
+   formally; no inverse is formed): both Gramians come from the same solver
+   of A P E^T + E P A^T + B B^T = 0, P ~ Z Z^T with Z of low rank. Manual
+   2.8 (use) and 8.13 (the algorithms). Vectors are in the object's internal
+   ordering (phgmg_ph_sparse_to_banded_order / _to_user_order). */
+#ifndef PHGMG_NO_OFFLINE
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Shifted sparse solves (A + p E) X = F with the model's pencil (dual = 1:
+   the dual model's, A = (-J - R) Q), for real and complex shifts p, on ONE
+   symbolic analysis of the sparse LU of >>sparse (ordering, elimination
+   tree, supernodes, assembly map; made here, whatever solver the object's
+   stepper uses), whose complex numeric factorization serves a complex p
+   (the unknowns interleaved re/im in one complex front per supernode: half
+   the memory and half the flops of the real 2 x 2 embedding [[Re, -Im],
+   [Im, Re]], which would also need the analysis of a doubled pattern; manual
+   8.13). The numeric factors of the last `keep` shifts (0: 2) are kept:
+   a repeated shift is solved without refactoring. Pivots are static (the
+   fill-reducing order's diagonal, manual 8.12), checked per factorization.
+   Errors: PHGMG_ERR_INVALID_ARG (NULL, keep < 0), _UNSUPPORTED (an E with
+   a zero row or column: index one, manual 1.8), _NOMEM. *out NULL on
+   failure. sp must outlive the object. */
+typedef struct phgmg_shifted phgmg_shifted;
+PHGMG_DEF phgmg_result phgmg_shifted_create(phgmg_shifted **out, const phgmg_ph_sparse *sp, int dual, int keep,
+                                            const phgmg_allocator *alloc);
+/* X = (A + p E)^{-1} F, p = pr + i pi. pi == 0: F and X real, N x nrhs (ld
+   ldf, ldx >= N); pi != 0: F and X complex, interleaved (re, im) pairs, N x
+   nrhs with ld in complex entries (column j at 2 j ld doubles). X == F
+   (same ld) solves in place. Errors: PHGMG_ERR_INVALID_ARG (NULL, a shift
+   not finite, nrhs < 0, ld < N, X == F with ldx != ldf), _NANINF (F not
+   finite), _SINGULAR (a static
+   pivot below PHGMG_SPARSE_PIVTOL max|K| or growth above
+   PHGMG_SPARSE_GROWTH: this shift needs row exchanges the LU does not make;
+   X unspecified, the object stays usable), _NOMEM. */
+PHGMG_DEF phgmg_result phgmg_shifted_solve(phgmg_shifted *s, double pr, double pi, int nrhs, const double *F,
+                                           int ldf, double *X, int ldx);
+/* Y = A X (which 'A') or E X ('E'; E = I without a mass matrix), real N x
+   nrhs (ldx, ldy >= N), with the pencil's sparse copies. */
+PHGMG_DEF void phgmg_shifted_apply(const phgmg_shifted *s, char which, int nrhs, const double *X, int ldx,
+                                   double *Y, int ldy);
+/* Transfer function G(i w) = B^T Q (i w E - A)^{-1} B of the object's model
+   (dual 1: of the dual model), B the model's (internal order, m ports):
+   m x m complex, interleaved (re, im), column-major, into G (2 m^2
+   doubles). One complex factorization of i w E - A on the object's analysis
+   (kept like a shift's: p = -i w), m solves; w = 0: a real one, which the
+   static pivots refuse (PHGMG_ERR_SINGULAR) when A has zero diagonal
+   entries where the LU condenses states (a mass-spring model's positions),
+   as they refuse |w| below about PHGMG_SPARSE_PIVTOL max|A| there. Errors:
+   PHGMG_ERR_INVALID_ARG (NULL, w not finite), the codes of
+   phgmg_shifted_solve, _NOMEM. */
+PHGMG_DEF phgmg_result phgmg_shifted_transfer(phgmg_shifted *s, double w, double *G);
+/* Sampled H-infinity norms through those solves (frequency response at
+   scale, no dense N x N matrix): hinf = max over nw log-spaced w in [wmin,
+   wmax] (the grid of phgmg_ss_error) of sigma_max(G(i w) - Gr(i w)), Gr the
+   reduced state-space model (Ar r x r, Br r x m, Cr m x r; Er = I, e.g. from
+   phgmg_lrbt); hinf_ref the same of G alone. Either output may be NULL;
+   Ar/Br/Cr may be NULL together (r = 0): hinf_ref only. Cost: nw complex
+   factorizations. Errors: PHGMG_ERR_INVALID_ARG (NULL s, only some of
+   Ar/Br/Cr), _SIZE (r < 0, m > 16, nw < 1, wmin <= 0, wmax < wmin), the codes
+   of phgmg_shifted_transfer and phgmg_ss_transfer, _NOMEM. */
+PHGMG_DEF phgmg_result phgmg_shifted_hinf(phgmg_shifted *s, int r, const double *Ar, const double *Br,
+                                          const double *Cr, int nw, double wmin, double wmax, double *hinf,
+                                          double *hinf_ref);
+/* Numeric factorizations made so far (a repeated shift that was kept does
+   not count again). */
+PHGMG_DEF int phgmg_shifted_factorizations(const phgmg_shifted *s);
+/* Frees the object (NULL is fine). */
+PHGMG_DEF void phgmg_shifted_destroy(phgmg_shifted *s);
+
+/* Options of the low-rank ADI (zero: default). */
+typedef struct phgmg_lradi_opts {
+  double tol;        /* stop when ||W^T W||_2 <= tol ||B^T B||_2 (0: 1e-10)        */
+  int maxit;         /* ADI steps, a complex pair counting two (0: 500)            */
+  int shift_blocks;  /* projection shifts: Ritz values on the last this many
+                        ADI blocks (0: 6)                                          */
+  double trunc;      /* compression: singular values of Z below trunc sigma_1
+                        dropped (0: 1e-12; < 0: no compression)                    */
+  void (*progress)(const char *phase, void *user); /* NULL: none (manual 2.8)      */
+  void *progress_user;
+} phgmg_lradi_opts;
+
+/* What a low-rank ADI run did. */
+typedef struct phgmg_lradi_info {
+  int iters;        /* ADI steps (a complex pair counts two)                    */
+  int cols;         /* columns of Z before compression                          */
+  int rank;         /* columns after compression (= *k)                         */
+  int shift_sets;   /* projection-shift computations                            */
+  int factorizations; /* numeric factorizations of the shifted matrices         */
+  double res;       /* ||W^T W||_2 / ||B^T B||_2 at the stop: the relative
+                       residual ||A Z Z^T E^T + E Z Z^T A^T + B B^T||_2 / ||B^T B||_2 */
+} phgmg_lradi_info;
+
+/* Low-rank ADI for A P E^T + E P A^T + B B^T = 0 with the pencil of s
+   (dual 0: the controllability Gramian; dual 1 with C = B^T Q: O = Q Z Z^T
+   Q, see above), B real N x m (ldb >= N). P ~ Z Z^T, *Z (N x *k, ld N)
+   allocated with alloc (free it with phgmg_lowrank_free). Steps: V = (A +
+   p E)^{-1} W, W <- W - 2 Re(p) E V (W_0 = B: the residual is W W^T), a
+   complex-conjugate pair in one complex solve with the real-arithmetic
+   update (Benner, Kuerschner, Saak), projection shifts, stop on ||W^T W||_2
+   <= tol ||B^T B||_2, then column compression (manual 8.13). info (may be
+   NULL) receives the counts and the residual. opts may be NULL. Errors:
+   PHGMG_ERR_INVALID_ARG (NULL, m < 1, ldb < N, tol outside [0, 1), negative
+   maxit/shift_blocks, trunc >= 1 or NaN), _NANINF (B), _RANK (B = 0), _NOT_STABLE (no Ritz value of the pencil in
+   the open left half-plane: no shift), _NOT_CONVERGED (maxit reached; info
+   then holds the residual reached, *Z NULL), the codes of
+   phgmg_shifted_solve, _NOMEM. */
+PHGMG_DEF phgmg_result phgmg_lradi(phgmg_shifted *s, int m, const double *B, int ldb, const phgmg_lradi_opts *opts,
+                                   double **Z, int *k, phgmg_lradi_info *info, const phgmg_allocator *alloc);
+/* Frees a factor from phgmg_lradi (NULL is fine). */
+PHGMG_DEF void phgmg_lowrank_free(double *Z, const phgmg_allocator *alloc);
+
+/* What low-rank balanced truncation did. */
+typedef struct phgmg_lrbt_info {
+  phgmg_lradi_info ctrl, obs; /* the two ADI runs (obs = ctrl when J = 0: one run) */
+  int nhsv;                   /* Hankel singular values computed (the rank of Z_o^T E Z_c) */
+  double bound;               /* 2 sum_{i > r} sigma_i over the computed ones (approximate) */
+  double hsv_tail;            /* sigma_{r+1} (0 if not computed)                    */
+} phgmg_lrbt_info;
+
+/* Low-rank square-root balanced truncation of a sparse linear pH model: the
+   factors Z_c, Z_o = Q Z_y by phgmg_lradi (one run when J = 0: the dual
+   model is the model), the SVD Z_o^T E Z_c = U S V^T (the Hankel singular
+   values S), T = Z_c V_r S_r^{-1/2}, W = Z_o U_r S_r^{-1/2} (W^T E T = I),
+   Ar = W^T A T (r x r), Br = W^T B (r x m), Cr = B^T Q T (m x r): the
+   reduced model xr' = Ar xr + Br u, y = Cr xr (Er = I), like phgmg_bt's.
+   hsv (may be NULL): the first r Hankel singular values; T, W (N x r,
+   internal order, may be NULL). info (may be NULL): the ADI runs, the count
+   of computed Hankel singular values and the H-infinity bound 2 sum of the
+   truncated ones -- of the computed ones only, so approximate: the factors
+   are of low rank and the values beyond their rank (below the ADI
+   tolerance's level) are not in it. Errors: PHGMG_ERR_INVALID_ARG (NULL
+   sp/Ar/Br/Cr), _SIZE (r outside 1..N), _RANK (fewer than r Hankel singular
+   values computed), the codes of phgmg_shifted_create and phgmg_lradi,
+   _NOMEM. Call phgmg_ph_validate on phgmg_ph_sparse_system(sp) first for
+   the structure (skew J, R >= 0, Q > 0 or E^T Q > 0). */
+PHGMG_DEF phgmg_result phgmg_lrbt(const phgmg_ph_sparse *sp, int r, const phgmg_lradi_opts *opts, double *Ar,
+                                  double *Br, double *Cr, double *hsv, double *T, double *W, phgmg_lrbt_info *info,
+                                  const phgmg_allocator *alloc);
+
+/* pH-preserving low-rank balancing (one Lyapunov equation; manual 8.13):
+   the controllability factor Z_c by phgmg_lradi, balanced against the
+   energy matrix E^T Q of the Hamiltonian H = x^T E^T Q x / 2 instead of the
+   observability Gramian: Z_c^T E^T Q Z_c = Y diag(sigma^2) Y^T, T = Z_c Y_r
+   Sigma_r^{-1/2} (T^T E^T Q T = Sigma_r), and the Galerkin projection in the
+   energy inner product, through sparse products with J, R, Q, E only (no
+   Q^{-1}, no E^{-1}):
+       Jr = skew(T^T Q J Q T),  Rr = sym(T^T Q R Q T),  Qr = Sigma_r^{-1},
+       Br = T^T Q B            (Er = I),
+   the reduced model xi' = (Jr - Rr) Qr xi + Br u, y = Br^T Qr xi (xi =
+   Sigma_r times the Galerkin coordinates; x ~ V xi with V = T
+   Sigma_r^{-1}). Jr is skew exactly, Rr symmetric and positive
+   semidefinite up to round-off (a congruence of R), Qr diagonal positive:
+   a pH model by construction, passive. All r x r (Br r x m), column-major.
+   sigma (may be NULL): the first r values sigma_i = sqrt(eig(P E^T Q)) --
+   they rank the states by reachability in the energy norm; they give no
+   H-infinity bound like BT's. V (N x r, internal order, may be NULL).
+   info (may be NULL): info->ctrl the ADI run, info->nhsv the values
+   computed, info->hsv_tail sigma_{r+1} (bound 0: none). Errors: as
+   phgmg_lrbt. */
+PHGMG_DEF phgmg_result phgmg_lrphbt(const phgmg_ph_sparse *sp, int r, const phgmg_lradi_opts *opts, double *Jr,
+                                    double *Rr, double *Qr, double *Br, double *sigma, double *V,
+                                    phgmg_lrbt_info *info, const phgmg_allocator *alloc);
 
 #ifdef __cplusplus
 }
@@ -7546,9 +7869,12 @@ struct phgmg_ph_sparse {
   phgmg_ph_sparse_info inf;
 };
 
-/* The analysis of sp's stage matrices from its CSC copies (J - R merged,
-   zero values dropped, as from band storage); condense as phgmg__spsym_create. */
-PHGMG__PRIV phgmg_result phgmg__spsym_create_sp(phgmg__spsym **out, const phgmg_ph_sparse *sp, int condense) {
+/* The analysis of sp's stage matrices from its CSC copies (js J - R merged,
+   zero values dropped, as from band storage); condense as phgmg__spsym_create.
+   js = 1: the model; js = -1: its dual with J -> -J (the observability
+   equation of the low-rank solvers, >>lowrank). */
+PHGMG__PRIV phgmg_result phgmg__spsym_create_js(phgmg__spsym **out, const phgmg_ph_sparse *sp, int condense,
+                                                double js) {
   const phgmg_allocator *al = sp->alloc;
   const int n = sp->sys.N;
   phgmg__spsym *S = PHGMG__CAST(phgmg__spsym *, phgmg__alloc(al, sizeof(phgmg__spsym)));
@@ -7570,7 +7896,7 @@ PHGMG__PRIV phgmg_result phgmg__spsym_create_sp(phgmg__spsym **out, const phgmg_
       while (p < sp->cp[0][j + 1] || q < sp->cp[1][j + 1]) {
         int ip = p < sp->cp[0][j + 1] ? sp->ci[0][p] : n, iq = q < sp->cp[1][j + 1] ? sp->ci[1][q] : n;
         int i = PHGMG__MIN(ip, iq);
-        double v = (ip == i ? sp->cx[0][p++] : 0.0) - (iq == i ? sp->cx[1][q++] : 0.0);
+        double v = (ip == i ? js * sp->cx[0][p++] : 0.0) - (iq == i ? sp->cx[1][q++] : 0.0);
         if (v == 0.0) continue;
         if (pass) { S->jr_i[nz] = i; S->jr_x[nz] = v; }
         ++nz;
@@ -7592,6 +7918,9 @@ PHGMG__PRIV phgmg_result phgmg__spsym_create_sp(phgmg__spsym **out, const phgmg_
   if (rc != PHGMG_OK) { phgmg__spsym_free(al, S); return rc; }
   *out = S;
   return PHGMG_OK;
+}
+PHGMG__PRIV phgmg_result phgmg__spsym_create_sp(phgmg__spsym **out, const phgmg_ph_sparse *sp, int condense) {
+  return phgmg__spsym_create_js(out, sp, condense, 1.0);
 }
 
 PHGMG_DEF void phgmg_ph_sparse_destroy(phgmg_ph_sparse *sp) {
@@ -17961,6 +18290,696 @@ PHGMG_DEF phgmg_result phgmg_ss_error(int n1, const double *A1, const double *B1
     if (hinf_ref) *hinf_ref = hr;
   }
   phgmg__free(alloc, G1);
+  return rc;
+}
+#endif /* PHGMG_NO_OFFLINE */
+
+/* >>lowrank (implementation) ============================================= */
+#ifndef PHGMG_NO_OFFLINE
+/* One kept numeric factorization of K(sigma) = sigma E + M (M = -A), sigma =
+   -p: (A + p E) = -K(-p). */
+typedef struct phgmg__shf {
+  double sr, si;
+  long used;      /* last use (the object's clock); 0: empty */
+  int valid;
+  phgmg__spnum F;
+} phgmg__shf;
+
+struct phgmg_shifted {
+  phgmg_allocator a;
+  const phgmg_allocator *alloc;
+  const phgmg_ph_sparse *sp;
+  phgmg__spsym *S; /* the analysis: J - R (dual: -J - R), Q, E        */
+  double *Mx;      /* M = -A in the pattern of K                       */
+  double *w;       /* N doubles of scratch (products)                  */
+  int N, keep, nfact;
+  long clock;
+  phgmg__shf *f;   /* keep entries                                     */
+};
+
+PHGMG_DEF void phgmg_shifted_destroy(phgmg_shifted *s) {
+  const phgmg_allocator *al;
+  int i;
+  if (!s) return;
+  al = s->alloc;
+  for (i = 0; s->f && i < s->keep; ++i) phgmg__spnum_free(al, &s->f[i].F);
+  phgmg__free(al, s->f);
+  phgmg__free(al, s->Mx);
+  phgmg__free(al, s->w);
+  phgmg__spsym_free(al, s->S);
+  phgmg__free(al, s);
+}
+
+PHGMG_DEF phgmg_result phgmg_shifted_create(phgmg_shifted **out, const phgmg_ph_sparse *sp, int dual, int keep,
+                                            const phgmg_allocator *alloc) {
+  phgmg_shifted *s;
+  phgmg_result rc;
+  int e;
+  if (!out) return PHGMG_ERR_INVALID_ARG;
+  *out = NULL;
+  if (!sp || keep < 0) return PHGMG_ERR_INVALID_ARG;
+  if ((e = phgmg__ph_sparse_e_regular(sp)) < 0) return PHGMG_ERR_NOMEM;
+  if (!e) return PHGMG_ERR_UNSUPPORTED;
+  s = PHGMG__CAST(phgmg_shifted *, phgmg__alloc(alloc, sizeof *s));
+  if (!s) return PHGMG_ERR_NOMEM;
+  memset(s, 0, sizeof *s);
+  if (alloc) { s->a = *alloc; s->alloc = &s->a; }
+  s->N = sp->sys.N;
+  s->sp = sp;
+  s->keep = keep ? keep : 2;
+  rc = phgmg__spsym_create_js(&s->S, sp, -1, dual ? -1.0 : 1.0);
+  if (rc == PHGMG_OK) {
+    s->Mx = phgmg__dalloc(s->alloc, (size_t)s->S->k_p[s->N] + 1);
+    s->w = phgmg__dalloc(s->alloc, (size_t)s->N);
+    s->f = PHGMG__CAST(phgmg__shf *, phgmg__alloc(s->alloc, sizeof(phgmg__shf) * (size_t)s->keep));
+    if (!s->Mx || !s->w || !s->f) rc = PHGMG_ERR_NOMEM;
+  }
+  if (rc != PHGMG_OK) { phgmg_shifted_destroy(s); return rc; }
+  memset(s->f, 0, sizeof(phgmg__shf) * (size_t)s->keep);
+  phgmg__sp_stage_values(s->S, NULL, s->Mx, s->w); /* M = -(J - R) Q */
+  *out = s;
+  return PHGMG_OK;
+}
+
+/* The factors of K(sigma), sigma = sr + i si: a kept one, or the least
+   recently used entry refactored. */
+PHGMG__PRIV phgmg_result phgmg__shifted_factor(phgmg_shifted *s, double sr, double si, const phgmg__spnum **out) {
+  const int cplx = si != 0.0;
+  int i, lru = 0;
+  phgmg__shf *e;
+  for (i = 0; i < s->keep; ++i)
+    if (s->f[i].valid && s->f[i].sr == sr && s->f[i].si == si) {
+      s->f[i].used = ++s->clock;
+      *out = &s->f[i].F;
+      return PHGMG_OK;
+    }
+  for (i = 1; i < s->keep; ++i)
+    if (s->f[i].used < s->f[lru].used) lru = i;
+  e = &s->f[lru];
+  e->valid = 0;
+  e->used = 0;
+  if (e->F.X && e->F.cplx != cplx) phgmg__spnum_free(s->alloc, &e->F);
+  if (!e->F.X && phgmg__spnum_alloc(s->alloc, s->S, cplx, &e->F) != PHGMG_OK) return PHGMG_ERR_NOMEM;
+  phgmg__sp_factor(s->S, &e->F, s->Mx, sr, si, PHGMG_SPARSE_PIVTOL);
+  ++s->nfact;
+  if (e->F.nstatic || !(e->F.growth <= PHGMG_SPARSE_GROWTH)) return PHGMG_ERR_SINGULAR;
+  e->sr = sr; e->si = si; e->valid = 1; e->used = ++s->clock;
+  *out = &e->F;
+  return PHGMG_OK;
+}
+
+PHGMG_DEF phgmg_result phgmg_shifted_solve(phgmg_shifted *s, double pr, double pi, int nrhs, const double *F,
+                                           int ldf, double *X, int ldx) {
+  const phgmg__spnum *K;
+  phgmg_result rc;
+  int j, w = pi != 0.0 ? 2 : 1;
+  size_t i, len;
+  if (!s || !F || !X || nrhs < 0 || ldf < s->N || ldx < s->N || !isfinite(pr) || !isfinite(pi) ||
+      (X == F && ldx != ldf))
+    return PHGMG_ERR_INVALID_ARG;
+  len = (size_t)w * (size_t)s->N;
+  for (j = 0; j < nrhs; ++j)
+    if (!phgmg__all_finite(F + (size_t)w * (size_t)j * (size_t)ldf, len)) return PHGMG_ERR_NANINF;
+  if (nrhs == 0) return PHGMG_OK;
+  if ((rc = phgmg__shifted_factor(s, -pr, -pi, &K)) != PHGMG_OK) return rc;
+  for (j = 0; j < nrhs; ++j) { /* (A + p E) x = f  <=>  K(-p) x = -f */
+    const double *f = F + (size_t)w * (size_t)j * (size_t)ldf;
+    double *x = X + (size_t)w * (size_t)j * (size_t)ldx;
+    if (x != f) memmove(x, f, sizeof(double) * len);
+    phgmg__sp_solve(s->S, K, x);
+    for (i = 0; i < len; ++i) x[i] = -x[i];
+  }
+  return PHGMG_OK;
+}
+
+/* y = E x (x when the model has no mass matrix); S's pencil. */
+PHGMG__PRIV void phgmg__lr_emul(const phgmg__spsym *S, const double *x, double *y) {
+  int j, p;
+  if (!S->e_p) { memcpy(y, x, sizeof(double) * (size_t)S->n); return; }
+  for (j = 0; j < S->n; ++j) y[j] = 0.0;
+  for (j = 0; j < S->n; ++j)
+    for (p = S->e_p[j]; p < S->e_p[j + 1]; ++p) y[S->e_i[p]] += S->e_x[p] * x[j];
+}
+
+/* y = A x = (J - R) Q x (the dual: (-J - R) Q x); w: n doubles. */
+PHGMG__PRIV void phgmg__lr_amul(const phgmg__spsym *S, const double *x, double *y, double *w) {
+  int j, p;
+  phgmg__sp_qmv(S, x, w);
+  for (j = 0; j < S->n; ++j) y[j] = 0.0;
+  for (j = 0; j < S->n; ++j) {
+    const double v = w[j];
+    if (v == 0.0) continue;
+    for (p = S->jr_p[j]; p < S->jr_p[j + 1]; ++p) y[S->jr_i[p]] += S->jr_x[p] * v;
+  }
+}
+
+PHGMG_DEF void phgmg_shifted_apply(const phgmg_shifted *s, char which, int nrhs, const double *X, int ldx,
+                                   double *Y, int ldy) {
+  int j;
+  PHGMG_ASSERT(s && X && Y && (which == 'A' || which == 'E'));
+  for (j = 0; j < nrhs; ++j) {
+    const double *x = X + (size_t)j * (size_t)ldx;
+    double *y = Y + (size_t)j * (size_t)ldy;
+    if (which == 'A') phgmg__lr_amul(s->S, x, y, s->w);
+    else phgmg__lr_emul(s->S, x, y);
+  }
+}
+
+PHGMG_DEF int phgmg_shifted_factorizations(const phgmg_shifted *s) { return s ? s->nfact : 0; }
+
+PHGMG_DEF phgmg_result phgmg_shifted_transfer(phgmg_shifted *s, double w, double *G) {
+  const int N = s ? s->N : 0, m = s ? s->sp->sys.m : 0;
+  const double *B = s ? s->sp->sys.B : NULL;
+  double *X, *col;
+  phgmg_result rc;
+  int a, b, i, part;
+  if (!s || !G || !isfinite(w)) return PHGMG_ERR_INVALID_ARG;
+  X = phgmg__dalloc(s->alloc, 3 * (size_t)N * (size_t)m);
+  if (!X) return PHGMG_ERR_NOMEM;
+  col = X + 2 * (size_t)N * (size_t)m;
+  if (w != 0.0) { /* (A - i w E) X = B */
+    for (i = 0; i < N * m; ++i) { X[2 * i] = B[i]; X[2 * i + 1] = 0.0; }
+    rc = phgmg_shifted_solve(s, 0.0, -w, m, X, N, X, N);
+  } else {
+    rc = phgmg_shifted_solve(s, 0.0, 0.0, m, B, N, X, N);
+  }
+  for (b = 0; b < m && rc == PHGMG_OK; ++b)
+    for (part = 0; part < 2; ++part) { /* G = C (i w E - A)^{-1} B = -B^T Q X: real, imaginary part */
+      if (w == 0.0 && part == 1) {
+        for (a = 0; a < m; ++a) G[2 * (a + (size_t)b * m) + 1] = 0.0;
+        continue;
+      }
+      if (w != 0.0) for (i = 0; i < N; ++i) col[i] = X[2 * (i + (size_t)b * N) + part];
+      else memcpy(col, X + (size_t)b * N, sizeof(double) * (size_t)N);
+      phgmg__sp_qmv(s->S, col, s->w);
+      for (a = 0; a < m; ++a) G[2 * (a + (size_t)b * m) + part] = -phgmg__dot(N, B + (size_t)a * N, s->w);
+    }
+  phgmg__free(s->alloc, X);
+  return rc;
+}
+
+PHGMG_DEF phgmg_result phgmg_shifted_hinf(phgmg_shifted *s, int r, const double *Ar, const double *Br,
+                                          const double *Cr, int nw, double wmin, double wmax, double *hinf,
+                                          double *hinf_ref) {
+  const int m = s ? s->sp->sys.m : 0, red = Ar != NULL;
+  double G[2 * 16 * 16], Gr[2 * 16 * 16], hi = 0.0, hr = 0.0;
+  phgmg_result rc = PHGMG_OK;
+  int j, i;
+  if (!s || (Br != NULL) != red || (Cr != NULL) != red) return PHGMG_ERR_INVALID_ARG;
+  if (r < 0 || (red && r < 1) || m > 16 || nw < 1 || !(wmin > 0.0) || !(wmax >= wmin)) return PHGMG_ERR_SIZE;
+  for (j = 0; j < nw && rc == PHGMG_OK; ++j) {
+    const double w = wmin * pow(wmax / wmin, nw > 1 ? (double)j / (nw - 1) : 0.0);
+    rc = phgmg_shifted_transfer(s, w, G);
+    if (rc == PHGMG_OK && red) rc = phgmg_ss_transfer(r, m, m, Ar, Br, Cr, w, Gr, s->alloc);
+    if (rc != PHGMG_OK) break;
+    hr = PHGMG__MAX(hr, phgmg__zsigma_max(m, m, G));
+    if (!red) continue;
+    for (i = 0; i < 2 * m * m; ++i) Gr[i] = G[i] - Gr[i];
+    hi = PHGMG__MAX(hi, phgmg__zsigma_max(m, m, Gr));
+  }
+  if (rc == PHGMG_OK) {
+    if (hinf) *hinf = hi;
+    if (hinf_ref) *hinf_ref = hr;
+  }
+  return rc;
+}
+
+PHGMG_DEF void phgmg_lowrank_free(double *Z, const phgmg_allocator *alloc) { phgmg__free(alloc, Z); }
+
+/* State of one LR-ADI run. */
+typedef struct phgmg__lradi {
+  phgmg_shifted *s;
+  const phgmg_allocator *al;
+  int N, m, kz, cap, nblk, bcap;
+  double *Z;          /* N x cap, kz columns filled                       */
+  int *bstart;        /* first column of block b (nblk blocks)            */
+  double *W, *V, *Y;  /* residual factor N x m; V 2N x m; Y N x m         */
+  double *sh;         /* shifts (re, im), one per conjugate pair (im > 0) */
+  int nsh, jsh;
+} phgmg__lradi;
+
+/* Room for `add` more columns of Z (and one more block). */
+PHGMG__PRIV phgmg_result phgmg__lr_grow(phgmg__lradi *st, int add) {
+  if (st->kz + add > st->cap) {
+    int cap = PHGMG__MAX(2 * st->cap, st->kz + add);
+    double *z = phgmg__dalloc(st->al, (size_t)st->N * (size_t)cap);
+    if (!z) return PHGMG_ERR_NOMEM;
+    if (st->kz) memcpy(z, st->Z, sizeof(double) * (size_t)st->N * (size_t)st->kz);
+    phgmg__free(st->al, st->Z);
+    st->Z = z;
+    st->cap = cap;
+  }
+  if (st->nblk + 1 > st->bcap) {
+    int bcap = 2 * st->bcap + 8, *b = phgmg__ialloc(st->al, (size_t)bcap);
+    if (!b) return PHGMG_ERR_NOMEM;
+    if (st->nblk) memcpy(b, st->bstart, sizeof(int) * (size_t)st->nblk);
+    phgmg__free(st->al, st->bstart);
+    st->bstart = b;
+    st->bcap = bcap;
+  }
+  st->bstart[st->nblk++] = st->kz;
+  return PHGMG_OK;
+}
+
+/* Eigenvalues of the pencil (Ap, Ep) (order k, ld k; Ap overwritten by
+   Ep^{-1} Ap) into ev (k complex pairs); 0 or a result code. */
+PHGMG__PRIV phgmg_result phgmg__lr_pencil_eig(int k, double *Ap, double *Ep, double *ev, const phgmg_allocator *al) {
+  int *ip = phgmg__ialloc(al, (size_t)k), i;
+  double *T = phgmg__dalloc(al, 4 * (size_t)k * (size_t)k + 3 * (size_t)k);
+  phgmg_result rc = PHGMG_ERR_NOMEM;
+  if (ip && T) {
+    rc = phgmg_lu_factor(k, Ep, k, ip);
+    if (rc == PHGMG_OK) {
+      phgmg_lu_solve('N', k, Ep, k, ip, k, Ap, k);
+      rc = phgmg__zschur(k, Ap, k, T, T + 2 * (size_t)k * (size_t)k, T + 4 * (size_t)k * (size_t)k);
+    }
+    if (rc == PHGMG_OK)
+      for (i = 0; i < k; ++i) { ev[2 * i] = T[2 * (i + (size_t)i * k)]; ev[2 * i + 1] = T[2 * (i + (size_t)i * k) + 1]; }
+  }
+  phgmg__free(al, ip);
+  phgmg__free(al, T);
+  return rc;
+}
+
+/* The stable ones of k eigenvalues ev as shifts: imaginary parts below
+   1e-8 |lambda| dropped (real shifts), one member (im > 0) of each pair;
+   sorted by modulus when a pair is among them, else by value (most negative
+   first). Returns their number (written to sh). */
+PHGMG__PRIV int phgmg__lr_pick_shifts(int k, const double *ev, double *sh) {
+  int i, j, n = 0, cplx = 0;
+  for (i = 0; i < k; ++i) {
+    double re = ev[2 * i], im = ev[2 * i + 1];
+    if (!(re < 0.0) || !isfinite(im)) continue;
+    if (fabs(im) <= 1e-8 * hypot(re, im)) im = 0.0;
+    if (im < 0.0) continue;
+    cplx |= im > 0.0;
+    sh[2 * n] = re; sh[2 * n + 1] = im; ++n;
+  }
+  for (i = 1; i < n; ++i) { /* insertion sort */
+    double re = sh[2 * i], im = sh[2 * i + 1], key = cplx ? hypot(re, im) : re;
+    for (j = i - 1; j >= 0; --j) {
+      double kj = cplx ? hypot(sh[2 * j], sh[2 * j + 1]) : sh[2 * j];
+      if (kj <= key) break;
+      sh[2 * j + 2] = sh[2 * j]; sh[2 * j + 3] = sh[2 * j + 1];
+    }
+    sh[2 * j + 2] = re; sh[2 * j + 3] = im;
+  }
+  return n;
+}
+
+/* Projection shifts: the Ritz values of the pencil (A, E) on span(Y) (N x
+   L, ld N): an orthonormal basis U by pivoted QR (columns with |R_jj| <=
+   1e-12 |R_00| dropped), Ap = U^T A U, Ep = U^T E U, their eigenvalues, the
+   stable ones as shifts. st->nsh = 0 when none is stable. */
+PHGMG__PRIV phgmg_result phgmg__lr_shifts(phgmg__lradi *st, const double *Y, int L) {
+  const int N = st->N;
+  const phgmg_allocator *al = st->al;
+  double *U = phgmg__dalloc(al, 2 * (size_t)N * (size_t)L), *AU = U + (size_t)N * (size_t)L;
+  double *sm = phgmg__dalloc(al, 2 * (size_t)L * (size_t)L + 6 * (size_t)L + 2);
+  int *jp = phgmg__ialloc(al, (size_t)L), k = 0, j;
+  phgmg_result rc = PHGMG_ERR_NOMEM;
+  double *Ap = sm, *Ep = sm + (size_t)L * L, *tau = Ep + (size_t)L * L, *wk = tau + L, *ev = wk + 2 * L;
+  st->nsh = 0; st->jsh = 0;
+  if (!U || !sm || !jp) goto done;
+  memcpy(U, Y, sizeof(double) * (size_t)N * (size_t)L);
+  if ((rc = phgmg_qrcp(N, L, U, N, tau, jp, wk)) != PHGMG_OK) goto done;
+  while (k < L && fabs(U[k + (size_t)k * N]) > 1e-12 * fabs(U[0])) ++k;
+  if (k == 0) goto done;
+  phgmg_qr_form_q(N, k, U, N, tau, wk);
+  for (j = 0; j < k; ++j) phgmg__lr_amul(st->s->S, U + (size_t)j * N, AU + (size_t)j * N, st->s->w);
+  phgmg_gemm('T', 'N', k, k, N, 1.0, U, N, AU, N, 0.0, Ap, k);
+  for (j = 0; j < k; ++j) phgmg__lr_emul(st->s->S, U + (size_t)j * N, AU + (size_t)j * N);
+  phgmg_gemm('T', 'N', k, k, N, 1.0, U, N, AU, N, 0.0, Ep, k);
+  rc = phgmg__lr_pencil_eig(k, Ap, Ep, ev, al);
+  if (rc == PHGMG_ERR_SINGULAR || rc == PHGMG_ERR_NOT_CONVERGED) { rc = PHGMG_OK; goto done; } /* no shifts */
+  if (rc != PHGMG_OK) goto done;
+  phgmg__free(al, st->sh);
+  st->sh = phgmg__dalloc(al, 2 * (size_t)k);
+  if (!st->sh) { rc = PHGMG_ERR_NOMEM; goto done; }
+  st->nsh = phgmg__lr_pick_shifts(k, ev, st->sh);
+done:
+  phgmg__free(al, U); phgmg__free(al, sm); phgmg__free(al, jp);
+  return rc;
+}
+
+/* One ADI step with shift p = pr + i pi (pi > 0: the pair p, conj(p)):
+   V = (A + p E)^{-1} W; real p: W <- W - 2 pr E V, Z += sqrt(-2 pr) V;
+   pair: with g = sqrt(-4 pr), d = pr / pi, Y = Re V + d Im V:
+   W <- W + g^2 E Y, Z += [g Y, g sqrt(d^2 + 1) Im V]. */
+PHGMG__PRIV phgmg_result phgmg__lr_step(phgmg__lradi *st, double pr, double pi) {
+  const int N = st->N, m = st->m;
+  const size_t Nm = (size_t)N * (size_t)m;
+  phgmg_result rc;
+  size_t i;
+  int j;
+  if ((rc = phgmg__lr_grow(st, pi != 0.0 ? 2 * m : m)) != PHGMG_OK) return rc;
+  if (pi == 0.0) {
+    const double g = sqrt(-2.0 * pr);
+    double *z = st->Z + (size_t)N * (size_t)st->kz;
+    if ((rc = phgmg_shifted_solve(st->s, pr, 0.0, m, st->W, N, z, N)) != PHGMG_OK) return rc;
+    for (j = 0; j < m; ++j) phgmg__lr_emul(st->s->S, z + (size_t)j * N, st->Y + (size_t)j * N);
+    for (i = 0; i < Nm; ++i) { st->W[i] -= 2.0 * pr * st->Y[i]; z[i] *= g; }
+    st->kz += m;
+  } else {
+    const double g = sqrt(-4.0 * pr), d = pr / pi, gi = g * sqrt(d * d + 1.0);
+    double *z = st->Z + (size_t)N * (size_t)st->kz, *zi = z + Nm;
+    for (i = 0; i < Nm; ++i) { st->V[2 * i] = st->W[i]; st->V[2 * i + 1] = 0.0; }
+    if ((rc = phgmg_shifted_solve(st->s, pr, pi, m, st->V, N, st->V, N)) != PHGMG_OK) return rc;
+    for (i = 0; i < Nm; ++i) { z[i] = st->V[2 * i] + d * st->V[2 * i + 1]; zi[i] = gi * st->V[2 * i + 1]; }
+    for (j = 0; j < m; ++j) phgmg__lr_emul(st->s->S, z + (size_t)j * N, st->Y + (size_t)j * N);
+    for (i = 0; i < Nm; ++i) { st->W[i] += g * g * st->Y[i]; z[i] *= g; }
+    st->kz += 2 * m;
+  }
+  return PHGMG_OK;
+}
+
+/* ||X^T X||_2 of X (N x m): the largest eigenvalue of the Gram matrix. */
+PHGMG__PRIV double phgmg__lr_gram2(int N, int m, const double *X, const phgmg_allocator *al) {
+  double *G = phgmg__dalloc(al, (size_t)m * (size_t)m + (size_t)m), v = (double)NAN;
+  if (!G) return v;
+  phgmg_gemm('T', 'N', m, m, N, 1.0, X, N, X, N, 0.0, G, m);
+  if (phgmg_sym_eig(m, G, m, G + (size_t)m * m, NULL, m) == PHGMG_OK) v = G[(size_t)m * m + (size_t)m - 1];
+  phgmg__free(al, G);
+  return v;
+}
+
+/* Column compression of Z (N x kz): Z <- U_k S_k from its thin SVD, the
+   singular values above trunc sigma_1. */
+PHGMG__PRIV phgmg_result phgmg__lr_compress(phgmg__lradi *st, double trunc) {
+  const int N = st->N, kz = st->kz;
+  double *U = phgmg__dalloc(st->al, (size_t)N * (size_t)kz + 1), *S = phgmg__dalloc(st->al, (size_t)kz + 1);
+  int k = 0, j;
+  phgmg_result rc = PHGMG_ERR_NOMEM;
+  size_t i;
+  if (U && S) rc = phgmg_svd(N, kz, st->Z, N, kz, S, U, N, NULL, 1, &k, NULL, st->al);
+  if (rc == PHGMG_OK) {
+    while (k > 1 && !(S[k - 1] > trunc * S[0])) --k;
+    for (j = 0; j < k; ++j)
+      for (i = 0; i < (size_t)N; ++i) U[i + (size_t)j * N] *= S[j];
+    phgmg__free(st->al, st->Z);
+    st->Z = U; U = NULL;
+    st->kz = st->cap = k;
+  }
+  phgmg__free(st->al, U);
+  phgmg__free(st->al, S);
+  return rc;
+}
+
+PHGMG__PRIV void phgmg__lr_progress(const phgmg_lradi_opts *o, const char *phase) {
+  if (o && o->progress) o->progress(phase, o->progress_user);
+}
+
+/* The ADI iteration of phgmg_lradi on st (W = B set); *res the residual. */
+PHGMG__PRIV phgmg_result phgmg__lr_iterate(phgmg__lradi *st, const phgmg_lradi_opts *o, double tol, int maxit,
+                                           int nblocks, double bnorm, phgmg_lradi_info *inf) {
+  phgmg_result rc = phgmg__lr_shifts(st, st->W, st->m);
+  double *sh0 = NULL;
+  int ns0 = 0;
+  inf->shift_sets = 1;
+  if (rc != PHGMG_OK) return rc;
+  if (st->nsh == 0) return PHGMG_ERR_NOT_STABLE;
+  inf->res = phgmg__lr_gram2(st->N, st->m, st->W, st->al) / bnorm;
+  while (!(inf->res <= tol)) {
+    double pr, pi;
+    if (inf->iters >= maxit) return PHGMG_ERR_NOT_CONVERGED;
+    if (st->jsh == st->nsh) { /* new projection shifts, or the last set again */
+      int b0 = PHGMG__MAX(0, st->nblk - nblocks), c0 = st->bstart[b0];
+      ns0 = st->nsh;
+      sh0 = phgmg__dalloc(st->al, 2 * (size_t)ns0);
+      if (!sh0) return PHGMG_ERR_NOMEM;
+      memcpy(sh0, st->sh, sizeof(double) * 2 * (size_t)ns0);
+      phgmg__lr_progress(o, "lradi: shifts");
+      rc = phgmg__lr_shifts(st, st->Z + (size_t)st->N * (size_t)c0, st->kz - c0);
+      ++inf->shift_sets;
+      if (rc == PHGMG_OK && st->nsh == 0) { phgmg__free(st->al, st->sh); st->sh = sh0; st->nsh = ns0; sh0 = NULL; }
+      phgmg__free(st->al, sh0);
+      sh0 = NULL;
+      if (rc != PHGMG_OK) return rc;
+    }
+    pr = st->sh[2 * st->jsh]; pi = st->sh[2 * st->jsh + 1];
+    ++st->jsh;
+    if ((rc = phgmg__lr_step(st, pr, pi)) != PHGMG_OK) return rc;
+    inf->iters += pi != 0.0 ? 2 : 1;
+    inf->res = phgmg__lr_gram2(st->N, st->m, st->W, st->al) / bnorm;
+    if (inf->res != inf->res) return PHGMG_ERR_NOMEM;
+  }
+  return PHGMG_OK;
+}
+
+PHGMG_DEF phgmg_result phgmg_lradi(phgmg_shifted *s, int m, const double *B, int ldb, const phgmg_lradi_opts *opts,
+                                   double **Z, int *k, phgmg_lradi_info *info, const phgmg_allocator *alloc) {
+  phgmg_lradi_info inf;
+  phgmg__lradi st;
+  phgmg_result rc = PHGMG_OK;
+  double tol = 1e-10, trunc = 1e-12, bnorm;
+  int maxit = 500, nblocks = 6, j, nf0;
+  memset(&inf, 0, sizeof inf);
+  if (info) *info = inf;
+  if (Z) *Z = NULL;
+  if (k) *k = 0;
+  if (!s || !B || !Z || !k || m < 1 || ldb < s->N) return PHGMG_ERR_INVALID_ARG;
+  if (opts) {
+    if (!(opts->tol >= 0.0 && opts->tol < 1.0) || opts->maxit < 0 || opts->shift_blocks < 0 ||
+        !(opts->trunc < 1.0))
+      return PHGMG_ERR_INVALID_ARG;
+    if (opts->tol > 0.0) tol = opts->tol;
+    if (opts->maxit > 0) maxit = opts->maxit;
+    if (opts->shift_blocks > 0) nblocks = opts->shift_blocks;
+    if (opts->trunc != 0.0) trunc = opts->trunc;
+  }
+  for (j = 0; j < m; ++j)
+    if (!phgmg__all_finite(B + (size_t)j * (size_t)ldb, (size_t)s->N)) return PHGMG_ERR_NANINF;
+  memset(&st, 0, sizeof st);
+  nf0 = s->nfact;
+  st.s = s; st.al = alloc; st.N = s->N; st.m = m;
+  st.W = phgmg__dalloc(alloc, 4 * (size_t)s->N * (size_t)m);
+  if (!st.W) return PHGMG_ERR_NOMEM;
+  st.Y = st.W + (size_t)s->N * (size_t)m;
+  st.V = st.Y + (size_t)s->N * (size_t)m;
+  for (j = 0; j < m; ++j) memcpy(st.W + (size_t)j * s->N, B + (size_t)j * ldb, sizeof(double) * (size_t)s->N);
+  bnorm = phgmg__lr_gram2(s->N, m, st.W, alloc);
+  if (bnorm != bnorm) rc = PHGMG_ERR_NOMEM;
+  else if (!(bnorm > 0.0)) rc = PHGMG_ERR_RANK; /* B = 0: P = 0, nothing to factor */
+  if (rc == PHGMG_OK) rc = phgmg__lr_iterate(&st, opts, tol, maxit, nblocks, bnorm, &inf);
+  inf.cols = st.kz;
+  if (rc == PHGMG_OK && trunc > 0.0 && st.kz > 0) rc = phgmg__lr_compress(&st, trunc);
+  inf.rank = st.kz;
+  inf.factorizations = s->nfact - nf0;
+  if (info) *info = inf;
+  phgmg__free(alloc, st.W); phgmg__free(alloc, st.sh); phgmg__free(alloc, st.bstart);
+  if (rc != PHGMG_OK || st.kz == 0) {
+    phgmg__free(alloc, st.Z);
+    if (info) info->rank = 0;
+    return rc != PHGMG_OK ? rc : PHGMG_ERR_RANK;
+  }
+  *Z = st.Z;
+  *k = st.kz;
+  return PHGMG_OK;
+}
+
+/* The two Gramian factors of phgmg_lrbt: Zc (kc columns) and Zo = Q Zy
+   (ko columns), with the ADI runs' info. */
+PHGMG__PRIV phgmg_result phgmg__lrbt_factors(const phgmg_ph_sparse *sp, const phgmg_lradi_opts *opts,
+                                             phgmg_shifted *sc, double **Zc, int *kc, double **Zo, int *ko,
+                                             phgmg_lrbt_info *inf, const phgmg_allocator *al) {
+  const int N = sp->sys.N, m = sp->sys.m;
+  phgmg_shifted *sd = NULL;
+  double *Zy = NULL;
+  int j, jzero = 1;
+  phgmg_result rc;
+  phgmg__lr_progress(opts, "controllability Gramian");
+  rc = phgmg_lradi(sc, m, sp->sys.B, N, opts, Zc, kc, &inf->ctrl, al);
+  if (rc != PHGMG_OK) return rc;
+  for (j = 0; j < sp->cp[0][N] && jzero; ++j) jzero = sp->cx[0][j] == 0.0;
+  if (jzero) { /* the dual model is the model: Zy = Zc */
+    inf->obs = inf->ctrl;
+    *ko = *kc;
+    Zy = *Zc;
+  } else {
+    phgmg__lr_progress(opts, "observability Gramian");
+    rc = phgmg_shifted_create(&sd, sp, 1, 0, al);
+    if (rc == PHGMG_OK) rc = phgmg_lradi(sd, m, sp->sys.B, N, opts, &Zy, ko, &inf->obs, al);
+    phgmg_shifted_destroy(sd);
+    if (rc != PHGMG_OK) return rc;
+  }
+  *Zo = phgmg__dalloc(al, (size_t)N * (size_t)*ko);
+  if (*Zo)
+    for (j = 0; j < *ko; ++j) phgmg__sp_qmv(sc->S, Zy + (size_t)j * N, *Zo + (size_t)j * N);
+  if (Zy != *Zc) phgmg__free(al, Zy);
+  return *Zo ? PHGMG_OK : PHGMG_ERR_NOMEM;
+}
+
+/* The balancing of phgmg_lrbt from the factors: SVD of Zo^T E Zc, the
+   bases T, W (N x r each, into TW), the reduced matrices, the values. */
+PHGMG__PRIV phgmg_result phgmg__lrbt_balance(const phgmg_ph_sparse *sp, phgmg_shifted *sc, int r, const double *Zc,
+                                             int kc, const double *Zo, int ko, double *TW, double *Ar, double *Br,
+                                             double *Cr, double *hsv, phgmg_lrbt_info *inf,
+                                             const phgmg_allocator *al) {
+  const int N = sp->sys.N, m = sp->sys.m, kmin = PHGMG__MIN(kc, ko);
+  double *EZ = phgmg__dalloc(al, (size_t)N * (size_t)PHGMG__MAX(kc, r));
+  double *M = phgmg__dalloc(al, (size_t)ko * (size_t)kc + (size_t)kmin * (size_t)(ko + kc + 1));
+  double *U = M + (size_t)ko * kc, *V = U + (size_t)ko * kmin, *S = V + (size_t)kc * kmin, *T = TW, *W = TW + (size_t)N * r;
+  int k = 0, i, j;
+  phgmg_result rc = PHGMG_ERR_NOMEM;
+  if (!EZ || !M) goto done;
+  for (j = 0; j < kc; ++j) phgmg__lr_emul(sc->S, Zc + (size_t)j * N, EZ + (size_t)j * N);
+  phgmg_gemm('T', 'N', ko, kc, N, 1.0, Zo, N, EZ, N, 0.0, M, ko);
+  rc = phgmg_svd(ko, kc, M, ko, kmin, S, U, ko, V, kc, &k, NULL, al);
+  if (rc != PHGMG_OK) goto done;
+  inf->nhsv = k;
+  if (k < r) { rc = PHGMG_ERR_RANK; goto done; }
+  for (j = 0; j < r; ++j) { /* T = Zc V_r S_r^{-1/2}, W = Zo U_r S_r^{-1/2} */
+    const double sc1 = 1.0 / sqrt(S[j]);
+    for (i = 0; i < kc; ++i) V[i + (size_t)j * kc] *= sc1;
+    for (i = 0; i < ko; ++i) U[i + (size_t)j * ko] *= sc1;
+    if (hsv) hsv[j] = S[j];
+  }
+  phgmg_gemm('N', 'N', N, r, kc, 1.0, Zc, N, V, kc, 0.0, T, N);
+  phgmg_gemm('N', 'N', N, r, ko, 1.0, Zo, N, U, ko, 0.0, W, N);
+  for (j = 0; j < r; ++j) phgmg__lr_amul(sc->S, T + (size_t)j * N, EZ + (size_t)j * N, sc->w);
+  phgmg_gemm('T', 'N', r, r, N, 1.0, W, N, EZ, N, 0.0, Ar, r);
+  phgmg_gemm('T', 'N', r, m, N, 1.0, W, N, sp->sys.B, N, 0.0, Br, r);
+  for (j = 0; j < r; ++j) phgmg__sp_qmv(sc->S, T + (size_t)j * N, EZ + (size_t)j * N);
+  phgmg_gemm('T', 'N', m, r, N, 1.0, sp->sys.B, N, EZ, N, 0.0, Cr, m);
+  inf->bound = 0.0;
+  for (j = r; j < k; ++j) inf->bound += 2.0 * S[j];
+  inf->hsv_tail = k > r ? S[r] : 0.0;
+done:
+  phgmg__free(al, EZ);
+  phgmg__free(al, M);
+  return rc;
+}
+
+PHGMG_DEF phgmg_result phgmg_lrbt(const phgmg_ph_sparse *sp, int r, const phgmg_lradi_opts *opts, double *Ar,
+                                  double *Br, double *Cr, double *hsv, double *T, double *W, phgmg_lrbt_info *info,
+                                  const phgmg_allocator *alloc) {
+  phgmg_lrbt_info inf;
+  phgmg_shifted *sc = NULL;
+  double *Zc = NULL, *Zo = NULL, *TW = NULL;
+  int kc = 0, ko = 0, N;
+  phgmg_result rc;
+  memset(&inf, 0, sizeof inf);
+  if (info) *info = inf;
+  if (!sp || !Ar || !Br || !Cr) return PHGMG_ERR_INVALID_ARG;
+  N = sp->sys.N;
+  if (r < 1 || r > N) return PHGMG_ERR_SIZE;
+  rc = phgmg_shifted_create(&sc, sp, 0, 0, alloc);
+  if (rc == PHGMG_OK) rc = phgmg__lrbt_factors(sp, opts, sc, &Zc, &kc, &Zo, &ko, &inf, alloc);
+  if (rc == PHGMG_OK) {
+    phgmg__lr_progress(opts, "balancing");
+    TW = phgmg__dalloc(alloc, 2 * (size_t)N * (size_t)r);
+    rc = TW ? phgmg__lrbt_balance(sp, sc, r, Zc, kc, Zo, ko, TW, Ar, Br, Cr, hsv, &inf, alloc) : PHGMG_ERR_NOMEM;
+  }
+  if (rc == PHGMG_OK && T) memcpy(T, TW, sizeof(double) * (size_t)N * (size_t)r);
+  if (rc == PHGMG_OK && W) memcpy(W, TW + (size_t)N * (size_t)r, sizeof(double) * (size_t)N * (size_t)r);
+  if (rc == PHGMG_OK) phgmg__lr_progress(opts, "done");
+  phgmg__free(alloc, TW); phgmg__free(alloc, Zc); phgmg__free(alloc, Zo);
+  phgmg_shifted_destroy(sc);
+  if (info) *info = inf;
+  return rc;
+}
+
+/* y = A x for one of the object's CSC copies (a: 0 J, 1 R, 2 Q, 3 E). */
+PHGMG__PRIV void phgmg__lr_cscmv(const phgmg_ph_sparse *sp, int a, const double *x, double *y) {
+  int j, p;
+  for (j = 0; j < sp->sys.N; ++j) y[j] = 0.0;
+  for (j = 0; j < sp->sys.N; ++j)
+    for (p = sp->cp[a][j]; p < sp->cp[a][j + 1]; ++p) y[sp->ci[a][p]] += sp->cx[a][p] * x[j];
+}
+
+/* The reduced pH matrices of phgmg_lrphbt from T (N x r): M = Q T, Jr =
+   skew(M^T J M), Rr = sym(M^T R M), Br = M^T B. */
+PHGMG__PRIV phgmg_result phgmg__lrph_project(const phgmg_ph_sparse *sp, int r, const double *T, double *Jr,
+                                             double *Rr, double *Br, const phgmg_allocator *al) {
+  const int N = sp->sys.N;
+  double *M = phgmg__dalloc(al, 2 * (size_t)N * (size_t)r), *X = M + (size_t)N * r;
+  int i, j, a;
+  if (!M) return PHGMG_ERR_NOMEM;
+  for (j = 0; j < r; ++j) phgmg__lr_cscmv(sp, 2, T + (size_t)j * N, M + (size_t)j * N);
+  phgmg_gemm('T', 'N', r, sp->sys.m, N, 1.0, M, N, sp->sys.B, N, 0.0, Br, r);
+  for (a = 0; a < 2; ++a) {
+    double *D = a ? Rr : Jr;
+    for (j = 0; j < r; ++j) phgmg__lr_cscmv(sp, a, M + (size_t)j * N, X + (size_t)j * N);
+    phgmg_gemm('T', 'N', r, r, N, 1.0, M, N, X, N, 0.0, D, r);
+    for (j = 0; j < r; ++j)
+      for (i = 0; i <= j; ++i) {
+        const double u = D[i + (size_t)j * r], l = D[j + (size_t)i * r];
+        D[i + (size_t)j * r] = a ? 0.5 * (u + l) : 0.5 * (u - l);
+        D[j + (size_t)i * r] = a ? D[i + (size_t)j * r] : -D[i + (size_t)j * r];
+      }
+  }
+  phgmg__free(al, M);
+  return PHGMG_OK;
+}
+
+/* The energy balancing of phgmg_lrphbt: Z^T E^T Q Z = Y diag(s^2) Y^T, T = Z
+   Y_r S_r^{-1/2} (N x r) and S (descending) into S (kc). Returns the count
+   of positive values in *k. */
+PHGMG__PRIV phgmg_result phgmg__lrph_basis(const phgmg_ph_sparse *sp, int r, const double *Z, int kc, double *T,
+                                           double *S, int *k, const phgmg_allocator *al) {
+  const int N = sp->sys.N;
+  double *EZ = phgmg__dalloc(al, (size_t)N * (size_t)kc + (size_t)N), *t = EZ + (size_t)N * kc;
+  double *G = phgmg__dalloc(al, 2 * (size_t)kc * (size_t)kc + (size_t)kc), *Y = G + (size_t)kc * kc, *w = Y + (size_t)kc * kc;
+  phgmg_result rc = PHGMG_ERR_NOMEM;
+  int i, j;
+  if (!EZ || !G) goto done;
+  for (j = 0; j < kc; ++j) { /* E^T Q Z = Q E Z */
+    if (sp->cp[3]) { phgmg__lr_cscmv(sp, 3, Z + (size_t)j * N, t); phgmg__lr_cscmv(sp, 2, t, EZ + (size_t)j * N); }
+    else phgmg__lr_cscmv(sp, 2, Z + (size_t)j * N, EZ + (size_t)j * N);
+  }
+  phgmg_gemm('T', 'N', kc, kc, N, 1.0, Z, N, EZ, N, 0.0, G, kc);
+  if ((rc = phgmg_sym_eig(kc, G, kc, w, Y, kc)) != PHGMG_OK) goto done;
+  for (*k = 0, j = kc - 1; j >= 0 && w[j] > 1e-14 * w[kc - 1]; --j) S[(*k)++] = sqrt(w[j]);
+  if (*k < r) { rc = PHGMG_ERR_RANK; goto done; }
+  for (j = 0; j < r; ++j) { /* column kc - 1 - j of Y, scaled */
+    const double sc1 = 1.0 / sqrt(S[j]);
+    for (i = 0; i < kc; ++i) G[i + (size_t)j * kc] = Y[i + (size_t)(kc - 1 - j) * kc] * sc1;
+  }
+  phgmg_gemm('N', 'N', N, r, kc, 1.0, Z, N, G, kc, 0.0, T, N);
+done:
+  phgmg__free(al, EZ); phgmg__free(al, G);
+  return rc;
+}
+
+PHGMG_DEF phgmg_result phgmg_lrphbt(const phgmg_ph_sparse *sp, int r, const phgmg_lradi_opts *opts, double *Jr,
+                                    double *Rr, double *Qr, double *Br, double *sigma, double *V,
+                                    phgmg_lrbt_info *info, const phgmg_allocator *alloc) {
+  phgmg_lrbt_info inf;
+  phgmg_shifted *sc = NULL;
+  double *Z = NULL, *T = NULL, *S = NULL;
+  int kc = 0, k = 0, N, i, j;
+  phgmg_result rc;
+  memset(&inf, 0, sizeof inf);
+  if (info) *info = inf;
+  if (!sp || !Jr || !Rr || !Qr || !Br) return PHGMG_ERR_INVALID_ARG;
+  N = sp->sys.N;
+  if (r < 1 || r > N) return PHGMG_ERR_SIZE;
+  rc = phgmg_shifted_create(&sc, sp, 0, 0, alloc);
+  if (rc == PHGMG_OK) {
+    phgmg__lr_progress(opts, "controllability Gramian");
+    rc = phgmg_lradi(sc, sp->sys.m, sp->sys.B, N, opts, &Z, &kc, &inf.ctrl, alloc);
+  }
+  phgmg_shifted_destroy(sc);
+  if (rc == PHGMG_OK) {
+    phgmg__lr_progress(opts, "balancing");
+    T = phgmg__dalloc(alloc, (size_t)N * (size_t)r);
+    S = phgmg__dalloc(alloc, (size_t)kc + 1);
+    rc = T && S ? phgmg__lrph_basis(sp, r, Z, kc, T, S, &k, alloc) : PHGMG_ERR_NOMEM;
+    inf.nhsv = k;
+  }
+  if (rc == PHGMG_OK) rc = phgmg__lrph_project(sp, r, T, Jr, Rr, Br, alloc);
+  if (rc == PHGMG_OK) {
+    for (j = 0; j < r; ++j)
+      for (i = 0; i < r; ++i) Qr[i + (size_t)j * r] = i == j ? 1.0 / S[j] : 0.0;
+    if (sigma) memcpy(sigma, S, sizeof(double) * (size_t)r);
+    if (V)
+      for (j = 0; j < r; ++j)
+        for (i = 0; i < N; ++i) V[i + (size_t)j * N] = T[i + (size_t)j * N] / S[j];
+    inf.hsv_tail = k > r ? S[r] : 0.0;
+    phgmg__lr_progress(opts, "done");
+  }
+  phgmg__free(alloc, Z); phgmg__free(alloc, T); phgmg__free(alloc, S);
+  if (info) *info = inf;
   return rc;
 }
 #endif /* PHGMG_NO_OFFLINE */

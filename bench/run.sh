@@ -11,7 +11,9 @@
 #    the snapshots; about 2 minutes and 5 GB of memory),
 #    bench/bench_desc.c (desc2d_N10082_band / _sparse: a 2-D lattice with a
 #    mass matrix, 1000 steps with the band LU and with the sparse LU, 3
-#    paired runs; about a minute) into
+#    paired runs; about a minute),
+#    bench/bench_lowrank.c (lrbt_heat_N10000_r20: low-rank BT of a 2-D heat
+#    model, one run, about a second) into
 #    build/ (a missing or broken source is skipped with a warning) and runs
 #    each, appending `case,median_s,min_s,max_s,runs` lines to the CSV;
 # 2b. bench/bench_sparse.sh: `phgmg simulate` on scrambled 2-D/3-D lattices
@@ -57,7 +59,7 @@ echo "$machine" > "$BUILD/bench_machine.txt"
 make phgmg.h >/dev/null || { echo "run.sh: cannot build phgmg.h" >&2; exit 1; }
 echo "case,median_s,min_s,max_s,runs" > "$CSV"
 
-for prog in bench_linalg bench_fom bench_rom bench_linear bench_scale bench_desc; do
+for prog in bench_linalg bench_fom bench_rom bench_linear bench_scale bench_desc bench_lowrank; do
   src=bench/$prog.c
   if [ ! -f "$src" ]; then
     echo "run.sh: warning: $src is missing, skipped" >&2

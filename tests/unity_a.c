@@ -23,6 +23,7 @@
 #include "test_hyper.c"
 #include "test_linalg.c"
 #include "test_linear.c"
+#include "test_lowrank.c"
 #include "test_npy.c"
 #include "test_online.c"
 #include "test_qm_wide.c"

@@ -1,0 +1,161 @@
+/* bench_lowrank.c — low-rank balanced truncation (phgmg_lrbt, manual 2.8,
+   8.13) of large sparse linear pH models.
+
+   heat:    J = 0, R = the 2-D Dirichlet Laplacian (5-point stencil: 4 on
+            the diagonal, -1 to each neighbour) on an n x n grid, Q = I,
+            N = n^2, two boundary ports: input 1 on the nodes of the left
+            edge, input 2 on the nodes of the bottom edge (weights 1). J = 0:
+            one Lyapunov equation (the dual model is the model), real shifts.
+   lattice: an n x n mass-spring-damper lattice, x = (q, p) per mass, N =
+            2 n^2: K = 2-D Dirichlet Laplacian + 0.01 I, D = 0.5 I + 0.01 K,
+            unit masses, forces on the corner masses (0, 0) and (n-1, n-1)
+            (collocated ports); two Lyapunov equations, complex shifts.
+   Each run: phgmg_ph_sparse_create (ordering), then phgmg_lrbt to order
+   --r (default 20) with the default options (tol 1e-10). Prints the wall and
+   CPU time of each, the ADI steps, the factors' columns and ranks, the
+   residuals, the numeric factorizations, the first Hankel singular values
+   and the bound 2 sum_{i > r} sigma_i / sigma_1; then (--nw, default 20,
+   0: skip) the sampled H-infinity error of the reduced model on --nw
+   log-spaced frequencies in [1e-2, 1e2] through the sparse model's shifted
+   solves (phgmg_shifted_hinf: one complex factorization per frequency),
+   relative to the sampled norm of G, against the bound.
+
+     cc -std=c99 -O2 -march=native bench/bench_lowrank.c -o build/bench_lowrank -lm
+     ./build/bench_lowrank --model heat --n 100 [--r 20] [--nw 20] [--out bench/results.csv]
+     ./build/bench_lowrank --model heat --n 317
+     ./build/bench_lowrank --model lattice --n 71 */
+#define _POSIX_C_SOURCE 199309L
+#define PHGMG_IMPLEMENTATION
+#include "../phgmg.h"
+#include "bench_args.h"
+#include <stdio.h>
+#include <stdlib.h>
+#include <time.h>
+
+typedef struct bl_csc { int *cp, *ri; double *v; int nz, cap; phgmg_csc A; } bl_csc;
+
+static double bl_now(void) {
+  struct timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static void bl_init(bl_csc *c, int N, int cap) {
+  c->cp = (int *)malloc(sizeof(int) * (size_t)(N + 1));
+  c->ri = (int *)malloc(sizeof(int) * (size_t)(cap + 1));
+  c->v = (double *)malloc(sizeof(double) * (size_t)(cap + 1));
+  c->nz = 0; c->cap = cap;
+  c->A.n_rows = c->A.n_cols = N; c->A.colptr = c->cp; c->A.rowidx = c->ri; c->A.values = c->v;
+}
+static void bl_add(bl_csc *c, int i, double v) { c->ri[c->nz] = i; c->v[c->nz++] = v; }
+static void bl_free(bl_csc *c) { free(c->cp); free(c->ri); free(c->v); }
+
+/* Column of the 5-point Laplacian (+ shift on the diagonal, times scale) at
+   node a of an n x n grid, rows increasing, offset added to the rows. */
+static void bl_lap_col(bl_csc *c, int n, int a, double shift, double scale, int offset) {
+  const int x = a % n, y = a / n;
+  if (y > 0) bl_add(c, offset + a - n, -scale);
+  if (x > 0) bl_add(c, offset + a - 1, -scale);
+  bl_add(c, offset + a, scale * (4.0 + shift));
+  if (x < n - 1) bl_add(c, offset + a + 1, -scale);
+  if (y < n - 1) bl_add(c, offset + a + n, -scale);
+}
+
+/* The model's J, R, Q and B (dense N x 2). Returns N. */
+static int bl_model(int lattice, int n, bl_csc *J, bl_csc *R, bl_csc *Q, double **B) {
+  const int n2 = n * n, N = lattice ? 2 * n2 : n2;
+  int a;
+  bl_init(J, N, lattice ? N : 0); bl_init(R, N, 5 * n2); bl_init(Q, N, 5 * n2 + n2);
+  *B = (double *)calloc((size_t)N * 2, sizeof(double));
+  for (a = 0; a < N; ++a) {
+    J->cp[a] = J->nz; R->cp[a] = R->nz; Q->cp[a] = Q->nz;
+    if (!lattice) {
+      bl_lap_col(R, n, a, 0.0, 1.0, 0);
+      bl_add(Q, a, 1.0);
+      continue;
+    }
+    if (a < n2) { /* position column: J(p_a, q_a) = -1, Q = K */
+      bl_add(J, n2 + a, -1.0);
+      bl_lap_col(Q, n, a, 0.01, 1.0, 0);
+    } else {      /* momentum column: J(q_a, p_a) = 1, R = D, Q = I */
+      const int b = a - n2, x = b % n, y = b / n;
+      bl_add(J, b, 1.0);
+      if (y > 0) bl_add(R, a - n, -0.01);
+      if (x > 0) bl_add(R, a - 1, -0.01);
+      bl_add(R, a, 0.5 + 0.01 * 4.01);
+      if (x < n - 1) bl_add(R, a + 1, -0.01);
+      if (y < n - 1) bl_add(R, a + n, -0.01);
+      bl_add(Q, a, 1.0);
+    }
+  }
+  J->cp[N] = J->nz; R->cp[N] = R->nz; Q->cp[N] = Q->nz;
+  if (!lattice)
+    for (a = 0; a < n; ++a) { (*B)[a * n] = 1.0; (*B)[a + (size_t)N] = 1.0; } /* left edge (x = 0), bottom edge (y = 0) */
+  else { (*B)[n2] = 1.0; (*B)[n2 + n2 - 1 + (size_t)N] = 1.0; }
+  return N;
+}
+
+int main(int argc, char **argv) {
+  static const char *const extra[] = {"--model", "--n", "--r", "--nw", NULL};
+  const char *vals[4] = {NULL, NULL, NULL, NULL}, *outname;
+  bl_csc J, R, Q;
+  double *B, *Ar, *Br, *Cr, *hsv, t0, t1, t2, c0, c1, c2;
+  phgmg_ph_sparse *sp = NULL;
+  phgmg_ph_sparse_info si;
+  phgmg_lrbt_info inf;
+  phgmg_result rc;
+  int lattice, n, r, N, i, nw, err = 0;
+  FILE *csv;
+  i = bench_args(argc, argv, "bench_lowrank", "Low-rank BT of a 2-D heat model or a 2-D mass-spring-damper lattice.\n"
+                 "  --model heat|lattice (heat)  --n grid side (100)  --r order (20)\n"
+                 "  --nw frequencies of the sampled H-infinity error (20; 0: none)", &outname, extra, vals);
+  if (i) return i == 1 ? 0 : 2;
+  lattice = vals[0] && !strcmp(vals[0], "lattice");
+  if (vals[0] && !lattice && strcmp(vals[0], "heat")) { fprintf(stderr, "bench_lowrank: --model heat|lattice\n"); return 2; }
+  n = vals[1] ? atoi(vals[1]) : 100;
+  r = vals[2] ? atoi(vals[2]) : 20;
+  nw = vals[3] ? atoi(vals[3]) : 20;
+  if (n < 4 || r < 1 || nw < 0) { fprintf(stderr, "bench_lowrank: --n >= 4, --r >= 1, --nw >= 0\n"); return 2; }
+  csv = bench_open_csv("bench_lowrank", outname, &err);
+  if (err) return 1;
+  N = bl_model(lattice, n, &J, &R, &Q, &B);
+  Ar = (double *)malloc(sizeof(double) * (size_t)r * r); Br = (double *)malloc(sizeof(double) * (size_t)r * 2);
+  Cr = (double *)malloc(sizeof(double) * (size_t)r * 2); hsv = (double *)malloc(sizeof(double) * (size_t)r);
+  t0 = bl_now(); c0 = (double)clock() / CLOCKS_PER_SEC;
+  rc = phgmg_ph_sparse_create(&sp, N, 2, &J.A, &R.A, &Q.A, B, NULL, &si, NULL);
+  t1 = bl_now(); c1 = (double)clock() / CLOCKS_PER_SEC;
+  if (rc == PHGMG_OK) rc = phgmg_lrbt(sp, r, NULL, Ar, Br, Cr, hsv, NULL, NULL, &inf, NULL);
+  t2 = bl_now(); c2 = (double)clock() / CLOCKS_PER_SEC;
+  if (rc != PHGMG_OK) { fprintf(stderr, "bench_lowrank: %s\n", phgmg_result_string(rc)); return 1; }
+  printf("%s n = %d, N = %d, r = %d\n", lattice ? "lattice" : "heat", n, N, r);
+  printf("  create (ordering)  %.2f s wall, %.2f s CPU\n", t1 - t0, c1 - c0);
+  printf("  lrbt               %.2f s wall, %.2f s CPU\n", t2 - t1, c2 - c1);
+  printf("  controllability: %d ADI steps, %d columns -> rank %d, residual %.2e, %d factorizations, %d shift sets\n",
+         inf.ctrl.iters, inf.ctrl.cols, inf.ctrl.rank, inf.ctrl.res, inf.ctrl.factorizations, inf.ctrl.shift_sets);
+  printf("  observability:   %d ADI steps, %d columns -> rank %d, residual %.2e, %d factorizations%s\n",
+         inf.obs.iters, inf.obs.cols, inf.obs.rank, inf.obs.res, inf.obs.factorizations,
+         lattice ? "" : " (J = 0: the same run)");
+  printf("  Hankel singular values computed %d; sigma_1 %.6e, sigma_r %.3e, sigma_r+1 %.3e; bound 2 sum_{i>r} / sigma_1 = %.2e\n",
+         inf.nhsv, hsv[0], hsv[r - 1], inf.hsv_tail, inf.bound / hsv[0]);
+  if (nw > 0) {
+    phgmg_shifted *s = NULL;
+    double hinf = 0.0, href = 0.0;
+    t0 = bl_now(); c0 = (double)clock() / CLOCKS_PER_SEC;
+    rc = phgmg_shifted_create(&s, sp, 0, 1, NULL);
+    if (rc == PHGMG_OK) rc = phgmg_shifted_hinf(s, r, Ar, Br, Cr, nw, 1e-2, 1e2, &hinf, &href);
+    t1 = bl_now(); c1 = (double)clock() / CLOCKS_PER_SEC;
+    phgmg_shifted_destroy(s);
+    if (rc != PHGMG_OK) { fprintf(stderr, "bench_lowrank: sampled error: %s\n", phgmg_result_string(rc)); return 1; }
+    printf("  sampled H-infinity error on %d frequencies in [1e-2, 1e2]: %.3e (relative to the sampled ||G|| %.3e: %.2e), "
+           "bound %.3e: %s; %.2f s wall, %.2f s CPU\n", nw, hinf, href, hinf / href, inf.bound,
+           hinf <= inf.bound ? "within" : "ABOVE", t1 - t0, c1 - c0);
+  }
+  if (csv) {
+    fprintf(csv, "lrbt_%s_N%d_r%d,%.6f,%.6f,%.6f,1\n", lattice ? "lattice" : "heat", N, r, t2 - t1, t2 - t1, t2 - t1);
+    fclose(csv);
+  }
+  phgmg_ph_sparse_destroy(sp);
+  bl_free(&J); bl_free(&R); bl_free(&Q);
+  free(B); free(Ar); free(Br); free(Cr); free(hsv);
+  return 0;
+}
