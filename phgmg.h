@@ -10752,7 +10752,7 @@ struct phgmg_study {
   int ldx, ns, N, m;
   double xx;               /* ||X||_F^2                                          */
   double *QB, *RB;         /* thin QR of B (N x m, m x m)                        */
-  double *Ua, *Ca, *CB, *Ta, *Gf, *Qf; /* GMG: POD of Xa = X - BB^+X (N x ka), Ua^T Xa,
+  double *Ua, *Ca, *CB, *Ta, *Gf, *Qf, *Gfa; /* GMG: POD of Xa = X - BB^+X (N x ka), Ua^T Xa,
                               QB^T X (m x ns), tails Ta[k] = sum_i ||(I - P_[QB, Ua_1..k]) x_i||^2
                               (ka + 1), [B, Ua]^T G [B, Ua] and [B, Ua]^T Q [B, Ua] ((m+ka)^2) */
   int ka;
@@ -10864,6 +10864,18 @@ PHGMG_DEF int phgmg_reduced_N(const phgmg_reduced *red) { return red ? red->N : 
 /* C (m x n) = A^T B with A: k x m, B: k x n (column-major, tight). */
 PHGMG__PRIV void phgmg__atb(int k, int m, int n, const double *A, const double *B, double *C) {
   phgmg_gemm('T', 'N', m, n, k, 1.0, A, k, B, k, 0.0, C, m);
+}
+/* C (m x n, ld ldc) = |A|^T |B| with A: k x m, B: k x n (tight): the scale
+   of A^T B's rounding errors. */
+PHGMG__PRIV void phgmg__atb_abs(int k, int m, int n, const double *A, const double *B, double *C, int ldc) {
+  int i, j, l;
+  for (j = 0; j < n; ++j)
+    for (i = 0; i < m; ++i) {
+      const double *a = A + (size_t)i * k, *b = B + (size_t)j * k;
+      double t = 0.0;
+      for (l = 0; l < k; ++l) t += fabs(a[l]) * fabs(b[l]);
+      C[i + (size_t)j * ldc] = t;
+    }
 }
 
 #ifndef PHGMG_POD_OVERSAMPLE
@@ -12596,6 +12608,11 @@ typedef struct phgmg__rctx {
   const double *Xf;
   int ldxf;
   double *Xc;
+  /* GMG non-degeneracy (manual 8.9): dgs the reduced coordinates' scaling
+     (r), dga = |D|^T |G D| the rounding scale of G00 (r x r, dga_ok = 1 once
+     computed), dgref = ||S dga S||_1 (0: unknown) */
+  double *dgs, *dga, dgref;
+  int dga_ok;
 } phgmg__rctx;
 
 PHGMG__PRIV void phgmg__rctx_free(phgmg__rctx *c) {
@@ -12612,6 +12629,8 @@ PHGMG__PRIV void phgmg__rctx_free(phgmg__rctx *c) {
   c->Uw = c->Cw = NULL;
   phgmg__free(c->alloc, c->Xc);
   c->Xc = NULL;
+  phgmg__free(c->alloc, c->dga);
+  c->dga = c->dgs = NULL;
   c->jr = NULL; c->Xa = c->lg = c->Tq = c->V2h = NULL; c->runcol = NULL;
   c->Bp_own = c->sepw_own = NULL; c->ef = NULL;
 }
@@ -13777,18 +13796,54 @@ PHGMG__PRIV double phgmg__rcond_inplace(int n, double *E, int *ip, double *work)
   return phgmg_lu_rcond(n, E, n, ip, anorm, work, ip + n);
 }
 
-/* The degeneracy check measures D^T G D with unit port columns: rows and
-   columns a < m of E (r x r) scaled by 1 / ||B_a|| -- the same invertibility,
-   but a condition independent of the units of B (B scaled by s while G
-   scales by 1/s^2, as for states in other units, would otherwise move rcond
-   by s^2 and fail a well-posed model). */
-PHGMG__PRIV void phgmg__dgd_unit_ports(const phgmg_reduced *red, double *E) {
-  const int r = red->r, m = red->m, N = red->N;
-  int a, i;
-  for (a = 0; a < m; ++a) {
-    const double nb = phgmg_normf(N, 1, red->sys->B + (size_t)a * N, N), f = nb > 0.0 ? 1.0 / nb : 1.0;
-    for (i = 0; i < r; ++i) { E[a + (size_t)i * r] *= f; E[i + (size_t)a * r] *= f; }
+/* The degeneracy check's scaling of the reduced coordinates (manual 8.9):
+   s (r powers of two, so S A S is exact) that equilibrates A = D^T G D by a
+   congruence, symmetric Ruiz on C_ij = max(|a_ij|, |a_ji|) (a skew A has a
+   zero diagonal, so no Jacobi scaling): sweeps until every row of S C S has
+   its largest entry in [1/2, 2), at most 64. A zero row and column keeps 1. */
+PHGMG__PRIV int phgmg__half_exponent(double v) {   /* k with 4^k v in [1/2, 2) */
+  int e, t;
+  (void)frexp(v, &e);
+  t = 1 - e;
+  return t >= 0 ? t / 2 : -((1 - t) / 2);
+}
+PHGMG__PRIV void phgmg__dgd_equilibrate(int r, const double *A, double *s) {
+  int i, j, it, moved = 1;
+  for (i = 0; i < r; ++i) s[i] = 1.0;
+  for (it = 0; it < 64 && moved; ++it) {
+    moved = 0;
+    for (i = 0; i < r; ++i) {
+      double cmax = 0.0;
+      int k;
+      for (j = 0; j < r; ++j) {
+        const double v = PHGMG__MAX(fabs(A[i + (size_t)j * r]), fabs(A[j + (size_t)i * r])) * s[j];
+        if (v > cmax) cmax = v;
+      }
+      cmax *= s[i];
+      if (!(cmax > 0.0 && cmax < HUGE_VAL)) continue;
+      k = phgmg__half_exponent(cmax);
+      if (k != 0) { s[i] = ldexp(s[i], k); moved = 1; }
+    }
   }
+}
+
+/* E (r x r) <- S E S with the check's scaling c->dgs. */
+PHGMG__PRIV void phgmg__dgd_scale(const phgmg__rctx *c, double *E) {
+  const int r = c->red->r;
+  int i, j;
+  for (j = 0; j < r; ++j)
+    for (i = 0; i < r; ++i) E[i + (size_t)j * r] *= c->dgs[i] * c->dgs[j];
+}
+
+/* The non-degeneracy measure of E = S (D^T G D) S (r x r; destroyed by its
+   LU): rcond(E) ||E||_1 / max(||E||_1, ||S Abar S||_1), Abar = |D|^T |G D|
+   the entries' rounding scale (c->dgref, 0 if unknown): 1 / (||E^{-1}||_1
+   ||S Abar S||_1), the relative change of the entries, on the scale they were
+   computed at, that makes E singular. ip: 2r ints, wk: 2r. */
+PHGMG__PRIV double phgmg__dgd_measure(const phgmg__rctx *c, double *E, int *ip, double *wk) {
+  const int r = c->red->r;
+  const double an = phgmg_norm1(r, r, E, r), rc = phgmg__rcond_inplace(r, E, ip, wk);
+  return an > 0.0 && c->dgref > an ? rc * (an / c->dgref) : rc;
 }
 
 /* Smallest rcond of D^T G D over the snapshots (QUADRATIC kind); with the
@@ -13812,8 +13867,8 @@ PHGMG__PRIV phgmg_result phgmg__dgd_rcond_snapshots(phgmg__rctx *c, double stop_
       double rc_i;
       phgmg__eta_d(red, x2b + (size_t)i * ld2, NULL, Lp, NULL, red->rwork);
       phgmg__dgd_d(red, Lp, E, tmp);
-      phgmg__dgd_unit_ports(red, E);
-      rc_i = phgmg__rcond_inplace(r, E, ip, wk);
+      phgmg__dgd_scale(c, E);
+      rc_i = phgmg__dgd_measure(c, E, ip, wk);
       if (rc_i < *rmin) *rmin = rc_i;
       if (!(rc_i >= stop_below)) { j0 = c->ns; break; }
     }
@@ -13829,13 +13884,23 @@ PHGMG__PRIV phgmg_result phgmg__dgd_rcond_snapshots(phgmg__rctx *c, double stop_
    lambda (M -> 0 as lambda grows, and D^T G D -> G00). */
 PHGMG__PRIV double phgmg__dgd_rcond0(phgmg__rctx *c) {
   phgmg_reduced *red = c->red;
-  const size_t rr = (size_t)red->r * red->r;
-  double *E = phgmg__dalloc(c->alloc, rr), rc0;
-  if (!E) return -1.0;
+  const int r = red->r;
+  const size_t rr = (size_t)r * r;
+  double *E = phgmg__dalloc(c->alloc, rr + 2 * (size_t)r), rc0;
+  int *ip = phgmg__ialloc(c->alloc, 2 * (size_t)r);
+  if (!E || !ip) { phgmg__free(c->alloc, E); phgmg__free(c->alloc, ip); return -1.0; }
+  phgmg__dgd_equilibrate(r, red->G00, c->dgs);
+  c->dgref = 0.0;
+  if (c->dga_ok) {
+    memcpy(E, c->dga, rr * sizeof(double));
+    phgmg__dgd_scale(c, E);
+    c->dgref = phgmg_norm1(r, r, E, r);
+  }
   memcpy(E, red->G00, rr * sizeof(double));
-  phgmg__dgd_unit_ports(red, E);
-  rc0 = phgmg__rcond_of(red->r, E, c->alloc);
+  phgmg__dgd_scale(c, E);
+  rc0 = phgmg__dgd_measure(c, E, ip, E + rr);
   phgmg__free(c->alloc, E);
+  phgmg__free(c->alloc, ip);
   return rc0;
 }
 PHGMG__PRIV phgmg_result phgmg__check_degeneracy(phgmg__rctx *c) {
@@ -14405,6 +14470,8 @@ PHGMG__PRIV phgmg_result phgmg__study_gmg_blocks(phgmg__rctx *c) {
   phgmg_reduced *red = c->red;
   const int r = red->r, rn = red->rn, nf = red->m + c->st->ka;
   phgmg__subblock(r, r, c->st->Gf, nf, 0, 0, red->G00);
+  phgmg__subblock(r, r, c->st->Gfa, nf, 0, 0, c->dga);
+  c->dga_ok = 1;
   if (rn) {
     phgmg__subblock(r, rn, c->st->Gf, nf, 0, r, red->G01);
     phgmg__subblock(rn, r, c->st->Gf, nf, r, 0, red->G10);
@@ -14551,6 +14618,8 @@ PHGMG__PRIV phgmg_result phgmg__gmg_blocks_solve(phgmg__rctx *c) {
   }
   phgmg_jr_solve(c->jr, 'N', r + rn, GV, N);           /* GV = G [V0, V2] */
   phgmg__atb(N, r, r, L0, GV, red->G00);
+  phgmg__atb_abs(N, r, r, L0, GV, c->dga, r);
+  c->dga_ok = 1;
   if (rn) {
     phgmg__atb(N, r, rn, L0, GV + (size_t)N * r, red->G01);
     phgmg__atb(N, rn, r, L2, GV, red->G10);
@@ -14558,6 +14627,21 @@ PHGMG__PRIV phgmg_result phgmg__gmg_blocks_solve(phgmg__rctx *c) {
   }
   phgmg__free(c->alloc, GV);
   return PHGMG_OK;
+}
+
+/* K = G00^{-1} formed in the check's coordinates: S (S G00 S)^{-1} S (the
+   scaling is by powers of two, so only the pivoting sees it). */
+PHGMG__PRIV phgmg_result phgmg__inv_scaled(const phgmg__rctx *c, const double *A, double *K) {
+  const int r = c->red->r;
+  double *T = phgmg__dalloc(c->alloc, (size_t)r * r);
+  phgmg_result rc;
+  if (!T) return PHGMG_ERR_NOMEM;
+  memcpy(T, A, (size_t)r * r * sizeof(double));
+  phgmg__dgd_scale(c, T);
+  rc = phgmg__inv(r, T, K, c->alloc);
+  if (rc == PHGMG_OK) phgmg__dgd_scale(c, K);
+  phgmg__free(c->alloc, T);
+  return rc;
 }
 
 PHGMG__PRIV phgmg_result phgmg__stage_gmg_blocks(phgmg__rctx *c) {
@@ -14573,6 +14657,11 @@ PHGMG__PRIV phgmg_result phgmg__stage_gmg_blocks(phgmg__rctx *c) {
     red->G11 = phgmg__red_d(red, (size_t)rn * rn);
   }
   if (!red->G00 || !red->Bh || (rn && (!red->G01 || !red->G10 || !red->G11))) return PHGMG_ERR_NOMEM;
+  phgmg__free(c->alloc, c->dga);
+  c->dga = phgmg__dalloc(c->alloc, (size_t)r * r + (size_t)r);
+  if (!c->dga) return PHGMG_ERR_NOMEM;
+  c->dgs = c->dga + (size_t)r * r;
+  c->dga_ok = 0;
   rc = c->sf == PHGMG__SF_GMG ? phgmg__study_gmg_blocks(c) : phgmg__gmg_blocks_solve(c);
   if (rc != PHGMG_OK) return rc;
   for (j = 0; j < m; ++j) red->Bh[j + (size_t)j * r] = 1.0;
@@ -14580,7 +14669,7 @@ PHGMG__PRIV phgmg_result phgmg__stage_gmg_blocks(phgmg__rctx *c) {
   if (rc != PHGMG_OK || red->kind != PHGMG_ROM_LINEAR) return rc;
   red->K = phgmg__red_d(red, (size_t)r * r);
   if (!red->K) return PHGMG_ERR_NOMEM;
-  rc = phgmg__inv(r, red->G00, red->K, c->alloc);
+  rc = phgmg__inv_scaled(c, red->G00, red->K);
   return (rc == PHGMG_OK && (c->sys->ndamp || phgmg__has_feed(c->sys))) ? phgmg__gmg_dampers(c) : rc;
 }
 
@@ -15688,10 +15777,10 @@ PHGMG__PRIV phgmg_result phgmg__study_gmg(phgmg_study *st, int kmax, double *T, 
   double *V, *GV;
   phgmg_jr_factor *jr = NULL;
   phgmg_result rc;
-  st->Ua = phgmg__dalloc(alloc, (size_t)N * kmax + (size_t)kmax * ns + (size_t)m * ns + (size_t)kmax + 1 + 2 * nf * nf);
+  st->Ua = phgmg__dalloc(alloc, (size_t)N * kmax + (size_t)kmax * ns + (size_t)m * ns + (size_t)kmax + 1 + 3 * nf * nf);
   if (!st->Ua) return PHGMG_ERR_NOMEM;
   st->Ca = st->Ua + (size_t)N * kmax; st->CB = st->Ca + (size_t)kmax * ns; st->Ta = st->CB + (size_t)m * ns;
-  st->Gf = st->Ta + kmax + 1; st->Qf = st->Gf + nf * nf;
+  st->Gf = st->Ta + kmax + 1; st->Qf = st->Gf + nf * nf; st->Gfa = st->Qf + nf * nf;
   rc = phgmg_adjust_snapshots(N, m, st->sys->B, ns, st->X, st->ldx, T, N, alloc);
   if (rc == PHGMG_OK)
     rc = phgmg__study_pod(st, T, kmax, phgmg__rank_floor(N, ns, st->X, st->ldx), st->Ua, &st->ka, st->Ca, st->Ta, alloc);
@@ -15708,6 +15797,7 @@ PHGMG__PRIV phgmg_result phgmg__study_gmg(phgmg_study *st, int kmax, double *T, 
   if (rc == PHGMG_OK) {
     phgmg_jr_solve(jr, 'N', m + st->ka, GV, N);
     phgmg__atb(N, m + st->ka, m + st->ka, V, GV, st->Gf);
+    phgmg__atb_abs(N, m + st->ka, m + st->ka, V, GV, st->Gfa, m + st->ka);   /* rounding scale (8.9) */
     phgmg_ph_apply(st->sys, 'Q', m + st->ka, V, N, GV, N);
     phgmg__atb(N, m + st->ka, m + st->ka, V, GV, st->Qf);
   }

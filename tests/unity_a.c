@@ -14,6 +14,7 @@
 #include "test_dae.c"
 #include "test_defects.c"
 #include "test_defects3.c"
+#include "test_degen.c"
 #include "test_deploy.c"
 #include "test_descriptor.c"
 #include "test_dissip.c"
