@@ -503,9 +503,9 @@
                                                the m port coordinates)
      dt                   0 (no step map)      > 0: precompute the GL3 step
                                                map of a LINEAR model (2.2)
-     degeneracy_tol       1e-12                least reciprocal condition of
-                                               D^T G D before _ERR_DEGENERATE
-                                               (below the table)
+     degeneracy_tol       1e-12                least non-degeneracy measure
+                                               of D^T G D (8.9) before
+                                               _ERR_DEGENERATE (below the table)
      nrun/runs            0/NULL (one run of   the training runs that made X
                           unknown input)       (4.1)
      ref / ref_x          PHGMG_REF_NONE       affine reference state (3.6):
@@ -537,7 +537,7 @@
      select.folds         5                    _REGRESSION: folds (>= 2)
      select.blocks        min(ns, 100)         _REGRESSION: time blocks
      select.rcond         1e-6                 conditioning guard, relative to
-                                               rcond(D^T G D) at xr = 0
+                                               D^T G D's measure (8.9) at xr = 0
      select.tolerance     1.02                 _VALIDATED: admissible e_y
                                                ratio to the linear limit
      select.train_only    0                    1: validate on the training
@@ -565,10 +565,11 @@
      cache.deim_pts/_w/_count NULL             cached DEIM result
    Bad values (NaN, out of range, unknown enums) give PHGMG_ERR_INVALID_ARG;
    sizes that do not fit the model or the snapshots' rank give PHGMG_ERR_SIZE.
-   degeneracy_tol is compared with rcond(D^T G D) computed with D's port
-   columns B_a scaled to unit length, so that the units of the states and of
-   B do not change the verdict. Only method and r are required; every other
-   field may stay zero.
+   degeneracy_tol is compared with the measure of 8.9: D^T G D's distance to
+   singularity in equilibrated reduced coordinates, relative to the scale its
+   entries are computed at, so that the units of the states and of B, a mass
+   matrix and the mesh width do not change the verdict. Only method and r are
+   required; every other field may stay zero.
 
    3.3 GMG-QM manifold constructions (opts.qm)
      PHGMG_MANIFOLD_POD     the paper's hierarchical POD: V1 the leading POD
@@ -814,8 +815,9 @@
        and predicts the held-out
        quadratic correction V2^T x. The lambda with the smallest held-out error
        summed over the folds (ties within 1e-6 relative: the larger) fits M on
-       all snapshots. Guard: while rcond(D^T G D) at some snapshot is below
-       select.rcond times its value at xr = 0, the next larger lambda is taken
+       all snapshots. Guard: while the measure of D^T G D (8.9) at some
+       snapshot is below select.rcond times its value at xr = 0, the next
+       larger lambda is taken
        (info.lambda_raised); if even select.lambda_max does not help, M = 0.
        This choice measures the regression, not the reduced model, and picks
        very small lambdas that overfit (see 8.6).
@@ -956,10 +958,11 @@
                                     least-squares problem (phgmg_lstsq; GMG-QM
                                     with lambda < 0 takes the minimum-norm
                                     solution instead)
-     PHGMG_ERR_DEGENERATE (-12)     GMG non-degeneracy fails: rcond(D^T G D)
-                                    below degeneracy_tol at xr = 0 or (GMG-QM)
-                                    at a snapshot; SP1/SP2 likewise
-                                    (info->rcond_dgd says how close)
+     PHGMG_ERR_DEGENERATE (-12)     GMG non-degeneracy fails: the measure of
+                                    D^T G D (8.9) below degeneracy_tol at
+                                    xr = 0 or (GMG-QM) at a snapshot; SP1/SP2:
+                                    rcond(V^T Vg) below it (info->rcond_dgd
+                                    says how close; 8.9 says what to change)
      PHGMG_ERR_NEGATIVE_WEIGHT (-13) DEIM gave a negative weight and
                                     hyper.allow_negative is 0
      PHGMG_ERR_FORMAT (-14)         a malformed model image or .npy file
@@ -1144,11 +1147,50 @@
    10^-2.5), e_proj of the linear GMG map at the same r. These choices are
    the examples' (examples/msd_models.h), not the library's.
 
-   8.9 Non-degeneracy. GMG needs det(D^T G D) != 0. phgmg estimates the
-   reciprocal condition number with the port columns of D scaled to unit
-   length, so the result does not depend on the units of B or of the states,
-   at xr = 0 and (GMG-QM) at every snapshot. Examples: R = 0 makes G skew, so
-   every odd r fails.
+   8.9 Non-degeneracy. GMG needs A = D^T G D (with a mass matrix E:
+   (E D)^T G (E D)) invertible: the reduced model is xr' = A^{-1} grad Hr + Bh u,
+   and the online stepper solves with A. What the check must guard follows
+   from two facts.
+   (a) The reduced coordinates are a choice. xr -> S xr (S invertible, here
+   diagonal) maps A to S A S and Qh to S Qh S and leaves the lifted trajectory
+   phi(xr(t)) and the outputs unchanged. The plain rcond(A) is not invariant:
+   POD columns have unit Euclidean length whatever the states' units, so a
+   state group in units s of the others moves rcond(A) by s^2, and a mass
+   matrix scaling like h^d (d the dimension, h the mesh width) moves it by
+   about h^(2d) relative to the port columns; the acoustic model of a
+   2-D mesh gave 1.6e-10 at N = 2e3 and 8.3e-14 at N = 1e5 for the same,
+   well-defined reduced model. So phgmg measures A in equilibrated
+   coordinates: S = diag(s_i), s_i powers of two (S A S is exact), chosen by
+   symmetric Ruiz sweeps until every row of S C S, C_ij = max(|a_ij|, |a_ji|),
+   has its largest entry in [1/2, 2) (a Jacobi scaling by the diagonal is not
+   possible: with R = 0 the diagonal of A is zero). Diagonal rescalings of
+   the reduced coordinates then change the measure by a small factor only,
+   and GEPP with the scaled matrix solves as accurately as the conditioning
+   of S A S allows (K = A^{-1} of a linear model is formed as
+   S (S A S)^{-1} S).
+   (b) Equilibration alone would accept a singular A: a direction of the
+   basis whose row and column of A vanish in exact arithmetic holds rounding
+   errors only, and scaling them up to order one makes a random, regular
+   matrix. The entries are computed as dot products d_i^T (G d_j), whose
+   rounding error is bounded by a multiple of the unit round-off times
+   Abar_ij = |d_i|^T |G d_j| (entrywise absolute values; invariant under
+   diagonal changes of the full state's units, as the dot product is). The
+   measure is therefore
+       rcond_dgd = 1 / (||(S A S)^{-1}||_1 ||S Abar S||_1)
+                 = rcond(S A S) ||S A S||_1 / ||S Abar S||_1  (<= rcond(S A S)),
+   the smallest relative change of A's entries, on the scale they were
+   computed at, that makes A singular. It falls to the unit round-off for a
+   rank-deficient A in any units and is independent of a diagonal scaling of
+   the states or of the reduced coordinates; for a discretized field, A and
+   Abar converge together under refinement, so the measure does not drift
+   with the mesh. degeneracy_tol = 1e-12 (about 4500 unit round-offs) then
+   refuses only what rounding cannot tell from singular. The measure is taken
+   at xr = 0 and (GMG-QM) at every snapshot, with the S and Abar of xr = 0
+   (the coordinates of the model). Examples: R = 0 makes G skew, so every odd
+   r fails; a basis containing a direction d with G d and G^T d orthogonal to
+   the basis fails for every r. When it fails: a smaller r, a basis from other
+   snapshots, or (only if the reduced model is known to be fine) a lower
+   degeneracy_tol (command line: --degeneracy-tol).
 
    8.10 Tiny numbers and the floating-point environment. The decaying tail of
    a wave through a chain at rest passes through the subnormal range, where
@@ -2571,8 +2613,8 @@ typedef struct phgmg_select_opts {
   int per_decade;      /* grid points per decade, 1..100 (0: 4)                          */
   int folds;           /* REGRESSION: folds, >= 2 (0: 5)                                 */
   int blocks;          /* REGRESSION: contiguous time blocks, folds..ns (0: min(ns, 100))*/
-  double rcond;        /* conditioning guard, relative to rcond(D^T G D) at x = 0, in
-                          [0, 1] (0: 1e-6)                                               */
+  double rcond;        /* conditioning guard, relative to D^T G D's measure (manual 8.9)
+                          at x = 0, in [0, 1] (0: 1e-6)                                  */
   double tolerance;    /* VALIDATED: admissible e_y ratio to the linear limit, >= 1 and
                           finite (0: 1.02)                                               */
   int train_only;      /* VALIDATED: 1 = training runs only, no probe runs; 0 or 1      */
@@ -2613,8 +2655,9 @@ typedef struct phgmg_reduce_opts {
                             port coordinates; SP: 1..min(N, ns)), else PHGMG_ERR_SIZE     */
   double dt;             /* > 0: precompute the GL3 step map for this step (LINEAR map,
                             quadratic H; manual 2.2); 0: none; < 0, NaN, Inf: _INVALID_ARG */
-  double degeneracy_tol; /* least rcond of D^T G D at the snapshots (port columns at unit
-                            length), in [0, 1) (0: 1e-12); below: PHGMG_ERR_DEGENERATE   */
+  double degeneracy_tol; /* least non-degeneracy measure of D^T G D at the snapshots
+                            (manual 8.9: equilibrated, relative to its entries' rounding
+                            scale), in [0, 1) (0: 1e-12); below: PHGMG_ERR_DEGENERATE   */
   int nrun;              /* runs[0..nrun-1] (nrun <= 64): the runs that made X, laid   */
   const phgmg_run *runs; /* out as by phgmg_simulate_inputs (manual 4.1; columns summing
                             to ns, else _SIZE). 0/NULL: X is one run of an unknown input */
@@ -2641,8 +2684,8 @@ typedef struct phgmg_reduce_info {
                               DEIM; every term without hyper.on             */
   int deim_negative;       /* number of negative DEIM weights               */
   double deim_sigma_ratio; /* sigma_{nd+1}/sigma_1 of the nonlinear snapshots (0 if all kept) */
-  double rcond_dgd;        /* GMG: smallest rcond of D^T G D seen (at x = 0 and the
-                              snapshots; port columns of D at unit length, see
+  double rcond_dgd;        /* GMG: smallest non-degeneracy measure of D^T G D seen
+                              (at x = 0 and the snapshots; manual 8.9, compared with
                               degeneracy_tol). SP1/SP2: rcond of V^T Vg, the matrix
                               inverted for W (no D^T G D there)                   */
   double rcond_jr;         /* rcond of J - R                                  */
@@ -13798,32 +13841,31 @@ PHGMG__PRIV double phgmg__rcond_inplace(int n, double *E, int *ip, double *work)
 
 /* The degeneracy check's scaling of the reduced coordinates (manual 8.9):
    s (r powers of two, so S A S is exact) that equilibrates A = D^T G D by a
-   congruence, symmetric Ruiz on C_ij = max(|a_ij|, |a_ji|) (a skew A has a
-   zero diagonal, so no Jacobi scaling): sweeps until every row of S C S has
-   its largest entry in [1/2, 2), at most 64. A zero row and column keeps 1. */
-PHGMG__PRIV int phgmg__half_exponent(double v) {   /* k with 4^k v in [1/2, 2) */
-  int e, t;
-  (void)frexp(v, &e);
-  t = 1 - e;
-  return t >= 0 ? t / 2 : -((1 - t) / 2);
-}
-PHGMG__PRIV void phgmg__dgd_equilibrate(int r, const double *A, double *s) {
-  int i, j, it, moved = 1;
+   congruence: the symmetric Sinkhorn-Knopp iteration s <- sqrt(s ./ (C s)),
+   C_ij = max(|a_ij|, |a_ji|), towards unit row sums of S C S (Knight 2008;
+   a skew A has a zero diagonal, so no Jacobi scaling, and the max-norm
+   balance is not unique for an arrow-shaped A with a zero corner), until
+   every row sum is within 5 % of one or after 400 sweeps; then rounded to
+   powers of two. A zero row and column keeps 1. w: r doubles. */
+PHGMG__PRIV void phgmg__dgd_equilibrate(int r, const double *A, double *s, double *w) {
+  int i, j, it;
   for (i = 0; i < r; ++i) s[i] = 1.0;
-  for (it = 0; it < 64 && moved; ++it) {
-    moved = 0;
+  for (it = 0; it < 400; ++it) {
+    double dev = 0.0;
     for (i = 0; i < r; ++i) {
-      double cmax = 0.0;
-      int k;
-      for (j = 0; j < r; ++j) {
-        const double v = PHGMG__MAX(fabs(A[i + (size_t)j * r]), fabs(A[j + (size_t)i * r])) * s[j];
-        if (v > cmax) cmax = v;
-      }
-      cmax *= s[i];
-      if (!(cmax > 0.0 && cmax < HUGE_VAL)) continue;
-      k = phgmg__half_exponent(cmax);
-      if (k != 0) { s[i] = ldexp(s[i], k); moved = 1; }
+      double t = 0.0;
+      for (j = 0; j < r; ++j) t += PHGMG__MAX(fabs(A[i + (size_t)j * r]), fabs(A[j + (size_t)i * r])) * s[j];
+      w[i] = t;
+      if (t > 0.0 && t < HUGE_VAL) dev = PHGMG__MAX(dev, fabs(s[i] * t - 1.0));
     }
+    if (dev < 0.05) break;
+    for (i = 0; i < r; ++i)
+      if (w[i] > 0.0 && w[i] < HUGE_VAL) s[i] = sqrt(s[i] / w[i]);
+  }
+  for (i = 0; i < r; ++i) {
+    int e;
+    const double m = frexp(s[i], &e);   /* s = m 2^e, m in [1/2, 1) */
+    s[i] = s[i] > 0.0 && s[i] < HUGE_VAL ? ldexp(1.0, m < 0.70710678118654752 ? e - 1 : e) : 1.0;
   }
 }
 
@@ -13889,7 +13931,7 @@ PHGMG__PRIV double phgmg__dgd_rcond0(phgmg__rctx *c) {
   double *E = phgmg__dalloc(c->alloc, rr + 2 * (size_t)r), rc0;
   int *ip = phgmg__ialloc(c->alloc, 2 * (size_t)r);
   if (!E || !ip) { phgmg__free(c->alloc, E); phgmg__free(c->alloc, ip); return -1.0; }
-  phgmg__dgd_equilibrate(r, red->G00, c->dgs);
+  phgmg__dgd_equilibrate(r, red->G00, c->dgs, E);
   c->dgref = 0.0;
   if (c->dga_ok) {
     memcpy(E, c->dga, rr * sizeof(double));

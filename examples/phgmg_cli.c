@@ -216,6 +216,11 @@ static const char *const help_lines[] = {
   "                      no Newton iteration at that step). Default: the --dt of\n",
   "                      --simulate, none with --X; 0 = none. A step map with spectral\n",
   "                      radius above 1 (an amplifying step) is refused.\n",
+  "  --degeneracy-tol T  gmg: least non-degeneracy measure of D^T G D (the reduced\n",
+  "                      model's operator, measured in equilibrated coordinates against\n",
+  "                      the rounding of its entries, so independent of units and mesh;\n",
+  "                      reported as rcond(D^T G D)); sp1/sp2: least rcond of V^T W.\n",
+  "                      Below it the reduction is refused. Default 1e-12; 0 < T < 1.\n",
   "  --out DIR           output directory, created if missing (required).\n",
   "  --name NAME         base name of the outputs and C identifier prefix (default rom;\n",
   "                      letters, digits and _, not starting with a digit; not a C/C++\n",
@@ -1190,6 +1195,7 @@ typedef struct reduce_args {
   double hyper_tol;
   int simulate, steps, r, rn, no_deim, deim_max, deim_neg, save_snap, have_dt_map, newton_iter;
   double dt, amp, lambda, deim_tol, dt_map, newton_tol;
+  double degeneracy_tol;        /* --degeneracy-tol (0: the library's default) */
   int have_lambda;
   int lambda_auto;              /* --lambda auto (1) / cv (2) */
   int manifold;                 /* --manifold pod (0) / greedy (1) / altmin (2) */
@@ -1389,6 +1395,11 @@ static int parse_reduce(int argc, char **argv, reduce_args *A) {
     else if (!strcmp(o, "--dt-map")) {
       if (!(v = optval(argc, argv, &i)) || !parse_double(o, v, 0.0, &A->dt_map)) return 2;
       A->have_dt_map = 1;
+    }
+    else if (!strcmp(o, "--degeneracy-tol")) {
+      if (!(v = optval(argc, argv, &i)) || !parse_double(o, v, 0.0, &A->degeneracy_tol)) return 2;
+      if (!(A->degeneracy_tol > 0.0 && A->degeneracy_tol < 1.0))
+        return usage_error("--degeneracy-tol: expected a number with 0 < T < 1, got '%s'", v);
     }
     else if (!strcmp(o, "--simulate")) A->simulate = 1;
     else if (!strcmp(o, "--no-deim") || !strcmp(o, "--no-hyper")) A->no_deim = 1;
@@ -2358,6 +2369,7 @@ static int run_reduction(const reduce_args *A, reduce_state *S, int method, cons
   o.ref = A->ref;
   o.ref_x = A->ref == PHGMG_REF_GIVEN ? S->refm.a : NULL;
   o.qm.greedy_window = A->greedy_window;
+  o.degeneracy_tol = A->degeneracy_tol;   /* 0: the library's 1e-12 */
   if (S->nrun > 0) { o.nrun = S->nrun; o.runs = S->runs; } /* --simulate: the runs are known */
   if (A->lambda_auto == 1) { o.select.newton_tol = A->newton_tol; o.select.newton_iter = A->newton_iter; }
   memset(&info, 0, sizeof info);
@@ -2376,7 +2388,16 @@ static int run_reduction(const reduce_args *A, reduce_state *S, int method, cons
       case PHGMG_ERR_RANK:
         return fail("reduction failed: %s (%s, or the port matrix %s)", phgmg_result_string(rc), src, A->B);
       case PHGMG_ERR_DEGENERATE:
-        return fail("reduction failed: %s (try another --r, or for gmg-qm a larger --lambda)", phgmg_result_string(rc));
+        if (method == PHGMG_METHOD_SP1 || method == PHGMG_METHOD_SP2)
+          return fail("reduction failed: %s: rcond(V^T W) = %.3g is below --degeneracy-tol %g (try another --r or "
+                      "more varied snapshots)", phgmg_result_string(rc), info.rcond_dgd,
+                      A->degeneracy_tol > 0.0 ? A->degeneracy_tol : 1e-12);
+        return fail("reduction failed: %s: D^T G D's non-degeneracy measure %.3g is below --degeneracy-tol %g. "
+                    "Try another --r (with R = 0, an even --r), snapshots that excite more of the model, %s"
+                    "or, only if the reduced model is known to be fine, a smaller --degeneracy-tol (down to "
+                    "about 1e-15; below, D^T G D is singular to rounding)", phgmg_result_string(rc),
+                    info.rcond_dgd, A->degeneracy_tol > 0.0 ? A->degeneracy_tol : 1e-12,
+                    method == PHGMG_METHOD_GMG_QM ? "a larger --lambda, " : "");
       case PHGMG_ERR_STEP_MAP:
         return fail("reduction failed: --dt-map %g: %s (or --dt-map 0: none)", A->dt_map, phgmg_result_string(rc));
       case PHGMG_ERR_TOL_UNREACHABLE:
