@@ -882,7 +882,10 @@
    with dampers or feedthrough, 2 for one with several separable functions,
    else 1; all three load); phgmg_rom_deserialize / _load read it into caller
    memory, checking magic, version, sizes, checksum and values; a file written
-   by a double build loads into a float build and vice versa. Models that call
+   by a double build loads into a float build and vice versa. The header's
+   dt is the step map's step, or without a map the training step if the
+   writer recorded it (0: none; see phgmg_rom.dt); files with dt = 0 load as
+   before. Models that call
    back into user code cannot be serialised; the C export references the
    firmware's <name>_phi / <name>_eta instead (a GENERAL model, callback
    dampers: not at all). A loaded model with dampers must have weights >= 0
@@ -903,7 +906,10 @@
                         writes NAME.phgmgrom, NAME.c, NAME.json and the
                         reduced operators as NAME_*.npy;
      phgmg simulate-rom run a model file on an input, outputs (and states) as
-                        .npy;
+                        .npy; its default step is the model's dt (its step
+                        map's, or the step reduce recorded as the training
+                        step: --simulate's --dt, or --dt with --X), else 0.1,
+                        with a note when --dt differs from it;
      phgmg validate     reduce, then test full against reduced model on each
                         --test-input (exit 1 if one fails);
      phgmg info         describe a model file.
@@ -2156,7 +2162,12 @@ typedef struct phgmg_rom {
   const phgmg_real *w;    /* nd       weights (structure-preserving DEIM) */
   const phgmg_real *poly; /* (nphi or 1) x (poly_deg+1) coefficients of phi, constant first */
   /* precomputed GL3 step map (LINEAR, nd == 0; NULL if absent) for step dt:
-     x+ = Phi x + Gam u3, stage values Y = SX x + SU u3 (for the energy). */
+     x+ = Phi x + Gam u3, stage values Y = SX x + SU u3 (for the energy).
+     Without a step map dt may record the step the model was trained at
+     (0: unknown; phgmg_reduce leaves it 0, the command line's reduce sets it):
+     information for the caller, stored in the model file's header (every
+     format version has the field) and the C export; the steppers read it
+     only with Phi. */
   phgmg_real dt;
   const phgmg_real *Phi;  /* r x r    */
   const phgmg_real *Gam;  /* r x 3m   (u3 = [u(t+c1 h); u(t+c2 h); u(t+c3 h)]) */

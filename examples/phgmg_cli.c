@@ -107,6 +107,8 @@ static const char *const help_lines[] = {
   "                      trajectory x(t_0), ..., x(t_n), normally starting at x = 0).\n",
   "                      Repeatable (up to 16): one training run per file, the runs'\n",
   "                      boundaries known to the reduction (--lambda cv folds).\n",
+  "                      --dt DT with --X: the snapshots' step, recorded in the model\n",
+  "                      (simulate-rom's default step).\n",
   "  --X-input KIND      the input that made each --X run (one per --X, same order;\n",
   "                      KIND as --input, sampled with --dt = the snapshots' step):\n",
   "                      --lambda auto then simulates the runs from their first\n",
@@ -119,7 +121,8 @@ static const char *const help_lines[] = {
   "  --simulate          instead of --X: simulate the full model from x0 = 0 with the\n",
   "                      3-stage Gauss-Legendre method (order 6) and use the steps+1\n",
   "                      states as snapshots. Options:\n",
-  "    --dt DT           step (default 0.1)\n",
+  "    --dt DT           step (default 0.1), recorded in the model as its training\n",
+  "                      step (simulate-rom's default)\n",
   "    --steps N         number of steps (default 1000), t in [0, N*DT]\n",
   "    --input KIND      sin (default): u(t) = AMP sin(t); with m > 1 ports each port\n",
   "                      at its own frequency, u_a(t) = AMP sin((1 + a/m) t) for\n",
@@ -273,7 +276,10 @@ static const char *const help_lines[] = {
   "  --out FILE          output .npy (required)\n",
   "  --states FILE       also write the reduced states (r x (steps+1)); written together\n",
   "                      with --out: both or neither\n",
-  "  --dt DT             step (default: the model's step-map DT if it has one, else 0.1)\n",
+  "  --dt DT             step (default: the model's step-map DT if it has one, else the\n",
+  "                      step it was trained at (reduce records --simulate's --dt, the\n",
+  "                      --dt of --X with --X-input, or --dt given with --X), else 0.1;\n",
+  "                      a note on stderr when --dt differs from the model's)\n",
   "  --steps N, --input KIND, --amp AMP, --newton-tol T, --newton-iter K:  as above\n",
   "  --quiet             no progress lines\n",
   "\n",
@@ -1194,6 +1200,7 @@ typedef struct reduce_args {
   const char *expf, *potential, *hyper;
   double hyper_tol;
   int simulate, steps, r, rn, no_deim, deim_max, deim_neg, save_snap, have_dt_map, newton_iter;
+  int have_dt;                  /* --dt given (with --X alone: the snapshots' step) */
   double dt, amp, lambda, deim_tol, dt_map, newton_tol;
   double degeneracy_tol;        /* --degeneracy-tol (0: the library's default) */
   int have_lambda;
@@ -1356,6 +1363,7 @@ static int parse_reduce(int argc, char **argv, reduce_args *A) {
     else if (!strcmp(o, "--dt")) {
       if (!(v = optval(argc, argv, &i)) || !parse_double(o, v, 0.0, &A->dt)) return 2;
       if (!(A->dt > 0.0)) return usage_error("--dt must be > 0");
+      A->have_dt = 1;
     }
     else if (!strcmp(o, "--lambda")) {
       if (!(v = optval(argc, argv, &i))) return 2;
@@ -2533,6 +2541,7 @@ static void json_snapshots(FILE *jf, const reduce_args *A, int ns, double t_sim)
       for (i = 0; i < A->nxin; ++i) { if (i) fprintf(jf, ", "); json_str(jf, A->xin[i]); }
       fprintf(jf, "], \"dt\": "); json_num(jf, A->dt);
     }
+    else if (A->have_dt) { fprintf(jf, ", \"dt\": "); json_num(jf, A->dt); }
   }
   else {
     fprintf(jf, "\"simulate\": {\"dt\": "); json_num(jf, A->dt);
@@ -2652,12 +2661,18 @@ static int write_json(const reduce_args *A, reduce_state *S, int method, int ns,
 
 /* The model file, its C source and the json record (written last: it lists
    the arrays); then every output of this run moves into place. */
+/* The step the snapshots were taken at: --simulate's, the --X-input runs', or
+   --dt given with --X; 0 if unknown. */
+static double train_dt(const reduce_args *A) { return A->simulate || A->nxin || A->have_dt ? A->dt : 0.0; }
+
 static int write_model_files(const reduce_args *A, reduce_state *S, int method, int ns, double t_sim, double t_red,
                              const phgmg_reduce_opts *o, const phgmg_reduce_info *info, const outlist *ol) {
-  const phgmg_rom *rom = phgmg_reduced_rom(S->red);
+  phgmg_rom rs = *phgmg_reduced_rom(S->red);
+  const phgmg_rom *rom = &rs;
   phgmg_result rc;
   char path[4096 + 256];
   const char *wp;
+  if (!rs.Phi) rs.dt = (phgmg_real)train_dt(A);   /* no step map: dt records the training step */
   snprintf(path, sizeof path, "%s/%s.phgmgrom", A->out, A->name);
   if (!(wp = stage_path(&S->sg, path))) return 1;
   rc = phgmg_rom_save(rom, wp);
@@ -2847,6 +2862,26 @@ static int parse_simulate_rom(int argc, char **argv, simrom_args *P) {
   return 0;
 }
 
+/* simulate-rom's step: --dt, else the model's dt (its step map's, or the
+   step it was trained at), else 0.1; a note when they differ or the model
+   records none. 0 (never fails). */
+static int simrom_dt(const phgmg_rom *rom, int have_dt, double *dt) {
+  const double mdt = (double)rom->dt;
+  const int what_ok = rom->Phi != NULL;
+  const char *what = what_ok ? "step map's" : "training";
+  if (!have_dt) {
+    *dt = mdt > 0.0 ? mdt : 0.1;
+    if (!(mdt > 0.0))
+      note("the model records no training step: stepping at dt = 0.1; give the --dt of its training run");
+    return 0;
+  }
+  if (mdt > 0.0 && fabs(*dt - mdt) > 1e-6 * mdt)
+    note("--dt %g differs from the model's %s dt %g%s", *dt, what, mdt,
+         what_ok ? " (the stepper then solves each step instead of applying the map)"
+                 : " (a model follows its full model best at the step it was trained at)");
+  return 0;
+}
+
 static int cmd_simulate_rom(int argc, char **argv) {
   simrom_args P;
   const char *model, *out, *states, *inspec;
@@ -2881,7 +2916,7 @@ static int cmd_simulate_rom(int argc, char **argv) {
   if (check_out_file(out, "--out") || (states && check_out_file(states, "--states"))) goto done;
   g_inputs = &pin;
   if (load_model(model, "--model", &rom, &block)) goto done;
-  if (!have_dt) dt = rom.Phi ? (double)rom.dt : 0.1;
+  if (simrom_dt(&rom, have_dt, &dt)) goto done;
   if (too_big(((double)rom.m + (states ? (double)rom.r : 0.0)) * ((double)steps + 1.0),
               "--steps: the outputs (m x (steps+1), states r x (steps+1))")) {
     status = 2;
