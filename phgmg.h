@@ -919,7 +919,11 @@
    s = z_i - z_j (j = -1: s = z_i) with force c1 s + c3 s^3 (1.7); e.g. cubic
    dampers on the velocities of a chain (tests/test_cli.sh builds one).
    `phgmg --help` lists every option with its default, the file formats and
-   examples. The reduction does not depend on the units of the states; GMG-QM's
+   examples. The log of a full-model simulation of a nonlinear model names
+   the Newton tolerance used (the default, 1e-10 relative to
+   max(1, |x|, |stage increment|), may leave outputs further than 1e-10 from
+   a converged solution -- 1e-6 on a nonlinear membrane model; --newton-tol
+   about 1e-13 times the states' size gives about 1e-10 there). The reduction does not depend on the units of the states; GMG-QM's
    lambda grid and the POD itself do (with ports of very different scale,
    scale the inputs and check each port's e_y with validate).
 

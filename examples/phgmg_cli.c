@@ -133,7 +133,10 @@ static const char *const help_lines[] = {
   "    --amp AMP         amplitude (default 0.1)\n",
   "    --newton-tol T    Newton tolerance (stage residual, inf-norm, absolute) for\n",
   "                      nonlinear models (default: the library's, 1e-10 times\n",
-  "                      max(1, |x|, |stage increment|): follows large states)\n",
+  "                      max(1, |x|, |stage increment|): follows large states; the log\n",
+  "                      of a nonlinear model's simulation names the tolerance used.\n",
+  "                      For a reference accurate to about 1e-10 give about 1e-13\n",
+  "                      times the states' size)\n",
   "    --newton-iter K   Newton iteration cap per step (default 10)\n",
   "  --method M          gmg-pod: linear map phi(x) = [B, V] x, GMG reduction (paper 4.2.1)\n",
   "                      gmg-qm:  quadratic manifold phi(x) = [B, V1] x + V2 M (x2 kron x2)\n",
@@ -284,9 +287,10 @@ static const char *const help_lines[] = {
   "  --quiet             no progress lines\n",
   "\n",
   "COMMAND info MODEL\n",
-  "  Prints the sizes of a .phgmgrom file and the bytes of stepper memory its\n",
-  "  firmware needs (phgmg_rom_stepper_memsize; with a step map also the bytes for\n",
-  "  stepping with another dt, phgmg_rom_stepper_memsize_dt).\n",
+  "  Prints the sizes of a .phgmgrom file, its step map's or training dt, and the\n",
+  "  bytes of stepper memory its firmware needs (phgmg_rom_stepper_memsize; with a\n",
+  "  step map also the bytes for stepping with another dt,\n",
+  "  phgmg_rom_stepper_memsize_dt).\n",
   "\n",
   "SPARSE MATRICES\n",
   "  SPEC is one (nnz, 3) array of rows (row, col, value), or three vectors\n",
@@ -658,6 +662,20 @@ static void note(const char *fmt, ...) {
   vfprintf(stderr, fmt, ap);
   va_end(ap);
   fputc('\n', stderr);
+}
+
+/* The Newton tolerance a full-model simulation used, in the log: for a
+   nonlinear model or dampers (a linear model's stage systems are solved to
+   round-off in one update), with the way to tighten it. */
+static void progress_newton_tol(const phgmg_ph_system *sys, double tol, const phgmg_gl3_stats *st) {
+  if (sys->nl == PHGMG_NL_NONE && sys->ndamp == 0) return;
+  if (tol > 0.0)
+    progress("  Newton tolerance %g (absolute, --newton-tol); largest final stage residual %.2g", tol,
+             st->max_residual);
+  else
+    progress("  Newton tolerance: the default, 1e-10 x max(1, |x|, |stage increment|) per step (largest final "
+             "stage residual %.2g); for a reference accurate to about 1e-10 give --newton-tol about 1e-13 "
+             "times the states' size", st->max_residual);
 }
 
 /* Say so when an input file ends before a run of length t_end: past its last
@@ -2293,6 +2311,7 @@ static int simulate_training_runs(const reduce_args *A, reduce_state *S, const d
                   rc == PHGMG_ERR_NOT_CONVERGED ? " (try a smaller --dt or more --newton-iter)" : "");
     }
     progress("  done (%ld Newton iterations, %ld factorizations)", st.newton_iters, st.factorizations);
+    progress_newton_tol(&S->sys, A->newton_tol, &st);
     memset(&S->runs[i], 0, sizeof S->runs[i]);
     S->runs[i].u = input_fn; S->runs[i].user = in; S->runs[i].dt = A->dt; S->runs[i].nsteps = A->steps;
   }
@@ -3107,6 +3126,7 @@ static int cmd_simulate(int argc, char **argv) {
   }
   progress("  done in %.3f s (%ld Newton iterations, %ld factorizations)", now_s() - t0, st.newton_iters,
            st.factorizations);
+  progress_newton_tol(&S.full, A.newton_tol, &st);
   if (X && S.sp) { /* states back into the user's ordering */
     XU = (double *)malloc(sizeof(double) * (size_t)N * ((size_t)A.steps + 1));
     if (!XU) { fail("out of memory"); goto out; }
@@ -3136,9 +3156,9 @@ static int cmd_info(int argc, char **argv) {
   if (rom.kind == PHGMG_ROM_QUADRATIC) printf(", r_n = %d", rom.rn);
   if (rom.nd) printf(", %d nonlinear terms (polynomial degree %d, %d exponentials%s)", rom.nd, rom.poly_deg, rom.nexp,
                      rom.nphi > 1 ? ", one function per term" : "");
-  if (rom.Phi) {
+  if (rom.Phi || rom.dt > 0) {
     char buf[32];
-    printf(", step map for dt = %s", num_str((double)rom.dt, buf));
+    printf(rom.Phi ? ", step map for dt = %s" : ", trained at dt = %s", num_str((double)rom.dt, buf));
   }
   printf("\nstepper memory: %lu bytes", (unsigned long)phgmg_rom_stepper_memsize(&rom));
   if (rom.Phi) { /* the step map serves its own dt only; another dt needs the Newton workspace */

@@ -9,13 +9,16 @@
 # 1. trained by --simulate at --dt 0.02: simulate-rom without --dt steps at
 #    0.02 (the log says so, the output equals that of --dt 0.02 exactly and
 #    differs from that of --dt 0.1); --dt 0.05 takes precedence, with a note
-#    naming the training dt.
+#    naming the training dt; info shows it.
 # 2. trained on --X snapshots with --dt 0.02: the same default; without --dt
 #    the model records no step: simulate-rom steps at 0.1 and says so.
 # 3. a model with a step map (--dt-map 0.04) still defaults to the map's step.
 # 4. reduce's --degeneracy-tol reaches the library: 0.99 refuses the chain's
 #    model with a message naming the option and the measure; 0 is a usage
 #    error.
+# 5. the log of a full-model simulation of a nonlinear model (Toda springs)
+#    names the Newton tolerance used (the default, relative, or --newton-tol)
+#    and how to tighten it; a linear model's log has no such line.
 # Needs NumPy to write the matrices (skipped with a note otherwise).
 set -u
 P=${1:-build/phgmg}
@@ -42,7 +45,8 @@ J = np.block([[Z, np.eye(n)], [-np.eye(n), Z]])
 R = np.block([[Z, Z], [Z, 0.2 * np.eye(n)]])
 Q = np.block([[K, Z], [Z, np.eye(n)]])
 B = np.zeros(2 * n); B[n] = 1.0
-for k, v in dict(J=J, R=R, Q=Q, B=B).items():
+idx = np.arange(n)
+for k, v in dict(J=J, R=R, Q=Q, B=B, idx=idx).items():
     np.save(k + ".npy", v)
 PYEOF
 SYS="--J J.npy --R R.npy --Q Q.npy --B B.npy"
@@ -65,6 +69,7 @@ grep -q "steps of dt = 0.05" err.txt && pass || bad "--dt 0.05 does not take pre
 grep -q "note: --dt 0.05 differs from the model's training dt 0.02" err.txt && pass \
   || bad "no note on --dt differing from the training dt: $(cat err.txt)"
 grep -q '"dt": 0.02' o1/rom.json && pass || bad "rom.json does not record the training dt"
+"$P" info o1/rom.phgmgrom 2>&1 | grep -q "trained at dt = 0.02" && pass || bad "info does not show the training dt"
 
 # 2. --X snapshots with and without --dt
 "$P" reduce $SYS --X o1/rom_snapshots.npy --dt 0.02 --method gmg-pod --r 4 --out o2 >/dev/null 2>err.txt && pass \
@@ -93,6 +98,20 @@ grep -q "steps of dt = 0.04 (precomputed step map)" err.txt && pass || bad "the 
 grep -q "is below --degeneracy-tol 0.99" err.txt && pass || bad "the refusal does not name the option: $(cat err.txt)"
 "$P" reduce $SYS --simulate --method gmg-pod --r 4 --degeneracy-tol 0 --out o6 >/dev/null 2>err.txt
 [ $? -eq 2 ] && grep -q "degeneracy-tol" err.txt && pass || bad "--degeneracy-tol 0: $(cat err.txt)"
+
+# 5. the Newton tolerance in the log
+NL="--potential toda --poly-idx idx.npy"
+"$P" simulate $SYS $NL --steps 50 --out yn.npy >/dev/null 2>err.txt && pass || bad "simulate (toda): $(tail -n 2 err.txt)"
+grep -q "Newton tolerance: the default, 1e-10 x max(1, |x|, |stage increment|)" err.txt \
+  && grep -q "give --newton-tol" err.txt && pass || bad "the default Newton tolerance is not in the log: $(cat err.txt)"
+"$P" simulate $SYS $NL --steps 50 --newton-tol 1e-13 --out yn2.npy >/dev/null 2>err.txt && pass \
+  || bad "simulate --newton-tol 1e-13: $(tail -n 2 err.txt)"
+grep -q "Newton tolerance 1e-13 (absolute, --newton-tol)" err.txt && pass || bad "--newton-tol not in the log: $(cat err.txt)"
+"$P" reduce $SYS $NL --simulate --steps 50 --method gmg-pod --r 4 --no-hyper --out o7 >/dev/null 2>err.txt && pass \
+  || bad "reduce --simulate (toda): $(tail -n 2 err.txt)"
+grep -q "Newton tolerance: the default" err.txt && pass || bad "reduce's log lacks the Newton tolerance: $(cat err.txt)"
+"$P" simulate $SYS --steps 50 --out yl.npy >/dev/null 2>err.txt && pass || bad "simulate (linear): $(tail -n 2 err.txt)"
+grep -q "Newton tolerance" err.txt && bad "a linear model's log names a Newton tolerance: $(cat err.txt)" || pass
 
 echo "test_rom_dt: $npass passed, $nfail failed"
 [ "$nfail" -eq 0 ]

@@ -147,7 +147,7 @@ static void init(void) {
     "pod", "altmin", "auto", "cv", "1e-300", "1e160", "1e15", "rom", "--E", "--E-coo", "--P", "--S", "--N", "--dampers", "--no-hyper", NULL};
   static const char *const files2[] = {"Jc.npy", "Rc.npy", "Qc.npy", "exp.npy", "o/rom.phgmgrom", "o/rom_V0.npy",
                                        "o/rom.json", NULL};
-  static const char *const words3[] = {"--ref", "mean", "none", "wide", "--greedy-window", NULL};   /* after files2: seeds keep their meaning */
+  static const char *const words3[] = {"--ref", "mean", "none", "wide", "--greedy-window", "--degeneracy-tol", NULL};   /* after files2: seeds keep their meaning */
   char *argv[24];
   int k, fb, argc = 0;   /* fb: the token of files[0] */
   FILE *f;
