@@ -1175,9 +1175,10 @@
    has its largest entry in [1/2, 2) (a Jacobi scaling by the diagonal is not
    possible: with R = 0 the diagonal of A is zero). Diagonal rescalings of
    the reduced coordinates then change the measure by a small factor only,
-   and GEPP with the scaled matrix solves as accurately as the conditioning
-   of S A S allows (K = A^{-1} of a linear model is formed as
-   S (S A S)^{-1} S).
+   and Gaussian elimination on S A S solves as accurately as its
+   conditioning allows (K = A^{-1} of a linear model is formed so, as
+   S (S A S)^{-1} S; the online solves of a quadratic model factor A(xr)
+   as stored, where partial pivoting sees the unscaled rows).
    (b) Equilibration alone would accept a singular A: a direction of the
    basis whose row and column of A vanish in exact arithmetic holds rounding
    errors only, and scaling them up to order one makes a random, regular
