@@ -2650,6 +2650,7 @@ static int write_json(const reduce_args *A, reduce_state *S, int method, int ns,
   fprintf(jf, ", \"rcond_jr\": "); json_num(jf, info->rcond_jr);
   if (o->method != PHGMG_METHOD_SP1 && o->method != PHGMG_METHOD_SP2) { /* GMG only */
     fprintf(jf, ", \"rcond_dgd\": "); json_num(jf, info->rcond_dgd);
+    fprintf(jf, ", \"degeneracy_tol\": "); json_num(jf, A->degeneracy_tol > 0.0 ? A->degeneracy_tol : 1e-12);
   }
   if (o->hyper.on && A->poly_idx) { /* the hyper-reduction's result */
     fprintf(jf, ", \"hyper\": {\"method\": ");

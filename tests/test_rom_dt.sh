@@ -69,6 +69,7 @@ grep -q "steps of dt = 0.05" err.txt && pass || bad "--dt 0.05 does not take pre
 grep -q "note: --dt 0.05 differs from the model's training dt 0.02" err.txt && pass \
   || bad "no note on --dt differing from the training dt: $(cat err.txt)"
 grep -q '"dt": 0.02' o1/rom.json && pass || bad "rom.json does not record the training dt"
+grep -q '"degeneracy_tol": 1e-12' o1/rom.json && pass || bad "rom.json does not record the degeneracy tolerance"
 "$P" info o1/rom.phgmgrom 2>&1 | grep -q "trained at dt = 0.02" && pass || bad "info does not show the training dt"
 
 # 2. --X snapshots with and without --dt
