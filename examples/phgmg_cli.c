@@ -2885,8 +2885,22 @@ static int parse_simulate_rom(int argc, char **argv, simrom_args *P) {
 /* simulate-rom's step: --dt, else the model's dt (its step map's, or the
    step it was trained at), else 0.1; a note when they differ or the model
    records none. 0 (never fails). */
+/* The shortest decimal (as a double) that the build's phgmg_real rounds to v:
+   a float build's 0.02f reads back as 0.02, as the user wrote it. */
+static double real_decimal(phgmg_real v) {
+  char b[40];
+  int p;
+  for (p = 6; p <= 17; ++p) {
+    double d;
+    snprintf(b, sizeof b, "%.*g", p, (double)v);
+    d = strtod(b, NULL);
+    if ((phgmg_real)d == v) return d;
+  }
+  return (double)v;
+}
+
 static int simrom_dt(const phgmg_rom *rom, int have_dt, double *dt) {
-  const double mdt = (double)rom->dt;
+  const double mdt = real_decimal(rom->dt);
   const int what_ok = rom->Phi != NULL;
   const char *what = what_ok ? "step map's" : "training";
   if (!have_dt) {
@@ -3159,7 +3173,7 @@ static int cmd_info(int argc, char **argv) {
                      rom.nphi > 1 ? ", one function per term" : "");
   if (rom.Phi || rom.dt > 0) {
     char buf[32];
-    printf(rom.Phi ? ", step map for dt = %s" : ", trained at dt = %s", num_str((double)rom.dt, buf));
+    printf(rom.Phi ? ", step map for dt = %s" : ", trained at dt = %s", num_str(real_decimal(rom.dt), buf));
   }
   printf("\nstepper memory: %lu bytes", (unsigned long)phgmg_rom_stepper_memsize(&rom));
   if (rom.Phi) { /* the step map serves its own dt only; another dt needs the Newton workspace */

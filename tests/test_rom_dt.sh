@@ -2,7 +2,8 @@
 # test_rom_dt.sh — the step a reduced model was trained at, recorded by reduce
 # and used by simulate-rom.
 #
-# Usage: sh tests/test_rom_dt.sh build/phgmg      (from the repository root)
+# Usage: sh tests/test_rom_dt.sh build/phgmg      (from the repository root; also
+#        run on build/phgmg-float, whose model files hold dt as a float)
 #
 # A mass-spring chain of 4 masses (N = 8, damped, one force port), GMG-POD
 # r = 4 without a step map (--dt-map 0):
