@@ -628,9 +628,9 @@
                                                the m port coordinates)
      dt                   0 (no step map)      > 0: precompute the GL3 step
                                                map of a LINEAR model (2.2)
-     degeneracy_tol       1e-12                least reciprocal condition of
-                                               D^T G D before _ERR_DEGENERATE
-                                               (below the table)
+     degeneracy_tol       1e-12                least non-degeneracy measure
+                                               of D^T G D (8.9) before
+                                               _ERR_DEGENERATE (below the table)
      nrun/runs            0/NULL (one run of   the training runs that made X
                           unknown input)       (4.1)
      ref / ref_x          PHGMG_REF_NONE       affine reference state (3.6):
@@ -662,7 +662,7 @@
      select.folds         5                    _REGRESSION: folds (>= 2)
      select.blocks        min(ns, 100)         _REGRESSION: time blocks
      select.rcond         1e-6                 conditioning guard, relative to
-                                               rcond(D^T G D) at xr = 0
+                                               D^T G D's measure (8.9) at xr = 0
      select.tolerance     1.02                 _VALIDATED: admissible e_y
                                                ratio to the linear limit
      select.train_only    0                    1: validate on the training
@@ -690,10 +690,11 @@
      cache.deim_pts/_w/_count NULL             cached DEIM result
    Bad values (NaN, out of range, unknown enums) give PHGMG_ERR_INVALID_ARG;
    sizes that do not fit the model or the snapshots' rank give PHGMG_ERR_SIZE.
-   degeneracy_tol is compared with rcond(D^T G D) computed with D's port
-   columns B_a scaled to unit length, so that the units of the states and of
-   B do not change the verdict. Only method and r are required; every other
-   field may stay zero.
+   degeneracy_tol is compared with the measure of 8.9: D^T G D's distance to
+   singularity in equilibrated reduced coordinates, relative to the scale its
+   entries are computed at, so that the units of the states and of B, a mass
+   matrix and the mesh width do not change the verdict. Only method and r are
+   required; every other field may stay zero.
 
    3.3 GMG-QM manifold constructions (opts.qm)
      PHGMG_MANIFOLD_POD     the paper's hierarchical POD: V1 the leading POD
@@ -939,8 +940,9 @@
        and predicts the held-out
        quadratic correction V2^T x. The lambda with the smallest held-out error
        summed over the folds (ties within 1e-6 relative: the larger) fits M on
-       all snapshots. Guard: while rcond(D^T G D) at some snapshot is below
-       select.rcond times its value at xr = 0, the next larger lambda is taken
+       all snapshots. Guard: while the measure of D^T G D (8.9) at some
+       snapshot is below select.rcond times its value at xr = 0, the next
+       larger lambda is taken
        (info.lambda_raised); if even select.lambda_max does not help, M = 0.
        This choice measures the regression, not the reduced model, and picks
        very small lambdas that overfit (see 8.6).
@@ -1005,7 +1007,10 @@
    with dampers or feedthrough, 2 for one with several separable functions,
    else 1; all three load); phgmg_rom_deserialize / _load read it into caller
    memory, checking magic, version, sizes, checksum and values; a file written
-   by a double build loads into a float build and vice versa. Models that call
+   by a double build loads into a float build and vice versa. The header's
+   dt is the step map's step, or without a map the training step if the
+   writer recorded it (0: none; see phgmg_rom.dt); files with dt = 0 load as
+   before. Models that call
    back into user code cannot be serialised; the C export references the
    firmware's <name>_phi / <name>_eta instead (a GENERAL model, callback
    dampers: not at all). A loaded model with dampers must have weights >= 0
@@ -1028,7 +1033,10 @@
                         writes NAME.phgmgrom, NAME.c, NAME.json and the
                         reduced operators as NAME_*.npy;
      phgmg simulate-rom run a model file on an input, outputs (and states) as
-                        .npy;
+                        .npy; its default step is the model's dt (its step
+                        map's, or the step reduce recorded as the training
+                        step: --simulate's --dt, or --dt with --X), else 0.1,
+                        with a note when --dt differs from it;
      phgmg validate     reduce, then test full against reduced model on each
                         --test-input (exit 1 if one fails);
      phgmg info         describe a model file.
@@ -1038,7 +1046,11 @@
    s = z_i - z_j (j = -1: s = z_i) with force c1 s + c3 s^3 (1.7); e.g. cubic
    dampers on the velocities of a chain (tests/test_cli.sh builds one).
    `phgmg --help` lists every option with its default, the file formats and
-   examples. The reduction does not depend on the units of the states; GMG-QM's
+   examples. The log of a full-model simulation of a nonlinear model names
+   the Newton tolerance used (the default, 1e-10 relative to
+   max(1, |x|, |stage increment|), may leave outputs further than 1e-10 from
+   a converged solution -- 1e-6 on a nonlinear membrane model; --newton-tol
+   about 1e-13 times the states' size gives about 1e-10 there). The reduction does not depend on the units of the states; GMG-QM's
    lambda grid and the POD itself do (with ports of very different scale,
    scale the inputs and check each port's e_y with validate).
 
@@ -1083,10 +1095,11 @@
                                     least-squares problem (phgmg_lstsq; GMG-QM
                                     with lambda < 0 takes the minimum-norm
                                     solution instead)
-     PHGMG_ERR_DEGENERATE (-12)     GMG non-degeneracy fails: rcond(D^T G D)
-                                    below degeneracy_tol at xr = 0 or (GMG-QM)
-                                    at a snapshot; SP1/SP2 likewise
-                                    (info->rcond_dgd says how close)
+     PHGMG_ERR_DEGENERATE (-12)     GMG non-degeneracy fails: the measure of
+                                    D^T G D (8.9) below degeneracy_tol at
+                                    xr = 0 or (GMG-QM) at a snapshot; SP1/SP2:
+                                    rcond(V^T Vg) below it (info->rcond_dgd
+                                    says how close; 8.9 says what to change)
      PHGMG_ERR_NEGATIVE_WEIGHT (-13) DEIM gave a negative weight and
                                     hyper.allow_negative is 0
      PHGMG_ERR_FORMAT (-14)         a malformed model image or .npy file
@@ -1273,11 +1286,51 @@
    10^-2.5), e_proj of the linear GMG map at the same r. These choices are
    the examples' (examples/msd_models.h), not the library's.
 
-   8.9 Non-degeneracy. GMG needs det(D^T G D) != 0. phgmg estimates the
-   reciprocal condition number with the port columns of D scaled to unit
-   length, so the result does not depend on the units of B or of the states,
-   at xr = 0 and (GMG-QM) at every snapshot. Examples: R = 0 makes G skew, so
-   every odd r fails.
+   8.9 Non-degeneracy. GMG needs A = D^T G D (with a mass matrix E:
+   (E D)^T G (E D)) invertible: the reduced model is xr' = A^{-1} grad Hr + Bh u,
+   and the online stepper solves with A. What the check must guard follows
+   from two facts.
+   (a) The reduced coordinates are a choice. xr -> S xr (S invertible, here
+   diagonal) maps A to S A S and Qh to S Qh S and leaves the lifted trajectory
+   phi(xr(t)) and the outputs unchanged. The plain rcond(A) is not invariant:
+   POD columns have unit Euclidean length whatever the states' units, so a
+   state group in units s of the others moves rcond(A) by s^2, and a mass
+   matrix scaling like h^d (d the dimension, h the mesh width) moves it by
+   about h^(2d) relative to the port columns; the acoustic model of a
+   2-D mesh gave 1.6e-10 at N = 2e3 and 8.3e-14 at N = 1e5 for the same,
+   well-defined reduced model. So phgmg measures A in equilibrated
+   coordinates: S = diag(s_i), s_i powers of two (S A S is exact), chosen by
+   symmetric Ruiz sweeps until every row of S C S, C_ij = max(|a_ij|, |a_ji|),
+   has its largest entry in [1/2, 2) (a Jacobi scaling by the diagonal is not
+   possible: with R = 0 the diagonal of A is zero). Diagonal rescalings of
+   the reduced coordinates then change the measure by a small factor only,
+   and Gaussian elimination on S A S solves as accurately as its
+   conditioning allows (K = A^{-1} of a linear model is formed so, as
+   S (S A S)^{-1} S; the online solves of a quadratic model factor A(xr)
+   as stored, where partial pivoting sees the unscaled rows).
+   (b) Equilibration alone would accept a singular A: a direction of the
+   basis whose row and column of A vanish in exact arithmetic holds rounding
+   errors only, and scaling them up to order one makes a random, regular
+   matrix. The entries are computed as dot products d_i^T (G d_j), whose
+   rounding error is bounded by a multiple of the unit round-off times
+   Abar_ij = |d_i|^T |G d_j| (entrywise absolute values; invariant under
+   diagonal changes of the full state's units, as the dot product is). The
+   measure is therefore
+       rcond_dgd = 1 / (||(S A S)^{-1}||_1 ||S Abar S||_1)
+                 = rcond(S A S) ||S A S||_1 / ||S Abar S||_1  (<= rcond(S A S)),
+   the smallest relative change of A's entries, on the scale they were
+   computed at, that makes A singular. It falls to the unit round-off for a
+   rank-deficient A in any units and is independent of a diagonal scaling of
+   the states or of the reduced coordinates; for a discretized field, A and
+   Abar converge together under refinement, so the measure does not drift
+   with the mesh. degeneracy_tol = 1e-12 (about 4500 unit round-offs) then
+   refuses only what rounding cannot tell from singular. The measure is taken
+   at xr = 0 and (GMG-QM) at every snapshot, with the S and Abar of xr = 0
+   (the coordinates of the model). Examples: R = 0 makes G skew, so every odd
+   r fails; a basis containing a direction d with G d and G^T d orthogonal to
+   the basis fails for every r. When it fails: a smaller r, a basis from other
+   snapshots, or (only if the reduced model is known to be fine) a lower
+   degeneracy_tol (command line: --degeneracy-tol).
 
    8.10 Tiny numbers and the floating-point environment. The decaying tail of
    a wave through a chain at rest passes through the subnormal range, where
@@ -2362,7 +2415,12 @@ typedef struct phgmg_rom {
   const phgmg_real *w;    /* nd       weights (structure-preserving DEIM) */
   const phgmg_real *poly; /* (nphi or 1) x (poly_deg+1) coefficients of phi, constant first */
   /* precomputed GL3 step map (LINEAR, nd == 0; NULL if absent) for step dt:
-     x+ = Phi x + Gam u3, stage values Y = SX x + SU u3 (for the energy). */
+     x+ = Phi x + Gam u3, stage values Y = SX x + SU u3 (for the energy).
+     Without a step map dt may record the step the model was trained at
+     (0: unknown; phgmg_reduce leaves it 0, the command line's reduce sets it):
+     information for the caller, stored in the model file's header (every
+     format version has the field) and the C export; the steppers read it
+     only with Phi. */
   phgmg_real dt;
   const phgmg_real *Phi;  /* r x r    */
   const phgmg_real *Gam;  /* r x 3m   (u3 = [u(t+c1 h); u(t+c2 h); u(t+c3 h)]) */
@@ -2827,8 +2885,8 @@ typedef struct phgmg_select_opts {
   int per_decade;      /* grid points per decade, 1..100 (0: 4)                          */
   int folds;           /* REGRESSION: folds, >= 2 (0: 5)                                 */
   int blocks;          /* REGRESSION: contiguous time blocks, folds..ns (0: min(ns, 100))*/
-  double rcond;        /* conditioning guard, relative to rcond(D^T G D) at x = 0, in
-                          [0, 1] (0: 1e-6)                                               */
+  double rcond;        /* conditioning guard, relative to D^T G D's measure (manual 8.9)
+                          at x = 0, in [0, 1] (0: 1e-6)                                  */
   double tolerance;    /* VALIDATED: admissible e_y ratio to the linear limit, >= 1 and
                           finite (0: 1.02)                                               */
   int train_only;      /* VALIDATED: 1 = training runs only, no probe runs; 0 or 1      */
@@ -2869,8 +2927,9 @@ typedef struct phgmg_reduce_opts {
                             port coordinates; SP: 1..min(N, ns)), else PHGMG_ERR_SIZE     */
   double dt;             /* > 0: precompute the GL3 step map for this step (LINEAR map,
                             quadratic H; manual 2.2); 0: none; < 0, NaN, Inf: _INVALID_ARG */
-  double degeneracy_tol; /* least rcond of D^T G D at the snapshots (port columns at unit
-                            length), in [0, 1) (0: 1e-12); below: PHGMG_ERR_DEGENERATE   */
+  double degeneracy_tol; /* least non-degeneracy measure of D^T G D at the snapshots
+                            (manual 8.9: equilibrated, relative to its entries' rounding
+                            scale), in [0, 1) (0: 1e-12); below: PHGMG_ERR_DEGENERATE   */
   int nrun;              /* runs[0..nrun-1] (nrun <= 64): the runs that made X, laid   */
   const phgmg_run *runs; /* out as by phgmg_simulate_inputs (manual 4.1; columns summing
                             to ns, else _SIZE). 0/NULL: X is one run of an unknown input */
@@ -2897,8 +2956,8 @@ typedef struct phgmg_reduce_info {
                               DEIM; every term without hyper.on             */
   int deim_negative;       /* number of negative DEIM weights               */
   double deim_sigma_ratio; /* sigma_{nd+1}/sigma_1 of the nonlinear snapshots (0 if all kept) */
-  double rcond_dgd;        /* GMG: smallest rcond of D^T G D seen (at x = 0 and the
-                              snapshots; port columns of D at unit length, see
+  double rcond_dgd;        /* GMG: smallest non-degeneracy measure of D^T G D seen
+                              (at x = 0 and the snapshots; manual 8.9, compared with
                               degeneracy_tol). SP1/SP2: rcond of V^T Vg, the matrix
                               inverted for W (no D^T G D there)                   */
   double rcond_jr;         /* rcond of J - R                                  */
@@ -11485,7 +11544,7 @@ struct phgmg_study {
   int ldx, ns, N, m;
   double xx;               /* ||X||_F^2                                          */
   double *QB, *RB;         /* thin QR of B (N x m, m x m)                        */
-  double *Ua, *Ca, *CB, *Ta, *Gf, *Qf; /* GMG: POD of Xa = X - BB^+X (N x ka), Ua^T Xa,
+  double *Ua, *Ca, *CB, *Ta, *Gf, *Qf, *Gfa; /* GMG: POD of Xa = X - BB^+X (N x ka), Ua^T Xa,
                               QB^T X (m x ns), tails Ta[k] = sum_i ||(I - P_[QB, Ua_1..k]) x_i||^2
                               (ka + 1), [B, Ua]^T G [B, Ua] and [B, Ua]^T Q [B, Ua] ((m+ka)^2) */
   int ka;
@@ -11597,6 +11656,18 @@ PHGMG_DEF int phgmg_reduced_N(const phgmg_reduced *red) { return red ? red->N : 
 /* C (m x n) = A^T B with A: k x m, B: k x n (column-major, tight). */
 PHGMG__PRIV void phgmg__atb(int k, int m, int n, const double *A, const double *B, double *C) {
   phgmg_gemm('T', 'N', m, n, k, 1.0, A, k, B, k, 0.0, C, m);
+}
+/* C (m x n, ld ldc) = |A|^T |B| with A: k x m, B: k x n (tight): the scale
+   of A^T B's rounding errors. */
+PHGMG__PRIV void phgmg__atb_abs(int k, int m, int n, const double *A, const double *B, double *C, int ldc) {
+  int i, j, l;
+  for (j = 0; j < n; ++j)
+    for (i = 0; i < m; ++i) {
+      const double *a = A + (size_t)i * k, *b = B + (size_t)j * k;
+      double t = 0.0;
+      for (l = 0; l < k; ++l) t += fabs(a[l]) * fabs(b[l]);
+      C[i + (size_t)j * ldc] = t;
+    }
 }
 
 #ifndef PHGMG_POD_OVERSAMPLE
@@ -13329,6 +13400,11 @@ typedef struct phgmg__rctx {
   const double *Xf;
   int ldxf;
   double *Xc;
+  /* GMG non-degeneracy (manual 8.9): dgs the reduced coordinates' scaling
+     (r), dga = |D|^T |G D| the rounding scale of G00 (r x r, dga_ok = 1 once
+     computed), dgref = ||S dga S||_1 (0: unknown) */
+  double *dgs, *dga, dgref;
+  int dga_ok;
 } phgmg__rctx;
 
 PHGMG__PRIV void phgmg__rctx_free(phgmg__rctx *c) {
@@ -13345,6 +13421,8 @@ PHGMG__PRIV void phgmg__rctx_free(phgmg__rctx *c) {
   c->Uw = c->Cw = NULL;
   phgmg__free(c->alloc, c->Xc);
   c->Xc = NULL;
+  phgmg__free(c->alloc, c->dga);
+  c->dga = c->dgs = NULL;
   c->jr = NULL; c->Xa = c->lg = c->Tq = c->V2h = NULL; c->runcol = NULL;
   c->Bp_own = c->sepw_own = NULL; c->ef = NULL;
 }
@@ -14510,18 +14588,53 @@ PHGMG__PRIV double phgmg__rcond_inplace(int n, double *E, int *ip, double *work)
   return phgmg_lu_rcond(n, E, n, ip, anorm, work, ip + n);
 }
 
-/* The degeneracy check measures D^T G D with unit port columns: rows and
-   columns a < m of E (r x r) scaled by 1 / ||B_a|| -- the same invertibility,
-   but a condition independent of the units of B (B scaled by s while G
-   scales by 1/s^2, as for states in other units, would otherwise move rcond
-   by s^2 and fail a well-posed model). */
-PHGMG__PRIV void phgmg__dgd_unit_ports(const phgmg_reduced *red, double *E) {
-  const int r = red->r, m = red->m, N = red->N;
-  int a, i;
-  for (a = 0; a < m; ++a) {
-    const double nb = phgmg_normf(N, 1, red->sys->B + (size_t)a * N, N), f = nb > 0.0 ? 1.0 / nb : 1.0;
-    for (i = 0; i < r; ++i) { E[a + (size_t)i * r] *= f; E[i + (size_t)a * r] *= f; }
+/* The degeneracy check's scaling of the reduced coordinates (manual 8.9):
+   s (r powers of two, so S A S is exact) that equilibrates A = D^T G D by a
+   congruence: the symmetric Sinkhorn-Knopp iteration s <- sqrt(s ./ (C s)),
+   C_ij = max(|a_ij|, |a_ji|), towards unit row sums of S C S (Knight 2008;
+   a skew A has a zero diagonal, so no Jacobi scaling, and the max-norm
+   balance is not unique for an arrow-shaped A with a zero corner), until
+   every row sum is within 5 % of one or after 400 sweeps; then rounded to
+   powers of two. A zero row and column keeps 1. w: r doubles. */
+PHGMG__PRIV void phgmg__dgd_equilibrate(int r, const double *A, double *s, double *w) {
+  int i, j, it;
+  for (i = 0; i < r; ++i) s[i] = 1.0;
+  for (it = 0; it < 400; ++it) {
+    double dev = 0.0;
+    for (i = 0; i < r; ++i) {
+      double t = 0.0;
+      for (j = 0; j < r; ++j) t += PHGMG__MAX(fabs(A[i + (size_t)j * r]), fabs(A[j + (size_t)i * r])) * s[j];
+      w[i] = t;
+      if (t > 0.0 && t < HUGE_VAL) dev = PHGMG__MAX(dev, fabs(s[i] * t - 1.0));
+    }
+    if (dev < 0.05) break;
+    for (i = 0; i < r; ++i)
+      if (w[i] > 0.0 && w[i] < HUGE_VAL) s[i] = sqrt(s[i] / w[i]);
   }
+  for (i = 0; i < r; ++i) {
+    int e;
+    const double m = frexp(s[i], &e);   /* s = m 2^e, m in [1/2, 1) */
+    s[i] = s[i] > 0.0 && s[i] < HUGE_VAL ? ldexp(1.0, m < 0.70710678118654752 ? e - 1 : e) : 1.0;
+  }
+}
+
+/* E (r x r) <- S E S with the check's scaling c->dgs. */
+PHGMG__PRIV void phgmg__dgd_scale(const phgmg__rctx *c, double *E) {
+  const int r = c->red->r;
+  int i, j;
+  for (j = 0; j < r; ++j)
+    for (i = 0; i < r; ++i) E[i + (size_t)j * r] *= c->dgs[i] * c->dgs[j];
+}
+
+/* The non-degeneracy measure of E = S (D^T G D) S (r x r; destroyed by its
+   LU): rcond(E) ||E||_1 / max(||E||_1, ||S Abar S||_1), Abar = |D|^T |G D|
+   the entries' rounding scale (c->dgref, 0 if unknown): 1 / (||E^{-1}||_1
+   ||S Abar S||_1), the relative change of the entries, on the scale they were
+   computed at, that makes E singular. ip: 2r ints, wk: 2r. */
+PHGMG__PRIV double phgmg__dgd_measure(const phgmg__rctx *c, double *E, int *ip, double *wk) {
+  const int r = c->red->r;
+  const double an = phgmg_norm1(r, r, E, r), rc = phgmg__rcond_inplace(r, E, ip, wk);
+  return an > 0.0 && c->dgref > an ? rc * (an / c->dgref) : rc;
 }
 
 /* Smallest rcond of D^T G D over the snapshots (QUADRATIC kind); with the
@@ -14545,8 +14658,8 @@ PHGMG__PRIV phgmg_result phgmg__dgd_rcond_snapshots(phgmg__rctx *c, double stop_
       double rc_i;
       phgmg__eta_d(red, x2b + (size_t)i * ld2, NULL, Lp, NULL, red->rwork);
       phgmg__dgd_d(red, Lp, E, tmp);
-      phgmg__dgd_unit_ports(red, E);
-      rc_i = phgmg__rcond_inplace(r, E, ip, wk);
+      phgmg__dgd_scale(c, E);
+      rc_i = phgmg__dgd_measure(c, E, ip, wk);
       if (rc_i < *rmin) *rmin = rc_i;
       if (!(rc_i >= stop_below)) { j0 = c->ns; break; }
     }
@@ -14562,13 +14675,23 @@ PHGMG__PRIV phgmg_result phgmg__dgd_rcond_snapshots(phgmg__rctx *c, double stop_
    lambda (M -> 0 as lambda grows, and D^T G D -> G00). */
 PHGMG__PRIV double phgmg__dgd_rcond0(phgmg__rctx *c) {
   phgmg_reduced *red = c->red;
-  const size_t rr = (size_t)red->r * red->r;
-  double *E = phgmg__dalloc(c->alloc, rr), rc0;
-  if (!E) return -1.0;
+  const int r = red->r;
+  const size_t rr = (size_t)r * r;
+  double *E = phgmg__dalloc(c->alloc, rr + 2 * (size_t)r), rc0;
+  int *ip = phgmg__ialloc(c->alloc, 2 * (size_t)r);
+  if (!E || !ip) { phgmg__free(c->alloc, E); phgmg__free(c->alloc, ip); return -1.0; }
+  phgmg__dgd_equilibrate(r, red->G00, c->dgs, E);
+  c->dgref = 0.0;
+  if (c->dga_ok) {
+    memcpy(E, c->dga, rr * sizeof(double));
+    phgmg__dgd_scale(c, E);
+    c->dgref = phgmg_norm1(r, r, E, r);
+  }
   memcpy(E, red->G00, rr * sizeof(double));
-  phgmg__dgd_unit_ports(red, E);
-  rc0 = phgmg__rcond_of(red->r, E, c->alloc);
+  phgmg__dgd_scale(c, E);
+  rc0 = phgmg__dgd_measure(c, E, ip, E + rr);
   phgmg__free(c->alloc, E);
+  phgmg__free(c->alloc, ip);
   return rc0;
 }
 PHGMG__PRIV phgmg_result phgmg__check_degeneracy(phgmg__rctx *c) {
@@ -15138,6 +15261,8 @@ PHGMG__PRIV phgmg_result phgmg__study_gmg_blocks(phgmg__rctx *c) {
   phgmg_reduced *red = c->red;
   const int r = red->r, rn = red->rn, nf = red->m + c->st->ka;
   phgmg__subblock(r, r, c->st->Gf, nf, 0, 0, red->G00);
+  phgmg__subblock(r, r, c->st->Gfa, nf, 0, 0, c->dga);
+  c->dga_ok = 1;
   if (rn) {
     phgmg__subblock(r, rn, c->st->Gf, nf, 0, r, red->G01);
     phgmg__subblock(rn, r, c->st->Gf, nf, r, 0, red->G10);
@@ -15284,6 +15409,8 @@ PHGMG__PRIV phgmg_result phgmg__gmg_blocks_solve(phgmg__rctx *c) {
   }
   phgmg_jr_solve(c->jr, 'N', r + rn, GV, N);           /* GV = G [V0, V2] */
   phgmg__atb(N, r, r, L0, GV, red->G00);
+  phgmg__atb_abs(N, r, r, L0, GV, c->dga, r);
+  c->dga_ok = 1;
   if (rn) {
     phgmg__atb(N, r, rn, L0, GV + (size_t)N * r, red->G01);
     phgmg__atb(N, rn, r, L2, GV, red->G10);
@@ -15291,6 +15418,21 @@ PHGMG__PRIV phgmg_result phgmg__gmg_blocks_solve(phgmg__rctx *c) {
   }
   phgmg__free(c->alloc, GV);
   return PHGMG_OK;
+}
+
+/* K = G00^{-1} formed in the check's coordinates: S (S G00 S)^{-1} S (the
+   scaling is by powers of two, so only the pivoting sees it). */
+PHGMG__PRIV phgmg_result phgmg__inv_scaled(const phgmg__rctx *c, const double *A, double *K) {
+  const int r = c->red->r;
+  double *T = phgmg__dalloc(c->alloc, (size_t)r * r);
+  phgmg_result rc;
+  if (!T) return PHGMG_ERR_NOMEM;
+  memcpy(T, A, (size_t)r * r * sizeof(double));
+  phgmg__dgd_scale(c, T);
+  rc = phgmg__inv(r, T, K, c->alloc);
+  if (rc == PHGMG_OK) phgmg__dgd_scale(c, K);
+  phgmg__free(c->alloc, T);
+  return rc;
 }
 
 PHGMG__PRIV phgmg_result phgmg__stage_gmg_blocks(phgmg__rctx *c) {
@@ -15306,6 +15448,11 @@ PHGMG__PRIV phgmg_result phgmg__stage_gmg_blocks(phgmg__rctx *c) {
     red->G11 = phgmg__red_d(red, (size_t)rn * rn);
   }
   if (!red->G00 || !red->Bh || (rn && (!red->G01 || !red->G10 || !red->G11))) return PHGMG_ERR_NOMEM;
+  phgmg__free(c->alloc, c->dga);
+  c->dga = phgmg__dalloc(c->alloc, (size_t)r * r + (size_t)r);
+  if (!c->dga) return PHGMG_ERR_NOMEM;
+  c->dgs = c->dga + (size_t)r * r;
+  c->dga_ok = 0;
   rc = c->sf == PHGMG__SF_GMG ? phgmg__study_gmg_blocks(c) : phgmg__gmg_blocks_solve(c);
   if (rc != PHGMG_OK) return rc;
   for (j = 0; j < m; ++j) red->Bh[j + (size_t)j * r] = 1.0;
@@ -15313,7 +15460,7 @@ PHGMG__PRIV phgmg_result phgmg__stage_gmg_blocks(phgmg__rctx *c) {
   if (rc != PHGMG_OK || red->kind != PHGMG_ROM_LINEAR) return rc;
   red->K = phgmg__red_d(red, (size_t)r * r);
   if (!red->K) return PHGMG_ERR_NOMEM;
-  rc = phgmg__inv(r, red->G00, red->K, c->alloc);
+  rc = phgmg__inv_scaled(c, red->G00, red->K);
   return (rc == PHGMG_OK && (c->sys->ndamp || phgmg__has_feed(c->sys))) ? phgmg__gmg_dampers(c) : rc;
 }
 
@@ -16421,10 +16568,10 @@ PHGMG__PRIV phgmg_result phgmg__study_gmg(phgmg_study *st, int kmax, double *T, 
   double *V, *GV;
   phgmg_jr_factor *jr = NULL;
   phgmg_result rc;
-  st->Ua = phgmg__dalloc(alloc, (size_t)N * kmax + (size_t)kmax * ns + (size_t)m * ns + (size_t)kmax + 1 + 2 * nf * nf);
+  st->Ua = phgmg__dalloc(alloc, (size_t)N * kmax + (size_t)kmax * ns + (size_t)m * ns + (size_t)kmax + 1 + 3 * nf * nf);
   if (!st->Ua) return PHGMG_ERR_NOMEM;
   st->Ca = st->Ua + (size_t)N * kmax; st->CB = st->Ca + (size_t)kmax * ns; st->Ta = st->CB + (size_t)m * ns;
-  st->Gf = st->Ta + kmax + 1; st->Qf = st->Gf + nf * nf;
+  st->Gf = st->Ta + kmax + 1; st->Qf = st->Gf + nf * nf; st->Gfa = st->Qf + nf * nf;
   rc = phgmg_adjust_snapshots(N, m, st->sys->B, ns, st->X, st->ldx, T, N, alloc);
   if (rc == PHGMG_OK)
     rc = phgmg__study_pod(st, T, kmax, phgmg__rank_floor(N, ns, st->X, st->ldx), st->Ua, &st->ka, st->Ca, st->Ta, alloc);
@@ -16441,6 +16588,7 @@ PHGMG__PRIV phgmg_result phgmg__study_gmg(phgmg_study *st, int kmax, double *T, 
   if (rc == PHGMG_OK) {
     phgmg_jr_solve(jr, 'N', m + st->ka, GV, N);
     phgmg__atb(N, m + st->ka, m + st->ka, V, GV, st->Gf);
+    phgmg__atb_abs(N, m + st->ka, m + st->ka, V, GV, st->Gfa, m + st->ka);   /* rounding scale (8.9) */
     phgmg_ph_apply(st->sys, 'Q', m + st->ka, V, N, GV, N);
     phgmg__atb(N, m + st->ka, m + st->ka, V, GV, st->Qf);
   }

@@ -111,6 +111,8 @@ static const char *const help_lines[] = {
   "                      trajectory x(t_0), ..., x(t_n), normally starting at x = 0).\n",
   "                      Repeatable (up to 16): one training run per file, the runs'\n",
   "                      boundaries known to the reduction (--lambda cv folds).\n",
+  "                      --dt DT with --X: the snapshots' step, recorded in the model\n",
+  "                      (simulate-rom's default step).\n",
   "  --X-input KIND      the input that made each --X run (one per --X, same order;\n",
   "                      KIND as --input, sampled with --dt = the snapshots' step):\n",
   "                      --lambda auto then simulates the runs from their first\n",
@@ -123,7 +125,8 @@ static const char *const help_lines[] = {
   "  --simulate          instead of --X: simulate the full model from x0 = 0 with the\n",
   "                      3-stage Gauss-Legendre method (order 6) and use the steps+1\n",
   "                      states as snapshots. Options:\n",
-  "    --dt DT           step (default 0.1)\n",
+  "    --dt DT           step (default 0.1), recorded in the model as its training\n",
+  "                      step (simulate-rom's default)\n",
   "    --steps N         number of steps (default 1000), t in [0, N*DT]\n",
   "    --input KIND      sin (default): u(t) = AMP sin(t); with m > 1 ports each port\n",
   "                      at its own frequency, u_a(t) = AMP sin((1 + a/m) t) for\n",
@@ -134,7 +137,10 @@ static const char *const help_lines[] = {
   "    --amp AMP         amplitude (default 0.1)\n",
   "    --newton-tol T    Newton tolerance (stage residual, inf-norm, absolute) for\n",
   "                      nonlinear models (default: the library's, 1e-10 times\n",
-  "                      max(1, |x|, |stage increment|): follows large states)\n",
+  "                      max(1, |x|, |stage increment|): follows large states; the log\n",
+  "                      of a nonlinear model's simulation names the tolerance used.\n",
+  "                      For a reference accurate to about 1e-10 give about 1e-13\n",
+  "                      times the states' size)\n",
   "    --newton-iter K   Newton iteration cap per step (default 10)\n",
   "  --method M          gmg-pod: linear map phi(x) = [B, V] x, GMG reduction (paper 4.2.1)\n",
   "                      gmg-qm:  quadratic manifold phi(x) = [B, V1] x + V2 M (x2 kron x2)\n",
@@ -220,6 +226,11 @@ static const char *const help_lines[] = {
   "                      no Newton iteration at that step). Default: the --dt of\n",
   "                      --simulate, none with --X; 0 = none. A step map with spectral\n",
   "                      radius above 1 (an amplifying step) is refused.\n",
+  "  --degeneracy-tol T  gmg: least non-degeneracy measure of D^T G D (the reduced\n",
+  "                      model's operator, measured in equilibrated coordinates against\n",
+  "                      the rounding of its entries, so independent of units and mesh;\n",
+  "                      reported as rcond(D^T G D)); sp1/sp2: least rcond of V^T W.\n",
+  "                      Below it the reduction is refused. Default 1e-12; 0 < T < 1.\n",
   "  --out DIR           output directory (required); created if missing, before\n",
   "                      any work (and removed again if the run fails); a file is\n",
   "                      created and removed there first to see that it is writable.\n",
@@ -283,14 +294,18 @@ static const char *const help_lines[] = {
   "  --out FILE          output .npy (required)\n",
   "  --states FILE       also write the reduced states (r x (steps+1)); written together\n",
   "                      with --out: both or neither\n",
-  "  --dt DT             step (default: the model's step-map DT if it has one, else 0.1)\n",
+  "  --dt DT             step (default: the model's step-map DT if it has one, else the\n",
+  "                      step it was trained at (reduce records --simulate's --dt, the\n",
+  "                      --dt of --X with --X-input, or --dt given with --X), else 0.1;\n",
+  "                      a note on stderr when --dt differs from the model's)\n",
   "  --steps N, --input KIND, --amp AMP, --newton-tol T, --newton-iter K:  as above\n",
   "  --quiet             no progress lines\n",
   "\n",
   "COMMAND info MODEL\n",
-  "  Prints the sizes of a .phgmgrom file and the bytes of stepper memory its\n",
-  "  firmware needs (phgmg_rom_stepper_memsize; with a step map also the bytes for\n",
-  "  stepping with another dt, phgmg_rom_stepper_memsize_dt).\n",
+  "  Prints the sizes of a .phgmgrom file, its step map's or training dt, and the\n",
+  "  bytes of stepper memory its firmware needs (phgmg_rom_stepper_memsize; with a\n",
+  "  step map also the bytes for stepping with another dt,\n",
+  "  phgmg_rom_stepper_memsize_dt).\n",
   "\n",
   "SPARSE MATRICES\n",
   "  SPEC is one (nnz, 3) array of rows (row, col, value), or three vectors\n",
@@ -679,6 +694,20 @@ static void note(const char *fmt, ...) {
   vfprintf(stderr, fmt, ap);
   va_end(ap);
   fputc('\n', stderr);
+}
+
+/* The Newton tolerance a full-model simulation used, in the log: for a
+   nonlinear model or dampers (a linear model's stage systems are solved to
+   round-off in one update), with the way to tighten it. */
+static void progress_newton_tol(const phgmg_ph_system *sys, double tol, const phgmg_gl3_stats *st) {
+  if (sys->nl == PHGMG_NL_NONE && sys->ndamp == 0) return;
+  if (tol > 0.0)
+    progress("  Newton tolerance %g (absolute, --newton-tol); largest final stage residual %.2g", tol,
+             st->max_residual);
+  else
+    progress("  Newton tolerance: the default, 1e-10 x max(1, |x|, |stage increment|) per step (largest final "
+             "stage residual %.2g); for a reference accurate to about 1e-10 give --newton-tol about 1e-13 "
+             "times the states' size", st->max_residual);
 }
 
 /* Say so when an input file ends before a run of length t_end: past its last
@@ -1275,7 +1304,9 @@ typedef struct reduce_args {
   const char *expf, *potential, *hyper;
   double hyper_tol;
   int simulate, steps, r, rn, no_deim, deim_max, deim_neg, save_snap, have_dt_map, newton_iter;
+  int have_dt;                  /* --dt given (with --X alone: the snapshots' step) */
   double dt, amp, lambda, deim_tol, dt_map, newton_tol;
+  double degeneracy_tol;        /* --degeneracy-tol (0: the library's default) */
   int have_lambda;
   int lambda_auto;              /* --lambda auto (1) / cv (2) */
   int manifold;                 /* --manifold pod (0) / greedy (1) / altmin (2) */
@@ -1480,6 +1511,7 @@ static int parse_reduce(int argc, char **argv, reduce_args *A) {
     else if (!strcmp(o, "--dt")) {
       if (!(v = optval(argc, argv, &i)) || !parse_double(o, v, 0.0, &A->dt)) return 2;
       if (!(A->dt > 0.0)) return usage_error("--dt must be > 0");
+      A->have_dt = 1;
     }
     else if (!strcmp(o, "--lambda")) {
       if (!(v = optval(argc, argv, &i))) return 2;
@@ -1519,6 +1551,11 @@ static int parse_reduce(int argc, char **argv, reduce_args *A) {
     else if (!strcmp(o, "--dt-map")) {
       if (!(v = optval(argc, argv, &i)) || !parse_double(o, v, 0.0, &A->dt_map) || real_bad(o, v, A->dt_map)) return 2;
       A->have_dt_map = 1;
+    }
+    else if (!strcmp(o, "--degeneracy-tol")) {
+      if (!(v = optval(argc, argv, &i)) || !parse_double(o, v, 0.0, &A->degeneracy_tol)) return 2;
+      if (!(A->degeneracy_tol > 0.0 && A->degeneracy_tol < 1.0))
+        return usage_error("--degeneracy-tol: expected a number with 0 < T < 1, got '%s'", v);
     }
     else if (!strcmp(o, "--simulate")) A->simulate = 1;
     else if (!strcmp(o, "--no-deim") || !strcmp(o, "--no-hyper")) A->no_deim = 1;
@@ -2619,6 +2656,7 @@ static int simulate_training_runs(const reduce_args *A, reduce_state *S, const d
                   rc == PHGMG_ERR_NOT_CONVERGED ? " (try a smaller --dt or more --newton-iter)" : "");
     }
     progress("  done (%ld Newton iterations, %ld factorizations)", st.newton_iters, st.factorizations);
+    progress_newton_tol(&S->sys, A->newton_tol, &st);
     memset(&S->runs[i], 0, sizeof S->runs[i]);
     S->runs[i].u = input_fn; S->runs[i].user = in; S->runs[i].dt = A->dt; S->runs[i].nsteps = A->steps;
   }
@@ -2703,6 +2741,7 @@ static int run_reduction(const reduce_args *A, reduce_state *S, int method, cons
   o.ref = A->ref;
   o.ref_x = A->ref == PHGMG_REF_GIVEN ? S->refm.a : NULL;
   o.qm.greedy_window = A->greedy_window;
+  o.degeneracy_tol = A->degeneracy_tol;   /* 0: the library's 1e-12 */
   if (S->nrun > 0) { o.nrun = S->nrun; o.runs = S->runs; } /* --simulate: the runs are known */
   if (A->lambda_auto == 1) { o.select.newton_tol = A->newton_tol; o.select.newton_iter = A->newton_iter; }
   memset(&info, 0, sizeof info);
@@ -2721,7 +2760,16 @@ static int run_reduction(const reduce_args *A, reduce_state *S, int method, cons
                     S->dae ? ": the differential states" : "");
       case PHGMG_ERR_RANK: return explain_rank(A, S, method, src);
       case PHGMG_ERR_DEGENERATE:
-        return fail("reduction failed: %s (try another --r, or for gmg-qm a larger --lambda)", phgmg_result_string(rc));
+        if (method == PHGMG_METHOD_SP1 || method == PHGMG_METHOD_SP2)
+          return fail("reduction failed: %s: rcond(V^T W) = %.3g is below --degeneracy-tol %g (try another --r or "
+                      "more varied snapshots)", phgmg_result_string(rc), info.rcond_dgd,
+                      A->degeneracy_tol > 0.0 ? A->degeneracy_tol : 1e-12);
+        return fail("reduction failed: %s: D^T G D's non-degeneracy measure %.3g is below --degeneracy-tol %g. "
+                    "Try another --r (with R = 0, an even --r), snapshots that excite more of the model, %s"
+                    "or, only if the reduced model is known to be fine, a smaller --degeneracy-tol (down to "
+                    "about 1e-15; below, D^T G D is singular to rounding)", phgmg_result_string(rc),
+                    info.rcond_dgd, A->degeneracy_tol > 0.0 ? A->degeneracy_tol : 1e-12,
+                    method == PHGMG_METHOD_GMG_QM ? "a larger --lambda, " : "");
       case PHGMG_ERR_STEP_MAP:
         return fail("reduction failed: --dt-map %g: %s (or --dt-map 0: none)", A->dt_map, phgmg_result_string(rc));
       case PHGMG_ERR_TOL_UNREACHABLE:
@@ -2854,6 +2902,7 @@ static void json_snapshots(FILE *jf, const reduce_args *A, int ns, double t_sim)
       for (i = 0; i < A->nxin; ++i) { if (i) fprintf(jf, ", "); json_str(jf, A->xin[i]); }
       fprintf(jf, "], \"dt\": "); json_num(jf, A->dt);
     }
+    else if (A->have_dt) { fprintf(jf, ", \"dt\": "); json_num(jf, A->dt); }
   }
   else {
     fprintf(jf, "\"simulate\": {\"dt\": "); json_num(jf, A->dt);
@@ -2951,6 +3000,7 @@ static int write_json(const reduce_args *A, reduce_state *S, int method, int ns,
   fprintf(jf, ", \"rcond_jr\": "); json_num(jf, info->rcond_jr);
   if (o->method != PHGMG_METHOD_SP1 && o->method != PHGMG_METHOD_SP2) { /* GMG only */
     fprintf(jf, ", \"rcond_dgd\": "); json_num(jf, info->rcond_dgd);
+    fprintf(jf, ", \"degeneracy_tol\": "); json_num(jf, A->degeneracy_tol > 0.0 ? A->degeneracy_tol : 1e-12);
   }
   if (o->hyper.on && A->poly_idx) { /* the hyper-reduction's result */
     fprintf(jf, ", \"hyper\": {\"method\": ");
@@ -2981,12 +3031,18 @@ static int write_json(const reduce_args *A, reduce_state *S, int method, int ns,
 
 /* The model file, its C source and the json record (written last: it lists
    the arrays); then every output of this run moves into place. */
+/* The step the snapshots were taken at: --simulate's, the --X-input runs', or
+   --dt given with --X; 0 if unknown. */
+static double train_dt(const reduce_args *A) { return A->simulate || A->nxin || A->have_dt ? A->dt : 0.0; }
+
 static int write_model_files(const reduce_args *A, reduce_state *S, int method, int ns, double t_sim, double t_red,
                              const phgmg_reduce_opts *o, const phgmg_reduce_info *info, const outlist *ol) {
-  const phgmg_rom *rom = phgmg_reduced_rom(S->red);
+  phgmg_rom rs = *phgmg_reduced_rom(S->red);
+  const phgmg_rom *rom = &rs;
   phgmg_result rc;
   char path[4096 + 256];
   const char *wp;
+  if (!rs.Phi) rs.dt = (phgmg_real)train_dt(A);   /* no step map: dt records the training step */
   snprintf(path, sizeof path, "%s/%s.phgmgrom", A->out, A->name);
   if (!(wp = stage_path(&S->sg, path))) return 1;
   rc = phgmg_rom_save(rom, wp);
@@ -3194,6 +3250,40 @@ static int parse_simulate_rom(int argc, char **argv, simrom_args *P) {
   return 0;
 }
 
+/* simulate-rom's step: --dt, else the model's dt (its step map's, or the
+   step it was trained at), else 0.1; a note when they differ or the model
+   records none. 0 (never fails). */
+/* The shortest decimal (as a double) that the build's phgmg_real rounds to v:
+   a float build's 0.02f reads back as 0.02, as the user wrote it. */
+static double real_decimal(phgmg_real v) {
+  char b[40];
+  int p;
+  for (p = 6; p <= 17; ++p) {
+    double d;
+    snprintf(b, sizeof b, "%.*g", p, (double)v);
+    d = strtod(b, NULL);
+    if ((phgmg_real)d == v) return d;
+  }
+  return (double)v;
+}
+
+static int simrom_dt(const phgmg_rom *rom, int have_dt, double *dt) {
+  const double mdt = real_decimal(rom->dt);
+  const int what_ok = rom->Phi != NULL;
+  const char *what = what_ok ? "step map's" : "training";
+  if (!have_dt) {
+    *dt = mdt > 0.0 ? mdt : 0.1;
+    if (!(mdt > 0.0))
+      note("the model records no training step: stepping at dt = 0.1; give the --dt of its training run");
+    return 0;
+  }
+  if (mdt > 0.0 && fabs(*dt - mdt) > 1e-6 * mdt)
+    note("--dt %g differs from the model's %s dt %g%s", *dt, what, mdt,
+         what_ok ? " (the stepper then solves each step instead of applying the map)"
+                 : " (a model follows its full model best at the step it was trained at)");
+  return 0;
+}
+
 static int cmd_simulate_rom(int argc, char **argv) {
   simrom_args P;
   const char *model, *out, *states, *inspec;
@@ -3228,7 +3318,7 @@ static int cmd_simulate_rom(int argc, char **argv) {
   if (check_out_file(out, "--out") || (states && check_out_file(states, "--states"))) goto done;
   g_inputs = &pin;
   if (load_model(model, "--model", &rom, &block)) goto done;
-  if (!have_dt) dt = rom.Phi ? (double)rom.dt : 0.1;
+  if (simrom_dt(&rom, have_dt, &dt)) goto done;
   if (too_big(((double)rom.m + (states ? (double)rom.r : 0.0)) * ((double)steps + 1.0),
               "--steps: the outputs (m x (steps+1), states r x (steps+1))")) {
     status = 2;
@@ -3393,6 +3483,7 @@ static int cmd_simulate(int argc, char **argv) {
   }
   progress("  done in %.3f s (%ld Newton iterations, %ld factorizations)", now_s() - t0, st.newton_iters,
            st.factorizations);
+  progress_newton_tol(&S.full, A.newton_tol, &st);
   if (X && S.sp) { /* states back into the user's ordering */
     XU = (double *)malloc(sizeof(double) * (size_t)N * ((size_t)A.steps + 1));
     if (!XU) { fail("out of memory"); goto out; }
@@ -3422,16 +3513,16 @@ static int cmd_info(int argc, char **argv) {
   if (rom.kind == PHGMG_ROM_QUADRATIC) printf(", r_n = %d", rom.rn);
   if (rom.nd) printf(", %d nonlinear terms (polynomial degree %d, %d exponentials%s)", rom.nd, rom.poly_deg, rom.nexp,
                      rom.nphi > 1 ? ", one function per term" : "");
-  if (rom.Phi) {
+  if (rom.Phi || rom.dt > 0) {
     char buf[32];
-    printf(", step map for dt = %s", real_str(rom.dt, buf));
+    printf(rom.Phi ? ", step map for dt = %s" : ", trained at dt = %s", num_str(real_decimal(rom.dt), buf));
   }
   if (rom.ndamp) printf(", %d nonlinear dampers (force law degree %d)", rom.ndamp, rom.damp_deg);
   if (rom.PD) printf(", feedthrough (S + N, %d x %d)", rom.m, rom.m);
   if (rom.PD)
     printf("\nfeedthrough: the output y of phgmg_rom_step and phgmg_rom_output leaves out (S + N) u; firmware "
-           "adds (S + N) u(t) itself, S + N the last %d x %d block of the model's PD = [Ph; S + N] "
-           "(simulate-rom does)", rom.m, rom.m);
+           "adds (S + N) u(t) (phgmg_rom_output_u does), S + N the last %d x %d block of the model's PD = "
+           "[Ph; S + N] (simulate-rom adds it)", rom.m, rom.m);
   if (rom.ndamp)
     printf("\ndampers: the model keeps all %d (each evaluation of the reduced forces costs O(%d r)); "
            "phgmg_rom_step applies them", rom.ndamp, rom.ndamp);

@@ -15,6 +15,7 @@
 #include "test_defects.c"
 #include "test_defects3.c"
 #include "test_defects4.c"
+#include "test_degen.c"
 #include "test_deploy.c"
 #include "test_descriptor.c"
 #include "test_dissip.c"
