@@ -1872,6 +1872,7 @@ typedef struct phgmg_ph_sparse_info {
   int supernodes;     /* supernodes of the sparse factor (0: not analysed)     */
   int front_max;      /* largest dense front (order)                           */
   int condensed;      /* states eliminated first by block elimination (manual 8.12) */
+  int colperm;        /* columns moved by the pivot matching of a descriptor model (manual 8.12) */
   int band_copy;      /* 1: the object holds band copies of J, R, Q (and E) (band solver) */
   double bytes;       /* memory the object holds now (its arrays, the analysis)   */
 } phgmg_ph_sparse_info;
@@ -1996,6 +1997,11 @@ typedef struct phgmg_gl3_opts {
 typedef struct phgmg_gl3_stats {
   long steps, newton_iters, factorizations, rhs_evals, failures;
   double max_residual;  /* largest final stage residual over the steps */
+  /* The stage-matrix solver (manual 8.12): sparse_lu = 1 while the stepper
+     solves with the sparse LU; band_fallback = 1 once its checked static
+     pivots failed and it switched to the band LU with partial pivoting for
+     the rest of its life (slower, O(N kb) memory: sparse_lu is then 0). */
+  int sparse_lu, band_fallback;
 } phgmg_gl3_stats;
 
 /* Energy bookkeeping of one run, per grid point n = 0..nsteps:
@@ -5920,6 +5926,7 @@ typedef struct phgmg__spsym {
   int *ca_p, *ca_i, *ca_k;        /* column a of K: rows, Mx indices   */
   int *ra_p, *ra_i, *ra_k;        /* row a of K: columns, Mx indices   */
   int *perm;                      /* fill position k: internal perm[k] */
+  int *cperm;                     /* factored column j = column cperm[j] of K (NULL: identity) */
   int nsup;
   int *sfirst, *sparent, *scp, *sch, *srp, *srow; /* sch[scp[s]..scp[s+1]): children, last first */
   size_t *lptr;                   /* factor offsets (scalars)          */
@@ -5935,7 +5942,7 @@ PHGMG__PRIV void phgmg__spsym_free(const phgmg_allocator *al, phgmg__spsym *S) {
   phgmg__free(al, S->q_p); phgmg__free(al, S->q_i); phgmg__free(al, S->q_x);
   phgmg__free(al, S->kex);
   if (S->f_p != S->k_p) { phgmg__free(al, S->f_p); phgmg__free(al, S->f_i); }
-  phgmg__free(al, S->k_p); phgmg__free(al, S->k_i); phgmg__free(al, S->perm);
+  phgmg__free(al, S->k_p); phgmg__free(al, S->k_i); phgmg__free(al, S->perm); phgmg__free(al, S->cperm);
   phgmg__free(al, S->f_d); phgmg__free(al, S->fidx); phgmg__free(al, S->bpos);
   phgmg__free(al, S->aidx); phgmg__free(al, S->ad_k);
   phgmg__free(al, S->ca_p); phgmg__free(al, S->ca_i); phgmg__free(al, S->ca_k);
@@ -6005,7 +6012,8 @@ PHGMG__PRIV phgmg_result phgmg__band_to_csc(int n, int kb, const double *M1, con
 }
 
 /* Pattern of M = (J - R) Q plus (J - R) plus the diagonal (and E's pattern
-   for a descriptor model), CSC, sorted rows. */
+   for a descriptor model), CSC, sorted rows; with a column permutation
+   (S->cperm) of K P: column j from column cperm[j] of M and E, plus (j, j). */
 PHGMG__PRIV phgmg_result phgmg__spsym_kpattern(phgmg__spsym *S, const phgmg_allocator *al) {
   int n = S->n, j, p, q, nz = 0, pass;
   int *mark = phgmg__ialloc(al, (size_t)n);
@@ -6016,13 +6024,14 @@ PHGMG__PRIV phgmg_result phgmg__spsym_kpattern(phgmg__spsym *S, const phgmg_allo
     for (j = 0; j < n; ++j) mark[j] = -1;
     nz = 0;
     for (j = 0; j < n; ++j) {
+      const int c = S->cperm ? S->cperm[j] : j; /* column c of K (manual 8.12: column permutation) */
       int start = nz;
       if (pass) S->k_p[j] = nz;
 #define PHGMG__KP_ADD(r) do { int r_ = (r); if (mark[r_] != j) { mark[r_] = j; if (pass) S->k_i[nz] = r_; ++nz; } } while (0)
       PHGMG__KP_ADD(j);
-      for (p = S->jr_p[j]; p < S->jr_p[j + 1]; ++p) PHGMG__KP_ADD(S->jr_i[p]);
-      if (S->e_p) for (p = S->e_p[j]; p < S->e_p[j + 1]; ++p) PHGMG__KP_ADD(S->e_i[p]);
-      for (q = S->q_p[j]; q < S->q_p[j + 1]; ++q) {
+      for (p = S->jr_p[c]; p < S->jr_p[c + 1]; ++p) PHGMG__KP_ADD(S->jr_i[p]);
+      if (S->e_p) for (p = S->e_p[c]; p < S->e_p[c + 1]; ++p) PHGMG__KP_ADD(S->e_i[p]);
+      for (q = S->q_p[c]; q < S->q_p[c + 1]; ++q) {
         int k = S->q_i[q];
         for (p = S->jr_p[k]; p < S->jr_p[k + 1]; ++p) PHGMG__KP_ADD(S->jr_i[p]);
       }
@@ -6047,9 +6056,10 @@ PHGMG__PRIV phgmg_result phgmg__spsym_kex(phgmg__spsym *S, const phgmg_allocator
   if (!S->kex) return PHGMG_ERR_NOMEM;
   S->emax = 0.0;
   for (j = 0; j < S->n; ++j) {
+    const int c = S->cperm ? S->cperm[j] : j;
     q = S->k_p[j];
     for (p = q; p < S->k_p[j + 1]; ++p) S->kex[p] = 0.0;
-    for (p = S->e_p[j]; p < S->e_p[j + 1]; ++p) { /* both columns sorted */
+    for (p = S->e_p[c]; p < S->e_p[c + 1]; ++p) { /* both columns sorted */
       while (S->k_i[q] < S->e_i[p]) ++q;
       S->kex[q] += S->e_x[p];
       S->emax = PHGMG__MAX(S->emax, fabs(S->e_x[p]));
@@ -6299,8 +6309,8 @@ PHGMG__PRIV phgmg_result phgmg__sp_condense_select(phgmg__spsym *S, const int *g
   S->bpos = phgmg__ialloc(al, (size_t)n + 1);
   if (!q || !st || !S->aidx || !S->fidx || !S->bpos) goto done;
   for (v = 0; v < n; ++v) st[v] = 0; /* 0 unseen, 1 queued, 2 chosen, 3 blocked */
-  for (v = 0; S->e_p && v < n; ++v) /* E couples v to another state: not condensed (real couplings) */
-    for (p = S->e_p[v]; p < S->e_p[v + 1]; ++p)
+  for (v = 0; S->e_p && v < n; ++v) /* E (E P) couples v to another state: not condensed (real couplings) */
+    for (p = S->e_p[S->cperm ? S->cperm[v] : v]; p < S->e_p[(S->cperm ? S->cperm[v] : v) + 1]; ++p)
       if (S->e_i[p] != v && S->e_x[p] != 0.0) { st[v] = st[S->e_i[p]] = 4; }
   for (r = 0; r < n; ++r) {
     if (st[r]) continue;
@@ -6500,7 +6510,7 @@ PHGMG__PRIV double phgmg__spsym_bytes(const phgmg__spsym *S) {
   double b = (2.0 * n + 2.0) * I + (double)(S->jr_p[S->n] + S->q_p[S->n]) * (I + sizeof(double));
   b += (double)S->k_p[S->n] * I + (n + 1.0) * I;
   if (S->f_p != S->k_p) b += (double)S->f_p[S->nf] * I + (nf + 1.0) * I;
-  b += (4.0 * n + nf + 3.0 * na) * I;
+  b += (4.0 * n + nf + 3.0 * na + (S->cperm ? n : 0.0)) * I;
   if (S->na) b += 2.0 * (double)(S->ca_p[S->na] + S->ra_p[S->na]) * I;
   b += (double)S->nsup * (6.0 * I + sizeof(size_t)) + (double)(S->srp ? S->srp[S->nsup] : 0) * I;
   if (S->amp) b += (double)S->amp[S->nsup] * (I + sizeof(size_t));
@@ -6834,9 +6844,22 @@ PHGMG__PRIV void phgmg__sp_solve_f(const phgmg__spsym *S, const phgmg__spnum *F,
   }
 }
 
+/* x <- P x: the solution y of (K P) y = b back to that of K x = b,
+   x[cperm[j]] = y[j] (F's solve scratch). */
+PHGMG__PRIV void phgmg__sp_unpermute(const phgmg__spsym *S, const phgmg__spnum *F, double *x) {
+  const int w = F->cplx ? 2 : 1;
+  int j;
+  memcpy(F->y, x, sizeof(double) * (size_t)w * (size_t)S->n);
+  for (j = 0; j < S->n; ++j) {
+    x[w * S->cperm[j]] = F->y[w * j];
+    if (w == 2) x[2 * S->cperm[j] + 1] = F->y[2 * j + 1];
+  }
+}
+
 /* x <- K^{-1} x: with a condensed block, u_a = x_a / K(a, a), x_b -= K_ba u_a,
-   the Schur complement's solve, x_a = u_a - K_ab x_b / K(a, a). */
-PHGMG__PRIV void phgmg__sp_solve(const phgmg__spsym *S, const phgmg__spnum *F, double *x) {
+   the Schur complement's solve, x_a = u_a - K_ab x_b / K(a, a); with a
+   column permutation the solve of K P, then x <- P x. */
+PHGMG__PRIV void phgmg__sp_solve_k(const phgmg__spsym *S, const phgmg__spnum *F, double *x) {
   int t, q;
   if (F->cplx) {
     for (t = 0; t < S->na; ++t) {
@@ -6874,21 +6897,26 @@ PHGMG__PRIV void phgmg__sp_solve(const phgmg__spsym *S, const phgmg__spnum *F, d
     }
   }
 }
+PHGMG__PRIV void phgmg__sp_solve(const phgmg__spsym *S, const phgmg__spnum *F, double *x) {
+  phgmg__sp_solve_k(S, F, x);
+  if (S->cperm) phgmg__sp_unpermute(S, F, x);
+}
 
-/* Values of M = -(J - R)(Q + diag(dd)) (dd may be NULL) in the k pattern,
-   with a dense scratch w (n). */
+/* Values of M = -(J - R)(Q + diag(dd)) (dd may be NULL) in the k pattern
+   (M P with a column permutation), with a dense scratch w (n). */
 PHGMG__PRIV void phgmg__sp_stage_values(const phgmg__spsym *S, const double *dd, double *Mx, double *w) {
   int n = S->n, j, p, q;
   for (j = 0; j < n; ++j) w[j] = 0.0;
   for (j = 0; j < n; ++j) {
-    double dj = dd ? dd[j] : 0.0;
-    for (q = S->q_p[j]; q < S->q_p[j + 1]; ++q) {
+    const int c = S->cperm ? S->cperm[j] : j; /* column c of M */
+    double dj = dd ? dd[c] : 0.0;
+    for (q = S->q_p[c]; q < S->q_p[c + 1]; ++q) {
       int k = S->q_i[q];
       double v = S->q_x[q];
       for (p = S->jr_p[k]; p < S->jr_p[k + 1]; ++p) w[S->jr_i[p]] -= S->jr_x[p] * v;
     }
     if (dj != 0.0)
-      for (p = S->jr_p[j]; p < S->jr_p[j + 1]; ++p) w[S->jr_i[p]] -= S->jr_x[p] * dj;
+      for (p = S->jr_p[c]; p < S->jr_p[c + 1]; ++p) w[S->jr_i[p]] -= S->jr_x[p] * dj;
     for (p = S->k_p[j]; p < S->k_p[j + 1]; ++p) { Mx[p] = w[S->k_i[p]]; w[S->k_i[p]] = 0.0; }
   }
 }
@@ -7155,6 +7183,139 @@ struct phgmg_ph_sparse {
   phgmg_ph_sparse_info inf;
 };
 
+/* Column permutation for the static pivots of a descriptor model (manual
+   8.12): a matching of rows to columns of E that maximises the product of
+   the matched magnitudes (a weighted bipartite matching, as MC64 does):
+   cost c(i, j) = log max_k |E(k, j)| - log |E(i, j)| >= 0 over the nonzero
+   entries, duals u (rows) and v (columns) from the row and column minima, a
+   greedy start on the edges of zero reduced cost, then one Dijkstra search
+   of shortest augmenting paths per unmatched column (binary heap). The
+   factored matrix is K P: its column j is column cperm[j] of K, so that
+   E(j, cperm[j]) sits on its diagonal. For a symmetric positive definite E
+   (a mass matrix) the identity is the unique optimum (|E(i, j)|^2 <
+   E(i, i) E(j, j)); for one with its columns permuted, the inverse of that
+   permutation. Returns 1 (a matching other than the identity, in cperm),
+   0 (the identity is optimal, or E has no perfect matching: structurally
+   singular; the static pivots then decide), -1 out of memory. */
+typedef struct phgmg__mt {
+  int n, *rmate, *cmate, *heap, *hpos, *pred, *done, nd;
+  double *u, *v, *d;
+} phgmg__mt;
+
+PHGMG__PRIV void phgmg__mt_up(phgmg__mt *m, int k) {
+  int r = m->heap[k];
+  while (k > 0) {
+    int p = (k - 1) / 2, q = m->heap[p];
+    if (!(m->d[q] > m->d[r])) break;
+    m->heap[k] = q; m->hpos[q] = k; k = p;
+  }
+  m->heap[k] = r; m->hpos[r] = k;
+}
+PHGMG__PRIV int phgmg__mt_pop(phgmg__mt *m, int *len) {
+  int top = m->heap[0], r, k = 0;
+  m->hpos[top] = -2;
+  if (--*len == 0) return top;
+  r = m->heap[*len];
+  for (;;) {
+    int c = 2 * k + 1;
+    if (c >= *len) break;
+    if (c + 1 < *len && m->d[m->heap[c + 1]] < m->d[m->heap[c]]) ++c;
+    if (!(m->d[m->heap[c]] < m->d[r])) break;
+    m->heap[k] = m->heap[c]; m->hpos[m->heap[k]] = k; k = c;
+  }
+  m->heap[k] = r; m->hpos[r] = k;
+  return top;
+}
+
+/* One shortest augmenting path from the free column j0 (reduced costs
+   c - u - v, w[p] = c of entry p); 1 augmented, 0 none. */
+PHGMG__PRIV int phgmg__mt_augment(phgmg__mt *m, const int *cp, const int *ci, const double *w, int j0) {
+  int len = 0, p, i, j, found = -1, t;
+  double D = 0.0;
+  m->nd = 0;
+  for (j = j0;;) { /* relax the entries of column j, reached at distance dj */
+    const double dj = j == j0 ? 0.0 : m->d[m->cmate[j]];
+    for (p = cp[j]; p < cp[j + 1]; ++p) {
+      double nd;
+      i = ci[p];
+      if (w[p] < 0.0 || m->hpos[i] == -2) continue;
+      nd = dj + PHGMG__MAX(0.0, w[p] - m->u[i] - m->v[j]);
+      if (m->hpos[i] == -1) { m->d[i] = nd; m->pred[i] = j; m->heap[len] = i; m->hpos[i] = len++; phgmg__mt_up(m, len - 1); }
+      else if (nd < m->d[i]) { m->d[i] = nd; m->pred[i] = j; phgmg__mt_up(m, m->hpos[i]); }
+    }
+    if (len == 0) break;
+    i = phgmg__mt_pop(m, &len);
+    m->done[m->nd++] = i;
+    if (m->rmate[i] < 0) { found = i; D = m->d[i]; break; }
+    j = m->rmate[i];
+  }
+  for (t = 0; t < len; ++t) m->hpos[m->heap[t]] = -1;
+  if (found < 0) { for (t = 0; t < m->nd; ++t) m->hpos[m->done[t]] = -1; return 0; }
+  m->v[j0] += D;
+  for (t = 0; t < m->nd; ++t) { /* duals: the path's edges tight, every reduced cost >= 0 */
+    i = m->done[t];
+    m->hpos[i] = -1;
+    if (i == found) continue;
+    m->u[i] -= D - m->d[i];
+    m->v[m->rmate[i]] += D - m->d[i];
+  }
+  for (i = found; i >= 0;) { /* flip the path */
+    j = m->pred[i];
+    t = m->cmate[j];
+    m->cmate[j] = i; m->rmate[i] = j;
+    i = j == j0 ? -1 : t;
+  }
+  return 1;
+}
+
+PHGMG__PRIV int phgmg__sp_match(int n, const int *cp, const int *ci, const double *cx, int *cperm,
+                                const phgmg_allocator *al) {
+  phgmg__mt m;
+  double *w = phgmg__dalloc(al, (size_t)cp[n] + 1);
+  int i, j, p, ok = 1, ident = 1;
+  memset(&m, 0, sizeof m);
+  m.n = n;
+  m.rmate = phgmg__ialloc(al, (size_t)n); m.cmate = phgmg__ialloc(al, (size_t)n);
+  m.heap = phgmg__ialloc(al, (size_t)n); m.hpos = phgmg__ialloc(al, (size_t)n);
+  m.pred = phgmg__ialloc(al, (size_t)n); m.done = phgmg__ialloc(al, (size_t)n);
+  m.u = phgmg__dalloc(al, (size_t)n); m.v = phgmg__dalloc(al, (size_t)n); m.d = phgmg__dalloc(al, (size_t)n);
+  if (!w || !m.rmate || !m.cmate || !m.heap || !m.hpos || !m.pred || !m.done || !m.u || !m.v || !m.d) {
+    ok = -1;
+    goto done;
+  }
+  for (i = 0; i < n; ++i) { m.rmate[i] = m.cmate[i] = -1; m.hpos[i] = -1; m.u[i] = HUGE_VAL; }
+  for (j = 0; j < n; ++j) { /* costs (-1: no edge), row minima */
+    double cm = 0.0;
+    for (p = cp[j]; p < cp[j + 1]; ++p) cm = PHGMG__MAX(cm, fabs(cx[p]));
+    for (p = cp[j]; p < cp[j + 1]; ++p) {
+      w[p] = cx[p] != 0.0 ? log(cm) - log(fabs(cx[p])) : -1.0;
+      if (w[p] >= 0.0 && w[p] < m.u[ci[p]]) m.u[ci[p]] = w[p];
+    }
+  }
+  for (i = 0; i < n; ++i) if (m.u[i] == HUGE_VAL) { ok = 0; goto done; } /* a zero row */
+  for (j = 0; j < n; ++j) { /* column duals, greedy matching on tight edges */
+    double vm = HUGE_VAL;
+    int best = -1;
+    for (p = cp[j]; p < cp[j + 1]; ++p)
+      if (w[p] >= 0.0 && w[p] - m.u[ci[p]] < vm) vm = w[p] - m.u[ci[p]];
+    if (vm == HUGE_VAL) { ok = 0; goto done; } /* a zero column */
+    m.v[j] = vm;
+    for (p = cp[j]; p < cp[j + 1]; ++p)
+      if (w[p] >= 0.0 && m.rmate[ci[p]] < 0 && w[p] - m.u[ci[p]] - vm <= 0.0 && (best < 0 || ci[p] == j)) best = ci[p];
+    if (best >= 0) { m.rmate[best] = j; m.cmate[j] = best; }
+  }
+  for (j = 0; j < n && ok == 1; ++j)
+    if (m.cmate[j] < 0 && !phgmg__mt_augment(&m, cp, ci, w, j)) ok = 0; /* structurally singular */
+  for (i = 0; i < n && ok == 1; ++i) { cperm[i] = m.rmate[i]; if (cperm[i] != i) ident = 0; }
+  if (ok == 1 && ident) ok = 0;
+done:
+  phgmg__free(al, w);
+  phgmg__free(al, m.rmate); phgmg__free(al, m.cmate); phgmg__free(al, m.heap); phgmg__free(al, m.hpos);
+  phgmg__free(al, m.pred); phgmg__free(al, m.done); phgmg__free(al, m.u); phgmg__free(al, m.v);
+  phgmg__free(al, m.d);
+  return ok;
+}
+
 /* The analysis of sp's stage matrices from its CSC copies (J - R merged,
    zero values dropped, as from band storage); condense as phgmg__spsym_create. */
 PHGMG__PRIV phgmg_result phgmg__spsym_create_sp(phgmg__spsym **out, const phgmg_ph_sparse *sp, int condense) {
@@ -7196,6 +7357,11 @@ PHGMG__PRIV phgmg_result phgmg__spsym_create_sp(phgmg__spsym **out, const phgmg_
       S->q_i = phgmg__ialloc(al, (size_t)nq + 1); S->q_x = phgmg__dalloc(al, (size_t)nq + 1);
       if (!S->jr_i || !S->jr_x || !S->q_i || !S->q_x) rc = PHGMG_ERR_NOMEM;
     }
+  }
+  if (rc == PHGMG_OK && S->e_p) { /* descriptor: columns matched to E's largest entries */
+    int r = (S->cperm = phgmg__ialloc(al, (size_t)n)) ? phgmg__sp_match(n, S->e_p, S->e_i, S->e_x, S->cperm, al) : -1;
+    if (r < 0) rc = PHGMG_ERR_NOMEM;
+    else if (r == 0) { phgmg__free(al, S->cperm); S->cperm = NULL; }
   }
   if (rc == PHGMG_OK) rc = phgmg__spsym_analyse(S, condense, al);
   if (rc != PHGMG_OK) { phgmg__spsym_free(al, S); return rc; }
@@ -7451,7 +7617,7 @@ PHGMG_DEF phgmg_result phgmg_ph_sparse_set_solver(phgmg_ph_sparse *sp, int solve
   phgmg_ph_sparse_info *f;
   const int N = sp ? sp->sys.N : 0;
   phgmg_result rc;
-  int use;
+  int use, j;
   if (!sp || solver < PHGMG_SOLVER_AUTO || solver > PHGMG_SOLVER_SPARSE_LU) return PHGMG_ERR_INVALID_ARG;
   f = &sp->inf;
   phgmg__ph_sparse_stage_bw(sp, &f->kl, &f->ku);
@@ -7472,6 +7638,8 @@ PHGMG_DEF phgmg_result phgmg_ph_sparse_set_solver(phgmg_ph_sparse *sp, int solve
     f->flops_sparse = sp->sym->flops;
     f->supernodes = sp->sym->nsup;
     f->condensed = sp->sym->na;
+    f->colperm = 0;
+    for (j = 0; sp->sym->cperm && j < N; ++j) f->colperm += sp->sym->cperm[j] != j;
     { size_t fm = 0; while ((fm + 1) * (fm + 1) <= sp->sym->front_max) ++fm; f->front_max = (int)fm; }
   }
   if (solver == PHGMG_SOLVER_AUTO)
@@ -8195,6 +8363,7 @@ PHGMG__PRIV void phgmg__gl3_setup_method(phgmg_gl3 *s, const phgmg_gl3_opts *opt
     s->mode = PHGMG__GL3_SPARSE;
   else
     s->mode = sys->storage == PHGMG_DENSE ? PHGMG__GL3_DENSE : PHGMG__GL3_BANDED;
+  s->st.sparse_lu = s->mode == PHGMG__GL3_SPARSE;
 
 }
 
@@ -8973,6 +9142,8 @@ PHGMG__PRIV phgmg_result phgmg__gl3_sparse_fallback(phgmg_gl3 *s) {
   phgmg__spnum_free(&s->al, &s->spf2);
   s->mode = PHGMG__GL3_BANDED;
   s->sps = NULL; /* from here exactly the band stepper */
+  s->st.sparse_lu = 0;
+  s->st.band_fallback = 1;
   phgmg__dia_free(&s->al, &s->dq);
   if (s->sys.storage == PHGMG_SPARSE) {
     rc = phgmg__gl3_sparse_dia(s);
@@ -9441,6 +9612,8 @@ PHGMG__PRIV phgmg_result phgmg__simulate_on(phgmg_gl3 *s, const phgmg_ph_system 
   int N = sys->N, m = sys->m, n, i, k, done = 0;
   phgmg_gl3_stats tot = s->st;
   memset(&s->st, 0, sizeof s->st);
+  s->st.sparse_lu = tot.sparse_lu;
+  s->st.band_fallback = tot.band_fallback;
   s->have_prev = 0;
   x = phgmg__dalloc(alloc, (size_t)N);
   g = phgmg__dalloc(alloc, (size_t)N);
@@ -9482,6 +9655,7 @@ done:
   tot.steps += s->st.steps; tot.newton_iters += s->st.newton_iters;
   tot.factorizations += s->st.factorizations; tot.rhs_evals += s->st.rhs_evals;
   tot.failures += s->st.failures; tot.max_residual = PHGMG__MAX(tot.max_residual, s->st.max_residual);
+  tot.sparse_lu = s->st.sparse_lu; tot.band_fallback = s->st.band_fallback;
   s->st = tot;
   if (steps_done) *steps_done = done;
   phgmg__free(alloc, x);

@@ -1764,7 +1764,11 @@ static void remove_stale(const char *dir, const outlist *rec, const outlist *ol)
 /* The GL3 stage-matrix solver phgmg_ph_sparse_create chose, for the log. */
 static const char *sparse_solver_desc(const phgmg_ph_sparse_info *inf) {
   static char buf[256];
-  if (inf->solver == PHGMG_SOLVER_SPARSE_LU)
+  if (inf->solver == PHGMG_SOLVER_SPARSE_LU && inf->colperm > 0)
+    snprintf(buf, sizeof buf, "sparse LU (%d columns matched to E's largest entries, %d states condensed, nested "
+             "dissection, %d supernodes, %.3g factor entries vs %.3g banded)", inf->colperm, inf->condensed,
+             inf->supernodes, inf->lu_sparse, inf->lu_band);
+  else if (inf->solver == PHGMG_SOLVER_SPARSE_LU)
     snprintf(buf, sizeof buf, "sparse LU (%d states condensed, nested dissection, %d supernodes, %.3g factor "
              "entries vs %.3g banded)", inf->condensed, inf->supernodes, inf->lu_sparse, inf->lu_band);
   else if (inf->lu_sparse > 0.0)
@@ -1772,6 +1776,13 @@ static const char *sparse_solver_desc(const phgmg_ph_sparse_info *inf) {
   else
     snprintf(buf, sizeof buf, "band LU (%.3g factor entries)", inf->lu_band);
   return buf;
+}
+
+/* A simulation whose sparse LU gave up its static pivots for the band LU says so. */
+static void note_band_fallback(const phgmg_gl3_stats *st) {
+  if (st->band_fallback)
+    progress("  note: the sparse LU's static pivots failed on this model; the stage systems were solved by the "
+             "band LU with partial pivoting instead (slower, memory O(N kb))");
 }
 
 /* The sparse system (--J-coo, --R-coo, --Q-coo, --B) into S->sp and sys. */
@@ -2274,6 +2285,7 @@ static int simulate_training_runs(const reduce_args *A, reduce_state *S, const d
                   rc == PHGMG_ERR_NOT_CONVERGED ? " (try a smaller --dt or more --newton-iter)" : "");
     }
     progress("  done (%ld Newton iterations, %ld factorizations)", st.newton_iters, st.factorizations);
+    note_band_fallback(&st);
     memset(&S->runs[i], 0, sizeof S->runs[i]);
     S->runs[i].u = input_fn; S->runs[i].user = in; S->runs[i].dt = A->dt; S->runs[i].nsteps = A->steps;
   }
@@ -3051,6 +3063,7 @@ static int cmd_simulate(int argc, char **argv) {
   }
   progress("  done in %.3f s (%ld Newton iterations, %ld factorizations)", now_s() - t0, st.newton_iters,
            st.factorizations);
+  note_band_fallback(&st);
   if (X && S.sp) { /* states back into the user's ordering */
     XU = (double *)malloc(sizeof(double) * (size_t)N * ((size_t)A.steps + 1));
     if (!XU) { fail("out of memory"); goto out; }
