@@ -3516,6 +3516,16 @@ PHGMG__PRIV phgmg_result phgmg__sym_tridiag_ql(int n, double *W, int ldw, int ve
    shifted band Cholesky instead of a dense eigenvalue computation. */
 #define PHGMG__PH_PSD_DENSE_MAX 2000
 
+/* phgmg_ph_validate's matrix checks of a sparse model's own system, done
+   once per object (manual 8.12): per key (tol, nl != NONE) the result of
+   the structure checks, of E's regularity and J - R's rcond. nrun counts
+   the runs of the checks (a test seam). Mutable through a const object:
+   one thread at a time validates an object. */
+typedef struct phgmg__valcache {
+  struct { int set; double tol; phgmg_result rc[2]; double rcond; } slot[2];
+  long nrun;
+} phgmg__valcache;
+PHGMG__PRIV phgmg__valcache *phgmg__ph_valcache(const phgmg_ph_system *sys);
 PHGMG__PRIV int phgmg__ph_csc_of(const phgmg_ph_system *s, const double *M, const int **cp, const int **ci,
                                  const double **cx);
 PHGMG__PRIV phgmg_result phgmg__ph_sparse_own_band(const phgmg_ph_system *s, int a1, int a2, phgmg_ph_system *t,
@@ -4217,24 +4227,26 @@ PHGMG__PRIV void phgmg__gbf_solve(const phgmg__gbf *f, char trans, double *b) {
   phgmg__gb_solve(trans, f->n, f->kl, f->ku, f->ue, f->ab, f->ldab, f->ipiv, f->dinv, b);
 }
 
-/* Hager/Higham estimate of ||A^{-1}||_1 from band factors (LAPACK dlacn2 logic).
-   work: 2n doubles, iwork: n ints. */
-PHGMG__PRIV double phgmg__gbf_inv_norm1(const phgmg__gbf *f, double *work, int *isgn) {
-  int n = f->n, i, j, jlast, iter, same;
+/* Hager/Higham estimate of ||A^{-1}||_1 from a solver of A x = b ('N') and
+   A^T x = b ('T') in place (LAPACK dlacn2 logic). work: 2n doubles, iwork:
+   n ints. */
+typedef void (*phgmg__solve_fn)(const void *ctx, char trans, double *x);
+PHGMG__PRIV double phgmg__inv_norm1(int n, phgmg__solve_fn solve, const void *f, double *work, int *isgn) {
+  int i, j, jlast, iter, same;
   double *x = work, est, estold, temp;
   for (i = 0; i < n; ++i) x[i] = 1.0 / (double)n;
-  phgmg__gbf_solve(f, 'N', x);
+  solve(f, 'N', x);
   if (n == 1) return fabs(x[0]);
   est = 0.0;
   for (i = 0; i < n; ++i) est += fabs(x[i]);
   for (i = 0; i < n; ++i) { isgn[i] = x[i] >= 0.0 ? 1 : -1; x[i] = (double)isgn[i]; }
-  phgmg__gbf_solve(f, 'T', x);
+  solve(f, 'T', x);
   j = 0;
   for (i = 1; i < n; ++i) if (fabs(x[i]) > fabs(x[j])) j = i;
   for (iter = 2;; ++iter) {
     for (i = 0; i < n; ++i) x[i] = 0.0;
     x[j] = 1.0;
-    phgmg__gbf_solve(f, 'N', x);
+    solve(f, 'N', x);
     estold = est;
     est = 0.0;
     for (i = 0; i < n; ++i) est += fabs(x[i]);
@@ -4243,18 +4255,24 @@ PHGMG__PRIV double phgmg__gbf_inv_norm1(const phgmg__gbf *f, double *work, int *
       if ((x[i] >= 0.0 ? 1 : -1) != isgn[i]) { same = 0; break; }
     if (same || est <= estold) { if (est < estold) est = estold; break; }
     for (i = 0; i < n; ++i) { isgn[i] = x[i] >= 0.0 ? 1 : -1; x[i] = (double)isgn[i]; }
-    phgmg__gbf_solve(f, 'T', x);
+    solve(f, 'T', x);
     jlast = j;
     j = 0;
     for (i = 1; i < n; ++i) if (fabs(x[i]) > fabs(x[j])) j = i;
     if (fabs(x[jlast]) == fabs(x[j]) || iter >= 5) break;
   }
   for (i = 0; i < n; ++i) x[i] = ((i & 1) ? -1.0 : 1.0) * (1.0 + (double)i / (double)(n - 1));
-  phgmg__gbf_solve(f, 'N', x);
+  solve(f, 'N', x);
   temp = 0.0;
   for (i = 0; i < n; ++i) temp += fabs(x[i]);
   temp = 2.0 * temp / (3.0 * (double)n);
   return temp > est ? temp : est;
+}
+PHGMG__PRIV void phgmg__gbf_solve_cb(const void *f, char trans, double *x) {
+  phgmg__gbf_solve(PHGMG__CAST(const phgmg__gbf *, f), trans, x);
+}
+PHGMG__PRIV double phgmg__gbf_inv_norm1(const phgmg__gbf *f, double *work, int *isgn) {
+  return phgmg__inv_norm1(f->n, phgmg__gbf_solve_cb, f, work, isgn);
 }
 
 /* ||J - R||_1 */
@@ -4299,7 +4317,11 @@ struct phgmg_jr_factor {
   phgmg__gbf gb; /* banded; SPARSE systems: in J - R's own RCM order, */
   int *perm;     /* position i holds index perm[i] (NULL: none)       */
   double *w;     /* N, the permuted right-hand side                   */
+  struct phgmg__spsym *sps;  /* a sparse LU (E of a SPARSE descriptor model, >>sparse) */
+  struct phgmg__spnum *spf;
 };
+PHGMG__PRIV void phgmg__jr_sp_free(phgmg_jr_factor *f);
+PHGMG__PRIV void phgmg__jr_sp_solve(const void *f, char trans, double *x);
 
 PHGMG_DEF void phgmg_jr_factor_destroy(phgmg_jr_factor *f) {
   phgmg_allocator al;
@@ -4310,6 +4332,7 @@ PHGMG_DEF void phgmg_jr_factor_destroy(phgmg_jr_factor *f) {
   phgmg__gbf_free(&al, &f->gb);
   phgmg__free(&al, f->perm);
   phgmg__free(&al, f->w);
+  phgmg__jr_sp_free(f);
   phgmg__free(&al, f);
 }
 
@@ -4396,6 +4419,10 @@ PHGMG_DEF void phgmg_jr_solve(const phgmg_jr_factor *f, char trans, int nrhs, do
   int c;
   PHGMG_ASSERT(f && X && ldx >= f->N);
   PHGMG_ASSERT(trans == 'N' || trans == 'n' || trans == 'T' || trans == 't');
+  if (f->sps) {
+    for (c = 0; c < nrhs; ++c) phgmg__jr_sp_solve(f, trans, X + (size_t)c * (size_t)ldx);
+    return;
+  }
   if (f->storage == PHGMG_DENSE) {
     phgmg_lu_solve(trans, f->N, f->LU, f->N, f->ipiv, nrhs, X, ldx);
     return;
@@ -4583,8 +4610,7 @@ PHGMG__PRIV int phgmg__sp_pd(int n, const int *cp, const int *ci, const double *
    the band checks above: a diagonal matrix by its diagonal; R of N <= the
    dense limit by its eigenvalues; else R + tol ||R||_1 I, Q (+ tol ||Q||_1 I
    with a nonlinear part) positive definite by the sparse LU's pivots
-   (phgmg__sp_pd), and when that cannot decide, by the band Cholesky of the
-   matrix alone in its own reverse Cuthill-McKee order. */
+   (phgmg__sp_pd). No band copy. */
 PHGMG__PRIV phgmg_result phgmg__ph_check_sparse_pd(const phgmg_ph_system *s, int a, double tol,
                                                    const phgmg_allocator *al) {
   const int N = s->N;
@@ -4613,13 +4639,18 @@ PHGMG__PRIV phgmg_result phgmg__ph_check_sparse_pd(const phgmg_ph_system *s, int
   if (a == 2 || N > PHGMG__PH_PSD_DENSE_MAX) r = phgmg__sp_pd(N, cp, ci, cx, shift, al);
   if (r < 0) return PHGMG_ERR_NOMEM;
   if (r < 2) return r ? PHGMG_OK : a == 1 ? PHGMG_ERR_NOT_PSD : PHGMG_ERR_Q_NOT_PD;
-  { /* the band checks on the matrix alone, in its own RCM order */
-    phgmg_ph_system t;
-    double *bands[2];
-    int *perm = NULL;
-    rc = phgmg__ph_sparse_own_band(s, a, -1, &t, bands, &perm, al);
-    if (rc == PHGMG_OK) rc = a == 1 ? phgmg__ph_check_psd(&t, tol, al) : phgmg__ph_check_q_pd(&t, tol, al);
-    phgmg__ph_own_band_free(&t, bands, perm, al);
+  { /* R of N <= the dense limit: its eigenvalues (a dense copy) */
+    double *A = phgmg__dalloc(al, (size_t)N * (size_t)N), *w = phgmg__dalloc(al, (size_t)N);
+    rc = A && w ? PHGMG_OK : PHGMG_ERR_NOMEM;
+    if (rc == PHGMG_OK) {
+      memset(A, 0, sizeof(double) * (size_t)N * (size_t)N);
+      for (j = 0; j < N; ++j)
+        for (p = cp[j]; p < cp[j + 1]; ++p) A[(size_t)ci[p] + (size_t)j * (size_t)N] = cx[p];
+      rc = phgmg_sym_eig(N, A, N, w, NULL, 0);
+      if (rc == PHGMG_OK && w[0] < -tol * PHGMG__MAX(fabs(w[0]), fabs(w[N - 1]))) rc = PHGMG_ERR_NOT_PSD;
+    }
+    phgmg__free(al, A);
+    phgmg__free(al, w);
   }
   return rc;
 }
@@ -4630,12 +4661,16 @@ PHGMG__PRIV phgmg_result phgmg__ph_check_sparse_pd(const phgmg_ph_system *s, int
    rcond_out (may be NULL): its reciprocal condition estimate. */
 PHGMG__PRIV phgmg_result phgmg__ph_sparse_eq_band(const phgmg_ph_system *s, phgmg_ph_system *t, double **bufs,
                                                  const phgmg_allocator *al);
+PHGMG__PRIV phgmg_result phgmg__sp_e_factor(const phgmg_ph_system *sys, phgmg_jr_factor **f, double *rcond_out,
+                                            const phgmg_allocator *alloc);
 PHGMG__PRIV phgmg_result phgmg__e_factor(const phgmg_ph_system *sys, phgmg_jr_factor **f, double *rcond_out,
                                          const phgmg_allocator *alloc) {
   phgmg_ph_system t;
-  if (sys->storage == PHGMG_SPARSE) { /* the band LU of E's band copy, made here and freed */
-    double *bufs[2];
-    phgmg_result rc = phgmg__ph_sparse_eq_band(sys, &t, bufs, alloc);
+  if (sys->storage == PHGMG_SPARSE) { /* the sparse LU of E; if its static pivots cannot decide, */
+    double *bufs[2];                  /* the band LU of E's band copy, made here and freed */
+    phgmg_result rc = phgmg__sp_e_factor(sys, f, rcond_out, alloc);
+    if (rc != PHGMG_ERR_UNSUPPORTED) return rc;
+    rc = phgmg__ph_sparse_eq_band(sys, &t, bufs, alloc);
     *f = NULL;
     if (rc == PHGMG_OK) rc = phgmg__e_factor(&t, f, rcond_out, alloc);
     phgmg__free(alloc, bufs[0]); phgmg__free(alloc, bufs[1]);
@@ -4690,26 +4725,24 @@ PHGMG__PRIV phgmg_result phgmg__etq_form(const phgmg_ph_system *sys, phgmg_ph_sy
 PHGMG__PRIV int phgmg__e_algebraic(const phgmg_ph_system *s, const phgmg_allocator *alloc);
 PHGMG__PRIV phgmg_result phgmg__dae_validate(const phgmg_ph_system *sys, double tol, const phgmg_allocator *alloc);
 
-/* The descriptor checks of phgmg_ph_validate: E finite and nonsingular,
-   E^T Q symmetric and positive (semi)definite, separable coordinates free of
-   mass coupling. */
-PHGMG__PRIV phgmg_result phgmg__ph_validate_e(const phgmg_ph_system *sys, double tol, const phgmg_allocator *alloc) {
+/* The descriptor checks of phgmg_ph_validate, part one: E finite, an E
+   with zero lines to the index-one checks (*whole = 1: their result is the
+   whole validation), E^T Q symmetric and positive (semi)definite (SPARSE: on
+   the sparse E^T Q, phgmg__ph_sparse_etq_check; no band copy). */
+PHGMG__PRIV phgmg_result phgmg__ph_sparse_etq_check(const phgmg_ph_system *s, double tol,
+                                                    const phgmg_allocator *al);
+PHGMG__PRIV phgmg_result phgmg__ph_validate_e(const phgmg_ph_system *sys, double tol, const phgmg_allocator *alloc,
+                                              int *whole) {
   phgmg_ph_system t;
-  phgmg_jr_factor *f = NULL;
-  double *buf = NULL, rcond = 0.0, nrm, def;
-  int k, j;
+  double *buf = NULL, nrm, def;
+  int k;
   phgmg_result rc;
+  *whole = 0;
   if (!phgmg__ph_mat_finite(sys, sys->E)) return PHGMG_ERR_NANINF;
-  if (sys->storage == PHGMG_SPARSE) { /* on band copies of E and Q, made here and freed */
-    double *bufs[2];
-    rc = phgmg__ph_sparse_eq_band(sys, &t, bufs, alloc);
-    if (rc == PHGMG_OK) rc = phgmg__ph_validate_e(&t, tol, alloc);
-    phgmg__free(alloc, bufs[0]); phgmg__free(alloc, bufs[1]);
-    return rc;
-  }
+  if (sys->storage == PHGMG_SPARSE) return phgmg__ph_sparse_etq_check(sys, tol, alloc); /* E regular */
   k = phgmg__e_algebraic(sys, alloc);   /* zero rows or columns: index one? (1.8) */
   if (k < 0) return PHGMG_ERR_NOMEM;
-  if (k > 0) return phgmg__dae_validate(sys, tol, alloc);
+  if (k > 0) { *whole = 1; return phgmg__dae_validate(sys, tol, alloc); }
   rc = phgmg__etq_form(sys, &t, &buf, alloc);
   if (rc != PHGMG_OK) return rc;
   phgmg__ph_sym_defect(&t, t.Q, -1.0, &nrm, &def);
@@ -4719,14 +4752,52 @@ PHGMG__PRIV phgmg_result phgmg__ph_validate_e(const phgmg_ph_system *sys, double
     if (rc == PHGMG_ERR_Q_NOT_PD) rc = PHGMG_ERR_EQ_NOT_PD;
   }
   phgmg__free(alloc, buf);
-  for (k = 0; rc == PHGMG_OK && sys->nl == PHGMG_NL_SEPARABLE && k < sys->nsep; ++k) {
-    const int ix = sys->sep_idx[k];
-    if (!(phgmg__ph_at(sys, sys->E, ix, ix) > 0.0)) rc = PHGMG_ERR_E_COUPLED;
+  return rc;
+}
+
+/* Part two: the separable coordinates free of mass coupling (row i_k of E
+   is E(i_k, i_k) e_{i_k}^T with E(i_k, i_k) > 0); one pass over E's entries
+   for SPARSE storage. */
+PHGMG__PRIV phgmg_result phgmg__ph_e_coupled(const phgmg_ph_system *sys, const phgmg_allocator *alloc) {
+  const int *cp, *ci;
+  const double *cx;
+  int k, j, p;
+  if (sys->nl != PHGMG_NL_SEPARABLE) return PHGMG_OK;
+  if (phgmg__ph_csc_of(sys, sys->E, &cp, &ci, &cx)) {
+    int *is = phgmg__ialloc(alloc, (size_t)sys->N);
+    phgmg_result rc = PHGMG_OK;
+    if (!is) return PHGMG_ERR_NOMEM;
+    for (j = 0; j < sys->N; ++j) is[j] = 0;
+    for (k = 0; k < sys->nsep; ++k) is[sys->sep_idx[k]] = 1;
+    for (j = 0; j < sys->N; ++j) /* positive diagonals (zero: not stored) */
+      if (is[j]) is[j] = 2;
     for (j = 0; j < sys->N && rc == PHGMG_OK; ++j)
-      if (j != ix && phgmg__ph_at(sys, sys->E, ix, j) != 0.0) rc = PHGMG_ERR_E_COUPLED;
+      for (p = cp[j]; p < cp[j + 1]; ++p) {
+        const int i = ci[p];
+        if (!is[i]) continue;
+        if (i == j && cx[p] > 0.0) is[i] = is[i] == 2 ? 1 : is[i];
+        else if (i != j && cx[p] != 0.0) { rc = PHGMG_ERR_E_COUPLED; break; }
+      }
+    for (j = 0; j < sys->N && rc == PHGMG_OK; ++j)
+      if (is[j] == 2) rc = PHGMG_ERR_E_COUPLED;
+    phgmg__free(alloc, is);
+    return rc;
   }
-  if (rc != PHGMG_OK) return rc;
-  rc = phgmg__e_factor(sys, &f, &rcond, alloc);
+  for (k = 0; k < sys->nsep; ++k) {
+    const int ix = sys->sep_idx[k];
+    if (!(phgmg__ph_at(sys, sys->E, ix, ix) > 0.0)) return PHGMG_ERR_E_COUPLED;
+    for (j = 0; j < sys->N; ++j)
+      if (j != ix && phgmg__ph_at(sys, sys->E, ix, j) != 0.0) return PHGMG_ERR_E_COUPLED;
+  }
+  return PHGMG_OK;
+}
+
+/* Part three: E nonsingular, 1 / cond_1(E) > tol (SPARSE: the sparse LU of
+   E, phgmg__e_factor). */
+PHGMG__PRIV phgmg_result phgmg__ph_e_regular(const phgmg_ph_system *sys, double tol, const phgmg_allocator *alloc) {
+  phgmg_jr_factor *f = NULL;
+  double rcond = 0.0;
+  phgmg_result rc = phgmg__e_factor(sys, &f, &rcond, alloc);
   phgmg_jr_factor_destroy(f);
   if (rc == PHGMG_ERR_NOMEM) return rc;
   return rc == PHGMG_OK && rcond > tol ? PHGMG_OK : PHGMG_ERR_E_SINGULAR;
@@ -4819,14 +4890,78 @@ PHGMG__PRIV phgmg_result phgmg__damp_jr_factor(phgmg_jr_factor **f, const phgmg_
   return rc;
 }
 
+/* The structure checks of phgmg_ph_validate in its order: J skew, R
+   symmetric, feedthrough, then with E: R PSD and E's checks (part one;
+   *whole = 1: an index-one model's whole result), else Q symmetric, R PSD,
+   Q positive (semi)definite. */
+PHGMG__PRIV phgmg_result phgmg__ph_validate_struct(const phgmg_ph_system *sys, double tol,
+                                                   const phgmg_allocator *alloc, int *whole) {
+  phgmg_result rc;
+  double nrm, def;
+  *whole = 0;
+  phgmg__ph_sym_defect(sys, sys->J, 1.0, &nrm, &def);
+  if (def > tol * nrm) return PHGMG_ERR_NOT_SKEW;
+  phgmg__ph_sym_defect(sys, sys->R, -1.0, &nrm, &def);
+  if (def > tol * nrm) return PHGMG_ERR_NOT_SYMMETRIC;
+  if (sys->P || sys->S || sys->Nskew) {
+    rc = phgmg__ph_check_psd(sys, tol, alloc);
+    if (rc == PHGMG_OK) rc = phgmg__ph_validate_feedthrough(sys, tol, alloc);
+    if (rc != PHGMG_OK) return rc;
+  }
+  if (sys->E) {   /* descriptor: E^T Q takes the place of Q */
+    rc = phgmg__ph_check_psd(sys, tol, alloc);
+    return rc == PHGMG_OK ? phgmg__ph_validate_e(sys, tol, alloc, whole) : rc;
+  }
+  phgmg__ph_sym_defect(sys, sys->Q, -1.0, &nrm, &def);
+  if (def > tol * nrm) return PHGMG_ERR_Q_NOT_SYMMETRIC;
+  rc = phgmg__ph_check_psd(sys, tol, alloc);
+  return rc == PHGMG_OK ? phgmg__ph_check_q_pd(sys, tol, alloc) : rc;
+}
+
+/* The matrix checks: r[0] the structure checks, r[1] E's regularity (E
+   only), *rcond the reciprocal condition of J - R (with dampers J - R - L);
+   from the object's cache for a sparse model's own system (run once per
+   key). Returns PHGMG_ERR_NOMEM, or PHGMG_OK with *whole as above. */
+PHGMG__PRIV phgmg_result phgmg__ph_validate_mats(const phgmg_ph_system *sys, double tol, const phgmg_allocator *alloc,
+                                                 phgmg_result r[2], double *rcond, int *whole) {
+  phgmg__valcache *vc = phgmg__ph_valcache(sys);
+  const int key = sys->nl != PHGMG_NL_NONE;
+  phgmg_jr_factor *f = NULL;
+  phgmg_result rc;
+  *whole = 0;
+  if (vc && vc->slot[key].set && vc->slot[key].tol == tol) {
+    r[0] = vc->slot[key].rc[0]; r[1] = vc->slot[key].rc[1]; *rcond = vc->slot[key].rcond;
+    return PHGMG_OK;
+  }
+  r[0] = phgmg__ph_validate_struct(sys, tol, alloc, whole);
+  r[1] = PHGMG_OK;
+  *rcond = 0.0;
+  if (r[0] == PHGMG_ERR_NOMEM) return r[0];
+  if (*whole) return PHGMG_OK;
+  if (r[0] == PHGMG_OK && sys->E) r[1] = phgmg__ph_e_regular(sys, tol, alloc);
+  if (r[1] == PHGMG_ERR_NOMEM) return r[1];
+  if (r[0] == PHGMG_OK && r[1] == PHGMG_OK) { /* J - R invertible (with dampers: J - R - L) */
+    rc = phgmg__damp_jr_factor(&f, sys, rcond, alloc);
+    phgmg_jr_factor_destroy(f);
+    if (rc == PHGMG_ERR_NOMEM) return rc;
+    if (rc != PHGMG_OK) *rcond = 0.0;
+  }
+  if (vc) {
+    vc->nrun++;
+    vc->slot[key].set = 1; vc->slot[key].tol = tol;
+    vc->slot[key].rc[0] = r[0]; vc->slot[key].rc[1] = r[1]; vc->slot[key].rcond = *rcond;
+  }
+  return PHGMG_OK;
+}
+
 /* phgmg_ph_validate; check_rank = 0 skips the rank test of B (the condensed
    model of an index-one model may have B' = 0 where a port acts through a
    constraint only, 1.8). */
 PHGMG__PRIV phgmg_result phgmg__ph_validate(const phgmg_ph_system *sys, double tol, double *rcond_out,
                                             const phgmg_allocator *alloc, int check_rank) {
-  phgmg_result rc;
-  double nrm, def;
-  int N, m;
+  phgmg_result rc, r[2];
+  double rcond = 0.0;
+  int N, m, whole = 0;
   if (rcond_out) *rcond_out = 0.0;
   rc = phgmg__ph_check(sys);
   if (rc != PHGMG_OK) return rc;
@@ -4843,27 +4978,13 @@ PHGMG__PRIV phgmg_result phgmg__ph_validate(const phgmg_ph_system *sys, double t
     if (sys->poly_deg > 0 && !phgmg__all_finite(sys->poly, (size_t)sys->poly_deg + 1))
       return PHGMG_ERR_NANINF;
   }
-  /* structure */
-  phgmg__ph_sym_defect(sys, sys->J, 1.0, &nrm, &def);
-  if (def > tol * nrm) return PHGMG_ERR_NOT_SKEW;
-  phgmg__ph_sym_defect(sys, sys->R, -1.0, &nrm, &def);
-  if (def > tol * nrm) return PHGMG_ERR_NOT_SYMMETRIC;
-  if (sys->P || sys->S || sys->Nskew) {
-    rc = phgmg__ph_check_psd(sys, tol, alloc);
-    if (rc == PHGMG_OK) rc = phgmg__ph_validate_feedthrough(sys, tol, alloc);
+  rc = phgmg__ph_validate_mats(sys, tol, alloc, r, &rcond, &whole);
+  if (rc != PHGMG_OK) return rc;
+  if (whole || r[0] != PHGMG_OK) return r[0];
+  if (sys->E) {
+    rc = phgmg__ph_e_coupled(sys, alloc);
     if (rc != PHGMG_OK) return rc;
-  }
-  if (sys->E) {   /* descriptor: E^T Q takes the place of Q */
-    rc = phgmg__ph_check_psd(sys, tol, alloc);
-    if (rc == PHGMG_OK) rc = phgmg__ph_validate_e(sys, tol, alloc);
-    if (rc != PHGMG_OK) return rc;
-  } else {
-    phgmg__ph_sym_defect(sys, sys->Q, -1.0, &nrm, &def);
-    if (def > tol * nrm) return PHGMG_ERR_Q_NOT_SYMMETRIC;
-    rc = phgmg__ph_check_psd(sys, tol, alloc);
-    if (rc != PHGMG_OK) return rc;
-    rc = phgmg__ph_check_q_pd(sys, tol, alloc);
-    if (rc != PHGMG_OK) return rc;
+    if (r[1] != PHGMG_OK) return r[1];
   }
   /* B full column rank: pivoted QR, |R(m-1,m-1)| > tol |R(0,0)| */
   if (check_rank) {
@@ -4885,17 +5006,8 @@ PHGMG__PRIV phgmg_result phgmg__ph_validate(const phgmg_ph_system *sys, double t
     phgmg__free(alloc, jpvt);
     if (rc != PHGMG_OK) return rc;
   }
-  /* J - R invertible (with dampers: J - R - L, L their linearisation at 0) */
-  {
-    phgmg_jr_factor *f = NULL;
-    double rcond = 0.0;
-    rc = phgmg__damp_jr_factor(&f, sys, &rcond, alloc);
-    if (rc == PHGMG_ERR_NOMEM) return rc;
-    if (rc != PHGMG_OK) rcond = 0.0;
-    phgmg_jr_factor_destroy(f);
-    if (rcond_out) *rcond_out = rcond;
-    if (!(rcond > tol)) return PHGMG_ERR_SINGULAR;
-  }
+  if (rcond_out) *rcond_out = rcond;
+  if (!(rcond > tol)) return PHGMG_ERR_SINGULAR;
   return PHGMG_OK;
 }
 
@@ -6934,11 +7046,13 @@ PHGMG__PRIV void phgmg__sp_qmv(const phgmg__spsym *S, const double *x, double *y
 
 /* Is the symmetric n x n CSC matrix A + shift I positive definite? Through
    the sparse LU of >>sparse (the stage matrix of J - R = -I, Q = A, sigma =
-   shift): without row exchanges the LU pivots of a symmetric matrix are the
-   D of its L D L^T, all positive exactly when it is definite (Sylvester),
-   and for a definite matrix the elimination is stable. 1 yes, 0 no, 2
-   undecided (a pivot replaced or large growth: the caller's band Cholesky
-   decides), -1 out of memory. Memory: the sparse factor, not a band. */
+   shift) with no pivot threshold: without row exchanges the LU pivots of a
+   symmetric matrix are the D of its L D L^T, all positive exactly when it
+   is definite (Sylvester's law of inertia; the first pivot <= 0 in the
+   elimination order shows a leading minor <= 0), and for a definite matrix
+   the elimination is as stable as Cholesky's, so the pivots decide: 1 every
+   pivot positive and finite, 0 not, -1 out of memory. Memory: the sparse
+   factor, not a band. */
 PHGMG__PRIV int phgmg__sp_pd(int n, const int *cp, const int *ci, const double *cx, double shift,
                              const phgmg_allocator *al) {
   phgmg__spsym *S = PHGMG__CAST(phgmg__spsym *, phgmg__alloc(al, sizeof(phgmg__spsym)));
@@ -6964,15 +7078,17 @@ PHGMG__PRIV int phgmg__sp_pd(int n, const int *cp, const int *ci, const double *
   w = phgmg__dalloc(al, (size_t)n);
   if (!Mx || !w || phgmg__spnum_alloc(al, S, 0, &F) != PHGMG_OK) goto done;
   phgmg__sp_stage_values(S, NULL, Mx, w);   /* M = -(J - R) Q = A */
-  phgmg__sp_factor(S, &F, Mx, shift, 0.0, PHGMG_SPARSE_PIVTOL);
-  ok = F.nstatic || !(F.growth <= PHGMG_SPARSE_GROWTH) ? 2 : 1;
+  phgmg__sp_factor(S, &F, Mx, shift, 0.0, 0.0);
+  ok = 1;
   for (t = 0; t < S->na && ok == 1; ++t)    /* condensed block: its diagonal */
-    if (!(Mx[S->ad_k[t]] + shift > 0.0)) ok = 0;
+    if (!(Mx[S->ad_k[t]] + shift > 0.0 && Mx[S->ad_k[t]] + shift < HUGE_VAL)) ok = 0;
   for (t = 0; t < S->nsup && ok == 1; ++t) { /* the pivots of each front */
     const int nc = S->sfirst[t + 1] - S->sfirst[t], nf = nc + S->srp[t + 1] - S->srp[t];
     const double *L = F.X + S->lptr[t];
-    for (j = 0; j < nc; ++j)
-      if (!(L[(size_t)j * (size_t)nf + (size_t)j] > 0.0)) { ok = 0; break; }
+    for (j = 0; j < nc; ++j) {
+      const double d = L[(size_t)j * (size_t)nf + (size_t)j];
+      if (!(d > 0.0 && d < HUGE_VAL)) { ok = 0; break; }
+    }
   }
 done:
   phgmg__spnum_free(al, &F);
@@ -7181,7 +7297,9 @@ struct phgmg_ph_sparse {
   phgmg__spsym *sym;            /* sparse LU analysis (NULL: not done) */
   int use_lu;                   /* 1: steppers use the sparse LU       */
   phgmg_ph_sparse_info inf;
+  struct phgmg__valcache *vc;   /* the matrix checks' results (phgmg_ph_validate) */
 };
+
 
 /* Column permutation for the static pivots of a descriptor model (manual
    8.12): a matching of rows to columns of E that maximises the product of
@@ -7369,6 +7487,268 @@ PHGMG__PRIV phgmg_result phgmg__spsym_create_sp(phgmg__spsym **out, const phgmg_
   return PHGMG_OK;
 }
 
+/* ---- sparse checks of a descriptor model (manual 8.12): E^T Q and E ---- */
+
+/* B = A^T (n x n CSC, rows sorted in each column); *bp, *bi, *bx owned. */
+PHGMG__PRIV phgmg_result phgmg__csc_transpose(int n, const int *ap, const int *ai, const double *ax, int **bp,
+                                              int **bi, double **bx, const phgmg_allocator *al) {
+  int j, p, *cnt;
+  *bp = phgmg__ialloc(al, (size_t)n + 1);
+  *bi = phgmg__ialloc(al, (size_t)ap[n] + 1);
+  *bx = phgmg__dalloc(al, (size_t)ap[n] + 1);
+  cnt = phgmg__ialloc(al, (size_t)n + 1);
+  if (!*bp || !*bi || !*bx || !cnt) { phgmg__free(al, cnt); return PHGMG_ERR_NOMEM; }
+  for (j = 0; j <= n; ++j) cnt[j] = 0;
+  for (p = 0; p < ap[n]; ++p) cnt[ai[p] + 1]++;
+  for (j = 0; j < n; ++j) cnt[j + 1] += cnt[j];
+  for (j = 0; j <= n; ++j) (*bp)[j] = cnt[j];
+  for (j = 0; j < n; ++j) /* columns in order: each new column's rows increase */
+    for (p = ap[j]; p < ap[j + 1]; ++p) { int q = cnt[ai[p]]++; (*bi)[q] = j; (*bx)[q] = ax[p]; }
+  phgmg__free(al, cnt);
+  return PHGMG_OK;
+}
+
+/* C = A^T B (n x n CSC, rows sorted): column j = sum_k B(k, j) (A^T)(:, k),
+   with At = A^T given. */
+PHGMG__PRIV phgmg_result phgmg__csc_atb(int n, const int *tp, const int *ti, const double *tx, const int *bp,
+                                        const int *bi, const double *bx, int **cp, int **ci, double **cx,
+                                        const phgmg_allocator *al) {
+  int j, p, q, pass, nz = 0, *mark = phgmg__ialloc(al, (size_t)n);
+  double *w = phgmg__dalloc(al, (size_t)n);
+  *cp = phgmg__ialloc(al, (size_t)n + 1);
+  *ci = NULL; *cx = NULL;
+  if (!mark || !w || !*cp) { phgmg__free(al, mark); phgmg__free(al, w); return PHGMG_ERR_NOMEM; }
+  for (pass = 0; pass < 2; ++pass) {
+    for (j = 0; j < n; ++j) { mark[j] = -1; w[j] = 0.0; }
+    nz = 0;
+    for (j = 0; j < n; ++j) {
+      const int start = nz;
+      (*cp)[j] = nz;
+      for (q = bp[j]; q < bp[j + 1]; ++q) {
+        const int k = bi[q];
+        for (p = tp[k]; p < tp[k + 1]; ++p) {
+          const int r = ti[p];
+          if (mark[r] != j) { mark[r] = j; if (pass) (*ci)[nz] = r; ++nz; }
+          if (pass) w[r] += tx[p] * bx[q];
+        }
+      }
+      if (!pass) continue;
+      phgmg__isort(*ci + start, (size_t)(nz - start));
+      for (p = start; p < nz; ++p) { (*cx)[p] = w[(*ci)[p]]; w[(*ci)[p]] = 0.0; }
+    }
+    if (!pass) {
+      *ci = phgmg__ialloc(al, (size_t)nz + 1);
+      *cx = phgmg__dalloc(al, (size_t)nz + 1);
+      if (!*ci || !*cx) { phgmg__free(al, mark); phgmg__free(al, w); return PHGMG_ERR_NOMEM; }
+    }
+  }
+  (*cp)[n] = nz;
+  phgmg__free(al, mark);
+  phgmg__free(al, w);
+  return PHGMG_OK;
+}
+
+/* C = (A + A^T) / 2 from A and At = A^T (both sorted), with the Frobenius
+   norms of A and of A - A^T; C's arrays owned. */
+PHGMG__PRIV phgmg_result phgmg__csc_sym_part(int n, const int *ap, const int *ai, const double *ax, const int *tp,
+                                             const int *ti, const double *tx, int **cp, int **ci, double **cx,
+                                             double *norm, double *defect, const phgmg_allocator *al) {
+  int j, p, q, nz = 0;
+  double a2 = 0.0, d2 = 0.0;
+  *cp = phgmg__ialloc(al, (size_t)n + 1);
+  *ci = phgmg__ialloc(al, (size_t)ap[n] + (size_t)tp[n] + 1);
+  *cx = phgmg__dalloc(al, (size_t)ap[n] + (size_t)tp[n] + 1);
+  if (!*cp || !*ci || !*cx) return PHGMG_ERR_NOMEM;
+  for (j = 0; j < n; ++j) {
+    (*cp)[j] = nz;
+    p = ap[j]; q = tp[j];
+    while (p < ap[j + 1] || q < tp[j + 1]) { /* the two sorted columns merged */
+      const int ra = p < ap[j + 1] ? ai[p] : n, rb = q < tp[j + 1] ? ti[q] : n, r = PHGMG__MIN(ra, rb);
+      const double va = ra == r ? ax[p++] : 0.0, vb = rb == r ? tx[q++] : 0.0;
+      a2 += va * va;
+      d2 += (va - vb) * (va - vb);
+      (*ci)[nz] = r; (*cx)[nz++] = 0.5 * (va + vb);
+    }
+  }
+  (*cp)[n] = nz;
+  *norm = sqrt(a2);
+  *defect = sqrt(d2);
+  return PHGMG_OK;
+}
+
+/* E^T Q of a SPARSE descriptor system: symmetric within tol (Frobenius, as
+   phgmg_ph_validate's other symmetry checks), then its symmetric part
+   positive definite (positive semidefinite within tol ||E^T Q||_1 with a
+   nonlinear part) by the pivots of phgmg__sp_pd: PHGMG_ERR_EQ_NOT_SYMMETRIC,
+   _EQ_NOT_PD. Memory O(nnz(E^T Q) + the sparse factor); no band copy. */
+PHGMG__PRIV phgmg_result phgmg__ph_sparse_etq_check(const phgmg_ph_system *s, double tol,
+                                                    const phgmg_allocator *al) {
+  const phgmg_ph_sparse *sp = s->sparse;
+  const int n = s->N;
+  int *tp = NULL, *ti = NULL, *cp = NULL, *ci = NULL, *ctp = NULL, *cti = NULL, *hp = NULL, *hi = NULL, j, p, r;
+  double *tx = NULL, *cx = NULL, *ctx = NULL, *hx = NULL, nrm = 0.0, def = 0.0, n1 = 0.0;
+  phgmg_result rc = phgmg__csc_transpose(n, sp->cp[3], sp->ci[3], sp->cx[3], &tp, &ti, &tx, al);
+  if (rc == PHGMG_OK) rc = phgmg__csc_atb(n, tp, ti, tx, sp->cp[2], sp->ci[2], sp->cx[2], &cp, &ci, &cx, al);
+  if (rc == PHGMG_OK) rc = phgmg__csc_transpose(n, cp, ci, cx, &ctp, &cti, &ctx, al);
+  if (rc == PHGMG_OK) rc = phgmg__csc_sym_part(n, cp, ci, cx, ctp, cti, ctx, &hp, &hi, &hx, &nrm, &def, al);
+  if (rc == PHGMG_OK && def > tol * nrm) rc = PHGMG_ERR_EQ_NOT_SYMMETRIC;
+  if (rc == PHGMG_OK) {
+    for (j = 0; j < n; ++j) {
+      double cs = 0.0;
+      for (p = hp[j]; p < hp[j + 1]; ++p) cs += fabs(hx[p]);
+      n1 = PHGMG__MAX(n1, cs);
+    }
+    r = phgmg__sp_pd(n, hp, hi, hx, s->nl != PHGMG_NL_NONE ? PHGMG__MAX(tol * n1, 1e-300) : 0.0, al);
+    rc = r < 0 ? PHGMG_ERR_NOMEM : r ? PHGMG_OK : PHGMG_ERR_EQ_NOT_PD;
+  }
+  phgmg__free(al, tp); phgmg__free(al, ti); phgmg__free(al, tx);
+  phgmg__free(al, cp); phgmg__free(al, ci); phgmg__free(al, cx);
+  phgmg__free(al, ctp); phgmg__free(al, cti); phgmg__free(al, ctx);
+  phgmg__free(al, hp); phgmg__free(al, hi); phgmg__free(al, hx);
+  return rc;
+}
+
+/* x <- K^{-T} x for a factor without a condensed block (real): the
+   solve of (K P)^T y = P^T x, U^T then L^T supernode by supernode. */
+PHGMG__PRIV void phgmg__sp_solve_t(const phgmg__spsym *S, const phgmg__spnum *F, double *x) {
+  const int n = S->nf, ns = S->nsup;
+  int s, i, j, k;
+  double *y = F->y;
+  for (i = 0; i < n; ++i) y[i] = x[S->cperm ? S->cperm[S->perm[i]] : S->perm[i]];
+  for (s = 0; s < ns; ++s) { /* forward: U^T */
+    const int f = S->sfirst[s], nc = S->sfirst[s + 1] - f, nr = S->srp[s + 1] - S->srp[s], nf = nc + nr;
+    const int *rows = S->srow + S->srp[s];
+    const double *L = F->X + S->lptr[s], *Up = L + (size_t)nf * (size_t)nc;
+    double *yf = y + f;
+    for (k = 0; k < nc; ++k) yf[k] = (yf[k] - phgmg__dot(k, L + (size_t)k * (size_t)nf, yf)) / L[(size_t)k * (size_t)nf + (size_t)k];
+    for (j = 0; j < nr; ++j) {
+      double acc = 0.0;
+      for (i = 0; i < nc; ++i) acc += Up[(size_t)i * (size_t)nr + (size_t)j] * yf[i];
+      y[rows[j]] -= acc;
+    }
+  }
+  for (s = ns - 1; s >= 0; --s) { /* backward: L^T, unit diagonal */
+    const int f = S->sfirst[s], nc = S->sfirst[s + 1] - f, nr = S->srp[s + 1] - S->srp[s], nf = nc + nr;
+    const int *rows = S->srow + S->srp[s];
+    const double *L = F->X + S->lptr[s];
+    double *yf = y + f;
+    for (k = nc - 1; k >= 0; --k) {
+      const double *lk = L + (size_t)k * (size_t)nf;
+      double v = yf[k] - phgmg__dot(nc - k - 1, lk + k + 1, yf + k + 1);
+      for (j = 0; j < nr; ++j) v -= lk[nc + j] * y[rows[j]];
+      yf[k] = v;
+    }
+  }
+  for (i = 0; i < n; ++i) x[S->perm[i]] = y[i];
+}
+
+/* The sparse LU of a nonsingular n x n CSC matrix A (a descriptor model's
+   E): columns matched to its largest entries, fill-reducing order without
+   condensation, static pivots with no threshold. PHGMG_OK; PHGMG_ERR_UNSUPPORTED
+   when a pivot is zero or not finite or the growth exceeds
+   PHGMG_SPARSE_GROWTH (the static order cannot decide: the caller takes
+   the band LU with partial pivoting); _NOMEM. */
+PHGMG__PRIV phgmg_result phgmg__sp_lu_create(int n, const int *cp, const int *ci, const double *cx, phgmg__spsym **So,
+                                             phgmg__spnum *F, const phgmg_allocator *al) {
+  phgmg__spsym *S = PHGMG__CAST(phgmg__spsym *, phgmg__alloc(al, sizeof(phgmg__spsym)));
+  double *Mx = NULL, *w = NULL;
+  int j, p, nq = 0, r;
+  phgmg_result rc = PHGMG_ERR_NOMEM;
+  *So = NULL;
+  memset(F, 0, sizeof *F);
+  if (!S) return rc;
+  memset(S, 0, sizeof *S);
+  S->n = n;
+  S->jr_p = phgmg__ialloc(al, (size_t)n + 1); S->jr_i = phgmg__ialloc(al, (size_t)n + 1);
+  S->jr_x = phgmg__dalloc(al, (size_t)n + 1); S->q_p = phgmg__ialloc(al, (size_t)n + 1);
+  S->q_i = phgmg__ialloc(al, (size_t)cp[n] + 1); S->q_x = phgmg__dalloc(al, (size_t)cp[n] + 1);
+  S->cperm = phgmg__ialloc(al, (size_t)n);
+  if (!S->jr_p || !S->jr_i || !S->jr_x || !S->q_p || !S->q_i || !S->q_x || !S->cperm) goto done;
+  for (j = 0; j < n; ++j) { /* J - R = -I, Q = A: M = A */
+    S->jr_p[j] = j; S->jr_i[j] = j; S->jr_x[j] = -1.0; S->q_p[j] = nq;
+    for (p = cp[j]; p < cp[j + 1]; ++p)
+      if (cx[p] != 0.0) { S->q_i[nq] = ci[p]; S->q_x[nq] = cx[p]; ++nq; }
+  }
+  S->jr_p[n] = n; S->q_p[n] = nq;
+  if ((r = phgmg__sp_match(n, S->q_p, S->q_i, S->q_x, S->cperm, al)) < 0) goto done;
+  if (r == 0) { phgmg__free(al, S->cperm); S->cperm = NULL; }
+  if ((rc = phgmg__spsym_analyse(S, 0, al)) != PHGMG_OK) goto done;
+  rc = PHGMG_ERR_NOMEM;
+  Mx = phgmg__dalloc(al, (size_t)S->k_p[n] + 1);
+  w = phgmg__dalloc(al, (size_t)n);
+  if (!Mx || !w || phgmg__spnum_alloc(al, S, 0, F) != PHGMG_OK) goto done;
+  phgmg__sp_stage_values(S, NULL, Mx, w);
+  phgmg__sp_factor(S, F, Mx, 0.0, 0.0, 0.0);
+  rc = F->growth <= PHGMG_SPARSE_GROWTH ? PHGMG_OK : PHGMG_ERR_UNSUPPORTED;
+  for (j = 0; j < S->nsup && rc == PHGMG_OK; ++j) { /* the pivots */
+    const int nc = S->sfirst[j + 1] - S->sfirst[j], nf = nc + S->srp[j + 1] - S->srp[j];
+    for (p = 0; p < nc; ++p) {
+      const double d = F->X[S->lptr[j] + (size_t)p * (size_t)nf + (size_t)p];
+      if (!(fabs(d) > 0.0 && fabs(d) < HUGE_VAL)) { rc = PHGMG_ERR_UNSUPPORTED; break; }
+    }
+  }
+done:
+  phgmg__free(al, Mx);
+  phgmg__free(al, w);
+  if (rc != PHGMG_OK) { phgmg__spnum_free(al, F); phgmg__spsym_free(al, S); return rc; }
+  *So = S;
+  return PHGMG_OK;
+}
+
+PHGMG__PRIV void phgmg__jr_sp_free(phgmg_jr_factor *f) {
+  if (f->spf) { phgmg__spnum_free(&f->al, f->spf); phgmg__free(&f->al, f->spf); }
+  phgmg__spsym_free(&f->al, f->sps);
+  f->spf = NULL; f->sps = NULL;
+}
+PHGMG__PRIV void phgmg__jr_sp_solve(const void *fv, char trans, double *x) {
+  const phgmg_jr_factor *f = PHGMG__CAST(const phgmg_jr_factor *, fv);
+  if (trans == 'T' || trans == 't') phgmg__sp_solve_t(f->sps, f->spf, x);
+  else phgmg__sp_solve(f->sps, f->spf, x);
+}
+
+/* The factor of E of a SPARSE descriptor model by the sparse LU
+   (phgmg__sp_lu_create) in a phgmg_jr_factor (phgmg_jr_solve applies E^{-1},
+   E^{-T}); rcond_out (may be NULL): 1 / (||E||_1 est ||E^{-1}||_1) (Hager's
+   estimate through its solves). PHGMG_ERR_UNSUPPORTED when the static
+   pivots cannot decide (the caller takes the band LU). */
+PHGMG__PRIV phgmg_result phgmg__sp_e_factor(const phgmg_ph_system *sys, phgmg_jr_factor **out, double *rcond_out,
+                                            const phgmg_allocator *alloc) {
+  const phgmg_ph_sparse *sp = sys->sparse;
+  const int N = sys->N;
+  phgmg_jr_factor *f = PHGMG__CAST(phgmg_jr_factor *, phgmg__alloc(alloc, sizeof(phgmg_jr_factor)));
+  phgmg_result rc = PHGMG_ERR_NOMEM;
+  *out = NULL;
+  if (!f) return rc;
+  memset(f, 0, sizeof *f);
+  if (alloc) f->al = *alloc;
+  f->N = N;
+  f->storage = PHGMG_SPARSE;
+  f->spf = PHGMG__CAST(phgmg__spnum *, phgmg__alloc(alloc, sizeof(phgmg__spnum)));
+  if (f->spf) {
+    memset(f->spf, 0, sizeof *f->spf);
+    rc = phgmg__sp_lu_create(N, sp->cp[3], sp->ci[3], sp->cx[3], &f->sps, f->spf, alloc);
+  }
+  if (rc == PHGMG_OK && rcond_out) {
+    double *work = phgmg__dalloc(alloc, 2 * (size_t)N), en = 0.0, est;
+    int *iwork = phgmg__ialloc(alloc, (size_t)N), j, p;
+    if (!work || !iwork) rc = PHGMG_ERR_NOMEM;
+    for (j = 0; j < N && rc == PHGMG_OK; ++j) {
+      double cs = 0.0;
+      for (p = sp->cp[3][j]; p < sp->cp[3][j + 1]; ++p) cs += fabs(sp->cx[3][p]);
+      en = PHGMG__MAX(en, cs);
+    }
+    if (rc == PHGMG_OK) {
+      est = phgmg__inv_norm1(N, phgmg__jr_sp_solve, f, work, iwork);
+      *rcond_out = en > 0.0 && est > 0.0 && est < HUGE_VAL ? (1.0 / est) / en : 0.0;
+    }
+    phgmg__free(alloc, work);
+    phgmg__free(alloc, iwork);
+  }
+  if (rc != PHGMG_OK) { phgmg_jr_factor_destroy(f); return rc; }
+  *out = f;
+  return PHGMG_OK;
+}
+
 PHGMG_DEF void phgmg_ph_sparse_destroy(phgmg_ph_sparse *sp) {
   const phgmg_allocator *alloc;
   int a;
@@ -7386,6 +7766,7 @@ PHGMG_DEF void phgmg_ph_sparse_destroy(phgmg_ph_sparse *sp) {
     phgmg__free(alloc, sp->cp[a]); phgmg__free(alloc, sp->ci[a]); phgmg__free(alloc, sp->cx[a]);
   }
   phgmg__spsym_free(alloc, sp->sym);
+  phgmg__free(alloc, sp->vc);
   phgmg__free(alloc, sp);
 }
 
@@ -7477,7 +7858,9 @@ PHGMG_DEF phgmg_result phgmg_ph_sparse_create_e(phgmg_ph_sparse **out, int N, in
   if (alloc) { sp->a = *alloc; sp->alloc = &sp->a; }
   sp->perm = phgmg__ialloc(alloc, (size_t)N);
   sp->iperm = phgmg__ialloc(alloc, (size_t)N);
-  if (!sp->perm || !sp->iperm) { phgmg_ph_sparse_destroy(sp); return PHGMG_ERR_NOMEM; }
+  sp->vc = PHGMG__CAST(phgmg__valcache *, phgmg__alloc(alloc, sizeof(phgmg__valcache)));
+  if (!sp->perm || !sp->iperm || !sp->vc) { phgmg_ph_sparse_destroy(sp); return PHGMG_ERR_NOMEM; }
+  memset(sp->vc, 0, sizeof *sp->vc);
   rc = phgmg_rcm(N, na, A, sp->perm, &kb_rcm, alloc);
   if (rc != PHGMG_OK) { phgmg_ph_sparse_destroy(sp); return rc; }
   for (a = 0; a < na; ++a) {
@@ -7694,6 +8077,17 @@ PHGMG__PRIV const phgmg__spsym *phgmg__ph_sparse_lu(const phgmg_ph_system *sys) 
       sys->J != sp->cx[0] || sys->R != sp->cx[1] || sys->Q != sp->cx[2] || sys->nl == PHGMG_NL_GENERAL)
     return NULL;
   return sp->sym;
+}
+
+/* The validation cache of sys when sys is a sparse object's own system
+   (its current J, R, Q, E, no dampers or feedthrough), else NULL. */
+PHGMG__PRIV phgmg__valcache *phgmg__ph_valcache(const phgmg_ph_system *sys) {
+  const phgmg_ph_sparse *sp = sys->sparse;
+  if (!sp || !sp->vc || sys->N != sp->sys.N || sys->storage != sp->sys.storage || sys->kb != sp->sys.kb ||
+      sys->J != sp->sys.J || sys->R != sp->sys.R || sys->Q != sp->sys.Q || sys->E != sp->sys.E || sys->ndamp ||
+      sys->P || sys->S || sys->Nskew)
+    return NULL;
+  return sp->vc;
 }
 
 /* phgmg__ph_check's part for SPARSE storage: the object's own matrices, and
