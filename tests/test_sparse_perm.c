@@ -20,6 +20,11 @@
 typedef struct sp4_mat { int *cp, *ri; double *v; phgmg_csc A; } sp4_mat;
 typedef struct sp4_model { int N; sp4_mat M[4]; double *B; } sp4_model;
 
+/* The coefficients: Mc's off-diagonal (0.1), the on-site springs (0.1), a
+   coupling c of the momenta's damping R = 0.05 I + c A on the momenta (A:
+   the lattice's adjacency; 0). */
+static double sp4_mc = 0.1, sp4_onsite = 0.1, sp4_rc = 0.0;
+
 static int sp4_col(int a, int nx, int j, int *ri, double *v) {
   const int n = j / 2, x = n % nx, y = n / nx, isp = j & 1;
   int k = 0, d, nb[4], nn = 0;
@@ -28,14 +33,14 @@ static int sp4_col(int a, int nx, int j, int *ri, double *v) {
   if (x + 1 < nx) nb[nn++] = n + 1;
   if (y + 1 < nx) nb[nn++] = n + nx;
   if (a == 0) { ri[0] = isp ? 2 * n : 2 * n + 1; v[0] = isp ? 1.0 : -1.0; return 1; }
-  if (a == 1) { if (!isp) return 0; ri[0] = j; v[0] = 0.05; return 1; }
+  if (a == 1 && !isp) return 0;
   if (a == 2 && isp) { ri[0] = j; v[0] = 1.0; return 1; }
   if (a == 3 && !isp) { ri[0] = j; v[0] = 1.0; return 1; }
+  for (d = 0; d < nn; ++d) /* Q: the stiffness on the positions; E: Mc, R: the damping on the momenta */
+    if (nb[d] < n) { ri[k] = 2 * nb[d] + isp; v[k++] = a == 2 ? -1.0 : a == 1 ? sp4_rc : sp4_mc; }
+  ri[k] = j; v[k++] = a == 2 ? nn + sp4_onsite : a == 1 ? 0.05 : 1.0;
   for (d = 0; d < nn; ++d)
-    if (nb[d] < n) { ri[k] = 2 * nb[d] + isp; v[k++] = a == 2 ? -1.0 : 0.1; }
-  ri[k] = j; v[k++] = a == 2 ? nn + 0.1 : 1.0;
-  for (d = 0; d < nn; ++d)
-    if (nb[d] > n) { ri[k] = 2 * nb[d] + isp; v[k++] = a == 2 ? -1.0 : 0.1; }
+    if (nb[d] > n) { ri[k] = 2 * nb[d] + isp; v[k++] = a == 2 ? -1.0 : a == 1 ? sp4_rc : sp4_mc; }
   return k;
 }
 
@@ -125,6 +130,72 @@ TEST(test_sparse_perm_swapped_columns) {
   free(X0); free(X1);
 }
 
+/* phgmg_ph_validate of the lattice (E or not, columns swapped or not) with
+   the sparse LU (SPARSE storage: no band copy) and with the band LU (BANDED
+   storage: band checks), and the once-per-object count of the matrix checks
+   of the first. */
+static void sp4_validate(int nx, int withE, int swap, phgmg_result *rs, phgmg_result *rb, long *nrun) {
+  sp4_model md;
+  int run;
+  sp4_build(&md, nx, swap);
+  for (run = 0; run < 2; ++run) {
+    phgmg_ph_sparse *sp = NULL;
+    CHECK_RC(phgmg_ph_sparse_create_e(&sp, md.N, 1, &md.M[0].A, &md.M[1].A, &md.M[2].A, withE ? &md.M[3].A : NULL,
+                                      md.B, NULL, NULL, NULL), PHGMG_OK);
+    CHECK_RC(phgmg_ph_sparse_set_solver(sp, run ? PHGMG_SOLVER_BAND : PHGMG_SOLVER_SPARSE_LU, NULL), PHGMG_OK);
+    CHECK(phgmg_ph_sparse_system(sp)->storage == (run ? PHGMG_BANDED : PHGMG_SPARSE));
+    *(run ? rb : rs) = phgmg_ph_validate(phgmg_ph_sparse_system(sp), 0.0, NULL, NULL);
+    if (!run) {
+      CHECK_RC(phgmg_ph_validate(phgmg_ph_sparse_system(sp), 0.0, NULL, NULL), *rs); /* the same, not run again */
+      if (withE && *rs == PHGMG_OK) { /* no algebraic line: phgmg_dae_create reuses the checks too */
+        phgmg_dae *dae = NULL;
+        CHECK_RC(phgmg_dae_create(&dae, phgmg_ph_sparse_system(sp), 0.0, NULL), PHGMG_OK);
+        CHECK(dae && phgmg_dae_nalg(dae) == 0);
+        phgmg_dae_destroy(dae);
+      }
+      *nrun = sp->vc->nrun;
+    }
+    phgmg_ph_sparse_destroy(sp);
+  }
+  sp4_free(&md);
+}
+
+TEST(test_sparse_perm_validate_closed_forms) {
+  /* Expected results in closed form, with A the adjacency of the nx x nx
+     lattice (eigenvalues 2 cos(pi i/(nx+1)) + 2 cos(pi k/(nx+1)), the
+     smallest -4 cos(pi/(nx+1))) and the stiffness L + s I (L the graph
+     Laplacian, smallest eigenvalue 0): E^T Q = blockdiag(L + s I, Mc) with
+     Mc = I + c A on the momenta.
+     - c = 0.1, s = 0.1: E^T Q positive definite, R = 0.05 I: valid;
+     - c = 0.3 (1 - 1.2 cos(pi/33) < 0): E^T Q indefinite: EQ_NOT_PD;
+     - s = -0.1: the stiffness has the eigenvalue -0.1: EQ_NOT_PD, and
+       without E Q_NOT_PD;
+     - R = 0.05 I + 0.1 A on the momenta (0.05 - 0.4 cos(pi/33) < 0): R
+       not PSD (N = 2048 > the dense-eigenvalue limit: the sparse pivots).
+     Each also with the columns of E and Q swapped in pairs (E P, Q P: E^T Q
+     becomes P^T E^T Q P, the same inertia). The sparse checks give the
+     band checks' result, and run once for two validations (and
+     phgmg_dae_create of a valid model). */
+  static const struct { double mc, onsite, rc; int withE; phgmg_result want; } cs[] = {
+    {0.1, 0.1, 0.0, 1, PHGMG_OK},          {0.3, 0.1, 0.0, 1, PHGMG_ERR_EQ_NOT_PD},
+    {0.1, -0.1, 0.0, 1, PHGMG_ERR_EQ_NOT_PD}, {0.1, -0.1, 0.0, 0, PHGMG_ERR_Q_NOT_PD},
+    {0.1, 0.1, 0.1, 1, PHGMG_ERR_NOT_PSD},  {0.1, 0.1, 0.1, 0, PHGMG_ERR_NOT_PSD},
+    {0.1, 0.1, 0.0, 0, PHGMG_OK}};
+  int c, swap;
+  for (c = 0; c < (int)(sizeof cs / sizeof cs[0]); ++c)
+    for (swap = 0; swap < 1 + cs[c].withE; ++swap) {
+      phgmg_result rs = PHGMG_ERR_INVALID_ARG, rb = PHGMG_ERR_INVALID_ARG;
+      long nrun = 0;
+      sp4_mc = cs[c].mc; sp4_onsite = cs[c].onsite; sp4_rc = cs[c].rc;
+      sp4_validate(32, cs[c].withE, swap, &rs, &rb, &nrun);
+      CHECK_RC(rs, cs[c].want);
+      CHECK_RC(rb, cs[c].want);
+      CHECK(nrun == 1);
+    }
+  sp4_mc = 0.1; sp4_onsite = 0.1; sp4_rc = 0.0;
+}
+
 SUITE(sparse_perm) {
   RUN(test_sparse_perm_swapped_columns);
+  RUN(test_sparse_perm_validate_closed_forms);
 }
