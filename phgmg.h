@@ -465,8 +465,14 @@
    flops is used; phgmg_ph_sparse_info reports the choice and
    phgmg_ph_sparse_set_solver forces one. Descriptor models (E, a mass
    matrix) take the same choice: their stage matrices sigma E + M are
-   analysed with E's pattern joined (manual 8.12); an E with a zero row or
-   column (index one, 1.8) keeps the band LU.
+   analysed with E's pattern joined, their columns first permuted to put
+   E's largest entries on the diagonal (so a model whose E has zero
+   diagonal entries, e.g. with its columns in another order, keeps the
+   static pivots; manual 8.12); an E with a zero row or column (index one,
+   1.8) keeps the band LU. A stepper that falls back to the band LU says so
+   (phgmg_gl3_stats.band_fallback; the command line logs it).
+   phgmg_ph_validate checks a sparse model without band copies, once per
+   object: phgmg_dae_create and every reduction reuse the result.
 
    3. METHODS AND OPTIONS -------------------------------------------------------
    Every option struct is "zero means default": memset it to 0 and set what you
@@ -1281,7 +1287,9 @@
      PHGMG_SPARSE_PIVTOL max|K| is replaced by that value, and when any was
      replaced or the largest factor entry exceeds PHGMG_SPARSE_GROWTH
      max|K|, the stepper drops the sparse factors and uses the band LU with
-     partial pivoting for the rest of its life.
+     partial pivoting for the rest of its life, and says so:
+     phgmg_gl3_stats.sparse_lu becomes 0 and band_fallback 1 (the command
+     line logs a note after the run).
    Factors are kept across steps and, in phgmg_simulate_inputs (runs of
    one dt) and the automatic lambda's three full-model probe runs, across
    runs: one stepper serves them all (a linear model factors once).
@@ -1307,7 +1315,32 @@
    nothing but the diagonal (a mass-spring model with E = blockdiag(I, Mc):
    the positions, as without E); a state that E couples to another is never
    condensed. Static pivots are checked and fall back to the band LU as
-   above. An E with a zero row or column (the index-one path of 1.8, which
+   above.
+   Column permutation. The diagonal of sigma E + M need not hold E's
+   entries: a model whose E and Q have their columns permuted (E P, Q P:
+   the same dynamics for the state P^T x, the same outputs) has zero
+   diagonal entries in E P and often in sigma E P + M P, and static pivots
+   on them fail. Before the fill-reducing ordering the analysis therefore
+   permutes the columns of the stage matrix, K P_c with column j of K P_c
+   column cperm[j] of K, so that E's largest entries sit on the diagonal: a
+   maximum-product matching of the rows and columns of E (as MC64 computes
+   one; maximise prod_j |E(j, cperm[j])|, costs log max_k |E(k, j)| -
+   log |E(i, j)| >= 0, dual variables from the row and column minima, a
+   greedy start on the edges of zero reduced cost, then one Dijkstra search
+   of a shortest augmenting path per unmatched column). E is the part of
+   sigma E + M that dominates for the step sizes GL3 is used with, and for a
+   symmetric positive definite E (a mass matrix) the identity is the unique
+   optimum (|E(i, j)|^2 < E(i, i) E(j, j)), so a model in its natural order
+   keeps its analysis and one with permuted columns gets the permutation
+   back. The nested dissection, condensation and supernodes then work on
+   K P_c (its symmetrised pattern), a solve of K x = b solves K P_c y = b
+   and sets x[cperm[j]] = y[j]. phgmg_ph_sparse_info.colperm counts the
+   moved columns. An E with no perfect matching (structurally singular)
+   keeps the identity; the checked pivots then decide. Measured
+   (bench/bench_desc.c --swap 1 --setup 1, columns of E and Q exchanged in
+   pairs, Intel Xeon, one run): N = 3 200, 100 steps: the band fall-back
+   took 2.23 s to simulate, the sparse LU with the matching 0.19 s (0.14 s
+   for the natural order). An E with a zero row or column (the index-one path of 1.8, which
    condenses the algebraic lines in band or dense storage) keeps the band
    LU (forcing the sparse LU: PHGMG_ERR_UNSUPPORTED). Measured on a 2-D
    lattice whose momenta carry a mass matrix with the mesh's pattern
@@ -1327,21 +1360,53 @@
      each position with its momentum: bandwidth 1);
    - the definiteness of Q (and of R + tol ||R||_1 I, semidefiniteness of
      R, for N above the dense-eigenvalue limit) is read from the pivots of
-     the sparse LU of that matrix (static pivots, no exchanges): for a
+     the sparse LU of that matrix (its own analysis: condensation, nested
+     dissection; static pivots, no exchanges and no pivot threshold): for a
      symmetric matrix they are the D of its L D L^T, all positive exactly
-     when it is definite (Sylvester's law of inertia), and the elimination
-     of a definite matrix needs no pivoting to be stable. When a pivot had
-     to be replaced or the growth check fails, the band Cholesky of that
-     matrix alone (in its own reverse Cuthill-McKee order) decides;
+     when it is definite (Sylvester's law of inertia: the first pivot <= 0
+     in the elimination order shows a leading minor <= 0), and the
+     elimination of a definite matrix needs no pivoting to be stable (it is
+     Cholesky's, scaled). Tolerance policy: Q (and E^T Q) of a quadratic H
+     must have every pivot > 0 (positive definite to working precision, no
+     tolerance, as the dense and band Cholesky checks); with a nonlinear
+     part, and for R, the matrix shifted by tol times its 1-norm (an upper
+     bound of its 2-norm) must, i.e. lambda_min >= -tol ||.||_1 roughly; a
+     pivot that is NaN or infinite counts as not positive;
    - a stepper whose static pivots fail falls back to the band LU with band
      copies made inside the stepper (the O(N kb) memory is then spent);
    - a descriptor model's E is a fourth CSC copy (sys.E points at its
      values): products with E and E^T (the stepper's E Z, the Hamiltonian,
-     the reductions' E V and E^T G) go through it; the checks of
-     phgmg_ph_validate (E^T Q symmetric and definite, E nonsingular) and
-     the factor of E a reduction of a descriptor model keeps (B' = E^{-1} B)
-     work on band copies of E (and Q) made for that call and freed after:
-     O(N kb) memory while they run, none held by the object.
+     the reductions' E V and E^T G) go through it. The checks of
+     phgmg_ph_validate make no band copy either: E^T Q is formed as a sparse
+     product (E's transpose times Q, column by column), its symmetry is the
+     Frobenius test of the other checks (||E^T Q - Q^T E|| <= tol
+     ||E^T Q||), its symmetric part's definiteness the pivots above; the
+     separable coordinates' rows of E are read in one pass over its
+     entries; E's regularity (1 / cond_1(E) > tol) is Hager's estimate of
+     ||E^{-1}||_1 through the solves and transposed solves of a sparse LU
+     of E (matched columns, nested dissection, no condensation, static
+     pivots without threshold). The same factor serves a reduction's
+     B' = E^{-1} B and E^{-T} products. Only when that factor meets a zero
+     or non-finite pivot or growth above PHGMG_SPARSE_GROWTH (the static
+     order cannot decide) does the band LU of a band copy of E, made for the
+     call and freed after, take over.
+   - validation once per object: the matrix checks of phgmg_ph_validate (J
+     skew, R symmetric and PSD, the Q or E^T Q checks, E's regularity, the
+     rcond of J - R) of a sparse object's own system (its J, R, Q, E; no
+     dampers or feedthrough added) are kept in the object, per tolerance
+     and per "nl is NONE or not" (which decides definite or semidefinite),
+     and reused by every later phgmg_ph_validate of that system or of a
+     copy with a nonlinear part, by phgmg_dae_create (which validates the
+     model again when it has no algebraic line) and by every reduction
+     (each validates its system first). The cheap checks (sizes, finite
+     values, the nonlinear part, B's rank, the mass coupling of separable
+     coordinates) run every time. The object's matrices never change, so
+     the result stays valid for its life; validating one object from two
+     threads at once is not supported. Measured (bench/bench_desc.c
+     --setup 1, 2-D lattice with mass matrix, Intel Xeon, one run): N =
+     3 200: phgmg_ph_validate 0.20 s on band copies, 0.03-0.07 s sparse;
+     N = 20 000: 8.4 s on band copies (and again 8.6 s, and 9.8 s inside
+     phgmg_dae_create), 0.25 s sparse (then 0.000 s and 0.001 s).
    Measured on a 2-D lattice with N = 200 978 (bench/bench_sparse.sh),
    `phgmg reduce --simulate --steps 200 --method gmg-pod --r 20` peaks at
    about twice the snapshot matrix.
@@ -1706,7 +1771,11 @@ typedef struct phgmg_ph_system {
    failure is returned: PHGMG_ERR_INVALID_ARG (NULL pointers, missing
    callbacks) / _SIZE / _NANINF / _NOT_SKEW / _NOT_SYMMETRIC (R) /
    _Q_NOT_SYMMETRIC / _NOT_PSD (R) / _Q_NOT_PD / _RANK / _SINGULAR, or _NOMEM.
-   The system is never modified. */
+   The system is never modified. A sparse model's system (SPARSE storage):
+   the same decisions from the pivots of sparse factorizations, no band
+   copy; for any system of a phgmg_ph_sparse object the matrix checks run
+   once per object and tolerance, later calls (phgmg_dae_create's and every
+   reduction's too) reuse the result (manual 8.12). */
 PHGMG_DEF phgmg_result phgmg_ph_validate(const phgmg_ph_system *sys, double tol,
                                          double *rcond_out, const phgmg_allocator *alloc);
 
