@@ -23,7 +23,7 @@ typedef struct sp4_model { int N; sp4_mat M[4]; double *B; } sp4_model;
 /* The coefficients: Mc's off-diagonal (0.1), the on-site springs (0.1), a
    coupling c of the momenta's damping R = 0.05 I + c A on the momenta (A:
    the lattice's adjacency; 0). */
-static double sp4_mc = 0.1, sp4_onsite = 0.1, sp4_rc = 0.0;
+static double sp4_mc = 0.1, sp4_onsite = 0.1, sp4_rc = 0.0, sp4_ks = 1.0; /* sp4_ks: scales the stiffness */
 
 static int sp4_col(int a, int nx, int j, int *ri, double *v) {
   const int n = j / 2, x = n % nx, y = n / nx, isp = j & 1;
@@ -60,6 +60,7 @@ static void sp4_build(sp4_model *md, int nx, int swap) {
       nz += sp4_col(a, nx, src, M->ri + nz, M->v + nz);
     }
     M->cp[N] = nz;
+    if (a == 2) for (j = 0; j < nz; ++j) if (!(M->ri[j] & 1)) M->v[j] *= sp4_ks;
     M->A.n_rows = M->A.n_cols = N;
     M->A.colptr = M->cp; M->A.rowidx = M->ri; M->A.values = M->v;
   }
@@ -195,7 +196,55 @@ TEST(test_sparse_perm_validate_closed_forms) {
   sp4_mc = 0.1; sp4_onsite = 0.1; sp4_rc = 0.0;
 }
 
+TEST(test_sparse_perm_fallback_reported) {
+  /* Springs so stiff (stiffness times 1e10) that sigma E is below the
+     static-pivot threshold next to M on the momenta's rows: the checked
+     pivots fail and the stepper switches to the band LU; the statistics
+     say so (sparse_lu 0, band_fallback 1), and the states equal those of
+     the band solver's run. The unscaled model keeps the sparse LU. */
+  const int nx = 8, steps = 3, N = 2 * nx * nx;
+  sp4_model md;
+  double *x0 = (double *)calloc((size_t)N, sizeof(double)), *X[2], d = 0.0, xm = 0.0;
+  int run, k;
+  sp4_ks = 1e10;
+  sp4_build(&md, nx, 0);
+  sp4_ks = 1.0;
+  for (run = 0; run < 2; ++run) {
+    phgmg_ph_sparse *sp = NULL;
+    phgmg_gl3_stats st;
+    X[run] = (double *)malloc(sizeof(double) * (size_t)N * (steps + 1));
+    CHECK_RC(phgmg_ph_sparse_create_e(&sp, N, 1, &md.M[0].A, &md.M[1].A, &md.M[2].A, &md.M[3].A, md.B, NULL, NULL,
+                                      NULL), PHGMG_OK);
+    CHECK_RC(phgmg_ph_sparse_set_solver(sp, run ? PHGMG_SOLVER_BAND : PHGMG_SOLVER_SPARSE_LU, NULL), PHGMG_OK);
+    CHECK_RC(phgmg_simulate(phgmg_ph_sparse_system(sp), x0, 0.0, 0.1, steps, sp4_u, NULL, NULL, X[run], NULL, NULL,
+                            &st, NULL, NULL), PHGMG_OK);
+    if (!run) CHECK(st.sparse_lu == 0 && st.band_fallback == 1);
+    else CHECK(st.sparse_lu == 0 && st.band_fallback == 0);
+    phgmg_ph_sparse_destroy(sp);
+  }
+  {
+    sp4_model m1;
+    phgmg_ph_sparse *sp = NULL;
+    phgmg_gl3_stats st;
+    sp4_build(&m1, nx, 0);
+    CHECK_RC(phgmg_ph_sparse_create_e(&sp, N, 1, &m1.M[0].A, &m1.M[1].A, &m1.M[2].A, &m1.M[3].A, m1.B, NULL, NULL,
+                                      NULL), PHGMG_OK);
+    CHECK_RC(phgmg_ph_sparse_set_solver(sp, PHGMG_SOLVER_SPARSE_LU, NULL), PHGMG_OK);
+    CHECK_RC(phgmg_simulate(phgmg_ph_sparse_system(sp), x0, 0.0, 0.1, steps, sp4_u, NULL, NULL, NULL, NULL, NULL,
+                            &st, NULL, NULL), PHGMG_OK);
+    CHECK(st.sparse_lu == 1 && st.band_fallback == 0);
+    phgmg_ph_sparse_destroy(sp);
+    sp4_free(&m1);
+  }
+  for (k = 0; k < N * (steps + 1); ++k) { d = fmax(d, fabs(X[0][k] - X[1][k])); xm = fmax(xm, fabs(X[1][k])); }
+  CHECK(xm > 0.0);
+  CHECK_LE(d, 1e-10 * xm);
+  free(X[0]); free(X[1]); free(x0);
+  sp4_free(&md);
+}
+
 SUITE(sparse_perm) {
+  RUN(test_sparse_perm_fallback_reported);
   RUN(test_sparse_perm_swapped_columns);
   RUN(test_sparse_perm_validate_closed_forms);
 }
