@@ -1303,8 +1303,12 @@
    one factorization's memory traffic. phgmg_ph_sparse_set_solver forces a
    choice (tests, comparisons). The choice and both predictions are in
    phgmg_ph_sparse_info. The sparse solver serves the GL3 stepper of a
-   system with nl NONE or SEPARABLE; a GENERAL Hessian (banded by its
-   callback) keeps the band LU.
+   system with nl NONE or SEPARABLE, with or without feedthrough (P enters
+   the input matrix B - P and the outputs, not the stage matrices; the
+   check of [[R, P], [P^T, S]] is the pivots of its sparse L D L^T,
+   shifted by tol times its 1-norm, above the dense-eigenvalue limit of
+   2000 states); a GENERAL Hessian (banded by its callback) and dampers
+   keep the band LU.
    Descriptor models. With a mass matrix E the stage matrices are
    K(sigma) = sigma E + M (E in place of I). The analysis uses the pattern
    of M, of the identity and of E; the numeric assembly adds sigma times
@@ -1887,9 +1891,9 @@ PHGMG_DEF phgmg_result phgmg_rcm(int N, int na, const phgmg_csc *const *A, int *
    phgmg_ph_sparse_system gives the ready phgmg_ph_system (nl = NONE;
    storage BANDED or SPARSE by that choice): copy it to add a SEPARABLE
    nonlinear part. A SPARSE system serves validation, simulation and every
-   reduction method; it refuses (PHGMG_ERR_UNSUPPORTED) a GENERAL nonlinear
-   part, dampers, feedthrough, E and the shifted-solve callbacks, which need
-   band storage: call phgmg_ph_sparse_set_solver(sp, PHGMG_SOLVER_BAND, ..)
+   reduction method, E and feedthrough (P, S, Nskew) included; it refuses
+   (PHGMG_ERR_UNSUPPORTED) a GENERAL nonlinear part, dampers and the
+   shifted-solve callbacks, which need band storage: call phgmg_ph_sparse_set_solver(sp, PHGMG_SOLVER_BAND, ..)
    first (a copy made before that call no longer matches the object: copy
    again). Nothing is densified. Banded: the GL3 stepper, phgmg_jr_factor,
    phgmg_ph_validate cost O(N kb^2), solves O(N kb). Sparse: manual 8.12.
@@ -4875,7 +4879,10 @@ PHGMG__PRIV phgmg_result phgmg__ph_e_regular(const phgmg_ph_system *sys, double 
 /* Feedthrough: P, S, N finite, N skew, S symmetric and [[R, P], [P^T, S]]
    positive semidefinite (smallest eigenvalue >= -tol times the largest
    magnitude; dense eigenvalues of the (N + m) block, so banded models with
-   N > PHGMG__PH_PSD_DENSE_MAX are not checked: PHGMG_ERR_UNSUPPORTED). */
+   N > PHGMG__PH_PSD_DENSE_MAX are not checked: PHGMG_ERR_UNSUPPORTED;
+   SPARSE ones are, by phgmg__ph_sparse_feedthrough). */
+PHGMG__PRIV phgmg_result phgmg__ph_sparse_feedthrough(const phgmg_ph_system *s, double tol,
+                                                      const phgmg_allocator *al);
 PHGMG__PRIV phgmg_result phgmg__ph_validate_feedthrough(const phgmg_ph_system *sys, double tol,
                                                         const phgmg_allocator *alloc) {
   const int N = sys->N, m = sys->m, n = N + m;
@@ -4891,6 +4898,7 @@ PHGMG__PRIV phgmg_result phgmg__ph_validate_feedthrough(const phgmg_ph_system *s
       a += v * v; d += e * e;
     }
   if (sqrt(d) > tol * sqrt(a)) return PHGMG_ERR_FEEDTHROUGH;
+  if (sys->storage == PHGMG_SPARSE && N > PHGMG__PH_PSD_DENSE_MAX) return phgmg__ph_sparse_feedthrough(sys, tol, alloc);
   if (sys->storage == PHGMG_BANDED && N > PHGMG__PH_PSD_DENSE_MAX) return PHGMG_ERR_UNSUPPORTED;
   A = phgmg__dalloc(alloc, (size_t)n * n);
   w = phgmg__dalloc(alloc, (size_t)n);
@@ -7677,6 +7685,43 @@ PHGMG__PRIV phgmg_result phgmg__ph_sparse_etq_check(const phgmg_ph_system *s, do
   return rc;
 }
 
+/* The feedthrough block of a SPARSE system, [[R, P], [P^T, S]] ((N + m)
+   square; P dense N x m, S symmetric m x m), positive semidefinite within
+   tol: the block plus tol times its 1-norm times I positive definite by
+   the pivots of phgmg__sp_pd (R's policy; S symmetric is checked by the
+   caller). PHGMG_ERR_FEEDTHROUGH, _NOMEM. */
+PHGMG__PRIV phgmg_result phgmg__ph_sparse_feedthrough(const phgmg_ph_system *s, double tol,
+                                                      const phgmg_allocator *al) {
+  const phgmg_ph_sparse *sp = s->sparse;
+  const int N = s->N, m = s->m, n = N + m;
+  const size_t nz = (size_t)sp->cp[1][N] + 2 * (size_t)N * (size_t)m + (size_t)m * (size_t)m + 1;
+  int *cp = phgmg__ialloc(al, (size_t)n + 1), *ci = phgmg__ialloc(al, nz), j, p, k = 0, r;
+  double *cx = phgmg__dalloc(al, nz), n1 = 0.0;
+  phgmg_result rc = PHGMG_ERR_NOMEM;
+  if (!cp || !ci || !cx) goto done;
+  for (j = 0; j < n; ++j) { /* column j: R's (or P^T's) rows, then P's (or S's) */
+    double cs = 0.0;
+    cp[j] = k;
+    if (j < N) {
+      for (p = sp->cp[1][j]; p < sp->cp[1][j + 1]; ++p) { ci[k] = sp->ci[1][p]; cx[k++] = sp->cx[1][p]; }
+      for (r = 0; s->P && r < m; ++r) /* P's nonzero entries only: the pattern stays sparse */
+        if (s->P[(size_t)j + (size_t)r * (size_t)N] != 0.0) { ci[k] = N + r; cx[k++] = s->P[(size_t)j + (size_t)r * (size_t)N]; }
+    } else {
+      for (r = 0; s->P && r < N; ++r)
+        if (s->P[(size_t)r + (size_t)(j - N) * (size_t)N] != 0.0) { ci[k] = r; cx[k++] = s->P[(size_t)r + (size_t)(j - N) * (size_t)N]; }
+      for (r = 0; r < m; ++r) { ci[k] = N + r; cx[k++] = s->S ? s->S[(size_t)r + (size_t)(j - N) * (size_t)m] : 0.0; }
+    }
+    for (p = cp[j]; p < k; ++p) cs += fabs(cx[p]);
+    n1 = PHGMG__MAX(n1, cs);
+  }
+  cp[n] = k;
+  r = n1 > 0.0 ? phgmg__sp_pd(n, cp, ci, cx, tol * n1, al) : 1;
+  rc = r < 0 ? PHGMG_ERR_NOMEM : r ? PHGMG_OK : PHGMG_ERR_FEEDTHROUGH;
+done:
+  phgmg__free(al, cp); phgmg__free(al, ci); phgmg__free(al, cx);
+  return rc;
+}
+
 /* x <- K^{-T} x for a factor without a condensed block (real): the
    solve of (K P)^T y = P^T x, U^T then L^T supernode by supernode. */
 PHGMG__PRIV void phgmg__sp_solve_t(const phgmg__spsym *S, const phgmg__spnum *F, double *x) {
@@ -8166,7 +8211,7 @@ PHGMG__PRIV phgmg_result phgmg__ph_check_sparse(const phgmg_ph_system *s) {
   if (!sp || s->N != sp->sys.N || s->J != sp->cx[0] || s->R != sp->cx[1] || s->Q != sp->cx[2] ||
       s->E != sp->cx[3])
     return PHGMG_ERR_INVALID_ARG;
-  if (s->ndamp || s->P || s->S || s->Nskew || s->nl == PHGMG_NL_GENERAL || s->shifted_factor)
+  if (s->ndamp || s->nl == PHGMG_NL_GENERAL || s->shifted_factor)
     return PHGMG_ERR_UNSUPPORTED;
   return PHGMG_OK;
 }

@@ -1801,8 +1801,8 @@ static int load_sparse_system(const reduce_args *A, reduce_state *S, phgmg_ph_sy
   rc = phgmg_ph_sparse_create_e(&S->sp, N, m, &S->cJ.A, &S->cR.A, &S->cQ.A, A->Ecoo ? &S->cE.A : NULL, S->B.a,
                                 NULL, &inf, NULL);
   if (rc != PHGMG_OK) return fail("sparse J, R, Q%s: %s", A->Ecoo ? ", E" : "", phgmg_result_string(rc));
-  if ((A->Pf || A->Sf || A->Nf || A->dampf) && inf.solver == PHGMG_SOLVER_SPARSE_LU &&
-      (rc = phgmg_ph_sparse_set_solver(S->sp, PHGMG_SOLVER_BAND, &inf)) != PHGMG_OK) /* the sparse LU: no feedthrough, dampers */
+  if (A->dampf && inf.solver == PHGMG_SOLVER_SPARSE_LU &&
+      (rc = phgmg_ph_sparse_set_solver(S->sp, PHGMG_SOLVER_BAND, &inf)) != PHGMG_OK) /* the sparse LU: no dampers */
     return fail("sparse J, R, Q: band solver: %s", phgmg_result_string(rc));
   *sys = *phgmg_ph_sparse_system(S->sp);
   progress("sparse J, R, Q: N = %d, %ld stored entries; half-bandwidth %d (given order %d, reverse "

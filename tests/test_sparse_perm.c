@@ -243,7 +243,61 @@ TEST(test_sparse_perm_fallback_reported) {
   sp4_free(&md);
 }
 
+/* The lattice with E and feedthrough P = p e_1 (the driven momentum), S = 1:
+   validation and a run of steps steps on the solver given; outputs into Y. */
+static phgmg_result sp4_feed(int nx, double pv, int solver, int steps, double *Y, phgmg_gl3_stats *st) {
+  sp4_model md;
+  phgmg_ph_sparse *sp = NULL;
+  phgmg_ph_system sys;
+  double *P, *Pi, *x0, S1 = 1.0;
+  phgmg_result rc;
+  sp4_build(&md, nx, 0);
+  P = (double *)calloc((size_t)md.N, sizeof(double));
+  Pi = (double *)calloc((size_t)md.N, sizeof(double));
+  x0 = (double *)calloc((size_t)md.N, sizeof(double));
+  P[1] = pv;
+  CHECK_RC(phgmg_ph_sparse_create_e(&sp, md.N, 1, &md.M[0].A, &md.M[1].A, &md.M[2].A, &md.M[3].A, md.B, NULL, NULL,
+                                    NULL), PHGMG_OK);
+  CHECK_RC(phgmg_ph_sparse_set_solver(sp, solver, NULL), PHGMG_OK);
+  CHECK_RC(phgmg_ph_sparse_to_banded_order(sp, 1, P, md.N, Pi, md.N), PHGMG_OK);
+  sys = *phgmg_ph_sparse_system(sp);
+  sys.P = Pi; sys.S = &S1;
+  rc = phgmg_ph_validate(&sys, 0.0, NULL, NULL);
+  if (rc == PHGMG_OK && Y)
+    CHECK_RC(phgmg_simulate(&sys, x0, 0.0, 0.1, steps, sp4_u, NULL, NULL, NULL, Y, NULL, st, NULL, NULL), PHGMG_OK);
+  phgmg_ph_sparse_destroy(sp);
+  free(P); free(Pi); free(x0);
+  sp4_free(&md);
+  return rc;
+}
+
+TEST(test_sparse_perm_feedthrough) {
+  /* Feedthrough on the sparse LU: P only changes the input matrix (B - P)
+     and the outputs, not the stage matrices. [[R, P], [P^T, S]] with R =
+     0.05 on the momenta, P = p e_1, S = 1 is PSD iff p^2 <= 0.05: p = 0.2
+     valid, p = 0.3 not (PHGMG_ERR_FEEDTHROUGH), by the band solver's dense
+     check (N = 512) and the sparse one, also above the dense limit (N = 2048,
+     the sparse pivots; the band storage cannot check it there). The run
+     with p = 0.2 takes the sparse LU throughout and its outputs equal the
+     band solver's to 1e-10. */
+  const int steps = 40;
+  double Ys[41], Yb[41], d = 0.0, ym = 0.0;
+  phgmg_gl3_stats ss, sb;
+  int k;
+  CHECK_RC(sp4_feed(16, 0.2, PHGMG_SOLVER_SPARSE_LU, steps, Ys, &ss), PHGMG_OK);
+  CHECK_RC(sp4_feed(16, 0.2, PHGMG_SOLVER_BAND, steps, Yb, &sb), PHGMG_OK);
+  CHECK(ss.sparse_lu == 1 && ss.band_fallback == 0 && sb.sparse_lu == 0);
+  for (k = 0; k <= steps; ++k) { d = fmax(d, fabs(Ys[k] - Yb[k])); ym = fmax(ym, fabs(Yb[k])); }
+  CHECK(ym > 0.0);
+  CHECK_LE(d, 1e-10 * ym);
+  CHECK_RC(sp4_feed(16, 0.3, PHGMG_SOLVER_SPARSE_LU, 0, NULL, NULL), PHGMG_ERR_FEEDTHROUGH);
+  CHECK_RC(sp4_feed(16, 0.3, PHGMG_SOLVER_BAND, 0, NULL, NULL), PHGMG_ERR_FEEDTHROUGH);
+  CHECK_RC(sp4_feed(32, 0.2, PHGMG_SOLVER_SPARSE_LU, 0, NULL, NULL), PHGMG_OK);
+  CHECK_RC(sp4_feed(32, 0.3, PHGMG_SOLVER_SPARSE_LU, 0, NULL, NULL), PHGMG_ERR_FEEDTHROUGH);
+}
+
 SUITE(sparse_perm) {
+  RUN(test_sparse_perm_feedthrough);
   RUN(test_sparse_perm_fallback_reported);
   RUN(test_sparse_perm_swapped_columns);
   RUN(test_sparse_perm_validate_closed_forms);
