@@ -296,7 +296,58 @@ TEST(test_sparse_perm_feedthrough) {
   CHECK_RC(sp4_feed(32, 0.3, PHGMG_SOLVER_SPARSE_LU, 0, NULL, NULL), PHGMG_ERR_FEEDTHROUGH);
 }
 
+TEST(test_sparse_perm_e_factor_solves) {
+  /* The sparse LU of E with its columns swapped in pairs (zero diagonal;
+     the matching restores it), as validation and reductions use it: x =
+     E^{-1} b and E^{-T} b satisfy E x = b, E^T x = b to round-off
+     (residuals by products with the CSC matrix, an independent
+     computation), and the rcond estimate is the band LU's (both Hager's
+     estimate of the same norm) within a factor 2. */
+  sp4_model md;
+  phgmg_ph_sparse *sp = NULL;
+  phgmg_jr_factor *f = NULL;
+  const phgmg_ph_system *sys;
+  double *b, *x, *r, rs = 0.0, rb = 0.0, res, bn;
+  int N, t, j, p;
+  sp4_build(&md, 12, 1);
+  N = md.N;
+  CHECK_RC(phgmg_ph_sparse_create_e(&sp, N, 1, &md.M[0].A, &md.M[1].A, &md.M[2].A, &md.M[3].A, md.B, NULL, NULL,
+                                    NULL), PHGMG_OK);
+  CHECK_RC(phgmg_ph_sparse_set_solver(sp, PHGMG_SOLVER_SPARSE_LU, NULL), PHGMG_OK);
+  sys = phgmg_ph_sparse_system(sp);
+  CHECK_RC(phgmg__e_factor(sys, &f, &rs, NULL), PHGMG_OK);
+  CHECK(f && f->sps != NULL && f->sps->cperm != NULL);
+  b = (double *)malloc(sizeof(double) * (size_t)N); x = (double *)malloc(sizeof(double) * (size_t)N);
+  r = (double *)malloc(sizeof(double) * (size_t)N);
+  for (t = 0; t < 2 && f; ++t) {
+    for (j = 0; j < N; ++j) b[j] = x[j] = sin(1.0 + 0.37 * j);
+    phgmg_jr_solve(f, t ? 'T' : 'N', 1, x, N);
+    for (j = 0; j < N; ++j) r[j] = -b[j];
+    for (j = 0; j < N; ++j) /* r += E x (t = 0) or E^T x (t = 1) */
+      for (p = sp->cp[3][j]; p < sp->cp[3][j + 1]; ++p) {
+        if (!t) r[sp->ci[3][p]] += sp->cx[3][p] * x[j];
+        else r[j] += sp->cx[3][p] * x[sp->ci[3][p]];
+      }
+    res = 0.0; bn = 0.0;
+    for (j = 0; j < N; ++j) { res = fmax(res, fabs(r[j])); bn = fmax(bn, fabs(b[j])); }
+    CHECK_LE(res, 1e-13 * bn);
+  }
+  phgmg_jr_factor_destroy(f);
+  CHECK_RC(phgmg_ph_sparse_set_solver(sp, PHGMG_SOLVER_BAND, NULL), PHGMG_OK);
+  f = NULL;
+  CHECK_RC(phgmg__e_factor(phgmg_ph_sparse_system(sp), &f, &rb, NULL), PHGMG_OK);
+  CHECK(f && f->sps == NULL);
+  CHECK(rs > 0.0 && rb > 0.0);
+  CHECK_LE(rs, 2.0 * rb);
+  CHECK_LE(rb, 2.0 * rs);
+  phgmg_jr_factor_destroy(f);
+  phgmg_ph_sparse_destroy(sp);
+  free(b); free(x); free(r);
+  sp4_free(&md);
+}
+
 SUITE(sparse_perm) {
+  RUN(test_sparse_perm_e_factor_solves);
   RUN(test_sparse_perm_feedthrough);
   RUN(test_sparse_perm_fallback_reported);
   RUN(test_sparse_perm_swapped_columns);
