@@ -4845,18 +4845,16 @@ PHGMG__PRIV phgmg_result phgmg__ph_e_coupled(const phgmg_ph_system *sys, const p
     phgmg_result rc = PHGMG_OK;
     if (!is) return PHGMG_ERR_NOMEM;
     for (j = 0; j < sys->N; ++j) is[j] = 0;
-    for (k = 0; k < sys->nsep; ++k) is[sys->sep_idx[k]] = 1;
-    for (j = 0; j < sys->N; ++j) /* positive diagonals (zero: not stored) */
-      if (is[j]) is[j] = 2;
+    for (k = 0; k < sys->nsep; ++k) is[sys->sep_idx[k]] = 1;   /* 1: a row still to show E(i, i) > 0 */
     for (j = 0; j < sys->N && rc == PHGMG_OK; ++j)
       for (p = cp[j]; p < cp[j + 1]; ++p) {
         const int i = ci[p];
         if (!is[i]) continue;
-        if (i == j && cx[p] > 0.0) is[i] = is[i] == 2 ? 1 : is[i];
+        if (i == j && cx[p] > 0.0) is[i] = 2;                    /* 2: its diagonal is positive */
         else if (i != j && cx[p] != 0.0) { rc = PHGMG_ERR_E_COUPLED; break; }
       }
     for (j = 0; j < sys->N && rc == PHGMG_OK; ++j)
-      if (is[j] == 2) rc = PHGMG_ERR_E_COUPLED;
+      if (is[j] == 1) rc = PHGMG_ERR_E_COUPLED;
     phgmg__free(alloc, is);
     return rc;
   }

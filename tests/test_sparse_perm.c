@@ -346,7 +346,36 @@ TEST(test_sparse_perm_e_factor_solves) {
   sp4_free(&md);
 }
 
+static double sp4_phi(int k, double v, void *user) { (void)k; (void)user; return cosh(v); }
+
+TEST(test_sparse_perm_separable_coupling) {
+  /* A separable term on a position (E's row: the identity's) is accepted; on
+     a momentum (E's row holds the mass matrix's couplings to the
+     neighbours) it is refused with PHGMG_ERR_E_COUPLED, by the sparse checks
+     (one pass over E's entries) as by the band ones. */
+  sp4_model md;
+  int run, c;
+  sp4_build(&md, 8, 0);
+  for (run = 0; run < 2; ++run)
+    for (c = 0; c < 2; ++c) {
+      phgmg_ph_sparse *sp = NULL;
+      phgmg_ph_system sys;
+      const int idx = c ? 11 : 10;   /* the momentum, the position of mass 5 */
+      CHECK_RC(phgmg_ph_sparse_create_e(&sp, md.N, 1, &md.M[0].A, &md.M[1].A, &md.M[2].A, &md.M[3].A, md.B, NULL,
+                                        NULL, NULL), PHGMG_OK);
+      CHECK_RC(phgmg_ph_sparse_set_solver(sp, run ? PHGMG_SOLVER_BAND : PHGMG_SOLVER_SPARSE_LU, NULL), PHGMG_OK);
+      sys = *phgmg_ph_sparse_system(sp);
+      sys.nl = PHGMG_NL_SEPARABLE;
+      sys.phi = sys.dphi = sys.ddphi = sp4_phi;
+      CHECK_RC(phgmg_ph_sparse_sep_idx(sp, 1, &idx, NULL, &sys), PHGMG_OK);
+      CHECK_RC(phgmg_ph_validate(&sys, 0.0, NULL, NULL), c ? PHGMG_ERR_E_COUPLED : PHGMG_OK);
+      phgmg_ph_sparse_destroy(sp);
+    }
+  sp4_free(&md);
+}
+
 SUITE(sparse_perm) {
+  RUN(test_sparse_perm_separable_coupling);
   RUN(test_sparse_perm_e_factor_solves);
   RUN(test_sparse_perm_feedthrough);
   RUN(test_sparse_perm_fallback_reported);
