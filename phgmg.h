@@ -476,8 +476,14 @@
    flops is used; phgmg_ph_sparse_info reports the choice and
    phgmg_ph_sparse_set_solver forces one. Descriptor models (E, a mass
    matrix) take the same choice: their stage matrices sigma E + M are
-   analysed with E's pattern joined (manual 8.12); an E with a zero row or
-   column (index one, 1.8) keeps the band LU.
+   analysed with E's pattern joined, their columns first permuted to put
+   E's largest entries on the diagonal (so a model whose E has zero
+   diagonal entries, e.g. with its columns in another order, keeps the
+   static pivots; manual 8.12); an E with a zero row or column (index one,
+   1.8) keeps the band LU. A stepper that falls back to the band LU says so
+   (phgmg_gl3_stats.band_fallback; the command line logs it).
+   phgmg_ph_validate checks a sparse model without band copies, once per
+   object: phgmg_dae_create and every reduction reuse the result.
 
    2.7 Distributed offline phase (>>mpi; define PHGMG_MPI before the include,
    compile with mpicc; the section includes <mpi.h> and needs nothing else).
@@ -1463,7 +1469,9 @@
      PHGMG_SPARSE_PIVTOL max|K| is replaced by that value, and when any was
      replaced or the largest factor entry exceeds PHGMG_SPARSE_GROWTH
      max|K|, the stepper drops the sparse factors and uses the band LU with
-     partial pivoting for the rest of its life.
+     partial pivoting for the rest of its life, and says so:
+     phgmg_gl3_stats.sparse_lu becomes 0 and band_fallback 1 (the command
+     line logs a note after the run).
    Factors are kept across steps and, in phgmg_simulate_inputs (runs of
    one dt) and the automatic lambda's three full-model probe runs, across
    runs: one stepper serves them all (a linear model factors once).
@@ -1477,8 +1485,12 @@
    one factorization's memory traffic. phgmg_ph_sparse_set_solver forces a
    choice (tests, comparisons). The choice and both predictions are in
    phgmg_ph_sparse_info. The sparse solver serves the GL3 stepper of a
-   system with nl NONE or SEPARABLE; a GENERAL Hessian (banded by its
-   callback) keeps the band LU.
+   system with nl NONE or SEPARABLE, with or without feedthrough (P enters
+   the input matrix B - P and the outputs, not the stage matrices; the
+   check of [[R, P], [P^T, S]] is the pivots of its sparse L D L^T,
+   shifted by tol times its 1-norm, above the dense-eigenvalue limit of
+   2000 states); a GENERAL Hessian (banded by its callback) and dampers
+   keep the band LU.
    Descriptor models. With a mass matrix E the stage matrices are
    K(sigma) = sigma E + M (E in place of I). The analysis uses the pattern
    of M, of the identity and of E; the numeric assembly adds sigma times
@@ -1489,7 +1501,34 @@
    nothing but the diagonal (a mass-spring model with E = blockdiag(I, Mc):
    the positions, as without E); a state that E couples to another is never
    condensed. Static pivots are checked and fall back to the band LU as
-   above. An E with a zero row or column (the index-one path of 1.8, which
+   above.
+   Column permutation. The diagonal of sigma E + M need not hold E's
+   entries: a model whose E and Q have their columns permuted (E P, Q P:
+   the same dynamics for the state P^T x, the same outputs) has zero
+   diagonal entries in E P and often in sigma E P + M P, and static pivots
+   on them fail. Before the fill-reducing ordering the analysis therefore
+   permutes the columns of the stage matrix, K P_c with column j of K P_c
+   column cperm[j] of K, so that E's largest entries sit on the diagonal: a
+   maximum-product matching of the rows and columns of E (as MC64 computes
+   one; maximise prod_j |E(j, cperm[j])|, costs log max_k |E(k, j)| -
+   log |E(i, j)| >= 0, dual variables from the row and column minima, a
+   greedy start on the edges of zero reduced cost, then one Dijkstra search
+   of a shortest augmenting path per unmatched column). E is the part of
+   sigma E + M that dominates for the step sizes GL3 is used with, and for a
+   symmetric positive definite E (a mass matrix) the identity is the unique
+   optimum (|E(i, j)|^2 < E(i, i) E(j, j)), so a model in its natural order
+   keeps its analysis and one with permuted columns gets the permutation
+   back. The nested dissection, condensation and supernodes then work on
+   K P_c (its symmetrised pattern), a solve of K x = b solves K P_c y = b
+   and sets x[cperm[j]] = y[j]. phgmg_ph_sparse_info.colperm counts the
+   moved columns. An E with no perfect matching (structurally singular)
+   keeps the identity; the checked pivots then decide. A diagonal that
+   holds each column's largest entry (a mass matrix in its natural order)
+   is taken as it is, without the search. Measured (bench/bench_desc.c
+   --nx 40 --steps 100 --swap 1 --setup 1, columns of E and Q exchanged in
+   pairs, N = 3 200, Intel Xeon): the band fall-back took 1.21 s to
+   simulate, the sparse LU with the matching 0.068 s (0.054-0.059 s for the
+   natural order). An E with a zero row or column (the index-one path of 1.8, which
    condenses the algebraic lines in band or dense storage) keeps the band
    LU (forcing the sparse LU: PHGMG_ERR_UNSUPPORTED). Measured on a 2-D
    lattice whose momenta carry a mass matrix with the mesh's pattern
@@ -1509,21 +1548,55 @@
      each position with its momentum: bandwidth 1);
    - the definiteness of Q (and of R + tol ||R||_1 I, semidefiniteness of
      R, for N above the dense-eigenvalue limit) is read from the pivots of
-     the sparse LU of that matrix (static pivots, no exchanges): for a
+     the sparse LU of that matrix (its own analysis: condensation, nested
+     dissection; static pivots, no exchanges and no pivot threshold): for a
      symmetric matrix they are the D of its L D L^T, all positive exactly
-     when it is definite (Sylvester's law of inertia), and the elimination
-     of a definite matrix needs no pivoting to be stable. When a pivot had
-     to be replaced or the growth check fails, the band Cholesky of that
-     matrix alone (in its own reverse Cuthill-McKee order) decides;
+     when it is definite (Sylvester's law of inertia: the first pivot <= 0
+     in the elimination order shows a leading minor <= 0), and the
+     elimination of a definite matrix needs no pivoting to be stable (it is
+     Cholesky's, scaled). Tolerance policy: Q (and E^T Q) of a quadratic H
+     must have every pivot > 0 (positive definite to working precision, no
+     tolerance, as the dense and band Cholesky checks); with a nonlinear
+     part, and for R, the matrix shifted by tol times its 1-norm (an upper
+     bound of its 2-norm) must, i.e. lambda_min >= -tol ||.||_1 roughly; a
+     pivot that is NaN or infinite counts as not positive;
    - a stepper whose static pivots fail falls back to the band LU with band
      copies made inside the stepper (the O(N kb) memory is then spent);
    - a descriptor model's E is a fourth CSC copy (sys.E points at its
      values): products with E and E^T (the stepper's E Z, the Hamiltonian,
-     the reductions' E V and E^T G) go through it; the checks of
-     phgmg_ph_validate (E^T Q symmetric and definite, E nonsingular) and
-     the factor of E a reduction of a descriptor model keeps (B' = E^{-1} B)
-     work on band copies of E (and Q) made for that call and freed after:
-     O(N kb) memory while they run, none held by the object.
+     the reductions' E V and E^T G) go through it. The checks of
+     phgmg_ph_validate make no band copy either: E^T Q is formed as a sparse
+     product (E's transpose times Q, column by column), its symmetry is the
+     Frobenius test of the other checks (||E^T Q - Q^T E|| <= tol
+     ||E^T Q||), its symmetric part's definiteness the pivots above; the
+     separable coordinates' rows of E are read in one pass over its
+     entries; E's regularity (1 / cond_1(E) > tol) is Hager's estimate of
+     ||E^{-1}||_1 through the solves and transposed solves of a sparse LU
+     of E (matched columns, nested dissection, no condensation, static
+     pivots without threshold). The same factor serves a reduction's
+     B' = E^{-1} B and E^{-T} products. Only when that factor meets a zero
+     or non-finite pivot or growth above PHGMG_SPARSE_GROWTH (the static
+     order cannot decide) does the band LU of a band copy of E, made for the
+     call and freed after, take over.
+   - validation once per object: the matrix checks of phgmg_ph_validate (J
+     skew, R symmetric and PSD, the Q or E^T Q checks, E's regularity, the
+     rcond of J - R) of a sparse object's own system (its J, R, Q, E; no
+     dampers or feedthrough added) are kept in the object, per tolerance
+     and per "nl is NONE or not" (which decides definite or semidefinite),
+     and reused by every later phgmg_ph_validate of that system or of a
+     copy with a nonlinear part, by phgmg_dae_create (which validates the
+     model again when it has no algebraic line) and by every reduction
+     (each validates its system first). The cheap checks (sizes, finite
+     values, the nonlinear part, B's rank, the mass coupling of separable
+     coordinates) run every time. The object's matrices never change, so
+     the result stays valid for its life; validating one object from two
+     threads at once is not supported. Measured (bench/bench_desc.c
+     --setup 1, 2-D lattice with mass matrix, Intel Xeon): N = 3 200
+     (--nx 40): phgmg_ph_validate 0.11-0.16 s on band copies (and again
+     0.10 s, and 0.11 s inside phgmg_dae_create), 0.014-0.021 s sparse (then
+     0.000 s twice); N = 20 000 (--nx 100): 3.6 s on band copies (again
+     3.6 s, 3.6 s in phgmg_dae_create), 0.10 s sparse (then 0.000 s and
+     0.001 s).
    Measured on a 2-D lattice with N = 200 978 (bench/bench_sparse.sh),
    `phgmg reduce --simulate --steps 200 --method gmg-pod --r 20` peaks at
    about twice the snapshot matrix.
@@ -1998,7 +2071,11 @@ typedef struct phgmg_ph_system {
    Descriptor models (E set) add the codes of manual 1.8; a singular E that
    is neither dense nor of the zero-line form is PHGMG_ERR_E_SINGULAR, also
    where E^T Q's checks would fail first (its cause is E).
-   The system is never modified. */
+   The system is never modified. A sparse model's system (SPARSE storage):
+   the same decisions from the pivots of sparse factorizations, no band
+   copy; for any system of a phgmg_ph_sparse object the matrix checks run
+   once per object and tolerance, later calls (phgmg_dae_create's and every
+   reduction's too) reuse the result (manual 8.12). */
 PHGMG_DEF phgmg_result phgmg_ph_validate(const phgmg_ph_system *sys, double tol,
                                          double *rcond_out, const phgmg_allocator *alloc);
 
@@ -2119,9 +2196,9 @@ PHGMG_DEF phgmg_result phgmg_rcm(int N, int na, const phgmg_csc *const *A, int *
    phgmg_ph_sparse_system gives the ready phgmg_ph_system (nl = NONE;
    storage BANDED or SPARSE by that choice): copy it to add a SEPARABLE
    nonlinear part. A SPARSE system serves validation, simulation and every
-   reduction method; it refuses (PHGMG_ERR_UNSUPPORTED) a GENERAL nonlinear
-   part, dampers, feedthrough, E and the shifted-solve callbacks, which need
-   band storage: call phgmg_ph_sparse_set_solver(sp, PHGMG_SOLVER_BAND, ..)
+   reduction method, E and feedthrough (P, S, Nskew) included; it refuses
+   (PHGMG_ERR_UNSUPPORTED) a GENERAL nonlinear part, dampers and the
+   shifted-solve callbacks, which need band storage: call phgmg_ph_sparse_set_solver(sp, PHGMG_SOLVER_BAND, ..)
    first (a copy made before that call no longer matches the object: copy
    again). Nothing is densified. Banded: the GL3 stepper, phgmg_jr_factor,
    phgmg_ph_validate cost O(N kb^2), solves O(N kb). Sparse: manual 8.12.
@@ -2173,6 +2250,7 @@ typedef struct phgmg_ph_sparse_info {
   int supernodes;     /* supernodes of the sparse factor (0: not analysed)     */
   int front_max;      /* largest dense front (order)                           */
   int condensed;      /* states eliminated first by block elimination (manual 8.12) */
+  int colperm;        /* columns moved by the pivot matching of a descriptor model (manual 8.12) */
   int band_copy;      /* 1: the object holds band copies of J, R, Q (and E) (band solver) */
   double bytes;       /* memory the object holds now (its arrays, the analysis)   */
 } phgmg_ph_sparse_info;
@@ -2297,6 +2375,11 @@ typedef struct phgmg_gl3_opts {
 typedef struct phgmg_gl3_stats {
   long steps, newton_iters, factorizations, rhs_evals, failures;
   double max_residual;  /* largest final stage residual over the steps */
+  /* The stage-matrix solver (manual 8.12): sparse_lu = 1 while the stepper
+     solves with the sparse LU; band_fallback = 1 once its checked static
+     pivots failed and it switched to the band LU with partial pivoting for
+     the rest of its life (slower, O(N kb) memory: sparse_lu is then 0). */
+  int sparse_lu, band_fallback;
 } phgmg_gl3_stats;
 
 /* Energy bookkeeping of one run, per grid point n = 0..nsteps:
@@ -4221,6 +4304,16 @@ PHGMG__PRIV phgmg_result phgmg__sym_tridiag_ql(int n, double *W, int ldw, int ve
    shifted band Cholesky instead of a dense eigenvalue computation. */
 #define PHGMG__PH_PSD_DENSE_MAX 2000
 
+/* phgmg_ph_validate's matrix checks of a sparse model's own system, done
+   once per object (manual 8.12): per key (tol, nl != NONE) the result of
+   the structure checks, of E's regularity and J - R's rcond. nrun counts
+   the runs of the checks (a test seam). Mutable through a const object:
+   one thread at a time validates an object. */
+typedef struct phgmg__valcache {
+  struct { int set; double tol; phgmg_result rc[2]; double rcond; } slot[2];
+  long nrun;
+} phgmg__valcache;
+PHGMG__PRIV phgmg__valcache *phgmg__ph_valcache(const phgmg_ph_system *sys);
 PHGMG__PRIV int phgmg__ph_csc_of(const phgmg_ph_system *s, const double *M, const int **cp, const int **ci,
                                  const double **cx);
 PHGMG__PRIV phgmg_result phgmg__ph_sparse_own_band(const phgmg_ph_system *s, int a1, int a2, phgmg_ph_system *t,
@@ -4922,24 +5015,26 @@ PHGMG__PRIV void phgmg__gbf_solve(const phgmg__gbf *f, char trans, double *b) {
   phgmg__gb_solve(trans, f->n, f->kl, f->ku, f->ue, f->ab, f->ldab, f->ipiv, f->dinv, b);
 }
 
-/* Hager/Higham estimate of ||A^{-1}||_1 from band factors (LAPACK dlacn2 logic).
-   work: 2n doubles, iwork: n ints. */
-PHGMG__PRIV double phgmg__gbf_inv_norm1(const phgmg__gbf *f, double *work, int *isgn) {
-  int n = f->n, i, j, jlast, iter, same;
+/* Hager/Higham estimate of ||A^{-1}||_1 from a solver of A x = b ('N') and
+   A^T x = b ('T') in place (LAPACK dlacn2 logic). work: 2n doubles, iwork:
+   n ints. */
+typedef void (*phgmg__solve_fn)(const void *ctx, char trans, double *x);
+PHGMG__PRIV double phgmg__inv_norm1(int n, phgmg__solve_fn solve, const void *f, double *work, int *isgn) {
+  int i, j, jlast, iter, same;
   double *x = work, est, estold, temp;
   for (i = 0; i < n; ++i) x[i] = 1.0 / (double)n;
-  phgmg__gbf_solve(f, 'N', x);
+  solve(f, 'N', x);
   if (n == 1) return fabs(x[0]);
   est = 0.0;
   for (i = 0; i < n; ++i) est += fabs(x[i]);
   for (i = 0; i < n; ++i) { isgn[i] = x[i] >= 0.0 ? 1 : -1; x[i] = (double)isgn[i]; }
-  phgmg__gbf_solve(f, 'T', x);
+  solve(f, 'T', x);
   j = 0;
   for (i = 1; i < n; ++i) if (fabs(x[i]) > fabs(x[j])) j = i;
   for (iter = 2;; ++iter) {
     for (i = 0; i < n; ++i) x[i] = 0.0;
     x[j] = 1.0;
-    phgmg__gbf_solve(f, 'N', x);
+    solve(f, 'N', x);
     estold = est;
     est = 0.0;
     for (i = 0; i < n; ++i) est += fabs(x[i]);
@@ -4948,18 +5043,24 @@ PHGMG__PRIV double phgmg__gbf_inv_norm1(const phgmg__gbf *f, double *work, int *
       if ((x[i] >= 0.0 ? 1 : -1) != isgn[i]) { same = 0; break; }
     if (same || est <= estold) { if (est < estold) est = estold; break; }
     for (i = 0; i < n; ++i) { isgn[i] = x[i] >= 0.0 ? 1 : -1; x[i] = (double)isgn[i]; }
-    phgmg__gbf_solve(f, 'T', x);
+    solve(f, 'T', x);
     jlast = j;
     j = 0;
     for (i = 1; i < n; ++i) if (fabs(x[i]) > fabs(x[j])) j = i;
     if (fabs(x[jlast]) == fabs(x[j]) || iter >= 5) break;
   }
   for (i = 0; i < n; ++i) x[i] = ((i & 1) ? -1.0 : 1.0) * (1.0 + (double)i / (double)(n - 1));
-  phgmg__gbf_solve(f, 'N', x);
+  solve(f, 'N', x);
   temp = 0.0;
   for (i = 0; i < n; ++i) temp += fabs(x[i]);
   temp = 2.0 * temp / (3.0 * (double)n);
   return temp > est ? temp : est;
+}
+PHGMG__PRIV void phgmg__gbf_solve_cb(const void *f, char trans, double *x) {
+  phgmg__gbf_solve(PHGMG__CAST(const phgmg__gbf *, f), trans, x);
+}
+PHGMG__PRIV double phgmg__gbf_inv_norm1(const phgmg__gbf *f, double *work, int *isgn) {
+  return phgmg__inv_norm1(f->n, phgmg__gbf_solve_cb, f, work, isgn);
 }
 
 /* ||J - R||_1 */
@@ -5004,7 +5105,11 @@ struct phgmg_jr_factor {
   phgmg__gbf gb; /* banded; SPARSE systems: in J - R's own RCM order, */
   int *perm;     /* position i holds index perm[i] (NULL: none)       */
   double *w;     /* N, the permuted right-hand side                   */
+  struct phgmg__spsym *sps;  /* a sparse LU (E of a SPARSE descriptor model, >>sparse) */
+  struct phgmg__spnum *spf;
 };
+PHGMG__PRIV void phgmg__jr_sp_free(phgmg_jr_factor *f);
+PHGMG__PRIV void phgmg__jr_sp_solve(const void *f, char trans, double *x);
 
 PHGMG_DEF void phgmg_jr_factor_destroy(phgmg_jr_factor *f) {
   phgmg_allocator al;
@@ -5015,6 +5120,7 @@ PHGMG_DEF void phgmg_jr_factor_destroy(phgmg_jr_factor *f) {
   phgmg__gbf_free(&al, &f->gb);
   phgmg__free(&al, f->perm);
   phgmg__free(&al, f->w);
+  phgmg__jr_sp_free(f);
   phgmg__free(&al, f);
 }
 
@@ -5101,6 +5207,10 @@ PHGMG_DEF void phgmg_jr_solve(const phgmg_jr_factor *f, char trans, int nrhs, do
   int c;
   PHGMG_ASSERT(f && X && ldx >= f->N);
   PHGMG_ASSERT(trans == 'N' || trans == 'n' || trans == 'T' || trans == 't');
+  if (f->sps) {
+    for (c = 0; c < nrhs; ++c) phgmg__jr_sp_solve(f, trans, X + (size_t)c * (size_t)ldx);
+    return;
+  }
   if (f->storage == PHGMG_DENSE) {
     phgmg_lu_solve(trans, f->N, f->LU, f->N, f->ipiv, nrhs, X, ldx);
     return;
@@ -5288,8 +5398,7 @@ PHGMG__PRIV int phgmg__sp_pd(int n, const int *cp, const int *ci, const double *
    the band checks above: a diagonal matrix by its diagonal; R of N <= the
    dense limit by its eigenvalues; else R + tol ||R||_1 I, Q (+ tol ||Q||_1 I
    with a nonlinear part) positive definite by the sparse LU's pivots
-   (phgmg__sp_pd), and when that cannot decide, by the band Cholesky of the
-   matrix alone in its own reverse Cuthill-McKee order. */
+   (phgmg__sp_pd). No band copy. */
 PHGMG__PRIV phgmg_result phgmg__ph_check_sparse_pd(const phgmg_ph_system *s, int a, double tol,
                                                    const phgmg_allocator *al) {
   const int N = s->N;
@@ -5318,13 +5427,18 @@ PHGMG__PRIV phgmg_result phgmg__ph_check_sparse_pd(const phgmg_ph_system *s, int
   if (a == 2 || N > PHGMG__PH_PSD_DENSE_MAX) r = phgmg__sp_pd(N, cp, ci, cx, shift, al);
   if (r < 0) return PHGMG_ERR_NOMEM;
   if (r < 2) return r ? PHGMG_OK : a == 1 ? PHGMG_ERR_NOT_PSD : PHGMG_ERR_Q_NOT_PD;
-  { /* the band checks on the matrix alone, in its own RCM order */
-    phgmg_ph_system t;
-    double *bands[2];
-    int *perm = NULL;
-    rc = phgmg__ph_sparse_own_band(s, a, -1, &t, bands, &perm, al);
-    if (rc == PHGMG_OK) rc = a == 1 ? phgmg__ph_check_psd(&t, tol, al) : phgmg__ph_check_q_pd(&t, tol, al);
-    phgmg__ph_own_band_free(&t, bands, perm, al);
+  { /* R of N <= the dense limit: its eigenvalues (a dense copy) */
+    double *A = phgmg__dalloc(al, (size_t)N * (size_t)N), *w = phgmg__dalloc(al, (size_t)N);
+    rc = A && w ? PHGMG_OK : PHGMG_ERR_NOMEM;
+    if (rc == PHGMG_OK) {
+      memset(A, 0, sizeof(double) * (size_t)N * (size_t)N);
+      for (j = 0; j < N; ++j)
+        for (p = cp[j]; p < cp[j + 1]; ++p) A[(size_t)ci[p] + (size_t)j * (size_t)N] = cx[p];
+      rc = phgmg_sym_eig(N, A, N, w, NULL, 0);
+      if (rc == PHGMG_OK && w[0] < -tol * PHGMG__MAX(fabs(w[0]), fabs(w[N - 1]))) rc = PHGMG_ERR_NOT_PSD;
+    }
+    phgmg__free(al, A);
+    phgmg__free(al, w);
   }
   return rc;
 }
@@ -5335,12 +5449,16 @@ PHGMG__PRIV phgmg_result phgmg__ph_check_sparse_pd(const phgmg_ph_system *s, int
    rcond_out (may be NULL): its reciprocal condition estimate. */
 PHGMG__PRIV phgmg_result phgmg__ph_sparse_eq_band(const phgmg_ph_system *s, phgmg_ph_system *t, double **bufs,
                                                  const phgmg_allocator *al);
+PHGMG__PRIV phgmg_result phgmg__sp_e_factor(const phgmg_ph_system *sys, phgmg_jr_factor **f, double *rcond_out,
+                                            const phgmg_allocator *alloc);
 PHGMG__PRIV phgmg_result phgmg__e_factor(const phgmg_ph_system *sys, phgmg_jr_factor **f, double *rcond_out,
                                          const phgmg_allocator *alloc) {
   phgmg_ph_system t;
-  if (sys->storage == PHGMG_SPARSE) { /* the band LU of E's band copy, made here and freed */
-    double *bufs[2];
-    phgmg_result rc = phgmg__ph_sparse_eq_band(sys, &t, bufs, alloc);
+  if (sys->storage == PHGMG_SPARSE) { /* the sparse LU of E; if its static pivots cannot decide, */
+    double *bufs[2];                  /* the band LU of E's band copy, made here and freed */
+    phgmg_result rc = phgmg__sp_e_factor(sys, f, rcond_out, alloc);
+    if (rc != PHGMG_ERR_UNSUPPORTED) return rc;
+    rc = phgmg__ph_sparse_eq_band(sys, &t, bufs, alloc);
     *f = NULL;
     if (rc == PHGMG_OK) rc = phgmg__e_factor(&t, f, rcond_out, alloc);
     phgmg__free(alloc, bufs[0]); phgmg__free(alloc, bufs[1]);
@@ -5395,26 +5513,24 @@ PHGMG__PRIV phgmg_result phgmg__etq_form(const phgmg_ph_system *sys, phgmg_ph_sy
 PHGMG__PRIV int phgmg__e_algebraic(const phgmg_ph_system *s, const phgmg_allocator *alloc);
 PHGMG__PRIV phgmg_result phgmg__dae_validate(const phgmg_ph_system *sys, double tol, const phgmg_allocator *alloc);
 
-/* The descriptor checks of phgmg_ph_validate: E finite and nonsingular,
-   E^T Q symmetric and positive (semi)definite, separable coordinates free of
-   mass coupling. */
-PHGMG__PRIV phgmg_result phgmg__ph_validate_e(const phgmg_ph_system *sys, double tol, const phgmg_allocator *alloc) {
+/* The descriptor checks of phgmg_ph_validate, part one: E finite, an E
+   with zero lines to the index-one checks (*whole = 1: their result is the
+   whole validation), E^T Q symmetric and positive (semi)definite (SPARSE: on
+   the sparse E^T Q, phgmg__ph_sparse_etq_check; no band copy). */
+PHGMG__PRIV phgmg_result phgmg__ph_sparse_etq_check(const phgmg_ph_system *s, double tol,
+                                                    const phgmg_allocator *al);
+PHGMG__PRIV phgmg_result phgmg__ph_validate_e(const phgmg_ph_system *sys, double tol, const phgmg_allocator *alloc,
+                                              int *whole) {
   phgmg_ph_system t;
-  phgmg_jr_factor *f = NULL;
-  double *buf = NULL, rcond = 0.0, nrm, def;
-  int k, j;
+  double *buf = NULL, nrm, def;
+  int k;
   phgmg_result rc;
+  *whole = 0;
   if (!phgmg__ph_mat_finite(sys, sys->E)) return PHGMG_ERR_NANINF;
-  if (sys->storage == PHGMG_SPARSE) { /* on band copies of E and Q, made here and freed */
-    double *bufs[2];
-    rc = phgmg__ph_sparse_eq_band(sys, &t, bufs, alloc);
-    if (rc == PHGMG_OK) rc = phgmg__ph_validate_e(&t, tol, alloc);
-    phgmg__free(alloc, bufs[0]); phgmg__free(alloc, bufs[1]);
-    return rc;
-  }
+  if (sys->storage == PHGMG_SPARSE) return phgmg__ph_sparse_etq_check(sys, tol, alloc); /* E regular */
   k = phgmg__e_algebraic(sys, alloc);   /* zero rows or columns: index one? (1.8) */
   if (k < 0) return PHGMG_ERR_NOMEM;
-  if (k > 0) return phgmg__dae_validate(sys, tol, alloc);
+  if (k > 0) { *whole = 1; return phgmg__dae_validate(sys, tol, alloc); }
   rc = phgmg__etq_form(sys, &t, &buf, alloc);
   if (rc != PHGMG_OK) return rc;
   phgmg__ph_sym_defect(&t, t.Q, -1.0, &nrm, &def);
@@ -5424,14 +5540,50 @@ PHGMG__PRIV phgmg_result phgmg__ph_validate_e(const phgmg_ph_system *sys, double
     if (rc == PHGMG_ERR_Q_NOT_PD) rc = PHGMG_ERR_EQ_NOT_PD;
   }
   phgmg__free(alloc, buf);
-  for (k = 0; rc == PHGMG_OK && sys->nl == PHGMG_NL_SEPARABLE && k < sys->nsep; ++k) {
-    const int ix = sys->sep_idx[k];
-    if (!(phgmg__ph_at(sys, sys->E, ix, ix) > 0.0)) rc = PHGMG_ERR_E_COUPLED;
+  return rc;
+}
+
+/* Part two: the separable coordinates free of mass coupling (row i_k of E
+   is E(i_k, i_k) e_{i_k}^T with E(i_k, i_k) > 0); one pass over E's entries
+   for SPARSE storage. */
+PHGMG__PRIV phgmg_result phgmg__ph_e_coupled(const phgmg_ph_system *sys, const phgmg_allocator *alloc) {
+  const int *cp, *ci;
+  const double *cx;
+  int k, j, p;
+  if (sys->nl != PHGMG_NL_SEPARABLE) return PHGMG_OK;
+  if (phgmg__ph_csc_of(sys, sys->E, &cp, &ci, &cx)) {
+    int *is = phgmg__ialloc(alloc, (size_t)sys->N);
+    phgmg_result rc = PHGMG_OK;
+    if (!is) return PHGMG_ERR_NOMEM;
+    for (j = 0; j < sys->N; ++j) is[j] = 0;
+    for (k = 0; k < sys->nsep; ++k) is[sys->sep_idx[k]] = 1;   /* 1: a row still to show E(i, i) > 0 */
     for (j = 0; j < sys->N && rc == PHGMG_OK; ++j)
-      if (j != ix && phgmg__ph_at(sys, sys->E, ix, j) != 0.0) rc = PHGMG_ERR_E_COUPLED;
+      for (p = cp[j]; p < cp[j + 1]; ++p) {
+        const int i = ci[p];
+        if (!is[i]) continue;
+        if (i == j && cx[p] > 0.0) is[i] = 2;                    /* 2: its diagonal is positive */
+        else if (i != j && cx[p] != 0.0) { rc = PHGMG_ERR_E_COUPLED; break; }
+      }
+    for (j = 0; j < sys->N && rc == PHGMG_OK; ++j)
+      if (is[j] == 1) rc = PHGMG_ERR_E_COUPLED;
+    phgmg__free(alloc, is);
+    return rc;
   }
-  if (rc != PHGMG_OK) return rc;
-  rc = phgmg__e_factor(sys, &f, &rcond, alloc);
+  for (k = 0; k < sys->nsep; ++k) {
+    const int ix = sys->sep_idx[k];
+    if (!(phgmg__ph_at(sys, sys->E, ix, ix) > 0.0)) return PHGMG_ERR_E_COUPLED;
+    for (j = 0; j < sys->N; ++j)
+      if (j != ix && phgmg__ph_at(sys, sys->E, ix, j) != 0.0) return PHGMG_ERR_E_COUPLED;
+  }
+  return PHGMG_OK;
+}
+
+/* Part three: E nonsingular, 1 / cond_1(E) > tol (SPARSE: the sparse LU of
+   E, phgmg__e_factor). */
+PHGMG__PRIV phgmg_result phgmg__ph_e_regular(const phgmg_ph_system *sys, double tol, const phgmg_allocator *alloc) {
+  phgmg_jr_factor *f = NULL;
+  double rcond = 0.0;
+  phgmg_result rc = phgmg__e_factor(sys, &f, &rcond, alloc);
   phgmg_jr_factor_destroy(f);
   if (rc == PHGMG_ERR_NOMEM) return rc;
   return rc == PHGMG_OK && rcond > tol ? PHGMG_OK : PHGMG_ERR_E_SINGULAR;
@@ -5440,7 +5592,10 @@ PHGMG__PRIV phgmg_result phgmg__ph_validate_e(const phgmg_ph_system *sys, double
 /* Feedthrough: P, S, N finite, N skew, S symmetric and [[R, P], [P^T, S]]
    positive semidefinite (smallest eigenvalue >= -tol times the largest
    magnitude; dense eigenvalues of the (N + m) block, so banded models with
-   N > PHGMG__PH_PSD_DENSE_MAX are not checked: PHGMG_ERR_UNSUPPORTED). */
+   N > PHGMG__PH_PSD_DENSE_MAX are not checked: PHGMG_ERR_UNSUPPORTED;
+   SPARSE ones are, by phgmg__ph_sparse_feedthrough). */
+PHGMG__PRIV phgmg_result phgmg__ph_sparse_feedthrough(const phgmg_ph_system *s, double tol,
+                                                      const phgmg_allocator *al);
 PHGMG__PRIV phgmg_result phgmg__ph_validate_feedthrough(const phgmg_ph_system *sys, double tol,
                                                         const phgmg_allocator *alloc) {
   const int N = sys->N, m = sys->m, n = N + m;
@@ -5456,6 +5611,7 @@ PHGMG__PRIV phgmg_result phgmg__ph_validate_feedthrough(const phgmg_ph_system *s
       a += v * v; d += e * e;
     }
   if (sqrt(d) > tol * sqrt(a)) return PHGMG_ERR_FEEDTHROUGH;
+  if (sys->storage == PHGMG_SPARSE && N > PHGMG__PH_PSD_DENSE_MAX) return phgmg__ph_sparse_feedthrough(sys, tol, alloc);
   if (sys->storage == PHGMG_BANDED && N > PHGMG__PH_PSD_DENSE_MAX) return PHGMG_ERR_UNSUPPORTED;
   A = phgmg__dalloc(alloc, (size_t)n * n);
   w = phgmg__dalloc(alloc, (size_t)n);
@@ -5524,14 +5680,78 @@ PHGMG__PRIV phgmg_result phgmg__damp_jr_factor(phgmg_jr_factor **f, const phgmg_
   return rc;
 }
 
+/* The structure checks of phgmg_ph_validate in its order: J skew, R
+   symmetric, feedthrough, then with E: R PSD and E's checks (part one;
+   *whole = 1: an index-one model's whole result), else Q symmetric, R PSD,
+   Q positive (semi)definite. */
+PHGMG__PRIV phgmg_result phgmg__ph_validate_struct(const phgmg_ph_system *sys, double tol,
+                                                   const phgmg_allocator *alloc, int *whole) {
+  phgmg_result rc;
+  double nrm, def;
+  *whole = 0;
+  phgmg__ph_sym_defect(sys, sys->J, 1.0, &nrm, &def);
+  if (def > tol * nrm) return PHGMG_ERR_NOT_SKEW;
+  phgmg__ph_sym_defect(sys, sys->R, -1.0, &nrm, &def);
+  if (def > tol * nrm) return PHGMG_ERR_NOT_SYMMETRIC;
+  if (sys->P || sys->S || sys->Nskew) {
+    rc = phgmg__ph_check_psd(sys, tol, alloc);
+    if (rc == PHGMG_OK) rc = phgmg__ph_validate_feedthrough(sys, tol, alloc);
+    if (rc != PHGMG_OK) return rc;
+  }
+  if (sys->E) {   /* descriptor: E^T Q takes the place of Q */
+    rc = phgmg__ph_check_psd(sys, tol, alloc);
+    return rc == PHGMG_OK ? phgmg__ph_validate_e(sys, tol, alloc, whole) : rc;
+  }
+  phgmg__ph_sym_defect(sys, sys->Q, -1.0, &nrm, &def);
+  if (def > tol * nrm) return PHGMG_ERR_Q_NOT_SYMMETRIC;
+  rc = phgmg__ph_check_psd(sys, tol, alloc);
+  return rc == PHGMG_OK ? phgmg__ph_check_q_pd(sys, tol, alloc) : rc;
+}
+
+/* The matrix checks: r[0] the structure checks, r[1] E's regularity (E
+   only), *rcond the reciprocal condition of J - R (with dampers J - R - L);
+   from the object's cache for a sparse model's own system (run once per
+   key). Returns PHGMG_ERR_NOMEM, or PHGMG_OK with *whole as above. */
+PHGMG__PRIV phgmg_result phgmg__ph_validate_mats(const phgmg_ph_system *sys, double tol, const phgmg_allocator *alloc,
+                                                 phgmg_result r[2], double *rcond, int *whole) {
+  phgmg__valcache *vc = phgmg__ph_valcache(sys);
+  const int key = sys->nl != PHGMG_NL_NONE;
+  phgmg_jr_factor *f = NULL;
+  phgmg_result rc;
+  *whole = 0;
+  if (vc && vc->slot[key].set && vc->slot[key].tol == tol) {
+    r[0] = vc->slot[key].rc[0]; r[1] = vc->slot[key].rc[1]; *rcond = vc->slot[key].rcond;
+    return PHGMG_OK;
+  }
+  r[0] = phgmg__ph_validate_struct(sys, tol, alloc, whole);
+  r[1] = PHGMG_OK;
+  *rcond = 0.0;
+  if (r[0] == PHGMG_ERR_NOMEM) return r[0];
+  if (*whole) return PHGMG_OK;
+  if (r[0] == PHGMG_OK && sys->E) r[1] = phgmg__ph_e_regular(sys, tol, alloc);
+  if (r[1] == PHGMG_ERR_NOMEM) return r[1];
+  if (r[0] == PHGMG_OK && r[1] == PHGMG_OK) { /* J - R invertible (with dampers: J - R - L) */
+    rc = phgmg__damp_jr_factor(&f, sys, rcond, alloc);
+    phgmg_jr_factor_destroy(f);
+    if (rc == PHGMG_ERR_NOMEM) return rc;
+    if (rc != PHGMG_OK) *rcond = 0.0;
+  }
+  if (vc) {
+    vc->nrun++;
+    vc->slot[key].set = 1; vc->slot[key].tol = tol;
+    vc->slot[key].rc[0] = r[0]; vc->slot[key].rc[1] = r[1]; vc->slot[key].rcond = *rcond;
+  }
+  return PHGMG_OK;
+}
+
 /* phgmg_ph_validate; check_rank = 0 skips the rank test of B (the condensed
    model of an index-one model may have B' = 0 where a port acts through a
    constraint only, 1.8). */
 PHGMG__PRIV phgmg_result phgmg__ph_validate(const phgmg_ph_system *sys, double tol, double *rcond_out,
                                             const phgmg_allocator *alloc, int check_rank) {
-  phgmg_result rc;
-  double nrm, def;
-  int N, m;
+  phgmg_result rc, r[2];
+  double rcond = 0.0;
+  int N, m, whole = 0;
   if (rcond_out) *rcond_out = 0.0;
   rc = phgmg__ph_check(sys);
   if (rc != PHGMG_OK) return rc;
@@ -5548,27 +5768,13 @@ PHGMG__PRIV phgmg_result phgmg__ph_validate(const phgmg_ph_system *sys, double t
     if (sys->poly_deg > 0 && !phgmg__all_finite(sys->poly, (size_t)sys->poly_deg + 1))
       return PHGMG_ERR_NANINF;
   }
-  /* structure */
-  phgmg__ph_sym_defect(sys, sys->J, 1.0, &nrm, &def);
-  if (def > tol * nrm) return PHGMG_ERR_NOT_SKEW;
-  phgmg__ph_sym_defect(sys, sys->R, -1.0, &nrm, &def);
-  if (def > tol * nrm) return PHGMG_ERR_NOT_SYMMETRIC;
-  if (sys->P || sys->S || sys->Nskew) {
-    rc = phgmg__ph_check_psd(sys, tol, alloc);
-    if (rc == PHGMG_OK) rc = phgmg__ph_validate_feedthrough(sys, tol, alloc);
+  rc = phgmg__ph_validate_mats(sys, tol, alloc, r, &rcond, &whole);
+  if (rc != PHGMG_OK) return rc;
+  if (whole || r[0] != PHGMG_OK) return r[0];
+  if (sys->E) {
+    rc = phgmg__ph_e_coupled(sys, alloc);
     if (rc != PHGMG_OK) return rc;
-  }
-  if (sys->E) {   /* descriptor: E^T Q takes the place of Q */
-    rc = phgmg__ph_check_psd(sys, tol, alloc);
-    if (rc == PHGMG_OK) rc = phgmg__ph_validate_e(sys, tol, alloc);
-    if (rc != PHGMG_OK) return rc;
-  } else {
-    phgmg__ph_sym_defect(sys, sys->Q, -1.0, &nrm, &def);
-    if (def > tol * nrm) return PHGMG_ERR_Q_NOT_SYMMETRIC;
-    rc = phgmg__ph_check_psd(sys, tol, alloc);
-    if (rc != PHGMG_OK) return rc;
-    rc = phgmg__ph_check_q_pd(sys, tol, alloc);
-    if (rc != PHGMG_OK) return rc;
+    if (r[1] != PHGMG_OK) return r[1];
   }
   /* B full column rank: pivoted QR, |R(m-1,m-1)| > tol |R(0,0)| */
   if (check_rank) {
@@ -5590,17 +5796,8 @@ PHGMG__PRIV phgmg_result phgmg__ph_validate(const phgmg_ph_system *sys, double t
     phgmg__free(alloc, jpvt);
     if (rc != PHGMG_OK) return rc;
   }
-  /* J - R invertible (with dampers: J - R - L, L their linearisation at 0) */
-  {
-    phgmg_jr_factor *f = NULL;
-    double rcond = 0.0;
-    rc = phgmg__damp_jr_factor(&f, sys, &rcond, alloc);
-    if (rc == PHGMG_ERR_NOMEM) return rc;
-    if (rc != PHGMG_OK) rcond = 0.0;
-    phgmg_jr_factor_destroy(f);
-    if (rcond_out) *rcond_out = rcond;
-    if (!(rcond > tol)) return PHGMG_ERR_SINGULAR;
-  }
+  if (rcond_out) *rcond_out = rcond;
+  if (!(rcond > tol)) return PHGMG_ERR_SINGULAR;
   return PHGMG_OK;
 }
 
@@ -6693,6 +6890,7 @@ typedef struct phgmg__spsym {
   int *ca_p, *ca_i, *ca_k;        /* column a of K: rows, Mx indices   */
   int *ra_p, *ra_i, *ra_k;        /* row a of K: columns, Mx indices   */
   int *perm;                      /* fill position k: internal perm[k] */
+  int *cperm;                     /* factored column j = column cperm[j] of K (NULL: identity) */
   int nsup;
   int *sfirst, *sparent, *scp, *sch, *srp, *srow; /* sch[scp[s]..scp[s+1]): children, last first */
   size_t *lptr;                   /* factor offsets (scalars)          */
@@ -6708,7 +6906,7 @@ PHGMG__PRIV void phgmg__spsym_free(const phgmg_allocator *al, phgmg__spsym *S) {
   phgmg__free(al, S->q_p); phgmg__free(al, S->q_i); phgmg__free(al, S->q_x);
   phgmg__free(al, S->kex);
   if (S->f_p != S->k_p) { phgmg__free(al, S->f_p); phgmg__free(al, S->f_i); }
-  phgmg__free(al, S->k_p); phgmg__free(al, S->k_i); phgmg__free(al, S->perm);
+  phgmg__free(al, S->k_p); phgmg__free(al, S->k_i); phgmg__free(al, S->perm); phgmg__free(al, S->cperm);
   phgmg__free(al, S->f_d); phgmg__free(al, S->fidx); phgmg__free(al, S->bpos);
   phgmg__free(al, S->aidx); phgmg__free(al, S->ad_k);
   phgmg__free(al, S->ca_p); phgmg__free(al, S->ca_i); phgmg__free(al, S->ca_k);
@@ -6778,7 +6976,8 @@ PHGMG__PRIV phgmg_result phgmg__band_to_csc(int n, int kb, const double *M1, con
 }
 
 /* Pattern of M = (J - R) Q plus (J - R) plus the diagonal (and E's pattern
-   for a descriptor model), CSC, sorted rows. */
+   for a descriptor model), CSC, sorted rows; with a column permutation
+   (S->cperm) of K P: column j from column cperm[j] of M and E, plus (j, j). */
 PHGMG__PRIV phgmg_result phgmg__spsym_kpattern(phgmg__spsym *S, const phgmg_allocator *al) {
   int n = S->n, j, p, q, nz = 0, pass;
   int *mark = phgmg__ialloc(al, (size_t)n);
@@ -6789,13 +6988,14 @@ PHGMG__PRIV phgmg_result phgmg__spsym_kpattern(phgmg__spsym *S, const phgmg_allo
     for (j = 0; j < n; ++j) mark[j] = -1;
     nz = 0;
     for (j = 0; j < n; ++j) {
+      const int c = S->cperm ? S->cperm[j] : j; /* column c of K (manual 8.12: column permutation) */
       int start = nz;
       if (pass) S->k_p[j] = nz;
 #define PHGMG__KP_ADD(r) do { int r_ = (r); if (mark[r_] != j) { mark[r_] = j; if (pass) S->k_i[nz] = r_; ++nz; } } while (0)
       PHGMG__KP_ADD(j);
-      for (p = S->jr_p[j]; p < S->jr_p[j + 1]; ++p) PHGMG__KP_ADD(S->jr_i[p]);
-      if (S->e_p) for (p = S->e_p[j]; p < S->e_p[j + 1]; ++p) PHGMG__KP_ADD(S->e_i[p]);
-      for (q = S->q_p[j]; q < S->q_p[j + 1]; ++q) {
+      for (p = S->jr_p[c]; p < S->jr_p[c + 1]; ++p) PHGMG__KP_ADD(S->jr_i[p]);
+      if (S->e_p) for (p = S->e_p[c]; p < S->e_p[c + 1]; ++p) PHGMG__KP_ADD(S->e_i[p]);
+      for (q = S->q_p[c]; q < S->q_p[c + 1]; ++q) {
         int k = S->q_i[q];
         for (p = S->jr_p[k]; p < S->jr_p[k + 1]; ++p) PHGMG__KP_ADD(S->jr_i[p]);
       }
@@ -6820,9 +7020,10 @@ PHGMG__PRIV phgmg_result phgmg__spsym_kex(phgmg__spsym *S, const phgmg_allocator
   if (!S->kex) return PHGMG_ERR_NOMEM;
   S->emax = 0.0;
   for (j = 0; j < S->n; ++j) {
+    const int c = S->cperm ? S->cperm[j] : j;
     q = S->k_p[j];
     for (p = q; p < S->k_p[j + 1]; ++p) S->kex[p] = 0.0;
-    for (p = S->e_p[j]; p < S->e_p[j + 1]; ++p) { /* both columns sorted */
+    for (p = S->e_p[c]; p < S->e_p[c + 1]; ++p) { /* both columns sorted */
       while (S->k_i[q] < S->e_i[p]) ++q;
       S->kex[q] += S->e_x[p];
       S->emax = PHGMG__MAX(S->emax, fabs(S->e_x[p]));
@@ -7072,8 +7273,8 @@ PHGMG__PRIV phgmg_result phgmg__sp_condense_select(phgmg__spsym *S, const int *g
   S->bpos = phgmg__ialloc(al, (size_t)n + 1);
   if (!q || !st || !S->aidx || !S->fidx || !S->bpos) goto done;
   for (v = 0; v < n; ++v) st[v] = 0; /* 0 unseen, 1 queued, 2 chosen, 3 blocked */
-  for (v = 0; S->e_p && v < n; ++v) /* E couples v to another state: not condensed (real couplings) */
-    for (p = S->e_p[v]; p < S->e_p[v + 1]; ++p)
+  for (v = 0; S->e_p && v < n; ++v) /* E (E P) couples v to another state: not condensed (real couplings) */
+    for (p = S->e_p[S->cperm ? S->cperm[v] : v]; p < S->e_p[(S->cperm ? S->cperm[v] : v) + 1]; ++p)
       if (S->e_i[p] != v && S->e_x[p] != 0.0) { st[v] = st[S->e_i[p]] = 4; }
   for (r = 0; r < n; ++r) {
     if (st[r]) continue;
@@ -7273,7 +7474,7 @@ PHGMG__PRIV double phgmg__spsym_bytes(const phgmg__spsym *S) {
   double b = (2.0 * n + 2.0) * I + (double)(S->jr_p[S->n] + S->q_p[S->n]) * (I + sizeof(double));
   b += (double)S->k_p[S->n] * I + (n + 1.0) * I;
   if (S->f_p != S->k_p) b += (double)S->f_p[S->nf] * I + (nf + 1.0) * I;
-  b += (4.0 * n + nf + 3.0 * na) * I;
+  b += (4.0 * n + nf + 3.0 * na + (S->cperm ? n : 0.0)) * I;
   if (S->na) b += 2.0 * (double)(S->ca_p[S->na] + S->ra_p[S->na]) * I;
   b += (double)S->nsup * (6.0 * I + sizeof(size_t)) + (double)(S->srp ? S->srp[S->nsup] : 0) * I;
   if (S->amp) b += (double)S->amp[S->nsup] * (I + sizeof(size_t));
@@ -7607,9 +7808,22 @@ PHGMG__PRIV void phgmg__sp_solve_f(const phgmg__spsym *S, const phgmg__spnum *F,
   }
 }
 
+/* x <- P x: the solution y of (K P) y = b back to that of K x = b,
+   x[cperm[j]] = y[j] (F's solve scratch). */
+PHGMG__PRIV void phgmg__sp_unpermute(const phgmg__spsym *S, const phgmg__spnum *F, double *x) {
+  const int w = F->cplx ? 2 : 1;
+  int j;
+  memcpy(F->y, x, sizeof(double) * (size_t)w * (size_t)S->n);
+  for (j = 0; j < S->n; ++j) {
+    x[w * S->cperm[j]] = F->y[w * j];
+    if (w == 2) x[2 * S->cperm[j] + 1] = F->y[2 * j + 1];
+  }
+}
+
 /* x <- K^{-1} x: with a condensed block, u_a = x_a / K(a, a), x_b -= K_ba u_a,
-   the Schur complement's solve, x_a = u_a - K_ab x_b / K(a, a). */
-PHGMG__PRIV void phgmg__sp_solve(const phgmg__spsym *S, const phgmg__spnum *F, double *x) {
+   the Schur complement's solve, x_a = u_a - K_ab x_b / K(a, a); with a
+   column permutation the solve of K P, then x <- P x. */
+PHGMG__PRIV void phgmg__sp_solve_k(const phgmg__spsym *S, const phgmg__spnum *F, double *x) {
   int t, q;
   if (F->cplx) {
     for (t = 0; t < S->na; ++t) {
@@ -7647,21 +7861,26 @@ PHGMG__PRIV void phgmg__sp_solve(const phgmg__spsym *S, const phgmg__spnum *F, d
     }
   }
 }
+PHGMG__PRIV void phgmg__sp_solve(const phgmg__spsym *S, const phgmg__spnum *F, double *x) {
+  phgmg__sp_solve_k(S, F, x);
+  if (S->cperm) phgmg__sp_unpermute(S, F, x);
+}
 
-/* Values of M = -(J - R)(Q + diag(dd)) (dd may be NULL) in the k pattern,
-   with a dense scratch w (n). */
+/* Values of M = -(J - R)(Q + diag(dd)) (dd may be NULL) in the k pattern
+   (M P with a column permutation), with a dense scratch w (n). */
 PHGMG__PRIV void phgmg__sp_stage_values(const phgmg__spsym *S, const double *dd, double *Mx, double *w) {
   int n = S->n, j, p, q;
   for (j = 0; j < n; ++j) w[j] = 0.0;
   for (j = 0; j < n; ++j) {
-    double dj = dd ? dd[j] : 0.0;
-    for (q = S->q_p[j]; q < S->q_p[j + 1]; ++q) {
+    const int c = S->cperm ? S->cperm[j] : j; /* column c of M */
+    double dj = dd ? dd[c] : 0.0;
+    for (q = S->q_p[c]; q < S->q_p[c + 1]; ++q) {
       int k = S->q_i[q];
       double v = S->q_x[q];
       for (p = S->jr_p[k]; p < S->jr_p[k + 1]; ++p) w[S->jr_i[p]] -= S->jr_x[p] * v;
     }
     if (dj != 0.0)
-      for (p = S->jr_p[j]; p < S->jr_p[j + 1]; ++p) w[S->jr_i[p]] -= S->jr_x[p] * dj;
+      for (p = S->jr_p[c]; p < S->jr_p[c + 1]; ++p) w[S->jr_i[p]] -= S->jr_x[p] * dj;
     for (p = S->k_p[j]; p < S->k_p[j + 1]; ++p) { Mx[p] = w[S->k_i[p]]; w[S->k_i[p]] = 0.0; }
   }
 }
@@ -7679,11 +7898,13 @@ PHGMG__PRIV void phgmg__sp_qmv(const phgmg__spsym *S, const double *x, double *y
 
 /* Is the symmetric n x n CSC matrix A + shift I positive definite? Through
    the sparse LU of >>sparse (the stage matrix of J - R = -I, Q = A, sigma =
-   shift): without row exchanges the LU pivots of a symmetric matrix are the
-   D of its L D L^T, all positive exactly when it is definite (Sylvester),
-   and for a definite matrix the elimination is stable. 1 yes, 0 no, 2
-   undecided (a pivot replaced or large growth: the caller's band Cholesky
-   decides), -1 out of memory. Memory: the sparse factor, not a band. */
+   shift) with no pivot threshold: without row exchanges the LU pivots of a
+   symmetric matrix are the D of its L D L^T, all positive exactly when it
+   is definite (Sylvester's law of inertia; the first pivot <= 0 in the
+   elimination order shows a leading minor <= 0), and for a definite matrix
+   the elimination is as stable as Cholesky's, so the pivots decide: 1 every
+   pivot positive and finite, 0 not, -1 out of memory. Memory: the sparse
+   factor, not a band. */
 PHGMG__PRIV int phgmg__sp_pd(int n, const int *cp, const int *ci, const double *cx, double shift,
                              const phgmg_allocator *al) {
   phgmg__spsym *S = PHGMG__CAST(phgmg__spsym *, phgmg__alloc(al, sizeof(phgmg__spsym)));
@@ -7709,15 +7930,17 @@ PHGMG__PRIV int phgmg__sp_pd(int n, const int *cp, const int *ci, const double *
   w = phgmg__dalloc(al, (size_t)n);
   if (!Mx || !w || phgmg__spnum_alloc(al, S, 0, &F) != PHGMG_OK) goto done;
   phgmg__sp_stage_values(S, NULL, Mx, w);   /* M = -(J - R) Q = A */
-  phgmg__sp_factor(S, &F, Mx, shift, 0.0, PHGMG_SPARSE_PIVTOL);
-  ok = F.nstatic || !(F.growth <= PHGMG_SPARSE_GROWTH) ? 2 : 1;
+  phgmg__sp_factor(S, &F, Mx, shift, 0.0, 0.0);
+  ok = 1;
   for (t = 0; t < S->na && ok == 1; ++t)    /* condensed block: its diagonal */
-    if (!(Mx[S->ad_k[t]] + shift > 0.0)) ok = 0;
+    if (!(Mx[S->ad_k[t]] + shift > 0.0 && Mx[S->ad_k[t]] + shift < HUGE_VAL)) ok = 0;
   for (t = 0; t < S->nsup && ok == 1; ++t) { /* the pivots of each front */
     const int nc = S->sfirst[t + 1] - S->sfirst[t], nf = nc + S->srp[t + 1] - S->srp[t];
     const double *L = F.X + S->lptr[t];
-    for (j = 0; j < nc; ++j)
-      if (!(L[(size_t)j * (size_t)nf + (size_t)j] > 0.0)) { ok = 0; break; }
+    for (j = 0; j < nc; ++j) {
+      const double d = L[(size_t)j * (size_t)nf + (size_t)j];
+      if (!(d > 0.0 && d < HUGE_VAL)) { ok = 0; break; }
+    }
   }
 done:
   phgmg__spnum_free(al, &F);
@@ -7926,7 +8149,155 @@ struct phgmg_ph_sparse {
   phgmg__spsym *sym;            /* sparse LU analysis (NULL: not done) */
   int use_lu;                   /* 1: steppers use the sparse LU       */
   phgmg_ph_sparse_info inf;
+  struct phgmg__valcache *vc;   /* the matrix checks' results (phgmg_ph_validate) */
 };
+
+
+/* Column permutation for the static pivots of a descriptor model (manual
+   8.12): a matching of rows to columns of E that maximises the product of
+   the matched magnitudes (a weighted bipartite matching, as MC64 does):
+   cost c(i, j) = log max_k |E(k, j)| - log |E(i, j)| >= 0 over the nonzero
+   entries, duals u (rows) and v (columns) from the row and column minima, a
+   greedy start on the edges of zero reduced cost, then one Dijkstra search
+   of shortest augmenting paths per unmatched column (binary heap). The
+   factored matrix is K P: its column j is column cperm[j] of K, so that
+   E(j, cperm[j]) sits on its diagonal. For a symmetric positive definite E
+   (a mass matrix) the identity is the unique optimum (|E(i, j)|^2 <
+   E(i, i) E(j, j)); for one with its columns permuted, the inverse of that
+   permutation. A diagonal that holds each column's largest magnitude
+   costs 0, so the identity is taken without the search. Returns 1 (a
+   matching other than the identity, in cperm),
+   0 (the identity is optimal, or E has no perfect matching: structurally
+   singular; the static pivots then decide), -1 out of memory. */
+typedef struct phgmg__mt {
+  int n, *rmate, *cmate, *heap, *hpos, *pred, *done, nd;
+  double *u, *v, *d;
+} phgmg__mt;
+
+PHGMG__PRIV void phgmg__mt_up(phgmg__mt *m, int k) {
+  int r = m->heap[k];
+  while (k > 0) {
+    int p = (k - 1) / 2, q = m->heap[p];
+    if (!(m->d[q] > m->d[r])) break;
+    m->heap[k] = q; m->hpos[q] = k; k = p;
+  }
+  m->heap[k] = r; m->hpos[r] = k;
+}
+PHGMG__PRIV int phgmg__mt_pop(phgmg__mt *m, int *len) {
+  int top = m->heap[0], r, k = 0;
+  m->hpos[top] = -2;
+  if (--*len == 0) return top;
+  r = m->heap[*len];
+  for (;;) {
+    int c = 2 * k + 1;
+    if (c >= *len) break;
+    if (c + 1 < *len && m->d[m->heap[c + 1]] < m->d[m->heap[c]]) ++c;
+    if (!(m->d[m->heap[c]] < m->d[r])) break;
+    m->heap[k] = m->heap[c]; m->hpos[m->heap[k]] = k; k = c;
+  }
+  m->heap[k] = r; m->hpos[r] = k;
+  return top;
+}
+
+/* One shortest augmenting path from the free column j0 (reduced costs
+   c - u - v, w[p] = c of entry p); 1 augmented, 0 none. */
+PHGMG__PRIV int phgmg__mt_augment(phgmg__mt *m, const int *cp, const int *ci, const double *w, int j0) {
+  int len = 0, p, i, j, found = -1, t;
+  double D = 0.0;
+  m->nd = 0;
+  for (j = j0;;) { /* relax the entries of column j, reached at distance dj */
+    const double dj = j == j0 ? 0.0 : m->d[m->cmate[j]];
+    for (p = cp[j]; p < cp[j + 1]; ++p) {
+      double nd;
+      i = ci[p];
+      if (w[p] < 0.0 || m->hpos[i] == -2) continue;
+      nd = dj + PHGMG__MAX(0.0, w[p] - m->u[i] - m->v[j]);
+      if (m->hpos[i] == -1) { m->d[i] = nd; m->pred[i] = j; m->heap[len] = i; m->hpos[i] = len++; phgmg__mt_up(m, len - 1); }
+      else if (nd < m->d[i]) { m->d[i] = nd; m->pred[i] = j; phgmg__mt_up(m, m->hpos[i]); }
+    }
+    if (len == 0) break;
+    i = phgmg__mt_pop(m, &len);
+    m->done[m->nd++] = i;
+    if (m->rmate[i] < 0) { found = i; D = m->d[i]; break; }
+    j = m->rmate[i];
+  }
+  for (t = 0; t < len; ++t) m->hpos[m->heap[t]] = -1;
+  if (found < 0) { for (t = 0; t < m->nd; ++t) m->hpos[m->done[t]] = -1; return 0; }
+  m->v[j0] += D;
+  for (t = 0; t < m->nd; ++t) { /* duals: the path's edges tight, every reduced cost >= 0 */
+    i = m->done[t];
+    m->hpos[i] = -1;
+    if (i == found) continue;
+    m->u[i] -= D - m->d[i];
+    m->v[m->rmate[i]] += D - m->d[i];
+  }
+  for (i = found; i >= 0;) { /* flip the path */
+    j = m->pred[i];
+    t = m->cmate[j];
+    m->cmate[j] = i; m->rmate[i] = j;
+    i = j == j0 ? -1 : t;
+  }
+  return 1;
+}
+
+PHGMG__PRIV int phgmg__sp_match(int n, const int *cp, const int *ci, const double *cx, int *cperm,
+                                const phgmg_allocator *al) {
+  phgmg__mt m;
+  double *w;
+  int i, j, p, ok = 1, ident = 1;
+  for (j = 0; j < n && ident; ++j) { /* every diagonal entry its column's largest: the identity costs 0 */
+    double dj = 0.0, cm = 0.0;
+    for (p = cp[j]; p < cp[j + 1]; ++p) {
+      if (ci[p] == j) dj = fabs(cx[p]);
+      cm = PHGMG__MAX(cm, fabs(cx[p]));
+    }
+    ident = dj > 0.0 && dj >= cm;
+  }
+  if (ident) return 0;
+  w = phgmg__dalloc(al, (size_t)cp[n] + 1);
+  ident = 1;
+  memset(&m, 0, sizeof m);
+  m.n = n;
+  m.rmate = phgmg__ialloc(al, (size_t)n); m.cmate = phgmg__ialloc(al, (size_t)n);
+  m.heap = phgmg__ialloc(al, (size_t)n); m.hpos = phgmg__ialloc(al, (size_t)n);
+  m.pred = phgmg__ialloc(al, (size_t)n); m.done = phgmg__ialloc(al, (size_t)n);
+  m.u = phgmg__dalloc(al, (size_t)n); m.v = phgmg__dalloc(al, (size_t)n); m.d = phgmg__dalloc(al, (size_t)n);
+  if (!w || !m.rmate || !m.cmate || !m.heap || !m.hpos || !m.pred || !m.done || !m.u || !m.v || !m.d) {
+    ok = -1;
+    goto done;
+  }
+  for (i = 0; i < n; ++i) { m.rmate[i] = m.cmate[i] = -1; m.hpos[i] = -1; m.u[i] = HUGE_VAL; }
+  for (j = 0; j < n; ++j) { /* costs (-1: no edge), row minima */
+    double cm = 0.0;
+    for (p = cp[j]; p < cp[j + 1]; ++p) cm = PHGMG__MAX(cm, fabs(cx[p]));
+    for (p = cp[j]; p < cp[j + 1]; ++p) {
+      w[p] = cx[p] != 0.0 ? log(cm) - log(fabs(cx[p])) : -1.0;
+      if (w[p] >= 0.0 && w[p] < m.u[ci[p]]) m.u[ci[p]] = w[p];
+    }
+  }
+  for (i = 0; i < n; ++i) if (m.u[i] == HUGE_VAL) { ok = 0; goto done; } /* a zero row */
+  for (j = 0; j < n; ++j) { /* column duals, greedy matching on tight edges */
+    double vm = HUGE_VAL;
+    int best = -1;
+    for (p = cp[j]; p < cp[j + 1]; ++p)
+      if (w[p] >= 0.0 && w[p] - m.u[ci[p]] < vm) vm = w[p] - m.u[ci[p]];
+    if (vm == HUGE_VAL) { ok = 0; goto done; } /* a zero column */
+    m.v[j] = vm;
+    for (p = cp[j]; p < cp[j + 1]; ++p)
+      if (w[p] >= 0.0 && m.rmate[ci[p]] < 0 && w[p] - m.u[ci[p]] - vm <= 0.0 && (best < 0 || ci[p] == j)) best = ci[p];
+    if (best >= 0) { m.rmate[best] = j; m.cmate[j] = best; }
+  }
+  for (j = 0; j < n && ok == 1; ++j)
+    if (m.cmate[j] < 0 && !phgmg__mt_augment(&m, cp, ci, w, j)) ok = 0; /* structurally singular */
+  for (i = 0; i < n && ok == 1; ++i) { cperm[i] = m.rmate[i]; if (cperm[i] != i) ident = 0; }
+  if (ok == 1 && ident) ok = 0;
+done:
+  phgmg__free(al, w);
+  phgmg__free(al, m.rmate); phgmg__free(al, m.cmate); phgmg__free(al, m.heap); phgmg__free(al, m.hpos);
+  phgmg__free(al, m.pred); phgmg__free(al, m.done); phgmg__free(al, m.u); phgmg__free(al, m.v);
+  phgmg__free(al, m.d);
+  return ok;
+}
 
 /* The analysis of sp's stage matrices from its CSC copies (js J - R merged,
    zero values dropped, as from band storage); condense as phgmg__spsym_create.
@@ -7973,6 +8344,11 @@ PHGMG__PRIV phgmg_result phgmg__spsym_create_js(phgmg__spsym **out, const phgmg_
       if (!S->jr_i || !S->jr_x || !S->q_i || !S->q_x) rc = PHGMG_ERR_NOMEM;
     }
   }
+  if (rc == PHGMG_OK && S->e_p) { /* descriptor: columns matched to E's largest entries */
+    int r = (S->cperm = phgmg__ialloc(al, (size_t)n)) ? phgmg__sp_match(n, S->e_p, S->e_i, S->e_x, S->cperm, al) : -1;
+    if (r < 0) rc = PHGMG_ERR_NOMEM;
+    else if (r == 0) { phgmg__free(al, S->cperm); S->cperm = NULL; }
+  }
   if (rc == PHGMG_OK) rc = phgmg__spsym_analyse(S, condense, al);
   if (rc != PHGMG_OK) { phgmg__spsym_free(al, S); return rc; }
   *out = S;
@@ -7980,6 +8356,305 @@ PHGMG__PRIV phgmg_result phgmg__spsym_create_js(phgmg__spsym **out, const phgmg_
 }
 PHGMG__PRIV phgmg_result phgmg__spsym_create_sp(phgmg__spsym **out, const phgmg_ph_sparse *sp, int condense) {
   return phgmg__spsym_create_js(out, sp, condense, 1.0);
+}
+
+/* ---- sparse checks of a descriptor model (manual 8.12): E^T Q and E ---- */
+
+/* B = A^T (n x n CSC, rows sorted in each column); *bp, *bi, *bx owned. */
+PHGMG__PRIV phgmg_result phgmg__csc_transpose(int n, const int *ap, const int *ai, const double *ax, int **bp,
+                                              int **bi, double **bx, const phgmg_allocator *al) {
+  int j, p, *cnt;
+  *bp = phgmg__ialloc(al, (size_t)n + 1);
+  *bi = phgmg__ialloc(al, (size_t)ap[n] + 1);
+  *bx = phgmg__dalloc(al, (size_t)ap[n] + 1);
+  cnt = phgmg__ialloc(al, (size_t)n + 1);
+  if (!*bp || !*bi || !*bx || !cnt) { phgmg__free(al, cnt); return PHGMG_ERR_NOMEM; }
+  for (j = 0; j <= n; ++j) cnt[j] = 0;
+  for (p = 0; p < ap[n]; ++p) cnt[ai[p] + 1]++;
+  for (j = 0; j < n; ++j) cnt[j + 1] += cnt[j];
+  for (j = 0; j <= n; ++j) (*bp)[j] = cnt[j];
+  for (j = 0; j < n; ++j) /* columns in order: each new column's rows increase */
+    for (p = ap[j]; p < ap[j + 1]; ++p) { int q = cnt[ai[p]]++; (*bi)[q] = j; (*bx)[q] = ax[p]; }
+  phgmg__free(al, cnt);
+  return PHGMG_OK;
+}
+
+/* C = A^T B (n x n CSC, rows sorted): column j = sum_k B(k, j) (A^T)(:, k),
+   with At = A^T given. */
+PHGMG__PRIV phgmg_result phgmg__csc_atb(int n, const int *tp, const int *ti, const double *tx, const int *bp,
+                                        const int *bi, const double *bx, int **cp, int **ci, double **cx,
+                                        const phgmg_allocator *al) {
+  int j, p, q, pass, nz = 0, *mark = phgmg__ialloc(al, (size_t)n);
+  double *w = phgmg__dalloc(al, (size_t)n);
+  *cp = phgmg__ialloc(al, (size_t)n + 1);
+  *ci = NULL; *cx = NULL;
+  if (!mark || !w || !*cp) { phgmg__free(al, mark); phgmg__free(al, w); return PHGMG_ERR_NOMEM; }
+  for (pass = 0; pass < 2; ++pass) {
+    for (j = 0; j < n; ++j) { mark[j] = -1; w[j] = 0.0; }
+    nz = 0;
+    for (j = 0; j < n; ++j) {
+      const int start = nz;
+      (*cp)[j] = nz;
+      for (q = bp[j]; q < bp[j + 1]; ++q) {
+        const int k = bi[q];
+        for (p = tp[k]; p < tp[k + 1]; ++p) {
+          const int r = ti[p];
+          if (mark[r] != j) { mark[r] = j; if (pass) (*ci)[nz] = r; ++nz; }
+          if (pass) w[r] += tx[p] * bx[q];
+        }
+      }
+      if (!pass) continue;
+      phgmg__isort(*ci + start, (size_t)(nz - start));
+      for (p = start; p < nz; ++p) { (*cx)[p] = w[(*ci)[p]]; w[(*ci)[p]] = 0.0; }
+    }
+    if (!pass) {
+      *ci = phgmg__ialloc(al, (size_t)nz + 1);
+      *cx = phgmg__dalloc(al, (size_t)nz + 1);
+      if (!*ci || !*cx) { phgmg__free(al, mark); phgmg__free(al, w); return PHGMG_ERR_NOMEM; }
+    }
+  }
+  (*cp)[n] = nz;
+  phgmg__free(al, mark);
+  phgmg__free(al, w);
+  return PHGMG_OK;
+}
+
+/* C = (A + A^T) / 2 from A and At = A^T (both sorted), with the Frobenius
+   norms of A and of A - A^T; C's arrays owned. */
+PHGMG__PRIV phgmg_result phgmg__csc_sym_part(int n, const int *ap, const int *ai, const double *ax, const int *tp,
+                                             const int *ti, const double *tx, int **cp, int **ci, double **cx,
+                                             double *norm, double *defect, const phgmg_allocator *al) {
+  int j, p, q, nz = 0;
+  double a2 = 0.0, d2 = 0.0;
+  *cp = phgmg__ialloc(al, (size_t)n + 1);
+  *ci = phgmg__ialloc(al, (size_t)ap[n] + (size_t)tp[n] + 1);
+  *cx = phgmg__dalloc(al, (size_t)ap[n] + (size_t)tp[n] + 1);
+  if (!*cp || !*ci || !*cx) return PHGMG_ERR_NOMEM;
+  for (j = 0; j < n; ++j) {
+    (*cp)[j] = nz;
+    p = ap[j]; q = tp[j];
+    while (p < ap[j + 1] || q < tp[j + 1]) { /* the two sorted columns merged */
+      const int ra = p < ap[j + 1] ? ai[p] : n, rb = q < tp[j + 1] ? ti[q] : n, r = PHGMG__MIN(ra, rb);
+      const double va = ra == r ? ax[p++] : 0.0, vb = rb == r ? tx[q++] : 0.0;
+      a2 += va * va;
+      d2 += (va - vb) * (va - vb);
+      (*ci)[nz] = r; (*cx)[nz++] = 0.5 * (va + vb);
+    }
+  }
+  (*cp)[n] = nz;
+  *norm = sqrt(a2);
+  *defect = sqrt(d2);
+  return PHGMG_OK;
+}
+
+/* E^T Q of a SPARSE descriptor system: symmetric within tol (Frobenius, as
+   phgmg_ph_validate's other symmetry checks), then its symmetric part
+   positive definite (positive semidefinite within tol ||E^T Q||_1 with a
+   nonlinear part) by the pivots of phgmg__sp_pd: PHGMG_ERR_EQ_NOT_SYMMETRIC,
+   _EQ_NOT_PD. Memory O(nnz(E^T Q) + the sparse factor); no band copy. */
+PHGMG__PRIV phgmg_result phgmg__ph_sparse_etq_check(const phgmg_ph_system *s, double tol,
+                                                    const phgmg_allocator *al) {
+  const phgmg_ph_sparse *sp = s->sparse;
+  const int n = s->N;
+  int *tp = NULL, *ti = NULL, *cp = NULL, *ci = NULL, *ctp = NULL, *cti = NULL, *hp = NULL, *hi = NULL, j, p, r;
+  double *tx = NULL, *cx = NULL, *ctx = NULL, *hx = NULL, nrm = 0.0, def = 0.0, n1 = 0.0;
+  phgmg_result rc = phgmg__csc_transpose(n, sp->cp[3], sp->ci[3], sp->cx[3], &tp, &ti, &tx, al);
+  if (rc == PHGMG_OK) rc = phgmg__csc_atb(n, tp, ti, tx, sp->cp[2], sp->ci[2], sp->cx[2], &cp, &ci, &cx, al);
+  if (rc == PHGMG_OK) rc = phgmg__csc_transpose(n, cp, ci, cx, &ctp, &cti, &ctx, al);
+  if (rc == PHGMG_OK) rc = phgmg__csc_sym_part(n, cp, ci, cx, ctp, cti, ctx, &hp, &hi, &hx, &nrm, &def, al);
+  if (rc == PHGMG_OK && def > tol * nrm) rc = PHGMG_ERR_EQ_NOT_SYMMETRIC;
+  if (rc == PHGMG_OK) {
+    for (j = 0; j < n; ++j) {
+      double cs = 0.0;
+      for (p = hp[j]; p < hp[j + 1]; ++p) cs += fabs(hx[p]);
+      n1 = PHGMG__MAX(n1, cs);
+    }
+    r = phgmg__sp_pd(n, hp, hi, hx, s->nl != PHGMG_NL_NONE ? PHGMG__MAX(tol * n1, 1e-300) : 0.0, al);
+    rc = r < 0 ? PHGMG_ERR_NOMEM : r ? PHGMG_OK : PHGMG_ERR_EQ_NOT_PD;
+  }
+  phgmg__free(al, tp); phgmg__free(al, ti); phgmg__free(al, tx);
+  phgmg__free(al, cp); phgmg__free(al, ci); phgmg__free(al, cx);
+  phgmg__free(al, ctp); phgmg__free(al, cti); phgmg__free(al, ctx);
+  phgmg__free(al, hp); phgmg__free(al, hi); phgmg__free(al, hx);
+  return rc;
+}
+
+/* The feedthrough block of a SPARSE system, [[R, P], [P^T, S]] ((N + m)
+   square; P dense N x m, S symmetric m x m), positive semidefinite within
+   tol: the block plus tol times its 1-norm times I positive definite by
+   the pivots of phgmg__sp_pd (R's policy; S symmetric is checked by the
+   caller). PHGMG_ERR_FEEDTHROUGH, _NOMEM. */
+PHGMG__PRIV phgmg_result phgmg__ph_sparse_feedthrough(const phgmg_ph_system *s, double tol,
+                                                      const phgmg_allocator *al) {
+  const phgmg_ph_sparse *sp = s->sparse;
+  const int N = s->N, m = s->m, n = N + m;
+  const size_t nz = (size_t)sp->cp[1][N] + 2 * (size_t)N * (size_t)m + (size_t)m * (size_t)m + 1;
+  int *cp = phgmg__ialloc(al, (size_t)n + 1), *ci = phgmg__ialloc(al, nz), j, p, k = 0, r;
+  double *cx = phgmg__dalloc(al, nz), n1 = 0.0;
+  phgmg_result rc = PHGMG_ERR_NOMEM;
+  if (!cp || !ci || !cx) goto done;
+  for (j = 0; j < n; ++j) { /* column j: R's (or P^T's) rows, then P's (or S's) */
+    double cs = 0.0;
+    cp[j] = k;
+    if (j < N) {
+      for (p = sp->cp[1][j]; p < sp->cp[1][j + 1]; ++p) { ci[k] = sp->ci[1][p]; cx[k++] = sp->cx[1][p]; }
+      for (r = 0; s->P && r < m; ++r) /* P's nonzero entries only: the pattern stays sparse */
+        if (s->P[(size_t)j + (size_t)r * (size_t)N] != 0.0) { ci[k] = N + r; cx[k++] = s->P[(size_t)j + (size_t)r * (size_t)N]; }
+    } else {
+      for (r = 0; s->P && r < N; ++r)
+        if (s->P[(size_t)r + (size_t)(j - N) * (size_t)N] != 0.0) { ci[k] = r; cx[k++] = s->P[(size_t)r + (size_t)(j - N) * (size_t)N]; }
+      for (r = 0; r < m; ++r) { ci[k] = N + r; cx[k++] = s->S ? s->S[(size_t)r + (size_t)(j - N) * (size_t)m] : 0.0; }
+    }
+    for (p = cp[j]; p < k; ++p) cs += fabs(cx[p]);
+    n1 = PHGMG__MAX(n1, cs);
+  }
+  cp[n] = k;
+  r = n1 > 0.0 ? phgmg__sp_pd(n, cp, ci, cx, tol * n1, al) : 1;
+  rc = r < 0 ? PHGMG_ERR_NOMEM : r ? PHGMG_OK : PHGMG_ERR_FEEDTHROUGH;
+done:
+  phgmg__free(al, cp); phgmg__free(al, ci); phgmg__free(al, cx);
+  return rc;
+}
+
+/* x <- K^{-T} x for a factor without a condensed block (real): the
+   solve of (K P)^T y = P^T x, U^T then L^T supernode by supernode. */
+PHGMG__PRIV void phgmg__sp_solve_t(const phgmg__spsym *S, const phgmg__spnum *F, double *x) {
+  const int n = S->nf, ns = S->nsup;
+  int s, i, j, k;
+  double *y = F->y;
+  for (i = 0; i < n; ++i) y[i] = x[S->cperm ? S->cperm[S->perm[i]] : S->perm[i]];
+  for (s = 0; s < ns; ++s) { /* forward: U^T */
+    const int f = S->sfirst[s], nc = S->sfirst[s + 1] - f, nr = S->srp[s + 1] - S->srp[s], nf = nc + nr;
+    const int *rows = S->srow + S->srp[s];
+    const double *L = F->X + S->lptr[s], *Up = L + (size_t)nf * (size_t)nc;
+    double *yf = y + f;
+    for (k = 0; k < nc; ++k) yf[k] = (yf[k] - phgmg__dot(k, L + (size_t)k * (size_t)nf, yf)) / L[(size_t)k * (size_t)nf + (size_t)k];
+    for (j = 0; j < nr; ++j) {
+      double acc = 0.0;
+      for (i = 0; i < nc; ++i) acc += Up[(size_t)i * (size_t)nr + (size_t)j] * yf[i];
+      y[rows[j]] -= acc;
+    }
+  }
+  for (s = ns - 1; s >= 0; --s) { /* backward: L^T, unit diagonal */
+    const int f = S->sfirst[s], nc = S->sfirst[s + 1] - f, nr = S->srp[s + 1] - S->srp[s], nf = nc + nr;
+    const int *rows = S->srow + S->srp[s];
+    const double *L = F->X + S->lptr[s];
+    double *yf = y + f;
+    for (k = nc - 1; k >= 0; --k) {
+      const double *lk = L + (size_t)k * (size_t)nf;
+      double v = yf[k] - phgmg__dot(nc - k - 1, lk + k + 1, yf + k + 1);
+      for (j = 0; j < nr; ++j) v -= lk[nc + j] * y[rows[j]];
+      yf[k] = v;
+    }
+  }
+  for (i = 0; i < n; ++i) x[S->perm[i]] = y[i];
+}
+
+/* The sparse LU of a nonsingular n x n CSC matrix A (a descriptor model's
+   E): columns matched to its largest entries, fill-reducing order without
+   condensation, static pivots with no threshold. PHGMG_OK; PHGMG_ERR_UNSUPPORTED
+   when a pivot is zero or not finite or the growth exceeds
+   PHGMG_SPARSE_GROWTH (the static order cannot decide: the caller takes
+   the band LU with partial pivoting); _NOMEM. */
+PHGMG__PRIV phgmg_result phgmg__sp_lu_create(int n, const int *cp, const int *ci, const double *cx, phgmg__spsym **So,
+                                             phgmg__spnum *F, const phgmg_allocator *al) {
+  phgmg__spsym *S = PHGMG__CAST(phgmg__spsym *, phgmg__alloc(al, sizeof(phgmg__spsym)));
+  double *Mx = NULL, *w = NULL;
+  int j, p, nq = 0, r;
+  phgmg_result rc = PHGMG_ERR_NOMEM;
+  *So = NULL;
+  memset(F, 0, sizeof *F);
+  if (!S) return rc;
+  memset(S, 0, sizeof *S);
+  S->n = n;
+  S->jr_p = phgmg__ialloc(al, (size_t)n + 1); S->jr_i = phgmg__ialloc(al, (size_t)n + 1);
+  S->jr_x = phgmg__dalloc(al, (size_t)n + 1); S->q_p = phgmg__ialloc(al, (size_t)n + 1);
+  S->q_i = phgmg__ialloc(al, (size_t)cp[n] + 1); S->q_x = phgmg__dalloc(al, (size_t)cp[n] + 1);
+  S->cperm = phgmg__ialloc(al, (size_t)n);
+  if (!S->jr_p || !S->jr_i || !S->jr_x || !S->q_p || !S->q_i || !S->q_x || !S->cperm) goto done;
+  for (j = 0; j < n; ++j) { /* J - R = -I, Q = A: M = A */
+    S->jr_p[j] = j; S->jr_i[j] = j; S->jr_x[j] = -1.0; S->q_p[j] = nq;
+    for (p = cp[j]; p < cp[j + 1]; ++p)
+      if (cx[p] != 0.0) { S->q_i[nq] = ci[p]; S->q_x[nq] = cx[p]; ++nq; }
+  }
+  S->jr_p[n] = n; S->q_p[n] = nq;
+  if ((r = phgmg__sp_match(n, S->q_p, S->q_i, S->q_x, S->cperm, al)) < 0) goto done;
+  if (r == 0) { phgmg__free(al, S->cperm); S->cperm = NULL; }
+  if ((rc = phgmg__spsym_analyse(S, 0, al)) != PHGMG_OK) goto done;
+  rc = PHGMG_ERR_NOMEM;
+  Mx = phgmg__dalloc(al, (size_t)S->k_p[n] + 1);
+  w = phgmg__dalloc(al, (size_t)n);
+  if (!Mx || !w || phgmg__spnum_alloc(al, S, 0, F) != PHGMG_OK) goto done;
+  phgmg__sp_stage_values(S, NULL, Mx, w);
+  phgmg__sp_factor(S, F, Mx, 0.0, 0.0, 0.0);
+  rc = F->growth <= PHGMG_SPARSE_GROWTH ? PHGMG_OK : PHGMG_ERR_UNSUPPORTED;
+  for (j = 0; j < S->nsup && rc == PHGMG_OK; ++j) { /* the pivots */
+    const int nc = S->sfirst[j + 1] - S->sfirst[j], nf = nc + S->srp[j + 1] - S->srp[j];
+    for (p = 0; p < nc; ++p) {
+      const double d = F->X[S->lptr[j] + (size_t)p * (size_t)nf + (size_t)p];
+      if (!(fabs(d) > 0.0 && fabs(d) < HUGE_VAL)) { rc = PHGMG_ERR_UNSUPPORTED; break; }
+    }
+  }
+done:
+  phgmg__free(al, Mx);
+  phgmg__free(al, w);
+  if (rc != PHGMG_OK) { phgmg__spnum_free(al, F); phgmg__spsym_free(al, S); return rc; }
+  *So = S;
+  return PHGMG_OK;
+}
+
+PHGMG__PRIV void phgmg__jr_sp_free(phgmg_jr_factor *f) {
+  if (f->spf) { phgmg__spnum_free(&f->al, f->spf); phgmg__free(&f->al, f->spf); }
+  phgmg__spsym_free(&f->al, f->sps);
+  f->spf = NULL; f->sps = NULL;
+}
+PHGMG__PRIV void phgmg__jr_sp_solve(const void *fv, char trans, double *x) {
+  const phgmg_jr_factor *f = PHGMG__CAST(const phgmg_jr_factor *, fv);
+  if (trans == 'T' || trans == 't') phgmg__sp_solve_t(f->sps, f->spf, x);
+  else phgmg__sp_solve(f->sps, f->spf, x);
+}
+
+/* The factor of E of a SPARSE descriptor model by the sparse LU
+   (phgmg__sp_lu_create) in a phgmg_jr_factor (phgmg_jr_solve applies E^{-1},
+   E^{-T}); rcond_out (may be NULL): 1 / (||E||_1 est ||E^{-1}||_1) (Hager's
+   estimate through its solves). PHGMG_ERR_UNSUPPORTED when the static
+   pivots cannot decide (the caller takes the band LU). */
+PHGMG__PRIV phgmg_result phgmg__sp_e_factor(const phgmg_ph_system *sys, phgmg_jr_factor **out, double *rcond_out,
+                                            const phgmg_allocator *alloc) {
+  const phgmg_ph_sparse *sp = sys->sparse;
+  const int N = sys->N;
+  phgmg_jr_factor *f = PHGMG__CAST(phgmg_jr_factor *, phgmg__alloc(alloc, sizeof(phgmg_jr_factor)));
+  phgmg_result rc = PHGMG_ERR_NOMEM;
+  *out = NULL;
+  if (!f) return rc;
+  memset(f, 0, sizeof *f);
+  if (alloc) f->al = *alloc;
+  f->N = N;
+  f->storage = PHGMG_SPARSE;
+  f->spf = PHGMG__CAST(phgmg__spnum *, phgmg__alloc(alloc, sizeof(phgmg__spnum)));
+  if (f->spf) {
+    memset(f->spf, 0, sizeof *f->spf);
+    rc = phgmg__sp_lu_create(N, sp->cp[3], sp->ci[3], sp->cx[3], &f->sps, f->spf, alloc);
+  }
+  if (rc == PHGMG_OK && rcond_out) {
+    double *work = phgmg__dalloc(alloc, 2 * (size_t)N), en = 0.0, est;
+    int *iwork = phgmg__ialloc(alloc, (size_t)N), j, p;
+    if (!work || !iwork) rc = PHGMG_ERR_NOMEM;
+    for (j = 0; j < N && rc == PHGMG_OK; ++j) {
+      double cs = 0.0;
+      for (p = sp->cp[3][j]; p < sp->cp[3][j + 1]; ++p) cs += fabs(sp->cx[3][p]);
+      en = PHGMG__MAX(en, cs);
+    }
+    if (rc == PHGMG_OK) {
+      est = phgmg__inv_norm1(N, phgmg__jr_sp_solve, f, work, iwork);
+      *rcond_out = en > 0.0 && est > 0.0 && est < HUGE_VAL ? (1.0 / est) / en : 0.0;
+    }
+    phgmg__free(alloc, work);
+    phgmg__free(alloc, iwork);
+  }
+  if (rc != PHGMG_OK) { phgmg_jr_factor_destroy(f); return rc; }
+  *out = f;
+  return PHGMG_OK;
 }
 
 PHGMG_DEF void phgmg_ph_sparse_destroy(phgmg_ph_sparse *sp) {
@@ -7999,6 +8674,7 @@ PHGMG_DEF void phgmg_ph_sparse_destroy(phgmg_ph_sparse *sp) {
     phgmg__free(alloc, sp->cp[a]); phgmg__free(alloc, sp->ci[a]); phgmg__free(alloc, sp->cx[a]);
   }
   phgmg__spsym_free(alloc, sp->sym);
+  phgmg__free(alloc, sp->vc);
   phgmg__free(alloc, sp);
 }
 
@@ -8090,7 +8766,9 @@ PHGMG_DEF phgmg_result phgmg_ph_sparse_create_e(phgmg_ph_sparse **out, int N, in
   if (alloc) { sp->a = *alloc; sp->alloc = &sp->a; }
   sp->perm = phgmg__ialloc(alloc, (size_t)N);
   sp->iperm = phgmg__ialloc(alloc, (size_t)N);
-  if (!sp->perm || !sp->iperm) { phgmg_ph_sparse_destroy(sp); return PHGMG_ERR_NOMEM; }
+  sp->vc = PHGMG__CAST(phgmg__valcache *, phgmg__alloc(alloc, sizeof(phgmg__valcache)));
+  if (!sp->perm || !sp->iperm || !sp->vc) { phgmg_ph_sparse_destroy(sp); return PHGMG_ERR_NOMEM; }
+  memset(sp->vc, 0, sizeof *sp->vc);
   rc = phgmg_rcm(N, na, A, sp->perm, &kb_rcm, alloc);
   if (rc != PHGMG_OK) { phgmg_ph_sparse_destroy(sp); return rc; }
   for (a = 0; a < na; ++a) {
@@ -8230,7 +8908,7 @@ PHGMG_DEF phgmg_result phgmg_ph_sparse_set_solver(phgmg_ph_sparse *sp, int solve
   phgmg_ph_sparse_info *f;
   const int N = sp ? sp->sys.N : 0;
   phgmg_result rc;
-  int use;
+  int use, j;
   if (!sp || solver < PHGMG_SOLVER_AUTO || solver > PHGMG_SOLVER_SPARSE_LU) return PHGMG_ERR_INVALID_ARG;
   f = &sp->inf;
   phgmg__ph_sparse_stage_bw(sp, &f->kl, &f->ku);
@@ -8251,6 +8929,8 @@ PHGMG_DEF phgmg_result phgmg_ph_sparse_set_solver(phgmg_ph_sparse *sp, int solve
     f->flops_sparse = sp->sym->flops;
     f->supernodes = sp->sym->nsup;
     f->condensed = sp->sym->na;
+    f->colperm = 0;
+    for (j = 0; sp->sym->cperm && j < N; ++j) f->colperm += sp->sym->cperm[j] != j;
     { size_t fm = 0; while ((fm + 1) * (fm + 1) <= sp->sym->front_max) ++fm; f->front_max = (int)fm; }
   }
   if (solver == PHGMG_SOLVER_AUTO)
@@ -8307,6 +8987,17 @@ PHGMG__PRIV const phgmg__spsym *phgmg__ph_sparse_lu(const phgmg_ph_system *sys) 
   return sp->sym;
 }
 
+/* The validation cache of sys when sys is a sparse object's own system
+   (its current J, R, Q, E, no dampers or feedthrough), else NULL. */
+PHGMG__PRIV phgmg__valcache *phgmg__ph_valcache(const phgmg_ph_system *sys) {
+  const phgmg_ph_sparse *sp = sys->sparse;
+  if (!sp || !sp->vc || sys->N != sp->sys.N || sys->storage != sp->sys.storage || sys->kb != sp->sys.kb ||
+      sys->J != sp->sys.J || sys->R != sp->sys.R || sys->Q != sp->sys.Q || sys->E != sp->sys.E || sys->ndamp ||
+      sys->P || sys->S || sys->Nskew)
+    return NULL;
+  return sp->vc;
+}
+
 /* phgmg__ph_check's part for SPARSE storage: the object's own matrices, and
    only what the sparse path serves (see phgmg_ph_sparse_system). */
 PHGMG__PRIV phgmg_result phgmg__ph_check_sparse(const phgmg_ph_system *s) {
@@ -8314,7 +9005,7 @@ PHGMG__PRIV phgmg_result phgmg__ph_check_sparse(const phgmg_ph_system *s) {
   if (!sp || s->N != sp->sys.N || s->J != sp->cx[0] || s->R != sp->cx[1] || s->Q != sp->cx[2] ||
       s->E != sp->cx[3])
     return PHGMG_ERR_INVALID_ARG;
-  if (s->ndamp || s->P || s->S || s->Nskew || s->nl == PHGMG_NL_GENERAL || s->shifted_factor)
+  if (s->ndamp || s->nl == PHGMG_NL_GENERAL || s->shifted_factor)
     return PHGMG_ERR_UNSUPPORTED;
   return PHGMG_OK;
 }
@@ -8974,6 +9665,7 @@ PHGMG__PRIV void phgmg__gl3_setup_method(phgmg_gl3 *s, const phgmg_gl3_opts *opt
     s->mode = PHGMG__GL3_SPARSE;
   else
     s->mode = sys->storage == PHGMG_DENSE ? PHGMG__GL3_DENSE : PHGMG__GL3_BANDED;
+  s->st.sparse_lu = s->mode == PHGMG__GL3_SPARSE;
 
 }
 
@@ -9752,6 +10444,8 @@ PHGMG__PRIV phgmg_result phgmg__gl3_sparse_fallback(phgmg_gl3 *s) {
   phgmg__spnum_free(&s->al, &s->spf2);
   s->mode = PHGMG__GL3_BANDED;
   s->sps = NULL; /* from here exactly the band stepper */
+  s->st.sparse_lu = 0;
+  s->st.band_fallback = 1;
   phgmg__dia_free(&s->al, &s->dq);
   if (s->sys.storage == PHGMG_SPARSE) {
     rc = phgmg__gl3_sparse_dia(s);
@@ -10220,6 +10914,8 @@ PHGMG__PRIV phgmg_result phgmg__simulate_on(phgmg_gl3 *s, const phgmg_ph_system 
   int N = sys->N, m = sys->m, n, i, k, done = 0;
   phgmg_gl3_stats tot = s->st;
   memset(&s->st, 0, sizeof s->st);
+  s->st.sparse_lu = tot.sparse_lu;
+  s->st.band_fallback = tot.band_fallback;
   s->have_prev = 0;
   x = phgmg__dalloc(alloc, (size_t)N);
   g = phgmg__dalloc(alloc, (size_t)N);
@@ -10261,6 +10957,7 @@ done:
   tot.steps += s->st.steps; tot.newton_iters += s->st.newton_iters;
   tot.factorizations += s->st.factorizations; tot.rhs_evals += s->st.rhs_evals;
   tot.failures += s->st.failures; tot.max_residual = PHGMG__MAX(tot.max_residual, s->st.max_residual);
+  tot.sparse_lu = s->st.sparse_lu; tot.band_fallback = s->st.band_fallback;
   s->st = tot;
   if (steps_done) *steps_done = done;
   phgmg__free(alloc, x);

@@ -14,9 +14,19 @@
    max wall time of each, the median of the pairs' ratios band / sparse, the
    predicted LU entries of both and the largest relative difference of the
    outputs.
+   --swap 1: the columns of E and Q of the masses 2k and 2k + 1 exchanged
+   (the same dynamics; sigma E + M then has zero diagonals: the sparse LU's
+   column matching puts E's entries back on its diagonal).
+   --setup 1: instead, the set-up of one model with the automatic solver
+   choice, phase by phase: phgmg_ph_sparse_create_e (ordering, matching,
+   analysis), phgmg_ph_validate (first call; a second call reuses the
+   result), phgmg_dae_create (no algebraic line: reuses it too) and
+   phgmg_simulate of --steps steps; and whether the sparse LU served the
+   whole run (phgmg_gl3_stats).
 
      cc -std=c99 -O2 -march=native bench/bench_desc.c -o build/bench_desc -lm
-     ./build/bench_desc --nx 71 --steps 1000 --runs 5 [--out bench/results.csv] */
+     ./build/bench_desc --nx 71 --steps 1000 --runs 5 [--out bench/results.csv]
+     ./build/bench_desc --nx 40 --steps 100 --swap 1 --setup 1 */
 #define _POSIX_C_SOURCE 199309L
 #define PHGMG_IMPLEMENTATION
 #include "../phgmg.h"
@@ -53,13 +63,17 @@ static int bd_col(int a, int nx, int j, int *ri, double *v) {
   return k;
 }
 
-static void bd_build(bd_csc *M, int a, int nx) {
+static void bd_build(bd_csc *M, int a, int nx, int swap) {
   const int N = 2 * nx * nx;
   int j, nz = 0;
   M->cp = (int *)malloc(sizeof(int) * (size_t)(N + 1));
   M->ri = (int *)malloc(sizeof(int) * (size_t)N * 5);
   M->v = (double *)malloc(sizeof(double) * (size_t)N * 5);
-  for (j = 0; j < N; ++j) { M->cp[j] = nz; nz += bd_col(a, nx, j, M->ri + nz, M->v + nz); }
+  for (j = 0; j < N; ++j) {
+    const int src = swap && a >= 2 && (j ^ 2) < N ? j ^ 2 : j; /* E P, Q P */
+    M->cp[j] = nz;
+    nz += bd_col(a, nx, src, M->ri + nz, M->v + nz);
+  }
   M->cp[N] = nz;
   M->A.n_rows = M->A.n_cols = N;
   M->A.colptr = M->cp; M->A.rowidx = M->ri; M->A.values = M->v;
@@ -84,6 +98,43 @@ static double bd_run(const bd_csc *M, const double *B, int N, int solver, int st
   return t1 - t0;
 }
 
+/* --setup: the phases of one model's set-up and run, timed. */
+static void bd_setup(const bd_csc *M, const double *B, int N, int steps) {
+  phgmg_ph_sparse *sp = NULL;
+  phgmg_ph_sparse_info inf;
+  phgmg_gl3_stats st;
+  phgmg_dae *dae = NULL;
+  double *x0 = (double *)calloc((size_t)N, sizeof(double)), *Y = (double *)malloc(sizeof(double) * (size_t)(steps + 1));
+  double t[6];
+  phgmg_result rc, rv, rv2;
+  t[0] = bd_now();
+  rc = phgmg_ph_sparse_create_e(&sp, N, 1, &M[0].A, &M[1].A, &M[2].A, &M[3].A, B, NULL, &inf, NULL);
+  t[1] = bd_now();
+  if (rc != PHGMG_OK) { fprintf(stderr, "bench_desc: %s\n", phgmg_result_string(rc)); exit(1); }
+  rv = phgmg_ph_validate(phgmg_ph_sparse_system(sp), 0.0, NULL, NULL);
+  t[2] = bd_now();
+  rv2 = phgmg_ph_validate(phgmg_ph_sparse_system(sp), 0.0, NULL, NULL);
+  t[3] = bd_now();
+  rc = phgmg_dae_create(&dae, phgmg_ph_sparse_system(sp), 0.0, NULL);
+  phgmg_dae_destroy(dae);
+  t[4] = bd_now();
+  if (rc == PHGMG_OK)
+    rc = phgmg_simulate(phgmg_ph_sparse_system(sp), x0, 0.0, 0.1, steps, bd_u, NULL, NULL, NULL, Y, NULL, &st, NULL,
+                        NULL);
+  t[5] = bd_now();
+  if (rc != PHGMG_OK || rv != PHGMG_OK || rv2 != PHGMG_OK) {
+    fprintf(stderr, "bench_desc: %s\n", phgmg_result_string(rc != PHGMG_OK ? rc : rv != PHGMG_OK ? rv : rv2));
+    exit(1);
+  }
+  printf("setup N = %d (kb %d): solver %s (%d columns matched, %d condensed)\n", N, inf.kb,
+         inf.solver == PHGMG_SOLVER_SPARSE_LU ? "sparse LU" : "band LU", inf.colperm, inf.condensed);
+  printf("  create %.3f s, validate %.3f s, validate again %.3f s, dae_create %.3f s, simulate %d steps %.3f s "
+         "(sparse LU throughout: %s)\n", t[1] - t[0], t[2] - t[1], t[3] - t[2], t[4] - t[3], steps, t[5] - t[4],
+         st.sparse_lu && !st.band_fallback ? "yes" : "no, band LU fall-back");
+  phgmg_ph_sparse_destroy(sp);
+  free(x0); free(Y);
+}
+
 static int bd_cmp(const void *a, const void *b) {
   double x = *(const double *)a, y = *(const double *)b;
   return x < y ? -1 : x > y;
@@ -94,8 +145,8 @@ static double bd_median(double *t, int n) {
 }
 
 int main(int argc, char **argv) {
-  static const char *const extra[] = {"--nx", "--steps", "--runs", NULL};
-  const char *val[3] = {NULL, NULL, NULL}, *out;
+  static const char *const extra[] = {"--nx", "--steps", "--runs", "--swap", "--setup", NULL};
+  const char *val[5] = {NULL, NULL, NULL, NULL, NULL}, *out;
   int nx, steps, runs, N, a, r, i, err;
   double *tb, *ts, *tr, *Yb, *Ys, *B, d = 0.0, ym = 0.0, mb, ms, mr;
   bd_csc M[4];
@@ -107,12 +158,18 @@ int main(int argc, char **argv) {
   steps = val[1] ? atoi(val[1]) : 1000;
   runs = val[2] ? atoi(val[2]) : 3;
   if (nx < 2 || steps < 1 || runs < 1) { fprintf(stderr, "bench_desc: bad --nx, --steps or --runs\n"); return 2; }
-  csv = bench_open_csv("bench_desc", out, &err);
-  if (err) return 1;
   N = 2 * nx * nx;
-  for (a = 0; a < 4; ++a) bd_build(&M[a], a, nx);
+  for (a = 0; a < 4; ++a) bd_build(&M[a], a, nx, val[3] && atoi(val[3]));
   B = (double *)calloc((size_t)N, sizeof(double));
   B[1] = 1.0;
+  if (val[4] && atoi(val[4])) {
+    bd_setup(M, B, N, steps);
+    for (a = 0; a < 4; ++a) { free(M[a].cp); free(M[a].ri); free(M[a].v); }
+    free(B);
+    return 0;
+  }
+  csv = bench_open_csv("bench_desc", out, &err);
+  if (err) return 1;
   tb = (double *)malloc(sizeof(double) * (size_t)runs); ts = (double *)malloc(sizeof(double) * (size_t)runs);
   tr = (double *)malloc(sizeof(double) * (size_t)runs);
   Yb = (double *)malloc(sizeof(double) * (size_t)(steps + 1)); Ys = (double *)malloc(sizeof(double) * (size_t)(steps + 1));

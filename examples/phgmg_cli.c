@@ -1941,7 +1941,11 @@ static void remove_stale(const char *dir, const outlist *rec, const outlist *ol)
 /* The GL3 stage-matrix solver phgmg_ph_sparse_create chose, for the log. */
 static const char *sparse_solver_desc(const phgmg_ph_sparse_info *inf) {
   static char buf[256];
-  if (inf->solver == PHGMG_SOLVER_SPARSE_LU)
+  if (inf->solver == PHGMG_SOLVER_SPARSE_LU && inf->colperm > 0)
+    snprintf(buf, sizeof buf, "sparse LU (%d columns matched to E's largest entries, %d states condensed, nested "
+             "dissection, %d supernodes, %.3g factor entries vs %.3g banded)", inf->colperm, inf->condensed,
+             inf->supernodes, inf->lu_sparse, inf->lu_band);
+  else if (inf->solver == PHGMG_SOLVER_SPARSE_LU)
     snprintf(buf, sizeof buf, "sparse LU (%d states condensed, nested dissection, %d supernodes, %.3g factor "
              "entries vs %.3g banded)", inf->condensed, inf->supernodes, inf->lu_sparse, inf->lu_band);
   else if (inf->lu_sparse > 0.0)
@@ -1949,6 +1953,13 @@ static const char *sparse_solver_desc(const phgmg_ph_sparse_info *inf) {
   else
     snprintf(buf, sizeof buf, "band LU (%.3g factor entries)", inf->lu_band);
   return buf;
+}
+
+/* A simulation whose sparse LU gave up its static pivots for the band LU says so. */
+static void note_band_fallback(const phgmg_gl3_stats *st) {
+  if (st->band_fallback)
+    progress("  note: the sparse LU's static pivots failed on this model; the stage systems were solved by the "
+             "band LU with partial pivoting instead (slower, memory O(N kb))");
 }
 
 /* The sparse system (--J-coo, --R-coo, --Q-coo, --B) into S->sp and sys. */
@@ -1967,8 +1978,8 @@ static int load_sparse_system(const reduce_args *A, reduce_state *S, phgmg_ph_sy
   rc = phgmg_ph_sparse_create_e(&S->sp, N, m, &S->cJ.A, &S->cR.A, &S->cQ.A, A->Ecoo ? &S->cE.A : NULL, S->B.a,
                                 NULL, &inf, NULL);
   if (rc != PHGMG_OK) return fail("sparse J, R, Q%s: %s", A->Ecoo ? ", E" : "", phgmg_result_string(rc));
-  if ((A->Pf || A->Sf || A->Nf || A->dampf) && inf.solver == PHGMG_SOLVER_SPARSE_LU &&
-      (rc = phgmg_ph_sparse_set_solver(S->sp, PHGMG_SOLVER_BAND, &inf)) != PHGMG_OK) /* the sparse LU: no feedthrough, dampers */
+  if (A->dampf && inf.solver == PHGMG_SOLVER_SPARSE_LU &&
+      (rc = phgmg_ph_sparse_set_solver(S->sp, PHGMG_SOLVER_BAND, &inf)) != PHGMG_OK) /* the sparse LU: no dampers */
     return fail("sparse J, R, Q: band solver: %s", phgmg_result_string(rc));
   *sys = *phgmg_ph_sparse_system(S->sp);
   progress("sparse J, R, Q: N = %d, %ld stored entries; half-bandwidth %d (given order %d, reverse "
@@ -2657,6 +2668,7 @@ static int simulate_training_runs(const reduce_args *A, reduce_state *S, const d
     }
     progress("  done (%ld Newton iterations, %ld factorizations)", st.newton_iters, st.factorizations);
     progress_newton_tol(&S->sys, A->newton_tol, &st);
+    note_band_fallback(&st);
     memset(&S->runs[i], 0, sizeof S->runs[i]);
     S->runs[i].u = input_fn; S->runs[i].user = in; S->runs[i].dt = A->dt; S->runs[i].nsteps = A->steps;
   }
@@ -3484,6 +3496,7 @@ static int cmd_simulate(int argc, char **argv) {
   progress("  done in %.3f s (%ld Newton iterations, %ld factorizations)", now_s() - t0, st.newton_iters,
            st.factorizations);
   progress_newton_tol(&S.full, A.newton_tol, &st);
+  note_band_fallback(&st);
   if (X && S.sp) { /* states back into the user's ordering */
     XU = (double *)malloc(sizeof(double) * (size_t)N * ((size_t)A.steps + 1));
     if (!XU) { fail("out of memory"); goto out; }

@@ -32,6 +32,7 @@
 #include "test_options.c"
 #include "test_sparse.c"
 #include "test_sparse_lu.c"
+#include "test_sparse_perm.c"
 #include "test_study.c"
 #include "test_subnormal.c"
 #include "test_dae_ports.c"
