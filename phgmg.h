@@ -1805,9 +1805,9 @@
 
 /* >>config ================================================================ */
 #define PHGMG_VERSION_MAJOR 0
-#define PHGMG_VERSION_MINOR 5
+#define PHGMG_VERSION_MINOR 6
 #define PHGMG_VERSION_PATCH 0
-#define PHGMG_VERSION_STRING "0.5.0"
+#define PHGMG_VERSION_STRING "0.6.0"
 
 #include <stddef.h>
 
@@ -23408,6 +23408,48 @@ PHGMG_DEF phgmg_result phgmg_sym_eig(int n, double *A, int lda, double *w, doubl
 
 /*
    REVISION HISTORY
+   0.6.0  (2026-11-28)
+          - Changed: phgmg_dae_restrict, phgmg_dae_embed and phgmg_dae_lift
+            return a phgmg_result (PHGMG_ERR_INVALID_ARG for a NULL object or
+            vector, or for overlapping vectors other than exact aliasing); in
+            place (xi == x) they work, through the object's scratch. Calls
+            that ignore the result still compile.
+          - Changed: phgmg_dae_create refuses a negative, NaN or infinite
+            tolerance, phgmg_ph_validate a NaN or +Inf one (0 is the default).
+            E = 0 is PHGMG_ERR_E_SINGULAR (was _SIZE); so is a singular
+            sparse E without zero lines (was the E^T Q code).
+          - Changed: loading a model file checks every field that drives the
+            online model: the training envelope (lo <= hi), q_max, the rest
+            state (finite energy, within reach of the training range in
+            working precision); damper and feedthrough blocks give
+            PHGMG_ERR_DAMPER / _FEEDTHROUGH.
+          - Changed: GMG's non-degeneracy test measures D^T G D in
+            equilibrated coordinates against the rounding of its entries
+            (manual 8.9): independent of units and mesh size; a truly
+            singular D^T G D is still refused. info.rcond_dgd reports the
+            new measure; the default tolerance stays 1e-12.
+          - New: phgmg_rom_output_u, the output including the feedthrough
+            (S + N) u; the C export of a model with feedthrough says so.
+          - New: sparse descriptor models keep the sparse LU when sigma E + M
+            has zero diagonals (a column matching on E before the ordering);
+            a fall-back to the band LU is reported (phgmg_gl3_stats.sparse_lu,
+            .band_fallback; phgmg_ph_sparse_info.colperm). The checks of E,
+            E^T Q, Q and R of a sparse model use sparse factorizations (no
+            band copies) and run once per object. Feedthrough takes the
+            sparse LU.
+          - New: >>lowrank (manual 2.8, 8.13): shifted sparse solves on one
+            analysis, LR-ADI, low-rank BT (phgmg_lrbt), pH-preserving
+            low-rank balancing (phgmg_lrphbt), transfer functions and sampled
+            H-infinity errors of sparse models.
+          - New: >>mpi with PHGMG_MPI (manual 2.7): distributed context,
+            TSQR, POD and streamed POD, DEIM points independent of the
+            partition, row-distributed sparse operators, GMG-POD of a linear
+            model; errors agree over the ranks.
+          - Command line: every input file option is in one list and checked
+            by file identity against every output before any work; output
+            directories are created or probed first; --degeneracy-tol; the
+            training dt recorded in the model and used by simulate-rom; the
+            Newton tolerance named in the log; refusals name their cause.
    0.5.0  (2026-11-26)
           - Changed (breaking): the options of phgmg_reduce_opts are grouped
             in sub-structs, qm (phgmg_qm_opts), select (phgmg_select_opts),
