@@ -2576,8 +2576,9 @@ typedef struct phgmg_rom {
   void (*damp_cb)(int term, phgmg_real s, phgmg_real d[2], void *user);
   const int *dterm;         /* ndamp: full-model damper of each kept one (NULL: j) */
   void *damp_user;
-  /* feedthrough (NULL: none; LINEAR kind): PD = [Ph; Dh], Ph = W_z^T P
-     (r x m), then Dh = S + N (m x m):  x' = ... + (Bh - Ph) u,
+  /* feedthrough (NULL: none; LINEAR kind): PD = [Ph; Dh], two column-major
+     blocks one after the other: Ph = W_z^T P (r x m, PD[a + b r]), then
+     Dh = S + N (m x m, PD[r m + a + b m]):  x' = ... + (Bh - Ph) u,
      y = (Bh + Ph)^T grad H + Dh u, dissipation block [[-sym K, Ph],
      [Ph^T, sym Dh]] positive semidefinite (manual 1.6). phgmg_rom_output and
      the stepper's y give (Bh + Ph)^T grad H: they have no u; the whole output

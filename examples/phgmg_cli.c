@@ -3538,8 +3538,8 @@ static int cmd_info(int argc, char **argv) {
   if (rom.PD) printf(", feedthrough (S + N, %d x %d)", rom.m, rom.m);
   if (rom.PD)
     printf("\nfeedthrough: the output y of phgmg_rom_step and phgmg_rom_output leaves out (S + N) u; firmware "
-           "adds (S + N) u(t) (phgmg_rom_output_u does), S + N the last %d x %d block of the model's PD = "
-           "[Ph; S + N] (simulate-rom adds it)", rom.m, rom.m);
+           "adds (S + N) u(t) (phgmg_rom_output_u does); S + N is the %d x %d column-major block at PD + r m, "
+           "after Ph (r x m) (simulate-rom adds it)", rom.m, rom.m);
   if (rom.ndamp)
     printf("\ndampers: the model keeps all %d (each evaluation of the reduced forces costs O(%d r)); "
            "phgmg_rom_step applies them", rom.ndamp, rom.ndamp);
