@@ -9817,25 +9817,8 @@ PHGMG__PRIV phgmg_result phgmg__gl3_csr(phgmg_gl3 *s) {
    (the same entries, columns increasing in each row, as from band storage). */
 PHGMG__PRIV phgmg_result phgmg__gl3_csr_sparse(phgmg_gl3 *s) {
   const phgmg__spsym *S = s->sps ? s->sps : phgmg__ph_sparse_lu(&s->sys);
-  const int N = s->N;
-  const size_t nnz = S ? (size_t)S->jr_p[N] : 0;
-  int j, p;
   if (!S) return PHGMG_ERR_UNSUPPORTED;
-  s->jr_ptr = phgmg__ialloc(&s->al, (size_t)N + 1);
-  s->jr_col = phgmg__ialloc(&s->al, nnz + 1);
-  s->jr_val = phgmg__dalloc(&s->al, nnz + 1);
-  if (!s->jr_ptr || !s->jr_col || !s->jr_val) return PHGMG_ERR_NOMEM;
-  for (j = 0; j <= N; ++j) s->jr_ptr[j] = 0;
-  for (p = 0; p < (int)nnz; ++p) s->jr_ptr[S->jr_i[p] + 1]++;
-  for (j = 0; j < N; ++j) s->jr_ptr[j + 1] += s->jr_ptr[j];
-  for (j = 0; j < N; ++j) /* columns in order: each row's columns increase */
-    for (p = S->jr_p[j]; p < S->jr_p[j + 1]; ++p) {
-      int q = s->jr_ptr[S->jr_i[p]]++;
-      s->jr_col[q] = j; s->jr_val[q] = S->jr_x[p];
-    }
-  for (j = N; j > 0; --j) s->jr_ptr[j] = s->jr_ptr[j - 1];
-  s->jr_ptr[0] = 0;
-  return PHGMG_OK;
+  return phgmg__csc_transpose(s->N, S->jr_p, S->jr_i, S->jr_x, &s->jr_ptr, &s->jr_col, &s->jr_val, &s->al);
 }
 
 /* The sparse LU's factors and the values of M (manual 8.12). */
