@@ -18,7 +18,8 @@ acoustic: a 2-D acoustic wave in mixed P1 elements, state x = (p, vx, vy),
      B = two Gaussian sources in the pressure equation (M g_k).
 biot: Biot poroelasticity in the port-Hamiltonian form of Altmann, Mehrmann &
   Unger, P1/P1, displacement u (2 components, clamped on the bottom edge),
-  velocity w = u', pressure p; x = (u, w, p), N = 4 n_u + N_SIDE^2:
+  velocity w = u', pressure p (drained, p = 0, on the top edge);
+  x = (u, w, p), N = 4 n_u + N_SIDE (N_SIDE - 1):
      E = blkdiag(K_u, M_u, M_p),  Q = I,
      J - R = [[0, K_u, 0], [-K_u, 0, D^T], [0, -D, -K_p]],
   K_u the plane-strain elasticity stiffness (mu = 1, lambda = 2), M_u the
@@ -136,12 +137,14 @@ def biot(n, rng, alpha=0.8):
     free = np.flatnonzero(np.repeat(pts[:, 1] > 1e-12, 2))   # clamped on the bottom edge
     Ku, Mu, D = Ku[free][:, free], Mu[free][:, free], D[:, free]
     nu = free.size
-    Mp, Kp = M / 10.0, 0.1 * K
+    pf = np.flatnonzero(pts[:, 1] < 1.0 - 1e-12)             # drained (p = 0) on the top edge
+    Mp, Kp, D = (M / 10.0)[pf][:, pf], (0.1 * K)[pf][:, pf], D[pf]
+    npf = pf.size
     Z = None
     E = sps.block_diag([Ku, Mu, Mp])
     J = sps.bmat([[Z, Ku, Z], [-Ku, Z, D.T], [Z, -D, Z]])
     R = sps.block_diag([sps.csr_matrix((2 * nu, 2 * nu)), Kp])
-    N = 2 * nu + nn
+    N = 2 * nu + npf
     B = np.zeros((N, 2))
     top = np.flatnonzero(np.abs(pts[:, 1] - 1.0) < 1e-12)
     ftop = np.zeros(2 * nn)
@@ -150,7 +153,7 @@ def biot(n, rng, alpha=0.8):
     ftop[2 * order[:-1] + 1] += seg / 2
     ftop[2 * order[1:] + 1] += seg / 2
     B[nu:2 * nu, 0] = -ftop[free]
-    B[2 * nu:, 1] = M @ gauss(pts, 0.5, 0.5, 0.1)
+    B[2 * nu:, 1] = (M @ gauss(pts, 0.5, 0.5, 0.1))[pf]
     return E, J, R, sps.identity(N), B
 
 
