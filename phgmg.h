@@ -1543,9 +1543,14 @@
    - products with J, R, Q (right-hand sides, Hamiltonian, the reduced
      operators V^T M W of every method) go through the CSC copies;
    - phgmg_jr_factor (G = (J - R)^{-1} in GMG, rcond in the validation)
-     factors J - R in band storage in the reverse Cuthill-McKee order of J - R
-     alone: its bandwidth, not the model's (a mass-spring model's J - R pairs
-     each position with its momentum: bandwidth 1);
+     factors J - R by the sparse LU (its own analysis: the column matching
+     below, nested dissection, no condensation, static pivots checked as
+     for E: a zero or non-finite pivot or growth above PHGMG_SPARSE_GROWTH
+     rejects the factor); only then J - R is factored in band storage in
+     the reverse Cuthill-McKee order of J - R alone: its bandwidth, not the
+     model's (a mass-spring model's J - R pairs each position with its
+     momentum: bandwidth 1; a mixed finite-element model's couples every
+     mesh neighbour, and its band took 3 x 1.5e8 bytes at N = 20 667);
    - the definiteness of Q (and of R + tol ||R||_1 I, semidefiniteness of
      R, for N above the dense-eigenvalue limit) is read from the pivots of
      the sparse LU of that matrix (its own analysis: condensation, nested
@@ -2144,7 +2149,8 @@ PHGMG_DEF void phgmg_ph_output(const phgmg_ph_system *sys, const double *x, doub
 PHGMG_DEF void phgmg_ph_apply(const phgmg_ph_system *sys, char which, int nrhs,
                               const double *X, int ldx, double *Y, int ldy);
 
-/* A factorization of J - R (dense LU or banded LU, by the system's storage),
+/* A factorization of J - R (dense LU, banded LU, or for SPARSE storage the
+   sparse LU with a band LU fall-back: manual 8.12; by the system's storage),
    for applying G = (J - R)^{-1} without forming it. PHGMG_ERR_SINGULAR for an
    exactly zero pivot, PHGMG_ERR_NANINF, _NOMEM; rcond_out (may be NULL): the
    reciprocal 1-norm condition estimate. */
@@ -9576,8 +9582,25 @@ PHGMG__PRIV void phgmg__gl3_e_times(const phgmg_gl3 *s, const double *V, double 
     phgmg_gemm('N', 'N', s->N, 3, s->N, 1.0, s->sys.E, s->N, V, s->N, 0.0, EZ, s->N);
     return;
   }
-  if (s->sys.storage == PHGMG_SPARSE) { /* E's CSC copy */
-    for (st = 0; st < 3; ++st) phgmg__ph_mv(&s->sys, s->sys.E, V + (size_t)st * (size_t)s->N, EZ + (size_t)st * (size_t)s->N);
+  if (s->sys.storage == PHGMG_SPARSE) { /* E's CSC copy, read once for the three columns */
+    const int *cp, *ci;
+    const double *cx;
+    const size_t n = (size_t)s->N;
+    int j, p;
+    if (!phgmg__ph_csc_of(&s->sys, s->sys.E, &cp, &ci, &cx)) {
+      for (st = 0; st < 3; ++st) phgmg__ph_mv(&s->sys, s->sys.E, V + (size_t)st * n, EZ + (size_t)st * n);
+      return;
+    }
+    for (j = 0; j < 3 * s->N; ++j) EZ[j] = 0.0;
+    for (j = 0; j < s->N; ++j) {
+      const double v0 = V[j], v1 = V[n + (size_t)j], v2 = V[2 * n + (size_t)j];
+      if (v0 == 0.0 && v1 == 0.0 && v2 == 0.0) continue;
+      for (p = cp[j]; p < cp[j + 1]; ++p) {
+        const size_t i = (size_t)ci[p];
+        const double e = cx[p];
+        EZ[i] += e * v0; EZ[n + i] += e * v1; EZ[2 * n + i] += e * v2;
+      }
+    }
     return;
   }
   for (st = 0; st < 3; ++st) phgmg__dia_mv(&s->de, V + (size_t)st * (size_t)s->N, EZ + (size_t)st * (size_t)s->N);
