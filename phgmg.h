@@ -1543,9 +1543,14 @@
    - products with J, R, Q (right-hand sides, Hamiltonian, the reduced
      operators V^T M W of every method) go through the CSC copies;
    - phgmg_jr_factor (G = (J - R)^{-1} in GMG, rcond in the validation)
-     factors J - R in band storage in the reverse Cuthill-McKee order of J - R
-     alone: its bandwidth, not the model's (a mass-spring model's J - R pairs
-     each position with its momentum: bandwidth 1);
+     factors J - R by the sparse LU (its own analysis: the column matching
+     below, nested dissection, no condensation, static pivots checked as
+     for E: a zero or non-finite pivot or growth above PHGMG_SPARSE_GROWTH
+     rejects the factor); only then J - R is factored in band storage in
+     the reverse Cuthill-McKee order of J - R alone: its bandwidth, not the
+     model's (a mass-spring model's J - R pairs each position with its
+     momentum: bandwidth 1; a mixed finite-element model's couples every
+     mesh neighbour, and its band took 3 x 1.5e8 bytes at N = 20 667);
    - the definiteness of Q (and of R + tol ||R||_1 I, semidefiniteness of
      R, for N above the dense-eigenvalue limit) is read from the pivots of
      the sparse LU of that matrix (its own analysis: condensation, nested
@@ -2144,7 +2149,8 @@ PHGMG_DEF void phgmg_ph_output(const phgmg_ph_system *sys, const double *x, doub
 PHGMG_DEF void phgmg_ph_apply(const phgmg_ph_system *sys, char which, int nrhs,
                               const double *X, int ldx, double *Y, int ldy);
 
-/* A factorization of J - R (dense LU or banded LU, by the system's storage),
+/* A factorization of J - R (dense LU, banded LU, or for SPARSE storage the
+   sparse LU with a band LU fall-back: manual 8.12; by the system's storage),
    for applying G = (J - R)^{-1} without forming it. PHGMG_ERR_SINGULAR for an
    exactly zero pivot, PHGMG_ERR_NANINF, _NOMEM; rcond_out (may be NULL): the
    reciprocal 1-norm condition estimate. */
@@ -5111,6 +5117,8 @@ struct phgmg_jr_factor {
 };
 PHGMG__PRIV void phgmg__jr_sp_free(phgmg_jr_factor *f);
 PHGMG__PRIV void phgmg__jr_sp_solve(const void *f, char trans, double *x);
+PHGMG__PRIV phgmg_result phgmg__sp_jr_factor(const phgmg_ph_system *sys, phgmg_jr_factor **out, double *rcond_out,
+                                             const phgmg_allocator *alloc);
 
 PHGMG_DEF void phgmg_jr_factor_destroy(phgmg_jr_factor *f) {
   phgmg_allocator al;
@@ -5178,7 +5186,15 @@ PHGMG_DEF phgmg_result phgmg_jr_factor_create(phgmg_jr_factor **out, const phgmg
         f->LU[k] = sys->J[k] - sys->R[k];
       }
     rc = phgmg_lu_factor(N, f->LU, N, f->ipiv);
-  } else if (sys->storage == PHGMG_SPARSE) { /* J - R in band storage, its own RCM order */
+  } else if (sys->storage == PHGMG_SPARSE) { /* the sparse LU, else J - R in band storage, its own RCM order */
+    phgmg_jr_factor *sf = NULL;
+    rc = phgmg__sp_jr_factor(sys, &sf, rcond_out, alloc);
+    if (rc != PHGMG_ERR_UNSUPPORTED) {
+      phgmg_jr_factor_destroy(f);
+      *out = sf;
+      if (rc != PHGMG_OK && rcond_out) *rcond_out = 0.0;
+      return rc;
+    }
     rc = phgmg__ph_sparse_own_band(sys, 0, 1, &t, bands, &f->perm, alloc);
     f->w = phgmg__dalloc(alloc, (size_t)N);
     if (rc == PHGMG_OK && !f->w) rc = PHGMG_ERR_NOMEM;
@@ -8615,15 +8631,14 @@ PHGMG__PRIV void phgmg__jr_sp_solve(const void *fv, char trans, double *x) {
   else phgmg__sp_solve(f->sps, f->spf, x);
 }
 
-/* The factor of E of a SPARSE descriptor model by the sparse LU
-   (phgmg__sp_lu_create) in a phgmg_jr_factor (phgmg_jr_solve applies E^{-1},
-   E^{-T}); rcond_out (may be NULL): 1 / (||E||_1 est ||E^{-1}||_1) (Hager's
-   estimate through its solves). PHGMG_ERR_UNSUPPORTED when the static
-   pivots cannot decide (the caller takes the band LU). */
-PHGMG__PRIV phgmg_result phgmg__sp_e_factor(const phgmg_ph_system *sys, phgmg_jr_factor **out, double *rcond_out,
-                                            const phgmg_allocator *alloc) {
-  const phgmg_ph_sparse *sp = sys->sparse;
-  const int N = sys->N;
+/* The sparse LU (phgmg__sp_lu_create) of the n x n CSC matrix (cp, ci, cx)
+   in a phgmg_jr_factor (phgmg_jr_solve applies its inverse and the inverse's
+   transpose); rcond_out (may be NULL): 1 / (||A||_1 est ||A^{-1}||_1)
+   (Hager's estimate through its solves). PHGMG_ERR_UNSUPPORTED when the
+   static pivots cannot decide (the caller takes the band LU). */
+PHGMG__PRIV phgmg_result phgmg__sp_csc_factor(int N, const int *cp, const int *ci, const double *cx,
+                                              phgmg_jr_factor **out, double *rcond_out,
+                                              const phgmg_allocator *alloc) {
   phgmg_jr_factor *f = PHGMG__CAST(phgmg_jr_factor *, phgmg__alloc(alloc, sizeof(phgmg_jr_factor)));
   phgmg_result rc = PHGMG_ERR_NOMEM;
   *out = NULL;
@@ -8635,7 +8650,7 @@ PHGMG__PRIV phgmg_result phgmg__sp_e_factor(const phgmg_ph_system *sys, phgmg_jr
   f->spf = PHGMG__CAST(phgmg__spnum *, phgmg__alloc(alloc, sizeof(phgmg__spnum)));
   if (f->spf) {
     memset(f->spf, 0, sizeof *f->spf);
-    rc = phgmg__sp_lu_create(N, sp->cp[3], sp->ci[3], sp->cx[3], &f->sps, f->spf, alloc);
+    rc = phgmg__sp_lu_create(N, cp, ci, cx, &f->sps, f->spf, alloc);
   }
   if (rc == PHGMG_OK && rcond_out) {
     double *work = phgmg__dalloc(alloc, 2 * (size_t)N), en = 0.0, est;
@@ -8643,7 +8658,7 @@ PHGMG__PRIV phgmg_result phgmg__sp_e_factor(const phgmg_ph_system *sys, phgmg_jr
     if (!work || !iwork) rc = PHGMG_ERR_NOMEM;
     for (j = 0; j < N && rc == PHGMG_OK; ++j) {
       double cs = 0.0;
-      for (p = sp->cp[3][j]; p < sp->cp[3][j + 1]; ++p) cs += fabs(sp->cx[3][p]);
+      for (p = cp[j]; p < cp[j + 1]; ++p) cs += fabs(cx[p]);
       en = PHGMG__MAX(en, cs);
     }
     if (rc == PHGMG_OK) {
@@ -8656,6 +8671,51 @@ PHGMG__PRIV phgmg_result phgmg__sp_e_factor(const phgmg_ph_system *sys, phgmg_jr
   if (rc != PHGMG_OK) { phgmg_jr_factor_destroy(f); return rc; }
   *out = f;
   return PHGMG_OK;
+}
+
+/* The factor of E of a SPARSE descriptor model by the sparse LU
+   (phgmg__sp_csc_factor). */
+PHGMG__PRIV phgmg_result phgmg__sp_e_factor(const phgmg_ph_system *sys, phgmg_jr_factor **out, double *rcond_out,
+                                            const phgmg_allocator *alloc) {
+  const phgmg_ph_sparse *sp = sys->sparse;
+  return phgmg__sp_csc_factor(sys->N, sp->cp[3], sp->ci[3], sp->cx[3], out, rcond_out, alloc);
+}
+
+/* The factor of J - R of a SPARSE system whose J and R are its CSC copies, by
+   the sparse LU (matched columns, nested dissection, static pivots checked;
+   manual 8.12), with rcond as phgmg__sp_csc_factor. PHGMG_ERR_UNSUPPORTED:
+   not such a system, or the static pivots cannot decide (the caller takes
+   the band LU of J - R in its own reverse Cuthill-McKee order). */
+PHGMG__PRIV phgmg_result phgmg__sp_jr_factor(const phgmg_ph_system *sys, phgmg_jr_factor **out, double *rcond_out,
+                                             const phgmg_allocator *alloc) {
+  const int N = sys->N;
+  const int *jp, *ji, *rp, *ri;
+  const double *jx, *rx;
+  int *dp, *di, j, nz = 0;
+  double *dx;
+  phgmg_result rc;
+  *out = NULL;
+  if (!phgmg__ph_csc_of(sys, sys->J, &jp, &ji, &jx) || !phgmg__ph_csc_of(sys, sys->R, &rp, &ri, &rx))
+    return PHGMG_ERR_UNSUPPORTED;
+  dp = phgmg__ialloc(alloc, (size_t)N + 1);
+  di = phgmg__ialloc(alloc, (size_t)jp[N] + (size_t)rp[N] + 1);
+  dx = phgmg__dalloc(alloc, (size_t)jp[N] + (size_t)rp[N] + 1);
+  rc = dp && di && dx ? PHGMG_OK : PHGMG_ERR_NOMEM;
+  for (j = 0; j < N && rc == PHGMG_OK; ++j) { /* the two sorted columns merged: J - R */
+    int p = jp[j], q = rp[j];
+    dp[j] = nz;
+    while (p < jp[j + 1] || q < rp[j + 1]) {
+      const int a = p < jp[j + 1] ? ji[p] : N, b = q < rp[j + 1] ? ri[q] : N, r = PHGMG__MIN(a, b);
+      const double v = (a == r ? jx[p++] : 0.0) - (b == r ? rx[q++] : 0.0);
+      di[nz] = r; dx[nz++] = v;
+    }
+  }
+  if (rc == PHGMG_OK) {
+    dp[N] = nz;
+    rc = phgmg__sp_csc_factor(N, dp, di, dx, out, rcond_out, alloc);
+  }
+  phgmg__free(alloc, dp); phgmg__free(alloc, di); phgmg__free(alloc, dx);
+  return rc;
 }
 
 PHGMG_DEF void phgmg_ph_sparse_destroy(phgmg_ph_sparse *sp) {
@@ -9522,8 +9582,25 @@ PHGMG__PRIV void phgmg__gl3_e_times(const phgmg_gl3 *s, const double *V, double 
     phgmg_gemm('N', 'N', s->N, 3, s->N, 1.0, s->sys.E, s->N, V, s->N, 0.0, EZ, s->N);
     return;
   }
-  if (s->sys.storage == PHGMG_SPARSE) { /* E's CSC copy */
-    for (st = 0; st < 3; ++st) phgmg__ph_mv(&s->sys, s->sys.E, V + (size_t)st * (size_t)s->N, EZ + (size_t)st * (size_t)s->N);
+  if (s->sys.storage == PHGMG_SPARSE) { /* E's CSC copy, read once for the three columns */
+    const int *cp, *ci;
+    const double *cx;
+    const size_t n = (size_t)s->N;
+    int j, p;
+    if (!phgmg__ph_csc_of(&s->sys, s->sys.E, &cp, &ci, &cx)) {
+      for (st = 0; st < 3; ++st) phgmg__ph_mv(&s->sys, s->sys.E, V + (size_t)st * n, EZ + (size_t)st * n);
+      return;
+    }
+    for (j = 0; j < 3 * s->N; ++j) EZ[j] = 0.0;
+    for (j = 0; j < s->N; ++j) {
+      const double v0 = V[j], v1 = V[n + (size_t)j], v2 = V[2 * n + (size_t)j];
+      if (v0 == 0.0 && v1 == 0.0 && v2 == 0.0) continue;
+      for (p = cp[j]; p < cp[j + 1]; ++p) {
+        const size_t i = (size_t)ci[p];
+        const double e = cx[p];
+        EZ[i] += e * v0; EZ[n + i] += e * v1; EZ[2 * n + i] += e * v2;
+      }
+    }
     return;
   }
   for (st = 0; st < 3; ++st) phgmg__dia_mv(&s->de, V + (size_t)st * (size_t)s->N, EZ + (size_t)st * (size_t)s->N);

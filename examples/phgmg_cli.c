@@ -2478,6 +2478,8 @@ static int load_system(const reduce_args *A, reduce_state *S) {
              sys.phi_nfun > 1 ? " (one function per term)" : "");
   }
   if (load_feedthrough(A, S, &sys) || load_dampers(A, S, &sys) || load_ref(A, S, sys.N)) return 1;
+  if (sys.storage != PHGMG_DENSE && sys.N >= 20000) /* seconds of sparse factorizations: say so first */
+    progress("checking the model (symmetry, definiteness and regularity by sparse factorizations) ...");
   rc = phgmg_ph_validate(&sys, 0.0, &rcond, NULL);
   if (sys.ndamp && rc != PHGMG_OK && explain_dampers(A, S, &sys, rc)) return 1;
   if (sys.ndamp && (rc == PHGMG_ERR_DAMPER || rc == PHGMG_ERR_SIZE || rc == PHGMG_ERR_NANINF))
