@@ -345,10 +345,64 @@
    t_{n+1} (the collocation polynomial's end value of an algebraic variable
    is not consistent: the Gauss methods' stability function is -1 at
    infinity). That is the same as GL3 on the condensed ODE followed by the
-   lift, which is how it is computed: consistent states at every step (x0's
+   lift, which is how it is computed for dense and banded storage:
+   consistent states at every step (x0's
    algebraic part is replaced by the consistent one), the discrete energy
    balance of 1.7 (exact for a quadratic H: the lift changes only x_c, on
-   which H does not depend). Reduction: reduce the condensed model,
+   which H does not depend).
+   Sparse storage: the DAE itself on the sparse pencil. A SPARSE system
+   (phgmg_ph_sparse on the sparse LU; the command line's simulate of COO
+   input) is not condensed: nothing dense of order k is formed and the
+   number of algebraic lines is limited by memory only. Why the collocation
+   of the DAE gives the condensed ODE's trajectory: with the stage values
+   X_i = x_n + Z_i and F_j = L z(X_j) + G u(t_n + c_j h), GL3's stage
+   equations are E Z_i = h sum_j a_ij F_j, all N rows. Their algebraic rows
+   read 0 = sum_j a_ij (L_ad z_d(X_j) + L_aa z_a(X_j) + G_a u_j) for each i;
+   A = (a_ij) is nonsingular, so every stage satisfies the constraint,
+   z_a(X_j) = -L_aa^{-1} (L_ad z_d(X_j) + G_a u_j). Put into the
+   differential rows, E_dd Z_i,d = h sum_j a_ij (L' z_d(X_j) + G' u_j): the
+   condensed ODE's stage equations for the same differential stages (and
+   z_d(X_j) does not depend on x_c, Q_dc = 0). The update x_{n+1} = x_n +
+   sum_i d_i Z_i (d = A^{-T} b, the stepper's form with E) gives, in the
+   differential rows, E_dd x_{n+1,d} = E_dd x_{n,d} + h sum_j b_j F'_j: the
+   condensed step. So the differential trajectory is the condensed one,
+   independent of x_n's algebraic part. The algebraic end values are then
+   taken from the constraints at t_{n+1}: z_d from x_{n+1,d},
+   z_a = -L_aa^{-1} (L_ad z_d + G_a u(t_{n+1})), x_c = Q_ac^{-1} (z_a -
+   Q_ad x_d), which is phgmg_dae_lift's formula; so the states and the
+   outputs equal the condensed path's up to round-off and the Newton
+   tolerance (tests/test_dae_sparse.c: 1e-10). How: the stage matrices
+   sigma E - (J - R) Q are singular in no direction (index one) though E
+   is; they go through the sparse LU of 8.12, whose column matching pairs
+   E's largest entries on the differential rows and the entries of
+   -(J - R) Q on the algebraic rows (an algebraic variable's column is zero
+   in E, so the k algebraic columns take the k algebraic rows); the stage
+   matrix's pattern is that of (J - R) Q, E and the identity (a separable
+   coordinate i needs Q(i, i) stored, else PHGMG_ERR_UNSUPPORTED). The end
+   values use the sparse LUs of L_aa and Q_ac (k x k, the same solver,
+   factored once) and the couplings L_ad, Q_ad: per step three sparse
+   products of the algebraic rows and two sparse solves of order k; x0's
+   algebraic part is replaced by the consistent one at t0. Validation
+   (phgmg_ph_validate) of a SPARSE system checks the same as the condensing
+   path without condensing: the zero lines, Q_dc = 0, E^T Q symmetric and
+   positive definite on the differential variables (the pivots of its
+   sparse factor with the algebraic lines left out), no separable
+   coordinate on an algebraic line, index one by the sparse LUs of L_aa and
+   Q_ac with 1 / ||block^{-1}||_1 (Hager's estimate through their solves)
+   > tol times max |J| + max |R| resp. max |Q| (a zero pivot in the static
+   order also counts as PHGMG_ERR_INDEX; a singular pencil is not told
+   apart from index two here). A phgmg_ph_sparse object with algebraic
+   lines chooses its stage solver by the predicted costs (8.12) like any
+   other, and always the sparse LU beyond 4096 algebraic lines; on the band
+   LU it keeps the condensing path (phgmg_dae_create), on the sparse LU
+   phgmg_dae_create returns PHGMG_ERR_UNSUPPORTED (call
+   phgmg_ph_sparse_set_solver(sp, PHGMG_SOLVER_BAND, ..) for the condensed
+   model; k <= 4096). The stepper object (phgmg_gl3_create) takes such a
+   SPARSE system directly. Measured (bench/README.md, RLC grid of 40 x 40
+   mains, N = 7 840, 3 920 algebraic, rows and columns scrambled, 1 000
+   steps): 3.0 s CPU and 14 MB against SciPy + SuperLU's 6.5 s and 61 MB
+   doing the same steps, outputs 1.6e-16 apart.
+   Reduction: reduce the condensed model,
    phgmg_dae_system(d), with snapshots restricted to x_d (phgmg_reduce of the
    full model is PHGMG_ERR_UNSUPPORTED; the command line does this by
    itself). The reduced model is a port-Hamiltonian ODE with the same
@@ -480,7 +534,9 @@
    E's largest entries on the diagonal (so a model whose E has zero
    diagonal entries, e.g. with its columns in another order, keeps the
    static pivots; manual 8.12); an E with a zero row or column (index one,
-   1.8) keeps the band LU. A stepper that falls back to the band LU says so
+   1.8) takes the same choice too (and the sparse LU beyond 4096 algebraic
+   lines): on the sparse LU the DAE is stepped on its sparse pencil without
+   condensing, on the band LU the algebraic lines are condensed. A stepper that falls back to the band LU says so
    (phgmg_gl3_stats.band_fallback; the command line logs it).
    phgmg_ph_validate checks a sparse model without band copies, once per
    object: phgmg_dae_create and every reduction reuse the result.
@@ -1528,9 +1584,12 @@
    --nx 40 --steps 100 --swap 1 --setup 1, columns of E and Q exchanged in
    pairs, N = 3 200, Intel Xeon): the band fall-back took 1.21 s to
    simulate, the sparse LU with the matching 0.068 s (0.054-0.059 s for the
-   natural order). An E with a zero row or column (the index-one path of 1.8, which
-   condenses the algebraic lines in band or dense storage) keeps the band
-   LU (forcing the sparse LU: PHGMG_ERR_UNSUPPORTED). Measured on a 2-D
+   natural order). An E with a zero row or column (index one, 1.8) is
+   matched on a combined matrix instead: E's rows where E has entries,
+   those of M = -(J - R) Q in E's zero rows (the algebraic equations), so
+   the algebraic rows get M's pivots; the stage matrix's pattern is then
+   that of M, E and the identity (without the separate (J - R) term of a
+   separable Hessian, see 1.8). Measured on a 2-D
    lattice whose momenta carry a mass matrix with the mesh's pattern
    (bench/bench_desc.c, AMD EPYC, medians of 3 paired runs): N = 10 082,
    1000 steps: band 16.3 s, sparse 1.26 s (13x); N = 100 352, 20 steps:
@@ -2087,16 +2146,21 @@ PHGMG_DEF phgmg_result phgmg_ph_validate(const phgmg_ph_system *sys, double tol,
    zero: no differential state) or E is singular but not of this form and not dense (a dense E without zero lines is rotated into it,
    manual 1.8; phgmg_dae_restrict/_embed/_lift then rotate back), PHGMG_ERR_EQ_NOT_SYMMETRIC when the kept co-states depend on the
    algebraic variables, PHGMG_ERR_UNSUPPORTED for a separable coordinate or a
-   damper on an algebraic line, k > 4096, or an elimination whose dense
-   blocks would exceed 1e8 doubles) and builds the condensed model: a
+   damper on an algebraic line, k > 4096, an elimination whose dense
+   blocks would exceed 1e8 doubles, or a SPARSE system: the condensation is
+   made in band or dense storage, phgmg_ph_sparse_set_solver(sp,
+   PHGMG_SOLVER_BAND, ..) first) and builds the condensed model: a
    port-Hamiltonian ODE in the n = N - k differential coordinates, with the
    same outputs, Hamiltonian and dissipation (phgmg_dae_system; feedthrough P,
    S, Nskew where a constraint touches a port), which it validates
    (phgmg_ph_validate's codes). Validate the full model with
    phgmg_ph_validate first (it runs this check too). With k = 0 the
    condensed model is the model itself. phgmg_simulate and
-   phgmg_simulate_run take index-one models directly (consistent states);
-   the stepper object (phgmg_gl3_create), phgmg_simulate_inputs and
+   phgmg_simulate_run take index-one models directly (consistent states; a
+   SPARSE system is stepped as the DAE on its sparse pencil, without
+   condensing and without the limit k <= 4096, and so does the stepper
+   object phgmg_gl3_create: manual 1.8); for dense and banded storage the
+   stepper object, and for every storage phgmg_simulate_inputs and
    phgmg_reduce return PHGMG_ERR_UNSUPPORTED for them: give them
    phgmg_dae_system(d), with snapshots restricted by phgmg_dae_restrict. The object keeps pointers into sys
    (the nonlinear part's functions and weights): sys must outlive it. tol is

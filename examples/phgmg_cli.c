@@ -93,7 +93,11 @@ static const char *const help_lines[] = {
   "                      feedthrough, which gmg-qm and --ref do not take: gmg-pod,\n",
   "                      sp1, sp2 without --ref), simulated with consistent states and reduced;\n",
   "                      written states are full (basis rows of the algebraic\n",
-  "                      variables zero).\n",
+  "                      variables zero). The condensation is dense in the\n",
+  "                      algebraic lines (at most 4096); simulate of a sparse model\n",
+  "                      (--E-coo) does not condense: it steps the DAE itself on the\n",
+  "                      sparse LU of its pencil (algebraic variables from the\n",
+  "                      constraints at every step), with no limit on them.\n",
   "  --P FILE, --S FILE, --N FILE   feedthrough (N x m, m x m, m x m; each optional):\n",
   "                      E x' = (J - R) z + (B - P) u, y = (B + P)^T z + (S + N) u, with\n",
   "                      [[R, P], [P^T, S]] symmetric positive semidefinite and N skew.\n",
@@ -1983,7 +1987,7 @@ static int sparse_dae_solver(const reduce_args *A, reduce_state *S, phgmg_ph_spa
   if (inf->solver != want && (rc = phgmg_ph_sparse_set_solver(S->sp, want, inf)) != PHGMG_OK)
     return fail("sparse J, R, Q, E: %s solver: %s", want == PHGMG_SOLVER_BAND ? "band" : "sparse LU",
                 phgmg_result_string(rc));
-  S->dae_direct = inf->solver == PHGMG_SOLVER_SPARSE_LU;
+  S->dae_direct = S->dae_direct && inf->solver == PHGMG_SOLVER_SPARSE_LU;
   return 0;
 }
 
