@@ -345,10 +345,64 @@
    t_{n+1} (the collocation polynomial's end value of an algebraic variable
    is not consistent: the Gauss methods' stability function is -1 at
    infinity). That is the same as GL3 on the condensed ODE followed by the
-   lift, which is how it is computed: consistent states at every step (x0's
+   lift, which is how it is computed for dense and banded storage:
+   consistent states at every step (x0's
    algebraic part is replaced by the consistent one), the discrete energy
    balance of 1.7 (exact for a quadratic H: the lift changes only x_c, on
-   which H does not depend). Reduction: reduce the condensed model,
+   which H does not depend).
+   Sparse storage: the DAE itself on the sparse pencil. A SPARSE system
+   (phgmg_ph_sparse on the sparse LU; the command line's simulate of COO
+   input) is not condensed: nothing dense of order k is formed and the
+   number of algebraic lines is limited by memory only. Why the collocation
+   of the DAE gives the condensed ODE's trajectory: with the stage values
+   X_i = x_n + Z_i and F_j = L z(X_j) + G u(t_n + c_j h), GL3's stage
+   equations are E Z_i = h sum_j a_ij F_j, all N rows. Their algebraic rows
+   read 0 = sum_j a_ij (L_ad z_d(X_j) + L_aa z_a(X_j) + G_a u_j) for each i;
+   A = (a_ij) is nonsingular, so every stage satisfies the constraint,
+   z_a(X_j) = -L_aa^{-1} (L_ad z_d(X_j) + G_a u_j). Put into the
+   differential rows, E_dd Z_i,d = h sum_j a_ij (L' z_d(X_j) + G' u_j): the
+   condensed ODE's stage equations for the same differential stages (and
+   z_d(X_j) does not depend on x_c, Q_dc = 0). The update x_{n+1} = x_n +
+   sum_i d_i Z_i (d = A^{-T} b, the stepper's form with E) gives, in the
+   differential rows, E_dd x_{n+1,d} = E_dd x_{n,d} + h sum_j b_j F'_j: the
+   condensed step. So the differential trajectory is the condensed one,
+   independent of x_n's algebraic part. The algebraic end values are then
+   taken from the constraints at t_{n+1}: z_d from x_{n+1,d},
+   z_a = -L_aa^{-1} (L_ad z_d + G_a u(t_{n+1})), x_c = Q_ac^{-1} (z_a -
+   Q_ad x_d), which is phgmg_dae_lift's formula; so the states and the
+   outputs equal the condensed path's up to round-off and the Newton
+   tolerance (tests/test_dae_sparse.c: 1e-10). How: the stage matrices
+   sigma E - (J - R) Q are singular in no direction (index one) though E
+   is; they go through the sparse LU of 8.12, whose column matching pairs
+   E's largest entries on the differential rows and the entries of
+   -(J - R) Q on the algebraic rows (an algebraic variable's column is zero
+   in E, so the k algebraic columns take the k algebraic rows); the stage
+   matrix's pattern is that of (J - R) Q, E and the identity (a separable
+   coordinate i needs Q(i, i) stored, else PHGMG_ERR_UNSUPPORTED). The end
+   values use the sparse LUs of L_aa and Q_ac (k x k, the same solver,
+   factored once) and the couplings L_ad, Q_ad: per step three sparse
+   products of the algebraic rows and two sparse solves of order k; x0's
+   algebraic part is replaced by the consistent one at t0. Validation
+   (phgmg_ph_validate) of a SPARSE system checks the same as the condensing
+   path without condensing: the zero lines, Q_dc = 0, E^T Q symmetric and
+   positive definite on the differential variables (the pivots of its
+   sparse factor with the algebraic lines left out), no separable
+   coordinate on an algebraic line, index one by the sparse LUs of L_aa and
+   Q_ac with 1 / ||block^{-1}||_1 (Hager's estimate through their solves)
+   > tol times max |J| + max |R| resp. max |Q| (a zero pivot in the static
+   order also counts as PHGMG_ERR_INDEX; a singular pencil is not told
+   apart from index two here). A phgmg_ph_sparse object with algebraic
+   lines chooses its stage solver by the predicted costs (8.12) like any
+   other, and always the sparse LU beyond 4096 algebraic lines; on the band
+   LU it keeps the condensing path (phgmg_dae_create), on the sparse LU
+   phgmg_dae_create returns PHGMG_ERR_UNSUPPORTED (call
+   phgmg_ph_sparse_set_solver(sp, PHGMG_SOLVER_BAND, ..) for the condensed
+   model; k <= 4096). The stepper object (phgmg_gl3_create) takes such a
+   SPARSE system directly. Measured (bench/README.md, RLC grid of 40 x 40
+   mains, N = 7 840, 3 920 algebraic, rows and columns scrambled, 1 000
+   steps): 3.0 s CPU and 14 MB against SciPy + SuperLU's 6.5 s and 61 MB
+   doing the same steps, outputs 1.6e-16 apart.
+   Reduction: reduce the condensed model,
    phgmg_dae_system(d), with snapshots restricted to x_d (phgmg_reduce of the
    full model is PHGMG_ERR_UNSUPPORTED; the command line does this by
    itself). The reduced model is a port-Hamiltonian ODE with the same
@@ -480,7 +534,9 @@
    E's largest entries on the diagonal (so a model whose E has zero
    diagonal entries, e.g. with its columns in another order, keeps the
    static pivots; manual 8.12); an E with a zero row or column (index one,
-   1.8) keeps the band LU. A stepper that falls back to the band LU says so
+   1.8) takes the same choice too (and the sparse LU beyond 4096 algebraic
+   lines): on the sparse LU the DAE is stepped on its sparse pencil without
+   condensing, on the band LU the algebraic lines are condensed. A stepper that falls back to the band LU says so
    (phgmg_gl3_stats.band_fallback; the command line logs it).
    phgmg_ph_validate checks a sparse model without band copies, once per
    object: phgmg_dae_create and every reduction reuse the result.
@@ -1528,9 +1584,12 @@
    --nx 40 --steps 100 --swap 1 --setup 1, columns of E and Q exchanged in
    pairs, N = 3 200, Intel Xeon): the band fall-back took 1.21 s to
    simulate, the sparse LU with the matching 0.068 s (0.054-0.059 s for the
-   natural order). An E with a zero row or column (the index-one path of 1.8, which
-   condenses the algebraic lines in band or dense storage) keeps the band
-   LU (forcing the sparse LU: PHGMG_ERR_UNSUPPORTED). Measured on a 2-D
+   natural order). An E with a zero row or column (index one, 1.8) is
+   matched on a combined matrix instead: E's rows where E has entries,
+   those of M = -(J - R) Q in E's zero rows (the algebraic equations), so
+   the algebraic rows get M's pivots; the stage matrix's pattern is then
+   that of M, E and the identity (without the separate (J - R) term of a
+   separable Hessian, see 1.8). Measured on a 2-D
    lattice whose momenta carry a mass matrix with the mesh's pattern
    (bench/bench_desc.c, AMD EPYC, medians of 3 paired runs): N = 10 082,
    1000 steps: band 16.3 s, sparse 1.26 s (13x); N = 100 352, 20 steps:
@@ -2092,16 +2151,21 @@ PHGMG_DEF phgmg_result phgmg_ph_validate(const phgmg_ph_system *sys, double tol,
    zero: no differential state) or E is singular but not of this form and not dense (a dense E without zero lines is rotated into it,
    manual 1.8; phgmg_dae_restrict/_embed/_lift then rotate back), PHGMG_ERR_EQ_NOT_SYMMETRIC when the kept co-states depend on the
    algebraic variables, PHGMG_ERR_UNSUPPORTED for a separable coordinate or a
-   damper on an algebraic line, k > 4096, or an elimination whose dense
-   blocks would exceed 1e8 doubles) and builds the condensed model: a
+   damper on an algebraic line, k > 4096, an elimination whose dense
+   blocks would exceed 1e8 doubles, or a SPARSE system: the condensation is
+   made in band or dense storage, phgmg_ph_sparse_set_solver(sp,
+   PHGMG_SOLVER_BAND, ..) first) and builds the condensed model: a
    port-Hamiltonian ODE in the n = N - k differential coordinates, with the
    same outputs, Hamiltonian and dissipation (phgmg_dae_system; feedthrough P,
    S, Nskew where a constraint touches a port), which it validates
    (phgmg_ph_validate's codes). Validate the full model with
    phgmg_ph_validate first (it runs this check too). With k = 0 the
    condensed model is the model itself. phgmg_simulate and
-   phgmg_simulate_run take index-one models directly (consistent states);
-   the stepper object (phgmg_gl3_create), phgmg_simulate_inputs and
+   phgmg_simulate_run take index-one models directly (consistent states; a
+   SPARSE system is stepped as the DAE on its sparse pencil, without
+   condensing and without the limit k <= 4096, and so does the stepper
+   object phgmg_gl3_create: manual 1.8); for dense and banded storage the
+   stepper object, and for every storage phgmg_simulate_inputs and
    phgmg_reduce return PHGMG_ERR_UNSUPPORTED for them: give them
    phgmg_dae_system(d), with snapshots restricted by phgmg_dae_restrict. The object keeps pointers into sys
    (the nonlinear part's functions and weights): sys must outlive it. tol is
@@ -5534,8 +5598,9 @@ PHGMG__PRIV phgmg_result phgmg__dae_validate(const phgmg_ph_system *sys, double 
    with zero lines to the index-one checks (*whole = 1: their result is the
    whole validation), E^T Q symmetric and positive (semi)definite (SPARSE: on
    the sparse E^T Q, phgmg__ph_sparse_etq_check; no band copy). */
-PHGMG__PRIV phgmg_result phgmg__ph_sparse_etq_check(const phgmg_ph_system *s, double tol,
+PHGMG__PRIV phgmg_result phgmg__ph_sparse_etq_check(const phgmg_ph_system *s, double tol, const int *cmap,
                                                     const phgmg_allocator *al);
+PHGMG__PRIV phgmg_result phgmg__sdae_validate(const phgmg_ph_system *sys, double tol, const phgmg_allocator *alloc);
 PHGMG__PRIV phgmg_result phgmg__ph_validate_e(const phgmg_ph_system *sys, double tol, const phgmg_allocator *alloc,
                                               int *whole) {
   phgmg_ph_system t;
@@ -5544,9 +5609,10 @@ PHGMG__PRIV phgmg_result phgmg__ph_validate_e(const phgmg_ph_system *sys, double
   phgmg_result rc;
   *whole = 0;
   if (!phgmg__ph_mat_finite(sys, sys->E)) return PHGMG_ERR_NANINF;
-  if (sys->storage == PHGMG_SPARSE) return phgmg__ph_sparse_etq_check(sys, tol, alloc); /* E regular */
   k = phgmg__e_algebraic(sys, alloc);   /* zero rows or columns: index one? (1.8) */
   if (k < 0) return PHGMG_ERR_NOMEM;
+  if (sys->storage == PHGMG_SPARSE && k > 0) { *whole = 1; return phgmg__sdae_validate(sys, tol, alloc); }
+  if (sys->storage == PHGMG_SPARSE) return phgmg__ph_sparse_etq_check(sys, tol, NULL, alloc); /* E regular */
   if (k > 0) { *whole = 1; return phgmg__dae_validate(sys, tol, alloc); }
   rc = phgmg__etq_form(sys, &t, &buf, alloc);
   if (rc != PHGMG_OK) return rc;
@@ -6427,6 +6493,7 @@ PHGMG_DEF phgmg_result phgmg_dae_create(phgmg_dae **out, const phgmg_ph_system *
   if (rc == PHGMG_OK) {
     const int kind = phgmg__e_algebraic(sys, &d->al);
     if (kind < 0) rc = PHGMG_ERR_NOMEM;
+    else if (kind == 1 && sys->storage == PHGMG_SPARSE) rc = PHGMG_ERR_UNSUPPORTED; /* condensed in band storage */
     else if (kind == 2) rc = phgmg__dae_rotate(d, sys, tol, &rot, &rbuf);
     if (kind == 2 && rc == PHGMG_OK) { sys = &rot; d->sys = rot; }
   }
@@ -6908,6 +6975,7 @@ typedef struct phgmg__spsym {
   int *ra_p, *ra_i, *ra_k;        /* row a of K: columns, Mx indices   */
   int *perm;                      /* fill position k: internal perm[k] */
   int *cperm;                     /* factored column j = column cperm[j] of K (NULL: identity) */
+  int dae;                        /* E has zero rows: M's pattern without the (J - R) D term */
   int nsup;
   int *sfirst, *sparent, *scp, *sch, *srp, *srow; /* sch[scp[s]..scp[s+1]): children, last first */
   size_t *lptr;                   /* factor offsets (scalars)          */
@@ -7010,7 +7078,7 @@ PHGMG__PRIV phgmg_result phgmg__spsym_kpattern(phgmg__spsym *S, const phgmg_allo
       if (pass) S->k_p[j] = nz;
 #define PHGMG__KP_ADD(r) do { int r_ = (r); if (mark[r_] != j) { mark[r_] = j; if (pass) S->k_i[nz] = r_; ++nz; } } while (0)
       PHGMG__KP_ADD(j);
-      for (p = S->jr_p[c]; p < S->jr_p[c + 1]; ++p) PHGMG__KP_ADD(S->jr_i[p]);
+      for (p = S->jr_p[c]; p < S->jr_p[c + 1] && !S->dae; ++p) PHGMG__KP_ADD(S->jr_i[p]);
       if (S->e_p) for (p = S->e_p[c]; p < S->e_p[c + 1]; ++p) PHGMG__KP_ADD(S->e_i[p]);
       for (q = S->q_p[c]; q < S->q_p[c + 1]; ++q) {
         int k = S->q_i[q];
@@ -8316,6 +8384,52 @@ done:
   return ok;
 }
 
+/* The column matching of a descriptor model's stage matrix sigma E + M
+   (phgmg__sp_match into S->cperm): on E itself, or, when E has zero rows
+   (algebraic equations, manual 1.8), on E's rows with M = -(J - R) Q's
+   entries in the zero rows: an algebraic column (zero in E) then meets an
+   algebraic row, whose pivot is M's; the differential rows keep E's. */
+PHGMG__PRIV int phgmg__sp_match_e(phgmg__spsym *S, const phgmg_allocator *al) {
+  const int n = S->n;
+  int *zr = phgmg__ialloc(al, (size_t)n), *mark = phgmg__ialloc(al, (size_t)n), *cp = NULL, *ci = NULL;
+  double *cx = NULL, *w = phgmg__dalloc(al, (size_t)n);
+  int i, j, p, q, nz = 0, pass, r = -1, any = 0;
+  if (!zr || !mark || !w) goto done;
+  for (i = 0; i < n; ++i) { zr[i] = 1; mark[i] = -1; w[i] = 0.0; }
+  for (p = 0; p < S->e_p[n]; ++p) if (S->e_x[p] != 0.0) zr[S->e_i[p]] = 0;
+  for (i = 0; i < n; ++i) any |= zr[i];
+  S->dae = any;
+  if (!any) { r = phgmg__sp_match(n, S->e_p, S->e_i, S->e_x, S->cperm, al); goto done; }
+  for (pass = 0; pass < 2; ++pass) { /* count, then fill */
+    for (j = 0, nz = 0; j < n; ++j) {
+      const int start = nz;
+      if (pass) cp[j] = nz;
+      for (p = S->e_p[j]; p < S->e_p[j + 1]; ++p)
+        if (S->e_x[p] != 0.0) { if (pass) { ci[nz] = S->e_i[p]; cx[nz] = S->e_x[p]; } ++nz; }
+      for (q = S->q_p[j]; q < S->q_p[j + 1]; ++q) /* column j of -(J - R) Q on the zero rows */
+        for (p = S->jr_p[S->q_i[q]]; p < S->jr_p[S->q_i[q] + 1]; ++p) {
+          const int row = S->jr_i[p];
+          if (!zr[row]) continue;
+          if (mark[row] != j) { mark[row] = j; if (pass) ci[nz] = row; ++nz; }
+          if (pass) w[row] -= S->jr_x[p] * S->q_x[q];
+        }
+      for (p = start; pass && p < nz; ++p) if (zr[ci[p]]) { cx[p] = w[ci[p]]; w[ci[p]] = 0.0; }
+    }
+    for (i = 0; i < n; ++i) mark[i] = -1;
+    if (!pass) {
+      cp = phgmg__ialloc(al, (size_t)n + 1); ci = phgmg__ialloc(al, (size_t)nz + 1);
+      cx = phgmg__dalloc(al, (size_t)nz + 1);
+      if (!cp || !ci || !cx) goto done;
+    }
+  }
+  cp[n] = nz;
+  r = phgmg__sp_match(n, cp, ci, cx, S->cperm, al);
+done:
+  phgmg__free(al, zr); phgmg__free(al, mark); phgmg__free(al, w);
+  phgmg__free(al, cp); phgmg__free(al, ci); phgmg__free(al, cx);
+  return r;
+}
+
 /* The analysis of sp's stage matrices from its CSC copies (js J - R merged,
    zero values dropped, as from band storage); condense as phgmg__spsym_create.
    js = 1: the model; js = -1: its dual with J -> -J (the observability
@@ -8362,7 +8476,7 @@ PHGMG__PRIV phgmg_result phgmg__spsym_create_js(phgmg__spsym **out, const phgmg_
     }
   }
   if (rc == PHGMG_OK && S->e_p) { /* descriptor: columns matched to E's largest entries */
-    int r = (S->cperm = phgmg__ialloc(al, (size_t)n)) ? phgmg__sp_match(n, S->e_p, S->e_i, S->e_x, S->cperm, al) : -1;
+    int r = (S->cperm = phgmg__ialloc(al, (size_t)n)) ? phgmg__sp_match_e(S, al) : -1;
     if (r < 0) rc = PHGMG_ERR_NOMEM;
     else if (r == 0) { phgmg__free(al, S->cperm); S->cperm = NULL; }
   }
@@ -8469,10 +8583,34 @@ PHGMG__PRIV phgmg_result phgmg__csc_sym_part(int n, const int *ap, const int *ai
    positive definite (positive semidefinite within tol ||E^T Q||_1 with a
    nonlinear part) by the pivots of phgmg__sp_pd: PHGMG_ERR_EQ_NOT_SYMMETRIC,
    _EQ_NOT_PD. Memory O(nnz(E^T Q) + the sparse factor); no band copy. */
-PHGMG__PRIV phgmg_result phgmg__ph_sparse_etq_check(const phgmg_ph_system *s, double tol,
+PHGMG__PRIV phgmg_result phgmg__csc_sub(int n, const int *ap, const int *ai, const double *ax, const int *rmap,
+                                        const int *cmap, int nc, int **bp, int **bi, double **bx,
+                                        const phgmg_allocator *al);
+/* The n x n CSC matrix *hp, *hi, *hx replaced by its rows and columns j
+   with cmap[j] < 0 (order *nk). */
+PHGMG__PRIV phgmg_result phgmg__sdae_keep(int n, int **hp, int **hi, double **hx, const int *cmap, int *nk,
+                                         const phgmg_allocator *al) {
+  int *keep = phgmg__ialloc(al, (size_t)n + 1), *bp = NULL, *bi = NULL, j, c = 0;
+  double *bx = NULL;
+  phgmg_result rc;
+  if (!keep) return PHGMG_ERR_NOMEM;
+  for (j = 0; j < n; ++j) keep[j] = cmap[j] < 0 ? c++ : -1;
+  rc = phgmg__csc_sub(n, *hp, *hi, *hx, keep, keep, c, &bp, &bi, &bx, al);
+  phgmg__free(al, keep);
+  phgmg__free(al, *hp); phgmg__free(al, *hi); phgmg__free(al, *hx);
+  *hp = bp; *hi = bi; *hx = bx;
+  *nk = c;
+  return rc;
+}
+
+/* E^T Q symmetric and its symmetric part positive definite (semidefinite
+   within tol with a nonlinear part); cmap (N, may be NULL): the lines with
+   cmap[j] >= 0 (an index-one model's algebraic variables, where E^T Q
+   vanishes) are left out of the definiteness test. */
+PHGMG__PRIV phgmg_result phgmg__ph_sparse_etq_check(const phgmg_ph_system *s, double tol, const int *cmap,
                                                     const phgmg_allocator *al) {
   const phgmg_ph_sparse *sp = s->sparse;
-  const int n = s->N;
+  int n = s->N;
   int *tp = NULL, *ti = NULL, *cp = NULL, *ci = NULL, *ctp = NULL, *cti = NULL, *hp = NULL, *hi = NULL, j, p, r;
   double *tx = NULL, *cx = NULL, *ctx = NULL, *hx = NULL, nrm = 0.0, def = 0.0, n1 = 0.0;
   phgmg_result rc = phgmg__csc_transpose(n, sp->cp[3], sp->ci[3], sp->cx[3], &tp, &ti, &tx, al);
@@ -8480,6 +8618,7 @@ PHGMG__PRIV phgmg_result phgmg__ph_sparse_etq_check(const phgmg_ph_system *s, do
   if (rc == PHGMG_OK) rc = phgmg__csc_transpose(n, cp, ci, cx, &ctp, &cti, &ctx, al);
   if (rc == PHGMG_OK) rc = phgmg__csc_sym_part(n, cp, ci, cx, ctp, cti, ctx, &hp, &hi, &hx, &nrm, &def, al);
   if (rc == PHGMG_OK && def > tol * nrm) rc = PHGMG_ERR_EQ_NOT_SYMMETRIC;
+  if (rc == PHGMG_OK && cmap) rc = phgmg__sdae_keep(n, &hp, &hi, &hx, cmap, &n, al);
   if (rc == PHGMG_OK) {
     for (j = 0; j < n; ++j) {
       double cs = 0.0;
@@ -8951,16 +9090,19 @@ PHGMG__PRIV void phgmg__ph_sparse_storage(phgmg_ph_sparse *sp) {
 }
 
 /* 1: no E, or every row and column of E holds a nonzero (no algebraic
-   equation); 0: E has a zero row or column; -1: no memory. */
-PHGMG__PRIV int phgmg__ph_sparse_e_regular(const phgmg_ph_sparse *sp) {
+   equation); 0: E has a zero row or column (*nalg: the more numerous of
+   the two); -1: no memory. */
+PHGMG__PRIV int phgmg__ph_sparse_e_regular(const phgmg_ph_sparse *sp, int *nalg) {
   phgmg_ph_system v = sp->sys; /* a SPARSE view: phgmg__e_zero_lines reads E's CSC copy */
-  int *z, kr, kc;
+  int *z, kr = 0, kc = 0;
+  *nalg = 0;
   if (!sp->cp[3]) return 1;
   z = phgmg__ialloc(sp->alloc, 2 * (size_t)v.N);
   if (!z) return -1;
   v.storage = PHGMG_SPARSE; v.sparse = sp; v.E = sp->cx[3];
   phgmg__e_zero_lines(&v, z, z + v.N, &kr, &kc);
   phgmg__free(sp->alloc, z);
+  *nalg = PHGMG__MAX(kr, kc);
   return kr == 0 && kc == 0;
 }
 
@@ -8969,17 +9111,15 @@ PHGMG_DEF phgmg_result phgmg_ph_sparse_set_solver(phgmg_ph_sparse *sp, int solve
   phgmg_ph_sparse_info *f;
   const int N = sp ? sp->sys.N : 0;
   phgmg_result rc;
-  int use, j;
+  int use, j, nalg;
   if (!sp || solver < PHGMG_SOLVER_AUTO || solver > PHGMG_SOLVER_SPARSE_LU) return PHGMG_ERR_INVALID_ARG;
   f = &sp->inf;
   phgmg__ph_sparse_stage_bw(sp, &f->kl, &f->ku);
   f->lu_band = (double)N * (double)(2 * f->kl + f->ku + 1);
   f->flops_band = 2.0 * (double)N * (double)f->kl * (double)(f->kl + f->ku + 1);
-  if ((use = phgmg__ph_sparse_e_regular(sp)) < 0) return PHGMG_ERR_NOMEM;
-  if (!use) { /* E with zero lines (index one, manual 1.8): the band path condenses them */
-    if (solver == PHGMG_SOLVER_SPARSE_LU) return PHGMG_ERR_UNSUPPORTED;
-    solver = PHGMG_SOLVER_BAND;
-  }
+  if ((use = phgmg__ph_sparse_e_regular(sp, &nalg)) < 0) return PHGMG_ERR_NOMEM;
+  if (!use && solver == PHGMG_SOLVER_AUTO && nalg > PHGMG__DAE_KMAX) /* beyond the condensation (manual 1.8) */
+    solver = PHGMG_SOLVER_SPARSE_LU;
   if (!sp->sym && solver != PHGMG_SOLVER_BAND && (solver == PHGMG_SOLVER_SPARSE_LU ||
                    (solver == PHGMG_SOLVER_AUTO && sp->sys.kb > PHGMG_SPARSE_MIN_KB))) {
     rc = phgmg__spsym_create_sp(&sp->sym, sp, -1);
@@ -9210,6 +9350,302 @@ PHGMG_DEF phgmg_result phgmg_ph_sparse_to_banded_order(const phgmg_ph_sparse *sp
 PHGMG_DEF phgmg_result phgmg_ph_sparse_to_user_order(const phgmg_ph_sparse *sp, int ncols, const double *X,
                                                      int ldx, double *Y, int ldy) {
   return phgmg__sparse_reorder(sp, ncols, X, ldx, Y, ldy, 1);
+}
+
+/* ---- index-one descriptor models on the sparse LU (manual 1.8) ----------
+   A SPARSE system whose E has k zero rows (the algebraic equations, set a)
+   and k zero columns (the algebraic variables, set c) is stepped as the DAE
+   it is: the GL3 stage systems sigma E + M through the sparse LU of the
+   whole pencil, the algebraic variables at each step's end from the
+   constraints. This object holds what the end values need: the sparse LUs
+   of the k x k blocks L_aa = (J - R)[a, a] and Q_ac = Q[a, c]. */
+typedef struct phgmg__sdae {
+  phgmg_ph_system sys;        /* the full model (arrays not owned)            */
+  phgmg_allocator al;
+  int N, m, k;
+  int *ra, *ca;               /* k: the algebraic rows, columns (ascending)   */
+  int *rmap, *cmap;           /* N: position in ra / ca, or -1                */
+  phgmg__spsym *Sl, *Sq;      /* sparse LUs of L_aa and Q_ac                  */
+  phgmg__spnum Fl, Fq;
+  int *ld_p, *ld_i, *qd_p, *qd_i; /* L[a, not a] (k x N), Q[a, not c] (k x N), CSC */
+  double *ld_x, *qd_x;
+  int *notr, *notc;           /* N: j for the columns kept in those, else -1  */
+  double *z, *v, *w, *u;      /* scratch: 3 N, m                              */
+} phgmg__sdae;
+
+PHGMG__PRIV void phgmg__sdae_free(phgmg__sdae *D) {
+  phgmg_allocator al;
+  if (!D) return;
+  al = D->al;
+  phgmg__free(&al, D->ra); phgmg__free(&al, D->rmap);
+  phgmg__spnum_free(&al, &D->Fl); phgmg__spnum_free(&al, &D->Fq);
+  phgmg__spsym_free(&al, D->Sl); phgmg__spsym_free(&al, D->Sq);
+  phgmg__free(&al, D->z); phgmg__free(&al, D->u);
+  phgmg__free(&al, D->ld_p); phgmg__free(&al, D->ld_i); phgmg__free(&al, D->ld_x);
+  phgmg__free(&al, D->qd_p); phgmg__free(&al, D->qd_i); phgmg__free(&al, D->qd_x);
+  phgmg__free(&al, D->notr);
+  phgmg__free(&al, D);
+}
+
+/* B = A[rows i with rmap[i] >= 0, columns j with cmap[j] >= 0], renumbered
+   by the maps (increasing on the kept lines: rows stay sorted), nc columns,
+   zero values dropped; *bp, *bi, *bx owned. */
+PHGMG__PRIV phgmg_result phgmg__csc_sub(int n, const int *ap, const int *ai, const double *ax, const int *rmap,
+                                        const int *cmap, int nc, int **bp, int **bi, double **bx,
+                                        const phgmg_allocator *al) {
+  int j, p, c;
+  *bp = phgmg__ialloc(al, (size_t)nc + 1);
+  if (!*bp) return PHGMG_ERR_NOMEM;
+  for (c = 0; c <= nc; ++c) (*bp)[c] = 0;
+  for (j = 0; j < n; ++j) /* counts, then offsets: a new column without an old one stays empty */
+    if (cmap[j] >= 0)
+      for (p = ap[j]; p < ap[j + 1]; ++p) (*bp)[cmap[j] + 1] += rmap[ai[p]] >= 0 && ax[p] != 0.0;
+  for (c = 0; c < nc; ++c) (*bp)[c + 1] += (*bp)[c];
+  *bi = phgmg__ialloc(al, (size_t)(*bp)[nc] + 1);
+  *bx = phgmg__dalloc(al, (size_t)(*bp)[nc] + 1);
+  if (!*bi || !*bx) return PHGMG_ERR_NOMEM;
+  for (j = 0; j < n; ++j) {
+    int q;
+    if (cmap[j] < 0) continue;
+    q = (*bp)[cmap[j]];
+    for (p = ap[j]; p < ap[j + 1]; ++p)
+      if (rmap[ai[p]] >= 0 && ax[p] != 0.0) { (*bi)[q] = rmap[ai[p]]; (*bx)[q++] = ax[p]; }
+  }
+  return PHGMG_OK;
+}
+
+typedef struct { const phgmg__spsym *S; const phgmg__spnum *F; } phgmg__sp_ctx;
+PHGMG__PRIV void phgmg__sp_ctx_solve(const void *c, char trans, double *x) {
+  const phgmg__sp_ctx *f = PHGMG__CAST(const phgmg__sp_ctx *, c);
+  if (trans == 'T' || trans == 't') phgmg__sp_solve_t(f->S, f->F, x);
+  else phgmg__sp_solve(f->S, f->F, x);
+}
+
+/* C = A - B (k x k CSC, sorted rows, merged column by column); *cp, *ci,
+   *cx owned. */
+PHGMG__PRIV phgmg_result phgmg__csc_minus(int k, const int *ap, const int *ai, const double *ax, const int *bp,
+                                          const int *bi, const double *bx, int **cp, int **ci, double **cx,
+                                          const phgmg_allocator *al) {
+  int j, p, q, nz = 0;
+  *cp = phgmg__ialloc(al, (size_t)k + 1);
+  *ci = phgmg__ialloc(al, (size_t)ap[k] + (size_t)bp[k] + 1);
+  *cx = phgmg__dalloc(al, (size_t)ap[k] + (size_t)bp[k] + 1);
+  if (!*cp || !*ci || !*cx) return PHGMG_ERR_NOMEM;
+  for (j = 0; j < k; ++j) {
+    (*cp)[j] = nz;
+    for (p = ap[j], q = bp[j]; p < ap[j + 1] || q < bp[j + 1];) {
+      const int ia = p < ap[j + 1] ? ai[p] : k, ib = q < bp[j + 1] ? bi[q] : k, i = PHGMG__MIN(ia, ib);
+      const double v = (ia == i ? ax[p++] : 0.0) - (ib == i ? bx[q++] : 0.0);
+      if (v != 0.0) { (*ci)[nz] = i; (*cx)[nz++] = v; }
+    }
+  }
+  (*cp)[k] = nz;
+  return PHGMG_OK;
+}
+
+/* The k x k block L_aa (which 0: J - R) or Q_ac (which 2) as CSC. */
+PHGMG__PRIV phgmg_result phgmg__sdae_sub(phgmg__sdae *D, int which, int **bp, int **bi, double **bx) {
+  const phgmg_ph_sparse *sp = D->sys.sparse;
+  int *p1 = NULL, *i1 = NULL, *p2 = NULL, *i2 = NULL;
+  double *x1 = NULL, *x2 = NULL;
+  phgmg_result rc;
+  if (which == 2)
+    return phgmg__csc_sub(D->N, sp->cp[2], sp->ci[2], sp->cx[2], D->rmap, D->cmap, D->k, bp, bi, bx, &D->al);
+  rc = phgmg__csc_sub(D->N, sp->cp[0], sp->ci[0], sp->cx[0], D->rmap, D->rmap, D->k, &p1, &i1, &x1, &D->al);
+  if (rc == PHGMG_OK)
+    rc = phgmg__csc_sub(D->N, sp->cp[1], sp->ci[1], sp->cx[1], D->rmap, D->rmap, D->k, &p2, &i2, &x2, &D->al);
+  if (rc == PHGMG_OK) rc = phgmg__csc_minus(D->k, p1, i1, x1, p2, i2, x2, bp, bi, bx, &D->al);
+  phgmg__free(&D->al, p1); phgmg__free(&D->al, i1); phgmg__free(&D->al, x1);
+  phgmg__free(&D->al, p2); phgmg__free(&D->al, i2); phgmg__free(&D->al, x2);
+  return rc;
+}
+
+/* The sparse LU of L_aa (which 0) or Q_ac (which 2), regular against the
+   whole matrix M (J - R or Q): 1 / ||block^{-1}||_1 > tol max|M| (Hager's
+   estimate through the factor's solves), the dense check of 1.8.
+   PHGMG_ERR_INDEX when it is not (or the static order meets a zero pivot:
+   index two or a singular pencil, not told apart here), _NOMEM. */
+PHGMG__PRIV phgmg_result phgmg__sdae_block(phgmg__sdae *D, int which, double tol, phgmg__spsym **S,
+                                           phgmg__spnum *F) {
+  const phgmg_ph_sparse *sp = D->sys.sparse;
+  int *bp = NULL, *bi = NULL, *iw = phgmg__ialloc(&D->al, (size_t)D->k + 1), a, p;
+  double *bx = NULL, *work = phgmg__dalloc(&D->al, 2 * (size_t)D->k + 1), mx = 0.0, est;
+  phgmg_result rc = iw && work ? phgmg__sdae_sub(D, which, &bp, &bi, &bx) : PHGMG_ERR_NOMEM;
+  phgmg__sp_ctx ctx;
+  for (a = which == 2 ? 2 : 0; a <= (which == 2 ? 2 : 1); ++a) { /* max|J| + max|R| bounds max|J - R| */
+    double ma = 0.0;
+    for (p = 0; p < sp->cp[a][D->N]; ++p) ma = PHGMG__MAX(ma, fabs(sp->cx[a][p]));
+    mx += ma;
+  }
+  if (rc == PHGMG_OK) {
+    rc = phgmg__sp_lu_create(D->k, bp, bi, bx, S, F, &D->al);
+    if (rc == PHGMG_ERR_UNSUPPORTED) rc = PHGMG_ERR_INDEX;
+  }
+  if (rc == PHGMG_OK) {
+    ctx.S = *S; ctx.F = F;
+    est = phgmg__inv_norm1(D->k, phgmg__sp_ctx_solve, &ctx, work, iw);
+    if (!(est > 0.0 && est < HUGE_VAL && 1.0 / est > tol * mx)) rc = PHGMG_ERR_INDEX;
+  }
+  phgmg__free(&D->al, bp); phgmg__free(&D->al, bi); phgmg__free(&D->al, bx);
+  phgmg__free(&D->al, iw); phgmg__free(&D->al, work);
+  return rc;
+}
+
+/* The algebraic lines of a SPARSE system (E's zero rows and columns) into D:
+   PHGMG_ERR_E_SINGULAR when their counts differ or E = 0, _SIZE when m
+   exceeds the differential states, _NOMEM. */
+PHGMG__PRIV phgmg_result phgmg__sdae_lines(phgmg__sdae *D) {
+  const int N = D->N;
+  int kr, kc, i, a = 0, c = 0;
+  D->rmap = phgmg__ialloc(&D->al, 2 * (size_t)N);
+  if (!D->rmap) return PHGMG_ERR_NOMEM;
+  D->cmap = D->rmap + N;
+  phgmg__e_zero_lines(&D->sys, D->rmap, D->cmap, &kr, &kc);
+  if (kr != kc || kr == N) return PHGMG_ERR_E_SINGULAR;
+  if (D->m > N - kr) return PHGMG_ERR_SIZE;
+  D->k = kr;
+  D->ra = phgmg__ialloc(&D->al, 2 * (size_t)kr + 1);
+  if (!D->ra) return PHGMG_ERR_NOMEM;
+  D->ca = D->ra + kr;
+  for (i = 0; i < N; ++i) {
+    if (D->rmap[i]) { D->ra[a] = i; D->rmap[i] = a++; } else D->rmap[i] = -1;
+    if (D->cmap[i]) { D->ca[c] = i; D->cmap[i] = c++; } else D->cmap[i] = -1;
+  }
+  return PHGMG_OK;
+}
+
+/* The couplings of the algebraic equations to the differential part, L_ad =
+   (J - R)[a, columns outside a] and Q_ad = Q[a, columns outside c], as
+   k x N CSC matrices (the other columns empty): the end values' products
+   then touch the k algebraic rows only. */
+PHGMG__PRIV phgmg_result phgmg__sdae_couplings(phgmg__sdae *D) {
+  const phgmg_ph_sparse *sp = D->sys.sparse;
+  const int N = D->N;
+  int *p1 = NULL, *i1 = NULL, *p2 = NULL, *i2 = NULL, j;
+  double *x1 = NULL, *x2 = NULL;
+  phgmg_result rc;
+  D->notr = phgmg__ialloc(&D->al, 2 * (size_t)N);
+  if (!D->notr) return PHGMG_ERR_NOMEM;
+  D->notc = D->notr + N;
+  for (j = 0; j < N; ++j) { D->notr[j] = D->rmap[j] < 0 ? j : -1; D->notc[j] = D->cmap[j] < 0 ? j : -1; }
+  rc = phgmg__csc_sub(N, sp->cp[2], sp->ci[2], sp->cx[2], D->rmap, D->notc, N, &D->qd_p, &D->qd_i, &D->qd_x, &D->al);
+  if (rc == PHGMG_OK) rc = phgmg__csc_sub(N, sp->cp[0], sp->ci[0], sp->cx[0], D->rmap, D->notr, N, &p1, &i1, &x1, &D->al);
+  if (rc == PHGMG_OK) rc = phgmg__csc_sub(N, sp->cp[1], sp->ci[1], sp->cx[1], D->rmap, D->notr, N, &p2, &i2, &x2, &D->al);
+  if (rc == PHGMG_OK) rc = phgmg__csc_minus(N, p1, i1, x1, p2, i2, x2, &D->ld_p, &D->ld_i, &D->ld_x, &D->al);
+  phgmg__free(&D->al, p1); phgmg__free(&D->al, i1); phgmg__free(&D->al, x1);
+  phgmg__free(&D->al, p2); phgmg__free(&D->al, i2); phgmg__free(&D->al, x2);
+  return rc;
+}
+
+/* The object for a SPARSE system sys with algebraic lines (sys's arrays must
+   outlive it): the lines, the sparse LUs of L_aa and Q_ac (regular: index
+   one, else PHGMG_ERR_INDEX), scratch. */
+PHGMG__PRIV phgmg_result phgmg__sdae_create(phgmg__sdae **out, const phgmg_ph_system *sys, double tol,
+                                            const phgmg_allocator *alloc) {
+  phgmg__sdae *D = PHGMG__CAST(phgmg__sdae *, phgmg__alloc(alloc, sizeof(phgmg__sdae)));
+  phgmg_result rc;
+  *out = NULL;
+  if (!D) return PHGMG_ERR_NOMEM;
+  memset(D, 0, sizeof *D);
+  if (alloc) D->al = *alloc;
+  D->sys = *sys;
+  D->N = sys->N; D->m = sys->m;
+  rc = phgmg__sdae_lines(D);
+  if (rc == PHGMG_OK) rc = phgmg__sdae_block(D, 0, tol, &D->Sl, &D->Fl);
+  if (rc == PHGMG_OK) rc = phgmg__sdae_block(D, 2, tol, &D->Sq, &D->Fq);
+  if (rc == PHGMG_OK) rc = phgmg__sdae_couplings(D);
+  if (rc == PHGMG_OK) {
+    D->z = phgmg__dalloc(&D->al, 3 * (size_t)D->N);
+    D->u = phgmg__dalloc(&D->al, (size_t)D->m);
+    if (!D->z || !D->u) rc = PHGMG_ERR_NOMEM;
+    else { D->v = D->z + D->N; D->w = D->v + D->N; }
+  }
+  if (rc != PHGMG_OK) { phgmg__sdae_free(D); return rc; }
+  *out = D;
+  return PHGMG_OK;
+}
+
+/* The algebraic variables of x (N) from the constraints at input u (m; NULL
+   = 0), its differential part as it is: the co-states z_d = grad H(x)_d do
+   not depend on x_c (Q_dc = 0), the algebraic equations
+   0 = L_ad z_d + L_aa z_a + G_a u (G = B - P) give z_a, and
+   z_a = Q_ad x_d + Q_ac x_c gives x_c. Three products with the sparse
+   matrices and two sparse solves of order k. */
+PHGMG__PRIV void phgmg__sdae_consistent(phgmg__sdae *D, const double *u, double *x) {
+  const phgmg_ph_system *s = &D->sys;
+  const int k = D->k, m = D->m, N = D->N;
+  double *z = D->z, *v = D->v, *w = D->w;
+  int q, j, p;
+  for (q = 0; q < k; ++q) x[D->ca[q]] = 0.0;
+  phgmg__ph_grad(s, x, z, w);            /* z_d (not z_a) */
+  for (q = 0; q < k; ++q) {              /* v = -(L_ad z_d + G_a u) */
+    const int i = D->ra[q];
+    double acc = 0.0;
+    for (j = 0; u && j < m; ++j)
+      acc += (s->B[i + (size_t)j * N] - (s->P ? s->P[i + (size_t)j * N] : 0.0)) * u[j];
+    v[q] = -acc;
+  }
+  for (j = 0; j < N; ++j)
+    for (p = D->ld_p[j]; p < D->ld_p[j + 1]; ++p) v[D->ld_i[p]] -= D->ld_x[p] * z[j];
+  phgmg__sp_solve(D->Sl, &D->Fl, v);     /* z_a */
+  for (j = 0; j < N; ++j)                /* Q_ac x_c = z_a - Q_ad x_d */
+    for (p = D->qd_p[j]; p < D->qd_p[j + 1]; ++p) v[D->qd_i[p]] -= D->qd_x[p] * x[j];
+  phgmg__sp_solve(D->Sq, &D->Fq, v);
+  for (q = 0; q < k; ++q) x[D->ca[q]] = v[q];
+}
+
+/* Q_dc = 0 to within tol max|Q| (d: the rows outside a, c: the algebraic
+   variables): E^T Q symmetric with E[:, c] = 0 requires it, and the kept
+   co-states must not depend on x_c. PHGMG_ERR_EQ_NOT_SYMMETRIC if not. */
+PHGMG__PRIV phgmg_result phgmg__sdae_qdc(const phgmg__sdae *D, double tol) {
+  const phgmg_ph_sparse *sp = D->sys.sparse;
+  double qmax = 0.0, off = 0.0;
+  int j, p;
+  for (j = 0; j < D->N; ++j)
+    for (p = sp->cp[2][j]; p < sp->cp[2][j + 1]; ++p) {
+      const double v = fabs(sp->cx[2][p]);
+      qmax = PHGMG__MAX(qmax, v);
+      if (D->cmap[j] >= 0 && D->rmap[sp->ci[2][p]] < 0) off = PHGMG__MAX(off, v);
+    }
+  return off > tol * qmax ? PHGMG_ERR_EQ_NOT_SYMMETRIC : PHGMG_OK;
+}
+
+/* phgmg_ph_validate's descriptor checks of a SPARSE system with algebraic
+   lines (manual 1.8), without condensing: the lines (E_SINGULAR, SIZE), a
+   separable coordinate on an algebraic line (UNSUPPORTED), Q_dc = 0 and
+   E^T Q symmetric, positive definite on the differential variables
+   (EQ_NOT_SYMMETRIC, EQ_NOT_PD), mass coupling of separable coordinates
+   (E_COUPLED), index one: L_aa and Q_ac regular (INDEX). */
+PHGMG__PRIV phgmg_result phgmg__sdae_validate(const phgmg_ph_system *sys, double tol, const phgmg_allocator *alloc) {
+  phgmg__sdae *D = PHGMG__CAST(phgmg__sdae *, phgmg__alloc(alloc, sizeof(phgmg__sdae)));
+  phgmg_result rc;
+  int t;
+  if (!D) return PHGMG_ERR_NOMEM;
+  memset(D, 0, sizeof *D);
+  if (alloc) D->al = *alloc;
+  D->sys = *sys;
+  D->N = sys->N; D->m = sys->m;
+  rc = phgmg__sdae_lines(D);
+  for (t = 0; rc == PHGMG_OK && sys->nl == PHGMG_NL_SEPARABLE && t < sys->nsep; ++t)
+    if (D->rmap[sys->sep_idx[t]] >= 0 || D->cmap[sys->sep_idx[t]] >= 0) rc = PHGMG_ERR_UNSUPPORTED;
+  if (rc == PHGMG_OK) rc = phgmg__sdae_qdc(D, tol);
+  if (rc == PHGMG_OK) rc = phgmg__ph_sparse_etq_check(sys, tol, D->cmap, &D->al);
+  if (rc == PHGMG_OK) rc = phgmg__ph_e_coupled(sys, &D->al);
+  if (rc == PHGMG_OK) rc = phgmg__sdae_block(D, 0, tol, &D->Sl, &D->Fl);
+  if (rc == PHGMG_OK) rc = phgmg__sdae_block(D, 2, tol, &D->Sq, &D->Fq);
+  phgmg__sdae_free(D);
+  return rc;
+}
+
+/* An index-one model the stepper takes directly: SPARSE on the sparse LU,
+   and each separable coordinate i with Q(i, i) stored (the stage matrix's
+   pattern holds (J - R)(Q + D) through Q's pattern, manual 1.8). */
+PHGMG__PRIV int phgmg__sdae_stepper_ok(const phgmg_ph_system *sys) {
+  int t;
+  if (!phgmg__ph_sparse_lu(sys)) return 0;
+  for (t = 0; sys->nl == PHGMG_NL_SEPARABLE && t < sys->nsep; ++t)
+    if (phgmg__ph_at(sys, sys->Q, sys->sep_idx[t], sys->sep_idx[t]) == 0.0) return 0;
+  return 1;
 }
 
 /* >>gl3 (implementation) ================================================= */
@@ -9519,6 +9955,8 @@ struct phgmg_gl3 {
   double *dz;
   phgmg__dia ddm;
   int ddm_w, damp_bad;
+  /* index one on the sparse LU (manual 1.8): the end values' constraints */
+  phgmg__sdae *dae;
 };
 
 PHGMG_DEF void phgmg_gl3_destroy(phgmg_gl3 *s) {
@@ -9551,6 +9989,7 @@ PHGMG_DEF void phgmg_gl3_destroy(phgmg_gl3 *s) {
   phgmg__free(&al, s->Bout);
   phgmg__free(&al, s->dz);
   phgmg__dia_free(&al, &s->ddm);
+  phgmg__sdae_free(s->dae);
   phgmg__free(&al, s);
 }
 
@@ -10062,12 +10501,14 @@ PHGMG_DEF phgmg_result phgmg_gl3_create(phgmg_gl3 **out, const phgmg_ph_system *
                                         const phgmg_gl3_opts *opts, const phgmg_allocator *alloc) {
   phgmg_gl3 *s;
   phgmg_result rc;
+  int alg = 0;
   if (!out) return PHGMG_ERR_INVALID_ARG;
   *out = NULL;
   rc = phgmg__ph_check(sys);
   if (rc != PHGMG_OK) return rc;
   if (!(dt > 0.0) || dt == HUGE_VAL) return PHGMG_ERR_INVALID_ARG;
-  if (sys->E && phgmg__e_algebraic(sys, alloc) != 0) return PHGMG_ERR_UNSUPPORTED;   /* step the condensed model (1.8) */
+  if (sys->E && (alg = phgmg__e_algebraic(sys, alloc)) != 0 && (alg < 0 || !phgmg__sdae_stepper_ok(sys)))
+    return alg < 0 ? PHGMG_ERR_NOMEM : PHGMG_ERR_UNSUPPORTED;   /* step the condensed model (1.8) */
   if (opts && (opts->max_iter < 0 || opts->tol < 0.0 || opts->contraction < 0.0 ||
                opts->tol != opts->tol || opts->contraction != opts->contraction))
     return PHGMG_ERR_INVALID_ARG;
@@ -10103,6 +10544,7 @@ PHGMG_DEF phgmg_result phgmg_gl3_create(phgmg_gl3 **out, const phgmg_ph_system *
     if (rc == PHGMG_OK) rc = phgmg__gl3_setup_buffers(s);
     s->need_factor = 1;
   }
+  if (rc == PHGMG_OK && alg) rc = phgmg__sdae_create(&s->dae, sys, 1e-12, alloc); /* sys: B and P apart */
   if (rc != PHGMG_OK) {
     phgmg_gl3_destroy(s);
     return rc;
@@ -10837,6 +11279,21 @@ PHGMG__PRIV void phgmg__gl3_guess(phgmg_gl3 *s, int cont) {
   }
 }
 
+/* Index one on the sparse LU (manual 1.8): the collocation end value of an
+   algebraic variable is not consistent (the Gauss methods' stability
+   function is -1 at infinity); it is replaced by the constraints' solution
+   at t_{n+1} from the new differential state (exact: the differential
+   update is the condensed ODE's GL3 step). */
+PHGMG__PRIV int phgmg__gl3_dae_end(phgmg_gl3 *s, double t1, phgmg_input_fn uf, void *uuser) {
+  double *u = s->dae->u, am = 0.0;
+  int i;
+  if (uf) uf(t1, u, uuser);
+  phgmg__sdae_consistent(s->dae, uf ? u : NULL, s->xnew);
+  for (i = 0; i < s->N; ++i) am = PHGMG__MAX(am, fabs(s->xnew[i]));
+  s->xamax = am;
+  return am < HUGE_VAL;   /* (NaN compares false) */
+}
+
 PHGMG_DEF phgmg_result phgmg_gl3_step(phgmg_gl3 *s, double t, double *x, phgmg_input_fn uf,
                                       void *uuser, double energy_inc[2]) {
   int N, m, st, i, fresh = 0, cont;
@@ -10906,6 +11363,7 @@ PHGMG_DEF phgmg_result phgmg_gl3_step(phgmg_gl3 *s, double t, double *x, phgmg_i
     if (chk - chk != 0.0) { s->st.failures++; return PHGMG_ERR_NANINF; }
     s->xamax = am;
   }
+  if (s->dae && !phgmg__gl3_dae_end(s, t + s->h, uf, uuser)) { s->st.failures++; return PHGMG_ERR_NANINF; }
   if (energy_inc) phgmg__gl3_energy(s, energy_inc);
   { /* keep the converged stages for the next guess (Newton updates cancel
        to tiny values at the edge of the support: flushed) */
@@ -11027,6 +11485,29 @@ done:
   return rc;
 }
 
+/* phgmg_simulate of an index-one SPARSE model: GL3 on its sparse pencil
+   (the stepper corrects each step's algebraic end values), from x0 with its
+   algebraic variables replaced by the consistent ones at t0 (manual 1.8). */
+PHGMG__PRIV phgmg_result phgmg__simulate_sdae(const phgmg_ph_system *sys, const double *x0, double t0, double dt,
+                                              int nsteps, phgmg_input_fn uf, void *uuser,
+                                              const phgmg_gl3_opts *opts, double *X, double *Y,
+                                              const phgmg_energy *energy, phgmg_gl3_stats *stats,
+                                              int *steps_done, const phgmg_allocator *alloc) {
+  phgmg_gl3 *s = NULL;
+  double *xc;
+  phgmg_result rc = phgmg_gl3_create(&s, sys, dt, opts, alloc);
+  if (rc != PHGMG_OK) return rc;
+  xc = phgmg__dalloc(alloc, (size_t)sys->N);
+  if (!xc) { phgmg_gl3_destroy(s); return PHGMG_ERR_NOMEM; }
+  memcpy(xc, x0, sizeof(double) * (size_t)sys->N);
+  if (uf) uf(t0, s->dae->u, uuser);
+  phgmg__sdae_consistent(s->dae, uf ? s->dae->u : NULL, xc);
+  rc = phgmg__simulate_on(s, sys, xc, t0, dt, nsteps, uf, uuser, X, Y, energy, stats, steps_done, alloc);
+  phgmg__free(alloc, xc);
+  phgmg_gl3_destroy(s);
+  return rc;
+}
+
 PHGMG_DEF phgmg_result phgmg_simulate(const phgmg_ph_system *sys, const double *x0, double t0,
                                       double dt, int nsteps, phgmg_input_fn uf, void *uuser,
                                       const phgmg_gl3_opts *opts, double *X, double *Y,
@@ -11038,6 +11519,8 @@ PHGMG_DEF phgmg_result phgmg_simulate(const phgmg_ph_system *sys, const double *
   if (stats) memset(stats, 0, sizeof *stats);
   if (!sys || !x0 || nsteps < 0) return PHGMG_ERR_INVALID_ARG;
   if (energy && (!energy->H || !energy->S || !energy->D)) return PHGMG_ERR_INVALID_ARG;
+  if (sys->E && sys->storage == PHGMG_SPARSE && phgmg__e_algebraic(sys, alloc) != 0)   /* the sparse pencil (1.8) */
+    return phgmg__simulate_sdae(sys, x0, t0, dt, nsteps, uf, uuser, opts, X, Y, energy, stats, steps_done, alloc);
   if (sys->E && phgmg__e_algebraic(sys, alloc) != 0)   /* index one (1.8), or no memory */
     return phgmg__simulate_dae(sys, x0, t0, dt, nsteps, uf, uuser, opts, X, Y, energy, stats, steps_done, alloc);
   rc = phgmg_gl3_create(&s, sys, dt, opts, alloc);
@@ -19240,11 +19723,11 @@ PHGMG_DEF phgmg_result phgmg_shifted_create(phgmg_shifted **out, const phgmg_ph_
                                             const phgmg_allocator *alloc) {
   phgmg_shifted *s;
   phgmg_result rc;
-  int e;
+  int e, nalg;
   if (!out) return PHGMG_ERR_INVALID_ARG;
   *out = NULL;
   if (!sp || keep < 0) return PHGMG_ERR_INVALID_ARG;
-  if ((e = phgmg__ph_sparse_e_regular(sp)) < 0) return PHGMG_ERR_NOMEM;
+  if ((e = phgmg__ph_sparse_e_regular(sp, &nalg)) < 0) return PHGMG_ERR_NOMEM;
   if (!e) return PHGMG_ERR_UNSUPPORTED;
   s = PHGMG__CAST(phgmg_shifted *, phgmg__alloc(alloc, sizeof *s));
   if (!s) return PHGMG_ERR_NOMEM;

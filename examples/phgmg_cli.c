@@ -93,7 +93,11 @@ static const char *const help_lines[] = {
   "                      feedthrough, which gmg-qm and --ref do not take: gmg-pod,\n",
   "                      sp1, sp2 without --ref), simulated with consistent states and reduced;\n",
   "                      written states are full (basis rows of the algebraic\n",
-  "                      variables zero).\n",
+  "                      variables zero). The condensation is dense in the\n",
+  "                      algebraic lines (at most 4096); simulate of a sparse model\n",
+  "                      (--E-coo) does not condense: it steps the DAE itself on the\n",
+  "                      sparse LU of its pencil (algebraic variables from the\n",
+  "                      constraints at every step), with no limit on them.\n",
   "  --P FILE, --S FILE, --N FILE   feedthrough (N x m, m x m, m x m; each optional):\n",
   "                      E x' = (J - R) z + (B - P) u, y = (B + P)^T z + (S + N) u, with\n",
   "                      [[R, P], [P^T, S]] symmetric positive semidefinite and N skew.\n",
@@ -1771,6 +1775,7 @@ typedef struct reduce_state {
                              index-one model's condensed ODE) */
   phgmg_ph_system full;   /* the full model (= sys unless E has algebraic lines) */
   phgmg_dae *dae;         /* an index-one model's condensation, else NULL */
+  int dae_direct;         /* simulate: a sparse index-one model is stepped as the DAE (no condensation) */
   const double *Xgiven;   /* --X of an index-one model: the given states (internal order) */
   double *Xres;           /* ... and their differential part */
   phgmg_reduced *red;
@@ -1966,6 +1971,26 @@ static void note_band_fallback(const phgmg_gl3_stats *st) {
              "band LU with partial pivoting instead (slower, memory O(N kb))");
 }
 
+static int e_zero_lines(const reduce_state *S, int N, int *zr, int *zc, int *dk, int *dl);
+
+/* An index-one sparse model (zero rows and columns of --E-coo): simulate
+   steps the DAE on the sparse pencil (the sparse LU, S->dae_direct); reduce
+   condenses the algebraic lines, in band storage up to 4096 of them. */
+static int sparse_dae_solver(const reduce_args *A, reduce_state *S, phgmg_ph_sparse_info *inf) {
+  int zr = 0, zc = 0, want;
+  phgmg_result rc;
+  if (!A->Ecoo || A->dampf || e_zero_lines(S, phgmg_ph_sparse_system(S->sp)->N, &zr, &zc, NULL, NULL) == 0) {
+    S->dae_direct = 0;
+    return 0;
+  }
+  want = S->dae_direct || zr > 4096 ? PHGMG_SOLVER_SPARSE_LU : PHGMG_SOLVER_BAND;
+  if (inf->solver != want && (rc = phgmg_ph_sparse_set_solver(S->sp, want, inf)) != PHGMG_OK)
+    return fail("sparse J, R, Q, E: %s solver: %s", want == PHGMG_SOLVER_BAND ? "band" : "sparse LU",
+                phgmg_result_string(rc));
+  S->dae_direct = S->dae_direct && inf->solver == PHGMG_SOLVER_SPARSE_LU;
+  return 0;
+}
+
 /* The sparse system (--J-coo, --R-coo, --Q-coo, --B) into S->sp and sys. */
 static int load_sparse_system(const reduce_args *A, reduce_state *S, phgmg_ph_system *sys) {
   phgmg_ph_sparse_info inf;
@@ -1985,6 +2010,7 @@ static int load_sparse_system(const reduce_args *A, reduce_state *S, phgmg_ph_sy
   if (A->dampf && inf.solver == PHGMG_SOLVER_SPARSE_LU &&
       (rc = phgmg_ph_sparse_set_solver(S->sp, PHGMG_SOLVER_BAND, &inf)) != PHGMG_OK) /* the sparse LU: no dampers */
     return fail("sparse J, R, Q: band solver: %s", phgmg_result_string(rc));
+  if (sparse_dae_solver(A, S, &inf)) return 1;
   *sys = *phgmg_ph_sparse_system(S->sp);
   progress("sparse J, R, Q: N = %d, %ld stored entries; half-bandwidth %d (given order %d, reverse "
            "Cuthill-McKee %d)%s", N, inf.nnz, inf.kb, inf.kb_input, inf.kb_rcm,
@@ -2328,6 +2354,17 @@ static int explain_dampers(const reduce_args *A, const reduce_state *S, const ph
   return 1;
 }
 
+/* The algebraic lines of a linear model exceed what the condensation takes. */
+static int unsupported_algebraic(const reduce_args *A, const reduce_state *S, int N) {
+  int zr = 0, zc = 0;
+  e_zero_lines(S, N, &zr, &zc, NULL, NULL);
+  return fail("%s (%s): %d algebraic equations and variables (zero rows and columns of E): the condensation to the "
+              "differential states (reduce, validate, and simulate of a dense model) is dense in the algebraic "
+              "lines and takes at most 4096 of them%s", A->E ? A->E : A->Ecoo, A->E ? "--E" : "--E-coo", zr,
+              A->Ecoo ? "" : "; give the model as sparse COO files (--J-coo ... --E-coo): simulate then steps the "
+                             "DAE itself on the sparse pencil, without that limit");
+}
+
 /* A failed validation of a descriptor model explained in terms of E (1:
    reported, 0: not a cause this explains). */
 static int explain_descriptor(const reduce_args *A, const reduce_state *S, const phgmg_ph_system *sys,
@@ -2348,8 +2385,11 @@ static int explain_descriptor(const reduce_args *A, const reduce_state *S, const
     case PHGMG_ERR_EQ_NOT_SYMMETRIC:
     case PHGMG_ERR_EQ_NOT_PD: return fail("%s, %s (--E, --Q): %s", ef, qf, phgmg_result_string(rc));
     case PHGMG_ERR_E_COUPLED: return fail("%s, %s (--E, --poly-idx): %s", ef, A->poly_idx, phgmg_result_string(rc));
-    case PHGMG_ERR_UNSUPPORTED: return fail("%s (--E): %s (a descriptor model takes a separable nonlinear part only; "
-                                            "with algebraic lines of E, none on them)", ef, phgmg_result_string(rc));
+    case PHGMG_ERR_UNSUPPORTED:
+      if (sys->nl != PHGMG_NL_NONE || sys->ndamp)
+        return fail("%s (--E): %s (a descriptor model takes a separable nonlinear part only; with algebraic lines "
+                    "of E, none on them)", ef, phgmg_result_string(rc));
+      return unsupported_algebraic(A, S, sys->N);
     case PHGMG_ERR_INDEX:
     case PHGMG_ERR_PENCIL:
       return fail("%s, %s, %s, %s (--E, --J, --R, --Q): %s: %s, and the equations must determine the variables "
@@ -2401,7 +2441,7 @@ static int e_zero_lines(const reduce_state *S, int N, int *zr, int *zc, int *dk,
 
 /* The full model from the files: dense or sparse J, R, Q, B and the nonlinear
    part, checked (phgmg_ph_validate), into S->sys. */
-static int condense_algebraic(reduce_state *S);
+static int condense_algebraic(const reduce_args *A, reduce_state *S);
 static int load_system(const reduce_args *A, reduce_state *S) {
   phgmg_ph_system sys;
   phgmg_result rc;
@@ -2494,14 +2534,24 @@ static int load_system(const reduce_args *A, reduce_state *S) {
   if (rc != PHGMG_OK) return explain_validate(rc, &S->J, &S->R, &S->B, &S->Q, rcond);
   progress("system: N = %d, m = %d, valid port-Hamiltonian (rcond(J - R) = %.3g)", N, m, rcond);
   S->sys = S->full = sys;
-  return sys.E ? condense_algebraic(S) : 0;
+  return sys.E ? condense_algebraic(A, S) : 0;
 }
 
 /* An index-one model (E with zero rows and columns): S->sys becomes its
    condensed ODE in the differential coordinates, which is what is simulated
    for training and reduced; states written out are lifted back. */
-static int condense_algebraic(reduce_state *S) {
-  phgmg_result rc = phgmg_dae_create(&S->dae, &S->full, 0.0, NULL);
+static int condense_algebraic(const reduce_args *A, reduce_state *S) {
+  phgmg_result rc;
+  if (S->dae_direct) {
+    int zr = 0, zc = 0;
+    e_zero_lines(S, S->full.N, &zr, &zc, NULL, NULL);
+    progress("algebraic constraints: E singular, %d algebraic equations and variables (index one); the DAE is "
+             "stepped on the sparse pencil", zr);
+    return 0;
+  }
+  rc = phgmg_dae_create(&S->dae, &S->full, 0.0, NULL);
+  if (rc == PHGMG_ERR_UNSUPPORTED && S->full.nl == PHGMG_NL_NONE && !S->full.ndamp)
+    return unsupported_algebraic(A, S, S->full.N);
   if (rc != PHGMG_OK) return fail("the algebraic part of the descriptor model: %s", phgmg_result_string(rc));
   if (phgmg_dae_nalg(S->dae) == 0) {
     phgmg_dae_destroy(S->dae);
@@ -3469,6 +3519,7 @@ static int cmd_simulate(int argc, char **argv) {
   int status, N, m, done = 0;
   if ((status = parse_simulate(argc, argv, &A, &states)) != 0) return status < 0 ? 0 : status;
   memset(&S, 0, sizeof S);
+  S.dae_direct = 1;   /* a sparse index-one model: no condensation */
   if ((status = simulate_outputs_ok(&A, &S, states)) != 0) goto out;
   status = 1;
   if (load_system(&A, &S) || check_dt_scale(&A, &S)) goto out;

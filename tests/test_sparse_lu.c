@@ -762,8 +762,8 @@ TEST(test_sparse_lu_descriptor_choice) {
      and chosen (the old code kept the band LU), the object holds no band
      copy (its bytes stay below one band matrix of (2 kb + 1) N doubles) and
      the band solver makes the copies of J, R, Q and E; an E with a zero row
-     and column (an algebraic equation) keeps the band path, forcing the
-     sparse LU is refused. */
+     and column (an algebraic equation) is chosen by the same prediction and
+     takes either solver (the index-one path of the sparse LU, manual 1.8). */
   slu_lat L;
   slu_mass M;
   slu_count cnt = {0.0, 0.0};
@@ -791,8 +791,11 @@ TEST(test_sparse_lu_descriptor_choice) {
   for (p = M.cp[0]; p < M.cp[1]; ++p) M.v[p] = 0.0; /* state 0: zero column and (E symmetric: its only entry) row */
   sp = NULL;
   CHECK_RC(phgmg_ph_sparse_create_e(&sp, L.N, 1, &L.M[0], &L.M[1], &L.M[2], &M.E, L.B, NULL, &inf, NULL), PHGMG_OK);
-  CHECK(inf.solver == PHGMG_SOLVER_BAND);
-  CHECK_RC(phgmg_ph_sparse_set_solver(sp, PHGMG_SOLVER_SPARSE_LU, &inf), PHGMG_ERR_UNSUPPORTED);
+  CHECK(inf.solver == PHGMG_SOLVER_SPARSE_LU && inf.band_copy == 0);
+  CHECK_RC(phgmg_ph_sparse_set_solver(sp, PHGMG_SOLVER_BAND, &inf), PHGMG_OK);
+  CHECK(phgmg_ph_sparse_system(sp)->storage == PHGMG_BANDED);
+  CHECK_RC(phgmg_ph_sparse_set_solver(sp, PHGMG_SOLVER_SPARSE_LU, &inf), PHGMG_OK);
+  CHECK(phgmg_ph_sparse_system(sp)->storage == PHGMG_SPARSE && inf.band_copy == 0);
   phgmg_ph_sparse_destroy(sp);
   (void)keep;
   slu_mass_free(&M);

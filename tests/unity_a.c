@@ -37,3 +37,4 @@
 #include "test_subnormal.c"
 #include "test_dae_ports.c"
 #include "test_setup.c"
+#include "test_dae_sparse.c"
