@@ -494,10 +494,9 @@
    the internal order; right-hand sides from the sparse copies; neither
    the sparse nor the band LU is used). Validation takes them all (with
    dampers the rcond of J - R - L comes from the sparse copies); reductions
-   take dampers (GMG-POD, SP1, SP2 as in 1.7), not a GENERAL part of a
-   SPARSE system (PHGMG_ERR_UNSUPPORTED: its reduced Hessian needs a dense or
-   band Hessian; use phgmg_ph_sparse_set_solver(sp, PHGMG_SOLVER_BAND, ..) and
-   the band callback).
+   take dampers (GMG-POD, SP1, SP2 as in 1.7) and a GENERAL part as with
+   band storage (3.4: the reduced model evaluates it in full dimension, its
+   reduced Hessian Dphi^T H Dphi through the pattern's values).
    phgmg_ph_validate checks a sparse model without band copies, once per
    object: phgmg_dae_create and every reduction reuse the result.
 
@@ -2250,10 +2249,9 @@ PHGMG_DEF phgmg_result phgmg_rcm(int N, int na, const phgmg_csc *const *A, int *
    reduction method, E, feedthrough (P, S, Nskew), dampers and the
    shifted-solve callbacks included; a GENERAL nonlinear part needs its
    Hessian pattern (hess_p / hess_i, phgmg_ph_sparse_hess_pattern; without
-   it PHGMG_ERR_UNSUPPORTED) and is simulated and validated, not reduced
-   (PHGMG_ERR_UNSUPPORTED: call phgmg_ph_sparse_set_solver(sp,
-   PHGMG_SOLVER_BAND, ..) first and give the band Hessian; a copy made before
-   that call no longer matches the object: copy again). Manual 2.6. Nothing is densified. Banded: the GL3 stepper, phgmg_jr_factor,
+   it PHGMG_ERR_UNSUPPORTED). phgmg_ph_sparse_set_solver changes the storage
+   (a copy made before that call no longer matches the object: copy
+   again). Manual 2.6. Nothing is densified. Banded: the GL3 stepper, phgmg_jr_factor,
    phgmg_ph_validate cost O(N kb^2), solves O(N kb). Sparse: manual 8.12.
    Call phgmg_ph_validate on the system for the structural checks
    (skew J, symmetric PSD R, ...: the usual codes; a nonsymmetric pattern is
@@ -14118,7 +14116,16 @@ PHGMG__PRIV void phgmg__phi_tramp(int term, phgmg_real s, phgmg_real d[3], void 
   for (k = 0; k < 3; ++k) d[k] = (phgmg_real)phgmg__ph_phi(red->sys, term, (double)s, k);
 }
 
-/* Y (N x r) = Hs X for the Hessian of a GENERAL part, dense or banded like Q. */
+/* Doubles of a GENERAL part's Hessian as hess_nl fills it: dense N x N,
+   banded like Q, or (SPARSE storage) the values of its pattern hess_p. */
+PHGMG__PRIV size_t phgmg__hess_size(const phgmg_ph_system *sys) {
+  const size_t N = (size_t)sys->N;
+  if (sys->storage == PHGMG_SPARSE) return (size_t)sys->hess_p[N] + 1;
+  return sys->storage == PHGMG_BANDED ? (size_t)(2 * sys->kb + 1) * N : N * N;
+}
+
+/* Y (N x r) = Hs X for the Hessian of a GENERAL part, dense, banded like Q,
+   or the values of its pattern (SPARSE storage). */
 PHGMG__PRIV void phgmg__hess_apply(const phgmg_ph_system *sys, const double *Hs, int r, const double *X, double *Y) {
   const int N = sys->N;
   int i, j, a;
@@ -14127,6 +14134,15 @@ PHGMG__PRIV void phgmg__hess_apply(const phgmg_ph_system *sys, const double *Hs,
     return;
   }
   memset(Y, 0, (size_t)N * r * sizeof(double));
+  if (sys->storage == PHGMG_SPARSE) {
+    for (a = 0; a < r; ++a)
+      for (j = 0; j < N; ++j) {
+        const double xj = X[j + (size_t)a * N];
+        if (xj != 0.0)
+          for (i = sys->hess_p[j]; i < sys->hess_p[j + 1]; ++i) Y[sys->hess_i[i] + (size_t)a * N] += Hs[i] * xj;
+      }
+    return;
+  }
   for (a = 0; a < r; ++a)
     for (j = 0; j < N; ++j) {
       const double xj = X[j + (size_t)a * N];
@@ -14143,7 +14159,7 @@ PHGMG__PRIV void phgmg__ham_general(const phgmg_real *x, phgmg_real *Hn, phgmg_r
   phgmg_reduced *red = PHGMG__CAST(phgmg_reduced *, user);
   const phgmg_ph_system *sys = red->sys;
   const int N = red->N, r = red->r, m = red->m, p = red->p, rn = red->rn;
-  const size_t nh = sys->storage == PHGMG_BANDED ? (size_t)(2 * sys->kb + 1) * N : (size_t)N * N;
+  const size_t nh = phgmg__hess_size(sys);
   double *xr = red->gwork, *xf = xr + r, *gf = xf + N, *HN = gf + N, *D = HN + nh, *T = D + (size_t)N * r;
   double *v = T + (size_t)N * r, *D2 = v + rn, *Hr = D2 + (size_t)rn * p * p;
   int a, b, i;
@@ -14617,8 +14633,6 @@ PHGMG__PRIV phgmg_result phgmg__reduce_check(const phgmg_ph_system *sys, const d
   if ((int)o->hyper.kind < 0 || (int)o->hyper.kind >= (int)PHGMG_HYPER_COUNT) return PHGMG_ERR_INVALID_ARG;
   if (!(o->hyper.tol >= 0.0 && o->hyper.tol < 1.0)) return PHGMG_ERR_INVALID_ARG;
   if (o->hyper.on && sys->nl == PHGMG_NL_GENERAL) return PHGMG_ERR_UNSUPPORTED;
-  if (sys->storage == PHGMG_SPARSE && sys->nl == PHGMG_NL_GENERAL)
-    return PHGMG_ERR_UNSUPPORTED;   /* the reduced Hessian takes a dense or band Hessian (manual 2.6) */
   if ((sys->P || sys->S || sys->Nskew || sys->ndamp) && !phgmg__method(o->method)->extras)
     return PHGMG_ERR_UNSUPPORTED;   /* dampers, feedthrough: linear maps only (manual 1.6, 1.7) */
   if ((sys->P || sys->S || sys->Nskew || sys->ndamp) && o->ref != PHGMG_REF_NONE)
@@ -16939,9 +16953,10 @@ PHGMG__PRIV phgmg_result phgmg__stage_separable_terms(phgmg__rctx *c) {
 PHGMG__PRIV phgmg_result phgmg__stage_general_term(phgmg__rctx *c) {
   phgmg_reduced *red = c->red;
   const int N = red->N, r = red->r;
-  const size_t nh = c->sys->storage == PHGMG_BANDED ? (size_t)(2 * c->sys->kb + 1) * N : (size_t)N * N;
   const size_t rn = (size_t)red->rn, p = (size_t)red->p;
+  size_t nh;
   if (c->sys->nl != PHGMG_NL_GENERAL) return PHGMG_OK;
+  nh = phgmg__hess_size(c->sys);
   c->inf.online_full_dim = 1;
   red->gwork = phgmg__red_d(red, (size_t)r + 2 * (size_t)N + nh + 2 * (size_t)N * r + rn + rn * p * p + (size_t)r * r);
   return red->gwork ? PHGMG_OK : PHGMG_ERR_NOMEM;

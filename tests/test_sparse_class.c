@@ -293,8 +293,10 @@ static void spc_springs(const spc_model *m, const phgmg_ph_sparse *sp, spc_gen *
    and mapped by phgmg_ph_sparse_hess_pattern: map[e] is the internal entry
    of user entry e), the stepper on the sparse LU calling the Hessian in
    that pattern, trajectory and outputs equal to the band LU's (band
-   Hessian) to 1e-10 of their scale; a malformed or missing pattern is
-   refused with its code. */
+   Hessian) to 1e-10 of their scale with the same Newton iterations, a
+   GMG-POD model reduced from the sparse system (its reduced Hessian from
+   the pattern's values) simulating as the one from the band system; a
+   malformed or missing pattern is refused with its code. */
 TEST(test_spclass_general) {
   spc_model m;
   phgmg_ph_sparse *sp = NULL;
@@ -303,7 +305,8 @@ TEST(test_spclass_general) {
   spc_gen G;
   int a[128], b[128], pos[512], *cp, *ri, *map, N, i, j, k, nz = 0, bad;
   const int *perm;
-  double *X1, *X2, *Y1, *Y2, sc;
+  double *X1, *X2, *Y1, *Y2, sc, Yr1[SPC_STEPS + 1], Yr2[SPC_STEPS + 1];
+  phgmg_reduced *red1, *red2;
   spc_build(&m, 6, 5);
   N = m.N;
   X1 = (double *)malloc(sizeof(double) * (size_t)N * (SPC_STEPS + 1));
@@ -352,14 +355,7 @@ TEST(test_spclass_general) {
   CHECK_RC(spc_sim(&sys, X1, Y1, &st1, NULL), PHGMG_OK);
   CHECK(st1.sparse_lu == 1 && st1.band_fallback == 0);
   CHECK(G.q.nhess > 0);
-  {
-    phgmg_reduce_opts o;
-    phgmg_reduced *red = NULL;
-    memset(&o, 0, sizeof o);
-    o.method = PHGMG_METHOD_GMG_POD; o.r = 8;   /* the reduced Hessian needs a dense or band one */
-    CHECK_RC(phgmg_reduce(&red, &sys, X1, N, SPC_STEPS + 1, &o, NULL, NULL), PHGMG_ERR_UNSUPPORTED);
-    CHECK(red == NULL);
-  }
+  red1 = spc_reduce(&sys, X1, Yr1);   /* the reduced Hessian through the pattern's values */
   CHECK_RC(phgmg_ph_sparse_set_solver(sp, PHGMG_SOLVER_BAND, NULL), PHGMG_OK);
   sys = *phgmg_ph_sparse_system(sp);
   sys.nl = PHGMG_NL_GENERAL;
@@ -367,6 +363,12 @@ TEST(test_spclass_general) {
   G.q.band = 1; G.q.kb = sys.kb; G.q.nhess = 0;
   CHECK_RC(spc_sim(&sys, X2, Y2, &st2, NULL), PHGMG_OK);
   CHECK(st2.sparse_lu == 0 && G.q.nhess > 0);
+  red2 = spc_reduce(&sys, X1, Yr2);
+  CHECK(red1 && red2);
+  CHECK_LE(spc_maxdiff(SPC_STEPS + 1, Yr1, Yr2, &sc), 1e-9 * sc);
+  CHECK(sc > 0.1);
+  phgmg_reduced_destroy(red1);
+  phgmg_reduced_destroy(red2);
   CHECK_LE(labs(st1.newton_iters - st2.newton_iters), 2 + st2.newton_iters / 100); /* the same Jacobian */
   CHECK_LE(spc_maxdiff(N * (SPC_STEPS + 1), X1, X2, &sc), 1e-10 * sc);
   CHECK(sc > 0.1);
