@@ -223,8 +223,9 @@
    Full model. GL3 with the dampers in the stage right-hand sides
    F_i = (J - R) z_i - r(z_i) + B u_i, z_i = z(Y_i); the simplified-Newton
    matrices take the slopes rho_k' at the factorization point,
-   sigma E - (J - R - sum_k rho_k'(s_k) c_k c_k^T) Hess (dense or banded;
-   the sparse stage LU and the linear step map are not used with dampers).
+   sigma E - (J - R - sum_k rho_k'(s_k) c_k c_k^T) Hess (dense, banded, or
+   the sparse stage LU with the dampers' pattern joined, manual 8.12; the
+   linear step map is not used with dampers).
    Discrete energy balance: GL3 is the collocation method of the cubic p with
    p(t_n) = x_n, E p'(t_n + c_i h) = F_i. For a quadratic H,
    H(p(t))' = z(p)^T E p' is a polynomial of degree 5, integrated exactly by
@@ -538,6 +539,20 @@
    lines): on the sparse LU the DAE is stepped on its sparse pencil without
    condensing, on the band LU the algebraic lines are condensed. A stepper that falls back to the band LU says so
    (phgmg_gl3_stats.band_fallback; the command line logs it).
+   Model classes on the sparse LU: linear and SEPARABLE models, E,
+   feedthrough, and (on a copy of phgmg_ph_sparse_system) nonlinear
+   dampers (1.7; the stepper joins the pattern of sum_k c_k c_k^T to that of
+   J - R in its own analysis), a GENERAL nonlinear part with a Hessian
+   pattern (phgmg_ph_system.hess_p / hess_i, an N x N CSC in the internal
+   order that hess_nl fills by values; phgmg_ph_sparse_hess_pattern maps
+   one given in the user's order and says where each entry goes) and the
+   shifted-solve callbacks (the stepper then solves with them, K(sigma) in
+   the internal order; right-hand sides from the sparse copies; neither
+   the sparse nor the band LU is used). Validation takes them all (with
+   dampers the rcond of J - R - L comes from the sparse copies); reductions
+   take dampers (GMG-POD, SP1, SP2 as in 1.7) and a GENERAL part as with
+   band storage (3.4: the reduced model evaluates it in full dimension, its
+   reduced Hessian Dphi^T H Dphi through the pattern's values).
    phgmg_ph_validate checks a sparse model without band copies, once per
    object: phgmg_dae_create and every reduction reuse the result.
 
@@ -1545,8 +1560,31 @@
    the input matrix B - P and the outputs, not the stage matrices; the
    check of [[R, P], [P^T, S]] is the pivots of its sparse L D L^T,
    shifted by tol times its 1-norm, above the dense-eigenvalue limit of
-   2000 states); a GENERAL Hessian (banded by its callback) and dampers
-   keep the band LU.
+   2000 states), with dampers and with a GENERAL part given with its
+   Hessian pattern.
+   Dampers and GENERAL Hessians. The Newton matrices are then
+   sigma E - (J - R - L) (Q + Hess H_nl), L = sum_k rho_k'(s_k) c_k c_k^T,
+   whose pattern is not that of the object's analysis. The stepper makes
+   its own analysis (steps 0-2, the same code) of the stage matrices with
+   the pattern of sum_k c_k c_k^T (entries (i, i), (j, j), (i, j), (j, i)
+   of each damper) joined to J - R and that of hess_p / hess_i joined to Q:
+   M = -(J - R - L)(Q + H) has its pattern inside that of
+   (J - R + L)(Q + H) + (J - R + L) + I, which step 0's pattern covers
+   when both factors carry the joined entries (stored as explicit zeros). At
+   each factorization one function (the stepper's Jacobian provider) copies
+   J - R and Q into those patterns, subtracts rho_k'(c_k^T z(x)) at each
+   damper's four positions and adds the Hessian callback's values at the
+   positions of its pattern (both lists of positions found once), then
+   forms M's values as for a plain model; the static-pivot checks and the
+   fall-back are unchanged (the band LU then takes the Hessian's values
+   scattered into the band: the pattern must lie within the half-bandwidth
+   kb, checked, PHGMG_ERR_SIZE). The analysis costs one more analysis per
+   stepper (phgmg_simulate_inputs shares one stepper across runs). The
+   shifted-solve callbacks replace the stage solves altogether: with a
+   SPARSE system the stepper uses them (and the sparse copies for the
+   right-hand sides) and reports sparse_lu = 0. tests/test_sparse_class.c
+   checks each class against the band LU (trajectories and outputs to 1e-10
+   of their scale, the same Newton iteration counts).
    Descriptor models. With a mass matrix E the stage matrices are
    K(sigma) = sigma E + M (E in place of I). The analysis uses the pattern
    of M, of the identity and of E; the numeric assembly adds sigma times
@@ -1813,7 +1851,7 @@
            phgmg_dae_destroy, phgmg_rcm, phgmg_ph_sparse_create, phgmg_ph_sparse_create_e,
            phgmg_ph_sparse_create_desc,
            phgmg_ph_sparse_system,
-           phgmg_ph_sparse_perm, phgmg_ph_sparse_sep_idx,
+           phgmg_ph_sparse_perm, phgmg_ph_sparse_sep_idx, phgmg_ph_sparse_hess_pattern,
            phgmg_ph_sparse_to_banded_order, phgmg_ph_sparse_to_user_order,
            phgmg_ph_sparse_destroy, phgmg_ph_sparse_set_solver,
            phgmg_gl3_create, phgmg_gl3_destroy,
@@ -1861,7 +1899,7 @@
            phgmg_lu_rcond, phgmg_norm1, phgmg_normf, phgmg_zlu_factor,
            phgmg_zlu_solve, phgmg_qr, phgmg_qrcp, phgmg_qr_form_q,
            phgmg_qr_apply, phgmg_lstsq, phgmg_svd, phgmg_sym_eig
-   (153 functions; 17 of them only with PHGMG_MPI; also the macros
+   (154 functions; 17 of them only with PHGMG_MPI; also the macros
    PHGMG_ROM_STEPPER_MEMSIZE_MAX and _MAX_CB.)
 */
 #ifndef PHGMG_H_INCLUDED
@@ -2037,9 +2075,21 @@ typedef struct phgmg_ph_system {
   /* GENERAL */
   double (*H_nl)(const double *x, void *user);
   void (*grad_nl)(const double *x, double *g, void *user);
-  /* Hessian of H_nl: dense N x N (ld N) or banded like Q. */
+  /* Hessian of H_nl: dense N x N (ld N) or banded like Q; for SPARSE
+     storage (a phgmg_ph_sparse model on the sparse LU) the values of the
+     pattern hess_p / hess_i below, in its order (Hs[e] = entry e). */
   void (*hess_nl)(const double *x, double *Hs, void *user);
   void *user;
+  /* GENERAL with SPARSE storage (required there, read only there): the
+     pattern of Hess H_nl as an N x N CSC in the system's (internal) order:
+     column j holds rows hess_i[hess_p[j] .. hess_p[j+1]-1], strictly
+     increasing, hess_p[0] = 0, every |i - j| <= kb (the model's band: the
+     band LU a stepper may fall back to takes them); hess_nl fills
+     hess_p[N] values in this order. Malformed: PHGMG_ERR_FORMAT; an entry
+     outside the band: PHGMG_ERR_SIZE; missing: PHGMG_ERR_UNSUPPORTED.
+     phgmg_ph_sparse_hess_pattern maps a pattern from the user's order.
+     Manual 2.6, 8.12. */
+  const int *hess_p, *hess_i;
   /* Optional caller-supplied solver for the shifted Newton matrices of the GL3
      stepper, K(sigma) = sigma I - (J - R) Hess H(x_lin), sigma = sr + i si, so a
      model can bring its own O(N) solve. Both NULL (default): the library's
@@ -2266,11 +2316,12 @@ PHGMG_DEF phgmg_result phgmg_rcm(int N, int na, const phgmg_csc *const *A, int *
    phgmg_ph_sparse_system gives the ready phgmg_ph_system (nl = NONE;
    storage BANDED or SPARSE by that choice): copy it to add a SEPARABLE
    nonlinear part. A SPARSE system serves validation, simulation and every
-   reduction method, E and feedthrough (P, S, Nskew) included; it refuses
-   (PHGMG_ERR_UNSUPPORTED) a GENERAL nonlinear part, dampers and the
-   shifted-solve callbacks, which need band storage: call phgmg_ph_sparse_set_solver(sp, PHGMG_SOLVER_BAND, ..)
-   first (a copy made before that call no longer matches the object: copy
-   again). Nothing is densified. Banded: the GL3 stepper, phgmg_jr_factor,
+   reduction method, E, feedthrough (P, S, Nskew), dampers and the
+   shifted-solve callbacks included; a GENERAL nonlinear part needs its
+   Hessian pattern (hess_p / hess_i, phgmg_ph_sparse_hess_pattern; without
+   it PHGMG_ERR_UNSUPPORTED). phgmg_ph_sparse_set_solver changes the storage
+   (a copy made before that call no longer matches the object: copy
+   again). Manual 2.6. Nothing is densified. Banded: the GL3 stepper, phgmg_jr_factor,
    phgmg_ph_validate cost O(N kb^2), solves O(N kb). Sparse: manual 8.12.
    Call phgmg_ph_validate on the system for the structural checks
    (skew J, symmetric PSD R, ...: the usual codes; a nonsymmetric pattern is
@@ -2362,6 +2413,18 @@ PHGMG_DEF const int *phgmg_ph_sparse_perm(const phgmg_ph_sparse *sp);
    index outside 0..N-1), _NOMEM. */
 PHGMG_DEF phgmg_result phgmg_ph_sparse_sep_idx(phgmg_ph_sparse *sp, int nsep, const int *sep_idx_user,
                                                int *idx_out, phgmg_ph_system *sys);
+/* A GENERAL Hessian's pattern (phgmg_ph_system.hess_p, hess_i) from the
+   user's ordering: cp (N + 1) / ri the N x N CSC pattern of Hess H_nl in
+   the user's order (rows strictly increasing in each column). Stores the
+   pattern in the internal order in sp (replacing an earlier call's) and, if
+   sys is not NULL, sets sys->hess_p / hess_i to it; map (may be NULL;
+   cp[N] entries) receives for user entry e its position map[e] in the
+   internal pattern, where the hess_nl callback stores that entry's value.
+   PHGMG_ERR_INVALID_ARG (NULL sp, cp or ri), _FORMAT (malformed pattern),
+   _SIZE (an entry farther than the object's half-bandwidth kb from the
+   diagonal in the internal order), _NOMEM. Manual 2.6. */
+PHGMG_DEF phgmg_result phgmg_ph_sparse_hess_pattern(phgmg_ph_sparse *sp, const int *cp, const int *ri, int *map,
+                                                    phgmg_ph_system *sys);
 /* Y (N x ncols, ldy) = rows of X (N x ncols, ldx) moved from the user's to
    the internal ordering: Y[i] = X[perm[i]]; _to_user_order the inverse,
    Y[perm[i]] = X[i]. Snapshot matrices, trajectories, lifted states.
@@ -4389,6 +4452,18 @@ PHGMG__PRIV int phgmg__ph_csc_of(const phgmg_ph_system *s, const double *M, cons
                                  const double **cx);
 PHGMG__PRIV phgmg_result phgmg__ph_sparse_own_band(const phgmg_ph_system *s, int a1, int a2, phgmg_ph_system *t,
                                                   double **bands, int **perm, const phgmg_allocator *al);
+PHGMG__PRIV phgmg_result phgmg__ph_sparse_own_band_x(const phgmg_ph_system *s, int a1, int a2, const phgmg_csc *over2,
+                                                    phgmg_ph_system *t, double **bands, int **perm,
+                                                    const phgmg_allocator *al);
+struct phgmg_jr_factor;
+PHGMG__PRIV phgmg_result phgmg__jr_factor_sparse(struct phgmg_jr_factor *f, const phgmg_ph_system *sys,
+                                                 const phgmg_csc *r_over, double *rcond_out,
+                                                 const phgmg_allocator *alloc);
+PHGMG__PRIV phgmg_result phgmg__damp_pattern(const phgmg_ph_system *sys, int **pp, int **pi,
+                                             const phgmg_allocator *al);
+PHGMG__PRIV phgmg_result phgmg__csc_join(int n, int **p, int **i, double **x, const int *xp, const int *xi,
+                                         const phgmg_allocator *al);
+PHGMG__PRIV int phgmg__csc_find(const int *cp, const int *ci, int row, int col);
 PHGMG__PRIV void phgmg__ph_own_band_free(phgmg_ph_system *t, double **bands, int *perm, const phgmg_allocator *al);
 
 /* Element (i,j) of J, R or Q (0 outside the band or the pattern). */
@@ -4658,6 +4733,7 @@ PHGMG__PRIV phgmg_result phgmg__ph_check_dampers(const phgmg_ph_system *s) {
 }
 
 PHGMG__PRIV phgmg_result phgmg__ph_check_sparse(const phgmg_ph_system *s);
+PHGMG__PRIV phgmg_result phgmg__ph_check_hess_pattern(const phgmg_ph_system *s);
 
 /* Structural checks shared by every entry point (no O(N^2) work). */
 PHGMG__PRIV phgmg_result phgmg__ph_check(const phgmg_ph_system *s) {
@@ -5220,11 +5296,27 @@ PHGMG__PRIV double phgmg__jr_rcond(const phgmg_jr_factor *f, const phgmg_ph_syst
   return rc;
 }
 
+/* SPARSE storage: f (allocated, N and storage set) := J - R in band
+   storage in the reverse Cuthill-McKee order of its own pattern, with the
+   CSC r_over in place of R (NULL: R; the dampers' R + L). */
+PHGMG__PRIV phgmg_result phgmg__jr_factor_sparse(phgmg_jr_factor *f, const phgmg_ph_system *sys,
+                                                 const phgmg_csc *r_over, double *rcond_out,
+                                                 const phgmg_allocator *alloc) {
+  phgmg_ph_system t;
+  double *bands[2] = {NULL, NULL};
+  phgmg_result rc = phgmg__ph_sparse_own_band_x(sys, 0, 1, r_over, &t, bands, &f->perm, alloc);
+  f->w = phgmg__dalloc(alloc, (size_t)sys->N);
+  if (rc == PHGMG_OK && !f->w) rc = PHGMG_ERR_NOMEM;
+  if (rc == PHGMG_OK) rc = phgmg__gbf_jr(alloc, &t, &f->gb);
+  if (rc == PHGMG_OK && rcond_out) *rcond_out = phgmg__jr_rcond(f, &t);
+  phgmg__ph_own_band_free(&t, bands, NULL, alloc);
+  if (rc == PHGMG_OK && rcond_out && *rcond_out < 0.0) rc = PHGMG_ERR_NOMEM;
+  return rc;
+}
+
 PHGMG_DEF phgmg_result phgmg_jr_factor_create(phgmg_jr_factor **out, const phgmg_ph_system *sys,
                                               double *rcond_out, const phgmg_allocator *alloc) {
   phgmg_jr_factor *f;
-  phgmg_ph_system t;
-  double *bands[2] = {NULL, NULL};
   phgmg_result rc;
   int N, i, j;
   if (!out) return PHGMG_ERR_INVALID_ARG;
@@ -5259,13 +5351,7 @@ PHGMG_DEF phgmg_result phgmg_jr_factor_create(phgmg_jr_factor **out, const phgmg
       if (rc != PHGMG_OK && rcond_out) *rcond_out = 0.0;
       return rc;
     }
-    rc = phgmg__ph_sparse_own_band(sys, 0, 1, &t, bands, &f->perm, alloc);
-    f->w = phgmg__dalloc(alloc, (size_t)N);
-    if (rc == PHGMG_OK && !f->w) rc = PHGMG_ERR_NOMEM;
-    if (rc == PHGMG_OK) rc = phgmg__gbf_jr(alloc, &t, &f->gb);
-    if (rc == PHGMG_OK && rcond_out) *rcond_out = phgmg__jr_rcond(f, &t);
-    phgmg__ph_own_band_free(&t, bands, NULL, alloc);
-    if (rc == PHGMG_OK && rcond_out && *rcond_out < 0.0) rc = PHGMG_ERR_NOMEM;
+    rc = phgmg__jr_factor_sparse(f, sys, NULL, rcond_out, alloc);
     if (rc == PHGMG_OK) { *out = f; return PHGMG_OK; }
   } else {
     rc = phgmg__gbf_jr(alloc, sys, &f->gb);
@@ -5747,6 +5833,8 @@ PHGMG__PRIV phgmg_result phgmg__damp_r_lin(const phgmg_ph_system *sys, double **
   return PHGMG_OK;
 }
 
+PHGMG__PRIV phgmg_result phgmg__damp_jr_sparse(phgmg_jr_factor **out, const phgmg_ph_system *sys, double *rcond,
+                                               const phgmg_allocator *alloc);
 /* phgmg_jr_factor_create of J - R, or with dampers of J - R - L. */
 PHGMG__PRIV phgmg_result phgmg__damp_jr_factor(phgmg_jr_factor **f, const phgmg_ph_system *sys, double *rcond,
                                                const phgmg_allocator *alloc) {
@@ -5754,6 +5842,7 @@ PHGMG__PRIV phgmg_result phgmg__damp_jr_factor(phgmg_jr_factor **f, const phgmg_
   double *Rl = NULL;
   phgmg_result rc;
   if (!sys->ndamp) return phgmg_jr_factor_create(f, sys, rcond, alloc);
+  if (sys->storage == PHGMG_SPARSE) return phgmg__damp_jr_sparse(f, sys, rcond, alloc);
   rc = phgmg__damp_r_lin(sys, &Rl, alloc);
   lin = *sys;
   lin.R = Rl;
@@ -7953,7 +8042,15 @@ PHGMG__PRIV void phgmg__sp_solve(const phgmg__spsym *S, const phgmg__spnum *F, d
 
 /* Values of M = -(J - R)(Q + diag(dd)) (dd may be NULL) in the k pattern
    (M P with a column permutation), with a dense scratch w (n). */
+PHGMG__PRIV void phgmg__sp_stage_values_x(const phgmg__spsym *S, const double *jrx, const double *qx,
+                                           const double *dd, double *Mx, double *w);
 PHGMG__PRIV void phgmg__sp_stage_values(const phgmg__spsym *S, const double *dd, double *Mx, double *w) {
+  phgmg__sp_stage_values_x(S, S->jr_x, S->q_x, dd, Mx, w);
+}
+/* The same with the values jrx of J - R (S's jr pattern) and qx of Q (S's q
+   pattern) given: a stepper's Jacobian with dampers or a GENERAL Hessian. */
+PHGMG__PRIV void phgmg__sp_stage_values_x(const phgmg__spsym *S, const double *jrx, const double *qx,
+                                           const double *dd, double *Mx, double *w) {
   int n = S->n, j, p, q;
   for (j = 0; j < n; ++j) w[j] = 0.0;
   for (j = 0; j < n; ++j) {
@@ -7961,11 +8058,12 @@ PHGMG__PRIV void phgmg__sp_stage_values(const phgmg__spsym *S, const double *dd,
     double dj = dd ? dd[c] : 0.0;
     for (q = S->q_p[c]; q < S->q_p[c + 1]; ++q) {
       int k = S->q_i[q];
-      double v = S->q_x[q];
-      for (p = S->jr_p[k]; p < S->jr_p[k + 1]; ++p) w[S->jr_i[p]] -= S->jr_x[p] * v;
+      double v = qx[q];
+      if (v == 0.0) continue;
+      for (p = S->jr_p[k]; p < S->jr_p[k + 1]; ++p) w[S->jr_i[p]] -= jrx[p] * v;
     }
     if (dj != 0.0)
-      for (p = S->jr_p[c]; p < S->jr_p[c + 1]; ++p) w[S->jr_i[p]] -= S->jr_x[p] * dj;
+      for (p = S->jr_p[c]; p < S->jr_p[c + 1]; ++p) w[S->jr_i[p]] -= jrx[p] * dj;
     for (p = S->k_p[j]; p < S->k_p[j + 1]; ++p) { Mx[p] = w[S->k_i[p]]; w[S->k_i[p]] = 0.0; }
   }
 }
@@ -8227,6 +8325,7 @@ struct phgmg_ph_sparse {
   phgmg_allocator a;
   const phgmg_allocator *alloc; /* &a or NULL */
   int *perm, *iperm, *sep;
+  int *hp, *hi;                 /* a GENERAL Hessian's pattern (phgmg_ph_sparse_hess_pattern) */
   double *J, *R, *Q, *B;
   double *E;   /* descriptor models: E's band copy (band LU only), else NULL */
   int *cp[4], *ci[4];           /* J, R, Q (and E) as CSC in the internal order */
@@ -8434,8 +8533,61 @@ done:
    zero values dropped, as from band storage); condense as phgmg__spsym_create.
    js = 1: the model; js = -1: its dual with J -> -J (the observability
    equation of the low-rank solvers, >>lowrank). */
+/* An extra pattern joined to an analysis of the stage matrices (manual
+   8.12): lp/li to J - R (the dampers' sum_k c_k c_k^T), hp/hi to Q (a
+   GENERAL Hessian's pattern); CSC, rows strictly increasing; NULL: none.
+   The joined entries hold zeros in the analysis's values: the stepper adds
+   the Jacobian's values there at each factorization (phgmg__gl3_sparse_jac). */
+typedef struct phgmg__spext { const int *lp, *li, *hp, *hi; } phgmg__spext;
+
+/* (*p, *i, *x) (n x n CSC, rows strictly increasing) := its union with the
+   pattern (xp, xi) (rows strictly increasing), zero values at new entries. */
+PHGMG__PRIV phgmg_result phgmg__csc_join(int n, int **p, int **i, double **x, const int *xp, const int *xi,
+                                         const phgmg_allocator *al) {
+  int pass, j, a, b, nz = 0, *np = phgmg__ialloc(al, (size_t)n + 1), *ni = NULL;
+  double *nx = NULL;
+  if (!np) return PHGMG_ERR_NOMEM;
+  for (pass = 0; pass < 2; ++pass) {
+    for (nz = 0, j = 0; j < n; ++j) {
+      np[j] = nz;
+      for (a = (*p)[j], b = xp[j]; a < (*p)[j + 1] || b < xp[j + 1]; ++nz) {
+        const int ra = a < (*p)[j + 1] ? (*i)[a] : n, rb = b < xp[j + 1] ? xi[b] : n, r = PHGMG__MIN(ra, rb);
+        if (pass) { ni[nz] = r; nx[nz] = ra == r ? (*x)[a] : 0.0; }
+        if (ra == r) ++a;
+        if (rb == r) ++b;
+      }
+    }
+    np[n] = nz;
+    if (!pass && (!(ni = phgmg__ialloc(al, (size_t)nz + 1)) || !(nx = phgmg__dalloc(al, (size_t)nz + 1)))) {
+      phgmg__free(al, np); phgmg__free(al, ni);
+      return PHGMG_ERR_NOMEM;
+    }
+  }
+  phgmg__free(al, *p); phgmg__free(al, *i); phgmg__free(al, *x);
+  *p = np; *i = ni; *x = nx;
+  return PHGMG_OK;
+}
+
+/* Position of entry (row, col) in a CSC pattern with sorted rows, -1 if absent. */
+PHGMG__PRIV int phgmg__csc_find(const int *cp, const int *ci, int row, int col) {
+  int lo = cp[col], hi = cp[col + 1];
+  while (lo < hi) {
+    const int mid = lo + (hi - lo) / 2;
+    if (ci[mid] < row) lo = mid + 1;
+    else hi = mid;
+  }
+  return lo < cp[col + 1] && ci[lo] == row ? lo : -1;
+}
+
+PHGMG__PRIV phgmg_result phgmg__spsym_create_x(phgmg__spsym **out, const phgmg_ph_sparse *sp, int condense,
+                                               double js, const phgmg__spext *ext);
 PHGMG__PRIV phgmg_result phgmg__spsym_create_js(phgmg__spsym **out, const phgmg_ph_sparse *sp, int condense,
                                                 double js) {
+  return phgmg__spsym_create_x(out, sp, condense, js, NULL);
+}
+/* The same with an extra pattern (ext may be NULL). */
+PHGMG__PRIV phgmg_result phgmg__spsym_create_x(phgmg__spsym **out, const phgmg_ph_sparse *sp, int condense,
+                                               double js, const phgmg__spext *ext) {
   const phgmg_allocator *al = sp->alloc;
   const int n = sp->sys.N;
   phgmg__spsym *S = PHGMG__CAST(phgmg__spsym *, phgmg__alloc(al, sizeof(phgmg__spsym)));
@@ -8475,6 +8627,8 @@ PHGMG__PRIV phgmg_result phgmg__spsym_create_js(phgmg__spsym **out, const phgmg_
       if (!S->jr_i || !S->jr_x || !S->q_i || !S->q_x) rc = PHGMG_ERR_NOMEM;
     }
   }
+  if (rc == PHGMG_OK && ext && ext->lp) rc = phgmg__csc_join(n, &S->jr_p, &S->jr_i, &S->jr_x, ext->lp, ext->li, al);
+  if (rc == PHGMG_OK && ext && ext->hp) rc = phgmg__csc_join(n, &S->q_p, &S->q_i, &S->q_x, ext->hp, ext->hi, al);
   if (rc == PHGMG_OK && S->e_p) { /* descriptor: columns matched to E's largest entries */
     int r = (S->cperm = phgmg__ialloc(al, (size_t)n)) ? phgmg__sp_match_e(S, al) : -1;
     if (r < 0) rc = PHGMG_ERR_NOMEM;
@@ -8865,6 +9019,8 @@ PHGMG_DEF void phgmg_ph_sparse_destroy(phgmg_ph_sparse *sp) {
   phgmg__free(alloc, sp->perm);
   phgmg__free(alloc, sp->iperm);
   phgmg__free(alloc, sp->sep);
+  phgmg__free(alloc, sp->hp);
+  phgmg__free(alloc, sp->hi);
   phgmg__free(alloc, sp->J);
   phgmg__free(alloc, sp->R);
   phgmg__free(alloc, sp->Q);
@@ -9183,7 +9339,8 @@ PHGMG__PRIV int phgmg__ph_sparse_mv(const phgmg_ph_system *s, const double *M, c
 PHGMG__PRIV const phgmg__spsym *phgmg__ph_sparse_lu(const phgmg_ph_system *sys) {
   const phgmg_ph_sparse *sp = sys->sparse;
   if (!sp || !sp->use_lu || !sp->sym || sys->E != sp->cx[3] || sys->storage != PHGMG_SPARSE || sys->N != sp->sys.N ||
-      sys->J != sp->cx[0] || sys->R != sp->cx[1] || sys->Q != sp->cx[2] || sys->nl == PHGMG_NL_GENERAL)
+      sys->J != sp->cx[0] || sys->R != sp->cx[1] || sys->Q != sp->cx[2] ||
+      (sys->nl == PHGMG_NL_GENERAL && !sys->hess_p))
     return NULL;
   return sp->sym;
 }
@@ -9206,8 +9363,23 @@ PHGMG__PRIV phgmg_result phgmg__ph_check_sparse(const phgmg_ph_system *s) {
   if (!sp || s->N != sp->sys.N || s->J != sp->cx[0] || s->R != sp->cx[1] || s->Q != sp->cx[2] ||
       s->E != sp->cx[3])
     return PHGMG_ERR_INVALID_ARG;
-  if (s->ndamp || s->nl == PHGMG_NL_GENERAL || s->shifted_factor)
-    return PHGMG_ERR_UNSUPPORTED;
+  return s->nl == PHGMG_NL_GENERAL ? phgmg__ph_check_hess_pattern(s) : PHGMG_OK;
+}
+
+/* A SPARSE system's GENERAL Hessian pattern (phgmg_ph_system.hess_p):
+   present (else _UNSUPPORTED), well formed (_FORMAT), inside the band (_SIZE). */
+PHGMG__PRIV phgmg_result phgmg__ph_check_hess_pattern(const phgmg_ph_system *s) {
+  const int N = s->N, *hp = s->hess_p, *hi = s->hess_i;
+  int j, e;
+  if (!hp || !hi) return PHGMG_ERR_UNSUPPORTED;
+  if (hp[0] != 0) return PHGMG_ERR_FORMAT;
+  for (j = 0; j < N; ++j) {
+    if (hp[j + 1] < hp[j]) return PHGMG_ERR_FORMAT;
+    for (e = hp[j]; e < hp[j + 1]; ++e) {
+      if (hi[e] < 0 || hi[e] >= N || (e > hp[j] && hi[e] <= hi[e - 1])) return PHGMG_ERR_FORMAT;
+      if ((hi[e] > j ? hi[e] - j : j - hi[e]) > s->kb) return PHGMG_ERR_SIZE;
+    }
+  }
   return PHGMG_OK;
 }
 
@@ -9219,6 +9391,12 @@ PHGMG__PRIV phgmg_result phgmg__ph_check_sparse(const phgmg_ph_system *s) {
    model's. t's other matrices point at a1's band. */
 PHGMG__PRIV phgmg_result phgmg__ph_sparse_own_band(const phgmg_ph_system *s, int a1, int a2, phgmg_ph_system *t,
                                                   double **bands, int **perm, const phgmg_allocator *al) {
+  return phgmg__ph_sparse_own_band_x(s, a1, a2, NULL, t, bands, perm, al);
+}
+/* The same with the CSC over2 (internal order) in place of matrix a2 (NULL: a2's own). */
+PHGMG__PRIV phgmg_result phgmg__ph_sparse_own_band_x(const phgmg_ph_system *s, int a1, int a2, const phgmg_csc *over2,
+                                                    phgmg_ph_system *t, double **bands, int **perm,
+                                                    const phgmg_allocator *al) {
   const phgmg_ph_sparse *sp = s->sparse;
   const int N = s->N, na = a2 >= 0 ? 2 : 1;
   phgmg_csc A[2];
@@ -9238,6 +9416,7 @@ PHGMG__PRIV phgmg_result phgmg__ph_sparse_own_band(const phgmg_ph_system *s, int
     int a = k ? a2 : a1;
     A[k].n_rows = A[k].n_cols = N;
     A[k].colptr = sp->cp[a]; A[k].rowidx = sp->ci[a]; A[k].values = sp->cx[a];
+    if (k && over2) A[k] = *over2;
     Ap[k] = &A[k];
   }
   rc = phgmg_rcm(N, na, Ap, *perm, &kb, al);
@@ -9251,7 +9430,7 @@ PHGMG__PRIV phgmg_result phgmg__ph_sparse_own_band(const phgmg_ph_system *s, int
     memset(b, 0, sizeof(double) * len);
     if (!k) for (j = 0; j < N; ++j) ip[(*perm)[j]] = j;
     for (j = 0; j < N; ++j)
-      for (p = sp->cp[a][j]; p < sp->cp[a][j + 1]; ++p) b[PHGMG__PHB(kb, ip[sp->ci[a][p]], ip[j])] = sp->cx[a][p];
+      for (p = A[k].colptr[j]; p < A[k].colptr[j + 1]; ++p) b[PHGMG__PHB(kb, ip[A[k].rowidx[p]], ip[j])] = A[k].values[p];
     *slot[a] = b;
     if (!k) t->J = t->R = t->Q = b, *slot[a] = b;
   }
@@ -9307,6 +9486,96 @@ PHGMG_DEF phgmg_result phgmg_ph_sparse_sep_idx(phgmg_ph_sparse *sp, int nsep, co
   sp->sep = s;
   if (sys) { sys->nsep = nsep; sys->sep_idx = s; }
   return PHGMG_OK;
+}
+
+/* A GENERAL Hessian's pattern from the user's order (CSC cp/ri, rows
+   strictly increasing) to the internal one: the pattern in sp (replacing an
+   earlier call's), map[e] = its entry for user entry e. */
+PHGMG_DEF phgmg_result phgmg_ph_sparse_hess_pattern(phgmg_ph_sparse *sp, const int *cp, const int *ri, int *map,
+                                                    phgmg_ph_system *sys) {
+  int N, j, e, r, *rp = NULL, *byrow = NULL, *hp = NULL, *hi = NULL, *col = NULL;
+  phgmg_result rc = PHGMG_OK;
+  if (!sp || !cp || !ri) return PHGMG_ERR_INVALID_ARG;
+  N = sp->sys.N;
+  if (cp[0] != 0) return PHGMG_ERR_FORMAT;
+  for (j = 0; j < N; ++j) {
+    if (cp[j + 1] < cp[j]) return PHGMG_ERR_FORMAT;
+    for (e = cp[j]; e < cp[j + 1]; ++e) {
+      const int a = sp->iperm[j], b = ri[e] >= 0 && ri[e] < N ? sp->iperm[ri[e]] : 0;
+      if (ri[e] < 0 || ri[e] >= N || (e > cp[j] && ri[e] <= ri[e - 1])) return PHGMG_ERR_FORMAT;
+      if ((a > b ? a - b : b - a) > sp->sys.kb) return PHGMG_ERR_SIZE;
+    }
+  }
+  rp = phgmg__ialloc(sp->alloc, (size_t)N + 1); byrow = phgmg__ialloc(sp->alloc, (size_t)cp[N] + 1);
+  hp = phgmg__ialloc(sp->alloc, (size_t)N + 1); hi = phgmg__ialloc(sp->alloc, (size_t)cp[N] + 1);
+  col = phgmg__ialloc(sp->alloc, (size_t)cp[N] + 1);
+  if (!rp || !byrow || !hp || !hi || !col) { rc = PHGMG_ERR_NOMEM; goto done; }
+  for (j = 0; j <= N; ++j) rp[j] = hp[j] = 0;
+  for (j = 0; j < N; ++j) /* bucket the entries by internal row, then by internal column in row order */
+    for (e = cp[j]; e < cp[j + 1]; ++e) { col[e] = sp->iperm[j]; rp[sp->iperm[ri[e]] + 1]++; hp[col[e] + 1]++; }
+  for (j = 0; j < N; ++j) { rp[j + 1] += rp[j]; hp[j + 1] += hp[j]; }
+  for (j = 0; j < N; ++j)
+    for (e = cp[j]; e < cp[j + 1]; ++e) byrow[rp[sp->iperm[ri[e]]]++] = e;
+  for (r = 0, e = 0; r < cp[N]; ++r) { /* byrow holds the entries by increasing internal row */
+    const int u = byrow[r], q = hp[col[u]]++;
+    while (e < N && r >= rp[e]) ++e; /* rp[k] now ends row k: e is the row of position r */
+    hi[q] = e;
+    if (map) map[u] = q;
+  }
+  for (j = N; j > 0; --j) hp[j] = hp[j - 1];
+  hp[0] = 0;
+  phgmg__free(sp->alloc, sp->hp); phgmg__free(sp->alloc, sp->hi);
+  sp->hp = hp; sp->hi = hi; hp = hi = NULL;
+  if (sys) { sys->hess_p = sp->hp; sys->hess_i = sp->hi; }
+done:
+  phgmg__free(sp->alloc, rp); phgmg__free(sp->alloc, byrow); phgmg__free(sp->alloc, hp);
+  phgmg__free(sp->alloc, hi); phgmg__free(sp->alloc, col);
+  return rc;
+}
+
+/* SPARSE storage: J - R - L factored as phgmg_jr_factor_create factors
+   J - R, with R + L (L as in phgmg__damp_r_lin) a CSC made here. */
+PHGMG__PRIV phgmg_result phgmg__damp_jr_sparse(phgmg_jr_factor **out, const phgmg_ph_system *sys, double *rcond,
+                                               const phgmg_allocator *alloc) {
+  const phgmg_ph_sparse *sp = sys->sparse;
+  const int N = sys->N, nz = sp->cp[1][N];
+  int *rp = phgmg__ialloc(alloc, (size_t)N + 1), *ri = phgmg__ialloc(alloc, (size_t)nz + 1), *lp = NULL, *li = NULL, k;
+  double *rx = phgmg__dalloc(alloc, (size_t)nz + 1), d[2];
+  phgmg_jr_factor *f = NULL;
+  phgmg_csc over;
+  phgmg_result rc = rp && ri && rx ? phgmg__damp_pattern(sys, &lp, &li, alloc) : PHGMG_ERR_NOMEM;
+  *out = NULL;
+  if (rc == PHGMG_OK) {
+    memcpy(rp, sp->cp[1], sizeof(int) * ((size_t)N + 1));
+    memcpy(ri, sp->ci[1], sizeof(int) * (size_t)nz);
+    memcpy(rx, sp->cx[1], sizeof(double) * (size_t)nz);
+    rc = phgmg__csc_join(N, &rp, &ri, &rx, lp, li, alloc);
+  }
+  for (k = 0; k < sys->ndamp && rc == PHGMG_OK; ++k) {
+    const int i = sys->damp_i[k], j = phgmg__damp_j(sys, k);
+    phgmg__damp_law(sys, k, 0.0, d);
+    if (!(d[1] >= 0.0) || d[1] == HUGE_VAL) { rc = d[1] != d[1] ? PHGMG_ERR_NANINF : PHGMG_ERR_DAMPER; break; }
+    rx[phgmg__csc_find(rp, ri, i, i)] += d[1];
+    if (j < 0) continue;
+    rx[phgmg__csc_find(rp, ri, j, j)] += d[1];
+    rx[phgmg__csc_find(rp, ri, i, j)] -= d[1];
+    rx[phgmg__csc_find(rp, ri, j, i)] -= d[1];
+  }
+  if (rc == PHGMG_OK && !(f = PHGMG__CAST(phgmg_jr_factor *, phgmg__alloc(alloc, sizeof(phgmg_jr_factor)))))
+    rc = PHGMG_ERR_NOMEM;
+  if (rc == PHGMG_OK) {
+    memset(f, 0, sizeof *f);
+    if (alloc) f->al = *alloc;
+    f->N = N;
+    f->storage = PHGMG_SPARSE;
+    over.n_rows = over.n_cols = N; over.colptr = rp; over.rowidx = ri; over.values = rx;
+    rc = phgmg__jr_factor_sparse(f, sys, &over, rcond, alloc);
+  }
+  if (rc == PHGMG_OK) *out = f;
+  else phgmg_jr_factor_destroy(f);
+  phgmg__free(alloc, rp); phgmg__free(alloc, ri); phgmg__free(alloc, rx);
+  phgmg__free(alloc, lp); phgmg__free(alloc, li);
+  return rc;
 }
 
 #include <stdint.h> /* uintptr_t: the overlap test of the orderings' row moves */
@@ -9957,6 +10226,15 @@ struct phgmg_gl3 {
   int ddm_w, damp_bad;
   /* index one on the sparse LU (manual 1.8): the end values' constraints */
   phgmg__sdae *dae;
+  /* sparse LU with dampers or a GENERAL Hessian (manual 8.12): the
+     stepper's own analysis (sps points at it), the positions of the
+     dampers' entries (4 per damper: (i,i), (j,j), (i,j), (j,i); -1 none) in
+     its J - R pattern and of the Hessian's entries in its Q pattern, and
+     the Jacobian's value arrays in those patterns (jrx, hqx) and the
+     Hessian callback's values (hv) */
+  struct phgmg__spsym *sown;
+  int *dpos, *hpos;
+  double *jrx, *hqx, *hv;
 };
 
 PHGMG_DEF void phgmg_gl3_destroy(phgmg_gl3 *s) {
@@ -9990,6 +10268,9 @@ PHGMG_DEF void phgmg_gl3_destroy(phgmg_gl3 *s) {
   phgmg__free(&al, s->dz);
   phgmg__dia_free(&al, &s->ddm);
   phgmg__sdae_free(s->dae);
+  phgmg__spsym_free(&al, s->sown);
+  phgmg__free(&al, s->dpos); phgmg__free(&al, s->hpos);
+  phgmg__free(&al, s->jrx); phgmg__free(&al, s->hqx); phgmg__free(&al, s->hv);
   phgmg__free(&al, s);
 }
 
@@ -10176,9 +10457,11 @@ PHGMG__PRIV void phgmg__gl3_setup_method(phgmg_gl3 *s, const phgmg_gl3_opts *opt
   if (s->linear && !(opts && opts->no_step_map) && sys->storage == PHGMG_DENSE &&
       N <= PHGMG_GL3_STEP_MAP_MAX_N)
     s->mode = PHGMG__GL3_MAP;
-  else if (sys->shifted_factor)
+  else if (sys->shifted_factor) {
     s->mode = PHGMG__GL3_CALLBACK;
-  else if (!sys->ndamp && (s->sps = phgmg__ph_sparse_lu(sys)) != NULL)
+    s->sps = phgmg__ph_sparse_lu(sys); /* SPARSE storage: J - R and Q of its analysis (right-hand sides) */
+  }
+  else if ((s->sps = phgmg__ph_sparse_lu(sys)) != NULL)
     s->mode = PHGMG__GL3_SPARSE;
   else
     s->mode = sys->storage == PHGMG_DENSE ? PHGMG__GL3_DENSE : PHGMG__GL3_BANDED;
@@ -10369,6 +10652,130 @@ PHGMG__PRIV phgmg_result phgmg__gl3_sparse_qdiag(phgmg_gl3 *s) {
   return PHGMG_OK;
 }
 
+/* The pattern of the dampers' linearisation sum_k c_k c_k^T (CSC, rows
+   strictly increasing): (i, i), and with j >= 0 also (j, j), (i, j), (j, i). */
+PHGMG__PRIV phgmg_result phgmg__damp_pattern(const phgmg_ph_system *sys, int **pp, int **pi,
+                                             const phgmg_allocator *al) {
+  const int N = sys->N;
+  int k, j, p, q, *cnt = phgmg__ialloc(al, (size_t)N + 1), *ci = phgmg__ialloc(al, 4 * (size_t)sys->ndamp + 1);
+  *pp = cnt; *pi = ci;
+  if (!cnt || !ci) return PHGMG_ERR_NOMEM;
+  for (j = 0; j <= N; ++j) cnt[j] = 0;
+  for (k = 0; k < sys->ndamp; ++k) {
+    const int i = sys->damp_i[k], jj = phgmg__damp_j(sys, k);
+    cnt[i + 1] += jj >= 0 ? 2 : 1;
+    if (jj >= 0) cnt[jj + 1] += 2;
+  }
+  for (j = 0; j < N; ++j) cnt[j + 1] += cnt[j];
+  for (k = 0; k < sys->ndamp; ++k) { /* cnt[c] runs ahead, restored below */
+    const int i = sys->damp_i[k], jj = phgmg__damp_j(sys, k);
+    ci[cnt[i]++] = i;
+    if (jj < 0) continue;
+    ci[cnt[i]++] = jj;
+    ci[cnt[jj]++] = jj;
+    ci[cnt[jj]++] = i;
+  }
+  for (j = N; j > 0; --j) cnt[j] = cnt[j - 1];
+  cnt[0] = 0;
+  for (j = 0, q = 0; j < N; ++j) { /* sort and drop duplicates, in place */
+    const int a = cnt[j], b = cnt[j + 1];
+    phgmg__isort(ci + a, (size_t)(b - a));
+    cnt[j] = q;
+    for (p = a; p < b; ++p)
+      if (p == a || ci[p] != ci[p - 1]) ci[q++] = ci[p];
+  }
+  cnt[N] = q;
+  return PHGMG_OK;
+}
+
+/* Sparse LU with dampers or a GENERAL Hessian (manual 8.12): the stepper's
+   own analysis of the stage matrices with the dampers' pattern joined to
+   J - R and the Hessian's (sys.hess_p, hess_i) to Q, the positions of those
+   entries, and the value arrays of phgmg__gl3_sparse_jac. */
+PHGMG__PRIV phgmg_result phgmg__gl3_sparse_ext(phgmg_gl3 *s) {
+  const phgmg_ph_system *sys = &s->sys;
+  phgmg__spext ext;
+  int *lp = NULL, *li = NULL, k, j, e;
+  phgmg_result rc = PHGMG_OK;
+  const phgmg__spsym *S;
+  memset(&ext, 0, sizeof ext);
+  if (sys->ndamp) rc = phgmg__damp_pattern(sys, &lp, &li, &s->al);
+  ext.lp = lp; ext.li = li;
+  if (sys->nl == PHGMG_NL_GENERAL) { ext.hp = sys->hess_p; ext.hi = sys->hess_i; }
+  if (rc == PHGMG_OK) rc = phgmg__spsym_create_x(&s->sown, sys->sparse, -1, 1.0, &ext);
+  phgmg__free(&s->al, lp); phgmg__free(&s->al, li);
+  if (rc != PHGMG_OK) return rc;
+  s->sps = S = s->sown;
+  if (sys->ndamp) {
+    if (!(s->dpos = phgmg__ialloc(&s->al, 4 * (size_t)sys->ndamp)) ||
+        !(s->jrx = phgmg__dalloc(&s->al, (size_t)S->jr_p[s->N] + 1))) return PHGMG_ERR_NOMEM;
+    for (k = 0; k < sys->ndamp; ++k) {
+      const int i = sys->damp_i[k], jj = phgmg__damp_j(sys, k);
+      s->dpos[4 * k] = phgmg__csc_find(S->jr_p, S->jr_i, i, i);
+      s->dpos[4 * k + 1] = jj < 0 ? -1 : phgmg__csc_find(S->jr_p, S->jr_i, jj, jj);
+      s->dpos[4 * k + 2] = jj < 0 ? -1 : phgmg__csc_find(S->jr_p, S->jr_i, i, jj);
+      s->dpos[4 * k + 3] = jj < 0 ? -1 : phgmg__csc_find(S->jr_p, S->jr_i, jj, i);
+    }
+  }
+  if (sys->nl == PHGMG_NL_GENERAL) {
+    const size_t nh = (size_t)sys->hess_p[s->N];
+    if (!(s->hpos = phgmg__ialloc(&s->al, nh + 1)) || !(s->hv = phgmg__dalloc(&s->al, nh + 1)) ||
+        !(s->hqx = phgmg__dalloc(&s->al, (size_t)S->q_p[s->N] + 1))) return PHGMG_ERR_NOMEM;
+    for (j = 0; j < s->N; ++j)
+      for (e = sys->hess_p[j]; e < sys->hess_p[j + 1]; ++e) s->hpos[e] = phgmg__csc_find(S->q_p, S->q_i, sys->hess_i[e], j);
+  }
+  return PHGMG_OK;
+}
+
+/* The sparse stepper's Jacobian at x, the one provider of its values:
+   J - R - sum_k rho_k'(s_k) c_k c_k^T (dampers, s_k = c_k^T z(x)) in the J - R
+   pattern, Q + Hess H_nl(x) (GENERAL, sys.hess_nl filling the values of the
+   pattern hess_p/hess_i) in the Q pattern, then the stage values
+   M = -(J - R - L)(Q + Hess H_nl + diag(dd)) into s->spM. */
+PHGMG__PRIV void phgmg__gl3_sparse_jac(phgmg_gl3 *s, const double *x) {
+  const phgmg_ph_system *sys = &s->sys;
+  const phgmg__spsym *S = s->sps;
+  const double *jx = S->jr_x, *qx = S->q_x;
+  int k;
+  if (sys->ndamp) {
+    memcpy(s->jrx, S->jr_x, sizeof(double) * (size_t)S->jr_p[s->N]);
+    phgmg__ph_grad(sys, x, s->dz, s->tmp);   /* the co-state z(x) */
+    for (k = 0; k < sys->ndamp; ++k) {
+      const int *pos = s->dpos + 4 * k;
+      double d[2];
+      phgmg__damp_law(sys, k, phgmg__damp_s(sys, k, s->dz), d);
+      s->jrx[pos[0]] -= d[1];
+      if (pos[1] < 0) continue;
+      s->jrx[pos[1]] -= d[1];
+      s->jrx[pos[2]] += d[1];
+      s->jrx[pos[3]] += d[1];
+    }
+    jx = s->jrx;
+  }
+  if (sys->nl == PHGMG_NL_GENERAL) {
+    const int nh = sys->hess_p[s->N];
+    memcpy(s->hqx, S->q_x, sizeof(double) * (size_t)S->q_p[s->N]);
+    sys->hess_nl(x, s->hv, sys->user);
+    for (k = 0; k < nh; ++k) s->hqx[s->hpos[k]] += s->hv[k];
+    qx = s->hqx;
+  }
+  phgmg__sp_stage_values_x(S, jx, qx, sys->nl == PHGMG_NL_SEPARABLE ? s->dd : NULL, s->spM, s->spw);
+}
+
+/* Banded factorization of a GENERAL model: the Hessian of H_nl at x into
+   s->hband; with a pattern (sys.hess_p: a SPARSE model's stepper fallen
+   back to the band LU) its values scattered into the band. */
+PHGMG__PRIV void phgmg__gl3_hess_band(phgmg_gl3 *s, const double *x) {
+  const phgmg_ph_system *sys = &s->sys;
+  const int kb = sys->kb;
+  int j, e;
+  if (!sys->hess_p || sys->storage != PHGMG_SPARSE) { sys->hess_nl(x, s->hband, sys->user); return; }
+  sys->hess_nl(x, s->hv, sys->user);
+  memset(s->hband, 0, sizeof(double) * (size_t)(2 * kb + 1) * (size_t)s->N);
+  for (j = 0; j < s->N; ++j)
+    for (e = sys->hess_p[j]; e < sys->hess_p[j + 1]; ++e) s->hband[PHGMG__PHB(kb, sys->hess_i[e], j)] = s->hv[e];
+}
+
 /* Banded storage: diagonals of J - R and Q, the CSR forms, and the
    workspaces of the stage solver. */
 PHGMG__PRIV phgmg_result phgmg__gl3_setup_banded(phgmg_gl3 *s) {
@@ -10376,7 +10783,11 @@ PHGMG__PRIV phgmg_result phgmg__gl3_setup_banded(phgmg_gl3 *s) {
   const int N = s->N;
   phgmg_result rc;
   int kb = sys->kb;
-  if (s->mode == PHGMG__GL3_SPARSE) {
+  if (s->mode == PHGMG__GL3_SPARSE && (sys->ndamp || sys->nl == PHGMG_NL_GENERAL)) {
+    rc = phgmg__gl3_sparse_ext(s);  /* the Jacobian's extra pattern joined: the stepper's own analysis */
+    if (rc != PHGMG_OK) return rc;
+  }
+  if (s->sps) {
     rc = phgmg__gl3_sparse_qdiag(s);
   } else {
     rc = phgmg__dia_build(&s->al, &s->djr, N, kb, sys->J, sys->R, 0, 0);
@@ -10912,9 +11323,9 @@ PHGMG__PRIV void phgmg__gl3_damp_jac_band(phgmg_gl3 *s, const double *x) {
 /* (Re)factor the shifted Newton matrices at x. */
 /* Sparse LU of both stage matrices (manual 8.12); PHGMG_ERR_SINGULAR when
    a static pivot was replaced or the factors grew beyond PHGMG_SPARSE_GROWTH. */
-PHGMG__PRIV phgmg_result phgmg__gl3_sparse_factor(phgmg_gl3 *s, double sg, double sa, double sb) {
+PHGMG__PRIV phgmg_result phgmg__gl3_sparse_factor(phgmg_gl3 *s, const double *x, double sg, double sa, double sb) {
   const phgmg__spsym *S = s->sps;
-  phgmg__sp_stage_values(S, s->sys.nl == PHGMG_NL_SEPARABLE ? s->dd : NULL, s->spM, s->spw);
+  phgmg__gl3_sparse_jac(s, x);
   if (!phgmg__all_finite(s->spM, (size_t)S->k_p[s->N])) return PHGMG_ERR_NANINF;
   phgmg__sp_factor(S, &s->spf1, s->spM, sg, 0.0, PHGMG_SPARSE_PIVTOL);
   if (s->spf1.nstatic || !(s->spf1.growth <= PHGMG_SPARSE_GROWTH)) return PHGMG_ERR_SINGULAR;
@@ -10983,7 +11394,7 @@ PHGMG__PRIV phgmg_result phgmg__gl3_factor(phgmg_gl3 *s, const double *x) {
     return rc;
   }
   if (s->mode == PHGMG__GL3_SPARSE) {
-    rc = phgmg__gl3_sparse_factor(s, sg, sa, sb);
+    rc = phgmg__gl3_sparse_factor(s, x, sg, sa, sb);
     if (rc != PHGMG_ERR_SINGULAR) return rc;
     rc = phgmg__gl3_sparse_fallback(s); /* static pivots not good enough: band LU */
     if (rc != PHGMG_OK) return rc;
@@ -11028,7 +11439,7 @@ PHGMG__PRIV phgmg_result phgmg__gl3_factor(phgmg_gl3 *s, const double *x) {
     if (sys->nl == PHGMG_NL_SEPARABLE) {
       phgmg__dia_prod_band(&s->djr, NULL, s->dd, -1.0, s->AB1, ld, kv);
     } else if (sys->nl == PHGMG_NL_GENERAL) {
-      sys->hess_nl(x, s->hband, sys->user);
+      phgmg__gl3_hess_band(s, x);
       phgmg__dia_refill(&s->dh, sys->kb, s->hband);
       phgmg__dia_prod_band(&s->djr, &s->dh, NULL, -1.0, s->AB1, ld, kv);
     }
@@ -14265,7 +14676,16 @@ PHGMG__PRIV void phgmg__phi_tramp(int term, phgmg_real s, phgmg_real d[3], void 
   for (k = 0; k < 3; ++k) d[k] = (phgmg_real)phgmg__ph_phi(red->sys, term, (double)s, k);
 }
 
-/* Y (N x r) = Hs X for the Hessian of a GENERAL part, dense or banded like Q. */
+/* Doubles of a GENERAL part's Hessian as hess_nl fills it: dense N x N,
+   banded like Q, or (SPARSE storage) the values of its pattern hess_p. */
+PHGMG__PRIV size_t phgmg__hess_size(const phgmg_ph_system *sys) {
+  const size_t N = (size_t)sys->N;
+  if (sys->storage == PHGMG_SPARSE) return (size_t)sys->hess_p[N] + 1;
+  return sys->storage == PHGMG_BANDED ? (size_t)(2 * sys->kb + 1) * N : N * N;
+}
+
+/* Y (N x r) = Hs X for the Hessian of a GENERAL part, dense, banded like Q,
+   or the values of its pattern (SPARSE storage). */
 PHGMG__PRIV void phgmg__hess_apply(const phgmg_ph_system *sys, const double *Hs, int r, const double *X, double *Y) {
   const int N = sys->N;
   int i, j, a;
@@ -14274,6 +14694,15 @@ PHGMG__PRIV void phgmg__hess_apply(const phgmg_ph_system *sys, const double *Hs,
     return;
   }
   memset(Y, 0, (size_t)N * r * sizeof(double));
+  if (sys->storage == PHGMG_SPARSE) {
+    for (a = 0; a < r; ++a)
+      for (j = 0; j < N; ++j) {
+        const double xj = X[j + (size_t)a * N];
+        if (xj != 0.0)
+          for (i = sys->hess_p[j]; i < sys->hess_p[j + 1]; ++i) Y[sys->hess_i[i] + (size_t)a * N] += Hs[i] * xj;
+      }
+    return;
+  }
   for (a = 0; a < r; ++a)
     for (j = 0; j < N; ++j) {
       const double xj = X[j + (size_t)a * N];
@@ -14290,7 +14719,7 @@ PHGMG__PRIV void phgmg__ham_general(const phgmg_real *x, phgmg_real *Hn, phgmg_r
   phgmg_reduced *red = PHGMG__CAST(phgmg_reduced *, user);
   const phgmg_ph_system *sys = red->sys;
   const int N = red->N, r = red->r, m = red->m, p = red->p, rn = red->rn;
-  const size_t nh = sys->storage == PHGMG_BANDED ? (size_t)(2 * sys->kb + 1) * N : (size_t)N * N;
+  const size_t nh = phgmg__hess_size(sys);
   double *xr = red->gwork, *xf = xr + r, *gf = xf + N, *HN = gf + N, *D = HN + nh, *T = D + (size_t)N * r;
   double *v = T + (size_t)N * r, *D2 = v + rn, *Hr = D2 + (size_t)rn * p * p;
   int a, b, i;
@@ -17084,9 +17513,10 @@ PHGMG__PRIV phgmg_result phgmg__stage_separable_terms(phgmg__rctx *c) {
 PHGMG__PRIV phgmg_result phgmg__stage_general_term(phgmg__rctx *c) {
   phgmg_reduced *red = c->red;
   const int N = red->N, r = red->r;
-  const size_t nh = c->sys->storage == PHGMG_BANDED ? (size_t)(2 * c->sys->kb + 1) * N : (size_t)N * N;
   const size_t rn = (size_t)red->rn, p = (size_t)red->p;
+  size_t nh;
   if (c->sys->nl != PHGMG_NL_GENERAL) return PHGMG_OK;
+  nh = phgmg__hess_size(c->sys);
   c->inf.online_full_dim = 1;
   red->gwork = phgmg__red_d(red, (size_t)r + 2 * (size_t)N + nh + 2 * (size_t)N * r + rn + rn * p * p + (size_t)r * r);
   return red->gwork ? PHGMG_OK : PHGMG_ERR_NOMEM;

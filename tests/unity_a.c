@@ -38,3 +38,4 @@
 #include "test_dae_ports.c"
 #include "test_setup.c"
 #include "test_dae_sparse.c"
+#include "test_sparse_class.c"
