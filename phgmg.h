@@ -23948,7 +23948,11 @@ PHGMG_DEF phgmg_result phgmg_sym_eig(int n, double *A, int lda, double *w, doubl
           - New: >>lowrank (manual 2.8, 8.13): shifted sparse solves on one
             analysis, LR-ADI, low-rank BT (phgmg_lrbt), pH-preserving
             low-rank balancing (phgmg_lrphbt), transfer functions and sampled
-            H-infinity errors of sparse models.
+            H-infinity errors of sparse models; phgmg_balanced_reduce (BT,
+            PRBT, pH-preserving balancing as pH reduced models, sparse or
+            dense), phgmg_ss_to_ph; the command line's reduce --method
+            bt|prbt|phbt (no snapshots). Model files may carry the methods
+            BT and PHBT (header method 7, 8).
           - New: >>mpi with PHGMG_MPI (manual 2.7): distributed context,
             TSQR, POD and streamed POD, DEIM points independent of the
             partition, row-distributed sparse operators, GMG-POD of a linear
