@@ -665,8 +665,23 @@
          Galerkin projection in the energy inner product: Jr skew, Rr >= 0,
          Qr > 0 diagonal (Er = I) by construction, through sparse products
          (never Q^{-1}); less accurate than BT at the same order (8.13).
+     phgmg_balanced_reduce
+         the balancing methods as pH reduced models (a phgmg_reduced:
+         simulate, save, export it like any other), sparse (the low-rank
+         solvers) or dense (phgmg_bt, phgmg_prbt): PHGMG_METHOD_BT (the BT
+         model put in pH form by phgmg_ss_to_ph, when it is passive),
+         PHGMG_METHOD_PRBT (dense: phgmg_prbt; sparse: two stages, the pH
+         Galerkin projection onto the span of the controllability factor,
+         then the dense PRBT of that model), PHGMG_METHOD_PHBT (sparse:
+         phgmg_lrphbt); info: the ranks, residuals, values and bound. The
+         command line's `reduce --method bt|prbt|phbt` is this function
+         (COO input: sparse; dense input: dense);
+     phgmg_ss_to_ph
+         the pH form (K, Qh, Bh = Br) of a passive reduced state-space model
+         (Ar, Br, Cr): Qh the minimal solution of its positive-real lemma.
    The reduced model of phgmg_lrbt (Ar, Br, Cr) is a plain state-space
-   model (as phgmg_bt's), not a pH model. Not yet: index-one E (zero rows/columns:
+   model (as phgmg_bt's), not a pH model (phgmg_ss_to_ph gives its pH form
+   when it is passive). Not yet: index-one E (zero rows/columns:
    PHGMG_ERR_UNSUPPORTED), feedthrough, nonlinear parts. Algorithms and
    measured times: 8.13.
 
@@ -687,7 +702,10 @@
                                eta = M (x2 kron x2), GMG-POD the case r_n = 0.
      PHGMG_METHOD_SP1          baseline: phi = V xr (POD of X), W = QV(V^TQV)^-1.
      PHGMG_METHOD_SP2          baseline: W from a POD of the gradient snapshots.
-     PHGMG_METHOD_PRBT         positive-real balanced truncation (phgmg_prbt only).
+     PHGMG_METHOD_PRBT         positive-real balanced truncation (phgmg_prbt,
+                               phgmg_balanced_reduce).
+     PHGMG_METHOD_BT, _PHBT    balanced truncation in pH form, pH-preserving
+                               balancing (phgmg_balanced_reduce only, 2.8).
 
    3.2 phgmg_reduce_opts
    phgmg_reduce_opts_default fills a struct with these defaults (the library
@@ -1794,6 +1812,46 @@
    frequencies in [1e-2, 1e2]) is within the bound: heat N = 100 489:
    1.3e-2 against 5.4e-2 (11.8 s CPU), lattice N = 100 352: 9.6e-6 against
    5.3e-5 (24 s CPU).
+   pH form of a reduced model (phgmg_ss_to_ph). A reduced state-space model
+   xr' = Ar xr + Br u, y = Cr xr is the pH model xr' = K Qh xr + Br u, y =
+   Br^T Qh xr iff Qh = X > 0 with X Br = Cr^T and K = Ar X^{-1}; K + K^T =
+   X^{-1} (X Ar + Ar^T X) X^{-1} <= 0 iff X solves the positive-real lemma
+   with zero feedthrough, Ar^T X + X Ar <= 0, X Br = Cr^T, which has a
+   solution iff the model is passive (Kalman-Yakubovich-Popov). X Br = Cr^T
+   forces Cr Br = Br^T X Br symmetric: a BT model of a pH model has Cr Br =
+   B^T Q T W^T B, symmetric for a reciprocal model (G = G^T, e.g. a
+   mechanical model with collocated ports: its balanced realization is
+   sign-symmetric) up to round-off and the Gramians' accuracy; that skew
+   part is removed first by the least change of Cr (Frobenius norm) with Cr
+   Br symmetric, Cr <- Cr - skew(Cr Br) (Br^T Br)^{-1} Br^T (reported).
+   Then X = the minimal solution (phgmg__pr_zero_d, the zero-feedthrough
+   limit of the regularised Riccati equation, 8.11), and eigenvalues of K +
+   K^T above 0 by at most 1e-8 of its norm (round-off) are set to 0. A BT
+   model of a passive model need not be passive: where G vanishes at w = 0
+   (velocity outputs of a mass-spring model with on-site springs: G(i w) ~
+   i w B^T K^{-1} B, Re G ~ w^2) the BT error at w = 0 (BT does not match
+   G(0)) can make Re G_r(0) indefinite. On the 8 x 8 lattice of the tests
+   the BT models of orders 8-20 are passive, those of 22-28 are not (min
+   eig(G_r + G_r^H) = -3.8e-5 at w = 0.01, r = 28): phgmg_balanced_reduce
+   then returns PHGMG_ERR_STRUCTURE rather than a model that is not pH.
+   PRBT of a sparse model in two stages (phgmg_balanced_reduce). A low-rank
+   positive-real balancing needs the two positive-real Riccati equations in
+   low-rank form (Newton-Kleinman with low-rank ADI inner solves): not done
+   here. Instead: stage 1, the Galerkin projection in the energy inner
+   product onto V = span(Z_c) (Z_c the controllability factor of LR-ADI,
+   tolerance 1e-10; its compressed columns are orthogonal, normalised here):
+   x = V xi, tested with Q E V: M xi' = (Jr - Rr) xi + Br u with M = V^T Q E
+   V, Jr = skew(V^T Q J Q V), Rr = sym(V^T Q R Q V), Br = V^T Q B, so in z =
+   M xi the model z' = (Jr - Rr) M^{-1} z + Br u, y = Br^T M^{-1} z is pH
+   (Qk = M^{-1}) and passive by construction, of order k = rank(Z_c); V
+   holds the reachable states to the ADI tolerance, and span(Z_c) is a
+   rational Krylov space of (A, B) at the ADI shifts. Stage 2: the dense
+   PRBT (phgmg_prbt, O(k^3)) of that model; the bases composed (x = V
+   M^{-1} V2 xr, xr = W2^T (Q E V)^T x). The positive-real singular values
+   of the 8 x 8 lattice (k = 66, r = 8) equal the dense PRBT's of the full
+   model to 4e-15 (tests/check_cli_lowrank.py). The intermediate model must
+   be passive, which is why stage 1 is this projection and not a BT model
+   (see above).
 
 
    9. CONFIGURATION MACROS (define before including) -----------------------------
@@ -1882,7 +1940,8 @@
    lowrank: phgmg_shifted_create, phgmg_shifted_solve, phgmg_shifted_apply,
            phgmg_shifted_transfer, phgmg_shifted_hinf,
            phgmg_shifted_factorizations, phgmg_shifted_destroy, phgmg_lradi,
-           phgmg_lowrank_free, phgmg_lrbt, phgmg_lrphbt
+           phgmg_lowrank_free, phgmg_lrbt, phgmg_lrphbt, phgmg_ss_to_ph,
+           phgmg_balanced_reduce
    export: phgmg_rom_serialized_size, phgmg_rom_serialize,
            phgmg_rom_deserialize_size, phgmg_rom_deserialize, phgmg_rom_save,
            phgmg_rom_load, phgmg_rom_export_c
@@ -1899,7 +1958,7 @@
            phgmg_lu_rcond, phgmg_norm1, phgmg_normf, phgmg_zlu_factor,
            phgmg_zlu_solve, phgmg_qr, phgmg_qrcp, phgmg_qr_form_q,
            phgmg_qr_apply, phgmg_lstsq, phgmg_svd, phgmg_sym_eig
-   (154 functions; 17 of them only with PHGMG_MPI; also the macros
+   (156 functions; 17 of them only with PHGMG_MPI; also the macros
    PHGMG_ROM_STEPPER_MEMSIZE_MAX and _MAX_CB.)
 */
 #ifndef PHGMG_H_INCLUDED
@@ -2595,6 +2654,8 @@ typedef enum phgmg_method {
   PHGMG_METHOD_SP2 = 4,     /* SP2-POD: W = V_gradH (V_POD^T V_gradH)^-1 (manual 8.8) */
   PHGMG_METHOD_GMG_MANIFOLD = 5, /* your own manifold phi = [B, V1] x + V2 eta(x2), GMG reduction */
   PHGMG_METHOD_PRBT = 6,    /* positive-real balanced truncation, pH form (phgmg_prbt, >>linear) */
+  PHGMG_METHOD_BT = 7,      /* balanced truncation in pH form (phgmg_balanced_reduce, >>lowrank) */
+  PHGMG_METHOD_PHBT = 8,    /* pH-preserving balancing (phgmg_balanced_reduce, >>lowrank)         */
   PHGMG_METHOD_COUNT
 } phgmg_method;
 
@@ -3780,6 +3841,68 @@ PHGMG_DEF phgmg_result phgmg_lrbt(const phgmg_ph_sparse *sp, int r, const phgmg_
 PHGMG_DEF phgmg_result phgmg_lrphbt(const phgmg_ph_sparse *sp, int r, const phgmg_lradi_opts *opts, double *Jr,
                                     double *Rr, double *Qr, double *Br, double *sigma, double *V,
                                     phgmg_lrbt_info *info, const phgmg_allocator *alloc);
+
+/* The pH form of a reduced state-space model xr' = Ar xr + Br u, y = Cr xr
+   (r x r, r x m, m x r; m < r), e.g. from balanced truncation: K, Qh (r x r)
+   with K Qh = Ar, Br^T Qh = Cr, Qh positive definite and K + K^T negative
+   semidefinite, so that xr' = K Qh xr + Br u, y = Br^T Qh xr is the same
+   model as a pH model. Qh is the minimal solution X of the model's
+   positive-real lemma with zero feedthrough (Ar^T X + X Ar <= 0, X Br =
+   Cr^T; manual 8.13), which exists iff the model is passive. Cr Br must be
+   symmetric for X Br = Cr^T: its skew part (round-off, or the accuracy of
+   low-rank Gramians, for a reciprocal model) is removed first by the least
+   change of Cr, Cr <- Cr - skew(Cr Br) (Br^T Br)^{-1} Br^T; eigenvalues of
+   K + K^T above 0 by at most 1e-8 of its norm (round-off) are set to 0.
+   change (may be NULL): the relative size of both changes (||dCr||_F /
+   ||Cr||_F, max |clipped eigenvalue| / ||K + K^T||_2). Errors:
+   PHGMG_ERR_INVALID_ARG (NULL), _SIZE (m < 1 or r <= m), PHGMG_ERR_STRUCTURE
+   (Br of rank below m, sym(Cr Br) not positive definite, or no passive
+   realization: the model is not passive), _NOMEM. */
+PHGMG_DEF phgmg_result phgmg_ss_to_ph(int r, int m, const double *Ar, const double *Br, const double *Cr, double *K,
+                                      double *Qh, double *change, const phgmg_allocator *alloc);
+
+/* What phgmg_balanced_reduce did. */
+typedef struct phgmg_balanced_info {
+  phgmg_lrbt_info lr;  /* low-rank: the ADI runs (ranks, residuals, steps), nhsv, the BT bound
+                          (of the first stage for a two-stage PRBT); dense: nhsv, bound         */
+  int lowrank;         /* 1: low-rank solvers (sparse model), 0: dense solvers                 */
+  int stages;          /* 1, or 2: low-rank BT to order inter, then the dense PRBT (PRBT)       */
+  int inter;           /* the intermediate order of a two-stage PRBT (0: none)                   */
+  double ph_change;    /* BT: the change of phgmg_ss_to_ph (two-stage PRBT: of its first stage) */
+  double res_ctrl, res_obs; /* Lyapunov residuals, relative (low-rank: the ADI's ||W^T W|| /
+                          ||B^T B||; dense: phgmg_lyap_residual's); PHBT: res_obs 0             */
+  int nsv;             /* values written to sv                                                   */
+} phgmg_balanced_info;
+
+/* Balancing-based reduction of a linear pH model to a pH reduced model
+   (phgmg_reduced, kind LINEAR: simulate it, save it, export it like any
+   other), sparse or dense: with sp (a phgmg_ph_sparse; sys ignored) the
+   low-rank solvers, with sys alone (dense or banded storage, standard form,
+   quadratic H) the dense ones. method:
+     PHGMG_METHOD_BT    balanced truncation (phgmg_lrbt / phgmg_bt), the
+                        model put in pH form by phgmg_ss_to_ph (it must be
+                        passive: else PHGMG_ERR_STRUCTURE; PRBT or PHBT then
+                        apply). sv: Hankel singular values; bound 2 sum_{i >
+                        r} sigma_i (low-rank: of the computed ones).
+     PHGMG_METHOD_PRBT  positive-real BT. Dense: phgmg_prbt. Sparse: two
+                        stages (stated in info->stages): low-rank BT to the
+                        order inter = min(max(2 r, r + 20), computed values),
+                        its pH form, then the dense PRBT of that model (manual
+                        8.13). sv: the positive-real singular values of the
+                        last stage.
+     PHGMG_METHOD_PHBT  pH-preserving balancing (phgmg_lrphbt; sparse only,
+                        else PHGMG_ERR_UNSUPPORTED). sv: its values sigma.
+   Lift x = V0 xr (phgmg_reduced_lift; V0 in the sparse object's internal
+   order for sp), restrict xr = W^T x (W^T V0 = I). sv (may be NULL): up to
+   nsv values (info->nsv of them). opts: the ADI options (sparse only; may be
+   NULL). info may be NULL. Errors: PHGMG_ERR_INVALID_ARG (NULL out, both sys
+   and sp NULL, nsv < 0), _UNSUPPORTED (another method, PHBT without sp), the
+   codes of the solvers named, _NOMEM; *out NULL on failure. sp / sys must
+   outlive the model. */
+PHGMG_DEF phgmg_result phgmg_balanced_reduce(phgmg_reduced **out, const phgmg_ph_system *sys,
+                                             const phgmg_ph_sparse *sp, int method, int r,
+                                             const phgmg_lradi_opts *opts, double *sv, int nsv,
+                                             phgmg_balanced_info *info, const phgmg_allocator *alloc);
 
 #ifdef __cplusplus
 }
@@ -13120,6 +13243,8 @@ static const phgmg__method_row phgmg__methods[PHGMG_METHOD_COUNT] = {
   {1, 0, 0, 1, 1},   /* SP2          */
   {1, 1, 1, 0, 0},   /* GMG_MANIFOLD */
   {0, 0, 0, 1, 0},   /* PRBT         */
+  {0, 0, 0, 1, 0},   /* BT           */
+  {0, 0, 0, 1, 0},   /* PHBT         */
 };
 PHGMG__PRIV const phgmg__method_row *phgmg__method(int method) {
   return phgmg__methods + (method > 0 && method < (int)PHGMG_METHOD_COUNT ? method : 0);
@@ -20629,10 +20754,11 @@ PHGMG__PRIV phgmg_result phgmg__lrbt_factors(const phgmg_ph_sparse *sp, const ph
 }
 
 /* The balancing of phgmg_lrbt from the factors: SVD of Zo^T E Zc, the
-   bases T, W (N x r each, into TW), the reduced matrices, the values. */
+   bases T, W (N x r each, into TW), the reduced matrices, the first nsv
+   values (fewer if fewer were computed: inf->nhsv). */
 PHGMG__PRIV phgmg_result phgmg__lrbt_balance(const phgmg_ph_sparse *sp, phgmg_shifted *sc, int r, const double *Zc,
                                              int kc, const double *Zo, int ko, double *TW, double *Ar, double *Br,
-                                             double *Cr, double *hsv, phgmg_lrbt_info *inf,
+                                             double *Cr, double *hsv, int nsv, phgmg_lrbt_info *inf,
                                              const phgmg_allocator *al) {
   const int N = sp->sys.N, m = sp->sys.m, kmin = PHGMG__MIN(kc, ko);
   double *EZ = phgmg__dalloc(al, (size_t)N * (size_t)PHGMG__MAX(kc, r));
@@ -20651,8 +20777,8 @@ PHGMG__PRIV phgmg_result phgmg__lrbt_balance(const phgmg_ph_sparse *sp, phgmg_sh
     const double sc1 = 1.0 / sqrt(S[j]);
     for (i = 0; i < kc; ++i) V[i + (size_t)j * kc] *= sc1;
     for (i = 0; i < ko; ++i) U[i + (size_t)j * ko] *= sc1;
-    if (hsv) hsv[j] = S[j];
   }
+  for (j = 0; hsv && j < PHGMG__MIN(k, nsv); ++j) hsv[j] = S[j];
   phgmg_gemm('N', 'N', N, r, kc, 1.0, Zc, N, V, kc, 0.0, T, N);
   phgmg_gemm('N', 'N', N, r, ko, 1.0, Zo, N, U, ko, 0.0, W, N);
   for (j = 0; j < r; ++j) phgmg__lr_amul(sc->S, T + (size_t)j * N, EZ + (size_t)j * N, sc->w);
@@ -20687,7 +20813,7 @@ PHGMG_DEF phgmg_result phgmg_lrbt(const phgmg_ph_sparse *sp, int r, const phgmg_
   if (rc == PHGMG_OK) {
     phgmg__lr_progress(opts, "balancing");
     TW = phgmg__dalloc(alloc, 2 * (size_t)N * (size_t)r);
-    rc = TW ? phgmg__lrbt_balance(sp, sc, r, Zc, kc, Zo, ko, TW, Ar, Br, Cr, hsv, &inf, alloc) : PHGMG_ERR_NOMEM;
+    rc = TW ? phgmg__lrbt_balance(sp, sc, r, Zc, kc, Zo, ko, TW, Ar, Br, Cr, hsv, r, &inf, alloc) : PHGMG_ERR_NOMEM;
   }
   if (rc == PHGMG_OK && T) memcpy(T, TW, sizeof(double) * (size_t)N * (size_t)r);
   if (rc == PHGMG_OK && W) memcpy(W, TW + (size_t)N * (size_t)r, sizeof(double) * (size_t)N * (size_t)r);
@@ -20798,6 +20924,404 @@ PHGMG_DEF phgmg_result phgmg_lrphbt(const phgmg_ph_sparse *sp, int r, const phgm
     phgmg__lr_progress(opts, "done");
   }
   phgmg__free(alloc, Z); phgmg__free(alloc, T); phgmg__free(alloc, S);
+  if (info) *info = inf;
+  return rc;
+}
+/* >>lowrank: balancing-based reduction to pH reduced models ---------------- */
+
+/* Cs = Cr - skew(Cr Br) (Br^T Br)^{-1} Br^T (m x r), so Cs Br = sym(Cr Br);
+   *d = ||Cs - Cr||_F / ||Cr||_F. PHGMG_ERR_STRUCTURE: Br of rank below m. */
+PHGMG__PRIV phgmg_result phgmg__ph_sym_output(int r, int m, const double *Br, const double *Cr, double *Cs,
+                                              double *d, const phgmg_allocator *al) {
+  const size_t mm = (size_t)m * m;
+  double *M = phgmg__dalloc(al, 3 * mm + (size_t)m * r), *G = M + mm, *Gi = G + mm, *Y = Gi + mm, dn = 0.0, cn;
+  phgmg_result rc;
+  int i, j;
+  if (!M) return PHGMG_ERR_NOMEM;
+  phgmg_gemm('N', 'N', m, m, r, 1.0, Cr, m, Br, r, 0.0, M, m);
+  phgmg_gemm('T', 'N', m, m, r, 1.0, Br, r, Br, r, 0.0, G, m);
+  rc = phgmg__inv(m, G, Gi, al);
+  if (rc == PHGMG_ERR_SINGULAR || rc == PHGMG_ERR_NANINF) rc = PHGMG_ERR_STRUCTURE;
+  if (rc == PHGMG_OK) {
+    for (j = 0; j < m; ++j)
+      for (i = 0; i < m; ++i) G[i + (size_t)j * m] = 0.5 * (M[i + (size_t)j * m] - M[j + (size_t)i * m]);
+    phgmg_gemm('N', 'T', m, r, m, 1.0, Gi, m, Br, r, 0.0, Y, m);
+    memcpy(Cs, Cr, sizeof(double) * (size_t)m * (size_t)r);
+    phgmg_gemm('N', 'N', m, r, m, -1.0, G, m, Y, m, 1.0, Cs, m);
+    for (i = 0; i < m * r; ++i) dn += (Cs[i] - Cr[i]) * (Cs[i] - Cr[i]);
+    cn = phgmg_normf(m, r, Cr, m);
+    *d = cn > 0.0 ? sqrt(dn) / cn : 0.0;
+  }
+  phgmg__free(al, M);
+  return rc;
+}
+
+/* K <- skew(K) - Rc with Rc = -sym(K) whose eigenvalues below 0 by at most
+   1e-8 of its largest modulus are set to 0 (only if there are any); *clip =
+   the largest such modulus relative. PHGMG_ERR_STRUCTURE for a larger one. */
+PHGMG__PRIV phgmg_result phgmg__ph_clip(int r, double *K, double *clip, const phgmg_allocator *al) {
+  const size_t rr = (size_t)r * r;
+  double *R = phgmg__dalloc(al, 2 * rr + r), *V = R + rr, *w = V + rr, wmax;
+  phgmg_result rc;
+  int i, j, k;
+  *clip = 0.0;
+  if (!R) return PHGMG_ERR_NOMEM;
+  for (j = 0; j < r; ++j)
+    for (i = 0; i < r; ++i) R[i + (size_t)j * r] = -0.5 * (K[i + (size_t)j * r] + K[j + (size_t)i * r]);
+  rc = phgmg_sym_eig(r, R, r, w, V, r);
+  wmax = PHGMG__MAX(fabs(w[0]), fabs(w[r - 1]));
+  if (rc == PHGMG_OK && w[0] < -1e-8 * wmax) rc = PHGMG_ERR_STRUCTURE;
+  if (rc == PHGMG_OK && w[0] < 0.0) {
+    *clip = -w[0] / wmax;
+    for (j = 0; j < r; ++j)
+      for (i = 0; i <= j; ++i) {
+        double s = 0.0;
+        for (k = 0; k < r; ++k) s += w[k] > 0.0 ? V[i + (size_t)k * r] * w[k] * V[j + (size_t)k * r] : 0.0;
+        {
+          const double sk = 0.5 * (K[i + (size_t)j * r] - K[j + (size_t)i * r]);
+          K[i + (size_t)j * r] = sk - s;
+          K[j + (size_t)i * r] = -sk - s;
+        }
+      }
+  }
+  phgmg__free(al, R);
+  return rc;
+}
+
+PHGMG_DEF phgmg_result phgmg_ss_to_ph(int r, int m, const double *Ar, const double *Br, const double *Cr, double *K,
+                                      double *Qh, double *change, const phgmg_allocator *alloc) {
+  const size_t rr = (size_t)r * r;
+  double *Cs, *X, *Xi, d = 0.0, clip = 0.0;
+  phgmg_result rc;
+  if (!Ar || !Br || !Cr || !K || !Qh) return PHGMG_ERR_INVALID_ARG;
+  if (m < 1 || r <= m) return PHGMG_ERR_SIZE;
+  Cs = phgmg__dalloc(alloc, (size_t)m * r + 3 * rr);
+  if (!Cs) return PHGMG_ERR_NOMEM;
+  X = Cs + (size_t)m * r; Xi = X + rr;
+  rc = phgmg__ph_sym_output(r, m, Br, Cr, Cs, &d, alloc);
+  if (rc == PHGMG_OK) rc = phgmg__pr_zero_d(r, m, Ar, Br, Cs, X, alloc);
+  if (rc == PHGMG_OK) rc = phgmg__inv(r, X, Xi, alloc);
+  if (rc == PHGMG_OK) {   /* X positive definite */
+    memcpy(Xi + rr, X, rr * sizeof(double));
+    if (phgmg__chol_small(r, Xi + rr) != 0) rc = PHGMG_ERR_STRUCTURE;
+  }
+  if (rc == PHGMG_OK) {
+    phgmg_gemm('N', 'N', r, r, r, 1.0, Ar, r, Xi, r, 0.0, K, r);   /* K = Ar X^{-1} */
+    rc = phgmg__ph_clip(r, K, &clip, alloc);
+  }
+  if (rc == PHGMG_OK) memcpy(Qh, X, rr * sizeof(double));
+  if (rc == PHGMG_ERR_SINGULAR || rc == PHGMG_ERR_NOT_CONVERGED || rc == PHGMG_ERR_NOT_STABILIZABLE ||
+      rc == PHGMG_ERR_NANINF)
+    rc = PHGMG_ERR_STRUCTURE;   /* no passive realization found */
+  if (change) *change = PHGMG__MAX(d, clip);
+  phgmg__free(alloc, Cs);
+  return rc;
+}
+
+/* A LINEAR reduced object of method `method` from its pH blocks and bases
+   (V0, W: N x r), for the system sys. */
+PHGMG__PRIV phgmg_result phgmg__bal_red(phgmg_reduced **out, const phgmg_ph_system *sys, int r, int method,
+                                        const double *K, const double *Qh, const double *Bh, const double *V0,
+                                        const double *W, const phgmg_allocator *alloc) {
+  const int N = sys->N, m = sys->m;
+  phgmg_reduced *red = PHGMG__CAST(phgmg_reduced *, phgmg__alloc(alloc, sizeof(phgmg_reduced)));
+  phgmg_result rc = PHGMG_OK;
+  if (!red) return PHGMG_ERR_NOMEM;
+  memset(red, 0, sizeof *red);
+  if (alloc) { red->alloc = *alloc; red->use_alloc = 1; }
+  red->N = N; red->m = m; red->r = r; red->p = r; red->method = method;
+  red->kind = PHGMG_ROM_LINEAR; red->sys = sys;
+  red->V0 = phgmg__red_d(red, (size_t)N * r);
+  red->W = phgmg__red_d(red, (size_t)N * r);
+  red->Bh = phgmg__red_d(red, (size_t)r * m);
+  red->Qh = phgmg__red_d(red, (size_t)r * r);
+  red->K = phgmg__red_d(red, (size_t)r * r);
+  if (!red->V0 || !red->W || !red->Bh || !red->Qh || !red->K) rc = PHGMG_ERR_NOMEM;
+  if (rc == PHGMG_OK) {
+    memcpy(red->V0, V0, sizeof(double) * (size_t)N * r);
+    memcpy(red->W, W, sizeof(double) * (size_t)N * r);
+    memcpy(red->Bh, Bh, sizeof(double) * (size_t)r * m);
+    memcpy(red->Qh, Qh, sizeof(double) * (size_t)r * r);
+    memcpy(red->K, K, sizeof(double) * (size_t)r * r);
+    rc = phgmg__publish(red);
+  }
+  if (rc != PHGMG_OK) { phgmg_reduced_destroy(red); return rc; }
+  *out = red;
+  return PHGMG_OK;
+}
+
+/* Low-rank BT of sp to order r into *blk = [T (N r), W (N r), Ar (r r), Br
+   (r m), Cr (m r)] (allocated here); the first nsv values into sv. */
+PHGMG__PRIV phgmg_result phgmg__bal_lr_stage(const phgmg_ph_sparse *sp, const phgmg_lradi_opts *opts, int r,
+                                             double *sv, int nsv, double **blk, phgmg_balanced_info *inf,
+                                             const phgmg_allocator *al) {
+  const int N = sp->sys.N, m = sp->sys.m;
+  const size_t nr = (size_t)N * r, q = (size_t)r * r, rm = (size_t)r * m;
+  phgmg_shifted *sc = NULL;
+  double *Zc = NULL, *Zo = NULL, *Ar;
+  int kc = 0, ko = 0;
+  phgmg_result rc = phgmg_shifted_create(&sc, sp, 0, 0, al);
+  *blk = NULL;
+  if (rc == PHGMG_OK) rc = phgmg__lrbt_factors(sp, opts, sc, &Zc, &kc, &Zo, &ko, &inf->lr, al);
+  if (rc == PHGMG_OK) {
+    phgmg__lr_progress(opts, "balancing");
+    *blk = phgmg__dalloc(al, 2 * nr + q + 2 * rm);
+    Ar = *blk ? *blk + 2 * nr : NULL;
+    rc = Ar ? phgmg__lrbt_balance(sp, sc, r, Zc, kc, Zo, ko, *blk, Ar, Ar + q, Ar + q + rm, sv, nsv, &inf->lr, al)
+            : PHGMG_ERR_NOMEM;
+  }
+  inf->lowrank = 1;
+  inf->res_ctrl = inf->lr.ctrl.res;
+  inf->res_obs = inf->lr.obs.res;
+  inf->nsv = PHGMG__MIN(inf->lr.nhsv, nsv);
+  phgmg__free(al, Zc); phgmg__free(al, Zo);
+  phgmg_shifted_destroy(sc);
+  return rc;
+}
+
+/* The first stage of the sparse PRBT: the Galerkin projection in the energy
+   inner product onto V = the controllability factor's span (its columns
+   normalised: the compressed factor's columns are orthogonal), a pH model
+   of order k = its rank: M = V^T Q E V, Jr = skew(V^T Q J Q V), Rr =
+   sym(V^T Q R Q V), Br = V^T Q B, in z = M xi: Qk = M^{-1}; lift x = V M^{-1}
+   z, restrict z = (Q E V)^T x. Into blk = [V0 (N k), W (N k), Jr, Rr, Qk (k
+   k each), Br (k m)] (allocated here). */
+PHGMG__PRIV phgmg_result phgmg__bal_pr_stage1(const phgmg_ph_sparse *sp, const phgmg_lradi_opts *opts, int *k,
+                                              double **blk, phgmg_balanced_info *inf, const phgmg_allocator *al) {
+  const int N = sp->sys.N, m = sp->sys.m;
+  phgmg_shifted *sc = NULL;
+  double *Z = NULL, *V0, *W, *Jr, *Rr, *Qk, *Br, *M;
+  phgmg_result rc = phgmg_shifted_create(&sc, sp, 0, 0, al);
+  int i, j, kk;
+  *blk = NULL;
+  if (rc == PHGMG_OK) {
+    phgmg__lr_progress(opts, "controllability Gramian");
+    rc = phgmg_lradi(sc, m, sp->sys.B, N, opts, &Z, k, &inf->lr.ctrl, al);
+  }
+  phgmg_shifted_destroy(sc);
+  inf->lowrank = 1;
+  inf->res_ctrl = inf->lr.ctrl.res;
+  if (rc != PHGMG_OK) return rc;
+  phgmg__lr_progress(opts, "projection");
+  kk = *k;
+  *blk = phgmg__dalloc(al, 2 * (size_t)N * kk + 4 * (size_t)kk * kk + (size_t)kk * m);
+  if (!*blk) { phgmg__free(al, Z); return PHGMG_ERR_NOMEM; }
+  V0 = *blk; W = V0 + (size_t)N * kk; Jr = W + (size_t)N * kk; Rr = Jr + (size_t)kk * kk; Qk = Rr + (size_t)kk * kk;
+  M = Qk + (size_t)kk * kk; Br = M + (size_t)kk * kk;
+  for (j = 0; j < kk; ++j) {   /* V = Z normalised (into Z), W = Q E V */
+    double *v = Z + (size_t)j * N, *w = W + (size_t)j * N;
+    const double nv = phgmg_normf(N, 1, v, N);
+    for (i = 0; i < N; ++i) v[i] /= nv;
+    if (sp->cp[3]) { phgmg__lr_cscmv(sp, 3, v, V0); phgmg__lr_cscmv(sp, 2, V0, w); }
+    else phgmg__lr_cscmv(sp, 2, v, w);
+  }
+  rc = phgmg__lrph_project(sp, kk, Z, Jr, Rr, Br, al);
+  if (rc == PHGMG_OK) {
+    phgmg_gemm('T', 'N', kk, kk, N, 1.0, Z, N, W, N, 0.0, M, kk);   /* M = V^T Q E V */
+    rc = phgmg__inv(kk, M, Qk, al);
+  }
+  if (rc == PHGMG_OK) {
+    for (j = 0; j < kk; ++j)
+      for (i = 0; i < j; ++i) {
+        const double t = 0.5 * (Qk[i + (size_t)j * kk] + Qk[j + (size_t)i * kk]);
+        Qk[i + (size_t)j * kk] = t; Qk[j + (size_t)i * kk] = t;
+      }
+    phgmg_gemm('N', 'N', N, kk, kk, 1.0, Z, N, Qk, kk, 0.0, V0, N);   /* V0 = V M^{-1} */
+  }
+  phgmg__free(al, Z);
+  return rc;
+}
+
+/* Sparse PRBT in two stages: phgmg__bal_pr_stage1 (order k, passive by
+   construction), then the dense PRBT of that model; the bases composed. */
+PHGMG__PRIV phgmg_result phgmg__bal_sparse_prbt(phgmg_reduced **out, const phgmg_ph_sparse *sp, int r,
+                                                const phgmg_lradi_opts *opts, double *sv, int nsv,
+                                                phgmg_balanced_info *inf, const phgmg_allocator *al) {
+  const int N = sp->sys.N, m = sp->sys.m;
+  double *blk = NULL, *V0 = NULL, *W0;
+  phgmg_reduced *red2 = NULL;
+  phgmg_ph_system s2;
+  int k = 0;
+  phgmg_result rc = phgmg__bal_pr_stage1(sp, opts, &k, &blk, inf, al);
+  inf->stages = 2; inf->inter = k;
+  if (rc == PHGMG_OK && k < r) rc = PHGMG_ERR_RANK;
+  if (rc == PHGMG_OK) {
+    const size_t kk = (size_t)k * k;
+    memset(&s2, 0, sizeof s2);
+    s2.N = k; s2.m = m; s2.J = blk + 2 * (size_t)N * k; s2.R = s2.J + kk; s2.Q = s2.R + kk; s2.B = s2.Q + 2 * kk;
+    phgmg__lr_progress(opts, "dense PRBT");
+    rc = phgmg_prbt(&red2, &s2, r, NULL, NULL, NULL, al);
+  }
+  if (rc == PHGMG_OK) {
+    V0 = phgmg__dalloc(al, 2 * (size_t)N * r);
+    if (!V0) rc = PHGMG_ERR_NOMEM;
+  }
+  if (rc == PHGMG_OK) {
+    W0 = V0 + (size_t)N * r;
+    phgmg_gemm('N', 'N', N, r, k, 1.0, blk, N, red2->V0, k, 0.0, V0, N);
+    phgmg_gemm('N', 'N', N, r, k, 1.0, blk + (size_t)N * k, N, red2->W, k, 0.0, W0, N);
+    rc = phgmg__bal_red(out, &sp->sys, r, PHGMG_METHOD_PRBT, red2->K, red2->Qh, red2->Bh, V0, W0, al);
+    {   /* the positive-real singular values: Qh = Sigma of the dense PRBT */
+      int j;
+      inf->nsv = PHGMG__MIN(r, nsv);
+      for (j = 0; j < inf->nsv; ++j) sv[j] = red2->Qh[j + (size_t)j * r];
+    }
+  }
+  phgmg_reduced_destroy(red2);
+  phgmg__free(al, blk); phgmg__free(al, V0);
+  return rc;
+}
+
+/* Sparse BT to a pH reduced object (phgmg_lrbt, phgmg_ss_to_ph). */
+PHGMG__PRIV phgmg_result phgmg__bal_sparse_bt(phgmg_reduced **out, const phgmg_ph_sparse *sp, int r,
+                                              const phgmg_lradi_opts *opts, double *sv, int nsv,
+                                              phgmg_balanced_info *inf, const phgmg_allocator *al) {
+  const int N = sp->sys.N, m = sp->sys.m, k = r;
+  double *blk = NULL, *KQ = NULL, *T, *W, *Ar;
+  phgmg_result rc = phgmg__bal_lr_stage(sp, opts, r, sv, nsv, &blk, inf, al);
+  if (rc == PHGMG_OK) {
+    T = blk; W = T + (size_t)N * k; Ar = W + (size_t)N * k;
+    KQ = phgmg__dalloc(al, 2 * (size_t)k * k);
+    rc = KQ ? phgmg_ss_to_ph(k, m, Ar, Ar + (size_t)k * k, Ar + (size_t)k * (k + m), KQ, KQ + (size_t)k * k,
+                             &inf->ph_change, al)
+            : PHGMG_ERR_NOMEM;
+    if (rc == PHGMG_OK)
+      rc = phgmg__bal_red(out, &sp->sys, r, PHGMG_METHOD_BT, KQ, KQ + (size_t)k * k, Ar + (size_t)k * k, T, W, al);
+  }
+  phgmg__free(al, blk); phgmg__free(al, KQ);
+  return rc;
+}
+
+/* Sparse pH-preserving balancing (phgmg_lrphbt) to a reduced object: K = Jr
+   - Rr, Qh = Qr, V0 = V, W = Q E T (T = V Sigma: W^T V0 = I). */
+PHGMG__PRIV phgmg_result phgmg__bal_sparse_phbt(phgmg_reduced **out, const phgmg_ph_sparse *sp, int r,
+                                                const phgmg_lradi_opts *opts, double *sv, int nsv,
+                                                phgmg_balanced_info *inf, const phgmg_allocator *al) {
+  const int N = sp->sys.N, m = sp->sys.m;
+  const size_t rr = (size_t)r * r;
+  double *Jr = phgmg__dalloc(al, 3 * rr + (size_t)r * m + r + 3 * (size_t)N * r), *Rr = Jr + rr, *Qr = Rr + rr,
+         *Br = Qr + rr, *sg = Br + (size_t)r * m, *V = sg + r, *W = V + (size_t)N * r, *t = W + (size_t)N * r;
+  phgmg_result rc;
+  int i, j;
+  if (!Jr) return PHGMG_ERR_NOMEM;
+  rc = phgmg_lrphbt(sp, r, opts, Jr, Rr, Qr, Br, sg, V, &inf->lr, al);
+  inf->lowrank = 1;
+  inf->res_ctrl = inf->lr.ctrl.res;
+  if (rc == PHGMG_OK) {
+    for (i = 0; i < (int)rr; ++i) Jr[i] -= Rr[i];   /* K = Jr - Rr */
+    for (j = 0; j < r; ++j) {
+      const double *v = V + (size_t)j * N;
+      double *w = W + (size_t)j * N;
+      if (sp->cp[3]) { phgmg__lr_cscmv(sp, 3, v, t); phgmg__lr_cscmv(sp, 2, t, w); }
+      else phgmg__lr_cscmv(sp, 2, v, w);
+      for (i = 0; i < N; ++i) w[i] *= sg[j];
+    }
+    rc = phgmg__bal_red(out, &sp->sys, r, PHGMG_METHOD_PHBT, Jr, Qr, Br, V, W, al);
+    inf->nsv = PHGMG__MIN(r, nsv);
+    if (sv) memcpy(sv, sg, sizeof(double) * (size_t)inf->nsv);
+  }
+  phgmg__free(al, Jr);
+  return rc;
+}
+
+/* The dense Gramians' Hankel singular values (all N, descending: sqrt(eig(L^T
+   O L)), P = L L^T), the Lyapunov residuals and the BT bound at order r. */
+PHGMG__PRIV phgmg_result phgmg__bal_dense_values(const phgmg_ph_system *sys, int r, double *sv, int nsv,
+                                                 phgmg_balanced_info *inf, const phgmg_allocator *al) {
+  const int N = sys->N, m = sys->m;
+  const size_t nn = (size_t)N * N;
+  double *A = phgmg__dalloc(al, 5 * nn + (size_t)m * N + N), *F = A + nn, *P = F + nn, *O = P + nn, *U = O + nn,
+         *C = U + nn, *w = C + (size_t)m * N;
+  phgmg_result rc;
+  int i, j;
+  if (!A) return PHGMG_ERR_NOMEM;
+  rc = phgmg_ph_abc(sys, A, C, al);
+  if (rc == PHGMG_OK) {
+    phgmg_gemm('N', 'T', N, N, m, 1.0, sys->B, N, sys->B, N, 0.0, F, N);
+    rc = phgmg_lyap(N, A, F, P, NULL, al);
+    if (rc == PHGMG_OK) inf->res_ctrl = phgmg_lyap_residual(N, A, F, P, al);
+  }
+  if (rc == PHGMG_OK) {
+    for (j = 0; j < N; ++j)
+      for (i = 0; i < N; ++i) U[i + (size_t)j * N] = A[j + (size_t)i * N];
+    phgmg_gemm('T', 'N', N, N, m, 1.0, C, m, C, m, 0.0, F, N);
+    rc = phgmg_lyap(N, U, F, O, NULL, al);
+    if (rc == PHGMG_OK) inf->res_obs = phgmg_lyap_residual(N, U, F, O, al);
+  }
+  if (rc == PHGMG_OK) rc = phgmg_sym_eig(N, P, N, w, U, N);
+  if (rc == PHGMG_OK) {   /* L = U sqrt(w+), M = L^T O L */
+    for (j = 0; j < N; ++j) {
+      const double s = sqrt(w[j] > 0.0 ? w[j] : 0.0);
+      for (i = 0; i < N; ++i) U[i + (size_t)j * N] *= s;
+    }
+    phgmg_gemm('N', 'N', N, N, N, 1.0, O, N, U, N, 0.0, A, N);
+    phgmg_gemm('T', 'N', N, N, N, 1.0, U, N, A, N, 0.0, P, N);
+    rc = phgmg_sym_eig(N, P, N, w, NULL, 0);
+  }
+  if (rc == PHGMG_OK) {
+    inf->lr.bound = 0.0;
+    inf->lr.nhsv = 0;
+    for (i = 0; i < N; ++i) {
+      const double s = sqrt(w[N - 1 - i] > 0.0 ? w[N - 1 - i] : 0.0);
+      if (s > 0.0) inf->lr.nhsv = i + 1;
+      if (i >= r) inf->lr.bound += 2.0 * s;
+      if (i == r) inf->lr.hsv_tail = s;
+      if (sv && i < nsv) sv[i] = s;
+    }
+    inf->nsv = PHGMG__MIN(inf->lr.nhsv, nsv);
+  }
+  phgmg__free(al, A);
+  return rc;
+}
+
+/* Dense BT (phgmg_bt) to a pH reduced object (phgmg_ss_to_ph). */
+PHGMG__PRIV phgmg_result phgmg__bal_dense_bt(phgmg_reduced **out, const phgmg_ph_system *sys, int r, double *sv,
+                                             int nsv, phgmg_balanced_info *inf, const phgmg_allocator *al) {
+  const int N = sys->N, m = sys->m;
+  const size_t rr = (size_t)r * r;
+  double *T = phgmg__dalloc(al, 2 * (size_t)N * r + 3 * rr + 2 * (size_t)r * m), *W = T + (size_t)N * r,
+         *Ar = W + (size_t)N * r, *K = Ar + rr, *Qh = K + rr, *Br = Qh + rr, *Cr = Br + (size_t)r * m;
+  phgmg_result rc;
+  if (!T) return PHGMG_ERR_NOMEM;
+  rc = phgmg_bt(sys, r, Ar, Br, Cr, NULL, T, W, al);
+  if (rc == PHGMG_OK) rc = phgmg__bal_dense_values(sys, r, sv, nsv, inf, al);
+  if (rc == PHGMG_OK) rc = phgmg_ss_to_ph(r, m, Ar, Br, Cr, K, Qh, &inf->ph_change, al);
+  if (rc == PHGMG_OK) rc = phgmg__bal_red(out, sys, r, PHGMG_METHOD_BT, K, Qh, Br, T, W, al);
+  phgmg__free(al, T);
+  return rc;
+}
+
+PHGMG_DEF phgmg_result phgmg_balanced_reduce(phgmg_reduced **out, const phgmg_ph_system *sys,
+                                             const phgmg_ph_sparse *sp, int method, int r,
+                                             const phgmg_lradi_opts *opts, double *sv, int nsv,
+                                             phgmg_balanced_info *info, const phgmg_allocator *alloc) {
+  phgmg_balanced_info inf;
+  phgmg_result rc;
+  const phgmg_ph_system *s;
+  memset(&inf, 0, sizeof inf);
+  inf.stages = 1;
+  if (info) *info = inf;
+  if (!out) return PHGMG_ERR_INVALID_ARG;
+  *out = NULL;
+  if ((!sys && !sp) || nsv < 0) return PHGMG_ERR_INVALID_ARG;
+  if (!sv) nsv = 0;
+  if (method != PHGMG_METHOD_BT && method != PHGMG_METHOD_PRBT && method != PHGMG_METHOD_PHBT)
+    return PHGMG_ERR_UNSUPPORTED;
+  if (!sp && method == PHGMG_METHOD_PHBT) return PHGMG_ERR_UNSUPPORTED;
+  s = sp ? &sp->sys : sys;
+  if (r < 1 || r > s->N || (method != PHGMG_METHOD_PHBT && r <= s->m)) return PHGMG_ERR_SIZE;
+  if (sp && method == PHGMG_METHOD_PHBT) rc = phgmg__bal_sparse_phbt(out, sp, r, opts, sv, nsv, &inf, alloc);
+  else if (sp && method == PHGMG_METHOD_BT) rc = phgmg__bal_sparse_bt(out, sp, r, opts, sv, nsv, &inf, alloc);
+  else if (sp) rc = phgmg__bal_sparse_prbt(out, sp, r, opts, sv, nsv, &inf, alloc);
+  else if (method == PHGMG_METHOD_BT) rc = phgmg__bal_dense_bt(out, sys, r, sv, nsv, &inf, alloc);
+  else {
+    double *ps = phgmg__dalloc(alloc, (size_t)r);
+    rc = ps ? phgmg_prbt(out, sys, r, NULL, ps, NULL, alloc) : PHGMG_ERR_NOMEM;
+    inf.nsv = rc == PHGMG_OK ? PHGMG__MIN(r, nsv) : 0;
+    if (rc == PHGMG_OK && nsv) memcpy(sv, ps, sizeof(double) * (size_t)inf.nsv);
+    phgmg__free(alloc, ps);
+  }
+  if (rc != PHGMG_OK && *out) { phgmg_reduced_destroy(*out); *out = NULL; }
   if (info) *info = inf;
   return rc;
 }
@@ -21026,7 +21550,7 @@ PHGMG__ONLINE phgmg_result phgmg__rom_header(const unsigned char *b, size_t len,
   }
   if (phgmg__get32(b + 24) > 4096u || phgmg__get32(b + 28) > 4096u || phgmg__get32(b + 32) > 4096u ||
       phgmg__get32(b + 36) > (1u << 24) || phgmg__get32(b + 40) > 32u || phgmg__get32(b + 16) > 2u ||
-      phgmg__get32(b + 20) > 6u)
+      phgmg__get32(b + 20) >= (unsigned)PHGMG_METHOD_COUNT)
     return PHGMG_ERR_FORMAT;
   rom->kind = (int)phgmg__get32(b + 16);
   rom->method = (int)phgmg__get32(b + 20);
@@ -24414,7 +24938,11 @@ PHGMG_DEF phgmg_result phgmg_sym_eig(int n, double *A, int lda, double *w, doubl
           - New: >>lowrank (manual 2.8, 8.13): shifted sparse solves on one
             analysis, LR-ADI, low-rank BT (phgmg_lrbt), pH-preserving
             low-rank balancing (phgmg_lrphbt), transfer functions and sampled
-            H-infinity errors of sparse models.
+            H-infinity errors of sparse models; phgmg_balanced_reduce (BT,
+            PRBT, pH-preserving balancing as pH reduced models, sparse or
+            dense), phgmg_ss_to_ph; the command line's reduce --method
+            bt|prbt|phbt (no snapshots). Model files may carry the methods
+            BT and PHBT (header method 7, 8).
           - New: >>mpi with PHGMG_MPI (manual 2.7): distributed context,
             TSQR, POD and streamed POD, DEIM points independent of the
             partition, row-distributed sparse operators, GMG-POD of a linear

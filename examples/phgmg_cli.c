@@ -45,6 +45,8 @@ static const char *const help_lines[] = {
   "               [--manifold pod|greedy|altmin] [--train-input KIND]...\n",
   "               [--poly coeffs.npy --poly-idx idx.npy [--poly-w w.npy]] [DEIM options]\n",
   "               --out DIR [--name rom] [--dt-map DT] [--save-snapshots] [--quiet]\n",
+  "  phgmg reduce <the model options> --method bt|prbt|phbt --r R --out DIR [--name rom]\n",
+  "               (balancing of a linear model: no snapshots; see BALANCING METHODS)\n",
   "  phgmg simulate <the model options of reduce> --out y.npy [--states x.npy]\n",
   "               [--dt 0.1] [--steps 1000] [--input sin] [--amp 0.1] [--quiet]\n",
   "  phgmg simulate-rom --model DIR/NAME.phgmgrom --out y.npy [--states xr.npy]\n",
@@ -151,6 +153,8 @@ static const char *const help_lines[] = {
   "                               (paper 4.2.2)\n",
   "                      sp1:     SP1-POD, phi = V x, W = QV (V^T Q V)^-1 (baseline)\n",
   "                      sp2:     SP2-POD, W from a POD of the gradient snapshots\n",
+  "                      bt, prbt, phbt: balancing of a linear model, no snapshots\n",
+  "                               (see BALANCING METHODS)\n",
   "                      (required)\n",
   "  --r R               reduced order (required). For gmg-pod/gmg-qm it includes the m\n",
   "                      port coordinates, so m < R <= N; R - m (gmg) or R (sp1/sp2) must\n",
@@ -325,6 +329,39 @@ static const char *const help_lines[] = {
   "    c = A.tocoo(); np.save('J_rows.npy', c.row); np.save('J_cols.npy', c.col)\n",
   "    np.save('J_vals.npy', c.data)     # --J-coo J_rows.npy,J_cols.npy,J_vals.npy\n",
   "    np.save('J.npy', np.column_stack([c.row, c.col, c.data]))   # --J-coo J.npy\n",
+  "\n",
+  "BALANCING METHODS (--method bt, prbt, phbt)\n",
+  "  Input-independent reduction of a linear model (no --X, no --simulate, no\n",
+  "  nonlinear part, dampers or feedthrough) from its matrices alone. The solvers\n",
+  "  follow the input's form: a model given by --J-coo/--R-coo/--Q-coo (and\n",
+  "  --E-coo, a mass matrix of full rank) goes to the low-rank solvers -- Gramian\n",
+  "  factors by low-rank ADI on sparse LU factorizations (tolerance 1e-10), no\n",
+  "  N x N matrix, for N up to 10^5 and more -- a model given by --J/--R/--Q (dense,\n",
+  "  standard form) to the dense solvers (O(N^3): up to a few thousand states).\n",
+  "    bt    balanced truncation (needs m < R); the H-infinity error bound\n",
+  "          2 sum_{i>R} sigma_i (low-rank: over the values computed) in the log\n",
+  "          and NAME.json. The reduced model is written in pH form (NAME_K,\n",
+  "          NAME_Qh, NAME_Bh: K Qh, Bh, Bh^T Qh are the BT model's matrices, Qh a\n",
+  "          solution of its positive-real lemma): that needs the BT model to be\n",
+  "          passive; when it is not (it can happen near w = 0 for models whose\n",
+  "          transfer function vanishes there) the run fails and says so: use\n",
+  "          prbt or phbt, or another R.\n",
+  "    prbt  positive-real balanced truncation (needs m < R): a passive pH\n",
+  "          reduced model by construction. Sparse input: two stages, stated in\n",
+  "          the log and NAME.json -- the pH Galerkin projection onto the span\n",
+  "          of the controllability Gramian's low-rank factor, then the dense\n",
+  "          PRBT of that model (order: the factor's rank, typically 50-200).\n",
+  "    phbt  pH-preserving balancing with one Lyapunov equation (sparse input\n",
+  "          only): pH by construction, no error bound, less accurate than bt.\n",
+  "  NAME.json's \"info\" holds the solver (low-rank or dense), the Gramian\n",
+  "  factors' ranks, ADI steps and factorizations, the Lyapunov residuals\n",
+  "  (relative), the singular values (first 64) and, for bt, \"error_bound\". The\n",
+  "  log shows every phase (Gramians, shifts, balancing) that starts after the\n",
+  "  first second. The model files are the usual ones; simulate-rom runs them.\n",
+  "  Example (a 2-D model with 10^5 states, one core: about 10 s for heat,\n",
+  "  90 s for a mass-spring lattice):\n",
+  "    phgmg reduce --J-coo J.npy --R-coo R.npy --Q-coo Q.npy --B B.npy \\\n",
+  "          --method bt --r 20 --out out --name bt\n",
   "\n",
   "INPUT FILES (.npy)\n",
   "  Read: format versions 1.0-3.0, float64, float32, int8-int64, uint8-uint64 or\n",
@@ -1378,6 +1415,9 @@ static int input_opt_find(const char *o, int simulate) {
 
 static const char *method_name(int m) {
   switch (m) {
+    case PHGMG_METHOD_BT: return "bt";
+    case PHGMG_METHOD_PRBT: return "prbt";
+    case PHGMG_METHOD_PHBT: return "phbt";
     case PHGMG_METHOD_GMG_POD: return "gmg-pod";
     case PHGMG_METHOD_GMG_QM: return "gmg-qm";
     case PHGMG_METHOD_SP1: return "sp1";
@@ -1615,12 +1655,38 @@ static int check_model_opts(const char *cmd, const reduce_args *A) {
   return 0;
 }
 
+/* --method bt, prbt or phbt: balancing, computed from the matrices alone. */
+static int balancing_method(const char *m) { return !strcmp(m, "bt") || !strcmp(m, "prbt") || !strcmp(m, "phbt"); }
+
+/* The options of a balancing method: a linear model and the outputs; every
+   option about snapshots, training runs or nonlinear terms is refused. 0 or
+   the usage status 2. */
+static int check_balancing_args(reduce_args *A, const char *const *seen, int nseen) {
+  static const char *const refused[] = {"--simulate", "--input", "--steps",
+                                        "--amp", "--dt", "--dt-map", "--save-snapshots", "--poly-idx", "--dampers",
+                                        "--P", "--S", "--N", "--ref", "--rn", "--lambda", "--manifold", "--hyper",
+                                        "--no-hyper", "--greedy-window", "--degeneracy-tol", NULL};
+  int k;
+  if (A->X || A->nxin || A->ntrain)
+    return usage_error("reduce: --method %s computes the reduced model from the linear model's matrices: %s "
+                       "does not apply (no snapshots)", A->method, A->X ? "--X" : A->nxin ? "--X-input" : "--train-input");
+  for (k = 0; refused[k]; ++k)
+    if (given(refused[k], seen, nseen))
+      return usage_error("reduce: --method %s computes the reduced model from the linear model's matrices: %s "
+                         "does not apply (no snapshots, no nonlinear part, dampers or feedthrough)", A->method,
+                         refused[k]);
+  if (name_problem(A->name)) return usage_error("--name '%s': %s", A->name, name_problem(A->name));
+  A->input = "sin";
+  return 0;
+}
+
 static int check_reduce_args(reduce_args *A, const char *const *seen, int nseen) {
   int e;
   if ((e = check_model_opts("reduce", A)) != 0) return e;
-  if (!A->method) return usage_error("reduce: --method is required (gmg-pod, gmg-qm, sp1 or sp2)");
+  if (!A->method) return usage_error("reduce: --method is required (gmg-pod, gmg-qm, sp1, sp2, bt, prbt or phbt)");
   if (!A->r) return usage_error("reduce: --r is required");
   if (!A->out) return usage_error("reduce: --out DIR is required");
+  if (balancing_method(A->method)) return check_balancing_args(A, seen, nseen);
   if (!!A->X == !!A->simulate) return usage_error("reduce: give exactly one of --X FILE and --simulate");
   if (A->hyper && strcmp(A->hyper, "ecsw") && strcmp(A->hyper, "qdeim") && strcmp(A->hyper, "greedy"))
     return usage_error("--hyper '%s': expected ecsw, qdeim or greedy", A->hyper);
@@ -1785,6 +1851,9 @@ typedef struct reduce_state {
   staged sg; /* the outputs, renamed into place at the end */
   outlist ol; /* the arrays written */
   pathset pin, pout; /* the files read; the files the run may write */
+  int bal_on;               /* --method bt, prbt, phbt: what the balancing did */
+  phgmg_balanced_info bal;
+  double bal_sv[64];        /* its first values (bal.nsv) */
 } reduce_state;
 
 /* Is w phi(s), phi(s) = sum_j c_j s^j + sum_e a_e exp(b_e s), bounded below
@@ -2667,6 +2736,8 @@ static int check_sizes(const reduce_args *A, int method, int N, int m, int k) {
       return usage_error("--rn %d: gmg-qm needs r + r_n <= N (N = %s)", A->rn, nd);
     if (method == PHGMG_METHOD_GMG_QM && A->r >= N)
       return usage_error("--r %d: gmg-qm needs r < N (N = %s): room for at least one quadratic mode", A->r, nd);
+  } else if ((method == PHGMG_METHOD_BT || method == PHGMG_METHOD_PRBT) && (A->r <= m || A->r > N)) {
+    return usage_error("--r %d: %s needs m < r <= N (m = %d ports from %s, N = %s)", A->r, A->method, m, A->B, nd);
   } else if (A->r > N) {
     return usage_error("--r %d: needs r <= N = %s", A->r, nd);
   }
@@ -3022,6 +3093,35 @@ static void json_options(FILE *jf, const reduce_args *A, const reduce_state *S, 
   fprintf(jf, "},\n");
 }
 
+/* The json record's "info" of a balancing method (opened, not closed): the
+   solvers, the Gramian factors' ranks and residuals, the values, the bound. */
+static void json_balancing(FILE *jf, const reduce_state *S, int method) {
+  const phgmg_balanced_info *b = &S->bal;
+  int i;
+  fprintf(jf, "{\"solver\": \"%s\", \"stages\": %d", b->lowrank ? "low-rank" : "dense", b->stages);
+  if (b->stages == 2) fprintf(jf, ", \"intermediate_order\": %d", b->inter);
+  if (b->lowrank) {   /* one Lyapunov equation for prbt and phbt: the second entries 0 */
+    fprintf(jf, ", \"gramian_rank\": [%d, %d], \"adi_steps\": [%d, %d], \"factorizations\": [%d, %d]",
+            b->lr.ctrl.rank, b->lr.obs.rank, b->lr.ctrl.iters, b->lr.obs.iters, b->lr.ctrl.factorizations,
+            b->lr.obs.factorizations);
+  }
+  if (method != PHGMG_METHOD_PRBT || b->lowrank) {
+    fprintf(jf, ", \"lyapunov_residual\": ["); json_num(jf, b->res_ctrl);
+    fprintf(jf, ", "); json_num(jf, b->res_obs); fprintf(jf, "]");
+  }
+  if (method != PHGMG_METHOD_PRBT) fprintf(jf, ", \"values_computed\": %d", b->lr.nhsv);
+  fprintf(jf, ", \"%s\": [", method == PHGMG_METHOD_BT ? "hankel_singular_values"
+                            : method == PHGMG_METHOD_PRBT ? "positive_real_singular_values" : "energy_singular_values");
+  for (i = 0; i < b->nsv; ++i) { if (i) fprintf(jf, ", "); json_num(jf, S->bal_sv[i]); }
+  fprintf(jf, "]");
+  if (method == PHGMG_METHOD_BT) {
+    fprintf(jf, ", \"error_bound\": ");
+    json_num(jf, b->lr.bound);
+    fprintf(jf, ", \"ph_form_change\": "); json_num(jf, b->ph_change);
+  }
+}
+
+static int write_json_tail(FILE *jf, const reduce_args *A, reduce_state *S, const outlist *ol, const char *path);
 static int write_json(const reduce_args *A, reduce_state *S, int method, int ns, double t_sim, double t_red,
                       const phgmg_reduce_opts *o, const phgmg_reduce_info *info, const outlist *ol) {
   const phgmg_rom *rom = phgmg_reduced_rom(S->red);
@@ -3029,7 +3129,6 @@ static int write_json(const reduce_args *A, reduce_state *S, int method, int ns,
   char path[4096 + 256];
   const char *wp;
   FILE *jf;
-  int i;
   snprintf(path, sizeof path, "%s/%s.json", A->out, A->name);
   if (!(wp = stage_path(&S->sg, path))) return 1;
   jf = fopen(wp, "w");
@@ -3061,6 +3160,12 @@ static int write_json(const reduce_args *A, reduce_state *S, int method, int ns,
     fprintf(jf, ", \"poly_idx\": "); json_str(jf, A->poly_idx);
     if (A->poly_w) { fprintf(jf, ", \"poly_w\": "); json_str(jf, A->poly_w); }
   }
+  if (S->bal_on) {   /* balancing: no snapshots, its own info */
+    fprintf(jf, "},\n  \"snapshots\": {\"count\": 0},\n  \"info\": ");
+    json_balancing(jf, S, method);
+    fprintf(jf, ", \"reduce_seconds\": "); json_num(jf, t_red);
+    return write_json_tail(jf, A, S, ol, path);
+  }
   json_snapshots(jf, A, ns, t_sim);
   json_options(jf, A, S, method, o, info);
   fprintf(jf, "  \"info\": {\"pod_sigma_ratio\": ");
@@ -3085,6 +3190,14 @@ static int write_json(const reduce_args *A, reduce_state *S, int method, int ns,
     fprintf(jf, "}");
   }
   fprintf(jf, ", \"reduce_seconds\": "); json_num(jf, t_red);
+  return write_json_tail(jf, A, S, ol, path);
+}
+
+/* The json record's end: the stepper's memory, the reconstruction and the
+   files; closes jf. */
+static int write_json_tail(FILE *jf, const reduce_args *A, reduce_state *S, const outlist *ol, const char *path) {
+  const phgmg_rom *rom = phgmg_reduced_rom(S->red);
+  int i;
   fprintf(jf, "},\n  \"stepper_memsize_bytes\": %lu,\n", (unsigned long)phgmg_rom_stepper_memsize(rom));
   fprintf(jf, "  \"reconstruction\": \"%s\",\n",
           rom->kind == PHGMG_ROM_QUADRATIC ? "x = V0 @ xr + V2 @ (M @ kron(xr[m:], xr[m:]))" : "x = V0 @ xr");
@@ -3195,6 +3308,9 @@ static int method_code(const char *m) {
   if (!strcmp(m, "gmg-qm")) return PHGMG_METHOD_GMG_QM;
   if (!strcmp(m, "sp1")) return PHGMG_METHOD_SP1;
   if (!strcmp(m, "sp2")) return PHGMG_METHOD_SP2;
+  if (!strcmp(m, "bt")) return PHGMG_METHOD_BT;
+  if (!strcmp(m, "prbt")) return PHGMG_METHOD_PRBT;
+  if (!strcmp(m, "phbt")) return PHGMG_METHOD_PHBT;
   return -1;
 }
 
@@ -3204,7 +3320,7 @@ static int method_code(const char *m) {
 static int reduce_prepare(const reduce_args *A, reduce_state *S, const char *const *tests, int nt) {
   int e;
   if ((S->method = method_code(A->method)) < 0)
-    return usage_error("--method '%s': expected gmg-pod, gmg-qm, sp1 or sp2", A->method);
+    return usage_error("--method '%s': expected gmg-pod, gmg-qm, sp1, sp2, bt, prbt or phbt", A->method);
   reduce_paths(A, S, tests, nt);
   if ((e = check_collisions("reduce", &S->pin, &S->pout)) != 0) return e;
   g_inputs = &S->pin;
@@ -3219,6 +3335,68 @@ static int reduce_prepare(const reduce_args *A, reduce_state *S, const char *con
   return A->X ? load_snapshot_files(A, S, S->sys.N, S->sys.m, &S->Xd, &S->ns) : 0;
 }
 
+/* The error of a balancing method, explained. */
+static int explain_balancing(const reduce_args *A, const reduce_state *S, phgmg_result rc) {
+  const phgmg_balanced_info *b = &S->bal;
+  switch (rc) {
+    case PHGMG_ERR_STRUCTURE:
+      return fail("reduction failed: the balanced truncation model of order %d is not passive, so it has no "
+                  "port-Hamiltonian form (K + K^T <= 0); use --method prbt or phbt (pH by construction), or "
+                  "another --r (H-infinity error bound %.3g)", A->r, b->lr.bound);
+    case PHGMG_ERR_RANK:
+      return fail("reduction failed: --r %d exceeds the %d singular values computed (the Gramian factors "
+                  "have ranks %d and %d): use a smaller --r", A->r, b->lr.nhsv, b->lr.ctrl.rank, b->lr.obs.rank);
+    case PHGMG_ERR_NOT_CONVERGED:
+      return fail("reduction failed: %s (low-rank ADI: residual %.3g after %d steps)", phgmg_result_string(rc),
+                  b->lr.obs.iters ? b->lr.obs.res : b->lr.ctrl.res,
+                  b->lr.obs.iters ? b->lr.obs.iters : b->lr.ctrl.iters);
+    case PHGMG_ERR_UNSUPPORTED:
+      if (S->method == PHGMG_METHOD_PHBT && !S->sp)
+        return fail("reduction failed: --method phbt needs the sparse model (--J-coo, --R-coo, --Q-coo)");
+      return fail("reduction failed: %s (dense BT and PRBT take standard-form models: give a mass matrix as "
+                  "--E-coo with --J-coo, --R-coo, --Q-coo for the low-rank solvers)", phgmg_result_string(rc));
+    default:
+      return fail("reduction failed: %s", phgmg_result_string(rc));
+  }
+}
+
+/* --method bt, prbt, phbt: phgmg_balanced_reduce on the sparse model (COO
+   input: the low-rank solvers) or the dense one (dense input: the dense
+   solvers), with a progress line per phase after the first second. */
+static int run_balancing(const reduce_args *A, reduce_state *S, double *t_red) {
+  const phgmg_balanced_info *b = &S->bal;
+  phgmg_lradi_opts lo;
+  phase_log plog;
+  phgmg_result rc;
+  double t0;
+  if (S->dae) return fail("--method %s: index-one descriptor models (E with zero rows) are not supported; give "
+                          "an E of full rank", A->method);
+  memset(&lo, 0, sizeof lo);
+  progress("reducing: %s, r = %d (%s solvers)", A->method, A->r, S->sp ? "low-rank, sparse" : "dense");
+  t0 = now_s();
+  plog.t0 = t0; plog.all = 0; plog.ncand = plog.nprobe = 0;
+  if (!g_quiet) { lo.progress = reduce_phase; lo.progress_user = &plog; }
+  S->bal_on = 1;
+  rc = phgmg_balanced_reduce(&S->red, S->sp ? NULL : &S->sys, S->sp, S->method, A->r, &lo, S->bal_sv, 64, &S->bal,
+                             NULL);
+  *t_red = now_s() - t0;
+  if (rc != PHGMG_OK) return explain_balancing(A, S, rc);
+  if (b->lowrank)
+    progress("  done in %.2f s: Gramian factor ranks %d / %d, ADI steps %d / %d, Lyapunov residuals %.2g / %.2g",
+             *t_red, b->lr.ctrl.rank, b->lr.obs.rank, b->lr.ctrl.iters, b->lr.obs.iters, b->res_ctrl, b->res_obs);
+  else
+    progress("  done in %.2f s: Lyapunov residuals %.2g / %.2g", *t_red, b->res_ctrl, b->res_obs);
+  if (S->method == PHGMG_METHOD_BT)
+    progress("  Hankel singular values: sigma_1 = %.6g, sigma_{r+1} = %.3g; H-infinity error bound 2 sum_{i>r} "
+             "sigma_i = %.3g%s", S->bal_sv[0], b->lr.hsv_tail, b->lr.bound,
+             b->ph_change > 0.0 ? "" : "");
+  if (S->bal.stages == 2)
+    progress("  two stages: the pH Galerkin projection onto the controllability factor (order %d), then the "
+             "dense PRBT; positive-real singular values %.6g ... %.3g", b->inter, S->bal_sv[0],
+             S->bal_sv[b->nsv > 0 ? b->nsv - 1 : 0]);
+  return 0;
+}
+
 /* The snapshots, the reduction and every output written under its temporary
    name (reduce_commit moves them into place). */
 static int reduce_build(const reduce_args *A, reduce_state *S) {
@@ -3229,6 +3407,11 @@ static int reduce_build(const reduce_args *A, reduce_state *S) {
   int ns = S->ns, e;
   memset(&o, 0, sizeof o);
   memset(&info, 0, sizeof info);
+  if (S->method == PHGMG_METHOD_BT || S->method == PHGMG_METHOD_PRBT || S->method == PHGMG_METHOD_PHBT) {
+    if ((e = run_balancing(A, S, &t_red)) != 0) return e;   /* no snapshots */
+    if ((e = write_arrays(A, S, NULL, 0, &S->ol)) != 0) return e;
+    return write_model_files(A, S, S->method, 0, 0.0, t_red, &o, &info, &S->ol);
+  }
   if (!A->X && (e = simulate_training_runs(A, S, &X, &ns, &t_sim)) != 0) return e;
   if ((e = run_reduction(A, S, S->method, X, ns, &o, &info, &t_red)) != 0) return e;
   if ((e = write_arrays(A, S, X, ns, &S->ol)) != 0) return e;

@@ -39,3 +39,4 @@
 #include "test_setup.c"
 #include "test_dae_sparse.c"
 #include "test_sparse_class.c"
+#include "test_balanced.c"
