@@ -965,8 +965,10 @@
    fills phgmg_validation: e_red, e_y, e_proj, e_energy (and the full model's),
    Newton statistics, the first failing step, pass (completed, no Newton
    failure, e_y <= ey_max). A failing reduced model is a result (pass = 0), not
-   an error. The command line's `phgmg validate` does the same for a list of
-   test inputs and exits 1 when one fails.
+   an error. phgmg_reduced_validate_many compares several reduced models of
+   one full model (a sweep over r or methods) with a single full run. The
+   command line's `phgmg validate` does the same for a list of test inputs
+   (and a list of --r and --method) and exits 1 when one fails.
 
    4.4 Online indicators. Every reduced model carries a training envelope
    (env_lo, env_hi: the range of the training snapshots' reduced coordinates,
@@ -1767,7 +1769,7 @@
            phgmg_reduced_rom, phgmg_reduced_N, phgmg_reduced_lift,
            phgmg_reduced_restrict, phgmg_reduced_dphi, phgmg_reduced_W,
            phgmg_reduced_simulate, phgmg_reduced_simulate_run,
-           phgmg_reduced_validate, phgmg_rel_error,
+           phgmg_reduced_validate, phgmg_reduced_validate_many, phgmg_rel_error,
            phgmg_err_red, phgmg_err_proj, phgmg_err_lowerbound,
            phgmg_err_energy, phgmg_study_create, phgmg_study_destroy,
            phgmg_study_basis, phgmg_study_reduce, phgmg_study_errors,
@@ -1797,7 +1799,7 @@
            phgmg_lu_rcond, phgmg_norm1, phgmg_normf, phgmg_zlu_factor,
            phgmg_zlu_solve, phgmg_qr, phgmg_qrcp, phgmg_qr_form_q,
            phgmg_qr_apply, phgmg_lstsq, phgmg_svd, phgmg_sym_eig
-   (153 functions; 17 of them only with PHGMG_MPI; also the macros
+   (154 functions; 17 of them only with PHGMG_MPI; also the macros
    PHGMG_ROM_STEPPER_MEMSIZE_MAX and _MAX_CB.)
 */
 #ifndef PHGMG_H_INCLUDED
@@ -3183,6 +3185,18 @@ typedef struct phgmg_validation {
 PHGMG_DEF phgmg_result phgmg_reduced_validate(const phgmg_reduced *red, const phgmg_ph_system *sys,
                                               const phgmg_run *run, double tol, int max_iter, double ey_max,
                                               phgmg_validation *v, const phgmg_allocator *alloc);
+/* phgmg_reduced_validate of nred reduced models of the same full model (a
+   sweep over orders or methods) on one run: the full model is simulated
+   once, each reduced model compared with that run into v[k] (nred entries).
+   v[k] is what phgmg_reduced_validate(reds[k], ...) gives. Returns the full
+   run's code if it fails, PHGMG_ERR_NOMEM, else the first model's
+   PHGMG_ERR_NANINF / _OVERFLOW (every model is still compared), else
+   PHGMG_OK; PHGMG_ERR_INVALID_ARG (nred < 1, a NULL model), _SIZE (a model
+   not of sys's N, m). Cost: one full run and nred reduced runs. */
+PHGMG_DEF phgmg_result phgmg_reduced_validate_many(const phgmg_reduced *const *reds, int nred,
+                                                   const phgmg_ph_system *sys, const phgmg_run *run, double tol,
+                                                   int max_iter, double ey_max, phgmg_validation *v,
+                                                   const phgmg_allocator *alloc);
 
 /* >>errors ================================================================ */
 /* --- error measures (paper 5.1) --- */
@@ -16952,40 +16966,27 @@ PHGMG__PRIV phgmg_result phgmg__validate_finite(const phgmg_validation *v, const
   return nan ? PHGMG_ERR_NANINF : PHGMG_ERR_OVERFLOW;
 }
 
-PHGMG_DEF phgmg_result phgmg_reduced_validate(const phgmg_reduced *red, const phgmg_ph_system *sys,
-                                              const phgmg_run *run, double tol, int max_iter, double ey_max,
-                                              phgmg_validation *v, const phgmg_allocator *alloc) {
-  int N, m, r, ns, k, done, j;
-  size_t nb;
-  double *buf, *X, *Y, *XR, *YR, *xr0, *H, *S, *D, *Hf, *Sf, *Df;
-  phgmg_energy ef, er;
-  phgmg_gl3_opts go;
+/* The reduced side of a validation: red simulated on run from rho(x0),
+   compared with the full run (X, Y: N x ns, m x ns; its energy terms Hf,
+   Sf, Df), into *v. */
+PHGMG__PRIV phgmg_result phgmg__validate_rom(const phgmg_reduced *red, const phgmg_run *run, double tol, int max_iter,
+                                             double ey_max, const double *X, const double *Y, const double *Hf,
+                                             const double *Sf, const double *Df, phgmg_validation *v,
+                                             const phgmg_allocator *alloc) {
+  const int N = red->N, m = red->m, r = red->r, ns = run->nsteps + 1;
+  double *buf, *XR, *YR, *xr0, *H, *S, *D;
+  phgmg_energy er;
   phgmg_result rc;
-  if (!v) return PHGMG_ERR_INVALID_ARG;
-  memset(v, 0, sizeof *v);
-  v->first_failure = -1;
-  if (!red || !sys || !run) return PHGMG_ERR_INVALID_ARG;
-  if (phgmg_runs_columns(1, run) < 0 || run->nsteps < 1 || !(tol < 1.0) || ey_max != ey_max)
-    return PHGMG_ERR_INVALID_ARG;
-  N = red->N; m = red->m; r = red->r; ns = run->nsteps + 1;
-  if (sys->N != N || sys->m != m) return PHGMG_ERR_SIZE;
-  nb = (size_t)N * ns + (size_t)m * ns * 2 + (size_t)r * ns + (size_t)r + 6 * (size_t)ns + (size_t)N;
-  buf = phgmg__dalloc(alloc, nb);
+  int k, done, j;
+  buf = phgmg__dalloc(alloc, (size_t)r * ns + (size_t)m * ns + (size_t)r + 3 * (size_t)ns);
   if (!buf) return PHGMG_ERR_NOMEM;
-  X = buf; Y = X + (size_t)N * ns; YR = Y + (size_t)m * ns; XR = YR + (size_t)m * ns; xr0 = XR + (size_t)r * ns;
-  H = xr0 + r; S = H + ns; D = S + ns; Hf = D + ns; Sf = Hf + ns; Df = Sf + ns;
-  memset(Df + ns, 0, (size_t)N * sizeof(double));    /* x0 = 0 when run->x0 is NULL */
-  ef.H = Hf; ef.S = Sf; ef.D = Df; er.H = H; er.S = S; er.D = D;
-  memset(&go, 0, sizeof go);
-  go.tol = tol > 0.0 ? tol : 1e-10;
-  go.max_iter = max_iter > 0 ? max_iter : 20;
-  rc = phgmg_simulate(sys, run->x0 ? run->x0 : Df + ns, run->t0, run->dt, run->nsteps, run->u, run->user, &go, X, Y,
-                      &ef, NULL, NULL, alloc);
-  if (rc != PHGMG_OK) { phgmg__free(alloc, buf); return rc; }
+  XR = buf; YR = XR + (size_t)r * ns; xr0 = YR + (size_t)m * ns; H = xr0 + r; S = H + ns; D = S + ns;
+  er.H = H; er.S = S; er.D = D;
   for (k = 0; k < r * ns; ++k) XR[k] = (double)NAN;
   phgmg_reduced_restrict(red, X, xr0);
   v->rom_rc = phgmg_reduced_simulate(red, xr0, run->t0, run->dt, run->nsteps, run->u, run->user,
-                                     tol > 0.0 ? tol : 0.0, go.max_iter, XR, YR, &er, &v->stats, alloc);
+                                     tol > 0.0 ? tol : 0.0, max_iter > 0 ? max_iter : 20, XR, YR, &er, &v->stats,
+                                     alloc);
   if (v->rom_rc == PHGMG_ERR_NOMEM) { phgmg__free(alloc, buf); return PHGMG_ERR_NOMEM; }
   for (done = 0; done + 1 < ns && XR[(size_t)(done + 1) * r] == XR[(size_t)(done + 1) * r]; ++done) {}
   v->nsteps = run->nsteps;
@@ -17008,6 +17009,54 @@ PHGMG_DEF phgmg_result phgmg_reduced_validate(const phgmg_reduced *red, const ph
   v->pass = rc == PHGMG_OK && v->rom_rc == PHGMG_OK && v->stats.failures == 0 && (ey_max <= 0.0 || v->e_y <= ey_max);
   phgmg__free(alloc, buf);
   return rc;
+}
+
+PHGMG_DEF phgmg_result phgmg_reduced_validate_many(const phgmg_reduced *const *reds, int nred,
+                                                   const phgmg_ph_system *sys, const phgmg_run *run, double tol,
+                                                   int max_iter, double ey_max, phgmg_validation *v,
+                                                   const phgmg_allocator *alloc) {
+  int N, m, ns, k;
+  size_t nb;
+  double *buf, *X, *Y, *Hf, *Sf, *Df;
+  phgmg_energy ef;
+  phgmg_gl3_opts go;
+  phgmg_result rc, rc1 = PHGMG_OK;
+  if (!v || nred < 1) return PHGMG_ERR_INVALID_ARG;
+  for (k = 0; k < nred; ++k) { memset(&v[k], 0, sizeof v[k]); v[k].first_failure = -1; }
+  if (!reds || !sys || !run) return PHGMG_ERR_INVALID_ARG;
+  for (k = 0; k < nred; ++k)
+    if (!reds[k]) return PHGMG_ERR_INVALID_ARG;
+  if (phgmg_runs_columns(1, run) < 0 || run->nsteps < 1 || !(tol < 1.0) || ey_max != ey_max)
+    return PHGMG_ERR_INVALID_ARG;
+  N = sys->N; m = sys->m; ns = run->nsteps + 1;
+  for (k = 0; k < nred; ++k)
+    if (reds[k]->N != N || reds[k]->m != m) return PHGMG_ERR_SIZE;
+  nb = (size_t)N * ns + (size_t)m * ns + 3 * (size_t)ns + (size_t)N;
+  buf = phgmg__dalloc(alloc, nb);
+  if (!buf) return PHGMG_ERR_NOMEM;
+  X = buf; Y = X + (size_t)N * ns; Hf = Y + (size_t)m * ns; Sf = Hf + ns; Df = Sf + ns;
+  memset(Df + ns, 0, (size_t)N * sizeof(double));    /* x0 = 0 when run->x0 is NULL */
+  ef.H = Hf; ef.S = Sf; ef.D = Df;
+  memset(&go, 0, sizeof go);
+  go.tol = tol > 0.0 ? tol : 1e-10;
+  go.max_iter = max_iter > 0 ? max_iter : 20;
+  rc = phgmg_simulate(sys, run->x0 ? run->x0 : Df + ns, run->t0, run->dt, run->nsteps, run->u, run->user, &go, X, Y,
+                      &ef, NULL, NULL, alloc);
+  for (k = 0; k < nred && rc == PHGMG_OK; ++k) {   /* one full run, every reduced model against it */
+    const phgmg_result rk = phgmg__validate_rom(reds[k], run, tol, go.max_iter, ey_max, X, Y, Hf, Sf, Df, &v[k], alloc);
+    if (rk == PHGMG_ERR_NOMEM) rc = rk;
+    else if (rk != PHGMG_OK && rc1 == PHGMG_OK) rc1 = rk;
+  }
+  phgmg__free(alloc, buf);
+  return rc != PHGMG_OK ? rc : rc1;
+}
+
+PHGMG_DEF phgmg_result phgmg_reduced_validate(const phgmg_reduced *red, const phgmg_ph_system *sys,
+                                              const phgmg_run *run, double tol, int max_iter, double ey_max,
+                                              phgmg_validation *v, const phgmg_allocator *alloc) {
+  if (!v) return PHGMG_ERR_INVALID_ARG;
+  if (!red) { memset(v, 0, sizeof *v); v->first_failure = -1; return PHGMG_ERR_INVALID_ARG; }
+  return phgmg_reduced_validate_many(&red, 1, sys, run, tol, max_iter, ey_max, v, alloc);
 }
 
 /* --- error measures ------------------------------------------------------ */

@@ -1,0 +1,71 @@
+/* Library parts of a finite-element engineer's workflow: several reduced
+   models of one full model validated against a single full run, and a
+   sparse matrix assembled from coordinate triplets with duplicates. */
+#define PHGMG_STATIC
+#define PHGMG_IMPLEMENTATION
+#include "../phgmg.h"
+#include "harness.h"
+#include <stdlib.h>
+
+#include "fixture_msd.h"
+static void wf_u_sin(double t, double *u, void *user) { (void)user; u[0] = 0.5 * sin(1.3 * t); }
+
+/* validate_many: each model's e_y equals the relative output error computed
+   here from a full simulation and the model's own reduced simulation; the
+   full model is the same for every entry (e_energy_fom equal). */
+TEST(test_validate_many_matches_own_runs) {
+  dmodel t;
+  const int n = 20, N = 40, ns = 201, rs[3] = {6, 10, 14};
+  double *X = (double *)calloc((size_t)N * ns, sizeof(double)), *x0 = (double *)calloc((size_t)N, sizeof(double));
+  double *Y = (double *)malloc(sizeof(double) * ns), *YR = (double *)malloc(sizeof(double) * ns), *xr0;
+  phgmg_reduced *red[3] = {NULL, NULL, NULL};
+  phgmg_validation v[3];
+  phgmg_run run;
+  phgmg_reduce_opts o;
+  int k;
+  dmodel_msd(&t, n);
+  CHECK_RC(phgmg_simulate(&t.sys, x0, 0.0, 0.1, ns - 1, wf_u_sin, NULL, NULL, X, Y, NULL, NULL, NULL, NULL), PHGMG_OK);
+  for (k = 0; k < 3; ++k) {
+    phgmg_reduce_opts_default(&o);
+    o.method = k == 1 ? PHGMG_METHOD_SP1 : PHGMG_METHOD_GMG_POD;
+    o.r = rs[k];
+    CHECK_RC(phgmg_reduce(&red[k], &t.sys, X, N, ns, &o, NULL, NULL), PHGMG_OK);
+  }
+  memset(&run, 0, sizeof run);
+  run.u = wf_u_sin; run.dt = 0.1; run.nsteps = ns - 1;
+  CHECK_RC(phgmg_reduced_validate_many((const phgmg_reduced *const *)red, 3, &t.sys, &run, 0.0, 0, 0.0, v, NULL),
+           PHGMG_OK);
+  xr0 = (double *)calloc(16, sizeof(double));
+  for (k = 0; k < 3; ++k) {
+    double ey;
+    CHECK_RC(phgmg_reduced_simulate(red[k], xr0, 0.0, 0.1, ns - 1, wf_u_sin, NULL, 0.0, 20, NULL, YR, NULL, NULL,
+                                    NULL), PHGMG_OK);
+    ey = phgmg_rel_error(1, ns, Y, 1, YR, 1);
+    CHECK(v[k].pass == 1 && v[k].first_failure == -1 && v[k].steps_done == ns - 1);
+    CHECK_LE(fabs(v[k].e_y - ey), 1e-12 * (ey + 1e-300) + 1e-15);
+    CHECK(v[k].e_energy_fom == v[0].e_energy_fom);
+  }
+  /* the errors fall with r along the GMG-POD models */
+  CHECK(v[2].e_y < v[0].e_y);
+  /* bad arguments: counted, NULL model, another model's size */
+  CHECK_RC(phgmg_reduced_validate_many((const phgmg_reduced *const *)red, 0, &t.sys, &run, 0.0, 0, 0.0, v, NULL),
+           PHGMG_ERR_INVALID_ARG);
+  {
+    const phgmg_reduced *two[2];
+    two[0] = red[0]; two[1] = NULL;
+    CHECK_RC(phgmg_reduced_validate_many(two, 2, &t.sys, &run, 0.0, 0, 0.0, v, NULL), PHGMG_ERR_INVALID_ARG);
+  }
+  {
+    phgmg_ph_system s2 = t.sys;
+    s2.N = N - 2;
+    CHECK_RC(phgmg_reduced_validate_many((const phgmg_reduced *const *)red, 3, &s2, &run, 0.0, 0, 0.0, v, NULL),
+             PHGMG_ERR_SIZE);
+  }
+  for (k = 0; k < 3; ++k) phgmg_reduced_destroy(red[k]);
+  free(X); free(x0); free(Y); free(YR); free(xr0);
+  dmodel_free(&t);
+}
+
+SUITE(workflow) {
+  RUN(test_validate_many_matches_own_runs);
+}
