@@ -3049,7 +3049,8 @@ typedef struct phgmg_reduce_info {
   double rcond_jr;         /* rcond of J - R                                  */
   double pod_sigma_ratio;  /* sigma_{r'+1}/sigma_1 of what the method PODs (GMG:
                               the adjusted snapshots, r' = r - m; SP1/SP2: X,
-                              r' = r); 0 if no further mode or a given basis */
+                              r' = r; also on a study's bases); 0 if no
+                              further mode or a basis of your own */
   double lambda;           /* GMG-QM: the ridge lambda used (fixed or chosen)  */
   double lambda_cv_err;    /* lambda chosen: held-out relative error of the quadratic
                               correction at that lambda, sum ||V2^T x - M(z kron z)||^2
@@ -14348,6 +14349,19 @@ PHGMG__PRIV phgmg_result phgmg__basis_pod_implicit(phgmg__rctx *c, double *tmp) 
   return phgmg__basis_take(c, V1, S, k);
 }
 
+/* sigma_{p+1} / sigma_1 from a study's coordinates C = U^T X (k x ns, U
+   the left singular vectors: row j has the norm sigma_{j+1}); 0 if p >= k. */
+PHGMG__PRIV double phgmg__coord_sigma_ratio(const double *C, int k, int ns, int p) {
+  double s0 = 0.0, sp = 0.0;
+  int j;
+  if (!C || p >= k || k < 1) return 0.0;
+  for (j = 0; j < ns; ++j) {
+    s0 += C[(size_t)j * k] * C[(size_t)j * k];
+    sp += C[p + (size_t)j * k] * C[p + (size_t)j * k];
+  }
+  return s0 > 0.0 ? sqrt(sp / s0) : 0.0;
+}
+
 /* Stage 1, basis. GMG: V0 = [B, V1], V1 = POD of the adjusted snapshots
    X - B B^+ X (c->Xa keeps them, for the manifold stage). SP1/SP2: V0 =
    V_POD of X. opts.cache.pod_basis replaces the POD. */
@@ -14368,6 +14382,8 @@ PHGMG__PRIV phgmg_result phgmg__stage_basis(phgmg__rctx *c) {
   if (!phgmg__is_gmg(red->method)) {
     if (c->o->cache.pod_basis) {
       memcpy(red->V0, c->o->cache.pod_basis, (size_t)N * p * sizeof(double));
+      if (c->sf == PHGMG__SF_SP1 || c->sf == PHGMG__SF_SP2)   /* the study's POD: its singular values */
+        c->inf.pod_sigma_ratio = phgmg__coord_sigma_ratio(c->st->Cp, c->st->kp, ns, p);
       return PHGMG_OK;
     }
     /* one mode more than kept when the data have it: sigma_{r+1} for info */
@@ -14387,6 +14403,7 @@ PHGMG__PRIV phgmg_result phgmg__stage_basis(phgmg__rctx *c) {
   if (c->sf == PHGMG__SF_GMG) { /* the study's basis: Xa is not needed (its coordinates are cached) */
     memcpy(red->V0, c->sys->B, (size_t)N * m * sizeof(double));
     memcpy(red->V0 + (size_t)N * m, c->o->cache.pod_basis, (size_t)N * p * sizeof(double));
+    c->inf.pod_sigma_ratio = phgmg__coord_sigma_ratio(c->st->Ca, c->st->ka, ns, p);
     return PHGMG_OK;
   }
   kk = phgmg__v2_from_basis(c) ? p + red->rn + 1 : p + 1;

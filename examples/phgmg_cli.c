@@ -147,8 +147,10 @@ static const char *const help_lines[] = {
   "                               (paper 4.2.2)\n",
   "                      sp1:     SP1-POD, phi = V x, W = QV (V^T Q V)^-1 (baseline)\n",
   "                      sp2:     SP2-POD, W from a POD of the gradient snapshots\n",
-  "                      (required)\n",
-  "  --r R               reduced order (required). For gmg-pod/gmg-qm it includes the m\n",
+  "                      (required). A comma-separated list (e.g. gmg-pod,sp1) builds\n",
+  "                      a model for each method (see SWEEPS).\n",
+  "  --r R               reduced order (required); a list R1,R2,... (e.g. 10,20,40, up\n",
+  "                      to 16 orders) builds a model for each (see SWEEPS). For gmg-pod/gmg-qm it includes the m\n",
   "                      port coordinates, so m < R <= N; R - m (gmg) or R (sp1/sp2) must\n",
   "                      not exceed the rank of the (adjusted) snapshots.\n",
   "  --rn K              gmg-qm only: lifting dimension r_n (default 8, or the largest that\n",
@@ -265,6 +267,20 @@ static const char *const help_lines[] = {
   "  input is refused before any work (status 2).\n",
   "  The reduced model (LINEAR kind) is x' = K grad H(x) + Bh u, y = Bh^T grad H(x),\n",
   "  H(x) = 1/2 x^T Qh x (+ sum_j w_j phi(P0_j x)); it is again port-Hamiltonian.\n",
+  "\n",
+  "SWEEPS (several --method and --r in one call)\n",
+  "  reduce and validate with a list in --method or --r build every (method, r)\n",
+  "  pair (up to 32 models) from one set-up: the files are read and checked, the\n",
+  "  training runs simulated and the snapshots' bases (POD) computed once; every\n",
+  "  size is checked for every pair before any work. Model (M, R) is written as\n",
+  "  NAME_<M>_r<R>.* with the method's '-' as '_' (rom_gmg_pod_r20.phgmgrom,\n",
+  "  rom_sp1_r40_V0.npy, rom_gmg_pod_r20.json, ...); NAME_sweep.json lists the\n",
+  "  models (method, r, name, reduction seconds, written or not, and with\n",
+  "  validate each test's e_y, e_red and verdict). With a single method and\n",
+  "  order the names are NAME.* as above. reduce writes all models or none;\n",
+  "  validate runs the full model once per test input for all models (one\n",
+  "  table line per test and model), writes the models that pass every test and\n",
+  "  not those that fail (exit 1 if one fails).\n",
   "\n",
   "COMMAND simulate\n",
   "  Runs the full model (the model options of reduce: --J/--R/--Q or the -coo\n",
@@ -386,7 +402,7 @@ static void progress(const char *fmt, ...) {
    runs numbered. Every phase of a long reduction (N * ns >= 1e7, e.g.
    N >= 10 000 with 1001 snapshots); of others, the phases that start after
    the reduction has run a second (a short reduction stays quiet). */
-typedef struct phase_log { double t0; int all, ncand, nprobe; } phase_log;
+typedef struct phase_log { double t0; int all, ncand, nprobe, qm, hyper; } phase_log;
 static void reduce_phase(const char *phase, void *user) {
   phase_log *pl = (phase_log *)user;
   const double t = now_s() - pl->t0;
@@ -394,6 +410,9 @@ static void reduce_phase(const char *phase, void *user) {
   if (strcmp(phase, "lambda: candidate") == 0) k = ++pl->ncand;
   if (strcmp(phase, "lambda: full-model probe run") == 0) k = ++pl->nprobe;
   if (strcmp(phase, "done") == 0 || (!pl->all && t < 1.0)) return;
+  /* stages that do nothing for this model are not shown: the manifold is
+     gmg-qm's, the hyper-reduction needs a hyper-reduced nonlinear part */
+  if ((!pl->qm && !strcmp(phase, "manifold")) || (!pl->hyper && !strcmp(phase, "hyper-reduction"))) return;
   if (k) progress("  ... %s %d (%.1f s)", phase, k, t);
   else progress("  ... %s (%.1f s)", phase, t);
 }
@@ -851,7 +870,7 @@ static int file_id_same(const file_id *a, const file_id *b) {
 }
 
 /* A list of paths with the options they came from (copies). */
-#define PATHS_MAX 160
+#define PATHS_MAX 2400
 typedef struct pathset {
   char *path[PATHS_MAX];
   const char *opt[PATHS_MAX];
@@ -1324,6 +1343,9 @@ typedef struct reduce_args {
   int nx;
   const char *xin[16];          /* --X-input KIND, repeatable: the input of each --X run */
   int nxin;
+  int rlist[16], nrl;           /* --r R1,R2,...: the orders of a sweep (r = the one being built) */
+  int mlist[4], nml;            /* --method M1,M2,...: the methods of a sweep (method = the one built) */
+  const char *name0;            /* --name as given (name: the model being built, see sweep_name) */
 } reduce_args;
 
 /* ---- the input files of reduce, validate and simulate: ONE list -----------
@@ -1474,6 +1496,81 @@ static int check_hyper_opts(const reduce_args *A, const char *const *seen, int n
   return 0;
 }
 
+/* --r R or a comma-separated list R1,R2,... (up to 16 distinct orders, a
+   sweep): into A->rlist; A->r is the first. 0, or 1 after a usage message. */
+static int parse_r_list(const char *v, reduce_args *A) {
+  const char *p = v;
+  char buf[32];
+  int k;
+  A->nrl = 0;
+  while (*p) {
+    const size_t l = strcspn(p, ",");
+    int r;
+    if (l == 0 || l >= sizeof buf) { usage_error("--r '%s': expected an order R or a list R1,R2,... (no spaces)", v); return 1; }
+    memcpy(buf, p, l); buf[l] = '\0';
+    if (!parse_int("--r", buf, 1, INT_MAX, &r)) return 1;
+    for (k = 0; k < A->nrl; ++k)
+      if (A->rlist[k] == r) { usage_error("--r '%s': the order %d is listed twice", v, r); return 1; }
+    if (A->nrl == 16) { usage_error("--r '%s': at most 16 orders", v); return 1; }
+    A->rlist[A->nrl++] = r;
+    p += l;
+    if (*p == ',') { ++p; if (!*p) { usage_error("--r '%s': a trailing comma", v); return 1; } }
+  }
+  A->r = A->rlist[0];
+  return 0;
+}
+
+static int method_code(const char *m);
+/* --method M or a comma-separated list (each of gmg-pod, gmg-qm, sp1, sp2
+   once) into A->mlist; A->method is the first's name. 0 or the usage status 2. */
+static int parse_method_list(reduce_args *A) {
+  const char *p = A->method, *v = A->method;
+  char buf[16];
+  int k;
+  A->nml = 0;
+  while (*p) {
+    const size_t l = strcspn(p, ",");
+    int c;
+    if (l == 0 || l >= sizeof buf) c = -1;
+    else { memcpy(buf, p, l); buf[l] = '\0'; c = method_code(buf); }
+    if (c < 0) return usage_error("--method '%s': expected gmg-pod, gmg-qm, sp1 or sp2, or a list of them (e.g. gmg-pod,sp1)", v);
+    for (k = 0; k < A->nml; ++k)
+      if (A->mlist[k] == c) return usage_error("--method '%s': %s is listed twice", v, buf);
+    A->mlist[A->nml++] = c;
+    p += l;
+    if (*p == ',') { ++p; if (!*p) return usage_error("--method '%s': a trailing comma", v); }
+  }
+  return 0;
+}
+
+static const char *method_name(int m);
+/* 1 if method code c is among the methods of the run. */
+static int has_method(const reduce_args *A, int c) {
+  int k;
+  for (k = 0; k < A->nml; ++k)
+    if (A->mlist[k] == c) return 1;
+  return 0;
+}
+
+/* The number of models a run builds: every (method, r) of the lists. */
+static int sweep_count(const reduce_args *A) { return A->nml * A->nrl; }
+
+/* Model k of a sweep (methods outer, orders inner): its method and order
+   into A, and its name: --name for a single model, else
+   NAME_<method>_r<R> with the method's '-' as '_' (rom_gmg_pod_r20). */
+static void sweep_set(reduce_args *A, int k, char *name, size_t cap) {
+  const int mc = A->mlist[k / A->nrl];
+  char mn[16];
+  size_t i;
+  A->r = A->rlist[k % A->nrl];
+  A->method = method_name(mc);
+  snprintf(mn, sizeof mn, "%s", A->method);
+  for (i = 0; mn[i]; ++i) if (mn[i] == '-') mn[i] = '_';
+  if (sweep_count(A) == 1) snprintf(name, cap, "%s", A->name0);
+  else snprintf(name, cap, "%s_%s_r%d", A->name0, mn, A->r);
+  A->name = name;
+}
+
 /* Returns 0, the usage status 2, or -1 after printing --help. */
 static int check_reduce_args(reduce_args *A, const char *const *seen, int nseen);
 static int parse_reduce(int argc, char **argv, reduce_args *A) {
@@ -1509,7 +1606,8 @@ static int parse_reduce(int argc, char **argv, reduce_args *A) {
     STR("--potential", potential) STR("--hyper", hyper)
     DBL("--hyper-tol", hyper_tol, 0.0)
     STR("--out", out) STR("--name", name) STR("--method", method)
-    INT("--steps", steps, 1, INT_MAX - 1) INT("--r", r, 1, INT_MAX) 
+    INT("--steps", steps, 1, INT_MAX - 1)
+    else if (!strcmp(o, "--r")) { if (!(v = optval(argc, argv, &i)) || parse_r_list(v, A)) return 2; }
     INT("--deim-max", deim_max, 1, INT_MAX) INT("--newton-iter", newton_iter, 1, 1000)
     DBL("--amp", amp, -HUGE_VAL) DBL("--deim-tol", deim_tol, 0.0) DBL("--newton-tol", newton_tol, 0.0)
     else if (!strcmp(o, "--dt")) {
@@ -1616,12 +1714,29 @@ static int check_reduce_args(reduce_args *A, const char *const *seen, int nseen)
   if ((e = check_model_opts("reduce", A)) != 0) return e;
   if (!A->method) return usage_error("reduce: --method is required (gmg-pod, gmg-qm, sp1 or sp2)");
   if (!A->r) return usage_error("reduce: --r is required");
+  if ((e = parse_method_list(A)) != 0) return e;
+  A->method = method_name(A->mlist[0]);
   if (!A->out) return usage_error("reduce: --out DIR is required");
   if (!!A->X == !!A->simulate) return usage_error("reduce: give exactly one of --X FILE and --simulate");
   if (A->hyper && strcmp(A->hyper, "ecsw") && strcmp(A->hyper, "qdeim") && strcmp(A->hyper, "greedy"))
     return usage_error("--hyper '%s': expected ecsw, qdeim or greedy", A->hyper);
   if ((e = check_hyper_opts(A, seen, nseen)) != 0) return e;
   if (name_problem(A->name)) return usage_error("--name '%s': %s", A->name, name_problem(A->name));
+  A->name0 = A->name;
+  if (sweep_count(A) > 32)
+    return usage_error("reduce: %d methods x %d orders = %d models; a sweep builds at most 32", A->nml, A->nrl,
+                       sweep_count(A));
+  {   /* every model's name of a sweep (NAME_<method>_r<R>) a C identifier too */
+    char nm[128];
+    int k;
+    reduce_args T = *A;
+    for (k = 0; k < sweep_count(A); ++k) {
+      sweep_set(&T, k, nm, sizeof nm);
+      if (name_problem(nm))
+        return usage_error("--name '%s': the name %s of the sweep's model (%s, r = %d) %s", A->name, nm, T.method, T.r,
+                           name_problem(nm));
+    }
+  }
   if (A->ntrain && !A->simulate) return usage_error("reduce: --train-input needs --simulate");
   if (A->nxin && A->nxin != A->nx)
     return usage_error("reduce: %d --X-input for %d --X files: give one input per --X file, in the same order",
@@ -1629,7 +1744,7 @@ static int check_reduce_args(reduce_args *A, const char *const *seen, int nseen)
   if (A->ntrain && A->input)
     return usage_error("reduce: give the training input either by --input or by --train-input, not both");
   if (!A->input) A->input = A->ntrain ? A->train[0] : "sin";
-  if ((A->have_lambda || A->manifold_s || A->rn) && strcmp(A->method, "gmg-qm") != 0)
+  if ((A->have_lambda || A->manifold_s || A->rn) && !has_method(A, PHGMG_METHOD_GMG_QM))
     return usage_error("reduce: --lambda, --rn and --manifold apply to --method gmg-qm only (not %s)", A->method);
   if (A->greedy_window && (A->manifold != PHGMG_MANIFOLD_GREEDY && A->manifold != PHGMG_MANIFOLD_ALTMIN))
     return usage_error("reduce: --greedy-window applies to --method gmg-qm with --manifold greedy or altmin");
@@ -1638,7 +1753,7 @@ static int check_reduce_args(reduce_args *A, const char *const *seen, int nseen)
                        "residual)");
   /* gmg-qm without --lambda: the validated choice (a fixed lambda can give a
      model whose Newton solve fails on inputs unlike the training run) */
-  if (!A->have_lambda && !strcmp(A->method, "gmg-qm")) A->lambda_auto = 1;
+  if (!A->have_lambda && has_method(A, PHGMG_METHOD_GMG_QM)) A->lambda_auto = 1;
   if (A->lambda_auto == 1 && A->have_lambda && A->X && !A->nxin)
     return usage_error("reduce: --lambda auto with --X needs the inputs of the runs (--X-input, one per --X): it "
                        "simulates them; or give a fixed --lambda, or --lambda cv");
@@ -1746,8 +1861,27 @@ done:
   return err;
 }
 
+/* One model of a run (a sweep builds several): its outputs staged under
+   temporary names until the run commits them. */
+typedef struct sweep_model {
+  staged sg;             /* its files */
+  outlist ol;            /* its arrays */
+  char name[64];
+  int method, r, rr, m, pass;
+  double t_red;
+  double ey[16], ered[16];   /* validate: each test's e_y, e_red */
+  int tpass[16];
+  phgmg_reduced *red;    /* kept by validate for its tests */
+} sweep_model;
+
 typedef struct reduce_state {
   mat J, R, B, Q, X, poly, pidx, pw, ex;
+  sweep_model *models;    /* every (method, r) of the run, sweep_count of them */
+  int nmodels;
+  staged dirs;            /* the directories --out made (removed again if nothing is written) */
+  staged sweep_sg;        /* NAME_sweep.json of a sweep */
+  phgmg_study *study;     /* a sweep's shared bases (NULL: each model computes its own) */
+  double t_sim;
   int *idx;
   double *fpoly, *fexp, named[8]; /* the family's coefficients as phgmg_ph_system wants them */
   double *Xsim, *Ysim, *V0;
@@ -1883,6 +2017,14 @@ static void reduce_cleanup(reduce_state *S) {
   phgmg_dae_destroy(S->dae); free(S->Xres);
   phgmg_reduced_destroy(S->red);
   stage_abort(&S->sg); /* after a failure: no output of this run stays */
+  if (S->models) {
+    int k;
+    for (k = 0; k < S->nmodels; ++k) { phgmg_reduced_destroy(S->models[k].red); stage_abort(&S->models[k].sg); }
+    free(S->models);
+  }
+  stage_abort(&S->sweep_sg);
+  stage_abort(&S->dirs);
+  phgmg_study_destroy(S->study);
   g_inputs = NULL;
   paths_free(&S->pin); paths_free(&S->pout);
 }
@@ -2752,7 +2894,7 @@ static int run_reduction(const reduce_args *A, reduce_state *S, int method, cons
   o.hyper.deim_max = A->deim_max;
   o.hyper.allow_negative = A->deim_neg;
   o.dt = A->dt_map;
-  o.select.lambda_mode = A->lambda_auto;
+  o.select.lambda_mode = method == PHGMG_METHOD_GMG_QM ? A->lambda_auto : 0;
   o.qm.manifold = A->manifold;
   o.ref = A->ref;
   o.ref_x = A->ref == PHGMG_REF_GIVEN ? S->refm.a : NULL;
@@ -2764,8 +2906,9 @@ static int run_reduction(const reduce_args *A, reduce_state *S, int method, cons
   progress("reducing: %s, r = %d%s", A->method, A->r, method == PHGMG_METHOD_GMG_QM ? " (quadratic manifold)" : "");
   t0 = now_s();
   plog.t0 = t0; plog.all = (double)N * (double)ns >= 1e7; plog.ncand = plog.nprobe = 0;
+  plog.qm = method == PHGMG_METHOD_GMG_QM; plog.hyper = o.hyper.on;
   if (!g_quiet) { o.progress = reduce_phase; o.progress_user = &plog; }
-  rc = phgmg_reduce(&S->red, &S->sys, X, N, ns, &o, &info, NULL);
+  rc = S->study ? phgmg_study_reduce(S->study, &o, &S->red, &info) : phgmg_reduce(&S->red, &S->sys, X, N, ns, &o, &info, NULL);
   *t_red = now_s() - t0;
   if (rc != PHGMG_OK) {
     const char *src = A->X ? A->X : "the simulated snapshots";
@@ -2867,6 +3010,7 @@ static int write_arrays(const reduce_args *A, reduce_state *S, const double *X, 
   {
     /* V0 = Dphi(0), the linear part of the reduction map (exactly V0 for every method). */
     double *xr0 = (double *)calloc((size_t)rom->r, sizeof(double));
+    free(S->V0);
     S->V0 = (double *)malloc(sizeof(double) * (size_t)N * (size_t)rom->r);
     if (!xr0 || !S->V0) { free(xr0); return fail("out of memory"); }
     phgmg_reduced_dphi(S->red, xr0, S->V0, N);
@@ -3070,20 +3214,84 @@ static int write_model_files(const reduce_args *A, reduce_state *S, int method, 
   return write_json(A, S, method, ns, t_sim, t_red, o, info, ol);
 }
 
-/* Every output of the run moves into place; then the arrays an earlier run
-   recorded and this one did not write are removed. */
-static int reduce_commit(const reduce_args *A, reduce_state *S) {
-  const phgmg_rom *rom = phgmg_reduced_rom(S->red);
+/* Model k's outputs move into place; then the arrays an earlier run
+   recorded under its name and this one did not write are removed. */
+static int commit_model(const reduce_args *A, reduce_state *S, sweep_model *M) {
   outlist rec;
   char nfull[64] = "";
-  read_record(A->out, A->name, &rec); /* before this run's record replaces it */
-  if (stage_commit(&S->sg)) return 1;
-  remove_stale(A->out, &rec, &S->ol);
+  read_record(A->out, M->name, &rec); /* before this run's record replaces it */
+  if (stage_commit(&M->sg)) return 1;
+  remove_stale(A->out, &rec, &M->ol);
   if (S->dae) /* the arrays are full-size; the reduction ran on the differential states */
     snprintf(nfull, sizeof nfull, ", of which %d differential", S->sys.N);
   printf("wrote %s/%s.phgmgrom, %s/%s.c, %s/%s.json and %d arrays %s/%s_*.npy (%s, r = %d, m = %d, N = %d%s)\n",
-         A->out, A->name, A->out, A->name, A->out, A->name, S->ol.n, A->out, A->name, method_name(S->method),
-         rom->r, rom->m, S->full.N, nfull);
+         A->out, M->name, A->out, M->name, A->out, M->name, M->ol.n, A->out, M->name, method_name(M->method),
+         M->rr, M->m, S->full.N, nfull);
+  return 0;
+}
+
+/* NAME_sweep.json of a sweep: every model with its method, order, name,
+   reduction time, whether it was written, and validate's tests (nt, names). */
+static int write_sweep_json(const reduce_args *A, reduce_state *S, const char *const *tests, int nt) {
+  char path[4096 + 256];
+  const char *wp;
+  FILE *jf;
+  int k, t;
+  snprintf(path, sizeof path, "%s/%s_sweep.json", A->out, A->name0);
+  if (!(wp = stage_path(&S->sweep_sg, path))) return 1;
+  if (!(jf = fopen(wp, "w"))) return fail("%s: cannot write: %s", path, strerror(errno));
+  fprintf(jf, "{\n  \"phgmg_version\": \"%s\",\n  \"name\": ", PHGMG_VERSION_STRING);
+  json_str(jf, A->name0);
+  fprintf(jf, ",\n  \"naming\": \"NAME_<method>_r<R>, method with '-' as '_'\",\n");
+  fprintf(jf, "  \"shared_bases\": %s,\n  \"snapshot_seconds\": ", S->study ? "true" : "false");
+  json_num(jf, S->t_sim);
+  fprintf(jf, ",\n  \"models\": [");
+  for (k = 0; k < S->nmodels; ++k) {
+    const sweep_model *M = &S->models[k];
+    fprintf(jf, "%s\n    {\"name\": ", k ? "," : "");
+    json_str(jf, M->name);
+    fprintf(jf, ", \"method\": \"%s\", \"r\": %d, \"json\": ", method_name(M->method), M->r);
+    {
+      char f[128];
+      snprintf(f, sizeof f, "%s.json", M->name);
+      json_str(jf, f);
+    }
+    fprintf(jf, ", \"reduce_seconds\": "); json_num(jf, M->t_red);
+    fprintf(jf, ", \"written\": %s", M->pass ? "true" : "false");
+    if (nt > 0) {
+      fprintf(jf, ", \"tests\": [");
+      for (t = 0; t < nt; ++t) {
+        fprintf(jf, "%s{\"input\": ", t ? ", " : "");
+        json_str(jf, tests[t]);
+        fprintf(jf, ", \"e_y\": "); json_num(jf, M->ey[t]);
+        fprintf(jf, ", \"e_red\": "); json_num(jf, M->ered[t]);
+        fprintf(jf, ", \"pass\": %s}", M->tpass[t] ? "true" : "false");
+      }
+      fprintf(jf, "]");
+    }
+    fprintf(jf, "}");
+  }
+  fprintf(jf, "\n  ]\n}\n");
+  if (fclose(jf) != 0) return fail("%s: write error", path);
+  return 0;
+}
+
+/* Every model marked pass moves into place (reduce: all of them), then a
+   sweep's record. 1 if a commit failed. */
+static int reduce_commit(const reduce_args *A, reduce_state *S, const char *const *tests, int nt) {
+  int k, any = 0;
+  if (S->nmodels > 1 && write_sweep_json(A, S, tests, nt)) return 1;
+  for (k = 0; k < S->nmodels; ++k) {
+    if (!S->models[k].pass) { stage_abort(&S->models[k].sg); continue; }
+    if (commit_model(A, S, &S->models[k])) return 1;
+    any = 1;
+  }
+  if (S->nmodels > 1) {
+    if (stage_commit(&S->sweep_sg)) return 1;
+    any = 1;
+    printf("wrote %s/%s_sweep.json (%d models)\n", A->out, A->name0, S->nmodels);
+  }
+  if (any) stage_free(&S->dirs, 0);   /* the directories stay */
   return 0;
 }
 
@@ -3126,14 +3334,23 @@ static void register_inputs(const reduce_args *A, pathset *ps, const char *const
 static void reduce_paths(const reduce_args *A, reduce_state *S, const char *const *tests, int nt) {
   char path[4096 + 256];
   int k;
+  reduce_args T = *A;
+  char nm[128];
+  int j;
   register_inputs(A, &S->pin, tests, nt);
-  snprintf(path, sizeof path, "%s/%s.phgmgrom", A->out, A->name); paths_add(&S->pout, "--out/--name", path, 1);
-  snprintf(path, sizeof path, "%s/%s.c", A->out, A->name); paths_add(&S->pout, "--out/--name", path, 1);
-  snprintf(path, sizeof path, "%s/%s.json", A->out, A->name); paths_add(&S->pout, "--out/--name", path, 1);
-  for (k = 0; all_fields[k]; ++k) {
-    if (!A->save_snap && (!strcmp(all_fields[k], "snapshots") || !strcmp(all_fields[k], "fom_y"))) continue;
-    snprintf(path, sizeof path, "%s/%s_%s.npy", A->out, A->name, all_fields[k]);
-    paths_add(&S->pout, "--out/--name", path, 1);
+  if (sweep_count(A) > 1) {
+    snprintf(path, sizeof path, "%s/%s_sweep.json", A->out, A->name0); paths_add(&S->pout, "--out/--name", path, 1);
+  }
+  for (j = 0; j < sweep_count(A); ++j) {
+    sweep_set(&T, j, nm, sizeof nm);
+    snprintf(path, sizeof path, "%s/%s.phgmgrom", T.out, T.name); paths_add(&S->pout, "--out/--name", path, 1);
+    snprintf(path, sizeof path, "%s/%s.c", T.out, T.name); paths_add(&S->pout, "--out/--name", path, 1);
+    snprintf(path, sizeof path, "%s/%s.json", T.out, T.name); paths_add(&S->pout, "--out/--name", path, 1);
+    for (k = 0; all_fields[k]; ++k) {
+      if (!T.save_snap && (!strcmp(all_fields[k], "snapshots") || !strcmp(all_fields[k], "fom_y"))) continue;
+      snprintf(path, sizeof path, "%s/%s_%s.npy", T.out, T.name, all_fields[k]);
+      paths_add(&S->pout, "--out/--name", path, 1);
+    }
   }
 }
 
@@ -3150,7 +3367,9 @@ static int method_code(const char *m) {
    output an input or another output, the output directory usable, the files
    read and the system valid, the sizes. */
 static int reduce_prepare(const reduce_args *A, reduce_state *S, const char *const *tests, int nt) {
-  int e;
+  int e, k;
+  reduce_args T = *A;
+  char nm[128];
   if ((S->method = method_code(A->method)) < 0)
     return usage_error("--method '%s': expected gmg-pod, gmg-qm, sp1 or sp2", A->method);
   reduce_paths(A, S, tests, nt);
@@ -3162,32 +3381,94 @@ static int reduce_prepare(const reduce_args *A, reduce_state *S, const char *con
     return 1;
   if ((e = load_system(A, S)) != 0) return e;
   if ((A->simulate || A->nxin || nt) && check_dt_scale(A, S)) return 1;
-  if (check_extras(A, S)) return 1;
-  if ((e = check_sizes(A, S->method, S->sys.N, S->sys.m, S->dae ? phgmg_dae_nalg(S->dae) : 0)) != 0) return e;
+  for (k = 0; k < sweep_count(A); ++k) {   /* every model of a sweep, before any of them is built */
+    sweep_set(&T, k, nm, sizeof nm);
+    S->method = method_code(T.method);
+    if (check_extras(&T, S)) return 1;
+    if ((e = check_sizes(&T, S->method, S->sys.N, S->sys.m, S->dae ? phgmg_dae_nalg(S->dae) : 0)) != 0) return e;
+  }
+  S->method = method_code(A->method);
   return A->X ? load_snapshot_files(A, S, S->sys.N, S->sys.m, &S->Xd, &S->ns) : 0;
+}
+
+/* A sweep's shared bases: a study over the snapshots for the largest order
+   asked (phgmg_study_create), so that each model's reduction works in the
+   study's coordinates. A model class the study does not take (a mass
+   matrix, feedthrough) or a study that fails: each model computes its own
+   bases (said in the log). */
+static void sweep_study(const reduce_args *A, reduce_state *S, const double *X, int ns) {
+  const int N = S->sys.N, m = S->sys.m;
+  phgmg_study_opts so;
+  phgmg_result rc;
+  int k, kmax = 0;
+  unsigned what = 0;
+  if (sweep_count(A) < 2) return;
+  for (k = 0; k < sweep_count(A); ++k) {
+    const int mc = A->mlist[k / A->nrl], r = A->rlist[k % A->nrl];
+    if (mc == PHGMG_METHOD_GMG_POD || (mc == PHGMG_METHOD_GMG_QM && A->rn != PHGMG_RN_WIDE)) {
+      const int rn = mc == PHGMG_METHOD_GMG_QM ? (A->rn ? A->rn : default_rn(N, r, m)) : 0;
+      what |= PHGMG_STUDY_GMG;
+      kmax = PHGMG__MAX(kmax, r - m + rn);
+    } else if (mc == PHGMG_METHOD_SP1 || mc == PHGMG_METHOD_SP2) {
+      what |= mc == PHGMG_METHOD_SP2 ? PHGMG_STUDY_SP2 : PHGMG_STUDY_SP;
+      kmax = PHGMG__MAX(kmax, r);
+    }
+  }
+  kmax = PHGMG__MIN(kmax + 1, PHGMG__MIN(N, ns));   /* one mode more: sigma_{r'+1} for the log */
+  if (!what || kmax < 1) return;
+  memset(&so, 0, sizeof so);
+  so.what = what; so.kmax = kmax;
+  progress("sweep of %d models: the snapshots' bases once, for up to %d modes", sweep_count(A), kmax);
+  rc = phgmg_study_create(&S->study, &S->sys, X, N, ns, &so, NULL);
+  if (rc != PHGMG_OK) {
+    S->study = NULL;
+    progress("  shared bases not available for this model (%s): each model computes its own",
+             phgmg_result_string(rc));
+  }
 }
 
 /* The snapshots, the reduction and every output written under its temporary
    name (reduce_commit moves them into place). */
-static int reduce_build(const reduce_args *A, reduce_state *S) {
-  phgmg_reduce_opts o;
-  phgmg_reduce_info info;
-  double t_sim = 0.0, t_red = 0.0;
+static int reduce_build(const reduce_args *A, reduce_state *S, int keep) {
   const double *X = S->Xd;
-  int ns = S->ns, e;
-  memset(&o, 0, sizeof o);
-  memset(&info, 0, sizeof info);
-  if (!A->X && (e = simulate_training_runs(A, S, &X, &ns, &t_sim)) != 0) return e;
-  if ((e = run_reduction(A, S, S->method, X, ns, &o, &info, &t_red)) != 0) return e;
-  if ((e = write_arrays(A, S, X, ns, &S->ol)) != 0) return e;
-  return write_model_files(A, S, S->method, ns, t_sim, t_red, &o, &info, &S->ol);
+  int ns = S->ns, e, k;
+  S->dirs = S->sg;   /* the directories made; each model stages its own files */
+  memset(&S->sg, 0, sizeof S->sg);
+  S->nmodels = sweep_count(A);
+  S->models = (sweep_model *)calloc((size_t)S->nmodels, sizeof(sweep_model));
+  if (!S->models) return fail("out of memory");
+  if (!A->X && (e = simulate_training_runs(A, S, &X, &ns, &S->t_sim)) != 0) return e;
+  sweep_study(A, S, X, ns);
+  for (k = 0; k < S->nmodels; ++k) {
+    sweep_model *M = &S->models[k];
+    reduce_args T = *A;
+    phgmg_reduce_opts o;
+    phgmg_reduce_info info;
+    const phgmg_rom *rom;
+    memset(&o, 0, sizeof o);
+    memset(&info, 0, sizeof info);
+    sweep_set(&T, k, M->name, sizeof M->name);
+    M->method = S->method = method_code(T.method);
+    M->r = T.r;
+    if ((e = run_reduction(&T, S, S->method, X, ns, &o, &info, &M->t_red)) != 0) return e;
+    if ((e = write_arrays(&T, S, X, ns, &S->ol)) != 0) return e;
+    if ((e = write_model_files(&T, S, S->method, ns, S->t_sim, M->t_red, &o, &info, &S->ol)) != 0) return e;
+    rom = phgmg_reduced_rom(S->red);
+    M->rr = rom->r; M->m = rom->m; M->pass = 1;
+    M->sg = S->sg; M->ol = S->ol;
+    memset(&S->sg, 0, sizeof S->sg);
+    if (keep) M->red = S->red;
+    else phgmg_reduced_destroy(S->red);
+    S->red = NULL;
+  }
+  return 0;
 }
 
 static int cmd_reduce_impl(const reduce_args *A, reduce_state *S) {
   int e;
   if ((e = reduce_prepare(A, S, NULL, 0)) != 0) return e;
-  if ((e = reduce_build(A, S)) != 0) return e;
-  return reduce_commit(A, S);
+  if ((e = reduce_build(A, S, 0)) != 0) return e;
+  return reduce_commit(A, S, NULL, 0);
 }
 
 static int cmd_reduce(int argc, char **argv) {
@@ -3636,33 +3917,58 @@ static int validate_error(const char *spec, phgmg_result rc, const reduce_state 
   return fail("validate: %s: %s", spec, phgmg_result_string(rc));
 }
 
-/* One test of validate: full and reduced model on input `spec` over nsteps
-   from x0 (NULL: 0); prints its line; 0 pass, 1 fail or error. */
-static int validate_one(const reduce_args *A, reduce_state *S, cli_input *in, const char *spec, int nsteps,
-                        const double *x0, double max_ey) {
+/* The largest order of the run's --r list. */
+static int max_order(const reduce_args *A) {
+  int k, r = 0;
+  for (k = 0; k < A->nrl; ++k) r = PHGMG__MAX(r, A->rlist[k]);
+  return r;
+}
+
+/* One test of validate: the full model and every model of the run on input
+   `spec` over nsteps from x0 (NULL: 0), one full run for all of them
+   (phgmg_reduced_validate_many); prints a line per model; a model that fails
+   loses its pass mark. Test t of the run. 0 all pass, 1 a fail or an error. */
+static int validate_test(const reduce_args *A, reduce_state *S, cli_input *in, const char *spec, int nsteps,
+                         const double *x0, double max_ey, int t) {
   const phgmg_ph_system sys = S->sys;   /* as reduced: any potential, sparse input in its internal order */
+  const phgmg_reduced *reds[32];
+  phgmg_validation vs[32];
   phgmg_run run;
-  phgmg_validation v;
   phgmg_result rc;
+  int k, bad = 0;
   memset(&run, 0, sizeof run);
   run.u = input_fn; run.user = in; run.dt = A->dt; run.nsteps = nsteps; run.x0 = x0;
-  rc = phgmg_reduced_validate(S->red, &sys, &run, A->newton_tol, A->newton_iter, max_ey, &v, NULL);
-  if (rc != PHGMG_OK) return validate_error(spec, rc, S, nsteps);
-  printf("%-24s %10.3e %10.3e %10.3e %10.3e %10.3e %8.2f %8ld %8ld %8d  %s\n", spec, v.e_red, v.e_y, v.e_proj,
-         v.e_energy, v.e_energy_fom, v.stats.steps ? (double)v.stats.newton_iters / v.stats.steps : 0.0,
-         v.stats.outside_steps, v.stats.q_outside_steps, v.first_failure, v.pass ? "pass" : "FAIL");
-  if (v.first_failure >= 0) {
-    printf("  first failing step: %d (t = %g -> %g): %s\n", v.first_failure, v.first_failure * A->dt,
-           (v.first_failure + 1) * A->dt, phgmg_result_string(v.rom_rc));
+  for (k = 0; k < S->nmodels; ++k) reds[k] = S->models[k].red;
+  rc = phgmg_reduced_validate_many(reds, S->nmodels, &sys, &run, A->newton_tol, A->newton_iter, max_ey, vs, NULL);
+  if (rc != PHGMG_OK) {
+    for (k = 0; k < S->nmodels; ++k) S->models[k].pass = 0;
+    S->red = S->models[0].red;
+    validate_error(spec, rc, S, nsteps);
+    S->red = NULL;
     return 1;
   }
-  if (!(isfinite(v.e_y) && isfinite(v.e_red) && isfinite(v.e_proj))) {
-    printf("  the error norms overflow the double range (states too large; try a smaller --test-amp)\n");
-    return 1;
+  for (k = 0; k < S->nmodels; ++k) {
+    const phgmg_validation *v = &vs[k];
+    sweep_model *M = &S->models[k];
+    char label[160];
+    if (S->nmodels > 1) snprintf(label, sizeof label, "%s [%s r=%d]", spec, method_name(M->method), M->r);
+    else snprintf(label, sizeof label, "%s", spec);
+    M->ey[t] = v->e_y; M->ered[t] = v->e_red; M->tpass[t] = 0;
+    printf("%-24s %10.3e %10.3e %10.3e %10.3e %10.3e %8.2f %8ld %8ld %8d  %s\n", label, v->e_red, v->e_y, v->e_proj,
+           v->e_energy, v->e_energy_fom, v->stats.steps ? (double)v->stats.newton_iters / v->stats.steps : 0.0,
+           v->stats.outside_steps, v->stats.q_outside_steps, v->first_failure, v->pass ? "pass" : "FAIL");
+    if (v->first_failure >= 0)
+      printf("  first failing step: %d (t = %g -> %g): %s\n", v->first_failure, v->first_failure * A->dt,
+             (v->first_failure + 1) * A->dt, phgmg_result_string(v->rom_rc));
+    else if (!(isfinite(v->e_y) && isfinite(v->e_red) && isfinite(v->e_proj)))
+      printf("  the error norms overflow the double range (states too large; try a smaller --test-amp)\n");
+    else if (!v->pass)
+      printf("  e_y %.3e above --max-ey %g\n", v->e_y, max_ey);
+    if (v->pass && v->first_failure < 0 && isfinite(v->e_y) && isfinite(v->e_red) && isfinite(v->e_proj))
+      M->tpass[t] = 1;
+    else { M->pass = 0; bad = 1; }
   }
-  if (v.pass) return 0;
-  printf("  e_y %.3e above --max-ey %g\n", v.e_y, max_ey);
-  return 1;
+  return bad;
 }
 
 /* ---- validate: reduce, then check the reduced model against the full one ----
@@ -3708,21 +4014,23 @@ static int cmd_validate(int argc, char **argv) {
     steps[k] = V.steps_t ? V.steps_t : !A.X ? A.steps : (run ? S.Xs[run].cols : S.X.cols) - 1;
     status = input_setup(&tin[k], "--test-input", V.tests[k], V.have_amp ? V.amp_t : A.amp, S.sys.m, A.dt);
     if (!status) input_covers(&tin[k], V.tests[k], "--test-input", steps[k] * A.dt);
-    if (!status && too_big(((double)S.sys.N + 2.0 * S.sys.m + A.r + 8.0) * ((double)steps[k] + 1.0),
+    if (!status && too_big(((double)S.sys.N + 2.0 * S.sys.m + max_order(&A) + 8.0) * ((double)steps[k] + 1.0),
                            "validate: a test run (the full model's states and outputs, N x (steps+1))"))
       status = 2;
   }
-  if (!status) status = reduce_build(&A, &S);
+  if (!status) status = reduce_build(&A, &S, 1);
   if (status == 0) {
     printf("%-24s %10s %10s %10s %10s %10s %8s %8s %8s %8s  %s\n", "test input", "e_red", "e_y", "e_proj", "e_energy",
            "(FOM)", "newton", "outside", "q-out", "fail@", "verdict");
     for (k = 0; k < nt; ++k)
-      if (validate_one(&A, &S, &tin[k], V.tests[k], steps[k], from_x[k] ? S.runs[k].x0 : NULL, V.max_ey)) status = 1;
+      if (validate_test(&A, &S, &tin[k], V.tests[k], steps[k], from_x[k] ? S.runs[k].x0 : NULL, V.max_ey, k))
+        status = 1;
     printf("validate: %s\n", status ? "FAILED" : "passed");
-    if (status == 0) status = reduce_commit(&A, &S);
-    else
-      printf("validate: the model was not written: %s/%s.* is unchanged (the same options with `phgmg reduce` "
-             "write the failing model)\n", A.out, A.name);
+    for (k = 0; k < S.nmodels; ++k)
+      if (!S.models[k].pass)
+        printf("validate: the model was not written: %s/%s.* is unchanged (the same options with `phgmg reduce` "
+               "write the failing model)\n", A.out, S.models[k].name);
+    if (reduce_commit(&A, &S, V.tests, nt)) status = 1;
   }
   for (k = 0; k < 16; ++k) mat_free(&tin[k].tab);
   reduce_cleanup(&S);

@@ -66,6 +66,40 @@ TEST(test_validate_many_matches_own_runs) {
   dmodel_free(&t);
 }
 
+/* A study's models report the POD's sigma_{r'+1}/sigma_1 as phgmg_reduce
+   does (GMG on the adjusted snapshots, SP1 on X). */
+TEST(test_study_reports_sigma_ratio) {
+  dmodel t;
+  const int n = 20, N = 40, ns = 201;
+  const phgmg_method meth[2] = {PHGMG_METHOD_GMG_POD, PHGMG_METHOD_SP1};
+  double *X = (double *)calloc((size_t)N * ns, sizeof(double)), *x0 = (double *)calloc((size_t)N, sizeof(double));
+  phgmg_study *st = NULL;
+  phgmg_study_opts so;
+  int k;
+  dmodel_msd(&t, n);
+  CHECK_RC(phgmg_simulate(&t.sys, x0, 0.0, 0.1, ns - 1, wf_u_sin, NULL, NULL, X, NULL, NULL, NULL, NULL, NULL), PHGMG_OK);
+  memset(&so, 0, sizeof so);
+  so.kmax = 14;
+  CHECK_RC(phgmg_study_create(&st, &t.sys, X, N, ns, &so, NULL), PHGMG_OK);
+  for (k = 0; k < 2; ++k) {
+    phgmg_reduce_opts o;
+    phgmg_reduce_info i1, i2;
+    phgmg_reduced *a = NULL, *b = NULL;
+    phgmg_reduce_opts_default(&o);
+    o.method = meth[k]; o.r = 8;
+    CHECK_RC(phgmg_reduce(&a, &t.sys, X, N, ns, &o, &i1, NULL), PHGMG_OK);
+    CHECK_RC(phgmg_study_reduce(st, &o, &b, &i2), PHGMG_OK);
+    CHECK(i1.pod_sigma_ratio > 0.0);
+    CHECK_LE(fabs(i2.pod_sigma_ratio - i1.pod_sigma_ratio), 1e-8 * i1.pod_sigma_ratio);
+    phgmg_reduced_destroy(a);
+    phgmg_reduced_destroy(b);
+  }
+  phgmg_study_destroy(st);
+  free(X); free(x0);
+  dmodel_free(&t);
+}
+
 SUITE(workflow) {
+  RUN(test_study_reports_sigma_ratio);
   RUN(test_validate_many_matches_own_runs);
 }

@@ -1,0 +1,116 @@
+#!/bin/sh
+# test_cli_workflow.sh — the command line in a finite-element engineer's
+# workflow.
+#
+# Usage: sh tests/test_cli_workflow.sh build/phgmg      (from the repository root)
+#
+# A damped mass-spring chain of 12 masses (N = 24, one force port):
+# 1. a sweep in one call: reduce --method gmg-pod,sp1 --r 4,6,8 writes
+#    NAME_<method>_r<R>.* for every pair and NAME_sweep.json listing them;
+#    each model equals the model a single-model reduce builds (to 1e-12);
+#    validate --r 2,16 (one full run per test for both) writes the models that pass, not those that
+#    fail (exit 1), and records every test in NAME_sweep.json.
+# 2. cheap checks before any work: a malformed list, an order too large for
+#    one of the models, an unknown method in a list -- status 2, nothing
+#    simulated, nothing written.
+# Needs NumPy/SciPy (/usr/bin/python3) to write the inputs (skipped otherwise).
+set -u
+P=${1:-build/phgmg}
+case "$P" in /*) ;; *) P="$PWD/$P" ;; esac
+PY=/usr/bin/python3
+T=$(mktemp -d "${TMPDIR:-/tmp}/phgmg_wf.XXXXXX") || exit 1
+trap 'rm -rf "$T"' EXIT INT TERM
+npass=0
+nfail=0
+pass() { npass=$((npass + 1)); }
+bad() { echo "FAIL: $*"; nfail=$((nfail + 1)); }
+[ -x "$P" ] || { echo "test_cli_workflow: $P is not an executable (build it first)"; exit 1; }
+cd "$T" || exit 1
+if ! "$PY" -c 'import numpy, scipy' 2>/dev/null; then
+  echo "test_cli_workflow: skipped ($PY has no NumPy/SciPy)"
+  exit 0
+fi
+"$PY" - <<'PYEOF' || bad "writing the chain"
+import numpy as np
+n = 12
+K = 2 * np.eye(n) - np.eye(n, k=1) - np.eye(n, k=-1)
+Z = np.zeros((n, n))
+J = np.block([[Z, np.eye(n)], [-np.eye(n), Z]])
+R = np.block([[Z, Z], [Z, 0.1 * np.eye(n)]])
+Q = np.block([[K, Z], [Z, np.eye(n)]])
+B = np.zeros(2 * n); B[n] = 1.0
+for k, v in dict(J=J, R=R, Q=Q, B=B).items():
+    np.save(k + ".npy", v)
+PYEOF
+SYS="--J J.npy --R R.npy --Q Q.npy --B B.npy"
+TRAIN="--simulate --steps 200 --dt 0.1"
+close() { "$PY" -c "
+import numpy as np, sys
+a, b = np.load('$1'), np.load('$2')
+sys.exit(0 if a.shape == b.shape and np.abs(a - b).max() <= 1e-12 * max(1.0, np.abs(b).max()) else 1)"; }
+
+# 1. reduce: a sweep over two methods and three orders
+"$P" reduce $SYS $TRAIN --method gmg-pod,sp1 --r 4,6,8 --out sw >out.txt 2>err.txt && pass \
+  || bad "reduce sweep: $(tail -n 2 err.txt)"
+for m in gmg_pod sp1; do for r in 4 6 8; do
+  for f in rom_${m}_r$r.phgmgrom rom_${m}_r$r.c rom_${m}_r$r.json rom_${m}_r${r}_Qh.npy rom_${m}_r${r}_V0.npy; do
+    [ -f "sw/$f" ] && pass || bad "sweep: sw/$f missing"
+  done
+done; done
+[ -f sw/rom.phgmgrom ] && bad "a sweep wrote the single-model name rom.phgmgrom" || pass
+"$PY" - <<'PYEOF' && pass || bad "rom_sweep.json does not list the six models"
+import json
+d = json.load(open("sw/rom_sweep.json"))
+got = sorted((m["method"], m["r"], m["name"], m["written"]) for m in d["models"])
+want = sorted((me, r, "rom_%s_r%d" % (me.replace("-", "_"), r), True) for me in ("gmg-pod", "sp1") for r in (4, 6, 8))
+assert got == want, got
+for m in d["models"]:
+    j = json.load(open("sw/" + m["json"]))
+    assert j["method"] == m["method"] and j["r"] == m["r"], j
+PYEOF
+grep -c "^phgmg: simulating the full model" err.txt | grep -qx 1 && pass \
+  || bad "the sweep did not simulate the training run once: $(grep -c simulating err.txt)"
+# each model of the sweep is the model a reduce of that (method, r) alone builds
+"$P" reduce $SYS $TRAIN --method gmg-pod --r 6 --out one --name g6 >/dev/null 2>err.txt && pass || bad "reduce r 6"
+"$P" reduce $SYS $TRAIN --method sp1 --r 8 --out one --name s8 >/dev/null 2>err.txt && pass || bad "reduce sp1 r 8"
+for f in Qh K Bh V0; do
+  close sw/rom_gmg_pod_r6_$f.npy one/g6_$f.npy && pass || bad "sweep gmg-pod r 6: $f differs from the single model's"
+  close sw/rom_sp1_r8_$f.npy one/s8_$f.npy && pass || bad "sweep sp1 r 8: $f differs from the single model's"
+done
+"$PY" -c "
+import json, sys
+a, b = json.load(open('sw/rom_gmg_pod_r6.json')), json.load(open('one/g6.json'))
+x, y = a['info']['pod_sigma_ratio'], b['info']['pod_sigma_ratio']
+sys.exit(0 if y > 0 and abs(x - y) <= 1e-8 * y else 1)" && pass || bad "the sweep's sigma ratio is not the single model's"
+
+# validate: a sweep whose small order fails --max-ey
+"$P" validate $SYS $TRAIN --method gmg-pod --r 2,16 --max-ey 0.05 --out va >vout.txt 2>verr.txt
+[ $? -eq 1 ] && pass || bad "validate sweep with a failing model: status not 1: $(tail -n 3 vout.txt verr.txt)"
+[ -f va/rom_gmg_pod_r16.phgmgrom ] && pass || bad "validate sweep: the passing model r = 16 was not written"
+[ -f va/rom_gmg_pod_r2.phgmgrom ] && bad "validate sweep: the failing model r = 2 was written" || pass
+grep -q "sin \[gmg-pod r=2\]" vout.txt && grep -q "sin \[gmg-pod r=16\]" vout.txt && pass \
+  || bad "validate sweep: no line per model: $(cat vout.txt)"
+"$PY" - <<'PYEOF' && pass || bad "va/rom_sweep.json does not record the tests"
+import json
+d = json.load(open("va/rom_sweep.json"))
+m = {x["r"]: x for x in d["models"]}
+assert m[2]["written"] is False and m[16]["written"] is True
+assert m[2]["tests"][0]["input"] == "sin" and m[2]["tests"][0]["pass"] is False
+assert m[16]["tests"][0]["e_y"] < 0.05 < m[2]["tests"][0]["e_y"]
+PYEOF
+
+# 2. cheap checks first
+for spec in "4,,6" "4,4" "0" "4," "a"; do
+  "$P" reduce $SYS $TRAIN --method gmg-pod --r "$spec" --out bad1 >/dev/null 2>err.txt
+  [ $? -eq 2 ] && pass || bad "--r '$spec': status not 2"
+done
+"$P" reduce $SYS $TRAIN --method gmg-pod,sp3 --r 4 --out bad1 >/dev/null 2>err.txt
+[ $? -eq 2 ] && grep -q "sp3\|gmg-pod,sp3" err.txt && pass || bad "--method gmg-pod,sp3: $(cat err.txt)"
+"$P" reduce $SYS $TRAIN --method gmg-pod,sp1 --r 4,30 --out bad2 >/dev/null 2>err.txt
+st=$?
+[ $st -eq 2 ] && grep -q -- "--r 30" err.txt && pass || bad "--r 4,30 with N = 24: status $st: $(cat err.txt)"
+grep -q "simulating" err.txt && bad "--r 4,30: simulated before refusing" || pass
+[ -e bad2 ] && bad "--r 4,30: the output directory was left behind" || pass
+
+echo "test_cli_workflow: $npass passed, $nfail failed"
+[ "$nfail" -eq 0 ]
