@@ -463,7 +463,9 @@
 
    2.6 Sparse models (>>ph, >>sparse). phgmg_ph_sparse_create takes J, R, Q
    (and E; or all of them in one phgmg_ph_sparse_desc:
-   phgmg_ph_sparse_create_desc) as compressed sparse columns in any ordering, reorders them by
+   phgmg_ph_sparse_create_desc) as compressed sparse columns in any ordering
+   (assembled triplets with duplicates: phgmg_csc_from_coo sums them into a
+   phgmg_csc, phgmg_csc_free releases it), reorders them by
    reverse Cuthill-McKee into band storage and, for meshes (a wide band),
    also analyses a sparse LU of the GL3 stage matrices: block elimination
    of an independent set of states first (a mass-spring model's positions:
@@ -1748,7 +1750,8 @@
            phgmg_jr_factor_create, phgmg_jr_solve, phgmg_jr_factor_destroy,
            phgmg_dae_create, phgmg_dae_system, phgmg_dae_nalg,
            phgmg_dae_restrict, phgmg_dae_embed, phgmg_dae_lift,
-           phgmg_dae_destroy, phgmg_rcm, phgmg_ph_sparse_create, phgmg_ph_sparse_create_e,
+           phgmg_dae_destroy, phgmg_csc_from_coo, phgmg_csc_free, phgmg_rcm,
+           phgmg_ph_sparse_create, phgmg_ph_sparse_create_e,
            phgmg_ph_sparse_create_desc,
            phgmg_ph_sparse_system,
            phgmg_ph_sparse_perm, phgmg_ph_sparse_sep_idx,
@@ -1799,7 +1802,7 @@
            phgmg_lu_rcond, phgmg_norm1, phgmg_normf, phgmg_zlu_factor,
            phgmg_zlu_solve, phgmg_qr, phgmg_qrcp, phgmg_qr_form_q,
            phgmg_qr_apply, phgmg_lstsq, phgmg_svd, phgmg_sym_eig
-   (154 functions; 17 of them only with PHGMG_MPI; also the macros
+   (156 functions; 17 of them only with PHGMG_MPI; also the macros
    PHGMG_ROM_STEPPER_MEMSIZE_MAX and _MAX_CB.)
 */
 #ifndef PHGMG_H_INCLUDED
@@ -2170,6 +2173,22 @@ typedef struct phgmg_csc {
   const int *rowidx;    /* nnz        */
   const double *values; /* nnz        */
 } phgmg_csc;
+
+/* A CSC matrix from coordinate triplets, as finite-element assembly writes
+   them: entry k adds vals[k] at (rows[k], cols[k]) (0-based), and entries
+   at the same position are summed (as scipy.sparse's coo -> csc does; a sum
+   that is zero stays a stored entry). The rows of each column come out
+   strictly increasing. Two stable counting sorts: O(nnz + n_rows + n_cols)
+   time, memory 2 nnz + n_rows + n_cols extra. *out owns its arrays (one
+   block): free them with phgmg_csc_free. PHGMG_ERR_INVALID_ARG (NULL out,
+   NULL arrays with nnz > 0), _SIZE (n_rows or n_cols < 1, nnz < 0 or above
+   INT_MAX, an index outside the matrix), _NANINF (a value not finite),
+   _NOMEM; on an error *out is zeroed. */
+PHGMG_DEF phgmg_result phgmg_csc_from_coo(phgmg_csc *out, int n_rows, int n_cols, long nnz, const int *rows,
+                                          const int *cols, const double *vals, const phgmg_allocator *alloc);
+/* Frees what phgmg_csc_from_coo allocated (with the same allocator) and
+   zeroes *A; NULL or a zeroed struct is fine. */
+PHGMG_DEF void phgmg_csc_free(phgmg_csc *A, const phgmg_allocator *alloc);
 
 /* Reverse Cuthill-McKee ordering of the symmetric pattern of |A_0| + ... +
    |A_{na-1}| (each N x N CSC; the pattern is symmetrized, the diagonal
@@ -8111,6 +8130,66 @@ PHGMG__PRIV int phgmg__rcm_peripheral(const int *xadj, const int *adj, const int
   }
   for (i = 0; i < cnt; ++i) level[q[i]] = -1;
   return root;
+}
+
+/* The triplets' checks for phgmg_csc_from_coo: PHGMG_OK or the code. */
+PHGMG__PRIV phgmg_result phgmg__coo_check(int n_rows, int n_cols, long nnz, const int *rows, const int *cols,
+                                          const double *vals) {
+  long k;
+  if (nnz > 0 && (!rows || !cols || !vals)) return PHGMG_ERR_INVALID_ARG;
+  if (n_rows < 1 || n_cols < 1 || nnz < 0 || nnz > 2147483646L) return PHGMG_ERR_SIZE;
+  for (k = 0; k < nnz; ++k)
+    if (rows[k] < 0 || rows[k] >= n_rows || cols[k] < 0 || cols[k] >= n_cols) return PHGMG_ERR_SIZE;
+  for (k = 0; k < nnz; ++k)
+    if (!isfinite(vals[k])) return PHGMG_ERR_NANINF;
+  return PHGMG_OK;
+}
+
+PHGMG_DEF phgmg_result phgmg_csc_from_coo(phgmg_csc *out, int n_rows, int n_cols, long nnz, const int *rows,
+                                          const int *cols, const double *vals, const phgmg_allocator *alloc) {
+  const int nz = (int)(nnz > 0 ? nnz : 0);
+  double *v, *tv;
+  int *cp, *ri, *rp, *tr, *tc, *pos, k, j, q;
+  phgmg_result rc;
+  if (!out) return PHGMG_ERR_INVALID_ARG;
+  memset(out, 0, sizeof *out);
+  if ((rc = phgmg__coo_check(n_rows, n_cols, nnz, rows, cols, vals)) != PHGMG_OK) return rc;
+  /* one block: values (nnz), then colptr (n_cols + 1), rowidx (nnz) */
+  v = PHGMG__CAST(double *, phgmg__alloc(alloc, (size_t)(nz + 1) * sizeof(double) +
+                                                    ((size_t)n_cols + 1 + (size_t)nz + 1) * sizeof(int)));
+  tv = phgmg__dalloc(alloc, (size_t)nz + 1);
+  rp = phgmg__ialloc(alloc, (size_t)n_rows + 1 + 2 * ((size_t)nz + 1) + (size_t)n_cols);
+  if (!v || !tv || !rp) { phgmg__free(alloc, v); phgmg__free(alloc, tv); phgmg__free(alloc, rp); return PHGMG_ERR_NOMEM; }
+  cp = PHGMG__CAST(int *, (void *)(v + nz + 1)); ri = cp + n_cols + 1;
+  tr = rp + n_rows + 1; tc = tr + nz + 1; pos = tc + nz + 1;
+  /* pass 1: stable by row into (tc, tv); pass 2: stable by column, so rows ascend within each column */
+  memset(rp, 0, sizeof(int) * ((size_t)n_rows + 1));
+  for (k = 0; k < nz; ++k) rp[rows[k] + 1]++;
+  for (j = 0; j < n_rows; ++j) rp[j + 1] += rp[j];
+  for (k = 0; k < nz; ++k) { q = rp[rows[k]]++; tr[q] = rows[k]; tc[q] = cols[k]; tv[q] = vals[k]; }
+  memset(cp, 0, sizeof(int) * ((size_t)n_cols + 1));
+  for (k = 0; k < nz; ++k) cp[tc[k] + 1]++;
+  for (j = 0; j < n_cols; ++j) { cp[j + 1] += cp[j]; pos[j] = cp[j]; }
+  for (k = 0; k < nz; ++k) { q = pos[tc[k]]++; ri[q] = tr[k]; v[q] = tv[k]; }
+  for (j = 0, q = 0; j < n_cols; ++j) {   /* sum the duplicates, compact in place */
+    const int a = cp[j], b = cp[j + 1];
+    cp[j] = q;
+    for (k = a; k < b; ++k) {
+      if (q > cp[j] && ri[q - 1] == ri[k]) v[q - 1] += v[k];
+      else { ri[q] = ri[k]; v[q] = v[k]; ++q; }
+    }
+  }
+  cp[n_cols] = q;
+  phgmg__free(alloc, tv);
+  phgmg__free(alloc, rp);
+  out->n_rows = n_rows; out->n_cols = n_cols; out->colptr = cp; out->rowidx = ri; out->values = v;
+  return PHGMG_OK;
+}
+
+PHGMG_DEF void phgmg_csc_free(phgmg_csc *A, const phgmg_allocator *alloc) {
+  if (!A) return;
+  phgmg__free(alloc, (void *)A->values);
+  memset(A, 0, sizeof *A);
 }
 
 PHGMG_DEF phgmg_result phgmg_rcm(int N, int na, const phgmg_csc *const *A, int *perm, int *kb_out,

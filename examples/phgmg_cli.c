@@ -326,7 +326,8 @@ static const char *const help_lines[] = {
   "SPARSE MATRICES\n",
   "  SPEC is one (nnz, 3) array of rows (row, col, value), or three vectors\n",
   "  rows.npy,cols.npy,vals.npy (comma-separated, no spaces): 0-based integer indices\n",
-  "  in [0, N), duplicates summed (as scipy.sparse does). The stepper's stage\n",
+  "  in [0, N), duplicates summed (as scipy.sparse does; the library's\n",
+  "  phgmg_csc_from_coo does it in C for your own code). The stepper's stage\n",
   "  systems are solved by the header's sparse direct LU (fill-reducing ordering,\n",
   "  with a mass matrix a column matching that keeps the pivots on E's large\n",
   "  entries) or, where that is predicted cheaper (narrow bands), by a band LU after\n",
@@ -1765,26 +1766,49 @@ static int check_reduce_args(reduce_args *A, const char *const *seen, int nseen)
 
 /* ---- sparse matrices from coordinate triplets ------------------------------------ */
 typedef struct cli_csc {
-  phgmg_csc A;
-  int *cp, *ri;
-  double *v;
+  phgmg_csc A;      /* phgmg_csc_from_coo's; cp, v its colptr and values (NULL: none) */
+  const int *cp;
+  const double *v;
 } cli_csc;
-static void cli_csc_free(cli_csc *c) { free(c->cp); free(c->ri); free(c->v); memset(c, 0, sizeof *c); }
+static void cli_csc_free(cli_csc *c) { phgmg_csc_free(&c->A, NULL); memset(c, 0, sizeof *c); }
 
 /* Entry k of a triplet source: rows/cols/vals three vectors, or one (nnz, 3) array. */
-static int coo_index(const mat *M, int k, int which, int nnz, const char *spec, const char *opt, int N, int *out) {
+static int coo_index(const mat *M, int k, int which, int nnz, const char *spec, const char *opt, int N, int *out,
+                     int is_col) {
   const double v = M->a[(size_t)k + (size_t)which * (size_t)nnz];
   if (!(v >= 0.0 && v < (double)N && v == floor(v)))
     return fail("%s (%s): entry %d: %s index %g; expected an integer in [0, %d) (N from --B)", spec, opt, k,
-                which == 0 ? "row" : "column", v, N);
+                is_col ? "column" : "row", v, N);
   *out = (int)v;
   return 0;
+}
+
+/* The triplets (the index columns ci of rows and cols, the value column cv)
+   checked and summed into c by phgmg_csc_from_coo (duplicates summed, rows
+   sorted in each column). 0, or 1 after a message naming the entry. */
+static int coo_assemble(cli_csc *c, const mat *rows, const mat *cols, const mat *vals, int ci, int cv, int nnz,
+                        const char *spec, const char *opt, int N) {
+  int *ri = (int *)malloc(sizeof(int) * ((size_t)nnz + 1)), *cj = (int *)malloc(sizeof(int) * ((size_t)nnz + 1));
+  double *v = (double *)malloc(sizeof(double) * ((size_t)nnz + 1));
+  phgmg_result rc;
+  int k, err = 0;
+  if (!ri || !cj || !v) err = fail("out of memory");
+  for (k = 0; k < nnz && !err; ++k) {
+    if ((err = coo_index(rows, k, 0, nnz, spec, opt, N, &ri[k], 0)) == 0)
+      err = coo_index(cols, k, ci, nnz, spec, opt, N, &cj[k], 1);
+    v[k] = vals->a[(size_t)k + (size_t)cv * (size_t)nnz];
+  }
+  if (!err && (rc = phgmg_csc_from_coo(&c->A, N, N, nnz, ri, cj, v, NULL)) != PHGMG_OK)
+    err = fail("%s (%s): %s", spec, opt, phgmg_result_string(rc));
+  if (!err) { c->cp = c->A.colptr; c->v = c->A.values; }
+  free(ri); free(cj); free(v);
+  return err;
 }
 
 /* --X-coo SPEC into an N x N CSC matrix (columns sorted, duplicates summed). */
 static int load_coo(cli_csc *c, const char *opt, const char *spec, int N) {
   mat M[3];
-  int nf = 1, nnz, k, j, p, q, err = 0;
+  int nf = 1, nnz, k, j, err = 0;
   const mat *rows, *cols, *vals;
   char buf[3][4096];
   memset(M, 0, sizeof M);
@@ -1820,42 +1844,7 @@ static int load_coo(cli_csc *c, const char *opt, const char *spec, int N) {
       }
     rows = &M[0]; cols = &M[1]; vals = &M[2];
   }
-  c->cp = (int *)calloc((size_t)N + 1, sizeof(int));
-  c->ri = (int *)malloc(sizeof(int) * ((size_t)nnz + 1));
-  c->v = (double *)malloc(sizeof(double) * ((size_t)nnz + 1));
-  if (!c->cp || !c->ri || !c->v) { err = fail("out of memory"); goto done; }
-  for (k = 0; k < nnz && !err; ++k) { /* count per column */
-    int col;
-    if ((err = coo_index(cols, k, nf == 3 ? 0 : 1, nnz, spec, opt, N, &col)) == 0) c->cp[col + 1]++;
-  }
-  for (j = 0; j < N && !err; ++j) c->cp[j + 1] += c->cp[j];
-  for (k = 0; k < nnz && !err; ++k) { /* place; cp[j] advances to the end of column j */
-    int r, col;
-    if ((err = coo_index(rows, k, 0, nnz, spec, opt, N, &r)) != 0) break;
-    coo_index(cols, k, nf == 3 ? 0 : 1, nnz, spec, opt, N, &col);
-    c->ri[c->cp[col]] = r;
-    c->v[c->cp[col]++] = vals->a[(size_t)k + (nf == 3 ? 0u : 2u) * (size_t)nnz];
-  }
-  if (err) goto done;
-  for (j = N; j > 0; --j) c->cp[j] = c->cp[j - 1];
-  c->cp[0] = 0;
-  for (j = 0, q = 0; j < N; ++j) { /* sort each column by row (insertion), sum duplicates */
-    int start = c->cp[j], end = c->cp[j + 1];
-    for (p = start + 1; p < end; ++p) {
-      int r = c->ri[p], t;
-      double v = c->v[p];
-      for (t = p; t > start && c->ri[t - 1] > r; --t) { c->ri[t] = c->ri[t - 1]; c->v[t] = c->v[t - 1]; }
-      c->ri[t] = r; c->v[t] = v;
-    }
-    c->cp[j] = q;
-    for (p = start; p < end; ++p) {
-      if (q > c->cp[j] && c->ri[q - 1] == c->ri[p]) c->v[q - 1] += c->v[p];
-      else { c->ri[q] = c->ri[p]; c->v[q] = c->v[p]; ++q; }
-    }
-  }
-  c->cp[N] = q;
-  c->A.n_rows = c->A.n_cols = N;
-  c->A.colptr = c->cp; c->A.rowidx = c->ri; c->A.values = c->v;
+  err = coo_assemble(c, rows, cols, vals, nf == 3 ? 0 : 1, nf == 3 ? 0 : 2, nnz, spec, opt, N);
 done:
   for (k = 0; k < nf; ++k) mat_free(&M[k]);
   return err;

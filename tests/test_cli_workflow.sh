@@ -13,6 +13,8 @@
 # 2. cheap checks before any work: a malformed list, an order too large for
 #    one of the models, an unknown method in a list -- status 2, nothing
 #    simulated, nothing written.
+# 3. --J-coo triplets with duplicates (split entries, a cancelling pair) give
+#    the dense model's output (phgmg_csc_from_coo sums them).
 # Needs NumPy/SciPy (/usr/bin/python3) to write the inputs (skipped otherwise).
 set -u
 P=${1:-build/phgmg}
@@ -111,6 +113,28 @@ st=$?
 [ $st -eq 2 ] && grep -q -- "--r 30" err.txt && pass || bad "--r 4,30 with N = 24: status $st: $(cat err.txt)"
 grep -q "simulating" err.txt && bad "--r 4,30: simulated before refusing" || pass
 [ -e bad2 ] && bad "--r 4,30: the output directory was left behind" || pass
+
+# 3. coordinate triplets as FE assembly writes them: each entry split into
+#    two parts and a pair that cancels -- the model is the dense one
+"$PY" - <<'PYEOF' || bad "writing the triplets"
+import numpy as np
+for k in "JRQ":
+    A = np.load(k + ".npy")
+    r, c = np.nonzero(A)
+    v = A[r, c]
+    rows = np.concatenate([r, r, [0, 0]]); cols = np.concatenate([c, c, [1, 1]])
+    vals = np.concatenate([0.25 * v, 0.75 * v, [0.5, -0.5]])
+    p = np.random.default_rng(1).permutation(len(rows))
+    np.save(k + "_coo.npy", np.column_stack([rows[p], cols[p], vals[p]]))
+PYEOF
+"$P" simulate $SYS --steps 100 --out yd.npy >/dev/null 2>err.txt && pass || bad "simulate dense: $(tail -n 2 err.txt)"
+"$P" simulate --J-coo J_coo.npy --R-coo R_coo.npy --Q-coo Q_coo.npy --B B.npy --steps 100 --out yc.npy >/dev/null \
+  2>err.txt && pass || bad "simulate from triplets with duplicates: $(tail -n 2 err.txt)"
+"$PY" -c "
+import numpy as np, sys
+a, b = np.load('yd.npy'), np.load('yc.npy')
+sys.exit(0 if np.abs(a - b).max() <= 1e-12 * np.abs(a).max() else 1)" && pass \
+  || bad "the model from triplets with duplicates differs from the dense one"
 
 echo "test_cli_workflow: $npass passed, $nfail failed"
 [ "$nfail" -eq 0 ]

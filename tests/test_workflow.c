@@ -99,7 +99,60 @@ TEST(test_study_reports_sigma_ratio) {
   dmodel_free(&t);
 }
 
+/* phgmg_csc_from_coo against a dense accumulation of the same triplets:
+   every entry the sum of its duplicates, rows strictly increasing in each
+   column, the pattern exactly the positions that occur; the errors. */
+TEST(test_csc_from_coo_sums_duplicates) {
+  enum { NR = 7, NC = 5, NZ = 60 };
+  int rows[NZ], cols[NZ], k, j, p, seen[NR * NC];
+  double vals[NZ], D[NR * NC];
+  unsigned s = 12345u;
+  phgmg_csc A;
+  memset(D, 0, sizeof D);
+  memset(seen, 0, sizeof seen);
+  for (k = 0; k < NZ; ++k) {   /* a small generator: many duplicates, one empty column (3) */
+    s = s * 1103515245u + 12345u; rows[k] = (int)((s >> 16) % NR);
+    s = s * 1103515245u + 12345u; cols[k] = (int)((s >> 16) % NC);
+    if (cols[k] == 3) cols[k] = 4;
+    vals[k] = (double)((int)((s >> 8) % 17) - 8) / 4.0;
+    D[rows[k] + NR * cols[k]] += vals[k];
+    seen[rows[k] + NR * cols[k]] = 1;
+  }
+  CHECK_RC(phgmg_csc_from_coo(&A, NR, NC, NZ, rows, cols, vals, NULL), PHGMG_OK);
+  CHECK(A.n_rows == NR && A.n_cols == NC && A.colptr[0] == 0);
+  CHECK(A.colptr[3] == A.colptr[4]);
+  for (j = 0; j < NC; ++j)
+    for (p = A.colptr[j]; p < A.colptr[j + 1]; ++p) {
+      CHECK(p == A.colptr[j] || A.rowidx[p] > A.rowidx[p - 1]);
+      CHECK(seen[A.rowidx[p] + NR * j] == 1);
+      CHECK(A.values[p] == D[A.rowidx[p] + NR * j]);   /* sums of quarters: exact */
+      seen[A.rowidx[p] + NR * j] = 2;
+    }
+  for (k = 0; k < NR * NC; ++k) CHECK(seen[k] != 1);   /* every position that occurs is stored once */
+  phgmg_csc_free(&A, NULL);
+  CHECK(A.values == NULL && A.colptr == NULL);
+  phgmg_csc_free(&A, NULL);   /* twice: fine */
+  /* no entries: an all-zero matrix */
+  CHECK_RC(phgmg_csc_from_coo(&A, 3, 2, 0, NULL, NULL, NULL, NULL), PHGMG_OK);
+  CHECK(A.colptr[0] == 0 && A.colptr[2] == 0);
+  phgmg_csc_free(&A, NULL);
+  /* errors: an index outside, a value not finite, bad sizes, NULL */
+  rows[5] = NR;
+  CHECK_RC(phgmg_csc_from_coo(&A, NR, NC, NZ, rows, cols, vals, NULL), PHGMG_ERR_SIZE);
+  CHECK(A.colptr == NULL);
+  rows[5] = 0; cols[7] = -1;
+  CHECK_RC(phgmg_csc_from_coo(&A, NR, NC, NZ, rows, cols, vals, NULL), PHGMG_ERR_SIZE);
+  cols[7] = 0; vals[9] = (double)NAN;
+  CHECK_RC(phgmg_csc_from_coo(&A, NR, NC, NZ, rows, cols, vals, NULL), PHGMG_ERR_NANINF);
+  vals[9] = 1.0;
+  CHECK_RC(phgmg_csc_from_coo(&A, 0, NC, NZ, rows, cols, vals, NULL), PHGMG_ERR_SIZE);
+  CHECK_RC(phgmg_csc_from_coo(&A, NR, NC, -1, rows, cols, vals, NULL), PHGMG_ERR_SIZE);
+  CHECK_RC(phgmg_csc_from_coo(&A, NR, NC, NZ, NULL, cols, vals, NULL), PHGMG_ERR_INVALID_ARG);
+  CHECK_RC(phgmg_csc_from_coo(NULL, NR, NC, NZ, rows, cols, vals, NULL), PHGMG_ERR_INVALID_ARG);
+}
+
 SUITE(workflow) {
+  RUN(test_csc_from_coo_sums_duplicates);
   RUN(test_study_reports_sigma_ratio);
   RUN(test_validate_many_matches_own_runs);
 }
