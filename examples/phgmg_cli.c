@@ -254,10 +254,17 @@ static const char *const help_lines[] = {
   "                      shape: Bh (r x m), Qh (r x r), K (r x r, = J_r - R_r), and as\n",
   "                      they apply G00 G01 G10 G11 Q01 Q11 Ms (gmg-qm), P0 P1 w poly\n",
   "                      (nonlinear), Phi Gam SX SU (step map); see phgmg.h >>online.\n",
+  "    NAME_PD.npy        (feedthrough: --P, --S, --N, or a port on a constraint) the\n",
+  "                      reduced feedthrough [Ph; S + N], (r + m) x m: rows 0..r-1\n",
+  "                      Ph = W_z^T P (x' = ... + (Bh - Ph) u), rows r..r+m-1 S + N\n",
+  "                      (y = (Bh + Ph)^T grad H + (S + N) u)\n",
   "    NAME_V0.npy        the reduction basis V0 (N x r): x ~ V0 xr (every method)\n",
   "    NAME_V2.npy, NAME_M.npy  (gmg-qm) V2 (N x r_n) and M (r_n x p^2, p = r - m):\n",
   "                      x ~ V0 xr + V2 M kron(x2, x2), x2 = xr[m:]\n",
-  "    NAME.json          sizes, method, options, diagnostics and the list of files\n",
+  "    NAME.json          sizes, method, options, diagnostics and the list of files;\n",
+  "                      \"E\": whether the model has a mass matrix, \"N_full\": all its\n",
+  "                      states (\"N\" is the number reduced: an index-one model's\n",
+  "                      differential states), \"algebraic\", \"feedthrough\"\n",
   "  A run writes all of these or none: they are written under temporary names and\n",
   "  renamed at the end; the NAME_*.npy arrays that an earlier run listed in its\n",
   "  NAME.json and this run does not produce (another method) are removed. A run\n",
@@ -2020,7 +2027,7 @@ static void reduce_cleanup(reduce_state *S) {
 
 /* The fields NAME_<field>.npy a run may write. */
 static const char *const all_fields[] = {"Bh", "Qh", "K", "G00", "G01", "G10", "G11", "Q01", "Q11", "Ms",
-                                         "P0", "P1", "w", "poly", "expo", "Phi", "Gam", "SX", "SU", "V0", "V2",
+                                         "P0", "P1", "w", "poly", "expo", "Phi", "Gam", "SX", "SU", "PD", "V0", "V2",
                                          "M", "snapshots", "fom_y", NULL};
 
 /* The arrays an earlier run recorded as its own in DIR/NAME.json ("arrays":
@@ -2969,6 +2976,23 @@ static int run_reduction(const reduce_args *A, reduce_state *S, int method, cons
   return 0;
 }
 
+/* NAME_PD.npy: the reduced feedthrough as one (r + m) x m matrix [Ph; S + N]
+   (rows 0..r-1: Ph = W_z^T P; rows r..r+m-1: S + N), from phgmg_rom.PD's two
+   column-major blocks. */
+static int write_feedthrough(const reduce_args *A, reduce_state *S, const phgmg_rom *rom, outlist *ol) {
+  const int r = rom->r, m = rom->m;
+  double *D = (double *)malloc(sizeof(double) * (size_t)(r + m) * (size_t)m);
+  int a, b, e;
+  if (!D) return fail("out of memory");
+  for (b = 0; b < m; ++b) {
+    for (a = 0; a < r; ++a) D[a + (size_t)b * (r + m)] = (double)rom->PD[a + (size_t)b * r];
+    for (a = 0; a < m; ++a) D[r + a + (size_t)b * (r + m)] = (double)rom->PD[(size_t)r * m + a + (size_t)b * m];
+  }
+  e = write_field(A->out, A->name, "PD", D, r + m, m, ol, &S->sg);
+  free(D);
+  return e;
+}
+
 /* The reduced model's arrays (NAME_*.npy), V0 = Dphi(0), V2 and M of a
    quadratic map, and with --save-snapshots the snapshots and their outputs. */
 static int write_arrays(const reduce_args *A, reduce_state *S, const double *X, int ns, outlist *ol) {
@@ -2996,6 +3020,7 @@ static int write_arrays(const reduce_args *A, reduce_state *S, const double *X, 
     }
     free(buf);
   }
+  if (rom->PD && write_feedthrough(A, S, rom, ol)) return 1;
   {
     /* V0 = Dphi(0), the linear part of the reduction map (exactly V0 for every method). */
     double *xr0 = (double *)calloc((size_t)rom->r, sizeof(double));
@@ -3121,6 +3146,10 @@ static int write_json(const reduce_args *A, reduce_state *S, int method, int ns,
           rom->kind == PHGMG_ROM_QUADRATIC ? "quadratic" : "linear");
   fprintf(jf, "  \"N\": %d, \"m\": %d, \"r\": %d, \"rn\": %d, \"nd\": %d, \"poly_deg\": %d,\n", N, m, rom->r,
           rom->rn, rom->nd, rom->nd ? rom->poly_deg : 0);
+  /* the model as given: its mass matrix, all its states (an index-one model is reduced on its differential
+     ones: N above), the reduced feedthrough */
+  fprintf(jf, "  \"E\": %s, \"N_full\": %d, \"algebraic\": %d, \"feedthrough\": %s,\n",
+          S->full.E ? "true" : "false", S->full.N, S->dae ? phgmg_dae_nalg(S->dae) : 0, rom->PD ? "true" : "false");
   fprintf(jf, "  \"dt_map\": ");
   if (rom->Phi) { char buf[32]; fputs(isfinite((double)rom->dt) ? real_str(rom->dt, buf) : "null", jf); }   /* float: "0.1" */
   else fputs("0", jf);

@@ -15,6 +15,8 @@
 #    simulated, nothing written.
 # 3. --J-coo triplets with duplicates (split entries, a cancelling pair) give
 #    the dense model's output (phgmg_csc_from_coo sums them).
+# 4. NAME_PD.npy ([Ph; S + N]) of a model with feedthrough; NAME.json's E,
+#    N_full and feedthrough.
 # Needs NumPy/SciPy (/usr/bin/python3) to write the inputs (skipped otherwise).
 set -u
 P=${1:-build/phgmg}
@@ -135,6 +137,35 @@ import numpy as np, sys
 a, b = np.load('yd.npy'), np.load('yc.npy')
 sys.exit(0 if np.abs(a - b).max() <= 1e-12 * np.abs(a).max() else 1)" && pass \
   || bad "the model from triplets with duplicates differs from the dense one"
+
+# 4. feedthrough where users read the model: NAME_PD.npy is [Ph; S + N]
+#    ((r + m) x m, the last m rows S + N exactly); NAME.json records E and
+#    the model's whole N
+"$PY" - <<'PYEOF' || bad "writing P, S, E"
+import numpy as np
+n = 12
+P = np.zeros(2 * n); P[n + 3] = 0.05
+np.save("P.npy", P); np.save("S.npy", np.array([[0.5]])); np.save("E.npy", 2.0 * np.eye(2 * n))
+PYEOF
+"$P" reduce $SYS --P P.npy --S S.npy $TRAIN --method gmg-pod --r 6 --out fd >/dev/null 2>err.txt && pass \
+  || bad "reduce with feedthrough: $(tail -n 2 err.txt)"
+"$PY" - <<'PYEOF' && pass || bad "fd/rom_PD.npy or fd/rom.json"
+import json, numpy as np
+D = np.load("fd/rom_PD.npy")
+assert D.shape == (7, 1), D.shape
+assert D[6, 0] == 0.5 and np.abs(D[:6]).max() > 0
+j = json.load(open("fd/rom.json"))
+assert j["E"] is False and j["N_full"] == 24 and j["feedthrough"] is True
+assert "rom_PD.npy" in j["files"]["arrays"]
+PYEOF
+"$P" reduce $SYS --E E.npy $TRAIN --method gmg-pod --r 6 --out fe >/dev/null 2>err.txt && pass \
+  || bad "reduce with E: $(tail -n 2 err.txt)"
+"$PY" -c "
+import json, sys
+j = json.load(open('fe/rom.json'))
+sys.exit(0 if j['E'] is True and j['feedthrough'] is False and j['N_full'] == 24 else 1)" && pass \
+  || bad "fe/rom.json does not record the mass matrix"
+[ -f fe/rom_PD.npy ] && bad "a model without feedthrough has rom_PD.npy" || pass
 
 echo "test_cli_workflow: $npass passed, $nfail failed"
 [ "$nfail" -eq 0 ]
