@@ -133,8 +133,18 @@ static const char *const help_lines[] = {
   "                      a = 0..m-1, so that the ports are excited independently;\n",
   "                      const: u(t) = AMP on every port (the same on all: pointed out\n",
   "                      for m > 1, as for a table whose columns are equal); or a\n",
-  "                      FILE.npy (see INPUT FILES; AMP is then not used)\n",
+  "                      FILE.npy (see INPUT FILES; AMP is then not used);\n",
+  "                      chirp: u(t) = AMP sin(p(t)), its angular frequency p'(t)\n",
+  "                      rising linearly from --freq to --freq-end over the run\n",
+  "                      (t in [0, steps*DT]; port a: p(t) (1 + a/m))\n",
   "    --amp AMP         amplitude (default 0.1)\n",
+  "    --freq W          angular frequency of sin (rad per unit of time; W/(2 pi) in\n",
+  "                      Hz), u(t) = AMP sin(W t) (port a: W (1 + a/m)); chirp's\n",
+  "                      start. Default 1\n",
+  "    --freq-end W1     chirp's final angular frequency (default 10 W)\n",
+  "    --x0 FILE         initial state of the training runs (N values, the files'\n",
+  "                      ordering; default 0; not for a model with algebraic\n",
+  "                      constraints); also for simulate\n",
   "    --newton-tol T    Newton tolerance (stage residual, inf-norm, absolute) for\n",
   "                      nonlinear models (default: the library's, 1e-10 times\n",
   "                      max(1, |x|, |stage increment|): follows large states; the log\n",
@@ -303,8 +313,8 @@ static const char *const help_lines[] = {
   "  resolves, dt max|J - R| max|Q| / max|E| > 1/eps = 4.5e15 (the stage equations\n",
   "  lose the mass term; the output would be round-off, zero or NaN), is refused\n",
   "  (also by reduce --simulate and validate).\n",
-  "  --dt DT, --steps N, --input KIND, --amp AMP, --newton-tol T, --newton-iter K:\n",
-  "                      as for reduce --simulate\n",
+  "  --dt DT, --steps N, --input KIND, --amp AMP, --freq W, --freq-end W1, --x0 FILE,\n",
+  "  --newton-tol T, --newton-iter K:  as for reduce --simulate\n",
   "  Sparse input: the log names the solver of the stage systems (band LU, or the\n",
   "  sparse LU for 2-D/3-D meshes; see phgmg.h >>sparse).\n",
   "  --quiet             no progress lines\n",
@@ -321,7 +331,9 @@ static const char *const help_lines[] = {
   "                      step it was trained at (reduce records --simulate's --dt, the\n",
   "                      --dt of --X with --X-input, or --dt given with --X), else 0.1;\n",
   "                      a note on stderr when --dt differs from the model's)\n",
-  "  --steps N, --input KIND, --amp AMP, --newton-tol T, --newton-iter K:  as above\n",
+  "  --steps N, --input KIND, --amp AMP, --freq W, --freq-end W1, --newton-tol T,\n",
+  "  --newton-iter K:    as above\n",
+  "  --x0 FILE           the reduced initial state xr0 (r values; default: rest)\n",
   "  --quiet             no progress lines\n",
   "\n",
   "COMMAND info MODEL\n",
@@ -613,10 +625,14 @@ static const char *shape_str(const mat *m) {
 static int is_vector(const mat *m) { return m->ndim <= 1 || m->rows == 1 || m->cols == 1; }
 
 /* ---- the input signal ------------------------------------------------------- */
-enum { IN_SIN = 0, IN_CONST = 1, IN_TABLE = 2, IN_GRID = 3 };
+enum { IN_SIN = 0, IN_CONST = 1, IN_TABLE = 2, IN_GRID = 3, IN_CHIRP = 4 };
+/* --freq W (angular frequency of sin and the chirp's start, rad per unit of
+   time; default 1) and --freq-end W1 (the chirp's end; 0: 10 W). */
+static double g_freq = 1.0, g_freq_end = 0.0;
 typedef struct cli_input {
   int kind, m;
   double amp;
+  double w0, w1, T;   /* sin: w0; chirp: from w0 to w1 over the run's length T */
   mat tab;        /* IN_TABLE: K x (1+m); IN_GRID: K samples on t = k*grid_dt */
   double grid_dt;
   /* progress of a long simulation, reported from the input callback */
@@ -648,9 +664,16 @@ static void input_fn(double t, double *u, void *user) {
   cli_input *in = (cli_input *)user;
   int a;
   switch (in->kind) {
-    case IN_SIN: /* port a: its own frequency 1 + a/m, so that the ports are excited independently */
-      for (a = 0; a < in->m; ++a) u[a] = in->amp * sin((1.0 + (double)a / in->m) * t);
+    case IN_SIN: /* port a: its own frequency w (1 + a/m), so that the ports are excited independently */
+      for (a = 0; a < in->m; ++a) u[a] = in->amp * sin(in->w0 * (1.0 + (double)a / in->m) * t);
       break;
+    case IN_CHIRP: { /* a linear chirp w(t) = w0 + (w1 - w0) t / T, held at w1 after T; port a scaled by 1 + a/m */
+      const double tc = t < in->T ? t : in->T;
+      const double ph = in->w0 * tc + 0.5 * (in->w1 - in->w0) * tc * tc / (in->T > 0.0 ? in->T : 1.0) +
+                        in->w1 * (t - tc);
+      for (a = 0; a < in->m; ++a) u[a] = in->amp * sin((1.0 + (double)a / in->m) * ph);
+      break;
+    }
     case IN_CONST: for (a = 0; a < in->m; ++a) u[a] = in->amp; break;
     default: table_eval(in, t, u); break;
   }
@@ -666,17 +689,21 @@ static void input_fn(double t, double *u, void *user) {
 
 /* Set up the input from --input/--amp for m ports and step dt. Returns 0, or
    the exit status after a message (2: neither a kind nor an existing file). */
-static int input_setup(cli_input *in, const char *opt, const char *spec, double amp, int m, double dt) {
+static int input_setup(cli_input *in, const char *opt, const char *spec, double amp, int m, double dt, double T) {
   struct stat st;
   const size_t l = strlen(spec);
   memset(in, 0, sizeof *in);
   in->m = m;
   in->amp = amp;
   in->grid_dt = dt;
+  in->w0 = g_freq;
+  in->w1 = g_freq_end > 0.0 ? g_freq_end : 10.0 * g_freq;
+  in->T = T;
   if (!strcmp(spec, "sin")) { in->kind = IN_SIN; return 0; }
+  if (!strcmp(spec, "chirp")) { in->kind = IN_CHIRP; return 0; }
   if (!strcmp(spec, "const")) { in->kind = IN_CONST; return 0; }
   if (stat(spec, &st) != 0 && (l < 4 || strcmp(spec + l - 4, ".npy") != 0))
-    return usage_error("%s '%s': expected sin, const or a FILE.npy, and there is no file '%s'", opt, spec, spec);
+    return usage_error("%s '%s': expected sin, chirp, const or a FILE.npy, and there is no file '%s'", opt, spec, spec);
   if (mat_load(&in->tab, opt, spec)) return 1;
   if (in->tab.ndim == 2 && !(m == 1 && in->tab.cols == 1)) {
     int k;
@@ -709,9 +736,15 @@ static int input_setup(cli_input *in, const char *opt, const char *spec, double 
 
 static const char *input_desc(const cli_input *in, const char *spec) {
   static char buf[600];
-  if (in->kind == IN_SIN && in->m > 1)
+  if (in->kind == IN_SIN && in->m > 1 && in->w0 == 1.0)
     snprintf(buf, sizeof buf, "u_a(t) = %g sin((1 + a/%d) t) at port a = 0..%d", in->amp, in->m, in->m - 1);
-  else if (in->kind == IN_SIN) snprintf(buf, sizeof buf, "u(t) = %g sin(t)", in->amp);
+  else if (in->kind == IN_SIN && in->m > 1)
+    snprintf(buf, sizeof buf, "u_a(t) = %g sin(%g (1 + a/%d) t) at port a = 0..%d", in->amp, in->w0, in->m, in->m - 1);
+  else if (in->kind == IN_SIN && in->w0 == 1.0) snprintf(buf, sizeof buf, "u(t) = %g sin(t)", in->amp);
+  else if (in->kind == IN_SIN) snprintf(buf, sizeof buf, "u(t) = %g sin(%g t)", in->amp, in->w0);
+  else if (in->kind == IN_CHIRP)
+    snprintf(buf, sizeof buf, "u(t) = %g sin(phase), a linear chirp from %g to %g rad per unit time over t in [0, %g]%s",
+             in->amp, in->w0, in->w1, in->T, in->m > 1 ? " (port a: phase times 1 + a/m)" : "");
   else if (in->kind == IN_CONST) snprintf(buf, sizeof buf, "u(t) = %g", in->amp);
   else snprintf(buf, sizeof buf, "u(t) from %s", spec);
   return buf;
@@ -910,7 +943,7 @@ static void paths_add(pathset *ps, const char *opt, const char *path, int tmp) {
 
 /* An input spec that may be a file: anything but the input kinds sin, const. */
 static void paths_add_input(pathset *ps, const char *opt, const char *spec) {
-  if (spec && strcmp(spec, "sin") && strcmp(spec, "const")) paths_add(ps, opt, spec, 0);
+  if (spec && strcmp(spec, "sin") && strcmp(spec, "const") && strcmp(spec, "chirp")) paths_add(ps, opt, spec, 0);
 }
 
 /* The index in ps of the file path names, -1 if none. */
@@ -1332,6 +1365,7 @@ typedef struct reduce_args {
   const char *E, *Ecoo;            /* descriptor models: the mass matrix, dense or sparse */
   const char *Pf, *Sf, *Nf;        /* feedthrough P, S, N */
   const char *dampf;               /* --dampers: nonlinear dampers (k x 4: i, j, c1, c3) */
+  const char *x0f;                 /* --x0: the initial state of simulate and of reduce's training runs */
   const char *expf, *potential, *hyper;
   double hyper_tol;
   int simulate, steps, r, rn, no_deim, deim_max, deim_neg, save_snap, have_dt_map, newton_iter;
@@ -1377,6 +1411,7 @@ static const input_opt input_opts[] = {
   IOPT("--dampers", dampf, OPTF_FILE, OPTF_SIMULATE), IOPT("--poly", poly, OPTF_FILE, OPTF_SIMULATE),
   IOPT("--poly-idx", poly_idx, OPTF_FILE, OPTF_SIMULATE), IOPT("--poly-w", poly_w, OPTF_FILE, OPTF_SIMULATE),
   IOPT("--exp", expf, OPTF_FILE, OPTF_SIMULATE), IOPT("--input", input, OPTF_KIND, OPTF_SIMULATE),
+  IOPT("--x0", x0f, OPTF_FILE, OPTF_SIMULATE),
   IOPT("--ref", ref_file, OPTF_FILE, OPTF_SPECIAL),
   {NULL, 0, 0, 0}};
 #undef IOPT
@@ -1417,6 +1452,17 @@ static const char *optval(int argc, char **argv, int *i) {
   if (*i + 1 >= argc) { usage_error("%s needs a value", argv[*i]); return NULL; }
   if (!argv[*i + 1][0]) { usage_error("%s: empty value (a file name, a number or a word expected)", argv[*i]); return NULL; }
   return argv[++*i];
+}
+
+/* --freq W / --freq-end W1 (argv[*i]): a finite angular frequency > 0 into
+   g_freq / g_freq_end. 0, or 1 after a usage message. */
+static int parse_freq(int argc, char **argv, int *i) {
+  const char *o = argv[*i], *v;
+  double w;
+  if (!(v = optval(argc, argv, i)) || !parse_double(o, v, 0.0, &w)) return 1;
+  if (!(w > 0.0)) { usage_error("%s: expected an angular frequency > 0 (rad per unit of time), got '%s'", o, v); return 1; }
+  if (!strcmp(o, "--freq")) g_freq = w; else g_freq_end = w;
+  return 0;
 }
 
 /* A named potential (--potential NAME[:P1[:P2]]) as exp-polynomial
@@ -1662,6 +1708,7 @@ static int parse_reduce(int argc, char **argv, reduce_args *A) {
       if (!(v = optval(argc, argv, &i)) || !parse_double(o, v, 0.0, &A->dt_map) || real_bad(o, v, A->dt_map)) return 2;
       A->have_dt_map = 1;
     }
+    else if (!strcmp(o, "--freq") || !strcmp(o, "--freq-end")) { if (parse_freq(argc, argv, &i)) return 2; }
     else if (!strcmp(o, "--degeneracy-tol")) {
       if (!(v = optval(argc, argv, &i)) || !parse_double(o, v, 0.0, &A->degeneracy_tol)) return 2;
       if (!(A->degeneracy_tol > 0.0 && A->degeneracy_tol < 1.0))
@@ -2283,7 +2330,7 @@ static int load_snapshot_files(const reduce_args *A, reduce_state *S, int N, int
       const int c = k ? S->Xs[k].cols : S->X.cols;
       memset(&S->runs[k], 0, sizeof S->runs[k]);
       if (A->nxin) {
-        int e = input_setup(&S->xinp[k], "--X-input", A->xin[k], A->amp, m, A->dt);
+        int e = input_setup(&S->xinp[k], "--X-input", A->xin[k], A->amp, m, A->dt, (c - 1) * A->dt);
         if (e) return e;
         S->runs[k].u = input_fn; S->runs[k].user = &S->xinp[k];
         S->runs[k].x0 = X + col * (size_t)N;
@@ -2760,6 +2807,27 @@ static int check_sizes(const reduce_args *A, int method, int N, int m, int k) {
   return 0;
 }
 
+/* --x0 FILE into x0 (the N states the run simulates, zero without --x0):
+   N values in the files' ordering (sparse input: moved to the internal one).
+   Not for a model with algebraic constraints (its initial state must be
+   consistent). 0, or 1 after a message. */
+static int load_x0(const reduce_args *A, const reduce_state *S, int N, double *x0) {
+  mat M;
+  if (!A->x0f) return 0;
+  if (S->dae) return fail("%s (--x0): a model with algebraic constraints starts at rest (x = 0); --x0 is for "
+                          "models without zero rows of E", A->x0f);
+  if (mat_load(&M, "--x0", A->x0f)) return 1;
+  if (M.ndim == 0 || M.rows != N || M.cols != 1) {
+    fail("%s (--x0): expected shape (%d,) or (%d, 1) (one value per state), got %s", A->x0f, N, N, shape_str(&M));
+    mat_free(&M);
+    return 1;
+  }
+  if (S->sp) phgmg_ph_sparse_to_banded_order(S->sp, 1, M.a, N, x0, N);
+  else memcpy(x0, M.a, sizeof(double) * (size_t)N);
+  mat_free(&M);
+  return 0;
+}
+
 /* --simulate: the training runs (--input, or each --train-input) from x0 = 0,
    one after the other in S->Xsim, their outputs in S->Ysim, S->runs. */
 static int simulate_training_runs(const reduce_args *A, reduce_state *S, const double **Xo, int *nso, double *t_sim) {
@@ -2772,9 +2840,10 @@ static int simulate_training_runs(const reduce_args *A, reduce_state *S, const d
   double *x0;
   int done = 0;
   const int nrun = A->ntrain ? A->ntrain : 1;
-  if ((k = input_setup(&S->in, A->ntrain ? "--train-input" : "--input", A->input, A->amp, m, A->dt)) != 0) return k;
+  if ((k = input_setup(&S->in, A->ntrain ? "--train-input" : "--input", A->input, A->amp, m, A->dt, A->steps * A->dt)) != 0)
+    return k;
   for (i = 1; i < nrun; ++i)
-    if ((k = input_setup(&S->tin[i], "--train-input", A->train[i], A->amp, m, A->dt)) != 0) return k;
+    if ((k = input_setup(&S->tin[i], "--train-input", A->train[i], A->amp, m, A->dt, A->steps * A->dt)) != 0) return k;
   {
     const cli_input *ins[16];
     for (i = 0; i < nrun; ++i) ins[i] = i ? &S->tin[i] : &S->in;
@@ -2787,6 +2856,7 @@ static int simulate_training_runs(const reduce_args *A, reduce_state *S, const d
   S->Ysim = (double *)malloc(sizeof(double) * (size_t)m * (size_t)ns);
   x0 = (double *)calloc((size_t)N, sizeof(double));
   if (!S->Xsim || !S->Ysim || !x0) { free(x0); return fail("out of memory for %d snapshots of size %d", ns, N); }
+  if (load_x0(A, S, N, x0)) { free(x0); return 1; }
   memset(&go, 0, sizeof go);
   go.tol = A->newton_tol; go.max_iter = A->newton_iter;
   t0 = now_s();
@@ -3529,7 +3599,7 @@ static void rom_feed_out(const phgmg_rom *rom, double t, cli_input *in, double *
 
 /* simulate-rom's options (0 / NULL: not given). */
 typedef struct simrom_args {
-  const char *model, *out, *states, *inspec;
+  const char *model, *out, *states, *inspec, *x0;   /* x0: --x0, the reduced initial state */
   double dt, amp, newton_tol;   /* newton_tol 0: the library's default */
   int steps, newton_iter, have_dt;
 } simrom_args;
@@ -3559,6 +3629,8 @@ static int parse_simulate_rom(int argc, char **argv, simrom_args *P) {
     else if (!strcmp(o, "--steps")) { if (!(v = optval(argc, argv, &i)) || !parse_int(o, v, 1, INT_MAX - 1, &P->steps)) return 2; }
     else if (!strcmp(o, "--newton-iter")) { if (!(v = optval(argc, argv, &i)) || !parse_int(o, v, 1, 1000, &P->newton_iter)) return 2; }
     else if (!strcmp(o, "--quiet")) g_quiet = 1;
+    else if (!strcmp(o, "--freq") || !strcmp(o, "--freq-end")) { if (parse_freq(argc, argv, &i)) return 2; }
+    else if (!strcmp(o, "--x0")) { if (!(P->x0 = optval(argc, argv, &i))) return 2; }
     else return usage_error("simulate-rom: unknown option '%s'", o);
   }
   if (!P->model || !P->out) return usage_error("simulate-rom: --model FILE and --out FILE are required");
@@ -3626,6 +3698,7 @@ static int cmd_simulate_rom(int argc, char **argv) {
   memset(&pout, 0, sizeof pout);
   paths_add(&pin, "--model", model, 0);
   paths_add_input(&pin, "--input", inspec);
+  if (P.x0) paths_add(&pin, "--x0", P.x0, 0);
   paths_add(&pout, "--out", out, 1);
   if (states) paths_add(&pout, "--states", states, 1);
   if ((status = check_collisions("simulate-rom", &pin, &pout)) != 0) goto done;
@@ -3639,7 +3712,7 @@ static int cmd_simulate_rom(int argc, char **argv) {
     status = 2;
     goto done;
   }
-  if ((status = input_setup(&in, "--input", inspec, amp, rom.m, dt)) != 0) goto done;
+  if ((status = input_setup(&in, "--input", inspec, amp, rom.m, dt, steps * dt)) != 0) goto done;
   input_covers(&in, inspec, "--input", steps * dt);
   status = 1;
   msz = phgmg_rom_stepper_memsize_dt(&rom, (phgmg_real)dt);
@@ -3656,6 +3729,18 @@ static int cmd_simulate_rom(int argc, char **argv) {
            rom.kind == PHGMG_ROM_QUADRATIC ? ", quadratic manifold" : "", steps, dt,
            st.use_map ? " (precomputed step map)" : "", input_desc(&in, inspec));
   for (a = 0; a < rom.r; ++a) x[a] = rom.xr_rest ? rom.xr_rest[a] : (phgmg_real)0;   /* from rest: rho(0) */
+  if (P.x0) {   /* --x0: the reduced state xr0, r values */
+    mat M;
+    if (mat_load(&M, "--x0", P.x0)) goto done;
+    if (M.ndim == 0 || M.rows != rom.r || M.cols != 1) {
+      fail("%s (--x0): expected the reduced initial state, shape (%d,) (r = %d values), got %s", P.x0, rom.r, rom.r,
+           shape_str(&M));
+      mat_free(&M);
+      goto done;
+    }
+    for (a = 0; a < rom.r; ++a) x[a] = (phgmg_real)M.a[a];
+    mat_free(&M);
+  }
   /* the same sequence of operations as phgmg_reduced_simulate */
 #define RECORD(nn) do { \
     if (XR) for (a = 0; a < rom.r; ++a) XR[a + (size_t)(nn) * rom.r] = (double)x[a]; \
@@ -3733,6 +3818,7 @@ static int parse_simulate(int argc, char **argv, reduce_args *A, const char **st
     else if (!strcmp(o, "--newton-iter")) { if (!(v = optval(argc, argv, &i)) || !parse_int(o, v, 1, 1000, &A->newton_iter)) return 2; }
     else if (!strcmp(o, "--amp")) { if (!(v = optval(argc, argv, &i)) || !parse_double(o, v, -HUGE_VAL, &A->amp)) return 2; }
     else if (!strcmp(o, "--newton-tol")) { if (!(v = optval(argc, argv, &i)) || !parse_double(o, v, 0.0, &A->newton_tol)) return 2; }
+    else if (!strcmp(o, "--freq") || !strcmp(o, "--freq-end")) { if (parse_freq(argc, argv, &i)) return 2; }
     else return usage_error("simulate: unknown option '%s'", o);
   }
   if ((k = check_model_opts("simulate", A)) != 0) return k;
@@ -3776,9 +3862,10 @@ static int cmd_simulate(int argc, char **argv) {
     status = 2;
     goto out;
   }
-  if ((status = input_setup(&S.in, "--input", A.input, A.amp, m, A.dt)) != 0) goto out;
+  if ((status = input_setup(&S.in, "--input", A.input, A.amp, m, A.dt, A.steps * A.dt)) != 0) goto out;
   status = 1;
   x0 = (double *)calloc((size_t)N, sizeof(double));
+  if (x0 && load_x0(&A, &S, N, x0)) goto out;
   Y = (double *)malloc(sizeof(double) * (size_t)m * ((size_t)A.steps + 1));
   if (states) X = (double *)malloc(sizeof(double) * (size_t)N * ((size_t)A.steps + 1));
   if (!x0 || !Y || (states && !X)) { fail("out of memory for %d steps", A.steps); goto out; }
@@ -4030,7 +4117,8 @@ static int cmd_validate(int argc, char **argv) {
     /* the training run's length: --steps, or the --X run's (the first run's for a --test-input) */
     const int run = from_x[k] ? k : 0;
     steps[k] = V.steps_t ? V.steps_t : !A.X ? A.steps : (run ? S.Xs[run].cols : S.X.cols) - 1;
-    status = input_setup(&tin[k], "--test-input", V.tests[k], V.have_amp ? V.amp_t : A.amp, S.sys.m, A.dt);
+    status = input_setup(&tin[k], "--test-input", V.tests[k], V.have_amp ? V.amp_t : A.amp, S.sys.m, A.dt,
+                         steps[k] * A.dt);
     if (!status) input_covers(&tin[k], V.tests[k], "--test-input", steps[k] * A.dt);
     if (!status && too_big(((double)S.sys.N + 2.0 * S.sys.m + max_order(&A) + 8.0) * ((double)steps[k] + 1.0),
                            "validate: a test run (the full model's states and outputs, N x (steps+1))"))

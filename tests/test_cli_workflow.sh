@@ -17,6 +17,7 @@
 #    the dense model's output (phgmg_csc_from_coo sums them).
 # 4. NAME_PD.npy ([Ph; S + N]) of a model with feedthrough; NAME.json's E,
 #    N_full and feedthrough.
+# 5. --input sin --freq, --input chirp, --x0 against SciPy (solve_ivp, expm).
 # Needs NumPy/SciPy (/usr/bin/python3) to write the inputs (skipped otherwise).
 set -u
 P=${1:-build/phgmg}
@@ -166,6 +167,57 @@ j = json.load(open('fe/rom.json'))
 sys.exit(0 if j['E'] is True and j['feedthrough'] is False and j['N_full'] == 24 else 1)" && pass \
   || bad "fe/rom.json does not record the mass matrix"
 [ -f fe/rom_PD.npy ] && bad "a model without feedthrough has rom_PD.npy" || pass
+
+# 5. inputs: --input sin --freq 2 and --input chirp (--freq 1 --freq-end 4)
+#    against SciPy's solve_ivp; --x0 (simulate: N states; simulate-rom: r
+#    reduced states) against the matrix exponential with u = 0
+"$P" simulate $SYS --steps 200 --dt 0.05 --input sin --freq 2 --amp 0.3 --out ysin.npy >/dev/null 2>err.txt && pass \
+  || bad "simulate --freq: $(tail -n 2 err.txt)"
+"$P" simulate $SYS --steps 200 --dt 0.05 --input chirp --freq 1 --freq-end 4 --amp 0.3 --out ych.npy >/dev/null \
+  2>err.txt && pass || bad "simulate --input chirp: $(tail -n 2 err.txt)"
+grep -q "chirp from 1 to 4" err.txt && pass || bad "the log does not describe the chirp: $(cat err.txt)"
+"$PY" -c "import numpy as np; x = np.zeros(24); x[3] = 0.2; x[15] = -0.1; np.save('x0.npy', x)"
+"$P" simulate $SYS --steps 100 --dt 0.05 --amp 0 --x0 x0.npy --out yx0.npy >/dev/null 2>err.txt && pass \
+  || bad "simulate --x0: $(tail -n 2 err.txt)"
+"$PY" - <<'PYEOF' && pass || bad "sin --freq / chirp / --x0 differ from SciPy"
+import numpy as np
+from scipy.integrate import solve_ivp
+from scipy.linalg import expm
+J, R, Q, B = (np.load(k + ".npy") for k in "JRQB")
+A = (J - R) @ Q
+def run(u, T):
+    f = lambda t, x: A @ x + B * u(t)
+    t = np.arange(0, T + 1e-12, 0.05)
+    s = solve_ivp(f, (0, t[-1]), np.zeros(24), t_eval=t, method="DOP853", rtol=1e-12, atol=1e-14)
+    return B @ Q @ s.y
+T = 10.0
+ys = run(lambda t: 0.3 * np.sin(2 * t), T)
+yc = run(lambda t: 0.3 * np.sin(1 * t + 0.5 * (4 - 1) * t * t / T), T)
+for f, yr in (("ysin.npy", ys), ("ych.npy", yc)):
+    y = np.load(f)[0]
+    assert np.abs(y - yr).max() <= 1e-6 * np.abs(yr).max(), (f, np.abs(y - yr).max())
+x0 = np.load("x0.npy")
+y = np.load("yx0.npy")[0]
+ye = np.array([B @ Q @ expm(A * 0.05 * n) @ x0 for n in range(101)])
+assert np.abs(y - ye).max() <= 1e-8 * np.abs(ye).max(), np.abs(y - ye).max()
+PYEOF
+"$P" reduce $SYS $TRAIN --method gmg-pod --r 16 --dt-map 0 --out rx >/dev/null 2>err.txt && pass || bad "reduce r 16"
+"$PY" -c "import numpy as np; x = np.zeros(16); x[2] = 0.3; x[5] = -0.2; np.save('xr0.npy', x)"
+"$P" simulate-rom --model rx/rom.phgmgrom --steps 60 --dt 0.05 --amp 0 --x0 xr0.npy --out yrx.npy >/dev/null 2>err.txt \
+  && pass || bad "simulate-rom --x0: $(tail -n 2 err.txt)"
+"$PY" - <<'PYEOF' && pass || bad "simulate-rom --x0 differs from the reduced model's exponential"
+import numpy as np
+from scipy.linalg import expm
+K, Qh, Bh = (np.load("rx/rom_%s.npy" % k) for k in ("K", "Qh", "Bh"))
+x0 = np.load("xr0.npy")
+y = np.load("yrx.npy")[0]
+ye = np.array([(Bh.T @ Qh @ expm(K @ Qh * 0.05 * n) @ x0)[0] for n in range(61)])
+assert np.abs(y - ye).max() <= 1e-8 * np.abs(ye).max(), np.abs(y - ye).max()
+PYEOF
+"$P" simulate-rom --model rx/rom.phgmgrom --steps 10 --x0 x0.npy --out bad.npy >/dev/null 2>err.txt
+[ $? -eq 1 ] && grep -q "reduced initial state" err.txt && pass || bad "simulate-rom --x0 of the wrong size: $(cat err.txt)"
+"$P" simulate $SYS --steps 10 --freq 0 --out bad.npy >/dev/null 2>err.txt
+[ $? -eq 2 ] && pass || bad "--freq 0 accepted"
 
 echo "test_cli_workflow: $npass passed, $nfail failed"
 [ "$nfail" -eq 0 ]
