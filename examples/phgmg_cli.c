@@ -16,6 +16,7 @@
 #define _POSIX_C_SOURCE 200809L
 #define PHGMG_IMPLEMENTATION
 #include "../phgmg.h"
+#include <ctype.h>
 #include <errno.h>
 #include <fcntl.h>
 #include <float.h>
@@ -344,7 +345,11 @@ static const char *const help_lines[] = {
   "\n",
   "SPARSE MATRICES\n",
   "  SPEC is one (nnz, 3) array of rows (row, col, value), or three vectors\n",
-  "  rows.npy,cols.npy,vals.npy (comma-separated, no spaces): 0-based integer indices\n",
+  "  rows.npy,cols.npy,vals.npy (comma-separated, no spaces), or a SciPy sparse\n",
+  "  FILE.npz (scipy.sparse.save_npz of a csr, csc or coo matrix, compressed or\n",
+  "  not), or a Matrix Market FILE.mtx (scipy.io.mmwrite; coordinate, real or\n",
+  "  integer, general, symmetric or skew-symmetric: the upper triangle is added,\n",
+  "  negated for skew; 1-based as the format says), shape N x N: 0-based integer indices\n",
   "  in [0, N), duplicates summed (as scipy.sparse does; the library's\n",
   "  phgmg_csc_from_coo does it in C for your own code). The stepper's stage\n",
   "  systems are solved by the header's sparse direct LU (fill-reducing ordering,\n",
@@ -357,6 +362,8 @@ static const char *const help_lines[] = {
   "    c = A.tocoo(); np.save('J_rows.npy', c.row); np.save('J_cols.npy', c.col)\n",
   "    np.save('J_vals.npy', c.data)     # --J-coo J_rows.npy,J_cols.npy,J_vals.npy\n",
   "    np.save('J.npy', np.column_stack([c.row, c.col, c.data]))   # --J-coo J.npy\n",
+  "    scipy.sparse.save_npz('J.npz', A)                               # --J-coo J.npz\n",
+  "    scipy.io.mmwrite('J.mtx', A)                                    # --J-coo J.mtx\n",
   "\n",
   "INPUT FILES (.npy)\n",
   "  Read: format versions 1.0-3.0, float64, float32, int8-int64, uint8-uint64 or\n",
@@ -1859,6 +1866,412 @@ static int coo_assemble(cli_csc *c, const mat *rows, const mat *cols, const mat 
   return err;
 }
 
+/* ---- sparse matrices from SciPy .npz and Matrix Market .mtx files ----------
+   A small inflate (RFC 1951: stored, fixed and dynamic Huffman blocks) for
+   the members of a .npz (a zip archive; scipy.sparse.save_npz compresses by
+   default), a zip reader of the central directory, and a Matrix Market
+   coordinate reader. Both give coordinate triplets (0-based) that
+   coo_assemble sums into a CSC matrix. Every read is bounds-checked: a
+   malformed file is an error naming it, never a crash. */
+typedef struct inf_state {
+  const unsigned char *in;
+  size_t n, pos;      /* input bytes, the next byte */
+  unsigned bits, nb;  /* bit buffer, bits in it */
+  unsigned char *out;
+  size_t cap, len;    /* the expected output size, bytes written */
+  int err;
+} inf_state;
+typedef struct inf_huff { unsigned short count[16], sym[320]; } inf_huff;
+
+static unsigned inf_bits(inf_state *s, unsigned need) {
+  unsigned v;
+  while (s->nb < need) {
+    if (s->pos >= s->n) { s->err = 1; return 0; }
+    s->bits |= (unsigned)s->in[s->pos++] << s->nb;
+    s->nb += 8;
+  }
+  v = s->bits & ((1u << need) - 1u);
+  s->bits >>= need;
+  s->nb -= need;
+  return v;
+}
+
+/* Canonical Huffman table from n code lengths; 0, or 1 if over-subscribed. */
+static int inf_build(inf_huff *h, const unsigned char *len, int n) {
+  unsigned short offs[16];
+  int k, left = 1;
+  memset(h->count, 0, sizeof h->count);
+  for (k = 0; k < n; ++k) h->count[len[k]]++;
+  h->count[0] = 0;
+  for (k = 1; k < 16; ++k) { left <<= 1; left -= h->count[k]; if (left < 0) return 1; }
+  offs[1] = 0;
+  for (k = 1; k < 15; ++k) offs[k + 1] = (unsigned short)(offs[k] + h->count[k]);
+  for (k = 0; k < n; ++k)
+    if (len[k]) h->sym[offs[len[k]]++] = (unsigned short)k;
+  return 0;
+}
+
+static int inf_decode(inf_state *s, const inf_huff *h) {
+  int code = 0, first = 0, index = 0, l;
+  for (l = 1; l < 16; ++l) {
+    code |= (int)inf_bits(s, 1);
+    if (s->err) return -1;
+    if (code - h->count[l] < first) return h->sym[index + (code - first)];
+    index += h->count[l];
+    first += h->count[l];
+    first <<= 1;
+    code <<= 1;
+  }
+  s->err = 1;
+  return -1;
+}
+
+static const unsigned short inf_lbase[29] = {3, 4, 5, 6, 7, 8, 9, 10, 11, 13, 15, 17, 19, 23, 27, 31, 35, 43, 51, 59,
+                                             67, 83, 99, 115, 131, 163, 195, 227, 258};
+static const unsigned char inf_lext[29] = {0, 0, 0, 0, 0, 0, 0, 0, 1, 1, 1, 1, 2, 2, 2, 2, 3, 3, 3, 3, 4, 4, 4, 4, 5, 5, 5, 5, 0};
+static const unsigned short inf_dbase[30] = {1, 2, 3, 4, 5, 7, 9, 13, 17, 25, 33, 49, 65, 97, 129, 193, 257, 385, 513,
+                                             769, 1025, 1537, 2049, 3073, 4097, 6145, 8193, 12289, 16385, 24577};
+static const unsigned char inf_dext[30] = {0, 0, 0, 0, 1, 1, 2, 2, 3, 3, 4, 4, 5, 5, 6, 6, 7, 7, 8, 8, 9, 9, 10, 10, 11, 11,
+                                           12, 12, 13, 13};
+
+/* The symbols of one Huffman-coded block until end-of-block. */
+static int inf_codes(inf_state *s, const inf_huff *lh, const inf_huff *dh) {
+  for (;;) {
+    int sym = inf_decode(s, lh);
+    if (sym < 0) return 1;
+    if (sym < 256) {
+      if (s->len >= s->cap) return 1;
+      s->out[s->len++] = (unsigned char)sym;
+    } else if (sym == 256) {
+      return 0;
+    } else {
+      size_t len, dist;
+      sym -= 257;
+      if (sym >= 29) return 1;
+      len = inf_lbase[sym] + inf_bits(s, inf_lext[sym]);
+      sym = inf_decode(s, dh);
+      if (sym < 0 || sym >= 30) return 1;
+      dist = inf_dbase[sym] + inf_bits(s, inf_dext[sym]);
+      if (s->err || dist > s->len || len > s->cap - s->len) return 1;
+      for (; len; --len, ++s->len) s->out[s->len] = s->out[s->len - dist];
+    }
+  }
+}
+
+/* The code lengths of a dynamic block into lh, dh. */
+static int inf_dynamic(inf_state *s, inf_huff *lh, inf_huff *dh) {
+  static const unsigned char order[19] = {16, 17, 18, 0, 8, 7, 9, 6, 10, 5, 11, 4, 12, 3, 13, 2, 14, 1, 15};
+  unsigned char len[320];
+  const int nlen = (int)inf_bits(s, 5) + 257, ndist = (int)inf_bits(s, 5) + 1, ncode = (int)inf_bits(s, 4) + 4;
+  int k = 0;
+  if (s->err || nlen > 286 || ndist > 30) return 1;
+  memset(len, 0, sizeof len);
+  for (k = 0; k < ncode; ++k) len[order[k]] = (unsigned char)inf_bits(s, 3);
+  if (s->err || inf_build(lh, len, 19)) return 1;
+  for (k = 0; k < nlen + ndist;) {
+    int sym = inf_decode(s, lh), rep = 0;
+    unsigned char v = 0;
+    if (sym < 0) return 1;
+    if (sym < 16) { len[k++] = (unsigned char)sym; continue; }
+    if (sym == 16) { if (k == 0) return 1; v = len[k - 1]; rep = 3 + (int)inf_bits(s, 2); }
+    else if (sym == 17) rep = 3 + (int)inf_bits(s, 3);
+    else rep = 11 + (int)inf_bits(s, 7);
+    if (s->err || k + rep > nlen + ndist) return 1;
+    while (rep--) len[k++] = v;
+  }
+  if (len[256] == 0) return 1;
+  return inf_build(lh, len, nlen) || inf_build(dh, len + nlen, ndist);
+}
+
+/* Inflate n bytes into out (exactly cap bytes expected). 0, or 1 if the
+   data are not a valid deflate stream of that size. */
+static int inflate_buf(const unsigned char *in, size_t n, unsigned char *out, size_t cap) {
+  inf_state s;
+  inf_huff lh, dh;
+  unsigned last = 0;
+  memset(&s, 0, sizeof s);
+  s.in = in; s.n = n; s.out = out; s.cap = cap;
+  while (!last) {
+    unsigned type;
+    last = inf_bits(&s, 1);
+    type = inf_bits(&s, 2);
+    if (s.err) return 1;
+    if (type == 0) {   /* stored: LEN, NLEN after the byte boundary */
+      size_t len;
+      s.bits = 0; s.nb = 0;
+      if (s.pos + 4 > s.n) return 1;
+      len = (size_t)s.in[s.pos] | (size_t)s.in[s.pos + 1] << 8;
+      if ((len ^ ((size_t)s.in[s.pos + 2] | (size_t)s.in[s.pos + 3] << 8)) != 0xffffu) return 1;
+      s.pos += 4;
+      if (len > s.n - s.pos || len > s.cap - s.len) return 1;
+      memcpy(s.out + s.len, s.in + s.pos, len);
+      s.pos += len; s.len += len;
+    } else if (type == 1) {   /* fixed codes */
+      unsigned char len[320];
+      int k;
+      for (k = 0; k < 144; ++k) len[k] = 8;
+      for (; k < 256; ++k) len[k] = 9;
+      for (; k < 280; ++k) len[k] = 7;
+      for (; k < 288; ++k) len[k] = 8;
+      for (k = 0; k < 30; ++k) len[288 + k] = 5;
+      inf_build(&lh, len, 288);
+      inf_build(&dh, len + 288, 30);
+      if (inf_codes(&s, &lh, &dh)) return 1;
+    } else if (type == 2) {
+      if (inf_dynamic(&s, &lh, &dh) || inf_codes(&s, &lh, &dh)) return 1;
+    } else {
+      return 1;
+    }
+  }
+  return s.len == s.cap ? 0 : 1;
+}
+
+static unsigned long rd16(const unsigned char *p) { return (unsigned long)p[0] | (unsigned long)p[1] << 8; }
+static unsigned long rd32(const unsigned char *p) { return rd16(p) | rd16(p + 2) << 16; }
+
+/* Member `name` of the zip archive z[0..n) into a new buffer *out (*len
+   bytes): stored or deflated. 0; 1 not found; 2 malformed or unsupported
+   (the reason in *why). */
+static int zip_member(const unsigned char *z, size_t n, const char *name, unsigned char **out, size_t *len,
+                      const char **why) {
+  size_t e, cd, k, nent, i;
+  const size_t nl = strlen(name);
+  *why = "not a zip archive (no end of central directory)";
+  if (n < 22) return 2;
+  for (e = n - 22;; --e) {   /* the end of central directory record, from the back */
+    if (rd32(z + e) == 0x06054b50ul) break;
+    if (e == 0 || n - e > 22 + 65535) return 2;
+  }
+  nent = rd16(z + e + 10);
+  cd = rd32(z + e + 16);
+  *why = "a zip central directory outside the file";
+  for (k = 0, i = cd; k < nent; ++k) {
+    unsigned long meth, csz, usz, off, fl, xl, cl;
+    if (i > n || n - i < 46 || rd32(z + i) != 0x02014b50ul) return 2;
+    meth = rd16(z + i + 10); csz = rd32(z + i + 20); usz = rd32(z + i + 24);
+    fl = rd16(z + i + 28); xl = rd16(z + i + 30); cl = rd16(z + i + 32); off = rd32(z + i + 42);
+    if (n - i - 46 < fl) return 2;
+    if (fl == nl && !memcmp(z + i + 46, name, nl)) {
+      size_t d;
+      *why = "a member's data outside the file (or a zip64 archive over 4 GB)";
+      if (csz == 0xfffffffful || usz == 0xfffffffful || off == 0xfffffffful) return 2;
+      if (off > n || n - off < 30 || rd32(z + off) != 0x04034b50ul) return 2;
+      d = off + 30 + rd16(z + off + 26) + rd16(z + off + 28);
+      if (d > n || n - d < csz) return 2;
+      *why = "out of memory";
+      if (!(*out = (unsigned char *)malloc(usz + 1))) return 2;
+      *len = usz;
+      if (meth == 0 && csz == usz) { memcpy(*out, z + d, usz); return 0; }
+      *why = meth == 8 ? "a deflate stream that does not decode" : "a compression other than stored or deflate";
+      if (meth == 8 && !inflate_buf(z + d, csz, *out, usz)) return 0;
+      free(*out);
+      *out = NULL;
+      return 2;
+    }
+    i += 46 + fl + xl + cl;
+  }
+  return 1;
+}
+
+/* A whole file into memory (up to 2 GiB). NULL after a message. */
+static unsigned char *read_all(const char *path, const char *opt, size_t *n) {
+  FILE *f = fopen(path, "rb");
+  unsigned char *b;
+  long l;
+  if (!f) { fail("%s (%s): cannot open: %s", path, opt, strerror(errno)); return NULL; }
+  if (fseek(f, 0, SEEK_END) != 0 || (l = ftell(f)) < 0 || l > 0x7fffffffL || fseek(f, 0, SEEK_SET) != 0) {
+    fclose(f);
+    fail("%s (%s): cannot read (not a regular file, or over 2 GiB)", path, opt);
+    return NULL;
+  }
+  b = (unsigned char *)malloc((size_t)l + 1);
+  if (!b || fread(b, 1, (size_t)l, f) != (size_t)l) { fclose(f); free(b); fail("%s (%s): cannot read", path, opt); return NULL; }
+  fclose(f);
+  *n = (size_t)l;
+  return b;
+}
+
+/* Array `key`.npy of the .npz image into *M (a vector or matrix, as mat_load
+   gives). 0; 1 after a message (missing: only when need). */
+static int npz_array(const unsigned char *z, size_t n, const char *path, const char *opt, const char *key, mat *M,
+                     int need) {
+  char nm[32];
+  unsigned char *b = NULL;
+  size_t len = 0, i;
+  const char *why = "";
+  int e;
+  phgmg_result rc;
+  memset(M, 0, sizeof *M);
+  M->path = path;
+  snprintf(nm, sizeof nm, "%s.npy", key);
+  e = zip_member(z, n, nm, &b, &len, &why);
+  if (e == 1) return need ? fail("%s (%s): no array '%s' in the .npz (expected scipy.sparse.save_npz's csr, csc or "
+                                 "coo arrays)", path, opt, key) : 1;
+  if (e) return fail("%s (%s): %s: %s", path, opt, nm, why);
+  rc = phgmg_npy_parse(b, len, &M->a, &M->rows, &M->cols, &M->ndim, NULL);
+  free(b);
+  if (rc != PHGMG_OK) return fail("%s (%s): %s: %s", path, opt, nm, phgmg_result_string(rc));
+  for (i = 0; i < (size_t)M->rows * (size_t)M->cols; ++i)
+    if (!isfinite(M->a[i])) { mat_free(M); return fail("%s (%s): %s: NaN or Inf at entry %lu", path, opt, nm, (unsigned long)i); }
+  return 0;
+}
+
+/* The format string of a save_npz file ("csr", "csc", "coo", ...) from its
+   format.npy (a 0-d '|S3' or '<U3' array) into fmt (4 bytes). */
+static int npz_format(const unsigned char *z, size_t n, const char *path, const char *opt, char *fmt) {
+  unsigned char *b = NULL;
+  size_t len = 0, hl, i, k = 0;
+  const char *why = "";
+  int e = zip_member(z, n, "format.npy", &b, &len, &why);
+  if (e == 1) return fail("%s (%s): no format.npy: not a scipy.sparse.save_npz file", path, opt);
+  if (e) return fail("%s (%s): format.npy: %s", path, opt, why);
+  hl = len >= 10 && b[6] == 1 ? 10 + rd16(b + 8) : len >= 12 ? 12 + rd32(b + 8) : len + 1;
+  for (i = hl; i < len && k < 3; ++i)
+    if (b[i]) fmt[k++] = (char)b[i];
+  fmt[k] = '\0';
+  free(b);
+  if (hl > len || k != 3) return fail("%s (%s): format.npy does not hold a sparse format name", path, opt);
+  return 0;
+}
+
+/* A scipy.sparse .npz (csr, csc or coo) as triplets: rows, cols, vals (nnz)
+   allocated here; the shape must be N x N. */
+static int load_npz(const char *path, const char *opt, int N, int **ri, int **cj, double **v, int *nnz) {
+  size_t n = 0;
+  unsigned char *z = read_all(path, opt, &n);
+  mat sh, a, b, d;
+  char fmt[4];
+  int err = 0, k, j, p, cnt;
+  if (!z) return 1;
+  memset(&a, 0, sizeof a); memset(&b, 0, sizeof b); memset(&d, 0, sizeof d); memset(&sh, 0, sizeof sh);
+  if ((err = npz_format(z, n, path, opt, fmt)) != 0) goto done;
+  if (strcmp(fmt, "csr") && strcmp(fmt, "csc") && strcmp(fmt, "coo")) {
+    err = fail("%s (%s): sparse format '%s'; expected csr, csc or coo", path, opt, fmt);
+    goto done;
+  }
+  if ((err = npz_array(z, n, path, opt, "shape", &sh, 1)) != 0) goto done;
+  if (sh.rows * sh.cols != 2 || sh.a[0] != N || sh.a[1] != N) {
+    err = fail("%s (%s): shape %s (from its shape.npy), expected (%d, %d) (N from --B)", path, opt,
+               sh.rows * sh.cols == 2 ? "not N x N" : "not 2-d", N, N);
+    goto done;
+  }
+  if ((err = npz_array(z, n, path, opt, "data", &d, 1)) != 0) goto done;
+  cnt = d.rows * d.cols;
+  if (!strcmp(fmt, "coo")) err = npz_array(z, n, path, opt, "row", &a, 1) || npz_array(z, n, path, opt, "col", &b, 1);
+  else err = npz_array(z, n, path, opt, "indices", &a, 1) || npz_array(z, n, path, opt, "indptr", &b, 1);
+  if (err) goto done;
+  if (a.rows * a.cols != cnt || (!strcmp(fmt, "coo") ? b.rows * b.cols != cnt : b.rows * b.cols != N + 1)) {
+    err = fail("%s (%s): the arrays' lengths do not match (%s format, %d values)", path, opt, fmt, cnt);
+    goto done;
+  }
+  *ri = (int *)malloc(sizeof(int) * ((size_t)cnt + 1)); *cj = (int *)malloc(sizeof(int) * ((size_t)cnt + 1));
+  *v = (double *)malloc(sizeof(double) * ((size_t)cnt + 1));
+  if (!*ri || !*cj || !*v) { err = fail("out of memory"); goto done; }
+  for (k = 0; k < cnt; ++k) (*v)[k] = d.a[k];
+  if (!strcmp(fmt, "coo")) {
+    for (k = 0; k < cnt && !err; ++k) {
+      if (!(a.a[k] == floor(a.a[k]) && b.a[k] == floor(b.a[k]) && a.a[k] >= 0 && b.a[k] >= 0 && a.a[k] < N && b.a[k] < N))
+        err = fail("%s (%s): entry %d at (%g, %g) outside the %d x %d matrix", path, opt, k, a.a[k], b.a[k], N, N);
+      else { (*ri)[k] = (int)a.a[k]; (*cj)[k] = (int)b.a[k]; }
+    }
+  } else {   /* compressed: indptr b (N + 1), indices a */
+    const int csr = !strcmp(fmt, "csr");
+    if (b.a[0] != 0 || b.a[N] != cnt) err = fail("%s (%s): indptr does not run from 0 to %d", path, opt, cnt);
+    for (j = 0; j < N && !err; ++j)   /* indptr whole: integers, non-decreasing (so within [0, cnt]) */
+      if (!(b.a[j + 1] >= b.a[j] && b.a[j + 1] == floor(b.a[j + 1])))
+        err = fail("%s (%s): indptr decreases or is not an integer at %d", path, opt, j + 1);
+    for (j = 0; j < N && !err; ++j) {
+      for (p = (int)b.a[j]; p < (int)b.a[j + 1]; ++p) {
+        if (!(a.a[p] >= 0 && a.a[p] < N && a.a[p] == floor(a.a[p]))) {
+          err = fail("%s (%s): index %g at position %d outside [0, %d)", path, opt, a.a[p], p, N);
+          break;
+        }
+        (*ri)[p] = csr ? j : (int)a.a[p];
+        (*cj)[p] = csr ? (int)a.a[p] : j;
+      }
+    }
+  }
+  *nnz = cnt;
+done:
+  mat_free(&sh); mat_free(&a); mat_free(&b); mat_free(&d);
+  free(z);
+  return err;
+}
+
+/* A Matrix Market file (coordinate; real or integer; general, symmetric or
+   skew-symmetric: the other triangle added, negated for skew) as triplets,
+   N x N. */
+static int load_mtx(const char *path, const char *opt, int N, int **ri, int **cj, double **v, int *nnz) {
+  FILE *f = fopen(path, "r");
+  char line[1024], obj[64], fmtw[64], field[64], sym[64];
+  long M = 0, C = 0, L = 0, k;
+  int skew, symm, cnt = 0, err = 0, lineno = 1;
+  if (!f) return fail("%s (%s): cannot open: %s", path, opt, strerror(errno));
+  if (!fgets(line, sizeof line, f) || sscanf(line, "%%%%MatrixMarket %63s %63s %63s %63s", obj, fmtw, field, sym) != 4) {
+    fclose(f);
+    return fail("%s (%s): not a Matrix Market file (the first line must be '%%%%MatrixMarket matrix coordinate "
+                "real general' or similar)", path, opt);
+  }
+  for (k = 0; obj[k]; ++k) obj[k] = (char)tolower((unsigned char)obj[k]);
+  for (k = 0; fmtw[k]; ++k) fmtw[k] = (char)tolower((unsigned char)fmtw[k]);
+  for (k = 0; field[k]; ++k) field[k] = (char)tolower((unsigned char)field[k]);
+  for (k = 0; sym[k]; ++k) sym[k] = (char)tolower((unsigned char)sym[k]);
+  skew = !strcmp(sym, "skew-symmetric");
+  symm = !strcmp(sym, "symmetric");
+  if (strcmp(obj, "matrix") || strcmp(fmtw, "coordinate") || (strcmp(field, "real") && strcmp(field, "integer")) ||
+      (!skew && !symm && strcmp(sym, "general"))) {
+    fclose(f);
+    return fail("%s (%s): Matrix Market '%s %s %s %s' is not supported: expected matrix coordinate real|integer "
+                "general|symmetric|skew-symmetric", path, opt, obj, fmtw, field, sym);
+  }
+  do { ++lineno; } while (fgets(line, sizeof line, f) && (line[0] == '%' || strspn(line, " \t\r\n") == strlen(line)));
+  if (sscanf(line, "%ld %ld %ld", &M, &C, &L) != 3 || M != N || C != N || L < 0 || L > 1000000000L) {
+    fclose(f);
+    return fail("%s (%s): line %d: expected the size line 'rows cols entries' of a %d x %d matrix (N from --B)",
+                path, opt, lineno, N, N);
+  }
+  *ri = (int *)malloc(sizeof(int) * (2 * (size_t)L + 1)); *cj = (int *)malloc(sizeof(int) * (2 * (size_t)L + 1));
+  *v = (double *)malloc(sizeof(double) * (2 * (size_t)L + 1));
+  if (!*ri || !*cj || !*v) { fclose(f); return fail("out of memory for %ld entries", L); }
+  for (k = 0; k < L && !err; ++k) {
+    long i, j;
+    double x;
+    char *end;
+    ++lineno;
+    if (!fgets(line, sizeof line, f)) { err = fail("%s (%s): %ld entries announced, %ld found", path, opt, L, k); break; }
+    if (sscanf(line, "%ld %ld %n", &i, &j, &cnt) < 2) { err = fail("%s (%s): line %d: expected 'row col value'", path, opt, lineno); break; }
+    x = strtod(line + cnt, &end);
+    if (end == line + cnt || !isfinite(x)) { err = fail("%s (%s): line %d: the value is not a finite number", path, opt, lineno); break; }
+    if (i < 1 || i > N || j < 1 || j > N) { err = fail("%s (%s): line %d: entry (%ld, %ld) outside 1..%d", path, opt, lineno, i, j, N); break; }
+    if ((symm || skew) && i < j) { err = fail("%s (%s): line %d: (%ld, %ld) above the diagonal in a %s file (only the lower triangle is stored)", path, opt, lineno, i, j, sym); break; }
+    if (skew && i == j) { err = fail("%s (%s): line %d: a diagonal entry in a skew-symmetric file", path, opt, lineno); break; }
+    (*ri)[*nnz] = (int)i - 1; (*cj)[*nnz] = (int)j - 1; (*v)[(*nnz)++] = x;
+    if ((symm || skew) && i != j) { (*ri)[*nnz] = (int)j - 1; (*cj)[*nnz] = (int)i - 1; (*v)[(*nnz)++] = skew ? -x : x; }
+  }
+  fclose(f);
+  return err;
+}
+
+/* 1 if path ends in ext (".npz", ".mtx"). */
+static int has_ext(const char *path, const char *ext) {
+  const size_t l = strlen(path), e = strlen(ext);
+  return l > e && !strcmp(path + l - e, ext);
+}
+
+/* A .npz or .mtx SPEC into c (N x N, duplicates summed). */
+static int load_sparse_file(cli_csc *c, const char *opt, const char *spec, int N) {
+  int *ri = NULL, *cj = NULL, nnz = 0, err;
+  double *v = NULL;
+  phgmg_result rc;
+  if (is_dir(spec, opt)) return 1;
+  err = has_ext(spec, ".npz") ? load_npz(spec, opt, N, &ri, &cj, &v, &nnz) : load_mtx(spec, opt, N, &ri, &cj, &v, &nnz);
+  if (!err && (rc = phgmg_csc_from_coo(&c->A, N, N, nnz, ri, cj, v, NULL)) != PHGMG_OK)
+    err = fail("%s (%s): %s", spec, opt, phgmg_result_string(rc));
+  if (!err) { c->cp = c->A.colptr; c->v = c->A.values; }
+  free(ri); free(cj); free(v);
+  return err;
+}
+
 /* --X-coo SPEC into an N x N CSC matrix (columns sorted, duplicates summed). */
 static int load_coo(cli_csc *c, const char *opt, const char *spec, int N) {
   mat M[3];
@@ -1867,6 +2280,7 @@ static int load_coo(cli_csc *c, const char *opt, const char *spec, int N) {
   char buf[3][4096];
   memset(M, 0, sizeof M);
   memset(c, 0, sizeof *c);
+  if (!strchr(spec, ',') && (has_ext(spec, ".npz") || has_ext(spec, ".mtx"))) return load_sparse_file(c, opt, spec, N);
   if (strchr(spec, ',')) {
     const char *a = spec, *b = strchr(a, ','), *e = b ? strchr(b + 1, ',') : NULL;
     if (!b || !e || strchr(e + 1, ',') || b - a >= 4096 || e - b - 1 >= 4096 || strlen(e + 1) >= 4096 ||

@@ -18,6 +18,8 @@
 # 4. NAME_PD.npy ([Ph; S + N]) of a model with feedthrough; NAME.json's E,
 #    N_full and feedthrough.
 # 5. --input sin --freq, --input chirp, --x0 against SciPy (solve_ivp, expm).
+# 6. SciPy .npz (save_npz) and Matrix Market .mtx (mmwrite) as --X-coo specs;
+#    malformed ones refused with a message naming the file.
 # Needs NumPy/SciPy (/usr/bin/python3) to write the inputs (skipped otherwise).
 set -u
 P=${1:-build/phgmg}
@@ -220,6 +222,60 @@ PYEOF
 [ $? -eq 1 ] && grep -q "reduced initial state" err.txt && pass || bad "simulate-rom --x0 of the wrong size: $(cat err.txt)"
 "$P" simulate $SYS --steps 10 --freq 0 --out bad.npy >/dev/null 2>err.txt
 [ $? -eq 2 ] && pass || bad "--freq 0 accepted"
+
+# 6. SciPy's sparse files wherever a coordinate SPEC is taken: save_npz csr
+#    (deflate), csc, coo (stored) and Matrix Market general, symmetric and
+#    skew-symmetric (mmwrite) give the dense model's output; a random J of
+#    N = 400 (about 8 000 entries: dynamic Huffman blocks) too; malformed
+#    files: status 1 and a message naming the file
+"$PY" - <<'PYEOF' || bad "writing the .npz / .mtx files"
+import numpy as np, scipy.sparse as sp, scipy.io as sio
+J, R, Q = (np.load(k + ".npy") for k in "JRQ")
+for k, A in (("J", J), ("R", R), ("Q", Q)):
+    S = sp.csr_matrix(A)
+    sp.save_npz(k + "_csr.npz", S)
+    sp.save_npz(k + "_csc.npz", S.tocsc())
+    sp.save_npz(k + "_coo.npz", S.tocoo(), compressed=False)
+    sio.mmwrite(k + "_gen.mtx", sp.coo_matrix(A))
+    sio.mmwrite(k + "_sym.mtx", sp.coo_matrix(A), symmetry="skew-symmetric" if k == "J" else "symmetric")
+rng = np.random.default_rng(3)
+W = sp.random(400, 400, density=0.025, random_state=4, format="csr")
+JJ = (W - W.T).tocsr()
+sp.save_npz("J400.npz", JJ)
+np.save("J400.npy", JJ.toarray())
+np.save("R400.npy", 0.1 * np.eye(400)); np.save("Q400.npy", np.eye(400))
+b = np.zeros(400); b[7] = 1.0; np.save("B400.npy", b)
+sp.save_npz("R400.npz", sp.csr_matrix(0.1 * np.eye(400))); sp.save_npz("Q400.npz", sp.identity(400, format="csr"))
+raw = open("J_csr.npz", "rb").read()
+open("trunc.npz", "wb").write(raw[: len(raw) // 2])
+bad = bytearray(raw); i = raw.find(b"indices.npy") + 11 + 30; bad[i:i + 8] = b"\xff" * 8
+open("corrupt.npz", "wb").write(bytes(bad))
+open("bad_head.mtx", "w").write("%%MatrixMarket matrix array real general\n24 24\n")
+open("bad_idx.mtx", "w").write("%%MatrixMarket matrix coordinate real general\n24 24 1\n25 1 1.0\n")
+open("bad_size.mtx", "w").write("%%MatrixMarket matrix coordinate real general\n23 23 0\n")
+PYEOF
+for f in csr csc coo gen sym; do
+  ext=npz; case $f in gen|sym) ext=mtx ;; esac
+  "$P" simulate --J-coo J_$f.$ext --R-coo R_$f.$ext --Q-coo Q_$f.$ext --B B.npy --steps 100 --out y_$f.npy >/dev/null \
+    2>err.txt && pass || bad "simulate from $f.$ext: $(tail -n 2 err.txt)"
+  "$PY" -c "
+import numpy as np, sys
+a, b = np.load('yd.npy'), np.load('y_$f.npy')
+sys.exit(0 if np.abs(a - b).max() <= 1e-12 * np.abs(a).max() else 1)" && pass || bad "$f.$ext: not the dense model"
+done
+"$P" simulate --J J400.npy --R R400.npy --Q Q400.npy --B B400.npy --steps 20 --out y4d.npy >/dev/null 2>&1 && pass \
+  || bad "simulate N = 400 dense"
+"$P" simulate --J-coo J400.npz --R-coo R400.npz --Q-coo Q400.npz --B B400.npy --steps 20 --out y4s.npy >/dev/null \
+  2>err.txt && pass || bad "simulate N = 400 from .npz: $(tail -n 2 err.txt)"
+"$PY" -c "
+import numpy as np, sys
+a, b = np.load('y4d.npy'), np.load('y4s.npy')
+sys.exit(0 if np.abs(a - b).max() <= 1e-12 * np.abs(a).max() else 1)" && pass || bad "N = 400 .npz: not the dense model"
+for f in trunc.npz corrupt.npz bad_head.mtx bad_idx.mtx bad_size.mtx; do
+  "$P" simulate --J-coo $f --R-coo R_gen.mtx --Q-coo Q_gen.mtx --B B.npy --steps 5 --out yb.npy >/dev/null 2>err.txt
+  st=$?
+  [ $st -eq 1 ] && grep -q "$f (--J-coo)" err.txt && pass || bad "malformed $f: status $st: $(cat err.txt)"
+done
 
 echo "test_cli_workflow: $npass passed, $nfail failed"
 [ "$nfail" -eq 0 ]
