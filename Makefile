@@ -205,6 +205,7 @@ test-cli: $(BUILD)/phgmg $(BUILD)/phgmg-float
 	sh tests/test_lib_msgs4.sh $(BUILD)/phgmg
 	sh tests/test_rom_dt.sh $(BUILD)/phgmg
 	sh tests/test_rom_dt.sh $(BUILD)/phgmg-float
+	sh tests/test_cli_workflow.sh $(BUILD)/phgmg
 	/usr/bin/python3 tests/check_dae_bar.py $(BUILD)/phgmg 100 $(BUILD)/dae_bar
 	sh tests/test_cli_lowrank.sh $(BUILD)/phgmg
 

@@ -518,7 +518,9 @@
 
    2.6 Sparse models (>>ph, >>sparse). phgmg_ph_sparse_create takes J, R, Q
    (and E; or all of them in one phgmg_ph_sparse_desc:
-   phgmg_ph_sparse_create_desc) as compressed sparse columns in any ordering, reorders them by
+   phgmg_ph_sparse_create_desc) as compressed sparse columns in any ordering
+   (assembled triplets with duplicates: phgmg_csc_from_coo sums them into a
+   phgmg_csc, phgmg_csc_free releases it), reorders them by
    reverse Cuthill-McKee into band storage and, for meshes (a wide band),
    also analyses a sparse LU of the GL3 stage matrices: block elimination
    of an independent set of states first (a mass-spring model's positions:
@@ -1054,8 +1056,10 @@
    fills phgmg_validation: e_red, e_y, e_proj, e_energy (and the full model's),
    Newton statistics, the first failing step, pass (completed, no Newton
    failure, e_y <= ey_max). A failing reduced model is a result (pass = 0), not
-   an error. The command line's `phgmg validate` does the same for a list of
-   test inputs and exits 1 when one fails.
+   an error. phgmg_reduced_validate_many compares several reduced models of
+   one full model (a sweep over r or methods) with a single full run. The
+   command line's `phgmg validate` does the same for a list of test inputs
+   (and a list of --r and --method) and exits 1 when one fails.
 
    4.4 Online indicators. Every reduced model carries a training envelope
    (env_lo, env_hi: the range of the training snapshots' reduced coordinates,
@@ -1906,7 +1910,8 @@
            phgmg_jr_factor_create, phgmg_jr_solve, phgmg_jr_factor_destroy,
            phgmg_dae_create, phgmg_dae_system, phgmg_dae_nalg,
            phgmg_dae_restrict, phgmg_dae_embed, phgmg_dae_lift,
-           phgmg_dae_destroy, phgmg_rcm, phgmg_ph_sparse_create, phgmg_ph_sparse_create_e,
+           phgmg_dae_destroy, phgmg_csc_from_coo, phgmg_csc_free, phgmg_rcm,
+           phgmg_ph_sparse_create, phgmg_ph_sparse_create_e,
            phgmg_ph_sparse_create_desc,
            phgmg_ph_sparse_system,
            phgmg_ph_sparse_perm, phgmg_ph_sparse_sep_idx, phgmg_ph_sparse_hess_pattern,
@@ -1927,7 +1932,7 @@
            phgmg_reduced_rom, phgmg_reduced_N, phgmg_reduced_lift,
            phgmg_reduced_restrict, phgmg_reduced_dphi, phgmg_reduced_W,
            phgmg_reduced_simulate, phgmg_reduced_simulate_run,
-           phgmg_reduced_validate, phgmg_rel_error,
+           phgmg_reduced_validate, phgmg_reduced_validate_many, phgmg_rel_error,
            phgmg_err_red, phgmg_err_proj, phgmg_err_lowerbound,
            phgmg_err_energy, phgmg_study_create, phgmg_study_destroy,
            phgmg_study_basis, phgmg_study_reduce, phgmg_study_errors,
@@ -2347,6 +2352,22 @@ typedef struct phgmg_csc {
   const int *rowidx;    /* nnz        */
   const double *values; /* nnz        */
 } phgmg_csc;
+
+/* A CSC matrix from coordinate triplets, as finite-element assembly writes
+   them: entry k adds vals[k] at (rows[k], cols[k]) (0-based), and entries
+   at the same position are summed (as scipy.sparse's coo -> csc does; a sum
+   that is zero stays a stored entry). The rows of each column come out
+   strictly increasing. Two stable counting sorts: O(nnz + n_rows + n_cols)
+   time, memory 2 nnz + n_rows + n_cols extra. *out owns its arrays (one
+   block): free them with phgmg_csc_free. PHGMG_ERR_INVALID_ARG (NULL out,
+   NULL arrays with nnz > 0), _SIZE (n_rows or n_cols < 1, nnz < 0 or above
+   INT_MAX, an index outside the matrix), _NANINF (a value not finite),
+   _NOMEM; on an error *out is zeroed. */
+PHGMG_DEF phgmg_result phgmg_csc_from_coo(phgmg_csc *out, int n_rows, int n_cols, long nnz, const int *rows,
+                                          const int *cols, const double *vals, const phgmg_allocator *alloc);
+/* Frees what phgmg_csc_from_coo allocated (with the same allocator) and
+   zeroes *A; NULL or a zeroed struct is fine. */
+PHGMG_DEF void phgmg_csc_free(phgmg_csc *A, const phgmg_allocator *alloc);
 
 /* Reverse Cuthill-McKee ordering of the symmetric pattern of |A_0| + ... +
    |A_{na-1}| (each N x N CSC; the pattern is symmetrized, the diagonal
@@ -3241,7 +3262,8 @@ typedef struct phgmg_reduce_info {
   double rcond_jr;         /* rcond of J - R                                  */
   double pod_sigma_ratio;  /* sigma_{r'+1}/sigma_1 of what the method PODs (GMG:
                               the adjusted snapshots, r' = r - m; SP1/SP2: X,
-                              r' = r); 0 if no further mode or a given basis */
+                              r' = r; also on a study's bases); 0 if no
+                              further mode or a basis of your own */
   double lambda;           /* GMG-QM: the ridge lambda used (fixed or chosen)  */
   double lambda_cv_err;    /* lambda chosen: held-out relative error of the quadratic
                               correction at that lambda, sum ||V2^T x - M(z kron z)||^2
@@ -3377,6 +3399,18 @@ typedef struct phgmg_validation {
 PHGMG_DEF phgmg_result phgmg_reduced_validate(const phgmg_reduced *red, const phgmg_ph_system *sys,
                                               const phgmg_run *run, double tol, int max_iter, double ey_max,
                                               phgmg_validation *v, const phgmg_allocator *alloc);
+/* phgmg_reduced_validate of nred reduced models of the same full model (a
+   sweep over orders or methods) on one run: the full model is simulated
+   once, each reduced model compared with that run into v[k] (nred entries).
+   v[k] is what phgmg_reduced_validate(reds[k], ...) gives. Returns the full
+   run's code if it fails, PHGMG_ERR_NOMEM, else the first model's
+   PHGMG_ERR_NANINF / _OVERFLOW (every model is still compared), else
+   PHGMG_OK; PHGMG_ERR_INVALID_ARG (nred < 1, a NULL model), _SIZE (a model
+   not of sys's N, m). Cost: one full run and nred reduced runs. */
+PHGMG_DEF phgmg_result phgmg_reduced_validate_many(const phgmg_reduced *const *reds, int nred,
+                                                   const phgmg_ph_system *sys, const phgmg_run *run, double tol,
+                                                   int max_iter, double ey_max, phgmg_validation *v,
+                                                   const phgmg_allocator *alloc);
 
 /* >>errors ================================================================ */
 /* --- error measures (paper 5.1) --- */
@@ -8401,6 +8435,66 @@ PHGMG__PRIV int phgmg__rcm_peripheral(const int *xadj, const int *adj, const int
   }
   for (i = 0; i < cnt; ++i) level[q[i]] = -1;
   return root;
+}
+
+/* The triplets' checks for phgmg_csc_from_coo: PHGMG_OK or the code. */
+PHGMG__PRIV phgmg_result phgmg__coo_check(int n_rows, int n_cols, long nnz, const int *rows, const int *cols,
+                                          const double *vals) {
+  long k;
+  if (nnz > 0 && (!rows || !cols || !vals)) return PHGMG_ERR_INVALID_ARG;
+  if (n_rows < 1 || n_cols < 1 || nnz < 0 || nnz > 2147483646L) return PHGMG_ERR_SIZE;
+  for (k = 0; k < nnz; ++k)
+    if (rows[k] < 0 || rows[k] >= n_rows || cols[k] < 0 || cols[k] >= n_cols) return PHGMG_ERR_SIZE;
+  for (k = 0; k < nnz; ++k)
+    if (!isfinite(vals[k])) return PHGMG_ERR_NANINF;
+  return PHGMG_OK;
+}
+
+PHGMG_DEF phgmg_result phgmg_csc_from_coo(phgmg_csc *out, int n_rows, int n_cols, long nnz, const int *rows,
+                                          const int *cols, const double *vals, const phgmg_allocator *alloc) {
+  const int nz = (int)(nnz > 0 ? nnz : 0);
+  double *v, *tv;
+  int *cp, *ri, *rp, *tr, *tc, *pos, k, j, q;
+  phgmg_result rc;
+  if (!out) return PHGMG_ERR_INVALID_ARG;
+  memset(out, 0, sizeof *out);
+  if ((rc = phgmg__coo_check(n_rows, n_cols, nnz, rows, cols, vals)) != PHGMG_OK) return rc;
+  /* one block: values (nnz), then colptr (n_cols + 1), rowidx (nnz) */
+  v = PHGMG__CAST(double *, phgmg__alloc(alloc, (size_t)(nz + 1) * sizeof(double) +
+                                                    ((size_t)n_cols + 1 + (size_t)nz + 1) * sizeof(int)));
+  tv = phgmg__dalloc(alloc, (size_t)nz + 1);
+  rp = phgmg__ialloc(alloc, (size_t)n_rows + 1 + 2 * ((size_t)nz + 1) + (size_t)n_cols);
+  if (!v || !tv || !rp) { phgmg__free(alloc, v); phgmg__free(alloc, tv); phgmg__free(alloc, rp); return PHGMG_ERR_NOMEM; }
+  cp = PHGMG__CAST(int *, (void *)(v + nz + 1)); ri = cp + n_cols + 1;
+  tr = rp + n_rows + 1; tc = tr + nz + 1; pos = tc + nz + 1;
+  /* pass 1: stable by row into (tc, tv); pass 2: stable by column, so rows ascend within each column */
+  memset(rp, 0, sizeof(int) * ((size_t)n_rows + 1));
+  for (k = 0; k < nz; ++k) rp[rows[k] + 1]++;
+  for (j = 0; j < n_rows; ++j) rp[j + 1] += rp[j];
+  for (k = 0; k < nz; ++k) { q = rp[rows[k]]++; tr[q] = rows[k]; tc[q] = cols[k]; tv[q] = vals[k]; }
+  memset(cp, 0, sizeof(int) * ((size_t)n_cols + 1));
+  for (k = 0; k < nz; ++k) cp[tc[k] + 1]++;
+  for (j = 0; j < n_cols; ++j) { cp[j + 1] += cp[j]; pos[j] = cp[j]; }
+  for (k = 0; k < nz; ++k) { q = pos[tc[k]]++; ri[q] = tr[k]; v[q] = tv[k]; }
+  for (j = 0, q = 0; j < n_cols; ++j) {   /* sum the duplicates, compact in place */
+    const int a = cp[j], b = cp[j + 1];
+    cp[j] = q;
+    for (k = a; k < b; ++k) {
+      if (q > cp[j] && ri[q - 1] == ri[k]) v[q - 1] += v[k];
+      else { ri[q] = ri[k]; v[q] = v[k]; ++q; }
+    }
+  }
+  cp[n_cols] = q;
+  phgmg__free(alloc, tv);
+  phgmg__free(alloc, rp);
+  out->n_rows = n_rows; out->n_cols = n_cols; out->colptr = cp; out->rowidx = ri; out->values = v;
+  return PHGMG_OK;
+}
+
+PHGMG_DEF void phgmg_csc_free(phgmg_csc *A, const phgmg_allocator *alloc) {
+  if (!A) return;
+  phgmg__free(alloc, (void *)A->values);
+  memset(A, 0, sizeof *A);
 }
 
 PHGMG_DEF phgmg_result phgmg_rcm(int N, int na, const phgmg_csc *const *A, int *perm, int *kb_out,
@@ -15448,6 +15542,19 @@ PHGMG__PRIV phgmg_result phgmg__basis_pod_implicit(phgmg__rctx *c, double *tmp) 
   return phgmg__basis_take(c, V1, S, k);
 }
 
+/* sigma_{p+1} / sigma_1 from a study's coordinates C = U^T X (k x ns, U
+   the left singular vectors: row j has the norm sigma_{j+1}); 0 if p >= k. */
+PHGMG__PRIV double phgmg__coord_sigma_ratio(const double *C, int k, int ns, int p) {
+  double s0 = 0.0, sp = 0.0;
+  int j;
+  if (!C || p >= k || k < 1) return 0.0;
+  for (j = 0; j < ns; ++j) {
+    s0 += C[(size_t)j * k] * C[(size_t)j * k];
+    sp += C[p + (size_t)j * k] * C[p + (size_t)j * k];
+  }
+  return s0 > 0.0 ? sqrt(sp / s0) : 0.0;
+}
+
 /* Stage 1, basis. GMG: V0 = [B, V1], V1 = POD of the adjusted snapshots
    X - B B^+ X (c->Xa keeps them, for the manifold stage). SP1/SP2: V0 =
    V_POD of X. opts.cache.pod_basis replaces the POD. */
@@ -15468,6 +15575,8 @@ PHGMG__PRIV phgmg_result phgmg__stage_basis(phgmg__rctx *c) {
   if (!phgmg__is_gmg(red->method)) {
     if (c->o->cache.pod_basis) {
       memcpy(red->V0, c->o->cache.pod_basis, (size_t)N * p * sizeof(double));
+      if (c->sf == PHGMG__SF_SP1 || c->sf == PHGMG__SF_SP2)   /* the study's POD: its singular values */
+        c->inf.pod_sigma_ratio = phgmg__coord_sigma_ratio(c->st->Cp, c->st->kp, ns, p);
       return PHGMG_OK;
     }
     /* one mode more than kept when the data have it: sigma_{r+1} for info */
@@ -15487,6 +15596,7 @@ PHGMG__PRIV phgmg_result phgmg__stage_basis(phgmg__rctx *c) {
   if (c->sf == PHGMG__SF_GMG) { /* the study's basis: Xa is not needed (its coordinates are cached) */
     memcpy(red->V0, c->sys->B, (size_t)N * m * sizeof(double));
     memcpy(red->V0 + (size_t)N * m, c->o->cache.pod_basis, (size_t)N * p * sizeof(double));
+    c->inf.pod_sigma_ratio = phgmg__coord_sigma_ratio(c->st->Ca, c->st->ka, ns, p);
     return PHGMG_OK;
   }
   kk = phgmg__v2_from_basis(c) ? p + red->rn + 1 : p + 1;
@@ -18067,40 +18177,27 @@ PHGMG__PRIV phgmg_result phgmg__validate_finite(const phgmg_validation *v, const
   return nan ? PHGMG_ERR_NANINF : PHGMG_ERR_OVERFLOW;
 }
 
-PHGMG_DEF phgmg_result phgmg_reduced_validate(const phgmg_reduced *red, const phgmg_ph_system *sys,
-                                              const phgmg_run *run, double tol, int max_iter, double ey_max,
-                                              phgmg_validation *v, const phgmg_allocator *alloc) {
-  int N, m, r, ns, k, done, j;
-  size_t nb;
-  double *buf, *X, *Y, *XR, *YR, *xr0, *H, *S, *D, *Hf, *Sf, *Df;
-  phgmg_energy ef, er;
-  phgmg_gl3_opts go;
+/* The reduced side of a validation: red simulated on run from rho(x0),
+   compared with the full run (X, Y: N x ns, m x ns; its energy terms Hf,
+   Sf, Df), into *v. */
+PHGMG__PRIV phgmg_result phgmg__validate_rom(const phgmg_reduced *red, const phgmg_run *run, double tol, int max_iter,
+                                             double ey_max, const double *X, const double *Y, const double *Hf,
+                                             const double *Sf, const double *Df, phgmg_validation *v,
+                                             const phgmg_allocator *alloc) {
+  const int N = red->N, m = red->m, r = red->r, ns = run->nsteps + 1;
+  double *buf, *XR, *YR, *xr0, *H, *S, *D;
+  phgmg_energy er;
   phgmg_result rc;
-  if (!v) return PHGMG_ERR_INVALID_ARG;
-  memset(v, 0, sizeof *v);
-  v->first_failure = -1;
-  if (!red || !sys || !run) return PHGMG_ERR_INVALID_ARG;
-  if (phgmg_runs_columns(1, run) < 0 || run->nsteps < 1 || !(tol < 1.0) || ey_max != ey_max)
-    return PHGMG_ERR_INVALID_ARG;
-  N = red->N; m = red->m; r = red->r; ns = run->nsteps + 1;
-  if (sys->N != N || sys->m != m) return PHGMG_ERR_SIZE;
-  nb = (size_t)N * ns + (size_t)m * ns * 2 + (size_t)r * ns + (size_t)r + 6 * (size_t)ns + (size_t)N;
-  buf = phgmg__dalloc(alloc, nb);
+  int k, done, j;
+  buf = phgmg__dalloc(alloc, (size_t)r * ns + (size_t)m * ns + (size_t)r + 3 * (size_t)ns);
   if (!buf) return PHGMG_ERR_NOMEM;
-  X = buf; Y = X + (size_t)N * ns; YR = Y + (size_t)m * ns; XR = YR + (size_t)m * ns; xr0 = XR + (size_t)r * ns;
-  H = xr0 + r; S = H + ns; D = S + ns; Hf = D + ns; Sf = Hf + ns; Df = Sf + ns;
-  memset(Df + ns, 0, (size_t)N * sizeof(double));    /* x0 = 0 when run->x0 is NULL */
-  ef.H = Hf; ef.S = Sf; ef.D = Df; er.H = H; er.S = S; er.D = D;
-  memset(&go, 0, sizeof go);
-  go.tol = tol > 0.0 ? tol : 1e-10;
-  go.max_iter = max_iter > 0 ? max_iter : 20;
-  rc = phgmg_simulate(sys, run->x0 ? run->x0 : Df + ns, run->t0, run->dt, run->nsteps, run->u, run->user, &go, X, Y,
-                      &ef, NULL, NULL, alloc);
-  if (rc != PHGMG_OK) { phgmg__free(alloc, buf); return rc; }
+  XR = buf; YR = XR + (size_t)r * ns; xr0 = YR + (size_t)m * ns; H = xr0 + r; S = H + ns; D = S + ns;
+  er.H = H; er.S = S; er.D = D;
   for (k = 0; k < r * ns; ++k) XR[k] = (double)NAN;
   phgmg_reduced_restrict(red, X, xr0);
   v->rom_rc = phgmg_reduced_simulate(red, xr0, run->t0, run->dt, run->nsteps, run->u, run->user,
-                                     tol > 0.0 ? tol : 0.0, go.max_iter, XR, YR, &er, &v->stats, alloc);
+                                     tol > 0.0 ? tol : 0.0, max_iter > 0 ? max_iter : 20, XR, YR, &er, &v->stats,
+                                     alloc);
   if (v->rom_rc == PHGMG_ERR_NOMEM) { phgmg__free(alloc, buf); return PHGMG_ERR_NOMEM; }
   for (done = 0; done + 1 < ns && XR[(size_t)(done + 1) * r] == XR[(size_t)(done + 1) * r]; ++done) {}
   v->nsteps = run->nsteps;
@@ -18123,6 +18220,54 @@ PHGMG_DEF phgmg_result phgmg_reduced_validate(const phgmg_reduced *red, const ph
   v->pass = rc == PHGMG_OK && v->rom_rc == PHGMG_OK && v->stats.failures == 0 && (ey_max <= 0.0 || v->e_y <= ey_max);
   phgmg__free(alloc, buf);
   return rc;
+}
+
+PHGMG_DEF phgmg_result phgmg_reduced_validate_many(const phgmg_reduced *const *reds, int nred,
+                                                   const phgmg_ph_system *sys, const phgmg_run *run, double tol,
+                                                   int max_iter, double ey_max, phgmg_validation *v,
+                                                   const phgmg_allocator *alloc) {
+  int N, m, ns, k;
+  size_t nb;
+  double *buf, *X, *Y, *Hf, *Sf, *Df;
+  phgmg_energy ef;
+  phgmg_gl3_opts go;
+  phgmg_result rc, rc1 = PHGMG_OK;
+  if (!v || nred < 1) return PHGMG_ERR_INVALID_ARG;
+  for (k = 0; k < nred; ++k) { memset(&v[k], 0, sizeof v[k]); v[k].first_failure = -1; }
+  if (!reds || !sys || !run) return PHGMG_ERR_INVALID_ARG;
+  for (k = 0; k < nred; ++k)
+    if (!reds[k]) return PHGMG_ERR_INVALID_ARG;
+  if (phgmg_runs_columns(1, run) < 0 || run->nsteps < 1 || !(tol < 1.0) || ey_max != ey_max)
+    return PHGMG_ERR_INVALID_ARG;
+  N = sys->N; m = sys->m; ns = run->nsteps + 1;
+  for (k = 0; k < nred; ++k)
+    if (reds[k]->N != N || reds[k]->m != m) return PHGMG_ERR_SIZE;
+  nb = (size_t)N * ns + (size_t)m * ns + 3 * (size_t)ns + (size_t)N;
+  buf = phgmg__dalloc(alloc, nb);
+  if (!buf) return PHGMG_ERR_NOMEM;
+  X = buf; Y = X + (size_t)N * ns; Hf = Y + (size_t)m * ns; Sf = Hf + ns; Df = Sf + ns;
+  memset(Df + ns, 0, (size_t)N * sizeof(double));    /* x0 = 0 when run->x0 is NULL */
+  ef.H = Hf; ef.S = Sf; ef.D = Df;
+  memset(&go, 0, sizeof go);
+  go.tol = tol > 0.0 ? tol : 1e-10;
+  go.max_iter = max_iter > 0 ? max_iter : 20;
+  rc = phgmg_simulate(sys, run->x0 ? run->x0 : Df + ns, run->t0, run->dt, run->nsteps, run->u, run->user, &go, X, Y,
+                      &ef, NULL, NULL, alloc);
+  for (k = 0; k < nred && rc == PHGMG_OK; ++k) {   /* one full run, every reduced model against it */
+    const phgmg_result rk = phgmg__validate_rom(reds[k], run, tol, go.max_iter, ey_max, X, Y, Hf, Sf, Df, &v[k], alloc);
+    if (rk == PHGMG_ERR_NOMEM) rc = rk;
+    else if (rk != PHGMG_OK && rc1 == PHGMG_OK) rc1 = rk;
+  }
+  phgmg__free(alloc, buf);
+  return rc != PHGMG_OK ? rc : rc1;
+}
+
+PHGMG_DEF phgmg_result phgmg_reduced_validate(const phgmg_reduced *red, const phgmg_ph_system *sys,
+                                              const phgmg_run *run, double tol, int max_iter, double ey_max,
+                                              phgmg_validation *v, const phgmg_allocator *alloc) {
+  if (!v) return PHGMG_ERR_INVALID_ARG;
+  if (!red) { memset(v, 0, sizeof *v); v->first_failure = -1; return PHGMG_ERR_INVALID_ARG; }
+  return phgmg_reduced_validate_many(&red, 1, sys, run, tol, max_iter, ey_max, v, alloc);
 }
 
 /* --- error measures ------------------------------------------------------ */

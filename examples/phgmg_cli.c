@@ -16,6 +16,7 @@
 #define _POSIX_C_SOURCE 200809L
 #define PHGMG_IMPLEMENTATION
 #include "../phgmg.h"
+#include <ctype.h>
 #include <errno.h>
 #include <fcntl.h>
 #include <float.h>
@@ -139,8 +140,18 @@ static const char *const help_lines[] = {
   "                      a = 0..m-1, so that the ports are excited independently;\n",
   "                      const: u(t) = AMP on every port (the same on all: pointed out\n",
   "                      for m > 1, as for a table whose columns are equal); or a\n",
-  "                      FILE.npy (see INPUT FILES; AMP is then not used)\n",
+  "                      FILE.npy (see INPUT FILES; AMP is then not used);\n",
+  "                      chirp: u(t) = AMP sin(p(t)), its angular frequency p'(t)\n",
+  "                      rising linearly from --freq to --freq-end over the run\n",
+  "                      (t in [0, steps*DT]; port a: p(t) (1 + a/m))\n",
   "    --amp AMP         amplitude (default 0.1)\n",
+  "    --freq W          angular frequency of sin (rad per unit of time; W/(2 pi) in\n",
+  "                      Hz), u(t) = AMP sin(W t) (port a: W (1 + a/m)); chirp's\n",
+  "                      start. Default 1\n",
+  "    --freq-end W1     chirp's final angular frequency (default 10 W)\n",
+  "    --x0 FILE         initial state of the training runs (N values, the files'\n",
+  "                      ordering; default 0; not for a model with algebraic\n",
+  "                      constraints); also for simulate\n",
   "    --newton-tol T    Newton tolerance (stage residual, inf-norm, absolute) for\n",
   "                      nonlinear models (default: the library's, 1e-10 times\n",
   "                      max(1, |x|, |stage increment|): follows large states; the log\n",
@@ -155,8 +166,10 @@ static const char *const help_lines[] = {
   "                      sp2:     SP2-POD, W from a POD of the gradient snapshots\n",
   "                      bt, prbt, phbt: balancing of a linear model, no snapshots\n",
   "                               (see BALANCING METHODS)\n",
-  "                      (required)\n",
-  "  --r R               reduced order (required). For gmg-pod/gmg-qm it includes the m\n",
+  "                      (required). A comma-separated list (e.g. gmg-pod,sp1) builds\n",
+  "                      a model for each method (see SWEEPS).\n",
+  "  --r R               reduced order (required); a list R1,R2,... (e.g. 10,20,40, up\n",
+  "                      to 16 orders) builds a model for each (see SWEEPS). For gmg-pod/gmg-qm it includes the m\n",
   "                      port coordinates, so m < R <= N; R - m (gmg) or R (sp1/sp2) must\n",
   "                      not exceed the rank of the (adjusted) snapshots.\n",
   "  --rn K              gmg-qm only: lifting dimension r_n (default 8, or the largest that\n",
@@ -260,10 +273,17 @@ static const char *const help_lines[] = {
   "                      shape: Bh (r x m), Qh (r x r), K (r x r, = J_r - R_r), and as\n",
   "                      they apply G00 G01 G10 G11 Q01 Q11 Ms (gmg-qm), P0 P1 w poly\n",
   "                      (nonlinear), Phi Gam SX SU (step map); see phgmg.h >>online.\n",
+  "    NAME_PD.npy        (feedthrough: --P, --S, --N, or a port on a constraint) the\n",
+  "                      reduced feedthrough [Ph; S + N], (r + m) x m: rows 0..r-1\n",
+  "                      Ph = W_z^T P (x' = ... + (Bh - Ph) u), rows r..r+m-1 S + N\n",
+  "                      (y = (Bh + Ph)^T grad H + (S + N) u)\n",
   "    NAME_V0.npy        the reduction basis V0 (N x r): x ~ V0 xr (every method)\n",
   "    NAME_V2.npy, NAME_M.npy  (gmg-qm) V2 (N x r_n) and M (r_n x p^2, p = r - m):\n",
   "                      x ~ V0 xr + V2 M kron(x2, x2), x2 = xr[m:]\n",
-  "    NAME.json          sizes, method, options, diagnostics and the list of files\n",
+  "    NAME.json          sizes, method, options, diagnostics and the list of files;\n",
+  "                      \"E\": whether the model has a mass matrix, \"N_full\": all its\n",
+  "                      states (\"N\" is the number reduced: an index-one model's\n",
+  "                      differential states), \"algebraic\", \"feedthrough\"\n",
   "  A run writes all of these or none: they are written under temporary names and\n",
   "  renamed at the end; the NAME_*.npy arrays that an earlier run listed in its\n",
   "  NAME.json and this run does not produce (another method) are removed. A run\n",
@@ -273,6 +293,20 @@ static const char *const help_lines[] = {
   "  input is refused before any work (status 2).\n",
   "  The reduced model (LINEAR kind) is x' = K grad H(x) + Bh u, y = Bh^T grad H(x),\n",
   "  H(x) = 1/2 x^T Qh x (+ sum_j w_j phi(P0_j x)); it is again port-Hamiltonian.\n",
+  "\n",
+  "SWEEPS (several --method and --r in one call)\n",
+  "  reduce and validate with a list in --method or --r build every (method, r)\n",
+  "  pair (up to 32 models) from one set-up: the files are read and checked, the\n",
+  "  training runs simulated and the snapshots' bases (POD) computed once; every\n",
+  "  size is checked for every pair before any work. Model (M, R) is written as\n",
+  "  NAME_<M>_r<R>.* with the method's '-' as '_' (rom_gmg_pod_r20.phgmgrom,\n",
+  "  rom_sp1_r40_V0.npy, rom_gmg_pod_r20.json, ...); NAME_sweep.json lists the\n",
+  "  models (method, r, name, reduction seconds, written or not, and with\n",
+  "  validate each test's e_y, e_red and verdict). With a single method and\n",
+  "  order the names are NAME.* as above. reduce writes all models or none;\n",
+  "  validate runs the full model once per test input for all models (one\n",
+  "  table line per test and model), writes the models that pass every test and\n",
+  "  not those that fail (exit 1 if one fails).\n",
   "\n",
   "COMMAND simulate\n",
   "  Runs the full model (the model options of reduce: --J/--R/--Q or the -coo\n",
@@ -288,8 +322,8 @@ static const char *const help_lines[] = {
   "  resolves, dt max|J - R| max|Q| / max|E| > 1/eps = 4.5e15 (the stage equations\n",
   "  lose the mass term; the output would be round-off, zero or NaN), is refused\n",
   "  (also by reduce --simulate and validate).\n",
-  "  --dt DT, --steps N, --input KIND, --amp AMP, --newton-tol T, --newton-iter K:\n",
-  "                      as for reduce --simulate\n",
+  "  --dt DT, --steps N, --input KIND, --amp AMP, --freq W, --freq-end W1, --x0 FILE,\n",
+  "  --newton-tol T, --newton-iter K:  as for reduce --simulate\n",
   "  Sparse input: the log names the solver of the stage systems (band LU, or the\n",
   "  sparse LU for 2-D/3-D meshes; see phgmg.h >>sparse).\n",
   "  --quiet             no progress lines\n",
@@ -306,7 +340,9 @@ static const char *const help_lines[] = {
   "                      step it was trained at (reduce records --simulate's --dt, the\n",
   "                      --dt of --X with --X-input, or --dt given with --X), else 0.1;\n",
   "                      a note on stderr when --dt differs from the model's)\n",
-  "  --steps N, --input KIND, --amp AMP, --newton-tol T, --newton-iter K:  as above\n",
+  "  --steps N, --input KIND, --amp AMP, --freq W, --freq-end W1, --newton-tol T,\n",
+  "  --newton-iter K:    as above\n",
+  "  --x0 FILE           the reduced initial state xr0 (r values; default: rest)\n",
   "  --quiet             no progress lines\n",
   "\n",
   "COMMAND info MODEL\n",
@@ -317,8 +353,13 @@ static const char *const help_lines[] = {
   "\n",
   "SPARSE MATRICES\n",
   "  SPEC is one (nnz, 3) array of rows (row, col, value), or three vectors\n",
-  "  rows.npy,cols.npy,vals.npy (comma-separated, no spaces): 0-based integer indices\n",
-  "  in [0, N), duplicates summed (as scipy.sparse does). The stepper's stage\n",
+  "  rows.npy,cols.npy,vals.npy (comma-separated, no spaces), or a SciPy sparse\n",
+  "  FILE.npz (scipy.sparse.save_npz of a csr, csc or coo matrix, compressed or\n",
+  "  not), or a Matrix Market FILE.mtx (scipy.io.mmwrite; coordinate, real or\n",
+  "  integer, general, symmetric or skew-symmetric: the upper triangle is added,\n",
+  "  negated for skew; 1-based as the format says), shape N x N: 0-based integer indices\n",
+  "  in [0, N), duplicates summed (as scipy.sparse does; the library's\n",
+  "  phgmg_csc_from_coo does it in C for your own code). The stepper's stage\n",
   "  systems are solved by the header's sparse direct LU (fill-reducing ordering,\n",
   "  with a mass matrix a column matching that keeps the pivots on E's large\n",
   "  entries) or, where that is predicted cheaper (narrow bands), by a band LU after\n",
@@ -329,6 +370,8 @@ static const char *const help_lines[] = {
   "    c = A.tocoo(); np.save('J_rows.npy', c.row); np.save('J_cols.npy', c.col)\n",
   "    np.save('J_vals.npy', c.data)     # --J-coo J_rows.npy,J_cols.npy,J_vals.npy\n",
   "    np.save('J.npy', np.column_stack([c.row, c.col, c.data]))   # --J-coo J.npy\n",
+  "    scipy.sparse.save_npz('J.npz', A)                               # --J-coo J.npz\n",
+  "    scipy.io.mmwrite('J.mtx', A)                                    # --J-coo J.mtx\n",
   "\n",
   "BALANCING METHODS (--method bt, prbt, phbt)\n",
   "  Input-independent reduction of a linear model (no --X, no --simulate, no\n",
@@ -427,7 +470,7 @@ static void progress(const char *fmt, ...) {
    runs numbered. Every phase of a long reduction (N * ns >= 1e7, e.g.
    N >= 10 000 with 1001 snapshots); of others, the phases that start after
    the reduction has run a second (a short reduction stays quiet). */
-typedef struct phase_log { double t0; int all, ncand, nprobe; } phase_log;
+typedef struct phase_log { double t0; int all, ncand, nprobe, qm, hyper; } phase_log;
 static void reduce_phase(const char *phase, void *user) {
   phase_log *pl = (phase_log *)user;
   const double t = now_s() - pl->t0;
@@ -435,6 +478,9 @@ static void reduce_phase(const char *phase, void *user) {
   if (strcmp(phase, "lambda: candidate") == 0) k = ++pl->ncand;
   if (strcmp(phase, "lambda: full-model probe run") == 0) k = ++pl->nprobe;
   if (strcmp(phase, "done") == 0 || (!pl->all && t < 1.0)) return;
+  /* stages that do nothing for this model are not shown: the manifold is
+     gmg-qm's, the hyper-reduction needs a hyper-reduced nonlinear part */
+  if ((!pl->qm && !strcmp(phase, "manifold")) || (!pl->hyper && !strcmp(phase, "hyper-reduction"))) return;
   if (k) progress("  ... %s %d (%.1f s)", phase, k, t);
   else progress("  ... %s (%.1f s)", phase, t);
 }
@@ -627,10 +673,14 @@ static const char *shape_str(const mat *m) {
 static int is_vector(const mat *m) { return m->ndim <= 1 || m->rows == 1 || m->cols == 1; }
 
 /* ---- the input signal ------------------------------------------------------- */
-enum { IN_SIN = 0, IN_CONST = 1, IN_TABLE = 2, IN_GRID = 3 };
+enum { IN_SIN = 0, IN_CONST = 1, IN_TABLE = 2, IN_GRID = 3, IN_CHIRP = 4 };
+/* --freq W (angular frequency of sin and the chirp's start, rad per unit of
+   time; default 1) and --freq-end W1 (the chirp's end; 0: 10 W). */
+static double g_freq = 1.0, g_freq_end = 0.0;
 typedef struct cli_input {
   int kind, m;
   double amp;
+  double w0, w1, T;   /* sin: w0; chirp: from w0 to w1 over the run's length T */
   mat tab;        /* IN_TABLE: K x (1+m); IN_GRID: K samples on t = k*grid_dt */
   double grid_dt;
   /* progress of a long simulation, reported from the input callback */
@@ -662,9 +712,16 @@ static void input_fn(double t, double *u, void *user) {
   cli_input *in = (cli_input *)user;
   int a;
   switch (in->kind) {
-    case IN_SIN: /* port a: its own frequency 1 + a/m, so that the ports are excited independently */
-      for (a = 0; a < in->m; ++a) u[a] = in->amp * sin((1.0 + (double)a / in->m) * t);
+    case IN_SIN: /* port a: its own frequency w (1 + a/m), so that the ports are excited independently */
+      for (a = 0; a < in->m; ++a) u[a] = in->amp * sin(in->w0 * (1.0 + (double)a / in->m) * t);
       break;
+    case IN_CHIRP: { /* a linear chirp w(t) = w0 + (w1 - w0) t / T, held at w1 after T; port a scaled by 1 + a/m */
+      const double tc = t < in->T ? t : in->T;
+      const double ph = in->w0 * tc + 0.5 * (in->w1 - in->w0) * tc * tc / (in->T > 0.0 ? in->T : 1.0) +
+                        in->w1 * (t - tc);
+      for (a = 0; a < in->m; ++a) u[a] = in->amp * sin((1.0 + (double)a / in->m) * ph);
+      break;
+    }
     case IN_CONST: for (a = 0; a < in->m; ++a) u[a] = in->amp; break;
     default: table_eval(in, t, u); break;
   }
@@ -680,17 +737,21 @@ static void input_fn(double t, double *u, void *user) {
 
 /* Set up the input from --input/--amp for m ports and step dt. Returns 0, or
    the exit status after a message (2: neither a kind nor an existing file). */
-static int input_setup(cli_input *in, const char *opt, const char *spec, double amp, int m, double dt) {
+static int input_setup(cli_input *in, const char *opt, const char *spec, double amp, int m, double dt, double T) {
   struct stat st;
   const size_t l = strlen(spec);
   memset(in, 0, sizeof *in);
   in->m = m;
   in->amp = amp;
   in->grid_dt = dt;
+  in->w0 = g_freq;
+  in->w1 = g_freq_end > 0.0 ? g_freq_end : 10.0 * g_freq;
+  in->T = T;
   if (!strcmp(spec, "sin")) { in->kind = IN_SIN; return 0; }
+  if (!strcmp(spec, "chirp")) { in->kind = IN_CHIRP; return 0; }
   if (!strcmp(spec, "const")) { in->kind = IN_CONST; return 0; }
   if (stat(spec, &st) != 0 && (l < 4 || strcmp(spec + l - 4, ".npy") != 0))
-    return usage_error("%s '%s': expected sin, const or a FILE.npy, and there is no file '%s'", opt, spec, spec);
+    return usage_error("%s '%s': expected sin, chirp, const or a FILE.npy, and there is no file '%s'", opt, spec, spec);
   if (mat_load(&in->tab, opt, spec)) return 1;
   if (in->tab.ndim == 2 && !(m == 1 && in->tab.cols == 1)) {
     int k;
@@ -723,9 +784,15 @@ static int input_setup(cli_input *in, const char *opt, const char *spec, double 
 
 static const char *input_desc(const cli_input *in, const char *spec) {
   static char buf[600];
-  if (in->kind == IN_SIN && in->m > 1)
+  if (in->kind == IN_SIN && in->m > 1 && in->w0 == 1.0)
     snprintf(buf, sizeof buf, "u_a(t) = %g sin((1 + a/%d) t) at port a = 0..%d", in->amp, in->m, in->m - 1);
-  else if (in->kind == IN_SIN) snprintf(buf, sizeof buf, "u(t) = %g sin(t)", in->amp);
+  else if (in->kind == IN_SIN && in->m > 1)
+    snprintf(buf, sizeof buf, "u_a(t) = %g sin(%g (1 + a/%d) t) at port a = 0..%d", in->amp, in->w0, in->m, in->m - 1);
+  else if (in->kind == IN_SIN && in->w0 == 1.0) snprintf(buf, sizeof buf, "u(t) = %g sin(t)", in->amp);
+  else if (in->kind == IN_SIN) snprintf(buf, sizeof buf, "u(t) = %g sin(%g t)", in->amp, in->w0);
+  else if (in->kind == IN_CHIRP)
+    snprintf(buf, sizeof buf, "u(t) = %g sin(phase), a linear chirp from %g to %g rad per unit time over t in [0, %g]%s",
+             in->amp, in->w0, in->w1, in->T, in->m > 1 ? " (port a: phase times 1 + a/m)" : "");
   else if (in->kind == IN_CONST) snprintf(buf, sizeof buf, "u(t) = %g", in->amp);
   else snprintf(buf, sizeof buf, "u(t) from %s", spec);
   return buf;
@@ -892,7 +959,7 @@ static int file_id_same(const file_id *a, const file_id *b) {
 }
 
 /* A list of paths with the options they came from (copies). */
-#define PATHS_MAX 160
+#define PATHS_MAX 2400
 typedef struct pathset {
   char *path[PATHS_MAX];
   const char *opt[PATHS_MAX];
@@ -924,7 +991,7 @@ static void paths_add(pathset *ps, const char *opt, const char *path, int tmp) {
 
 /* An input spec that may be a file: anything but the input kinds sin, const. */
 static void paths_add_input(pathset *ps, const char *opt, const char *spec) {
-  if (spec && strcmp(spec, "sin") && strcmp(spec, "const")) paths_add(ps, opt, spec, 0);
+  if (spec && strcmp(spec, "sin") && strcmp(spec, "const") && strcmp(spec, "chirp")) paths_add(ps, opt, spec, 0);
 }
 
 /* The index in ps of the file path names, -1 if none. */
@@ -1346,6 +1413,7 @@ typedef struct reduce_args {
   const char *E, *Ecoo;            /* descriptor models: the mass matrix, dense or sparse */
   const char *Pf, *Sf, *Nf;        /* feedthrough P, S, N */
   const char *dampf;               /* --dampers: nonlinear dampers (k x 4: i, j, c1, c3) */
+  const char *x0f;                 /* --x0: the initial state of simulate and of reduce's training runs */
   const char *expf, *potential, *hyper;
   double hyper_tol;
   int simulate, steps, r, rn, no_deim, deim_max, deim_neg, save_snap, have_dt_map, newton_iter;
@@ -1365,6 +1433,9 @@ typedef struct reduce_args {
   int nx;
   const char *xin[16];          /* --X-input KIND, repeatable: the input of each --X run */
   int nxin;
+  int rlist[16], nrl;           /* --r R1,R2,...: the orders of a sweep (r = the one being built) */
+  int mlist[8], nml;            /* --method M1,M2,...: the methods of a sweep (method = the one built) */
+  const char *name0;            /* --name as given (name: the model being built, see sweep_name) */
 } reduce_args;
 
 /* ---- the input files of reduce, validate and simulate: ONE list -----------
@@ -1388,6 +1459,7 @@ static const input_opt input_opts[] = {
   IOPT("--dampers", dampf, OPTF_FILE, OPTF_SIMULATE), IOPT("--poly", poly, OPTF_FILE, OPTF_SIMULATE),
   IOPT("--poly-idx", poly_idx, OPTF_FILE, OPTF_SIMULATE), IOPT("--poly-w", poly_w, OPTF_FILE, OPTF_SIMULATE),
   IOPT("--exp", expf, OPTF_FILE, OPTF_SIMULATE), IOPT("--input", input, OPTF_KIND, OPTF_SIMULATE),
+  IOPT("--x0", x0f, OPTF_FILE, OPTF_SIMULATE),
   IOPT("--ref", ref_file, OPTF_FILE, OPTF_SPECIAL),
   {NULL, 0, 0, 0}};
 #undef IOPT
@@ -1431,6 +1503,17 @@ static const char *optval(int argc, char **argv, int *i) {
   if (*i + 1 >= argc) { usage_error("%s needs a value", argv[*i]); return NULL; }
   if (!argv[*i + 1][0]) { usage_error("%s: empty value (a file name, a number or a word expected)", argv[*i]); return NULL; }
   return argv[++*i];
+}
+
+/* --freq W / --freq-end W1 (argv[*i]): a finite angular frequency > 0 into
+   g_freq / g_freq_end. 0, or 1 after a usage message. */
+static int parse_freq(int argc, char **argv, int *i) {
+  const char *o = argv[*i], *v;
+  double w;
+  if (!(v = optval(argc, argv, i)) || !parse_double(o, v, 0.0, &w)) return 1;
+  if (!(w > 0.0)) { usage_error("%s: expected an angular frequency > 0 (rad per unit of time), got '%s'", o, v); return 1; }
+  if (!strcmp(o, "--freq")) g_freq = w; else g_freq_end = w;
+  return 0;
 }
 
 /* A named potential (--potential NAME[:P1[:P2]]) as exp-polynomial
@@ -1518,6 +1601,94 @@ static int check_hyper_opts(const reduce_args *A, const char *const *seen, int n
   return 0;
 }
 
+/* --r R or a comma-separated list R1,R2,... (up to 16 distinct orders, a
+   sweep): into A->rlist; A->r is the first. 0, or 1 after a usage message. */
+static int parse_r_list(const char *v, reduce_args *A) {
+  const char *p = v;
+  char buf[32];
+  int k;
+  A->nrl = 0;
+  while (*p) {
+    const size_t l = strcspn(p, ",");
+    int r;
+    if (l == 0 || l >= sizeof buf) { usage_error("--r '%s': expected an order R or a list R1,R2,... (no spaces)", v); return 1; }
+    memcpy(buf, p, l); buf[l] = '\0';
+    if (!parse_int("--r", buf, 1, INT_MAX, &r)) return 1;
+    for (k = 0; k < A->nrl; ++k)
+      if (A->rlist[k] == r) { usage_error("--r '%s': the order %d is listed twice", v, r); return 1; }
+    if (A->nrl == 16) { usage_error("--r '%s': at most 16 orders", v); return 1; }
+    A->rlist[A->nrl++] = r;
+    p += l;
+    if (*p == ',') { ++p; if (!*p) { usage_error("--r '%s': a trailing comma", v); return 1; } }
+  }
+  A->r = A->rlist[0];
+  return 0;
+}
+
+static int method_code(const char *m);
+/* --method M or a comma-separated list (each of gmg-pod, gmg-qm, sp1, sp2,
+   bt, prbt, phbt once) into A->mlist; A->method is the first's name. 0 or the usage status 2. */
+static int parse_method_list(reduce_args *A) {
+  const char *p = A->method, *v = A->method;
+  char buf[16];
+  int k;
+  A->nml = 0;
+  while (*p) {
+    const size_t l = strcspn(p, ",");
+    int c;
+    if (l == 0 || l >= sizeof buf) c = -1;
+    else { memcpy(buf, p, l); buf[l] = '\0'; c = method_code(buf); }
+    if (c < 0) return usage_error("--method '%s': expected gmg-pod, gmg-qm, sp1, sp2, bt, prbt or phbt, or a list of "
+                                  "them (e.g. gmg-pod,sp1)", v);
+    if (A->nml == (int)(sizeof A->mlist / sizeof A->mlist[0]))
+      return usage_error("--method '%s': more methods than there are", v);
+    for (k = 0; k < A->nml; ++k)
+      if (A->mlist[k] == c) return usage_error("--method '%s': %s is listed twice", v, buf);
+    A->mlist[A->nml++] = c;
+    p += l;
+    if (*p == ',') { ++p; if (!*p) return usage_error("--method '%s': a trailing comma", v); }
+  }
+  return 0;
+}
+
+static const char *method_name(int m);
+/* 1 if method code c is among the methods of the run. */
+static int has_method(const reduce_args *A, int c) {
+  int k;
+  for (k = 0; k < A->nml; ++k)
+    if (A->mlist[k] == c) return 1;
+  return 0;
+}
+
+/* The number of models a run builds: every (method, r) of the lists. */
+static int sweep_count(const reduce_args *A) { return A->nml * A->nrl; }
+static int is_balancing(int method) {
+  return method == PHGMG_METHOD_BT || method == PHGMG_METHOD_PRBT || method == PHGMG_METHOD_PHBT;
+}
+/* Does any model of the sweep need snapshots (a method other than balancing)? */
+static int sweep_needs_snapshots(const reduce_args *A) {
+  int k;
+  for (k = 0; k < A->nml; ++k)
+    if (!is_balancing(A->mlist[k])) return 1;
+  return 0;
+}
+
+/* Model k of a sweep (methods outer, orders inner): its method and order
+   into A, and its name: --name for a single model, else
+   NAME_<method>_r<R> with the method's '-' as '_' (rom_gmg_pod_r20). */
+static void sweep_set(reduce_args *A, int k, char *name, size_t cap) {
+  const int mc = A->mlist[k / A->nrl];
+  char mn[16];
+  size_t i;
+  A->r = A->rlist[k % A->nrl];
+  A->method = method_name(mc);
+  snprintf(mn, sizeof mn, "%s", A->method);
+  for (i = 0; mn[i]; ++i) if (mn[i] == '-') mn[i] = '_';
+  if (sweep_count(A) == 1) snprintf(name, cap, "%s", A->name0);
+  else snprintf(name, cap, "%s_%s_r%d", A->name0, mn, A->r);
+  A->name = name;
+}
+
 /* Returns 0, the usage status 2, or -1 after printing --help. */
 static int check_reduce_args(reduce_args *A, const char *const *seen, int nseen);
 static int parse_reduce(int argc, char **argv, reduce_args *A) {
@@ -1553,7 +1724,8 @@ static int parse_reduce(int argc, char **argv, reduce_args *A) {
     STR("--potential", potential) STR("--hyper", hyper)
     DBL("--hyper-tol", hyper_tol, 0.0)
     STR("--out", out) STR("--name", name) STR("--method", method)
-    INT("--steps", steps, 1, INT_MAX - 1) INT("--r", r, 1, INT_MAX) 
+    INT("--steps", steps, 1, INT_MAX - 1)
+    else if (!strcmp(o, "--r")) { if (!(v = optval(argc, argv, &i)) || parse_r_list(v, A)) return 2; }
     INT("--deim-max", deim_max, 1, INT_MAX) INT("--newton-iter", newton_iter, 1, 1000)
     DBL("--amp", amp, -HUGE_VAL) DBL("--deim-tol", deim_tol, 0.0) DBL("--newton-tol", newton_tol, 0.0)
     else if (!strcmp(o, "--dt")) {
@@ -1600,6 +1772,7 @@ static int parse_reduce(int argc, char **argv, reduce_args *A) {
       if (!(v = optval(argc, argv, &i)) || !parse_double(o, v, 0.0, &A->dt_map) || real_bad(o, v, A->dt_map)) return 2;
       A->have_dt_map = 1;
     }
+    else if (!strcmp(o, "--freq") || !strcmp(o, "--freq-end")) { if (parse_freq(argc, argv, &i)) return 2; }
     else if (!strcmp(o, "--degeneracy-tol")) {
       if (!(v = optval(argc, argv, &i)) || !parse_double(o, v, 0.0, &A->degeneracy_tol)) return 2;
       if (!(A->degeneracy_tol > 0.0 && A->degeneracy_tol < 1.0))
@@ -1680,18 +1853,45 @@ static int check_balancing_args(reduce_args *A, const char *const *seen, int nse
   return 0;
 }
 
+/* 1 if the methods of the run mix balancing (no snapshots) and snapshot methods. */
+static int mixes_balancing(const reduce_args *A) {
+  int k, nb = 0;
+  for (k = 0; k < A->nml; ++k) nb += is_balancing(A->mlist[k]);
+  return nb > 0 && nb < A->nml;
+}
+
 static int check_reduce_args(reduce_args *A, const char *const *seen, int nseen) {
   int e;
   if ((e = check_model_opts("reduce", A)) != 0) return e;
   if (!A->method) return usage_error("reduce: --method is required (gmg-pod, gmg-qm, sp1, sp2, bt, prbt or phbt)");
   if (!A->r) return usage_error("reduce: --r is required");
+  if ((e = parse_method_list(A)) != 0) return e;
+  if (mixes_balancing(A))
+    return usage_error("--method '%s': the balancing methods (bt, prbt, phbt: no snapshots) and the snapshot "
+                       "methods cannot be mixed in one run; give them in two runs", A->method);
+  A->method = method_name(A->mlist[0]);
   if (!A->out) return usage_error("reduce: --out DIR is required");
+  if (name_problem(A->name)) return usage_error("--name '%s': %s", A->name, name_problem(A->name));
+  A->name0 = A->name;
   if (balancing_method(A->method)) return check_balancing_args(A, seen, nseen);
   if (!!A->X == !!A->simulate) return usage_error("reduce: give exactly one of --X FILE and --simulate");
   if (A->hyper && strcmp(A->hyper, "ecsw") && strcmp(A->hyper, "qdeim") && strcmp(A->hyper, "greedy"))
     return usage_error("--hyper '%s': expected ecsw, qdeim or greedy", A->hyper);
   if ((e = check_hyper_opts(A, seen, nseen)) != 0) return e;
-  if (name_problem(A->name)) return usage_error("--name '%s': %s", A->name, name_problem(A->name));
+  if (sweep_count(A) > 32)
+    return usage_error("reduce: %d methods x %d orders = %d models; a sweep builds at most 32", A->nml, A->nrl,
+                       sweep_count(A));
+  {   /* every model's name of a sweep (NAME_<method>_r<R>) a C identifier too */
+    char nm[128];
+    int k;
+    reduce_args T = *A;
+    for (k = 0; k < sweep_count(A); ++k) {
+      sweep_set(&T, k, nm, sizeof nm);
+      if (name_problem(nm))
+        return usage_error("--name '%s': the name %s of the sweep's model (%s, r = %d) %s", A->name, nm, T.method, T.r,
+                           name_problem(nm));
+    }
+  }
   if (A->ntrain && !A->simulate) return usage_error("reduce: --train-input needs --simulate");
   if (A->nxin && A->nxin != A->nx)
     return usage_error("reduce: %d --X-input for %d --X files: give one input per --X file, in the same order",
@@ -1699,7 +1899,7 @@ static int check_reduce_args(reduce_args *A, const char *const *seen, int nseen)
   if (A->ntrain && A->input)
     return usage_error("reduce: give the training input either by --input or by --train-input, not both");
   if (!A->input) A->input = A->ntrain ? A->train[0] : "sin";
-  if ((A->have_lambda || A->manifold_s || A->rn) && strcmp(A->method, "gmg-qm") != 0)
+  if ((A->have_lambda || A->manifold_s || A->rn) && !has_method(A, PHGMG_METHOD_GMG_QM))
     return usage_error("reduce: --lambda, --rn and --manifold apply to --method gmg-qm only (not %s)", A->method);
   if (A->greedy_window && (A->manifold != PHGMG_MANIFOLD_GREEDY && A->manifold != PHGMG_MANIFOLD_ALTMIN))
     return usage_error("reduce: --greedy-window applies to --method gmg-qm with --manifold greedy or altmin");
@@ -1708,7 +1908,7 @@ static int check_reduce_args(reduce_args *A, const char *const *seen, int nseen)
                        "residual)");
   /* gmg-qm without --lambda: the validated choice (a fixed lambda can give a
      model whose Newton solve fails on inputs unlike the training run) */
-  if (!A->have_lambda && !strcmp(A->method, "gmg-qm")) A->lambda_auto = 1;
+  if (!A->have_lambda && has_method(A, PHGMG_METHOD_GMG_QM)) A->lambda_auto = 1;
   if (A->lambda_auto == 1 && A->have_lambda && A->X && !A->nxin)
     return usage_error("reduce: --lambda auto with --X needs the inputs of the runs (--X-input, one per --X): it "
                        "simulates them; or give a fixed --lambda, or --lambda cv");
@@ -1720,30 +1920,460 @@ static int check_reduce_args(reduce_args *A, const char *const *seen, int nseen)
 
 /* ---- sparse matrices from coordinate triplets ------------------------------------ */
 typedef struct cli_csc {
-  phgmg_csc A;
-  int *cp, *ri;
-  double *v;
+  phgmg_csc A;      /* phgmg_csc_from_coo's; cp, v its colptr and values (NULL: none) */
+  const int *cp;
+  const double *v;
 } cli_csc;
-static void cli_csc_free(cli_csc *c) { free(c->cp); free(c->ri); free(c->v); memset(c, 0, sizeof *c); }
+static void cli_csc_free(cli_csc *c) { phgmg_csc_free(&c->A, NULL); memset(c, 0, sizeof *c); }
 
 /* Entry k of a triplet source: rows/cols/vals three vectors, or one (nnz, 3) array. */
-static int coo_index(const mat *M, int k, int which, int nnz, const char *spec, const char *opt, int N, int *out) {
+static int coo_index(const mat *M, int k, int which, int nnz, const char *spec, const char *opt, int N, int *out,
+                     int is_col) {
   const double v = M->a[(size_t)k + (size_t)which * (size_t)nnz];
   if (!(v >= 0.0 && v < (double)N && v == floor(v)))
     return fail("%s (%s): entry %d: %s index %g; expected an integer in [0, %d) (N from --B)", spec, opt, k,
-                which == 0 ? "row" : "column", v, N);
+                is_col ? "column" : "row", v, N);
   *out = (int)v;
   return 0;
+}
+
+/* The triplets (the index columns ci of rows and cols, the value column cv)
+   checked and summed into c by phgmg_csc_from_coo (duplicates summed, rows
+   sorted in each column). 0, or 1 after a message naming the entry. */
+static int coo_assemble(cli_csc *c, const mat *rows, const mat *cols, const mat *vals, int ci, int cv, int nnz,
+                        const char *spec, const char *opt, int N) {
+  int *ri = (int *)malloc(sizeof(int) * ((size_t)nnz + 1)), *cj = (int *)malloc(sizeof(int) * ((size_t)nnz + 1));
+  double *v = (double *)malloc(sizeof(double) * ((size_t)nnz + 1));
+  phgmg_result rc;
+  int k, err = 0;
+  if (!ri || !cj || !v) err = fail("out of memory");
+  for (k = 0; k < nnz && !err; ++k) {
+    if ((err = coo_index(rows, k, 0, nnz, spec, opt, N, &ri[k], 0)) == 0)
+      err = coo_index(cols, k, ci, nnz, spec, opt, N, &cj[k], 1);
+    v[k] = vals->a[(size_t)k + (size_t)cv * (size_t)nnz];
+  }
+  if (!err && (rc = phgmg_csc_from_coo(&c->A, N, N, nnz, ri, cj, v, NULL)) != PHGMG_OK)
+    err = fail("%s (%s): %s", spec, opt, phgmg_result_string(rc));
+  if (!err) { c->cp = c->A.colptr; c->v = c->A.values; }
+  free(ri); free(cj); free(v);
+  return err;
+}
+
+/* ---- sparse matrices from SciPy .npz and Matrix Market .mtx files ----------
+   A small inflate (RFC 1951: stored, fixed and dynamic Huffman blocks) for
+   the members of a .npz (a zip archive; scipy.sparse.save_npz compresses by
+   default), a zip reader of the central directory, and a Matrix Market
+   coordinate reader. Both give coordinate triplets (0-based) that
+   coo_assemble sums into a CSC matrix. Every read is bounds-checked: a
+   malformed file is an error naming it, never a crash. */
+typedef struct inf_state {
+  const unsigned char *in;
+  size_t n, pos;      /* input bytes, the next byte */
+  unsigned bits, nb;  /* bit buffer, bits in it */
+  unsigned char *out;
+  size_t cap, len;    /* the expected output size, bytes written */
+  int err;
+} inf_state;
+typedef struct inf_huff { unsigned short count[16], sym[320]; } inf_huff;
+
+static unsigned inf_bits(inf_state *s, unsigned need) {
+  unsigned v;
+  while (s->nb < need) {
+    if (s->pos >= s->n) { s->err = 1; return 0; }
+    s->bits |= (unsigned)s->in[s->pos++] << s->nb;
+    s->nb += 8;
+  }
+  v = s->bits & ((1u << need) - 1u);
+  s->bits >>= need;
+  s->nb -= need;
+  return v;
+}
+
+/* Canonical Huffman table from n code lengths; 0, or 1 if over-subscribed. */
+static int inf_build(inf_huff *h, const unsigned char *len, int n) {
+  unsigned short offs[16];
+  int k, left = 1;
+  memset(h->count, 0, sizeof h->count);
+  for (k = 0; k < n; ++k) h->count[len[k]]++;
+  h->count[0] = 0;
+  for (k = 1; k < 16; ++k) { left <<= 1; left -= h->count[k]; if (left < 0) return 1; }
+  offs[1] = 0;
+  for (k = 1; k < 15; ++k) offs[k + 1] = (unsigned short)(offs[k] + h->count[k]);
+  for (k = 0; k < n; ++k)
+    if (len[k]) h->sym[offs[len[k]]++] = (unsigned short)k;
+  return 0;
+}
+
+static int inf_decode(inf_state *s, const inf_huff *h) {
+  int code = 0, first = 0, index = 0, l;
+  for (l = 1; l < 16; ++l) {
+    code |= (int)inf_bits(s, 1);
+    if (s->err) return -1;
+    if (code - h->count[l] < first) return h->sym[index + (code - first)];
+    index += h->count[l];
+    first += h->count[l];
+    first <<= 1;
+    code <<= 1;
+  }
+  s->err = 1;
+  return -1;
+}
+
+static const unsigned short inf_lbase[29] = {3, 4, 5, 6, 7, 8, 9, 10, 11, 13, 15, 17, 19, 23, 27, 31, 35, 43, 51, 59,
+                                             67, 83, 99, 115, 131, 163, 195, 227, 258};
+static const unsigned char inf_lext[29] = {0, 0, 0, 0, 0, 0, 0, 0, 1, 1, 1, 1, 2, 2, 2, 2, 3, 3, 3, 3, 4, 4, 4, 4, 5, 5, 5, 5, 0};
+static const unsigned short inf_dbase[30] = {1, 2, 3, 4, 5, 7, 9, 13, 17, 25, 33, 49, 65, 97, 129, 193, 257, 385, 513,
+                                             769, 1025, 1537, 2049, 3073, 4097, 6145, 8193, 12289, 16385, 24577};
+static const unsigned char inf_dext[30] = {0, 0, 0, 0, 1, 1, 2, 2, 3, 3, 4, 4, 5, 5, 6, 6, 7, 7, 8, 8, 9, 9, 10, 10, 11, 11,
+                                           12, 12, 13, 13};
+
+/* The symbols of one Huffman-coded block until end-of-block. */
+static int inf_codes(inf_state *s, const inf_huff *lh, const inf_huff *dh) {
+  for (;;) {
+    int sym = inf_decode(s, lh);
+    if (sym < 0) return 1;
+    if (sym < 256) {
+      if (s->len >= s->cap) return 1;
+      s->out[s->len++] = (unsigned char)sym;
+    } else if (sym == 256) {
+      return 0;
+    } else {
+      size_t len, dist;
+      sym -= 257;
+      if (sym >= 29) return 1;
+      len = inf_lbase[sym] + inf_bits(s, inf_lext[sym]);
+      sym = inf_decode(s, dh);
+      if (sym < 0 || sym >= 30) return 1;
+      dist = inf_dbase[sym] + inf_bits(s, inf_dext[sym]);
+      if (s->err || dist > s->len || len > s->cap - s->len) return 1;
+      for (; len; --len, ++s->len) s->out[s->len] = s->out[s->len - dist];
+    }
+  }
+}
+
+/* The code lengths of a dynamic block into lh, dh. */
+static int inf_dynamic(inf_state *s, inf_huff *lh, inf_huff *dh) {
+  static const unsigned char order[19] = {16, 17, 18, 0, 8, 7, 9, 6, 10, 5, 11, 4, 12, 3, 13, 2, 14, 1, 15};
+  unsigned char len[320];
+  const int nlen = (int)inf_bits(s, 5) + 257, ndist = (int)inf_bits(s, 5) + 1, ncode = (int)inf_bits(s, 4) + 4;
+  int k = 0;
+  if (s->err || nlen > 286 || ndist > 30) return 1;
+  memset(len, 0, sizeof len);
+  for (k = 0; k < ncode; ++k) len[order[k]] = (unsigned char)inf_bits(s, 3);
+  if (s->err || inf_build(lh, len, 19)) return 1;
+  for (k = 0; k < nlen + ndist;) {
+    int sym = inf_decode(s, lh), rep = 0;
+    unsigned char v = 0;
+    if (sym < 0) return 1;
+    if (sym < 16) { len[k++] = (unsigned char)sym; continue; }
+    if (sym == 16) { if (k == 0) return 1; v = len[k - 1]; rep = 3 + (int)inf_bits(s, 2); }
+    else if (sym == 17) rep = 3 + (int)inf_bits(s, 3);
+    else rep = 11 + (int)inf_bits(s, 7);
+    if (s->err || k + rep > nlen + ndist) return 1;
+    while (rep--) len[k++] = v;
+  }
+  if (len[256] == 0) return 1;
+  return inf_build(lh, len, nlen) || inf_build(dh, len + nlen, ndist);
+}
+
+/* Inflate n bytes into out (exactly cap bytes expected). 0, or 1 if the
+   data are not a valid deflate stream of that size. */
+static int inflate_buf(const unsigned char *in, size_t n, unsigned char *out, size_t cap) {
+  inf_state s;
+  inf_huff lh, dh;
+  unsigned last = 0;
+  memset(&s, 0, sizeof s);
+  s.in = in; s.n = n; s.out = out; s.cap = cap;
+  while (!last) {
+    unsigned type;
+    last = inf_bits(&s, 1);
+    type = inf_bits(&s, 2);
+    if (s.err) return 1;
+    if (type == 0) {   /* stored: LEN, NLEN after the byte boundary */
+      size_t len;
+      s.bits = 0; s.nb = 0;
+      if (s.pos + 4 > s.n) return 1;
+      len = (size_t)s.in[s.pos] | (size_t)s.in[s.pos + 1] << 8;
+      if ((len ^ ((size_t)s.in[s.pos + 2] | (size_t)s.in[s.pos + 3] << 8)) != 0xffffu) return 1;
+      s.pos += 4;
+      if (len > s.n - s.pos || len > s.cap - s.len) return 1;
+      memcpy(s.out + s.len, s.in + s.pos, len);
+      s.pos += len; s.len += len;
+    } else if (type == 1) {   /* fixed codes */
+      unsigned char len[320];
+      int k;
+      for (k = 0; k < 144; ++k) len[k] = 8;
+      for (; k < 256; ++k) len[k] = 9;
+      for (; k < 280; ++k) len[k] = 7;
+      for (; k < 288; ++k) len[k] = 8;
+      for (k = 0; k < 30; ++k) len[288 + k] = 5;
+      inf_build(&lh, len, 288);
+      inf_build(&dh, len + 288, 30);
+      if (inf_codes(&s, &lh, &dh)) return 1;
+    } else if (type == 2) {
+      if (inf_dynamic(&s, &lh, &dh) || inf_codes(&s, &lh, &dh)) return 1;
+    } else {
+      return 1;
+    }
+  }
+  return s.len == s.cap ? 0 : 1;
+}
+
+static unsigned long rd16(const unsigned char *p) { return (unsigned long)p[0] | (unsigned long)p[1] << 8; }
+static unsigned long rd32(const unsigned char *p) { return rd16(p) | rd16(p + 2) << 16; }
+
+/* Member `name` of the zip archive z[0..n) into a new buffer *out (*len
+   bytes): stored or deflated. 0; 1 not found; 2 malformed or unsupported
+   (the reason in *why). */
+static int zip_member(const unsigned char *z, size_t n, const char *name, unsigned char **out, size_t *len,
+                      const char **why) {
+  size_t e, cd, k, nent, i;
+  const size_t nl = strlen(name);
+  *why = "not a zip archive (no end of central directory)";
+  if (n < 22) return 2;
+  for (e = n - 22;; --e) {   /* the end of central directory record, from the back */
+    if (rd32(z + e) == 0x06054b50ul) break;
+    if (e == 0 || n - e > 22 + 65535) return 2;
+  }
+  nent = rd16(z + e + 10);
+  cd = rd32(z + e + 16);
+  *why = "a zip central directory outside the file";
+  for (k = 0, i = cd; k < nent; ++k) {
+    unsigned long meth, csz, usz, off, fl, xl, cl;
+    if (i > n || n - i < 46 || rd32(z + i) != 0x02014b50ul) return 2;
+    meth = rd16(z + i + 10); csz = rd32(z + i + 20); usz = rd32(z + i + 24);
+    fl = rd16(z + i + 28); xl = rd16(z + i + 30); cl = rd16(z + i + 32); off = rd32(z + i + 42);
+    if (n - i - 46 < fl) return 2;
+    if (fl == nl && !memcmp(z + i + 46, name, nl)) {
+      size_t d;
+      *why = "a member's data outside the file (or a zip64 archive over 4 GB)";
+      if (csz == 0xfffffffful || usz == 0xfffffffful || off == 0xfffffffful) return 2;
+      if (off > n || n - off < 30 || rd32(z + off) != 0x04034b50ul) return 2;
+      d = off + 30 + rd16(z + off + 26) + rd16(z + off + 28);
+      if (d > n || n - d < csz) return 2;
+      *why = "out of memory";
+      if (!(*out = (unsigned char *)malloc(usz + 1))) return 2;
+      *len = usz;
+      if (meth == 0 && csz == usz) { memcpy(*out, z + d, usz); return 0; }
+      *why = meth == 8 ? "a deflate stream that does not decode" : "a compression other than stored or deflate";
+      if (meth == 8 && !inflate_buf(z + d, csz, *out, usz)) return 0;
+      free(*out);
+      *out = NULL;
+      return 2;
+    }
+    i += 46 + fl + xl + cl;
+  }
+  return 1;
+}
+
+/* A whole file into memory (up to 2 GiB). NULL after a message. */
+static unsigned char *read_all(const char *path, const char *opt, size_t *n) {
+  FILE *f = fopen(path, "rb");
+  unsigned char *b;
+  long l;
+  if (!f) { fail("%s (%s): cannot open: %s", path, opt, strerror(errno)); return NULL; }
+  if (fseek(f, 0, SEEK_END) != 0 || (l = ftell(f)) < 0 || l > 0x7fffffffL || fseek(f, 0, SEEK_SET) != 0) {
+    fclose(f);
+    fail("%s (%s): cannot read (not a regular file, or over 2 GiB)", path, opt);
+    return NULL;
+  }
+  b = (unsigned char *)malloc((size_t)l + 1);
+  if (!b || fread(b, 1, (size_t)l, f) != (size_t)l) { fclose(f); free(b); fail("%s (%s): cannot read", path, opt); return NULL; }
+  fclose(f);
+  *n = (size_t)l;
+  return b;
+}
+
+/* Array `key`.npy of the .npz image into *M (a vector or matrix, as mat_load
+   gives). 0; 1 after a message (missing: only when need). */
+static int npz_array(const unsigned char *z, size_t n, const char *path, const char *opt, const char *key, mat *M,
+                     int need) {
+  char nm[32];
+  unsigned char *b = NULL;
+  size_t len = 0, i;
+  const char *why = "";
+  int e;
+  phgmg_result rc;
+  memset(M, 0, sizeof *M);
+  M->path = path;
+  snprintf(nm, sizeof nm, "%s.npy", key);
+  e = zip_member(z, n, nm, &b, &len, &why);
+  if (e == 1) return need ? fail("%s (%s): no array '%s' in the .npz (expected scipy.sparse.save_npz's csr, csc or "
+                                 "coo arrays)", path, opt, key) : 1;
+  if (e) return fail("%s (%s): %s: %s", path, opt, nm, why);
+  rc = phgmg_npy_parse(b, len, &M->a, &M->rows, &M->cols, &M->ndim, NULL);
+  free(b);
+  if (rc != PHGMG_OK) return fail("%s (%s): %s: %s", path, opt, nm, phgmg_result_string(rc));
+  for (i = 0; i < (size_t)M->rows * (size_t)M->cols; ++i)
+    if (!isfinite(M->a[i])) { mat_free(M); return fail("%s (%s): %s: NaN or Inf at entry %lu", path, opt, nm, (unsigned long)i); }
+  return 0;
+}
+
+/* The format string of a save_npz file ("csr", "csc", "coo", ...) from its
+   format.npy (a 0-d '|S3' or '<U3' array) into fmt (4 bytes). */
+static int npz_format(const unsigned char *z, size_t n, const char *path, const char *opt, char *fmt) {
+  unsigned char *b = NULL;
+  size_t len = 0, hl, i, k = 0;
+  const char *why = "";
+  int e = zip_member(z, n, "format.npy", &b, &len, &why);
+  if (e == 1) return fail("%s (%s): no format.npy: not a scipy.sparse.save_npz file", path, opt);
+  if (e) return fail("%s (%s): format.npy: %s", path, opt, why);
+  hl = len >= 10 && b[6] == 1 ? 10 + rd16(b + 8) : len >= 12 ? 12 + rd32(b + 8) : len + 1;
+  for (i = hl; i < len && k < 3; ++i)
+    if (b[i]) fmt[k++] = (char)b[i];
+  fmt[k] = '\0';
+  free(b);
+  if (hl > len || k != 3) return fail("%s (%s): format.npy does not hold a sparse format name", path, opt);
+  return 0;
+}
+
+/* A scipy.sparse .npz (csr, csc or coo) as triplets: rows, cols, vals (nnz)
+   allocated here; the shape must be N x N. */
+static int load_npz(const char *path, const char *opt, int N, int **ri, int **cj, double **v, int *nnz) {
+  size_t n = 0;
+  unsigned char *z = read_all(path, opt, &n);
+  mat sh, a, b, d;
+  char fmt[4];
+  int err = 0, k, j, p, cnt;
+  if (!z) return 1;
+  memset(&a, 0, sizeof a); memset(&b, 0, sizeof b); memset(&d, 0, sizeof d); memset(&sh, 0, sizeof sh);
+  if ((err = npz_format(z, n, path, opt, fmt)) != 0) goto done;
+  if (strcmp(fmt, "csr") && strcmp(fmt, "csc") && strcmp(fmt, "coo")) {
+    err = fail("%s (%s): sparse format '%s'; expected csr, csc or coo", path, opt, fmt);
+    goto done;
+  }
+  if ((err = npz_array(z, n, path, opt, "shape", &sh, 1)) != 0) goto done;
+  if (sh.rows * sh.cols != 2 || sh.a[0] != N || sh.a[1] != N) {
+    err = fail("%s (%s): shape %s (from its shape.npy), expected (%d, %d) (N from --B)", path, opt,
+               sh.rows * sh.cols == 2 ? "not N x N" : "not 2-d", N, N);
+    goto done;
+  }
+  if ((err = npz_array(z, n, path, opt, "data", &d, 1)) != 0) goto done;
+  cnt = d.rows * d.cols;
+  if (!strcmp(fmt, "coo")) err = npz_array(z, n, path, opt, "row", &a, 1) || npz_array(z, n, path, opt, "col", &b, 1);
+  else err = npz_array(z, n, path, opt, "indices", &a, 1) || npz_array(z, n, path, opt, "indptr", &b, 1);
+  if (err) goto done;
+  if (a.rows * a.cols != cnt || (!strcmp(fmt, "coo") ? b.rows * b.cols != cnt : b.rows * b.cols != N + 1)) {
+    err = fail("%s (%s): the arrays' lengths do not match (%s format, %d values)", path, opt, fmt, cnt);
+    goto done;
+  }
+  *ri = (int *)malloc(sizeof(int) * ((size_t)cnt + 1)); *cj = (int *)malloc(sizeof(int) * ((size_t)cnt + 1));
+  *v = (double *)malloc(sizeof(double) * ((size_t)cnt + 1));
+  if (!*ri || !*cj || !*v) { err = fail("out of memory"); goto done; }
+  for (k = 0; k < cnt; ++k) (*v)[k] = d.a[k];
+  if (!strcmp(fmt, "coo")) {
+    for (k = 0; k < cnt && !err; ++k) {
+      if (!(a.a[k] == floor(a.a[k]) && b.a[k] == floor(b.a[k]) && a.a[k] >= 0 && b.a[k] >= 0 && a.a[k] < N && b.a[k] < N))
+        err = fail("%s (%s): entry %d at (%g, %g) outside the %d x %d matrix", path, opt, k, a.a[k], b.a[k], N, N);
+      else { (*ri)[k] = (int)a.a[k]; (*cj)[k] = (int)b.a[k]; }
+    }
+  } else {   /* compressed: indptr b (N + 1), indices a */
+    const int csr = !strcmp(fmt, "csr");
+    if (b.a[0] != 0 || b.a[N] != cnt) err = fail("%s (%s): indptr does not run from 0 to %d", path, opt, cnt);
+    for (j = 0; j < N && !err; ++j)   /* indptr whole: integers, non-decreasing (so within [0, cnt]) */
+      if (!(b.a[j + 1] >= b.a[j] && b.a[j + 1] == floor(b.a[j + 1])))
+        err = fail("%s (%s): indptr decreases or is not an integer at %d", path, opt, j + 1);
+    for (j = 0; j < N && !err; ++j) {
+      for (p = (int)b.a[j]; p < (int)b.a[j + 1]; ++p) {
+        if (!(a.a[p] >= 0 && a.a[p] < N && a.a[p] == floor(a.a[p]))) {
+          err = fail("%s (%s): index %g at position %d outside [0, %d)", path, opt, a.a[p], p, N);
+          break;
+        }
+        (*ri)[p] = csr ? j : (int)a.a[p];
+        (*cj)[p] = csr ? (int)a.a[p] : j;
+      }
+    }
+  }
+  *nnz = cnt;
+done:
+  mat_free(&sh); mat_free(&a); mat_free(&b); mat_free(&d);
+  free(z);
+  return err;
+}
+
+/* A Matrix Market file (coordinate; real or integer; general, symmetric or
+   skew-symmetric: the other triangle added, negated for skew) as triplets,
+   N x N. */
+static int load_mtx(const char *path, const char *opt, int N, int **ri, int **cj, double **v, int *nnz) {
+  FILE *f = fopen(path, "r");
+  char line[1024], obj[64], fmtw[64], field[64], sym[64];
+  long M = 0, C = 0, L = 0, k;
+  int skew, symm, cnt = 0, err = 0, lineno = 1;
+  if (!f) return fail("%s (%s): cannot open: %s", path, opt, strerror(errno));
+  if (!fgets(line, sizeof line, f) || sscanf(line, "%%%%MatrixMarket %63s %63s %63s %63s", obj, fmtw, field, sym) != 4) {
+    fclose(f);
+    return fail("%s (%s): not a Matrix Market file (the first line must be '%%%%MatrixMarket matrix coordinate "
+                "real general' or similar)", path, opt);
+  }
+  for (k = 0; obj[k]; ++k) obj[k] = (char)tolower((unsigned char)obj[k]);
+  for (k = 0; fmtw[k]; ++k) fmtw[k] = (char)tolower((unsigned char)fmtw[k]);
+  for (k = 0; field[k]; ++k) field[k] = (char)tolower((unsigned char)field[k]);
+  for (k = 0; sym[k]; ++k) sym[k] = (char)tolower((unsigned char)sym[k]);
+  skew = !strcmp(sym, "skew-symmetric");
+  symm = !strcmp(sym, "symmetric");
+  if (strcmp(obj, "matrix") || strcmp(fmtw, "coordinate") || (strcmp(field, "real") && strcmp(field, "integer")) ||
+      (!skew && !symm && strcmp(sym, "general"))) {
+    fclose(f);
+    return fail("%s (%s): Matrix Market '%s %s %s %s' is not supported: expected matrix coordinate real|integer "
+                "general|symmetric|skew-symmetric", path, opt, obj, fmtw, field, sym);
+  }
+  do { ++lineno; } while (fgets(line, sizeof line, f) && (line[0] == '%' || strspn(line, " \t\r\n") == strlen(line)));
+  if (sscanf(line, "%ld %ld %ld", &M, &C, &L) != 3 || M != N || C != N || L < 0 || L > 1000000000L) {
+    fclose(f);
+    return fail("%s (%s): line %d: expected the size line 'rows cols entries' of a %d x %d matrix (N from --B)",
+                path, opt, lineno, N, N);
+  }
+  *ri = (int *)malloc(sizeof(int) * (2 * (size_t)L + 1)); *cj = (int *)malloc(sizeof(int) * (2 * (size_t)L + 1));
+  *v = (double *)malloc(sizeof(double) * (2 * (size_t)L + 1));
+  if (!*ri || !*cj || !*v) { fclose(f); return fail("out of memory for %ld entries", L); }
+  for (k = 0; k < L && !err; ++k) {
+    long i, j;
+    double x;
+    char *end;
+    ++lineno;
+    if (!fgets(line, sizeof line, f)) { err = fail("%s (%s): %ld entries announced, %ld found", path, opt, L, k); break; }
+    if (sscanf(line, "%ld %ld %n", &i, &j, &cnt) < 2) { err = fail("%s (%s): line %d: expected 'row col value'", path, opt, lineno); break; }
+    x = strtod(line + cnt, &end);
+    if (end == line + cnt || !isfinite(x)) { err = fail("%s (%s): line %d: the value is not a finite number", path, opt, lineno); break; }
+    if (i < 1 || i > N || j < 1 || j > N) { err = fail("%s (%s): line %d: entry (%ld, %ld) outside 1..%d", path, opt, lineno, i, j, N); break; }
+    if ((symm || skew) && i < j) { err = fail("%s (%s): line %d: (%ld, %ld) above the diagonal in a %s file (only the lower triangle is stored)", path, opt, lineno, i, j, sym); break; }
+    if (skew && i == j) { err = fail("%s (%s): line %d: a diagonal entry in a skew-symmetric file", path, opt, lineno); break; }
+    (*ri)[*nnz] = (int)i - 1; (*cj)[*nnz] = (int)j - 1; (*v)[(*nnz)++] = x;
+    if ((symm || skew) && i != j) { (*ri)[*nnz] = (int)j - 1; (*cj)[*nnz] = (int)i - 1; (*v)[(*nnz)++] = skew ? -x : x; }
+  }
+  fclose(f);
+  return err;
+}
+
+/* 1 if path ends in ext (".npz", ".mtx"). */
+static int has_ext(const char *path, const char *ext) {
+  const size_t l = strlen(path), e = strlen(ext);
+  return l > e && !strcmp(path + l - e, ext);
+}
+
+/* A .npz or .mtx SPEC into c (N x N, duplicates summed). */
+static int load_sparse_file(cli_csc *c, const char *opt, const char *spec, int N) {
+  int *ri = NULL, *cj = NULL, nnz = 0, err;
+  double *v = NULL;
+  phgmg_result rc;
+  if (is_dir(spec, opt)) return 1;
+  err = has_ext(spec, ".npz") ? load_npz(spec, opt, N, &ri, &cj, &v, &nnz) : load_mtx(spec, opt, N, &ri, &cj, &v, &nnz);
+  if (!err && (rc = phgmg_csc_from_coo(&c->A, N, N, nnz, ri, cj, v, NULL)) != PHGMG_OK)
+    err = fail("%s (%s): %s", spec, opt, phgmg_result_string(rc));
+  if (!err) { c->cp = c->A.colptr; c->v = c->A.values; }
+  free(ri); free(cj); free(v);
+  return err;
 }
 
 /* --X-coo SPEC into an N x N CSC matrix (columns sorted, duplicates summed). */
 static int load_coo(cli_csc *c, const char *opt, const char *spec, int N) {
   mat M[3];
-  int nf = 1, nnz, k, j, p, q, err = 0;
+  int nf = 1, nnz, k, j, err = 0;
   const mat *rows, *cols, *vals;
   char buf[3][4096];
   memset(M, 0, sizeof M);
   memset(c, 0, sizeof *c);
+  if (!strchr(spec, ',') && (has_ext(spec, ".npz") || has_ext(spec, ".mtx"))) return load_sparse_file(c, opt, spec, N);
   if (strchr(spec, ',')) {
     const char *a = spec, *b = strchr(a, ','), *e = b ? strchr(b + 1, ',') : NULL;
     if (!b || !e || strchr(e + 1, ',') || b - a >= 4096 || e - b - 1 >= 4096 || strlen(e + 1) >= 4096 ||
@@ -1775,49 +2405,33 @@ static int load_coo(cli_csc *c, const char *opt, const char *spec, int N) {
       }
     rows = &M[0]; cols = &M[1]; vals = &M[2];
   }
-  c->cp = (int *)calloc((size_t)N + 1, sizeof(int));
-  c->ri = (int *)malloc(sizeof(int) * ((size_t)nnz + 1));
-  c->v = (double *)malloc(sizeof(double) * ((size_t)nnz + 1));
-  if (!c->cp || !c->ri || !c->v) { err = fail("out of memory"); goto done; }
-  for (k = 0; k < nnz && !err; ++k) { /* count per column */
-    int col;
-    if ((err = coo_index(cols, k, nf == 3 ? 0 : 1, nnz, spec, opt, N, &col)) == 0) c->cp[col + 1]++;
-  }
-  for (j = 0; j < N && !err; ++j) c->cp[j + 1] += c->cp[j];
-  for (k = 0; k < nnz && !err; ++k) { /* place; cp[j] advances to the end of column j */
-    int r, col;
-    if ((err = coo_index(rows, k, 0, nnz, spec, opt, N, &r)) != 0) break;
-    coo_index(cols, k, nf == 3 ? 0 : 1, nnz, spec, opt, N, &col);
-    c->ri[c->cp[col]] = r;
-    c->v[c->cp[col]++] = vals->a[(size_t)k + (nf == 3 ? 0u : 2u) * (size_t)nnz];
-  }
-  if (err) goto done;
-  for (j = N; j > 0; --j) c->cp[j] = c->cp[j - 1];
-  c->cp[0] = 0;
-  for (j = 0, q = 0; j < N; ++j) { /* sort each column by row (insertion), sum duplicates */
-    int start = c->cp[j], end = c->cp[j + 1];
-    for (p = start + 1; p < end; ++p) {
-      int r = c->ri[p], t;
-      double v = c->v[p];
-      for (t = p; t > start && c->ri[t - 1] > r; --t) { c->ri[t] = c->ri[t - 1]; c->v[t] = c->v[t - 1]; }
-      c->ri[t] = r; c->v[t] = v;
-    }
-    c->cp[j] = q;
-    for (p = start; p < end; ++p) {
-      if (q > c->cp[j] && c->ri[q - 1] == c->ri[p]) c->v[q - 1] += c->v[p];
-      else { c->ri[q] = c->ri[p]; c->v[q] = c->v[p]; ++q; }
-    }
-  }
-  c->cp[N] = q;
-  c->A.n_rows = c->A.n_cols = N;
-  c->A.colptr = c->cp; c->A.rowidx = c->ri; c->A.values = c->v;
+  err = coo_assemble(c, rows, cols, vals, nf == 3 ? 0 : 1, nf == 3 ? 0 : 2, nnz, spec, opt, N);
 done:
   for (k = 0; k < nf; ++k) mat_free(&M[k]);
   return err;
 }
 
+/* One model of a run (a sweep builds several): its outputs staged under
+   temporary names until the run commits them. */
+typedef struct sweep_model {
+  staged sg;             /* its files */
+  outlist ol;            /* its arrays */
+  char name[64];
+  int method, r, rr, m, pass;
+  double t_red;
+  double ey[16], ered[16];   /* validate: each test's e_y, e_red */
+  int tpass[16];
+  phgmg_reduced *red;    /* kept by validate for its tests */
+} sweep_model;
+
 typedef struct reduce_state {
   mat J, R, B, Q, X, poly, pidx, pw, ex;
+  sweep_model *models;    /* every (method, r) of the run, sweep_count of them */
+  int nmodels;
+  staged dirs;            /* the directories --out made (removed again if nothing is written) */
+  staged sweep_sg;        /* NAME_sweep.json of a sweep */
+  phgmg_study *study;     /* a sweep's shared bases (NULL: each model computes its own) */
+  double t_sim;
   int *idx;
   double *fpoly, *fexp, named[8]; /* the family's coefficients as phgmg_ph_system wants them */
   double *Xsim, *Ysim, *V0;
@@ -1957,13 +2571,21 @@ static void reduce_cleanup(reduce_state *S) {
   phgmg_dae_destroy(S->dae); free(S->Xres);
   phgmg_reduced_destroy(S->red);
   stage_abort(&S->sg); /* after a failure: no output of this run stays */
+  if (S->models) {
+    int k;
+    for (k = 0; k < S->nmodels; ++k) { phgmg_reduced_destroy(S->models[k].red); stage_abort(&S->models[k].sg); }
+    free(S->models);
+  }
+  stage_abort(&S->sweep_sg);
+  stage_abort(&S->dirs);
+  phgmg_study_destroy(S->study);
   g_inputs = NULL;
   paths_free(&S->pin); paths_free(&S->pout);
 }
 
 /* The fields NAME_<field>.npy a run may write. */
 static const char *const all_fields[] = {"Bh", "Qh", "K", "G00", "G01", "G10", "G11", "Q01", "Q11", "Ms",
-                                         "P0", "P1", "w", "poly", "expo", "Phi", "Gam", "SX", "SU", "V0", "V2",
+                                         "P0", "P1", "w", "poly", "expo", "Phi", "Gam", "SX", "SU", "PD", "V0", "V2",
                                          "M", "snapshots", "fom_y", NULL};
 
 /* The arrays an earlier run recorded as its own in DIR/NAME.json ("arrays":
@@ -2240,7 +2862,7 @@ static int load_snapshot_files(const reduce_args *A, reduce_state *S, int N, int
       const int c = k ? S->Xs[k].cols : S->X.cols;
       memset(&S->runs[k], 0, sizeof S->runs[k]);
       if (A->nxin) {
-        int e = input_setup(&S->xinp[k], "--X-input", A->xin[k], A->amp, m, A->dt);
+        int e = input_setup(&S->xinp[k], "--X-input", A->xin[k], A->amp, m, A->dt, (c - 1) * A->dt);
         if (e) return e;
         S->runs[k].u = input_fn; S->runs[k].user = &S->xinp[k];
         S->runs[k].x0 = X + col * (size_t)N;
@@ -2745,6 +3367,27 @@ static int check_sizes(const reduce_args *A, int method, int N, int m, int k) {
   return 0;
 }
 
+/* --x0 FILE into x0 (the N states the run simulates, zero without --x0):
+   N values in the files' ordering (sparse input: moved to the internal one).
+   Not for a model with algebraic constraints (its initial state must be
+   consistent). 0, or 1 after a message. */
+static int load_x0(const reduce_args *A, const reduce_state *S, int N, double *x0) {
+  mat M;
+  if (!A->x0f) return 0;
+  if (S->dae) return fail("%s (--x0): a model with algebraic constraints starts at rest (x = 0); --x0 is for "
+                          "models without zero rows of E", A->x0f);
+  if (mat_load(&M, "--x0", A->x0f)) return 1;
+  if (M.ndim == 0 || M.rows != N || M.cols != 1) {
+    fail("%s (--x0): expected shape (%d,) or (%d, 1) (one value per state), got %s", A->x0f, N, N, shape_str(&M));
+    mat_free(&M);
+    return 1;
+  }
+  if (S->sp) phgmg_ph_sparse_to_banded_order(S->sp, 1, M.a, N, x0, N);
+  else memcpy(x0, M.a, sizeof(double) * (size_t)N);
+  mat_free(&M);
+  return 0;
+}
+
 /* --simulate: the training runs (--input, or each --train-input) from x0 = 0,
    one after the other in S->Xsim, their outputs in S->Ysim, S->runs. */
 static int simulate_training_runs(const reduce_args *A, reduce_state *S, const double **Xo, int *nso, double *t_sim) {
@@ -2757,9 +3400,10 @@ static int simulate_training_runs(const reduce_args *A, reduce_state *S, const d
   double *x0;
   int done = 0;
   const int nrun = A->ntrain ? A->ntrain : 1;
-  if ((k = input_setup(&S->in, A->ntrain ? "--train-input" : "--input", A->input, A->amp, m, A->dt)) != 0) return k;
+  if ((k = input_setup(&S->in, A->ntrain ? "--train-input" : "--input", A->input, A->amp, m, A->dt, A->steps * A->dt)) != 0)
+    return k;
   for (i = 1; i < nrun; ++i)
-    if ((k = input_setup(&S->tin[i], "--train-input", A->train[i], A->amp, m, A->dt)) != 0) return k;
+    if ((k = input_setup(&S->tin[i], "--train-input", A->train[i], A->amp, m, A->dt, A->steps * A->dt)) != 0) return k;
   {
     const cli_input *ins[16];
     for (i = 0; i < nrun; ++i) ins[i] = i ? &S->tin[i] : &S->in;
@@ -2772,6 +3416,7 @@ static int simulate_training_runs(const reduce_args *A, reduce_state *S, const d
   S->Ysim = (double *)malloc(sizeof(double) * (size_t)m * (size_t)ns);
   x0 = (double *)calloc((size_t)N, sizeof(double));
   if (!S->Xsim || !S->Ysim || !x0) { free(x0); return fail("out of memory for %d snapshots of size %d", ns, N); }
+  if (load_x0(A, S, N, x0)) { free(x0); return 1; }
   memset(&go, 0, sizeof go);
   go.tol = A->newton_tol; go.max_iter = A->newton_iter;
   t0 = now_s();
@@ -2875,7 +3520,7 @@ static int run_reduction(const reduce_args *A, reduce_state *S, int method, cons
   o.hyper.deim_max = A->deim_max;
   o.hyper.allow_negative = A->deim_neg;
   o.dt = A->dt_map;
-  o.select.lambda_mode = A->lambda_auto;
+  o.select.lambda_mode = method == PHGMG_METHOD_GMG_QM ? A->lambda_auto : 0;
   o.qm.manifold = A->manifold;
   o.ref = A->ref;
   o.ref_x = A->ref == PHGMG_REF_GIVEN ? S->refm.a : NULL;
@@ -2887,8 +3532,9 @@ static int run_reduction(const reduce_args *A, reduce_state *S, int method, cons
   progress("reducing: %s, r = %d%s", A->method, A->r, method == PHGMG_METHOD_GMG_QM ? " (quadratic manifold)" : "");
   t0 = now_s();
   plog.t0 = t0; plog.all = (double)N * (double)ns >= 1e7; plog.ncand = plog.nprobe = 0;
+  plog.qm = method == PHGMG_METHOD_GMG_QM; plog.hyper = o.hyper.on;
   if (!g_quiet) { o.progress = reduce_phase; o.progress_user = &plog; }
-  rc = phgmg_reduce(&S->red, &S->sys, X, N, ns, &o, &info, NULL);
+  rc = S->study ? phgmg_study_reduce(S->study, &o, &S->red, &info) : phgmg_reduce(&S->red, &S->sys, X, N, ns, &o, &info, NULL);
   *t_red = now_s() - t0;
   if (rc != PHGMG_OK) {
     const char *src = A->X ? A->X : "the simulated snapshots";
@@ -2960,6 +3606,23 @@ static int run_reduction(const reduce_args *A, reduce_state *S, int method, cons
   return 0;
 }
 
+/* NAME_PD.npy: the reduced feedthrough as one (r + m) x m matrix [Ph; S + N]
+   (rows 0..r-1: Ph = W_z^T P; rows r..r+m-1: S + N), from phgmg_rom.PD's two
+   column-major blocks. */
+static int write_feedthrough(const reduce_args *A, reduce_state *S, const phgmg_rom *rom, outlist *ol) {
+  const int r = rom->r, m = rom->m;
+  double *D = (double *)malloc(sizeof(double) * (size_t)(r + m) * (size_t)m);
+  int a, b, e;
+  if (!D) return fail("out of memory");
+  for (b = 0; b < m; ++b) {
+    for (a = 0; a < r; ++a) D[a + (size_t)b * (r + m)] = (double)rom->PD[a + (size_t)b * r];
+    for (a = 0; a < m; ++a) D[r + a + (size_t)b * (r + m)] = (double)rom->PD[(size_t)r * m + a + (size_t)b * m];
+  }
+  e = write_field(A->out, A->name, "PD", D, r + m, m, ol, &S->sg);
+  free(D);
+  return e;
+}
+
 /* The reduced model's arrays (NAME_*.npy), V0 = Dphi(0), V2 and M of a
    quadratic map, and with --save-snapshots the snapshots and their outputs. */
 static int write_arrays(const reduce_args *A, reduce_state *S, const double *X, int ns, outlist *ol) {
@@ -2987,9 +3650,11 @@ static int write_arrays(const reduce_args *A, reduce_state *S, const double *X, 
     }
     free(buf);
   }
+  if (rom->PD && write_feedthrough(A, S, rom, ol)) return 1;
   {
     /* V0 = Dphi(0), the linear part of the reduction map (exactly V0 for every method). */
     double *xr0 = (double *)calloc((size_t)rom->r, sizeof(double));
+    free(S->V0);
     S->V0 = (double *)malloc(sizeof(double) * (size_t)N * (size_t)rom->r);
     if (!xr0 || !S->V0) { free(xr0); return fail("out of memory"); }
     phgmg_reduced_dphi(S->red, xr0, S->V0, N);
@@ -3139,6 +3804,10 @@ static int write_json(const reduce_args *A, reduce_state *S, int method, int ns,
           rom->kind == PHGMG_ROM_QUADRATIC ? "quadratic" : "linear");
   fprintf(jf, "  \"N\": %d, \"m\": %d, \"r\": %d, \"rn\": %d, \"nd\": %d, \"poly_deg\": %d,\n", N, m, rom->r,
           rom->rn, rom->nd, rom->nd ? rom->poly_deg : 0);
+  /* the model as given: its mass matrix, all its states (an index-one model is reduced on its differential
+     ones: N above), the reduced feedthrough */
+  fprintf(jf, "  \"E\": %s, \"N_full\": %d, \"algebraic\": %d, \"feedthrough\": %s,\n",
+          S->full.E ? "true" : "false", S->full.N, S->dae ? phgmg_dae_nalg(S->dae) : 0, rom->PD ? "true" : "false");
   fprintf(jf, "  \"dt_map\": ");
   if (rom->Phi) { char buf[32]; fputs(isfinite((double)rom->dt) ? real_str(rom->dt, buf) : "null", jf); }   /* float: "0.1" */
   else fputs("0", jf);
@@ -3235,20 +3904,84 @@ static int write_model_files(const reduce_args *A, reduce_state *S, int method, 
   return write_json(A, S, method, ns, t_sim, t_red, o, info, ol);
 }
 
-/* Every output of the run moves into place; then the arrays an earlier run
-   recorded and this one did not write are removed. */
-static int reduce_commit(const reduce_args *A, reduce_state *S) {
-  const phgmg_rom *rom = phgmg_reduced_rom(S->red);
+/* Model k's outputs move into place; then the arrays an earlier run
+   recorded under its name and this one did not write are removed. */
+static int commit_model(const reduce_args *A, reduce_state *S, sweep_model *M) {
   outlist rec;
   char nfull[64] = "";
-  read_record(A->out, A->name, &rec); /* before this run's record replaces it */
-  if (stage_commit(&S->sg)) return 1;
-  remove_stale(A->out, &rec, &S->ol);
+  read_record(A->out, M->name, &rec); /* before this run's record replaces it */
+  if (stage_commit(&M->sg)) return 1;
+  remove_stale(A->out, &rec, &M->ol);
   if (S->dae) /* the arrays are full-size; the reduction ran on the differential states */
     snprintf(nfull, sizeof nfull, ", of which %d differential", S->sys.N);
   printf("wrote %s/%s.phgmgrom, %s/%s.c, %s/%s.json and %d arrays %s/%s_*.npy (%s, r = %d, m = %d, N = %d%s)\n",
-         A->out, A->name, A->out, A->name, A->out, A->name, S->ol.n, A->out, A->name, method_name(S->method),
-         rom->r, rom->m, S->full.N, nfull);
+         A->out, M->name, A->out, M->name, A->out, M->name, M->ol.n, A->out, M->name, method_name(M->method),
+         M->rr, M->m, S->full.N, nfull);
+  return 0;
+}
+
+/* NAME_sweep.json of a sweep: every model with its method, order, name,
+   reduction time, whether it was written, and validate's tests (nt, names). */
+static int write_sweep_json(const reduce_args *A, reduce_state *S, const char *const *tests, int nt) {
+  char path[4096 + 256];
+  const char *wp;
+  FILE *jf;
+  int k, t;
+  snprintf(path, sizeof path, "%s/%s_sweep.json", A->out, A->name0);
+  if (!(wp = stage_path(&S->sweep_sg, path))) return 1;
+  if (!(jf = fopen(wp, "w"))) return fail("%s: cannot write: %s", path, strerror(errno));
+  fprintf(jf, "{\n  \"phgmg_version\": \"%s\",\n  \"name\": ", PHGMG_VERSION_STRING);
+  json_str(jf, A->name0);
+  fprintf(jf, ",\n  \"naming\": \"NAME_<method>_r<R>, method with '-' as '_'\",\n");
+  fprintf(jf, "  \"shared_bases\": %s,\n  \"snapshot_seconds\": ", S->study ? "true" : "false");
+  json_num(jf, S->t_sim);
+  fprintf(jf, ",\n  \"models\": [");
+  for (k = 0; k < S->nmodels; ++k) {
+    const sweep_model *M = &S->models[k];
+    fprintf(jf, "%s\n    {\"name\": ", k ? "," : "");
+    json_str(jf, M->name);
+    fprintf(jf, ", \"method\": \"%s\", \"r\": %d, \"json\": ", method_name(M->method), M->r);
+    {
+      char f[128];
+      snprintf(f, sizeof f, "%s.json", M->name);
+      json_str(jf, f);
+    }
+    fprintf(jf, ", \"reduce_seconds\": "); json_num(jf, M->t_red);
+    fprintf(jf, ", \"written\": %s", M->pass ? "true" : "false");
+    if (nt > 0) {
+      fprintf(jf, ", \"tests\": [");
+      for (t = 0; t < nt; ++t) {
+        fprintf(jf, "%s{\"input\": ", t ? ", " : "");
+        json_str(jf, tests[t]);
+        fprintf(jf, ", \"e_y\": "); json_num(jf, M->ey[t]);
+        fprintf(jf, ", \"e_red\": "); json_num(jf, M->ered[t]);
+        fprintf(jf, ", \"pass\": %s}", M->tpass[t] ? "true" : "false");
+      }
+      fprintf(jf, "]");
+    }
+    fprintf(jf, "}");
+  }
+  fprintf(jf, "\n  ]\n}\n");
+  if (fclose(jf) != 0) return fail("%s: write error", path);
+  return 0;
+}
+
+/* Every model marked pass moves into place (reduce: all of them), then a
+   sweep's record. 1 if a commit failed. */
+static int reduce_commit(const reduce_args *A, reduce_state *S, const char *const *tests, int nt) {
+  int k, any = 0;
+  if (S->nmodels > 1 && write_sweep_json(A, S, tests, nt)) return 1;
+  for (k = 0; k < S->nmodels; ++k) {
+    if (!S->models[k].pass) { stage_abort(&S->models[k].sg); continue; }
+    if (commit_model(A, S, &S->models[k])) return 1;
+    any = 1;
+  }
+  if (S->nmodels > 1) {
+    if (stage_commit(&S->sweep_sg)) return 1;
+    any = 1;
+    printf("wrote %s/%s_sweep.json (%d models)\n", A->out, A->name0, S->nmodels);
+  }
+  if (any) stage_free(&S->dirs, 0);   /* the directories stay */
   return 0;
 }
 
@@ -3291,14 +4024,23 @@ static void register_inputs(const reduce_args *A, pathset *ps, const char *const
 static void reduce_paths(const reduce_args *A, reduce_state *S, const char *const *tests, int nt) {
   char path[4096 + 256];
   int k;
+  reduce_args T = *A;
+  char nm[128];
+  int j;
   register_inputs(A, &S->pin, tests, nt);
-  snprintf(path, sizeof path, "%s/%s.phgmgrom", A->out, A->name); paths_add(&S->pout, "--out/--name", path, 1);
-  snprintf(path, sizeof path, "%s/%s.c", A->out, A->name); paths_add(&S->pout, "--out/--name", path, 1);
-  snprintf(path, sizeof path, "%s/%s.json", A->out, A->name); paths_add(&S->pout, "--out/--name", path, 1);
-  for (k = 0; all_fields[k]; ++k) {
-    if (!A->save_snap && (!strcmp(all_fields[k], "snapshots") || !strcmp(all_fields[k], "fom_y"))) continue;
-    snprintf(path, sizeof path, "%s/%s_%s.npy", A->out, A->name, all_fields[k]);
-    paths_add(&S->pout, "--out/--name", path, 1);
+  if (sweep_count(A) > 1) {
+    snprintf(path, sizeof path, "%s/%s_sweep.json", A->out, A->name0); paths_add(&S->pout, "--out/--name", path, 1);
+  }
+  for (j = 0; j < sweep_count(A); ++j) {
+    sweep_set(&T, j, nm, sizeof nm);
+    snprintf(path, sizeof path, "%s/%s.phgmgrom", T.out, T.name); paths_add(&S->pout, "--out/--name", path, 1);
+    snprintf(path, sizeof path, "%s/%s.c", T.out, T.name); paths_add(&S->pout, "--out/--name", path, 1);
+    snprintf(path, sizeof path, "%s/%s.json", T.out, T.name); paths_add(&S->pout, "--out/--name", path, 1);
+    for (k = 0; all_fields[k]; ++k) {
+      if (!T.save_snap && (!strcmp(all_fields[k], "snapshots") || !strcmp(all_fields[k], "fom_y"))) continue;
+      snprintf(path, sizeof path, "%s/%s_%s.npy", T.out, T.name, all_fields[k]);
+      paths_add(&S->pout, "--out/--name", path, 1);
+    }
   }
 }
 
@@ -3318,7 +4060,9 @@ static int method_code(const char *m) {
    output an input or another output, the output directory usable, the files
    read and the system valid, the sizes. */
 static int reduce_prepare(const reduce_args *A, reduce_state *S, const char *const *tests, int nt) {
-  int e;
+  int e, k;
+  reduce_args T = *A;
+  char nm[128];
   if ((S->method = method_code(A->method)) < 0)
     return usage_error("--method '%s': expected gmg-pod, gmg-qm, sp1, sp2, bt, prbt or phbt", A->method);
   reduce_paths(A, S, tests, nt);
@@ -3330,8 +4074,13 @@ static int reduce_prepare(const reduce_args *A, reduce_state *S, const char *con
     return 1;
   if ((e = load_system(A, S)) != 0) return e;
   if ((A->simulate || A->nxin || nt) && check_dt_scale(A, S)) return 1;
-  if (check_extras(A, S)) return 1;
-  if ((e = check_sizes(A, S->method, S->sys.N, S->sys.m, S->dae ? phgmg_dae_nalg(S->dae) : 0)) != 0) return e;
+  for (k = 0; k < sweep_count(A); ++k) {   /* every model of a sweep, before any of them is built */
+    sweep_set(&T, k, nm, sizeof nm);
+    S->method = method_code(T.method);
+    if (check_extras(&T, S)) return 1;
+    if ((e = check_sizes(&T, S->method, S->sys.N, S->sys.m, S->dae ? phgmg_dae_nalg(S->dae) : 0)) != 0) return e;
+  }
+  S->method = method_code(A->method);
   return A->X ? load_snapshot_files(A, S, S->sys.N, S->sys.m, &S->Xd, &S->ns) : 0;
 }
 
@@ -3397,32 +4146,90 @@ static int run_balancing(const reduce_args *A, reduce_state *S, double *t_red) {
   return 0;
 }
 
+/* A sweep's shared bases: a study over the snapshots for the largest order
+   asked (phgmg_study_create), so that each model's reduction works in the
+   study's coordinates. A model class the study does not take (a mass
+   matrix, feedthrough) or a study that fails: each model computes its own
+   bases (said in the log). */
+static void sweep_study(const reduce_args *A, reduce_state *S, const double *X, int ns) {
+  const int N = S->sys.N, m = S->sys.m;
+  phgmg_study_opts so;
+  phgmg_result rc;
+  int k, kmax = 0;
+  unsigned what = 0;
+  if (sweep_count(A) < 2) return;
+  for (k = 0; k < sweep_count(A); ++k) {
+    const int mc = A->mlist[k / A->nrl], r = A->rlist[k % A->nrl];
+    if (mc == PHGMG_METHOD_GMG_POD || (mc == PHGMG_METHOD_GMG_QM && A->rn != PHGMG_RN_WIDE)) {
+      const int rn = mc == PHGMG_METHOD_GMG_QM ? (A->rn ? A->rn : default_rn(N, r, m)) : 0;
+      what |= PHGMG_STUDY_GMG;
+      kmax = PHGMG__MAX(kmax, r - m + rn);
+    } else if (mc == PHGMG_METHOD_SP1 || mc == PHGMG_METHOD_SP2) {
+      what |= mc == PHGMG_METHOD_SP2 ? PHGMG_STUDY_SP2 : PHGMG_STUDY_SP;
+      kmax = PHGMG__MAX(kmax, r);
+    }
+  }
+  kmax = PHGMG__MIN(kmax + 1, PHGMG__MIN(N, ns));   /* one mode more: sigma_{r'+1} for the log */
+  if (!what || kmax < 1) return;
+  memset(&so, 0, sizeof so);
+  so.what = what; so.kmax = kmax;
+  progress("sweep of %d models: the snapshots' bases once, for up to %d modes", sweep_count(A), kmax);
+  rc = phgmg_study_create(&S->study, &S->sys, X, N, ns, &so, NULL);
+  if (rc != PHGMG_OK) {
+    S->study = NULL;
+    progress("  shared bases not available for this model (%s): each model computes its own",
+             phgmg_result_string(rc));
+  }
+}
+
 /* The snapshots, the reduction and every output written under its temporary
    name (reduce_commit moves them into place). */
-static int reduce_build(const reduce_args *A, reduce_state *S) {
-  phgmg_reduce_opts o;
-  phgmg_reduce_info info;
-  double t_sim = 0.0, t_red = 0.0;
+static int reduce_build(const reduce_args *A, reduce_state *S, int keep) {
   const double *X = S->Xd;
-  int ns = S->ns, e;
-  memset(&o, 0, sizeof o);
-  memset(&info, 0, sizeof info);
-  if (S->method == PHGMG_METHOD_BT || S->method == PHGMG_METHOD_PRBT || S->method == PHGMG_METHOD_PHBT) {
-    if ((e = run_balancing(A, S, &t_red)) != 0) return e;   /* no snapshots */
-    if ((e = write_arrays(A, S, NULL, 0, &S->ol)) != 0) return e;
-    return write_model_files(A, S, S->method, 0, 0.0, t_red, &o, &info, &S->ol);
+  int ns = S->ns, e, k;
+  S->dirs = S->sg;   /* the directories made; each model stages its own files */
+  memset(&S->sg, 0, sizeof S->sg);
+  S->nmodels = sweep_count(A);
+  S->models = (sweep_model *)calloc((size_t)S->nmodels, sizeof(sweep_model));
+  if (!S->models) return fail("out of memory");
+  if (sweep_needs_snapshots(A) && !A->X && (e = simulate_training_runs(A, S, &X, &ns, &S->t_sim)) != 0) return e;
+  sweep_study(A, S, X, ns);
+  for (k = 0; k < S->nmodels; ++k) {
+    sweep_model *M = &S->models[k];
+    reduce_args T = *A;
+    phgmg_reduce_opts o;
+    phgmg_reduce_info info;
+    const phgmg_rom *rom;
+    memset(&o, 0, sizeof o);
+    memset(&info, 0, sizeof info);
+    sweep_set(&T, k, M->name, sizeof M->name);
+    M->method = S->method = method_code(T.method);
+    M->r = T.r;
+    if (is_balancing(S->method)) {   /* no snapshots */
+      if ((e = run_balancing(&T, S, &M->t_red)) != 0) return e;
+      if ((e = write_arrays(&T, S, NULL, 0, &S->ol)) != 0) return e;
+      if ((e = write_model_files(&T, S, S->method, 0, 0.0, M->t_red, &o, &info, &S->ol)) != 0) return e;
+    } else {
+      if ((e = run_reduction(&T, S, S->method, X, ns, &o, &info, &M->t_red)) != 0) return e;
+      if ((e = write_arrays(&T, S, X, ns, &S->ol)) != 0) return e;
+      if ((e = write_model_files(&T, S, S->method, ns, S->t_sim, M->t_red, &o, &info, &S->ol)) != 0) return e;
+    }
+    rom = phgmg_reduced_rom(S->red);
+    M->rr = rom->r; M->m = rom->m; M->pass = 1;
+    M->sg = S->sg; M->ol = S->ol;
+    memset(&S->sg, 0, sizeof S->sg);
+    if (keep) M->red = S->red;
+    else phgmg_reduced_destroy(S->red);
+    S->red = NULL;
   }
-  if (!A->X && (e = simulate_training_runs(A, S, &X, &ns, &t_sim)) != 0) return e;
-  if ((e = run_reduction(A, S, S->method, X, ns, &o, &info, &t_red)) != 0) return e;
-  if ((e = write_arrays(A, S, X, ns, &S->ol)) != 0) return e;
-  return write_model_files(A, S, S->method, ns, t_sim, t_red, &o, &info, &S->ol);
+  return 0;
 }
 
 static int cmd_reduce_impl(const reduce_args *A, reduce_state *S) {
   int e;
   if ((e = reduce_prepare(A, S, NULL, 0)) != 0) return e;
-  if ((e = reduce_build(A, S)) != 0) return e;
-  return reduce_commit(A, S);
+  if ((e = reduce_build(A, S, 0)) != 0) return e;
+  return reduce_commit(A, S, NULL, 0);
 }
 
 static int cmd_reduce(int argc, char **argv) {
@@ -3465,7 +4272,7 @@ static void rom_feed_out(const phgmg_rom *rom, double t, cli_input *in, double *
 
 /* simulate-rom's options (0 / NULL: not given). */
 typedef struct simrom_args {
-  const char *model, *out, *states, *inspec;
+  const char *model, *out, *states, *inspec, *x0;   /* x0: --x0, the reduced initial state */
   double dt, amp, newton_tol;   /* newton_tol 0: the library's default */
   int steps, newton_iter, have_dt;
 } simrom_args;
@@ -3495,6 +4302,8 @@ static int parse_simulate_rom(int argc, char **argv, simrom_args *P) {
     else if (!strcmp(o, "--steps")) { if (!(v = optval(argc, argv, &i)) || !parse_int(o, v, 1, INT_MAX - 1, &P->steps)) return 2; }
     else if (!strcmp(o, "--newton-iter")) { if (!(v = optval(argc, argv, &i)) || !parse_int(o, v, 1, 1000, &P->newton_iter)) return 2; }
     else if (!strcmp(o, "--quiet")) g_quiet = 1;
+    else if (!strcmp(o, "--freq") || !strcmp(o, "--freq-end")) { if (parse_freq(argc, argv, &i)) return 2; }
+    else if (!strcmp(o, "--x0")) { if (!(P->x0 = optval(argc, argv, &i))) return 2; }
     else return usage_error("simulate-rom: unknown option '%s'", o);
   }
   if (!P->model || !P->out) return usage_error("simulate-rom: --model FILE and --out FILE are required");
@@ -3562,6 +4371,7 @@ static int cmd_simulate_rom(int argc, char **argv) {
   memset(&pout, 0, sizeof pout);
   paths_add(&pin, "--model", model, 0);
   paths_add_input(&pin, "--input", inspec);
+  if (P.x0) paths_add(&pin, "--x0", P.x0, 0);
   paths_add(&pout, "--out", out, 1);
   if (states) paths_add(&pout, "--states", states, 1);
   if ((status = check_collisions("simulate-rom", &pin, &pout)) != 0) goto done;
@@ -3575,7 +4385,7 @@ static int cmd_simulate_rom(int argc, char **argv) {
     status = 2;
     goto done;
   }
-  if ((status = input_setup(&in, "--input", inspec, amp, rom.m, dt)) != 0) goto done;
+  if ((status = input_setup(&in, "--input", inspec, amp, rom.m, dt, steps * dt)) != 0) goto done;
   input_covers(&in, inspec, "--input", steps * dt);
   status = 1;
   msz = phgmg_rom_stepper_memsize_dt(&rom, (phgmg_real)dt);
@@ -3592,6 +4402,18 @@ static int cmd_simulate_rom(int argc, char **argv) {
            rom.kind == PHGMG_ROM_QUADRATIC ? ", quadratic manifold" : "", steps, dt,
            st.use_map ? " (precomputed step map)" : "", input_desc(&in, inspec));
   for (a = 0; a < rom.r; ++a) x[a] = rom.xr_rest ? rom.xr_rest[a] : (phgmg_real)0;   /* from rest: rho(0) */
+  if (P.x0) {   /* --x0: the reduced state xr0, r values */
+    mat M;
+    if (mat_load(&M, "--x0", P.x0)) goto done;
+    if (M.ndim == 0 || M.rows != rom.r || M.cols != 1) {
+      fail("%s (--x0): expected the reduced initial state, shape (%d,) (r = %d values), got %s", P.x0, rom.r, rom.r,
+           shape_str(&M));
+      mat_free(&M);
+      goto done;
+    }
+    for (a = 0; a < rom.r; ++a) x[a] = (phgmg_real)M.a[a];
+    mat_free(&M);
+  }
   /* the same sequence of operations as phgmg_reduced_simulate */
 #define RECORD(nn) do { \
     if (XR) for (a = 0; a < rom.r; ++a) XR[a + (size_t)(nn) * rom.r] = (double)x[a]; \
@@ -3669,6 +4491,7 @@ static int parse_simulate(int argc, char **argv, reduce_args *A, const char **st
     else if (!strcmp(o, "--newton-iter")) { if (!(v = optval(argc, argv, &i)) || !parse_int(o, v, 1, 1000, &A->newton_iter)) return 2; }
     else if (!strcmp(o, "--amp")) { if (!(v = optval(argc, argv, &i)) || !parse_double(o, v, -HUGE_VAL, &A->amp)) return 2; }
     else if (!strcmp(o, "--newton-tol")) { if (!(v = optval(argc, argv, &i)) || !parse_double(o, v, 0.0, &A->newton_tol)) return 2; }
+    else if (!strcmp(o, "--freq") || !strcmp(o, "--freq-end")) { if (parse_freq(argc, argv, &i)) return 2; }
     else return usage_error("simulate: unknown option '%s'", o);
   }
   if ((k = check_model_opts("simulate", A)) != 0) return k;
@@ -3713,9 +4536,10 @@ static int cmd_simulate(int argc, char **argv) {
     status = 2;
     goto out;
   }
-  if ((status = input_setup(&S.in, "--input", A.input, A.amp, m, A.dt)) != 0) goto out;
+  if ((status = input_setup(&S.in, "--input", A.input, A.amp, m, A.dt, A.steps * A.dt)) != 0) goto out;
   status = 1;
   x0 = (double *)calloc((size_t)N, sizeof(double));
+  if (x0 && load_x0(&A, &S, N, x0)) goto out;
   Y = (double *)malloc(sizeof(double) * (size_t)m * ((size_t)A.steps + 1));
   if (states) X = (double *)malloc(sizeof(double) * (size_t)N * ((size_t)A.steps + 1));
   if (!x0 || !Y || (states && !X)) { fail("out of memory for %d steps", A.steps); goto out; }
@@ -3872,33 +4696,58 @@ static int validate_error(const char *spec, phgmg_result rc, const reduce_state 
   return fail("validate: %s: %s", spec, phgmg_result_string(rc));
 }
 
-/* One test of validate: full and reduced model on input `spec` over nsteps
-   from x0 (NULL: 0); prints its line; 0 pass, 1 fail or error. */
-static int validate_one(const reduce_args *A, reduce_state *S, cli_input *in, const char *spec, int nsteps,
-                        const double *x0, double max_ey) {
+/* The largest order of the run's --r list. */
+static int max_order(const reduce_args *A) {
+  int k, r = 0;
+  for (k = 0; k < A->nrl; ++k) r = PHGMG__MAX(r, A->rlist[k]);
+  return r;
+}
+
+/* One test of validate: the full model and every model of the run on input
+   `spec` over nsteps from x0 (NULL: 0), one full run for all of them
+   (phgmg_reduced_validate_many); prints a line per model; a model that fails
+   loses its pass mark. Test t of the run. 0 all pass, 1 a fail or an error. */
+static int validate_test(const reduce_args *A, reduce_state *S, cli_input *in, const char *spec, int nsteps,
+                         const double *x0, double max_ey, int t) {
   const phgmg_ph_system sys = S->sys;   /* as reduced: any potential, sparse input in its internal order */
+  const phgmg_reduced *reds[32];
+  phgmg_validation vs[32];
   phgmg_run run;
-  phgmg_validation v;
   phgmg_result rc;
+  int k, bad = 0;
   memset(&run, 0, sizeof run);
   run.u = input_fn; run.user = in; run.dt = A->dt; run.nsteps = nsteps; run.x0 = x0;
-  rc = phgmg_reduced_validate(S->red, &sys, &run, A->newton_tol, A->newton_iter, max_ey, &v, NULL);
-  if (rc != PHGMG_OK) return validate_error(spec, rc, S, nsteps);
-  printf("%-24s %10.3e %10.3e %10.3e %10.3e %10.3e %8.2f %8ld %8ld %8d  %s\n", spec, v.e_red, v.e_y, v.e_proj,
-         v.e_energy, v.e_energy_fom, v.stats.steps ? (double)v.stats.newton_iters / v.stats.steps : 0.0,
-         v.stats.outside_steps, v.stats.q_outside_steps, v.first_failure, v.pass ? "pass" : "FAIL");
-  if (v.first_failure >= 0) {
-    printf("  first failing step: %d (t = %g -> %g): %s\n", v.first_failure, v.first_failure * A->dt,
-           (v.first_failure + 1) * A->dt, phgmg_result_string(v.rom_rc));
+  for (k = 0; k < S->nmodels; ++k) reds[k] = S->models[k].red;
+  rc = phgmg_reduced_validate_many(reds, S->nmodels, &sys, &run, A->newton_tol, A->newton_iter, max_ey, vs, NULL);
+  if (rc != PHGMG_OK) {
+    for (k = 0; k < S->nmodels; ++k) S->models[k].pass = 0;
+    S->red = S->models[0].red;
+    validate_error(spec, rc, S, nsteps);
+    S->red = NULL;
     return 1;
   }
-  if (!(isfinite(v.e_y) && isfinite(v.e_red) && isfinite(v.e_proj))) {
-    printf("  the error norms overflow the double range (states too large; try a smaller --test-amp)\n");
-    return 1;
+  for (k = 0; k < S->nmodels; ++k) {
+    const phgmg_validation *v = &vs[k];
+    sweep_model *M = &S->models[k];
+    char label[160];
+    if (S->nmodels > 1) snprintf(label, sizeof label, "%s [%s r=%d]", spec, method_name(M->method), M->r);
+    else snprintf(label, sizeof label, "%s", spec);
+    M->ey[t] = v->e_y; M->ered[t] = v->e_red; M->tpass[t] = 0;
+    printf("%-24s %10.3e %10.3e %10.3e %10.3e %10.3e %8.2f %8ld %8ld %8d  %s\n", label, v->e_red, v->e_y, v->e_proj,
+           v->e_energy, v->e_energy_fom, v->stats.steps ? (double)v->stats.newton_iters / v->stats.steps : 0.0,
+           v->stats.outside_steps, v->stats.q_outside_steps, v->first_failure, v->pass ? "pass" : "FAIL");
+    if (v->first_failure >= 0)
+      printf("  first failing step: %d (t = %g -> %g): %s\n", v->first_failure, v->first_failure * A->dt,
+             (v->first_failure + 1) * A->dt, phgmg_result_string(v->rom_rc));
+    else if (!(isfinite(v->e_y) && isfinite(v->e_red) && isfinite(v->e_proj)))
+      printf("  the error norms overflow the double range (states too large; try a smaller --test-amp)\n");
+    else if (!v->pass)
+      printf("  e_y %.3e above --max-ey %g\n", v->e_y, max_ey);
+    if (v->pass && v->first_failure < 0 && isfinite(v->e_y) && isfinite(v->e_red) && isfinite(v->e_proj))
+      M->tpass[t] = 1;
+    else { M->pass = 0; bad = 1; }
   }
-  if (v.pass) return 0;
-  printf("  e_y %.3e above --max-ey %g\n", v.e_y, max_ey);
-  return 1;
+  return bad;
 }
 
 /* ---- validate: reduce, then check the reduced model against the full one ----
@@ -3942,23 +4791,26 @@ static int cmd_validate(int argc, char **argv) {
     /* the training run's length: --steps, or the --X run's (the first run's for a --test-input) */
     const int run = from_x[k] ? k : 0;
     steps[k] = V.steps_t ? V.steps_t : !A.X ? A.steps : (run ? S.Xs[run].cols : S.X.cols) - 1;
-    status = input_setup(&tin[k], "--test-input", V.tests[k], V.have_amp ? V.amp_t : A.amp, S.sys.m, A.dt);
+    status = input_setup(&tin[k], "--test-input", V.tests[k], V.have_amp ? V.amp_t : A.amp, S.sys.m, A.dt,
+                         steps[k] * A.dt);
     if (!status) input_covers(&tin[k], V.tests[k], "--test-input", steps[k] * A.dt);
-    if (!status && too_big(((double)S.sys.N + 2.0 * S.sys.m + A.r + 8.0) * ((double)steps[k] + 1.0),
+    if (!status && too_big(((double)S.sys.N + 2.0 * S.sys.m + max_order(&A) + 8.0) * ((double)steps[k] + 1.0),
                            "validate: a test run (the full model's states and outputs, N x (steps+1))"))
       status = 2;
   }
-  if (!status) status = reduce_build(&A, &S);
+  if (!status) status = reduce_build(&A, &S, 1);
   if (status == 0) {
     printf("%-24s %10s %10s %10s %10s %10s %8s %8s %8s %8s  %s\n", "test input", "e_red", "e_y", "e_proj", "e_energy",
            "(FOM)", "newton", "outside", "q-out", "fail@", "verdict");
     for (k = 0; k < nt; ++k)
-      if (validate_one(&A, &S, &tin[k], V.tests[k], steps[k], from_x[k] ? S.runs[k].x0 : NULL, V.max_ey)) status = 1;
+      if (validate_test(&A, &S, &tin[k], V.tests[k], steps[k], from_x[k] ? S.runs[k].x0 : NULL, V.max_ey, k))
+        status = 1;
     printf("validate: %s\n", status ? "FAILED" : "passed");
-    if (status == 0) status = reduce_commit(&A, &S);
-    else
-      printf("validate: the model was not written: %s/%s.* is unchanged (the same options with `phgmg reduce` "
-             "write the failing model)\n", A.out, A.name);
+    for (k = 0; k < S.nmodels; ++k)
+      if (!S.models[k].pass)
+        printf("validate: the model was not written: %s/%s.* is unchanged (the same options with `phgmg reduce` "
+               "write the failing model)\n", A.out, S.models[k].name);
+    if (reduce_commit(&A, &S, V.tests, nt)) status = 1;
   }
   for (k = 0; k < 16; ++k) mat_free(&tin[k].tab);
   reduce_cleanup(&S);

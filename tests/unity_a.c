@@ -40,3 +40,4 @@
 #include "test_dae_sparse.c"
 #include "test_sparse_class.c"
 #include "test_balanced.c"
+#include "test_workflow.c"
