@@ -599,6 +599,34 @@
    PHGMG_ERR_UNSUPPORTED), feedthrough, nonlinear parts. Algorithms and
    measured times: 8.13.
 
+   2.9 Snapshot sets larger than memory (>>pod, >>reduce; no MPI needed).
+   phgmg_pod_stream_begin / _add / _end take the snapshots a block of
+   columns at a time (from a time stepper, or read from a file in blocks)
+   and keep only an incremental SVD at a fixed rank (Brand's update, each
+   block's residual re-orthogonalised against the basis and B), with the
+   error split stated: the result is the exact POD of a matrix within
+   `discarded` (the sum over the updates of the norms of what each
+   truncation cut) of the snapshot matrix, so the N x ns matrix never
+   exists. Begun with B, the stream PODs the adjusted snapshots X - B B^+ X
+   of GMG and keeps their B coordinates. phgmg_reduce_stream then builds the
+   model from the stream alone -- GMG-POD and SP1 need only the basis and the
+   snapshots' coordinates in it (for the training envelope): the same model
+   as phgmg_reduce on the snapshots when the stream kept their numerical
+   rank, and within the stated bound otherwise. Not from a stream: GMG-QM and
+   SP2 (they fit or POD functions of the snapshots themselves), a
+   hyper-reduced separable part (its gradient snapshots), opts.ref = MEAN,
+   dampers and E. Memory: N (kmax + m) for the stream plus the block being
+   added (N (2 nb + ...) during an add). The command line streams
+   `reduce --simulate` and `--X FILE` (read in column blocks) with --stream,
+   and by default when the snapshots would not fit its 4 GiB limit.
+
+       phgmg_pod_stream *st;
+       phgmg_pod_stream_begin(&st, N, m, sys.B, N, 2 * (r - m) + 2, 0.0, NULL);
+       for (each block Xb of nb states) phgmg_pod_stream_add(st, nb, Xb, N);
+       opts.method = PHGMG_METHOD_GMG_POD; opts.r = r;
+       phgmg_reduce_stream(&red, &sys, st, &opts, &info, NULL);
+       phgmg_pod_stream_destroy(st);
+
    3. METHODS AND OPTIONS -------------------------------------------------------
    Every option struct is "zero means default": memset it to 0 and set what you
    need. The tables give each field's default (the value a zero field takes).
@@ -1767,7 +1795,9 @@
            phgmg_reduced_rom, phgmg_reduced_N, phgmg_reduced_lift,
            phgmg_reduced_restrict, phgmg_reduced_dphi, phgmg_reduced_W,
            phgmg_reduced_simulate, phgmg_reduced_simulate_run,
-           phgmg_reduced_validate, phgmg_rel_error,
+           phgmg_reduced_validate, phgmg_rel_error, phgmg_pod_stream_begin,
+           phgmg_pod_stream_add, phgmg_pod_stream_end, phgmg_pod_stream_columns,
+           phgmg_pod_stream_destroy, phgmg_reduce_stream,
            phgmg_err_red, phgmg_err_proj, phgmg_err_lowerbound,
            phgmg_err_energy, phgmg_study_create, phgmg_study_destroy,
            phgmg_study_basis, phgmg_study_reduce, phgmg_study_errors,
@@ -1797,7 +1827,7 @@
            phgmg_lu_rcond, phgmg_norm1, phgmg_normf, phgmg_zlu_factor,
            phgmg_zlu_solve, phgmg_qr, phgmg_qrcp, phgmg_qr_form_q,
            phgmg_qr_apply, phgmg_lstsq, phgmg_svd, phgmg_sym_eig
-   (153 functions; 17 of them only with PHGMG_MPI; also the macros
+   (159 functions; 17 of them only with PHGMG_MPI; also the macros
    PHGMG_ROM_STEPPER_MEMSIZE_MAX and _MAX_CB.)
 */
 #ifndef PHGMG_H_INCLUDED
@@ -2763,6 +2793,55 @@ PHGMG_DEF phgmg_result phgmg_pod_hierarchical(int N, int m, const double *B, int
                                               int ldx, int p, int rn, double *V1, double *V2,
                                               const phgmg_allocator *alloc);
 
+/* Streaming POD (manual 2.9): the POD of snapshots that arrive in column
+   blocks, so the N x ns snapshot matrix never exists -- a time stepper
+   feeds its states as it makes them, a file is read a block at a time.
+   An incremental SVD (Brand 2006) kept at rank kmax: with the basis V
+   (N x k, orthonormal) and values S so far, a block Xb (N x nb) is split
+   into C = V^T Xb and the residual Xb - V C (twice, for orthogonality),
+   the residual is factored Qb Rb by Householder QR (in chunks of 4096 rows),
+   the small matrix [[diag(S), C], [0, Rb]] ((k + nb) square) is decomposed
+   and V, S are rotated and truncated to the kmax leading modes (and to
+   sigma_j > tol sigma_1 with tol > 0; values below the SVD's numerical
+   rank count as zero). Deflation: with B (N x m, m >= 1, full column rank)
+   every block is first adjusted, Xb - QB QB^T Xb with B = QB RB (the
+   adjusted snapshots of GMG, as phgmg_adjust_snapshots), and its
+   coordinates QB^T Xb are kept; m = 0 (B NULL): the snapshots as given
+   (SP1). The stream also keeps the coordinates Z = V^T (adjusted
+   snapshots) of every column seen (k x ns, updated by the same rotations):
+   what phgmg_reduce_stream needs besides the basis.
+   Error split: with no truncation (kmax at least the numerical rank of
+   the columns seen) the result is the POD of all the columns, to rounding
+   (values at or below max(N, ns) eps ||X||_F count as zero, as in
+   phgmg_reduce). Each truncation drops the values it cuts; the final V, S and Z are
+   exactly the POD and coordinates of a matrix within `discarded` = the sum
+   over the updates of sqrt(sum of the squares of the values dropped) of
+   the true (adjusted) snapshot matrix in the Frobenius norm, so by Weyl
+   each singular value is off by at most that bound. Keep kmax a few modes
+   above the modes you use (phgmg_reduce_stream uses r - m (GMG) or r
+   (SP1) of them; the command line keeps twice as many plus one).
+   Cost per block of nb columns: about N (4 k nb + 4 nb^2 + 2 (k + nb) k)
+   multiply-adds; memory: N (kmax + m) doubles for V and B's factor, N
+   (2 nb + kmax) more during an add, and (kmax + m) ns for the coordinates.
+   begin: *st (NULL on failure); PHGMG_ERR_INVALID_ARG (NULL st, B NULL with
+   m > 0, tol NaN or outside [0, 1)), _SIZE (N < 1, m < 0, kmax < 1, kmax +
+   m > N, ldb < N), _RANK (B rank deficient), _NOMEM. add: nb >= 1 columns
+   Xb (ldx >= N); a block with NaN/Inf is refused whole (PHGMG_ERR_NANINF,
+   the stream unchanged); _SIZE, _NOMEM. end: V (N x k, ldv >= N; may be
+   NULL), S (k, may be NULL), *k_out = k (0 before any column),
+   *discarded (may be NULL) the bound above; the stream stays valid (add
+   more, end again). */
+typedef struct phgmg_pod_stream phgmg_pod_stream;
+PHGMG_DEF phgmg_result phgmg_pod_stream_begin(phgmg_pod_stream **st, int N, int m, const double *B, int ldb,
+                                              int kmax, double tol, const phgmg_allocator *alloc);
+PHGMG_DEF phgmg_result phgmg_pod_stream_add(phgmg_pod_stream *st, int nb, const double *Xb, int ldx);
+PHGMG_DEF phgmg_result phgmg_pod_stream_end(const phgmg_pod_stream *st, double *V, int ldv, double *S, int *k_out,
+                                            double *discarded);
+/* Columns added so far (0 for NULL). */
+PHGMG_DEF int phgmg_pod_stream_columns(const phgmg_pod_stream *st);
+/* NULL is a no-op. */
+PHGMG_DEF void phgmg_pod_stream_destroy(phgmg_pod_stream *st);
+
 /* >>hyper ================================================================= */
 /* Hyper-reduction: points and weights that stand for a separable sum of
    terms (DEIM, ECSW) and the solvers behind them. */
@@ -3111,6 +3190,24 @@ typedef struct phgmg_reduced phgmg_reduced;
 PHGMG_DEF phgmg_result phgmg_reduce(phgmg_reduced **out, const phgmg_ph_system *sys, const double *X,
                                     int ldx, int ns, const phgmg_reduce_opts *opts,
                                     phgmg_reduce_info *info, const phgmg_allocator *alloc);
+/* phgmg_reduce from a streaming POD (phgmg_pod_stream_*, manual 2.9): the
+   reduced model of all the columns streamed, for the methods whose model
+   depends on the snapshots only through their POD basis and the
+   coordinates the stream keeps -- GMG-POD (stream begun with the model's
+   B, the same N x m values) and SP1 (stream begun without B) -- of a model
+   without dampers or mass matrix E, with opts.ref = PHGMG_REF_NONE and no
+   hyper-reduced separable part (a separable part with hyper.on = 0 keeps
+   every term and is fine). The basis: the r - m (GMG) or r (SP1) leading
+   modes of the stream; the checks and info as phgmg_reduce (its
+   pod_sigma_ratio from the stream's values); the training envelope from
+   the stream's coordinates. opts.runs and opts.cache are ignored (there
+   are no snapshots to simulate from). The stream is not changed. Errors:
+   PHGMG_ERR_UNSUPPORTED (another method or a model or option above),
+   PHGMG_ERR_INVALID_ARG (NULL, the stream's B not the model's), _SIZE (r
+   above the modes the stream holds), and phgmg_reduce's codes. */
+PHGMG_DEF phgmg_result phgmg_reduce_stream(phgmg_reduced **out, const phgmg_ph_system *sys,
+                                           const phgmg_pod_stream *st, const phgmg_reduce_opts *opts,
+                                           phgmg_reduce_info *info, const phgmg_allocator *alloc);
 PHGMG_DEF void phgmg_reduced_destroy(phgmg_reduced *red);
 /* The online model (views into the reduced object; valid until destroy). */
 PHGMG_DEF const phgmg_rom *phgmg_reduced_rom(const phgmg_reduced *red);
@@ -12660,6 +12757,290 @@ PHGMG_DEF phgmg_result phgmg_pod_hierarchical(int N, int m, const double *B, int
   return rc;
 }
 
+/* Local QR of X (n x ns, n >= 1) into W (n x ns, ld n: the explicit Q in
+   the first kq = min(n, ns) columns) and Rl (ns x ns, ld ns, zero below the
+   diagonal and below row kq). Tall blocks go by a flat tree: chunks of
+   about PHGMG__QR_CHUNK rows (at least ns) factored each in cache, their
+   R factors stacked and factored again, each chunk's Q times its block of
+   the second Q (the unblocked Householder QR of the whole block would
+   stream it from memory once per column). */
+#define PHGMG__QR_CHUNK 4096
+PHGMG__PRIV phgmg_result phgmg__chunked_qr(int n, int ns, const double *X, int ldx, double *W, double *Rl,
+                                             const phgmg_allocator *al) {
+  const int nc = n / PHGMG__MAX(PHGMG__QR_CHUNK, ns), kq = PHGMG__MIN(n, ns), ms = PHGMG__MAX(nc, 1) * ns;
+  const int cmax = n / PHGMG__MAX(nc, 1) + 1;
+  double *S2 = phgmg__dalloc(al, (size_t)ms * ns + 2 * (size_t)ns + (nc > 1 ? (size_t)cmax * ns : 0));
+  double *tau, *work, *T;
+  int i, j, c;
+  phgmg_result rc = S2 ? PHGMG_OK : PHGMG_ERR_NOMEM;
+  if (rc != PHGMG_OK) return rc;
+  tau = S2 + (size_t)ms * ns; work = tau + ns; T = work + ns;
+  for (j = 0; j < ns; ++j) memcpy(W + (size_t)j * n, X + (size_t)j * ldx, (size_t)n * sizeof(double));
+  memset(Rl, 0, (size_t)ns * ns * sizeof(double));
+  if (nc <= 1) {
+    rc = phgmg_qr(n, ns, W, n, tau);
+    for (j = 0; j < ns && rc == PHGMG_OK; ++j)
+      for (i = 0; i <= j && i < kq; ++i) Rl[i + (size_t)j * ns] = W[i + (size_t)j * n];
+    if (rc == PHGMG_OK) phgmg_qr_form_q(n, kq, W, n, tau, work);
+    phgmg__free(al, S2);
+    return rc;
+  }
+  memset(S2, 0, (size_t)ms * ns * sizeof(double));
+  for (c = 0; c < nc && rc == PHGMG_OK; ++c) {   /* chunk c: rows r0 .. r0 + nb - 1 (nb >= ns) */
+    const int r0 = (int)((long long)n * c / nc), nb = (int)((long long)n * (c + 1) / nc) - r0;
+    rc = phgmg_qr(nb, ns, W + r0, n, tau);
+    for (j = 0; j < ns && rc == PHGMG_OK; ++j)
+      for (i = 0; i <= j; ++i) S2[c * ns + i + (size_t)j * ms] = W[r0 + i + (size_t)j * n];
+    if (rc == PHGMG_OK) phgmg_qr_form_q(nb, ns, W + r0, n, tau, work);
+  }
+  if (rc == PHGMG_OK) rc = phgmg_qr(ms, ns, S2, ms, tau);
+  if (rc == PHGMG_OK) {
+    for (j = 0; j < ns; ++j)
+      for (i = 0; i <= j; ++i) Rl[i + (size_t)j * ns] = S2[i + (size_t)j * ms];
+    phgmg_qr_form_q(ms, ns, S2, ms, tau, work);
+    for (c = 0; c < nc; ++c) {
+      const int r0 = (int)((long long)n * c / nc), nb = (int)((long long)n * (c + 1) / nc) - r0;
+      phgmg_gemm('N', 'N', nb, ns, ns, 1.0, W + r0, n, S2 + (size_t)c * ns, ms, 0.0, T, nb);
+      for (j = 0; j < ns; ++j) memcpy(W + r0 + (size_t)j * n, T + (size_t)j * nb, (size_t)nb * sizeof(double));
+    }
+  }
+  phgmg__free(al, S2);
+  return rc;
+}
+
+/* ---- streaming POD (manual 2.9) ------------------------------------------ */
+struct phgmg_pod_stream {
+  int N, m, kmax, k, ns, cap;
+  double tol, discarded, fro2; /* fro2: squared Frobenius norm of the columns seen */
+  double *B, *QB, *RB; /* N x m copy of B, its thin QR                     */
+  double *V, *S;       /* N x kmax basis, kmax values                        */
+  double *Z, *A;       /* kmax x cap coordinates V^T Xa; m x cap: QB^T X     */
+  phgmg_allocator al;  /* a copy of the allocator (zero: malloc/free)        */
+};
+
+PHGMG_DEF void phgmg_pod_stream_destroy(phgmg_pod_stream *st) {
+  phgmg_allocator al;
+  if (!st) return;
+  al = st->al;
+  phgmg__free(&al, st->B);
+  phgmg__free(&al, st->V);
+  phgmg__free(&al, st->Z);
+  phgmg__free(&al, st);
+}
+
+PHGMG_DEF phgmg_result phgmg_pod_stream_begin(phgmg_pod_stream **st, int N, int m, const double *B, int ldb,
+                                              int kmax, double tol, const phgmg_allocator *alloc) {
+  phgmg_pod_stream *s;
+  phgmg_result rc = PHGMG_OK;
+  int j;
+  if (!st) return PHGMG_ERR_INVALID_ARG;
+  *st = NULL;
+  if (tol != tol || tol < 0.0 || tol >= 1.0 || (m > 0 && !B)) return PHGMG_ERR_INVALID_ARG;
+  if (N < 1 || m < 0 || kmax < 1 || kmax > N - m || (m > 0 && ldb < N)) return PHGMG_ERR_SIZE;
+  s = PHGMG__CAST(phgmg_pod_stream *, phgmg__alloc(alloc, sizeof *s));
+  if (!s) return PHGMG_ERR_NOMEM;
+  memset(s, 0, sizeof *s);
+  if (alloc) s->al = *alloc;
+  s->N = N; s->m = m; s->kmax = kmax; s->tol = tol;
+  s->V = phgmg__dalloc(&s->al, (size_t)N * kmax + (size_t)kmax);
+  if (m > 0) s->B = phgmg__dalloc(&s->al, 2 * (size_t)N * m + (size_t)m * m);
+  if (!s->V || (m > 0 && !s->B)) rc = PHGMG_ERR_NOMEM;
+  if (rc == PHGMG_OK) {
+    s->S = s->V + (size_t)N * kmax;
+    if (m > 0) {
+      s->QB = s->B + (size_t)N * m; s->RB = s->QB + (size_t)N * m;
+      for (j = 0; j < m; ++j) memcpy(s->B + (size_t)j * N, B + (size_t)j * ldb, (size_t)N * sizeof(double));
+      if (!phgmg__all_finite(s->B, (size_t)N * m)) rc = PHGMG_ERR_NANINF;
+      else rc = phgmg__thin_qr(N, m, s->B, s->QB, s->RB, &s->al);
+    }
+  }
+  if (rc != PHGMG_OK) { phgmg_pod_stream_destroy(s); return rc; }
+  *st = s;
+  return PHGMG_OK;
+}
+
+/* Room for ncol columns of coordinates (Z: kmax rows, A: m rows). */
+PHGMG__PRIV phgmg_result phgmg__pod_stream_grow(phgmg_pod_stream *s, int ncol) {
+  const size_t rows = (size_t)s->kmax + (size_t)s->m;
+  double *Zn;
+  int cap = s->cap;
+  if (ncol <= cap) return PHGMG_OK;
+  while (cap < ncol) cap = cap < 64 ? 64 : (cap > (int)(~0u >> 2) ? ncol : 2 * cap);
+  Zn = phgmg__dalloc(&s->al, rows * cap);
+  if (!Zn) return PHGMG_ERR_NOMEM;
+  if (s->ns > 0) {
+    memcpy(Zn, s->Z, (size_t)s->kmax * s->ns * sizeof(double));
+    if (s->m > 0) memcpy(Zn + (size_t)s->kmax * cap, s->A, (size_t)s->m * s->ns * sizeof(double));
+  }
+  phgmg__free(&s->al, s->Z);
+  s->Z = Zn;
+  s->A = Zn + (size_t)s->kmax * cap;
+  s->cap = cap;
+  return PHGMG_OK;
+}
+
+/* Res (N x nb) adjusted by B (its coordinates into A's new columns), then
+   projected off V twice; Cs (k x nb) = the sum of both coefficient blocks,
+   Ct: k x nb scratch. */
+PHGMG__PRIV void phgmg__pod_stream_project(phgmg_pod_stream *s, int nb, double *Res, double *Cs, double *Ct) {
+  const int N = s->N, k = s->k, m = s->m;
+  int pass, i;
+  if (m > 0) {
+    double *Ab = s->A + (size_t)m * s->ns;
+    phgmg_gemm('T', 'N', m, nb, N, 1.0, s->QB, N, Res, N, 0.0, Ab, m);
+    phgmg_gemm('N', 'N', N, nb, m, -1.0, s->QB, N, Ab, m, 1.0, Res, N);
+  }
+  if (k > 0) memset(Cs, 0, (size_t)k * nb * sizeof(double));
+  for (pass = 0; pass < 1 && k > 0; ++pass) {
+    phgmg_gemm('T', 'N', k, nb, N, 1.0, s->V, N, Res, N, 0.0, Ct, k);
+    phgmg_gemm('N', 'N', N, nb, k, -1.0, s->V, N, Ct, k, 1.0, Res, N);
+    for (i = 0; i < k * nb; ++i) Cs[i] += Ct[i];
+  }
+}
+
+/* The update from the SVD of M = [[diag(S), C], [0, Rb]] (K2 = k + nb
+   square): V <- [V, Qb] Um(:, 0:kn), Z <- Um(:, 0:kn)^T [[Z, C], [0, Rb]],
+   truncated to kmax, the numerical rank and tol. w: K2 + 2 K2^2 + 4096 kmax +
+   K2 (ns + nb) doubles. */
+PHGMG__PRIV phgmg_result phgmg__pod_stream_update(phgmg_pod_stream *s, int nb, const double *M, const double *Qb,
+                                                  double *w) {
+  const int N = s->N, k = s->k, K2 = k + nb, nt = s->ns + nb;
+  double *sv = w, *Um = sv + K2, *Vn = Um + (size_t)K2 * K2, *Zf = Vn + (size_t)PHGMG__QR_CHUNK * s->kmax, drop = 0.0;
+  int kk = 0, rank = 0, kn, i, j;
+  phgmg_result rc = phgmg_svd(K2, K2, M, K2, K2, sv, Um, K2, NULL, 1, &kk, &rank, &s->al);
+  if (rc != PHGMG_OK) return rc;
+  kn = PHGMG__MIN(kk, s->kmax);
+  for (i = 0; i < kn; ++i)   /* the rounding floor of the columns seen (as phgmg_reduce's), and tol */
+    if (!(sv[i] > (double)PHGMG__MAX(N, nt) * PHGMG__EPS * sqrt(s->fro2)) || !(sv[i] > s->tol * sv[0])) { kn = i; break; }
+  for (i = kn; i < kk; ++i) drop += sv[i] * sv[i];
+  s->discarded += sqrt(drop);
+  if (kn > 0) {
+    for (i = 0; i < N; i += PHGMG__QR_CHUNK) {   /* by row chunks, in place: V's rows i .. i + nr - 1 */
+      const int nr = PHGMG__MIN(PHGMG__QR_CHUNK, N - i);
+      if (k > 0) phgmg_gemm('N', 'N', nr, kn, k, 1.0, s->V + i, N, Um, K2, 0.0, Vn, nr);
+      phgmg_gemm('N', 'N', nr, kn, nb, 1.0, Qb + i, N, Um + k, K2, k > 0 ? 1.0 : 0.0, Vn, nr);
+      for (j = 0; j < kn; ++j) memcpy(s->V + i + (size_t)j * N, Vn + (size_t)j * nr, (size_t)nr * sizeof(double));
+    }
+    /* Zf = [[Z, C], [0, Rb]] (K2 x nt, the C and Rb block taken from M) */
+    memset(Zf, 0, (size_t)K2 * nt * sizeof(double));
+    for (j = 0; j < s->ns; ++j) memcpy(Zf + (size_t)j * K2, s->Z + (size_t)j * s->kmax, (size_t)k * sizeof(double));
+    for (j = 0; j < nb; ++j) memcpy(Zf + (size_t)(s->ns + j) * K2, M + (size_t)(k + j) * K2, (size_t)K2 * sizeof(double));
+    phgmg_gemm('T', 'N', kn, nt, K2, 1.0, Um, K2, Zf, K2, 0.0, s->Z, s->kmax);
+  }
+  for (i = 0; i < kn; ++i) s->S[i] = sv[i];
+  s->k = kn;
+  s->ns = nt;
+  return PHGMG_OK;
+}
+
+/* The residual's orthonormal factor W (N x nb; Res = W Rb) made orthogonal
+   to QB and V to working precision whatever the residual's size (a
+   residual at the rounding level gives a W that is not): W -= [QB, V] E
+   twice, then W = W2 R2 by QR; Rb <- R2 Rb, C += E_V Rb, the B coordinates
+   += E_B Rb. Res: N x nb scratch (receives W2 before the copy back), Ct: k
+   x nb scratch. */
+PHGMG__PRIV phgmg_result phgmg__pod_stream_reorth(phgmg_pod_stream *s, int nb, double *W, double *Res, double *Rb,
+                                                  double *Cs, double *Ct) {
+  const int N = s->N, k = s->k, m = s->m;
+  double *E = phgmg__dalloc(&s->al, (size_t)(k + m) * nb * 2 + (size_t)nb * nb * 2);
+  double *Et, *R2, *T;
+  phgmg_result rc;
+  int pass, i, j, l;
+  if (!E) return PHGMG_ERR_NOMEM;
+  Et = E + (size_t)(k + m) * nb; R2 = Et + (size_t)(k + m) * nb; T = R2 + (size_t)nb * nb;
+  memset(E, 0, (size_t)(k + m) * nb * sizeof(double));
+  for (pass = 0; pass < 2; ++pass) {   /* E (k + m) x nb: rows 0..k-1 for V, k.. for QB */
+    if (k > 0) {
+      phgmg_gemm('T', 'N', k, nb, N, 1.0, s->V, N, W, N, 0.0, Et, k + m);
+      phgmg_gemm('N', 'N', N, nb, k, -1.0, s->V, N, Et, k + m, 1.0, W, N);
+    }
+    if (m > 0) {
+      phgmg_gemm('T', 'N', m, nb, N, 1.0, s->QB, N, W, N, 0.0, Et + k, k + m);
+      phgmg_gemm('N', 'N', N, nb, m, -1.0, s->QB, N, Et + k, k + m, 1.0, W, N);
+    }
+    for (i = 0; i < (k + m) * nb; ++i) E[i] += Et[i];
+  }
+  rc = phgmg__chunked_qr(N, nb, W, N, Res, R2, &s->al);
+  if (rc == PHGMG_OK) {
+    const int kq = PHGMG__MIN(N, nb);
+    double *Ab = s->A + (size_t)m * s->ns;
+    memcpy(W, Res, (size_t)N * kq * sizeof(double));
+    if (kq < nb) memset(W + (size_t)N * kq, 0, (size_t)N * (nb - kq) * sizeof(double));
+    /* T = E Rb ((k + m) x nb): C += T(0:k), Ab += T(k:); Rb <- R2 Rb */
+    phgmg_gemm('N', 'N', k + m, nb, nb, 1.0, E, k + m, Rb, nb, 0.0, Et, k + m);
+    for (j = 0; j < nb; ++j) {
+      for (i = 0; i < k; ++i) Cs[i + (size_t)j * k] += Et[i + (size_t)j * (k + m)];
+      for (i = 0; i < m; ++i) Ab[i + (size_t)j * m] += Et[k + i + (size_t)j * (k + m)];
+      for (i = 0; i < nb; ++i) {
+        double t = 0.0;
+        for (l = i; l <= j; ++l) t += R2[i + (size_t)l * nb] * Rb[l + (size_t)j * nb];
+        T[i + (size_t)j * nb] = t;
+      }
+    }
+    memcpy(Rb, T, (size_t)nb * nb * sizeof(double));
+  }
+  (void)Ct;
+  phgmg__free(&s->al, E);
+  return rc;
+}
+
+PHGMG_DEF phgmg_result phgmg_pod_stream_add(phgmg_pod_stream *st, int nb, const double *Xb, int ldx) {
+  double *Res, *W, *Cs, *Ct, *Rb, *M, *w;
+  size_t need;
+  phgmg_result rc;
+  int N, k, K2, i, j, kq;
+  if (!st || !Xb) return PHGMG_ERR_INVALID_ARG;
+  N = st->N; k = st->k; K2 = k + nb;
+  if (nb < 1 || ldx < N || nb > (int)(~0u >> 2) - st->ns || nb > (int)(~0u >> 2) - k) return PHGMG_ERR_SIZE;
+  for (j = 0; j < nb; ++j)
+    if (!phgmg__all_finite(Xb + (size_t)j * ldx, (size_t)N)) return PHGMG_ERR_NANINF;
+  rc = phgmg__pod_stream_grow(st, st->ns + nb);
+  if (rc != PHGMG_OK) return rc;
+  kq = PHGMG__MIN(N, nb);
+  need = 2 * (size_t)N * nb + 2 * (size_t)k * nb + (size_t)nb * nb + (size_t)K2 * K2 + (size_t)K2 +
+         2 * (size_t)K2 * K2 + (size_t)PHGMG__QR_CHUNK * st->kmax + (size_t)K2 * ((size_t)st->ns + nb);
+  Res = phgmg__dalloc(&st->al, need);
+  if (!Res) return PHGMG_ERR_NOMEM;
+  W = Res + (size_t)N * nb; Cs = W + (size_t)N * nb; Ct = Cs + (size_t)k * nb; Rb = Ct + (size_t)k * nb;
+  M = Rb + (size_t)nb * nb; w = M + (size_t)K2 * K2;
+  for (j = 0; j < nb; ++j) memcpy(Res + (size_t)j * N, Xb + (size_t)j * ldx, (size_t)N * sizeof(double));
+  phgmg__pod_stream_project(st, nb, Res, Cs, Ct);
+  for (j = 0; j < nb; ++j) {   /* the adjusted columns' norms: their residual plus their coordinates */
+    const double a = phgmg_normf(N, 1, Res + (size_t)j * N, N), b = k > 0 ? phgmg_normf(k, 1, Cs + (size_t)j * k, k) : 0.0;
+    st->fro2 += a * a + b * b;
+  }
+  rc = phgmg__chunked_qr(N, nb, Res, N, W, Rb, &st->al);
+  if (rc == PHGMG_OK) {
+    if (kq < nb) memset(W + (size_t)N * kq, 0, (size_t)N * (nb - kq) * sizeof(double));
+    rc = phgmg__pod_stream_reorth(st, nb, W, Res, Rb, Cs, Ct);
+  }
+  if (rc == PHGMG_OK) {
+    memset(M, 0, (size_t)K2 * K2 * sizeof(double));
+    for (i = 0; i < k; ++i) M[i + (size_t)i * K2] = st->S[i];
+    for (j = 0; j < nb; ++j) {
+      for (i = 0; i < k; ++i) M[i + (size_t)(k + j) * K2] = Cs[i + (size_t)j * k];
+      for (i = 0; i <= j; ++i) M[k + i + (size_t)(k + j) * K2] = Rb[i + (size_t)j * nb];
+    }
+    rc = phgmg__pod_stream_update(st, nb, M, W, w);
+  }
+  phgmg__free(&st->al, Res);
+  return rc;
+}
+
+PHGMG_DEF phgmg_result phgmg_pod_stream_end(const phgmg_pod_stream *st, double *V, int ldv, double *S, int *k_out,
+                                            double *discarded) {
+  int j;
+  if (!st || !k_out) return PHGMG_ERR_INVALID_ARG;
+  if (V && ldv < st->N) return PHGMG_ERR_SIZE;
+  for (j = 0; j < st->k && V; ++j) memcpy(V + (size_t)j * ldv, st->V + (size_t)j * st->N, (size_t)st->N * sizeof(double));
+  for (j = 0; j < st->k && S; ++j) S[j] = st->S[j];
+  *k_out = st->k;
+  if (discarded) *discarded = st->discarded;
+  return PHGMG_OK;
+}
+
+PHGMG_DEF int phgmg_pod_stream_columns(const phgmg_pod_stream *st) { return st ? st->ns : 0; }
+
 /* >>hyper (implementation) ================================================ */
 PHGMG_DEF phgmg_result phgmg_deim(int nterms, int ns, const double *F, int ldf, const double *sw,
                                   double tol, int kmax, int *pts, double *w, int *nd_out,
@@ -15523,17 +15904,14 @@ PHGMG__PRIV phgmg_result phgmg__q_envelope(phgmg__rctx *c) {
    range of rho(x_j) over the snapshots, widened on each side by 10 % of its
    width plus 2 % of the largest width (a coordinate the training barely
    moves must not fire on the reduced model's own error). */
-PHGMG__PRIV phgmg_result phgmg__stage_envelope(phgmg__rctx *c) {
-  phgmg_reduced *red = c->red;
+/* The envelope from the reduced coordinates xr (r x ns) into red->env and
+   the model's env_lo/hi (red->env allocated). */
+PHGMG__PRIV phgmg_result phgmg__envelope_set(phgmg_reduced *red, int ns, const double *xr) {
   const int r = red->r;
-  double *xr, big = 0.0;
+  double big = 0.0;
   int j, a;
   phgmg_result rc;
-  red->env = phgmg__red_d(red, 2 * (size_t)r);
-  xr = phgmg__dalloc(c->alloc, (size_t)r * c->ns);
-  if (!red->env || !xr) { phgmg__free(c->alloc, xr); return PHGMG_ERR_NOMEM; }
-  phgmg__restrict_snapshots(c, xr);
-  for (j = 0; j < c->ns; ++j) {
+  for (j = 0; j < ns; ++j) {
     const double *xj = xr + (size_t)j * r;
     for (a = 0; a < r; ++a) {
       if (j == 0 || xj[a] < red->env[a]) red->env[a] = xj[a];
@@ -15546,9 +15924,22 @@ PHGMG__PRIV phgmg_result phgmg__stage_envelope(phgmg__rctx *c) {
     red->env[a] -= w;
     red->env[r + a] += w;
   }
-  phgmg__free(c->alloc, xr);
   rc = phgmg__to_real(red, red->env, (size_t)r, &red->rom.env_lo);
   if (rc == PHGMG_OK) rc = phgmg__to_real(red, red->env + r, (size_t)r, &red->rom.env_hi);
+  return rc;
+}
+
+PHGMG__PRIV phgmg_result phgmg__stage_envelope(phgmg__rctx *c) {
+  phgmg_reduced *red = c->red;
+  const int r = red->r;
+  double *xr;
+  phgmg_result rc;
+  red->env = phgmg__red_d(red, 2 * (size_t)r);
+  xr = phgmg__dalloc(c->alloc, (size_t)r * c->ns);
+  if (!red->env || !xr) { phgmg__free(c->alloc, xr); return PHGMG_ERR_NOMEM; }
+  phgmg__restrict_snapshots(c, xr);
+  rc = phgmg__envelope_set(red, c->ns, xr);
+  phgmg__free(c->alloc, xr);
   if (rc == PHGMG_OK && red->kind == PHGMG_ROM_QUADRATIC && red->M && !red->eta) rc = phgmg__q_envelope(c);
   return rc;
 }
@@ -16743,6 +17134,70 @@ PHGMG_DEF phgmg_result phgmg_reduce(phgmg_reduced **out, const phgmg_ph_system *
                                     int ldx, int ns, const phgmg_reduce_opts *opts,
                                     phgmg_reduce_info *info, const phgmg_allocator *alloc) {
   return phgmg__reduce_run(out, sys, X, ldx, ns, opts, info, alloc, NULL);
+}
+
+/* The training envelope of a model reduced from a stream: the reduced
+   coordinates of the streamed columns, GMG [RB^-1 QB^T x; V1^T Vs z] and
+   SP1 W^T Vs z (Vs, z: the stream's basis and coordinates). */
+PHGMG__PRIV phgmg_result phgmg__stream_envelope(phgmg_reduced *red, const phgmg_pod_stream *st,
+                                                const phgmg_allocator *alloc) {
+  const int N = red->N, r = red->r, m = red->m, k = st->k, ns = st->ns, gmg = st->m > 0;
+  const int q = gmg ? r - m : r;
+  double *T = phgmg__dalloc(alloc, (size_t)q * k + (size_t)r * ns);
+  double *XR;
+  phgmg_result rc;
+  int i, j, l;
+  if (!T) return PHGMG_ERR_NOMEM;
+  XR = T + (size_t)q * k;
+  phgmg_gemm('T', 'N', q, k, N, 1.0, gmg ? red->V0 + (size_t)N * m : red->W, N, st->V, N, 0.0, T, q);
+  phgmg_gemm('N', 'N', q, ns, k, 1.0, T, q, st->Z, st->kmax, 0.0, XR + (gmg ? m : 0), r);
+  for (j = 0; j < ns && gmg; ++j) {   /* RB^-1 (QB^T x_j) */
+    double *xr = XR + (size_t)j * r;
+    for (i = m - 1; i >= 0; --i) {
+      double sm = st->A[i + (size_t)j * m];
+      for (l = i + 1; l < m; ++l) sm -= red->RB[i + l * m] * xr[l];
+      xr[i] = sm / red->RB[i + i * m];
+    }
+  }
+  if (!red->env) red->env = phgmg__red_d(red, 2 * (size_t)r);
+  rc = red->env ? phgmg__envelope_set(red, ns, XR) : PHGMG_ERR_NOMEM;
+  phgmg__free(alloc, T);
+  return rc;
+}
+
+PHGMG_DEF phgmg_result phgmg_reduce_stream(phgmg_reduced **out, const phgmg_ph_system *sys,
+                                           const phgmg_pod_stream *st, const phgmg_reduce_opts *opts,
+                                           phgmg_reduce_info *info, const phgmg_allocator *alloc) {
+  phgmg_reduce_opts o;
+  phgmg_result rc;
+  double *Xe;
+  int j, i, gmg;
+  if (!out) return PHGMG_ERR_INVALID_ARG;
+  *out = NULL;
+  if (!sys || !st || !opts) return PHGMG_ERR_INVALID_ARG;
+  gmg = opts->method == PHGMG_METHOD_GMG_POD;
+  if ((!gmg && opts->method != PHGMG_METHOD_SP1) || opts->ref != PHGMG_REF_NONE || sys->E || sys->ndamp > 0 ||
+      (opts->hyper.on && sys->nl == PHGMG_NL_SEPARABLE))
+    return PHGMG_ERR_UNSUPPORTED;
+  if (st->N != sys->N || (gmg && (st->m != sys->m || !sys->B)) || (!gmg && st->m != 0))
+    return PHGMG_ERR_INVALID_ARG;
+  for (j = 0; j < st->m; ++j)
+    for (i = 0; i < st->N; ++i)
+      if (st->B[i + (size_t)j * st->N] != sys->B[i + (size_t)j * st->N]) return PHGMG_ERR_INVALID_ARG;
+  if (st->k < 1 || opts->r - (gmg ? sys->m : 0) > st->k) return PHGMG_ERR_SIZE;
+  /* V diag(S): a matrix whose POD is the stream's (the basis as snapshots) */
+  Xe = phgmg__dalloc(alloc, (size_t)st->N * st->k);
+  if (!Xe) return PHGMG_ERR_NOMEM;
+  for (j = 0; j < st->k; ++j)
+    for (i = 0; i < st->N; ++i) Xe[i + (size_t)j * st->N] = st->V[i + (size_t)j * st->N] * st->S[j];
+  o = *opts;
+  o.nrun = 0; o.runs = NULL;
+  memset(&o.cache, 0, sizeof o.cache);
+  rc = phgmg_reduce(out, sys, Xe, st->N, st->k, &o, info, alloc);
+  phgmg__free(alloc, Xe);
+  if (rc == PHGMG_OK) rc = phgmg__stream_envelope(*out, st, alloc);
+  if (rc != PHGMG_OK) { phgmg_reduced_destroy(*out); *out = NULL; }
+  return rc;
 }
 
 PHGMG_DEF void phgmg_reduced_lift(const phgmg_reduced *red, const double *xr, double *x) {
@@ -21186,57 +21641,6 @@ PHGMG_DEF phgmg_result phgmg_mpi_atb(const phgmg_mpi_ctx *ctx, int ka, int kb, c
   return PHGMG_OK;
 }
 
-/* Local QR of X (n x ns, n >= 1) into W (n x ns, ld n: the explicit Q in
-   the first kq = min(n, ns) columns) and Rl (ns x ns, ld ns, zero below the
-   diagonal and below row kq). Tall blocks go by a flat tree: chunks of
-   about PHGMG__MPI_CHUNK rows (at least ns) factored each in cache, their
-   R factors stacked and factored again, each chunk's Q times its block of
-   the second Q (the unblocked Householder QR of the whole block would
-   stream it from memory once per column). */
-#define PHGMG__MPI_CHUNK 4096
-PHGMG__PRIV phgmg_result phgmg__mpi_local_qr(int n, int ns, const double *X, int ldx, double *W, double *Rl,
-                                             const phgmg_allocator *al) {
-  const int nc = n / PHGMG__MAX(PHGMG__MPI_CHUNK, ns), kq = PHGMG__MIN(n, ns), ms = PHGMG__MAX(nc, 1) * ns;
-  const int cmax = n / PHGMG__MAX(nc, 1) + 1;
-  double *S2 = phgmg__dalloc(al, (size_t)ms * ns + 2 * (size_t)ns + (nc > 1 ? (size_t)cmax * ns : 0));
-  double *tau, *work, *T;
-  int i, j, c;
-  phgmg_result rc = S2 ? PHGMG_OK : PHGMG_ERR_NOMEM;
-  if (rc != PHGMG_OK) return rc;
-  tau = S2 + (size_t)ms * ns; work = tau + ns; T = work + ns;
-  for (j = 0; j < ns; ++j) memcpy(W + (size_t)j * n, X + (size_t)j * ldx, (size_t)n * sizeof(double));
-  memset(Rl, 0, (size_t)ns * ns * sizeof(double));
-  if (nc <= 1) {
-    rc = phgmg_qr(n, ns, W, n, tau);
-    for (j = 0; j < ns && rc == PHGMG_OK; ++j)
-      for (i = 0; i <= j && i < kq; ++i) Rl[i + (size_t)j * ns] = W[i + (size_t)j * n];
-    if (rc == PHGMG_OK) phgmg_qr_form_q(n, kq, W, n, tau, work);
-    phgmg__free(al, S2);
-    return rc;
-  }
-  memset(S2, 0, (size_t)ms * ns * sizeof(double));
-  for (c = 0; c < nc && rc == PHGMG_OK; ++c) {   /* chunk c: rows r0 .. r0 + nb - 1 (nb >= ns) */
-    const int r0 = (int)((long long)n * c / nc), nb = (int)((long long)n * (c + 1) / nc) - r0;
-    rc = phgmg_qr(nb, ns, W + r0, n, tau);
-    for (j = 0; j < ns && rc == PHGMG_OK; ++j)
-      for (i = 0; i <= j; ++i) S2[c * ns + i + (size_t)j * ms] = W[r0 + i + (size_t)j * n];
-    if (rc == PHGMG_OK) phgmg_qr_form_q(nb, ns, W + r0, n, tau, work);
-  }
-  if (rc == PHGMG_OK) rc = phgmg_qr(ms, ns, S2, ms, tau);
-  if (rc == PHGMG_OK) {
-    for (j = 0; j < ns; ++j)
-      for (i = 0; i <= j; ++i) Rl[i + (size_t)j * ns] = S2[i + (size_t)j * ms];
-    phgmg_qr_form_q(ms, ns, S2, ms, tau, work);
-    for (c = 0; c < nc; ++c) {
-      const int r0 = (int)((long long)n * c / nc), nb = (int)((long long)n * (c + 1) / nc) - r0;
-      phgmg_gemm('N', 'N', nb, ns, ns, 1.0, W + r0, n, S2 + (size_t)c * ns, ms, 0.0, T, nb);
-      for (j = 0; j < ns; ++j) memcpy(W + r0 + (size_t)j * n, T + (size_t)j * nb, (size_t)nb * sizeof(double));
-    }
-  }
-  phgmg__free(al, S2);
-  return rc;
-}
-
 /* The TSQR kernel. W (nloc x ns, ld max(1, nloc)) receives X's local
    Householder QR with its explicit Q in the first kq = min(nloc, ns)
    columns; R (ns x ns) the global triangular factor (diagonal >= 0); Q2
@@ -21250,7 +21654,7 @@ PHGMG__PRIV phgmg_result phgmg__mpi_tsqr_core(const phgmg_mpi_ctx *ctx, int ns, 
   phgmg_result rc = PHGMG_OK;
   int i, j, q;
   memset(Rl, 0, (size_t)ns * ns * sizeof(double));
-  if (n > 0) rc = phgmg__mpi_local_qr(n, ns, X, ldx, W, Rl, &ctx->al);
+  if (n > 0) rc = phgmg__chunked_qr(n, ns, X, ldx, W, Rl, &ctx->al);
   rc = phgmg__mpi_agree(ctx, rc);
   if (rc != PHGMG_OK) return rc;
   MPI_Allgather(Rl, ns * ns, MPI_DOUBLE, Sg, ns * ns, MPI_DOUBLE, ctx->comm);

@@ -36,3 +36,4 @@
 #include "test_study.c"
 #include "test_subnormal.c"
 #include "test_dae_ports.c"
+#include "test_pod_stream.c"
