@@ -128,6 +128,15 @@ static const char *const help_lines[] = {
   "    --dt DT           step (default 0.1), recorded in the model as its training\n",
   "                      step (simulate-rom's default)\n",
   "    --steps N         number of steps (default 1000), t in [0, N*DT]\n",
+  "    --stream          stream the states into an incremental POD as they are made\n",
+  "                      instead of storing the N x (steps+1) snapshots (the default\n",
+  "                      when they would exceed the 4 GiB limit): memory about N\n",
+  "                      (3 K + 64) doubles, K = max(2 (R' + 1), R' + 41) modes kept,\n",
+  "                      R' = R - m (gmg-pod) or R (sp1). For --method gmg-pod and sp1\n",
+  "                      only, without a hyper-reduced --poly-idx part (--no-hyper),\n",
+  "                      --ref, --save-snapshots, --E, feedthrough or --dampers; the\n",
+  "                      model equals the stored run's when the snapshots' numerical\n",
+  "                      rank is at most K (the log states the POD's error bound)\n",
   "    --input KIND      sin (default): u(t) = AMP sin(t); with m > 1 ports each port\n",
   "                      at its own frequency, u_a(t) = AMP sin((1 + a/m) t) for\n",
   "                      a = 0..m-1, so that the ports are excited independently;\n",
@@ -1308,6 +1317,7 @@ typedef struct reduce_args {
   const char *expf, *potential, *hyper;
   double hyper_tol;
   int simulate, steps, r, rn, no_deim, deim_max, deim_neg, save_snap, have_dt_map, newton_iter;
+  int stream;                      /* --stream: the simulated snapshots streamed, never stored */
   int have_dt;                  /* --dt given (with --X alone: the snapshots' step) */
   double dt, amp, lambda, deim_tol, dt_map, newton_tol;
   double degeneracy_tol;        /* --degeneracy-tol (0: the library's default) */
@@ -1562,6 +1572,7 @@ static int parse_reduce(int argc, char **argv, reduce_args *A) {
         return usage_error("--degeneracy-tol: expected a number with 0 < T < 1, got '%s'", v);
     }
     else if (!strcmp(o, "--simulate")) A->simulate = 1;
+    else if (!strcmp(o, "--stream")) A->stream = 1;
     else if (!strcmp(o, "--no-deim") || !strcmp(o, "--no-hyper")) A->no_deim = 1;
     else if (!strcmp(o, "--deim-allow-negative")) A->deim_neg = 1;
     else if (!strcmp(o, "--save-snapshots")) A->save_snap = 1;
@@ -2728,6 +2739,84 @@ static double step_map_radius(const phgmg_rom *rom) {
   return exp(L);
 }
 
+/* ---- reduce --simulate, streamed: the snapshots never stored ------------------ */
+/* The stream phgmg_reduce_stream reduces from (run_reduction uses it when set). */
+static phgmg_pod_stream *g_stream;
+
+/* 1 if this run streams its snapshots: --stream, or --simulate whose
+   snapshots exceed CLI_MAX_BYTES, for a method and model the stream serves
+   (gmg-pod or sp1; no hyper-reduced --poly, --ref mean, --save-snapshots,
+   descriptor, feedthrough or dampers). --stream otherwise: a usage error
+   (2); *why names the reason. */
+static int stream_use(const reduce_args *A, const reduce_state *S, const char **why) {
+  const double cols = (double)(A->ntrain ? A->ntrain : 1) * ((double)A->steps + 1.0);
+  *why = NULL;
+  if (!A->stream && !(A->simulate && 8.0 * (double)S->sys.N * cols > CLI_MAX_BYTES)) return 0;
+  if (!A->simulate) *why = "--X (streamed from --simulate only)";
+  else if (S->method != PHGMG_METHOD_GMG_POD && S->method != PHGMG_METHOD_SP1) *why = "--method gmg-qm or sp2";
+  else if (A->poly_idx && !A->no_deim) *why = "a hyper-reduced --poly-idx part (add --no-hyper)";
+  else if (A->ref != PHGMG_REF_NONE) *why = "--ref";
+  else if (A->save_snap) *why = "--save-snapshots";
+  else if (S->dae || A->E || A->Ecoo || A->Pf || A->Sf || A->Nf || A->dampf) *why = "--E, feedthrough or --dampers";
+  return *why ? 0 : 1;
+}
+
+/* Run i of the training runs (from x0 = 0) on a stepper, each state into
+   the column block blk (N x nb), each full block into g_stream. */
+static int stream_run(const reduce_args *A, reduce_state *S, cli_input *in, const char *spec, double *blk, int nb,
+                      int *fill) {
+  const int N = S->sys.N;
+  phgmg_gl3_opts go;
+  phgmg_gl3 *g = NULL;
+  double *x = (double *)calloc((size_t)N, sizeof(double));
+  phgmg_result rc;
+  int n;
+  memset(&go, 0, sizeof go);
+  go.tol = A->newton_tol; go.max_iter = A->newton_iter;
+  if (!x) return fail("out of memory");
+  rc = phgmg_gl3_create(&g, &S->sys, A->dt, &go, NULL);
+  input_covers(in, spec, A->ntrain ? "--train-input" : "--input", A->steps * A->dt);
+  progress("simulating the full model (streamed): %d steps of dt = %g, %s", A->steps, A->dt, input_desc(in, spec));
+  for (n = 0; rc == PHGMG_OK; ++n) {   /* the loop of phgmg_simulate: t_n = n dt */
+    memcpy(blk + (size_t)*fill * N, x, sizeof(double) * (size_t)N);
+    if (++*fill == nb) { rc = phgmg_pod_stream_add(g_stream, nb, blk, N); *fill = 0; }
+    if (n == A->steps || rc != PHGMG_OK) break;
+    rc = phgmg_gl3_step(g, n * A->dt, x, input_fn, in, NULL);
+  }
+  phgmg_gl3_destroy(g);
+  free(x);
+  if (rc != PHGMG_OK)
+    return fail("streamed simulation failed at step %d of %d: %s", n + 1, A->steps, phgmg_result_string(rc));
+  return 0;
+}
+
+/* The training runs streamed into g_stream (kept at rank max(2(r'+1), r'+41)
+   with r' = r - m (gmg-pod) or r (sp1), at most N - m). */
+static int stream_training_runs(const reduce_args *A, reduce_state *S, int *nso, double *t_sim) {
+  const int N = S->sys.N, m = S->sys.m, gmg = S->method == PHGMG_METHOD_GMG_POD, nrun = A->ntrain ? A->ntrain : 1;
+  const int p = gmg ? A->r - m : A->r, kmax = PHGMG__MIN(N - (gmg ? m : 0), PHGMG__MAX(2 * (p + 1), p + 41));
+  const int nb = PHGMG__MAX(16, PHGMG__MIN(64, kmax));
+  double *blk, t0 = now_s(), disc = 0.0;
+  int i, k, fill = 0;
+  phgmg_result rc;
+  if ((k = input_setup(&S->in, A->ntrain ? "--train-input" : "--input", A->input, A->amp, m, A->dt)) != 0) return k;
+  for (i = 1; i < nrun; ++i)
+    if ((k = input_setup(&S->tin[i], "--train-input", A->train[i], A->amp, m, A->dt)) != 0) return k;
+  rc = phgmg_pod_stream_begin(&g_stream, N, gmg ? m : 0, gmg ? S->sys.B : NULL, N, kmax, 0.0, NULL);
+  if (rc != PHGMG_OK) return fail("streamed POD: %s", phgmg_result_string(rc));
+  if (!(blk = (double *)malloc(sizeof(double) * (size_t)N * (size_t)nb))) return fail("out of memory");
+  for (i = 0, k = 0; i < nrun && !k; ++i) k = stream_run(A, S, i ? &S->tin[i] : &S->in, i ? A->train[i] : A->input, blk, nb, &fill);
+  if (!k && fill > 0 && (rc = phgmg_pod_stream_add(g_stream, fill, blk, N)) != PHGMG_OK)
+    k = fail("streamed POD: %s", phgmg_result_string(rc));
+  free(blk);
+  if (k) return k;
+  phgmg_pod_stream_end(g_stream, NULL, N, NULL, &i, &disc);
+  progress("  streamed POD: %d modes kept of %d snapshots (error bound %.3g)", i, phgmg_pod_stream_columns(g_stream), disc);
+  *nso = phgmg_pod_stream_columns(g_stream);
+  *t_sim = now_s() - t0;
+  return 0;
+}
+
 /* phgmg_reduce with the options of the command line; reports what it did. */
 static int run_reduction(const reduce_args *A, reduce_state *S, int method, const double *X, int ns,
                          phgmg_reduce_opts *op, phgmg_reduce_info *ip, double *t_red) {
@@ -2765,7 +2854,8 @@ static int run_reduction(const reduce_args *A, reduce_state *S, int method, cons
   t0 = now_s();
   plog.t0 = t0; plog.all = (double)N * (double)ns >= 1e7; plog.ncand = plog.nprobe = 0;
   if (!g_quiet) { o.progress = reduce_phase; o.progress_user = &plog; }
-  rc = phgmg_reduce(&S->red, &S->sys, X, N, ns, &o, &info, NULL);
+  rc = g_stream ? phgmg_reduce_stream(&S->red, &S->sys, g_stream, &o, &info, NULL)
+               : phgmg_reduce(&S->red, &S->sys, X, N, ns, &o, &info, NULL);
   *t_red = now_s() - t0;
   if (rc != PHGMG_OK) {
     const char *src = A->X ? A->X : "the simulated snapshots";
@@ -3175,8 +3265,19 @@ static int reduce_build(const reduce_args *A, reduce_state *S) {
   double t_sim = 0.0, t_red = 0.0;
   const double *X = S->Xd;
   int ns = S->ns, e;
+  const char *why;
   memset(&o, 0, sizeof o);
   memset(&info, 0, sizeof info);
+  if (stream_use(A, S, &why)) {   /* streamed: no snapshot matrix (run_reduction reduces from g_stream) */
+    e = stream_training_runs(A, S, &ns, &t_sim);
+    if (!e) e = run_reduction(A, S, S->method, NULL, ns, &o, &info, &t_red);
+    phgmg_pod_stream_destroy(g_stream);
+    g_stream = NULL;
+    if (e) return e;
+    if ((e = write_arrays(A, S, NULL, ns, &S->ol)) != 0) return e;
+    return write_model_files(A, S, S->method, ns, t_sim, t_red, &o, &info, &S->ol);
+  }
+  if (A->stream) return usage_error("--stream: not with %s", why);
   if (!A->X && (e = simulate_training_runs(A, S, &X, &ns, &t_sim)) != 0) return e;
   if ((e = run_reduction(A, S, S->method, X, ns, &o, &info, &t_red)) != 0) return e;
   if ((e = write_arrays(A, S, X, ns, &S->ol)) != 0) return e;
