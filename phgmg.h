@@ -1814,7 +1814,7 @@
    export: phgmg_rom_serialized_size, phgmg_rom_serialize,
            phgmg_rom_deserialize_size, phgmg_rom_deserialize, phgmg_rom_save,
            phgmg_rom_load, phgmg_rom_export_c
-   npy:    phgmg_npy_parse, phgmg_npy_serialize, phgmg_npy_free,
+   npy:    phgmg_npy_parse, phgmg_npy_serialize, phgmg_npy_free, phgmg_npy_read_cols,
            phgmg_npy_read, phgmg_npy_write
    mpi:    (with PHGMG_MPI) phgmg_mpi_agree, phgmg_mpi_ctx_create,
            phgmg_mpi_ctx_destroy, phgmg_mpi_atb, phgmg_mpi_tsqr, phgmg_mpi_pod,
@@ -1827,7 +1827,7 @@
            phgmg_lu_rcond, phgmg_norm1, phgmg_normf, phgmg_zlu_factor,
            phgmg_zlu_solve, phgmg_qr, phgmg_qrcp, phgmg_qr_form_q,
            phgmg_qr_apply, phgmg_lstsq, phgmg_svd, phgmg_sym_eig
-   (159 functions; 17 of them only with PHGMG_MPI; also the macros
+   (160 functions; 17 of them only with PHGMG_MPI; also the macros
    PHGMG_ROM_STEPPER_MEMSIZE_MAX and _MAX_CB.)
 */
 #ifndef PHGMG_H_INCLUDED
@@ -3902,6 +3902,17 @@ PHGMG_DEF void phgmg_npy_free(double *p, const phgmg_allocator *alloc);
    from a pipe the buffer grows with the data that actually arrives). */
 PHGMG_DEF phgmg_result phgmg_npy_read(const char *path, double **out, int *rows, int *cols,
                                       int *ndim, const phgmg_allocator *alloc);
+
+/* Columns j0 .. j0 + nb - 1 of the .npy file path into out (rows x nb, ldo
+   >= rows), read and converted as phgmg_npy_read does, without reading the
+   rest of the data: a snapshot file larger than memory a block at a time
+   (Fortran order: one contiguous read per column; C order: nb values from
+   each row). *rows, *cols (each may be NULL) receive the file's shape; with
+   out NULL or nb = 0 only the shape is read. Errors: PHGMG_ERR_INVALID_ARG
+   (NULL path), _IO, _FORMAT (also a file shorter than its header says),
+   _DTYPE, _INEXACT, _SIZE (columns beyond the file, ldo < rows), _NOMEM. */
+PHGMG_DEF phgmg_result phgmg_npy_read_cols(const char *path, int j0, int nb, double *out, int ldo, int *rows,
+                                           int *cols);
 
 /* Write A (as phgmg_npy_serialize) to the file path, streaming, without
    allocating. Errors as phgmg_npy_serialize (except WORKSPACE), plus
@@ -21493,6 +21504,72 @@ PHGMG_DEF phgmg_result phgmg_npy_read(const char *path, double **out, int *rows,
   *cols = h.cols;
   if (ndim) *ndim = h.ndim;
   return PHGMG_OK;
+}
+
+/* The header of the open file f into h; *doff the offset of the data. */
+PHGMG__PRIV phgmg_result phgmg__npy_fheader(FILE *f, phgmg__npy_hdr *h, size_t *doff) {
+  unsigned char pre[12];
+  size_t hoff = 0, hlen = 0;
+  phgmg_result rc = phgmg__npy_fread(f, pre, 10);
+  char *text;
+  if (rc == PHGMG_OK && (pre[6] == 2 || pre[6] == 3)) rc = phgmg__npy_fread(f, pre + 10, 2);
+  if (rc == PHGMG_OK) rc = phgmg__npy_preamble(pre, (pre[6] == 2 || pre[6] == 3) ? 12 : 10, &hoff, &hlen);
+  if (rc != PHGMG_OK) return rc;
+  text = PHGMG__CAST(char *, phgmg__alloc(NULL, hlen ? hlen : 1));
+  if (!text) return PHGMG_ERR_NOMEM;
+  rc = phgmg__npy_fread(f, text, hlen);
+  if (rc == PHGMG_OK) rc = phgmg__npy_dict(text, hlen, h);
+  phgmg__free(NULL, text);
+  *doff = hoff + hlen;
+  return rc;
+}
+
+/* n elements from file offset off decoded into out[0..n) (flat order). */
+PHGMG__PRIV phgmg_result phgmg__npy_fdecode(FILE *f, const phgmg__npy_hdr *h, long off, size_t n, double *out) {
+  unsigned char chunk[4096];
+  phgmg__npy_hdr flat = *h;
+  phgmg_result rc = PHGMG_OK;
+  flat.corder = 0;
+  if (fseek(f, off, SEEK_SET) != 0) return PHGMG_ERR_IO;
+  while (n > 0 && rc == PHGMG_OK) {
+    const size_t c = PHGMG__MIN(n, sizeof chunk / (size_t)h->es);
+    rc = phgmg__npy_fread(f, chunk, c * (size_t)h->es);
+    if (rc == PHGMG_OK) rc = phgmg__npy_decode(&flat, chunk, 0, c, out);
+    out += c;
+    n -= c;
+  }
+  return rc;
+}
+
+PHGMG_DEF phgmg_result phgmg_npy_read_cols(const char *path, int j0, int nb, double *out, int ldo, int *rows,
+                                           int *cols) {
+  phgmg__npy_hdr h;
+  phgmg_result rc;
+  size_t doff = 0;
+  double *tmp = NULL;
+  FILE *f;
+  int i, j;
+  memset(&h, 0, sizeof h);
+  if (!path) return PHGMG_ERR_INVALID_ARG;
+  if (!(f = fopen(path, "rb"))) return PHGMG_ERR_IO;
+  rc = phgmg__npy_fheader(f, &h, &doff);
+  if (rc == PHGMG_OK) {
+    if (rows) *rows = h.rows;
+    if (cols) *cols = h.cols;
+    if (out && nb > 0 && (j0 < 0 || j0 > h.cols - nb || ldo < PHGMG__MAX(1, h.rows))) rc = PHGMG_ERR_SIZE;
+  }
+  if (rc == PHGMG_OK && out && nb > 0 && h.corder) tmp = phgmg__dalloc(NULL, (size_t)nb);
+  if (rc == PHGMG_OK && out && nb > 0 && h.corder && !tmp) rc = PHGMG_ERR_NOMEM;
+  for (j = 0; rc == PHGMG_OK && out && !h.corder && j < nb; ++j)   /* Fortran order: columns are contiguous */
+    rc = phgmg__npy_fdecode(f, &h, (long)(doff + (size_t)(j0 + j) * h.rows * h.es), (size_t)h.rows,
+                            out + (size_t)j * ldo);
+  for (i = 0; rc == PHGMG_OK && tmp && i < h.rows; ++i) {   /* C order: nb values of each row */
+    rc = phgmg__npy_fdecode(f, &h, (long)(doff + ((size_t)i * h.cols + (size_t)j0) * h.es), (size_t)nb, tmp);
+    for (j = 0; j < nb && rc == PHGMG_OK; ++j) out[i + (size_t)j * ldo] = tmp[j];
+  }
+  phgmg__free(NULL, tmp);
+  fclose(f);
+  return rc;
 }
 
 PHGMG_DEF phgmg_result phgmg_npy_write(const char *path, const double *A, int rows, int cols,

@@ -112,7 +112,9 @@ static const char *const help_lines[] = {
   "                      Repeatable (up to 16): one training run per file, the runs'\n",
   "                      boundaries known to the reduction (--lambda cv folds).\n",
   "                      --dt DT with --X: the snapshots' step, recorded in the model\n",
-  "                      (simulate-rom's default step).\n",
+  "                      (simulate-rom's default step). With --stream (the default\n",
+  "                      when the files hold more than 4 GiB) the files are read a\n",
+  "                      block of columns at a time, never whole (see --stream).\n",
   "  --X-input KIND      the input that made each --X run (one per --X, same order;\n",
   "                      KIND as --input, sampled with --dt = the snapshots' step):\n",
   "                      --lambda auto then simulates the runs from their first\n",
@@ -129,12 +131,13 @@ static const char *const help_lines[] = {
   "                      step (simulate-rom's default)\n",
   "    --steps N         number of steps (default 1000), t in [0, N*DT]\n",
   "    --stream          stream the states into an incremental POD as they are made\n",
-  "                      instead of storing the N x (steps+1) snapshots (the default\n",
-  "                      when they would exceed the 4 GiB limit): memory about N\n",
+  "                      (or as they are read, with --X) instead of storing the N x ns\n",
+  "                      snapshots (the default when they would exceed 4 GiB): memory about N\n",
   "                      (3 K + 64) doubles, K = max(2 (R' + 1), R' + 41) modes kept,\n",
   "                      R' = R - m (gmg-pod) or R (sp1). For --method gmg-pod and sp1\n",
   "                      only, without a hyper-reduced --poly-idx part (--no-hyper),\n",
-  "                      --ref, --save-snapshots, --E, feedthrough or --dampers; the\n",
+  "                      --ref, --save-snapshots, --X-input, --E, feedthrough or\n",
+  "                      --dampers (--stream then is a usage error); the\n",
   "                      model equals the stored run's when the snapshots' numerical\n",
   "                      rank is at most K (the log states the POD's error bound)\n",
   "    --input KIND      sin (default): u(t) = AMP sin(t); with m > 1 ports each port\n",
@@ -2748,16 +2751,28 @@ static phgmg_pod_stream *g_stream;
    (gmg-pod or sp1; no hyper-reduced --poly, --ref mean, --save-snapshots,
    descriptor, feedthrough or dampers). --stream otherwise: a usage error
    (2); *why names the reason. */
+/* The columns of the --X files (0 if a shape cannot be read: the in-core
+   reader reports it). */
+static double stream_x_columns(const reduce_args *A) {
+  double t = 0.0;
+  int k, rows = 0, cols = 0;
+  for (k = 0; k < A->nx; ++k) {
+    if (phgmg_npy_read_cols(A->xs[k], 0, 0, NULL, 1, &rows, &cols) != PHGMG_OK) return 0.0;
+    t += cols;
+  }
+  return t;
+}
+
 static int stream_use(const reduce_args *A, const reduce_state *S, const char **why) {
-  const double cols = (double)(A->ntrain ? A->ntrain : 1) * ((double)A->steps + 1.0);
+  const double cols = A->X ? stream_x_columns(A) : (double)(A->ntrain ? A->ntrain : 1) * ((double)A->steps + 1.0);
   *why = NULL;
-  if (!A->stream && !(A->simulate && 8.0 * (double)S->sys.N * cols > CLI_MAX_BYTES)) return 0;
-  if (!A->simulate) *why = "--X (streamed from --simulate only)";
-  else if (S->method != PHGMG_METHOD_GMG_POD && S->method != PHGMG_METHOD_SP1) *why = "--method gmg-qm or sp2";
+  if (!A->stream && !(8.0 * (double)S->sys.N * cols > CLI_MAX_BYTES)) return 0;
+  if (S->method != PHGMG_METHOD_GMG_POD && S->method != PHGMG_METHOD_SP1) *why = "--method gmg-qm or sp2";
   else if (A->poly_idx && !A->no_deim) *why = "a hyper-reduced --poly-idx part (add --no-hyper)";
   else if (A->ref != PHGMG_REF_NONE) *why = "--ref";
   else if (A->save_snap) *why = "--save-snapshots";
   else if (S->dae || A->E || A->Ecoo || A->Pf || A->Sf || A->Nf || A->dampf) *why = "--E, feedthrough or --dampers";
+  else if (A->nxin) *why = "--X-input";
   return *why ? 0 : 1;
 }
 
@@ -2790,31 +2805,72 @@ static int stream_run(const reduce_args *A, reduce_state *S, cli_input *in, cons
   return 0;
 }
 
-/* The training runs streamed into g_stream (kept at rank max(2(r'+1), r'+41)
-   with r' = r - m (gmg-pod) or r (sp1), at most N - m). */
-static int stream_training_runs(const reduce_args *A, reduce_state *S, int *nso, double *t_sim) {
-  const int N = S->sys.N, m = S->sys.m, gmg = S->method == PHGMG_METHOD_GMG_POD, nrun = A->ntrain ? A->ntrain : 1;
+/* g_stream begun (kept at rank max(2(r'+1), r'+41) with r' = r - m
+   (gmg-pod) or r (sp1), at most N - m) and a block of *nb columns. */
+static int stream_begin(const reduce_args *A, const reduce_state *S, double **blk, int *nb) {
+  const int N = S->sys.N, m = S->sys.m, gmg = S->method == PHGMG_METHOD_GMG_POD;
   const int p = gmg ? A->r - m : A->r, kmax = PHGMG__MIN(N - (gmg ? m : 0), PHGMG__MAX(2 * (p + 1), p + 41));
-  const int nb = PHGMG__MAX(16, PHGMG__MIN(64, kmax));
-  double *blk, t0 = now_s(), disc = 0.0;
-  int i, k, fill = 0;
-  phgmg_result rc;
+  phgmg_result rc = phgmg_pod_stream_begin(&g_stream, N, gmg ? m : 0, gmg ? S->sys.B : NULL, N, kmax, 0.0, NULL);
+  if (rc != PHGMG_OK) return fail("streamed POD: %s", phgmg_result_string(rc));
+  *nb = PHGMG__MAX(16, PHGMG__MIN(64, kmax));
+  if (!(*blk = (double *)malloc(sizeof(double) * (size_t)N * (size_t)*nb))) return fail("out of memory");
+  return 0;
+}
+
+/* The last block into the stream, the log line, the column count. */
+static int stream_finish(const reduce_state *S, double *blk, int fill, int *nso) {
+  double disc = 0.0;
+  int k = 0;
+  phgmg_result rc = fill > 0 ? phgmg_pod_stream_add(g_stream, fill, blk, S->sys.N) : PHGMG_OK;
+  free(blk);
+  if (rc != PHGMG_OK) return fail("streamed POD: %s", phgmg_result_string(rc));
+  phgmg_pod_stream_end(g_stream, NULL, S->sys.N, NULL, &k, &disc);
+  progress("  streamed POD: %d modes kept of %d snapshots (error bound %.3g)", k, phgmg_pod_stream_columns(g_stream), disc);
+  *nso = phgmg_pod_stream_columns(g_stream);
+  return 0;
+}
+
+/* The training runs streamed into g_stream. */
+static int stream_training_runs(const reduce_args *A, reduce_state *S, int *nso, double *t_sim) {
+  const int m = S->sys.m, nrun = A->ntrain ? A->ntrain : 1;
+  double *blk = NULL, t0 = now_s();
+  int i, k, nb = 0, fill = 0;
   if ((k = input_setup(&S->in, A->ntrain ? "--train-input" : "--input", A->input, A->amp, m, A->dt)) != 0) return k;
   for (i = 1; i < nrun; ++i)
     if ((k = input_setup(&S->tin[i], "--train-input", A->train[i], A->amp, m, A->dt)) != 0) return k;
-  rc = phgmg_pod_stream_begin(&g_stream, N, gmg ? m : 0, gmg ? S->sys.B : NULL, N, kmax, 0.0, NULL);
-  if (rc != PHGMG_OK) return fail("streamed POD: %s", phgmg_result_string(rc));
-  if (!(blk = (double *)malloc(sizeof(double) * (size_t)N * (size_t)nb))) return fail("out of memory");
+  if ((k = stream_begin(A, S, &blk, &nb)) != 0) { free(blk); return k; }
   for (i = 0, k = 0; i < nrun && !k; ++i) k = stream_run(A, S, i ? &S->tin[i] : &S->in, i ? A->train[i] : A->input, blk, nb, &fill);
-  if (!k && fill > 0 && (rc = phgmg_pod_stream_add(g_stream, fill, blk, N)) != PHGMG_OK)
-    k = fail("streamed POD: %s", phgmg_result_string(rc));
-  free(blk);
-  if (k) return k;
-  phgmg_pod_stream_end(g_stream, NULL, N, NULL, &i, &disc);
-  progress("  streamed POD: %d modes kept of %d snapshots (error bound %.3g)", i, phgmg_pod_stream_columns(g_stream), disc);
-  *nso = phgmg_pod_stream_columns(g_stream);
+  if (k) { free(blk); return k; }
   *t_sim = now_s() - t0;
-  return 0;
+  return stream_finish(S, blk, fill, nso);
+}
+
+/* The --X files read in blocks of columns into g_stream (in the model's
+   internal order for a sparse model). */
+static int stream_x_files(const reduce_args *A, reduce_state *S, int *nso) {
+  const int N = S->sys.N;
+  double *blk = NULL, *perm = NULL;
+  int f, j, nb = 0, k, rows = 0, cols = 0;
+  phgmg_result rc = PHGMG_OK;
+  if ((k = stream_begin(A, S, &blk, &nb)) != 0) { free(blk); return k; }
+  if (S->sp && !(perm = (double *)malloc(sizeof(double) * (size_t)N * (size_t)nb))) { free(blk); return fail("out of memory"); }
+  for (f = 0; f < A->nx && rc == PHGMG_OK; ++f) {
+    if ((rc = phgmg_npy_read_cols(A->xs[f], 0, 0, NULL, 1, &rows, &cols)) != PHGMG_OK) break;
+    if (rows != N || cols < 2) {
+      free(blk); free(perm);
+      return fail("%s (--X): expected shape (%d, ns), ns >= 2 snapshots as columns, got (%d, %d)", A->xs[f], N, rows, cols);
+    }
+    progress("streaming %s: %d snapshots in blocks of %d", A->xs[f], cols, nb);
+    for (j = 0; j < cols && rc == PHGMG_OK; j += nb) {
+      const int c = PHGMG__MIN(nb, cols - j);
+      rc = phgmg_npy_read_cols(A->xs[f], j, c, blk, N, NULL, NULL);
+      if (rc == PHGMG_OK && S->sp) phgmg_ph_sparse_to_banded_order(S->sp, c, blk, N, perm, N);
+      if (rc == PHGMG_OK) rc = phgmg_pod_stream_add(g_stream, c, S->sp ? perm : blk, N);
+    }
+  }
+  free(perm);
+  if (rc != PHGMG_OK) { free(blk); return fail("%s (--X): %s", A->xs[PHGMG__MIN(f, A->nx - 1)], phgmg_result_string(rc)); }
+  return stream_finish(S, blk, 0, nso);
 }
 
 /* phgmg_reduce with the options of the command line; reports what it did. */
@@ -3240,6 +3296,7 @@ static int method_code(const char *m) {
    output an input or another output, the output directory usable, the files
    read and the system valid, the sizes. */
 static int reduce_prepare(const reduce_args *A, reduce_state *S, const char *const *tests, int nt) {
+  const char *why;
   int e;
   if ((S->method = method_code(A->method)) < 0)
     return usage_error("--method '%s': expected gmg-pod, gmg-qm, sp1 or sp2", A->method);
@@ -3254,6 +3311,7 @@ static int reduce_prepare(const reduce_args *A, reduce_state *S, const char *con
   if ((A->simulate || A->nxin || nt) && check_dt_scale(A, S)) return 1;
   if (check_extras(A, S)) return 1;
   if ((e = check_sizes(A, S->method, S->sys.N, S->sys.m, S->dae ? phgmg_dae_nalg(S->dae) : 0)) != 0) return e;
+  if (A->X && stream_use(A, S, &why)) return 0;   /* read in blocks by reduce_build */
   return A->X ? load_snapshot_files(A, S, S->sys.N, S->sys.m, &S->Xd, &S->ns) : 0;
 }
 
@@ -3269,7 +3327,7 @@ static int reduce_build(const reduce_args *A, reduce_state *S) {
   memset(&o, 0, sizeof o);
   memset(&info, 0, sizeof info);
   if (stream_use(A, S, &why)) {   /* streamed: no snapshot matrix (run_reduction reduces from g_stream) */
-    e = stream_training_runs(A, S, &ns, &t_sim);
+    e = A->X ? stream_x_files(A, S, &ns) : stream_training_runs(A, S, &ns, &t_sim);
     if (!e) e = run_reduction(A, S, S->method, NULL, ns, &o, &info, &t_red);
     phgmg_pod_stream_destroy(g_stream);
     g_stream = NULL;
