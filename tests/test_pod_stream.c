@@ -239,9 +239,33 @@ TEST(test_pod_stream_errors) {
   dmodel_free(&t);
 }
 
+/* phgmg_npy_read_cols: columns 3..6 of a 9 x 8 file written in Fortran and
+   in C order are those columns exactly; the shape alone with out NULL;
+   columns beyond the file: PHGMG_ERR_SIZE; no file: PHGMG_ERR_IO. */
+TEST(test_pod_stream_npy_cols) {
+  const char *path = "build/test_npy_cols.npy";
+  double A[72], out[9 * 4 + 5];
+  int i, ord, rows = 0, cols = 0;
+  for (i = 0; i < 72; ++i) A[i] = 0.25 * i - 3.0;
+  for (ord = 0; ord < 2; ++ord) {
+    CHECK_RC(phgmg_npy_write(path, A, 9, 8, 9, 2, ord ? PHGMG_NPY_C_ORDER : 0u), PHGMG_OK);
+    CHECK_RC(phgmg_npy_read_cols(path, 0, 0, NULL, 1, &rows, &cols), PHGMG_OK);
+    CHECK(rows == 9 && cols == 8);
+    for (i = 0; i < 9 * 4 + 5; ++i) out[i] = -1.0;
+    CHECK_RC(phgmg_npy_read_cols(path, 3, 4, out, 10, NULL, NULL), PHGMG_OK);
+    for (i = 0; i < 9 * 4; ++i) CHECK(out[(i / 9) * 10 + i % 9] == A[27 + i]);
+    CHECK(out[9] == -1.0);   /* ldo 10: the gap untouched */
+    CHECK_RC(phgmg_npy_read_cols(path, 5, 4, out, 9, NULL, NULL), PHGMG_ERR_SIZE);
+    CHECK_RC(phgmg_npy_read_cols(path, 0, 1, out, 8, NULL, NULL), PHGMG_ERR_SIZE);
+  }
+  remove(path);
+  CHECK_RC(phgmg_npy_read_cols(path, 0, 0, NULL, 1, &rows, &cols), PHGMG_ERR_IO);
+}
+
 SUITE(pod_stream) {
   RUN(test_pod_stream_known_svd);
   RUN(test_pod_stream_deflated);
   RUN(test_pod_stream_reduce);
   RUN(test_pod_stream_errors);
+  RUN(test_pod_stream_npy_cols);
 }
