@@ -505,6 +505,13 @@
                             snapshot matrix never exists, on one rank too
      phgmg_mpi_deim_greedy  greedy DEIM points as global indices, ties to the
                             lower global index: the same for every partition
+     phgmg_mpi_ecsw         ECSW of a separable sum whose terms are spread
+                            over the ranks: Lawson-Hanson with one maximum
+                            reduction (ties to the lower global index) and one
+                            broadcast of a column per point, the small least
+                            squares replicated; the target summed in
+                            double-double, so points and weights are the same
+                            for every partition
      phgmg_mpi_op_*         a row-distributed CSR operator: the halo exchange
                             plan built once, A X, V^T A V (replicated)
      phgmg_mpi_atb          A^T B of two row-distributed blocks (replicated)
@@ -1822,12 +1829,12 @@
            phgmg_mpi_pod_stream_end, phgmg_mpi_pod_stream_destroy,
            phgmg_mpi_deim_greedy, phgmg_mpi_op_create, phgmg_mpi_op_destroy,
            phgmg_mpi_op_info, phgmg_mpi_op_apply, phgmg_mpi_op_project,
-           phgmg_mpi_gmg_pod_linear
+           phgmg_mpi_gmg_pod_linear, phgmg_mpi_ecsw
    linalg: phgmg_gemm, phgmg_gemv, phgmg_lu_factor, phgmg_lu_solve,
            phgmg_lu_rcond, phgmg_norm1, phgmg_normf, phgmg_zlu_factor,
            phgmg_zlu_solve, phgmg_qr, phgmg_qrcp, phgmg_qr_form_q,
            phgmg_qr_apply, phgmg_lstsq, phgmg_svd, phgmg_sym_eig
-   (160 functions; 17 of them only with PHGMG_MPI; also the macros
+   (161 functions; 18 of them only with PHGMG_MPI; also the macros
    PHGMG_ROM_STEPPER_MEMSIZE_MAX and _MAX_CB.)
 */
 #ifndef PHGMG_H_INCLUDED
@@ -4062,6 +4069,32 @@ PHGMG_DEF void phgmg_mpi_pod_stream_destroy(phgmg_mpi_pod_stream *st);
    singular (U rank deficient), PHGMG_ERR_SIZE if k > N. */
 PHGMG_DEF phgmg_result phgmg_mpi_deim_greedy(const phgmg_mpi_ctx *ctx, int k, const double *U, int ldu,
                                              const double *sw, phgmg_gidx *pts, double *w);
+
+/* Distributed ECSW (the problem of phgmg_ecsw_separable, manual 2.7): the
+   terms of a separable sum distributed over the ranks, each rank passing
+   its nt terms (nt = 0 allowed): F (nt x ns, ldf) = phi_k'(l_k(x_i)), Vt
+   (nt x r, ldvt) row k = d l_k / d xr (e.g. V's row idx_k), sw (nt; NULL:
+   1) the terms' weights, gid (nt) their global indices (distinct over all
+   ranks). Finds w >= 0 with ||sum_k (w_k - sw_k) F[k,:]^T Vt[k,:]||_F <= tol
+   ||sum_k sw_k F[k,:]^T Vt[k,:]||_F by Lawson-Hanson on the full ns r
+   training rows: per iteration each rank computes the gradient of its own
+   terms, one maximum reduction picks the term (ties to the lower global
+   index, so the point set does not depend on the partition) and its owner
+   broadcasts the term's training column (ns r doubles); the passive-set
+   least squares (ns r x nd) are small and solved alike on every rank. The
+   target is summed in double-double (each rank's partial sums gathered and
+   added in rank order), so it, the gradients and the least squares are the
+   same for every partition, and so are the points and weights. Outputs,
+   identical on every rank: pts (room for max_pts) the kept terms' global
+   indices ascending, w their weights (> 0), *nd_out, *resid_out (may be
+   NULL) the relative residual. tol: as phgmg_ecsw (0: 1e-6; NaN, < 0 or
+   >= 1: PHGMG_ERR_INVALID_ARG). PHGMG_ERR_NOT_CONVERGED (every rank) when
+   max_pts points or no improving term leave tol unmet: the outputs hold the
+   best found. Collective. */
+PHGMG_DEF phgmg_result phgmg_mpi_ecsw(const phgmg_mpi_ctx *ctx, int nt, int ns, const double *F, int ldf, int r,
+                                      const double *Vt, int ldvt, const double *sw, const phgmg_gidx *gid,
+                                      double tol, int max_pts, phgmg_gidx *pts, double *w, int *nd_out,
+                                      double *resid_out);
 
 /* A row-distributed sparse operator: this rank's rows of a global N x N
    matrix as CSR (rowptr: nloc + 1 entries from 0, col: global column
@@ -22066,6 +22099,202 @@ PHGMG_DEF phgmg_result phgmg_mpi_deim_greedy(const phgmg_mpi_ctx *ctx, int k, co
   MPI_Type_free(&t);
   phgmg__free(al, Pr);
   phgmg__free(al, ipiv);
+  return rc;
+}
+
+/* ---- distributed ECSW ------------------------------------------------------------ */
+/* The training column of a term (M = ns r entries, row (i, a) at i + a ns). */
+PHGMG__PRIV void phgmg__mpi_ecsw_col(int ns, int r, const double *F, int ldf, const double *Vt, int ldvt, int k,
+                                     double *col) {
+  int i, a;
+  for (a = 0; a < r; ++a)
+    for (i = 0; i < ns; ++i) col[i + (size_t)a * ns] = F[k + (size_t)i * ldf] * Vt[k + (size_t)a * ldvt];
+}
+
+/* State of the distributed Lawson-Hanson iteration (replicated but the flags). */
+typedef struct phgmg__mpi_nnls {
+  int M, np, cap;          /* rows, passive terms, room                         */
+  double *G, *x, *z, *b, *res, *t;   /* M x cap passive columns, weights, LS solution, target, residual, ns scratch */
+  phgmg_gidx *id;          /* global indices of the passive terms              */
+  char *inP;               /* this rank's terms in the passive set             */
+} phgmg__mpi_nnls;
+
+/* res = b - G x (replicated). */
+PHGMG__PRIV void phgmg__mpi_nnls_res(phgmg__mpi_nnls *s) {
+  memcpy(s->res, s->b, (size_t)s->M * sizeof(double));
+  if (s->np > 0) phgmg_gemv('N', s->M, s->np, -1.0, s->G, s->M, s->x, 1.0, s->res);
+}
+
+/* The passive set's least squares with the Lawson-Hanson step back until
+   every weight is positive (terms at zero leave the set). */
+PHGMG__PRIV phgmg_result phgmg__mpi_nnls_solve(phgmg__mpi_nnls *s, const phgmg_gidx *gid, int nt,
+                                               const phgmg_allocator *al) {
+  int it, j, q;
+  for (it = 0; it < 3 * s->cap + 3; ++it) {
+    double alpha = 1.0;
+    phgmg_result rc = phgmg_lstsq(s->M, s->np, 1, s->G, s->M, s->b, s->M, 0.0, s->z, s->np, al);
+    if (rc != PHGMG_OK) return rc;
+    for (j = 0; j < s->np; ++j)
+      if (!(s->z[j] > 0.0)) alpha = PHGMG__MIN(alpha, s->x[j] / (s->x[j] - s->z[j]));
+    if (alpha >= 1.0) { memcpy(s->x, s->z, (size_t)s->np * sizeof(double)); return PHGMG_OK; }
+    for (j = 0; j < s->np; ++j) s->x[j] += alpha * (s->z[j] - s->x[j]);
+    for (j = 0, q = 0; j < s->np; ++j) {   /* drop the terms at zero, keep the order */
+      if (s->x[j] > 0.0) {
+        if (q != j) {
+          memcpy(s->G + (size_t)q * s->M, s->G + (size_t)j * s->M, (size_t)s->M * sizeof(double));
+          s->x[q] = s->x[j]; s->id[q] = s->id[j];
+        }
+        ++q;
+      } else {
+        int k;
+        for (k = 0; k < nt; ++k) if (gid[k] == s->id[j]) s->inP[k] = 0;
+      }
+    }
+    s->np = q;
+    if (q == 0) return PHGMG_OK;
+  }
+  return PHGMG_ERR_NOT_CONVERGED;
+}
+
+/* The term of largest positive gradient G_k^T res over all ranks (ties to
+   the lower global index) into the passive set: its column broadcast by
+   its owner. *none = 1 if no term has a positive gradient. */
+PHGMG__PRIV void phgmg__mpi_nnls_pick(const phgmg_mpi_ctx *ctx, phgmg__mpi_nnls *s, int nt, int ns, int r,
+                                      const double *F, int ldf, const double *Vt, int ldvt, const phgmg_gidx *gid,
+                                      MPI_Datatype t, MPI_Op op, int *none) {
+  phgmg__mpi_vi loc, glob;
+  int k, i, a, owner, lk = -1, lo = ctx->size;
+  loc.v = 0.0; loc.i = PHGMG__GIDX_MAX;
+  for (k = 0; k < nt; ++k) {
+    double g = 0.0;
+    if (s->inP[k]) continue;
+    for (i = 0; i < ns; ++i) {   /* g = sum_i F[k, i] (res_i . Vt[k, :]) */
+      double ti = 0.0;
+      for (a = 0; a < r; ++a) ti += s->res[i + (size_t)a * ns] * Vt[k + (size_t)a * ldvt];
+      g += F[k + (size_t)i * ldf] * ti;
+    }
+    if (g > loc.v || (g == loc.v && g > 0.0 && gid[k] < loc.i)) { loc.v = g; loc.i = gid[k]; lk = k; }
+  }
+  MPI_Allreduce(&loc, &glob, 1, t, op, ctx->comm);
+  *none = !(glob.v > 0.0);
+  if (*none) return;
+  owner = (lk >= 0 && gid[lk] == glob.i) ? ctx->rank : ctx->size;
+  MPI_Allreduce(&owner, &lo, 1, MPI_INT, MPI_MIN, ctx->comm);
+  if (ctx->rank == lo) {
+    phgmg__mpi_ecsw_col(ns, r, F, ldf, Vt, ldvt, lk, s->G + (size_t)s->np * s->M);
+    s->inP[lk] = 1;
+  }
+  MPI_Bcast(s->G + (size_t)s->np * s->M, s->M, MPI_DOUBLE, lo, ctx->comm);
+  s->id[s->np] = glob.i;
+  s->x[s->np] = 0.0;
+  s->np++;
+}
+
+/* (hi, lo) += v in double-double (Knuth's TwoSum). */
+PHGMG__PRIV void phgmg__dd_add(double *hi, double *lo, double v) {
+  const double sm = *hi + v, bb = sm - *hi, err = (*hi - (sm - bb)) + (v - bb);
+  const double t = *lo + err, h2 = sm + t;
+  *lo = t - (h2 - sm);
+  *hi = h2;
+}
+
+/* The target b = sum_k sw_k (term k's column) over all ranks' terms, in
+   double-double: each rank's partial sums (hi, lo) gathered and added in
+   rank order on every rank, so b is the correctly rounded sum to within
+   ~1e-32 relative whatever the partition (the same bits for every P but in
+   exceptional rounding ties). ws: 2 M (size + 1) doubles. */
+PHGMG__PRIV void phgmg__mpi_ecsw_target(const phgmg_mpi_ctx *ctx, phgmg__mpi_nnls *s, int nt, int ns, int r,
+                                        const double *F, int ldf, const double *Vt, int ldvt, const double *sw,
+                                        double *ws) {
+  const int M = s->M;
+  double *loc = ws, *all = ws + 2 * (size_t)M;
+  int k, i, q;
+  memset(loc, 0, 2 * (size_t)M * sizeof(double));
+  for (k = 0; k < nt; ++k) {
+    phgmg__mpi_ecsw_col(ns, r, F, ldf, Vt, ldvt, k, s->z);
+    for (i = 0; i < M; ++i) phgmg__dd_add(loc + i, loc + M + i, (sw ? sw[k] : 1.0) * s->z[i]);
+  }
+  MPI_Allgather(loc, 2 * M, MPI_DOUBLE, all, 2 * M, MPI_DOUBLE, ctx->comm);
+  for (i = 0; i < M; ++i) {
+    double hi = 0.0, lo = 0.0;
+    for (q = 0; q < ctx->size; ++q) {
+      phgmg__dd_add(&hi, &lo, all[(size_t)q * 2 * M + i]);
+      phgmg__dd_add(&hi, &lo, all[(size_t)q * 2 * M + M + i]);
+    }
+    s->b[i] = hi + lo;
+  }
+}
+
+/* Sorted output: pts ascending, w alike. */
+PHGMG__PRIV void phgmg__mpi_ecsw_out(const phgmg__mpi_nnls *s, phgmg_gidx *pts, double *w) {
+  int i, j;
+  for (i = 0; i < s->np; ++i) { pts[i] = s->id[i]; w[i] = s->x[i]; }
+  for (i = 1; i < s->np; ++i)   /* insertion sort by global index */
+    for (j = i; j > 0 && pts[j - 1] > pts[j]; --j) {
+      const phgmg_gidx tp = pts[j]; const double tw = w[j];
+      pts[j] = pts[j - 1]; w[j] = w[j - 1]; pts[j - 1] = tp; w[j - 1] = tw;
+    }
+}
+
+PHGMG_DEF phgmg_result phgmg_mpi_ecsw(const phgmg_mpi_ctx *ctx, int nt, int ns, const double *F, int ldf, int r,
+                                      const double *Vt, int ldvt, const double *sw, const phgmg_gidx *gid,
+                                      double tol, int max_pts, phgmg_gidx *pts, double *w, int *nd_out,
+                                      double *resid_out) {
+  const phgmg_allocator *al;
+  phgmg__mpi_nnls s;
+  phgmg_result rc = PHGMG_OK;
+  MPI_Datatype t;
+  MPI_Op op;
+  double bn = 0.0, rn = 0.0;
+  int none = 0;
+  if (!ctx) return PHGMG_ERR_INVALID_ARG;
+  al = &ctx->al;
+  memset(&s, 0, sizeof s);
+  if (ns < 1 || r < 1 || nt < 0 || max_pts < 1 || (nt > 0 && (ldf < nt || ldvt < nt)) ||
+      (double)ns * r > 1e8)
+    rc = PHGMG_ERR_SIZE;
+  else if (!pts || !w || !nd_out || (nt > 0 && (!F || !Vt || !gid)) || tol != tol || tol < 0.0 || tol >= 1.0)
+    rc = PHGMG_ERR_INVALID_ARG;
+  else if (nt > 0 && (!phgmg__mat_finite(nt, ns, F, ldf) || !phgmg__mat_finite(nt, r, Vt, ldvt)))
+    rc = PHGMG_ERR_NANINF;
+  else {
+    s.M = ns * r; s.cap = max_pts;
+    s.G = phgmg__dalloc(al, (size_t)s.M * (max_pts + 3) + 3 * (size_t)max_pts);
+    s.id = PHGMG__CAST(phgmg_gidx *, phgmg__alloc(al, sizeof(phgmg_gidx) * (size_t)max_pts));
+    s.inP = PHGMG__CAST(char *, phgmg__alloc(al, (size_t)nt + 1));
+    if (!s.G || !s.id || !s.inP) rc = PHGMG_ERR_NOMEM;
+  }
+  rc = phgmg__mpi_agree(ctx, rc);
+  if (rc == PHGMG_OK) {
+    s.b = s.G + (size_t)s.M * max_pts; s.res = s.b + s.M; s.z = s.res + s.M; s.x = s.z + PHGMG__MAX(s.M, max_pts);
+    memset(s.inP, 0, (size_t)nt + 1);
+    if (tol == 0.0) tol = 1e-6;
+    MPI_Type_contiguous((int)sizeof(phgmg__mpi_vi), MPI_BYTE, &t);
+    MPI_Type_commit(&t);
+    MPI_Op_create(phgmg__mpi_maxloc_fn, 1, &op);
+    double *ws = phgmg__dalloc(al, 2 * (size_t)s.M * ((size_t)ctx->size + 1));
+    if (!ws) rc = PHGMG_ERR_NOMEM;
+    rc = phgmg__mpi_agree(ctx, rc);
+    if (rc == PHGMG_OK) phgmg__mpi_ecsw_target(ctx, &s, nt, ns, r, F, ldf, Vt, ldvt, sw, ws);
+    phgmg__free(al, ws);
+    bn = phgmg_normf(s.M, 1, s.b, s.M);
+    phgmg__mpi_nnls_res(&s);
+    while (rc == PHGMG_OK && (rn = phgmg_normf(s.M, 1, s.res, s.M)) > tol * bn) {
+      if (s.np == max_pts) { rc = PHGMG_ERR_NOT_CONVERGED; break; }
+      phgmg__mpi_nnls_pick(ctx, &s, nt, ns, r, F, ldf, Vt, ldvt, gid, t, op, &none);
+      if (none) { rc = PHGMG_ERR_NOT_CONVERGED; break; }
+      rc = phgmg__mpi_nnls_solve(&s, gid, nt, al);
+      phgmg__mpi_nnls_res(&s);
+    }
+    MPI_Op_free(&op);
+    MPI_Type_free(&t);
+    phgmg__mpi_ecsw_out(&s, pts, w);
+    *nd_out = s.np;
+    if (resid_out) *resid_out = bn > 0.0 ? rn / bn : 0.0;
+  }
+  phgmg__free(al, s.G);
+  phgmg__free(al, s.id);
+  phgmg__free(al, s.inP);
   return rc;
 }
 
