@@ -498,6 +498,9 @@
      phgmg_mpi_tsqr         X = Q R: local Householder QR, the ranks' small
                             R factors gathered (one allgather of ns^2 doubles
                             each) and factored again on every rank
+     phgmg_mpi_cholqr       X = Q R by shifted Cholesky-QR (two shifted and
+                            two plain steps, one reduction of ns^2 each): the
+                            alternative to TSQR with less communication
      phgmg_mpi_pod          POD by TSQR and the SVD of R; values identical
                             on every rank, V this rank's rows
      phgmg_mpi_pod_stream_* the same from column batches (incremental SVD at
@@ -1829,12 +1832,12 @@
            phgmg_mpi_pod_stream_end, phgmg_mpi_pod_stream_destroy,
            phgmg_mpi_deim_greedy, phgmg_mpi_op_create, phgmg_mpi_op_destroy,
            phgmg_mpi_op_info, phgmg_mpi_op_apply, phgmg_mpi_op_project,
-           phgmg_mpi_gmg_pod_linear, phgmg_mpi_ecsw
+           phgmg_mpi_gmg_pod_linear, phgmg_mpi_ecsw, phgmg_mpi_cholqr
    linalg: phgmg_gemm, phgmg_gemv, phgmg_lu_factor, phgmg_lu_solve,
            phgmg_lu_rcond, phgmg_norm1, phgmg_normf, phgmg_zlu_factor,
            phgmg_zlu_solve, phgmg_qr, phgmg_qrcp, phgmg_qr_form_q,
            phgmg_qr_apply, phgmg_lstsq, phgmg_svd, phgmg_sym_eig
-   (161 functions; 18 of them only with PHGMG_MPI; also the macros
+   (162 functions; 19 of them only with PHGMG_MPI; also the macros
    PHGMG_ROM_STEPPER_MEMSIZE_MAX and _MAX_CB.)
 */
 #ifndef PHGMG_H_INCLUDED
@@ -4017,6 +4020,20 @@ PHGMG_DEF phgmg_result phgmg_mpi_atb(const phgmg_mpi_ctx *ctx, int ka, int kb, c
    (2 size + 3 + nloc / 4096) ns^2 doubles. */
 PHGMG_DEF phgmg_result phgmg_mpi_tsqr(const phgmg_mpi_ctx *ctx, int ns, const double *X, int ldx, double *Q,
                                       int ldq, double *R, int ldr);
+
+/* Shifted Cholesky-QR, the alternative to phgmg_mpi_tsqr (Fukaya,
+   Kannan, Nakatsukasa, Yamamoto and Yanagisawa 2020): X = Q R by two
+   shifted steps then two plain ones, each step G = Q^T Q (phgmg_mpi_atb:
+   one reduction of ns^2 doubles to rank 0 and a broadcast, instead of
+   TSQR's allgather of P ns^2), G + s I = L L^T (s = 11 (N ns + ns (ns + 1))
+   eps trace G on the shifted steps, 0 after), Q <- Q L^-T, R <- L^T R. Stable
+   for cond(X) up to about 1/eps (the shift makes the first Cholesky
+   succeed, the later steps restore orthogonality); PHGMG_ERR_RANK (every
+   rank) if a factorization still fails. Q (nloc x ns, ldq) this rank's
+   rows; R (ns x ns, ldr) upper triangular with positive diagonal,
+   identical on every rank. Memory: 3 ns^2 doubles besides Q. Collective. */
+PHGMG_DEF phgmg_result phgmg_mpi_cholqr(const phgmg_mpi_ctx *ctx, int ns, const double *X, int ldx, double *Q,
+                                        int ldq, double *R, int ldr);
 
 /* Distributed POD: the leading left singular vectors of the row-distributed
    X (nloc x ns per rank), as phgmg_pod: kmax modes, or with tol > 0 only
@@ -21856,6 +21873,67 @@ PHGMG_DEF phgmg_result phgmg_mpi_pod(const phgmg_mpi_ctx *ctx, int ns, const dou
     *k_out = k;
   }
   phgmg__free(al, W);
+  return rc;
+}
+
+/* ---- shifted Cholesky-QR ------------------------------------------------------- */
+/* One step: G = Q^T Q (+ shift), G = L L^T, Q <- Q L^-T, Rt <- L^T Rt. G, T: ns^2. */
+PHGMG__PRIV phgmg_result phgmg__mpi_cholqr_step(const phgmg_mpi_ctx *ctx, int ns, double *Q, int ldq, int shifted,
+                                                double *G, double *T, double *Rt) {
+  const int n = ctx->nloc;
+  double tr = 0.0;
+  int i, j, l, bad;
+  phgmg_result rc = phgmg_mpi_atb(ctx, ns, ns, Q, ldq, Q, ldq, G, ns);
+  if (rc != PHGMG_OK) return rc;
+  for (i = 0; i < ns; ++i) tr += G[i + (size_t)i * ns];
+  if (shifted) {
+    const double s = 11.0 * ((double)ctx->N * ns + (double)ns * (ns + 1)) * PHGMG__EPS * tr;
+    for (i = 0; i < ns; ++i) G[i + (size_t)i * ns] += s;
+  }
+  bad = !(tr > 0.0) || phgmg__chol_small(ns, G) != 0;   /* the same G on every rank: the same verdict */
+  if (bad) return PHGMG_ERR_RANK;
+  for (j = 0; j < ns && n > 0; ++j) {   /* Q(:, j) = (Q(:, j) - sum_{i<j} Q(:, i) L(j, i)) / L(j, j) */
+    double *qj = Q + (size_t)j * ldq;
+    for (i = 0; i < j; ++i) {
+      const double lji = G[j + (size_t)i * ns];
+      const double *qi = Q + (size_t)i * ldq;
+      for (l = 0; l < n; ++l) qj[l] -= lji * qi[l];
+    }
+    for (l = 0; l < n; ++l) qj[l] /= G[j + (size_t)j * ns];
+  }
+  for (j = 0; j < ns; ++j)   /* T = L^T Rt (both upper triangular) */
+    for (i = 0; i < ns; ++i) {
+      double t = 0.0;
+      for (l = i; l <= j; ++l) t += G[l + (size_t)i * ns] * Rt[l + (size_t)j * ns];
+      T[i + (size_t)j * ns] = i <= j ? t : 0.0;
+    }
+  memcpy(Rt, T, (size_t)ns * ns * sizeof(double));
+  return PHGMG_OK;
+}
+
+PHGMG_DEF phgmg_result phgmg_mpi_cholqr(const phgmg_mpi_ctx *ctx, int ns, const double *X, int ldx, double *Q,
+                                        int ldq, double *R, int ldr) {
+  const phgmg_allocator *al;
+  double *G = NULL;
+  phgmg_result rc = PHGMG_OK;
+  int n, i, j, step;
+  if (!ctx) return PHGMG_ERR_INVALID_ARG;
+  al = &ctx->al; n = ctx->nloc;
+  if (ns < 1 || (phgmg_gidx)ns > ctx->N || !phgmg__mpi_ld_ok(ctx, ldx) || !phgmg__mpi_ld_ok(ctx, ldq) || ldr < ns)
+    rc = PHGMG_ERR_SIZE;
+  else if (!R || !Q || (n > 0 && !X)) rc = PHGMG_ERR_INVALID_ARG;
+  else if (n > 0 && !phgmg__mat_finite(n, ns, X, ldx)) rc = PHGMG_ERR_NANINF;
+  else if (!(G = phgmg__dalloc(al, 3 * (size_t)ns * ns))) rc = PHGMG_ERR_NOMEM;
+  rc = phgmg__mpi_agree(ctx, rc);
+  if (rc != PHGMG_OK) { phgmg__free(al, G); return rc; }
+  for (j = 0; j < ns && n > 0; ++j) memcpy(Q + (size_t)j * ldq, X + (size_t)j * ldx, (size_t)n * sizeof(double));
+  memset(G + 2 * (size_t)ns * ns, 0, (size_t)ns * ns * sizeof(double));
+  for (i = 0; i < ns; ++i) G[2 * (size_t)ns * ns + i + (size_t)i * ns] = 1.0;
+  for (step = 0; step < 4 && rc == PHGMG_OK; ++step)
+    rc = phgmg__mpi_cholqr_step(ctx, ns, Q, ldq, step < 2, G, G + (size_t)ns * ns, G + 2 * (size_t)ns * ns);
+  for (j = 0; j < ns && rc == PHGMG_OK; ++j)
+    memcpy(R + (size_t)j * ldr, G + 2 * (size_t)ns * ns + (size_t)j * ns, (size_t)ns * sizeof(double));
+  phgmg__free(al, G);
   return rc;
 }
 

@@ -734,6 +734,43 @@ static void test_ecsw(void) {
   phgmg_mpi_ctx_destroy(c);
 }
 
+/* ---- shifted Cholesky-QR ----------------------------------------------------- */
+/* On the graded matrix (singular values 1 ... 1e-13): Q orthonormal to 1e-13,
+   X = Q R to 1e-14 relative, R's singular values the exact ones to 1e-12
+   (what the Gram matrix alone cannot give: test_pod's negative control), and
+   the same at every P (compare_runs). */
+static void test_cholqr(void) {
+  const int N = 600, ns = 40;
+  double *X = (double *)malloc(sizeof(double) * N * ns), *U = (double *)malloc(sizeof(double) * N * ns), sig[40];
+  double *Xl, *Ql, R[40 * 40], G[40 * 40], sv[40], eo = 0.0, es = 0.0, rl[2] = {0.0, 0.0}, rg[2];
+  int ld, i, j, l, k = 0, rank = 0;
+  phgmg_mpi_ctx *c = make_ctx(N);
+  rng_ = 12345;
+  graded(N, ns, X, U, sig);
+  Xl = own_rows(c, ns, X);
+  ld = c->nloc > 0 ? c->nloc : 1;
+  Ql = (double *)malloc(sizeof(double) * ((size_t)ld * ns));
+  CHECK(phgmg_mpi_cholqr(c, ns, Xl, ld, Ql, ld, R, ns) == PHGMG_OK, "cholqr");
+  CHECK(phgmg_mpi_atb(c, ns, ns, Ql, ld, Ql, ld, G, ns) == PHGMG_OK, "Q^T Q");
+  for (j = 0; j < ns; ++j) for (i = 0; i < ns; ++i) eo = fmax(eo, fabs(G[i + j * ns] - (i == j)));
+  for (j = 0; j < ns; ++j)
+    for (i = 0; i < c->nloc; ++i) {
+      double t = Xl[i + (size_t)j * c->nloc];
+      for (l = 0; l <= j; ++l) t -= Ql[i + (size_t)l * ld] * R[l + j * ns];
+      rl[0] += t * t;
+      rl[1] += Xl[i + (size_t)j * c->nloc] * Xl[i + (size_t)j * c->nloc];
+    }
+  MPI_Allreduce(rl, rg, 2, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
+  CHECK(phgmg_svd(ns, ns, R, ns, ns, sv, G, ns, NULL, 1, &k, &rank, NULL) == PHGMG_OK && k == ns, "svd of R");
+  for (i = 0; i < k; ++i) es = fmax(es, fabs(sv[i] - sig[i]));
+  CHECK(eo <= 1e-13 && sqrt(rg[0] / rg[1]) <= 1e-14 && es <= 1e-12,
+        "cholqr: orthogonality %.2e, residual %.2e, singular values %.2e", eo, sqrt(rg[0] / rg[1]), es);
+  if (rank_ == 0) printf("  cholqr: orthogonality %.2e, residual %.2e, singular values %.2e\n", eo, sqrt(rg[0] / rg[1]), es);
+  put(sv, k);
+  free(X); free(U); free(Xl); free(Ql);
+  phgmg_mpi_ctx_destroy(c);
+}
+
 int main(int argc, char **argv) {
   int total = 0;
   double t0;
@@ -751,6 +788,7 @@ int main(int argc, char **argv) {
   test_gmg();
   test_errors();
   test_ecsw();
+  test_cholqr();
   compare_runs(argc > 1 ? argv[1] : NULL);
   MPI_Allreduce(&fails_, &total, 1, MPI_INT, MPI_SUM, MPI_COMM_WORLD);
   if (rank_ == 0) printf("test_mpi: P = %d: %s (%d failed checks, %.2f s)\n", size_, total ? "FAILED" : "passed", total, MPI_Wtime() - t0);
