@@ -17232,7 +17232,7 @@ PHGMG_DEF phgmg_result phgmg_reduce_stream(phgmg_reduced **out, const phgmg_ph_s
   phgmg_reduce_opts o;
   phgmg_result rc;
   double *Xe;
-  int j, i, gmg;
+  int j, i, gmg, kk;
   if (!out) return PHGMG_ERR_INVALID_ARG;
   *out = NULL;
   if (!sys || !st || !opts) return PHGMG_ERR_INVALID_ARG;
@@ -17245,16 +17245,18 @@ PHGMG_DEF phgmg_result phgmg_reduce_stream(phgmg_reduced **out, const phgmg_ph_s
   for (j = 0; j < st->m; ++j)
     for (i = 0; i < st->N; ++i)
       if (st->B[i + (size_t)j * st->N] != sys->B[i + (size_t)j * st->N]) return PHGMG_ERR_INVALID_ARG;
-  if (st->k < 1 || opts->r - (gmg ? sys->m : 0) > st->k) return PHGMG_ERR_SIZE;
-  /* V diag(S): a matrix whose POD is the stream's (the basis as snapshots) */
-  Xe = phgmg__dalloc(alloc, (size_t)st->N * st->k);
+  if (st->k < 1 || opts->r - (gmg ? sys->m : 0) < 1 || opts->r - (gmg ? sys->m : 0) > st->k) return PHGMG_ERR_SIZE;
+  /* V diag(S) for the modes the method uses and one more (info.pod_sigma_ratio):
+     a matrix whose POD is the stream's leading modes (the basis as snapshots) */
+  kk = PHGMG__MIN(st->k, opts->r - (gmg ? sys->m : 0) + 1);
+  Xe = phgmg__dalloc(alloc, (size_t)st->N * kk);
   if (!Xe) return PHGMG_ERR_NOMEM;
-  for (j = 0; j < st->k; ++j)
+  for (j = 0; j < kk; ++j)
     for (i = 0; i < st->N; ++i) Xe[i + (size_t)j * st->N] = st->V[i + (size_t)j * st->N] * st->S[j];
   o = *opts;
   o.nrun = 0; o.runs = NULL;
   memset(&o.cache, 0, sizeof o.cache);
-  rc = phgmg_reduce(out, sys, Xe, st->N, st->k, &o, info, alloc);
+  rc = phgmg_reduce(out, sys, Xe, st->N, kk, &o, info, alloc);
   phgmg__free(alloc, Xe);
   if (rc == PHGMG_OK) rc = phgmg__stream_envelope(*out, st, alloc);
   if (rc != PHGMG_OK) { phgmg_reduced_destroy(*out); *out = NULL; }
