@@ -523,6 +523,9 @@
                             collective solve callback: the user's KSP, MUMPS
                             or AMG): K, Qh, Bh of the serial phgmg_reduce
      phgmg_mpi_agree        one result for all ranks
+     phgmg_mpi_counts_*     this rank's collective calls and bytes, halo
+                            exchanges and bytes: read around a call for that
+                            phase's counts (independent of N)
    Why TSQR and not the Gram matrix X^T X (the method of snapshots): the
    Gram matrix squares the condition number, so singular values below
    sqrt(eps) sigma_1 ~ 1e-8 sigma_1 are lost and the basis of the modes near
@@ -1832,12 +1835,13 @@
            phgmg_mpi_pod_stream_end, phgmg_mpi_pod_stream_destroy,
            phgmg_mpi_deim_greedy, phgmg_mpi_op_create, phgmg_mpi_op_destroy,
            phgmg_mpi_op_info, phgmg_mpi_op_apply, phgmg_mpi_op_project,
-           phgmg_mpi_gmg_pod_linear, phgmg_mpi_ecsw, phgmg_mpi_cholqr
+           phgmg_mpi_gmg_pod_linear, phgmg_mpi_ecsw, phgmg_mpi_cholqr,
+           phgmg_mpi_counts_get, phgmg_mpi_counts_reset
    linalg: phgmg_gemm, phgmg_gemv, phgmg_lu_factor, phgmg_lu_solve,
            phgmg_lu_rcond, phgmg_norm1, phgmg_normf, phgmg_zlu_factor,
            phgmg_zlu_solve, phgmg_qr, phgmg_qrcp, phgmg_qr_form_q,
            phgmg_qr_apply, phgmg_lstsq, phgmg_svd, phgmg_sym_eig
-   (162 functions; 19 of them only with PHGMG_MPI; also the macros
+   (164 functions; 21 of them only with PHGMG_MPI; also the macros
    PHGMG_ROM_STEPPER_MEMSIZE_MAX and _MAX_CB.)
 */
 #ifndef PHGMG_H_INCLUDED
@@ -3977,7 +3981,23 @@ typedef struct phgmg_mpi_ctx {
   int nloc;             /* rows owned by this rank (may be 0)                      */
   phgmg_gidx *starts;   /* size + 1 offsets: rank q owns [starts[q], starts[q+1])  */
   phgmg_allocator al;   /* a copy of the allocator given (zero: malloc/free)       */
+  struct phgmg_mpi_counts *counts; /* this rank's communication counts (phgmg_mpi_counts_get) */
 } phgmg_mpi_ctx;
+
+/* Communication counts of this rank on a context, since its creation or the
+   last reset: the library's collective calls (reductions, broadcasts,
+   gathers, all-to-all, result agreements) and their payload in bytes on
+   this rank's side, and the neighbour (halo) exchanges of the distributed
+   operators with the bytes this rank sent. Read them around a call to get
+   that phase's counts (phgmg_mpi_pod, phgmg_mpi_gmg_pod_linear, ...); they
+   do not depend on N, only on the sizes of the small replicated
+   quantities (and the halo on the operator's pattern). Not collective. */
+typedef struct phgmg_mpi_counts {
+  long long collectives, bytes;          /* collective calls and their payload */
+  long long exchanges, exchange_bytes;   /* halo exchanges and the bytes sent  */
+} phgmg_mpi_counts;
+PHGMG_DEF void phgmg_mpi_counts_get(const phgmg_mpi_ctx *ctx, phgmg_mpi_counts *out);
+PHGMG_DEF void phgmg_mpi_counts_reset(const phgmg_mpi_ctx *ctx);
 
 /* Agree on a result: every rank passes its own rc and gets back the most
    negative of them (PHGMG_OK only if every rank passed PHGMG_OK). One
@@ -21669,8 +21689,24 @@ PHGMG_DEF phgmg_result phgmg_mpi_agree(MPI_Comm comm, phgmg_result rc) {
   return (phgmg_result)out;
 }
 
+/* One collective call of `bytes` payload counted on the context. */
+PHGMG__PRIV void phgmg__mpi_count(const phgmg_mpi_ctx *ctx, double bytes) {
+  if (ctx->counts) { ctx->counts->collectives++; ctx->counts->bytes += (long long)bytes; }
+}
+
+PHGMG_DEF void phgmg_mpi_counts_get(const phgmg_mpi_ctx *ctx, phgmg_mpi_counts *out) {
+  if (!out) return;
+  if (ctx && ctx->counts) *out = *ctx->counts;
+  else memset(out, 0, sizeof *out);
+}
+
+PHGMG_DEF void phgmg_mpi_counts_reset(const phgmg_mpi_ctx *ctx) {
+  if (ctx && ctx->counts) memset(ctx->counts, 0, sizeof *ctx->counts);
+}
+
 /* rc agreed over the context's ranks (ctx not NULL). */
 PHGMG__PRIV phgmg_result phgmg__mpi_agree(const phgmg_mpi_ctx *ctx, phgmg_result rc) {
+  phgmg__mpi_count(ctx, (double)sizeof(int));
   return phgmg_mpi_agree(ctx->comm, rc);
 }
 
@@ -21700,7 +21736,7 @@ PHGMG_DEF phgmg_result phgmg_mpi_ctx_create(phgmg_mpi_ctx **ctx, MPI_Comm comm, 
   if (!ctx) rc = PHGMG_ERR_INVALID_ARG;
   else if (N < 1 || nloc < 0 || row0 < 0 || row0 > N - nloc) rc = PHGMG_ERR_SIZE;
   if (rc == PHGMG_OK) {
-    c = PHGMG__CAST(phgmg_mpi_ctx *, phgmg__alloc(alloc, sizeof *c));
+    c = PHGMG__CAST(phgmg_mpi_ctx *, phgmg__alloc(alloc, sizeof *c + sizeof(phgmg_mpi_counts)));
     all = PHGMG__CAST(phgmg_gidx *, phgmg__alloc(alloc, (size_t)(3 * size + 1) * sizeof(phgmg_gidx)));
     if (!c || !all) rc = PHGMG_ERR_NOMEM;
   }
@@ -21723,6 +21759,8 @@ PHGMG_DEF phgmg_result phgmg_mpi_ctx_create(phgmg_mpi_ctx **ctx, MPI_Comm comm, 
   memset(c, 0, sizeof *c);
   MPI_Comm_dup(comm, &c->comm);
   c->rank = rank; c->size = size; c->N = N; c->row0 = row0; c->nloc = nloc;
+  c->counts = PHGMG__CAST(phgmg_mpi_counts *, PHGMG__CAST(void *, c + 1));   /* allocated with c */
+  memset(c->counts, 0, sizeof *c->counts);
   if (alloc) c->al = *alloc;
   for (q = 0; q < size; ++q) all[q] = all[3 * q];   /* compact into the offsets (q <= 3q) */
   all[size] = N;
@@ -21746,6 +21784,8 @@ PHGMG_DEF void phgmg_mpi_ctx_destroy(phgmg_mpi_ctx *ctx) {
 PHGMG__PRIV void phgmg__mpi_sum(const phgmg_mpi_ctx *ctx, int n, const double *in, double *out) {
   MPI_Reduce(in, out, n, MPI_DOUBLE, MPI_SUM, 0, ctx->comm);
   MPI_Bcast(out, n, MPI_DOUBLE, 0, ctx->comm);
+  phgmg__mpi_count(ctx, 8.0 * n);
+  phgmg__mpi_count(ctx, 8.0 * n);
 }
 
 PHGMG_DEF phgmg_result phgmg_mpi_atb(const phgmg_mpi_ctx *ctx, int ka, int kb, const double *A, int lda,
@@ -21787,6 +21827,7 @@ PHGMG__PRIV phgmg_result phgmg__mpi_tsqr_core(const phgmg_mpi_ctx *ctx, int ns, 
   rc = phgmg__mpi_agree(ctx, rc);
   if (rc != PHGMG_OK) return rc;
   MPI_Allgather(Rl, ns * ns, MPI_DOUBLE, Sg, ns * ns, MPI_DOUBLE, ctx->comm);
+  phgmg__mpi_count(ctx, 8.0 * ns * ns);
   for (q = 0; q < P; ++q)   /* stack the R factors: rows q ns .. q ns + ns - 1 */
     for (j = 0; j < ns; ++j)
       memcpy(S + (size_t)q * ns + (size_t)j * ms, Sg + (size_t)q * ns * ns + (size_t)j * ns, (size_t)ns * sizeof(double));
@@ -22098,6 +22139,7 @@ PHGMG__PRIV phgmg_gidx phgmg__mpi_argmax(const phgmg_mpi_ctx *ctx, const double 
   for (i = 0; i < ctx->nloc; ++i)
     if (fabs(r[i]) > loc.v) { loc.v = fabs(r[i]); loc.i = ctx->row0 + i; }
   MPI_Allreduce(&loc, &glob, 1, t, op, ctx->comm);
+  phgmg__mpi_count(ctx, (double)sizeof loc);
   *vmax = glob.v;
   return glob.i;
 }
@@ -22129,6 +22171,7 @@ PHGMG__PRIV phgmg_result phgmg__mpi_deim_point(const phgmg_mpi_ctx *ctx, int k, 
   if (owner == ctx->rank)
     for (a = 0; a < k; ++a) c[a] = U[(pts[l] - ctx->row0) + (size_t)a * ldu];
   MPI_Bcast(c, k, MPI_DOUBLE, owner, ctx->comm);
+  phgmg__mpi_count(ctx, 8.0 * k);
   for (a = 0; a < k; ++a) Pr[l + (size_t)a * k] = c[a];
   return PHGMG_OK;
 }
@@ -22260,11 +22303,14 @@ PHGMG__PRIV void phgmg__mpi_nnls_pick(const phgmg_mpi_ctx *ctx, phgmg__mpi_nnls 
   if (*none) return;
   owner = (lk >= 0 && gid[lk] == glob.i) ? ctx->rank : ctx->size;
   MPI_Allreduce(&owner, &lo, 1, MPI_INT, MPI_MIN, ctx->comm);
+  phgmg__mpi_count(ctx, (double)sizeof loc);
+  phgmg__mpi_count(ctx, (double)sizeof(int));
   if (ctx->rank == lo) {
     phgmg__mpi_ecsw_col(ns, r, F, ldf, Vt, ldvt, lk, s->G + (size_t)s->np * s->M);
     s->inP[lk] = 1;
   }
   MPI_Bcast(s->G + (size_t)s->np * s->M, s->M, MPI_DOUBLE, lo, ctx->comm);
+  phgmg__mpi_count(ctx, 8.0 * s->M);
   s->id[s->np] = glob.i;
   s->x[s->np] = 0.0;
   s->np++;
@@ -22295,6 +22341,7 @@ PHGMG__PRIV void phgmg__mpi_ecsw_target(const phgmg_mpi_ctx *ctx, phgmg__mpi_nnl
     for (i = 0; i < M; ++i) phgmg__dd_add(loc + i, loc + M + i, (sw ? sw[k] : 1.0) * s->z[i]);
   }
   MPI_Allgather(loc, 2 * M, MPI_DOUBLE, all, 2 * M, MPI_DOUBLE, ctx->comm);
+  phgmg__mpi_count(ctx, 16.0 * M);
   for (i = 0; i < M; ++i) {
     double hi = 0.0, lo = 0.0;
     for (q = 0; q < ctx->size; ++q) {
@@ -22486,11 +22533,13 @@ PHGMG__PRIV phgmg_result phgmg__mpi_op_plan(phgmg_mpi_op *op, const phgmg_gidx *
   for (q = 0; q < P; ++q) cr[q] = 0;
   for (h = 0; h < op->nhalo; ++h) cr[phgmg__mpi_owner(ctx, hg[h])]++;
   MPI_Alltoall(cr, 1, MPI_INT, cs, 1, MPI_INT, ctx->comm);
+  phgmg__mpi_count(ctx, (double)sizeof(int) * ctx->size);
   for (q = 0; q < P; ++q) { dr[q] = q ? dr[q - 1] + cr[q - 1] : 0; ds[q] = tot; tot += cs[q]; }
   sg = PHGMG__CAST(phgmg_gidx *, phgmg__alloc(al, (size_t)PHGMG__MAX(tot, 1) * sizeof(phgmg_gidx)));
   rc = phgmg__mpi_agree(ctx, sg ? PHGMG_OK : PHGMG_ERR_NOMEM);
   if (rc == PHGMG_OK) {
     MPI_Alltoallv(hg, cr, dr, MPI_LONG_LONG, sg, cs, ds, MPI_LONG_LONG, ctx->comm);
+    phgmg__mpi_count(ctx, 8.0 * (dr[ctx->size - 1] + cr[ctx->size - 1]));
     rc = phgmg__mpi_agree(ctx, phgmg__mpi_op_lists(op, cr, cs, sg));
   }
   phgmg__free(al, sg);
@@ -22545,8 +22594,10 @@ PHGMG__PRIV void phgmg__mpi_op_exchange(const phgmg_mpi_op *op, int k, const dou
     for (j = 0; j < k; ++j)
       for (i = 0; i < c; ++i) b[i + (size_t)j * c] = X[op->sidx[op->soff[q] + i] + (size_t)j * ldx];
     MPI_Isend(b, c * k, MPI_DOUBLE, op->srank[q], PHGMG__MPI_TAG, op->ctx->comm, req + op->nrecv + q);
+    if (op->ctx->counts) op->ctx->counts->exchange_bytes += 8LL * c * k;
   }
   MPI_Waitall(op->nrecv + op->nsend, req, MPI_STATUSES_IGNORE);
+  if (op->ctx->counts) op->ctx->counts->exchanges++;
   for (q = 0; q < op->nrecv; ++q) {
     const int c = op->roff[q + 1] - op->roff[q];
     const double *b = rb + (size_t)k * op->roff[q];

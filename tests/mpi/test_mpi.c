@@ -771,6 +771,47 @@ static void test_cholqr(void) {
   phgmg_mpi_ctx_destroy(c);
 }
 
+/* ---- communication counts ---------------------------------------------------- */
+/* The counts of a POD (TSQR) and of greedy DEIM on graded snapshots do not
+   depend on N (600 and 2400 rows, the same ns and k): the same number of
+   collectives and bytes; a POD makes some, and a fresh context none. */
+static void test_counts(void) {
+  const int ns = 20, kd = 8;
+  phgmg_mpi_counts cnt[2][2];
+  int pass;
+  for (pass = 0; pass < 2; ++pass) {
+    const int N = pass ? 2400 : 600;
+    double *X = (double *)malloc(sizeof(double) * N * ns), *U = (double *)malloc(sizeof(double) * N * ns), sig[20];
+    double *Xl, *V, S[20];
+    long long pts[8];
+    int k = 0, ld;
+    phgmg_mpi_ctx *c = make_ctx(N);
+    phgmg_mpi_counts z;
+    ld = c->nloc > 0 ? c->nloc : 1;
+    phgmg_mpi_counts_get(c, &z);
+    CHECK(z.collectives == 0 && z.bytes == 0 && z.exchanges == 0, "fresh context counts %lld", z.collectives);
+    rng_ = 99;
+    graded(N, ns, X, U, sig);
+    Xl = own_rows(c, ns, X);
+    V = (double *)malloc(sizeof(double) * ((size_t)ld * ns));
+    CHECK(phgmg_mpi_pod(c, ns, Xl, ld, kd, 0.0, V, ld, S, &k) == PHGMG_OK && k == kd, "pod for counts");
+    phgmg_mpi_counts_get(c, &cnt[pass][0]);
+    phgmg_mpi_counts_reset(c);
+    CHECK(phgmg_mpi_deim_greedy(c, kd, V, ld, NULL, pts, NULL) == PHGMG_OK, "deim for counts");
+    phgmg_mpi_counts_get(c, &cnt[pass][1]);
+    free(X); free(U); free(Xl); free(V);
+    phgmg_mpi_ctx_destroy(c);
+  }
+  CHECK(cnt[0][0].collectives > 0 && cnt[0][0].bytes >= 8LL * ns * ns && cnt[0][1].collectives >= kd, "counts made");
+  CHECK(cnt[0][0].collectives == cnt[1][0].collectives && cnt[0][0].bytes == cnt[1][0].bytes &&
+            cnt[0][1].collectives == cnt[1][1].collectives && cnt[0][1].bytes == cnt[1][1].bytes,
+        "counts depend on N: pod %lld/%lld, deim %lld/%lld", cnt[0][0].collectives, cnt[1][0].collectives,
+        cnt[0][1].collectives, cnt[1][1].collectives);
+  if (rank_ == 0)
+    printf("  counts: pod %lld collectives / %lld bytes, deim %lld / %lld (N = 600 and 2400 alike)\n",
+           cnt[0][0].collectives, cnt[0][0].bytes, cnt[0][1].collectives, cnt[0][1].bytes);
+}
+
 int main(int argc, char **argv) {
   int total = 0;
   double t0;
@@ -789,6 +830,7 @@ int main(int argc, char **argv) {
   test_errors();
   test_ecsw();
   test_cholqr();
+  test_counts();
   compare_runs(argc > 1 ? argv[1] : NULL);
   MPI_Allreduce(&fails_, &total, 1, MPI_INT, MPI_SUM, MPI_COMM_WORLD);
   if (rank_ == 0) printf("test_mpi: P = %d: %s (%d failed checks, %.2f s)\n", size_, total ? "FAILED" : "passed", total, MPI_Wtime() - t0);
