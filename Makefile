@@ -202,6 +202,7 @@ test-cli: $(BUILD)/phgmg $(BUILD)/phgmg-float
 	sh tests/test_cli.sh $(BUILD)/phgmg $(BUILD)/phgmg-float
 	sh tests/test_cli_defects4.sh $(BUILD)/phgmg $(BUILD)/phgmg-float
 	sh tests/test_simulate.sh $(BUILD)/phgmg
+	sh tests/test_stream.sh $(BUILD)/phgmg
 	sh tests/test_lib_msgs4.sh $(BUILD)/phgmg
 	sh tests/test_rom_dt.sh $(BUILD)/phgmg
 	sh tests/test_rom_dt.sh $(BUILD)/phgmg-float

@@ -571,6 +571,9 @@
      phgmg_mpi_tsqr         X = Q R: local Householder QR, the ranks' small
                             R factors gathered (one allgather of ns^2 doubles
                             each) and factored again on every rank
+     phgmg_mpi_cholqr       X = Q R by shifted Cholesky-QR (two shifted and
+                            two plain steps, one reduction of ns^2 each): the
+                            alternative to TSQR with less communication
      phgmg_mpi_pod          POD by TSQR and the SVD of R; values identical
                             on every rank, V this rank's rows
      phgmg_mpi_pod_stream_* the same from column batches (incremental SVD at
@@ -578,6 +581,13 @@
                             snapshot matrix never exists, on one rank too
      phgmg_mpi_deim_greedy  greedy DEIM points as global indices, ties to the
                             lower global index: the same for every partition
+     phgmg_mpi_ecsw         ECSW of a separable sum whose terms are spread
+                            over the ranks: Lawson-Hanson with one maximum
+                            reduction (ties to the lower global index) and one
+                            broadcast of a column per point, the small least
+                            squares replicated; the target summed in
+                            double-double, so points and weights are the same
+                            for every partition
      phgmg_mpi_op_*         a row-distributed CSR operator: the halo exchange
                             plan built once, A X, V^T A V (replicated)
      phgmg_mpi_atb          A^T B of two row-distributed blocks (replicated)
@@ -586,6 +596,9 @@
                             collective solve callback: the user's KSP, MUMPS
                             or AMG): K, Qh, Bh of the serial phgmg_reduce
      phgmg_mpi_agree        one result for all ranks
+     phgmg_mpi_counts_*     this rank's collective calls and bytes, halo
+                            exchanges and bytes: read around a call for that
+                            phase's counts (independent of N)
    Why TSQR and not the Gram matrix X^T X (the method of snapshots): the
    Gram matrix squares the condition number, so singular values below
    sqrt(eps) sigma_1 ~ 1e-8 sigma_1 are lost and the basis of the modes near
@@ -686,6 +699,34 @@
    when it is passive). Not yet: index-one E (zero rows/columns:
    PHGMG_ERR_UNSUPPORTED), feedthrough, nonlinear parts. Algorithms and
    measured times: 8.13.
+
+   2.9 Snapshot sets larger than memory (>>pod, >>reduce; no MPI needed).
+   phgmg_pod_stream_begin / _add / _end take the snapshots a block of
+   columns at a time (from a time stepper, or read from a file in blocks)
+   and keep only an incremental SVD at a fixed rank (Brand's update, each
+   block's residual re-orthogonalised against the basis and B), with the
+   error split stated: the result is the exact POD of a matrix within
+   `discarded` (the sum over the updates of the norms of what each
+   truncation cut) of the snapshot matrix, so the N x ns matrix never
+   exists. Begun with B, the stream PODs the adjusted snapshots X - B B^+ X
+   of GMG and keeps their B coordinates. phgmg_reduce_stream then builds the
+   model from the stream alone -- GMG-POD and SP1 need only the basis and the
+   snapshots' coordinates in it (for the training envelope): the same model
+   as phgmg_reduce on the snapshots when the stream kept their numerical
+   rank, and within the stated bound otherwise. Not from a stream: GMG-QM and
+   SP2 (they fit or POD functions of the snapshots themselves), a
+   hyper-reduced separable part (its gradient snapshots), opts.ref = MEAN,
+   dampers and E. Memory: N (kmax + m) for the stream plus the block being
+   added (N (2 nb + ...) during an add). The command line streams
+   `reduce --simulate` and `--X FILE` (read in column blocks) with --stream,
+   and by default when the snapshots would not fit its 4 GiB limit.
+
+       phgmg_pod_stream *st;
+       phgmg_pod_stream_begin(&st, N, m, sys.B, N, 2 * (r - m) + 2, 0.0, NULL);
+       for (each block Xb of nb states) phgmg_pod_stream_add(st, nb, Xb, N);
+       opts.method = PHGMG_METHOD_GMG_POD; opts.r = r;
+       phgmg_reduce_stream(&red, &sys, st, &opts, &info, NULL);
+       phgmg_pod_stream_destroy(st);
 
    3. METHODS AND OPTIONS -------------------------------------------------------
    Every option struct is "zero means default": memset it to 0 and set what you
@@ -1933,6 +1974,8 @@
            phgmg_reduced_restrict, phgmg_reduced_dphi, phgmg_reduced_W,
            phgmg_reduced_simulate, phgmg_reduced_simulate_run,
            phgmg_reduced_validate, phgmg_reduced_validate_many, phgmg_rel_error,
+           phgmg_pod_stream_begin, phgmg_pod_stream_add, phgmg_pod_stream_end,
+           phgmg_pod_stream_columns, phgmg_pod_stream_destroy, phgmg_reduce_stream,
            phgmg_err_red, phgmg_err_proj, phgmg_err_lowerbound,
            phgmg_err_energy, phgmg_study_create, phgmg_study_destroy,
            phgmg_study_basis, phgmg_study_reduce, phgmg_study_errors,
@@ -1950,7 +1993,7 @@
    export: phgmg_rom_serialized_size, phgmg_rom_serialize,
            phgmg_rom_deserialize_size, phgmg_rom_deserialize, phgmg_rom_save,
            phgmg_rom_load, phgmg_rom_export_c
-   npy:    phgmg_npy_parse, phgmg_npy_serialize, phgmg_npy_free,
+   npy:    phgmg_npy_parse, phgmg_npy_serialize, phgmg_npy_free, phgmg_npy_read_cols,
            phgmg_npy_read, phgmg_npy_write
    mpi:    (with PHGMG_MPI) phgmg_mpi_agree, phgmg_mpi_ctx_create,
            phgmg_mpi_ctx_destroy, phgmg_mpi_atb, phgmg_mpi_tsqr, phgmg_mpi_pod,
@@ -1958,12 +2001,13 @@
            phgmg_mpi_pod_stream_end, phgmg_mpi_pod_stream_destroy,
            phgmg_mpi_deim_greedy, phgmg_mpi_op_create, phgmg_mpi_op_destroy,
            phgmg_mpi_op_info, phgmg_mpi_op_apply, phgmg_mpi_op_project,
-           phgmg_mpi_gmg_pod_linear
+           phgmg_mpi_gmg_pod_linear, phgmg_mpi_ecsw, phgmg_mpi_cholqr,
+           phgmg_mpi_counts_get, phgmg_mpi_counts_reset
    linalg: phgmg_gemm, phgmg_gemv, phgmg_lu_factor, phgmg_lu_solve,
            phgmg_lu_rcond, phgmg_norm1, phgmg_normf, phgmg_zlu_factor,
            phgmg_zlu_solve, phgmg_qr, phgmg_qrcp, phgmg_qr_form_q,
            phgmg_qr_apply, phgmg_lstsq, phgmg_svd, phgmg_sym_eig
-   (156 functions; 17 of them only with PHGMG_MPI; also the macros
+   (170 functions; 21 of them only with PHGMG_MPI; also the macros
    PHGMG_ROM_STEPPER_MEMSIZE_MAX and _MAX_CB.)
 */
 #ifndef PHGMG_H_INCLUDED
@@ -2978,6 +3022,55 @@ PHGMG_DEF phgmg_result phgmg_pod_hierarchical(int N, int m, const double *B, int
                                               int ldx, int p, int rn, double *V1, double *V2,
                                               const phgmg_allocator *alloc);
 
+/* Streaming POD (manual 2.9): the POD of snapshots that arrive in column
+   blocks, so the N x ns snapshot matrix never exists -- a time stepper
+   feeds its states as it makes them, a file is read a block at a time.
+   An incremental SVD (Brand 2006) kept at rank kmax: with the basis V
+   (N x k, orthonormal) and values S so far, a block Xb (N x nb) is split
+   into C = V^T Xb and the residual Xb - V C (twice, for orthogonality),
+   the residual is factored Qb Rb by Householder QR (in chunks of 4096 rows),
+   the small matrix [[diag(S), C], [0, Rb]] ((k + nb) square) is decomposed
+   and V, S are rotated and truncated to the kmax leading modes (and to
+   sigma_j > tol sigma_1 with tol > 0; values below the SVD's numerical
+   rank count as zero). Deflation: with B (N x m, m >= 1, full column rank)
+   every block is first adjusted, Xb - QB QB^T Xb with B = QB RB (the
+   adjusted snapshots of GMG, as phgmg_adjust_snapshots), and its
+   coordinates QB^T Xb are kept; m = 0 (B NULL): the snapshots as given
+   (SP1). The stream also keeps the coordinates Z = V^T (adjusted
+   snapshots) of every column seen (k x ns, updated by the same rotations):
+   what phgmg_reduce_stream needs besides the basis.
+   Error split: with no truncation (kmax at least the numerical rank of
+   the columns seen) the result is the POD of all the columns, to rounding
+   (values at or below max(N, ns) eps ||X||_F count as zero, as in
+   phgmg_reduce). Each truncation drops the values it cuts; the final V, S and Z are
+   exactly the POD and coordinates of a matrix within `discarded` = the sum
+   over the updates of sqrt(sum of the squares of the values dropped) of
+   the true (adjusted) snapshot matrix in the Frobenius norm, so by Weyl
+   each singular value is off by at most that bound. Keep kmax a few modes
+   above the modes you use (phgmg_reduce_stream uses r - m (GMG) or r
+   (SP1) of them; the command line keeps twice as many plus one).
+   Cost per block of nb columns: about N (4 k nb + 4 nb^2 + 2 (k + nb) k)
+   multiply-adds; memory: N (kmax + m) doubles for V and B's factor, N
+   (2 nb + kmax) more during an add, and (kmax + m) ns for the coordinates.
+   begin: *st (NULL on failure); PHGMG_ERR_INVALID_ARG (NULL st, B NULL with
+   m > 0, tol NaN or outside [0, 1)), _SIZE (N < 1, m < 0, kmax < 1, kmax +
+   m > N, ldb < N), _RANK (B rank deficient), _NOMEM. add: nb >= 1 columns
+   Xb (ldx >= N); a block with NaN/Inf is refused whole (PHGMG_ERR_NANINF,
+   the stream unchanged); _SIZE, _NOMEM. end: V (N x k, ldv >= N; may be
+   NULL), S (k, may be NULL), *k_out = k (0 before any column),
+   *discarded (may be NULL) the bound above; the stream stays valid (add
+   more, end again). */
+typedef struct phgmg_pod_stream phgmg_pod_stream;
+PHGMG_DEF phgmg_result phgmg_pod_stream_begin(phgmg_pod_stream **st, int N, int m, const double *B, int ldb,
+                                              int kmax, double tol, const phgmg_allocator *alloc);
+PHGMG_DEF phgmg_result phgmg_pod_stream_add(phgmg_pod_stream *st, int nb, const double *Xb, int ldx);
+PHGMG_DEF phgmg_result phgmg_pod_stream_end(const phgmg_pod_stream *st, double *V, int ldv, double *S, int *k_out,
+                                            double *discarded);
+/* Columns added so far (0 for NULL). */
+PHGMG_DEF int phgmg_pod_stream_columns(const phgmg_pod_stream *st);
+/* NULL is a no-op. */
+PHGMG_DEF void phgmg_pod_stream_destroy(phgmg_pod_stream *st);
+
 /* >>hyper ================================================================= */
 /* Hyper-reduction: points and weights that stand for a separable sum of
    terms (DEIM, ECSW) and the solvers behind them. */
@@ -3327,6 +3420,24 @@ typedef struct phgmg_reduced phgmg_reduced;
 PHGMG_DEF phgmg_result phgmg_reduce(phgmg_reduced **out, const phgmg_ph_system *sys, const double *X,
                                     int ldx, int ns, const phgmg_reduce_opts *opts,
                                     phgmg_reduce_info *info, const phgmg_allocator *alloc);
+/* phgmg_reduce from a streaming POD (phgmg_pod_stream_*, manual 2.9): the
+   reduced model of all the columns streamed, for the methods whose model
+   depends on the snapshots only through their POD basis and the
+   coordinates the stream keeps -- GMG-POD (stream begun with the model's
+   B, the same N x m values) and SP1 (stream begun without B) -- of a model
+   without dampers or mass matrix E, with opts.ref = PHGMG_REF_NONE and no
+   hyper-reduced separable part (a separable part with hyper.on = 0 keeps
+   every term and is fine). The basis: the r - m (GMG) or r (SP1) leading
+   modes of the stream; the checks and info as phgmg_reduce (its
+   pod_sigma_ratio from the stream's values); the training envelope from
+   the stream's coordinates. opts.runs and opts.cache are ignored (there
+   are no snapshots to simulate from). The stream is not changed. Errors:
+   PHGMG_ERR_UNSUPPORTED (another method or a model or option above),
+   PHGMG_ERR_INVALID_ARG (NULL, the stream's B not the model's), _SIZE (r
+   above the modes the stream holds), and phgmg_reduce's codes. */
+PHGMG_DEF phgmg_result phgmg_reduce_stream(phgmg_reduced **out, const phgmg_ph_system *sys,
+                                           const phgmg_pod_stream *st, const phgmg_reduce_opts *opts,
+                                           phgmg_reduce_info *info, const phgmg_allocator *alloc);
 PHGMG_DEF void phgmg_reduced_destroy(phgmg_reduced *red);
 /* The online model (views into the reduced object; valid until destroy). */
 PHGMG_DEF const phgmg_rom *phgmg_reduced_rom(const phgmg_reduced *red);
@@ -4096,6 +4207,17 @@ PHGMG_DEF void phgmg_npy_free(double *p, const phgmg_allocator *alloc);
 PHGMG_DEF phgmg_result phgmg_npy_read(const char *path, double **out, int *rows, int *cols,
                                       int *ndim, const phgmg_allocator *alloc);
 
+/* Columns j0 .. j0 + nb - 1 of the .npy file path into out (rows x nb, ldo
+   >= rows), read and converted as phgmg_npy_read does, without reading the
+   rest of the data: a snapshot file larger than memory a block at a time
+   (Fortran order: one contiguous read per column; C order: nb values from
+   each row). *rows, *cols (each may be NULL) receive the file's shape; with
+   out NULL or nb = 0 only the shape is read. Errors: PHGMG_ERR_INVALID_ARG
+   (NULL path), _IO, _FORMAT (also a file shorter than its header says),
+   _DTYPE, _INEXACT, _SIZE (columns beyond the file, ldo < rows), _NOMEM. */
+PHGMG_DEF phgmg_result phgmg_npy_read_cols(const char *path, int j0, int nb, double *out, int ldo, int *rows,
+                                           int *cols);
+
 /* Write A (as phgmg_npy_serialize) to the file path, streaming, without
    allocating. Errors as phgmg_npy_serialize (except WORKSPACE), plus
    PHGMG_ERR_IO. After a write error a file this call created is removed; an
@@ -4149,7 +4271,23 @@ typedef struct phgmg_mpi_ctx {
   int nloc;             /* rows owned by this rank (may be 0)                      */
   phgmg_gidx *starts;   /* size + 1 offsets: rank q owns [starts[q], starts[q+1])  */
   phgmg_allocator al;   /* a copy of the allocator given (zero: malloc/free)       */
+  struct phgmg_mpi_counts *counts; /* this rank's communication counts (phgmg_mpi_counts_get) */
 } phgmg_mpi_ctx;
+
+/* Communication counts of this rank on a context, since its creation or the
+   last reset: the library's collective calls (reductions, broadcasts,
+   gathers, all-to-all, result agreements) and their payload in bytes on
+   this rank's side, and the neighbour (halo) exchanges of the distributed
+   operators with the bytes this rank sent. Read them around a call to get
+   that phase's counts (phgmg_mpi_pod, phgmg_mpi_gmg_pod_linear, ...); they
+   do not depend on N, only on the sizes of the small replicated
+   quantities (and the halo on the operator's pattern). Not collective. */
+typedef struct phgmg_mpi_counts {
+  long long collectives, bytes;          /* collective calls and their payload */
+  long long exchanges, exchange_bytes;   /* halo exchanges and the bytes sent  */
+} phgmg_mpi_counts;
+PHGMG_DEF void phgmg_mpi_counts_get(const phgmg_mpi_ctx *ctx, phgmg_mpi_counts *out);
+PHGMG_DEF void phgmg_mpi_counts_reset(const phgmg_mpi_ctx *ctx);
 
 /* Agree on a result: every rank passes its own rc and gets back the most
    negative of them (PHGMG_OK only if every rank passed PHGMG_OK). One
@@ -4192,6 +4330,20 @@ PHGMG_DEF phgmg_result phgmg_mpi_atb(const phgmg_mpi_ctx *ctx, int ka, int kb, c
    (2 size + 3 + nloc / 4096) ns^2 doubles. */
 PHGMG_DEF phgmg_result phgmg_mpi_tsqr(const phgmg_mpi_ctx *ctx, int ns, const double *X, int ldx, double *Q,
                                       int ldq, double *R, int ldr);
+
+/* Shifted Cholesky-QR, the alternative to phgmg_mpi_tsqr (Fukaya,
+   Kannan, Nakatsukasa, Yamamoto and Yanagisawa 2020): X = Q R by two
+   shifted steps then two plain ones, each step G = Q^T Q (phgmg_mpi_atb:
+   one reduction of ns^2 doubles to rank 0 and a broadcast, instead of
+   TSQR's allgather of P ns^2), G + s I = L L^T (s = 11 (N ns + ns (ns + 1))
+   eps trace G on the shifted steps, 0 after), Q <- Q L^-T, R <- L^T R. Stable
+   for cond(X) up to about 1/eps (the shift makes the first Cholesky
+   succeed, the later steps restore orthogonality); PHGMG_ERR_RANK (every
+   rank) if a factorization still fails. Q (nloc x ns, ldq) this rank's
+   rows; R (ns x ns, ldr) upper triangular with positive diagonal,
+   identical on every rank. Memory: 3 ns^2 doubles besides Q. Collective. */
+PHGMG_DEF phgmg_result phgmg_mpi_cholqr(const phgmg_mpi_ctx *ctx, int ns, const double *X, int ldx, double *Q,
+                                        int ldq, double *R, int ldr);
 
 /* Distributed POD: the leading left singular vectors of the row-distributed
    X (nloc x ns per rank), as phgmg_pod: kmax modes, or with tol > 0 only
@@ -4244,6 +4396,32 @@ PHGMG_DEF void phgmg_mpi_pod_stream_destroy(phgmg_mpi_pod_stream *st);
    singular (U rank deficient), PHGMG_ERR_SIZE if k > N. */
 PHGMG_DEF phgmg_result phgmg_mpi_deim_greedy(const phgmg_mpi_ctx *ctx, int k, const double *U, int ldu,
                                              const double *sw, phgmg_gidx *pts, double *w);
+
+/* Distributed ECSW (the problem of phgmg_ecsw_separable, manual 2.7): the
+   terms of a separable sum distributed over the ranks, each rank passing
+   its nt terms (nt = 0 allowed): F (nt x ns, ldf) = phi_k'(l_k(x_i)), Vt
+   (nt x r, ldvt) row k = d l_k / d xr (e.g. V's row idx_k), sw (nt; NULL:
+   1) the terms' weights, gid (nt) their global indices (distinct over all
+   ranks). Finds w >= 0 with ||sum_k (w_k - sw_k) F[k,:]^T Vt[k,:]||_F <= tol
+   ||sum_k sw_k F[k,:]^T Vt[k,:]||_F by Lawson-Hanson on the full ns r
+   training rows: per iteration each rank computes the gradient of its own
+   terms, one maximum reduction picks the term (ties to the lower global
+   index, so the point set does not depend on the partition) and its owner
+   broadcasts the term's training column (ns r doubles); the passive-set
+   least squares (ns r x nd) are small and solved alike on every rank. The
+   target is summed in double-double (each rank's partial sums gathered and
+   added in rank order), so it, the gradients and the least squares are the
+   same for every partition, and so are the points and weights. Outputs,
+   identical on every rank: pts (room for max_pts) the kept terms' global
+   indices ascending, w their weights (> 0), *nd_out, *resid_out (may be
+   NULL) the relative residual. tol: as phgmg_ecsw (0: 1e-6; NaN, < 0 or
+   >= 1: PHGMG_ERR_INVALID_ARG). PHGMG_ERR_NOT_CONVERGED (every rank) when
+   max_pts points or no improving term leave tol unmet: the outputs hold the
+   best found. Collective. */
+PHGMG_DEF phgmg_result phgmg_mpi_ecsw(const phgmg_mpi_ctx *ctx, int nt, int ns, const double *F, int ldf, int r,
+                                      const double *Vt, int ldvt, const double *sw, const phgmg_gidx *gid,
+                                      double tol, int max_pts, phgmg_gidx *pts, double *w, int *nd_out,
+                                      double *resid_out);
 
 /* A row-distributed sparse operator: this rank's rows of a global N x N
    matrix as CSR (rowptr: nloc + 1 entries from 0, col: global column
@@ -13850,6 +14028,290 @@ PHGMG_DEF phgmg_result phgmg_pod_hierarchical(int N, int m, const double *B, int
   return rc;
 }
 
+/* Local QR of X (n x ns, n >= 1) into W (n x ns, ld n: the explicit Q in
+   the first kq = min(n, ns) columns) and Rl (ns x ns, ld ns, zero below the
+   diagonal and below row kq). Tall blocks go by a flat tree: chunks of
+   about PHGMG__QR_CHUNK rows (at least ns) factored each in cache, their
+   R factors stacked and factored again, each chunk's Q times its block of
+   the second Q (the unblocked Householder QR of the whole block would
+   stream it from memory once per column). */
+#define PHGMG__QR_CHUNK 4096
+PHGMG__PRIV phgmg_result phgmg__chunked_qr(int n, int ns, const double *X, int ldx, double *W, double *Rl,
+                                             const phgmg_allocator *al) {
+  const int nc = n / PHGMG__MAX(PHGMG__QR_CHUNK, ns), kq = PHGMG__MIN(n, ns), ms = PHGMG__MAX(nc, 1) * ns;
+  const int cmax = n / PHGMG__MAX(nc, 1) + 1;
+  double *S2 = phgmg__dalloc(al, (size_t)ms * ns + 2 * (size_t)ns + (nc > 1 ? (size_t)cmax * ns : 0));
+  double *tau, *work, *T;
+  int i, j, c;
+  phgmg_result rc = S2 ? PHGMG_OK : PHGMG_ERR_NOMEM;
+  if (rc != PHGMG_OK) return rc;
+  tau = S2 + (size_t)ms * ns; work = tau + ns; T = work + ns;
+  for (j = 0; j < ns; ++j) memcpy(W + (size_t)j * n, X + (size_t)j * ldx, (size_t)n * sizeof(double));
+  memset(Rl, 0, (size_t)ns * ns * sizeof(double));
+  if (nc <= 1) {
+    rc = phgmg_qr(n, ns, W, n, tau);
+    for (j = 0; j < ns && rc == PHGMG_OK; ++j)
+      for (i = 0; i <= j && i < kq; ++i) Rl[i + (size_t)j * ns] = W[i + (size_t)j * n];
+    if (rc == PHGMG_OK) phgmg_qr_form_q(n, kq, W, n, tau, work);
+    phgmg__free(al, S2);
+    return rc;
+  }
+  memset(S2, 0, (size_t)ms * ns * sizeof(double));
+  for (c = 0; c < nc && rc == PHGMG_OK; ++c) {   /* chunk c: rows r0 .. r0 + nb - 1 (nb >= ns) */
+    const int r0 = (int)((long long)n * c / nc), nb = (int)((long long)n * (c + 1) / nc) - r0;
+    rc = phgmg_qr(nb, ns, W + r0, n, tau);
+    for (j = 0; j < ns && rc == PHGMG_OK; ++j)
+      for (i = 0; i <= j; ++i) S2[c * ns + i + (size_t)j * ms] = W[r0 + i + (size_t)j * n];
+    if (rc == PHGMG_OK) phgmg_qr_form_q(nb, ns, W + r0, n, tau, work);
+  }
+  if (rc == PHGMG_OK) rc = phgmg_qr(ms, ns, S2, ms, tau);
+  if (rc == PHGMG_OK) {
+    for (j = 0; j < ns; ++j)
+      for (i = 0; i <= j; ++i) Rl[i + (size_t)j * ns] = S2[i + (size_t)j * ms];
+    phgmg_qr_form_q(ms, ns, S2, ms, tau, work);
+    for (c = 0; c < nc; ++c) {
+      const int r0 = (int)((long long)n * c / nc), nb = (int)((long long)n * (c + 1) / nc) - r0;
+      phgmg_gemm('N', 'N', nb, ns, ns, 1.0, W + r0, n, S2 + (size_t)c * ns, ms, 0.0, T, nb);
+      for (j = 0; j < ns; ++j) memcpy(W + r0 + (size_t)j * n, T + (size_t)j * nb, (size_t)nb * sizeof(double));
+    }
+  }
+  phgmg__free(al, S2);
+  return rc;
+}
+
+/* ---- streaming POD (manual 2.9) ------------------------------------------ */
+struct phgmg_pod_stream {
+  int N, m, kmax, k, ns, cap;
+  double tol, discarded, fro2; /* fro2: squared Frobenius norm of the columns seen */
+  double *B, *QB, *RB; /* N x m copy of B, its thin QR                     */
+  double *V, *S;       /* N x kmax basis, kmax values                        */
+  double *Z, *A;       /* kmax x cap coordinates V^T Xa; m x cap: QB^T X     */
+  phgmg_allocator al;  /* a copy of the allocator (zero: malloc/free)        */
+};
+
+PHGMG_DEF void phgmg_pod_stream_destroy(phgmg_pod_stream *st) {
+  phgmg_allocator al;
+  if (!st) return;
+  al = st->al;
+  phgmg__free(&al, st->B);
+  phgmg__free(&al, st->V);
+  phgmg__free(&al, st->Z);
+  phgmg__free(&al, st);
+}
+
+PHGMG_DEF phgmg_result phgmg_pod_stream_begin(phgmg_pod_stream **st, int N, int m, const double *B, int ldb,
+                                              int kmax, double tol, const phgmg_allocator *alloc) {
+  phgmg_pod_stream *s;
+  phgmg_result rc = PHGMG_OK;
+  int j;
+  if (!st) return PHGMG_ERR_INVALID_ARG;
+  *st = NULL;
+  if (tol != tol || tol < 0.0 || tol >= 1.0 || (m > 0 && !B)) return PHGMG_ERR_INVALID_ARG;
+  if (N < 1 || m < 0 || kmax < 1 || kmax > N - m || (m > 0 && ldb < N)) return PHGMG_ERR_SIZE;
+  s = PHGMG__CAST(phgmg_pod_stream *, phgmg__alloc(alloc, sizeof *s));
+  if (!s) return PHGMG_ERR_NOMEM;
+  memset(s, 0, sizeof *s);
+  if (alloc) s->al = *alloc;
+  s->N = N; s->m = m; s->kmax = kmax; s->tol = tol;
+  s->V = phgmg__dalloc(&s->al, (size_t)N * kmax + (size_t)kmax);
+  if (m > 0) s->B = phgmg__dalloc(&s->al, 2 * (size_t)N * m + (size_t)m * m);
+  if (!s->V || (m > 0 && !s->B)) rc = PHGMG_ERR_NOMEM;
+  if (rc == PHGMG_OK) {
+    s->S = s->V + (size_t)N * kmax;
+    if (m > 0) {
+      s->QB = s->B + (size_t)N * m; s->RB = s->QB + (size_t)N * m;
+      for (j = 0; j < m; ++j) memcpy(s->B + (size_t)j * N, B + (size_t)j * ldb, (size_t)N * sizeof(double));
+      if (!phgmg__all_finite(s->B, (size_t)N * m)) rc = PHGMG_ERR_NANINF;
+      else rc = phgmg__thin_qr(N, m, s->B, s->QB, s->RB, &s->al);
+    }
+  }
+  if (rc != PHGMG_OK) { phgmg_pod_stream_destroy(s); return rc; }
+  *st = s;
+  return PHGMG_OK;
+}
+
+/* Room for ncol columns of coordinates (Z: kmax rows, A: m rows). */
+PHGMG__PRIV phgmg_result phgmg__pod_stream_grow(phgmg_pod_stream *s, int ncol) {
+  const size_t rows = (size_t)s->kmax + (size_t)s->m;
+  double *Zn;
+  int cap = s->cap;
+  if (ncol <= cap) return PHGMG_OK;
+  while (cap < ncol) cap = cap < 64 ? 64 : (cap > (int)(~0u >> 2) ? ncol : 2 * cap);
+  Zn = phgmg__dalloc(&s->al, rows * cap);
+  if (!Zn) return PHGMG_ERR_NOMEM;
+  if (s->ns > 0) {
+    memcpy(Zn, s->Z, (size_t)s->kmax * s->ns * sizeof(double));
+    if (s->m > 0) memcpy(Zn + (size_t)s->kmax * cap, s->A, (size_t)s->m * s->ns * sizeof(double));
+  }
+  phgmg__free(&s->al, s->Z);
+  s->Z = Zn;
+  s->A = Zn + (size_t)s->kmax * cap;
+  s->cap = cap;
+  return PHGMG_OK;
+}
+
+/* Res (N x nb) adjusted by B (its coordinates into A's new columns), then
+   projected off V twice; Cs (k x nb) = the sum of both coefficient blocks,
+   Ct: k x nb scratch. */
+PHGMG__PRIV void phgmg__pod_stream_project(phgmg_pod_stream *s, int nb, double *Res, double *Cs, double *Ct) {
+  const int N = s->N, k = s->k, m = s->m;
+  int pass, i;
+  if (m > 0) {
+    double *Ab = s->A + (size_t)m * s->ns;
+    phgmg_gemm('T', 'N', m, nb, N, 1.0, s->QB, N, Res, N, 0.0, Ab, m);
+    phgmg_gemm('N', 'N', N, nb, m, -1.0, s->QB, N, Ab, m, 1.0, Res, N);
+  }
+  if (k > 0) memset(Cs, 0, (size_t)k * nb * sizeof(double));
+  for (pass = 0; pass < 1 && k > 0; ++pass) {
+    phgmg_gemm('T', 'N', k, nb, N, 1.0, s->V, N, Res, N, 0.0, Ct, k);
+    phgmg_gemm('N', 'N', N, nb, k, -1.0, s->V, N, Ct, k, 1.0, Res, N);
+    for (i = 0; i < k * nb; ++i) Cs[i] += Ct[i];
+  }
+}
+
+/* The update from the SVD of M = [[diag(S), C], [0, Rb]] (K2 = k + nb
+   square): V <- [V, Qb] Um(:, 0:kn), Z <- Um(:, 0:kn)^T [[Z, C], [0, Rb]],
+   truncated to kmax, the numerical rank and tol. w: K2 + 2 K2^2 + 4096 kmax +
+   K2 (ns + nb) doubles. */
+PHGMG__PRIV phgmg_result phgmg__pod_stream_update(phgmg_pod_stream *s, int nb, const double *M, const double *Qb,
+                                                  double *w) {
+  const int N = s->N, k = s->k, K2 = k + nb, nt = s->ns + nb;
+  double *sv = w, *Um = sv + K2, *Vn = Um + (size_t)K2 * K2, *Zf = Vn + (size_t)PHGMG__QR_CHUNK * s->kmax, drop = 0.0;
+  int kk = 0, rank = 0, kn, i, j;
+  phgmg_result rc = phgmg_svd(K2, K2, M, K2, K2, sv, Um, K2, NULL, 1, &kk, &rank, &s->al);
+  if (rc != PHGMG_OK) return rc;
+  kn = PHGMG__MIN(kk, s->kmax);
+  for (i = 0; i < kn; ++i)   /* the rounding floor of the columns seen (as phgmg_reduce's), and tol */
+    if (!(sv[i] > (double)PHGMG__MAX(N, nt) * PHGMG__EPS * sqrt(s->fro2)) || !(sv[i] > s->tol * sv[0])) { kn = i; break; }
+  for (i = kn; i < kk; ++i) drop += sv[i] * sv[i];
+  s->discarded += sqrt(drop);
+  if (kn > 0) {
+    for (i = 0; i < N; i += PHGMG__QR_CHUNK) {   /* by row chunks, in place: V's rows i .. i + nr - 1 */
+      const int nr = PHGMG__MIN(PHGMG__QR_CHUNK, N - i);
+      if (k > 0) phgmg_gemm('N', 'N', nr, kn, k, 1.0, s->V + i, N, Um, K2, 0.0, Vn, nr);
+      phgmg_gemm('N', 'N', nr, kn, nb, 1.0, Qb + i, N, Um + k, K2, k > 0 ? 1.0 : 0.0, Vn, nr);
+      for (j = 0; j < kn; ++j) memcpy(s->V + i + (size_t)j * N, Vn + (size_t)j * nr, (size_t)nr * sizeof(double));
+    }
+    /* Zf = [[Z, C], [0, Rb]] (K2 x nt, the C and Rb block taken from M) */
+    memset(Zf, 0, (size_t)K2 * nt * sizeof(double));
+    for (j = 0; j < s->ns; ++j) memcpy(Zf + (size_t)j * K2, s->Z + (size_t)j * s->kmax, (size_t)k * sizeof(double));
+    for (j = 0; j < nb; ++j) memcpy(Zf + (size_t)(s->ns + j) * K2, M + (size_t)(k + j) * K2, (size_t)K2 * sizeof(double));
+    phgmg_gemm('T', 'N', kn, nt, K2, 1.0, Um, K2, Zf, K2, 0.0, s->Z, s->kmax);
+  }
+  for (i = 0; i < kn; ++i) s->S[i] = sv[i];
+  s->k = kn;
+  s->ns = nt;
+  return PHGMG_OK;
+}
+
+/* The residual's orthonormal factor W (N x nb; Res = W Rb) made orthogonal
+   to QB and V to working precision whatever the residual's size (a
+   residual at the rounding level gives a W that is not): W -= [QB, V] E
+   twice, then W = W2 R2 by QR; Rb <- R2 Rb, C += E_V Rb, the B coordinates
+   += E_B Rb. Res: N x nb scratch (receives W2 before the copy back), Ct: k
+   x nb scratch. */
+PHGMG__PRIV phgmg_result phgmg__pod_stream_reorth(phgmg_pod_stream *s, int nb, double *W, double *Res, double *Rb,
+                                                  double *Cs, double *Ct) {
+  const int N = s->N, k = s->k, m = s->m;
+  double *E = phgmg__dalloc(&s->al, (size_t)(k + m) * nb * 2 + (size_t)nb * nb * 2);
+  double *Et, *R2, *T;
+  phgmg_result rc;
+  int pass, i, j, l;
+  if (!E) return PHGMG_ERR_NOMEM;
+  Et = E + (size_t)(k + m) * nb; R2 = Et + (size_t)(k + m) * nb; T = R2 + (size_t)nb * nb;
+  memset(E, 0, (size_t)(k + m) * nb * sizeof(double));
+  for (pass = 0; pass < 2; ++pass) {   /* E (k + m) x nb: rows 0..k-1 for V, k.. for QB */
+    if (k > 0) {
+      phgmg_gemm('T', 'N', k, nb, N, 1.0, s->V, N, W, N, 0.0, Et, k + m);
+      phgmg_gemm('N', 'N', N, nb, k, -1.0, s->V, N, Et, k + m, 1.0, W, N);
+    }
+    if (m > 0) {
+      phgmg_gemm('T', 'N', m, nb, N, 1.0, s->QB, N, W, N, 0.0, Et + k, k + m);
+      phgmg_gemm('N', 'N', N, nb, m, -1.0, s->QB, N, Et + k, k + m, 1.0, W, N);
+    }
+    for (i = 0; i < (k + m) * nb; ++i) E[i] += Et[i];
+  }
+  rc = phgmg__chunked_qr(N, nb, W, N, Res, R2, &s->al);
+  if (rc == PHGMG_OK) {
+    const int kq = PHGMG__MIN(N, nb);
+    double *Ab = s->A + (size_t)m * s->ns;
+    memcpy(W, Res, (size_t)N * kq * sizeof(double));
+    if (kq < nb) memset(W + (size_t)N * kq, 0, (size_t)N * (nb - kq) * sizeof(double));
+    /* T = E Rb ((k + m) x nb): C += T(0:k), Ab += T(k:); Rb <- R2 Rb */
+    phgmg_gemm('N', 'N', k + m, nb, nb, 1.0, E, k + m, Rb, nb, 0.0, Et, k + m);
+    for (j = 0; j < nb; ++j) {
+      for (i = 0; i < k; ++i) Cs[i + (size_t)j * k] += Et[i + (size_t)j * (k + m)];
+      for (i = 0; i < m; ++i) Ab[i + (size_t)j * m] += Et[k + i + (size_t)j * (k + m)];
+      for (i = 0; i < nb; ++i) {
+        double t = 0.0;
+        for (l = i; l <= j; ++l) t += R2[i + (size_t)l * nb] * Rb[l + (size_t)j * nb];
+        T[i + (size_t)j * nb] = t;
+      }
+    }
+    memcpy(Rb, T, (size_t)nb * nb * sizeof(double));
+  }
+  (void)Ct;
+  phgmg__free(&s->al, E);
+  return rc;
+}
+
+PHGMG_DEF phgmg_result phgmg_pod_stream_add(phgmg_pod_stream *st, int nb, const double *Xb, int ldx) {
+  double *Res, *W, *Cs, *Ct, *Rb, *M, *w;
+  size_t need;
+  phgmg_result rc;
+  int N, k, K2, i, j, kq;
+  if (!st || !Xb) return PHGMG_ERR_INVALID_ARG;
+  N = st->N; k = st->k; K2 = k + nb;
+  if (nb < 1 || ldx < N || nb > (int)(~0u >> 2) - st->ns || nb > (int)(~0u >> 2) - k) return PHGMG_ERR_SIZE;
+  for (j = 0; j < nb; ++j)
+    if (!phgmg__all_finite(Xb + (size_t)j * ldx, (size_t)N)) return PHGMG_ERR_NANINF;
+  rc = phgmg__pod_stream_grow(st, st->ns + nb);
+  if (rc != PHGMG_OK) return rc;
+  kq = PHGMG__MIN(N, nb);
+  need = 2 * (size_t)N * nb + 2 * (size_t)k * nb + (size_t)nb * nb + (size_t)K2 * K2 + (size_t)K2 +
+         2 * (size_t)K2 * K2 + (size_t)PHGMG__QR_CHUNK * st->kmax + (size_t)K2 * ((size_t)st->ns + nb);
+  Res = phgmg__dalloc(&st->al, need);
+  if (!Res) return PHGMG_ERR_NOMEM;
+  W = Res + (size_t)N * nb; Cs = W + (size_t)N * nb; Ct = Cs + (size_t)k * nb; Rb = Ct + (size_t)k * nb;
+  M = Rb + (size_t)nb * nb; w = M + (size_t)K2 * K2;
+  for (j = 0; j < nb; ++j) memcpy(Res + (size_t)j * N, Xb + (size_t)j * ldx, (size_t)N * sizeof(double));
+  phgmg__pod_stream_project(st, nb, Res, Cs, Ct);
+  for (j = 0; j < nb; ++j) {   /* the adjusted columns' norms: their residual plus their coordinates */
+    const double a = phgmg_normf(N, 1, Res + (size_t)j * N, N), b = k > 0 ? phgmg_normf(k, 1, Cs + (size_t)j * k, k) : 0.0;
+    st->fro2 += a * a + b * b;
+  }
+  rc = phgmg__chunked_qr(N, nb, Res, N, W, Rb, &st->al);
+  if (rc == PHGMG_OK) {
+    if (kq < nb) memset(W + (size_t)N * kq, 0, (size_t)N * (nb - kq) * sizeof(double));
+    rc = phgmg__pod_stream_reorth(st, nb, W, Res, Rb, Cs, Ct);
+  }
+  if (rc == PHGMG_OK) {
+    memset(M, 0, (size_t)K2 * K2 * sizeof(double));
+    for (i = 0; i < k; ++i) M[i + (size_t)i * K2] = st->S[i];
+    for (j = 0; j < nb; ++j) {
+      for (i = 0; i < k; ++i) M[i + (size_t)(k + j) * K2] = Cs[i + (size_t)j * k];
+      for (i = 0; i <= j; ++i) M[k + i + (size_t)(k + j) * K2] = Rb[i + (size_t)j * nb];
+    }
+    rc = phgmg__pod_stream_update(st, nb, M, W, w);
+  }
+  phgmg__free(&st->al, Res);
+  return rc;
+}
+
+PHGMG_DEF phgmg_result phgmg_pod_stream_end(const phgmg_pod_stream *st, double *V, int ldv, double *S, int *k_out,
+                                            double *discarded) {
+  int j;
+  if (!st || !k_out) return PHGMG_ERR_INVALID_ARG;
+  if (V && ldv < st->N) return PHGMG_ERR_SIZE;
+  for (j = 0; j < st->k && V; ++j) memcpy(V + (size_t)j * ldv, st->V + (size_t)j * st->N, (size_t)st->N * sizeof(double));
+  for (j = 0; j < st->k && S; ++j) S[j] = st->S[j];
+  *k_out = st->k;
+  if (discarded) *discarded = st->discarded;
+  return PHGMG_OK;
+}
+
+PHGMG_DEF int phgmg_pod_stream_columns(const phgmg_pod_stream *st) { return st ? st->ns : 0; }
+
 /* >>hyper (implementation) ================================================ */
 PHGMG_DEF phgmg_result phgmg_deim(int nterms, int ns, const double *F, int ldf, const double *sw,
                                   double tol, int kmax, int *pts, double *w, int *nd_out,
@@ -16747,17 +17209,14 @@ PHGMG__PRIV phgmg_result phgmg__q_envelope(phgmg__rctx *c) {
    range of rho(x_j) over the snapshots, widened on each side by 10 % of its
    width plus 2 % of the largest width (a coordinate the training barely
    moves must not fire on the reduced model's own error). */
-PHGMG__PRIV phgmg_result phgmg__stage_envelope(phgmg__rctx *c) {
-  phgmg_reduced *red = c->red;
+/* The envelope from the reduced coordinates xr (r x ns) into red->env and
+   the model's env_lo/hi (red->env allocated). */
+PHGMG__PRIV phgmg_result phgmg__envelope_set(phgmg_reduced *red, int ns, const double *xr) {
   const int r = red->r;
-  double *xr, big = 0.0;
+  double big = 0.0;
   int j, a;
   phgmg_result rc;
-  red->env = phgmg__red_d(red, 2 * (size_t)r);
-  xr = phgmg__dalloc(c->alloc, (size_t)r * c->ns);
-  if (!red->env || !xr) { phgmg__free(c->alloc, xr); return PHGMG_ERR_NOMEM; }
-  phgmg__restrict_snapshots(c, xr);
-  for (j = 0; j < c->ns; ++j) {
+  for (j = 0; j < ns; ++j) {
     const double *xj = xr + (size_t)j * r;
     for (a = 0; a < r; ++a) {
       if (j == 0 || xj[a] < red->env[a]) red->env[a] = xj[a];
@@ -16770,9 +17229,22 @@ PHGMG__PRIV phgmg_result phgmg__stage_envelope(phgmg__rctx *c) {
     red->env[a] -= w;
     red->env[r + a] += w;
   }
-  phgmg__free(c->alloc, xr);
   rc = phgmg__to_real(red, red->env, (size_t)r, &red->rom.env_lo);
   if (rc == PHGMG_OK) rc = phgmg__to_real(red, red->env + r, (size_t)r, &red->rom.env_hi);
+  return rc;
+}
+
+PHGMG__PRIV phgmg_result phgmg__stage_envelope(phgmg__rctx *c) {
+  phgmg_reduced *red = c->red;
+  const int r = red->r;
+  double *xr;
+  phgmg_result rc;
+  red->env = phgmg__red_d(red, 2 * (size_t)r);
+  xr = phgmg__dalloc(c->alloc, (size_t)r * c->ns);
+  if (!red->env || !xr) { phgmg__free(c->alloc, xr); return PHGMG_ERR_NOMEM; }
+  phgmg__restrict_snapshots(c, xr);
+  rc = phgmg__envelope_set(red, c->ns, xr);
+  phgmg__free(c->alloc, xr);
   if (rc == PHGMG_OK && red->kind == PHGMG_ROM_QUADRATIC && red->M && !red->eta) rc = phgmg__q_envelope(c);
   return rc;
 }
@@ -17968,6 +18440,72 @@ PHGMG_DEF phgmg_result phgmg_reduce(phgmg_reduced **out, const phgmg_ph_system *
                                     int ldx, int ns, const phgmg_reduce_opts *opts,
                                     phgmg_reduce_info *info, const phgmg_allocator *alloc) {
   return phgmg__reduce_run(out, sys, X, ldx, ns, opts, info, alloc, NULL);
+}
+
+/* The training envelope of a model reduced from a stream: the reduced
+   coordinates of the streamed columns, GMG [RB^-1 QB^T x; V1^T Vs z] and
+   SP1 W^T Vs z (Vs, z: the stream's basis and coordinates). */
+PHGMG__PRIV phgmg_result phgmg__stream_envelope(phgmg_reduced *red, const phgmg_pod_stream *st,
+                                                const phgmg_allocator *alloc) {
+  const int N = red->N, r = red->r, m = red->m, k = st->k, ns = st->ns, gmg = st->m > 0;
+  const int q = gmg ? r - m : r;
+  double *T = phgmg__dalloc(alloc, (size_t)q * k + (size_t)r * ns);
+  double *XR;
+  phgmg_result rc;
+  int i, j, l;
+  if (!T) return PHGMG_ERR_NOMEM;
+  XR = T + (size_t)q * k;
+  phgmg_gemm('T', 'N', q, k, N, 1.0, gmg ? red->V0 + (size_t)N * m : red->W, N, st->V, N, 0.0, T, q);
+  phgmg_gemm('N', 'N', q, ns, k, 1.0, T, q, st->Z, st->kmax, 0.0, XR + (gmg ? m : 0), r);
+  for (j = 0; j < ns && gmg; ++j) {   /* RB^-1 (QB^T x_j) */
+    double *xr = XR + (size_t)j * r;
+    for (i = m - 1; i >= 0; --i) {
+      double sm = st->A[i + (size_t)j * m];
+      for (l = i + 1; l < m; ++l) sm -= red->RB[i + l * m] * xr[l];
+      xr[i] = sm / red->RB[i + i * m];
+    }
+  }
+  if (!red->env) red->env = phgmg__red_d(red, 2 * (size_t)r);
+  rc = red->env ? phgmg__envelope_set(red, ns, XR) : PHGMG_ERR_NOMEM;
+  phgmg__free(alloc, T);
+  return rc;
+}
+
+PHGMG_DEF phgmg_result phgmg_reduce_stream(phgmg_reduced **out, const phgmg_ph_system *sys,
+                                           const phgmg_pod_stream *st, const phgmg_reduce_opts *opts,
+                                           phgmg_reduce_info *info, const phgmg_allocator *alloc) {
+  phgmg_reduce_opts o;
+  phgmg_result rc;
+  double *Xe;
+  int j, i, gmg, kk;
+  if (!out) return PHGMG_ERR_INVALID_ARG;
+  *out = NULL;
+  if (!sys || !st || !opts) return PHGMG_ERR_INVALID_ARG;
+  gmg = opts->method == PHGMG_METHOD_GMG_POD;
+  if ((!gmg && opts->method != PHGMG_METHOD_SP1) || opts->ref != PHGMG_REF_NONE || sys->E || sys->ndamp > 0 ||
+      (opts->hyper.on && sys->nl == PHGMG_NL_SEPARABLE))
+    return PHGMG_ERR_UNSUPPORTED;
+  if (st->N != sys->N || (gmg && (st->m != sys->m || !sys->B)) || (!gmg && st->m != 0))
+    return PHGMG_ERR_INVALID_ARG;
+  for (j = 0; j < st->m; ++j)
+    for (i = 0; i < st->N; ++i)
+      if (st->B[i + (size_t)j * st->N] != sys->B[i + (size_t)j * st->N]) return PHGMG_ERR_INVALID_ARG;
+  if (st->k < 1 || opts->r - (gmg ? sys->m : 0) < 1 || opts->r - (gmg ? sys->m : 0) > st->k) return PHGMG_ERR_SIZE;
+  /* V diag(S) for the modes the method uses and one more (info.pod_sigma_ratio):
+     a matrix whose POD is the stream's leading modes (the basis as snapshots) */
+  kk = PHGMG__MIN(st->k, opts->r - (gmg ? sys->m : 0) + 1);
+  Xe = phgmg__dalloc(alloc, (size_t)st->N * kk);
+  if (!Xe) return PHGMG_ERR_NOMEM;
+  for (j = 0; j < kk; ++j)
+    for (i = 0; i < st->N; ++i) Xe[i + (size_t)j * st->N] = st->V[i + (size_t)j * st->N] * st->S[j];
+  o = *opts;
+  o.nrun = 0; o.runs = NULL;
+  memset(&o.cache, 0, sizeof o.cache);
+  rc = phgmg_reduce(out, sys, Xe, st->N, kk, &o, info, alloc);
+  phgmg__free(alloc, Xe);
+  if (rc == PHGMG_OK) rc = phgmg__stream_envelope(*out, st, alloc);
+  if (rc != PHGMG_OK) { phgmg_reduced_destroy(*out); *out = NULL; }
+  return rc;
 }
 
 PHGMG_DEF void phgmg_reduced_lift(const phgmg_reduced *red, const double *xr, double *x) {
@@ -22699,6 +23237,72 @@ PHGMG_DEF phgmg_result phgmg_npy_read(const char *path, double **out, int *rows,
   return PHGMG_OK;
 }
 
+/* The header of the open file f into h; *doff the offset of the data. */
+PHGMG__PRIV phgmg_result phgmg__npy_fheader(FILE *f, phgmg__npy_hdr *h, size_t *doff) {
+  unsigned char pre[12];
+  size_t hoff = 0, hlen = 0;
+  phgmg_result rc = phgmg__npy_fread(f, pre, 10);
+  char *text;
+  if (rc == PHGMG_OK && (pre[6] == 2 || pre[6] == 3)) rc = phgmg__npy_fread(f, pre + 10, 2);
+  if (rc == PHGMG_OK) rc = phgmg__npy_preamble(pre, (pre[6] == 2 || pre[6] == 3) ? 12 : 10, &hoff, &hlen);
+  if (rc != PHGMG_OK) return rc;
+  text = PHGMG__CAST(char *, phgmg__alloc(NULL, hlen ? hlen : 1));
+  if (!text) return PHGMG_ERR_NOMEM;
+  rc = phgmg__npy_fread(f, text, hlen);
+  if (rc == PHGMG_OK) rc = phgmg__npy_dict(text, hlen, h);
+  phgmg__free(NULL, text);
+  *doff = hoff + hlen;
+  return rc;
+}
+
+/* n elements from file offset off decoded into out[0..n) (flat order). */
+PHGMG__PRIV phgmg_result phgmg__npy_fdecode(FILE *f, const phgmg__npy_hdr *h, long off, size_t n, double *out) {
+  unsigned char chunk[4096];
+  phgmg__npy_hdr flat = *h;
+  phgmg_result rc = PHGMG_OK;
+  flat.corder = 0;
+  if (fseek(f, off, SEEK_SET) != 0) return PHGMG_ERR_IO;
+  while (n > 0 && rc == PHGMG_OK) {
+    const size_t c = PHGMG__MIN(n, sizeof chunk / (size_t)h->es);
+    rc = phgmg__npy_fread(f, chunk, c * (size_t)h->es);
+    if (rc == PHGMG_OK) rc = phgmg__npy_decode(&flat, chunk, 0, c, out);
+    out += c;
+    n -= c;
+  }
+  return rc;
+}
+
+PHGMG_DEF phgmg_result phgmg_npy_read_cols(const char *path, int j0, int nb, double *out, int ldo, int *rows,
+                                           int *cols) {
+  phgmg__npy_hdr h;
+  phgmg_result rc;
+  size_t doff = 0;
+  double *tmp = NULL;
+  FILE *f;
+  int i, j;
+  memset(&h, 0, sizeof h);
+  if (!path) return PHGMG_ERR_INVALID_ARG;
+  if (!(f = fopen(path, "rb"))) return PHGMG_ERR_IO;
+  rc = phgmg__npy_fheader(f, &h, &doff);
+  if (rc == PHGMG_OK) {
+    if (rows) *rows = h.rows;
+    if (cols) *cols = h.cols;
+    if (out && nb > 0 && (j0 < 0 || j0 > h.cols - nb || ldo < PHGMG__MAX(1, h.rows))) rc = PHGMG_ERR_SIZE;
+  }
+  if (rc == PHGMG_OK && out && nb > 0 && h.corder) tmp = phgmg__dalloc(NULL, (size_t)nb);
+  if (rc == PHGMG_OK && out && nb > 0 && h.corder && !tmp) rc = PHGMG_ERR_NOMEM;
+  for (j = 0; rc == PHGMG_OK && out && !h.corder && j < nb; ++j)   /* Fortran order: columns are contiguous */
+    rc = phgmg__npy_fdecode(f, &h, (long)(doff + (size_t)(j0 + j) * h.rows * h.es), (size_t)h.rows,
+                            out + (size_t)j * ldo);
+  for (i = 0; rc == PHGMG_OK && tmp && i < h.rows; ++i) {   /* C order: nb values of each row */
+    rc = phgmg__npy_fdecode(f, &h, (long)(doff + ((size_t)i * h.cols + (size_t)j0) * h.es), (size_t)nb, tmp);
+    for (j = 0; j < nb && rc == PHGMG_OK; ++j) out[i + (size_t)j * ldo] = tmp[j];
+  }
+  phgmg__free(NULL, tmp);
+  fclose(f);
+  return rc;
+}
+
 PHGMG_DEF phgmg_result phgmg_npy_write(const char *path, const double *A, int rows, int cols,
                                        int ld, int ndim, unsigned flags) {
   unsigned char head[256], chunk[4096];
@@ -22744,8 +23348,24 @@ PHGMG_DEF phgmg_result phgmg_mpi_agree(MPI_Comm comm, phgmg_result rc) {
   return (phgmg_result)out;
 }
 
+/* One collective call of `bytes` payload counted on the context. */
+PHGMG__PRIV void phgmg__mpi_count(const phgmg_mpi_ctx *ctx, double bytes) {
+  if (ctx->counts) { ctx->counts->collectives++; ctx->counts->bytes += (long long)bytes; }
+}
+
+PHGMG_DEF void phgmg_mpi_counts_get(const phgmg_mpi_ctx *ctx, phgmg_mpi_counts *out) {
+  if (!out) return;
+  if (ctx && ctx->counts) *out = *ctx->counts;
+  else memset(out, 0, sizeof *out);
+}
+
+PHGMG_DEF void phgmg_mpi_counts_reset(const phgmg_mpi_ctx *ctx) {
+  if (ctx && ctx->counts) memset(ctx->counts, 0, sizeof *ctx->counts);
+}
+
 /* rc agreed over the context's ranks (ctx not NULL). */
 PHGMG__PRIV phgmg_result phgmg__mpi_agree(const phgmg_mpi_ctx *ctx, phgmg_result rc) {
+  phgmg__mpi_count(ctx, (double)sizeof(int));
   return phgmg_mpi_agree(ctx->comm, rc);
 }
 
@@ -22775,7 +23395,7 @@ PHGMG_DEF phgmg_result phgmg_mpi_ctx_create(phgmg_mpi_ctx **ctx, MPI_Comm comm, 
   if (!ctx) rc = PHGMG_ERR_INVALID_ARG;
   else if (N < 1 || nloc < 0 || row0 < 0 || row0 > N - nloc) rc = PHGMG_ERR_SIZE;
   if (rc == PHGMG_OK) {
-    c = PHGMG__CAST(phgmg_mpi_ctx *, phgmg__alloc(alloc, sizeof *c));
+    c = PHGMG__CAST(phgmg_mpi_ctx *, phgmg__alloc(alloc, sizeof *c + sizeof(phgmg_mpi_counts)));
     all = PHGMG__CAST(phgmg_gidx *, phgmg__alloc(alloc, (size_t)(3 * size + 1) * sizeof(phgmg_gidx)));
     if (!c || !all) rc = PHGMG_ERR_NOMEM;
   }
@@ -22798,6 +23418,8 @@ PHGMG_DEF phgmg_result phgmg_mpi_ctx_create(phgmg_mpi_ctx **ctx, MPI_Comm comm, 
   memset(c, 0, sizeof *c);
   MPI_Comm_dup(comm, &c->comm);
   c->rank = rank; c->size = size; c->N = N; c->row0 = row0; c->nloc = nloc;
+  c->counts = PHGMG__CAST(phgmg_mpi_counts *, PHGMG__CAST(void *, c + 1));   /* allocated with c */
+  memset(c->counts, 0, sizeof *c->counts);
   if (alloc) c->al = *alloc;
   for (q = 0; q < size; ++q) all[q] = all[3 * q];   /* compact into the offsets (q <= 3q) */
   all[size] = N;
@@ -22821,6 +23443,8 @@ PHGMG_DEF void phgmg_mpi_ctx_destroy(phgmg_mpi_ctx *ctx) {
 PHGMG__PRIV void phgmg__mpi_sum(const phgmg_mpi_ctx *ctx, int n, const double *in, double *out) {
   MPI_Reduce(in, out, n, MPI_DOUBLE, MPI_SUM, 0, ctx->comm);
   MPI_Bcast(out, n, MPI_DOUBLE, 0, ctx->comm);
+  phgmg__mpi_count(ctx, 8.0 * n);
+  phgmg__mpi_count(ctx, 8.0 * n);
 }
 
 PHGMG_DEF phgmg_result phgmg_mpi_atb(const phgmg_mpi_ctx *ctx, int ka, int kb, const double *A, int lda,
@@ -22845,57 +23469,6 @@ PHGMG_DEF phgmg_result phgmg_mpi_atb(const phgmg_mpi_ctx *ctx, int ka, int kb, c
   return PHGMG_OK;
 }
 
-/* Local QR of X (n x ns, n >= 1) into W (n x ns, ld n: the explicit Q in
-   the first kq = min(n, ns) columns) and Rl (ns x ns, ld ns, zero below the
-   diagonal and below row kq). Tall blocks go by a flat tree: chunks of
-   about PHGMG__MPI_CHUNK rows (at least ns) factored each in cache, their
-   R factors stacked and factored again, each chunk's Q times its block of
-   the second Q (the unblocked Householder QR of the whole block would
-   stream it from memory once per column). */
-#define PHGMG__MPI_CHUNK 4096
-PHGMG__PRIV phgmg_result phgmg__mpi_local_qr(int n, int ns, const double *X, int ldx, double *W, double *Rl,
-                                             const phgmg_allocator *al) {
-  const int nc = n / PHGMG__MAX(PHGMG__MPI_CHUNK, ns), kq = PHGMG__MIN(n, ns), ms = PHGMG__MAX(nc, 1) * ns;
-  const int cmax = n / PHGMG__MAX(nc, 1) + 1;
-  double *S2 = phgmg__dalloc(al, (size_t)ms * ns + 2 * (size_t)ns + (nc > 1 ? (size_t)cmax * ns : 0));
-  double *tau, *work, *T;
-  int i, j, c;
-  phgmg_result rc = S2 ? PHGMG_OK : PHGMG_ERR_NOMEM;
-  if (rc != PHGMG_OK) return rc;
-  tau = S2 + (size_t)ms * ns; work = tau + ns; T = work + ns;
-  for (j = 0; j < ns; ++j) memcpy(W + (size_t)j * n, X + (size_t)j * ldx, (size_t)n * sizeof(double));
-  memset(Rl, 0, (size_t)ns * ns * sizeof(double));
-  if (nc <= 1) {
-    rc = phgmg_qr(n, ns, W, n, tau);
-    for (j = 0; j < ns && rc == PHGMG_OK; ++j)
-      for (i = 0; i <= j && i < kq; ++i) Rl[i + (size_t)j * ns] = W[i + (size_t)j * n];
-    if (rc == PHGMG_OK) phgmg_qr_form_q(n, kq, W, n, tau, work);
-    phgmg__free(al, S2);
-    return rc;
-  }
-  memset(S2, 0, (size_t)ms * ns * sizeof(double));
-  for (c = 0; c < nc && rc == PHGMG_OK; ++c) {   /* chunk c: rows r0 .. r0 + nb - 1 (nb >= ns) */
-    const int r0 = (int)((long long)n * c / nc), nb = (int)((long long)n * (c + 1) / nc) - r0;
-    rc = phgmg_qr(nb, ns, W + r0, n, tau);
-    for (j = 0; j < ns && rc == PHGMG_OK; ++j)
-      for (i = 0; i <= j; ++i) S2[c * ns + i + (size_t)j * ms] = W[r0 + i + (size_t)j * n];
-    if (rc == PHGMG_OK) phgmg_qr_form_q(nb, ns, W + r0, n, tau, work);
-  }
-  if (rc == PHGMG_OK) rc = phgmg_qr(ms, ns, S2, ms, tau);
-  if (rc == PHGMG_OK) {
-    for (j = 0; j < ns; ++j)
-      for (i = 0; i <= j; ++i) Rl[i + (size_t)j * ns] = S2[i + (size_t)j * ms];
-    phgmg_qr_form_q(ms, ns, S2, ms, tau, work);
-    for (c = 0; c < nc; ++c) {
-      const int r0 = (int)((long long)n * c / nc), nb = (int)((long long)n * (c + 1) / nc) - r0;
-      phgmg_gemm('N', 'N', nb, ns, ns, 1.0, W + r0, n, S2 + (size_t)c * ns, ms, 0.0, T, nb);
-      for (j = 0; j < ns; ++j) memcpy(W + r0 + (size_t)j * n, T + (size_t)j * nb, (size_t)nb * sizeof(double));
-    }
-  }
-  phgmg__free(al, S2);
-  return rc;
-}
-
 /* The TSQR kernel. W (nloc x ns, ld max(1, nloc)) receives X's local
    Householder QR with its explicit Q in the first kq = min(nloc, ns)
    columns; R (ns x ns) the global triangular factor (diagonal >= 0); Q2
@@ -22909,10 +23482,11 @@ PHGMG__PRIV phgmg_result phgmg__mpi_tsqr_core(const phgmg_mpi_ctx *ctx, int ns, 
   phgmg_result rc = PHGMG_OK;
   int i, j, q;
   memset(Rl, 0, (size_t)ns * ns * sizeof(double));
-  if (n > 0) rc = phgmg__mpi_local_qr(n, ns, X, ldx, W, Rl, &ctx->al);
+  if (n > 0) rc = phgmg__chunked_qr(n, ns, X, ldx, W, Rl, &ctx->al);
   rc = phgmg__mpi_agree(ctx, rc);
   if (rc != PHGMG_OK) return rc;
   MPI_Allgather(Rl, ns * ns, MPI_DOUBLE, Sg, ns * ns, MPI_DOUBLE, ctx->comm);
+  phgmg__mpi_count(ctx, 8.0 * ns * ns);
   for (q = 0; q < P; ++q)   /* stack the R factors: rows q ns .. q ns + ns - 1 */
     for (j = 0; j < ns; ++j)
       memcpy(S + (size_t)q * ns + (size_t)j * ms, Sg + (size_t)q * ns * ns + (size_t)j * ns, (size_t)ns * sizeof(double));
@@ -23001,6 +23575,67 @@ PHGMG_DEF phgmg_result phgmg_mpi_pod(const phgmg_mpi_ctx *ctx, int ns, const dou
     *k_out = k;
   }
   phgmg__free(al, W);
+  return rc;
+}
+
+/* ---- shifted Cholesky-QR ------------------------------------------------------- */
+/* One step: G = Q^T Q (+ shift), G = L L^T, Q <- Q L^-T, Rt <- L^T Rt. G, T: ns^2. */
+PHGMG__PRIV phgmg_result phgmg__mpi_cholqr_step(const phgmg_mpi_ctx *ctx, int ns, double *Q, int ldq, int shifted,
+                                                double *G, double *T, double *Rt) {
+  const int n = ctx->nloc;
+  double tr = 0.0;
+  int i, j, l, bad;
+  phgmg_result rc = phgmg_mpi_atb(ctx, ns, ns, Q, ldq, Q, ldq, G, ns);
+  if (rc != PHGMG_OK) return rc;
+  for (i = 0; i < ns; ++i) tr += G[i + (size_t)i * ns];
+  if (shifted) {
+    const double s = 11.0 * ((double)ctx->N * ns + (double)ns * (ns + 1)) * PHGMG__EPS * tr;
+    for (i = 0; i < ns; ++i) G[i + (size_t)i * ns] += s;
+  }
+  bad = !(tr > 0.0) || phgmg__chol_small(ns, G) != 0;   /* the same G on every rank: the same verdict */
+  if (bad) return PHGMG_ERR_RANK;
+  for (j = 0; j < ns && n > 0; ++j) {   /* Q(:, j) = (Q(:, j) - sum_{i<j} Q(:, i) L(j, i)) / L(j, j) */
+    double *qj = Q + (size_t)j * ldq;
+    for (i = 0; i < j; ++i) {
+      const double lji = G[j + (size_t)i * ns];
+      const double *qi = Q + (size_t)i * ldq;
+      for (l = 0; l < n; ++l) qj[l] -= lji * qi[l];
+    }
+    for (l = 0; l < n; ++l) qj[l] /= G[j + (size_t)j * ns];
+  }
+  for (j = 0; j < ns; ++j)   /* T = L^T Rt (both upper triangular) */
+    for (i = 0; i < ns; ++i) {
+      double t = 0.0;
+      for (l = i; l <= j; ++l) t += G[l + (size_t)i * ns] * Rt[l + (size_t)j * ns];
+      T[i + (size_t)j * ns] = i <= j ? t : 0.0;
+    }
+  memcpy(Rt, T, (size_t)ns * ns * sizeof(double));
+  return PHGMG_OK;
+}
+
+PHGMG_DEF phgmg_result phgmg_mpi_cholqr(const phgmg_mpi_ctx *ctx, int ns, const double *X, int ldx, double *Q,
+                                        int ldq, double *R, int ldr) {
+  const phgmg_allocator *al;
+  double *G = NULL;
+  phgmg_result rc = PHGMG_OK;
+  int n, i, j, step;
+  if (!ctx) return PHGMG_ERR_INVALID_ARG;
+  al = &ctx->al; n = ctx->nloc;
+  if (ns < 1 || (phgmg_gidx)ns > ctx->N || !phgmg__mpi_ld_ok(ctx, ldx) || !phgmg__mpi_ld_ok(ctx, ldq) || ldr < ns)
+    rc = PHGMG_ERR_SIZE;
+  else if (!R || !Q || (n > 0 && !X)) rc = PHGMG_ERR_INVALID_ARG;
+  else if (n > 0 && !phgmg__mat_finite(n, ns, X, ldx)) rc = PHGMG_ERR_NANINF;
+  else if (!(G = phgmg__dalloc(al, 3 * (size_t)ns * ns))) rc = PHGMG_ERR_NOMEM;
+  rc = phgmg__mpi_agree(ctx, rc);
+  if (rc != PHGMG_OK) { phgmg__free(al, G); return rc; }
+  for (j = 0; j < ns && n > 0; ++j) memcpy(Q + (size_t)j * ldq, X + (size_t)j * ldx, (size_t)n * sizeof(double));
+  memset(G + 2 * (size_t)ns * ns, 0, (size_t)ns * ns * sizeof(double));
+  for (i = 0; i < ns; ++i) G[2 * (size_t)ns * ns + i + (size_t)i * ns] = 1.0;
+  for (step = 0; step < 4 && rc == PHGMG_OK; ++step)
+    rc = phgmg__mpi_cholqr_step(ctx, ns, Q, ldq, step < 2, G, G + (size_t)ns * ns, G + 2 * (size_t)ns * ns);
+  for (j = 0; j < ns && rc == PHGMG_OK; ++j)
+    memcpy(R + (size_t)j * ldr, G + 2 * (size_t)ns * ns + (size_t)j * ns, (size_t)ns * sizeof(double));
+  phgmg__free(al, G);
   return rc;
 }
 
@@ -23163,6 +23798,7 @@ PHGMG__PRIV phgmg_gidx phgmg__mpi_argmax(const phgmg_mpi_ctx *ctx, const double 
   for (i = 0; i < ctx->nloc; ++i)
     if (fabs(r[i]) > loc.v) { loc.v = fabs(r[i]); loc.i = ctx->row0 + i; }
   MPI_Allreduce(&loc, &glob, 1, t, op, ctx->comm);
+  phgmg__mpi_count(ctx, (double)sizeof loc);
   *vmax = glob.v;
   return glob.i;
 }
@@ -23194,6 +23830,7 @@ PHGMG__PRIV phgmg_result phgmg__mpi_deim_point(const phgmg_mpi_ctx *ctx, int k, 
   if (owner == ctx->rank)
     for (a = 0; a < k; ++a) c[a] = U[(pts[l] - ctx->row0) + (size_t)a * ldu];
   MPI_Bcast(c, k, MPI_DOUBLE, owner, ctx->comm);
+  phgmg__mpi_count(ctx, 8.0 * k);
   for (a = 0; a < k; ++a) Pr[l + (size_t)a * k] = c[a];
   return PHGMG_OK;
 }
@@ -23244,6 +23881,206 @@ PHGMG_DEF phgmg_result phgmg_mpi_deim_greedy(const phgmg_mpi_ctx *ctx, int k, co
   MPI_Type_free(&t);
   phgmg__free(al, Pr);
   phgmg__free(al, ipiv);
+  return rc;
+}
+
+/* ---- distributed ECSW ------------------------------------------------------------ */
+/* The training column of a term (M = ns r entries, row (i, a) at i + a ns). */
+PHGMG__PRIV void phgmg__mpi_ecsw_col(int ns, int r, const double *F, int ldf, const double *Vt, int ldvt, int k,
+                                     double *col) {
+  int i, a;
+  for (a = 0; a < r; ++a)
+    for (i = 0; i < ns; ++i) col[i + (size_t)a * ns] = F[k + (size_t)i * ldf] * Vt[k + (size_t)a * ldvt];
+}
+
+/* State of the distributed Lawson-Hanson iteration (replicated but the flags). */
+typedef struct phgmg__mpi_nnls {
+  int M, np, cap;          /* rows, passive terms, room                         */
+  double *G, *x, *z, *b, *res, *t;   /* M x cap passive columns, weights, LS solution, target, residual, ns scratch */
+  phgmg_gidx *id;          /* global indices of the passive terms              */
+  char *inP;               /* this rank's terms in the passive set             */
+} phgmg__mpi_nnls;
+
+/* res = b - G x (replicated). */
+PHGMG__PRIV void phgmg__mpi_nnls_res(phgmg__mpi_nnls *s) {
+  memcpy(s->res, s->b, (size_t)s->M * sizeof(double));
+  if (s->np > 0) phgmg_gemv('N', s->M, s->np, -1.0, s->G, s->M, s->x, 1.0, s->res);
+}
+
+/* The passive set's least squares with the Lawson-Hanson step back until
+   every weight is positive (terms at zero leave the set). */
+PHGMG__PRIV phgmg_result phgmg__mpi_nnls_solve(phgmg__mpi_nnls *s, const phgmg_gidx *gid, int nt,
+                                               const phgmg_allocator *al) {
+  int it, j, q;
+  for (it = 0; it < 3 * s->cap + 3; ++it) {
+    double alpha = 1.0;
+    phgmg_result rc = phgmg_lstsq(s->M, s->np, 1, s->G, s->M, s->b, s->M, 0.0, s->z, s->np, al);
+    if (rc != PHGMG_OK) return rc;
+    for (j = 0; j < s->np; ++j)
+      if (!(s->z[j] > 0.0)) alpha = PHGMG__MIN(alpha, s->x[j] / (s->x[j] - s->z[j]));
+    if (alpha >= 1.0) { memcpy(s->x, s->z, (size_t)s->np * sizeof(double)); return PHGMG_OK; }
+    for (j = 0; j < s->np; ++j) s->x[j] += alpha * (s->z[j] - s->x[j]);
+    for (j = 0, q = 0; j < s->np; ++j) {   /* drop the terms at zero, keep the order */
+      if (s->x[j] > 0.0) {
+        if (q != j) {
+          memcpy(s->G + (size_t)q * s->M, s->G + (size_t)j * s->M, (size_t)s->M * sizeof(double));
+          s->x[q] = s->x[j]; s->id[q] = s->id[j];
+        }
+        ++q;
+      } else {
+        int k;
+        for (k = 0; k < nt; ++k) if (gid[k] == s->id[j]) s->inP[k] = 0;
+      }
+    }
+    s->np = q;
+    if (q == 0) return PHGMG_OK;
+  }
+  return PHGMG_ERR_NOT_CONVERGED;
+}
+
+/* The term of largest positive gradient G_k^T res over all ranks (ties to
+   the lower global index) into the passive set: its column broadcast by
+   its owner. *none = 1 if no term has a positive gradient. */
+PHGMG__PRIV void phgmg__mpi_nnls_pick(const phgmg_mpi_ctx *ctx, phgmg__mpi_nnls *s, int nt, int ns, int r,
+                                      const double *F, int ldf, const double *Vt, int ldvt, const phgmg_gidx *gid,
+                                      MPI_Datatype t, MPI_Op op, int *none) {
+  phgmg__mpi_vi loc, glob;
+  int k, i, a, owner, lk = -1, lo = ctx->size;
+  loc.v = 0.0; loc.i = PHGMG__GIDX_MAX;
+  for (k = 0; k < nt; ++k) {
+    double g = 0.0;
+    if (s->inP[k]) continue;
+    for (i = 0; i < ns; ++i) {   /* g = sum_i F[k, i] (res_i . Vt[k, :]) */
+      double ti = 0.0;
+      for (a = 0; a < r; ++a) ti += s->res[i + (size_t)a * ns] * Vt[k + (size_t)a * ldvt];
+      g += F[k + (size_t)i * ldf] * ti;
+    }
+    if (g > loc.v || (g == loc.v && g > 0.0 && gid[k] < loc.i)) { loc.v = g; loc.i = gid[k]; lk = k; }
+  }
+  MPI_Allreduce(&loc, &glob, 1, t, op, ctx->comm);
+  *none = !(glob.v > 0.0);
+  if (*none) return;
+  owner = (lk >= 0 && gid[lk] == glob.i) ? ctx->rank : ctx->size;
+  MPI_Allreduce(&owner, &lo, 1, MPI_INT, MPI_MIN, ctx->comm);
+  phgmg__mpi_count(ctx, (double)sizeof loc);
+  phgmg__mpi_count(ctx, (double)sizeof(int));
+  if (ctx->rank == lo) {
+    phgmg__mpi_ecsw_col(ns, r, F, ldf, Vt, ldvt, lk, s->G + (size_t)s->np * s->M);
+    s->inP[lk] = 1;
+  }
+  MPI_Bcast(s->G + (size_t)s->np * s->M, s->M, MPI_DOUBLE, lo, ctx->comm);
+  phgmg__mpi_count(ctx, 8.0 * s->M);
+  s->id[s->np] = glob.i;
+  s->x[s->np] = 0.0;
+  s->np++;
+}
+
+/* (hi, lo) += v in double-double (Knuth's TwoSum). */
+PHGMG__PRIV void phgmg__dd_add(double *hi, double *lo, double v) {
+  const double sm = *hi + v, bb = sm - *hi, err = (*hi - (sm - bb)) + (v - bb);
+  const double t = *lo + err, h2 = sm + t;
+  *lo = t - (h2 - sm);
+  *hi = h2;
+}
+
+/* The target b = sum_k sw_k (term k's column) over all ranks' terms, in
+   double-double: each rank's partial sums (hi, lo) gathered and added in
+   rank order on every rank, so b is the correctly rounded sum to within
+   ~1e-32 relative whatever the partition (the same bits for every P but in
+   exceptional rounding ties). ws: 2 M (size + 1) doubles. */
+PHGMG__PRIV void phgmg__mpi_ecsw_target(const phgmg_mpi_ctx *ctx, phgmg__mpi_nnls *s, int nt, int ns, int r,
+                                        const double *F, int ldf, const double *Vt, int ldvt, const double *sw,
+                                        double *ws) {
+  const int M = s->M;
+  double *loc = ws, *all = ws + 2 * (size_t)M;
+  int k, i, q;
+  memset(loc, 0, 2 * (size_t)M * sizeof(double));
+  for (k = 0; k < nt; ++k) {
+    phgmg__mpi_ecsw_col(ns, r, F, ldf, Vt, ldvt, k, s->z);
+    for (i = 0; i < M; ++i) phgmg__dd_add(loc + i, loc + M + i, (sw ? sw[k] : 1.0) * s->z[i]);
+  }
+  MPI_Allgather(loc, 2 * M, MPI_DOUBLE, all, 2 * M, MPI_DOUBLE, ctx->comm);
+  phgmg__mpi_count(ctx, 16.0 * M);
+  for (i = 0; i < M; ++i) {
+    double hi = 0.0, lo = 0.0;
+    for (q = 0; q < ctx->size; ++q) {
+      phgmg__dd_add(&hi, &lo, all[(size_t)q * 2 * M + i]);
+      phgmg__dd_add(&hi, &lo, all[(size_t)q * 2 * M + M + i]);
+    }
+    s->b[i] = hi + lo;
+  }
+}
+
+/* Sorted output: pts ascending, w alike. */
+PHGMG__PRIV void phgmg__mpi_ecsw_out(const phgmg__mpi_nnls *s, phgmg_gidx *pts, double *w) {
+  int i, j;
+  for (i = 0; i < s->np; ++i) { pts[i] = s->id[i]; w[i] = s->x[i]; }
+  for (i = 1; i < s->np; ++i)   /* insertion sort by global index */
+    for (j = i; j > 0 && pts[j - 1] > pts[j]; --j) {
+      const phgmg_gidx tp = pts[j]; const double tw = w[j];
+      pts[j] = pts[j - 1]; w[j] = w[j - 1]; pts[j - 1] = tp; w[j - 1] = tw;
+    }
+}
+
+PHGMG_DEF phgmg_result phgmg_mpi_ecsw(const phgmg_mpi_ctx *ctx, int nt, int ns, const double *F, int ldf, int r,
+                                      const double *Vt, int ldvt, const double *sw, const phgmg_gidx *gid,
+                                      double tol, int max_pts, phgmg_gidx *pts, double *w, int *nd_out,
+                                      double *resid_out) {
+  const phgmg_allocator *al;
+  phgmg__mpi_nnls s;
+  phgmg_result rc = PHGMG_OK;
+  MPI_Datatype t;
+  MPI_Op op;
+  double bn = 0.0, rn = 0.0;
+  int none = 0;
+  if (!ctx) return PHGMG_ERR_INVALID_ARG;
+  al = &ctx->al;
+  memset(&s, 0, sizeof s);
+  if (ns < 1 || r < 1 || nt < 0 || max_pts < 1 || (nt > 0 && (ldf < nt || ldvt < nt)) ||
+      (double)ns * r > 1e8)
+    rc = PHGMG_ERR_SIZE;
+  else if (!pts || !w || !nd_out || (nt > 0 && (!F || !Vt || !gid)) || tol != tol || tol < 0.0 || tol >= 1.0)
+    rc = PHGMG_ERR_INVALID_ARG;
+  else if (nt > 0 && (!phgmg__mat_finite(nt, ns, F, ldf) || !phgmg__mat_finite(nt, r, Vt, ldvt)))
+    rc = PHGMG_ERR_NANINF;
+  else {
+    s.M = ns * r; s.cap = max_pts;
+    s.G = phgmg__dalloc(al, (size_t)s.M * (max_pts + 3) + 3 * (size_t)max_pts);
+    s.id = PHGMG__CAST(phgmg_gidx *, phgmg__alloc(al, sizeof(phgmg_gidx) * (size_t)max_pts));
+    s.inP = PHGMG__CAST(char *, phgmg__alloc(al, (size_t)nt + 1));
+    if (!s.G || !s.id || !s.inP) rc = PHGMG_ERR_NOMEM;
+  }
+  rc = phgmg__mpi_agree(ctx, rc);
+  if (rc == PHGMG_OK) {
+    s.b = s.G + (size_t)s.M * max_pts; s.res = s.b + s.M; s.z = s.res + s.M; s.x = s.z + PHGMG__MAX(s.M, max_pts);
+    memset(s.inP, 0, (size_t)nt + 1);
+    if (tol == 0.0) tol = 1e-6;
+    MPI_Type_contiguous((int)sizeof(phgmg__mpi_vi), MPI_BYTE, &t);
+    MPI_Type_commit(&t);
+    MPI_Op_create(phgmg__mpi_maxloc_fn, 1, &op);
+    double *ws = phgmg__dalloc(al, 2 * (size_t)s.M * ((size_t)ctx->size + 1));
+    if (!ws) rc = PHGMG_ERR_NOMEM;
+    rc = phgmg__mpi_agree(ctx, rc);
+    if (rc == PHGMG_OK) phgmg__mpi_ecsw_target(ctx, &s, nt, ns, r, F, ldf, Vt, ldvt, sw, ws);
+    phgmg__free(al, ws);
+    bn = phgmg_normf(s.M, 1, s.b, s.M);
+    phgmg__mpi_nnls_res(&s);
+    while (rc == PHGMG_OK && (rn = phgmg_normf(s.M, 1, s.res, s.M)) > tol * bn) {
+      if (s.np == max_pts) { rc = PHGMG_ERR_NOT_CONVERGED; break; }
+      phgmg__mpi_nnls_pick(ctx, &s, nt, ns, r, F, ldf, Vt, ldvt, gid, t, op, &none);
+      if (none) { rc = PHGMG_ERR_NOT_CONVERGED; break; }
+      rc = phgmg__mpi_nnls_solve(&s, gid, nt, al);
+      phgmg__mpi_nnls_res(&s);
+    }
+    MPI_Op_free(&op);
+    MPI_Type_free(&t);
+    phgmg__mpi_ecsw_out(&s, pts, w);
+    *nd_out = s.np;
+    if (resid_out) *resid_out = bn > 0.0 ? rn / bn : 0.0;
+  }
+  phgmg__free(al, s.G);
+  phgmg__free(al, s.id);
+  phgmg__free(al, s.inP);
   return rc;
 }
 
@@ -23355,11 +24192,13 @@ PHGMG__PRIV phgmg_result phgmg__mpi_op_plan(phgmg_mpi_op *op, const phgmg_gidx *
   for (q = 0; q < P; ++q) cr[q] = 0;
   for (h = 0; h < op->nhalo; ++h) cr[phgmg__mpi_owner(ctx, hg[h])]++;
   MPI_Alltoall(cr, 1, MPI_INT, cs, 1, MPI_INT, ctx->comm);
+  phgmg__mpi_count(ctx, (double)sizeof(int) * ctx->size);
   for (q = 0; q < P; ++q) { dr[q] = q ? dr[q - 1] + cr[q - 1] : 0; ds[q] = tot; tot += cs[q]; }
   sg = PHGMG__CAST(phgmg_gidx *, phgmg__alloc(al, (size_t)PHGMG__MAX(tot, 1) * sizeof(phgmg_gidx)));
   rc = phgmg__mpi_agree(ctx, sg ? PHGMG_OK : PHGMG_ERR_NOMEM);
   if (rc == PHGMG_OK) {
     MPI_Alltoallv(hg, cr, dr, MPI_LONG_LONG, sg, cs, ds, MPI_LONG_LONG, ctx->comm);
+    phgmg__mpi_count(ctx, 8.0 * (dr[ctx->size - 1] + cr[ctx->size - 1]));
     rc = phgmg__mpi_agree(ctx, phgmg__mpi_op_lists(op, cr, cs, sg));
   }
   phgmg__free(al, sg);
@@ -23414,8 +24253,10 @@ PHGMG__PRIV void phgmg__mpi_op_exchange(const phgmg_mpi_op *op, int k, const dou
     for (j = 0; j < k; ++j)
       for (i = 0; i < c; ++i) b[i + (size_t)j * c] = X[op->sidx[op->soff[q] + i] + (size_t)j * ldx];
     MPI_Isend(b, c * k, MPI_DOUBLE, op->srank[q], PHGMG__MPI_TAG, op->ctx->comm, req + op->nrecv + q);
+    if (op->ctx->counts) op->ctx->counts->exchange_bytes += 8LL * c * k;
   }
   MPI_Waitall(op->nrecv + op->nsend, req, MPI_STATUSES_IGNORE);
+  if (op->ctx->counts) op->ctx->counts->exchanges++;
   for (q = 0; q < op->nrecv; ++q) {
     const int c = op->roff[q + 1] - op->roff[q];
     const double *b = rb + (size_t)k * op->roff[q];

@@ -119,7 +119,9 @@ static const char *const help_lines[] = {
   "                      Repeatable (up to 16): one training run per file, the runs'\n",
   "                      boundaries known to the reduction (--lambda cv folds).\n",
   "                      --dt DT with --X: the snapshots' step, recorded in the model\n",
-  "                      (simulate-rom's default step).\n",
+  "                      (simulate-rom's default step). With --stream (the default\n",
+  "                      when the files hold more than 4 GiB) the files are read a\n",
+  "                      block of columns at a time, never whole (see --stream).\n",
   "  --X-input KIND      the input that made each --X run (one per --X, same order;\n",
   "                      KIND as --input, sampled with --dt = the snapshots' step):\n",
   "                      --lambda auto then simulates the runs from their first\n",
@@ -135,6 +137,18 @@ static const char *const help_lines[] = {
   "    --dt DT           step (default 0.1), recorded in the model as its training\n",
   "                      step (simulate-rom's default)\n",
   "    --steps N         number of steps (default 1000), t in [0, N*DT]\n",
+  "    --stream          stream the states into an incremental POD as they are\n",
+  "                      made (or read, with --X) instead of storing the N x ns\n",
+  "                      snapshots; the default when they would exceed 4 GiB.\n",
+  "                      Memory about N (K + 3 min(K, 64)) doubles while streaming,\n",
+  "                      K = max(2 (R' + 1), R' + 41) modes kept (at most N - m),\n",
+  "                      R' = R - m (gmg-pod) or R (sp1). For --method gmg-pod and\n",
+  "                      sp1 only, without a hyper-reduced --poly-idx part (use\n",
+  "                      --no-hyper), --ref, --save-snapshots, --X-input, --E,\n",
+  "                      feedthrough or --dampers (--stream then is a usage error).\n",
+  "                      The model equals the stored run's when the snapshots'\n",
+  "                      numerical rank is at most K (the log states the POD's\n",
+  "                      error bound otherwise)\n",
   "    --input KIND      sin (default): u(t) = AMP sin(t); with m > 1 ports each port\n",
   "                      at its own frequency, u_a(t) = AMP sin((1 + a/m) t) for\n",
   "                      a = 0..m-1, so that the ports are excited independently;\n",
@@ -1417,6 +1431,7 @@ typedef struct reduce_args {
   const char *expf, *potential, *hyper;
   double hyper_tol;
   int simulate, steps, r, rn, no_deim, deim_max, deim_neg, save_snap, have_dt_map, newton_iter;
+  int stream;                      /* --stream: the simulated snapshots streamed, never stored */
   int have_dt;                  /* --dt given (with --X alone: the snapshots' step) */
   double dt, amp, lambda, deim_tol, dt_map, newton_tol;
   double degeneracy_tol;        /* --degeneracy-tol (0: the library's default) */
@@ -1779,6 +1794,7 @@ static int parse_reduce(int argc, char **argv, reduce_args *A) {
         return usage_error("--degeneracy-tol: expected a number with 0 < T < 1, got '%s'", v);
     }
     else if (!strcmp(o, "--simulate")) A->simulate = 1;
+    else if (!strcmp(o, "--stream")) A->stream = 1;
     else if (!strcmp(o, "--no-deim") || !strcmp(o, "--no-hyper")) A->no_deim = 1;
     else if (!strcmp(o, "--deim-allow-negative")) A->deim_neg = 1;
     else if (!strcmp(o, "--save-snapshots")) A->save_snap = 1;
@@ -3496,6 +3512,139 @@ static double step_map_radius(const phgmg_rom *rom) {
   return exp(L);
 }
 
+/* ---- reduce --simulate, streamed: the snapshots never stored ------------------ */
+/* The stream phgmg_reduce_stream reduces from (run_reduction uses it when set). */
+static phgmg_pod_stream *g_stream;
+
+/* 1 if this run streams its snapshots: --stream, or --simulate whose
+   snapshots exceed CLI_MAX_BYTES, for a method and model the stream serves
+   (gmg-pod or sp1; no hyper-reduced --poly, --ref mean, --save-snapshots,
+   descriptor, feedthrough or dampers). --stream otherwise: a usage error
+   (2); *why names the reason. */
+/* The columns of the --X files (0 if a shape cannot be read: the in-core
+   reader reports it). */
+static double stream_x_columns(const reduce_args *A) {
+  double t = 0.0;
+  int k, rows = 0, cols = 0;
+  for (k = 0; k < A->nx; ++k) {
+    if (phgmg_npy_read_cols(A->xs[k], 0, 0, NULL, 1, &rows, &cols) != PHGMG_OK) return 0.0;
+    t += cols;
+  }
+  return t;
+}
+
+static int stream_use(const reduce_args *A, const reduce_state *S, const char **why) {
+  const double cols = A->X ? stream_x_columns(A) : (double)(A->ntrain ? A->ntrain : 1) * ((double)A->steps + 1.0);
+  *why = NULL;
+  if (!A->stream && !(8.0 * (double)S->sys.N * cols > CLI_MAX_BYTES)) return 0;
+  if (S->method != PHGMG_METHOD_GMG_POD && S->method != PHGMG_METHOD_SP1) *why = "--method gmg-qm or sp2";
+  else if (A->poly_idx && !A->no_deim) *why = "a hyper-reduced --poly-idx part (add --no-hyper)";
+  else if (A->ref != PHGMG_REF_NONE) *why = "--ref";
+  else if (A->save_snap) *why = "--save-snapshots";
+  else if (S->dae || A->E || A->Ecoo || A->Pf || A->Sf || A->Nf || A->dampf) *why = "--E, feedthrough or --dampers";
+  else if (A->nxin) *why = "--X-input";
+  return *why ? 0 : 1;
+}
+
+/* Run i of the training runs (from --x0, else 0) on a stepper, each state into
+   the column block blk (N x nb), each full block into g_stream. */
+static int stream_run(const reduce_args *A, reduce_state *S, cli_input *in, const char *spec, double *blk, int nb,
+                      int *fill) {
+  const int N = S->sys.N;
+  phgmg_gl3_opts go;
+  phgmg_gl3 *g = NULL;
+  double *x = (double *)calloc((size_t)N, sizeof(double));
+  phgmg_result rc;
+  int n;
+  memset(&go, 0, sizeof go);
+  go.tol = A->newton_tol; go.max_iter = A->newton_iter;
+  if (!x) return fail("out of memory");
+  if (load_x0(A, S, N, x)) { free(x); return 1; }   /* --x0 (else 0) */
+  rc = phgmg_gl3_create(&g, &S->sys, A->dt, &go, NULL);
+  input_covers(in, spec, A->ntrain ? "--train-input" : "--input", A->steps * A->dt);
+  progress("simulating the full model (streamed): %d steps of dt = %g, %s", A->steps, A->dt, input_desc(in, spec));
+  for (n = 0; rc == PHGMG_OK; ++n) {   /* the loop of phgmg_simulate: t_n = n dt */
+    memcpy(blk + (size_t)*fill * N, x, sizeof(double) * (size_t)N);
+    if (++*fill == nb) { rc = phgmg_pod_stream_add(g_stream, nb, blk, N); *fill = 0; }
+    if (n == A->steps || rc != PHGMG_OK) break;
+    rc = phgmg_gl3_step(g, n * A->dt, x, input_fn, in, NULL);
+  }
+  phgmg_gl3_destroy(g);
+  free(x);
+  if (rc != PHGMG_OK)
+    return fail("streamed simulation failed at step %d of %d: %s", n + 1, A->steps, phgmg_result_string(rc));
+  return 0;
+}
+
+/* g_stream begun (kept at rank max(2(r'+1), r'+41) with r' = r - m
+   (gmg-pod) or r (sp1), at most N - m) and a block of *nb columns. */
+static int stream_begin(const reduce_args *A, const reduce_state *S, double **blk, int *nb) {
+  const int N = S->sys.N, m = S->sys.m, gmg = S->method == PHGMG_METHOD_GMG_POD;
+  const int p = gmg ? A->r - m : A->r, kmax = PHGMG__MIN(N - (gmg ? m : 0), PHGMG__MAX(2 * (p + 1), p + 41));
+  phgmg_result rc = phgmg_pod_stream_begin(&g_stream, N, gmg ? m : 0, gmg ? S->sys.B : NULL, N, kmax, 0.0, NULL);
+  if (rc != PHGMG_OK) return fail("streamed POD: %s", phgmg_result_string(rc));
+  *nb = PHGMG__MAX(16, PHGMG__MIN(64, kmax));
+  if (!(*blk = (double *)malloc(sizeof(double) * (size_t)N * (size_t)*nb))) return fail("out of memory");
+  return 0;
+}
+
+/* The last block into the stream, the log line, the column count. */
+static int stream_finish(const reduce_state *S, double *blk, int fill, int *nso) {
+  double disc = 0.0;
+  int k = 0;
+  phgmg_result rc = fill > 0 ? phgmg_pod_stream_add(g_stream, fill, blk, S->sys.N) : PHGMG_OK;
+  free(blk);
+  if (rc != PHGMG_OK) return fail("streamed POD: %s", phgmg_result_string(rc));
+  phgmg_pod_stream_end(g_stream, NULL, S->sys.N, NULL, &k, &disc);
+  progress("  streamed POD: %d modes kept of %d snapshots (error bound %.3g)", k, phgmg_pod_stream_columns(g_stream), disc);
+  *nso = phgmg_pod_stream_columns(g_stream);
+  return 0;
+}
+
+/* The training runs streamed into g_stream. */
+static int stream_training_runs(const reduce_args *A, reduce_state *S, int *nso, double *t_sim) {
+  const int m = S->sys.m, nrun = A->ntrain ? A->ntrain : 1;
+  double *blk = NULL, t0 = now_s();
+  int i, k, nb = 0, fill = 0;
+  if ((k = input_setup(&S->in, A->ntrain ? "--train-input" : "--input", A->input, A->amp, m, A->dt, A->steps * A->dt)) != 0)
+    return k;
+  for (i = 1; i < nrun; ++i)
+    if ((k = input_setup(&S->tin[i], "--train-input", A->train[i], A->amp, m, A->dt, A->steps * A->dt)) != 0) return k;
+  if ((k = stream_begin(A, S, &blk, &nb)) != 0) { free(blk); return k; }
+  for (i = 0, k = 0; i < nrun && !k; ++i) k = stream_run(A, S, i ? &S->tin[i] : &S->in, i ? A->train[i] : A->input, blk, nb, &fill);
+  if (k) { free(blk); return k; }
+  *t_sim = now_s() - t0;
+  return stream_finish(S, blk, fill, nso);
+}
+
+/* The --X files read in blocks of columns into g_stream (in the model's
+   internal order for a sparse model). */
+static int stream_x_files(const reduce_args *A, reduce_state *S, int *nso) {
+  const int N = S->sys.N;
+  double *blk = NULL, *perm = NULL;
+  int f, j, nb = 0, k, rows = 0, cols = 0;
+  phgmg_result rc = PHGMG_OK;
+  if ((k = stream_begin(A, S, &blk, &nb)) != 0) { free(blk); return k; }
+  if (S->sp && !(perm = (double *)malloc(sizeof(double) * (size_t)N * (size_t)nb))) { free(blk); return fail("out of memory"); }
+  for (f = 0; f < A->nx && rc == PHGMG_OK; ++f) {
+    if ((rc = phgmg_npy_read_cols(A->xs[f], 0, 0, NULL, 1, &rows, &cols)) != PHGMG_OK) break;
+    if (rows != N || cols < 2) {
+      free(blk); free(perm);
+      return fail("%s (--X): expected shape (%d, ns), ns >= 2 snapshots as columns, got (%d, %d)", A->xs[f], N, rows, cols);
+    }
+    progress("streaming %s: %d snapshots in blocks of %d", A->xs[f], cols, nb);
+    for (j = 0; j < cols && rc == PHGMG_OK; j += nb) {
+      const int c = PHGMG__MIN(nb, cols - j);
+      rc = phgmg_npy_read_cols(A->xs[f], j, c, blk, N, NULL, NULL);
+      if (rc == PHGMG_OK && S->sp) phgmg_ph_sparse_to_banded_order(S->sp, c, blk, N, perm, N);
+      if (rc == PHGMG_OK) rc = phgmg_pod_stream_add(g_stream, c, S->sp ? perm : blk, N);
+    }
+  }
+  free(perm);
+  if (rc != PHGMG_OK) { free(blk); return fail("%s (--X): %s", A->xs[PHGMG__MIN(f, A->nx - 1)], phgmg_result_string(rc)); }
+  return stream_finish(S, blk, 0, nso);
+}
+
 /* phgmg_reduce with the options of the command line; reports what it did. */
 static int run_reduction(const reduce_args *A, reduce_state *S, int method, const double *X, int ns,
                          phgmg_reduce_opts *op, phgmg_reduce_info *ip, double *t_red) {
@@ -3534,7 +3683,9 @@ static int run_reduction(const reduce_args *A, reduce_state *S, int method, cons
   plog.t0 = t0; plog.all = (double)N * (double)ns >= 1e7; plog.ncand = plog.nprobe = 0;
   plog.qm = method == PHGMG_METHOD_GMG_QM; plog.hyper = o.hyper.on;
   if (!g_quiet) { o.progress = reduce_phase; o.progress_user = &plog; }
-  rc = S->study ? phgmg_study_reduce(S->study, &o, &S->red, &info) : phgmg_reduce(&S->red, &S->sys, X, N, ns, &o, &info, NULL);
+  rc = g_stream ? phgmg_reduce_stream(&S->red, &S->sys, g_stream, &o, &info, NULL)
+       : S->study ? phgmg_study_reduce(S->study, &o, &S->red, &info)
+                  : phgmg_reduce(&S->red, &S->sys, X, N, ns, &o, &info, NULL);
   *t_red = now_s() - t0;
   if (rc != PHGMG_OK) {
     const char *src = A->X ? A->X : "the simulated snapshots";
@@ -4063,6 +4214,7 @@ static int reduce_prepare(const reduce_args *A, reduce_state *S, const char *con
   int e, k;
   reduce_args T = *A;
   char nm[128];
+  const char *why;
   if ((S->method = method_code(A->method)) < 0)
     return usage_error("--method '%s': expected gmg-pod, gmg-qm, sp1, sp2, bt, prbt or phbt", A->method);
   reduce_paths(A, S, tests, nt);
@@ -4081,6 +4233,7 @@ static int reduce_prepare(const reduce_args *A, reduce_state *S, const char *con
     if ((e = check_sizes(&T, S->method, S->sys.N, S->sys.m, S->dae ? phgmg_dae_nalg(S->dae) : 0)) != 0) return e;
   }
   S->method = method_code(A->method);
+  if (A->X && stream_use(A, S, &why) && A->nml == 1) return 0;   /* read in blocks by reduce_build */
   return A->X ? load_snapshot_files(A, S, S->sys.N, S->sys.m, &S->Xd, &S->ns) : 0;
 }
 
@@ -4182,47 +4335,65 @@ static void sweep_study(const reduce_args *A, reduce_state *S, const double *X, 
   }
 }
 
+/* Model k of a run (one of a sweep): reduced, its arrays and files written
+   under their temporary names, kept (keep) or destroyed. X NULL: the
+   streamed snapshots (g_stream) or none (balancing). */
+static int sweep_build_model(const reduce_args *A, reduce_state *S, int k, const double *X, int ns, int keep) {
+  sweep_model *M = &S->models[k];
+  reduce_args T = *A;
+  phgmg_reduce_opts o;
+  phgmg_reduce_info info;
+  const phgmg_rom *rom;
+  int e;
+  memset(&o, 0, sizeof o);
+  memset(&info, 0, sizeof info);
+  sweep_set(&T, k, M->name, sizeof M->name);
+  M->method = S->method = method_code(T.method);
+  M->r = T.r;
+  if (is_balancing(S->method)) {   /* no snapshots */
+    if ((e = run_balancing(&T, S, &M->t_red)) != 0) return e;
+    if ((e = write_arrays(&T, S, NULL, 0, &S->ol)) != 0) return e;
+    if ((e = write_model_files(&T, S, S->method, 0, 0.0, M->t_red, &o, &info, &S->ol)) != 0) return e;
+  } else {
+    if ((e = run_reduction(&T, S, S->method, X, ns, &o, &info, &M->t_red)) != 0) return e;
+    if ((e = write_arrays(&T, S, X, ns, &S->ol)) != 0) return e;
+    if ((e = write_model_files(&T, S, S->method, ns, S->t_sim, M->t_red, &o, &info, &S->ol)) != 0) return e;
+  }
+  rom = phgmg_reduced_rom(S->red);
+  M->rr = rom->r; M->m = rom->m; M->pass = 1;
+  M->sg = S->sg; M->ol = S->ol;
+  memset(&S->sg, 0, sizeof S->sg);
+  if (keep) M->red = S->red;
+  else phgmg_reduced_destroy(S->red);
+  S->red = NULL;
+  return 0;
+}
+
 /* The snapshots, the reduction and every output written under its temporary
    name (reduce_commit moves them into place). */
 static int reduce_build(const reduce_args *A, reduce_state *S, int keep) {
   const double *X = S->Xd;
   int ns = S->ns, e, k;
+  const char *why;
+  const int stream = stream_use(A, S, &why);
   S->dirs = S->sg;   /* the directories made; each model stages its own files */
   memset(&S->sg, 0, sizeof S->sg);
   S->nmodels = sweep_count(A);
   S->models = (sweep_model *)calloc((size_t)S->nmodels, sizeof(sweep_model));
   if (!S->models) return fail("out of memory");
-  if (sweep_needs_snapshots(A) && !A->X && (e = simulate_training_runs(A, S, &X, &ns, &S->t_sim)) != 0) return e;
-  sweep_study(A, S, X, ns);
-  for (k = 0; k < S->nmodels; ++k) {
-    sweep_model *M = &S->models[k];
-    reduce_args T = *A;
-    phgmg_reduce_opts o;
-    phgmg_reduce_info info;
-    const phgmg_rom *rom;
-    memset(&o, 0, sizeof o);
-    memset(&info, 0, sizeof info);
-    sweep_set(&T, k, M->name, sizeof M->name);
-    M->method = S->method = method_code(T.method);
-    M->r = T.r;
-    if (is_balancing(S->method)) {   /* no snapshots */
-      if ((e = run_balancing(&T, S, &M->t_red)) != 0) return e;
-      if ((e = write_arrays(&T, S, NULL, 0, &S->ol)) != 0) return e;
-      if ((e = write_model_files(&T, S, S->method, 0, 0.0, M->t_red, &o, &info, &S->ol)) != 0) return e;
-    } else {
-      if ((e = run_reduction(&T, S, S->method, X, ns, &o, &info, &M->t_red)) != 0) return e;
-      if ((e = write_arrays(&T, S, X, ns, &S->ol)) != 0) return e;
-      if ((e = write_model_files(&T, S, S->method, ns, S->t_sim, M->t_red, &o, &info, &S->ol)) != 0) return e;
-    }
-    rom = phgmg_reduced_rom(S->red);
-    M->rr = rom->r; M->m = rom->m; M->pass = 1;
-    M->sg = S->sg; M->ol = S->ol;
-    memset(&S->sg, 0, sizeof S->sg);
-    if (keep) M->red = S->red;
-    else phgmg_reduced_destroy(S->red);
-    S->red = NULL;
-  }
-  return 0;
+  if (stream && A->nml > 1)
+    return usage_error("--stream: one method per run (the stream keeps one method's basis; a list of --r is fine)");
+  if (!stream && A->stream) return usage_error("--stream: not with %s", why);
+  if (stream) {   /* streamed: no snapshot matrix (run_reduction reduces from g_stream) */
+    if ((e = A->X ? stream_x_files(A, S, &ns) : stream_training_runs(A, S, &ns, &S->t_sim)) != 0) return e;
+  } else if (sweep_needs_snapshots(A) && !A->X && (e = simulate_training_runs(A, S, &X, &ns, &S->t_sim)) != 0)
+    return e;
+  if (!stream) sweep_study(A, S, X, ns);
+  for (k = 0; k < S->nmodels; ++k)
+    if ((e = sweep_build_model(A, S, k, stream ? NULL : X, ns, keep)) != 0) break;
+  phgmg_pod_stream_destroy(g_stream);
+  g_stream = NULL;
+  return e;
 }
 
 static int cmd_reduce_impl(const reduce_args *A, reduce_state *S) {

@@ -41,3 +41,4 @@
 #include "test_sparse_class.c"
 #include "test_balanced.c"
 #include "test_workflow.c"
+#include "test_pod_stream.c"

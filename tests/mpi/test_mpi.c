@@ -670,6 +670,148 @@ static void compare_runs(const char *dir) {
   }
 }
 
+/* ---- distributed ECSW ----------------------------------------------------------- */
+/* Terms distributed by rows (term k at row k, 600 terms): F = tanh of the
+   graded snapshots, Vt = the leading 6 POD modes' rows. The point set, as
+   global indices, and the weights are the same at every P (compare_runs,
+   1e-12; P = 4 with a rank owning no terms); on every rank the relative
+   residual, recomputed from the full data on rank 0, meets tol and equals
+   the one returned; a tie between two equal terms goes to the lower index. */
+static void test_ecsw(void) {
+  const int N = 600, ns = 30, r = 6;
+  double *X = (double *)malloc(sizeof(double) * N * ns), *U = (double *)malloc(sizeof(double) * N * ns), sig[30];
+  double *Fl, *Vl, w[600], res = -1.0, pd[600];
+  long long *gid, pts[600];
+  int nd = 0, i, j, a;
+  phgmg_result rc;
+  phgmg_mpi_ctx *c = make_ctx(N);
+  rng_ = 777;
+  graded(N, ns, X, U, sig);
+  for (i = 0; i < N * ns; ++i) X[i] = tanh(30.0 * X[i]);
+  Fl = own_rows(c, ns, X);
+  Vl = own_rows(c, r, U);
+  gid = (long long *)malloc(sizeof(long long) * ((size_t)c->nloc + 1));
+  for (i = 0; i < c->nloc; ++i) gid[i] = c->row0 + i;
+  rc = phgmg_mpi_ecsw(c, c->nloc, ns, Fl, c->nloc > 0 ? c->nloc : 1, r, Vl, c->nloc > 0 ? c->nloc : 1, NULL, gid,
+                      1e-4, N, pts, w, &nd, &res);
+  CHECK(rc == PHGMG_OK && nd > r && nd < N / 2, "ecsw rc %d nd %d", (int)rc, nd);
+  CHECK(same_everywhere(nd), "ecsw: nd differs between ranks");
+  if (rank_ == 0 && rc == PHGMG_OK) {   /* the residual from the full data */
+    double *T = (double *)calloc((size_t)ns * r, sizeof(double)), num = 0.0, den = 0.0;
+    int q = 0;
+    for (i = 0; i < N; ++i) {
+      const double d = (q < nd && pts[q] == i) ? w[q++] - 1.0 : -1.0;
+      for (a = 0; a < r; ++a)
+        for (j = 0; j < ns; ++j) T[j + a * ns] += d * X[i + (size_t)j * N] * U[i + (size_t)a * N];
+    }
+    for (j = 0; j < ns * r; ++j) num += T[j] * T[j];
+    memset(T, 0, sizeof(double) * (size_t)ns * r);
+    for (i = 0; i < N; ++i)
+      for (a = 0; a < r; ++a)
+        for (j = 0; j < ns; ++j) T[j + a * ns] += X[i + (size_t)j * N] * U[i + (size_t)a * N];
+    for (j = 0; j < ns * r; ++j) den += T[j] * T[j];
+    CHECK(q == nd && sqrt(num / den) <= 1e-4 && fabs(sqrt(num / den) - res) <= 1e-10,
+          "ecsw residual %.3e (returned %.3e)", sqrt(num / den), res);
+    for (i = 1; i < nd; ++i) CHECK(pts[i - 1] < pts[i], "ecsw points not ascending");
+    for (i = 0; i < nd; ++i) CHECK(w[i] > 0.0, "ecsw weight %d = %g", i, w[i]);
+    free(T);
+  }
+  for (i = 0; i < nd; ++i) pd[i] = (double)pts[i];
+  put(pd, nd);
+  put(w, nd);
+  if (rank_ == 0) printf("  ecsw: %d points of %d terms, residual %.2e\n", nd, N, res);
+  /* a tie: two identical terms, 150 and 450 (other ranks at P > 1): the lower one is taken */
+  {
+    double Ft[2 * 3] = {1, 1, 2, 2, 3, 3}, Vt2[2] = {1, 1};
+    long long gt[2] = {450, 150}, pt[2];
+    const int nloc2 = rank_ == 0 ? 2 : 0;
+    double wt[2];
+    int n2 = 0;
+    rc = phgmg_mpi_ecsw(c, nloc2, 3, Ft, 2, 1, Vt2, 2, NULL, gt, 1e-6, 2, pt, wt, &n2, NULL);
+    CHECK(rc == PHGMG_OK && n2 == 1 && pt[0] == 150 && fabs(wt[0] - 2.0) <= 1e-12, "ecsw tie: %d %lld %g", n2, pt[0], wt[0]);
+  }
+  free(X); free(U); free(Fl); free(Vl); free(gid);
+  phgmg_mpi_ctx_destroy(c);
+}
+
+/* ---- shifted Cholesky-QR ----------------------------------------------------- */
+/* On the graded matrix (singular values 1 ... 1e-13): Q orthonormal to 1e-13,
+   X = Q R to 1e-14 relative, R's singular values the exact ones to 1e-12
+   (what the Gram matrix alone cannot give: test_pod's negative control), and
+   the same at every P (compare_runs). */
+static void test_cholqr(void) {
+  const int N = 600, ns = 40;
+  double *X = (double *)malloc(sizeof(double) * N * ns), *U = (double *)malloc(sizeof(double) * N * ns), sig[40];
+  double *Xl, *Ql, R[40 * 40], G[40 * 40], sv[40], eo = 0.0, es = 0.0, rl[2] = {0.0, 0.0}, rg[2];
+  int ld, i, j, l, k = 0, rank = 0;
+  phgmg_mpi_ctx *c = make_ctx(N);
+  rng_ = 12345;
+  graded(N, ns, X, U, sig);
+  Xl = own_rows(c, ns, X);
+  ld = c->nloc > 0 ? c->nloc : 1;
+  Ql = (double *)malloc(sizeof(double) * ((size_t)ld * ns));
+  CHECK(phgmg_mpi_cholqr(c, ns, Xl, ld, Ql, ld, R, ns) == PHGMG_OK, "cholqr");
+  CHECK(phgmg_mpi_atb(c, ns, ns, Ql, ld, Ql, ld, G, ns) == PHGMG_OK, "Q^T Q");
+  for (j = 0; j < ns; ++j) for (i = 0; i < ns; ++i) eo = fmax(eo, fabs(G[i + j * ns] - (i == j)));
+  for (j = 0; j < ns; ++j)
+    for (i = 0; i < c->nloc; ++i) {
+      double t = Xl[i + (size_t)j * c->nloc];
+      for (l = 0; l <= j; ++l) t -= Ql[i + (size_t)l * ld] * R[l + j * ns];
+      rl[0] += t * t;
+      rl[1] += Xl[i + (size_t)j * c->nloc] * Xl[i + (size_t)j * c->nloc];
+    }
+  MPI_Allreduce(rl, rg, 2, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
+  CHECK(phgmg_svd(ns, ns, R, ns, ns, sv, G, ns, NULL, 1, &k, &rank, NULL) == PHGMG_OK && k == ns, "svd of R");
+  for (i = 0; i < k; ++i) es = fmax(es, fabs(sv[i] - sig[i]));
+  CHECK(eo <= 1e-13 && sqrt(rg[0] / rg[1]) <= 1e-14 && es <= 1e-12,
+        "cholqr: orthogonality %.2e, residual %.2e, singular values %.2e", eo, sqrt(rg[0] / rg[1]), es);
+  if (rank_ == 0) printf("  cholqr: orthogonality %.2e, residual %.2e, singular values %.2e\n", eo, sqrt(rg[0] / rg[1]), es);
+  put(sv, k);
+  free(X); free(U); free(Xl); free(Ql);
+  phgmg_mpi_ctx_destroy(c);
+}
+
+/* ---- communication counts ---------------------------------------------------- */
+/* The counts of a POD (TSQR) and of greedy DEIM on graded snapshots do not
+   depend on N (600 and 2400 rows, the same ns and k): the same number of
+   collectives and bytes; a POD makes some, and a fresh context none. */
+static void test_counts(void) {
+  const int ns = 20, kd = 8;
+  phgmg_mpi_counts cnt[2][2];
+  int pass;
+  for (pass = 0; pass < 2; ++pass) {
+    const int N = pass ? 2400 : 600;
+    double *X = (double *)malloc(sizeof(double) * N * ns), *U = (double *)malloc(sizeof(double) * N * ns), sig[20];
+    double *Xl, *V, S[20];
+    long long pts[8];
+    int k = 0, ld;
+    phgmg_mpi_ctx *c = make_ctx(N);
+    phgmg_mpi_counts z;
+    ld = c->nloc > 0 ? c->nloc : 1;
+    phgmg_mpi_counts_get(c, &z);
+    CHECK(z.collectives == 0 && z.bytes == 0 && z.exchanges == 0, "fresh context counts %lld", z.collectives);
+    rng_ = 99;
+    graded(N, ns, X, U, sig);
+    Xl = own_rows(c, ns, X);
+    V = (double *)malloc(sizeof(double) * ((size_t)ld * ns));
+    CHECK(phgmg_mpi_pod(c, ns, Xl, ld, kd, 0.0, V, ld, S, &k) == PHGMG_OK && k == kd, "pod for counts");
+    phgmg_mpi_counts_get(c, &cnt[pass][0]);
+    phgmg_mpi_counts_reset(c);
+    CHECK(phgmg_mpi_deim_greedy(c, kd, V, ld, NULL, pts, NULL) == PHGMG_OK, "deim for counts");
+    phgmg_mpi_counts_get(c, &cnt[pass][1]);
+    free(X); free(U); free(Xl); free(V);
+    phgmg_mpi_ctx_destroy(c);
+  }
+  CHECK(cnt[0][0].collectives > 0 && cnt[0][0].bytes >= 8LL * ns * ns && cnt[0][1].collectives >= kd, "counts made");
+  CHECK(cnt[0][0].collectives == cnt[1][0].collectives && cnt[0][0].bytes == cnt[1][0].bytes &&
+            cnt[0][1].collectives == cnt[1][1].collectives && cnt[0][1].bytes == cnt[1][1].bytes,
+        "counts depend on N: pod %lld/%lld, deim %lld/%lld", cnt[0][0].collectives, cnt[1][0].collectives,
+        cnt[0][1].collectives, cnt[1][1].collectives);
+  if (rank_ == 0)
+    printf("  counts: pod %lld collectives / %lld bytes, deim %lld / %lld (N = 600 and 2400 alike)\n",
+           cnt[0][0].collectives, cnt[0][0].bytes, cnt[0][1].collectives, cnt[0][1].bytes);
+}
+
 int main(int argc, char **argv) {
   int total = 0;
   double t0;
@@ -686,6 +828,9 @@ int main(int argc, char **argv) {
   test_deim();
   test_gmg();
   test_errors();
+  test_ecsw();
+  test_cholqr();
+  test_counts();
   compare_runs(argc > 1 ? argv[1] : NULL);
   MPI_Allreduce(&fails_, &total, 1, MPI_INT, MPI_SUM, MPI_COMM_WORLD);
   if (rank_ == 0) printf("test_mpi: P = %d: %s (%d failed checks, %.2f s)\n", size_, total ? "FAILED" : "passed", total, MPI_Wtime() - t0);
