@@ -142,7 +142,9 @@ static const char *const help_lines[] = {
   "                      snapshots; the default when they would exceed 4 GiB.\n",
   "                      Memory about N (K + 3 min(K, 64)) doubles while streaming,\n",
   "                      K = max(2 (R' + 1), R' + 41) modes kept (at most N - m),\n",
-  "                      R' = R - m (gmg-pod) or R (sp1). For --method gmg-pod and\n",
+  "                      R' = R - m (gmg-pod) or R (sp1), R the largest order of\n",
+  "                      --r (one stream serves a list of orders, one method).\n",
+  "                      For --method gmg-pod and\n",
   "                      sp1 only, without a hyper-reduced --poly-idx part (use\n",
   "                      --no-hyper), --ref, --save-snapshots, --X-input, --E,\n",
   "                      feedthrough or --dampers (--stream then is a usage error).\n",
@@ -3576,11 +3578,19 @@ static int stream_run(const reduce_args *A, reduce_state *S, cli_input *in, cons
   return 0;
 }
 
+/* The largest order of the run's --r list. */
+static int max_order(const reduce_args *A) {
+  int k, r = A->r;
+  for (k = 0; k < A->nrl; ++k) r = PHGMG__MAX(r, A->rlist[k]);
+  return r;
+}
+
 /* g_stream begun (kept at rank max(2(r'+1), r'+41) with r' = r - m
-   (gmg-pod) or r (sp1), at most N - m) and a block of *nb columns. */
+   (gmg-pod) or r (sp1), r the largest order asked, at most N - m) and a
+   block of *nb columns. */
 static int stream_begin(const reduce_args *A, const reduce_state *S, double **blk, int *nb) {
-  const int N = S->sys.N, m = S->sys.m, gmg = S->method == PHGMG_METHOD_GMG_POD;
-  const int p = gmg ? A->r - m : A->r, kmax = PHGMG__MIN(N - (gmg ? m : 0), PHGMG__MAX(2 * (p + 1), p + 41));
+  const int N = S->sys.N, m = S->sys.m, gmg = S->method == PHGMG_METHOD_GMG_POD, rmax = max_order(A);
+  const int p = gmg ? rmax - m : rmax, kmax = PHGMG__MIN(N - (gmg ? m : 0), PHGMG__MAX(2 * (p + 1), p + 41));
   phgmg_result rc = phgmg_pod_stream_begin(&g_stream, N, gmg ? m : 0, gmg ? S->sys.B : NULL, N, kmax, 0.0, NULL);
   if (rc != PHGMG_OK) return fail("streamed POD: %s", phgmg_result_string(rc));
   *nb = PHGMG__MAX(16, PHGMG__MIN(64, kmax));

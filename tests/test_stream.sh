@@ -68,7 +68,14 @@ for o in xf xc; do
   same_y xin xs_$o && pass || bad "--X $o.npy: streamed and stored models differ"
 done
 
-# 3. what the stream cannot serve: usage errors
+# 3. a list of orders from one stream: each model equals the stored run's
+"$P" reduce $SYS $SIM --method gmg-pod --r 16,20 --out sw --stream >/dev/null 2>err.txt && pass || bad "reduce --r 16,20 --stream: $(tail -n 2 err.txt)"
+[ "$(grep -c "streamed POD: " err.txt)" -eq 1 ] && pass || bad "--r 16,20 --stream: not one stream: $(cat err.txt)"
+mkdir -p sw20 && cp sw/rom_gmg_pod_r20.phgmgrom sw20/rom.phgmgrom && same_y in_gmg-pod sw20 && pass || bad "--r 16,20 --stream: the r = 20 model differs from the stored run's"
+"$P" reduce $SYS $SIM --method gmg-pod,sp1 --r 20 --out e0 --stream >/dev/null 2>err.txt
+[ $? -eq 2 ] && grep -q -- "--stream: one method per run" err.txt && pass || bad "--stream with two methods: $(cat err.txt)"
+
+# 4. what the stream cannot serve: usage errors
 "$P" reduce $SYS $SIM --method gmg-qm --r 20 --lambda 1e-3 --out e1 --stream >/dev/null 2>err.txt
 [ $? -eq 2 ] && grep -q -- "--stream: not with --method gmg-qm" err.txt && pass || bad "--stream gmg-qm: $(cat err.txt)"
 "$P" reduce $SYS $SIM --method gmg-pod --r 20 --save-snapshots --out e2 --stream >/dev/null 2>err.txt
