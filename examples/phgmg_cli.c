@@ -4877,13 +4877,6 @@ static int validate_error(const char *spec, phgmg_result rc, const reduce_state 
   return fail("validate: %s: %s", spec, phgmg_result_string(rc));
 }
 
-/* The largest order of the run's --r list. */
-static int max_order(const reduce_args *A) {
-  int k, r = 0;
-  for (k = 0; k < A->nrl; ++k) r = PHGMG__MAX(r, A->rlist[k]);
-  return r;
-}
-
 /* One test of validate: the full model and every model of the run on input
    `spec` over nsteps from x0 (NULL: 0), one full run for all of them
    (phgmg_reduced_validate_many); prints a line per model; a model that fails
