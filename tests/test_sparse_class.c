@@ -180,18 +180,22 @@ static phgmg_result spc_sim(const phgmg_ph_system *sys, double *X, double *Y, ph
   return rc;
 }
 
-/* GMG-POD of order 8 from the snapshots X (SPC_STEPS + 1 columns) and its
-   outputs from rest under spc_u (NULL on failure). */
-static phgmg_reduced *spc_reduce(const phgmg_ph_system *sys, const double *X, double *Yr) {
+/* A reduced model of order 8 (method meth; spc_reduce: GMG-POD) from the
+   snapshots X (SPC_STEPS + 1 columns) and its outputs from rest under spc_u
+   (NULL on failure). */
+static phgmg_reduced *spc_reduce_m(const phgmg_ph_system *sys, const double *X, double *Yr, phgmg_method meth) {
   phgmg_reduce_opts o;
   phgmg_reduced *red = NULL;
   double xr0[8] = {0};
   memset(&o, 0, sizeof o);
-  o.method = PHGMG_METHOD_GMG_POD; o.r = 8;
+  o.method = meth; o.r = 8;
   if (phgmg_reduce(&red, sys, X, sys->N, SPC_STEPS + 1, &o, NULL, NULL) != PHGMG_OK) return NULL;
   if (phgmg_reduced_simulate(red, xr0, 0.0, 0.1, SPC_STEPS, spc_u, NULL, 1e-13, 30, NULL, Yr, NULL, NULL, NULL) !=
       PHGMG_OK) { phgmg_reduced_destroy(red); return NULL; }
   return red;
+}
+static phgmg_reduced *spc_reduce(const phgmg_ph_system *sys, const double *X, double *Yr) {
+  return spc_reduce_m(sys, X, Yr, PHGMG_METHOD_GMG_POD);
 }
 
 /* Dampers between the momenta (co-states: velocities) of x-neighbours,
@@ -216,9 +220,9 @@ static void spc_dampers(const spc_model *m, const phgmg_ph_sparse *sp, phgmg_ph_
    (stats), its trajectory and outputs equal the band LU's to 1e-10 of their
    scale with the same Newton iterations (the same Jacobian), the energy
    balance H_n - H_0 = S_n - D_n holds for a quadratic H, the validation
-   (J - R - L regular, through the sparse copies) passes, and a GMG-POD
-   model reduced from the sparse system (G = (J - R - L)^{-1} on the sparse
-   copies) simulates as the one reduced from the band system. */
+   (J - R - L regular, through the sparse copies) passes, and the GMG-POD
+   and SP1 models reduced from the sparse system (GMG: G = (J - R - L)^{-1}
+   on the sparse copies) simulate as those reduced from the band system. */
 TEST(test_spclass_dampers) {
   spc_model m;
   phgmg_ph_sparse *sp = NULL;
@@ -227,7 +231,8 @@ TEST(test_spclass_dampers) {
   phgmg_energy E;
   int di[64], dj[64], N, n;
   double *X1, *X2, *Y1, *Y2, sc, bal = 0.0, Hmax = 0.0, Yr1[SPC_STEPS + 1], Yr2[SPC_STEPS + 1];
-  phgmg_reduced *red1, *red2;
+  double Ys1[SPC_STEPS + 1], Ys2[SPC_STEPS + 1];
+  phgmg_reduced *red1, *red2, *sp1, *sp2;
   spc_build(&m, 6, 5);
   N = m.N;
   X1 = (double *)malloc(sizeof(double) * (size_t)N * (SPC_STEPS + 1));
@@ -255,17 +260,23 @@ TEST(test_spclass_dampers) {
   CHECK(E.D[SPC_STEPS] > 0.0);
   CHECK_LE(bal, 1e-10 * Hmax);
   red1 = spc_reduce(&sys, X1, Yr1);
+  sp1 = spc_reduce_m(&sys, X1, Ys1, PHGMG_METHOD_SP1);
   CHECK_RC(phgmg_ph_sparse_set_solver(sp, PHGMG_SOLVER_BAND, NULL), PHGMG_OK);
   sys = *phgmg_ph_sparse_system(sp);
   CHECK(sys.storage == PHGMG_BANDED);
   spc_dampers(&m, sp, &sys, di, dj);
   CHECK_RC(spc_sim(&sys, X2, Y2, &st2, NULL), PHGMG_OK);
   red2 = spc_reduce(&sys, X1, Yr2);   /* the same snapshots: only the solver of J - R - L differs */
-  CHECK(red1 && red2);
+  sp2 = spc_reduce_m(&sys, X1, Ys2, PHGMG_METHOD_SP1);
+  CHECK(red1 && red2 && sp1 && sp2);
   CHECK_LE(spc_maxdiff(SPC_STEPS + 1, Yr1, Yr2, &sc), 1e-9 * sc);
+  CHECK(sc > 0.1);
+  CHECK_LE(spc_maxdiff(SPC_STEPS + 1, Ys1, Ys2, &sc), 1e-9 * sc);
   CHECK(sc > 0.1);
   phgmg_reduced_destroy(red1);
   phgmg_reduced_destroy(red2);
+  phgmg_reduced_destroy(sp1);
+  phgmg_reduced_destroy(sp2);
   CHECK(st2.sparse_lu == 0);
   CHECK_LE(labs(st1.newton_iters - st2.newton_iters), 2 + st2.newton_iters / 100); /* the same Jacobian */
   CHECK_LE(spc_maxdiff(N * (SPC_STEPS + 1), X1, X2, &sc), 1e-10 * sc);
