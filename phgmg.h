@@ -420,6 +420,72 @@
    lines) against the coordinate-aligned one: the same outputs, the states
    rotated, index two found as index two.
 
+   1.9 Nonlinear energies of finite-element form
+   Finite-element codes write a nonlinear stored energy as a sum over
+   elements or springs of a function of one strain-like quantity:
+       H_nl(x) = sum_k w_k phi_k(s_k),   s_k = c_k^T x,
+   c_k = e_i - e_j (a spring between nodes i and j), e_i (one node: the
+   SEPARABLE form of 1.1), or any sparse vector (an element's strain). Then
+       grad H_nl = sum_k w_k phi_k'(s_k) c_k,
+       Hess H_nl = sum_k w_k phi_k''(s_k) c_k c_k^T,
+   with the pattern of the union of supp(c_k) x supp(c_k) (a spring: (i, i),
+   (j, j), (i, j), (j, i); on a mesh the stiffness matrix's pattern).
+   How to give it. c_k = e_i: SEPARABLE (built-in exp-polynomial phi,
+   hyper-reduction, export). Any other c_k: a GENERAL part, whose callbacks
+   evaluate the sums above; with a sparse model (phgmg_ph_sparse) its
+   Hessian pattern is phgmg_ph_system.hess_p / hess_i (give it in your
+   ordering through phgmg_ph_sparse_hess_pattern, which also says where
+   each of your entries goes), and the stepper factors the stage matrices
+   with the sparse LU (8.12): one callback call per factorization fills the
+   values of that pattern.
+   Energy balance of the full model. GL3 is the collocation method of the
+   cubic p with p(t_n) = x_n, p'(t_n + c_i h) = F_i (1.7), so
+       H(x_{n+1}) - H(x_n) = int_{t_n}^{t_n+1} grad H(p)^T p' dt
+                           = h sum_i b_i z_i^T F_i + (Gauss-rule error),
+   and h sum_i b_i z_i^T F_i = S - D exactly (supply and dissipation at the
+   stages, phgmg_energy). The three-point rule integrates degree 5 exactly:
+   grad H(p)^T p' has degree 3 d - 1 for a polynomial phi of degree d, so the
+   balance is exact to round-off for quadratic phi and otherwise holds to the
+   rule's error, O(h^7) per step and O(h^6) over a fixed time (quartic
+   springs: halving h divides it by about 64).
+   Reduction. GMG-POD (and SP1, SP2) keep H: Hr(xr) = H(phi(xr)) =
+   1/2 xr^T Qh xr + sum_k w_k phi_k(c_k^T V0 xr), a sum of the same
+   functions of the reduced arguments P0_k xr with P0_k = c_k^T V0 (for a
+   spring, row i minus row j of V0), and xr' = K grad Hr + Bh u with the
+   constant K = (D^T G D)^{-1}, whose symmetric part is negative
+   semidefinite (1.3): the reduced model is port-Hamiltonian with Hr as its
+   energy, and the balance above holds for it with Hr. Given as a GENERAL
+   part, the reduced model evaluates H_nl, its gradient and Hessian in full
+   dimension (3.4: O(N) per evaluation, O(nnz(Hess) r) for the reduced
+   Hessian Dphi^T Hess Dphi through the pattern's values); hyper-reduction
+   (opts.hyper), which would pick terms k with weights on the rows P0_k,
+   takes SEPARABLE terms only (a GENERAL part with opts.hyper.on is
+   PHGMG_ERR_UNSUPPORTED).
+   With a mass matrix E. The model needs E^T z(x) = grad H(x) (1.6). With
+   z(x) = Q x + sum_k w_k phi_k'(s_k) c_k, E^T z is a gradient only if its
+   Jacobian E^T Q + sum_k w_k phi_k''(s_k) E^T c_k c_k^T is symmetric for
+   every x, i.e. E^T c_k c_k^T symmetric, i.e. E^T c_k = lambda_k c_k: c_k
+   an eigenvector of E^T; then H = 1/2 x^T E^T Q x + sum_k lambda_k w_k
+   phi_k(s_k) (lambda_k > 0 for the convexity phi carries). For c_k = e_i
+   that is row i of E equal to E(i, i) e_i^T, the rule of 1.6 (checked:
+   PHGMG_ERR_E_COUPLED); for a spring, rows i and j of E unit rows with
+   E(i, i) = E(j, j). A consistent mass matrix that couples a nonlinear
+   node to its neighbours breaks it: E^T z is then no gradient, the model
+   in this form has no Hamiltonian, and no reduction can keep a structure
+   the model does not have. Finite-element models carry the nonlinearity
+   in the stiffness (the positions, where E is the identity) and the
+   consistent mass on the velocities, E = blockdiag(I, M): every such term
+   is taken (SEPARABLE on the positions). A GENERAL part with E is
+   PHGMG_ERR_UNSUPPORTED (the library cannot check a callback's c_k
+   against E).
+   tests/test_sparse_class.c checks, for quartic springs (c_k = e_i - e_j)
+   on a lattice given as a GENERAL part with its pattern on the sparse LU:
+   the stepper against the band LU (trajectories to 1e-10, the same Newton
+   iterations), the full balance and its h^6 decay, the GMG-POD model's
+   energy Hr = H o phi along its run, Rr >= 0 and its own balance, and the
+   reduced model from the sparse system against the one from the band
+   system.
+
    2. THE OFFLINE PIPELINE ------------------------------------------------------
    2.1 Simulate. phgmg_simulate (or a phgmg_gl3 object: _create / _step /
    _get_stats / _destroy) integrates the full model with the 3-stage
