@@ -379,7 +379,9 @@ static const char *const help_lines[] = {
   "  systems are solved by the header's sparse direct LU (fill-reducing ordering,\n",
   "  with a mass matrix a column matching that keeps the pivots on E's large\n",
   "  entries) or, where that is predicted cheaper (narrow bands), by a band LU after\n",
-  "  reverse Cuthill-McKee; dampers and an E with zero rows/columns take the band LU.\n",
+  "  reverse Cuthill-McKee. Dampers take the sparse LU too; an E with zero\n",
+  "  rows/columns is stepped on the sparse LU by simulate, and reduce condenses it\n",
+  "  (band LU, at most 4096 algebraic lines).\n",
   "  The log names the solver and any fall-back to the band LU. V0, V2 and the\n",
   "  snapshots are written in your ordering, --poly-idx and --X are in your ordering.\n",
   "  From SciPy (A any scipy.sparse matrix):\n",
@@ -2716,9 +2718,6 @@ static int load_sparse_system(const reduce_args *A, reduce_state *S, phgmg_ph_sy
   rc = phgmg_ph_sparse_create_e(&S->sp, N, m, &S->cJ.A, &S->cR.A, &S->cQ.A, A->Ecoo ? &S->cE.A : NULL, S->B.a,
                                 NULL, &inf, NULL);
   if (rc != PHGMG_OK) return fail("sparse J, R, Q%s: %s", A->Ecoo ? ", E" : "", phgmg_result_string(rc));
-  if (A->dampf && inf.solver == PHGMG_SOLVER_SPARSE_LU &&
-      (rc = phgmg_ph_sparse_set_solver(S->sp, PHGMG_SOLVER_BAND, &inf)) != PHGMG_OK) /* the sparse LU: no dampers */
-    return fail("sparse J, R, Q: band solver: %s", phgmg_result_string(rc));
   if (sparse_dae_solver(A, S, &inf)) return 1;
   *sys = *phgmg_ph_sparse_system(S->sp);
   progress("sparse J, R, Q: N = %d, %ld stored entries; half-bandwidth %d (given order %d, reverse "

@@ -12,6 +12,8 @@
 # 2. The same lattice with the on-site potential cosh (nonlinear, refactored
 #    stage matrices): the output agrees with that of the same model given as
 #    dense .npy matrices (the dense LU with partial pivoting) to 1e-10 relative.
+#    With nonlinear dampers (--dampers) the log names the sparse LU (no band
+#    fall-back) and the output equals the dense model's to 1e-10 relative.
 # 4. A 2-D lattice with a mass matrix (--E-coo) whose E and Q have their
 #    columns swapped in pairs (the same outputs): the log names the sparse LU
 #    with its matched columns and no fall-back, the output equals the natural
@@ -78,6 +80,24 @@ a, b = np.load('yn.npy'), np.load('yd.npy')
 e = np.abs(a - b).max() / np.abs(b).max()
 assert e <= 1e-10 and np.abs(b).max() > 0.1, e
 " && pass || bad "cosh: sparse LU and dense LU outputs differ"
+
+# 2b. nonlinear dampers on the sparse LU (no band fall-back): the same output
+#     as the dense model's LU
+"$PY" -c "
+import numpy as np
+np.save('damp.npy', np.array([[5, 17, 0.3, 0.5], [40, -1, 0.2, 1.0], [123, 7, 0.0, 2.0]]))
+" && pass || bad "damper file"
+"$P" simulate $SYS --dampers damp.npy --amp 5 --steps 300 --out ydn.npy 2>err.txt >/dev/null \
+  && pass || bad "simulate --dampers (sparse): $(tail -n 2 err.txt)"
+grep -q "stage solver: sparse LU" err.txt && ! grep -q "band LU" err.txt && pass || bad "--dampers: not on the sparse LU: $(cat err.txt)"
+"$P" simulate --J J_dense.npy --R R_dense.npy --Q Q_dense.npy --B lat/B.npy --dampers damp.npy \
+  --amp 5 --steps 300 --out ydd.npy 2>err.txt >/dev/null && pass || bad "simulate --dampers (dense): $(tail -n 2 err.txt)"
+"$PY" -c "
+import numpy as np
+a, b = np.load('ydn.npy'), np.load('ydd.npy')
+e = np.abs(a - b).max() / np.abs(b).max()
+assert e <= 1e-10 and np.abs(b).max() > 0.1, e
+" && pass || bad "dampers: sparse LU and dense LU outputs differ"
 
 # 4. columns of E and Q swapped in pairs; a fall-back to the band LU is logged
 "$PY" - <<'PYEOF' || bad "descriptor lattice files"
