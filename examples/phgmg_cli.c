@@ -418,7 +418,8 @@ static const char *const help_lines[] = {
   "  factors' ranks, ADI steps and factorizations, the Lyapunov residuals\n",
   "  (relative), the singular values (first 64) and, for bt, \"error_bound\". The\n",
   "  log shows every phase (Gramians, shifts, balancing) that starts after the\n",
-  "  first second. The model files are the usual ones; simulate-rom runs them.\n",
+  "  first second. The model files are the usual ones; simulate-rom runs them\n",
+  "  (validate does not take these methods: compare simulate with simulate-rom).\n",
   "  Example (a 2-D model with 10^5 states, one core: about 10 s for heat,\n",
   "  90 s for a mass-spring lattice):\n",
   "    phgmg reduce --J-coo J.npy --R-coo R.npy --Q-coo Q.npy --B B.npy \\\n",
@@ -4948,6 +4949,9 @@ static int cmd_validate(int argc, char **argv) {
   reduce_state S;
   if ((i = parse_validate(argc, argv, &V, reduce_argv, &rargc)) != 0) return i;
   if ((i = parse_reduce(rargc, (char **)reduce_argv, &A)) != 0) return i;
+  if (balancing_method(A.method))   /* its reduced model has no projection measures of validate */
+    return usage_error("validate: --method %s is not validated by this command: run `phgmg reduce`, then compare "
+                       "`phgmg simulate` with `phgmg simulate-rom` (or use the error bound in NAME.json)", A.method);
   nt = V.nt;
   memset(from_x, 0, sizeof from_x);
   if (nt == 0 && A.ntrain)   /* default: the training inputs */
