@@ -18937,8 +18937,8 @@ PHGMG__PRIV void phgmg__err_map_block(const phgmg_reduced *red, const double *X,
       for (i = 0; i < N; ++i) Xt[i + (size_t)k * N] = X[i + (size_t)k * ldx] - Xt[i + (size_t)k * N];
     return;
   }
-  if (mode == 1) { /* C = rho(X), as phgmg_reduced_restrict */
-    if (red->method == PHGMG_METHOD_SP1 || red->method == PHGMG_METHOD_SP2) {
+  if (mode == 1) { /* C = rho(X), as phgmg_reduced_restrict (a stored test basis: W^T X) */
+    if (phgmg__method(red->method)->test_w) {
       phgmg_gemm('T', 'N', r, nb, N, 1.0, red->W, N, X, ldx, 0.0, C, r);
     } else {
       phgmg_gemm('T', 'N', m, nb, N, 1.0, red->QB, N, X, ldx, 0.0, C, r);

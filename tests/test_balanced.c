@@ -182,7 +182,56 @@ TEST(test_balanced_sparse_dense) {
   free(J); free(R); free(Q); free(B);
 }
 
+/* The error measures and phgmg_reduced_validate of balanced models (a stored
+   test basis W, no GMG basis): e_proj equals the same sum formed column by
+   column through phgmg_reduced_restrict / _lift, and the validation's e_red
+   and e_y equal those of the reduced model simulated separately. */
+static void bal_u(double t, double *u, void *p) { (void)p; u[0] = 0.1 * sin(t); u[1] = 0.05 * cos(0.7 * t); }
+TEST(test_balanced_validate) {
+  enum { NS = 81 };
+  double *J, *R, *Q, *B, *X, *Y, *XR, *YR, xr[8], xp[72], num = 0.0, den = 0.0;
+  const int N = bal_lattice(6, &J, &R, &Q, &B);
+  phgmg_ph_system sys;
+  phgmg_reduced *red = NULL;
+  phgmg_validation v;
+  phgmg_run run;
+  int meth, i, j;
+  memset(&sys, 0, sizeof sys);
+  sys.N = N; sys.m = 2; sys.J = J; sys.R = R; sys.Q = Q; sys.B = B;
+  X = (double *)calloc((size_t)N * NS, sizeof(double)); Y = (double *)calloc(2 * NS, sizeof(double));
+  XR = (double *)calloc(8 * NS, sizeof(double)); YR = (double *)calloc(2 * NS, sizeof(double));
+  memset(&run, 0, sizeof run); run.u = bal_u; run.dt = 0.1; run.nsteps = NS - 1;
+  memset(xp, 0, sizeof xp);
+  CHECK_RC(phgmg_simulate(&sys, xp, 0.0, 0.1, NS - 1, bal_u, NULL, NULL, X, Y, NULL, NULL, NULL, NULL), PHGMG_OK);
+  for (meth = 0; meth < 2; ++meth) {
+    if (meth == 0) CHECK_RC(phgmg_prbt(&red, &sys, 8, NULL, NULL, NULL, NULL), PHGMG_OK);
+    else CHECK_RC(phgmg_balanced_reduce(&red, &sys, NULL, PHGMG_METHOD_BT, 8, NULL, NULL, 0, NULL, NULL),
+                  PHGMG_OK);
+    if (!red) continue;
+    for (j = 0, num = den = 0.0; j < NS; ++j) {   /* e_proj column by column */
+      phgmg_reduced_restrict(red, X + (size_t)j * N, xr);
+      phgmg_reduced_lift(red, xr, xp);
+      for (i = 0; i < N; ++i) {
+        const double d = X[i + (size_t)j * N] - xp[i];
+        num += d * d; den += X[i + (size_t)j * N] * X[i + (size_t)j * N];
+      }
+    }
+    CHECK_LE(fabs(phgmg_err_proj(red, X, N, NS) - sqrt(num / den)), 1e-12 * sqrt(num / den) + 1e-300);
+    memset(xr, 0, sizeof xr);
+    CHECK_RC(phgmg_reduced_simulate(red, xr, 0.0, 0.1, NS - 1, bal_u, NULL, 1e-10, 20, XR, YR, NULL, NULL, NULL),
+             PHGMG_OK);
+    CHECK_RC(phgmg_reduced_validate(red, &sys, &run, 1e-10, 20, 0.0, &v, NULL), PHGMG_OK);
+    CHECK(v.rom_rc == PHGMG_OK && v.steps_done == NS - 1);
+    CHECK_LE(fabs(v.e_red - phgmg_err_red(red, X, N, NS, XR, 8)), 1e-12 * v.e_red + 1e-300);
+    CHECK_LE(fabs(v.e_y - phgmg_rel_error(2, NS, Y, 2, YR, 2)), 1e-12 * v.e_y + 1e-300);
+    CHECK(v.e_y < 0.5);
+    phgmg_reduced_destroy(red); red = NULL;
+  }
+  free(X); free(Y); free(XR); free(YR); free(J); free(R); free(Q); free(B);
+}
+
 SUITE(balanced) {
   RUN(test_balanced_ss_to_ph);
   RUN(test_balanced_sparse_dense);
+  RUN(test_balanced_validate);
 }
