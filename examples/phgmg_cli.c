@@ -238,7 +238,9 @@ static const char *const help_lines[] = {
   "                      (linear models with quadratic H; the online stepper then needs\n",
   "                      no Newton iteration at that step). Default: the --dt of\n",
   "                      --simulate, none with --X; 0 = none. A step map with spectral\n",
-  "                      radius above 1 (an amplifying step) is refused.\n",
+  "                      radius above 1 (an amplifying step) is refused. A model that\n",
+  "                      cannot have one (nonlinear terms, dampers, feedthrough, gmg-qm)\n",
+  "                      gets none: a --dt-map given then draws a note saying why.\n",
   "  --degeneracy-tol T  gmg: least non-degeneracy measure of D^T G D (the reduced\n",
   "                      model's operator, measured in equilibrated coordinates against\n",
   "                      the rounding of its entries, so independent of units and mesh;\n",
@@ -255,7 +257,9 @@ static const char *const help_lines[] = {
   "                      (m x ns: the full model's output at the snapshots).\n",
   "  --quiet             no progress lines on stderr.\n",
   "\n",
-  "  Outputs in DIR:\n",
+  "  Outputs in DIR (entries below the smallest normal number of the build's\n",
+  "  scalar type, DBL_MIN or FLT_MIN, are set to 0 in every array of the reduced\n",
+  "  model: no subnormal constants in the model file, C source or .npy arrays):\n",
   "    NAME.phgmgrom      the binary model file (phgmg_rom_load; for simulate-rom)\n",
   "    NAME.c             C source: static const arrays NAME_<field> and a\n",
   "                      `static const phgmg_rom NAME` (include after phgmg.h),\n",
@@ -273,6 +277,8 @@ static const char *const help_lines[] = {
   "    NAME_V2.npy, NAME_M.npy  (gmg-qm) V2 (N x r_n) and M (r_n x p^2, p = r - m):\n",
   "                      x ~ V0 xr + V2 M kron(x2, x2), x2 = xr[m:]\n",
   "    NAME.json          sizes, method, options, diagnostics and the list of files;\n",
+  "                      \"kind\": linear or nonlinear (energy terms, dampers), \"map\":\n",
+  "                      the reduction map, linear (x = V0 xr) or quadratic (gmg-qm);\n",
   "                      \"E\": whether the model has a mass matrix, \"N_full\": all its\n",
   "                      states (\"N\" is the number reduced: an index-one model's\n",
   "                      differential states), \"algebraic\", \"feedthrough\"\n",
@@ -3439,6 +3445,11 @@ static int run_reduction(const reduce_args *A, reduce_state *S, int method, cons
     progress("  manifold %s, lambda %s: %.3g%s", A->manifold_s ? A->manifold_s : "pod",
              A->lambda_auto == 1 ? "auto" : A->lambda_auto == 2 ? "cv" : "fixed", info.lambda,
              info.lambda == HUGE_VAL ? " (M = 0: no safe quadratic correction found)" : "");
+  if (!rom->Phi && A->have_dt_map && A->dt_map > 0.0)   /* asked for, not built: say why */
+    note("--dt-map %g has no effect: a step map is built for a linear reduced model with a quadratic energy and "
+         "no feedthrough or dampers, and this model has %s; the online stepper solves each step (Newton)",
+         A->dt_map, rom->kind == PHGMG_ROM_QUADRATIC ? "a quadratic manifold" : rom->nd ? "nonlinear energy terms"
+         : rom->ndamp ? "dampers" : rom->PD ? "feedthrough" : "a nonlinear part");
   if (rom->Phi) { /* the precomputed step map must not amplify: spectral radius <= 1 */
     const double rho = step_map_radius(rom);
     progress("  step map for dt = %g: spectral radius %.6g", A->dt_map, rho);
@@ -3458,6 +3469,35 @@ static int run_reduction(const reduce_args *A, reduce_state *S, int method, cons
   *op = o;
   *ip = info;
   return 0;
+}
+
+/* Entries of the reduced model's arrays below the smallest normal number of
+   its scalar type (DBL_MIN, or FLT_MIN in the float build) -- rounding
+   residue, e.g. of Qh = V^T Q V of a badly scaled Q -- set to 0 before
+   anything is written: subnormal constants slow down firmware (and some
+   compilers and processors flush them anyway). In place, so that the
+   model validate tests is the model written. Returns the count. */
+static long flush_subnormal_entries(const phgmg_reduced *red) {
+  const phgmg_rom *rom = phgmg_reduced_rom(red);
+#ifdef PHGMG_REAL_FLOAT
+  const phgmg_real tiny = FLT_MIN;
+#else
+  const phgmg_real tiny = DBL_MIN;
+#endif
+  rom_field f[24];
+  long cnt = 0;
+  int nf = rom_fields(rom, f), i;
+  size_t q, n;
+  if (rom->PD && nf < 24) {
+    f[nf].name = "PD"; f[nf].a = rom->PD; f[nf].rows = rom->r + rom->m; f[nf].cols = rom->m; ++nf;
+  }
+  for (i = 0; i < nf; ++i) {
+    phgmg_real *a = (phgmg_real *)(void *)(size_t)f[i].a;   /* the CLI owns the reduced object */
+    n = (size_t)f[i].rows * (size_t)f[i].cols;
+    for (q = 0; q < n; ++q)
+      if (a[q] != (phgmg_real)0 && fabs((double)a[q]) < (double)tiny) { a[q] = (phgmg_real)0; ++cnt; }
+  }
+  return cnt;
 }
 
 /* NAME_PD.npy: the reduced feedthrough as one (r + m) x m matrix [Ph; S + N]
@@ -3486,6 +3526,10 @@ static int write_arrays(const reduce_args *A, reduce_state *S, const double *X, 
   int i, k, nf;
   /* --- outputs --- */
   if (mkdir_p(A->out, &S->sg)) return 1;
+  {
+    const long nt = flush_subnormal_entries(S->red);
+    if (nt) progress("  %ld entries of the reduced model's arrays below the smallest normal number set to 0", nt);
+  }
   memset(ol, 0, sizeof *ol);
   nf = rom_fields(rom, fields);
   {
@@ -3626,7 +3670,9 @@ static int write_json(const reduce_args *A, reduce_state *S, int method, int ns,
   if (!jf) return fail("%s: cannot write: %s", path, strerror(errno));
   fprintf(jf, "{\n  \"phgmg_version\": \"%s\",\n  \"name\": ", PHGMG_VERSION_STRING);
   json_str(jf, A->name);
-  fprintf(jf, ",\n  \"method\": \"%s\",\n  \"kind\": \"%s\",\n", method_name(method),
+  /* kind: the model's (nonlinear: energy terms or dampers); map: the reduction map's (phgmg_rom.kind) */
+  fprintf(jf, ",\n  \"method\": \"%s\",\n  \"kind\": \"%s\",\n  \"map\": \"%s\",\n", method_name(method),
+          rom->nd || rom->ndamp || S->sys.nl != PHGMG_NL_NONE ? "nonlinear" : "linear",
           rom->kind == PHGMG_ROM_QUADRATIC ? "quadratic" : "linear");
   fprintf(jf, "  \"N\": %d, \"m\": %d, \"r\": %d, \"rn\": %d, \"nd\": %d, \"poly_deg\": %d,\n", N, m, rom->r,
           rom->rn, rom->nd, rom->nd ? rom->poly_deg : 0);

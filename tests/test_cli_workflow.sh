@@ -20,6 +20,8 @@
 # 5. --input sin --freq, --input chirp, --x0 against SciPy (solve_ivp, expm).
 # 6. SciPy .npz (save_npz) and Matrix Market .mtx (mmwrite) as --X-coo specs;
 #    malformed ones refused with a message naming the file.
+# 7. subnormal entries flushed in the written model; --dt-map's note; the
+#    record's kind and map.
 # Needs NumPy/SciPy (/usr/bin/python3) to write the inputs (skipped otherwise).
 set -u
 P=${1:-build/phgmg}
@@ -276,6 +278,35 @@ for f in trunc.npz corrupt.npz bad_head.mtx bad_idx.mtx bad_size.mtx; do
   st=$?
   [ $st -eq 1 ] && grep -q "$f (--J-coo)" err.txt && pass || bad "malformed $f: status $st: $(cat err.txt)"
 done
+
+# 7. the log and the record: a badly scaled Q (1e-300, J and R 1e300) leaves
+#    rounding residue below DBL_MIN in Qh: set to 0 in rom_Qh.npy and rom.c;
+#    --dt-map on a model that cannot have a step map draws a note; "kind" is
+#    the model's (nonlinear for Toda springs), "map" the reduction map's
+"$PY" -c "
+import numpy as np
+np.save('Qt.npy', 1e-300 * np.load('Q.npy'))
+for k in 'JR': np.save(k + 't.npy', 1e300 * np.load(k + '.npy'))
+np.save('idx.npy', np.arange(12))"
+"$P" reduce --J Jt.npy --R Rt.npy --Q Qt.npy --B B.npy $TRAIN --method gmg-pod --r 8 --dt-map 0 --out sub >/dev/null \
+  2>err.txt && pass || bad "reduce of the badly scaled model: $(tail -n 2 err.txt)"
+"$PY" -c "
+import numpy as np, sys
+a = np.load('sub/rom_Qh.npy')
+sys.exit(0 if np.abs(a).max() > 0 and not ((a != 0) & (np.abs(a) < sys.float_info.min)).any() else 1)" && pass \
+  || bad "rom_Qh.npy holds subnormal entries"
+grep -q "below the smallest normal number set to 0" err.txt && pass || bad "no log line on the flushed entries"
+grep -Eq "e-3(0[89]|[1-2][0-9])[^0-9]" sub/rom.c && bad "rom.c holds subnormal constants" || pass
+"$P" reduce $SYS --potential toda --poly-idx idx.npy $TRAIN --method gmg-pod --r 8 --dt-map 0.1 --out tn >/dev/null \
+  2>err.txt && pass || bad "reduce Toda: $(tail -n 2 err.txt)"
+grep -q "note: --dt-map 0.1 has no effect" err.txt && pass || bad "--dt-map ignored without a word: $(cat err.txt)"
+"$PY" -c "
+import json, sys
+a, b = json.load(open('tn/rom.json')), json.load(open('one/g6.json'))
+sys.exit(0 if (a['kind'], a['map'], b['kind'], b['map']) == ('nonlinear', 'linear', 'linear', 'linear') else 1)" \
+  && pass || bad "rom.json's kind/map"
+"$P" reduce $SYS $TRAIN --method gmg-pod --r 6 --dt-map 0.1 --out tl >/dev/null 2>err.txt && pass || bad "reduce r 6"
+grep -q "note: --dt-map" err.txt && bad "a note on --dt-map where the map is built: $(cat err.txt)" || pass
 
 echo "test_cli_workflow: $npass passed, $nfail failed"
 [ "$nfail" -eq 0 ]
