@@ -2080,7 +2080,7 @@ static int zip_member(const unsigned char *z, size_t n, const char *name, unsign
 }
 
 /* A whole file into memory (up to 2 GiB). NULL after a message. */
-static unsigned char *read_all(const char *path, const char *opt, size_t *n) {
+static unsigned char *read_file_bytes(const char *path, const char *opt, size_t *n) {
   FILE *f = fopen(path, "rb");
   unsigned char *b;
   long l;
@@ -2144,7 +2144,7 @@ static int npz_format(const unsigned char *z, size_t n, const char *path, const 
    allocated here; the shape must be N x N. */
 static int load_npz(const char *path, const char *opt, int N, int **ri, int **cj, double **v, int *nnz) {
   size_t n = 0;
-  unsigned char *z = read_all(path, opt, &n);
+  unsigned char *z = read_file_bytes(path, opt, &n);
   mat sh, a, b, d;
   char fmt[4];
   int err = 0, k, j, p, cnt;

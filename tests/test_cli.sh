@@ -475,7 +475,7 @@ run_err "D12 --simulate --steps cap" 2 "would need" "$P" reduce $SYS --simulate 
   --method gmg-pod --r 12 --out e
 run_err "D12 --dt 1e-320" 2 "too small in magnitude" "$P" simulate-rom --model out/msd.phgmgrom --dt 1e-320 --out y12.npy
 run_err "D12 --dt 1e999" 2 "too large" "$P" simulate-rom --model out/msd.phgmgrom --dt 1e999 --out y12.npy
-run_err "D12 --input square" 2 "expected sin, const or a FILE.npy" "$P" simulate-rom --model out/msd.phgmgrom \
+run_err "D12 --input square" 2 "expected sin, chirp, const or a FILE.npy" "$P" simulate-rom --model out/msd.phgmgrom \
   --input square --out y12.npy
 run_err "D12 info names no option" 1 "nomodel.phgmgrom (info)" "$P" info nomodel.phgmgrom
 run_err "D12 directory as model" 1 "is a directory" "$P" simulate-rom --model out --out y12.npy
@@ -803,7 +803,7 @@ run_err "P23 unknown command lists validate" 2 "validate" "$P" frobnicate
 # 26: the fuzz harness of the command line knows every command and option of
 #     --help (the lines calling Python name compare.py's options, not phgmg's)
 missing=
-for o in reduce validate simulate-rom info $("$P" --help | grep -v python3 | grep -o -- '--[a-zA-Z][a-zA-Z-]*' | sort -u); do
+for o in reduce validate simulate-rom info $("$P" --help | grep -v python3 | grep -o -- '--[a-zA-Z][a-zA-Z0-9-]*' | sort -u); do
   grep -F -q -- "\"$o\"" "$ROOT/tests/fuzz/fuzz_cli.c" || missing="$missing $o"
 done
 [ -z "$missing" ] && pass || bad "P26: tests/fuzz/fuzz_cli.c does not know:$missing"
