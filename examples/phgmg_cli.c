@@ -2575,6 +2575,7 @@ static void note_band_fallback(const phgmg_gl3_stats *st) {
 static int load_sparse_system(const reduce_args *A, reduce_state *S, phgmg_ph_system *sys) {
   phgmg_ph_sparse_info inf;
   phgmg_result rc;
+  double t0;
   int N, m;
   if (mat_load(&S->B, "--B", A->B)) return 1;
   N = S->B.rows;
@@ -2584,8 +2585,11 @@ static int load_sparse_system(const reduce_args *A, reduce_state *S, phgmg_ph_sy
   if (load_coo(&S->cJ, "--J-coo", A->Jcoo, N) || load_coo(&S->cR, "--R-coo", A->Rcoo, N) ||
       load_coo(&S->cQ, "--Q-coo", A->Qcoo, N) || (A->Ecoo && load_coo(&S->cE, "--E-coo", A->Ecoo, N)))
     return 1;
+  if ((double)N >= 20000.0) progress("ordering the sparse system (N = %d) and analysing its stage solver", N);
+  t0 = now_s();
   rc = phgmg_ph_sparse_create_e(&S->sp, N, m, &S->cJ.A, &S->cR.A, &S->cQ.A, A->Ecoo ? &S->cE.A : NULL, S->B.a,
                                 NULL, &inf, NULL);
+  if (now_s() - t0 >= 1.0) progress("  done in %.1f s", now_s() - t0);
   if (rc != PHGMG_OK) return fail("sparse J, R, Q%s: %s", A->Ecoo ? ", E" : "", phgmg_result_string(rc));
   if (A->dampf && inf.solver == PHGMG_SOLVER_SPARSE_LU &&
       (rc = phgmg_ph_sparse_set_solver(S->sp, PHGMG_SOLVER_BAND, &inf)) != PHGMG_OK) /* the sparse LU: no dampers */
@@ -3010,7 +3014,7 @@ static int condense_algebraic(reduce_state *S);
 static int load_system(const reduce_args *A, reduce_state *S) {
   phgmg_ph_system sys;
   phgmg_result rc;
-  double rcond = 0.0;
+  double rcond = 0.0, t_chk;
   int N, m, k;
   /* --- the system --- */
   if (A->Jcoo) {
@@ -3083,7 +3087,11 @@ static int load_system(const reduce_args *A, reduce_state *S) {
              sys.phi_nfun > 1 ? " (one function per term)" : "");
   }
   if (load_feedthrough(A, S, &sys) || load_dampers(A, S, &sys) || load_ref(A, S, sys.N)) return 1;
+  if ((double)N >= 20000.0) progress("checking the system (N = %d): structure, definiteness, J - R", N);
+  t_chk = now_s();
   rc = phgmg_ph_validate(&sys, 0.0, &rcond, NULL);
+  t_chk = now_s() - t_chk;
+  if (t_chk >= 1.0) progress("  checks done in %.1f s", t_chk);
   if (sys.ndamp && rc != PHGMG_OK && explain_dampers(A, S, &sys, rc)) return 1;
   if (sys.ndamp && (rc == PHGMG_ERR_DAMPER || rc == PHGMG_ERR_SIZE || rc == PHGMG_ERR_NANINF))
     return fail("%s (--dampers): %s%s", A->dampf, phgmg_result_string(rc),
@@ -4504,7 +4512,10 @@ static int validate_test(const reduce_args *A, reduce_state *S, cli_input *in, c
   memset(&run, 0, sizeof run);
   run.u = input_fn; run.user = in; run.dt = A->dt; run.nsteps = nsteps; run.x0 = x0;
   for (k = 0; k < S->nmodels; ++k) reds[k] = S->models[k].red;
+  /* progress of the runs (full, then each reduced one) every 2 s, from the input callback */
+  in->report = 1; in->t_end = nsteps * A->dt; in->wall0 = in->wall_last = now_s();
   rc = phgmg_reduced_validate_many(reds, S->nmodels, &sys, &run, A->newton_tol, A->newton_iter, max_ey, vs, NULL);
+  in->report = 0;
   if (rc != PHGMG_OK) {
     for (k = 0; k < S->nmodels; ++k) S->models[k].pass = 0;
     S->red = S->models[0].red;

@@ -22,6 +22,7 @@
 #    malformed ones refused with a message naming the file.
 # 7. subnormal entries flushed in the written model; --dt-map's note; the
 #    record's kind and map.
+# 8. a progress line before a large model's set-up (ordering, checks).
 # Needs NumPy/SciPy (/usr/bin/python3) to write the inputs (skipped otherwise).
 set -u
 P=${1:-build/phgmg}
@@ -307,6 +308,22 @@ sys.exit(0 if (a['kind'], a['map'], b['kind'], b['map']) == ('nonlinear', 'linea
   && pass || bad "rom.json's kind/map"
 "$P" reduce $SYS $TRAIN --method gmg-pod --r 6 --dt-map 0.1 --out tl >/dev/null 2>err.txt && pass || bad "reduce r 6"
 grep -q "note: --dt-map" err.txt && bad "a note on --dt-map where the map is built: $(cat err.txt)" || pass
+
+# 8. a large model's set-up is announced before it starts (N >= 20 000)
+"$PY" - <<'PYEOF' || bad "writing the large chain"
+import numpy as np, scipy.sparse as sp
+n = 10000
+K = sp.diags([2.0 * np.ones(n), -np.ones(n - 1), -np.ones(n - 1)], [0, 1, -1])
+I = sp.identity(n)
+sp.save_npz("Jb.npz", sp.bmat([[None, I], [-I, None]]).tocsr())
+sp.save_npz("Rb.npz", sp.block_diag([sp.csr_matrix((n, n)), 0.1 * I]).tocsr())
+sp.save_npz("Qb.npz", sp.block_diag([K, I]).tocsr())
+b = np.zeros(2 * n); b[n] = 1.0; np.save("Bb.npy", b)
+PYEOF
+"$P" simulate --J-coo Jb.npz --R-coo Rb.npz --Q-coo Qb.npz --B Bb.npy --steps 2 --out yb.npy >/dev/null 2>err.txt \
+  && pass || bad "simulate N = 20000: $(tail -n 2 err.txt)"
+grep -q "ordering the sparse system (N = 20000)" err.txt && grep -q "checking the system (N = 20000)" err.txt && pass \
+  || bad "no progress line before a large model's set-up: $(cat err.txt)"
 
 echo "test_cli_workflow: $npass passed, $nfail failed"
 [ "$nfail" -eq 0 ]
