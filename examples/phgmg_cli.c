@@ -262,7 +262,9 @@ static const char *const help_lines[] = {
   "                      (linear models with quadratic H; the online stepper then needs\n",
   "                      no Newton iteration at that step). Default: the --dt of\n",
   "                      --simulate, none with --X; 0 = none. A step map with spectral\n",
-  "                      radius above 1 (an amplifying step) is refused.\n",
+  "                      radius above 1 (an amplifying step) is refused. A model that\n",
+  "                      cannot have one (nonlinear terms, dampers, feedthrough, gmg-qm)\n",
+  "                      gets none: a --dt-map given then draws a note saying why.\n",
   "  --degeneracy-tol T  gmg: least non-degeneracy measure of D^T G D (the reduced\n",
   "                      model's operator, measured in equilibrated coordinates against\n",
   "                      the rounding of its entries, so independent of units and mesh;\n",
@@ -279,7 +281,9 @@ static const char *const help_lines[] = {
   "                      (m x ns: the full model's output at the snapshots).\n",
   "  --quiet             no progress lines on stderr.\n",
   "\n",
-  "  Outputs in DIR:\n",
+  "  Outputs in DIR (entries below the smallest normal number of the build's\n",
+  "  scalar type, DBL_MIN or FLT_MIN, are set to 0 in every array of the reduced\n",
+  "  model: no subnormal constants in the model file, C source or .npy arrays):\n",
   "    NAME.phgmgrom      the binary model file (phgmg_rom_load; for simulate-rom)\n",
   "    NAME.c             C source: static const arrays NAME_<field> and a\n",
   "                      `static const phgmg_rom NAME` (include after phgmg.h),\n",
@@ -297,6 +301,8 @@ static const char *const help_lines[] = {
   "    NAME_V2.npy, NAME_M.npy  (gmg-qm) V2 (N x r_n) and M (r_n x p^2, p = r - m):\n",
   "                      x ~ V0 xr + V2 M kron(x2, x2), x2 = xr[m:]\n",
   "    NAME.json          sizes, method, options, diagnostics and the list of files;\n",
+  "                      \"kind\": linear or nonlinear (energy terms, dampers), \"map\":\n",
+  "                      the reduction map, linear (x = V0 xr) or quadratic (gmg-qm);\n",
   "                      \"E\": whether the model has a mass matrix, \"N_full\": all its\n",
   "                      states (\"N\" is the number reduced: an index-one model's\n",
   "                      differential states), \"algebraic\", \"feedthrough\"\n",
@@ -2188,7 +2194,7 @@ static int zip_member(const unsigned char *z, size_t n, const char *name, unsign
 }
 
 /* A whole file into memory (up to 2 GiB). NULL after a message. */
-static unsigned char *read_all(const char *path, const char *opt, size_t *n) {
+static unsigned char *read_file_bytes(const char *path, const char *opt, size_t *n) {
   FILE *f = fopen(path, "rb");
   unsigned char *b;
   long l;
@@ -2252,7 +2258,7 @@ static int npz_format(const unsigned char *z, size_t n, const char *path, const 
    allocated here; the shape must be N x N. */
 static int load_npz(const char *path, const char *opt, int N, int **ri, int **cj, double **v, int *nnz) {
   size_t n = 0;
-  unsigned char *z = read_all(path, opt, &n);
+  unsigned char *z = read_file_bytes(path, opt, &n);
   mat sh, a, b, d;
   char fmt[4];
   int err = 0, k, j, p, cnt;
@@ -2707,6 +2713,7 @@ static int sparse_dae_solver(const reduce_args *A, reduce_state *S, phgmg_ph_spa
 static int load_sparse_system(const reduce_args *A, reduce_state *S, phgmg_ph_system *sys) {
   phgmg_ph_sparse_info inf;
   phgmg_result rc;
+  double t0;
   int N, m;
   if (mat_load(&S->B, "--B", A->B)) return 1;
   N = S->B.rows;
@@ -2716,8 +2723,11 @@ static int load_sparse_system(const reduce_args *A, reduce_state *S, phgmg_ph_sy
   if (load_coo(&S->cJ, "--J-coo", A->Jcoo, N) || load_coo(&S->cR, "--R-coo", A->Rcoo, N) ||
       load_coo(&S->cQ, "--Q-coo", A->Qcoo, N) || (A->Ecoo && load_coo(&S->cE, "--E-coo", A->Ecoo, N)))
     return 1;
+  if ((double)N >= 20000.0) progress("ordering the sparse system (N = %d) and analysing its stage solver", N);
+  t0 = now_s();
   rc = phgmg_ph_sparse_create_e(&S->sp, N, m, &S->cJ.A, &S->cR.A, &S->cQ.A, A->Ecoo ? &S->cE.A : NULL, S->B.a,
                                 NULL, &inf, NULL);
+  if (now_s() - t0 >= 1.0) progress("  done in %.1f s", now_s() - t0);
   if (rc != PHGMG_OK) return fail("sparse J, R, Q%s: %s", A->Ecoo ? ", E" : "", phgmg_result_string(rc));
   if (sparse_dae_solver(A, S, &inf)) return 1;
   *sys = *phgmg_ph_sparse_system(S->sp);
@@ -3154,7 +3164,7 @@ static int condense_algebraic(const reduce_args *A, reduce_state *S);
 static int load_system(const reduce_args *A, reduce_state *S) {
   phgmg_ph_system sys;
   phgmg_result rc;
-  double rcond = 0.0;
+  double rcond = 0.0, t_chk;
   int N, m, k;
   /* --- the system --- */
   if (A->Jcoo) {
@@ -3227,9 +3237,12 @@ static int load_system(const reduce_args *A, reduce_state *S) {
              sys.phi_nfun > 1 ? " (one function per term)" : "");
   }
   if (load_feedthrough(A, S, &sys) || load_dampers(A, S, &sys) || load_ref(A, S, sys.N)) return 1;
-  if (sys.storage != PHGMG_DENSE && sys.N >= 20000) /* seconds of sparse factorizations: say so first */
-    progress("checking the model (symmetry, definiteness and regularity by sparse factorizations) ...");
+  if ((double)N >= 20000.0)   /* seconds of sparse factorizations: say so first */
+    progress("checking the model (N = %d): symmetry, definiteness and regularity by sparse factorizations ...", N);
+  t_chk = now_s();
   rc = phgmg_ph_validate(&sys, 0.0, &rcond, NULL);
+  t_chk = now_s() - t_chk;
+  if (t_chk >= 1.0) progress("  checks done in %.1f s", t_chk);
   if (sys.ndamp && rc != PHGMG_OK && explain_dampers(A, S, &sys, rc)) return 1;
   if (sys.ndamp && (rc == PHGMG_ERR_DAMPER || rc == PHGMG_ERR_SIZE || rc == PHGMG_ERR_NANINF))
     return fail("%s (--dampers): %s%s", A->dampf, phgmg_result_string(rc),
@@ -3746,6 +3759,11 @@ static int run_reduction(const reduce_args *A, reduce_state *S, int method, cons
     progress("  manifold %s, lambda %s: %.3g%s", A->manifold_s ? A->manifold_s : "pod",
              A->lambda_auto == 1 ? "auto" : A->lambda_auto == 2 ? "cv" : "fixed", info.lambda,
              info.lambda == HUGE_VAL ? " (M = 0: no safe quadratic correction found)" : "");
+  if (!rom->Phi && A->have_dt_map && A->dt_map > 0.0)   /* asked for, not built: say why */
+    note("--dt-map %g has no effect: a step map is built for a linear reduced model with a quadratic energy and "
+         "no feedthrough or dampers, and this model has %s; the online stepper solves each step (Newton)",
+         A->dt_map, rom->kind == PHGMG_ROM_QUADRATIC ? "a quadratic manifold" : rom->nd ? "nonlinear energy terms"
+         : rom->ndamp ? "dampers" : rom->PD ? "feedthrough" : "a nonlinear part");
   if (rom->Phi) { /* the precomputed step map must not amplify: spectral radius <= 1 */
     const double rho = step_map_radius(rom);
     progress("  step map for dt = %g: spectral radius %.6g", A->dt_map, rho);
@@ -3765,6 +3783,35 @@ static int run_reduction(const reduce_args *A, reduce_state *S, int method, cons
   *op = o;
   *ip = info;
   return 0;
+}
+
+/* Entries of the reduced model's arrays below the smallest normal number of
+   its scalar type (DBL_MIN, or FLT_MIN in the float build) -- rounding
+   residue, e.g. of Qh = V^T Q V of a badly scaled Q -- set to 0 before
+   anything is written: subnormal constants slow down firmware (and some
+   compilers and processors flush them anyway). In place, so that the
+   model validate tests is the model written. Returns the count. */
+static long flush_subnormal_entries(const phgmg_reduced *red) {
+  const phgmg_rom *rom = phgmg_reduced_rom(red);
+#ifdef PHGMG_REAL_FLOAT
+  const phgmg_real tiny = FLT_MIN;
+#else
+  const phgmg_real tiny = DBL_MIN;
+#endif
+  rom_field f[24];
+  long cnt = 0;
+  int nf = rom_fields(rom, f), i;
+  size_t q, n;
+  if (rom->PD && nf < 24) {
+    f[nf].name = "PD"; f[nf].a = rom->PD; f[nf].rows = rom->r + rom->m; f[nf].cols = rom->m; ++nf;
+  }
+  for (i = 0; i < nf; ++i) {
+    phgmg_real *a = (phgmg_real *)(void *)(size_t)f[i].a;   /* the CLI owns the reduced object */
+    n = (size_t)f[i].rows * (size_t)f[i].cols;
+    for (q = 0; q < n; ++q)
+      if (a[q] != (phgmg_real)0 && fabs((double)a[q]) < (double)tiny) { a[q] = (phgmg_real)0; ++cnt; }
+  }
+  return cnt;
 }
 
 /* NAME_PD.npy: the reduced feedthrough as one (r + m) x m matrix [Ph; S + N]
@@ -3793,6 +3840,10 @@ static int write_arrays(const reduce_args *A, reduce_state *S, const double *X, 
   int i, k, nf;
   /* --- outputs --- */
   if (mkdir_p(A->out, &S->sg)) return 1;
+  {
+    const long nt = flush_subnormal_entries(S->red);
+    if (nt) progress("  %ld entries of the reduced model's arrays below the smallest normal number set to 0", nt);
+  }
   memset(ol, 0, sizeof *ol);
   nf = rom_fields(rom, fields);
   {
@@ -3961,7 +4012,9 @@ static int write_json(const reduce_args *A, reduce_state *S, int method, int ns,
   if (!jf) return fail("%s: cannot write: %s", path, strerror(errno));
   fprintf(jf, "{\n  \"phgmg_version\": \"%s\",\n  \"name\": ", PHGMG_VERSION_STRING);
   json_str(jf, A->name);
-  fprintf(jf, ",\n  \"method\": \"%s\",\n  \"kind\": \"%s\",\n", method_name(method),
+  /* kind: the model's (nonlinear: energy terms or dampers); map: the reduction map's (phgmg_rom.kind) */
+  fprintf(jf, ",\n  \"method\": \"%s\",\n  \"kind\": \"%s\",\n  \"map\": \"%s\",\n", method_name(method),
+          rom->nd || rom->ndamp || S->sys.nl != PHGMG_NL_NONE ? "nonlinear" : "linear",
           rom->kind == PHGMG_ROM_QUADRATIC ? "quadratic" : "linear");
   fprintf(jf, "  \"N\": %d, \"m\": %d, \"r\": %d, \"rn\": %d, \"nd\": %d, \"poly_deg\": %d,\n", N, m, rom->r,
           rom->rn, rom->nd, rom->nd ? rom->poly_deg : 0);
@@ -4892,7 +4945,10 @@ static int validate_test(const reduce_args *A, reduce_state *S, cli_input *in, c
   memset(&run, 0, sizeof run);
   run.u = input_fn; run.user = in; run.dt = A->dt; run.nsteps = nsteps; run.x0 = x0;
   for (k = 0; k < S->nmodels; ++k) reds[k] = S->models[k].red;
+  /* progress of the runs (full, then each reduced one) every 2 s, from the input callback */
+  in->report = 1; in->t_end = nsteps * A->dt; in->wall0 = in->wall_last = now_s();
   rc = phgmg_reduced_validate_many(reds, S->nmodels, &sys, &run, A->newton_tol, A->newton_iter, max_ey, vs, NULL);
+  in->report = 0;
   if (rc != PHGMG_OK) {
     for (k = 0; k < S->nmodels; ++k) S->models[k].pass = 0;
     S->red = S->models[0].red;

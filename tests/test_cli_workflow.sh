@@ -20,6 +20,9 @@
 # 5. --input sin --freq, --input chirp, --x0 against SciPy (solve_ivp, expm).
 # 6. SciPy .npz (save_npz) and Matrix Market .mtx (mmwrite) as --X-coo specs;
 #    malformed ones refused with a message naming the file.
+# 7. subnormal entries flushed in the written model; --dt-map's note; the
+#    record's kind and map.
+# 8. a progress line before a large model's set-up (ordering, checks).
 # Needs NumPy/SciPy (/usr/bin/python3) to write the inputs (skipped otherwise).
 set -u
 P=${1:-build/phgmg}
@@ -276,6 +279,51 @@ for f in trunc.npz corrupt.npz bad_head.mtx bad_idx.mtx bad_size.mtx; do
   st=$?
   [ $st -eq 1 ] && grep -q "$f (--J-coo)" err.txt && pass || bad "malformed $f: status $st: $(cat err.txt)"
 done
+
+# 7. the log and the record: a badly scaled Q (1e-300, J and R 1e300) leaves
+#    rounding residue below DBL_MIN in Qh: set to 0 in rom_Qh.npy and rom.c;
+#    --dt-map on a model that cannot have a step map draws a note; "kind" is
+#    the model's (nonlinear for Toda springs), "map" the reduction map's
+"$PY" -c "
+import numpy as np
+np.save('Qt.npy', 1e-300 * np.load('Q.npy'))
+for k in 'JR': np.save(k + 't.npy', 1e300 * np.load(k + '.npy'))
+np.save('idx.npy', np.arange(12))"
+"$P" reduce --J Jt.npy --R Rt.npy --Q Qt.npy --B B.npy $TRAIN --method gmg-pod --r 8 --dt-map 0 --out sub >/dev/null \
+  2>err.txt && pass || bad "reduce of the badly scaled model: $(tail -n 2 err.txt)"
+"$PY" -c "
+import numpy as np, sys
+a = np.load('sub/rom_Qh.npy')
+sys.exit(0 if np.abs(a).max() > 0 and not ((a != 0) & (np.abs(a) < sys.float_info.min)).any() else 1)" && pass \
+  || bad "rom_Qh.npy holds subnormal entries"
+grep -q "below the smallest normal number set to 0" err.txt && pass || bad "no log line on the flushed entries"
+grep -Eq "e-3(0[89]|[1-2][0-9])[^0-9]" sub/rom.c && bad "rom.c holds subnormal constants" || pass
+"$P" reduce $SYS --potential toda --poly-idx idx.npy $TRAIN --method gmg-pod --r 8 --dt-map 0.1 --out tn >/dev/null \
+  2>err.txt && pass || bad "reduce Toda: $(tail -n 2 err.txt)"
+grep -q "note: --dt-map 0.1 has no effect" err.txt && pass || bad "--dt-map ignored without a word: $(cat err.txt)"
+"$PY" -c "
+import json, sys
+a, b = json.load(open('tn/rom.json')), json.load(open('one/g6.json'))
+sys.exit(0 if (a['kind'], a['map'], b['kind'], b['map']) == ('nonlinear', 'linear', 'linear', 'linear') else 1)" \
+  && pass || bad "rom.json's kind/map"
+"$P" reduce $SYS $TRAIN --method gmg-pod --r 6 --dt-map 0.1 --out tl >/dev/null 2>err.txt && pass || bad "reduce r 6"
+grep -q "note: --dt-map" err.txt && bad "a note on --dt-map where the map is built: $(cat err.txt)" || pass
+
+# 8. a large model's set-up is announced before it starts (N >= 20 000)
+"$PY" - <<'PYEOF' || bad "writing the large chain"
+import numpy as np, scipy.sparse as sp
+n = 10000
+K = sp.diags([2.0 * np.ones(n), -np.ones(n - 1), -np.ones(n - 1)], [0, 1, -1])
+I = sp.identity(n)
+sp.save_npz("Jb.npz", sp.bmat([[None, I], [-I, None]]).tocsr())
+sp.save_npz("Rb.npz", sp.block_diag([sp.csr_matrix((n, n)), 0.1 * I]).tocsr())
+sp.save_npz("Qb.npz", sp.block_diag([K, I]).tocsr())
+b = np.zeros(2 * n); b[n] = 1.0; np.save("Bb.npy", b)
+PYEOF
+"$P" simulate --J-coo Jb.npz --R-coo Rb.npz --Q-coo Qb.npz --B Bb.npy --steps 2 --out yb.npy >/dev/null 2>err.txt \
+  && pass || bad "simulate N = 20000: $(tail -n 2 err.txt)"
+grep -q "ordering the sparse system (N = 20000)" err.txt && grep -q "checking the system (N = 20000)" err.txt && pass \
+  || bad "no progress line before a large model's set-up: $(cat err.txt)"
 
 echo "test_cli_workflow: $npass passed, $nfail failed"
 [ "$nfail" -eq 0 ]

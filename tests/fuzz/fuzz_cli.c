@@ -173,8 +173,9 @@ static void init(void) {
   static const char *const files4[] = {"E.npy", "E_alg.npy", "Ec.npy", "P.npy", "S.npy", "N.npy", "d.npy", "ref.npy",
                                        "ln_d.npy", NULL};
   static const char *const words5[] = {"--degeneracy-tol", NULL};   /* after files4 */
-  static const char *const words6[] = {"--freq", "--freq-end", "chirp", "--x0", "--stream", "bt", "prbt", "phbt",
-                                       "gmg-pod,sp1", "10,20", NULL};   /* after words5 */
+  static const char *const words6[] = {"--freq", "--freq-end", "--x0", "chirp", "gmg-pod,sp1", "4,6", "4,,6",
+                                       "2,3,2", NULL};   /* after words5 */
+  static const char *const words7[] = {"--stream", "bt", "prbt", "phbt", "bt,sp1", NULL};   /* after words6 */
   char *argv[24];
   int k, fb, argc = 0;   /* fb: the token of files[0] */
   FILE *f;
@@ -193,6 +194,7 @@ static void init(void) {
   for (k = 0; files4[k]; ++k) snprintf(g_tok[g_ntok++], sizeof g_tok[0], "%s/%s", g_dir, files4[k]);
   for (k = 0; words5[k]; ++k) strcpy(g_tok[g_ntok++], words5[k]);
   for (k = 0; words6[k]; ++k) strcpy(g_tok[g_ntok++], words6[k]);
+  for (k = 0; words7[k]; ++k) strcpy(g_tok[g_ntok++], words7[k]);
   /* the model file, made once by the CLI itself */
   restore();
   argv[argc++] = (char *)"phgmg"; argv[argc++] = (char *)"reduce";

@@ -13,7 +13,7 @@ src = open('tests/fuzz/fuzz_cli.c').read()
 def arr(name):
     m = re.search(r'static const char \*const ' + name + r'\[\] = \{(.*?)NULL\};', src, re.S)
     return re.findall(r'"((?:[^"\\]|\\.)*)"', m.group(1))
-toks = arr('words') + arr('files') + arr('words2') + arr('files2') + arr('words3') + arr('words4') + arr('files4') + arr('words5') + arr('words6')
+toks = arr('words') + arr('files') + arr('words2') + arr('files2') + arr('words3') + arr('words4') + arr('files4') + arr('words5') + arr('words6') + arr('words7')
 assert len(toks) <= 160, len(toks)
 idx = {}
 for i, t in enumerate(toks):
