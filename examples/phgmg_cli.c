@@ -3238,7 +3238,7 @@ static int load_system(const reduce_args *A, reduce_state *S) {
   }
   if (load_feedthrough(A, S, &sys) || load_dampers(A, S, &sys) || load_ref(A, S, sys.N)) return 1;
   if ((double)N >= 20000.0)   /* seconds of sparse factorizations: say so first */
-    progress("checking the model (N = %d): symmetry, definiteness and regularity by sparse factorizations ...", N);
+    progress("checking the system (N = %d): symmetry, definiteness and regularity by sparse factorizations", N);
   t_chk = now_s();
   rc = phgmg_ph_validate(&sys, 0.0, &rcond, NULL);
   t_chk = now_s() - t_chk;
