@@ -2087,9 +2087,9 @@
 
 /* >>config ================================================================ */
 #define PHGMG_VERSION_MAJOR 0
-#define PHGMG_VERSION_MINOR 6
+#define PHGMG_VERSION_MINOR 7
 #define PHGMG_VERSION_PATCH 0
-#define PHGMG_VERSION_STRING "0.6.0"
+#define PHGMG_VERSION_STRING "0.7.0"
 
 #include <stddef.h>
 
@@ -25964,6 +25964,44 @@ PHGMG_DEF phgmg_result phgmg_sym_eig(int n, double *A, int lda, double *w, doubl
 
 /*
    REVISION HISTORY
+   0.7.0  (2026-11-28)
+          - Changed: an index-one model in SPARSE storage (E with zero rows
+            and columns) is simulated on its sparse pencil (manual 1.8): no
+            condensation, no limit on the algebraic lines but memory; its
+            validation needs no condensation either. phgmg_dae_create on such
+            a system returns PHGMG_ERR_UNSUPPORTED (give it dense or band
+            storage to condense).
+          - Changed: J - R of a SPARSE model is factored by the sparse LU
+            (validation, GMG's solves): no band copies, peak memory in
+            proportion to the factor.
+          - New: dampers, a GENERAL Hamiltonian with a Hessian pattern
+            (phgmg_ph_system.hess_p / hess_i, phgmg_ph_sparse_hess_pattern)
+            and the shifted-solve callbacks on SPARSE models; the stepper
+            joins the dampers' and the Hessian's patterns to its analysis
+            (manual 1.9, 8.12).
+          - New: phgmg_csc_from_coo / phgmg_csc_free (duplicates summed);
+            phgmg_reduced_validate_many (several reduced models against one
+            full run).
+          - New: a streaming POD without MPI (phgmg_pod_stream_*,
+            phgmg_reduce_stream, manual 2.9; phgmg_npy_read_cols reads .npy
+            columns in blocks): snapshot sets larger than memory.
+          - New: phgmg_balanced_reduce (BT, PRBT, pH-preserving balancing as
+            pH reduced models, sparse or dense) and phgmg_ss_to_ph; model
+            files may carry the methods BT and PHBT (header method 7, 8).
+          - New with PHGMG_MPI: phgmg_mpi_ecsw (points and weights the same
+            for every partition), phgmg_mpi_cholqr (shifted Cholesky-QR),
+            phgmg_mpi_counts_get / _reset (collectives and bytes).
+          - Fixed: phgmg_reduced_validate and phgmg_err_proj / _red of a
+            model with a stored test basis and no GMG basis (phgmg_prbt's,
+            the balancing methods') read a NULL basis.
+          - Command line: sweeps (--method and --r take lists; one set-up,
+            one training simulation, shared bases; NAME_sweep.json); reduce
+            --method bt|prbt|phbt without snapshots; --stream; SciPy .npz and
+            Matrix Market input; --x0; --input chirp, --freq, --freq-end;
+            NAME_PD.npy; NAME.json records E, the full N and the model's
+            kind; dampers and index-one simulation on the sparse LU;
+            subnormal entries flushed in written models; progress lines
+            before a large model's set-up.
    0.6.0  (2026-11-28)
           - Changed: phgmg_dae_restrict, phgmg_dae_embed and phgmg_dae_lift
             return a phgmg_result (PHGMG_ERR_INVALID_ARG for a NULL object or
@@ -25996,11 +26034,7 @@ PHGMG_DEF phgmg_result phgmg_sym_eig(int n, double *A, int lda, double *w, doubl
           - New: >>lowrank (manual 2.8, 8.13): shifted sparse solves on one
             analysis, LR-ADI, low-rank BT (phgmg_lrbt), pH-preserving
             low-rank balancing (phgmg_lrphbt), transfer functions and sampled
-            H-infinity errors of sparse models; phgmg_balanced_reduce (BT,
-            PRBT, pH-preserving balancing as pH reduced models, sparse or
-            dense), phgmg_ss_to_ph; the command line's reduce --method
-            bt|prbt|phbt (no snapshots). Model files may carry the methods
-            BT and PHBT (header method 7, 8).
+            H-infinity errors of sparse models.
           - New: >>mpi with PHGMG_MPI (manual 2.7): distributed context,
             TSQR, POD and streamed POD, DEIM points independent of the
             partition, row-distributed sparse operators, GMG-POD of a linear
