@@ -1973,6 +1973,12 @@
 
    9. CONFIGURATION MACROS (define before including) -----------------------------
      PHGMG_IMPLEMENTATION  compile the implementation in this translation unit
+     PHGMG_IMPLEMENTATION_ELSEWHERE  ignore PHGMG_IMPLEMENTATION in this
+                           translation unit (declarations only): for building
+                           several programs that each define
+                           PHGMG_IMPLEMENTATION against one separately
+                           compiled implementation with the same macros (the
+                           Makefile builds the examples this way)
      PHGMG_STATIC          all functions static (private copy per translation unit)
      PHGMG_DEF             storage class of the public functions (default extern)
      PHGMG_REAL_FLOAT      online scalar phgmg_real = float (default double);
@@ -4672,7 +4678,7 @@ PHGMG_DEF phgmg_result phgmg_sym_eig(int n, double *A, int lda, double *w, doubl
 /* ======================================================================== */
 /*                              IMPLEMENTATION                              */
 /* ======================================================================== */
-#ifdef PHGMG_IMPLEMENTATION
+#if defined(PHGMG_IMPLEMENTATION) && !defined(PHGMG_IMPLEMENTATION_ELSEWHERE)
 #ifndef PHGMG_IMPLEMENTATION_DONE
 #define PHGMG_IMPLEMENTATION_DONE
 

@@ -130,7 +130,7 @@ static void paper_order(nl_setup *S, demo_cache *cache, const double *X, const d
     T->ty[k * (NMETH + 1) + 1 + j] = res.e_y;
     if (meth_id[j] == PHGMG_METHOD_GMG_POD) T->tproj[k * 4 + 1] = res.e_proj;
     if (meth_id[j] == PHGMG_METHOD_GMG_QM) { T->tproj[k * 4 + 2] = res.e_proj; T->tproj[k * 4 + 3] = res.e_lower; }
-    ndeim = PHGMG__MAX(ndeim, res.info.deim_modes);
+    if (res.info.deim_modes > ndeim) ndeim = res.info.deim_modes;
     nneg += res.info.deim_negative;
     printf("  %9.3e / %9.3e", res.e_red, res.e_y);
   }

@@ -4820,7 +4820,10 @@ static int cmd_info(int argc, char **argv) {
   if (argc != 3) return usage_error("usage: phgmg info MODEL.phgmgrom");
   if (load_model(argv[2], "info", &rom, &block)) return 1;
   printf("%s: %s reduced model (%s), r = %d, m = %d", argv[2],
-         rom.kind == PHGMG_ROM_QUADRATIC ? "quadratic-manifold" : "linear", method_name(rom.method), rom.r, rom.m);
+         rom.kind == PHGMG_ROM_QUADRATIC ? "quadratic-manifold"
+         : rom.nd || rom.ndamp           ? "nonlinear (linear subspace)"
+                                         : "linear",
+         method_name(rom.method), rom.r, rom.m);
   if (rom.kind == PHGMG_ROM_QUADRATIC) printf(", r_n = %d", rom.rn);
   if (rom.nd) printf(", %d nonlinear terms (polynomial degree %d, %d exponentials%s)", rom.nd, rom.poly_deg, rom.nexp,
                      rom.nphi > 1 ? ", one function per term" : "");

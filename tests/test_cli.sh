@@ -106,6 +106,7 @@ run_ok "ACCEPTANCE gmg-pod r=12 CLI == demo path (1e-12)" "$REF" compare ref_gmg
 cat "$T/out.txt"
 run_ok "info" "$P" info out/msd.phgmgrom
 grep -F -q "r = 12, m = 1" "$T/out.txt" || bad "info does not print the sizes"
+grep -F -q "msd.phgmgrom: linear reduced model" "$T/out.txt" || bad "info does not call a linear model linear"
 
 # the same reduction from the saved snapshots (--X) gives the same model
 run_ok "reduce --X" "$P" reduce $SYS --X out/msd_snapshots.npy --dt-map 0.1 --method gmg-pod --r 12 --out ox --name m --quiet
@@ -525,6 +526,7 @@ PYEOF
   done
   run_ok "toda info" "$P" info toda/c/m.phgmgrom
   grep -F -q "1 exponentials, one function per term" "$T/out.txt" || bad "info does not describe the per-term family"
+  grep -F -q "nonlinear (linear subspace) reduced model" "$T/out.txt" || bad "info calls a model with nonlinear terms linear"
   run_ok "toda outputs" "$PY" - <<'PYEOF'
 import numpy as np
 y = {v: np.load(f"toda/y{v}.npy").ravel() for v in "abcde"}
