@@ -2669,8 +2669,9 @@ static void remove_stale(const char *dir, const outlist *rec, const outlist *ol)
 static const char *sparse_solver_desc(const phgmg_ph_sparse_info *inf) {
   static char buf[256];
   if (inf->solver == PHGMG_SOLVER_SPARSE_LU && inf->colperm > 0)
-    snprintf(buf, sizeof buf, "sparse LU (%d columns matched to E's largest entries, %d states condensed, nested "
-             "dissection, %d supernodes, %.3g factor entries vs %.3g banded)", inf->colperm, inf->condensed,
+    snprintf(buf, sizeof buf, "sparse LU (%d columns matched to large entries of E, and of (J - R) Q on "
+             "algebraic rows; %d states condensed, nested dissection, %d supernodes, %.3g factor entries vs "
+             "%.3g banded)", inf->colperm, inf->condensed,
              inf->supernodes, inf->lu_sparse, inf->lu_band);
   else if (inf->solver == PHGMG_SOLVER_SPARSE_LU)
     snprintf(buf, sizeof buf, "sparse LU (%d states condensed, nested dissection, %d supernodes, %.3g factor "
@@ -2733,7 +2734,7 @@ static int load_sparse_system(const reduce_args *A, reduce_state *S, phgmg_ph_sy
   *sys = *phgmg_ph_sparse_system(S->sp);
   progress("sparse J, R, Q: N = %d, %ld stored entries; half-bandwidth %d (given order %d, reverse "
            "Cuthill-McKee %d)%s", N, inf.nnz, inf.kb, inf.kb_input, inf.kb_rcm,
-           inf.wide ? "; wide band (kb > N/4): dense .npy input would be as fast" : "");
+           inf.wide && inf.solver != PHGMG_SOLVER_SPARSE_LU ? "; wide band (kb > N/4): dense .npy input would be as fast" : "");
   progress("  stage solver: %s", sparse_solver_desc(&inf));
   return 0;
 }

@@ -151,5 +151,20 @@ cp lat/B.npy B_before.npy
 "$P" simulate --J-coo lat/J.npy --out y3.npy >/dev/null 2>err.txt
 [ $? -eq 2 ] && pass || bad "incomplete model: $(cat err.txt)"
 
+# 6. a star (one state coupled to all others): its band is wide in every
+#    order, yet the sparse LU has no fill; the log names the sparse LU and
+#    gives no "dense input would be as fast" hint (true for the band LU only)
+"$PY" - <<'PYEOF' || bad "star model generation failed"
+import numpy as np
+N = 400
+np.save("sJ.npy", np.array([(0, i, 1.0) for i in range(1, N)] + [(i, 0, -1.0) for i in range(1, N)]))
+np.save("sR.npy", np.array([(i, i, 0.1) for i in range(N)]))
+np.save("sQ.npy", np.array([(i, i, 1.0) for i in range(N)]))
+B = np.zeros((N, 1)); B[0, 0] = 1.0; np.save("sB.npy", B)
+PYEOF
+"$P" simulate --J-coo sJ.npy --R-coo sR.npy --Q-coo sQ.npy --B sB.npy --steps 5 --out ys.npy >/dev/null 2>err.txt
+grep -q "stage solver: sparse LU" err.txt && ! grep -q "wide band" err.txt && pass \
+  || bad "star: sparse LU with a band hint: $(cat err.txt)"
+
 echo "test_simulate: $npass passed, $nfail failed"
 [ "$nfail" -eq 0 ]
