@@ -89,6 +89,8 @@ test-mpi:
 	$(MPICC) $(CFLAGS_T) -o $(BUILD)/test_mpi tests/mpi/test_mpi.c $(LDLIBS) && \
 	$(MPICC) -std=c99 $(WARN) -O0 -o $(BUILD)/mpi_pod examples/mpi_pod.c $(LDLIBS) && \
 	for p in 1 2 3 4; do timeout 120 $(MPIRUN) -np $$p ./$(BUILD)/test_mpi $(BUILD)/mpi || exit 1; done && \
+	$(MPICC) $(CFLAGS_T) -o $(BUILD)/test_mpi_stream tests/mpi/test_mpi_stream.c $(LDLIBS) && \
+	for p in 1 2 3 4; do timeout 120 $(MPIRUN) -np $$p ./$(BUILD)/test_mpi_stream || exit 1; done && \
 	$(MPIRUN) -np 3 ./$(BUILD)/mpi_pod --N 3000 > $(BUILD)/mpi/example.txt && echo "test-mpi: examples/mpi_pod.c runs at 3 ranks"
 
 # The documentation against the code: every public function in the manual's
