@@ -257,3 +257,11 @@ bench: phgmg.h examples
 
 clean:
 	rm -rf $(BUILD) results tests/suites.inc bench/results.csv
+
+# The distributed phases' timings and communication, as JSON (bench/README.md,
+# "The distributed offline phase: scaling model"; not part of make test):
+#   mpirun -np P build/bench_mpi_phases --nloc 25000 > p1.json
+#   /usr/bin/python3 bench/mpi_scaling.py p1.json ...
+$(BUILD)/bench_mpi_phases: bench/bench_mpi_phases.c phgmg.h
+	@mkdir -p $(BUILD)
+	$(MPICC) -std=c99 $(WARN) -O2 -o $@ bench/bench_mpi_phases.c $(LDLIBS)

@@ -252,6 +252,67 @@ static void test_gap_bound(void) {
   phgmg_mpi_ctx_destroy(c);
 }
 
+/* The communication of the streaming POD (blocks of 7, kmax 12), of
+   Cholesky-QR and of V^T A V (a chain's tridiagonal operator) does not
+   depend on N: the same collective calls and bytes, the same halo
+   exchanges and bytes, at N = 600 and 2400. */
+static void test_counts_stream(void) {
+  enum { NS = 21 };
+  phgmg_mpi_counts cnt[2][3];
+  int pass, a;
+  for (pass = 0; pass < 2; ++pass) {
+    const int N = pass ? 2400 : 600;
+    phgmg_mpi_ctx *c = make_ctx(N);
+    const int ld = c->nloc > 0 ? c->nloc : 1;
+    double *X = (double *)malloc(sizeof(double) * (size_t)N * NS), *U = (double *)malloc(sizeof(double) * (size_t)N * NS);
+    double sig[NS], S[NS], Ar[144], *Xl, *V = (double *)calloc((size_t)ld * NS, sizeof(double)), R[NS * NS], disc;
+    long long *rp = (long long *)malloc(sizeof(long long) * ((size_t)ld + 1)), *col = (long long *)malloc(sizeof(long long) * 3 * (size_t)ld);
+    double *val = (double *)malloc(sizeof(double) * 3 * (size_t)ld);
+    phgmg_mpi_pod_stream *st = NULL;
+    phgmg_mpi_op *op = NULL;
+    int i, j0, k = 0, nz = 0;
+    for (i = 0; i < NS; ++i) sig[i] = pow(10.0, -0.3 * i);
+    rng_ = 31;
+    low_rank(N, NS, NS, sig, X, U);
+    Xl = own_rows(c, NS, X);
+    phgmg_mpi_counts_reset(c);
+    CHECK(phgmg_mpi_pod_stream_begin(&st, c, 12, 0.0) == PHGMG_OK, "stream begin");
+    for (j0 = 0; j0 < NS; j0 += 7) CHECK(phgmg_mpi_pod_stream_add(st, 7, Xl + (size_t)j0 * ld, ld) == PHGMG_OK, "add");
+    CHECK(phgmg_mpi_pod_stream_end(st, V, ld, S, &k, &disc) == PHGMG_OK && k == 12, "stream end k = %d", k);
+    phgmg_mpi_pod_stream_destroy(st);
+    phgmg_mpi_counts_get(c, &cnt[pass][0]);
+    phgmg_mpi_counts_reset(c);
+    CHECK(phgmg_mpi_cholqr(c, NS, Xl, ld, U, ld, R, NS) == PHGMG_OK, "cholqr");
+    phgmg_mpi_counts_get(c, &cnt[pass][1]);
+    rp[0] = 0;
+    for (i = 0; i < c->nloc; ++i) {
+      const long long g = c->row0 + i;
+      col[nz] = g; val[nz++] = 3.0;
+      if (g > 0) { col[nz] = g - 1; val[nz++] = -1.0; }
+      if (g + 1 < N) { col[nz] = g + 1; val[nz++] = -1.0; }
+      rp[i + 1] = nz;
+    }
+    CHECK(phgmg_mpi_op_create(&op, c, rp, col, val) == PHGMG_OK, "op");
+    phgmg_mpi_counts_reset(c);
+    CHECK(phgmg_mpi_op_project(op, 12, V, ld, Ar, 12) == PHGMG_OK, "project");
+    phgmg_mpi_counts_get(c, &cnt[pass][2]);
+    phgmg_mpi_op_destroy(op);
+    free(X); free(U); free(Xl); free(V); free(rp); free(col); free(val);
+    phgmg_mpi_ctx_destroy(c);
+  }
+  for (a = 0; a < 3; ++a)
+    CHECK(cnt[0][a].collectives > 0 && cnt[0][a].collectives == cnt[1][a].collectives &&
+              cnt[0][a].bytes == cnt[1][a].bytes && cnt[0][a].exchanges == cnt[1][a].exchanges &&
+              cnt[0][a].exchange_bytes == cnt[1][a].exchange_bytes,
+          "phase %d: counts depend on N: %lld/%lld collectives, %lld/%lld bytes, %lld/%lld halo bytes", a,
+          cnt[0][a].collectives, cnt[1][a].collectives, cnt[0][a].bytes, cnt[1][a].bytes, cnt[0][a].exchange_bytes,
+          cnt[1][a].exchange_bytes);
+  if (rank_ == 0)
+    printf("  counts (N = 600 and 2400 alike): stream %lld / %lld bytes, cholqr %lld / %lld, V^T A V %lld / %lld + %lld halo\n",
+           cnt[0][0].collectives, cnt[0][0].bytes, cnt[0][1].collectives, cnt[0][1].bytes, cnt[0][2].collectives,
+           cnt[0][2].bytes, cnt[0][2].exchange_bytes);
+}
+
 int main(int argc, char **argv) {
   int total = 0;
   double t0;
@@ -263,6 +324,7 @@ int main(int argc, char **argv) {
   test_rank_deficient(15);
   test_rank_deficient(4242);
   test_gap_bound();
+  test_counts_stream();
   MPI_Allreduce(&fails_, &total, 1, MPI_INT, MPI_SUM, MPI_COMM_WORLD);
   if (rank_ == 0)
     printf("test_mpi_stream: P = %d: %s (%d failed checks, %.2f s)\n", size_, total ? "FAILED" : "passed", total,
