@@ -25,7 +25,10 @@
    Per phase, as JSON on stdout (rank 0): wall time (max over the ranks),
    CPU time user+sys (max over the ranks; the machine may be oversubscribed:
    then wall > CPU; with K reps the smallest of each), the wall and CPU
-   time in the user's solves (solve, solve_cpu), the library's counts
+   time in the user's solves (solve, solve_cpu), the CPU time outside MPI
+   calls and the user's solves (compute_cpu: the local work; OpenMPI
+   busy-waits inside its calls, so the CPU time alone counts waiting at P >
+   1), the wall time inside the library's MPI calls (mpi_wall), the library's counts
    (phgmg_mpi_counts: collectives, bytes, halo exchanges and bytes, max over
    the ranks), the MPI calls by kind as seen through the MPI profiling
    interface (count and bytes sent by this rank: allreduce, reduce, bcast,
@@ -54,47 +57,54 @@ enum { K_ALLREDUCE, K_REDUCE, K_BCAST, K_ALLGATHER, K_ALLTOALL, K_ALLTOALLV, K_I
 static const char *kind_name[NKIND] = {"allreduce", "reduce", "bcast", "allgather", "alltoall", "alltoallv", "isend"};
 static long long kcount[NKIND], kbytes[NKIND];
 static int in_user_solve;
+static double mpi_wall, mpi_cpu;   /* time inside the library's MPI calls (waiting included) */
+static double cpu_now(void);
 static void tally(int kind, int count, MPI_Datatype t) {
   int sz = 0;
-  if (in_user_solve) return;
+  if (in_user_solve || kind < 0) return;
   PMPI_Type_size(t, &sz);
   kcount[kind]++;
   kbytes[kind] += (long long)count * sz;
 }
+/* Every wrapped call: counted (kind >= 0) and timed, outside the user's solves. */
+#define WRAP(kind, count, type, call)                                   \
+  do {                                                                  \
+    double w0_ = 0.0, c0_ = 0.0;                                        \
+    int rc_;                                                            \
+    tally(kind, count, type);                                           \
+    if (!in_user_solve) { w0_ = PMPI_Wtime(); c0_ = cpu_now(); }        \
+    rc_ = call;                                                         \
+    if (!in_user_solve) { mpi_wall += PMPI_Wtime() - w0_; mpi_cpu += cpu_now() - c0_; } \
+    return rc_;                                                         \
+  } while (0)
 int MPI_Allreduce(const void *sb, void *rb, int n, MPI_Datatype t, MPI_Op op, MPI_Comm c) {
-  tally(K_ALLREDUCE, n, t);
-  return PMPI_Allreduce(sb, rb, n, t, op, c);
+  WRAP(K_ALLREDUCE, n, t, PMPI_Allreduce(sb, rb, n, t, op, c));
 }
 int MPI_Reduce(const void *sb, void *rb, int n, MPI_Datatype t, MPI_Op op, int root, MPI_Comm c) {
-  tally(K_REDUCE, n, t);
-  return PMPI_Reduce(sb, rb, n, t, op, root, c);
+  WRAP(K_REDUCE, n, t, PMPI_Reduce(sb, rb, n, t, op, root, c));
 }
 int MPI_Bcast(void *b, int n, MPI_Datatype t, int root, MPI_Comm c) {
-  tally(K_BCAST, n, t);
-  return PMPI_Bcast(b, n, t, root, c);
+  WRAP(K_BCAST, n, t, PMPI_Bcast(b, n, t, root, c));
 }
 int MPI_Allgather(const void *sb, int sn, MPI_Datatype st, void *rb, int rn, MPI_Datatype rt, MPI_Comm c) {
-  tally(K_ALLGATHER, sn, st);
-  return PMPI_Allgather(sb, sn, st, rb, rn, rt, c);
+  WRAP(K_ALLGATHER, sn, st, PMPI_Allgather(sb, sn, st, rb, rn, rt, c));
 }
 int MPI_Alltoall(const void *sb, int sn, MPI_Datatype st, void *rb, int rn, MPI_Datatype rt, MPI_Comm c) {
   int P = 1;
   PMPI_Comm_size(c, &P);
-  tally(K_ALLTOALL, sn * P, st);
-  return PMPI_Alltoall(sb, sn, st, rb, rn, rt, c);
+  WRAP(K_ALLTOALL, sn * P, st, PMPI_Alltoall(sb, sn, st, rb, rn, rt, c));
 }
 int MPI_Alltoallv(const void *sb, const int *sn, const int *sd, MPI_Datatype st, void *rb, const int *rn,
                   const int *rd, MPI_Datatype rt, MPI_Comm c) {
   int P = 1, q, tot = 0;
   PMPI_Comm_size(c, &P);
   for (q = 0; q < P; ++q) tot += sn[q];
-  tally(K_ALLTOALLV, tot, st);
-  return PMPI_Alltoallv(sb, sn, sd, st, rb, rn, rd, rt, c);
+  WRAP(K_ALLTOALLV, tot, st, PMPI_Alltoallv(sb, sn, sd, st, rb, rn, rd, rt, c));
 }
 int MPI_Isend(const void *b, int n, MPI_Datatype t, int dest, int tag, MPI_Comm c, MPI_Request *req) {
-  tally(K_ISEND, n, t);
-  return PMPI_Isend(b, n, t, dest, tag, c, req);
+  WRAP(K_ISEND, n, t, PMPI_Isend(b, n, t, dest, tag, c, req));
 }
+int MPI_Waitall(int n, MPI_Request *req, MPI_Status *st) { WRAP(-1, 0, MPI_INT, PMPI_Waitall(n, req, st)); }
 
 /* ---- the setup -------------------------------------------------------------------- */
 static int rank_, size_;
@@ -291,34 +301,36 @@ static const char *phase_name[] = {"tsqr", "cholqr", "pod", "pod_stream", "deim"
 /* One phase timed (the fastest of reps), counted, printed as a JSON object. */
 static void measure(bench *b, int ph, int last) {
   phgmg_mpi_counts cn;
-  double wall = 1e300, cpu = 0.0, solve = 0.0, solve_cpu = 0.0, v[8];
+  double wall = 1e300, cpu = 0.0, solve = 0.0, solve_cpu = 0.0, comp = 0.0, mwall = 0.0, v[8];
   long long kc[NKIND], kb[NKIND];
   int rep, q;
   for (rep = 0; rep < b->reps; ++rep) {
-    double t0, c0, t1;
+    double t0, c0, t1, lc;
     phgmg_result rc;
     MPI_Barrier(MPI_COMM_WORLD);
     phgmg_mpi_counts_reset(b->ctx);
     memset(kcount, 0, sizeof kcount); memset(kbytes, 0, sizeof kbytes);
-    b->solve_time = 0.0; b->solve_cpu = 0.0;
+    b->solve_time = 0.0; b->solve_cpu = 0.0; mpi_wall = 0.0; mpi_cpu = 0.0;
     c0 = cpu_now(); t0 = MPI_Wtime();
     rc = run_phase(b, ph);
     t1 = MPI_Wtime() - t0;
     if (rc != PHGMG_OK) fail(phase_name[ph], rc);
     phgmg_mpi_counts_get(b->ctx, &cn);
     memcpy(kc, kcount, sizeof kc); memcpy(kb, kbytes, sizeof kb);
-    c0 = gmax(cpu_now() - c0);
-    t1 = gmax(t1);
-    if (t1 < wall) { wall = t1; solve = gmax(b->solve_time); }
+    c0 = cpu_now() - c0;
+    lc = c0 - b->solve_cpu - mpi_cpu;   /* this rank's CPU time outside MPI and the user's solves */
+    c0 = gmax(c0); lc = gmax(lc); t1 = gmax(t1);
+    if (t1 < wall) { wall = t1; solve = gmax(b->solve_time); mwall = gmax(mpi_wall); }
     if (rep == 0 || c0 < cpu) { cpu = c0; solve_cpu = gmax(b->solve_cpu); } else gmax(0.0);
+    if (rep == 0 || lc < comp) comp = lc;
   }
   v[0] = gmax((double)cn.collectives); v[1] = gmax((double)cn.bytes); v[2] = gmax((double)cn.exchanges);
   v[3] = gmax((double)cn.exchange_bytes); v[4] = gmax(rss_mb());
   for (q = 0; q < NKIND; ++q) { kc[q] = (long long)gmax((double)kc[q]); kb[q] = (long long)gmax((double)kb[q]); }
   if (rank_ != 0) return;
-  printf("    {\"name\": \"%s\", \"wall\": %.6e, \"cpu\": %.6e, \"solve\": %.6e, \"solve_cpu\": %.6e, \"collectives\": %.0f, \"bytes\": %.0f, "
+  printf("    {\"name\": \"%s\", \"wall\": %.6e, \"cpu\": %.6e, \"solve\": %.6e, \"solve_cpu\": %.6e, \"compute_cpu\": %.6e, \"mpi_wall\": %.6e,\n      \"collectives\": %.0f, \"bytes\": %.0f, "
          "\"exchanges\": %.0f, \"exchange_bytes\": %.0f, \"rss_mb\": %.1f,\n      \"calls\": {",
-         phase_name[ph], wall, cpu, solve, solve_cpu, v[0], v[1], v[2], v[3], v[4]);
+         phase_name[ph], wall, cpu, solve, solve_cpu, comp, mwall, v[0], v[1], v[2], v[3], v[4]);
   for (q = 0; q < NKIND; ++q) printf("%s\"%s\": [%lld, %lld]", q ? ", " : "", kind_name[q], kc[q], kb[q]);
   printf("}}%s\n", last ? "" : ",");
 }
