@@ -89,6 +89,8 @@ test-mpi:
 	$(MPICC) $(CFLAGS_T) -o $(BUILD)/test_mpi tests/mpi/test_mpi.c $(LDLIBS) && \
 	$(MPICC) -std=c99 $(WARN) -O0 -o $(BUILD)/mpi_pod examples/mpi_pod.c $(LDLIBS) && \
 	for p in 1 2 3 4; do timeout 120 $(MPIRUN) -np $$p ./$(BUILD)/test_mpi $(BUILD)/mpi || exit 1; done && \
+	$(MPICC) $(CFLAGS_T) -o $(BUILD)/test_mpi_stream tests/mpi/test_mpi_stream.c $(LDLIBS) && \
+	for p in 1 2 3 4; do timeout 120 $(MPIRUN) -np $$p ./$(BUILD)/test_mpi_stream || exit 1; done && \
 	$(MPIRUN) -np 3 ./$(BUILD)/mpi_pod --N 3000 > $(BUILD)/mpi/example.txt && echo "test-mpi: examples/mpi_pod.c runs at 3 ranks"
 
 # The documentation against the code: every public function in the manual's
@@ -265,3 +267,11 @@ bench: phgmg.h examples
 
 clean:
 	rm -rf $(BUILD) results tests/suites.inc bench/results.csv
+
+# The distributed phases' timings and communication, as JSON (bench/README.md,
+# "The distributed offline phase: scaling model"; not part of make test):
+#   mpirun -np P build/bench_mpi_phases --nloc 25000 > p1.json
+#   /usr/bin/python3 bench/mpi_scaling.py p1.json ...
+$(BUILD)/bench_mpi_phases: bench/bench_mpi_phases.c phgmg.h
+	@mkdir -p $(BUILD)
+	$(MPICC) -std=c99 $(WARN) -O2 -o $@ bench/bench_mpi_phases.c $(LDLIBS)

@@ -642,9 +642,10 @@
                             alternative to TSQR with less communication
      phgmg_mpi_pod          POD by TSQR and the SVD of R; values identical
                             on every rank, V this rank's rows
-     phgmg_mpi_pod_stream_* the same from column batches (incremental SVD at
-                            rank kmax, with a stated error bound): the N x ns
-                            snapshot matrix never exists, on one rank too
+     phgmg_mpi_pod_stream_* the same from column batches (the serial
+                            stream's incremental SVD at rank kmax, with its
+                            rounding floor and stated error bound): the N x
+                            ns snapshot matrix never exists, on one rank too
      phgmg_mpi_deim_greedy  greedy DEIM points as global indices, ties to the
                             lower global index: the same for every partition
      phgmg_mpi_ecsw         ECSW of a separable sum whose terms are spread
@@ -696,10 +697,22 @@
    within 1.5e-15 relative at 1-4 ranks (after the sign of each POD mode,
    which the SVD leaves free), the reduced outputs over 200 steps within
    1e-15. Cost: per POD, one allgather of ns^2 doubles
-   per rank and a replicated QR of a (size ns) x ns matrix (fine to a few
-   hundred ranks; a reduction tree would remove the size factor); per DEIM
+   per rank and a replicated QR of a (size ns) x ns matrix (fine while
+   size ns is a few percent of the rows per rank; a reduction tree would
+   remove the size factor); per DEIM
    point one broadcast of k doubles and one reduction of a (value, index)
    pair; per operator product one exchange with the neighbouring ranks.
+   Scaling (bench/README.md): bench/bench_mpi_phases.c measures each
+   phase's local work, the time in the user's solves and the communication
+   by kind, and bench/mpi_scaling.py models time(P, N) = the local work
+   (per row, fitted at one rank) + TSQR's replicated QR of the stacked
+   factors + the collectives (alpha log2 P + beta bytes; the allgather's
+   bytes grow with P) + the halo. For N = 1e9 on 1000 ranks (1e6 rows each,
+   40 snapshots, r = 10; 2 us latency, 10 GB/s) it predicts collectives at
+   0.06 % of the time, a weak-scaling efficiency of 99 % without the user's
+   solves and about 1.5 GB per rank; the efficiency falls below 90 % near
+   16 000 ranks (size ns about 0.6 times the rows per rank), where TSQR's
+   replicated stack dominates.
    Not yet distributed: GMG-QM, SP1/SP2, ECSW, nonlinear Hamiltonians,
    dampers, descriptor models, the command line.
    2.8 Large sparse linear models (>>lowrank). For a phgmg_ph_sparse model
@@ -4435,20 +4448,28 @@ PHGMG_DEF phgmg_result phgmg_mpi_pod(const phgmg_mpi_ctx *ctx, int ns, const dou
                                      double tol, double *V, int ldv, double *S, int *k_out);
 
 /* Streaming POD of snapshots that arrive in column blocks (larger than
-   memory: the N x ns matrix never exists). An incremental SVD (Brand 2006)
-   kept at rank kmax: with the current basis V (N x k) and values S, a new
-   block Xb is split into C = V^T Xb and the residual Xb - V C (twice, for
-   orthogonality), the residual factored by TSQR into Qb Rb, and the small
-   matrix [[diag(S), C], [0, Rb]] decomposed (replicated); V, S are
-   updated and truncated to the kmax leading modes (and to sigma_k > tol
-   sigma_1 with tol > 0). Error statement: with no truncation (kmax >= the
-   number of columns seen) the result is the POD of all the columns; each
-   truncation discards the values it drops, and the final values and
-   basis are exactly those of a matrix within the sum, over the
-   truncations, of sqrt(sum of the squares of the values dropped) of the
-   true snapshot matrix in the Frobenius norm (phgmg_mpi_pod_stream_end
-   reports that bound; values below the SVD's rank threshold, eps times
-   the norm of the small matrix, count as zero). Memory: 2 nloc (kmax +
+   memory: the N x ns matrix never exists). The algorithm of the serial
+   phgmg_pod_stream_* (manual 2.9) on row blocks, an incremental SVD (Brand
+   2006) kept at rank kmax: with the current basis V (N x k) and values S,
+   a new block Xb is split into C = V^T Xb and the residual Xb - V C, the
+   residual factored by TSQR into Qb Rb, Qb re-orthogonalised against V
+   (twice, then TSQR again: orthogonal to working precision even when the
+   residual is at the rounding level, as for data of lower rank than the
+   columns seen), and the small matrix [[diag(S), C], [0, Rb]] decomposed
+   (replicated); V, S are updated and truncated to the kmax leading modes,
+   to the values above the rounding floor max(N, ns) eps ||X||_F of the ns
+   columns seen (as phgmg_reduce: below it a value is rounding noise and
+   counts as zero), and to sigma_k > tol sigma_1 with tol > 0. The values
+   equal the serial stream's to rounding. Error statement: with no
+   truncation (kmax at least the numerical rank of the columns seen) the
+   result is the POD of all the columns; each truncation discards the
+   values it drops, and the final values and basis are exactly those of a
+   matrix within the sum, over the truncations, of sqrt(sum of the squares
+   of the values dropped) of the true snapshot matrix in the Frobenius norm
+   (phgmg_mpi_pod_stream_end reports that bound; by Weyl every value is
+   within it of the exact one, and ||X - V V^T X||_F is at most it).
+   Communication per block: 3 reductions of k nb doubles (phgmg_mpi_atb)
+   and 2 TSQR allgathers of nb^2 doubles per rank. Memory: 2 nloc (kmax +
    nb) doubles for a block of nb columns. begin: *st (NULL on failure);
    add: nb >= 1 columns Xb (nloc x nb, ldx); end: V (nloc x k, ldv), S (k,
    may be NULL), *k_out = k, *discarded (may be NULL) = the bound above;
@@ -14247,6 +14268,61 @@ PHGMG__PRIV void phgmg__pod_stream_project(phgmg_pod_stream *s, int nb, double *
   }
 }
 
+/* The small kernels shared by the serial and the distributed stream
+   (phgmg_mpi_pod_stream_*, which keeps the same algorithm on row blocks). */
+/* The rounding floor of the columns seen (as phgmg_reduce's): max(N, ns)
+   eps ||X||_F, fro2 = ||X||_F^2 of the ns columns seen (N rows). */
+PHGMG__PRIV double phgmg__stream_floor(double N, int ns, double fro2) {
+  return (N > (double)ns ? N : (double)ns) * PHGMG__EPS * sqrt(fro2);
+}
+
+/* Of the kk values sv (descending) keep at most kmax, and only those above
+   the floor fl and above tol sv[0]; sqrt(the sum of the squares of the
+   others) is added to *discarded. Returns the number kept. */
+PHGMG__PRIV int phgmg__stream_cut(const double *sv, int kk, int kmax, double fl, double tol, double *discarded) {
+  int kn = PHGMG__MIN(kk, kmax), i;
+  double drop = 0.0;
+  for (i = 0; i < kn; ++i)
+    if (!(sv[i] > fl) || !(sv[i] > tol * sv[0])) { kn = i; break; }
+  for (i = kn; i < kk; ++i) drop += sv[i] * sv[i];
+  *discarded += sqrt(drop);
+  return kn;
+}
+
+/* M (K2 x K2, K2 = k + nb) = [[diag(S), C], [0, Rb]]: C k x nb, Rb nb x nb
+   upper triangular. */
+PHGMG__PRIV void phgmg__stream_small_matrix(int k, int nb, const double *S, const double *C, const double *Rb,
+                                            double *M) {
+  const int K2 = k + nb;
+  int i, j;
+  memset(M, 0, (size_t)K2 * K2 * sizeof(double));
+  for (i = 0; i < k; ++i) M[i + (size_t)i * K2] = S[i];
+  for (j = 0; j < nb; ++j) {
+    for (i = 0; i < k; ++i) M[i + (size_t)(k + j) * K2] = C[i + (size_t)j * k];
+    for (i = 0; i <= j; ++i) M[k + i + (size_t)(k + j) * K2] = Rb[i + (size_t)j * nb];
+  }
+}
+
+/* After the residual's factor W was re-orthogonalised, W = [V, QB] E + W2
+   R2: the coordinates and the triangular factor take the correction, T =
+   E Rb ((k + m) x nb, in Et): C (k x nb) += T(0:k), Ab (m x nb) += T(k:),
+   Rb <- R2 Rb (both upper triangular; T: nb x nb scratch). */
+PHGMG__PRIV void phgmg__stream_fold(int k, int m, int nb, const double *E, const double *R2, double *Rb, double *C,
+                                    double *Ab, double *Et, double *T) {
+  int i, j, l;
+  phgmg_gemm('N', 'N', k + m, nb, nb, 1.0, E, k + m, Rb, nb, 0.0, Et, k + m);
+  for (j = 0; j < nb; ++j) {
+    for (i = 0; i < k; ++i) C[i + (size_t)j * k] += Et[i + (size_t)j * (k + m)];
+    for (i = 0; i < m; ++i) Ab[i + (size_t)j * m] += Et[k + i + (size_t)j * (k + m)];
+    for (i = 0; i < nb; ++i) {
+      double t = 0.0;
+      for (l = i; l <= j; ++l) t += R2[i + (size_t)l * nb] * Rb[l + (size_t)j * nb];
+      T[i + (size_t)j * nb] = t;
+    }
+  }
+  memcpy(Rb, T, (size_t)nb * nb * sizeof(double));
+}
+
 /* The update from the SVD of M = [[diag(S), C], [0, Rb]] (K2 = k + nb
    square): V <- [V, Qb] Um(:, 0:kn), Z <- Um(:, 0:kn)^T [[Z, C], [0, Rb]],
    truncated to kmax, the numerical rank and tol. w: K2 + 2 K2^2 + 4096 kmax +
@@ -14254,15 +14330,11 @@ PHGMG__PRIV void phgmg__pod_stream_project(phgmg_pod_stream *s, int nb, double *
 PHGMG__PRIV phgmg_result phgmg__pod_stream_update(phgmg_pod_stream *s, int nb, const double *M, const double *Qb,
                                                   double *w) {
   const int N = s->N, k = s->k, K2 = k + nb, nt = s->ns + nb;
-  double *sv = w, *Um = sv + K2, *Vn = Um + (size_t)K2 * K2, *Zf = Vn + (size_t)PHGMG__QR_CHUNK * s->kmax, drop = 0.0;
+  double *sv = w, *Um = sv + K2, *Vn = Um + (size_t)K2 * K2, *Zf = Vn + (size_t)PHGMG__QR_CHUNK * s->kmax;
   int kk = 0, rank = 0, kn, i, j;
   phgmg_result rc = phgmg_svd(K2, K2, M, K2, K2, sv, Um, K2, NULL, 1, &kk, &rank, &s->al);
   if (rc != PHGMG_OK) return rc;
-  kn = PHGMG__MIN(kk, s->kmax);
-  for (i = 0; i < kn; ++i)   /* the rounding floor of the columns seen (as phgmg_reduce's), and tol */
-    if (!(sv[i] > (double)PHGMG__MAX(N, nt) * PHGMG__EPS * sqrt(s->fro2)) || !(sv[i] > s->tol * sv[0])) { kn = i; break; }
-  for (i = kn; i < kk; ++i) drop += sv[i] * sv[i];
-  s->discarded += sqrt(drop);
+  kn = phgmg__stream_cut(sv, kk, s->kmax, phgmg__stream_floor((double)N, nt, s->fro2), s->tol, &s->discarded);
   if (kn > 0) {
     for (i = 0; i < N; i += PHGMG__QR_CHUNK) {   /* by row chunks, in place: V's rows i .. i + nr - 1 */
       const int nr = PHGMG__MIN(PHGMG__QR_CHUNK, N - i);
@@ -14294,7 +14366,7 @@ PHGMG__PRIV phgmg_result phgmg__pod_stream_reorth(phgmg_pod_stream *s, int nb, d
   double *E = phgmg__dalloc(&s->al, (size_t)(k + m) * nb * 2 + (size_t)nb * nb * 2);
   double *Et, *R2, *T;
   phgmg_result rc;
-  int pass, i, j, l;
+  int pass, i;
   if (!E) return PHGMG_ERR_NOMEM;
   Et = E + (size_t)(k + m) * nb; R2 = Et + (size_t)(k + m) * nb; T = R2 + (size_t)nb * nb;
   memset(E, 0, (size_t)(k + m) * nb * sizeof(double));
@@ -14315,18 +14387,7 @@ PHGMG__PRIV phgmg_result phgmg__pod_stream_reorth(phgmg_pod_stream *s, int nb, d
     double *Ab = s->A + (size_t)m * s->ns;
     memcpy(W, Res, (size_t)N * kq * sizeof(double));
     if (kq < nb) memset(W + (size_t)N * kq, 0, (size_t)N * (nb - kq) * sizeof(double));
-    /* T = E Rb ((k + m) x nb): C += T(0:k), Ab += T(k:); Rb <- R2 Rb */
-    phgmg_gemm('N', 'N', k + m, nb, nb, 1.0, E, k + m, Rb, nb, 0.0, Et, k + m);
-    for (j = 0; j < nb; ++j) {
-      for (i = 0; i < k; ++i) Cs[i + (size_t)j * k] += Et[i + (size_t)j * (k + m)];
-      for (i = 0; i < m; ++i) Ab[i + (size_t)j * m] += Et[k + i + (size_t)j * (k + m)];
-      for (i = 0; i < nb; ++i) {
-        double t = 0.0;
-        for (l = i; l <= j; ++l) t += R2[i + (size_t)l * nb] * Rb[l + (size_t)j * nb];
-        T[i + (size_t)j * nb] = t;
-      }
-    }
-    memcpy(Rb, T, (size_t)nb * nb * sizeof(double));
+    phgmg__stream_fold(k, m, nb, E, R2, Rb, Cs, Ab, Et, T);
   }
   (void)Ct;
   phgmg__free(&s->al, E);
@@ -14337,7 +14398,7 @@ PHGMG_DEF phgmg_result phgmg_pod_stream_add(phgmg_pod_stream *st, int nb, const 
   double *Res, *W, *Cs, *Ct, *Rb, *M, *w;
   size_t need;
   phgmg_result rc;
-  int N, k, K2, i, j, kq;
+  int N, k, K2, j, kq;
   if (!st || !Xb) return PHGMG_ERR_INVALID_ARG;
   N = st->N; k = st->k; K2 = k + nb;
   if (nb < 1 || ldx < N || nb > (int)(~0u >> 2) - st->ns || nb > (int)(~0u >> 2) - k) return PHGMG_ERR_SIZE;
@@ -14364,12 +14425,7 @@ PHGMG_DEF phgmg_result phgmg_pod_stream_add(phgmg_pod_stream *st, int nb, const 
     rc = phgmg__pod_stream_reorth(st, nb, W, Res, Rb, Cs, Ct);
   }
   if (rc == PHGMG_OK) {
-    memset(M, 0, (size_t)K2 * K2 * sizeof(double));
-    for (i = 0; i < k; ++i) M[i + (size_t)i * K2] = st->S[i];
-    for (j = 0; j < nb; ++j) {
-      for (i = 0; i < k; ++i) M[i + (size_t)(k + j) * K2] = Cs[i + (size_t)j * k];
-      for (i = 0; i <= j; ++i) M[k + i + (size_t)(k + j) * K2] = Rb[i + (size_t)j * nb];
-    }
+    phgmg__stream_small_matrix(k, nb, st->S, Cs, Rb, M);
     rc = phgmg__pod_stream_update(st, nb, M, W, w);
   }
   phgmg__free(&st->al, Res);
@@ -23718,10 +23774,13 @@ PHGMG_DEF phgmg_result phgmg_mpi_cholqr(const phgmg_mpi_ctx *ctx, int ns, const 
 }
 
 /* ---- streaming POD ---------------------------------------------------------- */
+/* The serial stream's algorithm (phgmg_pod_stream_add) on row blocks: the
+   tall products are phgmg_mpi_atb and TSQR, the small kernels
+   (phgmg__stream_cut, _small_matrix, _fold) are shared with it. */
 struct phgmg_mpi_pod_stream {
   const phgmg_mpi_ctx *ctx;
-  int kmax, k;
-  double tol, discarded;
+  int kmax, k, ns;   /* ns: columns seen */
+  double tol, discarded, fro2;   /* fro2: squared Frobenius norm of the columns seen */
   double *V, *S;   /* nloc x kmax (ld max(1, nloc)), kmax */
 };
 
@@ -23744,21 +23803,21 @@ PHGMG_DEF phgmg_result phgmg_mpi_pod_stream_begin(phgmg_mpi_pod_stream **st, con
     if (s) { phgmg__free(&ctx->al, s->V); phgmg__free(&ctx->al, s); }
     return rc;
   }
-  s->ctx = ctx; s->kmax = kmax; s->k = 0; s->tol = tol; s->discarded = 0.0;
+  s->ctx = ctx; s->kmax = kmax; s->k = 0; s->ns = 0; s->tol = tol; s->discarded = 0.0; s->fro2 = 0.0;
   s->S = s->V + (size_t)PHGMG__MAX(1, ctx->nloc) * kmax;
   *st = s;
   return PHGMG_OK;
 }
 
-/* Res (nloc x nb) -= V C with C = V^T Res, twice; Cs (k x nb) = the sum of
-   both coefficient blocks, Ct: k x nb scratch. */
-PHGMG__PRIV phgmg_result phgmg__mpi_stream_project(const phgmg_mpi_pod_stream *s, int nb, double *Res, double *Cs,
-                                                   double *Ct) {
+/* Res (nloc x nb) -= V C with C = V^T Res, `passes` times; Cs (k x nb) =
+   the sum of the coefficient blocks, Ct: k x nb scratch. */
+PHGMG__PRIV phgmg_result phgmg__mpi_stream_project(const phgmg_mpi_pod_stream *s, int nb, int passes, double *Res,
+                                                   double *Cs, double *Ct) {
   const int n = s->ctx->nloc, ld = PHGMG__MAX(1, n), k = s->k;
   int pass, i;
   phgmg_result rc = PHGMG_OK;
   memset(Cs, 0, (size_t)k * nb * sizeof(double));
-  for (pass = 0; pass < 2 && rc == PHGMG_OK && k > 0; ++pass) {
+  for (pass = 0; pass < passes && rc == PHGMG_OK && k > 0; ++pass) {
     rc = phgmg_mpi_atb(s->ctx, k, nb, s->V, ld, Res, ld, Ct, k);
     if (rc != PHGMG_OK) break;
     if (n > 0) phgmg_gemm('N', 'N', n, nb, k, -1.0, s->V, ld, Ct, k, 1.0, Res, ld);
@@ -23767,22 +23826,49 @@ PHGMG__PRIV phgmg_result phgmg__mpi_stream_project(const phgmg_mpi_pod_stream *s
   return rc;
 }
 
+/* Workspace of a stream update with a block of nb columns (doubles). */
+PHGMG__PRIV size_t phgmg__mpi_stream_ws(const phgmg_mpi_pod_stream *s, int nb) {
+  const size_t ld = (size_t)PHGMG__MAX(1, s->ctx->nloc), k = (size_t)s->k, K2 = k + (size_t)nb;
+  return 2 * ld * nb + 3 * k * nb + 4 * (size_t)nb * nb + 2 * K2 * K2 + K2 + ld * (size_t)s->kmax +
+         phgmg__mpi_tsqr_ws(s->ctx, nb);
+}
+
+/* Qb (nloc x nb) = the orthonormal factor of the TSQR of Res: Res = Qb Rb.
+   W: nloc x nb, Q2: nb x nb, ws: phgmg__mpi_tsqr_ws doubles. Qb may be Res. */
+PHGMG__PRIV phgmg_result phgmg__mpi_stream_qr(const phgmg_mpi_ctx *ctx, int nb, const double *Res, double *W,
+                                              double *Rb, double *Q2, double *ws, double *Qb) {
+  const int n = ctx->nloc, ld = PHGMG__MAX(1, n);
+  phgmg_result rc = phgmg__mpi_tsqr_core(ctx, nb, Res, ld, W, Rb, Q2, ws);
+  if (rc == PHGMG_OK && n > 0) phgmg_gemm('N', 'N', n, nb, PHGMG__MIN(n, nb), 1.0, W, ld, Q2, nb, 0.0, Qb, ld);
+  return rc;
+}
+
+/* As the serial phgmg__pod_stream_reorth: the residual's factor Qb (nloc x
+   nb) made orthogonal to V to working precision whatever the residual's
+   size (a residual at the rounding level gives a Qb that is not): Qb -= V E
+   twice, Qb = Q2 R2 by TSQR, then C += E Rb, Rb <- R2 Rb. E, Et: k x nb;
+   R2, T, Q2: nb x nb; W: nloc x nb; ws: phgmg__mpi_tsqr_ws. */
+PHGMG__PRIV phgmg_result phgmg__mpi_stream_reorth(const phgmg_mpi_pod_stream *s, int nb, double *Qb, double *Rb,
+                                                  double *Cs, double *E, double *Et, double *R2, double *T,
+                                                  double *W, double *Q2, double *ws) {
+  phgmg_result rc = phgmg__mpi_stream_project(s, nb, 2, Qb, E, Et);
+  if (rc == PHGMG_OK) rc = phgmg__mpi_stream_qr(s->ctx, nb, Qb, W, R2, Q2, ws, Qb);
+  if (rc == PHGMG_OK) phgmg__stream_fold(s->k, 0, nb, E, R2, Rb, Cs, NULL, Et, T);
+  return rc;
+}
+
 /* The new basis and values from the SVD of M = [[diag(S), C], [0, Rb]]
-   (K2 x K2, K2 = k + nb): V <- [V, Qb] Um(:, 0:knew), truncated to kmax and
-   tol; the dropped values into s->discarded. sv, Um: K2, K2 x K2; Vn: nloc x kmax. */
+   (K2 x K2, K2 = k + nb): V <- [V, Qb] Um(:, 0:knew), truncated to kmax,
+   the rounding floor of the columns seen and tol; the dropped values into
+   s->discarded. sv, Um: K2, K2 x K2; Vn: nloc x kmax. */
 PHGMG__PRIV phgmg_result phgmg__mpi_stream_update(phgmg_mpi_pod_stream *s, int nb, const double *M, const double *Qb,
                                                   double *sv, double *Um, double *Vn) {
   const int n = s->ctx->nloc, ld = PHGMG__MAX(1, n), k = s->k, K2 = k + nb;
   int kk = 0, rank = 0, knew, i;
-  double drop = 0.0;
   phgmg_result rc = phgmg_svd(K2, K2, M, K2, K2, sv, Um, K2, NULL, 1, &kk, &rank, &s->ctx->al);
   if (rc != PHGMG_OK) return rc;
-  knew = PHGMG__MIN(kk, s->kmax);
-  if (s->tol > 0.0)
-    for (i = 0; i < knew; ++i)
-      if (!(sv[i] > s->tol * sv[0])) { knew = i; break; }
-  for (i = knew; i < kk; ++i) drop += sv[i] * sv[i];
-  s->discarded += sqrt(drop);
+  knew = phgmg__stream_cut(sv, kk, s->kmax, phgmg__stream_floor((double)s->ctx->N, s->ns + nb, s->fro2), s->tol,
+                           &s->discarded);
   if (n > 0 && knew > 0) {
     if (k > 0) phgmg_gemm('N', 'N', n, knew, k, 1.0, s->V, ld, Um, K2, 0.0, Vn, ld);
     phgmg_gemm('N', 'N', n, knew, nb, 1.0, Qb, ld, Um + k, K2, k > 0 ? 1.0 : 0.0, Vn, ld);
@@ -23790,39 +23876,47 @@ PHGMG__PRIV phgmg_result phgmg__mpi_stream_update(phgmg_mpi_pod_stream *s, int n
   }
   for (i = 0; i < knew; ++i) s->S[i] = sv[i];
   s->k = knew;
+  s->ns += nb;
   return PHGMG_OK;
+}
+
+/* fro2 += the squared norms of the new columns: their coordinates C (k x
+   nb) and residual, whose norms are those of Rb's columns (Res = Qb Rb). */
+PHGMG__PRIV void phgmg__mpi_stream_norms(phgmg_mpi_pod_stream *s, int nb, const double *C, const double *Rb) {
+  int j;
+  for (j = 0; j < nb; ++j) {
+    const double a = phgmg_normf(j + 1, 1, Rb + (size_t)j * nb, nb);
+    const double b = s->k > 0 ? phgmg_normf(s->k, 1, C + (size_t)j * s->k, s->k) : 0.0;
+    s->fro2 += a * a + b * b;
+  }
 }
 
 PHGMG_DEF phgmg_result phgmg_mpi_pod_stream_add(phgmg_mpi_pod_stream *st, int nb, const double *Xb, int ldx) {
   const phgmg_mpi_ctx *ctx;
   const phgmg_allocator *al;
-  double *Res = NULL, *W, *Cs, *Ct, *Rb, *Q2, *M, *sv, *Um, *Vn, *ws;
+  double *Res = NULL, *W, *Cs, *Ct, *E, *Rb, *R2, *T, *Q2, *M, *sv, *Um, *Vn, *ws;
   phgmg_result rc = PHGMG_OK;
-  int n, ld, k, K2, i, j;
+  int n, ld, k, K2, j;
   if (!st) return PHGMG_ERR_INVALID_ARG;
   ctx = st->ctx; al = &ctx->al; n = ctx->nloc; ld = PHGMG__MAX(1, n); k = st->k; K2 = k + nb;
-  if (nb < 1 || !phgmg__mpi_ld_ok(ctx, ldx)) rc = PHGMG_ERR_SIZE;
+  if (nb < 1 || !phgmg__mpi_ld_ok(ctx, ldx) || nb > (int)(~0u >> 2) - st->ns) rc = PHGMG_ERR_SIZE;
   else if (n > 0 && !Xb) rc = PHGMG_ERR_INVALID_ARG;
-  else if (!(Res = phgmg__dalloc(al, 2 * (size_t)ld * nb + 2 * (size_t)k * nb + 2 * (size_t)nb * nb +
-                                         (size_t)K2 * K2 * 2 + (size_t)K2 + (size_t)ld * st->kmax +
-                                         phgmg__mpi_tsqr_ws(ctx, nb))))
-    rc = PHGMG_ERR_NOMEM;
+  else if (!(Res = phgmg__dalloc(al, phgmg__mpi_stream_ws(st, nb)))) rc = PHGMG_ERR_NOMEM;
   rc = phgmg__mpi_agree(ctx, rc);
   if (rc != PHGMG_OK) { phgmg__free(al, Res); return rc; }
-  W = Res + (size_t)ld * nb; Cs = W + (size_t)ld * nb; Ct = Cs + (size_t)k * nb; Rb = Ct + (size_t)k * nb;
-  Q2 = Rb + (size_t)nb * nb; M = Q2 + (size_t)nb * nb; Um = M + (size_t)K2 * K2; sv = Um + (size_t)K2 * K2;
-  Vn = sv + K2; ws = Vn + (size_t)ld * st->kmax;
+  W = Res + (size_t)ld * nb; Cs = W + (size_t)ld * nb; Ct = Cs + (size_t)k * nb; E = Ct + (size_t)k * nb;
+  Rb = E + (size_t)k * nb; R2 = Rb + (size_t)nb * nb; T = R2 + (size_t)nb * nb; Q2 = T + (size_t)nb * nb;
+  M = Q2 + (size_t)nb * nb; Um = M + (size_t)K2 * K2; sv = Um + (size_t)K2 * K2; Vn = sv + K2;
+  ws = Vn + (size_t)ld * st->kmax;
   for (j = 0; j < nb && n > 0; ++j) memcpy(Res + (size_t)j * ld, Xb + (size_t)j * ldx, (size_t)n * sizeof(double));
-  rc = phgmg__mpi_stream_project(st, nb, Res, Cs, Ct);
-  if (rc == PHGMG_OK) rc = phgmg__mpi_tsqr_core(ctx, nb, Res, ld, W, Rb, Q2, ws);
+  rc = phgmg__mpi_stream_project(st, nb, 1, Res, Cs, Ct);   /* one pass, then the factor re-orthogonalised */
+  if (rc == PHGMG_OK) rc = phgmg__mpi_stream_qr(ctx, nb, Res, W, Rb, Q2, ws, Res);   /* Res <- Qb */
   if (rc == PHGMG_OK) {
-    if (n > 0) phgmg_gemm('N', 'N', n, nb, PHGMG__MIN(n, nb), 1.0, W, ld, Q2, nb, 0.0, Res, ld);   /* Qb */
-    memset(M, 0, (size_t)K2 * K2 * sizeof(double));
-    for (i = 0; i < k; ++i) M[i + (size_t)i * K2] = st->S[i];
-    for (j = 0; j < nb; ++j) {
-      for (i = 0; i < k; ++i) M[i + (size_t)(k + j) * K2] = Cs[i + (size_t)j * k];
-      for (i = 0; i <= j; ++i) M[k + i + (size_t)(k + j) * K2] = Rb[i + (size_t)j * nb];
-    }
+    phgmg__mpi_stream_norms(st, nb, Cs, Rb);
+    rc = phgmg__mpi_stream_reorth(st, nb, Res, Rb, Cs, E, Ct, R2, T, W, Q2, ws);
+  }
+  if (rc == PHGMG_OK) {
+    phgmg__stream_small_matrix(k, nb, st->S, Cs, Rb, M);
     rc = phgmg__mpi_stream_update(st, nb, M, Res, sv, Um, Vn);
   }
   phgmg__free(al, Res);
