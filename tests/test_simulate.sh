@@ -151,7 +151,7 @@ cp lat/B.npy B_before.npy
 "$P" simulate --J-coo lat/J.npy --out y3.npy >/dev/null 2>err.txt
 [ $? -eq 2 ] && pass || bad "incomplete model: $(cat err.txt)"
 
-# 6. a star (one state coupled to all others): its band is wide in every
+# 5. a star (one state coupled to all others): its band is wide in every
 #    order, yet the sparse LU has no fill; the log names the sparse LU and
 #    gives no "dense input would be as fast" hint (true for the band LU only)
 "$PY" - <<'PYEOF' || bad "star model generation failed"
