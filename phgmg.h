@@ -4616,14 +4616,15 @@ typedef struct phgmg_mpi_rom {
    envelope from the reduced coordinates of the snapshots. hyper.on = 0:
    every term kept with its weight (nd = all terms: O(terms) online).
    X: this rank's rows of the snapshots (nloc x ns, ldx). *out is filled
-   on success (zeroed on failure). Errors: those of
+   on success (zeroed on failure); V0 (nloc x r, ldv0, may be NULL) this
+   rank's rows of the basis (the lift x = V0 xr). Errors: those of
    phgmg_mpi_gmg_pod_linear (a failing solve's code on every rank),
    PHGMG_ERR_INVALID_ARG / _SIZE / _NANINF for bad terms,
    PHGMG_ERR_NOT_CONVERGED (the ECSW fit misses tol), PHGMG_ERR_UNSUPPORTED.
    Collective. */
 PHGMG_DEF phgmg_result phgmg_mpi_gmg_pod(const phgmg_mpi_ctx *ctx, const phgmg_mpi_sep_model *model, int ns,
                                          const double *X, int ldx, const phgmg_reduce_opts *opts,
-                                         phgmg_mpi_rom *out);
+                                         phgmg_mpi_rom *out, double *V0, int ldv0);
 /* Frees what phgmg_mpi_gmg_pod stored in *out and zeroes it (NULL or a
    zeroed struct: no-op). Not collective. */
 PHGMG_DEF void phgmg_mpi_rom_free(phgmg_mpi_rom *out);
@@ -24949,7 +24950,7 @@ PHGMG__PRIV phgmg_result phgmg__mpi_sep_terms(const phgmg_mpi_ctx *ctx, const ph
 
 PHGMG_DEF phgmg_result phgmg_mpi_gmg_pod(const phgmg_mpi_ctx *ctx, const phgmg_mpi_sep_model *model, int ns,
                                          const double *X, int ldx, const phgmg_reduce_opts *opts,
-                                         phgmg_mpi_rom *out) {
+                                         phgmg_mpi_rom *out, double *V0, int ldv0) {
   phgmg_reduce_opts o;
   phgmg__mpi_romdata d;
   double *b = NULL, resid = 0.0;
@@ -24960,6 +24961,7 @@ PHGMG_DEF phgmg_result phgmg_mpi_gmg_pod(const phgmg_mpi_ctx *ctx, const phgmg_m
   ld = PHGMG__MAX(1, ctx->nloc);
   memset(&d, 0, sizeof d);
   if (!model || !opts || !out) rc = PHGMG_ERR_INVALID_ARG;
+  else if (V0 && !phgmg__mpi_ld_ok(ctx, ldv0)) rc = PHGMG_ERR_SIZE;
   else {
     o = *opts;
     rc = phgmg__mpi_sep_check_local(ctx, model, &o);
@@ -24984,8 +24986,14 @@ PHGMG_DEF phgmg_result phgmg_mpi_gmg_pod(const phgmg_mpi_ctx *ctx, const phgmg_m
   if (rc == PHGMG_OK) rc = phgmg__mpi_sep_envelope(ctx, &model->lin, ns, X, ldx, d.env + 2 * r, r, (double *)d.env);
   d.nf = model->per_term ? d.nd : 1;
   if (rc == PHGMG_OK) rc = phgmg__mpi_agree(ctx, phgmg__mpi_rom_store(ctx, &d, out));
-  if (rc == PHGMG_OK) out->hyper_residual = resid;
-  else phgmg_mpi_rom_free(out);
+  if (rc == PHGMG_OK) {
+    int j;
+    out->hyper_residual = resid;
+    for (j = 0; V0 && ctx->nloc > 0 && j < r; ++j)
+      memcpy(V0 + (size_t)j * ldv0, d.env + 2 * r + (size_t)j * ld, (size_t)ctx->nloc * sizeof(double));
+  } else {
+    phgmg_mpi_rom_free(out);
+  }
   phgmg__free(&ctx->al, (void *)d.D);
   phgmg__free(&ctx->al, (void *)d.pts);
   phgmg__free(&ctx->al, (void *)d.w);
