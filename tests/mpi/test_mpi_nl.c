@@ -316,6 +316,16 @@ static void test_gmg_pod_ecsw(void) {
   rc = phgmg_mpi_gmg_pod(d.c, &d.md, ns, d.Xl, d.ld, &o, &mr, V0, d.ld);
   CHECK(rc == PHGMG_OK, "distributed GMG-POD: %d", (int)rc);
   V0f = gather_v0(d.c, r, V0, d.ld);
+  CHECK(same_everywhere(mr.nd) && mr.nd > 0, "nd %d differs between ranks", mr.nd);
+  if (rc == PHGMG_OK && size_ > 1) {   /* the points are spread: at least two ranks own some */
+    int q, j, owners = 0;
+    for (q = 0; q < size_; ++q) {
+      int has = 0;
+      for (j = 0; j < mr.nd; ++j) has |= mr.coord[j] >= d.c->starts[q] && mr.coord[j] < d.c->starts[q + 1];
+      owners += has;
+    }
+    CHECK(owners >= 2, "points on %d rank(s) only", owners);
+  }
   if (rank_ == 0 && rc == PHGMG_OK) {
     CHECK(phgmg_reduce(&red, &ch.sys, X, N, ns, &o, NULL, NULL) == PHGMG_OK, "serial reduce");
     if (red) compare_serial(&ch, ns, X, x0, red, &mr, V0f, "gmg-pod ecsw");
@@ -331,6 +341,54 @@ static void test_gmg_pod_ecsw(void) {
   free(X); free(x0); free(V0); free(V0f);
 }
 
+/* Bad input on one rank only (a term outside its rows, ids not ascending,
+   another function family, a NaN coefficient) and options this function
+   does not take: the same code on every rank, never a hang, *out zeroed. */
+static void test_errors(void) {
+  const int n = 60, N = 2 * n, ns = 21, r = 4, bad = size_ > 1 ? size_ - 1 : 0;
+  chain ch;
+  dist d;
+  double *X = (double *)malloc(sizeof(double) * (size_t)N * ns), *x0 = (double *)calloc((size_t)N, sizeof(double));
+  phgmg_reduce_opts o;
+  phgmg_mpi_rom mr;
+  phgmg_result rc;
+  int i, kase;
+  chain_build(&ch, n);
+  for (i = 0; i < n; ++i) x0[2 * i] = 0.5 * sin(0.1 * i);
+  CHECK(phgmg_simulate(&ch.sys, x0, 0.0, 0.2, ns - 1, u_in, NULL, NULL, X, NULL, NULL, NULL, NULL, NULL) == PHGMG_OK,
+        "simulate");
+  dist_build(&d, &ch, ns, X);
+  memset(&o, 0, sizeof o);
+  o.method = PHGMG_METHOD_GMG_POD; o.r = r; o.hyper.on = 1;
+  rc = phgmg_mpi_gmg_pod(d.c, &d.md, ns, d.Xl, d.ld, &o, &mr, NULL, 0);
+  CHECK(rc == PHGMG_OK && mr.nd > 0, "small model: %d", (int)rc);
+  phgmg_mpi_rom_free(&mr);
+  for (kase = 0; kase < 5; ++kase) {
+    phgmg_mpi_sep_model md = d.md;
+    phgmg_reduce_opts ob = o;
+    long long sidx[2];
+    double pn[2];
+    phgmg_result want = PHGMG_ERR_SIZE;
+    if (rank_ == bad && d.md.nsep >= 2) {
+      if (kase == 0) { sidx[0] = d.c->row0 + d.c->nloc; md.sep_idx = sidx; md.nsep = 1; }   /* outside its rows */
+      if (kase == 1) { sidx[0] = d.md.sep_id[1]; sidx[1] = d.md.sep_id[0]; md.sep_id = sidx; md.sep_idx = d.md.sep_idx; md.nsep = 2; }
+      if (kase == 2) md.nexp = 1;                            /* another family than the other ranks' */
+      if (kase == 3) { pn[0] = NAN; pn[1] = 0.0; md.poly = pn; md.nsep = 2; }
+      if (kase == 4) ob.method = PHGMG_METHOD_SP1;
+    }
+    if (kase == 1 || kase == 2) want = PHGMG_ERR_INVALID_ARG;
+    if (kase == 2 && size_ == 1) continue;   /* one rank: nothing to disagree with */
+    if (kase == 3) want = PHGMG_ERR_NANINF;
+    if (kase == 4) want = PHGMG_ERR_UNSUPPORTED;
+    memset(&mr, 1, sizeof mr);
+    rc = phgmg_mpi_gmg_pod(d.c, &md, ns, d.Xl, d.ld, &ob, &mr, NULL, 0);
+    CHECK(rc == want && same_everywhere(rc) && mr.mem_ == NULL && mr.nd == 0, "bad input %d on one rank: %d", kase, rc);
+  }
+  dist_free(&d);
+  chain_free(&ch);
+  free(X); free(x0);
+}
+
 int main(int argc, char **argv) {
   int total = 0;
   double t0;
@@ -340,6 +398,7 @@ int main(int argc, char **argv) {
   t0 = MPI_Wtime();
   if (rank_ == 0) printf("test_mpi_nl: P = %d\n", size_);
   test_gmg_pod_ecsw();
+  test_errors();
   MPI_Allreduce(&fails_, &total, 1, MPI_INT, MPI_SUM, MPI_COMM_WORLD);
   if (rank_ == 0)
     printf("test_mpi_nl: P = %d: %s (%d failed checks, %.2f s)\n", size_, total ? "FAILED" : "passed", total,
