@@ -661,6 +661,12 @@
                             B u (Q as an operator, B's rows, J - R through a
                             collective solve callback: the user's KSP, MUMPS
                             or AMG): K, Qh, Bh of the serial phgmg_reduce
+     phgmg_mpi_gmg_pod      GMG-POD of a model with a SEPARABLE Hamiltonian
+                            (built-in exp-polynomial terms held by the ranks
+                            that own their coordinates) with ECSW
+                            hyper-reduction: the serial phgmg_reduce's
+                            phgmg_rom, replicated, the kept terms as global
+                            indices (phgmg_mpi_rom_free)
      phgmg_mpi_agree        one result for all ranks
      phgmg_mpi_counts_*     this rank's collective calls and bytes, halo
                             exchanges and bytes: read around a call for that
@@ -695,13 +701,41 @@
    files work unchanged). Agreement with the serial phgmg_reduce: K and Qh
    within 1.5e-15 relative at 1-4 ranks (after the sign of each POD mode,
    which the SVD leaves free), the reduced outputs over 200 steps within
-   1e-15. Cost: per POD, one allgather of ns^2 doubles
+   1e-15.
+   phgmg_mpi_gmg_pod does the same for H(x) = 1/2 x^T Q x + sum_k w_k
+   phi_k(x[idx_k]) and adds the serial separable stage (3.4, 8.7): the
+   terms whose argument moves in some snapshot, F = phi_k'(x_i[idx_k]), and
+   ECSW as phgmg_ecsw_separable computes it -- F = U S W^T by TSQR and the
+   SVD on the terms' rows (phgmg_mpi_pod), the fit by phgmg_mpi_ecsw on the
+   training rows S_j U[k, j] V0[idx_k, a] of the modes sigma_j > 1e-3 tol
+   sigma_1 to tol / 2, the full residual ||F^T diag(w - sw) V0(idx, :)||_F
+   checked against tol (else the fit once more with every mode), from 4096
+   moving terms on the fit on the full ns r rows -- then the kept terms'
+   rows of V0 and functions from their owners (one reduction) and the
+   training envelope of the reduced snapshot coordinates. The result is the
+   phgmg_rom the serial phgmg_reduce builds (P0, w, per-term poly/expo, K,
+   Qh, Bh, env_lo/hi); the kept terms' global term and state indices come
+   with it (phgmg_mpi_rom.pts, .coord). On a damped chain with a cosh
+   potential (N = 2000, 1000 terms, r = 12, hyper.tol 1e-3;
+   tests/mpi/test_mpi_nl.c) at 1-4 ranks: the singular values within
+   3e-16 sigma_1, K within 4e-13 and Qh within 1.3e-15 relative (after the
+   modes' signs), the same 67 points as global indices, weights within
+   1.5e-14, the reduced outputs over 200 steps within 2.2e-12. The fit on
+   the full rows at tol alone (what phgmg_mpi_ecsw gives without the
+   compression) keeps 49 points, not the serial 67, and its model's outputs
+   differ by 6e-3: the compression and its tol / 2 are part of the serial
+   result. Cost of the fit: per point one broadcast of a training column
+   (q r doubles, q the modes kept) and a replicated least squares of q r
+   rows; a few hundred points take seconds.
+   Cost: per POD, one allgather of ns^2 doubles
    per rank and a replicated QR of a (size ns) x ns matrix (fine to a few
    hundred ranks; a reduction tree would remove the size factor); per DEIM
    point one broadcast of k doubles and one reduction of a (value, index)
    pair; per operator product one exchange with the neighbouring ranks.
-   Not yet distributed: GMG-QM, SP1/SP2, ECSW, nonlinear Hamiltonians,
-   dampers, descriptor models, the command line.
+   Not yet distributed: GMG-QM, SP1/SP2, DEIM hyper-reduction (hyper.kind
+   QDEIM or GREEDY), separable terms by callbacks and GENERAL nonlinear
+   Hamiltonians, a reference state (opts.ref), dampers, feedthrough,
+   descriptor models, the command line.
    2.8 Large sparse linear models (>>lowrank). For a phgmg_ph_sparse model
    with quadratic H (E x' = (J - R) Q x + B u, y = B^T Q x; E = I or a mass
    matrix of full rank) the Gramians are computed in low-rank factored form
@@ -2074,12 +2108,13 @@
            phgmg_mpi_deim_greedy, phgmg_mpi_op_create, phgmg_mpi_op_destroy,
            phgmg_mpi_op_info, phgmg_mpi_op_apply, phgmg_mpi_op_project,
            phgmg_mpi_gmg_pod_linear, phgmg_mpi_ecsw, phgmg_mpi_cholqr,
-           phgmg_mpi_counts_get, phgmg_mpi_counts_reset
+           phgmg_mpi_counts_get, phgmg_mpi_counts_reset, phgmg_mpi_gmg_pod,
+           phgmg_mpi_rom_free
    linalg: phgmg_gemm, phgmg_gemv, phgmg_lu_factor, phgmg_lu_solve,
            phgmg_lu_rcond, phgmg_norm1, phgmg_normf, phgmg_zlu_factor,
            phgmg_zlu_solve, phgmg_qr, phgmg_qrcp, phgmg_qr_form_q,
            phgmg_qr_apply, phgmg_lstsq, phgmg_svd, phgmg_sym_eig
-   (170 functions; 21 of them only with PHGMG_MPI; also the macros
+   (172 functions; 23 of them only with PHGMG_MPI; also the macros
    PHGMG_ROM_STEPPER_MEMSIZE_MAX and _MAX_CB.)
 */
 #ifndef PHGMG_H_INCLUDED
