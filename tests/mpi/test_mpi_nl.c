@@ -218,7 +218,7 @@ static void serial_sigma(const chain *ch, int ns, const double *X, int k, double
 /* Rank 0: the distributed model against the serial one. sg: the modes'
    signs (from the bases). */
 static void compare_serial(const chain *ch, int ns, const double *X, const double *x0, const phgmg_reduced *red,
-                           const phgmg_mpi_rom *mr, const double *V0f, const char *tag) {
+                           const phgmg_mpi_rom *mr, const double *V0f, int nsteps, const char *tag) {
   const phgmg_rom *ro = phgmg_reduced_rom(red);
   const int N = ch->N, r = mr->r, m = mr->m;
   double sg[64], S[64], e, col[8192], xr[64], xd[64];
@@ -243,7 +243,8 @@ static void compare_serial(const chain *ch, int ns, const double *X, const doubl
   e = rel_diff(r, m, mr->Bh, ro->Bh, sg, NULL);
   CHECK(e <= 1e-12, "%s: Bh %.2e", tag, e);
   CHECK(same, "%s: %d points, serial %d", tag, mr->nd, ro->nd);
-  for (j = 0; same && j < mr->nd; ++j) same = mr->pts[j] == red->term[j] && mr->coord[j] == ch->idx[red->term[j]];
+  for (j = 0; same && j < mr->nd; ++j)   /* serial: the kept terms' numbers (every term: none stored, j) */
+    same = mr->pts[j] == (red->term ? red->term[j] : j) && mr->coord[j] == ch->idx[mr->pts[j]];
   CHECK(same, "%s: point sets differ", tag);
   if (same) {
     double ew = 0.0, sw = 0.0;
@@ -254,7 +255,7 @@ static void compare_serial(const chain *ch, int ns, const double *X, const doubl
     CHECK(e <= 1e-12, "%s: P0 %.2e", tag, e);
     printf(", %d points, weights %.1e, P0 %.1e", mr->nd, ew / sw, e);
   }
-  {   /* the online models from the rest state x0's reduced coordinates, 200 steps */
+  {   /* the online models from x0's reduced coordinates, nsteps steps */
     static double m1[1 << 16], m2[1 << 16];
     phgmg_rom_stepper s1, s2;
     double u3[3], tc[3], y1 = 0.0, y2 = 0.0, ey = 0.0, sy = 0.0;
@@ -265,14 +266,14 @@ static void compare_serial(const chain *ch, int ns, const double *X, const doubl
     ok = phgmg_rom_stepper_init(&s1, &mr->rom, 0.1, 0.0, 0, m1, sizeof m1) == PHGMG_OK &&
          phgmg_rom_stepper_init(&s2, ro, 0.1, 0.0, 0, m2, sizeof m2) == PHGMG_OK;
     CHECK(ok, "%s: steppers", tag);
-    for (st = 0; ok && st < 200; ++st) {
+    for (st = 0; ok && st < nsteps; ++st) {
       phgmg_rom_stage_times(0.1 * st, 0.1, tc);
       for (i = 0; i < 3; ++i) u_in(tc[i], u3 + i, NULL);
       ok = phgmg_rom_step(&s1, xd, u3, &y1, NULL) == PHGMG_OK && phgmg_rom_step(&s2, xr, u3, &y2, NULL) == PHGMG_OK;
       ey = fmax(ey, fabs(y1 - y2)); sy = fmax(sy, fabs(y2));
     }
     CHECK(ok && ey <= 1e-10 * sy, "%s: reduced outputs against the serial model's: %.2e", tag, ey / sy);
-    printf(", outputs (200 steps) %.1e\n", ey / sy);
+    printf(", outputs (%d steps) %.1e\n", nsteps, ey / sy);
   }
 }
 
@@ -328,10 +329,21 @@ static void test_gmg_pod_ecsw(void) {
   }
   if (rank_ == 0 && rc == PHGMG_OK) {
     CHECK(phgmg_reduce(&red, &ch.sys, X, N, ns, &o, NULL, NULL) == PHGMG_OK, "serial reduce");
-    if (red) compare_serial(&ch, ns, X, x0, red, &mr, V0f, "gmg-pod ecsw");
+    if (red) compare_serial(&ch, ns, X, x0, red, &mr, V0f, 200, "gmg-pod ecsw");
     phgmg_reduced_destroy(red);
   }
   phgmg_mpi_rom_free(&mr);
+  /* without hyper-reduction: every term kept with its weight, as the serial model */
+  o.hyper.on = 0;
+  rc = phgmg_mpi_gmg_pod(d.c, &d.md, ns, d.Xl, d.ld, &o, &mr, NULL, 0);
+  CHECK(rc == PHGMG_OK && mr.nd == n, "distributed GMG-POD, every term: %d, nd %d", (int)rc, mr.nd);
+  if (rank_ == 0 && rc == PHGMG_OK) {
+    CHECK(phgmg_reduce(&red, &ch.sys, X, N, ns, &o, NULL, NULL) == PHGMG_OK, "serial reduce, every term");
+    if (red) compare_serial(&ch, ns, X, x0, red, &mr, V0f, 40, "gmg-pod, every term");
+    phgmg_reduced_destroy(red);
+  }
+  phgmg_mpi_rom_free(&mr);
+  o.hyper.on = 1;
   /* the solve fails on one rank only */
   d.sv.fail_rank = size_ > 1 ? size_ - 1 : 0;
   rc = phgmg_mpi_gmg_pod(d.c, &d.md, ns, d.Xl, d.ld, &o, &mr, NULL, 0);
