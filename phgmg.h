@@ -24770,9 +24770,171 @@ PHGMG__PRIV phgmg_result phgmg__mpi_sep_ecsw_svd(const phgmg_mpi_ctx *ctx, const
   return rc;
 }
 
+/* ---- the screened fit (PHGMG_ECSW_SCREEN_MIN live terms or more) ---- */
+/* State of the distributed screening (replicated but g, inW). */
+typedef struct phgmg__mpi_scr {
+  int m, wmax, nw, nd;
+  double *Gw, *col, *tg, *res, *ww, *x0, *g, *h, *cand;   /* m x wmax, m x ADD, m, m, wmax, wmax, nl, nl r, 2 ADD (size + 1) */
+  phgmg_gidx *W;                                   /* wmax: the working set's global ids, in screening order */
+  int *pw;
+  char *inW;                                       /* nl: this rank's terms in W */
+} phgmg__mpi_scr;
+
+/* Local index of global id g among this rank's live terms (ascending), -1 if not here. */
+PHGMG__PRIV int phgmg__mpi_term_at(const phgmg__mpi_terms *t, phgmg_gidx g) {
+  int lo = 0, hi = t->nl - 1;
+  while (lo <= hi) {
+    const int mid = (lo + hi) / 2;
+    if (t->gid[mid] == g) return mid;
+    if (t->gid[mid] < g) lo = mid + 1; else hi = mid - 1;
+  }
+  return -1;
+}
+
+/* g = this rank's terms' gradients F res .* Vt summed over a (as phgmg__ecsw_grad_sep). */
+PHGMG__PRIV void phgmg__mpi_scr_grad(const phgmg__mpi_terms *t, int ns, int r, phgmg__mpi_scr *s) {
+  int k, a;
+  if (t->nl == 0) return;
+  phgmg_gemm('N', 'N', t->nl, r, ns, 1.0, t->F, t->nl, s->res, ns, 0.0, s->h, t->nl);
+  for (k = 0; k < t->nl; ++k) s->g[k] = 0.0;
+  for (a = 0; a < r; ++a)
+    for (k = 0; k < t->nl; ++k) s->g[k] += t->Vt[k + (size_t)a * t->nl] * s->h[k + (size_t)a * t->nl];
+}
+
+/* phgmg__ecsw_screen_add over all ranks: up to `add` terms outside W with the
+   largest g > gtol (largest first, ties to the lower global id), appended to
+   W with their training columns (each rank's candidates gathered, the
+   columns from their owners in one reduction). Returns the number added. */
+PHGMG__PRIV int phgmg__mpi_scr_add(const phgmg_mpi_ctx *ctx, const phgmg__mpi_terms *t, int ns, int r,
+                                   phgmg__mpi_scr *s, double gtol, int add) {
+  double *loc = s->cand, *all = s->cand + 2 * (size_t)add, *C = s->Gw + (size_t)s->nw * s->m;
+  int cnt, k, q, i, a;
+  for (cnt = 0; cnt < add; ++cnt) {   /* this rank's best `add` (flag 2: taken here), as the serial scan */
+    int best = -1;
+    double gb = gtol;
+    for (k = 0; k < t->nl; ++k)
+      if (!s->inW[k] && s->g[k] > gb) { gb = s->g[k]; best = k; }
+    if (best >= 0) s->inW[best] = 2;
+    loc[2 * cnt] = best < 0 ? -HUGE_VAL : gb;
+    loc[2 * cnt + 1] = best < 0 ? 0.0 : (double)t->gid[best];
+  }
+  for (k = 0; k < t->nl; ++k) if (s->inW[k] == 2) s->inW[k] = 0;
+  MPI_Allgather(loc, 2 * add, MPI_DOUBLE, all, 2 * add, MPI_DOUBLE, ctx->comm);
+  phgmg__mpi_count(ctx, 16.0 * add);
+  memset(s->col, 0, (size_t)s->m * add * sizeof(double));
+  for (cnt = 0; cnt < add; ++cnt) {   /* merge: the best remaining over the ranks */
+    double *b = NULL;
+    for (q = 0; q < ctx->size; ++q)
+      for (i = 0; i < add; ++i) {
+        double *c = all + ((size_t)q * add + i) * 2;
+        if (c[0] > gtol && (!b || c[0] > b[0] || (c[0] == b[0] && c[1] < b[1]))) b = c;
+      }
+    if (!b) break;
+    s->W[s->nw + cnt] = (phgmg_gidx)b[1];
+    b[0] = -HUGE_VAL;
+    if ((k = phgmg__mpi_term_at(t, s->W[s->nw + cnt])) >= 0) {
+      s->inW[k] = 1;
+      for (a = 0; a < r; ++a)
+        for (i = 0; i < ns; ++i)
+          s->col[(size_t)cnt * s->m + i + (size_t)a * ns] = t->F[k + (size_t)i * t->nl] * t->Vt[k + (size_t)a * t->nl];
+    }
+  }
+  if (cnt > 0) phgmg__mpi_sum(ctx, s->m * cnt, s->col, C);
+  return cnt;
+}
+
+/* Prune W to the fit's support (as the serial driver): terms at weight 0
+   leave W (this rank's flags cleared), the kept ones move to the front with
+   their columns, their weights the next round's warm start. */
+PHGMG__PRIV void phgmg__mpi_scr_prune(const phgmg__mpi_terms *t, phgmg__mpi_scr *s) {
+  int j, k;
+  for (j = 0; j < s->nw; ++j)
+    if ((k = phgmg__mpi_term_at(t, s->W[j])) >= 0) s->inW[k] = 0;
+  for (j = 0; j < s->nd; ++j) {
+    s->W[j] = s->W[s->pw[j]];
+    if ((k = phgmg__mpi_term_at(t, s->W[j])) >= 0) s->inW[k] = 1;
+    if (s->pw[j] != j) memcpy(s->Gw + (size_t)j * s->m, s->Gw + (size_t)s->pw[j] * s->m, (size_t)s->m * sizeof(double));
+    s->pw[j] = j;
+    s->x0[j] = s->ww[j];
+  }
+  s->nw = s->nd;
+}
+
+/* The rounds of phgmg__ecsw_screened: add candidates, the Gram fit on W
+   (phgmg__ecsw_gram, replicated, warm-started), the residual and the
+   gradients, prune; then the points ascending. */
+PHGMG__PRIV phgmg_result phgmg__mpi_scr_run(const phgmg_mpi_ctx *ctx, const phgmg__mpi_terms *t, int ns, int r,
+                                            double tol, phgmg__mpi_scr *s, phgmg_gidx *pts, double *w,
+                                            double *rel) {
+  const int add0 = PHGMG_ECSW_SCREEN_ADD;
+  double gtol = 0.0, gl = 0.0;
+  int j, i, rounds = 0;
+  phgmg_result rc = PHGMG_ERR_NOT_CONVERGED;
+  *rel = HUGE_VAL;
+  memcpy(s->res, s->tg, (size_t)s->m * sizeof(double));
+  phgmg__mpi_scr_grad(t, ns, r, s);
+  for (j = 0; j < t->nl; ++j) gl = PHGMG__MAX(gl, fabs(s->g[j]));
+  MPI_Allreduce(&gl, &gtol, 1, MPI_DOUBLE, MPI_MAX, ctx->comm);
+  phgmg__mpi_count(ctx, 8.0);
+  gtol *= 1e3 * PHGMG__EPS;
+  for (;;) {
+    const int add = phgmg__mpi_scr_add(ctx, t, ns, r, s, gtol, PHGMG__MIN(add0, s->wmax - s->nw));
+    if (add == 0) break;
+    for (j = s->nw; j < s->nw + add; ++j) s->x0[j] = 0.0;
+    s->nw += add;
+    rc = phgmg__ecsw_gram(s->nw, s->m, s->Gw, s->m, s->tg, tol, rounds ? s->x0 : NULL, s->pw, s->ww, &s->nd, rel,
+                          &ctx->al);
+    if (rc != PHGMG_ERR_NOT_CONVERGED) break;   /* tol met, or an error (the same everywhere: replicated) */
+    memcpy(s->res, s->tg, (size_t)s->m * sizeof(double));
+    for (j = 0; j < s->nd; ++j) phgmg__axpy(s->m, -s->ww[j], s->Gw + (size_t)s->pw[j] * s->m, s->res);
+    phgmg__mpi_scr_grad(t, ns, r, s);
+    if (++rounds >= PHGMG_ECSW_SCREEN_ROUNDS) break;
+    phgmg__mpi_scr_prune(t, s);
+  }
+  if (rc == PHGMG_OK || rc == PHGMG_ERR_NOT_CONVERGED) {
+    for (j = 0; j < s->nd; ++j) {   /* W in screening order: insertion sort to ascending ids */
+      const phgmg_gidx pj = s->W[s->pw[j]];
+      const double wj = s->ww[j];
+      for (i = j; i > 0 && pts[i - 1] > pj; --i) { pts[i] = pts[i - 1]; w[i] = w[i - 1]; }
+      pts[i] = pj; w[i] = wj;
+    }
+    if (*rel == HUGE_VAL) *rel = 1.0;
+  }
+  return rc;
+}
+
+/* The screened fit as phgmg_ecsw_separable from PHGMG_ECSW_SCREEN_MIN terms
+   on (full ns r rows, tol): tg the target (ns r, replicated). pts, w: room
+   for min(nlg, 16 PHGMG_ECSW_SCREEN_ADD). Collective. */
+PHGMG__PRIV phgmg_result phgmg__mpi_sep_screened(const phgmg_mpi_ctx *ctx, const phgmg__mpi_terms *t, int ns, int r,
+                                                 double tol, phgmg_gidx nlg, const double *tg, phgmg_gidx *pts,
+                                                 double *w, int *nd, double *rel) {
+  const int m = ns * r, ad = PHGMG_ECSW_SCREEN_ADD, nl1 = PHGMG__MAX(t->nl, 1);
+  phgmg__mpi_scr s;
+  phgmg_result rc;
+  memset(&s, 0, sizeof s);
+  s.m = m; s.wmax = (int)PHGMG__MIN(nlg, (phgmg_gidx)16 * ad);
+  s.Gw = phgmg__dalloc(&ctx->al, (size_t)m * (s.wmax + ad + 2) + 2 * (size_t)s.wmax + (size_t)nl1 * (r + 1) +
+                                     2 * (size_t)ad * (ctx->size + 1));
+  s.W = PHGMG__CAST(phgmg_gidx *, phgmg__alloc(&ctx->al, sizeof(phgmg_gidx) * (size_t)s.wmax));
+  s.pw = phgmg__ialloc(&ctx->al, (size_t)s.wmax);
+  s.inW = PHGMG__CAST(char *, phgmg__alloc(&ctx->al, (size_t)nl1));
+  rc = phgmg__mpi_agree(ctx, s.Gw && s.W && s.pw && s.inW ? PHGMG_OK : PHGMG_ERR_NOMEM);
+  if (rc == PHGMG_OK) {
+    s.col = s.Gw + (size_t)m * s.wmax; s.tg = s.col + (size_t)m * ad; s.res = s.tg + m; s.ww = s.res + m;
+    s.x0 = s.ww + s.wmax; s.g = s.x0 + s.wmax; s.h = s.g + nl1; s.cand = s.h + (size_t)nl1 * r;
+    memcpy(s.tg, tg, (size_t)m * sizeof(double));
+    memset(s.inW, 0, (size_t)nl1);
+    rc = phgmg__mpi_scr_run(ctx, t, ns, r, tol, &s, pts, w, rel);
+    *nd = s.nd;
+  }
+  phgmg__free(&ctx->al, s.Gw); phgmg__free(&ctx->al, s.W); phgmg__free(&ctx->al, s.pw); phgmg__free(&ctx->al, s.inW);
+  return rc;
+}
+
 /* ECSW of the live terms as the serial phgmg_ecsw_separable: the target's
    norm first (nothing to fit: nd = 0), from PHGMG_ECSW_SCREEN_MIN live terms
-   on the fit on the full ns r rows at tol, else the compressed fit. */
+   on the screened fit on the full ns r rows at tol, else the compressed fit. */
 PHGMG__PRIV phgmg_result phgmg__mpi_sep_ecsw(const phgmg_mpi_ctx *ctx, const phgmg__mpi_terms *t, int ns, int r,
                                              double tol, phgmg_gidx nlg, phgmg_gidx *pts, double *w, int *nd,
                                              double *rel) {
@@ -24780,13 +24942,12 @@ PHGMG__PRIV phgmg_result phgmg__mpi_sep_ecsw(const phgmg_mpi_ctx *ctx, const phg
   double *work = phgmg__dalloc(&ctx->al, 2 * (size_t)ns * r + (size_t)ld * r), tn = 0.0;
   phgmg_result rc = phgmg__mpi_agree(ctx, work ? PHGMG_OK : PHGMG_ERR_NOMEM);
   *nd = 0; *rel = 0.0;
-  if (rc == PHGMG_OK) tn = phgmg__mpi_sep_norm(ctx, t, ns, r, t->sw, work);
+  if (rc == PHGMG_OK) tn = phgmg__mpi_sep_norm(ctx, t, ns, r, t->sw, work);   /* the target: work + ns r */
+  if (rc == PHGMG_OK && tn > 0.0)
+    rc = nlg >= PHGMG_ECSW_SCREEN_MIN ? phgmg__mpi_sep_screened(ctx, t, ns, r, tol, nlg, work + (size_t)ns * r, pts, w, nd, rel)
+                                      : phgmg__mpi_sep_ecsw_svd(ctx, t, ns, r, tol, nlg, tn, pts, w, nd, rel);
   phgmg__free(&ctx->al, work);
-  if (rc != PHGMG_OK || tn == 0.0) return rc;
-  if (nlg >= PHGMG_ECSW_SCREEN_MIN)
-    return phgmg_mpi_ecsw(ctx, t->nl, ns, t->F, ld, r, t->Vt, ld, t->sw, t->gid, tol,
-                          (int)PHGMG__MIN(nlg, (phgmg_gidx)ns * r), pts, w, nd, rel);
-  return phgmg__mpi_sep_ecsw_svd(ctx, t, ns, r, tol, nlg, tn, pts, w, nd, rel);
+  return rc;
 }
 
 /* The kept terms' data from their owners: row j of D (nd x wd, replicated)
@@ -24957,7 +25118,7 @@ PHGMG__PRIV phgmg_result phgmg__mpi_sep_terms(const phgmg_mpi_ctx *ctx, const ph
   MPI_Allreduce(&nl, &nlg, 1, MPI_LONG_LONG, MPI_SUM, ctx->comm);
   MPI_Allreduce(&ns1, &nsg, 1, MPI_LONG_LONG, MPI_SUM, ctx->comm);
   phgmg__mpi_count(ctx, 8.0); phgmg__mpi_count(ctx, 8.0);
-  room = o->hyper.on ? PHGMG__MIN(nlg, (phgmg_gidx)ns * r) : nsg;
+  room = o->hyper.on ? PHGMG__MIN(nlg, PHGMG__MAX((phgmg_gidx)ns * r, 16 * PHGMG_ECSW_SCREEN_ADD)) : nsg;
   if (rc == PHGMG_OK && room > 200000000) rc = PHGMG_ERR_SIZE;
   if (rc == PHGMG_OK) {
     pts = PHGMG__CAST(phgmg_gidx *, phgmg__alloc(&ctx->al, sizeof(phgmg_gidx) * (size_t)(room + 1)));

@@ -221,7 +221,7 @@ static void compare_serial(const chain *ch, int ns, const double *X, const doubl
                            const phgmg_mpi_rom *mr, const double *V0f, int nsteps, const char *tag) {
   const phgmg_rom *ro = phgmg_reduced_rom(red);
   const int N = ch->N, r = mr->r, m = mr->m;
-  double sg[64], S[64], e, col[8192], xr[64], xd[64];
+  double sg[64], S[64], e, *col = (double *)malloc(sizeof(double) * (size_t)ch->N), xr[64], xd[64];
   int i, j, same = ro->nd == mr->nd;
   for (j = 0; j < r; ++j) {   /* signs: the distributed basis against the serial one (lift of unit vectors) */
     double dot = 0.0;
@@ -275,6 +275,7 @@ static void compare_serial(const chain *ch, int ns, const double *X, const doubl
     CHECK(ok && ey <= 1e-10 * sy, "%s: reduced outputs against the serial model's: %.2e", tag, ey / sy);
     printf(", outputs (%d steps) %.1e\n", nsteps, ey / sy);
   }
+  free(col);
 }
 
 /* The distributed V0 (N x r) on rank 0 from the ranks' rows. */
