@@ -60,8 +60,8 @@ typedef struct chain {
   int *idx;
 } chain;
 
-static void chain_build(chain *c, int n) {
-  const int N = 2 * n, kb = 3, ld = 2 * kb + 1;
+static void chain_build(chain *c, int n, int all) {
+  const int N = 2 * n, kb = 3, ld = 2 * kb + 1, nt = all ? N : n;
   int i;
   memset(c, 0, sizeof *c);
   c->n = n; c->N = N; c->kb = kb;
@@ -69,19 +69,21 @@ static void chain_build(chain *c, int n) {
   c->R = (double *)calloc((size_t)ld * N, sizeof(double));
   c->Q = (double *)calloc((size_t)ld * N, sizeof(double));
   c->B = (double *)calloc((size_t)N, sizeof(double));
-  c->poly = (double *)malloc(sizeof(double) * (size_t)n);
-  c->expo = (double *)malloc(sizeof(double) * 4 * (size_t)n);
-  c->w = (double *)malloc(sizeof(double) * (size_t)n);
-  c->idx = (int *)malloc(sizeof(int) * (size_t)n);
+  c->poly = (double *)malloc(sizeof(double) * (size_t)nt);
+  c->expo = (double *)malloc(sizeof(double) * 4 * (size_t)nt);
+  c->w = (double *)malloc(sizeof(double) * (size_t)nt);
+  c->idx = (int *)malloc(sizeof(int) * (size_t)nt);
 #define AT(A, r, s) (A)[(size_t)(kb + (r) - (s)) + (size_t)(s) * ld]
   for (i = 0; i < n; ++i) {
     const int l = 2 * i, v = 2 * i + 1;
-    const double a = 0.5 + 0.4 * sin((double)i);
     AT(c->J, l, v) = 1.0; AT(c->J, v, l) = -1.0;
     if (i + 1 < n) { AT(c->J, l, v + 2) = -1.0; AT(c->J, v + 2, l) = 1.0; }
     AT(c->R, v, v) = 0.3;
     AT(c->Q, l, l) = 1.0; AT(c->Q, v, v) = 1.0;
-    c->idx[i] = l;
+  }
+  for (i = 0; i < nt; ++i) {
+    const double a = 0.5 + 0.4 * sin((double)i);
+    c->idx[i] = all ? i : 2 * i;
     c->w[i] = 1.0 + 0.5 * (i % 3);
     c->poly[i] = -a;
     c->expo[4 * i] = 0.5 * a; c->expo[4 * i + 1] = 1.0; c->expo[4 * i + 2] = 0.5 * a; c->expo[4 * i + 3] = -1.0;
@@ -90,8 +92,8 @@ static void chain_build(chain *c, int n) {
   c->B[1] = 1.0;
   c->sys.N = N; c->sys.m = 1; c->sys.storage = PHGMG_BANDED; c->sys.kb = kb;
   c->sys.J = c->J; c->sys.R = c->R; c->sys.Q = c->Q; c->sys.B = c->B;
-  c->sys.nl = PHGMG_NL_SEPARABLE; c->sys.nsep = n; c->sys.sep_idx = c->idx; c->sys.sep_w = c->w;
-  c->sys.poly_deg = 0; c->sys.poly = c->poly; c->sys.nexp = 2; c->sys.expo = c->expo; c->sys.phi_nfun = n;
+  c->sys.nl = PHGMG_NL_SEPARABLE; c->sys.nsep = nt; c->sys.sep_idx = c->idx; c->sys.sep_w = c->w;
+  c->sys.poly_deg = 0; c->sys.poly = c->poly; c->sys.nexp = 2; c->sys.expo = c->expo; c->sys.phi_nfun = nt;
 }
 
 static void chain_free(chain *c) {
@@ -166,12 +168,12 @@ static void dist_build(dist *d, const chain *ch, int ns, const double *X) {
   for (j = 0; j < ns; ++j)
     for (i = 0; i < nloc; ++i) d->Xl[i + (size_t)j * d->ld] = X[row0 + i + (size_t)j * N];
   /* this rank's terms: those whose coordinate it owns, global id = serial term number */
-  d->sidx = (long long *)malloc(sizeof(long long) * ((size_t)ch->n + 1));
-  d->sid = (long long *)malloc(sizeof(long long) * ((size_t)ch->n + 1));
-  d->pl = (double *)malloc(sizeof(double) * ((size_t)ch->n + 1));
-  d->el = (double *)malloc(sizeof(double) * 4 * ((size_t)ch->n + 1));
-  d->wl = (double *)malloc(sizeof(double) * ((size_t)ch->n + 1));
-  for (k = 0; k < ch->n; ++k)
+  d->sidx = (long long *)malloc(sizeof(long long) * ((size_t)ch->sys.nsep + 1));
+  d->sid = (long long *)malloc(sizeof(long long) * ((size_t)ch->sys.nsep + 1));
+  d->pl = (double *)malloc(sizeof(double) * ((size_t)ch->sys.nsep + 1));
+  d->el = (double *)malloc(sizeof(double) * 4 * ((size_t)ch->sys.nsep + 1));
+  d->wl = (double *)malloc(sizeof(double) * ((size_t)ch->sys.nsep + 1));
+  for (k = 0; k < ch->sys.nsep; ++k)
     if (ch->idx[k] >= row0 && ch->idx[k] < row0 + nloc) {
       d->sidx[nt] = ch->idx[k]; d->sid[nt] = k; d->pl[nt] = ch->poly[k]; d->wl[nt] = ch->w[k];
       memcpy(d->el + 4 * (size_t)nt, ch->expo + 4 * (size_t)k, 4 * sizeof(double));
@@ -218,7 +220,7 @@ static void serial_sigma(const chain *ch, int ns, const double *X, int k, double
 /* Rank 0: the distributed model against the serial one. sg: the modes'
    signs (from the bases). */
 static void compare_serial(const chain *ch, int ns, const double *X, const double *x0, const phgmg_reduced *red,
-                           const phgmg_mpi_rom *mr, const double *V0f, int nsteps, const char *tag) {
+                           const phgmg_mpi_rom *mr, const double *V0f, int nsteps, double ktol, const char *tag) {
   const phgmg_rom *ro = phgmg_reduced_rom(red);
   const int N = ch->N, r = mr->r, m = mr->m;
   double sg[64], S[64], e, *col = (double *)malloc(sizeof(double) * (size_t)ch->N), xr[64], xd[64];
@@ -235,7 +237,7 @@ static void compare_serial(const chain *ch, int ns, const double *X, const doubl
   CHECK(e <= 1e-12, "%s: singular values %.2e sigma_1", tag, e);
   printf("  %s: sigma %.1e sigma_1, sigma_r/sigma_1 %.1e", tag, e, mr->S[r - m - 1] / mr->S[0]);
   e = rel_diff(r, r, mr->K, ro->K, sg, sg);
-  CHECK(e <= 1e-12, "%s: K %.2e", tag, e);
+  CHECK(e <= ktol, "%s: K %.2e", tag, e);
   printf(", K %.1e", e);
   e = rel_diff(r, r, mr->Qh, ro->Qh, sg, sg);
   CHECK(e <= 1e-12, "%s: Qh %.2e", tag, e);
@@ -307,7 +309,7 @@ static void test_gmg_pod_ecsw(void) {
   phgmg_mpi_rom mr;
   phgmg_result rc;
   int i;
-  chain_build(&ch, n);
+  chain_build(&ch, n, 0);
   for (i = 0; i < n; ++i) x0[2 * i] = 0.8 * sin(3.0 * 3.14159265358979 * i / n) + 0.3 * sin(7.0 * 3.14159265358979 * i / n);
   CHECK(phgmg_simulate(&ch.sys, x0, 0.0, 0.2, ns - 1, u_in, NULL, NULL, X, NULL, NULL, NULL, NULL, NULL) == PHGMG_OK,
         "simulate");
@@ -330,7 +332,7 @@ static void test_gmg_pod_ecsw(void) {
   }
   if (rank_ == 0 && rc == PHGMG_OK) {
     CHECK(phgmg_reduce(&red, &ch.sys, X, N, ns, &o, NULL, NULL) == PHGMG_OK, "serial reduce");
-    if (red) compare_serial(&ch, ns, X, x0, red, &mr, V0f, 200, "gmg-pod ecsw");
+    if (red) compare_serial(&ch, ns, X, x0, red, &mr, V0f, 200, 1e-12, "gmg-pod ecsw");
     phgmg_reduced_destroy(red);
   }
   phgmg_mpi_rom_free(&mr);
@@ -340,7 +342,7 @@ static void test_gmg_pod_ecsw(void) {
   CHECK(rc == PHGMG_OK && mr.nd == n, "distributed GMG-POD, every term: %d, nd %d", (int)rc, mr.nd);
   if (rank_ == 0 && rc == PHGMG_OK) {
     CHECK(phgmg_reduce(&red, &ch.sys, X, N, ns, &o, NULL, NULL) == PHGMG_OK, "serial reduce, every term");
-    if (red) compare_serial(&ch, ns, X, x0, red, &mr, V0f, 40, "gmg-pod, every term");
+    if (red) compare_serial(&ch, ns, X, x0, red, &mr, V0f, 40, 1e-12, "gmg-pod, every term");
     phgmg_reduced_destroy(red);
   }
   phgmg_mpi_rom_free(&mr);
@@ -349,6 +351,45 @@ static void test_gmg_pod_ecsw(void) {
   d.sv.fail_rank = size_ > 1 ? size_ - 1 : 0;
   rc = phgmg_mpi_gmg_pod(d.c, &d.md, ns, d.Xl, d.ld, &o, &mr, NULL, 0);
   CHECK(rc == PHGMG_ERR_SINGULAR && same_everywhere(rc) && mr.mem_ == NULL, "failing solve on one rank: %d", rc);
+  dist_free(&d);
+  chain_free(&ch);
+  free(X); free(x0); free(V0); free(V0f);
+}
+
+/* From PHGMG_ECSW_SCREEN_MIN (4096) moving terms the serial ECSW screens
+   candidates in rounds: the same points (as global indices) and weights
+   from the distributed screening. A cosh term on every coordinate of a
+   chain of 2100 masses (4200 terms), 31 snapshots, r = 8. */
+static void test_screened(void) {
+  const int n = 2100, N = 2 * n, ns = 31, r = 8;
+  chain ch;
+  dist d;
+  double *X = (double *)malloc(sizeof(double) * (size_t)N * ns), *x0 = (double *)calloc((size_t)N, sizeof(double));
+  double *V0, *V0f;
+  phgmg_reduce_opts o;
+  phgmg_reduced *red = NULL;
+  phgmg_mpi_rom mr;
+  phgmg_result rc;
+  int i;
+  chain_build(&ch, n, 1);
+  for (i = 0; i < n; ++i) x0[2 * i] = 0.8 * sin(3.0 * 3.14159265358979 * i / n);
+  CHECK(phgmg_simulate(&ch.sys, x0, 0.0, 0.2, ns - 1, u_in, NULL, NULL, X, NULL, NULL, NULL, NULL, NULL) == PHGMG_OK,
+        "simulate");
+  memset(&o, 0, sizeof o);
+  o.method = PHGMG_METHOD_GMG_POD; o.r = r; o.hyper.on = 1; o.hyper.tol = 1e-3;
+  dist_build(&d, &ch, ns, X);
+  V0 = (double *)malloc(sizeof(double) * (size_t)d.ld * r);
+  rc = phgmg_mpi_gmg_pod(d.c, &d.md, ns, d.Xl, d.ld, &o, &mr, V0, d.ld);
+  CHECK(rc == PHGMG_OK && same_everywhere(mr.nd), "distributed GMG-POD, screened: %d", (int)rc);
+  V0f = gather_v0(d.c, r, V0, d.ld);
+  if (rank_ == 0 && rc == PHGMG_OK) {
+    CHECK(phgmg_reduce(&red, &ch.sys, X, N, ns, &o, NULL, NULL) == PHGMG_OK, "serial reduce, screened");
+    /* K = G00^{-1} with cond(G00) = 1e6 here (5e5 in test_gmg_pod_ecsw):
+       its forward error bound is cond eps ~ 2e-10; measured 6e-13 .. 2e-12 */
+    if (red) compare_serial(&ch, ns, X, x0, red, &mr, V0f, 100, 1e-11, "gmg-pod ecsw, 4200 terms");
+    phgmg_reduced_destroy(red);
+  }
+  phgmg_mpi_rom_free(&mr);
   dist_free(&d);
   chain_free(&ch);
   free(X); free(x0); free(V0); free(V0f);
@@ -366,7 +407,7 @@ static void test_errors(void) {
   phgmg_mpi_rom mr;
   phgmg_result rc;
   int i, kase;
-  chain_build(&ch, n);
+  chain_build(&ch, n, 0);
   for (i = 0; i < n; ++i) x0[2 * i] = 0.5 * sin(0.1 * i);
   CHECK(phgmg_simulate(&ch.sys, x0, 0.0, 0.2, ns - 1, u_in, NULL, NULL, X, NULL, NULL, NULL, NULL, NULL) == PHGMG_OK,
         "simulate");
@@ -411,6 +452,7 @@ int main(int argc, char **argv) {
   t0 = MPI_Wtime();
   if (rank_ == 0) printf("test_mpi_nl: P = %d\n", size_);
   test_gmg_pod_ecsw();
+  test_screened();
   test_errors();
   MPI_Allreduce(&fails_, &total, 1, MPI_INT, MPI_SUM, MPI_COMM_WORLD);
   if (rank_ == 0)
