@@ -709,9 +709,12 @@
    SVD on the terms' rows (phgmg_mpi_pod), the fit by phgmg_mpi_ecsw on the
    training rows S_j U[k, j] V0[idx_k, a] of the modes sigma_j > 1e-3 tol
    sigma_1 to tol / 2, the full residual ||F^T diag(w - sw) V0(idx, :)||_F
-   checked against tol (else the fit once more with every mode), from 4096
-   moving terms on the fit on the full ns r rows -- then the kept terms'
-   rows of V0 and functions from their owners (one reduction) and the
+   checked against tol (else the fit once more with every mode); from 4096
+   moving terms on, the serial screening (8.7) on the full ns r rows: per
+   round each rank's 64 terms of largest gradient gathered and merged (ties
+   to the lower global index), the chosen columns from their owners (one
+   reduction), the Gram fit on the working set replicated -- then the kept
+   terms' rows of V0 and functions from their owners (one reduction) and the
    training envelope of the reduced snapshot coordinates. The result is the
    phgmg_rom the serial phgmg_reduce builds (P0, w, per-term poly/expo, K,
    Qh, Bh, env_lo/hi); the kept terms' global term and state indices come
@@ -720,7 +723,10 @@
    tests/mpi/test_mpi_nl.c) at 1-4 ranks: the singular values within
    3e-16 sigma_1, K within 4e-13 and Qh within 1.3e-15 relative (after the
    modes' signs), the same 67 points as global indices, weights within
-   1.5e-14, the reduced outputs over 200 steps within 2.2e-12. The fit on
+   1.5e-14, the reduced outputs over 200 steps within 2.2e-12; with a term
+   on every coordinate of 2100 masses (4200 terms: the screened fit) the
+   same 36 points, weights within 3e-14, K within 2e-12 (cond G00 = 1e6),
+   outputs within 1e-11. The fit on
    the full rows at tol alone (what phgmg_mpi_ecsw gives without the
    compression) keeps 49 points, not the serial 67, and its model's outputs
    differ by 6e-3: the compression and its tol / 2 are part of the serial
@@ -4646,9 +4652,11 @@ typedef struct phgmg_mpi_rom {
    (phgmg_mpi_pod on the terms' rows), the fit on the rows of the modes
    sigma_j > 1e-3 tol sigma_1 (phgmg_mpi_ecsw, tolerance tol / 2), the full
    training residual checked against tol (else once more with every mode),
-   and from 4096 live terms on the fit on the full rows at tol; the kept
-   terms' rows of V0 and functions broadcast by their owners; the training
-   envelope from the reduced coordinates of the snapshots. hyper.on = 0:
+   and from 4096 live terms on the serial screening on the full rows at tol
+   (rounds of 64 candidates of largest gradient over the ranks, the Gram
+   fit on the working set replicated); the kept terms' rows of V0 and
+   functions broadcast by their owners; the training envelope from the
+   reduced coordinates of the snapshots. hyper.on = 0:
    every term kept with its weight (nd = all terms: O(terms) online).
    X: this rank's rows of the snapshots (nloc x ns, ldx). *out is filled
    on success (zeroed on failure); V0 (nloc x r, ldv0, may be NULL) this
