@@ -24890,9 +24890,9 @@ PHGMG__PRIV phgmg_result phgmg__mpi_scr_run(const phgmg_mpi_ctx *ctx, const phgm
     if (add == 0) break;
     for (j = s->nw; j < s->nw + add; ++j) s->x0[j] = 0.0;
     s->nw += add;
-    rc = phgmg__ecsw_gram(s->nw, s->m, s->Gw, s->m, s->tg, tol, rounds ? s->x0 : NULL, s->pw, s->ww, &s->nd, rel,
-                          &ctx->al);
-    if (rc != PHGMG_ERR_NOT_CONVERGED) break;   /* tol met, or an error (the same everywhere: replicated) */
+    rc = phgmg__mpi_agree(ctx, phgmg__ecsw_gram(s->nw, s->m, s->Gw, s->m, s->tg, tol, rounds ? s->x0 : NULL, s->pw,
+                                                 s->ww, &s->nd, rel, &ctx->al));   /* replicated but a failed allocation */
+    if (rc != PHGMG_ERR_NOT_CONVERGED) break;   /* tol met, or an error */
     memcpy(s->res, s->tg, (size_t)s->m * sizeof(double));
     for (j = 0; j < s->nd; ++j) phgmg__axpy(s->m, -s->ww[j], s->Gw + (size_t)s->pw[j] * s->m, s->res);
     phgmg__mpi_scr_grad(t, ns, r, s);
