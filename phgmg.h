@@ -661,7 +661,7 @@
                             B u (Q as an operator, B's rows, J - R through a
                             collective solve callback: the user's KSP, MUMPS
                             or AMG): K, Qh, Bh of the serial phgmg_reduce
-     phgmg_mpi_gmg_pod      GMG-POD of a model with a SEPARABLE Hamiltonian
+     phgmg_mpi_reduce      GMG-POD of a model with a SEPARABLE Hamiltonian
                             (built-in exp-polynomial terms held by the ranks
                             that own their coordinates) with ECSW
                             hyper-reduction: the serial phgmg_reduce's
@@ -702,7 +702,7 @@
    within 1.5e-15 relative at 1-4 ranks (after the sign of each POD mode,
    which the SVD leaves free), the reduced outputs over 200 steps within
    1e-15.
-   phgmg_mpi_gmg_pod does the same for H(x) = 1/2 x^T Q x + sum_k w_k
+   phgmg_mpi_reduce does the same for H(x) = 1/2 x^T Q x + sum_k w_k
    phi_k(x[idx_k]) and adds the serial separable stage (3.4, 8.7): the
    terms whose argument moves in some snapshot, F = phi_k'(x_i[idx_k]), and
    ECSW as phgmg_ecsw_separable computes it -- F = U S W^T by TSQR and the
@@ -2114,7 +2114,7 @@
            phgmg_mpi_deim_greedy, phgmg_mpi_op_create, phgmg_mpi_op_destroy,
            phgmg_mpi_op_info, phgmg_mpi_op_apply, phgmg_mpi_op_project,
            phgmg_mpi_gmg_pod_linear, phgmg_mpi_ecsw, phgmg_mpi_cholqr,
-           phgmg_mpi_counts_get, phgmg_mpi_counts_reset, phgmg_mpi_gmg_pod,
+           phgmg_mpi_counts_get, phgmg_mpi_counts_reset, phgmg_mpi_reduce,
            phgmg_mpi_rom_free
    linalg: phgmg_gemm, phgmg_gemv, phgmg_lu_factor, phgmg_lu_solve,
            phgmg_lu_rcond, phgmg_norm1, phgmg_normf, phgmg_zlu_factor,
@@ -4600,7 +4600,7 @@ PHGMG_DEF phgmg_result phgmg_mpi_gmg_pod_linear(const phgmg_mpi_ctx *ctx, const 
                                                 int ns, const double *X, int ldx, int r, double *K, double *Qh,
                                                 double *Bh, double *S, double *V0, int ldv0);
 
-/* ---- distributed GMG-POD of a separable nonlinear model (manual 2.7) ---- */
+/* ---- distributed reduction of a separable nonlinear model (manual 2.7) -- */
 /* A port-Hamiltonian model with a SEPARABLE Hamiltonian distributed by rows:
    x' = (J - R) grad H(x) + B u, y = B^T grad H(x),
    H(x) = 1/2 x^T Q x + sum_k w_k phi_k(x[idx_k]), phi_k of the built-in
@@ -4614,9 +4614,11 @@ PHGMG_DEF phgmg_result phgmg_mpi_gmg_pod_linear(const phgmg_mpi_ctx *ctx, const 
    = 0: one function for every term, poly ((poly_deg + 1), may be NULL) and
    expo (2 nexp) the same on every rank; per_term = 1: one per term, row k
    of poly (nsep x (poly_deg + 1), ld poly_deg + 1) and expo (2 nexp per
-   term) for this rank's term k. */
+   term) for this rank's term k. JR: J - R as a distributed operator, for
+   SP1 only (NULL otherwise). */
 typedef struct phgmg_mpi_sep_model {
   phgmg_mpi_linear_model lin;
+  const phgmg_mpi_op *JR;
   int nsep;
   const phgmg_gidx *sep_idx, *sep_id;
   const double *sep_w;
@@ -4624,11 +4626,12 @@ typedef struct phgmg_mpi_sep_model {
   const double *poly, *expo;
 } phgmg_mpi_sep_model;
 
-/* The result of phgmg_mpi_gmg_pod, identical on every rank: rom the online
-   model (kind PHGMG_ROM_LINEAR, method GMG_POD, its arrays owned by this
-   struct: phgmg_rom_check, the stepper, export and files as usual), and in
-   double: K, Qh (r x r), Bh (r x m), S (r - m singular values of the
-   adjusted snapshots), nd kept terms with pts (their global term indices,
+/* The result of phgmg_mpi_reduce, identical on every rank: rom the online
+   model (kind PHGMG_ROM_LINEAR, method GMG_POD or SP1, its arrays owned by
+   this struct: phgmg_rom_check, the stepper, export and files as usual),
+   and in double: K, Qh (r x r), Bh (r x m), S (GMG-POD: r - m singular
+   values of the adjusted snapshots; SP1: r of the snapshots), nd kept
+   terms with pts (their global term indices,
    ascending), coord (their global state indices), w (weights), P0 (nd x r:
    the rows of the basis V0 at coord), hyper_residual (the ECSW training
    residual; 0 without hyper-reduction). Free with phgmg_mpi_rom_free. */
@@ -4642,11 +4645,15 @@ typedef struct phgmg_mpi_rom {
   phgmg_allocator al_;
 } phgmg_mpi_rom;
 
-/* Distributed GMG-POD of a separable model, with ECSW hyper-reduction
-   (opts: method PHGMG_METHOD_GMG_POD, r, hyper.on, hyper.kind ECSW,
-   hyper.tol; the other fields zero, else PHGMG_ERR_UNSUPPORTED). The serial
-   phgmg_reduce's stages in its order and with its formulas: the basis and
-   the GMG blocks K, Qh, Bh as phgmg_mpi_gmg_pod_linear; the separable terms
+/* The distributed phgmg_reduce of a separable model, with ECSW
+   hyper-reduction (opts: method PHGMG_METHOD_GMG_POD or PHGMG_METHOD_SP1, r,
+   hyper.on, hyper.kind ECSW, hyper.tol; the other fields zero, else
+   PHGMG_ERR_UNSUPPORTED). The serial phgmg_reduce's stages in its order and
+   with its formulas: GMG-POD: the basis and the GMG blocks K, Qh, Bh as
+   phgmg_mpi_gmg_pod_linear; SP1 (model->JR needed): V the r leading POD
+   modes of X (TSQR), A = V^T Q V, its reciprocal condition >= 1e-12 (else
+   PHGMG_ERR_DEGENERATE), W = Q V A^{-1}, K = W^T (J - R) W, Bh = W^T B,
+   Qh = A symmetrised; then the separable terms
    whose argument moves in some snapshot (or phi'(0) != 0); ECSW as
    phgmg_ecsw_separable: F = phi_k'(x_i[idx_k]) factored by TSQR and the SVD
    (phgmg_mpi_pod on the terms' rows), the fit on the rows of the modes
@@ -4660,15 +4667,15 @@ typedef struct phgmg_mpi_rom {
    every term kept with its weight (nd = all terms: O(terms) online).
    X: this rank's rows of the snapshots (nloc x ns, ldx). *out is filled
    on success (zeroed on failure); V0 (nloc x r, ldv0, may be NULL) this
-   rank's rows of the basis (the lift x = V0 xr). Errors: those of
+   rank's rows of the basis (the lift x = V0 xr; SP1: V). Errors: those of
    phgmg_mpi_gmg_pod_linear (a failing solve's code on every rank),
    PHGMG_ERR_INVALID_ARG / _SIZE / _NANINF for bad terms,
    PHGMG_ERR_NOT_CONVERGED (the ECSW fit misses tol), PHGMG_ERR_UNSUPPORTED.
    Collective. */
-PHGMG_DEF phgmg_result phgmg_mpi_gmg_pod(const phgmg_mpi_ctx *ctx, const phgmg_mpi_sep_model *model, int ns,
-                                         const double *X, int ldx, const phgmg_reduce_opts *opts,
-                                         phgmg_mpi_rom *out, double *V0, int ldv0);
-/* Frees what phgmg_mpi_gmg_pod stored in *out and zeroes it (NULL or a
+PHGMG_DEF phgmg_result phgmg_mpi_reduce(const phgmg_mpi_ctx *ctx, const phgmg_mpi_sep_model *model, int ns,
+                                        const double *X, int ldx, const phgmg_reduce_opts *opts,
+                                        phgmg_mpi_rom *out, double *V0, int ldv0);
+/* Frees what phgmg_mpi_reduce stored in *out and zeroes it (NULL or a
    zeroed struct: no-op). Not collective. */
 PHGMG_DEF void phgmg_mpi_rom_free(phgmg_mpi_rom *out);
 
@@ -24620,7 +24627,8 @@ PHGMG__PRIV phgmg_result phgmg__mpi_sep_check_local(const phgmg_mpi_ctx *ctx, co
   const int nf = md->per_term ? md->nsep : 1, nc = md->poly_deg + 1;
   int k;
   phgmg__reduce_opts_resolve(o, 0);
-  if (o->method != PHGMG_METHOD_GMG_POD || (o->hyper.on && o->hyper.kind != PHGMG_HYPER_ECSW) ||
+  if ((o->method != PHGMG_METHOD_GMG_POD && o->method != PHGMG_METHOD_SP1) ||
+      (o->hyper.on && o->hyper.kind != PHGMG_HYPER_ECSW) ||
       o->ref != PHGMG_REF_NONE || o->dt != 0.0 || o->nrun || o->runs || o->cache.pod_basis || o->cache.deim_pts ||
       o->select.lambda_mode != PHGMG_LAMBDA_FIXED || o->degeneracy_tol != 1e-12)
     return PHGMG_ERR_UNSUPPORTED;
@@ -24632,6 +24640,7 @@ PHGMG__PRIV phgmg_result phgmg__mpi_sep_check_local(const phgmg_mpi_ctx *ctx, co
       (md->poly_deg == 0 && md->nexp == 0))
     return PHGMG_ERR_SIZE;
   if ((md->nexp > 0 && nf > 0 && !md->expo) || (md->nsep > 0 && !md->sep_idx)) return PHGMG_ERR_INVALID_ARG;
+  if (o->method == PHGMG_METHOD_SP1 && (!md->JR || md->JR->ctx != ctx)) return PHGMG_ERR_INVALID_ARG;
   if ((md->poly && nf > 0 && !phgmg__all_finite(md->poly, (size_t)nf * nc)) ||
       (md->nexp > 0 && nf > 0 && !phgmg__all_finite(md->expo, (size_t)nf * 2 * md->nexp)) ||
       (md->sep_w && md->nsep > 0 && !phgmg__all_finite(md->sep_w, (size_t)md->nsep)))
@@ -24989,20 +24998,26 @@ PHGMG__PRIV phgmg_result phgmg__mpi_sep_fetch(const phgmg_mpi_ctx *ctx, const ph
 
 /* The training envelope env (2r: lo, hi) as the serial reduction's: the
    range of rho(x_j) = [RB^{-1} QB^T x_j; V1^T x_j] (QB RB = B by TSQR) over
-   the snapshots, widened on each side by 10 % of its width plus 2 % of the
-   largest width. Collective. */
+   the snapshots (SP1, W given: rho(x_j) = W^T x_j), widened on each side by
+   10 % of its width plus 2 % of the largest width. Collective. */
 PHGMG__PRIV phgmg_result phgmg__mpi_sep_envelope(const phgmg_mpi_ctx *ctx, const phgmg_mpi_linear_model *lin,
                                                  int ns, const double *X, int ldx, const double *V0, int r,
-                                                 double *env) {
-  const int m = lin->m, ld = PHGMG__MAX(1, ctx->nloc);
+                                                 const double *W, double *env) {
+  const int ld = PHGMG__MAX(1, ctx->nloc);
+  int m = lin->m;
   double *QB = phgmg__dalloc(&ctx->al, (size_t)ld * m + (size_t)m * m + (size_t)r * ns), *RB, *XR, big = 0.0;
   int i, j, a;
   phgmg_result rc = phgmg__mpi_agree(ctx, QB ? PHGMG_OK : PHGMG_ERR_NOMEM);
   if (rc != PHGMG_OK) { phgmg__free(&ctx->al, QB); return rc; }
   RB = QB + (size_t)ld * m; XR = RB + (size_t)m * m;
-  rc = phgmg_mpi_tsqr(ctx, m, lin->B, lin->ldb, QB, ld, RB, m);
-  if (rc == PHGMG_OK) rc = phgmg_mpi_atb(ctx, m, ns, QB, ld, X, ldx, XR, r);
-  if (rc == PHGMG_OK) rc = phgmg_mpi_atb(ctx, r - m, ns, V0 + (size_t)ld * m, ld, X, ldx, XR + m, r);
+  if (W) {   /* SP1: rho(x) = W^T x */
+    rc = phgmg_mpi_atb(ctx, r, ns, W, ld, X, ldx, XR, r);
+    m = 0;
+  } else {
+    rc = phgmg_mpi_tsqr(ctx, m, lin->B, lin->ldb, QB, ld, RB, m);
+    if (rc == PHGMG_OK) rc = phgmg_mpi_atb(ctx, m, ns, QB, ld, X, ldx, XR, r);
+    if (rc == PHGMG_OK) rc = phgmg_mpi_atb(ctx, r - m, ns, V0 + (size_t)ld * m, ld, X, ldx, XR + m, r);
+  }
   for (j = 0; rc == PHGMG_OK && j < ns; ++j) {
     double *xr = XR + (size_t)j * r;
     for (i = m - 1; i >= 0; --i) {   /* RB^{-1} on the port coordinates */
@@ -25029,7 +25044,7 @@ PHGMG__PRIV phgmg_result phgmg__mpi_sep_envelope(const phgmg_mpi_ctx *ctx, const
    P0, poly, expo, env), the global indices, and the online model's
    phgmg_real arrays. D: the kept terms' rows (phgmg__mpi_sep_fetch). */
 typedef struct phgmg__mpi_romdata {
-  int r, m, nd, nf, nc, ne;   /* nc: poly_deg + 1, ne: nexp */
+  int r, m, nd, nf, nc, ne, nsv, method;   /* nc: poly_deg + 1, ne: nexp, nsv: singular values */
   const double *K, *Qh, *Bh, *S, *w, *D, *env;
   const phgmg_gidx *pts;
   const phgmg_mpi_sep_model *md;
@@ -25045,7 +25060,7 @@ PHGMG__PRIV phgmg_result phgmg__mpi_rom_store(const phgmg_mpi_ctx *ctx, const ph
   const size_t r = (size_t)d->r, m = (size_t)d->m, nd = (size_t)d->nd, nf = (size_t)d->nf;
   const size_t npc = nf * (size_t)d->nc, nex = nf * 2 * (size_t)d->ne;
   const size_t nv = 2 * r * r + r * m + nd * (1 + r) + npc + nex + 2 * r;   /* what the rom views */
-  double *b = phgmg__dalloc(&ctx->al, nv + (r - m) + 2 * nd + (nv * sizeof(phgmg_real)) / sizeof(double) + 1);
+  double *b = phgmg__dalloc(&ctx->al, nv + (size_t)d->nsv + 2 * nd + (nv * sizeof(phgmg_real)) / sizeof(double) + 1);
   double *K, *Qh, *Bh, *w, *P0, *po, *ex, *env, *S;
   phgmg_gidx *pts, *coord;
   phgmg_real *v;
@@ -25053,10 +25068,10 @@ PHGMG__PRIV phgmg_result phgmg__mpi_rom_store(const phgmg_mpi_ctx *ctx, const ph
   if (!b) return PHGMG_ERR_NOMEM;
   K = b; Qh = K + r * r; Bh = Qh + r * r; w = Bh + r * m; P0 = w + nd; po = P0 + nd * r; ex = po + npc;
   env = ex + nex; S = env + 2 * r;
-  pts = PHGMG__CAST(phgmg_gidx *, PHGMG__CAST(void *, S + (r - m))); coord = pts + nd;
+  pts = PHGMG__CAST(phgmg_gidx *, PHGMG__CAST(void *, S + d->nsv)); coord = pts + nd;
   v = PHGMG__CAST(phgmg_real *, PHGMG__CAST(void *, coord + nd));
   memcpy(K, d->K, r * r * sizeof(double)); memcpy(Qh, d->Qh, r * r * sizeof(double));
-  memcpy(Bh, d->Bh, r * m * sizeof(double)); memcpy(S, d->S, (r - m) * sizeof(double));
+  memcpy(Bh, d->Bh, r * m * sizeof(double)); memcpy(S, d->S, (size_t)d->nsv * sizeof(double));
   memcpy(env, d->env, 2 * r * sizeof(double));
   if (nd) memcpy(w, d->w, nd * sizeof(double));
   if (nd) memcpy(P0, d->D + nd, nd * r * sizeof(double));
@@ -25072,7 +25087,7 @@ PHGMG__PRIV phgmg_result phgmg__mpi_rom_store(const phgmg_mpi_ctx *ctx, const ph
   out->mem_ = b; out->al_ = ctx->al;
   out->r = d->r; out->m = d->m; out->nd = d->nd;
   out->K = K; out->Qh = Qh; out->Bh = Bh; out->S = S; out->w = w; out->P0 = P0; out->pts = pts; out->coord = coord;
-  out->rom.kind = PHGMG_ROM_LINEAR; out->rom.method = PHGMG_METHOD_GMG_POD; out->rom.r = d->r; out->rom.m = d->m;
+  out->rom.kind = PHGMG_ROM_LINEAR; out->rom.method = d->method; out->rom.r = d->r; out->rom.m = d->m;
   out->rom.K = v; out->rom.Qh = v + r * r; out->rom.Bh = v + 2 * r * r;
   out->rom.nd = d->nd;
   if (nd) {
@@ -25082,6 +25097,45 @@ PHGMG__PRIV phgmg_result phgmg__mpi_rom_store(const phgmg_mpi_ctx *ctx, const ph
   }
   out->rom.env_lo = v + (env - b); out->rom.env_hi = v + (env - b) + r;
   return PHGMG_OK;
+}
+
+/* SP1's blocks (the serial phgmg__stage_sp_blocks and the quadratic term):
+   V (ld x r) the r leading POD modes of X (TSQR; S their values), A = V^T Q
+   V with its non-degeneracy test, W (ld x r) = Q V A^{-1}, K = W^T (J - R)
+   W, Bh = W^T B, Qh = A symmetrised. Collective. */
+PHGMG__PRIV phgmg_result phgmg__mpi_sp1_blocks(const phgmg_mpi_ctx *ctx, const phgmg_mpi_sep_model *md, int ns,
+                                               const double *X, int ldx, int r, double *K, double *Qh, double *Bh,
+                                               double *S, double *V, double *W) {
+  const int n = ctx->nloc, ld = PHGMG__MAX(1, n), m = md->lin.m;
+  const int kk = (int)PHGMG__MIN((phgmg_gidx)PHGMG__MIN(r + 1, ns), ctx->N);
+  double *Vk = phgmg__dalloc(&ctx->al, (size_t)ld * kk + (size_t)kk + 2 * (size_t)ld * r + (size_t)r * r), *s, *QV, *T, *Ai;
+  int k = 0, j;
+  phgmg_result rc = phgmg__mpi_agree(ctx, Vk ? PHGMG_OK : PHGMG_ERR_NOMEM);
+  if (rc != PHGMG_OK) { phgmg__free(&ctx->al, Vk); return rc; }
+  s = Vk + (size_t)ld * kk; QV = s + kk; T = QV + (size_t)ld * r; Ai = T + (size_t)ld * r;
+  rc = phgmg_mpi_pod(ctx, ns, X, ldx, kk, 0.0, Vk, ld, s, &k);
+  if (rc == PHGMG_OK && k < r) rc = PHGMG_ERR_SIZE;   /* r beyond the snapshots' numerical rank */
+  if (rc == PHGMG_OK) {
+    memcpy(V, Vk, (size_t)ld * r * sizeof(double));
+    memcpy(S, s, (size_t)r * sizeof(double));
+    rc = phgmg_mpi_op_apply(md->lin.Q, r, V, ld, QV, ld);
+  }
+  if (rc == PHGMG_OK) rc = phgmg_mpi_atb(ctx, r, r, V, ld, QV, ld, Qh, r);   /* A = V^T Q V */
+  if (rc == PHGMG_OK) {   /* replicated data: the verdict is the same everywhere but a failed allocation */
+    const double rcd = phgmg__rcond_of(r, Qh, &ctx->al);
+    rc = rcd < 0.0 ? PHGMG_ERR_NOMEM : !(rcd >= 1e-12) ? PHGMG_ERR_DEGENERATE : phgmg__inv(r, Qh, Ai, &ctx->al);
+    rc = phgmg__mpi_agree(ctx, rc);
+  }
+  if (rc == PHGMG_OK) {
+    if (n > 0) phgmg_gemm('N', 'N', n, r, r, 1.0, QV, ld, Ai, r, 0.0, W, ld);   /* W = Q V A^{-1} */
+    rc = phgmg_mpi_op_apply(md->JR, r, W, ld, T, ld);
+  }
+  if (rc == PHGMG_OK) rc = phgmg_mpi_atb(ctx, r, r, W, ld, T, ld, K, r);
+  if (rc == PHGMG_OK) rc = phgmg_mpi_atb(ctx, r, m, W, ld, md->lin.B, md->lin.ldb, Bh, r);
+  if (rc == PHGMG_OK) phgmg__symmetrize(r, Qh);
+  for (j = 0; rc != PHGMG_OK && j < r * r; ++j) Qh[j] = 0.0;
+  phgmg__free(&ctx->al, Vk);
+  return rc;
 }
 
 /* Every term kept with its weight (hyper.on = 0): all ranks' ids and
@@ -25152,13 +25206,13 @@ PHGMG__PRIV phgmg_result phgmg__mpi_sep_terms(const phgmg_mpi_ctx *ctx, const ph
   return rc;
 }
 
-PHGMG_DEF phgmg_result phgmg_mpi_gmg_pod(const phgmg_mpi_ctx *ctx, const phgmg_mpi_sep_model *model, int ns,
-                                         const double *X, int ldx, const phgmg_reduce_opts *opts,
-                                         phgmg_mpi_rom *out, double *V0, int ldv0) {
+PHGMG_DEF phgmg_result phgmg_mpi_reduce(const phgmg_mpi_ctx *ctx, const phgmg_mpi_sep_model *model, int ns,
+                                        const double *X, int ldx, const phgmg_reduce_opts *opts,
+                                        phgmg_mpi_rom *out, double *V0, int ldv0) {
   phgmg_reduce_opts o;
   phgmg__mpi_romdata d;
-  double *b = NULL, resid = 0.0;
-  int r = 0, m = 0, ld, wd = 0;
+  double *b = NULL, *Vb, *Wb, resid = 0.0;
+  int r = 0, m = 0, ld, wd = 0, sp1;
   phgmg_result rc = PHGMG_OK;
   if (!ctx) return PHGMG_ERR_INVALID_ARG;
   if (out) memset(out, 0, sizeof *out);
@@ -25172,29 +25226,36 @@ PHGMG_DEF phgmg_result phgmg_mpi_gmg_pod(const phgmg_mpi_ctx *ctx, const phgmg_m
     r = o.r; m = model->lin.m;
   }
   rc = phgmg__mpi_sep_check_global(ctx, model ? model : NULL, rc);
-  if (rc == PHGMG_OK && (m < 1 || r <= m || (phgmg_gidx)r > ctx->N)) rc = PHGMG_ERR_SIZE;
+  sp1 = rc == PHGMG_OK && o.method == PHGMG_METHOD_SP1;
+  if (rc == PHGMG_OK && (m < 1 || (phgmg_gidx)r > ctx->N || (sp1 ? r < 1 || r > ns : r <= m))) rc = PHGMG_ERR_SIZE;
   if (rc == PHGMG_OK) {
-    b = phgmg__dalloc(&ctx->al, 2 * (size_t)r * r + (size_t)r * m + (size_t)r + 2 * (size_t)r + (size_t)ld * r);
+    b = phgmg__dalloc(&ctx->al, 2 * (size_t)r * r + (size_t)r * m + 3 * (size_t)r + 2 * (size_t)ld * r);
     rc = phgmg__mpi_agree(ctx, b ? PHGMG_OK : PHGMG_ERR_NOMEM);
   }
   if (rc != PHGMG_OK) { phgmg__free(&ctx->al, b); return rc; }
   d.r = r; d.m = m; d.K = b; d.Qh = b + (size_t)r * r; d.Bh = d.Qh + (size_t)r * r; d.S = d.Bh + (size_t)r * m;
-  d.env = d.S + r;
+  d.env = d.S + r; Vb = b + 2 * (size_t)r * r + (size_t)r * m + 3 * (size_t)r; Wb = Vb + (size_t)ld * r;
   d.nc = model->poly_deg + 1; d.ne = model->nexp; d.md = model;
+  d.nsv = sp1 ? r : r - m; d.method = o.method;
   wd = 1 + r + (model->per_term ? d.nc + 2 * d.ne : 0);
-  /* basis and GMG blocks (stages 1 and 3), the quadratic term (4a) */
-  rc = phgmg_mpi_gmg_pod_linear(ctx, &model->lin, ns, X, ldx, r, (double *)d.K, (double *)d.Qh, (double *)d.Bh,
-                                (double *)d.S, (double *)(d.env + 2 * r), ld);
+  /* basis and reduction blocks (stages 1 and 3), the quadratic term (4a) */
+  if (sp1)
+    rc = phgmg__mpi_sp1_blocks(ctx, model, ns, X, ldx, r, b, b + (size_t)r * r, b + 2 * (size_t)r * r,
+                               b + 2 * (size_t)r * r + (size_t)r * m, Vb, Wb);
+  else
+    rc = phgmg_mpi_gmg_pod_linear(ctx, &model->lin, ns, X, ldx, r, b, b + (size_t)r * r, b + 2 * (size_t)r * r,
+                                  b + 2 * (size_t)r * r + (size_t)r * m, Vb, ld);
   /* the separable terms (4b), then the training envelope */
-  if (rc == PHGMG_OK) rc = phgmg__mpi_sep_terms(ctx, model, &o, ns, X, ldx, d.env + 2 * r, r, wd, &d, &resid);
-  if (rc == PHGMG_OK) rc = phgmg__mpi_sep_envelope(ctx, &model->lin, ns, X, ldx, d.env + 2 * r, r, (double *)d.env);
+  if (rc == PHGMG_OK) rc = phgmg__mpi_sep_terms(ctx, model, &o, ns, X, ldx, Vb, r, wd, &d, &resid);
+  if (rc == PHGMG_OK)
+    rc = phgmg__mpi_sep_envelope(ctx, &model->lin, ns, X, ldx, Vb, r, sp1 ? Wb : NULL, b + 2 * (size_t)r * r + (size_t)r * m + r);
   d.nf = model->per_term ? d.nd : 1;
   if (rc == PHGMG_OK) rc = phgmg__mpi_agree(ctx, phgmg__mpi_rom_store(ctx, &d, out));
   if (rc == PHGMG_OK) {
     int j;
     out->hyper_residual = resid;
     for (j = 0; V0 && ctx->nloc > 0 && j < r; ++j)
-      memcpy(V0 + (size_t)j * ldv0, d.env + 2 * r + (size_t)j * ld, (size_t)ctx->nloc * sizeof(double));
+      memcpy(V0 + (size_t)j * ldv0, Vb + (size_t)j * ld, (size_t)ctx->nloc * sizeof(double));
   } else {
     phgmg_mpi_rom_free(out);
   }
