@@ -661,10 +661,10 @@
                             B u (Q as an operator, B's rows, J - R through a
                             collective solve callback: the user's KSP, MUMPS
                             or AMG): K, Qh, Bh of the serial phgmg_reduce
-     phgmg_mpi_reduce      GMG-POD of a model with a SEPARABLE Hamiltonian
-                            (built-in exp-polynomial terms held by the ranks
-                            that own their coordinates) with ECSW
-                            hyper-reduction: the serial phgmg_reduce's
+     phgmg_mpi_reduce       GMG-POD or SP1 of a model with a SEPARABLE
+                            Hamiltonian (built-in exp-polynomial terms held
+                            by the ranks that own their coordinates) with
+                            ECSW hyper-reduction: the serial phgmg_reduce's
                             phgmg_rom, replicated, the kept terms as global
                             indices (phgmg_mpi_rom_free)
      phgmg_mpi_agree        one result for all ranks
@@ -702,8 +702,11 @@
    within 1.5e-15 relative at 1-4 ranks (after the sign of each POD mode,
    which the SVD leaves free), the reduced outputs over 200 steps within
    1e-15.
-   phgmg_mpi_reduce does the same for H(x) = 1/2 x^T Q x + sum_k w_k
-   phi_k(x[idx_k]) and adds the serial separable stage (3.4, 8.7): the
+   phgmg_mpi_reduce does the same (opts.method GMG_POD; or SP1, with J - R
+   as a distributed operator: V the POD of X, A = V^T Q V, W = Q V A^{-1},
+   K = W^T (J - R) W, Bh = W^T B, Qh = A symmetrised, as the serial SP1) for
+   H(x) = 1/2 x^T Q x + sum_k w_k phi_k(x[idx_k]) and adds the serial
+   separable stage (3.4, 8.7): the
    terms whose argument moves in some snapshot, F = phi_k'(x_i[idx_k]), and
    ECSW as phgmg_ecsw_separable computes it -- F = U S W^T by TSQR and the
    SVD on the terms' rows (phgmg_mpi_pod), the fit by phgmg_mpi_ecsw on the
@@ -726,7 +729,8 @@
    1.5e-14, the reduced outputs over 200 steps within 2.2e-12; with a term
    on every coordinate of 2100 masses (4200 terms: the screened fit) the
    same 36 points, weights within 3e-14, K within 2e-12 (cond G00 = 1e6),
-   outputs within 1e-11. The fit on
+   outputs within 1e-11; SP1 on the first chain: K within 7e-15, the same
+   67 points, weights within 7e-14, outputs within 1e-14. The fit on
    the full rows at tol alone (what phgmg_mpi_ecsw gives without the
    compression) keeps 49 points, not the serial 67, and its model's outputs
    differ by 6e-3: the compression and its tol / 2 are part of the serial
@@ -738,7 +742,7 @@
    hundred ranks; a reduction tree would remove the size factor); per DEIM
    point one broadcast of k doubles and one reduction of a (value, index)
    pair; per operator product one exchange with the neighbouring ranks.
-   Not yet distributed: GMG-QM, SP1/SP2, DEIM hyper-reduction (hyper.kind
+   Not yet distributed: GMG-QM, SP2, DEIM hyper-reduction (hyper.kind
    QDEIM or GREEDY), separable terms by callbacks and GENERAL nonlinear
    Hamiltonians, a reference state (opts.ref), dampers, feedthrough,
    descriptor models, the command line.
