@@ -91,7 +91,7 @@ test-mpi:
 	$(MPICC) -std=c99 $(WARN) -O0 -o $(BUILD)/mpi_pod examples/mpi_pod.c $(LDLIBS) && \
 	for p in 1 2 3 4; do timeout 120 $(MPIRUN) -np $$p ./$(BUILD)/test_mpi $(BUILD)/mpi || exit 1; done && \
 	$(MPICC) $(CFLAGS_T) -o $(BUILD)/test_mpi_nl tests/mpi/test_mpi_nl.c $(LDLIBS) && \
-	for p in 1 2 3 4; do timeout 120 $(MPIRUN) -np $$p ./$(BUILD)/test_mpi_nl || exit 1; done && \
+	for p in 1 2 3 4; do timeout 120 $(MPIRUN) -np $$p ./$(BUILD)/test_mpi_nl $(BUILD)/mpi || exit 1; done && \
 	$(MPIRUN) -np 3 ./$(BUILD)/mpi_pod --N 3000 > $(BUILD)/mpi/example.txt && echo "test-mpi: examples/mpi_pod.c runs at 3 ranks"
 
 # The documentation against the code: every public function in the manual's

@@ -1,11 +1,12 @@
-/* The distributed GMG-POD of a nonlinear model with a separable Hamiltonian
-   and ECSW hyper-reduction (phgmg_mpi_reduce) against the serial
-   phgmg_reduce with the same options, at any number of ranks:
-   mpirun -np P build/test_mpi_nl. Layouts: P = 2 and 3 uneven blocks, P = 4
-   with rank 2 owning no rows. Rank 0 runs the serial reduction and compares
-   (the distributed results are replicated: every rank holds them). Exit
-   status 0 iff every check passed on every rank. Built with mpicc (make
-   test-mpi). */
+/* The distributed GMG-POD and SP1 of a nonlinear model with a separable
+   Hamiltonian and ECSW hyper-reduction (phgmg_mpi_reduce) against the
+   serial phgmg_reduce with the same options, at any number of ranks:
+   mpirun -np P build/test_mpi_nl [DIR]. Layouts: P = 2 and 3 uneven blocks,
+   P = 4 with rank 2 owning no rows. Rank 0 runs the serial reduction and
+   compares (the distributed results are replicated: every rank holds them);
+   with DIR it also saves, loads and exports the distributed models there.
+   Exit status 0 iff every check passed on every rank. Built with mpicc
+   (make test-mpi). */
 #define PHGMG_MPI
 #define PHGMG_STATIC
 #define PHGMG_IMPLEMENTATION
@@ -16,6 +17,7 @@
 #include <string.h>
 
 static int rank_, size_, fails_;
+static const char *dir_;   /* argv[1]: a directory for the model files (none: not written) */
 #define CHECK(cond, ...)                                                            \
   do {                                                                              \
     if (!(cond)) {                                                                  \
@@ -288,6 +290,28 @@ static void compare_serial(const chain *ch, int ns, const double *X, const doubl
     CHECK(ok && ey <= 1e-10 * sy, "%s: reduced outputs against the serial model's: %.2e", tag, ey / sy);
     printf(", outputs (%d steps) %.1e\n", nsteps, ey / sy);
   }
+  if (dir_) {   /* the model file and the C export: the loaded model steps to the same outputs, bitwise */
+    char path[1024];
+    phgmg_rom lr;
+    void *blk = NULL;
+    static double m1[1 << 16], m2[1 << 16];
+    phgmg_rom_stepper s1, s2;
+    double x1[64] = {0}, x2[64] = {0}, u3[3] = {0.1, 0.2, 0.3}, y1 = 0.0, y2 = 0.0;
+    int st, same_y = 1;
+    snprintf(path, sizeof path, "%s/nl_rom.bin", dir_);
+    CHECK(phgmg_rom_save(&mr->rom, path) == PHGMG_OK && phgmg_rom_load(path, &lr, &blk, NULL) == PHGMG_OK, "%s: save/load", tag);
+    CHECK(phgmg_rom_stepper_init(&s1, &mr->rom, 0.1, 0.0, 0, m1, sizeof m1) == PHGMG_OK &&
+              phgmg_rom_stepper_init(&s2, &lr, 0.1, 0.0, 0, m2, sizeof m2) == PHGMG_OK, "%s: steppers (file)", tag);
+    for (j = 0; j < r; ++j) x1[j] = x2[j] = 0.1 * (j + 1);
+    for (st = 0; st < 20; ++st) {
+      same_y &= phgmg_rom_step(&s1, x1, u3, &y1, NULL) == PHGMG_OK && phgmg_rom_step(&s2, x2, u3, &y2, NULL) == PHGMG_OK;
+      same_y &= y1 == y2;
+    }
+    CHECK(same_y, "%s: the loaded model's outputs differ", tag);
+    snprintf(path, sizeof path, "%s/nl_rom.h", dir_);
+    CHECK(phgmg_rom_export_c(&mr->rom, "nl_rom", path) == PHGMG_OK, "%s: C export", tag);
+    free(blk);
+  }
   free(col);
 }
 
@@ -473,6 +497,7 @@ int main(int argc, char **argv) {
   MPI_Init(&argc, &argv);
   MPI_Comm_rank(MPI_COMM_WORLD, &rank_);
   MPI_Comm_size(MPI_COMM_WORLD, &size_);
+  dir_ = argc > 1 ? argv[1] : NULL;
   t0 = MPI_Wtime();
   if (rank_ == 0) printf("test_mpi_nl: P = %d\n", size_);
   test_gmg_pod_ecsw();
