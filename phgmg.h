@@ -24615,7 +24615,7 @@ PHGMG_DEF phgmg_result phgmg_mpi_gmg_pod_linear(const phgmg_mpi_ctx *ctx, const 
   phgmg__free(al, iwork);
   return rc;
 }
-/* ---- distributed GMG-POD of a separable nonlinear model ------------------------- */
+/* ---- distributed reduction of a separable nonlinear model ----------------------- */
 /* The model's term functions as a phgmg_ph_system (for phgmg__ph_phi on this
    rank's terms: term k local, per_term: row k). */
 PHGMG__PRIV void phgmg__mpi_sep_sys(const phgmg_mpi_sep_model *md, phgmg_ph_system *s) {
@@ -24795,7 +24795,8 @@ PHGMG__PRIV phgmg_result phgmg__mpi_sep_ecsw_svd(const phgmg_mpi_ctx *ctx, const
 /* State of the distributed screening (replicated but g, inW). */
 typedef struct phgmg__mpi_scr {
   int m, wmax, nw, nd;
-  double *Gw, *col, *tg, *res, *ww, *x0, *g, *h, *cand;   /* m x wmax, m x ADD, m, m, wmax, wmax, nl, nl r, 2 ADD (size + 1) */
+  /* m x wmax, m x ADD, m, m, wmax, wmax, nl, nl r, 2 ADD (size + 1) */
+  double *Gw, *col, *tg, *res, *ww, *x0, *g, *h, *cand;
   phgmg_gidx *W;                                   /* wmax: the working set's global ids, in screening order */
   int *pw;
   char *inW;                                       /* nl: this rank's terms in W */
@@ -24965,8 +24966,9 @@ PHGMG__PRIV phgmg_result phgmg__mpi_sep_ecsw(const phgmg_mpi_ctx *ctx, const phg
   *nd = 0; *rel = 0.0;
   if (rc == PHGMG_OK) tn = phgmg__mpi_sep_norm(ctx, t, ns, r, t->sw, work);   /* the target: work + ns r */
   if (rc == PHGMG_OK && tn > 0.0)
-    rc = nlg >= PHGMG_ECSW_SCREEN_MIN ? phgmg__mpi_sep_screened(ctx, t, ns, r, tol, nlg, work + (size_t)ns * r, pts, w, nd, rel)
-                                      : phgmg__mpi_sep_ecsw_svd(ctx, t, ns, r, tol, nlg, tn, pts, w, nd, rel);
+    rc = nlg >= PHGMG_ECSW_SCREEN_MIN
+             ? phgmg__mpi_sep_screened(ctx, t, ns, r, tol, nlg, work + (size_t)ns * r, pts, w, nd, rel)
+             : phgmg__mpi_sep_ecsw_svd(ctx, t, ns, r, tol, nlg, tn, pts, w, nd, rel);
   phgmg__free(&ctx->al, work);
   return rc;
 }
@@ -25252,7 +25254,8 @@ PHGMG_DEF phgmg_result phgmg_mpi_reduce(const phgmg_mpi_ctx *ctx, const phgmg_mp
   /* the separable terms (4b), then the training envelope */
   if (rc == PHGMG_OK) rc = phgmg__mpi_sep_terms(ctx, model, &o, ns, X, ldx, Vb, r, wd, &d, &resid);
   if (rc == PHGMG_OK)
-    rc = phgmg__mpi_sep_envelope(ctx, &model->lin, ns, X, ldx, Vb, r, sp1 ? Wb : NULL, b + 2 * (size_t)r * r + (size_t)r * m + r);
+    rc = phgmg__mpi_sep_envelope(ctx, &model->lin, ns, X, ldx, Vb, r, sp1 ? Wb : NULL,
+                                 b + 2 * (size_t)r * r + (size_t)r * m + r);
   d.nf = model->per_term ? d.nd : 1;
   if (rc == PHGMG_OK) rc = phgmg__mpi_agree(ctx, phgmg__mpi_rom_store(ctx, &d, out));
   if (rc == PHGMG_OK) {
