@@ -68,7 +68,8 @@ test-build: tests/suites.inc
 	$(MAKE) -j2 $(BUILD)/test_run_asan $(EXAMPLES) $(BUILD)/phgmg-float $(BUILD)/npy_tool \
 	  $(BUILD)/export_model_d $(BUILD)/export_model_f
 
-# The distributed layer (PHGMG_MPI; tests/mpi/test_mpi.c, examples/mpi_pod.c)
+# The distributed layer (PHGMG_MPI; tests/mpi/test_mpi.c, tests/mpi/test_mpi_nl.c,
+# examples/mpi_pod.c)
 # at 1, 2, 3 and 4 ranks (4: one rank owns no rows; more ranks than cores),
 # each run's results compared with the one-rank run's; the section's compile
 # checks (C99, float online scalar, C++). Skipped, with a message, without
@@ -91,6 +92,8 @@ test-mpi:
 	for p in 1 2 3 4; do timeout 120 $(MPIRUN) -np $$p ./$(BUILD)/test_mpi $(BUILD)/mpi || exit 1; done && \
 	$(MPICC) $(CFLAGS_T) -o $(BUILD)/test_mpi_stream tests/mpi/test_mpi_stream.c $(LDLIBS) && \
 	for p in 1 2 3 4; do timeout 120 $(MPIRUN) -np $$p ./$(BUILD)/test_mpi_stream || exit 1; done && \
+	$(MPICC) $(CFLAGS_T) -o $(BUILD)/test_mpi_nl tests/mpi/test_mpi_nl.c $(LDLIBS) && \
+	for p in 1 2 3 4; do timeout 120 $(MPIRUN) -np $$p ./$(BUILD)/test_mpi_nl $(BUILD)/mpi || exit 1; done && \
 	$(MPIRUN) -np 3 ./$(BUILD)/mpi_pod --N 3000 > $(BUILD)/mpi/example.txt && echo "test-mpi: examples/mpi_pod.c runs at 3 ranks"
 
 # The documentation against the code: every public function in the manual's

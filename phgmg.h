@@ -662,6 +662,12 @@
                             B u (Q as an operator, B's rows, J - R through a
                             collective solve callback: the user's KSP, MUMPS
                             or AMG): K, Qh, Bh of the serial phgmg_reduce
+     phgmg_mpi_reduce       GMG-POD or SP1 of a model with a SEPARABLE
+                            Hamiltonian (built-in exp-polynomial terms held
+                            by the ranks that own their coordinates) with
+                            ECSW hyper-reduction: the serial phgmg_reduce's
+                            phgmg_rom, replicated, the kept terms as global
+                            indices (phgmg_mpi_rom_free)
      phgmg_mpi_agree        one result for all ranks
      phgmg_mpi_counts_*     this rank's collective calls and bytes, halo
                             exchanges and bytes: read around a call for that
@@ -696,7 +702,43 @@
    files work unchanged). Agreement with the serial phgmg_reduce: K and Qh
    within 1.5e-15 relative at 1-4 ranks (after the sign of each POD mode,
    which the SVD leaves free), the reduced outputs over 200 steps within
-   1e-15. Cost: per POD, one allgather of ns^2 doubles
+   1e-15.
+   phgmg_mpi_reduce does the same (opts.method GMG_POD; or SP1, with J - R
+   as a distributed operator: V the POD of X, A = V^T Q V, W = Q V A^{-1},
+   K = W^T (J - R) W, Bh = W^T B, Qh = A symmetrised, as the serial SP1) for
+   H(x) = 1/2 x^T Q x + sum_k w_k phi_k(x[idx_k]) and adds the serial
+   separable stage (3.4, 8.7): the
+   terms whose argument moves in some snapshot, F = phi_k'(x_i[idx_k]), and
+   ECSW as phgmg_ecsw_separable computes it -- F = U S W^T by TSQR and the
+   SVD on the terms' rows (phgmg_mpi_pod), the fit by phgmg_mpi_ecsw on the
+   training rows S_j U[k, j] V0[idx_k, a] of the modes sigma_j > 1e-3 tol
+   sigma_1 to tol / 2, the full residual ||F^T diag(w - sw) V0(idx, :)||_F
+   checked against tol (else the fit once more with every mode); from 4096
+   moving terms on, the serial screening (8.7) on the full ns r rows: per
+   round each rank's 64 terms of largest gradient gathered and merged (ties
+   to the lower global index), the chosen columns from their owners (one
+   reduction), the Gram fit on the working set replicated -- then the kept
+   terms' rows of V0 and functions from their owners (one reduction) and the
+   training envelope of the reduced snapshot coordinates. The result is the
+   phgmg_rom the serial phgmg_reduce builds (P0, w, per-term poly/expo, K,
+   Qh, Bh, env_lo/hi); the kept terms' global term and state indices come
+   with it (phgmg_mpi_rom.pts, .coord). On a damped chain with a cosh
+   potential (N = 2000, 1000 terms, r = 12, hyper.tol 1e-3;
+   tests/mpi/test_mpi_nl.c) at 1-4 ranks: the singular values within
+   3e-16 sigma_1, K within 4e-13 and Qh within 1.3e-15 relative (after the
+   modes' signs), the same 67 points as global indices, weights within
+   1.5e-14, the reduced outputs over 200 steps within 2.2e-12; with a term
+   on every coordinate of 2100 masses (4200 terms: the screened fit) the
+   same 36 points, weights within 3e-14, K within 2e-12 (cond G00 = 1e6),
+   outputs within 1e-11; SP1 on the first chain: K within 7e-15, the same
+   67 points, weights within 7e-14, outputs within 1e-14. The fit on
+   the full rows at tol alone (what phgmg_mpi_ecsw gives without the
+   compression) keeps 49 points, not the serial 67, and its model's outputs
+   differ by 6e-3: the compression and its tol / 2 are part of the serial
+   result. Cost of the fit: per point one broadcast of a training column
+   (q r doubles, q the modes kept) and a replicated least squares of q r
+   rows; a few hundred points take seconds.
+   Cost: per POD, one allgather of ns^2 doubles
    per rank and a replicated QR of a (size ns) x ns matrix (fine while
    size ns is a few percent of the rows per rank; a reduction tree would
    remove the size factor); per DEIM
@@ -713,8 +755,10 @@
    solves and about 1.5 GB per rank; the efficiency falls below 90 % near
    16 000 ranks (size ns about 0.6 times the rows per rank), where TSQR's
    replicated stack dominates.
-   Not yet distributed: GMG-QM, SP1/SP2, ECSW, nonlinear Hamiltonians,
-   dampers, descriptor models, the command line.
+   Not yet distributed: GMG-QM, SP2, DEIM hyper-reduction (hyper.kind
+   QDEIM or GREEDY), separable terms by callbacks and GENERAL nonlinear
+   Hamiltonians, a reference state (opts.ref), dampers, feedthrough,
+   descriptor models, the command line.
    2.8 Large sparse linear models (>>lowrank). For a phgmg_ph_sparse model
    with quadratic H (E x' = (J - R) Q x + B u, y = B^T Q x; E = I or a mass
    matrix of full rank) the Gramians are computed in low-rank factored form
@@ -2093,12 +2137,13 @@
            phgmg_mpi_deim_greedy, phgmg_mpi_op_create, phgmg_mpi_op_destroy,
            phgmg_mpi_op_info, phgmg_mpi_op_apply, phgmg_mpi_op_project,
            phgmg_mpi_gmg_pod_linear, phgmg_mpi_ecsw, phgmg_mpi_cholqr,
-           phgmg_mpi_counts_get, phgmg_mpi_counts_reset
+           phgmg_mpi_counts_get, phgmg_mpi_counts_reset, phgmg_mpi_reduce,
+           phgmg_mpi_rom_free
    linalg: phgmg_gemm, phgmg_gemv, phgmg_lu_factor, phgmg_lu_solve,
            phgmg_lu_rcond, phgmg_norm1, phgmg_normf, phgmg_zlu_factor,
            phgmg_zlu_solve, phgmg_qr, phgmg_qrcp, phgmg_qr_form_q,
            phgmg_qr_apply, phgmg_lstsq, phgmg_svd, phgmg_sym_eig
-   (170 functions; 21 of them only with PHGMG_MPI; also the macros
+   (172 functions; 23 of them only with PHGMG_MPI; also the macros
    PHGMG_ROM_STEPPER_MEMSIZE_MAX and _MAX_CB.)
 */
 #ifndef PHGMG_H_INCLUDED
@@ -4585,6 +4630,85 @@ typedef struct phgmg_mpi_linear_model {
 PHGMG_DEF phgmg_result phgmg_mpi_gmg_pod_linear(const phgmg_mpi_ctx *ctx, const phgmg_mpi_linear_model *model,
                                                 int ns, const double *X, int ldx, int r, double *K, double *Qh,
                                                 double *Bh, double *S, double *V0, int ldv0);
+
+/* ---- distributed reduction of a separable nonlinear model (manual 2.7) -- */
+/* A port-Hamiltonian model with a SEPARABLE Hamiltonian distributed by rows:
+   x' = (J - R) grad H(x) + B u, y = B^T grad H(x),
+   H(x) = 1/2 x^T Q x + sum_k w_k phi_k(x[idx_k]), phi_k of the built-in
+   exp-polynomial family (manual 1.1; the layout of phgmg_ph_system's poly,
+   expo). lin: Q, m, B and the solve with J - R as for a linear model. Each
+   rank passes its own terms: nsep (0 allowed), sep_idx their global state
+   indices (rows of this rank), sep_id their global term indices (distinct
+   over the ranks, ascending in rank order, e.g. the serial model's term
+   numbers; NULL: sep_idx), sep_w their weights (NULL: 1). poly_deg, nexp:
+   the same on every rank (poly_deg <= 32, nexp <= 8, not both 0); per_term
+   = 0: one function for every term, poly ((poly_deg + 1), may be NULL) and
+   expo (2 nexp) the same on every rank; per_term = 1: one per term, row k
+   of poly (nsep x (poly_deg + 1), ld poly_deg + 1) and expo (2 nexp per
+   term) for this rank's term k. JR: J - R as a distributed operator, for
+   SP1 only (NULL otherwise). */
+typedef struct phgmg_mpi_sep_model {
+  phgmg_mpi_linear_model lin;
+  const phgmg_mpi_op *JR;
+  int nsep;
+  const phgmg_gidx *sep_idx, *sep_id;
+  const double *sep_w;
+  int poly_deg, nexp, per_term;
+  const double *poly, *expo;
+} phgmg_mpi_sep_model;
+
+/* The result of phgmg_mpi_reduce, identical on every rank: rom the online
+   model (kind PHGMG_ROM_LINEAR, method GMG_POD or SP1, its arrays owned by
+   this struct: phgmg_rom_check, the stepper, export and files as usual),
+   and in double: K, Qh (r x r), Bh (r x m), S (GMG-POD: r - m singular
+   values of the adjusted snapshots; SP1: r of the snapshots), nd kept
+   terms with pts (their global term indices,
+   ascending), coord (their global state indices), w (weights), P0 (nd x r:
+   the rows of the basis V0 at coord), hyper_residual (the ECSW training
+   residual; 0 without hyper-reduction). Free with phgmg_mpi_rom_free. */
+typedef struct phgmg_mpi_rom {
+  phgmg_rom rom;
+  int r, m, nd;
+  const double *K, *Qh, *Bh, *S, *w, *P0;
+  const phgmg_gidx *pts, *coord;
+  double hyper_residual;
+  void *mem_;                 /* the storage (private) */
+  phgmg_allocator al_;
+} phgmg_mpi_rom;
+
+/* The distributed phgmg_reduce of a separable model, with ECSW
+   hyper-reduction (opts: method PHGMG_METHOD_GMG_POD or PHGMG_METHOD_SP1, r,
+   hyper.on, hyper.kind ECSW, hyper.tol; the other fields zero, else
+   PHGMG_ERR_UNSUPPORTED). The serial phgmg_reduce's stages in its order and
+   with its formulas: GMG-POD: the basis and the GMG blocks K, Qh, Bh as
+   phgmg_mpi_gmg_pod_linear; SP1 (model->JR needed): V the r leading POD
+   modes of X (TSQR), A = V^T Q V, its reciprocal condition >= 1e-12 (else
+   PHGMG_ERR_DEGENERATE), W = Q V A^{-1}, K = W^T (J - R) W, Bh = W^T B,
+   Qh = A symmetrised; then the separable terms
+   whose argument moves in some snapshot (or phi'(0) != 0); ECSW as
+   phgmg_ecsw_separable: F = phi_k'(x_i[idx_k]) factored by TSQR and the SVD
+   (phgmg_mpi_pod on the terms' rows), the fit on the rows of the modes
+   sigma_j > 1e-3 tol sigma_1 (phgmg_mpi_ecsw, tolerance tol / 2), the full
+   training residual checked against tol (else once more with every mode),
+   and from 4096 live terms on the serial screening on the full rows at tol
+   (rounds of 64 candidates of largest gradient over the ranks, the Gram
+   fit on the working set replicated); the kept terms' rows of V0 and
+   functions broadcast by their owners; the training envelope from the
+   reduced coordinates of the snapshots. hyper.on = 0:
+   every term kept with its weight (nd = all terms: O(terms) online).
+   X: this rank's rows of the snapshots (nloc x ns, ldx). *out is filled
+   on success (zeroed on failure); V0 (nloc x r, ldv0, may be NULL) this
+   rank's rows of the basis (the lift x = V0 xr; SP1: V). Errors: those of
+   phgmg_mpi_gmg_pod_linear (a failing solve's code on every rank),
+   PHGMG_ERR_INVALID_ARG / _SIZE / _NANINF for bad terms,
+   PHGMG_ERR_NOT_CONVERGED (the ECSW fit misses tol), PHGMG_ERR_UNSUPPORTED.
+   Collective. */
+PHGMG_DEF phgmg_result phgmg_mpi_reduce(const phgmg_mpi_ctx *ctx, const phgmg_mpi_sep_model *model, int ns,
+                                        const double *X, int ldx, const phgmg_reduce_opts *opts,
+                                        phgmg_mpi_rom *out, double *V0, int ldv0);
+/* Frees what phgmg_mpi_reduce stored in *out and zeroes it (NULL or a
+   zeroed struct: no-op). Not collective. */
+PHGMG_DEF void phgmg_mpi_rom_free(phgmg_mpi_rom *out);
 
 #ifdef __cplusplus
 }
@@ -24590,6 +24714,669 @@ PHGMG_DEF phgmg_result phgmg_mpi_gmg_pod_linear(const phgmg_mpi_ctx *ctx, const 
   phgmg__free(al, Vb);
   phgmg__free(al, iwork);
   return rc;
+}
+/* ---- distributed reduction of a separable nonlinear model ----------------------- */
+/* The model's term functions as a phgmg_ph_system (for phgmg__ph_phi on this
+   rank's terms: term k local, per_term: row k). */
+PHGMG__PRIV void phgmg__mpi_sep_sys(const phgmg_mpi_sep_model *md, phgmg_ph_system *s) {
+  memset(s, 0, sizeof *s);
+  s->nl = PHGMG_NL_SEPARABLE; s->nsep = md->nsep;
+  s->poly_deg = md->poly_deg; s->poly = md->poly; s->nexp = md->nexp; s->expo = md->expo;
+  s->phi_nfun = md->per_term ? md->nsep : 1;
+}
+
+/* The options this function takes (resolved copy in *o) and this rank's terms. */
+PHGMG__PRIV phgmg_result phgmg__mpi_sep_check_local(const phgmg_mpi_ctx *ctx, const phgmg_mpi_sep_model *md,
+                                                    phgmg_reduce_opts *o) {
+  const int nf = md->per_term ? md->nsep : 1, nc = md->poly_deg + 1;
+  int k;
+  phgmg__reduce_opts_resolve(o, 0);
+  if ((o->method != PHGMG_METHOD_GMG_POD && o->method != PHGMG_METHOD_SP1) ||
+      (o->hyper.on && o->hyper.kind != PHGMG_HYPER_ECSW) ||
+      o->ref != PHGMG_REF_NONE || o->dt != 0.0 || o->nrun || o->runs || o->cache.pod_basis || o->cache.deim_pts ||
+      o->select.lambda_mode != PHGMG_LAMBDA_FIXED || o->degeneracy_tol != 1e-12)
+    return PHGMG_ERR_UNSUPPORTED;
+  if ((o->hyper.on != 0 && o->hyper.on != 1) || !(o->hyper.tol > 0.0 && o->hyper.tol < 1.0) ||
+      (md->per_term != 0 && md->per_term != 1))
+    return PHGMG_ERR_INVALID_ARG;
+  if (o->hyper.on && o->hyper.tol < PHGMG__ECSW_TOL_MIN) return PHGMG_ERR_TOL_UNREACHABLE;
+  if (md->nsep < 0 || md->poly_deg < 0 || md->poly_deg > 32 || md->nexp < 0 || md->nexp > 8 ||
+      (md->poly_deg == 0 && md->nexp == 0))
+    return PHGMG_ERR_SIZE;
+  if ((md->nexp > 0 && nf > 0 && !md->expo) || (md->nsep > 0 && !md->sep_idx)) return PHGMG_ERR_INVALID_ARG;
+  if (o->method == PHGMG_METHOD_SP1 && (!md->JR || md->JR->ctx != ctx)) return PHGMG_ERR_INVALID_ARG;
+  if ((md->poly && nf > 0 && !phgmg__all_finite(md->poly, (size_t)nf * nc)) ||
+      (md->nexp > 0 && nf > 0 && !phgmg__all_finite(md->expo, (size_t)nf * 2 * md->nexp)) ||
+      (md->sep_w && md->nsep > 0 && !phgmg__all_finite(md->sep_w, (size_t)md->nsep)))
+    return PHGMG_ERR_NANINF;
+  for (k = 0; k < md->nsep; ++k) {
+    const phgmg_gidx g = md->sep_idx[k] - ctx->row0;
+    if (g < 0 || g >= ctx->nloc || (md->sep_id && md->sep_id[k] < 0)) return PHGMG_ERR_SIZE;
+    if (k > 0 && (md->sep_id ? md->sep_id[k] <= md->sep_id[k - 1] : md->sep_idx[k] <= md->sep_idx[k - 1]))
+      return PHGMG_ERR_INVALID_ARG;   /* ids ascending */
+  }
+  return PHGMG_OK;
+}
+
+/* The same function family on every rank: poly_deg, nexp, per_term equal
+   and, for a shared function, rank 0's coefficients. Collective. */
+PHGMG__PRIV phgmg_result phgmg__mpi_sep_check_global(const phgmg_mpi_ctx *ctx, const phgmg_mpi_sep_model *md,
+                                                     phgmg_result rc) {
+  int v[4] = {0, 0, 0, 0}, lo[4], hi[4], i;
+  double c[32 + 1 + 16];
+  const int nc = md ? md->poly_deg + 1 : 0, ne = md ? 2 * md->nexp : 0;
+  phgmg_gidx last = -1, prev = -1;   /* ids ascending in rank order: this rank's first above the last before */
+  if (md) { v[0] = md->poly_deg; v[1] = md->nexp; v[2] = md->per_term; }
+  v[3] = rc;
+  if (md && rc == PHGMG_OK && md->nsep > 0) last = md->sep_id ? md->sep_id[md->nsep - 1] : md->sep_idx[md->nsep - 1];
+  MPI_Allreduce(v, lo, 4, MPI_INT, MPI_MIN, ctx->comm);
+  MPI_Allreduce(v, hi, 4, MPI_INT, MPI_MAX, ctx->comm);
+  MPI_Exscan(&last, &prev, 1, MPI_LONG_LONG, MPI_MAX, ctx->comm);
+  phgmg__mpi_count(ctx, 16.0); phgmg__mpi_count(ctx, 16.0); phgmg__mpi_count(ctx, 8.0);
+  if (lo[3] != PHGMG_OK) return (phgmg_result)lo[3];
+  for (i = 0; i < 3; ++i) if (lo[i] != hi[i]) rc = PHGMG_ERR_INVALID_ARG;
+  if (ctx->rank > 0 && md->nsep > 0 && (md->sep_id ? md->sep_id[0] : md->sep_idx[0]) <= prev) rc = PHGMG_ERR_INVALID_ARG;
+  if (rc != PHGMG_OK || md->per_term) return phgmg__mpi_agree(ctx, rc);
+  for (i = 0; i < nc + ne; ++i) c[i] = i < nc ? (md->poly ? md->poly[i] : 0.0) : md->expo[i - nc];
+  MPI_Bcast(c, nc + ne, MPI_DOUBLE, 0, ctx->comm);
+  phgmg__mpi_count(ctx, 8.0 * (nc + ne));
+  for (i = 0; i < nc + ne; ++i)
+    if (c[i] != (i < nc ? (md->poly ? md->poly[i] : 0.0) : md->expo[i - nc])) rc = PHGMG_ERR_INVALID_ARG;
+  return phgmg__mpi_agree(ctx, rc);
+}
+
+/* This rank's live terms (phi'(0) != 0 or the argument not zero in some
+   snapshot, as the serial reduction): lv (their local indices), F (nl x ns)
+   = phi'(x_i[idx]), Vt (nl x r) = V0's rows, sw, gid. buf: one block of
+   nsep (ns + r + 2) doubles (lv, gid inside). */
+typedef struct phgmg__mpi_terms {
+  int nl, *lv;
+  double *F, *Vt, *sw;
+  phgmg_gidx *gid;
+} phgmg__mpi_terms;
+
+PHGMG__PRIV phgmg_result phgmg__mpi_sep_live(const phgmg_mpi_ctx *ctx, const phgmg_mpi_sep_model *md, int ns,
+                                             const double *X, int ldx, const double *V0, int ld, int r,
+                                             phgmg__mpi_terms *t) {
+  const int nt = md->nsep, n1 = PHGMG__MAX(nt, 1);
+  phgmg_ph_system s;
+  int k, i, a;
+  memset(t, 0, sizeof *t);
+  t->F = phgmg__dalloc(&ctx->al, (size_t)n1 * (ns + r + 1) + (size_t)n1);
+  t->gid = PHGMG__CAST(phgmg_gidx *, phgmg__alloc(&ctx->al, sizeof(phgmg_gidx) * (size_t)n1));
+  t->lv = phgmg__ialloc(&ctx->al, (size_t)n1);
+  if (!t->F || !t->gid || !t->lv) return PHGMG_ERR_NOMEM;
+  t->Vt = t->F + (size_t)n1 * ns; t->sw = t->Vt + (size_t)n1 * r;
+  phgmg__mpi_sep_sys(md, &s);
+  for (k = 0; k < nt; ++k) {
+    const int row = (int)(md->sep_idx[k] - ctx->row0);
+    int live = phgmg__ph_phi(&s, k, 0.0, 1) != 0.0;
+    for (i = 0; !live && i < ns; ++i) live = X[row + (size_t)i * ldx] != 0.0;
+    if (live) t->lv[t->nl++] = k;
+  }
+  for (k = 0; k < t->nl; ++k) {
+    const int j = t->lv[k], row = (int)(md->sep_idx[j] - ctx->row0);
+    for (i = 0; i < ns; ++i) t->F[k + (size_t)i * t->nl] = phgmg__ph_phi(&s, j, X[row + (size_t)i * ldx], 1);
+    for (a = 0; a < r; ++a) t->Vt[k + (size_t)a * t->nl] = V0[row + (size_t)a * ld];
+    t->sw[k] = md->sep_w ? md->sep_w[j] : 1.0;
+    t->gid[k] = md->sep_id ? md->sep_id[j] : md->sep_idx[j];
+  }
+  return PHGMG_OK;
+}
+
+PHGMG__PRIV void phgmg__mpi_terms_free(const phgmg_mpi_ctx *ctx, phgmg__mpi_terms *t) {
+  phgmg__free(&ctx->al, t->F);
+  phgmg__free(&ctx->al, t->gid);
+  phgmg__free(&ctx->al, t->lv);
+  memset(t, 0, sizeof *t);
+}
+
+/* ||sum over all ranks' terms of F[k,:]^T d_k Vt[k,:]||_F (ns x r; d: this
+   rank's nl values). work: 2 ns r + nl r doubles. Collective. */
+PHGMG__PRIV double phgmg__mpi_sep_norm(const phgmg_mpi_ctx *ctx, const phgmg__mpi_terms *t, int ns, int r,
+                                       const double *d, double *work) {
+  double *Y = work, *Z = work + (size_t)ns * r, *Bd = Z + (size_t)ns * r;
+  int k, a;
+  memset(Y, 0, (size_t)ns * r * sizeof(double));
+  for (a = 0; a < r; ++a)
+    for (k = 0; k < t->nl; ++k) Bd[k + (size_t)a * t->nl] = d[k] * t->Vt[k + (size_t)a * t->nl];
+  if (t->nl > 0) phgmg_gemm('T', 'N', ns, r, t->nl, 1.0, t->F, t->nl, Bd, t->nl, 0.0, Y, ns);
+  phgmg__mpi_sum(ctx, ns * r, Y, Z);
+  return phgmg_normf(ns * r, 1, Z, ns * r);
+}
+
+/* The compressed ECSW of phgmg_ecsw_separable on distributed terms: F = U S
+   W^T by TSQR and the SVD over the live terms (a context of nlg rows, this
+   rank's nl), the fit on the rows (j, a) = S_j U[k, j] Vt[k, a] of the modes
+   sigma_j > 1e-3 tol sigma_1 at tol / 2, the full residual against tol,
+   else once more with every mode. pts (room for min(nlg, ns r)), w, *nd,
+   *rel. tn > 0: the norm of the target. Collective. */
+PHGMG__PRIV phgmg_result phgmg__mpi_sep_ecsw_svd(const phgmg_mpi_ctx *ctx, const phgmg__mpi_terms *t, int ns, int r,
+                                                 double tol, phgmg_gidx nlg, double tn, phgmg_gidx *pts, double *w,
+                                                 int *nd, double *rel) {
+  const int nl = t->nl, ld = PHGMG__MAX(nl, 1), kk = (int)PHGMG__MIN((phgmg_gidx)ns, nlg);
+  phgmg_mpi_ctx *tc = NULL;
+  phgmg_gidx t0 = 0, nlc = nl;
+  double *U = phgmg__dalloc(&ctx->al, 2 * (size_t)ld * kk + (size_t)kk + (size_t)ld + 2 * (size_t)ns * r + (size_t)ld * r);
+  double *S, *Fc, *dw, *work;
+  int ks = 0, q, pass, i, k;
+  phgmg_result rc;
+  MPI_Exscan(&nlc, &t0, 1, MPI_LONG_LONG, MPI_SUM, ctx->comm);
+  phgmg__mpi_count(ctx, 8.0);
+  if (ctx->rank == 0) t0 = 0;   /* MPI_Exscan leaves rank 0's undefined */
+  rc = phgmg__mpi_agree(ctx, U ? PHGMG_OK : PHGMG_ERR_NOMEM);
+  if (rc == PHGMG_OK) rc = phgmg_mpi_ctx_create(&tc, ctx->comm, nlg, t0, nl, &ctx->al);
+  if (rc != PHGMG_OK) { phgmg__free(&ctx->al, U); return rc; }
+  S = U + (size_t)ld * kk; Fc = S + kk; dw = Fc + (size_t)ld * kk; work = dw + ld;
+  rc = phgmg_mpi_pod(tc, ns, t->F, ld, kk, 0.0, U, ld, S, &ks);
+  for (pass = 0; rc == PHGMG_OK && pass < 2; ++pass) {
+    for (q = 0; q < ks && (pass == 1 || S[q] > 1e-3 * tol * S[0]); ++q) {}
+    if (q < 1) q = 1;
+    for (i = 0; i < q; ++i)
+      for (k = 0; k < nl; ++k) Fc[k + (size_t)i * ld] = S[i] * U[k + (size_t)i * ld];
+    rc = phgmg_mpi_ecsw(ctx, nl, q, Fc, ld, r, t->Vt, ld, t->sw, t->gid, PHGMG__MAX(0.5 * tol, PHGMG__ECSW_TOL_MIN),
+                        (int)PHGMG__MIN(nlg, (phgmg_gidx)q * r), pts, w, nd, NULL);
+    if (rc != PHGMG_OK && rc != PHGMG_ERR_NOT_CONVERGED) break;
+    for (k = 0; k < nl; ++k) dw[k] = -t->sw[k];
+    for (i = 0, k = 0; i < *nd; ++i) {   /* pts and gid ascending */
+      while (k < nl && t->gid[k] < pts[i]) ++k;
+      if (k < nl && t->gid[k] == pts[i]) dw[k] += w[i];
+    }
+    *rel = phgmg__mpi_sep_norm(ctx, t, ns, r, dw, work) / tn;
+    rc = *rel <= tol ? PHGMG_OK : PHGMG_ERR_NOT_CONVERGED;
+    if (rc == PHGMG_OK || q >= ks) break;
+  }
+  phgmg_mpi_ctx_destroy(tc);
+  phgmg__free(&ctx->al, U);
+  return rc;
+}
+
+/* ---- the screened fit (PHGMG_ECSW_SCREEN_MIN live terms or more) ---- */
+/* State of the distributed screening (replicated but g, inW). */
+typedef struct phgmg__mpi_scr {
+  int m, wmax, nw, nd;
+  /* m x wmax, m x ADD, m, m, wmax, wmax, nl, nl r, 2 ADD (size + 1) */
+  double *Gw, *col, *tg, *res, *ww, *x0, *g, *h, *cand;
+  phgmg_gidx *W;                                   /* wmax: the working set's global ids, in screening order */
+  int *pw;
+  char *inW;                                       /* nl: this rank's terms in W */
+} phgmg__mpi_scr;
+
+/* Local index of global id g among this rank's live terms (ascending), -1 if not here. */
+PHGMG__PRIV int phgmg__mpi_term_at(const phgmg__mpi_terms *t, phgmg_gidx g) {
+  int lo = 0, hi = t->nl - 1;
+  while (lo <= hi) {
+    const int mid = (lo + hi) / 2;
+    if (t->gid[mid] == g) return mid;
+    if (t->gid[mid] < g) lo = mid + 1; else hi = mid - 1;
+  }
+  return -1;
+}
+
+/* g = this rank's terms' gradients F res .* Vt summed over a (as phgmg__ecsw_grad_sep). */
+PHGMG__PRIV void phgmg__mpi_scr_grad(const phgmg__mpi_terms *t, int ns, int r, phgmg__mpi_scr *s) {
+  int k, a;
+  if (t->nl == 0) return;
+  phgmg_gemm('N', 'N', t->nl, r, ns, 1.0, t->F, t->nl, s->res, ns, 0.0, s->h, t->nl);
+  for (k = 0; k < t->nl; ++k) s->g[k] = 0.0;
+  for (a = 0; a < r; ++a)
+    for (k = 0; k < t->nl; ++k) s->g[k] += t->Vt[k + (size_t)a * t->nl] * s->h[k + (size_t)a * t->nl];
+}
+
+/* phgmg__ecsw_screen_add over all ranks: up to `add` terms outside W with the
+   largest g > gtol (largest first, ties to the lower global id), appended to
+   W with their training columns (each rank's candidates gathered, the
+   columns from their owners in one reduction). Returns the number added. */
+PHGMG__PRIV int phgmg__mpi_scr_add(const phgmg_mpi_ctx *ctx, const phgmg__mpi_terms *t, int ns, int r,
+                                   phgmg__mpi_scr *s, double gtol, int add) {
+  double *loc = s->cand, *all = s->cand + 2 * (size_t)add, *C = s->Gw + (size_t)s->nw * s->m;
+  int cnt, k, q, i, a;
+  for (cnt = 0; cnt < add; ++cnt) {   /* this rank's best `add` (flag 2: taken here), as the serial scan */
+    int best = -1;
+    double gb = gtol;
+    for (k = 0; k < t->nl; ++k)
+      if (!s->inW[k] && s->g[k] > gb) { gb = s->g[k]; best = k; }
+    if (best >= 0) s->inW[best] = 2;
+    loc[2 * cnt] = best < 0 ? -HUGE_VAL : gb;
+    loc[2 * cnt + 1] = best < 0 ? 0.0 : (double)t->gid[best];
+  }
+  for (k = 0; k < t->nl; ++k) if (s->inW[k] == 2) s->inW[k] = 0;
+  MPI_Allgather(loc, 2 * add, MPI_DOUBLE, all, 2 * add, MPI_DOUBLE, ctx->comm);
+  phgmg__mpi_count(ctx, 16.0 * add);
+  memset(s->col, 0, (size_t)s->m * add * sizeof(double));
+  for (cnt = 0; cnt < add; ++cnt) {   /* merge: the best remaining over the ranks */
+    double *b = NULL;
+    for (q = 0; q < ctx->size; ++q)
+      for (i = 0; i < add; ++i) {
+        double *c = all + ((size_t)q * add + i) * 2;
+        if (c[0] > gtol && (!b || c[0] > b[0] || (c[0] == b[0] && c[1] < b[1]))) b = c;
+      }
+    if (!b) break;
+    s->W[s->nw + cnt] = (phgmg_gidx)b[1];
+    b[0] = -HUGE_VAL;
+    if ((k = phgmg__mpi_term_at(t, s->W[s->nw + cnt])) >= 0) {
+      s->inW[k] = 1;
+      for (a = 0; a < r; ++a)
+        for (i = 0; i < ns; ++i)
+          s->col[(size_t)cnt * s->m + i + (size_t)a * ns] = t->F[k + (size_t)i * t->nl] * t->Vt[k + (size_t)a * t->nl];
+    }
+  }
+  if (cnt > 0) phgmg__mpi_sum(ctx, s->m * cnt, s->col, C);
+  return cnt;
+}
+
+/* Prune W to the fit's support (as the serial driver): terms at weight 0
+   leave W (this rank's flags cleared), the kept ones move to the front with
+   their columns, their weights the next round's warm start. */
+PHGMG__PRIV void phgmg__mpi_scr_prune(const phgmg__mpi_terms *t, phgmg__mpi_scr *s) {
+  int j, k;
+  for (j = 0; j < s->nw; ++j)
+    if ((k = phgmg__mpi_term_at(t, s->W[j])) >= 0) s->inW[k] = 0;
+  for (j = 0; j < s->nd; ++j) {
+    s->W[j] = s->W[s->pw[j]];
+    if ((k = phgmg__mpi_term_at(t, s->W[j])) >= 0) s->inW[k] = 1;
+    if (s->pw[j] != j) memcpy(s->Gw + (size_t)j * s->m, s->Gw + (size_t)s->pw[j] * s->m, (size_t)s->m * sizeof(double));
+    s->pw[j] = j;
+    s->x0[j] = s->ww[j];
+  }
+  s->nw = s->nd;
+}
+
+/* The rounds of phgmg__ecsw_screened: add candidates, the Gram fit on W
+   (phgmg__ecsw_gram, replicated, warm-started), the residual and the
+   gradients, prune; then the points ascending. */
+PHGMG__PRIV phgmg_result phgmg__mpi_scr_run(const phgmg_mpi_ctx *ctx, const phgmg__mpi_terms *t, int ns, int r,
+                                            double tol, phgmg__mpi_scr *s, phgmg_gidx *pts, double *w,
+                                            double *rel) {
+  const int add0 = PHGMG_ECSW_SCREEN_ADD;
+  double gtol = 0.0, gl = 0.0;
+  int j, i, rounds = 0;
+  phgmg_result rc = PHGMG_ERR_NOT_CONVERGED;
+  *rel = HUGE_VAL;
+  memcpy(s->res, s->tg, (size_t)s->m * sizeof(double));
+  phgmg__mpi_scr_grad(t, ns, r, s);
+  for (j = 0; j < t->nl; ++j) gl = PHGMG__MAX(gl, fabs(s->g[j]));
+  MPI_Allreduce(&gl, &gtol, 1, MPI_DOUBLE, MPI_MAX, ctx->comm);
+  phgmg__mpi_count(ctx, 8.0);
+  gtol *= 1e3 * PHGMG__EPS;
+  for (;;) {
+    const int add = phgmg__mpi_scr_add(ctx, t, ns, r, s, gtol, PHGMG__MIN(add0, s->wmax - s->nw));
+    if (add == 0) break;
+    for (j = s->nw; j < s->nw + add; ++j) s->x0[j] = 0.0;
+    s->nw += add;
+    rc = phgmg__mpi_agree(ctx, phgmg__ecsw_gram(s->nw, s->m, s->Gw, s->m, s->tg, tol, rounds ? s->x0 : NULL, s->pw,
+                                                 s->ww, &s->nd, rel, &ctx->al));   /* replicated but a failed allocation */
+    if (rc != PHGMG_ERR_NOT_CONVERGED) break;   /* tol met, or an error */
+    memcpy(s->res, s->tg, (size_t)s->m * sizeof(double));
+    for (j = 0; j < s->nd; ++j) phgmg__axpy(s->m, -s->ww[j], s->Gw + (size_t)s->pw[j] * s->m, s->res);
+    phgmg__mpi_scr_grad(t, ns, r, s);
+    if (++rounds >= PHGMG_ECSW_SCREEN_ROUNDS) break;
+    phgmg__mpi_scr_prune(t, s);
+  }
+  if (rc == PHGMG_OK || rc == PHGMG_ERR_NOT_CONVERGED) {
+    for (j = 0; j < s->nd; ++j) {   /* W in screening order: insertion sort to ascending ids */
+      const phgmg_gidx pj = s->W[s->pw[j]];
+      const double wj = s->ww[j];
+      for (i = j; i > 0 && pts[i - 1] > pj; --i) { pts[i] = pts[i - 1]; w[i] = w[i - 1]; }
+      pts[i] = pj; w[i] = wj;
+    }
+    if (*rel == HUGE_VAL) *rel = 1.0;
+  }
+  return rc;
+}
+
+/* The screened fit as phgmg_ecsw_separable from PHGMG_ECSW_SCREEN_MIN terms
+   on (full ns r rows, tol): tg the target (ns r, replicated). pts, w: room
+   for min(nlg, 16 PHGMG_ECSW_SCREEN_ADD). Collective. */
+PHGMG__PRIV phgmg_result phgmg__mpi_sep_screened(const phgmg_mpi_ctx *ctx, const phgmg__mpi_terms *t, int ns, int r,
+                                                 double tol, phgmg_gidx nlg, const double *tg, phgmg_gidx *pts,
+                                                 double *w, int *nd, double *rel) {
+  const int m = ns * r, ad = PHGMG_ECSW_SCREEN_ADD, nl1 = PHGMG__MAX(t->nl, 1);
+  phgmg__mpi_scr s;
+  phgmg_result rc;
+  memset(&s, 0, sizeof s);
+  s.m = m; s.wmax = (int)PHGMG__MIN(nlg, (phgmg_gidx)16 * ad);
+  s.Gw = phgmg__dalloc(&ctx->al, (size_t)m * (s.wmax + ad + 2) + 2 * (size_t)s.wmax + (size_t)nl1 * (r + 1) +
+                                     2 * (size_t)ad * (ctx->size + 1));
+  s.W = PHGMG__CAST(phgmg_gidx *, phgmg__alloc(&ctx->al, sizeof(phgmg_gidx) * (size_t)s.wmax));
+  s.pw = phgmg__ialloc(&ctx->al, (size_t)s.wmax);
+  s.inW = PHGMG__CAST(char *, phgmg__alloc(&ctx->al, (size_t)nl1));
+  rc = phgmg__mpi_agree(ctx, s.Gw && s.W && s.pw && s.inW ? PHGMG_OK : PHGMG_ERR_NOMEM);
+  if (rc == PHGMG_OK) {
+    s.col = s.Gw + (size_t)m * s.wmax; s.tg = s.col + (size_t)m * ad; s.res = s.tg + m; s.ww = s.res + m;
+    s.x0 = s.ww + s.wmax; s.g = s.x0 + s.wmax; s.h = s.g + nl1; s.cand = s.h + (size_t)nl1 * r;
+    memcpy(s.tg, tg, (size_t)m * sizeof(double));
+    memset(s.inW, 0, (size_t)nl1);
+    rc = phgmg__mpi_scr_run(ctx, t, ns, r, tol, &s, pts, w, rel);
+    *nd = s.nd;
+  }
+  phgmg__free(&ctx->al, s.Gw); phgmg__free(&ctx->al, s.W); phgmg__free(&ctx->al, s.pw); phgmg__free(&ctx->al, s.inW);
+  return rc;
+}
+
+/* ECSW of the live terms as the serial phgmg_ecsw_separable: the target's
+   norm first (nothing to fit: nd = 0), from PHGMG_ECSW_SCREEN_MIN live terms
+   on the screened fit on the full ns r rows at tol, else the compressed fit. */
+PHGMG__PRIV phgmg_result phgmg__mpi_sep_ecsw(const phgmg_mpi_ctx *ctx, const phgmg__mpi_terms *t, int ns, int r,
+                                             double tol, phgmg_gidx nlg, phgmg_gidx *pts, double *w, int *nd,
+                                             double *rel) {
+  const int ld = PHGMG__MAX(t->nl, 1);
+  double *work = phgmg__dalloc(&ctx->al, 2 * (size_t)ns * r + (size_t)ld * r), tn = 0.0;
+  phgmg_result rc = phgmg__mpi_agree(ctx, work ? PHGMG_OK : PHGMG_ERR_NOMEM);
+  *nd = 0; *rel = 0.0;
+  if (rc == PHGMG_OK) tn = phgmg__mpi_sep_norm(ctx, t, ns, r, t->sw, work);   /* the target: work + ns r */
+  if (rc == PHGMG_OK && tn > 0.0)
+    rc = nlg >= PHGMG_ECSW_SCREEN_MIN
+             ? phgmg__mpi_sep_screened(ctx, t, ns, r, tol, nlg, work + (size_t)ns * r, pts, w, nd, rel)
+             : phgmg__mpi_sep_ecsw_svd(ctx, t, ns, r, tol, nlg, tn, pts, w, nd, rel);
+  phgmg__free(&ctx->al, work);
+  return rc;
+}
+
+/* The kept terms' data from their owners: row j of D (nd x wd, replicated)
+   = [state index, V0's row (r), the term's coefficients (per_term: poly_deg
+   + 1 + 2 nexp)] of the term pts[j] (global ids; this rank's terms sep_id
+   ascending). One reduction (one non-zero contribution per entry: exact). */
+PHGMG__PRIV phgmg_result phgmg__mpi_sep_fetch(const phgmg_mpi_ctx *ctx, const phgmg_mpi_sep_model *md,
+                                              const double *V0, int ld, int r, int nd, const phgmg_gidx *pts,
+                                              double *D, int wd) {
+  const int nc = md->poly_deg + 1, ne = 2 * md->nexp;
+  double *L = phgmg__dalloc(&ctx->al, (size_t)nd * wd + 1);
+  int j, k = 0, a;
+  phgmg_result rc = phgmg__mpi_agree(ctx, L ? PHGMG_OK : PHGMG_ERR_NOMEM);
+  if (rc != PHGMG_OK) { phgmg__free(&ctx->al, L); return rc; }
+  memset(L, 0, ((size_t)nd * wd + 1) * sizeof(double));
+  for (j = 0; j < nd; ++j) {
+    int row;
+    while (k < md->nsep && (md->sep_id ? md->sep_id[k] : md->sep_idx[k]) < pts[j]) ++k;
+    if (k >= md->nsep || (md->sep_id ? md->sep_id[k] : md->sep_idx[k]) != pts[j]) continue;
+    row = (int)(md->sep_idx[k] - ctx->row0);
+    L[j] = (double)md->sep_idx[k];
+    for (a = 0; a < r; ++a) L[j + (size_t)(1 + a) * nd] = V0[row + (size_t)a * ld];
+    for (a = 0; md->per_term && a < nc + ne; ++a)
+      L[j + (size_t)(1 + r + a) * nd] = a < nc ? (md->poly ? md->poly[(size_t)k * nc + a] : 0.0)
+                                               : md->expo[(size_t)k * ne + a - nc];
+  }
+  if (nd > 0) phgmg__mpi_sum(ctx, nd * wd, L, D);
+  phgmg__free(&ctx->al, L);
+  return PHGMG_OK;
+}
+
+/* The training envelope env (2r: lo, hi) as the serial reduction's: the
+   range of rho(x_j) = [RB^{-1} QB^T x_j; V1^T x_j] (QB RB = B by TSQR) over
+   the snapshots (SP1, W given: rho(x_j) = W^T x_j), widened on each side by
+   10 % of its width plus 2 % of the largest width. Collective. */
+PHGMG__PRIV phgmg_result phgmg__mpi_sep_envelope(const phgmg_mpi_ctx *ctx, const phgmg_mpi_linear_model *lin,
+                                                 int ns, const double *X, int ldx, const double *V0, int r,
+                                                 const double *W, double *env) {
+  const int ld = PHGMG__MAX(1, ctx->nloc);
+  int m = lin->m;
+  double *QB = phgmg__dalloc(&ctx->al, (size_t)ld * m + (size_t)m * m + (size_t)r * ns), *RB, *XR, big = 0.0;
+  int i, j, a;
+  phgmg_result rc = phgmg__mpi_agree(ctx, QB ? PHGMG_OK : PHGMG_ERR_NOMEM);
+  if (rc != PHGMG_OK) { phgmg__free(&ctx->al, QB); return rc; }
+  RB = QB + (size_t)ld * m; XR = RB + (size_t)m * m;
+  if (W) {   /* SP1: rho(x) = W^T x */
+    rc = phgmg_mpi_atb(ctx, r, ns, W, ld, X, ldx, XR, r);
+    m = 0;
+  } else {
+    rc = phgmg_mpi_tsqr(ctx, m, lin->B, lin->ldb, QB, ld, RB, m);
+    if (rc == PHGMG_OK) rc = phgmg_mpi_atb(ctx, m, ns, QB, ld, X, ldx, XR, r);
+    if (rc == PHGMG_OK) rc = phgmg_mpi_atb(ctx, r - m, ns, V0 + (size_t)ld * m, ld, X, ldx, XR + m, r);
+  }
+  for (j = 0; rc == PHGMG_OK && j < ns; ++j) {
+    double *xr = XR + (size_t)j * r;
+    for (i = m - 1; i >= 0; --i) {   /* RB^{-1} on the port coordinates */
+      double sm = xr[i];
+      for (a = i + 1; a < m; ++a) sm -= RB[i + a * m] * xr[a];
+      xr[i] = sm / RB[i + i * m];
+    }
+    for (a = 0; a < r; ++a) {
+      if (j == 0 || xr[a] < env[a]) env[a] = xr[a];
+      if (j == 0 || xr[a] > env[r + a]) env[r + a] = xr[a];
+    }
+  }
+  for (a = 0; rc == PHGMG_OK && a < r; ++a) big = PHGMG__MAX(big, env[r + a] - env[a]);
+  for (a = 0; rc == PHGMG_OK && a < r; ++a) {
+    const double wd = 0.1 * (env[r + a] - env[a]) + 0.02 * big;
+    env[a] -= wd;
+    env[r + a] += wd;
+  }
+  phgmg__free(&ctx->al, QB);
+  return rc;
+}
+
+/* The phgmg_mpi_rom's storage in one block: double copies (K, Qh, Bh, S, w,
+   P0, poly, expo, env), the global indices, and the online model's
+   phgmg_real arrays. D: the kept terms' rows (phgmg__mpi_sep_fetch). */
+typedef struct phgmg__mpi_romdata {
+  int r, m, nd, nf, nc, ne, nsv, method;   /* nc: poly_deg + 1, ne: nexp, nsv: singular values */
+  const double *K, *Qh, *Bh, *S, *w, *D, *env;
+  const phgmg_gidx *pts;
+  const phgmg_mpi_sep_model *md;
+} phgmg__mpi_romdata;
+
+PHGMG__PRIV void phgmg__mpi_rom_real(phgmg_real *dst, const double *src, size_t n) {
+  size_t i;
+  for (i = 0; i < n; ++i) dst[i] = (phgmg_real)src[i];
+}
+
+PHGMG__PRIV phgmg_result phgmg__mpi_rom_store(const phgmg_mpi_ctx *ctx, const phgmg__mpi_romdata *d,
+                                              phgmg_mpi_rom *out) {
+  const size_t r = (size_t)d->r, m = (size_t)d->m, nd = (size_t)d->nd, nf = (size_t)d->nf;
+  const size_t npc = nf * (size_t)d->nc, nex = nf * 2 * (size_t)d->ne;
+  const size_t nv = 2 * r * r + r * m + nd * (1 + r) + npc + nex + 2 * r;   /* what the rom views */
+  double *b = phgmg__dalloc(&ctx->al, nv + (size_t)d->nsv + 2 * nd + (nv * sizeof(phgmg_real)) / sizeof(double) + 1);
+  double *K, *Qh, *Bh, *w, *P0, *po, *ex, *env, *S;
+  phgmg_gidx *pts, *coord;
+  phgmg_real *v;
+  size_t j;
+  if (!b) return PHGMG_ERR_NOMEM;
+  K = b; Qh = K + r * r; Bh = Qh + r * r; w = Bh + r * m; P0 = w + nd; po = P0 + nd * r; ex = po + npc;
+  env = ex + nex; S = env + 2 * r;
+  pts = PHGMG__CAST(phgmg_gidx *, PHGMG__CAST(void *, S + d->nsv)); coord = pts + nd;
+  v = PHGMG__CAST(phgmg_real *, PHGMG__CAST(void *, coord + nd));
+  memcpy(K, d->K, r * r * sizeof(double)); memcpy(Qh, d->Qh, r * r * sizeof(double));
+  memcpy(Bh, d->Bh, r * m * sizeof(double)); memcpy(S, d->S, (size_t)d->nsv * sizeof(double));
+  memcpy(env, d->env, 2 * r * sizeof(double));
+  if (nd) memcpy(w, d->w, nd * sizeof(double));
+  if (nd) memcpy(P0, d->D + nd, nd * r * sizeof(double));
+  for (j = 0; j < nd; ++j) { pts[j] = d->pts[j]; coord[j] = (phgmg_gidx)d->D[j]; }
+  for (j = 0; j < npc + nex; ++j) {   /* shared: the model's; per term: the fetched rows */
+    const size_t t = j < npc ? j / (size_t)d->nc : (j - npc) / (2 * (size_t)d->ne);
+    const size_t c = j < npc ? j % (size_t)d->nc : (size_t)d->nc + (j - npc) % (2 * (size_t)d->ne);
+    (j < npc ? po : ex - npc)[j] = d->md->per_term ? d->D[t + (1 + r + c) * nd]
+                                  : c < (size_t)d->nc ? (d->md->poly ? d->md->poly[c] : 0.0) : d->md->expo[c - d->nc];
+  }
+  phgmg__mpi_rom_real(v, b, nv);
+  memset(out, 0, sizeof *out);
+  out->mem_ = b; out->al_ = ctx->al;
+  out->r = d->r; out->m = d->m; out->nd = d->nd;
+  out->K = K; out->Qh = Qh; out->Bh = Bh; out->S = S; out->w = w; out->P0 = P0; out->pts = pts; out->coord = coord;
+  out->rom.kind = PHGMG_ROM_LINEAR; out->rom.method = d->method; out->rom.r = d->r; out->rom.m = d->m;
+  out->rom.K = v; out->rom.Qh = v + r * r; out->rom.Bh = v + 2 * r * r;
+  out->rom.nd = d->nd;
+  if (nd) {
+    out->rom.w = v + (w - b); out->rom.P0 = v + (P0 - b);
+    out->rom.poly_deg = d->nc - 1; out->rom.nexp = d->ne; out->rom.nphi = d->md->per_term ? d->nd : 1;
+    out->rom.poly = v + (po - b); out->rom.expo = d->ne ? v + (ex - b) : NULL;
+  }
+  out->rom.env_lo = v + (env - b); out->rom.env_hi = v + (env - b) + r;
+  return PHGMG_OK;
+}
+
+/* SP1's blocks (the serial phgmg__stage_sp_blocks and the quadratic term):
+   V (ld x r) the r leading POD modes of X (TSQR; S their values), A = V^T Q
+   V with its non-degeneracy test, W (ld x r) = Q V A^{-1}, K = W^T (J - R)
+   W, Bh = W^T B, Qh = A symmetrised. Collective. */
+PHGMG__PRIV phgmg_result phgmg__mpi_sp1_blocks(const phgmg_mpi_ctx *ctx, const phgmg_mpi_sep_model *md, int ns,
+                                               const double *X, int ldx, int r, double *K, double *Qh, double *Bh,
+                                               double *S, double *V, double *W) {
+  const int n = ctx->nloc, ld = PHGMG__MAX(1, n), m = md->lin.m;
+  const int kk = (int)PHGMG__MIN((phgmg_gidx)PHGMG__MIN(r + 1, ns), ctx->N);
+  double *Vk = phgmg__dalloc(&ctx->al, (size_t)ld * kk + (size_t)kk + 2 * (size_t)ld * r + (size_t)r * r), *s, *QV, *T, *Ai;
+  int k = 0, j;
+  phgmg_result rc = phgmg__mpi_agree(ctx, Vk ? PHGMG_OK : PHGMG_ERR_NOMEM);
+  if (rc != PHGMG_OK) { phgmg__free(&ctx->al, Vk); return rc; }
+  s = Vk + (size_t)ld * kk; QV = s + kk; T = QV + (size_t)ld * r; Ai = T + (size_t)ld * r;
+  rc = phgmg_mpi_pod(ctx, ns, X, ldx, kk, 0.0, Vk, ld, s, &k);
+  if (rc == PHGMG_OK && k < r) rc = PHGMG_ERR_SIZE;   /* r beyond the snapshots' numerical rank */
+  if (rc == PHGMG_OK) {
+    memcpy(V, Vk, (size_t)ld * r * sizeof(double));
+    memcpy(S, s, (size_t)r * sizeof(double));
+    rc = phgmg_mpi_op_apply(md->lin.Q, r, V, ld, QV, ld);
+  }
+  if (rc == PHGMG_OK) rc = phgmg_mpi_atb(ctx, r, r, V, ld, QV, ld, Qh, r);   /* A = V^T Q V */
+  if (rc == PHGMG_OK) {   /* replicated data: the verdict is the same everywhere but a failed allocation */
+    const double rcd = phgmg__rcond_of(r, Qh, &ctx->al);
+    rc = rcd < 0.0 ? PHGMG_ERR_NOMEM : !(rcd >= 1e-12) ? PHGMG_ERR_DEGENERATE : phgmg__inv(r, Qh, Ai, &ctx->al);
+    rc = phgmg__mpi_agree(ctx, rc);
+  }
+  if (rc == PHGMG_OK) {
+    if (n > 0) phgmg_gemm('N', 'N', n, r, r, 1.0, QV, ld, Ai, r, 0.0, W, ld);   /* W = Q V A^{-1} */
+    rc = phgmg_mpi_op_apply(md->JR, r, W, ld, T, ld);
+  }
+  if (rc == PHGMG_OK) rc = phgmg_mpi_atb(ctx, r, r, W, ld, T, ld, K, r);
+  if (rc == PHGMG_OK) rc = phgmg_mpi_atb(ctx, r, m, W, ld, md->lin.B, md->lin.ldb, Bh, r);
+  if (rc == PHGMG_OK) phgmg__symmetrize(r, Qh);
+  for (j = 0; rc != PHGMG_OK && j < r * r; ++j) Qh[j] = 0.0;
+  phgmg__free(&ctx->al, Vk);
+  return rc;
+}
+
+/* Every term kept with its weight (hyper.on = 0): all ranks' ids and
+   weights gathered in rank order (ascending). pts, w: room for nsg. */
+PHGMG__PRIV phgmg_result phgmg__mpi_sep_all(const phgmg_mpi_ctx *ctx, const phgmg_mpi_sep_model *md, int nsg,
+                                            phgmg_gidx *pts, double *w) {
+  const int n = md->nsep;
+  double *b = phgmg__dalloc(&ctx->al, 2 * (size_t)nsg + 2 * (size_t)(n + 1));
+  int *cnt = phgmg__ialloc(&ctx->al, 2 * (size_t)ctx->size), k;
+  phgmg_result rc = phgmg__mpi_agree(ctx, b && cnt ? PHGMG_OK : PHGMG_ERR_NOMEM);
+  if (rc == PHGMG_OK) {
+    double *loc = b + 2 * (size_t)nsg;
+    const int two = 2 * n;
+    for (k = 0; k < n; ++k) {
+      loc[2 * k] = (double)(md->sep_id ? md->sep_id[k] : md->sep_idx[k]);
+      loc[2 * k + 1] = md->sep_w ? md->sep_w[k] : 1.0;
+    }
+    MPI_Allgather(&two, 1, MPI_INT, cnt, 1, MPI_INT, ctx->comm);
+    for (k = 0; k < ctx->size; ++k) cnt[ctx->size + k] = k == 0 ? 0 : cnt[ctx->size + k - 1] + cnt[k - 1];
+    MPI_Allgatherv(loc, two, MPI_DOUBLE, b, cnt, cnt + ctx->size, MPI_DOUBLE, ctx->comm);
+    phgmg__mpi_count(ctx, 4.0); phgmg__mpi_count(ctx, 16.0 * n);
+    for (k = 0; k < nsg; ++k) { pts[k] = (phgmg_gidx)b[2 * k]; w[k] = b[2 * k + 1]; }
+  }
+  phgmg__free(&ctx->al, b);
+  phgmg__free(&ctx->al, cnt);
+  return rc;
+}
+
+/* The separable stage: live terms, points and weights (ECSW or all terms),
+   the kept terms' rows fetched; *D (nd x wd) and *pts, *w allocated here. */
+PHGMG__PRIV phgmg_result phgmg__mpi_sep_terms(const phgmg_mpi_ctx *ctx, const phgmg_mpi_sep_model *md,
+                                              const phgmg_reduce_opts *o, int ns, const double *X, int ldx,
+                                              const double *V0, int r, int wd, phgmg__mpi_romdata *d,
+                                              double *resid) {
+  const int ld = PHGMG__MAX(1, ctx->nloc);
+  phgmg__mpi_terms t;
+  phgmg_gidx nlg = 0, nl, nsg = 0, ns1 = md->nsep, room;
+  phgmg_gidx *pts = NULL;
+  double *w = NULL;
+  phgmg_result rc = phgmg__mpi_agree(ctx, phgmg__mpi_sep_live(ctx, md, ns, X, ldx, V0, ld, r, &t));
+  nl = t.nl;
+  MPI_Allreduce(&nl, &nlg, 1, MPI_LONG_LONG, MPI_SUM, ctx->comm);
+  MPI_Allreduce(&ns1, &nsg, 1, MPI_LONG_LONG, MPI_SUM, ctx->comm);
+  phgmg__mpi_count(ctx, 8.0); phgmg__mpi_count(ctx, 8.0);
+  room = o->hyper.on ? PHGMG__MIN(nlg, PHGMG__MAX((phgmg_gidx)ns * r, 16 * PHGMG_ECSW_SCREEN_ADD)) : nsg;
+  if (rc == PHGMG_OK && room > 200000000) rc = PHGMG_ERR_SIZE;
+  if (rc == PHGMG_OK) {
+    pts = PHGMG__CAST(phgmg_gidx *, phgmg__alloc(&ctx->al, sizeof(phgmg_gidx) * (size_t)(room + 1)));
+    w = phgmg__dalloc(&ctx->al, (size_t)room + 1);
+    rc = phgmg__mpi_agree(ctx, pts && w ? PHGMG_OK : PHGMG_ERR_NOMEM);
+  }
+  *resid = 0.0;
+  d->nd = 0;
+  if (rc == PHGMG_OK && o->hyper.on && nlg > 0)
+    rc = phgmg__mpi_sep_ecsw(ctx, &t, ns, r, o->hyper.tol, nlg, pts, w, &d->nd, resid);
+  else if (rc == PHGMG_OK && !o->hyper.on) {
+    d->nd = (int)nsg;
+    rc = phgmg__mpi_sep_all(ctx, md, d->nd, pts, w);
+  }
+  phgmg__mpi_terms_free(ctx, &t);
+  if (rc == PHGMG_OK) {
+    double *D = phgmg__dalloc(&ctx->al, (size_t)d->nd * wd + 1);
+    rc = phgmg__mpi_agree(ctx, D ? PHGMG_OK : PHGMG_ERR_NOMEM);
+    if (rc == PHGMG_OK) rc = phgmg__mpi_sep_fetch(ctx, md, V0, ld, r, d->nd, pts, D, wd);
+    d->D = D;
+  }
+  d->pts = pts; d->w = w;
+  return rc;
+}
+
+PHGMG_DEF phgmg_result phgmg_mpi_reduce(const phgmg_mpi_ctx *ctx, const phgmg_mpi_sep_model *model, int ns,
+                                        const double *X, int ldx, const phgmg_reduce_opts *opts,
+                                        phgmg_mpi_rom *out, double *V0, int ldv0) {
+  phgmg_reduce_opts o;
+  phgmg__mpi_romdata d;
+  double *b = NULL, *Vb, *Wb, resid = 0.0;
+  int r = 0, m = 0, ld, wd = 0, sp1;
+  phgmg_result rc = PHGMG_OK;
+  if (!ctx) return PHGMG_ERR_INVALID_ARG;
+  if (out) memset(out, 0, sizeof *out);
+  ld = PHGMG__MAX(1, ctx->nloc);
+  memset(&d, 0, sizeof d);
+  if (!model || !opts || !out) rc = PHGMG_ERR_INVALID_ARG;
+  else if (V0 && !phgmg__mpi_ld_ok(ctx, ldv0)) rc = PHGMG_ERR_SIZE;
+  else {
+    o = *opts;
+    rc = phgmg__mpi_sep_check_local(ctx, model, &o);
+    r = o.r; m = model->lin.m;
+  }
+  rc = phgmg__mpi_sep_check_global(ctx, model ? model : NULL, rc);
+  sp1 = rc == PHGMG_OK && o.method == PHGMG_METHOD_SP1;
+  if (rc == PHGMG_OK && (m < 1 || (phgmg_gidx)r > ctx->N || (sp1 ? r < 1 || r > ns : r <= m))) rc = PHGMG_ERR_SIZE;
+  if (rc == PHGMG_OK) {
+    b = phgmg__dalloc(&ctx->al, 2 * (size_t)r * r + (size_t)r * m + 3 * (size_t)r + 2 * (size_t)ld * r);
+    rc = phgmg__mpi_agree(ctx, b ? PHGMG_OK : PHGMG_ERR_NOMEM);
+  }
+  if (rc != PHGMG_OK) { phgmg__free(&ctx->al, b); return rc; }
+  d.r = r; d.m = m; d.K = b; d.Qh = b + (size_t)r * r; d.Bh = d.Qh + (size_t)r * r; d.S = d.Bh + (size_t)r * m;
+  d.env = d.S + r; Vb = b + 2 * (size_t)r * r + (size_t)r * m + 3 * (size_t)r; Wb = Vb + (size_t)ld * r;
+  d.nc = model->poly_deg + 1; d.ne = model->nexp; d.md = model;
+  d.nsv = sp1 ? r : r - m; d.method = o.method;
+  wd = 1 + r + (model->per_term ? d.nc + 2 * d.ne : 0);
+  /* basis and reduction blocks (stages 1 and 3), the quadratic term (4a) */
+  if (sp1)
+    rc = phgmg__mpi_sp1_blocks(ctx, model, ns, X, ldx, r, b, b + (size_t)r * r, b + 2 * (size_t)r * r,
+                               b + 2 * (size_t)r * r + (size_t)r * m, Vb, Wb);
+  else
+    rc = phgmg_mpi_gmg_pod_linear(ctx, &model->lin, ns, X, ldx, r, b, b + (size_t)r * r, b + 2 * (size_t)r * r,
+                                  b + 2 * (size_t)r * r + (size_t)r * m, Vb, ld);
+  /* the separable terms (4b), then the training envelope */
+  if (rc == PHGMG_OK) rc = phgmg__mpi_sep_terms(ctx, model, &o, ns, X, ldx, Vb, r, wd, &d, &resid);
+  if (rc == PHGMG_OK)
+    rc = phgmg__mpi_sep_envelope(ctx, &model->lin, ns, X, ldx, Vb, r, sp1 ? Wb : NULL,
+                                 b + 2 * (size_t)r * r + (size_t)r * m + r);
+  d.nf = model->per_term ? d.nd : 1;
+  if (rc == PHGMG_OK) rc = phgmg__mpi_agree(ctx, phgmg__mpi_rom_store(ctx, &d, out));
+  if (rc == PHGMG_OK) {
+    int j;
+    out->hyper_residual = resid;
+    for (j = 0; V0 && ctx->nloc > 0 && j < r; ++j)
+      memcpy(V0 + (size_t)j * ldv0, Vb + (size_t)j * ld, (size_t)ctx->nloc * sizeof(double));
+  } else {
+    phgmg_mpi_rom_free(out);
+  }
+  phgmg__free(&ctx->al, (void *)d.D);
+  phgmg__free(&ctx->al, (void *)d.pts);
+  phgmg__free(&ctx->al, (void *)d.w);
+  phgmg__free(&ctx->al, b);
+  return rc;
+}
+
+PHGMG_DEF void phgmg_mpi_rom_free(phgmg_mpi_rom *out) {
+  if (!out) return;
+  if (out->mem_) phgmg__free(&out->al_, out->mem_);
+  memset(out, 0, sizeof *out);
 }
 
 #endif /* PHGMG_MPI && !PHGMG_NO_OFFLINE */

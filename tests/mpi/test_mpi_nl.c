@@ -1,0 +1,539 @@
+/* The distributed GMG-POD and SP1 of a nonlinear model with a separable
+   Hamiltonian and ECSW hyper-reduction (phgmg_mpi_reduce) against the
+   serial phgmg_reduce with the same options, at any number of ranks:
+   mpirun -np P build/test_mpi_nl [DIR]. Layouts: P = 2 and 3 uneven blocks,
+   P = 4 with rank 2 owning no rows. Rank 0 runs the serial reduction and
+   compares (the distributed results are replicated: every rank holds them);
+   with DIR it also saves, loads and exports the distributed models there.
+   Exit status 0 iff every check passed on every rank. Built with mpicc
+   (make test-mpi). */
+#define _POSIX_C_SOURCE 199309L   /* nanosleep */
+#define PHGMG_MPI
+#define PHGMG_STATIC
+#define PHGMG_IMPLEMENTATION
+#include "../../phgmg.h"
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+static int rank_, size_, fails_;
+static const char *dir_;   /* argv[1]: a directory for the model files (none: not written) */
+#define CHECK(cond, ...)                                                            \
+  do {                                                                              \
+    if (!(cond)) {                                                                  \
+      fails_++;                                                                     \
+      printf("[P=%d rank %d] FAIL %s:%d: ", size_, rank_, __FILE__, __LINE__);       \
+      printf(__VA_ARGS__);                                                          \
+      printf("\n");                                                                 \
+      fflush(stdout);                                                               \
+    }                                                                               \
+  } while (0)
+
+/* This rank's block of N rows: P = 2: 60/40 %, P = 3: 50/30/20 %, P = 4:
+   40/35/0/25 % (rank 2 empty); else even. */
+static void layout(long long N, long long *row0, int *nloc) {
+  static const double w2[] = {0.6, 0.4}, w3[] = {0.5, 0.3, 0.2}, w4[] = {0.4, 0.35, 0.0, 0.25};
+  const double *w = size_ == 2 ? w2 : size_ == 3 ? w3 : size_ == 4 ? w4 : NULL;
+  double c0 = 0.0, c1;
+  int q;
+  for (q = 0; q < rank_; ++q) c0 += w ? w[q] : 1.0 / size_;
+  c1 = c0 + (w ? w[rank_] : 1.0 / size_);
+  *row0 = (long long)floor(c0 * (double)N + 0.5);
+  *nloc = rank_ == size_ - 1 ? (int)(N - *row0) : (int)((long long)floor(c1 * (double)N + 0.5) - *row0);
+}
+
+/* Wait for rank 0's serial comparisons without spinning (the other ranks
+   sleep between tests of a non-blocking barrier: the cores stay free). */
+static void quiet_barrier(void) {
+  MPI_Request rq;
+  int done = 0;
+  MPI_Ibarrier(MPI_COMM_WORLD, &rq);
+  while (!done) {
+    struct timespec ts;
+    MPI_Test(&rq, &done, MPI_STATUS_IGNORE);
+    ts.tv_sec = 0; ts.tv_nsec = 2000000;
+    if (!done && rank_ != 0) nanosleep(&ts, NULL);
+  }
+}
+
+static int same_everywhere(int v) {
+  int lo, hi;
+  MPI_Allreduce(&v, &lo, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
+  MPI_Allreduce(&v, &hi, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
+  return lo == hi;
+}
+
+/* ---- the model: a damped chain with an on-site cosh potential ------------- */
+/* n masses, N = 2n, interleaved states (l_i, v_i) (banded, kb = 3):
+   J = [0 Tt; -Tt^T 0] (Tt: 1 on the diagonal, -1 above), R = 0.3 on the
+   velocities, Q = diag(1, 1), B = e_{v_1}; term i on l_i: weight
+   w_i = 1 + (i mod 3) / 2, phi_i(s) = a_i (cosh s - 1), a_i = 0.5 + 0.4
+   sin(i) (one function per term: poly = {-a_i}, expo = {a_i/2, 1, a_i/2, -1}). */
+typedef struct chain {
+  phgmg_ph_system sys;
+  int n, N, kb;
+  double *J, *R, *Q, *B, *poly, *expo, *w;
+  int *idx;
+} chain;
+
+static void chain_build(chain *c, int n, int all) {
+  const int N = 2 * n, kb = 3, ld = 2 * kb + 1, nt = all ? N : n;
+  int i;
+  memset(c, 0, sizeof *c);
+  c->n = n; c->N = N; c->kb = kb;
+  c->J = (double *)calloc((size_t)ld * N, sizeof(double));
+  c->R = (double *)calloc((size_t)ld * N, sizeof(double));
+  c->Q = (double *)calloc((size_t)ld * N, sizeof(double));
+  c->B = (double *)calloc((size_t)N, sizeof(double));
+  c->poly = (double *)malloc(sizeof(double) * (size_t)nt);
+  c->expo = (double *)malloc(sizeof(double) * 4 * (size_t)nt);
+  c->w = (double *)malloc(sizeof(double) * (size_t)nt);
+  c->idx = (int *)malloc(sizeof(int) * (size_t)nt);
+#define AT(A, r, s) (A)[(size_t)(kb + (r) - (s)) + (size_t)(s) * ld]
+  for (i = 0; i < n; ++i) {
+    const int l = 2 * i, v = 2 * i + 1;
+    AT(c->J, l, v) = 1.0; AT(c->J, v, l) = -1.0;
+    if (i + 1 < n) { AT(c->J, l, v + 2) = -1.0; AT(c->J, v + 2, l) = 1.0; }
+    AT(c->R, v, v) = 0.3;
+    AT(c->Q, l, l) = 1.0; AT(c->Q, v, v) = 1.0;
+  }
+  for (i = 0; i < nt; ++i) {
+    const double a = 0.5 + 0.4 * sin((double)i);
+    c->idx[i] = all ? i : 2 * i;
+    c->w[i] = 1.0 + 0.5 * (i % 3);
+    c->poly[i] = -a;
+    c->expo[4 * i] = 0.5 * a; c->expo[4 * i + 1] = 1.0; c->expo[4 * i + 2] = 0.5 * a; c->expo[4 * i + 3] = -1.0;
+  }
+#undef AT
+  c->B[1] = 1.0;
+  c->sys.N = N; c->sys.m = 1; c->sys.storage = PHGMG_BANDED; c->sys.kb = kb;
+  c->sys.J = c->J; c->sys.R = c->R; c->sys.Q = c->Q; c->sys.B = c->B;
+  c->sys.nl = PHGMG_NL_SEPARABLE; c->sys.nsep = nt; c->sys.sep_idx = c->idx; c->sys.sep_w = c->w;
+  c->sys.poly_deg = 0; c->sys.poly = c->poly; c->sys.nexp = 2; c->sys.expo = c->expo; c->sys.phi_nfun = nt;
+}
+
+static void chain_free(chain *c) {
+  free(c->J); free(c->R); free(c->Q); free(c->B); free(c->poly); free(c->expo); free(c->w); free(c->idx);
+}
+
+static void u_in(double t, double *u, void *user) { (void)user; u[0] = 0.5 * sin(0.7 * t); }
+
+/* The serial simulation (rank 0) broadcast to every rank: X (N x ns). */
+static void simulate_root(const chain *ch, const double *x0, double dt, int ns, double *X) {
+  int ok = 1;
+  if (rank_ == 0)
+    ok = phgmg_simulate(&ch->sys, x0, 0.0, dt, ns - 1, u_in, NULL, NULL, X, NULL, NULL, NULL, NULL, NULL) == PHGMG_OK;
+  MPI_Bcast(&ok, 1, MPI_INT, 0, MPI_COMM_WORLD);
+  MPI_Bcast(X, ch->N * ns, MPI_DOUBLE, 0, MPI_COMM_WORLD);
+  CHECK(ok, "simulate");
+}
+
+/* ---- the distributed inputs ----------------------------------------------------- */
+typedef struct solver {
+  const phgmg_mpi_ctx *c;
+  phgmg_jr_factor *f;
+  int fail_rank;
+} solver;
+
+/* The user's solve: the right-hand sides gathered, the banded LU of J - R
+   replicated. */
+static phgmg_result solve_cb(char trans, int nrhs, double *X, int ldx, void *user) {
+  solver *s = (solver *)user;
+  const phgmg_mpi_ctx *c = s->c;
+  const int N = (int)c->N;
+  double *full = (double *)malloc(sizeof(double) * (size_t)N * nrhs), *col = (double *)malloc(sizeof(double) * ((size_t)c->nloc + 1));
+  int *cnt = (int *)malloc(sizeof(int) * (size_t)size_), *dsp = (int *)malloc(sizeof(int) * (size_t)size_), q, j;
+  for (q = 0; q < size_; ++q) { cnt[q] = (int)(c->starts[q + 1] - c->starts[q]); dsp[q] = (int)c->starts[q]; }
+  for (j = 0; j < nrhs; ++j) {
+    memcpy(col, X + (size_t)j * ldx, sizeof(double) * (size_t)c->nloc);
+    MPI_Allgatherv(col, c->nloc, MPI_DOUBLE, full + (size_t)j * N, cnt, dsp, MPI_DOUBLE, MPI_COMM_WORLD);
+  }
+  phgmg_jr_solve(s->f, trans, nrhs, full, N);
+  for (j = 0; j < nrhs; ++j) memcpy(X + (size_t)j * ldx, full + c->row0 + (size_t)j * N, sizeof(double) * (size_t)c->nloc);
+  free(full); free(col); free(cnt); free(dsp);
+  return rank_ == s->fail_rank ? PHGMG_ERR_SINGULAR : PHGMG_OK;
+}
+
+/* Everything a rank passes: Q's rows as CSR, B's and X's rows, its terms. */
+typedef struct dist {
+  phgmg_mpi_ctx *c;
+  phgmg_mpi_op *Q, *JR;
+  phgmg_mpi_sep_model md;
+  solver sv;
+  double *Bl, *Xl, *pl, *el, *wl;
+  long long *sidx, *sid;
+  int ld;
+} dist;
+
+/* This rank's rows of the banded A - s C (C may be NULL) as a distributed operator. */
+static phgmg_mpi_op *band_op(const phgmg_mpi_ctx *c, const chain *ch, const double *A, const double *C, double s) {
+  const int N = ch->N, kb = ch->kb, nloc = c->nloc;
+  long long *rp = (long long *)malloc(sizeof(long long) * ((size_t)nloc + 1));
+  long long *cols = (long long *)malloc(sizeof(long long) * ((size_t)nloc * (2 * kb + 1) + 1));
+  double *vals = (double *)malloc(sizeof(double) * ((size_t)nloc * (2 * kb + 1) + 1));
+  phgmg_mpi_op *op = NULL;
+  int i, j, nz = 0;
+  rp[0] = 0;
+  for (i = 0; i < nloc; ++i) {
+    const int g = (int)c->row0 + i;
+    for (j = g - kb; j <= g + kb; ++j) {
+      const size_t at = (size_t)(kb + g - j) + (size_t)j * (2 * kb + 1);
+      const double v = (j >= 0 && j < N) ? A[at] - (C ? s * C[at] : 0.0) : 0.0;
+      if (v != 0.0) { cols[nz] = j; vals[nz++] = v; }
+    }
+    rp[i + 1] = nz;
+  }
+  CHECK(phgmg_mpi_op_create(&op, c, rp, cols, vals) == PHGMG_OK, "operator");
+  free(rp); free(cols); free(vals);
+  return op;
+}
+
+static void dist_build(dist *d, const chain *ch, int ns, const double *X) {
+  const int N = ch->N;
+  long long row0;
+  int nloc, i, j, k, nt = 0;
+  layout(N, &row0, &nloc);
+  memset(d, 0, sizeof *d);
+  CHECK(phgmg_mpi_ctx_create(&d->c, MPI_COMM_WORLD, N, row0, nloc, NULL) == PHGMG_OK, "ctx");
+  d->ld = nloc > 0 ? nloc : 1;
+  d->Q = band_op(d->c, ch, ch->Q, NULL, 0.0);
+  d->JR = band_op(d->c, ch, ch->J, ch->R, 1.0);
+  d->Bl = (double *)malloc(sizeof(double) * (size_t)d->ld);
+  d->Xl = (double *)malloc(sizeof(double) * (size_t)d->ld * ns);
+  for (i = 0; i < nloc; ++i) d->Bl[i] = ch->B[row0 + i];
+  for (j = 0; j < ns; ++j)
+    for (i = 0; i < nloc; ++i) d->Xl[i + (size_t)j * d->ld] = X[row0 + i + (size_t)j * N];
+  /* this rank's terms: those whose coordinate it owns, global id = serial term number */
+  d->sidx = (long long *)malloc(sizeof(long long) * ((size_t)ch->sys.nsep + 1));
+  d->sid = (long long *)malloc(sizeof(long long) * ((size_t)ch->sys.nsep + 1));
+  d->pl = (double *)malloc(sizeof(double) * ((size_t)ch->sys.nsep + 1));
+  d->el = (double *)malloc(sizeof(double) * 4 * ((size_t)ch->sys.nsep + 1));
+  d->wl = (double *)malloc(sizeof(double) * ((size_t)ch->sys.nsep + 1));
+  for (k = 0; k < ch->sys.nsep; ++k)
+    if (ch->idx[k] >= row0 && ch->idx[k] < row0 + nloc) {
+      d->sidx[nt] = ch->idx[k]; d->sid[nt] = k; d->pl[nt] = ch->poly[k]; d->wl[nt] = ch->w[k];
+      memcpy(d->el + 4 * (size_t)nt, ch->expo + 4 * (size_t)k, 4 * sizeof(double));
+      ++nt;
+    }
+  CHECK(phgmg_jr_factor_create(&d->sv.f, &ch->sys, NULL, NULL) == PHGMG_OK, "J - R factor");
+  d->sv.c = d->c; d->sv.fail_rank = -1;
+  d->md.lin.Q = d->Q; d->md.lin.m = 1; d->md.lin.B = d->Bl; d->md.lin.ldb = d->ld;
+  d->md.lin.solve = solve_cb; d->md.lin.solve_user = &d->sv; d->md.JR = d->JR;
+  d->md.nsep = nt; d->md.sep_idx = d->sidx; d->md.sep_id = d->sid; d->md.sep_w = d->wl;
+  d->md.poly_deg = 0; d->md.nexp = 2; d->md.per_term = 1; d->md.poly = d->pl; d->md.expo = d->el;
+}
+
+static void dist_free(dist *d) {
+  phgmg_jr_factor_destroy(d->sv.f);
+  phgmg_mpi_op_destroy(d->Q);
+  phgmg_mpi_op_destroy(d->JR);
+  free(d->Bl); free(d->Xl); free(d->pl); free(d->el); free(d->wl); free(d->sidx); free(d->sid);
+  phgmg_mpi_ctx_destroy(d->c);
+}
+
+/* Largest |A - d_i d_j B| / max |B| over r x c (d: the modes' signs). */
+static double rel_diff(int r, int c, const double *A, const double *B, const double *di, const double *dj) {
+  double e = 0.0, s = 0.0;
+  int i, j;
+  for (j = 0; j < c; ++j)
+    for (i = 0; i < r; ++i) {
+      e = fmax(e, fabs(di[i] * (dj ? dj[j] : 1.0) * A[i + (size_t)j * r] - B[i + (size_t)j * r]));
+      s = fmax(s, fabs(B[i + (size_t)j * r]));
+    }
+  return s > 0.0 ? e / s : e;
+}
+
+/* The serial singular values of the snapshots (adj: of the adjusted ones X - QB QB^T X). */
+static void serial_sigma(const chain *ch, int ns, const double *X, int k, int adj, double *S) {
+  const int N = ch->N;
+  double *Xa = (double *)malloc(sizeof(double) * (size_t)N * ns), *V = (double *)malloc(sizeof(double) * (size_t)N * k);
+  int j, kk = 0;
+  memcpy(Xa, X, sizeof(double) * (size_t)N * ns);
+  for (j = 0; adj && j < ns; ++j) Xa[1 + (size_t)j * N] = 0.0;   /* B = e_1: the projection removes row 1 */
+  CHECK(phgmg_pod(N, ns, Xa, N, k, 0.0, V, N, S, &kk, NULL) == PHGMG_OK && kk == k, "serial POD");
+  free(Xa); free(V);
+}
+
+/* Rank 0: the distributed model against the serial one. sg: the modes'
+   signs (from the bases). */
+static void compare_serial(const chain *ch, int ns, const double *X, const double *x0, const phgmg_reduced *red,
+                           const phgmg_mpi_rom *mr, const double *V0f, int nsteps, double ktol, const char *tag) {
+  const phgmg_rom *ro = phgmg_reduced_rom(red);
+  const int N = ch->N, r = mr->r, m = mr->m;
+  double sg[64], S[64], e, *col = (double *)malloc(sizeof(double) * (size_t)ch->N), xr[64], xd[64];
+  int i, j, same = ro->nd == mr->nd;
+  for (j = 0; j < r; ++j) {   /* signs: the distributed basis against the serial one (lift of unit vectors) */
+    double dot = 0.0;
+    memset(xr, 0, sizeof xr); xr[j] = 1.0;
+    phgmg_reduced_lift(red, xr, col);
+    for (i = 0; i < N; ++i) dot += col[i] * V0f[i + (size_t)j * N];
+    sg[j] = dot < 0.0 ? -1.0 : 1.0;
+  }
+  serial_sigma(ch, ns, X, mr->rom.method == PHGMG_METHOD_SP1 ? r : r - m, mr->rom.method != PHGMG_METHOD_SP1, S);
+  for (j = 0, e = 0.0; j < (mr->rom.method == PHGMG_METHOD_SP1 ? r : r - m); ++j) e = fmax(e, fabs(mr->S[j] - S[j]) / S[0]);
+  CHECK(e <= 1e-12, "%s: singular values %.2e sigma_1", tag, e);
+  printf("  %s: sigma %.1e sigma_1", tag, e);
+  e = rel_diff(r, r, mr->K, ro->K, sg, sg);
+  CHECK(e <= ktol, "%s: K %.2e", tag, e);
+  printf(", K %.1e", e);
+  e = rel_diff(r, r, mr->Qh, ro->Qh, sg, sg);
+  CHECK(e <= 1e-12, "%s: Qh %.2e", tag, e);
+  printf(", Qh %.1e", e);
+  e = rel_diff(r, m, mr->Bh, ro->Bh, sg, NULL);
+  CHECK(e <= 1e-12, "%s: Bh %.2e", tag, e);
+  CHECK(same, "%s: %d points, serial %d", tag, mr->nd, ro->nd);
+  for (j = 0; same && j < mr->nd; ++j)   /* serial: the kept terms' numbers (every term: none stored, j) */
+    same = mr->pts[j] == (red->term ? red->term[j] : j) && mr->coord[j] == ch->idx[mr->pts[j]];
+  CHECK(same, "%s: point sets differ", tag);
+  if (same) {
+    double ew = 0.0, sw = 0.0;
+    for (j = 0; j < mr->nd; ++j) { ew = fmax(ew, fabs(mr->w[j] - ro->w[j])); sw = fmax(sw, fabs(ro->w[j])); }
+    CHECK(ew <= 1e-12 * sw, "%s: weights %.2e", tag, ew / sw);
+    for (j = 0, e = 0.0; j < r; ++j)   /* rows of V0: columns scaled by the signs */
+      for (i = 0; i < mr->nd; ++i) e = fmax(e, fabs(sg[j] * mr->P0[i + (size_t)j * mr->nd] - ro->P0[i + (size_t)j * ro->nd]));
+    CHECK(e <= 1e-12, "%s: P0 %.2e", tag, e);
+    printf(", %d points, weights %.1e, P0 %.1e", mr->nd, ew / sw, e);
+  }
+  {   /* the online models from x0's reduced coordinates, nsteps steps */
+    static double m1[1 << 16], m2[1 << 16];
+    phgmg_rom_stepper s1, s2;
+    double u3[3], tc[3], y1 = 0.0, y2 = 0.0, ey = 0.0, sy = 0.0;
+    int st, ok = 1;
+    CHECK(phgmg_rom_check(&mr->rom) == PHGMG_OK, "%s: rom check", tag);
+    phgmg_reduced_restrict(red, x0, xr);
+    for (j = 0; j < r; ++j) xd[j] = sg[j] * xr[j];
+    ok = phgmg_rom_stepper_init(&s1, &mr->rom, 0.1, 0.0, 0, m1, sizeof m1) == PHGMG_OK &&
+         phgmg_rom_stepper_init(&s2, ro, 0.1, 0.0, 0, m2, sizeof m2) == PHGMG_OK;
+    CHECK(ok, "%s: steppers", tag);
+    for (st = 0; ok && st < nsteps; ++st) {
+      phgmg_rom_stage_times(0.1 * st, 0.1, tc);
+      for (i = 0; i < 3; ++i) u_in(tc[i], u3 + i, NULL);
+      ok = phgmg_rom_step(&s1, xd, u3, &y1, NULL) == PHGMG_OK && phgmg_rom_step(&s2, xr, u3, &y2, NULL) == PHGMG_OK;
+      ey = fmax(ey, fabs(y1 - y2)); sy = fmax(sy, fabs(y2));
+    }
+    CHECK(ok && ey <= 1e-10 * sy, "%s: reduced outputs against the serial model's: %.2e", tag, ey / sy);
+    printf(", outputs (%d steps) %.1e\n", nsteps, ey / sy);
+  }
+  if (dir_) {   /* the model file and the C export: the loaded model steps to the same outputs, bitwise */
+    char path[1024];
+    phgmg_rom lr;
+    void *blk = NULL;
+    static double m1[1 << 16], m2[1 << 16];
+    phgmg_rom_stepper s1, s2;
+    double x1[64] = {0}, x2[64] = {0}, u3[3] = {0.1, 0.2, 0.3}, y1 = 0.0, y2 = 0.0;
+    int st, same_y = 1;
+    snprintf(path, sizeof path, "%s/nl_rom.bin", dir_);
+    CHECK(phgmg_rom_save(&mr->rom, path) == PHGMG_OK && phgmg_rom_load(path, &lr, &blk, NULL) == PHGMG_OK, "%s: save/load", tag);
+    CHECK(phgmg_rom_stepper_init(&s1, &mr->rom, 0.1, 0.0, 0, m1, sizeof m1) == PHGMG_OK &&
+              phgmg_rom_stepper_init(&s2, &lr, 0.1, 0.0, 0, m2, sizeof m2) == PHGMG_OK, "%s: steppers (file)", tag);
+    for (j = 0; j < r; ++j) x1[j] = x2[j] = 0.1 * (j + 1);
+    for (st = 0; st < 20; ++st) {
+      same_y &= phgmg_rom_step(&s1, x1, u3, &y1, NULL) == PHGMG_OK && phgmg_rom_step(&s2, x2, u3, &y2, NULL) == PHGMG_OK;
+      same_y &= y1 == y2;
+    }
+    CHECK(same_y, "%s: the loaded model's outputs differ", tag);
+    snprintf(path, sizeof path, "%s/nl_rom.h", dir_);
+    CHECK(phgmg_rom_export_c(&mr->rom, "nl_rom", path) == PHGMG_OK, "%s: C export", tag);
+    free(blk);
+  }
+  free(col);
+}
+
+/* The distributed V0 (N x r) on rank 0 from the ranks' rows. */
+static double *gather_v0(const phgmg_mpi_ctx *c, int r, const double *V0, int ld) {
+  const int N = (int)c->N;
+  double *full = (double *)calloc((size_t)N * r + 1, sizeof(double)), *col = (double *)malloc(sizeof(double) * ((size_t)c->nloc + 1));
+  int *cnt = (int *)malloc(sizeof(int) * (size_t)size_), *dsp = (int *)malloc(sizeof(int) * (size_t)size_), q, j;
+  for (q = 0; q < size_; ++q) { cnt[q] = (int)(c->starts[q + 1] - c->starts[q]); dsp[q] = (int)c->starts[q]; }
+  for (j = 0; j < r; ++j) {
+    memcpy(col, V0 + (size_t)j * ld, sizeof(double) * (size_t)c->nloc);
+    MPI_Allgatherv(col, c->nloc, MPI_DOUBLE, full + (size_t)j * N, cnt, dsp, MPI_DOUBLE, MPI_COMM_WORLD);
+  }
+  free(col); free(cnt); free(dsp);
+  return full;
+}
+
+/* Distributed GMG-POD r = 12 with ECSW (tol 1e-3) of the cosh chain (N =
+   2000, 101 snapshots from a smooth initial displacement under a sine
+   input: every term moves, the points lie on every rank that owns rows) against the serial phgmg_reduce with the same options; then the
+   solve failing on one rank only: the same code on every rank. */
+static void test_gmg_pod_ecsw(void) {
+  const int n = 1000, N = 2 * n, ns = 101, r = 12;
+  chain ch;
+  dist d;
+  double *X = (double *)malloc(sizeof(double) * (size_t)N * ns), *x0 = (double *)calloc((size_t)N, sizeof(double));
+  double *V0, *V0f;
+  phgmg_reduce_opts o;
+  phgmg_reduced *red = NULL;
+  phgmg_mpi_rom mr;
+  phgmg_result rc;
+  int i;
+  chain_build(&ch, n, 0);
+  for (i = 0; i < n; ++i) x0[2 * i] = 0.8 * sin(3.0 * 3.14159265358979 * i / n) + 0.3 * sin(7.0 * 3.14159265358979 * i / n);
+  simulate_root(&ch, x0, 0.2, ns, X);
+  memset(&o, 0, sizeof o);
+  o.method = PHGMG_METHOD_GMG_POD; o.r = r; o.hyper.on = 1; o.hyper.kind = PHGMG_HYPER_ECSW; o.hyper.tol = 1e-3;
+  dist_build(&d, &ch, ns, X);
+  V0 = (double *)malloc(sizeof(double) * (size_t)d.ld * r);
+  rc = phgmg_mpi_reduce(d.c, &d.md, ns, d.Xl, d.ld, &o, &mr, V0, d.ld);
+  CHECK(rc == PHGMG_OK, "distributed GMG-POD: %d", (int)rc);
+  V0f = gather_v0(d.c, r, V0, d.ld);
+  CHECK(same_everywhere(mr.nd) && mr.nd > 0, "nd %d differs between ranks", mr.nd);
+  if (rc == PHGMG_OK && size_ > 1) {   /* the points are spread: at least two ranks own some */
+    int q, j, owners = 0;
+    for (q = 0; q < size_; ++q) {
+      int has = 0;
+      for (j = 0; j < mr.nd; ++j) has |= mr.coord[j] >= d.c->starts[q] && mr.coord[j] < d.c->starts[q + 1];
+      owners += has;
+    }
+    CHECK(owners >= 2, "points on %d rank(s) only", owners);
+  }
+  if (rank_ == 0 && rc == PHGMG_OK) {
+    CHECK(phgmg_reduce(&red, &ch.sys, X, N, ns, &o, NULL, NULL) == PHGMG_OK, "serial reduce");
+    if (red) compare_serial(&ch, ns, X, x0, red, &mr, V0f, 200, 1e-12, "gmg-pod ecsw");
+    phgmg_reduced_destroy(red);
+  }
+  quiet_barrier();
+  phgmg_mpi_rom_free(&mr);
+  /* without hyper-reduction: every term kept with its weight, as the serial model */
+  o.hyper.on = 0;
+  rc = phgmg_mpi_reduce(d.c, &d.md, ns, d.Xl, d.ld, &o, &mr, NULL, 0);
+  CHECK(rc == PHGMG_OK && mr.nd == n, "distributed GMG-POD, every term: %d, nd %d", (int)rc, mr.nd);
+  if (rank_ == 0 && rc == PHGMG_OK) {
+    CHECK(phgmg_reduce(&red, &ch.sys, X, N, ns, &o, NULL, NULL) == PHGMG_OK, "serial reduce, every term");
+    if (red) compare_serial(&ch, ns, X, x0, red, &mr, V0f, 40, 1e-12, "gmg-pod, every term");
+    phgmg_reduced_destroy(red);
+  }
+  quiet_barrier();
+  phgmg_mpi_rom_free(&mr);
+  o.hyper.on = 1;
+  /* SP1 with ECSW (J - R as an operator), as the serial SP1 */
+  o.method = PHGMG_METHOD_SP1;
+  rc = phgmg_mpi_reduce(d.c, &d.md, ns, d.Xl, d.ld, &o, &mr, V0, d.ld);
+  CHECK(rc == PHGMG_OK && same_everywhere(mr.nd), "distributed SP1: %d", (int)rc);
+  free(V0f);
+  V0f = gather_v0(d.c, r, V0, d.ld);
+  if (rank_ == 0 && rc == PHGMG_OK) {
+    CHECK(phgmg_reduce(&red, &ch.sys, X, N, ns, &o, NULL, NULL) == PHGMG_OK, "serial SP1");
+    if (red) compare_serial(&ch, ns, X, x0, red, &mr, V0f, 200, 1e-12, "sp1 ecsw");
+    phgmg_reduced_destroy(red);
+  }
+  quiet_barrier();
+  phgmg_mpi_rom_free(&mr);
+  o.method = PHGMG_METHOD_GMG_POD;
+  /* the solve fails on one rank only */
+  d.sv.fail_rank = size_ > 1 ? size_ - 1 : 0;
+  rc = phgmg_mpi_reduce(d.c, &d.md, ns, d.Xl, d.ld, &o, &mr, NULL, 0);
+  CHECK(rc == PHGMG_ERR_SINGULAR && same_everywhere(rc) && mr.mem_ == NULL, "failing solve on one rank: %d", rc);
+  dist_free(&d);
+  chain_free(&ch);
+  free(X); free(x0); free(V0); free(V0f);
+}
+
+/* From PHGMG_ECSW_SCREEN_MIN (4096) moving terms the serial ECSW screens
+   candidates in rounds: the same points (as global indices) and weights
+   from the distributed screening. A cosh term on every coordinate of a
+   chain of 2100 masses (4200 terms), 31 snapshots, r = 8. */
+static void test_screened(void) {
+  const int n = 2100, N = 2 * n, ns = 31, r = 8;
+  chain ch;
+  dist d;
+  double *X = (double *)malloc(sizeof(double) * (size_t)N * ns), *x0 = (double *)calloc((size_t)N, sizeof(double));
+  double *V0, *V0f;
+  phgmg_reduce_opts o;
+  phgmg_reduced *red = NULL;
+  phgmg_mpi_rom mr;
+  phgmg_result rc;
+  int i;
+  chain_build(&ch, n, 1);
+  for (i = 0; i < n; ++i) x0[2 * i] = 0.8 * sin(3.0 * 3.14159265358979 * i / n);
+  simulate_root(&ch, x0, 0.2, ns, X);
+  memset(&o, 0, sizeof o);
+  o.method = PHGMG_METHOD_GMG_POD; o.r = r; o.hyper.on = 1; o.hyper.tol = 1e-3;
+  dist_build(&d, &ch, ns, X);
+  V0 = (double *)malloc(sizeof(double) * (size_t)d.ld * r);
+  rc = phgmg_mpi_reduce(d.c, &d.md, ns, d.Xl, d.ld, &o, &mr, V0, d.ld);
+  CHECK(rc == PHGMG_OK && same_everywhere(mr.nd), "distributed GMG-POD, screened: %d", (int)rc);
+  V0f = gather_v0(d.c, r, V0, d.ld);
+  if (rank_ == 0 && rc == PHGMG_OK) {
+    CHECK(phgmg_reduce(&red, &ch.sys, X, N, ns, &o, NULL, NULL) == PHGMG_OK, "serial reduce, screened");
+    /* K = G00^{-1} with cond(G00) = 1e6 here (5e5 in test_gmg_pod_ecsw):
+       its forward error bound is cond eps ~ 2e-10; measured 6e-13 .. 2e-12 */
+    if (red) compare_serial(&ch, ns, X, x0, red, &mr, V0f, 100, 1e-11, "gmg-pod ecsw, 4200 terms");
+    phgmg_reduced_destroy(red);
+  }
+  quiet_barrier();
+  phgmg_mpi_rom_free(&mr);
+  dist_free(&d);
+  chain_free(&ch);
+  free(X); free(x0); free(V0); free(V0f);
+}
+
+/* Bad input on one rank only (a term outside its rows, ids not ascending,
+   another function family, a NaN coefficient) and options this function
+   does not take: the same code on every rank, never a hang, *out zeroed. */
+static void test_errors(void) {
+  const int n = 60, N = 2 * n, ns = 21, r = 4, bad = size_ > 1 ? size_ - 1 : 0;
+  chain ch;
+  dist d;
+  double *X = (double *)malloc(sizeof(double) * (size_t)N * ns), *x0 = (double *)calloc((size_t)N, sizeof(double));
+  phgmg_reduce_opts o;
+  phgmg_mpi_rom mr;
+  phgmg_result rc;
+  int i, kase;
+  chain_build(&ch, n, 0);
+  for (i = 0; i < n; ++i) x0[2 * i] = 0.5 * sin(0.1 * i);
+  simulate_root(&ch, x0, 0.2, ns, X);
+  dist_build(&d, &ch, ns, X);
+  memset(&o, 0, sizeof o);
+  o.method = PHGMG_METHOD_GMG_POD; o.r = r; o.hyper.on = 1;
+  rc = phgmg_mpi_reduce(d.c, &d.md, ns, d.Xl, d.ld, &o, &mr, NULL, 0);
+  CHECK(rc == PHGMG_OK && mr.nd > 0, "small model: %d", (int)rc);
+  phgmg_mpi_rom_free(&mr);
+  for (kase = 0; kase < 5; ++kase) {
+    phgmg_mpi_sep_model md = d.md;
+    phgmg_reduce_opts ob = o;
+    long long sidx[2];
+    double pn[2];
+    phgmg_result want = PHGMG_ERR_SIZE;
+    if (rank_ == bad && d.md.nsep >= 2) {
+      if (kase == 0) { sidx[0] = d.c->row0 + d.c->nloc; md.sep_idx = sidx; md.nsep = 1; }   /* outside its rows */
+      if (kase == 1) { sidx[0] = d.md.sep_id[1]; sidx[1] = d.md.sep_id[0]; md.sep_id = sidx; md.sep_idx = d.md.sep_idx; md.nsep = 2; }
+      if (kase == 2) md.nexp = 1;                            /* another family than the other ranks' */
+      if (kase == 3) { pn[0] = NAN; pn[1] = 0.0; md.poly = pn; md.nsep = 2; }
+      if (kase == 4) ob.method = PHGMG_METHOD_GMG_QM;
+    }
+    if (kase == 1 || kase == 2) want = PHGMG_ERR_INVALID_ARG;
+    if (kase == 2 && size_ == 1) continue;   /* one rank: nothing to disagree with */
+    if (kase == 3) want = PHGMG_ERR_NANINF;
+    if (kase == 4) want = PHGMG_ERR_UNSUPPORTED;
+    memset(&mr, 1, sizeof mr);
+    rc = phgmg_mpi_reduce(d.c, &md, ns, d.Xl, d.ld, &ob, &mr, NULL, 0);
+    CHECK(rc == want && same_everywhere(rc) && mr.mem_ == NULL && mr.nd == 0, "bad input %d on one rank: %d", kase, rc);
+  }
+  dist_free(&d);
+  chain_free(&ch);
+  free(X); free(x0);
+}
+
+int main(int argc, char **argv) {
+  int total = 0;
+  double t0;
+  MPI_Init(&argc, &argv);
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank_);
+  MPI_Comm_size(MPI_COMM_WORLD, &size_);
+  dir_ = argc > 1 ? argv[1] : NULL;
+  t0 = MPI_Wtime();
+  if (rank_ == 0) printf("test_mpi_nl: P = %d\n", size_);
+  test_gmg_pod_ecsw();
+  test_screened();
+  test_errors();
+  MPI_Allreduce(&fails_, &total, 1, MPI_INT, MPI_SUM, MPI_COMM_WORLD);
+  if (rank_ == 0)
+    printf("test_mpi_nl: P = %d: %s (%d failed checks, %.2f s)\n", size_, total ? "FAILED" : "passed", total,
+           MPI_Wtime() - t0);
+  MPI_Finalize();
+  return total ? 1 : 0;
+}
