@@ -40,7 +40,7 @@ def read(path):
 
 def check_index(header):
     lines = header.split("\n")
-    impl = next(i for i, l in enumerate(lines) if l.startswith("#ifdef PHGMG_IMPLEMENTATION"))
+    impl = next(i for i, l in enumerate(lines) if l.startswith(("#ifdef PHGMG_IMPLEMENTATION", "#if defined(PHGMG_IMPLEMENTATION)")))
     declared = set()
     for l in lines[:impl]:
         m = re.match(r"PHGMG_DEF\b.*?\b(phgmg_[A-Za-z0-9_]+)\s*\(", l)
