@@ -3466,6 +3466,12 @@ typedef struct phgmg_reduce_info {
                               -1 randomized, check failed, exact SVD used     */
   double pod_check;        /* randomized POD: ||X W - V diag(S)||_F / S_1 (the
                               triplets' backward error); 0 on the exact path  */
+  int rank_port;           /* a GMG method refused for B rank deficient
+                              (PHGMG_ERR_RANK): the first port (0-based) whose
+                              column of B is zero or depends on the earlier
+                              ones, e.g. a port that acts only through a
+                              constraint (manual 1.8; SP1 and SP2 take such a
+                              B); -1 otherwise                                 */
 } phgmg_reduce_info;
 
 /* The reduced model with its offline data (bases for reconstruction, double
@@ -16508,6 +16514,11 @@ PHGMG__PRIV phgmg_result phgmg__stage_basis(phgmg__rctx *c) {
   red->RB = phgmg__red_d(red, (size_t)m * m);
   if (!red->V0 || !red->QB || !red->RB) return PHGMG_ERR_NOMEM;
   rc = phgmg__thin_qr(N, m, c->Bp, red->QB, red->RB, c->alloc);
+  if (rc == PHGMG_ERR_RANK && !phgmg__is_gmg(red->method)) { /* SP1/SP2 do not use them: B may be deficient */
+    memset(red->QB, 0, sizeof(double) * (size_t)N * m);
+    memset(red->RB, 0, sizeof(double) * (size_t)m * m);
+    rc = PHGMG_OK;
+  }
   if (rc != PHGMG_OK) return rc;
   if (c->o->cache.pod_basis && c->o->cache.pod_cols < need) return PHGMG_ERR_SIZE;
   if (!phgmg__is_gmg(red->method)) {
@@ -18860,6 +18871,35 @@ PHGMG__PRIV phgmg_result phgmg__reduce_select(phgmg__rctx *c) {
   return rc;
 }
 
+/* The first column of B (N x m) that is zero or depends on the earlier ones
+   (QR without pivoting: |R(j, j)| <= 1e-12 times the largest column norm),
+   or -1. */
+PHGMG__PRIV int phgmg__b_dependent_port(int N, int m, const double *B, const phgmg_allocator *alloc) {
+  double *F = phgmg__dalloc(alloc, (size_t)N * m + (size_t)m), bmax = 0.0;
+  int j, port = -1;
+  if (!F) return -1;
+  memcpy(F, B, sizeof(double) * (size_t)N * m);
+  for (j = 0; j < m; ++j) bmax = PHGMG__MAX(bmax, sqrt(phgmg__dot(N, F + (size_t)j * N, F + (size_t)j * N)));
+  if (phgmg_qr(N, m, F, N, F + (size_t)N * m) == PHGMG_OK)
+    for (j = 0; j < m && port < 0; ++j)
+      if (!(fabs(F[j + (size_t)j * N]) > 1e-12 * bmax)) port = j;
+  if (bmax == 0.0) port = 0;
+  phgmg__free(alloc, F);
+  return port;
+}
+
+/* phgmg_ph_validate for a reduction: B of full column rank only for the GMG
+   methods (their trial basis holds B); SP1 and SP2 take any B, e.g. a zero
+   column of a port that acts only through a constraint (manual 1.8). A GMG
+   method refused for B: info.rank_port. */
+PHGMG__PRIV phgmg_result phgmg__reduce_validate(phgmg__rctx *c, const phgmg_ph_system *sys,
+                                                const phgmg_allocator *alloc) {
+  const int gmg = phgmg__is_gmg(c->o->method);
+  phgmg_result rc = phgmg__ph_e_cause(sys, phgmg__ph_validate(sys, 0.0, &c->inf.rcond_jr, alloc, gmg), alloc);
+  if (rc == PHGMG_ERR_RANK && gmg) c->inf.rank_port = phgmg__b_dependent_port(sys->N, sys->m, sys->B, alloc);
+  return rc;
+}
+
 /* The options resolved and checked, the model validated, the context set. */
 PHGMG__PRIV phgmg_result phgmg__reduce_setup(phgmg__rctx *c, const phgmg_ph_system *sys, const double *X, int ldx,
                                              int ns, const phgmg_reduce_opts *opts, const phgmg_allocator *alloc,
@@ -18874,7 +18914,8 @@ PHGMG__PRIV phgmg_result phgmg__reduce_setup(phgmg__rctx *c, const phgmg_ph_syst
   c->inf.hyper_method = -1;
   rc = phgmg__reduce_check(sys, X, ldx, ns, c->o, st != NULL);
   if (rc == PHGMG_OK) c->sf = (c->o->ref != PHGMG_REF_NONE || sys->ndamp) ? PHGMG__SF_NONE : phgmg__study_fast(st, c->o, sys->m);
-  if (rc == PHGMG_OK) rc = phgmg_ph_validate(sys, 0.0, &c->inf.rcond_jr, alloc);
+  c->inf.rank_port = -1;
+  if (rc == PHGMG_OK) rc = phgmg__reduce_validate(c, sys, alloc);
   if (rc == PHGMG_OK && sys->E && phgmg__e_algebraic(sys, alloc) != 0)   /* reduce the condensed model (1.8) */
     rc = PHGMG_ERR_UNSUPPORTED;
   if (rc != PHGMG_OK) return rc;

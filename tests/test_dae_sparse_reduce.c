@@ -448,8 +448,70 @@ TEST(test_dae_sparse_reduce_large) {
   dsr_free(&g);
 }
 
+/* A port that acts only through a constraint: a current source on a node
+   with only a shunt conductance 0.5 (no capacitor, no other element). Its
+   condensed input column vanishes and it becomes pure feedthrough, S'(2, 2)
+   = 1/0.5 = 2. GMG-POD refuses (PHGMG_ERR_RANK, info.rank_port = 2: the
+   port named); SP1 and SP2 reduce it: their models are port-Hamiltonian and
+   follow the full model's three outputs (1e-5 of their size at r = 20). */
+TEST(test_dae_sparse_reduce_vanishing_port) {
+  const int ns = 200, m = 3;
+  const double dt = 0.05;
+  dsr_model g;
+  phgmg_ph_system ss;
+  phgmg_ph_sparse *sp;
+  phgmg_dae *ds = NULL;
+  double *X, *XI, *Xs = NULL, *Y, *YR, *Pint;
+  int k, n, i, meth;
+  dsr_build(&g, 5, 0, 0, 0, 1);
+  X = (double *)malloc(sizeof(double) * (size_t)g.N * (ns + 1)); XI = (double *)malloc(sizeof(double) * (size_t)g.N * (ns + 1));
+  Y = (double *)malloc(sizeof(double) * 2 * m * (ns + 1)); YR = Y + (size_t)m * (ns + 1);
+  Pint = (double *)calloc((size_t)g.N * g.m, sizeof(double));
+  dsr_run(&g, ns, dt, X, Y);
+  sp = dsr_sparse(&g, &ss, Pint);
+  CHECK_RC(phgmg_dae_create(&ds, &ss, 0.0, NULL), PHGMG_OK);
+  if (ds && sp) {
+    const phgmg_ph_system *c = phgmg_dae_system(ds);
+    double bmax = 0.0, b2 = 0.0;
+    n = c->N;
+    for (i = 0; i < n; ++i) {
+      bmax = PHGMG__MAX(bmax, PHGMG__MAX(fabs(c->B[i]), fabs(c->B[i + n])));
+      b2 = PHGMG__MAX(b2, fabs(c->B[i + 2 * (size_t)n]));
+    }
+    CHECK(bmax > 0.5 && b2 == 0.0);
+    CHECK(c->S != NULL);
+    if (c->S) CHECK_LE(fabs(c->S[8] - 2.0), 1e-14);
+    Xs = (double *)malloc(sizeof(double) * (size_t)n * (ns + 1));
+    CHECK_RC(phgmg_ph_sparse_to_banded_order(sp, ns + 1, X, g.N, XI, g.N), PHGMG_OK);
+    for (k = 0; k <= ns; ++k) phgmg_dae_restrict(ds, XI + (size_t)k * g.N, Xs + (size_t)k * n);
+    for (meth = 0; meth < 3; ++meth) {
+      phgmg_reduce_opts o;
+      phgmg_reduce_info inf;
+      phgmg_reduced *red = NULL;
+      phgmg_reduce_opts_default(&o);
+      o.method = meth == 0 ? PHGMG_METHOD_GMG_POD : meth == 1 ? PHGMG_METHOD_SP1 : PHGMG_METHOD_SP2;
+      o.r = 20;
+      memset(&inf, 0, sizeof inf);
+      CHECK_RC(phgmg_reduce(&red, c, Xs, n, ns + 1, &o, &inf, NULL), meth == 0 ? PHGMG_ERR_RANK : PHGMG_OK);
+      CHECK(inf.rank_port == (meth == 0 ? 2 : -1));
+      if (red) {
+        const double e = dsr_red_err(red, ns, dt, m, Y, YR);
+        if (getenv("DAE_VERBOSE")) printf("vanishing port: method %d e %.3e\n", meth, e);
+        CHECK_LE(e, 1e-5);
+        dsr_check_ph(red, 20);
+      }
+      phgmg_reduced_destroy(red);
+    }
+  }
+  phgmg_dae_destroy(ds);
+  phgmg_ph_sparse_destroy(sp);
+  free(X); free(XI); free(Xs); free(Y); free(Pint);
+  dsr_free(&g);
+}
+
 SUITE(dae_sparse_reduce) {
   RUN(test_dae_sparse_reduce_matrices);
   RUN(test_dae_sparse_reduce_roms);
   RUN(test_dae_sparse_reduce_large);
+  RUN(test_dae_sparse_reduce_vanishing_port);
 }
