@@ -10754,6 +10754,29 @@ PHGMG__PRIV phgmg_result phgmg__dae_sp_object(phgmg_dae *d, const phgmg_csc *M) 
   return PHGMG_OK;
 }
 
+/* The order of the kept columns (cpos) that puts E[d, d]'s largest entries
+   on the diagonal (the matching of 8.12): with the rows and the states
+   scrambled differently, the condensed model's E' and Q' then have the
+   pattern of an unscrambled model, which its own ordering and sparse LU
+   take like any other (and a separable coordinate keeps rpos = cpos). */
+PHGMG__PRIV phgmg_result phgmg__dae_sp_match(phgmg_dae *d, const phgmg_ph_sparse *sp) {
+  int *p = NULL, *ix = NULL, *cperm = phgmg__ialloc(&d->al, 2 * (size_t)d->n), i, r = -1;
+  double *x = NULL;
+  phgmg_result rc = cperm ? phgmg__csc_sub(d->N, sp->cp[3], sp->ci[3], sp->cx[3], d->rpos, d->cpos, d->n, &p, &ix,
+                                           &x, &d->al)
+                          : PHGMG_ERR_NOMEM;
+  if (rc == PHGMG_OK) r = phgmg__sp_match(d->n, p, ix, x, cperm, &d->al);
+  if (rc == PHGMG_OK && r < 0) rc = PHGMG_ERR_NOMEM;
+  if (r == 1) { /* new column j is old column cperm[j] */
+    int *inv = cperm + d->n;
+    for (i = 0; i < d->n; ++i) inv[cperm[i]] = i;
+    for (i = 0; i < d->N; ++i)
+      if (d->cpos[i] >= 0) d->cpos[i] = inv[d->cpos[i]];
+  }
+  phgmg__free(&d->al, p); phgmg__free(&d->al, ix); phgmg__free(&d->al, x); phgmg__free(&d->al, cperm);
+  return rc;
+}
+
 /* phgmg_dae_create's condensation of a SPARSE system (manual 1.8), after
    the split: the index check on the sparse LUs of L[a, a] and Q[a, c] (the
    object kept for the lift), Q_dc = 0, the Schur updates per component,
@@ -10779,6 +10802,7 @@ PHGMG__PRIV phgmg_result phgmg__dae_sparse(phgmg_dae *d, const phgmg_ph_system *
   }
   if (rc == PHGMG_OK) rc = phgmg__dae_sp_jr(d, sp, &U, 0, &M[0]);
   if (rc == PHGMG_OK) rc = phgmg__dae_sp_jr(d, sp, &U, 1, &M[1]);
+  if (rc == PHGMG_OK) rc = phgmg__dae_sp_match(d, sp);
   for (w = 0; w < 2 && rc == PHGMG_OK; ++w) { /* Q' = Q[d, d], E' = E[d, d] */
     rc = phgmg__csc_sub(d->N, sp->cp[2 + w], sp->ci[2 + w], sp->cx[2 + w], d->rpos, d->cpos, d->n, &qp[w], &qi[w],
                         &qx[w], &d->al);
