@@ -3366,9 +3366,19 @@ static int all_zero(const double *a, size_t n) {
   return 1;
 }
 
+/* The largest |entry| of n doubles. */
+static double max_abs_n(const double *a, size_t n) {
+  double v = 0.0;
+  size_t k;
+  for (k = 0; k < n; ++k) v = PHGMG__MAX(v, fabs(a[k]));
+  return v;
+}
+
 /* phgmg_reduce's PHGMG_ERR_RANK explained: every port through a constraint
-   (an index-one model's condensed B = 0), a --lambda too small for the
-   quadratic fit, else the snapshots (src) or B. */
+   (an index-one model's condensed B = 0), one port through a constraint (its
+   condensed column of B zero to round-off: info->rank_port) or another port
+   dependent, a --lambda too small for the quadratic fit, else the snapshots
+   (src) or B. */
 static int explain_rank(const reduce_args *A, const reduce_state *S, int method, const char *src,
                         const phgmg_reduce_info *info) {
   const char *what = phgmg_result_string(PHGMG_ERR_RANK);
@@ -3377,9 +3387,11 @@ static int explain_rank(const reduce_args *A, const reduce_state *S, int method,
     return fail("reduction failed: %s: every port of %s acts through an algebraic constraint, so the condensed "
                 "model's port matrix B is zero (the ports act only through its feedthrough terms) and the "
                 "reduction has no port direction to keep", what, A->B);
-  if (S->dae && p >= 0 && p < S->sys.m && all_zero(S->sys.B + (size_t)p * S->sys.N, (size_t)S->sys.N))
+  if (S->dae && p >= 0 && p < S->sys.m && max_abs_n(S->sys.B + (size_t)p * S->sys.N, (size_t)S->sys.N) <=
+                                               1e-12 * max_abs_n(S->sys.B, (size_t)S->sys.N * (size_t)S->sys.m))
     return fail("reduction failed: --method %s: port %d (column %d of %s, counted from 0) acts only through a "
-                "constraint (its condensed input column vanishes: the port is pure feedthrough): use sp1 or sp2",
+                "constraint (its condensed input column vanishes: it enters only through the feedthrough terms): "
+                "use sp1 or sp2",
                 method == PHGMG_METHOD_GMG_QM ? "gmg-qm" : "gmg-pod", p, p, A->B);
   if (p >= 0)
     return fail("reduction failed: %s: port %d (column %d of %s, counted from 0) %s: gmg-pod and gmg-qm keep "
