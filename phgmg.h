@@ -334,7 +334,8 @@
    becomes feedthrough (a resistor between the port and the constraint:
    S' > 0); a constraint away from the ports changes J and R only.
    phgmg_dae_create builds the condensed model (dense or banded like the
-   input; the update is confined to the neighbours of the algebraic lines),
+   input; the update is confined to the neighbours of the algebraic lines;
+   a SPARSE input is condensed sparsely, below),
    phgmg_dae_lift recovers the algebraic variables (x_c = Q_ac^{-1} (z_a -
    Q_ad x_d)), phgmg_dae_restrict takes x_d; the three maps work in place
    (x == xi), refuse other overlaps and a NULL object (PHGMG_ERR_INVALID_ARG).
@@ -395,11 +396,45 @@
    apart from index two here). A phgmg_ph_sparse object with algebraic
    lines chooses its stage solver by the predicted costs (8.12) like any
    other, and always the sparse LU beyond 4096 algebraic lines; on the band
-   LU it keeps the condensing path (phgmg_dae_create), on the sparse LU
-   phgmg_dae_create returns PHGMG_ERR_UNSUPPORTED (call
-   phgmg_ph_sparse_set_solver(sp, PHGMG_SOLVER_BAND, ..) for the condensed
-   model; k <= 4096). The stepper object (phgmg_gl3_create) takes such a
-   SPARSE system directly. Measured (bench/README.md, RLC grid of 40 x 40
+   LU (BANDED storage) it keeps the band condensation (k <= 4096). The
+   stepper object (phgmg_gl3_create) takes such a SPARSE system directly.
+   Sparse condensation (phgmg_dae_create of a SPARSE system; the command
+   line's reduce of COO input): the condensed model is itself a SPARSE
+   system, of a phgmg_ph_sparse object that d owns (made by
+   phgmg_ph_sparse_create_e, so validation, simulation, every reduction
+   method and the low-rank tools take it as any sparse model), and nothing
+   of order k is dense. The algebraic block L_aa splits into the connected
+   components C of the graph of L_aa + L_aa^T (union-find over its
+   entries); L_aa^{-1} is block diagonal over them, so the update L_da
+   L_aa^{-1} L_ad is the sum over C of -L_dC L_CC^{-1} L_Cd, a dense block
+   on nbr(C) x nbr(C) only (the rows of L_dC by the columns of L_Cd: the
+   differential lines next to C). Per component: an LU of L_CC (dense with
+   partial pivoting up to 256 lines, the sparse LU of 8.12 beyond), the
+   right-hand sides [L_C,nbr, G_C] and F_C solved (L_CC^{-T} for F'),
+   the block and the port terms G', F', (S + N)' accumulated, the block's
+   entries appended to one triplet list; phgmg_csc_from_coo sums the
+   components' overlaps. J' and R' are then made exactly skew and
+   symmetric (each entry the half-difference or half-sum of the values at
+   (i, j) and (j, i)), Q' = Q_dd and E' = E_dd taken as they are, and the
+   differential states are ordered by the matching of E_dd (its largest
+   entries on the diagonal, as the sparse LU's column matching does): with
+   rows and states scrambled by different permutations, E' and Q' then
+   have the pattern of an unscrambled model and the condensed model's own
+   ordering and sparse LU cost what the full model's do. The index and
+   the lift use the sparse LUs of L_aa and Q_ac of the simulation path
+   (phgmg_dae_lift runs its end-value formula on the full state). Cost:
+   the components' LUs (c^3/3 each for c <= 256), sum over C of
+   (|C| + |nbr(C)|) |nbr(C)| work for the blocks, then the condensed
+   object's ordering and analysis; memory: the triplets, sum over C of
+   |nbr(C)|^2 entries, predicted before any work and allocated at once
+   (too many: PHGMG_ERR_NOMEM, nothing else allocated; no other limit),
+   plus the largest component's dense right-hand sides, |C| (|nbr(C)| + 2m)
+   doubles. A network whose algebraic nodes form small groups (an RLC
+   grid: groups of one to three lines) costs O(N): on a 100 x 100 grid
+   (N = 49 600, k = 24 800; -O2, Intel Xeon) phgmg_dae_create takes
+   0.47 s CPU, its condensed model's sparse factor 8.5e5 entries against
+   the full pencil's 9.2e5. A GENERAL nonlinear part on a SPARSE
+   index-one model: PHGMG_ERR_UNSUPPORTED. Measured (bench/README.md, RLC grid of 40 x 40
    mains, N = 7 840, 3 920 algebraic, rows and columns scrambled, 1 000
    steps): 3.0 s CPU and 14 MB against SciPy + SuperLU's 6.5 s and 61 MB
    doing the same steps, outputs 1.6e-16 apart.
@@ -407,9 +442,14 @@
    phgmg_dae_system(d), with snapshots restricted to x_d (phgmg_reduce of the
    full model is PHGMG_ERR_UNSUPPORTED; the command line does this by
    itself). The reduced model is a port-Hamiltonian ODE with the same
-   outputs; every method takes it (GMG needs B' of full rank: a port that
-   acts only through a constraint leaves B' = 0 there; SP1 and SP2 do not
-   need it). tests/test_dae.c checks each claim: the condensed matrices of a
+   outputs; every method takes it. GMG needs B' of full rank: a port that
+   acts only through a constraint (a current source on a node without
+   capacitor) leaves its column of B' zero (it enters through P', S' only),
+   and the GMG methods return PHGMG_ERR_RANK with
+   phgmg_reduce_info.rank_port naming it (the command line: "port p ...
+   acts only through a constraint ...: use sp1 or sp2"); SP1 and SP2 do not
+   need it (their bases are the snapshots' POD and W; phgmg_reduce checks
+   B's rank for the GMG methods only). tests/test_dae.c checks each claim: the condensed matrices of a
    three-state circuit against their closed forms, the simulation against
    an independent collocation of the DAE (its 3N stage system with the
    singular E solved directly), the constraints at every step, the energy
@@ -418,7 +458,13 @@
    pencil, E singular in another form and Q_dc != 0; and a bar with a
    massless node seen through orthogonal changes of coordinates (no zero
    lines) against the coordinate-aligned one: the same outputs, the states
-   rotated, index two found as index two.
+   rotated, index two found as index two. tests/test_dae_sparse_reduce.c:
+   the sparse condensation against the dense one of the same model's dense
+   copy (every condensed matrix to 1e-12; scrambled grids with and without
+   a port on a constraint, Q not diagonal, feedthrough, and a chain of 300
+   algebraic lines in one component), GMG-POD and SP1 models of both equal
+   (outputs to 1e-10), a grid beyond 4096 algebraic lines reduced, and a
+   port through a constraint: SP1 and SP2 reduce, GMG-POD names it.
 
    1.9 Nonlinear energies of finite-element form
    Finite-element codes write a nonlinear stored energy as a sum over
@@ -2381,14 +2427,19 @@ PHGMG_DEF phgmg_result phgmg_ph_validate(const phgmg_ph_system *sys, double tol,
    zero: no differential state) or E is singular but not of this form and not dense (a dense E without zero lines is rotated into it,
    manual 1.8; phgmg_dae_restrict/_embed/_lift then rotate back), PHGMG_ERR_EQ_NOT_SYMMETRIC when the kept co-states depend on the
    algebraic variables, PHGMG_ERR_UNSUPPORTED for a separable coordinate or a
-   damper on an algebraic line, k > 4096, an elimination whose dense
-   blocks would exceed 1e8 doubles, or a SPARSE system: the condensation is
-   made in band or dense storage, phgmg_ph_sparse_set_solver(sp,
-   PHGMG_SOLVER_BAND, ..) first) and builds the condensed model: a
+   damper on an algebraic line, for dense and banded storage k > 4096 or an
+   elimination whose dense blocks would exceed 1e8 doubles, for SPARSE
+   storage a GENERAL nonlinear part) and builds the condensed model: a
    port-Hamiltonian ODE in the n = N - k differential coordinates, with the
    same outputs, Hamiltonian and dissipation (phgmg_dae_system; feedthrough P,
    S, Nskew where a constraint touches a port), which it validates
-   (phgmg_ph_validate's codes). Validate the full model with
+   (phgmg_ph_validate's codes). A SPARSE system (phgmg_ph_sparse on the
+   sparse LU) is condensed sparsely, per connected component of the
+   algebraic block, with no limit on k: the condensed model is then a
+   SPARSE system of a phgmg_ph_sparse object owned by d, its states in that
+   object's internal order (phgmg_dae_restrict/_embed/_lift map between it
+   and the full model's internal order); memory beyond the allocator's:
+   PHGMG_ERR_NOMEM (manual 1.8). Validate the full model with
    phgmg_ph_validate first (it runs this check too). With k = 0 the
    condensed model is the model itself. phgmg_simulate and
    phgmg_simulate_run take index-one models directly (consistent states; a
@@ -3479,7 +3530,9 @@ typedef struct phgmg_reduce_info {
 typedef struct phgmg_reduced phgmg_reduced;
 
 /* Build a reduced model of `sys` from snapshots X (N x ns, ldx). The system must
-   validate (phgmg_ph_validate). The stages and the model kinds are described in
+   validate (phgmg_ph_validate; B of full column rank only for the GMG
+   methods, which keep B in their basis: SP1 and SP2 take any B, and a GMG
+   method refused for B sets info.rank_port). The stages and the model kinds are described in
    the manual (2.2, 3.1-3.4): every Hamiltonian kind reduces with every method;
    a GENERAL part makes the online model evaluate in full dimension
    (info.online_full_dim = 1, not exportable, the reduced object must outlive
@@ -26437,9 +26490,14 @@ PHGMG_DEF phgmg_result phgmg_sym_eig(int n, double *A, int lda, double *w, doubl
           - Changed: an index-one model in SPARSE storage (E with zero rows
             and columns) is simulated on its sparse pencil (manual 1.8): no
             condensation, no limit on the algebraic lines but memory; its
-            validation needs no condensation either. phgmg_dae_create on such
-            a system returns PHGMG_ERR_UNSUPPORTED (give it dense or band
-            storage to condense).
+            validation needs no condensation either. phgmg_dae_create
+            condenses such a system sparsely (per connected component of the
+            algebraic block; the condensed model a SPARSE system of its own
+            object), also without a limit on the algebraic lines.
+          - Changed: phgmg_reduce checks B's column rank for the GMG methods
+            only: SP1 and SP2 take a port whose condensed column of B
+            vanishes (it acts only through a constraint);
+            phgmg_reduce_info.rank_port names the port a GMG method refuses.
           - Changed: J - R of a SPARSE model is factored by the sparse LU
             (validation, GMG's solves): no band copies, peak memory in
             proportion to the factor.
@@ -26468,7 +26526,8 @@ PHGMG_DEF phgmg_result phgmg_sym_eig(int n, double *A, int lda, double *w, doubl
             --method bt|prbt|phbt without snapshots; --stream; SciPy .npz and
             Matrix Market input; --x0; --input chirp, --freq, --freq-end;
             NAME_PD.npy; NAME.json records E, the full N and the model's
-            kind; dampers and index-one simulation on the sparse LU;
+            kind; dampers and index-one simulation on the sparse LU; reduce
+            of index-one COO input condensed sparsely (no 4096 limit);
             subnormal entries flushed in written models; progress lines
             before a large model's set-up.
    0.6.0  (2026-11-28)
