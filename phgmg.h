@@ -10603,7 +10603,10 @@ PHGMG__PRIV phgmg_result phgmg__dae_cf_factor(const phgmg__dae_spc *X, const int
   if (bp && bi && bx) { /* local numbering, ascending like the members: rows stay sorted */
     for (t = 0, nz = 0; t < c; ++t) {
       bp[t] = nz;
-      for (p = L->colptr[memb[t]]; p < L->colptr[memb[t] + 1]; ++p) { bi[nz] = X->loc[L->rowidx[p]]; bx[nz++] = L->values[p]; }
+      for (p = L->colptr[memb[t]]; p < L->colptr[memb[t] + 1]; ++p) {
+        bi[nz] = X->loc[L->rowidx[p]];
+        bx[nz++] = L->values[p];
+      }
     }
     bp[c] = nz;
     rc = phgmg__sp_lu_create(c, bp, bi, bx, &f->S, &f->F, al);

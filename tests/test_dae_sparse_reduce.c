@@ -255,7 +255,7 @@ TEST(test_dae_sparse_reduce_matrices) {
     phgmg_dae *dd = NULL, *ds = NULL;
     double *Pint;
     if (cfg < 5) dsr_build(&g, 4, cfg & 1, (cfg >> 1) & 1, cfg >= 3, cfg == 4);
-    else dsr_chain(&g, getenv("DSR_K") ? atoi(getenv("DSR_K")) : 300, 12);
+    else dsr_chain(&g, 300, 12);
     Pint = (double *)calloc((size_t)g.N * g.m, sizeof(double));
     s = dsr_dense(&g);
     sp = dsr_sparse(&g, &ss, Pint);
@@ -398,11 +398,11 @@ TEST(test_dae_sparse_reduce_roms) {
 }
 
 /* A 3 x 701 grid: 4 553 algebraic lines (1 051 mains without capacitor,
-   3 502 mid nodes), beyond the dense condensation's 4 096. phgmg_dae_create condenses it sparsely (before: PHGMG_ERR_UNSUPPORTED);
-   GMG-POD with r = 10 from 40 steps of the DAE on its sparse pencil (the
-   snapshots restricted to x_d) follows the full model's outputs (1e-2 of
-   their size), is port-Hamiltonian, and the lift of the restricted final
-   state is the final state (consistent). */
+   3 502 mid nodes), beyond the dense condensation's 4 096, condensed
+   sparsely by phgmg_dae_create; GMG-POD with r = 10 from 40 steps of the
+   DAE on its sparse pencil (the snapshots restricted to x_d) follows the
+   full model's outputs (1e-2 of their size), is port-Hamiltonian, and the
+   lift of the restricted final state is the final state (consistent). */
 TEST(test_dae_sparse_reduce_large) {
   const int ns = 40;
   const double dt = 0.05;
