@@ -509,9 +509,64 @@ TEST(test_dae_sparse_reduce_vanishing_port) {
   dsr_free(&g);
 }
 
+/* An allocator that fails after a given number of allocations and counts
+   the blocks still held. */
+typedef struct { int left; long live; } dsr_fail_alloc;
+static void *dsr_falloc(size_t size, void *user) {
+  dsr_fail_alloc *f = (dsr_fail_alloc *)user;
+  void *p;
+  if (f->left-- <= 0) return NULL;
+  p = malloc(size);
+  if (p) f->live++;
+  return p;
+}
+static void dsr_ffree(void *p, void *user) {
+  if (!p) return;
+  ((dsr_fail_alloc *)user)->live--;
+  free(p);
+}
+
+/* Out of memory at every allocation of the sparse condensation in turn:
+   PHGMG_ERR_NOMEM, no object, every block returned; with enough memory the
+   same call succeeds (scrambled 3 x 3 grid, port on a constraint, Q not
+   diagonal, feedthrough). */
+TEST(test_dae_sparse_reduce_nomem) {
+  dsr_model g;
+  phgmg_ph_system ss;
+  phgmg_ph_sparse *sp;
+  double *Pint;
+  int k, done = 0;
+  dsr_build(&g, 3, 1, 1, 1, 0);
+  Pint = (double *)calloc((size_t)g.N * g.m, sizeof(double));
+  sp = dsr_sparse(&g, &ss, Pint);
+  CHECK_RC(phgmg_ph_validate(&ss, 0.0, NULL, NULL), PHGMG_OK);   /* the object's checks cached first */
+  for (k = 0; k < 5000 && !done; ++k) {
+    dsr_fail_alloc f;
+    phgmg_allocator al;
+    phgmg_dae *d = NULL;
+    phgmg_result rc;
+    f.left = k; f.live = 0;
+    al.alloc = dsr_falloc; al.free = dsr_ffree; al.user = &f;
+    rc = phgmg_dae_create(&d, &ss, 0.0, &al);
+    if (rc == PHGMG_OK) done = 1;
+    else {
+      CHECK_RC(rc, PHGMG_ERR_NOMEM);
+      CHECK(d == NULL);
+    }
+    phgmg_dae_destroy(d);
+    CHECK(f.live == 0);
+    if (f.live != 0 || (rc != PHGMG_OK && rc != PHGMG_ERR_NOMEM)) break;
+  }
+  CHECK(done && k > 20);
+  phgmg_ph_sparse_destroy(sp);
+  free(Pint);
+  dsr_free(&g);
+}
+
 SUITE(dae_sparse_reduce) {
   RUN(test_dae_sparse_reduce_matrices);
   RUN(test_dae_sparse_reduce_roms);
   RUN(test_dae_sparse_reduce_large);
   RUN(test_dae_sparse_reduce_vanishing_port);
+  RUN(test_dae_sparse_reduce_nomem);
 }
