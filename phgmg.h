@@ -651,7 +651,8 @@
    static pivots; manual 8.12); an E with a zero row or column (index one,
    1.8) takes the same choice too (and the sparse LU beyond 4096 algebraic
    lines): on the sparse LU the DAE is stepped on its sparse pencil without
-   condensing, on the band LU the algebraic lines are condensed. A stepper that falls back to the band LU says so
+   condensing (and phgmg_dae_create condenses it sparsely for reduction),
+   on the band LU the algebraic lines are condensed in band storage. A stepper that falls back to the band LU says so
    (phgmg_gl3_stats.band_fallback; the command line logs it).
    Model classes on the sparse LU: linear and SEPARABLE models, E,
    feedthrough, and (on a copy of phgmg_ph_sparse_system) nonlinear
