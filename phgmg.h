@@ -334,7 +334,8 @@
    becomes feedthrough (a resistor between the port and the constraint:
    S' > 0); a constraint away from the ports changes J and R only.
    phgmg_dae_create builds the condensed model (dense or banded like the
-   input; the update is confined to the neighbours of the algebraic lines),
+   input; the update is confined to the neighbours of the algebraic lines;
+   a SPARSE input is condensed sparsely, below),
    phgmg_dae_lift recovers the algebraic variables (x_c = Q_ac^{-1} (z_a -
    Q_ad x_d)), phgmg_dae_restrict takes x_d; the three maps work in place
    (x == xi), refuse other overlaps and a NULL object (PHGMG_ERR_INVALID_ARG).
@@ -395,11 +396,45 @@
    apart from index two here). A phgmg_ph_sparse object with algebraic
    lines chooses its stage solver by the predicted costs (8.12) like any
    other, and always the sparse LU beyond 4096 algebraic lines; on the band
-   LU it keeps the condensing path (phgmg_dae_create), on the sparse LU
-   phgmg_dae_create returns PHGMG_ERR_UNSUPPORTED (call
-   phgmg_ph_sparse_set_solver(sp, PHGMG_SOLVER_BAND, ..) for the condensed
-   model; k <= 4096). The stepper object (phgmg_gl3_create) takes such a
-   SPARSE system directly. Measured (bench/README.md, RLC grid of 40 x 40
+   LU (BANDED storage) it keeps the band condensation (k <= 4096). The
+   stepper object (phgmg_gl3_create) takes such a SPARSE system directly.
+   Sparse condensation (phgmg_dae_create of a SPARSE system; the command
+   line's reduce of COO input): the condensed model is itself a SPARSE
+   system, of a phgmg_ph_sparse object that d owns (made by
+   phgmg_ph_sparse_create_e, so validation, simulation, every reduction
+   method and the low-rank tools take it as any sparse model), and nothing
+   of order k is dense. The algebraic block L_aa splits into the connected
+   components C of the graph of L_aa + L_aa^T (union-find over its
+   entries); L_aa^{-1} is block diagonal over them, so the update L_da
+   L_aa^{-1} L_ad is the sum over C of -L_dC L_CC^{-1} L_Cd, a dense block
+   on nbr(C) x nbr(C) only (the rows of L_dC by the columns of L_Cd: the
+   differential lines next to C). Per component: an LU of L_CC (dense with
+   partial pivoting up to 256 lines, the sparse LU of 8.12 beyond), the
+   right-hand sides [L_C,nbr, G_C] and F_C solved (L_CC^{-T} for F'),
+   the block and the port terms G', F', (S + N)' accumulated, the block's
+   entries appended to one triplet list; phgmg_csc_from_coo sums the
+   components' overlaps. J' and R' are then made exactly skew and
+   symmetric (each entry the half-difference or half-sum of the values at
+   (i, j) and (j, i)), Q' = Q_dd and E' = E_dd taken as they are, and the
+   differential states are ordered by the matching of E_dd (its largest
+   entries on the diagonal, as the sparse LU's column matching does): with
+   rows and states scrambled by different permutations, E' and Q' then
+   have the pattern of an unscrambled model and the condensed model's own
+   ordering and sparse LU cost what the full model's do. The index and
+   the lift use the sparse LUs of L_aa and Q_ac of the simulation path
+   (phgmg_dae_lift runs its end-value formula on the full state). Cost:
+   the components' LUs (c^3/3 each for c <= 256), sum over C of
+   (|C| + |nbr(C)|) |nbr(C)| work for the blocks, then the condensed
+   object's ordering and analysis; memory: the triplets, sum over C of
+   |nbr(C)|^2 entries, predicted before any work and allocated at once
+   (too many: PHGMG_ERR_NOMEM, nothing else allocated; no other limit),
+   plus the largest component's dense right-hand sides, |C| (|nbr(C)| + 2m)
+   doubles. A network whose algebraic nodes form small groups (an RLC
+   grid: groups of one to three lines) costs O(N): on a 100 x 100 grid
+   (N = 49 600, k = 24 800; -O2, Intel Xeon) phgmg_dae_create takes
+   0.47 s CPU, its condensed model's sparse factor 8.5e5 entries against
+   the full pencil's 9.2e5. A GENERAL nonlinear part on a SPARSE
+   index-one model: PHGMG_ERR_UNSUPPORTED. Measured (bench/README.md, RLC grid of 40 x 40
    mains, N = 7 840, 3 920 algebraic, rows and columns scrambled, 1 000
    steps): 3.0 s CPU and 14 MB against SciPy + SuperLU's 6.5 s and 61 MB
    doing the same steps, outputs 1.6e-16 apart.
@@ -407,9 +442,14 @@
    phgmg_dae_system(d), with snapshots restricted to x_d (phgmg_reduce of the
    full model is PHGMG_ERR_UNSUPPORTED; the command line does this by
    itself). The reduced model is a port-Hamiltonian ODE with the same
-   outputs; every method takes it (GMG needs B' of full rank: a port that
-   acts only through a constraint leaves B' = 0 there; SP1 and SP2 do not
-   need it). tests/test_dae.c checks each claim: the condensed matrices of a
+   outputs; every method takes it. GMG needs B' of full rank: a port that
+   acts only through a constraint (a current source on a node without
+   capacitor) leaves its column of B' zero (it enters through P', S' only),
+   and the GMG methods return PHGMG_ERR_RANK with
+   phgmg_reduce_info.rank_port naming it (the command line: "port p ...
+   acts only through a constraint ...: use sp1 or sp2"); SP1 and SP2 do not
+   need it (their bases are the snapshots' POD and W; phgmg_reduce checks
+   B's rank for the GMG methods only). tests/test_dae.c checks each claim: the condensed matrices of a
    three-state circuit against their closed forms, the simulation against
    an independent collocation of the DAE (its 3N stage system with the
    singular E solved directly), the constraints at every step, the energy
@@ -418,7 +458,13 @@
    pencil, E singular in another form and Q_dc != 0; and a bar with a
    massless node seen through orthogonal changes of coordinates (no zero
    lines) against the coordinate-aligned one: the same outputs, the states
-   rotated, index two found as index two.
+   rotated, index two found as index two. tests/test_dae_sparse_reduce.c:
+   the sparse condensation against the dense one of the same model's dense
+   copy (every condensed matrix to 1e-12; scrambled grids with and without
+   a port on a constraint, Q not diagonal, feedthrough, and a chain of 300
+   algebraic lines in one component), GMG-POD and SP1 models of both equal
+   (outputs to 1e-10), a grid beyond 4096 algebraic lines reduced, and a
+   port through a constraint: SP1 and SP2 reduce, GMG-POD names it.
 
    1.9 Nonlinear energies of finite-element form
    Finite-element codes write a nonlinear stored energy as a sum over
@@ -605,7 +651,8 @@
    static pivots; manual 8.12); an E with a zero row or column (index one,
    1.8) takes the same choice too (and the sparse LU beyond 4096 algebraic
    lines): on the sparse LU the DAE is stepped on its sparse pencil without
-   condensing, on the band LU the algebraic lines are condensed. A stepper that falls back to the band LU says so
+   condensing (and phgmg_dae_create condenses it sparsely for reduction),
+   on the band LU the algebraic lines are condensed in band storage. A stepper that falls back to the band LU says so
    (phgmg_gl3_stats.band_fallback; the command line logs it).
    Model classes on the sparse LU: linear and SEPARABLE models, E,
    feedthrough, and (on a copy of phgmg_ph_sparse_system) nonlinear
@@ -2445,14 +2492,19 @@ PHGMG_DEF phgmg_result phgmg_ph_validate(const phgmg_ph_system *sys, double tol,
    zero: no differential state) or E is singular but not of this form and not dense (a dense E without zero lines is rotated into it,
    manual 1.8; phgmg_dae_restrict/_embed/_lift then rotate back), PHGMG_ERR_EQ_NOT_SYMMETRIC when the kept co-states depend on the
    algebraic variables, PHGMG_ERR_UNSUPPORTED for a separable coordinate or a
-   damper on an algebraic line, k > 4096, an elimination whose dense
-   blocks would exceed 1e8 doubles, or a SPARSE system: the condensation is
-   made in band or dense storage, phgmg_ph_sparse_set_solver(sp,
-   PHGMG_SOLVER_BAND, ..) first) and builds the condensed model: a
+   damper on an algebraic line, for dense and banded storage k > 4096 or an
+   elimination whose dense blocks would exceed 1e8 doubles, for SPARSE
+   storage a GENERAL nonlinear part) and builds the condensed model: a
    port-Hamiltonian ODE in the n = N - k differential coordinates, with the
    same outputs, Hamiltonian and dissipation (phgmg_dae_system; feedthrough P,
    S, Nskew where a constraint touches a port), which it validates
-   (phgmg_ph_validate's codes). Validate the full model with
+   (phgmg_ph_validate's codes). A SPARSE system (phgmg_ph_sparse on the
+   sparse LU) is condensed sparsely, per connected component of the
+   algebraic block, with no limit on k: the condensed model is then a
+   SPARSE system of a phgmg_ph_sparse object owned by d, its states in that
+   object's internal order (phgmg_dae_restrict/_embed/_lift map between it
+   and the full model's internal order); memory beyond the allocator's:
+   PHGMG_ERR_NOMEM (manual 1.8). Validate the full model with
    phgmg_ph_validate first (it runs this check too). With k = 0 the
    condensed model is the model itself. phgmg_simulate and
    phgmg_simulate_run take index-one models directly (consistent states; a
@@ -3530,6 +3582,12 @@ typedef struct phgmg_reduce_info {
                               -1 randomized, check failed, exact SVD used     */
   double pod_check;        /* randomized POD: ||X W - V diag(S)||_F / S_1 (the
                               triplets' backward error); 0 on the exact path  */
+  int rank_port;           /* a GMG method refused for B rank deficient
+                              (PHGMG_ERR_RANK): the first port (0-based) whose
+                              column of B is zero or depends on the earlier
+                              ones, e.g. a port that acts only through a
+                              constraint (manual 1.8; SP1 and SP2 take such a
+                              B); -1 otherwise                                 */
 } phgmg_reduce_info;
 
 /* The reduced model with its offline data (bases for reconstruction, double
@@ -3537,7 +3595,9 @@ typedef struct phgmg_reduce_info {
 typedef struct phgmg_reduced phgmg_reduced;
 
 /* Build a reduced model of `sys` from snapshots X (N x ns, ldx). The system must
-   validate (phgmg_ph_validate). The stages and the model kinds are described in
+   validate (phgmg_ph_validate; B of full column rank only for the GMG
+   methods, which keep B in their basis: SP1 and SP2 take any B, and a GMG
+   method refused for B sets info.rank_port). The stages and the model kinds are described in
    the manual (2.2, 3.1-3.4): every Hamiltonian kind reduces with every method;
    a GENERAL part makes the online model evaluate in full dimension
    (info.online_full_dim = 1, not exportable, the reduced object must outlive
@@ -6560,6 +6620,7 @@ PHGMG_DEF phgmg_result phgmg_ph_validate(const phgmg_ph_system *sys, double tol,
    algebraic equations, row set ra) and k zero columns (the algebraic
    variables, column set ca); the rest (rows rn, columns cn) condensed into a
    port-Hamiltonian ODE by eliminating the algebraic co-states z[ra]. */
+struct phgmg__sdae;
 struct phgmg_dae {
   phgmg_ph_system sys;          /* the condensed model (n = N - k states)           */
   phgmg_allocator al;           /* a copy of the caller's allocator (or zeros)       */
@@ -6577,7 +6638,15 @@ struct phgmg_dae {
   double *work;                 /* n + 2 k + m, N (rotated lift), 1, alias            */
   double *alias;                /* N: the input of an in-place restrict/embed/lift    */
   double *V;                    /* rotated (a dense E without zero lines): Qv, N x N   */
+  phgmg_ph_sparse *csp;         /* SPARSE input: the condensed model's sparse object  */
+  struct phgmg__sdae *sd;       /* SPARSE input: sparse LUs of L[ra, ra], Q[ra, ca]   */
 };
+
+/* The sparse condensation of a SPARSE system (after the split; below, with
+   the sparse LU), its object's release and the consistent algebraic values. */
+PHGMG__PRIV phgmg_result phgmg__dae_sparse(phgmg_dae *d, const phgmg_ph_system *s, double tol);
+PHGMG__PRIV void phgmg__sdae_free(struct phgmg__sdae *D);
+PHGMG__PRIV void phgmg__sdae_consistent(struct phgmg__sdae *D, const double *u, double *x);
 
 /* Size limits of the elimination, which is dense in the algebraic lines:
    k algebraic lines, and the blocks of the update (rows x k, k x columns,
@@ -6641,7 +6710,7 @@ PHGMG__PRIV phgmg_result phgmg__dae_split(phgmg_dae *d, const phgmg_ph_system *s
   int *zr = d->rpos, *zc = d->cpos, kr, kc, i, a = 0, b = 0, c = 0, e = 0;
   phgmg__e_zero_lines(s, zr, zc, &kr, &kc);
   if (kr != kc) return PHGMG_ERR_E_SINGULAR;
-  if (kr > PHGMG__DAE_KMAX) return PHGMG_ERR_UNSUPPORTED;
+  if (kr > PHGMG__DAE_KMAX && s->storage != PHGMG_SPARSE) return PHGMG_ERR_UNSUPPORTED; /* SPARSE: no limit */
   d->k = kr; d->n = s->N - kr;
   d->ra = phgmg__ialloc(&d->al, 2 * (size_t)kr);
   if (!d->ra) return PHGMG_ERR_NOMEM;
@@ -7109,6 +7178,7 @@ PHGMG_DEF void phgmg_dae_destroy(phgmg_dae *d) {
   phgmg__free(&al, d->L22); phgmg__free(&al, d->p22); phgmg__free(&al, d->dcol);
   phgmg__free(&al, d->qcol); phgmg__free(&al, d->D); phgmg__free(&al, d->Qa);
   phgmg__free(&al, d->Ga); phgmg__free(&al, d->work); phgmg__free(&al, d->V);
+  phgmg_ph_sparse_destroy(d->csp); phgmg__sdae_free(d->sd);
   phgmg__free(&al, d);
 }
 
@@ -7140,7 +7210,6 @@ PHGMG_DEF phgmg_result phgmg_dae_create(phgmg_dae **out, const phgmg_ph_system *
   if (rc == PHGMG_OK) {
     const int kind = phgmg__e_algebraic(sys, &d->al);
     if (kind < 0) rc = PHGMG_ERR_NOMEM;
-    else if (kind == 1 && sys->storage == PHGMG_SPARSE) rc = PHGMG_ERR_UNSUPPORTED; /* condensed in band storage */
     else if (kind == 2) rc = phgmg__dae_rotate(d, sys, tol, &rot, &rbuf);
     if (kind == 2 && rc == PHGMG_OK) { sys = &rot; d->sys = rot; }
   }
@@ -7149,8 +7218,10 @@ PHGMG_DEF phgmg_result phgmg_dae_create(phgmg_dae **out, const phgmg_ph_system *
   if (rc == PHGMG_OK && d->k > 0) {
     d->sys.N = d->n;
     rc = d->n == 0 ? PHGMG_ERR_E_SINGULAR   /* E = 0: no differential state */
-         : d->m <= d->n ? phgmg__dae_index(d, sys, tol) : PHGMG_ERR_SIZE;
-    if (rc == PHGMG_OK) rc = phgmg__dae_condense(d, sys, tol);
+         : d->m > d->n ? PHGMG_ERR_SIZE
+         : sys->storage == PHGMG_SPARSE ? phgmg__dae_sparse(d, sys, tol)   /* condensed sparsely */
+         : phgmg__dae_index(d, sys, tol);
+    if (rc == PHGMG_OK && sys->storage != PHGMG_SPARSE) rc = phgmg__dae_condense(d, sys, tol);
     if (rc == PHGMG_OK) rc = phgmg__dae_nonlinear(d, sys);
   }
   if (rc == PHGMG_OK) rc = phgmg__ph_validate(&d->sys, tol, NULL, &d->al, d->k == 0);
@@ -7231,6 +7302,7 @@ PHGMG__PRIV void phgmg__dae_lift_t(phgmg_dae *d, const double *xi, const double 
   int i, q;
   for (i = 0; i < d->N; ++i)
     if (d->cpos[i] >= 0) x[i] = xi[d->cpos[i]];
+  if (d->sd) { phgmg__sdae_consistent(d->sd, u, x); return; }   /* SPARSE: on the full state */
   if (k == 0) return;
   phgmg__ph_grad(&d->sys, xi, z, NULL);
   for (q = 0; q < k; ++q) {   /* t = L[ra, rn] z1 + G[ra] u */
@@ -10533,6 +10605,425 @@ PHGMG__PRIV int phgmg__sdae_stepper_ok(const phgmg_ph_system *sys) {
   for (t = 0; sys->nl == PHGMG_NL_SEPARABLE && t < sys->nsep; ++t)
     if (phgmg__ph_at(sys, sys->Q, sys->sep_idx[t], sys->sep_idx[t]) == 0.0) return 0;
   return 1;
+}
+
+/* ---- the sparse condensation of an index-one SPARSE system (manual 1.8) --
+   All in the full model's internal order. The kept rows and columns are
+   numbered by phgmg__dae_split (rpos, cpos: the "d-order", the condensed
+   model's own order given to phgmg_ph_sparse_create_e, which may reorder
+   it; rpos and cpos are then mapped to that object's internal order). */
+
+/* Triplets (rmap[i], cmap[j], sign v) (tr: (cmap[j], rmap[i], sign v)) of
+   the nonzero entries v of the CSC matrix (ap, ai, ax; N columns) with
+   rmap[i] >= 0 and cmap[j] >= 0, written from position nz on (only counted
+   when ri is NULL); returns the new count. */
+PHGMG__PRIV long phgmg__dae_sp_take(int N, const int *ap, const int *ai, const double *ax, double sign,
+                                    const int *rmap, const int *cmap, int tr, int *ri, int *ci, double *v, long nz) {
+  int j, p;
+  for (j = 0; j < N; ++j) {
+    if (cmap[j] < 0) continue;
+    for (p = ap[j]; p < ap[j + 1]; ++p) {
+      const int i = ai[p];
+      if (rmap[i] < 0 || ax[p] == 0.0) continue;
+      if (ri) { ri[nz] = tr ? cmap[j] : rmap[i]; ci[nz] = tr ? rmap[i] : cmap[j]; v[nz] = sign * ax[p]; }
+      ++nz;
+    }
+  }
+  return nz;
+}
+
+/* The block (J - R)[rows with rmap >= 0, columns with cmap >= 0] renumbered
+   by the maps (nr x nc; tr: its transpose, nc x nr) into *out (owned:
+   phgmg_csc_free). */
+PHGMG__PRIV phgmg_result phgmg__dae_sp_lblock(const phgmg_ph_sparse *sp, int N, const int *rmap, const int *cmap,
+                                              int nr, int nc, int tr, phgmg_csc *out, const phgmg_allocator *al) {
+  long nz = phgmg__dae_sp_take(N, sp->cp[0], sp->ci[0], sp->cx[0], 1.0, rmap, cmap, tr, NULL, NULL, NULL, 0);
+  int *ri, *ci;
+  double *v;
+  phgmg_result rc = PHGMG_ERR_NOMEM;
+  nz = phgmg__dae_sp_take(N, sp->cp[1], sp->ci[1], sp->cx[1], -1.0, rmap, cmap, tr, NULL, NULL, NULL, nz);
+  memset(out, 0, sizeof *out);
+  ri = phgmg__ialloc(al, (size_t)nz + 1); ci = phgmg__ialloc(al, (size_t)nz + 1); v = phgmg__dalloc(al, (size_t)nz + 1);
+  if (ri && ci && v) {
+    nz = phgmg__dae_sp_take(N, sp->cp[0], sp->ci[0], sp->cx[0], 1.0, rmap, cmap, tr, ri, ci, v, 0);
+    nz = phgmg__dae_sp_take(N, sp->cp[1], sp->ci[1], sp->cx[1], -1.0, rmap, cmap, tr, ri, ci, v, nz);
+    rc = phgmg_csc_from_coo(out, tr ? nc : nr, tr ? nr : nc, nz, ri, ci, v, al);
+  }
+  phgmg__free(al, ri); phgmg__free(al, ci); phgmg__free(al, v);
+  return rc;
+}
+
+/* The connected components of the graph of A + A^T (A: k x k CSC), by
+   union-find (each root the smallest member): comp[q] = the component of
+   line q (numbered by smallest member), first (ncomp + 1) and memb (k) list
+   each component's members in ascending order. Returns ncomp. */
+PHGMG__PRIV int phgmg__dae_sp_components(const phgmg_csc *A, int *comp, int *first, int *memb) {
+  const int k = A->n_cols;
+  int q, p, nc = 0;
+  for (q = 0; q < k; ++q) comp[q] = q;
+  for (q = 0; q < k; ++q)
+    for (p = A->colptr[q]; p < A->colptr[q + 1]; ++p) {
+      int a = A->rowidx[p], b = q;
+      while (comp[a] != a) a = comp[a] = comp[comp[a]];
+      while (comp[b] != b) b = comp[b] = comp[comp[b]];
+      if (a < b) comp[b] = a;
+      else if (b < a) comp[a] = b;
+    }
+  for (q = 0; q < k; ++q) { /* roots precede their members: memb = labels */
+    comp[q] = comp[comp[q]];   /* parents are smaller: comp[comp[q]] is the root */
+    memb[q] = comp[q] == q ? nc++ : memb[comp[q]];
+  }
+  for (q = 0; q <= nc; ++q) first[q] = 0;
+  for (q = 0; q < k; ++q) { comp[q] = memb[q]; ++first[comp[q] + 1]; }
+  for (q = 0; q < nc; ++q) first[q + 1] += first[q];
+  for (q = 0; q < k; ++q) memb[first[comp[q]]++] = q;
+  for (q = nc; q > 0; --q) first[q] = first[q - 1];
+  first[0] = 0;
+  return nc;
+}
+
+/* The rows of the columns memb[0..c) of A (CSC), each once (mark[i] =
+   stamp), listed in list (NULL: only counted); their count. */
+PHGMG__PRIV int phgmg__dae_sp_nbr(const phgmg_csc *A, const int *memb, int c, int *mark, int stamp, int *list) {
+  int t, p, n = 0;
+  for (t = 0; t < c; ++t)
+    for (p = A->colptr[memb[t]]; p < A->colptr[memb[t] + 1]; ++p)
+      if (mark[A->rowidx[p]] != stamp) {
+        mark[A->rowidx[p]] = stamp;
+        if (list) list[n] = A->rowidx[p];
+        ++n;
+      }
+  return n;
+}
+
+/* What the per-component updates share. */
+typedef struct phgmg__dae_spc {
+  phgmg_csc Laa, Lda, Ladt;     /* L[a, a] (k x k), L[d, a] (n x k), L[a, d]^T (n x k)  */
+  const double *B, *P;          /* the full model's ports (N x m)                      */
+  const int *ra;                /* k: the algebraic rows                               */
+  int N, n, k, m;
+  double *G, *F, *SN;           /* G', F' (n x m, d-order), (S + N)' (m x m)            */
+  int *ui, *uj;                 /* the triplets of U = L[d, a] L[a, a]^{-1} L[a, d]      */
+  double *ux;
+  long nu;
+  int *markr, *markc, *posr, *posc, *rows, *cols; /* n each                            */
+  int *loc;                     /* k: position of a line in its component               */
+} phgmg__dae_spc;
+
+/* LU of one component's block L[C, C] (c lines): dense with partial
+   pivoting up to PHGMG__DAE_DENSE_COMP lines, else the sparse LU (8.12). */
+#define PHGMG__DAE_DENSE_COMP 256
+typedef struct phgmg__dae_cf {
+  int c;
+  double *A;
+  int *piv;
+  phgmg__spsym *S;
+  phgmg__spnum F;
+} phgmg__dae_cf;
+
+PHGMG__PRIV void phgmg__dae_cf_free(phgmg__dae_cf *f, const phgmg_allocator *al) {
+  phgmg__free(al, f->A); phgmg__free(al, f->piv);
+  phgmg__spnum_free(al, &f->F); phgmg__spsym_free(al, f->S);
+}
+
+PHGMG__PRIV void phgmg__dae_cf_solve(const phgmg__dae_cf *f, char trans, double *x) {
+  if (f->A) phgmg_lu_solve(trans, f->c, f->A, f->c, f->piv, 1, x, f->c);
+  else if (trans == 'T') phgmg__sp_solve_t(f->S, &f->F, x);
+  else phgmg__sp_solve(f->S, &f->F, x);
+}
+
+PHGMG__PRIV phgmg_result phgmg__dae_cf_factor(const phgmg__dae_spc *X, const int *memb, int c, phgmg__dae_cf *f,
+                                              const phgmg_allocator *al) {
+  const phgmg_csc *L = &X->Laa;
+  int t, p, nz = 0, *bp, *bi;
+  double *bx;
+  phgmg_result rc = PHGMG_ERR_NOMEM;
+  memset(f, 0, sizeof *f);
+  f->c = c;
+  if (c <= PHGMG__DAE_DENSE_COMP) {
+    f->A = phgmg__dalloc(al, (size_t)c * c);
+    f->piv = phgmg__ialloc(al, (size_t)c);
+    if (!f->A || !f->piv) return PHGMG_ERR_NOMEM;
+    memset(f->A, 0, sizeof(double) * (size_t)c * c);
+    for (t = 0; t < c; ++t)
+      for (p = L->colptr[memb[t]]; p < L->colptr[memb[t] + 1]; ++p)
+        f->A[X->loc[L->rowidx[p]] + (size_t)t * c] += L->values[p];
+    return phgmg_lu_factor(c, f->A, c, f->piv) == PHGMG_OK ? PHGMG_OK : PHGMG_ERR_INDEX;
+  }
+  for (t = 0; t < c; ++t) nz += L->colptr[memb[t] + 1] - L->colptr[memb[t]];
+  bp = phgmg__ialloc(al, (size_t)c + 1); bi = phgmg__ialloc(al, (size_t)nz + 1); bx = phgmg__dalloc(al, (size_t)nz + 1);
+  if (bp && bi && bx) { /* local numbering, ascending like the members: rows stay sorted */
+    for (t = 0, nz = 0; t < c; ++t) {
+      bp[t] = nz;
+      for (p = L->colptr[memb[t]]; p < L->colptr[memb[t] + 1]; ++p) {
+        bi[nz] = X->loc[L->rowidx[p]];
+        bx[nz++] = L->values[p];
+      }
+    }
+    bp[c] = nz;
+    rc = phgmg__sp_lu_create(c, bp, bi, bx, &f->S, &f->F, al);
+    if (rc == PHGMG_ERR_UNSUPPORTED) rc = PHGMG_ERR_INDEX;
+  }
+  phgmg__free(al, bp); phgmg__free(al, bi); phgmg__free(al, bx);
+  return rc;
+}
+
+/* The right-hand sides of one component (c lines, its neighbour columns
+   cols, nc of them): Z = [L[C, cols], G_C] (c x (nc + m)), Y = F_C (c x m). */
+PHGMG__PRIV void phgmg__dae_sp_rhs(const phgmg__dae_spc *X, const int *memb, int c, int nc, double *Z, double *Y) {
+  const int m = X->m, w = nc + m;
+  int t, p, l;
+  memset(Z, 0, sizeof(double) * (size_t)c * w);
+  for (t = 0; t < c; ++t) {
+    const int q = memb[t], i = X->ra[q];
+    for (p = X->Ladt.colptr[q]; p < X->Ladt.colptr[q + 1]; ++p)
+      Z[t + (size_t)X->posc[X->Ladt.rowidx[p]] * c] += X->Ladt.values[p];
+    for (l = 0; l < m; ++l) {
+      const double b = X->B[i + (size_t)l * X->N], pp = X->P ? X->P[i + (size_t)l * X->N] : 0.0;
+      Z[t + (size_t)(nc + l) * c] = b - pp;
+      Y[t + (size_t)l * c] = b + pp;
+    }
+  }
+}
+
+/* One component C (members memb[0..c)): with Z = L_CC^{-1} [L[C, cols],
+   G_C] and Y = L_CC^{-T} F_C, the triplets of U = L[rows, C] Z[:, cols]
+   (L' = L_dd - U), G'[rows] -= L[rows, C] Z_G, F'[cols] -= L[C, cols]^T Y,
+   (S + N)' -= F_C^T Z_G. stamp: unique to this call. */
+PHGMG__PRIV phgmg_result phgmg__dae_sp_update(phgmg__dae_spc *X, const int *memb, int c, int stamp,
+                                              const phgmg_allocator *al) {
+  const int nr = phgmg__dae_sp_nbr(&X->Lda, memb, c, X->markr, stamp, X->rows);
+  const int nc = phgmg__dae_sp_nbr(&X->Ladt, memb, c, X->markc, stamp, X->cols);
+  const int m = X->m, w = nc + m, n = X->n;
+  double *Z = phgmg__dalloc(al, (size_t)c * (w + m)), *Y, *U = phgmg__dalloc(al, (size_t)nr * w + 1);
+  phgmg__dae_cf f;
+  phgmg_result rc = Z && U ? phgmg__dae_cf_factor(X, memb, c, &f, al) : PHGMG_ERR_NOMEM;
+  int s, t, p, l, j;
+  if (rc == PHGMG_OK) {
+    Y = Z + (size_t)c * w;
+    for (s = 0; s < nr; ++s) X->posr[X->rows[s]] = s;
+    for (t = 0; t < nc; ++t) X->posc[X->cols[t]] = t;
+    phgmg__dae_sp_rhs(X, memb, c, nc, Z, Y);
+    for (j = 0; j < w; ++j) phgmg__dae_cf_solve(&f, 'N', Z + (size_t)j * c);
+    for (l = 0; l < m; ++l) phgmg__dae_cf_solve(&f, 'T', Y + (size_t)l * c);
+    memset(U, 0, sizeof(double) * (size_t)nr * w);
+    for (t = 0; t < c; ++t)   /* U = L[rows, C] Z */
+      for (p = X->Lda.colptr[memb[t]]; p < X->Lda.colptr[memb[t] + 1]; ++p) {
+        const double v = X->Lda.values[p];
+        double *u = U + X->posr[X->Lda.rowidx[p]];
+        for (j = 0; j < w; ++j) u[(size_t)j * nr] += v * Z[t + (size_t)j * c];
+      }
+    for (j = 0; j < nc; ++j)
+      for (s = 0; s < nr; ++s)
+        if (U[s + (size_t)j * nr] != 0.0) {
+          X->ui[X->nu] = X->rows[s]; X->uj[X->nu] = X->cols[j]; X->ux[X->nu++] = U[s + (size_t)j * nr];
+        }
+    for (l = 0; l < m; ++l)
+      for (s = 0; s < nr; ++s) X->G[X->rows[s] + (size_t)l * n] -= U[s + (size_t)(nc + l) * nr];
+    for (l = 0; l < m; ++l)
+      for (j = 0; j < m; ++j) {
+        double acc = 0.0;
+        for (t = 0; t < c; ++t) {
+          const int i = X->ra[memb[t]];
+          acc += (X->B[i + (size_t)l * X->N] + (X->P ? X->P[i + (size_t)l * X->N] : 0.0)) * Z[t + (size_t)(nc + j) * c];
+        }
+        X->SN[l + (size_t)j * m] -= acc;
+      }
+    for (t = 0; t < c; ++t)
+      for (p = X->Ladt.colptr[memb[t]]; p < X->Ladt.colptr[memb[t] + 1]; ++p)
+        for (l = 0; l < m; ++l) X->F[X->Ladt.rowidx[p] + (size_t)l * n] -= X->Ladt.values[p] * Y[t + (size_t)l * c];
+  }
+  if (Z && U) phgmg__dae_cf_free(&f, al);
+  phgmg__free(al, Z); phgmg__free(al, U);
+  return rc;
+}
+
+/* The Schur updates of all components (manual 1.8): the blocks L[a, a],
+   L[d, a], L[a, d]^T, the components, the update's size predicted (the sum
+   over components of |rows| |cols| triplets, allocated at once: too much
+   is PHGMG_ERR_NOMEM before any work), then each component's update; G',
+   F', (S + N)' start from G_d, F_d, S + N. *U receives the update (n x n
+   CSC, duplicates summed). */
+PHGMG__PRIV phgmg_result phgmg__dae_sp_schur(phgmg_dae *d, const phgmg_ph_system *s, const struct phgmg__sdae *sd,
+                                             phgmg_csc *U) {
+  const phgmg_ph_sparse *sp = s->sparse;
+  const int N = d->N, n = d->n, k = d->k, m = d->m;
+  phgmg__dae_spc X;
+  int *iw = phgmg__ialloc(&d->al, 6 * (size_t)n + 4 * (size_t)k + 1), nco = 0, c, i, l;
+  double tot = 0.0;
+  phgmg_result rc = iw ? PHGMG_OK : PHGMG_ERR_NOMEM;
+  memset(&X, 0, sizeof X);
+  X.B = s->B; X.P = s->P; X.ra = d->ra; X.N = N; X.n = n; X.k = k; X.m = m;
+  X.G = d->Bc; X.F = d->Pc; X.SN = d->Sc;
+  if (rc == PHGMG_OK) rc = phgmg__dae_sp_lblock(sp, N, sd->rmap, sd->rmap, k, k, 0, &X.Laa, &d->al);
+  if (rc == PHGMG_OK) rc = phgmg__dae_sp_lblock(sp, N, d->rpos, sd->rmap, n, k, 0, &X.Lda, &d->al);
+  if (rc == PHGMG_OK) rc = phgmg__dae_sp_lblock(sp, N, sd->rmap, d->rpos, k, n, 1, &X.Ladt, &d->al);
+  if (rc == PHGMG_OK) {
+    int *comp = iw + 6 * (size_t)n + k, *first = comp + k, *memb = first + k + 1;
+    X.markr = iw; X.markc = iw + n; X.posr = iw + 2 * (size_t)n; X.posc = iw + 3 * (size_t)n;
+    X.rows = iw + 4 * (size_t)n; X.cols = iw + 5 * (size_t)n; X.loc = iw + 6 * (size_t)n;
+    nco = phgmg__dae_sp_components(&X.Laa, comp, first, memb);
+    for (i = 0; i < 2 * n; ++i) iw[i] = -1;
+    for (c = 0; c < nco; ++c) { /* the prediction */
+      const int nr = phgmg__dae_sp_nbr(&X.Lda, memb + first[c], first[c + 1] - first[c], X.markr, c, NULL);
+      tot += (double)nr * phgmg__dae_sp_nbr(&X.Ladt, memb + first[c], first[c + 1] - first[c], X.markc, c, NULL);
+    }
+    if (tot > 2147483647.0) rc = PHGMG_ERR_NOMEM;   /* the CSC indices are int */
+    else {
+      X.ui = phgmg__ialloc(&d->al, (size_t)tot + 1); X.uj = phgmg__ialloc(&d->al, (size_t)tot + 1);
+      X.ux = phgmg__dalloc(&d->al, (size_t)tot + 1);
+      if (!X.ui || !X.uj || !X.ux) rc = PHGMG_ERR_NOMEM;
+    }
+    for (i = 0; i < N; ++i) { /* G_d, F_d */
+      if (d->rpos[i] < 0) continue;
+      for (l = 0; l < m; ++l) {
+        const double b = s->B[i + (size_t)l * N], p = s->P ? s->P[i + (size_t)l * N] : 0.0;
+        X.G[d->rpos[i] + (size_t)l * n] = b - p;
+        X.F[d->rpos[i] + (size_t)l * n] = b + p;
+      }
+    }
+    for (i = 0; i < m * m; ++i) X.SN[i] = (s->S ? s->S[i] : 0.0) + (s->Nskew ? s->Nskew[i] : 0.0);
+    for (c = 0; c < nco; ++c)
+      for (i = first[c]; i < first[c + 1]; ++i) X.loc[memb[i]] = i - first[c];
+    for (c = 0; rc == PHGMG_OK && c < nco; ++c)
+      rc = phgmg__dae_sp_update(&X, memb + first[c], first[c + 1] - first[c], nco + c, &d->al);
+  }
+  if (rc == PHGMG_OK) rc = phgmg_csc_from_coo(U, n, n, X.nu, X.ui, X.uj, X.ux, &d->al);
+  phgmg_csc_free(&X.Laa, &d->al); phgmg_csc_free(&X.Lda, &d->al); phgmg_csc_free(&X.Ladt, &d->al);
+  phgmg__free(&d->al, X.ui); phgmg__free(&d->al, X.uj); phgmg__free(&d->al, X.ux);
+  phgmg__free(&d->al, iw);
+  return rc;
+}
+
+/* J' = J_dd - (U - U^T)/2 (which 0) or R' = R_dd + (U + U^T)/2 (which 1),
+   so that J' - R' = L_dd - U; then made exactly skew / symmetric, each entry
+   the half-difference / half-sum of the two values at (i, j) and (j, i). */
+PHGMG__PRIV phgmg_result phgmg__dae_sp_jr(const phgmg_dae *d, const phgmg_ph_sparse *sp, const phgmg_csc *U,
+                                          int which, phgmg_csc *out) {
+  const int n = d->n, nu = U->colptr[n];
+  const double sg = which == 0 ? -1.0 : 1.0;
+  long nz = phgmg__dae_sp_take(d->N, sp->cp[which], sp->ci[which], sp->cx[which], 1.0, d->rpos, d->rpos, 0, NULL,
+                               NULL, NULL, 0);
+  const size_t len = 2 * ((size_t)nz + 2 * (size_t)nu) + 1; /* the second pass: twice T's entries */
+  int *ri = phgmg__ialloc(&d->al, 2 * len), *ci = ri ? ri + len : NULL, j, p;
+  double *v = phgmg__dalloc(&d->al, len);
+  phgmg_csc T;
+  phgmg_result rc = ri && v ? PHGMG_OK : PHGMG_ERR_NOMEM;
+  memset(&T, 0, sizeof T);
+  memset(out, 0, sizeof *out);
+  if (rc == PHGMG_OK) {
+    nz = phgmg__dae_sp_take(d->N, sp->cp[which], sp->ci[which], sp->cx[which], 1.0, d->rpos, d->rpos, 0, ri, ci, v, 0);
+    for (j = 0; j < n; ++j)
+      for (p = U->colptr[j]; p < U->colptr[j + 1]; ++p) {
+        const int i = U->rowidx[p];
+        ri[nz] = i; ci[nz] = j; v[nz++] = 0.5 * sg * U->values[p];
+        ri[nz] = j; ci[nz] = i; v[nz++] = 0.5 * U->values[p];
+      }
+    rc = phgmg_csc_from_coo(&T, n, n, nz, ri, ci, v, &d->al);
+  }
+  for (j = 0, nz = 0; rc == PHGMG_OK && j < n; ++j)
+    for (p = T.colptr[j]; p < T.colptr[j + 1]; ++p) {
+      const int i = T.rowidx[p];
+      ri[nz] = i; ci[nz] = j; v[nz++] = 0.5 * T.values[p];
+      ri[nz] = j; ci[nz] = i; v[nz++] = (which == 0 ? -0.5 : 0.5) * T.values[p];
+    }
+  if (rc == PHGMG_OK) rc = phgmg_csc_from_coo(out, n, n, nz, ri, ci, v, &d->al);
+  phgmg_csc_free(&T, &d->al);
+  phgmg__free(&d->al, ri); phgmg__free(&d->al, v);
+  return rc;
+}
+
+/* The condensed model's object: phgmg_ph_sparse_create_e of J', R', Q',
+   E' and B' (d-order), then rpos and cpos moved to its internal order,
+   P' permuted the same way, and d->sys the object's system with the ports'
+   feedthrough (phgmg__dae_ports) and the full model's nonlinear part. */
+PHGMG__PRIV phgmg_result phgmg__dae_sp_object(phgmg_dae *d, const phgmg_csc *M) {
+  const int n = d->n, m = d->m;
+  const phgmg_ph_system *t;
+  const int *perm;
+  int *ip, i, l;
+  phgmg_result rc = phgmg_ph_sparse_create_e(&d->csp, n, m, &M[0], &M[1], &M[2], &M[3], d->Bc, NULL, NULL, &d->al);
+  if (rc != PHGMG_OK) return rc;
+  perm = phgmg_ph_sparse_perm(d->csp);
+  ip = phgmg__ialloc(&d->al, (size_t)n);
+  if (!ip) return PHGMG_ERR_NOMEM;
+  for (i = 0; i < n; ++i) ip[perm[i]] = i;
+  for (i = 0; i < d->N; ++i) {
+    if (d->rpos[i] >= 0) d->rpos[i] = ip[d->rpos[i]];
+    if (d->cpos[i] >= 0) d->cpos[i] = ip[d->cpos[i]];
+  }
+  phgmg__free(&d->al, ip);
+  for (l = 0; l < m; ++l) /* Bc is free now (the object holds B'): P' in the internal order */
+    for (i = 0; i < n; ++i) d->Bc[i + (size_t)l * n] = d->Pc[perm[i] + (size_t)l * n];
+  memcpy(d->Pc, d->Bc, sizeof(double) * (size_t)n * m);
+  t = phgmg_ph_sparse_system(d->csp);
+  d->sys.storage = t->storage; d->sys.kb = t->kb; d->sys.sparse = t->sparse;
+  d->sys.J = t->J; d->sys.R = t->R; d->sys.Q = t->Q; d->sys.E = t->E; d->sys.B = t->B;
+  return PHGMG_OK;
+}
+
+/* The order of the kept columns (cpos) that puts E[d, d]'s largest entries
+   on the diagonal (the matching of 8.12): with the rows and the states
+   scrambled differently, the condensed model's E' and Q' then have the
+   pattern of an unscrambled model, which its own ordering and sparse LU
+   take like any other (and a separable coordinate keeps rpos = cpos). */
+PHGMG__PRIV phgmg_result phgmg__dae_sp_match(phgmg_dae *d, const phgmg_ph_sparse *sp) {
+  int *p = NULL, *ix = NULL, *cperm = phgmg__ialloc(&d->al, 2 * (size_t)d->n), i, r = -1;
+  double *x = NULL;
+  phgmg_result rc = cperm ? phgmg__csc_sub(d->N, sp->cp[3], sp->ci[3], sp->cx[3], d->rpos, d->cpos, d->n, &p, &ix,
+                                           &x, &d->al)
+                          : PHGMG_ERR_NOMEM;
+  if (rc == PHGMG_OK) r = phgmg__sp_match(d->n, p, ix, x, cperm, &d->al);
+  if (rc == PHGMG_OK && r < 0) rc = PHGMG_ERR_NOMEM;
+  if (r == 1) { /* new column j is old column cperm[j] */
+    int *inv = cperm + d->n;
+    for (i = 0; i < d->n; ++i) inv[cperm[i]] = i;
+    for (i = 0; i < d->N; ++i)
+      if (d->cpos[i] >= 0) d->cpos[i] = inv[d->cpos[i]];
+  }
+  phgmg__free(&d->al, p); phgmg__free(&d->al, ix); phgmg__free(&d->al, x); phgmg__free(&d->al, cperm);
+  return rc;
+}
+
+/* phgmg_dae_create's condensation of a SPARSE system (manual 1.8), after
+   the split: the index check on the sparse LUs of L[a, a] and Q[a, c] (the
+   object kept for the lift), Q_dc = 0, the Schur updates per component,
+   J', R', Q' = Q_dd, E' = E_dd, the ports, and the condensed model's
+   sparse object. A GENERAL nonlinear part: PHGMG_ERR_UNSUPPORTED. */
+PHGMG__PRIV phgmg_result phgmg__dae_sparse(phgmg_dae *d, const phgmg_ph_system *s, double tol) {
+  const phgmg_ph_sparse *sp = s->sparse;
+  const size_t nm = (size_t)d->n * d->m, mm = (size_t)d->m * d->m;
+  phgmg_csc U, M[4];
+  int *qp[2] = {NULL, NULL}, *qi[2] = {NULL, NULL}, w;
+  double *qx[2] = {NULL, NULL};
+  phgmg_result rc;
+  if (s->nl == PHGMG_NL_GENERAL) return PHGMG_ERR_UNSUPPORTED;
+  memset(&U, 0, sizeof U);
+  memset(M, 0, sizeof M);
+  rc = phgmg__sdae_create(&d->sd, s, tol, &d->al);
+  if (rc == PHGMG_OK) rc = phgmg__sdae_qdc(d->sd, tol);
+  if (rc == PHGMG_OK) {
+    d->Bc = phgmg__dalloc(&d->al, 2 * nm + 2 * mm);
+    if (!d->Bc) return PHGMG_ERR_NOMEM;
+    d->Pc = d->Bc + nm; d->Sc = d->Pc + nm; d->Nc = d->Sc + mm;
+    rc = phgmg__dae_sp_schur(d, s, d->sd, &U);
+  }
+  if (rc == PHGMG_OK) rc = phgmg__dae_sp_jr(d, sp, &U, 0, &M[0]);
+  if (rc == PHGMG_OK) rc = phgmg__dae_sp_jr(d, sp, &U, 1, &M[1]);
+  if (rc == PHGMG_OK) rc = phgmg__dae_sp_match(d, sp);
+  for (w = 0; w < 2 && rc == PHGMG_OK; ++w) { /* Q' = Q[d, d], E' = E[d, d] */
+    rc = phgmg__csc_sub(d->N, sp->cp[2 + w], sp->ci[2 + w], sp->cx[2 + w], d->rpos, d->cpos, d->n, &qp[w], &qi[w],
+                        &qx[w], &d->al);
+    M[2 + w].n_rows = M[2 + w].n_cols = d->n;
+    M[2 + w].colptr = qp[w]; M[2 + w].rowidx = qi[w]; M[2 + w].values = qx[w];
+  }
+  if (rc == PHGMG_OK) {
+    phgmg__dae_ports(d);
+    rc = phgmg__dae_sp_object(d, M);
+  }
+  phgmg_csc_free(&U, &d->al); phgmg_csc_free(&M[0], &d->al); phgmg_csc_free(&M[1], &d->al);
+  for (w = 0; w < 2; ++w) { phgmg__free(&d->al, qp[w]); phgmg__free(&d->al, qi[w]); phgmg__free(&d->al, qx[w]); }
+  return rc;
 }
 
 /* >>gl3 (implementation) ================================================= */
@@ -16290,6 +16781,11 @@ PHGMG__PRIV phgmg_result phgmg__stage_basis(phgmg__rctx *c) {
   red->RB = phgmg__red_d(red, (size_t)m * m);
   if (!red->V0 || !red->QB || !red->RB) return PHGMG_ERR_NOMEM;
   rc = phgmg__thin_qr(N, m, c->Bp, red->QB, red->RB, c->alloc);
+  if (rc == PHGMG_ERR_RANK && !phgmg__is_gmg(red->method)) { /* SP1/SP2 do not use them: B may be deficient */
+    memset(red->QB, 0, sizeof(double) * (size_t)N * m);
+    memset(red->RB, 0, sizeof(double) * (size_t)m * m);
+    rc = PHGMG_OK;
+  }
   if (rc != PHGMG_OK) return rc;
   if (c->o->cache.pod_basis && c->o->cache.pod_cols < need) return PHGMG_ERR_SIZE;
   if (!phgmg__is_gmg(red->method)) {
@@ -18642,6 +19138,35 @@ PHGMG__PRIV phgmg_result phgmg__reduce_select(phgmg__rctx *c) {
   return rc;
 }
 
+/* The first column of B (N x m) that is zero or depends on the earlier ones
+   (QR without pivoting: |R(j, j)| <= 1e-12 times the largest column norm),
+   or -1. */
+PHGMG__PRIV int phgmg__b_dependent_port(int N, int m, const double *B, const phgmg_allocator *alloc) {
+  double *F = phgmg__dalloc(alloc, (size_t)N * m + (size_t)m), bmax = 0.0;
+  int j, port = -1;
+  if (!F) return -1;
+  memcpy(F, B, sizeof(double) * (size_t)N * m);
+  for (j = 0; j < m; ++j) bmax = PHGMG__MAX(bmax, sqrt(phgmg__dot(N, F + (size_t)j * N, F + (size_t)j * N)));
+  if (phgmg_qr(N, m, F, N, F + (size_t)N * m) == PHGMG_OK)
+    for (j = 0; j < m && port < 0; ++j)
+      if (!(fabs(F[j + (size_t)j * N]) > 1e-12 * bmax)) port = j;
+  if (bmax == 0.0) port = 0;
+  phgmg__free(alloc, F);
+  return port;
+}
+
+/* phgmg_ph_validate for a reduction: B of full column rank only for the GMG
+   methods (their trial basis holds B); SP1 and SP2 take any B, e.g. a zero
+   column of a port that acts only through a constraint (manual 1.8). A GMG
+   method refused for B: info.rank_port. */
+PHGMG__PRIV phgmg_result phgmg__reduce_validate(phgmg__rctx *c, const phgmg_ph_system *sys,
+                                                const phgmg_allocator *alloc) {
+  const int gmg = phgmg__is_gmg(c->o->method);
+  phgmg_result rc = phgmg__ph_e_cause(sys, phgmg__ph_validate(sys, 0.0, &c->inf.rcond_jr, alloc, gmg), alloc);
+  if (rc == PHGMG_ERR_RANK && gmg) c->inf.rank_port = phgmg__b_dependent_port(sys->N, sys->m, sys->B, alloc);
+  return rc;
+}
+
 /* The options resolved and checked, the model validated, the context set. */
 PHGMG__PRIV phgmg_result phgmg__reduce_setup(phgmg__rctx *c, const phgmg_ph_system *sys, const double *X, int ldx,
                                              int ns, const phgmg_reduce_opts *opts, const phgmg_allocator *alloc,
@@ -18656,7 +19181,8 @@ PHGMG__PRIV phgmg_result phgmg__reduce_setup(phgmg__rctx *c, const phgmg_ph_syst
   c->inf.hyper_method = -1;
   rc = phgmg__reduce_check(sys, X, ldx, ns, c->o, st != NULL);
   if (rc == PHGMG_OK) c->sf = (c->o->ref != PHGMG_REF_NONE || sys->ndamp) ? PHGMG__SF_NONE : phgmg__study_fast(st, c->o, sys->m);
-  if (rc == PHGMG_OK) rc = phgmg_ph_validate(sys, 0.0, &c->inf.rcond_jr, alloc);
+  c->inf.rank_port = -1;
+  if (rc == PHGMG_OK) rc = phgmg__reduce_validate(c, sys, alloc);
   if (rc == PHGMG_OK && sys->E && phgmg__e_algebraic(sys, alloc) != 0)   /* reduce the condensed model (1.8) */
     rc = PHGMG_ERR_UNSUPPORTED;
   if (rc != PHGMG_OK) return rc;
@@ -26855,9 +27381,14 @@ PHGMG_DEF phgmg_result phgmg_sym_eig(int n, double *A, int lda, double *w, doubl
           - Changed: an index-one model in SPARSE storage (E with zero rows
             and columns) is simulated on its sparse pencil (manual 1.8): no
             condensation, no limit on the algebraic lines but memory; its
-            validation needs no condensation either. phgmg_dae_create on such
-            a system returns PHGMG_ERR_UNSUPPORTED (give it dense or band
-            storage to condense).
+            validation needs no condensation either. phgmg_dae_create
+            condenses such a system sparsely (per connected component of the
+            algebraic block; the condensed model a SPARSE system of its own
+            object), also without a limit on the algebraic lines.
+          - Changed: phgmg_reduce checks B's column rank for the GMG methods
+            only: SP1 and SP2 take a port whose condensed column of B
+            vanishes (it acts only through a constraint);
+            phgmg_reduce_info.rank_port names the port a GMG method refuses.
           - Changed: J - R of a SPARSE model is factored by the sparse LU
             (validation, GMG's solves): no band copies, peak memory in
             proportion to the factor.
@@ -26886,7 +27417,8 @@ PHGMG_DEF phgmg_result phgmg_sym_eig(int n, double *A, int lda, double *w, doubl
             --method bt|prbt|phbt without snapshots; --stream; SciPy .npz and
             Matrix Market input; --x0; --input chirp, --freq, --freq-end;
             NAME_PD.npy; NAME.json records E, the full N and the model's
-            kind; dampers and index-one simulation on the sparse LU;
+            kind; dampers and index-one simulation on the sparse LU; reduce
+            of index-one COO input condensed sparsely (no 4096 limit);
             subnormal entries flushed in written models; progress lines
             before a large model's set-up.
    0.6.0  (2026-11-28)

@@ -71,6 +71,9 @@ def save_coo(path, M):
 
 
 def main_(argv):
+    if not argv or argv[0] in ("-h", "--help"):
+        print(__doc__)
+        return
     d = argv[0]
     opt = {"--n": 40, "--seed": 1, "--dt": 0.02, "--steps": 1000}
     for k in opt:

@@ -96,11 +96,15 @@ static const char *const help_lines[] = {
   "                      feedthrough, which gmg-qm and --ref do not take: gmg-pod,\n",
   "                      sp1, sp2 without --ref), simulated with consistent states and reduced;\n",
   "                      written states are full (basis rows of the algebraic\n",
-  "                      variables zero). The condensation is dense in the\n",
-  "                      algebraic lines (at most 4096); simulate of a sparse model\n",
-  "                      (--E-coo) does not condense: it steps the DAE itself on the\n",
-  "                      sparse LU of its pencil (algebraic variables from the\n",
-  "                      constraints at every step), with no limit on them.\n",
+  "                      variables zero). For dense input (--E) the condensation\n",
+  "                      is dense in the algebraic lines (at most 4096); sparse\n",
+  "                      input (--E-coo) is condensed sparsely, per connected group\n",
+  "                      of algebraic lines, with no limit on them, and simulate\n",
+  "                      of it steps the DAE itself on the sparse LU of its pencil\n",
+  "                      (algebraic variables from the constraints at every step).\n",
+  "                      A port that acts only through a constraint (its condensed\n",
+  "                      column of B is zero: pure feedthrough) is reduced by sp1\n",
+  "                      and sp2; gmg-pod and gmg-qm refuse it, naming the port.\n",
   "  --P FILE, --S FILE, --N FILE   feedthrough (N x m, m x m, m x m; each optional):\n",
   "                      E x' = (J - R) z + (B - P) u, y = (B + P)^T z + (S + N) u, with\n",
   "                      [[R, P], [P^T, S]] symmetric positive semidefinite and N skew.\n",
@@ -387,7 +391,7 @@ static const char *const help_lines[] = {
   "  entries) or, where that is predicted cheaper (narrow bands), by a band LU after\n",
   "  reverse Cuthill-McKee. Dampers take the sparse LU too; an E with zero\n",
   "  rows/columns is stepped on the sparse LU by simulate, and reduce condenses it\n",
-  "  (band LU, at most 4096 algebraic lines).\n",
+  "  sparsely (no limit on the algebraic lines; the condensed model on the sparse LU).\n",
   "  The log names the solver and any fall-back to the band LU. V0, V2 and the\n",
   "  snapshots are written in your ordering, --poly-idx and --X are in your ordering.\n",
   "  From SciPy (A any scipy.sparse matrix):\n",
@@ -2694,7 +2698,8 @@ static int e_zero_lines(const reduce_state *S, int N, int *zr, int *zc, int *dk,
 
 /* An index-one sparse model (zero rows and columns of --E-coo): simulate
    steps the DAE on the sparse pencil (the sparse LU, S->dae_direct); reduce
-   condenses the algebraic lines, in band storage up to 4096 of them. */
+   condenses the algebraic lines sparsely (phgmg_dae_create on the sparse LU,
+   no limit on them). */
 static int sparse_dae_solver(const reduce_args *A, reduce_state *S, phgmg_ph_sparse_info *inf) {
   int zr = 0, zc = 0, want;
   phgmg_result rc;
@@ -2702,7 +2707,7 @@ static int sparse_dae_solver(const reduce_args *A, reduce_state *S, phgmg_ph_spa
     S->dae_direct = 0;
     return 0;
   }
-  want = S->dae_direct || zr > 4096 ? PHGMG_SOLVER_SPARSE_LU : PHGMG_SOLVER_BAND;
+  want = PHGMG_SOLVER_SPARSE_LU;
   if (inf->solver != want && (rc = phgmg_ph_sparse_set_solver(S->sp, want, inf)) != PHGMG_OK)
     return fail("sparse J, R, Q, E: %s solver: %s", want == PHGMG_SOLVER_BAND ? "band" : "sparse LU",
                 phgmg_result_string(rc));
@@ -3074,15 +3079,17 @@ static int explain_dampers(const reduce_args *A, const reduce_state *S, const ph
   return 1;
 }
 
-/* The algebraic lines of a linear model exceed what the condensation takes. */
+/* The algebraic lines of a linear model exceed what the (dense) condensation takes. */
 static int unsupported_algebraic(const reduce_args *A, const reduce_state *S, int N) {
   int zr = 0, zc = 0;
   e_zero_lines(S, N, &zr, &zc, NULL, NULL);
-  return fail("%s (%s): %d algebraic equations and variables (zero rows and columns of E): the condensation to the "
-              "differential states (reduce, validate, and simulate of a dense model) is dense in the algebraic "
-              "lines and takes at most 4096 of them%s", A->E ? A->E : A->Ecoo, A->E ? "--E" : "--E-coo", zr,
-              A->Ecoo ? "" : "; give the model as sparse COO files (--J-coo ... --E-coo): simulate then steps the "
-                             "DAE itself on the sparse pencil, without that limit");
+  if (A->Ecoo)   /* sparse input is condensed sparsely, without a limit: not the cause */
+    return fail("%s (--E-coo): %d algebraic equations and variables (zero rows and columns of E): %s",
+                A->Ecoo, zr, phgmg_result_string(PHGMG_ERR_UNSUPPORTED));
+  return fail("%s (--E): %d algebraic equations and variables (zero rows and columns of E): the condensation to "
+              "the differential states of a dense model (reduce, validate, simulate) is dense in the algebraic "
+              "lines and takes at most 4096 of them; give the model as sparse COO files (--J-coo ... --E-coo): "
+              "reduce then condenses it sparsely and simulate steps the DAE itself, without that limit", A->E, zr);
 }
 
 /* A failed validation of a descriptor model explained in terms of E (1:
@@ -3273,7 +3280,7 @@ static int condense_algebraic(const reduce_args *A, reduce_state *S) {
     return 0;
   }
   rc = phgmg_dae_create(&S->dae, &S->full, 0.0, NULL);
-  if (rc == PHGMG_ERR_UNSUPPORTED && S->full.nl == PHGMG_NL_NONE && !S->full.ndamp)
+  if (rc == PHGMG_ERR_UNSUPPORTED && S->full.nl == PHGMG_NL_NONE && !S->full.ndamp && !S->sp)
     return unsupported_algebraic(A, S, S->full.N);
   if (rc != PHGMG_OK) return fail("the algebraic part of the descriptor model: %s", phgmg_result_string(rc));
   if (phgmg_dae_nalg(S->dae) == 0) {
@@ -3360,15 +3367,37 @@ static int all_zero(const double *a, size_t n) {
   return 1;
 }
 
+/* The largest |entry| of n doubles. */
+static double max_abs_n(const double *a, size_t n) {
+  double v = 0.0;
+  size_t k;
+  for (k = 0; k < n; ++k) v = PHGMG__MAX(v, fabs(a[k]));
+  return v;
+}
+
 /* phgmg_reduce's PHGMG_ERR_RANK explained: every port through a constraint
-   (an index-one model's condensed B = 0), a --lambda too small for the
-   quadratic fit, else the snapshots (src) or B. */
-static int explain_rank(const reduce_args *A, const reduce_state *S, int method, const char *src) {
+   (an index-one model's condensed B = 0), one port through a constraint (its
+   condensed column of B zero to round-off: info->rank_port) or another port
+   dependent, a --lambda too small for the quadratic fit, else the snapshots
+   (src) or B. */
+static int explain_rank(const reduce_args *A, const reduce_state *S, int method, const char *src,
+                        const phgmg_reduce_info *info) {
   const char *what = phgmg_result_string(PHGMG_ERR_RANK);
+  const int p = info->rank_port;
   if (S->dae && all_zero(S->sys.B, (size_t)S->sys.N * (size_t)S->sys.m))
     return fail("reduction failed: %s: every port of %s acts through an algebraic constraint, so the condensed "
                 "model's port matrix B is zero (the ports act only through its feedthrough terms) and the "
                 "reduction has no port direction to keep", what, A->B);
+  if (S->dae && p >= 0 && p < S->sys.m && max_abs_n(S->sys.B + (size_t)p * S->sys.N, (size_t)S->sys.N) <=
+                                               1e-12 * max_abs_n(S->sys.B, (size_t)S->sys.N * (size_t)S->sys.m))
+    return fail("reduction failed: --method %s: port %d (column %d of %s, counted from 0) acts only through a "
+                "constraint (its condensed input column vanishes: it enters only through the feedthrough terms): "
+                "use sp1 or sp2",
+                method == PHGMG_METHOD_GMG_QM ? "gmg-qm" : "gmg-pod", p, p, A->B);
+  if (p >= 0)
+    return fail("reduction failed: %s: port %d (column %d of %s, counted from 0) %s: gmg-pod and gmg-qm keep "
+                "B in their basis and need it of full column rank (sp1 and sp2 do not)", what, p, p, A->B,
+                S->dae ? "depends on the other ports after the condensation" : "depends on the other ports");
   if (method == PHGMG_METHOD_GMG_QM && A->have_lambda && !A->lambda_auto && A->lambda > 0.0)
     return fail("reduction failed: %s: --lambda %g, the ridge parameter of the quadratic fit, is too small to "
                 "regularise it against the scale of the quadratic features (give a larger --lambda, or leave "
@@ -3702,6 +3731,7 @@ static int run_reduction(const reduce_args *A, reduce_state *S, int method, cons
   if (S->nrun > 0) { o.nrun = S->nrun; o.runs = S->runs; } /* --simulate: the runs are known */
   if (A->lambda_auto == 1) { o.select.newton_tol = A->newton_tol; o.select.newton_iter = A->newton_iter; }
   memset(&info, 0, sizeof info);
+  info.rank_port = -1;
   progress("reducing: %s, r = %d%s", A->method, A->r, method == PHGMG_METHOD_GMG_QM ? " (quadratic manifold)" : "");
   t0 = now_s();
   plog.t0 = t0; plog.all = (double)N * (double)ns >= 1e7; plog.ncand = plog.nprobe = 0;
@@ -3718,7 +3748,7 @@ static int run_reduction(const reduce_args *A, reduce_state *S, int method, cons
         return fail("reduction failed: %s: r = %d%s exceeds the rank of %s (%d snapshots of size %d%s)",
                     phgmg_result_string(rc), A->r, method == PHGMG_METHOD_GMG_QM ? " plus r_n" : "", src, ns, N,
                     S->dae ? ": the differential states" : "");
-      case PHGMG_ERR_RANK: return explain_rank(A, S, method, src);
+      case PHGMG_ERR_RANK: return explain_rank(A, S, method, src, &info);
       case PHGMG_ERR_DEGENERATE:
         if (method == PHGMG_METHOD_SP1 || method == PHGMG_METHOD_SP2)
           return fail("reduction failed: %s: rcond(V^T W) = %.3g is below --degeneracy-tol %g (try another --r or "

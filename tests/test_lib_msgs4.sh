@@ -131,9 +131,11 @@ expect 2 "N = 19 differential states" "20 states less 1 algebraic" -- \
   reduce --J J.npy --R R.npy --Q Q.npy --B B.npy --E E5.npy --method gmg-pod --r 20 --simulate --out o
 expect 1 "snapshots of size 19: the differential states" -- \
   reduce --J J.npy --R R.npy --Q Q.npy --B B.npy --E E5.npy --method gmg-pod --r 10 --simulate --steps 5 --out o4
-# every port through a constraint: the condensed B is zero
+# every port through a constraint: the condensed B is zero; gmg-pod (B in its
+# basis) refuses, sp1 takes it (the port enters through the feedthrough terms)
 expect 1 "every port of cB.npy acts through an algebraic constraint" "port matrix B is zero" -- \
-  reduce --J cJ.npy --R cR.npy --Q cQ.npy --B cB.npy --E cE.npy --method sp1 --r 1 --simulate --out o2
+  reduce --J cJ.npy --R cR.npy --Q cQ.npy --B cB.npy --E cE.npy --method gmg-pod --r 2 --simulate --out o2
+expect 0 -- reduce --J cJ.npy --R cR.npy --Q cQ.npy --B cB.npy --E cE.npy --method sp1 --r 2 --simulate --out o2s
 # a ridge parameter too small for the quadratic fit
 expect 1 "--lambda 1e-300" "ridge parameter" -- reduce --J J.npy --R R.npy --Q Q.npy --B B.npy --method gmg-qm \
   --lambda 1e-300 --r 6 --rn 4 --simulate --steps 14 --out o3
