@@ -8313,76 +8313,224 @@ PHGMG__PRIV void phgmg__sp_factor(const phgmg__spsym *S, phgmg__spnum *F, const 
   F->growth = kmax > 0.0 ? fmax / kmax : 0.0;
 }
 
+/* Dense kernels of the supernodal solves (manual 8.12), four columns or
+   rows of a block per sweep over the short vector t, which stays in
+   registers or L1 while the factor streams by. Real: */
+/* t[0..nr) += A v, A nr x nc with columns ld apart. */
+PHGMG__PRIV void phgmg__sp_gemv_n(int nr, int nc, const double *A, size_t ld, const double *v, double *t) {
+  int k = 0, i;
+  for (; k + 4 <= nc; k += 4) {
+    const double *a0 = A + (size_t)k * ld, *a1 = a0 + ld, *a2 = a1 + ld, *a3 = a2 + ld;
+    const double v0 = v[k], v1 = v[k + 1], v2 = v[k + 2], v3 = v[k + 3];
+    if (v0 == 0.0 && v1 == 0.0 && v2 == 0.0 && v3 == 0.0) continue;
+    i = 0;
+#ifdef PHGMG__VEC4
+    {
+      const phgmg__v4 b0 = {v0, v0, v0, v0}, b1 = {v1, v1, v1, v1}, b2 = {v2, v2, v2, v2}, b3 = {v3, v3, v3, v3};
+      for (; i + 4 <= nr; i += 4) {
+        phgmg__v4 x0, x1, x2, x3, tv;
+        memcpy(&x0, a0 + i, sizeof x0); memcpy(&x1, a1 + i, sizeof x1);
+        memcpy(&x2, a2 + i, sizeof x2); memcpy(&x3, a3 + i, sizeof x3);
+        memcpy(&tv, t + i, sizeof tv);
+        tv += (x0 * b0 + x1 * b1) + (x2 * b2 + x3 * b3);
+        memcpy(t + i, &tv, sizeof tv);
+      }
+    }
+#endif
+    for (; i < nr; ++i) t[i] += (a0[i] * v0 + a1[i] * v1) + (a2[i] * v2 + a3[i] * v3);
+  }
+  for (; k < nc; ++k)
+    if (v[k] != 0.0) phgmg__axpy(nr, v[k], A + (size_t)k * ld, t);
+}
+
+/* y[k] -= A(k, :) t for the nc rows of A (nc x nr, rows contiguous). */
+PHGMG__PRIV void phgmg__sp_gemv_t(int nr, int nc, const double *A, const double *t, double *y) {
+  int k = 0, i;
+  for (; k + 4 <= nc; k += 4) {
+    const double *a0 = A + (size_t)k * (size_t)nr, *a1 = a0 + nr, *a2 = a1 + nr, *a3 = a2 + nr;
+    double s0 = 0.0, s1 = 0.0, s2 = 0.0, s3 = 0.0;
+    i = 0;
+#ifdef PHGMG__VEC4
+    if (nr >= 4) {
+      phgmg__v4 c0, c1, c2, c3, x, tv;
+      double h[4];
+      memset(&c0, 0, sizeof c0);
+      c1 = c2 = c3 = c0;
+      for (; i + 4 <= nr; i += 4) {
+        memcpy(&tv, t + i, sizeof tv);
+        memcpy(&x, a0 + i, sizeof x); c0 += x * tv;
+        memcpy(&x, a1 + i, sizeof x); c1 += x * tv;
+        memcpy(&x, a2 + i, sizeof x); c2 += x * tv;
+        memcpy(&x, a3 + i, sizeof x); c3 += x * tv;
+      }
+      memcpy(h, &c0, sizeof h); s0 = (h[0] + h[1]) + (h[2] + h[3]);
+      memcpy(h, &c1, sizeof h); s1 = (h[0] + h[1]) + (h[2] + h[3]);
+      memcpy(h, &c2, sizeof h); s2 = (h[0] + h[1]) + (h[2] + h[3]);
+      memcpy(h, &c3, sizeof h); s3 = (h[0] + h[1]) + (h[2] + h[3]);
+    }
+#endif
+    for (; i < nr; ++i) { s0 += a0[i] * t[i]; s1 += a1[i] * t[i]; s2 += a2[i] * t[i]; s3 += a3[i] * t[i]; }
+    y[k] -= s0; y[k + 1] -= s1; y[k + 2] -= s2; y[k + 3] -= s3;
+  }
+  for (; k < nc; ++k) y[k] -= phgmg__dot(nr, A + (size_t)k * (size_t)nr, t);
+}
+
+#ifdef PHGMG__VEC4
+/* (re, im, re, im) -> (im, re, im, re) */
+PHGMG__PRIV phgmg__v4 phgmg__v4_swap2(phgmg__v4 x) {
+#ifdef __clang__
+  return __builtin_shufflevector(x, x, 1, 0, 3, 2);
+#else
+  typedef long long phgmg__v4i __attribute__((vector_size(32)));
+  const phgmg__v4i sw = {1, 0, 3, 2};
+  return __builtin_shuffle(x, sw);
+#endif
+}
+#endif
+
+/* Complex (interleaved pairs): t[0..nr) += A v, A nr x nc, columns 2 ld
+   doubles apart. */
+PHGMG__PRIV void phgmg__sp_zgemv_n(int nr, int nc, const double *A, size_t ld, const double *v, double *t) {
+  int k = 0, i;
+  for (; k + 2 <= nc; k += 2) {
+    const double *a0 = A + 2 * (size_t)k * ld, *a1 = a0 + 2 * ld;
+    const double r0 = v[2 * k], i0 = v[2 * k + 1], r1 = v[2 * k + 2], i1 = v[2 * k + 3];
+    if (r0 == 0.0 && i0 == 0.0 && r1 == 0.0 && i1 == 0.0) continue;
+    i = 0;
+#ifdef PHGMG__VEC4
+    {
+      const phgmg__v4 br0 = {r0, r0, r0, r0}, bi0 = {-i0, i0, -i0, i0};
+      const phgmg__v4 br1 = {r1, r1, r1, r1}, bi1 = {-i1, i1, -i1, i1};
+      for (; i + 2 <= nr; i += 2) {
+        phgmg__v4 x0, x1, tv;
+        memcpy(&x0, a0 + 2 * i, sizeof x0); memcpy(&x1, a1 + 2 * i, sizeof x1);
+        memcpy(&tv, t + 2 * i, sizeof tv);
+        tv += (br0 * x0 + bi0 * phgmg__v4_swap2(x0)) + (br1 * x1 + bi1 * phgmg__v4_swap2(x1));
+        memcpy(t + 2 * i, &tv, sizeof tv);
+      }
+    }
+#endif
+    for (; i < nr; ++i) {
+      double xr0 = a0[2 * i], xi0 = a0[2 * i + 1], xr1 = a1[2 * i], xi1 = a1[2 * i + 1];
+      t[2 * i] += (r0 * xr0 - i0 * xi0) + (r1 * xr1 - i1 * xi1);
+      t[2 * i + 1] += (r0 * xi0 + i0 * xr0) + (r1 * xi1 + i1 * xr1);
+    }
+  }
+  for (; k < nc; ++k)
+    if (v[2 * k] != 0.0 || v[2 * k + 1] != 0.0)
+      phgmg__sp_zaxpy(nr, -v[2 * k], -v[2 * k + 1], A + 2 * (size_t)k * ld, t);
+}
+
+/* y[k] -= A(k, :) t (no conjugate) for the nc rows of A (nc x nr complex,
+   rows contiguous), two rows per sweep. */
+PHGMG__PRIV void phgmg__sp_zgemv_t(int nr, int nc, const double *A, const double *t, double *y) {
+  int k = 0, i;
+  for (; k < nc; k += 2) {
+    const int two = k + 1 < nc;
+    const double *a0 = A + 2 * (size_t)k * (size_t)nr, *a1 = two ? a0 + 2 * nr : a0;
+    double p0 = 0.0, q0 = 0.0, p1 = 0.0, q1 = 0.0; /* real and imaginary sums */
+    i = 0;
+#ifdef PHGMG__VEC4
+    if (nr >= 2) {
+      phgmg__v4 c0, d0, c1, d1, x, tv, ts;
+      double h[4];
+      memset(&c0, 0, sizeof c0);
+      d0 = c1 = d1 = c0;
+      for (; i + 2 <= nr; i += 2) {
+        memcpy(&tv, t + 2 * i, sizeof tv);
+        ts = phgmg__v4_swap2(tv);
+        memcpy(&x, a0 + 2 * i, sizeof x); c0 += x * tv; d0 += x * ts;
+        memcpy(&x, a1 + 2 * i, sizeof x); c1 += x * tv; d1 += x * ts;
+      }
+      memcpy(h, &c0, sizeof h); p0 = (h[0] - h[1]) + (h[2] - h[3]);
+      memcpy(h, &d0, sizeof h); q0 = (h[0] + h[1]) + (h[2] + h[3]);
+      memcpy(h, &c1, sizeof h); p1 = (h[0] - h[1]) + (h[2] - h[3]);
+      memcpy(h, &d1, sizeof h); q1 = (h[0] + h[1]) + (h[2] + h[3]);
+    }
+#endif
+    for (; i < nr; ++i) {
+      double tr = t[2 * i], ti = t[2 * i + 1];
+      p0 += a0[2 * i] * tr - a0[2 * i + 1] * ti; q0 += a0[2 * i] * ti + a0[2 * i + 1] * tr;
+      p1 += a1[2 * i] * tr - a1[2 * i + 1] * ti; q1 += a1[2 * i] * ti + a1[2 * i + 1] * tr;
+    }
+    y[2 * k] -= p0; y[2 * k + 1] -= q0;
+    if (two) { y[2 * k + 2] -= p1; y[2 * k + 3] -= q1; }
+  }
+}
+
+/* Forward substitution through supernode s: its unit lower triangle, then
+   t = L21 y_s scattered into the rows below. */
+PHGMG__PRIV void phgmg__sp_fwd_sn(const phgmg__spsym *S, const phgmg__spnum *F, int s, double *y, double *t) {
+  const int w = F->cplx ? 2 : 1, f = S->sfirst[s], nc = S->sfirst[s + 1] - f, nr = S->srp[s + 1] - S->srp[s];
+  const int nf = nc + nr, *rows = S->srow + S->srp[s];
+  const double *L = F->X + (size_t)w * S->lptr[s];
+  double *yf = y + (size_t)w * (size_t)f;
+  int i, k;
+  for (k = 0; k < nc; ++k) {
+    const double *lk = L + (size_t)w * (size_t)k * (size_t)nf;
+    if (w == 1) {
+      double v = yf[k];
+      if (v != 0.0) for (i = k + 1; i < nc; ++i) yf[i] -= v * lk[i];
+    } else {
+      double vr = yf[2 * k], vi = yf[2 * k + 1];
+      if (vr != 0.0 || vi != 0.0) phgmg__sp_zaxpy(nc - k - 1, vr, vi, lk + 2 * (k + 1), yf + 2 * (k + 1));
+    }
+  }
+  if (nr == 0) return;
+  for (i = 0; i < w * nr; ++i) t[i] = 0.0;
+  if (w == 1) {
+    phgmg__sp_gemv_n(nr, nc, L + nc, (size_t)nf, yf, t);
+    for (i = 0; i < nr; ++i) y[rows[i]] -= t[i];
+  } else {
+    phgmg__sp_zgemv_n(nr, nc, L + 2 * nc, (size_t)nf, yf, t);
+    for (i = 0; i < nr; ++i) { y[2 * rows[i]] -= t[2 * i]; y[2 * rows[i] + 1] -= t[2 * i + 1]; }
+  }
+}
+
+/* Backward substitution through supernode s: y_s -= U12 y(rows), then its
+   upper triangle. */
+PHGMG__PRIV void phgmg__sp_bwd_sn(const phgmg__spsym *S, const phgmg__spnum *F, int s, double *y, double *t) {
+  const int w = F->cplx ? 2 : 1, f = S->sfirst[s], nc = S->sfirst[s + 1] - f, nr = S->srp[s + 1] - S->srp[s];
+  const int nf = nc + nr, *rows = S->srow + S->srp[s];
+  const double *L = F->X + (size_t)w * S->lptr[s], *Up = L + (size_t)w * (size_t)nf * (size_t)nc;
+  double *yf = y + (size_t)w * (size_t)f;
+  int i, k;
+  if (w == 1) {
+    for (i = 0; i < nr; ++i) t[i] = y[rows[i]];
+    if (nr > 0) phgmg__sp_gemv_t(nr, nc, Up, t, yf);
+    for (k = nc - 1; k >= 0; --k) {
+      const double *lk = L + (size_t)k * (size_t)nf;
+      double v = yf[k] / lk[k];
+      yf[k] = v;
+      if (v != 0.0) for (i = 0; i < k; ++i) yf[i] -= v * lk[i];
+    }
+    return;
+  }
+  for (i = 0; i < nr; ++i) { t[2 * i] = y[2 * rows[i]]; t[2 * i + 1] = y[2 * rows[i] + 1]; }
+  if (nr > 0) phgmg__sp_zgemv_t(nr, nc, Up, t, yf);
+  for (k = nc - 1; k >= 0; --k) {
+    const double *lk = L + 2 * (size_t)k * (size_t)nf;
+    double ar = yf[2 * k], ai = yf[2 * k + 1], pr = lk[2 * k], pi = lk[2 * k + 1];
+    double d = pr * pr + pi * pi, vr = (ar * pr + ai * pi) / d, vi = (ai * pr - ar * pi) / d;
+    yf[2 * k] = vr;
+    yf[2 * k + 1] = vi;
+    if (vr != 0.0 || vi != 0.0) phgmg__sp_zaxpy(k, vr, vi, lk, yf);
+  }
+}
+
 /* x <- K^{-1} x (x internal order; real N or complex 2N interleaved):
    per supernode the dense triangular block, its off-diagonal block through a
    contiguous buffer (one scatter or gather per supernode). */
 PHGMG__PRIV void phgmg__sp_solve_f(const phgmg__spsym *S, const phgmg__spnum *F, double *x) {
   const int n = S->nf, ns = S->nsup, w = F->cplx ? 2 : 1;
-  int s, i, j, k;
+  int s, i;
   double *y = F->y, *t = F->y + (size_t)w * (size_t)n;
   for (i = 0; i < n; ++i) {
     y[w * i] = x[w * S->perm[i]];
     if (w == 2) y[2 * i + 1] = x[2 * S->perm[i] + 1];
   }
-  for (s = 0; s < ns; ++s) { /* forward: L, unit diagonal */
-    int f = S->sfirst[s], nc = S->sfirst[s + 1] - f, nr = S->srp[s + 1] - S->srp[s], nf = nc + nr;
-    const int *rows = S->srow + S->srp[s];
-    const double *L = F->X + (size_t)w * S->lptr[s];
-    double *yf = y + (size_t)w * (size_t)f;
-    for (i = 0; i < w * nr; ++i) t[i] = 0.0;
-    for (k = 0; k < nc; ++k) {
-      const double *lk = L + (size_t)w * (size_t)k * (size_t)nf;
-      if (w == 1) {
-        double v = yf[k];
-        if (v == 0.0) continue;
-        phgmg__axpy(nc - k - 1, -v, lk + k + 1, yf + k + 1);
-        phgmg__axpy(nr, v, lk + nc, t);
-      } else {
-        double vr = yf[2 * k], vi = yf[2 * k + 1];
-        if (vr == 0.0 && vi == 0.0) continue;
-        phgmg__sp_zaxpy(nc - k - 1, vr, vi, lk + 2 * (k + 1), yf + 2 * (k + 1));
-        phgmg__sp_zaxpy(nr, -vr, -vi, lk + 2 * nc, t);
-      }
-    }
-    if (w == 1) for (i = 0; i < nr; ++i) y[rows[i]] -= t[i];
-    else for (i = 0; i < nr; ++i) { y[2 * rows[i]] -= t[2 * i]; y[2 * rows[i] + 1] -= t[2 * i + 1]; }
-  }
-  for (s = ns - 1; s >= 0; --s) { /* backward: U */
-    int f = S->sfirst[s], nc = S->sfirst[s + 1] - f, nr = S->srp[s + 1] - S->srp[s], nf = nc + nr;
-    const int *rows = S->srow + S->srp[s];
-    const double *L = F->X + (size_t)w * S->lptr[s], *Up = L + (size_t)w * (size_t)nf * (size_t)nc;
-    double *yf = y + (size_t)w * (size_t)f;
-    if (w == 1) {
-      for (j = 0; j < nr; ++j) t[j] = y[rows[j]];
-      if (nr > 0) for (k = 0; k < nc; ++k) yf[k] -= phgmg__dot(nr, Up + (size_t)k * (size_t)nr, t);
-      for (k = nc - 1; k >= 0; --k) {
-        const double *lk = L + (size_t)k * (size_t)nf;
-        double v = yf[k] / lk[k];
-        yf[k] = v;
-        if (v != 0.0) phgmg__axpy(k, -v, lk, yf);
-      }
-    } else {
-      for (j = 0; j < nr; ++j) { t[2 * j] = y[2 * rows[j]]; t[2 * j + 1] = y[2 * rows[j] + 1]; }
-      for (k = 0; k < nc && nr > 0; ++k) {
-        const double *u = Up + 2 * (size_t)k * (size_t)nr;
-        double sr = 0.0, si = 0.0, sr2 = 0.0, si2 = 0.0;
-        for (j = 0; j < nr; ++j) {
-          sr += u[2 * j] * t[2 * j]; sr2 += u[2 * j + 1] * t[2 * j + 1];
-          si += u[2 * j] * t[2 * j + 1]; si2 += u[2 * j + 1] * t[2 * j];
-        }
-        yf[2 * k] -= sr - sr2;
-        yf[2 * k + 1] -= si + si2;
-      }
-      for (k = nc - 1; k >= 0; --k) {
-        const double *lk = L + 2 * (size_t)k * (size_t)nf;
-        double ar = yf[2 * k], ai = yf[2 * k + 1], pr = lk[2 * k], pi = lk[2 * k + 1];
-        double d = pr * pr + pi * pi, vr = (ar * pr + ai * pi) / d, vi = (ai * pr - ar * pi) / d;
-        yf[2 * k] = vr;
-        yf[2 * k + 1] = vi;
-        if (vr != 0.0 || vi != 0.0) phgmg__sp_zaxpy(k, vr, vi, lk, yf);
-      }
-    }
-  }
+  for (s = 0; s < ns; ++s) phgmg__sp_fwd_sn(S, F, s, y, t);
+  for (s = ns - 1; s >= 0; --s) phgmg__sp_bwd_sn(S, F, s, y, t);
   for (i = 0; i < n; ++i) {
     x[w * S->perm[i]] = y[w * i];
     if (w == 2) x[2 * S->perm[i] + 1] = y[2 * i + 1];
