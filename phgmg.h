@@ -4679,6 +4679,13 @@ PHGMG_DEF phgmg_result phgmg_sym_eig(int n, double *A, int lda, double *w, doubl
 /* >>config (implementation) ============================================== */
 #include <math.h>
 #include <string.h>
+/* The fused multiply-add tile of the sparse solver's fronts (>>linalg,
+   phgmg__gemm_micro_fma); PHGMG_NO_FMA_KERNEL turns it off. */
+#if (defined(__GNUC__) || defined(__clang__)) && (defined(__AVX512F__) || defined(__FMA__)) && \
+    !defined(PHGMG_NO_VECTOR_EXT) && !defined(PHGMG_NO_FMA_KERNEL) && !defined(PHGMG_NO_OFFLINE)
+#define PHGMG__FMA_KERNEL 1
+#include <immintrin.h>
+#endif
 
 #ifndef PHGMG_ASSERT
 #include <assert.h>
@@ -4787,6 +4794,8 @@ PHGMG__PRIV void phgmg__gemm_acc(int m, int n, int k, double alpha, int amode, c
                                  int lda, const double *B, size_t bsp, size_t bsj, double *C,
                                  int ldc);
 PHGMG__PRIV void phgmg__zgemm_acc(int m, int n, int k, double alpha, const double *A, int lda,
+                                  const double *B, int ldb, double *C, int ldc);
+PHGMG__PRIV void phgmg__zgemm_acc_fma(int m, int n, int k, double alpha, const double *A, int lda,
                                   const double *B, int ldb, double *C, int ldc);
 PHGMG__PRIV void phgmg__laswp(int ncols, double *A, int lda, int k1, int k2, const int *ipiv);
 PHGMG__PRIV void phgmg__trsm_llu(int n, int nrhs, const double *L, int ldl, double *B, int ldb);
@@ -7693,9 +7702,9 @@ PHGMG__PRIV phgmg_result phgmg__spsym_supernodes(phgmg__spsym *S, const int *ap,
   for (j = 0; j < n; ++j) if (parent[j] >= 0) nch[parent[j]]++;
   for (j = 0; j < n; ++j) {
     int join = 0;
-    if (j > 0 && parent[j - 1] == j && nch[j] == 1) {
+    if (j > 0 && parent[j - 1] == j) { /* j - 1: j's last child in the postorder */
       int f = S->sfirst[ns - 1], nc = j - f;  /* current supernode f..j-1 */
-      if (cnt[j - 1] == cnt[j] + 1) join = 1;  /* fundamental */
+      if (nch[j] == 1 && cnt[j - 1] == cnt[j] + 1) join = 1;  /* fundamental */
       else if (nc + 1 <= PHGMG__SP_RELAX) {
         /* extra zeros: columns f..j-1 padded to the structure of j */
         size_t extra = (size_t)nc * (size_t)(cnt[j] + 1 > cnt[j - 1] ? cnt[j] + 1 - cnt[j - 1] : 0);
@@ -8106,63 +8115,53 @@ PHGMG__PRIV phgmg_result phgmg__spnum_alloc(const phgmg_allocator *al, const phg
 
 /* y -= t x for complex t = tr + i ti, interleaved x, y (n entries). */
 PHGMG__PRIV void phgmg__sp_zaxpy(int n, double tr, double ti, const double *x, double *y) {
-  int i = 0;
-#if defined(PHGMG__VEC4) && (defined(__clang__) || defined(__GNUC__))
-  {
-    const phgmg__v4 vr = {tr, tr, tr, tr}, vi = {-ti, ti, -ti, ti};
-    for (; i + 2 <= n; i += 2) {
-      phgmg__v4 xv, yv, xs;
-      memcpy(&xv, x + 2 * i, sizeof xv);
-      memcpy(&yv, y + 2 * i, sizeof yv);
-#ifdef __clang__
-      xs = __builtin_shufflevector(xv, xv, 1, 0, 3, 2);
-#else
-      {
-        typedef long long phgmg__v4i __attribute__((vector_size(32)));
-        const phgmg__v4i sw = {1, 0, 3, 2};
-        xs = __builtin_shuffle(xv, sw);
-      }
-#endif
-      yv -= vr * xv + vi * xs;
-      memcpy(y + 2 * i, &yv, sizeof yv);
-    }
-  }
-#endif
-  for (; i < n; ++i) {
-    double xr = x[2 * i], xi = x[2 * i + 1];
-    y[2 * i] -= tr * xr - ti * xi;
-    y[2 * i + 1] -= tr * xi + ti * xr;
-  }
+  phgmg__zaxpy_neg(n, tr, ti, x, y);
 }
 
 /* Dense partial LU of a front (nf x nf, ld nf), the first nc pivots on the
    diagonal; a pivot below tiny in magnitude is replaced by tiny (same sign)
-   and counted. Real. */
-PHGMG__PRIV int phgmg__front_lu(int nf, int nc, double *F, double tiny) {
-  int k, i, j, nr = nf - nc, nrep = 0;
-  for (k = 0; k < nc; ++k) {
+   and counted. Blocked right-looking: PHGMG__FRONT_NB pivot columns at a
+   time by columns (phgmg__front_panel), then the block row of U by a
+   triangular solve and the trailing rows and columns of the front (also the
+   update matrix F22) by one GEMM, so the work of a large separator's front
+   runs in the GEMM kernel rather than in column updates. */
+#ifndef PHGMG__FRONT_NB
+#define PHGMG__FRONT_NB 32
+#endif
+/* Columns k0 .. k1-1 of a front (rows k0 .. nf-1) eliminated by columns. */
+PHGMG__PRIV int phgmg__front_panel(int nf, int k0, int k1, double *F, double tiny) {
+  int k, i, j, nrep = 0;
+  for (k = k0; k < k1; ++k) {
     double *ck = F + (size_t)k * (size_t)nf, p = ck[k], inv;
     if (!(fabs(p) >= tiny)) { p = p < 0.0 ? -tiny : tiny; ck[k] = p; ++nrep; }
     inv = 1.0 / p;
     for (i = k + 1; i < nf; ++i) ck[i] *= inv;
-    for (j = k + 1; j < nc; ++j) {
+    for (j = k + 1; j < k1; ++j) {
       double *cj = F + (size_t)j * (size_t)nf, f = cj[k];
       if (f != 0.0) phgmg__axpy(nf - k - 1, -f, ck + k + 1, cj + k + 1);
     }
   }
-  if (nr > 0) {
-    double *F12 = F + (size_t)nc * (size_t)nf;
-    phgmg__trsm_llu(nc, nr, F, nf, F12, nf);
-    phgmg_gemm('N', 'N', nr, nr, nc, -1.0, F + nc, nf, F12, nf, 1.0, F12 + nc, nf);
+  return nrep;
+}
+PHGMG__PRIV int phgmg__front_lu(int nf, int nc, double *F, double tiny) {
+  int k0, nrep = 0;
+  for (k0 = 0; k0 < nc; k0 += PHGMG__FRONT_NB) {
+    const int k1 = PHGMG__MIN(nc, k0 + PHGMG__FRONT_NB), kb = k1 - k0, nt = nf - k1;
+    double *Lkk = F + (size_t)k0 * (size_t)nf + k0, *U = F + (size_t)k1 * (size_t)nf + k0;
+    nrep += phgmg__front_panel(nf, k0, k1, F, tiny);
+    if (nt > 0) {
+      phgmg__trsm_llu(kb, nt, Lkk, nf, U, nf);
+      phgmg__gemm_acc(nt, nt, kb, -1.0, 4, Lkk + kb, nf, U, 1, (size_t)nf, U + kb, nf);
+    }
   }
   return nrep;
 }
 
 /* The same for complex fronts (pairs). */
-PHGMG__PRIV int phgmg__front_zlu(int nf, int nc, double *F, double tiny) {
+PHGMG__PRIV int phgmg__front_zpanel(int nf, int k0, int k1, double *F, double tiny) {
   int k, i, j, nrep = 0;
   size_t ld = 2 * (size_t)nf;
-  for (k = 0; k < nc; ++k) {
+  for (k = k0; k < k1; ++k) {
     double *ck = F + (size_t)k * ld, pr = ck[2 * k], pi = ck[2 * k + 1], mag = hypot(pr, pi), ir, ii, d;
     if (!(mag >= tiny)) {
       if (mag > 0.0) { pr *= tiny / mag; pi *= tiny / mag; } else { pr = tiny; pi = 0.0; }
@@ -8175,16 +8174,25 @@ PHGMG__PRIV int phgmg__front_zlu(int nf, int nc, double *F, double tiny) {
       ck[2 * i] = a * ir - b * ii;
       ck[2 * i + 1] = a * ii + b * ir;
     }
-    for (j = k + 1; j < nc; ++j) {
+    for (j = k + 1; j < k1; ++j) {
       double *cj = F + (size_t)j * ld, fr = cj[2 * k], fi = cj[2 * k + 1];
       if (fr == 0.0 && fi == 0.0) continue;
       phgmg__sp_zaxpy(nf - k - 1, fr, fi, ck + 2 * (k + 1), cj + 2 * (k + 1));
     }
   }
-  if (nf > nc) { /* U12 = L11^{-1} F12, F22 -= L21 U12 */
-    double *F12 = F + (size_t)nc * ld;
-    phgmg__ztrsm_llu(nc, nf - nc, F, nf, F12, nf);
-    phgmg__zgemm_acc(nf - nc, nf - nc, nc, -1.0, F + 2 * nc, nf, F12, nf, F12 + 2 * nc, nf);
+  return nrep;
+}
+PHGMG__PRIV int phgmg__front_zlu(int nf, int nc, double *F, double tiny) {
+  int k0, nrep = 0;
+  const size_t ld = 2 * (size_t)nf;
+  for (k0 = 0; k0 < nc; k0 += PHGMG__FRONT_NB) {
+    const int k1 = PHGMG__MIN(nc, k0 + PHGMG__FRONT_NB), kb = k1 - k0, nt = nf - k1;
+    double *Lkk = F + (size_t)k0 * ld + 2 * k0, *U = F + (size_t)k1 * ld + 2 * k0;
+    nrep += phgmg__front_zpanel(nf, k0, k1, F, tiny);
+    if (nt > 0) { /* U12 = L11^{-1} F12, F22 -= L21 U12 */
+      phgmg__ztrsm_llu(kb, nt, Lkk, nf, U, nf);
+      phgmg__zgemm_acc_fma(nt, nt, kb, -1.0, Lkk + 2 * kb, nf, U, nf, U + 2 * kb, nf);
+    }
   }
   return nrep;
 }
@@ -24891,10 +24899,74 @@ PHGMG__PRIV void phgmg__gemm_micro(int kc, const double *Ap, const double *B, si
   }
 }
 
+/* The same tile with fused multiply-adds (AVX-512F: one 8-wide register
+   per column of the tile; FMA3: two 4-wide ones), else phgmg__gemm_micro.
+   Only the sparse solver's fronts use it (manual 8.12): a fused
+   multiply-add rounds once, so the dense kernels keep their results. */
+PHGMG__PRIV void phgmg__gemm_micro_fma(int kc, const double *Ap, const double *B, size_t bsp,
+                                       size_t bsj, int mr, int nr, double alpha, double *C, int ldc) {
+#ifdef PHGMG__FMA_KERNEL
+  double tile[PHGMG__MR * PHGMG__NR];
+  const double *b0 = B, *b1 = B + (nr > 1 ? bsj : 0), *b2 = B + (nr > 2 ? 2 * bsj : 0);
+  const double *b3 = B + (nr > 3 ? 3 * bsj : 0), *b4 = B + (nr > 4 ? 4 * bsj : 0);
+  const double *b5 = B + (nr > 5 ? 5 * bsj : 0);
+  int p, i, j;
+#ifdef __AVX512F__
+  __m512d c0 = _mm512_setzero_pd(), c1 = c0, c2 = c0, c3 = c0, c4 = c0, c5 = c0, a;
+  for (p = 0; p < kc; ++p, Ap += PHGMG__MR) {
+    const size_t o = (size_t)p * bsp;
+    a = _mm512_loadu_pd(Ap);
+    c0 = _mm512_fmadd_pd(a, _mm512_set1_pd(b0[o]), c0);
+    c1 = _mm512_fmadd_pd(a, _mm512_set1_pd(b1[o]), c1);
+    c2 = _mm512_fmadd_pd(a, _mm512_set1_pd(b2[o]), c2);
+    c3 = _mm512_fmadd_pd(a, _mm512_set1_pd(b3[o]), c3);
+    c4 = _mm512_fmadd_pd(a, _mm512_set1_pd(b4[o]), c4);
+    c5 = _mm512_fmadd_pd(a, _mm512_set1_pd(b5[o]), c5);
+  }
+  if (mr == PHGMG__MR && nr == PHGMG__NR) { /* a whole tile: C updated from the registers */
+    const __m512d al = _mm512_set1_pd(alpha);
+    double *c = C;
+#define PHGMG__FMA_CUPD(cj) do { _mm512_storeu_pd(c, _mm512_fmadd_pd(al, cj, _mm512_loadu_pd(c))); c += ldc; } while (0)
+    PHGMG__FMA_CUPD(c0); PHGMG__FMA_CUPD(c1); PHGMG__FMA_CUPD(c2);
+    PHGMG__FMA_CUPD(c3); PHGMG__FMA_CUPD(c4); PHGMG__FMA_CUPD(c5);
+#undef PHGMG__FMA_CUPD
+    return;
+  }
+  _mm512_storeu_pd(tile, c0); _mm512_storeu_pd(tile + 8, c1); _mm512_storeu_pd(tile + 16, c2);
+  _mm512_storeu_pd(tile + 24, c3); _mm512_storeu_pd(tile + 32, c4); _mm512_storeu_pd(tile + 40, c5);
+#else
+  __m256d c00 = _mm256_setzero_pd(), c01 = c00, c10 = c00, c11 = c00, c20 = c00, c21 = c00;
+  __m256d c30 = c00, c31 = c00, c40 = c00, c41 = c00, c50 = c00, c51 = c00, a0, a1, x;
+  for (p = 0; p < kc; ++p, Ap += PHGMG__MR) {
+    const size_t o = (size_t)p * bsp;
+    a0 = _mm256_loadu_pd(Ap); a1 = _mm256_loadu_pd(Ap + 4);
+    x = _mm256_set1_pd(b0[o]); c00 = _mm256_fmadd_pd(a0, x, c00); c01 = _mm256_fmadd_pd(a1, x, c01);
+    x = _mm256_set1_pd(b1[o]); c10 = _mm256_fmadd_pd(a0, x, c10); c11 = _mm256_fmadd_pd(a1, x, c11);
+    x = _mm256_set1_pd(b2[o]); c20 = _mm256_fmadd_pd(a0, x, c20); c21 = _mm256_fmadd_pd(a1, x, c21);
+    x = _mm256_set1_pd(b3[o]); c30 = _mm256_fmadd_pd(a0, x, c30); c31 = _mm256_fmadd_pd(a1, x, c31);
+    x = _mm256_set1_pd(b4[o]); c40 = _mm256_fmadd_pd(a0, x, c40); c41 = _mm256_fmadd_pd(a1, x, c41);
+    x = _mm256_set1_pd(b5[o]); c50 = _mm256_fmadd_pd(a0, x, c50); c51 = _mm256_fmadd_pd(a1, x, c51);
+  }
+  _mm256_storeu_pd(tile, c00); _mm256_storeu_pd(tile + 4, c01); _mm256_storeu_pd(tile + 8, c10);
+  _mm256_storeu_pd(tile + 12, c11); _mm256_storeu_pd(tile + 16, c20); _mm256_storeu_pd(tile + 20, c21);
+  _mm256_storeu_pd(tile + 24, c30); _mm256_storeu_pd(tile + 28, c31); _mm256_storeu_pd(tile + 32, c40);
+  _mm256_storeu_pd(tile + 36, c41); _mm256_storeu_pd(tile + 40, c50); _mm256_storeu_pd(tile + 44, c51);
+#endif
+  for (j = 0; j < nr; ++j) {
+    double *c = C + (size_t)j * (size_t)ldc;
+    const double *t = tile + PHGMG__MR * j;
+    for (i = 0; i < mr; ++i) c[i] += alpha * t[i];
+  }
+#else
+  phgmg__gemm_micro(kc, Ap, B, bsp, bsj, mr, nr, alpha, C, ldc);
+#endif
+}
+
 /* C (m x n) += alpha * opA(A) * opB(B), opB(B)(p, j) = B[p*bsp + j*bsj];
    amode 0: opA(A)(i, p) = A[i + p*lda]; 1: A[p + i*lda] (transposed);
    2 (m even, A the real view of an interleaved complex matrix): rows 2r, 2r+1
-   of opA are (-Im, Re) of complex row r, i.e. the real view of i*A. */
+   of opA are (-Im, Re) of complex row r, i.e. the real view of i*A; amode + 4:
+   the same with the fused multiply-add tile (phgmg__gemm_micro_fma). */
 /* One row block ic:ic+mc of the product over k block pc:pc+kc (see below):
    packs its own copy of opA (stack), so row blocks are independent. */
 PHGMG__PRIV void phgmg__gemm_rowblock(int ic, int mc, int pc, int kc, int n, double alpha, int amode,
@@ -24906,14 +24978,14 @@ PHGMG__PRIV void phgmg__gemm_rowblock(int ic, int mc, int pc, int kc, int n, dou
   for (ir = 0; ir < mc; ir += PHGMG__MR) {
     int mr = PHGMG__MIN(PHGMG__MR, mc - ir);
     double *dst = Ap + (size_t)ir * (size_t)kc;
-    if (amode == 0) {
+    if ((amode & 3) == 0) {
       for (p = 0; p < kc; ++p) {
         const double *src = A + (ic + ir) + (size_t)(pc + p) * (size_t)lda;
         double *d = dst + (size_t)p * PHGMG__MR;
         for (i = 0; i < mr; ++i) d[i] = src[i];
         for (; i < PHGMG__MR; ++i) d[i] = 0.0;
       }
-    } else if (amode == 1) {
+    } else if ((amode & 3) == 1) {
       for (i = 0; i < PHGMG__MR; ++i) {
         if (i < mr) {
           const double *src = A + pc + (size_t)(ic + ir + i) * (size_t)lda;
@@ -24935,9 +25007,9 @@ PHGMG__PRIV void phgmg__gemm_rowblock(int ic, int mc, int pc, int kc, int n, dou
     int nr = PHGMG__MIN(PHGMG__NR, n - jr);
     const double *bp = B + (size_t)pc * bsp + (size_t)jr * bsj;
     for (ir = 0; ir < mc; ir += PHGMG__MR)
-      phgmg__gemm_micro(kc, Ap + (size_t)ir * (size_t)kc, bp, bsp, bsj,
-                        PHGMG__MIN(PHGMG__MR, mc - ir), nr, alpha,
-                        C + (ic + ir) + (size_t)jr * (size_t)ldc, ldc);
+      (amode & 4 ? phgmg__gemm_micro_fma : phgmg__gemm_micro)(kc, Ap + (size_t)ir * (size_t)kc, bp, bsp, bsj,
+                                                              PHGMG__MIN(PHGMG__MR, mc - ir), nr, alpha,
+                                                              C + (ic + ir) + (size_t)jr * (size_t)ldc, ldc);
   }
 }
 
@@ -24974,6 +25046,13 @@ PHGMG__PRIV void phgmg__zgemm_acc(int m, int n, int k, double alpha, const doubl
   size_t bsj = 2 * (size_t)ldb;
   phgmg__gemm_acc(2 * m, n, k, alpha, 0, A, 2 * lda, B, 2, bsj, C, 2 * ldc);
   phgmg__gemm_acc(2 * m, n, k, alpha, 2, A, 2 * lda, B + 1, 2, bsj, C, 2 * ldc);
+}
+/* The same with the fused multiply-add tile (the sparse fronts). */
+PHGMG__PRIV void phgmg__zgemm_acc_fma(int m, int n, int k, double alpha, const double *A, int lda,
+                                      const double *B, int ldb, double *C, int ldc) {
+  size_t bsj = 2 * (size_t)ldb;
+  phgmg__gemm_acc(2 * m, n, k, alpha, 4, A, 2 * lda, B, 2, bsj, C, 2 * ldc);
+  phgmg__gemm_acc(2 * m, n, k, alpha, 6, A, 2 * lda, B + 1, 2, bsj, C, 2 * ldc);
 }
 
 PHGMG_DEF void phgmg_gemm(char transa, char transb, int m, int n, int k, double alpha,
@@ -25183,10 +25262,32 @@ PHGMG__PRIV void phgmg__zdiv(double ar, double ai, double br, double bi, double 
   }
 }
 
-/* y -= (tr + i ti) x over n complex entries */
+/* y -= (tr + i ti) x over n complex entries (interleaved), two per vector:
+   the same operations in the same order as the scalar loop. */
 PHGMG__PRIV void phgmg__zaxpy_neg(int n, double tr, double ti, const double *x, double *y) {
-  int i;
-  for (i = 0; i < n; ++i) {
+  int i = 0;
+#if defined(PHGMG__VEC4) && (defined(__clang__) || defined(__GNUC__))
+  {
+    const phgmg__v4 vr = {tr, tr, tr, tr}, vi = {-ti, ti, -ti, ti};
+    for (; i + 2 <= n; i += 2) {
+      phgmg__v4 xv, yv, xs;
+      memcpy(&xv, x + 2 * i, sizeof xv);
+      memcpy(&yv, y + 2 * i, sizeof yv);
+#ifdef __clang__
+      xs = __builtin_shufflevector(xv, xv, 1, 0, 3, 2);
+#else
+      {
+        typedef long long phgmg__v4i __attribute__((vector_size(32)));
+        const phgmg__v4i sw = {1, 0, 3, 2};
+        xs = __builtin_shuffle(xv, sw);
+      }
+#endif
+      yv -= vr * xv + vi * xs;
+      memcpy(y + 2 * i, &yv, sizeof yv);
+    }
+  }
+#endif
+  for (; i < n; ++i) {
     double xr = x[2 * i], xi = x[2 * i + 1];
     y[2 * i] -= tr * xr - ti * xi;
     y[2 * i + 1] -= tr * xi + ti * xr;
