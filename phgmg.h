@@ -1652,16 +1652,29 @@
         parts of <= 48 nodes as they come, unconnected parts one by one.
      2. Symbolic analysis: elimination tree (Liu, path compression),
         postorder, column counts from the row subtrees (O(nnz(L))),
-        supernodes: fundamental ones, plus a child joined to its only-child
-        parent while the block has <= 16 columns and the padded zeros stay
-        below a fifth of its entries. The factor of the symmetric pattern
-        needs the same structure for L and U^T.
+        supernodes: fundamental ones, plus a column joined to the
+        supernode of its last child in the postorder (the column just
+        before it, whatever its other children) while the block has <= 16
+        columns and the padded zeros stay below a fifth of its entries.
+        The factor of the symmetric pattern needs the same structure for L
+        and U^T.
      3. Numeric factorization, multifrontal: per supernode (postorder) a
         dense front (its columns and rows) is assembled from K and the
         children's update matrices (a stack), its columns are eliminated
-        with the diagonal pivots (dense LU on the panel, a triangular solve
-        for U's block, one GEMM for the update matrix), L/U panels stored.
-     4. Solve: forward and backward substitution supernode by supernode.
+        with the diagonal pivots, blocked: 32 pivot columns at a time by
+        columns, then that block row of U by a triangular solve and all the
+        trailing rows and columns of the front (the update matrix among
+        them) by one GEMM, so a large separator's front runs in the GEMM
+        kernel; L/U panels stored. The fronts' GEMM uses a fused
+        multiply-add tile (AVX-512F or FMA3 builds; PHGMG_NO_FMA_KERNEL
+        turns it off), the dense kernels elsewhere keep their separate
+        multiply and add.
+     4. Solve: forward and backward substitution supernode by supernode:
+        the small triangle by columns, the off-diagonal block through a
+        contiguous buffer (one gather or scatter per supernode) by a
+        matrix-vector kernel that takes four columns (complex: two) or
+        four rows per sweep, so the buffer stays in registers while the
+        factor streams by (a solve is bound by reading the factor).
      Pivoting is static: the pivots are the diagonal of the fill-reducing
      order. This is safe here because K = sigma I + M with Re sigma > 0 is
      dominated by its shift for the step sizes GL3 is used with, but not
@@ -2013,6 +2026,9 @@
                            doubles, lives on the stack: 128 KiB by default)
      PHGMG_NO_VECTOR_EXT   the plain C GEMM micro-kernel instead of the
                            GCC/Clang vector extensions it uses on AVX targets
+     PHGMG_NO_FMA_KERNEL   the sparse LU's fronts without the fused
+                           multiply-add GEMM tile (AVX-512F / FMA3 builds;
+                           manual 8.12)
 
 
    10. INDEX OF PUBLIC FUNCTIONS -------------------------------------------------
