@@ -8131,7 +8131,33 @@ PHGMG__PRIV phgmg_result phgmg__spnum_alloc(const phgmg_allocator *al, const phg
 
 /* y -= t x for complex t = tr + i ti, interleaved x, y (n entries). */
 PHGMG__PRIV void phgmg__sp_zaxpy(int n, double tr, double ti, const double *x, double *y) {
-  phgmg__zaxpy_neg(n, tr, ti, x, y);
+  int i = 0;
+#if defined(PHGMG__VEC4) && (defined(__clang__) || defined(__GNUC__))
+  {
+    const phgmg__v4 vr = {tr, tr, tr, tr}, vi = {-ti, ti, -ti, ti};
+    for (; i + 2 <= n; i += 2) {
+      phgmg__v4 xv, yv, xs;
+      memcpy(&xv, x + 2 * i, sizeof xv);
+      memcpy(&yv, y + 2 * i, sizeof yv);
+#ifdef __clang__
+      xs = __builtin_shufflevector(xv, xv, 1, 0, 3, 2);
+#else
+      {
+        typedef long long phgmg__v4i __attribute__((vector_size(32)));
+        const phgmg__v4i sw = {1, 0, 3, 2};
+        xs = __builtin_shuffle(xv, sw);
+      }
+#endif
+      yv -= vr * xv + vi * xs;
+      memcpy(y + 2 * i, &yv, sizeof yv);
+    }
+  }
+#endif
+  for (; i < n; ++i) {
+    double xr = x[2 * i], xi = x[2 * i + 1];
+    y[2 * i] -= tr * xr - ti * xi;
+    y[2 * i + 1] -= tr * xi + ti * xr;
+  }
 }
 
 /* Dense partial LU of a front (nf x nf, ld nf), the first nc pivots on the
@@ -25294,32 +25320,10 @@ PHGMG__PRIV void phgmg__zdiv(double ar, double ai, double br, double bi, double 
   }
 }
 
-/* y -= (tr + i ti) x over n complex entries (interleaved), two per vector:
-   the same operations in the same order as the scalar loop. */
+/* y -= (tr + i ti) x over n complex entries */
 PHGMG__PRIV void phgmg__zaxpy_neg(int n, double tr, double ti, const double *x, double *y) {
-  int i = 0;
-#if defined(PHGMG__VEC4) && (defined(__clang__) || defined(__GNUC__))
-  {
-    const phgmg__v4 vr = {tr, tr, tr, tr}, vi = {-ti, ti, -ti, ti};
-    for (; i + 2 <= n; i += 2) {
-      phgmg__v4 xv, yv, xs;
-      memcpy(&xv, x + 2 * i, sizeof xv);
-      memcpy(&yv, y + 2 * i, sizeof yv);
-#ifdef __clang__
-      xs = __builtin_shufflevector(xv, xv, 1, 0, 3, 2);
-#else
-      {
-        typedef long long phgmg__v4i __attribute__((vector_size(32)));
-        const phgmg__v4i sw = {1, 0, 3, 2};
-        xs = __builtin_shuffle(xv, sw);
-      }
-#endif
-      yv -= vr * xv + vi * xs;
-      memcpy(y + 2 * i, &yv, sizeof yv);
-    }
-  }
-#endif
-  for (; i < n; ++i) {
+  int i;
+  for (i = 0; i < n; ++i) {
     double xr = x[2 * i], xi = x[2 * i + 1];
     y[2 * i] -= tr * xr - ti * xi;
     y[2 * i + 1] -= tr * xi + ti * xr;
