@@ -4803,6 +4803,8 @@ PHGMG__PRIV int phgmg__mat_finite(int m, int n, const double *A, int lda);
 PHGMG__PRIV double phgmg__sumsq(int n, int ns, const double *A, int lda);
 PHGMG__PRIV void phgmg__gemm_micro(int kc, const double *Ap, const double *B, size_t bsp,
                                    size_t bsj, int mr, int nr, double alpha, double *C, int ldc);
+PHGMG__PRIV void phgmg__gemm_micro_fma(int kc, const double *Ap, const double *B, size_t bsp,
+                                       size_t bsj, int mr, int nr, double alpha, double *C, int ldc);
 PHGMG__PRIV void phgmg__gemm_rowblock(int ic, int mc, int pc, int kc, int n, double alpha, int amode,
                                       const double *A, int lda, const double *B, size_t bsp,
                                       size_t bsj, double *C, int ldc);
