@@ -1756,16 +1756,29 @@
         parts of <= 48 nodes as they come, unconnected parts one by one.
      2. Symbolic analysis: elimination tree (Liu, path compression),
         postorder, column counts from the row subtrees (O(nnz(L))),
-        supernodes: fundamental ones, plus a child joined to its only-child
-        parent while the block has <= 16 columns and the padded zeros stay
-        below a fifth of its entries. The factor of the symmetric pattern
-        needs the same structure for L and U^T.
+        supernodes: fundamental ones, plus a column joined to the
+        supernode of its last child in the postorder (the column just
+        before it, whatever its other children) while the block has <= 16
+        columns and the padded zeros stay below a fifth of its entries.
+        The factor of the symmetric pattern needs the same structure for L
+        and U^T.
      3. Numeric factorization, multifrontal: per supernode (postorder) a
         dense front (its columns and rows) is assembled from K and the
         children's update matrices (a stack), its columns are eliminated
-        with the diagonal pivots (dense LU on the panel, a triangular solve
-        for U's block, one GEMM for the update matrix), L/U panels stored.
-     4. Solve: forward and backward substitution supernode by supernode.
+        with the diagonal pivots, blocked: 32 pivot columns at a time by
+        columns, then that block row of U by a triangular solve and all the
+        trailing rows and columns of the front (the update matrix among
+        them) by one GEMM, so a large separator's front runs in the GEMM
+        kernel; L/U panels stored. The fronts' GEMM uses a fused
+        multiply-add tile (AVX-512F or FMA3 builds; PHGMG_NO_FMA_KERNEL
+        turns it off), the dense kernels elsewhere keep their separate
+        multiply and add.
+     4. Solve: forward and backward substitution supernode by supernode:
+        the small triangle by columns, the off-diagonal block through a
+        contiguous buffer (one gather or scatter per supernode) by a
+        matrix-vector kernel that takes four columns (complex: two) or
+        four rows per sweep, so the buffer stays in registers while the
+        factor streams by (a solve is bound by reading the factor).
      Pivoting is static: the pivots are the diagonal of the fill-reducing
      order. This is safe here because K = sigma I + M with Re sigma > 0 is
      dominated by its shift for the step sizes GL3 is used with, but not
@@ -2123,6 +2136,9 @@
                            doubles, lives on the stack: 128 KiB by default)
      PHGMG_NO_VECTOR_EXT   the plain C GEMM micro-kernel instead of the
                            GCC/Clang vector extensions it uses on AVX targets
+     PHGMG_NO_FMA_KERNEL   the sparse LU's fronts without the fused
+                           multiply-add GEMM tile (AVX-512F / FMA3 builds;
+                           manual 8.12)
 
 
    10. INDEX OF PUBLIC FUNCTIONS -------------------------------------------------
@@ -4890,6 +4906,13 @@ PHGMG_DEF phgmg_result phgmg_sym_eig(int n, double *A, int lda, double *w, doubl
 /* >>config (implementation) ============================================== */
 #include <math.h>
 #include <string.h>
+/* The fused multiply-add tile of the sparse solver's fronts (>>linalg,
+   phgmg__gemm_micro_fma); PHGMG_NO_FMA_KERNEL turns it off. */
+#if (defined(__GNUC__) || defined(__clang__)) && (defined(__AVX512F__) || defined(__FMA__)) && \
+    !defined(PHGMG_NO_VECTOR_EXT) && !defined(PHGMG_NO_FMA_KERNEL) && !defined(PHGMG_NO_OFFLINE)
+#define PHGMG__FMA_KERNEL 1
+#include <immintrin.h>
+#endif
 
 #ifndef PHGMG_ASSERT
 #include <assert.h>
@@ -4991,6 +5014,8 @@ PHGMG__PRIV int phgmg__mat_finite(int m, int n, const double *A, int lda);
 PHGMG__PRIV double phgmg__sumsq(int n, int ns, const double *A, int lda);
 PHGMG__PRIV void phgmg__gemm_micro(int kc, const double *Ap, const double *B, size_t bsp,
                                    size_t bsj, int mr, int nr, double alpha, double *C, int ldc);
+PHGMG__PRIV void phgmg__gemm_micro_fma(int kc, const double *Ap, const double *B, size_t bsp,
+                                       size_t bsj, int mr, int nr, double alpha, double *C, int ldc);
 PHGMG__PRIV void phgmg__gemm_rowblock(int ic, int mc, int pc, int kc, int n, double alpha, int amode,
                                       const double *A, int lda, const double *B, size_t bsp,
                                       size_t bsj, double *C, int ldc);
@@ -4998,6 +5023,8 @@ PHGMG__PRIV void phgmg__gemm_acc(int m, int n, int k, double alpha, int amode, c
                                  int lda, const double *B, size_t bsp, size_t bsj, double *C,
                                  int ldc);
 PHGMG__PRIV void phgmg__zgemm_acc(int m, int n, int k, double alpha, const double *A, int lda,
+                                  const double *B, int ldb, double *C, int ldc);
+PHGMG__PRIV void phgmg__zgemm_acc_fma(int m, int n, int k, double alpha, const double *A, int lda,
                                   const double *B, int ldb, double *C, int ldc);
 PHGMG__PRIV void phgmg__laswp(int ncols, double *A, int lda, int k1, int k2, const int *ipiv);
 PHGMG__PRIV void phgmg__trsm_llu(int n, int nrhs, const double *L, int ldl, double *B, int ldb);
@@ -7916,9 +7943,9 @@ PHGMG__PRIV phgmg_result phgmg__spsym_supernodes(phgmg__spsym *S, const int *ap,
   for (j = 0; j < n; ++j) if (parent[j] >= 0) nch[parent[j]]++;
   for (j = 0; j < n; ++j) {
     int join = 0;
-    if (j > 0 && parent[j - 1] == j && nch[j] == 1) {
+    if (j > 0 && parent[j - 1] == j) { /* j - 1: j's last child in the postorder */
       int f = S->sfirst[ns - 1], nc = j - f;  /* current supernode f..j-1 */
-      if (cnt[j - 1] == cnt[j] + 1) join = 1;  /* fundamental */
+      if (nch[j] == 1 && cnt[j - 1] == cnt[j] + 1) join = 1;  /* fundamental */
       else if (nc + 1 <= PHGMG__SP_RELAX) {
         /* extra zeros: columns f..j-1 padded to the structure of j */
         size_t extra = (size_t)nc * (size_t)(cnt[j] + 1 > cnt[j - 1] ? cnt[j] + 1 - cnt[j - 1] : 0);
@@ -8360,32 +8387,48 @@ PHGMG__PRIV void phgmg__sp_zaxpy(int n, double tr, double ti, const double *x, d
 
 /* Dense partial LU of a front (nf x nf, ld nf), the first nc pivots on the
    diagonal; a pivot below tiny in magnitude is replaced by tiny (same sign)
-   and counted. Real. */
-PHGMG__PRIV int phgmg__front_lu(int nf, int nc, double *F, double tiny) {
-  int k, i, j, nr = nf - nc, nrep = 0;
-  for (k = 0; k < nc; ++k) {
+   and counted. Blocked right-looking: PHGMG__FRONT_NB pivot columns at a
+   time by columns (phgmg__front_panel), then the block row of U by a
+   triangular solve and the trailing rows and columns of the front (also the
+   update matrix F22) by one GEMM, so the work of a large separator's front
+   runs in the GEMM kernel rather than in column updates. */
+#ifndef PHGMG__FRONT_NB
+#define PHGMG__FRONT_NB 32
+#endif
+/* Columns k0 .. k1-1 of a front (rows k0 .. nf-1) eliminated by columns. */
+PHGMG__PRIV int phgmg__front_panel(int nf, int k0, int k1, double *F, double tiny) {
+  int k, i, j, nrep = 0;
+  for (k = k0; k < k1; ++k) {
     double *ck = F + (size_t)k * (size_t)nf, p = ck[k], inv;
     if (!(fabs(p) >= tiny)) { p = p < 0.0 ? -tiny : tiny; ck[k] = p; ++nrep; }
     inv = 1.0 / p;
     for (i = k + 1; i < nf; ++i) ck[i] *= inv;
-    for (j = k + 1; j < nc; ++j) {
+    for (j = k + 1; j < k1; ++j) {
       double *cj = F + (size_t)j * (size_t)nf, f = cj[k];
       if (f != 0.0) phgmg__axpy(nf - k - 1, -f, ck + k + 1, cj + k + 1);
     }
   }
-  if (nr > 0) {
-    double *F12 = F + (size_t)nc * (size_t)nf;
-    phgmg__trsm_llu(nc, nr, F, nf, F12, nf);
-    phgmg_gemm('N', 'N', nr, nr, nc, -1.0, F + nc, nf, F12, nf, 1.0, F12 + nc, nf);
+  return nrep;
+}
+PHGMG__PRIV int phgmg__front_lu(int nf, int nc, double *F, double tiny) {
+  int k0, nrep = 0;
+  for (k0 = 0; k0 < nc; k0 += PHGMG__FRONT_NB) {
+    const int k1 = PHGMG__MIN(nc, k0 + PHGMG__FRONT_NB), kb = k1 - k0, nt = nf - k1;
+    double *Lkk = F + (size_t)k0 * (size_t)nf + k0, *U = F + (size_t)k1 * (size_t)nf + k0;
+    nrep += phgmg__front_panel(nf, k0, k1, F, tiny);
+    if (nt > 0) {
+      phgmg__trsm_llu(kb, nt, Lkk, nf, U, nf);
+      phgmg__gemm_acc(nt, nt, kb, -1.0, 4, Lkk + kb, nf, U, 1, (size_t)nf, U + kb, nf);
+    }
   }
   return nrep;
 }
 
 /* The same for complex fronts (pairs). */
-PHGMG__PRIV int phgmg__front_zlu(int nf, int nc, double *F, double tiny) {
+PHGMG__PRIV int phgmg__front_zpanel(int nf, int k0, int k1, double *F, double tiny) {
   int k, i, j, nrep = 0;
   size_t ld = 2 * (size_t)nf;
-  for (k = 0; k < nc; ++k) {
+  for (k = k0; k < k1; ++k) {
     double *ck = F + (size_t)k * ld, pr = ck[2 * k], pi = ck[2 * k + 1], mag = hypot(pr, pi), ir, ii, d;
     if (!(mag >= tiny)) {
       if (mag > 0.0) { pr *= tiny / mag; pi *= tiny / mag; } else { pr = tiny; pi = 0.0; }
@@ -8398,16 +8441,25 @@ PHGMG__PRIV int phgmg__front_zlu(int nf, int nc, double *F, double tiny) {
       ck[2 * i] = a * ir - b * ii;
       ck[2 * i + 1] = a * ii + b * ir;
     }
-    for (j = k + 1; j < nc; ++j) {
+    for (j = k + 1; j < k1; ++j) {
       double *cj = F + (size_t)j * ld, fr = cj[2 * k], fi = cj[2 * k + 1];
       if (fr == 0.0 && fi == 0.0) continue;
       phgmg__sp_zaxpy(nf - k - 1, fr, fi, ck + 2 * (k + 1), cj + 2 * (k + 1));
     }
   }
-  if (nf > nc) { /* U12 = L11^{-1} F12, F22 -= L21 U12 */
-    double *F12 = F + (size_t)nc * ld;
-    phgmg__ztrsm_llu(nc, nf - nc, F, nf, F12, nf);
-    phgmg__zgemm_acc(nf - nc, nf - nc, nc, -1.0, F + 2 * nc, nf, F12, nf, F12 + 2 * nc, nf);
+  return nrep;
+}
+PHGMG__PRIV int phgmg__front_zlu(int nf, int nc, double *F, double tiny) {
+  int k0, nrep = 0;
+  const size_t ld = 2 * (size_t)nf;
+  for (k0 = 0; k0 < nc; k0 += PHGMG__FRONT_NB) {
+    const int k1 = PHGMG__MIN(nc, k0 + PHGMG__FRONT_NB), kb = k1 - k0, nt = nf - k1;
+    double *Lkk = F + (size_t)k0 * ld + 2 * k0, *U = F + (size_t)k1 * ld + 2 * k0;
+    nrep += phgmg__front_zpanel(nf, k0, k1, F, tiny);
+    if (nt > 0) { /* U12 = L11^{-1} F12, F22 -= L21 U12 */
+      phgmg__ztrsm_llu(kb, nt, Lkk, nf, U, nf);
+      phgmg__zgemm_acc_fma(nt, nt, kb, -1.0, Lkk + 2 * kb, nf, U, nf, U + 2 * kb, nf);
+    }
   }
   return nrep;
 }
@@ -8536,76 +8588,224 @@ PHGMG__PRIV void phgmg__sp_factor(const phgmg__spsym *S, phgmg__spnum *F, const 
   F->growth = kmax > 0.0 ? fmax / kmax : 0.0;
 }
 
+/* Dense kernels of the supernodal solves (manual 8.12), four columns or
+   rows of a block per sweep over the short vector t, which stays in
+   registers or L1 while the factor streams by. Real: */
+/* t[0..nr) += A v, A nr x nc with columns ld apart. */
+PHGMG__PRIV void phgmg__sp_gemv_n(int nr, int nc, const double *A, size_t ld, const double *v, double *t) {
+  int k = 0, i;
+  for (; k + 4 <= nc; k += 4) {
+    const double *a0 = A + (size_t)k * ld, *a1 = a0 + ld, *a2 = a1 + ld, *a3 = a2 + ld;
+    const double v0 = v[k], v1 = v[k + 1], v2 = v[k + 2], v3 = v[k + 3];
+    if (v0 == 0.0 && v1 == 0.0 && v2 == 0.0 && v3 == 0.0) continue;
+    i = 0;
+#ifdef PHGMG__VEC4
+    {
+      const phgmg__v4 b0 = {v0, v0, v0, v0}, b1 = {v1, v1, v1, v1}, b2 = {v2, v2, v2, v2}, b3 = {v3, v3, v3, v3};
+      for (; i + 4 <= nr; i += 4) {
+        phgmg__v4 x0, x1, x2, x3, tv;
+        memcpy(&x0, a0 + i, sizeof x0); memcpy(&x1, a1 + i, sizeof x1);
+        memcpy(&x2, a2 + i, sizeof x2); memcpy(&x3, a3 + i, sizeof x3);
+        memcpy(&tv, t + i, sizeof tv);
+        tv += (x0 * b0 + x1 * b1) + (x2 * b2 + x3 * b3);
+        memcpy(t + i, &tv, sizeof tv);
+      }
+    }
+#endif
+    for (; i < nr; ++i) t[i] += (a0[i] * v0 + a1[i] * v1) + (a2[i] * v2 + a3[i] * v3);
+  }
+  for (; k < nc; ++k)
+    if (v[k] != 0.0) phgmg__axpy(nr, v[k], A + (size_t)k * ld, t);
+}
+
+/* y[k] -= A(k, :) t for the nc rows of A (nc x nr, rows contiguous). */
+PHGMG__PRIV void phgmg__sp_gemv_t(int nr, int nc, const double *A, const double *t, double *y) {
+  int k = 0, i;
+  for (; k + 4 <= nc; k += 4) {
+    const double *a0 = A + (size_t)k * (size_t)nr, *a1 = a0 + nr, *a2 = a1 + nr, *a3 = a2 + nr;
+    double s0 = 0.0, s1 = 0.0, s2 = 0.0, s3 = 0.0;
+    i = 0;
+#ifdef PHGMG__VEC4
+    if (nr >= 4) {
+      phgmg__v4 c0, c1, c2, c3, x, tv;
+      double h[4];
+      memset(&c0, 0, sizeof c0);
+      c1 = c2 = c3 = c0;
+      for (; i + 4 <= nr; i += 4) {
+        memcpy(&tv, t + i, sizeof tv);
+        memcpy(&x, a0 + i, sizeof x); c0 += x * tv;
+        memcpy(&x, a1 + i, sizeof x); c1 += x * tv;
+        memcpy(&x, a2 + i, sizeof x); c2 += x * tv;
+        memcpy(&x, a3 + i, sizeof x); c3 += x * tv;
+      }
+      memcpy(h, &c0, sizeof h); s0 = (h[0] + h[1]) + (h[2] + h[3]);
+      memcpy(h, &c1, sizeof h); s1 = (h[0] + h[1]) + (h[2] + h[3]);
+      memcpy(h, &c2, sizeof h); s2 = (h[0] + h[1]) + (h[2] + h[3]);
+      memcpy(h, &c3, sizeof h); s3 = (h[0] + h[1]) + (h[2] + h[3]);
+    }
+#endif
+    for (; i < nr; ++i) { s0 += a0[i] * t[i]; s1 += a1[i] * t[i]; s2 += a2[i] * t[i]; s3 += a3[i] * t[i]; }
+    y[k] -= s0; y[k + 1] -= s1; y[k + 2] -= s2; y[k + 3] -= s3;
+  }
+  for (; k < nc; ++k) y[k] -= phgmg__dot(nr, A + (size_t)k * (size_t)nr, t);
+}
+
+#ifdef PHGMG__VEC4
+/* (re, im, re, im) -> (im, re, im, re) */
+PHGMG__PRIV phgmg__v4 phgmg__v4_swap2(phgmg__v4 x) {
+#ifdef __clang__
+  return __builtin_shufflevector(x, x, 1, 0, 3, 2);
+#else
+  typedef long long phgmg__v4i __attribute__((vector_size(32)));
+  const phgmg__v4i sw = {1, 0, 3, 2};
+  return __builtin_shuffle(x, sw);
+#endif
+}
+#endif
+
+/* Complex (interleaved pairs): t[0..nr) += A v, A nr x nc, columns 2 ld
+   doubles apart. */
+PHGMG__PRIV void phgmg__sp_zgemv_n(int nr, int nc, const double *A, size_t ld, const double *v, double *t) {
+  int k = 0, i;
+  for (; k + 2 <= nc; k += 2) {
+    const double *a0 = A + 2 * (size_t)k * ld, *a1 = a0 + 2 * ld;
+    const double r0 = v[2 * k], i0 = v[2 * k + 1], r1 = v[2 * k + 2], i1 = v[2 * k + 3];
+    if (r0 == 0.0 && i0 == 0.0 && r1 == 0.0 && i1 == 0.0) continue;
+    i = 0;
+#ifdef PHGMG__VEC4
+    {
+      const phgmg__v4 br0 = {r0, r0, r0, r0}, bi0 = {-i0, i0, -i0, i0};
+      const phgmg__v4 br1 = {r1, r1, r1, r1}, bi1 = {-i1, i1, -i1, i1};
+      for (; i + 2 <= nr; i += 2) {
+        phgmg__v4 x0, x1, tv;
+        memcpy(&x0, a0 + 2 * i, sizeof x0); memcpy(&x1, a1 + 2 * i, sizeof x1);
+        memcpy(&tv, t + 2 * i, sizeof tv);
+        tv += (br0 * x0 + bi0 * phgmg__v4_swap2(x0)) + (br1 * x1 + bi1 * phgmg__v4_swap2(x1));
+        memcpy(t + 2 * i, &tv, sizeof tv);
+      }
+    }
+#endif
+    for (; i < nr; ++i) {
+      double xr0 = a0[2 * i], xi0 = a0[2 * i + 1], xr1 = a1[2 * i], xi1 = a1[2 * i + 1];
+      t[2 * i] += (r0 * xr0 - i0 * xi0) + (r1 * xr1 - i1 * xi1);
+      t[2 * i + 1] += (r0 * xi0 + i0 * xr0) + (r1 * xi1 + i1 * xr1);
+    }
+  }
+  for (; k < nc; ++k)
+    if (v[2 * k] != 0.0 || v[2 * k + 1] != 0.0)
+      phgmg__sp_zaxpy(nr, -v[2 * k], -v[2 * k + 1], A + 2 * (size_t)k * ld, t);
+}
+
+/* y[k] -= A(k, :) t (no conjugate) for the nc rows of A (nc x nr complex,
+   rows contiguous), two rows per sweep. */
+PHGMG__PRIV void phgmg__sp_zgemv_t(int nr, int nc, const double *A, const double *t, double *y) {
+  int k = 0, i;
+  for (; k < nc; k += 2) {
+    const int two = k + 1 < nc;
+    const double *a0 = A + 2 * (size_t)k * (size_t)nr, *a1 = two ? a0 + 2 * nr : a0;
+    double p0 = 0.0, q0 = 0.0, p1 = 0.0, q1 = 0.0; /* real and imaginary sums */
+    i = 0;
+#ifdef PHGMG__VEC4
+    if (nr >= 2) {
+      phgmg__v4 c0, d0, c1, d1, x, tv, ts;
+      double h[4];
+      memset(&c0, 0, sizeof c0);
+      d0 = c1 = d1 = c0;
+      for (; i + 2 <= nr; i += 2) {
+        memcpy(&tv, t + 2 * i, sizeof tv);
+        ts = phgmg__v4_swap2(tv);
+        memcpy(&x, a0 + 2 * i, sizeof x); c0 += x * tv; d0 += x * ts;
+        memcpy(&x, a1 + 2 * i, sizeof x); c1 += x * tv; d1 += x * ts;
+      }
+      memcpy(h, &c0, sizeof h); p0 = (h[0] - h[1]) + (h[2] - h[3]);
+      memcpy(h, &d0, sizeof h); q0 = (h[0] + h[1]) + (h[2] + h[3]);
+      memcpy(h, &c1, sizeof h); p1 = (h[0] - h[1]) + (h[2] - h[3]);
+      memcpy(h, &d1, sizeof h); q1 = (h[0] + h[1]) + (h[2] + h[3]);
+    }
+#endif
+    for (; i < nr; ++i) {
+      double tr = t[2 * i], ti = t[2 * i + 1];
+      p0 += a0[2 * i] * tr - a0[2 * i + 1] * ti; q0 += a0[2 * i] * ti + a0[2 * i + 1] * tr;
+      p1 += a1[2 * i] * tr - a1[2 * i + 1] * ti; q1 += a1[2 * i] * ti + a1[2 * i + 1] * tr;
+    }
+    y[2 * k] -= p0; y[2 * k + 1] -= q0;
+    if (two) { y[2 * k + 2] -= p1; y[2 * k + 3] -= q1; }
+  }
+}
+
+/* Forward substitution through supernode s: its unit lower triangle, then
+   t = L21 y_s scattered into the rows below. */
+PHGMG__PRIV void phgmg__sp_fwd_sn(const phgmg__spsym *S, const phgmg__spnum *F, int s, double *y, double *t) {
+  const int w = F->cplx ? 2 : 1, f = S->sfirst[s], nc = S->sfirst[s + 1] - f, nr = S->srp[s + 1] - S->srp[s];
+  const int nf = nc + nr, *rows = S->srow + S->srp[s];
+  const double *L = F->X + (size_t)w * S->lptr[s];
+  double *yf = y + (size_t)w * (size_t)f;
+  int i, k;
+  for (k = 0; k < nc; ++k) {
+    const double *lk = L + (size_t)w * (size_t)k * (size_t)nf;
+    if (w == 1) {
+      double v = yf[k];
+      if (v != 0.0) for (i = k + 1; i < nc; ++i) yf[i] -= v * lk[i];
+    } else {
+      double vr = yf[2 * k], vi = yf[2 * k + 1];
+      if (vr != 0.0 || vi != 0.0) phgmg__sp_zaxpy(nc - k - 1, vr, vi, lk + 2 * (k + 1), yf + 2 * (k + 1));
+    }
+  }
+  if (nr == 0) return;
+  for (i = 0; i < w * nr; ++i) t[i] = 0.0;
+  if (w == 1) {
+    phgmg__sp_gemv_n(nr, nc, L + nc, (size_t)nf, yf, t);
+    for (i = 0; i < nr; ++i) y[rows[i]] -= t[i];
+  } else {
+    phgmg__sp_zgemv_n(nr, nc, L + 2 * nc, (size_t)nf, yf, t);
+    for (i = 0; i < nr; ++i) { y[2 * rows[i]] -= t[2 * i]; y[2 * rows[i] + 1] -= t[2 * i + 1]; }
+  }
+}
+
+/* Backward substitution through supernode s: y_s -= U12 y(rows), then its
+   upper triangle. */
+PHGMG__PRIV void phgmg__sp_bwd_sn(const phgmg__spsym *S, const phgmg__spnum *F, int s, double *y, double *t) {
+  const int w = F->cplx ? 2 : 1, f = S->sfirst[s], nc = S->sfirst[s + 1] - f, nr = S->srp[s + 1] - S->srp[s];
+  const int nf = nc + nr, *rows = S->srow + S->srp[s];
+  const double *L = F->X + (size_t)w * S->lptr[s], *Up = L + (size_t)w * (size_t)nf * (size_t)nc;
+  double *yf = y + (size_t)w * (size_t)f;
+  int i, k;
+  if (w == 1) {
+    for (i = 0; i < nr; ++i) t[i] = y[rows[i]];
+    if (nr > 0) phgmg__sp_gemv_t(nr, nc, Up, t, yf);
+    for (k = nc - 1; k >= 0; --k) {
+      const double *lk = L + (size_t)k * (size_t)nf;
+      double v = yf[k] / lk[k];
+      yf[k] = v;
+      if (v != 0.0) for (i = 0; i < k; ++i) yf[i] -= v * lk[i];
+    }
+    return;
+  }
+  for (i = 0; i < nr; ++i) { t[2 * i] = y[2 * rows[i]]; t[2 * i + 1] = y[2 * rows[i] + 1]; }
+  if (nr > 0) phgmg__sp_zgemv_t(nr, nc, Up, t, yf);
+  for (k = nc - 1; k >= 0; --k) {
+    const double *lk = L + 2 * (size_t)k * (size_t)nf;
+    double ar = yf[2 * k], ai = yf[2 * k + 1], pr = lk[2 * k], pi = lk[2 * k + 1];
+    double d = pr * pr + pi * pi, vr = (ar * pr + ai * pi) / d, vi = (ai * pr - ar * pi) / d;
+    yf[2 * k] = vr;
+    yf[2 * k + 1] = vi;
+    if (vr != 0.0 || vi != 0.0) phgmg__sp_zaxpy(k, vr, vi, lk, yf);
+  }
+}
+
 /* x <- K^{-1} x (x internal order; real N or complex 2N interleaved):
    per supernode the dense triangular block, its off-diagonal block through a
    contiguous buffer (one scatter or gather per supernode). */
 PHGMG__PRIV void phgmg__sp_solve_f(const phgmg__spsym *S, const phgmg__spnum *F, double *x) {
   const int n = S->nf, ns = S->nsup, w = F->cplx ? 2 : 1;
-  int s, i, j, k;
+  int s, i;
   double *y = F->y, *t = F->y + (size_t)w * (size_t)n;
   for (i = 0; i < n; ++i) {
     y[w * i] = x[w * S->perm[i]];
     if (w == 2) y[2 * i + 1] = x[2 * S->perm[i] + 1];
   }
-  for (s = 0; s < ns; ++s) { /* forward: L, unit diagonal */
-    int f = S->sfirst[s], nc = S->sfirst[s + 1] - f, nr = S->srp[s + 1] - S->srp[s], nf = nc + nr;
-    const int *rows = S->srow + S->srp[s];
-    const double *L = F->X + (size_t)w * S->lptr[s];
-    double *yf = y + (size_t)w * (size_t)f;
-    for (i = 0; i < w * nr; ++i) t[i] = 0.0;
-    for (k = 0; k < nc; ++k) {
-      const double *lk = L + (size_t)w * (size_t)k * (size_t)nf;
-      if (w == 1) {
-        double v = yf[k];
-        if (v == 0.0) continue;
-        phgmg__axpy(nc - k - 1, -v, lk + k + 1, yf + k + 1);
-        phgmg__axpy(nr, v, lk + nc, t);
-      } else {
-        double vr = yf[2 * k], vi = yf[2 * k + 1];
-        if (vr == 0.0 && vi == 0.0) continue;
-        phgmg__sp_zaxpy(nc - k - 1, vr, vi, lk + 2 * (k + 1), yf + 2 * (k + 1));
-        phgmg__sp_zaxpy(nr, -vr, -vi, lk + 2 * nc, t);
-      }
-    }
-    if (w == 1) for (i = 0; i < nr; ++i) y[rows[i]] -= t[i];
-    else for (i = 0; i < nr; ++i) { y[2 * rows[i]] -= t[2 * i]; y[2 * rows[i] + 1] -= t[2 * i + 1]; }
-  }
-  for (s = ns - 1; s >= 0; --s) { /* backward: U */
-    int f = S->sfirst[s], nc = S->sfirst[s + 1] - f, nr = S->srp[s + 1] - S->srp[s], nf = nc + nr;
-    const int *rows = S->srow + S->srp[s];
-    const double *L = F->X + (size_t)w * S->lptr[s], *Up = L + (size_t)w * (size_t)nf * (size_t)nc;
-    double *yf = y + (size_t)w * (size_t)f;
-    if (w == 1) {
-      for (j = 0; j < nr; ++j) t[j] = y[rows[j]];
-      if (nr > 0) for (k = 0; k < nc; ++k) yf[k] -= phgmg__dot(nr, Up + (size_t)k * (size_t)nr, t);
-      for (k = nc - 1; k >= 0; --k) {
-        const double *lk = L + (size_t)k * (size_t)nf;
-        double v = yf[k] / lk[k];
-        yf[k] = v;
-        if (v != 0.0) phgmg__axpy(k, -v, lk, yf);
-      }
-    } else {
-      for (j = 0; j < nr; ++j) { t[2 * j] = y[2 * rows[j]]; t[2 * j + 1] = y[2 * rows[j] + 1]; }
-      for (k = 0; k < nc && nr > 0; ++k) {
-        const double *u = Up + 2 * (size_t)k * (size_t)nr;
-        double sr = 0.0, si = 0.0, sr2 = 0.0, si2 = 0.0;
-        for (j = 0; j < nr; ++j) {
-          sr += u[2 * j] * t[2 * j]; sr2 += u[2 * j + 1] * t[2 * j + 1];
-          si += u[2 * j] * t[2 * j + 1]; si2 += u[2 * j + 1] * t[2 * j];
-        }
-        yf[2 * k] -= sr - sr2;
-        yf[2 * k + 1] -= si + si2;
-      }
-      for (k = nc - 1; k >= 0; --k) {
-        const double *lk = L + 2 * (size_t)k * (size_t)nf;
-        double ar = yf[2 * k], ai = yf[2 * k + 1], pr = lk[2 * k], pi = lk[2 * k + 1];
-        double d = pr * pr + pi * pi, vr = (ar * pr + ai * pi) / d, vi = (ai * pr - ar * pi) / d;
-        yf[2 * k] = vr;
-        yf[2 * k + 1] = vi;
-        if (vr != 0.0 || vi != 0.0) phgmg__sp_zaxpy(k, vr, vi, lk, yf);
-      }
-    }
-  }
+  for (s = 0; s < ns; ++s) phgmg__sp_fwd_sn(S, F, s, y, t);
+  for (s = ns - 1; s >= 0; --s) phgmg__sp_bwd_sn(S, F, s, y, t);
   for (i = 0; i < n; ++i) {
     x[w * S->perm[i]] = y[w * i];
     if (w == 2) x[2 * S->perm[i] + 1] = y[2 * i + 1];
@@ -8706,6 +8906,23 @@ PHGMG__PRIV void phgmg__sp_qmv(const phgmg__spsym *S, const double *x, double *y
     double xj = x[j];
     if (xj == 0.0) continue;
     for (p = S->q_p[j]; p < S->q_p[j + 1]; ++p) y[S->q_i[p]] += S->q_x[p] * xj;
+  }
+}
+
+/* The same for the three stage columns of X (n apart) into Y, Q read once
+   (the same sums as three phgmg__sp_qmv). */
+PHGMG__PRIV void phgmg__sp_qmv3(const phgmg__spsym *S, const double *X, double *Y) {
+  const size_t n = (size_t)S->n;
+  int j, p;
+  for (j = 0; j < 3 * S->n; ++j) Y[j] = 0.0;
+  for (j = 0; j < S->n; ++j) {
+    const double x0 = X[j], x1 = X[n + (size_t)j], x2 = X[2 * n + (size_t)j];
+    if (x0 == 0.0 && x1 == 0.0 && x2 == 0.0) continue;
+    for (p = S->q_p[j]; p < S->q_p[j + 1]; ++p) {
+      const size_t i = (size_t)S->q_i[p];
+      const double q = S->q_x[p];
+      Y[i] += q * x0; Y[n + i] += q * x1; Y[2 * n + i] += q * x2;
+    }
   }
 }
 
@@ -12213,8 +12430,7 @@ PHGMG__PRIV void phgmg__gl3_eval_jr(phgmg_gl3 *s, const double *x) {
       for (i = 0; i < N; ++i) g[i] = qd[i] * (x[i] + z[i]);
     }
   } else if (s->sps) {
-    for (st = 0; st < 3; ++st)
-      phgmg__sp_qmv(s->sps, s->Y + (size_t)st * (size_t)N, s->G + (size_t)st * (size_t)N);
+    phgmg__sp_qmv3(s->sps, s->Y, s->G);
   } else {
     for (st = 0; st < 3; ++st)
       phgmg__dia_mv(&s->dq, s->Y + (size_t)st * (size_t)N, s->G + (size_t)st * (size_t)N);
@@ -26156,10 +26372,74 @@ PHGMG__PRIV void phgmg__gemm_micro(int kc, const double *Ap, const double *B, si
   }
 }
 
+/* The same tile with fused multiply-adds (AVX-512F: one 8-wide register
+   per column of the tile; FMA3: two 4-wide ones), else phgmg__gemm_micro.
+   Only the sparse solver's fronts use it (manual 8.12): a fused
+   multiply-add rounds once, so the dense kernels keep their results. */
+PHGMG__PRIV void phgmg__gemm_micro_fma(int kc, const double *Ap, const double *B, size_t bsp,
+                                       size_t bsj, int mr, int nr, double alpha, double *C, int ldc) {
+#ifdef PHGMG__FMA_KERNEL
+  double tile[PHGMG__MR * PHGMG__NR];
+  const double *b0 = B, *b1 = B + (nr > 1 ? bsj : 0), *b2 = B + (nr > 2 ? 2 * bsj : 0);
+  const double *b3 = B + (nr > 3 ? 3 * bsj : 0), *b4 = B + (nr > 4 ? 4 * bsj : 0);
+  const double *b5 = B + (nr > 5 ? 5 * bsj : 0);
+  int p, i, j;
+#ifdef __AVX512F__
+  __m512d c0 = _mm512_setzero_pd(), c1 = c0, c2 = c0, c3 = c0, c4 = c0, c5 = c0, a;
+  for (p = 0; p < kc; ++p, Ap += PHGMG__MR) {
+    const size_t o = (size_t)p * bsp;
+    a = _mm512_loadu_pd(Ap);
+    c0 = _mm512_fmadd_pd(a, _mm512_set1_pd(b0[o]), c0);
+    c1 = _mm512_fmadd_pd(a, _mm512_set1_pd(b1[o]), c1);
+    c2 = _mm512_fmadd_pd(a, _mm512_set1_pd(b2[o]), c2);
+    c3 = _mm512_fmadd_pd(a, _mm512_set1_pd(b3[o]), c3);
+    c4 = _mm512_fmadd_pd(a, _mm512_set1_pd(b4[o]), c4);
+    c5 = _mm512_fmadd_pd(a, _mm512_set1_pd(b5[o]), c5);
+  }
+  if (mr == PHGMG__MR && nr == PHGMG__NR) { /* a whole tile: C updated from the registers */
+    const __m512d al = _mm512_set1_pd(alpha);
+    double *c = C;
+#define PHGMG__FMA_CUPD(cj) do { _mm512_storeu_pd(c, _mm512_fmadd_pd(al, cj, _mm512_loadu_pd(c))); c += ldc; } while (0)
+    PHGMG__FMA_CUPD(c0); PHGMG__FMA_CUPD(c1); PHGMG__FMA_CUPD(c2);
+    PHGMG__FMA_CUPD(c3); PHGMG__FMA_CUPD(c4); PHGMG__FMA_CUPD(c5);
+#undef PHGMG__FMA_CUPD
+    return;
+  }
+  _mm512_storeu_pd(tile, c0); _mm512_storeu_pd(tile + 8, c1); _mm512_storeu_pd(tile + 16, c2);
+  _mm512_storeu_pd(tile + 24, c3); _mm512_storeu_pd(tile + 32, c4); _mm512_storeu_pd(tile + 40, c5);
+#else
+  __m256d c00 = _mm256_setzero_pd(), c01 = c00, c10 = c00, c11 = c00, c20 = c00, c21 = c00;
+  __m256d c30 = c00, c31 = c00, c40 = c00, c41 = c00, c50 = c00, c51 = c00, a0, a1, x;
+  for (p = 0; p < kc; ++p, Ap += PHGMG__MR) {
+    const size_t o = (size_t)p * bsp;
+    a0 = _mm256_loadu_pd(Ap); a1 = _mm256_loadu_pd(Ap + 4);
+    x = _mm256_set1_pd(b0[o]); c00 = _mm256_fmadd_pd(a0, x, c00); c01 = _mm256_fmadd_pd(a1, x, c01);
+    x = _mm256_set1_pd(b1[o]); c10 = _mm256_fmadd_pd(a0, x, c10); c11 = _mm256_fmadd_pd(a1, x, c11);
+    x = _mm256_set1_pd(b2[o]); c20 = _mm256_fmadd_pd(a0, x, c20); c21 = _mm256_fmadd_pd(a1, x, c21);
+    x = _mm256_set1_pd(b3[o]); c30 = _mm256_fmadd_pd(a0, x, c30); c31 = _mm256_fmadd_pd(a1, x, c31);
+    x = _mm256_set1_pd(b4[o]); c40 = _mm256_fmadd_pd(a0, x, c40); c41 = _mm256_fmadd_pd(a1, x, c41);
+    x = _mm256_set1_pd(b5[o]); c50 = _mm256_fmadd_pd(a0, x, c50); c51 = _mm256_fmadd_pd(a1, x, c51);
+  }
+  _mm256_storeu_pd(tile, c00); _mm256_storeu_pd(tile + 4, c01); _mm256_storeu_pd(tile + 8, c10);
+  _mm256_storeu_pd(tile + 12, c11); _mm256_storeu_pd(tile + 16, c20); _mm256_storeu_pd(tile + 20, c21);
+  _mm256_storeu_pd(tile + 24, c30); _mm256_storeu_pd(tile + 28, c31); _mm256_storeu_pd(tile + 32, c40);
+  _mm256_storeu_pd(tile + 36, c41); _mm256_storeu_pd(tile + 40, c50); _mm256_storeu_pd(tile + 44, c51);
+#endif
+  for (j = 0; j < nr; ++j) {
+    double *c = C + (size_t)j * (size_t)ldc;
+    const double *t = tile + PHGMG__MR * j;
+    for (i = 0; i < mr; ++i) c[i] += alpha * t[i];
+  }
+#else
+  phgmg__gemm_micro(kc, Ap, B, bsp, bsj, mr, nr, alpha, C, ldc);
+#endif
+}
+
 /* C (m x n) += alpha * opA(A) * opB(B), opB(B)(p, j) = B[p*bsp + j*bsj];
    amode 0: opA(A)(i, p) = A[i + p*lda]; 1: A[p + i*lda] (transposed);
    2 (m even, A the real view of an interleaved complex matrix): rows 2r, 2r+1
-   of opA are (-Im, Re) of complex row r, i.e. the real view of i*A. */
+   of opA are (-Im, Re) of complex row r, i.e. the real view of i*A; amode + 4:
+   the same with the fused multiply-add tile (phgmg__gemm_micro_fma). */
 /* One row block ic:ic+mc of the product over k block pc:pc+kc (see below):
    packs its own copy of opA (stack), so row blocks are independent. */
 PHGMG__PRIV void phgmg__gemm_rowblock(int ic, int mc, int pc, int kc, int n, double alpha, int amode,
@@ -26171,14 +26451,14 @@ PHGMG__PRIV void phgmg__gemm_rowblock(int ic, int mc, int pc, int kc, int n, dou
   for (ir = 0; ir < mc; ir += PHGMG__MR) {
     int mr = PHGMG__MIN(PHGMG__MR, mc - ir);
     double *dst = Ap + (size_t)ir * (size_t)kc;
-    if (amode == 0) {
+    if ((amode & 3) == 0) {
       for (p = 0; p < kc; ++p) {
         const double *src = A + (ic + ir) + (size_t)(pc + p) * (size_t)lda;
         double *d = dst + (size_t)p * PHGMG__MR;
         for (i = 0; i < mr; ++i) d[i] = src[i];
         for (; i < PHGMG__MR; ++i) d[i] = 0.0;
       }
-    } else if (amode == 1) {
+    } else if ((amode & 3) == 1) {
       for (i = 0; i < PHGMG__MR; ++i) {
         if (i < mr) {
           const double *src = A + pc + (size_t)(ic + ir + i) * (size_t)lda;
@@ -26200,9 +26480,9 @@ PHGMG__PRIV void phgmg__gemm_rowblock(int ic, int mc, int pc, int kc, int n, dou
     int nr = PHGMG__MIN(PHGMG__NR, n - jr);
     const double *bp = B + (size_t)pc * bsp + (size_t)jr * bsj;
     for (ir = 0; ir < mc; ir += PHGMG__MR)
-      phgmg__gemm_micro(kc, Ap + (size_t)ir * (size_t)kc, bp, bsp, bsj,
-                        PHGMG__MIN(PHGMG__MR, mc - ir), nr, alpha,
-                        C + (ic + ir) + (size_t)jr * (size_t)ldc, ldc);
+      (amode & 4 ? phgmg__gemm_micro_fma : phgmg__gemm_micro)(kc, Ap + (size_t)ir * (size_t)kc, bp, bsp, bsj,
+                                                              PHGMG__MIN(PHGMG__MR, mc - ir), nr, alpha,
+                                                              C + (ic + ir) + (size_t)jr * (size_t)ldc, ldc);
   }
 }
 
@@ -26239,6 +26519,13 @@ PHGMG__PRIV void phgmg__zgemm_acc(int m, int n, int k, double alpha, const doubl
   size_t bsj = 2 * (size_t)ldb;
   phgmg__gemm_acc(2 * m, n, k, alpha, 0, A, 2 * lda, B, 2, bsj, C, 2 * ldc);
   phgmg__gemm_acc(2 * m, n, k, alpha, 2, A, 2 * lda, B + 1, 2, bsj, C, 2 * ldc);
+}
+/* The same with the fused multiply-add tile (the sparse fronts). */
+PHGMG__PRIV void phgmg__zgemm_acc_fma(int m, int n, int k, double alpha, const double *A, int lda,
+                                      const double *B, int ldb, double *C, int ldc) {
+  size_t bsj = 2 * (size_t)ldb;
+  phgmg__gemm_acc(2 * m, n, k, alpha, 4, A, 2 * lda, B, 2, bsj, C, 2 * ldc);
+  phgmg__gemm_acc(2 * m, n, k, alpha, 6, A, 2 * lda, B + 1, 2, bsj, C, 2 * ldc);
 }
 
 PHGMG_DEF void phgmg_gemm(char transa, char transb, int m, int n, int k, double alpha,
