@@ -4089,6 +4089,7 @@ typedef struct phgmg_balanced_info {
   double res_ctrl, res_obs; /* Lyapunov residuals, relative (low-rank: the ADI's ||W^T W|| /
                           ||B^T B||; dense: phgmg_lyap_residual's); PHBT: res_obs 0             */
   int nsv;             /* values written to sv                                                   */
+  int hmin;            /* PHBT: 1 balanced against the minimal Hamiltonian, 0 against the energy Q */
 } phgmg_balanced_info;
 
 /* Balancing-based reduction of a linear pH model to a pH reduced model
@@ -21947,35 +21948,106 @@ PHGMG__PRIV phgmg_result phgmg__bal_sparse_bt(phgmg_reduced **out, const phgmg_p
   return rc;
 }
 
-/* Sparse pH-preserving balancing (phgmg_lrphbt) to a reduced object: K = Jr
-   - Rr, Qh = Qr, V0 = V, W = Q E T (T = V Sigma: W^T V0 = I). */
+/* pH balancing of a dense pH model s (order k, E = I) against its minimal
+   Hamiltonian X (the minimal solution of the KYP inequality, phgmg__pr_zero_d)
+   instead of its energy matrix Q: P = L L^T (controllability Gramian), L^T X L
+   = Y diag(sig^2) Y^T, T = L Y_r Sig_r^{-1/2} (T^T X T = Sig_r), Galerkin in
+   the X inner product: F = T^T X A T, K = F (its symmetric part clipped by
+   phgmg__ph_clip), Qh = Sig_r^{-1}, Bh = (C T)^T; lift V2 = T Sig_r^{-1} and
+   restrict W2 = X T (k x r each, W2^T V2 = I); sig: all k values, descending.
+   s dense (J, R, Q k x k). Where the minimal Hamiltonian does not exist (a
+   port without damping: phgmg__pr_zero_d fails) X = Q; *hmin says which. */
+PHGMG__PRIV phgmg_result phgmg__phbt_min(const phgmg_ph_system *s, int r, double *K, double *Qh, double *Bh,
+                                         double *V2, double *W2, double *sig, int *hmin, const phgmg_allocator *al) {
+  const int k = s->N, m = s->m;
+  const size_t kk = (size_t)k * k;
+  double *A = phgmg__dalloc(al, 5 * kk + (size_t)m * k + k), *P = A + kk, *X = P + kk, *U = X + kk, *G = U + kk,
+         *C = G + kk, *w = C + (size_t)m * k, clip;
+  phgmg_result rc;
+  int i, j;
+  if (!A) return PHGMG_ERR_NOMEM;
+  rc = phgmg_ph_abc(s, A, C, al);
+  if (rc == PHGMG_OK) {
+    phgmg_gemm('N', 'T', k, k, m, 1.0, s->B, k, s->B, k, 0.0, G, k);
+    rc = phgmg_lyap(k, A, G, P, NULL, al);
+  }
+  if (rc == PHGMG_OK) {   /* no minimal Hamiltonian (a port without damping): the energy Q */
+    rc = phgmg__pr_zero_d(k, m, A, s->B, C, X, al);
+    *hmin = rc == PHGMG_OK;
+    if (rc != PHGMG_OK && rc != PHGMG_ERR_NOMEM) { memcpy(X, s->Q, sizeof(double) * kk); rc = PHGMG_OK; }
+  }
+  if (rc == PHGMG_OK) rc = phgmg_sym_eig(k, P, k, w, U, k);
+  if (rc == PHGMG_OK) {   /* L = U sqrt(w+) into U, G = L^T X L */
+    for (j = 0; j < k; ++j) {
+      const double t = sqrt(w[j] > 0.0 ? w[j] : 0.0);
+      for (i = 0; i < k; ++i) U[i + (size_t)j * k] *= t;
+    }
+    phgmg_gemm('N', 'N', k, k, k, 1.0, X, k, U, k, 0.0, P, k);
+    phgmg_gemm('T', 'N', k, k, k, 1.0, U, k, P, k, 0.0, G, k);
+    rc = phgmg_sym_eig(k, G, k, w, P, k);
+  }
+  if (rc == PHGMG_OK) {
+    for (j = 0; j < k; ++j) sig[j] = sqrt(w[k - 1 - j] > 0.0 ? w[k - 1 - j] : 0.0);
+    if (!(sig[r - 1] > 1e-14 * sig[0])) rc = PHGMG_ERR_RANK;
+  }
+  if (rc == PHGMG_OK) {   /* T = L Y_r Sig_r^{-1/2} into V2; W2 = X T; G = A T */
+    for (j = 0; j < r; ++j)
+      for (i = 0; i < k; ++i) G[i + (size_t)j * k] = P[i + (size_t)(k - 1 - j) * k] / sqrt(sig[j]);
+    phgmg_gemm('N', 'N', k, r, k, 1.0, U, k, G, k, 0.0, V2, k);
+    phgmg_gemm('N', 'N', k, r, k, 1.0, X, k, V2, k, 0.0, W2, k);
+    phgmg_gemm('N', 'N', k, r, k, 1.0, A, k, V2, k, 0.0, G, k);
+    phgmg_gemm('T', 'N', r, r, k, 1.0, W2, k, G, k, 0.0, K, r);
+    phgmg_gemm('T', 'T', r, m, k, 1.0, V2, k, C, m, 0.0, Bh, r);
+    rc = phgmg__ph_clip(r, K, &clip, al);
+  }
+  if (rc == PHGMG_OK)
+    for (j = 0; j < r; ++j) {
+      for (i = 0; i < r; ++i) Qh[i + (size_t)j * r] = i == j ? 1.0 / sig[j] : 0.0;
+      for (i = 0; i < k; ++i) V2[i + (size_t)j * k] /= sig[j];
+    }
+  phgmg__free(al, A);
+  return rc;
+}
+
+/* Sparse pH-preserving balancing to a reduced object, in two stages: the
+   first stage of the sparse PRBT (phgmg__bal_pr_stage1: the Galerkin
+   projection onto the controllability factor's span, order k), then
+   phgmg__phbt_min of that model (its minimal Hamiltonian; its energy where
+   none exists); the bases composed. */
 PHGMG__PRIV phgmg_result phgmg__bal_sparse_phbt(phgmg_reduced **out, const phgmg_ph_sparse *sp, int r,
                                                 const phgmg_lradi_opts *opts, double *sv, int nsv,
                                                 phgmg_balanced_info *inf, const phgmg_allocator *al) {
   const int N = sp->sys.N, m = sp->sys.m;
-  const size_t rr = (size_t)r * r;
-  double *Jr = phgmg__dalloc(al, 3 * rr + (size_t)r * m + r + 3 * (size_t)N * r), *Rr = Jr + rr, *Qr = Rr + rr,
-         *Br = Qr + rr, *sg = Br + (size_t)r * m, *V = sg + r, *W = V + (size_t)N * r, *t = W + (size_t)N * r;
-  phgmg_result rc;
-  int i, j;
-  if (!Jr) return PHGMG_ERR_NOMEM;
-  rc = phgmg_lrphbt(sp, r, opts, Jr, Rr, Qr, Br, sg, V, &inf->lr, al);
-  inf->lowrank = 1;
-  inf->res_ctrl = inf->lr.ctrl.res;
+  double *blk = NULL, *wk = NULL;
+  phgmg_ph_system s2;
+  int k = 0;
+  phgmg_result rc = phgmg__bal_pr_stage1(sp, opts, &k, &blk, inf, al);
+  inf->stages = 2; inf->inter = k;
+  if (rc == PHGMG_OK && k < r) rc = PHGMG_ERR_RANK;
   if (rc == PHGMG_OK) {
-    for (i = 0; i < (int)rr; ++i) Jr[i] -= Rr[i];   /* K = Jr - Rr */
-    for (j = 0; j < r; ++j) {
-      const double *v = V + (size_t)j * N;
-      double *w = W + (size_t)j * N;
-      if (sp->cp[3]) { phgmg__lr_cscmv(sp, 3, v, t); phgmg__lr_cscmv(sp, 2, t, w); }
-      else phgmg__lr_cscmv(sp, 2, v, w);
-      for (i = 0; i < N; ++i) w[i] *= sg[j];
+    const size_t kk = (size_t)k * k, rr = (size_t)r * r, kr = (size_t)k * r;
+    double *K, *Qh, *Bh, *V2, *W2, *sg, *V0, *W0;
+    memset(&s2, 0, sizeof s2);
+    s2.N = k; s2.m = m; s2.J = blk + 2 * (size_t)N * k; s2.R = s2.J + kk; s2.Q = s2.R + kk; s2.B = s2.Q + 2 * kk;
+    wk = phgmg__dalloc(al, 2 * rr + (size_t)r * m + 2 * kr + k + 2 * (size_t)N * r);
+    if (!wk) rc = PHGMG_ERR_NOMEM;
+    else {
+      K = wk; Qh = K + rr; Bh = Qh + rr; V2 = Bh + (size_t)r * m; W2 = V2 + kr; sg = W2 + kr; V0 = sg + k;
+      W0 = V0 + (size_t)N * r;
+      phgmg__lr_progress(opts, "balancing");
+      rc = phgmg__phbt_min(&s2, r, K, Qh, Bh, V2, W2, sg, &inf->hmin, al);
+      if (rc == PHGMG_OK) {
+        phgmg_gemm('N', 'N', N, r, k, 1.0, blk, N, V2, k, 0.0, V0, N);
+        phgmg_gemm('N', 'N', N, r, k, 1.0, blk + (size_t)N * k, N, W2, k, 0.0, W0, N);
+        rc = phgmg__bal_red(out, &sp->sys, r, PHGMG_METHOD_PHBT, K, Qh, Bh, V0, W0, al);
+        inf->lr.nhsv = k;
+        inf->lr.hsv_tail = k > r ? sg[r] : 0.0;
+        inf->nsv = PHGMG__MIN(k, nsv);
+        if (sv) memcpy(sv, sg, sizeof(double) * (size_t)inf->nsv);
+      }
     }
-    rc = phgmg__bal_red(out, &sp->sys, r, PHGMG_METHOD_PHBT, Jr, Qr, Br, V, W, al);
-    inf->nsv = PHGMG__MIN(r, nsv);
-    if (sv) memcpy(sv, sg, sizeof(double) * (size_t)inf->nsv);
   }
-  phgmg__free(al, Jr);
+  phgmg__free(al, blk); phgmg__free(al, wk);
   return rc;
 }
 

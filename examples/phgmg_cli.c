@@ -419,7 +419,11 @@ static const char *const help_lines[] = {
   "          of the controllability Gramian's low-rank factor, then the dense\n",
   "          PRBT of that model (order: the factor's rank, typically 50-200).\n",
   "    phbt  pH-preserving balancing with one Lyapunov equation (sparse input\n",
-  "          only): pH by construction, no error bound, less accurate than bt.\n",
+  "          only): the controllability Gramian balanced against the model's\n",
+  "          minimal Hamiltonian (the least energy function among its pH forms;\n",
+  "          the energy Q where none exists: a port without damping), in two\n",
+  "          stages like prbt. pH by construction, no error bound; about as\n",
+  "          accurate as prbt, less than bt.\n",
   "  NAME.json's \"info\" holds the solver (low-rank or dense), the Gramian\n",
   "  factors' ranks, ADI steps and factorizations, the Lyapunov residuals\n",
   "  (relative), the singular values (first 64) and, for bt, \"error_bound\". The\n",
@@ -4357,7 +4361,10 @@ static int run_balancing(const reduce_args *A, reduce_state *S, double *t_red) {
              b->ph_change > 0.0 ? "" : "");
   if (S->bal.stages == 2)
     progress("  two stages: the pH Galerkin projection onto the controllability factor (order %d), then the "
-             "dense PRBT; positive-real singular values %.6g ... %.3g", b->inter, S->bal_sv[0],
+             "dense %s; %s singular values %.6g ... %.3g", b->inter,
+             S->method == PHGMG_METHOD_PRBT ? "PRBT" : b->hmin ? "pH balancing against the minimal Hamiltonian"
+                                                            : "pH balancing against the energy (no minimal Hamiltonian)",
+             S->method == PHGMG_METHOD_PRBT ? "positive-real" : "pH", S->bal_sv[0],
              S->bal_sv[b->nsv > 0 ? b->nsv - 1 : 0]);
   return 0;
 }
