@@ -3991,6 +3991,7 @@ static void json_balancing(FILE *jf, const reduce_state *S, int method) {
     fprintf(jf, ", "); json_num(jf, b->res_obs); fprintf(jf, "]");
   }
   if (method != PHGMG_METHOD_PRBT) fprintf(jf, ", \"values_computed\": %d", b->lr.nhsv);
+  if (method == PHGMG_METHOD_PHBT) fprintf(jf, ", \"hamiltonian\": \"%s\"", b->hmin ? "minimal" : "energy");
   fprintf(jf, ", \"%s\": [", method == PHGMG_METHOD_BT ? "hankel_singular_values"
                             : method == PHGMG_METHOD_PRBT ? "positive_real_singular_values" : "energy_singular_values");
   for (i = 0; i < b->nsv; ++i) { if (i) fprintf(jf, ", "); json_num(jf, S->bal_sv[i]); }
