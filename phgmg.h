@@ -753,8 +753,11 @@
          model put in pH form by phgmg_ss_to_ph, when it is passive),
          PHGMG_METHOD_PRBT (dense: phgmg_prbt; sparse: two stages, the pH
          Galerkin projection onto the span of the controllability factor,
-         then the dense PRBT of that model), PHGMG_METHOD_PHBT (sparse:
-         phgmg_lrphbt); info: the ranks, residuals, values and bound. The
+         then the dense PRBT of that model), PHGMG_METHOD_PHBT (sparse: the
+         same first stage, then the controllability Gramian balanced against
+         the minimal Hamiltonian of that model, 8.13; phgmg_lrphbt balances
+         against the energy instead); info: the ranks, residuals, values,
+         bound and (hmin) the Hamiltonian used. The
          command line's `reduce --method bt|prbt|phbt` is this function
          (COO input: sparse; dense input: dense);
      phgmg_ss_to_ph
@@ -1902,9 +1905,35 @@
    Qr diagonal positive; the model is passive. The values sigma carry no
    H-infinity bound, and the error is larger than BT's: on the 8 x 8
    lattice of the tests 0.38 / 0.12 of the sampled norm at r = 4 / 12,
-   where BT has 0.044 at r = 8. Choosing the Hamiltonian that
-   minimises an error bound (the other half of the pH balancing
-   literature) is not done.
+   where BT has 0.044 at r = 8.
+   The choice of the Hamiltonian (phgmg_balanced_reduce's PHBT). A passive
+   model has many pH forms: any X > 0 with A^T X + X A <= 0 and X B = C^T
+   (the KYP inequality with zero feedthrough) is a Hamiltonian, A = (A
+   X^{-1}) X with A X^{-1} = J_X - R_X, and the balancing above works with
+   any of them in place of E^T Q (test space X T, Jr - Rr = T^T X A T, Br =
+   T^T C^T). The values sqrt(eig(P X)) grow with X, and E^T Q is not the
+   smallest: the minimal solution X_min (the available storage) gives the
+   smallest values and, measured, the smallest error. On the lattices of
+   bench/lowrank_models.py (the dense reference bench/phbt_ref.py, SciPy,
+   independent of the library): 16 x 16 (N = 512), r = 20: balancing
+   against Q: sampled H-infinity error 2.8e-2 of ||G||, output error (500
+   steps of dt 0.1, u = 0.1 sin on each port) 3.1e-2 -- the value of the N
+   = 100 352 run, so that is the method's error with Q, not a defect (the
+   library's model equals SciPy's: 2.928e-2 both); against X_min: 9.8e-4 /
+   1.05e-3 (BT: 8.7e-4 / 8.4e-4); 8 x 8, r = 12: 0.116 against Q, 0.037
+   against X_min. Q satisfies the observability Lyapunov inequality here (Q
+   (2R - B B^T) Q >= 0, R >= 0.5 I on the momenta), so BT's bound 2
+   sum_{i>r} sigma_i holds for the balancing against Q (0.59 at N = 512, r
+   = 20: true but loose); X_min does not (no bound is stated for it). X_min
+   costs a dense Riccati solve, so phgmg_balanced_reduce computes it for the
+   first stage of the sparse PRBT (the Galerkin model on span(Z_c), order k
+   = the factor's rank, see below; O(k^3)): P_k by phgmg_lyap, X_min by the
+   zero-feedthrough solver of phgmg_ss_to_ph (phgmg__pr_zero_d), the
+   balancing and projection of that model, the bases composed. The minimal
+   solution needs every port damped (B^T Q R Q B > 0); otherwise the
+   balancing is against the first stage's energy, which is phgmg_lrphbt's
+   (info->hmin = 0). phgmg_lrphbt itself keeps the energy E^T Q: its reduced
+   Hamiltonian approximates the physical energy, X_min's does not.
    Checked (tests/test_lowrank.c): an 8 x 8 mass-spring-damper lattice (N =
    128, complex shifts): Z Z^T and Q Z_y Z_y^T Q within 1.5e-10 (relative,
    Frobenius) of phgmg_lyap's dense Gramians, the residual reported and
@@ -4108,8 +4137,13 @@ typedef struct phgmg_balanced_info {
                         its pH form, then the dense PRBT of that model (manual
                         8.13). sv: the positive-real singular values of the
                         last stage.
-     PHGMG_METHOD_PHBT  pH-preserving balancing (phgmg_lrphbt; sparse only,
-                        else PHGMG_ERR_UNSUPPORTED). sv: its values sigma.
+     PHGMG_METHOD_PHBT  pH-preserving balancing (sparse only, else
+                        PHGMG_ERR_UNSUPPORTED), two stages like PRBT: the
+                        first stage's controllability Gramian P balanced
+                        against the minimal Hamiltonian X of that model (the
+                        minimal solution of its KYP inequality; info->hmin =
+                        1), or against its energy Q where X does not exist (a
+                        port without damping; hmin = 0). sv: sqrt(eig(P X)).
    Lift x = V0 xr (phgmg_reduced_lift; V0 in the sparse object's internal
    order for sp), restrict xr = W^T x (W^T V0 = I). sv (may be NULL): up to
    nsv values (info->nsv of them). opts: the ADI options (sparse only; may be
