@@ -4156,6 +4156,32 @@ PHGMG_DEF phgmg_result phgmg_balanced_reduce(phgmg_reduced **out, const phgmg_ph
                                              const phgmg_lradi_opts *opts, double *sv, int nsv,
                                              phgmg_balanced_info *info, const phgmg_allocator *alloc);
 
+/* The low-rank Gramian factors of one sparse model, kept between calls of
+   phgmg_balanced_reduce_cached (a sweep over methods and orders computes
+   them once). Zero it (memset) before the first call; the first call
+   binds it to its model (another model: PHGMG_ERR_INVALID_ARG) and stores
+   each factor when it is first computed (bt: both; prbt, phbt: the
+   controllability one); later calls copy them instead of running the ADI
+   (the same ADI options must be given: they are not compared). Free it
+   with phgmg_balanced_cache_free (the same allocator). Fields: read only. */
+typedef struct phgmg_balanced_cache {
+  const phgmg_ph_sparse *sp;   /* the model (NULL: unbound)                          */
+  double *Zc, *Zo;             /* the factors (N x kc, N x ko; NULL: not yet)          */
+  int kc, ko;
+  phgmg_lradi_info ctrl, obs;  /* the ADI runs that made them                        */
+  int adi_runs;                /* ADI runs made through this cache (a counter)        */
+} phgmg_balanced_cache;
+
+/* phgmg_balanced_reduce with a cache (may be NULL: the same as
+   phgmg_balanced_reduce); dense models ignore it. */
+PHGMG_DEF phgmg_result phgmg_balanced_reduce_cached(phgmg_reduced **out, const phgmg_ph_system *sys,
+                                                    const phgmg_ph_sparse *sp, int method, int r,
+                                                    const phgmg_lradi_opts *opts, double *sv, int nsv,
+                                                    phgmg_balanced_info *info, phgmg_balanced_cache *cache,
+                                                    const phgmg_allocator *alloc);
+/* Frees the factors of a cache and zeroes it (NULL: nothing). */
+PHGMG_DEF void phgmg_balanced_cache_free(phgmg_balanced_cache *cache, const phgmg_allocator *alloc);
+
 #ifdef __cplusplus
 }
 #endif
@@ -21513,33 +21539,48 @@ PHGMG_DEF phgmg_result phgmg_lradi(phgmg_shifted *s, int m, const double *B, int
 
 /* The two Gramian factors of phgmg_lrbt: Zc (kc columns) and Zo = Q Zy
    (ko columns), with the ADI runs' info. */
+PHGMG__PRIV phgmg_result phgmg__lrbt_obs(const phgmg_ph_sparse *sp, const phgmg_lradi_opts *opts, phgmg_shifted *sc,
+                                         const double *Zc, int kc, double **Zo, int *ko, phgmg_lrbt_info *inf,
+                                         const phgmg_allocator *al);
 PHGMG__PRIV phgmg_result phgmg__lrbt_factors(const phgmg_ph_sparse *sp, const phgmg_lradi_opts *opts,
                                              phgmg_shifted *sc, double **Zc, int *kc, double **Zo, int *ko,
                                              phgmg_lrbt_info *inf, const phgmg_allocator *al) {
   const int N = sp->sys.N, m = sp->sys.m;
-  phgmg_shifted *sd = NULL;
-  double *Zy = NULL;
-  int j, jzero = 1;
   phgmg_result rc;
   phgmg__lr_progress(opts, "controllability Gramian");
   rc = phgmg_lradi(sc, m, sp->sys.B, N, opts, Zc, kc, &inf->ctrl, al);
   if (rc != PHGMG_OK) return rc;
+  return phgmg__lrbt_obs(sp, opts, sc, *Zc, *kc, Zo, ko, inf, al);
+}
+
+/* The observability factor Zo = Q Zy of phgmg_lrbt (Zy: the dual model's
+   controllability factor; Zc when J = 0), inf->obs its ADI run. */
+PHGMG__PRIV phgmg_result phgmg__lrbt_obs(const phgmg_ph_sparse *sp, const phgmg_lradi_opts *opts, phgmg_shifted *sc,
+                                         const double *Zc, int kc, double **Zo, int *ko, phgmg_lrbt_info *inf,
+                                         const phgmg_allocator *al) {
+  const int N = sp->sys.N, m = sp->sys.m;
+  phgmg_shifted *sd = NULL;
+  double *Zy = NULL;
+  const double *Zu;
+  int j, jzero = 1;
+  phgmg_result rc;
   for (j = 0; j < sp->cp[0][N] && jzero; ++j) jzero = sp->cx[0][j] == 0.0;
   if (jzero) { /* the dual model is the model: Zy = Zc */
     inf->obs = inf->ctrl;
-    *ko = *kc;
-    Zy = *Zc;
+    *ko = kc;
+    Zu = Zc;
   } else {
     phgmg__lr_progress(opts, "observability Gramian");
     rc = phgmg_shifted_create(&sd, sp, 1, 0, al);
     if (rc == PHGMG_OK) rc = phgmg_lradi(sd, m, sp->sys.B, N, opts, &Zy, ko, &inf->obs, al);
     phgmg_shifted_destroy(sd);
     if (rc != PHGMG_OK) return rc;
+    Zu = Zy;
   }
   *Zo = phgmg__dalloc(al, (size_t)N * (size_t)*ko);
   if (*Zo)
-    for (j = 0; j < *ko; ++j) phgmg__sp_qmv(sc->S, Zy + (size_t)j * N, *Zo + (size_t)j * N);
-  if (Zy != *Zc) phgmg__free(al, Zy);
+    for (j = 0; j < *ko; ++j) phgmg__sp_qmv(sc->S, Zu + (size_t)j * N, *Zo + (size_t)j * N);
+  phgmg__free(al, Zy);
   return *Zo ? PHGMG_OK : PHGMG_ERR_NOMEM;
 }
 
@@ -21840,11 +21881,63 @@ PHGMG__PRIV phgmg_result phgmg__bal_red(phgmg_reduced **out, const phgmg_ph_syst
   return PHGMG_OK;
 }
 
+/* The cache's copy of n doubles into *Z (allocated). */
+PHGMG__PRIV phgmg_result phgmg__bal_copy(const double *x, size_t n, double **Z, const phgmg_allocator *al) {
+  *Z = phgmg__dalloc(al, n);
+  if (!*Z) return PHGMG_ERR_NOMEM;
+  memcpy(*Z, x, sizeof(double) * n);
+  return PHGMG_OK;
+}
+
+/* The controllability factor Z (k columns) of sp: the cache's copy when it
+   holds one, else phgmg_lradi on sc (created here when sc is NULL), kept in
+   the cache (c may be NULL). */
+PHGMG__PRIV phgmg_result phgmg__bal_ctrl(const phgmg_ph_sparse *sp, const phgmg_lradi_opts *opts, phgmg_shifted *sc,
+                                         phgmg_balanced_cache *c, double **Z, int *k, phgmg_lradi_info *ci,
+                                         const phgmg_allocator *al) {
+  const int N = sp->sys.N;
+  phgmg_shifted *own = NULL;
+  phgmg_result rc = PHGMG_OK;
+  if (c && c->Zc) { *k = c->kc; *ci = c->ctrl; return phgmg__bal_copy(c->Zc, (size_t)N * c->kc, Z, al); }
+  if (!sc) rc = phgmg_shifted_create(&own, sp, 0, 0, al);
+  if (rc == PHGMG_OK) {
+    phgmg__lr_progress(opts, "controllability Gramian");
+    rc = phgmg_lradi(sc ? sc : own, sp->sys.m, sp->sys.B, N, opts, Z, k, ci, al);
+    if (c) c->adi_runs++;
+  }
+  phgmg_shifted_destroy(own);
+  if (rc == PHGMG_OK && c && phgmg__bal_copy(*Z, (size_t)N * *k, &c->Zc, al) == PHGMG_OK) {
+    c->kc = *k; c->ctrl = *ci;
+  }
+  return rc;
+}
+
+/* The observability factor (phgmg__lrbt_obs) through the cache as above. */
+PHGMG__PRIV phgmg_result phgmg__bal_obs(const phgmg_ph_sparse *sp, const phgmg_lradi_opts *opts, phgmg_shifted *sc,
+                                        phgmg_balanced_cache *c, const double *Zc, int kc, double **Zo, int *ko,
+                                        phgmg_lrbt_info *inf, const phgmg_allocator *al) {
+  const int N = sp->sys.N;
+  phgmg_result rc;
+  if (c && c->Zo) { *ko = c->ko; inf->obs = c->obs; return phgmg__bal_copy(c->Zo, (size_t)N * c->ko, Zo, al); }
+  rc = phgmg__lrbt_obs(sp, opts, sc, Zc, kc, Zo, ko, inf, al);
+  if (c) c->adi_runs++;
+  if (rc == PHGMG_OK && c && phgmg__bal_copy(*Zo, (size_t)N * *ko, &c->Zo, al) == PHGMG_OK) {
+    c->ko = *ko; c->obs = inf->obs;
+  }
+  return rc;
+}
+
+PHGMG_DEF void phgmg_balanced_cache_free(phgmg_balanced_cache *cache, const phgmg_allocator *alloc) {
+  if (!cache) return;
+  phgmg__free(alloc, cache->Zc); phgmg__free(alloc, cache->Zo);
+  memset(cache, 0, sizeof *cache);
+}
+
 /* Low-rank BT of sp to order r into *blk = [T (N r), W (N r), Ar (r r), Br
    (r m), Cr (m r)] (allocated here); the first nsv values into sv. */
 PHGMG__PRIV phgmg_result phgmg__bal_lr_stage(const phgmg_ph_sparse *sp, const phgmg_lradi_opts *opts, int r,
                                              double *sv, int nsv, double **blk, phgmg_balanced_info *inf,
-                                             const phgmg_allocator *al) {
+                                             phgmg_balanced_cache *cache, const phgmg_allocator *al) {
   const int N = sp->sys.N, m = sp->sys.m;
   const size_t nr = (size_t)N * r, q = (size_t)r * r, rm = (size_t)r * m;
   phgmg_shifted *sc = NULL;
@@ -21852,7 +21945,8 @@ PHGMG__PRIV phgmg_result phgmg__bal_lr_stage(const phgmg_ph_sparse *sp, const ph
   int kc = 0, ko = 0;
   phgmg_result rc = phgmg_shifted_create(&sc, sp, 0, 0, al);
   *blk = NULL;
-  if (rc == PHGMG_OK) rc = phgmg__lrbt_factors(sp, opts, sc, &Zc, &kc, &Zo, &ko, &inf->lr, al);
+  if (rc == PHGMG_OK) rc = phgmg__bal_ctrl(sp, opts, sc, cache, &Zc, &kc, &inf->lr.ctrl, al);
+  if (rc == PHGMG_OK) rc = phgmg__bal_obs(sp, opts, sc, cache, Zc, kc, &Zo, &ko, &inf->lr, al);
   if (rc == PHGMG_OK) {
     phgmg__lr_progress(opts, "balancing");
     *blk = phgmg__dalloc(al, 2 * nr + q + 2 * rm);
@@ -21877,18 +21971,13 @@ PHGMG__PRIV phgmg_result phgmg__bal_lr_stage(const phgmg_ph_sparse *sp, const ph
    z, restrict z = (Q E V)^T x. Into blk = [V0 (N k), W (N k), Jr, Rr, Qk (k
    k each), Br (k m)] (allocated here). */
 PHGMG__PRIV phgmg_result phgmg__bal_pr_stage1(const phgmg_ph_sparse *sp, const phgmg_lradi_opts *opts, int *k,
-                                              double **blk, phgmg_balanced_info *inf, const phgmg_allocator *al) {
+                                              double **blk, phgmg_balanced_info *inf, phgmg_balanced_cache *cache,
+                                              const phgmg_allocator *al) {
   const int N = sp->sys.N, m = sp->sys.m;
-  phgmg_shifted *sc = NULL;
   double *Z = NULL, *V0, *W, *Jr, *Rr, *Qk, *Br, *M;
-  phgmg_result rc = phgmg_shifted_create(&sc, sp, 0, 0, al);
+  phgmg_result rc = phgmg__bal_ctrl(sp, opts, NULL, cache, &Z, k, &inf->lr.ctrl, al);
   int i, j, kk;
   *blk = NULL;
-  if (rc == PHGMG_OK) {
-    phgmg__lr_progress(opts, "controllability Gramian");
-    rc = phgmg_lradi(sc, m, sp->sys.B, N, opts, &Z, k, &inf->lr.ctrl, al);
-  }
-  phgmg_shifted_destroy(sc);
   inf->lowrank = 1;
   inf->res_ctrl = inf->lr.ctrl.res;
   if (rc != PHGMG_OK) return rc;
@@ -21926,13 +22015,13 @@ PHGMG__PRIV phgmg_result phgmg__bal_pr_stage1(const phgmg_ph_sparse *sp, const p
    construction), then the dense PRBT of that model; the bases composed. */
 PHGMG__PRIV phgmg_result phgmg__bal_sparse_prbt(phgmg_reduced **out, const phgmg_ph_sparse *sp, int r,
                                                 const phgmg_lradi_opts *opts, double *sv, int nsv,
-                                                phgmg_balanced_info *inf, const phgmg_allocator *al) {
+                                                phgmg_balanced_info *inf, phgmg_balanced_cache *cache, const phgmg_allocator *al) {
   const int N = sp->sys.N, m = sp->sys.m;
   double *blk = NULL, *V0 = NULL, *W0;
   phgmg_reduced *red2 = NULL;
   phgmg_ph_system s2;
   int k = 0;
-  phgmg_result rc = phgmg__bal_pr_stage1(sp, opts, &k, &blk, inf, al);
+  phgmg_result rc = phgmg__bal_pr_stage1(sp, opts, &k, &blk, inf, cache, al);
   inf->stages = 2; inf->inter = k;
   if (rc == PHGMG_OK && k < r) rc = PHGMG_ERR_RANK;
   if (rc == PHGMG_OK) {
@@ -21965,10 +22054,10 @@ PHGMG__PRIV phgmg_result phgmg__bal_sparse_prbt(phgmg_reduced **out, const phgmg
 /* Sparse BT to a pH reduced object (phgmg_lrbt, phgmg_ss_to_ph). */
 PHGMG__PRIV phgmg_result phgmg__bal_sparse_bt(phgmg_reduced **out, const phgmg_ph_sparse *sp, int r,
                                               const phgmg_lradi_opts *opts, double *sv, int nsv,
-                                              phgmg_balanced_info *inf, const phgmg_allocator *al) {
+                                              phgmg_balanced_info *inf, phgmg_balanced_cache *cache, const phgmg_allocator *al) {
   const int N = sp->sys.N, m = sp->sys.m, k = r;
   double *blk = NULL, *KQ = NULL, *T, *W, *Ar;
-  phgmg_result rc = phgmg__bal_lr_stage(sp, opts, r, sv, nsv, &blk, inf, al);
+  phgmg_result rc = phgmg__bal_lr_stage(sp, opts, r, sv, nsv, &blk, inf, cache, al);
   if (rc == PHGMG_OK) {
     T = blk; W = T + (size_t)N * k; Ar = W + (size_t)N * k;
     KQ = phgmg__dalloc(al, 2 * (size_t)k * k);
@@ -22050,12 +22139,12 @@ PHGMG__PRIV phgmg_result phgmg__phbt_min(const phgmg_ph_system *s, int r, double
    none exists); the bases composed. */
 PHGMG__PRIV phgmg_result phgmg__bal_sparse_phbt(phgmg_reduced **out, const phgmg_ph_sparse *sp, int r,
                                                 const phgmg_lradi_opts *opts, double *sv, int nsv,
-                                                phgmg_balanced_info *inf, const phgmg_allocator *al) {
+                                                phgmg_balanced_info *inf, phgmg_balanced_cache *cache, const phgmg_allocator *al) {
   const int N = sp->sys.N, m = sp->sys.m;
   double *blk = NULL, *wk = NULL;
   phgmg_ph_system s2;
   int k = 0;
-  phgmg_result rc = phgmg__bal_pr_stage1(sp, opts, &k, &blk, inf, al);
+  phgmg_result rc = phgmg__bal_pr_stage1(sp, opts, &k, &blk, inf, cache, al);
   inf->stages = 2; inf->inter = k;
   if (rc == PHGMG_OK && k < r) rc = PHGMG_ERR_RANK;
   if (rc == PHGMG_OK) {
@@ -22156,6 +22245,14 @@ PHGMG_DEF phgmg_result phgmg_balanced_reduce(phgmg_reduced **out, const phgmg_ph
                                              const phgmg_ph_sparse *sp, int method, int r,
                                              const phgmg_lradi_opts *opts, double *sv, int nsv,
                                              phgmg_balanced_info *info, const phgmg_allocator *alloc) {
+  return phgmg_balanced_reduce_cached(out, sys, sp, method, r, opts, sv, nsv, info, NULL, alloc);
+}
+
+PHGMG_DEF phgmg_result phgmg_balanced_reduce_cached(phgmg_reduced **out, const phgmg_ph_system *sys,
+                                                    const phgmg_ph_sparse *sp, int method, int r,
+                                                    const phgmg_lradi_opts *opts, double *sv, int nsv,
+                                                    phgmg_balanced_info *info, phgmg_balanced_cache *cache,
+                                                    const phgmg_allocator *alloc) {
   phgmg_balanced_info inf;
   phgmg_result rc;
   const phgmg_ph_system *s;
@@ -22171,9 +22268,12 @@ PHGMG_DEF phgmg_result phgmg_balanced_reduce(phgmg_reduced **out, const phgmg_ph
   if (!sp && method == PHGMG_METHOD_PHBT) return PHGMG_ERR_UNSUPPORTED;
   s = sp ? &sp->sys : sys;
   if (r < 1 || r > s->N || (method != PHGMG_METHOD_PHBT && r <= s->m)) return PHGMG_ERR_SIZE;
-  if (sp && method == PHGMG_METHOD_PHBT) rc = phgmg__bal_sparse_phbt(out, sp, r, opts, sv, nsv, &inf, alloc);
-  else if (sp && method == PHGMG_METHOD_BT) rc = phgmg__bal_sparse_bt(out, sp, r, opts, sv, nsv, &inf, alloc);
-  else if (sp) rc = phgmg__bal_sparse_prbt(out, sp, r, opts, sv, nsv, &inf, alloc);
+  if (!sp) cache = NULL;
+  if (cache && cache->sp && cache->sp != sp) return PHGMG_ERR_INVALID_ARG;
+  if (cache) cache->sp = sp;
+  if (sp && method == PHGMG_METHOD_PHBT) rc = phgmg__bal_sparse_phbt(out, sp, r, opts, sv, nsv, &inf, cache, alloc);
+  else if (sp && method == PHGMG_METHOD_BT) rc = phgmg__bal_sparse_bt(out, sp, r, opts, sv, nsv, &inf, cache, alloc);
+  else if (sp) rc = phgmg__bal_sparse_prbt(out, sp, r, opts, sv, nsv, &inf, cache, alloc);
   else if (method == PHGMG_METHOD_BT) rc = phgmg__bal_dense_bt(out, sys, r, sv, nsv, &inf, alloc);
   else {
     double *ps = phgmg__dalloc(alloc, (size_t)r);

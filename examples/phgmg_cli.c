@@ -2505,6 +2505,7 @@ typedef struct reduce_state {
   int bal_on;               /* --method bt, prbt, phbt: what the balancing did */
   phgmg_balanced_info bal;
   double bal_sv[64];        /* its first values (bal.nsv) */
+  phgmg_balanced_cache bcache; /* the Gramian factors, shared by a sweep's balancing models */
 } reduce_state;
 
 /* Is w phi(s), phi(s) = sum_j c_j s^j + sum_e a_e exp(b_e s), bounded below
@@ -2597,6 +2598,7 @@ static int load_family(const reduce_args *A, reduce_state *S, phgmg_ph_system *s
 }
 
 static void reduce_cleanup(reduce_state *S) {
+  phgmg_balanced_cache_free(&S->bcache, NULL);
   mat_free(&S->J); mat_free(&S->R); mat_free(&S->B); mat_free(&S->Q); mat_free(&S->E); mat_free(&S->Pm); mat_free(&S->Sm); mat_free(&S->Nm); mat_free(&S->Dm); mat_free(&S->refm);
   free(S->di); free(S->dj); free(S->dlaw); mat_free(&S->X);
   mat_free(&S->poly); mat_free(&S->pidx); mat_free(&S->pw); mat_free(&S->ex); mat_free(&S->in.tab);
@@ -4345,6 +4347,7 @@ static int run_balancing(const reduce_args *A, reduce_state *S, double *t_red) {
   phase_log plog;
   phgmg_result rc;
   double t0;
+  int runs0;
   if (S->dae) return fail("--method %s: index-one descriptor models (E with zero rows) are not supported; give "
                           "an E of full rank", A->method);
   memset(&lo, 0, sizeof lo);
@@ -4353,10 +4356,14 @@ static int run_balancing(const reduce_args *A, reduce_state *S, double *t_red) {
   plog.t0 = t0; plog.all = 0; plog.ncand = plog.nprobe = 0;
   if (!g_quiet) { lo.progress = reduce_phase; lo.progress_user = &plog; }
   S->bal_on = 1;
-  rc = phgmg_balanced_reduce(&S->red, S->sp ? NULL : &S->sys, S->sp, S->method, A->r, &lo, S->bal_sv, 64, &S->bal,
-                             NULL);
+  runs0 = S->bcache.adi_runs;
+  rc = phgmg_balanced_reduce_cached(&S->red, S->sp ? NULL : &S->sys, S->sp, S->method, A->r, &lo, S->bal_sv, 64,
+                                    &S->bal, &S->bcache, NULL);
   *t_red = now_s() - t0;
   if (rc != PHGMG_OK) return explain_balancing(A, S, rc);
+  if (b->lowrank)
+    progress("  Gramian factors: %s", S->bcache.adi_runs > runs0 ? "computed (low-rank ADI)"
+                                       : "reused (computed once for this model in this run)");
   if (b->lowrank)
     progress("  done in %.2f s: Gramian factor ranks %d / %d, ADI steps %d / %d, Lyapunov residuals %.2g / %.2g",
              *t_red, b->lr.ctrl.rank, b->lr.obs.rank, b->lr.ctrl.iters, b->lr.obs.iters, b->res_ctrl, b->res_obs);

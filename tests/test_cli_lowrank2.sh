@@ -4,7 +4,9 @@
 # each run passes, and its output error e_y (validate's table) is below the
 # H-infinity error bound 2 sum_{i>r} sigma_i of BT at the same order (the
 # bound of the L2 gain of the error system; written by the bt run into
-# NAME.json). Options of the test runs (--dt, --steps) are accepted.
+# NAME.json). Options of the test runs (--dt, --steps) are accepted. A sweep
+# (--method bt,prbt,phbt --r 10,12) computes the Gramian factors once (its
+# log) and writes the same models as six separate runs (files equal).
 # Usage: sh tests/test_cli_lowrank2.sh build/phgmg      (from the repository root)
 # Needs NumPy in /usr/bin/python3 (skipped with a note otherwise).
 set -u
@@ -38,5 +40,26 @@ for m in bt prbt phbt; do
   awk -v e="$ey" -v b="$bound" 'BEGIN { exit !(e + 0 > 0 && e + 0 < b + 0) }' ||
     { echo "FAIL: $m: e_y $ey not below the BT bound $bound"; nfail=$((nfail + 1)); }
   echo "validate --method $m --r 12: e_y $ey (BT bound $bound)"
+done
+# a sweep over methods and orders: the Gramian factors computed once (the
+# log), the models equal (arrays and model files, byte for byte) to those of
+# separate runs
+# shellcheck disable=SC2086
+"$P" reduce $M --method bt,prbt,phbt --r 10,12 --out "$T/sw" > "$T/sw.txt" 2>&1 ||
+  { echo "FAIL: the sweep"; cat "$T/sw.txt"; nfail=$((nfail + 1)); }
+n=$(grep -c "Gramian factors: computed" "$T/sw.txt")
+[ "$n" -eq 1 ] || { echo "FAIL: the sweep computed the Gramian factors $n times"; cat "$T/sw.txt"; nfail=$((nfail + 1)); }
+n=$(grep -c "Gramian factors: reused" "$T/sw.txt")
+[ "$n" -eq 5 ] || { echo "FAIL: the sweep reused the factors $n times (5 expected)"; nfail=$((nfail + 1)); }
+for m in bt prbt phbt; do
+  for r in 10 12; do
+    # shellcheck disable=SC2086
+    "$P" reduce $M --method $m --r $r --out "$T/one" --name "rom_${m}_r$r" --quiet > /dev/null 2>&1 ||
+      { echo "FAIL: reduce --method $m --r $r"; nfail=$((nfail + 1)); continue; }
+    for f in .phgmgrom _K.npy _Qh.npy _Bh.npy _V0.npy; do
+      cmp -s "$T/sw/rom_${m}_r$r$f" "$T/one/rom_${m}_r$r$f" ||
+        { echo "FAIL: $m r = $r: rom_${m}_r$r$f differs between the sweep and a separate run"; nfail=$((nfail + 1)); }
+    done
+  done
 done
 if [ "$nfail" -eq 0 ]; then echo "test_cli_lowrank2: all passed"; else echo "test_cli_lowrank2: $nfail failed"; exit 1; fi
