@@ -760,6 +760,12 @@
          bound and (hmin) the Hamiltonian used. The
          command line's `reduce --method bt|prbt|phbt` is this function
          (COO input: sparse; dense input: dense);
+     phgmg_balanced_reduce_cached, phgmg_balanced_cache_free
+         the same with a phgmg_balanced_cache: the Gramian factors of one
+         sparse model computed once and reused by every later call (a sweep
+         over methods and orders: the command line's `--method bt,prbt
+         --r 10,20` runs the ADI once per factor, and its models equal those
+         of separate runs, byte for byte);
      phgmg_ss_to_ph
          the pH form (K, Qh, Bh = Br) of a passive reduced state-space model
          (Ar, Br, Cr): Qh the minimal solution of its positive-real lemma.
@@ -2090,7 +2096,8 @@
            phgmg_shifted_transfer, phgmg_shifted_hinf,
            phgmg_shifted_factorizations, phgmg_shifted_destroy, phgmg_lradi,
            phgmg_lowrank_free, phgmg_lrbt, phgmg_lrphbt, phgmg_ss_to_ph,
-           phgmg_balanced_reduce
+           phgmg_balanced_reduce, phgmg_balanced_reduce_cached,
+           phgmg_balanced_cache_free
    export: phgmg_rom_serialized_size, phgmg_rom_serialize,
            phgmg_rom_deserialize_size, phgmg_rom_deserialize, phgmg_rom_save,
            phgmg_rom_load, phgmg_rom_export_c
@@ -2108,7 +2115,7 @@
            phgmg_lu_rcond, phgmg_norm1, phgmg_normf, phgmg_zlu_factor,
            phgmg_zlu_solve, phgmg_qr, phgmg_qrcp, phgmg_qr_form_q,
            phgmg_qr_apply, phgmg_lstsq, phgmg_svd, phgmg_sym_eig
-   (170 functions; 21 of them only with PHGMG_MPI; also the macros
+   (172 functions; 21 of them only with PHGMG_MPI; also the macros
    PHGMG_ROM_STEPPER_MEMSIZE_MAX and _MAX_CB.)
 */
 #ifndef PHGMG_H_INCLUDED
