@@ -42,3 +42,4 @@
 #include "test_balanced.c"
 #include "test_workflow.c"
 #include "test_pod_stream.c"
+#include "test_balanced2.c"
