@@ -1938,7 +1938,9 @@
    balancing and projection of that model, the bases composed. The minimal
    solution needs every port damped (B^T Q R Q B > 0); otherwise the
    balancing is against the first stage's energy, which is phgmg_lrphbt's
-   (info->hmin = 0). phgmg_lrphbt itself keeps the energy E^T Q: its reduced
+   (info->hmin = 0), as it is when the reduced K's symmetric part computed
+   with X_min is positive beyond round-off (1e-8 of its norm: X_min not
+   accurate enough). phgmg_lrphbt itself keeps the energy E^T Q: its reduced
    Hamiltonian approximates the physical energy, X_min's does not.
    Checked (tests/test_lowrank.c): an 8 x 8 mass-spring-damper lattice (N =
    128, complex shifts): Z Z^T and Q Z_y Z_y^T Q within 1.5e-10 (relative,
@@ -22086,9 +22088,11 @@ PHGMG__PRIV phgmg_result phgmg__bal_sparse_bt(phgmg_reduced **out, const phgmg_p
    phgmg__ph_clip), Qh = Sig_r^{-1}, Bh = (C T)^T; lift V2 = T Sig_r^{-1} and
    restrict W2 = X T (k x r each, W2^T V2 = I); sig: all k values, descending.
    s dense (J, R, Q k x k). Where the minimal Hamiltonian does not exist (a
-   port without damping: phgmg__pr_zero_d fails) X = Q; *hmin says which. */
+   port without damping: phgmg__pr_zero_d fails) or use_q X = Q; *hmin says
+   which. */
 PHGMG__PRIV phgmg_result phgmg__phbt_min(const phgmg_ph_system *s, int r, double *K, double *Qh, double *Bh,
-                                         double *V2, double *W2, double *sig, int *hmin, const phgmg_allocator *al) {
+                                         double *V2, double *W2, double *sig, int *hmin, int use_q,
+                                         const phgmg_allocator *al) {
   const int k = s->N, m = s->m;
   const size_t kk = (size_t)k * k;
   double *A = phgmg__dalloc(al, 5 * kk + (size_t)m * k + k), *P = A + kk, *X = P + kk, *U = X + kk, *G = U + kk,
@@ -22102,7 +22106,7 @@ PHGMG__PRIV phgmg_result phgmg__phbt_min(const phgmg_ph_system *s, int r, double
     rc = phgmg_lyap(k, A, G, P, NULL, al);
   }
   if (rc == PHGMG_OK) {   /* no minimal Hamiltonian (a port without damping): the energy Q */
-    rc = phgmg__pr_zero_d(k, m, A, s->B, C, X, al);
+    rc = use_q ? PHGMG_ERR_SINGULAR : phgmg__pr_zero_d(k, m, A, s->B, C, X, al);
     *hmin = rc == PHGMG_OK;
     if (rc != PHGMG_OK && rc != PHGMG_ERR_NOMEM) { memcpy(X, s->Q, sizeof(double) * kk); rc = PHGMG_OK; }
   }
@@ -22165,7 +22169,9 @@ PHGMG__PRIV phgmg_result phgmg__bal_sparse_phbt(phgmg_reduced **out, const phgmg
       K = wk; Qh = K + rr; Bh = Qh + rr; V2 = Bh + (size_t)r * m; W2 = V2 + kr; sg = W2 + kr; V0 = sg + k;
       W0 = V0 + (size_t)N * r;
       phgmg__lr_progress(opts, "balancing");
-      rc = phgmg__phbt_min(&s2, r, K, Qh, Bh, V2, W2, sg, &inf->hmin, al);
+      rc = phgmg__phbt_min(&s2, r, K, Qh, Bh, V2, W2, sg, &inf->hmin, 0, al);
+      if (rc == PHGMG_ERR_STRUCTURE && inf->hmin)   /* X_min too inaccurate for a dissipative K: Q */
+        rc = phgmg__phbt_min(&s2, r, K, Qh, Bh, V2, W2, sg, &inf->hmin, 1, al);
       if (rc == PHGMG_OK) {
         phgmg_gemm('N', 'N', N, r, k, 1.0, blk, N, V2, k, 0.0, V0, N);
         phgmg_gemm('N', 'N', N, r, k, 1.0, blk + (size_t)N * k, N, W2, k, 0.0, W0, N);
