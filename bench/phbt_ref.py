@@ -74,8 +74,6 @@ def kyp_min(A, B, C, eps):
 def balance(A, B, C, P, X, r):
     """Balancing of P against X (X a KYP solution), projection onto the r
     leading directions, test space X T."""
-    Lp = np.linalg.cholesky(P + 1e-300 * np.eye(P.shape[0])) if False else None
-    w, V = sla.eigh(X, np.linalg.inv(P)) if False else (None, None)
     # P X T = T S^2 with T^T X T = S: from the symmetric problem L^T X L
     U, s, _ = np.linalg.svd(P)
     L = U * np.sqrt(np.maximum(s, 0.0))
