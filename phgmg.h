@@ -759,7 +759,8 @@
          against the energy instead); info: the ranks, residuals, values,
          bound and (hmin) the Hamiltonian used. The
          command line's `reduce --method bt|prbt|phbt` is this function
-         (COO input: sparse; dense input: dense);
+         (COO input: sparse; dense input: dense), and so is its `validate`
+         with these methods (then phgmg_reduced_validate on the test runs);
      phgmg_balanced_reduce_cached, phgmg_balanced_cache_free
          the same with a phgmg_balanced_cache: the Gramian factors of one
          sparse model computed once and reused by every later call (a sweep
