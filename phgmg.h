@@ -857,10 +857,20 @@
          model put in pH form by phgmg_ss_to_ph, when it is passive),
          PHGMG_METHOD_PRBT (dense: phgmg_prbt; sparse: two stages, the pH
          Galerkin projection onto the span of the controllability factor,
-         then the dense PRBT of that model), PHGMG_METHOD_PHBT (sparse:
-         phgmg_lrphbt); info: the ranks, residuals, values and bound. The
+         then the dense PRBT of that model), PHGMG_METHOD_PHBT (sparse: the
+         same first stage, then the controllability Gramian balanced against
+         the minimal Hamiltonian of that model, 8.13; phgmg_lrphbt balances
+         against the energy instead); info: the ranks, residuals, values,
+         bound and (hmin) the Hamiltonian used. The
          command line's `reduce --method bt|prbt|phbt` is this function
-         (COO input: sparse; dense input: dense);
+         (COO input: sparse; dense input: dense), and so is its `validate`
+         with these methods (then phgmg_reduced_validate on the test runs);
+     phgmg_balanced_reduce_cached, phgmg_balanced_cache_free
+         the same with a phgmg_balanced_cache: the Gramian factors of one
+         sparse model computed once and reused by every later call (a sweep
+         over methods and orders: the command line's `--method bt,prbt
+         --r 10,20` runs the ADI once per factor, and its models equal those
+         of separate runs, byte for byte);
      phgmg_ss_to_ph
          the pH form (K, Qh, Bh = Br) of a passive reduced state-space model
          (Ar, Br, Cr): Qh the minimal solution of its positive-real lemma.
@@ -2019,9 +2029,37 @@
    Qr diagonal positive; the model is passive. The values sigma carry no
    H-infinity bound, and the error is larger than BT's: on the 8 x 8
    lattice of the tests 0.38 / 0.12 of the sampled norm at r = 4 / 12,
-   where BT has 0.044 at r = 8. Choosing the Hamiltonian that
-   minimises an error bound (the other half of the pH balancing
-   literature) is not done.
+   where BT has 0.044 at r = 8.
+   The choice of the Hamiltonian (phgmg_balanced_reduce's PHBT). A passive
+   model has many pH forms: any X > 0 with A^T X + X A <= 0 and X B = C^T
+   (the KYP inequality with zero feedthrough) is a Hamiltonian, A = (A
+   X^{-1}) X with A X^{-1} = J_X - R_X, and the balancing above works with
+   any of them in place of E^T Q (test space X T, Jr - Rr = T^T X A T, Br =
+   T^T C^T). The values sqrt(eig(P X)) grow with X, and E^T Q is not the
+   smallest: the minimal solution X_min (the available storage) gives the
+   smallest values and, measured, the smallest error. On the lattices of
+   bench/lowrank_models.py (the dense reference bench/phbt_ref.py, SciPy,
+   independent of the library): 16 x 16 (N = 512), r = 20: balancing
+   against Q: sampled H-infinity error 2.8e-2 of ||G||, output error (500
+   steps of dt 0.1, u = 0.1 sin on each port) 3.1e-2 -- the value of the N
+   = 100 352 run, so that is the method's error with Q, not a defect (the
+   library's model equals SciPy's: 2.928e-2 both); against X_min: 9.8e-4 /
+   1.05e-3 (BT: 8.7e-4 / 8.4e-4); 8 x 8, r = 12: 0.116 against Q, 0.037
+   against X_min. Q satisfies the observability Lyapunov inequality here (Q
+   (2R - B B^T) Q >= 0, R >= 0.5 I on the momenta), so BT's bound 2
+   sum_{i>r} sigma_i holds for the balancing against Q (0.59 at N = 512, r
+   = 20: true but loose); X_min does not (no bound is stated for it). X_min
+   costs a dense Riccati solve, so phgmg_balanced_reduce computes it for the
+   first stage of the sparse PRBT (the Galerkin model on span(Z_c), order k
+   = the factor's rank, see below; O(k^3)): P_k by phgmg_lyap, X_min by the
+   zero-feedthrough solver of phgmg_ss_to_ph (phgmg__pr_zero_d), the
+   balancing and projection of that model, the bases composed. The minimal
+   solution needs every port damped (B^T Q R Q B > 0); otherwise the
+   balancing is against the first stage's energy, which is phgmg_lrphbt's
+   (info->hmin = 0), as it is when the reduced K's symmetric part computed
+   with X_min is positive beyond round-off (1e-8 of its norm: X_min not
+   accurate enough). phgmg_lrphbt itself keeps the energy E^T Q: its reduced
+   Hamiltonian approximates the physical energy, X_min's does not.
    Checked (tests/test_lowrank.c): an 8 x 8 mass-spring-damper lattice (N =
    128, complex shifts): Z Z^T and Q Z_y Z_y^T Q within 1.5e-10 (relative,
    Frobenius) of phgmg_lyap's dense Gramians, the residual reported and
@@ -2187,7 +2225,8 @@
            phgmg_shifted_transfer, phgmg_shifted_hinf,
            phgmg_shifted_factorizations, phgmg_shifted_destroy, phgmg_lradi,
            phgmg_lowrank_free, phgmg_lrbt, phgmg_lrphbt, phgmg_ss_to_ph,
-           phgmg_balanced_reduce
+           phgmg_balanced_reduce, phgmg_balanced_reduce_cached,
+           phgmg_balanced_cache_free
    export: phgmg_rom_serialized_size, phgmg_rom_serialize,
            phgmg_rom_deserialize_size, phgmg_rom_deserialize, phgmg_rom_save,
            phgmg_rom_load, phgmg_rom_export_c
@@ -4229,6 +4268,7 @@ typedef struct phgmg_balanced_info {
   double res_ctrl, res_obs; /* Lyapunov residuals, relative (low-rank: the ADI's ||W^T W|| /
                           ||B^T B||; dense: phgmg_lyap_residual's); PHBT: res_obs 0             */
   int nsv;             /* values written to sv                                                   */
+  int hmin;            /* PHBT: 1 balanced against the minimal Hamiltonian, 0 against the energy Q */
 } phgmg_balanced_info;
 
 /* Balancing-based reduction of a linear pH model to a pH reduced model
@@ -4247,8 +4287,13 @@ typedef struct phgmg_balanced_info {
                         its pH form, then the dense PRBT of that model (manual
                         8.13). sv: the positive-real singular values of the
                         last stage.
-     PHGMG_METHOD_PHBT  pH-preserving balancing (phgmg_lrphbt; sparse only,
-                        else PHGMG_ERR_UNSUPPORTED). sv: its values sigma.
+     PHGMG_METHOD_PHBT  pH-preserving balancing (sparse only, else
+                        PHGMG_ERR_UNSUPPORTED), two stages like PRBT: the
+                        first stage's controllability Gramian P balanced
+                        against the minimal Hamiltonian X of that model (the
+                        minimal solution of its KYP inequality; info->hmin =
+                        1), or against its energy Q where X does not exist (a
+                        port without damping; hmin = 0). sv: sqrt(eig(P X)).
    Lift x = V0 xr (phgmg_reduced_lift; V0 in the sparse object's internal
    order for sp), restrict xr = W^T x (W^T V0 = I). sv (may be NULL): up to
    nsv values (info->nsv of them). opts: the ADI options (sparse only; may be
@@ -4260,6 +4305,32 @@ PHGMG_DEF phgmg_result phgmg_balanced_reduce(phgmg_reduced **out, const phgmg_ph
                                              const phgmg_ph_sparse *sp, int method, int r,
                                              const phgmg_lradi_opts *opts, double *sv, int nsv,
                                              phgmg_balanced_info *info, const phgmg_allocator *alloc);
+
+/* The low-rank Gramian factors of one sparse model, kept between calls of
+   phgmg_balanced_reduce_cached (a sweep over methods and orders computes
+   them once). Zero it (memset) before the first call; the first call
+   binds it to its model (another model: PHGMG_ERR_INVALID_ARG) and stores
+   each factor when it is first computed (bt: both; prbt, phbt: the
+   controllability one); later calls copy them instead of running the ADI
+   (the same ADI options must be given: they are not compared). Free it
+   with phgmg_balanced_cache_free (the same allocator). Fields: read only. */
+typedef struct phgmg_balanced_cache {
+  const phgmg_ph_sparse *sp;   /* the model (NULL: unbound)                          */
+  double *Zc, *Zo;             /* the factors (N x kc, N x ko; NULL: not yet)          */
+  int kc, ko;
+  phgmg_lradi_info ctrl, obs;  /* the ADI runs that made them                        */
+  int adi_runs;                /* ADI runs made through this cache (a counter)        */
+} phgmg_balanced_cache;
+
+/* phgmg_balanced_reduce with a cache (may be NULL: the same as
+   phgmg_balanced_reduce); dense models ignore it. */
+PHGMG_DEF phgmg_result phgmg_balanced_reduce_cached(phgmg_reduced **out, const phgmg_ph_system *sys,
+                                                    const phgmg_ph_sparse *sp, int method, int r,
+                                                    const phgmg_lradi_opts *opts, double *sv, int nsv,
+                                                    phgmg_balanced_info *info, phgmg_balanced_cache *cache,
+                                                    const phgmg_allocator *alloc);
+/* Frees the factors of a cache and zeroes it (NULL: nothing). */
+PHGMG_DEF void phgmg_balanced_cache_free(phgmg_balanced_cache *cache, const phgmg_allocator *alloc);
 
 #ifdef __cplusplus
 }
@@ -22406,33 +22477,48 @@ PHGMG_DEF phgmg_result phgmg_lradi(phgmg_shifted *s, int m, const double *B, int
 
 /* The two Gramian factors of phgmg_lrbt: Zc (kc columns) and Zo = Q Zy
    (ko columns), with the ADI runs' info. */
+PHGMG__PRIV phgmg_result phgmg__lrbt_obs(const phgmg_ph_sparse *sp, const phgmg_lradi_opts *opts, phgmg_shifted *sc,
+                                         const double *Zc, int kc, double **Zo, int *ko, phgmg_lrbt_info *inf,
+                                         const phgmg_allocator *al);
 PHGMG__PRIV phgmg_result phgmg__lrbt_factors(const phgmg_ph_sparse *sp, const phgmg_lradi_opts *opts,
                                              phgmg_shifted *sc, double **Zc, int *kc, double **Zo, int *ko,
                                              phgmg_lrbt_info *inf, const phgmg_allocator *al) {
   const int N = sp->sys.N, m = sp->sys.m;
-  phgmg_shifted *sd = NULL;
-  double *Zy = NULL;
-  int j, jzero = 1;
   phgmg_result rc;
   phgmg__lr_progress(opts, "controllability Gramian");
   rc = phgmg_lradi(sc, m, sp->sys.B, N, opts, Zc, kc, &inf->ctrl, al);
   if (rc != PHGMG_OK) return rc;
+  return phgmg__lrbt_obs(sp, opts, sc, *Zc, *kc, Zo, ko, inf, al);
+}
+
+/* The observability factor Zo = Q Zy of phgmg_lrbt (Zy: the dual model's
+   controllability factor; Zc when J = 0), inf->obs its ADI run. */
+PHGMG__PRIV phgmg_result phgmg__lrbt_obs(const phgmg_ph_sparse *sp, const phgmg_lradi_opts *opts, phgmg_shifted *sc,
+                                         const double *Zc, int kc, double **Zo, int *ko, phgmg_lrbt_info *inf,
+                                         const phgmg_allocator *al) {
+  const int N = sp->sys.N, m = sp->sys.m;
+  phgmg_shifted *sd = NULL;
+  double *Zy = NULL;
+  const double *Zu;
+  int j, jzero = 1;
+  phgmg_result rc;
   for (j = 0; j < sp->cp[0][N] && jzero; ++j) jzero = sp->cx[0][j] == 0.0;
   if (jzero) { /* the dual model is the model: Zy = Zc */
     inf->obs = inf->ctrl;
-    *ko = *kc;
-    Zy = *Zc;
+    *ko = kc;
+    Zu = Zc;
   } else {
     phgmg__lr_progress(opts, "observability Gramian");
     rc = phgmg_shifted_create(&sd, sp, 1, 0, al);
     if (rc == PHGMG_OK) rc = phgmg_lradi(sd, m, sp->sys.B, N, opts, &Zy, ko, &inf->obs, al);
     phgmg_shifted_destroy(sd);
     if (rc != PHGMG_OK) return rc;
+    Zu = Zy;
   }
   *Zo = phgmg__dalloc(al, (size_t)N * (size_t)*ko);
   if (*Zo)
-    for (j = 0; j < *ko; ++j) phgmg__sp_qmv(sc->S, Zy + (size_t)j * N, *Zo + (size_t)j * N);
-  if (Zy != *Zc) phgmg__free(al, Zy);
+    for (j = 0; j < *ko; ++j) phgmg__sp_qmv(sc->S, Zu + (size_t)j * N, *Zo + (size_t)j * N);
+  phgmg__free(al, Zy);
   return *Zo ? PHGMG_OK : PHGMG_ERR_NOMEM;
 }
 
@@ -22733,11 +22819,63 @@ PHGMG__PRIV phgmg_result phgmg__bal_red(phgmg_reduced **out, const phgmg_ph_syst
   return PHGMG_OK;
 }
 
+/* The cache's copy of n doubles into *Z (allocated). */
+PHGMG__PRIV phgmg_result phgmg__bal_copy(const double *x, size_t n, double **Z, const phgmg_allocator *al) {
+  *Z = phgmg__dalloc(al, n);
+  if (!*Z) return PHGMG_ERR_NOMEM;
+  memcpy(*Z, x, sizeof(double) * n);
+  return PHGMG_OK;
+}
+
+/* The controllability factor Z (k columns) of sp: the cache's copy when it
+   holds one, else phgmg_lradi on sc (created here when sc is NULL), kept in
+   the cache (c may be NULL). */
+PHGMG__PRIV phgmg_result phgmg__bal_ctrl(const phgmg_ph_sparse *sp, const phgmg_lradi_opts *opts, phgmg_shifted *sc,
+                                         phgmg_balanced_cache *c, double **Z, int *k, phgmg_lradi_info *ci,
+                                         const phgmg_allocator *al) {
+  const int N = sp->sys.N;
+  phgmg_shifted *own = NULL;
+  phgmg_result rc = PHGMG_OK;
+  if (c && c->Zc) { *k = c->kc; *ci = c->ctrl; return phgmg__bal_copy(c->Zc, (size_t)N * c->kc, Z, al); }
+  if (!sc) rc = phgmg_shifted_create(&own, sp, 0, 0, al);
+  if (rc == PHGMG_OK) {
+    phgmg__lr_progress(opts, "controllability Gramian");
+    rc = phgmg_lradi(sc ? sc : own, sp->sys.m, sp->sys.B, N, opts, Z, k, ci, al);
+    if (c) c->adi_runs++;
+  }
+  phgmg_shifted_destroy(own);
+  if (rc == PHGMG_OK && c && phgmg__bal_copy(*Z, (size_t)N * *k, &c->Zc, al) == PHGMG_OK) {
+    c->kc = *k; c->ctrl = *ci;
+  }
+  return rc;
+}
+
+/* The observability factor (phgmg__lrbt_obs) through the cache as above. */
+PHGMG__PRIV phgmg_result phgmg__bal_obs(const phgmg_ph_sparse *sp, const phgmg_lradi_opts *opts, phgmg_shifted *sc,
+                                        phgmg_balanced_cache *c, const double *Zc, int kc, double **Zo, int *ko,
+                                        phgmg_lrbt_info *inf, const phgmg_allocator *al) {
+  const int N = sp->sys.N;
+  phgmg_result rc;
+  if (c && c->Zo) { *ko = c->ko; inf->obs = c->obs; return phgmg__bal_copy(c->Zo, (size_t)N * c->ko, Zo, al); }
+  rc = phgmg__lrbt_obs(sp, opts, sc, Zc, kc, Zo, ko, inf, al);
+  if (c) c->adi_runs++;
+  if (rc == PHGMG_OK && c && phgmg__bal_copy(*Zo, (size_t)N * *ko, &c->Zo, al) == PHGMG_OK) {
+    c->ko = *ko; c->obs = inf->obs;
+  }
+  return rc;
+}
+
+PHGMG_DEF void phgmg_balanced_cache_free(phgmg_balanced_cache *cache, const phgmg_allocator *alloc) {
+  if (!cache) return;
+  phgmg__free(alloc, cache->Zc); phgmg__free(alloc, cache->Zo);
+  memset(cache, 0, sizeof *cache);
+}
+
 /* Low-rank BT of sp to order r into *blk = [T (N r), W (N r), Ar (r r), Br
    (r m), Cr (m r)] (allocated here); the first nsv values into sv. */
 PHGMG__PRIV phgmg_result phgmg__bal_lr_stage(const phgmg_ph_sparse *sp, const phgmg_lradi_opts *opts, int r,
                                              double *sv, int nsv, double **blk, phgmg_balanced_info *inf,
-                                             const phgmg_allocator *al) {
+                                             phgmg_balanced_cache *cache, const phgmg_allocator *al) {
   const int N = sp->sys.N, m = sp->sys.m;
   const size_t nr = (size_t)N * r, q = (size_t)r * r, rm = (size_t)r * m;
   phgmg_shifted *sc = NULL;
@@ -22745,7 +22883,8 @@ PHGMG__PRIV phgmg_result phgmg__bal_lr_stage(const phgmg_ph_sparse *sp, const ph
   int kc = 0, ko = 0;
   phgmg_result rc = phgmg_shifted_create(&sc, sp, 0, 0, al);
   *blk = NULL;
-  if (rc == PHGMG_OK) rc = phgmg__lrbt_factors(sp, opts, sc, &Zc, &kc, &Zo, &ko, &inf->lr, al);
+  if (rc == PHGMG_OK) rc = phgmg__bal_ctrl(sp, opts, sc, cache, &Zc, &kc, &inf->lr.ctrl, al);
+  if (rc == PHGMG_OK) rc = phgmg__bal_obs(sp, opts, sc, cache, Zc, kc, &Zo, &ko, &inf->lr, al);
   if (rc == PHGMG_OK) {
     phgmg__lr_progress(opts, "balancing");
     *blk = phgmg__dalloc(al, 2 * nr + q + 2 * rm);
@@ -22770,18 +22909,13 @@ PHGMG__PRIV phgmg_result phgmg__bal_lr_stage(const phgmg_ph_sparse *sp, const ph
    z, restrict z = (Q E V)^T x. Into blk = [V0 (N k), W (N k), Jr, Rr, Qk (k
    k each), Br (k m)] (allocated here). */
 PHGMG__PRIV phgmg_result phgmg__bal_pr_stage1(const phgmg_ph_sparse *sp, const phgmg_lradi_opts *opts, int *k,
-                                              double **blk, phgmg_balanced_info *inf, const phgmg_allocator *al) {
+                                              double **blk, phgmg_balanced_info *inf, phgmg_balanced_cache *cache,
+                                              const phgmg_allocator *al) {
   const int N = sp->sys.N, m = sp->sys.m;
-  phgmg_shifted *sc = NULL;
   double *Z = NULL, *V0, *W, *Jr, *Rr, *Qk, *Br, *M;
-  phgmg_result rc = phgmg_shifted_create(&sc, sp, 0, 0, al);
+  phgmg_result rc = phgmg__bal_ctrl(sp, opts, NULL, cache, &Z, k, &inf->lr.ctrl, al);
   int i, j, kk;
   *blk = NULL;
-  if (rc == PHGMG_OK) {
-    phgmg__lr_progress(opts, "controllability Gramian");
-    rc = phgmg_lradi(sc, m, sp->sys.B, N, opts, &Z, k, &inf->lr.ctrl, al);
-  }
-  phgmg_shifted_destroy(sc);
   inf->lowrank = 1;
   inf->res_ctrl = inf->lr.ctrl.res;
   if (rc != PHGMG_OK) return rc;
@@ -22819,13 +22953,13 @@ PHGMG__PRIV phgmg_result phgmg__bal_pr_stage1(const phgmg_ph_sparse *sp, const p
    construction), then the dense PRBT of that model; the bases composed. */
 PHGMG__PRIV phgmg_result phgmg__bal_sparse_prbt(phgmg_reduced **out, const phgmg_ph_sparse *sp, int r,
                                                 const phgmg_lradi_opts *opts, double *sv, int nsv,
-                                                phgmg_balanced_info *inf, const phgmg_allocator *al) {
+                                                phgmg_balanced_info *inf, phgmg_balanced_cache *cache, const phgmg_allocator *al) {
   const int N = sp->sys.N, m = sp->sys.m;
   double *blk = NULL, *V0 = NULL, *W0;
   phgmg_reduced *red2 = NULL;
   phgmg_ph_system s2;
   int k = 0;
-  phgmg_result rc = phgmg__bal_pr_stage1(sp, opts, &k, &blk, inf, al);
+  phgmg_result rc = phgmg__bal_pr_stage1(sp, opts, &k, &blk, inf, cache, al);
   inf->stages = 2; inf->inter = k;
   if (rc == PHGMG_OK && k < r) rc = PHGMG_ERR_RANK;
   if (rc == PHGMG_OK) {
@@ -22858,10 +22992,10 @@ PHGMG__PRIV phgmg_result phgmg__bal_sparse_prbt(phgmg_reduced **out, const phgmg
 /* Sparse BT to a pH reduced object (phgmg_lrbt, phgmg_ss_to_ph). */
 PHGMG__PRIV phgmg_result phgmg__bal_sparse_bt(phgmg_reduced **out, const phgmg_ph_sparse *sp, int r,
                                               const phgmg_lradi_opts *opts, double *sv, int nsv,
-                                              phgmg_balanced_info *inf, const phgmg_allocator *al) {
+                                              phgmg_balanced_info *inf, phgmg_balanced_cache *cache, const phgmg_allocator *al) {
   const int N = sp->sys.N, m = sp->sys.m, k = r;
   double *blk = NULL, *KQ = NULL, *T, *W, *Ar;
-  phgmg_result rc = phgmg__bal_lr_stage(sp, opts, r, sv, nsv, &blk, inf, al);
+  phgmg_result rc = phgmg__bal_lr_stage(sp, opts, r, sv, nsv, &blk, inf, cache, al);
   if (rc == PHGMG_OK) {
     T = blk; W = T + (size_t)N * k; Ar = W + (size_t)N * k;
     KQ = phgmg__dalloc(al, 2 * (size_t)k * k);
@@ -22875,35 +23009,110 @@ PHGMG__PRIV phgmg_result phgmg__bal_sparse_bt(phgmg_reduced **out, const phgmg_p
   return rc;
 }
 
-/* Sparse pH-preserving balancing (phgmg_lrphbt) to a reduced object: K = Jr
-   - Rr, Qh = Qr, V0 = V, W = Q E T (T = V Sigma: W^T V0 = I). */
-PHGMG__PRIV phgmg_result phgmg__bal_sparse_phbt(phgmg_reduced **out, const phgmg_ph_sparse *sp, int r,
-                                                const phgmg_lradi_opts *opts, double *sv, int nsv,
-                                                phgmg_balanced_info *inf, const phgmg_allocator *al) {
-  const int N = sp->sys.N, m = sp->sys.m;
-  const size_t rr = (size_t)r * r;
-  double *Jr = phgmg__dalloc(al, 3 * rr + (size_t)r * m + r + 3 * (size_t)N * r), *Rr = Jr + rr, *Qr = Rr + rr,
-         *Br = Qr + rr, *sg = Br + (size_t)r * m, *V = sg + r, *W = V + (size_t)N * r, *t = W + (size_t)N * r;
+/* pH balancing of a dense pH model s (order k, E = I) against its minimal
+   Hamiltonian X (the minimal solution of the KYP inequality, phgmg__pr_zero_d)
+   instead of its energy matrix Q: P = L L^T (controllability Gramian), L^T X L
+   = Y diag(sig^2) Y^T, T = L Y_r Sig_r^{-1/2} (T^T X T = Sig_r), Galerkin in
+   the X inner product: F = T^T X A T, K = F (its symmetric part clipped by
+   phgmg__ph_clip), Qh = Sig_r^{-1}, Bh = (C T)^T; lift V2 = T Sig_r^{-1} and
+   restrict W2 = X T (k x r each, W2^T V2 = I); sig: all k values, descending.
+   s dense (J, R, Q k x k). Where the minimal Hamiltonian does not exist (a
+   port without damping: phgmg__pr_zero_d fails) or use_q X = Q; *hmin says
+   which. */
+PHGMG__PRIV phgmg_result phgmg__phbt_min(const phgmg_ph_system *s, int r, double *K, double *Qh, double *Bh,
+                                         double *V2, double *W2, double *sig, int *hmin, int use_q,
+                                         const phgmg_allocator *al) {
+  const int k = s->N, m = s->m;
+  const size_t kk = (size_t)k * k;
+  double *A = phgmg__dalloc(al, 5 * kk + (size_t)m * k + k), *P = A + kk, *X = P + kk, *U = X + kk, *G = U + kk,
+         *C = G + kk, *w = C + (size_t)m * k, clip;
   phgmg_result rc;
   int i, j;
-  if (!Jr) return PHGMG_ERR_NOMEM;
-  rc = phgmg_lrphbt(sp, r, opts, Jr, Rr, Qr, Br, sg, V, &inf->lr, al);
-  inf->lowrank = 1;
-  inf->res_ctrl = inf->lr.ctrl.res;
+  if (!A) return PHGMG_ERR_NOMEM;
+  rc = phgmg_ph_abc(s, A, C, al);
   if (rc == PHGMG_OK) {
-    for (i = 0; i < (int)rr; ++i) Jr[i] -= Rr[i];   /* K = Jr - Rr */
-    for (j = 0; j < r; ++j) {
-      const double *v = V + (size_t)j * N;
-      double *w = W + (size_t)j * N;
-      if (sp->cp[3]) { phgmg__lr_cscmv(sp, 3, v, t); phgmg__lr_cscmv(sp, 2, t, w); }
-      else phgmg__lr_cscmv(sp, 2, v, w);
-      for (i = 0; i < N; ++i) w[i] *= sg[j];
-    }
-    rc = phgmg__bal_red(out, &sp->sys, r, PHGMG_METHOD_PHBT, Jr, Qr, Br, V, W, al);
-    inf->nsv = PHGMG__MIN(r, nsv);
-    if (sv) memcpy(sv, sg, sizeof(double) * (size_t)inf->nsv);
+    phgmg_gemm('N', 'T', k, k, m, 1.0, s->B, k, s->B, k, 0.0, G, k);
+    rc = phgmg_lyap(k, A, G, P, NULL, al);
   }
-  phgmg__free(al, Jr);
+  if (rc == PHGMG_OK) {   /* no minimal Hamiltonian (a port without damping): the energy Q */
+    rc = use_q ? PHGMG_ERR_SINGULAR : phgmg__pr_zero_d(k, m, A, s->B, C, X, al);
+    *hmin = rc == PHGMG_OK;
+    if (rc != PHGMG_OK && rc != PHGMG_ERR_NOMEM) { memcpy(X, s->Q, sizeof(double) * kk); rc = PHGMG_OK; }
+  }
+  if (rc == PHGMG_OK) rc = phgmg_sym_eig(k, P, k, w, U, k);
+  if (rc == PHGMG_OK) {   /* L = U sqrt(w+) into U, G = L^T X L */
+    for (j = 0; j < k; ++j) {
+      const double t = sqrt(w[j] > 0.0 ? w[j] : 0.0);
+      for (i = 0; i < k; ++i) U[i + (size_t)j * k] *= t;
+    }
+    phgmg_gemm('N', 'N', k, k, k, 1.0, X, k, U, k, 0.0, P, k);
+    phgmg_gemm('T', 'N', k, k, k, 1.0, U, k, P, k, 0.0, G, k);
+    rc = phgmg_sym_eig(k, G, k, w, P, k);
+  }
+  if (rc == PHGMG_OK) {
+    for (j = 0; j < k; ++j) sig[j] = sqrt(w[k - 1 - j] > 0.0 ? w[k - 1 - j] : 0.0);
+    if (!(sig[r - 1] > 1e-14 * sig[0])) rc = PHGMG_ERR_RANK;
+  }
+  if (rc == PHGMG_OK) {   /* T = L Y_r Sig_r^{-1/2} into V2; W2 = X T; G = A T */
+    for (j = 0; j < r; ++j)
+      for (i = 0; i < k; ++i) G[i + (size_t)j * k] = P[i + (size_t)(k - 1 - j) * k] / sqrt(sig[j]);
+    phgmg_gemm('N', 'N', k, r, k, 1.0, U, k, G, k, 0.0, V2, k);
+    phgmg_gemm('N', 'N', k, r, k, 1.0, X, k, V2, k, 0.0, W2, k);
+    phgmg_gemm('N', 'N', k, r, k, 1.0, A, k, V2, k, 0.0, G, k);
+    phgmg_gemm('T', 'N', r, r, k, 1.0, W2, k, G, k, 0.0, K, r);
+    phgmg_gemm('T', 'T', r, m, k, 1.0, V2, k, C, m, 0.0, Bh, r);
+    rc = phgmg__ph_clip(r, K, &clip, al);
+  }
+  if (rc == PHGMG_OK)
+    for (j = 0; j < r; ++j) {
+      for (i = 0; i < r; ++i) Qh[i + (size_t)j * r] = i == j ? 1.0 / sig[j] : 0.0;
+      for (i = 0; i < k; ++i) V2[i + (size_t)j * k] /= sig[j];
+    }
+  phgmg__free(al, A);
+  return rc;
+}
+
+/* Sparse pH-preserving balancing to a reduced object, in two stages: the
+   first stage of the sparse PRBT (phgmg__bal_pr_stage1: the Galerkin
+   projection onto the controllability factor's span, order k), then
+   phgmg__phbt_min of that model (its minimal Hamiltonian; its energy where
+   none exists); the bases composed. */
+PHGMG__PRIV phgmg_result phgmg__bal_sparse_phbt(phgmg_reduced **out, const phgmg_ph_sparse *sp, int r,
+                                                const phgmg_lradi_opts *opts, double *sv, int nsv,
+                                                phgmg_balanced_info *inf, phgmg_balanced_cache *cache, const phgmg_allocator *al) {
+  const int N = sp->sys.N, m = sp->sys.m;
+  double *blk = NULL, *wk = NULL;
+  phgmg_ph_system s2;
+  int k = 0;
+  phgmg_result rc = phgmg__bal_pr_stage1(sp, opts, &k, &blk, inf, cache, al);
+  inf->stages = 2; inf->inter = k;
+  if (rc == PHGMG_OK && k < r) rc = PHGMG_ERR_RANK;
+  if (rc == PHGMG_OK) {
+    const size_t kk = (size_t)k * k, rr = (size_t)r * r, kr = (size_t)k * r;
+    double *K, *Qh, *Bh, *V2, *W2, *sg, *V0, *W0;
+    memset(&s2, 0, sizeof s2);
+    s2.N = k; s2.m = m; s2.J = blk + 2 * (size_t)N * k; s2.R = s2.J + kk; s2.Q = s2.R + kk; s2.B = s2.Q + 2 * kk;
+    wk = phgmg__dalloc(al, 2 * rr + (size_t)r * m + 2 * kr + k + 2 * (size_t)N * r);
+    if (!wk) rc = PHGMG_ERR_NOMEM;
+    else {
+      K = wk; Qh = K + rr; Bh = Qh + rr; V2 = Bh + (size_t)r * m; W2 = V2 + kr; sg = W2 + kr; V0 = sg + k;
+      W0 = V0 + (size_t)N * r;
+      phgmg__lr_progress(opts, "balancing");
+      rc = phgmg__phbt_min(&s2, r, K, Qh, Bh, V2, W2, sg, &inf->hmin, 0, al);
+      if (rc == PHGMG_ERR_STRUCTURE && inf->hmin)   /* X_min too inaccurate for a dissipative K: Q */
+        rc = phgmg__phbt_min(&s2, r, K, Qh, Bh, V2, W2, sg, &inf->hmin, 1, al);
+      if (rc == PHGMG_OK) {
+        phgmg_gemm('N', 'N', N, r, k, 1.0, blk, N, V2, k, 0.0, V0, N);
+        phgmg_gemm('N', 'N', N, r, k, 1.0, blk + (size_t)N * k, N, W2, k, 0.0, W0, N);
+        rc = phgmg__bal_red(out, &sp->sys, r, PHGMG_METHOD_PHBT, K, Qh, Bh, V0, W0, al);
+        inf->lr.nhsv = k;
+        inf->lr.hsv_tail = k > r ? sg[r] : 0.0;
+        inf->nsv = PHGMG__MIN(k, nsv);
+        if (sv) memcpy(sv, sg, sizeof(double) * (size_t)inf->nsv);
+      }
+    }
+  }
+  phgmg__free(al, blk); phgmg__free(al, wk);
   return rc;
 }
 
@@ -22978,6 +23187,14 @@ PHGMG_DEF phgmg_result phgmg_balanced_reduce(phgmg_reduced **out, const phgmg_ph
                                              const phgmg_ph_sparse *sp, int method, int r,
                                              const phgmg_lradi_opts *opts, double *sv, int nsv,
                                              phgmg_balanced_info *info, const phgmg_allocator *alloc) {
+  return phgmg_balanced_reduce_cached(out, sys, sp, method, r, opts, sv, nsv, info, NULL, alloc);
+}
+
+PHGMG_DEF phgmg_result phgmg_balanced_reduce_cached(phgmg_reduced **out, const phgmg_ph_system *sys,
+                                                    const phgmg_ph_sparse *sp, int method, int r,
+                                                    const phgmg_lradi_opts *opts, double *sv, int nsv,
+                                                    phgmg_balanced_info *info, phgmg_balanced_cache *cache,
+                                                    const phgmg_allocator *alloc) {
   phgmg_balanced_info inf;
   phgmg_result rc;
   const phgmg_ph_system *s;
@@ -22993,9 +23210,12 @@ PHGMG_DEF phgmg_result phgmg_balanced_reduce(phgmg_reduced **out, const phgmg_ph
   if (!sp && method == PHGMG_METHOD_PHBT) return PHGMG_ERR_UNSUPPORTED;
   s = sp ? &sp->sys : sys;
   if (r < 1 || r > s->N || (method != PHGMG_METHOD_PHBT && r <= s->m)) return PHGMG_ERR_SIZE;
-  if (sp && method == PHGMG_METHOD_PHBT) rc = phgmg__bal_sparse_phbt(out, sp, r, opts, sv, nsv, &inf, alloc);
-  else if (sp && method == PHGMG_METHOD_BT) rc = phgmg__bal_sparse_bt(out, sp, r, opts, sv, nsv, &inf, alloc);
-  else if (sp) rc = phgmg__bal_sparse_prbt(out, sp, r, opts, sv, nsv, &inf, alloc);
+  if (!sp) cache = NULL;
+  if (cache && cache->sp && cache->sp != sp) return PHGMG_ERR_INVALID_ARG;
+  if (cache) cache->sp = sp;
+  if (sp && method == PHGMG_METHOD_PHBT) rc = phgmg__bal_sparse_phbt(out, sp, r, opts, sv, nsv, &inf, cache, alloc);
+  else if (sp && method == PHGMG_METHOD_BT) rc = phgmg__bal_sparse_bt(out, sp, r, opts, sv, nsv, &inf, cache, alloc);
+  else if (sp) rc = phgmg__bal_sparse_prbt(out, sp, r, opts, sv, nsv, &inf, cache, alloc);
   else if (method == PHGMG_METHOD_BT) rc = phgmg__bal_dense_bt(out, sys, r, sv, nsv, &inf, alloc);
   else {
     double *ps = phgmg__dalloc(alloc, (size_t)r);

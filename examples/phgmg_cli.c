@@ -323,7 +323,9 @@ static const char *const help_lines[] = {
   "SWEEPS (several --method and --r in one call)\n",
   "  reduce and validate with a list in --method or --r build every (method, r)\n",
   "  pair (up to 32 models) from one set-up: the files are read and checked, the\n",
-  "  training runs simulated and the snapshots' bases (POD) computed once; every\n",
+  "  training runs simulated and the snapshots' bases (POD) computed once (the\n",
+  "  balancing methods: the Gramian factors, once per model; the log says\n",
+  "  'Gramian factors: computed' or 'reused' per model); every\n",
   "  size is checked for every pair before any work. Model (M, R) is written as\n",
   "  NAME_<M>_r<R>.* with the method's '-' as '_' (rom_gmg_pod_r20.phgmgrom,\n",
   "  rom_sp1_r40_V0.npy, rom_gmg_pod_r20.json, ...); NAME_sweep.json lists the\n",
@@ -423,13 +425,18 @@ static const char *const help_lines[] = {
   "          of the controllability Gramian's low-rank factor, then the dense\n",
   "          PRBT of that model (order: the factor's rank, typically 50-200).\n",
   "    phbt  pH-preserving balancing with one Lyapunov equation (sparse input\n",
-  "          only): pH by construction, no error bound, less accurate than bt.\n",
+  "          only): the controllability Gramian balanced against the model's\n",
+  "          minimal Hamiltonian (the least energy function among its pH forms;\n",
+  "          the energy Q where none exists: a port without damping), in two\n",
+  "          stages like prbt. pH by construction, no error bound; about as\n",
+  "          accurate as prbt, less than bt.\n",
   "  NAME.json's \"info\" holds the solver (low-rank or dense), the Gramian\n",
   "  factors' ranks, ADI steps and factorizations, the Lyapunov residuals\n",
   "  (relative), the singular values (first 64) and, for bt, \"error_bound\". The\n",
   "  log shows every phase (Gramians, shifts, balancing) that starts after the\n",
   "  first second. The model files are the usual ones; simulate-rom runs them\n",
-  "  (validate does not take these methods: compare simulate with simulate-rom).\n",
+  "  validate takes these methods too: --dt, --steps, --input, --amp (or\n",
+  "  --test-input) then set its test runs (default: sin, 1000 steps of 0.1).\n",
   "  Example (a 2-D model with 10^5 states, one core: about 10 s for heat,\n",
   "  90 s for a mass-spring lattice):\n",
   "    phgmg reduce --J-coo J.npy --R-coo R.npy --Q-coo Q.npy --B B.npy \\\n",
@@ -1859,6 +1866,10 @@ static int check_model_opts(const char *cmd, const reduce_args *A) {
   return 0;
 }
 
+/* 1 while validate parses its reduce options: a balancing method then takes
+   --dt, --steps, --input and --amp (the test runs' step, length, input). */
+static int g_validating;
+
 /* --method bt, prbt or phbt: balancing, computed from the matrices alone. */
 static int balancing_method(const char *m) { return !strcmp(m, "bt") || !strcmp(m, "prbt") || !strcmp(m, "phbt"); }
 
@@ -1875,7 +1886,8 @@ static int check_balancing_args(reduce_args *A, const char *const *seen, int nse
     return usage_error("reduce: --method %s computes the reduced model from the linear model's matrices: %s "
                        "does not apply (no snapshots)", A->method, A->X ? "--X" : A->nxin ? "--X-input" : "--train-input");
   for (k = 0; refused[k]; ++k)
-    if (given(refused[k], seen, nseen))
+    if (given(refused[k], seen, nseen) &&
+        !(g_validating && (k == 1 || k == 2 || k == 3 || k == 4)))   /* --input, --steps, --amp, --dt */
       return usage_error("reduce: --method %s computes the reduced model from the linear model's matrices: %s "
                          "does not apply (no snapshots, no nonlinear part, dampers or feedthrough)", A->method,
                          refused[k]);
@@ -2499,6 +2511,7 @@ typedef struct reduce_state {
   int bal_on;               /* --method bt, prbt, phbt: what the balancing did */
   phgmg_balanced_info bal;
   double bal_sv[64];        /* its first values (bal.nsv) */
+  phgmg_balanced_cache bcache; /* the Gramian factors, shared by a sweep's balancing models */
 } reduce_state;
 
 /* Is w phi(s), phi(s) = sum_j c_j s^j + sum_e a_e exp(b_e s), bounded below
@@ -2591,6 +2604,7 @@ static int load_family(const reduce_args *A, reduce_state *S, phgmg_ph_system *s
 }
 
 static void reduce_cleanup(reduce_state *S) {
+  phgmg_balanced_cache_free(&S->bcache, NULL);
   mat_free(&S->J); mat_free(&S->R); mat_free(&S->B); mat_free(&S->Q); mat_free(&S->E); mat_free(&S->Pm); mat_free(&S->Sm); mat_free(&S->Nm); mat_free(&S->Dm); mat_free(&S->refm);
   free(S->di); free(S->dj); free(S->dlaw); mat_free(&S->X);
   mat_free(&S->poly); mat_free(&S->pidx); mat_free(&S->pw); mat_free(&S->ex); mat_free(&S->in.tab);
@@ -4018,6 +4032,7 @@ static void json_balancing(FILE *jf, const reduce_state *S, int method) {
     fprintf(jf, ", "); json_num(jf, b->res_obs); fprintf(jf, "]");
   }
   if (method != PHGMG_METHOD_PRBT) fprintf(jf, ", \"values_computed\": %d", b->lr.nhsv);
+  if (method == PHGMG_METHOD_PHBT) fprintf(jf, ", \"hamiltonian\": \"%s\"", b->hmin ? "minimal" : "energy");
   fprintf(jf, ", \"%s\": [", method == PHGMG_METHOD_BT ? "hankel_singular_values"
                             : method == PHGMG_METHOD_PRBT ? "positive_real_singular_values" : "energy_singular_values");
   for (i = 0; i < b->nsv; ++i) { if (i) fprintf(jf, ", "); json_num(jf, S->bal_sv[i]); }
@@ -4365,6 +4380,7 @@ static int run_balancing(const reduce_args *A, reduce_state *S, double *t_red) {
   phase_log plog;
   phgmg_result rc;
   double t0;
+  int runs0;
   if (S->dae) return fail("--method %s: index-one descriptor models (E with zero rows) are not supported; give "
                           "an E of full rank", A->method);
   memset(&lo, 0, sizeof lo);
@@ -4373,10 +4389,14 @@ static int run_balancing(const reduce_args *A, reduce_state *S, double *t_red) {
   plog.t0 = t0; plog.all = 0; plog.ncand = plog.nprobe = 0;
   if (!g_quiet) { lo.progress = reduce_phase; lo.progress_user = &plog; }
   S->bal_on = 1;
-  rc = phgmg_balanced_reduce(&S->red, S->sp ? NULL : &S->sys, S->sp, S->method, A->r, &lo, S->bal_sv, 64, &S->bal,
-                             NULL);
+  runs0 = S->bcache.adi_runs;
+  rc = phgmg_balanced_reduce_cached(&S->red, S->sp ? NULL : &S->sys, S->sp, S->method, A->r, &lo, S->bal_sv, 64,
+                                    &S->bal, &S->bcache, NULL);
   *t_red = now_s() - t0;
   if (rc != PHGMG_OK) return explain_balancing(A, S, rc);
+  if (b->lowrank)
+    progress("  Gramian factors: %s", S->bcache.adi_runs > runs0 ? "computed (low-rank ADI)"
+                                       : "reused (computed once for this model in this run)");
   if (b->lowrank)
     progress("  done in %.2f s: Gramian factor ranks %d / %d, ADI steps %d / %d, Lyapunov residuals %.2g / %.2g",
              *t_red, b->lr.ctrl.rank, b->lr.obs.rank, b->lr.ctrl.iters, b->lr.obs.iters, b->res_ctrl, b->res_obs);
@@ -4388,7 +4408,10 @@ static int run_balancing(const reduce_args *A, reduce_state *S, double *t_red) {
              b->ph_change > 0.0 ? "" : "");
   if (S->bal.stages == 2)
     progress("  two stages: the pH Galerkin projection onto the controllability factor (order %d), then the "
-             "dense PRBT; positive-real singular values %.6g ... %.3g", b->inter, S->bal_sv[0],
+             "dense %s; %s singular values %.6g ... %.3g", b->inter,
+             S->method == PHGMG_METHOD_PRBT ? "PRBT" : b->hmin ? "pH balancing against the minimal Hamiltonian"
+                                                            : "pH balancing against the energy (no minimal Hamiltonian)",
+             S->method == PHGMG_METHOD_PRBT ? "positive-real" : "pH", S->bal_sv[0],
              S->bal_sv[b->nsv > 0 ? b->nsv - 1 : 0]);
   return 0;
 }
@@ -5038,17 +5061,17 @@ static int cmd_validate(int argc, char **argv) {
   reduce_args A;
   reduce_state S;
   if ((i = parse_validate(argc, argv, &V, reduce_argv, &rargc)) != 0) return i;
-  if ((i = parse_reduce(rargc, (char **)reduce_argv, &A)) != 0) return i;
-  if (balancing_method(A.method))   /* its reduced model has no projection measures of validate */
-    return usage_error("validate: --method %s is not validated by this command: run `phgmg reduce`, then compare "
-                       "`phgmg simulate` with `phgmg simulate-rom` (or use the error bound in NAME.json)", A.method);
+  g_validating = 1;
+  i = parse_reduce(rargc, (char **)reduce_argv, &A);
+  g_validating = 0;
+  if (i != 0) return i;
   nt = V.nt;
   memset(from_x, 0, sizeof from_x);
   if (nt == 0 && A.ntrain)   /* default: the training inputs */
     for (i = 0; i < A.ntrain; ++i) V.tests[nt++] = A.train[i];
   if (nt == 0 && A.nxin)     /* --X: the inputs of the snapshot runs, from their first snapshot */
     for (i = 0; i < A.nxin; ++i) { from_x[nt] = 1; V.tests[nt++] = A.xin[i]; }
-  if (nt == 0 && !A.simulate)
+  if (nt == 0 && !A.simulate && !balancing_method(A.method))
     return usage_error("validate: with --X give --test-input (or --X-input): the inputs that made the snapshots are unknown");
   if (nt == 0) V.tests[nt++] = A.input;
   memset(&S, 0, sizeof S);

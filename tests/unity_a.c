@@ -43,3 +43,4 @@
 #include "test_workflow.c"
 #include "test_pod_stream.c"
 #include "test_dae_sparse_reduce.c"
+#include "test_balanced2.c"
