@@ -5,7 +5,7 @@
 
      make build/petsc_mumps      (mpicc + PETSc with MUMPS: Debian libpetsc-real-dev)
      mpirun -np 4 build/petsc_mumps --J-coo J.npy --R-coo R.npy --Q-coo Q.npy \
-         --B B.npy --X X.npy --r 12 --out rom.phgmgrom [--y y.npy] [--dt 0.1] \
+         --B B.npy --X X.npy --r 20 --out rom.phgmgrom [--y y.npy] [--dt 0.1] \
          [--steps 300] [--amp 0.1] [PETSc options, e.g. -ksp_view]
 
    Inputs are the files of `phgmg reduce` (manual chapter 6): J, R, Q as
@@ -27,7 +27,7 @@
    It is the serial `phgmg reduce --X X.npy --method gmg-pod --r R` (no
    reference state, no step map) computed on P ranks. Measured with
    tests/mpi/check_petsc.sh (make test-petsc; a scrambled chain of 1500
-   masses, N = 3000, 301 snapshots, r = 12): the outputs of
+   masses, N = 3000, 301 snapshots, r = 20): the outputs of
    `phgmg simulate-rom` on this model and on the serial one agree within
    the relative differences printed by the script (see bench/README.md). */
 #define PHGMG_MPI
