@@ -5,8 +5,8 @@
 
      make build/petsc_mumps      (mpicc + PETSc with MUMPS: Debian libpetsc-real-dev)
      mpirun -np 4 build/petsc_mumps --J-coo J.npy --R-coo R.npy --Q-coo Q.npy \
-         --B B.npy --X X.npy --r 20 --out rom.phgmgrom [--y y.npy] [--dt 0.1] \
-         [--steps 300] [--amp 0.1] [PETSc options, e.g. -ksp_view]
+         --B B.npy --X X.npy --r 20 --out rom.phgmgrom [--y y.npy] [--npy PREFIX] \
+         [--dt 0.1] [--steps 300] [--amp 0.1] [PETSc options, e.g. -ksp_view]
 
    Inputs are the files of `phgmg reduce` (manual chapter 6): J, R, Q as
    (nnz, 3) .npy arrays of (row, col, value) triplets (0-based, duplicates
@@ -23,7 +23,8 @@
      4. on rank 0 writes the reduced model (K, Qh, Bh: a phgmg_rom of kind
         PHGMG_ROM_LINEAR) with phgmg_rom_save, and with --y steps it from
         rest with the GL3 stepper, u_a(t) = AMP sin((1 + a/m) t) (the input
-        `sin` of the command line), writing the outputs y (m x (steps+1)).
+        `sin` of the command line), writing the outputs y (m x (steps+1));
+        with --npy PREFIX also K, Qh, Bh as PREFIX_K.npy, _Qh.npy, _Bh.npy.
    It is the serial `phgmg reduce --X X.npy --method gmg-pod --r R` (no
    reference state, no step map) computed on P ranks. Measured with
    `make test-petsc` (tests/mpi/check_petsc.sh: a scrambled chain of 1500
@@ -46,7 +47,7 @@
 #include <sys/stat.h>
 
 typedef struct args {
-  const char *J, *R, *Q, *B, *X, *out, *y;
+  const char *J, *R, *Q, *B, *X, *out, *y, *npy;
   int r, steps;
   double dt, amp;
 } args;
@@ -83,15 +84,24 @@ static int same_file(const char *p, const char *q) {
   return p && q && stat(p, &a) == 0 && stat(q, &b) == 0 && a.st_dev == b.st_dev && a.st_ino == b.st_ino;
 }
 
-/* 1 if an output (--out, --y) is one of the inputs or the other output:
+/* --npy PREFIX: the file of block k (0 K, 1 Qh, 2 Bh), named as the
+   command line's NAME_K.npy, NAME_Qh.npy, NAME_Bh.npy. */
+static void npy_name(char *buf, const char *prefix, int k) {
+  static const char *const suffix[3] = {"_K.npy", "_Qh.npy", "_Bh.npy"};
+  snprintf(buf, 4096, "%.4000s%s", prefix, suffix[k]);
+}
+
+/* 1 if an output (--out, --y, --npy's files) is one of the inputs or the other output:
    a run never overwrites its input files. */
 static int outputs_clash(const args *a) {
   const char *in[5];
   int k, o;
-  const char *out[2];
+  const char *out[5];
+  char nm[3][4096];
   in[0] = a->J; in[1] = a->R; in[2] = a->Q; in[3] = a->B; in[4] = a->X;
-  out[0] = a->out; out[1] = a->y;
-  for (o = 0; o < 2; ++o)
+  out[0] = a->out; out[1] = a->y; out[2] = out[3] = out[4] = NULL;
+  for (k = 0; k < 3 && a->npy; ++k) { npy_name(nm[k], a->npy, k); out[2 + k] = nm[k]; }
+  for (o = 0; o < 5; ++o)
     for (k = 0; k < 5; ++k)
       if (out[o] && (same_file(out[o], in[k]) || !strcmp(out[o], in[k]))) {
         say("%s is an input file: choose another output", out[o]);
@@ -115,6 +125,7 @@ static int parse_args(int argc, char **argv, args *a) {
     else if (!strcmp(o, "--X")) a->X = v;
     else if (!strcmp(o, "--out")) a->out = v;
     else if (!strcmp(o, "--y")) a->y = v;
+    else if (!strcmp(o, "--npy")) a->npy = v;
     else if (!strcmp(o, "--r")) a->r = atoi(v);
     else if (!strcmp(o, "--steps")) a->steps = atoi(v);
     else if (!strcmp(o, "--dt")) a->dt = atof(v);
@@ -124,7 +135,7 @@ static int parse_args(int argc, char **argv, args *a) {
   }
   if (!a->J || !a->R || !a->Q || !a->B || !a->X || !a->out || a->r < 1 || a->steps < 1 || !(a->dt > 0.0)) {
     say("usage: mpirun -np P petsc_mumps --J-coo J.npy --R-coo R.npy --Q-coo Q.npy --B B.npy --X X.npy --r R "
-        "--out MODEL.phgmgrom [--y y.npy] [--dt 0.1] [--steps 300] [--amp 0.1] [PETSc options]");
+        "--out MODEL.phgmgrom [--y y.npy] [--npy PREFIX] [--dt 0.1] [--steps 300] [--amp 0.1] [PETSc options]");
     return 1;
   }
   return outputs_clash(a);
@@ -342,6 +353,18 @@ static int write_rom(const args *a, int m, const double *K, const double *Qh, co
   if (rc == PHGMG_OK) rc = phgmg_rom_save(&rom, a->out);
   if (rc != PHGMG_OK) { say("%s: %s", a->out, phgmg_result_string(rc)); return 1; }
   printf("reduced model (r = %d, m = %d) written to %s\n", a->r, m, a->out);
+  if (a->npy) {
+    const double *blk[3];
+    char nm[4096];
+    int k;
+    blk[0] = K; blk[1] = Qh; blk[2] = Bh;
+    for (k = 0; k < 3 && rc == PHGMG_OK; ++k) {
+      npy_name(nm, a->npy, k);
+      rc = phgmg_npy_write(nm, blk[k], a->r, k < 2 ? a->r : m, a->r, 2, 0);
+      if (rc != PHGMG_OK) { say("%s: %s", nm, phgmg_result_string(rc)); return 1; }
+    }
+    printf("K, Qh, Bh written to %s_K.npy, %s_Qh.npy, %s_Bh.npy\n", a->npy, a->npy, a->npy);
+  }
   return a->y ? run_rom(&rom, a) : 0;
 }
 
