@@ -96,6 +96,22 @@ test-mpi:
 	for p in 1 2 3 4; do timeout 120 $(MPIRUN) -np $$p ./$(BUILD)/test_mpi_nl $(BUILD)/mpi || exit 1; done && \
 	$(MPIRUN) -np 3 ./$(BUILD)/mpi_pod --N 3000 > $(BUILD)/mpi/example.txt && echo "test-mpi: examples/mpi_pod.c runs at 3 ranks"
 
+# A real distributed solver behind the solve callback (examples/petsc_mumps.c:
+# PETSc assembles J - R as MPIAIJ, MUMPS factors it) checked against the
+# serial command line at 1, 2 and 4 ranks (tests/mpi/check_petsc.sh). Needs
+# mpicc and PETSc with MUMPS, found by pkg-config (Debian: libpetsc-real-dev;
+# another PETSc: PKG_CONFIG_PATH=$PETSC_DIR/$PETSC_ARCH/lib/pkgconfig).
+# Skipped without them; not part of make test. About 10 s after the compile.
+.PHONY: test-petsc
+PETSC_PC = pkg-config --exists petsc 2>/dev/null && command -v $(MPICC) >/dev/null 2>&1 && command -v mpirun >/dev/null 2>&1
+$(BUILD)/petsc_mumps: examples/petsc_mumps.c phgmg.h
+	@if ! $(PETSC_PC); then echo "petsc_mumps: skipped (needs $(MPICC), mpirun and PETSc via pkg-config; Debian: libpetsc-real-dev)"; exit 0; fi; \
+	mkdir -p $(BUILD) && echo "$(MPICC) ... -o $@ $< (PETSc: pkg-config petsc)" && \
+	$(MPICC) -std=c99 $(WARN) -O2 $$(pkg-config --cflags petsc) -o $@ $< $$(pkg-config --libs petsc) $(LDLIBS)
+test-petsc:
+	@if ! $(PETSC_PC); then echo "test-petsc: skipped (needs $(MPICC), mpirun and PETSc via pkg-config; Debian: libpetsc-real-dev)"; exit 0; fi; \
+	$(MAKE) --no-print-directory $(BUILD)/phgmg $(BUILD)/petsc_mumps && sh tests/mpi/check_petsc.sh $(BUILD)
+
 # The documentation against the code: every public function in the manual's
 # index, every CLI option in --help, README's first C block compiles and runs,
 # no tracked file named '-...', no issue numbers in README.md, phgmg.h, Makefile.

@@ -806,6 +806,18 @@
    QDEIM or GREEDY), separable terms by callbacks and GENERAL nonlinear
    Hamiltonians, a reference state (opts.ref), dampers, feedthrough,
    descriptor models, the command line.
+   A PETSc + MUMPS example. examples/petsc_mumps.c puts a real distributed
+   direct solver behind the solve callback: it reads the command line's
+   files (J, R, Q as (nnz, 3) triplets, B, the snapshots X), each rank
+   keeping the rows of PETSc's default layout, assembles J - R as an MPIAIJ
+   matrix, factors it once with MUMPS (KSPPREONLY, PCLU,
+   MATSOLVERMUMPS), and its callback runs KSPSolve / KSPSolveTranspose per
+   right-hand side; rank 0 writes K, Qh, Bh as a model file (phgmg_rom_save)
+   that `phgmg simulate-rom` runs. `make test-petsc` (PETSc found by
+   pkg-config; skipped without it) compares it at 1, 2 and 4 ranks with the
+   serial `phgmg reduce --method gmg-pod` on a chain of N = 3000 states: K
+   and Qh agree within 3e-15 relative (after the modes' signs), the reduced
+   outputs within 3.2e-15.
    2.8 Large sparse linear models (>>lowrank). For a phgmg_ph_sparse model
    with quadratic H (E x' = (J - R) Q x + B u, y = B^T Q x; E = I or a mass
    matrix of full rank) the Gramians are computed in low-rank factored form
