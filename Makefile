@@ -231,11 +231,8 @@ test-cli: $(BUILD)/phgmg $(BUILD)/phgmg-float
 	sh tests/test_cli_workflow.sh $(BUILD)/phgmg
 	/usr/bin/python3 tests/check_dae_bar.py $(BUILD)/phgmg 100 $(BUILD)/dae_bar
 	sh tests/test_cli_lowrank.sh $(BUILD)/phgmg
-<<<<<<< HEAD
 	sh tests/test_dae_reduce.sh $(BUILD)/phgmg
-=======
 	sh tests/test_cli_lowrank2.sh $(BUILD)/phgmg
->>>>>>> lowrank
 
 # The descriptor bar (N = 800, consistent mass, feedthrough, scrambled order)
 # and its index-one variant through the command line against SciPy.
