@@ -2265,9 +2265,9 @@
 
 /* >>config ================================================================ */
 #define PHGMG_VERSION_MAJOR 0
-#define PHGMG_VERSION_MINOR 7
+#define PHGMG_VERSION_MINOR 8
 #define PHGMG_VERSION_PATCH 0
-#define PHGMG_VERSION_STRING "0.7.0"
+#define PHGMG_VERSION_STRING "0.8.0"
 
 #include <stddef.h>
 
@@ -27896,18 +27896,51 @@ PHGMG_DEF phgmg_result phgmg_sym_eig(int n, double *A, int lda, double *w, doubl
 
 /*
    REVISION HISTORY
-   0.7.0  (2026-11-28)
-          - Changed: an index-one model in SPARSE storage (E with zero rows
-            and columns) is simulated on its sparse pencil (manual 1.8): no
-            condensation, no limit on the algebraic lines but memory; its
-            validation needs no condensation either. phgmg_dae_create
-            condenses such a system sparsely (per connected component of the
-            algebraic block; the condensed model a SPARSE system of its own
-            object), also without a limit on the algebraic lines.
+   0.8.0  (2026-11-28)
+          - New with PHGMG_MPI: phgmg_mpi_reduce / phgmg_mpi_rom_free
+            (GMG-POD and SP1 of a model with a separable nonlinear
+            Hamiltonian, ECSW hyper-reduction whose points and weights do not
+            depend on the partition; the reduced model identical on every
+            rank), phgmg_mpi_sep_model, phgmg_mpi_rom (manual 2.7).
+          - Changed: phgmg_mpi_pod_stream re-orthogonalises each block and
+            drops modes below the rounding floor, as the serial stream does.
+          - Changed: phgmg_dae_create condenses an index-one SPARSE system
+            sparsely (per connected component of the algebraic block; the
+            condensed model a SPARSE system owned by the object): no limit
+            on the algebraic lines but memory (manual 1.8).
           - Changed: phgmg_reduce checks B's column rank for the GMG methods
             only: SP1 and SP2 take a port whose condensed column of B
             vanishes (it acts only through a constraint);
             phgmg_reduce_info.rank_port names the port a GMG method refuses.
+          - Changed: pH-preserving balancing (PHBT) balances against the
+            model's minimal Hamiltonian (the minimal solution of its KYP
+            inequality, computed on the controllability factor's span) and
+            falls back to the energy Q when that model is not dissipative;
+            phgmg_balanced_info.hmin says which (manual 2.8, 8.13).
+          - New: phgmg_balanced_reduce_cached / phgmg_balanced_cache_free:
+            several balancing methods and orders from one computation of the
+            Gramian factors.
+          - New: PHGMG_IMPLEMENTATION_ELSEWHERE (one object file holds the
+            implementation, other files define PHGMG_IMPLEMENTATION too);
+            PHGMG_NO_FMA_KERNEL.
+          - Faster: the sparse LU factors its fronts in blocks of 32 pivots
+            with a register-blocked multiply-add kernel, and solves several
+            right-hand sides per supernode at once (low-rank BT, GMG's block
+            solves, the frequency sweeps).
+          - Command line: reduce and validate of index-one COO input condense
+            sparsely (no limit on the algebraic lines); a port acting only
+            through a constraint is named by the GMG methods' refusal;
+            validate --method bt|prbt|phbt; `info` names the reduced kind of
+            nonlinear models.
+          - Examples: examples/petsc_mumps.c, PETSc's MUMPS behind the
+            distributed solve callback (make test-petsc).
+   0.7.0  (2026-11-28)
+          - Changed: an index-one model in SPARSE storage (E with zero rows
+            and columns) is simulated on its sparse pencil (manual 1.8): no
+            condensation, no limit on the algebraic lines but memory; its
+            validation needs no condensation either. phgmg_dae_create on such
+            a system returns PHGMG_ERR_UNSUPPORTED (give it dense or band
+            storage to condense).
           - Changed: J - R of a SPARSE model is factored by the sparse LU
             (validation, GMG's solves): no band copies, peak memory in
             proportion to the factor.
@@ -27936,8 +27969,7 @@ PHGMG_DEF phgmg_result phgmg_sym_eig(int n, double *A, int lda, double *w, doubl
             --method bt|prbt|phbt without snapshots; --stream; SciPy .npz and
             Matrix Market input; --x0; --input chirp, --freq, --freq-end;
             NAME_PD.npy; NAME.json records E, the full N and the model's
-            kind; dampers and index-one simulation on the sparse LU; reduce
-            of index-one COO input condensed sparsely (no 4096 limit);
+            kind; dampers and index-one simulation on the sparse LU;
             subnormal entries flushed in written models; progress lines
             before a large model's set-up.
    0.6.0  (2026-11-28)
