@@ -236,12 +236,20 @@ static int same_file(const char *p, const char *q) {
   return stat(p, &a) == 0 && stat(q, &b) == 0 && a.st_dev == b.st_dev && a.st_ino == b.st_ino;
 }
 
+/* The message of a failed .npy read: for an I/O error the system's reason. */
+static void npy_fail(const char *opt, const char *path, phgmg_result rc) {
+  FILE *f = NULL;
+  if (rc == PHGMG_ERR_IO && !(f = fopen(path, "rb"))) say("%s %s: cannot read: %s", opt, path, strerror(errno));
+  else say("%s %s: %s", opt, path, phgmg_result_string(rc));
+  if (rc == PHGMG_ERR_IO && f) fclose(f);
+}
+
 /* B whole (N x m; N and m from its shape), then the layout: contiguous
    blocks of N / P rows in rank order (the first N mod P ranks one more). */
 static int read_B_layout(const args *a, dist *d) {
   int rows = 0, cols = 0, nd = 0, p;
   phgmg_result rc = phgmg_npy_read(a->B, &d->Bfull, &rows, &cols, &nd, NULL);
-  if (rc != PHGMG_OK) { say("--B %s: %s", a->B, phgmg_result_string(rc)); return 1; }
+  if (rc != PHGMG_OK) { npy_fail("--B", a->B, rc); return 1; }
   if (nd == 2 && rows == 1 && cols > 1) { rows = cols; cols = 1; }   /* a (1, N) row: one port */
   if (rows < 1 || cols < 1 || cols > rows) { say("--B %s: expected (N,) or (N, m) with 1 <= m <= N", a->B); return 1; }
   d->N = rows; d->m = cols;
@@ -272,7 +280,7 @@ static int read_triplets(const char *opt, const char *path, int N, double **T, l
   int rows = 0, cols = 0;
   long k;
   phgmg_result rc = phgmg_npy_read(path, T, &rows, &cols, NULL, NULL);
-  if (rc != PHGMG_OK) { say("%s %s: %s", opt, path, phgmg_result_string(rc)); return 1; }
+  if (rc != PHGMG_OK) { npy_fail(opt, path, rc); return 1; }
   if (cols != 3) {
     say("%s %s: expected an (nnz, 3) array of (row, col, value) triplets, got %d columns (phgmg-mpi reads "
         "one .npy file per matrix)", opt, path, cols);
@@ -298,7 +306,7 @@ static int read_X_rows(const args *a, dist *d) {
   int rows = 0, cols = 0, j0, nb, i, j;
   double *buf;
   phgmg_result rc = phgmg_npy_read_cols(a->X, 0, 0, NULL, 0, &rows, &cols);
-  if (rc != PHGMG_OK) { say("--X %s: %s", a->X, phgmg_result_string(rc)); return 1; }
+  if (rc != PHGMG_OK) { npy_fail("--X", a->X, rc); return 1; }
   if (rows != d->N || cols < 2) {
     say("--X %s: expected (%d, ns) snapshots with ns >= 2 (N from --B), got (%d, %d)", a->X, d->N, rows, cols);
     return 1;
@@ -311,7 +319,7 @@ static int read_X_rows(const args *a, dist *d) {
   for (j0 = 0; j0 < cols; j0 += nb) {
     const int k = nb < cols - j0 ? nb : cols - j0;
     rc = phgmg_npy_read_cols(a->X, j0, k, buf, rows, NULL, NULL);
-    if (rc != PHGMG_OK) { say("--X %s: %s", a->X, phgmg_result_string(rc)); free(buf); return 1; }
+    if (rc != PHGMG_OK) { npy_fail("--X", a->X, rc); free(buf); return 1; }
     for (j = 0; j < k; ++j)
       for (i = 0; i < d->nloc; ++i) {
         const double v = buf[d->row0 + i + (size_t)j * rows];
@@ -459,7 +467,6 @@ typedef struct result {
   phgmg_mpi_rom mr;
   double *V0;                    /* this rank's rows (nloc x r) */
   double sigma_ratio, rcond_jr, seconds;
-  int kb;                        /* half-bandwidth of J - R in the solver's order */
 } result;
 
 /* sigma_{p+1} / sigma_1 of what the method PODs (the serial info's
@@ -541,7 +548,6 @@ static int reduce(const args *a, dist *d, result *res) {
   }
   res->seconds = MPI_Wtime() - t0;
   res->rcond_jr = sv.rcond;
-  res->kb = sv.sp ? phgmg_ph_sparse_system(sv.sp)->kb : 0;
   if (rc == PHGMG_OK) rc = sigma_ratio(ctx, d, a, &res->sigma_ratio);
   if (rc != PHGMG_OK) explain(a, d, rc);
   solver_free(&sv);
