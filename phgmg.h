@@ -842,8 +842,10 @@
    `phgmg simulate --states`), dense matrices, --E, nonlinear terms,
    dampers, feedthrough, --ref, the other methods, several --X files,
    method or order lists -- is refused with a message naming the option;
-   bad input (a missing file, wrong shapes, bad indices) gives one message
-   and the same exit status 1 on every rank (usage errors: 2). Against the
+   bad input (a missing file, wrong shapes, bad indices; J, R, B and J - R
+   checked as the serial command checks them, Q's definiteness not: each
+   rank holds only its rows) gives one message and the same exit status 1
+   on every rank (usage errors: 2). Against the
    serial `phgmg reduce` on a chain of N = 2400 states (201 snapshots,
    r = 10; `make test-mpi`, tests/mpi/check_cli_mpi.sh) at 1-4 ranks: K,
    Qh, Bh and V0 within 1e-14 relative (after the modes' signs), the

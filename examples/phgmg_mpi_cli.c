@@ -57,6 +57,12 @@ static const char *const help_text =
   "                      (simulate-rom's default step).\n"
   "  --quiet             no summary line.\n"
   "\n"
+  "CHECKS\n"
+  "  As the serial command: J skew-symmetric, R symmetric positive semidefinite\n"
+  "  (relative tolerance 1e-12), B of full column rank, J - R nonsingular, indices\n"
+  "  in range, no NaN/Inf; the outputs must not be input files. Q's symmetry and\n"
+  "  definiteness are not checked here (every rank holds only its rows of Q).\n"
+  "\n"
   "OUTPUTS (written by rank 0, the files of the serial `phgmg reduce`)\n"
   "  DIR/NAME.phgmgrom   the reduced model (phgmg simulate-rom, phgmg info)\n"
   "  DIR/NAME.c          the model as C source\n"
@@ -279,7 +285,14 @@ static int own_B(dist *d) {
 static int read_triplets(const char *opt, const char *path, int N, double **T, long *nnz) {
   int rows = 0, cols = 0;
   long k;
-  phgmg_result rc = phgmg_npy_read(path, T, &rows, &cols, NULL, NULL);
+  const size_t n = strlen(path);
+  phgmg_result rc;
+  if (strchr(path, ',') || (n > 4 && (!strcmp(path + n - 4, ".npz") || !strcmp(path + n - 4, ".mtx")))) {
+    say("%s %s: phgmg-mpi reads one (nnz, 3) .npy file of (row, col, value) triplets per matrix (not three "
+        "files, .npz or .mtx: the serial `phgmg reduce` reads those)", opt, path);
+    return 1;
+  }
+  rc = phgmg_npy_read(path, T, &rows, &cols, NULL, NULL);
   if (rc != PHGMG_OK) { npy_fail(opt, path, rc); return 1; }
   if (cols != 3) {
     say("%s %s: expected an (nnz, 3) array of (row, col, value) triplets, got %d columns (phgmg-mpi reads "
@@ -408,8 +421,9 @@ static phgmg_result triplets_csc(int N, const double *T, long nnz, phgmg_csc *ou
 }
 
 /* The replicated solver: J - R (with Q = I, which the solve with J - R does
-   not see) as a sparse model, factored once by the library's sparse LU
-   (band LU fall-back; manual 8.12). Every rank does the same. */
+   not see) as a sparse model, checked as the serial command checks J, R
+   and B, factored once by the library's sparse LU (band LU fall-back;
+   manual 8.12). Every rank does the same. */
 static phgmg_result solver_create(const dist *d, solver *s) {
   phgmg_csc J, R, I;
   phgmg_result rc;
@@ -427,6 +441,8 @@ static phgmg_result solver_create(const dist *d, solver *s) {
   if (rc == PHGMG_OK) rc = triplets_csc(d->N, d->TR, d->nR, &R);
   if (rc == PHGMG_OK) rc = phgmg_csc_from_coo(&I, d->N, d->N, d->N, idx, idx, ones, NULL);
   if (rc == PHGMG_OK) rc = phgmg_ph_sparse_create(&s->sp, d->N, d->m, &J, &R, &I, d->Bfull, NULL, NULL, NULL);
+  /* the serial checks of J, R, B and J - R (relative tolerance 1e-12); Q here is I, so Q's are not made */
+  if (rc == PHGMG_OK) rc = phgmg_ph_validate(phgmg_ph_sparse_system(s->sp), 1e-12, NULL, NULL);
   if (rc == PHGMG_OK) rc = phgmg_jr_factor_create(&s->f, phgmg_ph_sparse_system(s->sp), &s->rcond, NULL);
   phgmg_csc_free(&J, NULL); phgmg_csc_free(&R, NULL); phgmg_csc_free(&I, NULL);
   free(idx); free(ones);
@@ -513,6 +529,11 @@ static void explain(const args *a, const dist *d, phgmg_result rc) {
         meth, a->J, a->R, phgmg_result_string(rc));
   else if (rc == PHGMG_ERR_RANK)
     say("%s: --B %s is rank deficient: %s", meth, a->B, phgmg_result_string(rc));
+  else if (rc == PHGMG_ERR_NOT_SKEW)
+    say("--J-coo %s: J is not skew-symmetric (relative tolerance 1e-12): %s", a->J, phgmg_result_string(rc));
+  else if (rc == PHGMG_ERR_NOT_SYMMETRIC || rc == PHGMG_ERR_NOT_PSD)
+    say("--R-coo %s: R is not symmetric positive semidefinite (relative tolerance 1e-12): %s", a->R,
+        phgmg_result_string(rc));
   else
     say("%s: %s", meth, phgmg_result_string(rc));
 }
@@ -532,9 +553,13 @@ static int reduce(const args *a, dist *d, result *res) {
   memset(&md, 0, sizeof md);
   t0 = MPI_Wtime();
   if (rc == PHGMG_OK) rc = make_op(ctx, d, d->TQ, d->nQ, 1.0, NULL, 0, 0.0, &Qop);
+  phgmg_npy_free(d->TQ, NULL);   /* Q lives in its operator now */
+  d->TQ = NULL;
   if (rc == PHGMG_OK && a->method == PHGMG_METHOD_SP1)
     rc = make_op(ctx, d, d->TJ, d->nJ, 1.0, d->TR, d->nR, -1.0, &JRop);
   if (rc == PHGMG_OK) rc = phgmg_mpi_agree(MPI_COMM_WORLD, solver_create(d, &sv));
+  phgmg_npy_free(d->TJ, NULL); phgmg_npy_free(d->TR, NULL); phgmg_npy_free(d->Bfull, NULL);
+  d->TJ = d->TR = d->Bfull = NULL;   /* J - R and B live in the solver (and the operators) now */
   res->V0 = (double *)malloc(sizeof(double) * ((size_t)ld * a->r + 1));
   if (rc == PHGMG_OK && any_rank(!res->V0)) rc = PHGMG_ERR_NOMEM;
   if (rc == PHGMG_OK) {
@@ -583,6 +608,15 @@ static int outputs_clash(const args *a) {
       }
   }
   return 0;
+}
+
+/* 1 if --out names something that is not a directory (checked before the
+   work; the directory itself is made when the outputs are written). */
+static int out_not_dir(const args *a) {
+  struct stat st;
+  if (stat(a->out, &st) != 0 || S_ISDIR(st.st_mode)) return 0;
+  say("--out %s: exists and is not a directory", a->out);
+  return 1;
 }
 
 /* mkdir -p DIR. */
@@ -784,7 +818,7 @@ static int run(const args *a, int size) {
   memset(&d, 0, sizeof d);
   memset(&res, 0, sizeof res);
   d.rank = g_rank; d.size = size;
-  err = any_rank(g_rank == 0 && outputs_clash(a));
+  err = any_rank(g_rank == 0 && (outputs_clash(a) || out_not_dir(a)));
   if (!err) err = read_inputs(a, &d);
   if (!err) err = any_rank(reduce(a, &d, &res));
   if (!err) err = write_outputs(a, &d, &res);
