@@ -568,7 +568,7 @@ static int reduce(const args *a, dist *d, result *res) {
     md.JR = JRop;
     md.poly_deg = 1;   /* no separable terms (nsep = 0): a linear model */
     memset(&o, 0, sizeof o);
-    o.method = a->method; o.r = a->r;
+    o.method = (phgmg_method)a->method; o.r = a->r;
     rc = phgmg_mpi_reduce(ctx, &md, d->ns, d->Xl, ld, &o, &res->mr, res->V0, ld);
   }
   res->seconds = MPI_Wtime() - t0;
