@@ -804,8 +804,8 @@ static int write_outputs(const args *a, const dist *d, result *res) {
   if (any_rank(bad)) return 1;
   if (d->rank == 0 && !a->quiet)
     printf("wrote %s/%s.phgmgrom, %s/%s.c, %s/%s.json and 4 arrays %s/%s_*.npy (%s, r = %d, m = %d, N = %d, "
-           "%d ranks)\n", a->out, a->name, a->out, a->name, a->out, a->name, a->out, a->name,
-           a->method == PHGMG_METHOD_SP1 ? "sp1" : "gmg-pod", a->r, d->m, d->N, d->size);
+           "%d rank%s)\n", a->out, a->name, a->out, a->name, a->out, a->name, a->out, a->name,
+           a->method == PHGMG_METHOD_SP1 ? "sp1" : "gmg-pod", a->r, d->m, d->N, d->size, d->size > 1 ? "s" : "");
   return 0;
 }
 
