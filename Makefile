@@ -69,12 +69,14 @@ test-build: tests/suites.inc
 	  $(BUILD)/export_model_d $(BUILD)/export_model_f
 
 # The distributed layer (PHGMG_MPI; tests/mpi/test_mpi.c, tests/mpi/test_mpi_nl.c,
-# examples/mpi_pod.c)
+# examples/mpi_pod.c; the distributed command line against the serial one,
+# tests/mpi/check_cli_mpi.sh)
 # at 1, 2, 3 and 4 ranks (4: one rank owns no rows; more ranks than cores),
 # each run's results compared with the one-rank run's; the section's compile
 # checks (C99, float online scalar, C++). Skipped, with a message, without
 # mpicc and mpirun (Debian: openmpi-bin libopenmpi-dev). A deadlock fails
-# after 120 s (timeout). Half a minute, most of it compiling.
+# after 120 s (timeout). About a minute, most of it compiling (the command-line
+# check: about 15 s after a 12 s compile).
 MPICC  ?= mpicc
 MPICXX ?= mpicxx
 MPIRUN  = mpirun --oversubscribe $$(if [ "$$(id -u)" = 0 ]; then echo --allow-run-as-root; fi)
@@ -94,7 +96,19 @@ test-mpi:
 	for p in 1 2 3 4; do timeout 120 $(MPIRUN) -np $$p ./$(BUILD)/test_mpi_stream || exit 1; done && \
 	$(MPICC) $(CFLAGS_T) -o $(BUILD)/test_mpi_nl tests/mpi/test_mpi_nl.c $(LDLIBS) && \
 	for p in 1 2 3 4; do timeout 120 $(MPIRUN) -np $$p ./$(BUILD)/test_mpi_nl $(BUILD)/mpi || exit 1; done && \
-	$(MPIRUN) -np 3 ./$(BUILD)/mpi_pod --N 3000 > $(BUILD)/mpi/example.txt && echo "test-mpi: examples/mpi_pod.c runs at 3 ranks"
+	$(MPIRUN) -np 3 ./$(BUILD)/mpi_pod --N 3000 > $(BUILD)/mpi/example.txt && echo "test-mpi: examples/mpi_pod.c runs at 3 ranks" && \
+	$(MPICC) $(CFLAGS_T) -o $(BUILD)/mpi/phgmg-mpi examples/phgmg_mpi_cli.c $(LDLIBS) && \
+	$(MAKE) --no-print-directory $(BUILD)/phgmg && sh tests/mpi/check_cli_mpi.sh $(BUILD)/phgmg $(BUILD)/mpi/phgmg-mpi
+
+# The distributed command line (examples/phgmg_mpi_cli.c; manual 2.7):
+#   mpirun -np P build/phgmg-mpi reduce --J-coo J.npy --R-coo R.npy --Q-coo Q.npy \
+#       --B B.npy --X X.npy --method gmg-pod|sp1 --r R --out DIR
+# the files of the serial `phgmg reduce`, the rows of the state spread over the
+# ranks, J - R solved by the library's sparse LU replicated on every rank.
+# (make test-mpi checks the same source compiled at -O1, as its other programs.)
+$(BUILD)/phgmg-mpi: examples/phgmg_mpi_cli.c phgmg.h
+	@mkdir -p $(BUILD)
+	$(MPICC) $(OPTFLAGS) -o $@ $< $(LDLIBS)
 
 # A real distributed solver behind the solve callback (examples/petsc_mumps.c:
 # PETSc assembles J - R as MPIAIJ, MUMPS factors it) checked against the

@@ -805,7 +805,8 @@
    Not yet distributed: GMG-QM, SP2, DEIM hyper-reduction (hyper.kind
    QDEIM or GREEDY), separable terms by callbacks and GENERAL nonlinear
    Hamiltonians, a reference state (opts.ref), dampers, feedthrough,
-   descriptor models, the command line.
+   descriptor models; in the command line (below) also the separable terms
+   and simulating the training runs.
    A PETSc + MUMPS example. examples/petsc_mumps.c puts a real distributed
    direct solver behind the solve callback: it reads the command line's
    files (J, R, Q as (nnz, 3) triplets, B, the snapshots X), each rank
@@ -818,6 +819,37 @@
    serial `phgmg reduce --method gmg-pod` on a chain of N = 3000 states: K
    and Qh agree within 3e-15 relative (after the modes' signs), the reduced
    outputs within 3.2e-15.
+   The command line with MPI. `make build/phgmg-mpi` builds
+   examples/phgmg_mpi_cli.c with mpicc, and
+     mpirun -np P build/phgmg-mpi reduce --J-coo J.npy --R-coo R.npy
+         --Q-coo Q.npy --B B.npy --X X.npy --method gmg-pod|sp1 --r R
+         --out DIR [--name rom] [--dt DT] [--quiet]
+   reads the files of the serial `phgmg reduce` (J, R, Q as (nnz, 3)
+   triplets, B, the snapshots X; chapter 6) and writes its files: DIR/
+   NAME.phgmgrom, NAME.c, NAME.json and NAME_Bh.npy, NAME_Qh.npy,
+   NAME_K.npy, NAME_V0.npy (rank 0 writes; V0 is gathered a column at a
+   time). Rank p keeps a contiguous block of about N / P rows of the
+   state: its rows of Q (phgmg_mpi_op_create), of B, of the snapshots (read
+   a batch of columns at a time, phgmg_npy_read_cols) and, for sp1, of
+   J - R; the reduction is phgmg_mpi_reduce on a linear model. The solves
+   with J - R that GMG-POD needs use the library's sparse LU of J - R
+   (phgmg_jr_factor_create on a phgmg_ph_sparse model) REPLICATED on every
+   rank: the right-hand sides are gathered to every rank, solved there,
+   and each rank keeps its rows. That is fine while the factor fits in one
+   rank's memory; beyond, put a distributed solver behind the same
+   callback, as examples/petsc_mumps.c does with MUMPS. Everything else of
+   `phgmg reduce` -- --simulate (make the snapshots with the serial
+   `phgmg simulate --states`), dense matrices, --E, nonlinear terms,
+   dampers, feedthrough, --ref, the other methods, several --X files,
+   method or order lists -- is refused with a message naming the option;
+   bad input (a missing file, wrong shapes, bad indices; J, R, B and J - R
+   checked as the serial command checks them, Q's definiteness not: each
+   rank holds only its rows) gives one message and the same exit status 1
+   on every rank (usage errors: 2). Against the
+   serial `phgmg reduce` on a chain of N = 2400 states (201 snapshots,
+   r = 10; `make test-mpi`, tests/mpi/check_cli_mpi.sh) at 1-4 ranks: K,
+   Qh, Bh and V0 within 1e-14 relative (after the modes' signs), the
+   outputs of `phgmg simulate-rom` within 5e-15, for gmg-pod and sp1.
    2.8 Large sparse linear models (>>lowrank). For a phgmg_ph_sparse model
    with quadratic H (E x' = (J - R) Q x + B u, y = B^T Q x; E = I or a mass
    matrix of full rank) the Gramians are computed in low-rank factored form
@@ -1372,6 +1404,10 @@
      phgmg validate     reduce, then test full against reduced model on each
                         --test-input (exit 1 if one fails);
      phgmg info         describe a model file.
+   On MPI ranks, `mpirun -np P build/phgmg-mpi reduce ...` (make
+   build/phgmg-mpi) reduces a linear model from the same files with
+   gmg-pod or sp1 and writes the same outputs (2.7, "The command line
+   with MPI").
    Model options shared by reduce, validate and simulate include the mass
    matrix (--E, --E-coo), feedthrough (--P, --S, --N) and nonlinear dampers:
    --dampers FILE, a (k, 4) array of rows (i, j, c1, c3), a damper on

@@ -1,0 +1,852 @@
+/* The distributed command line: `phgmg reduce` on P MPI ranks.
+
+     make build/phgmg-mpi        (mpicc; the library with PHGMG_MPI)
+     mpirun -np P build/phgmg-mpi reduce --J-coo J.npy --R-coo R.npy --Q-coo Q.npy \
+         --B B.npy --X X.npy --method gmg-pod|sp1 --r R --out DIR [--name rom] [--dt DT] [--quiet]
+
+   It reads the files of the serial `phgmg reduce` (J, R, Q as (nnz, 3) .npy
+   arrays of (row, col, value) triplets, 0-based, duplicates summed; B (N,)
+   or (N, m); the snapshots X (N, ns)) and writes what the serial command
+   writes for the same options: DIR/NAME.phgmgrom, DIR/NAME.c,
+   DIR/NAME.json and the arrays DIR/NAME_Bh.npy, _Qh.npy, _K.npy, _V0.npy.
+   Each rank keeps its own contiguous block of rows of the state: of Q, B,
+   the snapshots (read a batch of columns at a time) and, for sp1, of
+   J - R. The solves with J - R that GMG-POD needs go through the library's
+   sparse LU of J - R, replicated on every rank (the right-hand sides are
+   gathered, solved, and each rank keeps its rows): fine while that factor
+   fits on one rank; examples/petsc_mumps.c puts MUMPS (a distributed
+   factor) behind the same solve callback. Rank 0 writes the outputs; V0
+   is gathered a column at a time. Manual section 2.7. */
+#define _POSIX_C_SOURCE 200809L
+#define PHGMG_MPI
+#define PHGMG_IMPLEMENTATION
+#include "../phgmg.h"
+#include <errno.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/types.h>
+
+static const char *const help_text =
+  "phgmg-mpi " PHGMG_VERSION_STRING " - the distributed `phgmg reduce` (MPI): linear port-Hamiltonian\n"
+  "models x' = (J - R) Q x + B u, y = B^T Q x, reduced on P ranks.\n"
+  "\n"
+  "USAGE\n"
+  "  mpirun -np P phgmg-mpi reduce --J-coo J.npy --R-coo R.npy --Q-coo Q.npy --B B.npy\n"
+  "               --X X.npy --method gmg-pod|sp1 --r R --out DIR [--name rom]\n"
+  "               [--dt DT] [--quiet]\n"
+  "  phgmg-mpi --help | --version\n"
+  "\n"
+  "OPTIONS (those of `phgmg reduce`, with the same meaning)\n"
+  "  --J-coo FILE, --R-coo FILE, --Q-coo FILE   J, R, Q as (nnz, 3) .npy arrays of\n"
+  "                      (row, col, value) triplets, 0-based, duplicates summed.\n"
+  "  --B FILE            N x m port matrix, or a vector of length N for m = 1 (N is\n"
+  "                      taken from B).\n"
+  "  --X FILE            the snapshots, N x ns (one state per column). Every rank reads\n"
+  "                      only its own rows, a batch of columns at a time.\n"
+  "  --method M          gmg-pod (generalized manifold Galerkin on the POD of the\n"
+  "                      snapshots adjusted by B) or sp1 (structure-preserving\n"
+  "                      Galerkin on the POD of the snapshots).\n"
+  "  --r R               the reduced order (gmg-pod: R > m; sp1: R <= ns).\n"
+  "  --out DIR           output directory (created if missing).\n"
+  "  --name NAME         base name of the outputs (default rom; a C identifier).\n"
+  "  --dt DT             the snapshots' step, recorded in the model file\n"
+  "                      (simulate-rom's default step).\n"
+  "  --quiet             no summary line.\n"
+  "\n"
+  "CHECKS\n"
+  "  As the serial command: J skew-symmetric, R symmetric positive semidefinite\n"
+  "  (relative tolerance 1e-12), B of full column rank, J - R nonsingular, indices\n"
+  "  in range, no NaN/Inf; the outputs must not be input files. Q's symmetry and\n"
+  "  definiteness are not checked here (every rank holds only its rows of Q).\n"
+  "\n"
+  "OUTPUTS (written by rank 0, the files of the serial `phgmg reduce`)\n"
+  "  DIR/NAME.phgmgrom   the reduced model (phgmg simulate-rom, phgmg info)\n"
+  "  DIR/NAME.c          the model as C source\n"
+  "  DIR/NAME.json       what was reduced and how (with \"mpi_ranks\" and the solver)\n"
+  "  DIR/NAME_Bh.npy, DIR/NAME_Qh.npy, DIR/NAME_K.npy   the reduced blocks\n"
+  "  DIR/NAME_V0.npy     the basis (N x r): x = V0 @ xr\n"
+  "\n"
+  "DISTRIBUTION\n"
+  "  Rank p keeps rows [row0, row0 + nloc) of the state, contiguous blocks of\n"
+  "  N / P rows in rank order: its rows of Q, B and the snapshots (and, for sp1,\n"
+  "  of J - R). The small reduced matrices are identical on every rank.\n"
+  "  The solves with J - R (gmg-pod) use the library's sparse LU of J - R,\n"
+  "  REPLICATED on every rank: each rank factors the whole J - R once and the\n"
+  "  right-hand sides are gathered to every rank. This is fine while that\n"
+  "  factor fits in one rank's memory. For larger models use a distributed\n"
+  "  direct solver behind the same solve callback: examples/petsc_mumps.c\n"
+  "  (make build/petsc_mumps) does this reduction with PETSc and MUMPS.\n"
+  "\n"
+  "NOT SUPPORTED HERE (each is refused with a message naming it)\n"
+  "  --simulate (give the snapshots with --X; make them with the serial\n"
+  "  `phgmg simulate ... --states X.npy`), dense --J/--R/--Q, --E/--E-coo,\n"
+  "  nonlinear terms, dampers, feedthrough, --ref, gmg-qm, sp2, balancing,\n"
+  "  hyper-reduction options, several --X files, method or order lists, and\n"
+  "  every other option of `phgmg reduce`: use the serial `phgmg` for them.\n"
+  "\n"
+  "EXIT STATUS\n"
+  "  0 success, 1 an error in the inputs or the reduction, 2 a usage error;\n"
+  "  every rank exits with the same status.\n";
+
+typedef struct args {
+  const char *J, *R, *Q, *B, *X, *out, *name;
+  int method, r, quiet, have_dt;
+  double dt;
+} args;
+
+/* This rank's block of rows, the sizes, and what was read. */
+typedef struct dist {
+  int rank, size, N, m, nloc, ns;
+  long row0;
+  double *TJ, *TR, *TQ;          /* triplets (column-major nnz x 3), whole */
+  long nJ, nR, nQ;
+  double *Bfull, *Bl, *Xl;       /* B (N x m), its rows (nloc x m), the snapshots' rows (nloc x ns) */
+  int *cnt, *dsp;                /* rows per rank and their offsets */
+} dist;
+
+/* The replicated solver of J - R. */
+typedef struct solver {
+  phgmg_ph_sparse *sp;
+  phgmg_jr_factor *f;
+  double rcond;
+  double *full, *work;           /* N each */
+  const dist *d;
+} solver;
+
+static int g_rank = 0;
+
+/* An error message, printed by rank 0 only (every rank sees the same
+   fault: the verdicts are agreed before anything is printed). */
+static void say(const char *fmt, ...) {
+  va_list ap;
+  if (g_rank != 0) return;
+  fputs("phgmg-mpi: error: ", stderr);
+  va_start(ap, fmt);
+  vfprintf(stderr, fmt, ap);
+  va_end(ap);
+  fputc('\n', stderr);
+}
+
+static int usage(const char *fmt, ...) {
+  va_list ap;
+  if (g_rank != 0) return 2;
+  fputs("phgmg-mpi: ", stderr);
+  va_start(ap, fmt);
+  vfprintf(stderr, fmt, ap);
+  va_end(ap);
+  fputs("\n(run 'phgmg-mpi --help' for the options)\n", stderr);
+  return 2;
+}
+
+/* 1 on every rank if any rank passes bad != 0. */
+static int any_rank(int bad) {
+  int all = 0;
+  MPI_Allreduce(&bad, &all, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
+  return all;
+}
+
+/* ---- arguments --------------------------------------------------------------- */
+
+/* Options of the serial `phgmg reduce` that this program refuses, with the reason. */
+static const char *refused_reason(const char *o) {
+  if (!strcmp(o, "--simulate") || !strcmp(o, "--steps") || !strcmp(o, "--input") || !strcmp(o, "--amp") ||
+      !strcmp(o, "--train-input") || !strcmp(o, "--newton-tol") || !strcmp(o, "--newton-iter"))
+    return "the distributed build does not simulate: give the snapshots with --X (make them with the serial "
+           "`phgmg simulate <model options> --out y.npy --states X.npy`)";
+  if (!strcmp(o, "--J") || !strcmp(o, "--R") || !strcmp(o, "--Q"))
+    return "dense matrices are not read by the distributed build: give J, R, Q as triplets with --J-coo, "
+           "--R-coo, --Q-coo";
+  return "not supported by the distributed build (linear models, gmg-pod or sp1, snapshots from --X); use the "
+         "serial `phgmg reduce`";
+}
+
+static int parse_value(const char *o, const char *v, args *a) {
+  char *end;
+  if (!strcmp(o, "--r")) {
+    long r;
+    errno = 0;
+    r = strtol(v, &end, 10);
+    if (errno || end == v || *end || r < 1 || r > 100000)
+      return usage("--r: expected an integer in [1, 100000], got '%s'%s", v,
+                   strchr(v, ',') ? " (lists of orders are not supported by phgmg-mpi)" : "");
+    a->r = (int)r;
+  } else if (!strcmp(o, "--dt")) {
+    errno = 0;
+    a->dt = strtod(v, &end);
+    if (errno || end == v || *end || !(a->dt > 0.0) || !isfinite(a->dt))
+      return usage("--dt: expected a positive number, got '%s'", v);
+    a->have_dt = 1;
+  } else if (!strcmp(o, "--method")) {
+    if (!strcmp(v, "gmg-pod")) a->method = PHGMG_METHOD_GMG_POD;
+    else if (!strcmp(v, "sp1")) a->method = PHGMG_METHOD_SP1;
+    else
+      return usage("--method %s: phgmg-mpi reduces with gmg-pod or sp1 only%s", v,
+                   strchr(v, ',') ? " (no lists of methods)" : "; use the serial `phgmg reduce` for the others");
+  }
+  return 0;
+}
+
+/* 1 if NAME is a C identifier of at most 64 characters (NAME.c exports it). */
+static int name_ok(const char *s) {
+  size_t i, n = strlen(s);
+  if (n < 1 || n > 64 || !(s[0] == '_' || (s[0] >= 'A' && s[0] <= 'Z') || (s[0] >= 'a' && s[0] <= 'z'))) return 0;
+  for (i = 1; i < n; ++i)
+    if (!(s[i] == '_' || (s[i] >= 'A' && s[i] <= 'Z') || (s[i] >= 'a' && s[i] <= 'z') || (s[i] >= '0' && s[i] <= '9')))
+      return 0;
+  return 1;
+}
+
+/* argv[2..]: the options of reduce. 0 ok, 2 a usage error (the same on every rank: the same argv). */
+static int parse_args(int argc, char **argv, args *a) {
+  static const char *const with_value[] = {"--J-coo", "--R-coo", "--Q-coo", "--B", "--X", "--out", "--name",
+                                           "--method", "--r", "--dt"};
+  const char **slot[7];
+  int seen[10] = {0, 0, 0, 0, 0, 0, 0, 0, 0, 0}, i, k, rc;
+  memset(a, 0, sizeof *a);
+  a->name = "rom"; a->method = -1;
+  slot[0] = &a->J; slot[1] = &a->R; slot[2] = &a->Q; slot[3] = &a->B; slot[4] = &a->X; slot[5] = &a->out;
+  slot[6] = &a->name;
+  for (i = 2; i < argc; ++i) {
+    const char *o = argv[i];
+    if (!strcmp(o, "--quiet")) { a->quiet = 1; continue; }
+    for (k = 0; k < 10 && strcmp(o, with_value[k]); ++k) {}
+    if (k == 10) return usage("%s: %s", o, o[0] == '-' ? refused_reason(o) : "unexpected argument");
+    if (i + 1 >= argc) return usage("%s needs a value", o);
+    if (seen[k]++)
+      return usage("%s given twice%s", o, k == 4 ? " (several --X files are not supported by phgmg-mpi)" : "");
+    if (k < 7) {
+      *slot[k] = argv[++i];
+    } else if ((rc = parse_value(o, argv[++i], a)) != 0) {
+      return rc;
+    }
+  }
+  if (!a->J || !a->R || !a->Q) return usage("--J-coo, --R-coo and --Q-coo are required");
+  if (!a->B) return usage("--B is required");
+  if (!a->X) return usage("--X is required (the snapshots; phgmg-mpi does not simulate)");
+  if (a->method < 0) return usage("--method is required (gmg-pod or sp1)");
+  if (a->r < 1) return usage("--r is required");
+  if (!a->out) return usage("--out is required");
+  if (!name_ok(a->name)) return usage("--name %s: expected a C identifier of at most 64 characters", a->name);
+  return 0;
+}
+
+/* ---- inputs -------------------------------------------------------------------- */
+
+/* 1 if both paths name one existing file (however spelled or linked). */
+static int same_file(const char *p, const char *q) {
+  struct stat a, b;
+  return stat(p, &a) == 0 && stat(q, &b) == 0 && a.st_dev == b.st_dev && a.st_ino == b.st_ino;
+}
+
+/* The message of a failed .npy read: for an I/O error the system's reason. */
+static void npy_fail(const char *opt, const char *path, phgmg_result rc) {
+  FILE *f = NULL;
+  if (rc == PHGMG_ERR_IO && !(f = fopen(path, "rb"))) say("%s %s: cannot read: %s", opt, path, strerror(errno));
+  else say("%s %s: %s", opt, path, phgmg_result_string(rc));
+  if (rc == PHGMG_ERR_IO && f) fclose(f);
+}
+
+/* B whole (N x m; N and m from its shape), then the layout: contiguous
+   blocks of N / P rows in rank order (the first N mod P ranks one more). */
+static int read_B_layout(const args *a, dist *d) {
+  int rows = 0, cols = 0, nd = 0, p;
+  phgmg_result rc = phgmg_npy_read(a->B, &d->Bfull, &rows, &cols, &nd, NULL);
+  if (rc != PHGMG_OK) { npy_fail("--B", a->B, rc); return 1; }
+  if (nd == 2 && rows == 1 && cols > 1) { rows = cols; cols = 1; }   /* a (1, N) row: one port */
+  if (rows < 1 || cols < 1 || cols > rows) { say("--B %s: expected (N,) or (N, m) with 1 <= m <= N", a->B); return 1; }
+  d->N = rows; d->m = cols;
+  d->cnt = (int *)malloc(sizeof(int) * 2 * (size_t)d->size);
+  if (!d->cnt) { say("out of memory"); return 1; }
+  d->dsp = d->cnt + d->size;
+  for (p = 0; p < d->size; ++p) {
+    d->cnt[p] = d->N / d->size + (p < d->N % d->size);
+    d->dsp[p] = p == 0 ? 0 : d->dsp[p - 1] + d->cnt[p - 1];
+  }
+  d->nloc = d->cnt[d->rank]; d->row0 = d->dsp[d->rank];
+  return 0;
+}
+
+/* This rank's rows of B (nloc x m). */
+static int own_B(dist *d) {
+  int i, j;
+  d->Bl = (double *)malloc(sizeof(double) * ((size_t)d->nloc * d->m + 1));
+  if (!d->Bl) { say("out of memory"); return 1; }
+  for (j = 0; j < d->m; ++j)
+    for (i = 0; i < d->nloc; ++i) d->Bl[i + (size_t)j * d->nloc] = d->Bfull[d->row0 + i + (size_t)j * d->N];
+  return 0;
+}
+
+/* The triplets of a (nnz, 3) .npy file (column-major: rows, cols, values),
+   checked: integer indices in [0, N), finite values. */
+static int read_triplets(const char *opt, const char *path, int N, double **T, long *nnz) {
+  int rows = 0, cols = 0;
+  long k;
+  const size_t n = strlen(path);
+  phgmg_result rc;
+  if (strchr(path, ',') || (n > 4 && (!strcmp(path + n - 4, ".npz") || !strcmp(path + n - 4, ".mtx")))) {
+    say("%s %s: phgmg-mpi reads one (nnz, 3) .npy file of (row, col, value) triplets per matrix (not three "
+        "files, .npz or .mtx: the serial `phgmg reduce` reads those)", opt, path);
+    return 1;
+  }
+  rc = phgmg_npy_read(path, T, &rows, &cols, NULL, NULL);
+  if (rc != PHGMG_OK) { npy_fail(opt, path, rc); return 1; }
+  if (cols != 3) {
+    say("%s %s: expected an (nnz, 3) array of (row, col, value) triplets, got %d columns (phgmg-mpi reads "
+        "one .npy file per matrix)", opt, path, cols);
+    return 1;
+  }
+  for (k = 0; k < 2 * (long)rows; ++k) {
+    const double v = (*T)[k];
+    if (!(v >= 0.0 && v < (double)N && v == floor(v))) {
+      say("%s %s: index %g (triplet %ld) is not an integer in [0, %d) (N = %d from --B)", opt, path, v,
+          k % rows, N, N);
+      return 1;
+    }
+  }
+  for (k = 2 * (long)rows; k < 3 * (long)rows; ++k)
+    if (!isfinite((*T)[k])) { say("%s %s: a value is NaN or infinite (triplet %ld)", opt, path, k - 2 * (long)rows); return 1; }
+  *nnz = rows;
+  return 0;
+}
+
+/* This rank's rows of the (N, ns) snapshots, read a batch of columns at a
+   time (about 8 MB per batch): the N x ns matrix never exists on a rank. */
+static int read_X_rows(const args *a, dist *d) {
+  int rows = 0, cols = 0, j0, nb, i, j;
+  double *buf;
+  phgmg_result rc = phgmg_npy_read_cols(a->X, 0, 0, NULL, 0, &rows, &cols);
+  if (rc != PHGMG_OK) { npy_fail("--X", a->X, rc); return 1; }
+  if (rows != d->N || cols < 2) {
+    say("--X %s: expected (%d, ns) snapshots with ns >= 2 (N from --B), got (%d, %d)", a->X, d->N, rows, cols);
+    return 1;
+  }
+  nb = cols < 1048576 / d->N ? cols : 1048576 / d->N;
+  if (nb < 1) nb = 1;
+  buf = (double *)malloc(sizeof(double) * (size_t)rows * (size_t)nb);
+  d->Xl = (double *)malloc(sizeof(double) * ((size_t)d->nloc * (size_t)cols + 1));
+  if (!buf || !d->Xl) { free(buf); say("out of memory"); return 1; }
+  for (j0 = 0; j0 < cols; j0 += nb) {
+    const int k = nb < cols - j0 ? nb : cols - j0;
+    rc = phgmg_npy_read_cols(a->X, j0, k, buf, rows, NULL, NULL);
+    if (rc != PHGMG_OK) { npy_fail("--X", a->X, rc); free(buf); return 1; }
+    for (j = 0; j < k; ++j)
+      for (i = 0; i < d->nloc; ++i) {
+        const double v = buf[d->row0 + i + (size_t)j * rows];
+        if (!isfinite(v)) { say("--X %s: a snapshot entry is NaN or infinite", a->X); free(buf); return 1; }
+        d->Xl[i + (size_t)(j0 + j) * d->nloc] = v;
+      }
+  }
+  free(buf);
+  d->ns = cols;
+  return 0;
+}
+
+/* The inputs, each step agreed over the ranks (a fault on one rank stops all). */
+static int read_inputs(const args *a, dist *d) {
+  if (any_rank(read_B_layout(a, d))) return 1;
+  if (any_rank(own_B(d))) return 1;
+  if (any_rank(read_triplets("--J-coo", a->J, d->N, &d->TJ, &d->nJ))) return 1;
+  if (any_rank(read_triplets("--R-coo", a->R, d->N, &d->TR, &d->nR))) return 1;
+  if (any_rank(read_triplets("--Q-coo", a->Q, d->N, &d->TQ, &d->nQ))) return 1;
+  return any_rank(read_X_rows(a, d));
+}
+
+static void dist_free(dist *d) {
+  phgmg_npy_free(d->TJ, NULL); phgmg_npy_free(d->TR, NULL); phgmg_npy_free(d->TQ, NULL);
+  phgmg_npy_free(d->Bfull, NULL);
+  free(d->Bl); free(d->Xl); free(d->cnt);
+}
+
+/* ---- the operators ------------------------------------------------------------ */
+
+/* This rank's rows of sJ J + sR R (sJ or sR 0: left out) as CSR with global
+   columns (duplicates kept: the products sum them). */
+static int own_csr(const dist *d, const double *T1, long n1, double s1, const double *T2, long n2, double s2,
+                   phgmg_gidx **rp, phgmg_gidx **col, double **val) {
+  const double *T[2];
+  long n[2], k;
+  double s[2];
+  phgmg_gidx *pos;
+  int t, i;
+  T[0] = T1; T[1] = T2; n[0] = s1 != 0.0 ? n1 : 0; n[1] = s2 != 0.0 ? n2 : 0; s[0] = s1; s[1] = s2;
+  *rp = (phgmg_gidx *)calloc((size_t)d->nloc + 1, sizeof(phgmg_gidx));
+  pos = (phgmg_gidx *)calloc((size_t)d->nloc + 1, sizeof(phgmg_gidx));
+  if (!*rp || !pos) { free(pos); return 1; }
+  for (t = 0; t < 2; ++t)
+    for (k = 0; k < n[t]; ++k) {
+      const long r = (long)T[t][k] - d->row0;
+      if (r >= 0 && r < d->nloc) ++(*rp)[r + 1];
+    }
+  for (i = 0; i < d->nloc; ++i) (*rp)[i + 1] += (*rp)[i];
+  *col = (phgmg_gidx *)malloc(sizeof(phgmg_gidx) * (size_t)((*rp)[d->nloc] + 1));
+  *val = (double *)malloc(sizeof(double) * (size_t)((*rp)[d->nloc] + 1));
+  if (!*col || !*val) { free(pos); return 1; }
+  for (i = 0; i < d->nloc; ++i) pos[i] = (*rp)[i];
+  for (t = 0; t < 2; ++t)
+    for (k = 0; k < n[t]; ++k) {
+      const long r = (long)T[t][k] - d->row0;
+      if (r < 0 || r >= d->nloc) continue;
+      (*col)[pos[r]] = (phgmg_gidx)T[t][n[t] + k];
+      (*val)[pos[r]++] = s[t] * T[t][2 * n[t] + k];
+    }
+  free(pos);
+  return 0;
+}
+
+/* A distributed operator from this rank's rows of s1 T1 + s2 T2. Collective. */
+static phgmg_result make_op(const phgmg_mpi_ctx *ctx, const dist *d, const double *T1, long n1, double s1,
+                            const double *T2, long n2, double s2, phgmg_mpi_op **op) {
+  phgmg_gidx *rp = NULL, *col = NULL;
+  double *val = NULL;
+  phgmg_result rc = any_rank(own_csr(d, T1, n1, s1, T2, n2, s2, &rp, &col, &val)) ? PHGMG_ERR_NOMEM : PHGMG_OK;
+  if (rc == PHGMG_OK) rc = phgmg_mpi_op_create(op, ctx, rp, col, val);
+  free(rp); free(col); free(val);
+  return rc;
+}
+
+/* A CSC matrix (N x N) from triplets (indices checked by read_triplets). */
+static phgmg_result triplets_csc(int N, const double *T, long nnz, phgmg_csc *out) {
+  int *ri = (int *)malloc(sizeof(int) * (size_t)(2 * nnz + 1)), *ci = ri + nnz;
+  long k;
+  phgmg_result rc;
+  if (!ri) return PHGMG_ERR_NOMEM;
+  for (k = 0; k < nnz; ++k) { ri[k] = (int)T[k]; ci[k] = (int)T[nnz + k]; }
+  rc = phgmg_csc_from_coo(out, N, N, nnz, ri, ci, T + 2 * nnz, NULL);
+  free(ri);
+  return rc;
+}
+
+/* The replicated solver: J - R (with Q = I, which the solve with J - R does
+   not see) as a sparse model, checked as the serial command checks J, R
+   and B, factored once by the library's sparse LU (band LU fall-back;
+   manual 8.12). Every rank does the same. */
+static phgmg_result solver_create(const dist *d, solver *s) {
+  phgmg_csc J, R, I;
+  phgmg_result rc;
+  double one = 1.0;
+  int *idx = (int *)malloc(sizeof(int) * (size_t)d->N), i;
+  double *ones = (double *)malloc(sizeof(double) * (size_t)d->N);
+  memset(s, 0, sizeof *s);
+  memset(&J, 0, sizeof J); memset(&R, 0, sizeof R); memset(&I, 0, sizeof I);
+  s->d = d;
+  s->full = (double *)malloc(sizeof(double) * 2 * (size_t)d->N);
+  if (!idx || !ones || !s->full) { free(idx); free(ones); return PHGMG_ERR_NOMEM; }
+  s->work = s->full + d->N;
+  for (i = 0; i < d->N; ++i) { idx[i] = i; ones[i] = one; }
+  rc = triplets_csc(d->N, d->TJ, d->nJ, &J);
+  if (rc == PHGMG_OK) rc = triplets_csc(d->N, d->TR, d->nR, &R);
+  if (rc == PHGMG_OK) rc = phgmg_csc_from_coo(&I, d->N, d->N, d->N, idx, idx, ones, NULL);
+  if (rc == PHGMG_OK) rc = phgmg_ph_sparse_create(&s->sp, d->N, d->m, &J, &R, &I, d->Bfull, NULL, NULL, NULL);
+  /* the serial checks of J, R, B and J - R (relative tolerance 1e-12); Q here is I, so Q's are not made */
+  if (rc == PHGMG_OK) rc = phgmg_ph_validate(phgmg_ph_sparse_system(s->sp), 1e-12, NULL, NULL);
+  if (rc == PHGMG_OK) rc = phgmg_jr_factor_create(&s->f, phgmg_ph_sparse_system(s->sp), &s->rcond, NULL);
+  phgmg_csc_free(&J, NULL); phgmg_csc_free(&R, NULL); phgmg_csc_free(&I, NULL);
+  free(idx); free(ones);
+  return rc;
+}
+
+static void solver_free(solver *s) {
+  phgmg_jr_factor_destroy(s->f);
+  phgmg_ph_sparse_destroy(s->sp);
+  free(s->full);
+}
+
+/* The solve callback: each column of X (this rank's rows) gathered to every
+   rank, solved with the replicated factor of J - R (or its transpose), and
+   this rank's rows kept. Collective. */
+static phgmg_result solve_replicated(char trans, int nrhs, double *X, int ldx, void *user) {
+  solver *s = (solver *)user;
+  const dist *d = s->d;
+  phgmg_result rc = PHGMG_OK;
+  int j;
+  for (j = 0; j < nrhs; ++j) {
+    double *x = X + (size_t)j * ldx;
+    MPI_Allgatherv(x, d->nloc, MPI_DOUBLE, s->full, d->cnt, d->dsp, MPI_DOUBLE, MPI_COMM_WORLD);
+    if (rc == PHGMG_OK) rc = phgmg_ph_sparse_to_banded_order(s->sp, 1, s->full, d->N, s->work, d->N);
+    if (rc == PHGMG_OK) {
+      phgmg_jr_solve(s->f, trans, 1, s->work, d->N);
+      rc = phgmg_ph_sparse_to_user_order(s->sp, 1, s->work, d->N, s->full, d->N);
+    }
+    if (rc == PHGMG_OK && d->nloc > 0) memcpy(x, s->full + d->row0, sizeof(double) * (size_t)d->nloc);
+  }
+  return rc;
+}
+
+/* ---- the reduction ------------------------------------------------------------ */
+
+/* What the reduction gives rank 0 to write: the model, the basis rows, the info. */
+typedef struct result {
+  phgmg_mpi_rom mr;
+  double *V0;                    /* this rank's rows (nloc x r) */
+  double sigma_ratio, rcond_jr, seconds;
+} result;
+
+/* sigma_{p+1} / sigma_1 of what the method PODs (the serial info's
+   pod_sigma_ratio): GMG-POD the snapshots adjusted by B (X - QB QB^T X,
+   QB an orthonormal basis of B's columns), p = r - m; SP1 the snapshots,
+   p = r. 0 if there is no further mode. Collective. */
+static phgmg_result sigma_ratio(const phgmg_mpi_ctx *ctx, const dist *d, const args *a, double *ratio) {
+  const int ld = d->nloc > 0 ? d->nloc : 1, gmg = a->method == PHGMG_METHOD_GMG_POD, m = d->m, ns = d->ns;
+  const int p = gmg ? a->r - m : a->r;
+  int kmax = p + 1, k = 0, i, j;
+  double *Xa = (double *)malloc(sizeof(double) * ((size_t)ld * ns + (size_t)ld * (m + kmax) + (size_t)(m + kmax) * ns + 1));
+  double *QB = Xa + (size_t)ld * ns, *V = QB + (size_t)ld * m, *C = V + (size_t)ld * kmax, *S = C;
+  phgmg_result rc = any_rank(!Xa) ? PHGMG_ERR_NOMEM : PHGMG_OK;
+  *ratio = 0.0;
+  if (kmax > ns) kmax = ns;
+  if ((long)kmax > (long)d->N) kmax = d->N;
+  if (rc == PHGMG_OK && d->nloc > 0) memcpy(Xa, d->Xl, sizeof(double) * (size_t)d->nloc * ns);
+  if (rc == PHGMG_OK && gmg) {   /* Xa = X - QB (QB^T X) */
+    rc = phgmg_mpi_tsqr(ctx, m, d->Bl, ld, QB, ld, C, m);
+    if (rc == PHGMG_OK) rc = phgmg_mpi_atb(ctx, m, ns, QB, ld, Xa, ld, C, m);
+    for (j = 0; rc == PHGMG_OK && j < ns; ++j)
+      for (i = 0; i < d->nloc; ++i) {
+        double s = 0.0;
+        int q;
+        for (q = 0; q < m; ++q) s += QB[i + (size_t)q * ld] * C[q + (size_t)j * m];
+        Xa[i + (size_t)j * ld] -= s;
+      }
+  }
+  if (rc == PHGMG_OK && kmax > p) rc = phgmg_mpi_pod(ctx, ns, Xa, ld, kmax, 0.0, V, ld, S, &k);
+  if (rc == PHGMG_OK && k > p && S[0] > 0.0) *ratio = S[p] / S[0];
+  free(Xa);
+  return rc;
+}
+
+/* The message of a failed reduction. */
+static void explain(const args *a, const dist *d, phgmg_result rc) {
+  const char *meth = a->method == PHGMG_METHOD_SP1 ? "sp1" : "gmg-pod";
+  if (rc == PHGMG_ERR_SIZE)
+    say("%s: --r %d does not fit: %s (N = %d, m = %d, %d snapshots; the order must not exceed the snapshots' "
+        "numerical rank%s)", meth, a->r, phgmg_result_string(rc), d->N, d->m, d->ns,
+        a->method == PHGMG_METHOD_SP1 ? "" : " plus m, and must exceed m");
+  else if (rc == PHGMG_ERR_SINGULAR)
+    say("%s: J - R (--J-coo %s, --R-coo %s) is singular or its LU needs pivoting the sparse LU does not do: %s",
+        meth, a->J, a->R, phgmg_result_string(rc));
+  else if (rc == PHGMG_ERR_RANK)
+    say("%s: --B %s is rank deficient: %s", meth, a->B, phgmg_result_string(rc));
+  else if (rc == PHGMG_ERR_NOT_SKEW)
+    say("--J-coo %s: J is not skew-symmetric (relative tolerance 1e-12): %s", a->J, phgmg_result_string(rc));
+  else if (rc == PHGMG_ERR_NOT_SYMMETRIC || rc == PHGMG_ERR_NOT_PSD)
+    say("--R-coo %s: R is not symmetric positive semidefinite (relative tolerance 1e-12): %s", a->R,
+        phgmg_result_string(rc));
+  else
+    say("%s: %s", meth, phgmg_result_string(rc));
+}
+
+/* The reduction on every rank: the context, Q (and for sp1 J - R) as
+   distributed operators, the replicated solver, phgmg_mpi_reduce. */
+static int reduce(const args *a, dist *d, result *res) {
+  phgmg_mpi_ctx *ctx = NULL;
+  phgmg_mpi_op *Qop = NULL, *JRop = NULL;
+  phgmg_mpi_sep_model md;
+  phgmg_reduce_opts o;
+  solver sv;
+  const int ld = d->nloc > 0 ? d->nloc : 1;
+  double t0;
+  phgmg_result rc = phgmg_mpi_ctx_create(&ctx, MPI_COMM_WORLD, d->N, d->row0, d->nloc, NULL);
+  memset(&sv, 0, sizeof sv);
+  memset(&md, 0, sizeof md);
+  t0 = MPI_Wtime();
+  if (rc == PHGMG_OK) rc = make_op(ctx, d, d->TQ, d->nQ, 1.0, NULL, 0, 0.0, &Qop);
+  phgmg_npy_free(d->TQ, NULL);   /* Q lives in its operator now */
+  d->TQ = NULL;
+  if (rc == PHGMG_OK && a->method == PHGMG_METHOD_SP1)
+    rc = make_op(ctx, d, d->TJ, d->nJ, 1.0, d->TR, d->nR, -1.0, &JRop);
+  if (rc == PHGMG_OK) rc = phgmg_mpi_agree(MPI_COMM_WORLD, solver_create(d, &sv));
+  phgmg_npy_free(d->TJ, NULL); phgmg_npy_free(d->TR, NULL); phgmg_npy_free(d->Bfull, NULL);
+  d->TJ = d->TR = d->Bfull = NULL;   /* J - R and B live in the solver (and the operators) now */
+  res->V0 = (double *)malloc(sizeof(double) * ((size_t)ld * a->r + 1));
+  if (rc == PHGMG_OK && any_rank(!res->V0)) rc = PHGMG_ERR_NOMEM;
+  if (rc == PHGMG_OK) {
+    md.lin.Q = Qop; md.lin.m = d->m; md.lin.B = d->Bl; md.lin.ldb = ld;
+    md.lin.solve = solve_replicated; md.lin.solve_user = &sv;
+    md.JR = JRop;
+    md.poly_deg = 1;   /* no separable terms (nsep = 0): a linear model */
+    memset(&o, 0, sizeof o);
+    o.method = (phgmg_method)a->method; o.r = a->r;
+    rc = phgmg_mpi_reduce(ctx, &md, d->ns, d->Xl, ld, &o, &res->mr, res->V0, ld);
+  }
+  res->seconds = MPI_Wtime() - t0;
+  res->rcond_jr = sv.rcond;
+  if (rc == PHGMG_OK) rc = sigma_ratio(ctx, d, a, &res->sigma_ratio);
+  if (rc != PHGMG_OK) explain(a, d, rc);
+  solver_free(&sv);
+  phgmg_mpi_op_destroy(Qop);
+  phgmg_mpi_op_destroy(JRop);
+  phgmg_mpi_ctx_destroy(ctx);
+  return rc != PHGMG_OK;
+}
+
+/* ---- outputs (rank 0) ---------------------------------------------------------- */
+
+#define NOUT 7
+static const char *const out_suffix[NOUT] = {".phgmgrom", ".c", ".json", "_Bh.npy", "_Qh.npy", "_K.npy", "_V0.npy"};
+
+/* The output paths DIR/NAME<suffix> (4096 + 96 chars each). */
+static void out_path(const args *a, int k, char *buf, size_t cap) {
+  snprintf(buf, cap, "%.4000s/%s%s", a->out, a->name, out_suffix[k]);
+}
+
+/* 1 if an output is one of the input files: a run never overwrites its inputs. */
+static int outputs_clash(const args *a) {
+  const char *in[5];
+  const char *opt[5] = {"--J-coo", "--R-coo", "--Q-coo", "--B", "--X"};
+  char p[4200];
+  int k, i;
+  in[0] = a->J; in[1] = a->R; in[2] = a->Q; in[3] = a->B; in[4] = a->X;
+  for (k = 0; k < NOUT; ++k) {
+    out_path(a, k, p, sizeof p);
+    for (i = 0; i < 5; ++i)
+      if (same_file(p, in[i]) || !strcmp(p, in[i])) {
+        say("--out %s: the output %s is the input file of %s; choose another --out or --name", a->out, p, opt[i]);
+        return 1;
+      }
+  }
+  return 0;
+}
+
+/* 1 if --out names something that is not a directory (checked before the
+   work; the directory itself is made when the outputs are written). */
+static int out_not_dir(const args *a) {
+  struct stat st;
+  if (stat(a->out, &st) != 0 || S_ISDIR(st.st_mode)) return 0;
+  say("--out %s: exists and is not a directory", a->out);
+  return 1;
+}
+
+/* mkdir -p DIR. */
+static int make_dir(const char *dir) {
+  char buf[4096];
+  size_t i, n = strlen(dir);
+  struct stat st;
+  if (n == 0 || n >= sizeof buf) { say("--out: the path is empty or too long"); return 1; }
+  memcpy(buf, dir, n + 1);
+  for (i = 1; i <= n; ++i) {
+    if (buf[i] != '/' && buf[i] != '\0') continue;
+    buf[i] = '\0';
+    if (mkdir(buf, 0777) != 0 && errno != EEXIST) { say("--out %s: cannot create %s: %s", dir, buf, strerror(errno)); return 1; }
+    buf[i] = i < n ? '/' : '\0';
+  }
+  if (stat(dir, &st) != 0 || !S_ISDIR(st.st_mode)) { say("--out %s: not a directory", dir); return 1; }
+  return 0;
+}
+
+/* Every output is written to PATH.part and renamed at the end (a failed run
+   leaves the previous outputs as they were). */
+static void part_path(const args *a, int k, char *buf, size_t cap) {
+  char p[4200];
+  out_path(a, k, p, sizeof p);
+  snprintf(buf, cap, "%s.part", p);
+}
+
+static void parts_remove(const args *a) {
+  char p[4300];
+  int k;
+  for (k = 0; k < NOUT; ++k) { part_path(a, k, p, sizeof p); remove(p); }
+}
+
+static int parts_commit(const args *a) {
+  char p[4300], q[4200];
+  int k;
+  for (k = 0; k < NOUT; ++k) {
+    part_path(a, k, p, sizeof p);
+    out_path(a, k, q, sizeof q);
+    if (rename(p, q) != 0) { say("%s: cannot move into place: %s", q, strerror(errno)); return 1; }
+  }
+  return 0;
+}
+
+/* A .npy header (version 1.0, '<f8', Fortran order) for rows x cols, padded
+   to a multiple of 64 bytes as NumPy pads it. */
+static int npy_header(FILE *f, long rows, long cols) {
+  char dict[128];
+  unsigned char pre[10] = {0x93, 'N', 'U', 'M', 'P', 'Y', 1, 0, 0, 0};
+  int n = snprintf(dict, sizeof dict, "{'descr': '<f8', 'fortran_order': True, 'shape': (%ld, %ld), }", rows, cols);
+  int total = ((10 + n + 1 + 63) / 64) * 64, hl = total - 10, i;
+  pre[8] = (unsigned char)(hl & 0xff); pre[9] = (unsigned char)(hl >> 8);
+  if (fwrite(pre, 1, 10, f) != 10 || fwrite(dict, 1, (size_t)n, f) != (size_t)n) return 1;
+  for (i = 10 + n; i < total - 1; ++i) fputc(' ', f);
+  return fputc('\n', f) == EOF;
+}
+
+/* NAME_V0.npy (N x r): rank 0 writes the header, then each column gathered
+   from the ranks' rows. Collective; the verdict is agreed. */
+static int write_V0(const args *a, const dist *d, const double *V0) {
+  const int ld = d->nloc > 0 ? d->nloc : 1;
+  char p[4300];
+  FILE *f = NULL;
+  double *col = NULL;
+  int j, bad = 0;
+  if (d->rank == 0) {
+    part_path(a, 6, p, sizeof p);
+    f = fopen(p, "wb");
+    col = (double *)malloc(sizeof(double) * (size_t)d->N);
+    bad = !f || !col || npy_header(f, d->N, a->r);
+  }
+  if (any_rank(bad)) {
+    if (f) fclose(f);
+    free(col);
+    say("%s: cannot write: %s", p, strerror(errno));
+    return 1;
+  }
+  for (j = 0; j < a->r; ++j) {
+    MPI_Gatherv(V0 + (size_t)j * ld, d->nloc, MPI_DOUBLE, col, d->cnt, d->dsp, MPI_DOUBLE, 0, MPI_COMM_WORLD);
+    if (d->rank == 0 && !bad) bad = fwrite(col, sizeof(double), (size_t)d->N, f) != (size_t)d->N;
+  }
+  if (d->rank == 0) {
+    bad |= fclose(f) != 0;
+    if (bad) say("%s: write error", p);
+  }
+  free(col);
+  return any_rank(bad);
+}
+
+static void json_str(FILE *f, const char *s) {
+  fputc('"', f);
+  for (; *s; ++s) {
+    const unsigned char c = (unsigned char)*s;
+    if (c == '"' || c == '\\') fprintf(f, "\\%c", c);
+    else if (c < 0x20) fprintf(f, "\\u%04x", c);
+    else fputc(c, f);
+  }
+  fputc('"', f);
+}
+
+/* A JSON number: the shortest of %.15g..%.17g that reads back exactly; null for NaN/Inf. */
+static void json_num(FILE *f, double v) {
+  char buf[32];
+  int prec;
+  if (!isfinite(v)) { fputs("null", f); return; }
+  for (prec = 15; prec < 17; ++prec) {
+    snprintf(buf, sizeof buf, "%.*g", prec, v);
+    if (strtod(buf, NULL) == v) break;
+  }
+  fputs(buf, f);
+}
+
+/* NAME.json: the record of the serial command (what was reduced, how, and
+   where the outputs are), with the ranks and the solver of J - R. */
+static int write_json(const args *a, const dist *d, const result *res) {
+  const phgmg_rom *rom = &res->mr.rom;
+  const int gmg = a->method == PHGMG_METHOD_GMG_POD, r = a->r, m = d->m;
+  const int shape[4][2] = {{r, m}, {r, r}, {r, r}, {d->N, r}};
+  char p[4300];
+  FILE *f;
+  int k;
+  part_path(a, 2, p, sizeof p);
+  if (!(f = fopen(p, "w"))) { say("%s: cannot write: %s", p, strerror(errno)); return 1; }
+  fprintf(f, "{\n  \"phgmg_version\": \"%s\",\n  \"name\": ", PHGMG_VERSION_STRING);
+  json_str(f, a->name);
+  fprintf(f, ",\n  \"method\": \"%s\",\n  \"kind\": \"linear\",\n  \"map\": \"linear\",\n", gmg ? "gmg-pod" : "sp1");
+  fprintf(f, "  \"N\": %d, \"m\": %d, \"r\": %d, \"rn\": 0, \"nd\": 0, \"poly_deg\": 0,\n", d->N, m, r);
+  fprintf(f, "  \"E\": false, \"N_full\": %d, \"algebraic\": 0, \"feedthrough\": false,\n  \"dt_map\": 0,\n", d->N);
+  fprintf(f, "  \"system\": {\"J\": "); json_str(f, a->J);
+  fprintf(f, ", \"R\": "); json_str(f, a->R);
+  fprintf(f, ", \"B\": "); json_str(f, a->B);
+  fprintf(f, ", \"Q\": "); json_str(f, a->Q);
+  fprintf(f, ", \"sparse\": true},\n");
+  fprintf(f, "  \"snapshots\": {\"count\": %d, \"file\": ", d->ns); json_str(f, a->X);
+  if (a->have_dt) { fprintf(f, ", \"dt\": "); json_num(f, a->dt); }
+  fprintf(f, "},\n  \"options\": {\"training_runs\": 0, \"ref\": \"none\", \"hyper\": \"none\", \"deim\": false},\n");
+  fprintf(f, "  \"info\": {\"pod_sigma_ratio\": "); json_num(f, res->sigma_ratio);
+  fprintf(f, ", \"rcond_jr\": "); json_num(f, res->rcond_jr);
+  if (gmg) fprintf(f, ", \"degeneracy_tol\": 1e-12");
+  fprintf(f, ", \"reduce_seconds\": "); json_num(f, res->seconds);
+  fprintf(f, ", \"mpi_ranks\": %d, \"jr_solver\": \"sparse LU of J - R replicated on every rank\"},\n", d->size);
+  fprintf(f, "  \"stepper_memsize_bytes\": %lu,\n", (unsigned long)phgmg_rom_stepper_memsize(rom));
+  fprintf(f, "  \"reconstruction\": \"x = V0 @ xr\",\n");
+  fprintf(f, "  \"files\": {\n    \"model\": \"%s.phgmgrom\",\n    \"c_source\": \"%s.c\",\n    \"arrays\": {", a->name,
+          a->name);
+  for (k = 0; k < 4; ++k)
+    fprintf(f, "%s\n      \"%s%s\": [%d, %d]", k ? "," : "", a->name, out_suffix[3 + k], shape[k][0], shape[k][1]);
+  fprintf(f, "\n    }\n  }\n}\n");
+  if (fclose(f) != 0) { say("%s: write error", p); return 1; }
+  return 0;
+}
+
+/* Rank 0: the model file, its C source and the blocks K, Qh, Bh. */
+static int write_model(const args *a, const dist *d, result *res) {
+  phgmg_rom rom = res->mr.rom;
+  const double *blk[3];
+  const int cols[3] = {d->m, a->r, a->r};
+  char p[4300];
+  phgmg_result rc;
+  int k;
+  rom.dt = a->have_dt ? a->dt : 0.0;   /* the snapshots' step, if known (simulate-rom's default) */
+  part_path(a, 0, p, sizeof p);
+  rc = phgmg_rom_save(&rom, p);
+  if (rc != PHGMG_OK) { say("%s: cannot write the model file: %s", p, phgmg_result_string(rc)); return 1; }
+  part_path(a, 1, p, sizeof p);
+  rc = phgmg_rom_export_c(&rom, a->name, p);
+  if (rc != PHGMG_OK) { say("%s: cannot write the C source: %s", p, phgmg_result_string(rc)); return 1; }
+  blk[0] = res->mr.Bh; blk[1] = res->mr.Qh; blk[2] = res->mr.K;
+  for (k = 0; k < 3; ++k) {
+    part_path(a, 3 + k, p, sizeof p);
+    rc = phgmg_npy_write(p, blk[k], a->r, cols[k], a->r, 2, 0u);
+    if (rc != PHGMG_OK) { say("%s: cannot write: %s", p, phgmg_result_string(rc)); return 1; }
+  }
+  return 0;
+}
+
+/* Every output: the basis gathered (collective), then rank 0 writes the rest
+   and moves everything into place. */
+static int write_outputs(const args *a, const dist *d, result *res) {
+  int bad = 0;
+  if (any_rank(d->rank == 0 && make_dir(a->out))) return 1;
+  bad = write_V0(a, d, res->V0);
+  if (!bad && d->rank == 0) bad = write_model(a, d, res) || write_json(a, d, res) || parts_commit(a);
+  if (bad && d->rank == 0) parts_remove(a);
+  if (any_rank(bad)) return 1;
+  if (d->rank == 0 && !a->quiet)
+    printf("wrote %s/%s.phgmgrom, %s/%s.c, %s/%s.json and 4 arrays %s/%s_*.npy (%s, r = %d, m = %d, N = %d, "
+           "%d rank%s)\n", a->out, a->name, a->out, a->name, a->out, a->name, a->out, a->name,
+           a->method == PHGMG_METHOD_SP1 ? "sp1" : "gmg-pod", a->r, d->m, d->N, d->size, d->size > 1 ? "s" : "");
+  return 0;
+}
+
+/* ---- main ---------------------------------------------------------------------- */
+
+static int run(const args *a, int size) {
+  dist d;
+  result res;
+  int err;
+  memset(&d, 0, sizeof d);
+  memset(&res, 0, sizeof res);
+  d.rank = g_rank; d.size = size;
+  err = any_rank(g_rank == 0 && (outputs_clash(a) || out_not_dir(a)));
+  if (!err) err = read_inputs(a, &d);
+  if (!err) err = any_rank(reduce(a, &d, &res));
+  if (!err) err = write_outputs(a, &d, &res);
+  phgmg_mpi_rom_free(&res.mr);
+  free(res.V0);
+  dist_free(&d);
+  return err;
+}
+
+int main(int argc, char **argv) {
+  args a;
+  int size = 1, status;
+  MPI_Init(&argc, &argv);
+  MPI_Comm_rank(MPI_COMM_WORLD, &g_rank);
+  MPI_Comm_size(MPI_COMM_WORLD, &size);
+  if (argc >= 2 && (!strcmp(argv[1], "--help") || !strcmp(argv[1], "-h"))) {
+    if (g_rank == 0) fputs(help_text, stdout);
+    status = 0;
+  } else if (argc >= 2 && !strcmp(argv[1], "--version")) {
+    if (g_rank == 0) printf("phgmg-mpi %s\n", PHGMG_VERSION_STRING);
+    status = 0;
+  } else if (argc < 2 || strcmp(argv[1], "reduce")) {
+    status = usage(argc < 2 ? "a command is needed: reduce" : "%s: phgmg-mpi has one command, reduce "
+                   "(simulate, simulate-rom, info, validate: the serial `phgmg`)", argv[1]);
+  } else {
+    status = parse_args(argc, argv, &a);
+    if (status == 0) status = run(&a, size);
+  }
+  MPI_Finalize();
+  return status;
+}
