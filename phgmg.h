@@ -15052,11 +15052,12 @@ PHGMG_DEF phgmg_result phgmg_pod_hierarchical(int N, int m, const double *B, int
 
 /* Local QR of X (n x ns, n >= 1) into W (n x ns, ld n: the explicit Q in
    the first kq = min(n, ns) columns; W may be X itself with ldx = n) and
-   Rl (ns x ns, ld ns, zero below the diagonal and below row kq). Tall blocks go by a flat tree: chunks of
-   about PHGMG__QR_CHUNK rows (at least ns) factored each in cache, their
-   R factors stacked and factored again, each chunk's Q times its block of
-   the second Q (the unblocked Householder QR of the whole block would
-   stream it from memory once per column). */
+   Rl (ns x ns, ld ns, zero below the diagonal and below row kq). Tall
+   blocks go by a flat tree: chunks of about PHGMG__QR_CHUNK rows (at least
+   ns) factored each in cache, their R factors stacked and factored again,
+   each chunk's Q times its block of the second Q (the unblocked
+   Householder QR of the whole block would stream it from memory once per
+   column). */
 #define PHGMG__QR_CHUNK 4096
 PHGMG__PRIV phgmg_result phgmg__chunked_qr(int n, int ns, const double *X, int ldx, double *W, double *Rl,
                                              const phgmg_allocator *al) {
@@ -26333,7 +26334,8 @@ PHGMG_DEF phgmg_result phgmg_mpi_reduce(const phgmg_mpi_ctx *ctx, const phgmg_mp
   sp1 = rc == PHGMG_OK && o.method == PHGMG_METHOD_SP1;
   if (rc == PHGMG_OK && (m < 1 || (phgmg_gidx)r > ctx->N || (sp1 ? r < 1 || r > ns : r <= m))) rc = PHGMG_ERR_SIZE;
   if (rc == PHGMG_OK) {
-    b = phgmg__dalloc(&ctx->al, 2 * (size_t)r * r + (size_t)r * m + 3 * (size_t)r + (sp1 ? 2 : 1) * (size_t)ld * r);
+    b = phgmg__dalloc(&ctx->al, 2 * (size_t)r * r + (size_t)r * m + 3 * (size_t)r +
+                                    (sp1 ? 2 : 1) * (size_t)ld * r);   /* SP1: V and W */
     rc = phgmg__mpi_agree(ctx, b ? PHGMG_OK : PHGMG_ERR_NOMEM);
   }
   if (rc != PHGMG_OK) { phgmg__free(&ctx->al, b); return rc; }
