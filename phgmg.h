@@ -797,9 +797,9 @@
    Measured at N = 2e6 (phgmg_mpi_reduce, GMG-POD r = 20 with ECSW, 40
    snapshots, the solve local; bench/README.md): the peak resident memory
    per rank above that at N = 2e4 is 0.999 times one rank's divided by P
-   at P = 2 and at P = 4 (the library's own peak bytes: 0.998, 0.991); the
-   library holds at most 1007 bytes per row (the snapshots' 320 not
-   included), about 3 times the snapshots.
+   at P = 2 and at P = 4 (the library's own peak bytes: 0.998, 0.991).
+   There the library's peak is 1007 bytes per row (126 doubles with ns =
+   40, r = 20; the caller's snapshots, 320 bytes per row, not included).
    Scaling (bench/README.md): bench/bench_mpi_phases.c measures each
    phase's local work, the time in the user's solves and the communication
    by kind, and bench/mpi_scaling.py models time(P, N) = the local work
