@@ -310,3 +310,10 @@ clean:
 $(BUILD)/bench_mpi_phases: bench/bench_mpi_phases.c phgmg.h
 	@mkdir -p $(BUILD)
 	$(MPICC) -std=c99 $(WARN) -O2 -o $@ bench/bench_mpi_phases.c $(LDLIBS)
+
+# Peak memory per rank of phgmg_mpi_reduce at a fixed global size (bench/README.md,
+# "Memory per rank of the distributed offline phase"; not part of make test):
+#   sh bench/mpi_memory/run.sh
+$(BUILD)/bench_mpi_memory: bench/bench_mpi_memory.c tests/mpi/mem_chain.h phgmg.h
+	@mkdir -p $(BUILD)
+	$(MPICC) -std=c99 $(WARN) -O2 -o $@ bench/bench_mpi_memory.c $(LDLIBS)

@@ -791,6 +791,15 @@
    remove the size factor); per DEIM
    point one broadcast of k doubles and one reduction of a (value, index)
    pair; per operator product one exchange with the neighbouring ranks.
+   Memory per rank falls as 1/P: nothing of size N is replicated, only the
+   P ns x ns factors TSQR stacks, the fits' contributions gathered from the
+   ranks and the screened fit's working set (ns r x up to 1090 doubles).
+   Measured at N = 2e6 (phgmg_mpi_reduce, GMG-POD r = 20 with ECSW, 40
+   snapshots, the solve local; bench/README.md): the peak resident memory
+   per rank above that at N = 2e4 is 0.999 times one rank's divided by P
+   at P = 2 and at P = 4 (the library's own peak bytes: 0.998, 0.991).
+   There the library's peak is 1007 bytes per row (126 doubles with ns =
+   40, r = 20; the caller's snapshots, 320 bytes per row, not included).
    Scaling (bench/README.md): bench/bench_mpi_phases.c measures each
    phase's local work, the time in the user's solves and the communication
    by kind, and bench/mpi_scaling.py models time(P, N) = the local work
@@ -15078,12 +15087,13 @@ PHGMG_DEF phgmg_result phgmg_pod_hierarchical(int N, int m, const double *B, int
 }
 
 /* Local QR of X (n x ns, n >= 1) into W (n x ns, ld n: the explicit Q in
-   the first kq = min(n, ns) columns) and Rl (ns x ns, ld ns, zero below the
-   diagonal and below row kq). Tall blocks go by a flat tree: chunks of
-   about PHGMG__QR_CHUNK rows (at least ns) factored each in cache, their
-   R factors stacked and factored again, each chunk's Q times its block of
-   the second Q (the unblocked Householder QR of the whole block would
-   stream it from memory once per column). */
+   the first kq = min(n, ns) columns; W may be X itself with ldx = n) and
+   Rl (ns x ns, ld ns, zero below the diagonal and below row kq). Tall
+   blocks go by a flat tree: chunks of about PHGMG__QR_CHUNK rows (at least
+   ns) factored each in cache, their R factors stacked and factored again,
+   each chunk's Q times its block of the second Q (the unblocked
+   Householder QR of the whole block would stream it from memory once per
+   column). */
 #define PHGMG__QR_CHUNK 4096
 PHGMG__PRIV phgmg_result phgmg__chunked_qr(int n, int ns, const double *X, int ldx, double *W, double *Rl,
                                              const phgmg_allocator *al) {
@@ -15095,7 +15105,7 @@ PHGMG__PRIV phgmg_result phgmg__chunked_qr(int n, int ns, const double *X, int l
   phgmg_result rc = S2 ? PHGMG_OK : PHGMG_ERR_NOMEM;
   if (rc != PHGMG_OK) return rc;
   tau = S2 + (size_t)ms * ns; work = tau + ns; T = work + ns;
-  for (j = 0; j < ns; ++j) memcpy(W + (size_t)j * n, X + (size_t)j * ldx, (size_t)n * sizeof(double));
+  for (j = 0; j < ns && W != X; ++j) memcpy(W + (size_t)j * n, X + (size_t)j * ldx, (size_t)n * sizeof(double));
   memset(Rl, 0, (size_t)ns * ns * sizeof(double));
   if (nc <= 1) {
     rc = phgmg_qr(n, ns, W, n, tau);
@@ -24812,28 +24822,23 @@ PHGMG__PRIV void phgmg__mpi_tsqr_vectors(const phgmg_mpi_ctx *ctx, int ns, const
   phgmg_gemm('N', 'N', n, k, kq, 1.0, W, n, T, kq, 0.0, V, ldv);
 }
 
-PHGMG_DEF phgmg_result phgmg_mpi_pod(const phgmg_mpi_ctx *ctx, int ns, const double *X, int ldx, int kmax,
-                                     double tol, double *V, int ldv, double *S, int *k_out) {
-  const phgmg_allocator *al;
-  double *W = NULL, *R, *Q2, *U, *s, *T, *ws;
-  phgmg_result rc = PHGMG_OK;
-  int n, k = 0, rank = 0, i;
-  if (!ctx) return PHGMG_ERR_INVALID_ARG;
-  al = &ctx->al; n = ctx->nloc;
-  if (ns < 1 || kmax < 1 || (phgmg_gidx)kmax > ctx->N || kmax > ns || !phgmg__mpi_ld_ok(ctx, ldx) ||
-      !phgmg__mpi_ld_ok(ctx, ldv))
-    rc = PHGMG_ERR_SIZE;
-  else if (!V || !k_out || (n > 0 && !X) || tol != tol) rc = PHGMG_ERR_INVALID_ARG;
-  else if (!(W = phgmg__dalloc(al, (size_t)PHGMG__MAX(1, n) * ns + 2 * (size_t)ns * ns + (size_t)ns * kmax +
-                                       (size_t)kmax + (size_t)ns * kmax + phgmg__mpi_tsqr_ws(ctx, ns))))
-    rc = PHGMG_ERR_NOMEM;
-  rc = phgmg__mpi_agree(ctx, rc);
-  if (rc != PHGMG_OK) { phgmg__free(al, W); return rc; }
-  R = W + (size_t)PHGMG__MAX(1, n) * ns; Q2 = R + (size_t)ns * ns; U = Q2 + (size_t)ns * ns;
-  s = U + (size_t)ns * kmax; T = s + kmax; ws = T + (size_t)ns * kmax;
-  rc = phgmg__mpi_tsqr_core(ctx, ns, X, ldx, W, R, Q2, ws);
+/* Doubles of phgmg__mpi_pod_core's small workspace (replicated sizes). */
+PHGMG__PRIV size_t phgmg__mpi_pod_ws(const phgmg_mpi_ctx *ctx, int ns, int kmax) {
+  return 2 * (size_t)ns * ns + 2 * (size_t)ns * kmax + (size_t)kmax + phgmg__mpi_tsqr_ws(ctx, ns);
+}
+
+/* The POD after the argument checks: W (nloc x ns, ld max(1, nloc)) receives
+   the local QR factor and may be X itself (ldx = max(1, nloc): X is
+   overwritten, no copy of the snapshots); ws: phgmg__mpi_pod_ws doubles. */
+PHGMG__PRIV phgmg_result phgmg__mpi_pod_core(const phgmg_mpi_ctx *ctx, int ns, const double *X, int ldx, int kmax,
+                                             double tol, double *V, int ldv, double *S, int *k_out, double *W,
+                                             double *ws) {
+  double *R = ws, *Q2 = R + (size_t)ns * ns, *U = Q2 + (size_t)ns * ns, *s = U + (size_t)ns * kmax;
+  double *T = s + kmax, *tw = T + (size_t)ns * kmax;
+  int k = 0, rank = 0, i;
+  phgmg_result rc = phgmg__mpi_tsqr_core(ctx, ns, X, ldx, W, R, Q2, tw);
   /* the same R on every rank: the same SVD, no communication */
-  if (rc == PHGMG_OK) rc = phgmg_svd(ns, ns, R, ns, kmax, s, U, ns, NULL, 1, &k, &rank, al);
+  if (rc == PHGMG_OK) rc = phgmg_svd(ns, ns, R, ns, kmax, s, U, ns, NULL, 1, &k, &rank, &ctx->al);
   if (rc == PHGMG_OK) {
     if (tol > 0.0)
       for (i = 0; i < k; ++i)
@@ -24842,6 +24847,26 @@ PHGMG_DEF phgmg_result phgmg_mpi_pod(const phgmg_mpi_ctx *ctx, int ns, const dou
     for (i = 0; i < k && S; ++i) S[i] = s[i];
     *k_out = k;
   }
+  return rc;
+}
+
+PHGMG_DEF phgmg_result phgmg_mpi_pod(const phgmg_mpi_ctx *ctx, int ns, const double *X, int ldx, int kmax,
+                                     double tol, double *V, int ldv, double *S, int *k_out) {
+  const phgmg_allocator *al;
+  double *W = NULL;
+  phgmg_result rc = PHGMG_OK;
+  int n;
+  if (!ctx) return PHGMG_ERR_INVALID_ARG;
+  al = &ctx->al; n = ctx->nloc;
+  if (ns < 1 || kmax < 1 || (phgmg_gidx)kmax > ctx->N || kmax > ns || !phgmg__mpi_ld_ok(ctx, ldx) ||
+      !phgmg__mpi_ld_ok(ctx, ldv))
+    rc = PHGMG_ERR_SIZE;
+  else if (!V || !k_out || (n > 0 && !X) || tol != tol) rc = PHGMG_ERR_INVALID_ARG;
+  else if (!(W = phgmg__dalloc(al, (size_t)PHGMG__MAX(1, n) * ns + phgmg__mpi_pod_ws(ctx, ns, kmax))))
+    rc = PHGMG_ERR_NOMEM;
+  rc = phgmg__mpi_agree(ctx, rc);
+  if (rc == PHGMG_OK)
+    rc = phgmg__mpi_pod_core(ctx, ns, X, ldx, kmax, tol, V, ldv, S, k_out, W, W + (size_t)PHGMG__MAX(1, n) * ns);
   phgmg__free(al, W);
   return rc;
 }
@@ -25633,13 +25658,13 @@ PHGMG__PRIV phgmg_result phgmg__mpi_gmg_basis(const phgmg_mpi_ctx *ctx, const ph
   const int n = ctx->nloc, ld = PHGMG__MAX(1, n), m = md->m;
   const int kk = (int)PHGMG__MIN((phgmg_gidx)PHGMG__MIN(p + 1, ns), ctx->N);
   double *QB = phgmg__dalloc(&ctx->al, (size_t)ld * m + (size_t)m * m + (size_t)m * ns + (size_t)ld * ns +
-                                           (size_t)ld * kk + (size_t)kk);
-  double *RB, *C, *Xa, *V1, *s, rmax = 0.0;
+                                           (size_t)ld * kk + (size_t)kk + phgmg__mpi_pod_ws(ctx, ns, kk));
+  double *RB, *C, *Xa, *V1, *s, *ws, rmax = 0.0;
   int j, k = 0;
   phgmg_result rc = phgmg__mpi_agree(ctx, QB ? PHGMG_OK : PHGMG_ERR_NOMEM);
   if (rc != PHGMG_OK) { phgmg__free(&ctx->al, QB); return rc; }
   RB = QB + (size_t)ld * m; C = RB + (size_t)m * m; Xa = C + (size_t)m * ns; V1 = Xa + (size_t)ld * ns;
-  s = V1 + (size_t)ld * kk;
+  s = V1 + (size_t)ld * kk; ws = s + kk;
   rc = phgmg_mpi_tsqr(ctx, m, md->B, md->ldb, QB, ld, RB, m);
   for (j = 0; j < m && rc == PHGMG_OK; ++j) rmax = PHGMG__MAX(rmax, fabs(RB[j + j * m]));
   for (j = 0; j < m && rc == PHGMG_OK; ++j)
@@ -25648,7 +25673,7 @@ PHGMG__PRIV phgmg_result phgmg__mpi_gmg_basis(const phgmg_mpi_ctx *ctx, const ph
   if (rc == PHGMG_OK) {
     for (j = 0; j < ns && n > 0; ++j) memcpy(Xa + (size_t)j * ld, X + (size_t)j * ldx, (size_t)n * sizeof(double));
     if (n > 0) phgmg_gemm('N', 'N', n, ns, m, -1.0, QB, ld, C, m, 1.0, Xa, ld);
-    rc = phgmg_mpi_pod(ctx, ns, Xa, ld, kk, 0.0, V1, ld, s, &k);
+    rc = phgmg__mpi_pod_core(ctx, ns, Xa, ld, kk, 0.0, V1, ld, s, &k, Xa, ws);   /* Xa factored in place */
   }
   if (rc == PHGMG_OK && k < p) rc = PHGMG_ERR_SIZE;   /* r - m beyond the numerical rank */
   if (rc == PHGMG_OK) {
@@ -26345,12 +26370,14 @@ PHGMG_DEF phgmg_result phgmg_mpi_reduce(const phgmg_mpi_ctx *ctx, const phgmg_mp
   sp1 = rc == PHGMG_OK && o.method == PHGMG_METHOD_SP1;
   if (rc == PHGMG_OK && (m < 1 || (phgmg_gidx)r > ctx->N || (sp1 ? r < 1 || r > ns : r <= m))) rc = PHGMG_ERR_SIZE;
   if (rc == PHGMG_OK) {
-    b = phgmg__dalloc(&ctx->al, 2 * (size_t)r * r + (size_t)r * m + 3 * (size_t)r + 2 * (size_t)ld * r);
+    b = phgmg__dalloc(&ctx->al, 2 * (size_t)r * r + (size_t)r * m + 3 * (size_t)r +
+                                    (sp1 ? 2 : 1) * (size_t)ld * r);   /* SP1: V and W */
     rc = phgmg__mpi_agree(ctx, b ? PHGMG_OK : PHGMG_ERR_NOMEM);
   }
   if (rc != PHGMG_OK) { phgmg__free(&ctx->al, b); return rc; }
   d.r = r; d.m = m; d.K = b; d.Qh = b + (size_t)r * r; d.Bh = d.Qh + (size_t)r * r; d.S = d.Bh + (size_t)r * m;
-  d.env = d.S + r; Vb = b + 2 * (size_t)r * r + (size_t)r * m + 3 * (size_t)r; Wb = Vb + (size_t)ld * r;
+  d.env = d.S + r; Vb = b + 2 * (size_t)r * r + (size_t)r * m + 3 * (size_t)r;
+  Wb = sp1 ? Vb + (size_t)ld * r : NULL;   /* SP1's W = Q V A^{-1} */
   d.nc = model->poly_deg + 1; d.ne = model->nexp; d.md = model;
   d.nsv = sp1 ? r : r - m; d.method = o.method;
   wd = 1 + r + (model->per_term ? d.nc + 2 * d.ne : 0);

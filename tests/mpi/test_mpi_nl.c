@@ -12,6 +12,7 @@
 #define PHGMG_STATIC
 #define PHGMG_IMPLEMENTATION
 #include "../../phgmg.h"
+#include "mem_chain.h"
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -518,6 +519,52 @@ static void test_errors(void) {
   free(X); free(x0);
 }
 
+
+/* Memory per rank falls as 1/P: the library's peak allocation (a counting
+   allocator on the context) in phgmg_mpi_reduce (GMG-POD r = 12, ECSW, 24
+   snapshots) of the chain of tests/mpi/mem_chain.h at N = 1e5 above its
+   peak at N = 1e4, on P ranks against the same on rank 0 alone (MPI_COMM_SELF),
+   divided by P: within 1.15 times. Every byte is freed again. */
+static double mem_peak(MPI_Comm comm, long long N) {
+  mem_count cnt = {0, 0};
+  phgmg_allocator al;
+  mem_chain c;
+  phgmg_reduce_opts o;
+  phgmg_mpi_rom mr;
+  phgmg_result rc;
+  double peak, out = 0.0;
+  al.alloc = mem_count_alloc; al.free = mem_count_free; al.user = &cnt;
+  rc = mem_chain_create(&c, comm, N, 24, &al);
+  CHECK(rc == PHGMG_OK, "memory chain N = %lld: %d", N, (int)rc);
+  memset(&o, 0, sizeof o);
+  o.method = PHGMG_METHOD_GMG_POD; o.r = 12; o.hyper.on = 1; o.hyper.kind = PHGMG_HYPER_ECSW; o.hyper.tol = 1e-2;
+  if (rc == PHGMG_OK) {
+    rc = phgmg_mpi_reduce(c.ctx, &c.md, 24, c.X, c.nloc > 0 ? c.nloc : 1, &o, &mr, NULL, 0);
+    CHECK(rc == PHGMG_OK && mr.nd > 0, "memory chain N = %lld: reduce %d", N, (int)rc);
+    phgmg_mpi_rom_free(&mr);
+  }
+  mem_chain_free(&c);
+  CHECK(cnt.cur == 0, "memory chain N = %lld: %lu bytes not freed", N, (unsigned long)cnt.cur);
+  peak = (double)cnt.peak;
+  MPI_Allreduce(&peak, &out, 1, MPI_DOUBLE, MPI_MAX, comm);
+  return out;
+}
+
+static void test_memory(void) {
+  const long long N = 100000, NB = 10000;
+  double one[2] = {0.0, 0.0}, gp, g1, t0 = MPI_Wtime();
+  if (size_ == 1) return;   /* the comparison needs P > 1 */
+  if (rank_ == 0) { one[0] = mem_peak(MPI_COMM_SELF, N); one[1] = mem_peak(MPI_COMM_SELF, NB); }
+  quiet_barrier();
+  MPI_Bcast(one, 2, MPI_DOUBLE, 0, MPI_COMM_WORLD);
+  gp = mem_peak(MPI_COMM_WORLD, N) - mem_peak(MPI_COMM_WORLD, NB);
+  g1 = one[0] - one[1];
+  CHECK(g1 > 0.0 && gp <= 1.15 * g1 / size_, "library memory per rank above the baseline %.3g B, one rank's / P %.3g B",
+        gp, g1 / size_);
+  if (rank_ == 0) printf("  memory: library peak per rank above N = %lld's, N = %lld: %.1f MB, one rank's / P %.1f MB (%.3f; %.2f s)\n",
+                         NB, N, gp / 1048576.0, g1 / size_ / 1048576.0, gp / (g1 / size_), MPI_Wtime() - t0);
+}
+
 int main(int argc, char **argv) {
   int total = 0;
   double t0;
@@ -530,6 +577,7 @@ int main(int argc, char **argv) {
   test_gmg_pod_ecsw();
   test_screened();
   test_errors();
+  test_memory();
   MPI_Allreduce(&fails_, &total, 1, MPI_INT, MPI_SUM, MPI_COMM_WORLD);
   if (rank_ == 0)
     printf("test_mpi_nl: P = %d: %s (%d failed checks, %.2f s)\n", size_, total ? "FAILED" : "passed", total,
