@@ -19,7 +19,7 @@
    ties node 0 to the wall (one node, sep_jdx = -1), term k >= 1 joins node
    k to node k - 1: s_k = q_k - q_{k-1}, phi(s) = s^2/2 + s^4/4, weights
    w_k = 1 + 0.1 k. */
-#define SPR_NN 12
+#define SPR_NN 40
 #define SPR_N (2 * SPR_NN)
 #define SPR_STEPS 120
 #define SPR_DT 0.05
@@ -307,13 +307,17 @@ TEST(test_springs_balance) {
 }
 
 /* GMG-POD (r = 10) from the native and the GENERAL form on the same
-   snapshots: the reduced outputs equal to 1e-10; the native model is
-   port-Hamiltonian (Rr >= 0: K + K^T <= 0) with Hr = H o phi. ECSW
-   hyper-reduction at fit tolerance tau = 1e-6 keeps Rr >= 0, and its outputs
-   follow the exact reduced model's: the fit reproduces the reduced gradient
-   of the nonlinear part to tau relative on the training states, an error a
-   stable run amplifies by at most its conditioning over the run; 1e-3
-   (1000 tau) is asserted for the relative output difference. */
+   snapshots (a run from rest under the input: the motion spreads from node
+   0, so a few springs carry the training set): the reduced outputs equal to
+   1e-10; the native model is port-Hamiltonian (Rr >= 0: K + K^T <= 0) with
+   Hr = H o phi. ECSW hyper-reduction at fit tolerance tau = 1e-6 keeps
+   fewer terms and Rr >= 0, and its outputs follow the exact reduced
+   model's: the fit reproduces the reduced gradient of the nonlinear part
+   to tau relative on the training states; a perturbation of relative size
+   tau in the vector field moves a stable, damped run of length T = 6 by
+   about T L tau (L: the field's Lipschitz constant relative to its size,
+   a few units here), so 100 tau is asserted for the relative output
+   difference (measured: 4.5e-8). */
 TEST(test_springs_reduce) {
   static spr_model m;
   phgmg_ph_system nat, gen;
@@ -334,6 +338,7 @@ TEST(test_springs_reduce) {
   memset(&G, 0, sizeof G);
   G.a = m.idx; G.b = m.jdx; G.w = m.w; G.N = SPR_N;
   spr_general(&gen, &G);
+  memset(x0, 0, sizeof x0);
   CHECK_RC(spr_sim(&nat, x0, SPR_DT, SPR_STEPS, X, NULL, NULL), PHGMG_OK);
   memset(&o, 0, sizeof o);
   o.method = PHGMG_METHOD_GMG_POD; o.r = 10;
@@ -343,14 +348,14 @@ TEST(test_springs_reduce) {
   CHECK_RC(phgmg_reduce(&r3, &nat, X, SPR_N, SPR_STEPS + 1, &o, &inf, NULL), PHGMG_OK);
   if (!r1 || !r2 || !r3) { free(X); phgmg_reduced_destroy(r1); phgmg_reduced_destroy(r2); phgmg_reduced_destroy(r3); return; }
   CHECK(phgmg_reduced_rom(r1)->nd == SPR_NN);    /* every term kept online */
-  CHECK(phgmg_reduced_rom(r3)->nd <= SPR_NN && phgmg_reduced_rom(r3)->nd >= 1);
+  CHECK(phgmg_reduced_rom(r3)->nd < SPR_NN / 2 && phgmg_reduced_rom(r3)->nd >= 1);   /* measured: 11 of 40 */
   CHECK_LE(inf.hyper_residual, 1e-6);
   CHECK_RC(phgmg_reduced_simulate(r1, xr0, 0.0, SPR_DT, SPR_STEPS, spr_u, NULL, 1e-13, 30, XR, Y1, NULL, NULL, NULL), PHGMG_OK);
   CHECK_RC(phgmg_reduced_simulate(r2, xr0, 0.0, SPR_DT, SPR_STEPS, spr_u, NULL, 1e-13, 30, NULL, Y2, NULL, NULL, NULL), PHGMG_OK);
   CHECK_RC(phgmg_reduced_simulate(r3, xr0, 0.0, SPR_DT, SPR_STEPS, spr_u, NULL, 1e-13, 30, NULL, Y3, NULL, NULL, NULL), PHGMG_OK);
   CHECK_LE(spr_maxdiff(SPR_STEPS + 1, Y1, Y2, &sy), 1e-10 * sy);
   CHECK(sy > 0.05);
-  CHECK_LE(spr_maxdiff(SPR_STEPS + 1, Y3, Y1, NULL), 1e-3 * sy);
+  CHECK_LE(spr_maxdiff(SPR_STEPS + 1, Y3, Y1, NULL), 100.0 * 1e-6 * sy);
   for (pass = 0; pass < 2; ++pass) {   /* Rr >= 0 at a state of the run: exact and hyper-reduced */
     const phgmg_rom *rom = phgmg_reduced_rom(pass ? r3 : r1);
     work = (double *)malloc(sizeof(double) * (phgmg_rom_eval_work_size(rom) + 1));
