@@ -10,6 +10,7 @@
 #include "../phgmg.h"
 #include "harness.h"
 #include <stdlib.h>
+#include <time.h>
 
 /* A chain of SPR_NN masses, node n: position 2n, momentum 2n + 1 (N = 2 nn).
    J couples each position to its momentum, R = 0.05 on the momenta,
@@ -372,6 +373,26 @@ TEST(test_springs_reduce) {
       }
     free(work);
   }
+  { /* the hyper-reduced model through a model file: the same energy and gradient (nothing of N online) */
+    const phgmg_rom *rom = phgmg_reduced_rom(r3);
+    phgmg_rom ld;
+    void *blk = NULL;
+    char path[96];
+    double g1[10], g2[10], w1[4096], w2[4096];
+    CHECK(phgmg_rom_eval_work_size(rom) <= 4096);
+    snprintf(path, sizeof path, "build/springs_tmp_%lx.phgmgrom", (unsigned long)time(NULL) ^ (unsigned long)clock());
+    CHECK_RC(phgmg_rom_save(rom, path), PHGMG_OK);
+    CHECK_RC(phgmg_rom_load(path, &ld, &blk, NULL), PHGMG_OK);
+    if (blk) {
+      CHECK(ld.nd == rom->nd && ld.r == rom->r);
+      CHECK(phgmg_rom_hamiltonian(&ld, XR + 10 * 60, w2) == phgmg_rom_hamiltonian(rom, XR + 10 * 60, w1));
+      phgmg_rom_gradient(&ld, XR + 10 * 60, g2, w2);
+      phgmg_rom_gradient(rom, XR + 10 * 60, g1, w1);
+      CHECK(memcmp(g1, g2, sizeof g1) == 0);
+      free(blk);
+    }
+    remove(path);
+  }
   phgmg_reduced_destroy(r1); phgmg_reduced_destroy(r2); phgmg_reduced_destroy(r3);
   free(X);
 }
@@ -456,7 +477,60 @@ TEST(test_springs_refused) {
   }
 }
 
+/* SP1, SP2 and GMG-QM (r = 10; QM: its default manifold) from the native
+   and the GENERAL form on the same snapshots: the reduced outputs equal to
+   1e-10 (every term kept: the reduced arguments c_k^T V0 xr (+ c_k^T V2
+   eta) against the GENERAL part's full-dimension evaluation). */
+TEST(test_springs_methods) {
+  static spr_model m;
+  static const phgmg_method meth[3] = {PHGMG_METHOD_SP1, PHGMG_METHOD_SP2, PHGMG_METHOD_GMG_QM};
+  phgmg_ph_system nat, gen;
+  spr_gen G;
+  const size_t nx = (size_t)SPR_N * (SPR_STEPS + 1);
+  double *X = (double *)malloc(sizeof(double) * nx), x0[SPR_N], xr0[10] = {0}, Y1[SPR_STEPS + 1], Y2[SPR_STEPS + 1], sy;
+  int a;
+  spr_build(&m);
+  memset(x0, 0, sizeof x0);
+  memset(&nat, 0, sizeof nat);
+  nat.N = SPR_N; nat.m = 1; nat.J = m.J; nat.R = m.R; nat.Q = m.Q; nat.B = m.B;
+  gen = nat;
+  spr_native(&nat, m.idx, m.jdx, m.w);
+  memset(&G, 0, sizeof G);
+  G.a = m.idx; G.b = m.jdx; G.w = m.w; G.N = SPR_N;
+  spr_general(&gen, &G);
+  CHECK_RC(spr_sim(&nat, x0, SPR_DT, SPR_STEPS, X, NULL, NULL), PHGMG_OK);
+  for (a = 0; a < 3; ++a) {
+    phgmg_reduce_opts o;
+    phgmg_reduced *r1 = NULL, *r2 = NULL;
+    memset(&o, 0, sizeof o);
+    o.method = meth[a]; o.r = 10;
+    CHECK_RC(phgmg_reduce(&r1, &nat, X, SPR_N, SPR_STEPS + 1, &o, NULL, NULL), PHGMG_OK);
+    CHECK_RC(phgmg_reduce(&r2, &gen, X, SPR_N, SPR_STEPS + 1, &o, NULL, NULL), PHGMG_OK);
+    if (r1 && r2) {
+      const int r = phgmg_reduced_rom(r1)->r;
+      CHECK(r == phgmg_reduced_rom(r2)->r && r <= 10);
+      CHECK_RC(phgmg_reduced_simulate(r1, xr0, 0.0, SPR_DT, SPR_STEPS, spr_u, NULL, 1e-13, 30, NULL, Y1, NULL, NULL, NULL), PHGMG_OK);
+      CHECK_RC(phgmg_reduced_simulate(r2, xr0, 0.0, SPR_DT, SPR_STEPS, spr_u, NULL, 1e-13, 30, NULL, Y2, NULL, NULL, NULL), PHGMG_OK);
+      CHECK_LE(spr_maxdiff(SPR_STEPS + 1, Y1, Y2, &sy), 1e-10 * sy);
+      CHECK(sy > 0.05);
+    }
+    if (r1 && meth[a] == PHGMG_METHOD_GMG_QM) {   /* ECSW on the manifold's rows c_k^T V0, c_k^T V2 */
+      phgmg_reduced *r3 = NULL;
+      o.hyper.on = 1; o.hyper.kind = PHGMG_HYPER_ECSW; o.hyper.tol = 1e-6;
+      CHECK_RC(phgmg_reduce(&r3, &nat, X, SPR_N, SPR_STEPS + 1, &o, NULL, NULL), PHGMG_OK);
+      CHECK(r3 && phgmg_reduced_rom(r3)->nd < SPR_NN && phgmg_reduced_rom(r3)->nd >= 1);
+      if (r3)
+        CHECK_RC(phgmg_reduced_simulate(r3, xr0, 0.0, SPR_DT, SPR_STEPS, spr_u, NULL, 1e-13, 30, NULL, Y2, NULL, NULL, NULL), PHGMG_OK);
+      CHECK_LE(spr_maxdiff(SPR_STEPS + 1, Y2, Y1, NULL), 100.0 * 1e-6 * sy);   /* as in test_springs_reduce */
+      phgmg_reduced_destroy(r3);
+    }
+    phgmg_reduced_destroy(r1); phgmg_reduced_destroy(r2);
+  }
+  free(X);
+}
+
 SUITE(springs) {
+  RUN(test_springs_methods);
   RUN(test_springs_dense_band);
   RUN(test_springs_sparse);
   RUN(test_springs_balance);
