@@ -78,8 +78,10 @@
              with phgmg_ph_sparse_to_banded_order / _to_user_order.
    The nonlinear part H_nl (field nl):
      PHGMG_NL_NONE       quadratic H;
-     PHGMG_NL_SEPARABLE  H_nl(x) = sum_k w_k phi_k(x[idx_k]) (nsep terms),
-                         phi_k either from the built-in exp-polynomial family
+     PHGMG_NL_SEPARABLE  H_nl(x) = sum_k w_k phi_k(s_k) (nsep terms), each
+                         term on one coordinate, s_k = x[idx_k], or a spring
+                         between two, s_k = x[idx_k] - x[jdx_k] (sep_jdx,
+                         1.9); phi_k either from the built-in exp-polynomial family
                          phi(s) = sum_j c_j s^j + sum_e a_e exp(b_e s)
                          (degree <= 32, at most 8 exponentials; one function
                          for all terms or one per term; covers polynomial/FPU,
@@ -476,14 +478,31 @@
        Hess H_nl = sum_k w_k phi_k''(s_k) c_k c_k^T,
    with the pattern of the union of supp(c_k) x supp(c_k) (a spring: (i, i),
    (j, j), (i, j), (j, i); on a mesh the stiffness matrix's pattern).
-   How to give it. c_k = e_i: SEPARABLE (built-in exp-polynomial phi,
-   hyper-reduction, export). Any other c_k: a GENERAL part, whose callbacks
-   evaluate the sums above; with a sparse model (phgmg_ph_sparse) its
-   Hessian pattern is phgmg_ph_system.hess_p / hess_i (give it in your
-   ordering through phgmg_ph_sparse_hess_pattern, which also says where
-   each of your entries goes), and the stepper factors the stage matrices
-   with the sparse LU (8.12): one callback call per factorization fills the
-   values of that pattern.
+   How to give it. c_k = e_i (one node) or c_k = e_i - e_j (a spring):
+   SEPARABLE, with the built-in exp-polynomial phi or callbacks, and so
+   with hyper-reduction, model files and export to C. Term k's nodes are
+   sep_idx[k] and sep_jdx[k] (sep_jdx NULL: every term on one node;
+   sep_jdx[k] = -1: term k on one node; one model may mix both):
+       sys.nl = PHGMG_NL_SEPARABLE; sys.nsep = nsep;
+       sys.sep_idx = i; sys.sep_jdx = j; sys.sep_w = w;   // s_k = x[i_k] - x[j_k]
+       sys.poly_deg = 4; sys.poly = c;                    // phi(s) = c_2 s^2 + c_4 s^4
+   The library then evaluates the energy, the gradient and the Hessian
+   (w_k phi_k'' on (i, i), (j, j) and -w_k phi_k'' on (i, j), (j, i)) for
+   dense, band and sparse storage; in band storage a spring must lie in the
+   band, |i - j| <= kb (PHGMG_ERR_SIZE otherwise); a sparse model remaps
+   the nodes with phgmg_ph_sparse_sep_idx and phgmg_ph_sparse_sep_jdx (the
+   second refuses, PHGMG_ERR_SIZE, a spring farther apart than the band of
+   the internal ordering: give the spring's linear stiffness in Q, whose
+   pattern the ordering follows, and the two nodes stay close). The GL3
+   stepper takes a model with springs through its Hessian path (the same
+   factorizations as a GENERAL part with that pattern, on the dense, band
+   or sparse LU). Any other c_k (an element's strain over several nodes):
+   a GENERAL part, whose callbacks evaluate the sums above; with a sparse
+   model (phgmg_ph_sparse) its Hessian pattern is phgmg_ph_system.hess_p /
+   hess_i (give it in your ordering through phgmg_ph_sparse_hess_pattern,
+   which also says where each of your entries goes), and the stepper
+   factors the stage matrices with the sparse LU (8.12): one callback call
+   per factorization fills the values of that pattern.
    Energy balance of the full model. GL3 is the collocation method of the
    cubic p with p(t_n) = x_n, p'(t_n + c_i h) = F_i (1.7), so
        H(x_{n+1}) - H(x_n) = int_{t_n}^{t_n+1} grad H(p)^T p' dt
@@ -500,11 +519,15 @@
    spring, row i minus row j of V0), and xr' = K grad Hr + Bh u with the
    constant K = (D^T G D)^{-1}, whose symmetric part is negative
    semidefinite (1.3): the reduced model is port-Hamiltonian with Hr as its
-   energy, and the balance above holds for it with Hr. Given as a GENERAL
+   energy, and the balance above holds for it with Hr. For SEPARABLE terms
+   (springs included) the reduced model keeps the rows P0_k (and, for
+   GMG-QM, P1_k = c_k^T V2) of the kept terms and evaluates them in O(r)
+   each, never touching N; hyper-reduction (opts.hyper: ECSW or DEIM) picks
+   terms k with weights on these rows exactly as for one-node terms, and
+   ECSW's weights w >= 0 keep Hr convex where phi is. Given as a GENERAL
    part, the reduced model evaluates H_nl, its gradient and Hessian in full
    dimension (3.4: O(N) per evaluation, O(nnz(Hess) r) for the reduced
    Hessian Dphi^T Hess Dphi through the pattern's values); hyper-reduction
-   (opts.hyper), which would pick terms k with weights on the rows P0_k,
    takes SEPARABLE terms only (a GENERAL part with opts.hyper.on is
    PHGMG_ERR_UNSUPPORTED).
    With a mass matrix E. The model needs E^T z(x) = grad H(x) (1.6). With
@@ -515,16 +538,25 @@
    phi_k(s_k) (lambda_k > 0 for the convexity phi carries). For c_k = e_i
    that is row i of E equal to E(i, i) e_i^T, the rule of 1.6 (checked:
    PHGMG_ERR_E_COUPLED); for a spring, rows i and j of E unit rows with
-   E(i, i) = E(j, j). A consistent mass matrix that couples a nonlinear
+   E(i, i) = E(j, j) (checked for sep_jdx: PHGMG_ERR_E_COUPLED; the term's
+   energy then weighs lambda_k = E(i, i)). Springs with a singular E
+   (algebraic constraints, 1.8) are PHGMG_ERR_UNSUPPORTED. A consistent mass matrix that couples a nonlinear
    node to its neighbours breaks it: E^T z is then no gradient, the model
    in this form has no Hamiltonian, and no reduction can keep a structure
    the model does not have. Finite-element models carry the nonlinearity
    in the stiffness (the positions, where E is the identity) and the
    consistent mass on the velocities, E = blockdiag(I, M): every such term
-   is taken (SEPARABLE on the positions). A GENERAL part with E is
+   is taken (SEPARABLE on the positions, springs included). A GENERAL part with E is
    PHGMG_ERR_UNSUPPORTED (the library cannot check a callback's c_k
    against E).
-   tests/test_sparse_class.c checks, for quartic springs (c_k = e_i - e_j)
+   tests/test_springs.c checks springs given natively (sep_jdx) against the
+   same energy given as a GENERAL part: trajectories and outputs (dense,
+   band, sparse on the band and on the sparse LU) to 1e-10, the balance
+   (exact for quadratic phi, h^6 otherwise), GMG-POD, SP1, SP2 and GMG-QM
+   models from both forms to 1e-10, ECSW models (Rr >= 0, outputs within
+   100 times the fit tolerance of the exact reduced model's) and the
+   refusals (a second node out of range or outside the band, unequal
+   masses). tests/test_sparse_class.c checks, for quartic springs (c_k = e_i - e_j)
    on a lattice given as a GENERAL part with its pattern on the sparse LU:
    the stepper against the band LU (trajectories to 1e-10, the same Newton
    iterations), the full balance and its h^6 decay, the GMG-POD model's
@@ -1742,7 +1774,8 @@
    The GL3 stepper solves, per Newton iteration, one real and one complex
    system with the stage matrices K(sigma) = sigma I + M, M = -(J - R)(Q + D)
    (D: the Hessian diagonal of a SEPARABLE nonlinear part, 0 for a linear
-   model), sigma = gamma/h and (alpha - i beta)/h. In band storage these
+   model; with springs, 1.9, D is their Hessian, of the pattern (i, i),
+   (j, j), (i, j), (j, i) per spring, joined to Q's as a GENERAL part's), sigma = gamma/h and (alpha - i beta)/h. In band storage these
    factor in O(N kl (kl + ku)) and solve in O(N (kl + ku)) with kl, ku ~ 2 kb:
    right for chains, slow for 2-D and 3-D meshes (a 40 x 40 lattice has kb ~
    80, a 16^3 one ~ 400). phgmg_ph_sparse_create therefore predicts both
@@ -2393,7 +2426,7 @@ typedef enum phgmg_storage { PHGMG_DENSE = 0, PHGMG_BANDED = 1, PHGMG_SPARSE = 2
 
 typedef enum phgmg_nl_kind {
   PHGMG_NL_NONE = 0,      /* quadratic Hamiltonian only                          */
-  PHGMG_NL_SEPARABLE = 1, /* H_nl(x) = sum_k w_k phi_k(x[idx_k])  (DEIM needs this) */
+  PHGMG_NL_SEPARABLE = 1, /* H_nl(x) = sum_k w_k phi_k(x[idx_k] (- x[jdx_k])) (DEIM needs this) */
   PHGMG_NL_GENERAL = 2,   /* H_nl, grad and Hessian by callbacks                 */
   PHGMG_NL_COUNT
 } phgmg_nl_kind;
@@ -2470,11 +2503,13 @@ typedef struct phgmg_ph_system {
          E x' = (J - R) z(x) + B u,   y = B^T z(x),   E^T z(x) = grad H(x),
      where the co-state z(x) = Q x + grad H_nl(x) is what phgmg_ph_gradient
      returns (phgmg_ph_rhs gives E x' = (J - R) z + B u) and the Hamiltonian is
-         H(x) = 1/2 x^T E^T Q x + sum_k E(i_k, i_k) w_k phi_k(x[i_k]),
-     i_k = sep_idx[k] (phgmg_ph_hamiltonian). E^T Q must be symmetric positive
+         H(x) = 1/2 x^T E^T Q x + sum_k E(i_k, i_k) w_k phi_k(s_k),
+     i_k = sep_idx[k], s_k = x[i_k] (a spring: x[i_k] - x[j_k], sep_jdx below)
+     (phgmg_ph_hamiltonian). E^T Q must be symmetric positive
      definite (semidefinite with a nonlinear part) and, for a separable part,
      row i_k of E must be E(i_k, i_k) e_{i_k}^T with E(i_k, i_k) > 0 (the
-     nonlinear coordinates carry no mass coupling), so that E^T z is a
+     nonlinear coordinates carry no mass coupling; a spring: rows i_k and j_k,
+     E(i_k, i_k) = E(j_k, j_k)), so that E^T z is a
      gradient. A GENERAL part and the shifted_* callbacks are not supported
      with E (PHGMG_ERR_UNSUPPORTED). The stepper never forms E^{-1}: E enters
      its Newton matrices (sigma E - (J - R) Hess) and stage residuals. See
@@ -3033,8 +3068,9 @@ typedef struct phgmg_rom {
   const phgmg_real *Ms;   /* rn x p*p symmetrised M: Ms(:,k*p+j) = M(:,k*p+j) + M(:,j*p+k)
                              (symmetric in (k, j); the online code may read either order) */
   /* separable nonlinear part (nd > 0) */
-  const phgmg_real *P0;   /* nd x r   rows of V0 at the kept coordinates */
-  const phgmg_real *P1;   /* nd x rn  rows of V2 (QUADRATIC)             */
+  const phgmg_real *P0;   /* nd x r   rows c_k^T V0 of the kept terms (V0's row at the
+                             term's coordinate; a spring: row i minus row j)   */
+  const phgmg_real *P1;   /* nd x rn  the same rows of V2 (QUADRATIC)            */
   const phgmg_real *w;    /* nd       weights (structure-preserving DEIM) */
   const phgmg_real *poly; /* (nphi or 1) x (poly_deg+1) coefficients of phi, constant first */
   /* precomputed GL3 step map (LINEAR, nd == 0; NULL if absent) for step dt:
@@ -4821,7 +4857,8 @@ PHGMG_DEF phgmg_result phgmg_mpi_gmg_pod_linear(const phgmg_mpi_ctx *ctx, const 
    x' = (J - R) grad H(x) + B u, y = B^T grad H(x),
    H(x) = 1/2 x^T Q x + sum_k w_k phi_k(x[idx_k]), phi_k of the built-in
    exp-polynomial family (manual 1.1; the layout of phgmg_ph_system's poly,
-   expo). lin: Q, m, B and the solve with J - R as for a linear model. Each
+   expo). Every term acts on one coordinate: springs between two (manual
+   1.9, phgmg_ph_system.sep_jdx) are for the serial phgmg_reduce. lin: Q, m, B and the solve with J - R as for a linear model. Each
    rank passes its own terms: nsep (0 allowed), sep_idx their global state
    indices (rows of this rank), sep_id their global term indices (distinct
    over the ranks, ascending in rank order, e.g. the serial model's term
@@ -12048,7 +12085,8 @@ PHGMG__PRIV phgmg_result phgmg__gl3_setup_newton(phgmg_gl3 *s) {
       s->wc = phgmg__dalloc(&s->al, (size_t)N);
       if (!s->wc) return PHGMG_ERR_NOMEM;
       for (i = 0; i < N; ++i) s->wc[i] = 0.0;
-      for (k = 0; k < sys->nsep; ++k) s->wc[sys->sep_idx[k]] += sys->sep_w ? sys->sep_w[k] : 1.0;
+      for (k = 0; k < sys->nsep; ++k) s->wc[sys->sep_idx[k]] += phgmg__sep_w(sys, k);   /* one-node terms:
+                                                springs reach the stepper as a GENERAL part (phgmg__gl3_setup_springs) */
     }
   }
   return PHGMG_OK;
@@ -12623,7 +12661,9 @@ PHGMG__PRIV void phgmg__gl3_grad_fused(phgmg_gl3 *s, const double *x) {
 
 /* Adds the gradient of the nonlinear part at the stage values x + Z_st to
    G_st: a shared built-in separable function (derivative coefficients
-   precomputed), one built-in function per term, callbacks, or GENERAL. */
+   precomputed), one built-in function per term, callbacks, or GENERAL.
+   SEPARABLE here has one-node terms only (the Hessian diagonal dd):
+   springs are stepped as a GENERAL part (phgmg__gl3_setup_springs). */
 PHGMG__PRIV void phgmg__gl3_grad_nl(phgmg_gl3 *s, const double *x, int st) {
   const phgmg_ph_system *sys = &s->sys;
   const int N = s->N;
