@@ -529,7 +529,46 @@ TEST(test_springs_methods) {
   free(X);
 }
 
+/* DEIM on springs: the terms' gradient snapshots phi'(c_k^T x_i) are built
+   by phgmg_reduce and, once per study, by phgmg_study_reduce (two code
+   paths); both pick the same points and weights, so the two models give the
+   same outputs, and the model (allow_negative) simulates. */
+TEST(test_springs_deim) {
+  static spr_model m;
+  phgmg_ph_system nat;
+  phgmg_reduce_opts o;
+  phgmg_reduced *r1 = NULL, *r2 = NULL;
+  phgmg_study *st = NULL;
+  phgmg_study_opts so;
+  const size_t nx = (size_t)SPR_N * (SPR_STEPS + 1);
+  double *X = (double *)malloc(sizeof(double) * nx), x0[SPR_N], xr0[10] = {0}, Y1[SPR_STEPS + 1], Y2[SPR_STEPS + 1], sy;
+  spr_build(&m);
+  memset(x0, 0, sizeof x0);
+  memset(&nat, 0, sizeof nat);
+  nat.N = SPR_N; nat.m = 1; nat.J = m.J; nat.R = m.R; nat.Q = m.Q; nat.B = m.B;
+  spr_native(&nat, m.idx, m.jdx, m.w);
+  CHECK_RC(spr_sim(&nat, x0, SPR_DT, SPR_STEPS, X, NULL, NULL), PHGMG_OK);
+  memset(&o, 0, sizeof o);
+  o.method = PHGMG_METHOD_GMG_POD; o.r = 10;
+  o.hyper.on = 1; o.hyper.kind = PHGMG_HYPER_QDEIM; o.hyper.allow_negative = 1;
+  CHECK_RC(phgmg_reduce(&r1, &nat, X, SPR_N, SPR_STEPS + 1, &o, NULL, NULL), PHGMG_OK);
+  so.what = 0; so.kmax = 10;
+  CHECK_RC(phgmg_study_create(&st, &nat, X, SPR_N, SPR_STEPS + 1, &so, NULL), PHGMG_OK);
+  if (st) CHECK_RC(phgmg_study_reduce(st, &o, &r2, NULL), PHGMG_OK);
+  if (r1 && r2) {
+    const phgmg_rom *a = phgmg_reduced_rom(r1), *b = phgmg_reduced_rom(r2);
+    CHECK(a->nd == b->nd && a->nd >= 1 && a->nd < SPR_NN);
+    CHECK_RC(phgmg_reduced_simulate(r1, xr0, 0.0, SPR_DT, SPR_STEPS, spr_u, NULL, 1e-13, 30, NULL, Y1, NULL, NULL, NULL), PHGMG_OK);
+    CHECK_RC(phgmg_reduced_simulate(r2, xr0, 0.0, SPR_DT, SPR_STEPS, spr_u, NULL, 1e-13, 30, NULL, Y2, NULL, NULL, NULL), PHGMG_OK);
+    CHECK_LE(spr_maxdiff(SPR_STEPS + 1, Y1, Y2, &sy), 1e-10 * sy);
+    CHECK(sy > 0.05);
+  }
+  phgmg_reduced_destroy(r1); phgmg_reduced_destroy(r2); phgmg_study_destroy(st);
+  free(X);
+}
+
 SUITE(springs) {
+  RUN(test_springs_deim);
   RUN(test_springs_methods);
   RUN(test_springs_dense_band);
   RUN(test_springs_sparse);
