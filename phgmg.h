@@ -554,9 +554,9 @@
    band, sparse on the band and on the sparse LU) to 1e-10, the balance
    (exact for quadratic phi, h^6 otherwise), GMG-POD, SP1, SP2 and GMG-QM
    models from both forms to 1e-10, ECSW models (Rr >= 0, outputs within
-   100 times the fit tolerance of the exact reduced model's) and the
-   refusals (a second node out of range or outside the band, unequal
-   masses). tests/test_sparse_class.c checks, for quartic springs (c_k = e_i - e_j)
+   100 times the fit tolerance of the exact reduced model's), Q-DEIM, a
+   mass matrix (against the standard model of E x) and the refusals (a
+   second node out of range or outside the band, unequal masses). tests/test_sparse_class.c checks, for quartic springs (c_k = e_i - e_j)
    on a lattice given as a GENERAL part with its pattern on the sparse LU:
    the stepper against the band LU (trajectories to 1e-10, the same Newton
    iterations), the full balance and its h^6 decay, the GMG-POD model's
