@@ -12480,9 +12480,14 @@ PHGMG__PRIV double phgmg__spr_H(const double *x, void *user) {
 }
 PHGMG__PRIV void phgmg__spr_grad(const double *x, double *g, void *user) {
   const phgmg_ph_system *s = PHGMG__CAST(const phgmg_ph_system *, user);
+  const int builtin = PHGMG__PH_BUILTIN(s);
   int k;
   for (k = 0; k < s->N; ++k) g[k] = 0.0;
-  for (k = 0; k < s->nsep; ++k) phgmg__sep_add(s, k, phgmg__sep_w(s, k) * phgmg__ph_phi(s, k, phgmg__sep_arg(s, k, x), 1), g);
+  for (k = 0; k < s->nsep; ++k) {
+    const double v = phgmg__sep_arg(s, k, x);
+    const double d1 = builtin ? phgmg__ph_dphi_builtin(s, PHGMG__PH_FUN(s, k), v) : phgmg__ph_phi(s, k, v, 1);
+    phgmg__sep_add(s, k, phgmg__sep_w(s, k) * d1, g);
+  }
 }
 /* Hs(r, c) += a in the system's Hessian storage. */
 PHGMG__PRIV void phgmg__spr_put(const phgmg_ph_system *s, double *Hs, int r, int c, double a) {
