@@ -540,8 +540,8 @@
    PHGMG_ERR_E_COUPLED); for a spring, rows i and j of E unit rows with
    E(i, i) = E(j, j) (checked for sep_jdx: PHGMG_ERR_E_COUPLED; the term's
    energy then weighs lambda_k = E(i, i)). Springs with a singular E
-   (algebraic constraints, 1.8) are PHGMG_ERR_UNSUPPORTED. A consistent mass matrix that couples a nonlinear
-   node to its neighbours breaks it: E^T z is then no gradient, the model
+   (algebraic constraints, 1.8) are PHGMG_ERR_UNSUPPORTED. A consistent
+   mass matrix that couples a nonlinear node to its neighbours breaks it: E^T z is then no gradient, the model
    in this form has no Hamiltonian, and no reduction can keep a structure
    the model does not have. Finite-element models carry the nonlinearity
    in the stiffness (the positions, where E is the identity) and the
@@ -556,7 +556,8 @@
    models from both forms to 1e-10, ECSW models (Rr >= 0, outputs within
    100 times the fit tolerance of the exact reduced model's), Q-DEIM, a
    mass matrix (against the standard model of E x) and the refusals (a
-   second node out of range or outside the band, unequal masses). tests/test_sparse_class.c checks, for quartic springs (c_k = e_i - e_j)
+   second node out of range or outside the band, unequal masses).
+   tests/test_sparse_class.c checks, for quartic springs (c_k = e_i - e_j)
    on a lattice given as a GENERAL part with its pattern on the sparse LU:
    the stepper against the band LU (trajectories to 1e-10, the same Newton
    iterations), the full balance and its h^6 decay, the GMG-POD model's
@@ -1775,7 +1776,8 @@
    system with the stage matrices K(sigma) = sigma I + M, M = -(J - R)(Q + D)
    (D: the Hessian diagonal of a SEPARABLE nonlinear part, 0 for a linear
    model; with springs, 1.9, D is their Hessian, of the pattern (i, i),
-   (j, j), (i, j), (j, i) per spring, joined to Q's as a GENERAL part's), sigma = gamma/h and (alpha - i beta)/h. In band storage these
+   (j, j), (i, j), (j, i) per spring, joined to Q's as a GENERAL part's),
+   sigma = gamma/h and (alpha - i beta)/h. In band storage these
    factor in O(N kl (kl + ku)) and solve in O(N (kl + ku)) with kl, ku ~ 2 kb:
    right for chains, slow for 2-D and 3-D meshes (a 40 x 40 lattice has kb ~
    80, a 16^3 one ~ 400). phgmg_ph_sparse_create therefore predicts both
@@ -4858,7 +4860,8 @@ PHGMG_DEF phgmg_result phgmg_mpi_gmg_pod_linear(const phgmg_mpi_ctx *ctx, const 
    H(x) = 1/2 x^T Q x + sum_k w_k phi_k(x[idx_k]), phi_k of the built-in
    exp-polynomial family (manual 1.1; the layout of phgmg_ph_system's poly,
    expo). Every term acts on one coordinate: springs between two (manual
-   1.9, phgmg_ph_system.sep_jdx) are for the serial phgmg_reduce. lin: Q, m, B and the solve with J - R as for a linear model. Each
+   1.9, phgmg_ph_system.sep_jdx) are for the serial phgmg_reduce. lin: Q,
+   m, B and the solve with J - R as for a linear model. Each
    rank passes its own terms: nsep (0 allowed), sep_idx their global state
    indices (rows of this rank), sep_id their global term indices (distinct
    over the ranks, ascending in rank order, e.g. the serial model's term
@@ -28119,6 +28122,12 @@ PHGMG_DEF phgmg_result phgmg_sym_eig(int n, double *A, int lda, double *w, doubl
 /*
    REVISION HISTORY
    0.7.0  (2026-11-28)
+          - New: springs in the SEPARABLE Hamiltonian, sum_k w_k
+            phi_k(x[i_k] - x[j_k]) (phgmg_ph_system.sep_jdx, appended at
+            the end of the struct; phgmg_ph_sparse_sep_jdx; the command
+            line's --poly-jdx): full model on dense, band and sparse storage,
+            every reduction, hyper-reduction, model files and export to C
+            (manual 1.9). Before, such terms needed a GENERAL part.
           - Changed: an index-one model in SPARSE storage (E with zero rows
             and columns) is simulated on its sparse pencil (manual 1.8): no
             condensation, no limit on the algebraic lines but memory; its
