@@ -78,8 +78,10 @@
              with phgmg_ph_sparse_to_banded_order / _to_user_order.
    The nonlinear part H_nl (field nl):
      PHGMG_NL_NONE       quadratic H;
-     PHGMG_NL_SEPARABLE  H_nl(x) = sum_k w_k phi_k(x[idx_k]) (nsep terms),
-                         phi_k either from the built-in exp-polynomial family
+     PHGMG_NL_SEPARABLE  H_nl(x) = sum_k w_k phi_k(s_k) (nsep terms), each
+                         term on one coordinate, s_k = x[idx_k], or a spring
+                         between two, s_k = x[idx_k] - x[jdx_k] (sep_jdx,
+                         1.9); phi_k either from the built-in exp-polynomial family
                          phi(s) = sum_j c_j s^j + sum_e a_e exp(b_e s)
                          (degree <= 32, at most 8 exponentials; one function
                          for all terms or one per term; covers polynomial/FPU,
@@ -476,14 +478,31 @@
        Hess H_nl = sum_k w_k phi_k''(s_k) c_k c_k^T,
    with the pattern of the union of supp(c_k) x supp(c_k) (a spring: (i, i),
    (j, j), (i, j), (j, i); on a mesh the stiffness matrix's pattern).
-   How to give it. c_k = e_i: SEPARABLE (built-in exp-polynomial phi,
-   hyper-reduction, export). Any other c_k: a GENERAL part, whose callbacks
-   evaluate the sums above; with a sparse model (phgmg_ph_sparse) its
-   Hessian pattern is phgmg_ph_system.hess_p / hess_i (give it in your
-   ordering through phgmg_ph_sparse_hess_pattern, which also says where
-   each of your entries goes), and the stepper factors the stage matrices
-   with the sparse LU (8.12): one callback call per factorization fills the
-   values of that pattern.
+   How to give it. c_k = e_i (one node) or c_k = e_i - e_j (a spring):
+   SEPARABLE, with the built-in exp-polynomial phi or callbacks, and so
+   with hyper-reduction, model files and export to C. Term k's nodes are
+   sep_idx[k] and sep_jdx[k] (sep_jdx NULL: every term on one node;
+   sep_jdx[k] = -1: term k on one node; one model may mix both):
+       sys.nl = PHGMG_NL_SEPARABLE; sys.nsep = nsep;
+       sys.sep_idx = i; sys.sep_jdx = j; sys.sep_w = w;   // s_k = x[i_k] - x[j_k]
+       sys.poly_deg = 4; sys.poly = c;                    // phi(s) = c_2 s^2 + c_4 s^4
+   The library then evaluates the energy, the gradient and the Hessian
+   (w_k phi_k'' on (i, i), (j, j) and -w_k phi_k'' on (i, j), (j, i)) for
+   dense, band and sparse storage; in band storage a spring must lie in the
+   band, |i - j| <= kb (PHGMG_ERR_SIZE otherwise); a sparse model remaps
+   the nodes with phgmg_ph_sparse_sep_idx and phgmg_ph_sparse_sep_jdx (the
+   second refuses, PHGMG_ERR_SIZE, a spring farther apart than the band of
+   the internal ordering: give the spring's linear stiffness in Q, whose
+   pattern the ordering follows, and the two nodes stay close). The GL3
+   stepper takes a model with springs through its Hessian path (the same
+   factorizations as a GENERAL part with that pattern, on the dense, band
+   or sparse LU). Any other c_k (an element's strain over several nodes):
+   a GENERAL part, whose callbacks evaluate the sums above; with a sparse
+   model (phgmg_ph_sparse) its Hessian pattern is phgmg_ph_system.hess_p /
+   hess_i (give it in your ordering through phgmg_ph_sparse_hess_pattern,
+   which also says where each of your entries goes), and the stepper
+   factors the stage matrices with the sparse LU (8.12): one callback call
+   per factorization fills the values of that pattern.
    Energy balance of the full model. GL3 is the collocation method of the
    cubic p with p(t_n) = x_n, p'(t_n + c_i h) = F_i (1.7), so
        H(x_{n+1}) - H(x_n) = int_{t_n}^{t_n+1} grad H(p)^T p' dt
@@ -500,11 +519,15 @@
    spring, row i minus row j of V0), and xr' = K grad Hr + Bh u with the
    constant K = (D^T G D)^{-1}, whose symmetric part is negative
    semidefinite (1.3): the reduced model is port-Hamiltonian with Hr as its
-   energy, and the balance above holds for it with Hr. Given as a GENERAL
+   energy, and the balance above holds for it with Hr. For SEPARABLE terms
+   (springs included) the reduced model keeps the rows P0_k (and, for
+   GMG-QM, P1_k = c_k^T V2) of the kept terms and evaluates them in O(r)
+   each, never touching N; hyper-reduction (opts.hyper: ECSW or DEIM) picks
+   terms k with weights on these rows exactly as for one-node terms, and
+   ECSW's weights w >= 0 keep Hr convex where phi is. Given as a GENERAL
    part, the reduced model evaluates H_nl, its gradient and Hessian in full
    dimension (3.4: O(N) per evaluation, O(nnz(Hess) r) for the reduced
    Hessian Dphi^T Hess Dphi through the pattern's values); hyper-reduction
-   (opts.hyper), which would pick terms k with weights on the rows P0_k,
    takes SEPARABLE terms only (a GENERAL part with opts.hyper.on is
    PHGMG_ERR_UNSUPPORTED).
    With a mass matrix E. The model needs E^T z(x) = grad H(x) (1.6). With
@@ -515,15 +538,25 @@
    phi_k(s_k) (lambda_k > 0 for the convexity phi carries). For c_k = e_i
    that is row i of E equal to E(i, i) e_i^T, the rule of 1.6 (checked:
    PHGMG_ERR_E_COUPLED); for a spring, rows i and j of E unit rows with
-   E(i, i) = E(j, j). A consistent mass matrix that couples a nonlinear
-   node to its neighbours breaks it: E^T z is then no gradient, the model
+   E(i, i) = E(j, j) (checked for sep_jdx: PHGMG_ERR_E_COUPLED; the term's
+   energy then weighs lambda_k = E(i, i)). Springs with a singular E
+   (algebraic constraints, 1.8) are PHGMG_ERR_UNSUPPORTED. A consistent
+   mass matrix that couples a nonlinear node to its neighbours breaks it: E^T z is then no gradient, the model
    in this form has no Hamiltonian, and no reduction can keep a structure
    the model does not have. Finite-element models carry the nonlinearity
    in the stiffness (the positions, where E is the identity) and the
    consistent mass on the velocities, E = blockdiag(I, M): every such term
-   is taken (SEPARABLE on the positions). A GENERAL part with E is
+   is taken (SEPARABLE on the positions, springs included). A GENERAL part with E is
    PHGMG_ERR_UNSUPPORTED (the library cannot check a callback's c_k
    against E).
+   tests/test_springs.c checks springs given natively (sep_jdx) against the
+   same energy given as a GENERAL part: trajectories and outputs (dense,
+   band, sparse on the band and on the sparse LU) to 1e-10, the balance
+   (exact for quadratic phi, h^6 otherwise), GMG-POD, SP1, SP2 and GMG-QM
+   models from both forms to 1e-10, ECSW models (Rr >= 0, outputs within
+   100 times the fit tolerance of the exact reduced model's), Q-DEIM, a
+   mass matrix (against the standard model of E x) and the refusals (a
+   second node out of range or outside the band, unequal masses).
    tests/test_sparse_class.c checks, for quartic springs (c_k = e_i - e_j)
    on a lattice given as a GENERAL part with its pattern on the sparse LU:
    the stepper against the band LU (trajectories to 1e-10, the same Newton
@@ -1787,7 +1820,9 @@
    The GL3 stepper solves, per Newton iteration, one real and one complex
    system with the stage matrices K(sigma) = sigma I + M, M = -(J - R)(Q + D)
    (D: the Hessian diagonal of a SEPARABLE nonlinear part, 0 for a linear
-   model), sigma = gamma/h and (alpha - i beta)/h. In band storage these
+   model; with springs, 1.9, D is their Hessian, of the pattern (i, i),
+   (j, j), (i, j), (j, i) per spring, joined to Q's as a GENERAL part's),
+   sigma = gamma/h and (alpha - i beta)/h. In band storage these
    factor in O(N kl (kl + ku)) and solve in O(N (kl + ku)) with kl, ku ~ 2 kb:
    right for chains, slow for 2-D and 3-D meshes (a 40 x 40 lattice has kb ~
    80, a 16^3 one ~ 400). phgmg_ph_sparse_create therefore predicts both
@@ -2248,7 +2283,8 @@
            phgmg_ph_sparse_create, phgmg_ph_sparse_create_e,
            phgmg_ph_sparse_create_desc,
            phgmg_ph_sparse_system,
-           phgmg_ph_sparse_perm, phgmg_ph_sparse_sep_idx, phgmg_ph_sparse_hess_pattern,
+           phgmg_ph_sparse_perm, phgmg_ph_sparse_sep_idx, phgmg_ph_sparse_sep_jdx,
+           phgmg_ph_sparse_hess_pattern,
            phgmg_ph_sparse_to_banded_order, phgmg_ph_sparse_to_user_order,
            phgmg_ph_sparse_destroy, phgmg_ph_sparse_set_solver,
            phgmg_gl3_create, phgmg_gl3_destroy,
@@ -2302,7 +2338,7 @@
            phgmg_lu_rcond, phgmg_norm1, phgmg_normf, phgmg_zlu_factor,
            phgmg_zlu_solve, phgmg_qr, phgmg_qrcp, phgmg_qr_form_q,
            phgmg_qr_apply, phgmg_lstsq, phgmg_svd, phgmg_sym_eig
-   (174 functions; 23 of them only with PHGMG_MPI; also the macros
+   (175 functions; 23 of them only with PHGMG_MPI; also the macros
    PHGMG_ROM_STEPPER_MEMSIZE_MAX and _MAX_CB.)
 */
 #ifndef PHGMG_H_INCLUDED
@@ -2437,7 +2473,7 @@ typedef enum phgmg_storage { PHGMG_DENSE = 0, PHGMG_BANDED = 1, PHGMG_SPARSE = 2
 
 typedef enum phgmg_nl_kind {
   PHGMG_NL_NONE = 0,      /* quadratic Hamiltonian only                          */
-  PHGMG_NL_SEPARABLE = 1, /* H_nl(x) = sum_k w_k phi_k(x[idx_k])  (DEIM needs this) */
+  PHGMG_NL_SEPARABLE = 1, /* H_nl(x) = sum_k w_k phi_k(x[idx_k] (- x[jdx_k])) (DEIM needs this) */
   PHGMG_NL_GENERAL = 2,   /* H_nl, grad and Hessian by callbacks                 */
   PHGMG_NL_COUNT
 } phgmg_nl_kind;
@@ -2514,11 +2550,13 @@ typedef struct phgmg_ph_system {
          E x' = (J - R) z(x) + B u,   y = B^T z(x),   E^T z(x) = grad H(x),
      where the co-state z(x) = Q x + grad H_nl(x) is what phgmg_ph_gradient
      returns (phgmg_ph_rhs gives E x' = (J - R) z + B u) and the Hamiltonian is
-         H(x) = 1/2 x^T E^T Q x + sum_k E(i_k, i_k) w_k phi_k(x[i_k]),
-     i_k = sep_idx[k] (phgmg_ph_hamiltonian). E^T Q must be symmetric positive
+         H(x) = 1/2 x^T E^T Q x + sum_k E(i_k, i_k) w_k phi_k(s_k),
+     i_k = sep_idx[k], s_k = x[i_k] (a spring: x[i_k] - x[j_k], sep_jdx below)
+     (phgmg_ph_hamiltonian). E^T Q must be symmetric positive
      definite (semidefinite with a nonlinear part) and, for a separable part,
      row i_k of E must be E(i_k, i_k) e_{i_k}^T with E(i_k, i_k) > 0 (the
-     nonlinear coordinates carry no mass coupling), so that E^T z is a
+     nonlinear coordinates carry no mass coupling; a spring: rows i_k and j_k,
+     E(i_k, i_k) = E(j_k, j_k)), so that E^T z is a
      gradient. A GENERAL part and the shifted_* callbacks are not supported
      with E (PHGMG_ERR_UNSUPPORTED). The stepper never forms E^{-1}: E enters
      its Newton matrices (sigma E - (J - R) Hess) and stage residuals. See
@@ -2562,6 +2600,18 @@ typedef struct phgmg_ph_system {
      for indexing; the library reads them through sparse) and the GL3 stepper
      solves its stage systems with the sparse LU; else BANDED. */
   const phgmg_ph_sparse *sparse;
+  /* SEPARABLE, optional (NULL: every term acts on one coordinate): springs.
+     Term k acts on s_k = x[sep_idx[k]] - x[sep_jdx[k]] (a spring between
+     nodes i_k and j_k), or on x[sep_idx[k]] where sep_jdx[k] = -1:
+         H_nl(x) = sum_k w_k phi_k(s_k),
+     with the same weights and functions phi_k as above. 0 <= j_k < N,
+     j_k != i_k (PHGMG_ERR_SIZE otherwise); BANDED and SPARSE storage:
+     |i_k - j_k| <= kb (PHGMG_ERR_SIZE). With E: rows i_k and j_k of E unit
+     rows with E(i_k, i_k) = E(j_k, j_k) > 0 (PHGMG_ERR_E_COUPLED), and the
+     term's energy weighs E(i_k, i_k) w_k. Not with a singular E (index one,
+     PHGMG_ERR_UNSUPPORTED). A SPARSE model remaps it with
+     phgmg_ph_sparse_sep_jdx. Manual 1.9. */
+  const int *sep_jdx;
 } phgmg_ph_system;
 
 /* Validation of a system. tol (<= 0: 1e-12; NaN or +Inf:
@@ -2767,7 +2817,8 @@ PHGMG_DEF phgmg_result phgmg_rcm(int N, int na, const phgmg_csc *const *A, int *
    with phgmg_ph_sparse_to_user_order), phgmg_reduced_restrict and the error
    measures take internal-order states. A GENERAL nonlinear part's callbacks
    receive internal-order states (and a banded Hessian in the internal order);
-   a SEPARABLE one needs its coordinates remapped (phgmg_ph_sparse_sep_idx).
+   a SEPARABLE one needs its coordinates remapped (phgmg_ph_sparse_sep_idx;
+   springs' second nodes: phgmg_ph_sparse_sep_jdx).
 
        phgmg_ph_sparse *sp; phgmg_ph_sparse_info inf;
        phgmg_ph_sparse_create(&sp, N, m, &J, &R, &Q, B, NULL, &inf, NULL);
@@ -2837,6 +2888,18 @@ PHGMG_DEF const int *phgmg_ph_sparse_perm(const phgmg_ph_sparse *sp);
    index outside 0..N-1), _NOMEM. */
 PHGMG_DEF phgmg_result phgmg_ph_sparse_sep_idx(phgmg_ph_sparse *sp, int nsep, const int *sep_idx_user,
                                                int *idx_out, phgmg_ph_system *sys);
+/* The same for springs (phgmg_ph_system.sep_jdx): term k's second node is
+   user coordinate sep_jdx_user[k] (-1: none, kept). Stores the internal
+   nodes in sp (replacing an earlier call's array) and, if sys is not NULL,
+   sets sys->sep_jdx to it; jdx_out (may be NULL) also receives them.
+   PHGMG_ERR_INVALID_ARG (NULL sp or sep_jdx_user), _SIZE (nsep < 1, an
+   index outside -1..N-1, or a spring farther than the object's
+   half-bandwidth kb apart in the internal order: give the spring's
+   coupling in Q's pattern, e.g. its linear stiffness, so that the ordering
+   keeps the two nodes close), _NOMEM. Call phgmg_ph_sparse_sep_idx first
+   (the band check reads its nodes when sys is given). */
+PHGMG_DEF phgmg_result phgmg_ph_sparse_sep_jdx(phgmg_ph_sparse *sp, int nsep, const int *sep_jdx_user,
+                                               int *jdx_out, phgmg_ph_system *sys);
 /* A GENERAL Hessian's pattern (phgmg_ph_system.hess_p, hess_i) from the
    user's ordering: cp (N + 1) / ri the N x N CSC pattern of Hess H_nl in
    the user's order (rows strictly increasing in each column). Stores the
@@ -3052,8 +3115,9 @@ typedef struct phgmg_rom {
   const phgmg_real *Ms;   /* rn x p*p symmetrised M: Ms(:,k*p+j) = M(:,k*p+j) + M(:,j*p+k)
                              (symmetric in (k, j); the online code may read either order) */
   /* separable nonlinear part (nd > 0) */
-  const phgmg_real *P0;   /* nd x r   rows of V0 at the kept coordinates */
-  const phgmg_real *P1;   /* nd x rn  rows of V2 (QUADRATIC)             */
+  const phgmg_real *P0;   /* nd x r   rows c_k^T V0 of the kept terms (V0's row at the
+                             term's coordinate; a spring: row i minus row j)   */
+  const phgmg_real *P1;   /* nd x rn  the same rows of V2 (QUADRATIC)            */
   const phgmg_real *w;    /* nd       weights (structure-preserving DEIM) */
   const phgmg_real *poly; /* (nphi or 1) x (poly_deg+1) coefficients of phi, constant first */
   /* precomputed GL3 step map (LINEAR, nd == 0; NULL if absent) for step dt:
@@ -4840,7 +4904,9 @@ PHGMG_DEF phgmg_result phgmg_mpi_gmg_pod_linear(const phgmg_mpi_ctx *ctx, const 
    x' = (J - R) grad H(x) + B u, y = B^T grad H(x),
    H(x) = 1/2 x^T Q x + sum_k w_k phi_k(x[idx_k]), phi_k of the built-in
    exp-polynomial family (manual 1.1; the layout of phgmg_ph_system's poly,
-   expo). lin: Q, m, B and the solve with J - R as for a linear model. Each
+   expo). Every term acts on one coordinate: springs between two (manual
+   1.9, phgmg_ph_system.sep_jdx) are for the serial phgmg_reduce. lin: Q,
+   m, B and the solve with J - R as for a linear model. Each
    rank passes its own terms: nsep (0 allowed), sep_idx their global state
    indices (rows of this rank), sep_id their global term indices (distinct
    over the ranks, ascending in rank order, e.g. the serial model's term
@@ -5361,6 +5427,33 @@ PHGMG__PRIV double phgmg__ph_quad(const phgmg_ph_system *s, const double *M, con
 /* Function index t of term k for the built-in form (0: shared). */
 #define PHGMG__PH_FUN(s, k) ((s)->phi_nfun > 1 ? (k) : 0)
 
+/* Springs (phgmg_ph_system.sep_jdx, manual 1.9): term k acts on
+   s_k = c_k^T x with c_k = e_i - e_j, or c_k = e_i (one node). These few
+   helpers are the only readers of the terms' coordinates. */
+/* Term k's second node, or -1 (one node). */
+PHGMG__PRIV int phgmg__sep_j(const phgmg_ph_system *s, int k) { return s->sep_jdx ? s->sep_jdx[k] : -1; }
+/* Term k's argument s_k = c_k^T x (x: a full-dimension vector or one column). */
+PHGMG__PRIV double phgmg__sep_arg(const phgmg_ph_system *s, int k, const double *x) {
+  const int j = phgmg__sep_j(s, k);
+  return j >= 0 ? x[s->sep_idx[k]] - x[j] : x[s->sep_idx[k]];
+}
+/* g += v c_k. */
+PHGMG__PRIV void phgmg__sep_add(const phgmg_ph_system *s, int k, double v, double *g) {
+  const int j = phgmg__sep_j(s, k);
+  g[s->sep_idx[k]] += v;
+  if (j >= 0) g[j] -= v;
+}
+/* Does the separable part have a spring (a term with two nodes)? */
+PHGMG__PRIV int phgmg__sep_springs(const phgmg_ph_system *s) {
+  int k;
+  if (s->nl != PHGMG_NL_SEPARABLE || !s->sep_jdx) return 0;
+  for (k = 0; k < s->nsep; ++k)
+    if (s->sep_jdx[k] >= 0) return 1;
+  return 0;
+}
+/* Term k's weight w_k (1 when sep_w is NULL). */
+PHGMG__PRIV double phgmg__sep_w(const phgmg_ph_system *s, int k) { return s->sep_w ? s->sep_w[k] : 1.0; }
+
 /* d-th derivative (d = 0,1,2) of the scalar nonlinearity of term k at v. */
 PHGMG__PRIV double phgmg__ph_phi(const phgmg_ph_system *s, int k, double v, int d) {
   if (PHGMG__PH_BUILTIN(s)) {
@@ -5508,6 +5601,19 @@ PHGMG__PRIV phgmg_result phgmg__ph_check_dampers(const phgmg_ph_system *s) {
 PHGMG__PRIV phgmg_result phgmg__ph_check_sparse(const phgmg_ph_system *s);
 PHGMG__PRIV phgmg_result phgmg__ph_check_hess_pattern(const phgmg_ph_system *s);
 
+/* Springs: second nodes in range (-1: none), not the first node, and within
+   the band of BANDED or SPARSE storage (the stepper's band LU holds the
+   term's Hessian block there). */
+PHGMG__PRIV phgmg_result phgmg__ph_check_springs(const phgmg_ph_system *s) {
+  int k;
+  for (k = 0; k < s->nsep; ++k) {
+    const int i = s->sep_idx[k], j = s->sep_jdx[k];
+    if (j < -1 || j >= s->N || j == i) return PHGMG_ERR_SIZE;
+    if (j >= 0 && s->storage != PHGMG_DENSE && (i - j > s->kb || j - i > s->kb)) return PHGMG_ERR_SIZE;
+  }
+  return PHGMG_OK;
+}
+
 /* Structural checks shared by every entry point (no O(N^2) work). */
 PHGMG__PRIV phgmg_result phgmg__ph_check(const phgmg_ph_system *s) {
   phgmg_result rc;
@@ -5530,6 +5636,7 @@ PHGMG__PRIV phgmg_result phgmg__ph_check(const phgmg_ph_system *s) {
       if (s->nsep > 0 && !s->sep_idx) return PHGMG_ERR_INVALID_ARG;
       for (k = 0; k < s->nsep; ++k)
         if (s->sep_idx[k] < 0 || s->sep_idx[k] >= s->N) return PHGMG_ERR_SIZE;
+      if (s->sep_jdx && (rc = phgmg__ph_check_springs(s)) != PHGMG_OK) return rc;
       if (PHGMG__PH_BUILTIN(s)) {
         size_t nf = (size_t)(s->phi_nfun > 1 ? s->phi_nfun : 1);
         if ((s->poly_deg > 0 && !s->poly) || (s->nexp > 0 && !s->expo)) return PHGMG_ERR_INVALID_ARG;
@@ -5567,11 +5674,8 @@ PHGMG__PRIV void phgmg__ph_grad(const phgmg_ph_system *s, const double *x, doubl
   int k, i;
   phgmg__ph_mv(s, s->Q, x, g);
   if (s->nl == PHGMG_NL_SEPARABLE) {
-    for (k = 0; k < s->nsep; ++k) {
-      int ix = s->sep_idx[k];
-      double w = s->sep_w ? s->sep_w[k] : 1.0;
-      g[ix] += w * phgmg__ph_phi(s, k, x[ix], 1);
-    }
+    for (k = 0; k < s->nsep; ++k)
+      phgmg__sep_add(s, k, phgmg__sep_w(s, k) * phgmg__ph_phi(s, k, phgmg__sep_arg(s, k, x), 1), g);
   } else if (s->nl == PHGMG_NL_GENERAL) {
     s->grad_nl(x, tmp, s->user);
     for (i = 0; i < s->N; ++i) g[i] += tmp[i];
@@ -5604,7 +5708,7 @@ PHGMG__PRIV double phgmg__ph_hamiltonian_e(const phgmg_ph_system *sys, const dou
   if (sys->nl == PHGMG_NL_SEPARABLE)
     for (k = 0; k < sys->nsep; ++k) {
       const int ix = sys->sep_idx[k];
-      H += phgmg__ph_at(sys, sys->E, ix, ix) * (sys->sep_w ? sys->sep_w[k] : 1.0) * phgmg__ph_phi(sys, k, x[ix], 0);
+      H += phgmg__ph_at(sys, sys->E, ix, ix) * phgmg__sep_w(sys, k) * phgmg__ph_phi(sys, k, phgmg__sep_arg(sys, k, x), 0);
     }
   return H;
 }
@@ -5617,7 +5721,7 @@ PHGMG_DEF double phgmg_ph_hamiltonian(const phgmg_ph_system *sys, const double *
   H = 0.5 * phgmg__ph_quad(sys, sys->Q, x, x);
   if (sys->nl == PHGMG_NL_SEPARABLE) {
     for (k = 0; k < sys->nsep; ++k)
-      H += (sys->sep_w ? sys->sep_w[k] : 1.0) * phgmg__ph_phi(sys, k, x[sys->sep_idx[k]], 0);
+      H += phgmg__sep_w(sys, k) * phgmg__ph_phi(sys, k, phgmg__sep_arg(sys, k, x), 0);
   } else if (sys->nl == PHGMG_NL_GENERAL) {
     H += sys->H_nl(x, sys->user);
   }
@@ -6485,6 +6589,17 @@ PHGMG__PRIV phgmg_result phgmg__ph_validate_e(const phgmg_ph_system *sys, double
   return rc;
 }
 
+/* A spring's two nodes carry the same mass, E(i, i) = E(j, j) (manual 1.9:
+   then E^T c_k = E(i, i) c_k and E^T z stays a gradient). */
+PHGMG__PRIV phgmg_result phgmg__ph_e_springs(const phgmg_ph_system *sys) {
+  int k;
+  for (k = 0; k < sys->nsep; ++k) {
+    const int j = phgmg__sep_j(sys, k), i = sys->sep_idx[k];
+    if (j >= 0 && phgmg__ph_at(sys, sys->E, i, i) != phgmg__ph_at(sys, sys->E, j, j)) return PHGMG_ERR_E_COUPLED;
+  }
+  return PHGMG_OK;
+}
+
 /* Part two: the separable coordinates free of mass coupling (row i_k of E
    is E(i_k, i_k) e_{i_k}^T with E(i_k, i_k) > 0); one pass over E's entries
    for SPARSE storage. */
@@ -6498,7 +6613,10 @@ PHGMG__PRIV phgmg_result phgmg__ph_e_coupled(const phgmg_ph_system *sys, const p
     phgmg_result rc = PHGMG_OK;
     if (!is) return PHGMG_ERR_NOMEM;
     for (j = 0; j < sys->N; ++j) is[j] = 0;
-    for (k = 0; k < sys->nsep; ++k) is[sys->sep_idx[k]] = 1;   /* 1: a row still to show E(i, i) > 0 */
+    for (k = 0; k < sys->nsep; ++k) {     /* 1: a row still to show E(i, i) > 0 */
+      is[sys->sep_idx[k]] = 1;
+      if (phgmg__sep_j(sys, k) >= 0) is[phgmg__sep_j(sys, k)] = 1;
+    }
     for (j = 0; j < sys->N && rc == PHGMG_OK; ++j)
       for (p = cp[j]; p < cp[j + 1]; ++p) {
         const int i = ci[p];
@@ -6509,15 +6627,18 @@ PHGMG__PRIV phgmg_result phgmg__ph_e_coupled(const phgmg_ph_system *sys, const p
     for (j = 0; j < sys->N && rc == PHGMG_OK; ++j)
       if (is[j] == 1) rc = PHGMG_ERR_E_COUPLED;
     phgmg__free(alloc, is);
-    return rc;
+    return rc == PHGMG_OK ? phgmg__ph_e_springs(sys) : rc;
   }
   for (k = 0; k < sys->nsep; ++k) {
-    const int ix = sys->sep_idx[k];
-    if (!(phgmg__ph_at(sys, sys->E, ix, ix) > 0.0)) return PHGMG_ERR_E_COUPLED;
-    for (j = 0; j < sys->N; ++j)
-      if (j != ix && phgmg__ph_at(sys, sys->E, ix, j) != 0.0) return PHGMG_ERR_E_COUPLED;
+    int ix = sys->sep_idx[k], nd;
+    for (nd = 0; nd < 2; ++nd, ix = phgmg__sep_j(sys, k)) {   /* the term's one or two nodes */
+      if (ix < 0) break;
+      if (!(phgmg__ph_at(sys, sys->E, ix, ix) > 0.0)) return PHGMG_ERR_E_COUPLED;
+      for (j = 0; j < sys->N; ++j)
+        if (j != ix && phgmg__ph_at(sys, sys->E, ix, j) != 0.0) return PHGMG_ERR_E_COUPLED;
+    }
   }
-  return PHGMG_OK;
+  return phgmg__ph_e_springs(sys);
 }
 
 /* Part three: E nonsingular, 1 / cond_1(E) > tol (SPARSE: the sparse LU of
@@ -7196,6 +7317,7 @@ PHGMG__PRIV phgmg_result phgmg__dae_qmaps(phgmg_dae *d, const phgmg_ph_system *s
    a damper must act on kept co-states (PHGMG_ERR_UNSUPPORTED otherwise). */
 PHGMG__PRIV phgmg_result phgmg__dae_nonlinear(phgmg_dae *d, const phgmg_ph_system *s) {
   int t;
+  if (phgmg__sep_springs(s)) return PHGMG_ERR_UNSUPPORTED;   /* springs with algebraic constraints: not derived */
   if (s->nl == PHGMG_NL_SEPARABLE && s->nsep > 0) {
     d->sep_idx = phgmg__ialloc(&d->al, (size_t)s->nsep);
     if (!d->sep_idx) return PHGMG_ERR_NOMEM;
@@ -9359,7 +9481,7 @@ struct phgmg_ph_sparse {
   phgmg_ph_system sys;
   phgmg_allocator a;
   const phgmg_allocator *alloc; /* &a or NULL */
-  int *perm, *iperm, *sep;
+  int *perm, *iperm, *sep, *sepj;
   int *hp, *hi;                 /* a GENERAL Hessian's pattern (phgmg_ph_sparse_hess_pattern) */
   double *J, *R, *Q, *B;
   double *E;   /* descriptor models: E's band copy (band LU only), else NULL */
@@ -10054,6 +10176,7 @@ PHGMG_DEF void phgmg_ph_sparse_destroy(phgmg_ph_sparse *sp) {
   phgmg__free(alloc, sp->perm);
   phgmg__free(alloc, sp->iperm);
   phgmg__free(alloc, sp->sep);
+  phgmg__free(alloc, sp->sepj);
   phgmg__free(alloc, sp->hp);
   phgmg__free(alloc, sp->hi);
   phgmg__free(alloc, sp->J);
@@ -10523,6 +10646,28 @@ PHGMG_DEF phgmg_result phgmg_ph_sparse_sep_idx(phgmg_ph_sparse *sp, int nsep, co
   return PHGMG_OK;
 }
 
+PHGMG_DEF phgmg_result phgmg_ph_sparse_sep_jdx(phgmg_ph_sparse *sp, int nsep, const int *sep_jdx_user,
+                                               int *jdx_out, phgmg_ph_system *sys) {
+  int k, *s;
+  if (!sp || !sep_jdx_user) return PHGMG_ERR_INVALID_ARG;
+  if (nsep < 1) return PHGMG_ERR_SIZE;
+  for (k = 0; k < nsep; ++k)
+    if (sep_jdx_user[k] < -1 || sep_jdx_user[k] >= sp->sys.N) return PHGMG_ERR_SIZE;
+  s = phgmg__ialloc(sp->alloc, (size_t)nsep);
+  if (!s) return PHGMG_ERR_NOMEM;
+  for (k = 0; k < nsep; ++k) s[k] = sep_jdx_user[k] < 0 ? -1 : sp->iperm[sep_jdx_user[k]];
+  for (k = 0; sys && sys->sep_idx && sys->nsep == nsep && k < nsep; ++k)
+    if (s[k] >= 0 && (s[k] - sys->sep_idx[k] > sp->sys.kb || sys->sep_idx[k] - s[k] > sp->sys.kb)) {
+      phgmg__free(sp->alloc, s);
+      return PHGMG_ERR_SIZE;
+    }
+  if (jdx_out) memcpy(jdx_out, s, sizeof(int) * (size_t)nsep);
+  phgmg__free(sp->alloc, sp->sepj);
+  sp->sepj = s;
+  if (sys) sys->sep_jdx = s;
+  return PHGMG_OK;
+}
+
 /* A GENERAL Hessian's pattern from the user's order (CSC cp/ri, rows
    strictly increasing) to the internal one: the pattern in sp (replacing an
    earlier call's), map[e] = its entry for user entry e. */
@@ -10929,7 +11074,7 @@ PHGMG__PRIV phgmg_result phgmg__sdae_validate(const phgmg_ph_system *sys, double
   if (alloc) D->al = *alloc;
   D->sys = *sys;
   D->N = sys->N; D->m = sys->m;
-  rc = phgmg__sdae_lines(D);
+  rc = phgmg__sep_springs(sys) ? PHGMG_ERR_UNSUPPORTED : phgmg__sdae_lines(D);   /* springs: not with constraints */
   for (t = 0; rc == PHGMG_OK && sys->nl == PHGMG_NL_SEPARABLE && t < sys->nsep; ++t)
     if (D->rmap[sys->sep_idx[t]] >= 0 || D->cmap[sys->sep_idx[t]] >= 0) rc = PHGMG_ERR_UNSUPPORTED;
   if (rc == PHGMG_OK) rc = phgmg__sdae_qdc(D, tol);
@@ -10946,7 +11091,7 @@ PHGMG__PRIV phgmg_result phgmg__sdae_validate(const phgmg_ph_system *sys, double
    pattern holds (J - R)(Q + D) through Q's pattern, manual 1.8). */
 PHGMG__PRIV int phgmg__sdae_stepper_ok(const phgmg_ph_system *sys) {
   int t;
-  if (!phgmg__ph_sparse_lu(sys)) return 0;
+  if (!phgmg__ph_sparse_lu(sys) || phgmg__sep_springs(sys)) return 0;
   for (t = 0; sys->nl == PHGMG_NL_SEPARABLE && t < sys->nsep; ++t)
     if (phgmg__ph_at(sys, sys->Q, sys->sep_idx[t], sys->sep_idx[t]) == 0.0) return 0;
   return 1;
@@ -11689,6 +11834,11 @@ struct phgmg_gl3 {
   struct phgmg__spsym *sown;
   int *dpos, *hpos;
   double *jrx, *hqx, *hv;
+  /* springs (sys.sep_jdx, manual 1.9): the caller's separable system, which
+     the stepper's copy evaluates as a GENERAL part (phgmg__gl3_setup_springs),
+     and the Hessian pattern of SPARSE storage */
+  phgmg_ph_system spr;
+  int *spr_p, *spr_i;
 };
 
 PHGMG_DEF void phgmg_gl3_destroy(phgmg_gl3 *s) {
@@ -11703,6 +11853,7 @@ PHGMG_DEF void phgmg_gl3_destroy(phgmg_gl3 *s) {
   phgmg__free(&al, s->dinv1); phgmg__free(&al, s->dinv2); phgmg__free(&al, s->hband);
   phgmg__free(&al, s->dd);
   phgmg__free(&al, s->dpoly); phgmg__free(&al, s->wc);
+  phgmg__free(&al, s->spr_p); phgmg__free(&al, s->spr_i);
   phgmg__free(&al, s->jr_ptr); phgmg__free(&al, s->jr_col); phgmg__free(&al, s->jr_val);
   phgmg__free(&al, s->b_row); phgmg__free(&al, s->b_col); phgmg__free(&al, s->b_val);
   phgmg__free(&al, s->Phi); phgmg__free(&al, s->Gam); phgmg__free(&al, s->GX);
@@ -11982,7 +12133,8 @@ PHGMG__PRIV phgmg_result phgmg__gl3_setup_newton(phgmg_gl3 *s) {
       s->wc = phgmg__dalloc(&s->al, (size_t)N);
       if (!s->wc) return PHGMG_ERR_NOMEM;
       for (i = 0; i < N; ++i) s->wc[i] = 0.0;
-      for (k = 0; k < sys->nsep; ++k) s->wc[sys->sep_idx[k]] += sys->sep_w ? sys->sep_w[k] : 1.0;
+      for (k = 0; k < sys->nsep; ++k) s->wc[sys->sep_idx[k]] += phgmg__sep_w(sys, k);   /* one-node terms:
+                                                springs reach the stepper as a GENERAL part (phgmg__gl3_setup_springs) */
     }
   }
   return PHGMG_OK;
@@ -12362,6 +12514,74 @@ PHGMG__PRIV phgmg_result phgmg__gl3_setup_feedthrough(phgmg_gl3 *s) {
   return PHGMG_OK;
 }
 
+/* Springs (manual 1.9): their Hessian sum_k w_k phi_k''(s_k) c_k c_k^T is
+   not diagonal, so the stepper takes the separable part as a GENERAL one
+   whose callbacks evaluate the sums over the terms (s->spr, the caller's
+   system, is their user data); the Hessian fills the storage of the
+   system: dense, band (|i - j| <= kb, validated) or the pattern below. */
+PHGMG__PRIV double phgmg__spr_H(const double *x, void *user) {
+  const phgmg_ph_system *s = PHGMG__CAST(const phgmg_ph_system *, user);
+  double H = 0.0;
+  int k;
+  for (k = 0; k < s->nsep; ++k) H += phgmg__sep_w(s, k) * phgmg__ph_phi(s, k, phgmg__sep_arg(s, k, x), 0);
+  return H;
+}
+PHGMG__PRIV void phgmg__spr_grad(const double *x, double *g, void *user) {
+  const phgmg_ph_system *s = PHGMG__CAST(const phgmg_ph_system *, user);
+  const int builtin = PHGMG__PH_BUILTIN(s);
+  int k;
+  for (k = 0; k < s->N; ++k) g[k] = 0.0;
+  for (k = 0; k < s->nsep; ++k) {
+    const double v = phgmg__sep_arg(s, k, x);
+    const double d1 = builtin ? phgmg__ph_dphi_builtin(s, PHGMG__PH_FUN(s, k), v) : phgmg__ph_phi(s, k, v, 1);
+    phgmg__sep_add(s, k, phgmg__sep_w(s, k) * d1, g);
+  }
+}
+/* Hs(r, c) += a in the system's Hessian storage. */
+PHGMG__PRIV void phgmg__spr_put(const phgmg_ph_system *s, double *Hs, int r, int c, double a) {
+  if (s->storage == PHGMG_DENSE) Hs[(size_t)r + (size_t)c * (size_t)s->N] += a;
+  else if (s->storage == PHGMG_BANDED) Hs[PHGMG__PHB(s->kb, r, c)] += a;
+  else Hs[phgmg__csc_find(s->hess_p, s->hess_i, r, c)] += a;
+}
+PHGMG__PRIV void phgmg__spr_hess(const double *x, double *Hs, void *user) {
+  const phgmg_ph_system *s = PHGMG__CAST(const phgmg_ph_system *, user);
+  const size_t n = s->storage == PHGMG_DENSE ? (size_t)s->N * (size_t)s->N
+                 : s->storage == PHGMG_BANDED ? (size_t)(2 * s->kb + 1) * (size_t)s->N : (size_t)s->hess_p[s->N];
+  size_t e;
+  int k;
+  for (e = 0; e < n; ++e) Hs[e] = 0.0;
+  for (k = 0; k < s->nsep; ++k) {
+    const int i = s->sep_idx[k], j = phgmg__sep_j(s, k);
+    const double a = phgmg__sep_w(s, k) * phgmg__ph_phi(s, k, phgmg__sep_arg(s, k, x), 2);
+    phgmg__spr_put(s, Hs, i, i, a);
+    if (j < 0) continue;
+    phgmg__spr_put(s, Hs, j, j, a);
+    phgmg__spr_put(s, Hs, i, j, -a);
+    phgmg__spr_put(s, Hs, j, i, -a);
+  }
+}
+
+/* The stepper's copy of a system with springs becomes GENERAL (above); SPARSE
+   storage: the pattern (i, i), (j, j), (i, j), (j, i) of every term, built
+   as the dampers' pattern of the same node pairs. */
+PHGMG__PRIV phgmg_result phgmg__gl3_setup_springs(phgmg_gl3 *s) {
+  s->spr = s->sys;
+  if (s->sys.storage == PHGMG_SPARSE) {
+    phgmg_ph_system t;
+    memset(&t, 0, sizeof t);
+    t.N = s->N; t.ndamp = s->spr.nsep; t.damp_i = s->spr.sep_idx; t.damp_j = s->spr.sep_jdx;
+    if (phgmg__damp_pattern(&t, &s->spr_p, &s->spr_i, &s->al) != PHGMG_OK) return PHGMG_ERR_NOMEM;
+    s->spr.hess_p = s->sys.hess_p = s->spr_p;
+    s->spr.hess_i = s->sys.hess_i = s->spr_i;
+  }
+  s->sys.nl = PHGMG_NL_GENERAL;
+  s->sys.H_nl = phgmg__spr_H;
+  s->sys.grad_nl = phgmg__spr_grad;
+  s->sys.hess_nl = phgmg__spr_hess;
+  s->sys.user = &s->spr;
+  return PHGMG_OK;
+}
+
 PHGMG_DEF phgmg_result phgmg_gl3_create(phgmg_gl3 **out, const phgmg_ph_system *sys, double dt,
                                         const phgmg_gl3_opts *opts, const phgmg_allocator *alloc) {
   phgmg_gl3 *s;
@@ -12392,7 +12612,8 @@ PHGMG_DEF phgmg_result phgmg_gl3_create(phgmg_gl3 **out, const phgmg_ph_system *
   s->flush = !(opts && opts->keep_tiny);
   s->ftau = s->flush ? PHGMG__DBL_MIN : 0.0;
   s->linear = sys->nl == PHGMG_NL_NONE && sys->ndamp == 0;
-  if (sys->P && phgmg__gl3_setup_feedthrough(s) != PHGMG_OK) {
+  if ((phgmg__sep_springs(sys) && phgmg__gl3_setup_springs(s) != PHGMG_OK) ||
+      (sys->P && phgmg__gl3_setup_feedthrough(s) != PHGMG_OK)) {
     phgmg_gl3_destroy(s);
     return PHGMG_ERR_NOMEM;
   }
@@ -12493,7 +12714,9 @@ PHGMG__PRIV void phgmg__gl3_grad_fused(phgmg_gl3 *s, const double *x) {
 
 /* Adds the gradient of the nonlinear part at the stage values x + Z_st to
    G_st: a shared built-in separable function (derivative coefficients
-   precomputed), one built-in function per term, callbacks, or GENERAL. */
+   precomputed), one built-in function per term, callbacks, or GENERAL.
+   SEPARABLE here has one-node terms only (the Hessian diagonal dd):
+   springs are stepped as a GENERAL part (phgmg__gl3_setup_springs). */
 PHGMG__PRIV void phgmg__gl3_grad_nl(phgmg_gl3 *s, const double *x, int st) {
   const phgmg_ph_system *sys = &s->sys;
   const int N = s->N;
@@ -14611,7 +14834,7 @@ struct phgmg_reduced {
   double *QB, *RB;     /* thin QR of B: N x m, m x m           */
   double *W;           /* N x r point reduction for SP1/SP2    */
   double *M;           /* rn x p^2                             */
-  int *coord;          /* nd: coordinates of the kept terms    */
+  int *coord;          /* nd: (first) coordinates of the kept terms */
   const phgmg_ph_system *sys;
   /* double blocks (same meaning as the phgmg_rom fields) */
   double *Bh, *Qh, *K, *G00, *G01, *G10, *G11, *Q01, *Q11, *Ms, *P0, *P1, *w;
@@ -14722,8 +14945,9 @@ PHGMG__PRIV uint64_t phgmg__sys_fingerprint(const phgmg_ph_system *s) {
   if (s->nl == PHGMG_NL_SEPARABLE && s->nsep > 0) {
     const size_t nf = s->phi_nfun > 1 ? (size_t)s->phi_nfun : 1;
     for (k = 0; s->sep_idx && k < s->nsep; ++k) {
-      const double v = s->sep_idx[k];
+      const double v = s->sep_idx[k], vj = phgmg__sep_j(s, k);
       h = phgmg__hash_d(h, &v, 1);
+      if (s->sep_jdx) h = phgmg__hash_d(h, &vj, 1);   /* springs (absent: the hash of old) */
     }
     h = phgmg__hash_d(h, s->sep_w, (size_t)s->nsep);
     if (s->poly_deg > 0 && s->poly) h = phgmg__hash_d(h, s->poly, nf * (size_t)(s->poly_deg + 1));
@@ -16895,7 +17119,7 @@ PHGMG__PRIV phgmg_result phgmg__reduce_descriptor_setup(phgmg__rctx *c) {
     c->sepw_own = phgmg__dalloc(c->alloc, (size_t)sys->nsep);
     if (!c->sepw_own) return PHGMG_ERR_NOMEM;
     for (k = 0; k < sys->nsep; ++k)
-      c->sepw_own[k] = (sys->sep_w ? sys->sep_w[k] : 1.0) * phgmg__ph_at(sys, sys->E, sys->sep_idx[k], sys->sep_idx[k]);
+      c->sepw_own[k] = phgmg__sep_w(sys, k) * phgmg__ph_at(sys, sys->E, sys->sep_idx[k], sys->sep_idx[k]);   /* = E(j, j) */
     c->sepw = c->sepw_own;
   }
   return phgmg__all_finite(c->Bp_own, (size_t)N * m) ? PHGMG_OK : PHGMG_ERR_NANINF;
@@ -19119,13 +19343,13 @@ PHGMG__PRIV phgmg_result phgmg__hyper_ecsw_manifold(phgmg__rctx *c, const double
     i = u * stride;
     phgmg__eta_d(red, XR + (size_t)u * r + m, NULL, Dq, NULL, red->rwork);
     for (k = 0; k < nt; ++k) {
-      const int ix = sys->sep_idx[live[k]];
+      const int t = live[k];
       const double f = F[k + (size_t)i * nt];
       double *g = Gm + (size_t)u * r + (size_t)k * nrow;
-      for (a = 0; a < r; ++a) g[a] = f * red->V0[ix + (size_t)a * N];
+      for (a = 0; a < r; ++a) g[a] = f * phgmg__sep_arg(sys, t, red->V0 + (size_t)a * N);   /* c_t^T V0 */
       for (a = 0; a < p; ++a) {
         double s = 0.0;
-        for (j = 0; j < rn; ++j) s += red->V2[ix + (size_t)j * N] * Dq[j + (size_t)a * rn];
+        for (j = 0; j < rn; ++j) s += phgmg__sep_arg(sys, t, red->V2 + (size_t)j * N) * Dq[j + (size_t)a * rn];
         g[m + a] += f * s;
       }
     }
@@ -19154,11 +19378,11 @@ PHGMG__PRIV phgmg_result phgmg__hyper_ecsw(phgmg__rctx *c, const double *F, int 
   double *Vt, *sw;
   int k, a;
   phgmg_result rc;
-  Vt = phgmg__dalloc(c->alloc, (size_t)nl * (r + 1));   /* rows of V0 at the terms, weights */
+  Vt = phgmg__dalloc(c->alloc, (size_t)nl * (r + 1));   /* the terms' rows c_k^T V0, weights */
   if (!Vt) return PHGMG_ERR_NOMEM;
   sw = Vt + (size_t)nl * r;
   for (a = 0; a < r; ++a)
-    for (k = 0; k < nl; ++k) Vt[k + (size_t)a * nl] = red->V0[c->sys->sep_idx[live[k]] + (size_t)a * N];
+    for (k = 0; k < nl; ++k) Vt[k + (size_t)a * nl] = phgmg__sep_arg(c->sys, live[k], red->V0 + (size_t)a * N);
   for (k = 0; k < nl; ++k) sw[k] = c->sepw ? c->sepw[live[k]] : 1.0;
   rc = phgmg_ecsw_separable(nl, c->ns, F, nl, r, Vt, nl, sw, c->o->hyper.tol, pts, wt, nd,
                             &c->inf.hyper_residual, c->alloc);
@@ -19181,14 +19405,14 @@ PHGMG__PRIV phgmg_result phgmg__separable_gradients(phgmg__rctx *c, int compact,
   for (a = 0; a < nt; ++a) live[a] = !compact || phgmg__ph_phi(sys, a, 0.0, 1) != 0.0;
   for (i = 0; compact && i < ns; ++i) {
     const double *x = c->Xf + (size_t)i * c->ldxf;
-    for (a = 0; a < nt; ++a) live[a] |= x[sys->sep_idx[a]] != 0.0;
+    for (a = 0; a < nt; ++a) live[a] |= phgmg__sep_arg(sys, a, x) != 0.0;
   }
   for (a = 0; a < nt; ++a) if (live[a]) live[nl++] = a;   /* in place: nl <= a */
   F = phgmg__dalloc(c->alloc, (size_t)(nl ? nl : 1) * ns);
   if (!F) { phgmg__free(c->alloc, live); return PHGMG_ERR_NOMEM; }
   for (i = 0; i < ns; ++i)
     for (a = 0; a < nl; ++a)
-      F[a + (size_t)i * nl] = phgmg__ph_phi(sys, live[a], c->Xf[sys->sep_idx[live[a]] + (size_t)i * c->ldxf], 1);
+      F[a + (size_t)i * nl] = phgmg__ph_phi(sys, live[a], phgmg__sep_arg(sys, live[a], c->Xf + (size_t)i * c->ldxf), 1);
   *Fo = F; *liveo = live; *nlo = nl;
   return PHGMG_OK;
 }
@@ -19271,9 +19495,10 @@ PHGMG__PRIV phgmg_result phgmg__separable_functions(phgmg_reduced *red, const in
   return PHGMG_OK;
 }
 
-/* Stage 4b, separable nonlinear part sum_k w_k phi_k(x_{idx_k}): kept terms
-   (DEIM or all), their weights, and the rows P0 = V0(idx, :), P1 = V2(idx, :)
-   through which the online model evaluates them. */
+/* Stage 4b, separable nonlinear part sum_k w_k phi_k(c_k^T x): kept terms
+   (DEIM or all), their weights, and the rows P0 = c_k^T V0, P1 = c_k^T V2
+   (rows idx_k of V0, V2; a spring's row i minus row j) through which the
+   online model evaluates them. */
 PHGMG__PRIV phgmg_result phgmg__stage_separable_terms(phgmg__rctx *c) {
   phgmg_reduced *red = c->red;
   const int N = red->N, r = red->r, rn = red->rn, nt = c->sys->nsep;
@@ -19293,16 +19518,16 @@ PHGMG__PRIV phgmg_result phgmg__stage_separable_terms(phgmg__rctx *c) {
     if (!red->coord || !red->w || !red->P0 || (rn && !red->P1)) rc = PHGMG_ERR_NOMEM;
   }
   if (rc == PHGMG_OK) {
-    for (j = 0; j < nd; ++j) {
-      const int cj = c->sys->sep_idx[pts[j]];
-      red->coord[j] = cj;
+    for (j = 0; j < nd; ++j) {   /* the rows c_k^T V0, c_k^T V2 of the kept terms */
+      const phgmg_ph_system *sys = c->sys;
+      red->coord[j] = sys->sep_idx[pts[j]];
       red->w[j] = wt[j];
-      for (a = 0; a < r; ++a) red->P0[j + (size_t)a * nd] = red->V0[cj + (size_t)a * N];
-      for (a = 0; a < rn; ++a) red->P1[j + (size_t)a * nd] = red->V2[cj + (size_t)a * N];
+      for (a = 0; a < r; ++a) red->P0[j + (size_t)a * nd] = phgmg__sep_arg(sys, pts[j], red->V0 + (size_t)a * N);
+      for (a = 0; a < rn; ++a) red->P1[j + (size_t)a * nd] = phgmg__sep_arg(sys, pts[j], red->V2 + (size_t)a * N);
     }
-    if (red->xbar && nd > 0) {   /* the kept terms' argument offsets */
+    if (red->xbar && nd > 0) {   /* the kept terms' argument offsets c_k^T xbar */
       red->refs = phgmg__red_d(red, (size_t)nd);
-      for (j = 0; red->refs && j < nd; ++j) red->refs[j] = red->xbar[red->coord[j]];
+      for (j = 0; red->refs && j < nd; ++j) red->refs[j] = phgmg__sep_arg(c->sys, pts[j], red->xbar);
       if (!red->refs) rc = PHGMG_ERR_NOMEM;
     }
     if (rc == PHGMG_OK) rc = phgmg__separable_functions(red, pts);
@@ -20296,7 +20521,7 @@ PHGMG__PRIV int phgmg__study_deim(phgmg_study *st, const phgmg_reduce_opts *o) {
   if (!st->deim_pts || !st->deim_w || !F) { phgmg__free(alloc, F); return 0; }
   for (i = 0; i < ns; ++i)
     for (a = 0; a < nt; ++a)
-      F[a + (size_t)i * nt] = phgmg__ph_phi(sys, a, st->X[sys->sep_idx[a] + (size_t)i * st->ldx], 1);
+      F[a + (size_t)i * nt] = phgmg__ph_phi(sys, a, phgmg__sep_arg(sys, a, st->X + (size_t)i * st->ldx), 1);
   rc = phgmg_deim_select(nt, ns, F, nt, sys->sep_w, o->hyper.deim_tol, o->hyper.deim_max, meth, st->deim_pts, st->deim_w,
                          &st->deim_nd, &st->deim_nneg, &st->deim_sigma, alloc);
   phgmg__free(alloc, F);
@@ -27971,6 +28196,12 @@ PHGMG_DEF phgmg_result phgmg_sym_eig(int n, double *A, int lda, double *w, doubl
             sparsely (per connected component of the algebraic block; the
             condensed model a SPARSE system owned by the object): no limit
             on the algebraic lines but memory (manual 1.8).
+          - New: springs in the SEPARABLE Hamiltonian, sum_k w_k
+            phi_k(x[i_k] - x[j_k]) (phgmg_ph_system.sep_jdx, appended at
+            the end of the struct; phgmg_ph_sparse_sep_jdx; the command
+            line's --poly-jdx): full model on dense, band and sparse storage,
+            every reduction, hyper-reduction, model files and export to C
+            (manual 1.9). Before, such terms needed a GENERAL part.
           - Changed: phgmg_reduce checks B's column rank for the GMG methods
             only: SP1 and SP2 take a port whose condensed column of B
             vanishes (it acts only through a constraint);
@@ -27995,8 +28226,13 @@ PHGMG_DEF phgmg_result phgmg_sym_eig(int n, double *A, int lda, double *w, doubl
             through a constraint is named by the GMG methods' refusal;
             validate --method bt|prbt|phbt; `info` names the reduced kind of
             nonlinear models.
+          - Changed: the distributed GMG-POD factors its basis in place (a
+            third less peak memory); memory per rank falls as 1/P.
           - Examples: examples/petsc_mumps.c, PETSc's MUMPS behind the
-            distributed solve callback (make test-petsc).
+            distributed solve callback (make test-petsc);
+            examples/phgmg_mpi_cli.c, `mpirun -np P build/phgmg-mpi reduce`
+            (GMG-POD and SP1 of linear COO models from the serial command's
+            files, each rank reading its rows; the same output files).
    0.7.0  (2026-11-28)
           - Changed: an index-one model in SPARSE storage (E with zero rows
             and columns) is simulated on its sparse pencil (manual 1.8): no

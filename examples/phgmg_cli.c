@@ -248,6 +248,12 @@ static const char *const help_lines[] = {
   "  --poly-idx FILE     a vector of the 0-based state coordinates idx_k of the terms\n",
   "                      (each in [0, N); any integer dtype, e.g. np.arange, or float64).\n",
   "  --poly-w FILE       a vector of the term weights w_k (default all 1).\n",
+  "  --poly-jdx FILE     springs: a vector of second coordinates j_k, one per entry of\n",
+  "                      --poly-idx; term k then acts on x[idx_k] - x[j_k] (a spring\n",
+  "                      between two nodes), or on x[idx_k] where j_k = -1. Each j_k in\n",
+  "                      [-1, N), j_k != idx_k; with --E rows idx_k and j_k of E unit\n",
+  "                      rows with E(idx_k, idx_k) = E(j_k, j_k); a sparse model's\n",
+  "                      springs within its band (give their linear part in Q).\n",
   "  --no-hyper          keep every nonlinear term online (exact, cost O(terms));\n",
   "                      --no-deim is the former name. Default: the hyper-reduction\n",
   "                      (--hyper) keeps a few weighted terms.\n",
@@ -1444,7 +1450,7 @@ static int explain_validate(phgmg_result rc, const mat *J, const mat *R, const m
 
 /* ---- reduce ------------------------------------------------------------------- */
 typedef struct reduce_args {
-  const char *J, *R, *B, *Q, *X, *poly, *poly_idx, *poly_w, *out, *name, *input, *method;
+  const char *J, *R, *B, *Q, *X, *poly, *poly_idx, *poly_w, *poly_jdx, *out, *name, *input, *method;
   const char *Jcoo, *Rcoo, *Qcoo; /* sparse J, R, Q as coordinate triplets */
   const char *E, *Ecoo;            /* descriptor models: the mass matrix, dense or sparse */
   const char *Pf, *Sf, *Nf;        /* feedthrough P, S, N */
@@ -1495,6 +1501,7 @@ static const input_opt input_opts[] = {
   IOPT("--S", Sf, OPTF_FILE, OPTF_SIMULATE), IOPT("--N", Nf, OPTF_FILE, OPTF_SIMULATE),
   IOPT("--dampers", dampf, OPTF_FILE, OPTF_SIMULATE), IOPT("--poly", poly, OPTF_FILE, OPTF_SIMULATE),
   IOPT("--poly-idx", poly_idx, OPTF_FILE, OPTF_SIMULATE), IOPT("--poly-w", poly_w, OPTF_FILE, OPTF_SIMULATE),
+  IOPT("--poly-jdx", poly_jdx, OPTF_FILE, OPTF_SIMULATE),
   IOPT("--exp", expf, OPTF_FILE, OPTF_SIMULATE), IOPT("--input", input, OPTF_KIND, OPTF_SIMULATE),
   IOPT("--x0", x0f, OPTF_FILE, OPTF_SIMULATE),
   IOPT("--ref", ref_file, OPTF_FILE, OPTF_SPECIAL),
@@ -1858,6 +1865,7 @@ static int check_model_opts(const char *cmd, const reduce_args *A) {
   if (!!(A->poly || A->expf || A->potential) != !!A->poly_idx)
     return usage_error("%s: --poly/--exp/--potential and --poly-idx go together", cmd);
   if (A->poly_w && !A->poly_idx) return usage_error("%s: --poly-w needs a nonlinear part (--poly-idx)", cmd);
+  if (A->poly_jdx && !A->poly_idx) return usage_error("%s: --poly-jdx needs a nonlinear part (--poly-idx)", cmd);
   if (A->potential) {
     double c[8];
     int d, ne;
@@ -2468,14 +2476,14 @@ typedef struct sweep_model {
 } sweep_model;
 
 typedef struct reduce_state {
-  mat J, R, B, Q, X, poly, pidx, pw, ex;
+  mat J, R, B, Q, X, poly, pidx, pw, ex, pjdx;
   sweep_model *models;    /* every (method, r) of the run, sweep_count of them */
   int nmodels;
   staged dirs;            /* the directories --out made (removed again if nothing is written) */
   staged sweep_sg;        /* NAME_sweep.json of a sweep */
   phgmg_study *study;     /* a sweep's shared bases (NULL: each model computes its own) */
   double t_sim;
-  int *idx;
+  int *idx, *jdx;         /* --poly-idx, --poly-jdx */
   double *fpoly, *fexp, named[8]; /* the family's coefficients as phgmg_ph_system wants them */
   double *Xsim, *Ysim, *V0;
   cli_csc cJ, cR, cQ, cE; /* sparse input (--J-coo ..., --E-coo) */
@@ -2555,6 +2563,33 @@ static int check_bounded_below(const reduce_args *A, const phgmg_ph_system *sys)
   return 0;
 }
 
+/* --poly-jdx: the springs' second coordinates (-1: a one-node term), checked
+   here with messages that name the file and entry; a sparse model's are
+   remapped to its internal order. 0, or 1 after a message. */
+static int load_springs(const reduce_args *A, reduce_state *S, phgmg_ph_system *sys, int nt) {
+  phgmg_result rc;
+  int k;
+  if (mat_load(&S->pjdx, "--poly-jdx", A->poly_jdx)) return 1;
+  if (!is_vector(&S->pjdx) || S->pjdx.rows * S->pjdx.cols != nt)
+    return fail("%s (--poly-jdx): expected a vector of %d coordinates (one per entry of %s), got %s", A->poly_jdx,
+                nt, A->poly_idx, shape_str(&S->pjdx));
+  S->jdx = (int *)malloc(sizeof(int) * (size_t)nt);
+  if (!S->jdx) return fail("out of memory");
+  for (k = 0; k < nt; ++k) {
+    const double v = S->pjdx.a[k];
+    if (!(v >= -1.0 && v < (double)sys->N && v == floor(v)) || (int)v == S->idx[k])
+      return fail("%s (--poly-jdx): entry %d is %g; expected an integer coordinate in [-1, %d) other than "
+                  "entry %d of %s (%d)", A->poly_jdx, k, v, sys->N, k, A->poly_idx, S->idx[k]);
+    S->jdx[k] = (int)v;
+  }
+  sys->sep_jdx = S->jdx;
+  if (S->sp && (rc = phgmg_ph_sparse_sep_jdx(S->sp, nt, S->jdx, NULL, sys)) != PHGMG_OK)
+    return fail("%s (--poly-jdx): %s%s", A->poly_jdx, phgmg_result_string(rc),
+                rc == PHGMG_ERR_SIZE ? " (a spring's two coordinates lie farther apart than the sparse model's band: "
+                                       "give the spring's linear stiffness in --Q so that the ordering keeps them close)" : "");
+  return 0;
+}
+
 /* The exp-polynomial family of the separable part from --potential, or
    --poly (vector: shared; (terms, d+1): per term) and --exp ((n_exp, 2):
    shared; (terms, 2 n_exp): per term), into sys (row-major per term). */
@@ -2607,10 +2642,10 @@ static void reduce_cleanup(reduce_state *S) {
   phgmg_balanced_cache_free(&S->bcache, NULL);
   mat_free(&S->J); mat_free(&S->R); mat_free(&S->B); mat_free(&S->Q); mat_free(&S->E); mat_free(&S->Pm); mat_free(&S->Sm); mat_free(&S->Nm); mat_free(&S->Dm); mat_free(&S->refm);
   free(S->di); free(S->dj); free(S->dlaw); mat_free(&S->X);
-  mat_free(&S->poly); mat_free(&S->pidx); mat_free(&S->pw); mat_free(&S->ex); mat_free(&S->in.tab);
+  mat_free(&S->poly); mat_free(&S->pidx); mat_free(&S->pjdx); mat_free(&S->pw); mat_free(&S->ex); mat_free(&S->in.tab);
   { int k; for (k = 0; k < 16; ++k) { mat_free(&S->tin[k].tab); mat_free(&S->Xs[k]); mat_free(&S->xinp[k].tab); } }
   free(S->Xcat);
-  free(S->idx); free(S->fpoly); free(S->fexp); free(S->Xsim); free(S->Ysim); free(S->V0);
+  free(S->idx); free(S->jdx); free(S->fpoly); free(S->fexp); free(S->Xsim); free(S->Ysim); free(S->V0);
   cli_csc_free(&S->cJ); cli_csc_free(&S->cR); cli_csc_free(&S->cQ); cli_csc_free(&S->cE);
   phgmg_ph_sparse_destroy(S->sp); free(S->Xperm); free(S->Uord);
   phgmg_dae_destroy(S->dae); free(S->Xres);
@@ -3253,6 +3288,7 @@ static int load_system(const reduce_args *A, reduce_state *S) {
     if (S->sp && (rc = phgmg_ph_sparse_sep_idx(S->sp, nt, S->idx, NULL, &sys)) != PHGMG_OK)
       return fail("%s (--poly-idx): %s", A->poly_idx, phgmg_result_string(rc));
     sys.sep_w = A->poly_w ? S->pw.a : NULL;
+    if (A->poly_jdx && load_springs(A, S, &sys, nt)) return 1;
     if (load_family(A, S, &sys, nt) || check_bounded_below(A, &sys)) return 1;
     progress("nonlinear part: %d terms, %s, polynomial degree %d, %d exponentials%s", nt,
              A->potential ? A->potential : "exp-polynomial", sys.poly_deg, sys.nexp,
@@ -4088,6 +4124,7 @@ static int write_json(const reduce_args *A, reduce_state *S, int method, int ns,
     if (A->potential) { fprintf(jf, ", \"potential\": "); json_str(jf, A->potential); }
     fprintf(jf, ", \"poly_idx\": "); json_str(jf, A->poly_idx);
     if (A->poly_w) { fprintf(jf, ", \"poly_w\": "); json_str(jf, A->poly_w); }
+    if (A->poly_jdx) { fprintf(jf, ", \"poly_jdx\": "); json_str(jf, A->poly_jdx); }
   }
   if (S->bal_on) {   /* balancing: no snapshots, its own info */
     fprintf(jf, "},\n  \"snapshots\": {\"count\": 0},\n  \"info\": ");

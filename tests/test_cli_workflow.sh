@@ -23,6 +23,7 @@
 # 7. subnormal entries flushed in the written model; --dt-map's note; the
 #    record's kind and map.
 # 8. a progress line before a large model's set-up (ordering, checks).
+# 9. springs (--poly-jdx) against the same chain in relative coordinates.
 # Needs NumPy/SciPy (/usr/bin/python3) to write the inputs (skipped otherwise).
 set -u
 P=${1:-build/phgmg}
@@ -324,6 +325,48 @@ PYEOF
   && pass || bad "simulate N = 20000: $(tail -n 2 err.txt)"
 grep -q "ordering the sparse system (N = 20000)" err.txt && grep -q "checking the system (N = 20000)" err.txt && pass \
   || bad "no progress line before a large model's set-up: $(cat err.txt)"
+
+# 9. springs (--poly-jdx): a chain with cosh springs between neighbouring
+#    positions, phi(q_k - q_{k-1}) (node 0 to the wall: j = -1), against the
+#    same model in relative coordinates l = D q (NumPy: T = blockdiag(D, I),
+#    J~ = T J T^T, R~ = T R T^T, Q~ = T^-T Q T^-1, B~ = T B), where every
+#    term acts on one coordinate l_k (--poly-idx alone). The outputs are
+#    invariant and GL3 is covariant under linear maps, so both runs give
+#    the same y up to the Newton tolerance (1e-13 absolute here): 1e-10
+#    relative asserted. reduce takes the springs (hyper-reduced, rom.c
+#    written, poly_jdx recorded); a bad entry is refused naming the file.
+"$PY" - <<'PYEOF' || bad "writing the spring chain"
+import numpy as np
+n = 12
+D = np.eye(n) - np.eye(n, k=-1)                   # l = D q, l_0 = q_0 (the wall)
+Z, I = np.zeros((n, n)), np.eye(n)
+J = np.block([[Z, I], [-I, Z]])
+R = np.block([[Z, Z], [Z, 0.05 * I]])
+Q = np.block([[0.5 * D.T @ D, Z], [Z, I]])
+B = np.zeros(2 * n); B[n] = 1.0
+T = np.block([[D, Z], [Z, I]])
+Ti = np.linalg.inv(T)
+for k, v in dict(Js=J, Rs=R, Qs=Q, Bs=B, Jl=T @ J @ T.T, Rl=T @ R @ T.T, Ql=Ti.T @ Q @ Ti, Bl=T @ B).items():
+    np.save(k + ".npy", v)
+np.save("sidx.npy", np.arange(n)); np.save("sjdx.npy", np.arange(n) - 1)
+np.save("sjbad.npy", np.where(np.arange(n) == 5, 5, np.arange(n) - 1))
+PYEOF
+SPR="--potential cosh:1 --poly-idx sidx.npy --input sin --amp 1.5 --dt 0.05 --steps 200 --newton-tol 1e-13"
+"$P" simulate --J Js.npy --R Rs.npy --Q Qs.npy --B Bs.npy $SPR --poly-jdx sjdx.npy --out ys.npy >/dev/null 2>err.txt \
+  && pass || bad "simulate with --poly-jdx: $(tail -n 2 err.txt)"
+"$P" simulate --J Jl.npy --R Rl.npy --Q Ql.npy --B Bl.npy $SPR --out yl.npy >/dev/null 2>err.txt \
+  && pass || bad "simulate in relative coordinates: $(tail -n 2 err.txt)"
+"$PY" -c "
+import numpy as np, sys
+a, b = np.load('ys.npy'), np.load('yl.npy')
+sys.exit(0 if a.shape == b.shape and np.abs(b).max() > 0.5 and np.abs(a - b).max() <= 1e-10 * np.abs(b).max() else 1)" \
+  && pass || bad "springs (--poly-jdx) against the same chain in relative coordinates"
+"$P" reduce --J Js.npy --R Rs.npy --Q Qs.npy --B Bs.npy --potential cosh:1 --poly-idx sidx.npy --poly-jdx sjdx.npy \
+  --simulate --steps 200 --dt 0.05 --amp 1.5 --method gmg-pod --r 8 --out spr >/dev/null 2>err.txt \
+  && [ -s spr/rom.c ] && grep -q '"poly_jdx"' spr/rom.json && pass || bad "reduce with --poly-jdx: $(tail -n 2 err.txt)"
+"$P" simulate --J Js.npy --R Rs.npy --Q Qs.npy --B Bs.npy $SPR --poly-jdx sjbad.npy --out yb2.npy >/dev/null 2>err.txt
+[ $? -eq 1 ] && grep -q "sjbad.npy (--poly-jdx): entry 5" err.txt && [ ! -e yb2.npy ] && pass \
+  || bad "a spring from a node to itself not refused by name: $(tail -n 2 err.txt)"
 
 echo "test_cli_workflow: $npass passed, $nfail failed"
 [ "$nfail" -eq 0 ]

@@ -44,3 +44,4 @@
 #include "test_pod_stream.c"
 #include "test_dae_sparse_reduce.c"
 #include "test_balanced2.c"
+#include "test_springs.c"

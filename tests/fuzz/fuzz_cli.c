@@ -108,6 +108,10 @@ static void restore(void) {
   put_npy("J.npy", J4, 4, 4); put_npy("R.npy", R4, 4, 4); put_npy("Q.npy", Q4, 4, 4);
   put_npy("B.npy", B4, 4, 1); put_npy("X.npy", X, 4, 8); put_npy("poly.npy", poly, 5, 1);
   put_npy("idx.npy", idx, 2, 1); put_npy("u.npy", X, 8, 1);
+  {   /* --poly-jdx: the second term a spring to the first term's coordinate */
+    const double jdx[2] = {-1.0, idx[0]};
+    put_npy("jdx.npy", jdx, 2, 1);
+  }
   put_bytes("idx_i8.npy", int_idx, sizeof int_idx - 1);
   {   /* J, R, Q as (nnz, 3) coordinate triplets; one exponential pair (a, b) */
     double C[3 * 16], e2[2] = {1.0, 1.0};
@@ -176,6 +180,8 @@ static void init(void) {
   static const char *const words6[] = {"--freq", "--freq-end", "--x0", "chirp", "gmg-pod,sp1", "4,6", "4,,6",
                                        "2,3,2", NULL};   /* after words5 */
   static const char *const words7[] = {"--stream", "bt", "prbt", "phbt", "bt,sp1", NULL};   /* after words6 */
+  static const char *const words8[] = {"--poly-jdx", NULL};   /* after words7 */
+  static const char *const files8[] = {"jdx.npy", NULL};
   char *argv[24];
   int k, fb, argc = 0;   /* fb: the token of files[0] */
   FILE *f;
@@ -195,6 +201,8 @@ static void init(void) {
   for (k = 0; words5[k]; ++k) strcpy(g_tok[g_ntok++], words5[k]);
   for (k = 0; words6[k]; ++k) strcpy(g_tok[g_ntok++], words6[k]);
   for (k = 0; words7[k]; ++k) strcpy(g_tok[g_ntok++], words7[k]);
+  for (k = 0; words8[k]; ++k) strcpy(g_tok[g_ntok++], words8[k]);
+  for (k = 0; files8[k]; ++k) snprintf(g_tok[g_ntok++], sizeof g_tok[0], "%s/%s", g_dir, files8[k]);
   /* the model file, made once by the CLI itself */
   restore();
   argv[argc++] = (char *)"phgmg"; argv[argc++] = (char *)"reduce";
