@@ -6,9 +6,9 @@
    and 3 uneven blocks, P = 4 with rank 2 owning no rows. Exit status 0 iff
    every check passed on every rank. Built with mpicc (make test-mpi). */
 #define PHGMG_MPI
-#define PHGMG_STATIC
 #define PHGMG_IMPLEMENTATION
 #include "../../phgmg.h"
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -349,7 +349,7 @@ static void test_pod(void) {
     double fro = 0.0;
     int j0, k1 = 0, k2 = 0, kexp = 0, ld = c->nloc > 0 ? c->nloc : 1;
     for (i = 0; i < ns; ++i) fro += sig[i] * sig[i];
-    for (i = 0; i < ns; ++i) kexp += sig[i] > (double)N * PHGMG__EPS * sqrt(fro);
+    for (i = 0; i < ns; ++i) kexp += sig[i] > (double)N * DBL_EPSILON * sqrt(fro);
     CHECK(phgmg_mpi_pod_stream_begin(&st, c, ns, 0.0) == PHGMG_OK, "stream begin");
     CHECK(phgmg_mpi_pod_stream_begin(&st2, c, r, 0.0) == PHGMG_OK, "stream begin");
     for (j0 = 0; j0 < ns; j0 += 7) {

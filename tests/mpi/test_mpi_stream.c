@@ -5,7 +5,6 @@
    POD, Cholesky-QR and V^T A V do not depend on N. Exit status 0 iff every
    check passed on every rank. Built with mpicc (make test-mpi). */
 #define PHGMG_MPI
-#define PHGMG_STATIC
 #define PHGMG_IMPLEMENTATION
 #include "../../phgmg.h"
 #include <math.h>
