@@ -2299,7 +2299,7 @@
    reduce: phgmg_pod, phgmg_pod_randomized, phgmg_adjust_snapshots,
            phgmg_runs_columns, phgmg_simulate_inputs, phgmg_simulate_run,
            phgmg_reduce_opts_default, phgmg_reduce, phgmg_reduced_destroy,
-           phgmg_reduced_rom, phgmg_reduced_N, phgmg_reduced_lift,
+           phgmg_reduced_rom, phgmg_reduced_N, phgmg_reduced_qm, phgmg_reduced_lift,
            phgmg_reduced_restrict, phgmg_reduced_dphi, phgmg_reduced_W,
            phgmg_reduced_simulate, phgmg_reduced_simulate_run,
            phgmg_reduced_validate, phgmg_reduced_validate_many, phgmg_rel_error,
@@ -2338,7 +2338,7 @@
            phgmg_lu_rcond, phgmg_norm1, phgmg_normf, phgmg_zlu_factor,
            phgmg_zlu_solve, phgmg_qr, phgmg_qrcp, phgmg_qr_form_q,
            phgmg_qr_apply, phgmg_lstsq, phgmg_svd, phgmg_sym_eig
-   (175 functions; 23 of them only with PHGMG_MPI; also the macros
+   (176 functions; 23 of them only with PHGMG_MPI; also the macros
    PHGMG_ROM_STEPPER_MEMSIZE_MAX and _MAX_CB.)
 */
 #ifndef PHGMG_H_INCLUDED
@@ -3815,6 +3815,15 @@ PHGMG_DEF void phgmg_reduced_destroy(phgmg_reduced *red);
 PHGMG_DEF const phgmg_rom *phgmg_reduced_rom(const phgmg_reduced *red);
 /* The full-order dimension N the model was reduced from (0 for NULL). */
 PHGMG_DEF int phgmg_reduced_N(const phgmg_reduced *red);
+/* The quadratic manifold of a GMG-QM model (kind PHGMG_ROM_QUADRATIC):
+   phi(xr) = V0 xr + V2 q(x2) (+ the reference state), x2 = xr[m .. r-1]
+   (p = r - m coordinates), with the built-in quadratic features
+   q_i = sum_{a, j < p} M[i + (a p + j) rn] x2[a] x2[j]. *V2: N x rn, ld N,
+   in the state order of the system reduced (as phgmg_reduced_lift); *M:
+   rn x p^2, ld rn (NULL with features of your own: GMG_MANIFOLD). Views
+   valid until destroy. Returns rn; 0 (both views NULL) for any other model
+   or a NULL red. Either pointer may be NULL. */
+PHGMG_DEF int phgmg_reduced_qm(const phgmg_reduced *red, const double **V2, const double **M);
 /* Reconstruction x = phi(xr) (N). */
 PHGMG_DEF void phgmg_reduced_lift(const phgmg_reduced *red, const double *xr, double *x);
 /* Point reduction xr = rho(x) (r); rho(phi(xr)) = xr. */
@@ -14982,6 +14991,12 @@ PHGMG_DEF void phgmg_reduced_destroy(phgmg_reduced *red) {
 
 PHGMG_DEF const phgmg_rom *phgmg_reduced_rom(const phgmg_reduced *red) { return red ? &red->rom : NULL; }
 PHGMG_DEF int phgmg_reduced_N(const phgmg_reduced *red) { return red ? red->N : 0; }
+PHGMG_DEF int phgmg_reduced_qm(const phgmg_reduced *red, const double **V2, const double **M) {
+  const int q = red && red->kind == PHGMG_ROM_QUADRATIC;
+  if (V2) *V2 = q ? red->V2 : NULL;
+  if (M) *M = q && !red->eta ? red->M : NULL;
+  return q ? red->rn : 0;
+}
 
 /* >>pod (implementation) ================================================== */
 /* C (m x n) = A^T B with A: k x m, B: k x n (column-major, tight). */
@@ -28226,6 +28241,7 @@ PHGMG_DEF phgmg_result phgmg_sym_eig(int n, double *A, int lda, double *w, doubl
             through a constraint is named by the GMG methods' refusal;
             validate --method bt|prbt|phbt; `info` names the reduced kind of
             nonlinear models.
+          - New: phgmg_reduced_qm (the quadratic manifold's V2 and M).
           - Changed: the distributed GMG-POD factors its basis in place (a
             third less peak memory); memory per rank falls as 1/P.
           - Examples: examples/petsc_mumps.c, PETSc's MUMPS behind the

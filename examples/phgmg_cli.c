@@ -16,6 +16,8 @@
 #define _POSIX_C_SOURCE 200809L
 #define PHGMG_IMPLEMENTATION
 #include "../phgmg.h"
+#define CLI_MAX(a, b) ((a) > (b) ? (a) : (b))
+#define CLI_MIN(a, b) ((a) < (b) ? (a) : (b))
 #include <ctype.h>
 #include <errno.h>
 #include <fcntl.h>
@@ -2861,7 +2863,7 @@ static int check_x_inputs(const reduce_args *A, reduce_state *S, int N, int m) {
   go.tol = A->newton_tol; go.max_iter = A->newton_iter;
   for (k = 0; k < A->nx && !rc; ++k) {
     const phgmg_run *run = &S->runs[k];
-    const int n = PHGMG__MIN(X_CHECK_STEPS, run->nsteps);
+    const int n = CLI_MIN(X_CHECK_STEPS, run->nsteps);
     const double *X = run->x0;
     double num = 0.0, den = 0.0, x0n = 0.0;
     phgmg_result r = phgmg_simulate(&S->sys, X, 0.0, A->dt, n, input_fn, run->user, &go, W, W + (size_t)N * (n + 1),
@@ -2871,16 +2873,16 @@ static int check_x_inputs(const reduce_args *A, reduce_state *S, int N, int m) {
                 A->xs[k], A->xin[k], phgmg_result_string(r));
       break;
     }
-    for (i = 0; i < N; ++i) x0n = PHGMG__MAX(x0n, fabs(X[i]));
+    for (i = 0; i < N; ++i) x0n = CLI_MAX(x0n, fabs(X[i]));
     for (j = 1; j <= n; ++j) {
       double dn = 0.0, dd = 0.0;
       for (i = 0; i < N; ++i) {
         const double xs = X[i + (size_t)j * N];
-        dn = PHGMG__MAX(dn, fabs(W[i + (size_t)j * N] - xs));
-        dd = PHGMG__MAX(dd, fabs(xs - X[i]));
+        dn = CLI_MAX(dn, fabs(W[i + (size_t)j * N] - xs));
+        dd = CLI_MAX(dd, fabs(xs - X[i]));
       }
-      num = PHGMG__MAX(num, dn);
-      den = PHGMG__MAX(den, dd);
+      num = CLI_MAX(num, dn);
+      den = CLI_MAX(den, dd);
     }
     if (den == 0.0) den = x0n > 0.0 ? x0n : DBL_MIN;
     progress("--X-input check: %s from its first snapshot with %s: %d steps reproduced to %.2g (relative to the "
@@ -3092,7 +3094,7 @@ static int explain_feedthrough(const reduce_args *A, const reduce_state *S, phgm
     int i;
     if (A->Sf && m <= 64) {
       for (i = 0; i < m * m; ++i) c[i] = S->Sm.a[i];
-      if (phgmg_sym_eig(m, c, m, w, NULL, 0) == PHGMG_OK && w[0] < -1e-12 * PHGMG__MAX(fabs(w[0]), fabs(w[m - 1]))) {
+      if (phgmg_sym_eig(m, c, m, w, NULL, 0) == PHGMG_OK && w[0] < -1e-12 * CLI_MAX(fabs(w[0]), fabs(w[m - 1]))) {
         snprintf(why, sizeof why, "S is not positive semidefinite (smallest eigenvalue %.3g)", w[0]);
         return fail("%s (%s): the feedthrough is not valid: %s", files, opts, why);
       }
@@ -3359,7 +3361,7 @@ static double max_abs_entry(const mat *M, const cli_csc *C) {
   double v = 0.0;
   size_t k, n = M->a ? (size_t)M->rows * (size_t)M->cols : C->cp ? (size_t)C->cp[C->A.n_cols] : 0;
   const double *a = M->a ? M->a : C->v;
-  for (k = 0; k < n; ++k) v = PHGMG__MAX(v, fabs(a[k]));
+  for (k = 0; k < n; ++k) v = CLI_MAX(v, fabs(a[k]));
   return v;
 }
 
@@ -3371,7 +3373,7 @@ static double max_abs_entry(const mat *M, const cli_csc *C) {
    t = n dt must stay in the double range. 0, or 1 after a message. */
 #define DT_SCALE_MAX (1.0 / DBL_EPSILON)
 static int check_dt_scale(const reduce_args *A, const reduce_state *S) {
-  const double jr = PHGMG__MAX(max_abs_entry(&S->J, &S->cJ), max_abs_entry(&S->R, &S->cR));
+  const double jr = CLI_MAX(max_abs_entry(&S->J, &S->cJ), max_abs_entry(&S->R, &S->cR));
   const double q = max_abs_entry(&S->Q, &S->cQ);
   const double e = (A->E || A->Ecoo) ? max_abs_entry(&S->E, &S->cE) : 1.0;
   const double scale = e > 0.0 ? jr * q / e : 0.0;
@@ -3421,7 +3423,7 @@ static int all_zero(const double *a, size_t n) {
 static double max_abs_n(const double *a, size_t n) {
   double v = 0.0;
   size_t k;
-  for (k = 0; k < n; ++k) v = PHGMG__MAX(v, fabs(a[k]));
+  for (k = 0; k < n; ++k) v = CLI_MAX(v, fabs(a[k]));
   return v;
 }
 
@@ -3568,9 +3570,9 @@ static int default_rn(int N, int r, int m) {
   phgmg_reduce_opts def;
   int rn;
   phgmg_reduce_opts_default(&def);
-  rn = PHGMG__MIN(def.qm.rn, N - r);
-  if (r > m) rn = PHGMG__MIN(rn, 4096 / (r - m));
-  return PHGMG__MAX(rn, 1);
+  rn = CLI_MIN(def.qm.rn, N - r);
+  if (r > m) rn = CLI_MIN(rn, 4096 / (r - m));
+  return CLI_MAX(rn, 1);
 }
 
 /* The spectral radius of the step map Phi (r x r), from above:
@@ -3587,7 +3589,7 @@ static double step_map_radius(const phgmg_rom *rom) {
   for (i = 0; i < r * r; ++i) A[i] = (double)rom->Phi[i];
   for (it = 0; it <= 30; ++it) {
     double f = 0.0;
-    for (s = 0.0, i = 0; i < r * r; ++i) s = PHGMG__MAX(s, fabs(A[i])); /* scale first: no overflow in the norm */
+    for (s = 0.0, i = 0; i < r * r; ++i) s = CLI_MAX(s, fabs(A[i])); /* scale first: no overflow in the norm */
     if (!isfinite(s)) { free(A); return INFINITY; }
     if (s == 0.0) { free(A); return 0.0; }
     for (i = 0; i < r * r; ++i) { A[i] /= s; f += A[i] * A[i]; }
@@ -3674,7 +3676,7 @@ static int stream_run(const reduce_args *A, reduce_state *S, cli_input *in, cons
 /* The largest order of the run's --r list. */
 static int max_order(const reduce_args *A) {
   int k, r = A->r;
-  for (k = 0; k < A->nrl; ++k) r = PHGMG__MAX(r, A->rlist[k]);
+  for (k = 0; k < A->nrl; ++k) r = CLI_MAX(r, A->rlist[k]);
   return r;
 }
 
@@ -3683,10 +3685,10 @@ static int max_order(const reduce_args *A) {
    block of *nb columns. */
 static int stream_begin(const reduce_args *A, const reduce_state *S, double **blk, int *nb) {
   const int N = S->sys.N, m = S->sys.m, gmg = S->method == PHGMG_METHOD_GMG_POD, rmax = max_order(A);
-  const int p = gmg ? rmax - m : rmax, kmax = PHGMG__MIN(N - (gmg ? m : 0), PHGMG__MAX(2 * (p + 1), p + 41));
+  const int p = gmg ? rmax - m : rmax, kmax = CLI_MIN(N - (gmg ? m : 0), CLI_MAX(2 * (p + 1), p + 41));
   phgmg_result rc = phgmg_pod_stream_begin(&g_stream, N, gmg ? m : 0, gmg ? S->sys.B : NULL, N, kmax, 0.0, NULL);
   if (rc != PHGMG_OK) return fail("streamed POD: %s", phgmg_result_string(rc));
-  *nb = PHGMG__MAX(16, PHGMG__MIN(64, kmax));
+  *nb = CLI_MAX(16, CLI_MIN(64, kmax));
   if (!(*blk = (double *)malloc(sizeof(double) * (size_t)N * (size_t)*nb))) return fail("out of memory");
   return 0;
 }
@@ -3737,14 +3739,14 @@ static int stream_x_files(const reduce_args *A, reduce_state *S, int *nso) {
     }
     progress("streaming %s: %d snapshots in blocks of %d", A->xs[f], cols, nb);
     for (j = 0; j < cols && rc == PHGMG_OK; j += nb) {
-      const int c = PHGMG__MIN(nb, cols - j);
+      const int c = CLI_MIN(nb, cols - j);
       rc = phgmg_npy_read_cols(A->xs[f], j, c, blk, N, NULL, NULL);
       if (rc == PHGMG_OK && S->sp) phgmg_ph_sparse_to_banded_order(S->sp, c, blk, N, perm, N);
       if (rc == PHGMG_OK) rc = phgmg_pod_stream_add(g_stream, c, S->sp ? perm : blk, N);
     }
   }
   free(perm);
-  if (rc != PHGMG_OK) { free(blk); return fail("%s (--X): %s", A->xs[PHGMG__MIN(f, A->nx - 1)], phgmg_result_string(rc)); }
+  if (rc != PHGMG_OK) { free(blk); return fail("%s (--X): %s", A->xs[CLI_MIN(f, A->nx - 1)], phgmg_result_string(rc)); }
   return stream_finish(S, blk, 0, nso);
 }
 
@@ -3955,12 +3957,13 @@ static int write_arrays(const reduce_args *A, reduce_state *S, const double *X, 
     if (write_user_field(A, S, "V0", S->V0, rom->r, ol)) return 1;
   }
   if (rom->kind == PHGMG_ROM_QUADRATIC) {
-    /* V2 and M of the quadratic map. phgmg.h has no public accessor for them
-       yet; this program compiles the implementation, so it reads them from the
-       reduced object directly. */
+    /* V2 and M of the quadratic map */
     const int p = rom->r - rom->m;
-    if (write_user_field(A, S, "V2", S->red->V2, rom->rn, ol)) return 1;
-    if (write_field(A->out, A->name, "M", S->red->M, rom->rn, p * p, ol, &S->sg)) return 1;
+    const double *V2 = NULL, *M = NULL;
+    phgmg_reduced_qm(S->red, &V2, &M);
+    if (!V2 || !M) return fail("the quadratic manifold's arrays are not available");
+    if (write_user_field(A, S, "V2", V2, rom->rn, ol)) return 1;
+    if (write_field(A->out, A->name, "M", M, rom->rn, p * p, ol, &S->sg)) return 1;
   }
   if (A->save_snap) {
     double *Y = S->Ysim;
@@ -4470,13 +4473,13 @@ static void sweep_study(const reduce_args *A, reduce_state *S, const double *X, 
     if (mc == PHGMG_METHOD_GMG_POD || (mc == PHGMG_METHOD_GMG_QM && A->rn != PHGMG_RN_WIDE)) {
       const int rn = mc == PHGMG_METHOD_GMG_QM ? (A->rn ? A->rn : default_rn(N, r, m)) : 0;
       what |= PHGMG_STUDY_GMG;
-      kmax = PHGMG__MAX(kmax, r - m + rn);
+      kmax = CLI_MAX(kmax, r - m + rn);
     } else if (mc == PHGMG_METHOD_SP1 || mc == PHGMG_METHOD_SP2) {
       what |= mc == PHGMG_METHOD_SP2 ? PHGMG_STUDY_SP2 : PHGMG_STUDY_SP;
-      kmax = PHGMG__MAX(kmax, r);
+      kmax = CLI_MAX(kmax, r);
     }
   }
-  kmax = PHGMG__MIN(kmax + 1, PHGMG__MIN(N, ns));   /* one mode more: sigma_{r'+1} for the log */
+  kmax = CLI_MIN(kmax + 1, CLI_MIN(N, ns));   /* one mode more: sigma_{r'+1} for the log */
   if (!what || kmax < 1) return;
   memset(&so, 0, sizeof so);
   so.what = what; so.kmax = kmax;
