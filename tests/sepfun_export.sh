@@ -10,7 +10,11 @@ CXX=${CXX:-c++}
 D="$B/sepfun_export"
 mkdir -p "$D"
 W="-Wall -Wextra -Werror"
-$CC -std=c99 $W -pedantic -O1 -o "$D/gen" tests/sepfun_export.c -lm
+if [ -f "$B/phgmg_impl.o" ]; then   # the implementation compiled once by the Makefile
+  $CC -std=c99 $W -pedantic -O1 -DPHGMG_IMPLEMENTATION_ELSEWHERE -o "$D/gen" tests/sepfun_export.c "$B/phgmg_impl.o" -lm
+else
+  $CC -std=c99 $W -pedantic -O1 -o "$D/gen" tests/sepfun_export.c -lm
+fi
 "$D/gen" "$D"
 for m in sfx_poly sfx_cb sfx_eta sfx_lin; do
   $CC -std=c99 $W -pedantic -O1 -DPHGMG_NO_OFFLINE -DMODEL_HEADER="\"$m.h\"" -DMODEL_NAME=$m -I"$D" \
