@@ -277,11 +277,6 @@ $(BUILD)/%: examples/%.c phgmg.h $(EXHDRS) $(BUILD)/phgmg_impl.o
 	@mkdir -p $(BUILD)
 	$(CC) $(OPTFLAGS) -DPHGMG_IMPLEMENTATION_ELSEWHERE -o $@ $< $(BUILD)/phgmg_impl.o $(LDLIBS)
 
-# linear_bases.c calls one of the implementation's private helpers: one file.
-$(BUILD)/linear_bases: examples/linear_bases.c phgmg.h $(EXHDRS)
-	@mkdir -p $(BUILD)
-	$(CC) $(OPTFLAGS) -o $@ $< $(LDLIBS)
-
 # Reproduce Section 5 of the paper: tables on the terminal, CSVs and SVG figures in results/;
 # then the non-polynomial Morse-chain example, the transport example and their checks.
 demo: $(EXAMPLES)

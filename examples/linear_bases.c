@@ -32,6 +32,29 @@
 #include "msd_models.h"
 #include "demo_common.h"
 
+/* Largest singular value of the p x m complex matrix E (interleaved re, im,
+   column-major; m <= 16): the square root of the largest eigenvalue of the
+   real 2m x 2m form of E^H E. */
+static double zsigma_max(int p, int m, const double *E) {
+  double H[2 * 16 * 2 * 16], w[32];
+  int i, j, k;
+  if (m > 16) return (double)NAN;
+  for (i = 0; i < m; ++i)
+    for (j = 0; j < m; ++j) {
+      double re = 0.0, im = 0.0;   /* (E^H E)_ij = sum_k conj(E_ki) E_kj */
+      for (k = 0; k < p; ++k) {
+        const double ar = E[2 * (k + (size_t)i * p)], ai = E[2 * (k + (size_t)i * p) + 1];
+        const double br = E[2 * (k + (size_t)j * p)], bi = E[2 * (k + (size_t)j * p) + 1];
+        re += ar * br + ai * bi;
+        im += ar * bi - ai * br;
+      }
+      H[i + j * 2 * m] = re; H[(i + m) + (j + m) * 2 * m] = re;
+      H[(i + m) + j * 2 * m] = im; H[i + (j + m) * 2 * m] = -im;
+    }
+  if (phgmg_sym_eig(2 * m, H, 2 * m, w, NULL, 0) != PHGMG_OK) return (double)NAN;
+  return sqrt(w[2 * m - 1] > 0.0 ? w[2 * m - 1] : 0.0);
+}
+
 #define NIN 6
 #define NMETH 8
 #define RMAX 20
@@ -315,12 +338,12 @@ static void bode(const study *S, const char *path) {
       lw[k] = -2.0 + 3.5 * k / (nw - 1);
       if (j < 0) {
         phgmg_ss_transfer(N, m, m, S->A, S->sys->B, S->C, pow(10.0, lw[k]), Gf + 8 * k, NULL);
-        sg[k] = phgmg__zsigma_max(m, m, Gf + 8 * k);
+        sg[k] = zsigma_max(m, m, Gf + 8 * k);
       } else {
         phgmg_ss_transfer(r, m, m, Ar, Br, Cr, pow(10.0, lw[k]), G, NULL);
-        sg[k] = phgmg__zsigma_max(m, m, G);
+        sg[k] = zsigma_max(m, m, G);
         for (q = 0; q < 8; ++q) G[q] = Gf[8 * k + q] - G[q];
-        se[k] = phgmg__zsigma_max(m, m, G);
+        se[k] = zsigma_max(m, m, G);
       }
     }
     svgplot_series(fig, 0, j < 0 ? "full model" : meth_name[j], nw, lw, sg, j + 1);
@@ -390,7 +413,7 @@ int main(int argc, char **argv) {
       int k;
       for (k = 0; k < 400; ++k) {
         phgmg_ss_transfer(sys->N, sys->m, sys->m, S.A, sys->B, S.C, pow(10.0, -3.0 + 5.0 * k / 399.0), Gf + 8 * k, NULL);
-        hr = fmax(hr, phgmg__zsigma_max(sys->m, sys->m, Gf + 8 * k));
+        hr = fmax(hr, zsigma_max(sys->m, sys->m, Gf + 8 * k));
       }
       for (r = 12; r <= RMAX; r += 4)
         for (j = 0; j < NMETH; ++j) {
@@ -400,7 +423,7 @@ int main(int argc, char **argv) {
           for (k = 0; k < 400; ++k) {
             phgmg_ss_transfer(r, sys->m, sys->m, Ar, Br, Cr, pow(10.0, -3.0 + 5.0 * k / 399.0), G, NULL);
             for (q = 0; q < 8; ++q) G[q] = Gf[8 * k + q] - G[q];
-            hi = fmax(hi, phgmg__zsigma_max(sys->m, sys->m, G));
+            hi = fmax(hi, zsigma_max(sys->m, sys->m, G));
           }
           phgmg_ss_error(sys->N, S.A, sys->B, S.C, r, Ar, Br, Cr, sys->m, sys->m, 1, 1.0, 1.0, NULL, NULL, &h2,
                          &h2r, NULL);
