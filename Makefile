@@ -60,9 +60,10 @@ SYNC = $(if $(filter output-sync,$(.FEATURES)),--output-sync=target,)
 # The unit suites run once, under ASan + UBSan at -O1 with the warning flags
 # (the plain runner, `make test-plain`, runs the same tests without the
 # sanitizers; it is the quick one during development).
+# The runs go longest first, so that both cores stay busy to the end.
 test: test-build
-	$(MAKE) -j2 $(SYNC) test-asan test-cli test-fuzz-replay test-embedded-host test-demo compile-checks \
-	  test-validate test-npy test-hello docs-check test-mpi
+	$(MAKE) -j2 $(SYNC) test-asan test-mpi test-demo test-cli test-embedded-host compile-checks \
+	  test-fuzz-replay docs-check test-validate test-npy test-hello
 
 
 # Everything make test compiles, built first on both cores (the compiles are
