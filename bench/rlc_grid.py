@@ -31,6 +31,7 @@ per port, sampled at dt/16 up to steps dt) and with --dense the dense
 matrices Jd.npy, Rd.npy, Qd.npy, Ed.npy. Prints N and the algebraic count."""
 import sys
 
+import os
 import numpy as np
 import scipy.sparse as sps
 
@@ -87,6 +88,7 @@ def main_(argv):
         Pr = sps.csr_matrix((np.ones(N), (np.arange(N), pr)), shape=(N, N))   # (Pr x)_i = x[pr[i]]
         Pc = sps.csr_matrix((np.ones(N), (pc, np.arange(N))), shape=(N, N))
         J, R, Q, E, B = Pr @ J @ Pr.T, Pr @ R @ Pr.T, Pr @ Q @ Pc, Pr @ E @ Pc, Pr @ B
+    os.makedirs(d, exist_ok=True)
     for name, M in (("J", J), ("R", R), ("Q", Q), ("E", E)):
         save_coo("%s/%s.npy" % (d, name), M)
         if "--dense" in argv:
