@@ -16382,7 +16382,7 @@ PHGMG_DEF phgmg_result phgmg_ecsw_separable(int nterms, int ns, const double *F,
   *nd_out = 0;
   if (resid_out) *resid_out = 0.0;
   rc = phgmg_svd(nt, ns, F, ldf, kk, S, U, nt, NULL, 1, &ks, &rank, alloc);
-  for (pass = 0; rc == PHGMG_OK && pass < 2 && tn > 0.0; ++pass) {
+  for (pass = 0; (rc == PHGMG_OK || (pass == 1 && rc == PHGMG_ERR_NOT_CONVERGED)) && pass < 2 && tn > 0.0; ++pass) {
     /* pass 0: modes with sigma_j > 1e-3 tol sigma_1; pass 1 (if tol missed): all */
     for (q = 0; q < ks && (pass == 1 || S[q] > 1e-3 * tol * S[0]); ++q) {}
     if (q < 1) q = 1;
@@ -25484,13 +25484,18 @@ PHGMG__PRIV phgmg_result phgmg__mpi_nnls_solve(phgmg__mpi_nnls *s, const phgmg_g
                                                const phgmg_allocator *al) {
   int it, j, q;
   for (it = 0; it < 3 * s->cap + 3; ++it) {
-    double alpha = 1.0;
+    double alpha = 2.0;
+    int jmin = -1;
     phgmg_result rc = phgmg_lstsq(s->M, s->np, 1, s->G, s->M, s->b, s->M, 0.0, s->z, s->np, al);
     if (rc != PHGMG_OK) return rc;
     for (j = 0; j < s->np; ++j)
-      if (!(s->z[j] > 0.0)) alpha = PHGMG__MIN(alpha, s->x[j] / (s->x[j] - s->z[j]));
-    if (alpha >= 1.0) { memcpy(s->x, s->z, (size_t)s->np * sizeof(double)); return PHGMG_OK; }
+      if (!(s->z[j] > 0.0)) {
+        const double a = s->x[j] / (s->x[j] - s->z[j]);
+        if (a < alpha) { alpha = a; jmin = j; }
+      }
+    if (jmin < 0) { memcpy(s->x, s->z, (size_t)s->np * sizeof(double)); return PHGMG_OK; }
     for (j = 0; j < s->np; ++j) s->x[j] += alpha * (s->z[j] - s->x[j]);
+    s->x[jmin] = 0.0;   /* the blocking term leaves exactly (rounding may leave it at +1e-17: a cycle) */
     for (j = 0, q = 0; j < s->np; ++j) {   /* drop the terms at zero, keep the order */
       if (s->x[j] > 0.0) {
         if (q != j) {
@@ -26144,7 +26149,8 @@ PHGMG__PRIV phgmg_result phgmg__mpi_sep_ecsw_svd(const phgmg_mpi_ctx *ctx, const
   if (rc != PHGMG_OK) { phgmg__free(&ctx->al, U); return rc; }
   S = U + (size_t)ld * kk; Fc = S + kk; dw = Fc + (size_t)ld * kk; work = dw + ld;
   rc = phgmg_mpi_pod(tc, ns, t->F, ld, kk, 0.0, U, ld, S, &ks);
-  for (pass = 0; rc == PHGMG_OK && pass < 2; ++pass) {
+  /* pass 1 only after pass 0 missed tol (rc NOT_CONVERGED) */
+  for (pass = 0; (rc == PHGMG_OK || (pass == 1 && rc == PHGMG_ERR_NOT_CONVERGED)) && pass < 2; ++pass) {
     for (q = 0; q < ks && (pass == 1 || S[q] > 1e-3 * tol * S[0]); ++q) {}
     if (q < 1) q = 1;
     for (i = 0; i < q; ++i)

@@ -6,7 +6,9 @@
    compares (the distributed results are replicated: every rank holds them);
    with DIR it also saves, loads and exports the distributed models there.
    Exit status 0 iff every check passed on every rank. Built with mpicc
-   (make test-mpi). */
+   (make test-mpi). With --scale n (last) only the GMG-POD/SP1 comparison
+   runs, on a chain of n masses at r = 20, with a negative control (a
+   Gram-matrix POD must miss V^T (J - R) V): bench/mpi_equivalence.sh. */
 #define _POSIX_C_SOURCE 199309L   /* nanosleep */
 #define PHGMG_MPI
 #define PHGMG_STATIC
@@ -21,6 +23,7 @@
 
 #include "mpi_harness.h"
 static const char *dir_;   /* argv[1]: a directory for the model files (none: not written) */
+static int scale_;         /* --scale n: only the GMG-POD/SP1 comparison, n masses, r = 20 */
 
 
 /* Wait for rank 0's serial comparisons without spinning (the other ranks
@@ -235,21 +238,95 @@ static void serial_sigma(const chain *ch, int ns, const double *X, int k, int ad
   free(Xa); free(V);
 }
 
-/* Rank 0: the distributed model against the serial one. sg: the modes'
-   signs (from the bases). */
-static void compare_serial(const chain *ch, int ns, const double *X, const double *x0, const phgmg_reduced *red,
-                           const phgmg_mpi_rom *mr, const double *V0f, int nsteps, double ktol, const char *tag) {
-  const phgmg_rom *ro = phgmg_reduced_rom(red);
-  const int N = ch->N, r = mr->r, m = mr->m;
-  double sg[64], S[64], e, *col = (double *)malloc(sizeof(double) * (size_t)ch->N), xr[64], xd[64];
-  int i, j, same = ro->nd == mr->nd;
-  for (j = 0; j < r; ++j) {   /* signs: the distributed basis against the serial one (lift of unit vectors) */
+/* Largest output difference of two reduced models stepped nsteps steps of
+   0.1 from xa, xb under u_in, over the largest output (HUGE_VAL if a step
+   fails). */
+static double online_diff(const phgmg_rom *a, const phgmg_rom *b, const double *xa0, const double *xb0, int nsteps,
+                          const char *tag) {
+  static double m1[1 << 16], m2[1 << 16];
+  phgmg_rom_stepper s1, s2;
+  double u3[3], tc[3], y1 = 0.0, y2 = 0.0, ey = 0.0, sy = 0.0, xa[64], xb[64];
+  int st, i, ok;
+  memcpy(xa, xa0, sizeof(double) * (size_t)a->r);
+  memcpy(xb, xb0, sizeof(double) * (size_t)b->r);
+  CHECK(phgmg_rom_check(a) == PHGMG_OK, "%s: rom check", tag);
+  ok = phgmg_rom_stepper_init(&s1, a, 0.1, 0.0, 0, m1, sizeof m1) == PHGMG_OK &&
+       phgmg_rom_stepper_init(&s2, b, 0.1, 0.0, 0, m2, sizeof m2) == PHGMG_OK;
+  CHECK(ok, "%s: steppers", tag);
+  for (st = 0; ok && st < nsteps; ++st) {
+    phgmg_rom_stage_times(0.1 * st, 0.1, tc);
+    for (i = 0; i < 3; ++i) u_in(tc[i], u3 + i, NULL);
+    ok = phgmg_rom_step(&s1, xa, u3, &y1, NULL) == PHGMG_OK && phgmg_rom_step(&s2, xb, u3, &y2, NULL) == PHGMG_OK;
+    ey = fmax(ey, fabs(y1 - y2)); sy = fmax(sy, fabs(y2));
+  }
+  return ok ? ey / sy : HUGE_VAL;
+}
+
+/* The signs of the modes of basis V0f (N x r) against the serial model's
+   (lifts of unit vectors). */
+static void mode_signs(const phgmg_reduced *red, int N, int r, const double *V0f, double *sg) {
+  double *col = (double *)malloc(sizeof(double) * (size_t)N), xr[64];
+  int i, j;
+  for (j = 0; j < r; ++j) {
     double dot = 0.0;
     memset(xr, 0, sizeof xr); xr[j] = 1.0;
     phgmg_reduced_lift(red, xr, col);
     for (i = 0; i < N; ++i) dot += col[i] * V0f[i + (size_t)j * N];
     sg[j] = dot < 0.0 ? -1.0 : 1.0;
   }
+  free(col);
+}
+
+/* Scale mode: how far the serial model itself moves when every snapshot
+   entry is changed by one unit in the last place (random signs), far below
+   the snapshots' own error: the K difference (sign-normalised) and the
+   output difference. The distributed model cannot be expected closer to the
+   serial one than the serial one is to itself under rounding of its data;
+   tolerances become max(default, 10 x these). Rank 0. */
+static void serial_sensitivity(const chain *ch, int ns, const double *X, const double *x0, const phgmg_reduce_opts *o,
+                               const phgmg_reduced *red, double *ktol, double *ytol) {
+  const int N = ch->N;
+  double *X2 = (double *)malloc(sizeof(double) * (size_t)N * ns), xr[64], x2[64], sg[64], *V2f, eK, ey;
+  unsigned long long st = 2463534242ull;
+  phgmg_reduced *red2 = NULL;
+  const phgmg_rom *a, *b;
+  size_t i;
+  int j, r;
+  for (i = 0; i < (size_t)N * ns; ++i) {
+    st ^= st << 13; st ^= st >> 7; st ^= st << 17;
+    X2[i] = X[i] * (1.0 + ((st >> 11) & 1 ? 1.0 : -1.0) * 2.220446049250313e-16);
+  }
+  CHECK(phgmg_reduce(&red2, &ch->sys, X2, N, ns, o, NULL, NULL) == PHGMG_OK, "serial reduce, perturbed");
+  free(X2);
+  if (!red2) return;
+  a = phgmg_reduced_rom(red); b = phgmg_reduced_rom(red2); r = a->r;
+  V2f = (double *)calloc((size_t)N * r, sizeof(double));
+  for (j = 0; j < r; ++j) {
+    memset(xr, 0, sizeof xr); xr[j] = 1.0;
+    phgmg_reduced_lift(red2, xr, V2f + (size_t)j * N);
+  }
+  mode_signs(red, N, r, V2f, sg);
+  eK = rel_diff(r, r, b->K, a->K, sg, sg);
+  phgmg_reduced_restrict(red, x0, xr);
+  for (j = 0; j < r; ++j) x2[j] = sg[j] * xr[j];
+  ey = online_diff(b, a, x2, xr, 200, "perturbed");
+  printf("  serial model under one-ulp changes of the snapshots: K %.1e, outputs %.1e\n", eK, ey);
+  *ktol = fmax(*ktol, 10.0 * eK);
+  *ytol = fmax(*ytol, 10.0 * ey);
+  free(V2f);
+  phgmg_reduced_destroy(red2);
+}
+
+/* Rank 0: the distributed model against the serial one. sg: the modes'
+   signs (from the bases). */
+static void compare_serial(const chain *ch, int ns, const double *X, const double *x0, const phgmg_reduced *red,
+                           const phgmg_mpi_rom *mr, const double *V0f, int nsteps, double ktol, double ytol,
+                           const char *tag) {
+  const phgmg_rom *ro = phgmg_reduced_rom(red);
+  const int r = mr->r, m = mr->m;
+  double sg[64], S[64], e, xr[64], xd[64];
+  int i, j, same = ro->nd == mr->nd;
+  mode_signs(red, ch->N, r, V0f, sg);   /* the distributed basis's signs against the serial one's */
   serial_sigma(ch, ns, X, mr->rom.method == PHGMG_METHOD_SP1 ? r : r - m, mr->rom.method != PHGMG_METHOD_SP1, S);
   for (j = 0, e = 0.0; j < (mr->rom.method == PHGMG_METHOD_SP1 ? r : r - m); ++j) e = fmax(e, fabs(mr->S[j] - S[j]) / S[0]);
   CHECK(e <= 1e-12, "%s: singular values %.2e sigma_1", tag, e);
@@ -275,26 +352,11 @@ static void compare_serial(const chain *ch, int ns, const double *X, const doubl
     CHECK(e <= 1e-12, "%s: P0 %.2e", tag, e);
     printf(", %d points, weights %.1e, P0 %.1e", mr->nd, ew / sw, e);
   }
-  {   /* the online models from x0's reduced coordinates, nsteps steps */
-    static double m1[1 << 16], m2[1 << 16];
-    phgmg_rom_stepper s1, s2;
-    double u3[3], tc[3], y1 = 0.0, y2 = 0.0, ey = 0.0, sy = 0.0;
-    int st, ok = 1;
-    CHECK(phgmg_rom_check(&mr->rom) == PHGMG_OK, "%s: rom check", tag);
-    phgmg_reduced_restrict(red, x0, xr);
-    for (j = 0; j < r; ++j) xd[j] = sg[j] * xr[j];
-    ok = phgmg_rom_stepper_init(&s1, &mr->rom, 0.1, 0.0, 0, m1, sizeof m1) == PHGMG_OK &&
-         phgmg_rom_stepper_init(&s2, ro, 0.1, 0.0, 0, m2, sizeof m2) == PHGMG_OK;
-    CHECK(ok, "%s: steppers", tag);
-    for (st = 0; ok && st < nsteps; ++st) {
-      phgmg_rom_stage_times(0.1 * st, 0.1, tc);
-      for (i = 0; i < 3; ++i) u_in(tc[i], u3 + i, NULL);
-      ok = phgmg_rom_step(&s1, xd, u3, &y1, NULL) == PHGMG_OK && phgmg_rom_step(&s2, xr, u3, &y2, NULL) == PHGMG_OK;
-      ey = fmax(ey, fabs(y1 - y2)); sy = fmax(sy, fabs(y2));
-    }
-    CHECK(ok && ey <= 1e-10 * sy, "%s: reduced outputs against the serial model's: %.2e", tag, ey / sy);
-    printf(", outputs (%d steps) %.1e\n", nsteps, ey / sy);
-  }
+  phgmg_reduced_restrict(red, x0, xr);
+  for (j = 0; j < r; ++j) xd[j] = sg[j] * xr[j];
+  e = online_diff(&mr->rom, ro, xd, xr, nsteps, tag);
+  CHECK(e <= ytol, "%s: reduced outputs against the serial model's: %.2e", tag, e);
+  printf(", outputs (%d steps) %.1e\n", nsteps, e);
   if (dir_) {   /* the model file and the C export: the loaded model steps to the same outputs, bitwise */
     char path[1024];
     phgmg_rom lr;
@@ -320,7 +382,6 @@ static void compare_serial(const chain *ch, int ns, const double *X, const doubl
     CHECK(phgmg_rom_export_c(&mr->rom, "nl_rom", path) == PHGMG_OK, "%s: C export", tag);
     free(blk);
   }
-  free(col);
 }
 
 /* The distributed V0 (N x r) on rank 0 from the ranks' rows. */
@@ -337,12 +398,62 @@ static double *gather_v0(const phgmg_mpi_ctx *c, int r, const double *V0, int ld
   return full;
 }
 
+/* The negative control at scale: the reduced operator V^T (J - R) V of the
+   raw snapshots' r leading POD modes from the serial phgmg_pod (rank 0,
+   broadcast), from the distributed TSQR POD (phgmg_mpi_pod) and from a
+   Gram-matrix POD (eigenvectors W of X^T X, V = X W Lambda^{-1/2}), signs
+   from the serial basis: TSQR within 1e-12 relative of the serial, the Gram
+   basis off by more than that (it squares the condition: its vectors carry
+   eps (sigma_1 / sigma_r)^2 errors), which shows the comparison can fail. */
+static void gram_control(const dist *d, int N, int ns, const double *X, int r) {
+  const phgmg_mpi_ctx *c = d->c;
+  const int ld = d->ld, nl = c->nloc;
+  double *Vs = (double *)malloc(sizeof(double) * (size_t)N * r), *Ss = (double *)malloc(sizeof(double) * ns);
+  double *B[3], A[3][400], *G = (double *)malloc(sizeof(double) * ns * ns), *W = (double *)malloc(sizeof(double) * ns * ns);
+  double *lam = (double *)malloc(sizeof(double) * ns), *T = (double *)malloc(sizeof(double) * ns * r), S[64];
+  double e[3] = {0.0, 0.0, 0.0}, sc = 0.0;
+  int i, j, b, k = 0, ok = 1;
+  if (rank_ == 0) ok = phgmg_pod(N, ns, X, N, r, 0.0, Vs, N, Ss, &k, NULL) == PHGMG_OK && k == r;
+  MPI_Bcast(&ok, 1, MPI_INT, 0, MPI_COMM_WORLD);
+  MPI_Bcast(Vs, N * r, MPI_DOUBLE, 0, MPI_COMM_WORLD);
+  MPI_Bcast(Ss, ns, MPI_DOUBLE, 0, MPI_COMM_WORLD);
+  CHECK(ok, "serial POD of the raw snapshots");
+  for (b = 0; b < 3; ++b) B[b] = (double *)calloc((size_t)ld * r, sizeof(double));
+  for (j = 0; j < r; ++j) for (i = 0; i < nl; ++i) B[0][i + (size_t)j * ld] = Vs[c->row0 + i + (size_t)j * N];
+  CHECK(phgmg_mpi_pod(c, ns, d->Xl, ld, r, 0.0, B[1], ld, S, &k) == PHGMG_OK && k == r, "TSQR POD");
+  CHECK(phgmg_mpi_atb(c, ns, ns, d->Xl, ld, d->Xl, ld, G, ns) == PHGMG_OK, "Gram matrix");
+  phgmg_sym_eig(ns, G, ns, lam, W, ns);
+  for (j = 0; j < r; ++j)   /* leading eigenpairs last */
+    for (i = 0; i < ns; ++i) T[i + (size_t)j * ns] = W[i + (size_t)(ns - 1 - j) * ns] / sqrt(lam[ns - 1 - j]);
+  if (nl > 0) phgmg_gemm('N', 'N', nl, r, ns, 1.0, d->Xl, ld, T, ns, 0.0, B[2], ld);
+  for (b = 1; b < 3; ++b)
+    for (j = 0; j < r; ++j) {   /* signs from the serial basis */
+      double dl = 0.0, dg = 0.0;
+      for (i = 0; i < nl; ++i) dl += B[b][i + (size_t)j * ld] * B[0][i + (size_t)j * ld];
+      MPI_Allreduce(&dl, &dg, 1, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
+      if (dg < 0.0) for (i = 0; i < nl; ++i) B[b][i + (size_t)j * ld] = -B[b][i + (size_t)j * ld];
+    }
+  for (b = 0; b < 3; ++b) CHECK(phgmg_mpi_op_project(d->JR, r, B[b], ld, A[b], r) == PHGMG_OK, "project %d", b);
+  for (i = 0; i < r * r; ++i) sc = fmax(sc, fabs(A[0][i]));
+  for (b = 1; b < 3; ++b) for (i = 0; i < r * r; ++i) e[b] = fmax(e[b], fabs(A[b][i] - A[0][i]) / sc);
+  for (j = 0; j < r; ++j) e[0] = fmax(e[0], fabs(S[j] - Ss[j]) / Ss[0]);
+  CHECK(e[0] <= 1e-12, "TSQR singular values against the serial: %.2e sigma_1", e[0]);
+  CHECK(e[1] <= 1e-12, "V^T (J - R) V, TSQR basis against the serial: %.2e", e[1]);
+  CHECK(e[2] > 1e-12, "the Gram basis should miss V^T (J - R) V (%.2e)", e[2]);
+  if (rank_ == 0)
+    printf("  raw snapshots, r = %d: sigma_r/sigma_1 %.2e; sigma %.1e sigma_1; V^T (J - R) V: TSQR %.1e, Gram %.1e\n", r,
+           Ss[r - 1] / Ss[0], e[0], e[1], e[2]);
+  for (b = 0; b < 3; ++b) free(B[b]);
+  free(Vs); free(Ss); free(G); free(W); free(lam); free(T);
+}
+
 /* Distributed GMG-POD r = 12 with ECSW (tol 1e-3) of the cosh chain (N =
    2000, 101 snapshots from a smooth initial displacement under a sine
    input: every term moves, the points lie on every rank that owns rows) against the serial phgmg_reduce with the same options; then the
    solve failing on one rank only: the same code on every rank. */
-static void test_gmg_pod_ecsw(void) {
-  const int n = 1000, N = 2 * n, ns = 101, r = 12;
+static void gram_control(const dist *d, int N, int ns, const double *X, int r);
+static void test_gmg_pod_ecsw(int n, int r) {
+  const int N = 2 * n, ns = 101;
   chain ch;
   dist d;
   double *X = (double *)malloc(sizeof(double) * (size_t)N * ns), *x0 = (double *)calloc((size_t)N, sizeof(double));
@@ -358,6 +469,7 @@ static void test_gmg_pod_ecsw(void) {
   memset(&o, 0, sizeof o);
   o.method = PHGMG_METHOD_GMG_POD; o.r = r; o.hyper.on = 1; o.hyper.kind = PHGMG_HYPER_ECSW; o.hyper.tol = 1e-3;
   dist_build(&d, &ch, ns, X);
+  if (n != 1000) gram_control(&d, N, ns, X, r);
   V0 = (double *)malloc(sizeof(double) * (size_t)d.ld * r);
   rc = phgmg_mpi_reduce(d.c, &d.md, ns, d.Xl, d.ld, &o, &mr, V0, d.ld);
   CHECK(rc == PHGMG_OK, "distributed GMG-POD: %d", (int)rc);
@@ -373,23 +485,26 @@ static void test_gmg_pod_ecsw(void) {
     CHECK(owners >= 2, "points on %d rank(s) only", owners);
   }
   if (rank_ == 0 && rc == PHGMG_OK) {
+    double ktol = 1e-12, ytol = 1e-10;
     CHECK(phgmg_reduce(&red, &ch.sys, X, N, ns, &o, NULL, NULL) == PHGMG_OK, "serial reduce");
-    if (red) compare_serial(&ch, ns, X, x0, red, &mr, V0f, 200, 1e-12, "gmg-pod ecsw");
+    if (red && scale_) serial_sensitivity(&ch, ns, X, x0, &o, red, &ktol, &ytol);
+    if (red) compare_serial(&ch, ns, X, x0, red, &mr, V0f, 200, ktol, ytol, "gmg-pod ecsw");
     phgmg_reduced_destroy(red);
   }
   quiet_barrier();
   phgmg_mpi_rom_free(&mr);
-  /* without hyper-reduction: every term kept with its weight, as the serial model */
+  /* without hyper-reduction: every term kept with its weight, as the serial
+     model (not in scale mode: the online stepper's test buffer is small) */
   o.hyper.on = 0;
-  rc = phgmg_mpi_reduce(d.c, &d.md, ns, d.Xl, d.ld, &o, &mr, NULL, 0);
-  CHECK(rc == PHGMG_OK && mr.nd == n, "distributed GMG-POD, every term: %d, nd %d", (int)rc, mr.nd);
+  rc = scale_ ? PHGMG_ERR_UNSUPPORTED : phgmg_mpi_reduce(d.c, &d.md, ns, d.Xl, d.ld, &o, &mr, NULL, 0);
+  CHECK(scale_ || (rc == PHGMG_OK && mr.nd == n), "distributed GMG-POD, every term: %d, nd %d", (int)rc, mr.nd);
   if (rank_ == 0 && rc == PHGMG_OK) {
     CHECK(phgmg_reduce(&red, &ch.sys, X, N, ns, &o, NULL, NULL) == PHGMG_OK, "serial reduce, every term");
-    if (red) compare_serial(&ch, ns, X, x0, red, &mr, V0f, 40, 1e-12, "gmg-pod, every term");
+    if (red) compare_serial(&ch, ns, X, x0, red, &mr, V0f, 40, 1e-12, 1e-10, "gmg-pod, every term");
     phgmg_reduced_destroy(red);
   }
   quiet_barrier();
-  phgmg_mpi_rom_free(&mr);
+  if (!scale_) phgmg_mpi_rom_free(&mr);
   o.hyper.on = 1;
   /* SP1 with ECSW (J - R as an operator), as the serial SP1 */
   o.method = PHGMG_METHOD_SP1;
@@ -398,8 +513,10 @@ static void test_gmg_pod_ecsw(void) {
   free(V0f);
   V0f = gather_v0(d.c, r, V0, d.ld);
   if (rank_ == 0 && rc == PHGMG_OK) {
+    double ktol = 1e-12, ytol = 1e-10;
     CHECK(phgmg_reduce(&red, &ch.sys, X, N, ns, &o, NULL, NULL) == PHGMG_OK, "serial SP1");
-    if (red) compare_serial(&ch, ns, X, x0, red, &mr, V0f, 200, 1e-12, "sp1 ecsw");
+    if (red && scale_) serial_sensitivity(&ch, ns, X, x0, &o, red, &ktol, &ytol);
+    if (red) compare_serial(&ch, ns, X, x0, red, &mr, V0f, 200, ktol, ytol, "sp1 ecsw");
     phgmg_reduced_destroy(red);
   }
   quiet_barrier();
@@ -443,7 +560,7 @@ static void test_screened(void) {
     CHECK(phgmg_reduce(&red, &ch.sys, X, N, ns, &o, NULL, NULL) == PHGMG_OK, "serial reduce, screened");
     /* K = G00^{-1} with cond(G00) = 1e6 here (5e5 in test_gmg_pod_ecsw):
        its forward error bound is cond eps ~ 2e-10; measured 6e-13 .. 2e-12 */
-    if (red) compare_serial(&ch, ns, X, x0, red, &mr, V0f, 100, 1e-11, "gmg-pod ecsw, 4200 terms");
+    if (red) compare_serial(&ch, ns, X, x0, red, &mr, V0f, 100, 1e-11, 1e-10, "gmg-pod ecsw, 4200 terms");
     phgmg_reduced_destroy(red);
   }
   quiet_barrier();
@@ -552,13 +669,17 @@ int main(int argc, char **argv) {
   MPI_Init(&argc, &argv);
   MPI_Comm_rank(MPI_COMM_WORLD, &rank_);
   MPI_Comm_size(MPI_COMM_WORLD, &size_);
+  if (argc > 2 && !strcmp(argv[argc - 2], "--scale")) { scale_ = atoi(argv[argc - 1]); argc -= 2; }
   dir_ = argc > 1 ? argv[1] : NULL;
   t0 = MPI_Wtime();
   if (rank_ == 0) printf("test_mpi_nl: P = %d\n", size_);
-  test_gmg_pod_ecsw();
-  test_screened();
-  test_errors();
-  test_memory();
+  if (scale_ > 0) test_gmg_pod_ecsw(scale_, 20);
+  else {
+    test_gmg_pod_ecsw(1000, 12);
+    test_screened();
+    test_errors();
+    test_memory();
+  }
   MPI_Allreduce(&fails_, &total, 1, MPI_INT, MPI_SUM, MPI_COMM_WORLD);
   if (rank_ == 0)
     printf("test_mpi_nl: P = %d: %s (%d failed checks, %.2f s)\n", size_, total ? "FAILED" : "passed", total,
