@@ -3660,12 +3660,16 @@ static int stream_run(const reduce_args *A, reduce_state *S, cli_input *in, cons
   rc = phgmg_gl3_create(&g, &S->sys, A->dt, &go, NULL);
   input_covers(in, spec, A->ntrain ? "--train-input" : "--input", A->steps * A->dt);
   progress("simulating the full model (streamed): %d steps of dt = %g, %s", A->steps, A->dt, input_desc(in, spec));
+  in->report = 1;   /* progress lines from the input callback, as the stored run's */
+  in->t_end = A->steps * A->dt;
+  in->wall0 = in->wall_last = now_s();
   for (n = 0; rc == PHGMG_OK; ++n) {   /* the loop of phgmg_simulate: t_n = n dt */
     memcpy(blk + (size_t)*fill * N, x, sizeof(double) * (size_t)N);
     if (++*fill == nb) { rc = phgmg_pod_stream_add(g_stream, nb, blk, N); *fill = 0; }
     if (n == A->steps || rc != PHGMG_OK) break;
     rc = phgmg_gl3_step(g, n * A->dt, x, input_fn, in, NULL);
   }
+  in->report = 0;
   phgmg_gl3_destroy(g);
   free(x);
   if (rc != PHGMG_OK)
