@@ -742,7 +742,7 @@
                             B u (Q as an operator, B's rows, J - R through a
                             collective solve callback: the user's KSP, MUMPS
                             or AMG): K, Qh, Bh of the serial phgmg_reduce
-     phgmg_mpi_reduce       GMG-POD or SP1 of a model with a SEPARABLE
+     phgmg_mpi_reduce       GMG-POD, SP1 or SP2 of a model with a SEPARABLE
                             Hamiltonian (built-in exp-polynomial terms held
                             by the ranks that own their coordinates) with
                             ECSW hyper-reduction: the serial phgmg_reduce's
@@ -783,9 +783,13 @@
    within 1.5e-15 relative at 1-4 ranks (after the sign of each POD mode,
    which the SVD leaves free), the reduced outputs over 200 steps within
    1e-15.
-   phgmg_mpi_reduce does the same (opts.method GMG_POD; or SP1, with J - R
-   as a distributed operator: V the POD of X, A = V^T Q V, W = Q V A^{-1},
-   K = W^T (J - R) W, Bh = W^T B, Qh = A symmetrised, as the serial SP1) for
+   phgmg_mpi_reduce does the same (opts.method GMG_POD; or SP1 and SP2,
+   with J - R as a distributed operator: V the POD of X, the test basis Vg =
+   Q V (SP1) or the r leading POD modes of the gradient snapshots Q x_j +
+   sum_k w_k phi_k'(x_j[idx_k]) e_idx_k (SP2; each rank its rows and terms,
+   PHGMG_ERR_SIZE below the rounding floor as in the serial SP2), A = V^T
+   Vg, W = Vg A^{-1}, K = W^T (J - R) W, Bh = W^T B, Qh = V^T Q V
+   symmetrised, as the serial SP1/SP2) for
    H(x) = 1/2 x^T Q x + sum_k w_k phi_k(x[idx_k]) and adds the serial
    separable stage (3.4, 8.7): the
    terms whose argument moves in some snapshot, F = phi_k'(x_i[idx_k]), and
@@ -844,7 +848,7 @@
    solves and about 1.5 GB per rank; the efficiency falls below 90 % near
    16 000 ranks (size ns about 0.6 times the rows per rank), where TSQR's
    replicated stack dominates.
-   Not yet distributed: GMG-QM, SP2, DEIM hyper-reduction (hyper.kind
+   Not yet distributed: GMG-QM, DEIM hyper-reduction (hyper.kind
    QDEIM or GREEDY), separable terms by callbacks and GENERAL nonlinear
    Hamiltonians, a reference state (opts.ref), dampers, feedthrough,
    descriptor models; in the command line (below) also the separable terms
@@ -26011,7 +26015,7 @@ PHGMG__PRIV phgmg_result phgmg__mpi_sep_check_local(const phgmg_mpi_ctx *ctx, co
   const int nf = md->per_term ? md->nsep : 1, nc = md->poly_deg + 1;
   int k;
   phgmg__reduce_opts_resolve(o, 0);
-  if ((o->method != PHGMG_METHOD_GMG_POD && o->method != PHGMG_METHOD_SP1) ||
+  if ((o->method != PHGMG_METHOD_GMG_POD && o->method != PHGMG_METHOD_SP1 && o->method != PHGMG_METHOD_SP2) ||
       (o->hyper.on && o->hyper.kind != PHGMG_HYPER_ECSW) ||
       o->ref != PHGMG_REF_NONE || o->dt != 0.0 || o->nrun || o->runs || o->cache.pod_basis || o->cache.deim_pts ||
       o->select.lambda_mode != PHGMG_LAMBDA_FIXED || o->degeneracy_tol != 1e-12)
@@ -26024,7 +26028,7 @@ PHGMG__PRIV phgmg_result phgmg__mpi_sep_check_local(const phgmg_mpi_ctx *ctx, co
       (md->poly_deg == 0 && md->nexp == 0))
     return PHGMG_ERR_SIZE;
   if ((md->nexp > 0 && nf > 0 && !md->expo) || (md->nsep > 0 && !md->sep_idx)) return PHGMG_ERR_INVALID_ARG;
-  if (o->method == PHGMG_METHOD_SP1 && (!md->JR || md->JR->ctx != ctx)) return PHGMG_ERR_INVALID_ARG;
+  if (o->method != PHGMG_METHOD_GMG_POD && (!md->JR || md->JR->ctx != ctx)) return PHGMG_ERR_INVALID_ARG;
   if ((md->poly && nf > 0 && !phgmg__all_finite(md->poly, (size_t)nf * nc)) ||
       (md->nexp > 0 && nf > 0 && !phgmg__all_finite(md->expo, (size_t)nf * 2 * md->nexp)) ||
       (md->sep_w && md->nsep > 0 && !phgmg__all_finite(md->sep_w, (size_t)md->nsep)))
@@ -26486,20 +26490,60 @@ PHGMG__PRIV phgmg_result phgmg__mpi_rom_store(const phgmg_mpi_ctx *ctx, const ph
   return PHGMG_OK;
 }
 
-/* SP1's blocks (the serial phgmg__stage_sp_blocks and the quadratic term):
-   V (ld x r) the r leading POD modes of X (TSQR; S their values), A = V^T Q
-   V with its non-degeneracy test, W (ld x r) = Q V A^{-1}, K = W^T (J - R)
-   W, Bh = W^T B, Qh = A symmetrised. Collective. */
-PHGMG__PRIV phgmg_result phgmg__mpi_sp1_blocks(const phgmg_mpi_ctx *ctx, const phgmg_mpi_sep_model *md, int ns,
-                                               const double *X, int ldx, int r, double *K, double *Qh, double *Bh,
-                                               double *S, double *V, double *W) {
+/* SP2's test basis (the serial phgmg__sp_test_basis): the r leading POD
+   modes (TSQR) of the gradient snapshots grad H(x_j) = Q x_j + sum_k w_k
+   phi_k'(x_j[i_k]) e_{i_k} (this rank's rows and terms) into Vg (ld x r);
+   PHGMG_ERR_SIZE when fewer than r modes lie above the rounding floor
+   max(N, ns) eps ||grad||_F. Collective. */
+PHGMG__PRIV phgmg_result phgmg__mpi_sp2_test(const phgmg_mpi_ctx *ctx, const phgmg_mpi_sep_model *md, int ns,
+                                             const double *X, int ldx, int r, double *Vg) {
+  const int n = ctx->nloc, ld = PHGMG__MAX(1, n);
+  const int kk = (int)PHGMG__MIN((phgmg_gidx)PHGMG__MIN(r + 1, ns), ctx->N);
+  double *G = phgmg__dalloc(&ctx->al, (size_t)ld * ns + (size_t)ld * kk + (size_t)kk), *U, *sg, f2[2] = {0.0, 0.0};
+  phgmg_ph_system sy;
+  int k = 0, j;
+  phgmg_result rc = phgmg__mpi_agree(ctx, G ? PHGMG_OK : PHGMG_ERR_NOMEM);
+  if (rc != PHGMG_OK) { phgmg__free(&ctx->al, G); return rc; }
+  U = G + (size_t)ld * ns; sg = U + (size_t)ld * kk;
+  rc = phgmg_mpi_op_apply(md->lin.Q, ns, X, ldx, G, ld);
+  if (rc == PHGMG_OK) {
+    phgmg__mpi_sep_sys(md, &sy);
+    for (k = 0; k < md->nsep; ++k) {
+      const int row = (int)(md->sep_idx[k] - ctx->row0);
+      const double w = md->sep_w ? md->sep_w[k] : 1.0;
+      for (j = 0; j < ns; ++j) G[row + (size_t)j * ld] += w * phgmg__ph_phi(&sy, k, X[row + (size_t)j * ldx], 1);
+    }
+    f2[0] = n > 0 ? phgmg_normf(n, ns, G, ld) : 0.0;
+    f2[0] *= f2[0];
+    phgmg__mpi_sum(ctx, 1, f2, f2 + 1);
+    k = 0;
+    rc = phgmg_mpi_pod(ctx, ns, G, ld, kk, 0.0, U, ld, sg, &k);
+  }
+  if (rc == PHGMG_OK &&
+      (k < r || !(sg[r - 1] > (double)PHGMG__MAX(ctx->N, (phgmg_gidx)ns) * PHGMG__EPS * sqrt(f2[1]))))
+    rc = PHGMG_ERR_SIZE;
+  if (rc == PHGMG_OK) memcpy(Vg, U, (size_t)ld * r * sizeof(double));
+  phgmg__free(&ctx->al, G);
+  return rc;
+}
+
+/* SP1's and SP2's blocks (the serial phgmg__stage_sp_blocks and the
+   quadratic term): V (ld x r) the r leading POD modes of X (TSQR; S their
+   values); the test basis Vg = Q V (SP1) or the gradient snapshots' POD
+   (SP2); A = V^T Vg with its non-degeneracy test, W (ld x r) = Vg A^{-1},
+   K = W^T (J - R) W, Bh = W^T B, Qh = V^T Q V symmetrised. Collective. */
+PHGMG__PRIV phgmg_result phgmg__mpi_sp_blocks(const phgmg_mpi_ctx *ctx, const phgmg_mpi_sep_model *md, int ns,
+                                              const double *X, int ldx, int r, int sp2, double *K, double *Qh,
+                                              double *Bh, double *S, double *V, double *W) {
   const int n = ctx->nloc, ld = PHGMG__MAX(1, n), m = md->lin.m;
   const int kk = (int)PHGMG__MIN((phgmg_gidx)PHGMG__MIN(r + 1, ns), ctx->N);
-  double *Vk = phgmg__dalloc(&ctx->al, (size_t)ld * kk + (size_t)kk + 2 * (size_t)ld * r + (size_t)r * r), *s, *QV, *T, *Ai;
+  double *Vk = phgmg__dalloc(&ctx->al, (size_t)ld * kk + (size_t)kk + 3 * (size_t)ld * r + 2 * (size_t)r * r);
+  double *s, *QV, *T, *Vg, *A, *Ai;
   int k = 0, j;
   phgmg_result rc = phgmg__mpi_agree(ctx, Vk ? PHGMG_OK : PHGMG_ERR_NOMEM);
   if (rc != PHGMG_OK) { phgmg__free(&ctx->al, Vk); return rc; }
-  s = Vk + (size_t)ld * kk; QV = s + kk; T = QV + (size_t)ld * r; Ai = T + (size_t)ld * r;
+  s = Vk + (size_t)ld * kk; QV = s + kk; T = QV + (size_t)ld * r; Vg = T + (size_t)ld * r;
+  A = Vg + (size_t)ld * r; Ai = A + (size_t)r * r;
   rc = phgmg_mpi_pod(ctx, ns, X, ldx, kk, 0.0, Vk, ld, s, &k);
   if (rc == PHGMG_OK && k < r) rc = PHGMG_ERR_SIZE;   /* r beyond the snapshots' numerical rank */
   if (rc == PHGMG_OK) {
@@ -26507,14 +26551,17 @@ PHGMG__PRIV phgmg_result phgmg__mpi_sp1_blocks(const phgmg_mpi_ctx *ctx, const p
     memcpy(S, s, (size_t)r * sizeof(double));
     rc = phgmg_mpi_op_apply(md->lin.Q, r, V, ld, QV, ld);
   }
-  if (rc == PHGMG_OK) rc = phgmg_mpi_atb(ctx, r, r, V, ld, QV, ld, Qh, r);   /* A = V^T Q V */
+  if (rc == PHGMG_OK) rc = phgmg_mpi_atb(ctx, r, r, V, ld, QV, ld, Qh, r);   /* V^T Q V */
+  if (rc == PHGMG_OK && sp2) rc = phgmg__mpi_sp2_test(ctx, md, ns, X, ldx, r, Vg);
+  if (rc == PHGMG_OK && sp2) rc = phgmg_mpi_atb(ctx, r, r, V, ld, Vg, ld, A, r);
+  if (rc == PHGMG_OK && !sp2) { memcpy(Vg, QV, (size_t)ld * r * sizeof(double)); memcpy(A, Qh, (size_t)r * r * sizeof(double)); }
   if (rc == PHGMG_OK) {   /* replicated data: the verdict is the same everywhere but a failed allocation */
-    const double rcd = phgmg__rcond_of(r, Qh, &ctx->al);
-    rc = rcd < 0.0 ? PHGMG_ERR_NOMEM : !(rcd >= 1e-12) ? PHGMG_ERR_DEGENERATE : phgmg__inv(r, Qh, Ai, &ctx->al);
+    const double rcd = phgmg__rcond_of(r, A, &ctx->al);
+    rc = rcd < 0.0 ? PHGMG_ERR_NOMEM : !(rcd >= 1e-12) ? PHGMG_ERR_DEGENERATE : phgmg__inv(r, A, Ai, &ctx->al);
     rc = phgmg__mpi_agree(ctx, rc);
   }
   if (rc == PHGMG_OK) {
-    if (n > 0) phgmg_gemm('N', 'N', n, r, r, 1.0, QV, ld, Ai, r, 0.0, W, ld);   /* W = Q V A^{-1} */
+    if (n > 0) phgmg_gemm('N', 'N', n, r, r, 1.0, Vg, ld, Ai, r, 0.0, W, ld);   /* W = Vg A^{-1} */
     rc = phgmg_mpi_op_apply(md->JR, r, W, ld, T, ld);
   }
   if (rc == PHGMG_OK) rc = phgmg_mpi_atb(ctx, r, r, W, ld, T, ld, K, r);
@@ -26613,7 +26660,7 @@ PHGMG_DEF phgmg_result phgmg_mpi_reduce(const phgmg_mpi_ctx *ctx, const phgmg_mp
     r = o.r; m = model->lin.m;
   }
   rc = phgmg__mpi_sep_check_global(ctx, model ? model : NULL, rc);
-  sp1 = rc == PHGMG_OK && o.method == PHGMG_METHOD_SP1;
+  sp1 = rc == PHGMG_OK && (o.method == PHGMG_METHOD_SP1 || o.method == PHGMG_METHOD_SP2);   /* SP1 or SP2 */
   if (rc == PHGMG_OK && (m < 1 || (phgmg_gidx)r > ctx->N || (sp1 ? r < 1 || r > ns : r <= m))) rc = PHGMG_ERR_SIZE;
   if (rc == PHGMG_OK) {
     b = phgmg__dalloc(&ctx->al, 2 * (size_t)r * r + (size_t)r * m + 3 * (size_t)r +
@@ -26623,14 +26670,14 @@ PHGMG_DEF phgmg_result phgmg_mpi_reduce(const phgmg_mpi_ctx *ctx, const phgmg_mp
   if (rc != PHGMG_OK) { phgmg__free(&ctx->al, b); return rc; }
   d.r = r; d.m = m; d.K = b; d.Qh = b + (size_t)r * r; d.Bh = d.Qh + (size_t)r * r; d.S = d.Bh + (size_t)r * m;
   d.env = d.S + r; Vb = b + 2 * (size_t)r * r + (size_t)r * m + 3 * (size_t)r;
-  Wb = sp1 ? Vb + (size_t)ld * r : NULL;   /* SP1's W = Q V A^{-1} */
+  Wb = sp1 ? Vb + (size_t)ld * r : NULL;   /* SP1/SP2: W = Vg A^{-1} */
   d.nc = model->poly_deg + 1; d.ne = model->nexp; d.md = model;
   d.nsv = sp1 ? r : r - m; d.method = o.method;
   wd = 1 + r + (model->per_term ? d.nc + 2 * d.ne : 0);
   /* basis and reduction blocks (stages 1 and 3), the quadratic term (4a) */
   if (sp1)
-    rc = phgmg__mpi_sp1_blocks(ctx, model, ns, X, ldx, r, b, b + (size_t)r * r, b + 2 * (size_t)r * r,
-                               b + 2 * (size_t)r * r + (size_t)r * m, Vb, Wb);
+    rc = phgmg__mpi_sp_blocks(ctx, model, ns, X, ldx, r, o.method == PHGMG_METHOD_SP2, b, b + (size_t)r * r,
+                              b + 2 * (size_t)r * r, b + 2 * (size_t)r * r + (size_t)r * m, Vb, Wb);
   else
     rc = phgmg_mpi_gmg_pod_linear(ctx, &model->lin, ns, X, ldx, r, b, b + (size_t)r * r, b + 2 * (size_t)r * r,
                                   b + 2 * (size_t)r * r + (size_t)r * m, Vb, ld);
