@@ -312,6 +312,15 @@ bench: phgmg.h examples
 clean:
 	rm -rf $(BUILD) results tests/suites.inc bench/results.csv
 
+# The low-rank benchmark (bench/bench_lowrank.c; bench/README.md), with OpenMP
+# when the compiler has it (PHGMG_USE_OPENMP: phgmg_shifted_hinf's frequencies
+# on all cores, the same values; OMP_NUM_THREADS=1 for one core):
+#   ./build/bench_lowrank --model lattice --n 224 --r 20 --nw 200
+$(BUILD)/bench_lowrank: bench/bench_lowrank.c bench/bench_args.h phgmg.h
+	@mkdir -p $(BUILD)
+	$(CC) $(OPTFLAGS) $$(if printf 'int main(void){return 0;}\n' | $(CC) -fopenmp -x c - -o /dev/null >/dev/null 2>&1; \
+	  then echo -fopenmp -DPHGMG_USE_OPENMP; fi) -o $@ bench/bench_lowrank.c $(LDLIBS)
+
 # The distributed phases' timings and communication, as JSON (bench/README.md,
 # "The distributed offline phase: scaling model"; not part of make test):
 #   mpirun -np P build/bench_mpi_phases --nloc 25000 > p1.json

@@ -1845,13 +1845,18 @@
         position rows hold one entry (dq/dt = p / m), so condensing the
         positions leaves S with the pattern of the stiffness matrix (the
         symmetrised graph would have joined every two neighbours of a
-        mass). A is chosen greedily in breadth-first order among the states
-        of degree <= 32 (on a bipartite graph, as positions and momenta
-        are, one whole side); the condensed analysis is kept when its
-        predicted factor (entries of L of S, plus those of K_BA and K_AB)
-        is smaller than K's own. A pivot K(a, a) is checked like the
-        others (below). Lattices: the factor shrinks 2.8-3.3x (2-D 40 x 40
-        1.59e5 -> 5.6e4 entries; 3-D 16^3 1.95e6 -> 6.0e5).
+        mass). A is chosen greedily among the states of degree <= 32,
+        twice: in breadth-first order (on a bipartite graph, as positions
+        and momenta are, one whole side) and by increasing degree (dampers
+        between neighbouring masses join the momenta, so the graph is not
+        bipartite, but the positions, of lower degree, are still
+        independent); the larger set is kept. The condensed analysis is
+        kept when its predicted factor (entries of L of S, plus those of
+        K_BA and K_AB) is smaller than K's own. A pivot K(a, a) is checked
+        like the others (below). Lattices: the factor shrinks 2.8-3.3x (2-D
+        40 x 40 1.59e5 -> 5.6e4 entries; 3-D 16^3 1.95e6 -> 6.0e5; a 2-D
+        224 x 224 lattice with dampers between neighbours 1.05e7 -> 3.2e6
+        entries, 7.7x fewer flops).
      1. Ordering: nested dissection of the graph of M + M^T (the pattern of
         M is that of (J - R) Q + (J - R) + I; it is symmetric when J - R and
         Q have symmetric patterns only if their product's is, so the graph is
@@ -2244,7 +2249,8 @@
      PHGMG_ASSERT(x)       internal invariant checks (default assert)
      PHGMG_USE_CBLAS       use cblas_dgemm/cblas_dgemv (optional speed-up)
      PHGMG_USE_OPENMP      with -fopenmp: phgmg_gemm runs its row blocks in
-                           parallel (off by default; same results; OMP_NUM_THREADS)
+                           parallel, phgmg_shifted_hinf its frequencies (off by
+                           default; same results; OMP_NUM_THREADS)
      PHGMG_GL3_STEP_MAP_MAX_N  largest dense linear model that gets a step map
                            in the full-order stepper (default 1000)
      PHGMG_GL3_FLUSH_REL   relative flush threshold of tiny entries (1e-60)
@@ -4266,7 +4272,9 @@ PHGMG_DEF phgmg_result phgmg_shifted_transfer(phgmg_shifted *s, double w, double
    reduced state-space model (Ar r x r, Br r x m, Cr m x r; Er = I, e.g. from
    phgmg_lrbt); hinf_ref the same of G alone. Either output may be NULL;
    Ar/Br/Cr may be NULL together (r = 0): hinf_ref only. Cost: nw complex
-   factorizations. Errors: PHGMG_ERR_INVALID_ARG (NULL s, only some of
+   factorizations; with PHGMG_USE_OPENMP (and -fopenmp) the frequencies run
+   in parallel, each thread with a numeric factor of its own (memory: one
+   complex factor per thread; the same values as one thread). Errors: PHGMG_ERR_INVALID_ARG (NULL s, only some of
    Ar/Br/Cr), _SIZE (r < 0, m > 16, nw < 1, wmin <= 0, wmax < wmin), the codes
    of phgmg_shifted_transfer and phgmg_ss_transfer, _NOMEM. */
 PHGMG_DEF phgmg_result phgmg_shifted_hinf(phgmg_shifted *s, int r, const double *Ar, const double *Br,
@@ -8351,42 +8359,75 @@ PHGMG__PRIV phgmg_result phgmg__spsym_assembly(phgmg__spsym *S, const int *iperm
 }
 
 /* States condensed first (manual 8.12): an independent set of the graph
-   of K (no two joined, so K's block on them is diagonal), taken greedily in
+   of K (no two joined, so K's block on them is diagonal), only states of
+   degree at most PHGMG__SP_CONDENSE_DEG, taken greedily twice: in
    breadth-first order (on a bipartite graph, such as positions and momenta
-   of a mechanical model, one whole side), only states of degree at most
-   PHGMG__SP_CONDENSE_DEG. Sets na, aidx, bpos, fidx, nf. */
+   of a mechanical model, one whole side), and by increasing degree (a
+   mechanical model whose dampers join neighbouring momenta is not
+   bipartite; its positions, of the lower degree, still form an independent
+   set); the larger set is kept. Sets na, aidx, bpos, fidx, nf. */
 #define PHGMG__SP_CONDENSE_DEG 32
-PHGMG__PRIV phgmg_result phgmg__sp_condense_select(phgmg__spsym *S, const int *gp, const int *gi,
-                                                   const phgmg_allocator *al) {
-  int n = S->n, v, head = 0, tail = 0, r, p;
-  int *q = phgmg__ialloc(al, (size_t)n), *st = phgmg__ialloc(al, (size_t)n);
-  phgmg_result rc = PHGMG_ERR_NOMEM;
-  S->na = 0; S->nf = 0;
-  S->aidx = phgmg__ialloc(al, (size_t)n + 1);
-  S->fidx = phgmg__ialloc(al, (size_t)n + 1);
-  S->bpos = phgmg__ialloc(al, (size_t)n + 1);
-  if (!q || !st || !S->aidx || !S->fidx || !S->bpos) goto done;
-  for (v = 0; v < n; ++v) st[v] = 0; /* 0 unseen, 1 queued, 2 chosen, 3 blocked */
-  for (v = 0; S->e_p && v < n; ++v) /* E (E P) couples v to another state: not condensed (real couplings) */
-    for (p = S->e_p[S->cperm ? S->cperm[v] : v]; p < S->e_p[(S->cperm ? S->cperm[v] : v) + 1]; ++p)
-      if (S->e_i[p] != v && S->e_x[p] != 0.0) { st[v] = st[S->e_i[p]] = 4; }
-  for (r = 0; r < n; ++r) {
+/* Greedy pass: st[v] = 2 for the chosen states (st on entry: 0, or 4 for a
+   state that may not be chosen); visits in breadth-first order (bydeg 0) or
+   by increasing degree, ties by index (bydeg 1; q: n + 1 ints more).
+   Returns the number chosen. */
+PHGMG__PRIV int phgmg__sp_condense_greedy(int n, const int *gp, const int *gi, int *st, int *q, int bydeg) {
+  int v, head = 0, tail = 0, r, p, cnt = 0;
+  if (bydeg) { /* counting sort by degree (degrees above the limit never chosen) */
+    int *start = q + n, d;
+    for (d = 0; d <= PHGMG__SP_CONDENSE_DEG + 1; ++d) start[d] = 0;
+    for (v = 0; v < n; ++v) start[PHGMG__MIN(gp[v + 1] - gp[v], PHGMG__SP_CONDENSE_DEG) + 1]++;
+    for (d = 0; d < PHGMG__SP_CONDENSE_DEG; ++d) start[d + 1] += start[d];
+    for (v = 0; v < n; ++v) {
+      d = gp[v + 1] - gp[v];
+      if (d <= PHGMG__SP_CONDENSE_DEG) q[start[d]++] = v;
+    }
+    for (r = 0; r < start[PHGMG__SP_CONDENSE_DEG]; ++r) {
+      int u = q[r], free_ = st[u] == 0;
+      for (p = gp[u]; p < gp[u + 1] && free_; ++p) if (st[gi[p]] == 2) free_ = 0;
+      if (free_) { st[u] = 2; ++cnt; }
+    }
+    return cnt;
+  }
+  for (r = 0; r < n; ++r) { /* 0 unseen, 1 queued, 2 chosen, 3 blocked */
     if (st[r]) continue;
     st[r] = 1; q[tail++] = r;
     while (head < tail) {
       int u = q[head++], free_ = gp[u + 1] - gp[u] <= PHGMG__SP_CONDENSE_DEG;
       for (p = gp[u]; p < gp[u + 1] && free_; ++p) if (st[gi[p]] == 2) free_ = 0;
       st[u] = free_ ? 2 : 3;
+      cnt += free_;
       for (p = gp[u]; p < gp[u + 1]; ++p) if (!st[gi[p]]) { st[gi[p]] = 1; q[tail++] = gi[p]; }
     }
   }
+  return cnt;
+}
+PHGMG__PRIV phgmg_result phgmg__sp_condense_select(phgmg__spsym *S, const int *gp, const int *gi,
+                                                   const phgmg_allocator *al) {
+  int n = S->n, v, p, c1, c2;
+  int *q = phgmg__ialloc(al, (size_t)n + PHGMG__SP_CONDENSE_DEG + 2), *st = phgmg__ialloc(al, (size_t)n);
+  int *st2 = phgmg__ialloc(al, (size_t)n);
+  phgmg_result rc = PHGMG_ERR_NOMEM;
+  S->na = 0; S->nf = 0;
+  S->aidx = phgmg__ialloc(al, (size_t)n + 1);
+  S->fidx = phgmg__ialloc(al, (size_t)n + 1);
+  S->bpos = phgmg__ialloc(al, (size_t)n + 1);
+  if (!q || !st || !st2 || !S->aidx || !S->fidx || !S->bpos) goto done;
+  for (v = 0; v < n; ++v) st[v] = 0;
+  for (v = 0; S->e_p && v < n; ++v) /* E (E P) couples v to another state: not condensed (real couplings) */
+    for (p = S->e_p[S->cperm ? S->cperm[v] : v]; p < S->e_p[(S->cperm ? S->cperm[v] : v) + 1]; ++p)
+      if (S->e_i[p] != v && S->e_x[p] != 0.0) { st[v] = st[S->e_i[p]] = 4; }
+  for (v = 0; v < n; ++v) st2[v] = st[v];
+  c1 = phgmg__sp_condense_greedy(n, gp, gi, st, q, 0);
+  c2 = phgmg__sp_condense_greedy(n, gp, gi, st2, q, 1);
+  if (c2 > c1) { int *t = st; st = st2; st2 = t; }
   for (v = 0; v < n; ++v) {
     if (st[v] == 2) { S->bpos[v] = -1 - S->na; S->aidx[S->na++] = v; }
     else { S->bpos[v] = S->nf; S->fidx[S->nf++] = v; }
   }
   rc = PHGMG_OK;
 done:
-  phgmg__free(al, q); phgmg__free(al, st);
+  phgmg__free(al, q); phgmg__free(al, st); phgmg__free(al, st2);
   return rc;
 }
 
@@ -22478,24 +22519,115 @@ PHGMG_DEF phgmg_result phgmg_shifted_transfer(phgmg_shifted *s, double w, double
   return rc;
 }
 
+/* G(i w), w != 0, as phgmg_shifted_transfer computes it, with a numeric
+   factor F of the caller's (not one of the object's kept ones: a thread's
+   own) and scratch X (3 N m doubles) and v (N doubles); the object is only
+   read. */
+PHGMG__PRIV phgmg_result phgmg__shifted_transfer_own(const phgmg_shifted *s, double w, double *G, phgmg__spnum *F,
+                                                    double *X, double *v) {
+  const int N = s->N, m = s->sp->sys.m;
+  const double *B = s->sp->sys.B;
+  double *col = X + 2 * (size_t)N * (size_t)m;
+  size_t i, len = 2 * (size_t)N;
+  int a, b, part;
+  for (i = 0; i < (size_t)N * (size_t)m; ++i) { X[2 * i] = B[i]; X[2 * i + 1] = 0.0; }
+  for (b = 0; b < m; ++b)
+    if (!phgmg__all_finite(X + (size_t)b * len, len)) return PHGMG_ERR_NANINF;
+  phgmg__sp_factor(s->S, F, s->Mx, -0.0, w, PHGMG_SPARSE_PIVTOL); /* K(-p), p = -i w (phgmg_shifted_solve) */
+  if (F->nstatic || !(F->growth <= PHGMG_SPARSE_GROWTH)) return PHGMG_ERR_SINGULAR;
+  for (b = 0; b < m; ++b) {
+    double *x = X + (size_t)b * len;
+    phgmg__sp_solve(s->S, F, x);
+    for (i = 0; i < len; ++i) x[i] = -x[i];
+  }
+  for (b = 0; b < m; ++b)
+    for (part = 0; part < 2; ++part) {
+      for (i = 0; i < (size_t)N; ++i) col[i] = X[2 * (i + (size_t)b * N) + part];
+      phgmg__sp_qmv(s->S, col, v);
+      for (a = 0; a < m; ++a) G[2 * (a + (size_t)b * m) + part] = -phgmg__dot(N, B + (size_t)a * N, v);
+    }
+  return PHGMG_OK;
+}
+
+/* One frequency of phgmg_shifted_hinf: sigma_max of G and of G - Gr into
+   *h_ref, *h_err. F NULL: through phgmg_shifted_transfer (the object's kept
+   factors), else with F and the scratch X, v (phgmg__shifted_transfer_own:
+   the same numbers). */
+PHGMG__PRIV phgmg_result phgmg__shifted_hinf_at(phgmg_shifted *s, int r, const double *Ar, const double *Br,
+                                               const double *Cr, double w, phgmg__spnum *F, double *X, double *v,
+                                               double *h_ref, double *h_err) {
+  const int m = s->sp->sys.m;
+  double G[2 * 16 * 16] = {0.0}, Gr[2 * 16 * 16];
+  phgmg_result rc = F ? phgmg__shifted_transfer_own(s, w, G, F, X, v) : phgmg_shifted_transfer(s, w, G);
+  int i;
+  if (rc == PHGMG_OK && Ar) rc = phgmg_ss_transfer(r, m, m, Ar, Br, Cr, w, Gr, s->alloc);
+  if (rc != PHGMG_OK) return rc;
+  *h_ref = phgmg__zsigma_max(m, m, G);
+  *h_err = 0.0;
+  if (!Ar) return PHGMG_OK;
+  for (i = 0; i < 2 * m * m; ++i) Gr[i] = G[i] - Gr[i];
+  *h_err = phgmg__zsigma_max(m, m, Gr);
+  return PHGMG_OK;
+}
+
+#if defined(PHGMG_USE_OPENMP) && defined(_OPENMP)
+/* The frequencies in parallel (PHGMG_USE_OPENMP): each thread with its own
+   numeric factor and scratch; per frequency the numbers of the serial run,
+   hv/rv/cv (nw each) collected, then reduced in order. */
+PHGMG__PRIV phgmg_result phgmg__shifted_hinf_par(phgmg_shifted *s, int r, const double *Ar, const double *Br,
+                                                const double *Cr, int nw, double wmin, double wmax, double *hi,
+                                                double *hr) {
+  const size_t N = (size_t)s->N, m = (size_t)s->sp->sys.m;
+  double *hv = phgmg__dalloc(s->alloc, 2 * (size_t)nw);
+  int *cv = phgmg__ialloc(s->alloc, (size_t)nw), j;
+  phgmg_result rc = PHGMG_OK;
+  if (!hv || !cv) { phgmg__free(s->alloc, hv); phgmg__free(s->alloc, cv); return PHGMG_ERR_NOMEM; }
+#pragma omp parallel
+  {
+    phgmg__spnum F;
+    double *X = phgmg__dalloc(s->alloc, 3 * N * m + N);
+    int jj, ok = X != NULL && phgmg__spnum_alloc(s->alloc, s->S, 1, &F) == PHGMG_OK;
+#pragma omp for schedule(dynamic, 1)
+    for (jj = 0; jj < nw; ++jj) {
+      const double w = wmin * pow(wmax / wmin, nw > 1 ? (double)jj / (nw - 1) : 0.0);
+      cv[jj] = ok ? (int)phgmg__shifted_hinf_at(s, r, Ar, Br, Cr, w, &F, X, X + 3 * N * m, hv + 2 * jj, hv + 2 * jj + 1)
+                  : (int)PHGMG_ERR_NOMEM;
+    }
+    if (ok) phgmg__spnum_free(s->alloc, &F);
+    phgmg__free(s->alloc, X);
+  }
+  for (j = 0; j < nw && rc == PHGMG_OK; ++j) {
+    rc = (phgmg_result)cv[j];
+    if (cv[j] != (int)PHGMG_ERR_NOMEM) ++s->nfact;
+    if (rc != PHGMG_OK) break;
+    *hr = PHGMG__MAX(*hr, hv[2 * j]);
+    *hi = PHGMG__MAX(*hi, hv[2 * j + 1]);
+  }
+  phgmg__free(s->alloc, hv); phgmg__free(s->alloc, cv);
+  return rc;
+}
+#endif
+
 PHGMG_DEF phgmg_result phgmg_shifted_hinf(phgmg_shifted *s, int r, const double *Ar, const double *Br,
                                           const double *Cr, int nw, double wmin, double wmax, double *hinf,
                                           double *hinf_ref) {
   const int m = s ? s->sp->sys.m : 0, red = Ar != NULL;
-  double G[2 * 16 * 16], Gr[2 * 16 * 16], hi = 0.0, hr = 0.0;
+  double hi = 0.0, hr = 0.0;
   phgmg_result rc = PHGMG_OK;
-  int j, i;
+  int j;
   if (!s || (Br != NULL) != red || (Cr != NULL) != red) return PHGMG_ERR_INVALID_ARG;
   if (r < 0 || (red && r < 1) || m > 16 || nw < 1 || !(wmin > 0.0) || !(wmax >= wmin)) return PHGMG_ERR_SIZE;
+#if defined(PHGMG_USE_OPENMP) && defined(_OPENMP)
+  if (nw > 1) rc = phgmg__shifted_hinf_par(s, r, Ar, Br, Cr, nw, wmin, wmax, &hi, &hr);
+  else
+#endif
   for (j = 0; j < nw && rc == PHGMG_OK; ++j) {
     const double w = wmin * pow(wmax / wmin, nw > 1 ? (double)j / (nw - 1) : 0.0);
-    rc = phgmg_shifted_transfer(s, w, G);
-    if (rc == PHGMG_OK && red) rc = phgmg_ss_transfer(r, m, m, Ar, Br, Cr, w, Gr, s->alloc);
+    double h_ref, h_err;
+    rc = phgmg__shifted_hinf_at(s, r, Ar, Br, Cr, w, NULL, NULL, NULL, &h_ref, &h_err);
     if (rc != PHGMG_OK) break;
-    hr = PHGMG__MAX(hr, phgmg__zsigma_max(m, m, G));
-    if (!red) continue;
-    for (i = 0; i < 2 * m * m; ++i) Gr[i] = G[i] - Gr[i];
-    hi = PHGMG__MAX(hi, phgmg__zsigma_max(m, m, Gr));
+    hr = PHGMG__MAX(hr, h_ref);
+    hi = PHGMG__MAX(hi, h_err);
   }
   if (rc == PHGMG_OK) {
     if (hinf) *hinf = hi;
