@@ -4918,8 +4918,9 @@ PHGMG_DEF phgmg_result phgmg_mpi_gmg_pod_linear(const phgmg_mpi_ctx *ctx, const 
    m, B and the solve with J - R as for a linear model. Each
    rank passes its own terms: nsep (0 allowed), sep_idx their global state
    indices (rows of this rank), sep_id their global term indices (distinct
-   over the ranks, ascending in rank order, e.g. the serial model's term
-   numbers; NULL: sep_idx), sep_w their weights (NULL: 1). poly_deg, nexp:
+   over the ranks, ascending on each rank, in any order across the ranks:
+   e.g. the serial model's term numbers, whatever coordinates the terms act
+   on; NULL: sep_idx), sep_w their weights (NULL: 1). poly_deg, nexp:
    the same on every rank (poly_deg <= 32, nexp <= 8, not both 0); per_term
    = 0: one function for every term, poly ((poly_deg + 1), may be NULL) and
    expo (2 nexp) the same on every rank; per_term = 1: one per term, row k
@@ -26045,17 +26046,13 @@ PHGMG__PRIV phgmg_result phgmg__mpi_sep_check_global(const phgmg_mpi_ctx *ctx, c
   int v[4] = {0, 0, 0, 0}, lo[4], hi[4], i;
   double c[32 + 1 + 16];
   const int nc = md ? md->poly_deg + 1 : 0, ne = md ? 2 * md->nexp : 0;
-  phgmg_gidx last = -1, prev = -1;   /* ids ascending in rank order: this rank's first above the last before */
   if (md) { v[0] = md->poly_deg; v[1] = md->nexp; v[2] = md->per_term; }
   v[3] = rc;
-  if (md && rc == PHGMG_OK && md->nsep > 0) last = md->sep_id ? md->sep_id[md->nsep - 1] : md->sep_idx[md->nsep - 1];
   MPI_Allreduce(v, lo, 4, MPI_INT, MPI_MIN, ctx->comm);
   MPI_Allreduce(v, hi, 4, MPI_INT, MPI_MAX, ctx->comm);
-  MPI_Exscan(&last, &prev, 1, MPI_LONG_LONG, MPI_MAX, ctx->comm);
-  phgmg__mpi_count(ctx, 16.0); phgmg__mpi_count(ctx, 16.0); phgmg__mpi_count(ctx, 8.0);
+  phgmg__mpi_count(ctx, 16.0); phgmg__mpi_count(ctx, 16.0);
   if (lo[3] != PHGMG_OK) return (phgmg_result)lo[3];
   for (i = 0; i < 3; ++i) if (lo[i] != hi[i]) rc = PHGMG_ERR_INVALID_ARG;
-  if (ctx->rank > 0 && md->nsep > 0 && (md->sep_id ? md->sep_id[0] : md->sep_idx[0]) <= prev) rc = PHGMG_ERR_INVALID_ARG;
   if (rc != PHGMG_OK || md->per_term) return phgmg__mpi_agree(ctx, rc);
   for (i = 0; i < nc + ne; ++i) c[i] = i < nc ? (md->poly ? md->poly[i] : 0.0) : md->expo[i - nc];
   MPI_Bcast(c, nc + ne, MPI_DOUBLE, 0, ctx->comm);
@@ -26525,8 +26522,14 @@ PHGMG__PRIV phgmg_result phgmg__mpi_sp1_blocks(const phgmg_mpi_ctx *ctx, const p
   return rc;
 }
 
+/* (id, weight) pairs by id. */
+PHGMG__PRIV int phgmg__mpi_pair_cmp(const void *a, const void *b) {
+  const double x = *PHGMG__CAST(const double *, a), y = *PHGMG__CAST(const double *, b);
+  return (x > y) - (x < y);
+}
+
 /* Every term kept with its weight (hyper.on = 0): all ranks' ids and
-   weights gathered in rank order (ascending). pts, w: room for nsg. */
+   weights gathered, ascending by id. pts, w: room for nsg. */
 PHGMG__PRIV phgmg_result phgmg__mpi_sep_all(const phgmg_mpi_ctx *ctx, const phgmg_mpi_sep_model *md, int nsg,
                                             phgmg_gidx *pts, double *w) {
   const int n = md->nsep;
@@ -26544,6 +26547,7 @@ PHGMG__PRIV phgmg_result phgmg__mpi_sep_all(const phgmg_mpi_ctx *ctx, const phgm
     for (k = 0; k < ctx->size; ++k) cnt[ctx->size + k] = k == 0 ? 0 : cnt[ctx->size + k - 1] + cnt[k - 1];
     MPI_Allgatherv(loc, two, MPI_DOUBLE, b, cnt, cnt + ctx->size, MPI_DOUBLE, ctx->comm);
     phgmg__mpi_count(ctx, 4.0); phgmg__mpi_count(ctx, 16.0 * n);
+    if (nsg > 1) qsort(b, (size_t)nsg, 2 * sizeof(double), phgmg__mpi_pair_cmp);   /* ids in any rank order */
     for (k = 0; k < nsg; ++k) { pts[k] = (phgmg_gidx)b[2 * k]; w[k] = b[2 * k + 1]; }
   }
   phgmg__free(&ctx->al, b);
