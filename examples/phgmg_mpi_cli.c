@@ -3,12 +3,20 @@
      make build/phgmg-mpi        (mpicc; the library with PHGMG_MPI)
      mpirun -np P build/phgmg-mpi reduce --J-coo J.npy --R-coo R.npy --Q-coo Q.npy \
          --B B.npy --X X.npy --method gmg-pod|sp1 --r R --out DIR [--name rom] [--dt DT] [--quiet]
+         [--potential NAME | --poly c.npy [--exp e.npy]] --poly-idx idx.npy [--poly-w w.npy]
+         [--hyper ecsw] [--hyper-tol T] [--no-hyper]
 
    It reads the files of the serial `phgmg reduce` (J, R, Q as (nnz, 3) .npy
    arrays of (row, col, value) triplets, 0-based, duplicates summed; B (N,)
-   or (N, m); the snapshots X (N, ns)) and writes what the serial command
-   writes for the same options: DIR/NAME.phgmgrom, DIR/NAME.c,
-   DIR/NAME.json and the arrays DIR/NAME_Bh.npy, _Qh.npy, _K.npy, _V0.npy.
+   or (N, m); the snapshots X (N, ns); a separable nonlinear part
+   H_nl = sum_k w_k phi_k(x[idx_k]) as the serial command takes it) and
+   writes what the serial command writes for the same options:
+   DIR/NAME.phgmgrom, DIR/NAME.c, DIR/NAME.json and the arrays
+   DIR/NAME_Bh.npy, _Qh.npy, _K.npy, _V0.npy (with kept nonlinear terms also
+   _P0.npy, _w.npy, _poly.npy, _expo.npy). Every rank reads the terms' small
+   files whole and keeps the terms on its own rows, numbered as the serial
+   command numbers them; the hyper-reduction (ECSW, the serial default) is
+   the library's distributed one, so the kept terms are the serial run's.
    Each rank keeps its own contiguous block of rows of the state: of Q, B,
    the snapshots (read a batch of columns at a time) and, for sp1, of
    J - R. The solves with J - R that GMG-POD needs go through the library's
@@ -31,14 +39,18 @@
 #include <sys/stat.h>
 #include <sys/types.h>
 
-static const char *const help_text =
-  "phgmg-mpi " PHGMG_VERSION_STRING " - the distributed `phgmg reduce` (MPI): linear port-Hamiltonian\n"
-  "models x' = (J - R) Q x + B u, y = B^T Q x, reduced on P ranks.\n"
+/* In parts: C99 compilers need take no string longer than 4095 characters. */
+static const char *const help_text[] = {
+  "phgmg-mpi " PHGMG_VERSION_STRING " - the distributed `phgmg reduce` (MPI): port-Hamiltonian models\n"
+  "x' = (J - R) grad H(x) + B u, y = B^T grad H(x), with H(x) = 1/2 x^T Q x (linear) or\n"
+  "H(x) = 1/2 x^T Q x + sum_k w_k phi_k(x[idx_k]) (separable terms), reduced on P ranks.\n"
   "\n"
   "USAGE\n"
   "  mpirun -np P phgmg-mpi reduce --J-coo J.npy --R-coo R.npy --Q-coo Q.npy --B B.npy\n"
   "               --X X.npy --method gmg-pod|sp1 --r R --out DIR [--name rom]\n"
   "               [--dt DT] [--quiet]\n"
+  "               [--potential NAME | --poly FILE [--exp FILE]] --poly-idx FILE\n"
+  "               [--poly-w FILE] [--hyper ecsw] [--hyper-tol T] [--no-hyper]\n"
   "  phgmg-mpi --help | --version\n"
   "\n"
   "OPTIONS (those of `phgmg reduce`, with the same meaning)\n"
@@ -57,7 +69,27 @@ static const char *const help_text =
   "  --dt DT             the snapshots' step, recorded in the model file\n"
   "                      (simulate-rom's default step).\n"
   "  --quiet             no summary line.\n"
-  "\n"
+  "\n",
+  "NONLINEAR PART (optional; as `phgmg reduce` takes it)\n"
+  "  --poly FILE         phi from the exp-polynomial family phi(s) = sum_j c_j s^j +\n"
+  "                      sum_e a_e exp(b_e s): the coefficients c_0, ..., c_d as a vector\n"
+  "                      (shared by every term) or a (terms, d+1) matrix (one row per term).\n"
+  "  --exp FILE          the exponentials (a_e, b_e): (n_exp, 2) shared, or (terms, 2 n_exp)\n"
+  "                      per term (a (terms, 2) matrix with up to 8 terms is per term only\n"
+  "                      beside a per-term --poly).\n"
+  "  --potential NAME    a named potential instead of --poly/--exp: toda (e^s - 1 - s),\n"
+  "                      cosh:A ((cosh(A s) - 1)/A^2, A != 0), morse:D:A (D (1 - e^{-A s})^2,\n"
+  "                      D > 0, A != 0), fpu:K3:K4 (K3 s^3/3 + K4 s^4/4, K4 > 0). An energy\n"
+  "                      unbounded below is refused.\n"
+  "  --poly-idx FILE     the 0-based state coordinate of each term (a vector; term k is\n"
+  "                      entry k, wherever its coordinate lies among the ranks' rows).\n"
+  "  --poly-w FILE       the terms' weights w_k (default all 1).\n"
+  "  --hyper ecsw        the hyper-reduction (the default): ECSW keeps a few terms with\n"
+  "                      weights >= 0, the serial run's terms and weights.\n"
+  "  --hyper-tol T       ECSW's relative training residual (default 1e-6; 1e-14 <= T < 1).\n"
+  "  --no-hyper          keep every term online (exact, cost O(terms)); --no-deim is the\n"
+  "                      former name.\n"
+  "\n",
   "CHECKS\n"
   "  As the serial command: J skew-symmetric, R symmetric positive semidefinite\n"
   "  (relative tolerance 1e-12), B of full column rank, J - R nonsingular, indices\n"
@@ -70,11 +102,14 @@ static const char *const help_text =
   "  DIR/NAME.json       what was reduced and how (with \"mpi_ranks\" and the solver)\n"
   "  DIR/NAME_Bh.npy, DIR/NAME_Qh.npy, DIR/NAME_K.npy   the reduced blocks\n"
   "  DIR/NAME_V0.npy     the basis (N x r): x = V0 @ xr\n"
+  "  DIR/NAME_P0.npy, _w.npy, _poly.npy, _expo.npy   with nonlinear terms kept: their rows\n"
+  "                      of V0, weights and functions (expo only with exponentials)\n"
   "\n"
   "DISTRIBUTION\n"
   "  Rank p keeps rows [row0, row0 + nloc) of the state, contiguous blocks of\n"
   "  N / P rows in rank order: its rows of Q, B and the snapshots (and, for sp1,\n"
-  "  of J - R). The small reduced matrices are identical on every rank.\n"
+  "  of J - R), and the nonlinear terms whose coordinate is one of its rows.\n"
+  "  The small reduced matrices are identical on every rank.\n"
   "  The solves with J - R (gmg-pod) use the library's sparse LU of J - R,\n"
   "  REPLICATED on every rank: each rank factors the whole J - R once and the\n"
   "  right-hand sides are gathered to every rank. This is fine while that\n"
@@ -85,13 +120,14 @@ static const char *const help_text =
   "NOT SUPPORTED HERE (each is refused with a message naming it)\n"
   "  --simulate (give the snapshots with --X; make them with the serial\n"
   "  `phgmg simulate ... --states X.npy`), dense --J/--R/--Q, --E/--E-coo,\n"
-  "  nonlinear terms, dampers, feedthrough, --ref, gmg-qm, sp2, balancing,\n"
-  "  hyper-reduction options, several --X files, method or order lists, and\n"
-  "  every other option of `phgmg reduce`: use the serial `phgmg` for them.\n"
+  "  springs (--poly-jdx), DEIM hyper-reduction (--hyper qdeim or greedy,\n"
+  "  --deim-tol, --deim-max, --deim-allow-negative), dampers, feedthrough, --ref,\n"
+  "  gmg-qm, sp2, balancing, several --X files, method or order lists, and every\n"
+  "  other option of `phgmg reduce`: use the serial `phgmg` for them.\n"
   "\n"
   "EXIT STATUS\n"
   "  0 success, 1 an error in the inputs or the reduction, 2 a usage error;\n"
-  "  every rank exits with the same status.\n";
+  "  every rank exits with the same status.\n", NULL};
 
 typedef struct args {
   const char *J, *R, *Q, *B, *X, *out, *name;
@@ -1144,7 +1180,8 @@ int main(int argc, char **argv) {
   MPI_Comm_rank(MPI_COMM_WORLD, &g_rank);
   MPI_Comm_size(MPI_COMM_WORLD, &size);
   if (argc >= 2 && (!strcmp(argv[1], "--help") || !strcmp(argv[1], "-h"))) {
-    if (g_rank == 0) fputs(help_text, stdout);
+    int k;
+    for (k = 0; g_rank == 0 && help_text[k]; ++k) fputs(help_text[k], stdout);
     status = 0;
   } else if (argc >= 2 && !strcmp(argv[1], "--version")) {
     if (g_rank == 0) printf("phgmg-mpi %s\n", PHGMG_VERSION_STRING);
