@@ -14,6 +14,8 @@
 #   sh bench/mpi_cli_scale.sh [NX [R [DIR]]]     (defaults 100000 20 /tmp/mpi_cli_scale)
 # DIR keeps the model, the snapshots (1.6 GB at NX = 1e5) and the outputs;
 # steps whose outputs exist are not redone (delete DIR to start afresh).
+# METHODS (default "gmg-pod sp1") and PS (default "1 2 3 4") select the runs;
+# the table lists those that were made.
 # The machine may be shared: the times are those of this run.
 set -e
 NX=${1:-100000}
@@ -32,7 +34,7 @@ M="--J-coo J.npy --R-coo R.npy --Q-coo Q.npy --B B.npy --potential cosh:1 --poly
 now() { date +%s.%N; }
 [ -e idx.npy ] || $PY "$ROOT/bench/lattice.py" . "$NX" 1 --cosh > /dev/null
 [ -e X.npy ] || "$PHGMG" simulate $M --dt 0.1 --steps 1000 --out y_full.npy --states X.npy --quiet > /dev/null
-for meth in gmg-pod sp1; do
+for meth in ${METHODS:-gmg-pod sp1}; do
   if [ ! -e "y_serial_$meth.npy" ]; then
     t0=$(now)
     /usr/bin/time -v -o "time_serial_$meth.txt" "$PHGMG" reduce $M --X X.npy --method $meth --r "$R" \
@@ -40,7 +42,7 @@ for meth in gmg-pod sp1; do
     echo "$(now) $t0" | awk '{printf "%.2f\n", $1 - $2}' > "wall_serial_$meth.txt"
     "$PHGMG" simulate-rom --model "serial_$meth/rom.phgmgrom" --dt 0.1 --steps 1000 --out "y_serial_$meth.npy" --quiet > /dev/null
   fi
-  for p in 1 2 3 4; do
+  for p in ${PS:-1 2 3 4}; do
     [ -e "y_p${p}_$meth.npy" ] && continue
     rm -f time_p${p}_${meth}_rank*.txt
     t0=$(now)
@@ -53,6 +55,7 @@ done
 
 $PY - "$D" "$NX" "$R" <<'PYEOF'
 import glob
+import os
 import re
 import sys
 import numpy as np
@@ -68,10 +71,12 @@ def coords(P0, V0):   # the state coordinates of the kept terms: their rows of V
 
 print('chain of %d masses, N = %d, %d snapshots, r = %d, cosh:1 on every position, ECSW tol 1e-6' % (nx, 2 * nx, 1001, r))
 print()
-print('| method | run | wall [s] | CPU [s] | peak RSS, largest rank [MB] | vs P = 1 | ECSW points | same points as serial | simulate-rom max rel. diff |')
+print('| method | run | wall [s] | CPU [s] | peak RSS, largest rank [MB] | vs the first P | ECSW points | same points as serial | simulate-rom max rel. diff |')
 print('|---|---|---|---|---|---|---|---|---|')
 for meth in ('gmg-pod', 'sp1'):
     sd = '%s/serial_%s' % (d, meth)
+    if not os.path.exists('%s/y_serial_%s.npy' % (d, meth)):
+        continue
     V0s = np.load(sd + '/rom_V0.npy', mmap_mode='r')
     P0s = np.load(sd + '/rom_P0.npy')
     cs = coords(P0s, np.asarray(V0s))
@@ -82,11 +87,13 @@ for meth in ('gmg-pod', 'sp1'):
     rss1 = None
     for p in (1, 2, 3, 4):
         pd = '%s/p%d_%s' % (d, p, meth)
+        if not os.path.exists('%s/y_p%d_%s.npy' % (d, p, meth)):
+            continue
         ranks = sorted(glob.glob('%s/time_p%d_%s_rank*.txt' % (d, p, meth)))
         vals = [tv(f) for f in ranks]
         cpu = sum(v[0] for v in vals)
         rss = max(v[1] for v in vals)
-        rss1 = rss if p == 1 else rss1
+        rss1 = rss if rss1 is None else rss1
         wall = float(open('%s/wall_p%d_%s.txt' % (d, p, meth)).read())
         cd = coords(np.load(pd + '/rom_P0.npy'), np.asarray(np.load(pd + '/rom_V0.npy', mmap_mode='r')))
         y = np.load('%s/y_p%d_%s.npy' % (d, p, meth))
