@@ -851,8 +851,8 @@
    Not yet distributed: GMG-QM, DEIM hyper-reduction (hyper.kind
    QDEIM or GREEDY), separable terms by callbacks and GENERAL nonlinear
    Hamiltonians, a reference state (opts.ref), dampers, feedthrough,
-   descriptor models; in the command line (below) also the separable terms
-   and simulating the training runs.
+   descriptor models; in the command line (below) also simulating the
+   training runs.
    A PETSc + MUMPS example. examples/petsc_mumps.c puts a real distributed
    direct solver behind the solve callback: it reads the command line's
    files (J, R, Q as (nnz, 3) triplets, B, the snapshots X), each rank
@@ -870,14 +870,23 @@
      mpirun -np P build/phgmg-mpi reduce --J-coo J.npy --R-coo R.npy
          --Q-coo Q.npy --B B.npy --X X.npy --method gmg-pod|sp1 --r R
          --out DIR [--name rom] [--dt DT] [--quiet]
+         [--potential NAME | --poly c.npy [--exp e.npy]] --poly-idx idx.npy
+         [--poly-w w.npy] [--hyper ecsw] [--hyper-tol T] [--no-hyper]
    reads the files of the serial `phgmg reduce` (J, R, Q as (nnz, 3)
-   triplets, B, the snapshots X; chapter 6) and writes its files: DIR/
-   NAME.phgmgrom, NAME.c, NAME.json and NAME_Bh.npy, NAME_Qh.npy,
-   NAME_K.npy, NAME_V0.npy (rank 0 writes; V0 is gathered a column at a
-   time). Rank p keeps a contiguous block of about N / P rows of the
-   state: its rows of Q (phgmg_mpi_op_create), of B, of the snapshots (read
-   a batch of columns at a time, phgmg_npy_read_cols) and, for sp1, of
-   J - R; the reduction is phgmg_mpi_reduce on a linear model. The solves
+   triplets, B, the snapshots X, the separable nonlinear part as the
+   serial command takes it: a named potential or exp-polynomial
+   coefficients, the terms' coordinates and weights; chapter 6) and writes
+   its files: DIR/NAME.phgmgrom, NAME.c, NAME.json and NAME_Bh.npy,
+   NAME_Qh.npy, NAME_K.npy, NAME_V0.npy, with kept nonlinear terms also
+   NAME_P0.npy, NAME_w.npy, NAME_poly.npy, NAME_expo.npy (rank 0 writes; V0
+   is gathered a column at a time). Rank p keeps a contiguous block of
+   about N / P rows of the state: its rows of Q (phgmg_mpi_op_create), of
+   B, of the snapshots (read a batch of columns at a time,
+   phgmg_npy_read_cols) and, for sp1, of J - R, and the nonlinear terms
+   on its rows with their serial term numbers as global ids (any order
+   across the ranks); the reduction is phgmg_mpi_reduce with the serial
+   default hyper-reduction, ECSW at tolerance 1e-6 (--hyper-tol; --no-hyper
+   keeps every term). The solves
    with J - R that GMG-POD needs use the library's sparse LU of J - R
    (phgmg_jr_factor_create on a phgmg_ph_sparse model) REPLICATED on every
    rank: the right-hand sides are gathered to every rank, solved there,
@@ -885,8 +894,9 @@
    rank's memory; beyond, put a distributed solver behind the same
    callback, as examples/petsc_mumps.c does with MUMPS. Everything else of
    `phgmg reduce` -- --simulate (make the snapshots with the serial
-   `phgmg simulate --states`), dense matrices, --E, nonlinear terms,
-   dampers, feedthrough, --ref, the other methods, several --X files,
+   `phgmg simulate --states`), dense matrices, --E, springs (--poly-jdx),
+   DEIM hyper-reduction (--hyper qdeim or greedy), dampers, feedthrough,
+   --ref, the other methods, several --X files,
    method or order lists -- is refused with a message naming the option;
    bad input (a missing file, wrong shapes, bad indices; J, R, B and J - R
    checked as the serial command checks them, Q's definiteness not: each
@@ -895,7 +905,11 @@
    serial `phgmg reduce` on a chain of N = 2400 states (201 snapshots,
    r = 10; `make test-mpi`, tests/mpi/check_cli_mpi.sh) at 1-4 ranks: K,
    Qh, Bh and V0 within 1e-14 relative (after the modes' signs), the
-   outputs of `phgmg simulate-rom` within 5e-15, for gmg-pod and sp1.
+   outputs of `phgmg simulate-rom` within 5e-15, for gmg-pod and sp1; with
+   an on-site cosh potential on its 1200 positions (default ECSW): the
+   same 16 points as global indices, in the same order, P0 within 5e-15,
+   the weights within 1e-11, K, Qh, Bh, V0 within 7e-15, the outputs within
+   8e-15. Measured at N = 2e5 (1001 snapshots, r = 20): bench/README.md.
    2.8 Large sparse linear models (>>lowrank). For a phgmg_ph_sparse model
    with quadratic H (E x' = (J - R) Q x + B u, y = B^T Q x; E = I or a mass
    matrix of full rank) the Gramians are computed in low-rank factored form
@@ -1451,9 +1465,10 @@
                         --test-input (exit 1 if one fails);
      phgmg info         describe a model file.
    On MPI ranks, `mpirun -np P build/phgmg-mpi reduce ...` (make
-   build/phgmg-mpi) reduces a linear model from the same files with
-   gmg-pod or sp1 and writes the same outputs (2.7, "The command line
-   with MPI").
+   build/phgmg-mpi) reduces a linear model, or one with separable
+   nonlinear terms (--potential or --poly/--exp, --poly-idx, ECSW), from
+   the same files with gmg-pod or sp1 and writes the same outputs (2.7,
+   "The command line with MPI").
    Model options shared by reduce, validate and simulate include the mass
    matrix (--E, --E-coo), feedthrough (--P, --S, --N) and nonlinear dampers:
    --dampers FILE, a (k, 4) array of rows (i, j, c1, c3), a damper on
@@ -4930,8 +4945,9 @@ PHGMG_DEF phgmg_result phgmg_mpi_gmg_pod_linear(const phgmg_mpi_ctx *ctx, const 
    m, B and the solve with J - R as for a linear model. Each
    rank passes its own terms: nsep (0 allowed), sep_idx their global state
    indices (rows of this rank), sep_id their global term indices (distinct
-   over the ranks, ascending in rank order, e.g. the serial model's term
-   numbers; NULL: sep_idx), sep_w their weights (NULL: 1). poly_deg, nexp:
+   over the ranks, ascending on each rank, in any order across the ranks:
+   e.g. the serial model's term numbers, whatever coordinates the terms act
+   on; NULL: sep_idx), sep_w their weights (NULL: 1). poly_deg, nexp:
    the same on every rank (poly_deg <= 32, nexp <= 8, not both 0); per_term
    = 0: one function for every term, poly ((poly_deg + 1), may be NULL) and
    expo (2 nexp) the same on every rank; per_term = 1: one per term, row k
@@ -26181,17 +26197,13 @@ PHGMG__PRIV phgmg_result phgmg__mpi_sep_check_global(const phgmg_mpi_ctx *ctx, c
   int v[4] = {0, 0, 0, 0}, lo[4], hi[4], i;
   double c[32 + 1 + 16];
   const int nc = md ? md->poly_deg + 1 : 0, ne = md ? 2 * md->nexp : 0;
-  phgmg_gidx last = -1, prev = -1;   /* ids ascending in rank order: this rank's first above the last before */
   if (md) { v[0] = md->poly_deg; v[1] = md->nexp; v[2] = md->per_term; }
   v[3] = rc;
-  if (md && rc == PHGMG_OK && md->nsep > 0) last = md->sep_id ? md->sep_id[md->nsep - 1] : md->sep_idx[md->nsep - 1];
   MPI_Allreduce(v, lo, 4, MPI_INT, MPI_MIN, ctx->comm);
   MPI_Allreduce(v, hi, 4, MPI_INT, MPI_MAX, ctx->comm);
-  MPI_Exscan(&last, &prev, 1, MPI_LONG_LONG, MPI_MAX, ctx->comm);
-  phgmg__mpi_count(ctx, 16.0); phgmg__mpi_count(ctx, 16.0); phgmg__mpi_count(ctx, 8.0);
+  phgmg__mpi_count(ctx, 16.0); phgmg__mpi_count(ctx, 16.0);
   if (lo[3] != PHGMG_OK) return (phgmg_result)lo[3];
   for (i = 0; i < 3; ++i) if (lo[i] != hi[i]) rc = PHGMG_ERR_INVALID_ARG;
-  if (ctx->rank > 0 && md->nsep > 0 && (md->sep_id ? md->sep_id[0] : md->sep_idx[0]) <= prev) rc = PHGMG_ERR_INVALID_ARG;
   if (rc != PHGMG_OK || md->per_term) return phgmg__mpi_agree(ctx, rc);
   for (i = 0; i < nc + ne; ++i) c[i] = i < nc ? (md->poly ? md->poly[i] : 0.0) : md->expo[i - nc];
   MPI_Bcast(c, nc + ne, MPI_DOUBLE, 0, ctx->comm);
@@ -26704,8 +26716,14 @@ PHGMG__PRIV phgmg_result phgmg__mpi_sp_blocks(const phgmg_mpi_ctx *ctx, const ph
   return rc;
 }
 
+/* (id, weight) pairs by id. */
+PHGMG__PRIV int phgmg__mpi_pair_cmp(const void *a, const void *b) {
+  const double x = *PHGMG__CAST(const double *, a), y = *PHGMG__CAST(const double *, b);
+  return (x > y) - (x < y);
+}
+
 /* Every term kept with its weight (hyper.on = 0): all ranks' ids and
-   weights gathered in rank order (ascending). pts, w: room for nsg. */
+   weights gathered, ascending by id. pts, w: room for nsg. */
 PHGMG__PRIV phgmg_result phgmg__mpi_sep_all(const phgmg_mpi_ctx *ctx, const phgmg_mpi_sep_model *md, int nsg,
                                             phgmg_gidx *pts, double *w) {
   const int n = md->nsep;
@@ -26723,6 +26741,7 @@ PHGMG__PRIV phgmg_result phgmg__mpi_sep_all(const phgmg_mpi_ctx *ctx, const phgm
     for (k = 0; k < ctx->size; ++k) cnt[ctx->size + k] = k == 0 ? 0 : cnt[ctx->size + k - 1] + cnt[k - 1];
     MPI_Allgatherv(loc, two, MPI_DOUBLE, b, cnt, cnt + ctx->size, MPI_DOUBLE, ctx->comm);
     phgmg__mpi_count(ctx, 4.0); phgmg__mpi_count(ctx, 16.0 * n);
+    if (nsg > 1) qsort(b, (size_t)nsg, 2 * sizeof(double), phgmg__mpi_pair_cmp);   /* ids in any rank order */
     for (k = 0; k < nsg; ++k) { pts[k] = (phgmg_gidx)b[2 * k]; w[k] = b[2 * k + 1]; }
   }
   phgmg__free(&ctx->al, b);
@@ -28432,8 +28451,11 @@ PHGMG_DEF phgmg_result phgmg_sym_eig(int n, double *A, int lda, double *w, doubl
           - Examples: examples/petsc_mumps.c, PETSc's MUMPS behind the
             distributed solve callback (make test-petsc);
             examples/phgmg_mpi_cli.c, `mpirun -np P build/phgmg-mpi reduce`
-            (GMG-POD and SP1 of linear COO models from the serial command's
-            files, each rank reading its rows; the same output files).
+            (GMG-POD and SP1 of COO models from the serial command's files,
+            linear or with separable nonlinear terms and ECSW, each rank
+            reading its rows; the same output files). phgmg_mpi_sep_model's
+            term ids may come in any order across the ranks (ascending on
+            each rank).
    0.7.0  (2026-11-28)
           - Changed: an index-one model in SPARSE storage (E with zero rows
             and columns) is simulated on its sparse pencil (manual 1.8): no

@@ -3,12 +3,20 @@
      make build/phgmg-mpi        (mpicc; the library with PHGMG_MPI)
      mpirun -np P build/phgmg-mpi reduce --J-coo J.npy --R-coo R.npy --Q-coo Q.npy \
          --B B.npy --X X.npy --method gmg-pod|sp1 --r R --out DIR [--name rom] [--dt DT] [--quiet]
+         [--potential NAME | --poly c.npy [--exp e.npy]] --poly-idx idx.npy [--poly-w w.npy]
+         [--hyper ecsw] [--hyper-tol T] [--no-hyper]
 
    It reads the files of the serial `phgmg reduce` (J, R, Q as (nnz, 3) .npy
    arrays of (row, col, value) triplets, 0-based, duplicates summed; B (N,)
-   or (N, m); the snapshots X (N, ns)) and writes what the serial command
-   writes for the same options: DIR/NAME.phgmgrom, DIR/NAME.c,
-   DIR/NAME.json and the arrays DIR/NAME_Bh.npy, _Qh.npy, _K.npy, _V0.npy.
+   or (N, m); the snapshots X (N, ns); a separable nonlinear part
+   H_nl = sum_k w_k phi_k(x[idx_k]) as the serial command takes it) and
+   writes what the serial command writes for the same options:
+   DIR/NAME.phgmgrom, DIR/NAME.c, DIR/NAME.json and the arrays
+   DIR/NAME_Bh.npy, _Qh.npy, _K.npy, _V0.npy (with kept nonlinear terms also
+   _P0.npy, _w.npy, _poly.npy, _expo.npy). Every rank reads the terms' small
+   files whole and keeps the terms on its own rows, numbered as the serial
+   command numbers them; the hyper-reduction (ECSW, the serial default) is
+   the library's distributed one, so the kept terms are the serial run's.
    Each rank keeps its own contiguous block of rows of the state: of Q, B,
    the snapshots (read a batch of columns at a time) and, for sp1, of
    J - R. The solves with J - R that GMG-POD needs go through the library's
@@ -22,6 +30,7 @@
 #define PHGMG_IMPLEMENTATION
 #include "../phgmg.h"
 #include <errno.h>
+#include <float.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -30,14 +39,18 @@
 #include <sys/stat.h>
 #include <sys/types.h>
 
-static const char *const help_text =
-  "phgmg-mpi " PHGMG_VERSION_STRING " - the distributed `phgmg reduce` (MPI): linear port-Hamiltonian\n"
-  "models x' = (J - R) Q x + B u, y = B^T Q x, reduced on P ranks.\n"
+/* In parts: C99 compilers need take no string longer than 4095 characters. */
+static const char *const help_text[] = {
+  "phgmg-mpi " PHGMG_VERSION_STRING " - the distributed `phgmg reduce` (MPI): port-Hamiltonian models\n"
+  "x' = (J - R) grad H(x) + B u, y = B^T grad H(x), with H(x) = 1/2 x^T Q x (linear) or\n"
+  "H(x) = 1/2 x^T Q x + sum_k w_k phi_k(x[idx_k]) (separable terms), reduced on P ranks.\n"
   "\n"
   "USAGE\n"
   "  mpirun -np P phgmg-mpi reduce --J-coo J.npy --R-coo R.npy --Q-coo Q.npy --B B.npy\n"
   "               --X X.npy --method gmg-pod|sp1 --r R --out DIR [--name rom]\n"
   "               [--dt DT] [--quiet]\n"
+  "               [--potential NAME | --poly FILE [--exp FILE]] --poly-idx FILE\n"
+  "               [--poly-w FILE] [--hyper ecsw] [--hyper-tol T] [--no-hyper]\n"
   "  phgmg-mpi --help | --version\n"
   "\n"
   "OPTIONS (those of `phgmg reduce`, with the same meaning)\n"
@@ -56,7 +69,27 @@ static const char *const help_text =
   "  --dt DT             the snapshots' step, recorded in the model file\n"
   "                      (simulate-rom's default step).\n"
   "  --quiet             no summary line.\n"
-  "\n"
+  "\n",
+  "NONLINEAR PART (optional; as `phgmg reduce` takes it)\n"
+  "  --poly FILE         phi from the exp-polynomial family phi(s) = sum_j c_j s^j +\n"
+  "                      sum_e a_e exp(b_e s): the coefficients c_0, ..., c_d as a vector\n"
+  "                      (shared by every term) or a (terms, d+1) matrix (one row per term).\n"
+  "  --exp FILE          the exponentials (a_e, b_e): (n_exp, 2) shared, or (terms, 2 n_exp)\n"
+  "                      per term (a (terms, 2) matrix with up to 8 terms is per term only\n"
+  "                      beside a per-term --poly).\n"
+  "  --potential NAME    a named potential instead of --poly/--exp: toda (e^s - 1 - s),\n"
+  "                      cosh:A ((cosh(A s) - 1)/A^2, A != 0), morse:D:A (D (1 - e^{-A s})^2,\n"
+  "                      D > 0, A != 0), fpu:K3:K4 (K3 s^3/3 + K4 s^4/4, K4 > 0). An energy\n"
+  "                      unbounded below is refused.\n"
+  "  --poly-idx FILE     the 0-based state coordinate of each term (a vector; term k is\n"
+  "                      entry k, wherever its coordinate lies among the ranks' rows).\n"
+  "  --poly-w FILE       the terms' weights w_k (default all 1).\n"
+  "  --hyper ecsw        the hyper-reduction (the default): ECSW keeps a few terms with\n"
+  "                      weights >= 0, the serial run's terms and weights.\n"
+  "  --hyper-tol T       ECSW's relative training residual (default 1e-6; 1e-14 <= T < 1).\n"
+  "  --no-hyper          keep every term online (exact, cost O(terms)); --no-deim is the\n"
+  "                      former name.\n"
+  "\n",
   "CHECKS\n"
   "  As the serial command: J skew-symmetric, R symmetric positive semidefinite\n"
   "  (relative tolerance 1e-12), B of full column rank, J - R nonsingular, indices\n"
@@ -69,11 +102,14 @@ static const char *const help_text =
   "  DIR/NAME.json       what was reduced and how (with \"mpi_ranks\" and the solver)\n"
   "  DIR/NAME_Bh.npy, DIR/NAME_Qh.npy, DIR/NAME_K.npy   the reduced blocks\n"
   "  DIR/NAME_V0.npy     the basis (N x r): x = V0 @ xr\n"
+  "  DIR/NAME_P0.npy, _w.npy, _poly.npy, _expo.npy   with nonlinear terms kept: their rows\n"
+  "                      of V0, weights and functions (expo only with exponentials)\n"
   "\n"
   "DISTRIBUTION\n"
   "  Rank p keeps rows [row0, row0 + nloc) of the state, contiguous blocks of\n"
   "  N / P rows in rank order: its rows of Q, B and the snapshots (and, for sp1,\n"
-  "  of J - R). The small reduced matrices are identical on every rank.\n"
+  "  of J - R), and the nonlinear terms whose coordinate is one of its rows.\n"
+  "  The small reduced matrices are identical on every rank.\n"
   "  The solves with J - R (gmg-pod) use the library's sparse LU of J - R,\n"
   "  REPLICATED on every rank: each rank factors the whole J - R once and the\n"
   "  right-hand sides are gathered to every rank. This is fine while that\n"
@@ -84,18 +120,20 @@ static const char *const help_text =
   "NOT SUPPORTED HERE (each is refused with a message naming it)\n"
   "  --simulate (give the snapshots with --X; make them with the serial\n"
   "  `phgmg simulate ... --states X.npy`), dense --J/--R/--Q, --E/--E-coo,\n"
-  "  nonlinear terms, dampers, feedthrough, --ref, gmg-qm, sp2, balancing,\n"
-  "  hyper-reduction options, several --X files, method or order lists, and\n"
-  "  every other option of `phgmg reduce`: use the serial `phgmg` for them.\n"
+  "  springs (--poly-jdx), DEIM hyper-reduction (--hyper qdeim or greedy,\n"
+  "  --deim-tol, --deim-max, --deim-allow-negative), dampers, feedthrough, --ref,\n"
+  "  gmg-qm, sp2, balancing, several --X files, method or order lists, and every\n"
+  "  other option of `phgmg reduce`: use the serial `phgmg` for them.\n"
   "\n"
   "EXIT STATUS\n"
   "  0 success, 1 an error in the inputs or the reduction, 2 a usage error;\n"
-  "  every rank exits with the same status.\n";
+  "  every rank exits with the same status.\n", NULL};
 
 typedef struct args {
   const char *J, *R, *Q, *B, *X, *out, *name;
-  int method, r, quiet, have_dt;
-  double dt;
+  const char *potential, *poly, *expf, *poly_idx, *poly_w;   /* the separable nonlinear part */
+  int method, r, quiet, have_dt, no_hyper, have_hyper, have_hyper_tol;
+  double dt, hyper_tol;
 } args;
 
 /* This rank's block of rows, the sizes, and what was read. */
@@ -106,6 +144,12 @@ typedef struct dist {
   long nJ, nR, nQ;
   double *Bfull, *Bl, *Xl;       /* B (N x m), its rows (nloc x m), the snapshots' rows (nloc x ns) */
   int *cnt, *dsp;                /* rows per rank and their offsets */
+  /* the separable terms this rank owns (those on its rows), with their
+     serial term numbers; the family: poly_deg, nexp, shared or one per term */
+  int nsep, poly_deg, nexp, per_term, nterms;
+  phgmg_gidx *sidx, *sid;
+  double *sw, *spoly, *sexpo;    /* sw NULL: weights 1 */
+  double named[8];               /* --potential's coefficients (shared) */
 } dist;
 
 /* The replicated solver of J - R. */
@@ -160,8 +204,58 @@ static const char *refused_reason(const char *o) {
   if (!strcmp(o, "--J") || !strcmp(o, "--R") || !strcmp(o, "--Q"))
     return "dense matrices are not read by the distributed build: give J, R, Q as triplets with --J-coo, "
            "--R-coo, --Q-coo";
-  return "not supported by the distributed build (linear models, gmg-pod or sp1, snapshots from --X); use the "
-         "serial `phgmg reduce`";
+  if (!strcmp(o, "--poly-jdx"))
+    return "springs (terms on the difference of two coordinates) are not distributed: phgmg-mpi takes terms on "
+           "one coordinate each (--poly-idx); use the serial `phgmg reduce`";
+  if (!strcmp(o, "--deim-tol") || !strcmp(o, "--deim-max") || !strcmp(o, "--deim-allow-negative"))
+    return "DEIM hyper-reduction (--hyper qdeim or greedy) is not distributed: phgmg-mpi hyper-reduces with "
+           "ecsw (the default; --hyper-tol) or keeps every term (--no-hyper); use the serial `phgmg reduce`";
+  return "not supported by the distributed build (gmg-pod or sp1 of a linear model or one with separable "
+         "terms, snapshots from --X); use the serial `phgmg reduce`";
+}
+
+/* A named potential (--potential NAME[:P1[:P2]]) as exp-polynomial
+   coefficients into c (the polynomial c_0..c_deg, then the pairs (a_e,
+   b_e)), as the serial command reads it: toda, cosh:A, morse:D:A,
+   fpu:K3:K4. 0, or the usage status 2 after a message. */
+static int named_potential(const char *spec, double *c, int *deg, int *nexp) {
+  double p[2] = {1.0, 1.0};
+  int n = 0, k;
+  const char *colon = strchr(spec, ':');
+  const size_t len = colon ? (size_t)(colon - spec) : strlen(spec);
+  const char *what = "expected toda, cosh:A (A != 0), morse:D:A (D > 0, A != 0) or fpu:K3:K4 (K4 > 0)";
+  while (colon) {   /* each field a whole finite number */
+    char *end;
+    if (n == 2) return usage("--potential '%s': too many fields; %s", spec, what);
+    errno = 0;
+    p[n] = strtod(colon + 1, &end);
+    if (end == colon + 1 || (*end && *end != ':') || errno == ERANGE || !isfinite(p[n]))
+      return usage("--potential '%s': field %d is %s; %s", spec, n + 1,
+                   end == colon + 1 ? "empty or not a number" : "not a finite double", what);
+    ++n;
+    colon = *end == ':' ? end : NULL;
+  }
+  memset(c, 0, 8 * sizeof(double));
+  if (len == 4 && !strncmp(spec, "toda", 4) && n == 0) {   /* e^s - 1 - s */
+    c[0] = -1.0; c[1] = -1.0; *deg = 1; *nexp = 1; c[2] = 1.0; c[3] = 1.0;
+  } else if (len == 4 && !strncmp(spec, "cosh", 4) && n <= 1 && p[0] != 0.0) {   /* (cosh(a s) - 1)/a^2 */
+    c[0] = -1.0 / (p[0] * p[0]); *deg = 0; *nexp = 2;
+    c[1] = 0.5 / (p[0] * p[0]); c[2] = p[0]; c[3] = 0.5 / (p[0] * p[0]); c[4] = -p[0];
+  } else if (len == 5 && !strncmp(spec, "morse", 5) && n == 2 && p[0] > 0.0 && p[1] != 0.0) {   /* D (1 - e^{-a s})^2 */
+    c[0] = p[0]; *deg = 0; *nexp = 2; c[1] = -2.0 * p[0]; c[2] = -p[1]; c[3] = p[0]; c[4] = -2.0 * p[1];
+  } else if (len == 3 && !strncmp(spec, "fpu", 3) && n == 2 && p[1] > 0.0) {   /* k3 s^3/3 + k4 s^4/4 */
+    c[3] = p[0] / 3.0; c[4] = p[1] / 4.0; *deg = 4; *nexp = 0;
+  } else {
+    return usage("--potential '%s': %s%s", spec, what,
+                 (len == 5 && !strncmp(spec, "morse", 5) && n == 2 && p[0] <= 0.0) ||
+                 (len == 3 && !strncmp(spec, "fpu", 3) && n == 2 && p[1] <= 0.0)
+                     ? " (else the energy is unbounded below)" : "");
+  }
+  for (k = 0; k < 8; ++k)
+    if (!isfinite(c[k]) || (c[k] != 0.0 && fabs(c[k]) < DBL_MIN))
+      return usage("--potential '%s': its coefficients leave the double range (%g); use parameters of moderate "
+                   "size", spec, c[k]);
+  return 0;
 }
 
 static int parse_value(const char *o, const char *v, args *a) {
@@ -180,6 +274,26 @@ static int parse_value(const char *o, const char *v, args *a) {
     if (errno || end == v || *end || !(a->dt > 0.0) || !isfinite(a->dt))
       return usage("--dt: expected a positive number, got '%s'", v);
     a->have_dt = 1;
+  } else if (!strcmp(o, "--hyper")) {
+    if (!strcmp(v, "qdeim") || !strcmp(v, "greedy"))
+      return usage("--hyper %s: DEIM hyper-reduction is not distributed: phgmg-mpi hyper-reduces with ecsw (the "
+                   "default) or keeps every term (--no-hyper); use the serial `phgmg reduce` for %s", v, v);
+    if (strcmp(v, "ecsw")) return usage("--hyper '%s': expected ecsw, qdeim or greedy", v);
+    a->have_hyper = 1;
+  } else if (!strcmp(o, "--hyper-tol")) {
+    errno = 0;
+    a->hyper_tol = strtod(v, &end);
+    if (errno || end == v || *end || !(a->hyper_tol > 0.0 && a->hyper_tol < 1.0))
+      return usage("--hyper-tol %s: expected 0 < T < 1 (a relative residual)", v);
+    if (a->hyper_tol < 1e-14)
+      return usage("--hyper-tol %g: below what double precision resolves in a relative residual (1e-14); for "
+                   "every term exactly, use --no-hyper", a->hyper_tol);
+    a->have_hyper_tol = 1;
+  } else if (!strcmp(o, "--potential")) {
+    double c[8];
+    int deg, ne;
+    a->potential = v;
+    return named_potential(v, c, &deg, &ne);
   } else if (!strcmp(o, "--method")) {
     if (!strcmp(v, "gmg-pod")) a->method = PHGMG_METHOD_GMG_POD;
     else if (!strcmp(v, "sp1")) a->method = PHGMG_METHOD_SP1;
@@ -201,29 +315,43 @@ static int name_ok(const char *s) {
 }
 
 /* argv[2..]: the options of reduce. 0 ok, 2 a usage error (the same on every rank: the same argv). */
+#define NVOPT 18   /* options with a value; the first NSOPT are file or name strings */
+#define NSOPT 11
 static int parse_args(int argc, char **argv, args *a) {
-  static const char *const with_value[] = {"--J-coo", "--R-coo", "--Q-coo", "--B", "--X", "--out", "--name",
-                                           "--method", "--r", "--dt"};
-  const char **slot[7];
-  int seen[10] = {0, 0, 0, 0, 0, 0, 0, 0, 0, 0}, i, k, rc;
+  static const char *const with_value[NVOPT] = {"--J-coo", "--R-coo", "--Q-coo", "--B", "--X", "--out", "--name",
+                                                "--poly", "--exp", "--poly-idx", "--poly-w", "--method", "--r",
+                                                "--dt", "--potential", "--hyper", "--hyper-tol", ""};
+  const char **slot[NSOPT];
+  int seen[NVOPT], i, k, rc;
   memset(a, 0, sizeof *a);
+  memset(seen, 0, sizeof seen);
   a->name = "rom"; a->method = -1;
   slot[0] = &a->J; slot[1] = &a->R; slot[2] = &a->Q; slot[3] = &a->B; slot[4] = &a->X; slot[5] = &a->out;
-  slot[6] = &a->name;
+  slot[6] = &a->name; slot[7] = &a->poly; slot[8] = &a->expf; slot[9] = &a->poly_idx; slot[10] = &a->poly_w;
   for (i = 2; i < argc; ++i) {
     const char *o = argv[i];
     if (!strcmp(o, "--quiet")) { a->quiet = 1; continue; }
-    for (k = 0; k < 10 && strcmp(o, with_value[k]); ++k) {}
-    if (k == 10) return usage("%s: %s", o, o[0] == '-' ? refused_reason(o) : "unexpected argument");
+    if (!strcmp(o, "--no-hyper") || !strcmp(o, "--no-deim")) { a->no_hyper = 1; continue; }
+    for (k = 0; k < NVOPT - 1 && strcmp(o, with_value[k]); ++k) {}
+    if (k == NVOPT - 1) return usage("%s: %s", o, o[0] == '-' ? refused_reason(o) : "unexpected argument");
     if (i + 1 >= argc) return usage("%s needs a value", o);
     if (seen[k]++)
       return usage("%s given twice%s", o, k == 4 ? " (several --X files are not supported by phgmg-mpi)" : "");
-    if (k < 7) {
+    if (k < NSOPT) {
       *slot[k] = argv[++i];
     } else if ((rc = parse_value(o, argv[++i], a)) != 0) {
       return rc;
     }
   }
+  if (a->potential && (a->poly || a->expf)) return usage("--potential replaces --poly and --exp");
+  if (!!(a->poly || a->expf || a->potential) != !!a->poly_idx)
+    return usage("--poly/--exp/--potential and --poly-idx go together");
+  if (a->poly_w && !a->poly_idx) return usage("--poly-w needs a nonlinear part (--poly-idx)");
+  if ((a->have_hyper || a->have_hyper_tol || a->no_hyper) && !a->poly_idx)
+    return usage("%s applies to a nonlinear part (--poly, --exp or --potential with --poly-idx); this model has "
+                 "none", a->have_hyper ? "--hyper" : a->have_hyper_tol ? "--hyper-tol" : "--no-hyper");
+  if (a->no_hyper && (a->have_hyper || a->have_hyper_tol))
+    return usage("--no-hyper keeps every nonlinear term: %s does not apply", a->have_hyper ? "--hyper" : "--hyper-tol");
   if (!a->J || !a->R || !a->Q) return usage("--J-coo, --R-coo and --Q-coo are required");
   if (!a->B) return usage("--B is required");
   if (!a->X) return usage("--X is required (the snapshots; phgmg-mpi does not simulate)");
@@ -345,6 +473,149 @@ static int read_X_rows(const args *a, dist *d) {
   return 0;
 }
 
+/* A vector or matrix of finite numbers (an .npy file, column-major), or 1 after a message. */
+static int read_array(const char *opt, const char *path, double **v, int *rows, int *cols, int *vec) {
+  int nd = 0;
+  long k;
+  phgmg_result rc = phgmg_npy_read(path, v, rows, cols, &nd, NULL);
+  if (rc != PHGMG_OK) { npy_fail(opt, path, rc); return 1; }
+  for (k = 0; k < (long)*rows * *cols; ++k)
+    if (!isfinite((*v)[k])) { say("%s %s: entry %ld is NaN or infinite", opt, path, k); return 1; }
+  *vec = nd <= 1 || *rows == 1 || *cols == 1;
+  return 0;
+}
+
+/* Is w phi(s), phi(s) = sum_j c_j s^j + sum_e a_e exp(b_e s), bounded below
+   as s -> dir * inf (dir = +1 or -1)? The fastest-growing exponential
+   decides when there is one, else the leading power of degree >= 3 (the
+   serial command's test). 1 bounded, 0 not. */
+static int phi_bounded(const double *c, int deg, const double *ex, int ne, double w, double dir) {
+  double bmax = 0.0, amax = 0.0;
+  int e, f, j;
+  for (e = 0; e < ne; ++e) {   /* the largest rate dir * b > 0 with a nonzero net coefficient */
+    double s = 0.0;
+    const double rate = dir * ex[2 * e + 1];
+    if (!(rate > bmax)) continue;
+    for (f = 0; f < ne; ++f)
+      if (ex[2 * f + 1] == ex[2 * e + 1]) s += ex[2 * f];
+    if (s != 0.0) { bmax = rate; amax = s; }
+  }
+  if (bmax > 0.0) return w * amax > 0.0;
+  for (j = deg; j >= 3; --j)
+    if (c[j] != 0.0) return w * c[j] * ((j % 2 && dir < 0.0) ? -1.0 : 1.0) > 0.0;
+  return 1;
+}
+
+/* The separable nonlinear part, as the serial command reads it: --poly-idx
+   (the terms' coordinates), --poly-w (weights), the family from --potential
+   or --poly (a vector: shared; (terms, d+1): one per term) and --exp
+   ((n_exp, 2): shared; (terms, 2 n_exp): one per term). Every rank reads
+   the whole (small) files and checks every term (the same verdict and
+   message everywhere), then keeps the terms on its own rows with their
+   serial term numbers. 0, or 1 after a message. */
+static int read_terms(const args *a, dist *d) {
+  double *idx = NULL, *w = NULL, *P = NULL, *E = NULL, *fp = NULL, *fe = NULL;
+  int nt, rows, cols, vec, prow = 0, pcol = 0, erow = 0, ecol = 0, per_p = 0, per_e = 0, deg = 0, ne = 0, t, j, k;
+  int bad = 1, own = 0;
+  if (!a->poly_idx) return 0;
+  if (read_array("--poly-idx", a->poly_idx, &idx, &rows, &cols, &vec)) goto done;
+  nt = rows * cols;
+  if (!vec || nt < 1) { say("--poly-idx %s: expected a non-empty vector of coordinates, got (%d, %d)", a->poly_idx, rows, cols); goto done; }
+  for (k = 0; k < nt; ++k)
+    if (!(idx[k] >= 0.0 && idx[k] < (double)d->N && idx[k] == floor(idx[k]))) {
+      say("--poly-idx %s: entry %d is %g; expected an integer coordinate in [0, %d)", a->poly_idx, k, idx[k], d->N);
+      goto done;
+    }
+  if (a->poly_w) {
+    if (read_array("--poly-w", a->poly_w, &w, &rows, &cols, &vec)) goto done;
+    if (!vec || rows * cols != nt) {
+      say("--poly-w %s: expected a vector of %d weights (one per entry of %s), got (%d, %d)", a->poly_w, nt,
+          a->poly_idx, rows, cols);
+      goto done;
+    }
+  }
+  if (a->potential) {
+    named_potential(a->potential, d->named, &deg, &ne);   /* checked by parse_args */
+    fp = d->named; fe = d->named + deg + 1;
+  } else {
+    if (a->poly) {
+      if (read_array("--poly", a->poly, &P, &prow, &pcol, &vec)) goto done;
+      per_p = !vec;
+      if (per_p && prow != nt) {
+        say("--poly %s: expected a vector of d+1 coefficients or a (%d, d+1) matrix, got (%d, %d)", a->poly, nt, prow, pcol);
+        goto done;
+      }
+      deg = (per_p ? pcol : prow * pcol) - 1;
+      if (deg < 0 || deg > 32) { say("--poly %s: degree %d; expected 0..32", a->poly, deg); goto done; }
+    }
+    if (a->expf) {
+      if (read_array("--exp", a->expf, &E, &erow, &ecol, &vec)) goto done;
+      /* (terms, 2 n_exp) is per term; a (terms, 2) matrix with up to 8 terms is per term only beside a per-term --poly */
+      per_e = erow == nt && ecol % 2 == 0 && (ecol != 2 || nt > 8 || per_p);
+      ne = per_e ? ecol / 2 : erow;
+      if ((!per_e && ecol != 2) || ne < 1 || ne > 8) {
+        say("--exp %s: expected (n_exp, 2) pairs (a, b) or a (%d, 2 n_exp) matrix, 1 <= n_exp <= 8, got (%d, %d)",
+            a->expf, nt, erow, ecol);
+        goto done;
+      }
+    }
+    if (deg < 1 && ne == 0) { say("--poly: a nonlinear part needs degree >= 1 or --exp"); goto done; }
+    t = per_p || per_e ? nt : 1;   /* the functions, row-major (the files are column-major) */
+    fp = (double *)calloc((size_t)t * (size_t)(deg + 1), sizeof(double));
+    fe = (double *)calloc((size_t)t * 2 * (size_t)(ne ? ne : 1), sizeof(double));
+    if (!fp || !fe) { say("out of memory"); goto done; }
+    for (k = 0; k < t; ++k) {
+      for (j = 0; P && j <= deg; ++j) fp[(size_t)k * (deg + 1) + j] = per_p ? P[k + (size_t)j * prow] : P[j];
+      for (j = 0; j < ne; ++j) {
+        fe[(size_t)k * 2 * ne + 2 * j] = per_e ? E[k + (size_t)(2 * j) * erow] : E[j];
+        fe[(size_t)k * 2 * ne + 2 * j + 1] = per_e ? E[k + (size_t)(2 * j + 1) * erow] : E[j + erow];
+      }
+    }
+  }
+  d->per_term = per_p || per_e; d->poly_deg = deg; d->nexp = ne; d->nterms = nt;
+  for (k = 0; k < nt; ++k) {   /* every term bounded below, as the serial command checks */
+    const double wk = w ? w[k] : 1.0, *c = fp + (size_t)(d->per_term ? k : 0) * (deg + 1);
+    const double *ex = fe + (size_t)(d->per_term ? k : 0) * 2 * ne;
+    int dir;
+    if (wk == 0.0) continue;
+    for (dir = -1; dir <= 1; dir += 2)
+      if (!phi_bounded(c, deg, ex, ne, wk, (double)dir)) {
+        say("%s: term %d (weight %g): w phi(s) -> -inf as s -> %cinf, so the energy H is unbounded below and the "
+            "model is not a passive port-Hamiltonian system (check the sign of the leading coefficient%s)",
+            a->potential ? a->potential : a->poly ? a->poly : a->expf, k, wk, dir > 0 ? '+' : '-',
+            a->poly_w ? " and of the weights in --poly-w" : "");
+        goto done;
+      }
+  }
+  for (k = 0; k < nt; ++k) own += idx[k] >= (double)d->row0 && idx[k] < (double)(d->row0 + d->nloc);
+  d->sidx = (phgmg_gidx *)malloc(sizeof(phgmg_gidx) * 2 * ((size_t)own + 1));
+  d->sw = w ? (double *)malloc(sizeof(double) * ((size_t)own + 1)) : NULL;
+  d->spoly = (double *)malloc(sizeof(double) * ((size_t)(d->per_term ? own : 1) * (deg + 1) + 1));
+  d->sexpo = (double *)malloc(sizeof(double) * ((size_t)(d->per_term ? own : 1) * 2 * ne + 1));
+  if (!d->sidx || (w && !d->sw) || !d->spoly || !d->sexpo) { say("out of memory"); goto done; }
+  d->sid = d->sidx + own + 1;
+  if (!d->per_term) {
+    memcpy(d->spoly, fp, sizeof(double) * (size_t)(deg + 1));
+    memcpy(d->sexpo, fe, sizeof(double) * 2 * (size_t)ne);
+  }
+  for (k = 0; k < nt; ++k) {   /* this rank's terms, ascending serial term numbers */
+    const int s = d->nsep;
+    if (!(idx[k] >= (double)d->row0 && idx[k] < (double)(d->row0 + d->nloc))) continue;
+    d->sidx[s] = (phgmg_gidx)idx[k]; d->sid[s] = k;
+    if (w) d->sw[s] = w[k];
+    if (d->per_term) {
+      memcpy(d->spoly + (size_t)s * (deg + 1), fp + (size_t)k * (deg + 1), sizeof(double) * (size_t)(deg + 1));
+      memcpy(d->sexpo + (size_t)s * 2 * ne, fe + (size_t)k * 2 * ne, sizeof(double) * 2 * (size_t)ne);
+    }
+    ++d->nsep;
+  }
+  bad = 0;
+done:
+  phgmg_npy_free(idx, NULL); phgmg_npy_free(w, NULL); phgmg_npy_free(P, NULL); phgmg_npy_free(E, NULL);
+  if (fp != d->named) { free(fp); free(fe); }
+  return bad;
+}
+
 /* The inputs, each step agreed over the ranks (a fault on one rank stops all). */
 static int read_inputs(const args *a, dist *d) {
   if (any_rank(read_B_layout(a, d))) return 1;
@@ -352,6 +623,7 @@ static int read_inputs(const args *a, dist *d) {
   if (any_rank(read_triplets("--J-coo", a->J, d->N, &d->TJ, &d->nJ))) return 1;
   if (any_rank(read_triplets("--R-coo", a->R, d->N, &d->TR, &d->nR))) return 1;
   if (any_rank(read_triplets("--Q-coo", a->Q, d->N, &d->TQ, &d->nQ))) return 1;
+  if (any_rank(read_terms(a, d))) return 1;
   return any_rank(read_X_rows(a, d));
 }
 
@@ -359,6 +631,7 @@ static void dist_free(dist *d) {
   phgmg_npy_free(d->TJ, NULL); phgmg_npy_free(d->TR, NULL); phgmg_npy_free(d->TQ, NULL);
   phgmg_npy_free(d->Bfull, NULL);
   free(d->Bl); free(d->Xl); free(d->cnt);
+  free(d->sidx); free(d->sw); free(d->spoly); free(d->sexpo);
 }
 
 /* ---- the operators ------------------------------------------------------------ */
@@ -534,6 +807,13 @@ static void explain(const args *a, const dist *d, phgmg_result rc) {
   else if (rc == PHGMG_ERR_NOT_SYMMETRIC || rc == PHGMG_ERR_NOT_PSD)
     say("--R-coo %s: R is not symmetric positive semidefinite (relative tolerance 1e-12): %s", a->R,
         phgmg_result_string(rc));
+  else if (rc == PHGMG_ERR_NOT_CONVERGED && a->poly_idx)
+    say("%s: the ECSW hyper-reduction misses --hyper-tol %g: %s (a larger --hyper-tol, or --no-hyper)", meth,
+        a->have_hyper_tol ? a->hyper_tol : 1e-6, phgmg_result_string(rc));
+  else if (rc == PHGMG_ERR_TOL_UNREACHABLE)
+    say("%s: --hyper-tol %g: %s", meth, a->hyper_tol, phgmg_result_string(rc));
+  else if ((rc == PHGMG_ERR_INVALID_ARG || rc == PHGMG_ERR_SIZE || rc == PHGMG_ERR_NANINF) && a->poly_idx)
+    say("%s: the nonlinear terms (--poly-idx %s): %s", meth, a->poly_idx, phgmg_result_string(rc));
   else
     say("%s: %s", meth, phgmg_result_string(rc));
 }
@@ -566,9 +846,19 @@ static int reduce(const args *a, dist *d, result *res) {
     md.lin.Q = Qop; md.lin.m = d->m; md.lin.B = d->Bl; md.lin.ldb = ld;
     md.lin.solve = solve_replicated; md.lin.solve_user = &sv;
     md.JR = JRop;
-    md.poly_deg = 1;   /* no separable terms (nsep = 0): a linear model */
+    if (a->poly_idx) {   /* this rank's terms, their serial term numbers as global ids */
+      md.nsep = d->nsep; md.sep_idx = d->sidx; md.sep_id = d->sid; md.sep_w = d->sw;
+      md.poly_deg = d->poly_deg; md.nexp = d->nexp; md.per_term = d->per_term;
+      md.poly = d->spoly; md.expo = d->sexpo;
+    } else {
+      md.poly_deg = 1;   /* no separable terms (nsep = 0): a linear model */
+    }
     memset(&o, 0, sizeof o);
     o.method = (phgmg_method)a->method; o.r = a->r;
+    /* the serial default: ECSW (tolerance 1e-6 unless --hyper-tol) on a nonlinear part, --no-hyper keeps every term */
+    o.hyper.on = a->poly_idx && !a->no_hyper;
+    o.hyper.kind = PHGMG_HYPER_ECSW;
+    o.hyper.tol = a->have_hyper_tol ? a->hyper_tol : 0.0;
     rc = phgmg_mpi_reduce(ctx, &md, d->ns, d->Xl, ld, &o, &res->mr, res->V0, ld);
   }
   res->seconds = MPI_Wtime() - t0;
@@ -584,8 +874,12 @@ static int reduce(const args *a, dist *d, result *res) {
 
 /* ---- outputs (rank 0) ---------------------------------------------------------- */
 
-#define NOUT 7
-static const char *const out_suffix[NOUT] = {".phgmgrom", ".c", ".json", "_Bh.npy", "_Qh.npy", "_K.npy", "_V0.npy"};
+/* The outputs: the first 7 always, then those of kept nonlinear terms
+   (P0, w, poly; expo with exponentials): g_nout of them. */
+#define NOUT 11
+static const char *const out_suffix[NOUT] = {".phgmgrom", ".c", ".json", "_Bh.npy", "_Qh.npy", "_K.npy", "_V0.npy",
+                                             "_P0.npy", "_w.npy", "_poly.npy", "_expo.npy"};
+static int g_nout = 7;
 
 /* The output paths DIR/NAME<suffix> (4096 + 96 chars each). */
 static void out_path(const args *a, int k, char *buf, size_t cap) {
@@ -594,15 +888,16 @@ static void out_path(const args *a, int k, char *buf, size_t cap) {
 
 /* 1 if an output is one of the input files: a run never overwrites its inputs. */
 static int outputs_clash(const args *a) {
-  const char *in[5];
-  const char *opt[5] = {"--J-coo", "--R-coo", "--Q-coo", "--B", "--X"};
+  const char *in[9];
+  const char *opt[9] = {"--J-coo", "--R-coo", "--Q-coo", "--B", "--X", "--poly-idx", "--poly-w", "--poly", "--exp"};
   char p[4200];
   int k, i;
   in[0] = a->J; in[1] = a->R; in[2] = a->Q; in[3] = a->B; in[4] = a->X;
-  for (k = 0; k < NOUT; ++k) {
+  in[5] = a->poly_idx; in[6] = a->poly_w; in[7] = a->poly; in[8] = a->expf;
+  for (k = 0; k < (a->poly_idx ? NOUT : 7); ++k) {
     out_path(a, k, p, sizeof p);
-    for (i = 0; i < 5; ++i)
-      if (same_file(p, in[i]) || !strcmp(p, in[i])) {
+    for (i = 0; i < 9; ++i)
+      if (in[i] && (same_file(p, in[i]) || !strcmp(p, in[i]))) {
         say("--out %s: the output %s is the input file of %s; choose another --out or --name", a->out, p, opt[i]);
         return 1;
       }
@@ -647,13 +942,13 @@ static void part_path(const args *a, int k, char *buf, size_t cap) {
 static void parts_remove(const args *a) {
   char p[4300];
   int k;
-  for (k = 0; k < NOUT; ++k) { part_path(a, k, p, sizeof p); remove(p); }
+  for (k = 0; k < g_nout; ++k) { part_path(a, k, p, sizeof p); remove(p); }
 }
 
 static int parts_commit(const args *a) {
   char p[4300], q[4200];
   int k;
-  for (k = 0; k < NOUT; ++k) {
+  for (k = 0; k < g_nout; ++k) {
     part_path(a, k, p, sizeof p);
     out_path(a, k, q, sizeof q);
     if (rename(p, q) != 0) { say("%s: cannot move into place: %s", q, strerror(errno)); return 1; }
@@ -733,39 +1028,88 @@ static void json_num(FILE *f, double v) {
    where the outputs are), with the ranks and the solver of J - R. */
 static int write_json(const args *a, const dist *d, const result *res) {
   const phgmg_rom *rom = &res->mr.rom;
-  const int gmg = a->method == PHGMG_METHOD_GMG_POD, r = a->r, m = d->m;
-  const int shape[4][2] = {{r, m}, {r, r}, {r, r}, {d->N, r}};
+  const int gmg = a->method == PHGMG_METHOD_GMG_POD, r = a->r, m = d->m, nd = res->mr.nd;
+  const int nf = rom->nphi > 1 ? rom->nphi : 1, hyper = a->poly_idx && !a->no_hyper;
+  /* the arrays in the serial command's order: Bh, Qh, K, (P0, w, poly, expo), V0 */
+  const int shape[NOUT][2] = {{0, 0}, {0, 0}, {0, 0}, {r, m}, {r, r}, {r, r}, {d->N, r}, {nd, r}, {nd, 1},
+                              {nf, rom->poly_deg + 1}, {nf, 2 * rom->nexp}};
   char p[4300];
   FILE *f;
-  int k;
+  int k, j, nneg = 0;
+  double wmin = HUGE_VAL;
+  for (j = 0; j < nd; ++j) { wmin = fmin(wmin, res->mr.w[j]); nneg += res->mr.w[j] < 0.0; }
   part_path(a, 2, p, sizeof p);
   if (!(f = fopen(p, "w"))) { say("%s: cannot write: %s", p, strerror(errno)); return 1; }
   fprintf(f, "{\n  \"phgmg_version\": \"%s\",\n  \"name\": ", PHGMG_VERSION_STRING);
   json_str(f, a->name);
-  fprintf(f, ",\n  \"method\": \"%s\",\n  \"kind\": \"linear\",\n  \"map\": \"linear\",\n", gmg ? "gmg-pod" : "sp1");
-  fprintf(f, "  \"N\": %d, \"m\": %d, \"r\": %d, \"rn\": 0, \"nd\": 0, \"poly_deg\": 0,\n", d->N, m, r);
+  fprintf(f, ",\n  \"method\": \"%s\",\n  \"kind\": \"%s\",\n  \"map\": \"linear\",\n", gmg ? "gmg-pod" : "sp1",
+          a->poly_idx ? "nonlinear" : "linear");
+  fprintf(f, "  \"N\": %d, \"m\": %d, \"r\": %d, \"rn\": 0, \"nd\": %d, \"poly_deg\": %d,\n", d->N, m, r, nd,
+          nd ? rom->poly_deg : 0);
   fprintf(f, "  \"E\": false, \"N_full\": %d, \"algebraic\": 0, \"feedthrough\": false,\n  \"dt_map\": 0,\n", d->N);
   fprintf(f, "  \"system\": {\"J\": "); json_str(f, a->J);
   fprintf(f, ", \"R\": "); json_str(f, a->R);
   fprintf(f, ", \"B\": "); json_str(f, a->B);
   fprintf(f, ", \"Q\": "); json_str(f, a->Q);
-  fprintf(f, ", \"sparse\": true},\n");
+  fprintf(f, ", \"sparse\": true");
+  if (a->poly_idx) {
+    if (a->poly) { fprintf(f, ", \"poly\": "); json_str(f, a->poly); }
+    if (a->expf) { fprintf(f, ", \"exp\": "); json_str(f, a->expf); }
+    if (a->potential) { fprintf(f, ", \"potential\": "); json_str(f, a->potential); }
+    fprintf(f, ", \"poly_idx\": "); json_str(f, a->poly_idx);
+    if (a->poly_w) { fprintf(f, ", \"poly_w\": "); json_str(f, a->poly_w); }
+  }
+  fprintf(f, "},\n");
   fprintf(f, "  \"snapshots\": {\"count\": %d, \"file\": ", d->ns); json_str(f, a->X);
   if (a->have_dt) { fprintf(f, ", \"dt\": "); json_num(f, a->dt); }
-  fprintf(f, "},\n  \"options\": {\"training_runs\": 0, \"ref\": \"none\", \"hyper\": \"none\", \"deim\": false},\n");
+  fprintf(f, "},\n  \"options\": {\"training_runs\": 0, \"ref\": \"none\", \"hyper\": \"%s\"", hyper ? "ecsw" : "none");
+  if (hyper) { fprintf(f, ", \"hyper_tol\": "); json_num(f, a->have_hyper_tol ? a->hyper_tol : 1e-6); }
+  fprintf(f, ", \"deim\": false},\n");
   fprintf(f, "  \"info\": {\"pod_sigma_ratio\": "); json_num(f, res->sigma_ratio);
   fprintf(f, ", \"rcond_jr\": "); json_num(f, res->rcond_jr);
   if (gmg) fprintf(f, ", \"degeneracy_tol\": 1e-12");
+  if (hyper) {
+    fprintf(f, ", \"hyper\": {\"method\": \"ecsw\", \"points\": %d, \"negative_weights\": %d, \"min_weight\": ", nd, nneg);
+    json_num(f, nd ? wmin : 0.0);
+    fprintf(f, ", \"tol\": "); json_num(f, a->have_hyper_tol ? a->hyper_tol : 1e-6);
+    fprintf(f, ", \"residual\": "); json_num(f, res->mr.hyper_residual);
+    fprintf(f, "}");
+  }
   fprintf(f, ", \"reduce_seconds\": "); json_num(f, res->seconds);
   fprintf(f, ", \"mpi_ranks\": %d, \"jr_solver\": \"sparse LU of J - R replicated on every rank\"},\n", d->size);
   fprintf(f, "  \"stepper_memsize_bytes\": %lu,\n", (unsigned long)phgmg_rom_stepper_memsize(rom));
   fprintf(f, "  \"reconstruction\": \"x = V0 @ xr\",\n");
   fprintf(f, "  \"files\": {\n    \"model\": \"%s.phgmgrom\",\n    \"c_source\": \"%s.c\",\n    \"arrays\": {", a->name,
           a->name);
-  for (k = 0; k < 4; ++k)
-    fprintf(f, "%s\n      \"%s%s\": [%d, %d]", k ? "," : "", a->name, out_suffix[3 + k], shape[k][0], shape[k][1]);
+  for (j = 3; j < g_nout; ++j) {
+    k = j < 6 ? j : j == g_nout - 1 ? 6 : j + 1;   /* V0 last */
+    fprintf(f, "%s\n      \"%s%s\": [%d, %d]", j > 3 ? "," : "", a->name, out_suffix[k], shape[k][0], shape[k][1]);
+  }
   fprintf(f, "\n    }\n  }\n}\n");
   if (fclose(f) != 0) { say("%s: write error", p); return 1; }
+  return 0;
+}
+
+/* Rank 0: the kept terms' arrays as the serial command writes them: P0
+   (nd x r), w (nd x 1), and the functions as the model holds them, one row
+   of coefficients per function (poly: nf x (poly_deg + 1); expo: nf x 2
+   nexp, nf = nd per term, else 1), written as those shapes. */
+static int write_terms(const args *a, const result *res) {
+  const phgmg_rom *rom = &res->mr.rom;
+  const int nd = res->mr.nd, nf = rom->nphi > 1 ? rom->nphi : 1, nc = rom->poly_deg + 1, ne = 2 * rom->nexp;
+  double *buf = (double *)malloc(sizeof(double) * ((size_t)nf * (size_t)(nc + ne) + 1));
+  char p[4300];
+  phgmg_result rc = buf ? PHGMG_OK : PHGMG_ERR_NOMEM;
+  size_t i;
+  for (i = 0; buf && i < (size_t)nf * nc; ++i) buf[i] = (double)rom->poly[i];
+  for (i = 0; buf && i < (size_t)nf * ne; ++i) buf[(size_t)nf * nc + i] = (double)rom->expo[i];
+  part_path(a, 7, p, sizeof p);
+  if (rc == PHGMG_OK) rc = phgmg_npy_write(p, res->mr.P0, nd, a->r, nd, 2, 0u);
+  if (rc == PHGMG_OK) { part_path(a, 8, p, sizeof p); rc = phgmg_npy_write(p, res->mr.w, nd, 1, nd, 2, 0u); }
+  if (rc == PHGMG_OK) { part_path(a, 9, p, sizeof p); rc = phgmg_npy_write(p, buf, nf, nc, nf, 2, 0u); }
+  if (rc == PHGMG_OK && ne) { part_path(a, 10, p, sizeof p); rc = phgmg_npy_write(p, buf + (size_t)nf * nc, nf, ne, nf, 2, 0u); }
+  free(buf);
+  if (rc != PHGMG_OK) { say("%s: cannot write: %s", p, phgmg_result_string(rc)); return 1; }
   return 0;
 }
 
@@ -790,21 +1134,22 @@ static int write_model(const args *a, const dist *d, result *res) {
     rc = phgmg_npy_write(p, blk[k], a->r, cols[k], a->r, 2, 0u);
     if (rc != PHGMG_OK) { say("%s: cannot write: %s", p, phgmg_result_string(rc)); return 1; }
   }
-  return 0;
+  return g_nout > 7 && write_terms(a, res);
 }
 
 /* Every output: the basis gathered (collective), then rank 0 writes the rest
    and moves everything into place. */
 static int write_outputs(const args *a, const dist *d, result *res) {
   int bad = 0;
+  g_nout = res->mr.nd > 0 ? (res->mr.rom.nexp > 0 ? 11 : 10) : 7;   /* the kept terms' arrays, as the serial command */
   if (any_rank(d->rank == 0 && make_dir(a->out))) return 1;
   bad = write_V0(a, d, res->V0);
   if (!bad && d->rank == 0) bad = write_model(a, d, res) || write_json(a, d, res) || parts_commit(a);
   if (bad && d->rank == 0) parts_remove(a);
   if (any_rank(bad)) return 1;
   if (d->rank == 0 && !a->quiet)
-    printf("wrote %s/%s.phgmgrom, %s/%s.c, %s/%s.json and 4 arrays %s/%s_*.npy (%s, r = %d, m = %d, N = %d, "
-           "%d rank%s)\n", a->out, a->name, a->out, a->name, a->out, a->name, a->out, a->name,
+    printf("wrote %s/%s.phgmgrom, %s/%s.c, %s/%s.json and %d arrays %s/%s_*.npy (%s, r = %d, m = %d, N = %d, "
+           "%d rank%s)\n", a->out, a->name, a->out, a->name, a->out, a->name, g_nout - 3, a->out, a->name,
            a->method == PHGMG_METHOD_SP1 ? "sp1" : "gmg-pod", a->r, d->m, d->N, d->size, d->size > 1 ? "s" : "");
   return 0;
 }
@@ -835,7 +1180,8 @@ int main(int argc, char **argv) {
   MPI_Comm_rank(MPI_COMM_WORLD, &g_rank);
   MPI_Comm_size(MPI_COMM_WORLD, &size);
   if (argc >= 2 && (!strcmp(argv[1], "--help") || !strcmp(argv[1], "-h"))) {
-    if (g_rank == 0) fputs(help_text, stdout);
+    int k;
+    for (k = 0; g_rank == 0 && help_text[k]; ++k) fputs(help_text[k], stdout);
     status = 0;
   } else if (argc >= 2 && !strcmp(argv[1], "--version")) {
     if (g_rank == 0) printf("phgmg-mpi %s\n", PHGMG_VERSION_STRING);

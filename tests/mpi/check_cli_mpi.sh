@@ -14,11 +14,23 @@
 #     K -> S K S, Qh -> S Qh S, Bh -> S Bh, V0 -> V0 S);
 #   - the outputs of `phgmg simulate-rom --dt 0.1 --steps 300` on each model
 #     within 1e-10 of those on the serial model (relative to their largest).
+# The same chain with an on-site cosh potential on every position
+# (--potential cosh:1 --poly-idx idx.npy: 1200 terms, scrambled over the
+# ranks' rows), its own 201 snapshots, gmg-pod and sp1 at r = 10 with the
+# default ECSW hyper-reduction: besides the above, the arrays of the kept
+# terms (P0 after the modes' signs, w, poly, expo) within 1e-10, the json's
+# kind, nd and hyper-reduction options the serial's, and the same ECSW
+# points as global indices (each kept term's state coordinate, found as the
+# row of V0 that its row of P0 is) in the same order. And at P = 3 sp1 with
+# --no-hyper (every term kept, gathered from the ranks in serial order) of
+# the chain with one function per term and weights (--poly (terms, 2),
+# --exp (terms, 4), --poly-w, --poly-idx as int64).
 # Bad input at P = 3: a missing --X file must end every rank with a nonzero
 # status (each rank's status recorded by a wrapper), one message, within the
 # timeout (no rank left waiting in a collective); snapshots of the wrong
-# shape, --simulate and an option of the serial reduce that the distributed
-# build does not take (--ref) are refused with a message naming them.
+# shape, --simulate and options of the serial reduce that the distributed
+# build does not take (--ref, springs --poly-jdx, --hyper qdeim) are refused
+# with a message naming them.
 #   sh tests/mpi/check_cli_mpi.sh SERIAL_PHGMG PHGMG_MPI     (make test-mpi)
 # MPIRUN overrides the launcher (default: mpirun --oversubscribe, plus
 # --allow-run-as-root as root).
@@ -33,15 +45,38 @@ if [ -z "$MPIRUN" ]; then
 fi
 D=$(mktemp -d "${TMPDIR:-/tmp}/check_cli_mpi.XXXXXX")
 trap 'rm -rf "$D"' EXIT
-$PY bench/lattice.py "$D" 1200 1 > /dev/null
+$PY bench/lattice.py "$D" 1200 1 --cosh > /dev/null
 M="--J-coo $D/J.npy --R-coo $D/R.npy --Q-coo $D/Q.npy --B $D/B.npy"
+NL="--potential cosh:1 --poly-idx $D/idx.npy"
+PT="--poly $D/pp.npy --exp $D/pe.npy --poly-w $D/pw.npy --poly-idx $D/idx_int.npy"
+$PY - "$D" <<'PYEOF'
+import sys
+import numpy as np
+d = sys.argv[1]
+idx = np.load(d + '/idx.npy')
+k = np.arange(len(idx))
+a = 0.5 + 0.4 * np.sin(k)   # w_k a_k (cosh(s) - 1): one function per term
+np.save(d + '/pp.npy', np.column_stack([-a, np.zeros(len(k))]))
+np.save(d + '/pe.npy', np.column_stack([a / 2, np.ones(len(k)), a / 2, -np.ones(len(k))]))
+np.save(d + '/pw.npy', 1.0 + 0.5 * (k % 3))
+np.save(d + '/idx_int.npy', idx.astype(np.int64))
+PYEOF
 "$PHGMG" simulate $M --dt 0.1 --steps 200 --out "$D/y_full.npy" --states "$D/X.npy" --quiet > /dev/null
-for meth in gmg-pod sp1; do
-  "$PHGMG" reduce $M --X "$D/X.npy" --method $meth --r 10 --out "$D/serial_$meth" --quiet > /dev/null
-  "$PHGMG" simulate-rom --model "$D/serial_$meth/rom.phgmgrom" --dt 0.1 --steps 300 --out "$D/y_serial_$meth.npy" --quiet > /dev/null
-  for p in 1 2 3 4; do
-    timeout 120 $MPIRUN -np $p "$PMPI" reduce $M --X "$D/X.npy" --method $meth --r 10 --out "$D/p${p}_$meth" --quiet
-    "$PHGMG" simulate-rom --model "$D/p${p}_$meth/rom.phgmgrom" --dt 0.1 --steps 300 --out "$D/y_p${p}_$meth.npy" --quiet > /dev/null
+"$PHGMG" simulate $M $NL --dt 0.1 --steps 200 --out "$D/y_full_nl.npy" --states "$D/X_nl.npy" --quiet > /dev/null
+"$PHGMG" simulate $M $PT --dt 0.1 --steps 200 --out "$D/y_full_pt.npy" --states "$D/X_pt.npy" --quiet > /dev/null
+# case: linear (gmg-pod, sp1), cosh (cosh-gmg-pod, cosh-sp1), per-term functions without hyper-reduction (terms-sp1)
+for case in gmg-pod sp1 cosh-gmg-pod cosh-sp1 terms-sp1; do
+  ps="1 2 3 4"
+  case $case in
+    cosh-*) meth=${case#cosh-}; X="$D/X_nl.npy"; opt=$NL ;;
+    terms-*) meth=${case#terms-}; X="$D/X_pt.npy"; opt="$PT --no-hyper"; ps=3 ;;
+    *) meth=$case; X="$D/X.npy"; opt="" ;;
+  esac
+  "$PHGMG" reduce $M $opt --X "$X" --method $meth --r 10 --out "$D/serial_$case" --quiet > /dev/null
+  "$PHGMG" simulate-rom --model "$D/serial_$case/rom.phgmgrom" --dt 0.1 --steps 300 --out "$D/y_serial_$case.npy" --quiet > /dev/null
+  for p in $ps; do
+    timeout 120 $MPIRUN -np $p "$PMPI" reduce $M $opt --X "$X" --method $meth --r 10 --out "$D/p${p}_$case" --quiet
+    "$PHGMG" simulate-rom --model "$D/p${p}_$case/rom.phgmgrom" --dt 0.1 --steps 300 --out "$D/y_p${p}_$case.npy" --quiet > /dev/null
   done
 done
 
@@ -72,7 +107,9 @@ refused() {   # expected words, then the options
 refused "expected (2400, ns)" --X "$D/B.npy"
 refused "--simulate: the distributed build does not simulate" --simulate
 refused "--ref: not supported by the distributed build" --X "$D/X.npy" --ref mean
-echo "check_cli_mpi: wrong snapshot shape, --simulate, --ref refused with messages naming them"
+refused "--poly-jdx: springs" --X "$D/X_nl.npy" $NL --poly-jdx "$D/idx.npy"
+refused "--hyper qdeim: DEIM hyper-reduction is not distributed" --X "$D/X_nl.npy" $NL --hyper qdeim
+echo "check_cli_mpi: wrong snapshot shape, --simulate, --ref, --poly-jdx, --hyper qdeim refused with messages naming them"
 
 $PY - "$D" <<'PYEOF'
 import json
@@ -82,31 +119,73 @@ import numpy as np
 d = sys.argv[1]
 TOL = 1e-10
 rel = lambda a, b: np.abs(a - b).max() / np.abs(b).max()
+
+def coords(P0, V0):
+    """The state coordinate of each kept term: the row of V0 that its row of P0 is (-1: none)."""
+    out = []
+    for row in P0:
+        e = np.abs(V0 - row).max(axis=1)
+        i = int(np.argmin(e))
+        out.append(i if e[i] <= 1e-14 * np.abs(V0).max() else -1)
+    return out
+
 bad = 0
-for meth in ('gmg-pod', 'sp1'):
-    sd = '%s/serial_%s' % (d, meth)
-    ser = {n: np.load('%s/rom_%s.npy' % (sd, n)) for n in ('K', 'Qh', 'Bh', 'V0')}
+for case in ('gmg-pod', 'sp1', 'cosh-gmg-pod', 'cosh-sp1', 'terms-sp1'):
+    nl = case.startswith('cosh-') or case.startswith('terms-')
+    names = ('K', 'Qh', 'Bh', 'V0') + (('P0', 'w', 'poly', 'expo') if nl else ())
+    sd = '%s/serial_%s' % (d, case)
+    ser = {n: np.load('%s/rom_%s.npy' % (sd, n)) for n in names}
     sj = json.load(open(sd + '/rom.json'))
-    ys = np.load('%s/y_serial_%s.npy' % (d, meth))
-    for p in (1, 2, 3, 4):
-        pd = '%s/p%d_%s' % (d, p, meth)
+    ys = np.load('%s/y_serial_%s.npy' % (d, case))
+    idx = np.load(d + '/idx.npy').astype(int)
+    if case.startswith('terms-'):   # every term, in serial order: P0 = V0[idx] (rows of V0 may repeat here)
+        kept = lambda P0, V0: list(idx) if P0.shape[0] == len(idx) and \
+            np.abs(P0 - V0[idx]).max() <= 1e-14 * np.abs(V0).max() else [-1]
+    else:
+        kept = coords
+    cs = kept(ser['P0'], ser['V0']) if nl else []
+    if nl and (len(cs) < 2 or -1 in cs or len(set(cs)) != len(cs)):
+        print('check_cli_mpi: %s: the serial points were not found in V0' % case)
+        bad = 1
+    for p in ((3,) if case.startswith('terms-') else (1, 2, 3, 4)):
+        pd = '%s/p%d_%s' % (d, p, case)
         files_ok = sorted(os.listdir(pd)) == sorted(os.listdir(sd))
         pj = json.load(open(pd + '/rom.json'))
-        keys_ok = all(pj[k] == sj[k] for k in ('method', 'N', 'm', 'r', 'kind', 'map')) and \
-            pj['snapshots']['count'] == sj['snapshots']['count'] and pj['files'] == sj['files']
+        keys_ok = all(pj[k] == sj[k] for k in ('method', 'N', 'm', 'r', 'kind', 'map', 'nd', 'poly_deg')) and \
+            pj['snapshots']['count'] == sj['snapshots']['count'] and pj['files'] == sj['files'] and \
+            pj['options'] == sj['options'] and \
+            all(pj['system'].get(k) == sj['system'].get(k) for k in ('potential', 'poly', 'exp', 'poly_idx', 'poly_w'))
+        if 'hyper' in sj['info'] or 'hyper' in pj['info']:
+            hs, hp = sj['info']['hyper'], pj['info']['hyper']
+            keys_ok = keys_ok and all(hp[k] == hs[k] for k in ('method', 'points', 'negative_weights', 'tol')) and \
+                abs(hp['min_weight'] - hs['min_weight']) <= TOL * abs(hs['min_weight'])
         e_sig = abs(pj['info']['pod_sigma_ratio'] - sj['info']['pod_sigma_ratio']) / sj['info']['pod_sigma_ratio']
         e_rc = abs(pj['info']['rcond_jr'] - sj['info']['rcond_jr']) / sj['info']['rcond_jr']
-        dis = {n: np.load('%s/rom_%s.npy' % (pd, n)) for n in ('K', 'Qh', 'Bh', 'V0')}
+        dis = {n: np.load('%s/rom_%s.npy' % (pd, n)) for n in names}
         sg = np.sign(np.sum(dis['V0'] * ser['V0'], axis=0))
         sg[sg == 0] = 1.0
         S = np.diag(sg)
         e = {'K': rel(S @ dis['K'] @ S, ser['K']), 'Qh': rel(S @ dis['Qh'] @ S, ser['Qh']),
              'Bh': rel(S @ dis['Bh'], ser['Bh']), 'V0': rel(dis['V0'] @ S, ser['V0'])}
-        ey = np.abs(np.load('%s/y_p%d_%s.npy' % (d, p, meth)) - ys).max() / np.abs(ys).max()
+        pts = ''
+        if nl:
+            cd = kept(dis['P0'], dis['V0'])
+            same = all(dis[n].shape == ser[n].shape for n in ('P0', 'w', 'poly', 'expo'))
+            if same:
+                e.update({'P0': rel(dis['P0'] @ S, ser['P0']), 'w': rel(dis['w'], ser['w']),
+                          'poly': rel(dis['poly'], ser['poly']), 'expo': rel(dis['expo'], ser['expo'])})
+            else:
+                e['P0'] = np.inf
+            pts_ok = cd == cs
+            keys_ok = keys_ok and pts_ok
+            pts = '; %d points %s, P0 %.1e, w %.1e, poly %.1e, expo %.1e' % (
+                len(cd), 'the same' if pts_ok else 'DIFFER', e['P0'], e.get('w', np.inf), e.get('poly', np.inf),
+                e.get('expo', np.inf))
+        ey = np.abs(np.load('%s/y_p%d_%s.npy' % (d, p, case)) - ys).max() / np.abs(ys).max()
         ok = files_ok and keys_ok and e_sig <= TOL and e_rc <= TOL and max(e.values()) <= TOL and ey <= TOL
-        print('check_cli_mpi: %-7s P = %d: K %.1e, Qh %.1e, Bh %.1e, V0 %.1e, simulate-rom %.1e; '
-              'sigma ratio %.1e, rcond %.1e; files %s, json %s%s'
-              % (meth, p, e['K'], e['Qh'], e['Bh'], e['V0'], ey, e_sig, e_rc, 'same' if files_ok else 'DIFFER',
+        print('check_cli_mpi: %-12s P = %d: K %.1e, Qh %.1e, Bh %.1e, V0 %.1e, simulate-rom %.1e; '
+              'sigma ratio %.1e, rcond %.1e%s; files %s, json %s%s'
+              % (case, p, e['K'], e['Qh'], e['Bh'], e['V0'], ey, e_sig, e_rc, pts, 'same' if files_ok else 'DIFFER',
                  'agrees' if keys_ok else 'DIFFERS', '' if ok else '  <-- FAILED'))
         bad |= not ok
 if bad:
