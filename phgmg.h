@@ -2317,7 +2317,7 @@
    lowrank: phgmg_shifted_create, phgmg_shifted_solve, phgmg_shifted_apply,
            phgmg_shifted_transfer, phgmg_shifted_hinf,
            phgmg_shifted_factorizations, phgmg_shifted_destroy, phgmg_lradi,
-           phgmg_lowrank_free, phgmg_lrbt, phgmg_lrphbt, phgmg_ss_to_ph,
+           phgmg_lowrank_free, phgmg_lrbt, phgmg_lrbt_feedthrough, phgmg_lrphbt, phgmg_ss_to_ph,
            phgmg_balanced_reduce, phgmg_balanced_reduce_cached,
            phgmg_balanced_cache_free
    export: phgmg_rom_serialized_size, phgmg_rom_serialize,
@@ -4322,6 +4322,9 @@ typedef struct phgmg_lrbt_info {
   int nhsv;                   /* Hankel singular values computed (the rank of Z_o^T E Z_c) */
   double bound;               /* 2 sum_{i > r} sigma_i over the computed ones (approximate) */
   double hsv_tail;            /* sigma_{r+1} (0 if not computed)                    */
+  int nalg;                   /* algebraic lines (E's zero rows) of an index-one model */
+  double dmax;                /* index one: the largest |D(i, j)| of the feedthrough
+                                 (phgmg_lrbt_feedthrough); 0: none               */
 } phgmg_lrbt_info;
 
 /* Low-rank square-root balanced truncation of a sparse linear pH model: the
@@ -4343,6 +4346,13 @@ typedef struct phgmg_lrbt_info {
 PHGMG_DEF phgmg_result phgmg_lrbt(const phgmg_ph_sparse *sp, int r, const phgmg_lradi_opts *opts, double *Ar,
                                   double *Br, double *Cr, double *hsv, double *T, double *W, phgmg_lrbt_info *info,
                                   const phgmg_allocator *alloc);
+/* The feedthrough D (m x m) of an index-one sparse model (manual 8.14): D =
+   -C_2 A_22^{-1} B_2 = -B_a^T L_aa^{-1} B_a, the ports acting through a
+   constraint; zero when E is regular or no port is on an algebraic row.
+   phgmg_lrbt's reduced model of such a model is xr' = Ar xr + Br u, y = Cr
+   xr + D u. Errors: PHGMG_ERR_INVALID_ARG (NULL), the index-one codes of
+   phgmg_shifted_create, _NOMEM. */
+PHGMG_DEF phgmg_result phgmg_lrbt_feedthrough(const phgmg_ph_sparse *sp, double *D, const phgmg_allocator *alloc);
 
 /* pH-preserving low-rank balancing (one Lyapunov equation; manual 8.13):
    the controllability factor Z_c by phgmg_lradi, balanced against the
@@ -6938,6 +6948,7 @@ PHGMG__PRIV void phgmg__sdae_consistent(struct phgmg__sdae *D, const double *u, 
    rows x columns) in doubles. */
 #define PHGMG__DAE_KMAX 4096
 #define PHGMG__DAE_BLOCK_MAX 1e8
+#define PHGMG__LR_DAE_TOL 1e-12  /* index one of the low-rank tools: L_aa, Q_ac regular (the stepper's) */
 
 /* Row range [a, b] of the stored entries of column (or row) i. */
 PHGMG__PRIV void phgmg__ph_span(const phgmg_ph_system *s, int i, int *a, int *b) {
@@ -22309,6 +22320,7 @@ struct phgmg_shifted {
   double *Mx;      /* M = -A in the pattern of K                       */
   double *w;       /* N doubles of scratch (products)                  */
   int N, keep, nfact;
+  int nalg;        /* algebraic lines (index one: the whole pencil)    */
   long clock;
   phgmg__shf *f;   /* keep entries                                     */
 };
@@ -22326,6 +22338,28 @@ PHGMG_DEF void phgmg_shifted_destroy(phgmg_shifted *s) {
   phgmg__free(al, s);
 }
 
+/* The algebraic lines of an index-one SPARSE model (manual 8.14) as the
+   object phgmg__sdae_create makes of them: the lines, the sparse LUs of L_aa
+   and Q_ac (regular: PHGMG_ERR_INDEX otherwise), Q_dc = 0 (else
+   PHGMG_ERR_EQ_NOT_SYMMETRIC); read through a SPARSE view of sp's copies. */
+PHGMG__PRIV phgmg_result phgmg__lr_sdae(const phgmg_ph_sparse *sp, phgmg__sdae **D, const phgmg_allocator *al) {
+  phgmg_ph_system v = sp->sys;
+  phgmg_result rc;
+  v.storage = PHGMG_SPARSE; v.sparse = sp; v.E = sp->cx[3];
+  rc = phgmg__sdae_create(D, &v, PHGMG__LR_DAE_TOL, al);
+  if (rc == PHGMG_OK) rc = phgmg__sdae_qdc(*D, PHGMG__LR_DAE_TOL);
+  if (rc != PHGMG_OK) { phgmg__sdae_free(*D); *D = NULL; }
+  return rc;
+}
+
+/* phgmg_shifted_create's check of a pencil with algebraic lines: index one. */
+PHGMG__PRIV phgmg_result phgmg__lr_index_one(const phgmg_ph_sparse *sp, const phgmg_allocator *al) {
+  phgmg__sdae *D = NULL;
+  phgmg_result rc = phgmg__lr_sdae(sp, &D, al);
+  phgmg__sdae_free(D);
+  return rc;
+}
+
 PHGMG_DEF phgmg_result phgmg_shifted_create(phgmg_shifted **out, const phgmg_ph_sparse *sp, int dual, int keep,
                                             const phgmg_allocator *alloc) {
   phgmg_shifted *s;
@@ -22335,13 +22369,14 @@ PHGMG_DEF phgmg_result phgmg_shifted_create(phgmg_shifted **out, const phgmg_ph_
   *out = NULL;
   if (!sp || keep < 0) return PHGMG_ERR_INVALID_ARG;
   if ((e = phgmg__ph_sparse_e_regular(sp, &nalg)) < 0) return PHGMG_ERR_NOMEM;
-  if (!e) return PHGMG_ERR_UNSUPPORTED;
+  if (!e && (rc = phgmg__lr_index_one(sp, alloc)) != PHGMG_OK) return rc; /* index one: the whole pencil */
   s = PHGMG__CAST(phgmg_shifted *, phgmg__alloc(alloc, sizeof *s));
   if (!s) return PHGMG_ERR_NOMEM;
   memset(s, 0, sizeof *s);
   if (alloc) { s->a = *alloc; s->alloc = &s->a; }
   s->N = sp->sys.N;
   s->sp = sp;
+  s->nalg = e ? 0 : nalg;
   s->keep = keep ? keep : 2;
   rc = phgmg__spsym_create_js(&s->S, sp, -1, dual ? -1.0 : 1.0);
   if (rc == PHGMG_OK) {
@@ -22586,11 +22621,15 @@ PHGMG__PRIV int phgmg__lr_pick_shifts(int k, const double *ev, double *sh) {
 /* Projection shifts: the Ritz values of the pencil (A, E) on span(Y) (N x
    L, ld N): an orthonormal basis U by pivoted QR (columns with |R_jj| <=
    1e-12 |R_00| dropped), Ap = U^T A U, Ep = U^T E U, their eigenvalues, the
-   stable ones as shifts. st->nsh = 0 when none is stable. */
+   stable ones as shifts. An index-one pencil is tested with the co-states
+   Q U instead (Ap = U^T Q^T A U, Ep = U^T Q^T E U = U^T E^T Q U, manual
+   8.14): the energy Galerkin projection, whose values lie in the closed left
+   half-plane. st->nsh = 0 when none is stable. */
 PHGMG__PRIV phgmg_result phgmg__lr_shifts(phgmg__lradi *st, const double *Y, int L) {
-  const int N = st->N;
+  const int N = st->N, qt = st->s->nalg > 0;
   const phgmg_allocator *al = st->al;
-  double *U = phgmg__dalloc(al, 2 * (size_t)N * (size_t)L), *AU = U + (size_t)N * (size_t)L;
+  double *U = phgmg__dalloc(al, (size_t)(qt ? 3 : 2) * (size_t)N * (size_t)L), *AU = U + (size_t)N * (size_t)L;
+  double *TU = qt ? AU + (size_t)N * (size_t)L : U;   /* the test basis: U, or Q U (index one) */
   double *sm = phgmg__dalloc(al, 2 * (size_t)L * (size_t)L + 6 * (size_t)L + 2);
   int *jp = phgmg__ialloc(al, (size_t)L), k = 0, j;
   phgmg_result rc = PHGMG_ERR_NOMEM;
@@ -22602,10 +22641,11 @@ PHGMG__PRIV phgmg_result phgmg__lr_shifts(phgmg__lradi *st, const double *Y, int
   while (k < L && fabs(U[k + (size_t)k * N]) > 1e-12 * fabs(U[0])) ++k;
   if (k == 0) goto done;
   phgmg_qr_form_q(N, k, U, N, tau, wk);
+  for (j = 0; qt && j < k; ++j) phgmg__sp_qmv(st->s->S, U + (size_t)j * N, TU + (size_t)j * N);
   for (j = 0; j < k; ++j) phgmg__lr_amul(st->s->S, U + (size_t)j * N, AU + (size_t)j * N, st->s->w);
-  phgmg_gemm('T', 'N', k, k, N, 1.0, U, N, AU, N, 0.0, Ap, k);
+  phgmg_gemm('T', 'N', k, k, N, 1.0, TU, N, AU, N, 0.0, Ap, k);
   for (j = 0; j < k; ++j) phgmg__lr_emul(st->s->S, U + (size_t)j * N, AU + (size_t)j * N);
-  phgmg_gemm('T', 'N', k, k, N, 1.0, U, N, AU, N, 0.0, Ep, k);
+  phgmg_gemm('T', 'N', k, k, N, 1.0, TU, N, AU, N, 0.0, Ep, k);
   rc = phgmg__lr_pencil_eig(k, Ap, Ep, ev, al);
   if (rc == PHGMG_ERR_SINGULAR || rc == PHGMG_ERR_NOT_CONVERGED) { rc = PHGMG_OK; goto done; } /* no shifts */
   if (rc != PHGMG_OK) goto done;
@@ -22685,10 +22725,34 @@ PHGMG__PRIV void phgmg__lr_progress(const phgmg_lradi_opts *o, const char *phase
   if (o && o->progress) o->progress(phase, o->progress_user);
 }
 
+/* The first shift of an index-one pencil (B's columns are equations, not
+   states: no Ritz values on span(B)): the real shift -||A||_1 / ||E||_1
+   (its bound ||J - R||_1 ||Q||_1 for ||A||_1), the projection shifts from
+   the first ADI block on. */
+PHGMG__PRIV phgmg_result phgmg__lr_shift0(phgmg__lradi *st) {
+  const phgmg__spsym *S = st->s->S;
+  double nl = 0.0, nq = 0.0, ne = 0.0, na;
+  int j, p;
+  for (j = 0; j < st->N; ++j) {   /* ||A||_1 <= ||J - R||_1 ||Q||_1 */
+    double cl = 0.0, cq = 0.0, ce = 0.0;
+    for (p = S->e_p[j]; p < S->e_p[j + 1]; ++p) ce += fabs(S->e_x[p]);
+    for (p = S->jr_p[j]; p < S->jr_p[j + 1]; ++p) cl += fabs(S->jr_x[p]);
+    for (p = S->q_p[j]; p < S->q_p[j + 1]; ++p) cq += fabs(S->q_x[p]);
+    nl = PHGMG__MAX(nl, cl); nq = PHGMG__MAX(nq, cq); ne = PHGMG__MAX(ne, ce);
+  }
+  na = nl * nq;
+  phgmg__free(st->al, st->sh);
+  st->sh = phgmg__dalloc(st->al, 2);
+  if (!st->sh) return PHGMG_ERR_NOMEM;
+  st->sh[0] = ne > 0.0 && na > 0.0 ? -na / ne : -1.0; st->sh[1] = 0.0;
+  st->nsh = 1; st->jsh = 0;
+  return PHGMG_OK;
+}
+
 /* The ADI iteration of phgmg_lradi on st (W = B set); *res the residual. */
 PHGMG__PRIV phgmg_result phgmg__lr_iterate(phgmg__lradi *st, const phgmg_lradi_opts *o, double tol, int maxit,
                                            int nblocks, double bnorm, phgmg_lradi_info *inf) {
-  phgmg_result rc = phgmg__lr_shifts(st, st->W, st->m);
+  phgmg_result rc = st->s->nalg ? phgmg__lr_shift0(st) : phgmg__lr_shifts(st, st->W, st->m);
   double *sh0 = NULL;
   int ns0 = 0;
   inf->shift_sets = 1;
@@ -22773,27 +22837,104 @@ PHGMG_DEF phgmg_result phgmg_lradi(phgmg_shifted *s, int m, const double *B, int
   return PHGMG_OK;
 }
 
+/* The ports of an index-one pencil (manual 8.14): Bc = B - L y, y the
+   embedding of L_aa^{-1} B_a (the condensed input B_d - L_da L_aa^{-1} B_a
+   in the rows d, zero rows a), Fc = B - L^T y', y' that of L_aa^{-T} B_a
+   (the dual pencil's, whose transpose gives the condensed output), D =
+   -B_a^T L_aa^{-1} B_a (m x m). Bc = Fc = NULL (B itself) and D = 0 when E
+   is regular or no port acts on an algebraic row. */
+typedef struct phgmg__lrports {
+  double *Bc, *Fc;  /* N x m each (one block), or NULL */
+  double *D;        /* m x m, or NULL (zero)           */
+} phgmg__lrports;
+
+PHGMG__PRIV void phgmg__lr_ports_free(phgmg__lrports *pt, const phgmg_allocator *al) {
+  phgmg__free(al, pt->Bc);   /* one block: Bc, Fc, D */
+  pt->Bc = pt->Fc = pt->D = NULL;
+}
+
+/* out = B[:, j] - L y (t = 0) or - L^T y (t = 1), L = J - R (sp's CSC
+   copies), y = v on the algebraic rows ra (k), zero elsewhere; rows ra of
+   out set to zero (there the difference vanishes: L_aa L_aa^{-1} B_a). */
+PHGMG__PRIV void phgmg__lr_port_col(const phgmg_ph_sparse *sp, const phgmg__sdae *D, int j, int t,
+                                    const double *v, double *y, double *out) {
+  const int N = sp->sys.N;
+  int a, q, i, p;
+  for (i = 0; i < N; ++i) { out[i] = sp->sys.B[i + (size_t)j * N]; y[i] = 0.0; }
+  for (q = 0; q < D->k; ++q) y[D->ra[q]] = v[q];
+  for (a = 0; a < 2; ++a) {
+    const double sg = a ? -1.0 : 1.0;   /* L = J - R */
+    for (i = 0; i < N; ++i)
+      for (p = sp->cp[a][i]; p < sp->cp[a][i + 1]; ++p) {
+        if (t) out[i] -= sg * sp->cx[a][p] * y[sp->ci[a][p]];          /* (L^T y)_i */
+        else out[sp->ci[a][p]] -= sg * sp->cx[a][p] * y[i];            /* (L y)     */
+      }
+  }
+  for (q = 0; q < D->k; ++q) out[D->ra[q]] = 0.0;
+}
+
+/* The ports of sp into pt (see phgmg__lrports); *nalg the algebraic lines. */
+PHGMG__PRIV phgmg_result phgmg__lr_ports(const phgmg_ph_sparse *sp, phgmg__lrports *pt, int *nalg,
+                                         const phgmg_allocator *al) {
+  const int N = sp->sys.N, m = sp->sys.m;
+  const double *B = sp->sys.B;
+  phgmg__sdae *D = NULL;
+  double *v = NULL;
+  int e, q, i, j, t, act = 0;
+  phgmg_result rc;
+  memset(pt, 0, sizeof *pt);
+  if ((e = phgmg__ph_sparse_e_regular(sp, nalg)) < 0) return PHGMG_ERR_NOMEM;
+  if (e) { *nalg = 0; return PHGMG_OK; }
+  if ((rc = phgmg__lr_sdae(sp, &D, al)) != PHGMG_OK) return rc;
+  for (j = 0; j < m; ++j)
+    for (q = 0; q < D->k; ++q) act |= B[D->ra[q] + (size_t)j * N] != 0.0;
+  if (act) {
+    pt->Bc = phgmg__dalloc(al, 2 * (size_t)N * m + (size_t)m * m);
+    v = phgmg__dalloc(al, (size_t)D->k + (size_t)N);
+    if (!pt->Bc || !v) rc = PHGMG_ERR_NOMEM;
+  }
+  if (act && rc == PHGMG_OK) {
+    pt->Fc = pt->Bc + (size_t)N * m; pt->D = pt->Fc + (size_t)N * m;
+    for (j = 0; j < m; ++j)
+      for (t = 0; t < 2; ++t) {
+        for (q = 0; q < D->k; ++q) v[q] = B[D->ra[q] + (size_t)j * N];
+        if (t) phgmg__sp_solve_t(D->Sl, &D->Fl, v); else phgmg__sp_solve(D->Sl, &D->Fl, v);
+        for (i = 0; !t && i < m; ++i) {   /* D(i, j) = -(B_a^T L_aa^{-1} B_a)(i, j) */
+          double acc = 0.0;
+          for (q = 0; q < D->k; ++q) acc += B[D->ra[q] + (size_t)i * N] * v[q];
+          pt->D[i + (size_t)j * m] = -acc;
+        }
+        phgmg__lr_port_col(sp, D, j, t, v, v + D->k, (t ? pt->Fc : pt->Bc) + (size_t)j * N);
+      }
+  }
+  phgmg__free(al, v);
+  phgmg__sdae_free(D);
+  if (rc != PHGMG_OK) { phgmg__free(al, pt->Bc); memset(pt, 0, sizeof *pt); }
+  return rc;
+}
+
 /* The two Gramian factors of phgmg_lrbt: Zc (kc columns) and Zo = Q Zy
    (ko columns), with the ADI runs' info. */
 PHGMG__PRIV phgmg_result phgmg__lrbt_obs(const phgmg_ph_sparse *sp, const phgmg_lradi_opts *opts, phgmg_shifted *sc,
-                                         const double *Zc, int kc, double **Zo, int *ko, phgmg_lrbt_info *inf,
-                                         const phgmg_allocator *al);
+                                         const double *Fb, const double *Zc, int kc, double **Zo, int *ko,
+                                         phgmg_lrbt_info *inf, const phgmg_allocator *al);
 PHGMG__PRIV phgmg_result phgmg__lrbt_factors(const phgmg_ph_sparse *sp, const phgmg_lradi_opts *opts,
-                                             phgmg_shifted *sc, double **Zc, int *kc, double **Zo, int *ko,
-                                             phgmg_lrbt_info *inf, const phgmg_allocator *al) {
+                                             phgmg_shifted *sc, const phgmg__lrports *pt, double **Zc, int *kc,
+                                             double **Zo, int *ko, phgmg_lrbt_info *inf, const phgmg_allocator *al) {
   const int N = sp->sys.N, m = sp->sys.m;
   phgmg_result rc;
   phgmg__lr_progress(opts, "controllability Gramian");
-  rc = phgmg_lradi(sc, m, sp->sys.B, N, opts, Zc, kc, &inf->ctrl, al);
+  rc = phgmg_lradi(sc, m, pt->Bc ? pt->Bc : sp->sys.B, N, opts, Zc, kc, &inf->ctrl, al);
   if (rc != PHGMG_OK) return rc;
-  return phgmg__lrbt_obs(sp, opts, sc, *Zc, *kc, Zo, ko, inf, al);
+  return phgmg__lrbt_obs(sp, opts, sc, pt->Fc ? pt->Fc : sp->sys.B, *Zc, *kc, Zo, ko, inf, al);
 }
 
 /* The observability factor Zo = Q Zy of phgmg_lrbt (Zy: the dual model's
-   controllability factor; Zc when J = 0), inf->obs its ADI run. */
+   controllability factor with input Fb -- B, or an index-one model's
+   condensed dual input; Zc when J = 0), inf->obs its ADI run. */
 PHGMG__PRIV phgmg_result phgmg__lrbt_obs(const phgmg_ph_sparse *sp, const phgmg_lradi_opts *opts, phgmg_shifted *sc,
-                                         const double *Zc, int kc, double **Zo, int *ko, phgmg_lrbt_info *inf,
-                                         const phgmg_allocator *al) {
+                                         const double *Fb, const double *Zc, int kc, double **Zo, int *ko,
+                                         phgmg_lrbt_info *inf, const phgmg_allocator *al) {
   const int N = sp->sys.N, m = sp->sys.m;
   phgmg_shifted *sd = NULL;
   double *Zy = NULL;
@@ -22808,7 +22949,7 @@ PHGMG__PRIV phgmg_result phgmg__lrbt_obs(const phgmg_ph_sparse *sp, const phgmg_
   } else {
     phgmg__lr_progress(opts, "observability Gramian");
     rc = phgmg_shifted_create(&sd, sp, 1, 0, al);
-    if (rc == PHGMG_OK) rc = phgmg_lradi(sd, m, sp->sys.B, N, opts, &Zy, ko, &inf->obs, al);
+    if (rc == PHGMG_OK) rc = phgmg_lradi(sd, m, Fb, N, opts, &Zy, ko, &inf->obs, al);
     phgmg_shifted_destroy(sd);
     if (rc != PHGMG_OK) return rc;
     Zu = Zy;
@@ -22821,10 +22962,11 @@ PHGMG__PRIV phgmg_result phgmg__lrbt_obs(const phgmg_ph_sparse *sp, const phgmg_
 }
 
 /* The balancing of phgmg_lrbt from the factors: SVD of Zo^T E Zc, the
-   bases T, W (N x r each, into TW), the reduced matrices, the first nsv
-   values (fewer if fewer were computed: inf->nhsv). */
-PHGMG__PRIV phgmg_result phgmg__lrbt_balance(const phgmg_ph_sparse *sp, phgmg_shifted *sc, int r, const double *Zc,
-                                             int kc, const double *Zo, int ko, double *TW, double *Ar, double *Br,
+   bases T, W (N x r each, into TW), the reduced matrices (Br = W^T Bb: B,
+   or an index-one model's condensed input), the first nsv values (fewer if
+   fewer were computed: inf->nhsv). */
+PHGMG__PRIV phgmg_result phgmg__lrbt_balance(const phgmg_ph_sparse *sp, phgmg_shifted *sc, const double *Bb, int r,
+                                             const double *Zc, int kc, const double *Zo, int ko, double *TW, double *Ar, double *Br,
                                              double *Cr, double *hsv, int nsv, phgmg_lrbt_info *inf,
                                              const phgmg_allocator *al) {
   const int N = sp->sys.N, m = sp->sys.m, kmin = PHGMG__MIN(kc, ko);
@@ -22850,7 +22992,7 @@ PHGMG__PRIV phgmg_result phgmg__lrbt_balance(const phgmg_ph_sparse *sp, phgmg_sh
   phgmg_gemm('N', 'N', N, r, ko, 1.0, Zo, N, U, ko, 0.0, W, N);
   for (j = 0; j < r; ++j) phgmg__lr_amul(sc->S, T + (size_t)j * N, EZ + (size_t)j * N, sc->w);
   phgmg_gemm('T', 'N', r, r, N, 1.0, W, N, EZ, N, 0.0, Ar, r);
-  phgmg_gemm('T', 'N', r, m, N, 1.0, W, N, sp->sys.B, N, 0.0, Br, r);
+  phgmg_gemm('T', 'N', r, m, N, 1.0, W, N, Bb, N, 0.0, Br, r);
   for (j = 0; j < r; ++j) phgmg__sp_qmv(sc->S, T + (size_t)j * N, EZ + (size_t)j * N);
   phgmg_gemm('T', 'N', m, r, N, 1.0, sp->sys.B, N, EZ, N, 0.0, Cr, m);
   inf->bound = 0.0;
@@ -22867,27 +23009,65 @@ PHGMG_DEF phgmg_result phgmg_lrbt(const phgmg_ph_sparse *sp, int r, const phgmg_
                                   const phgmg_allocator *alloc) {
   phgmg_lrbt_info inf;
   phgmg_shifted *sc = NULL;
+  phgmg__lrports pt;
   double *Zc = NULL, *Zo = NULL, *TW = NULL;
   int kc = 0, ko = 0, N;
   phgmg_result rc;
   memset(&inf, 0, sizeof inf);
+  memset(&pt, 0, sizeof pt);
   if (info) *info = inf;
   if (!sp || !Ar || !Br || !Cr) return PHGMG_ERR_INVALID_ARG;
   N = sp->sys.N;
   if (r < 1 || r > N) return PHGMG_ERR_SIZE;
-  rc = phgmg_shifted_create(&sc, sp, 0, 0, alloc);
-  if (rc == PHGMG_OK) rc = phgmg__lrbt_factors(sp, opts, sc, &Zc, &kc, &Zo, &ko, &inf, alloc);
+  rc = phgmg__lr_ports(sp, &pt, &inf.nalg, alloc);
+  if (rc == PHGMG_OK) rc = phgmg_shifted_create(&sc, sp, 0, 0, alloc);
+  if (rc == PHGMG_OK) rc = phgmg__lrbt_factors(sp, opts, sc, &pt, &Zc, &kc, &Zo, &ko, &inf, alloc);
   if (rc == PHGMG_OK) {
     phgmg__lr_progress(opts, "balancing");
     TW = phgmg__dalloc(alloc, 2 * (size_t)N * (size_t)r);
-    rc = TW ? phgmg__lrbt_balance(sp, sc, r, Zc, kc, Zo, ko, TW, Ar, Br, Cr, hsv, r, &inf, alloc) : PHGMG_ERR_NOMEM;
+    rc = TW ? phgmg__lrbt_balance(sp, sc, pt.Bc ? pt.Bc : sp->sys.B, r, Zc, kc, Zo, ko, TW, Ar, Br, Cr, hsv, r,
+                                  &inf, alloc)
+            : PHGMG_ERR_NOMEM;
   }
+  if (rc == PHGMG_OK && pt.D) {   /* the largest entry of the feedthrough */
+    int i;
+    for (i = 0; i < sp->sys.m * sp->sys.m; ++i) inf.dmax = PHGMG__MAX(inf.dmax, fabs(pt.D[i]));
+  }
+  phgmg__lr_ports_free(&pt, alloc);
   if (rc == PHGMG_OK && T) memcpy(T, TW, sizeof(double) * (size_t)N * (size_t)r);
   if (rc == PHGMG_OK && W) memcpy(W, TW + (size_t)N * (size_t)r, sizeof(double) * (size_t)N * (size_t)r);
   if (rc == PHGMG_OK) phgmg__lr_progress(opts, "done");
   phgmg__free(alloc, TW); phgmg__free(alloc, Zc); phgmg__free(alloc, Zo);
   phgmg_shifted_destroy(sc);
   if (info) *info = inf;
+  return rc;
+}
+
+PHGMG_DEF phgmg_result phgmg_lrbt_feedthrough(const phgmg_ph_sparse *sp, double *D, const phgmg_allocator *alloc) {
+  phgmg__lrports pt;
+  phgmg_result rc;
+  int nalg = 0, m;
+  if (!sp || !D) return PHGMG_ERR_INVALID_ARG;
+  m = sp->sys.m;
+  rc = phgmg__lr_ports(sp, &pt, &nalg, alloc);
+  if (rc == PHGMG_OK) {
+    if (pt.D) memcpy(D, pt.D, sizeof(double) * (size_t)m * (size_t)m);
+    else memset(D, 0, sizeof(double) * (size_t)m * (size_t)m);
+  }
+  phgmg__lr_ports_free(&pt, alloc);
+  return rc;
+}
+
+/* The pH reduced objects of an index-one sparse model: the same solvers on
+   the whole pencil (manual 8.14), as long as no port acts on an algebraic
+   row (a feedthrough, which the pH forms here do not carry):
+   PHGMG_ERR_UNSUPPORTED then; the index-one codes of phgmg_shifted_create. */
+PHGMG__PRIV phgmg_result phgmg__bal_ports(const phgmg_ph_sparse *sp, const phgmg_allocator *al) {
+  phgmg__lrports pt;
+  int nalg;
+  phgmg_result rc = phgmg__lr_ports(sp, &pt, &nalg, al);
+  if (rc == PHGMG_OK && pt.Bc) rc = PHGMG_ERR_UNSUPPORTED;
+  phgmg__lr_ports_free(&pt, al);
   return rc;
 }
 
@@ -22966,7 +23146,8 @@ PHGMG_DEF phgmg_result phgmg_lrphbt(const phgmg_ph_sparse *sp, int r, const phgm
   if (!sp || !Jr || !Rr || !Qr || !Br) return PHGMG_ERR_INVALID_ARG;
   N = sp->sys.N;
   if (r < 1 || r > N) return PHGMG_ERR_SIZE;
-  rc = phgmg_shifted_create(&sc, sp, 0, 0, alloc);
+  rc = phgmg__bal_ports(sp, alloc);   /* index one: no port on an algebraic row */
+  if (rc == PHGMG_OK) rc = phgmg_shifted_create(&sc, sp, 0, 0, alloc);
   if (rc == PHGMG_OK) {
     phgmg__lr_progress(opts, "controllability Gramian");
     rc = phgmg_lradi(sc, sp->sys.m, sp->sys.B, N, opts, &Z, &kc, &inf.ctrl, alloc);
@@ -23155,7 +23336,7 @@ PHGMG__PRIV phgmg_result phgmg__bal_obs(const phgmg_ph_sparse *sp, const phgmg_l
   const int N = sp->sys.N;
   phgmg_result rc;
   if (c && c->Zo) { *ko = c->ko; inf->obs = c->obs; return phgmg__bal_copy(c->Zo, (size_t)N * c->ko, Zo, al); }
-  rc = phgmg__lrbt_obs(sp, opts, sc, Zc, kc, Zo, ko, inf, al);
+  rc = phgmg__lrbt_obs(sp, opts, sc, sp->sys.B, Zc, kc, Zo, ko, inf, al);
   if (c) c->adi_runs++;
   if (rc == PHGMG_OK && c && phgmg__bal_copy(*Zo, (size_t)N * *ko, &c->Zo, al) == PHGMG_OK) {
     c->ko = *ko; c->obs = inf->obs;
@@ -23187,7 +23368,8 @@ PHGMG__PRIV phgmg_result phgmg__bal_lr_stage(const phgmg_ph_sparse *sp, const ph
     phgmg__lr_progress(opts, "balancing");
     *blk = phgmg__dalloc(al, 2 * nr + q + 2 * rm);
     Ar = *blk ? *blk + 2 * nr : NULL;
-    rc = Ar ? phgmg__lrbt_balance(sp, sc, r, Zc, kc, Zo, ko, *blk, Ar, Ar + q, Ar + q + rm, sv, nsv, &inf->lr, al)
+    rc = Ar ? phgmg__lrbt_balance(sp, sc, sp->sys.B, r, Zc, kc, Zo, ko, *blk, Ar, Ar + q, Ar + q + rm, sv, nsv,
+                                  &inf->lr, al)
             : PHGMG_ERR_NOMEM;
   }
   inf->lowrank = 1;
@@ -23511,6 +23693,7 @@ PHGMG_DEF phgmg_result phgmg_balanced_reduce_cached(phgmg_reduced **out, const p
   if (!sp) cache = NULL;
   if (cache && cache->sp && cache->sp != sp) return PHGMG_ERR_INVALID_ARG;
   if (cache) cache->sp = sp;
+  if (sp && (rc = phgmg__bal_ports(sp, alloc)) != PHGMG_OK) return rc;
   if (sp && method == PHGMG_METHOD_PHBT) rc = phgmg__bal_sparse_phbt(out, sp, r, opts, sv, nsv, &inf, cache, alloc);
   else if (sp && method == PHGMG_METHOD_BT) rc = phgmg__bal_sparse_bt(out, sp, r, opts, sv, nsv, &inf, cache, alloc);
   else if (sp) rc = phgmg__bal_sparse_prbt(out, sp, r, opts, sv, nsv, &inf, cache, alloc);

@@ -4402,6 +4402,10 @@ static int explain_balancing(const reduce_args *A, const reduce_state *S, phgmg_
                   b->lr.obs.iters ? b->lr.obs.res : b->lr.ctrl.res,
                   b->lr.obs.iters ? b->lr.obs.iters : b->lr.ctrl.iters);
     case PHGMG_ERR_UNSUPPORTED:
+      if (S->sp && S->dae_direct && A->Ecoo)
+        return fail("reduction failed: a port acts on an algebraic equation (a zero row of E, %s): through the "
+                    "constraint it has a feedthrough D, which the port-Hamiltonian forms of --method bt, prbt "
+                    "and phbt do not carry; reduce with --method sp1 or sp2 (snapshots)", A->Ecoo);
       if (S->method == PHGMG_METHOD_PHBT && !S->sp)
         return fail("reduction failed: --method phbt needs the sparse model (--J-coo, --R-coo, --Q-coo)");
       return fail("reduction failed: %s (dense BT and PRBT take standard-form models: give a mass matrix as "
@@ -4421,8 +4425,8 @@ static int run_balancing(const reduce_args *A, reduce_state *S, double *t_red) {
   phgmg_result rc;
   double t0;
   int runs0;
-  if (S->dae) return fail("--method %s: index-one descriptor models (E with zero rows) are not supported; give "
-                          "an E of full rank", A->method);
+  if (S->dae) return fail("--method %s on an index-one descriptor model (E with zero rows): not in one run with "
+                          "snapshot methods; reduce with the balancing methods in a run of their own", A->method);
   memset(&lo, 0, sizeof lo);
   progress("reducing: %s, r = %d (%s solvers)", A->method, A->r, S->sp ? "low-rank, sparse" : "dense");
   t0 = now_s();
@@ -4566,6 +4570,7 @@ static int cmd_reduce(int argc, char **argv) {
   int rc = parse_reduce(argc, argv, &A);
   if (rc) return rc < 0 ? 0 : rc;
   memset(&S, 0, sizeof S);
+  S.dae_direct = !sweep_needs_snapshots(&A);   /* balancing only: an index-one model on its whole pencil */
   rc = cmd_reduce_impl(&A, &S);
   reduce_cleanup(&S);
   return rc;
