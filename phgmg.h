@@ -183,8 +183,10 @@
    against the reduction of the explicitly formed J_E, R_E, Q_E = E^T Q, B_E
    and against the closed forms above.
    Not for descriptor models (PHGMG_ERR_UNSUPPORTED): a GENERAL nonlinear part,
-   the shifted_* callbacks, the linear-systems toolbox (BT, PRBT, Gramian
-   bases, phgmg_ph_abc) and studies. Singular E (algebraic constraints of
+   the shifted_* callbacks, the dense linear-systems toolbox (phgmg_bt,
+   phgmg_prbt, Gramian bases, phgmg_ph_abc) and studies. Balanced truncation
+   of a descriptor model is done by the low-rank tools on its sparse form
+   (2.8; E of full rank, or of index one: 8.14). Singular E (algebraic constraints of
    index one) is the subject of 1.8, nonlinear dissipation of 1.7. Feedthrough (phgmg_ph_system.P,
    S, Nskew: E x' = (J - R) z + (B - P) u, y = (B + P)^T z + (S + N) u) is
    taken by the full model -- validation of [[R, P], [P^T, S]] >= 0 and N
@@ -443,7 +445,9 @@
    Reduction: reduce the condensed model,
    phgmg_dae_system(d), with snapshots restricted to x_d (phgmg_reduce of the
    full model is PHGMG_ERR_UNSUPPORTED; the command line does this by
-   itself). The reduced model is a port-Hamiltonian ODE with the same
+   itself). Balanced truncation needs no condensation: the low-rank tools
+   take the SPARSE index-one model itself and solve with its whole pencil
+   (8.14; the command line's reduce --method bt, prbt, phbt on COO input). The reduced model is a port-Hamiltonian ODE with the same
    outputs; every method takes it. GMG needs B' of full rank: a port that
    acts only through a constraint (a current source on a node without
    capacitor) leaves its column of B' zero (it enters through P', S' only),
@@ -962,9 +966,12 @@
          (Ar, Br, Cr): Qh the minimal solution of its positive-real lemma.
    The reduced model of phgmg_lrbt (Ar, Br, Cr) is a plain state-space
    model (as phgmg_bt's), not a pH model (phgmg_ss_to_ph gives its pH form
-   when it is passive). Not yet: index-one E (zero rows/columns:
-   PHGMG_ERR_UNSUPPORTED), feedthrough, nonlinear parts. Algorithms and
-   measured times: 8.13.
+   when it is passive). Index-one E (zero rows and columns: algebraic
+   constraints) is solved on the whole sparse pencil, the Gramians being
+   those of the condensed model, never formed; a port on a constraint
+   gives the reduced model a feedthrough D (phgmg_lrbt_feedthrough): 8.14.
+   Not yet: feedthrough of the model itself (P, S, N), nonlinear parts.
+   Algorithms and measured times: 8.13.
 
    2.9 Snapshot sets larger than memory (>>pod, >>reduce; no MPI needed).
    phgmg_pod_stream_begin / _add / _end take the snapshots a block of
@@ -2216,6 +2223,104 @@
    model to 4e-15 (tests/check_cli_lowrank.py). The intermediate model must
    be passive, which is why stage 1 is this projection and not a BT model
    (see above).
+
+   8.14 Low-rank balancing of index-one descriptor models (>>lowrank).
+   A sparse model whose E has k zero rows (the algebraic equations, set a)
+   and k zero columns (the algebraic variables, set c), of index one (1.8:
+   L_aa and Q_ac regular, L = J - R), in blocks with d for the other rows
+   and columns (A = L Q, C = B^T Q; Q_dc = 0, so A_ac = L_aa Q_ac and A_dc
+   = L_da Q_ac):
+       [E_dd 0; 0 0] x' = [A_dd A_dc; A_ad A_ac] x + [B_d; B_a] u,
+       y = [C_d C_c] x.
+   Condensed model. The algebraic rows fix x_c = -A_ac^{-1} (A_ad x_d +
+   B_a u); in the differential state x_d alone the model is the ODE
+       E_dd x_d' = A' x_d + B' u,  y = C' x_d + D u,
+       A' = A_dd - A_dc A_ac^{-1} A_ad,   B' = B_d - A_dc A_ac^{-1} B_a
+                                             = B_d - L_da L_aa^{-1} B_a,
+       C' = C_d - C_c A_ac^{-1} A_ad,     D  = -C_c A_ac^{-1} B_a
+                                             = -B_a^T L_aa^{-1} B_a,
+   and the transfer function of the descriptor model is C (s E - A)^{-1} B
+   = C' (s E_dd - A')^{-1} B' + D: at index one the pencil has no other
+   part; what is left at s -> infinity is the constant D. The Gramians of
+   the descriptor model are those of this ODE (the condensed Gramians):
+   A' P E_dd^T + E_dd P A'^T + B' B'^T = 0 and A'^T O E_dd + E_dd^T O A' +
+   C'^T C' = 0, Hankel singular values sqrt(eig(P E_dd^T O E_dd)).
+   Where the feedthrough comes from. A port on an algebraic row (a current
+   source into a node without capacitor, a force on a massless node) acts
+   at once through the constraint: z_a = -L_aa^{-1} (L_ad z_d + B_a u), and
+   y = B^T z picks up -B_a^T L_aa^{-1} B_a u. Its symmetric part is
+   B_a^T L_aa^{-T} R_aa L_aa^{-1} B_a >= 0 (the resistance the port sees);
+   a model whose ports all sit on differential rows (B_a = 0) has D = 0
+   and B' = B_d, C' = F'^T Q_dd with F' = B_d.
+   Why the pencil solve is the condensed solve. Nothing of order k is
+   formed, and no Schur complement A': each ADI step solves with the whole
+   sparse pencil (A + p E) (the sparse LU with the column matching of 1.8
+   that the stepper uses; one analysis for all shifts, 8.13). For a
+   right-hand side f with f_a = 0 the algebraic rows of (A + p E) v = f read
+   A_ad v_d + A_ac v_c = 0 (E's rows a vanish), so v_c = -A_ac^{-1} A_ad v_d,
+   and the differential rows (A_dd + p E_dd) v_d + A_dc v_c = f_d become
+   (A' + p E_dd) v_d = f_d: v_d is the condensed solve and v_c its
+   consistent completion. LR-ADI starts from W_0 = [B'; 0] and updates W <-
+   W - 2 Re(p) E V, whose algebraic rows stay zero (E's rows a vanish); so
+   every solve has such a right-hand side, and the ADI of the whole pencil
+   is, row for row, the ADI of the condensed model, its factor Z_c = [Z_d;
+   -A_ac^{-1} A_ad Z_d] carrying consistent algebraic rows; the residual
+   W W^T is that of the condensed equation. Only B' (m vectors) needs the
+   algebraic blocks: the embedding y of L_aa^{-1} B_a (sparse LU of L_aa)
+   gives [B'; 0] = B - L y, one sparse product.
+   Observability. The condensed model is port-Hamiltonian (1.8): E_dd x_d'
+   = L' Q_dd x_d + G' u, y = F'^T Q_dd x_d + D u, L' = L_dd - L_da L_aa^{-1}
+   L_ad, G' = B', F' = B_d - L_ad^T L_aa^{-T} B_a. The identity of 8.13
+   (O = Q^T Y Q with Y the controllability Gramian of the dual model J ->
+   -J, from E^T Q = Q^T E) holds for it, and the dual of the condensed
+   model is the condensation of the dual model (L'^T is the Schur
+   complement of L^T): so Y comes from the same ADI on the dual pencil (-J
+   - R) Q with input [F'; 0] = B - L^T y' (y' the embedding of L_aa^{-T}
+   B_a, the transposed solve with the same LU), and Z_o = Q Z_y.
+   Balancing. Z_o^T E Z_c = Z_o,d^T E_dd Z_c,d (E's zero columns ignore the
+   algebraic rows of Z_c, its zero rows those of Z_o): its singular values
+   are the condensed Hankel singular values. T = Z_c V_r S_r^{-1/2} is a
+   combination of consistent columns, so A T has zero algebraic rows and
+   (A T)_d = A' T_d; hence Ar = W^T A T = W_d^T A' T_d, Br = W^T [B'; 0],
+   Cr = B^T Q T = C' T_d (at a consistent state B^T z = F'^T z_d), W^T E T
+   = I: the square-root BT of the condensed model, computed on the full
+   pencil. The reduced model is
+       xr' = Ar xr + Br u,   y = Cr xr + D u,
+   D carried over exactly, so the error G - Gr is the BT error of the
+   condensed model and the bound is BT's: ||G - Gr||_inf <= 2 sum_{i>r}
+   sigma_i over the condensed Hankel singular values (over the computed
+   ones, as in 2.8).
+   Shifts. B's columns live in the equation space, so no Ritz values are
+   taken on span(B): the first shift is the real -||J - R||_1 ||Q||_1 /
+   ||E||_1, and the projection shifts then come from the ADI blocks with
+   the co-states Q U as the test basis (the energy Galerkin projection:
+   U^T Q^T E U = U^T E^T Q U positive definite on consistent U, U^T Q^T A U
+   with negative semidefinite symmetric part -(Q U)^T R (Q U), so every
+   Ritz value lies in the closed left half-plane).
+   In the library: phgmg_shifted_create takes such a pencil (the index-one
+   checks of 1.8: PHGMG_ERR_INDEX, _EQ_NOT_SYMMETRIC; phgmg_shifted_transfer
+   then gives the descriptor model's G, D included); phgmg_lrbt returns Ar,
+   Br, Cr (info->nalg the algebraic lines, info->dmax the largest |D(i,
+   j)|), phgmg_lrbt_feedthrough returns D. phgmg_shifted_hinf takes no D:
+   with a port on a constraint it measures the reduced model without D.
+   The pH forms (phgmg_balanced_reduce: BT, PRBT, PHBT; phgmg_lrphbt; the
+   command line's reduce --method bt, prbt, phbt on --E-coo with zero rows)
+   take index-one models whose ports all sit on differential rows (D = 0:
+   B itself is the condensed input of both pencils; PRBT's and PHBT's first
+   stage, the energy Galerkin projection onto the consistent factor, is
+   that of the condensed model because L Q V has zero algebraic rows); a
+   port on an algebraic row is PHGMG_ERR_UNSUPPORTED there (a pH form with
+   feedthrough is not built: use phgmg_lrbt and phgmg_lrbt_feedthrough, or
+   SP1/SP2 on the condensed model, 1.8).
+   Checked (tests/check_lowrank_dae.py, against NumPy/SciPy: dense
+   condensation, scipy.linalg.solve_continuous_lyapunov, the singular
+   values of Lo^T Lp): an 8 x 8 RLC grid (bench/rlc_grid.py, N = 288, 144
+   algebraic lines, rows and states scrambled) reduced by the command line
+   to r = 10: Hankel singular values within 4.4e-13 sigma_1, the sampled
+   H-infinity error against the descriptor model's own C (i w E - A)^{-1} B
+   (200 frequencies in [1e-2, 1e2]) 1.15e-3 within the bound 3.08e-3;
+   the same grid with a port on a constraint: D != 0 and --method bt
+   refused naming the feedthrough.
 
 
    9. CONFIGURATION MACROS (define before including) -----------------------------
@@ -4224,9 +4329,13 @@ extern "C" {
    8.13). The numeric factors of the last `keep` shifts (0: 2) are kept:
    a repeated shift is solved without refactoring. Pivots are static (the
    fill-reducing order's diagonal, manual 8.12), checked per factorization.
-   Errors: PHGMG_ERR_INVALID_ARG (NULL, keep < 0), _UNSUPPORTED (an E with
-   a zero row or column: index one, manual 1.8), _NOMEM. *out NULL on
-   failure. sp must outlive the object. */
+   An E with zero rows and columns (algebraic constraints) is taken when
+   the pencil is of index one: the solves are with the whole pencil
+   (manual 8.14). Errors: PHGMG_ERR_INVALID_ARG (NULL, keep < 0), for an E
+   with zero lines those of the index-one checks of manual 1.8
+   (_E_SINGULAR: unequal counts of zero rows and columns, _INDEX,
+   _EQ_NOT_SYMMETRIC: Q_dc != 0), _NOMEM. *out NULL on failure. sp must
+   outlive the object. */
 typedef struct phgmg_shifted phgmg_shifted;
 PHGMG_DEF phgmg_result phgmg_shifted_create(phgmg_shifted **out, const phgmg_ph_sparse *sp, int dual, int keep,
                                             const phgmg_allocator *alloc);
@@ -6948,6 +7057,8 @@ PHGMG__PRIV void phgmg__sdae_consistent(struct phgmg__sdae *D, const double *u, 
    rows x columns) in doubles. */
 #define PHGMG__DAE_KMAX 4096
 #define PHGMG__DAE_BLOCK_MAX 1e8
+#define PHGMG__LR_STALL 0.5        /* LR-ADI: a shift cycle that leaves more than this of the residual ...   */
+#define PHGMG__LR_BLOCKS_MAX 48    /* ... doubles the projection shifts' window of blocks, up to this many   */
 #define PHGMG__LR_DAE_TOL 1e-12  /* index one of the low-rank tools: L_aa, Q_ac regular (the stepper's) */
 
 /* Row range [a, b] of the stored entries of column (or row) i. */
@@ -22753,17 +22864,20 @@ PHGMG__PRIV phgmg_result phgmg__lr_shift0(phgmg__lradi *st) {
 PHGMG__PRIV phgmg_result phgmg__lr_iterate(phgmg__lradi *st, const phgmg_lradi_opts *o, double tol, int maxit,
                                            int nblocks, double bnorm, phgmg_lradi_info *inf) {
   phgmg_result rc = st->s->nalg ? phgmg__lr_shift0(st) : phgmg__lr_shifts(st, st->W, st->m);
-  double *sh0 = NULL;
+  double *sh0 = NULL, res0;
   int ns0 = 0;
   inf->shift_sets = 1;
   if (rc != PHGMG_OK) return rc;
   if (st->nsh == 0) return PHGMG_ERR_NOT_STABLE;
-  inf->res = phgmg__lr_gram2(st->N, st->m, st->W, st->al) / bnorm;
+  inf->res = res0 = phgmg__lr_gram2(st->N, st->m, st->W, st->al) / bnorm;
   while (!(inf->res <= tol)) {
     double pr, pi;
     if (inf->iters >= maxit) return PHGMG_ERR_NOT_CONVERGED;
     if (st->jsh == st->nsh) { /* new projection shifts, or the last set again */
-      int b0 = PHGMG__MAX(0, st->nblk - nblocks), c0 = st->bstart[b0];
+      int b0, c0;
+      if (inf->res > PHGMG__LR_STALL * res0) nblocks = PHGMG__MIN(2 * nblocks, PHGMG__LR_BLOCKS_MAX);
+      res0 = inf->res;
+      b0 = PHGMG__MAX(0, st->nblk - nblocks); c0 = st->bstart[b0];
       ns0 = st->nsh;
       sh0 = phgmg__dalloc(st->al, 2 * (size_t)ns0);
       if (!sh0) return PHGMG_ERR_NOMEM;
