@@ -3357,8 +3357,9 @@ static int condense_algebraic(const reduce_args *A, reduce_state *S) {
   if (S->dae_direct) {
     int zr = 0, zc = 0;
     e_zero_lines(S, S->full.N, &zr, &zc, NULL, NULL);
-    progress("algebraic constraints: E singular, %d algebraic equations and variables (index one); the DAE is "
-             "stepped on the sparse pencil", zr);
+    progress("algebraic constraints: E singular, %d algebraic equations and variables (index one); %s", zr,
+             A->nml > 0 && !sweep_needs_snapshots(A) ? "the Gramians' solves use the whole sparse pencil (the "
+             "condensed model is never formed)" : "the DAE is stepped on the sparse pencil");
     return 0;
   }
   rc = phgmg_dae_create(&S->dae, &S->full, 0.0, NULL);
