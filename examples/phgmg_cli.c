@@ -5155,6 +5155,7 @@ static int cmd_validate(int argc, char **argv) {
     return usage_error("validate: with --X give --test-input (or --X-input): the inputs that made the snapshots are unknown");
   if (nt == 0) V.tests[nt++] = A.input;
   memset(&S, 0, sizeof S);
+  S.dae_direct = !sweep_needs_snapshots(&A);   /* balancing only: an index-one model on its whole pencil */
   memset(tin, 0, sizeof tin);
   status = reduce_prepare(&A, &S, V.tests, nt);
   for (k = 0; k < nt && !status; ++k) { /* every test input and run length, up front */
