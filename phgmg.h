@@ -2220,14 +2220,14 @@
    here. Instead: stage 1, the Galerkin projection in the energy inner
    product onto V = span(Z_c) (Z_c the controllability factor of LR-ADI,
    tolerance 1e-10; its compressed columns are orthogonal, normalised here):
-   x = V xi, tested with Q E V: M xi' = (Jr - Rr) xi + Br u with M = V^T Q E
-   V, Jr = skew(V^T Q J Q V), Rr = sym(V^T Q R Q V), Br = V^T Q B, so in z =
-   M xi the model z' = (Jr - Rr) M^{-1} z + Br u, y = Br^T M^{-1} z is pH
+   x = V xi, the equations tested with Q V: M xi' = (Jr - Rr) xi + Br u with
+   M = V^T E^T Q V, Jr = skew(V^T Q J Q V), Rr = sym(V^T Q R Q V), Br =
+   V^T Q B, so in z = M xi the model z' = (Jr - Rr) M^{-1} z + Br u, y = Br^T M^{-1} z is pH
    (Qk = M^{-1}) and passive by construction, of order k = rank(Z_c); V
    holds the reachable states to the ADI tolerance, and span(Z_c) is a
    rational Krylov space of (A, B) at the ADI shifts. Stage 2: the dense
    PRBT (phgmg_prbt, O(k^3)) of that model; the bases composed (x = V
-   M^{-1} V2 xr, xr = W2^T (Q E V)^T x). The positive-real singular values
+   M^{-1} V2 xr, xr = W2^T (E^T Q V)^T x). The positive-real singular values
    of the 8 x 8 lattice (k = 66, r = 8) equal the dense PRBT's of the full
    model to 4e-15 (tests/check_cli_lowrank.py). The intermediate model must
    be passive, which is why stage 1 is this projection and not a BT model
@@ -23219,6 +23219,20 @@ PHGMG__PRIV void phgmg__lr_cscmv(const phgmg_ph_sparse *sp, int a, const double 
     for (p = sp->cp[a][j]; p < sp->cp[a][j + 1]; ++p) y[sp->ci[a][p]] += sp->cx[a][p] * x[j];
 }
 
+/* y = E^T Q x (Q x without a mass matrix): the energy matrix, also where
+   rows and states are ordered differently (Q E is not E^T Q then); t: N
+   doubles of scratch. */
+PHGMG__PRIV void phgmg__lr_etq(const phgmg_ph_sparse *sp, const double *x, double *t, double *y) {
+  int j, p;
+  if (!sp->cp[3]) { phgmg__lr_cscmv(sp, 2, x, y); return; }
+  phgmg__lr_cscmv(sp, 2, x, t);
+  for (j = 0; j < sp->sys.N; ++j) {
+    double acc = 0.0;
+    for (p = sp->cp[3][j]; p < sp->cp[3][j + 1]; ++p) acc += sp->cx[3][p] * t[sp->ci[3][p]];
+    y[j] = acc;
+  }
+}
+
 /* The reduced pH matrices of phgmg_lrphbt from T (N x r): M = Q T, Jr =
    skew(M^T J M), Rr = sym(M^T R M), Br = M^T B. */
 PHGMG__PRIV phgmg_result phgmg__lrph_project(const phgmg_ph_sparse *sp, int r, const double *T, double *Jr,
@@ -23255,10 +23269,7 @@ PHGMG__PRIV phgmg_result phgmg__lrph_basis(const phgmg_ph_sparse *sp, int r, con
   phgmg_result rc = PHGMG_ERR_NOMEM;
   int i, j;
   if (!EZ || !G) goto done;
-  for (j = 0; j < kc; ++j) { /* E^T Q Z = Q E Z */
-    if (sp->cp[3]) { phgmg__lr_cscmv(sp, 3, Z + (size_t)j * N, t); phgmg__lr_cscmv(sp, 2, t, EZ + (size_t)j * N); }
-    else phgmg__lr_cscmv(sp, 2, Z + (size_t)j * N, EZ + (size_t)j * N);
-  }
+  for (j = 0; j < kc; ++j) phgmg__lr_etq(sp, Z + (size_t)j * N, t, EZ + (size_t)j * N); /* E^T Q Z */
   phgmg_gemm('T', 'N', kc, kc, N, 1.0, Z, N, EZ, N, 0.0, G, kc);
   if ((rc = phgmg_sym_eig(kc, G, kc, w, Y, kc)) != PHGMG_OK) goto done;
   for (*k = 0, j = kc - 1; j >= 0 && w[j] > 1e-14 * w[kc - 1]; --j) S[(*k)++] = sqrt(w[j]);
@@ -23524,9 +23535,9 @@ PHGMG__PRIV phgmg_result phgmg__bal_lr_stage(const phgmg_ph_sparse *sp, const ph
 /* The first stage of the sparse PRBT: the Galerkin projection in the energy
    inner product onto V = the controllability factor's span (its columns
    normalised: the compressed factor's columns are orthogonal), a pH model
-   of order k = its rank: M = V^T Q E V, Jr = skew(V^T Q J Q V), Rr =
+   of order k = its rank: M = V^T E^T Q V, Jr = skew(V^T Q J Q V), Rr =
    sym(V^T Q R Q V), Br = V^T Q B, in z = M xi: Qk = M^{-1}; lift x = V M^{-1}
-   z, restrict z = (Q E V)^T x. Into blk = [V0 (N k), W (N k), Jr, Rr, Qk (k
+   z, restrict z = (E^T Q V)^T x. Into blk = [V0 (N k), W (N k), Jr, Rr, Qk (k
    k each), Br (k m)] (allocated here). */
 PHGMG__PRIV phgmg_result phgmg__bal_pr_stage1(const phgmg_ph_sparse *sp, const phgmg_lradi_opts *opts, int *k,
                                               double **blk, phgmg_balanced_info *inf, phgmg_balanced_cache *cache,
@@ -23545,16 +23556,15 @@ PHGMG__PRIV phgmg_result phgmg__bal_pr_stage1(const phgmg_ph_sparse *sp, const p
   if (!*blk) { phgmg__free(al, Z); return PHGMG_ERR_NOMEM; }
   V0 = *blk; W = V0 + (size_t)N * kk; Jr = W + (size_t)N * kk; Rr = Jr + (size_t)kk * kk; Qk = Rr + (size_t)kk * kk;
   M = Qk + (size_t)kk * kk; Br = M + (size_t)kk * kk;
-  for (j = 0; j < kk; ++j) {   /* V = Z normalised (into Z), W = Q E V */
+  for (j = 0; j < kk; ++j) {   /* V = Z normalised (into Z), W = E^T Q V */
     double *v = Z + (size_t)j * N, *w = W + (size_t)j * N;
     const double nv = phgmg_normf(N, 1, v, N);
     for (i = 0; i < N; ++i) v[i] /= nv;
-    if (sp->cp[3]) { phgmg__lr_cscmv(sp, 3, v, V0); phgmg__lr_cscmv(sp, 2, V0, w); }
-    else phgmg__lr_cscmv(sp, 2, v, w);
+    phgmg__lr_etq(sp, v, V0, w);
   }
   rc = phgmg__lrph_project(sp, kk, Z, Jr, Rr, Br, al);
   if (rc == PHGMG_OK) {
-    phgmg_gemm('T', 'N', kk, kk, N, 1.0, Z, N, W, N, 0.0, M, kk);   /* M = V^T Q E V */
+    phgmg_gemm('T', 'N', kk, kk, N, 1.0, Z, N, W, N, 0.0, M, kk);   /* M = V^T E^T Q V */
     rc = phgmg__inv(kk, M, Qk, al);
   }
   if (rc == PHGMG_OK) {
