@@ -26,7 +26,9 @@ an independent dense computation (NumPy/SciPy):
   > 0 and K + K^T <= 0, and its sampled H-infinity error against the
   descriptor model's own transfer function C (i w E - A)^{-1} B (the whole
   pencil, no condensation) on 200 frequencies in [1e-2, 1e2] within that
-  bound. rlc with a port on an algebraic node (--port-on-constraint): the
+  bound. rlc prbt: the positive-real singular values of the scrambled grid
+  equal to those of the same grid in natural order (1e-8), the models pH.
+  rlc with a port on an algebraic node (--port-on-constraint): the
   reference's feedthrough D = -C_c A_ac^{-1} B_a is not zero, and bt is
   refused with a message naming the feedthrough.
 
@@ -172,6 +174,30 @@ bt_case("rlc 8 x 8 bt r=10", d, 10)
 d = os.path.join(work, "acoustic")
 gen("fe_mesh.py", "acoustic", d, "9")
 bt_case("acoustic 9 x 9 bt r=10", d, 10, passive=False)
+
+# prbt on the index-one grid: the same model with rows and states in their
+# natural order (--no-scramble) must give the same positive-real singular
+# values (the energy matrix is E^T Q, not Q E, where the orders differ), and
+# a pH, positive-real model
+pr = []
+for sub, extra in (("rlc", []), ("rlc_u", ["--no-scramble"])):
+    d = os.path.join(work, sub)
+    if extra:
+        gen("rlc_grid.py", d, "--n", "8", "--seed", "4", *extra)
+    rc, err = run("reduce", "--J-coo", d + "/J.npy", "--R-coo", d + "/R.npy", "--Q-coo", d + "/Q.npy",
+                  "--E-coo", d + "/E.npy", "--B", d + "/B.npy", "--method", "prbt", "--r", "10", "--out", d,
+                  "--name", "prbt")
+    claim(rc == 0, "rlc %s prbt: reduce (%s)" % (sub, err.strip()))
+    if rc == 0:
+        pr.append(np.array(json.load(open(os.path.join(d, "prbt.json")))["info"]["positive_real_singular_values"]))
+        K, Qh, Bh = (np.load(os.path.join(d, "prbt_%s.npy" % f)) for f in ("K", "Qh", "Bh"))
+        ek = np.linalg.eigvalsh(K + K.T)
+        claim(ek.max() <= 1e-10 * np.abs(ek).max() and np.linalg.eigvalsh((Qh + Qh.T) / 2).min() > 0,
+              "rlc %s prbt: pH (K + K^T <= 0, Qh > 0)" % sub)
+if len(pr) == 2:
+    e = np.abs(pr[0] - pr[1]).max() / pr[0][0]
+    claim(e <= 1e-8, "rlc prbt: scrambled vs natural order %.3g" % e)
+    print("rlc 8 x 8 prbt r=10: positive-real singular values scrambled vs natural order %.2g" % e)
 
 d = os.path.join(work, "rlc_pc")
 gen("rlc_grid.py", d, "--n", "8", "--seed", "4", "--port-on-constraint")
