@@ -4459,6 +4459,10 @@ static int run_balancing(const reduce_args *A, reduce_state *S, double *t_red) {
   phgmg_result rc;
   double t0;
   int runs0;
+  if (S->dae && !S->sp)
+    return fail("--method %s on an index-one descriptor model (E with zero rows): the dense solvers take "
+                "standard-form models; give the model as COO files (--J-coo, --R-coo, --Q-coo, --E-coo) for the "
+                "low-rank solvers", A->method);
   if (S->dae) return fail("--method %s on an index-one descriptor model (E with zero rows): not in one run with "
                           "snapshot methods; reduce with the balancing methods in a run of their own", A->method);
   memset(&lo, 0, sizeof lo);
@@ -4605,7 +4609,7 @@ static int cmd_reduce(int argc, char **argv) {
   int rc = parse_reduce(argc, argv, &A);
   if (rc) return rc < 0 ? 0 : rc;
   memset(&S, 0, sizeof S);
-  S.dae_direct = !sweep_needs_snapshots(&A);   /* balancing only: an index-one model on its whole pencil */
+  S.dae_direct = A.Jcoo && !sweep_needs_snapshots(&A);   /* balancing only: a sparse index-one model on its pencil */
   rc = cmd_reduce_impl(&A, &S);
   reduce_cleanup(&S);
   return rc;
@@ -5155,7 +5159,7 @@ static int cmd_validate(int argc, char **argv) {
     return usage_error("validate: with --X give --test-input (or --X-input): the inputs that made the snapshots are unknown");
   if (nt == 0) V.tests[nt++] = A.input;
   memset(&S, 0, sizeof S);
-  S.dae_direct = !sweep_needs_snapshots(&A);   /* balancing only: an index-one model on its whole pencil */
+  S.dae_direct = A.Jcoo && !sweep_needs_snapshots(&A);   /* balancing only: a sparse index-one model on its pencil */
   memset(tin, 0, sizeof tin);
   status = reduce_prepare(&A, &S, V.tests, nt);
   for (k = 0; k < nt && !status; ++k) { /* every test input and run length, up front */
