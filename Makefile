@@ -262,6 +262,7 @@ test-cli: $(BUILD)/phgmg $(BUILD)/phgmg-float
 	sh tests/test_cli_lowrank.sh $(BUILD)/phgmg
 	sh tests/test_dae_reduce.sh $(BUILD)/phgmg
 	sh tests/test_cli_lowrank2.sh $(BUILD)/phgmg
+	sh tests/test_lowrank_dae.sh $(BUILD)/phgmg
 
 # The descriptor bar (N = 800, consistent mass, feedthrough, scrambled order)
 # and its index-one variant through the command line against SciPy.

@@ -87,7 +87,8 @@ static const char *const help_lines[] = {
   "                      E^T Q must be symmetric positive definite (semidefinite with\n",
   "                      --poly), and rows of E at --poly-idx coordinates unit rows\n",
   "                      times E_kk > 0. Methods gmg-pod, gmg-qm, sp1, sp2 (the\n",
-  "                      reduced model is an ordinary pH model: simulate-rom, export).\n",
+  "                      reduced model is an ordinary pH model: simulate-rom, export),\n",
+  "                      and bt, prbt, phbt with --E-coo (see BALANCING METHODS).\n",
   "                      Algebraic constraints: k zero rows and k zero columns of E\n",
   "                      (equations without a derivative, e.g. a massless node or a\n",
   "                      Kirchhoff law; a dense singular E is rotated into this form)\n",
@@ -107,6 +108,10 @@ static const char *const help_lines[] = {
   "                      A port that acts only through a constraint (its condensed\n",
   "                      column of B is zero: pure feedthrough) is reduced by sp1\n",
   "                      and sp2; gmg-pod and gmg-qm refuse it, naming the port.\n",
+  "                      bt, prbt, phbt on --E-coo with algebraic lines: no\n",
+  "                      condensation, the Gramians' solves use the whole sparse\n",
+  "                      pencil; a port on a constraint is refused there (its\n",
+  "                      feedthrough is not carried by their pH forms).\n",
   "  --P FILE, --S FILE, --N FILE   feedthrough (N x m, m x m, m x m; each optional):\n",
   "                      E x' = (J - R) z + (B - P) u, y = (B + P)^T z + (S + N) u, with\n",
   "                      [[R, P], [P^T, S]] symmetric positive semidefinite and N skew.\n",
@@ -415,10 +420,22 @@ static const char *const help_lines[] = {
   "  Input-independent reduction of a linear model (no --X, no --simulate, no\n",
   "  nonlinear part, dampers or feedthrough) from its matrices alone. The solvers\n",
   "  follow the input's form: a model given by --J-coo/--R-coo/--Q-coo (and\n",
-  "  --E-coo, a mass matrix of full rank) goes to the low-rank solvers -- Gramian\n",
-  "  factors by low-rank ADI on sparse LU factorizations (tolerance 1e-10), no\n",
-  "  N x N matrix, for N up to 10^5 and more -- a model given by --J/--R/--Q (dense,\n",
-  "  standard form) to the dense solvers (O(N^3): up to a few thousand states).\n",
+  "  --E-coo) goes to the low-rank solvers -- Gramian factors by low-rank ADI on\n",
+  "  sparse LU factorizations (tolerance 1e-10), no N x N matrix, for N up to 10^5\n",
+  "  and more -- a model given by --J/--R/--Q (dense, standard form; no --E) to the\n",
+  "  dense solvers (O(N^3): up to a few thousand states). --E-coo may be a mass\n",
+  "  matrix of full rank or have algebraic lines of index one (zero rows and\n",
+  "  columns): then the ADI solves with the whole pencil and the Gramians are\n",
+  "  those of the condensed model, which is never formed (the algebraic lines\n",
+  "  are not condensed in a run of balancing methods alone); all ports must act\n",
+  "  on differential rows (a port on a constraint has a feedthrough, which the\n",
+  "  pH forms written here do not carry: the run fails and says so; use sp1/sp2).\n",
+  "  Lightly damped models (wave equations, eigenvalues close to the imaginary\n",
+  "  axis) need many ADI steps (Gramian ranks of hundreds to thousands): raise\n",
+  "  --adi-maxit when the log reports no convergence.\n",
+  "  --adi-maxit K       low-rank ADI steps per Gramian before giving up (default\n",
+  "                      500; a complex shift pair counts two); memory grows with\n",
+  "                      the steps (N m doubles per step, m the ports).\n",
   "    bt    balanced truncation (needs m < R); the H-infinity error bound\n",
   "          2 sum_{i>R} sigma_i (low-rank: over the values computed) in the log\n",
   "          and NAME.json. The reduced model is written in pH form (NAME_K,\n",
@@ -1472,6 +1489,7 @@ typedef struct reduce_args {
   int ref;                      /* --ref none (0) / mean (PHGMG_REF_MEAN) / FILE (PHGMG_REF_GIVEN) */
   const char *ref_file;         /* --ref FILE: the reference state, N values */
   int greedy_window;            /* --greedy-window W (0: the library's default) */
+  int adi_maxit;                /* --adi-maxit K: low-rank ADI steps (0: the library's default) */
   const char *train[16];        /* --train-input KIND, repeatable */
   int ntrain;
   const char *xs[16];           /* --X FILE, repeatable: one run each (X = xs[0]) */
@@ -1803,7 +1821,9 @@ static int parse_reduce(int argc, char **argv, reduce_args *A) {
         A->ref = PHGMG_REF_GIVEN; A->ref_file = v;
       }
     }
-    else if (!strcmp(o, "--greedy-window")) {
+    else if (!strcmp(o, "--adi-maxit")) {
+      if (!(v = optval(argc, argv, &i)) || !parse_int(o, v, 1, 1000000, &A->adi_maxit)) return 2;
+    } else if (!strcmp(o, "--greedy-window")) {
       if (!(v = optval(argc, argv, &i)) || !parse_int(o, v, 1, 100000, &A->greedy_window)) return 2;
     }
     else if (!strcmp(o, "--manifold")) {
@@ -1906,6 +1926,14 @@ static int check_balancing_args(reduce_args *A, const char *const *seen, int nse
   return 0;
 }
 
+/* 1 if a method of the run is a balancing one. */
+static int sweep_has_balancing(const reduce_args *A) {
+  int k;
+  for (k = 0; k < A->nml; ++k)
+    if (is_balancing(A->mlist[k])) return 1;
+  return 0;
+}
+
 /* 1 if the methods of the run mix balancing (no snapshots) and snapshot methods. */
 static int mixes_balancing(const reduce_args *A) {
   int k, nb = 0;
@@ -1954,6 +1982,8 @@ static int check_reduce_args(reduce_args *A, const char *const *seen, int nseen)
   if (!A->input) A->input = A->ntrain ? A->train[0] : "sin";
   if ((A->have_lambda || A->manifold_s || A->rn) && !has_method(A, PHGMG_METHOD_GMG_QM))
     return usage_error("reduce: --lambda, --rn and --manifold apply to --method gmg-qm only (not %s)", A->method);
+  if (A->adi_maxit && !sweep_has_balancing(A))
+    return usage_error("reduce: --adi-maxit applies to --method bt, prbt and phbt (the low-rank ADI)");
   if (A->greedy_window && (A->manifold != PHGMG_MANIFOLD_GREEDY && A->manifold != PHGMG_MANIFOLD_ALTMIN))
     return usage_error("reduce: --greedy-window applies to --method gmg-qm with --manifold greedy or altmin");
   if (A->greedy_window && A->rn != PHGMG_RN_WIDE)
@@ -3327,8 +3357,9 @@ static int condense_algebraic(const reduce_args *A, reduce_state *S) {
   if (S->dae_direct) {
     int zr = 0, zc = 0;
     e_zero_lines(S, S->full.N, &zr, &zc, NULL, NULL);
-    progress("algebraic constraints: E singular, %d algebraic equations and variables (index one); the DAE is "
-             "stepped on the sparse pencil", zr);
+    progress("algebraic constraints: E singular, %d algebraic equations and variables (index one); %s", zr,
+             A->nml > 0 && !sweep_needs_snapshots(A) ? "the Gramians' solves use the whole sparse pencil (the "
+             "condensed model is never formed)" : "the DAE is stepped on the sparse pencil");
     return 0;
   }
   rc = phgmg_dae_create(&S->dae, &S->full, 0.0, NULL);
@@ -4095,6 +4126,7 @@ static int write_json(const reduce_args *A, reduce_state *S, int method, int ns,
   char path[4096 + 256];
   const char *wp;
   FILE *jf;
+  int nalg = 0, zc = 0;
   snprintf(path, sizeof path, "%s/%s.json", A->out, A->name);
   if (!(wp = stage_path(&S->sg, path))) return 1;
   jf = fopen(wp, "w");
@@ -4109,8 +4141,10 @@ static int write_json(const reduce_args *A, reduce_state *S, int method, int ns,
           rom->rn, rom->nd, rom->nd ? rom->poly_deg : 0);
   /* the model as given: its mass matrix, all its states (an index-one model is reduced on its differential
      ones: N above), the reduced feedthrough */
+  if (S->dae) nalg = phgmg_dae_nalg(S->dae);
+  else if (S->dae_direct && S->sp && S->full.E) e_zero_lines(S, S->full.N, &nalg, &zc, NULL, NULL); /* the whole pencil */
   fprintf(jf, "  \"E\": %s, \"N_full\": %d, \"algebraic\": %d, \"feedthrough\": %s,\n",
-          S->full.E ? "true" : "false", S->full.N, S->dae ? phgmg_dae_nalg(S->dae) : 0, rom->PD ? "true" : "false");
+          S->full.E ? "true" : "false", S->full.N, nalg, rom->PD ? "true" : "false");
   fprintf(jf, "  \"dt_map\": ");
   if (rom->Phi) { char buf[32]; fputs(isfinite((double)rom->dt) ? real_str(rom->dt, buf) : "null", jf); }   /* float: "0.1" */
   else fputs("0", jf);
@@ -4406,6 +4440,10 @@ static int explain_balancing(const reduce_args *A, const reduce_state *S, phgmg_
                   b->lr.obs.iters ? b->lr.obs.res : b->lr.ctrl.res,
                   b->lr.obs.iters ? b->lr.obs.iters : b->lr.ctrl.iters);
     case PHGMG_ERR_UNSUPPORTED:
+      if (S->sp && S->dae_direct && A->Ecoo)
+        return fail("reduction failed: a port acts on an algebraic equation (a zero row of E, %s): through the "
+                    "constraint it has a feedthrough D, which the port-Hamiltonian forms of --method bt, prbt "
+                    "and phbt do not carry; reduce with --method sp1 or sp2 (snapshots)", A->Ecoo);
       if (S->method == PHGMG_METHOD_PHBT && !S->sp)
         return fail("reduction failed: --method phbt needs the sparse model (--J-coo, --R-coo, --Q-coo)");
       return fail("reduction failed: %s (dense BT and PRBT take standard-form models: give a mass matrix as "
@@ -4425,9 +4463,14 @@ static int run_balancing(const reduce_args *A, reduce_state *S, double *t_red) {
   phgmg_result rc;
   double t0;
   int runs0;
-  if (S->dae) return fail("--method %s: index-one descriptor models (E with zero rows) are not supported; give "
-                          "an E of full rank", A->method);
+  if (S->dae && !S->sp)
+    return fail("--method %s on an index-one descriptor model (E with zero rows): the dense solvers take "
+                "standard-form models; give the model as COO files (--J-coo, --R-coo, --Q-coo, --E-coo) for the "
+                "low-rank solvers", A->method);
+  if (S->dae) return fail("--method %s on an index-one descriptor model (E with zero rows): not in one run with "
+                          "snapshot methods; reduce with the balancing methods in a run of their own", A->method);
   memset(&lo, 0, sizeof lo);
+  lo.maxit = A->adi_maxit;
   progress("reducing: %s, r = %d (%s solvers)", A->method, A->r, S->sp ? "low-rank, sparse" : "dense");
   t0 = now_s();
   plog.t0 = t0; plog.all = 0; plog.ncand = plog.nprobe = 0;
@@ -4570,6 +4613,7 @@ static int cmd_reduce(int argc, char **argv) {
   int rc = parse_reduce(argc, argv, &A);
   if (rc) return rc < 0 ? 0 : rc;
   memset(&S, 0, sizeof S);
+  S.dae_direct = A.Jcoo && !sweep_needs_snapshots(&A);   /* balancing only: a sparse index-one model on its pencil */
   rc = cmd_reduce_impl(&A, &S);
   reduce_cleanup(&S);
   return rc;
@@ -5119,6 +5163,7 @@ static int cmd_validate(int argc, char **argv) {
     return usage_error("validate: with --X give --test-input (or --X-input): the inputs that made the snapshots are unknown");
   if (nt == 0) V.tests[nt++] = A.input;
   memset(&S, 0, sizeof S);
+  S.dae_direct = A.Jcoo && !sweep_needs_snapshots(&A);   /* balancing only: a sparse index-one model on its pencil */
   memset(tin, 0, sizeof tin);
   status = reduce_prepare(&A, &S, V.tests, nt);
   for (k = 0; k < nt && !status; ++k) { /* every test input and run length, up front */

@@ -3,7 +3,9 @@
    against the dense Lyapunov solutions (with the residual recomputed here),
    low-rank BT's Hankel singular values against the dense Gramians' and its reduced
    model's sampled H-infinity error against the bound, a model with a mass
-   matrix against the dense solution of the equivalent E^{-1} model. */
+   matrix against the dense solution of the equivalent E^{-1} model, an
+   index-one model with a port on a constraint: its feedthrough against the
+   closed form and the descriptor model's own transfer function. */
 #define PHGMG_STATIC
 #define PHGMG_IMPLEMENTATION
 #include "../phgmg.h"
@@ -529,20 +531,86 @@ TEST(test_lowrank_arguments) {
   CHECK_RC(phgmg_lrbt(sp, N + 1, NULL, Ar, Br, Cr, NULL, NULL, NULL, NULL, NULL), PHGMG_ERR_SIZE);
   CHECK_RC(phgmg_lrbt(sp, binf.nhsv + 1, NULL, Ar, Br, Cr, NULL, NULL, NULL, &binf, NULL), PHGMG_ERR_RANK);
   CHECK_RC(phgmg_lrbt(NULL, 4, NULL, Ar, Br, Cr, NULL, NULL, NULL, NULL, NULL), PHGMG_ERR_INVALID_ARG);
-  { /* an E with a zero row and column: refused */
+  { /* an E with a zero row but no zero column: not of the index-one form */
     lr_model M1 = M;
     M1.E = (double *)calloc((size_t)N * N, sizeof(double));
     for (k = 0; k < N - 1; ++k) M1.E[k + (size_t)k * N] = 1.0;
+    M1.E[N - 2 + (size_t)(N - 1) * N] = 0.1;
     sp1 = lr_sparse(&M1);
     free(M1.E);
   }
   phgmg_shifted_destroy(s);
   s = NULL;
-  CHECK_RC(phgmg_shifted_create(&s, sp1, 0, 0, NULL), PHGMG_ERR_UNSUPPORTED);
+  CHECK_RC(phgmg_shifted_create(&s, sp1, 0, 0, NULL), PHGMG_ERR_E_SINGULAR);
   CHECK(s == NULL);
-  CHECK_RC(phgmg_lrbt(sp1, 4, NULL, Ar, Br, Cr, NULL, NULL, NULL, NULL, NULL), PHGMG_ERR_UNSUPPORTED);
+  CHECK_RC(phgmg_lrbt(sp1, 4, NULL, Ar, Br, Cr, NULL, NULL, NULL, NULL, NULL), PHGMG_ERR_E_SINGULAR);
   phgmg_ph_sparse_destroy(sp); phgmg_ph_sparse_destroy(sp1);
   free(B0);
+  lr_free(&M);
+}
+
+
+/* sigma_max of a complex 2 x 2 matrix (interleaved re, im; column-major). */
+static double lr_smax2(const double *M) {
+  double a = 0.0, d = 0.0, br = 0.0, bi = 0.0;
+  int i;
+  for (i = 0; i < 2; ++i) { /* H = M^H M: a = |col 0|^2, d = |col 1|^2, b = col0^H col1 */
+    const double xr = M[2 * i], xi = M[2 * i + 1], yr = M[4 + 2 * i], yi = M[4 + 2 * i + 1];
+    a += xr * xr + xi * xi; d += yr * yr + yi * yi;
+    br += xr * yr + xi * yi; bi += xr * yi - xi * yr;
+  }
+  return sqrt(0.5 * (a + d) + sqrt(0.25 * (a - d) * (a - d) + br * br + bi * bi));
+}
+
+/* An index-one model: the 4 x 4 lattice with three massless nodes (E = I
+   but zero rows and columns at the momenta of masses 0, 5, 10: algebraic
+   equations 0 = -(K q)_a - (R z)_a + B_a u), the port of mass 0 on a
+   constraint. Closed form of the feedthrough: the three are not
+   neighbours, so L_aa = -R_aa = -(0.01 K_aa + 0.5) I = -0.5401 I and D =
+   -B_a^T L_aa^{-1} B_a = diag(1 / 0.5401, 0). Checked: phgmg_lrbt_feedthrough
+   against it; the descriptor model's own transfer function (phgmg_shifted_
+   transfer: the whole pencil, no condensation) tends to D (w = 1e8); the
+   reduced model Cr (i w - Ar)^{-1} Br + D within the BT bound of it on 60
+   frequencies in [1e-2, 1e2], and without D not (D is carried). */
+TEST(test_lowrank_index_one) {
+  static const int massless[3] = {0, 5, 10};
+  const int r = 8, n2 = 16;
+  const double d00 = 1.0 / (0.01 * 4.01 + 0.5);
+  lr_model M;
+  phgmg_ph_sparse *sp;
+  phgmg_shifted *s = NULL;
+  phgmg_lrbt_info inf;
+  double Ar[64], Br[16], Cr[16], D[4], hsv[8], G[8], Gr[8], e = 0.0, e0 = 0.0;
+  int N, k;
+  lr_lattice(&M, 4, 0);
+  N = M.N;
+  M.E = (double *)calloc((size_t)N * N, sizeof(double));
+  for (k = 0; k < N; ++k) M.E[k + (size_t)k * N] = 1.0;
+  for (k = 0; k < 3; ++k) M.E[n2 + massless[k] + (size_t)(n2 + massless[k]) * N] = 0.0;
+  sp = lr_sparse(&M);
+  CHECK_RC(phgmg_lrbt(sp, r, NULL, Ar, Br, Cr, hsv, NULL, NULL, &inf, NULL), PHGMG_OK);
+  CHECK(inf.nalg == 3 && inf.ctrl.res <= 1e-10 && inf.obs.res <= 1e-10 && inf.bound > 0.0);
+  CHECK_RC(phgmg_lrbt_feedthrough(sp, D, NULL), PHGMG_OK);
+  CHECK_LE(fabs(D[0] - d00), 1e-14 * d00);
+  CHECK(D[1] == 0.0 && D[2] == 0.0 && D[3] == 0.0);
+  CHECK_LE(fabs(inf.dmax - d00), 1e-14 * d00);
+  CHECK_RC(phgmg_shifted_create(&s, sp, 0, 0, NULL), PHGMG_OK);
+  CHECK_RC(phgmg_shifted_transfer(s, 1e5, G), PHGMG_OK);   /* G - D = O(1 / w) */
+  for (k = 0; k < 4; ++k) CHECK_LE(hypot(G[2 * k] - D[k], G[2 * k + 1]), 1e-4 * d00);
+  for (k = 0; k < 60; ++k) {
+    const double w = pow(10.0, -2.0 + 4.0 * k / 59.0);
+    int i;
+    CHECK_RC(phgmg_shifted_transfer(s, w, G), PHGMG_OK);
+    CHECK_RC(phgmg_ss_transfer(r, 2, 2, Ar, Br, Cr, w, Gr, NULL), PHGMG_OK);
+    for (i = 0; i < 8; ++i) Gr[i] = G[i] - Gr[i];
+    e0 = PHGMG__MAX(e0, lr_smax2(Gr));
+    for (i = 0; i < 4; ++i) Gr[2 * i] -= D[i];
+    e = PHGMG__MAX(e, lr_smax2(Gr));
+  }
+  CHECK_LE(e, inf.bound);
+  CHECK(e0 > inf.bound);
+  phgmg_shifted_destroy(s);
+  phgmg_ph_sparse_destroy(sp);
   lr_free(&M);
 }
 
@@ -551,4 +619,5 @@ SUITE(lowrank) {
   RUN(test_lowrank_lradi_lattice);
   RUN(test_lowrank_mass_matrix);
   RUN(test_lowrank_arguments);
+  RUN(test_lowrank_index_one);
 }

@@ -182,6 +182,7 @@ static void init(void) {
   static const char *const words7[] = {"--stream", "bt", "prbt", "phbt", "bt,sp1", NULL};   /* after words6 */
   static const char *const words8[] = {"--poly-jdx", NULL};   /* after words7 */
   static const char *const files8[] = {"jdx.npy", NULL};
+  static const char *const words9[] = {"--adi-maxit", NULL};   /* after files8 */
   char *argv[24];
   int k, fb, argc = 0;   /* fb: the token of files[0] */
   FILE *f;
@@ -203,6 +204,7 @@ static void init(void) {
   for (k = 0; words7[k]; ++k) strcpy(g_tok[g_ntok++], words7[k]);
   for (k = 0; words8[k]; ++k) strcpy(g_tok[g_ntok++], words8[k]);
   for (k = 0; files8[k]; ++k) snprintf(g_tok[g_ntok++], sizeof g_tok[0], "%s/%s", g_dir, files8[k]);
+  for (k = 0; words9[k]; ++k) strcpy(g_tok[g_ntok++], words9[k]);
   /* the model file, made once by the CLI itself */
   restore();
   argv[argc++] = (char *)"phgmg"; argv[argc++] = (char *)"reduce";

@@ -1,0 +1,215 @@
+"""`phgmg reduce --method bt` (low-rank, sparse) on descriptor models, against
+an independent dense computation (NumPy/SciPy):
+
+  rlc: an index-one RLC grid (bench/rlc_grid.py, 8 x 8 mains, N = 288, 144
+     algebraic equations and variables, rows and states scrambled by
+     different permutations). The reference condenses the DAE densely
+     (A = (J - R) Q, the algebraic rows a = E's zero rows, the algebraic
+     variables c = its zero columns: A' = A_dd - A_dc A_ac^{-1} A_ad,
+     E' = E_dd, B' = B_d - A_dc A_ac^{-1} B_a, C' = C_d - C_c A_ac^{-1} A_ad,
+     C = B^T Q), solves the two Lyapunov equations of E'^{-1} A' with
+     scipy.linalg.solve_continuous_lyapunov and takes the Hankel singular
+     values sqrt(eig(P O)).
+  acoustic: the 2-D acoustic model in P1 finite elements with a consistent
+     mass matrix (bench/fe_mesh.py, 9 x 9 nodes, N = 243), the same without
+     algebraic lines (E^{-1} formed densely here). Its BT models are not
+     passive (nor are those of the dense BT here: eig(G_r + G_r^H) < 0 on
+     the grid), so they have no pH form: reduce refuses them, and the claim
+     is the refusal and the H-infinity bound in its message (3 digits)
+     against the reference's.
+
+  Claims, each model: the Hankel singular values in NAME.json within 1e-8
+  sigma_1 of the reference's (the first 40; the reference takes them as the
+  singular values of Lo^T Lp, P = Lp Lp^T, O = Lo Lo^T), the bound
+  2 sum_{i>r} sigma_i within 1e-6 of the reference's over the values the
+  low-rank run computed, the written pH model (K, Qh, Bh) with Qh
+  > 0 and K + K^T <= 0, and its sampled H-infinity error against the
+  descriptor model's own transfer function C (i w E - A)^{-1} B (the whole
+  pencil, no condensation) on 200 frequencies in [1e-2, 1e2] within that
+  bound. rlc prbt: the positive-real singular values of the scrambled grid
+  equal to those of the same grid in natural order (1e-8), the models pH.
+  rlc with a port on an algebraic node (--port-on-constraint): the
+  reference's feedthrough D = -C_c A_ac^{-1} B_a is not zero, and bt is
+  refused with a message naming the feedthrough.
+
+Usage: /usr/bin/python3 tests/check_lowrank_dae.py PHGMG_BINARY WORKDIR
+Exits 1 when a claim fails."""
+import json, os, re, subprocess, sys
+import numpy as np
+import scipy.linalg as sla
+
+exe, work = sys.argv[1], sys.argv[2]
+bench = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "bench")
+fails = []
+W = np.logspace(-2, 2, 200)
+
+
+def claim(ok, what):
+    if not ok:
+        fails.append(what)
+        print("FAIL: " + what)
+
+
+def run(*args):
+    r = subprocess.run([exe] + list(args) + ["--quiet"], capture_output=True, text=True)
+    return r.returncode, r.stderr
+
+
+def dense(path, N):
+    t = np.load(path)
+    M = np.zeros((N, N))
+    np.add.at(M, (t[:, 0].astype(int), t[:, 1].astype(int)), t[:, 2])
+    return M
+
+
+def load(d):
+    B = np.load(os.path.join(d, "B.npy"))
+    N = B.shape[0]
+    J, R, Q, E = (dense(os.path.join(d, n + ".npy"), N) for n in "JRQE")
+    return (J - R) @ Q, E, B, B.T @ Q
+
+
+def condense(A, E, B, C):
+    """The dense condensation of an index-one descriptor model (E regular: as is)."""
+    a = np.flatnonzero(np.abs(E).sum(axis=1) == 0)
+    c = np.flatnonzero(np.abs(E).sum(axis=0) == 0)
+    d = np.setdiff1d(np.arange(E.shape[0]), a)
+    dc = np.setdiff1d(np.arange(E.shape[1]), c)
+    if a.size == 0:
+        return A, E, B, C, np.zeros((B.shape[1], B.shape[1]))
+    Aac = A[np.ix_(a, c)]
+    X = np.linalg.solve(Aac, np.hstack([A[np.ix_(a, dc)], B[a]]))
+    Xa, Xb = X[:, :dc.size], X[:, dc.size:]
+    Ac = A[np.ix_(d, dc)] - A[np.ix_(d, c)] @ Xa
+    Bc = B[d] - A[np.ix_(d, c)] @ Xb
+    Cc = C[:, dc] - C[:, c] @ Xa
+    Dc = -C[:, c] @ Xb
+    return Ac, E[np.ix_(d, dc)], Bc, Cc, Dc
+
+
+def hsv(A, E, B, C):
+    """sigma(Lo^T Lp), P = Lp Lp^T, O = Lo Lo^T (square roots by eigh): accurate
+    to round-off of sigma_1 also for the small values (sqrt(eig(P O)) is not)."""
+    Ad, Bd = np.linalg.solve(E, A), np.linalg.solve(E, B)
+    P = sla.solve_continuous_lyapunov(Ad, -Bd @ Bd.T)
+    O = sla.solve_continuous_lyapunov(Ad.T, -C.T @ C)
+
+    def fac(X):
+        w, U = np.linalg.eigh((X + X.T) / 2)
+        return U * np.sqrt(np.maximum(w, 0))
+    return np.linalg.svd(fac(O).T @ fac(P), compute_uv=False)
+
+
+def bt_case(tag, d, r, passive=True):
+    A, E, B, C = load(d)
+    Ac, Ec, Bc, Cc, Dc = condense(A, E, B, C)
+    s_ref = hsv(Ac, Ec, Bc, Cc)
+    bound = 2 * s_ref[r:].sum()
+    coo = ["--J-coo", d + "/J.npy", "--R-coo", d + "/R.npy", "--Q-coo", d + "/Q.npy", "--E-coo", d + "/E.npy",
+           "--B", d + "/B.npy"]
+    rc, err = run("reduce", *coo, "--method", "bt", "--r", str(r), "--out", d, "--name", "bt")
+    if not passive:   # the BT model has no pH form: refused, the bound (3 digits) in the message
+        m = re.search(r"not passive.*error bound ([0-9.e+-]+)\)", err)
+        claim(rc == 1 and m is not None, "%s: refused as not passive (%d: %s)" % (tag, rc, err.strip()))
+        if m:
+            claim(abs(float(m.group(1)) - bound) <= 5e-3 * bound,
+                  "%s: bound in the message %s vs %.6g" % (tag, m.group(1), bound))
+            print("%s: N = %d, BT model not passive (as the dense BT's: %s), bound %s vs SciPy %.6g" %
+                  (tag, A.shape[0], "min eig(G_r + G_r^H) %.3g" % dense_bt_pr(Ac, Ec, Bc, Cc, r), m.group(1), bound))
+        return
+    if rc != 0:
+        claim(False, "%s: reduce --method bt failed: %s" % (tag, err.strip()))
+        return
+    info = json.load(open(os.path.join(d, "bt.json")))["info"]
+    s = np.array(info["hankel_singular_values"])
+    k = min(len(s), 40)
+    e_s = np.abs(s[:k] - s_ref[:k]).max() / s_ref[0]
+    claim(e_s <= 1e-8, "%s: HSVs vs SciPy %.3g sigma_1" % (tag, e_s))
+    nv = info["values_computed"]   # the low-rank bound sums the computed values (manual 2.8)
+    bound_k = 2 * s_ref[r:nv].sum()
+    claim(abs(info["error_bound"] - bound_k) <= 1e-6 * bound_k,
+          "%s: bound %.6g vs %.6g (the first %d values)" % (tag, info["error_bound"], bound_k, nv))
+    K, Qh, Bh = (np.load(os.path.join(d, "bt_%s.npy" % f)) for f in ("K", "Qh", "Bh"))
+    claim(np.allclose(Qh, Qh.T, atol=1e-12 * np.abs(Qh).max()) and np.linalg.eigvalsh(Qh).min() > 0,
+          tag + ": Qh symmetric positive definite")
+    ek = np.linalg.eigvalsh(K + K.T)
+    claim(ek.max() <= 1e-10 * np.abs(ek).max(), tag + ": K + K^T <= 0 (max eig %.3g)" % ek.max())
+    Ar, Cr = K @ Qh, Bh.T @ Qh
+    e = 0.0
+    for w in W:
+        G = C @ np.linalg.solve(1j * w * E - A, B)
+        Gr = Cr @ np.linalg.solve(1j * w * np.eye(r) - Ar, Bh)
+        e = max(e, np.linalg.norm(G - Gr, 2))
+    claim(e <= bound, "%s: sampled H-inf error %.3g within the bound %.3g" % (tag, e, bound))
+    print("%s: N = %d (%d algebraic), HSVs vs SciPy %.2g sigma_1, sampled H-inf error %.3g <= bound %.3g" %
+          (tag, A.shape[0], A.shape[0] - Ac.shape[0], e_s, e, bound))
+
+
+def dense_bt_pr(A, E, B, C, r):
+    """min over the grid of eig(G_r + G_r^H) of the dense square-root BT model."""
+    Ad, Bd = np.linalg.solve(E, A), np.linalg.solve(E, B)
+    P = sla.solve_continuous_lyapunov(Ad, -Bd @ Bd.T)
+    O = sla.solve_continuous_lyapunov(Ad.T, -C.T @ C)
+
+    def fac(X):
+        w, U = np.linalg.eigh((X + X.T) / 2)
+        return U * np.sqrt(np.maximum(w, 0))
+    Lp, Lo = fac(P), fac(O)
+    U, s, Vt = np.linalg.svd(Lo.T @ Lp)
+    T, Wm = Lp @ Vt[:r].T / np.sqrt(s[:r]), Lo @ U[:, :r] / np.sqrt(s[:r])
+    Ar, Br, Cr = Wm.T @ Ad @ T, Wm.T @ Bd, C @ T
+    return min(np.linalg.eigvalsh(G + G.conj().T).min()
+               for G in (Cr @ np.linalg.solve(1j * w * np.eye(r) - Ar, Br) for w in np.r_[0.0, W]))
+
+
+def gen(script, *args):
+    subprocess.run(["/usr/bin/python3", os.path.join(bench, script)] + list(args), check=True,
+                   capture_output=True)
+
+
+d = os.path.join(work, "rlc")
+gen("rlc_grid.py", d, "--n", "8", "--seed", "4")
+bt_case("rlc 8 x 8 bt r=10", d, 10)
+
+d = os.path.join(work, "acoustic")
+gen("fe_mesh.py", "acoustic", d, "9")
+bt_case("acoustic 9 x 9 bt r=10", d, 10, passive=False)
+
+# prbt on the index-one grid: the same model with rows and states in their
+# natural order (--no-scramble) must give the same positive-real singular
+# values (the energy matrix is E^T Q, not Q E, where the orders differ), and
+# a pH, positive-real model
+pr = []
+for sub, extra in (("rlc", []), ("rlc_u", ["--no-scramble"])):
+    d = os.path.join(work, sub)
+    if extra:
+        gen("rlc_grid.py", d, "--n", "8", "--seed", "4", *extra)
+    rc, err = run("reduce", "--J-coo", d + "/J.npy", "--R-coo", d + "/R.npy", "--Q-coo", d + "/Q.npy",
+                  "--E-coo", d + "/E.npy", "--B", d + "/B.npy", "--method", "prbt", "--r", "10", "--out", d,
+                  "--name", "prbt")
+    claim(rc == 0, "rlc %s prbt: reduce (%s)" % (sub, err.strip()))
+    if rc == 0:
+        pr.append(np.array(json.load(open(os.path.join(d, "prbt.json")))["info"]["positive_real_singular_values"]))
+        K, Qh, Bh = (np.load(os.path.join(d, "prbt_%s.npy" % f)) for f in ("K", "Qh", "Bh"))
+        ek = np.linalg.eigvalsh(K + K.T)
+        claim(ek.max() <= 1e-10 * np.abs(ek).max() and np.linalg.eigvalsh((Qh + Qh.T) / 2).min() > 0,
+              "rlc %s prbt: pH (K + K^T <= 0, Qh > 0)" % sub)
+if len(pr) == 2:
+    e = np.abs(pr[0] - pr[1]).max() / pr[0][0]
+    claim(e <= 1e-8, "rlc prbt: scrambled vs natural order %.3g" % e)
+    print("rlc 8 x 8 prbt r=10: positive-real singular values scrambled vs natural order %.2g" % e)
+
+d = os.path.join(work, "rlc_pc")
+gen("rlc_grid.py", d, "--n", "8", "--seed", "4", "--port-on-constraint")
+A, E, B, C = load(d)
+Dc = condense(A, E, B, C)[4]
+claim(np.abs(Dc).max() > 1e-3, "rlc port on a constraint: the reference feedthrough is not zero")
+rc, err = run("reduce", "--J-coo", d + "/J.npy", "--R-coo", d + "/R.npy", "--Q-coo", d + "/Q.npy",
+              "--E-coo", d + "/E.npy", "--B", d + "/B.npy", "--method", "bt", "--r", "10", "--out", d)
+claim(rc == 1 and "feedthrough" in err, "rlc port on a constraint: bt refused naming the feedthrough (%d: %s)" %
+      (rc, err.strip()))
+
+if fails:
+    print("check_lowrank_dae: %d claims failed" % len(fails))
+    sys.exit(1)
+print("check_lowrank_dae: all claims hold")
