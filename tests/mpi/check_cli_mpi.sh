@@ -4,7 +4,8 @@
 # N = 2400), 201 snapshots from `phgmg simulate --dt 0.1 --steps 200`,
 # reduced by `phgmg reduce --method gmg-pod --r 10` and `--method sp1 --r 10`
 # and by `mpirun -np P phgmg-mpi reduce` with the same options at P = 1, 2,
-# 3, 4 (4: more ranks than cores), each into its own directory. NumPy checks:
+# 3, 4 (4: more ranks than cores; sp1 at P = 2, 4 on the linear chain and
+# P = 1, 3 on the cosh chain), each into its own directory. NumPy checks:
 #   - the same files (NAME.phgmgrom, .c, .json, _Bh, _Qh, _K, _V0.npy) as the
 #     serial run, the json's method, N, m, r and snapshot count the serial's,
 #     its pod_sigma_ratio and rcond_jr within 1e-10 relative of the serial's;
@@ -72,6 +73,7 @@ for case in gmg-pod sp1 cosh-gmg-pod cosh-sp1 terms-sp1; do
     terms-*) meth=${case#terms-}; X="$D/X_pt.npy"; opt="$PT --no-hyper"; ps=3 ;;
     *) meth=$case; X="$D/X.npy"; opt="" ;;
   esac
+  case $case in sp1) ps="2 4" ;; cosh-sp1) ps="1 3" ;; esac   # sp1: every P over the two cases
   "$PHGMG" reduce $M $opt --X "$X" --method $meth --r 10 --out "$D/serial_$case" --quiet > /dev/null
   "$PHGMG" simulate-rom --model "$D/serial_$case/rom.phgmgrom" --dt 0.1 --steps 300 --out "$D/y_serial_$case.npy" --quiet > /dev/null
   for p in $ps; do
@@ -147,7 +149,7 @@ for case in ('gmg-pod', 'sp1', 'cosh-gmg-pod', 'cosh-sp1', 'terms-sp1'):
     if nl and (len(cs) < 2 or -1 in cs or len(set(cs)) != len(cs)):
         print('check_cli_mpi: %s: the serial points were not found in V0' % case)
         bad = 1
-    for p in ((3,) if case.startswith('terms-') else (1, 2, 3, 4)):
+    for p in {'terms-sp1': (3,), 'sp1': (2, 4), 'cosh-sp1': (1, 3)}.get(case, (1, 2, 3, 4)):
         pd = '%s/p%d_%s' % (d, p, case)
         files_ok = sorted(os.listdir(pd)) == sorted(os.listdir(sd))
         pj = json.load(open(pd + '/rom.json'))
