@@ -507,36 +507,25 @@ static void test_gmg_pod_ecsw(int n, int r) {
   quiet_barrier();
   if (!scale_) phgmg_mpi_rom_free(&mr);
   o.hyper.on = 1;
-  /* SP1 with ECSW (J - R as an operator), as the serial SP1 */
-  o.method = PHGMG_METHOD_SP1;
-  rc = phgmg_mpi_reduce(d.c, &d.md, ns, d.Xl, d.ld, &o, &mr, V0, d.ld);
-  CHECK(rc == PHGMG_OK && same_everywhere(mr.nd), "distributed SP1: %d", (int)rc);
-  free(V0f);
-  V0f = gather_v0(d.c, r, V0, d.ld);
-  if (rank_ == 0 && rc == PHGMG_OK) {
-    double ktol = 1e-12, ytol = 1e-10;
-    CHECK(phgmg_reduce(&red, &ch.sys, X, N, ns, &o, NULL, NULL) == PHGMG_OK, "serial SP1");
-    if (red && scale_) serial_sensitivity(&ch, ns, X, x0, &o, red, &ktol, &ytol);
-    if (red) compare_serial(&ch, ns, X, x0, red, &mr, V0f, 200, ktol, ytol, "sp1 ecsw");
-    phgmg_reduced_destroy(red);
+  /* SP1 and SP2 with ECSW (J - R as an operator; SP2's W from the POD of the
+     gradient snapshots), as the serial SP1 and SP2 */
+  for (i = 0; i < 2; ++i) {
+    const char *tag = i ? "sp2 ecsw" : "sp1 ecsw";
+    o.method = i ? PHGMG_METHOD_SP2 : PHGMG_METHOD_SP1;
+    rc = phgmg_mpi_reduce(d.c, &d.md, ns, d.Xl, d.ld, &o, &mr, V0, d.ld);
+    CHECK(rc == PHGMG_OK && same_everywhere(mr.nd), "distributed %s: %d", tag, (int)rc);
+    free(V0f);
+    V0f = gather_v0(d.c, r, V0, d.ld);
+    if (rank_ == 0 && rc == PHGMG_OK) {
+      double ktol = 1e-12, ytol = 1e-10;
+      CHECK(phgmg_reduce(&red, &ch.sys, X, N, ns, &o, NULL, NULL) == PHGMG_OK, "serial %s", tag);
+      if (red && scale_) serial_sensitivity(&ch, ns, X, x0, &o, red, &ktol, &ytol);
+      if (red) compare_serial(&ch, ns, X, x0, red, &mr, V0f, 200, ktol, ytol, tag);
+      phgmg_reduced_destroy(red);
+    }
+    quiet_barrier();
+    phgmg_mpi_rom_free(&mr);
   }
-  quiet_barrier();
-  phgmg_mpi_rom_free(&mr);
-  /* SP2 with ECSW (W from the POD of the gradient snapshots), as the serial SP2 */
-  o.method = PHGMG_METHOD_SP2;
-  rc = phgmg_mpi_reduce(d.c, &d.md, ns, d.Xl, d.ld, &o, &mr, V0, d.ld);
-  CHECK(rc == PHGMG_OK && same_everywhere(mr.nd), "distributed SP2: %d", (int)rc);
-  free(V0f);
-  V0f = gather_v0(d.c, r, V0, d.ld);
-  if (rank_ == 0 && rc == PHGMG_OK) {
-    double ktol = 1e-12, ytol = 1e-10;
-    CHECK(phgmg_reduce(&red, &ch.sys, X, N, ns, &o, NULL, NULL) == PHGMG_OK, "serial SP2");
-    if (red && scale_) serial_sensitivity(&ch, ns, X, x0, &o, red, &ktol, &ytol);
-    if (red) compare_serial(&ch, ns, X, x0, red, &mr, V0f, 200, ktol, ytol, "sp2 ecsw");
-    phgmg_reduced_destroy(red);
-  }
-  quiet_barrier();
-  phgmg_mpi_rom_free(&mr);
   o.method = PHGMG_METHOD_GMG_POD;
   /* the solve fails on one rank only */
   d.sv.fail_rank = size_ > 1 ? size_ - 1 : 0;
