@@ -17,18 +17,15 @@ solve_continuous_lyapunov on small grids (it must agree to rounding).
     /usr/bin/python3 bench/lowrank_hsv_modal.py build/phgmg WORKDIR [HEAT_N LATTICE_N] [--check]
 
 (defaults 100 and 71: N = 10 000 and 10 082). Prints max_{i <= 25} |sigma_i - ref_i| / sigma_1."""
-import json
 import os
-import subprocess
 import sys
 import time
 
 import numpy as np
-import scipy.linalg as sla
 import scipy.sparse.linalg as spla
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import lowrank_models as lm   # noqa: E402
+from lowrank_hsv_ref import dense_reference, reduce_bt   # noqa: E402
 
 
 def sine_modes(n):
@@ -91,19 +88,6 @@ def lattice_reference(n, k=25):
     return np.sort(np.sqrt(np.abs(w.real)))[::-1][:k]
 
 
-def dense_reference(kind, n, k=25):
-    N, trip, B = lm.model(kind, n)
-    J, R, Q = (lm.dense(N, t) for t in trip)
-    A, C = (J - R) @ Q, B.T @ Q
-    P = sla.solve_continuous_lyapunov(A, -B @ B.T)
-    O = sla.solve_continuous_lyapunov(A.T, -C.T @ C)
-
-    def fac(X):
-        w, U = np.linalg.eigh((X + X.T) / 2)
-        return U * np.sqrt(np.maximum(w, 0))
-    return np.linalg.svd(fac(O).T @ fac(P), compute_uv=False)[:k]
-
-
 def main(argv):
     check = "--check" in argv
     args = [a for a in argv if not a.startswith("--")]
@@ -112,24 +96,15 @@ def main(argv):
     ref_fn = {"heat": heat_reference, "lattice": lattice_reference}
     if check:   # the modal reference against the dense one on small grids
         for kind, n in (("heat", 12), ("lattice", 9)):
-            a, b = ref_fn[kind](n, 20), dense_reference(kind, n, 20)
+            a, b = ref_fn[kind](n, 20), dense_reference(kind, n)[:20]
             e = np.abs(a - b).max() / b[0]
             print("check %s n=%d: modal against dense SciPy: %.2e sigma_1" % (kind, n, e))
             if not e <= 1e-12:
                 sys.exit("lowrank_hsv_modal.py: the modal reference disagrees with the dense one")
     for kind, n in zip(("heat", "lattice"), sizes):
-        d = os.path.join(work, "%s%d" % (kind, n))
-        N, trip, B = lm.model(kind, n)
-        os.makedirs(d, exist_ok=True)
-        for nm, t in zip("JRQ", trip):
-            np.save(os.path.join(d, nm + ".npy"), t)
-        np.save(os.path.join(d, "B.npy"), B)
         t0 = time.time()
-        subprocess.run([exe, "reduce", "--J-coo", d + "/J.npy", "--R-coo", d + "/R.npy", "--Q-coo", d + "/Q.npy",
-                        "--B", d + "/B.npy", "--method", "bt", "--r", "20", "--out", d, "--name", "bt", "--quiet"],
-                       check=True)
+        N, s = reduce_bt(exe, work, kind, n)
         t1 = time.time()
-        s = np.array(json.load(open(os.path.join(d, "bt.json")))["info"]["hankel_singular_values"])
         c0 = time.process_time()
         ref = ref_fn[kind](n)
         print("%s n=%d N=%d: max_{i<=25} |sigma_i - ref_i| / sigma_1 = %.2e (sigma_25/sigma_1 = %.1e; "

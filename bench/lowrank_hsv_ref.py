@@ -12,9 +12,10 @@ import scipy.linalg as sla
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import lowrank_models as lm   # noqa: E402
 
-exe, work = sys.argv[1], sys.argv[2]
-sizes = (int(sys.argv[3]), int(sys.argv[4])) if len(sys.argv) > 4 else (40, 28)
-for kind, n in zip(("heat", "lattice"), sizes):
+
+def reduce_bt(exe, work, kind, n):
+    """The scrambled model written to WORK/KINDn and `phgmg reduce --method bt --r 20` run on
+    it: (N, its Hankel singular values)."""
     d = os.path.join(work, "%s%d" % (kind, n))
     N, trip, B = lm.model(kind, n)
     os.makedirs(d, exist_ok=True)
@@ -24,16 +25,34 @@ for kind, n in zip(("heat", "lattice"), sizes):
     subprocess.run([exe, "reduce", "--J-coo", d + "/J.npy", "--R-coo", d + "/R.npy", "--Q-coo", d + "/Q.npy",
                     "--B", d + "/B.npy", "--method", "bt", "--r", "20", "--out", d, "--name", "bt", "--quiet"],
                    check=True)
-    s = np.array(json.load(open(os.path.join(d, "bt.json")))["info"]["hankel_singular_values"])
+    return N, np.array(json.load(open(os.path.join(d, "bt.json")))["info"]["hankel_singular_values"])
+
+
+def dense_reference(kind, n):
+    """The Hankel singular values from SciPy's dense Lyapunov solutions (sigma = the singular
+    values of Lo^T Lp, P = Lp Lp^T, O = Lo Lo^T by eigh)."""
+    N, trip, B = lm.model(kind, n)
     J, R, Q = (lm.dense(N, t) for t in trip)
     A, C = (J - R) @ Q, B.T @ Q
-    c0 = time.process_time()
     P = sla.solve_continuous_lyapunov(A, -B @ B.T)
     O = sla.solve_continuous_lyapunov(A.T, -C.T @ C)
 
     def fac(X):
         w, U = np.linalg.eigh((X + X.T) / 2)
         return U * np.sqrt(np.maximum(w, 0))
-    ref = np.linalg.svd(fac(O).T @ fac(P), compute_uv=False)
-    print("%s n=%d N=%d: max_{i<=25} |sigma_i - ref_i| / sigma_1 = %.2e (SciPy dense %.1f s CPU)" %
-          (kind, n, N, np.abs(s[:25] - ref[:25]).max() / ref[0], time.process_time() - c0))
+    return np.linalg.svd(fac(O).T @ fac(P), compute_uv=False)
+
+
+def main(argv):
+    exe, work = argv[0], argv[1]
+    sizes = (int(argv[2]), int(argv[3])) if len(argv) > 3 else (40, 28)
+    for kind, n in zip(("heat", "lattice"), sizes):
+        N, s = reduce_bt(exe, work, kind, n)
+        c0 = time.process_time()
+        ref = dense_reference(kind, n)
+        print("%s n=%d N=%d: max_{i<=25} |sigma_i - ref_i| / sigma_1 = %.2e (SciPy dense %.1f s CPU)" %
+              (kind, n, N, np.abs(s[:25] - ref[:25]).max() / ref[0], time.process_time() - c0))
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:])
