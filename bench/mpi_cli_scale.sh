@@ -1,7 +1,8 @@
 #!/bin/sh
 # The distributed command line on a large nonlinear model: a scrambled chain
-# of NX masses with an on-site cosh potential (bench/lattice.py --cosh,
-# N = 2 NX), 1001 snapshots from the serial `phgmg simulate`, reduced by the
+# of NX masses (or, with NY > 1, a 2-D lattice of NX x NY masses: a 2-D mesh)
+# with an on-site cosh potential (bench/lattice.py --cosh, N = 2 NX NY), 1001
+# snapshots from the serial `phgmg simulate`, reduced by the
 # serial `phgmg reduce` and by `mpirun -np P phgmg-mpi reduce` (gmg-pod and
 # sp1, --r R, the default ECSW hyper-reduction) at P = 1, 2, 3, 4. Reports
 # per run: the wall time (around mpirun), the CPU time (user + sys summed
@@ -11,7 +12,7 @@
 # the outputs of `phgmg simulate-rom --dt 0.1 --steps 1000` from the serial
 # model's, relative to their largest value. Not part of make test.
 # From the repository's root, after make build/phgmg build/phgmg-mpi:
-#   sh bench/mpi_cli_scale.sh [NX [R [DIR]]]     (defaults 100000 20 /tmp/mpi_cli_scale)
+#   sh bench/mpi_cli_scale.sh [NX [R [DIR [NY]]]]  (defaults 100000 20 /tmp/mpi_cli_scale 1)
 # DIR keeps the model, the snapshots (1.6 GB at NX = 1e5) and the outputs;
 # steps whose outputs exist are not redone (delete DIR to start afresh).
 # METHODS (default "gmg-pod sp1") and PS (default "1 2 3 4") select the runs;
@@ -21,6 +22,7 @@ set -e
 NX=${1:-100000}
 R=${2:-20}
 D=${3:-/tmp/mpi_cli_scale}
+NY=${4:-1}
 ROOT=$(pwd)
 PHGMG=$ROOT/build/phgmg
 PMPI=$ROOT/build/phgmg-mpi
@@ -32,7 +34,7 @@ mkdir -p "$D"
 cd "$D"
 M="--J-coo J.npy --R-coo R.npy --Q-coo Q.npy --B B.npy --potential cosh:1 --poly-idx idx.npy"
 now() { date +%s.%N; }
-[ -e idx.npy ] || $PY "$ROOT/bench/lattice.py" . "$NX" 1 --cosh > /dev/null
+[ -e idx.npy ] || $PY "$ROOT/bench/lattice.py" . "$NX" "$NY" --cosh > /dev/null
 [ -e X.npy ] || "$PHGMG" simulate $M --dt 0.1 --steps 1000 --out y_full.npy --states X.npy --quiet > /dev/null
 for meth in ${METHODS:-gmg-pod sp1}; do
   if [ ! -e "y_serial_$meth.npy" ]; then
@@ -53,26 +55,36 @@ for meth in ${METHODS:-gmg-pod sp1}; do
   done
 done
 
-$PY - "$D" "$NX" "$R" <<'PYEOF'
+$PY - "$D" "$NX" "$R" "$NY" <<'PYEOF'
 import glob
 import os
 import re
 import sys
 import numpy as np
-d, nx, r = sys.argv[1], int(sys.argv[2]), int(sys.argv[3])
+d, nx, r, ny = sys.argv[1], int(sys.argv[2]), int(sys.argv[3]), int(sys.argv[4])
 
 def tv(path):
     t = open(path).read()
     g = lambda k: float(re.search(k + r':\s*([0-9.:]+)', t).group(1))
     return g('User time \\(seconds\\)') + g('System time \\(seconds\\)'), g('Maximum resident set size \\(kbytes\\)') / 1024.0
 
+def opdiff(sd, pd):   # K and Qh of run pd against the serial sd, the modes' signs matched through V0
+    Vs, Vp = np.load(sd + '/rom_V0.npy', mmap_mode='r'), np.load(pd + '/rom_V0.npy', mmap_mode='r')
+    sg = np.array([1.0 if float(np.dot(Vs[:, j], Vp[:, j])) >= 0 else -1.0 for j in range(Vs.shape[1])])
+    out = []
+    for name in ('K', 'Qh'):
+        As, Ap = np.load('%s/rom_%s.npy' % (sd, name)), np.load('%s/rom_%s.npy' % (pd, name))
+        out.append(np.abs(sg[:, None] * Ap * sg[None, :] - As).max() / np.abs(As).max())
+    return out
+
 def coords(P0, V0):   # the state coordinates of the kept terms: their rows of V0
     return [int(np.argmin(np.abs(V0 - row).max(axis=1))) for row in P0]
 
-print('chain of %d masses, N = %d, %d snapshots, r = %d, cosh:1 on every position, ECSW tol 1e-6' % (nx, 2 * nx, 1001, r))
+shape = 'chain of %d masses' % nx if ny == 1 else '2-D lattice of %d x %d masses' % (nx, ny)
+print('%s, N = %d, %d snapshots, r = %d, cosh:1 on every position, ECSW tol 1e-6' % (shape, 2 * nx * ny, 1001, r))
 print()
-print('| method | run | wall [s] | CPU [s] | peak RSS, largest rank [MB] | vs the first P | ECSW points | same points as serial | simulate-rom max rel. diff |')
-print('|---|---|---|---|---|---|---|---|---|')
+print('| method | run | wall [s] | CPU [s] | peak RSS, largest rank [MB] | vs the first P | ECSW points | same points as serial | K, Qh rel. diff | simulate-rom max rel. diff |')
+print('|---|---|---|---|---|---|---|---|---|---|')
 for meth in ('gmg-pod', 'sp1'):
     sd = '%s/serial_%s' % (d, meth)
     if not os.path.exists('%s/y_serial_%s.npy' % (d, meth)):
@@ -83,7 +95,7 @@ for meth in ('gmg-pod', 'sp1'):
     ys = np.load('%s/y_serial_%s.npy' % (d, meth))
     cpu, rss = tv('%s/time_serial_%s.txt' % (d, meth))
     wall = float(open('%s/wall_serial_%s.txt' % (d, meth)).read())
-    print('| %s | serial | %.1f | %.1f | %.0f | | %d | | |' % (meth, wall, cpu, rss, len(cs)))
+    print('| %s | serial | %.1f | %.1f | %.0f | | %d | | | |' % (meth, wall, cpu, rss, len(cs)))
     rss1 = None
     for p in (1, 2, 3, 4):
         pd = '%s/p%d_%s' % (d, p, meth)
@@ -98,6 +110,7 @@ for meth in ('gmg-pod', 'sp1'):
         cd = coords(np.load(pd + '/rom_P0.npy'), np.asarray(np.load(pd + '/rom_V0.npy', mmap_mode='r')))
         y = np.load('%s/y_p%d_%s.npy' % (d, p, meth))
         ey = np.abs(y - ys).max() / np.abs(ys).max()
-        print('| %s | P = %d | %.1f | %.1f | %.0f | %.3f | %d | %s | %.1e |' % (meth, p, wall, cpu, rss, rss / rss1, len(cd),
-              'yes' if cd == cs else 'NO', ey))
+        dk, dq = opdiff(sd, pd)
+        print('| %s | P = %d | %.1f | %.1f | %.0f | %.3f | %d | %s | %.1e, %.1e | %.1e |' % (meth, p, wall, cpu, rss, rss / rss1,
+              len(cd), 'yes' if cd == cs else 'NO', dk, dq, ey))
 PYEOF

@@ -531,11 +531,17 @@ static void progress(const char *fmt, ...) {
    runs numbered. Every phase of a long reduction (N * ns >= 1e7, e.g.
    N >= 10 000 with 1001 snapshots); of others, the phases that start after
    the reduction has run a second (a short reduction stays quiet). */
-typedef struct phase_log { double t0; int all, ncand, nprobe, qm, hyper; } phase_log;
+typedef struct phase_log {
+  double t0;
+  int all, ncand, nprobe, qm, hyper, quiet;
+  const char *last;   /* the phase running now (a failure names it) */
+} phase_log;
 static void reduce_phase(const char *phase, void *user) {
   phase_log *pl = (phase_log *)user;
   const double t = now_s() - pl->t0;
   int k = 0;
+  pl->last = phase;
+  if (pl->quiet) return;
   if (strcmp(phase, "lambda: candidate") == 0) k = ++pl->ncand;
   if (strcmp(phase, "lambda: full-model probe run") == 0) k = ++pl->nprobe;
   if (strcmp(phase, "done") == 0 || (!pl->all && t < 1.0)) return;
@@ -3823,7 +3829,8 @@ static int run_reduction(const reduce_args *A, reduce_state *S, int method, cons
   t0 = now_s();
   plog.t0 = t0; plog.all = (double)N * (double)ns >= 1e7; plog.ncand = plog.nprobe = 0;
   plog.qm = method == PHGMG_METHOD_GMG_QM; plog.hyper = o.hyper.on;
-  if (!g_quiet) { o.progress = reduce_phase; o.progress_user = &plog; }
+  plog.quiet = g_quiet; plog.last = NULL;
+  o.progress = reduce_phase; o.progress_user = &plog;
   rc = g_stream ? phgmg_reduce_stream(&S->red, &S->sys, g_stream, &o, &info, NULL)
        : S->study ? phgmg_study_reduce(S->study, &o, &S->red, &info)
                   : phgmg_reduce(&S->red, &S->sys, X, N, ns, &o, &info, NULL);
@@ -3851,6 +3858,12 @@ static int run_reduction(const reduce_args *A, reduce_state *S, int method, cons
         return fail("reduction failed: --dt-map %g: %s (or --dt-map 0: none)", A->dt_map, phgmg_result_string(rc));
       case PHGMG_ERR_TOL_UNREACHABLE:
         return fail("reduction failed: --hyper-tol %g: %s", A->hyper_tol, phgmg_result_string(rc));
+      case PHGMG_ERR_NOT_CONVERGED:
+        if (plog.last && !strcmp(plog.last, "hyper-reduction") && o.hyper.kind == PHGMG_HYPER_ECSW)
+          return fail("reduction failed: the ECSW hyper-reduction did not reach --hyper-tol %g on these snapshots "
+                      "(%s); a larger --hyper-tol, or --no-hyper, reduces without it",
+                      o.hyper.tol > 0.0 ? o.hyper.tol : 1e-6, phgmg_result_string(rc));
+        return fail("reduction failed: %s", phgmg_result_string(rc));
       case PHGMG_ERR_NEGATIVE_WEIGHT:
         return fail("reduction failed: %s (use --deim-allow-negative, a smaller --deim-tol, or --no-hyper)",
                     phgmg_result_string(rc));
@@ -4473,7 +4486,7 @@ static int run_balancing(const reduce_args *A, reduce_state *S, double *t_red) {
   lo.maxit = A->adi_maxit;
   progress("reducing: %s, r = %d (%s solvers)", A->method, A->r, S->sp ? "low-rank, sparse" : "dense");
   t0 = now_s();
-  plog.t0 = t0; plog.all = 0; plog.ncand = plog.nprobe = 0;
+  plog.t0 = t0; plog.all = 0; plog.ncand = plog.nprobe = 0; plog.quiet = 0; plog.last = NULL;
   if (!g_quiet) { lo.progress = reduce_phase; lo.progress_user = &plog; }
   S->bal_on = 1;
   runs0 = S->bcache.adi_runs;

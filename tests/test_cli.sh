@@ -788,6 +788,9 @@ if [ "$HAVE_NP" = 1 ]; then
   run_err "P7 --hyper-tol 1e-300" 2 "below what double precision resolves" "$P" reduce $TS --potential toda \
     --hyper-tol 1e-300 $TR --out p7
   run_err "P7 --hyper-tol 0" 2 "--hyper-tol 0" "$P" reduce $TS --potential toda --hyper-tol 0 $TR --out p7
+  # an ECSW tolerance the fit cannot reach on these snapshots: the message names ECSW and the way out
+  run_err "P7 --hyper-tol 1e-14 unreachable" 1 "the ECSW hyper-reduction did not reach --hyper-tol 1e-14" "$P" reduce \
+    $TS --potential toda --hyper-tol 1e-14 $TR --out p7 --quiet
 fi
 # 23: messages name the option the value came from; every command listed
 run_err "P23 --train-input file" 1 "nofile.npy (--train-input)" "$P" reduce $SYS $QSIM --train-input sin \

@@ -96,6 +96,38 @@ TEST(test_ecsw_screened_separable) {
   free(F); free(Vt); free(G); free(t); free(w); free(x); free(xn); free(pts);
 }
 
+/* Terms of very different sizes: 10 large terms whose training columns lie
+   in the rows of the first reduced coordinate, and 300 tiny ones (columns
+   1e-9 of theirs) in the rows of the second; the target (sum of all) then
+   has a part of relative size ~1e-9 * 300 / 10 that only tiny terms can
+   fit. Their gradients are far below the large terms' (a threshold relative
+   to the largest gradient stops with the tolerance missed), yet far above
+   their own rounding level: the screened fit must take them and meet tol.
+   The residual is recomputed here from the explicit rows. */
+TEST(test_ecsw_screened_tiny_terms) {
+  enum { NB = 10, NS = 300, NT = NB + NS, SN = 6, R = 2, M = SN * R };
+  static double F[NT * SN], Vt[NT * R], G[M * NT], t[M], w[NT], x[NT];
+  static int pts[NT];
+  double rel = -1.0;
+  int nd = 0, i, k;
+  for (k = 0; k < NT; ++k) {
+    const double s = k < NB ? 1.0 : 1e-9;
+    for (i = 0; i < SN; ++i) F[k + i * NT] = s * (1.0 + 0.5 * sin(1.3 * k + 0.7 * i * (i + 1)));
+    Vt[k] = k < NB ? 1.0 : 0.0;
+    Vt[k + NT] = k < NB ? 0.0 : 1.0;
+  }
+  sc_rows(NT, SN, R, F, Vt, G, t);
+  CHECK_RC(phgmg_ecsw_separable(NT, SN, F, NT, R, Vt, NT, NULL, 1e-12, pts, w, &nd, &rel, NULL), PHGMG_OK);
+  for (k = 0; k < NT; ++k) x[k] = 0.0;
+  for (i = 0; i < nd; ++i) {
+    CHECK(w[i] > 0.0);
+    x[pts[i]] = w[i];
+  }
+  CHECK_LE(sc_rel(M, NT, G, x, t), 1e-12);
+  /* tiny terms were needed: some are kept */
+  CHECK(nd > 0 && pts[nd - 1] >= NB);
+}
+
 /* Target outside the cone of the columns: tol unreachable. The screened
    solution must be optimal over all n terms (KKT), with phgmg_nnls's residual. */
 TEST(test_ecsw_screened_optimal) {
@@ -381,6 +413,7 @@ SUITE(scale) {
   RUN(test_reduce_ecsw_qm_skips_resting_terms);
   RUN(test_ecsw_screened_separable);
   RUN(test_ecsw_screened_optimal);
+  RUN(test_ecsw_screened_tiny_terms);
   RUN(test_reduce_pod_randomized_and_fallback);
   RUN(test_reduce_sp_sigma_ratio);
 }
