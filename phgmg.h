@@ -3633,7 +3633,9 @@ PHGMG_DEF phgmg_result phgmg_deim_select(int nterms, int ns, const double *F, in
    squares by a fresh QR (k p^2 flops, k = min(m, n), p passive indices; for
    large problems see phgmg_ecsw's Gram form). Stops early once ||A x - b|| <=
    tol ||b|| (tol <= 0: solve to optimality: no free index with gradient
-   [A^T (b - A x)]_j > 10 max(m,n) eps ||A||_F ||b||). max_iter (<= 0: 3n)
+   [A^T (b - A x)]_j > 10 max(m,n) eps ||A(:, j)|| ||b||, each column's
+   gradient against its own rounding level, so that columns much smaller
+   than others still count). max_iter (<= 0: 3n)
    caps the iterations (one per index added or dropped). Outputs: x (n),
    resid = ||A x - b|| (may be NULL), nnz_out = entries of x > 0 (may be NULL).
    Errors: PHGMG_ERR_INVALID_ARG (NULL A, b, x), PHGMG_ERR_SIZE, PHGMG_ERR_NANINF,
@@ -16217,7 +16219,7 @@ PHGMG_DEF phgmg_result phgmg_nnls(int m, int n, const double *A, int lda, const 
                                   int max_iter, double *x, double *resid, int *nnz_out,
                                   const phgmg_allocator *alloc) {
   phgmg__nnls_prob pb;
-  double *Q = NULL, *tau, *qb, bn, res2 = 0.0;
+  double *Q = NULL, *tau, *qb, *cn, bn, res2 = 0.0;
   int i, j, nz = 0;
   phgmg_result rc;
   if (!A || !b || !x) return PHGMG_ERR_INVALID_ARG;
@@ -16227,10 +16229,14 @@ PHGMG_DEF phgmg_result phgmg_nnls(int m, int n, const double *A, int lda, const 
   memset(&pb, 0, sizeof pb);
   pb.n = n;
   bn = phgmg_normf(m, 1, b, m);
-  pb.wtol = 10.0 * (double)PHGMG__MAX(m, n) * PHGMG__EPS * phgmg_normf(m, n, A, lda) * bn;
+  /* index j's gradient against its own rounding level (column j's norm) */
+  pb.wtol = 10.0 * (double)PHGMG__MAX(m, n) * PHGMG__EPS * bn;
+  Q = phgmg__dalloc(alloc, (m > n ? (size_t)m * n + (size_t)m : 0) + (size_t)n + (size_t)n);
+  if (!Q) return PHGMG_ERR_NOMEM;
+  cn = Q + (m > n ? (size_t)m * n + (size_t)n + (size_t)m : (size_t)n);
+  for (j = 0; j < n; ++j) cn[j] = phgmg_normf(m, 1, A + (size_t)j * lda, m);
+  pb.wsc = cn;
   if (m > n) { /* compress: A = Q R, min ||R x - (Q^T b)_{1:n}||^2 + ||(Q^T b)_{n+1:m}||^2 */
-    Q = phgmg__dalloc(alloc, (size_t)m * n + (size_t)n + (size_t)m);
-    if (!Q) return PHGMG_ERR_NOMEM;
     tau = Q + (size_t)m * n;
     qb = tau + n;
     for (j = 0; j < n; ++j) memcpy(Q + (size_t)j * m, A + (size_t)j * lda, (size_t)m * sizeof(double));
@@ -28795,7 +28801,8 @@ PHGMG_DEF phgmg_result phgmg_sym_eig(int n, double *A, int lda, double *w, doubl
             a gradient as zero below a threshold relative to the LARGEST
             term; each term's gradient is now compared with its own
             rounding level (its column's norm times the residual's), in the
-            serial and the distributed fits alike. The command line names
+            serial and the distributed fits alike, and in phgmg_nnls (which
+            took such a fit as optimal). The command line names
             ECSW and --hyper-tol / --no-hyper when the fit misses its
             tolerance.
    0.9.0  (2026-11-29)

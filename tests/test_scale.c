@@ -126,6 +126,15 @@ TEST(test_ecsw_screened_tiny_terms) {
   CHECK_LE(sc_rel(M, NT, G, x, t), 1e-12);
   /* tiny terms were needed: some are kept */
   CHECK(nd > 0 && pts[nd - 1] >= NB);
+  /* phgmg_nnls solved to optimality (tol 0) on the explicit rows: the same */
+  {
+    double rn = -1.0, tn = 0.0;
+    int nnz = 0;
+    for (i = 0; i < M; ++i) tn += t[i] * t[i];
+    CHECK_RC(phgmg_nnls(M, NT, G, M, t, 0.0, 0, x, &rn, &nnz, NULL), PHGMG_OK);
+    CHECK_LE(rn, 1e-12 * sqrt(tn));
+    CHECK_LE(sc_rel(M, NT, G, x, t), 1e-12);
+  }
 }
 
 /* Target outside the cone of the columns: tol unreachable. The screened
