@@ -575,6 +575,171 @@ static void test_screened(void) {
   free(X); free(x0); free(V0); free(V0f);
 }
 
+/* Largest |sg_i sg2_j A - B| / max |B| of the quadratic blocks' sign
+   pattern (A, B: r x c; si, sj the rows' and columns' signs). */
+static double qm_diff(int r, int c, const phgmg_real *A, const phgmg_real *B, const double *si, const double *sj) {
+  double e = 0.0, s = 0.0;
+  int i, j;
+  for (j = 0; j < c; ++j)
+    for (i = 0; i < r; ++i) {
+      e = fmax(e, fabs(si[i] * sj[j] * (double)A[i + (size_t)j * r] - (double)B[i + (size_t)j * r]));
+      s = fmax(s, fabs((double)B[i + (size_t)j * r]));
+    }
+  return s > 0.0 ? e / s : e;
+}
+
+/* Rank 0: a distributed GMG-QM model against the serial one. The basis
+   [B, V1] (the same selected modes: each column of V0f against the serial
+   V0 = lift(e_j) - V2 M(e_j kron e_j)), signs sg of V0's columns; the signs
+   sg2 of V2's modes from G01 (V2 itself stays distributed); then every
+   block of the quadratic model (G00, G01, G10, G11, Qh, Q01, Q11, Ms, Bh,
+   the kept terms' P0, P1, w), q_max and the outputs over nsteps steps. */
+static void compare_qm(const chain *ch, const double *x0, const phgmg_reduced *red, const phgmg_mpi_rom *mr,
+                       const double *V0f, int nsteps, const char *tag) {
+  const phgmg_rom *ro = phgmg_reduced_rom(red), *rd = &mr->rom;
+  const int N = ch->N, r = mr->r, m = mr->m, p = r - m, rn = ro->rn;
+  const double *V2s = NULL, *Ms = NULL;
+  double sg[64], sg2[64], sgm[64 * 64], one = 1.0, e = 0.0, eb = 0.0, xr[64], xd[64], *col = (double *)malloc(sizeof(double) * (size_t)N);
+  int i, j, a, same;
+  CHECK(rd->kind == PHGMG_ROM_QUADRATIC && rd->rn == rn && phgmg_reduced_qm(red, &V2s, &Ms) == rn, "%s: kind/rn", tag);
+  mode_signs(red, N, r, V0f, sg);
+  for (j = 0; j < r; ++j) {   /* the basis: the same modes */
+    double cm = 0.0, em = 0.0;
+    memset(xr, 0, sizeof xr); xr[j] = 1.0;
+    phgmg_reduced_lift(red, xr, col);
+    for (i = 0; j >= m && i < N; ++i)
+      for (a = 0; a < rn; ++a) col[i] -= V2s[i + (size_t)a * N] * Ms[a + (size_t)((j - m) * p + (j - m)) * rn];
+    for (i = 0; i < N; ++i) { em = fmax(em, fabs(sg[j] * V0f[i + (size_t)j * N] - col[i])); cm = fmax(cm, fabs(col[i])); }
+    eb = fmax(eb, em / cm);
+  }
+  CHECK(eb <= 1e-10, "%s: basis [B, V1] %.2e (not the same modes)", tag, eb);
+  for (a = 0; a < rn; ++a) {   /* V2's signs */
+    double dt = 0.0;
+    for (i = 0; i < r; ++i) dt += sg[i] * (double)rd->G01[i + (size_t)a * r] * (double)ro->G01[i + (size_t)a * r];
+    sg2[a] = dt < 0.0 ? -1.0 : 1.0;
+  }
+  for (a = 0; a < p; ++a)
+    for (j = 0; j < p; ++j) sgm[a * p + j] = sg[m + a] * sg[m + j];
+#define QD(A, rr, cc, si, sj) do { double t_ = qm_diff(rr, cc, rd->A, ro->A, si, sj); \
+    CHECK(t_ <= 1e-12, "%s: " #A " %.2e", tag, t_); e = fmax(e, t_); } while (0)
+  QD(G00, r, r, sg, sg); QD(G01, r, rn, sg, sg2); QD(G10, rn, r, sg2, sg); QD(G11, rn, rn, sg2, sg2);
+  QD(Qh, r, r, sg, sg); QD(Q11, rn, rn, sg2, sg2); QD(Ms, rn, p * p, sg2, sgm); QD(Bh, r, m, sg, &one);
+  {   /* Q01 = V0^T Q V2 is rounding for Q = I (V2 orthogonal to B and V1): on the scale of Qh */
+    double t_ = 0.0, s_ = 0.0;
+    for (i = 0; i < r * rn; ++i) t_ = fmax(t_, fabs(sg[i % r] * sg2[i / r] * rd->Q01[i] - ro->Q01[i]));
+    for (i = 0; i < r * r; ++i) s_ = fmax(s_, fabs(ro->Qh[i]));
+    CHECK(t_ <= 1e-12 * s_, "%s: Q01 %.2e", tag, t_ / s_);
+  }
+#undef QD
+  CHECK(fabs(rd->q_max[0] - ro->q_max[0]) <= 1e-12 * ro->q_max[0], "%s: q_max %.17g, serial %.17g", tag,
+        (double)rd->q_max[0], (double)ro->q_max[0]);
+  same = rd->nd == ro->nd && (rd->nd == 0 || (rd->P1 && ro->P1));
+  CHECK(same, "%s: %d terms, serial %d", tag, rd->nd, ro->nd);
+  for (j = 0; same && j < rd->nd; ++j) same = mr->pts[j] == j && mr->coord[j] == ch->idx[j] && rd->w[j] == ro->w[j];
+  CHECK(same, "%s: the kept terms differ", tag);
+  for (j = 0; same && j < rd->nd; ++j) {
+    for (a = 0; a < r; ++a) e = fmax(e, fabs(sg[a] * rd->P0[j + (size_t)a * rd->nd] - ro->P0[j + (size_t)a * rd->nd]));
+    for (a = 0; a < rn; ++a) e = fmax(e, fabs(sg2[a] * rd->P1[j + (size_t)a * rd->nd] - ro->P1[j + (size_t)a * rd->nd]));
+  }
+  CHECK(e <= 1e-12, "%s: blocks/rows %.2e", tag, e);
+  phgmg_reduced_restrict(red, x0, xr);
+  for (j = 0; j < r; ++j) xd[j] = sg[j] * xr[j];
+  {
+    const double ey = online_diff(rd, ro, xd, xr, nsteps, tag);
+    CHECK(ey <= 1e-10, "%s: reduced outputs against the serial model's: %.2e", tag, ey);
+    printf("  %s: basis %.1e, blocks %.1e, q_max %.1e, %d terms, outputs (%d steps) %.1e\n", tag, eb, e,
+           fabs(rd->q_max[0] - ro->q_max[0]) / ro->q_max[0], rd->nd, nsteps, ey);
+  }
+  free(col);
+}
+
+/* Distributed GMG-QM (r = 8, rn = 4, 3 on the linear chain; manifold POD and GREEDY; no
+   hyper-reduction) of the linear chain (no terms) and of the cosh chain
+   (every term kept) against the serial phgmg_reduce with the same options;
+   then unsupported options (the wide V2, ALTMIN, ECSW) refused on every
+   rank and a solve failing on one rank only. */
+static void test_gmg_qm(void) {
+  const int n = 300, N = 2 * n, ns = 81, r = 8;
+  chain ch;
+  dist d;
+  double *X = (double *)malloc(sizeof(double) * (size_t)N * ns), *x0 = (double *)calloc((size_t)N, sizeof(double));
+  double *V0 = NULL, *V0f, *Vpod = NULL;
+  phgmg_reduce_opts o;
+  phgmg_reduced *red = NULL;
+  phgmg_mpi_rom mr;
+  phgmg_result rc;
+  int i, lin, mf;
+  for (lin = 1; lin >= 0; --lin) {
+    chain_build(&ch, n, 0);
+    if (lin) { ch.sys.nl = PHGMG_NL_NONE; ch.sys.nsep = 0; }
+    for (i = 0; i < n; ++i) x0[2 * i] = 0.8 * sin(3.0 * 3.14159265358979 * i / n) + 0.3 * sin(7.0 * 3.14159265358979 * i / n);
+    simulate_root(&ch, x0, 0.2, ns, X);
+    dist_build(&d, &ch, ns, X);
+    if (lin) d.md.nsep = 0;
+    V0 = (double *)malloc(sizeof(double) * (size_t)d.ld * r);
+    for (mf = 0; mf < 2; ++mf) {
+      char tag[64];
+      snprintf(tag, sizeof tag, "gmg-qm %s, %s chain", mf ? "greedy" : "pod", lin ? "linear" : "cosh");
+      memset(&o, 0, sizeof o);
+      o.method = PHGMG_METHOD_GMG_QM; o.r = r; o.qm.rn = lin ? 3 : 4;   /* the linear chain's spectrum falls faster: V2's modes as well conditioned */
+      o.qm.manifold = mf ? PHGMG_MANIFOLD_GREEDY : PHGMG_MANIFOLD_POD;
+      rc = phgmg_mpi_reduce(d.c, &d.md, ns, d.Xl, d.ld, &o, &mr, V0, d.ld);
+      CHECK(rc == PHGMG_OK && same_everywhere(mr.nd), "distributed %s: %d", tag, (int)rc);
+      V0f = gather_v0(d.c, r, V0, d.ld);
+      if (rank_ == 0 && rc == PHGMG_OK) {
+        CHECK(phgmg_reduce(&red, &ch.sys, X, N, ns, &o, NULL, NULL) == PHGMG_OK, "serial %s", tag);
+        if (red) compare_qm(&ch, x0, red, &mr, V0f, 100, tag);
+        phgmg_reduced_destroy(red);
+        red = NULL;
+      }
+      if (rank_ == 0 && mf == 1 && Vpod && rc == PHGMG_OK) {   /* the greedy's modes outside the POD's leading p */
+        int j, k, out = 0;
+        for (j = 1; j < r; ++j) {
+          double best = 0.0;
+          for (k = 1; k < r; ++k) {
+            double dt = 0.0;
+            for (i = 0; i < N; ++i) dt += V0f[i + (size_t)j * N] * Vpod[i + (size_t)k * N];
+            best = fmax(best, fabs(dt));
+          }
+          out += best < 0.5;
+        }
+        printf("  %s: %d of the %d modes of V1 beyond the POD's leading ones\n", tag, out, r - 1);
+        CHECK(lin || out > 0, "%s: the greedy took the leading modes (a weak test)", tag);
+      }
+      quiet_barrier();
+      phgmg_mpi_rom_free(&mr);
+      if (mf == 0) { free(Vpod); Vpod = V0f; } else free(V0f);
+    }
+    free(Vpod);
+    Vpod = NULL;
+    if (!lin) {   /* what the distributed GMG-QM does not take: refused everywhere */
+      for (i = 0; i < 3; ++i) {
+        memset(&o, 0, sizeof o);
+        o.method = PHGMG_METHOD_GMG_QM; o.r = r; o.qm.rn = 6; o.qm.manifold = PHGMG_MANIFOLD_GREEDY;
+        if (i == 0) o.qm.rn = 0;                                 /* greedy's default: the wide V2 */
+        if (i == 1) o.qm.manifold = PHGMG_MANIFOLD_ALTMIN;
+        if (i == 2) o.hyper.on = 1;
+        memset(&mr, 1, sizeof mr);
+        rc = phgmg_mpi_reduce(d.c, &d.md, ns, d.Xl, d.ld, &o, &mr, NULL, 0);
+        CHECK(rc == PHGMG_ERR_UNSUPPORTED && same_everywhere(rc) && mr.mem_ == NULL, "gmg-qm unsupported %d: %d", i, rc);
+      }
+      memset(&o, 0, sizeof o);   /* bad input on one rank: an rn beyond N - r there, the solve failing on another */
+      o.method = PHGMG_METHOD_GMG_QM; o.r = r; o.qm.rn = 6;
+      if (rank_ == 0) o.qm.rn = N;
+      rc = phgmg_mpi_reduce(d.c, &d.md, ns, d.Xl, d.ld, &o, &mr, NULL, 0);
+      CHECK(rc == PHGMG_ERR_SIZE && same_everywhere(rc) && mr.mem_ == NULL, "gmg-qm rn beyond N - r on rank 0: %d", rc);
+      o.qm.rn = 6;
+      d.sv.fail_rank = size_ > 1 ? size_ - 1 : 0;
+      rc = phgmg_mpi_reduce(d.c, &d.md, ns, d.Xl, d.ld, &o, &mr, NULL, 0);
+      CHECK(rc == PHGMG_ERR_SINGULAR && same_everywhere(rc) && mr.mem_ == NULL, "gmg-qm failing solve on one rank: %d", rc);
+    }
+    dist_free(&d);
+    chain_free(&ch);
+    free(V0);
+  }
+  free(X); free(x0);
+}
+
 /* Bad input on one rank only (a term outside its rows, ids not ascending,
    another function family, a NaN coefficient) and options this function
    does not take: the same code on every rank, never a hang, *out zeroed. */
@@ -682,6 +847,7 @@ int main(int argc, char **argv) {
   else {
     test_gmg_pod_ecsw(1000, 12);
     test_screened();
+    test_gmg_qm();
     test_errors();
     test_memory();
   }
