@@ -747,10 +747,12 @@
                             B u (Q as an operator, B's rows, J - R through a
                             collective solve callback: the user's KSP, MUMPS
                             or AMG): K, Qh, Bh of the serial phgmg_reduce
-     phgmg_mpi_reduce       GMG-POD, SP1 or SP2 of a model with a SEPARABLE
-                            Hamiltonian (built-in exp-polynomial terms held
-                            by the ranks that own their coordinates) with
-                            ECSW hyper-reduction: the serial phgmg_reduce's
+     phgmg_mpi_reduce       GMG-POD, SP1, SP2 or GMG-QM of a model with a
+                            SEPARABLE Hamiltonian (built-in exp-polynomial
+                            terms held by the ranks that own their
+                            coordinates) with ECSW hyper-reduction (GMG-QM:
+                            the POD and greedy manifolds with a narrow V2,
+                            every term kept): the serial phgmg_reduce's
                             phgmg_rom, replicated, the kept terms as global
                             indices (phgmg_mpi_rom_free)
      phgmg_mpi_agree        one result for all ranks
@@ -794,7 +796,7 @@
    sum_k w_k phi_k'(x_j[idx_k]) e_idx_k (SP2; each rank its rows and terms,
    PHGMG_ERR_SIZE below the rounding floor as in the serial SP2), A = V^T
    Vg, W = Vg A^{-1}, K = W^T (J - R) W, Bh = W^T B, Qh = V^T Q V
-   symmetrised, as the serial SP1/SP2) for
+   symmetrised, as the serial SP1/SP2; or GMG-QM, below) for
    H(x) = 1/2 x^T Q x + sum_k w_k phi_k(x[idx_k]) and adds the serial
    separable stage (3.4, 8.7): the
    terms whose argument moves in some snapshot, F = phi_k'(x_i[idx_k]), and
@@ -811,7 +813,37 @@
    training envelope of the reduced snapshot coordinates. The result is the
    phgmg_rom the serial phgmg_reduce builds (P0, w, per-term poly/expo, K,
    Qh, Bh, env_lo/hi); the kept terms' global term and state indices come
-   with it (phgmg_mpi_rom.pts, .coord). On a damped chain with a cosh
+   with it (phgmg_mpi_rom.pts, .coord).
+   GMG-QM (opts.method GMG_QM, qm.manifold POD or GREEDY, qm.rn > 0, the
+   fixed qm.lambda, hyper.on = 0) runs the serial pipeline's stages on the
+   same data: the adjusted snapshots Xa = X - QB QB^T X and their POD by
+   TSQR with as many modes as the serial basis and greedy stages take (the
+   same rank floor max(N, ns) eps ||X||_F); V1 the p = r - m leading modes
+   (POD; V2 the next rn when they lie above the floor, as the serial
+   hierarchical POD) or the greedy choice among the q = min(p + rn,
+   min(N, ns) - 1) leading ones, made by the serial code on their
+   coordinates S = U^T Xa (q x ns, replicated: no communication per trial);
+   V2 the rn leading POD modes of Xa - V1 V1^T Xa; Z1 = V1^T X and Z2 = V2^T
+   Xa replicated, from which the serial ridge problem and fit give M; r + rn
+   solves give G00, G01, G10, G11 = [V0, V2]^T (J - R)^{-1} [V0, V2], and the
+   serial non-degeneracy check of D^T G D (at 0 and at every snapshot, its
+   scaling from |V0|^T |G V0|) runs on them; Qh, Q01, Q11 from [V0, V2]^T Q
+   [V0, V2]; every term kept (P0 and P1 its rows of V0 and V2, from its
+   owner); the envelope and q_max from the replicated reduced coordinates.
+   The result is the serial phgmg_rom of kind PHGMG_ROM_QUADRATIC. On the
+   chain below (N = 600, 81 snapshots, r = 8, rn = 4; rn = 3 without the
+   cosh terms, whose faster falling spectrum leaves V2's deeper modes less
+   well determined) at 1-4 ranks: the basis [B, V1] within 3e-13 (the
+   greedy takes the same modes, 2 and 1 of 7 beyond the leading ones),
+   every block within 6e-13 relative (after the modes' signs), q_max within
+   1.1e-14, the reduced outputs over 100 steps within 1e-12. Not yet: the
+   wide V2 (qm.rn = PHGMG_RN_WIDE, the greedy manifold's default: set qm.rn
+   > 0), the ALTMIN manifold, a chosen lambda, your own eta
+   (GMG_MANIFOLD), hyper-reduction with GMG-QM (all PHGMG_ERR_UNSUPPORTED).
+   Cost beyond GMG-POD: the POD of the residual (one TSQR), r + rn solves
+   instead of r, products of N x (r + rn) blocks; memory per rank the
+   adjusted snapshots and three N x (r + rn) blocks (still 1/P).
+   On a damped chain with a cosh
    potential (N = 2000, 1000 terms, r = 12, hyper.tol 1e-3;
    tests/mpi/test_mpi_nl.c) at 1-4 ranks: the singular values within
    3e-16 sigma_1, K within 4e-13 and Qh within 1.3e-15 relative (after the
@@ -853,7 +885,8 @@
    solves and about 1.5 GB per rank; the efficiency falls below 90 % near
    16 000 ranks (size ns about 0.6 times the rows per rank), where TSQR's
    replicated stack dominates.
-   Not yet distributed: GMG-QM, DEIM hyper-reduction (hyper.kind
+   Not yet distributed: GMG-QM with a wide V2, ALTMIN, a chosen lambda or
+   hyper-reduction; GMG_MANIFOLD; DEIM hyper-reduction (hyper.kind
    QDEIM or GREEDY), separable terms by callbacks and GENERAL nonlinear
    Hamiltonians, a reference state (opts.ref), dampers, feedthrough,
    descriptor models; in the command line (below) also simulating the
@@ -5128,8 +5161,9 @@ typedef struct phgmg_mpi_rom {
 } phgmg_mpi_rom;
 
 /* The distributed phgmg_reduce of a separable model, with ECSW
-   hyper-reduction (opts: method PHGMG_METHOD_GMG_POD or PHGMG_METHOD_SP1, r,
-   hyper.on, hyper.kind ECSW, hyper.tol; the other fields zero, else
+   hyper-reduction (opts: method PHGMG_METHOD_GMG_POD, SP1, SP2 or GMG_QM,
+   r, hyper.on, hyper.kind ECSW, hyper.tol; GMG_QM: qm.manifold POD or
+   GREEDY, qm.rn > 0, qm.lambda, hyper.on = 0; the other fields zero, else
    PHGMG_ERR_UNSUPPORTED). The serial phgmg_reduce's stages in its order and
    with its formulas: GMG-POD: the basis and the GMG blocks K, Qh, Bh as
    phgmg_mpi_gmg_pod_linear; SP1 (model->JR needed): V the r leading POD
@@ -5147,9 +5181,20 @@ typedef struct phgmg_mpi_rom {
    functions broadcast by their owners; the training envelope from the
    reduced coordinates of the snapshots. hyper.on = 0:
    every term kept with its weight (nd = all terms: O(terms) online).
+   GMG_QM: the serial GMG-QM's stages with every N-dimensional product
+   distributed: V1 the p = r - m leading POD modes (TSQR) of the adjusted
+   snapshots X - QB QB^T X (POD manifold) or the serial greedy choice among
+   the min(p + rn, min(N, ns) - 1) leading ones, made on their replicated
+   coordinates (GREEDY); V2 the rn leading POD modes of the residual of
+   [B, V1]; M the serial ridge fit at qm.lambda; G00, G01, G10, G11 from
+   r + rn solves, the serial non-degeneracy check of D^T G D at 0 and at
+   every snapshot; Qh, Q01, Q11 = [V0, V2]^T Q [V0, V2]; q_max; the kept
+   terms' rows of V0 and V2 (P0, P1). out->rom is then of kind
+   PHGMG_ROM_QUADRATIC (out->K NULL; the blocks in out->rom).
    X: this rank's rows of the snapshots (nloc x ns, ldx). *out is filled
    on success (zeroed on failure); V0 (nloc x r, ldv0, may be NULL) this
-   rank's rows of the basis (the lift x = V0 xr; SP1: V). Errors: those of
+   rank's rows of the basis (the lift x = V0 xr; SP1: V; GMG_QM: [B, V1],
+   the lift x = V0 xr + V2 q(xr) with V2 not returned). Errors: those of
    phgmg_mpi_gmg_pod_linear (a failing solve's code on every rank),
    PHGMG_ERR_INVALID_ARG / _SIZE / _NANINF for bad terms,
    PHGMG_ERR_NOT_CONVERGED (the ECSW fit misses tol), PHGMG_ERR_UNSUPPORTED.
@@ -29047,6 +29092,13 @@ PHGMG_DEF phgmg_result phgmg_sym_eig(int n, double *A, int lda, double *w, doubl
 
 /*
    REVISION HISTORY
+   0.10.0
+          - New with PHGMG_MPI: phgmg_mpi_reduce does GMG-QM with the POD
+            and greedy manifolds (a narrow V2, qm.rn > 0; fixed lambda; every
+            separable term kept): the serial GMG-QM's phgmg_rom of kind
+            PHGMG_ROM_QUADRATIC, replicated on every rank (manual 2.7). The
+            wide V2, ALTMIN, a chosen lambda and ECSW with GMG-QM return
+            PHGMG_ERR_UNSUPPORTED.
    0.9.0  (2026-11-29)
           - New: the low-rank tools take index-one SPARSE descriptor models
             (phgmg_shifted_create on the whole pencil, phgmg_lrbt with the
