@@ -751,8 +751,8 @@
                             SEPARABLE Hamiltonian (built-in exp-polynomial
                             terms held by the ranks that own their
                             coordinates) with ECSW hyper-reduction (GMG-QM:
-                            the POD and greedy manifolds with a narrow V2,
-                            every term kept): the serial phgmg_reduce's
+                            the POD and greedy manifolds with a narrow V2):
+                            the serial phgmg_reduce's
                             phgmg_rom, replicated, the kept terms as global
                             indices (phgmg_mpi_rom_free)
      phgmg_mpi_agree        one result for all ranks
@@ -815,7 +815,7 @@
    Qh, Bh, env_lo/hi); the kept terms' global term and state indices come
    with it (phgmg_mpi_rom.pts, .coord).
    GMG-QM (opts.method GMG_QM, qm.manifold POD or GREEDY, qm.rn > 0, the
-   fixed qm.lambda, hyper.on = 0) runs the serial pipeline's stages on the
+   fixed qm.lambda) runs the serial pipeline's stages on the
    same data: the adjusted snapshots Xa = X - QB QB^T X and their POD by
    TSQR with as many modes as the serial basis and greedy stages take (the
    same rank floor max(N, ns) eps ||X||_F); V1 the p = r - m leading modes
@@ -828,18 +828,28 @@
    solves give G00, G01, G10, G11 = [V0, V2]^T (J - R)^{-1} [V0, V2], and the
    serial non-degeneracy check of D^T G D (at 0 and at every snapshot, its
    scaling from |V0|^T |G V0|) runs on them; Qh, Q01, Q11 from [V0, V2]^T Q
-   [V0, V2]; every term kept (P0 and P1 its rows of V0 and V2, from its
-   owner); the envelope and q_max from the replicated reduced coordinates.
+   [V0, V2]; the envelope and q_max from the replicated reduced
+   coordinates; the terms: every one (hyper.on = 0), or ECSW as the serial
+   GMG-QM's, on the training rows (u, a) of every stride-th snapshot u
+   (stride = ns r nsep / 4e6 + 1), term k's column phi_k'(x_u[idx_k])
+   (V0[idx_k, a] + V2[idx_k, :] Dq(x2_u)[:, a - m]) formed by the rank that
+   owns it, Dq from the replicated M and reduced coordinates, fitted by the
+   distributed Lawson-Hanson of phgmg_mpi_ecsw at hyper.tol (fewer than 4096
+   live terms: the serial fit screens candidates from there on); P0 and P1
+   the kept terms' rows of V0 and V2, from their owners.
    The result is the serial phgmg_rom of kind PHGMG_ROM_QUADRATIC. On the
    chain below (N = 600, 81 snapshots, r = 8, rn = 4; rn = 3 without the
    cosh terms, whose faster falling spectrum leaves V2's deeper modes less
    well determined) at 1-4 ranks: the basis [B, V1] within 3e-13 (the
    greedy takes the same modes, 2 and 1 of 7 beyond the leading ones),
    every block within 6e-13 relative (after the modes' signs), q_max within
-   1.1e-14, the reduced outputs over 100 steps within 1e-12. Not yet: the
+   1.1e-14, the reduced outputs over 100 steps within 1e-12; with ECSW at
+   hyper.tol 1e-3 (300 terms) the same 56 (POD) and 53 (greedy) points as
+   global indices, weights within 3.4e-13, outputs within 2.9e-12. Not yet: the
    wide V2 (qm.rn = PHGMG_RN_WIDE, the greedy manifold's default: set qm.rn
    > 0), the ALTMIN manifold, a chosen lambda, your own eta
-   (GMG_MANIFOLD), hyper-reduction with GMG-QM (all PHGMG_ERR_UNSUPPORTED).
+   (GMG_MANIFOLD), ECSW with GMG-QM from 4096 live terms (all
+   PHGMG_ERR_UNSUPPORTED).
    Cost beyond GMG-POD: the POD of the residual (one TSQR), r + rn solves
    instead of r, products of N x (r + rn) blocks; memory per rank the
    adjusted snapshots and three N x (r + rn) blocks (still 1/P).
@@ -885,8 +895,8 @@
    solves and about 1.5 GB per rank; the efficiency falls below 90 % near
    16 000 ranks (size ns about 0.6 times the rows per rank), where TSQR's
    replicated stack dominates.
-   Not yet distributed: GMG-QM with a wide V2, ALTMIN, a chosen lambda or
-   hyper-reduction; GMG_MANIFOLD; DEIM hyper-reduction (hyper.kind
+   Not yet distributed: GMG-QM with a wide V2, ALTMIN, a chosen lambda, or
+   ECSW from 4096 live terms; GMG_MANIFOLD; DEIM hyper-reduction (hyper.kind
    QDEIM or GREEDY), separable terms by callbacks and GENERAL nonlinear
    Hamiltonians, a reference state (opts.ref), dampers, feedthrough,
    descriptor models; in the command line (below) also simulating the
@@ -5163,7 +5173,7 @@ typedef struct phgmg_mpi_rom {
 /* The distributed phgmg_reduce of a separable model, with ECSW
    hyper-reduction (opts: method PHGMG_METHOD_GMG_POD, SP1, SP2 or GMG_QM,
    r, hyper.on, hyper.kind ECSW, hyper.tol; GMG_QM: qm.manifold POD or
-   GREEDY, qm.rn > 0, qm.lambda, hyper.on = 0; the other fields zero, else
+   GREEDY, qm.rn > 0, qm.lambda; the other fields zero, else
    PHGMG_ERR_UNSUPPORTED). The serial phgmg_reduce's stages in its order and
    with its formulas: GMG-POD: the basis and the GMG blocks K, Qh, Bh as
    phgmg_mpi_gmg_pod_linear; SP1 (model->JR needed): V the r leading POD
@@ -5188,9 +5198,12 @@ typedef struct phgmg_mpi_rom {
    coordinates (GREEDY); V2 the rn leading POD modes of the residual of
    [B, V1]; M the serial ridge fit at qm.lambda; G00, G01, G10, G11 from
    r + rn solves, the serial non-degeneracy check of D^T G D at 0 and at
-   every snapshot; Qh, Q01, Q11 = [V0, V2]^T Q [V0, V2]; q_max; the kept
-   terms' rows of V0 and V2 (P0, P1). out->rom is then of kind
-   PHGMG_ROM_QUADRATIC (out->K NULL; the blocks in out->rom).
+   every snapshot; Qh, Q01, Q11 = [V0, V2]^T Q [V0, V2]; q_max; ECSW as
+   the serial GMG-QM's (the training rows phi_k'(x_i[idx_k]) Dphi(rho(x_i))
+   [idx_k, :] of every stride-th snapshot, the fit at tol; fewer than 4096
+   live terms, else PHGMG_ERR_UNSUPPORTED); the kept terms' rows of V0 and
+   V2 (P0, P1). out->rom is then of kind PHGMG_ROM_QUADRATIC (out->K NULL;
+   the blocks in out->rom).
    X: this rank's rows of the snapshots (nloc x ns, ldx). *out is filled
    on success (zeroed on failure); V0 (nloc x r, ldv0, may be NULL) this
    rank's rows of the basis (the lift x = V0 xr; SP1: V; GMG_QM: [B, V1],
@@ -26018,12 +26031,34 @@ PHGMG_DEF phgmg_result phgmg_mpi_deim_greedy(const phgmg_mpi_ctx *ctx, int k, co
 }
 
 /* ---- distributed ECSW ------------------------------------------------------------ */
-/* The training column of a term (M = ns r entries, row (i, a) at i + a ns). */
-PHGMG__PRIV void phgmg__mpi_ecsw_col(int ns, int r, const double *F, int ldf, const double *Vt, int ldvt, int k,
-                                     double *col) {
+/* This rank's terms' training columns: separable (G NULL: row (i, a) =
+   F[k, i] Vt[k, a] at i + a ns, M = ns r entries) or given (column k of G,
+   M = the rows). */
+typedef struct phgmg__mpi_cols {
+  int ns, r, ldf, ldvt, ldg;
+  const double *F, *Vt, *G;
+} phgmg__mpi_cols;
+
+/* The training column of a term. */
+PHGMG__PRIV void phgmg__mpi_ecsw_col(const phgmg__mpi_cols *src, int M, int k, double *col) {
+  const int ns = src->ns;
   int i, a;
-  for (a = 0; a < r; ++a)
-    for (i = 0; i < ns; ++i) col[i + (size_t)a * ns] = F[k + (size_t)i * ldf] * Vt[k + (size_t)a * ldvt];
+  if (src->G) { memcpy(col, src->G + (size_t)k * src->ldg, (size_t)M * sizeof(double)); return; }
+  for (a = 0; a < src->r; ++a)
+    for (i = 0; i < ns; ++i) col[i + (size_t)a * ns] = src->F[k + (size_t)i * src->ldf] * src->Vt[k + (size_t)a * src->ldvt];
+}
+
+/* A term's gradient (its column)^T res. */
+PHGMG__PRIV double phgmg__mpi_ecsw_grad(const phgmg__mpi_cols *src, int M, int k, const double *res) {
+  double g = 0.0;
+  int i, a;
+  if (src->G) return phgmg__dot(M, src->G + (size_t)k * src->ldg, res);
+  for (i = 0; i < src->ns; ++i) {   /* g = sum_i F[k, i] (res_i . Vt[k, :]) */
+    double ti = 0.0;
+    for (a = 0; a < src->r; ++a) ti += res[i + (size_t)a * src->ns] * src->Vt[k + (size_t)a * src->ldvt];
+    g += src->F[k + (size_t)i * src->ldf] * ti;
+  }
+  return g;
 }
 
 /* State of the distributed Lawson-Hanson iteration (replicated but the flags). */
@@ -26079,20 +26114,16 @@ PHGMG__PRIV phgmg_result phgmg__mpi_nnls_solve(phgmg__mpi_nnls *s, const phgmg_g
 /* The term of largest positive gradient G_k^T res over all ranks (ties to
    the lower global index) into the passive set: its column broadcast by
    its owner. *none = 1 if no term has a positive gradient. */
-PHGMG__PRIV void phgmg__mpi_nnls_pick(const phgmg_mpi_ctx *ctx, phgmg__mpi_nnls *s, int nt, int ns, int r,
-                                      const double *F, int ldf, const double *Vt, int ldvt, const phgmg_gidx *gid,
-                                      MPI_Datatype t, MPI_Op op, int *none) {
+PHGMG__PRIV void phgmg__mpi_nnls_pick(const phgmg_mpi_ctx *ctx, phgmg__mpi_nnls *s, int nt,
+                                      const phgmg__mpi_cols *src, const phgmg_gidx *gid, MPI_Datatype t, MPI_Op op,
+                                      int *none) {
   phgmg__mpi_vi loc, glob;
-  int k, i, a, owner, lk = -1, lo = ctx->size;
+  int k, owner, lk = -1, lo = ctx->size;
   loc.v = 0.0; loc.i = PHGMG__GIDX_MAX;
   for (k = 0; k < nt; ++k) {
-    double g = 0.0;
+    double g;
     if (s->inP[k]) continue;
-    for (i = 0; i < ns; ++i) {   /* g = sum_i F[k, i] (res_i . Vt[k, :]) */
-      double ti = 0.0;
-      for (a = 0; a < r; ++a) ti += s->res[i + (size_t)a * ns] * Vt[k + (size_t)a * ldvt];
-      g += F[k + (size_t)i * ldf] * ti;
-    }
+    g = phgmg__mpi_ecsw_grad(src, s->M, k, s->res);
     if (g > loc.v || (g == loc.v && g > 0.0 && gid[k] < loc.i)) { loc.v = g; loc.i = gid[k]; lk = k; }
   }
   MPI_Allreduce(&loc, &glob, 1, t, op, ctx->comm);
@@ -26103,7 +26134,7 @@ PHGMG__PRIV void phgmg__mpi_nnls_pick(const phgmg_mpi_ctx *ctx, phgmg__mpi_nnls 
   phgmg__mpi_count(ctx, (double)sizeof loc);
   phgmg__mpi_count(ctx, (double)sizeof(int));
   if (ctx->rank == lo) {
-    phgmg__mpi_ecsw_col(ns, r, F, ldf, Vt, ldvt, lk, s->G + (size_t)s->np * s->M);
+    phgmg__mpi_ecsw_col(src, s->M, lk, s->G + (size_t)s->np * s->M);
     s->inP[lk] = 1;
   }
   MPI_Bcast(s->G + (size_t)s->np * s->M, s->M, MPI_DOUBLE, lo, ctx->comm);
@@ -26126,15 +26157,14 @@ PHGMG__PRIV void phgmg__dd_add(double *hi, double *lo, double v) {
    rank order on every rank, so b is the correctly rounded sum to within
    ~1e-32 relative whatever the partition (the same bits for every P but in
    exceptional rounding ties). ws: 2 M (size + 1) doubles. */
-PHGMG__PRIV void phgmg__mpi_ecsw_target(const phgmg_mpi_ctx *ctx, phgmg__mpi_nnls *s, int nt, int ns, int r,
-                                        const double *F, int ldf, const double *Vt, int ldvt, const double *sw,
-                                        double *ws) {
+PHGMG__PRIV void phgmg__mpi_ecsw_target(const phgmg_mpi_ctx *ctx, phgmg__mpi_nnls *s, int nt,
+                                        const phgmg__mpi_cols *src, const double *sw, double *ws) {
   const int M = s->M;
   double *loc = ws, *all = ws + 2 * (size_t)M;
   int k, i, q;
   memset(loc, 0, 2 * (size_t)M * sizeof(double));
   for (k = 0; k < nt; ++k) {
-    phgmg__mpi_ecsw_col(ns, r, F, ldf, Vt, ldvt, k, s->z);
+    phgmg__mpi_ecsw_col(src, M, k, s->z);
     for (i = 0; i < M; ++i) phgmg__dd_add(loc + i, loc + M + i, (sw ? sw[k] : 1.0) * s->z[i]);
   }
   MPI_Allgather(loc, 2 * M, MPI_DOUBLE, all, 2 * M, MPI_DOUBLE, ctx->comm);
@@ -26160,52 +26190,38 @@ PHGMG__PRIV void phgmg__mpi_ecsw_out(const phgmg__mpi_nnls *s, phgmg_gidx *pts, 
     }
 }
 
-PHGMG_DEF phgmg_result phgmg_mpi_ecsw(const phgmg_mpi_ctx *ctx, int nt, int ns, const double *F, int ldf, int r,
-                                      const double *Vt, int ldvt, const double *sw, const phgmg_gidx *gid,
-                                      double tol, int max_pts, phgmg_gidx *pts, double *w, int *nd_out,
-                                      double *resid_out) {
-  const phgmg_allocator *al;
+/* The distributed Lawson-Hanson fit on checked arguments: M training rows,
+   this rank's nt terms' columns from src (ids gid ascending, weights sw),
+   at most max_pts points, until ||res|| <= tol ||target||. Collective. */
+PHGMG__PRIV phgmg_result phgmg__mpi_ecsw_run(const phgmg_mpi_ctx *ctx, int nt, int M, const phgmg__mpi_cols *src,
+                                             const double *sw, const phgmg_gidx *gid, double tol, int max_pts,
+                                             phgmg_gidx *pts, double *w, int *nd_out, double *resid_out) {
+  const phgmg_allocator *al = &ctx->al;
   phgmg__mpi_nnls s;
-  phgmg_result rc = PHGMG_OK;
+  phgmg_result rc;
   MPI_Datatype t;
   MPI_Op op;
-  double bn = 0.0, rn = 0.0;
+  double bn = 0.0, rn = 0.0, *ws = NULL;
   int none = 0;
-  if (!ctx) return PHGMG_ERR_INVALID_ARG;
-  al = &ctx->al;
   memset(&s, 0, sizeof s);
-  if (ns < 1 || r < 1 || nt < 0 || max_pts < 1 || (nt > 0 && (ldf < nt || ldvt < nt)) ||
-      (double)ns * r > 1e8)
-    rc = PHGMG_ERR_SIZE;
-  else if (!pts || !w || !nd_out || (nt > 0 && (!F || !Vt || !gid)) || tol != tol || tol < 0.0 || tol >= 1.0)
-    rc = PHGMG_ERR_INVALID_ARG;
-  else if (nt > 0 && (!phgmg__mat_finite(nt, ns, F, ldf) || !phgmg__mat_finite(nt, r, Vt, ldvt)))
-    rc = PHGMG_ERR_NANINF;
-  else {
-    s.M = ns * r; s.cap = max_pts;
-    s.G = phgmg__dalloc(al, (size_t)s.M * (max_pts + 3) + 3 * (size_t)max_pts);
-    s.id = PHGMG__CAST(phgmg_gidx *, phgmg__alloc(al, sizeof(phgmg_gidx) * (size_t)max_pts));
-    s.inP = PHGMG__CAST(char *, phgmg__alloc(al, (size_t)nt + 1));
-    if (!s.G || !s.id || !s.inP) rc = PHGMG_ERR_NOMEM;
-  }
-  rc = phgmg__mpi_agree(ctx, rc);
+  s.M = M; s.cap = max_pts;
+  s.G = phgmg__dalloc(al, (size_t)s.M * (max_pts + 3) + 3 * (size_t)max_pts);
+  s.id = PHGMG__CAST(phgmg_gidx *, phgmg__alloc(al, sizeof(phgmg_gidx) * (size_t)max_pts));
+  s.inP = PHGMG__CAST(char *, phgmg__alloc(al, (size_t)nt + 1));
+  ws = phgmg__dalloc(al, 2 * (size_t)s.M * ((size_t)ctx->size + 1));
+  rc = phgmg__mpi_agree(ctx, s.G && s.id && s.inP && ws ? PHGMG_OK : PHGMG_ERR_NOMEM);
   if (rc == PHGMG_OK) {
     s.b = s.G + (size_t)s.M * max_pts; s.res = s.b + s.M; s.z = s.res + s.M; s.x = s.z + PHGMG__MAX(s.M, max_pts);
     memset(s.inP, 0, (size_t)nt + 1);
-    if (tol == 0.0) tol = 1e-6;
     MPI_Type_contiguous((int)sizeof(phgmg__mpi_vi), MPI_BYTE, &t);
     MPI_Type_commit(&t);
     MPI_Op_create(phgmg__mpi_maxloc_fn, 1, &op);
-    double *ws = phgmg__dalloc(al, 2 * (size_t)s.M * ((size_t)ctx->size + 1));
-    if (!ws) rc = PHGMG_ERR_NOMEM;
-    rc = phgmg__mpi_agree(ctx, rc);
-    if (rc == PHGMG_OK) phgmg__mpi_ecsw_target(ctx, &s, nt, ns, r, F, ldf, Vt, ldvt, sw, ws);
-    phgmg__free(al, ws);
+    phgmg__mpi_ecsw_target(ctx, &s, nt, src, sw, ws);
     bn = phgmg_normf(s.M, 1, s.b, s.M);
     phgmg__mpi_nnls_res(&s);
     while (rc == PHGMG_OK && (rn = phgmg_normf(s.M, 1, s.res, s.M)) > tol * bn) {
       if (s.np == max_pts) { rc = PHGMG_ERR_NOT_CONVERGED; break; }
-      phgmg__mpi_nnls_pick(ctx, &s, nt, ns, r, F, ldf, Vt, ldvt, gid, t, op, &none);
+      phgmg__mpi_nnls_pick(ctx, &s, nt, src, gid, t, op, &none);
       if (none) { rc = PHGMG_ERR_NOT_CONVERGED; break; }
       rc = phgmg__mpi_nnls_solve(&s, gid, nt, al);
       phgmg__mpi_nnls_res(&s);
@@ -26216,10 +26232,33 @@ PHGMG_DEF phgmg_result phgmg_mpi_ecsw(const phgmg_mpi_ctx *ctx, int nt, int ns, 
     *nd_out = s.np;
     if (resid_out) *resid_out = bn > 0.0 ? rn / bn : 0.0;
   }
+  phgmg__free(al, ws);
   phgmg__free(al, s.G);
   phgmg__free(al, s.id);
   phgmg__free(al, s.inP);
   return rc;
+}
+
+PHGMG_DEF phgmg_result phgmg_mpi_ecsw(const phgmg_mpi_ctx *ctx, int nt, int ns, const double *F, int ldf, int r,
+                                      const double *Vt, int ldvt, const double *sw, const phgmg_gidx *gid,
+                                      double tol, int max_pts, phgmg_gidx *pts, double *w, int *nd_out,
+                                      double *resid_out) {
+  phgmg__mpi_cols src;
+  phgmg_result rc = PHGMG_OK;
+  if (!ctx) return PHGMG_ERR_INVALID_ARG;
+  if (ns < 1 || r < 1 || nt < 0 || max_pts < 1 || (nt > 0 && (ldf < nt || ldvt < nt)) ||
+      (double)ns * r > 1e8)
+    rc = PHGMG_ERR_SIZE;
+  else if (!pts || !w || !nd_out || (nt > 0 && (!F || !Vt || !gid)) || tol != tol || tol < 0.0 || tol >= 1.0)
+    rc = PHGMG_ERR_INVALID_ARG;
+  else if (nt > 0 && (!phgmg__mat_finite(nt, ns, F, ldf) || !phgmg__mat_finite(nt, r, Vt, ldvt)))
+    rc = PHGMG_ERR_NANINF;
+  rc = phgmg__mpi_agree(ctx, rc);
+  if (rc != PHGMG_OK) return rc;
+  memset(&src, 0, sizeof src);
+  src.ns = ns; src.r = r; src.F = F; src.ldf = ldf; src.Vt = Vt; src.ldvt = ldvt;
+  return phgmg__mpi_ecsw_run(ctx, nt, ns * r, &src, sw, gid, tol == 0.0 ? 1e-6 : tol, max_pts, pts, w, nd_out,
+                             resid_out);
 }
 
 /* ---- distributed sparse operator ------------------------------------------------ */
@@ -26598,8 +26637,8 @@ PHGMG__PRIV phgmg_result phgmg__mpi_sep_check_local(const phgmg_mpi_ctx *ctx, co
   if (qm && ((int)o->qm.manifold < 0 || (int)o->qm.manifold >= (int)PHGMG_MANIFOLD_COUNT || o->qm.rn < PHGMG_RN_WIDE ||
              o->qm.lambda != o->qm.lambda))
     return PHGMG_ERR_INVALID_ARG;
-  /* GMG-QM: the POD and greedy manifolds with a narrow V2, no hyper-reduction */
-  if (qm && (o->qm.manifold == PHGMG_MANIFOLD_ALTMIN || o->qm.rn == PHGMG_RN_WIDE || o->qm.eta || o->hyper.on))
+  /* GMG-QM: the POD and greedy manifolds with a narrow V2 */
+  if (qm && (o->qm.manifold == PHGMG_MANIFOLD_ALTMIN || o->qm.rn == PHGMG_RN_WIDE || o->qm.eta))
     return PHGMG_ERR_UNSUPPORTED;
   if (o->hyper.on && o->hyper.tol < PHGMG__ECSW_TOL_MIN) return PHGMG_ERR_TOL_UNREACHABLE;
   if (md->nsep < 0 || md->poly_deg < 0 || md->poly_deg > 32 || md->nexp < 0 || md->nexp > 8 ||
@@ -27204,12 +27243,67 @@ PHGMG__PRIV phgmg_result phgmg__mpi_sep_all(const phgmg_mpi_ctx *ctx, const phgm
   return rc;
 }
 
+/* GMG-QM's reduced object and the replicated reduced snapshot coordinates
+   XR (r x ns) for its ECSW (phgmg__mpi_qm_ecsw). */
+typedef struct phgmg__mpi_qmfit {
+  const phgmg_reduced *red;
+  const double *XR;
+} phgmg__mpi_qmfit;
+
+/* ECSW of GMG-QM as the serial phgmg__hyper_ecsw_manifold: the training
+   rows (u, a) of every stride-th snapshot (stride = ns r nsg / 4e6 + 1, nsg
+   the model's terms), column of term k: phi_k'(x_i[idx_k]) Dphi(rho(x_i))
+   [idx_k, a] = f (V0[idx_k, a] + (a >= m) V2[idx_k, :] Dq(x2_i)[:, a - m])
+   (t->Vt: the rows of [V0, V2]), the target their sum with the terms'
+   weights, the fit by phgmg__mpi_ecsw_run at tol on these rows (the
+   terms' columns formed by their owners). From PHGMG_ECSW_SCREEN_MIN live
+   terms on (the serial screening) PHGMG_ERR_UNSUPPORTED. Collective. */
+PHGMG__PRIV phgmg_result phgmg__mpi_qm_ecsw(const phgmg_mpi_ctx *ctx, const phgmg__mpi_terms *t, int ns,
+                                            const phgmg__mpi_qmfit *qf, phgmg_gidx nsg, double tol, phgmg_gidx nlg,
+                                            phgmg_gidx *pts, double *w, int *nd, double *rel) {
+  const phgmg_reduced *red = qf->red;
+  const int r = red->r, m = red->m, p = red->p, rn = red->rn, nl = t->nl;
+  const int stride = (int)(((double)ns * r * (double)nsg) / 4e6) + 1, nsu = (ns + stride - 1) / stride;
+  const size_t nrow = (size_t)nsu * r;
+  double *Gm, *Dq;
+  phgmg__mpi_cols src;
+  int u, k, a, j;
+  phgmg_result rc;
+  if (nlg >= PHGMG_ECSW_SCREEN_MIN) return PHGMG_ERR_UNSUPPORTED;   /* nlg: the same on every rank */
+  Gm = phgmg__dalloc(&ctx->al, nrow * (size_t)PHGMG__MAX(nl, 1) + (size_t)rn * p);
+  rc = phgmg__mpi_agree(ctx, Gm ? PHGMG_OK : PHGMG_ERR_NOMEM);
+  if (rc != PHGMG_OK) { phgmg__free(&ctx->al, Gm); return rc; }
+  Dq = Gm + nrow * (size_t)PHGMG__MAX(nl, 1);
+  for (u = 0; u < nsu; ++u) {
+    const int i = u * stride;
+    phgmg__eta_d(red, qf->XR + (size_t)i * r + m, NULL, Dq, NULL, NULL);
+    for (k = 0; k < nl; ++k) {
+      const double f = t->F[k + (size_t)i * nl];
+      double *g = Gm + (size_t)u * r + (size_t)k * nrow;
+      for (a = 0; a < r; ++a) g[a] = f * t->Vt[k + (size_t)a * nl];
+      for (a = 0; a < p; ++a) {
+        double sm = 0.0;
+        for (j = 0; j < rn; ++j) sm += t->Vt[k + (size_t)(r + j) * nl] * Dq[j + (size_t)a * rn];
+        g[m + a] += f * sm;
+      }
+    }
+  }
+  memset(&src, 0, sizeof src);
+  src.G = Gm; src.ldg = (int)nrow;
+  rc = phgmg__mpi_ecsw_run(ctx, nl, (int)nrow, &src, t->sw, t->gid, tol, (int)PHGMG__MIN(nlg, (phgmg_gidx)nrow), pts, w,
+                           nd, rel);
+  phgmg__free(&ctx->al, Gm);
+  return rc;
+}
+
 /* The separable stage: live terms, points and weights (ECSW or all terms),
-   the kept terms' rows fetched; *D (nd x wd) and *pts, *w allocated here. */
+   the kept terms' rows fetched; *D (nd x wd) and *pts, *w allocated here.
+   qf: GMG-QM's (V0: [V0, V2], r their columns; the fit of
+   phgmg__mpi_qm_ecsw), else NULL. */
 PHGMG__PRIV phgmg_result phgmg__mpi_sep_terms(const phgmg_mpi_ctx *ctx, const phgmg_mpi_sep_model *md,
                                               const phgmg_reduce_opts *o, int ns, const double *X, int ldx,
-                                              const double *V0, int r, int wd, phgmg__mpi_romdata *d,
-                                              double *resid) {
+                                              const double *V0, int r, int wd, const phgmg__mpi_qmfit *qf,
+                                              phgmg__mpi_romdata *d, double *resid) {
   const int ld = PHGMG__MAX(1, ctx->nloc);
   phgmg__mpi_terms t;
   phgmg_gidx nlg = 0, nl, nsg = 0, ns1 = md->nsep, room;
@@ -27230,7 +27324,8 @@ PHGMG__PRIV phgmg_result phgmg__mpi_sep_terms(const phgmg_mpi_ctx *ctx, const ph
   *resid = 0.0;
   d->nd = 0;
   if (rc == PHGMG_OK && o->hyper.on && nlg > 0)
-    rc = phgmg__mpi_sep_ecsw(ctx, &t, ns, r, o->hyper.tol, nlg, pts, w, &d->nd, resid);
+    rc = qf ? phgmg__mpi_qm_ecsw(ctx, &t, ns, qf, nsg, o->hyper.tol, nlg, pts, w, &d->nd, resid)
+            : phgmg__mpi_sep_ecsw(ctx, &t, ns, r, o->hyper.tol, nlg, pts, w, &d->nd, resid);
   else if (rc == PHGMG_OK && !o->hyper.on) {
     d->nd = (int)nsg;
     rc = phgmg__mpi_sep_all(ctx, md, d->nd, pts, w);
@@ -27450,16 +27545,18 @@ PHGMG__PRIV phgmg_result phgmg__mpi_qm_reduce(const phgmg_mpi_ctx *ctx, const ph
   }
   if (rc == PHGMG_OK) rc = phgmg__mpi_qm_manifold(ctx, ns, X, ldx, &q);
   if (rc == PHGMG_OK) rc = phgmg__mpi_qm_blocks(ctx, &model->lin, &q);
+  if (rc == PHGMG_OK)   /* the envelope first: ECSW takes the reduced coordinates */
+    rc = phgmg__mpi_sep_envelope(ctx, &model->lin, ns, X, ldx, q.L, r, NULL, red->env,
+                                 q.Z + (size_t)(red->p + red->rn) * ns);
   if (rc == PHGMG_OK) {
+    phgmg__mpi_qmfit qf;
+    qf.red = red; qf.XR = q.c.XRs;
     d.r = r; d.m = m; d.rn = red->rn; d.rv = r + red->rn; d.nc = model->poly_deg + 1; d.ne = model->nexp;
     d.md = model; d.nsv = red->p; d.method = o->method;
     d.Qh = red->Qh; d.Bh = red->Bh; d.S = q.S; d.env = red->env; d.quad = red->G00;
     rc = phgmg__mpi_sep_terms(ctx, model, o, ns, X, ldx, q.L, r + red->rn,
-                              1 + r + red->rn + (model->per_term ? d.nc + 2 * d.ne : 0), &d, &resid);
+                              1 + r + red->rn + (model->per_term ? d.nc + 2 * d.ne : 0), &qf, &d, &resid);
   }
-  if (rc == PHGMG_OK)
-    rc = phgmg__mpi_sep_envelope(ctx, &model->lin, ns, X, ldx, q.L, r, NULL, red->env,
-                                 q.Z + (size_t)(red->p + red->rn) * ns);
   if (rc == PHGMG_OK) rc = phgmg__mpi_agree(ctx, phgmg__q_envelope(&q.c));
   d.nf = model->per_term ? d.nd : 1;
   if (rc == PHGMG_OK) {
@@ -27522,7 +27619,7 @@ PHGMG_DEF phgmg_result phgmg_mpi_reduce(const phgmg_mpi_ctx *ctx, const phgmg_mp
     rc = phgmg_mpi_gmg_pod_linear(ctx, &model->lin, ns, X, ldx, r, b, b + (size_t)r * r, b + 2 * (size_t)r * r,
                                   b + 2 * (size_t)r * r + (size_t)r * m, Vb, ld);
   /* the separable terms (4b), then the training envelope */
-  if (rc == PHGMG_OK) rc = phgmg__mpi_sep_terms(ctx, model, &o, ns, X, ldx, Vb, r, wd, &d, &resid);
+  if (rc == PHGMG_OK) rc = phgmg__mpi_sep_terms(ctx, model, &o, ns, X, ldx, Vb, r, wd, NULL, &d, &resid);
   if (rc == PHGMG_OK)
     rc = phgmg__mpi_sep_envelope(ctx, &model->lin, ns, X, ldx, Vb, r, sp1 ? Wb : NULL,
                                  b + 2 * (size_t)r * r + (size_t)r * m + r, NULL);
@@ -29095,10 +29192,11 @@ PHGMG_DEF phgmg_result phgmg_sym_eig(int n, double *A, int lda, double *w, doubl
    0.10.0
           - New with PHGMG_MPI: phgmg_mpi_reduce does GMG-QM with the POD
             and greedy manifolds (a narrow V2, qm.rn > 0; fixed lambda; every
-            separable term kept): the serial GMG-QM's phgmg_rom of kind
+            separable term kept, or ECSW as the serial GMG-QM's below 4096
+            live terms): the serial GMG-QM's phgmg_rom of kind
             PHGMG_ROM_QUADRATIC, replicated on every rank (manual 2.7). The
-            wide V2, ALTMIN, a chosen lambda and ECSW with GMG-QM return
-            PHGMG_ERR_UNSUPPORTED.
+            wide V2, ALTMIN, a chosen lambda and the screened ECSW with
+            GMG-QM return PHGMG_ERR_UNSUPPORTED.
    0.9.0  (2026-11-29)
           - New: the low-rank tools take index-one SPARSE descriptor models
             (phgmg_shifted_create on the whole pencil, phgmg_lrbt with the
