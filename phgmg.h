@@ -838,21 +838,27 @@
    live terms: the serial fit screens candidates from there on); P0 and P1
    the kept terms' rows of V0 and V2, from their owners.
    The result is the serial phgmg_rom of kind PHGMG_ROM_QUADRATIC. On the
-   chain below (N = 600, 81 snapshots, r = 8, rn = 4; rn = 3 without the
+   damped chain described below, of 300 masses (N = 600, 81 snapshots, r =
+   8, rn = 4; rn = 3 without the
    cosh terms, whose faster falling spectrum leaves V2's deeper modes less
    well determined) at 1-4 ranks: the basis [B, V1] within 3e-13 (the
    greedy takes the same modes, 2 and 1 of 7 beyond the leading ones),
-   every block within 6e-13 relative (after the modes' signs), q_max within
-   1.1e-14, the reduced outputs over 100 steps within 1e-12; with ECSW at
+   every block within 7e-14 relative (after the modes' signs; G01, G10,
+   G11 on the scale of the whole G, Q01 on Qh's), q_max within 1.1e-14,
+   the reduced outputs over 100 steps within 1e-12; with ECSW at
    hyper.tol 1e-3 (300 terms) the same 56 (POD) and 53 (greedy) points as
-   global indices, weights within 3.4e-13, outputs within 2.9e-12. Not yet: the
+   global indices, weights within 3.4e-13, outputs within 2.9e-12. At N =
+   2e5 (the linear chain, bench/README.md) the blocks agree within 1.2e-11
+   and the outputs within 5.3e-11, the same at every P including one: the
+   POD's route (TSQR against the serial SVD), not the partition. Not yet: the
    wide V2 (qm.rn = PHGMG_RN_WIDE, the greedy manifold's default: set qm.rn
    > 0), the ALTMIN manifold, a chosen lambda, your own eta
    (GMG_MANIFOLD), ECSW with GMG-QM from 4096 live terms (all
    PHGMG_ERR_UNSUPPORTED).
    Cost beyond GMG-POD: the POD of the residual (one TSQR), r + rn solves
-   instead of r, products of N x (r + rn) blocks; memory per rank the
-   adjusted snapshots and three N x (r + rn) blocks (still 1/P).
+   instead of r, products of N x (r + rn) blocks; memory per rank its rows
+   of the adjusted snapshots and of three N x (r + rn) blocks, with ECSW its
+   terms' training columns (still 1/P).
    On a damped chain with a cosh
    potential (N = 2000, 1000 terms, r = 12, hyper.tol 1e-3;
    tests/mpi/test_mpi_nl.c) at 1-4 ranks: the singular values within
