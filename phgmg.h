@@ -747,10 +747,12 @@
                             B u (Q as an operator, B's rows, J - R through a
                             collective solve callback: the user's KSP, MUMPS
                             or AMG): K, Qh, Bh of the serial phgmg_reduce
-     phgmg_mpi_reduce       GMG-POD, SP1 or SP2 of a model with a SEPARABLE
-                            Hamiltonian (built-in exp-polynomial terms held
-                            by the ranks that own their coordinates) with
-                            ECSW hyper-reduction: the serial phgmg_reduce's
+     phgmg_mpi_reduce       GMG-POD, SP1, SP2 or GMG-QM of a model with a
+                            SEPARABLE Hamiltonian (built-in exp-polynomial
+                            terms held by the ranks that own their
+                            coordinates) with ECSW hyper-reduction (GMG-QM:
+                            the POD and greedy manifolds with a narrow V2):
+                            the serial phgmg_reduce's
                             phgmg_rom, replicated, the kept terms as global
                             indices (phgmg_mpi_rom_free)
      phgmg_mpi_agree        one result for all ranks
@@ -794,7 +796,7 @@
    sum_k w_k phi_k'(x_j[idx_k]) e_idx_k (SP2; each rank its rows and terms,
    PHGMG_ERR_SIZE below the rounding floor as in the serial SP2), A = V^T
    Vg, W = Vg A^{-1}, K = W^T (J - R) W, Bh = W^T B, Qh = V^T Q V
-   symmetrised, as the serial SP1/SP2) for
+   symmetrised, as the serial SP1/SP2; or GMG-QM, below) for
    H(x) = 1/2 x^T Q x + sum_k w_k phi_k(x[idx_k]) and adds the serial
    separable stage (3.4, 8.7): the
    terms whose argument moves in some snapshot, F = phi_k'(x_i[idx_k]), and
@@ -811,7 +813,53 @@
    training envelope of the reduced snapshot coordinates. The result is the
    phgmg_rom the serial phgmg_reduce builds (P0, w, per-term poly/expo, K,
    Qh, Bh, env_lo/hi); the kept terms' global term and state indices come
-   with it (phgmg_mpi_rom.pts, .coord). On a damped chain with a cosh
+   with it (phgmg_mpi_rom.pts, .coord).
+   GMG-QM (opts.method GMG_QM, qm.manifold POD or GREEDY, qm.rn > 0, the
+   fixed qm.lambda) runs the serial pipeline's stages on the
+   same data: the adjusted snapshots Xa = X - QB QB^T X and their POD by
+   TSQR with as many modes as the serial basis and greedy stages take (the
+   same rank floor max(N, ns) eps ||X||_F); V1 the p = r - m leading modes
+   (POD; V2 the next rn when they lie above the floor, as the serial
+   hierarchical POD) or the greedy choice among the q = min(p + rn,
+   min(N, ns) - 1) leading ones, made by the serial code on their
+   coordinates S = U^T Xa (q x ns, replicated: no communication per trial);
+   V2 the rn leading POD modes of Xa - V1 V1^T Xa; Z1 = V1^T X and Z2 = V2^T
+   Xa replicated, from which the serial ridge problem and fit give M; r + rn
+   solves give G00, G01, G10, G11 = [V0, V2]^T (J - R)^{-1} [V0, V2], and the
+   serial non-degeneracy check of D^T G D (at 0 and at every snapshot, its
+   scaling from |V0|^T |G V0|) runs on them; Qh, Q01, Q11 from [V0, V2]^T Q
+   [V0, V2]; the envelope and q_max from the replicated reduced
+   coordinates; the terms: every one (hyper.on = 0), or ECSW as the serial
+   GMG-QM's, on the training rows (u, a) of every stride-th snapshot u
+   (stride = ns r nsep / 4e6 + 1), term k's column phi_k'(x_u[idx_k])
+   (V0[idx_k, a] + V2[idx_k, :] Dq(x2_u)[:, a - m]) formed by the rank that
+   owns it, Dq from the replicated M and reduced coordinates, fitted by the
+   distributed Lawson-Hanson of phgmg_mpi_ecsw at hyper.tol (fewer than 4096
+   live terms: the serial fit screens candidates from there on); P0 and P1
+   the kept terms' rows of V0 and V2, from their owners.
+   The result is the serial phgmg_rom of kind PHGMG_ROM_QUADRATIC. On the
+   damped chain described below, of 300 masses (N = 600, 81 snapshots, r =
+   8, rn = 4; rn = 3 without the
+   cosh terms, whose faster falling spectrum leaves V2's deeper modes less
+   well determined) at 1-4 ranks: the basis [B, V1] within 3e-13 (the
+   greedy takes the same modes, 2 and 1 of 7 beyond the leading ones),
+   every block within 7e-14 relative (after the modes' signs; G01, G10,
+   G11 on the scale of the whole G, Q01 on Qh's), q_max within 1.1e-14,
+   the reduced outputs over 100 steps within 1e-12; with ECSW at
+   hyper.tol 1e-3 (300 terms) the same 56 (POD) and 53 (greedy) points as
+   global indices, weights within 3.4e-13, outputs within 2.9e-12. At N =
+   2e5 (the linear chain, bench/README.md) the blocks agree within 1.2e-11
+   and the outputs within 5.3e-11, the same at every P including one: the
+   POD's route (TSQR against the serial SVD), not the partition. Not yet: the
+   wide V2 (qm.rn = PHGMG_RN_WIDE, the greedy manifold's default: set qm.rn
+   > 0), the ALTMIN manifold, a chosen lambda, your own eta
+   (GMG_MANIFOLD), ECSW with GMG-QM from 4096 live terms (all
+   PHGMG_ERR_UNSUPPORTED).
+   Cost beyond GMG-POD: the POD of the residual (one TSQR), r + rn solves
+   instead of r, products of N x (r + rn) blocks; memory per rank its rows
+   of the adjusted snapshots and of three N x (r + rn) blocks, with ECSW its
+   terms' training columns (still 1/P).
+   On a damped chain with a cosh
    potential (N = 2000, 1000 terms, r = 12, hyper.tol 1e-3;
    tests/mpi/test_mpi_nl.c) at 1-4 ranks: the singular values within
    3e-16 sigma_1, K within 4e-13 and Qh within 1.3e-15 relative (after the
@@ -853,7 +901,8 @@
    solves and about 1.5 GB per rank; the efficiency falls below 90 % near
    16 000 ranks (size ns about 0.6 times the rows per rank), where TSQR's
    replicated stack dominates.
-   Not yet distributed: GMG-QM, DEIM hyper-reduction (hyper.kind
+   Not yet distributed: GMG-QM with a wide V2, ALTMIN, a chosen lambda, or
+   ECSW from 4096 live terms; GMG_MANIFOLD; DEIM hyper-reduction (hyper.kind
    QDEIM or GREEDY), separable terms by callbacks and GENERAL nonlinear
    Hamiltonians, a reference state (opts.ref), dampers, feedthrough,
    descriptor models; in the command line (below) also simulating the
@@ -5136,8 +5185,9 @@ typedef struct phgmg_mpi_rom {
 } phgmg_mpi_rom;
 
 /* The distributed phgmg_reduce of a separable model, with ECSW
-   hyper-reduction (opts: method PHGMG_METHOD_GMG_POD or PHGMG_METHOD_SP1, r,
-   hyper.on, hyper.kind ECSW, hyper.tol; the other fields zero, else
+   hyper-reduction (opts: method PHGMG_METHOD_GMG_POD, SP1, SP2 or GMG_QM,
+   r, hyper.on, hyper.kind ECSW, hyper.tol; GMG_QM: qm.manifold POD or
+   GREEDY, qm.rn > 0, qm.lambda; the other fields zero, else
    PHGMG_ERR_UNSUPPORTED). The serial phgmg_reduce's stages in its order and
    with its formulas: GMG-POD: the basis and the GMG blocks K, Qh, Bh as
    phgmg_mpi_gmg_pod_linear; SP1 (model->JR needed): V the r leading POD
@@ -5155,9 +5205,23 @@ typedef struct phgmg_mpi_rom {
    functions broadcast by their owners; the training envelope from the
    reduced coordinates of the snapshots. hyper.on = 0:
    every term kept with its weight (nd = all terms: O(terms) online).
+   GMG_QM: the serial GMG-QM's stages with every N-dimensional product
+   distributed: V1 the p = r - m leading POD modes (TSQR) of the adjusted
+   snapshots X - QB QB^T X (POD manifold) or the serial greedy choice among
+   the min(p + rn, min(N, ns) - 1) leading ones, made on their replicated
+   coordinates (GREEDY); V2 the rn leading POD modes of the residual of
+   [B, V1]; M the serial ridge fit at qm.lambda; G00, G01, G10, G11 from
+   r + rn solves, the serial non-degeneracy check of D^T G D at 0 and at
+   every snapshot; Qh, Q01, Q11 = [V0, V2]^T Q [V0, V2]; q_max; ECSW as
+   the serial GMG-QM's (the training rows phi_k'(x_i[idx_k]) Dphi(rho(x_i))
+   [idx_k, :] of every stride-th snapshot, the fit at tol; fewer than 4096
+   live terms, else PHGMG_ERR_UNSUPPORTED); the kept terms' rows of V0 and
+   V2 (P0, P1). out->rom is then of kind PHGMG_ROM_QUADRATIC (out->K NULL;
+   the blocks in out->rom).
    X: this rank's rows of the snapshots (nloc x ns, ldx). *out is filled
    on success (zeroed on failure); V0 (nloc x r, ldv0, may be NULL) this
-   rank's rows of the basis (the lift x = V0 xr; SP1: V). Errors: those of
+   rank's rows of the basis (the lift x = V0 xr; SP1: V; GMG_QM: [B, V1],
+   the lift x = V0 xr + V2 q(xr) with V2 not returned). Errors: those of
    phgmg_mpi_gmg_pod_linear (a failing solve's code on every rank),
    PHGMG_ERR_INVALID_ARG / _SIZE / _NANINF for bad terms,
    PHGMG_ERR_NOT_CONVERGED (the ECSW fit misses tol), PHGMG_ERR_UNSUPPORTED.
@@ -17355,6 +17419,11 @@ typedef struct phgmg__rctx {
      computed), dgref = ||S dga S||_1 (0: unknown) */
   double *dgs, *dga, dgref;
   int dga_ok;
+  /* the snapshots' reduced coordinates given instead of computed from the
+     N-dimensional bases (the distributed GMG-QM, phgmg_mpi_reduce; else
+     NULL): Z1 = V1^T X (p x ns), Z2 = V2^T Xa (rn x ns), XRs = rho of the
+     snapshots (r x ns) */
+  const double *Z1, *Z2, *XRs;
 } phgmg__rctx;
 
 PHGMG__PRIV void phgmg__rctx_free(phgmg__rctx *c) {
@@ -17713,6 +17782,7 @@ PHGMG__PRIV const double *phgmg__snap_v1(const phgmg__rctx *c, int j0, int nb, d
   const phgmg_reduced *red = c->red;
   const int N = red->N, m = red->m, p = red->p;
   if (c->sf == PHGMG__SF_GMG) { *ld = c->st->ka; return c->st->Ca + (size_t)j0 * c->st->ka; }
+  if (c->Z1) { *ld = p; return c->Z1 + (size_t)j0 * p; }
   phgmg_gemm('T', 'N', p, nb, N, 1.0, red->V0 + (size_t)N * m, N, c->X + (size_t)j0 * c->ldx, c->ldx, 0.0, buf, p);
   *ld = p;
   return buf;
@@ -17721,6 +17791,7 @@ PHGMG__PRIV const double *phgmg__snap_v2(const phgmg__rctx *c, int j0, int nb, d
   const phgmg_reduced *red = c->red;
   const int N = red->N, rn = red->rn;
   if (c->sf == PHGMG__SF_GMG) { *ld = c->st->ka; return c->st->Ca + (size_t)j0 * c->st->ka + red->p; }
+  if (c->Z2) { *ld = rn; return c->Z2 + (size_t)j0 * rn; }
   phgmg_gemm('T', 'N', rn, nb, N, 1.0, red->V2, N, c->Xa + (size_t)j0 * N, N, 0.0, buf, rn);
   *ld = rn;
   return buf;
@@ -17792,37 +17863,22 @@ PHGMG__PRIV phgmg_result phgmg__qm_lambda_auto(phgmg__rctx *c) {
   return PHGMG_OK;
 }
 
-/* opts.qm.manifold = 1, greedy linear part (Schwerdtner & Peherstorfer 2024):
-   among the q = min(p + rn, available) leading POD modes U of the adjusted
-   snapshots, V1 takes one mode at a time -- the one whose reduced
-   coordinates z (with those already taken) best predict the remaining
-   modes' coordinates by the quadratic ridge fit M (z kron z) (ridge lambda
-   1e-9 when lambda is chosen, whose lambda is not known yet; else opts.qm.lambda). Works in the
-   q POD coordinates S = U^T Xa of every k-th snapshot (k = ceil(ns / 400)),
-   so a trial costs one small least-squares solve. Writes V1 into red->V0. */
-PHGMG__PRIV phgmg_result phgmg__qm_greedy(phgmg__rctx *c) {
-  phgmg_reduced *red = c->red;
-  const int N = red->N, m = red->m, p = red->p, rn = red->rn, ns = c->ns;
+/* The greedy choice of phgmg__qm_greedy on the q POD coordinates S (q x
+   ns, ld q) of the adjusted snapshots: for j = 0 .. p - 1 the mode k not
+   taken whose coordinates (with those of sel[0 .. j-1]) best predict the
+   remaining modes' coordinates by the ridge fit (lambda lam) on every st-th
+   snapshot (st = ceil(ns / 400)); ties to the lower k. sel: 2 q ints (the
+   chosen modes in sel[0 .. p-1]). Works on small data only: the serial and
+   the distributed reductions (phgmg_mpi_reduce) call it on the same S. */
+PHGMG__PRIV phgmg_result phgmg__qm_greedy_select(int p, int q, int ns, const double *S, double lam, int *sel,
+                                                 const phgmg_allocator *alloc) {
   const int st = (ns + 399) / 400, nsub = (ns + st - 1) / st;
-  const int navail = c->o->cache.pod_basis ? c->o->cache.pod_cols : PHGMG__MIN(N, ns) - 1;
-  const int q = PHGMG__MIN(p + rn, navail);
-  const double lam = c->o->select.lambda_mode != PHGMG_LAMBDA_FIXED ? 1e-9 : (c->lambda > 0.0 ? c->lambda : 1e-12);
-  double *U, *S, *Kt, *Rt, *T, best_err;
-  int *sel, *used, j, k, a, b, i, cc, best, nc, nr, kk = 0;
+  double *Kt, *Rt, *T, best_err;
+  int *used = sel + q, j, k, a, b, i, cc, best, nc, nr;
   phgmg_result rc = PHGMG_OK;
-  if (q <= p) return PHGMG_OK;   /* no choice: the leading modes */
-  U = phgmg__dalloc(c->alloc, (size_t)N * q + (size_t)q * ns + (size_t)q);
-  Kt = phgmg__dalloc(c->alloc, (size_t)nsub * (p * (p + 1) / 2) + (size_t)nsub * q + (size_t)(p * (p + 1) / 2) * q);
-  sel = phgmg__ialloc(c->alloc, 2 * (size_t)q);
-  if (!U || !Kt || !sel) { phgmg__free(c->alloc, U); phgmg__free(c->alloc, Kt); phgmg__free(c->alloc, sel); return PHGMG_ERR_NOMEM; }
-  S = U + (size_t)N * q; Rt = Kt + (size_t)nsub * (p * (p + 1) / 2); T = Rt + (size_t)nsub * q;
-  used = sel + q;
-  if (c->o->cache.pod_basis) memcpy(U, c->o->cache.pod_basis, (size_t)N * q * sizeof(double));
-  else {
-    rc = phgmg_pod(N, ns, c->Xa, N, q, 0.0, U, N, S, &kk, c->alloc);
-    if (rc == PHGMG_OK && kk < q) rc = PHGMG_ERR_SIZE;
-  }
-  if (rc == PHGMG_OK) phgmg_gemm('T', 'N', q, ns, N, 1.0, U, N, c->Xa, N, 0.0, S, q);
+  Kt = phgmg__dalloc(alloc, (size_t)nsub * (p * (p + 1) / 2) + (size_t)nsub * q + (size_t)(p * (p + 1) / 2) * q);
+  if (!Kt) return PHGMG_ERR_NOMEM;
+  Rt = Kt + (size_t)nsub * (p * (p + 1) / 2); T = Rt + (size_t)nsub * q;
   for (k = 0; k < q; ++k) used[k] = 0;
   for (j = 0; j < p && rc == PHGMG_OK; ++j) {
     best = -1; best_err = HUGE_VAL;
@@ -17839,7 +17895,7 @@ PHGMG__PRIV phgmg_result phgmg__qm_greedy(phgmg__rctx *c) {
           if (!used[a] && a != k) Rt[i + (size_t)(cc++) * nsub] = s[a];
       }
       if (nr > 0) {
-        rc = phgmg_lstsq(nsub, nc, nr, Kt, nsub, Rt, nsub, lam, T, nc, c->alloc);
+        rc = phgmg_lstsq(nsub, nc, nr, Kt, nsub, Rt, nsub, lam, T, nc, alloc);
         if (rc != PHGMG_OK) break;
         for (a = 0; a < nr; ++a)
           for (i = 0; i < nsub; ++i) {
@@ -17854,10 +17910,48 @@ PHGMG__PRIV phgmg_result phgmg__qm_greedy(phgmg__rctx *c) {
     sel[j] = best;
     used[best] = 1;
   }
+  phgmg__free(alloc, Kt);
+  return rc;
+}
+
+/* The greedy's ridge lambda: 1e-9 when lambda is chosen (not known yet),
+   else opts.qm.lambda (1e-12 for an exactly zero one). */
+PHGMG__PRIV double phgmg__qm_greedy_lambda(const phgmg_reduce_opts *o, double lambda) {
+  return o->select.lambda_mode != PHGMG_LAMBDA_FIXED ? 1e-9 : (lambda > 0.0 ? lambda : 1e-12);
+}
+
+/* opts.qm.manifold = 1, greedy linear part (Schwerdtner & Peherstorfer 2024):
+   among the q = min(p + rn, available) leading POD modes U of the adjusted
+   snapshots, V1 takes one mode at a time -- the one whose reduced
+   coordinates z (with those already taken) best predict the remaining
+   modes' coordinates by the quadratic ridge fit M (z kron z) (ridge lambda
+   1e-9 when lambda is chosen, whose lambda is not known yet; else opts.qm.lambda). Works in the
+   q POD coordinates S = U^T Xa of every k-th snapshot (k = ceil(ns / 400)),
+   so a trial costs one small least-squares solve (phgmg__qm_greedy_select).
+   Writes V1 into red->V0. */
+PHGMG__PRIV phgmg_result phgmg__qm_greedy(phgmg__rctx *c) {
+  phgmg_reduced *red = c->red;
+  const int N = red->N, m = red->m, p = red->p, rn = red->rn, ns = c->ns;
+  const int navail = c->o->cache.pod_basis ? c->o->cache.pod_cols : PHGMG__MIN(N, ns) - 1;
+  const int q = PHGMG__MIN(p + rn, navail);
+  double *U, *S;
+  int *sel, j, kk = 0;
+  phgmg_result rc = PHGMG_OK;
+  if (q <= p) return PHGMG_OK;   /* no choice: the leading modes */
+  U = phgmg__dalloc(c->alloc, (size_t)N * q + (size_t)q * ns + (size_t)q);
+  sel = phgmg__ialloc(c->alloc, 2 * (size_t)q);
+  if (!U || !sel) { phgmg__free(c->alloc, U); phgmg__free(c->alloc, sel); return PHGMG_ERR_NOMEM; }
+  S = U + (size_t)N * q;
+  if (c->o->cache.pod_basis) memcpy(U, c->o->cache.pod_basis, (size_t)N * q * sizeof(double));
+  else {
+    rc = phgmg_pod(N, ns, c->Xa, N, q, 0.0, U, N, S, &kk, c->alloc);
+    if (rc == PHGMG_OK && kk < q) rc = PHGMG_ERR_SIZE;
+  }
+  if (rc == PHGMG_OK) phgmg_gemm('T', 'N', q, ns, N, 1.0, U, N, c->Xa, N, 0.0, S, q);
+  if (rc == PHGMG_OK) rc = phgmg__qm_greedy_select(p, q, ns, S, phgmg__qm_greedy_lambda(c->o, c->lambda), sel, c->alloc);
   if (rc == PHGMG_OK)
     for (j = 0; j < p; ++j) memcpy(red->V0 + (size_t)N * (m + j), U + (size_t)N * sel[j], (size_t)N * sizeof(double));
   phgmg__free(c->alloc, U);
-  phgmg__free(c->alloc, Kt);
   phgmg__free(c->alloc, sel);
   return rc;
 }
@@ -18759,8 +18853,8 @@ PHGMG_DEF phgmg_result phgmg_simulate_inputs(const phgmg_ph_system *sys, int nru
 }
 
 /* XR (r x ns) = rho of the snapshots: from the study's coordinates on its
-   bases (GMG: [RB^{-1} QB^T x; Ua_1..p^T Xa]; SP: Ainv^T Vg^T x), else
-   phgmg__restrict_block. */
+   bases (GMG: [RB^{-1} QB^T x; Ua_1..p^T Xa]; SP: Ainv^T Vg^T x), or
+   the given ones (c->XRs), else phgmg__restrict_block. */
 PHGMG__PRIV void phgmg__restrict_snapshots(const phgmg__rctx *c, double *XR) {
   const phgmg_reduced *red = c->red;
   const phgmg_study *st = c->st;
@@ -18781,6 +18875,8 @@ PHGMG__PRIV void phgmg__restrict_snapshots(const phgmg__rctx *c, double *XR) {
     const double *Cv = c->sf == PHGMG__SF_SP1 ? st->Cq : st->Cg;
     const int ld = c->sf == PHGMG__SF_SP1 ? st->kp : st->kg;
     phgmg_gemm('T', 'N', r, ns, r, 1.0, red->Ainv, r, Cv, ld, 0.0, XR, r);
+  } else if (c->XRs) {
+    memcpy(XR, c->XRs, (size_t)r * ns * sizeof(double));
   } else {
     phgmg__restrict_block(red, ns, c->Xf, c->ldxf, XR);
   }
@@ -25999,12 +26095,34 @@ PHGMG_DEF phgmg_result phgmg_mpi_deim_greedy(const phgmg_mpi_ctx *ctx, int k, co
 }
 
 /* ---- distributed ECSW ------------------------------------------------------------ */
-/* The training column of a term (M = ns r entries, row (i, a) at i + a ns). */
-PHGMG__PRIV void phgmg__mpi_ecsw_col(int ns, int r, const double *F, int ldf, const double *Vt, int ldvt, int k,
-                                     double *col) {
+/* This rank's terms' training columns: separable (G NULL: row (i, a) =
+   F[k, i] Vt[k, a] at i + a ns, M = ns r entries) or given (column k of G,
+   M = the rows). */
+typedef struct phgmg__mpi_cols {
+  int ns, r, ldf, ldvt, ldg;
+  const double *F, *Vt, *G;
+} phgmg__mpi_cols;
+
+/* The training column of a term. */
+PHGMG__PRIV void phgmg__mpi_ecsw_col(const phgmg__mpi_cols *src, int M, int k, double *col) {
+  const int ns = src->ns;
   int i, a;
-  for (a = 0; a < r; ++a)
-    for (i = 0; i < ns; ++i) col[i + (size_t)a * ns] = F[k + (size_t)i * ldf] * Vt[k + (size_t)a * ldvt];
+  if (src->G) { memcpy(col, src->G + (size_t)k * src->ldg, (size_t)M * sizeof(double)); return; }
+  for (a = 0; a < src->r; ++a)
+    for (i = 0; i < ns; ++i) col[i + (size_t)a * ns] = src->F[k + (size_t)i * src->ldf] * src->Vt[k + (size_t)a * src->ldvt];
+}
+
+/* A term's gradient (its column)^T res. */
+PHGMG__PRIV double phgmg__mpi_ecsw_grad(const phgmg__mpi_cols *src, int M, int k, const double *res) {
+  double g = 0.0;
+  int i, a;
+  if (src->G) return phgmg__dot(M, src->G + (size_t)k * src->ldg, res);
+  for (i = 0; i < src->ns; ++i) {   /* g = sum_i F[k, i] (res_i . Vt[k, :]) */
+    double ti = 0.0;
+    for (a = 0; a < src->r; ++a) ti += res[i + (size_t)a * src->ns] * src->Vt[k + (size_t)a * src->ldvt];
+    g += src->F[k + (size_t)i * src->ldf] * ti;
+  }
+  return g;
 }
 
 /* State of the distributed Lawson-Hanson iteration (replicated but the flags). */
@@ -26060,20 +26178,16 @@ PHGMG__PRIV phgmg_result phgmg__mpi_nnls_solve(phgmg__mpi_nnls *s, const phgmg_g
 /* The term of largest positive gradient G_k^T res over all ranks (ties to
    the lower global index) into the passive set: its column broadcast by
    its owner. *none = 1 if no term has a positive gradient. */
-PHGMG__PRIV void phgmg__mpi_nnls_pick(const phgmg_mpi_ctx *ctx, phgmg__mpi_nnls *s, int nt, int ns, int r,
-                                      const double *F, int ldf, const double *Vt, int ldvt, const phgmg_gidx *gid,
-                                      MPI_Datatype t, MPI_Op op, int *none) {
+PHGMG__PRIV void phgmg__mpi_nnls_pick(const phgmg_mpi_ctx *ctx, phgmg__mpi_nnls *s, int nt,
+                                      const phgmg__mpi_cols *src, const phgmg_gidx *gid, MPI_Datatype t, MPI_Op op,
+                                      int *none) {
   phgmg__mpi_vi loc, glob;
-  int k, i, a, owner, lk = -1, lo = ctx->size;
+  int k, owner, lk = -1, lo = ctx->size;
   loc.v = 0.0; loc.i = PHGMG__GIDX_MAX;
   for (k = 0; k < nt; ++k) {
-    double g = 0.0;
+    double g;
     if (s->inP[k]) continue;
-    for (i = 0; i < ns; ++i) {   /* g = sum_i F[k, i] (res_i . Vt[k, :]) */
-      double ti = 0.0;
-      for (a = 0; a < r; ++a) ti += s->res[i + (size_t)a * ns] * Vt[k + (size_t)a * ldvt];
-      g += F[k + (size_t)i * ldf] * ti;
-    }
+    g = phgmg__mpi_ecsw_grad(src, s->M, k, s->res);
     if (g > loc.v || (g == loc.v && g > 0.0 && gid[k] < loc.i)) { loc.v = g; loc.i = gid[k]; lk = k; }
   }
   MPI_Allreduce(&loc, &glob, 1, t, op, ctx->comm);
@@ -26084,7 +26198,7 @@ PHGMG__PRIV void phgmg__mpi_nnls_pick(const phgmg_mpi_ctx *ctx, phgmg__mpi_nnls 
   phgmg__mpi_count(ctx, (double)sizeof loc);
   phgmg__mpi_count(ctx, (double)sizeof(int));
   if (ctx->rank == lo) {
-    phgmg__mpi_ecsw_col(ns, r, F, ldf, Vt, ldvt, lk, s->G + (size_t)s->np * s->M);
+    phgmg__mpi_ecsw_col(src, s->M, lk, s->G + (size_t)s->np * s->M);
     s->inP[lk] = 1;
   }
   MPI_Bcast(s->G + (size_t)s->np * s->M, s->M, MPI_DOUBLE, lo, ctx->comm);
@@ -26107,15 +26221,14 @@ PHGMG__PRIV void phgmg__dd_add(double *hi, double *lo, double v) {
    rank order on every rank, so b is the correctly rounded sum to within
    ~1e-32 relative whatever the partition (the same bits for every P but in
    exceptional rounding ties). ws: 2 M (size + 1) doubles. */
-PHGMG__PRIV void phgmg__mpi_ecsw_target(const phgmg_mpi_ctx *ctx, phgmg__mpi_nnls *s, int nt, int ns, int r,
-                                        const double *F, int ldf, const double *Vt, int ldvt, const double *sw,
-                                        double *ws) {
+PHGMG__PRIV void phgmg__mpi_ecsw_target(const phgmg_mpi_ctx *ctx, phgmg__mpi_nnls *s, int nt,
+                                        const phgmg__mpi_cols *src, const double *sw, double *ws) {
   const int M = s->M;
   double *loc = ws, *all = ws + 2 * (size_t)M;
   int k, i, q;
   memset(loc, 0, 2 * (size_t)M * sizeof(double));
   for (k = 0; k < nt; ++k) {
-    phgmg__mpi_ecsw_col(ns, r, F, ldf, Vt, ldvt, k, s->z);
+    phgmg__mpi_ecsw_col(src, M, k, s->z);
     for (i = 0; i < M; ++i) phgmg__dd_add(loc + i, loc + M + i, (sw ? sw[k] : 1.0) * s->z[i]);
   }
   MPI_Allgather(loc, 2 * M, MPI_DOUBLE, all, 2 * M, MPI_DOUBLE, ctx->comm);
@@ -26141,52 +26254,38 @@ PHGMG__PRIV void phgmg__mpi_ecsw_out(const phgmg__mpi_nnls *s, phgmg_gidx *pts, 
     }
 }
 
-PHGMG_DEF phgmg_result phgmg_mpi_ecsw(const phgmg_mpi_ctx *ctx, int nt, int ns, const double *F, int ldf, int r,
-                                      const double *Vt, int ldvt, const double *sw, const phgmg_gidx *gid,
-                                      double tol, int max_pts, phgmg_gidx *pts, double *w, int *nd_out,
-                                      double *resid_out) {
-  const phgmg_allocator *al;
+/* The distributed Lawson-Hanson fit on checked arguments: M training rows,
+   this rank's nt terms' columns from src (ids gid ascending, weights sw),
+   at most max_pts points, until ||res|| <= tol ||target||. Collective. */
+PHGMG__PRIV phgmg_result phgmg__mpi_ecsw_run(const phgmg_mpi_ctx *ctx, int nt, int M, const phgmg__mpi_cols *src,
+                                             const double *sw, const phgmg_gidx *gid, double tol, int max_pts,
+                                             phgmg_gidx *pts, double *w, int *nd_out, double *resid_out) {
+  const phgmg_allocator *al = &ctx->al;
   phgmg__mpi_nnls s;
-  phgmg_result rc = PHGMG_OK;
+  phgmg_result rc;
   MPI_Datatype t;
   MPI_Op op;
-  double bn = 0.0, rn = 0.0;
+  double bn = 0.0, rn = 0.0, *ws = NULL;
   int none = 0;
-  if (!ctx) return PHGMG_ERR_INVALID_ARG;
-  al = &ctx->al;
   memset(&s, 0, sizeof s);
-  if (ns < 1 || r < 1 || nt < 0 || max_pts < 1 || (nt > 0 && (ldf < nt || ldvt < nt)) ||
-      (double)ns * r > 1e8)
-    rc = PHGMG_ERR_SIZE;
-  else if (!pts || !w || !nd_out || (nt > 0 && (!F || !Vt || !gid)) || tol != tol || tol < 0.0 || tol >= 1.0)
-    rc = PHGMG_ERR_INVALID_ARG;
-  else if (nt > 0 && (!phgmg__mat_finite(nt, ns, F, ldf) || !phgmg__mat_finite(nt, r, Vt, ldvt)))
-    rc = PHGMG_ERR_NANINF;
-  else {
-    s.M = ns * r; s.cap = max_pts;
-    s.G = phgmg__dalloc(al, (size_t)s.M * (max_pts + 3) + 3 * (size_t)max_pts);
-    s.id = PHGMG__CAST(phgmg_gidx *, phgmg__alloc(al, sizeof(phgmg_gidx) * (size_t)max_pts));
-    s.inP = PHGMG__CAST(char *, phgmg__alloc(al, (size_t)nt + 1));
-    if (!s.G || !s.id || !s.inP) rc = PHGMG_ERR_NOMEM;
-  }
-  rc = phgmg__mpi_agree(ctx, rc);
+  s.M = M; s.cap = max_pts;
+  s.G = phgmg__dalloc(al, (size_t)s.M * (max_pts + 3) + 3 * (size_t)max_pts);
+  s.id = PHGMG__CAST(phgmg_gidx *, phgmg__alloc(al, sizeof(phgmg_gidx) * (size_t)max_pts));
+  s.inP = PHGMG__CAST(char *, phgmg__alloc(al, (size_t)nt + 1));
+  ws = phgmg__dalloc(al, 2 * (size_t)s.M * ((size_t)ctx->size + 1));
+  rc = phgmg__mpi_agree(ctx, s.G && s.id && s.inP && ws ? PHGMG_OK : PHGMG_ERR_NOMEM);
   if (rc == PHGMG_OK) {
     s.b = s.G + (size_t)s.M * max_pts; s.res = s.b + s.M; s.z = s.res + s.M; s.x = s.z + PHGMG__MAX(s.M, max_pts);
     memset(s.inP, 0, (size_t)nt + 1);
-    if (tol == 0.0) tol = 1e-6;
     MPI_Type_contiguous((int)sizeof(phgmg__mpi_vi), MPI_BYTE, &t);
     MPI_Type_commit(&t);
     MPI_Op_create(phgmg__mpi_maxloc_fn, 1, &op);
-    double *ws = phgmg__dalloc(al, 2 * (size_t)s.M * ((size_t)ctx->size + 1));
-    if (!ws) rc = PHGMG_ERR_NOMEM;
-    rc = phgmg__mpi_agree(ctx, rc);
-    if (rc == PHGMG_OK) phgmg__mpi_ecsw_target(ctx, &s, nt, ns, r, F, ldf, Vt, ldvt, sw, ws);
-    phgmg__free(al, ws);
+    phgmg__mpi_ecsw_target(ctx, &s, nt, src, sw, ws);
     bn = phgmg_normf(s.M, 1, s.b, s.M);
     phgmg__mpi_nnls_res(&s);
     while (rc == PHGMG_OK && (rn = phgmg_normf(s.M, 1, s.res, s.M)) > tol * bn) {
       if (s.np == max_pts) { rc = PHGMG_ERR_NOT_CONVERGED; break; }
-      phgmg__mpi_nnls_pick(ctx, &s, nt, ns, r, F, ldf, Vt, ldvt, gid, t, op, &none);
+      phgmg__mpi_nnls_pick(ctx, &s, nt, src, gid, t, op, &none);
       if (none) { rc = PHGMG_ERR_NOT_CONVERGED; break; }
       rc = phgmg__mpi_nnls_solve(&s, gid, nt, al);
       phgmg__mpi_nnls_res(&s);
@@ -26197,10 +26296,33 @@ PHGMG_DEF phgmg_result phgmg_mpi_ecsw(const phgmg_mpi_ctx *ctx, int nt, int ns, 
     *nd_out = s.np;
     if (resid_out) *resid_out = bn > 0.0 ? rn / bn : 0.0;
   }
+  phgmg__free(al, ws);
   phgmg__free(al, s.G);
   phgmg__free(al, s.id);
   phgmg__free(al, s.inP);
   return rc;
+}
+
+PHGMG_DEF phgmg_result phgmg_mpi_ecsw(const phgmg_mpi_ctx *ctx, int nt, int ns, const double *F, int ldf, int r,
+                                      const double *Vt, int ldvt, const double *sw, const phgmg_gidx *gid,
+                                      double tol, int max_pts, phgmg_gidx *pts, double *w, int *nd_out,
+                                      double *resid_out) {
+  phgmg__mpi_cols src;
+  phgmg_result rc = PHGMG_OK;
+  if (!ctx) return PHGMG_ERR_INVALID_ARG;
+  if (ns < 1 || r < 1 || nt < 0 || max_pts < 1 || (nt > 0 && (ldf < nt || ldvt < nt)) ||
+      (double)ns * r > 1e8)
+    rc = PHGMG_ERR_SIZE;
+  else if (!pts || !w || !nd_out || (nt > 0 && (!F || !Vt || !gid)) || tol != tol || tol < 0.0 || tol >= 1.0)
+    rc = PHGMG_ERR_INVALID_ARG;
+  else if (nt > 0 && (!phgmg__mat_finite(nt, ns, F, ldf) || !phgmg__mat_finite(nt, r, Vt, ldvt)))
+    rc = PHGMG_ERR_NANINF;
+  rc = phgmg__mpi_agree(ctx, rc);
+  if (rc != PHGMG_OK) return rc;
+  memset(&src, 0, sizeof src);
+  src.ns = ns; src.r = r; src.F = F; src.ldf = ldf; src.Vt = Vt; src.ldvt = ldvt;
+  return phgmg__mpi_ecsw_run(ctx, nt, ns * r, &src, sw, gid, tol == 0.0 ? 1e-6 : tol, max_pts, pts, w, nd_out,
+                             resid_out);
 }
 
 /* ---- distributed sparse operator ------------------------------------------------ */
@@ -26439,20 +26561,16 @@ PHGMG_DEF phgmg_result phgmg_mpi_op_project(const phgmg_mpi_op *op, int k, const
 }
 
 /* ---- distributed GMG-POD of a linear model -------------------------------------- */
-/* V0 (ld max(1, nloc)) = [B, V1]: QB = TSQR(B) (rank checked as the serial
-   reduction does), V1 = the p leading POD modes of X - QB QB^T X; S (p). */
-PHGMG__PRIV phgmg_result phgmg__mpi_gmg_basis(const phgmg_mpi_ctx *ctx, const phgmg_mpi_linear_model *md, int ns,
-                                              const double *X, int ldx, int p, double *V0, double *S) {
+/* The adjusted snapshots Xa (ld max(1, nloc) x ns) = X - QB QB^T X, QB =
+   TSQR(B) (B's rank checked as the serial reduction does). Collective. */
+PHGMG__PRIV phgmg_result phgmg__mpi_adjust(const phgmg_mpi_ctx *ctx, const phgmg_mpi_linear_model *md, int ns,
+                                           const double *X, int ldx, double *Xa) {
   const int n = ctx->nloc, ld = PHGMG__MAX(1, n), m = md->m;
-  const int kk = (int)PHGMG__MIN((phgmg_gidx)PHGMG__MIN(p + 1, ns), ctx->N);
-  double *QB = phgmg__dalloc(&ctx->al, (size_t)ld * m + (size_t)m * m + (size_t)m * ns + (size_t)ld * ns +
-                                           (size_t)ld * kk + (size_t)kk + phgmg__mpi_pod_ws(ctx, ns, kk));
-  double *RB, *C, *Xa, *V1, *s, *ws, rmax = 0.0;
-  int j, k = 0;
+  double *QB = phgmg__dalloc(&ctx->al, (size_t)ld * m + (size_t)m * m + (size_t)m * ns), *RB, *C, rmax = 0.0;
+  int j;
   phgmg_result rc = phgmg__mpi_agree(ctx, QB ? PHGMG_OK : PHGMG_ERR_NOMEM);
   if (rc != PHGMG_OK) { phgmg__free(&ctx->al, QB); return rc; }
-  RB = QB + (size_t)ld * m; C = RB + (size_t)m * m; Xa = C + (size_t)m * ns; V1 = Xa + (size_t)ld * ns;
-  s = V1 + (size_t)ld * kk; ws = s + kk;
+  RB = QB + (size_t)ld * m; C = RB + (size_t)m * m;
   rc = phgmg_mpi_tsqr(ctx, m, md->B, md->ldb, QB, ld, RB, m);
   for (j = 0; j < m && rc == PHGMG_OK; ++j) rmax = PHGMG__MAX(rmax, fabs(RB[j + j * m]));
   for (j = 0; j < m && rc == PHGMG_OK; ++j)
@@ -26461,15 +26579,32 @@ PHGMG__PRIV phgmg_result phgmg__mpi_gmg_basis(const phgmg_mpi_ctx *ctx, const ph
   if (rc == PHGMG_OK) {
     for (j = 0; j < ns && n > 0; ++j) memcpy(Xa + (size_t)j * ld, X + (size_t)j * ldx, (size_t)n * sizeof(double));
     if (n > 0) phgmg_gemm('N', 'N', n, ns, m, -1.0, QB, ld, C, m, 1.0, Xa, ld);
-    rc = phgmg__mpi_pod_core(ctx, ns, Xa, ld, kk, 0.0, V1, ld, s, &k, Xa, ws);   /* Xa factored in place */
   }
+  phgmg__free(&ctx->al, QB);
+  return rc;
+}
+
+/* V0 (ld max(1, nloc)) = [B, V1]: V1 = the p leading POD modes of the
+   adjusted snapshots (phgmg__mpi_adjust); S (p). */
+PHGMG__PRIV phgmg_result phgmg__mpi_gmg_basis(const phgmg_mpi_ctx *ctx, const phgmg_mpi_linear_model *md, int ns,
+                                              const double *X, int ldx, int p, double *V0, double *S) {
+  const int n = ctx->nloc, ld = PHGMG__MAX(1, n), m = md->m;
+  const int kk = (int)PHGMG__MIN((phgmg_gidx)PHGMG__MIN(p + 1, ns), ctx->N);
+  double *Xa = phgmg__dalloc(&ctx->al, (size_t)ld * ns + (size_t)ld * kk + (size_t)kk + phgmg__mpi_pod_ws(ctx, ns, kk));
+  double *V1, *s, *ws;
+  int j, k = 0;
+  phgmg_result rc = phgmg__mpi_agree(ctx, Xa ? PHGMG_OK : PHGMG_ERR_NOMEM);
+  if (rc != PHGMG_OK) { phgmg__free(&ctx->al, Xa); return rc; }
+  V1 = Xa + (size_t)ld * ns; s = V1 + (size_t)ld * kk; ws = s + kk;
+  rc = phgmg__mpi_adjust(ctx, md, ns, X, ldx, Xa);
+  if (rc == PHGMG_OK) rc = phgmg__mpi_pod_core(ctx, ns, Xa, ld, kk, 0.0, V1, ld, s, &k, Xa, ws);   /* Xa factored in place */
   if (rc == PHGMG_OK && k < p) rc = PHGMG_ERR_SIZE;   /* r - m beyond the numerical rank */
   if (rc == PHGMG_OK) {
     for (j = 0; j < m && n > 0; ++j) memcpy(V0 + (size_t)j * ld, md->B + (size_t)j * md->ldb, (size_t)n * sizeof(double));
     if (n > 0) memcpy(V0 + (size_t)m * ld, V1, (size_t)ld * p * sizeof(double));
     memcpy(S, s, (size_t)p * sizeof(double));
   }
-  phgmg__free(&ctx->al, QB);
+  phgmg__free(&ctx->al, Xa);
   return rc;
 }
 
@@ -26552,9 +26687,10 @@ PHGMG__PRIV void phgmg__mpi_sep_sys(const phgmg_mpi_sep_model *md, phgmg_ph_syst
 PHGMG__PRIV phgmg_result phgmg__mpi_sep_check_local(const phgmg_mpi_ctx *ctx, const phgmg_mpi_sep_model *md,
                                                     phgmg_reduce_opts *o) {
   const int nf = md->per_term ? md->nsep : 1, nc = md->poly_deg + 1;
-  int k;
+  int k, qm;
   phgmg__reduce_opts_resolve(o, 0);
-  if ((o->method != PHGMG_METHOD_GMG_POD && o->method != PHGMG_METHOD_SP1 && o->method != PHGMG_METHOD_SP2) ||
+  qm = o->method == PHGMG_METHOD_GMG_QM;
+  if ((o->method != PHGMG_METHOD_GMG_POD && o->method != PHGMG_METHOD_SP1 && o->method != PHGMG_METHOD_SP2 && !qm) ||
       (o->hyper.on && o->hyper.kind != PHGMG_HYPER_ECSW) ||
       o->ref != PHGMG_REF_NONE || o->dt != 0.0 || o->nrun || o->runs || o->cache.pod_basis || o->cache.deim_pts ||
       o->select.lambda_mode != PHGMG_LAMBDA_FIXED || o->degeneracy_tol != 1e-12)
@@ -26562,12 +26698,19 @@ PHGMG__PRIV phgmg_result phgmg__mpi_sep_check_local(const phgmg_mpi_ctx *ctx, co
   if ((o->hyper.on != 0 && o->hyper.on != 1) || !(o->hyper.tol > 0.0 && o->hyper.tol < 1.0) ||
       (md->per_term != 0 && md->per_term != 1))
     return PHGMG_ERR_INVALID_ARG;
+  if (qm && ((int)o->qm.manifold < 0 || (int)o->qm.manifold >= (int)PHGMG_MANIFOLD_COUNT || o->qm.rn < PHGMG_RN_WIDE ||
+             o->qm.lambda != o->qm.lambda))
+    return PHGMG_ERR_INVALID_ARG;
+  /* GMG-QM: the POD and greedy manifolds with a narrow V2 */
+  if (qm && (o->qm.manifold == PHGMG_MANIFOLD_ALTMIN || o->qm.rn == PHGMG_RN_WIDE || o->qm.eta))
+    return PHGMG_ERR_UNSUPPORTED;
   if (o->hyper.on && o->hyper.tol < PHGMG__ECSW_TOL_MIN) return PHGMG_ERR_TOL_UNREACHABLE;
   if (md->nsep < 0 || md->poly_deg < 0 || md->poly_deg > 32 || md->nexp < 0 || md->nexp > 8 ||
       (md->poly_deg == 0 && md->nexp == 0))
     return PHGMG_ERR_SIZE;
   if ((md->nexp > 0 && nf > 0 && !md->expo) || (md->nsep > 0 && !md->sep_idx)) return PHGMG_ERR_INVALID_ARG;
-  if (o->method != PHGMG_METHOD_GMG_POD && (!md->JR || md->JR->ctx != ctx)) return PHGMG_ERR_INVALID_ARG;
+  if ((o->method == PHGMG_METHOD_SP1 || o->method == PHGMG_METHOD_SP2) && (!md->JR || md->JR->ctx != ctx))
+    return PHGMG_ERR_INVALID_ARG;
   if ((md->poly && nf > 0 && !phgmg__all_finite(md->poly, (size_t)nf * nc)) ||
       (md->nexp > 0 && nf > 0 && !phgmg__all_finite(md->expo, (size_t)nf * 2 * md->nexp)) ||
       (md->sep_w && md->nsep > 0 && !phgmg__all_finite(md->sep_w, (size_t)md->nsep)))
@@ -26923,10 +27066,11 @@ PHGMG__PRIV phgmg_result phgmg__mpi_sep_fetch(const phgmg_mpi_ctx *ctx, const ph
 /* The training envelope env (2r: lo, hi) as the serial reduction's: the
    range of rho(x_j) = [RB^{-1} QB^T x_j; V1^T x_j] (QB RB = B by TSQR) over
    the snapshots (SP1, W given: rho(x_j) = W^T x_j), widened on each side by
-   10 % of its width plus 2 % of the largest width. Collective. */
+   10 % of its width plus 2 % of the largest width; xr (r x ns; may be
+   NULL) receives rho(x_j). Collective. */
 PHGMG__PRIV phgmg_result phgmg__mpi_sep_envelope(const phgmg_mpi_ctx *ctx, const phgmg_mpi_linear_model *lin,
                                                  int ns, const double *X, int ldx, const double *V0, int r,
-                                                 const double *W, double *env) {
+                                                 const double *W, double *env, double *xr_out) {
   const int ld = PHGMG__MAX(1, ctx->nloc);
   int m = lin->m;
   double *QB = phgmg__dalloc(&ctx->al, (size_t)ld * m + (size_t)m * m + (size_t)r * ns), *RB, *XR, big = 0.0;
@@ -26954,6 +27098,7 @@ PHGMG__PRIV phgmg_result phgmg__mpi_sep_envelope(const phgmg_mpi_ctx *ctx, const
       if (j == 0 || xr[a] > env[r + a]) env[r + a] = xr[a];
     }
   }
+  if (rc == PHGMG_OK && xr_out) memcpy(xr_out, XR, (size_t)r * ns * sizeof(double));
   for (a = 0; rc == PHGMG_OK && a < r; ++a) big = PHGMG__MAX(big, env[r + a] - env[a]);
   for (a = 0; rc == PHGMG_OK && a < r; ++a) {
     const double wd = 0.1 * (env[r + a] - env[a]) + 0.02 * big;
@@ -26965,10 +27110,14 @@ PHGMG__PRIV phgmg_result phgmg__mpi_sep_envelope(const phgmg_mpi_ctx *ctx, const
 }
 
 /* The phgmg_mpi_rom's storage in one block: double copies (K, Qh, Bh, S, w,
-   P0, poly, expo, env), the global indices, and the online model's
-   phgmg_real arrays. D: the kept terms' rows (phgmg__mpi_sep_fetch). */
+   P0, poly, expo, env; GMG-QM: the blocks quad = [G00, G01, G10, G11, Q01,
+   Q11, Ms], P1, q_max), the global indices, and the online model's
+   phgmg_real arrays. D: the kept terms' rows (phgmg__mpi_sep_fetch: rv
+   columns of the basis, [V0, V2] for GMG-QM). K NULL: none (GMG-QM). */
 typedef struct phgmg__mpi_romdata {
   int r, m, nd, nf, nc, ne, nsv, method;   /* nc: poly_deg + 1, ne: nexp, nsv: singular values */
+  int rn, rv;                              /* GMG-QM: rn > 0; rv: V columns in D (r + rn) */
+  const double *quad, *qmax;
   const double *K, *Qh, *Bh, *S, *w, *D, *env;
   const phgmg_gidx *pts;
   const phgmg_mpi_sep_model *md;
@@ -26982,19 +27131,27 @@ PHGMG__PRIV void phgmg__mpi_rom_real(phgmg_real *dst, const double *src, size_t 
 PHGMG__PRIV phgmg_result phgmg__mpi_rom_store(const phgmg_mpi_ctx *ctx, const phgmg__mpi_romdata *d,
                                               phgmg_mpi_rom *out) {
   const size_t r = (size_t)d->r, m = (size_t)d->m, nd = (size_t)d->nd, nf = (size_t)d->nf;
-  const size_t npc = nf * (size_t)d->nc, nex = nf * 2 * (size_t)d->ne;
-  const size_t nv = 2 * r * r + r * m + nd * (1 + r) + npc + nex + 2 * r;   /* what the rom views */
+  const size_t npc = nf * (size_t)d->nc, nex = nf * 2 * (size_t)d->ne, rv = (size_t)d->rv;
+  const size_t rn = (size_t)d->rn, p = r - m, nq = rn ? r * r + 2 * r * rn + 2 * rn * rn + r * rn + rn * p * p : 0;
+  const size_t nv = 2 * r * r + r * m + nd * (1 + r) + npc + nex + 2 * r +
+                    (rn ? nq + nd * rn + 1 : 0);   /* what the rom views */
   double *b = phgmg__dalloc(&ctx->al, nv + (size_t)d->nsv + 2 * nd + (nv * sizeof(phgmg_real)) / sizeof(double) + 1);
-  double *K, *Qh, *Bh, *w, *P0, *po, *ex, *env, *S;
+  double *K, *Qh, *Bh, *w, *P0, *po, *ex, *env, *qd, *P1, *qm, *S;
   phgmg_gidx *pts, *coord;
   phgmg_real *v;
   size_t j;
   if (!b) return PHGMG_ERR_NOMEM;
   K = b; Qh = K + r * r; Bh = Qh + r * r; w = Bh + r * m; P0 = w + nd; po = P0 + nd * r; ex = po + npc;
-  env = ex + nex; S = env + 2 * r;
+  env = ex + nex; qd = env + 2 * r; P1 = qd + nq; qm = P1 + (rn ? nd * rn : 0); S = qm + (rn ? 1 : 0);
   pts = PHGMG__CAST(phgmg_gidx *, PHGMG__CAST(void *, S + d->nsv)); coord = pts + nd;
   v = PHGMG__CAST(phgmg_real *, PHGMG__CAST(void *, coord + nd));
-  memcpy(K, d->K, r * r * sizeof(double)); memcpy(Qh, d->Qh, r * r * sizeof(double));
+  if (d->K) memcpy(K, d->K, r * r * sizeof(double));
+  memcpy(Qh, d->Qh, r * r * sizeof(double));
+  if (rn) {
+    memcpy(qd, d->quad, nq * sizeof(double));
+    if (nd) memcpy(P1, d->D + nd * (1 + r), nd * rn * sizeof(double));
+    qm[0] = d->qmax[0];
+  }
   memcpy(Bh, d->Bh, r * m * sizeof(double)); memcpy(S, d->S, (size_t)d->nsv * sizeof(double));
   memcpy(env, d->env, 2 * r * sizeof(double));
   if (nd) memcpy(w, d->w, nd * sizeof(double));
@@ -27003,16 +27160,26 @@ PHGMG__PRIV phgmg_result phgmg__mpi_rom_store(const phgmg_mpi_ctx *ctx, const ph
   for (j = 0; j < npc + nex; ++j) {   /* shared: the model's; per term: the fetched rows */
     const size_t t = j < npc ? j / (size_t)d->nc : (j - npc) / (2 * (size_t)d->ne);
     const size_t c = j < npc ? j % (size_t)d->nc : (size_t)d->nc + (j - npc) % (2 * (size_t)d->ne);
-    (j < npc ? po : ex - npc)[j] = d->md->per_term ? d->D[t + (1 + r + c) * nd]
+    (j < npc ? po : ex - npc)[j] = d->md->per_term ? d->D[t + (1 + rv + c) * nd]
                                   : c < (size_t)d->nc ? (d->md->poly ? d->md->poly[c] : 0.0) : d->md->expo[c - d->nc];
   }
   phgmg__mpi_rom_real(v, b, nv);
   memset(out, 0, sizeof *out);
   out->mem_ = b; out->al_ = ctx->al;
   out->r = d->r; out->m = d->m; out->nd = d->nd;
-  out->K = K; out->Qh = Qh; out->Bh = Bh; out->S = S; out->w = w; out->P0 = P0; out->pts = pts; out->coord = coord;
-  out->rom.kind = PHGMG_ROM_LINEAR; out->rom.method = d->method; out->rom.r = d->r; out->rom.m = d->m;
-  out->rom.K = v; out->rom.Qh = v + r * r; out->rom.Bh = v + 2 * r * r;
+  out->K = d->K ? K : NULL; out->Qh = Qh; out->Bh = Bh; out->S = S; out->w = w; out->P0 = P0; out->pts = pts;
+  out->coord = coord;
+  out->rom.kind = rn ? PHGMG_ROM_QUADRATIC : PHGMG_ROM_LINEAR; out->rom.method = d->method; out->rom.r = d->r;
+  out->rom.m = d->m;
+  out->rom.K = d->K ? v : NULL; out->rom.Qh = v + r * r; out->rom.Bh = v + 2 * r * r;
+  if (rn) {   /* the quadratic blocks (phgmg__publish's) */
+    const phgmg_real *vq = v + (qd - b);
+    out->rom.rn = d->rn;
+    out->rom.G00 = vq; out->rom.G01 = vq + r * r; out->rom.G10 = out->rom.G01 + r * rn;
+    out->rom.G11 = out->rom.G10 + rn * r; out->rom.Q01 = out->rom.G11 + rn * rn; out->rom.Q11 = out->rom.Q01 + r * rn;
+    out->rom.Ms = out->rom.Q11 + rn * rn; out->rom.q_max = v + (qm - b);
+    if (nd) out->rom.P1 = v + (P1 - b);
+  }
   out->rom.nd = d->nd;
   if (nd) {
     out->rom.w = v + (w - b); out->rom.P0 = v + (P0 - b);
@@ -27138,12 +27305,67 @@ PHGMG__PRIV phgmg_result phgmg__mpi_sep_all(const phgmg_mpi_ctx *ctx, const phgm
   return rc;
 }
 
+/* GMG-QM's reduced object and the replicated reduced snapshot coordinates
+   XR (r x ns) for its ECSW (phgmg__mpi_qm_ecsw). */
+typedef struct phgmg__mpi_qmfit {
+  const phgmg_reduced *red;
+  const double *XR;
+} phgmg__mpi_qmfit;
+
+/* ECSW of GMG-QM as the serial phgmg__hyper_ecsw_manifold: the training
+   rows (u, a) of every stride-th snapshot (stride = ns r nsg / 4e6 + 1, nsg
+   the model's terms), column of term k: phi_k'(x_i[idx_k]) Dphi(rho(x_i))
+   [idx_k, a] = f (V0[idx_k, a] + (a >= m) V2[idx_k, :] Dq(x2_i)[:, a - m])
+   (t->Vt: the rows of [V0, V2]), the target their sum with the terms'
+   weights, the fit by phgmg__mpi_ecsw_run at tol on these rows (the
+   terms' columns formed by their owners). From PHGMG_ECSW_SCREEN_MIN live
+   terms on (the serial screening) PHGMG_ERR_UNSUPPORTED. Collective. */
+PHGMG__PRIV phgmg_result phgmg__mpi_qm_ecsw(const phgmg_mpi_ctx *ctx, const phgmg__mpi_terms *t, int ns,
+                                            const phgmg__mpi_qmfit *qf, phgmg_gidx nsg, double tol, phgmg_gidx nlg,
+                                            phgmg_gidx *pts, double *w, int *nd, double *rel) {
+  const phgmg_reduced *red = qf->red;
+  const int r = red->r, m = red->m, p = red->p, rn = red->rn, nl = t->nl;
+  const int stride = (int)(((double)ns * r * (double)nsg) / 4e6) + 1, nsu = (ns + stride - 1) / stride;
+  const size_t nrow = (size_t)nsu * r;
+  double *Gm, *Dq;
+  phgmg__mpi_cols src;
+  int u, k, a, j;
+  phgmg_result rc;
+  if (nlg >= PHGMG_ECSW_SCREEN_MIN) return PHGMG_ERR_UNSUPPORTED;   /* nlg: the same on every rank */
+  Gm = phgmg__dalloc(&ctx->al, nrow * (size_t)PHGMG__MAX(nl, 1) + (size_t)rn * p);
+  rc = phgmg__mpi_agree(ctx, Gm ? PHGMG_OK : PHGMG_ERR_NOMEM);
+  if (rc != PHGMG_OK) { phgmg__free(&ctx->al, Gm); return rc; }
+  Dq = Gm + nrow * (size_t)PHGMG__MAX(nl, 1);
+  for (u = 0; u < nsu; ++u) {
+    const int i = u * stride;
+    phgmg__eta_d(red, qf->XR + (size_t)i * r + m, NULL, Dq, NULL, NULL);
+    for (k = 0; k < nl; ++k) {
+      const double f = t->F[k + (size_t)i * nl];
+      double *g = Gm + (size_t)u * r + (size_t)k * nrow;
+      for (a = 0; a < r; ++a) g[a] = f * t->Vt[k + (size_t)a * nl];
+      for (a = 0; a < p; ++a) {
+        double sm = 0.0;
+        for (j = 0; j < rn; ++j) sm += t->Vt[k + (size_t)(r + j) * nl] * Dq[j + (size_t)a * rn];
+        g[m + a] += f * sm;
+      }
+    }
+  }
+  memset(&src, 0, sizeof src);
+  src.G = Gm; src.ldg = (int)nrow;
+  rc = phgmg__mpi_ecsw_run(ctx, nl, (int)nrow, &src, t->sw, t->gid, tol, (int)PHGMG__MIN(nlg, (phgmg_gidx)nrow), pts, w,
+                           nd, rel);
+  phgmg__free(&ctx->al, Gm);
+  return rc;
+}
+
 /* The separable stage: live terms, points and weights (ECSW or all terms),
-   the kept terms' rows fetched; *D (nd x wd) and *pts, *w allocated here. */
+   the kept terms' rows fetched; *D (nd x wd) and *pts, *w allocated here.
+   qf: GMG-QM's (V0: [V0, V2], r their columns; the fit of
+   phgmg__mpi_qm_ecsw), else NULL. */
 PHGMG__PRIV phgmg_result phgmg__mpi_sep_terms(const phgmg_mpi_ctx *ctx, const phgmg_mpi_sep_model *md,
                                               const phgmg_reduce_opts *o, int ns, const double *X, int ldx,
-                                              const double *V0, int r, int wd, phgmg__mpi_romdata *d,
-                                              double *resid) {
+                                              const double *V0, int r, int wd, const phgmg__mpi_qmfit *qf,
+                                              phgmg__mpi_romdata *d, double *resid) {
   const int ld = PHGMG__MAX(1, ctx->nloc);
   phgmg__mpi_terms t;
   phgmg_gidx nlg = 0, nl, nsg = 0, ns1 = md->nsep, room;
@@ -27164,7 +27386,8 @@ PHGMG__PRIV phgmg_result phgmg__mpi_sep_terms(const phgmg_mpi_ctx *ctx, const ph
   *resid = 0.0;
   d->nd = 0;
   if (rc == PHGMG_OK && o->hyper.on && nlg > 0)
-    rc = phgmg__mpi_sep_ecsw(ctx, &t, ns, r, o->hyper.tol, nlg, pts, w, &d->nd, resid);
+    rc = qf ? phgmg__mpi_qm_ecsw(ctx, &t, ns, qf, nsg, o->hyper.tol, nlg, pts, w, &d->nd, resid)
+            : phgmg__mpi_sep_ecsw(ctx, &t, ns, r, o->hyper.tol, nlg, pts, w, &d->nd, resid);
   else if (rc == PHGMG_OK && !o->hyper.on) {
     d->nd = (int)nsg;
     rc = phgmg__mpi_sep_all(ctx, md, d->nd, pts, w);
@@ -27177,6 +27400,240 @@ PHGMG__PRIV phgmg_result phgmg__mpi_sep_terms(const phgmg_mpi_ctx *ctx, const ph
     d->D = D;
   }
   d->pts = pts; d->w = w;
+  return rc;
+}
+
+/* ---- distributed GMG-QM (manifold POD or GREEDY, narrow V2) -------------------- */
+/* The distributed GMG-QM's state: the serial pipeline's context and a
+   reduced object that hold only small data (the blocks, M, the checks'
+   scaling; the snapshots' reduced coordinates given as c.Z1, c.Z2, c.XRs),
+   so that the serial stages on small data run unchanged on every rank; and
+   this rank's rows: L = [B, V1, V2] (ld x (r + rn)), Xa (ld x ns) the
+   adjusted snapshots, then their residual after V1. */
+typedef struct phgmg__mpi_qm {
+  phgmg__rctx c;
+  phgmg_ph_system sys;
+  double *L, *Xa, *Z, *S, rfloor;   /* Z: p x ns Z1, rn x ns Z2, r x ns XR; S: p values */
+  int v2ok;
+} phgmg__mpi_qm;
+
+PHGMG__PRIV void phgmg__mpi_qm_free(const phgmg_mpi_ctx *ctx, phgmg__mpi_qm *q) {
+  phgmg__free(&ctx->al, q->L);
+  phgmg__free(&ctx->al, q->c.dga);
+  phgmg__free(&ctx->al, q->c.Tq);
+  phgmg_reduced_destroy(q->c.red);
+  memset(q, 0, sizeof *q);
+}
+
+/* The small reduced object with the sizes of phgmg__reduce_new, the context
+   (options resolved, fixed lambda), the row blocks. Local. */
+PHGMG__PRIV phgmg_result phgmg__mpi_qm_init(const phgmg_mpi_ctx *ctx, const phgmg_mpi_sep_model *md,
+                                            const phgmg_reduce_opts *o, int ns, phgmg__mpi_qm *q) {
+  const int ld = PHGMG__MAX(1, ctx->nloc), m = md->lin.m, r = o->r, rn = o->qm.rn, p = r - m;
+  phgmg_reduced *red;
+  memset(q, 0, sizeof *q);
+  if (ns < 1 || rn < 1 || (phgmg_gidx)rn > ctx->N - r || ctx->N > 2147483647) return PHGMG_ERR_SIZE;
+  red = PHGMG__CAST(phgmg_reduced *, phgmg__alloc(&ctx->al, sizeof(phgmg_reduced)));
+  if (!red) return PHGMG_ERR_NOMEM;
+  memset(red, 0, sizeof *red);
+  red->alloc = ctx->al; red->use_alloc = 1;
+  q->c.red = red; q->c.sys = &q->sys; q->c.ro = *o; q->c.o = &q->c.ro; q->c.ns = ns; q->c.alloc = &ctx->al;
+  q->c.gsel = -1; q->c.degtol = o->degeneracy_tol; q->c.lambda = o->qm.lambda < 0.0 ? 0.0 : o->qm.lambda;
+  q->sys.N = (int)ctx->N; q->sys.m = m;
+  red->N = (int)ctx->N; red->m = m; red->r = r; red->p = p; red->rn = rn; red->method = o->method;
+  red->kind = PHGMG_ROM_QUADRATIC; red->sys = &q->sys;
+  /* G00 G01 G10 G11 Q01 Q11 Ms contiguous (phgmg__mpi_romdata.quad), then M */
+  red->G00 = phgmg__red_d(red, (size_t)(r + rn) * (r + rn) + (size_t)r * rn + (size_t)rn * rn + 2 * (size_t)rn * p * p);
+  red->Qh = phgmg__red_d(red, (size_t)r * r + (size_t)r * m + 2 * (size_t)r);
+  q->c.dga = phgmg__dalloc(&ctx->al, (size_t)r * r + (size_t)r);
+  q->L = phgmg__dalloc(&ctx->al, (size_t)ld * (r + rn) + (size_t)ld * ns + (size_t)(p + rn + r) * ns + (size_t)p);
+  if (!red->G00 || !red->Qh || !q->c.dga || !q->L) return PHGMG_ERR_NOMEM;
+  red->G01 = red->G00 + (size_t)r * r; red->G10 = red->G01 + (size_t)r * rn; red->G11 = red->G10 + (size_t)rn * r;
+  red->Q01 = red->G11 + (size_t)rn * rn; red->Q11 = red->Q01 + (size_t)r * rn; red->Ms = red->Q11 + (size_t)rn * rn; red->M = red->Ms + (size_t)rn * p * p;
+  red->Bh = red->Qh + (size_t)r * r; red->env = red->Bh + (size_t)r * m;
+  q->c.dgs = q->c.dga + (size_t)r * r;
+  q->Xa = q->L + (size_t)ld * (r + rn); q->Z = q->Xa + (size_t)ld * ns; q->S = q->Z + (size_t)(p + rn + r) * ns;
+  q->c.Z1 = q->Z; q->c.Z2 = q->Z + (size_t)p * ns; q->c.XRs = q->Z + (size_t)(p + rn) * ns;
+  return PHGMG_OK;
+}
+
+/* The serial rank floor max(N, ns) eps ||X||_F of the snapshots. Collective. */
+PHGMG__PRIV double phgmg__mpi_rank_floor(const phgmg_mpi_ctx *ctx, int ns, const double *X, int ldx) {
+  double f2[2] = {0.0, 0.0};
+  f2[0] = ctx->nloc > 0 ? phgmg_normf(ctx->nloc, ns, X, ldx) : 0.0;
+  f2[0] *= f2[0];
+  phgmg__mpi_sum(ctx, 1, f2, f2 + 1);
+  return (double)PHGMG__MAX(ctx->N, (phgmg_gidx)ns) * PHGMG__EPS * sqrt(f2[1]);
+}
+
+/* Stages 1 and 2a (phgmg__stage_basis, the manifold's V1): the POD of the
+   adjusted snapshots by TSQR (as many modes as the serial basis stage and
+   greedy take), V1 its p leading modes (POD manifold; V2 its next rn when
+   they lie above the rank floor) or the greedy choice among its q = min(p
+   + rn, min(N, ns) - 1) leading ones, made by phgmg__qm_greedy_select on
+   their replicated coordinates U^T Xa. Collective. */
+PHGMG__PRIV phgmg_result phgmg__mpi_qm_v1(const phgmg_mpi_ctx *ctx, int ns, phgmg__mpi_qm *q) {
+  const phgmg_reduced *red = q->c.red;
+  const int n = ctx->nloc, ld = PHGMG__MAX(1, n), m = red->m, p = red->p, rn = red->rn;
+  const int nmin = (int)PHGMG__MIN((phgmg_gidx)ns, ctx->N), greedy = q->c.o->qm.manifold == PHGMG_MANIFOLD_GREEDY;
+  const int qg = PHGMG__MIN(p + rn, nmin - 1), kk = greedy ? PHGMG__MAX(PHGMG__MIN(p + 1, nmin), qg)
+                                                           : PHGMG__MIN(p + rn + 1, nmin);
+  double *U = phgmg__dalloc(&ctx->al, (size_t)ld * kk + (size_t)kk + (size_t)kk * ns), *s, *C;
+  int *sel = phgmg__ialloc(&ctx->al, 2 * (size_t)PHGMG__MAX(kk, 1)), k = 0, j;
+  phgmg_result rc = phgmg__mpi_agree(ctx, U && sel ? PHGMG_OK : PHGMG_ERR_NOMEM);
+  if (rc == PHGMG_OK) {
+    s = U + (size_t)ld * kk; C = s + kk;
+    rc = phgmg_mpi_pod(ctx, ns, q->Xa, ld, kk, 0.0, U, ld, s, &k);
+    if (rc == PHGMG_OK && (k < p || !(s[p - 1] > q->rfloor))) rc = PHGMG_ERR_SIZE;   /* r - m > rank */
+    for (j = 0; j < p; ++j) sel[j] = j;
+    if (rc == PHGMG_OK && greedy && qg > p) {
+      rc = k < qg ? PHGMG_ERR_SIZE : phgmg_mpi_atb(ctx, qg, ns, U, ld, q->Xa, ld, C, qg);   /* S = U^T Xa */
+      if (rc == PHGMG_OK)
+        rc = phgmg__mpi_agree(ctx, phgmg__qm_greedy_select(p, qg, ns, C, phgmg__qm_greedy_lambda(q->c.o, q->c.lambda),
+                                                           sel, &ctx->al));
+    }
+    if (rc == PHGMG_OK) {
+      memcpy(q->S, s, (size_t)p * sizeof(double));
+      for (j = 0; j < p && n > 0; ++j) memcpy(q->L + (size_t)(m + j) * ld, U + (size_t)sel[j] * ld, (size_t)n * sizeof(double));
+      q->v2ok = !greedy && k >= p + rn && s[p + rn - 1] > q->rfloor;   /* the same SVD's next modes */
+      if (q->v2ok && n > 0) memcpy(q->L + (size_t)(m + p) * ld, U + (size_t)p * ld, (size_t)n * rn * sizeof(double));
+    }
+  }
+  phgmg__free(&ctx->al, U);
+  phgmg__free(&ctx->al, sel);
+  return rc;
+}
+
+/* Stage 2b (phgmg__stage_manifold): Xa minus its part in span V1, V2 the
+   rn leading POD modes of that residual (unless the basis stage's SVD gave
+   them), the coordinates Z1 = V1^T X and Z2 = V2^T Xa (replicated), then
+   the serial ridge problem and fit of M (phgmg__qm_problem, phgmg__qm_fit)
+   at the fixed lambda. Collective. */
+PHGMG__PRIV phgmg_result phgmg__mpi_qm_manifold(const phgmg_mpi_ctx *ctx, int ns, const double *X, int ldx,
+                                                phgmg__mpi_qm *q) {
+  phgmg_reduced *red = q->c.red;
+  const int n = ctx->nloc, ld = PHGMG__MAX(1, n), m = red->m, p = red->p, rn = red->rn, nc = p * (p + 1) / 2;
+  double *V1 = q->L + (size_t)ld * m, *V2 = V1 + (size_t)ld * p, *Z1 = q->Z, *Z2 = Z1 + (size_t)p * ns;
+  double *T = phgmg__dalloc(&ctx->al, (size_t)p * ns + (size_t)rn);
+  int k = 0;
+  phgmg_result rc = phgmg__mpi_agree(ctx, T ? PHGMG_OK : PHGMG_ERR_NOMEM);
+  if (rc == PHGMG_OK) rc = phgmg_mpi_atb(ctx, p, ns, V1, ld, q->Xa, ld, T, p);
+  if (rc == PHGMG_OK && n > 0) phgmg_gemm('N', 'N', n, ns, p, -1.0, V1, ld, T, p, 1.0, q->Xa, ld);
+  if (rc == PHGMG_OK && !q->v2ok) {
+    rc = phgmg_mpi_pod(ctx, ns, q->Xa, ld, rn, 0.0, V2, ld, T, &k);
+    if (rc == PHGMG_OK && (k < rn || !(T[rn - 1] > q->rfloor))) rc = PHGMG_ERR_SIZE;
+  }
+  if (rc == PHGMG_OK) rc = phgmg_mpi_atb(ctx, p, ns, V1, ld, X, ldx, Z1, p);
+  if (rc == PHGMG_OK) rc = phgmg_mpi_atb(ctx, rn, ns, V2, ld, q->Xa, ld, Z2, rn);
+  phgmg__free(&ctx->al, T);
+  if (rc == PHGMG_OK) rc = phgmg__qm_problem(&q->c);   /* replicated data from here on */
+  if (rc == PHGMG_OK)
+    rc = phgmg__qm_fit(red, ns, q->c.Tq, q->c.Tq + (size_t)ns * nc, q->c.lambda, q->c.Tq + (size_t)ns * (nc + rn),
+                       &ctx->al);
+  return phgmg__mpi_agree(ctx, rc);
+}
+
+/* Stage 3 (phgmg__gmg_blocks_solve, phgmg__stage_gmg_blocks) and 4a
+   (phgmg__quadratic_terms_apply): GL = (J - R)^{-1} L by the user's solve,
+   [G00 G01; G10 G11] = L^T GL, the rounding scale |V0|^T |G V0| of G00,
+   Bh = [I; 0], the serial non-degeneracy check of D^T G D at 0 and at every
+   snapshot (phgmg__check_degeneracy); [Qh Q01; . Q11] = L^T Q L, Qh
+   symmetrised. Collective. */
+PHGMG__PRIV phgmg_result phgmg__mpi_qm_blocks(const phgmg_mpi_ctx *ctx, const phgmg_mpi_linear_model *lin,
+                                              phgmg__mpi_qm *q) {
+  phgmg_reduced *red = q->c.red;
+  const int n = ctx->nloc, ld = PHGMG__MAX(1, n), m = red->m, r = red->r, rn = red->rn, t = r + rn;
+  double *GL = phgmg__dalloc(&ctx->al, 2 * (size_t)ld * t + (size_t)t * t), *AL, *A;
+  size_t i;
+  int a, j;
+  phgmg_result rc = phgmg__mpi_agree(ctx, GL ? PHGMG_OK : PHGMG_ERR_NOMEM);
+  if (rc != PHGMG_OK) { phgmg__free(&ctx->al, GL); return rc; }
+  AL = GL + (size_t)ld * t; A = AL + (size_t)ld * t;
+  memcpy(GL, q->L, (size_t)ld * t * sizeof(double));
+  rc = phgmg__mpi_agree(ctx, lin->solve('N', t, GL, ld, lin->solve_user));
+  if (rc == PHGMG_OK) rc = phgmg_mpi_atb(ctx, t, t, q->L, ld, GL, ld, A, t);
+  for (j = 0; rc == PHGMG_OK && j < t; ++j)
+    for (a = 0; a < t; ++a) {
+      const double v = A[a + (size_t)j * t];
+      if (a < r && j < r) red->G00[a + (size_t)j * r] = v;
+      else if (a < r) red->G01[a + (size_t)(j - r) * r] = v;
+      else if (j < r) red->G10[(a - r) + (size_t)j * rn] = v;
+      else red->G11[(a - r) + (size_t)(j - r) * rn] = v;
+    }
+  for (i = 0; rc == PHGMG_OK && i < (size_t)ld * t; ++i) { AL[i] = fabs(q->L[i]); GL[i] = fabs(GL[i]); }
+  if (rc == PHGMG_OK) rc = phgmg_mpi_atb(ctx, r, r, AL, ld, GL, ld, q->c.dga, r);
+  if (rc == PHGMG_OK) {
+    q->c.dga_ok = 1;
+    for (j = 0; j < m; ++j) red->Bh[j + (size_t)j * r] = 1.0;
+    rc = phgmg__mpi_agree(ctx, phgmg__check_degeneracy(&q->c));
+  }
+  if (rc == PHGMG_OK) rc = phgmg_mpi_op_apply(lin->Q, t, q->L, ld, GL, ld);
+  if (rc == PHGMG_OK) rc = phgmg_mpi_atb(ctx, t, t, q->L, ld, GL, ld, A, t);
+  for (j = 0; rc == PHGMG_OK && j < t; ++j)
+    for (a = 0; a < t; ++a) {
+      const double v = A[a + (size_t)j * t];
+      if (a < r && j < r) red->Qh[a + (size_t)j * r] = v;
+      else if (a < r) red->Q01[a + (size_t)(j - r) * r] = v;
+      else if (j >= r) red->Q11[(a - r) + (size_t)(j - r) * rn] = v;
+    }
+  if (rc == PHGMG_OK) phgmg__symmetrize(r, red->Qh);
+  phgmg__free(&ctx->al, GL);
+  return rc;
+}
+
+/* GMG-QM of phgmg_mpi_reduce (o resolved and checked): the stages above,
+   the separable terms (every term: the rows of [V0, V2] of each from its
+   owner), the training envelope and q_max (phgmg__q_envelope on the
+   replicated reduced coordinates); *out as the serial phgmg_reduce's
+   phgmg_rom of kind PHGMG_ROM_QUADRATIC. Collective. */
+PHGMG__PRIV phgmg_result phgmg__mpi_qm_reduce(const phgmg_mpi_ctx *ctx, const phgmg_mpi_sep_model *model,
+                                              const phgmg_reduce_opts *o, int ns, const double *X, int ldx,
+                                              phgmg_mpi_rom *out, double *V0, int ldv0) {
+  const int ld = PHGMG__MAX(1, ctx->nloc), r = o->r, m = model->lin.m;
+  phgmg__mpi_qm q;
+  phgmg__mpi_romdata d;
+  phgmg_reduced *red;
+  double resid = 0.0;
+  int j;
+  phgmg_result rc = phgmg__mpi_agree(ctx, phgmg__mpi_qm_init(ctx, model, o, ns, &q));
+  red = q.c.red;
+  memset(&d, 0, sizeof d);
+  if (rc == PHGMG_OK) rc = phgmg__mpi_adjust(ctx, &model->lin, ns, X, ldx, q.Xa);
+  if (rc == PHGMG_OK) {
+    q.rfloor = phgmg__mpi_rank_floor(ctx, ns, X, ldx);
+    for (j = 0; j < m && ctx->nloc > 0; ++j)
+      memcpy(q.L + (size_t)j * ld, model->lin.B + (size_t)j * model->lin.ldb, (size_t)ctx->nloc * sizeof(double));
+    rc = phgmg__mpi_qm_v1(ctx, ns, &q);
+  }
+  if (rc == PHGMG_OK) rc = phgmg__mpi_qm_manifold(ctx, ns, X, ldx, &q);
+  if (rc == PHGMG_OK) rc = phgmg__mpi_qm_blocks(ctx, &model->lin, &q);
+  if (rc == PHGMG_OK)   /* the envelope first: ECSW takes the reduced coordinates */
+    rc = phgmg__mpi_sep_envelope(ctx, &model->lin, ns, X, ldx, q.L, r, NULL, red->env,
+                                 q.Z + (size_t)(red->p + red->rn) * ns);
+  if (rc == PHGMG_OK) {
+    phgmg__mpi_qmfit qf;
+    qf.red = red; qf.XR = q.c.XRs;
+    d.r = r; d.m = m; d.rn = red->rn; d.rv = r + red->rn; d.nc = model->poly_deg + 1; d.ne = model->nexp;
+    d.md = model; d.nsv = red->p; d.method = o->method;
+    d.Qh = red->Qh; d.Bh = red->Bh; d.S = q.S; d.env = red->env; d.quad = red->G00;
+    rc = phgmg__mpi_sep_terms(ctx, model, o, ns, X, ldx, q.L, r + red->rn,
+                              1 + r + red->rn + (model->per_term ? d.nc + 2 * d.ne : 0), &qf, &d, &resid);
+  }
+  if (rc == PHGMG_OK) rc = phgmg__mpi_agree(ctx, phgmg__q_envelope(&q.c));
+  d.nf = model->per_term ? d.nd : 1;
+  if (rc == PHGMG_OK) {
+    d.qmax = red->qmax;
+    rc = phgmg__mpi_agree(ctx, phgmg__mpi_rom_store(ctx, &d, out));
+  }
+  if (rc == PHGMG_OK) {
+    out->hyper_residual = resid;
+    for (j = 0; V0 && ctx->nloc > 0 && j < r; ++j)
+      memcpy(V0 + (size_t)j * ldv0, q.L + (size_t)j * ld, (size_t)ctx->nloc * sizeof(double));
+  }
+  phgmg__free(&ctx->al, (void *)d.D);
+  phgmg__free(&ctx->al, (void *)d.pts);
+  phgmg__free(&ctx->al, (void *)d.w);
+  phgmg__mpi_qm_free(ctx, &q);
   return rc;
 }
 
@@ -27202,6 +27659,8 @@ PHGMG_DEF phgmg_result phgmg_mpi_reduce(const phgmg_mpi_ctx *ctx, const phgmg_mp
   rc = phgmg__mpi_sep_check_global(ctx, model ? model : NULL, rc);
   sp1 = rc == PHGMG_OK && (o.method == PHGMG_METHOD_SP1 || o.method == PHGMG_METHOD_SP2);   /* SP1 or SP2 */
   if (rc == PHGMG_OK && (m < 1 || (phgmg_gidx)r > ctx->N || (sp1 ? r < 1 || r > ns : r <= m))) rc = PHGMG_ERR_SIZE;
+  if (rc == PHGMG_OK && o.method == PHGMG_METHOD_GMG_QM)   /* the quadratic manifold: its own stages */
+    return phgmg__mpi_qm_reduce(ctx, model, &o, ns, X, ldx, out, V0, ldv0);
   if (rc == PHGMG_OK) {
     b = phgmg__dalloc(&ctx->al, 2 * (size_t)r * r + (size_t)r * m + 3 * (size_t)r +
                                     (sp1 ? 2 : 1) * (size_t)ld * r);   /* SP1: V and W */
@@ -27212,7 +27671,7 @@ PHGMG_DEF phgmg_result phgmg_mpi_reduce(const phgmg_mpi_ctx *ctx, const phgmg_mp
   d.env = d.S + r; Vb = b + 2 * (size_t)r * r + (size_t)r * m + 3 * (size_t)r;
   Wb = sp1 ? Vb + (size_t)ld * r : NULL;   /* SP1/SP2: W = Vg A^{-1} */
   d.nc = model->poly_deg + 1; d.ne = model->nexp; d.md = model;
-  d.nsv = sp1 ? r : r - m; d.method = o.method;
+  d.nsv = sp1 ? r : r - m; d.method = o.method; d.rv = r;
   wd = 1 + r + (model->per_term ? d.nc + 2 * d.ne : 0);
   /* basis and reduction blocks (stages 1 and 3), the quadratic term (4a) */
   if (sp1)
@@ -27222,10 +27681,10 @@ PHGMG_DEF phgmg_result phgmg_mpi_reduce(const phgmg_mpi_ctx *ctx, const phgmg_mp
     rc = phgmg_mpi_gmg_pod_linear(ctx, &model->lin, ns, X, ldx, r, b, b + (size_t)r * r, b + 2 * (size_t)r * r,
                                   b + 2 * (size_t)r * r + (size_t)r * m, Vb, ld);
   /* the separable terms (4b), then the training envelope */
-  if (rc == PHGMG_OK) rc = phgmg__mpi_sep_terms(ctx, model, &o, ns, X, ldx, Vb, r, wd, &d, &resid);
+  if (rc == PHGMG_OK) rc = phgmg__mpi_sep_terms(ctx, model, &o, ns, X, ldx, Vb, r, wd, NULL, &d, &resid);
   if (rc == PHGMG_OK)
     rc = phgmg__mpi_sep_envelope(ctx, &model->lin, ns, X, ldx, Vb, r, sp1 ? Wb : NULL,
-                                 b + 2 * (size_t)r * r + (size_t)r * m + r);
+                                 b + 2 * (size_t)r * r + (size_t)r * m + r, NULL);
   d.nf = model->per_term ? d.nd : 1;
   if (rc == PHGMG_OK) rc = phgmg__mpi_agree(ctx, phgmg__mpi_rom_store(ctx, &d, out));
   if (rc == PHGMG_OK) {
@@ -28805,6 +29264,13 @@ PHGMG_DEF phgmg_result phgmg_sym_eig(int n, double *A, int lda, double *w, doubl
             took such a fit as optimal). The command line names
             ECSW and --hyper-tol / --no-hyper when the fit misses its
             tolerance.
+          - New with PHGMG_MPI: phgmg_mpi_reduce does GMG-QM with the POD
+            and greedy manifolds (a narrow V2, qm.rn > 0; fixed lambda; every
+            separable term kept, or ECSW as the serial GMG-QM's below 4096
+            live terms): the serial GMG-QM's phgmg_rom of kind
+            PHGMG_ROM_QUADRATIC, replicated on every rank (manual 2.7). The
+            wide V2, ALTMIN, a chosen lambda and the screened ECSW with
+            GMG-QM return PHGMG_ERR_UNSUPPORTED.
    0.9.0  (2026-11-29)
           - New: the low-rank tools take index-one SPARSE descriptor models
             (phgmg_shifted_create on the whole pencil, phgmg_lrbt with the

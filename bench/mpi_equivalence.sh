@@ -9,7 +9,10 @@
 # a Gram-matrix POD (the negative control: it must miss), the serial model's
 # own movement under one-ulp changes of the snapshots, and K, Qh, the ECSW
 # points and weights, V0's rows at the points and 200 steps of outputs
-# against the serial model.
+# against the serial model. Then GMG-QM (POD and greedy manifolds, r = 8,
+# rn = 3, no terms: the linear chain of n masses, 81 snapshots) against the
+# serial GMG-QM: the basis [B, V1], every block, q_max, 100 steps of
+# outputs. QM_ONLY=1: only the GMG-QM comparison.
 #   sh bench/mpi_equivalence.sh [n] [P ...]      (log: build/mpi_equivalence.txt)
 set -e
 n=${1:-100000}
@@ -24,7 +27,8 @@ mkdir -p build
 $MPICC -O2 -std=c99 -o build/test_mpi_nl_scale tests/mpi/test_mpi_nl.c -lm
 : > build/mpi_equivalence.txt
 for p in $PS; do
-  /usr/bin/time -f "P = $p: %e s wall, %M KB peak (largest rank)" $MPIRUN -np "$p" ./build/test_mpi_nl_scale --scale "$n" 2>&1 \
+  /usr/bin/time -f "P = $p: %e s wall, %M KB peak (largest rank)" $MPIRUN -np "$p" ./build/test_mpi_nl_scale \
+      "$([ -n "$QM_ONLY" ] && echo --scale-qm || echo --scale)" "$n" 2>&1 \
     | grep -v '^--\|^$\|Primary job\|non-zero exit\|mpirun detected\|Process name\|Exit code\|aborted\|thus causing\|terminated' \
     | tee -a build/mpi_equivalence.txt
 done

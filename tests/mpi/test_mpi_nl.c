@@ -8,7 +8,9 @@
    Exit status 0 iff every check passed on every rank. Built with mpicc
    (make test-mpi). With --scale n (last) only the GMG-POD/SP1 comparison
    runs, on a chain of n masses at r = 20, with a negative control (a
-   Gram-matrix POD must miss V^T (J - R) V): bench/mpi_equivalence.sh. */
+   Gram-matrix POD must miss V^T (J - R) V), then GMG-QM (POD and greedy
+   manifolds, r = 8) on the linear chain of n masses; --scale-qm n: only
+   the latter (bench/mpi_equivalence.sh). */
 #define _POSIX_C_SOURCE 199309L   /* nanosleep */
 #define PHGMG_MPI
 #define PHGMG_STATIC
@@ -23,7 +25,8 @@
 
 #include "mpi_harness.h"
 static const char *dir_;   /* argv[1]: a directory for the model files (none: not written) */
-static int scale_;         /* --scale n: only the GMG-POD/SP1 comparison, n masses, r = 20 */
+static int scale_;         /* --scale n: only the comparisons at scale, n masses (GMG-POD/SP1 r = 20, GMG-QM r = 8) */
+static int qm_only_;       /* --scale-qm n: only GMG-QM at scale */
 
 
 /* Wait for rank 0's serial comparisons without spinning (the other ranks
@@ -575,6 +578,230 @@ static void test_screened(void) {
   free(X); free(x0); free(V0); free(V0f);
 }
 
+/* Largest |si_i sj_j A - B| / max(sc, max |B|) (A, B: r x c; si, sj the
+   rows' and columns' signs; sc: the scale of the operator B is a block of). */
+static double qm_diff(int r, int c, const phgmg_real *A, const phgmg_real *B, const double *si, const double *sj,
+                      double sc) {
+  double e = 0.0, s = 0.0;
+  int i, j;
+  for (j = 0; j < c; ++j)
+    for (i = 0; i < r; ++i) {
+      e = fmax(e, fabs(si[i] * sj[j] * (double)A[i + (size_t)j * r] - (double)B[i + (size_t)j * r]));
+      s = fmax(s, fabs((double)B[i + (size_t)j * r]));
+    }
+  s = fmax(s, sc);
+  return s > 0.0 ? e / s : e;
+}
+
+/* Rank 0: a distributed GMG-QM model against the serial one. The basis
+   [B, V1] (the same selected modes: each column of V0f against the serial
+   V0 = lift(e_j) - V2 M(e_j kron e_j)), signs sg of V0's columns; the signs
+   sg2 of V2's modes from G01 (V2 itself stays distributed); then every
+   block of the quadratic model (G00, G01, G10, G11, Qh, Q01, Q11, Ms, Bh,
+   the kept terms' P0, P1, w), q_max and the outputs over nsteps steps. */
+static void compare_qm(const chain *ch, const double *x0, const phgmg_reduced *red, const phgmg_mpi_rom *mr,
+                       const double *V0f, int nsteps, double btol, double ytol, double *diffs, const char *tag) {
+  const phgmg_rom *ro = phgmg_reduced_rom(red), *rd = &mr->rom;
+  const int N = ch->N, r = mr->r, m = mr->m, p = r - m, rn = ro->rn;
+  const double *V2s = NULL, *Ms = NULL;
+  double sg[64], sg2[64], sgm[64 * 64], one = 1.0, e = 0.0, eb = 0.0, ew = 0.0, gsc = 0.0, xr[64], xd[64], *col = (double *)malloc(sizeof(double) * (size_t)N);
+  int i, j, a, same;
+  CHECK(rd->kind == PHGMG_ROM_QUADRATIC && rd->rn == rn && phgmg_reduced_qm(red, &V2s, &Ms) == rn, "%s: kind/rn", tag);
+  mode_signs(red, N, r, V0f, sg);
+  for (j = 0; j < r; ++j) {   /* the basis: the same modes */
+    double cm = 0.0, em = 0.0;
+    memset(xr, 0, sizeof xr); xr[j] = 1.0;
+    phgmg_reduced_lift(red, xr, col);
+    for (i = 0; j >= m && i < N; ++i)
+      for (a = 0; a < rn; ++a) col[i] -= V2s[i + (size_t)a * N] * Ms[a + (size_t)((j - m) * p + (j - m)) * rn];
+    for (i = 0; i < N; ++i) { em = fmax(em, fabs(sg[j] * V0f[i + (size_t)j * N] - col[i])); cm = fmax(cm, fabs(col[i])); }
+    eb = fmax(eb, em / cm);
+  }
+  CHECK(eb <= 100.0 * btol, "%s: basis [B, V1] %.2e (not the same modes)", tag, eb);
+  for (a = 0; a < rn; ++a) {   /* V2's signs */
+    double dt = 0.0;
+    for (i = 0; i < r; ++i) dt += sg[i] * (double)rd->G01[i + (size_t)a * r] * (double)ro->G01[i + (size_t)a * r];
+    sg2[a] = dt < 0.0 ? -1.0 : 1.0;
+  }
+  for (a = 0; a < p; ++a)
+    for (j = 0; j < p; ++j) sgm[a * p + j] = sg[m + a] * sg[m + j];
+  {   /* G01, G10, G11 on the scale of G = [V0, V2]^T (J - R)^{-1} [V0, V2] they are blocks of */
+    const phgmg_real *gb[4];
+    const int gn[4] = {r * r, r * rn, rn * r, rn * rn};
+    gb[0] = ro->G00; gb[1] = ro->G01; gb[2] = ro->G10; gb[3] = ro->G11;
+    for (a = 0; a < 4; ++a)
+      for (i = 0; i < gn[a]; ++i) gsc = fmax(gsc, fabs((double)gb[a][i]));
+  }
+#define QD(A, rr, cc, si, sj, sc) do { double t_ = qm_diff(rr, cc, rd->A, ro->A, si, sj, sc); \
+    CHECK(t_ <= btol, "%s: " #A " %.2e", tag, t_); e = fmax(e, t_); } while (0)
+  QD(G00, r, r, sg, sg, 0.0); QD(G01, r, rn, sg, sg2, gsc); QD(G10, rn, r, sg2, sg, gsc);
+  QD(G11, rn, rn, sg2, sg2, gsc); QD(Qh, r, r, sg, sg, 0.0); QD(Q11, rn, rn, sg2, sg2, 0.0);
+  QD(Ms, rn, p * p, sg2, sgm, 0.0); QD(Bh, r, m, sg, &one, 0.0);
+  {   /* Q01 = V0^T Q V2 is rounding for Q = I (V2 orthogonal to B and V1): on the scale of Qh */
+    double t_ = 0.0, s_ = 0.0;
+    for (i = 0; i < r * rn; ++i) t_ = fmax(t_, fabs(sg[i % r] * sg2[i / r] * rd->Q01[i] - ro->Q01[i]));
+    for (i = 0; i < r * r; ++i) s_ = fmax(s_, fabs(ro->Qh[i]));
+    CHECK(t_ <= btol * s_, "%s: Q01 %.2e", tag, t_ / s_);
+  }
+#undef QD
+  CHECK(fabs(rd->q_max[0] - ro->q_max[0]) <= btol * ro->q_max[0], "%s: q_max %.17g, serial %.17g", tag,
+        (double)rd->q_max[0], (double)ro->q_max[0]);
+  same = rd->nd == ro->nd && (rd->nd == 0 || (rd->P1 && ro->P1));
+  CHECK(same, "%s: %d terms, serial %d", tag, rd->nd, ro->nd);
+  for (j = 0; same && j < rd->nd; ++j) {   /* serial: the kept terms' numbers (every term: none stored, j) */
+    const int tj = red->term ? red->term[j] : j;
+    same = mr->pts[j] == tj && mr->coord[j] == ch->idx[tj] && fabs(rd->w[j] - ro->w[j]) <= 1e-12 * fabs(ro->w[j]);
+    ew = fmax(ew, fabs(rd->w[j] - ro->w[j]) / fabs(ro->w[j]));
+  }
+  CHECK(same, "%s: the kept terms or their weights differ", tag);
+  for (j = 0; same && j < rd->nd; ++j) {
+    for (a = 0; a < r; ++a) e = fmax(e, fabs(sg[a] * rd->P0[j + (size_t)a * rd->nd] - ro->P0[j + (size_t)a * rd->nd]));
+    for (a = 0; a < rn; ++a) e = fmax(e, fabs(sg2[a] * rd->P1[j + (size_t)a * rd->nd] - ro->P1[j + (size_t)a * rd->nd]));
+  }
+  CHECK(e <= btol, "%s: blocks/rows %.2e", tag, e);
+  phgmg_reduced_restrict(red, x0, xr);
+  for (j = 0; j < r; ++j) xd[j] = sg[j] * xr[j];
+  {
+    const double ey = online_diff(rd, ro, xd, xr, nsteps, tag);
+    CHECK(ey <= ytol, "%s: reduced outputs against the serial model's: %.2e", tag, ey);
+    if (diffs) { diffs[0] = e; diffs[1] = ey; }
+    printf("  %s: basis %.1e, blocks %.1e, q_max %.1e, %d terms (weights %.1e), outputs (%d steps) %.1e\n", tag, eb,
+           e, fabs(rd->q_max[0] - ro->q_max[0]) / ro->q_max[0], rd->nd, ew, nsteps, ey);
+  }
+  free(col);
+}
+
+/* Scale mode: how far the serial GMG-QM model itself moves when every
+   snapshot entry changes by one unit in the last place (as
+   serial_sensitivity): the blocks and outputs of compare_qm between the two
+   serial models; the tolerances become max(default, 10 x these). Rank 0. */
+static void qm_sensitivity(const chain *ch, int ns, const double *X, const double *x0, const phgmg_reduce_opts *o,
+                           const phgmg_reduced *red, double *btol, double *ytol) {
+  const int N = ch->N, r = o->r, m = 1, p = r - m;
+  double *X2 = (double *)malloc(sizeof(double) * (size_t)N * ns), *V0f, xr[64], d[2] = {0.0, 0.0};
+  const double *V2s = NULL, *Ms = NULL;
+  unsigned long long st = 2463534242ull;
+  phgmg_reduced *red2 = NULL;
+  phgmg_mpi_rom fake;
+  size_t i;
+  int j, a, rn;
+  for (i = 0; i < (size_t)N * ns; ++i) {
+    st ^= st << 13; st ^= st >> 7; st ^= st << 17;
+    X2[i] = X[i] * (1.0 + ((st >> 11) & 1 ? 1.0 : -1.0) * 2.220446049250313e-16);
+  }
+  CHECK(phgmg_reduce(&red2, &ch->sys, X2, N, ns, o, NULL, NULL) == PHGMG_OK, "serial GMG-QM, perturbed");
+  free(X2);
+  if (!red2) return;
+  rn = phgmg_reduced_qm(red2, &V2s, &Ms);
+  V0f = (double *)calloc((size_t)N * r, sizeof(double));
+  for (j = 0; j < r; ++j) {   /* the perturbed model's V0 = lift(e_j) - V2 M (e_j kron e_j) */
+    memset(xr, 0, sizeof xr); xr[j] = 1.0;
+    phgmg_reduced_lift(red2, xr, V0f + (size_t)j * N);
+    for (i = 0; j >= m && i < (size_t)N; ++i)
+      for (a = 0; a < rn; ++a) V0f[i + (size_t)j * N] -= V2s[i + (size_t)a * N] * Ms[a + (size_t)((j - m) * p + (j - m)) * rn];
+  }
+  memset(&fake, 0, sizeof fake);
+  fake.rom = *phgmg_reduced_rom(red2); fake.r = r; fake.m = m;
+  compare_qm(ch, x0, red, &fake, V0f, 100, HUGE_VAL, HUGE_VAL, d, "serial, perturbed");
+  *btol = fmax(*btol, 10.0 * d[0]);
+  *ytol = fmax(*ytol, 10.0 * d[1]);
+  free(V0f);
+  phgmg_reduced_destroy(red2);
+}
+
+/* Distributed GMG-QM (r = 8, rn = 4, 3 on the linear chain; manifold POD
+   and GREEDY) of the linear chain (no terms) and of the cosh chain (every
+   term kept, and ECSW at hyper.tol 1e-3) against the serial phgmg_reduce
+   with the same options; then unsupported options (the wide V2, ALTMIN, a
+   chosen lambda) refused on every rank, bad input on one rank and a solve
+   failing on one rank only. Scale mode (n masses): the linear chain only,
+   r = 8, rn = 3, without the error cases. */
+static void test_gmg_qm(int n, int r) {
+  const int N = 2 * n, ns = 81;
+  chain ch;
+  dist d;
+  double *X = (double *)malloc(sizeof(double) * (size_t)N * ns), *x0 = (double *)calloc((size_t)N, sizeof(double));
+  double *V0 = NULL, *V0f, *Vpod = NULL;
+  phgmg_reduce_opts o;
+  phgmg_reduced *red = NULL;
+  phgmg_mpi_rom mr;
+  phgmg_result rc;
+  int i, lin, mf;
+  for (lin = 1; lin >= (scale_ ? 1 : 0); --lin) {
+    chain_build(&ch, n, 0);
+    if (lin) { ch.sys.nl = PHGMG_NL_NONE; ch.sys.nsep = 0; }
+    for (i = 0; i < n; ++i) x0[2 * i] = 0.8 * sin(3.0 * 3.14159265358979 * i / n) + 0.3 * sin(7.0 * 3.14159265358979 * i / n);
+    simulate_root(&ch, x0, 0.2, ns, X);
+    dist_build(&d, &ch, ns, X);
+    if (lin) d.md.nsep = 0;
+    V0 = (double *)malloc(sizeof(double) * (size_t)d.ld * r);
+    for (mf = 0; mf < (lin ? 2 : 4); ++mf) {   /* the cosh chain: mf 2, 3 with ECSW */
+      char tag[64];
+      snprintf(tag, sizeof tag, "gmg-qm %s, %s chain%s", mf % 2 ? "greedy" : "pod", lin ? "linear" : "cosh",
+               mf > 1 ? ", ecsw" : "");
+      memset(&o, 0, sizeof o);
+      if (mf > 1) { o.hyper.on = 1; o.hyper.kind = PHGMG_HYPER_ECSW; o.hyper.tol = 1e-3; }
+      o.method = PHGMG_METHOD_GMG_QM; o.r = r; o.qm.rn = lin ? 3 : 4;   /* the linear chain's spectrum falls faster: V2's modes as well conditioned */
+      o.qm.manifold = mf % 2 ? PHGMG_MANIFOLD_GREEDY : PHGMG_MANIFOLD_POD;
+      rc = phgmg_mpi_reduce(d.c, &d.md, ns, d.Xl, d.ld, &o, &mr, V0, d.ld);
+      CHECK(rc == PHGMG_OK && same_everywhere(mr.nd), "distributed %s: %d", tag, (int)rc);
+      V0f = gather_v0(d.c, r, V0, d.ld);
+      if (rank_ == 0 && rc == PHGMG_OK) {
+        CHECK(phgmg_reduce(&red, &ch.sys, X, N, ns, &o, NULL, NULL) == PHGMG_OK, "serial %s", tag);
+        double btol = 1e-12, ytol = 1e-10;
+        if (red && scale_) qm_sensitivity(&ch, ns, X, x0, &o, red, &btol, &ytol);
+        if (red) compare_qm(&ch, x0, red, &mr, V0f, 100, btol, ytol, NULL, tag);
+        phgmg_reduced_destroy(red);
+        red = NULL;
+      }
+      if (rank_ == 0 && mf == 1 && Vpod && rc == PHGMG_OK) {   /* the greedy's modes outside the POD's leading p */
+        int j, k, out = 0;
+        for (j = 1; j < r; ++j) {
+          double best = 0.0;
+          for (k = 1; k < r; ++k) {
+            double dt = 0.0;
+            for (i = 0; i < N; ++i) dt += V0f[i + (size_t)j * N] * Vpod[i + (size_t)k * N];
+            best = fmax(best, fabs(dt));
+          }
+          out += best < 0.5;
+        }
+        printf("  %s: %d of the %d modes of V1 beyond the POD's leading ones\n", tag, out, r - 1);
+        CHECK(lin || out > 0, "%s: the greedy took the leading modes (a weak test)", tag);
+      }
+      quiet_barrier();
+      phgmg_mpi_rom_free(&mr);
+      if (mf == 0) { free(Vpod); Vpod = V0f; } else free(V0f);
+    }
+    free(Vpod);
+    Vpod = NULL;
+    if (!lin) {   /* what the distributed GMG-QM does not take: refused everywhere */
+      for (i = 0; i < 3; ++i) {
+        memset(&o, 0, sizeof o);
+        o.method = PHGMG_METHOD_GMG_QM; o.r = r; o.qm.rn = 6; o.qm.manifold = PHGMG_MANIFOLD_GREEDY;
+        if (i == 0) o.qm.rn = 0;                                 /* greedy's default: the wide V2 */
+        if (i == 1) o.qm.manifold = PHGMG_MANIFOLD_ALTMIN;
+        if (i == 2) o.select.lambda_mode = PHGMG_LAMBDA_REGRESSION;
+        memset(&mr, 1, sizeof mr);
+        rc = phgmg_mpi_reduce(d.c, &d.md, ns, d.Xl, d.ld, &o, &mr, NULL, 0);
+        CHECK(rc == PHGMG_ERR_UNSUPPORTED && same_everywhere(rc) && mr.mem_ == NULL, "gmg-qm unsupported %d: %d", i, rc);
+      }
+      memset(&o, 0, sizeof o);   /* bad input on one rank: an rn beyond N - r there, the solve failing on another */
+      o.method = PHGMG_METHOD_GMG_QM; o.r = r; o.qm.rn = 6;
+      if (rank_ == 0) o.qm.rn = N;
+      rc = phgmg_mpi_reduce(d.c, &d.md, ns, d.Xl, d.ld, &o, &mr, NULL, 0);
+      CHECK(rc == PHGMG_ERR_SIZE && same_everywhere(rc) && mr.mem_ == NULL, "gmg-qm rn beyond N - r on rank 0: %d", rc);
+      o.qm.rn = 6;
+      d.sv.fail_rank = size_ > 1 ? size_ - 1 : 0;
+      rc = phgmg_mpi_reduce(d.c, &d.md, ns, d.Xl, d.ld, &o, &mr, NULL, 0);
+      CHECK(rc == PHGMG_ERR_SINGULAR && same_everywhere(rc) && mr.mem_ == NULL, "gmg-qm failing solve on one rank: %d", rc);
+    }
+    dist_free(&d);
+    chain_free(&ch);
+    free(V0);
+  }
+  free(X); free(x0);
+}
+
 /* Bad input on one rank only (a term outside its rows, ids not ascending,
    another function family, a NaN coefficient) and options this function
    does not take: the same code on every rank, never a hang, *out zeroed. */
@@ -607,7 +834,7 @@ static void test_errors(void) {
       if (kase == 1) { sidx[0] = d.md.sep_id[1]; sidx[1] = d.md.sep_id[0]; md.sep_id = sidx; md.sep_idx = d.md.sep_idx; md.nsep = 2; }
       if (kase == 2) md.nexp = 1;                            /* another family than the other ranks' */
       if (kase == 3) { pn[0] = NAN; pn[1] = 0.0; md.poly = pn; md.nsep = 2; }
-      if (kase == 4) ob.method = PHGMG_METHOD_GMG_QM;
+      if (kase == 4) { ob.method = PHGMG_METHOD_GMG_QM; ob.qm.manifold = PHGMG_MANIFOLD_ALTMIN; }   /* not distributed */
     }
     if (kase == 1 || kase == 2) want = PHGMG_ERR_INVALID_ARG;
     if (kase == 2 && size_ == 1) continue;   /* one rank: nothing to disagree with */
@@ -674,14 +901,22 @@ int main(int argc, char **argv) {
   MPI_Init(&argc, &argv);
   MPI_Comm_rank(MPI_COMM_WORLD, &rank_);
   MPI_Comm_size(MPI_COMM_WORLD, &size_);
-  if (argc > 2 && !strcmp(argv[argc - 2], "--scale")) { scale_ = atoi(argv[argc - 1]); argc -= 2; }
+  if (argc > 2 && (!strcmp(argv[argc - 2], "--scale") || !strcmp(argv[argc - 2], "--scale-qm"))) {
+    qm_only_ = !strcmp(argv[argc - 2], "--scale-qm");
+    scale_ = atoi(argv[argc - 1]);
+    argc -= 2;
+  }
   dir_ = argc > 1 ? argv[1] : NULL;
   t0 = MPI_Wtime();
   if (rank_ == 0) printf("test_mpi_nl: P = %d\n", size_);
-  if (scale_ > 0) test_gmg_pod_ecsw(scale_, 20);
+  if (scale_ > 0) {
+    if (!qm_only_) test_gmg_pod_ecsw(scale_, 20);
+    test_gmg_qm(scale_, 8);
+  }
   else {
     test_gmg_pod_ecsw(1000, 12);
     test_screened();
+    test_gmg_qm(300, 8);
     test_errors();
     test_memory();
   }
