@@ -23196,6 +23196,7 @@ typedef struct phgmg__eksm {
   double p;                  /* shift of the inverse directions (A + p I)^{-1}       */
   double *V, *QV, *T, *G;
   double *AL, *U, *QU;       /* one buffer: N x w each                               */
+  int maxb;                  /* blocks at most (maxit)                                */
   int np, nm;                /* the last block: np columns from A, then nm from the
                                 inverse (fewer than m each after deflation)          */
   int up, um;                /* the same of the new block U                           */
@@ -23212,11 +23213,12 @@ PHGMG__PRIV void phgmg__lr_ltmul(const phgmg__spsym *S, const double *x, double 
   }
 }
 
-/* Room for one more block: V, QV (N x cap), T, G (cap x cap) grown by
-   doubling, their contents kept. */
+/* Room for one more block: V, QV (N x cap), T, G (cap x cap), first for
+   32 blocks, then grown by doubling (up to maxit blocks), their contents
+   kept. */
 PHGMG__PRIV phgmg_result phgmg__ek_grow(phgmg__eksm *st) {
   const size_t N = (size_t)st->N;
-  int cap = 2 * st->cap + 4 * st->w, j;
+  int cap = PHGMG__MIN(st->cap ? 2 * st->cap : 32 * st->w, st->maxb * st->w), j;
   double *V, *QV, *T, *G;
   if (st->nc + st->w <= st->cap) return PHGMG_OK;
   V = phgmg__dalloc(st->al, N * (size_t)cap);
@@ -23413,9 +23415,49 @@ PHGMG__PRIV phgmg_result phgmg__ek_resid(phgmg__eksm *st, const double *Y, doubl
   return rc;
 }
 
+/* The compression of Z = V Yh (Yh n x kp) without a QR of the N x kp
+   matrix: with the Euclidean Gram matrix G = V^T V = L L^T (Cholesky; V is
+   orthonormal in the energy inner product, so G is as well conditioned as
+   Q), V L^{-T} has orthonormal columns and the thin SVD L^T Yh = U S W^T
+   gives Z's singular values S; Z <- V L^{-T} U_k S_k (the singular values
+   above trunc sigma_1: the rule of phgmg_lradi's compression) into *Z.
+   PHGMG_ERR_SINGULAR when G is not numerically positive definite. */
+PHGMG__PRIV phgmg_result phgmg__ek_compress(phgmg__eksm *st, const double *Yh, int kp, double trunc, double **Z,
+                                            int *kz) {
+  const int n = st->nc, N = st->N, kmin = PHGMG__MIN(n, kp);
+  double *L = phgmg__dalloc(st->al, 3 * (size_t)n * (size_t)n + (size_t)n * (size_t)kp + (size_t)n), *M, *U, *S;
+  phgmg_result rc = PHGMG_OK;
+  int i, j, l, k = 0;
+  if (!L) return PHGMG_ERR_NOMEM;
+  M = L + (size_t)n * n; U = M + (size_t)n * kp; S = U + (size_t)n * n;
+  for (j = 0; j < n; ++j) memcpy(L + (size_t)j * n, st->G + (size_t)j * st->ld, sizeof(double) * (size_t)n);
+  if (phgmg__chol_small(n, L) != 0) rc = PHGMG_ERR_SINGULAR;
+  if (rc == PHGMG_OK) {
+    phgmg_gemm('T', 'N', n, kp, n, 1.0, L, n, Yh, n, 0.0, M, n);          /* L^T Yh */
+    rc = phgmg_svd(n, kp, M, n, kmin, S, U, n, NULL, 1, &k, NULL, st->al);
+  }
+  if (rc == PHGMG_OK) {
+    while (k > 1 && !(S[k - 1] > trunc * S[0])) --k;
+    for (j = 0; j < k; ++j) {                                             /* U_k S_k <- L^{-T} U_k S_k */
+      double *u = U + (size_t)j * n;
+      for (i = n - 1; i >= 0; --i) {
+        double t = u[i] * S[j];
+        for (l = i + 1; l < n; ++l) t -= L[l + (size_t)i * n] * u[l];
+        u[i] = t / L[i + (size_t)i * n];
+      }
+    }
+    if (!(*Z = phgmg__dalloc(st->al, (size_t)N * (size_t)k))) rc = PHGMG_ERR_NOMEM;
+  }
+  if (rc == PHGMG_OK) { phgmg_gemm('N', 'N', N, k, n, 1.0, st->V, N, U, n, 0.0, *Z, N); *kz = k; }
+  phgmg__free(st->al, L);
+  return rc;
+}
+
 /* The factor of the projected solution: Y = U diag(lambda) U^T, Z = V U_+
-   diag(sqrt(lambda_+)) (the positive eigenvalues; N x *kz, allocated), the
-   compression of phgmg_lradi (trunc > 0) applied. Y is destroyed. */
+   diag(sqrt(lambda_+)) (the positive eigenvalues; N x *kz, allocated),
+   compressed as phgmg_lradi's (trunc > 0; phgmg__ek_compress, or the QR
+   based phgmg__lr_compress should G not be positive definite). Y is
+   destroyed. */
 PHGMG__PRIV phgmg_result phgmg__ek_factor(phgmg__eksm *st, double *Y, double trunc, double **Z, int *kz) {
   const int n = st->nc, N = st->N;
   double *Ev = phgmg__dalloc(st->al, (size_t)n * (size_t)n + (size_t)n), *ev;
@@ -23427,16 +23469,21 @@ PHGMG__PRIV phgmg_result phgmg__ek_factor(phgmg__eksm *st, double *Y, double tru
   rc = phgmg_sym_eig(n, Y, n, ev, Ev, n);
   while (rc == PHGMG_OK && k0 < n && !(ev[k0] > 0.0)) ++k0;
   kp = n - k0;
+  if (rc == PHGMG_OK && kp == 0) rc = PHGMG_ERR_RANK;
+  for (j = k0; rc == PHGMG_OK && j < n; ++j) {
+    const double sq = sqrt(ev[j]);
+    int i;
+    for (i = 0; i < n; ++i) Ev[i + (size_t)j * n] *= sq;
+  }
+  if (rc == PHGMG_OK && trunc > 0.0) {
+    rc = phgmg__ek_compress(st, Ev + (size_t)k0 * n, kp, trunc, Z, kz);
+    if (rc != PHGMG_ERR_SINGULAR) { phgmg__free(st->al, Ev); return rc; }
+    rc = PHGMG_OK;
+  }
   memset(&lr, 0, sizeof lr);
   lr.al = st->al; lr.N = N; lr.kz = lr.cap = kp;
-  if (rc == PHGMG_OK && kp == 0) rc = PHGMG_ERR_RANK;
   if (rc == PHGMG_OK && !(lr.Z = phgmg__dalloc(st->al, (size_t)N * (size_t)kp))) rc = PHGMG_ERR_NOMEM;
   if (rc == PHGMG_OK) {
-    for (j = k0; j < n; ++j) {
-      const double sq = sqrt(ev[j]);
-      int i;
-      for (i = 0; i < n; ++i) Ev[i + (size_t)j * n] *= sq;
-    }
     phgmg_gemm('N', 'N', N, kp, n, 1.0, st->V, N, Ev + (size_t)k0 * n, n, 0.0, lr.Z, N);
     if (trunc > 0.0) rc = phgmg__lr_compress(&lr, trunc);
   }
@@ -23558,7 +23605,7 @@ PHGMG_DEF phgmg_result phgmg_lrkrylov(phgmg_shifted *s, int m, const double *B, 
   if ((rc = phgmg__ek_args(s, m, B, ldb, opts, &tol, &maxit, &trunc)) != PHGMG_OK) return rc;
   memset(&st, 0, sizeof st);
   nf0 = s->nfact;
-  st.s = s; st.al = alloc; st.N = s->N; st.m = m; st.w = 2 * m;
+  st.s = s; st.al = alloc; st.N = s->N; st.m = m; st.w = 2 * m; st.maxb = maxit;
   st.AL = phgmg__dalloc(alloc, 3 * (size_t)s->N * (size_t)st.w);
   wk = phgmg__dalloc(alloc, (size_t)st.w * (size_t)st.w + (size_t)st.w);
   if (!st.AL || !wk) rc = PHGMG_ERR_NOMEM;
