@@ -936,6 +936,18 @@
          projection shifts, residual-factor stop ||W^T W||_2 <= tol ||B^T
          B||_2 (tol 1e-10), column compression; phgmg_lradi_info reports
          steps, columns, rank, residual, factorizations;
+     phgmg_lrkrylov
+         the extended Krylov subspace method (EKSM) for the same equation
+         when E = I: ONE real sparse LU for the whole run (of A, or of A +
+         p I with a real p < 0 when the static pivots refuse A), a basis of
+         span{B, A^{-1} B, A B, A^{-2} B, ...} in blocks of 2 m columns, the
+         small projected equation by phgmg_lyap, the same residual measure,
+         stop (1e-10) and compression as phgmg_lradi; more columns than the
+         ADI, no shifts to choose. phgmg_lradi_opts.solver =
+         PHGMG_LYAP_EKSM makes phgmg_lradi -- so phgmg_lrbt, phgmg_lrphbt
+         and phgmg_balanced_reduce -- run it (the command line's reduce
+         --lyap eksm); zero (PHGMG_LYAP_ADI) keeps the ADI. A mass matrix or
+         algebraic lines: PHGMG_ERR_UNSUPPORTED (use the ADI);
      phgmg_lrbt
          low-rank square-root BT: Ar, Br, Cr (Er = I) like phgmg_bt, the
          Hankel singular values and the H-infinity bound 2 sum_{i > r}
@@ -944,7 +956,8 @@
    Vectors (B, Z, T, W, F, X) are in the object's internal ordering.
    phgmg_lradi_opts.progress (NULL: none) is called as progress(phase, user)
    like phgmg_reduce's (2.2): "lradi: shifts" before each new set of
-   projection shifts; phgmg_lrbt also calls "controllability Gramian",
+   projection shifts ("eksm: projected equation" before each projected
+   solve of phgmg_lrkrylov); phgmg_lrbt also calls "controllability Gramian",
    "observability Gramian" (not when J = 0: the dual model is the model and
    one ADI run serves both), "balancing" and "done".
 
@@ -2471,7 +2484,7 @@
    lowrank: phgmg_shifted_create, phgmg_shifted_solve, phgmg_shifted_apply,
            phgmg_shifted_transfer, phgmg_shifted_hinf,
            phgmg_shifted_factorizations, phgmg_shifted_destroy, phgmg_lradi,
-           phgmg_lowrank_free, phgmg_lrbt, phgmg_lrbt_feedthrough, phgmg_lrphbt, phgmg_ss_to_ph,
+           phgmg_lrkrylov, phgmg_lowrank_free, phgmg_lrbt, phgmg_lrbt_feedthrough, phgmg_lrphbt, phgmg_ss_to_ph,
            phgmg_balanced_reduce, phgmg_balanced_reduce_cached,
            phgmg_balanced_cache_free
    export: phgmg_rom_serialized_size, phgmg_rom_serialize,
@@ -4494,36 +4507,38 @@ typedef struct phgmg_lradi_info {
 PHGMG_DEF phgmg_result phgmg_lradi(phgmg_shifted *s, int m, const double *B, int ldb, const phgmg_lradi_opts *opts,
                                    double **Z, int *k, phgmg_lradi_info *info, const phgmg_allocator *alloc);
 /* The extended Krylov subspace method (EKSM; Simoncini, Druskin and
-   Knizhnerman) for A P + P A^T + B B^T = 0 (E = I) with the pencil of s, the
-   same contract as phgmg_lradi (Z, *k, info, opts; Z freed by
-   phgmg_lowrank_free): one real factorization of A serves the whole run.
-   The basis V of the extended Krylov space span{B, A^{-1} B, A B, A^{-2} B,
-   ...} grows by blocks of 2 m columns, [A V_j^+, A^{-1} V_j^-] from the
-   last block's two halves, orthonormalised in the energy inner product x^T
-   Q y (block Gram-Schmidt against the basis, done twice, then Cholesky QR
-   twice): then T = V^T Q A V has T + T^T = -2 V^T Q R Q V <= 0, so the
-   projected equation T Y + Y T^T + (V^T Q B)(V^T Q B)^T = 0 (Galerkin
-   with the test space Q V) is stable; T is built from one sparse product
-   with A and one with (J - R)^T per basis vector. After blocks 1, ..., 8
-   and then every quarter of the blocks so far, Y by phgmg_lyap and the
-   residual ||A V Y V^T + V Y V^T A^T + B B^T||_2 / ||B^T B||_2 -- the
-   relative spectral norm phgmg_lradi reports -- computed exactly through
-   the last block (A maps the earlier blocks into the basis) and a small
-   Gram matrix, no N x N matrix. Stop at tol (1e-10), then Z = V Y^{1/2}
-   compressed as phgmg_lradi's (singular values below trunc sigma_1, 1e-12,
-   dropped). When the static pivots of the sparse LU refuse A itself (a
-   mass-spring model's positions: zero diagonal), the inverse directions
-   use (A + p I)^{-1} with the real p = -|theta|, theta the Ritz value of A
-   on span(B) of least modulus (info->shift): the same space structure, one
-   pole moved off the origin. dual = 1 gives the dual model's factor, as
-   with phgmg_lradi. Memory: 4 m vectors of length N per block (the basis
-   and Q times it), maxit blocks at most (0: 100). info->iters counts
-   blocks, info->cols the basis's columns. Errors: as phgmg_lradi's
-   (PHGMG_ERR_RANK also when [B, A^{-1} B] is rank deficient;
-   _NOT_CONVERGED at maxit blocks or when the space became invariant
-   without reaching tol), PHGMG_ERR_UNSUPPORTED for a model with a mass
-   matrix E or algebraic lines (E != I: the operator E^{-1} A would need
-   solves with E, which the object does not make). Manual 8.13. */
+   Knizhnerman) for A P + P A^T + B B^T = 0 (E = I) with the pencil of s, with
+   the contract of phgmg_lradi (Z, *k, info, opts; Z freed by
+   phgmg_lowrank_free): one real factorization serves the whole run. The basis
+   V of the extended Krylov space span{B, A^{-1} B, A B, A^{-2} B, ...} grows
+   by blocks of 2 m columns, [A V_j^+, A^{-1} V_j^-] from the last block's two
+   halves, orthonormalised in the energy inner product x^T Q y (block
+   Gram-Schmidt against the basis, then modified Gram-Schmidt within the block,
+   the whole done twice; a direction whose part outside the basis is below 1e-8
+   of its norm is dropped, so blocks may get narrower). Then T = V^T Q A V has
+   T + T^T = -2 V^T Q R Q V <= 0, so the projected equation T Y + Y T^T + (V^T
+   Q B)(V^T Q B)^T = 0 (Galerkin with the test space Q V) is stable; T takes
+   one sparse product with A and one with (J - R)^T per basis vector. After
+   blocks 1, ..., 8 and then every quarter of the blocks so far: Y by
+   phgmg_lyap and the residual ||A V Y V^T + V Y V^T A^T + B B^T||_2 / ||B^T
+   B||_2 -- the relative spectral norm that phgmg_lradi reports -- from the
+   last block (A maps the earlier blocks into the basis) and a Gram matrix of
+   order n + 2 m (n the basis's columns), no N x N matrix. Stop at tol (1e-10),
+   then Z = V Y^{1/2} compressed as phgmg_lradi's (singular values below trunc
+   sigma_1, 1e-12, dropped; computed through V's small Gram matrix). When the
+   static pivots of the sparse LU refuse A itself (a mass-spring model's
+   positions: zero diagonal), the inverse directions use (A + p I)^{-1} with
+   the real p = -|theta|, theta the Ritz value of A on span(B) of least
+   modulus: the same structure of the space, its pole moved off the origin.
+   dual = 1 gives the dual model's factor, as with phgmg_lradi. Memory: 4 m
+   vectors of length N per block (the basis and Q times it; room for 32 blocks
+   first, doubled when needed), maxit blocks at most (0: 100). info: iters the
+   blocks, cols the basis's columns, shift the p used, factorizations 1 (2 when
+   A was refused), shift_sets 0. Errors: those of phgmg_lradi (_NOT_CONVERGED
+   at maxit blocks, or when no new direction is left before tol is reached),
+   PHGMG_ERR_UNSUPPORTED for a model with a mass matrix or algebraic lines (E
+   != I: E^{-1} A would need solves with E, which the object does not make; use
+   the ADI). Manual 8.13. */
 PHGMG_DEF phgmg_result phgmg_lrkrylov(phgmg_shifted *s, int m, const double *B, int ldb, const phgmg_lradi_opts *opts,
                                       double **Z, int *k, phgmg_lradi_info *info, const phgmg_allocator *alloc);
 /* Frees a factor from phgmg_lradi or phgmg_lrkrylov (NULL is fine). */
@@ -29242,6 +29257,13 @@ PHGMG_DEF phgmg_result phgmg_sym_eig(int n, double *A, int lda, double *w, doubl
 
 /*
    REVISION HISTORY
+   0.10.0 (unreleased)
+          - New: phgmg_lrkrylov, the extended Krylov subspace method for the
+            low-rank Lyapunov equation (E = I; one sparse LU per run),
+            chosen by phgmg_lradi_opts.solver = PHGMG_LYAP_EKSM wherever the
+            ADI runs (phgmg_lrbt, phgmg_lrphbt, phgmg_balanced_reduce);
+            phgmg_lradi_info.solver and .shift; the command line's reduce
+            --lyap adi|eksm (manual 8.13).
    0.9.0  (2026-11-29)
           - New: the low-rank tools take index-one SPARSE descriptor models
             (phgmg_shifted_create on the whole pencil, phgmg_lrbt with the
