@@ -4531,8 +4531,8 @@ PHGMG_DEF phgmg_result phgmg_lradi(phgmg_shifted *s, int m, const double *B, int
    the real p = -|theta|, theta the Ritz value of A on span(B) of least
    modulus: the same structure of the space, its pole moved off the origin.
    dual = 1 gives the dual model's factor, as with phgmg_lradi. Memory: 4 m
-   vectors of length N per block (the basis and Q times it; room for 32 blocks
-   first, doubled when needed), maxit blocks at most (0: 100). info: iters the
+   vectors of length N per block (the basis and Q times it; room for 256
+   columns first, doubled when needed), maxit blocks at most (0: 100). info: iters the
    blocks, cols the basis's columns, shift the p used, factorizations 1 (2 when
    A was refused), shift_sets 0. Errors: those of phgmg_lradi (_NOT_CONVERGED
    at maxit blocks, or when no new direction is left before tol is reached),
@@ -7179,7 +7179,9 @@ PHGMG__PRIV void phgmg__sdae_consistent(struct phgmg__sdae *D, const double *u, 
 #define PHGMG__DAE_BLOCK_MAX 1e8
 #define PHGMG__LR_STALL 0.5        /* LR-ADI: a shift cycle that leaves more than this of the residual ...   */
 #define PHGMG__LR_BLOCKS_MAX 48    /* ... doubles the projection shifts' window of blocks, up to this many   */
-#define PHGMG__EK_DEFL 1e-8       /* EKSM: a new direction whose part outside the basis is below this is deflated */
+#define PHGMG__EK_CAP0 256   /* EKSM: the basis' first allocation, columns (then doubled)                     */
+#define PHGMG__EK_CHUNK 64    /* EKSM: basis columns per step of the block Gram-Schmidt                        */
+#define PHGMG__EK_DEFL 1e-8   /* EKSM: a new direction whose part outside the basis is below this is deflated */
 #define PHGMG__LR_DAE_TOL 1e-12  /* index one of the low-rank tools: L_aa, Q_ac regular (the stepper's) */
 
 /* Row range [a, b] of the stored entries of column (or row) i. */
@@ -23209,7 +23211,7 @@ typedef struct phgmg__eksm {
   const phgmg_allocator *al;
   int N, m, w, nc, cap, ld;  /* w = 2 m columns per block; nc filled, cap allocated */
   double p;                  /* shift of the inverse directions (A + p I)^{-1}       */
-  double *V, *QV, *T, *G;
+  double *V, *QV, *T, *G, *tm; /* tm: cap x 2 w scratch (with T, G: one allocation)  */
   double *AL, *U, *QU;       /* one buffer: N x w each                               */
   int maxb;                  /* blocks at most (maxit)                                */
   int np, nm;                /* the last block: np columns from A, then nm from the
@@ -23229,16 +23231,17 @@ PHGMG__PRIV void phgmg__lr_ltmul(const phgmg__spsym *S, const double *x, double 
 }
 
 /* Room for one more block: V, QV (N x cap), T, G (cap x cap), first for
-   32 blocks, then grown by doubling (up to maxit blocks), their contents
-   kept. */
+   PHGMG__EK_CAP0 columns (whole blocks, one at least), then grown by
+   doubling (up to maxit blocks), their contents kept. */
 PHGMG__PRIV phgmg_result phgmg__ek_grow(phgmg__eksm *st) {
   const size_t N = (size_t)st->N;
-  int cap = PHGMG__MIN(st->cap ? 2 * st->cap : 32 * st->w, st->maxb * st->w), j;
+  const int cap0 = st->w * PHGMG__MAX(1, PHGMG__EK_CAP0 / st->w);
+  int cap = PHGMG__MIN(st->cap ? 2 * st->cap : cap0, st->maxb * st->w), j;
   double *V, *QV, *T, *G;
   if (st->nc + st->w <= st->cap) return PHGMG_OK;
   V = phgmg__dalloc(st->al, N * (size_t)cap);
   QV = phgmg__dalloc(st->al, N * (size_t)cap);
-  T = phgmg__dalloc(st->al, 2 * (size_t)cap * (size_t)cap);
+  T = phgmg__dalloc(st->al, 2 * (size_t)cap * (size_t)cap + 2 * (size_t)cap * (size_t)st->w);
   if (!V || !QV || !T) { phgmg__free(st->al, V); phgmg__free(st->al, QV); phgmg__free(st->al, T); return PHGMG_ERR_NOMEM; }
   G = T + (size_t)cap * (size_t)cap;
   if (st->nc) {
@@ -23250,21 +23253,22 @@ PHGMG__PRIV phgmg_result phgmg__ek_grow(phgmg__eksm *st) {
     }
   }
   phgmg__free(st->al, st->V); phgmg__free(st->al, st->QV); phgmg__free(st->al, st->T);
-  st->V = V; st->QV = QV; st->T = T; st->G = G; st->cap = st->ld = cap;
+  st->V = V; st->QV = QV; st->T = T; st->G = G; st->tm = G + (size_t)cap * (size_t)cap;
+  st->cap = st->ld = cap;
   return PHGMG_OK;
 }
 
-/* Block Gram-Schmidt of U's first c columns (QU = Q U along) against the
-   basis in the energy inner product, 2 m basis columns at a time (h: w x w
-   scratch). */
+/* Block modified Gram-Schmidt of U's first c columns against the basis in
+   the energy inner product, PHGMG__EK_CHUNK basis columns at a time (h:
+   PHGMG__EK_CHUNK x w scratch); QU is left stale (the caller recomputes
+   it). */
 PHGMG__PRIV void phgmg__ek_bgs(phgmg__eksm *st, int c, double *h) {
   const int N = st->N;
   int b;
-  for (b = 0; b < st->nc; b += st->w) {
-    const int cw = PHGMG__MIN(st->w, st->nc - b);
+  for (b = 0; b < st->nc; b += PHGMG__EK_CHUNK) {
+    const int cw = PHGMG__MIN(PHGMG__EK_CHUNK, st->nc - b);
     phgmg_gemm('T', 'N', cw, c, N, 1.0, st->QV + (size_t)b * N, N, st->U, N, 0.0, h, cw);
     phgmg_gemm('N', 'N', N, c, cw, -1.0, st->V + (size_t)b * N, N, h, cw, 1.0, st->U, N);
-    phgmg_gemm('N', 'N', N, c, cw, -1.0, st->QV + (size_t)b * N, N, h, cw, 1.0, st->QU, N);
   }
 }
 
@@ -23318,7 +23322,7 @@ PHGMG__PRIV void phgmg__ek_qmul(phgmg__eksm *st, int c) {
 PHGMG__PRIV int phgmg__ek_orth(phgmg__eksm *st, double *wk) {
   const int N = st->N;
   int c = st->up + st->um;
-  double *h = wk, *nrm = wk + (size_t)st->w * st->w;
+  double *h = wk, *nrm = wk + (size_t)PHGMG__EK_CHUNK * st->w;
   int j;
   for (j = 0; j < c; ++j) {
     const double *u = st->U + (size_t)j * N, *qu = st->QU + (size_t)j * N;
@@ -23338,18 +23342,23 @@ PHGMG__PRIV int phgmg__ek_orth(phgmg__eksm *st, double *wk) {
   return c;
 }
 
-/* Appends the orthonormal block U (QU) to the basis: AL = A U, the new
-   columns and rows of T = V^T Q A V (rows: (L^T Q V_k)^T Q V, L = J - R,
-   since Q A = Q L Q) and of G = V^T V. U is scratch afterwards. */
+/* Appends the orthonormal block U (QU) to the basis: AL = A U, X = L^T Q U
+   (L = J - R) next to it, the new columns and rows of T = V^T Q A V from
+   one product Q V^T [AL, X] (rows: V_k^T Q A V = (L^T Q V_k)^T Q V, since Q
+   A = Q L Q) and of G = V^T V. U is scratch afterwards. */
 PHGMG__PRIV void phgmg__ek_append(phgmg__eksm *st) {
   const int N = st->N, w = st->up + st->um, c0 = st->nc, c1 = c0 + w, ld = st->ld;
+  double *X = st->AL + (size_t)w * N, *M = st->tm; /* X: w columns after AL's w (AL + U hold 2 st->w) */
   int i, j;
   memcpy(st->V + (size_t)c0 * N, st->U, sizeof(double) * (size_t)N * (size_t)w);
   memcpy(st->QV + (size_t)c0 * N, st->QU, sizeof(double) * (size_t)N * (size_t)w);
   for (j = 0; j < w; ++j) phgmg__lr_amul(st->s->S, st->V + (size_t)(c0 + j) * N, st->AL + (size_t)j * N, st->s->w);
-  for (j = 0; j < w; ++j) phgmg__lr_ltmul(st->s->S, st->QU + (size_t)j * N, st->U + (size_t)j * N);
-  phgmg_gemm('T', 'N', c1, w, N, 1.0, st->QV, N, st->AL, N, 0.0, st->T + (size_t)c0 * ld, ld);
-  if (c0) phgmg_gemm('T', 'N', w, c0, N, 1.0, st->U, N, st->QV, N, 0.0, st->T + c0, ld);
+  for (j = 0; j < w; ++j) phgmg__lr_ltmul(st->s->S, st->QV + (size_t)(c0 + j) * N, X + (size_t)j * N);
+  phgmg_gemm('T', 'N', c1, 2 * w, N, 1.0, st->QV, N, st->AL, N, 0.0, M, c1);
+  for (j = 0; j < w; ++j) {
+    memcpy(st->T + (size_t)(c0 + j) * ld, M + (size_t)j * c1, sizeof(double) * (size_t)c1);
+    for (i = 0; i < c0; ++i) st->T[c0 + j + (size_t)i * ld] = M[i + (size_t)(w + j) * c1];
+  }
   phgmg_gemm('T', 'N', c1, w, N, 1.0, st->V, N, st->V + (size_t)c0 * N, N, 0.0, st->G + (size_t)c0 * ld, ld);
   for (j = c0; j < c1; ++j)
     for (i = 0; i < c0; ++i) st->G[j + (size_t)i * ld] = st->G[i + (size_t)j * ld];
@@ -23622,7 +23631,7 @@ PHGMG_DEF phgmg_result phgmg_lrkrylov(phgmg_shifted *s, int m, const double *B, 
   nf0 = s->nfact;
   st.s = s; st.al = alloc; st.N = s->N; st.m = m; st.w = 2 * m; st.maxb = maxit;
   st.AL = phgmg__dalloc(alloc, 3 * (size_t)s->N * (size_t)st.w);
-  wk = phgmg__dalloc(alloc, (size_t)st.w * (size_t)st.w + (size_t)st.w);
+  wk = phgmg__dalloc(alloc, (size_t)PHGMG__EK_CHUNK * (size_t)st.w + (size_t)st.w);
   if (!st.AL || !wk) rc = PHGMG_ERR_NOMEM;
   if (rc == PHGMG_OK) {
     st.U = st.AL + (size_t)s->N * (size_t)st.w; st.QU = st.U + (size_t)s->N * (size_t)st.w;
