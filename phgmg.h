@@ -2156,6 +2156,75 @@
    maxit steps (PHGMG_ERR_NOT_CONVERGED). Compression at the end: Z <- U_k
    S_k from the thin SVD (phgmg_svd), singular values above trunc = 1e-12
    sigma_1 (the Gramian changes by at most 1e-24 of its norm).
+   Extended Krylov (phgmg_lrkrylov; Simoncini 2007, Druskin and Knizhnerman).
+   For E = I, instead of one sparse LU per ADI shift, ONE real LU serves the
+   whole run: the space span{B, A^{-1} B, A B, A^{-2} B, ...} grows by blocks
+   of 2 m columns, block j + 1 from [A V_j^+, A^{-1} V_j^-] (the halves of
+   block j that came from A and from A^{-1}). The basis is orthonormal in the
+   energy inner product x^T Q y: then T = V^T Q A V = V^T Q (J - R) Q V has T
+   + T^T = -2 V^T Q R Q V <= 0, so the Galerkin equation T Y + Y T^T + b b^T =
+   0 (b = V^T Q B, test space Q V) is stable whenever the model is; in the
+   Euclidean product V^T A V need not be stable when Q != I. T's new columns
+   V^T Q (A V_j) and rows (L^T Q V_j)^T Q V (L = J - R, Q A = Q L Q) take one
+   product Q V^T [A V_j, L^T Q V_j] per block; no product with A^T.
+   Orthonormalisation: block Gram-Schmidt against the basis (64 columns at a
+   time), modified Gram-Schmidt within the block, all twice, with Q V_j
+   recomputed from V_j after each pass (updating Q U along with U drifts when
+   a column is normalised from a small rest: on the 16 x 16 lattice the energy
+   orthogonality fell to 4e-2 at 88 columns and the residual grew from 1e-5 to
+   2e-2); a direction whose rest is below 1e-8 of its norm lies in the basis
+   to that accuracy and is dropped (the 8 x 8 lattice, whose reachable space
+   is about 64 of its 128 states, narrows its blocks after 13 of them and
+   stops at 70 columns).
+   Residual. A maps the first j - 1 blocks into the first j, so A V = V T +
+   W_L E_j^T with W_L = A V_j - V T(:, j) (the last block only), and with Y
+   the projected solution R = A V Y V^T + V Y V^T A^T + B B^T = X [0, Y_L^T;
+   Y_L, 0] X^T, X = [V, W_L], Y_L = Y's last rows: ||R||_2 is the largest
+   |eigenvalue| of Gamma^{1/2} [0, Y_L^T; Y_L, 0] Gamma^{1/2}, Gamma = X^T X
+   of order n + 2 m (from V^T V, kept up to date, V^T W_L and W_L^T W_L). It
+   is the 2-norm relative to ||B^T B||_2 that LR-ADI reports, and the same
+   stop (1e-10). Y comes from phgmg_lyap (the sign iteration, O(n^3) per
+   step), so the projected equation is solved after blocks 1, ..., 8 and then
+   every quarter of the blocks so far. Z = V Y^{1/2} is compressed by the rule
+   of LR-ADI (singular values below 1e-12 sigma_1 dropped), its SVD from the
+   small matrix L^T Y^{1/2} with V^T V = L L^T (V L^{-T} has orthonormal
+   columns), never a QR of the N x n factor.
+   The pole. The sparse LU's static pivots refuse A itself where the
+   factorization condenses states with a zero diagonal (a mass-spring model's
+   positions, 8.12): then the inverse directions use (A + p I)^{-1} with p =
+   -|theta|, theta the Ritz value of A on span(B) of least modulus -- a
+   rational Krylov space with one real pole instead of 0, the same algebra (A
+   (A + p I)^{-1} = I - p (A + p I)^{-1}, so A still maps each block into the
+   next). On the lattices p = -0.540 (the damping of the corner masses). A
+   mass matrix would need solves with E for E^{-1} A (the object has none):
+   PHGMG_ERR_UNSUPPORTED, the ADI serves such models.
+   Checked (tests/test_eksm.c): the 16 x 16 heat model (N = 256, p = 0, one
+   factorization): Z Z^T within 2.3e-12 (relative, Frobenius) of the dense
+   Gramian from R's eigen-decomposition, the residual of a run at tol 1e-7
+   (6.69e-10) equal to the densely recomputed one to 1e-6, Hankel singular
+   values within 4e-15 sigma_1 of the dense values and of the ADI's; the 7 x 7
+   lattice (N = 98, p = -0.540): P and O = Q Zy Zy^T Q (dual model) within
+   6e-15 of phgmg_lyap's, the residual (tol 1e-4 run, 7.66e-6) to 5e-11,
+   Hankel singular values within 6e-15 sigma_1 of the dense ones and 5e-12
+   sigma_1 of the ADI's; bad arguments, a mass matrix (PHGMG_ERR_UNSUPPORTED),
+   too few blocks (PHGMG_ERR_NOT_CONVERGED). tests/test_cli_lowrank.sh:
+   `reduce --method bt --lyap eksm` on the 8 x 8 lattice, Hankel singular
+   values within 1.2e-10 sigma_1 of the --lyap adi run's.
+   Measured (bench/bench_lowrank.c --lyap eksm against --lyap adi, r = 20, AMD
+   EPYC under KVM, 2 vCPUs shared with other jobs, CPU time user + sys of the
+   whole run, two runs each; bench/README.md): heat N = 100 489: EKSM 10.0 -
+   10.3 s, 41 blocks, 164 columns -> rank 125, residual 4.8e-12, 1
+   factorization, 500 MB peak; ADI 9.6 - 9.7 s, 50 steps, rank 97, residual
+   9.2e-11, 50 factorizations, 472 MB. Lattice N = 100 352 (p = -0.540, two
+   Gramians): EKSM 27.1 - 29.2 s, 51 blocks, 204 columns -> rank 187, residual
+   3.2e-11, 790 MB; ADI 33.1 - 37.4 s, 87 steps, rank 170, residual 5.5e-11,
+   46 factorizations per Gramian, 839 MB. The Hankel singular values printed
+   agree (sigma_1, sigma_20 to 4 digits). So on these 2-D models EKSM is as
+   fast as the ADI on the heat model and about 20 % faster on the lightly
+   damped lattice, with wider factors (its blocks of 2 m columns are each
+   orthogonalised against the whole basis: O(N n^2), the larger part of its
+   time); the one factorization saves most where a factorization is expensive
+   (not measured here: 3-D meshes), and no shifts are chosen.
    Balanced truncation: Z_o^T E Z_c = U S V^T, T = Z_c V_r S_r^{-1/2}, W =
    Z_o U_r S_r^{-1/2}, so W^T E T = I and the reduced model is Ar = W^T A T,
    Br = W^T B, Cr = B^T Q T (Er = I). The Hankel singular values beyond the

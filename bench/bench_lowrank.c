@@ -163,7 +163,7 @@ int main(int argc, char **argv) {
   if (lo.solver == PHGMG_LYAP_EKSM)
     printf("  EKSM inverse directions: (A + p I)^{-1} with p = %.4g (controllability), %.4g (observability)\n",
            inf.ctrl.shift, inf.obs.shift);
-  printf("  Hankel singular values computed %d; sigma_1 %.6e, sigma_r %.3e, sigma_r+1 %.3e; bound 2 sum_{i>r} / sigma_1 = %.2e\n",
+  printf("  Hankel singular values computed %d; sigma_1 %.6e, sigma_r %.6e, sigma_r+1 %.6e; bound 2 sum_{i>r} / sigma_1 = %.2e\n",
          inf.nhsv, hsv[0], hsv[r - 1], inf.hsv_tail, inf.bound / hsv[0]);
   if (nw > 0) {
     phgmg_shifted *s = NULL;
