@@ -4616,7 +4616,7 @@ PHGMG_DEF void phgmg_lowrank_free(double *Z, const phgmg_allocator *alloc);
 
 /* What low-rank balanced truncation did. */
 typedef struct phgmg_lrbt_info {
-  phgmg_lradi_info ctrl, obs; /* the two ADI runs (obs = ctrl when J = 0: one run) */
+  phgmg_lradi_info ctrl, obs; /* the two ADI (or EKSM) runs (obs = ctrl when J = 0: one run) */
   int nhsv;                   /* Hankel singular values computed (the rank of Z_o^T E Z_c) */
   double bound;               /* 2 sum_{i > r} sigma_i over the computed ones (approximate) */
   double hsv_tail;            /* sigma_{r+1} (0 if not computed)                    */
@@ -4704,7 +4704,8 @@ typedef struct phgmg_balanced_info {
   int inter;           /* the intermediate order of a two-stage PRBT (0: none)                   */
   double ph_change;    /* BT: the change of phgmg_ss_to_ph (two-stage PRBT: of its first stage) */
   double res_ctrl, res_obs; /* Lyapunov residuals, relative (low-rank: the ADI's ||W^T W|| /
-                          ||B^T B||; dense: phgmg_lyap_residual's); PHBT: res_obs 0             */
+                          ||B^T B||, or EKSM's same measure; dense: phgmg_lyap_residual's); PHBT:
+                          res_obs 0                                                              */
   int nsv;             /* values written to sv                                                   */
   int hmin;            /* PHBT: 1 balanced against the minimal Hamiltonian, 0 against the energy Q */
 } phgmg_balanced_info;
