@@ -23716,6 +23716,7 @@ PHGMG_DEF phgmg_result phgmg_lrkrylov(phgmg_shifted *s, int m, const double *B, 
   if (rc == PHGMG_OK && (orc = phgmg__ek_orth(&st, wk)) <= 0) rc = orc == 0 ? PHGMG_ERR_RANK : PHGMG_ERR_NANINF;
   if (rc == PHGMG_OK) {
     phgmg__ek_append(&st);
+    inf.res = 1.0;   /* Z = 0: the residual B B^T */
     rc = phgmg__ek_iterate(&st, B, ldb, opts, tol, maxit, bnorm, wk, &Y, &inf);
   }
   inf.cols = st.nc;
