@@ -23313,7 +23313,10 @@ PHGMG__PRIV phgmg_result phgmg__ek_grow(phgmg__eksm *st) {
   V = phgmg__dalloc(st->al, N * (size_t)cap);
   QV = phgmg__dalloc(st->al, N * (size_t)cap);
   T = phgmg__dalloc(st->al, 2 * (size_t)cap * (size_t)cap + 2 * (size_t)cap * (size_t)st->w);
-  if (!V || !QV || !T) { phgmg__free(st->al, V); phgmg__free(st->al, QV); phgmg__free(st->al, T); return PHGMG_ERR_NOMEM; }
+  if (!V || !QV || !T) {
+    phgmg__free(st->al, V); phgmg__free(st->al, QV); phgmg__free(st->al, T);
+    return PHGMG_ERR_NOMEM;
+  }
   G = T + (size_t)cap * (size_t)cap;
   if (st->nc) {
     memcpy(V, st->V, sizeof(double) * N * (size_t)st->nc);
