@@ -985,6 +985,18 @@
          projection shifts, residual-factor stop ||W^T W||_2 <= tol ||B^T
          B||_2 (tol 1e-10), column compression; phgmg_lradi_info reports
          steps, columns, rank, residual, factorizations;
+     phgmg_lrkrylov
+         the extended Krylov subspace method (EKSM) for the same equation
+         when E = I: ONE real sparse LU for the whole run (of A, or of A +
+         p I with a real p < 0 when the static pivots refuse A), a basis of
+         span{B, A^{-1} B, A B, A^{-2} B, ...} in blocks of 2 m columns, the
+         small projected equation by phgmg_lyap, the same residual measure,
+         stop (1e-10) and compression as phgmg_lradi; more columns than the
+         ADI, no shifts to choose. phgmg_lradi_opts.solver =
+         PHGMG_LYAP_EKSM makes phgmg_lradi -- so phgmg_lrbt, phgmg_lrphbt
+         and phgmg_balanced_reduce -- run it (the command line's reduce
+         --lyap eksm); zero (PHGMG_LYAP_ADI) keeps the ADI. A mass matrix or
+         algebraic lines: PHGMG_ERR_UNSUPPORTED (use the ADI);
      phgmg_lrbt
          low-rank square-root BT: Ar, Br, Cr (Er = I) like phgmg_bt, the
          Hankel singular values and the H-infinity bound 2 sum_{i > r}
@@ -993,7 +1005,8 @@
    Vectors (B, Z, T, W, F, X) are in the object's internal ordering.
    phgmg_lradi_opts.progress (NULL: none) is called as progress(phase, user)
    like phgmg_reduce's (2.2): "lradi: shifts" before each new set of
-   projection shifts; phgmg_lrbt also calls "controllability Gramian",
+   projection shifts ("eksm: projected equation" before each projected
+   solve of phgmg_lrkrylov); phgmg_lrbt also calls "controllability Gramian",
    "observability Gramian" (not when J = 0: the dual model is the model and
    one ADI run serves both), "balancing" and "done".
 
@@ -2198,6 +2211,76 @@
    maxit steps (PHGMG_ERR_NOT_CONVERGED). Compression at the end: Z <- U_k
    S_k from the thin SVD (phgmg_svd), singular values above trunc = 1e-12
    sigma_1 (the Gramian changes by at most 1e-24 of its norm).
+   Extended Krylov (phgmg_lrkrylov; Simoncini 2007, Druskin and Knizhnerman).
+   For E = I, instead of one sparse LU per ADI shift, ONE real LU serves the
+   whole run: the space span{B, A^{-1} B, A B, A^{-2} B, ...} grows by blocks
+   of 2 m columns, block j + 1 from [A V_j^+, A^{-1} V_j^-] (the halves of
+   block j that came from A and from A^{-1}). The basis is orthonormal in the
+   energy inner product x^T Q y: then T = V^T Q A V = V^T Q (J - R) Q V has T
+   + T^T = -2 V^T Q R Q V <= 0, so the Galerkin equation T Y + Y T^T + b b^T =
+   0 (b = V^T Q B, test space Q V) is stable whenever the model is; in the
+   Euclidean product V^T A V need not be stable when Q != I. T's new columns
+   V^T Q (A V_j) and rows (L^T Q V_j)^T Q V (L = J - R, Q A = Q L Q) take one
+   product Q V^T [A V_j, L^T Q V_j] per block; no product with A^T.
+   Orthonormalisation: block Gram-Schmidt against the basis (64 columns at a
+   time), modified Gram-Schmidt within the block, all twice, with Q V_j
+   recomputed from V_j after each pass (updating Q U along with U drifts when
+   a column is normalised from a small rest: on the 16 x 16 lattice the energy
+   orthogonality fell to 4e-2 at 88 columns and the residual grew from 1e-5 to
+   2e-2); a direction whose rest is below 1e-8 of its norm lies in the basis
+   to that accuracy and is dropped (the 8 x 8 lattice, whose reachable space
+   is about 64 of its 128 states, narrows its blocks after 13 of them and
+   stops at 70 columns).
+   Residual. A maps the first j - 1 blocks into the first j, so A V = V T +
+   W_L E_j^T with W_L = A V_j - V T(:, j) (the last block only), and with Y
+   the projected solution R = A V Y V^T + V Y V^T A^T + B B^T = X [0, Y_L^T;
+   Y_L, 0] X^T, X = [V, W_L], Y_L = Y's last rows: ||R||_2 is the largest
+   |eigenvalue| of Gamma^{1/2} [0, Y_L^T; Y_L, 0] Gamma^{1/2}, Gamma = X^T X
+   of order n + 2 m (from V^T V, kept up to date, V^T W_L and W_L^T W_L). It
+   is the 2-norm relative to ||B^T B||_2 that LR-ADI reports, and the same
+   stop (1e-10). Y comes from phgmg_lyap (the sign iteration, O(n^3) per
+   step), so the projected equation is solved after blocks 1, ..., 8 and then
+   every quarter of the blocks so far. Z = V Y^{1/2} is compressed by the rule
+   of LR-ADI (singular values below 1e-12 sigma_1 dropped), its SVD from the
+   small matrix L^T Y^{1/2} with V^T V = L L^T (V L^{-T} has orthonormal
+   columns), never a QR of the N x n factor.
+   The pole. The sparse LU's static pivots refuse A itself where the
+   factorization condenses states with a zero diagonal (a mass-spring model's
+   positions, 8.12): then the inverse directions use (A + p I)^{-1} with p =
+   -|theta|, theta the Ritz value of A on span(B) of least modulus -- a
+   rational Krylov space with one real pole instead of 0, the same algebra (A
+   (A + p I)^{-1} = I - p (A + p I)^{-1}, so A still maps each block into the
+   next). On the lattices p = -0.540 (the damping of the corner masses). A
+   mass matrix would need solves with E for E^{-1} A (the object has none):
+   PHGMG_ERR_UNSUPPORTED, the ADI serves such models.
+   Checked (tests/test_eksm.c): the 16 x 16 heat model (N = 256, p = 0, one
+   factorization): Z Z^T within 2.3e-12 (relative, Frobenius) of the dense
+   Gramian from R's eigen-decomposition, the residual of a run at tol 1e-7
+   (6.69e-10) equal to the densely recomputed one to 1e-6, Hankel singular
+   values within 4e-15 sigma_1 of the dense values and of the ADI's; the 7 x 7
+   lattice (N = 98, p = -0.540): P and O = Q Zy Zy^T Q (dual model) within
+   6e-15 of phgmg_lyap's, the residual (tol 1e-4 run, 7.66e-6) to 5e-11,
+   Hankel singular values within 6e-15 sigma_1 of the dense ones and 5e-12
+   sigma_1 of the ADI's; bad arguments, a mass matrix (PHGMG_ERR_UNSUPPORTED),
+   too few blocks (PHGMG_ERR_NOT_CONVERGED). tests/test_cli_lowrank.sh:
+   `reduce --method bt --lyap eksm` on the 8 x 8 lattice, Hankel singular
+   values within 1.2e-10 sigma_1 of the --lyap adi run's.
+   Measured (bench/bench_lowrank.c --lyap eksm against --lyap adi, r = 20, AMD
+   EPYC under KVM, 2 vCPUs shared with other jobs, CPU time user + sys of the
+   whole run, two runs each; bench/README.md): heat N = 100 489: EKSM 10.0 -
+   10.3 s, 41 blocks, 164 columns -> rank 125, residual 4.8e-12, 1
+   factorization, 500 MB peak; ADI 9.6 - 9.7 s, 50 steps, rank 97, residual
+   9.2e-11, 50 factorizations, 472 MB. Lattice N = 100 352 (p = -0.540, two
+   Gramians): EKSM 27.1 - 29.2 s, 51 blocks, 204 columns -> rank 187, residual
+   3.2e-11, 790 MB; ADI 33.1 - 37.4 s, 87 steps, rank 170, residual 5.5e-11,
+   46 factorizations per Gramian, 839 MB. The Hankel singular values agree:
+   sigma_1 and sigma_20 to the 7 digits printed (sigma_21, at the level of the
+   ADI's accuracy, 2.2e-8 sigma_1 apart). So on these 2-D models EKSM is as
+   fast as the ADI on the heat model and about 20 % faster on the lightly
+   damped lattice, with wider factors (its blocks of 2 m columns are each
+   orthogonalised against the whole basis: O(N n^2), the larger part of its
+   time); the one factorization saves most where a factorization is expensive
+   (not measured here: 3-D meshes), and no shifts are chosen.
    Balanced truncation: Z_o^T E Z_c = U S V^T, T = Z_c V_r S_r^{-1/2}, W =
    Z_o U_r S_r^{-1/2}, so W^T E T = I and the reduced model is Ar = W^T A T,
    Br = W^T B, Cr = B^T Q T (Er = I). The Hankel singular values beyond the
@@ -2526,7 +2609,7 @@
    lowrank: phgmg_shifted_create, phgmg_shifted_solve, phgmg_shifted_apply,
            phgmg_shifted_transfer, phgmg_shifted_hinf,
            phgmg_shifted_factorizations, phgmg_shifted_destroy, phgmg_lradi,
-           phgmg_lowrank_free, phgmg_lrbt, phgmg_lrbt_feedthrough, phgmg_lrphbt, phgmg_ss_to_ph,
+           phgmg_lrkrylov, phgmg_lowrank_free, phgmg_lrbt, phgmg_lrbt_feedthrough, phgmg_lrphbt, phgmg_ss_to_ph,
            phgmg_balanced_reduce, phgmg_balanced_reduce_cached,
            phgmg_balanced_cache_free
    export: phgmg_rom_serialized_size, phgmg_rom_serialize,
@@ -2547,7 +2630,7 @@
            phgmg_lu_rcond, phgmg_norm1, phgmg_normf, phgmg_zlu_factor,
            phgmg_zlu_solve, phgmg_qr, phgmg_qrcp, phgmg_qr_form_q,
            phgmg_qr_apply, phgmg_lstsq, phgmg_svd, phgmg_sym_eig
-   (177 functions; 23 of them only with PHGMG_MPI; also the macros
+   (178 functions; 23 of them only with PHGMG_MPI; also the macros
    PHGMG_ROM_STEPPER_MEMSIZE_MAX and _MAX_CB.)
 */
 #ifndef PHGMG_H_INCLUDED
@@ -4491,10 +4574,19 @@ PHGMG_DEF int phgmg_shifted_factorizations(const phgmg_shifted *s);
 /* Frees the object (NULL is fine). */
 PHGMG_DEF void phgmg_shifted_destroy(phgmg_shifted *s);
 
-/* Options of the low-rank ADI (zero: default). */
+/* The solvers of the low-rank Lyapunov equation (phgmg_lradi_opts.solver). */
+enum {
+  PHGMG_LYAP_ADI = 0,  /* low-rank ADI (phgmg_lradi; the default)                  */
+  PHGMG_LYAP_EKSM = 1  /* extended Krylov subspace method (phgmg_lrkrylov; E = I) */
+};
+
+/* Options of the low-rank Lyapunov solvers (zero: default, low-rank ADI). */
 typedef struct phgmg_lradi_opts {
-  double tol;        /* stop when ||W^T W||_2 <= tol ||B^T B||_2 (0: 1e-10)        */
-  int maxit;         /* ADI steps, a complex pair counting two (0: 500)            */
+  double tol;        /* stop when the relative residual ||A Z Z^T E^T + E Z Z^T
+                        A^T + B B^T||_2 / ||B^T B||_2 <= tol (0: 1e-10); ADI:
+                        ||W^T W||_2 <= tol ||B^T B||_2, the same quantity         */
+  int maxit;         /* ADI steps, a complex pair counting two (0: 500); EKSM:
+                        blocks of 2 m basis vectors (0: 100)                      */
   int shift_blocks;  /* projection shifts: Ritz values on the last this many
                         ADI blocks (0: 6); doubled (up to 48) after a cycle of
                         shifts that leaves more than half of the residual      */
@@ -4502,17 +4594,25 @@ typedef struct phgmg_lradi_opts {
                         dropped (0: 1e-12; < 0: no compression)                    */
   void (*progress)(const char *phase, void *user); /* NULL: none (manual 2.8)      */
   void *progress_user;
+  int solver;        /* PHGMG_LYAP_ADI (0): low-rank ADI; PHGMG_LYAP_EKSM: the
+                        extended Krylov method (phgmg_lrkrylov). phgmg_lradi, and
+                        so phgmg_lrbt, phgmg_lrphbt and phgmg_balanced_reduce,
+                        run the one chosen here (shift_blocks: ADI only)         */
 } phgmg_lradi_opts;
 
 /* What a low-rank ADI run did. */
 typedef struct phgmg_lradi_info {
-  int iters;        /* ADI steps (a complex pair counts two)                    */
+  int iters;        /* ADI steps (a complex pair counts two); EKSM: blocks      */
   int cols;         /* columns of Z before compression                          */
   int rank;         /* columns after compression (= *k)                         */
-  int shift_sets;   /* projection-shift computations                            */
+  int shift_sets;   /* projection-shift computations (EKSM: 0)                  */
   int factorizations; /* numeric factorizations of the shifted matrices         */
   double res;       /* ||W^T W||_2 / ||B^T B||_2 at the stop: the relative
-                       residual ||A Z Z^T E^T + E Z Z^T A^T + B B^T||_2 / ||B^T B||_2 */
+                       residual ||A Z Z^T E^T + E Z Z^T A^T + B B^T||_2 / ||B^T B||_2
+                       (EKSM: the same quantity, computed from the projection) */
+  int solver;       /* the solver that ran: PHGMG_LYAP_ADI or PHGMG_LYAP_EKSM    */
+  double shift;     /* EKSM: the real shift p of the inverse directions (A + p
+                       I)^{-1} (0: A^{-1}; see phgmg_lrkrylov); ADI: 0           */
 } phgmg_lradi_info;
 
 /* Low-rank ADI for A P E^T + E P A^T + B B^T = 0 with the pencil of s
@@ -4528,15 +4628,52 @@ typedef struct phgmg_lradi_info {
    maxit/shift_blocks, trunc >= 1 or NaN), _NANINF (B), _RANK (B = 0), _NOT_STABLE (no Ritz value of the pencil in
    the open left half-plane: no shift), _NOT_CONVERGED (maxit reached; info
    then holds the residual reached, *Z NULL), the codes of
-   phgmg_shifted_solve, _NOMEM. */
+   phgmg_shifted_solve, _NOMEM. With opts->solver = PHGMG_LYAP_EKSM it is
+   phgmg_lrkrylov (its arguments, results and codes); another solver value:
+   PHGMG_ERR_INVALID_ARG. */
 PHGMG_DEF phgmg_result phgmg_lradi(phgmg_shifted *s, int m, const double *B, int ldb, const phgmg_lradi_opts *opts,
                                    double **Z, int *k, phgmg_lradi_info *info, const phgmg_allocator *alloc);
-/* Frees a factor from phgmg_lradi (NULL is fine). */
+/* The extended Krylov subspace method (EKSM; Simoncini, Druskin and
+   Knizhnerman) for A P + P A^T + B B^T = 0 (E = I) with the pencil of s, with
+   the contract of phgmg_lradi (Z, *k, info, opts; Z freed by
+   phgmg_lowrank_free): one real factorization serves the whole run. The basis
+   V of the extended Krylov space span{B, A^{-1} B, A B, A^{-2} B, ...} grows
+   by blocks of 2 m columns, [A V_j^+, A^{-1} V_j^-] from the last block's two
+   halves, orthonormalised in the energy inner product x^T Q y (block
+   Gram-Schmidt against the basis, then modified Gram-Schmidt within the block,
+   the whole done twice; a direction whose part outside the basis is below 1e-8
+   of its norm is dropped, so blocks may get narrower). Then T = V^T Q A V has
+   T + T^T = -2 V^T Q R Q V <= 0, so the projected equation T Y + Y T^T + (V^T
+   Q B)(V^T Q B)^T = 0 (Galerkin with the test space Q V) is stable; T takes
+   one sparse product with A and one with (J - R)^T per basis vector. After
+   blocks 1, ..., 8 and then every quarter of the blocks so far: Y by
+   phgmg_lyap and the residual ||A V Y V^T + V Y V^T A^T + B B^T||_2 / ||B^T
+   B||_2 -- the relative spectral norm that phgmg_lradi reports -- from the
+   last block (A maps the earlier blocks into the basis) and a Gram matrix of
+   order n + 2 m (n the basis's columns), no N x N matrix. Stop at tol (1e-10),
+   then Z = V Y^{1/2} compressed as phgmg_lradi's (singular values below trunc
+   sigma_1, 1e-12, dropped; computed through V's small Gram matrix). When the
+   static pivots of the sparse LU refuse A itself (a mass-spring model's
+   positions: zero diagonal), the inverse directions use (A + p I)^{-1} with
+   the real p = -|theta|, theta the Ritz value of A on span(B) of least
+   modulus: the same structure of the space, its pole moved off the origin.
+   dual = 1 gives the dual model's factor, as with phgmg_lradi. Memory: 4 m
+   vectors of length N per block (the basis and Q times it; room for 256
+   columns first, doubled when needed), maxit blocks at most (0: 100). info: iters the
+   blocks, cols the basis's columns, shift the p used, factorizations 1 (2 when
+   A was refused), shift_sets 0. Errors: those of phgmg_lradi (_NOT_CONVERGED
+   at maxit blocks, or when no new direction is left before tol is reached),
+   PHGMG_ERR_UNSUPPORTED for a model with a mass matrix or algebraic lines (E
+   != I: E^{-1} A would need solves with E, which the object does not make; use
+   the ADI). Manual 8.13. */
+PHGMG_DEF phgmg_result phgmg_lrkrylov(phgmg_shifted *s, int m, const double *B, int ldb, const phgmg_lradi_opts *opts,
+                                      double **Z, int *k, phgmg_lradi_info *info, const phgmg_allocator *alloc);
+/* Frees a factor from phgmg_lradi or phgmg_lrkrylov (NULL is fine). */
 PHGMG_DEF void phgmg_lowrank_free(double *Z, const phgmg_allocator *alloc);
 
 /* What low-rank balanced truncation did. */
 typedef struct phgmg_lrbt_info {
-  phgmg_lradi_info ctrl, obs; /* the two ADI runs (obs = ctrl when J = 0: one run) */
+  phgmg_lradi_info ctrl, obs; /* the two ADI (or EKSM) runs (obs = ctrl when J = 0: one run) */
   int nhsv;                   /* Hankel singular values computed (the rank of Z_o^T E Z_c) */
   double bound;               /* 2 sum_{i > r} sigma_i over the computed ones (approximate) */
   double hsv_tail;            /* sigma_{r+1} (0 if not computed)                    */
@@ -4624,7 +4761,8 @@ typedef struct phgmg_balanced_info {
   int inter;           /* the intermediate order of a two-stage PRBT (0: none)                   */
   double ph_change;    /* BT: the change of phgmg_ss_to_ph (two-stage PRBT: of its first stage) */
   double res_ctrl, res_obs; /* Lyapunov residuals, relative (low-rank: the ADI's ||W^T W|| /
-                          ||B^T B||; dense: phgmg_lyap_residual's); PHBT: res_obs 0             */
+                          ||B^T B||, or EKSM's same measure; dense: phgmg_lyap_residual's); PHBT:
+                          res_obs 0                                                              */
   int nsv;             /* values written to sv                                                   */
   int hmin;            /* PHBT: 1 balanced against the minimal Hamiltonian, 0 against the energy Q */
 } phgmg_balanced_info;
@@ -7184,6 +7322,9 @@ PHGMG__PRIV void phgmg__sdae_consistent(struct phgmg__sdae *D, const double *u, 
 #define PHGMG__DAE_BLOCK_MAX 1e8
 #define PHGMG__LR_STALL 0.5        /* LR-ADI: a shift cycle that leaves more than this of the residual ...   */
 #define PHGMG__LR_BLOCKS_MAX 48    /* ... doubles the projection shifts' window of blocks, up to this many   */
+#define PHGMG__EK_CAP0 256   /* EKSM: the basis' first allocation, columns (then doubled)                     */
+#define PHGMG__EK_CHUNK 64    /* EKSM: basis columns per step of the block Gram-Schmidt                        */
+#define PHGMG__EK_DEFL 1e-8   /* EKSM: a new direction whose part outside the basis is below this is deflated */
 #define PHGMG__LR_DAE_TOL 1e-12  /* index one of the low-rank tools: L_aa, Q_ac regular (the stepper's) */
 
 /* Row range [a, b] of the stored entries of column (or row) i. */
@@ -23238,6 +23379,8 @@ PHGMG_DEF phgmg_result phgmg_lradi(phgmg_shifted *s, int m, const double *B, int
   phgmg_result rc = PHGMG_OK;
   double tol = 1e-10, trunc = 1e-12, bnorm;
   int maxit = 500, nblocks = 6, j, nf0;
+  if (opts && opts->solver == PHGMG_LYAP_EKSM) /* the one place that picks the solver */
+    return phgmg_lrkrylov(s, m, B, ldb, opts, Z, k, info, alloc);
   memset(&inf, 0, sizeof inf);
   if (info) *info = inf;
   if (Z) *Z = NULL;
@@ -23245,7 +23388,7 @@ PHGMG_DEF phgmg_result phgmg_lradi(phgmg_shifted *s, int m, const double *B, int
   if (!s || !B || !Z || !k || m < 1 || ldb < s->N) return PHGMG_ERR_INVALID_ARG;
   if (opts) {
     if (!(opts->tol >= 0.0 && opts->tol < 1.0) || opts->maxit < 0 || opts->shift_blocks < 0 ||
-        !(opts->trunc < 1.0))
+        !(opts->trunc < 1.0) || opts->solver != PHGMG_LYAP_ADI)
       return PHGMG_ERR_INVALID_ARG;
     if (opts->tol > 0.0) tol = opts->tol;
     if (opts->maxit > 0) maxit = opts->maxit;
@@ -23280,6 +23423,468 @@ PHGMG_DEF phgmg_result phgmg_lradi(phgmg_shifted *s, int m, const double *B, int
   *Z = st.Z;
   *k = st.kz;
   return PHGMG_OK;
+}
+
+/* >>lowrank: the extended Krylov subspace method (EKSM) ------------------ */
+/* State of one EKSM run (E = I): the basis V (N x nc, orthonormal in the
+   energy inner product <x, y> = x^T Q y), QV = Q V, the projected matrix T =
+   V^T Q A V and the Euclidean Gram matrix G = V^T V (both ld = ld), AL = A
+   times the last block, U / QU the next block (N x w each, w = 2 m: a
+   block's width at most). */
+typedef struct phgmg__eksm {
+  phgmg_shifted *s;
+  const phgmg_allocator *al;
+  int N, m, w, nc, cap, ld;  /* w = 2 m columns per block; nc filled, cap allocated */
+  double p;                  /* shift of the inverse directions (A + p I)^{-1}       */
+  double *V, *QV, *T, *G, *tm; /* tm: cap x 2 w scratch (with T, G: one allocation)  */
+  double *AL, *U, *QU;       /* one buffer: N x w each                               */
+  int maxb;                  /* blocks at most (maxit)                                */
+  int np, nm;                /* the last block: np columns from A, then nm from the
+                                inverse (fewer than m each after deflation)          */
+  int up, um;                /* the same of the new block U                           */
+  int breakdown;             /* 1: the last new block had no new direction           */
+} phgmg__eksm;
+
+/* y = L^T x with L = J - R of S's pencil (the dual's: -J - R), CSC. */
+PHGMG__PRIV void phgmg__lr_ltmul(const phgmg__spsym *S, const double *x, double *y) {
+  int j, p;
+  for (j = 0; j < S->n; ++j) {
+    double acc = 0.0;
+    for (p = S->jr_p[j]; p < S->jr_p[j + 1]; ++p) acc += S->jr_x[p] * x[S->jr_i[p]];
+    y[j] = acc;
+  }
+}
+
+/* Room for one more block: V, QV (N x cap), T, G (cap x cap), first for
+   PHGMG__EK_CAP0 columns (whole blocks, one at least), then grown by
+   doubling (up to maxit blocks), their contents kept. */
+PHGMG__PRIV phgmg_result phgmg__ek_grow(phgmg__eksm *st) {
+  const size_t N = (size_t)st->N;
+  const int cap0 = st->w * PHGMG__MAX(1, PHGMG__EK_CAP0 / st->w);
+  int cap = PHGMG__MIN(st->cap ? 2 * st->cap : cap0, st->maxb * st->w), j;
+  double *V, *QV, *T, *G;
+  if (st->nc + st->w <= st->cap) return PHGMG_OK;
+  V = phgmg__dalloc(st->al, N * (size_t)cap);
+  QV = phgmg__dalloc(st->al, N * (size_t)cap);
+  T = phgmg__dalloc(st->al, 2 * (size_t)cap * (size_t)cap + 2 * (size_t)cap * (size_t)st->w);
+  if (!V || !QV || !T) {
+    phgmg__free(st->al, V); phgmg__free(st->al, QV); phgmg__free(st->al, T);
+    return PHGMG_ERR_NOMEM;
+  }
+  G = T + (size_t)cap * (size_t)cap;
+  if (st->nc) {
+    memcpy(V, st->V, sizeof(double) * N * (size_t)st->nc);
+    memcpy(QV, st->QV, sizeof(double) * N * (size_t)st->nc);
+    for (j = 0; j < st->nc; ++j) {
+      memcpy(T + (size_t)j * cap, st->T + (size_t)j * st->ld, sizeof(double) * (size_t)st->nc);
+      memcpy(G + (size_t)j * cap, st->G + (size_t)j * st->ld, sizeof(double) * (size_t)st->nc);
+    }
+  }
+  phgmg__free(st->al, st->V); phgmg__free(st->al, st->QV); phgmg__free(st->al, st->T);
+  st->V = V; st->QV = QV; st->T = T; st->G = G; st->tm = G + (size_t)cap * (size_t)cap;
+  st->cap = st->ld = cap;
+  return PHGMG_OK;
+}
+
+/* Block modified Gram-Schmidt of U's first c columns against the basis in
+   the energy inner product, PHGMG__EK_CHUNK basis columns at a time (h:
+   PHGMG__EK_CHUNK x w scratch); QU is left stale (the caller recomputes
+   it). */
+PHGMG__PRIV void phgmg__ek_bgs(phgmg__eksm *st, int c, double *h) {
+  const int N = st->N;
+  int b;
+  for (b = 0; b < st->nc; b += PHGMG__EK_CHUNK) {
+    const int cw = PHGMG__MIN(PHGMG__EK_CHUNK, st->nc - b);
+    phgmg_gemm('T', 'N', cw, c, N, 1.0, st->QV + (size_t)b * N, N, st->U, N, 0.0, h, cw);
+    phgmg_gemm('N', 'N', N, c, cw, -1.0, st->V + (size_t)b * N, N, h, cw, 1.0, st->U, N);
+  }
+}
+
+/* Modified Gram-Schmidt of U's columns among themselves (energy inner
+   product): column j against the kept ones, normalised, or dropped when its
+   new part is at most PHGMG__EK_DEFL of nrm[j] (its norm before the block
+   Gram-Schmidt; NULL: 1). The kept columns are moved to the front, in
+   order; *np, *nm (the counts from A and from the inverse, in that order)
+   updated. Returns the columns kept. */
+PHGMG__PRIV int phgmg__ek_mgs(phgmg__eksm *st, const double *nrm, int *np, int *nm) {
+  const int N = st->N, c = *np + *nm;
+  int j, i, kept = 0, kp = 0;
+  size_t r;
+  for (j = 0; j < c; ++j) {
+    double *u = st->U + (size_t)j * N, *qu = st->QU + (size_t)j * N, d = 0.0;
+    for (i = 0; i < kept; ++i) {
+      const double *ui = st->U + (size_t)i * N, *qi = st->QU + (size_t)i * N;
+      double cf = 0.0;
+      for (r = 0; r < (size_t)N; ++r) cf += qi[r] * u[r];
+      for (r = 0; r < (size_t)N; ++r) { u[r] -= cf * ui[r]; qu[r] -= cf * qi[r]; }
+    }
+    for (r = 0; r < (size_t)N; ++r) d += u[r] * qu[r];
+    d = sqrt(d > 0.0 ? d : 0.0);
+    if (!(d > PHGMG__EK_DEFL * (nrm ? nrm[j] : 1.0))) continue;
+    for (r = 0; r < (size_t)N; ++r) { u[r] /= d; qu[r] /= d; }
+    if (kept != j) {
+      memcpy(st->U + (size_t)kept * N, u, sizeof(double) * (size_t)N);
+      memcpy(st->QU + (size_t)kept * N, qu, sizeof(double) * (size_t)N);
+    }
+    kp += j < *np;
+    ++kept;
+  }
+  *nm = kept - kp;
+  *np = kp;
+  return kept;
+}
+
+/* QU = Q U for U's first c columns (recomputed: the updates of QU along
+   with U drift from Q U when a column is normalised from a small rest). */
+PHGMG__PRIV void phgmg__ek_qmul(phgmg__eksm *st, int c) {
+  int j;
+  for (j = 0; j < c; ++j) phgmg__sp_qmv(st->s->S, st->U + (size_t)j * st->N, st->QU + (size_t)j * st->N);
+}
+
+/* The new block U (QU = Q U; st->up columns from A, then st->um from the
+   inverse) orthonormalised in the energy inner product: block Gram-Schmidt
+   against the basis, then modified Gram-Schmidt within the block, the
+   whole done twice; directions already in the basis (to PHGMG__EK_DEFL)
+   deflated. Returns the columns kept (0: the space is invariant), -1 on
+   NaN. */
+PHGMG__PRIV int phgmg__ek_orth(phgmg__eksm *st, double *wk) {
+  const int N = st->N;
+  int c = st->up + st->um;
+  double *h = wk, *nrm = wk + (size_t)PHGMG__EK_CHUNK * st->w;
+  int j;
+  for (j = 0; j < c; ++j) {
+    const double *u = st->U + (size_t)j * N, *qu = st->QU + (size_t)j * N;
+    double acc = 0.0;
+    size_t r;
+    for (r = 0; r < (size_t)N; ++r) acc += u[r] * qu[r];
+    if (acc != acc) return -1;
+    nrm[j] = sqrt(acc > 0.0 ? acc : 0.0);
+  }
+  phgmg__ek_bgs(st, c, h);
+  phgmg__ek_qmul(st, c);
+  phgmg__ek_mgs(st, nrm, &st->up, &st->um);
+  phgmg__ek_bgs(st, st->up + st->um, h);
+  phgmg__ek_qmul(st, st->up + st->um);
+  c = phgmg__ek_mgs(st, NULL, &st->up, &st->um);
+  phgmg__ek_qmul(st, c);
+  return c;
+}
+
+/* Appends the orthonormal block U (QU) to the basis: AL = A U, X = L^T Q U
+   (L = J - R) next to it, the new columns and rows of T = V^T Q A V from
+   one product Q V^T [AL, X] (rows: V_k^T Q A V = (L^T Q V_k)^T Q V, since Q
+   A = Q L Q) and of G = V^T V. U is scratch afterwards. */
+PHGMG__PRIV void phgmg__ek_append(phgmg__eksm *st) {
+  const int N = st->N, w = st->up + st->um, c0 = st->nc, c1 = c0 + w, ld = st->ld;
+  double *X = st->AL + (size_t)w * N, *M = st->tm; /* X: w columns after AL's w (AL + U hold 2 st->w) */
+  int i, j;
+  memcpy(st->V + (size_t)c0 * N, st->U, sizeof(double) * (size_t)N * (size_t)w);
+  memcpy(st->QV + (size_t)c0 * N, st->QU, sizeof(double) * (size_t)N * (size_t)w);
+  for (j = 0; j < w; ++j) phgmg__lr_amul(st->s->S, st->V + (size_t)(c0 + j) * N, st->AL + (size_t)j * N, st->s->w);
+  for (j = 0; j < w; ++j) phgmg__lr_ltmul(st->s->S, st->QV + (size_t)(c0 + j) * N, X + (size_t)j * N);
+  phgmg_gemm('T', 'N', c1, 2 * w, N, 1.0, st->QV, N, st->AL, N, 0.0, M, c1);
+  for (j = 0; j < w; ++j) {
+    memcpy(st->T + (size_t)(c0 + j) * ld, M + (size_t)j * c1, sizeof(double) * (size_t)c1);
+    for (i = 0; i < c0; ++i) st->T[c0 + j + (size_t)i * ld] = M[i + (size_t)(w + j) * c1];
+  }
+  phgmg_gemm('T', 'N', c1, w, N, 1.0, st->V, N, st->V + (size_t)c0 * N, N, 0.0, st->G + (size_t)c0 * ld, ld);
+  for (j = c0; j < c1; ++j)
+    for (i = 0; i < c0; ++i) st->G[j + (size_t)i * ld] = st->G[i + (size_t)j * ld];
+  st->nc = c1;
+  st->np = st->up; st->nm = st->um;
+}
+
+/* The next block's directions: U = [A V_k^+, (A + p I)^{-1} V_k^-] (V_k^+:
+   the last block's np columns from A, V_k^-: its nm from the inverse), QU
+   = Q U. */
+PHGMG__PRIV phgmg_result phgmg__ek_next(phgmg__eksm *st) {
+  const int N = st->N, np = st->np, nm = st->nm;
+  phgmg_result rc;
+  int j;
+  memcpy(st->U, st->AL, sizeof(double) * (size_t)N * (size_t)np);
+  rc = phgmg_shifted_solve(st->s, st->p, 0.0, nm, st->V + (size_t)(st->nc - nm) * N, N, st->U + (size_t)np * N, N);
+  if (rc != PHGMG_OK) return rc;
+  st->up = np; st->um = nm;
+  for (j = 0; j < np + nm; ++j) phgmg__sp_qmv(st->s->S, st->U + (size_t)j * N, st->QU + (size_t)j * N);
+  return PHGMG_OK;
+}
+
+/* The projected equation T Y + Y T^T + b b^T = 0 (order n = st->nc, b = V^T
+   Q B) by phgmg_lyap into Y (n x n). */
+PHGMG__PRIV phgmg_result phgmg__ek_project(phgmg__eksm *st, const double *B, int ldb, double *Y) {
+  const int n = st->nc, m = st->m, N = st->N;
+  double *Tk = phgmg__dalloc(st->al, 2 * (size_t)n * (size_t)n + (size_t)n * (size_t)m), *F, *b;
+  phgmg_result rc;
+  int i, j;
+  if (!Tk) return PHGMG_ERR_NOMEM;
+  F = Tk + (size_t)n * n; b = F + (size_t)n * n;
+  for (j = 0; j < n; ++j) memcpy(Tk + (size_t)j * n, st->T + (size_t)j * st->ld, sizeof(double) * (size_t)n);
+  phgmg_gemm('T', 'N', n, m, N, 1.0, st->QV, N, B, ldb, 0.0, b, n);
+  phgmg_gemm('N', 'T', n, n, m, 1.0, b, n, b, n, 0.0, F, n);
+  for (j = 0; j < n; ++j)
+    for (i = 0; i < j; ++i) F[i + (size_t)j * n] = F[j + (size_t)i * n];
+  rc = phgmg_lyap(n, Tk, F, Y, NULL, st->al);
+  phgmg__free(st->al, Tk);
+  return rc;
+}
+
+/* ||A V Y V^T + V Y V^T A^T + B B^T||_2 for the projected solution Y,
+   exactly and without an N x N matrix: A V = V T + W_L [0 I] with W_L = A
+   V_k - V T(:, k) (the last block k only: A maps the earlier blocks into
+   the basis), so the residual is X S X^T with X = [V, W_L] and S = [0,
+   Y_L^T; Y_L, 0], Y_L = Y's last w rows; its 2-norm is the largest |eig|
+   of Gamma^{1/2} S Gamma^{1/2}, Gamma = X^T X (from G, V^T W_L, W_L^T W_L). */
+PHGMG__PRIV phgmg_result phgmg__ek_resid(phgmg__eksm *st, const double *Y, double *res) {
+  const int N = st->N, w = st->np + st->nm, n = st->nc, c0 = n - w, q = n + w;
+  double *Wl = st->U, *M = phgmg__dalloc(st->al, 3 * (size_t)q * (size_t)q + (size_t)q), *S, *Ev, *ev;
+  phgmg_result rc;
+  int i, j;
+  if (!M) return PHGMG_ERR_NOMEM;
+  S = M + (size_t)q * q; Ev = S + (size_t)q * q; ev = Ev + (size_t)q * q;
+  memcpy(Wl, st->AL, sizeof(double) * (size_t)N * (size_t)w);
+  phgmg_gemm('N', 'N', N, w, n, -1.0, st->V, N, st->T + (size_t)c0 * st->ld, st->ld, 1.0, Wl, N);
+  for (j = 0; j < n; ++j) memcpy(M + (size_t)j * q, st->G + (size_t)j * st->ld, sizeof(double) * (size_t)n);
+  phgmg_gemm('T', 'N', n, w, N, 1.0, st->V, N, Wl, N, 0.0, M + (size_t)n * q, q);
+  phgmg_gemm('T', 'N', w, w, N, 1.0, Wl, N, Wl, N, 0.0, M + (size_t)n * q + n, q);
+  for (j = n; j < q; ++j)
+    for (i = 0; i < n; ++i) M[j + (size_t)i * q] = M[i + (size_t)j * q];
+  rc = phgmg_sym_eig(q, M, q, ev, Ev, q);          /* Gamma = Ev diag(ev) Ev^T */
+  if (rc == PHGMG_OK) {
+    for (j = 0; j < q; ++j) {
+      const double sq = sqrt(ev[j] > 0.0 ? ev[j] : 0.0);
+      for (i = 0; i < q; ++i) Ev[i + (size_t)j * q] *= sqrt(sq);
+    }
+    phgmg_gemm('N', 'T', q, q, q, 1.0, Ev, q, Ev, q, 0.0, M, q); /* Gamma^{1/2} */
+    memset(S, 0, sizeof(double) * (size_t)q * q);
+    for (j = 0; j < n; ++j)
+      for (i = 0; i < w; ++i) S[n + i + (size_t)j * q] = S[j + (size_t)(n + i) * q] = Y[c0 + i + (size_t)j * n];
+    phgmg_gemm('N', 'N', q, q, q, 1.0, M, q, S, q, 0.0, Ev, q);
+    phgmg_gemm('N', 'N', q, q, q, 1.0, Ev, q, M, q, 0.0, S, q);
+    rc = phgmg_sym_eig(q, S, q, ev, NULL, q);
+  }
+  if (rc == PHGMG_OK) *res = PHGMG__MAX(fabs(ev[0]), fabs(ev[q - 1]));
+  phgmg__free(st->al, M);
+  return rc;
+}
+
+/* The compression of Z = V Yh (Yh n x kp) without a QR of the N x kp
+   matrix: with the Euclidean Gram matrix G = V^T V = L L^T (Cholesky; V is
+   orthonormal in the energy inner product, so G is as well conditioned as
+   Q), V L^{-T} has orthonormal columns and the thin SVD L^T Yh = U S W^T
+   gives Z's singular values S; Z <- V L^{-T} U_k S_k (the singular values
+   above trunc sigma_1: the rule of phgmg_lradi's compression) into *Z.
+   PHGMG_ERR_SINGULAR when G is not numerically positive definite. */
+PHGMG__PRIV phgmg_result phgmg__ek_compress(phgmg__eksm *st, const double *Yh, int kp, double trunc, double **Z,
+                                            int *kz) {
+  const int n = st->nc, N = st->N, kmin = PHGMG__MIN(n, kp);
+  double *L = phgmg__dalloc(st->al, 3 * (size_t)n * (size_t)n + (size_t)n * (size_t)kp + (size_t)n), *M, *U, *S;
+  phgmg_result rc = PHGMG_OK;
+  int i, j, l, k = 0;
+  if (!L) return PHGMG_ERR_NOMEM;
+  M = L + (size_t)n * n; U = M + (size_t)n * kp; S = U + (size_t)n * n;
+  for (j = 0; j < n; ++j) memcpy(L + (size_t)j * n, st->G + (size_t)j * st->ld, sizeof(double) * (size_t)n);
+  if (phgmg__chol_small(n, L) != 0) rc = PHGMG_ERR_SINGULAR;
+  if (rc == PHGMG_OK) {
+    phgmg_gemm('T', 'N', n, kp, n, 1.0, L, n, Yh, n, 0.0, M, n);          /* L^T Yh */
+    rc = phgmg_svd(n, kp, M, n, kmin, S, U, n, NULL, 1, &k, NULL, st->al);
+  }
+  if (rc == PHGMG_OK) {
+    while (k > 1 && !(S[k - 1] > trunc * S[0])) --k;
+    for (j = 0; j < k; ++j) {                                             /* U_k S_k <- L^{-T} U_k S_k */
+      double *u = U + (size_t)j * n;
+      for (i = n - 1; i >= 0; --i) {
+        double t = u[i] * S[j];
+        for (l = i + 1; l < n; ++l) t -= L[l + (size_t)i * n] * u[l];
+        u[i] = t / L[i + (size_t)i * n];
+      }
+    }
+    if (!(*Z = phgmg__dalloc(st->al, (size_t)N * (size_t)k))) rc = PHGMG_ERR_NOMEM;
+  }
+  if (rc == PHGMG_OK) { phgmg_gemm('N', 'N', N, k, n, 1.0, st->V, N, U, n, 0.0, *Z, N); *kz = k; }
+  phgmg__free(st->al, L);
+  return rc;
+}
+
+/* The factor of the projected solution: Y = U diag(lambda) U^T, Z = V U_+
+   diag(sqrt(lambda_+)) (the positive eigenvalues; N x *kz, allocated),
+   compressed as phgmg_lradi's (trunc > 0; phgmg__ek_compress, or the QR
+   based phgmg__lr_compress should G not be positive definite). Y is
+   destroyed. */
+PHGMG__PRIV phgmg_result phgmg__ek_factor(phgmg__eksm *st, double *Y, double trunc, double **Z, int *kz) {
+  const int n = st->nc, N = st->N;
+  double *Ev = phgmg__dalloc(st->al, (size_t)n * (size_t)n + (size_t)n), *ev;
+  phgmg__lradi lr;
+  phgmg_result rc;
+  int j, k0 = 0, kp;
+  if (!Ev) return PHGMG_ERR_NOMEM;
+  ev = Ev + (size_t)n * n;
+  rc = phgmg_sym_eig(n, Y, n, ev, Ev, n);
+  while (rc == PHGMG_OK && k0 < n && !(ev[k0] > 0.0)) ++k0;
+  kp = n - k0;
+  if (rc == PHGMG_OK && kp == 0) rc = PHGMG_ERR_RANK;
+  for (j = k0; rc == PHGMG_OK && j < n; ++j) {
+    const double sq = sqrt(ev[j]);
+    int i;
+    for (i = 0; i < n; ++i) Ev[i + (size_t)j * n] *= sq;
+  }
+  if (rc == PHGMG_OK && trunc > 0.0) {
+    rc = phgmg__ek_compress(st, Ev + (size_t)k0 * n, kp, trunc, Z, kz);
+    if (rc != PHGMG_ERR_SINGULAR) { phgmg__free(st->al, Ev); return rc; }
+    rc = PHGMG_OK;
+  }
+  memset(&lr, 0, sizeof lr);
+  lr.al = st->al; lr.N = N; lr.kz = lr.cap = kp;
+  if (rc == PHGMG_OK && !(lr.Z = phgmg__dalloc(st->al, (size_t)N * (size_t)kp))) rc = PHGMG_ERR_NOMEM;
+  if (rc == PHGMG_OK) {
+    phgmg_gemm('N', 'N', N, kp, n, 1.0, st->V, N, Ev + (size_t)k0 * n, n, 0.0, lr.Z, N);
+    if (trunc > 0.0) rc = phgmg__lr_compress(&lr, trunc);
+  }
+  phgmg__free(st->al, Ev);
+  if (rc != PHGMG_OK) { phgmg__free(st->al, lr.Z); return rc; }
+  *Z = lr.Z; *kz = lr.kz;
+  return PHGMG_OK;
+}
+
+/* The first block's directions U = [B, (A + p I)^{-1} B], QU = Q U, with p
+   = 0 (A^{-1}), or -- when the static pivots refuse A (PHGMG_ERR_SINGULAR:
+   a mass-spring model's positions) -- p = -|theta|, theta the Ritz value
+   of A on span(B) of least modulus (the first projection shift of
+   phgmg_lradi's kind, so A + p I is factored like an ADI shift). */
+PHGMG__PRIV phgmg_result phgmg__ek_first(phgmg__eksm *st, const double *B, int ldb) {
+  const int N = st->N, m = st->m;
+  const size_t Nm = (size_t)N * (size_t)m;
+  phgmg_result rc;
+  int j;
+  for (j = 0; j < m; ++j) memcpy(st->U + (size_t)j * N, B + (size_t)j * ldb, sizeof(double) * (size_t)N);
+  st->p = 0.0;
+  rc = phgmg_shifted_solve(st->s, 0.0, 0.0, m, st->U, N, st->U + Nm, N);
+  if (rc == PHGMG_ERR_SINGULAR) {
+    phgmg__lradi lr;
+    double amin = HUGE_VAL;
+    memset(&lr, 0, sizeof lr);
+    lr.s = st->s; lr.al = st->al; lr.N = N; lr.m = m;
+    rc = phgmg__lr_shifts(&lr, st->U, m);
+    for (j = 0; rc == PHGMG_OK && j < lr.nsh; ++j) amin = PHGMG__MIN(amin, hypot(lr.sh[2 * j], lr.sh[2 * j + 1]));
+    phgmg__free(st->al, lr.sh);
+    if (rc != PHGMG_OK) return rc;
+    if (lr.nsh == 0) return PHGMG_ERR_NOT_STABLE;
+    st->p = -amin;
+    rc = phgmg_shifted_solve(st->s, st->p, 0.0, m, st->U, N, st->U + Nm, N);
+  }
+  if (rc != PHGMG_OK) return rc;
+  st->up = st->um = m;
+  for (j = 0; j < 2 * m; ++j) phgmg__sp_qmv(st->s->S, st->U + (size_t)j * N, st->QU + (size_t)j * N);
+  return PHGMG_OK;
+}
+
+/* One check of phgmg_lrkrylov: the projected equation and its residual
+   relative to bnorm into inf->res; *Y (n x n, allocated) the solution when
+   it converged (inf->res <= tol), else NULL. A projected matrix that
+   phgmg_lyap refuses leaves the residual as it was (the next block may
+   fix it). */
+PHGMG__PRIV phgmg_result phgmg__ek_check(phgmg__eksm *st, const double *B, int ldb, double bnorm, double tol,
+                                         double **Y, phgmg_lradi_info *inf) {
+  double *y = phgmg__dalloc(st->al, (size_t)st->nc * (size_t)st->nc), res = 0.0;
+  phgmg_result rc;
+  *Y = NULL;
+  if (!y) return PHGMG_ERR_NOMEM;
+  rc = phgmg__ek_project(st, B, ldb, y);
+  if (rc == PHGMG_ERR_SINGULAR || rc == PHGMG_ERR_NOT_CONVERGED) { phgmg__free(st->al, y); return PHGMG_OK; }
+  if (rc == PHGMG_OK) rc = phgmg__ek_resid(st, y, &res);
+  if (rc == PHGMG_OK) inf->res = res / bnorm;
+  if (rc == PHGMG_OK && inf->res <= tol) *Y = y;
+  else phgmg__free(st->al, y);
+  return rc;
+}
+
+/* The block loop of phgmg_lrkrylov (the first block in the basis): a new
+   block per pass, the projected equation checked after blocks 1, 2, ... 8
+   and then every quarter of the blocks so far; *Y the converged solution. */
+PHGMG__PRIV phgmg_result phgmg__ek_iterate(phgmg__eksm *st, const double *B, int ldb, const phgmg_lradi_opts *o,
+                                           double tol, int maxit, double bnorm, double *wk, double **Y,
+                                           phgmg_lradi_info *inf) {
+  int next = 1, orc;
+  phgmg_result rc;
+  inf->iters = 1;
+  for (;;) {
+    if (inf->iters >= next || st->breakdown || inf->iters >= maxit) {
+      phgmg__lr_progress(o, "eksm: projected equation");
+      if ((rc = phgmg__ek_check(st, B, ldb, bnorm, tol, Y, inf)) != PHGMG_OK || *Y) return rc;
+      next = inf->iters + PHGMG__MAX(1, inf->iters / 4);
+      if (st->breakdown || inf->iters >= maxit) return PHGMG_ERR_NOT_CONVERGED;
+    }
+    if ((rc = phgmg__ek_grow(st)) != PHGMG_OK || (rc = phgmg__ek_next(st)) != PHGMG_OK) return rc;
+    orc = phgmg__ek_orth(st, wk);
+    if (orc < 0) return PHGMG_ERR_NANINF;
+    if (orc == 0) { st->breakdown = 1; continue; }
+    phgmg__ek_append(st);
+    ++inf->iters;
+  }
+}
+
+/* Arguments and options of phgmg_lrkrylov (those of phgmg_lradi). */
+PHGMG__PRIV phgmg_result phgmg__ek_args(const phgmg_shifted *s, int m, const double *B, int ldb,
+                                        const phgmg_lradi_opts *o, double *tol, int *maxit, double *trunc) {
+  int j;
+  if (!s || !B || m < 1 || ldb < s->N) return PHGMG_ERR_INVALID_ARG;
+  if (o) {
+    if (!(o->tol >= 0.0 && o->tol < 1.0) || o->maxit < 0 || o->shift_blocks < 0 || !(o->trunc < 1.0) ||
+        o->solver < 0 || o->solver > PHGMG_LYAP_EKSM)
+      return PHGMG_ERR_INVALID_ARG;
+    if (o->tol > 0.0) *tol = o->tol;
+    if (o->maxit > 0) *maxit = o->maxit;
+    if (o->trunc != 0.0) *trunc = o->trunc;
+  }
+  if (s->S->e_p || s->nalg) return PHGMG_ERR_UNSUPPORTED; /* E = I only */
+  for (j = 0; j < m; ++j)
+    if (!phgmg__all_finite(B + (size_t)j * (size_t)ldb, (size_t)s->N)) return PHGMG_ERR_NANINF;
+  return PHGMG_OK;
+}
+
+PHGMG_DEF phgmg_result phgmg_lrkrylov(phgmg_shifted *s, int m, const double *B, int ldb, const phgmg_lradi_opts *opts,
+                                      double **Z, int *k, phgmg_lradi_info *info, const phgmg_allocator *alloc) {
+  phgmg_lradi_info inf;
+  phgmg__eksm st;
+  phgmg_result rc;
+  double tol = 1e-10, trunc = 1e-12, bnorm = 0.0, *Y = NULL, *wk;
+  int maxit = 100, nf0, j, orc;
+  memset(&inf, 0, sizeof inf);
+  inf.solver = PHGMG_LYAP_EKSM;
+  if (info) *info = inf;
+  if (Z) *Z = NULL;
+  if (k) *k = 0;
+  if (!Z || !k) return PHGMG_ERR_INVALID_ARG;
+  if ((rc = phgmg__ek_args(s, m, B, ldb, opts, &tol, &maxit, &trunc)) != PHGMG_OK) return rc;
+  memset(&st, 0, sizeof st);
+  nf0 = s->nfact;
+  st.s = s; st.al = alloc; st.N = s->N; st.m = m; st.w = 2 * m; st.maxb = maxit;
+  st.AL = phgmg__dalloc(alloc, 3 * (size_t)s->N * (size_t)st.w);
+  wk = phgmg__dalloc(alloc, (size_t)PHGMG__EK_CHUNK * (size_t)st.w + (size_t)st.w);
+  if (!st.AL || !wk) rc = PHGMG_ERR_NOMEM;
+  if (rc == PHGMG_OK) {
+    st.U = st.AL + (size_t)s->N * (size_t)st.w; st.QU = st.U + (size_t)s->N * (size_t)st.w;
+    for (j = 0; j < m; ++j) memcpy(st.U + (size_t)j * s->N, B + (size_t)j * ldb, sizeof(double) * (size_t)s->N);
+    bnorm = phgmg__lr_gram2(s->N, m, st.U, alloc);
+    if (bnorm != bnorm) rc = PHGMG_ERR_NOMEM;
+    else if (!(bnorm > 0.0)) rc = PHGMG_ERR_RANK; /* B = 0 */
+  }
+  if (rc == PHGMG_OK) rc = phgmg__ek_first(&st, B, ldb);
+  if (rc == PHGMG_OK) rc = phgmg__ek_grow(&st);
+  if (rc == PHGMG_OK && (orc = phgmg__ek_orth(&st, wk)) <= 0) rc = orc == 0 ? PHGMG_ERR_RANK : PHGMG_ERR_NANINF;
+  if (rc == PHGMG_OK) {
+    phgmg__ek_append(&st);
+    inf.res = 1.0;   /* Z = 0: the residual B B^T */
+    rc = phgmg__ek_iterate(&st, B, ldb, opts, tol, maxit, bnorm, wk, &Y, &inf);
+  }
+  inf.cols = st.nc;
+  inf.shift = st.p;
+  if (rc == PHGMG_OK) rc = phgmg__ek_factor(&st, Y, trunc, Z, k);
+  inf.rank = rc == PHGMG_OK ? *k : 0;
+  inf.factorizations = s->nfact - nf0;
+  if (info) *info = inf;
+  phgmg__free(alloc, Y); phgmg__free(alloc, wk); phgmg__free(alloc, st.AL);
+  phgmg__free(alloc, st.V); phgmg__free(alloc, st.QV); phgmg__free(alloc, st.T);
+  return rc;
 }
 
 /* The ports of an index-one pencil (manual 8.14): Bc = B - L y, y the
@@ -29271,6 +29876,12 @@ PHGMG_DEF phgmg_result phgmg_sym_eig(int n, double *A, int lda, double *w, doubl
             PHGMG_ROM_QUADRATIC, replicated on every rank (manual 2.7). The
             wide V2, ALTMIN, a chosen lambda and the screened ECSW with
             GMG-QM return PHGMG_ERR_UNSUPPORTED.
+          - New: phgmg_lrkrylov, the extended Krylov subspace method for the
+            low-rank Lyapunov equation (E = I; one sparse LU per run),
+            chosen by phgmg_lradi_opts.solver = PHGMG_LYAP_EKSM wherever the
+            ADI runs (phgmg_lrbt, phgmg_lrphbt, phgmg_balanced_reduce);
+            phgmg_lradi_info.solver and .shift; the command line's reduce
+            --lyap adi|eksm (manual 8.13).
    0.9.0  (2026-11-29)
           - New: the low-rank tools take index-one SPARSE descriptor models
             (phgmg_shifted_create on the whole pencil, phgmg_lrbt with the

@@ -18,12 +18,16 @@
    0: skip) the sampled H-infinity error of the reduced model on --nw
    log-spaced frequencies in [1e-2, 1e2] through the sparse model's shifted
    solves (phgmg_shifted_hinf: one complex factorization per frequency),
-   relative to the sampled norm of G, against the bound.
+   relative to the sampled norm of G, against the bound. --lyap eksm runs
+   the Lyapunov equations by the extended Krylov method (phgmg_lrkrylov,
+   opts.solver = PHGMG_LYAP_EKSM; --maxit its blocks, default 100) instead
+   of the low-rank ADI (--lyap adi, the default): "steps" are then blocks.
 
      cc -std=c99 -O2 -march=native bench/bench_lowrank.c -o build/bench_lowrank -lm
      ./build/bench_lowrank --model heat --n 100 [--r 20] [--nw 20] [--out bench/results.csv]
      ./build/bench_lowrank --model heat --n 317
-     ./build/bench_lowrank --model lattice --n 71 */
+     ./build/bench_lowrank --model lattice --n 71
+     ./build/bench_lowrank --model heat --n 317 --lyap eksm [--maxit 200] */
 #define _POSIX_C_SOURCE 199309L
 #define PHGMG_IMPLEMENTATION
 #include "../phgmg.h"
@@ -96,20 +100,34 @@ static int bl_model(int lattice, int n, bl_csc *J, bl_csc *R, bl_csc *Q, double 
 }
 
 int main(int argc, char **argv) {
-  static const char *const extra[] = {"--model", "--n", "--r", "--nw", NULL};
-  const char *vals[4] = {NULL, NULL, NULL, NULL}, *outname;
+  static const char *const extra[] = {"--model", "--n", "--r", "--nw", "--lyap", "--maxit", NULL};
+  const char *vals[6] = {NULL, NULL, NULL, NULL, NULL, NULL}, *outname;
+  phgmg_lradi_opts lo;
+  const char *steps;
   bl_csc J, R, Q;
   double *B, *Ar, *Br, *Cr, *hsv, t0, t1, t2, c0, c1, c2;
   phgmg_ph_sparse *sp = NULL;
   phgmg_ph_sparse_info si;
   phgmg_lrbt_info inf;
+  memset(&inf, 0, sizeof inf);
   phgmg_result rc;
   int lattice, n, r, N, i, nw, err = 0;
   FILE *csv;
   i = bench_args(argc, argv, "bench_lowrank", "Low-rank BT of a 2-D heat model or a 2-D mass-spring-damper lattice.\n"
                  "  --model heat|lattice (heat)  --n grid side (100)  --r order (20)\n"
-                 "  --nw frequencies of the sampled H-infinity error (20; 0: none)", &outname, extra, vals);
+                 "  --nw frequencies of the sampled H-infinity error (20; 0: none)\n"
+                 "  --lyap adi|eksm Lyapunov solver (adi)  --maxit ADI steps / EKSM blocks (0: default)",
+                 &outname, extra, vals);
   if (i) return i == 1 ? 0 : 2;
+  memset(&lo, 0, sizeof lo);
+  if (vals[4] && strcmp(vals[4], "adi") && strcmp(vals[4], "eksm")) {
+    fprintf(stderr, "bench_lowrank: --lyap adi|eksm\n");
+    return 2;
+  }
+  lo.solver = vals[4] && !strcmp(vals[4], "eksm") ? PHGMG_LYAP_EKSM : PHGMG_LYAP_ADI;
+  lo.maxit = vals[5] ? atoi(vals[5]) : 0;
+  steps = lo.solver == PHGMG_LYAP_EKSM ? "EKSM blocks" : "ADI steps";
+  if (lo.maxit < 0) { fprintf(stderr, "bench_lowrank: --maxit >= 0\n"); return 2; }
   lattice = vals[0] && !strcmp(vals[0], "lattice");
   if (vals[0] && !lattice && strcmp(vals[0], "heat")) { fprintf(stderr, "bench_lowrank: --model heat|lattice\n"); return 2; }
   n = vals[1] ? atoi(vals[1]) : 100;
@@ -124,18 +142,28 @@ int main(int argc, char **argv) {
   t0 = bl_now(); c0 = (double)clock() / CLOCKS_PER_SEC;
   rc = phgmg_ph_sparse_create(&sp, N, 2, &J.A, &R.A, &Q.A, B, NULL, &si, NULL);
   t1 = bl_now(); c1 = (double)clock() / CLOCKS_PER_SEC;
-  if (rc == PHGMG_OK) rc = phgmg_lrbt(sp, r, NULL, Ar, Br, Cr, hsv, NULL, NULL, &inf, NULL);
+  if (rc == PHGMG_OK) rc = phgmg_lrbt(sp, r, &lo, Ar, Br, Cr, hsv, NULL, NULL, &inf, NULL);
   t2 = bl_now(); c2 = (double)clock() / CLOCKS_PER_SEC;
-  if (rc != PHGMG_OK) { fprintf(stderr, "bench_lowrank: %s\n", phgmg_result_string(rc)); return 1; }
-  printf("%s n = %d, N = %d, r = %d\n", lattice ? "lattice" : "heat", n, N, r);
+  if (rc != PHGMG_OK) {
+    fprintf(stderr, "bench_lowrank: %s (controllability: %d steps, residual %.2e; observability: %d steps, "
+            "residual %.2e; %.2f s CPU)\n", phgmg_result_string(rc), inf.ctrl.iters, inf.ctrl.res, inf.obs.iters,
+            inf.obs.res, c2 - c1);
+    return 1;
+  }
+  printf("%s n = %d, N = %d, r = %d, Lyapunov solver %s\n", lattice ? "lattice" : "heat", n, N, r,
+         lo.solver == PHGMG_LYAP_EKSM ? "eksm (steps: blocks)" : "adi");
   printf("  create (ordering)  %.2f s wall, %.2f s CPU\n", t1 - t0, c1 - c0);
   printf("  lrbt               %.2f s wall, %.2f s CPU\n", t2 - t1, c2 - c1);
-  printf("  controllability: %d ADI steps, %d columns -> rank %d, residual %.2e, %d factorizations, %d shift sets\n",
-         inf.ctrl.iters, inf.ctrl.cols, inf.ctrl.rank, inf.ctrl.res, inf.ctrl.factorizations, inf.ctrl.shift_sets);
-  printf("  observability:   %d ADI steps, %d columns -> rank %d, residual %.2e, %d factorizations%s\n",
-         inf.obs.iters, inf.obs.cols, inf.obs.rank, inf.obs.res, inf.obs.factorizations,
+  printf("  controllability: %d %s, %d columns -> rank %d, residual %.2e, %d factorizations, %d shift sets\n",
+         inf.ctrl.iters, steps, inf.ctrl.cols, inf.ctrl.rank, inf.ctrl.res, inf.ctrl.factorizations,
+         inf.ctrl.shift_sets);
+  printf("  observability:   %d %s, %d columns -> rank %d, residual %.2e, %d factorizations%s\n",
+         inf.obs.iters, steps, inf.obs.cols, inf.obs.rank, inf.obs.res, inf.obs.factorizations,
          lattice ? "" : " (J = 0: the same run)");
-  printf("  Hankel singular values computed %d; sigma_1 %.6e, sigma_r %.3e, sigma_r+1 %.3e; bound 2 sum_{i>r} / sigma_1 = %.2e\n",
+  if (lo.solver == PHGMG_LYAP_EKSM)
+    printf("  EKSM inverse directions: (A + p I)^{-1} with p = %.4g (controllability), %.4g (observability)\n",
+           inf.ctrl.shift, inf.obs.shift);
+  printf("  Hankel singular values computed %d; sigma_1 %.6e, sigma_r %.6e, sigma_r+1 %.6e; bound 2 sum_{i>r} / sigma_1 = %.2e\n",
          inf.nhsv, hsv[0], hsv[r - 1], inf.hsv_tail, inf.bound / hsv[0]);
   if (nw > 0) {
     phgmg_shifted *s = NULL;

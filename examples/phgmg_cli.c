@@ -435,7 +435,14 @@ static const char *const help_lines[] = {
   "  --adi-maxit when the log reports no convergence.\n",
   "  --adi-maxit K       low-rank ADI steps per Gramian before giving up (default\n",
   "                      500; a complex shift pair counts two); memory grows with\n",
-  "                      the steps (N m doubles per step, m the ports).\n",
+  "                      the steps (N m doubles per step, m the ports). With --lyap\n",
+  "                      eksm: extended Krylov blocks (default 100; 4 N m doubles\n",
+  "                      per block).\n",
+  "  --lyap adi|eksm     the low-rank Lyapunov solver of bt, prbt and phbt: adi (the\n",
+  "                      default; the low-rank ADI, one sparse LU per shift) or eksm\n",
+  "                      (the extended Krylov method: one sparse LU for the whole\n",
+  "                      run, more columns; models without a mass matrix only).\n",
+  "                      The same relative residual 1e-10; NAME.json names it.\n",
   "    bt    balanced truncation (needs m < R); the H-infinity error bound\n",
   "          2 sum_{i>R} sigma_i (low-rank: over the values computed) in the log\n",
   "          and NAME.json. The reduced model is written in pH form (NAME_K,\n",
@@ -1496,6 +1503,7 @@ typedef struct reduce_args {
   const char *ref_file;         /* --ref FILE: the reference state, N values */
   int greedy_window;            /* --greedy-window W (0: the library's default) */
   int adi_maxit;                /* --adi-maxit K: low-rank ADI steps (0: the library's default) */
+  int lyap;                     /* --lyap adi (PHGMG_LYAP_ADI) | eksm (PHGMG_LYAP_EKSM)        */
   const char *train[16];        /* --train-input KIND, repeatable */
   int ntrain;
   const char *xs[16];           /* --X FILE, repeatable: one run each (X = xs[0]) */
@@ -1829,6 +1837,11 @@ static int parse_reduce(int argc, char **argv, reduce_args *A) {
     }
     else if (!strcmp(o, "--adi-maxit")) {
       if (!(v = optval(argc, argv, &i)) || !parse_int(o, v, 1, 1000000, &A->adi_maxit)) return 2;
+    } else if (!strcmp(o, "--lyap")) {
+      if (!(v = optval(argc, argv, &i))) return 2;
+      if (!strcmp(v, "adi")) A->lyap = PHGMG_LYAP_ADI;
+      else if (!strcmp(v, "eksm")) A->lyap = PHGMG_LYAP_EKSM;
+      else return usage_error("--lyap: expected adi or eksm, got '%s'", v);
     } else if (!strcmp(o, "--greedy-window")) {
       if (!(v = optval(argc, argv, &i)) || !parse_int(o, v, 1, 100000, &A->greedy_window)) return 2;
     }
@@ -1990,6 +2003,8 @@ static int check_reduce_args(reduce_args *A, const char *const *seen, int nseen)
     return usage_error("reduce: --lambda, --rn and --manifold apply to --method gmg-qm only (not %s)", A->method);
   if (A->adi_maxit && !sweep_has_balancing(A))
     return usage_error("reduce: --adi-maxit applies to --method bt, prbt and phbt (the low-rank ADI)");
+  if (A->lyap && !sweep_has_balancing(A))
+    return usage_error("reduce: --lyap applies to --method bt, prbt and phbt (the low-rank Lyapunov solver)");
   if (A->greedy_window && (A->manifold != PHGMG_MANIFOLD_GREEDY && A->manifold != PHGMG_MANIFOLD_ALTMIN))
     return usage_error("reduce: --greedy-window applies to --method gmg-qm with --manifold greedy or altmin");
   if (A->greedy_window && A->rn != PHGMG_RN_WIDE)
@@ -4110,6 +4125,7 @@ static void json_balancing(FILE *jf, const reduce_state *S, int method) {
   fprintf(jf, "{\"solver\": \"%s\", \"stages\": %d", b->lowrank ? "low-rank" : "dense", b->stages);
   if (b->stages == 2) fprintf(jf, ", \"intermediate_order\": %d", b->inter);
   if (b->lowrank) {   /* one Lyapunov equation for prbt and phbt: the second entries 0 */
+    fprintf(jf, ", \"lyapunov_solver\": \"%s\"", b->lr.ctrl.solver == PHGMG_LYAP_EKSM ? "eksm" : "adi");
     fprintf(jf, ", \"gramian_rank\": [%d, %d], \"adi_steps\": [%d, %d], \"factorizations\": [%d, %d]",
             b->lr.ctrl.rank, b->lr.obs.rank, b->lr.ctrl.iters, b->lr.obs.iters, b->lr.ctrl.factorizations,
             b->lr.obs.factorizations);
@@ -4449,10 +4465,15 @@ static int explain_balancing(const reduce_args *A, const reduce_state *S, phgmg_
       return fail("reduction failed: --r %d exceeds the %d singular values computed (the Gramian factors "
                   "have ranks %d and %d): use a smaller --r", A->r, b->lr.nhsv, b->lr.ctrl.rank, b->lr.obs.rank);
     case PHGMG_ERR_NOT_CONVERGED:
-      return fail("reduction failed: %s (low-rank ADI: residual %.3g after %d steps)", phgmg_result_string(rc),
+      return fail("reduction failed: %s (%s: residual %.3g after %d %s)", phgmg_result_string(rc),
+                  A->lyap == PHGMG_LYAP_EKSM ? "extended Krylov" : "low-rank ADI",
                   b->lr.obs.iters ? b->lr.obs.res : b->lr.ctrl.res,
-                  b->lr.obs.iters ? b->lr.obs.iters : b->lr.ctrl.iters);
+                  b->lr.obs.iters ? b->lr.obs.iters : b->lr.ctrl.iters,
+                  A->lyap == PHGMG_LYAP_EKSM ? "blocks" : "steps");
     case PHGMG_ERR_UNSUPPORTED:
+      if (S->sp && A->lyap == PHGMG_LYAP_EKSM && A->Ecoo)
+        return fail("reduction failed: --lyap eksm takes models without a mass matrix (E = I; given: --E-coo "
+                    "%s); use --lyap adi", A->Ecoo);
       if (S->sp && S->dae_direct && A->Ecoo)
         return fail("reduction failed: a port acts on an algebraic equation (a zero row of E, %s): through the "
                     "constraint it has a feedthrough D, which the port-Hamiltonian forms of --method bt, prbt "
@@ -4484,6 +4505,7 @@ static int run_balancing(const reduce_args *A, reduce_state *S, double *t_red) {
                           "snapshot methods; reduce with the balancing methods in a run of their own", A->method);
   memset(&lo, 0, sizeof lo);
   lo.maxit = A->adi_maxit;
+  lo.solver = A->lyap;
   progress("reducing: %s, r = %d (%s solvers)", A->method, A->r, S->sp ? "low-rank, sparse" : "dense");
   t0 = now_s();
   plog.t0 = t0; plog.all = 0; plog.ncand = plog.nprobe = 0; plog.quiet = 0; plog.last = NULL;
@@ -4495,11 +4517,13 @@ static int run_balancing(const reduce_args *A, reduce_state *S, double *t_red) {
   *t_red = now_s() - t0;
   if (rc != PHGMG_OK) return explain_balancing(A, S, rc);
   if (b->lowrank)
-    progress("  Gramian factors: %s", S->bcache.adi_runs > runs0 ? "computed (low-rank ADI)"
+    progress("  Gramian factors: %s", S->bcache.adi_runs > runs0 ? (A->lyap == PHGMG_LYAP_EKSM ?
+                                       "computed (extended Krylov, EKSM)" : "computed (low-rank ADI)")
                                        : "reused (computed once for this model in this run)");
   if (b->lowrank)
-    progress("  done in %.2f s: Gramian factor ranks %d / %d, ADI steps %d / %d, Lyapunov residuals %.2g / %.2g",
-             *t_red, b->lr.ctrl.rank, b->lr.obs.rank, b->lr.ctrl.iters, b->lr.obs.iters, b->res_ctrl, b->res_obs);
+    progress("  done in %.2f s: Gramian factor ranks %d / %d, %s %d / %d, Lyapunov residuals %.2g / %.2g",
+             *t_red, b->lr.ctrl.rank, b->lr.obs.rank, b->lr.ctrl.solver == PHGMG_LYAP_EKSM ? "EKSM blocks" : "ADI steps",
+             b->lr.ctrl.iters, b->lr.obs.iters, b->res_ctrl, b->res_obs);
   else
     progress("  done in %.2f s: Lyapunov residuals %.2g / %.2g", *t_red, b->res_ctrl, b->res_obs);
   if (S->method == PHGMG_METHOD_BT)

@@ -4,7 +4,7 @@
 # tests/check_cli_lowrank.py (what it checks is described there) on a small
 # lattice and heat model, as COO files (the low-rank solvers) and dense .npy
 # files (the dense solvers); and the log of a low-rank run (the solver, the
-# Gramian ranks and residuals, the bound).
+# Gramian ranks and residuals, the bound); --lyap eksm against the ADI run.
 # Usage: sh tests/test_cli_lowrank.sh build/phgmg      (from the repository root)
 # Needs NumPy and SciPy in /usr/bin/python3 (skipped with a note otherwise).
 set -u
@@ -29,4 +29,25 @@ for w in "reducing: bt, r = 8 (low-rank, sparse solvers)" "Gramian factor ranks"
   grep -F -q "$w" "$T/log.txt" || { echo "FAIL: the log lacks '$w'"; cat "$T/log.txt"; nfail=$((nfail + 1)); }
 done
 grep -q '"gramian_rank": \[[1-9]' "$T/log/bt.json" || { echo "FAIL: bt.json lacks the Gramian ranks"; nfail=$((nfail + 1)); }
+# The extended Krylov solver (--lyap eksm) on the same lattice: its Hankel
+# singular values against the ADI run's above (within 1e-8 sigma_1), the
+# solver named in the log and in the json records; a bad value is a usage error.
+"$P" reduce --J-coo "$D/J.npy" --R-coo "$D/R.npy" --Q-coo "$D/Q.npy" --B "$D/B.npy" --method bt --r 8 \
+  --lyap eksm --out "$T/log" --name bteksm > "$T/logk.txt" 2>&1 || { echo "FAIL: bt --lyap eksm run"; cat "$T/logk.txt"; nfail=$((nfail + 1)); }
+grep -F -q "computed (extended Krylov, EKSM)" "$T/logk.txt" || { echo "FAIL: the eksm log lacks its solver"; cat "$T/logk.txt"; nfail=$((nfail + 1)); }
+"$PY" - "$T/log/bt.json" "$T/log/bteksm.json" <<'EOF_PY' || nfail=$((nfail + 1))
+import json, sys
+a, k = (json.load(open(f))["info"] for f in sys.argv[1:3])
+sa, sk = a["hankel_singular_values"], k["hankel_singular_values"]
+n = min(len(sa), len(sk))
+err = max(abs(x - y) for x, y in zip(sa[:n], sk[:n])) / sa[0]
+ok = a["lyapunov_solver"] == "adi" and k["lyapunov_solver"] == "eksm" and n >= 8 and err <= 1e-8 and \
+     max(k["lyapunov_residual"]) <= 1e-10
+print("test_cli_lowrank: --lyap eksm vs adi: %d Hankel singular values within %.2g sigma_1, residuals %s%s"
+      % (n, err, k["lyapunov_residual"], "" if ok else "  FAIL"))
+sys.exit(0 if ok else 1)
+EOF_PY
+"$P" reduce --J-coo "$D/J.npy" --R-coo "$D/R.npy" --Q-coo "$D/Q.npy" --B "$D/B.npy" --method bt --r 8 \
+  --lyap krylov --out "$T/log" --name bad > "$T/logb.txt" 2>&1
+[ $? -eq 2 ] || { echo "FAIL: --lyap krylov is not a usage error"; nfail=$((nfail + 1)); }
 if [ "$nfail" -eq 0 ]; then echo "test_cli_lowrank: all passed"; else echo "test_cli_lowrank: $nfail failed"; exit 1; fi

@@ -45,3 +45,4 @@
 #include "test_dae_sparse_reduce.c"
 #include "test_balanced2.c"
 #include "test_springs.c"
+#include "test_eksm.c"

@@ -1,0 +1,398 @@
+/* The extended Krylov solver of the low-rank Lyapunov equation
+   (phgmg_lrkrylov, opts.solver = PHGMG_LYAP_EKSM; >>lowrank): its factors
+   against dense solutions computed here independently (the 2-D heat model
+   by the eigen-decomposition of its symmetric A, a mass-spring-damper
+   lattice by phgmg_lyap), the reported residual against the residual of Z
+   Z^T computed densely, the Hankel singular values of low-rank BT run on
+   its factors against the dense ones and against the ADI's, the dual model
+   (observability), the codes of bad arguments and of a mass matrix, and
+   that zeroed options still run the low-rank ADI. */
+#define PHGMG_STATIC
+#define PHGMG_IMPLEMENTATION
+#include "../phgmg.h"
+#include "harness.h"
+#include <stdlib.h>
+
+/* Dense model (column-major, user ordering): J, R, Q, B (N x 2), E (NULL:
+   none). */
+typedef struct tk_model {
+  int N;
+  double *J, *R, *Q, *E, *B;
+} tk_model;
+
+static void tk_alloc(tk_model *M, int N, int with_e) {
+  M->N = N;
+  M->J = (double *)calloc((size_t)N * N, sizeof(double));
+  M->R = (double *)calloc((size_t)N * N, sizeof(double));
+  M->Q = (double *)calloc((size_t)N * N, sizeof(double));
+  M->B = (double *)calloc((size_t)N * 2, sizeof(double));
+  M->E = with_e ? (double *)calloc((size_t)N * N, sizeof(double)) : NULL;
+}
+
+static void tk_free(tk_model *M) { free(M->J); free(M->R); free(M->Q); free(M->E); free(M->B); }
+
+/* The 5-point Dirichlet Laplacian (+ shift on the diagonal) of an n x n
+   grid into the n^2 x n^2 block of X at (off, off), leading dimension ld,
+   times scale. */
+static void tk_lap(double *X, int ld, int off, int n, double shift, double scale) {
+  int i, j;
+  for (j = 0; j < n; ++j)
+    for (i = 0; i < n; ++i) {
+      const int a = i + n * j;
+      double *c = X + off + (size_t)(off + a) * ld;
+      c[a] += scale * (4.0 + shift);
+      if (i > 0) c[a - 1] -= scale;
+      if (i < n - 1) c[a + 1] -= scale;
+      if (j > 0) c[a - n] -= scale;
+      if (j < n - 1) c[a + n] -= scale;
+    }
+}
+
+/* 2-D heat model on an n x n grid: J = 0, R = Laplacian, Q = I, ports on
+   the left and the bottom edge. */
+static void tk_heat(tk_model *M, int n) {
+  const int N = n * n;
+  int a;
+  tk_alloc(M, N, 0);
+  tk_lap(M->R, N, 0, n, 0.0, 1.0);
+  for (a = 0; a < N; ++a) M->Q[a + (size_t)a * N] = 1.0;
+  for (a = 0; a < n; ++a) { M->B[a * n] = 1.0; M->B[a + (size_t)N] = 1.0; }
+}
+
+/* n x n mass-spring-damper lattice, x = (q, p): J = [0 I; -I 0], R = [0 0;
+   0 D], Q = [K 0; 0 I], K = Laplacian + 0.01 I, D = d0 I + 0.01 K, forces
+   on the corner masses; with_e: a consistent-mass E = [I 0; 0 Mc]. */
+static void tk_lattice(tk_model *M, int n, double d0, int with_e) {
+  const int n2 = n * n, N = 2 * n2;
+  int a;
+  tk_alloc(M, N, with_e);
+  tk_lap(M->Q, N, 0, n, 0.01, 1.0);
+  tk_lap(M->R, N, n2, n, 0.01, 0.01);
+  for (a = 0; a < n2; ++a) {
+    M->J[a + (size_t)(n2 + a) * N] = 1.0;
+    M->J[n2 + a + (size_t)a * N] = -1.0;
+    M->Q[n2 + a + (size_t)(n2 + a) * N] = 1.0;
+    M->R[n2 + a + (size_t)(n2 + a) * N] += d0;
+    if (with_e) { M->E[a + (size_t)a * N] = 1.0; M->E[n2 + a + (size_t)(n2 + a) * N] = 1.1; }
+  }
+  if (with_e)
+    for (a = 0; a + 1 < n2; ++a) M->E[n2 + a + (size_t)(n2 + a + 1) * N] = M->E[n2 + a + 1 + (size_t)(n2 + a) * N] = 0.01;
+  M->B[n2] = 1.0;
+  M->B[n2 + n2 - 1 + (size_t)N] = 1.0;
+}
+
+/* CSC of a dense N x N matrix (malloc'ed arrays). */
+static phgmg_csc tk_csc(int N, const double *A) {
+  phgmg_csc c;
+  int j, i, nz = 0;
+  int *cp = (int *)malloc(sizeof(int) * (size_t)(N + 1)), *ri;
+  double *v;
+  for (j = 0; j < N * N; ++j) nz += A[j] != 0.0;
+  ri = (int *)malloc(sizeof(int) * (size_t)(nz + 1));
+  v = (double *)malloc(sizeof(double) * (size_t)(nz + 1));
+  nz = 0;
+  for (j = 0; j < N; ++j) {
+    cp[j] = nz;
+    for (i = 0; i < N; ++i)
+      if (A[i + (size_t)j * N] != 0.0) { ri[nz] = i; v[nz++] = A[i + (size_t)j * N]; }
+  }
+  cp[N] = nz;
+  c.n_rows = c.n_cols = N; c.colptr = cp; c.rowidx = ri; c.values = v;
+  return c;
+}
+
+static void tk_csc_free(phgmg_csc *c) { free((void *)c->colptr); free((void *)c->rowidx); free((void *)c->values); }
+
+static phgmg_ph_sparse *tk_sparse(const tk_model *M) {
+  phgmg_ph_sparse *sp = NULL;
+  phgmg_csc J = tk_csc(M->N, M->J), R = tk_csc(M->N, M->R), Q = tk_csc(M->N, M->Q), E;
+  if (M->E) E = tk_csc(M->N, M->E);
+  CHECK_RC(phgmg_ph_sparse_create_e(&sp, M->N, 2, &J, &R, &Q, M->E ? &E : NULL, M->B, NULL, NULL, NULL), PHGMG_OK);
+  tk_csc_free(&J); tk_csc_free(&R); tk_csc_free(&Q);
+  if (M->E) tk_csc_free(&E);
+  return sp;
+}
+
+/* A = (J - R) Q (dense). */
+static double *tk_dense_a(const tk_model *M) {
+  const int N = M->N;
+  double *JR = (double *)malloc(sizeof(double) * (size_t)N * N), *A = (double *)malloc(sizeof(double) * (size_t)N * N);
+  int i;
+  for (i = 0; i < N * N; ++i) JR[i] = M->J[i] - M->R[i];
+  phgmg_gemm('N', 'N', N, N, N, 1.0, JR, N, M->Q, N, 0.0, A, N);
+  free(JR);
+  return A;
+}
+
+/* Z (internal order, N x k) -> Z Z^T in the user's order. */
+static double *tk_gram_user(phgmg_ph_sparse *sp, int N, const double *Z, int k) {
+  double *Zu = (double *)malloc(sizeof(double) * (size_t)N * k), *P = (double *)malloc(sizeof(double) * (size_t)N * N);
+  CHECK_RC(phgmg_ph_sparse_to_user_order(sp, k, Z, N, Zu, N), PHGMG_OK);
+  phgmg_gemm('N', 'T', N, N, k, 1.0, Zu, N, Zu, N, 0.0, P, N);
+  free(Zu);
+  return P;
+}
+
+static double tk_reldiff(int n, const double *X, const double *Y) {
+  double d = 0.0, y = 0.0;
+  int i;
+  for (i = 0; i < n; ++i) { d += (X[i] - Y[i]) * (X[i] - Y[i]); y += Y[i] * Y[i]; }
+  return sqrt(d / y);
+}
+
+/* ||A P + P A^T + B B^T||_2 / ||B^T B||_2, dense. */
+static double tk_lyap_res(int N, const double *A, const double *B, const double *P) {
+  double *T = (double *)malloc(sizeof(double) * (size_t)N * N), *Rr = (double *)malloc(sizeof(double) * (size_t)N * N);
+  double *w = (double *)malloc(sizeof(double) * (size_t)N), G[4], g[2], r;
+  int i, j;
+  phgmg_gemm('N', 'N', N, N, N, 1.0, A, N, P, N, 0.0, Rr, N);
+  for (j = 0; j < N; ++j)
+    for (i = 0; i < N; ++i) T[i + (size_t)j * N] = Rr[i + (size_t)j * N] + Rr[j + (size_t)i * N];
+  phgmg_gemm('N', 'T', N, N, 2, 1.0, B, N, B, N, 1.0, T, N);
+  CHECK_RC(phgmg_sym_eig(N, T, N, w, NULL, N), PHGMG_OK);
+  r = PHGMG__MAX(fabs(w[0]), fabs(w[N - 1]));
+  phgmg_gemm('T', 'N', 2, 2, N, 1.0, B, N, B, N, 0.0, G, 2);
+  CHECK_RC(phgmg_sym_eig(2, G, 2, g, NULL, 2), PHGMG_OK);
+  free(T); free(Rr); free(w);
+  return r / g[1];
+}
+
+/* The heat model's Gramian by the eigen-decomposition of R = U diag(l) U^T
+   (A = -R symmetric): P = U Pt U^T, Pt_ij = (U^T B B^T U)_ij / (l_i + l_j). */
+static double *tk_heat_gramian(const tk_model *M) {
+  const int N = M->N;
+  double *U = (double *)malloc(sizeof(double) * (size_t)N * N), *T = (double *)malloc(sizeof(double) * (size_t)N * N);
+  double *P = (double *)malloc(sizeof(double) * (size_t)N * N), *l = (double *)malloc(sizeof(double) * (size_t)N);
+  double *C = (double *)malloc(sizeof(double) * (size_t)N * 2);
+  int i, j;
+  memcpy(T, M->R, sizeof(double) * (size_t)N * N);
+  CHECK_RC(phgmg_sym_eig(N, T, N, l, U, N), PHGMG_OK);
+  phgmg_gemm('T', 'N', N, 2, N, 1.0, U, N, M->B, N, 0.0, C, N);
+  phgmg_gemm('N', 'T', N, N, 2, 1.0, C, N, C, N, 0.0, P, N);
+  for (j = 0; j < N; ++j)
+    for (i = 0; i < N; ++i) P[i + (size_t)j * N] /= l[i] + l[j];
+  phgmg_gemm('N', 'N', N, N, N, 1.0, U, N, P, N, 0.0, T, N);
+  phgmg_gemm('N', 'T', N, N, N, 1.0, T, N, U, N, 0.0, P, N);
+  free(U); free(T); free(l); free(C);
+  return P;
+}
+
+/* Dense Hankel singular values (n, descending): P = L L^T, sigma^2 =
+   eig(L^T O L). */
+static void tk_dense_hsv(int N, const double *P, const double *O, double *hsv, int n) {
+  double *V = (double *)malloc(sizeof(double) * (size_t)N * N), *W = (double *)malloc(sizeof(double) * (size_t)N * N);
+  double *T = (double *)malloc(sizeof(double) * (size_t)N * N), *w = (double *)malloc(sizeof(double) * (size_t)N);
+  int i, j;
+  memcpy(T, P, sizeof(double) * (size_t)N * N);
+  CHECK_RC(phgmg_sym_eig(N, T, N, w, V, N), PHGMG_OK);
+  for (j = 0; j < N; ++j)
+    for (i = 0; i < N; ++i) V[i + (size_t)j * N] *= sqrt(w[j] > 0.0 ? w[j] : 0.0);
+  phgmg_gemm('N', 'N', N, N, N, 1.0, O, N, V, N, 0.0, W, N);
+  phgmg_gemm('T', 'N', N, N, N, 1.0, V, N, W, N, 0.0, T, N);
+  CHECK_RC(phgmg_sym_eig(N, T, N, w, NULL, N), PHGMG_OK);
+  for (i = 0; i < n; ++i) hsv[i] = sqrt(w[N - 1 - i] > 0.0 ? w[N - 1 - i] : 0.0);
+  free(V); free(W); free(T); free(w);
+}
+
+/* Low-rank BT's first r Hankel singular values with the solver `solver`. */
+static void tk_lrbt_hsv(phgmg_ph_sparse *sp, int solver, int r, double *hsv, phgmg_lrbt_info *inf) {
+  double *Ar = (double *)malloc(sizeof(double) * (size_t)r * r), *Br = (double *)malloc(sizeof(double) * (size_t)r * 2);
+  double *Cr = (double *)malloc(sizeof(double) * (size_t)r * 2);
+  phgmg_lradi_opts o;
+  memset(&o, 0, sizeof o);
+  o.solver = solver;
+  CHECK_RC(phgmg_lrbt(sp, r, &o, Ar, Br, Cr, hsv, NULL, NULL, inf, NULL), PHGMG_OK);
+  free(Ar); free(Br); free(Cr);
+}
+
+/* EKSM on the 16 x 16 heat model (N = 256; A = -R is regular: the inverse
+   directions are A^{-1}, one factorization): Z Z^T against the dense
+   Gramian, the reported residual (a run at tol 1e-7, so that it stands
+   above the dense computation's round-off) against the dense residual of
+   its Z Z^T; BT's Hankel singular values (J = 0, Q = I: O = P, sigma =
+   eig(P)) against the dense values and the ADI's. */
+TEST(test_eksm_heat) {
+  enum { r = 12 };
+  tk_model M;
+  phgmg_ph_sparse *sp;
+  phgmg_shifted *s = NULL;
+  phgmg_lradi_info inf;
+  phgmg_lradi_opts o;
+  phgmg_lrbt_info bi, ba;
+  double *A, *P, *Plr, *Z = NULL, *w, hsv[r], hsva[r], res;
+  int N, k = 0, i;
+  tk_heat(&M, 16);
+  N = M.N;
+  A = tk_dense_a(&M);
+  P = tk_heat_gramian(&M);
+  sp = tk_sparse(&M);
+  memset(&o, 0, sizeof o);
+  o.solver = PHGMG_LYAP_EKSM;
+  CHECK_RC(phgmg_shifted_create(&s, sp, 0, 0, NULL), PHGMG_OK);
+  CHECK_RC(phgmg_lrkrylov(s, 2, phgmg_ph_sparse_system(sp)->B, N, NULL, &Z, &k, &inf, NULL), PHGMG_OK);
+  CHECK(inf.solver == PHGMG_LYAP_EKSM && inf.shift == 0.0 && inf.factorizations == 1);
+  CHECK(inf.res <= 1e-10 && inf.iters > 1 && inf.rank == k && k <= inf.cols && k < N);
+  Plr = tk_gram_user(sp, N, Z, k);
+  CHECK_LE(tk_reldiff(N * N, Plr, P), 1e-8);
+  free(Plr); phgmg_lowrank_free(Z, NULL); Z = NULL;
+  /* the residual, at a tolerance whose residual is far above round-off */
+  o.tol = 1e-7;
+  CHECK_RC(phgmg_lradi(s, 2, phgmg_ph_sparse_system(sp)->B, N, &o, &Z, &k, &inf, NULL), PHGMG_OK);
+  CHECK(inf.solver == PHGMG_LYAP_EKSM && inf.res <= 1e-7 && inf.res > 1e-12);
+  Plr = tk_gram_user(sp, N, Z, k);
+  res = tk_lyap_res(N, A, M.B, Plr);
+  CHECK_LE(fabs(res - inf.res), 0.02 * inf.res);
+  free(Plr); phgmg_lowrank_free(Z, NULL);
+  /* BT: sigma = eig(P) */
+  w = (double *)malloc(sizeof(double) * (size_t)N);
+  CHECK_RC(phgmg_sym_eig(N, P, N, w, NULL, N), PHGMG_OK);
+  tk_lrbt_hsv(sp, PHGMG_LYAP_EKSM, r, hsv, &bi);
+  tk_lrbt_hsv(sp, PHGMG_LYAP_ADI, r, hsva, &ba);
+  CHECK(bi.ctrl.solver == PHGMG_LYAP_EKSM && ba.ctrl.solver == PHGMG_LYAP_ADI && bi.nhsv > r);
+  for (i = 0; i < r; ++i) {
+    CHECK_LE(fabs(hsv[i] - w[N - 1 - i]), 1e-8 * w[N - 1]);
+    CHECK_LE(fabs(hsv[i] - hsva[i]), 1e-8 * hsva[0]);
+  }
+  free(w);
+  phgmg_shifted_destroy(s); phgmg_ph_sparse_destroy(sp);
+  free(A); free(P);
+  tk_free(&M);
+}
+
+/* EKSM on the 7 x 7 lattice (N = 98, J != 0, Q != I; complex spectrum):
+   the static pivots refuse A itself (zero diagonal on the positions), so
+   the inverse directions use a real shift p < 0; Z Z^T and the dual
+   model's Q Zy Zy^T Q against phgmg_lyap's dense Gramians, the residual
+   (tol 1e-4 run) against the dense one, BT's Hankel singular values
+   against the dense ones and the ADI's. */
+TEST(test_eksm_lattice) {
+  enum { r = 8 };
+  tk_model M;
+  phgmg_ph_sparse *sp;
+  phgmg_shifted *s = NULL, *sd = NULL;
+  phgmg_lradi_info inf;
+  phgmg_lradi_opts o;
+  phgmg_lrbt_info bi, ba;
+  double *A, *At, *F, *P, *O, *T, *Plr, *Z = NULL, hsv[r], hsva[r], hsvd[r], res;
+  int N, k = 0, i, j;
+  tk_lattice(&M, 7, 0.5, 0);
+  N = M.N;
+  A = tk_dense_a(&M);
+  At = (double *)malloc(sizeof(double) * (size_t)N * N); F = (double *)malloc(sizeof(double) * (size_t)N * N);
+  P = (double *)malloc(sizeof(double) * (size_t)N * N); O = (double *)malloc(sizeof(double) * (size_t)N * N);
+  T = (double *)malloc(sizeof(double) * (size_t)N * N);
+  phgmg_gemm('N', 'T', N, N, 2, 1.0, M.B, N, M.B, N, 0.0, F, N);
+  CHECK_RC(phgmg_lyap(N, A, F, P, NULL, NULL), PHGMG_OK);
+  for (j = 0; j < N; ++j)
+    for (i = 0; i < N; ++i) At[i + (size_t)j * N] = A[j + (size_t)i * N];
+  phgmg_gemm('N', 'N', N, 2, N, 1.0, M.Q, N, M.B, N, 0.0, T, N);      /* C^T = Q B */
+  phgmg_gemm('N', 'T', N, N, 2, 1.0, T, N, T, N, 0.0, F, N);
+  CHECK_RC(phgmg_lyap(N, At, F, O, NULL, NULL), PHGMG_OK);
+  sp = tk_sparse(&M);
+  memset(&o, 0, sizeof o);
+  o.solver = PHGMG_LYAP_EKSM;
+  CHECK_RC(phgmg_shifted_create(&s, sp, 0, 0, NULL), PHGMG_OK);
+  CHECK_RC(phgmg_lradi(s, 2, phgmg_ph_sparse_system(sp)->B, N, &o, &Z, &k, &inf, NULL), PHGMG_OK);
+  CHECK(inf.solver == PHGMG_LYAP_EKSM && inf.shift < 0.0 && inf.res <= 1e-10 && inf.rank == k && k < N);
+  Plr = tk_gram_user(sp, N, Z, k);
+  CHECK_LE(tk_reldiff(N * N, Plr, P), 1e-8);
+  free(Plr); phgmg_lowrank_free(Z, NULL); Z = NULL;
+  /* observability: the dual model's factor, O = Q Zy Zy^T Q */
+  CHECK_RC(phgmg_shifted_create(&sd, sp, 1, 0, NULL), PHGMG_OK);
+  CHECK_RC(phgmg_lradi(sd, 2, phgmg_ph_sparse_system(sp)->B, N, &o, &Z, &k, &inf, NULL), PHGMG_OK);
+  Plr = tk_gram_user(sp, N, Z, k);
+  phgmg_gemm('N', 'N', N, N, N, 1.0, M.Q, N, Plr, N, 0.0, T, N);
+  phgmg_gemm('N', 'N', N, N, N, 1.0, T, N, M.Q, N, 0.0, Plr, N);
+  CHECK_LE(tk_reldiff(N * N, Plr, O), 1e-8);
+  free(Plr); phgmg_lowrank_free(Z, NULL); Z = NULL;
+  /* the residual at tol 1e-4 */
+  o.tol = 1e-4;
+  CHECK_RC(phgmg_lrkrylov(s, 2, phgmg_ph_sparse_system(sp)->B, N, &o, &Z, &k, &inf, NULL), PHGMG_OK);
+  CHECK(inf.res <= 1e-4 && inf.res > 1e-12);
+  Plr = tk_gram_user(sp, N, Z, k);
+  res = tk_lyap_res(N, A, M.B, Plr);
+  CHECK_LE(fabs(res - inf.res), 0.02 * inf.res);
+  free(Plr); phgmg_lowrank_free(Z, NULL);
+  /* balanced truncation */
+  tk_dense_hsv(N, P, O, hsvd, r);
+  tk_lrbt_hsv(sp, PHGMG_LYAP_EKSM, r, hsv, &bi);
+  tk_lrbt_hsv(sp, PHGMG_LYAP_ADI, r, hsva, &ba);
+  CHECK(bi.ctrl.solver == PHGMG_LYAP_EKSM && bi.obs.solver == PHGMG_LYAP_EKSM && bi.obs.res <= 1e-10);
+  for (i = 0; i < r; ++i) {
+    CHECK_LE(fabs(hsv[i] - hsvd[i]), 1e-8 * hsvd[0]);
+    CHECK_LE(fabs(hsv[i] - hsva[i]), 1e-8 * hsva[0]);
+  }
+  phgmg_shifted_destroy(s); phgmg_shifted_destroy(sd); phgmg_ph_sparse_destroy(sp);
+  free(A); free(At); free(F); free(P); free(O); free(T);
+  tk_free(&M);
+}
+
+/* Bad arguments and the documented codes: NULL, m < 1, ldb < N, a solver
+   value out of range, B = 0 (_RANK), NaN in B (_NANINF), maxit blocks too
+   few (_NOT_CONVERGED, the residual reached in info, no factor), a mass
+   matrix (_UNSUPPORTED); zeroed options run the ADI (the same factor as
+   NULL options). */
+TEST(test_eksm_arguments) {
+  tk_model M, Me;
+  phgmg_ph_sparse *sp, *spe;
+  phgmg_shifted *s = NULL, *se = NULL;
+  phgmg_lradi_info inf;
+  phgmg_lradi_opts o;
+  double *Z = NULL, *Z2 = NULL, *B0;
+  const double *B, *Be;
+  int N, k = 0, k2 = 0;
+  size_t i;
+  tk_lattice(&M, 4, 0.5, 0);
+  tk_lattice(&Me, 4, 0.5, 1);
+  N = M.N;
+  sp = tk_sparse(&M);
+  spe = tk_sparse(&Me);
+  CHECK_RC(phgmg_shifted_create(&s, sp, 0, 0, NULL), PHGMG_OK);
+  CHECK_RC(phgmg_shifted_create(&se, spe, 0, 0, NULL), PHGMG_OK);
+  B = phgmg_ph_sparse_system(sp)->B;     /* internal order */
+  Be = phgmg_ph_sparse_system(spe)->B;
+  memset(&o, 0, sizeof o);
+  o.solver = PHGMG_LYAP_EKSM;
+  CHECK_RC(phgmg_lrkrylov(NULL, 2, B, N, NULL, &Z, &k, &inf, NULL), PHGMG_ERR_INVALID_ARG);
+  CHECK_RC(phgmg_lrkrylov(s, 0, B, N, NULL, &Z, &k, &inf, NULL), PHGMG_ERR_INVALID_ARG);
+  CHECK_RC(phgmg_lrkrylov(s, 2, B, N - 1, NULL, &Z, &k, &inf, NULL), PHGMG_ERR_INVALID_ARG);
+  CHECK_RC(phgmg_lrkrylov(s, 2, NULL, N, NULL, &Z, &k, &inf, NULL), PHGMG_ERR_INVALID_ARG);
+  CHECK_RC(phgmg_lrkrylov(s, 2, B, N, NULL, NULL, &k, &inf, NULL), PHGMG_ERR_INVALID_ARG);
+  o.solver = 2;
+  CHECK_RC(phgmg_lradi(s, 2, B, N, &o, &Z, &k, &inf, NULL), PHGMG_ERR_INVALID_ARG);
+  o.solver = -1;
+  CHECK_RC(phgmg_lradi(s, 2, B, N, &o, &Z, &k, &inf, NULL), PHGMG_ERR_INVALID_ARG);
+  o.solver = PHGMG_LYAP_EKSM;
+  o.tol = 1.0;
+  CHECK_RC(phgmg_lradi(s, 2, B, N, &o, &Z, &k, &inf, NULL), PHGMG_ERR_INVALID_ARG);
+  o.tol = 0.0;
+  B0 = (double *)calloc((size_t)N * 2, sizeof(double));
+  CHECK_RC(phgmg_lrkrylov(s, 2, B0, N, NULL, &Z, &k, &inf, NULL), PHGMG_ERR_RANK);
+  B0[3] = NAN;
+  CHECK_RC(phgmg_lrkrylov(s, 2, B0, N, NULL, &Z, &k, &inf, NULL), PHGMG_ERR_NANINF);
+  o.maxit = 2;
+  CHECK_RC(phgmg_lrkrylov(s, 2, B, N, &o, &Z, &k, &inf, NULL), PHGMG_ERR_NOT_CONVERGED);
+  CHECK(Z == NULL && k == 0 && inf.iters == 2 && inf.res > 1e-10 && inf.rank == 0);
+  o.maxit = 0;
+  CHECK_RC(phgmg_lrkrylov(se, 2, Be, N, &o, &Z, &k, &inf, NULL), PHGMG_ERR_UNSUPPORTED);
+  CHECK(Z == NULL && k == 0);
+  CHECK_RC(phgmg_lradi(se, 2, Be, N, &o, &Z, &k, &inf, NULL), PHGMG_ERR_UNSUPPORTED);
+  /* zeroed options: the ADI, as with NULL */
+  memset(&o, 0, sizeof o);
+  CHECK_RC(phgmg_lradi(s, 2, B, N, &o, &Z, &k, &inf, NULL), PHGMG_OK);
+  CHECK(inf.solver == PHGMG_LYAP_ADI && inf.shift_sets > 0);
+  CHECK_RC(phgmg_lradi(s, 2, B, N, NULL, &Z2, &k2, NULL, NULL), PHGMG_OK);
+  CHECK(k == k2);
+  for (i = 0; k == k2 && i < (size_t)N * (size_t)k; ++i) CHECK(Z[i] == Z2[i]);
+  phgmg_lowrank_free(Z, NULL); phgmg_lowrank_free(Z2, NULL);
+  free(B0);
+  phgmg_shifted_destroy(s); phgmg_shifted_destroy(se);
+  phgmg_ph_sparse_destroy(sp); phgmg_ph_sparse_destroy(spe);
+  tk_free(&M); tk_free(&Me);
+}
+
+SUITE(eksm) {
+  RUN(test_eksm_heat);
+  RUN(test_eksm_lattice);
+  RUN(test_eksm_arguments);
+}
