@@ -21881,12 +21881,8 @@ PHGMG__PRIV void phgmg__zgemm(char ta, char tb, int m, int n, int k, const doubl
       double br, bi;
       if (tb == 'N') { br = B[2 * (l + (size_t)j * ldb)]; bi = B[2 * (l + (size_t)j * ldb) + 1]; }
       else { br = B[2 * (j + (size_t)l * ldb)]; bi = -B[2 * (j + (size_t)l * ldb) + 1]; }
-      if (ta == 'N') {   /* c += A(:, l) b */
-        const double *a = A + 2 * (size_t)l * lda;
-        for (i = 0; i < m; ++i) {
-          c[2 * i] += a[2 * i] * br - a[2 * i + 1] * bi;
-          c[2 * i + 1] += a[2 * i] * bi + a[2 * i + 1] * br;
-        }
+      if (ta == 'N') {   /* c += A(:, l) b, as c -= (-b) A(:, l): the same products and sums */
+        phgmg__sp_zaxpy(m, -br, -bi, A + 2 * (size_t)l * lda, c);
       } else {           /* c_i += conj(A(l, i)) b */
         for (i = 0; i < m; ++i) {
           const double ar = A[2 * (l + (size_t)i * lda)], ai = -A[2 * (l + (size_t)i * lda) + 1];
@@ -27567,8 +27563,7 @@ PHGMG__PRIV void phgmg__gemm_micro(int kc, const double *Ap, const double *B, si
   }
   if (mr == PHGMG__MR && nr == PHGMG__NR) { /* a whole tile: C updated from the registers */
     phgmg__v8 cv;
-#define PHGMG__V8_CUPD(k, cj) do { memcpy(&cv, C + (size_t)(k) * (size_t)ldc, sizeof cv); cv += alpha * (cj); \
-                                   memcpy(C + (size_t)(k) * (size_t)ldc, &cv, sizeof cv); } while (0)
+#define PHGMG__V8_CUPD(k, cj) do { double *ck_ = C + (size_t)(k) * (size_t)ldc; memcpy(&cv, ck_, sizeof cv); cv += alpha * (cj); memcpy(ck_, &cv, sizeof cv); } while (0)
     PHGMG__V8_CUPD(0, c0); PHGMG__V8_CUPD(1, c1); PHGMG__V8_CUPD(2, c2);
     PHGMG__V8_CUPD(3, c3); PHGMG__V8_CUPD(4, c4); PHGMG__V8_CUPD(5, c5);
 #undef PHGMG__V8_CUPD
