@@ -28911,7 +28911,7 @@ PHGMG_DEF phgmg_result phgmg_sym_eig(int n, double *A, int lda, double *w, doubl
             iterates on the symmetric part of F. Results change at the
             rounding level.
           - Faster: phgmg_gemm's micro-kernel keeps a column of the tile in
-            one 8-wide vector on AVX-512 targets (1.3x at n = 1000; the same
+            one 8-wide vector on AVX-512 targets (1.3x-1.7x at n = 1000; the same
             sums in the same order, so the same results).
           - Faster: the GMG-H2 basis (phgmg_linear_basis, kind H2): the
             transposed triangular Sylvester solve runs by columns of T^H,
