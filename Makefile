@@ -322,6 +322,13 @@ $(BUILD)/bench_lowrank: bench/bench_lowrank.c bench/bench_args.h phgmg.h
 	$(CC) $(OPTFLAGS) $$(if printf 'int main(void){return 0;}\n' | $(CC) -fopenmp -x c - -o /dev/null >/dev/null 2>&1; \
 	  then echo -fopenmp -DPHGMG_USE_OPENMP; fi) -o $@ bench/bench_lowrank.c $(LDLIBS)
 
+# The dense Lyapunov solver and its kernels against SciPy/OpenBLAS
+# (bench/README.md, "Dense Lyapunov"; one thread, no OpenMP):
+#   ./build/bench_lyap --n 1000 --dir /tmp/ly && /usr/bin/python3 bench/lyap_scipy.py /tmp/ly
+$(BUILD)/bench_lyap: bench/bench_lyap.c phgmg.h examples/msd_models.h
+	@mkdir -p $(BUILD)
+	$(CC) $(OPTFLAGS) -o $@ bench/bench_lyap.c $(LDLIBS)
+
 # The distributed phases' timings and communication, as JSON (bench/README.md,
 # "The distributed offline phase: scaling model"; not part of make test):
 #   mpirun -np P build/bench_mpi_phases --nloc 25000 > p1.json

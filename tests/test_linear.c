@@ -430,11 +430,12 @@ TEST(test_zschur_known_eigenvalues) {
   }
 }
 
-/* Triangular Sylvester equations, both modes, against the products. */
+/* Triangular Sylvester equations, both modes (mode 1 also by columns of a
+   given T^H), against the products. */
 TEST(test_ztrsyl_residual) {
   enum { n = 7, k = 4 };
-  double T[2 * n * n], S[2 * k * k], F[2 * n * k], X[2 * n * k], P[2 * n * k], Q[2 * n * k];
-  int i, j, mode;
+  double T[2 * n * n], TH[2 * n * n], S[2 * k * k], F[2 * n * k], X[2 * n * k], P[2 * n * k], Q[2 * n * k];
+  int i, j, mode, md;
   memset(T, 0, sizeof T); memset(S, 0, sizeof S);
   for (j = 0; j < n; ++j)
     for (i = 0; i <= j; ++i) {
@@ -447,9 +448,11 @@ TEST(test_ztrsyl_residual) {
       S[2 * (i + j * k) + 1] = i == j ? 1.0 - j : -0.2 * j;
     }
   for (i = 0; i < 2 * n * k; ++i) F[i] = sin(1.0 + i);
-  for (mode = 0; mode < 2; ++mode) {
+  phgmg__zconj_transpose(n, T, TH);
+  for (md = 0; md < 3; ++md) {
+    mode = md == 2 ? 1 : md;
     memcpy(X, F, sizeof X);
-    CHECK_RC(phgmg__ztrsyl(mode, n, T, k, S, X), PHGMG_OK);
+    CHECK_RC(phgmg__ztrsyl_h(mode, n, T, k, S, X, md == 2 ? TH : NULL), PHGMG_OK);
     if (mode == 0) { phgmg__zgemm('N', 'N', n, k, n, T, n, X, n, P, n); phgmg__zgemm('N', 'C', n, k, k, X, n, S, k, Q, n); }
     else { phgmg__zgemm('C', 'N', n, k, n, T, n, X, n, P, n); phgmg__zgemm('N', 'N', n, k, k, X, n, S, k, Q, n); }
     for (i = 0; i < 2 * n * k; ++i) CHECK_LE(fabs(P[i] + Q[i] - F[i]), 1e-13);
