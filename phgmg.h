@@ -2638,9 +2638,9 @@
 
 /* >>config ================================================================ */
 #define PHGMG_VERSION_MAJOR 0
-#define PHGMG_VERSION_MINOR 9
+#define PHGMG_VERSION_MINOR 10
 #define PHGMG_VERSION_PATCH 0
-#define PHGMG_VERSION_STRING "0.9.0"
+#define PHGMG_VERSION_STRING "0.10.0"
 
 #include <stddef.h>
 
