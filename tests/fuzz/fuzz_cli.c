@@ -38,7 +38,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
 static char g_dir[64];
 static int g_home = -1; /* the starting working directory */
-static char g_tok[160][128];
+static char g_tok[192][128];
 static int g_ntok;
 static unsigned char *g_rom;
 static size_t g_rom_len;
@@ -183,6 +183,7 @@ static void init(void) {
   static const char *const words8[] = {"--poly-jdx", NULL};   /* after words7 */
   static const char *const files8[] = {"jdx.npy", NULL};
   static const char *const words9[] = {"--adi-maxit", NULL};   /* after files8 */
+  static const char *const words10[] = {"--lyap", "adi", "eksm", NULL};   /* after words9 */
   char *argv[24];
   int k, fb, argc = 0;   /* fb: the token of files[0] */
   FILE *f;
@@ -205,6 +206,7 @@ static void init(void) {
   for (k = 0; words8[k]; ++k) strcpy(g_tok[g_ntok++], words8[k]);
   for (k = 0; files8[k]; ++k) snprintf(g_tok[g_ntok++], sizeof g_tok[0], "%s/%s", g_dir, files8[k]);
   for (k = 0; words9[k]; ++k) strcpy(g_tok[g_ntok++], words9[k]);
+  for (k = 0; words10[k]; ++k) strcpy(g_tok[g_ntok++], words10[k]);
   /* the model file, made once by the CLI itself */
   restore();
   argv[argc++] = (char *)"phgmg"; argv[argc++] = (char *)"reduce";
