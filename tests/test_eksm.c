@@ -11,6 +11,7 @@
 #define PHGMG_IMPLEMENTATION
 #include "../phgmg.h"
 #include "harness.h"
+#include "dense_csc.h"
 #include <stdlib.h>
 
 /* Dense model (column-major, user ordering): J, R, Q, B (N x 2), E (NULL:
@@ -81,35 +82,14 @@ static void tk_lattice(tk_model *M, int n, double d0, int with_e) {
   M->B[n2 + n2 - 1 + (size_t)N] = 1.0;
 }
 
-/* CSC of a dense N x N matrix (malloc'ed arrays). */
-static phgmg_csc tk_csc(int N, const double *A) {
-  phgmg_csc c;
-  int j, i, nz = 0;
-  int *cp = (int *)malloc(sizeof(int) * (size_t)(N + 1)), *ri;
-  double *v;
-  for (j = 0; j < N * N; ++j) nz += A[j] != 0.0;
-  ri = (int *)malloc(sizeof(int) * (size_t)(nz + 1));
-  v = (double *)malloc(sizeof(double) * (size_t)(nz + 1));
-  nz = 0;
-  for (j = 0; j < N; ++j) {
-    cp[j] = nz;
-    for (i = 0; i < N; ++i)
-      if (A[i + (size_t)j * N] != 0.0) { ri[nz] = i; v[nz++] = A[i + (size_t)j * N]; }
-  }
-  cp[N] = nz;
-  c.n_rows = c.n_cols = N; c.colptr = cp; c.rowidx = ri; c.values = v;
-  return c;
-}
-
-static void tk_csc_free(phgmg_csc *c) { free((void *)c->colptr); free((void *)c->rowidx); free((void *)c->values); }
 
 static phgmg_ph_sparse *tk_sparse(const tk_model *M) {
   phgmg_ph_sparse *sp = NULL;
-  phgmg_csc J = tk_csc(M->N, M->J), R = tk_csc(M->N, M->R), Q = tk_csc(M->N, M->Q), E;
-  if (M->E) E = tk_csc(M->N, M->E);
+  phgmg_csc J = th_dense_csc(M->N, M->J), R = th_dense_csc(M->N, M->R), Q = th_dense_csc(M->N, M->Q), E;
+  if (M->E) E = th_dense_csc(M->N, M->E);
   CHECK_RC(phgmg_ph_sparse_create_e(&sp, M->N, 2, &J, &R, &Q, M->E ? &E : NULL, M->B, NULL, NULL, NULL), PHGMG_OK);
-  tk_csc_free(&J); tk_csc_free(&R); tk_csc_free(&Q);
-  if (M->E) tk_csc_free(&E);
+  th_csc_free(&J); th_csc_free(&R); th_csc_free(&Q);
+  if (M->E) th_csc_free(&E);
   return sp;
 }
 

@@ -10,6 +10,7 @@
 #define PHGMG_IMPLEMENTATION
 #include "../phgmg.h"
 #include "harness.h"
+#include "dense_csc.h"
 #include <stdlib.h>
 
 /* A 2-D mass-spring-damper lattice (n x n unit masses, x = (q, p), N =
@@ -63,35 +64,15 @@ static void lr_lattice(lr_model *M, int n, int consistent) {
 
 static void lr_free(lr_model *M) { free(M->J); free(M->R); free(M->Q); free(M->E); free(M->B); }
 
-/* CSC of a dense N x N matrix (its nonzero entries); arrays malloc'ed. */
-static phgmg_csc lr_csc(int N, const double *A) {
-  phgmg_csc c;
-  int j, i, nz = 0;
-  int *cp = (int *)malloc(sizeof(int) * (size_t)(N + 1)), *ri;
-  double *v;
-  for (j = 0; j < N * N; ++j) nz += A[j] != 0.0;
-  ri = (int *)malloc(sizeof(int) * (size_t)(nz + 1));
-  v = (double *)malloc(sizeof(double) * (size_t)(nz + 1));
-  nz = 0;
-  for (j = 0; j < N; ++j) {
-    cp[j] = nz;
-    for (i = 0; i < N; ++i)
-      if (A[i + (size_t)j * N] != 0.0) { ri[nz] = i; v[nz++] = A[i + (size_t)j * N]; }
-  }
-  cp[N] = nz;
-  c.n_rows = c.n_cols = N; c.colptr = cp; c.rowidx = ri; c.values = v;
-  return c;
-}
-static void lr_csc_free(phgmg_csc *c) { free((void *)c->colptr); free((void *)c->rowidx); free((void *)c->values); }
 
 static phgmg_ph_sparse *lr_sparse(const lr_model *M) {
   phgmg_ph_sparse *sp = NULL;
-  phgmg_csc J = lr_csc(M->N, M->J), R = lr_csc(M->N, M->R), Q = lr_csc(M->N, M->Q), E;
-  if (M->E) E = lr_csc(M->N, M->E);
+  phgmg_csc J = th_dense_csc(M->N, M->J), R = th_dense_csc(M->N, M->R), Q = th_dense_csc(M->N, M->Q), E;
+  if (M->E) E = th_dense_csc(M->N, M->E);
   CHECK_RC(phgmg_ph_sparse_create_e(&sp, M->N, M->m, &J, &R, &Q, M->E ? &E : NULL, M->B, NULL, NULL, NULL),
            PHGMG_OK);
-  lr_csc_free(&J); lr_csc_free(&R); lr_csc_free(&Q);
-  if (M->E) lr_csc_free(&E);
+  th_csc_free(&J); th_csc_free(&R); th_csc_free(&Q);
+  if (M->E) th_csc_free(&E);
   return sp;
 }
 
