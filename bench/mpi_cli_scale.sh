@@ -15,6 +15,8 @@
 #   sh bench/mpi_cli_scale.sh [NX [R [DIR [NY]]]]  (defaults 100000 20 /tmp/mpi_cli_scale 1)
 # DIR keeps the model, the snapshots (1.6 GB at NX = 1e5) and the outputs;
 # steps whose outputs exist are not redone (delete DIR to start afresh).
+# B2 (e.g. 0.5) adds a second input weight on mass 1 (bench/lattice.py --b2:
+# no mirror symmetry, so that the hyper-reduction points are unique).
 # METHODS (default "gmg-pod sp1") and PS (default "1 2 3 4") select the runs;
 # the table lists those that were made.
 # The machine may be shared: the times are those of this run.
@@ -34,7 +36,7 @@ mkdir -p "$D"
 cd "$D"
 M="--J-coo J.npy --R-coo R.npy --Q-coo Q.npy --B B.npy --potential cosh:1 --poly-idx idx.npy"
 now() { date +%s.%N; }
-[ -e idx.npy ] || $PY "$ROOT/bench/lattice.py" . "$NX" "$NY" --cosh > /dev/null
+[ -e idx.npy ] || $PY "$ROOT/bench/lattice.py" . "$NX" "$NY" --cosh ${B2:+--b2 "$B2"} > /dev/null
 [ -e X.npy ] || "$PHGMG" simulate $M --dt 0.1 --steps 1000 --out y_full.npy --states X.npy --quiet > /dev/null
 for meth in ${METHODS:-gmg-pod sp1}; do
   if [ ! -e "y_serial_$meth.npy" ]; then
