@@ -37,7 +37,7 @@ TEST_UNITS   = tests/run.c tests/unity_a.c tests/unity_b.c $(TEST_SOLO)
 TESTOBJ      = $(patsubst tests/%.c,$(BUILD)/obj/%.o,$(TEST_UNITS))
 TESTOBJ_ASAN = $(patsubst tests/%.c,$(BUILD)/obj_asan/%.o,$(TEST_UNITS))
 $(BUILD)/obj/unity_%.o $(BUILD)/obj_asan/unity_%.o: $(filter-out $(TEST_SOLO),$(TESTSRC)) \
-  examples/msd_models.h tests/sepfun_models.h tests/dense_csc.h
+  examples/msd_models.h tests/sepfun_models.h tests/lowrank_fixture.h
 
 $(BUILD)/obj/%.o: tests/%.c phgmg.h tests/harness.h tests/fixture_msd.h tests/suites.inc
 	@mkdir -p $(BUILD)/obj

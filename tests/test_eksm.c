@@ -11,7 +11,7 @@
 #define PHGMG_IMPLEMENTATION
 #include "../phgmg.h"
 #include "harness.h"
-#include "dense_csc.h"
+#include "lowrank_fixture.h"
 #include <stdlib.h>
 
 /* Dense model (column-major, user ordering): J, R, Q, B (N x 2), E (NULL:
@@ -104,39 +104,6 @@ static double *tk_dense_a(const tk_model *M) {
   return A;
 }
 
-/* Z (internal order, N x k) -> Z Z^T in the user's order. */
-static double *tk_gram_user(phgmg_ph_sparse *sp, int N, const double *Z, int k) {
-  double *Zu = (double *)malloc(sizeof(double) * (size_t)N * k), *P = (double *)malloc(sizeof(double) * (size_t)N * N);
-  CHECK_RC(phgmg_ph_sparse_to_user_order(sp, k, Z, N, Zu, N), PHGMG_OK);
-  phgmg_gemm('N', 'T', N, N, k, 1.0, Zu, N, Zu, N, 0.0, P, N);
-  free(Zu);
-  return P;
-}
-
-static double tk_reldiff(int n, const double *X, const double *Y) {
-  double d = 0.0, y = 0.0;
-  int i;
-  for (i = 0; i < n; ++i) { d += (X[i] - Y[i]) * (X[i] - Y[i]); y += Y[i] * Y[i]; }
-  return sqrt(d / y);
-}
-
-/* ||A P + P A^T + B B^T||_2 / ||B^T B||_2, dense. */
-static double tk_lyap_res(int N, const double *A, const double *B, const double *P) {
-  double *T = (double *)malloc(sizeof(double) * (size_t)N * N), *Rr = (double *)malloc(sizeof(double) * (size_t)N * N);
-  double *w = (double *)malloc(sizeof(double) * (size_t)N), G[4], g[2], r;
-  int i, j;
-  phgmg_gemm('N', 'N', N, N, N, 1.0, A, N, P, N, 0.0, Rr, N);
-  for (j = 0; j < N; ++j)
-    for (i = 0; i < N; ++i) T[i + (size_t)j * N] = Rr[i + (size_t)j * N] + Rr[j + (size_t)i * N];
-  phgmg_gemm('N', 'T', N, N, 2, 1.0, B, N, B, N, 1.0, T, N);
-  CHECK_RC(phgmg_sym_eig(N, T, N, w, NULL, N), PHGMG_OK);
-  r = PHGMG__MAX(fabs(w[0]), fabs(w[N - 1]));
-  phgmg_gemm('T', 'N', 2, 2, N, 1.0, B, N, B, N, 0.0, G, 2);
-  CHECK_RC(phgmg_sym_eig(2, G, 2, g, NULL, 2), PHGMG_OK);
-  free(T); free(Rr); free(w);
-  return r / g[1];
-}
-
 /* The heat model's Gramian by the eigen-decomposition of R = U diag(l) U^T
    (A = -R symmetric): P = U Pt U^T, Pt_ij = (U^T B B^T U)_ij / (l_i + l_j). */
 static double *tk_heat_gramian(const tk_model *M) {
@@ -155,23 +122,6 @@ static double *tk_heat_gramian(const tk_model *M) {
   phgmg_gemm('N', 'T', N, N, N, 1.0, T, N, U, N, 0.0, P, N);
   free(U); free(T); free(l); free(C);
   return P;
-}
-
-/* Dense Hankel singular values (n, descending): P = L L^T, sigma^2 =
-   eig(L^T O L). */
-static void tk_dense_hsv(int N, const double *P, const double *O, double *hsv, int n) {
-  double *V = (double *)malloc(sizeof(double) * (size_t)N * N), *W = (double *)malloc(sizeof(double) * (size_t)N * N);
-  double *T = (double *)malloc(sizeof(double) * (size_t)N * N), *w = (double *)malloc(sizeof(double) * (size_t)N);
-  int i, j;
-  memcpy(T, P, sizeof(double) * (size_t)N * N);
-  CHECK_RC(phgmg_sym_eig(N, T, N, w, V, N), PHGMG_OK);
-  for (j = 0; j < N; ++j)
-    for (i = 0; i < N; ++i) V[i + (size_t)j * N] *= sqrt(w[j] > 0.0 ? w[j] : 0.0);
-  phgmg_gemm('N', 'N', N, N, N, 1.0, O, N, V, N, 0.0, W, N);
-  phgmg_gemm('T', 'N', N, N, N, 1.0, V, N, W, N, 0.0, T, N);
-  CHECK_RC(phgmg_sym_eig(N, T, N, w, NULL, N), PHGMG_OK);
-  for (i = 0; i < n; ++i) hsv[i] = sqrt(w[N - 1 - i] > 0.0 ? w[N - 1 - i] : 0.0);
-  free(V); free(W); free(T); free(w);
 }
 
 /* Low-rank BT's first r Hankel singular values with the solver `solver`. */
@@ -212,15 +162,15 @@ TEST(test_eksm_heat) {
   CHECK_RC(phgmg_lrkrylov(s, 2, phgmg_ph_sparse_system(sp)->B, N, NULL, &Z, &k, &inf, NULL), PHGMG_OK);
   CHECK(inf.solver == PHGMG_LYAP_EKSM && inf.shift == 0.0 && inf.factorizations == 1);
   CHECK(inf.res <= 1e-10 && inf.iters > 1 && inf.rank == k && k <= inf.cols && k < N);
-  Plr = tk_gram_user(sp, N, Z, k);
-  CHECK_LE(tk_reldiff(N * N, Plr, P), 1e-8);
+  Plr = th_gram_user(sp, N, Z, k);
+  CHECK_LE(th_reldiff(N * N, Plr, P), 1e-8);
   free(Plr); phgmg_lowrank_free(Z, NULL); Z = NULL;
   /* the residual, at a tolerance whose residual is far above round-off */
   o.tol = 1e-7;
   CHECK_RC(phgmg_lradi(s, 2, phgmg_ph_sparse_system(sp)->B, N, &o, &Z, &k, &inf, NULL), PHGMG_OK);
   CHECK(inf.solver == PHGMG_LYAP_EKSM && inf.res <= 1e-7 && inf.res > 1e-12);
-  Plr = tk_gram_user(sp, N, Z, k);
-  res = tk_lyap_res(N, A, M.B, Plr);
+  Plr = th_gram_user(sp, N, Z, k);
+  res = th_lyap_res(N, 2, A, NULL, M.B, Plr);
   CHECK_LE(fabs(res - inf.res), 0.02 * inf.res);
   free(Plr); phgmg_lowrank_free(Z, NULL);
   /* BT: sigma = eig(P) */
@@ -274,27 +224,27 @@ TEST(test_eksm_lattice) {
   CHECK_RC(phgmg_shifted_create(&s, sp, 0, 0, NULL), PHGMG_OK);
   CHECK_RC(phgmg_lradi(s, 2, phgmg_ph_sparse_system(sp)->B, N, &o, &Z, &k, &inf, NULL), PHGMG_OK);
   CHECK(inf.solver == PHGMG_LYAP_EKSM && inf.shift < 0.0 && inf.res <= 1e-10 && inf.rank == k && k < N);
-  Plr = tk_gram_user(sp, N, Z, k);
-  CHECK_LE(tk_reldiff(N * N, Plr, P), 1e-8);
+  Plr = th_gram_user(sp, N, Z, k);
+  CHECK_LE(th_reldiff(N * N, Plr, P), 1e-8);
   free(Plr); phgmg_lowrank_free(Z, NULL); Z = NULL;
   /* observability: the dual model's factor, O = Q Zy Zy^T Q */
   CHECK_RC(phgmg_shifted_create(&sd, sp, 1, 0, NULL), PHGMG_OK);
   CHECK_RC(phgmg_lradi(sd, 2, phgmg_ph_sparse_system(sp)->B, N, &o, &Z, &k, &inf, NULL), PHGMG_OK);
-  Plr = tk_gram_user(sp, N, Z, k);
+  Plr = th_gram_user(sp, N, Z, k);
   phgmg_gemm('N', 'N', N, N, N, 1.0, M.Q, N, Plr, N, 0.0, T, N);
   phgmg_gemm('N', 'N', N, N, N, 1.0, T, N, M.Q, N, 0.0, Plr, N);
-  CHECK_LE(tk_reldiff(N * N, Plr, O), 1e-8);
+  CHECK_LE(th_reldiff(N * N, Plr, O), 1e-8);
   free(Plr); phgmg_lowrank_free(Z, NULL); Z = NULL;
   /* the residual at tol 1e-4 */
   o.tol = 1e-4;
   CHECK_RC(phgmg_lrkrylov(s, 2, phgmg_ph_sparse_system(sp)->B, N, &o, &Z, &k, &inf, NULL), PHGMG_OK);
   CHECK(inf.res <= 1e-4 && inf.res > 1e-12);
-  Plr = tk_gram_user(sp, N, Z, k);
-  res = tk_lyap_res(N, A, M.B, Plr);
+  Plr = th_gram_user(sp, N, Z, k);
+  res = th_lyap_res(N, 2, A, NULL, M.B, Plr);
   CHECK_LE(fabs(res - inf.res), 0.02 * inf.res);
   free(Plr); phgmg_lowrank_free(Z, NULL);
   /* balanced truncation */
-  tk_dense_hsv(N, P, O, hsvd, r);
+  th_dense_hsv(N, P, O, hsvd, r);
   tk_lrbt_hsv(sp, PHGMG_LYAP_EKSM, r, hsv, &bi);
   tk_lrbt_hsv(sp, PHGMG_LYAP_ADI, r, hsva, &ba);
   CHECK(bi.ctrl.solver == PHGMG_LYAP_EKSM && bi.obs.solver == PHGMG_LYAP_EKSM && bi.obs.res <= 1e-10);

@@ -10,7 +10,7 @@
 #define PHGMG_IMPLEMENTATION
 #include "../phgmg.h"
 #include "harness.h"
-#include "dense_csc.h"
+#include "lowrank_fixture.h"
 #include <stdlib.h>
 
 /* A 2-D mass-spring-damper lattice (n x n unit masses, x = (q, p), N =
@@ -95,58 +95,6 @@ static void lr_dense_abc(const lr_model *M, double *A, double *Bp, double *C) {
   }
   phgmg_gemm('T', 'N', m, N, N, 1.0, M->B, N, M->Q, N, 0.0, C, m);
   free(JR);
-}
-
-/* Z (internal order, N x k) -> Z Z^T in the user's order. */
-static double *lr_gram_user(phgmg_ph_sparse *sp, int N, const double *Z, int k) {
-  double *Zu = (double *)malloc(sizeof(double) * (size_t)N * k), *P = (double *)malloc(sizeof(double) * (size_t)N * N);
-  CHECK_RC(phgmg_ph_sparse_to_user_order(sp, k, Z, N, Zu, N), PHGMG_OK);
-  phgmg_gemm('N', 'T', N, N, k, 1.0, Zu, N, Zu, N, 0.0, P, N);
-  free(Zu);
-  return P;
-}
-
-static double lr_reldiff(int n, const double *X, const double *Y) {
-  double d = 0.0, y = 0.0;
-  int i;
-  for (i = 0; i < n; ++i) { d += (X[i] - Y[i]) * (X[i] - Y[i]); y += Y[i] * Y[i]; }
-  return sqrt(d / y);
-}
-
-/* ||A P E^T + E P A^T + B B^T||_2 / ||B^T B||_2 (dense, E NULL = I). */
-static double lr_lyap_res(int N, int m, const double *A, const double *E, const double *B, const double *P) {
-  double *T = (double *)malloc(sizeof(double) * (size_t)N * N), *Rr = (double *)malloc(sizeof(double) * (size_t)N * N);
-  double *w = (double *)malloc(sizeof(double) * (size_t)N), G[4], g[2], r;
-  int i, j;
-  phgmg_gemm('N', 'N', N, N, N, 1.0, A, N, P, N, 0.0, T, N);                    /* A P */
-  if (E) phgmg_gemm('N', 'T', N, N, N, 1.0, T, N, E, N, 0.0, Rr, N);             /* A P E^T */
-  else memcpy(Rr, T, sizeof(double) * (size_t)N * N);
-  for (j = 0; j < N; ++j)
-    for (i = 0; i < N; ++i) T[i + (size_t)j * N] = Rr[i + (size_t)j * N] + Rr[j + (size_t)i * N];
-  phgmg_gemm('N', 'T', N, N, m, 1.0, B, N, B, N, 1.0, T, N);
-  CHECK_RC(phgmg_sym_eig(N, T, N, w, NULL, N), PHGMG_OK);
-  r = PHGMG__MAX(fabs(w[0]), fabs(w[N - 1]));
-  phgmg_gemm('T', 'N', m, m, N, 1.0, B, N, B, N, 0.0, G, m);
-  CHECK_RC(phgmg_sym_eig(m, G, m, g, NULL, m), PHGMG_OK);
-  free(T); free(Rr); free(w);
-  return r / g[m - 1];
-}
-
-/* Dense Hankel singular values (descending, n of them) from the Gramians:
-   P = L L^T (eigen-decomposition), sigma^2 = eig(L^T O L). */
-static void lr_dense_hsv(int N, const double *P, const double *O, double *hsv, int n) {
-  double *V = (double *)malloc(sizeof(double) * (size_t)N * N), *W = (double *)malloc(sizeof(double) * (size_t)N * N);
-  double *T = (double *)malloc(sizeof(double) * (size_t)N * N), *w = (double *)malloc(sizeof(double) * (size_t)N);
-  int i, j;
-  memcpy(T, P, sizeof(double) * (size_t)N * N);
-  CHECK_RC(phgmg_sym_eig(N, T, N, w, V, N), PHGMG_OK);
-  for (j = 0; j < N; ++j)
-    for (i = 0; i < N; ++i) V[i + (size_t)j * N] *= sqrt(w[j] > 0.0 ? w[j] : 0.0);
-  phgmg_gemm('N', 'N', N, N, N, 1.0, O, N, V, N, 0.0, W, N);
-  phgmg_gemm('T', 'N', N, N, N, 1.0, V, N, W, N, 0.0, T, N);
-  CHECK_RC(phgmg_sym_eig(N, T, N, w, NULL, N), PHGMG_OK);
-  for (i = 0; i < n; ++i) hsv[i] = sqrt(w[N - 1 - i] > 0.0 ? w[N - 1 - i] : 0.0);
-  free(V); free(W); free(T); free(w);
 }
 
 /* Dense Gramians P (A P + P A^T + B B^T = 0) and O (A^T O + O A + C^T C = 0)
@@ -263,19 +211,19 @@ TEST(test_lowrank_lradi_lattice) {
   CHECK_RC(phgmg_shifted_create(&s, sp, 0, 0, NULL), PHGMG_OK);
   CHECK_RC(phgmg_lradi(s, 2, phgmg_ph_sparse_system(sp)->B, N, NULL, &Z, &k, &inf, NULL), PHGMG_OK);
   CHECK(inf.res <= 1e-10 && inf.iters > 0 && inf.rank == k && k <= inf.cols && k < N);
-  Plr = lr_gram_user(sp, N, Z, k);
-  CHECK_LE(lr_reldiff(N * N, Plr, P), 1e-8);
-  res = lr_lyap_res(N, 2, A, NULL, M.B, Plr);
+  Plr = th_gram_user(sp, N, Z, k);
+  CHECK_LE(th_reldiff(N * N, Plr, P), 1e-8);
+  res = th_lyap_res(N, 2, A, NULL, M.B, Plr);
   CHECK_LE(fabs(res - inf.res), 0.05 * inf.res + 1e-13);
   /* observability: the dual model's factor, O = Q Zy Zy^T Q */
   CHECK_RC(phgmg_shifted_create(&sd, sp, 1, 0, NULL), PHGMG_OK);
   CHECK_RC(phgmg_lradi(sd, 2, phgmg_ph_sparse_system(sp)->B, N, NULL, &Zy, &ky, &infd, NULL), PHGMG_OK);
-  Olr = lr_gram_user(sp, N, Zy, ky);
+  Olr = th_gram_user(sp, N, Zy, ky);
   phgmg_gemm('N', 'N', N, N, N, 1.0, M.Q, N, Olr, N, 0.0, T, N);
   phgmg_gemm('N', 'N', N, N, N, 1.0, T, N, M.Q, N, 0.0, Olr, N);
-  CHECK_LE(lr_reldiff(N * N, Olr, O), 1e-8);
+  CHECK_LE(th_reldiff(N * N, Olr, O), 1e-8);
   /* balanced truncation */
-  lr_dense_hsv(N, P, O, hsvd, r);
+  th_dense_hsv(N, P, O, hsvd, r);
   CHECK_RC(phgmg_lrbt(sp, r, NULL, Ar, Br, Cr, hsv, NULL, NULL, &binf, NULL), PHGMG_OK);
   for (i = 0; i < r; ++i) CHECK_LE(fabs(hsv[i] - hsvd[i]), 1e-8 * hsvd[0]);
   CHECK(binf.nhsv > r && binf.bound > 0.0 && binf.hsv_tail <= hsv[r - 1]);
@@ -286,7 +234,7 @@ TEST(test_lowrank_lradi_lattice) {
      passivity, an error that falls with the order */
   {
     double sq[12], e4, e12;
-    lr_dense_hsv(N, P, M.Q, sq, 12);
+    th_dense_hsv(N, P, M.Q, sq, 12);
     e4 = lr_check_phbt(sp, sq, 4);
     e12 = lr_check_phbt(sp, sq, 12);
     CHECK(e12 < e4);
@@ -322,19 +270,19 @@ TEST(test_lowrank_mass_matrix) {
   sp = lr_sparse(&M);
   CHECK_RC(phgmg_shifted_create(&s, sp, 0, 0, NULL), PHGMG_OK);
   CHECK_RC(phgmg_lradi(s, 2, phgmg_ph_sparse_system(sp)->B, N, NULL, &Z, &k, &inf, NULL), PHGMG_OK);
-  Plr = lr_gram_user(sp, N, Z, k);
-  CHECK_LE(lr_reldiff(N * N, Plr, P), 1e-8);
+  Plr = th_gram_user(sp, N, Z, k);
+  CHECK_LE(th_reldiff(N * N, Plr, P), 1e-8);
   { /* the residual of the generalized equation, with A = (J - R) Q and E */
     lr_model M0 = M;
     double *Bq = (double *)malloc(sizeof(double) * (size_t)N * 2);
     M0.E = NULL;
     lr_dense_abc(&M0, A0, Bq, C0);
-    res = lr_lyap_res(N, 2, A0, M.E, M.B, Plr);
+    res = th_lyap_res(N, 2, A0, M.E, M.B, Plr);
     CHECK(inf.res <= 1e-10);
     CHECK_LE(fabs(res - inf.res), 0.05 * inf.res + 1e-13);
     free(Bq);
   }
-  lr_dense_hsv(N, P, O, hsvd, r);
+  th_dense_hsv(N, P, O, hsvd, r);
   CHECK_RC(phgmg_lrbt(sp, r, NULL, Ar, Br, Cr, hsv, NULL, NULL, &binf, NULL), PHGMG_OK);
   for (i = 0; i < r; ++i) CHECK_LE(fabs(hsv[i] - hsvd[i]), 1e-8 * hsvd[0]);
   res = lr_hinf(&M, sp, r, Ar, Br, Cr, 24);
@@ -343,7 +291,7 @@ TEST(test_lowrank_mass_matrix) {
   { /* pH-preserving balancing against E^T Q */
     double *EQ = (double *)malloc(sizeof(double) * (size_t)N * N), sd[r];
     phgmg_gemm('T', 'N', N, N, N, 1.0, M.E, N, M.Q, N, 0.0, EQ, N);
-    lr_dense_hsv(N, P, EQ, sd, r);
+    th_dense_hsv(N, P, EQ, sd, r);
     lr_check_phbt(sp, sd, r);
     free(EQ);
   }
