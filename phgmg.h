@@ -750,7 +750,8 @@
      phgmg_mpi_reduce       GMG-POD, SP1, SP2 or GMG-QM of a model with a
                             SEPARABLE Hamiltonian (built-in exp-polynomial
                             terms held by the ranks that own their
-                            coordinates) with ECSW hyper-reduction (GMG-QM:
+                            coordinates) with ECSW or DEIM (Q-DEIM, greedy)
+                            hyper-reduction (GMG-QM:
                             the POD and greedy manifolds with a narrow V2):
                             the serial phgmg_reduce's
                             phgmg_rom, replicated, the kept terms as global
@@ -868,7 +869,17 @@
    on every coordinate of 2100 masses (4200 terms: the screened fit) the
    same 36 points, weights within 3e-14, K within 2e-12 (cond G00 = 1e6),
    outputs within 1e-11; SP1 on the first chain: K within 7e-15, the same
-   67 points, weights within 7e-14, outputs within 1e-14. The fit on
+   67 points, weights within 7e-14, outputs within 1e-14. DEIM
+   (hyper.kind QDEIM or GREEDY) on the first chain with modes down to
+   hyper.deim_tol = 1e-4, GMG-POD, SP1 and GMG-QM: the same 29 (GMG-QM:
+   26) points in the same order as global term indices, weights within
+   4e-13 of the largest, outputs within 7e-11 (where the DEIM model cannot
+   go on -- Q-DEIM's leaves its envelope after 22-53 steps -- the serial
+   one stops at the same step with the same code). At the default 1e-8 the
+   points are still the serial ones but the weights agree only to 1e-9:
+   they depend on the span of the kept gradient modes, which rounding moves
+   by about eps sigma_1 / (the gap after the last kept value), the same
+   for the serial computation on snapshots changed by one ulp. The fit on
    the full rows at tol alone (what phgmg_mpi_ecsw gives without the
    compression) keeps 49 points, not the serial 67, and its model's outputs
    differ by 6e-3: the compression and its tol / 2 are part of the serial
@@ -879,8 +890,8 @@
    per rank and a replicated QR of a (size ns) x ns matrix (fine while
    size ns is a few percent of the rows per rank; a reduction tree would
    remove the size factor); per DEIM
-   point one broadcast of k doubles and one reduction of a (value, index)
-   pair; per operator product one exchange with the neighbouring ranks.
+   point one broadcast (or, on the terms, a sum reduction) of k doubles and
+   one reduction of a (value, index) pair; per operator product one exchange with the neighbouring ranks.
    Memory per rank falls as 1/P: nothing of size N is replicated, only the
    P ns x ns factors TSQR stacks, the fits' contributions gathered from the
    ranks and the screened fit's working set (ns r x up to 1090 doubles).
@@ -902,8 +913,8 @@
    16 000 ranks (size ns about 0.6 times the rows per rank), where TSQR's
    replicated stack dominates.
    Not yet distributed: GMG-QM with a wide V2, ALTMIN, a chosen lambda, or
-   ECSW from 4096 live terms; GMG_MANIFOLD; DEIM hyper-reduction (hyper.kind
-   QDEIM or GREEDY), separable terms by callbacks and GENERAL nonlinear
+   ECSW from 4096 live terms; GMG_MANIFOLD; cached DEIM points
+   (opts.cache), separable terms by callbacks and GENERAL nonlinear
    Hamiltonians, a reference state (opts.ref), dampers, feedthrough,
    descriptor models; in the command line (below) also simulating the
    training runs.
@@ -5322,13 +5333,16 @@ typedef struct phgmg_mpi_rom {
   const double *K, *Qh, *Bh, *S, *w, *P0;
   const phgmg_gidx *pts, *coord;
   double hyper_residual;
+  int deim_negative;          /* DEIM: negative weights kept (hyper.allow_negative) */
+  double deim_sigma_ratio;    /* DEIM: sigma_{nd+1} / sigma_1 of the terms' gradients (0: all kept) */
   void *mem_;                 /* the storage (private) */
   phgmg_allocator al_;
 } phgmg_mpi_rom;
 
-/* The distributed phgmg_reduce of a separable model, with ECSW
+/* The distributed phgmg_reduce of a separable model, with ECSW or DEIM
    hyper-reduction (opts: method PHGMG_METHOD_GMG_POD, SP1, SP2 or GMG_QM,
-   r, hyper.on, hyper.kind ECSW, hyper.tol; GMG_QM: qm.manifold POD or
+   r, hyper.on, hyper.kind ECSW, QDEIM or GREEDY, hyper.tol (ECSW),
+   hyper.deim_tol, hyper.deim_max, hyper.allow_negative (DEIM); GMG_QM: qm.manifold POD or
    GREEDY, qm.rn > 0, qm.lambda; the other fields zero, else
    PHGMG_ERR_UNSUPPORTED). The serial phgmg_reduce's stages in its order and
    with its formulas: GMG-POD: the basis and the GMG blocks K, Qh, Bh as
@@ -5345,7 +5359,16 @@ typedef struct phgmg_mpi_rom {
    (rounds of 64 candidates of largest gradient over the ranks, the Gram
    fit on the working set replicated); the kept terms' rows of V0 and
    functions broadcast by their owners; the training envelope from the
-   reduced coordinates of the snapshots. hyper.on = 0:
+   reduced coordinates of the snapshots. DEIM as phgmg_deim_select on the
+   gradients phi_k'(x_i[idx_k]) of every term: their POD by TSQR over the
+   terms, the modes sigma_j > deim_tol sigma_1 (at most deim_max), the
+   points by Q-DEIM (the column-pivoted QR of U^T, pivots by norms computed
+   afresh) or greedy DEIM, each pivot found by a maximum reduction with ties
+   to the lower global term index, so the points and their order do not
+   depend on the partition; the weights (P^T U)^{-T} U^T sw, negative ones
+   refused (PHGMG_ERR_NEGATIVE_WEIGHT on every rank) unless
+   hyper.allow_negative; out->deim_negative, out->deim_sigma_ratio as the
+   serial info's; the kept terms in the points' order. hyper.on = 0:
    every term kept with its weight (nd = all terms: O(terms) online).
    GMG_QM: the serial GMG-QM's stages with every N-dimensional product
    distributed: V1 the p = r - m leading POD modes (TSQR) of the adjusted
@@ -26749,30 +26772,68 @@ PHGMG__PRIV void phgmg__mpi_maxloc_fn(void *in, void *inout, int *len, MPI_Datat
     if (a[j].v > b[j].v || (a[j].v == b[j].v && a[j].i < b[j].i)) b[j] = a[j];
 }
 
-/* The global row of largest |r| (r: this rank's nloc entries), ties to the
-   lower global index. *vmax its value (-1 if N = 0). */
-PHGMG__PRIV phgmg_gidx phgmg__mpi_argmax(const phgmg_mpi_ctx *ctx, const double *r, MPI_Datatype t, MPI_Op op,
-                                         double *vmax) {
+/* The row of largest |r| among this rank's n entries, whose global indices
+   are gid (ascending; NULL: the context's rows row0 + i), over all ranks,
+   ties to the lower global index. *vmax its value (-1 if there are no rows). */
+PHGMG__PRIV phgmg_gidx phgmg__mpi_argmax(const phgmg_mpi_ctx *ctx, int n, const double *r, const phgmg_gidx *gid,
+                                         MPI_Datatype t, MPI_Op op, double *vmax) {
   phgmg__mpi_vi loc, glob;
   int i;
   loc.v = -1.0; loc.i = PHGMG__GIDX_MAX;
-  for (i = 0; i < ctx->nloc; ++i)
-    if (fabs(r[i]) > loc.v) { loc.v = fabs(r[i]); loc.i = ctx->row0 + i; }
+  for (i = 0; i < n; ++i)
+    if (fabs(r[i]) > loc.v) { loc.v = fabs(r[i]); loc.i = gid ? gid[i] : ctx->row0 + i; }
   MPI_Allreduce(&loc, &glob, 1, t, op, ctx->comm);
   phgmg__mpi_count(ctx, (double)sizeof loc);
   *vmax = glob.v;
   return glob.i;
 }
 
+/* This rank's local index of the global index g (gid ascending, n entries;
+   NULL: the context's rows), -1 if another rank has it. */
+PHGMG__PRIV int phgmg__mpi_local(const phgmg_mpi_ctx *ctx, int n, const phgmg_gidx *gid, phgmg_gidx g) {
+  int lo = 0, hi = n - 1;
+  if (!gid) return g >= ctx->row0 && g < ctx->row0 + ctx->nloc ? (int)(g - ctx->row0) : -1;
+  while (lo <= hi) {
+    const int mid = lo + (hi - lo) / 2;
+    if (gid[mid] == g) return mid;
+    if (gid[mid] < g) lo = mid + 1; else hi = mid - 1;
+  }
+  return -1;
+}
+
+/* The nc entries of row g of A (entry a of local row i at A[i ars + a acs])
+   and of row g of B (n rows, ldb; may be NULL: none) into out (nc, then nc
+   more with B), on every rank: from the context's rows (gid NULL) by a broadcast from the owner,
+   else by one sum reduction with a single non-zero contribution per entry
+   (exact). buf: 2 nc doubles. */
+PHGMG__PRIV void phgmg__mpi_fetch_row(const phgmg_mpi_ctx *ctx, int n, const phgmg_gidx *gid, phgmg_gidx g, int nc,
+                                      const double *A, size_t ars, size_t acs, const double *B, int ldb,
+                                      double *buf, double *out) {
+  const int li = phgmg__mpi_local(ctx, n, gid, g), w = B ? 2 * nc : nc;
+  int a;
+  memset(buf, 0, (size_t)w * sizeof(double));
+  for (a = 0; li >= 0 && a < nc; ++a) {
+    buf[a] = A[(size_t)li * ars + (size_t)a * acs];
+    if (B) buf[nc + a] = B[li + (size_t)a * ldb];
+  }
+  if (gid) MPI_Allreduce(buf, out, w, MPI_DOUBLE, MPI_SUM, ctx->comm);
+  else {
+    memcpy(out, buf, (size_t)w * sizeof(double));
+    MPI_Bcast(out, w, MPI_DOUBLE, phgmg__mpi_owner(ctx, g), ctx->comm);
+  }
+  phgmg__mpi_count(ctx, 8.0 * w);
+}
+
 /* Point l of greedy DEIM: c = (P^T U_{<l})^{-1} P^T u_l from Pr (rows of U
-   at the points, k x k), the residual into res, its argmax into pts[l] and
-   that row of U (broadcast by its owner) into Pr. */
-PHGMG__PRIV phgmg_result phgmg__mpi_deim_point(const phgmg_mpi_ctx *ctx, int k, const double *U, int ldu, int l,
-                                               phgmg_gidx *pts, double *Pr, double *res, double *LU, int *ipiv,
-                                               MPI_Datatype t, MPI_Op op) {
+   at the points, k x k), the residual into res (n entries: this rank's rows,
+   global indices gid as in phgmg__mpi_argmax), its argmax into pts[l] and
+   that row of U (from its owner) into Pr. LU: k^2 + 3 k doubles. */
+PHGMG__PRIV phgmg_result phgmg__mpi_deim_point(const phgmg_mpi_ctx *ctx, int n, const phgmg_gidx *gid, int k,
+                                               const double *U, int ldu, int l, phgmg_gidx *pts, double *Pr,
+                                               double *res, double *LU, int *ipiv, MPI_Datatype t, MPI_Op op) {
   double *c = LU + (size_t)k * k, vmax;
-  int i, j, a, owner;
-  for (i = 0; i < ctx->nloc; ++i) res[i] = U[i + (size_t)l * ldu];
+  int i, j, a;
+  for (i = 0; i < n; ++i) res[i] = U[i + (size_t)l * ldu];
   if (l > 0) {
     for (j = 0; j < l; ++j) {
       for (i = 0; i < l; ++i) LU[i + (size_t)j * l] = Pr[i + (size_t)j * k];
@@ -26781,22 +26842,57 @@ PHGMG__PRIV phgmg_result phgmg__mpi_deim_point(const phgmg_mpi_ctx *ctx, int k, 
     if (phgmg_lu_factor(l, LU, l, ipiv) != PHGMG_OK) return PHGMG_ERR_SINGULAR;   /* same data everywhere */
     phgmg_lu_solve('N', l, LU, l, ipiv, 1, c, l);
     for (j = 0; j < l; ++j)
-      for (i = 0; i < ctx->nloc; ++i) res[i] -= U[i + (size_t)j * ldu] * c[j];
+      for (i = 0; i < n; ++i) res[i] -= U[i + (size_t)j * ldu] * c[j];
   }
-  pts[l] = phgmg__mpi_argmax(ctx, res, t, op, &vmax);
-  if (!(vmax > 0.0) || pts[l] < 0 || pts[l] >= ctx->N) return PHGMG_ERR_SINGULAR;
+  pts[l] = phgmg__mpi_argmax(ctx, n, res, gid, t, op, &vmax);
+  if (!(vmax > 0.0) || pts[l] < 0 || (!gid && pts[l] >= ctx->N)) return PHGMG_ERR_SINGULAR;
   for (j = 0; j < l; ++j)
     if (pts[j] == pts[l]) return PHGMG_ERR_SINGULAR;
-  owner = phgmg__mpi_owner(ctx, pts[l]);
-  if (owner == ctx->rank)
-    for (a = 0; a < k; ++a) c[a] = U[(pts[l] - ctx->row0) + (size_t)a * ldu];
-  MPI_Bcast(c, k, MPI_DOUBLE, owner, ctx->comm);
-  phgmg__mpi_count(ctx, 8.0 * k);
+  phgmg__mpi_fetch_row(ctx, n, gid, pts[l], k, U, 1, (size_t)ldu, NULL, 0, c + k, c);
   for (a = 0; a < k; ++a) Pr[l + (size_t)a * k] = c[a];
   return PHGMG_OK;
 }
 
-/* DEIM weights: Pr^T w = U^T sw. buf: nloc + k doubles. */
+/* Q-DEIM points (phgmg_deim_select's PHGMG_DEIM_QDEIM: the column-pivoted
+   Householder QR of U^T) of U (this rank's n rows, global indices gid, k
+   columns): pivot j is the column of the partly reduced U^T of largest norm
+   in rows j .. k - 1 (computed afresh each step, not downdated; ties to the
+   lower global index); its column and its row of U come from the owner, the
+   reflector is formed alike on every rank and applied to this rank's
+   columns, so each column's arithmetic does not depend on the partition.
+   pts (k) in pivot order, Pr (k x k) the rows of U at them. C: k n, nrm: n,
+   buf: 4 k doubles. */
+PHGMG__PRIV phgmg_result phgmg__mpi_qdeim(const phgmg_mpi_ctx *ctx, int n, const phgmg_gidx *gid, int k,
+                                          const double *U, int ldu, phgmg_gidx *pts, double *Pr, double *C,
+                                          double *nrm, double *buf, MPI_Datatype t, MPI_Op op) {
+  double *v = buf + 2 * k, *urow = v + k, vmax, alpha, tau;
+  int i, j, a, li;
+  for (i = 0; i < n; ++i)
+    for (a = 0; a < k; ++a) C[a + (size_t)i * k] = U[i + (size_t)a * ldu];
+  for (j = 0; j < k; ++j) {
+    for (i = 0; i < n; ++i) nrm[i] = phgmg_normf(k - j, 1, C + j + (size_t)i * k, k - j);
+    pts[j] = phgmg__mpi_argmax(ctx, n, nrm, gid, t, op, &vmax);
+    if (!(vmax > 0.0)) return PHGMG_ERR_SINGULAR;   /* U rank deficient */
+    li = phgmg__mpi_local(ctx, n, gid, pts[j]);
+    /* the pivot's column of C (k entries, as a row of C^T) and its row of U */
+    phgmg__mpi_fetch_row(ctx, n, gid, pts[j], k, C, (size_t)k, 1, U, ldu, buf, v);
+    for (a = 0; a < k; ++a) Pr[j + (size_t)a * k] = urow[a];
+    alpha = v[j];
+    phgmg__larfg(k - j, &alpha, v + j + 1, &tau);
+    for (i = 0; i < n; ++i) {
+      if (i == li) {   /* the pivot: (alpha, 0, ..., 0) below row j, exactly */
+        C[j + (size_t)i * k] = alpha;
+        for (a = j + 1; a < k; ++a) C[a + (size_t)i * k] = 0.0;
+      } else {
+        phgmg__larf_left(k - j, 1, v + j, tau, C + j + (size_t)i * k, k - j);
+      }
+    }
+  }
+  return PHGMG_OK;
+}
+
+/* DEIM weights: Pr^T w = U^T sw (U: this rank's rows of the context). buf:
+   nloc + k doubles. */
 PHGMG__PRIV phgmg_result phgmg__mpi_deim_weights(const phgmg_mpi_ctx *ctx, int k, const double *U, int ldu,
                                                  const double *sw, const double *Pr, double *LU, int *ipiv,
                                                  double *buf, double *w) {
@@ -26812,37 +26908,54 @@ PHGMG__PRIV phgmg_result phgmg__mpi_deim_weights(const phgmg_mpi_ctx *ctx, int k
   return phgmg__all_finite(w, (size_t)k) ? PHGMG_OK : PHGMG_ERR_SINGULAR;
 }
 
-PHGMG_DEF phgmg_result phgmg_mpi_deim_greedy(const phgmg_mpi_ctx *ctx, int k, const double *U, int ldu,
-                                             const double *sw, phgmg_gidx *pts, double *w) {
-  const phgmg_allocator *al;
-  double *Pr = NULL, *res, *LU;
-  int *ipiv = NULL, l, n;
+/* DEIM points of U (this rank's rows of the context, global indices gid
+   ascending, NULL: the context's rows; k columns) by greedy DEIM (method
+   PHGMG_DEIM_GREEDY) or Q-DEIM, then the weights if w != NULL. Arguments
+   checked by the caller. Collective. */
+PHGMG__PRIV phgmg_result phgmg__mpi_deim_run(const phgmg_mpi_ctx *ctx, const phgmg_gidx *gid, int k, const double *U,
+                                             int ldu, const double *sw, phgmg_deim_method method, phgmg_gidx *pts,
+                                             double *w) {
+  const phgmg_allocator *al = &ctx->al;
+  const int n = ctx->nloc, qd = method == PHGMG_DEIM_QDEIM;
+  double *Pr, *LU, *res;
+  int *ipiv, l;
   MPI_Datatype t;
   MPI_Op op;
-  phgmg_result rc = PHGMG_OK;
-  if (!ctx) return PHGMG_ERR_INVALID_ARG;
-  al = &ctx->al; n = ctx->nloc;
-  if (k < 1 || (phgmg_gidx)k > ctx->N || !phgmg__mpi_ld_ok(ctx, ldu)) rc = PHGMG_ERR_SIZE;
-  else if (!pts || (n > 0 && !U)) rc = PHGMG_ERR_INVALID_ARG;
-  else if (n > 0 && !phgmg__mat_finite(n, k, U, ldu)) rc = PHGMG_ERR_NANINF;
-  else {
-    Pr = phgmg__dalloc(al, 2 * (size_t)k * k + (size_t)k + (size_t)n + (size_t)k);
-    ipiv = phgmg__ialloc(al, (size_t)k);
-    if (!Pr || !ipiv) rc = PHGMG_ERR_NOMEM;
-  }
-  rc = phgmg__mpi_agree(ctx, rc);
+  phgmg_result rc;
+  /* Pr, LU (k^2 + 3 k), res (n + k), Q-DEIM: C (k n), norms (n), buffer (4 k) */
+  Pr = phgmg__dalloc(al, 2 * (size_t)k * k + 4 * (size_t)k + (size_t)n + (qd ? (size_t)k * n + n + 4 * (size_t)k : 0));
+  ipiv = phgmg__ialloc(al, (size_t)k);
+  rc = phgmg__mpi_agree(ctx, Pr && ipiv ? PHGMG_OK : PHGMG_ERR_NOMEM);
   if (rc != PHGMG_OK) { phgmg__free(al, Pr); phgmg__free(al, ipiv); return rc; }
-  LU = Pr + (size_t)k * k; res = LU + (size_t)k * k + k;
+  LU = Pr + (size_t)k * k; res = LU + (size_t)k * k + 3 * (size_t)k;
   MPI_Type_contiguous((int)sizeof(phgmg__mpi_vi), MPI_BYTE, &t);
   MPI_Type_commit(&t);
   MPI_Op_create(phgmg__mpi_maxloc_fn, 1, &op);
-  for (l = 0; l < k && rc == PHGMG_OK; ++l) rc = phgmg__mpi_deim_point(ctx, k, U, ldu, l, pts, Pr, res, LU, ipiv, t, op);
+  if (qd) {
+    double *C = res + (size_t)n + k, *nrm = C + (size_t)k * n;
+    rc = phgmg__mpi_qdeim(ctx, n, gid, k, U, ldu, pts, Pr, C, nrm, nrm + n, t, op);
+  }
+  for (l = 0; !qd && l < k && rc == PHGMG_OK; ++l)
+    rc = phgmg__mpi_deim_point(ctx, n, gid, k, U, ldu, l, pts, Pr, res, LU, ipiv, t, op);
   if (rc == PHGMG_OK && w) rc = phgmg__mpi_deim_weights(ctx, k, U, ldu, sw, Pr, LU, ipiv, res, w);
   MPI_Op_free(&op);
   MPI_Type_free(&t);
   phgmg__free(al, Pr);
   phgmg__free(al, ipiv);
   return rc;
+}
+
+PHGMG_DEF phgmg_result phgmg_mpi_deim_greedy(const phgmg_mpi_ctx *ctx, int k, const double *U, int ldu,
+                                             const double *sw, phgmg_gidx *pts, double *w) {
+  int n;
+  phgmg_result rc = PHGMG_OK;
+  if (!ctx) return PHGMG_ERR_INVALID_ARG;
+  n = ctx->nloc;
+  if (k < 1 || (phgmg_gidx)k > ctx->N || !phgmg__mpi_ld_ok(ctx, ldu)) rc = PHGMG_ERR_SIZE;
+  else if (!pts || (n > 0 && !U)) rc = PHGMG_ERR_INVALID_ARG;
+  else if (n > 0 && !phgmg__mat_finite(n, k, U, ldu)) rc = PHGMG_ERR_NANINF;
+  rc = phgmg__mpi_agree(ctx, rc);
+  return rc != PHGMG_OK ? rc : phgmg__mpi_deim_run(ctx, NULL, k, U, ldu, sw, PHGMG_DEIM_GREEDY, pts, w);
 }
 
 /* ---- distributed ECSW ------------------------------------------------------------ */
@@ -27442,12 +27555,13 @@ PHGMG__PRIV phgmg_result phgmg__mpi_sep_check_local(const phgmg_mpi_ctx *ctx, co
   phgmg__reduce_opts_resolve(o, 0);
   qm = o->method == PHGMG_METHOD_GMG_QM;
   if ((o->method != PHGMG_METHOD_GMG_POD && o->method != PHGMG_METHOD_SP1 && o->method != PHGMG_METHOD_SP2 && !qm) ||
-      (o->hyper.on && o->hyper.kind != PHGMG_HYPER_ECSW) ||
       o->ref != PHGMG_REF_NONE || o->dt != 0.0 || o->nrun || o->runs || o->cache.pod_basis || o->cache.deim_pts ||
       o->select.lambda_mode != PHGMG_LAMBDA_FIXED || o->degeneracy_tol != 1e-12)
     return PHGMG_ERR_UNSUPPORTED;
   if ((o->hyper.on != 0 && o->hyper.on != 1) || !(o->hyper.tol > 0.0 && o->hyper.tol < 1.0) ||
-      (md->per_term != 0 && md->per_term != 1))
+      (int)o->hyper.kind < 0 || (int)o->hyper.kind >= (int)PHGMG_HYPER_COUNT ||
+      !(o->hyper.deim_tol >= 0.0 && o->hyper.deim_tol < 1.0) || o->hyper.deim_max < 0 ||
+      (o->hyper.allow_negative != 0 && o->hyper.allow_negative != 1) || (md->per_term != 0 && md->per_term != 1))
     return PHGMG_ERR_INVALID_ARG;
   if (qm && ((int)o->qm.manifold < 0 || (int)o->qm.manifold >= (int)PHGMG_MANIFOLD_COUNT || o->qm.rn < PHGMG_RN_WIDE ||
              o->qm.lambda != o->qm.lambda))
@@ -27455,7 +27569,8 @@ PHGMG__PRIV phgmg_result phgmg__mpi_sep_check_local(const phgmg_mpi_ctx *ctx, co
   /* GMG-QM: the POD and greedy manifolds with a narrow V2 */
   if (qm && (o->qm.manifold == PHGMG_MANIFOLD_ALTMIN || o->qm.rn == PHGMG_RN_WIDE || o->qm.eta))
     return PHGMG_ERR_UNSUPPORTED;
-  if (o->hyper.on && o->hyper.tol < PHGMG__ECSW_TOL_MIN) return PHGMG_ERR_TOL_UNREACHABLE;
+  if (o->hyper.on && phgmg__hypers[o->hyper.kind].quadrature && o->hyper.tol < PHGMG__ECSW_TOL_MIN)
+    return PHGMG_ERR_TOL_UNREACHABLE;
   if (md->nsep < 0 || md->poly_deg < 0 || md->poly_deg > 32 || md->nexp < 0 || md->nexp > 8 ||
       (md->poly_deg == 0 && md->nexp == 0))
     return PHGMG_ERR_SIZE;
@@ -27787,8 +27902,8 @@ PHGMG__PRIV phgmg_result phgmg__mpi_sep_ecsw(const phgmg_mpi_ctx *ctx, const phg
 
 /* The kept terms' data from their owners: row j of D (nd x wd, replicated)
    = [state index, V0's row (r), the term's coefficients (per_term: poly_deg
-   + 1 + 2 nexp)] of the term pts[j] (global ids; this rank's terms sep_id
-   ascending). One reduction (one non-zero contribution per entry: exact). */
+   + 1 + 2 nexp)] of the term pts[j] (global ids in any order; this rank's
+   terms sep_id ascending). One reduction (one non-zero contribution per entry: exact). */
 PHGMG__PRIV phgmg_result phgmg__mpi_sep_fetch(const phgmg_mpi_ctx *ctx, const phgmg_mpi_sep_model *md,
                                               const double *V0, int ld, int r, int nd, const phgmg_gidx *pts,
                                               double *D, int wd) {
@@ -27800,8 +27915,8 @@ PHGMG__PRIV phgmg_result phgmg__mpi_sep_fetch(const phgmg_mpi_ctx *ctx, const ph
   memset(L, 0, ((size_t)nd * wd + 1) * sizeof(double));
   for (j = 0; j < nd; ++j) {
     int row;
-    while (k < md->nsep && (md->sep_id ? md->sep_id[k] : md->sep_idx[k]) < pts[j]) ++k;
-    if (k >= md->nsep || (md->sep_id ? md->sep_id[k] : md->sep_idx[k]) != pts[j]) continue;
+    k = phgmg__mpi_local(ctx, md->nsep, md->sep_id ? md->sep_id : md->sep_idx, pts[j]);
+    if (k < 0) continue;
     row = (int)(md->sep_idx[k] - ctx->row0);
     L[j] = (double)md->sep_idx[k];
     for (a = 0; a < r; ++a) L[j + (size_t)(1 + a) * nd] = V0[row + (size_t)a * ld];
@@ -27872,6 +27987,8 @@ typedef struct phgmg__mpi_romdata {
   const double *K, *Qh, *Bh, *S, *w, *D, *env;
   const phgmg_gidx *pts;
   const phgmg_mpi_sep_model *md;
+  int deim_neg;                            /* DEIM: negative weights, sigma_{nd+1}/sigma_1 */
+  double deim_sratio;
 } phgmg__mpi_romdata;
 
 PHGMG__PRIV void phgmg__mpi_rom_real(phgmg_real *dst, const double *src, size_t n) {
@@ -28056,6 +28173,59 @@ PHGMG__PRIV phgmg_result phgmg__mpi_sep_all(const phgmg_mpi_ctx *ctx, const phgm
   return rc;
 }
 
+/* Structure-preserving DEIM of the separable terms as the serial
+   phgmg_deim_select: F (terms x ns) = phi_k'(x_i[idx_k]) of every term (live
+   or not), its POD by TSQR over the terms (a context of nsg rows, this
+   rank's nsep), the modes sigma_j > deim_tol sigma_1 (at most deim_max),
+   points by Q-DEIM or greedy DEIM on the global term ids (ties to the lower
+   id), weights w = (P^T U)^{-T} U^T sw. pts, w: room for min(nsg, ns);
+   d->nd, d->deim_neg, d->deim_sratio set. PHGMG_ERR_NEGATIVE_WEIGHT (every
+   rank) for a negative weight without hyper.allow_negative. Collective. */
+PHGMG__PRIV phgmg_result phgmg__mpi_sep_deim(const phgmg_mpi_ctx *ctx, const phgmg_mpi_sep_model *md,
+                                             const phgmg_reduce_opts *o, int ns, const double *X, int ldx,
+                                             phgmg_gidx nsg, phgmg_gidx *pts, double *w, phgmg__mpi_romdata *d) {
+  const int n = md->nsep, ld = PHGMG__MAX(n, 1);
+  const double tol = o->hyper.deim_tol > 0.0 ? o->hyper.deim_tol : 1e-8;
+  int kk = (int)PHGMG__MIN(nsg, (phgmg_gidx)ns), ks = 0, keep = 0, i, k;
+  phgmg_mpi_ctx *tc = NULL;
+  phgmg_gidx t0 = 0, nl = n;
+  phgmg_ph_system s;
+  double *F, *U, *S, *sw;
+  phgmg_result rc;
+  if (o->hyper.deim_max > 0) kk = PHGMG__MIN(kk, o->hyper.deim_max + 1);
+  F = phgmg__dalloc(&ctx->al, (size_t)ld * ns + (size_t)ld * kk + (size_t)kk + (size_t)ld);
+  rc = phgmg__mpi_agree(ctx, F ? PHGMG_OK : PHGMG_ERR_NOMEM);
+  MPI_Exscan(&nl, &t0, 1, MPI_LONG_LONG, MPI_SUM, ctx->comm);
+  phgmg__mpi_count(ctx, 8.0);
+  if (ctx->rank == 0) t0 = 0;   /* MPI_Exscan leaves rank 0's undefined */
+  if (rc == PHGMG_OK) rc = phgmg_mpi_ctx_create(&tc, ctx->comm, nsg, t0, n, &ctx->al);
+  if (rc != PHGMG_OK) { phgmg__free(&ctx->al, F); return rc; }
+  U = F + (size_t)ld * ns; S = U + (size_t)ld * kk; sw = S + kk;
+  phgmg__mpi_sep_sys(md, &s);
+  for (k = 0; k < n; ++k) {
+    const int row = (int)(md->sep_idx[k] - ctx->row0);
+    for (i = 0; i < ns; ++i) F[k + (size_t)i * ld] = phgmg__ph_phi(&s, k, X[row + (size_t)i * ldx], 1);
+    sw[k] = md->sep_w ? md->sep_w[k] : 1.0;
+  }
+  rc = phgmg_mpi_pod(tc, ns, F, ld, kk, 0.0, U, ld, S, &ks);
+  if (rc == PHGMG_OK) {
+    for (i = 0; i < ks; ++i) if (S[i] > tol * S[0]) keep = i + 1;
+    if (o->hyper.deim_max > 0 && keep > o->hyper.deim_max) keep = o->hyper.deim_max;
+    if (keep < 1) keep = 1;   /* as the serial: a zero F then fails to find a point */
+    d->deim_sratio = keep < ks && S[0] > 0.0 ? S[keep] / S[0] : 0.0;
+    rc = phgmg__mpi_deim_run(tc, md->sep_id ? md->sep_id : md->sep_idx, keep, U, ld, sw,
+                             phgmg__hypers[o->hyper.kind].points, pts, w);
+  }
+  if (rc == PHGMG_OK) {
+    d->nd = keep;
+    for (i = 0; i < keep; ++i) d->deim_neg += w[i] < 0.0;
+    if (d->deim_neg > 0 && !o->hyper.allow_negative) rc = PHGMG_ERR_NEGATIVE_WEIGHT;
+  }
+  phgmg_mpi_ctx_destroy(tc);
+  phgmg__free(&ctx->al, F);
+  return rc;
+}
+
 /* GMG-QM's reduced object and the replicated reduced snapshot coordinates
    XR (r x ns) for its ECSW (phgmg__mpi_qm_ecsw). */
 typedef struct phgmg__mpi_qmfit {
@@ -28109,7 +28279,7 @@ PHGMG__PRIV phgmg_result phgmg__mpi_qm_ecsw(const phgmg_mpi_ctx *ctx, const phgm
   return rc;
 }
 
-/* The separable stage: live terms, points and weights (ECSW or all terms),
+/* The separable stage: live terms, points and weights (ECSW, DEIM or all terms),
    the kept terms' rows fetched; *D (nd x wd) and *pts, *w allocated here.
    qf: GMG-QM's (V0: [V0, V2], r their columns; the fit of
    phgmg__mpi_qm_ecsw), else NULL. */
@@ -28117,7 +28287,7 @@ PHGMG__PRIV phgmg_result phgmg__mpi_sep_terms(const phgmg_mpi_ctx *ctx, const ph
                                               const phgmg_reduce_opts *o, int ns, const double *X, int ldx,
                                               const double *V0, int r, int wd, const phgmg__mpi_qmfit *qf,
                                               phgmg__mpi_romdata *d, double *resid) {
-  const int ld = PHGMG__MAX(1, ctx->nloc);
+  const int ld = PHGMG__MAX(1, ctx->nloc), deim = o->hyper.on && !phgmg__hypers[o->hyper.kind].quadrature;
   phgmg__mpi_terms t;
   phgmg_gidx nlg = 0, nl, nsg = 0, ns1 = md->nsep, room;
   phgmg_gidx *pts = NULL;
@@ -28127,7 +28297,9 @@ PHGMG__PRIV phgmg_result phgmg__mpi_sep_terms(const phgmg_mpi_ctx *ctx, const ph
   MPI_Allreduce(&nl, &nlg, 1, MPI_LONG_LONG, MPI_SUM, ctx->comm);
   MPI_Allreduce(&ns1, &nsg, 1, MPI_LONG_LONG, MPI_SUM, ctx->comm);
   phgmg__mpi_count(ctx, 8.0); phgmg__mpi_count(ctx, 8.0);
-  room = o->hyper.on ? PHGMG__MIN(nlg, PHGMG__MAX((phgmg_gidx)ns * r, 16 * PHGMG_ECSW_SCREEN_ADD)) : nsg;
+  room = !o->hyper.on ? nsg
+         : deim ? PHGMG__MIN(nsg, (phgmg_gidx)ns)
+                : PHGMG__MIN(nlg, PHGMG__MAX((phgmg_gidx)ns * r, 16 * PHGMG_ECSW_SCREEN_ADD));
   if (rc == PHGMG_OK && room > 200000000) rc = PHGMG_ERR_SIZE;
   if (rc == PHGMG_OK) {
     pts = PHGMG__CAST(phgmg_gidx *, phgmg__alloc(&ctx->al, sizeof(phgmg_gidx) * (size_t)(room + 1)));
@@ -28136,7 +28308,9 @@ PHGMG__PRIV phgmg_result phgmg__mpi_sep_terms(const phgmg_mpi_ctx *ctx, const ph
   }
   *resid = 0.0;
   d->nd = 0;
-  if (rc == PHGMG_OK && o->hyper.on && nlg > 0)
+  if (rc == PHGMG_OK && deim && nsg > 0)
+    rc = phgmg__mpi_sep_deim(ctx, md, o, ns, X, ldx, nsg, pts, w, d);
+  else if (rc == PHGMG_OK && o->hyper.on && !deim && nlg > 0)
     rc = qf ? phgmg__mpi_qm_ecsw(ctx, &t, ns, qf, nsg, o->hyper.tol, nlg, pts, w, &d->nd, resid)
             : phgmg__mpi_sep_ecsw(ctx, &t, ns, r, o->hyper.tol, nlg, pts, w, &d->nd, resid);
   else if (rc == PHGMG_OK && !o->hyper.on) {
@@ -28378,6 +28552,8 @@ PHGMG__PRIV phgmg_result phgmg__mpi_qm_reduce(const phgmg_mpi_ctx *ctx, const ph
   }
   if (rc == PHGMG_OK) {
     out->hyper_residual = resid;
+    out->deim_negative = d.deim_neg;
+    out->deim_sigma_ratio = d.deim_sratio;
     for (j = 0; V0 && ctx->nloc > 0 && j < r; ++j)
       memcpy(V0 + (size_t)j * ldv0, q.L + (size_t)j * ld, (size_t)ctx->nloc * sizeof(double));
   }
@@ -28441,6 +28617,8 @@ PHGMG_DEF phgmg_result phgmg_mpi_reduce(const phgmg_mpi_ctx *ctx, const phgmg_mp
   if (rc == PHGMG_OK) {
     int j;
     out->hyper_residual = resid;
+    out->deim_negative = d.deim_neg;
+    out->deim_sigma_ratio = d.deim_sratio;
     for (j = 0; V0 && ctx->nloc > 0 && j < r; ++j)
       memcpy(V0 + (size_t)j * ldv0, Vb + (size_t)j * ld, (size_t)ctx->nloc * sizeof(double));
   } else {

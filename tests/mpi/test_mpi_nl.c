@@ -27,6 +27,7 @@
 static const char *dir_;   /* argv[1]: a directory for the model files (none: not written) */
 static int scale_;         /* --scale n: only the comparisons at scale, n masses (GMG-POD/SP1 r = 20, GMG-QM r = 8) */
 static int qm_only_;       /* --scale-qm n: only GMG-QM at scale */
+static int qm_deim_;        /* compare_qm: DEIM weights (normwise) */
 
 
 /* Wait for rank 0's serial comparisons without spinning (the other ranks
@@ -242,8 +243,10 @@ static void serial_sigma(const chain *ch, int ns, const double *X, int k, int ad
 }
 
 /* Largest output difference of two reduced models stepped nsteps steps of
-   0.1 from xa, xb under u_in, over the largest output (HUGE_VAL if a step
-   fails). */
+   0.1 from xa, xb under u_in, over the largest output. HUGE_VAL if a step
+   fails on one model only, or on both within the first 10 steps; both
+   failing at the same later step with the same code (a hyper-reduced model
+   that leaves its training envelope) ends the comparison there. */
 static double online_diff(const phgmg_rom *a, const phgmg_rom *b, const double *xa0, const double *xb0, int nsteps,
                           const char *tag) {
   static double m1[1 << 16], m2[1 << 16];
@@ -259,7 +262,12 @@ static double online_diff(const phgmg_rom *a, const phgmg_rom *b, const double *
   for (st = 0; ok && st < nsteps; ++st) {
     phgmg_rom_stage_times(0.1 * st, 0.1, tc);
     for (i = 0; i < 3; ++i) u_in(tc[i], u3 + i, NULL);
-    ok = phgmg_rom_step(&s1, xa, u3, &y1, NULL) == PHGMG_OK && phgmg_rom_step(&s2, xb, u3, &y2, NULL) == PHGMG_OK;
+    const phgmg_result e1 = phgmg_rom_step(&s1, xa, u3, &y1, NULL), e2 = phgmg_rom_step(&s2, xb, u3, &y2, NULL);
+    if (e1 != PHGMG_OK || e2 != PHGMG_OK) {   /* a model that cannot go on: the other must stop alike */
+      if (e1 != e2 || st < 10) return HUGE_VAL;
+      printf(" [both stop at step %d: %s]", st, phgmg_result_string(e1));
+      break;
+    }
     ey = fmax(ey, fabs(y1 - y2)); sy = fmax(sy, fabs(y2));
   }
   return ok ? ey / sy : HUGE_VAL;
@@ -529,6 +537,50 @@ static void test_gmg_pod_ecsw(int n, int r) {
     quiet_barrier();
     phgmg_mpi_rom_free(&mr);
   }
+  /* DEIM hyper-reduction (Q-DEIM and greedy points) with GMG-POD and SP1:
+     the same points in the same order, as global term indices, and the same
+     weights as the serial DEIM (negative weights allowed on both sides: the
+     comparison is of the computation; the refusal is checked below). DEIM
+     modes down to 1e-4 sigma_1: the weights depend on the span of the kept
+     modes, which rounding moves by about eps sigma_1 / (the gap after the
+     last kept value): at the default 1e-8 that is 1e-9 of the weights for
+     the serial computation itself, here 1e-13. */
+  for (i = 0; i < 4; ++i) {
+    char tag[64];
+    o.method = i < 2 ? PHGMG_METHOD_GMG_POD : PHGMG_METHOD_SP1;
+    o.hyper.kind = i % 2 ? PHGMG_HYPER_GREEDY : PHGMG_HYPER_QDEIM;
+    o.hyper.allow_negative = 1; o.hyper.deim_tol = 1e-4;
+    snprintf(tag, sizeof tag, "%s %s", i < 2 ? "gmg-pod" : "sp1", i % 2 ? "greedy deim" : "q-deim");
+    rc = phgmg_mpi_reduce(d.c, &d.md, ns, d.Xl, d.ld, &o, &mr, V0, d.ld);
+    CHECK(rc == PHGMG_OK && same_everywhere(mr.nd) && mr.nd > 1, "distributed %s: %d", tag, (int)rc);
+    CHECK(same_everywhere(mr.deim_negative), "%s: negative weights differ between ranks", tag);
+    free(V0f);
+    V0f = gather_v0(d.c, r, V0, d.ld);
+    if (rank_ == 0 && rc == PHGMG_OK) {
+      double ktol = 1e-12, ytol = 1e-10;
+      phgmg_reduce_info inf;
+      CHECK(phgmg_reduce(&red, &ch.sys, X, N, ns, &o, &inf, NULL) == PHGMG_OK, "serial %s", tag);
+      if (red && scale_) serial_sensitivity(&ch, ns, X, x0, &o, red, &ktol, &ytol);
+      if (red) {
+        compare_serial(&ch, ns, X, x0, red, &mr, V0f, 200, ktol, ytol, tag);
+        CHECK(mr.deim_negative == inf.deim_negative, "%s: %d negative weights, serial %d", tag, mr.deim_negative,
+              inf.deim_negative);
+        CHECK(fabs(mr.deim_sigma_ratio - inf.deim_sigma_ratio) <= 1e-12,
+              "%s: sigma ratio %.3e, serial %.3e", tag, mr.deim_sigma_ratio, inf.deim_sigma_ratio);
+      }
+      phgmg_reduced_destroy(red);
+    }
+    if (rank_ == 0 && rc == PHGMG_OK) printf("  %s: %d negative weights\n", tag, mr.deim_negative);
+    quiet_barrier();
+    if (rc == PHGMG_OK && mr.deim_negative > 0) {   /* refused without allow_negative, on every rank */
+      phgmg_mpi_rom m2;
+      o.hyper.allow_negative = 0;
+      rc = phgmg_mpi_reduce(d.c, &d.md, ns, d.Xl, d.ld, &o, &m2, NULL, 0);
+      CHECK(rc == PHGMG_ERR_NEGATIVE_WEIGHT && same_everywhere(rc), "%s without allow_negative: %d", tag, (int)rc);
+    }
+    phgmg_mpi_rom_free(&mr);
+  }
+  o.hyper.kind = PHGMG_HYPER_ECSW; o.hyper.allow_negative = 0;
   o.method = PHGMG_METHOD_GMG_POD;
   /* the solve fails on one rank only */
   d.sv.fail_rank = size_ > 1 ? size_ - 1 : 0;
@@ -604,7 +656,7 @@ static void compare_qm(const chain *ch, const double *x0, const phgmg_reduced *r
   const phgmg_rom *ro = phgmg_reduced_rom(red), *rd = &mr->rom;
   const int N = ch->N, r = mr->r, m = mr->m, p = r - m, rn = ro->rn;
   const double *V2s = NULL, *Ms = NULL;
-  double sg[64], sg2[64], sgm[64 * 64], one = 1.0, e = 0.0, eb = 0.0, ew = 0.0, gsc = 0.0, xr[64], xd[64], *col = (double *)malloc(sizeof(double) * (size_t)N);
+  double sg[64], sg2[64], sgm[64 * 64], one = 1.0, e = 0.0, eb = 0.0, ew = 0.0, wmax = 0.0, gsc = 0.0, xr[64], xd[64], *col = (double *)malloc(sizeof(double) * (size_t)N);
   int i, j, a, same;
   CHECK(rd->kind == PHGMG_ROM_QUADRATIC && rd->rn == rn && phgmg_reduced_qm(red, &V2s, &Ms) == rn, "%s: kind/rn", tag);
   mode_signs(red, N, r, V0f, sg);
@@ -648,10 +700,14 @@ static void compare_qm(const chain *ch, const double *x0, const phgmg_reduced *r
         (double)rd->q_max[0], (double)ro->q_max[0]);
   same = rd->nd == ro->nd && (rd->nd == 0 || (rd->P1 && ro->P1));
   CHECK(same, "%s: %d terms, serial %d", tag, rd->nd, ro->nd);
+  for (j = 0, wmax = 0.0; same && j < rd->nd; ++j) wmax = fmax(wmax, fabs(ro->w[j]));
   for (j = 0; same && j < rd->nd; ++j) {   /* serial: the kept terms' numbers (every term: none stored, j) */
     const int tj = red->term ? red->term[j] : j;
-    same = mr->pts[j] == tj && mr->coord[j] == ch->idx[tj] && fabs(rd->w[j] - ro->w[j]) <= 1e-12 * fabs(ro->w[j]);
-    ew = fmax(ew, fabs(rd->w[j] - ro->w[j]) / fabs(ro->w[j]));
+    /* ECSW's weights (> 0) each to 1e-12; DEIM's, the solution of a linear
+       system with weights of both signs, to 1e-12 of the largest */
+    const double wref = red->nd > 0 && qm_deim_ ? wmax : fabs(ro->w[j]);
+    same = mr->pts[j] == tj && mr->coord[j] == ch->idx[tj] && fabs(rd->w[j] - ro->w[j]) <= 1e-12 * wref;
+    ew = fmax(ew, fabs(rd->w[j] - ro->w[j]) / wref);
   }
   CHECK(same, "%s: the kept terms or their weights differ", tag);
   for (j = 0; same && j < rd->nd; ++j) {
@@ -735,12 +791,14 @@ static void test_gmg_qm(int n, int r) {
     dist_build(&d, &ch, ns, X);
     if (lin) d.md.nsep = 0;
     V0 = (double *)malloc(sizeof(double) * (size_t)d.ld * r);
-    for (mf = 0; mf < (lin ? 2 : 4); ++mf) {   /* the cosh chain: mf 2, 3 with ECSW */
+    for (mf = 0; mf < (lin ? 2 : 6); ++mf) {   /* the cosh chain: mf 2, 3 with ECSW, 4, 5 with greedy DEIM */
       char tag[64];
       snprintf(tag, sizeof tag, "gmg-qm %s, %s chain%s", mf % 2 ? "greedy" : "pod", lin ? "linear" : "cosh",
-               mf > 1 ? ", ecsw" : "");
+               mf > 3 ? ", deim" : mf > 1 ? ", ecsw" : "");
       memset(&o, 0, sizeof o);
       if (mf > 1) { o.hyper.on = 1; o.hyper.kind = PHGMG_HYPER_ECSW; o.hyper.tol = 1e-3; }
+      if (mf > 3) { o.hyper.kind = PHGMG_HYPER_GREEDY; o.hyper.deim_tol = 1e-4; o.hyper.allow_negative = 1; }
+      qm_deim_ = mf > 3;
       o.method = PHGMG_METHOD_GMG_QM; o.r = r; o.qm.rn = lin ? 3 : 4;   /* the linear chain's spectrum falls faster: V2's modes as well conditioned */
       o.qm.manifold = mf % 2 ? PHGMG_MANIFOLD_GREEDY : PHGMG_MANIFOLD_POD;
       rc = phgmg_mpi_reduce(d.c, &d.md, ns, d.Xl, d.ld, &o, &mr, V0, d.ld);
