@@ -933,10 +933,11 @@
    The command line with MPI. `make build/phgmg-mpi` builds
    examples/phgmg_mpi_cli.c with mpicc, and
      mpirun -np P build/phgmg-mpi reduce --J-coo J.npy --R-coo R.npy
-         --Q-coo Q.npy --B B.npy --X X.npy --method gmg-pod|sp1 --r R
+         --Q-coo Q.npy --B B.npy --X X.npy --method gmg-pod|sp1|sp2 --r R
          --out DIR [--name rom] [--dt DT] [--quiet]
          [--potential NAME | --poly c.npy [--exp e.npy]] --poly-idx idx.npy
-         [--poly-w w.npy] [--hyper ecsw] [--hyper-tol T] [--no-hyper]
+         [--poly-w w.npy] [--hyper ecsw|qdeim|greedy] [--hyper-tol T]
+         [--deim-tol T] [--deim-max K] [--deim-allow-negative] [--no-hyper]
    reads the files of the serial `phgmg reduce` (J, R, Q as (nnz, 3)
    triplets, B, the snapshots X, the separable nonlinear part as the
    serial command takes it: a named potential or exp-polynomial
@@ -947,11 +948,13 @@
    is gathered a column at a time). Rank p keeps a contiguous block of
    about N / P rows of the state: its rows of Q (phgmg_mpi_op_create), of
    B, of the snapshots (read a batch of columns at a time,
-   phgmg_npy_read_cols) and, for sp1, of J - R, and the nonlinear terms
-   on its rows with their serial term numbers as global ids (any order
-   across the ranks); the reduction is phgmg_mpi_reduce with the serial
-   default hyper-reduction, ECSW at tolerance 1e-6 (--hyper-tol; --no-hyper
-   keeps every term). The solves
+   phgmg_npy_read_cols) and, for sp1 and sp2, of J - R, and the nonlinear
+   terms on its rows with their serial term numbers as global ids (any
+   order across the ranks); the reduction is phgmg_mpi_reduce with the
+   serial default hyper-reduction, ECSW at tolerance 1e-6 (--hyper-tol;
+   --hyper qdeim or greedy: DEIM with --deim-tol, --deim-max,
+   --deim-allow-negative as the serial command; --no-hyper keeps every
+   term). The solves
    with J - R that GMG-POD needs use the library's sparse LU of J - R
    (phgmg_jr_factor_create on a phgmg_ph_sparse model) REPLICATED on every
    rank: the right-hand sides are gathered to every rank, solved there,
@@ -960,8 +963,8 @@
    callback, as examples/petsc_mumps.c does with MUMPS. Everything else of
    `phgmg reduce` -- --simulate (make the snapshots with the serial
    `phgmg simulate --states`), dense matrices, --E, springs (--poly-jdx),
-   DEIM hyper-reduction (--hyper qdeim or greedy), dampers, feedthrough,
-   --ref, the other methods, several --X files,
+   dampers, feedthrough, --ref, the other methods (gmg-qm, balancing),
+   several --X files,
    method or order lists -- is refused with a message naming the option;
    bad input (a missing file, wrong shapes, bad indices; J, R, B and J - R
    checked as the serial command checks them, Q's definiteness not: each
@@ -974,6 +977,9 @@
    an on-site cosh potential on its 1200 positions (default ECSW): the
    same 16 points as global indices, in the same order, P0 within 5e-15,
    the weights within 1e-11, K, Qh, Bh, V0 within 7e-15, the outputs within
+   8e-15; with DEIM (--deim-tol 1e-4 --deim-allow-negative, gmg-pod with
+   Q-DEIM at P = 1, 3, sp2 with greedy points at P = 2, 4): the same 12
+   points in the same order, the weights within 1.2e-14, the outputs within
    8e-15. Measured at N = 2e5 (1001 snapshots, r = 20): bench/README.md.
    2.8 Large sparse linear models (>>lowrank). For a phgmg_ph_sparse model
    with quadratic H (E x' = (J - R) Q x + B u, y = B^T Q x; E = I or a mass

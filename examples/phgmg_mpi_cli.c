@@ -47,10 +47,11 @@ static const char *const help_text[] = {
   "\n"
   "USAGE\n"
   "  mpirun -np P phgmg-mpi reduce --J-coo J.npy --R-coo R.npy --Q-coo Q.npy --B B.npy\n"
-  "               --X X.npy --method gmg-pod|sp1 --r R --out DIR [--name rom]\n"
+  "               --X X.npy --method gmg-pod|sp1|sp2 --r R --out DIR [--name rom]\n"
   "               [--dt DT] [--quiet]\n"
   "               [--potential NAME | --poly FILE [--exp FILE]] --poly-idx FILE\n"
-  "               [--poly-w FILE] [--hyper ecsw] [--hyper-tol T] [--no-hyper]\n"
+  "               [--poly-w FILE] [--hyper ecsw|qdeim|greedy] [--hyper-tol T]\n"
+  "               [--deim-tol T] [--deim-max K] [--deim-allow-negative] [--no-hyper]\n"
   "  phgmg-mpi --help | --version\n"
   "\n"
   "OPTIONS (those of `phgmg reduce`, with the same meaning)\n"
@@ -61,9 +62,10 @@ static const char *const help_text[] = {
   "  --X FILE            the snapshots, N x ns (one state per column). Every rank reads\n"
   "                      only its own rows, a batch of columns at a time.\n"
   "  --method M          gmg-pod (generalized manifold Galerkin on the POD of the\n"
-  "                      snapshots adjusted by B) or sp1 (structure-preserving\n"
-  "                      Galerkin on the POD of the snapshots).\n"
-  "  --r R               the reduced order (gmg-pod: R > m; sp1: R <= ns).\n"
+  "                      snapshots adjusted by B), sp1 (structure-preserving\n"
+  "                      Galerkin on the POD of the snapshots) or sp2 (sp1's trial\n"
+  "                      basis, the test basis from the POD of the gradient snapshots).\n"
+  "  --r R               the reduced order (gmg-pod: R > m; sp1, sp2: R <= ns).\n"
   "  --out DIR           output directory (created if missing).\n"
   "  --name NAME         base name of the outputs (default rom; a C identifier).\n"
   "  --dt DT             the snapshots' step, recorded in the model file\n"
@@ -84,9 +86,16 @@ static const char *const help_text[] = {
   "  --poly-idx FILE     the 0-based state coordinate of each term (a vector; term k is\n"
   "                      entry k, wherever its coordinate lies among the ranks' rows).\n"
   "  --poly-w FILE       the terms' weights w_k (default all 1).\n"
-  "  --hyper ecsw        the hyper-reduction (the default): ECSW keeps a few terms with\n"
-  "                      weights >= 0, the serial run's terms and weights.\n"
+  "  --hyper H           the hyper-reduction: ecsw (the default) keeps a few terms with\n"
+  "                      weights >= 0; qdeim or greedy: structure-preserving DEIM on the\n"
+  "                      terms' gradients with Q-DEIM or greedy points (weights of either\n"
+  "                      sign). The serial run's terms and weights, in its order.\n"
   "  --hyper-tol T       ECSW's relative training residual (default 1e-6; 1e-14 <= T < 1).\n"
+  "  --deim-tol T        qdeim/greedy: keep the modes with sigma_k / sigma_1 > T\n"
+  "                      (default 1e-8; 0 <= T < 1).\n"
+  "  --deim-max K        qdeim/greedy: at most K DEIM points (default: no cap).\n"
+  "  --deim-allow-negative  qdeim/greedy: accept negative weights (else refused: the\n"
+  "                      reduced energy may then not be bounded below).\n"
   "  --no-hyper          keep every term online (exact, cost O(terms)); --no-deim is the\n"
   "                      former name.\n"
   "\n",
@@ -120,9 +129,8 @@ static const char *const help_text[] = {
   "NOT SUPPORTED HERE (each is refused with a message naming it)\n"
   "  --simulate (give the snapshots with --X; make them with the serial\n"
   "  `phgmg simulate ... --states X.npy`), dense --J/--R/--Q, --E/--E-coo,\n"
-  "  springs (--poly-jdx), DEIM hyper-reduction (--hyper qdeim or greedy,\n"
-  "  --deim-tol, --deim-max, --deim-allow-negative), dampers, feedthrough, --ref,\n"
-  "  gmg-qm, sp2, balancing, several --X files, method or order lists, and every\n"
+  "  springs (--poly-jdx), dampers, feedthrough, --ref,\n"
+  "  gmg-qm, balancing, several --X files, method or order lists, and every\n"
   "  other option of `phgmg reduce`: use the serial `phgmg` for them.\n"
   "\n"
   "EXIT STATUS\n"
@@ -133,7 +141,8 @@ typedef struct args {
   const char *J, *R, *Q, *B, *X, *out, *name;
   const char *potential, *poly, *expf, *poly_idx, *poly_w;   /* the separable nonlinear part */
   int method, r, quiet, have_dt, no_hyper, have_hyper, have_hyper_tol;
-  double dt, hyper_tol;
+  int hyper_kind, deim_max, deim_neg, have_deim_opt;   /* --hyper (PHGMG_HYPER_*), the DEIM options */
+  double dt, hyper_tol, deim_tol;
 } args;
 
 /* This rank's block of rows, the sizes, and what was read. */
@@ -193,6 +202,14 @@ static int any_rank(int bad) {
   return all;
 }
 
+/* The names of a method and of a hyper-reduction, as the serial command writes them. */
+static const char *method_name(int method) {
+  return method == PHGMG_METHOD_SP1 ? "sp1" : method == PHGMG_METHOD_SP2 ? "sp2" : "gmg-pod";
+}
+static const char *hyper_name(int kind) {
+  return kind == PHGMG_HYPER_QDEIM ? "qdeim" : kind == PHGMG_HYPER_GREEDY ? "greedy" : "ecsw";
+}
+
 /* ---- arguments --------------------------------------------------------------- */
 
 /* Options of the serial `phgmg reduce` that this program refuses, with the reason. */
@@ -207,10 +224,7 @@ static const char *refused_reason(const char *o) {
   if (!strcmp(o, "--poly-jdx"))
     return "springs (terms on the difference of two coordinates) are not distributed: phgmg-mpi takes terms on "
            "one coordinate each (--poly-idx); use the serial `phgmg reduce`";
-  if (!strcmp(o, "--deim-tol") || !strcmp(o, "--deim-max") || !strcmp(o, "--deim-allow-negative"))
-    return "DEIM hyper-reduction (--hyper qdeim or greedy) is not distributed: phgmg-mpi hyper-reduces with "
-           "ecsw (the default; --hyper-tol) or keeps every term (--no-hyper); use the serial `phgmg reduce`";
-  return "not supported by the distributed build (gmg-pod or sp1 of a linear model or one with separable "
+  return "not supported by the distributed build (gmg-pod, sp1 or sp2 of a linear model or one with separable "
          "terms, snapshots from --X); use the serial `phgmg reduce`";
 }
 
@@ -275,11 +289,25 @@ static int parse_value(const char *o, const char *v, args *a) {
       return usage("--dt: expected a positive number, got '%s'", v);
     a->have_dt = 1;
   } else if (!strcmp(o, "--hyper")) {
-    if (!strcmp(v, "qdeim") || !strcmp(v, "greedy"))
-      return usage("--hyper %s: DEIM hyper-reduction is not distributed: phgmg-mpi hyper-reduces with ecsw (the "
-                   "default) or keeps every term (--no-hyper); use the serial `phgmg reduce` for %s", v, v);
-    if (strcmp(v, "ecsw")) return usage("--hyper '%s': expected ecsw, qdeim or greedy", v);
+    if (!strcmp(v, "ecsw")) a->hyper_kind = PHGMG_HYPER_ECSW;
+    else if (!strcmp(v, "qdeim")) a->hyper_kind = PHGMG_HYPER_QDEIM;
+    else if (!strcmp(v, "greedy")) a->hyper_kind = PHGMG_HYPER_GREEDY;
+    else return usage("--hyper '%s': expected ecsw, qdeim or greedy", v);
     a->have_hyper = 1;
+  } else if (!strcmp(o, "--deim-tol")) {
+    errno = 0;
+    a->deim_tol = strtod(v, &end);
+    if (errno || end == v || *end || !(a->deim_tol >= 0.0 && a->deim_tol < 1.0))
+      return usage("--deim-tol %s: expected 0 <= T < 1 (DEIM keeps the modes with sigma_k / sigma_1 > T)", v);
+    a->have_deim_opt = 1;
+  } else if (!strcmp(o, "--deim-max")) {
+    long k;
+    errno = 0;
+    k = strtol(v, &end, 10);
+    if (errno || end == v || *end || k < 1 || k > 100000000)
+      return usage("--deim-max: expected an integer in [1, 100000000], got '%s'", v);
+    a->deim_max = (int)k;
+    a->have_deim_opt = 1;
   } else if (!strcmp(o, "--hyper-tol")) {
     errno = 0;
     a->hyper_tol = strtod(v, &end);
@@ -297,8 +325,9 @@ static int parse_value(const char *o, const char *v, args *a) {
   } else if (!strcmp(o, "--method")) {
     if (!strcmp(v, "gmg-pod")) a->method = PHGMG_METHOD_GMG_POD;
     else if (!strcmp(v, "sp1")) a->method = PHGMG_METHOD_SP1;
+    else if (!strcmp(v, "sp2")) a->method = PHGMG_METHOD_SP2;
     else
-      return usage("--method %s: phgmg-mpi reduces with gmg-pod or sp1 only%s", v,
+      return usage("--method %s: phgmg-mpi reduces with gmg-pod, sp1 or sp2 only%s", v,
                    strchr(v, ',') ? " (no lists of methods)" : "; use the serial `phgmg reduce` for the others");
   }
   return 0;
@@ -315,12 +344,13 @@ static int name_ok(const char *s) {
 }
 
 /* argv[2..]: the options of reduce. 0 ok, 2 a usage error (the same on every rank: the same argv). */
-#define NVOPT 18   /* options with a value; the first NSOPT are file or name strings */
+#define NVOPT 20   /* options with a value; the first NSOPT are file or name strings */
 #define NSOPT 11
 static int parse_args(int argc, char **argv, args *a) {
   static const char *const with_value[NVOPT] = {"--J-coo", "--R-coo", "--Q-coo", "--B", "--X", "--out", "--name",
                                                 "--poly", "--exp", "--poly-idx", "--poly-w", "--method", "--r",
-                                                "--dt", "--potential", "--hyper", "--hyper-tol", ""};
+                                                "--dt", "--potential", "--hyper", "--hyper-tol", "--deim-tol",
+                                                "--deim-max", ""};
   const char **slot[NSOPT];
   int seen[NVOPT], i, k, rc;
   memset(a, 0, sizeof *a);
@@ -332,6 +362,7 @@ static int parse_args(int argc, char **argv, args *a) {
     const char *o = argv[i];
     if (!strcmp(o, "--quiet")) { a->quiet = 1; continue; }
     if (!strcmp(o, "--no-hyper") || !strcmp(o, "--no-deim")) { a->no_hyper = 1; continue; }
+    if (!strcmp(o, "--deim-allow-negative")) { a->deim_neg = a->have_deim_opt = 1; continue; }
     for (k = 0; k < NVOPT - 1 && strcmp(o, with_value[k]); ++k) {}
     if (k == NVOPT - 1) return usage("%s: %s", o, o[0] == '-' ? refused_reason(o) : "unexpected argument");
     if (i + 1 >= argc) return usage("%s needs a value", o);
@@ -347,15 +378,22 @@ static int parse_args(int argc, char **argv, args *a) {
   if (!!(a->poly || a->expf || a->potential) != !!a->poly_idx)
     return usage("--poly/--exp/--potential and --poly-idx go together");
   if (a->poly_w && !a->poly_idx) return usage("--poly-w needs a nonlinear part (--poly-idx)");
-  if ((a->have_hyper || a->have_hyper_tol || a->no_hyper) && !a->poly_idx)
+  if ((a->have_hyper || a->have_hyper_tol || a->no_hyper || a->have_deim_opt) && !a->poly_idx)
     return usage("%s applies to a nonlinear part (--poly, --exp or --potential with --poly-idx); this model has "
-                 "none", a->have_hyper ? "--hyper" : a->have_hyper_tol ? "--hyper-tol" : "--no-hyper");
-  if (a->no_hyper && (a->have_hyper || a->have_hyper_tol))
-    return usage("--no-hyper keeps every nonlinear term: %s does not apply", a->have_hyper ? "--hyper" : "--hyper-tol");
+                 "none", a->have_hyper ? "--hyper" : a->have_hyper_tol ? "--hyper-tol" : a->no_hyper ? "--no-hyper"
+                 : "--deim-tol/--deim-max/--deim-allow-negative");
+  if (a->no_hyper && (a->have_hyper || a->have_hyper_tol || a->have_deim_opt))
+    return usage("--no-hyper keeps every nonlinear term: %s does not apply",
+                 a->have_hyper ? "--hyper" : a->have_hyper_tol ? "--hyper-tol" : "the DEIM options");
+  if (a->have_hyper_tol && a->hyper_kind != PHGMG_HYPER_ECSW)
+    return usage("--hyper-tol applies to --hyper ecsw (DEIM's tolerance is --deim-tol)");
+  if (a->have_deim_opt && a->hyper_kind == PHGMG_HYPER_ECSW)
+    return usage("--deim-tol, --deim-max and --deim-allow-negative apply to --hyper qdeim or greedy (ecsw's "
+                 "tolerance is --hyper-tol)");
   if (!a->J || !a->R || !a->Q) return usage("--J-coo, --R-coo and --Q-coo are required");
   if (!a->B) return usage("--B is required");
   if (!a->X) return usage("--X is required (the snapshots; phgmg-mpi does not simulate)");
-  if (a->method < 0) return usage("--method is required (gmg-pod or sp1)");
+  if (a->method < 0) return usage("--method is required (gmg-pod, sp1 or sp2)");
   if (a->r < 1) return usage("--r is required");
   if (!a->out) return usage("--out is required");
   if (!name_ok(a->name)) return usage("--name %s: expected a C identifier of at most 64 characters", a->name);
@@ -792,11 +830,11 @@ static phgmg_result sigma_ratio(const phgmg_mpi_ctx *ctx, const dist *d, const a
 
 /* The message of a failed reduction. */
 static void explain(const args *a, const dist *d, phgmg_result rc) {
-  const char *meth = a->method == PHGMG_METHOD_SP1 ? "sp1" : "gmg-pod";
+  const char *meth = method_name(a->method);
   if (rc == PHGMG_ERR_SIZE)
     say("%s: --r %d does not fit: %s (N = %d, m = %d, %d snapshots; the order must not exceed the snapshots' "
         "numerical rank%s)", meth, a->r, phgmg_result_string(rc), d->N, d->m, d->ns,
-        a->method == PHGMG_METHOD_SP1 ? "" : " plus m, and must exceed m");
+        a->method != PHGMG_METHOD_GMG_POD ? "" : " plus m, and must exceed m");
   else if (rc == PHGMG_ERR_SINGULAR)
     say("%s: J - R (--J-coo %s, --R-coo %s) is singular or its LU needs pivoting the sparse LU does not do: %s",
         meth, a->J, a->R, phgmg_result_string(rc));
@@ -807,6 +845,8 @@ static void explain(const args *a, const dist *d, phgmg_result rc) {
   else if (rc == PHGMG_ERR_NOT_SYMMETRIC || rc == PHGMG_ERR_NOT_PSD)
     say("--R-coo %s: R is not symmetric positive semidefinite (relative tolerance 1e-12): %s", a->R,
         phgmg_result_string(rc));
+  else if (rc == PHGMG_ERR_NEGATIVE_WEIGHT)
+    say("%s: %s (use --deim-allow-negative, a smaller --deim-tol, or --hyper ecsw)", meth, phgmg_result_string(rc));
   else if (rc == PHGMG_ERR_NOT_CONVERGED && a->poly_idx)
     say("%s: the ECSW hyper-reduction misses --hyper-tol %g: %s (a larger --hyper-tol, or --no-hyper)", meth,
         a->have_hyper_tol ? a->hyper_tol : 1e-6, phgmg_result_string(rc));
@@ -835,7 +875,7 @@ static int reduce(const args *a, dist *d, result *res) {
   if (rc == PHGMG_OK) rc = make_op(ctx, d, d->TQ, d->nQ, 1.0, NULL, 0, 0.0, &Qop);
   phgmg_npy_free(d->TQ, NULL);   /* Q lives in its operator now */
   d->TQ = NULL;
-  if (rc == PHGMG_OK && a->method == PHGMG_METHOD_SP1)
+  if (rc == PHGMG_OK && a->method != PHGMG_METHOD_GMG_POD)   /* sp1, sp2: J - R as an operator */
     rc = make_op(ctx, d, d->TJ, d->nJ, 1.0, d->TR, d->nR, -1.0, &JRop);
   if (rc == PHGMG_OK) rc = phgmg_mpi_agree(MPI_COMM_WORLD, solver_create(d, &sv));
   phgmg_npy_free(d->TJ, NULL); phgmg_npy_free(d->TR, NULL); phgmg_npy_free(d->Bfull, NULL);
@@ -857,8 +897,9 @@ static int reduce(const args *a, dist *d, result *res) {
     o.method = (phgmg_method)a->method; o.r = a->r;
     /* the serial default: ECSW (tolerance 1e-6 unless --hyper-tol) on a nonlinear part, --no-hyper keeps every term */
     o.hyper.on = a->poly_idx && !a->no_hyper;
-    o.hyper.kind = PHGMG_HYPER_ECSW;
+    o.hyper.kind = (phgmg_hyper)a->hyper_kind;
     o.hyper.tol = a->have_hyper_tol ? a->hyper_tol : 0.0;
+    o.hyper.deim_tol = a->deim_tol; o.hyper.deim_max = a->deim_max; o.hyper.allow_negative = a->deim_neg;
     rc = phgmg_mpi_reduce(ctx, &md, d->ns, d->Xl, ld, &o, &res->mr, res->V0, ld);
   }
   res->seconds = MPI_Wtime() - t0;
@@ -1030,6 +1071,7 @@ static int write_json(const args *a, const dist *d, const result *res) {
   const phgmg_rom *rom = &res->mr.rom;
   const int gmg = a->method == PHGMG_METHOD_GMG_POD, r = a->r, m = d->m, nd = res->mr.nd;
   const int nf = rom->nphi > 1 ? rom->nphi : 1, hyper = a->poly_idx && !a->no_hyper;
+  const int deim = hyper && a->hyper_kind != PHGMG_HYPER_ECSW;
   /* the arrays in the serial command's order: Bh, Qh, K, (P0, w, poly, expo), V0 */
   const int shape[NOUT][2] = {{0, 0}, {0, 0}, {0, 0}, {r, m}, {r, r}, {r, r}, {d->N, r}, {nd, r}, {nd, 1},
                               {nf, rom->poly_deg + 1}, {nf, 2 * rom->nexp}};
@@ -1042,7 +1084,7 @@ static int write_json(const args *a, const dist *d, const result *res) {
   if (!(f = fopen(p, "w"))) { say("%s: cannot write: %s", p, strerror(errno)); return 1; }
   fprintf(f, "{\n  \"phgmg_version\": \"%s\",\n  \"name\": ", PHGMG_VERSION_STRING);
   json_str(f, a->name);
-  fprintf(f, ",\n  \"method\": \"%s\",\n  \"kind\": \"%s\",\n  \"map\": \"linear\",\n", gmg ? "gmg-pod" : "sp1",
+  fprintf(f, ",\n  \"method\": \"%s\",\n  \"kind\": \"%s\",\n  \"map\": \"linear\",\n", method_name(a->method),
           a->poly_idx ? "nonlinear" : "linear");
   fprintf(f, "  \"N\": %d, \"m\": %d, \"r\": %d, \"rn\": 0, \"nd\": %d, \"poly_deg\": %d,\n", d->N, m, r, nd,
           nd ? rom->poly_deg : 0);
@@ -1062,17 +1104,29 @@ static int write_json(const args *a, const dist *d, const result *res) {
   fprintf(f, "},\n");
   fprintf(f, "  \"snapshots\": {\"count\": %d, \"file\": ", d->ns); json_str(f, a->X);
   if (a->have_dt) { fprintf(f, ", \"dt\": "); json_num(f, a->dt); }
-  fprintf(f, "},\n  \"options\": {\"training_runs\": 0, \"ref\": \"none\", \"hyper\": \"%s\"", hyper ? "ecsw" : "none");
-  if (hyper) { fprintf(f, ", \"hyper_tol\": "); json_num(f, a->have_hyper_tol ? a->hyper_tol : 1e-6); }
-  fprintf(f, ", \"deim\": false},\n");
+  fprintf(f, "},\n  \"options\": {\"training_runs\": 0, \"ref\": \"none\", \"hyper\": \"%s\"",
+          hyper ? hyper_name(a->hyper_kind) : "none");
+  if (hyper && !deim) { fprintf(f, ", \"hyper_tol\": "); json_num(f, a->have_hyper_tol ? a->hyper_tol : 1e-6); }
+  fprintf(f, ", \"deim\": %s", deim ? "true" : "false");
+  if (deim) {
+    fprintf(f, ", \"deim_tol\": "); json_num(f, a->deim_tol);
+    fprintf(f, ", \"deim_max\": %d, \"deim_allow_negative\": %s", a->deim_max, a->deim_neg ? "true" : "false");
+  }
+  fprintf(f, "},\n");
   fprintf(f, "  \"info\": {\"pod_sigma_ratio\": "); json_num(f, res->sigma_ratio);
   fprintf(f, ", \"rcond_jr\": "); json_num(f, res->rcond_jr);
   if (gmg) fprintf(f, ", \"degeneracy_tol\": 1e-12");
   if (hyper) {
-    fprintf(f, ", \"hyper\": {\"method\": \"ecsw\", \"points\": %d, \"negative_weights\": %d, \"min_weight\": ", nd, nneg);
+    fprintf(f, ", \"hyper\": {\"method\": \"%s\", \"points\": %d, \"negative_weights\": %d, \"min_weight\": ",
+            hyper_name(a->hyper_kind), nd, nneg);
     json_num(f, nd ? wmin : 0.0);
-    fprintf(f, ", \"tol\": "); json_num(f, a->have_hyper_tol ? a->hyper_tol : 1e-6);
-    fprintf(f, ", \"residual\": "); json_num(f, res->mr.hyper_residual);
+    if (deim) {
+      fprintf(f, ", \"tol\": "); json_num(f, a->deim_tol);
+      fprintf(f, ", \"sigma_ratio\": "); json_num(f, res->mr.deim_sigma_ratio);
+    } else {
+      fprintf(f, ", \"tol\": "); json_num(f, a->have_hyper_tol ? a->hyper_tol : 1e-6);
+      fprintf(f, ", \"residual\": "); json_num(f, res->mr.hyper_residual);
+    }
     fprintf(f, "}");
   }
   fprintf(f, ", \"reduce_seconds\": "); json_num(f, res->seconds);
@@ -1150,7 +1204,7 @@ static int write_outputs(const args *a, const dist *d, result *res) {
   if (d->rank == 0 && !a->quiet)
     printf("wrote %s/%s.phgmgrom, %s/%s.c, %s/%s.json and %d arrays %s/%s_*.npy (%s, r = %d, m = %d, N = %d, "
            "%d rank%s)\n", a->out, a->name, a->out, a->name, a->out, a->name, g_nout - 3, a->out, a->name,
-           a->method == PHGMG_METHOD_SP1 ? "sp1" : "gmg-pod", a->r, d->m, d->N, d->size, d->size > 1 ? "s" : "");
+           method_name(a->method), a->r, d->m, d->N, d->size, d->size > 1 ? "s" : "");
   return 0;
 }
 

@@ -30,7 +30,7 @@
 # status (each rank's status recorded by a wrapper), one message, within the
 # timeout (no rank left waiting in a collective); snapshots of the wrong
 # shape, --simulate and options of the serial reduce that the distributed
-# build does not take (--ref, springs --poly-jdx, --hyper qdeim) are refused
+# build does not take (--ref, springs --poly-jdx), DEIM options without --hyper qdeim/greedy and negative DEIM weights without --deim-allow-negative are refused
 # with a message naming them.
 #   sh tests/mpi/check_cli_mpi.sh SERIAL_PHGMG PHGMG_MPI     (make test-mpi)
 # MPIRUN overrides the launcher (default: mpirun --oversubscribe, plus
@@ -65,15 +65,17 @@ PYEOF
 "$PHGMG" simulate $M --dt 0.1 --steps 200 --out "$D/y_full.npy" --states "$D/X.npy" --quiet > /dev/null
 "$PHGMG" simulate $M $NL --dt 0.1 --steps 200 --out "$D/y_full_nl.npy" --states "$D/X_nl.npy" --quiet > /dev/null
 "$PHGMG" simulate $M $PT --dt 0.1 --steps 200 --out "$D/y_full_pt.npy" --states "$D/X_pt.npy" --quiet > /dev/null
-# case: linear (gmg-pod, sp1), cosh (cosh-gmg-pod, cosh-sp1), per-term functions without hyper-reduction (terms-sp1)
-for case in gmg-pod sp1 cosh-gmg-pod cosh-sp1 terms-sp1; do
+# case: linear (gmg-pod, sp1), cosh (cosh-gmg-pod, cosh-sp1), per-term functions without hyper-reduction
+# (terms-sp1), cosh with DEIM (qdeim-gmg-pod, greedy-sp2)
+for case in gmg-pod sp1 cosh-gmg-pod cosh-sp1 terms-sp1 qdeim-gmg-pod greedy-sp2; do
   ps="1 2 3 4"
   case $case in
     cosh-*) meth=${case#cosh-}; X="$D/X_nl.npy"; opt=$NL ;;
+    qdeim-*|greedy-*) meth=${case#*-}; X="$D/X_nl.npy"; opt="$NL --hyper ${case%%-*} --deim-tol 1e-4 --deim-allow-negative" ;;
     terms-*) meth=${case#terms-}; X="$D/X_pt.npy"; opt="$PT --no-hyper"; ps=3 ;;
     *) meth=$case; X="$D/X.npy"; opt="" ;;
   esac
-  case $case in sp1) ps="2 4" ;; cosh-sp1) ps="1 3" ;; esac   # sp1: every P over the two cases
+  case $case in sp1) ps="2 4" ;; cosh-sp1) ps="1 3" ;; qdeim-*) ps="1 3" ;; greedy-*) ps="2 4" ;; esac   # sp1, DEIM: every P over two cases
   "$PHGMG" reduce $M $opt --X "$X" --method $meth --r 10 --out "$D/serial_$case" --quiet > /dev/null
   "$PHGMG" simulate-rom --model "$D/serial_$case/rom.phgmgrom" --dt 0.1 --steps 300 --out "$D/y_serial_$case.npy" --quiet > /dev/null
   for p in $ps; do
@@ -110,8 +112,9 @@ refused "expected (2400, ns)" --X "$D/B.npy"
 refused "--simulate: the distributed build does not simulate" --simulate
 refused "--ref: not supported by the distributed build" --X "$D/X.npy" --ref mean
 refused "--poly-jdx: springs" --X "$D/X_nl.npy" $NL --poly-jdx "$D/idx.npy"
-refused "--hyper qdeim: DEIM hyper-reduction is not distributed" --X "$D/X_nl.npy" $NL --hyper qdeim
-echo "check_cli_mpi: wrong snapshot shape, --simulate, --ref, --poly-jdx, --hyper qdeim refused with messages naming them"
+refused "--deim-tol, --deim-max and --deim-allow-negative apply to --hyper qdeim or greedy" --X "$D/X_nl.npy" $NL --deim-tol 1e-4
+refused "use --deim-allow-negative" --X "$D/X_nl.npy" $NL --hyper greedy --deim-tol 1e-4
+echo "check_cli_mpi: wrong snapshot shape, --simulate, --ref, --poly-jdx, DEIM options without DEIM, negative DEIM weights refused with messages naming them"
 
 $PY - "$D" <<'PYEOF'
 import json
@@ -132,8 +135,8 @@ def coords(P0, V0):
     return out
 
 bad = 0
-for case in ('gmg-pod', 'sp1', 'cosh-gmg-pod', 'cosh-sp1', 'terms-sp1'):
-    nl = case.startswith('cosh-') or case.startswith('terms-')
+for case in ('gmg-pod', 'sp1', 'cosh-gmg-pod', 'cosh-sp1', 'terms-sp1', 'qdeim-gmg-pod', 'greedy-sp2'):
+    nl = case.startswith(('cosh-', 'terms-', 'qdeim-', 'greedy-'))
     names = ('K', 'Qh', 'Bh', 'V0') + (('P0', 'w', 'poly', 'expo') if nl else ())
     sd = '%s/serial_%s' % (d, case)
     ser = {n: np.load('%s/rom_%s.npy' % (sd, n)) for n in names}
@@ -149,7 +152,8 @@ for case in ('gmg-pod', 'sp1', 'cosh-gmg-pod', 'cosh-sp1', 'terms-sp1'):
     if nl and (len(cs) < 2 or -1 in cs or len(set(cs)) != len(cs)):
         print('check_cli_mpi: %s: the serial points were not found in V0' % case)
         bad = 1
-    for p in {'terms-sp1': (3,), 'sp1': (2, 4), 'cosh-sp1': (1, 3)}.get(case, (1, 2, 3, 4)):
+    for p in {'terms-sp1': (3,), 'sp1': (2, 4), 'cosh-sp1': (1, 3), 'qdeim-gmg-pod': (1, 3),
+              'greedy-sp2': (2, 4)}.get(case, (1, 2, 3, 4)):
         pd = '%s/p%d_%s' % (d, p, case)
         files_ok = sorted(os.listdir(pd)) == sorted(os.listdir(sd))
         pj = json.load(open(pd + '/rom.json'))
