@@ -835,8 +835,10 @@
    (stride = ns r nsep / 4e6 + 1), term k's column phi_k'(x_u[idx_k])
    (V0[idx_k, a] + V2[idx_k, :] Dq(x2_u)[:, a - m]) formed by the rank that
    owns it, Dq from the replicated M and reduced coordinates, fitted by the
-   distributed Lawson-Hanson of phgmg_mpi_ecsw at hyper.tol (fewer than 4096
-   live terms: the serial fit screens candidates from there on); P0 and P1
+   distributed Lawson-Hanson of phgmg_mpi_ecsw at hyper.tol below 4096
+   live terms, from there on by the serial fit's screening (rounds of 64
+   candidates of largest gradient over the ranks, the Gram fit on the
+   working set replicated), as phgmg_ecsw does; P0 and P1
    the kept terms' rows of V0 and V2, from their owners.
    The result is the serial phgmg_rom of kind PHGMG_ROM_QUADRATIC. On the
    damped chain described below, of 300 masses (N = 600, 81 snapshots, r =
@@ -854,8 +856,11 @@
    POD's route (TSQR against the serial SVD), not the partition. Not yet: the
    wide V2 (qm.rn = PHGMG_RN_WIDE, the greedy manifold's default: set qm.rn
    > 0), the ALTMIN manifold, a chosen lambda, your own eta
-   (GMG_MANIFOLD), ECSW with GMG-QM from 4096 live terms (all
-   PHGMG_ERR_UNSUPPORTED).
+   (GMG_MANIFOLD) (all PHGMG_ERR_UNSUPPORTED). With 4200 terms (a cosh
+   term on every coordinate of 2100 masses, 31 snapshots, r = 8, rn = 4,
+   the POD manifold, ECSW at 1e-3: the screened fit) at 1-4 ranks: the
+   same 37 points, weights within 1.9e-13, blocks within 1.2e-13, outputs
+   within 5.3e-11.
    Cost beyond GMG-POD: the POD of the residual (one TSQR), r + rn solves
    instead of r, products of N x (r + rn) blocks; memory per rank its rows
    of the adjusted snapshots and of three N x (r + rn) blocks, with ECSW its
@@ -912,8 +917,8 @@
    solves and about 1.5 GB per rank; the efficiency falls below 90 % near
    16 000 ranks (size ns about 0.6 times the rows per rank), where TSQR's
    replicated stack dominates.
-   Not yet distributed: GMG-QM with a wide V2, ALTMIN, a chosen lambda, or
-   ECSW from 4096 live terms; GMG_MANIFOLD; cached DEIM points
+   Not yet distributed: GMG-QM with a wide V2, ALTMIN or a chosen lambda;
+   GMG_MANIFOLD; cached DEIM points
    (opts.cache), separable terms by callbacks and GENERAL nonlinear
    Hamiltonians, a reference state (opts.ref), dampers, feedthrough,
    descriptor models; in the command line (below) also simulating the
@@ -5385,8 +5390,8 @@ typedef struct phgmg_mpi_rom {
    r + rn solves, the serial non-degeneracy check of D^T G D at 0 and at
    every snapshot; Qh, Q01, Q11 = [V0, V2]^T Q [V0, V2]; q_max; ECSW as
    the serial GMG-QM's (the training rows phi_k'(x_i[idx_k]) Dphi(rho(x_i))
-   [idx_k, :] of every stride-th snapshot, the fit at tol; fewer than 4096
-   live terms, else PHGMG_ERR_UNSUPPORTED); the kept terms' rows of V0 and
+   [idx_k, :] of every stride-th snapshot, the fit at tol, from 4096 live
+   terms on screened as phgmg_ecsw); the kept terms' rows of V0 and
    V2 (P0, P1). out->rom is then of kind PHGMG_ROM_QUADRATIC (out->K NULL;
    the blocks in out->rom).
    X: this rank's rows of the snapshots (nloc x ns, ldx). *out is filled
@@ -27735,6 +27740,8 @@ typedef struct phgmg__mpi_scr {
   phgmg_gidx *W;                                   /* wmax: the working set's global ids, in screening order */
   int *pw;
   char *inW;                                       /* nl: this rank's terms in W */
+  const double *G;                                 /* given columns (m x nl, ldg; GMG-QM), NULL: separable */
+  int ldg;
 } phgmg__mpi_scr;
 
 /* Local index of global id g among this rank's live terms (ascending), -1 if not here. */
@@ -27748,10 +27755,15 @@ PHGMG__PRIV int phgmg__mpi_term_at(const phgmg__mpi_terms *t, phgmg_gidx g) {
   return -1;
 }
 
-/* g = this rank's terms' gradients F res .* Vt summed over a (as phgmg__ecsw_grad_sep). */
+/* g = this rank's terms' gradients: F res .* Vt summed over a (as
+   phgmg__ecsw_grad_sep), or G^T res for given columns. */
 PHGMG__PRIV void phgmg__mpi_scr_grad(const phgmg__mpi_terms *t, int ns, int r, phgmg__mpi_scr *s) {
   int k, a;
   if (t->nl == 0) return;
+  if (s->G) {
+    for (k = 0; k < t->nl; ++k) s->g[k] = phgmg__dot(s->m, s->G + (size_t)k * s->ldg, s->res);
+    return;
+  }
   phgmg_gemm('N', 'N', t->nl, r, ns, 1.0, t->F, t->nl, s->res, ns, 0.0, s->h, t->nl);
   for (k = 0; k < t->nl; ++k) s->g[k] = 0.0;
   for (a = 0; a < r; ++a)
@@ -27791,7 +27803,8 @@ PHGMG__PRIV int phgmg__mpi_scr_add(const phgmg_mpi_ctx *ctx, const phgmg__mpi_te
     b[0] = -HUGE_VAL;
     if ((k = phgmg__mpi_term_at(t, s->W[s->nw + cnt])) >= 0) {
       s->inW[k] = 1;
-      for (a = 0; a < r; ++a)
+      if (s->G) memcpy(s->col + (size_t)cnt * s->m, s->G + (size_t)k * s->ldg, (size_t)s->m * sizeof(double));
+      for (a = 0; !s->G && a < r; ++a)
         for (i = 0; i < ns; ++i)
           s->col[(size_t)cnt * s->m + i + (size_t)a * ns] = t->F[k + (size_t)i * t->nl] * t->Vt[k + (size_t)a * t->nl];
     }
@@ -27828,7 +27841,11 @@ PHGMG__PRIV phgmg_result phgmg__mpi_scr_run(const phgmg_mpi_ctx *ctx, const phgm
   phgmg_result rc = PHGMG_ERR_NOT_CONVERGED;
   *rel = HUGE_VAL;
   memcpy(s->res, s->tg, (size_t)s->m * sizeof(double));
-  phgmg__sep_cnorm(t->nl, ns, t->F, PHGMG__MAX(t->nl, 1), r, t->Vt, PHGMG__MAX(t->nl, 1), s->cn, s->cn + PHGMG__MAX(t->nl, 1));
+  if (s->G)
+    for (j = 0; j < t->nl; ++j) s->cn[j] = phgmg_normf(s->m, 1, s->G + (size_t)j * s->ldg, s->m);
+  else
+    phgmg__sep_cnorm(t->nl, ns, t->F, PHGMG__MAX(t->nl, 1), r, t->Vt, PHGMG__MAX(t->nl, 1), s->cn,
+                     s->cn + PHGMG__MAX(t->nl, 1));
   phgmg__mpi_scr_grad(t, ns, r, s);
   for (;;) {
     const double tau = 1e3 * PHGMG__EPS * phgmg_normf(s->m, 1, s->res, s->m);   /* replicated */
@@ -27858,16 +27875,18 @@ PHGMG__PRIV phgmg_result phgmg__mpi_scr_run(const phgmg_mpi_ctx *ctx, const phgm
 }
 
 /* The screened fit as phgmg_ecsw_separable from PHGMG_ECSW_SCREEN_MIN terms
-   on (full ns r rows, tol): tg the target (ns r, replicated). pts, w: room
-   for min(nlg, 16 PHGMG_ECSW_SCREEN_ADD). Collective. */
+   on (full ns r rows, tol): tg the target (ns r, replicated). With given
+   columns G (ns x nl, ldg: pass r = 1) the screening of phgmg_ecsw on
+   them. pts, w: room for min(nlg, 16 PHGMG_ECSW_SCREEN_ADD). Collective. */
 PHGMG__PRIV phgmg_result phgmg__mpi_sep_screened(const phgmg_mpi_ctx *ctx, const phgmg__mpi_terms *t, int ns, int r,
-                                                 double tol, phgmg_gidx nlg, const double *tg, phgmg_gidx *pts,
-                                                 double *w, int *nd, double *rel) {
+                                                 const double *G, int ldg, double tol, phgmg_gidx nlg,
+                                                 const double *tg, phgmg_gidx *pts, double *w, int *nd,
+                                                 double *rel) {
   const int m = ns * r, ad = PHGMG_ECSW_SCREEN_ADD, nl1 = PHGMG__MAX(t->nl, 1);
   phgmg__mpi_scr s;
   phgmg_result rc;
   memset(&s, 0, sizeof s);
-  s.m = m; s.wmax = (int)PHGMG__MIN(nlg, (phgmg_gidx)16 * ad);
+  s.m = m; s.wmax = (int)PHGMG__MIN(nlg, (phgmg_gidx)16 * ad); s.G = G; s.ldg = ldg;
   s.Gw = phgmg__dalloc(&ctx->al, (size_t)m * (s.wmax + ad + 2) + 2 * (size_t)s.wmax + (size_t)nl1 * (r + 1) +
                                      2 * (size_t)ad * (ctx->size + 1) + 2 * (size_t)nl1);
   s.W = PHGMG__CAST(phgmg_gidx *, phgmg__alloc(&ctx->al, sizeof(phgmg_gidx) * (size_t)s.wmax));
@@ -27900,7 +27919,7 @@ PHGMG__PRIV phgmg_result phgmg__mpi_sep_ecsw(const phgmg_mpi_ctx *ctx, const phg
   if (rc == PHGMG_OK) tn = phgmg__mpi_sep_norm(ctx, t, ns, r, t->sw, work);   /* the target: work + ns r */
   if (rc == PHGMG_OK && tn > 0.0)
     rc = nlg >= PHGMG_ECSW_SCREEN_MIN
-             ? phgmg__mpi_sep_screened(ctx, t, ns, r, tol, nlg, work + (size_t)ns * r, pts, w, nd, rel)
+             ? phgmg__mpi_sep_screened(ctx, t, ns, r, NULL, 0, tol, nlg, work + (size_t)ns * r, pts, w, nd, rel)
              : phgmg__mpi_sep_ecsw_svd(ctx, t, ns, r, tol, nlg, tn, pts, w, nd, rel);
   phgmg__free(&ctx->al, work);
   return rc;
@@ -28239,14 +28258,32 @@ typedef struct phgmg__mpi_qmfit {
   const double *XR;
 } phgmg__mpi_qmfit;
 
+/* GMG-QM's ECSW from PHGMG_ECSW_SCREEN_MIN live terms: the target tg =
+   sum_k sw_k G[:, k] over every rank's terms (one reduction), nothing to
+   fit (nd = 0) when it is zero, else the screened fit on the columns G
+   (nrow x nl). work: 2 nrow doubles. Collective. */
+PHGMG__PRIV phgmg_result phgmg__mpi_qm_screened(const phgmg_mpi_ctx *ctx, const phgmg__mpi_terms *t, const double *G,
+                                                int nrow, double tol, phgmg_gidx nlg, double *work, phgmg_gidx *pts,
+                                                double *w, int *nd, double *rel) {
+  double *loc = work, *tg = work + nrow;
+  int k;
+  memset(loc, 0, (size_t)nrow * sizeof(double));
+  for (k = 0; k < t->nl; ++k) phgmg__axpy(nrow, t->sw[k], G + (size_t)k * nrow, loc);
+  phgmg__mpi_sum(ctx, nrow, loc, tg);
+  *nd = 0; *rel = 0.0;
+  if (!(phgmg_normf(nrow, 1, tg, nrow) > 0.0)) return PHGMG_OK;
+  return phgmg__mpi_sep_screened(ctx, t, nrow, 1, G, nrow, tol, nlg, tg, pts, w, nd, rel);
+}
+
 /* ECSW of GMG-QM as the serial phgmg__hyper_ecsw_manifold: the training
    rows (u, a) of every stride-th snapshot (stride = ns r nsg / 4e6 + 1, nsg
    the model's terms), column of term k: phi_k'(x_i[idx_k]) Dphi(rho(x_i))
    [idx_k, a] = f (V0[idx_k, a] + (a >= m) V2[idx_k, :] Dq(x2_i)[:, a - m])
    (t->Vt: the rows of [V0, V2]), the target their sum with the terms'
    weights, the fit by phgmg__mpi_ecsw_run at tol on these rows (the
-   terms' columns formed by their owners). From PHGMG_ECSW_SCREEN_MIN live
-   terms on (the serial screening) PHGMG_ERR_UNSUPPORTED. Collective. */
+   terms' columns formed by their owners); from PHGMG_ECSW_SCREEN_MIN live
+   terms on, as the serial phgmg_ecsw, the screened fit on these columns
+   (the target summed over the ranks). Collective. */
 PHGMG__PRIV phgmg_result phgmg__mpi_qm_ecsw(const phgmg_mpi_ctx *ctx, const phgmg__mpi_terms *t, int ns,
                                             const phgmg__mpi_qmfit *qf, phgmg_gidx nsg, double tol, phgmg_gidx nlg,
                                             phgmg_gidx *pts, double *w, int *nd, double *rel) {
@@ -28258,8 +28295,7 @@ PHGMG__PRIV phgmg_result phgmg__mpi_qm_ecsw(const phgmg_mpi_ctx *ctx, const phgm
   phgmg__mpi_cols src;
   int u, k, a, j;
   phgmg_result rc;
-  if (nlg >= PHGMG_ECSW_SCREEN_MIN) return PHGMG_ERR_UNSUPPORTED;   /* nlg: the same on every rank */
-  Gm = phgmg__dalloc(&ctx->al, nrow * (size_t)PHGMG__MAX(nl, 1) + (size_t)rn * p);
+  Gm = phgmg__dalloc(&ctx->al, nrow * (size_t)PHGMG__MAX(nl, 1) + (size_t)rn * p + 2 * nrow);
   rc = phgmg__mpi_agree(ctx, Gm ? PHGMG_OK : PHGMG_ERR_NOMEM);
   if (rc != PHGMG_OK) { phgmg__free(&ctx->al, Gm); return rc; }
   Dq = Gm + nrow * (size_t)PHGMG__MAX(nl, 1);
@@ -28276,6 +28312,11 @@ PHGMG__PRIV phgmg_result phgmg__mpi_qm_ecsw(const phgmg_mpi_ctx *ctx, const phgm
         g[m + a] += f * sm;
       }
     }
+  }
+  if (nlg >= PHGMG_ECSW_SCREEN_MIN) {   /* nlg: the same on every rank */
+    rc = phgmg__mpi_qm_screened(ctx, t, Gm, (int)nrow, tol, nlg, Dq + (size_t)rn * p, pts, w, nd, rel);
+    phgmg__free(&ctx->al, Gm);
+    return rc;
   }
   memset(&src, 0, sizeof src);
   src.G = Gm; src.ldg = (int)nrow;

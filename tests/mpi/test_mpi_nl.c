@@ -938,6 +938,45 @@ static double mem_peak(MPI_Comm comm, long long N) {
   return out;
 }
 
+/* GMG-QM (POD manifold, rn = 4) with ECSW from PHGMG_ECSW_SCREEN_MIN live
+   terms: the screened fit on the manifold's training columns, against the
+   serial phgmg_reduce (the chain of test_screened: 4200 terms; its greedy
+   manifold's model, serial and distributed alike, stops at step 2: a
+   reduced model of this data that cannot be stepped, so not compared). */
+static void test_qm_screened(void) {
+  const int n = 2100, N = 2 * n, ns = 31, r = 8;
+  chain ch;
+  dist d;
+  double *X = (double *)malloc(sizeof(double) * (size_t)N * ns), *x0 = (double *)calloc((size_t)N, sizeof(double));
+  double *V0, *V0f;
+  phgmg_reduce_opts o;
+  phgmg_reduced *red = NULL;
+  phgmg_mpi_rom mr;
+  phgmg_result rc;
+  int i;
+  chain_build(&ch, n, 1);
+  for (i = 0; i < n; ++i) x0[2 * i] = 0.8 * sin(3.0 * 3.14159265358979 * i / n);
+  simulate_root(&ch, x0, 0.2, ns, X);
+  memset(&o, 0, sizeof o);
+  o.method = PHGMG_METHOD_GMG_QM; o.r = r; o.qm.rn = 4; o.qm.manifold = PHGMG_MANIFOLD_POD;
+  o.hyper.on = 1; o.hyper.tol = 1e-3;
+  dist_build(&d, &ch, ns, X);
+  V0 = (double *)malloc(sizeof(double) * (size_t)d.ld * r);
+  rc = phgmg_mpi_reduce(d.c, &d.md, ns, d.Xl, d.ld, &o, &mr, V0, d.ld);
+  CHECK(rc == PHGMG_OK && same_everywhere(mr.nd) && mr.nd > 0, "distributed GMG-QM, screened ECSW: %d", (int)rc);
+  V0f = gather_v0(d.c, r, V0, d.ld);
+  if (rank_ == 0 && rc == PHGMG_OK) {
+    CHECK(phgmg_reduce(&red, &ch.sys, X, N, ns, &o, NULL, NULL) == PHGMG_OK, "serial GMG-QM, screened ECSW");
+    if (red) compare_qm(&ch, x0, red, &mr, V0f, 100, 1e-11, 1e-10, NULL, "gmg-qm pod ecsw, 4200 terms");
+    phgmg_reduced_destroy(red);
+  }
+  quiet_barrier();
+  phgmg_mpi_rom_free(&mr);
+  dist_free(&d);
+  chain_free(&ch);
+  free(X); free(x0); free(V0); free(V0f);
+}
+
 static void test_memory(void) {
   const long long N = 100000, NB = 10000;
   double one[2] = {0.0, 0.0}, gp, g1, t0 = MPI_Wtime();
@@ -975,6 +1014,7 @@ int main(int argc, char **argv) {
     test_gmg_pod_ecsw(1000, 12);
     test_screened();
     test_gmg_qm(300, 8);
+    test_qm_screened();
     test_errors();
     test_memory();
   }
