@@ -12,7 +12,10 @@
 # against the serial model. Then GMG-QM (POD and greedy manifolds, r = 8,
 # rn = 3, no terms: the linear chain of n masses, 81 snapshots) against the
 # serial GMG-QM: the basis [B, V1], every block, q_max, 100 steps of
-# outputs. QM_ONLY=1: only the GMG-QM comparison.
+# outputs. QM_ONLY=1: only the GMG-QM comparison; QM_COSH=1: only GMG-QM,
+# on the linear chain and then on the cosh chain with ECSW (r = 8, rn = 4,
+# the POD and greedy manifolds; from 4096 live terms the screened fit),
+# also against the serial ECSW points and weights.
 #   sh bench/mpi_equivalence.sh [n] [P ...]      (log: build/mpi_equivalence.txt)
 set -e
 n=${1:-100000}
@@ -28,7 +31,7 @@ $MPICC -O2 -std=c99 -o build/test_mpi_nl_scale tests/mpi/test_mpi_nl.c -lm
 : > build/mpi_equivalence.txt
 for p in $PS; do
   /usr/bin/time -f "P = $p: %e s wall, %M KB peak (largest rank)" $MPIRUN -np "$p" ./build/test_mpi_nl_scale \
-      "$([ -n "$QM_ONLY" ] && echo --scale-qm || echo --scale)" "$n" 2>&1 \
+      "$([ -n "$QM_COSH" ] && echo --scale-qm-cosh || { [ -n "$QM_ONLY" ] && echo --scale-qm || echo --scale; })" "$n" 2>&1 \
     | grep -v '^--\|^$\|Primary job\|non-zero exit\|mpirun detected\|Process name\|Exit code\|aborted\|thus causing\|terminated' \
     | tee -a build/mpi_equivalence.txt
 done
