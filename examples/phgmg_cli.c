@@ -1504,6 +1504,8 @@ typedef struct reduce_args {
   int greedy_window;            /* --greedy-window W (0: the library's default) */
   int adi_maxit;                /* --adi-maxit K: low-rank ADI steps (0: the library's default) */
   int lyap;                     /* --lyap adi (PHGMG_LYAP_ADI) | eksm (PHGMG_LYAP_EKSM)        */
+  const char *form_s;           /* --form ph | ss as given (NULL: not given)                    */
+  int form_ss;                  /* --form ss: bt's reduced model as state-space arrays A, B, C, D */
   const char *train[16];        /* --train-input KIND, repeatable */
   int ntrain;
   const char *xs[16];           /* --X FILE, repeatable: one run each (X = xs[0]) */
@@ -1842,6 +1844,11 @@ static int parse_reduce(int argc, char **argv, reduce_args *A) {
       if (!strcmp(v, "adi")) A->lyap = PHGMG_LYAP_ADI;
       else if (!strcmp(v, "eksm")) A->lyap = PHGMG_LYAP_EKSM;
       else return usage_error("--lyap: expected adi or eksm, got '%s'", v);
+    } else if (!strcmp(o, "--form")) {
+      if (!(v = optval(argc, argv, &i))) return 2;
+      if (strcmp(v, "ph") && strcmp(v, "ss")) return usage_error("--form: expected ph or ss, got '%s'", v);
+      A->form_s = v;
+      A->form_ss = !strcmp(v, "ss");
     } else if (!strcmp(o, "--greedy-window")) {
       if (!(v = optval(argc, argv, &i)) || !parse_int(o, v, 1, 100000, &A->greedy_window)) return 2;
     }
@@ -1960,6 +1967,24 @@ static int mixes_balancing(const reduce_args *A) {
   return nb > 0 && nb < A->nml;
 }
 
+/* --form ss: balanced truncation's model as state-space arrays, which only
+   the low-rank BT of one sparse model to one order gives (reduce only). 0 or
+   the usage status 2. */
+static int check_form(const reduce_args *A) {
+  if (!A->form_ss) return 0;
+  if (A->nml != 1 || A->mlist[0] != PHGMG_METHOD_BT)
+    return usage_error("--form ss: the state-space model is balanced truncation's: give --method bt (not '%s'); "
+                       "the other methods give port-Hamiltonian models (--form ph)", A->method);
+  if (g_validating)
+    return usage_error("validate: --form ss is not taken (validate runs port-Hamiltonian models); reduce with "
+                       "--form ss, then run the model with simulate-rom --ss DIR/NAME");
+  if (A->nrl != 1) return usage_error("--form ss: one order per run (--r R, not a list)");
+  if (!A->Jcoo)
+    return usage_error("--form ss: the state-space model comes from the low-rank BT of a sparse model: give J, R, "
+                       "Q (and E) as --J-coo, --R-coo, --Q-coo (--E-coo)");
+  return 0;
+}
+
 static int check_reduce_args(reduce_args *A, const char *const *seen, int nseen) {
   int e;
   if ((e = check_model_opts("reduce", A)) != 0) return e;
@@ -1969,6 +1994,7 @@ static int check_reduce_args(reduce_args *A, const char *const *seen, int nseen)
   if (mixes_balancing(A))
     return usage_error("--method '%s': the balancing methods (bt, prbt, phbt: no snapshots) and the snapshot "
                        "methods cannot be mixed in one run; give them in two runs", A->method);
+  if ((e = check_form(A)) != 0) return e;
   A->method = method_name(A->mlist[0]);
   if (!A->out) return usage_error("reduce: --out DIR is required");
   if (name_problem(A->name)) return usage_error("--name '%s': %s", A->name, name_problem(A->name));
@@ -2522,11 +2548,20 @@ typedef struct sweep_model {
   outlist ol;            /* its arrays */
   char name[64];
   int method, r, rr, m, pass;
+  int ss;                /* written in state-space form (--form ss) */
   double t_red;
   double ey[16], ered[16];   /* validate: each test's e_y, e_red */
   int tpass[16];
   phgmg_reduced *red;    /* kept by validate for its tests */
 } sweep_model;
+
+/* --form ss: balanced truncation's reduced model x_r' = A x_r + B u, y = C x_r
+   + D u (phgmg_lrbt, phgmg_lrbt_feedthrough), its first r Hankel singular
+   values and its basis T (N x r, the sparse object's internal order). */
+typedef struct ss_model {
+  double *A, *B, *C, *D, *hsv, *T;
+  phgmg_lrbt_info inf;
+} ss_model;
 
 typedef struct reduce_state {
   mat J, R, B, Q, X, poly, pidx, pw, ex, pjdx;
@@ -2573,6 +2608,7 @@ typedef struct reduce_state {
   phgmg_balanced_info bal;
   double bal_sv[64];        /* its first values (bal.nsv) */
   phgmg_balanced_cache bcache; /* the Gramian factors, shared by a sweep's balancing models */
+  ss_model ss;              /* --form ss: the state-space BT model */
 } reduce_state;
 
 /* Is w phi(s), phi(s) = sum_j c_j s^j + sum_e a_e exp(b_e s), bounded below
@@ -2693,6 +2729,7 @@ static int load_family(const reduce_args *A, reduce_state *S, phgmg_ph_system *s
 
 static void reduce_cleanup(reduce_state *S) {
   phgmg_balanced_cache_free(&S->bcache, NULL);
+  free(S->ss.A); free(S->ss.B); free(S->ss.C); free(S->ss.D); free(S->ss.hsv); free(S->ss.T);
   mat_free(&S->J); mat_free(&S->R); mat_free(&S->B); mat_free(&S->Q); mat_free(&S->E); mat_free(&S->Pm); mat_free(&S->Sm); mat_free(&S->Nm); mat_free(&S->Dm); mat_free(&S->refm);
   free(S->di); free(S->dj); free(S->dlaw); mat_free(&S->X);
   mat_free(&S->poly); mat_free(&S->pidx); mat_free(&S->pjdx); mat_free(&S->pw); mat_free(&S->ex); mat_free(&S->in.tab);
@@ -2719,7 +2756,7 @@ static void reduce_cleanup(reduce_state *S) {
 /* The fields NAME_<field>.npy a run may write. */
 static const char *const all_fields[] = {"Bh", "Qh", "K", "G00", "G01", "G10", "G11", "Q01", "Q11", "Ms",
                                          "P0", "P1", "w", "poly", "expo", "Phi", "Gam", "SX", "SU", "PD", "V0", "V2",
-                                         "M", "snapshots", "fom_y", NULL};
+                                         "M", "A", "B", "C", "D", "snapshots", "fom_y", NULL};
 
 /* The arrays an earlier run recorded as its own in DIR/NAME.json ("arrays":
    {"NAME_<field>.npy": [rows, cols], ...}), those of the form NAME_<field>.npy
@@ -4147,6 +4184,30 @@ static void json_balancing(FILE *jf, const reduce_state *S, int method) {
   }
 }
 
+/* The json record's "system" object, opened and not closed: the files of the
+   model as given (a model rebuilt from the record is this model). */
+static void json_system(FILE *jf, const reduce_args *A, const reduce_state *S) {
+  fprintf(jf, ",\n  \"system\": {\"J\": ");
+  json_str(jf, A->J ? A->J : A->Jcoo); fprintf(jf, ", \"R\": "); json_str(jf, A->R ? A->R : A->Rcoo);
+  fprintf(jf, ", \"B\": "); json_str(jf, A->B); fprintf(jf, ", \"Q\": "); json_str(jf, A->Q ? A->Q : A->Qcoo);
+  if (S->sp) fprintf(jf, ", \"sparse\": true, \"kb\": %d", S->sys.kb);
+  { /* the descriptor, feedthrough and damper files: a model rebuilt from this record is this model */
+    const char *const v[5] = {A->E ? A->E : A->Ecoo, A->Pf, A->Sf, A->Nf, A->dampf};
+    const char *const key[5] = {"E", "P", "S", "N", "dampers"};
+    int k;
+    for (k = 0; k < 5; ++k)
+      if (v[k]) { fprintf(jf, ", \"%s\": ", key[k]); json_str(jf, v[k]); }
+  }
+  if (A->poly_idx) {
+    if (A->poly) { fprintf(jf, ", \"poly\": "); json_str(jf, A->poly); }
+    if (A->expf) { fprintf(jf, ", \"exp\": "); json_str(jf, A->expf); }
+    if (A->potential) { fprintf(jf, ", \"potential\": "); json_str(jf, A->potential); }
+    fprintf(jf, ", \"poly_idx\": "); json_str(jf, A->poly_idx);
+    if (A->poly_w) { fprintf(jf, ", \"poly_w\": "); json_str(jf, A->poly_w); }
+    if (A->poly_jdx) { fprintf(jf, ", \"poly_jdx\": "); json_str(jf, A->poly_jdx); }
+  }
+}
+
 static int write_json_tail(FILE *jf, const reduce_args *A, reduce_state *S, const outlist *ol, const char *path);
 static int write_json(const reduce_args *A, reduce_state *S, int method, int ns, double t_sim, double t_red,
                       const phgmg_reduce_opts *o, const phgmg_reduce_info *info, const outlist *ol) {
@@ -4177,25 +4238,7 @@ static int write_json(const reduce_args *A, reduce_state *S, int method, int ns,
   fprintf(jf, "  \"dt_map\": ");
   if (rom->Phi) { char buf[32]; fputs(isfinite((double)rom->dt) ? real_str(rom->dt, buf) : "null", jf); }   /* float: "0.1" */
   else fputs("0", jf);
-  fprintf(jf, ",\n  \"system\": {\"J\": ");
-  json_str(jf, A->J ? A->J : A->Jcoo); fprintf(jf, ", \"R\": "); json_str(jf, A->R ? A->R : A->Rcoo);
-  fprintf(jf, ", \"B\": "); json_str(jf, A->B); fprintf(jf, ", \"Q\": "); json_str(jf, A->Q ? A->Q : A->Qcoo);
-  if (S->sp) fprintf(jf, ", \"sparse\": true, \"kb\": %d", S->sys.kb);
-  { /* the descriptor, feedthrough and damper files: a model rebuilt from this record is this model */
-    const char *const v[5] = {A->E ? A->E : A->Ecoo, A->Pf, A->Sf, A->Nf, A->dampf};
-    const char *const key[5] = {"E", "P", "S", "N", "dampers"};
-    int k;
-    for (k = 0; k < 5; ++k)
-      if (v[k]) { fprintf(jf, ", \"%s\": ", key[k]); json_str(jf, v[k]); }
-  }
-  if (A->poly_idx) {
-    if (A->poly) { fprintf(jf, ", \"poly\": "); json_str(jf, A->poly); }
-    if (A->expf) { fprintf(jf, ", \"exp\": "); json_str(jf, A->expf); }
-    if (A->potential) { fprintf(jf, ", \"potential\": "); json_str(jf, A->potential); }
-    fprintf(jf, ", \"poly_idx\": "); json_str(jf, A->poly_idx);
-    if (A->poly_w) { fprintf(jf, ", \"poly_w\": "); json_str(jf, A->poly_w); }
-    if (A->poly_jdx) { fprintf(jf, ", \"poly_jdx\": "); json_str(jf, A->poly_jdx); }
-  }
+  json_system(jf, A, S);
   if (S->bal_on) {   /* balancing: no snapshots, its own info */
     fprintf(jf, "},\n  \"snapshots\": {\"count\": 0},\n  \"info\": ");
     json_balancing(jf, S, method);
@@ -4271,6 +4314,23 @@ static int write_model_files(const reduce_args *A, reduce_state *S, int method, 
   return write_json(A, S, method, ns, t_sim, t_red, o, info, ol);
 }
 
+/* After a state-space model is written as DIR/NAME: the model file and C
+   source of an earlier run under that name (rec: its record held arrays)
+   are removed -- never an input of this run, only regular files. */
+static void remove_stale_model(const char *dir, const char *name, const outlist *rec) {
+  static const char *const ext[2] = {"phgmgrom", "c"};
+  char path[4096 + 256];
+  struct stat st;
+  int k;
+  if (rec->n == 0) return;
+  for (k = 0; k < 2; ++k) {
+    snprintf(path, sizeof path, "%s/%s.%s", dir, name, ext[k]);
+    if (g_inputs && paths_find(g_inputs, path) >= 0) continue;
+    if (lstat(path, &st) == 0 && S_ISREG(st.st_mode) && remove(path) == 0)
+      progress("removed %s (of an earlier run's model under this name)", path);
+  }
+}
+
 /* Model k's outputs move into place; then the arrays an earlier run
    recorded under its name and this one did not write are removed. */
 static int commit_model(const reduce_args *A, reduce_state *S, sweep_model *M) {
@@ -4279,6 +4339,12 @@ static int commit_model(const reduce_args *A, reduce_state *S, sweep_model *M) {
   read_record(A->out, M->name, &rec); /* before this run's record replaces it */
   if (stage_commit(&M->sg)) return 1;
   remove_stale(A->out, &rec, &M->ol);
+  if (M->ss) {   /* no model file: an earlier run's NAME.phgmgrom and NAME.c are of another model */
+    remove_stale_model(A->out, M->name, &rec);
+    printf("wrote %s/%s.json and %d arrays %s/%s_*.npy (bt, state-space form A, B, C, D, r = %d, m = %d, N = %d)\n",
+           A->out, M->name, M->ol.n, A->out, M->name, M->rr, M->m, S->full.N);
+    return 0;
+  }
   if (S->dae) /* the arrays are full-size; the reduction ran on the differential states */
     snprintf(nfull, sizeof nfull, ", of which %d differential", S->sys.N);
   printf("wrote %s/%s.phgmgrom, %s/%s.c, %s/%s.json and %d arrays %s/%s_*.npy (%s, r = %d, m = %d, N = %d%s)\n",
@@ -4459,8 +4525,9 @@ static int explain_balancing(const reduce_args *A, const reduce_state *S, phgmg_
   switch (rc) {
     case PHGMG_ERR_STRUCTURE:
       return fail("reduction failed: the balanced truncation model of order %d is not passive, so it has no "
-                  "port-Hamiltonian form (K + K^T <= 0); use --method prbt or phbt (pH by construction), or "
-                  "another --r (H-infinity error bound %.3g)", A->r, b->lr.bound);
+                  "port-Hamiltonian form (K + K^T <= 0); use --form ss for it as a state-space model (A, B, C, "
+                  "D), --method prbt or phbt (pH by construction), or another --r (H-infinity error bound %.3g)",
+                  A->r, b->lr.bound);
     case PHGMG_ERR_RANK:
       return fail("reduction failed: --r %d exceeds the %d singular values computed (the Gramian factors "
                   "have ranks %d and %d): use a smaller --r", A->r, b->lr.nhsv, b->lr.ctrl.rank, b->lr.obs.rank);
@@ -4477,7 +4544,8 @@ static int explain_balancing(const reduce_args *A, const reduce_state *S, phgmg_
       if (S->sp && S->dae_direct && A->Ecoo)
         return fail("reduction failed: a port acts on an algebraic equation (a zero row of E, %s): through the "
                     "constraint it has a feedthrough D, which the port-Hamiltonian forms of --method bt, prbt "
-                    "and phbt do not carry; reduce with --method sp1 or sp2 (snapshots)", A->Ecoo);
+                    "and phbt do not carry; use --method bt --form ss for the state-space model with D, or "
+                    "--method sp1 or sp2 (snapshots)", A->Ecoo);
       if (S->method == PHGMG_METHOD_PHBT && !S->sp)
         return fail("reduction failed: --method phbt needs the sparse model (--J-coo, --R-coo, --Q-coo)");
       return fail("reduction failed: %s (dense BT and PRBT take standard-form models: give a mass matrix as "
@@ -4540,6 +4608,105 @@ static int run_balancing(const reduce_args *A, reduce_state *S, double *t_red) {
   return 0;
 }
 
+/* --method bt --form ss: phgmg_lrbt and phgmg_lrbt_feedthrough on the sparse
+   model into S->ss, with the progress lines of run_balancing. */
+static int run_ss_bt(const reduce_args *A, reduce_state *S, double *t_red) {
+  const phgmg_ph_system *sy = phgmg_ph_sparse_system(S->sp);
+  const int N = sy->N, m = sy->m, r = A->r;
+  ss_model *M = &S->ss;
+  phgmg_lradi_opts lo;
+  phase_log plog;
+  phgmg_result rc;
+  double t0;
+  memset(&lo, 0, sizeof lo);
+  lo.maxit = A->adi_maxit;
+  lo.solver = A->lyap;
+  M->A = (double *)malloc(sizeof(double) * (size_t)r * (size_t)r);
+  M->B = (double *)malloc(sizeof(double) * (size_t)r * (size_t)m);
+  M->C = (double *)malloc(sizeof(double) * (size_t)m * (size_t)r);
+  M->D = (double *)malloc(sizeof(double) * (size_t)m * (size_t)m);
+  M->hsv = (double *)malloc(sizeof(double) * (size_t)r);
+  M->T = (double *)malloc(sizeof(double) * (size_t)N * (size_t)r);
+  if (!M->A || !M->B || !M->C || !M->D || !M->hsv || !M->T) return fail("out of memory");
+  progress("reducing: bt, r = %d (low-rank, sparse), state-space form", r);
+  t0 = now_s();
+  plog.t0 = t0; plog.all = 0; plog.ncand = plog.nprobe = 0; plog.quiet = 0; plog.last = NULL;
+  if (!g_quiet) { lo.progress = reduce_phase; lo.progress_user = &plog; }
+  rc = phgmg_lrbt(S->sp, r, &lo, M->A, M->B, M->C, M->hsv, M->T, NULL, &M->inf, NULL);
+  if (rc == PHGMG_OK) rc = phgmg_lrbt_feedthrough(S->sp, M->D, NULL);
+  *t_red = now_s() - t0;
+  if (rc != PHGMG_OK) {   /* the messages of the pH form's failures (ranks, steps, residuals) */
+    S->bal.lr = M->inf;
+    return explain_balancing(A, S, rc);
+  }
+  progress("  done in %.2f s: Gramian factor ranks %d / %d, %s %d / %d, Lyapunov residuals %.2g / %.2g", *t_red,
+           M->inf.ctrl.rank, M->inf.obs.rank, M->inf.ctrl.solver == PHGMG_LYAP_EKSM ? "EKSM blocks" : "ADI steps",
+           M->inf.ctrl.iters, M->inf.obs.iters, M->inf.ctrl.res, M->inf.obs.res);
+  progress("  Hankel singular values: sigma_1 = %.6g, sigma_{r+1} = %.3g; H-infinity error bound 2 sum_{i>r} "
+           "sigma_i = %.3g%s", M->hsv[0], M->inf.hsv_tail, M->inf.bound,
+           M->inf.dmax > 0.0 ? "; feedthrough D (a port on a constraint)" : "");
+  return 0;
+}
+
+/* The json record of a state-space model (--form ss): the model's files, the
+   form, the solvers' ranks, steps and residuals, the values and the bound. */
+static int write_ss_json(const reduce_args *A, reduce_state *S, double t_red, const outlist *ol) {
+  const ss_model *M = &S->ss;
+  const phgmg_ph_system *sy = phgmg_ph_sparse_system(S->sp);
+  char path[4096 + 256];
+  const char *wp;
+  FILE *jf;
+  int i, nalg = 0, zc = 0;
+  snprintf(path, sizeof path, "%s/%s.json", A->out, A->name);
+  if (!(wp = stage_path(&S->sg, path))) return 1;
+  if (!(jf = fopen(wp, "w"))) return fail("%s: cannot write: %s", path, strerror(errno));
+  if (S->full.E) e_zero_lines(S, S->full.N, &nalg, &zc, NULL, NULL);
+  fprintf(jf, "{\n  \"phgmg_version\": \"%s\",\n  \"name\": ", PHGMG_VERSION_STRING);
+  json_str(jf, A->name);
+  fprintf(jf, ",\n  \"method\": \"bt\",\n  \"form\": \"ss\",\n  \"kind\": \"linear\",\n"
+              "  \"model\": \"xr' = A xr + B u, y = C xr + D u\",\n");
+  fprintf(jf, "  \"N\": %d, \"m\": %d, \"r\": %d,\n", sy->N, sy->m, A->r);
+  fprintf(jf, "  \"E\": %s, \"N_full\": %d, \"algebraic\": %d, \"feedthrough\": %s", S->full.E ? "true" : "false",
+          S->full.N, nalg, M->inf.dmax > 0.0 ? "true" : "false");
+  json_system(jf, A, S);
+  fprintf(jf, "},\n  \"info\": {\"solver\": \"low-rank\", \"lyapunov_solver\": \"%s\"",
+          M->inf.ctrl.solver == PHGMG_LYAP_EKSM ? "eksm" : "adi");
+  fprintf(jf, ", \"gramian_rank\": [%d, %d], \"adi_steps\": [%d, %d], \"factorizations\": [%d, %d]",
+          M->inf.ctrl.rank, M->inf.obs.rank, M->inf.ctrl.iters, M->inf.obs.iters, M->inf.ctrl.factorizations,
+          M->inf.obs.factorizations);
+  fprintf(jf, ", \"lyapunov_residual\": ["); json_num(jf, M->inf.ctrl.res);
+  fprintf(jf, ", "); json_num(jf, M->inf.obs.res);
+  fprintf(jf, "], \"values_computed\": %d, \"hankel_singular_values\": [", M->inf.nhsv);
+  for (i = 0; i < A->r; ++i) { if (i) fprintf(jf, ", "); json_num(jf, M->hsv[i]); }
+  fprintf(jf, "], \"hsv_next\": "); json_num(jf, M->inf.hsv_tail);
+  fprintf(jf, ", \"error_bound\": "); json_num(jf, M->inf.bound);
+  fprintf(jf, ", \"feedthrough_max\": "); json_num(jf, M->inf.dmax);
+  fprintf(jf, ", \"reduce_seconds\": "); json_num(jf, t_red);
+  fprintf(jf, "},\n  \"reconstruction\": \"x = V0 @ xr\",\n  \"files\": {\n    \"arrays\": {");
+  for (i = 0; i < ol->n; ++i)
+    fprintf(jf, "%s\n      \"%s\": [%d, %d]", i ? "," : "", ol->names[i], ol->rows[i], ol->cols[i]);
+  fprintf(jf, "\n    }\n  }\n}\n");
+  if (fclose(jf) != 0) return fail("%s: write error", path);
+  return 0;
+}
+
+/* --form ss's files: NAME_A, _B, _C, _D, the basis NAME_V0 (your ordering)
+   and NAME.json, under their temporary names. */
+static int write_ss_model(const reduce_args *A, reduce_state *S, double t_red) {
+  const ss_model *M = &S->ss;
+  const int r = A->r, m = phgmg_ph_sparse_system(S->sp)->m;
+  outlist *ol = &S->ol;
+  if (mkdir_p(A->out, &S->sg)) return 1;
+  memset(ol, 0, sizeof *ol);
+  if (write_field(A->out, A->name, "A", M->A, r, r, ol, &S->sg) ||
+      write_field(A->out, A->name, "B", M->B, r, m, ol, &S->sg) ||
+      write_field(A->out, A->name, "C", M->C, m, r, ol, &S->sg) ||
+      write_field(A->out, A->name, "D", M->D, m, m, ol, &S->sg) ||
+      write_user_field(A, S, "V0", M->T, r, ol))
+    return 1;
+  return write_ss_json(A, S, t_red, ol);
+}
+
 /* A sweep's shared bases: a study over the snapshots for the largest order
    asked (phgmg_study_create), so that each model's reduction works in the
    study's coordinates. A model class the study does not take (a mass
@@ -4591,6 +4758,13 @@ static int sweep_build_model(const reduce_args *A, reduce_state *S, int k, const
   sweep_set(&T, k, M->name, sizeof M->name);
   M->method = S->method = method_code(T.method);
   M->r = T.r;
+  if (T.form_ss) {   /* bt as a state-space model: no phgmg_reduced (check_form: one model) */
+    if ((e = run_ss_bt(&T, S, &M->t_red)) != 0 || (e = write_ss_model(&T, S, M->t_red)) != 0) return e;
+    M->rr = T.r; M->m = S->sys.m; M->pass = 1; M->ss = 1;
+    M->sg = S->sg; M->ol = S->ol;
+    memset(&S->sg, 0, sizeof S->sg);
+    return 0;
+  }
   if (is_balancing(S->method)) {   /* no snapshots */
     if ((e = run_balancing(&T, S, &M->t_red)) != 0) return e;
     if ((e = write_arrays(&T, S, NULL, 0, &S->ol)) != 0) return e;
