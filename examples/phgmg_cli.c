@@ -4860,6 +4860,7 @@ static void rom_feed_out(const phgmg_rom *rom, double t, cli_input *in, double *
 /* simulate-rom's options (0 / NULL: not given). */
 typedef struct simrom_args {
   const char *model, *out, *states, *inspec, *x0;   /* x0: --x0, the reduced initial state */
+  const char *ss;               /* --ss DIR/NAME: a state-space model (reduce --form ss) */
   double dt, amp, newton_tol;   /* newton_tol 0: the library's default */
   int steps, newton_iter, have_dt;
 } simrom_args;
@@ -4876,6 +4877,7 @@ static int parse_simulate_rom(int argc, char **argv, simrom_args *P) {
     if (!strcmp(o, "--help") || !strcmp(o, "-h")) { print_help(); return -1; }
     if (repeated_opt(o, seen, &nseen)) return 2;
     else if (!strcmp(o, "--model")) { if (!(P->model = optval(argc, argv, &i))) return 2; }
+    else if (!strcmp(o, "--ss")) { if (!(P->ss = optval(argc, argv, &i))) return 2; }
     else if (!strcmp(o, "--out")) { if (!(P->out = optval(argc, argv, &i))) return 2; }
     else if (!strcmp(o, "--states")) { if (!(P->states = optval(argc, argv, &i))) return 2; }
     else if (!strcmp(o, "--input")) { if (!(P->inspec = optval(argc, argv, &i))) return 2; }
@@ -4893,7 +4895,13 @@ static int parse_simulate_rom(int argc, char **argv, simrom_args *P) {
     else if (!strcmp(o, "--x0")) { if (!(P->x0 = optval(argc, argv, &i))) return 2; }
     else return usage_error("simulate-rom: unknown option '%s'", o);
   }
-  if (!P->model || !P->out) return usage_error("simulate-rom: --model FILE and --out FILE are required");
+  if (P->model && P->ss)
+    return usage_error("simulate-rom: give one model: --model FILE (port-Hamiltonian) or --ss DIR/NAME (state-space)");
+  if (P->ss && (!*P->ss || P->ss[strlen(P->ss) - 1] == '/'))
+    return usage_error("--ss '%s': expected DIR/NAME, the prefix of NAME_A.npy, NAME_B.npy, NAME_C.npy and "
+                       "NAME_D.npy", P->ss);
+  if (!(P->model || P->ss) || !P->out)
+    return usage_error("simulate-rom: --model FILE (or --ss DIR/NAME) and --out FILE are required");
   return 0;
 }
 
@@ -4931,6 +4939,215 @@ static int simrom_dt(const phgmg_rom *rom, int have_dt, double *dt) {
   return 0;
 }
 
+/* ---- simulate-rom --ss: a state-space model ------------------------------------- */
+/* The model xr' = A xr + B u, y = C xr + D u of reduce --form ss, read from
+   PREFIX_A.npy ... PREFIX_D.npy, and the 3-stage Gauss-Legendre step of it:
+   the stage equations (I - dt (a (x) A)) K = [A x + B u(t + c_i dt)]_i
+   factored once (LU of order 3 r), x <- x + dt sum_i b_i K_i. */
+typedef struct ss_sim {
+  mat A, B, C, D;
+  int r, m;
+  double *LU, *K, *x;   /* 3r x 3r factors, 3r stage values, r states */
+  int *piv;
+} ss_sim;
+
+static void ss_sim_free(ss_sim *M) {
+  mat_free(&M->A); mat_free(&M->B); mat_free(&M->C); mat_free(&M->D);
+  free(M->LU); free(M->K); free(M->x); free(M->piv);
+}
+
+/* The four arrays' paths (path[k], k = A, B, C, D) of --ss PREFIX. */
+static void ss_paths(const char *prefix, char path[4][4096 + 16]) {
+  static const char *const f[4] = {"A", "B", "C", "D"};
+  int k;
+  for (k = 0; k < 4; ++k) snprintf(path[k], sizeof path[k], "%s_%s.npy", prefix, f[k]);
+}
+
+/* Reads the four arrays and checks their shapes (A r x r, B r x m, C m x r,
+   D m x m). 0 or 1 after a message. */
+static int ss_load(ss_sim *M, char path[4][4096 + 16]) {
+  mat *a[4];
+  int k, r, m;
+  a[0] = &M->A; a[1] = &M->B; a[2] = &M->C; a[3] = &M->D;
+  for (k = 0; k < 4; ++k)
+    if (mat_load(a[k], "--ss", path[k])) return 1;
+  r = M->A.rows; m = M->B.cols;
+  if (M->A.cols != r || r < 1)
+    return fail("%s (--ss): A must be square (r x r), got %s", path[0], shape_str(&M->A));
+  if (M->B.rows != r || m < 1 || m > 64)
+    return fail("%s (--ss): B must be r x m (r = %d, 1 <= m <= 64), got %s", path[1], r, shape_str(&M->B));
+  if (M->C.rows != m || M->C.cols != r)
+    return fail("%s (--ss): C must be m x r = %d x %d, got %s", path[2], m, r, shape_str(&M->C));
+  if (M->D.rows != m || M->D.cols != m)
+    return fail("%s (--ss): D must be m x m = %d x %d, got %s", path[3], m, m, shape_str(&M->D));
+  M->r = r; M->m = m;
+  return 0;
+}
+
+/* The Gauss-Legendre stage matrix I - dt (a (x) A), factored. 0 or 1. */
+static int ss_gl3_setup(ss_sim *M, double dt, const char *prefix) {
+  const double s = sqrt(15.0);
+  const double a[3][3] = {{5.0 / 36, 2.0 / 9 - s / 15, 5.0 / 36 - s / 30},
+                          {5.0 / 36 + s / 24, 2.0 / 9, 5.0 / 36 - s / 24},
+                          {5.0 / 36 + s / 30, 2.0 / 9 + s / 15, 5.0 / 36}};
+  const int r = M->r, n = 3 * r;
+  int i, j, p, q;
+  M->LU = (double *)calloc((size_t)n * (size_t)n, sizeof(double));
+  M->K = (double *)malloc(sizeof(double) * (size_t)n);
+  M->x = (double *)calloc((size_t)r, sizeof(double));
+  M->piv = (int *)malloc(sizeof(int) * (size_t)n);
+  if (!M->LU || !M->K || !M->x || !M->piv) return fail("out of memory");
+  for (i = 0; i < 3; ++i)
+    for (j = 0; j < 3; ++j)
+      for (q = 0; q < r; ++q)
+        for (p = 0; p < r; ++p)
+          M->LU[(size_t)(i * r + p) + (size_t)(j * r + q) * n] = -dt * a[i][j] * M->A.a[p + (size_t)q * r];
+  for (p = 0; p < n; ++p) M->LU[(size_t)p + (size_t)p * n] += 1.0;
+  if (phgmg_lu_factor(n, M->LU, n, M->piv) != PHGMG_OK)
+    return fail("%s: the stage equations of dt = %g are singular (A has an eigenvalue 1 / (dt a) for a stage "
+                "weight a): try another --dt", prefix, dt);
+  return 0;
+}
+
+/* y = C x + D u. */
+static void ss_output(const ss_sim *M, const double *u, double *y) {
+  int a, k;
+  for (a = 0; a < M->m; ++a) {
+    double acc = 0.0;
+    for (k = 0; k < M->r; ++k) acc += M->C.a[a + (size_t)k * M->m] * M->x[k];
+    for (k = 0; k < M->m; ++k) acc += M->D.a[a + (size_t)k * M->m] * u[k];
+    y[a] = acc;
+  }
+}
+
+/* One step from t: the stage values K_i = A (x + dt sum_j a_ij K_j) + B u_i, then x. */
+static void ss_step(ss_sim *M, double t, double dt, cli_input *in) {
+  const double s15 = sqrt(15.0) / 10.0, cs[3] = {0.5 - s15, 0.5, 0.5 + s15};
+  const double b[3] = {5.0 / 18, 4.0 / 9, 5.0 / 18};
+  const int r = M->r, m = M->m;
+  double u[64];
+  int i, p, k;
+  for (i = 0; i < 3; ++i) {
+    input_fn(t + cs[i] * dt, u, in);
+    for (p = 0; p < r; ++p) {
+      double acc = 0.0;
+      for (k = 0; k < r; ++k) acc += M->A.a[p + (size_t)k * r] * M->x[k];
+      for (k = 0; k < m; ++k) acc += M->B.a[p + (size_t)k * r] * u[k];
+      M->K[i * r + p] = acc;
+    }
+  }
+  phgmg_lu_solve('N', 3 * r, M->LU, 3 * r, M->piv, 1, M->K, 3 * r);
+  for (p = 0; p < r; ++p) M->x[p] += dt * (b[0] * M->K[p] + b[1] * M->K[r + p] + b[2] * M->K[2 * r + p]);
+}
+
+/* --x0 for a state-space model: r values into M->x. 0 or 1. */
+static int ss_x0(ss_sim *M, const char *file) {
+  mat X;
+  int a;
+  if (mat_load(&X, "--x0", file)) return 1;
+  if (X.ndim == 0 || X.rows != M->r || X.cols != 1) {
+    fail("%s (--x0): expected the reduced initial state, shape (%d,) (r = %d values), got %s", file, M->r, M->r,
+         shape_str(&X));
+    mat_free(&X);
+    return 1;
+  }
+  for (a = 0; a < M->r; ++a) M->x[a] = X.a[a];
+  mat_free(&X);
+  return 0;
+}
+
+/* The run: steps of dt from x0 (rest or --x0), the outputs (and states) into Y (XR). */
+static void ss_run(ss_sim *M, const simrom_args *P, double dt, cli_input *in, double *Y, double *XR) {
+  double u[64], t0 = now_s(), wall_last = t0;
+  int n, a;
+  for (n = 0; n <= P->steps; ++n) {
+    if (n > 0) ss_step(M, (double)(n - 1) * dt, dt, in);
+    input_fn((double)n * dt, u, in);
+    ss_output(M, u, Y + (size_t)n * M->m);
+    if (XR) for (a = 0; a < M->r; ++a) XR[a + (size_t)n * M->r] = M->x[a];
+    if (!g_quiet && (n & 255) == 255 && now_s() - wall_last >= 2.0) {
+      wall_last = now_s();
+      progress("  ... step %d of %d (%.1f s)", n, P->steps, wall_last - t0);
+    }
+  }
+  progress("  done in %.3f s (one LU of order %d)", now_s() - t0, 3 * M->r);
+}
+
+/* simulate-rom --ss DIR/NAME: the state-space model stepped by the same
+   3-stage Gauss-Legendre method as the port-Hamiltonian models (at the same
+   input points), the outputs as theirs: y (m x (steps+1)), --states xr. */
+static int simulate_ss(const simrom_args *P) {
+  char path[4][4096 + 16];
+  pathset pin, pout;
+  staged sg;
+  cli_input in;
+  ss_sim M;
+  double dt = P->dt, *Y = NULL, *XR = NULL;
+  const char *wp;
+  int k, status = 1;
+  memset(&pin, 0, sizeof pin); memset(&pout, 0, sizeof pout); memset(&sg, 0, sizeof sg);
+  memset(&in, 0, sizeof in); memset(&M, 0, sizeof M);
+  ss_paths(P->ss, path);
+  for (k = 0; k < 4; ++k) paths_add(&pin, "--ss", path[k], 0);
+  paths_add_input(&pin, "--input", P->inspec);
+  if (P->x0) paths_add(&pin, "--x0", P->x0, 0);
+  paths_add(&pout, "--out", P->out, 1);
+  if (P->states) paths_add(&pout, "--states", P->states, 1);
+  if ((status = check_collisions("simulate-rom", &pin, &pout)) != 0) goto done;
+  status = 1;
+  if (check_out_file(P->out, "--out") || (P->states && check_out_file(P->states, "--states"))) goto done;
+  g_inputs = &pin;
+  if (ss_load(&M, path)) goto done;
+  if (!P->have_dt) {
+    dt = 0.1;
+    note("a state-space model records no step: stepping at dt = 0.1; give --dt");
+  }
+  if (P->newton_tol > 0.0 || P->newton_iter != 10)
+    note("--newton-tol and --newton-iter do not apply to a state-space model (linear: one LU, no Newton)");
+  if (too_big(((double)M.m + (P->states ? (double)M.r : 0.0)) * ((double)P->steps + 1.0),
+               "--steps: the outputs (m x (steps+1), states r x (steps+1))")) { status = 2; goto done; }
+  if ((status = input_setup(&in, "--input", P->inspec, P->amp, M.m, dt, P->steps * dt)) != 0) goto done;
+  input_covers(&in, P->inspec, "--input", P->steps * dt);
+  status = 1;
+  Y = (double *)malloc(sizeof(double) * (size_t)M.m * ((size_t)P->steps + 1));
+  if (P->states) XR = (double *)malloc(sizeof(double) * (size_t)M.r * ((size_t)P->steps + 1));
+  if (!Y || (P->states && !XR)) { fail("out of memory for %d steps", P->steps); goto done; }
+  if (ss_gl3_setup(&M, dt, P->ss) || (P->x0 && ss_x0(&M, P->x0))) goto done;
+  progress("simulating %s (state-space, r = %d, m = %d): %d steps of dt = %g, %s", P->ss, M.r, M.m, P->steps, dt,
+           input_desc(&in, P->inspec));
+  ss_run(&M, P, dt, &in, Y, XR);
+  /* both outputs or neither */
+  if (!(wp = stage_path(&sg, P->out)) || write_npy(P->out, wp, Y, M.m, P->steps + 1, 2)) goto done;
+  if (P->states && (!(wp = stage_path(&sg, P->states)) || write_npy(P->states, wp, XR, M.r, P->steps + 1, 2)))
+    goto done;
+  if (stage_commit(&sg)) goto done;
+  printf("wrote %s (%d x %d)%s%s\n", P->out, M.m, P->steps + 1, P->states ? " and " : "", P->states ? P->states : "");
+  status = 0;
+done:
+  stage_abort(&sg);
+  g_inputs = NULL;
+  paths_free(&pin); paths_free(&pout);
+  mat_free(&in.tab);
+  ss_sim_free(&M);
+  free(Y); free(XR);
+  return status;
+}
+
+/* --model DIR/NAME.phgmgrom that does not exist where DIR/NAME_A.npy does (a
+   model of reduce --form ss): the option to use instead. 0 or 1 after a message. */
+static int model_is_ss(const char *model) {
+  char pre[4096], a[4096 + 16];
+  const size_t l = strlen(model);
+  struct stat st;
+  if (l < 9 || l >= sizeof pre || strcmp(model + l - 9, ".phgmgrom") != 0 || stat(model, &st) == 0) return 0;
+  memcpy(pre, model, l - 9);
+  pre[l - 9] = '\0';
+  snprintf(a, sizeof a, "%s_A.npy", pre);
+  if (stat(a, &st) != 0) return 0;
+  return fail("%s (--model): no such file, but %s is there: a state-space model (reduce --form ss) has no model "
+              "file; run it with simulate-rom --ss %s", model, a, pre);
+}
+
 static int cmd_simulate_rom(int argc, char **argv) {
   simrom_args P;
   const char *model, *out, *states, *inspec;
@@ -4948,6 +5165,8 @@ static int cmd_simulate_rom(int argc, char **argv) {
   const char *wp;
   pathset pin, pout; /* the files read; the files written */
   if (status != 0) return status < 0 ? 0 : status;
+  if (P.ss) return simulate_ss(&P);
+  if (model_is_ss(P.model)) return 1;
   model = P.model; out = P.out; states = P.states; inspec = P.inspec;
   dt = P.dt; amp = P.amp; newton_tol = P.newton_tol;
   steps = P.steps; newton_iter = P.newton_iter; have_dt = P.have_dt;
