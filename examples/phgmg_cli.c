@@ -2787,6 +2787,9 @@ static const char *const all_fields[] = {"Bh", "Qh", "K", "G00", "G01", "G10", "
                                          "P0", "P1", "w", "poly", "expo", "Phi", "Gam", "SX", "SU", "PD", "V0", "V2",
                                          "M", "A", "B", "C", "D", "snapshots", "fom_y", NULL};
 
+/* 1 for the arrays of the state-space form (--form ss) among all_fields. */
+static int ss_field(const char *f) { return f[0] >= 'A' && f[0] <= 'D' && !f[1]; }
+
 /* The arrays an earlier run recorded as its own in DIR/NAME.json ("arrays":
    {"NAME_<field>.npy": [rows, cols], ...}), those of the form NAME_<field>.npy
    with a known field only, into rec. Nothing when there is no such record. */
@@ -4500,6 +4503,7 @@ static void reduce_paths(const reduce_args *A, reduce_state *S, const char *cons
     snprintf(path, sizeof path, "%s/%s.json", T.out, T.name); paths_add(&S->pout, "--out/--name", path, 1);
     for (k = 0; all_fields[k]; ++k) {
       if (!T.save_snap && (!strcmp(all_fields[k], "snapshots") || !strcmp(all_fields[k], "fom_y"))) continue;
+      if (!T.form_ss != !ss_field(all_fields[k]) && strcmp(all_fields[k], "V0")) continue;   /* the other form's */
       snprintf(path, sizeof path, "%s/%s_%s.npy", T.out, T.name, all_fields[k]);
       paths_add(&S->pout, "--out/--name", path, 1);
     }

@@ -49,7 +49,8 @@ an independent dense computation (NumPy/SciPy):
   validate; --form xy; an output that would overwrite an input (the file
   unchanged); simulate-rom --model of a state-space model (naming --ss),
   --model with --ss. One name reduced in both forms in turn: each run
-  removes the other form's files.
+  removes the other form's files; a pH run takes an input named like a
+  state-space array (NAME_B.npy).
 
 Usage: /usr/bin/python3 tests/check_lowrank_dae.py PHGMG_BINARY WORKDIR
 Exits 1 when a claim fails."""
@@ -373,6 +374,12 @@ rc3, _ = run("reduce", *coo_args(d), "--method", "bt", "--r", "10", "--out", d +
 left = sorted(os.listdir(d + "/two"))
 claim(rc3 == 0 and "m_A.npy" not in left and "m.phgmgrom" in left, "ss then ph: the state-space arrays removed (%s)" %
       left)
+# a pH run does not write NAME_B.npy: an input of that name is no collision there
+os.makedirs(d + "/phB", exist_ok=True)
+np.save(d + "/phB/q_B.npy", np.load(d + "/B.npy"))
+rc, err = run("reduce", *coo_args(d, d + "/phB/q_B.npy"), "--method", "bt", "--r", "10", "--out", d + "/phB",
+              "--name", "q")
+claim(rc == 0 and os.path.exists(d + "/phB/q_B.npy"), "pH run with an input named NAME_B.npy (%s)" % err.strip())
 
 if fails:
     print("check_lowrank_dae: %d claims failed" % len(fails))
