@@ -1528,12 +1528,16 @@
      phgmg reduce       J, R, Q, B (or sparse triplets) as .npy, snapshots
                         (--X) or --simulate, --method, --r, ... --out DIR:
                         writes NAME.phgmgrom, NAME.c, NAME.json and the
-                        reduced operators as NAME_*.npy;
+                        reduced operators as NAME_*.npy (--method bt --form
+                        ss: balanced truncation's state-space model,
+                        NAME_A, _B, _C, _D.npy and NAME.json, 2.8);
      phgmg simulate-rom run a model file on an input, outputs (and states) as
                         .npy; its default step is the model's dt (its step
                         map's, or the step reduce recorded as the training
                         step: --simulate's --dt, or --dt with --X), else 0.1,
-                        with a note when --dt differs from it;
+                        with a note when --dt differs from it; --ss DIR/NAME
+                        runs a state-space model by the same Gauss-Legendre
+                        steps;
      phgmg validate     reduce, then test full against reduced model on each
                         --test-input (exit 1 if one fails);
      phgmg info         describe a model file.
