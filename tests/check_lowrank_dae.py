@@ -48,7 +48,7 @@ an independent dense computation (NumPy/SciPy):
   prbt, a method list, a list of orders, a snapshot method, dense input,
   validate; --form xy; an output that would overwrite an input (the file
   unchanged); simulate-rom --model of a state-space model (naming --ss),
-  --model with --ss. One name reduced in both forms in turn: each run
+  --model with --ss, --out onto the model's arrays, a B of the wrong shape. One name reduced in both forms in turn: each run
   removes the other form's files; a pH run takes an input named like a
   state-space array (NAME_B.npy).
 
@@ -362,6 +362,14 @@ claim(rc == 1 and "--ss " + d + "/ss/ss" in err, "simulate-rom --model of a stat
       err.strip())
 rc, err = run("simulate-rom", "--model", d + "/ss/ss.phgmgrom", "--ss", d + "/ss/ss", "--out", d + "/y.npy")
 claim(rc == 2, "simulate-rom --model with --ss refused (%s)" % err.strip())
+rc, err = run("simulate-rom", "--ss", d + "/ss/ss", "--out", d + "/ss/ss_A.npy")
+claim(rc == 2 and "never overwrites" in err, "simulate-rom --ss: --out onto the model's A refused (%s)" % err.strip())
+os.makedirs(d + "/bad", exist_ok=True)
+for f, g in (("A", "A"), ("B", "C"), ("C", "C"), ("D", "D")):   # B of C's shape (m x r)
+    np.save(d + "/bad/m_%s.npy" % f, np.load(d + "/ss/ss_%s.npy" % g))
+rc, err = run("simulate-rom", "--ss", d + "/bad/m", "--out", d + "/bad/y.npy")
+claim(rc == 1 and "B must be r x m" in err and not os.path.exists(d + "/bad/y.npy"),
+      "simulate-rom --ss: a B of the wrong shape refused (%s)" % err.strip())
 
 # one name, two forms: each run removes the other form's files of that name
 d = os.path.join(work, "rlc")
