@@ -1073,6 +1073,9 @@
    constraints) is solved on the whole sparse pencil, the Gramians being
    those of the condensed model, never formed; a port on a constraint
    gives the reduced model a feedthrough D (phgmg_lrbt_feedthrough): 8.14.
+   The command line writes this state-space model as it is with reduce
+   --method bt --form ss (NAME_A, _B, _C, _D.npy; the values and the bound
+   in NAME.json), passive or not, and simulate-rom --ss runs it.
    Not yet: feedthrough of the model itself (P, S, N), nonlinear parts.
    Algorithms and measured times: 8.13.
 
@@ -1547,12 +1550,16 @@
      phgmg reduce       J, R, Q, B (or sparse triplets) as .npy, snapshots
                         (--X) or --simulate, --method, --r, ... --out DIR:
                         writes NAME.phgmgrom, NAME.c, NAME.json and the
-                        reduced operators as NAME_*.npy;
+                        reduced operators as NAME_*.npy (--method bt --form
+                        ss: balanced truncation's state-space model,
+                        NAME_A, _B, _C, _D.npy and NAME.json, 2.8);
      phgmg simulate-rom run a model file on an input, outputs (and states) as
                         .npy; its default step is the model's dt (its step
                         map's, or the step reduce recorded as the training
                         step: --simulate's --dt, or --dt with --X), else 0.1,
-                        with a note when --dt differs from it;
+                        with a note when --dt differs from it; --ss DIR/NAME
+                        runs a state-space model by the same Gauss-Legendre
+                        steps;
      phgmg validate     reduce, then test full against reduced model on each
                         --test-input (exit 1 if one fails);
      phgmg info         describe a model file.
@@ -2503,8 +2510,9 @@
    stage, the energy Galerkin projection onto the consistent factor, is
    that of the condensed model because L Q V has zero algebraic rows); a
    port on an algebraic row is PHGMG_ERR_UNSUPPORTED there (a pH form with
-   feedthrough is not built: use phgmg_lrbt and phgmg_lrbt_feedthrough, or
-   SP1/SP2 on the condensed model, 1.8).
+   feedthrough is not built: use phgmg_lrbt and phgmg_lrbt_feedthrough --
+   the command line's reduce --method bt --form ss -- or SP1/SP2 on the
+   condensed model, 1.8).
    Checked (tests/check_lowrank_dae.py, against NumPy/SciPy: dense
    condensation, scipy.linalg.solve_continuous_lyapunov, the singular
    values of Lo^T Lp): an 8 x 8 RLC grid (bench/rlc_grid.py, N = 288, 144
@@ -2516,7 +2524,12 @@
    refused naming the feedthrough; the acoustic model of bench/fe_mesh.py
    (P1, consistent mass, N = 243): its BT models (as those of SciPy's
    dense BT: min eig(G_r + G_r^H) = -0.05 at r = 10) are not passive, so
-   reduce refuses their pH form, with the bound of SciPy's values.
+   reduce refuses their pH form, with the bound of SciPy's values. With
+   --form ss (the state-space model, D included) both models are written:
+   the first 10 Hankel values within 1e-8 sigma_1 of SciPy's, D equal to
+   the closed form -C_c A_ac^{-1} B_a, the sampled error within the bound
+   (without D, for the grid with the port on a constraint, above it), and
+   simulate-rom --ss within 1e-6 of the exact response of A, B, C, D.
    tests/test_lowrank.c: a 4 x 4 lattice with three massless nodes, one of
    them a port: phgmg_lrbt_feedthrough equal to the closed form, the
    descriptor model's transfer function through the whole pencil within

@@ -49,11 +49,13 @@ static const char *const help_lines[] = {
   "               [--poly coeffs.npy --poly-idx idx.npy [--poly-w w.npy]] [DEIM options]\n",
   "               --out DIR [--name rom] [--dt-map DT] [--save-snapshots] [--quiet]\n",
   "  phgmg reduce <the model options> --method bt|prbt|phbt --r R --out DIR [--name rom]\n",
-  "               (balancing of a linear model: no snapshots; see BALANCING METHODS)\n",
+  "               [--form ph|ss]  (balancing of a linear model: no snapshots; see\n",
+  "               BALANCING METHODS)\n",
   "  phgmg simulate <the model options of reduce> --out y.npy [--states x.npy]\n",
   "               [--dt 0.1] [--steps 1000] [--input sin] [--amp 0.1] [--quiet]\n",
-  "  phgmg simulate-rom --model DIR/NAME.phgmgrom --out y.npy [--states xr.npy]\n",
-  "               [--dt DT] [--steps 1000] [--input sin] [--amp 0.1] [--quiet]\n",
+  "  phgmg simulate-rom --model DIR/NAME.phgmgrom | --ss DIR/NAME --out y.npy\n",
+  "               [--states xr.npy] [--dt DT] [--steps 1000] [--input sin] [--amp 0.1]\n",
+  "               [--quiet]\n",
   "  phgmg info MODEL.phgmgrom\n",
   "  phgmg validate <the options of reduce> [--test-input KIND]... [--test-amp A]\n",
   "               [--test-steps N] [--max-ey E]   (reduce, then run full and reduced\n",
@@ -111,7 +113,8 @@ static const char *const help_lines[] = {
   "                      bt, prbt, phbt on --E-coo with algebraic lines: no\n",
   "                      condensation, the Gramians' solves use the whole sparse\n",
   "                      pencil; a port on a constraint is refused there (its\n",
-  "                      feedthrough is not carried by their pH forms).\n",
+  "                      feedthrough is not carried by their pH forms; bt --form ss\n",
+  "                      writes the model with it).\n",
   "  --P FILE, --S FILE, --N FILE   feedthrough (N x m, m x m, m x m; each optional):\n",
   "                      E x' = (J - R) z + (B - P) u, y = (B + P)^T z + (S + N) u, with\n",
   "                      [[R, P], [P^T, S]] symmetric positive semidefinite and N skew.\n",
@@ -373,7 +376,14 @@ static const char *const help_lines[] = {
   "  Runs a reduced model from rest (the full state 0: xr = 0, or the model's\n",
   "  xr_rest = rho(0) when it has a reference state, see --ref) with the online GL3\n",
   "  stepper and writes its output y, an m x (steps+1) matrix (column n = y(n*DT)).\n",
-  "  --model FILE        a .phgmgrom file written by reduce (required)\n",
+  "  --model FILE        a .phgmgrom file written by reduce (required, or --ss)\n",
+  "  --ss DIR/NAME       instead of --model: the state-space model of reduce --method\n",
+  "                      bt --form ss (DIR/NAME_A.npy, _B, _C, _D), stepped by the\n",
+  "                      same 3-stage Gauss-Legendre method at the same input points\n",
+  "                      (linear: one LU of order 3 r, no Newton), from xr = 0 or\n",
+  "                      --x0; y = C xr + D u, in double (also in the float build).\n",
+  "                      Default --dt 0.1 (the model records no step: a note says\n",
+  "                      so). The outputs as for --model.\n",
   "  --out FILE          output .npy (required)\n",
   "  --states FILE       also write the reduced states (r x (steps+1)); written together\n",
   "                      with --out: both or neither\n",
@@ -429,7 +439,8 @@ static const char *const help_lines[] = {
   "  those of the condensed model, which is never formed (the algebraic lines\n",
   "  are not condensed in a run of balancing methods alone); all ports must act\n",
   "  on differential rows (a port on a constraint has a feedthrough, which the\n",
-  "  pH forms written here do not carry: the run fails and says so; use sp1/sp2).\n",
+  "  pH forms written here do not carry: the run fails and says so; use bt with\n",
+  "  --form ss, or sp1/sp2).\n",
   "  Lightly damped models (wave equations, eigenvalues close to the imaginary\n",
   "  axis) need many ADI steps (Gramian ranks of hundreds to thousands): raise\n",
   "  --adi-maxit when the log reports no convergence.\n",
@@ -449,7 +460,8 @@ static const char *const help_lines[] = {
   "          NAME_Qh, NAME_Bh: K Qh, Bh, Bh^T Qh are the BT model's matrices, Qh a\n",
   "          solution of its positive-real lemma): that needs the BT model to be\n",
   "          passive; when it is not (it can happen near w = 0 for models whose\n",
-  "          transfer function vanishes there) the run fails and says so: use\n",
+  "          transfer function vanishes there; finite-element models with a\n",
+  "          consistent mass matrix) the run fails and says so: use --form ss,\n",
   "          prbt or phbt, or another R.\n",
   "    prbt  positive-real balanced truncation (needs m < R): a passive pH\n",
   "          reduced model by construction. Sparse input: two stages, stated in\n",
@@ -462,6 +474,23 @@ static const char *const help_lines[] = {
   "          the energy Q where none exists: a port without damping), in two\n",
   "          stages like prbt. pH by construction, no error bound; about as\n",
   "          accurate as prbt, less than bt.\n",
+  "  --form ph|ss        the form of the reduced model. ph (the default): a pH\n",
+  "                      model, the usual files. ss (--method bt only, sparse input\n",
+  "                      --J-coo ..., one --r): balanced truncation's model as it is,\n",
+  "                      xr' = A xr + B u, y = C xr + D u (Er = I), written as\n",
+  "                      NAME_A.npy (r x r), NAME_B.npy (r x m), NAME_C.npy (m x r),\n",
+  "                      NAME_D.npy (m x m: zero, or the feedthrough of ports on\n",
+  "                      constraints), NAME_V0.npy (N x r: the balancing basis, x ~\n",
+  "                      V0 xr; with a port on a constraint the algebraic variables\n",
+  "                      also depend on u) and NAME.json (\"form\": \"ss\"; \"info\": the\n",
+  "                      Gramian ranks, ADI steps, Lyapunov residuals, the first R\n",
+  "                      Hankel singular values, \"hsv_next\" sigma_{R+1},\n",
+  "                      \"error_bound\" 2 sum_{i>R} sigma_i over the values computed,\n",
+  "                      \"feedthrough_max\" max |D|). It exists whether or not the\n",
+  "                      model is passive, and the bound holds for it with D.\n",
+  "                      No model file or C source (an earlier run's NAME.phgmgrom\n",
+  "                      and NAME.c are removed); simulate-rom --ss DIR/NAME runs it.\n",
+  "                      validate does not take it.\n",
   "  NAME.json's \"info\" holds the solver (low-rank or dense), the Gramian\n",
   "  factors' ranks, ADI steps and factorizations, the Lyapunov residuals\n",
   "  (relative), the singular values (first 64) and, for bt, \"error_bound\". The\n",
@@ -1504,6 +1533,8 @@ typedef struct reduce_args {
   int greedy_window;            /* --greedy-window W (0: the library's default) */
   int adi_maxit;                /* --adi-maxit K: low-rank ADI steps (0: the library's default) */
   int lyap;                     /* --lyap adi (PHGMG_LYAP_ADI) | eksm (PHGMG_LYAP_EKSM)        */
+  const char *form_s;           /* --form ph | ss as given (NULL: not given)                    */
+  int form_ss;                  /* --form ss: bt's reduced model as state-space arrays A, B, C, D */
   const char *train[16];        /* --train-input KIND, repeatable */
   int ntrain;
   const char *xs[16];           /* --X FILE, repeatable: one run each (X = xs[0]) */
@@ -1842,6 +1873,11 @@ static int parse_reduce(int argc, char **argv, reduce_args *A) {
       if (!strcmp(v, "adi")) A->lyap = PHGMG_LYAP_ADI;
       else if (!strcmp(v, "eksm")) A->lyap = PHGMG_LYAP_EKSM;
       else return usage_error("--lyap: expected adi or eksm, got '%s'", v);
+    } else if (!strcmp(o, "--form")) {
+      if (!(v = optval(argc, argv, &i))) return 2;
+      if (strcmp(v, "ph") && strcmp(v, "ss")) return usage_error("--form: expected ph or ss, got '%s'", v);
+      A->form_s = v;
+      A->form_ss = !strcmp(v, "ss");
     } else if (!strcmp(o, "--greedy-window")) {
       if (!(v = optval(argc, argv, &i)) || !parse_int(o, v, 1, 100000, &A->greedy_window)) return 2;
     }
@@ -1960,6 +1996,24 @@ static int mixes_balancing(const reduce_args *A) {
   return nb > 0 && nb < A->nml;
 }
 
+/* --form ss: balanced truncation's model as state-space arrays, which only
+   the low-rank BT of one sparse model to one order gives (reduce only). 0 or
+   the usage status 2. */
+static int check_form(const reduce_args *A) {
+  if (!A->form_ss) return 0;
+  if (A->nml != 1 || A->mlist[0] != PHGMG_METHOD_BT)
+    return usage_error("--form ss: the state-space model is balanced truncation's: give --method bt (not '%s'); "
+                       "the other methods give port-Hamiltonian models (--form ph)", A->method);
+  if (g_validating)
+    return usage_error("validate: --form ss is not taken (validate runs port-Hamiltonian models); reduce with "
+                       "--form ss, then run the model with simulate-rom --ss DIR/NAME");
+  if (A->nrl != 1) return usage_error("--form ss: one order per run (--r R, not a list)");
+  if (!A->Jcoo)
+    return usage_error("--form ss: the state-space model comes from the low-rank BT of a sparse model: give J, R, "
+                       "Q (and E) as --J-coo, --R-coo, --Q-coo (--E-coo)");
+  return 0;
+}
+
 static int check_reduce_args(reduce_args *A, const char *const *seen, int nseen) {
   int e;
   if ((e = check_model_opts("reduce", A)) != 0) return e;
@@ -1969,6 +2023,7 @@ static int check_reduce_args(reduce_args *A, const char *const *seen, int nseen)
   if (mixes_balancing(A))
     return usage_error("--method '%s': the balancing methods (bt, prbt, phbt: no snapshots) and the snapshot "
                        "methods cannot be mixed in one run; give them in two runs", A->method);
+  if ((e = check_form(A)) != 0) return e;
   A->method = method_name(A->mlist[0]);
   if (!A->out) return usage_error("reduce: --out DIR is required");
   if (name_problem(A->name)) return usage_error("--name '%s': %s", A->name, name_problem(A->name));
@@ -2522,11 +2577,20 @@ typedef struct sweep_model {
   outlist ol;            /* its arrays */
   char name[64];
   int method, r, rr, m, pass;
+  int ss;                /* written in state-space form (--form ss) */
   double t_red;
   double ey[16], ered[16];   /* validate: each test's e_y, e_red */
   int tpass[16];
   phgmg_reduced *red;    /* kept by validate for its tests */
 } sweep_model;
+
+/* --form ss: balanced truncation's reduced model x_r' = A x_r + B u, y = C x_r
+   + D u (phgmg_lrbt, phgmg_lrbt_feedthrough), its first r Hankel singular
+   values and its basis T (N x r, the sparse object's internal order). */
+typedef struct ss_model {
+  double *A, *B, *C, *D, *hsv, *T;
+  phgmg_lrbt_info inf;
+} ss_model;
 
 typedef struct reduce_state {
   mat J, R, B, Q, X, poly, pidx, pw, ex, pjdx;
@@ -2573,6 +2637,7 @@ typedef struct reduce_state {
   phgmg_balanced_info bal;
   double bal_sv[64];        /* its first values (bal.nsv) */
   phgmg_balanced_cache bcache; /* the Gramian factors, shared by a sweep's balancing models */
+  ss_model ss;              /* --form ss: the state-space BT model */
 } reduce_state;
 
 /* Is w phi(s), phi(s) = sum_j c_j s^j + sum_e a_e exp(b_e s), bounded below
@@ -2693,6 +2758,7 @@ static int load_family(const reduce_args *A, reduce_state *S, phgmg_ph_system *s
 
 static void reduce_cleanup(reduce_state *S) {
   phgmg_balanced_cache_free(&S->bcache, NULL);
+  free(S->ss.A); free(S->ss.B); free(S->ss.C); free(S->ss.D); free(S->ss.hsv); free(S->ss.T);
   mat_free(&S->J); mat_free(&S->R); mat_free(&S->B); mat_free(&S->Q); mat_free(&S->E); mat_free(&S->Pm); mat_free(&S->Sm); mat_free(&S->Nm); mat_free(&S->Dm); mat_free(&S->refm);
   free(S->di); free(S->dj); free(S->dlaw); mat_free(&S->X);
   mat_free(&S->poly); mat_free(&S->pidx); mat_free(&S->pjdx); mat_free(&S->pw); mat_free(&S->ex); mat_free(&S->in.tab);
@@ -2719,7 +2785,10 @@ static void reduce_cleanup(reduce_state *S) {
 /* The fields NAME_<field>.npy a run may write. */
 static const char *const all_fields[] = {"Bh", "Qh", "K", "G00", "G01", "G10", "G11", "Q01", "Q11", "Ms",
                                          "P0", "P1", "w", "poly", "expo", "Phi", "Gam", "SX", "SU", "PD", "V0", "V2",
-                                         "M", "snapshots", "fom_y", NULL};
+                                         "M", "A", "B", "C", "D", "snapshots", "fom_y", NULL};
+
+/* 1 for the arrays of the state-space form (--form ss) among all_fields. */
+static int ss_field(const char *f) { return f[0] >= 'A' && f[0] <= 'D' && !f[1]; }
 
 /* The arrays an earlier run recorded as its own in DIR/NAME.json ("arrays":
    {"NAME_<field>.npy": [rows, cols], ...}), those of the form NAME_<field>.npy
@@ -4147,6 +4216,30 @@ static void json_balancing(FILE *jf, const reduce_state *S, int method) {
   }
 }
 
+/* The json record's "system" object, opened and not closed: the files of the
+   model as given (a model rebuilt from the record is this model). */
+static void json_system(FILE *jf, const reduce_args *A, const reduce_state *S) {
+  fprintf(jf, ",\n  \"system\": {\"J\": ");
+  json_str(jf, A->J ? A->J : A->Jcoo); fprintf(jf, ", \"R\": "); json_str(jf, A->R ? A->R : A->Rcoo);
+  fprintf(jf, ", \"B\": "); json_str(jf, A->B); fprintf(jf, ", \"Q\": "); json_str(jf, A->Q ? A->Q : A->Qcoo);
+  if (S->sp) fprintf(jf, ", \"sparse\": true, \"kb\": %d", S->sys.kb);
+  { /* the descriptor, feedthrough and damper files: a model rebuilt from this record is this model */
+    const char *const v[5] = {A->E ? A->E : A->Ecoo, A->Pf, A->Sf, A->Nf, A->dampf};
+    const char *const key[5] = {"E", "P", "S", "N", "dampers"};
+    int k;
+    for (k = 0; k < 5; ++k)
+      if (v[k]) { fprintf(jf, ", \"%s\": ", key[k]); json_str(jf, v[k]); }
+  }
+  if (A->poly_idx) {
+    if (A->poly) { fprintf(jf, ", \"poly\": "); json_str(jf, A->poly); }
+    if (A->expf) { fprintf(jf, ", \"exp\": "); json_str(jf, A->expf); }
+    if (A->potential) { fprintf(jf, ", \"potential\": "); json_str(jf, A->potential); }
+    fprintf(jf, ", \"poly_idx\": "); json_str(jf, A->poly_idx);
+    if (A->poly_w) { fprintf(jf, ", \"poly_w\": "); json_str(jf, A->poly_w); }
+    if (A->poly_jdx) { fprintf(jf, ", \"poly_jdx\": "); json_str(jf, A->poly_jdx); }
+  }
+}
+
 static int write_json_tail(FILE *jf, const reduce_args *A, reduce_state *S, const outlist *ol, const char *path);
 static int write_json(const reduce_args *A, reduce_state *S, int method, int ns, double t_sim, double t_red,
                       const phgmg_reduce_opts *o, const phgmg_reduce_info *info, const outlist *ol) {
@@ -4177,25 +4270,7 @@ static int write_json(const reduce_args *A, reduce_state *S, int method, int ns,
   fprintf(jf, "  \"dt_map\": ");
   if (rom->Phi) { char buf[32]; fputs(isfinite((double)rom->dt) ? real_str(rom->dt, buf) : "null", jf); }   /* float: "0.1" */
   else fputs("0", jf);
-  fprintf(jf, ",\n  \"system\": {\"J\": ");
-  json_str(jf, A->J ? A->J : A->Jcoo); fprintf(jf, ", \"R\": "); json_str(jf, A->R ? A->R : A->Rcoo);
-  fprintf(jf, ", \"B\": "); json_str(jf, A->B); fprintf(jf, ", \"Q\": "); json_str(jf, A->Q ? A->Q : A->Qcoo);
-  if (S->sp) fprintf(jf, ", \"sparse\": true, \"kb\": %d", S->sys.kb);
-  { /* the descriptor, feedthrough and damper files: a model rebuilt from this record is this model */
-    const char *const v[5] = {A->E ? A->E : A->Ecoo, A->Pf, A->Sf, A->Nf, A->dampf};
-    const char *const key[5] = {"E", "P", "S", "N", "dampers"};
-    int k;
-    for (k = 0; k < 5; ++k)
-      if (v[k]) { fprintf(jf, ", \"%s\": ", key[k]); json_str(jf, v[k]); }
-  }
-  if (A->poly_idx) {
-    if (A->poly) { fprintf(jf, ", \"poly\": "); json_str(jf, A->poly); }
-    if (A->expf) { fprintf(jf, ", \"exp\": "); json_str(jf, A->expf); }
-    if (A->potential) { fprintf(jf, ", \"potential\": "); json_str(jf, A->potential); }
-    fprintf(jf, ", \"poly_idx\": "); json_str(jf, A->poly_idx);
-    if (A->poly_w) { fprintf(jf, ", \"poly_w\": "); json_str(jf, A->poly_w); }
-    if (A->poly_jdx) { fprintf(jf, ", \"poly_jdx\": "); json_str(jf, A->poly_jdx); }
-  }
+  json_system(jf, A, S);
   if (S->bal_on) {   /* balancing: no snapshots, its own info */
     fprintf(jf, "},\n  \"snapshots\": {\"count\": 0},\n  \"info\": ");
     json_balancing(jf, S, method);
@@ -4271,6 +4346,23 @@ static int write_model_files(const reduce_args *A, reduce_state *S, int method, 
   return write_json(A, S, method, ns, t_sim, t_red, o, info, ol);
 }
 
+/* After a state-space model is written as DIR/NAME: the model file and C
+   source of an earlier run under that name (rec: its record held arrays)
+   are removed -- never an input of this run, only regular files. */
+static void remove_stale_model(const char *dir, const char *name, const outlist *rec) {
+  static const char *const ext[2] = {"phgmgrom", "c"};
+  char path[4096 + 256];
+  struct stat st;
+  int k;
+  if (rec->n == 0) return;
+  for (k = 0; k < 2; ++k) {
+    snprintf(path, sizeof path, "%s/%s.%s", dir, name, ext[k]);
+    if (g_inputs && paths_find(g_inputs, path) >= 0) continue;
+    if (lstat(path, &st) == 0 && S_ISREG(st.st_mode) && remove(path) == 0)
+      progress("removed %s (of an earlier run's model under this name)", path);
+  }
+}
+
 /* Model k's outputs move into place; then the arrays an earlier run
    recorded under its name and this one did not write are removed. */
 static int commit_model(const reduce_args *A, reduce_state *S, sweep_model *M) {
@@ -4279,6 +4371,12 @@ static int commit_model(const reduce_args *A, reduce_state *S, sweep_model *M) {
   read_record(A->out, M->name, &rec); /* before this run's record replaces it */
   if (stage_commit(&M->sg)) return 1;
   remove_stale(A->out, &rec, &M->ol);
+  if (M->ss) {   /* no model file: an earlier run's NAME.phgmgrom and NAME.c are of another model */
+    remove_stale_model(A->out, M->name, &rec);
+    printf("wrote %s/%s.json and %d arrays %s/%s_*.npy (bt, state-space form A, B, C, D, r = %d, m = %d, N = %d)\n",
+           A->out, M->name, M->ol.n, A->out, M->name, M->rr, M->m, S->full.N);
+    return 0;
+  }
   if (S->dae) /* the arrays are full-size; the reduction ran on the differential states */
     snprintf(nfull, sizeof nfull, ", of which %d differential", S->sys.N);
   printf("wrote %s/%s.phgmgrom, %s/%s.c, %s/%s.json and %d arrays %s/%s_*.npy (%s, r = %d, m = %d, N = %d%s)\n",
@@ -4405,6 +4503,7 @@ static void reduce_paths(const reduce_args *A, reduce_state *S, const char *cons
     snprintf(path, sizeof path, "%s/%s.json", T.out, T.name); paths_add(&S->pout, "--out/--name", path, 1);
     for (k = 0; all_fields[k]; ++k) {
       if (!T.save_snap && (!strcmp(all_fields[k], "snapshots") || !strcmp(all_fields[k], "fom_y"))) continue;
+      if (!T.form_ss != !ss_field(all_fields[k]) && strcmp(all_fields[k], "V0")) continue;   /* the other form's */
       snprintf(path, sizeof path, "%s/%s_%s.npy", T.out, T.name, all_fields[k]);
       paths_add(&S->pout, "--out/--name", path, 1);
     }
@@ -4459,8 +4558,9 @@ static int explain_balancing(const reduce_args *A, const reduce_state *S, phgmg_
   switch (rc) {
     case PHGMG_ERR_STRUCTURE:
       return fail("reduction failed: the balanced truncation model of order %d is not passive, so it has no "
-                  "port-Hamiltonian form (K + K^T <= 0); use --method prbt or phbt (pH by construction), or "
-                  "another --r (H-infinity error bound %.3g)", A->r, b->lr.bound);
+                  "port-Hamiltonian form (K + K^T <= 0); use --form ss for it as a state-space model (A, B, C, "
+                  "D), --method prbt or phbt (pH by construction), or another --r (H-infinity error bound %.3g)",
+                  A->r, b->lr.bound);
     case PHGMG_ERR_RANK:
       return fail("reduction failed: --r %d exceeds the %d singular values computed (the Gramian factors "
                   "have ranks %d and %d): use a smaller --r", A->r, b->lr.nhsv, b->lr.ctrl.rank, b->lr.obs.rank);
@@ -4477,7 +4577,8 @@ static int explain_balancing(const reduce_args *A, const reduce_state *S, phgmg_
       if (S->sp && S->dae_direct && A->Ecoo)
         return fail("reduction failed: a port acts on an algebraic equation (a zero row of E, %s): through the "
                     "constraint it has a feedthrough D, which the port-Hamiltonian forms of --method bt, prbt "
-                    "and phbt do not carry; reduce with --method sp1 or sp2 (snapshots)", A->Ecoo);
+                    "and phbt do not carry; use --method bt --form ss for the state-space model with D, or "
+                    "--method sp1 or sp2 (snapshots)", A->Ecoo);
       if (S->method == PHGMG_METHOD_PHBT && !S->sp)
         return fail("reduction failed: --method phbt needs the sparse model (--J-coo, --R-coo, --Q-coo)");
       return fail("reduction failed: %s (dense BT and PRBT take standard-form models: give a mass matrix as "
@@ -4540,6 +4641,105 @@ static int run_balancing(const reduce_args *A, reduce_state *S, double *t_red) {
   return 0;
 }
 
+/* --method bt --form ss: phgmg_lrbt and phgmg_lrbt_feedthrough on the sparse
+   model into S->ss, with the progress lines of run_balancing. */
+static int run_ss_bt(const reduce_args *A, reduce_state *S, double *t_red) {
+  const phgmg_ph_system *sy = phgmg_ph_sparse_system(S->sp);
+  const int N = sy->N, m = sy->m, r = A->r;
+  ss_model *M = &S->ss;
+  phgmg_lradi_opts lo;
+  phase_log plog;
+  phgmg_result rc;
+  double t0;
+  memset(&lo, 0, sizeof lo);
+  lo.maxit = A->adi_maxit;
+  lo.solver = A->lyap;
+  M->A = (double *)malloc(sizeof(double) * (size_t)r * (size_t)r);
+  M->B = (double *)malloc(sizeof(double) * (size_t)r * (size_t)m);
+  M->C = (double *)malloc(sizeof(double) * (size_t)m * (size_t)r);
+  M->D = (double *)malloc(sizeof(double) * (size_t)m * (size_t)m);
+  M->hsv = (double *)malloc(sizeof(double) * (size_t)r);
+  M->T = (double *)malloc(sizeof(double) * (size_t)N * (size_t)r);
+  if (!M->A || !M->B || !M->C || !M->D || !M->hsv || !M->T) return fail("out of memory");
+  progress("reducing: bt, r = %d (low-rank, sparse), state-space form", r);
+  t0 = now_s();
+  plog.t0 = t0; plog.all = 0; plog.ncand = plog.nprobe = 0; plog.quiet = 0; plog.last = NULL;
+  if (!g_quiet) { lo.progress = reduce_phase; lo.progress_user = &plog; }
+  rc = phgmg_lrbt(S->sp, r, &lo, M->A, M->B, M->C, M->hsv, M->T, NULL, &M->inf, NULL);
+  if (rc == PHGMG_OK) rc = phgmg_lrbt_feedthrough(S->sp, M->D, NULL);
+  *t_red = now_s() - t0;
+  if (rc != PHGMG_OK) {   /* the messages of the pH form's failures (ranks, steps, residuals) */
+    S->bal.lr = M->inf;
+    return explain_balancing(A, S, rc);
+  }
+  progress("  done in %.2f s: Gramian factor ranks %d / %d, %s %d / %d, Lyapunov residuals %.2g / %.2g", *t_red,
+           M->inf.ctrl.rank, M->inf.obs.rank, M->inf.ctrl.solver == PHGMG_LYAP_EKSM ? "EKSM blocks" : "ADI steps",
+           M->inf.ctrl.iters, M->inf.obs.iters, M->inf.ctrl.res, M->inf.obs.res);
+  progress("  Hankel singular values: sigma_1 = %.6g, sigma_{r+1} = %.3g; H-infinity error bound 2 sum_{i>r} "
+           "sigma_i = %.3g%s", M->hsv[0], M->inf.hsv_tail, M->inf.bound,
+           M->inf.dmax > 0.0 ? "; feedthrough D (a port on a constraint)" : "");
+  return 0;
+}
+
+/* The json record of a state-space model (--form ss): the model's files, the
+   form, the solvers' ranks, steps and residuals, the values and the bound. */
+static int write_ss_json(const reduce_args *A, reduce_state *S, double t_red, const outlist *ol) {
+  const ss_model *M = &S->ss;
+  const phgmg_ph_system *sy = phgmg_ph_sparse_system(S->sp);
+  char path[4096 + 256];
+  const char *wp;
+  FILE *jf;
+  int i, nalg = 0, zc = 0;
+  snprintf(path, sizeof path, "%s/%s.json", A->out, A->name);
+  if (!(wp = stage_path(&S->sg, path))) return 1;
+  if (!(jf = fopen(wp, "w"))) return fail("%s: cannot write: %s", path, strerror(errno));
+  if (S->full.E) e_zero_lines(S, S->full.N, &nalg, &zc, NULL, NULL);
+  fprintf(jf, "{\n  \"phgmg_version\": \"%s\",\n  \"name\": ", PHGMG_VERSION_STRING);
+  json_str(jf, A->name);
+  fprintf(jf, ",\n  \"method\": \"bt\",\n  \"form\": \"ss\",\n  \"kind\": \"linear\",\n"
+              "  \"model\": \"xr' = A xr + B u, y = C xr + D u\",\n");
+  fprintf(jf, "  \"N\": %d, \"m\": %d, \"r\": %d,\n", sy->N, sy->m, A->r);
+  fprintf(jf, "  \"E\": %s, \"N_full\": %d, \"algebraic\": %d, \"feedthrough\": %s", S->full.E ? "true" : "false",
+          S->full.N, nalg, M->inf.dmax > 0.0 ? "true" : "false");
+  json_system(jf, A, S);
+  fprintf(jf, "},\n  \"info\": {\"solver\": \"low-rank\", \"lyapunov_solver\": \"%s\"",
+          M->inf.ctrl.solver == PHGMG_LYAP_EKSM ? "eksm" : "adi");
+  fprintf(jf, ", \"gramian_rank\": [%d, %d], \"adi_steps\": [%d, %d], \"factorizations\": [%d, %d]",
+          M->inf.ctrl.rank, M->inf.obs.rank, M->inf.ctrl.iters, M->inf.obs.iters, M->inf.ctrl.factorizations,
+          M->inf.obs.factorizations);
+  fprintf(jf, ", \"lyapunov_residual\": ["); json_num(jf, M->inf.ctrl.res);
+  fprintf(jf, ", "); json_num(jf, M->inf.obs.res);
+  fprintf(jf, "], \"values_computed\": %d, \"hankel_singular_values\": [", M->inf.nhsv);
+  for (i = 0; i < A->r; ++i) { if (i) fprintf(jf, ", "); json_num(jf, M->hsv[i]); }
+  fprintf(jf, "], \"hsv_next\": "); json_num(jf, M->inf.hsv_tail);
+  fprintf(jf, ", \"error_bound\": "); json_num(jf, M->inf.bound);
+  fprintf(jf, ", \"feedthrough_max\": "); json_num(jf, M->inf.dmax);
+  fprintf(jf, ", \"reduce_seconds\": "); json_num(jf, t_red);
+  fprintf(jf, "},\n  \"reconstruction\": \"x = V0 @ xr\",\n  \"files\": {\n    \"arrays\": {");
+  for (i = 0; i < ol->n; ++i)
+    fprintf(jf, "%s\n      \"%s\": [%d, %d]", i ? "," : "", ol->names[i], ol->rows[i], ol->cols[i]);
+  fprintf(jf, "\n    }\n  }\n}\n");
+  if (fclose(jf) != 0) return fail("%s: write error", path);
+  return 0;
+}
+
+/* --form ss's files: NAME_A, _B, _C, _D, the basis NAME_V0 (your ordering)
+   and NAME.json, under their temporary names. */
+static int write_ss_model(const reduce_args *A, reduce_state *S, double t_red) {
+  const ss_model *M = &S->ss;
+  const int r = A->r, m = phgmg_ph_sparse_system(S->sp)->m;
+  outlist *ol = &S->ol;
+  if (mkdir_p(A->out, &S->sg)) return 1;
+  memset(ol, 0, sizeof *ol);
+  if (write_field(A->out, A->name, "A", M->A, r, r, ol, &S->sg) ||
+      write_field(A->out, A->name, "B", M->B, r, m, ol, &S->sg) ||
+      write_field(A->out, A->name, "C", M->C, m, r, ol, &S->sg) ||
+      write_field(A->out, A->name, "D", M->D, m, m, ol, &S->sg) ||
+      write_user_field(A, S, "V0", M->T, r, ol))
+    return 1;
+  return write_ss_json(A, S, t_red, ol);
+}
+
 /* A sweep's shared bases: a study over the snapshots for the largest order
    asked (phgmg_study_create), so that each model's reduction works in the
    study's coordinates. A model class the study does not take (a mass
@@ -4591,6 +4791,13 @@ static int sweep_build_model(const reduce_args *A, reduce_state *S, int k, const
   sweep_set(&T, k, M->name, sizeof M->name);
   M->method = S->method = method_code(T.method);
   M->r = T.r;
+  if (T.form_ss) {   /* bt as a state-space model: no phgmg_reduced (check_form: one model) */
+    if ((e = run_ss_bt(&T, S, &M->t_red)) != 0 || (e = write_ss_model(&T, S, M->t_red)) != 0) return e;
+    M->rr = T.r; M->m = S->sys.m; M->pass = 1; M->ss = 1;
+    M->sg = S->sg; M->ol = S->ol;
+    memset(&S->sg, 0, sizeof S->sg);
+    return 0;
+  }
   if (is_balancing(S->method)) {   /* no snapshots */
     if ((e = run_balancing(&T, S, &M->t_red)) != 0) return e;
     if ((e = write_arrays(&T, S, NULL, 0, &S->ol)) != 0) return e;
@@ -4686,6 +4893,7 @@ static void rom_feed_out(const phgmg_rom *rom, double t, cli_input *in, double *
 /* simulate-rom's options (0 / NULL: not given). */
 typedef struct simrom_args {
   const char *model, *out, *states, *inspec, *x0;   /* x0: --x0, the reduced initial state */
+  const char *ss;               /* --ss DIR/NAME: a state-space model (reduce --form ss) */
   double dt, amp, newton_tol;   /* newton_tol 0: the library's default */
   int steps, newton_iter, have_dt;
 } simrom_args;
@@ -4702,6 +4910,7 @@ static int parse_simulate_rom(int argc, char **argv, simrom_args *P) {
     if (!strcmp(o, "--help") || !strcmp(o, "-h")) { print_help(); return -1; }
     if (repeated_opt(o, seen, &nseen)) return 2;
     else if (!strcmp(o, "--model")) { if (!(P->model = optval(argc, argv, &i))) return 2; }
+    else if (!strcmp(o, "--ss")) { if (!(P->ss = optval(argc, argv, &i))) return 2; }
     else if (!strcmp(o, "--out")) { if (!(P->out = optval(argc, argv, &i))) return 2; }
     else if (!strcmp(o, "--states")) { if (!(P->states = optval(argc, argv, &i))) return 2; }
     else if (!strcmp(o, "--input")) { if (!(P->inspec = optval(argc, argv, &i))) return 2; }
@@ -4719,7 +4928,13 @@ static int parse_simulate_rom(int argc, char **argv, simrom_args *P) {
     else if (!strcmp(o, "--x0")) { if (!(P->x0 = optval(argc, argv, &i))) return 2; }
     else return usage_error("simulate-rom: unknown option '%s'", o);
   }
-  if (!P->model || !P->out) return usage_error("simulate-rom: --model FILE and --out FILE are required");
+  if (P->model && P->ss)
+    return usage_error("simulate-rom: give one model: --model FILE (port-Hamiltonian) or --ss DIR/NAME (state-space)");
+  if (P->ss && (!*P->ss || P->ss[strlen(P->ss) - 1] == '/'))
+    return usage_error("--ss '%s': expected DIR/NAME, the prefix of NAME_A.npy, NAME_B.npy, NAME_C.npy and "
+                       "NAME_D.npy", P->ss);
+  if (!(P->model || P->ss) || !P->out)
+    return usage_error("simulate-rom: --model FILE (or --ss DIR/NAME) and --out FILE are required");
   return 0;
 }
 
@@ -4757,6 +4972,215 @@ static int simrom_dt(const phgmg_rom *rom, int have_dt, double *dt) {
   return 0;
 }
 
+/* ---- simulate-rom --ss: a state-space model ------------------------------------- */
+/* The model xr' = A xr + B u, y = C xr + D u of reduce --form ss, read from
+   PREFIX_A.npy ... PREFIX_D.npy, and the 3-stage Gauss-Legendre step of it:
+   the stage equations (I - dt (a (x) A)) K = [A x + B u(t + c_i dt)]_i
+   factored once (LU of order 3 r), x <- x + dt sum_i b_i K_i. */
+typedef struct ss_sim {
+  mat A, B, C, D;
+  int r, m;
+  double *LU, *K, *x;   /* 3r x 3r factors, 3r stage values, r states */
+  int *piv;
+} ss_sim;
+
+static void ss_sim_free(ss_sim *M) {
+  mat_free(&M->A); mat_free(&M->B); mat_free(&M->C); mat_free(&M->D);
+  free(M->LU); free(M->K); free(M->x); free(M->piv);
+}
+
+/* The four arrays' paths (path[k], k = A, B, C, D) of --ss PREFIX. */
+static void ss_paths(const char *prefix, char path[4][4096 + 16]) {
+  static const char *const f[4] = {"A", "B", "C", "D"};
+  int k;
+  for (k = 0; k < 4; ++k) snprintf(path[k], sizeof path[k], "%s_%s.npy", prefix, f[k]);
+}
+
+/* Reads the four arrays and checks their shapes (A r x r, B r x m, C m x r,
+   D m x m). 0 or 1 after a message. */
+static int ss_load(ss_sim *M, char path[4][4096 + 16]) {
+  mat *a[4];
+  int k, r, m;
+  a[0] = &M->A; a[1] = &M->B; a[2] = &M->C; a[3] = &M->D;
+  for (k = 0; k < 4; ++k)
+    if (mat_load(a[k], "--ss", path[k])) return 1;
+  r = M->A.rows; m = M->B.cols;
+  if (M->A.cols != r || r < 1)
+    return fail("%s (--ss): A must be square (r x r), got %s", path[0], shape_str(&M->A));
+  if (M->B.rows != r || m < 1 || m > 64)
+    return fail("%s (--ss): B must be r x m (r = %d, 1 <= m <= 64), got %s", path[1], r, shape_str(&M->B));
+  if (M->C.rows != m || M->C.cols != r)
+    return fail("%s (--ss): C must be m x r = %d x %d, got %s", path[2], m, r, shape_str(&M->C));
+  if (M->D.rows != m || M->D.cols != m)
+    return fail("%s (--ss): D must be m x m = %d x %d, got %s", path[3], m, m, shape_str(&M->D));
+  M->r = r; M->m = m;
+  return 0;
+}
+
+/* The Gauss-Legendre stage matrix I - dt (a (x) A), factored. 0 or 1. */
+static int ss_gl3_setup(ss_sim *M, double dt, const char *prefix) {
+  const double s = sqrt(15.0);
+  const double a[3][3] = {{5.0 / 36, 2.0 / 9 - s / 15, 5.0 / 36 - s / 30},
+                          {5.0 / 36 + s / 24, 2.0 / 9, 5.0 / 36 - s / 24},
+                          {5.0 / 36 + s / 30, 2.0 / 9 + s / 15, 5.0 / 36}};
+  const int r = M->r, n = 3 * r;
+  int i, j, p, q;
+  M->LU = (double *)calloc((size_t)n * (size_t)n, sizeof(double));
+  M->K = (double *)malloc(sizeof(double) * (size_t)n);
+  M->x = (double *)calloc((size_t)r, sizeof(double));
+  M->piv = (int *)malloc(sizeof(int) * (size_t)n);
+  if (!M->LU || !M->K || !M->x || !M->piv) return fail("out of memory");
+  for (i = 0; i < 3; ++i)
+    for (j = 0; j < 3; ++j)
+      for (q = 0; q < r; ++q)
+        for (p = 0; p < r; ++p)
+          M->LU[(size_t)(i * r + p) + (size_t)(j * r + q) * n] = -dt * a[i][j] * M->A.a[p + (size_t)q * r];
+  for (p = 0; p < n; ++p) M->LU[(size_t)p + (size_t)p * n] += 1.0;
+  if (phgmg_lu_factor(n, M->LU, n, M->piv) != PHGMG_OK)
+    return fail("%s: the stage equations of dt = %g are singular (A has an eigenvalue 1 / (dt a) for a stage "
+                "weight a): try another --dt", prefix, dt);
+  return 0;
+}
+
+/* y = C x + D u. */
+static void ss_output(const ss_sim *M, const double *u, double *y) {
+  int a, k;
+  for (a = 0; a < M->m; ++a) {
+    double acc = 0.0;
+    for (k = 0; k < M->r; ++k) acc += M->C.a[a + (size_t)k * M->m] * M->x[k];
+    for (k = 0; k < M->m; ++k) acc += M->D.a[a + (size_t)k * M->m] * u[k];
+    y[a] = acc;
+  }
+}
+
+/* One step from t: the stage values K_i = A (x + dt sum_j a_ij K_j) + B u_i, then x. */
+static void ss_step(ss_sim *M, double t, double dt, cli_input *in) {
+  const double s15 = sqrt(15.0) / 10.0, cs[3] = {0.5 - s15, 0.5, 0.5 + s15};
+  const double b[3] = {5.0 / 18, 4.0 / 9, 5.0 / 18};
+  const int r = M->r, m = M->m;
+  double u[64];
+  int i, p, k;
+  for (i = 0; i < 3; ++i) {
+    input_fn(t + cs[i] * dt, u, in);
+    for (p = 0; p < r; ++p) {
+      double acc = 0.0;
+      for (k = 0; k < r; ++k) acc += M->A.a[p + (size_t)k * r] * M->x[k];
+      for (k = 0; k < m; ++k) acc += M->B.a[p + (size_t)k * r] * u[k];
+      M->K[i * r + p] = acc;
+    }
+  }
+  phgmg_lu_solve('N', 3 * r, M->LU, 3 * r, M->piv, 1, M->K, 3 * r);
+  for (p = 0; p < r; ++p) M->x[p] += dt * (b[0] * M->K[p] + b[1] * M->K[r + p] + b[2] * M->K[2 * r + p]);
+}
+
+/* --x0 for a state-space model: r values into M->x. 0 or 1. */
+static int ss_x0(ss_sim *M, const char *file) {
+  mat X;
+  int a;
+  if (mat_load(&X, "--x0", file)) return 1;
+  if (X.ndim == 0 || X.rows != M->r || X.cols != 1) {
+    fail("%s (--x0): expected the reduced initial state, shape (%d,) (r = %d values), got %s", file, M->r, M->r,
+         shape_str(&X));
+    mat_free(&X);
+    return 1;
+  }
+  for (a = 0; a < M->r; ++a) M->x[a] = X.a[a];
+  mat_free(&X);
+  return 0;
+}
+
+/* The run: steps of dt from x0 (rest or --x0), the outputs (and states) into Y (XR). */
+static void ss_run(ss_sim *M, const simrom_args *P, double dt, cli_input *in, double *Y, double *XR) {
+  double u[64], t0 = now_s(), wall_last = t0;
+  int n, a;
+  for (n = 0; n <= P->steps; ++n) {
+    if (n > 0) ss_step(M, (double)(n - 1) * dt, dt, in);
+    input_fn((double)n * dt, u, in);
+    ss_output(M, u, Y + (size_t)n * M->m);
+    if (XR) for (a = 0; a < M->r; ++a) XR[a + (size_t)n * M->r] = M->x[a];
+    if (!g_quiet && (n & 255) == 255 && now_s() - wall_last >= 2.0) {
+      wall_last = now_s();
+      progress("  ... step %d of %d (%.1f s)", n, P->steps, wall_last - t0);
+    }
+  }
+  progress("  done in %.3f s (one LU of order %d)", now_s() - t0, 3 * M->r);
+}
+
+/* simulate-rom --ss DIR/NAME: the state-space model stepped by the same
+   3-stage Gauss-Legendre method as the port-Hamiltonian models (at the same
+   input points), the outputs as theirs: y (m x (steps+1)), --states xr. */
+static int simulate_ss(const simrom_args *P) {
+  char path[4][4096 + 16];
+  pathset pin, pout;
+  staged sg;
+  cli_input in;
+  ss_sim M;
+  double dt = P->dt, *Y = NULL, *XR = NULL;
+  const char *wp;
+  int k, status = 1;
+  memset(&pin, 0, sizeof pin); memset(&pout, 0, sizeof pout); memset(&sg, 0, sizeof sg);
+  memset(&in, 0, sizeof in); memset(&M, 0, sizeof M);
+  ss_paths(P->ss, path);
+  for (k = 0; k < 4; ++k) paths_add(&pin, "--ss", path[k], 0);
+  paths_add_input(&pin, "--input", P->inspec);
+  if (P->x0) paths_add(&pin, "--x0", P->x0, 0);
+  paths_add(&pout, "--out", P->out, 1);
+  if (P->states) paths_add(&pout, "--states", P->states, 1);
+  if ((status = check_collisions("simulate-rom", &pin, &pout)) != 0) goto done;
+  status = 1;
+  if (check_out_file(P->out, "--out") || (P->states && check_out_file(P->states, "--states"))) goto done;
+  g_inputs = &pin;
+  if (ss_load(&M, path)) goto done;
+  if (!P->have_dt) {
+    dt = 0.1;
+    note("a state-space model records no step: stepping at dt = 0.1; give --dt");
+  }
+  if (P->newton_tol > 0.0 || P->newton_iter != 10)
+    note("--newton-tol and --newton-iter do not apply to a state-space model (linear: one LU, no Newton)");
+  if (too_big(((double)M.m + (P->states ? (double)M.r : 0.0)) * ((double)P->steps + 1.0),
+               "--steps: the outputs (m x (steps+1), states r x (steps+1))")) { status = 2; goto done; }
+  if ((status = input_setup(&in, "--input", P->inspec, P->amp, M.m, dt, P->steps * dt)) != 0) goto done;
+  input_covers(&in, P->inspec, "--input", P->steps * dt);
+  status = 1;
+  Y = (double *)malloc(sizeof(double) * (size_t)M.m * ((size_t)P->steps + 1));
+  if (P->states) XR = (double *)malloc(sizeof(double) * (size_t)M.r * ((size_t)P->steps + 1));
+  if (!Y || (P->states && !XR)) { fail("out of memory for %d steps", P->steps); goto done; }
+  if (ss_gl3_setup(&M, dt, P->ss) || (P->x0 && ss_x0(&M, P->x0))) goto done;
+  progress("simulating %s (state-space, r = %d, m = %d): %d steps of dt = %g, %s", P->ss, M.r, M.m, P->steps, dt,
+           input_desc(&in, P->inspec));
+  ss_run(&M, P, dt, &in, Y, XR);
+  /* both outputs or neither */
+  if (!(wp = stage_path(&sg, P->out)) || write_npy(P->out, wp, Y, M.m, P->steps + 1, 2)) goto done;
+  if (P->states && (!(wp = stage_path(&sg, P->states)) || write_npy(P->states, wp, XR, M.r, P->steps + 1, 2)))
+    goto done;
+  if (stage_commit(&sg)) goto done;
+  printf("wrote %s (%d x %d)%s%s\n", P->out, M.m, P->steps + 1, P->states ? " and " : "", P->states ? P->states : "");
+  status = 0;
+done:
+  stage_abort(&sg);
+  g_inputs = NULL;
+  paths_free(&pin); paths_free(&pout);
+  mat_free(&in.tab);
+  ss_sim_free(&M);
+  free(Y); free(XR);
+  return status;
+}
+
+/* --model DIR/NAME.phgmgrom that does not exist where DIR/NAME_A.npy does (a
+   model of reduce --form ss): the option to use instead. 0 or 1 after a message. */
+static int model_is_ss(const char *model) {
+  char pre[4096], a[4096 + 16];
+  const size_t l = strlen(model);
+  struct stat st;
+  if (l < 9 || l >= sizeof pre || strcmp(model + l - 9, ".phgmgrom") != 0 || stat(model, &st) == 0) return 0;
+  memcpy(pre, model, l - 9);
+  pre[l - 9] = '\0';
+  snprintf(a, sizeof a, "%s_A.npy", pre);
+  if (stat(a, &st) != 0) return 0;
+  return fail("%s (--model): no such file, but %s is there: a state-space model (reduce --form ss) has no model "
+              "file; run it with simulate-rom --ss %s", model, a, pre);
+}
+
 static int cmd_simulate_rom(int argc, char **argv) {
   simrom_args P;
   const char *model, *out, *states, *inspec;
@@ -4774,6 +5198,8 @@ static int cmd_simulate_rom(int argc, char **argv) {
   const char *wp;
   pathset pin, pout; /* the files read; the files written */
   if (status != 0) return status < 0 ? 0 : status;
+  if (P.ss) return simulate_ss(&P);
+  if (model_is_ss(P.model)) return 1;
   model = P.model; out = P.out; states = P.states; inspec = P.inspec;
   dt = P.dt; amp = P.amp; newton_tol = P.newton_tol;
   steps = P.steps; newton_iter = P.newton_iter; have_dt = P.have_dt;

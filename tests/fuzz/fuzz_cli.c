@@ -184,6 +184,7 @@ static void init(void) {
   static const char *const files8[] = {"jdx.npy", NULL};
   static const char *const words9[] = {"--adi-maxit", NULL};   /* after files8 */
   static const char *const words10[] = {"--lyap", "adi", "eksm", NULL};   /* after words9 */
+  static const char *const words11[] = {"--form", "ph", "ss", "--ss", NULL};   /* after words10 */
   char *argv[24];
   int k, fb, argc = 0;   /* fb: the token of files[0] */
   FILE *f;
@@ -207,6 +208,7 @@ static void init(void) {
   for (k = 0; files8[k]; ++k) snprintf(g_tok[g_ntok++], sizeof g_tok[0], "%s/%s", g_dir, files8[k]);
   for (k = 0; words9[k]; ++k) strcpy(g_tok[g_ntok++], words9[k]);
   for (k = 0; words10[k]; ++k) strcpy(g_tok[g_ntok++], words10[k]);
+  for (k = 0; words11[k]; ++k) strcpy(g_tok[g_ntok++], words11[k]);
   /* the model file, made once by the CLI itself */
   restore();
   argv[argc++] = (char *)"phgmg"; argv[argc++] = (char *)"reduce";
