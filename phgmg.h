@@ -921,8 +921,25 @@
    GMG_MANIFOLD; cached DEIM points
    (opts.cache), separable terms by callbacks and GENERAL nonlinear
    Hamiltonians, a reference state (opts.ref), dampers, feedthrough,
-   descriptor models; in the command line (below) also simulating the
-   training runs.
+   algebraic constraints (singular E), and a mass matrix with SP1, SP2 or
+   GMG-QM; in the command line (below) also simulating the training runs
+   and mass matrices.
+   Mass matrices. A descriptor model E x' = (J - R) z + B u (manual 1.6, E
+   of full rank) reduces by GMG-POD: phgmg_mpi_linear_model.E (the rows of
+   E as a distributed operator) and solve_E (the user's collective solve
+   with E). The serial formulas, each N-dimensional product distributed:
+   the ports' columns Bp = E^{-1} B (m solves with E), the POD of X - QB
+   QB^T X (QB RB = Bp by TSQR), V0 = [Bp, V1], L = E V0 (one product with
+   E), G00 = L^T (J - R)^{-1} L, Qh = L^T Q V0, Bh = [I; 0], the separable
+   weights E(i_k, i_k) w_k read from the rank's own rows of E, whose rows
+   at the terms' coordinates must be positive multiples of unit rows
+   (PHGMG_ERR_E_COUPLED on every rank otherwise). On the damped chain of
+   600 masses with a mass matrix (consistent-mass pattern on the
+   velocities, tests/mpi/test_mpi_nl.c) at 1-4 ranks, against the serial
+   phgmg_reduce: the singular values within 2e-16 sigma_1, Qh within
+   1e-15, the same 56 ECSW points, weights within 3e-14, K within 8.3e-12
+   and the outputs within 6.5e-12 -- the serial model itself moves K by
+   3.7e-12 when the snapshots change by one ulp (cond G00).
    A PETSc + MUMPS example. examples/petsc_mumps.c puts a real distributed
    direct solver behind the solve callback: it reads the command line's
    files (J, R, Q as (nnz, 3) triplets, B, the snapshots X), each rank
@@ -5284,7 +5301,16 @@ typedef phgmg_result (*phgmg_mpi_solve_fn)(char trans, int nrhs, double *X, int 
 
 /* A linear port-Hamiltonian model distributed by rows: x' = (J - R) Q x + B u,
    y = B^T Q x. Q as a distributed operator, B this rank's rows (nloc x m,
-   ld ldb), J - R through its solve. */
+   ld ldb), J - R through its solve. With a mass matrix (a descriptor model,
+   manual 1.6: E x' = (J - R) z + B u, y = B^T z, E^T z = grad H, z = Q x
+   (+ the separable terms' gradients), E of full rank, E^T Q symmetric
+   positive (semi)definite): E as a distributed operator and solve_E, a
+   collective solve X <- E^{-1} X on this rank's rows (nrhs columns; trans
+   is always 'N'); zero E: E = I. GMG-POD only (phgmg_mpi_gmg_pod_linear,
+   phgmg_mpi_reduce; the other methods: PHGMG_ERR_UNSUPPORTED): the serial
+   reduction's formulas, basis [E^{-1} B, V1], the G-blocks of E V0.
+   Zero the struct (memset) before setting its fields: a field left zero
+   keeps its default. */
 typedef struct phgmg_mpi_linear_model {
   const phgmg_mpi_op *Q;
   int m;
@@ -5292,6 +5318,9 @@ typedef struct phgmg_mpi_linear_model {
   int ldb;
   phgmg_mpi_solve_fn solve;
   void *solve_user;
+  const phgmg_mpi_op *E;       /* NULL: E = I */
+  phgmg_mpi_solve_fn solve_E;  /* with E: X <- E^{-1} X */
+  void *solve_E_user;
 } phgmg_mpi_linear_model;
 
 /* Distributed GMG-POD of a linear model (the serial phgmg_reduce with
@@ -27513,52 +27542,122 @@ PHGMG__PRIV phgmg_result phgmg__mpi_gmg_invert(int r, int m, const double *G00, 
   return phgmg__inv(r, G00, K, al);
 }
 
-PHGMG_DEF phgmg_result phgmg_mpi_gmg_pod_linear(const phgmg_mpi_ctx *ctx, const phgmg_mpi_linear_model *model,
-                                                int ns, const double *X, int ldx, int r, double *K, double *Qh,
-                                                double *Bh, double *S, double *V0, int ldv0) {
-  const phgmg_allocator *al;
-  double *Vb = NULL, *GV, *G00, *s, *bn, *work;
-  int *iwork = NULL, n, ld, m, p, i, j;
-  phgmg_result rc = PHGMG_OK;
-  if (!ctx) return PHGMG_ERR_INVALID_ARG;
-  al = &ctx->al; n = ctx->nloc; ld = PHGMG__MAX(1, n);
-  if (!model || !model->Q || !model->solve || !K || !Qh || !Bh || (n > 0 && (!X || !model->B)) ||
-      model->Q->ctx != ctx)
-    rc = PHGMG_ERR_INVALID_ARG;
-  else if ((m = model->m) < 1 || r <= m || (phgmg_gidx)r > ctx->N || ns < 1 || r - m > ns ||
-           !phgmg__mpi_ld_ok(ctx, model->ldb) || !phgmg__mpi_ld_ok(ctx, ldx) || (V0 && !phgmg__mpi_ld_ok(ctx, ldv0)))
-    rc = PHGMG_ERR_SIZE;
-  else {
-    Vb = phgmg__dalloc(al, 2 * (size_t)ld * r + 4 * (size_t)r * r + 3 * (size_t)r + (size_t)m * m);
-    iwork = phgmg__ialloc(al, 2 * (size_t)r);
-    if (!Vb || !iwork) rc = PHGMG_ERR_NOMEM;
-  }
-  rc = phgmg__mpi_agree(ctx, rc);
-  if (rc != PHGMG_OK) { phgmg__free(al, Vb); phgmg__free(al, iwork); return rc; }
-  m = model->m; p = r - m;
-  GV = Vb + (size_t)ld * r; G00 = GV + (size_t)ld * r; s = G00 + (size_t)r * r; bn = s + r;
+/* ---- descriptor models: the ports E^{-1} B and the left factor E V (1.6) ---- */
+/* *out = *md; with a mass matrix its B replaced by Bp = E^{-1} B (m solves
+   with E; *Bp allocated here, the caller frees it), the GMG basis's port
+   columns; *Bp NULL without E. Collective. */
+PHGMG__PRIV phgmg_result phgmg__mpi_ports(const phgmg_mpi_ctx *ctx, const phgmg_mpi_linear_model *md,
+                                          phgmg_mpi_linear_model *out, double **Bp) {
+  const int n = ctx->nloc, ld = PHGMG__MAX(1, n), m = md->m;
+  int j;
+  phgmg_result rc;
+  *out = *md;
+  *Bp = NULL;
+  if (!md->E) return PHGMG_OK;
+  *Bp = phgmg__dalloc(&ctx->al, (size_t)ld * m);
+  rc = phgmg__mpi_agree(ctx, *Bp ? PHGMG_OK : PHGMG_ERR_NOMEM);
+  if (rc != PHGMG_OK) return rc;
+  for (j = 0; j < m; ++j)
+    if (n > 0) memcpy(*Bp + (size_t)j * ld, md->B + (size_t)j * md->ldb, (size_t)n * sizeof(double));
+  rc = phgmg__mpi_agree(ctx, md->solve_E('N', m, *Bp, ld, md->solve_E_user));
+  if (rc == PHGMG_OK) rc = phgmg__mpi_agree(ctx, phgmg__mat_finite(n, m, *Bp, ld) ? PHGMG_OK : PHGMG_ERR_NANINF);
+  out->B = *Bp; out->ldb = ld;
+  return rc;
+}
+
+/* L = E V (k columns of this rank's rows, ld), V itself without E. Collective. */
+PHGMG__PRIV phgmg_result phgmg__mpi_e_left(const phgmg_mpi_ctx *ctx, const phgmg_mpi_linear_model *md, int k,
+                                           const double *V, int ld, double *L) {
+  if (md->E) return phgmg_mpi_op_apply(md->E, k, V, ld, L, ld);
+  if (ctx->nloc > 0) memcpy(L, V, (size_t)ld * k * sizeof(double));
+  return PHGMG_OK;
+}
+
+/* GMG-POD on a model whose B holds the basis's port columns (Bp, from
+   phgmg__mpi_ports): V0 = [Bp, V1], L = E V0, G00 = L^T (J - R)^{-1} L,
+   K = G00^{-1} after the check, Qh = L^T Q V0, Bh = [I; 0] (L's first m
+   columns are B). Vb: this rank's rows of V0 (ld x r). Collective. */
+PHGMG__PRIV phgmg_result phgmg__mpi_gmg_pod(const phgmg_mpi_ctx *ctx, const phgmg_mpi_linear_model *md, int ns,
+                                            const double *X, int ldx, int r, double *K, double *Qh, double *Bh,
+                                            double *S, double *Vb) {
+  const phgmg_allocator *al = &ctx->al;
+  const int n = ctx->nloc, ld = PHGMG__MAX(1, n), m = md->m, p = r - m;
+  double *L = phgmg__dalloc(al, 2 * (size_t)ld * r + 4 * (size_t)r * r + 3 * (size_t)r + (size_t)m * m);
+  double *GV, *G00, *s, *bn, *work;
+  int *iwork = phgmg__ialloc(al, 2 * (size_t)r), i, j;
+  phgmg_result rc = phgmg__mpi_agree(ctx, L && iwork ? PHGMG_OK : PHGMG_ERR_NOMEM);
+  if (rc != PHGMG_OK) { phgmg__free(al, L); phgmg__free(al, iwork); return rc; }
+  GV = L + (size_t)ld * r; G00 = GV + (size_t)ld * r; s = G00 + (size_t)r * r; bn = s + r;
   work = bn + (size_t)m * m;
-  rc = phgmg__mpi_gmg_basis(ctx, model, ns, X, ldx, p, Vb, s);
-  if (rc == PHGMG_OK) {   /* GV = (J - R)^{-1} V0 by the user's solve */
-    memcpy(GV, Vb, (size_t)ld * r * sizeof(double));
-    rc = phgmg__mpi_agree(ctx, model->solve('N', r, GV, ld, model->solve_user));
+  rc = phgmg__mpi_gmg_basis(ctx, md, ns, X, ldx, p, Vb, s);
+  if (rc == PHGMG_OK) rc = phgmg__mpi_e_left(ctx, md, r, Vb, ld, L);
+  if (rc == PHGMG_OK) {   /* GV = (J - R)^{-1} L by the user's solve */
+    memcpy(GV, L, (size_t)ld * r * sizeof(double));
+    rc = phgmg__mpi_agree(ctx, md->solve('N', r, GV, ld, md->solve_user));
   }
-  if (rc == PHGMG_OK) rc = phgmg_mpi_atb(ctx, r, r, Vb, ld, GV, ld, G00, r);
-  if (rc == PHGMG_OK) rc = phgmg_mpi_atb(ctx, m, m, Vb, ld, Vb, ld, bn, m);
+  if (rc == PHGMG_OK) rc = phgmg_mpi_atb(ctx, r, r, L, ld, GV, ld, G00, r);
+  if (rc == PHGMG_OK) rc = phgmg_mpi_atb(ctx, m, m, L, ld, L, ld, bn, m);
   if (rc == PHGMG_OK) {
     for (j = 0; j < m; ++j) bn[j] = sqrt(bn[j + (size_t)j * m]);   /* j <= j m: in place */
     rc = phgmg__mpi_gmg_invert(r, m, G00, bn, K, work, iwork, al);   /* replicated data: replicated verdict */
   }
-  if (rc == PHGMG_OK) rc = phgmg_mpi_op_project(model->Q, r, Vb, ld, Qh, r);
+  if (rc == PHGMG_OK && !md->E) rc = phgmg_mpi_op_project(md->Q, r, Vb, ld, Qh, r);
+  if (rc == PHGMG_OK && md->E) {   /* Qh = (E V0)^T (Q V0) */
+    rc = phgmg_mpi_op_apply(md->Q, r, Vb, ld, GV, ld);
+    if (rc == PHGMG_OK) rc = phgmg_mpi_atb(ctx, r, r, L, ld, GV, ld, Qh, r);
+  }
   if (rc == PHGMG_OK) {
     phgmg__symmetrize(r, Qh);
     for (j = 0; j < m; ++j)
       for (i = 0; i < r; ++i) Bh[i + (size_t)j * r] = i == j ? 1.0 : 0.0;
     for (i = 0; i < p && S; ++i) S[i] = s[i];
-    for (j = 0; j < r && V0 && n > 0; ++j) memcpy(V0 + (size_t)j * ldv0, Vb + (size_t)j * ld, (size_t)n * sizeof(double));
   }
-  phgmg__free(al, Vb);
+  phgmg__free(al, L);
   phgmg__free(al, iwork);
+  return rc;
+}
+
+/* The linear model's operators, callbacks and B (X: the snapshots). */
+PHGMG__PRIV phgmg_result phgmg__mpi_lin_args(const phgmg_mpi_ctx *ctx, const phgmg_mpi_linear_model *md,
+                                             const double *X, int ldx) {
+  if (!md->Q || !md->solve || (ctx->nloc > 0 && (!X || !md->B)) || md->Q->ctx != ctx ||
+      (md->E && (!md->solve_E || md->E->ctx != ctx)))
+    return PHGMG_ERR_INVALID_ARG;
+  if (!phgmg__mpi_ld_ok(ctx, md->ldb) || !phgmg__mpi_ld_ok(ctx, ldx)) return PHGMG_ERR_SIZE;
+  return PHGMG_OK;
+}
+
+/* GMG-POD's arguments: the model's, and r, ns. */
+PHGMG__PRIV phgmg_result phgmg__mpi_lin_check(const phgmg_mpi_ctx *ctx, const phgmg_mpi_linear_model *md, int ns,
+                                              const double *X, int ldx, int r) {
+  const phgmg_result rc = phgmg__mpi_lin_args(ctx, md, X, ldx);
+  if (rc != PHGMG_OK) return rc;
+  if (md->m < 1 || r <= md->m || (phgmg_gidx)r > ctx->N || ns < 1 || r - md->m > ns) return PHGMG_ERR_SIZE;
+  return PHGMG_OK;
+}
+
+PHGMG_DEF phgmg_result phgmg_mpi_gmg_pod_linear(const phgmg_mpi_ctx *ctx, const phgmg_mpi_linear_model *model,
+                                                int ns, const double *X, int ldx, int r, double *K, double *Qh,
+                                                double *Bh, double *S, double *V0, int ldv0) {
+  const phgmg_allocator *al;
+  phgmg_mpi_linear_model md;
+  double *Vb = NULL, *Bp = NULL;
+  int n, ld, j;
+  phgmg_result rc = PHGMG_OK;
+  if (!ctx) return PHGMG_ERR_INVALID_ARG;
+  al = &ctx->al; n = ctx->nloc; ld = PHGMG__MAX(1, n);
+  if (!model || !K || !Qh || !Bh) rc = PHGMG_ERR_INVALID_ARG;
+  else if ((rc = phgmg__mpi_lin_check(ctx, model, ns, X, ldx, r)) == PHGMG_OK && V0 && !phgmg__mpi_ld_ok(ctx, ldv0))
+    rc = PHGMG_ERR_SIZE;
+  else if (rc == PHGMG_OK && !(Vb = phgmg__dalloc(al, (size_t)ld * r)))
+    rc = PHGMG_ERR_NOMEM;
+  rc = phgmg__mpi_agree(ctx, rc);
+  if (rc == PHGMG_OK) rc = phgmg__mpi_ports(ctx, model, &md, &Bp);
+  if (rc == PHGMG_OK) rc = phgmg__mpi_gmg_pod(ctx, &md, ns, X, ldx, r, K, Qh, Bh, S, Vb);
+  for (j = 0; rc == PHGMG_OK && j < r && V0 && n > 0; ++j)
+    memcpy(V0 + (size_t)j * ldv0, Vb + (size_t)j * ld, (size_t)n * sizeof(double));
+  phgmg__free(al, Vb);
+  phgmg__free(al, Bp);
   return rc;
 }
 /* ---- distributed reduction of a separable nonlinear model ----------------------- */
@@ -27569,6 +27668,38 @@ PHGMG__PRIV void phgmg__mpi_sep_sys(const phgmg_mpi_sep_model *md, phgmg_ph_syst
   s->nl = PHGMG_NL_SEPARABLE; s->nsep = md->nsep;
   s->poly_deg = md->poly_deg; s->poly = md->poly; s->nexp = md->nexp; s->expo = md->expo;
   s->phi_nfun = md->per_term ? md->nsep : 1;
+}
+
+/* With a mass matrix the energy's separable weights are E(i_k, i_k) w_k,
+   and E's row at each term's coordinate must be that positive multiple of
+   the unit row (manual 1.6; else PHGMG_ERR_E_COUPLED). Term k's weight
+   (this rank's term k). */
+PHGMG__PRIV double phgmg__mpi_term_w(const phgmg_mpi_ctx *ctx, const phgmg_mpi_sep_model *md, int k) {
+  const double w = md->sep_w ? md->sep_w[k] : 1.0;
+  const phgmg_mpi_op *E = md->lin.E;
+  const int row = (int)(md->sep_idx[k] - ctx->row0);
+  size_t q;
+  double e = 0.0;
+  if (!E) return w;
+  for (q = E->rp[row]; q < E->rp[row + 1]; ++q)
+    if (E->cl[q] == row) e += E->va[q];
+  return e * w;
+}
+/* E's rows at this rank's terms' coordinates: positive multiples of unit rows. */
+PHGMG__PRIV phgmg_result phgmg__mpi_e_rows(const phgmg_mpi_ctx *ctx, const phgmg_mpi_sep_model *md) {
+  const phgmg_mpi_op *E = md->lin.E;
+  int k;
+  size_t q;
+  for (k = 0; E && k < md->nsep; ++k) {
+    const int row = (int)(md->sep_idx[k] - ctx->row0);
+    double diag = 0.0, off = 0.0;
+    for (q = E->rp[row]; q < E->rp[row + 1]; ++q) {
+      if (E->cl[q] == row) diag += E->va[q];
+      else off = PHGMG__MAX(off, fabs(E->va[q]));
+    }
+    if (!(diag > 0.0) || off != 0.0) return PHGMG_ERR_E_COUPLED;
+  }
+  return PHGMG_OK;
 }
 
 /* The options this function takes (resolved copy in *o) and this rank's terms. */
@@ -27670,7 +27801,7 @@ PHGMG__PRIV phgmg_result phgmg__mpi_sep_live(const phgmg_mpi_ctx *ctx, const phg
     const int j = t->lv[k], row = (int)(md->sep_idx[j] - ctx->row0);
     for (i = 0; i < ns; ++i) t->F[k + (size_t)i * t->nl] = phgmg__ph_phi(&s, j, X[row + (size_t)i * ldx], 1);
     for (a = 0; a < r; ++a) t->Vt[k + (size_t)a * t->nl] = V0[row + (size_t)a * ld];
-    t->sw[k] = md->sep_w ? md->sep_w[j] : 1.0;
+    t->sw[k] = phgmg__mpi_term_w(ctx, md, j);   /* E(i, i) w with a mass matrix */
     t->gid[k] = md->sep_id ? md->sep_id[j] : md->sep_idx[j];
   }
   return PHGMG_OK;
@@ -28197,7 +28328,7 @@ PHGMG__PRIV phgmg_result phgmg__mpi_sep_all(const phgmg_mpi_ctx *ctx, const phgm
     const int two = 2 * n;
     for (k = 0; k < n; ++k) {
       loc[2 * k] = (double)(md->sep_id ? md->sep_id[k] : md->sep_idx[k]);
-      loc[2 * k + 1] = md->sep_w ? md->sep_w[k] : 1.0;
+      loc[2 * k + 1] = phgmg__mpi_term_w(ctx, md, k);
     }
     MPI_Allgather(&two, 1, MPI_INT, cnt, 1, MPI_INT, ctx->comm);
     for (k = 0; k < ctx->size; ++k) cnt[ctx->size + k] = k == 0 ? 0 : cnt[ctx->size + k - 1] + cnt[k - 1];
@@ -28243,7 +28374,7 @@ PHGMG__PRIV phgmg_result phgmg__mpi_sep_deim(const phgmg_mpi_ctx *ctx, const phg
   for (k = 0; k < n; ++k) {
     const int row = (int)(md->sep_idx[k] - ctx->row0);
     for (i = 0; i < ns; ++i) F[k + (size_t)i * ld] = phgmg__ph_phi(&s, k, X[row + (size_t)i * ldx], 1);
-    sw[k] = md->sep_w ? md->sep_w[k] : 1.0;
+    sw[k] = phgmg__mpi_term_w(ctx, md, k);
   }
   rc = phgmg_mpi_pod(tc, ns, F, ld, kk, 0.0, U, ld, S, &ks);
   if (rc == PHGMG_OK) {
@@ -28629,7 +28760,8 @@ PHGMG_DEF phgmg_result phgmg_mpi_reduce(const phgmg_mpi_ctx *ctx, const phgmg_mp
                                         phgmg_mpi_rom *out, double *V0, int ldv0) {
   phgmg_reduce_opts o;
   phgmg__mpi_romdata d;
-  double *b = NULL, *Vb, *Wb, resid = 0.0;
+  phgmg_mpi_linear_model lin;   /* model->lin with the GMG basis's port columns (E^{-1} B with a mass matrix) */
+  double *b = NULL, *Vb, *Wb, *Bp = NULL, resid = 0.0;
   int r = 0, m = 0, ld, wd = 0, sp1;
   phgmg_result rc = PHGMG_OK;
   if (!ctx) return PHGMG_ERR_INVALID_ARG;
@@ -28641,6 +28773,9 @@ PHGMG_DEF phgmg_result phgmg_mpi_reduce(const phgmg_mpi_ctx *ctx, const phgmg_mp
   else {
     o = *opts;
     rc = phgmg__mpi_sep_check_local(ctx, model, &o);
+    if (rc == PHGMG_OK) rc = phgmg__mpi_lin_args(ctx, &model->lin, X, ldx);
+    if (rc == PHGMG_OK && model->lin.E && o.method != PHGMG_METHOD_GMG_POD) rc = PHGMG_ERR_UNSUPPORTED;
+    if (rc == PHGMG_OK) rc = phgmg__mpi_e_rows(ctx, model);
     r = o.r; m = model->lin.m;
   }
   rc = phgmg__mpi_sep_check_global(ctx, model ? model : NULL, rc);
@@ -28653,7 +28788,8 @@ PHGMG_DEF phgmg_result phgmg_mpi_reduce(const phgmg_mpi_ctx *ctx, const phgmg_mp
                                     (sp1 ? 2 : 1) * (size_t)ld * r);   /* SP1: V and W */
     rc = phgmg__mpi_agree(ctx, b ? PHGMG_OK : PHGMG_ERR_NOMEM);
   }
-  if (rc != PHGMG_OK) { phgmg__free(&ctx->al, b); return rc; }
+  if (rc == PHGMG_OK) rc = phgmg__mpi_ports(ctx, &model->lin, &lin, &Bp);
+  if (rc != PHGMG_OK) { phgmg__free(&ctx->al, b); phgmg__free(&ctx->al, Bp); return rc; }
   d.r = r; d.m = m; d.K = b; d.Qh = b + (size_t)r * r; d.Bh = d.Qh + (size_t)r * r; d.S = d.Bh + (size_t)r * m;
   d.env = d.S + r; Vb = b + 2 * (size_t)r * r + (size_t)r * m + 3 * (size_t)r;
   Wb = sp1 ? Vb + (size_t)ld * r : NULL;   /* SP1/SP2: W = Vg A^{-1} */
@@ -28665,12 +28801,12 @@ PHGMG_DEF phgmg_result phgmg_mpi_reduce(const phgmg_mpi_ctx *ctx, const phgmg_mp
     rc = phgmg__mpi_sp_blocks(ctx, model, ns, X, ldx, r, o.method == PHGMG_METHOD_SP2, b, b + (size_t)r * r,
                               b + 2 * (size_t)r * r, b + 2 * (size_t)r * r + (size_t)r * m, Vb, Wb);
   else
-    rc = phgmg_mpi_gmg_pod_linear(ctx, &model->lin, ns, X, ldx, r, b, b + (size_t)r * r, b + 2 * (size_t)r * r,
-                                  b + 2 * (size_t)r * r + (size_t)r * m, Vb, ld);
+    rc = phgmg__mpi_gmg_pod(ctx, &lin, ns, X, ldx, r, b, b + (size_t)r * r, b + 2 * (size_t)r * r,
+                            b + 2 * (size_t)r * r + (size_t)r * m, Vb);
   /* the separable terms (4b), then the training envelope */
   if (rc == PHGMG_OK) rc = phgmg__mpi_sep_terms(ctx, model, &o, ns, X, ldx, Vb, r, wd, NULL, &d, &resid);
   if (rc == PHGMG_OK)
-    rc = phgmg__mpi_sep_envelope(ctx, &model->lin, ns, X, ldx, Vb, r, sp1 ? Wb : NULL,
+    rc = phgmg__mpi_sep_envelope(ctx, &lin, ns, X, ldx, Vb, r, sp1 ? Wb : NULL,
                                  b + 2 * (size_t)r * r + (size_t)r * m + r, NULL);
   d.nf = model->per_term ? d.nd : 1;
   if (rc == PHGMG_OK) rc = phgmg__mpi_agree(ctx, phgmg__mpi_rom_store(ctx, &d, out));
@@ -28688,6 +28824,7 @@ PHGMG_DEF phgmg_result phgmg_mpi_reduce(const phgmg_mpi_ctx *ctx, const phgmg_mp
   phgmg__free(&ctx->al, (void *)d.pts);
   phgmg__free(&ctx->al, (void *)d.w);
   phgmg__free(&ctx->al, b);
+  phgmg__free(&ctx->al, Bp);
   return rc;
 }
 

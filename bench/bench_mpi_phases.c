@@ -283,6 +283,7 @@ static phgmg_result run_phase(bench *b, int ph) {
   case 9: {
     phgmg_mpi_linear_model md;
     double *K = (double *)malloc(sizeof(double) * (size_t)r * r * 3), *Qh = K + (size_t)r * r, *Bh = Qh + (size_t)r * r;
+    memset(&md, 0, sizeof md);
     md.Q = b->Q; md.m = b->m; md.B = b->B; md.ldb = n; md.solve = solve_cb; md.solve_user = b;
     rc = phgmg_mpi_gmg_pod_linear(b->ctx, &md, ns, b->X, n, r, K, Qh, Bh, S, b->W, n);
     free(K);

@@ -383,6 +383,7 @@ static int reduce(const args *a, const layout *L, petsc_solver *sv, const double
   MPI_Comm_rank(PETSC_COMM_WORLD, &rank);
   if (rc == PHGMG_OK && any_rank(!K || q_csr(L, TQ, nQ, &rp, &col, &val))) rc = PHGMG_ERR_NOMEM;
   if (rc == PHGMG_OK) rc = phgmg_mpi_op_create(&Qop, ctx, rp, col, val);
+  memset(&md, 0, sizeof md);   /* fields not set: zero (E = I) */
   md.Q = Qop; md.m = m; md.B = Bl; md.ldb = L->nloc > 0 ? (int)L->nloc : 1;
   md.solve = petsc_solve; md.solve_user = sv;
   t0 = MPI_Wtime();

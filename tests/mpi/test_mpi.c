@@ -493,6 +493,7 @@ static void test_gmg(void) {
   for (i = 0; i < N * N; ++i) sv.LU[i] = t.J[i] - t.R[i];
   CHECK(phgmg_lu_factor(N, sv.LU, N, sv.ipiv) == PHGMG_OK, "LU");
   Xl = own_rows(c, ns, X); Bl = own_rows(c, m, t.B);
+  memset(&md, 0, sizeof md);   /* fields not set: zero (E = I) */
   md.Q = Qop; md.m = m; md.B = Bl; md.ldb = ld; md.solve = solve_cb; md.solve_user = &sv;
   V0 = (double *)malloc(sizeof(double) * ((size_t)ld * r));
   CHECK(phgmg_mpi_gmg_pod_linear(c, &md, ns, Xl, ld, r, K, Qh, Bh, S, V0, ld) == PHGMG_OK, "distributed GMG-POD");
@@ -604,6 +605,7 @@ static void test_errors(void) {
     /* B = 0: rank deficient (every rank sees the same R factor) */
     {
       double *Bz = (double *)calloc((size_t)ld, sizeof(double));
+      memset(&md, 0, sizeof md);
       md.Q = op; md.m = 1; md.B = Bz; md.ldb = ld; md.solve = solve_cb; md.solve_user = NULL;
       rc = phgmg_mpi_gmg_pod_linear(c, &md, ns, X, ld, 3, K, Qh, Bh, NULL, NULL, ld);
       CHECK(rc == PHGMG_ERR_RANK && same_everywhere(rc), "gmg, B = 0: %d", rc);

@@ -240,7 +240,23 @@ static void serial_sigma(const chain *ch, int ns, const double *X, int k, int ad
   double *Xa = (double *)malloc(sizeof(double) * (size_t)N * ns), *V = (double *)malloc(sizeof(double) * (size_t)N * k);
   int j, kk = 0;
   memcpy(Xa, X, sizeof(double) * (size_t)N * ns);
-  for (j = 0; adj && j < ns; ++j) Xa[1 + (size_t)j * N] = 0.0;   /* B = e_1: the projection removes row 1 */
+  if (adj && ch->sys.E) {   /* a mass matrix: the ports' columns b = E^{-1} B, Xa = X - b (b^T X) / (b^T b) */
+    double *b = (double *)calloc((size_t)N, sizeof(double)), bb = 0.0;
+    phgmg_jr_factor *f = NULL;
+    int i;
+    b[1] = 1.0;
+    CHECK(phgmg__e_factor(&ch->sys, &f, NULL, NULL) == PHGMG_OK, "E factor (reference)");
+    if (f) phgmg_jr_solve(f, 'N', 1, b, N);
+    for (i = 0; i < N; ++i) bb += b[i] * b[i];
+    for (j = 0; j < ns; ++j) {
+      double c = 0.0;
+      for (i = 0; i < N; ++i) c += b[i] * Xa[i + (size_t)j * N];
+      for (i = 0; i < N; ++i) Xa[i + (size_t)j * N] -= b[i] * c / bb;
+    }
+    phgmg_jr_factor_destroy(f);
+    free(b);
+  }
+  for (j = 0; adj && !ch->sys.E && j < ns; ++j) Xa[1 + (size_t)j * N] = 0.0;   /* B = e_1: the projection removes row 1 */
   CHECK(phgmg_pod(N, ns, Xa, N, k, 0.0, V, N, S, &kk, NULL) == PHGMG_OK && kk == k, "serial POD");
   free(Xa); free(V);
 }
@@ -1001,6 +1017,82 @@ static void test_qm_screened(void) {
   free(X); free(x0); free(V0); free(V0f);
 }
 
+/* A descriptor model (manual 1.6): the chain with a mass matrix E (banded,
+   symmetric positive definite): E(l_i, l_i) = 1 + 0.3 sin(i) on the
+   positions (unit rows there: the terms' coordinates), a consistent-mass
+   pattern on the velocities (2/3 on the diagonal, 1/6 between neighbours);
+   E^T Q = E symmetric. GMG-POD r = 12 with ECSW against the serial
+   phgmg_reduce of the same model; E (and E^{-1} through the user's solve)
+   distributed. SP1 with E: PHGMG_ERR_UNSUPPORTED; a coupled row of E at a
+   term's coordinate: PHGMG_ERR_E_COUPLED, on every rank. */
+static solver esv_;
+static phgmg_result solve_e_cb(char trans, int nrhs, double *X, int ldx, void *user) {
+  (void)user;
+  return solve_cb(trans, nrhs, X, ldx, &esv_);
+}
+static void test_descriptor(void) {
+  const int n = 600, N = 2 * n, ns = 101, r = 12, kb = 3, ld = 2 * kb + 1;
+  chain ch;
+  dist d;
+  double *X = (double *)malloc(sizeof(double) * (size_t)N * ns), *x0 = (double *)calloc((size_t)N, sizeof(double));
+  double *E = (double *)calloc((size_t)ld * N, sizeof(double)), *V0, *V0f;
+  phgmg_mpi_op *Eop;
+  phgmg_reduce_opts o;
+  phgmg_reduced *red = NULL;
+  phgmg_mpi_rom mr;
+  phgmg_result rc;
+  int i;
+  chain_build(&ch, n, 0);
+#define AT(A, r, s) (A)[(size_t)(kb + (r) - (s)) + (size_t)(s) * ld]
+  for (i = 0; i < n; ++i) {
+    const int l = 2 * i, v = 2 * i + 1;
+    AT(E, l, l) = 1.0 + 0.3 * sin((double)i);
+    AT(E, v, v) = 2.0 / 3.0;
+    if (i + 1 < n) { AT(E, v, v + 2) = 1.0 / 6.0; AT(E, v + 2, v) = 1.0 / 6.0; }
+  }
+  ch.sys.E = E;
+  for (i = 0; i < n; ++i) x0[2 * i] = 0.8 * sin(3.0 * 3.14159265358979 * i / n) + 0.3 * sin(7.0 * 3.14159265358979 * i / n);
+  simulate_root(&ch, x0, 0.2, ns, X);
+  memset(&o, 0, sizeof o);
+  o.method = PHGMG_METHOD_GMG_POD; o.r = r; o.hyper.on = 1; o.hyper.kind = PHGMG_HYPER_ECSW; o.hyper.tol = 1e-3;
+  dist_build(&d, &ch, ns, X);
+  Eop = band_op(d.c, &ch, E, NULL, 0.0);
+  esv_.c = d.c; esv_.fail_rank = -1;
+  CHECK(phgmg__e_factor(&ch.sys, &esv_.f, NULL, NULL) == PHGMG_OK, "E factor");
+  d.md.lin.E = Eop; d.md.lin.solve_E = solve_e_cb;
+  V0 = (double *)malloc(sizeof(double) * (size_t)d.ld * r);
+  rc = phgmg_mpi_reduce(d.c, &d.md, ns, d.Xl, d.ld, &o, &mr, V0, d.ld);
+  CHECK(rc == PHGMG_OK && same_everywhere(mr.nd) && mr.nd > 0, "distributed GMG-POD, mass matrix: %d", (int)rc);
+  V0f = gather_v0(d.c, r, V0, d.ld);
+  if (rank_ == 0 && rc == PHGMG_OK) {
+    double ktol = 1e-12, ytol = 1e-10;
+    CHECK(phgmg_reduce(&red, &ch.sys, X, N, ns, &o, NULL, NULL) == PHGMG_OK, "serial reduce, mass matrix");
+    /* K = G00^{-1}: the serial model's own movement under one-ulp changes of
+       the snapshots sets its tolerance (as at scale) */
+    if (red) serial_sensitivity(&ch, ns, X, x0, &o, red, &ktol, &ytol);
+    if (red) compare_serial(&ch, ns, X, x0, red, &mr, V0f, 200, ktol, ytol, "gmg-pod ecsw, mass matrix");
+    phgmg_reduced_destroy(red);
+  }
+  quiet_barrier();
+  phgmg_mpi_rom_free(&mr);
+  o.method = PHGMG_METHOD_SP1;
+  rc = phgmg_mpi_reduce(d.c, &d.md, ns, d.Xl, d.ld, &o, &mr, NULL, 0);
+  CHECK(rc == PHGMG_ERR_UNSUPPORTED && same_everywhere(rc), "sp1 with a mass matrix: %d", (int)rc);
+  o.method = PHGMG_METHOD_GMG_POD;
+  phgmg_mpi_op_destroy(Eop);   /* a coupling at the last term's coordinate l_{n-1}, owned by one rank */
+  AT(E, 2 * n - 2, 2 * n - 1) = 0.05; AT(E, 2 * n - 1, 2 * n - 2) = 0.05;
+  Eop = band_op(d.c, &ch, E, NULL, 0.0);
+  d.md.lin.E = Eop;
+  rc = phgmg_mpi_reduce(d.c, &d.md, ns, d.Xl, d.ld, &o, &mr, NULL, 0);
+  CHECK(rc == PHGMG_ERR_E_COUPLED && same_everywhere(rc) && mr.mem_ == NULL, "coupled row of E: %d", (int)rc);
+#undef AT
+  phgmg_mpi_op_destroy(Eop);
+  phgmg_jr_factor_destroy(esv_.f);
+  dist_free(&d);
+  chain_free(&ch);
+  free(E); free(X); free(x0); free(V0); free(V0f);
+}
+
 static void test_memory(void) {
   const long long N = 100000, NB = 10000;
   double one[2] = {0.0, 0.0}, gp, g1, t0 = MPI_Wtime();
@@ -1041,6 +1133,7 @@ int main(int argc, char **argv) {
     test_screened();
     test_gmg_qm(300, 8);
     test_qm_screened();
+    test_descriptor();
     test_errors();
     test_memory();
   }
