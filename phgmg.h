@@ -960,6 +960,7 @@
          [--potential NAME | --poly c.npy [--exp e.npy]] --poly-idx idx.npy
          [--poly-w w.npy] [--hyper ecsw|qdeim|greedy] [--hyper-tol T]
          [--deim-tol T] [--deim-max K] [--deim-allow-negative] [--no-hyper]
+         [--E-coo E.npy]
    reads the files of the serial `phgmg reduce` (J, R, Q as (nnz, 3)
    triplets, B, the snapshots X, the separable nonlinear part as the
    serial command takes it: a named potential or exp-polynomial
@@ -984,7 +985,8 @@
    rank's memory; beyond, put a distributed solver behind the same
    callback, as examples/petsc_mumps.c does with MUMPS. Everything else of
    `phgmg reduce` -- --simulate (make the snapshots with the serial
-   `phgmg simulate --states`), dense matrices, --E, springs (--poly-jdx),
+   `phgmg simulate --states`), dense matrices, a mass matrix with zero rows
+   (algebraic constraints) or with sp1/sp2, springs (--poly-jdx),
    dampers, feedthrough, --ref, the other methods (gmg-qm, balancing),
    several --X files,
    method or order lists -- is refused with a message naming the option;
@@ -1002,7 +1004,11 @@
    8e-15; with DEIM (--deim-tol 1e-4 --deim-allow-negative, gmg-pod with
    Q-DEIM at P = 1, 3, sp2 with greedy points at P = 2, 4): the same 12
    points in the same order, the weights within 1.2e-14, the outputs within
-   8e-15. Measured at N = 2e5 (1001 snapshots, r = 20): bench/README.md.
+   8e-15; with a mass matrix (--E-coo: consistent-mass pattern on the
+   momenta, gmg-pod with the cosh terms, P = 2, 3; E factored by the
+   library's sparse LU, replicated as J - R): the same 22 points, K within
+   2.7e-15, the weights within 1.4e-12, the outputs within 4.5e-15.
+   Measured at N = 2e5 (1001 snapshots, r = 20): bench/README.md.
    2.8 Large sparse linear models (>>lowrank). For a phgmg_ph_sparse model
    with quadratic H (E x' = (J - R) Q x + B u, y = B^T Q x; E = I or a mass
    matrix of full rank) the Gramians are computed in low-rank factored form
@@ -2620,7 +2626,7 @@
    result: phgmg_result_string
    ph:     phgmg_ph_validate, phgmg_ph_hamiltonian, phgmg_ph_gradient,
            phgmg_ph_rhs, phgmg_ph_output, phgmg_ph_apply,
-           phgmg_jr_factor_create, phgmg_jr_solve, phgmg_jr_factor_destroy,
+           phgmg_jr_factor_create, phgmg_e_factor_create, phgmg_jr_solve, phgmg_jr_factor_destroy,
            phgmg_dae_create, phgmg_dae_system, phgmg_dae_nalg,
            phgmg_dae_restrict, phgmg_dae_embed, phgmg_dae_lift,
            phgmg_dae_destroy, phgmg_csc_from_coo, phgmg_csc_free, phgmg_rcm,
@@ -3073,6 +3079,15 @@ PHGMG_DEF void phgmg_ph_apply(const phgmg_ph_system *sys, char which, int nrhs,
 typedef struct phgmg_jr_factor phgmg_jr_factor;
 PHGMG_DEF phgmg_result phgmg_jr_factor_create(phgmg_jr_factor **out, const phgmg_ph_system *sys,
                                               double *rcond_out, const phgmg_allocator *alloc);
+/* A factorization of a descriptor model's mass matrix E (phgmg_ph_system.E;
+   a sparse model's from phgmg_ph_sparse_create_e: its sparse LU, band LU
+   fall-back), for applying E^{-1} with phgmg_jr_solve ('N': E^{-1}, 'T':
+   E^{-T}), vectors as for phgmg_jr_factor_create's factor of the same
+   system (a sparse model: its banded order, phgmg_ph_sparse_to_banded_order).
+   PHGMG_ERR_INVALID_ARG (NULL, or a system without E), PHGMG_ERR_SINGULAR,
+   _NANINF, _NOMEM; rcond_out (may be NULL) as phgmg_jr_factor_create's. */
+PHGMG_DEF phgmg_result phgmg_e_factor_create(phgmg_jr_factor **out, const phgmg_ph_system *sys,
+                                             double *rcond_out, const phgmg_allocator *alloc);
 /* X <- (J - R)^{-1} X (trans 'N') or (J - R)^{-T} X (trans 'T'); X is N x nrhs. */
 PHGMG_DEF void phgmg_jr_solve(const phgmg_jr_factor *f, char trans, int nrhs, double *X, int ldx);
 /* Frees the factorization (NULL is fine). */
@@ -6997,6 +7012,14 @@ PHGMG__PRIV phgmg_result phgmg__e_factor(const phgmg_ph_system *sys, phgmg_jr_fa
   rc = phgmg_jr_factor_create(f, &t, rcond_out, alloc);
   phgmg__free(alloc, zero);
   return rc;
+}
+
+PHGMG_DEF phgmg_result phgmg_e_factor_create(phgmg_jr_factor **out, const phgmg_ph_system *sys,
+                                             double *rcond_out, const phgmg_allocator *alloc) {
+  if (!out) return PHGMG_ERR_INVALID_ARG;
+  *out = NULL;
+  if (!sys || !sys->E) return PHGMG_ERR_INVALID_ARG;
+  return phgmg__e_factor(sys, out, rcond_out, alloc);
 }
 
 /* E^T Q into a system view t (only t.Q meaningful: dense N x N, or banded

@@ -52,11 +52,17 @@ static const char *const help_text[] = {
   "               [--potential NAME | --poly FILE [--exp FILE]] --poly-idx FILE\n"
   "               [--poly-w FILE] [--hyper ecsw|qdeim|greedy] [--hyper-tol T]\n"
   "               [--deim-tol T] [--deim-max K] [--deim-allow-negative] [--no-hyper]\n"
+  "               [--E-coo E.npy]\n"
   "  phgmg-mpi --help | --version\n"
   "\n"
   "OPTIONS (those of `phgmg reduce`, with the same meaning)\n"
   "  --J-coo FILE, --R-coo FILE, --Q-coo FILE   J, R, Q as (nnz, 3) .npy arrays of\n"
   "                      (row, col, value) triplets, 0-based, duplicates summed.\n"
+  "  --E-coo FILE        a mass matrix E of full rank, (nnz, 3) triplets: the\n"
+  "                      descriptor model E x' = (J - R) z + B u, E^T z = grad H\n"
+  "                      (E^T Q symmetric; E's rows at the terms' coordinates positive\n"
+  "                      multiples of unit rows); gmg-pod only. Its solves use the\n"
+  "                      library's sparse LU of E, replicated as that of J - R.\n"
   "  --B FILE            N x m port matrix, or a vector of length N for m = 1 (N is\n"
   "                      taken from B).\n"
   "  --X FILE            the snapshots, N x ns (one state per column). Every rank reads\n"
@@ -128,9 +134,10 @@ static const char *const help_text[] = {
   "\n"
   "NOT SUPPORTED HERE (each is refused with a message naming it)\n"
   "  --simulate (give the snapshots with --X; make them with the serial\n"
-  "  `phgmg simulate ... --states X.npy`), dense --J/--R/--Q, --E/--E-coo,\n"
-  "  springs (--poly-jdx), dampers, feedthrough, --ref,\n"
-  "  gmg-qm, balancing, several --X files, method or order lists, and every\n"
+  "  `phgmg simulate ... --states X.npy`), dense --J/--R/--Q/--E, a mass matrix\n"
+  "  with zero rows (algebraic constraints) or with sp1/sp2, springs\n"
+  "  (--poly-jdx), dampers, feedthrough, --ref, gmg-qm, balancing, several --X\n"
+  "  files, method or order lists, and every\n"
   "  other option of `phgmg reduce`: use the serial `phgmg` for them.\n"
   "\n"
   "EXIT STATUS\n"
@@ -140,6 +147,7 @@ static const char *const help_text[] = {
 typedef struct args {
   const char *J, *R, *Q, *B, *X, *out, *name;
   const char *potential, *poly, *expf, *poly_idx, *poly_w;   /* the separable nonlinear part */
+  const char *E;                                             /* --E-coo: a mass matrix */
   int method, r, quiet, have_dt, no_hyper, have_hyper, have_hyper_tol;
   int hyper_kind, deim_max, deim_neg, have_deim_opt;   /* --hyper (PHGMG_HYPER_*), the DEIM options */
   double dt, hyper_tol, deim_tol;
@@ -149,8 +157,8 @@ typedef struct args {
 typedef struct dist {
   int rank, size, N, m, nloc, ns;
   long row0;
-  double *TJ, *TR, *TQ;          /* triplets (column-major nnz x 3), whole */
-  long nJ, nR, nQ;
+  double *TJ, *TR, *TQ, *TE;     /* triplets (column-major nnz x 3), whole (TE: --E-coo, else NULL) */
+  long nJ, nR, nQ, nE;
   double *Bfull, *Bl, *Xl;       /* B (N x m), its rows (nloc x m), the snapshots' rows (nloc x ns) */
   int *cnt, *dsp;                /* rows per rank and their offsets */
   /* the separable terms this rank owns (those on its rows), with their
@@ -218,9 +226,9 @@ static const char *refused_reason(const char *o) {
       !strcmp(o, "--train-input") || !strcmp(o, "--newton-tol") || !strcmp(o, "--newton-iter"))
     return "the distributed build does not simulate: give the snapshots with --X (make them with the serial "
            "`phgmg simulate <model options> --out y.npy --states X.npy`)";
-  if (!strcmp(o, "--J") || !strcmp(o, "--R") || !strcmp(o, "--Q"))
-    return "dense matrices are not read by the distributed build: give J, R, Q as triplets with --J-coo, "
-           "--R-coo, --Q-coo";
+  if (!strcmp(o, "--J") || !strcmp(o, "--R") || !strcmp(o, "--Q") || !strcmp(o, "--E"))
+    return "dense matrices are not read by the distributed build: give J, R, Q (and E) as triplets with "
+           "--J-coo, --R-coo, --Q-coo (--E-coo)";
   if (!strcmp(o, "--poly-jdx"))
     return "springs (terms on the difference of two coordinates) are not distributed: phgmg-mpi takes terms on "
            "one coordinate each (--poly-idx); use the serial `phgmg reduce`";
@@ -344,11 +352,11 @@ static int name_ok(const char *s) {
 }
 
 /* argv[2..]: the options of reduce. 0 ok, 2 a usage error (the same on every rank: the same argv). */
-#define NVOPT 20   /* options with a value; the first NSOPT are file or name strings */
-#define NSOPT 11
+#define NVOPT 21   /* options with a value; the first NSOPT are file or name strings */
+#define NSOPT 12
 static int parse_args(int argc, char **argv, args *a) {
   static const char *const with_value[NVOPT] = {"--J-coo", "--R-coo", "--Q-coo", "--B", "--X", "--out", "--name",
-                                                "--poly", "--exp", "--poly-idx", "--poly-w", "--method", "--r",
+                                                "--poly", "--exp", "--poly-idx", "--poly-w", "--E-coo", "--method", "--r",
                                                 "--dt", "--potential", "--hyper", "--hyper-tol", "--deim-tol",
                                                 "--deim-max", ""};
   const char **slot[NSOPT];
@@ -358,6 +366,7 @@ static int parse_args(int argc, char **argv, args *a) {
   a->name = "rom"; a->method = -1;
   slot[0] = &a->J; slot[1] = &a->R; slot[2] = &a->Q; slot[3] = &a->B; slot[4] = &a->X; slot[5] = &a->out;
   slot[6] = &a->name; slot[7] = &a->poly; slot[8] = &a->expf; slot[9] = &a->poly_idx; slot[10] = &a->poly_w;
+  slot[11] = &a->E;
   for (i = 2; i < argc; ++i) {
     const char *o = argv[i];
     if (!strcmp(o, "--quiet")) { a->quiet = 1; continue; }
@@ -394,6 +403,9 @@ static int parse_args(int argc, char **argv, args *a) {
   if (!a->B) return usage("--B is required");
   if (!a->X) return usage("--X is required (the snapshots; phgmg-mpi does not simulate)");
   if (a->method < 0) return usage("--method is required (gmg-pod, sp1 or sp2)");
+  if (a->E && a->method != PHGMG_METHOD_GMG_POD)
+    return usage("--E-coo: phgmg-mpi reduces models with a mass matrix by gmg-pod (for %s use the serial `phgmg "
+                 "reduce`)", method_name(a->method));
   if (a->r < 1) return usage("--r is required");
   if (!a->out) return usage("--out is required");
   if (!name_ok(a->name)) return usage("--name %s: expected a C identifier of at most 64 characters", a->name);
@@ -661,12 +673,14 @@ static int read_inputs(const args *a, dist *d) {
   if (any_rank(read_triplets("--J-coo", a->J, d->N, &d->TJ, &d->nJ))) return 1;
   if (any_rank(read_triplets("--R-coo", a->R, d->N, &d->TR, &d->nR))) return 1;
   if (any_rank(read_triplets("--Q-coo", a->Q, d->N, &d->TQ, &d->nQ))) return 1;
+  if (a->E && any_rank(read_triplets("--E-coo", a->E, d->N, &d->TE, &d->nE))) return 1;
   if (any_rank(read_terms(a, d))) return 1;
   return any_rank(read_X_rows(a, d));
 }
 
 static void dist_free(dist *d) {
   phgmg_npy_free(d->TJ, NULL); phgmg_npy_free(d->TR, NULL); phgmg_npy_free(d->TQ, NULL);
+  phgmg_npy_free(d->TE, NULL);
   phgmg_npy_free(d->Bfull, NULL);
   free(d->Bl); free(d->Xl); free(d->cnt);
   free(d->sidx); free(d->sw); free(d->spoly); free(d->sexpo);
@@ -760,6 +774,42 @@ static phgmg_result solver_create(const dist *d, solver *s) {
   return rc;
 }
 
+/* The replicated solver of the mass matrix (--E-coo): E joins J, R and
+   (here) Q = I in a sparse model, whose factor of E (phgmg_e_factor_create)
+   solve_replicated then applies. A row of E without a non-zero (an
+   algebraic constraint) is refused first: PHGMG_ERR_E_SINGULAR. */
+static phgmg_result solver_e_create(const dist *d, solver *s) {
+  phgmg_csc J, R, I, E;
+  phgmg_result rc;
+  int *idx = (int *)malloc(sizeof(int) * (size_t)d->N), i;
+  double *ones = (double *)malloc(sizeof(double) * (size_t)d->N);
+  char *nz = (char *)calloc((size_t)d->N + 1, 1);
+  long k;
+  memset(s, 0, sizeof *s);
+  memset(&J, 0, sizeof J); memset(&R, 0, sizeof R); memset(&I, 0, sizeof I); memset(&E, 0, sizeof E);
+  s->d = d;
+  s->full = (double *)malloc(sizeof(double) * 2 * (size_t)d->N);
+  rc = idx && ones && nz && s->full ? PHGMG_OK : PHGMG_ERR_NOMEM;
+  for (k = 0; rc == PHGMG_OK && k < d->nE; ++k)
+    if (d->TE[2 * d->nE + k] != 0.0) nz[(int)d->TE[k]] = 1;
+  for (i = 0; rc == PHGMG_OK && i < d->N; ++i)
+    if (!nz[i]) rc = PHGMG_ERR_E_SINGULAR;
+  if (rc == PHGMG_OK) {
+    s->work = s->full + d->N;
+    for (i = 0; i < d->N; ++i) { idx[i] = i; ones[i] = 1.0; }
+    rc = triplets_csc(d->N, d->TJ, d->nJ, &J);
+  }
+  if (rc == PHGMG_OK) rc = triplets_csc(d->N, d->TR, d->nR, &R);
+  if (rc == PHGMG_OK) rc = triplets_csc(d->N, d->TE, d->nE, &E);
+  if (rc == PHGMG_OK) rc = phgmg_csc_from_coo(&I, d->N, d->N, d->N, idx, idx, ones, NULL);
+  if (rc == PHGMG_OK) rc = phgmg_ph_sparse_create_e(&s->sp, d->N, d->m, &J, &R, &I, &E, d->Bfull, NULL, NULL, NULL);
+  if (rc == PHGMG_OK) rc = phgmg_e_factor_create(&s->f, phgmg_ph_sparse_system(s->sp), &s->rcond, NULL);
+  if (rc == PHGMG_ERR_SINGULAR) rc = PHGMG_ERR_E_SINGULAR;   /* the message names E, not J - R */
+  phgmg_csc_free(&J, NULL); phgmg_csc_free(&R, NULL); phgmg_csc_free(&I, NULL); phgmg_csc_free(&E, NULL);
+  free(idx); free(ones); free(nz);
+  return rc;
+}
+
 static void solver_free(solver *s) {
   phgmg_jr_factor_destroy(s->f);
   phgmg_ph_sparse_destroy(s->sp);
@@ -800,7 +850,7 @@ typedef struct result {
    pod_sigma_ratio): GMG-POD the snapshots adjusted by B (X - QB QB^T X,
    QB an orthonormal basis of B's columns), p = r - m; SP1 the snapshots,
    p = r. 0 if there is no further mode. Collective. */
-static phgmg_result sigma_ratio(const phgmg_mpi_ctx *ctx, const dist *d, const args *a, double *ratio) {
+static phgmg_result sigma_ratio(const phgmg_mpi_ctx *ctx, const dist *d, const args *a, solver *se, double *ratio) {
   const int ld = d->nloc > 0 ? d->nloc : 1, gmg = a->method == PHGMG_METHOD_GMG_POD, m = d->m, ns = d->ns;
   const int p = gmg ? a->r - m : a->r;
   int kmax = p + 1, k = 0, i, j;
@@ -811,8 +861,14 @@ static phgmg_result sigma_ratio(const phgmg_mpi_ctx *ctx, const dist *d, const a
   if (kmax > ns) kmax = ns;
   if ((long)kmax > (long)d->N) kmax = d->N;
   if (rc == PHGMG_OK && d->nloc > 0) memcpy(Xa, d->Xl, sizeof(double) * (size_t)d->nloc * ns);
-  if (rc == PHGMG_OK && gmg) {   /* Xa = X - QB (QB^T X) */
-    rc = phgmg_mpi_tsqr(ctx, m, d->Bl, ld, QB, ld, C, m);
+  if (rc == PHGMG_OK && gmg) {   /* Xa = X - QB (QB^T X); with a mass matrix QB from E^{-1} B */
+    double *Bp = (double *)malloc(sizeof(double) * (size_t)ld * m);
+    if (any_rank(!Bp)) rc = PHGMG_ERR_NOMEM;
+    for (j = 0; rc == PHGMG_OK && j < m && d->nloc > 0; ++j)
+      memcpy(Bp + (size_t)j * ld, d->Bl + (size_t)j * ld, sizeof(double) * (size_t)d->nloc);
+    if (rc == PHGMG_OK && se) rc = phgmg_mpi_agree(MPI_COMM_WORLD, solve_replicated('N', m, Bp, ld, se));
+    if (rc == PHGMG_OK) rc = phgmg_mpi_tsqr(ctx, m, Bp, ld, QB, ld, C, m);
+    free(Bp);
     if (rc == PHGMG_OK) rc = phgmg_mpi_atb(ctx, m, ns, QB, ld, Xa, ld, C, m);
     for (j = 0; rc == PHGMG_OK && j < ns; ++j)
       for (i = 0; i < d->nloc; ++i) {
@@ -845,6 +901,12 @@ static void explain(const args *a, const dist *d, phgmg_result rc) {
   else if (rc == PHGMG_ERR_NOT_SYMMETRIC || rc == PHGMG_ERR_NOT_PSD)
     say("--R-coo %s: R is not symmetric positive semidefinite (relative tolerance 1e-12): %s", a->R,
         phgmg_result_string(rc));
+  else if (rc == PHGMG_ERR_E_COUPLED)
+    say("--E-coo %s: %s (E's row at a nonlinear term's coordinate must be a positive multiple of the unit row)",
+        a->E, phgmg_result_string(rc));
+  else if (rc == PHGMG_ERR_E_SINGULAR)
+    say("--E-coo %s: %s (phgmg-mpi takes a mass matrix of full rank; algebraic constraints -- zero rows of E -- "
+        "reduce with the serial `phgmg reduce`)", a->E, phgmg_result_string(rc));
   else if (rc == PHGMG_ERR_NEGATIVE_WEIGHT)
     say("%s: %s (use --deim-allow-negative, a smaller --deim-tol, or --hyper ecsw)", meth, phgmg_result_string(rc));
   else if (rc == PHGMG_ERR_NOT_CONVERGED && a->poly_idx)
@@ -862,14 +924,15 @@ static void explain(const args *a, const dist *d, phgmg_result rc) {
    distributed operators, the replicated solver, phgmg_mpi_reduce. */
 static int reduce(const args *a, dist *d, result *res) {
   phgmg_mpi_ctx *ctx = NULL;
-  phgmg_mpi_op *Qop = NULL, *JRop = NULL;
+  phgmg_mpi_op *Qop = NULL, *JRop = NULL, *Eop = NULL;
   phgmg_mpi_sep_model md;
   phgmg_reduce_opts o;
-  solver sv;
+  solver sv, svE;
   const int ld = d->nloc > 0 ? d->nloc : 1;
   double t0;
   phgmg_result rc = phgmg_mpi_ctx_create(&ctx, MPI_COMM_WORLD, d->N, d->row0, d->nloc, NULL);
   memset(&sv, 0, sizeof sv);
+  memset(&svE, 0, sizeof svE);
   memset(&md, 0, sizeof md);
   t0 = MPI_Wtime();
   if (rc == PHGMG_OK) rc = make_op(ctx, d, d->TQ, d->nQ, 1.0, NULL, 0, 0.0, &Qop);
@@ -878,6 +941,12 @@ static int reduce(const args *a, dist *d, result *res) {
   if (rc == PHGMG_OK && a->method != PHGMG_METHOD_GMG_POD)   /* sp1, sp2: J - R as an operator */
     rc = make_op(ctx, d, d->TJ, d->nJ, 1.0, d->TR, d->nR, -1.0, &JRop);
   if (rc == PHGMG_OK) rc = phgmg_mpi_agree(MPI_COMM_WORLD, solver_create(d, &sv));
+  if (rc == PHGMG_OK && a->E) {   /* the mass matrix: its rows as an operator, its replicated solver */
+    rc = make_op(ctx, d, d->TE, d->nE, 1.0, NULL, 0, 0.0, &Eop);
+    if (rc == PHGMG_OK) rc = phgmg_mpi_agree(MPI_COMM_WORLD, solver_e_create(d, &svE));
+  }
+  phgmg_npy_free(d->TE, NULL);
+  d->TE = NULL;
   phgmg_npy_free(d->TJ, NULL); phgmg_npy_free(d->TR, NULL); phgmg_npy_free(d->Bfull, NULL);
   d->TJ = d->TR = d->Bfull = NULL;   /* J - R and B live in the solver (and the operators) now */
   res->V0 = (double *)malloc(sizeof(double) * ((size_t)ld * a->r + 1));
@@ -885,6 +954,7 @@ static int reduce(const args *a, dist *d, result *res) {
   if (rc == PHGMG_OK) {
     md.lin.Q = Qop; md.lin.m = d->m; md.lin.B = d->Bl; md.lin.ldb = ld;
     md.lin.solve = solve_replicated; md.lin.solve_user = &sv;
+    if (Eop) { md.lin.E = Eop; md.lin.solve_E = solve_replicated; md.lin.solve_E_user = &svE; }
     md.JR = JRop;
     if (a->poly_idx) {   /* this rank's terms, their serial term numbers as global ids */
       md.nsep = d->nsep; md.sep_idx = d->sidx; md.sep_id = d->sid; md.sep_w = d->sw;
@@ -904,9 +974,11 @@ static int reduce(const args *a, dist *d, result *res) {
   }
   res->seconds = MPI_Wtime() - t0;
   res->rcond_jr = sv.rcond;
-  if (rc == PHGMG_OK) rc = sigma_ratio(ctx, d, a, &res->sigma_ratio);
+  if (rc == PHGMG_OK) rc = sigma_ratio(ctx, d, a, Eop ? &svE : NULL, &res->sigma_ratio);
   if (rc != PHGMG_OK) explain(a, d, rc);
   solver_free(&sv);
+  solver_free(&svE);
+  phgmg_mpi_op_destroy(Eop);
   phgmg_mpi_op_destroy(Qop);
   phgmg_mpi_op_destroy(JRop);
   phgmg_mpi_ctx_destroy(ctx);
@@ -1088,12 +1160,14 @@ static int write_json(const args *a, const dist *d, const result *res) {
           a->poly_idx ? "nonlinear" : "linear");
   fprintf(f, "  \"N\": %d, \"m\": %d, \"r\": %d, \"rn\": 0, \"nd\": %d, \"poly_deg\": %d,\n", d->N, m, r, nd,
           nd ? rom->poly_deg : 0);
-  fprintf(f, "  \"E\": false, \"N_full\": %d, \"algebraic\": 0, \"feedthrough\": false,\n  \"dt_map\": 0,\n", d->N);
+  fprintf(f, "  \"E\": %s, \"N_full\": %d, \"algebraic\": 0, \"feedthrough\": false,\n  \"dt_map\": 0,\n",
+          a->E ? "true" : "false", d->N);
   fprintf(f, "  \"system\": {\"J\": "); json_str(f, a->J);
   fprintf(f, ", \"R\": "); json_str(f, a->R);
   fprintf(f, ", \"B\": "); json_str(f, a->B);
   fprintf(f, ", \"Q\": "); json_str(f, a->Q);
   fprintf(f, ", \"sparse\": true");
+  if (a->E) { fprintf(f, ", \"E\": "); json_str(f, a->E); }
   if (a->poly_idx) {
     if (a->poly) { fprintf(f, ", \"poly\": "); json_str(f, a->poly); }
     if (a->expf) { fprintf(f, ", \"exp\": "); json_str(f, a->expf); }

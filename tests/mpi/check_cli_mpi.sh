@@ -25,12 +25,18 @@
 # row of V0 that its row of P0 is) in the same order. And at P = 3 sp1 with
 # --no-hyper (every term kept, gathered from the ranks in serial order) of
 # the chain with one function per term and weights (--poly (terms, 2),
-# --exp (terms, 4), --poly-w, --poly-idx as int64).
+# --exp (terms, 4), --poly-w, --poly-idx as int64). DEIM (--hyper qdeim
+# with gmg-pod at P = 1, 3, --hyper greedy with sp2 at P = 2, 4; --deim-tol
+# 1e-4 --deim-allow-negative): the same points in the same order and the
+# same checks. A mass matrix (--E-coo: 1.25 on the positions, a
+# consistent-mass pattern on the momenta; its own 201 snapshots from the
+# serial simulate) with the cosh terms, gmg-pod at P = 2, 3: the same
+# checks, and the json's "E".
 # Bad input at P = 3: a missing --X file must end every rank with a nonzero
 # status (each rank's status recorded by a wrapper), one message, within the
 # timeout (no rank left waiting in a collective); snapshots of the wrong
 # shape, --simulate and options of the serial reduce that the distributed
-# build does not take (--ref, springs --poly-jdx), DEIM options without --hyper qdeim/greedy and negative DEIM weights without --deim-allow-negative are refused
+# build does not take (--ref, springs --poly-jdx, dense --E, a mass matrix with a zero row), DEIM options without --hyper qdeim/greedy and negative DEIM weights without --deim-allow-negative are refused
 # with a message naming them.
 #   sh tests/mpi/check_cli_mpi.sh SERIAL_PHGMG PHGMG_MPI     (make test-mpi)
 # MPIRUN overrides the launcher (default: mpirun --oversubscribe, plus
@@ -61,21 +67,39 @@ np.save(d + '/pp.npy', np.column_stack([-a, np.zeros(len(k))]))
 np.save(d + '/pe.npy', np.column_stack([a / 2, np.ones(len(k)), a / 2, -np.ones(len(k))]))
 np.save(d + '/pw.npy', 1.0 + 0.5 * (k % 3))
 np.save(d + '/idx_int.npy', idx.astype(np.int64))
+# a mass matrix E (triplets): 1.25 on each position (a positive multiple of the unit row there: the cosh
+# terms' coordinates; one scale, so that it commutes with the springs' K), a consistent-mass pattern on the
+# momenta (2/3 (1 + 0.3 sin^2 k) on the diagonal, 1/6 between neighbours); with Q = blkdiag(K, I) the
+# energy matrix E^T Q = blkdiag(1.25 K, E_p) is symmetric positive definite
+N = 2 * len(idx)
+perm = np.random.default_rng(1).permutation(N)   # bench/lattice.py's order: q = perm[0::2], p = perm[1::2]
+q, p = perm[0::2], perm[1::2]
+assert (np.sort(q) == np.sort(idx)).all()
+n = len(p)
+mp = 2.0 / 3.0 * (1.0 + 0.3 * np.sin(np.arange(n)) ** 2)
+rows = np.concatenate([q, p, p[:-1], p[1:]])
+cols = np.concatenate([q, p, p[1:], p[:-1]])
+vals = np.concatenate([1.25 * np.ones(n), mp, np.full(n - 1, 1.0 / 6.0), np.full(n - 1, 1.0 / 6.0)])
+np.save(d + '/E.npy', np.column_stack([rows, cols, vals]))
+keep = rows != q[5]   # one position's row empty: an algebraic constraint (refused by phgmg-mpi)
+np.save(d + '/E0.npy', np.column_stack([rows[keep], cols[keep], vals[keep]]))
 PYEOF
 "$PHGMG" simulate $M --dt 0.1 --steps 200 --out "$D/y_full.npy" --states "$D/X.npy" --quiet > /dev/null
 "$PHGMG" simulate $M $NL --dt 0.1 --steps 200 --out "$D/y_full_nl.npy" --states "$D/X_nl.npy" --quiet > /dev/null
 "$PHGMG" simulate $M $PT --dt 0.1 --steps 200 --out "$D/y_full_pt.npy" --states "$D/X_pt.npy" --quiet > /dev/null
+"$PHGMG" simulate $M --E-coo "$D/E.npy" $NL --dt 0.1 --steps 200 --out "$D/y_full_e.npy" --states "$D/X_e.npy" --quiet > /dev/null
 # case: linear (gmg-pod, sp1), cosh (cosh-gmg-pod, cosh-sp1), per-term functions without hyper-reduction
-# (terms-sp1), cosh with DEIM (qdeim-gmg-pod, greedy-sp2)
-for case in gmg-pod sp1 cosh-gmg-pod cosh-sp1 terms-sp1 qdeim-gmg-pod greedy-sp2; do
+# (terms-sp1), cosh with DEIM (qdeim-gmg-pod, greedy-sp2), cosh with a mass matrix (mass-gmg-pod)
+for case in gmg-pod sp1 cosh-gmg-pod cosh-sp1 terms-sp1 qdeim-gmg-pod greedy-sp2 mass-gmg-pod; do
   ps="1 2 3 4"
   case $case in
     cosh-*) meth=${case#cosh-}; X="$D/X_nl.npy"; opt=$NL ;;
     qdeim-*|greedy-*) meth=${case#*-}; X="$D/X_nl.npy"; opt="$NL --hyper ${case%%-*} --deim-tol 1e-4 --deim-allow-negative" ;;
+    mass-*) meth=${case#mass-}; X="$D/X_e.npy"; opt="$NL --E-coo $D/E.npy" ;;
     terms-*) meth=${case#terms-}; X="$D/X_pt.npy"; opt="$PT --no-hyper"; ps=3 ;;
     *) meth=$case; X="$D/X.npy"; opt="" ;;
   esac
-  case $case in sp1) ps="2 4" ;; cosh-sp1) ps="1 3" ;; qdeim-*) ps="1 3" ;; greedy-*) ps="2 4" ;; esac   # sp1, DEIM: every P over two cases
+  case $case in sp1) ps="2 4" ;; cosh-sp1) ps="1 3" ;; qdeim-*) ps="1 3" ;; greedy-*) ps="2 4" ;; mass-*) ps="2 3" ;; esac   # sp1, DEIM: every P over two cases
   "$PHGMG" reduce $M $opt --X "$X" --method $meth --r 10 --out "$D/serial_$case" --quiet > /dev/null
   "$PHGMG" simulate-rom --model "$D/serial_$case/rom.phgmgrom" --dt 0.1 --steps 300 --out "$D/y_serial_$case.npy" --quiet > /dev/null
   for p in $ps; do
@@ -114,7 +138,9 @@ refused "--ref: not supported by the distributed build" --X "$D/X.npy" --ref mea
 refused "--poly-jdx: springs" --X "$D/X_nl.npy" $NL --poly-jdx "$D/idx.npy"
 refused "--deim-tol, --deim-max and --deim-allow-negative apply to --hyper qdeim or greedy" --X "$D/X_nl.npy" $NL --deim-tol 1e-4
 refused "use --deim-allow-negative" --X "$D/X_nl.npy" $NL --hyper greedy --deim-tol 1e-4
-echo "check_cli_mpi: wrong snapshot shape, --simulate, --ref, --poly-jdx, DEIM options without DEIM, negative DEIM weights refused with messages naming them"
+refused "algebraic constraints -- zero rows of E" --X "$D/X_e.npy" $NL --E-coo "$D/E0.npy"
+refused "--E: dense matrices are not read" --X "$D/X_e.npy" --E "$D/E.npy"
+echo "check_cli_mpi: wrong snapshot shape, --simulate, --ref, --poly-jdx, DEIM options without DEIM, negative DEIM weights, a mass matrix with a zero row, dense --E refused with messages naming them"
 
 $PY - "$D" <<'PYEOF'
 import json
@@ -135,8 +161,8 @@ def coords(P0, V0):
     return out
 
 bad = 0
-for case in ('gmg-pod', 'sp1', 'cosh-gmg-pod', 'cosh-sp1', 'terms-sp1', 'qdeim-gmg-pod', 'greedy-sp2'):
-    nl = case.startswith(('cosh-', 'terms-', 'qdeim-', 'greedy-'))
+for case in ('gmg-pod', 'sp1', 'cosh-gmg-pod', 'cosh-sp1', 'terms-sp1', 'qdeim-gmg-pod', 'greedy-sp2', 'mass-gmg-pod'):
+    nl = case.startswith(('cosh-', 'terms-', 'qdeim-', 'greedy-', 'mass-'))
     names = ('K', 'Qh', 'Bh', 'V0') + (('P0', 'w', 'poly', 'expo') if nl else ())
     sd = '%s/serial_%s' % (d, case)
     ser = {n: np.load('%s/rom_%s.npy' % (sd, n)) for n in names}
@@ -153,14 +179,14 @@ for case in ('gmg-pod', 'sp1', 'cosh-gmg-pod', 'cosh-sp1', 'terms-sp1', 'qdeim-g
         print('check_cli_mpi: %s: the serial points were not found in V0' % case)
         bad = 1
     for p in {'terms-sp1': (3,), 'sp1': (2, 4), 'cosh-sp1': (1, 3), 'qdeim-gmg-pod': (1, 3),
-              'greedy-sp2': (2, 4)}.get(case, (1, 2, 3, 4)):
+              'greedy-sp2': (2, 4), 'mass-gmg-pod': (2, 3)}.get(case, (1, 2, 3, 4)):
         pd = '%s/p%d_%s' % (d, p, case)
         files_ok = sorted(os.listdir(pd)) == sorted(os.listdir(sd))
         pj = json.load(open(pd + '/rom.json'))
-        keys_ok = all(pj[k] == sj[k] for k in ('method', 'N', 'm', 'r', 'kind', 'map', 'nd', 'poly_deg')) and \
+        keys_ok = all(pj[k] == sj[k] for k in ('method', 'N', 'm', 'r', 'kind', 'map', 'nd', 'poly_deg', 'E')) and \
             pj['snapshots']['count'] == sj['snapshots']['count'] and pj['files'] == sj['files'] and \
             pj['options'] == sj['options'] and \
-            all(pj['system'].get(k) == sj['system'].get(k) for k in ('potential', 'poly', 'exp', 'poly_idx', 'poly_w'))
+            all(pj['system'].get(k) == sj['system'].get(k) for k in ('potential', 'poly', 'exp', 'poly_idx', 'poly_w', 'E'))
         if 'hyper' in sj['info'] or 'hyper' in pj['info']:
             hs, hp = sj['info']['hyper'], pj['info']['hyper']
             keys_ok = keys_ok and all(hp[k] == hs[k] for k in ('method', 'points', 'negative_weights', 'tol')) and \
