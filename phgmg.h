@@ -2696,9 +2696,9 @@
 
 /* >>config ================================================================ */
 #define PHGMG_VERSION_MAJOR 0
-#define PHGMG_VERSION_MINOR 10
+#define PHGMG_VERSION_MINOR 11
 #define PHGMG_VERSION_PATCH 0
-#define PHGMG_VERSION_STRING "0.10.0"
+#define PHGMG_VERSION_STRING "0.11.0"
 
 #include <stddef.h>
 
@@ -30421,6 +30421,25 @@ PHGMG_DEF phgmg_result phgmg_sym_eig(int n, double *A, int lda, double *w, doubl
 
 /*
    REVISION HISTORY
+   0.11.0 (2026-11-29)
+          - phgmg_mpi_reduce: DEIM hyper-reduction (hyper.kind QDEIM or
+            GREEDY) with every method it takes: the gradients' POD by TSQR
+            over the terms, Q-DEIM or greedy points found by maximum
+            reductions with ties to the lower global term index (the
+            serial points, in the serial order, for every partition), the
+            weights, negative ones refused unless allowed;
+            phgmg_mpi_rom.deim_negative and .deim_sigma_ratio.
+          - phgmg_mpi_reduce: GMG-QM with ECSW from 4096 live terms (the
+            serial screening on the manifold's training columns).
+          - Descriptor models on MPI: phgmg_mpi_linear_model.E and .solve_E
+            (a mass matrix of full rank), reduced by GMG-POD with the
+            serial formulas (ports E^{-1} B, G-blocks of E V0, the
+            separable weights E(i, i) w_k). New public
+            phgmg_e_factor_create (a factor of a model's E for
+            phgmg_jr_solve). Zero a phgmg_mpi_linear_model before setting
+            its fields.
+          - phgmg-mpi: --method sp2, --hyper qdeim|greedy with --deim-tol,
+            --deim-max, --deim-allow-negative, and --E-coo.
    0.10.0 (2026-11-29)
           - Fixed: ECSW stopped with PHGMG_ERR_NOT_CONVERGED above its
             tolerance when some terms' training columns were many orders
