@@ -14,7 +14,8 @@
 # serial GMG-QM: the basis [B, V1], every block, q_max, 100 steps of
 # outputs. QM_ONLY=1: only the GMG-QM comparison; QM_COSH=1: only GMG-QM,
 # on the linear chain and then on the cosh chain with ECSW (r = 8, rn = 4,
-# the POD and greedy manifolds; from 4096 live terms the screened fit),
+# the POD and greedy manifolds; from 4096 live terms the screened fit;
+# stepped at 0.001: these reduced models are stiff),
 # also against the serial ECSW points and weights.
 #   sh bench/mpi_equivalence.sh [n] [P ...]      (log: build/mpi_equivalence.txt)
 set -e

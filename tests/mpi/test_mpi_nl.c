@@ -29,7 +29,7 @@ static int scale_;         /* --scale n: only the comparisons at scale, n masses
 static int qm_only_;       /* --scale-qm n: only GMG-QM at scale */
 static int qm_cosh_;       /* --scale-qm-cosh n: GMG-QM at scale, also on the cosh chain with ECSW */
 static int qm_deim_;        /* compare_qm: DEIM weights (normwise) */
-static double online_dt_ = 0.1; /* online_diff's step (the cosh chain's GMG-QM models at scale: 0.01, stiff) */
+static double online_dt_ = 0.1; /* online_diff's step (the cosh chain's GMG-QM models at scale: 0.001, stiff) */
 static double wtol_ = 1e-12; /* compare_qm: the weights' tolerance (scale mode: from the serial model's movement) */
 
 
@@ -806,7 +806,7 @@ static void qm_sensitivity(const chain *ch, int ns, const double *X, const doubl
    chosen lambda) refused on every rank, bad input on one rank and a solve
    failing on one rank only. Scale mode (n masses): the linear chain, r =
    8, rn = 3, and with --scale-qm-cosh the cosh chain with ECSW (r = 8, rn
-   = 4; stepped at 0.01: its reduced models are stiff), without the error
+   = 4; stepped at 0.001: its reduced models are stiff), without the error
    cases. */
 static void test_gmg_qm(int n, int r) {
   const int N = 2 * n, ns = 81;
@@ -820,7 +820,7 @@ static void test_gmg_qm(int n, int r) {
   phgmg_result rc;
   int i, lin, mf;
   for (lin = 1; lin >= (scale_ && !qm_cosh_ ? 1 : 0); --lin) {
-    online_dt_ = scale_ && !lin ? 0.01 : 0.1;   /* the cosh chain's reduced models at scale are stiff: Newton needs 0.01 */
+    online_dt_ = scale_ && !lin ? 0.001 : 0.1;   /* the cosh chain's reduced models at scale are stiff: Newton needs 0.001 at N = 2e5 */
     chain_build(&ch, n, 0);
     if (lin) { ch.sys.nl = PHGMG_NL_NONE; ch.sys.nsep = 0; }
     for (i = 0; i < n; ++i) x0[2 * i] = 0.8 * sin(3.0 * 3.14159265358979 * i / n) + 0.3 * sin(7.0 * 3.14159265358979 * i / n);
