@@ -670,6 +670,71 @@ TEST(test_descriptor_reduce) {
   dbar_free(&b);
 }
 
+/* phgmg_e_factor_create: E^{-1} and E^{-T} applied by phgmg_jr_solve, for
+   the bar's dense model and for its scrambled sparse form (vectors in the
+   sparse model's banded order); the residual ||E x - b|| against ||b||;
+   no E, or NULL: PHGMG_ERR_INVALID_ARG. */
+TEST(test_descriptor_e_factor) {
+  dbar b;
+  phgmg_ph_system sd;
+  phgmg_ph_sparse *sp = NULL;
+  phgmg_jr_factor *f = NULL;
+  dcsc cE, cJ, cR, cQ;
+  double rhs[64], x[64], xb[64], eN = 0.0, eT = 0.0, bn = 0.0, rcond = 0.0;
+  int N, perm[64], i, j, k, t;
+  dbar_make(&b, 20);
+  N = b.N;
+  sd = dbar_system(&b, 0);
+  for (i = 0; i < N; ++i) { rhs[i] = sin(1.0 + i); bn = fmax(bn, fabs(rhs[i])); }
+  CHECK_RC(phgmg_e_factor_create(&f, &sd, &rcond, NULL), PHGMG_OK);
+  CHECK(rcond > 0.0 && rcond <= 1.0);
+  for (t = 0; f && t < 2; ++t) {   /* E x = b, E^T x = b */
+    memcpy(x, rhs, sizeof(double) * (size_t)N);
+    phgmg_jr_solve(f, t ? 'T' : 'N', 1, x, N);
+    for (i = 0; i < N; ++i) {
+      double r = -rhs[i];
+      for (j = 0; j < N; ++j) r += (t ? b.E[j + (size_t)i * N] : b.E[i + (size_t)j * N]) * x[j];
+      if (t) eT = fmax(eT, fabs(r)); else eN = fmax(eN, fabs(r));
+    }
+  }
+  CHECK_LE(eN, 1e-13 * bn);
+  CHECK_LE(eT, 1e-13 * bn);
+  phgmg_jr_factor_destroy(f);
+  f = NULL;
+  /* the scrambled sparse model: user order -> banded order, solve, back */
+  for (i = 0; i < N; ++i) perm[i] = i;
+  for (i = N - 1; i > 0; --i) { j = (int)((th_rand() + 1.0) * 0.5 * (i + 1)); if (j > i) j = i; k = perm[i]; perm[i] = perm[j]; perm[j] = k; }
+  dcsc_make(&cE, N, b.E, perm); dcsc_make(&cJ, N, b.J, perm); dcsc_make(&cR, N, b.R, perm); dcsc_make(&cQ, N, b.Q, perm);
+  {
+    double Bp[128];
+    for (j = 0; j < 2; ++j) for (i = 0; i < N; ++i) Bp[i + (size_t)j * N] = b.B[perm[i] + (size_t)j * N];
+    CHECK_RC(phgmg_ph_sparse_create_e(&sp, N, 2, &cJ.A, &cR.A, &cQ.A, &cE.A, Bp, NULL, NULL, NULL), PHGMG_OK);
+  }
+  if (sp) {
+    CHECK_RC(phgmg_e_factor_create(&f, phgmg_ph_sparse_system(sp), NULL, NULL), PHGMG_OK);
+    CHECK_RC(phgmg_ph_sparse_to_banded_order(sp, 1, rhs, N, xb, N), PHGMG_OK);
+    if (f) phgmg_jr_solve(f, 'N', 1, xb, N);
+    CHECK_RC(phgmg_ph_sparse_to_user_order(sp, 1, xb, N, x, N), PHGMG_OK);
+    eN = 0.0;   /* the scrambled E: E_u(i, j) = E(perm[i], perm[j]) */
+    for (i = 0; i < N; ++i) {
+      double r = -rhs[i];
+      for (j = 0; j < N; ++j) r += b.E[perm[i] + (size_t)perm[j] * N] * x[j];
+      eN = fmax(eN, fabs(r));
+    }
+    CHECK_LE(eN, 1e-13 * bn);
+  }
+  phgmg_jr_factor_destroy(f);
+  phgmg_ph_sparse_destroy(sp);
+  /* no mass matrix, or no output pointer */
+  sd.E = NULL;
+  f = (phgmg_jr_factor *)&sd;   /* must come back NULL */
+  CHECK_RC(phgmg_e_factor_create(&f, &sd, NULL, NULL), PHGMG_ERR_INVALID_ARG);
+  CHECK(f == NULL);
+  CHECK_RC(phgmg_e_factor_create(NULL, &sd, NULL, NULL), PHGMG_ERR_INVALID_ARG);
+  dcsc_free(&cE); dcsc_free(&cJ); dcsc_free(&cR); dcsc_free(&cQ);
+  dbar_free(&b);
+}
+
 SUITE(descriptor) {
   RUN(test_descriptor_fom_linear);
   RUN(test_descriptor_fom_nonlinear);
@@ -678,4 +743,5 @@ SUITE(descriptor) {
   RUN(test_descriptor_sparse_scrambled);
   RUN(test_descriptor_feedthrough);
   RUN(test_descriptor_reduce);
+  RUN(test_descriptor_e_factor);
 }
