@@ -22961,6 +22961,8 @@ struct phgmg_shifted {
   int nalg;        /* algebraic lines (index one: the whole pencil)    */
   long clock;
   phgmg__shf *f;   /* keep entries                                     */
+  phgmg__spnum ef; /* E's own factorization (phgmg__shifted_esolve)    */
+  int ef_state;    /* 0: not yet made, 1: made, -1: refused            */
 };
 
 PHGMG_DEF void phgmg_shifted_destroy(phgmg_shifted *s) {
@@ -22969,6 +22971,7 @@ PHGMG_DEF void phgmg_shifted_destroy(phgmg_shifted *s) {
   if (!s) return;
   al = s->alloc;
   for (i = 0; s->f && i < s->keep; ++i) phgmg__spnum_free(al, &s->f[i].F);
+  phgmg__spnum_free(al, &s->ef);
   phgmg__free(al, s->f);
   phgmg__free(al, s->Mx);
   phgmg__free(al, s->w);
@@ -23079,6 +23082,43 @@ PHGMG_DEF phgmg_result phgmg_shifted_solve(phgmg_shifted *s, double pr, double p
     for (i = 0; i < len; ++i) x[i] = -x[i];
   }
   return PHGMG_OK;
+}
+
+/* X <- E^{-1} X (N x nrhs, ld ldx) for a mass matrix of full rank (no-op
+   without one): E's numeric factorization on the pencil's analysis -- the
+   K(sigma) = sigma E + M of 8.13 at sigma = 1 with M = 0, whose pattern
+   holds E's, and whose condensed states E couples to no other (8.12) --
+   made at the first call and kept (counted in nfact). PHGMG_ERR_SINGULAR
+   when the static pivots refuse E, _NOMEM. */
+PHGMG__PRIV phgmg_result phgmg__shifted_esolve(phgmg_shifted *s, int nrhs, double *X, int ldx) {
+  int j;
+  if (!s->S->e_p || nrhs < 1) return PHGMG_OK;
+  if (s->ef_state == 0) {
+    double *zero = phgmg__dalloc(s->alloc, (size_t)s->S->k_p[s->N] + 1);
+    if (!zero || phgmg__spnum_alloc(s->alloc, s->S, 0, &s->ef) != PHGMG_OK) {
+      phgmg__free(s->alloc, zero);
+      return PHGMG_ERR_NOMEM;
+    }
+    memset(zero, 0, sizeof(double) * ((size_t)s->S->k_p[s->N] + 1));
+    phgmg__sp_factor(s->S, &s->ef, zero, 1.0, 0.0, PHGMG_SPARSE_PIVTOL);
+    phgmg__free(s->alloc, zero);
+    ++s->nfact;
+    s->ef_state = s->ef.nstatic || !(s->ef.growth <= PHGMG_SPARSE_GROWTH) ? -1 : 1;
+  }
+  if (s->ef_state < 0) return PHGMG_ERR_SINGULAR;
+  for (j = 0; j < nrhs; ++j) phgmg__sp_solve(s->S, &s->ef, X + (size_t)j * (size_t)ldx);
+  return PHGMG_OK;
+}
+
+/* y = E^T x (x without a mass matrix); S's pencil. */
+PHGMG__PRIV void phgmg__lr_etmul(const phgmg__spsym *S, const double *x, double *y) {
+  int j, p;
+  if (!S->e_p) { memcpy(y, x, sizeof(double) * (size_t)S->n); return; }
+  for (j = 0; j < S->n; ++j) {
+    double acc = 0.0;
+    for (p = S->e_p[j]; p < S->e_p[j + 1]; ++p) acc += S->e_x[p] * x[S->e_i[p]];
+    y[j] = acc;
+  }
 }
 
 /* y = E x (x when the model has no mass matrix); S's pencil. */
@@ -23572,18 +23612,25 @@ PHGMG_DEF phgmg_result phgmg_lradi(phgmg_shifted *s, int m, const double *B, int
 }
 
 /* >>lowrank: the extended Krylov subspace method (EKSM) ------------------ */
-/* State of one EKSM run (E = I): the basis V (N x nc, orthonormal in the
-   energy inner product <x, y> = x^T Q y), QV = Q V, the projected matrix T =
-   V^T Q A V and the Euclidean Gram matrix G = V^T V (both ld = ld), AL = A
-   times the last block, U / QU the next block (N x w each, w = 2 m: a
-   block's width at most). */
+/* State of one EKSM run on the extended Krylov space of (E^{-1} A, E^{-1} B)
+   (manual 8.13; E = I without a mass matrix): the basis V (N x nc,
+   orthonormal in the energy inner product <x, y> = x^T E^T Q y), QV = E^T Q
+   V (the name of the E = I case, where it is Q V), the projected matrix T =
+   V^T E^T Q E^{-1} A V and the Euclidean Gram matrices G = V^T V and GE =
+   (E V)^T (E V) (GE = G without E; all ld = ld), AL = E^{-1} A times the
+   last block, U / QU the next block (N x w each, w = 2 m: a block's width at
+   most), Bt = E^{-1} B (B itself without E). */
 typedef struct phgmg__eksm {
   phgmg_shifted *s;
   const phgmg_allocator *al;
   int N, m, w, nc, cap, ld;  /* w = 2 m columns per block; nc filled, cap allocated */
-  double p;                  /* shift of the inverse directions (A + p I)^{-1}       */
-  double *V, *QV, *T, *G, *tm; /* tm: cap x 2 w scratch (with T, G: one allocation)  */
+  int hase;                  /* 1: a mass matrix E (solves with E)                  */
+  double p;                  /* shift of the inverse directions (A + p E)^{-1}       */
+  double *V, *QV, *T, *G, *GE, *tm; /* tm: cap x 2 w scratch (with T, G, GE: one allocation) */
   double *AL, *U, *QU;       /* one buffer: N x w each                               */
+  const double *Bt;          /* E^{-1} B (N x m, ld ldbt)                            */
+  double *Bown;              /* Bt when allocated here (a mass matrix), else NULL    */
+  int ldbt;
   int maxb;                  /* blocks at most (maxit)                                */
   int np, nm;                /* the last block: np columns from A, then nm from the
                                 inverse (fewer than m each after deflation)          */
@@ -23607,27 +23654,31 @@ PHGMG__PRIV void phgmg__lr_ltmul(const phgmg__spsym *S, const double *x, double 
 PHGMG__PRIV phgmg_result phgmg__ek_grow(phgmg__eksm *st) {
   const size_t N = (size_t)st->N;
   const int cap0 = st->w * PHGMG__MAX(1, PHGMG__EK_CAP0 / st->w);
-  int cap = PHGMG__MIN(st->cap ? 2 * st->cap : cap0, st->maxb * st->w), j;
-  double *V, *QV, *T, *G;
+  const int cap = PHGMG__MIN(st->cap ? 2 * st->cap : cap0, st->maxb * st->w), nsq = st->hase ? 3 : 2;
+  const size_t cc = (size_t)cap;
+  int j;
+  double *V, *QV, *T, *G, *GE;
   if (st->nc + st->w <= st->cap) return PHGMG_OK;
-  V = phgmg__dalloc(st->al, N * (size_t)cap);
-  QV = phgmg__dalloc(st->al, N * (size_t)cap);
-  T = phgmg__dalloc(st->al, 2 * (size_t)cap * (size_t)cap + 2 * (size_t)cap * (size_t)st->w);
+  V = phgmg__dalloc(st->al, N * cc);
+  QV = phgmg__dalloc(st->al, N * cc);
+  T = phgmg__dalloc(st->al, (size_t)nsq * cc * cc + 2 * cc * (size_t)st->w);
   if (!V || !QV || !T) {
     phgmg__free(st->al, V); phgmg__free(st->al, QV); phgmg__free(st->al, T);
     return PHGMG_ERR_NOMEM;
   }
-  G = T + (size_t)cap * (size_t)cap;
+  G = T + cc * cc;
+  GE = st->hase ? G + cc * cc : G;
   if (st->nc) {
     memcpy(V, st->V, sizeof(double) * N * (size_t)st->nc);
     memcpy(QV, st->QV, sizeof(double) * N * (size_t)st->nc);
     for (j = 0; j < st->nc; ++j) {
       memcpy(T + (size_t)j * cap, st->T + (size_t)j * st->ld, sizeof(double) * (size_t)st->nc);
       memcpy(G + (size_t)j * cap, st->G + (size_t)j * st->ld, sizeof(double) * (size_t)st->nc);
+      if (st->hase) memcpy(GE + (size_t)j * cap, st->GE + (size_t)j * st->ld, sizeof(double) * (size_t)st->nc);
     }
   }
   phgmg__free(st->al, st->V); phgmg__free(st->al, st->QV); phgmg__free(st->al, st->T);
-  st->V = V; st->QV = QV; st->T = T; st->G = G; st->tm = G + (size_t)cap * (size_t)cap;
+  st->V = V; st->QV = QV; st->T = T; st->G = G; st->GE = GE; st->tm = T + (size_t)nsq * cc * cc;
   st->cap = st->ld = cap;
   return PHGMG_OK;
 }
@@ -23680,11 +23731,17 @@ PHGMG__PRIV int phgmg__ek_mgs(phgmg__eksm *st, const double *nrm, int *np, int *
   return kept;
 }
 
-/* QU = Q U for U's first c columns (recomputed: the updates of QU along
-   with U drift from Q U when a column is normalised from a small rest). */
+/* QU = E^T Q U (Q U without a mass matrix) for U's first c columns
+   (recomputed: the updates of QU along with U drift from E^T Q U when a
+   column is normalised from a small rest). */
 PHGMG__PRIV void phgmg__ek_qmul(phgmg__eksm *st, int c) {
   int j;
-  for (j = 0; j < c; ++j) phgmg__sp_qmv(st->s->S, st->U + (size_t)j * st->N, st->QU + (size_t)j * st->N);
+  for (j = 0; j < c; ++j) {
+    double *u = st->U + (size_t)j * st->N, *qu = st->QU + (size_t)j * st->N;
+    if (!st->hase) { phgmg__sp_qmv(st->s->S, u, qu); continue; }
+    phgmg__sp_qmv(st->s->S, u, st->s->w);
+    phgmg__lr_etmul(st->s->S, st->s->w, qu);
+  }
 }
 
 /* The new block U (QU = Q U; st->up columns from A, then st->um from the
@@ -23716,48 +23773,80 @@ PHGMG__PRIV int phgmg__ek_orth(phgmg__eksm *st, double *wk) {
   return c;
 }
 
-/* Appends the orthonormal block U (QU) to the basis: AL = A U, X = L^T Q U
-   (L = J - R) next to it, the new columns and rows of T = V^T Q A V from
-   one product Q V^T [AL, X] (rows: V_k^T Q A V = (L^T Q V_k)^T Q V, since Q
-   A = Q L Q) and of G = V^T V. U is scratch afterwards. */
-PHGMG__PRIV void phgmg__ek_append(phgmg__eksm *st) {
+/* The new columns c0..c1 of the symmetric Gram matrix Gm = V^T Y (Y: N x
+   (c1 - c0), the product of the new block), mirrored into its rows. */
+PHGMG__PRIV void phgmg__ek_gram_cols(phgmg__eksm *st, double *Gm, int c0, int c1, const double *Y) {
+  const int N = st->N, ld = st->ld;
+  int i, j;
+  phgmg_gemm('T', 'N', c1, c1 - c0, N, 1.0, st->V, N, Y, N, 0.0, Gm + (size_t)c0 * ld, ld);
+  for (j = c0; j < c1; ++j)
+    for (i = 0; i < c0; ++i) Gm[j + (size_t)i * ld] = Gm[i + (size_t)j * ld];
+}
+
+/* Appends the orthonormal block U (QU) to the basis: AL = E^{-1} A U, X =
+   E^{-1} L^T Q U (L = J - R) next to it, the new columns and rows of T =
+   V^T E^T Q E^{-1} A V from one product (E^T Q V)^T [AL, X] (rows: V_k^T
+   E^T Q E^{-1} A V = (L^T Q V_k)^T Q V = X_k^T E^T Q V, since E^T Q E^{-1}
+   = Q^T), of G = V^T V and (a mass matrix) of GE = V^T E^T E V. U and QU
+   are scratch afterwards. PHGMG_ERR_SINGULAR etc. from the solves with E. */
+PHGMG__PRIV phgmg_result phgmg__ek_append(phgmg__eksm *st) {
   const int N = st->N, w = st->up + st->um, c0 = st->nc, c1 = c0 + w, ld = st->ld;
   double *X = st->AL + (size_t)w * N, *M = st->tm; /* X: w columns after AL's w (AL + U hold 2 st->w) */
+  phgmg_result rc;
   int i, j;
   memcpy(st->V + (size_t)c0 * N, st->U, sizeof(double) * (size_t)N * (size_t)w);
   memcpy(st->QV + (size_t)c0 * N, st->QU, sizeof(double) * (size_t)N * (size_t)w);
   for (j = 0; j < w; ++j) phgmg__lr_amul(st->s->S, st->V + (size_t)(c0 + j) * N, st->AL + (size_t)j * N, st->s->w);
-  for (j = 0; j < w; ++j) phgmg__lr_ltmul(st->s->S, st->QV + (size_t)(c0 + j) * N, X + (size_t)j * N);
+  for (j = 0; j < w; ++j) {
+    if (st->hase) phgmg__sp_qmv(st->s->S, st->V + (size_t)(c0 + j) * N, st->QU);
+    phgmg__lr_ltmul(st->s->S, st->hase ? st->QU : st->QV + (size_t)(c0 + j) * N, X + (size_t)j * N);
+  }
+  if ((rc = phgmg__shifted_esolve(st->s, w, st->AL, N)) != PHGMG_OK ||
+      (rc = phgmg__shifted_esolve(st->s, w, X, N)) != PHGMG_OK)
+    return rc;
   phgmg_gemm('T', 'N', c1, 2 * w, N, 1.0, st->QV, N, st->AL, N, 0.0, M, c1);
   for (j = 0; j < w; ++j) {
     memcpy(st->T + (size_t)(c0 + j) * ld, M + (size_t)j * c1, sizeof(double) * (size_t)c1);
     for (i = 0; i < c0; ++i) st->T[c0 + j + (size_t)i * ld] = M[i + (size_t)(w + j) * c1];
   }
-  phgmg_gemm('T', 'N', c1, w, N, 1.0, st->V, N, st->V + (size_t)c0 * N, N, 0.0, st->G + (size_t)c0 * ld, ld);
-  for (j = c0; j < c1; ++j)
-    for (i = 0; i < c0; ++i) st->G[j + (size_t)i * ld] = st->G[i + (size_t)j * ld];
+  phgmg__ek_gram_cols(st, st->G, c0, c1, st->V + (size_t)c0 * N);
+  if (st->hase) { /* GE's new columns: V^T E^T E V_k (E V_k in QU, then E^T of it in U) */
+    for (j = 0; j < w; ++j) {
+      phgmg__lr_emul(st->s->S, st->V + (size_t)(c0 + j) * N, st->QU + (size_t)j * N);
+      phgmg__lr_etmul(st->s->S, st->QU + (size_t)j * N, st->U + (size_t)j * N);
+    }
+    phgmg__ek_gram_cols(st, st->GE, c0, c1, st->U);
+  }
   st->nc = c1;
   st->np = st->up; st->nm = st->um;
+  return PHGMG_OK;
 }
 
-/* The next block's directions: U = [A V_k^+, (A + p I)^{-1} V_k^-] (V_k^+:
-   the last block's np columns from A, V_k^-: its nm from the inverse), QU
-   = Q U. */
+/* The next block's directions: U = [E^{-1} A V_k^+, (A + p E)^{-1} E V_k^-]
+   (V_k^+: the last block's np columns from E^{-1} A, V_k^-: its nm from the
+   inverse; (A + p E)^{-1} E = (E^{-1} A + p I)^{-1}), QU = E^T Q U. */
 PHGMG__PRIV phgmg_result phgmg__ek_next(phgmg__eksm *st) {
   const int N = st->N, np = st->np, nm = st->nm;
+  const double *Vm = st->V + (size_t)(st->nc - nm) * N;
+  double *Um = st->U + (size_t)np * N;
   phgmg_result rc;
   int j;
   memcpy(st->U, st->AL, sizeof(double) * (size_t)N * (size_t)np);
-  rc = phgmg_shifted_solve(st->s, st->p, 0.0, nm, st->V + (size_t)(st->nc - nm) * N, N, st->U + (size_t)np * N, N);
+  if (st->hase) {
+    for (j = 0; j < nm; ++j) phgmg__lr_emul(st->s->S, Vm + (size_t)j * N, Um + (size_t)j * N);
+    rc = phgmg_shifted_solve(st->s, st->p, 0.0, nm, Um, N, Um, N);
+  } else {
+    rc = phgmg_shifted_solve(st->s, st->p, 0.0, nm, Vm, N, Um, N);
+  }
   if (rc != PHGMG_OK) return rc;
   st->up = np; st->um = nm;
-  for (j = 0; j < np + nm; ++j) phgmg__sp_qmv(st->s->S, st->U + (size_t)j * N, st->QU + (size_t)j * N);
+  phgmg__ek_qmul(st, np + nm);
   return PHGMG_OK;
 }
 
 /* The projected equation T Y + Y T^T + b b^T = 0 (order n = st->nc, b = V^T
-   Q B) by phgmg_lyap into Y (n x n). */
-PHGMG__PRIV phgmg_result phgmg__ek_project(phgmg__eksm *st, const double *B, int ldb, double *Y) {
+   E^T Q E^{-1} B = (E^T Q V)^T Bt) by phgmg_lyap into Y (n x n). */
+PHGMG__PRIV phgmg_result phgmg__ek_project(phgmg__eksm *st, double *Y) {
   const int n = st->nc, m = st->m, N = st->N;
   double *Tk = phgmg__dalloc(st->al, 2 * (size_t)n * (size_t)n + (size_t)n * (size_t)m), *F, *b;
   phgmg_result rc;
@@ -23765,7 +23854,7 @@ PHGMG__PRIV phgmg_result phgmg__ek_project(phgmg__eksm *st, const double *B, int
   if (!Tk) return PHGMG_ERR_NOMEM;
   F = Tk + (size_t)n * n; b = F + (size_t)n * n;
   for (j = 0; j < n; ++j) memcpy(Tk + (size_t)j * n, st->T + (size_t)j * st->ld, sizeof(double) * (size_t)n);
-  phgmg_gemm('T', 'N', n, m, N, 1.0, st->QV, N, B, ldb, 0.0, b, n);
+  phgmg_gemm('T', 'N', n, m, N, 1.0, st->QV, N, st->Bt, st->ldbt, 0.0, b, n);
   phgmg_gemm('N', 'T', n, n, m, 1.0, b, n, b, n, 0.0, F, n);
   for (j = 0; j < n; ++j)
     for (i = 0; i < j; ++i) F[i + (size_t)j * n] = F[j + (size_t)i * n];
@@ -23774,24 +23863,31 @@ PHGMG__PRIV phgmg_result phgmg__ek_project(phgmg__eksm *st, const double *B, int
   return rc;
 }
 
-/* ||A V Y V^T + V Y V^T A^T + B B^T||_2 for the projected solution Y,
-   exactly and without an N x N matrix: A V = V T + W_L [0 I] with W_L = A
-   V_k - V T(:, k) (the last block k only: A maps the earlier blocks into
-   the basis), so the residual is X S X^T with X = [V, W_L] and S = [0,
-   Y_L^T; Y_L, 0], Y_L = Y's last w rows; its 2-norm is the largest |eig|
-   of Gamma^{1/2} S Gamma^{1/2}, Gamma = X^T X (from G, V^T W_L, W_L^T W_L). */
+/* ||A V Y V^T E^T + E V Y V^T A^T + B B^T||_2 for the projected solution
+   Y, exactly and without an N x N matrix: E^{-1} A V = V T + W_L [0 I] with
+   W_L = E^{-1} A V_k - V T(:, k) (the last block k only: E^{-1} A maps the
+   earlier blocks into the basis) and E^{-1} B in span(V), so the residual
+   is E X S X^T E^T with X = [V, W_L] and S = [0, Y_L^T; Y_L, 0], Y_L = Y's
+   last w rows; its 2-norm is the largest |eig| of Gamma^{1/2} S
+   Gamma^{1/2}, Gamma = X^T E^T E X (from GE, V^T E^T E W_L, W_L^T E^T E
+   W_L; E = I without a mass matrix). */
 PHGMG__PRIV phgmg_result phgmg__ek_resid(phgmg__eksm *st, const double *Y, double *res) {
   const int N = st->N, w = st->np + st->nm, n = st->nc, c0 = n - w, q = n + w;
-  double *Wl = st->U, *M = phgmg__dalloc(st->al, 3 * (size_t)q * (size_t)q + (size_t)q), *S, *Ev, *ev;
+  double *Wl = st->U, *EEw = st->hase ? st->QU : st->U, *S, *Ev, *ev;
+  double *M = phgmg__dalloc(st->al, 3 * (size_t)q * (size_t)q + (size_t)q);
   phgmg_result rc;
   int i, j;
   if (!M) return PHGMG_ERR_NOMEM;
   S = M + (size_t)q * q; Ev = S + (size_t)q * q; ev = Ev + (size_t)q * q;
   memcpy(Wl, st->AL, sizeof(double) * (size_t)N * (size_t)w);
   phgmg_gemm('N', 'N', N, w, n, -1.0, st->V, N, st->T + (size_t)c0 * st->ld, st->ld, 1.0, Wl, N);
-  for (j = 0; j < n; ++j) memcpy(M + (size_t)j * q, st->G + (size_t)j * st->ld, sizeof(double) * (size_t)n);
-  phgmg_gemm('T', 'N', n, w, N, 1.0, st->V, N, Wl, N, 0.0, M + (size_t)n * q, q);
-  phgmg_gemm('T', 'N', w, w, N, 1.0, Wl, N, Wl, N, 0.0, M + (size_t)n * q + n, q);
+  for (j = 0; st->hase && j < w; ++j) { /* E^T E W_L */
+    phgmg__lr_emul(st->s->S, Wl + (size_t)j * N, st->s->w);
+    phgmg__lr_etmul(st->s->S, st->s->w, EEw + (size_t)j * N);
+  }
+  for (j = 0; j < n; ++j) memcpy(M + (size_t)j * q, st->GE + (size_t)j * st->ld, sizeof(double) * (size_t)n);
+  phgmg_gemm('T', 'N', n, w, N, 1.0, st->V, N, EEw, N, 0.0, M + (size_t)n * q, q);
+  phgmg_gemm('T', 'N', w, w, N, 1.0, Wl, N, EEw, N, 0.0, M + (size_t)n * q + n, q);
   for (j = n; j < q; ++j)
     for (i = 0; i < n; ++i) M[j + (size_t)i * q] = M[i + (size_t)j * q];
   rc = phgmg_sym_eig(q, M, q, ev, Ev, q);          /* Gamma = Ev diag(ev) Ev^T */
@@ -23891,19 +23987,20 @@ PHGMG__PRIV phgmg_result phgmg__ek_factor(phgmg__eksm *st, double *Y, double tru
   return PHGMG_OK;
 }
 
-/* The first block's directions U = [B, (A + p I)^{-1} B], QU = Q U, with p
-   = 0 (A^{-1}), or -- when the static pivots refuse A (PHGMG_ERR_SINGULAR:
-   a mass-spring model's positions) -- p = -|theta|, theta the Ritz value
-   of A on span(B) of least modulus (the first projection shift of
-   phgmg_lradi's kind, so A + p I is factored like an ADI shift). */
+/* The first block's directions U = [E^{-1} B, (A + p E)^{-1} B] (= [Bt,
+   (E^{-1} A + p I)^{-1} Bt]), QU = E^T Q U, with p = 0 (A^{-1}), or -- when
+   the static pivots refuse A (PHGMG_ERR_SINGULAR: a mass-spring model's
+   positions) -- p = -|theta|, theta the Ritz value of the pencil on
+   span(Bt) of least modulus (the first projection shift of phgmg_lradi's
+   kind, so A + p E is factored like an ADI shift). */
 PHGMG__PRIV phgmg_result phgmg__ek_first(phgmg__eksm *st, const double *B, int ldb) {
   const int N = st->N, m = st->m;
   const size_t Nm = (size_t)N * (size_t)m;
   phgmg_result rc;
   int j;
-  for (j = 0; j < m; ++j) memcpy(st->U + (size_t)j * N, B + (size_t)j * ldb, sizeof(double) * (size_t)N);
+  for (j = 0; j < m; ++j) memcpy(st->U + (size_t)j * N, st->Bt + (size_t)j * st->ldbt, sizeof(double) * (size_t)N);
   st->p = 0.0;
-  rc = phgmg_shifted_solve(st->s, 0.0, 0.0, m, st->U, N, st->U + Nm, N);
+  rc = phgmg_shifted_solve(st->s, 0.0, 0.0, m, B, ldb, st->U + Nm, N);
   if (rc == PHGMG_ERR_SINGULAR) {
     phgmg__lradi lr;
     double amin = HUGE_VAL;
@@ -23915,11 +24012,11 @@ PHGMG__PRIV phgmg_result phgmg__ek_first(phgmg__eksm *st, const double *B, int l
     if (rc != PHGMG_OK) return rc;
     if (lr.nsh == 0) return PHGMG_ERR_NOT_STABLE;
     st->p = -amin;
-    rc = phgmg_shifted_solve(st->s, st->p, 0.0, m, st->U, N, st->U + Nm, N);
+    rc = phgmg_shifted_solve(st->s, st->p, 0.0, m, B, ldb, st->U + Nm, N);
   }
   if (rc != PHGMG_OK) return rc;
   st->up = st->um = m;
-  for (j = 0; j < 2 * m; ++j) phgmg__sp_qmv(st->s->S, st->U + (size_t)j * N, st->QU + (size_t)j * N);
+  phgmg__ek_qmul(st, 2 * m);
   return PHGMG_OK;
 }
 
@@ -23928,13 +24025,13 @@ PHGMG__PRIV phgmg_result phgmg__ek_first(phgmg__eksm *st, const double *B, int l
    it converged (inf->res <= tol), else NULL. A projected matrix that
    phgmg_lyap refuses leaves the residual as it was (the next block may
    fix it). */
-PHGMG__PRIV phgmg_result phgmg__ek_check(phgmg__eksm *st, const double *B, int ldb, double bnorm, double tol,
-                                         double **Y, phgmg_lradi_info *inf) {
+PHGMG__PRIV phgmg_result phgmg__ek_check(phgmg__eksm *st, double bnorm, double tol, double **Y,
+                                         phgmg_lradi_info *inf) {
   double *y = phgmg__dalloc(st->al, (size_t)st->nc * (size_t)st->nc), res = 0.0;
   phgmg_result rc;
   *Y = NULL;
   if (!y) return PHGMG_ERR_NOMEM;
-  rc = phgmg__ek_project(st, B, ldb, y);
+  rc = phgmg__ek_project(st, y);
   if (rc == PHGMG_ERR_SINGULAR || rc == PHGMG_ERR_NOT_CONVERGED) { phgmg__free(st->al, y); return PHGMG_OK; }
   if (rc == PHGMG_OK) rc = phgmg__ek_resid(st, y, &res);
   if (rc == PHGMG_OK) inf->res = res / bnorm;
@@ -23946,16 +24043,15 @@ PHGMG__PRIV phgmg_result phgmg__ek_check(phgmg__eksm *st, const double *B, int l
 /* The block loop of phgmg_lrkrylov (the first block in the basis): a new
    block per pass, the projected equation checked after blocks 1, 2, ... 8
    and then every quarter of the blocks so far; *Y the converged solution. */
-PHGMG__PRIV phgmg_result phgmg__ek_iterate(phgmg__eksm *st, const double *B, int ldb, const phgmg_lradi_opts *o,
-                                           double tol, int maxit, double bnorm, double *wk, double **Y,
-                                           phgmg_lradi_info *inf) {
+PHGMG__PRIV phgmg_result phgmg__ek_iterate(phgmg__eksm *st, const phgmg_lradi_opts *o, double tol, int maxit,
+                                           double bnorm, double *wk, double **Y, phgmg_lradi_info *inf) {
   int next = 1, orc;
   phgmg_result rc;
   inf->iters = 1;
   for (;;) {
     if (inf->iters >= next || st->breakdown || inf->iters >= maxit) {
       phgmg__lr_progress(o, "eksm: projected equation");
-      if ((rc = phgmg__ek_check(st, B, ldb, bnorm, tol, Y, inf)) != PHGMG_OK || *Y) return rc;
+      if ((rc = phgmg__ek_check(st, bnorm, tol, Y, inf)) != PHGMG_OK || *Y) return rc;
       next = inf->iters + PHGMG__MAX(1, inf->iters / 4);
       if (st->breakdown || inf->iters >= maxit) return PHGMG_ERR_NOT_CONVERGED;
     }
@@ -23963,9 +24059,22 @@ PHGMG__PRIV phgmg_result phgmg__ek_iterate(phgmg__eksm *st, const double *B, int
     orc = phgmg__ek_orth(st, wk);
     if (orc < 0) return PHGMG_ERR_NANINF;
     if (orc == 0) { st->breakdown = 1; continue; }
-    phgmg__ek_append(st);
+    if ((rc = phgmg__ek_append(st)) != PHGMG_OK) return rc;
     ++inf->iters;
   }
+}
+
+/* Bt = E^{-1} B (a mass matrix: allocated, B's columns solved with E's
+   factorization), else B itself. */
+PHGMG__PRIV phgmg_result phgmg__ek_bt(phgmg__eksm *st, const double *B, int ldb) {
+  const int N = st->N;
+  int j;
+  st->Bt = B; st->ldbt = ldb;
+  if (!st->hase) return PHGMG_OK;
+  if (!(st->Bown = phgmg__dalloc(st->al, (size_t)N * (size_t)st->m))) return PHGMG_ERR_NOMEM;
+  for (j = 0; j < st->m; ++j) memcpy(st->Bown + (size_t)j * N, B + (size_t)j * ldb, sizeof(double) * (size_t)N);
+  st->Bt = st->Bown; st->ldbt = N;
+  return phgmg__shifted_esolve(st->s, st->m, st->Bown, N);
 }
 
 /* Arguments and options of phgmg_lrkrylov (those of phgmg_lradi). */
@@ -23981,7 +24090,7 @@ PHGMG__PRIV phgmg_result phgmg__ek_args(const phgmg_shifted *s, int m, const dou
     if (o->maxit > 0) *maxit = o->maxit;
     if (o->trunc != 0.0) *trunc = o->trunc;
   }
-  if (s->S->e_p || s->nalg) return PHGMG_ERR_UNSUPPORTED; /* E = I only */
+  if (s->nalg) return PHGMG_ERR_UNSUPPORTED; /* E of full rank only (no algebraic lines) */
   for (j = 0; j < m; ++j)
     if (!phgmg__all_finite(B + (size_t)j * (size_t)ldb, (size_t)s->N)) return PHGMG_ERR_NANINF;
   return PHGMG_OK;
@@ -24004,6 +24113,7 @@ PHGMG_DEF phgmg_result phgmg_lrkrylov(phgmg_shifted *s, int m, const double *B, 
   memset(&st, 0, sizeof st);
   nf0 = s->nfact;
   st.s = s; st.al = alloc; st.N = s->N; st.m = m; st.w = 2 * m; st.maxb = maxit;
+  st.hase = s->S->e_p != NULL;
   st.AL = phgmg__dalloc(alloc, 3 * (size_t)s->N * (size_t)st.w);
   wk = phgmg__dalloc(alloc, (size_t)PHGMG__EK_CHUNK * (size_t)st.w + (size_t)st.w);
   if (!st.AL || !wk) rc = PHGMG_ERR_NOMEM;
@@ -24014,13 +24124,13 @@ PHGMG_DEF phgmg_result phgmg_lrkrylov(phgmg_shifted *s, int m, const double *B, 
     if (bnorm != bnorm) rc = PHGMG_ERR_NOMEM;
     else if (!(bnorm > 0.0)) rc = PHGMG_ERR_RANK; /* B = 0 */
   }
+  if (rc == PHGMG_OK) rc = phgmg__ek_bt(&st, B, ldb);
   if (rc == PHGMG_OK) rc = phgmg__ek_first(&st, B, ldb);
   if (rc == PHGMG_OK) rc = phgmg__ek_grow(&st);
   if (rc == PHGMG_OK && (orc = phgmg__ek_orth(&st, wk)) <= 0) rc = orc == 0 ? PHGMG_ERR_RANK : PHGMG_ERR_NANINF;
-  if (rc == PHGMG_OK) {
-    phgmg__ek_append(&st);
+  if (rc == PHGMG_OK && (rc = phgmg__ek_append(&st)) == PHGMG_OK) {
     inf.res = 1.0;   /* Z = 0: the residual B B^T */
-    rc = phgmg__ek_iterate(&st, B, ldb, opts, tol, maxit, bnorm, wk, &Y, &inf);
+    rc = phgmg__ek_iterate(&st, opts, tol, maxit, bnorm, wk, &Y, &inf);
   }
   inf.cols = st.nc;
   inf.shift = st.p;
@@ -24028,7 +24138,7 @@ PHGMG_DEF phgmg_result phgmg_lrkrylov(phgmg_shifted *s, int m, const double *B, 
   inf.rank = rc == PHGMG_OK ? *k : 0;
   inf.factorizations = s->nfact - nf0;
   if (info) *info = inf;
-  phgmg__free(alloc, Y); phgmg__free(alloc, wk); phgmg__free(alloc, st.AL);
+  phgmg__free(alloc, Y); phgmg__free(alloc, wk); phgmg__free(alloc, st.AL); phgmg__free(alloc, st.Bown);
   phgmg__free(alloc, st.V); phgmg__free(alloc, st.QV); phgmg__free(alloc, st.T);
   return rc;
 }
