@@ -987,16 +987,19 @@
          steps, columns, rank, residual, factorizations;
      phgmg_lrkrylov
          the extended Krylov subspace method (EKSM) for the same equation
-         when E = I: ONE real sparse LU for the whole run (of A, or of A +
-         p I with a real p < 0 when the static pivots refuse A), a basis of
-         span{B, A^{-1} B, A B, A^{-2} B, ...} in blocks of 2 m columns, the
-         small projected equation by phgmg_lyap, the same residual measure,
-         stop (1e-10) and compression as phgmg_lradi; more columns than the
-         ADI, no shifts to choose. phgmg_lradi_opts.solver =
-         PHGMG_LYAP_EKSM makes phgmg_lradi -- so phgmg_lrbt, phgmg_lrphbt
-         and phgmg_balanced_reduce -- run it (the command line's reduce
-         --lyap eksm); zero (PHGMG_LYAP_ADI) keeps the ADI. A mass matrix or
-         algebraic lines: PHGMG_ERR_UNSUPPORTED (use the ADI);
+         when E is I or a mass matrix of full rank: ONE real sparse LU of
+         the pencil for the whole run (of A, or of A + p E with a real p <
+         0 when the static pivots refuse A), with a mass matrix one more of
+         E, a basis of span{B', A'^{-1} B', A' B', A'^{-2} B', ...} (A' =
+         E^{-1} A, B' = E^{-1} B) in blocks of 2 m columns, orthonormal in
+         the energy inner product x^T E^T Q y, the small projected equation
+         by phgmg_lyap, the same residual measure, stop (1e-10) and
+         compression as phgmg_lradi; more columns than the ADI, no shifts to
+         choose. phgmg_lradi_opts.solver = PHGMG_LYAP_EKSM makes phgmg_lradi
+         -- so phgmg_lrbt, phgmg_lrphbt and phgmg_balanced_reduce -- run it
+         (the command line's reduce --lyap eksm); zero (PHGMG_LYAP_ADI) keeps
+         the ADI. Algebraic lines (an index-one E): PHGMG_ERR_UNSUPPORTED
+         (use the ADI);
      phgmg_lrbt
          low-rank square-root BT: Ar, Br, Cr (Er = I) like phgmg_bt, the
          Hankel singular values and the H-infinity bound 2 sum_{i > r}
@@ -2212,18 +2215,42 @@
    S_k from the thin SVD (phgmg_svd), singular values above trunc = 1e-12
    sigma_1 (the Gramian changes by at most 1e-24 of its norm).
    Extended Krylov (phgmg_lrkrylov; Simoncini 2007, Druskin and Knizhnerman).
-   For E = I, instead of one sparse LU per ADI shift, ONE real LU serves the
-   whole run: the space span{B, A^{-1} B, A B, A^{-2} B, ...} grows by blocks
-   of 2 m columns, block j + 1 from [A V_j^+, A^{-1} V_j^-] (the halves of
-   block j that came from A and from A^{-1}). The basis is orthonormal in the
-   energy inner product x^T Q y: then T = V^T Q A V = V^T Q (J - R) Q V has T
-   + T^T = -2 V^T Q R Q V <= 0, so the Galerkin equation T Y + Y T^T + b b^T =
-   0 (b = V^T Q B, test space Q V) is stable whenever the model is; in the
-   Euclidean product V^T A V need not be stable when Q != I. T's new columns
-   V^T Q (A V_j) and rows (L^T Q V_j)^T Q V (L = J - R, Q A = Q L Q) take one
-   product Q V^T [A V_j, L^T Q V_j] per block; no product with A^T.
+   Instead of one sparse LU per ADI shift, ONE real LU serves the whole run.
+   With E of full rank the equation is that of A' = E^{-1} A, B' = E^{-1} B:
+   multiplying A P E^T + E P A^T + B B^T = 0 by E^{-1} from the left and
+   E^{-T} from the right gives A' P + P A'^T + B' B'^T = 0, the same P. The
+   space span{B', A'^{-1} B', A' B', A'^{-2} B', ...} grows by blocks of 2 m
+   columns, block j + 1 from [A' V_j^+, A'^{-1} V_j^-] (the halves of block j
+   that came from A' and from A'^{-1}), where A' v = E^{-1} (A v) is a
+   product and a solve with E, A'^{-1} v = A^{-1} (E v) a product and a solve
+   with A, and B' = E^{-1} B, A'^{-1} B' = A^{-1} B start it: E and A are
+   each factored once (E on the pencil's own analysis: K(sigma) = sigma E +
+   M at sigma = 1 and M = 0, whose pattern holds E's; the LU's condensed
+   states are never coupled by E, 8.12); E = I needs neither E solve nor
+   product, and the algebra below is then that of Q. The energy. A pH
+   descriptor model E x' = (J - R) Q x has H = x^T E^T Q x / 2 with M_E = E^T
+   Q = Q^T E symmetric positive definite, so <x, y> = x^T M_E y is an inner
+   product; the basis V is orthonormal in it (V^T M_E V = I). From E^T Q =
+   Q^T E, E^T Q E^{-1} = Q^T and so M_E A' = E^T Q E^{-1} (J - R) Q = Q^T (J -
+   R) Q: the projected matrix
+       T = V^T M_E A' V = (Q V)^T (J - R) (Q V)
+   has T + T^T = (Q V)^T ((J - R) + (J - R)^T) (Q V) = -2 (Q V)^T R (Q V) <= 0
+   (R >= 0, J skew), and the Galerkin equation (test space M_E V, b = V^T M_E
+   B' = V^T Q^T B)
+       V^T M_E (A' P + P A'^T + B' B'^T) M_E V = T Y + Y T^T + b b^T = 0
+   for P ~ V Y V^T is stable whenever the model is (the same argument as for
+   E = I, where M_E = Q); in the Euclidean product V^T A' V need not be
+   stable. This needs only E^T Q symmetric positive definite -- what the pH
+   descriptor form requires -- not E or Q alone symmetric. The dual model (J
+   -> -J, the observability Gramian, above) has the same M_E. In the code QV
+   = M_E V = E^T (Q V) is kept with V (for E = I, Q V); T's new columns are
+   (M_E V)^T (A' V_j), its new rows V_j^T M_E A' V = (L^T Q V_j)^T (Q V) =
+   (E^{-1} L^T Q V_j)^T (M_E V) (L = J - R, Q V = E^{-T} M_E V): one product
+   (M_E V)^T [A' V_j, E^{-1} L^T Q V_j] per block, no product with A^T and
+   no Q V for the old columns (with E: two solves with E per new column,
+   cheaper than a product with the N x n basis).
    Orthonormalisation: block Gram-Schmidt against the basis (64 columns at a
-   time), modified Gram-Schmidt within the block, all twice, with Q V_j
+   time), modified Gram-Schmidt within the block, all twice, with M_E V_j
    recomputed from V_j after each pass (updating Q U along with U drifts when
    a column is normalised from a small rest: on the 16 x 16 lattice the energy
    orthogonality fell to 4e-2 at 88 columns and the residual grew from 1e-5 to
@@ -2231,14 +2258,17 @@
    to that accuracy and is dropped (the 8 x 8 lattice, whose reachable space
    is about 64 of its 128 states, narrows its blocks after 13 of them and
    stops at 70 columns).
-   Residual. A maps the first j - 1 blocks into the first j, so A V = V T +
-   W_L E_j^T with W_L = A V_j - V T(:, j) (the last block only), and with Y
-   the projected solution R = A V Y V^T + V Y V^T A^T + B B^T = X [0, Y_L^T;
-   Y_L, 0] X^T, X = [V, W_L], Y_L = Y's last rows: ||R||_2 is the largest
-   |eigenvalue| of Gamma^{1/2} [0, Y_L^T; Y_L, 0] Gamma^{1/2}, Gamma = X^T X
-   of order n + 2 m (from V^T V, kept up to date, V^T W_L and W_L^T W_L). It
-   is the 2-norm relative to ||B^T B||_2 that LR-ADI reports, and the same
-   stop (1e-10). Y comes from phgmg_lyap (the sign iteration, O(n^3) per
+   Residual. A' maps the first j - 1 blocks into the first j, so A' V = V T
+   + W_L E_j^T with W_L = A' V_j - V T(:, j) (the last block only), and with
+   Y the projected solution (B' in the first block's span) R' = A' V Y V^T +
+   V Y V^T A'^T + B' B'^T = X [0, Y_L^T; Y_L, 0] X^T, X = [V, W_L], Y_L = Y's
+   last rows. The residual of the generalized equation is R = A P E^T + E P
+   A^T + B B^T = E R' E^T = (E X) [0, Y_L^T; Y_L, 0] (E X)^T, so ||R||_2 is the
+   largest |eigenvalue| of Gamma^{1/2} [0, Y_L^T; Y_L, 0] Gamma^{1/2}, Gamma
+   = (E X)^T (E X) of order n + 2 m (from (E V)^T (E V), kept up to date
+   with V^T V, V^T E^T E W_L and W_L^T E^T E W_L; E = I: X^T X). It is the
+   2-norm of the generalized residual relative to ||B^T B||_2 that LR-ADI
+   reports (||W^T W||_2 / ||B^T B||_2 there), and the same stop (1e-10). Y comes from phgmg_lyap (the sign iteration, O(n^3) per
    step), so the projected equation is solved after blocks 1, ..., 8 and then
    every quarter of the blocks so far. Z = V Y^{1/2} is compressed by the rule
    of LR-ADI (singular values below 1e-12 sigma_1 dropped), its SVD from the
@@ -2246,13 +2276,16 @@
    columns), never a QR of the N x n factor.
    The pole. The sparse LU's static pivots refuse A itself where the
    factorization condenses states with a zero diagonal (a mass-spring model's
-   positions, 8.12): then the inverse directions use (A + p I)^{-1} with p =
-   -|theta|, theta the Ritz value of A on span(B) of least modulus -- a
-   rational Krylov space with one real pole instead of 0, the same algebra (A
-   (A + p I)^{-1} = I - p (A + p I)^{-1}, so A still maps each block into the
-   next). On the lattices p = -0.540 (the damping of the corner masses). A
-   mass matrix would need solves with E for E^{-1} A (the object has none):
-   PHGMG_ERR_UNSUPPORTED, the ADI serves such models.
+   positions, 8.12): then the inverse directions use (A' + p I)^{-1} = (A + p
+   E)^{-1} E with p = -|theta|, theta the Ritz value of the pencil on
+   span(B') of least modulus -- a rational Krylov space with one real pole
+   instead of 0, the same algebra (A' (A' + p I)^{-1} = I - p (A' + p
+   I)^{-1}, so A' still maps each block into the next). On the lattices p =
+   -0.540 (the damping of the corner masses). Algebraic lines (E with zero
+   rows and columns, index one, 8.14): E^{-1} does not exist, and the space
+   of the condensed model would need its A_dd - A_dc A_ac^{-1} A_ad, which
+   is never formed: PHGMG_ERR_UNSUPPORTED, the ADI serves such models on the
+   whole pencil.
    Checked (tests/test_eksm.c): the 16 x 16 heat model (N = 256, p = 0, one
    factorization): Z Z^T within 2.3e-12 (relative, Frobenius) of the dense
    Gramian from R's eigen-decomposition, the residual of a run at tol 1e-7
@@ -2261,10 +2294,24 @@
    lattice (N = 98, p = -0.540): P and O = Q Zy Zy^T Q (dual model) within
    6e-15 of phgmg_lyap's, the residual (tol 1e-4 run, 7.66e-6) to 5e-11,
    Hankel singular values within 6e-15 sigma_1 of the dense ones and 5e-12
-   sigma_1 of the ADI's; bad arguments, a mass matrix (PHGMG_ERR_UNSUPPORTED),
-   too few blocks (PHGMG_ERR_NOT_CONVERGED). tests/test_cli_lowrank.sh:
-   `reduce --method bt --lyap eksm` on the 8 x 8 lattice, Hankel singular
-   values within 1.2e-10 sigma_1 of the --lyap adi run's.
+   sigma_1 of the ADI's. Mass matrices, against the dense Gramians of the
+   E^{-1} model (phgmg_lu_solve, phgmg_lyap): a 1-D acoustic model in P1
+   elements (x = (p, v), E = blkdiag(M, M) consistent mass, Q = blkdiag(2 I,
+   0.5 I), R = 0.05 E + 0.01 blkdiag(K, K), N = 160, states scrambled; p = 0,
+   2 factorizations, 27 blocks, 108 columns -> rank 91): Z Z^T within 1e-13,
+   the generalized residual of a tol 1e-5 run (4.02e-7) equal to the densely
+   recomputed ||A P E^T + E P A^T + B B^T||_2 / ||B^T B||_2 to 3e-8 of
+   itself, Hankel singular values within 1.2e-14 sigma_1 of the dense ones
+   and 4.3e-14 sigma_1 of the ADI's; the 8 x 8 lattice with E = [I 0; 0 Mc]
+   (Mc tridiagonal; N = 128, A refused: p = -0.491, 3 factorizations, 108
+   columns -> rank 103): Z Z^T within 1.1e-11, values within 1.6e-13 sigma_1
+   of the dense ones and 2.4e-12 sigma_1 of the ADI's. Bad arguments,
+   algebraic lines (a massless node: PHGMG_ERR_UNSUPPORTED), too few blocks
+   (PHGMG_ERR_NOT_CONVERGED). tests/test_cli_lowrank.sh: `reduce --method bt
+   --lyap eksm` on the 8 x 8 lattice, Hankel singular values within 1.2e-10
+   sigma_1 of the --lyap adi run's; with --E-coo (a 1-D P1 heat model,
+   consistent mass, N = 150, scrambled) within 3.4e-12 sigma_1 of the ADI's
+   and 7.9e-11 sigma_1 of SciPy's dense values.
    Measured (bench/bench_lowrank.c --lyap eksm against --lyap adi, r = 20, AMD
    EPYC under KVM, 2 vCPUs shared with other jobs, CPU time user + sys of the
    whole run, two runs each; bench/README.md): heat N = 100 489: EKSM 10.0 -
@@ -4581,7 +4628,7 @@ PHGMG_DEF void phgmg_shifted_destroy(phgmg_shifted *s);
 /* The solvers of the low-rank Lyapunov equation (phgmg_lradi_opts.solver). */
 enum {
   PHGMG_LYAP_ADI = 0,  /* low-rank ADI (phgmg_lradi; the default)                  */
-  PHGMG_LYAP_EKSM = 1  /* extended Krylov subspace method (phgmg_lrkrylov; E = I) */
+  PHGMG_LYAP_EKSM = 1  /* extended Krylov subspace method (phgmg_lrkrylov; E of full rank) */
 };
 
 /* Options of the low-rank Lyapunov solvers (zero: default, low-rank ADI). */
@@ -4616,7 +4663,7 @@ typedef struct phgmg_lradi_info {
                        (EKSM: the same quantity, computed from the projection) */
   int solver;       /* the solver that ran: PHGMG_LYAP_ADI or PHGMG_LYAP_EKSM    */
   double shift;     /* EKSM: the real shift p of the inverse directions (A + p
-                       I)^{-1} (0: A^{-1}; see phgmg_lrkrylov); ADI: 0           */
+                       E)^{-1} E (0: A^{-1} E; see phgmg_lrkrylov); ADI: 0       */
 } phgmg_lradi_info;
 
 /* Low-rank ADI for A P E^T + E P A^T + B B^T = 0 with the pencil of s
@@ -4638,38 +4685,46 @@ typedef struct phgmg_lradi_info {
 PHGMG_DEF phgmg_result phgmg_lradi(phgmg_shifted *s, int m, const double *B, int ldb, const phgmg_lradi_opts *opts,
                                    double **Z, int *k, phgmg_lradi_info *info, const phgmg_allocator *alloc);
 /* The extended Krylov subspace method (EKSM; Simoncini, Druskin and
-   Knizhnerman) for A P + P A^T + B B^T = 0 (E = I) with the pencil of s, with
-   the contract of phgmg_lradi (Z, *k, info, opts; Z freed by
-   phgmg_lowrank_free): one real factorization serves the whole run. The basis
-   V of the extended Krylov space span{B, A^{-1} B, A B, A^{-2} B, ...} grows
-   by blocks of 2 m columns, [A V_j^+, A^{-1} V_j^-] from the last block's two
-   halves, orthonormalised in the energy inner product x^T Q y (block
-   Gram-Schmidt against the basis, then modified Gram-Schmidt within the block,
-   the whole done twice; a direction whose part outside the basis is below 1e-8
-   of its norm is dropped, so blocks may get narrower). Then T = V^T Q A V has
-   T + T^T = -2 V^T Q R Q V <= 0, so the projected equation T Y + Y T^T + (V^T
-   Q B)(V^T Q B)^T = 0 (Galerkin with the test space Q V) is stable; T takes
-   one sparse product with A and one with (J - R)^T per basis vector. After
-   blocks 1, ..., 8 and then every quarter of the blocks so far: Y by
-   phgmg_lyap and the residual ||A V Y V^T + V Y V^T A^T + B B^T||_2 / ||B^T
-   B||_2 -- the relative spectral norm that phgmg_lradi reports -- from the
-   last block (A maps the earlier blocks into the basis) and a Gram matrix of
-   order n + 2 m (n the basis's columns), no N x N matrix. Stop at tol (1e-10),
-   then Z = V Y^{1/2} compressed as phgmg_lradi's (singular values below trunc
-   sigma_1, 1e-12, dropped; computed through V's small Gram matrix). When the
-   static pivots of the sparse LU refuse A itself (a mass-spring model's
-   positions: zero diagonal), the inverse directions use (A + p I)^{-1} with
-   the real p = -|theta|, theta the Ritz value of A on span(B) of least
-   modulus: the same structure of the space, its pole moved off the origin.
-   dual = 1 gives the dual model's factor, as with phgmg_lradi. Memory: 4 m
-   vectors of length N per block (the basis and Q times it; room for 256
-   columns first, doubled when needed), maxit blocks at most (0: 100). info: iters the
-   blocks, cols the basis's columns, shift the p used, factorizations 1 (2 when
-   A was refused), shift_sets 0. Errors: those of phgmg_lradi (_NOT_CONVERGED
-   at maxit blocks, or when no new direction is left before tol is reached),
-   PHGMG_ERR_UNSUPPORTED for a model with a mass matrix or algebraic lines (E
-   != I: E^{-1} A would need solves with E, which the object does not make; use
-   the ADI). Manual 8.13. */
+   Knizhnerman) for A P E^T + E P A^T + B B^T = 0 with the pencil of s, E = I
+   or a mass matrix of full rank, with the contract of phgmg_lradi (Z, *k,
+   info, opts; Z freed by phgmg_lowrank_free): one real factorization of the
+   pencil serves the whole run, and with a mass matrix one of E (made on the
+   pencil's analysis, kept by s). It solves the equivalent A' P + P A'^T + B'
+   B'^T = 0, A' = E^{-1} A, B' = E^{-1} B (E = I: A, B). The basis V of the
+   extended Krylov space span{B', A'^{-1} B', A' B', A'^{-2} B', ...} grows by
+   blocks of 2 m columns, [A' V_j^+, A'^{-1} V_j^-] from the last block's two
+   halves (A' v: a product with A and a solve with E; A'^{-1} v = A^{-1} E v),
+   orthonormalised in the energy inner product x^T E^T Q y (block Gram-Schmidt
+   against the basis, then modified Gram-Schmidt within the block, the whole
+   done twice; a direction whose part outside the basis is below 1e-8 of its
+   norm is dropped, so blocks may get narrower). Then T = V^T E^T Q A' V = (Q
+   V)^T (J - R) (Q V) (E^T Q = Q^T E) has T + T^T = -2 (Q V)^T R (Q V) <= 0,
+   so the projected equation T Y + Y T^T + (V^T Q^T B)(V^T Q^T B)^T = 0
+   (Galerkin with the test space E^T Q V) is stable; T takes one sparse
+   product with A and one with (J - R)^T per basis vector (with E: two solves
+   with E). After blocks 1, ..., 8 and then every quarter of the blocks so
+   far: Y by phgmg_lyap and the residual ||A V Y V^T E^T + E V Y V^T A^T + B
+   B^T||_2 / ||B^T B||_2 -- the relative spectral norm that phgmg_lradi
+   reports -- from the last block (A' maps the earlier blocks into the basis)
+   and a Gram matrix of order n + 2 m (n the basis's columns), no N x N
+   matrix. Stop at tol (1e-10), then Z = V Y^{1/2} compressed as
+   phgmg_lradi's (singular values below trunc sigma_1, 1e-12, dropped;
+   computed through V's small Gram matrix). When the static pivots of the
+   sparse LU refuse A itself (a mass-spring model's positions: zero
+   diagonal), the inverse directions use (A + p E)^{-1} E with the real p =
+   -|theta|, theta the Ritz value of the pencil on span(B') of least modulus:
+   the same structure of the space, its pole moved off the origin. dual = 1
+   gives the dual model's factor, as with phgmg_lradi. Memory: 4 m vectors of
+   length N per block (the basis and E^T Q times it; room for 256 columns
+   first, doubled when needed), maxit blocks at most (0: 100); a mass matrix
+   adds E's factor and m vectors. info: iters the blocks, cols the basis's
+   columns, shift the p used, factorizations 1 (2 when A was refused; one
+   more for E), shift_sets 0. Errors: those of phgmg_lradi (_NOT_CONVERGED at
+   maxit blocks, or when no new direction is left before tol is reached),
+   PHGMG_ERR_SINGULAR also when the static pivots refuse E, and
+   PHGMG_ERR_UNSUPPORTED for a model with algebraic lines (an index-one E
+   with zero rows and columns: E^{-1} A does not exist; use the ADI, manual
+   8.14). Manual 8.13. */
 PHGMG_DEF phgmg_result phgmg_lrkrylov(phgmg_shifted *s, int m, const double *B, int ldb, const phgmg_lradi_opts *opts,
                                       double **Z, int *k, phgmg_lradi_info *info, const phgmg_allocator *alloc);
 /* Frees a factor from phgmg_lradi or phgmg_lrkrylov (NULL is fine). */
@@ -30154,7 +30209,9 @@ PHGMG_DEF phgmg_result phgmg_sym_eig(int n, double *A, int lda, double *w, doubl
             wide V2, ALTMIN, a chosen lambda and the screened ECSW with
             GMG-QM return PHGMG_ERR_UNSUPPORTED.
           - New: phgmg_lrkrylov, the extended Krylov subspace method for the
-            low-rank Lyapunov equation (E = I; one sparse LU per run),
+            low-rank Lyapunov equation (E = I or a mass matrix of full rank,
+            in the energy inner product x^T E^T Q y; one sparse LU per run,
+            and one of E),
             chosen by phgmg_lradi_opts.solver = PHGMG_LYAP_EKSM wherever the
             ADI runs (phgmg_lrbt, phgmg_lrphbt, phgmg_balanced_reduce);
             phgmg_lradi_info.solver and .shift; the command line's reduce
