@@ -111,6 +111,13 @@ print("test_cli_lowrank: mass matrix, --lyap eksm vs adi: %d Hankel singular val
       "SciPy %.2g; residuals %s%s" % (n, e_ak, e_ref, k["lyapunov_residual"], "" if ok else "  FAIL"))
 sys.exit(0 if ok else 1)
 EOF_PY
+# Algebraic equations (an index-one RLC grid, bench/rlc_grid.py): --lyap eksm
+# refuses them (exit 1), naming the zero rows of E.
+"$PY" "$ROOT/bench/rlc_grid.py" "$T/rlc" --n 6 > /dev/null 2>&1 || { echo "FAIL: rlc_grid.py"; nfail=$((nfail + 1)); }
+"$P" reduce --J-coo "$T/rlc/J.npy" --R-coo "$T/rlc/R.npy" --Q-coo "$T/rlc/Q.npy" --E-coo "$T/rlc/E.npy" \
+  --B "$T/rlc/B.npy" --method bt --r 6 --lyap eksm --out "$T/log" --name btrlc > "$T/logr.txt" 2>&1
+[ $? -eq 1 ] && grep -F -q "mass matrix of full rank only" "$T/logr.txt" && grep -F -q "zero rows" "$T/logr.txt" ||
+  { echo "FAIL: --lyap eksm on algebraic equations"; cat "$T/logr.txt"; nfail=$((nfail + 1)); }
 "$P" reduce --J-coo "$D/J.npy" --R-coo "$D/R.npy" --Q-coo "$D/Q.npy" --B "$D/B.npy" --method bt --r 8 \
   --lyap krylov --out "$T/log" --name bad > "$T/logb.txt" 2>&1
 [ $? -eq 2 ] || { echo "FAIL: --lyap krylov is not a usage error"; nfail=$((nfail + 1)); }
