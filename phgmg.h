@@ -2266,9 +2266,12 @@
    A^T + B B^T = E R' E^T = (E X) [0, Y_L^T; Y_L, 0] (E X)^T, so ||R||_2 is the
    largest |eigenvalue| of Gamma^{1/2} [0, Y_L^T; Y_L, 0] Gamma^{1/2}, Gamma
    = (E X)^T (E X) of order n + 2 m (from (E V)^T (E V), kept up to date
-   with V^T V, V^T E^T E W_L and W_L^T E^T E W_L; E = I: X^T X). It is the
-   2-norm of the generalized residual relative to ||B^T B||_2 that LR-ADI
-   reports (||W^T W||_2 / ||B^T B||_2 there), and the same stop (1e-10). Y comes from phgmg_lyap (the sign iteration, O(n^3) per
+   with V^T V, V^T E^T E W_L and W_L^T E^T E W_L; E = I: X^T X). The middle
+   factor is U C U^T with U = [Y_L^T 0; 0 I] and C = [0 I; I 0], so the
+   nonzero eigenvalues are those of H^{1/2} C H^{1/2}, H = U^T Gamma U of
+   order 4 m: O(n^2 m) work, not O(n^3). It is the 2-norm of the generalized
+   residual relative to ||B^T B||_2 that LR-ADI reports (||W^T W||_2 / ||B^T
+   B||_2 there), and the same stop (1e-10). Y comes from phgmg_lyap (the sign iteration, O(n^3) per
    step), so the projected equation is solved after blocks 1, ..., 8 and then
    every quarter of the blocks so far. Z = V Y^{1/2} is compressed by the rule
    of LR-ADI (singular values below 1e-12 sigma_1 dropped), its SVD from the
@@ -23923,41 +23926,51 @@ PHGMG__PRIV phgmg_result phgmg__ek_project(phgmg__eksm *st, double *Y) {
    W_L = E^{-1} A V_k - V T(:, k) (the last block k only: E^{-1} A maps the
    earlier blocks into the basis) and E^{-1} B in span(V), so the residual
    is E X S X^T E^T with X = [V, W_L] and S = [0, Y_L^T; Y_L, 0], Y_L = Y's
-   last w rows; its 2-norm is the largest |eig| of Gamma^{1/2} S
-   Gamma^{1/2}, Gamma = X^T E^T E X (from GE, V^T E^T E W_L, W_L^T E^T E
-   W_L; E = I without a mass matrix). */
+   last w rows. S = U C U^T with U = [Y_L^T 0; 0 I] (order n + w by 2 w) and
+   C = [0 I; I 0], so the residual's nonzero eigenvalues are those of C H, H
+   = U^T Gamma U = [Y_L G Y_L^T, Y_L V^T E^T E W_L; ., W_L^T E^T E W_L] (2 w
+   x 2 w; Gamma = X^T E^T E X, G = (E V)^T (E V); E = I without a mass
+   matrix), the same as those of H^{1/2} C H^{1/2}: the 2-norm from two
+   eigenproblems of order 2 w after O(n^2 w) products. */
 PHGMG__PRIV phgmg_result phgmg__ek_resid(phgmg__eksm *st, const double *Y, double *res) {
-  const int N = st->N, w = st->np + st->nm, n = st->nc, c0 = n - w, q = n + w;
-  double *Wl = st->U, *EEw = st->hase ? st->QU : st->U, *S, *Ev, *ev;
-  double *M = phgmg__dalloc(st->al, 3 * (size_t)q * (size_t)q + (size_t)q);
+  const int N = st->N, w = st->np + st->nm, n = st->nc, c0 = n - w, q = 2 * w;
+  const double *YL = Y + (size_t)c0 * n;   /* Y_L^T = Y(:, c0:n) (Y symmetric), n x w */
+  double *Wl = st->U, *EEw = st->hase ? st->QU : st->U, *G2, *GY, *H, *Ev, *ev, *K;
+  double *M = phgmg__dalloc(st->al, 2 * (size_t)n * (size_t)w + 4 * (size_t)q * (size_t)q + (size_t)q);
   phgmg_result rc;
   int i, j;
   if (!M) return PHGMG_ERR_NOMEM;
-  S = M + (size_t)q * q; Ev = S + (size_t)q * q; ev = Ev + (size_t)q * q;
+  G2 = M; GY = G2 + (size_t)n * w; H = GY + (size_t)n * w; Ev = H + (size_t)q * q; K = Ev + (size_t)q * q;
+  ev = K + (size_t)q * q;
   memcpy(Wl, st->AL, sizeof(double) * (size_t)N * (size_t)w);
   phgmg_gemm('N', 'N', N, w, n, -1.0, st->V, N, st->T + (size_t)c0 * st->ld, st->ld, 1.0, Wl, N);
   for (j = 0; st->hase && j < w; ++j) { /* E^T E W_L */
     phgmg__lr_emul(st->s->S, Wl + (size_t)j * N, st->s->w);
     phgmg__lr_etmul(st->s->S, st->s->w, EEw + (size_t)j * N);
   }
-  for (j = 0; j < n; ++j) memcpy(M + (size_t)j * q, st->GE + (size_t)j * st->ld, sizeof(double) * (size_t)n);
-  phgmg_gemm('T', 'N', n, w, N, 1.0, st->V, N, EEw, N, 0.0, M + (size_t)n * q, q);
-  phgmg_gemm('T', 'N', w, w, N, 1.0, Wl, N, EEw, N, 0.0, M + (size_t)n * q + n, q);
-  for (j = n; j < q; ++j)
-    for (i = 0; i < n; ++i) M[j + (size_t)i * q] = M[i + (size_t)j * q];
-  rc = phgmg_sym_eig(q, M, q, ev, Ev, q);          /* Gamma = Ev diag(ev) Ev^T */
+  phgmg_gemm('T', 'N', n, w, N, 1.0, st->V, N, EEw, N, 0.0, G2, n);                 /* V^T E^T E W_L */
+  phgmg_gemm('N', 'N', n, w, n, 1.0, st->GE, st->ld, YL, n, 0.0, GY, n);             /* G Y_L^T */
+  phgmg_gemm('T', 'N', w, w, n, 1.0, YL, n, GY, n, 0.0, H, q);                       /* Y_L G Y_L^T */
+  phgmg_gemm('T', 'N', w, w, n, 1.0, YL, n, G2, n, 0.0, H + (size_t)w * q, q);       /* Y_L V^T E^T E W_L */
+  phgmg_gemm('T', 'N', w, w, N, 1.0, Wl, N, EEw, N, 0.0, H + (size_t)w * q + w, q);  /* W_L^T E^T E W_L */
+  for (j = 0; j < q; ++j)   /* symmetric: the upper triangle's values */
+    for (i = j + 1; i < q; ++i) H[i + (size_t)j * q] = H[j + (size_t)i * q];
+  rc = phgmg_sym_eig(q, H, q, ev, Ev, q);          /* H = Ev diag(ev) Ev^T */
   if (rc == PHGMG_OK) {
     for (j = 0; j < q; ++j) {
       const double sq = sqrt(ev[j] > 0.0 ? ev[j] : 0.0);
       for (i = 0; i < q; ++i) Ev[i + (size_t)j * q] *= sqrt(sq);
     }
-    phgmg_gemm('N', 'T', q, q, q, 1.0, Ev, q, Ev, q, 0.0, M, q); /* Gamma^{1/2} */
-    memset(S, 0, sizeof(double) * (size_t)q * q);
-    for (j = 0; j < n; ++j)
-      for (i = 0; i < w; ++i) S[n + i + (size_t)j * q] = S[j + (size_t)(n + i) * q] = Y[c0 + i + (size_t)j * n];
-    phgmg_gemm('N', 'N', q, q, q, 1.0, M, q, S, q, 0.0, Ev, q);
-    phgmg_gemm('N', 'N', q, q, q, 1.0, Ev, q, M, q, 0.0, S, q);
-    rc = phgmg_sym_eig(q, S, q, ev, NULL, q);
+    phgmg_gemm('N', 'T', q, q, q, 1.0, Ev, q, Ev, q, 0.0, H, q);   /* H^{1/2} */
+    for (j = 0; j < q; ++j)                                        /* C H^{1/2}: the halves' rows swapped */
+      for (i = 0; i < q; ++i) Ev[i + (size_t)j * q] = H[(i + w) % q + (size_t)j * q];
+    phgmg_gemm('N', 'N', q, q, q, 1.0, H, q, Ev, q, 0.0, K, q);    /* H^{1/2} C H^{1/2} */
+    for (j = 0; j < q; ++j)
+      for (i = j + 1; i < q; ++i) {
+        const double a = 0.5 * (K[i + (size_t)j * q] + K[j + (size_t)i * q]);
+        K[i + (size_t)j * q] = K[j + (size_t)i * q] = a;
+      }
+    rc = phgmg_sym_eig(q, K, q, ev, NULL, q);
   }
   if (rc == PHGMG_OK) *res = PHGMG__MAX(fabs(ev[0]), fabs(ev[q - 1]));
   phgmg__free(st->al, M);
