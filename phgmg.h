@@ -1037,16 +1037,19 @@
          steps, columns, rank, residual, factorizations;
      phgmg_lrkrylov
          the extended Krylov subspace method (EKSM) for the same equation
-         when E = I: ONE real sparse LU for the whole run (of A, or of A +
-         p I with a real p < 0 when the static pivots refuse A), a basis of
-         span{B, A^{-1} B, A B, A^{-2} B, ...} in blocks of 2 m columns, the
-         small projected equation by phgmg_lyap, the same residual measure,
-         stop (1e-10) and compression as phgmg_lradi; more columns than the
-         ADI, no shifts to choose. phgmg_lradi_opts.solver =
-         PHGMG_LYAP_EKSM makes phgmg_lradi -- so phgmg_lrbt, phgmg_lrphbt
-         and phgmg_balanced_reduce -- run it (the command line's reduce
-         --lyap eksm); zero (PHGMG_LYAP_ADI) keeps the ADI. A mass matrix or
-         algebraic lines: PHGMG_ERR_UNSUPPORTED (use the ADI);
+         when E is I or a mass matrix of full rank: ONE real sparse LU of
+         the pencil for the whole run (of A, or of A + p E with a real p <
+         0 when the static pivots refuse A), with a mass matrix one more of
+         E, a basis of span{B', A'^{-1} B', A' B', A'^{-2} B', ...} (A' =
+         E^{-1} A, B' = E^{-1} B) in blocks of 2 m columns, orthonormal in
+         the energy inner product x^T E^T Q y, the small projected equation
+         by phgmg_lyap, the same residual measure, stop (1e-10) and
+         compression as phgmg_lradi; more columns than the ADI, no shifts to
+         choose. phgmg_lradi_opts.solver = PHGMG_LYAP_EKSM makes phgmg_lradi
+         -- so phgmg_lrbt, phgmg_lrphbt and phgmg_balanced_reduce -- run it
+         (the command line's reduce --lyap eksm); zero (PHGMG_LYAP_ADI) keeps
+         the ADI. Algebraic lines (an index-one E): PHGMG_ERR_UNSUPPORTED
+         (use the ADI);
      phgmg_lrbt
          low-rank square-root BT: Ar, Br, Cr (Er = I) like phgmg_bt, the
          Hankel singular values and the H-infinity bound 2 sum_{i > r}
@@ -2269,18 +2272,42 @@
    S_k from the thin SVD (phgmg_svd), singular values above trunc = 1e-12
    sigma_1 (the Gramian changes by at most 1e-24 of its norm).
    Extended Krylov (phgmg_lrkrylov; Simoncini 2007, Druskin and Knizhnerman).
-   For E = I, instead of one sparse LU per ADI shift, ONE real LU serves the
-   whole run: the space span{B, A^{-1} B, A B, A^{-2} B, ...} grows by blocks
-   of 2 m columns, block j + 1 from [A V_j^+, A^{-1} V_j^-] (the halves of
-   block j that came from A and from A^{-1}). The basis is orthonormal in the
-   energy inner product x^T Q y: then T = V^T Q A V = V^T Q (J - R) Q V has T
-   + T^T = -2 V^T Q R Q V <= 0, so the Galerkin equation T Y + Y T^T + b b^T =
-   0 (b = V^T Q B, test space Q V) is stable whenever the model is; in the
-   Euclidean product V^T A V need not be stable when Q != I. T's new columns
-   V^T Q (A V_j) and rows (L^T Q V_j)^T Q V (L = J - R, Q A = Q L Q) take one
-   product Q V^T [A V_j, L^T Q V_j] per block; no product with A^T.
+   Instead of one sparse LU per ADI shift, ONE real LU serves the whole run.
+   With E of full rank the equation is that of A' = E^{-1} A, B' = E^{-1} B:
+   multiplying A P E^T + E P A^T + B B^T = 0 by E^{-1} from the left and
+   E^{-T} from the right gives A' P + P A'^T + B' B'^T = 0, the same P. The
+   space span{B', A'^{-1} B', A' B', A'^{-2} B', ...} grows by blocks of 2 m
+   columns, block j + 1 from [A' V_j^+, A'^{-1} V_j^-] (the halves of block j
+   that came from A' and from A'^{-1}), where A' v = E^{-1} (A v) is a
+   product and a solve with E, A'^{-1} v = A^{-1} (E v) a product and a solve
+   with A, and B' = E^{-1} B, A'^{-1} B' = A^{-1} B start it: E and A are
+   each factored once (E on the pencil's own analysis: K(sigma) = sigma E +
+   M at sigma = 1 and M = 0, whose pattern holds E's; the LU's condensed
+   states are never coupled by E, 8.12); E = I needs neither E solve nor
+   product, and the algebra below is then that of Q. The energy. A pH
+   descriptor model E x' = (J - R) Q x has H = x^T E^T Q x / 2 with M_E = E^T
+   Q = Q^T E symmetric positive definite, so <x, y> = x^T M_E y is an inner
+   product; the basis V is orthonormal in it (V^T M_E V = I). From E^T Q =
+   Q^T E, E^T Q E^{-1} = Q^T and so M_E A' = E^T Q E^{-1} (J - R) Q = Q^T (J -
+   R) Q: the projected matrix
+       T = V^T M_E A' V = (Q V)^T (J - R) (Q V)
+   has T + T^T = (Q V)^T ((J - R) + (J - R)^T) (Q V) = -2 (Q V)^T R (Q V) <= 0
+   (R >= 0, J skew), and the Galerkin equation (test space M_E V, b = V^T M_E
+   B' = V^T Q^T B)
+       V^T M_E (A' P + P A'^T + B' B'^T) M_E V = T Y + Y T^T + b b^T = 0
+   for P ~ V Y V^T is stable whenever the model is (the same argument as for
+   E = I, where M_E = Q); in the Euclidean product V^T A' V need not be
+   stable. This needs only E^T Q symmetric positive definite -- what the pH
+   descriptor form requires -- not E or Q alone symmetric. The dual model (J
+   -> -J, the observability Gramian, above) has the same M_E. In the code QV
+   = M_E V = E^T (Q V) is kept with V (for E = I, Q V); T's new columns are
+   (M_E V)^T (A' V_j), its new rows V_j^T M_E A' V = (L^T Q V_j)^T (Q V) =
+   (E^{-1} L^T Q V_j)^T (M_E V) (L = J - R, Q V = E^{-T} M_E V): one product
+   (M_E V)^T [A' V_j, E^{-1} L^T Q V_j] per block, no product with A^T and
+   no Q V for the old columns (with E: two solves with E per new column,
+   cheaper than a product with the N x n basis).
    Orthonormalisation: block Gram-Schmidt against the basis (64 columns at a
-   time), modified Gram-Schmidt within the block, all twice, with Q V_j
+   time), modified Gram-Schmidt within the block, all twice, with M_E V_j
    recomputed from V_j after each pass (updating Q U along with U drifts when
    a column is normalised from a small rest: on the 16 x 16 lattice the energy
    orthogonality fell to 4e-2 at 88 columns and the residual grew from 1e-5 to
@@ -2288,14 +2315,20 @@
    to that accuracy and is dropped (the 8 x 8 lattice, whose reachable space
    is about 64 of its 128 states, narrows its blocks after 13 of them and
    stops at 70 columns).
-   Residual. A maps the first j - 1 blocks into the first j, so A V = V T +
-   W_L E_j^T with W_L = A V_j - V T(:, j) (the last block only), and with Y
-   the projected solution R = A V Y V^T + V Y V^T A^T + B B^T = X [0, Y_L^T;
-   Y_L, 0] X^T, X = [V, W_L], Y_L = Y's last rows: ||R||_2 is the largest
-   |eigenvalue| of Gamma^{1/2} [0, Y_L^T; Y_L, 0] Gamma^{1/2}, Gamma = X^T X
-   of order n + 2 m (from V^T V, kept up to date, V^T W_L and W_L^T W_L). It
-   is the 2-norm relative to ||B^T B||_2 that LR-ADI reports, and the same
-   stop (1e-10). Y comes from phgmg_lyap (the sign iteration, O(n^3) per
+   Residual. A' maps the first j - 1 blocks into the first j, so A' V = V T
+   + W_L E_j^T with W_L = A' V_j - V T(:, j) (the last block only), and with
+   Y the projected solution (B' in the first block's span) R' = A' V Y V^T +
+   V Y V^T A'^T + B' B'^T = X [0, Y_L^T; Y_L, 0] X^T, X = [V, W_L], Y_L = Y's
+   last rows. The residual of the generalized equation is R = A P E^T + E P
+   A^T + B B^T = E R' E^T = (E X) [0, Y_L^T; Y_L, 0] (E X)^T, so ||R||_2 is the
+   largest |eigenvalue| of Gamma^{1/2} [0, Y_L^T; Y_L, 0] Gamma^{1/2}, Gamma
+   = (E X)^T (E X) of order n + 2 m (from (E V)^T (E V), kept up to date
+   with V^T V, V^T E^T E W_L and W_L^T E^T E W_L; E = I: X^T X). The middle
+   factor is U C U^T with U = [Y_L^T 0; 0 I] and C = [0 I; I 0], so the
+   nonzero eigenvalues are those of H^{1/2} C H^{1/2}, H = U^T Gamma U of
+   order 4 m: O(n^2 m) work, not O(n^3). It is the 2-norm of the generalized
+   residual relative to ||B^T B||_2 that LR-ADI reports (||W^T W||_2 / ||B^T
+   B||_2 there), and the same stop (1e-10). Y comes from phgmg_lyap (the sign iteration, O(n^3) per
    step), so the projected equation is solved after blocks 1, ..., 8 and then
    every quarter of the blocks so far. Z = V Y^{1/2} is compressed by the rule
    of LR-ADI (singular values below 1e-12 sigma_1 dropped), its SVD from the
@@ -2303,13 +2336,16 @@
    columns), never a QR of the N x n factor.
    The pole. The sparse LU's static pivots refuse A itself where the
    factorization condenses states with a zero diagonal (a mass-spring model's
-   positions, 8.12): then the inverse directions use (A + p I)^{-1} with p =
-   -|theta|, theta the Ritz value of A on span(B) of least modulus -- a
-   rational Krylov space with one real pole instead of 0, the same algebra (A
-   (A + p I)^{-1} = I - p (A + p I)^{-1}, so A still maps each block into the
-   next). On the lattices p = -0.540 (the damping of the corner masses). A
-   mass matrix would need solves with E for E^{-1} A (the object has none):
-   PHGMG_ERR_UNSUPPORTED, the ADI serves such models.
+   positions, 8.12): then the inverse directions use (A' + p I)^{-1} = (A + p
+   E)^{-1} E with p = -|theta|, theta the Ritz value of the pencil on
+   span(B') of least modulus -- a rational Krylov space with one real pole
+   instead of 0, the same algebra (A' (A' + p I)^{-1} = I - p (A' + p
+   I)^{-1}, so A' still maps each block into the next). On the lattices p =
+   -0.540 (the damping of the corner masses). Algebraic lines (E with zero
+   rows and columns, index one, 8.14): E^{-1} does not exist, and the space
+   of the condensed model would need its A_dd - A_dc A_ac^{-1} A_ad, which
+   is never formed: PHGMG_ERR_UNSUPPORTED, the ADI serves such models on the
+   whole pencil.
    Checked (tests/test_eksm.c): the 16 x 16 heat model (N = 256, p = 0, one
    factorization): Z Z^T within 2.3e-12 (relative, Frobenius) of the dense
    Gramian from R's eigen-decomposition, the residual of a run at tol 1e-7
@@ -2318,10 +2354,24 @@
    lattice (N = 98, p = -0.540): P and O = Q Zy Zy^T Q (dual model) within
    6e-15 of phgmg_lyap's, the residual (tol 1e-4 run, 7.66e-6) to 5e-11,
    Hankel singular values within 6e-15 sigma_1 of the dense ones and 5e-12
-   sigma_1 of the ADI's; bad arguments, a mass matrix (PHGMG_ERR_UNSUPPORTED),
-   too few blocks (PHGMG_ERR_NOT_CONVERGED). tests/test_cli_lowrank.sh:
-   `reduce --method bt --lyap eksm` on the 8 x 8 lattice, Hankel singular
-   values within 1.2e-10 sigma_1 of the --lyap adi run's.
+   sigma_1 of the ADI's. Mass matrices, against the dense Gramians of the
+   E^{-1} model (phgmg_lu_solve, phgmg_lyap): a 1-D acoustic model in P1
+   elements (x = (p, v), E = blkdiag(M, M) consistent mass, Q = blkdiag(2 I,
+   0.5 I), R = 0.05 E + 0.01 blkdiag(K, K), N = 160, states scrambled; p = 0,
+   2 factorizations, 27 blocks, 108 columns -> rank 91): Z Z^T within 1e-13,
+   the generalized residual of a tol 1e-5 run (4.02e-7) equal to the densely
+   recomputed ||A P E^T + E P A^T + B B^T||_2 / ||B^T B||_2 to 3e-8 of
+   itself, Hankel singular values within 1.2e-14 sigma_1 of the dense ones
+   and 4.3e-14 sigma_1 of the ADI's; the 8 x 8 lattice with E = [I 0; 0 Mc]
+   (Mc tridiagonal; N = 128, A refused: p = -0.491, 3 factorizations, 108
+   columns -> rank 103): Z Z^T within 1.1e-11, values within 1.6e-13 sigma_1
+   of the dense ones and 2.4e-12 sigma_1 of the ADI's. Bad arguments,
+   algebraic lines (a massless node: PHGMG_ERR_UNSUPPORTED), too few blocks
+   (PHGMG_ERR_NOT_CONVERGED). tests/test_cli_lowrank.sh: `reduce --method bt
+   --lyap eksm` on the 8 x 8 lattice, Hankel singular values within 1.2e-10
+   sigma_1 of the --lyap adi run's; with --E-coo (a 1-D P1 heat model,
+   consistent mass, N = 150, scrambled) within 3.4e-12 sigma_1 of the ADI's
+   and 7.9e-11 sigma_1 of SciPy's dense values.
    Measured (bench/bench_lowrank.c --lyap eksm against --lyap adi, r = 20, AMD
    EPYC under KVM, 2 vCPUs shared with other jobs, CPU time user + sys of the
    whole run, two runs each; bench/README.md): heat N = 100 489: EKSM 10.0 -
@@ -2337,7 +2387,14 @@
    damped lattice, with wider factors (its blocks of 2 m columns are each
    orthogonalised against the whole basis: O(N n^2), the larger part of its
    time); the one factorization saves most where a factorization is expensive
-   (not measured here: 3-D meshes), and no shifts are chosen.
+   (not measured here: 3-D meshes), and no shifts are chosen. Not so on
+   lightly damped wave models, whose Gramians are of nearly full rank: the
+   P1 acoustic model of bench/fe_mesh.py with its consistent mass matrix (N =
+   1 200, r = 20): EKSM 50.6 s CPU, its basis filling the whole space (300
+   blocks) before the tolerance, against the ADI's 12.3 s (1 214 steps, rank
+   846), the same Hankel singular values and sampled error; at N = 20 172 one
+   Gramian was still at a residual of 7.8e-6 after 891 blocks (3 564
+   columns, 923 s CPU, 2.4 GB): for such models the ADI is the solver.
    Balanced truncation: Z_o^T E Z_c = U S V^T, T = Z_c V_r S_r^{-1/2}, W =
    Z_o U_r S_r^{-1/2}, so W^T E T = I and the reduced model is Ar = W^T A T,
    Br = W^T B, Cr = B^T Q T (Er = I). The Hankel singular values beyond the
@@ -4653,7 +4710,7 @@ PHGMG_DEF void phgmg_shifted_destroy(phgmg_shifted *s);
 /* The solvers of the low-rank Lyapunov equation (phgmg_lradi_opts.solver). */
 enum {
   PHGMG_LYAP_ADI = 0,  /* low-rank ADI (phgmg_lradi; the default)                  */
-  PHGMG_LYAP_EKSM = 1  /* extended Krylov subspace method (phgmg_lrkrylov; E = I) */
+  PHGMG_LYAP_EKSM = 1  /* extended Krylov subspace method (phgmg_lrkrylov; E of full rank) */
 };
 
 /* Options of the low-rank Lyapunov solvers (zero: default, low-rank ADI). */
@@ -4688,7 +4745,7 @@ typedef struct phgmg_lradi_info {
                        (EKSM: the same quantity, computed from the projection) */
   int solver;       /* the solver that ran: PHGMG_LYAP_ADI or PHGMG_LYAP_EKSM    */
   double shift;     /* EKSM: the real shift p of the inverse directions (A + p
-                       I)^{-1} (0: A^{-1}; see phgmg_lrkrylov); ADI: 0           */
+                       E)^{-1} E (0: A^{-1} E; see phgmg_lrkrylov); ADI: 0       */
 } phgmg_lradi_info;
 
 /* Low-rank ADI for A P E^T + E P A^T + B B^T = 0 with the pencil of s
@@ -4710,38 +4767,46 @@ typedef struct phgmg_lradi_info {
 PHGMG_DEF phgmg_result phgmg_lradi(phgmg_shifted *s, int m, const double *B, int ldb, const phgmg_lradi_opts *opts,
                                    double **Z, int *k, phgmg_lradi_info *info, const phgmg_allocator *alloc);
 /* The extended Krylov subspace method (EKSM; Simoncini, Druskin and
-   Knizhnerman) for A P + P A^T + B B^T = 0 (E = I) with the pencil of s, with
-   the contract of phgmg_lradi (Z, *k, info, opts; Z freed by
-   phgmg_lowrank_free): one real factorization serves the whole run. The basis
-   V of the extended Krylov space span{B, A^{-1} B, A B, A^{-2} B, ...} grows
-   by blocks of 2 m columns, [A V_j^+, A^{-1} V_j^-] from the last block's two
-   halves, orthonormalised in the energy inner product x^T Q y (block
-   Gram-Schmidt against the basis, then modified Gram-Schmidt within the block,
-   the whole done twice; a direction whose part outside the basis is below 1e-8
-   of its norm is dropped, so blocks may get narrower). Then T = V^T Q A V has
-   T + T^T = -2 V^T Q R Q V <= 0, so the projected equation T Y + Y T^T + (V^T
-   Q B)(V^T Q B)^T = 0 (Galerkin with the test space Q V) is stable; T takes
-   one sparse product with A and one with (J - R)^T per basis vector. After
-   blocks 1, ..., 8 and then every quarter of the blocks so far: Y by
-   phgmg_lyap and the residual ||A V Y V^T + V Y V^T A^T + B B^T||_2 / ||B^T
-   B||_2 -- the relative spectral norm that phgmg_lradi reports -- from the
-   last block (A maps the earlier blocks into the basis) and a Gram matrix of
-   order n + 2 m (n the basis's columns), no N x N matrix. Stop at tol (1e-10),
-   then Z = V Y^{1/2} compressed as phgmg_lradi's (singular values below trunc
-   sigma_1, 1e-12, dropped; computed through V's small Gram matrix). When the
-   static pivots of the sparse LU refuse A itself (a mass-spring model's
-   positions: zero diagonal), the inverse directions use (A + p I)^{-1} with
-   the real p = -|theta|, theta the Ritz value of A on span(B) of least
-   modulus: the same structure of the space, its pole moved off the origin.
-   dual = 1 gives the dual model's factor, as with phgmg_lradi. Memory: 4 m
-   vectors of length N per block (the basis and Q times it; room for 256
-   columns first, doubled when needed), maxit blocks at most (0: 100). info: iters the
-   blocks, cols the basis's columns, shift the p used, factorizations 1 (2 when
-   A was refused), shift_sets 0. Errors: those of phgmg_lradi (_NOT_CONVERGED
-   at maxit blocks, or when no new direction is left before tol is reached),
-   PHGMG_ERR_UNSUPPORTED for a model with a mass matrix or algebraic lines (E
-   != I: E^{-1} A would need solves with E, which the object does not make; use
-   the ADI). Manual 8.13. */
+   Knizhnerman) for A P E^T + E P A^T + B B^T = 0 with the pencil of s, E = I
+   or a mass matrix of full rank, with the contract of phgmg_lradi (Z, *k,
+   info, opts; Z freed by phgmg_lowrank_free): one real factorization of the
+   pencil serves the whole run, and with a mass matrix one of E (made on the
+   pencil's analysis, kept by s). It solves the equivalent A' P + P A'^T + B'
+   B'^T = 0, A' = E^{-1} A, B' = E^{-1} B (E = I: A, B). The basis V of the
+   extended Krylov space span{B', A'^{-1} B', A' B', A'^{-2} B', ...} grows by
+   blocks of 2 m columns, [A' V_j^+, A'^{-1} V_j^-] from the last block's two
+   halves (A' v: a product with A and a solve with E; A'^{-1} v = A^{-1} E v),
+   orthonormalised in the energy inner product x^T E^T Q y (block Gram-Schmidt
+   against the basis, then modified Gram-Schmidt within the block, the whole
+   done twice; a direction whose part outside the basis is below 1e-8 of its
+   norm is dropped, so blocks may get narrower). Then T = V^T E^T Q A' V = (Q
+   V)^T (J - R) (Q V) (E^T Q = Q^T E) has T + T^T = -2 (Q V)^T R (Q V) <= 0,
+   so the projected equation T Y + Y T^T + (V^T Q^T B)(V^T Q^T B)^T = 0
+   (Galerkin with the test space E^T Q V) is stable; T takes one sparse
+   product with A and one with (J - R)^T per basis vector (with E: two solves
+   with E). After blocks 1, ..., 8 and then every quarter of the blocks so
+   far: Y by phgmg_lyap and the residual ||A V Y V^T E^T + E V Y V^T A^T + B
+   B^T||_2 / ||B^T B||_2 -- the relative spectral norm that phgmg_lradi
+   reports -- from the last block (A' maps the earlier blocks into the basis)
+   and a Gram matrix of order n + 2 m (n the basis's columns), no N x N
+   matrix. Stop at tol (1e-10), then Z = V Y^{1/2} compressed as
+   phgmg_lradi's (singular values below trunc sigma_1, 1e-12, dropped;
+   computed through V's small Gram matrix). When the static pivots of the
+   sparse LU refuse A itself (a mass-spring model's positions: zero
+   diagonal), the inverse directions use (A + p E)^{-1} E with the real p =
+   -|theta|, theta the Ritz value of the pencil on span(B') of least modulus:
+   the same structure of the space, its pole moved off the origin. dual = 1
+   gives the dual model's factor, as with phgmg_lradi. Memory: 4 m vectors of
+   length N per block (the basis and E^T Q times it; room for 256 columns
+   first, doubled when needed), maxit blocks at most (0: 100); a mass matrix
+   adds E's factor and m vectors. info: iters the blocks, cols the basis's
+   columns, shift the p used, factorizations 1 (2 when A was refused; one
+   more for E), shift_sets 0. Errors: those of phgmg_lradi (_NOT_CONVERGED at
+   maxit blocks, or when no new direction is left before tol is reached),
+   PHGMG_ERR_SINGULAR also when the static pivots refuse E, and
+   PHGMG_ERR_UNSUPPORTED for a model with algebraic lines (an index-one E
+   with zero rows and columns: E^{-1} A does not exist; use the ADI, manual
+   8.14). Manual 8.13. */
 PHGMG_DEF phgmg_result phgmg_lrkrylov(phgmg_shifted *s, int m, const double *B, int ldb, const phgmg_lradi_opts *opts,
                                       double **Z, int *k, phgmg_lradi_info *info, const phgmg_allocator *alloc);
 /* Frees a factor from phgmg_lradi or phgmg_lrkrylov (NULL is fine). */
@@ -23065,6 +23130,8 @@ struct phgmg_shifted {
   int nalg;        /* algebraic lines (index one: the whole pencil)    */
   long clock;
   phgmg__shf *f;   /* keep entries                                     */
+  phgmg__spnum ef; /* E's own factorization (phgmg__shifted_esolve)    */
+  int ef_state;    /* 0: not yet made, 1: made, -1: refused            */
 };
 
 PHGMG_DEF void phgmg_shifted_destroy(phgmg_shifted *s) {
@@ -23073,6 +23140,7 @@ PHGMG_DEF void phgmg_shifted_destroy(phgmg_shifted *s) {
   if (!s) return;
   al = s->alloc;
   for (i = 0; s->f && i < s->keep; ++i) phgmg__spnum_free(al, &s->f[i].F);
+  phgmg__spnum_free(al, &s->ef);
   phgmg__free(al, s->f);
   phgmg__free(al, s->Mx);
   phgmg__free(al, s->w);
@@ -23183,6 +23251,43 @@ PHGMG_DEF phgmg_result phgmg_shifted_solve(phgmg_shifted *s, double pr, double p
     for (i = 0; i < len; ++i) x[i] = -x[i];
   }
   return PHGMG_OK;
+}
+
+/* X <- E^{-1} X (N x nrhs, ld ldx) for a mass matrix of full rank (no-op
+   without one): E's numeric factorization on the pencil's analysis -- the
+   K(sigma) = sigma E + M of 8.13 at sigma = 1 with M = 0, whose pattern
+   holds E's, and whose condensed states E couples to no other (8.12) --
+   made at the first call and kept (counted in nfact). PHGMG_ERR_SINGULAR
+   when the static pivots refuse E, _NOMEM. */
+PHGMG__PRIV phgmg_result phgmg__shifted_esolve(phgmg_shifted *s, int nrhs, double *X, int ldx) {
+  int j;
+  if (!s->S->e_p || nrhs < 1) return PHGMG_OK;
+  if (s->ef_state == 0) {
+    double *zero = phgmg__dalloc(s->alloc, (size_t)s->S->k_p[s->N] + 1);
+    if (!zero || phgmg__spnum_alloc(s->alloc, s->S, 0, &s->ef) != PHGMG_OK) {
+      phgmg__free(s->alloc, zero);
+      return PHGMG_ERR_NOMEM;
+    }
+    memset(zero, 0, sizeof(double) * ((size_t)s->S->k_p[s->N] + 1));
+    phgmg__sp_factor(s->S, &s->ef, zero, 1.0, 0.0, PHGMG_SPARSE_PIVTOL);
+    phgmg__free(s->alloc, zero);
+    ++s->nfact;
+    s->ef_state = s->ef.nstatic || !(s->ef.growth <= PHGMG_SPARSE_GROWTH) ? -1 : 1;
+  }
+  if (s->ef_state < 0) return PHGMG_ERR_SINGULAR;
+  for (j = 0; j < nrhs; ++j) phgmg__sp_solve(s->S, &s->ef, X + (size_t)j * (size_t)ldx);
+  return PHGMG_OK;
+}
+
+/* y = E^T x (x without a mass matrix); S's pencil. */
+PHGMG__PRIV void phgmg__lr_etmul(const phgmg__spsym *S, const double *x, double *y) {
+  int j, p;
+  if (!S->e_p) { memcpy(y, x, sizeof(double) * (size_t)S->n); return; }
+  for (j = 0; j < S->n; ++j) {
+    double acc = 0.0;
+    for (p = S->e_p[j]; p < S->e_p[j + 1]; ++p) acc += S->e_x[p] * x[S->e_i[p]];
+    y[j] = acc;
+  }
 }
 
 /* y = E x (x when the model has no mass matrix); S's pencil. */
@@ -23676,18 +23781,25 @@ PHGMG_DEF phgmg_result phgmg_lradi(phgmg_shifted *s, int m, const double *B, int
 }
 
 /* >>lowrank: the extended Krylov subspace method (EKSM) ------------------ */
-/* State of one EKSM run (E = I): the basis V (N x nc, orthonormal in the
-   energy inner product <x, y> = x^T Q y), QV = Q V, the projected matrix T =
-   V^T Q A V and the Euclidean Gram matrix G = V^T V (both ld = ld), AL = A
-   times the last block, U / QU the next block (N x w each, w = 2 m: a
-   block's width at most). */
+/* State of one EKSM run on the extended Krylov space of (E^{-1} A, E^{-1} B)
+   (manual 8.13; E = I without a mass matrix): the basis V (N x nc,
+   orthonormal in the energy inner product <x, y> = x^T E^T Q y), QV = E^T Q
+   V (the name of the E = I case, where it is Q V), the projected matrix T =
+   V^T E^T Q E^{-1} A V and the Euclidean Gram matrices G = V^T V and GE =
+   (E V)^T (E V) (GE = G without E; all ld = ld), AL = E^{-1} A times the
+   last block, U / QU the next block (N x w each, w = 2 m: a block's width at
+   most), Bt = E^{-1} B (B itself without E). */
 typedef struct phgmg__eksm {
   phgmg_shifted *s;
   const phgmg_allocator *al;
   int N, m, w, nc, cap, ld;  /* w = 2 m columns per block; nc filled, cap allocated */
-  double p;                  /* shift of the inverse directions (A + p I)^{-1}       */
-  double *V, *QV, *T, *G, *tm; /* tm: cap x 2 w scratch (with T, G: one allocation)  */
+  int hase;                  /* 1: a mass matrix E (solves with E)                  */
+  double p;                  /* shift of the inverse directions (A + p E)^{-1}       */
+  double *V, *QV, *T, *G, *GE, *tm; /* tm: cap x 2 w scratch (with T, G, GE: one allocation) */
   double *AL, *U, *QU;       /* one buffer: N x w each                               */
+  const double *Bt;          /* E^{-1} B (N x m, ld ldbt)                            */
+  double *Bown;              /* Bt when allocated here (a mass matrix), else NULL    */
+  int ldbt;
   int maxb;                  /* blocks at most (maxit)                                */
   int np, nm;                /* the last block: np columns from A, then nm from the
                                 inverse (fewer than m each after deflation)          */
@@ -23711,27 +23823,31 @@ PHGMG__PRIV void phgmg__lr_ltmul(const phgmg__spsym *S, const double *x, double 
 PHGMG__PRIV phgmg_result phgmg__ek_grow(phgmg__eksm *st) {
   const size_t N = (size_t)st->N;
   const int cap0 = st->w * PHGMG__MAX(1, PHGMG__EK_CAP0 / st->w);
-  int cap = PHGMG__MIN(st->cap ? 2 * st->cap : cap0, st->maxb * st->w), j;
-  double *V, *QV, *T, *G;
+  const int cap = PHGMG__MIN(st->cap ? 2 * st->cap : cap0, st->maxb * st->w), nsq = st->hase ? 3 : 2;
+  const size_t cc = (size_t)cap;
+  int j;
+  double *V, *QV, *T, *G, *GE;
   if (st->nc + st->w <= st->cap) return PHGMG_OK;
-  V = phgmg__dalloc(st->al, N * (size_t)cap);
-  QV = phgmg__dalloc(st->al, N * (size_t)cap);
-  T = phgmg__dalloc(st->al, 2 * (size_t)cap * (size_t)cap + 2 * (size_t)cap * (size_t)st->w);
+  V = phgmg__dalloc(st->al, N * cc);
+  QV = phgmg__dalloc(st->al, N * cc);
+  T = phgmg__dalloc(st->al, (size_t)nsq * cc * cc + 2 * cc * (size_t)st->w);
   if (!V || !QV || !T) {
     phgmg__free(st->al, V); phgmg__free(st->al, QV); phgmg__free(st->al, T);
     return PHGMG_ERR_NOMEM;
   }
-  G = T + (size_t)cap * (size_t)cap;
+  G = T + cc * cc;
+  GE = st->hase ? G + cc * cc : G;
   if (st->nc) {
     memcpy(V, st->V, sizeof(double) * N * (size_t)st->nc);
     memcpy(QV, st->QV, sizeof(double) * N * (size_t)st->nc);
     for (j = 0; j < st->nc; ++j) {
       memcpy(T + (size_t)j * cap, st->T + (size_t)j * st->ld, sizeof(double) * (size_t)st->nc);
       memcpy(G + (size_t)j * cap, st->G + (size_t)j * st->ld, sizeof(double) * (size_t)st->nc);
+      if (st->hase) memcpy(GE + (size_t)j * cap, st->GE + (size_t)j * st->ld, sizeof(double) * (size_t)st->nc);
     }
   }
   phgmg__free(st->al, st->V); phgmg__free(st->al, st->QV); phgmg__free(st->al, st->T);
-  st->V = V; st->QV = QV; st->T = T; st->G = G; st->tm = G + (size_t)cap * (size_t)cap;
+  st->V = V; st->QV = QV; st->T = T; st->G = G; st->GE = GE; st->tm = T + (size_t)nsq * cc * cc;
   st->cap = st->ld = cap;
   return PHGMG_OK;
 }
@@ -23784,11 +23900,17 @@ PHGMG__PRIV int phgmg__ek_mgs(phgmg__eksm *st, const double *nrm, int *np, int *
   return kept;
 }
 
-/* QU = Q U for U's first c columns (recomputed: the updates of QU along
-   with U drift from Q U when a column is normalised from a small rest). */
+/* QU = E^T Q U (Q U without a mass matrix) for U's first c columns
+   (recomputed: the updates of QU along with U drift from E^T Q U when a
+   column is normalised from a small rest). */
 PHGMG__PRIV void phgmg__ek_qmul(phgmg__eksm *st, int c) {
   int j;
-  for (j = 0; j < c; ++j) phgmg__sp_qmv(st->s->S, st->U + (size_t)j * st->N, st->QU + (size_t)j * st->N);
+  for (j = 0; j < c; ++j) {
+    double *u = st->U + (size_t)j * st->N, *qu = st->QU + (size_t)j * st->N;
+    if (!st->hase) { phgmg__sp_qmv(st->s->S, u, qu); continue; }
+    phgmg__sp_qmv(st->s->S, u, st->s->w);
+    phgmg__lr_etmul(st->s->S, st->s->w, qu);
+  }
 }
 
 /* The new block U (QU = Q U; st->up columns from A, then st->um from the
@@ -23820,48 +23942,80 @@ PHGMG__PRIV int phgmg__ek_orth(phgmg__eksm *st, double *wk) {
   return c;
 }
 
-/* Appends the orthonormal block U (QU) to the basis: AL = A U, X = L^T Q U
-   (L = J - R) next to it, the new columns and rows of T = V^T Q A V from
-   one product Q V^T [AL, X] (rows: V_k^T Q A V = (L^T Q V_k)^T Q V, since Q
-   A = Q L Q) and of G = V^T V. U is scratch afterwards. */
-PHGMG__PRIV void phgmg__ek_append(phgmg__eksm *st) {
+/* The new columns c0..c1 of the symmetric Gram matrix Gm = V^T Y (Y: N x
+   (c1 - c0), the product of the new block), mirrored into its rows. */
+PHGMG__PRIV void phgmg__ek_gram_cols(phgmg__eksm *st, double *Gm, int c0, int c1, const double *Y) {
+  const int N = st->N, ld = st->ld;
+  int i, j;
+  phgmg_gemm('T', 'N', c1, c1 - c0, N, 1.0, st->V, N, Y, N, 0.0, Gm + (size_t)c0 * ld, ld);
+  for (j = c0; j < c1; ++j)
+    for (i = 0; i < c0; ++i) Gm[j + (size_t)i * ld] = Gm[i + (size_t)j * ld];
+}
+
+/* Appends the orthonormal block U (QU) to the basis: AL = E^{-1} A U, X =
+   E^{-1} L^T Q U (L = J - R) next to it, the new columns and rows of T =
+   V^T E^T Q E^{-1} A V from one product (E^T Q V)^T [AL, X] (rows: V_k^T
+   E^T Q E^{-1} A V = (L^T Q V_k)^T Q V = X_k^T E^T Q V, since E^T Q E^{-1}
+   = Q^T), of G = V^T V and (a mass matrix) of GE = V^T E^T E V. U and QU
+   are scratch afterwards. PHGMG_ERR_SINGULAR etc. from the solves with E. */
+PHGMG__PRIV phgmg_result phgmg__ek_append(phgmg__eksm *st) {
   const int N = st->N, w = st->up + st->um, c0 = st->nc, c1 = c0 + w, ld = st->ld;
   double *X = st->AL + (size_t)w * N, *M = st->tm; /* X: w columns after AL's w (AL + U hold 2 st->w) */
+  phgmg_result rc;
   int i, j;
   memcpy(st->V + (size_t)c0 * N, st->U, sizeof(double) * (size_t)N * (size_t)w);
   memcpy(st->QV + (size_t)c0 * N, st->QU, sizeof(double) * (size_t)N * (size_t)w);
   for (j = 0; j < w; ++j) phgmg__lr_amul(st->s->S, st->V + (size_t)(c0 + j) * N, st->AL + (size_t)j * N, st->s->w);
-  for (j = 0; j < w; ++j) phgmg__lr_ltmul(st->s->S, st->QV + (size_t)(c0 + j) * N, X + (size_t)j * N);
+  for (j = 0; j < w; ++j) {
+    if (st->hase) phgmg__sp_qmv(st->s->S, st->V + (size_t)(c0 + j) * N, st->QU);
+    phgmg__lr_ltmul(st->s->S, st->hase ? st->QU : st->QV + (size_t)(c0 + j) * N, X + (size_t)j * N);
+  }
+  if ((rc = phgmg__shifted_esolve(st->s, w, st->AL, N)) != PHGMG_OK ||
+      (rc = phgmg__shifted_esolve(st->s, w, X, N)) != PHGMG_OK)
+    return rc;
   phgmg_gemm('T', 'N', c1, 2 * w, N, 1.0, st->QV, N, st->AL, N, 0.0, M, c1);
   for (j = 0; j < w; ++j) {
     memcpy(st->T + (size_t)(c0 + j) * ld, M + (size_t)j * c1, sizeof(double) * (size_t)c1);
     for (i = 0; i < c0; ++i) st->T[c0 + j + (size_t)i * ld] = M[i + (size_t)(w + j) * c1];
   }
-  phgmg_gemm('T', 'N', c1, w, N, 1.0, st->V, N, st->V + (size_t)c0 * N, N, 0.0, st->G + (size_t)c0 * ld, ld);
-  for (j = c0; j < c1; ++j)
-    for (i = 0; i < c0; ++i) st->G[j + (size_t)i * ld] = st->G[i + (size_t)j * ld];
+  phgmg__ek_gram_cols(st, st->G, c0, c1, st->V + (size_t)c0 * N);
+  if (st->hase) { /* GE's new columns: V^T E^T E V_k (E V_k in QU, then E^T of it in U) */
+    for (j = 0; j < w; ++j) {
+      phgmg__lr_emul(st->s->S, st->V + (size_t)(c0 + j) * N, st->QU + (size_t)j * N);
+      phgmg__lr_etmul(st->s->S, st->QU + (size_t)j * N, st->U + (size_t)j * N);
+    }
+    phgmg__ek_gram_cols(st, st->GE, c0, c1, st->U);
+  }
   st->nc = c1;
   st->np = st->up; st->nm = st->um;
+  return PHGMG_OK;
 }
 
-/* The next block's directions: U = [A V_k^+, (A + p I)^{-1} V_k^-] (V_k^+:
-   the last block's np columns from A, V_k^-: its nm from the inverse), QU
-   = Q U. */
+/* The next block's directions: U = [E^{-1} A V_k^+, (A + p E)^{-1} E V_k^-]
+   (V_k^+: the last block's np columns from E^{-1} A, V_k^-: its nm from the
+   inverse; (A + p E)^{-1} E = (E^{-1} A + p I)^{-1}), QU = E^T Q U. */
 PHGMG__PRIV phgmg_result phgmg__ek_next(phgmg__eksm *st) {
   const int N = st->N, np = st->np, nm = st->nm;
+  const double *Vm = st->V + (size_t)(st->nc - nm) * N;
+  double *Um = st->U + (size_t)np * N;
   phgmg_result rc;
   int j;
   memcpy(st->U, st->AL, sizeof(double) * (size_t)N * (size_t)np);
-  rc = phgmg_shifted_solve(st->s, st->p, 0.0, nm, st->V + (size_t)(st->nc - nm) * N, N, st->U + (size_t)np * N, N);
+  if (st->hase) {
+    for (j = 0; j < nm; ++j) phgmg__lr_emul(st->s->S, Vm + (size_t)j * N, Um + (size_t)j * N);
+    rc = phgmg_shifted_solve(st->s, st->p, 0.0, nm, Um, N, Um, N);
+  } else {
+    rc = phgmg_shifted_solve(st->s, st->p, 0.0, nm, Vm, N, Um, N);
+  }
   if (rc != PHGMG_OK) return rc;
   st->up = np; st->um = nm;
-  for (j = 0; j < np + nm; ++j) phgmg__sp_qmv(st->s->S, st->U + (size_t)j * N, st->QU + (size_t)j * N);
+  phgmg__ek_qmul(st, np + nm);
   return PHGMG_OK;
 }
 
 /* The projected equation T Y + Y T^T + b b^T = 0 (order n = st->nc, b = V^T
-   Q B) by phgmg_lyap into Y (n x n). */
-PHGMG__PRIV phgmg_result phgmg__ek_project(phgmg__eksm *st, const double *B, int ldb, double *Y) {
+   E^T Q E^{-1} B = (E^T Q V)^T Bt) by phgmg_lyap into Y (n x n). */
+PHGMG__PRIV phgmg_result phgmg__ek_project(phgmg__eksm *st, double *Y) {
   const int n = st->nc, m = st->m, N = st->N;
   double *Tk = phgmg__dalloc(st->al, 2 * (size_t)n * (size_t)n + (size_t)n * (size_t)m), *F, *b;
   phgmg_result rc;
@@ -23869,7 +24023,7 @@ PHGMG__PRIV phgmg_result phgmg__ek_project(phgmg__eksm *st, const double *B, int
   if (!Tk) return PHGMG_ERR_NOMEM;
   F = Tk + (size_t)n * n; b = F + (size_t)n * n;
   for (j = 0; j < n; ++j) memcpy(Tk + (size_t)j * n, st->T + (size_t)j * st->ld, sizeof(double) * (size_t)n);
-  phgmg_gemm('T', 'N', n, m, N, 1.0, st->QV, N, B, ldb, 0.0, b, n);
+  phgmg_gemm('T', 'N', n, m, N, 1.0, st->QV, N, st->Bt, st->ldbt, 0.0, b, n);
   phgmg_gemm('N', 'T', n, n, m, 1.0, b, n, b, n, 0.0, F, n);
   for (j = 0; j < n; ++j)
     for (i = 0; i < j; ++i) F[i + (size_t)j * n] = F[j + (size_t)i * n];
@@ -23878,39 +24032,56 @@ PHGMG__PRIV phgmg_result phgmg__ek_project(phgmg__eksm *st, const double *B, int
   return rc;
 }
 
-/* ||A V Y V^T + V Y V^T A^T + B B^T||_2 for the projected solution Y,
-   exactly and without an N x N matrix: A V = V T + W_L [0 I] with W_L = A
-   V_k - V T(:, k) (the last block k only: A maps the earlier blocks into
-   the basis), so the residual is X S X^T with X = [V, W_L] and S = [0,
-   Y_L^T; Y_L, 0], Y_L = Y's last w rows; its 2-norm is the largest |eig|
-   of Gamma^{1/2} S Gamma^{1/2}, Gamma = X^T X (from G, V^T W_L, W_L^T W_L). */
+/* ||A V Y V^T E^T + E V Y V^T A^T + B B^T||_2 for the projected solution
+   Y, exactly and without an N x N matrix: E^{-1} A V = V T + W_L [0 I] with
+   W_L = E^{-1} A V_k - V T(:, k) (the last block k only: E^{-1} A maps the
+   earlier blocks into the basis) and E^{-1} B in span(V), so the residual
+   is E X S X^T E^T with X = [V, W_L] and S = [0, Y_L^T; Y_L, 0], Y_L = Y's
+   last w rows. S = U C U^T with U = [Y_L^T 0; 0 I] (order n + w by 2 w) and
+   C = [0 I; I 0], so the residual's nonzero eigenvalues are those of C H, H
+   = U^T Gamma U = [Y_L G Y_L^T, Y_L V^T E^T E W_L; ., W_L^T E^T E W_L] (2 w
+   x 2 w; Gamma = X^T E^T E X, G = (E V)^T (E V); E = I without a mass
+   matrix), the same as those of H^{1/2} C H^{1/2}: the 2-norm from two
+   eigenproblems of order 2 w after O(n^2 w) products. */
 PHGMG__PRIV phgmg_result phgmg__ek_resid(phgmg__eksm *st, const double *Y, double *res) {
-  const int N = st->N, w = st->np + st->nm, n = st->nc, c0 = n - w, q = n + w;
-  double *Wl = st->U, *M = phgmg__dalloc(st->al, 3 * (size_t)q * (size_t)q + (size_t)q), *S, *Ev, *ev;
+  const int N = st->N, w = st->np + st->nm, n = st->nc, c0 = n - w, q = 2 * w;
+  const double *YL = Y + (size_t)c0 * n;   /* Y_L^T = Y(:, c0:n) (Y symmetric), n x w */
+  double *Wl = st->U, *EEw = st->hase ? st->QU : st->U, *G2, *GY, *H, *Ev, *ev, *K;
+  double *M = phgmg__dalloc(st->al, 2 * (size_t)n * (size_t)w + 4 * (size_t)q * (size_t)q + (size_t)q);
   phgmg_result rc;
   int i, j;
   if (!M) return PHGMG_ERR_NOMEM;
-  S = M + (size_t)q * q; Ev = S + (size_t)q * q; ev = Ev + (size_t)q * q;
+  G2 = M; GY = G2 + (size_t)n * w; H = GY + (size_t)n * w; Ev = H + (size_t)q * q; K = Ev + (size_t)q * q;
+  ev = K + (size_t)q * q;
   memcpy(Wl, st->AL, sizeof(double) * (size_t)N * (size_t)w);
   phgmg_gemm('N', 'N', N, w, n, -1.0, st->V, N, st->T + (size_t)c0 * st->ld, st->ld, 1.0, Wl, N);
-  for (j = 0; j < n; ++j) memcpy(M + (size_t)j * q, st->G + (size_t)j * st->ld, sizeof(double) * (size_t)n);
-  phgmg_gemm('T', 'N', n, w, N, 1.0, st->V, N, Wl, N, 0.0, M + (size_t)n * q, q);
-  phgmg_gemm('T', 'N', w, w, N, 1.0, Wl, N, Wl, N, 0.0, M + (size_t)n * q + n, q);
-  for (j = n; j < q; ++j)
-    for (i = 0; i < n; ++i) M[j + (size_t)i * q] = M[i + (size_t)j * q];
-  rc = phgmg_sym_eig(q, M, q, ev, Ev, q);          /* Gamma = Ev diag(ev) Ev^T */
+  for (j = 0; st->hase && j < w; ++j) { /* E^T E W_L */
+    phgmg__lr_emul(st->s->S, Wl + (size_t)j * N, st->s->w);
+    phgmg__lr_etmul(st->s->S, st->s->w, EEw + (size_t)j * N);
+  }
+  phgmg_gemm('T', 'N', n, w, N, 1.0, st->V, N, EEw, N, 0.0, G2, n);                 /* V^T E^T E W_L */
+  phgmg_gemm('N', 'N', n, w, n, 1.0, st->GE, st->ld, YL, n, 0.0, GY, n);             /* G Y_L^T */
+  phgmg_gemm('T', 'N', w, w, n, 1.0, YL, n, GY, n, 0.0, H, q);                       /* Y_L G Y_L^T */
+  phgmg_gemm('T', 'N', w, w, n, 1.0, YL, n, G2, n, 0.0, H + (size_t)w * q, q);       /* Y_L V^T E^T E W_L */
+  phgmg_gemm('T', 'N', w, w, N, 1.0, Wl, N, EEw, N, 0.0, H + (size_t)w * q + w, q);  /* W_L^T E^T E W_L */
+  for (j = 0; j < q; ++j)   /* symmetric: the upper triangle's values */
+    for (i = j + 1; i < q; ++i) H[i + (size_t)j * q] = H[j + (size_t)i * q];
+  rc = phgmg_sym_eig(q, H, q, ev, Ev, q);          /* H = Ev diag(ev) Ev^T */
   if (rc == PHGMG_OK) {
     for (j = 0; j < q; ++j) {
       const double sq = sqrt(ev[j] > 0.0 ? ev[j] : 0.0);
       for (i = 0; i < q; ++i) Ev[i + (size_t)j * q] *= sqrt(sq);
     }
-    phgmg_gemm('N', 'T', q, q, q, 1.0, Ev, q, Ev, q, 0.0, M, q); /* Gamma^{1/2} */
-    memset(S, 0, sizeof(double) * (size_t)q * q);
-    for (j = 0; j < n; ++j)
-      for (i = 0; i < w; ++i) S[n + i + (size_t)j * q] = S[j + (size_t)(n + i) * q] = Y[c0 + i + (size_t)j * n];
-    phgmg_gemm('N', 'N', q, q, q, 1.0, M, q, S, q, 0.0, Ev, q);
-    phgmg_gemm('N', 'N', q, q, q, 1.0, Ev, q, M, q, 0.0, S, q);
-    rc = phgmg_sym_eig(q, S, q, ev, NULL, q);
+    phgmg_gemm('N', 'T', q, q, q, 1.0, Ev, q, Ev, q, 0.0, H, q);   /* H^{1/2} */
+    for (j = 0; j < q; ++j)                                        /* C H^{1/2}: the halves' rows swapped */
+      for (i = 0; i < q; ++i) Ev[i + (size_t)j * q] = H[(i + w) % q + (size_t)j * q];
+    phgmg_gemm('N', 'N', q, q, q, 1.0, H, q, Ev, q, 0.0, K, q);    /* H^{1/2} C H^{1/2} */
+    for (j = 0; j < q; ++j)
+      for (i = j + 1; i < q; ++i) {
+        const double a = 0.5 * (K[i + (size_t)j * q] + K[j + (size_t)i * q]);
+        K[i + (size_t)j * q] = K[j + (size_t)i * q] = a;
+      }
+    rc = phgmg_sym_eig(q, K, q, ev, NULL, q);
   }
   if (rc == PHGMG_OK) *res = PHGMG__MAX(fabs(ev[0]), fabs(ev[q - 1]));
   phgmg__free(st->al, M);
@@ -23995,19 +24166,20 @@ PHGMG__PRIV phgmg_result phgmg__ek_factor(phgmg__eksm *st, double *Y, double tru
   return PHGMG_OK;
 }
 
-/* The first block's directions U = [B, (A + p I)^{-1} B], QU = Q U, with p
-   = 0 (A^{-1}), or -- when the static pivots refuse A (PHGMG_ERR_SINGULAR:
-   a mass-spring model's positions) -- p = -|theta|, theta the Ritz value
-   of A on span(B) of least modulus (the first projection shift of
-   phgmg_lradi's kind, so A + p I is factored like an ADI shift). */
+/* The first block's directions U = [E^{-1} B, (A + p E)^{-1} B] (= [Bt,
+   (E^{-1} A + p I)^{-1} Bt]), QU = E^T Q U, with p = 0 (A^{-1}), or -- when
+   the static pivots refuse A (PHGMG_ERR_SINGULAR: a mass-spring model's
+   positions) -- p = -|theta|, theta the Ritz value of the pencil on
+   span(Bt) of least modulus (the first projection shift of phgmg_lradi's
+   kind, so A + p E is factored like an ADI shift). */
 PHGMG__PRIV phgmg_result phgmg__ek_first(phgmg__eksm *st, const double *B, int ldb) {
   const int N = st->N, m = st->m;
   const size_t Nm = (size_t)N * (size_t)m;
   phgmg_result rc;
   int j;
-  for (j = 0; j < m; ++j) memcpy(st->U + (size_t)j * N, B + (size_t)j * ldb, sizeof(double) * (size_t)N);
+  for (j = 0; j < m; ++j) memcpy(st->U + (size_t)j * N, st->Bt + (size_t)j * st->ldbt, sizeof(double) * (size_t)N);
   st->p = 0.0;
-  rc = phgmg_shifted_solve(st->s, 0.0, 0.0, m, st->U, N, st->U + Nm, N);
+  rc = phgmg_shifted_solve(st->s, 0.0, 0.0, m, B, ldb, st->U + Nm, N);
   if (rc == PHGMG_ERR_SINGULAR) {
     phgmg__lradi lr;
     double amin = HUGE_VAL;
@@ -24019,11 +24191,11 @@ PHGMG__PRIV phgmg_result phgmg__ek_first(phgmg__eksm *st, const double *B, int l
     if (rc != PHGMG_OK) return rc;
     if (lr.nsh == 0) return PHGMG_ERR_NOT_STABLE;
     st->p = -amin;
-    rc = phgmg_shifted_solve(st->s, st->p, 0.0, m, st->U, N, st->U + Nm, N);
+    rc = phgmg_shifted_solve(st->s, st->p, 0.0, m, B, ldb, st->U + Nm, N);
   }
   if (rc != PHGMG_OK) return rc;
   st->up = st->um = m;
-  for (j = 0; j < 2 * m; ++j) phgmg__sp_qmv(st->s->S, st->U + (size_t)j * N, st->QU + (size_t)j * N);
+  phgmg__ek_qmul(st, 2 * m);
   return PHGMG_OK;
 }
 
@@ -24032,13 +24204,13 @@ PHGMG__PRIV phgmg_result phgmg__ek_first(phgmg__eksm *st, const double *B, int l
    it converged (inf->res <= tol), else NULL. A projected matrix that
    phgmg_lyap refuses leaves the residual as it was (the next block may
    fix it). */
-PHGMG__PRIV phgmg_result phgmg__ek_check(phgmg__eksm *st, const double *B, int ldb, double bnorm, double tol,
-                                         double **Y, phgmg_lradi_info *inf) {
+PHGMG__PRIV phgmg_result phgmg__ek_check(phgmg__eksm *st, double bnorm, double tol, double **Y,
+                                         phgmg_lradi_info *inf) {
   double *y = phgmg__dalloc(st->al, (size_t)st->nc * (size_t)st->nc), res = 0.0;
   phgmg_result rc;
   *Y = NULL;
   if (!y) return PHGMG_ERR_NOMEM;
-  rc = phgmg__ek_project(st, B, ldb, y);
+  rc = phgmg__ek_project(st, y);
   if (rc == PHGMG_ERR_SINGULAR || rc == PHGMG_ERR_NOT_CONVERGED) { phgmg__free(st->al, y); return PHGMG_OK; }
   if (rc == PHGMG_OK) rc = phgmg__ek_resid(st, y, &res);
   if (rc == PHGMG_OK) inf->res = res / bnorm;
@@ -24050,16 +24222,15 @@ PHGMG__PRIV phgmg_result phgmg__ek_check(phgmg__eksm *st, const double *B, int l
 /* The block loop of phgmg_lrkrylov (the first block in the basis): a new
    block per pass, the projected equation checked after blocks 1, 2, ... 8
    and then every quarter of the blocks so far; *Y the converged solution. */
-PHGMG__PRIV phgmg_result phgmg__ek_iterate(phgmg__eksm *st, const double *B, int ldb, const phgmg_lradi_opts *o,
-                                           double tol, int maxit, double bnorm, double *wk, double **Y,
-                                           phgmg_lradi_info *inf) {
+PHGMG__PRIV phgmg_result phgmg__ek_iterate(phgmg__eksm *st, const phgmg_lradi_opts *o, double tol, int maxit,
+                                           double bnorm, double *wk, double **Y, phgmg_lradi_info *inf) {
   int next = 1, orc;
   phgmg_result rc;
   inf->iters = 1;
   for (;;) {
     if (inf->iters >= next || st->breakdown || inf->iters >= maxit) {
       phgmg__lr_progress(o, "eksm: projected equation");
-      if ((rc = phgmg__ek_check(st, B, ldb, bnorm, tol, Y, inf)) != PHGMG_OK || *Y) return rc;
+      if ((rc = phgmg__ek_check(st, bnorm, tol, Y, inf)) != PHGMG_OK || *Y) return rc;
       next = inf->iters + PHGMG__MAX(1, inf->iters / 4);
       if (st->breakdown || inf->iters >= maxit) return PHGMG_ERR_NOT_CONVERGED;
     }
@@ -24067,9 +24238,22 @@ PHGMG__PRIV phgmg_result phgmg__ek_iterate(phgmg__eksm *st, const double *B, int
     orc = phgmg__ek_orth(st, wk);
     if (orc < 0) return PHGMG_ERR_NANINF;
     if (orc == 0) { st->breakdown = 1; continue; }
-    phgmg__ek_append(st);
+    if ((rc = phgmg__ek_append(st)) != PHGMG_OK) return rc;
     ++inf->iters;
   }
+}
+
+/* Bt = E^{-1} B (a mass matrix: allocated, B's columns solved with E's
+   factorization), else B itself. */
+PHGMG__PRIV phgmg_result phgmg__ek_bt(phgmg__eksm *st, const double *B, int ldb) {
+  const int N = st->N;
+  int j;
+  st->Bt = B; st->ldbt = ldb;
+  if (!st->hase) return PHGMG_OK;
+  if (!(st->Bown = phgmg__dalloc(st->al, (size_t)N * (size_t)st->m))) return PHGMG_ERR_NOMEM;
+  for (j = 0; j < st->m; ++j) memcpy(st->Bown + (size_t)j * N, B + (size_t)j * ldb, sizeof(double) * (size_t)N);
+  st->Bt = st->Bown; st->ldbt = N;
+  return phgmg__shifted_esolve(st->s, st->m, st->Bown, N);
 }
 
 /* Arguments and options of phgmg_lrkrylov (those of phgmg_lradi). */
@@ -24085,7 +24269,7 @@ PHGMG__PRIV phgmg_result phgmg__ek_args(const phgmg_shifted *s, int m, const dou
     if (o->maxit > 0) *maxit = o->maxit;
     if (o->trunc != 0.0) *trunc = o->trunc;
   }
-  if (s->S->e_p || s->nalg) return PHGMG_ERR_UNSUPPORTED; /* E = I only */
+  if (s->nalg) return PHGMG_ERR_UNSUPPORTED; /* E of full rank only (no algebraic lines) */
   for (j = 0; j < m; ++j)
     if (!phgmg__all_finite(B + (size_t)j * (size_t)ldb, (size_t)s->N)) return PHGMG_ERR_NANINF;
   return PHGMG_OK;
@@ -24108,6 +24292,7 @@ PHGMG_DEF phgmg_result phgmg_lrkrylov(phgmg_shifted *s, int m, const double *B, 
   memset(&st, 0, sizeof st);
   nf0 = s->nfact;
   st.s = s; st.al = alloc; st.N = s->N; st.m = m; st.w = 2 * m; st.maxb = maxit;
+  st.hase = s->S->e_p != NULL;
   st.AL = phgmg__dalloc(alloc, 3 * (size_t)s->N * (size_t)st.w);
   wk = phgmg__dalloc(alloc, (size_t)PHGMG__EK_CHUNK * (size_t)st.w + (size_t)st.w);
   if (!st.AL || !wk) rc = PHGMG_ERR_NOMEM;
@@ -24118,13 +24303,13 @@ PHGMG_DEF phgmg_result phgmg_lrkrylov(phgmg_shifted *s, int m, const double *B, 
     if (bnorm != bnorm) rc = PHGMG_ERR_NOMEM;
     else if (!(bnorm > 0.0)) rc = PHGMG_ERR_RANK; /* B = 0 */
   }
+  if (rc == PHGMG_OK) rc = phgmg__ek_bt(&st, B, ldb);
   if (rc == PHGMG_OK) rc = phgmg__ek_first(&st, B, ldb);
   if (rc == PHGMG_OK) rc = phgmg__ek_grow(&st);
   if (rc == PHGMG_OK && (orc = phgmg__ek_orth(&st, wk)) <= 0) rc = orc == 0 ? PHGMG_ERR_RANK : PHGMG_ERR_NANINF;
-  if (rc == PHGMG_OK) {
-    phgmg__ek_append(&st);
+  if (rc == PHGMG_OK && (rc = phgmg__ek_append(&st)) == PHGMG_OK) {
     inf.res = 1.0;   /* Z = 0: the residual B B^T */
-    rc = phgmg__ek_iterate(&st, B, ldb, opts, tol, maxit, bnorm, wk, &Y, &inf);
+    rc = phgmg__ek_iterate(&st, opts, tol, maxit, bnorm, wk, &Y, &inf);
   }
   inf.cols = st.nc;
   inf.shift = st.p;
@@ -24132,7 +24317,7 @@ PHGMG_DEF phgmg_result phgmg_lrkrylov(phgmg_shifted *s, int m, const double *B, 
   inf.rank = rc == PHGMG_OK ? *k : 0;
   inf.factorizations = s->nfact - nf0;
   if (info) *info = inf;
-  phgmg__free(alloc, Y); phgmg__free(alloc, wk); phgmg__free(alloc, st.AL);
+  phgmg__free(alloc, Y); phgmg__free(alloc, wk); phgmg__free(alloc, st.AL); phgmg__free(alloc, st.Bown);
   phgmg__free(alloc, st.V); phgmg__free(alloc, st.QV); phgmg__free(alloc, st.T);
   return rc;
 }
@@ -30466,7 +30651,9 @@ PHGMG_DEF phgmg_result phgmg_sym_eig(int n, double *A, int lda, double *w, doubl
             wide V2, ALTMIN, a chosen lambda and the screened ECSW with
             GMG-QM return PHGMG_ERR_UNSUPPORTED.
           - New: phgmg_lrkrylov, the extended Krylov subspace method for the
-            low-rank Lyapunov equation (E = I; one sparse LU per run),
+            low-rank Lyapunov equation (E = I or a mass matrix of full rank,
+            in the energy inner product x^T E^T Q y; one sparse LU per run,
+            and one of E),
             chosen by phgmg_lradi_opts.solver = PHGMG_LYAP_EKSM wherever the
             ADI runs (phgmg_lrbt, phgmg_lrphbt, phgmg_balanced_reduce);
             phgmg_lradi_info.solver and .shift; the command line's reduce

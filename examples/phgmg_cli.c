@@ -452,7 +452,8 @@ static const char *const help_lines[] = {
   "  --lyap adi|eksm     the low-rank Lyapunov solver of bt, prbt and phbt: adi (the\n",
   "                      default; the low-rank ADI, one sparse LU per shift) or eksm\n",
   "                      (the extended Krylov method: one sparse LU for the whole\n",
-  "                      run, more columns; models without a mass matrix only).\n",
+  "                      run, and one of the mass matrix E; more columns; E of\n",
+  "                      full rank only: no algebraic equations).\n",
   "                      The same relative residual 1e-10; NAME.json names it.\n",
   "    bt    balanced truncation (needs m < R); the H-infinity error bound\n",
   "          2 sum_{i>R} sigma_i (low-rank: over the values computed) in the log\n",
@@ -4571,9 +4572,12 @@ static int explain_balancing(const reduce_args *A, const reduce_state *S, phgmg_
                   b->lr.obs.iters ? b->lr.obs.iters : b->lr.ctrl.iters,
                   A->lyap == PHGMG_LYAP_EKSM ? "blocks" : "steps");
     case PHGMG_ERR_UNSUPPORTED:
-      if (S->sp && A->lyap == PHGMG_LYAP_EKSM && A->Ecoo)
-        return fail("reduction failed: --lyap eksm takes models without a mass matrix (E = I; given: --E-coo "
-                    "%s); use --lyap adi", A->Ecoo);
+      if (S->sp && A->lyap == PHGMG_LYAP_EKSM && A->Ecoo && S->full.E) {
+        int zr = 0, zc = 0;
+        if (e_zero_lines(S, S->full.N, &zr, &zc, NULL, NULL) > 0)
+          return fail("reduction failed: --lyap eksm takes a mass matrix of full rank only (--E-coo %s has %d "
+                      "zero rows: algebraic equations); use --lyap adi", A->Ecoo, zr);
+      }
       if (S->sp && S->dae_direct && A->Ecoo)
         return fail("reduction failed: a port acts on an algebraic equation (a zero row of E, %s): through the "
                     "constraint it has a feedthrough D, which the port-Hamiltonian forms of --method bt, prbt "

@@ -4,7 +4,8 @@
 # tests/check_cli_lowrank.py (what it checks is described there) on a small
 # lattice and heat model, as COO files (the low-rank solvers) and dense .npy
 # files (the dense solvers); and the log of a low-rank run (the solver, the
-# Gramian ranks and residuals, the bound); --lyap eksm against the ADI run.
+# Gramian ranks and residuals, the bound); --lyap eksm against the ADI run,
+# also on a model with a mass matrix (--E-coo).
 # Usage: sh tests/test_cli_lowrank.sh build/phgmg      (from the repository root)
 # Needs NumPy and SciPy in /usr/bin/python3 (skipped with a note otherwise).
 set -u
@@ -47,6 +48,76 @@ print("test_cli_lowrank: --lyap eksm vs adi: %d Hankel singular values within %.
       % (n, err, k["lyapunov_residual"], "" if ok else "  FAIL"))
 sys.exit(0 if ok else 1)
 EOF_PY
+# A mass matrix (--E-coo): a 1-D heat model in P1 finite elements (150 nodes,
+# consistent mass E = M, R = K + 0.1 M, J = 0, Q = I, two ports M g, states
+# scrambled): --lyap eksm and --lyap adi, their Hankel singular values against
+# each other and against SciPy's dense ones (the E^{-1} model's Gramians by
+# solve_continuous_lyapunov), both within 1e-8 sigma_1.
+M="$T/mass"
+"$PY" - "$M" <<'EOF_PY' || { echo "FAIL: the mass-matrix model"; nfail=$((nfail + 1)); }
+import os, sys
+import numpy as np
+import scipy.sparse as sps
+out, n = sys.argv[1], 150
+rng = np.random.default_rng(5)
+x = np.linspace(0.0, 1.0, n)
+x[1:-1] += rng.uniform(-0.3, 0.3, n - 2) / (n - 1)
+M = np.zeros((n, n)); K = np.zeros((n, n))
+for e in range(n - 1):
+    h = x[e + 1] - x[e]
+    M[e:e + 2, e:e + 2] += h * np.array([[1 / 3, 1 / 6], [1 / 6, 1 / 3]])
+    K[e:e + 2, e:e + 2] += np.array([[1, -1], [-1, 1]]) / h
+g = [np.maximum(0, 1 - np.abs(x - 0.2) / 0.15), np.maximum(0, 1 - np.abs(x - 0.75) / 0.2)]
+B = np.column_stack([M @ g[0], M @ g[1]])
+p = rng.permutation(n)
+os.makedirs(out, exist_ok=True)
+for name, A in (("E", M), ("R", K + 0.1 * M), ("J", np.zeros((n, n))), ("Q", np.eye(n))):
+    c = sps.coo_matrix(A[np.ix_(p, p)])
+    np.save("%s/%s.npy" % (out, name), np.column_stack([c.row, c.col, c.data]).astype(float))
+np.save(out + "/B.npy", B[p])
+EOF_PY
+for s in adi eksm; do
+  "$P" reduce --J-coo "$M/J.npy" --R-coo "$M/R.npy" --Q-coo "$M/Q.npy" --E-coo "$M/E.npy" --B "$M/B.npy" \
+    --method bt --r 8 --lyap $s --out "$T/log" --name btm$s > "$T/logm$s.txt" 2>&1 ||
+    { echo "FAIL: bt --E-coo --lyap $s run"; cat "$T/logm$s.txt"; nfail=$((nfail + 1)); }
+done
+"$PY" - "$M" "$T/log/btmadi.json" "$T/log/btmeksm.json" <<'EOF_PY' || nfail=$((nfail + 1))
+import json, sys
+import numpy as np
+import scipy.linalg as sla
+d = sys.argv[1]
+a, k = (json.load(open(f))["info"] for f in sys.argv[2:4])
+B = np.load(d + "/B.npy")
+N = B.shape[0]
+def dense(name):
+    t = np.load("%s/%s.npy" % (d, name))
+    X = np.zeros((N, N))
+    np.add.at(X, (t[:, 0].astype(int), t[:, 1].astype(int)), t[:, 2])
+    return X
+E, J, R, Q = (dense(x) for x in "EJRQ")
+Ai = np.linalg.solve(E, (J - R) @ Q)
+Bi = np.linalg.solve(E, B)
+C = B.T @ Q
+P = sla.solve_continuous_lyapunov(Ai, -Bi @ Bi.T)
+O = sla.solve_continuous_lyapunov(Ai.T, -C.T @ C)
+ref = np.sort(np.sqrt(np.abs(np.linalg.eigvals(P @ O))))[::-1]
+sa, sk = a["hankel_singular_values"], k["hankel_singular_values"]
+n = min(len(sa), len(sk), 8)
+e_ak = max(abs(x - y) for x, y in zip(sa[:n], sk[:n])) / sa[0]
+e_ref = max(abs(x - y) for x, y in zip(sk[:n], ref[:n])) / ref[0]
+ok = a["lyapunov_solver"] == "adi" and k["lyapunov_solver"] == "eksm" and n == 8 and e_ak <= 1e-8 and \
+     e_ref <= 1e-8 and max(k["lyapunov_residual"]) <= 1e-10
+print("test_cli_lowrank: mass matrix, --lyap eksm vs adi: %d Hankel singular values within %.2g sigma_1, vs "
+      "SciPy %.2g; residuals %s%s" % (n, e_ak, e_ref, k["lyapunov_residual"], "" if ok else "  FAIL"))
+sys.exit(0 if ok else 1)
+EOF_PY
+# Algebraic equations (an index-one RLC grid, bench/rlc_grid.py): --lyap eksm
+# refuses them (exit 1), naming the zero rows of E.
+"$PY" "$ROOT/bench/rlc_grid.py" "$T/rlc" --n 6 > /dev/null 2>&1 || { echo "FAIL: rlc_grid.py"; nfail=$((nfail + 1)); }
+"$P" reduce --J-coo "$T/rlc/J.npy" --R-coo "$T/rlc/R.npy" --Q-coo "$T/rlc/Q.npy" --E-coo "$T/rlc/E.npy" \
+  --B "$T/rlc/B.npy" --method bt --r 6 --lyap eksm --out "$T/log" --name btrlc > "$T/logr.txt" 2>&1
+[ $? -eq 1 ] && grep -F -q "mass matrix of full rank only" "$T/logr.txt" && grep -F -q "zero rows" "$T/logr.txt" ||
+  { echo "FAIL: --lyap eksm on algebraic equations"; cat "$T/logr.txt"; nfail=$((nfail + 1)); }
 "$P" reduce --J-coo "$D/J.npy" --R-coo "$D/R.npy" --Q-coo "$D/Q.npy" --B "$D/B.npy" --method bt --r 8 \
   --lyap krylov --out "$T/log" --name bad > "$T/logb.txt" 2>&1
 [ $? -eq 2 ] || { echo "FAIL: --lyap krylov is not a usage error"; nfail=$((nfail + 1)); }

@@ -5,8 +5,11 @@
    lattice by phgmg_lyap), the reported residual against the residual of Z
    Z^T computed densely, the Hankel singular values of low-rank BT run on
    its factors against the dense ones and against the ADI's, the dual model
-   (observability), the codes of bad arguments and of a mass matrix, and
-   that zeroed options still run the low-rank ADI. */
+   (observability), a model with a mass matrix (a 1-D finite-element
+   acoustic model, consistent mass, states scrambled; a lattice with a
+   consistent-mass-like E) against the dense Gramians of its E^{-1} model,
+   the codes of bad arguments and of algebraic lines, and that zeroed
+   options still run the low-rank ADI. */
 #define PHGMG_STATIC
 #define PHGMG_IMPLEMENTATION
 #include "../phgmg.h"
@@ -82,6 +85,67 @@ static void tk_lattice(tk_model *M, int n, double d0, int with_e) {
   M->B[n2 + n2 - 1 + (size_t)N] = 1.0;
 }
 
+/* 1-D acoustic model in P1 finite elements on n nodes of [0, 1] (interior
+   nodes moved by up to 0.3 h), x = (p, v): E = blkdiag(M, M) (M the
+   consistent mass matrix), Q = blkdiag(2 I, 0.5 I) (E^T Q symmetric), J =
+   [0, D^T; -D, 0] with D(i, j) = int phi_i phi_j', R = 0.05 E + 1e-3
+   blkdiag(K, K) (K the stiffness), two ports M g in the pressure equation
+   (g a hat over [0.1, 0.5] and the left half of [0.4, 1]); then the
+   states put in a scrambled order (the same permutation of rows and
+   columns of every matrix, of B's rows). */
+static void tk_fe_acoustic(tk_model *M, int n) {
+  const int N = 2 * n;
+  double *x = (double *)malloc(sizeof(double) * (size_t)n), g[2];
+  int *perm = (int *)malloc(sizeof(int) * (size_t)N), e, a, b, i, j, c;
+  unsigned seed = 12345u;
+  tk_model W;
+  tk_alloc(&W, N, 1);
+  for (i = 0; i < n; ++i) {
+    x[i] = (double)i / (n - 1);
+    seed = seed * 1103515245u + 12345u;
+    if (i > 0 && i < n - 1) x[i] += 0.3 / (n - 1) * (((double)((seed >> 16) & 1023u) / 1023.0) * 2.0 - 1.0);
+  }
+  for (e = 0; e + 1 < n; ++e) {
+    const double h = x[e + 1] - x[e], Me[2][2] = {{h / 3, h / 6}, {h / 6, h / 3}};
+    const double De[2][2] = {{-0.5, 0.5}, {-0.5, 0.5}}, Ke[2][2] = {{1 / h, -1 / h}, {-1 / h, 1 / h}};
+    for (a = 0; a < 2; ++a)
+      for (b = 0; b < 2; ++b) {
+        const int r = e + a, q = e + b;
+        for (c = 0; c < 2; ++c) {
+          const int o = c * n;
+          W.E[o + r + (size_t)(o + q) * N] += Me[a][b];
+          W.R[o + r + (size_t)(o + q) * N] += 0.05 * Me[a][b] + 1e-2 * Ke[a][b];
+        }
+        W.J[r + (size_t)(n + q) * N] += De[b][a];      /* D^T */
+        W.J[n + r + (size_t)q * N] -= De[a][b];        /* -D  */
+      }
+  }
+  for (i = 0; i < n; ++i) { W.Q[i + (size_t)i * N] = 2.0; W.Q[n + i + (size_t)(n + i) * N] = 0.5; }
+  for (i = 0; i < n; ++i) {
+    g[0] = x[i] > 0.1 && x[i] < 0.5 ? 1.0 - fabs(x[i] - 0.3) / 0.2 : 0.0;
+    g[1] = x[i] > 0.4 && x[i] < 0.7 ? 1.0 - fabs(x[i] - 0.7) / 0.3 : 0.0;
+    for (c = 0; c < 2; ++c)
+      for (j = 0; j < n; ++j) W.B[j + (size_t)c * N] += W.E[j + (size_t)i * N] * g[c];
+  }
+  for (i = 0; i < N; ++i) perm[i] = i;
+  for (i = N - 1; i > 0; --i) { /* Fisher-Yates with a fixed LCG */
+    int t;
+    seed = seed * 1103515245u + 12345u;
+    j = (int)((seed >> 8) % (unsigned)(i + 1));
+    t = perm[i]; perm[i] = perm[j]; perm[j] = t;
+  }
+  tk_alloc(M, N, 1);
+  for (j = 0; j < N; ++j) {
+    for (i = 0; i < N; ++i) {
+      const size_t d = (size_t)i + (size_t)j * N, s0 = (size_t)perm[i] + (size_t)perm[j] * N;
+      M->J[d] = W.J[s0]; M->R[d] = W.R[s0]; M->Q[d] = W.Q[s0]; M->E[d] = W.E[s0];
+    }
+  }
+  for (c = 0; c < 2; ++c)
+    for (i = 0; i < N; ++i) M->B[i + (size_t)c * N] = W.B[perm[i] + (size_t)c * N];
+  tk_free(&W);
+  free(x); free(perm);
+}
 
 static phgmg_ph_sparse *tk_sparse(const tk_model *M) {
   phgmg_ph_sparse *sp = NULL;
@@ -102,6 +166,34 @@ static double *tk_dense_a(const tk_model *M) {
   phgmg_gemm('N', 'N', N, N, N, 1.0, JR, N, M->Q, N, 0.0, A, N);
   free(JR);
   return A;
+}
+
+/* The dense Gramians of a model with a mass matrix through its E^{-1}
+   model (A' = E^{-1} A, B' = E^{-1} B, C = B^T Q; phgmg_lyap): P solves A
+   P E^T + E P A^T + B B^T = 0, O' = E^T O E the E^{-1} model's
+   observability Gramian, so that the Hankel singular values are sqrt(eig(P
+   O')); A (N x N) returns (J - R) Q. */
+static void tk_dense_e_gramians(const tk_model *M, double *A, double *P, double *O) {
+  const int N = M->N;
+  double *Ap = (double *)malloc(sizeof(double) * (size_t)N * N), *F = (double *)malloc(sizeof(double) * (size_t)N * N);
+  double *LU = (double *)malloc(sizeof(double) * (size_t)N * N), *Bp = (double *)malloc(sizeof(double) * (size_t)N * 2);
+  double *C = (double *)malloc(sizeof(double) * (size_t)N * 2), *A0 = tk_dense_a(M);
+  int *ip = (int *)malloc(sizeof(int) * (size_t)N), i, j;
+  memcpy(A, A0, sizeof(double) * (size_t)N * N);
+  memcpy(Ap, A0, sizeof(double) * (size_t)N * N);
+  memcpy(Bp, M->B, sizeof(double) * (size_t)N * 2);
+  memcpy(LU, M->E, sizeof(double) * (size_t)N * N);
+  CHECK_RC(phgmg_lu_factor(N, LU, N, ip), PHGMG_OK);
+  phgmg_lu_solve('N', N, LU, N, ip, N, Ap, N);
+  phgmg_lu_solve('N', N, LU, N, ip, 2, Bp, N);
+  phgmg_gemm('N', 'T', N, N, 2, 1.0, Bp, N, Bp, N, 0.0, F, N);
+  CHECK_RC(phgmg_lyap(N, Ap, F, P, NULL, NULL), PHGMG_OK);
+  for (j = 0; j < N; ++j)
+    for (i = 0; i < N; ++i) A0[i + (size_t)j * N] = Ap[j + (size_t)i * N];
+  phgmg_gemm('T', 'N', N, 2, N, 1.0, M->Q, N, M->B, N, 0.0, C, N);   /* C^T = Q^T B */
+  phgmg_gemm('N', 'T', N, N, 2, 1.0, C, N, C, N, 0.0, F, N);
+  CHECK_RC(phgmg_lyap(N, A0, F, O, NULL, NULL), PHGMG_OK);
+  free(Ap); free(F); free(LU); free(Bp); free(C); free(A0); free(ip);
 }
 
 /* The heat model's Gramian by the eigen-decomposition of R = U diag(l) U^T
@@ -257,11 +349,106 @@ TEST(test_eksm_lattice) {
   tk_free(&M);
 }
 
+/* A mass matrix: the P1 acoustic model (N = 160, consistent mass, Q != I,
+   states scrambled; A regular, so the inverse directions are A^{-1} E: one
+   factorization of A, one of E). Z Z^T against the dense Gramian of the
+   E^{-1} model, the residual of the generalized equation (tol 1e-7 run)
+   against the dense one with E, BT's Hankel singular values against the
+   dense ones and the ADI's. */
+TEST(test_eksm_mass_fe) {
+  enum { r = 10 };
+  tk_model M;
+  phgmg_ph_sparse *sp;
+  phgmg_shifted *s = NULL;
+  phgmg_lradi_info inf;
+  phgmg_lradi_opts o;
+  phgmg_lrbt_info bi, ba;
+  double *A, *P, *O, *Plr, *Z = NULL, hsv[r], hsva[r], hsvd[r], res;
+  int N, k = 0, i;
+  tk_fe_acoustic(&M, 80);
+  N = M.N;
+  A = (double *)malloc(sizeof(double) * (size_t)N * N);
+  P = (double *)malloc(sizeof(double) * (size_t)N * N); O = (double *)malloc(sizeof(double) * (size_t)N * N);
+  tk_dense_e_gramians(&M, A, P, O);
+  sp = tk_sparse(&M);
+  memset(&o, 0, sizeof o);
+  o.solver = PHGMG_LYAP_EKSM;
+  CHECK_RC(phgmg_shifted_create(&s, sp, 0, 0, NULL), PHGMG_OK);
+  CHECK_RC(phgmg_lradi(s, 2, phgmg_ph_sparse_system(sp)->B, N, &o, &Z, &k, &inf, NULL), PHGMG_OK);
+  CHECK(inf.solver == PHGMG_LYAP_EKSM && inf.shift == 0.0 && inf.factorizations == 2);
+  CHECK(inf.res <= 1e-10 && inf.rank == k && k <= inf.cols && inf.cols < N);
+  Plr = th_gram_user(sp, N, Z, k);
+  CHECK_LE(th_reldiff(N * N, Plr, P), 1e-8);
+  free(Plr); phgmg_lowrank_free(Z, NULL); Z = NULL;
+  /* the residual of A P E^T + E P A^T + B B^T (tol 1e-5: far above round-off) */
+  o.tol = 1e-5;
+  CHECK_RC(phgmg_lrkrylov(s, 2, phgmg_ph_sparse_system(sp)->B, N, &o, &Z, &k, &inf, NULL), PHGMG_OK);
+  CHECK(inf.res <= 1e-5 && inf.res > 1e-12);
+  Plr = th_gram_user(sp, N, Z, k);
+  res = th_lyap_res(N, 2, A, M.E, M.B, Plr);
+  CHECK_LE(fabs(res - inf.res), 0.02 * inf.res);
+  free(Plr); phgmg_lowrank_free(Z, NULL);
+  /* balanced truncation (two EKSM runs: J != 0) */
+  th_dense_hsv(N, P, O, hsvd, r);
+  tk_lrbt_hsv(sp, PHGMG_LYAP_EKSM, r, hsv, &bi);
+  tk_lrbt_hsv(sp, PHGMG_LYAP_ADI, r, hsva, &ba);
+  CHECK(bi.ctrl.solver == PHGMG_LYAP_EKSM && bi.obs.solver == PHGMG_LYAP_EKSM && bi.obs.res <= 1e-10);
+  for (i = 0; i < r; ++i) {
+    CHECK_LE(fabs(hsv[i] - hsvd[i]), 1e-8 * hsvd[0]);
+    CHECK_LE(fabs(hsv[i] - hsva[i]), 1e-8 * hsva[0]);
+  }
+  phgmg_shifted_destroy(s); phgmg_ph_sparse_destroy(sp);
+  free(A); free(P); free(O);
+  tk_free(&M);
+}
+
+/* A mass matrix and a refused A: the 8 x 8 lattice with E = [I 0; 0 Mc]
+   (Mc tridiagonal): the inverse directions (A + p E)^{-1} E with the
+   pencil's Ritz value p < 0; Z Z^T and the Hankel singular values against
+   the dense E^{-1} model's, and the values against the ADI's. */
+TEST(test_eksm_mass_lattice) {
+  enum { r = 8 };
+  tk_model M;
+  phgmg_ph_sparse *sp;
+  phgmg_shifted *s = NULL;
+  phgmg_lradi_info inf;
+  phgmg_lradi_opts o;
+  phgmg_lrbt_info bi, ba;
+  double *A, *P, *O, *Plr, *Z = NULL, hsv[r], hsva[r], hsvd[r];
+  int N, k = 0, i;
+  tk_lattice(&M, 8, 0.5, 1);
+  N = M.N;
+  A = (double *)malloc(sizeof(double) * (size_t)N * N);
+  P = (double *)malloc(sizeof(double) * (size_t)N * N); O = (double *)malloc(sizeof(double) * (size_t)N * N);
+  tk_dense_e_gramians(&M, A, P, O);
+  sp = tk_sparse(&M);
+  memset(&o, 0, sizeof o);
+  o.solver = PHGMG_LYAP_EKSM;
+  CHECK_RC(phgmg_shifted_create(&s, sp, 0, 0, NULL), PHGMG_OK);
+  CHECK_RC(phgmg_lradi(s, 2, phgmg_ph_sparse_system(sp)->B, N, &o, &Z, &k, &inf, NULL), PHGMG_OK);
+  CHECK(inf.solver == PHGMG_LYAP_EKSM && inf.shift < 0.0 && inf.factorizations == 3 && inf.res <= 1e-10);
+  CHECK(inf.rank == k && inf.cols < N); /* converged before the basis filled the space */
+  Plr = th_gram_user(sp, N, Z, k);
+  CHECK_LE(th_reldiff(N * N, Plr, P), 1e-8);
+  free(Plr); phgmg_lowrank_free(Z, NULL);
+  th_dense_hsv(N, P, O, hsvd, r);
+  tk_lrbt_hsv(sp, PHGMG_LYAP_EKSM, r, hsv, &bi);
+  tk_lrbt_hsv(sp, PHGMG_LYAP_ADI, r, hsva, &ba);
+  CHECK(bi.ctrl.solver == PHGMG_LYAP_EKSM && bi.obs.res <= 1e-10);
+  for (i = 0; i < r; ++i) {
+    CHECK_LE(fabs(hsv[i] - hsvd[i]), 1e-8 * hsvd[0]);
+    CHECK_LE(fabs(hsv[i] - hsva[i]), 1e-8 * hsva[0]);
+  }
+  phgmg_shifted_destroy(s); phgmg_ph_sparse_destroy(sp);
+  free(A); free(P); free(O);
+  tk_free(&M);
+}
+
 /* Bad arguments and the documented codes: NULL, m < 1, ldb < N, a solver
    value out of range, B = 0 (_RANK), NaN in B (_NANINF), maxit blocks too
-   few (_NOT_CONVERGED, the residual reached in info, no factor), a mass
-   matrix (_UNSUPPORTED); zeroed options run the ADI (the same factor as
-   NULL options). */
+   few (_NOT_CONVERGED, the residual reached in info, no factor), an E
+   with algebraic lines (a massless node: index one, _UNSUPPORTED); zeroed
+   options run the ADI (the same factor as NULL options). */
 TEST(test_eksm_arguments) {
   tk_model M, Me;
   phgmg_ph_sparse *sp, *spe;
@@ -275,6 +462,8 @@ TEST(test_eksm_arguments) {
   tk_lattice(&M, 4, 0.5, 0);
   tk_lattice(&Me, 4, 0.5, 1);
   N = M.N;
+  for (i = 0; i < (size_t)N; ++i) /* the momentum of node 5 without mass: an algebraic line */
+    Me.E[i + (size_t)(16 + 5) * N] = Me.E[16 + 5 + i * N] = 0.0;
   sp = tk_sparse(&M);
   spe = tk_sparse(&Me);
   CHECK_RC(phgmg_shifted_create(&s, sp, 0, 0, NULL), PHGMG_OK);
@@ -324,5 +513,7 @@ TEST(test_eksm_arguments) {
 SUITE(eksm) {
   RUN(test_eksm_heat);
   RUN(test_eksm_lattice);
+  RUN(test_eksm_mass_fe);
+  RUN(test_eksm_mass_lattice);
   RUN(test_eksm_arguments);
 }
