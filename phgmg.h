@@ -30630,6 +30630,13 @@ PHGMG_DEF phgmg_result phgmg_sym_eig(int n, double *A, int lda, double *w, doubl
             its fields.
           - phgmg-mpi: --method sp2, --hyper qdeim|greedy with --deim-tol,
             --deim-max, --deim-allow-negative, and --E-coo.
+          - phgmg_lrkrylov (extended Krylov) takes a mass matrix of full
+            rank: the space of (E^{-1} A, E^{-1} B) in the energy inner
+            product x^T E^T Q y, E factored once on the pencil's analysis;
+            its residual from an eigenproblem of order 4 m.
+          - Command line: reduce --method bt --form ss writes balanced
+            truncation's state-space model (A, B, C, D) when it has no
+            port-Hamiltonian form, and simulate-rom --ss steps it.
    0.10.0 (2026-11-29)
           - Fixed: ECSW stopped with PHGMG_ERR_NOT_CONVERGED above its
             tolerance when some terms' training columns were many orders
@@ -30651,9 +30658,7 @@ PHGMG_DEF phgmg_result phgmg_sym_eig(int n, double *A, int lda, double *w, doubl
             wide V2, ALTMIN, a chosen lambda and the screened ECSW with
             GMG-QM return PHGMG_ERR_UNSUPPORTED.
           - New: phgmg_lrkrylov, the extended Krylov subspace method for the
-            low-rank Lyapunov equation (E = I or a mass matrix of full rank,
-            in the energy inner product x^T E^T Q y; one sparse LU per run,
-            and one of E),
+            low-rank Lyapunov equation (E = I; one sparse LU per run),
             chosen by phgmg_lradi_opts.solver = PHGMG_LYAP_EKSM wherever the
             ADI runs (phgmg_lrbt, phgmg_lrphbt, phgmg_balanced_reduce);
             phgmg_lradi_info.solver and .shift; the command line's reduce
