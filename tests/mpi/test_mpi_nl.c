@@ -624,10 +624,16 @@ static void test_gmg_pod_ecsw(int n, int r) {
   free(X); free(x0); free(V0); free(V0f);
 }
 
+static void compare_qm(const chain *ch, const double *x0, const phgmg_reduced *red, const phgmg_mpi_rom *mr,
+                       const double *V0f, int nsteps, double btol, double ytol, double *diffs, const char *tag);
+static void qm_sensitivity(const chain *ch, int ns, const double *X, const double *x0, const phgmg_reduce_opts *o,
+                           const phgmg_reduced *red, double *btol, double *ytol);
 /* From PHGMG_ECSW_SCREEN_MIN (4096) moving terms the serial ECSW screens
    candidates in rounds: the same points (as global indices) and weights
    from the distributed screening. A cosh term on every coordinate of a
-   chain of 2100 masses (4200 terms), 31 snapshots, r = 8. */
+   chain of 2100 masses (4200 terms), 31 snapshots, r = 8: GMG-POD, then
+   GMG-QM (POD manifold, rn = 4) with the screened fit on its training
+   columns. */
 static void test_screened(void) {
   const int n = 2100, N = 2 * n, ns = 31, r = 8;
   chain ch;
@@ -654,6 +660,27 @@ static void test_screened(void) {
     /* K = G00^{-1} with cond(G00) = 1e6 here (5e5 in test_gmg_pod_ecsw):
        its forward error bound is cond eps ~ 2e-10; measured 6e-13 .. 2e-12 */
     if (red) compare_serial(&ch, ns, X, x0, red, &mr, V0f, 100, 1e-11, 1e-10, "gmg-pod ecsw, 4200 terms");
+    phgmg_reduced_destroy(red);
+    red = NULL;
+  }
+  quiet_barrier();
+  phgmg_mpi_rom_free(&mr);
+  /* GMG-QM (POD manifold, rn = 4) with the screened ECSW on the manifold's
+     training columns (its greedy manifold's model, serial and distributed
+     alike, stops at step 2 on this data: not compared) */
+  o.method = PHGMG_METHOD_GMG_QM; o.qm.rn = 4; o.qm.manifold = PHGMG_MANIFOLD_POD;
+  rc = phgmg_mpi_reduce(d.c, &d.md, ns, d.Xl, d.ld, &o, &mr, V0, d.ld);
+  CHECK(rc == PHGMG_OK && same_everywhere(mr.nd) && mr.nd > 0, "distributed GMG-QM, screened ECSW: %d", (int)rc);
+  free(V0f);
+  V0f = gather_v0(d.c, r, V0, d.ld);
+  if (rank_ == 0 && rc == PHGMG_OK) {
+    double btol = 1e-11, ytol = 1e-10;
+    CHECK(phgmg_reduce(&red, &ch.sys, X, N, ns, &o, NULL, NULL) == PHGMG_OK, "serial GMG-QM, screened ECSW");
+    /* the weights (each to its own size) held to ten times the serial
+       model's own movement under one-ulp changes of the snapshots */
+    if (red) qm_sensitivity(&ch, ns, X, x0, &o, red, &btol, &ytol);
+    if (red) compare_qm(&ch, x0, red, &mr, V0f, 100, btol, ytol, NULL, "gmg-qm pod ecsw, 4200 terms");
+    wtol_ = 1e-12;
     phgmg_reduced_destroy(red);
   }
   quiet_barrier();
@@ -911,6 +938,7 @@ static void test_gmg_qm(int n, int r) {
     free(V0);
   }
   online_dt_ = 0.1;
+  qm_deim_ = 0;   /* compare_qm's weights: each to its own size again */
   free(X); free(x0);
 }
 
@@ -990,45 +1018,6 @@ static double mem_peak(MPI_Comm comm, long long N) {
   peak = (double)cnt.peak;
   MPI_Allreduce(&peak, &out, 1, MPI_DOUBLE, MPI_MAX, comm);
   return out;
-}
-
-/* GMG-QM (POD manifold, rn = 4) with ECSW from PHGMG_ECSW_SCREEN_MIN live
-   terms: the screened fit on the manifold's training columns, against the
-   serial phgmg_reduce (the chain of test_screened: 4200 terms; its greedy
-   manifold's model, serial and distributed alike, stops at step 2: a
-   reduced model of this data that cannot be stepped, so not compared). */
-static void test_qm_screened(void) {
-  const int n = 2100, N = 2 * n, ns = 31, r = 8;
-  chain ch;
-  dist d;
-  double *X = (double *)malloc(sizeof(double) * (size_t)N * ns), *x0 = (double *)calloc((size_t)N, sizeof(double));
-  double *V0, *V0f;
-  phgmg_reduce_opts o;
-  phgmg_reduced *red = NULL;
-  phgmg_mpi_rom mr;
-  phgmg_result rc;
-  int i;
-  chain_build(&ch, n, 1);
-  for (i = 0; i < n; ++i) x0[2 * i] = 0.8 * sin(3.0 * 3.14159265358979 * i / n);
-  simulate_root(&ch, x0, 0.2, ns, X);
-  memset(&o, 0, sizeof o);
-  o.method = PHGMG_METHOD_GMG_QM; o.r = r; o.qm.rn = 4; o.qm.manifold = PHGMG_MANIFOLD_POD;
-  o.hyper.on = 1; o.hyper.tol = 1e-3;
-  dist_build(&d, &ch, ns, X);
-  V0 = (double *)malloc(sizeof(double) * (size_t)d.ld * r);
-  rc = phgmg_mpi_reduce(d.c, &d.md, ns, d.Xl, d.ld, &o, &mr, V0, d.ld);
-  CHECK(rc == PHGMG_OK && same_everywhere(mr.nd) && mr.nd > 0, "distributed GMG-QM, screened ECSW: %d", (int)rc);
-  V0f = gather_v0(d.c, r, V0, d.ld);
-  if (rank_ == 0 && rc == PHGMG_OK) {
-    CHECK(phgmg_reduce(&red, &ch.sys, X, N, ns, &o, NULL, NULL) == PHGMG_OK, "serial GMG-QM, screened ECSW");
-    if (red) compare_qm(&ch, x0, red, &mr, V0f, 100, 1e-11, 1e-10, NULL, "gmg-qm pod ecsw, 4200 terms");
-    phgmg_reduced_destroy(red);
-  }
-  quiet_barrier();
-  phgmg_mpi_rom_free(&mr);
-  dist_free(&d);
-  chain_free(&ch);
-  free(X); free(x0); free(V0); free(V0f);
 }
 
 /* A descriptor model (manual 1.6): the chain with a mass matrix E (banded,
@@ -1146,7 +1135,6 @@ int main(int argc, char **argv) {
     test_gmg_pod_ecsw(1000, 12);
     test_screened();
     test_gmg_qm(300, 8);
-    test_qm_screened();
     test_descriptor();
     test_errors();
     test_memory();
