@@ -79,13 +79,15 @@ test-build: tests/suites.inc
 # each run's results compared with the one-rank run's; the section's compile
 # checks (C99, float online scalar, C++). Skipped, with a message, without
 # mpicc and mpirun (Debian: openmpi-bin libopenmpi-dev). A deadlock fails
-# after 120 s (timeout). The programs share one compile of the implementation
+# after 120 s (timeout). More ranks than cores: the ranks yield the core while
+# they wait (mpi_yield_when_idle), so that the jobs beside them keep it. The
+# programs share one compile of the implementation
 # ($(BUILD)/mpi/lib.o; they are built with PHGMG_IMPLEMENTATION_ELSEWHERE),
 # except test_mpi_nl, which reads the reduced object's internals.
 # About 45 s.
 MPICC  ?= mpicc
 MPICXX ?= mpicxx
-MPIRUN  = mpirun --oversubscribe $$(if [ "$$(id -u)" = 0 ]; then echo --allow-run-as-root; fi)
+MPIRUN  = mpirun --oversubscribe --mca mpi_yield_when_idle 1 $$(if [ "$$(id -u)" = 0 ]; then echo --allow-run-as-root; fi)
 test-mpi:
 	@if ! command -v $(MPICC) >/dev/null 2>&1 || ! command -v mpirun >/dev/null 2>&1; then \
 	  echo "test-mpi: skipped (no $(MPICC) or mpirun; Debian packages openmpi-bin libopenmpi-dev)"; exit 0; fi; \

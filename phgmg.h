@@ -1008,10 +1008,10 @@
    same 16 points as global indices, in the same order, P0 within 5e-15,
    the weights within 1e-11, K, Qh, Bh, V0 within 7e-15, the outputs within
    8e-15; with DEIM (--deim-tol 1e-4 --deim-allow-negative, gmg-pod with
-   Q-DEIM at P = 1, 3, sp2 with greedy points at P = 2, 4): the same 12
+   Q-DEIM at P = 3, sp2 with greedy points at P = 4): the same 12
    points in the same order, the weights within 1.2e-14, the outputs within
    8e-15; with a mass matrix (--E-coo: consistent-mass pattern on the
-   momenta, gmg-pod with the cosh terms, P = 2, 3; E factored by the
+   momenta, gmg-pod with the cosh terms, P = 2; E factored by the
    library's sparse LU, replicated as J - R): the same 22 points, K within
    2.7e-15, the weights within 1.4e-12, the outputs within 4.5e-15.
    Measured at N = 2e5 (1001 snapshots, r = 20): bench/README.md.
