@@ -4,8 +4,9 @@
 # N = 2400), 201 snapshots from `phgmg simulate --dt 0.1 --steps 200`,
 # reduced by `phgmg reduce --method gmg-pod --r 10` and `--method sp1 --r 10`
 # and by `mpirun -np P phgmg-mpi reduce` with the same options at P = 1, 2,
-# 3, 4 (4: more ranks than cores; sp1 at P = 2, 4 on the linear chain and
-# P = 1, 3 on the cosh chain), each into its own directory. NumPy checks:
+# 3, 4 over the cases (4: more ranks than cores; gmg-pod at P = 1, 3 on the
+# linear chain and 2, 4 on the cosh chain, sp1 the other way round), each
+# into its own directory. NumPy checks:
 #   - the same files (NAME.phgmgrom, .c, .json, _Bh, _Qh, _K, _V0.npy) as the
 #     serial run, the json's method, N, m, r and snapshot count the serial's,
 #     its pod_sigma_ratio and rcond_jr within 1e-10 relative of the serial's;
@@ -100,7 +101,10 @@ for case in gmg-pod sp1 cosh-gmg-pod cosh-sp1 terms-sp1 qdeim-gmg-pod greedy-sp2
     terms-*) meth=${case#terms-}; X="$D/X_pt.npy"; opt="$PT --no-hyper"; ps=3 ;;
     *) meth=$case; X="$D/X.npy"; opt="" ;;
   esac
-  case $case in sp1) ps="2 4" ;; cosh-sp1) ps="1 3" ;; qdeim-*) ps="3" ;; greedy-*) ps="4" ;; mass-*) ps="2" ;; esac   # sp1: every P over two cases
+  case $case in   # every P over the two cases of a method (the library's layer is checked at each P by test_mpi_nl)
+    gmg-pod) ps="1 3" ;; sp1) ps="2 4" ;; cosh-gmg-pod) ps="2 4" ;; cosh-sp1) ps="1 3" ;;
+    qdeim-*) ps="3" ;; greedy-*) ps="4" ;; mass-*) ps="2" ;;
+  esac
   "$PHGMG" reduce $M $opt --X "$X" --method $meth --r 10 --out "$D/serial_$case" --quiet > /dev/null
   "$PHGMG" simulate-rom --model "$D/serial_$case/rom.phgmgrom" --dt 0.1 --steps 300 --out "$D/y_serial_$case.npy" --quiet > /dev/null
   for p in $ps; do
@@ -179,8 +183,8 @@ for case in ('gmg-pod', 'sp1', 'cosh-gmg-pod', 'cosh-sp1', 'terms-sp1', 'qdeim-g
     if nl and (len(cs) < 2 or -1 in cs or len(set(cs)) != len(cs)):
         print('check_cli_mpi: %s: the serial points were not found in V0' % case)
         bad = 1
-    for p in {'terms-sp1': (3,), 'sp1': (2, 4), 'cosh-sp1': (1, 3), 'qdeim-gmg-pod': (3,),
-              'greedy-sp2': (4,), 'mass-gmg-pod': (2,)}.get(case, (1, 2, 3, 4)):
+    for p in {'gmg-pod': (1, 3), 'sp1': (2, 4), 'cosh-gmg-pod': (2, 4), 'cosh-sp1': (1, 3), 'terms-sp1': (3,),
+              'qdeim-gmg-pod': (3,), 'greedy-sp2': (4,), 'mass-gmg-pod': (2,)}[case]:
         pd = '%s/p%d_%s' % (d, p, case)
         files_ok = sorted(os.listdir(pd)) == sorted(os.listdir(sd))
         pj = json.load(open(pd + '/rom.json'))
