@@ -885,8 +885,9 @@
    hyper.deim_tol = 1e-4, GMG-POD, SP1 and GMG-QM: the same 29 (GMG-QM:
    26) points in the same order as global term indices, weights within
    4e-13 of the largest, outputs within 7e-11 (where the DEIM model cannot
-   go on -- Q-DEIM's leaves its envelope after 22-53 steps -- the serial
-   one stops at the same step with the same code). At the default 1e-8 the
+   go on -- four of these models, with negative weights, stop after 22-53
+   steps (NaN, or Newton failing) -- the serial one stops at the same step
+   with the same code). At the default 1e-8 the
    points are still the serial ones but the weights agree only to 1e-9:
    they depend on the span of the kept gradient modes, which rounding moves
    by about eps sigma_1 / (the gap after the last kept value), the same
