@@ -227,6 +227,40 @@ static void tk_lrbt_hsv(phgmg_ph_sparse *sp, int solver, int r, double *hsv, phg
   free(Ar); free(Br); free(Cr);
 }
 
+/* The residual EKSM reports (phgmg_lradi with solver EKSM) at a tolerance
+   tol well above round-off, against the dense residual of its Z Z^T in
+   A P E^T + E P A^T + B B^T = 0 (A dense, E = M->E or I): within 2 %. */
+static void tk_check_residual(phgmg_shifted *s, phgmg_ph_sparse *sp, const tk_model *M, const double *A, double tol) {
+  phgmg_lradi_opts o;
+  phgmg_lradi_info inf;
+  double *Z = NULL, *Plr, res;
+  int k = 0;
+  memset(&o, 0, sizeof o);
+  o.solver = PHGMG_LYAP_EKSM; o.tol = tol;
+  CHECK_RC(phgmg_lradi(s, 2, phgmg_ph_sparse_system(sp)->B, M->N, &o, &Z, &k, &inf, NULL), PHGMG_OK);
+  CHECK(inf.solver == PHGMG_LYAP_EKSM && inf.res <= tol && inf.res > 1e-12);
+  if (!Z) return;
+  Plr = th_gram_user(sp, M->N, Z, k);
+  res = th_lyap_res(M->N, 2, A, M->E, M->B, Plr);
+  CHECK_LE(fabs(res - inf.res), 0.02 * inf.res);
+  free(Plr);
+  phgmg_lowrank_free(Z, NULL);
+}
+
+/* Low-rank BT's first r (<= 32) Hankel singular values by EKSM against
+   ref (dense, descending) and against the ADI's, each within 1e-8 of the
+   largest; the two runs' infos in bi, ba for the caller's checks. */
+static void tk_check_bt(phgmg_ph_sparse *sp, int r, const double *ref, phgmg_lrbt_info *bi, phgmg_lrbt_info *ba) {
+  double hsv[32], hsva[32];
+  int i;
+  tk_lrbt_hsv(sp, PHGMG_LYAP_EKSM, r, hsv, bi);
+  tk_lrbt_hsv(sp, PHGMG_LYAP_ADI, r, hsva, ba);
+  for (i = 0; i < r; ++i) {
+    CHECK_LE(fabs(hsv[i] - ref[i]), 1e-8 * ref[0]);
+    CHECK_LE(fabs(hsv[i] - hsva[i]), 1e-8 * hsva[0]);
+  }
+}
+
 /* EKSM on the 16 x 16 heat model (N = 256; A = -R is regular: the inverse
    directions are A^{-1}, one factorization): Z Z^T against the dense
    Gramian, the reported residual (a run at tol 1e-7, so that it stands
@@ -241,7 +275,7 @@ TEST(test_eksm_heat) {
   phgmg_lradi_info inf;
   phgmg_lradi_opts o;
   phgmg_lrbt_info bi, ba;
-  double *A, *P, *Plr, *Z = NULL, *w, hsv[r], hsva[r], res;
+  double *A, *P, *Plr, *Z = NULL, *w, hsvd[r];
   int N, k = 0, i;
   tk_heat(&M, 16);
   N = M.N;
@@ -258,23 +292,13 @@ TEST(test_eksm_heat) {
   CHECK_LE(th_reldiff(N * N, Plr, P), 1e-8);
   free(Plr); phgmg_lowrank_free(Z, NULL); Z = NULL;
   /* the residual, at a tolerance whose residual is far above round-off */
-  o.tol = 1e-7;
-  CHECK_RC(phgmg_lradi(s, 2, phgmg_ph_sparse_system(sp)->B, N, &o, &Z, &k, &inf, NULL), PHGMG_OK);
-  CHECK(inf.solver == PHGMG_LYAP_EKSM && inf.res <= 1e-7 && inf.res > 1e-12);
-  Plr = th_gram_user(sp, N, Z, k);
-  res = th_lyap_res(N, 2, A, NULL, M.B, Plr);
-  CHECK_LE(fabs(res - inf.res), 0.02 * inf.res);
-  free(Plr); phgmg_lowrank_free(Z, NULL);
+  tk_check_residual(s, sp, &M, A, 1e-7);
   /* BT: sigma = eig(P) */
   w = (double *)malloc(sizeof(double) * (size_t)N);
   CHECK_RC(phgmg_sym_eig(N, P, N, w, NULL, N), PHGMG_OK);
-  tk_lrbt_hsv(sp, PHGMG_LYAP_EKSM, r, hsv, &bi);
-  tk_lrbt_hsv(sp, PHGMG_LYAP_ADI, r, hsva, &ba);
+  for (i = 0; i < r; ++i) hsvd[i] = w[N - 1 - i];
+  tk_check_bt(sp, r, hsvd, &bi, &ba);
   CHECK(bi.ctrl.solver == PHGMG_LYAP_EKSM && ba.ctrl.solver == PHGMG_LYAP_ADI && bi.nhsv > r);
-  for (i = 0; i < r; ++i) {
-    CHECK_LE(fabs(hsv[i] - w[N - 1 - i]), 1e-8 * w[N - 1]);
-    CHECK_LE(fabs(hsv[i] - hsva[i]), 1e-8 * hsva[0]);
-  }
   free(w);
   phgmg_shifted_destroy(s); phgmg_ph_sparse_destroy(sp);
   free(A); free(P);
@@ -295,7 +319,7 @@ TEST(test_eksm_lattice) {
   phgmg_lradi_info inf;
   phgmg_lradi_opts o;
   phgmg_lrbt_info bi, ba;
-  double *A, *At, *F, *P, *O, *T, *Plr, *Z = NULL, hsv[r], hsva[r], hsvd[r], res;
+  double *A, *At, *F, *P, *O, *T, *Plr, *Z = NULL, hsvd[r];
   int N, k = 0, i, j;
   tk_lattice(&M, 7, 0.5, 0);
   N = M.N;
@@ -328,22 +352,11 @@ TEST(test_eksm_lattice) {
   CHECK_LE(th_reldiff(N * N, Plr, O), 1e-8);
   free(Plr); phgmg_lowrank_free(Z, NULL); Z = NULL;
   /* the residual at tol 1e-4 */
-  o.tol = 1e-4;
-  CHECK_RC(phgmg_lrkrylov(s, 2, phgmg_ph_sparse_system(sp)->B, N, &o, &Z, &k, &inf, NULL), PHGMG_OK);
-  CHECK(inf.res <= 1e-4 && inf.res > 1e-12);
-  Plr = th_gram_user(sp, N, Z, k);
-  res = th_lyap_res(N, 2, A, NULL, M.B, Plr);
-  CHECK_LE(fabs(res - inf.res), 0.02 * inf.res);
-  free(Plr); phgmg_lowrank_free(Z, NULL);
+  tk_check_residual(s, sp, &M, A, 1e-4);
   /* balanced truncation */
   th_dense_hsv(N, P, O, hsvd, r);
-  tk_lrbt_hsv(sp, PHGMG_LYAP_EKSM, r, hsv, &bi);
-  tk_lrbt_hsv(sp, PHGMG_LYAP_ADI, r, hsva, &ba);
+  tk_check_bt(sp, r, hsvd, &bi, &ba);
   CHECK(bi.ctrl.solver == PHGMG_LYAP_EKSM && bi.obs.solver == PHGMG_LYAP_EKSM && bi.obs.res <= 1e-10);
-  for (i = 0; i < r; ++i) {
-    CHECK_LE(fabs(hsv[i] - hsvd[i]), 1e-8 * hsvd[0]);
-    CHECK_LE(fabs(hsv[i] - hsva[i]), 1e-8 * hsva[0]);
-  }
   phgmg_shifted_destroy(s); phgmg_shifted_destroy(sd); phgmg_ph_sparse_destroy(sp);
   free(A); free(At); free(F); free(P); free(O); free(T);
   tk_free(&M);
@@ -363,8 +376,8 @@ TEST(test_eksm_mass_fe) {
   phgmg_lradi_info inf;
   phgmg_lradi_opts o;
   phgmg_lrbt_info bi, ba;
-  double *A, *P, *O, *Plr, *Z = NULL, hsv[r], hsva[r], hsvd[r], res;
-  int N, k = 0, i;
+  double *A, *P, *O, *Plr, *Z = NULL, hsvd[r];
+  int N, k = 0;
   tk_fe_acoustic(&M, 80);
   N = M.N;
   A = (double *)malloc(sizeof(double) * (size_t)N * N);
@@ -381,22 +394,11 @@ TEST(test_eksm_mass_fe) {
   CHECK_LE(th_reldiff(N * N, Plr, P), 1e-8);
   free(Plr); phgmg_lowrank_free(Z, NULL); Z = NULL;
   /* the residual of A P E^T + E P A^T + B B^T (tol 1e-5: far above round-off) */
-  o.tol = 1e-5;
-  CHECK_RC(phgmg_lrkrylov(s, 2, phgmg_ph_sparse_system(sp)->B, N, &o, &Z, &k, &inf, NULL), PHGMG_OK);
-  CHECK(inf.res <= 1e-5 && inf.res > 1e-12);
-  Plr = th_gram_user(sp, N, Z, k);
-  res = th_lyap_res(N, 2, A, M.E, M.B, Plr);
-  CHECK_LE(fabs(res - inf.res), 0.02 * inf.res);
-  free(Plr); phgmg_lowrank_free(Z, NULL);
+  tk_check_residual(s, sp, &M, A, 1e-5);
   /* balanced truncation (two EKSM runs: J != 0) */
   th_dense_hsv(N, P, O, hsvd, r);
-  tk_lrbt_hsv(sp, PHGMG_LYAP_EKSM, r, hsv, &bi);
-  tk_lrbt_hsv(sp, PHGMG_LYAP_ADI, r, hsva, &ba);
+  tk_check_bt(sp, r, hsvd, &bi, &ba);
   CHECK(bi.ctrl.solver == PHGMG_LYAP_EKSM && bi.obs.solver == PHGMG_LYAP_EKSM && bi.obs.res <= 1e-10);
-  for (i = 0; i < r; ++i) {
-    CHECK_LE(fabs(hsv[i] - hsvd[i]), 1e-8 * hsvd[0]);
-    CHECK_LE(fabs(hsv[i] - hsva[i]), 1e-8 * hsva[0]);
-  }
   phgmg_shifted_destroy(s); phgmg_ph_sparse_destroy(sp);
   free(A); free(P); free(O);
   tk_free(&M);
@@ -414,8 +416,8 @@ TEST(test_eksm_mass_lattice) {
   phgmg_lradi_info inf;
   phgmg_lradi_opts o;
   phgmg_lrbt_info bi, ba;
-  double *A, *P, *O, *Plr, *Z = NULL, hsv[r], hsva[r], hsvd[r];
-  int N, k = 0, i;
+  double *A, *P, *O, *Plr, *Z = NULL, hsvd[r];
+  int N, k = 0;
   tk_lattice(&M, 8, 0.5, 1);
   N = M.N;
   A = (double *)malloc(sizeof(double) * (size_t)N * N);
@@ -432,13 +434,8 @@ TEST(test_eksm_mass_lattice) {
   CHECK_LE(th_reldiff(N * N, Plr, P), 1e-8);
   free(Plr); phgmg_lowrank_free(Z, NULL);
   th_dense_hsv(N, P, O, hsvd, r);
-  tk_lrbt_hsv(sp, PHGMG_LYAP_EKSM, r, hsv, &bi);
-  tk_lrbt_hsv(sp, PHGMG_LYAP_ADI, r, hsva, &ba);
+  tk_check_bt(sp, r, hsvd, &bi, &ba);
   CHECK(bi.ctrl.solver == PHGMG_LYAP_EKSM && bi.obs.res <= 1e-10);
-  for (i = 0; i < r; ++i) {
-    CHECK_LE(fabs(hsv[i] - hsvd[i]), 1e-8 * hsvd[0]);
-    CHECK_LE(fabs(hsv[i] - hsva[i]), 1e-8 * hsva[0]);
-  }
   phgmg_shifted_destroy(s); phgmg_ph_sparse_destroy(sp);
   free(A); free(P); free(O);
   tk_free(&M);
