@@ -5110,6 +5110,19 @@ static void ss_run(ss_sim *M, const simrom_args *P, double dt, cli_input *in, do
   progress("  done in %.3f s (one LU of order %d)", now_s() - t0, 3 * M->r);
 }
 
+/* simulate-rom's outputs, both or neither (staged, then moved into place):
+   the outputs y (m x steps + 1) to out and, if states is given, the reduced
+   states (r x steps + 1). 0, or 1 after a message. */
+static int write_rom_outputs(staged *sg, const char *out, const double *Y, int m, const char *states,
+                             const double *XR, int r, int steps) {
+  const char *wp;
+  if (!(wp = stage_path(sg, out)) || write_npy(out, wp, Y, m, steps + 1, 2)) return 1;
+  if (states && (!(wp = stage_path(sg, states)) || write_npy(states, wp, XR, r, steps + 1, 2))) return 1;
+  if (stage_commit(sg)) return 1;
+  printf("wrote %s (%d x %d)%s%s\n", out, m, steps + 1, states ? " and " : "", states ? states : "");
+  return 0;
+}
+
 /* simulate-rom --ss DIR/NAME: the state-space model stepped by the same
    3-stage Gauss-Legendre method as the port-Hamiltonian models (at the same
    input points), the outputs as theirs: y (m x (steps+1)), --states xr. */
@@ -5120,7 +5133,6 @@ static int simulate_ss(const simrom_args *P) {
   cli_input in;
   ss_sim M;
   double dt = P->dt, *Y = NULL, *XR = NULL;
-  const char *wp;
   int k, status = 1;
   memset(&pin, 0, sizeof pin); memset(&pout, 0, sizeof pout); memset(&sg, 0, sizeof sg);
   memset(&in, 0, sizeof in); memset(&M, 0, sizeof M);
@@ -5153,13 +5165,7 @@ static int simulate_ss(const simrom_args *P) {
   progress("simulating %s (state-space, r = %d, m = %d): %d steps of dt = %g, %s", P->ss, M.r, M.m, P->steps, dt,
            input_desc(&in, P->inspec));
   ss_run(&M, P, dt, &in, Y, XR);
-  /* both outputs or neither */
-  if (!(wp = stage_path(&sg, P->out)) || write_npy(P->out, wp, Y, M.m, P->steps + 1, 2)) goto done;
-  if (P->states && (!(wp = stage_path(&sg, P->states)) || write_npy(P->states, wp, XR, M.r, P->steps + 1, 2)))
-    goto done;
-  if (stage_commit(&sg)) goto done;
-  printf("wrote %s (%d x %d)%s%s\n", P->out, M.m, P->steps + 1, P->states ? " and " : "", P->states ? P->states : "");
-  status = 0;
+  status = write_rom_outputs(&sg, P->out, Y, M.m, P->states, XR, M.r, P->steps);
 done:
   stage_abort(&sg);
   g_inputs = NULL;
@@ -5199,7 +5205,6 @@ static int cmd_simulate_rom(int argc, char **argv) {
   cli_input in;
   size_t msz, nreal;
   staged sg;
-  const char *wp;
   pathset pin, pout; /* the files read; the files written */
   if (status != 0) return status < 0 ? 0 : status;
   if (P.ss) return simulate_ss(&P);
@@ -5291,12 +5296,7 @@ static int cmd_simulate_rom(int argc, char **argv) {
 #undef RECORD
   progress("  done in %.3f s (%ld Newton iterations, %ld factorizations)", now_s() - t0, st.stats.newton_iters,
            st.stats.factorizations);
-  /* both outputs or neither */
-  if (!(wp = stage_path(&sg, out)) || write_npy(out, wp, Y, rom.m, steps + 1, 2)) goto done;
-  if (states && (!(wp = stage_path(&sg, states)) || write_npy(states, wp, XR, rom.r, steps + 1, 2))) goto done;
-  if (stage_commit(&sg)) goto done;
-  printf("wrote %s (%d x %d)%s%s\n", out, rom.m, steps + 1, states ? " and " : "", states ? states : "");
-  status = 0;
+  status = write_rom_outputs(&sg, out, Y, rom.m, states, XR, rom.r, steps);
 done:
   stage_abort(&sg);
   g_inputs = NULL;
