@@ -962,8 +962,9 @@
    The command line with MPI. `make build/phgmg-mpi` builds
    examples/phgmg_mpi_cli.c with mpicc, and
      mpirun -np P build/phgmg-mpi reduce --J-coo J.npy --R-coo R.npy
-         --Q-coo Q.npy --B B.npy --X X.npy --method gmg-pod|sp1|sp2 --r R
-         --out DIR [--name rom] [--dt DT] [--quiet]
+         --Q-coo Q.npy --B B.npy --X X.npy --method gmg-pod|gmg-qm|sp1|sp2
+         --r R --out DIR [--name rom] [--dt DT] [--quiet]
+         [--manifold pod|greedy] [--rn RN] [--lambda L]
          [--potential NAME | --poly c.npy [--exp e.npy]] --poly-idx idx.npy
          [--poly-w w.npy] [--hyper ecsw|qdeim|greedy] [--hyper-tol T]
          [--deim-tol T] [--deim-max K] [--deim-allow-negative] [--no-hyper]
@@ -974,8 +975,14 @@
    coefficients, the terms' coordinates and weights; chapter 6) and writes
    its files: DIR/NAME.phgmgrom, NAME.c, NAME.json and NAME_Bh.npy,
    NAME_Qh.npy, NAME_K.npy, NAME_V0.npy, with kept nonlinear terms also
-   NAME_P0.npy, NAME_w.npy, NAME_poly.npy, NAME_expo.npy (rank 0 writes; V0
-   is gathered a column at a time). Rank p keeps a contiguous block of
+   NAME_P0.npy, NAME_w.npy, NAME_poly.npy, NAME_expo.npy; gmg-qm writes
+   the quadratic model's blocks NAME_G00, _G01, _G10, _G11, _Q01, _Q11,
+   _Ms (and _P1 with kept terms) instead of NAME_K, and the lift's
+   NAME_V2.npy and NAME_M.npy (phgmg_mpi_rom.V2, .M) (rank 0 writes; V0
+   and V2 are gathered a column at a time). gmg-qm needs a fixed --lambda
+   (0: exactly zero): the serial default, --lambda auto, chooses lambda by
+   simulating the runs, which the distributed build does not do; --rn
+   defaults to the serial command's min(8, N - R, 4096 / (R - m)). Rank p keeps a contiguous block of
    about N / P rows of the state: its rows of Q (phgmg_mpi_op_create), of
    B, of the snapshots (read a batch of columns at a time,
    phgmg_npy_read_cols) and, for sp1 and sp2, of J - R, and the nonlinear
@@ -994,8 +1001,8 @@
    `phgmg reduce` -- --simulate (make the snapshots with the serial
    `phgmg simulate --states`), dense matrices, a mass matrix with zero rows
    (algebraic constraints) or with sp1/sp2, springs (--poly-jdx),
-   dampers, feedthrough, --ref, the other methods (gmg-qm, balancing),
-   several --X files,
+   dampers, feedthrough, --ref, gmg-qm's --lambda auto or cv, --rn wide
+   and --manifold altmin, balancing, several --X files,
    method or order lists -- is refused with a message naming the option;
    bad input (a missing file, wrong shapes, bad indices; J, R, B and J - R
    checked as the serial command checks them, Q's definiteness not: each
@@ -1014,7 +1021,11 @@
    8e-15; with a mass matrix (--E-coo: consistent-mass pattern on the
    momenta, gmg-pod with the cosh terms, P = 2; E factored by the
    library's sparse LU, replicated as J - R): the same 22 points, K within
-   2.7e-15, the weights within 1.4e-12, the outputs within 4.5e-15.
+   2.7e-15, the weights within 1.4e-12, the outputs within 4.5e-15;
+   gmg-qm with --lambda 1e-3 (the POD manifold with --rn 4 on the linear
+   chain at P = 1, 3; the greedy manifold, default rn and ECSW on the cosh
+   chain at P = 2, 4): every block of the quadratic model, P1, V2 and M
+   within 2.5e-12, the same 16 points, the outputs within 3.6e-15.
    Measured at N = 2e5 (1001 snapshots, r = 20): bench/README.md.
    2.8 Large sparse linear models (>>lowrank). For a phgmg_ph_sparse model
    with quadratic H (E x' = (J - R) Q x + B u, y = B^T Q x; E = I or a mass
@@ -1598,8 +1609,9 @@
      phgmg info         describe a model file.
    On MPI ranks, `mpirun -np P build/phgmg-mpi reduce ...` (make
    build/phgmg-mpi) reduces a linear model, or one with separable
-   nonlinear terms (--potential or --poly/--exp, --poly-idx, ECSW), from
-   the same files with gmg-pod or sp1 and writes the same outputs (2.7,
+   nonlinear terms (--potential or --poly/--exp, --poly-idx, ECSW or
+   DEIM), from the same files with gmg-pod, gmg-qm (a fixed --lambda), sp1
+   or sp2 and writes the same outputs (2.7,
    "The command line with MPI").
    Model options shared by reduce, validate and simulate include the mass
    matrix (--E, --E-coo), feedthrough (--P, --S, --N) and nonlinear dampers:
@@ -2760,9 +2772,9 @@
 
 /* >>config ================================================================ */
 #define PHGMG_VERSION_MAJOR 0
-#define PHGMG_VERSION_MINOR 11
+#define PHGMG_VERSION_MINOR 12
 #define PHGMG_VERSION_PATCH 0
-#define PHGMG_VERSION_STRING "0.11.0"
+#define PHGMG_VERSION_STRING "0.12.0"
 
 #include <stddef.h>
 
@@ -5477,6 +5489,13 @@ typedef struct phgmg_mpi_rom {
   double deim_sigma_ratio;    /* DEIM: sigma_{nd+1} / sigma_1 of the terms' gradients (0: all kept) */
   void *mem_;                 /* the storage (private) */
   phgmg_allocator al_;
+  /* GMG-QM (rom.kind PHGMG_ROM_QUADRATIC; else rn = 0, NULL): the lift
+     x = V0 xr + V2 M kron(x2, x2), x2 = xr[m:], p = r - m; M (rn x p^2,
+     replicated, the serial phgmg_reduced_qm's M) and V2 this rank's rows
+     (nloc x rn, leading dimension max(1, nloc)) */
+  int rn;
+  const double *M, *V2;
+  void *qm_mem_;              /* their storage (private) */
 } phgmg_mpi_rom;
 
 /* The distributed phgmg_reduce of a separable model, with ECSW or DEIM
@@ -5526,7 +5545,8 @@ typedef struct phgmg_mpi_rom {
    X: this rank's rows of the snapshots (nloc x ns, ldx). *out is filled
    on success (zeroed on failure); V0 (nloc x r, ldv0, may be NULL) this
    rank's rows of the basis (the lift x = V0 xr; SP1: V; GMG_QM: [B, V1],
-   the lift x = V0 xr + V2 q(xr) with V2 not returned). Errors: those of
+   the lift x = V0 xr + V2 M kron(x2, x2) with this rank's rows of V2 and
+   M in out->V2, out->M). Errors: those of
    phgmg_mpi_gmg_pod_linear (a failing solve's code on every rank),
    PHGMG_ERR_INVALID_ARG / _SIZE / _NANINF for bad terms,
    PHGMG_ERR_NOT_CONVERGED (the ECSW fit misses tol), PHGMG_ERR_UNSUPPORTED.
@@ -28912,6 +28932,20 @@ PHGMG__PRIV phgmg_result phgmg__mpi_qm_blocks(const phgmg_mpi_ctx *ctx, const ph
   return rc;
 }
 
+/* The lift's V2 (this rank's rows) and M into out (its own block). Local. */
+PHGMG__PRIV phgmg_result phgmg__mpi_qm_lift(const phgmg_mpi_ctx *ctx, const phgmg__mpi_qm *q, phgmg_mpi_rom *out) {
+  const phgmg_reduced *red = q->c.red;
+  const int ld = PHGMG__MAX(1, ctx->nloc), rn = red->rn, p = red->p;
+  const size_t nv = (size_t)ld * rn, nm = (size_t)rn * p * p;
+  double *b = phgmg__dalloc(&ctx->al, nv + nm);
+  if (!b) return PHGMG_ERR_NOMEM;
+  memset(b, 0, nv * sizeof(double));
+  if (ctx->nloc > 0) memcpy(b, q->L + (size_t)ld * red->r, nv * sizeof(double));
+  memcpy(b + nv, red->M, nm * sizeof(double));
+  out->rn = rn; out->V2 = b; out->M = b + nv; out->qm_mem_ = b;
+  return PHGMG_OK;
+}
+
 /* GMG-QM of phgmg_mpi_reduce (o resolved and checked): the stages above,
    the separable terms (every term: the rows of [V0, V2] of each from its
    owner), the training envelope and q_max (phgmg__q_envelope on the
@@ -28962,6 +28996,8 @@ PHGMG__PRIV phgmg_result phgmg__mpi_qm_reduce(const phgmg_mpi_ctx *ctx, const ph
     out->deim_sigma_ratio = d.deim_sratio;
     for (j = 0; V0 && ctx->nloc > 0 && j < r; ++j)
       memcpy(V0 + (size_t)j * ldv0, q.L + (size_t)j * ld, (size_t)ctx->nloc * sizeof(double));
+    rc = phgmg__mpi_agree(ctx, phgmg__mpi_qm_lift(ctx, &q, out));
+    if (rc != PHGMG_OK) phgmg_mpi_rom_free(out);
   }
   phgmg__free(&ctx->al, (void *)d.D);
   phgmg__free(&ctx->al, (void *)d.pts);
@@ -29046,6 +29082,7 @@ PHGMG_DEF phgmg_result phgmg_mpi_reduce(const phgmg_mpi_ctx *ctx, const phgmg_mp
 PHGMG_DEF void phgmg_mpi_rom_free(phgmg_mpi_rom *out) {
   if (!out) return;
   if (out->mem_) phgmg__free(&out->al_, out->mem_);
+  if (out->qm_mem_) phgmg__free(&out->al_, out->qm_mem_);
   memset(out, 0, sizeof *out);
 }
 
@@ -30613,6 +30650,13 @@ PHGMG_DEF phgmg_result phgmg_sym_eig(int n, double *A, int lda, double *w, doubl
 
 /*
    REVISION HISTORY
+   0.12.0 (2026-11-29)
+          - phgmg_mpi_rom.rn, .M, .V2: GMG-QM's lift (M replicated, V2 this
+            rank's rows).
+          - phgmg-mpi: --method gmg-qm with --manifold pod|greedy, --rn and
+            a fixed --lambda; it writes the serial command's files (the
+            quadratic blocks, V2, M). An output path equal to the --E-coo
+            file is now refused (it was overwritten).
    0.11.0 (2026-11-29)
           - phgmg_mpi_reduce: DEIM hyper-reduction (hyper.kind QDEIM or
             GREEDY) with every method it takes: the gradients' POD by TSQR

@@ -2,7 +2,8 @@
 
      make build/phgmg-mpi        (mpicc; the library with PHGMG_MPI)
      mpirun -np P build/phgmg-mpi reduce --J-coo J.npy --R-coo R.npy --Q-coo Q.npy \
-         --B B.npy --X X.npy --method gmg-pod|sp1 --r R --out DIR [--name rom] [--dt DT] [--quiet]
+         --B B.npy --X X.npy --method gmg-pod|gmg-qm|sp1|sp2 --r R --out DIR [--name rom] [--dt DT] [--quiet]
+         [--manifold pod|greedy] [--rn RN] [--lambda L]
          [--potential NAME | --poly c.npy [--exp e.npy]] --poly-idx idx.npy [--poly-w w.npy]
          [--hyper ecsw] [--hyper-tol T] [--no-hyper]
 
@@ -13,7 +14,8 @@
    writes what the serial command writes for the same options:
    DIR/NAME.phgmgrom, DIR/NAME.c, DIR/NAME.json and the arrays
    DIR/NAME_Bh.npy, _Qh.npy, _K.npy, _V0.npy (with kept nonlinear terms also
-   _P0.npy, _w.npy, _poly.npy, _expo.npy). Every rank reads the terms' small
+   _P0.npy, _w.npy, _poly.npy, _expo.npy; gmg-qm the quadratic model's
+   blocks, _V2.npy and _M.npy instead of _K.npy). Every rank reads the terms' small
    files whole and keeps the terms on its own rows, numbered as the serial
    command numbers them; the hyper-reduction (ECSW, the serial default) is
    the library's distributed one, so the kept terms are the serial run's.
@@ -24,7 +26,7 @@
    gathered, solved, and each rank keeps its rows): fine while that factor
    fits on one rank; examples/petsc_mumps.c puts MUMPS (a distributed
    factor) behind the same solve callback. Rank 0 writes the outputs; V0
-   is gathered a column at a time. Manual section 2.7. */
+   (and V2) are gathered a column at a time. Manual section 2.7. */
 #define _POSIX_C_SOURCE 200809L
 #define PHGMG_MPI
 #define PHGMG_IMPLEMENTATION
@@ -47,8 +49,8 @@ static const char *const help_text[] = {
   "\n"
   "USAGE\n"
   "  mpirun -np P phgmg-mpi reduce --J-coo J.npy --R-coo R.npy --Q-coo Q.npy --B B.npy\n"
-  "               --X X.npy --method gmg-pod|sp1|sp2 --r R --out DIR [--name rom]\n"
-  "               [--dt DT] [--quiet]\n"
+  "               --X X.npy --method gmg-pod|gmg-qm|sp1|sp2 --r R --out DIR [--name rom]\n"
+  "               [--dt DT] [--quiet] [--manifold pod|greedy] [--rn RN] [--lambda L]\n"
   "               [--potential NAME | --poly FILE [--exp FILE]] --poly-idx FILE\n"
   "               [--poly-w FILE] [--hyper ecsw|qdeim|greedy] [--hyper-tol T]\n"
   "               [--deim-tol T] [--deim-max K] [--deim-allow-negative] [--no-hyper]\n"
@@ -70,13 +72,27 @@ static const char *const help_text[] = {
   "  --method M          gmg-pod (generalized manifold Galerkin on the POD of the\n"
   "                      snapshots adjusted by B), sp1 (structure-preserving\n"
   "                      Galerkin on the POD of the snapshots) or sp2 (sp1's trial\n"
-  "                      basis, the test basis from the POD of the gradient snapshots).\n"
-  "  --r R               the reduced order (gmg-pod: R > m; sp1, sp2: R <= ns).\n"
+  "                      basis, the test basis from the POD of the gradient snapshots)\n"
+  "                      or gmg-qm (the quadratic manifold phi(x) = [B, V1] x +\n"
+  "                      V2 M (x2 kron x2), with a fixed --lambda).\n"
+  "  --r R               the reduced order (gmg-pod, gmg-qm: R > m; sp1, sp2: R <= ns).\n"
   "  --out DIR           output directory (created if missing).\n"
   "  --name NAME         base name of the outputs (default rom; a C identifier).\n"
   "  --dt DT             the snapshots' step, recorded in the model file\n"
   "                      (simulate-rom's default step).\n"
   "  --quiet             no summary line.\n"
+  "\n"
+  "GMG-QM (--method gmg-qm)\n"
+  "  --lambda L          required here: the ridge parameter of the quadratic fit M, on the\n"
+  "                      un-normalised sum over the snapshots (e.g. 1e-3, the paper's;\n"
+  "                      0 means exactly zero). The serial default, --lambda auto,\n"
+  "                      chooses it by simulating the runs, which phgmg-mpi does not do.\n"
+  "  --manifold KIND     pod (default: V1 the leading POD modes of the snapshots adjusted\n"
+  "                      by B) or greedy (V1 chosen greedily among the leading modes for\n"
+  "                      the quadratic fit).\n"
+  "  --rn RN             the lifting dimension, 1..4096 (default min(8, N - R,\n"
+  "                      4096 / (R - m))); V2 the RN leading POD modes of the snapshots'\n"
+  "                      residual after [B, V1].\n"
   "\n",
   "NONLINEAR PART (optional; as `phgmg reduce` takes it)\n"
   "  --poly FILE         phi from the exp-polynomial family phi(s) = sum_j c_j s^j +\n"
@@ -117,6 +133,10 @@ static const char *const help_text[] = {
   "  DIR/NAME.json       what was reduced and how (with \"mpi_ranks\" and the solver)\n"
   "  DIR/NAME_Bh.npy, DIR/NAME_Qh.npy, DIR/NAME_K.npy   the reduced blocks\n"
   "  DIR/NAME_V0.npy     the basis (N x r): x = V0 @ xr\n"
+  "  DIR/NAME_G00.npy, _G01, _G10, _G11, _Q01, _Q11, _Ms, _P1 (gmg-qm, in place of\n"
+  "                      _K) the quadratic model's blocks; DIR/NAME_V2.npy (N x RN) and\n"
+  "                      DIR/NAME_M.npy (RN x (R - m)^2): x = V0 @ xr + V2 @ (M @\n"
+  "                      kron(xr[m:], xr[m:]))\n"
   "  DIR/NAME_P0.npy, _w.npy, _poly.npy, _expo.npy   with nonlinear terms kept: their rows\n"
   "                      of V0, weights and functions (expo only with exponentials)\n"
   "\n"
@@ -136,8 +156,9 @@ static const char *const help_text[] = {
   "  --simulate (give the snapshots with --X; make them with the serial\n"
   "  `phgmg simulate ... --states X.npy`), dense --J/--R/--Q/--E, a mass matrix\n"
   "  with zero rows (algebraic constraints) or with sp1/sp2, springs\n"
-  "  (--poly-jdx), dampers, feedthrough, --ref, gmg-qm, balancing, several --X\n"
-  "  files, method or order lists, and every\n"
+  "  (--poly-jdx), dampers, feedthrough, --ref, gmg-qm's --lambda auto or cv,\n"
+  "  --rn wide and --manifold altmin, balancing, several --X files, method or\n"
+  "  order lists, and every\n"
   "  other option of `phgmg reduce`: use the serial `phgmg` for them.\n"
   "\n"
   "EXIT STATUS\n"
@@ -150,7 +171,8 @@ typedef struct args {
   const char *E;                                             /* --E-coo: a mass matrix */
   int method, r, quiet, have_dt, no_hyper, have_hyper, have_hyper_tol;
   int hyper_kind, deim_max, deim_neg, have_deim_opt;   /* --hyper (PHGMG_HYPER_*), the DEIM options */
-  double dt, hyper_tol, deim_tol;
+  int manifold, rn, have_lambda, have_qm_opt;            /* gmg-qm: --manifold, --rn, --lambda */
+  double dt, hyper_tol, deim_tol, lambda;
 } args;
 
 /* This rank's block of rows, the sizes, and what was read. */
@@ -212,7 +234,8 @@ static int any_rank(int bad) {
 
 /* The names of a method and of a hyper-reduction, as the serial command writes them. */
 static const char *method_name(int method) {
-  return method == PHGMG_METHOD_SP1 ? "sp1" : method == PHGMG_METHOD_SP2 ? "sp2" : "gmg-pod";
+  return method == PHGMG_METHOD_SP1 ? "sp1" : method == PHGMG_METHOD_SP2 ? "sp2"
+         : method == PHGMG_METHOD_GMG_QM ? "gmg-qm" : "gmg-pod";
 }
 static const char *hyper_name(int kind) {
   return kind == PHGMG_HYPER_QDEIM ? "qdeim" : kind == PHGMG_HYPER_GREEDY ? "greedy" : "ecsw";
@@ -232,8 +255,8 @@ static const char *refused_reason(const char *o) {
   if (!strcmp(o, "--poly-jdx"))
     return "springs (terms on the difference of two coordinates) are not distributed: phgmg-mpi takes terms on "
            "one coordinate each (--poly-idx); use the serial `phgmg reduce`";
-  return "not supported by the distributed build (gmg-pod, sp1 or sp2 of a linear model or one with separable "
-         "terms, snapshots from --X); use the serial `phgmg reduce`";
+  return "not supported by the distributed build (gmg-pod, gmg-qm, sp1 or sp2 of a linear model or one with "
+         "separable terms, snapshots from --X); use the serial `phgmg reduce`";
 }
 
 /* A named potential (--potential NAME[:P1[:P2]]) as exp-polynomial
@@ -277,6 +300,41 @@ static int named_potential(const char *spec, double *c, int *deg, int *nexp) {
     if (!isfinite(c[k]) || (c[k] != 0.0 && fabs(c[k]) < DBL_MIN))
       return usage("--potential '%s': its coefficients leave the double range (%g); use parameters of moderate "
                    "size", spec, c[k]);
+  return 0;
+}
+
+/* gmg-qm's options: --manifold pod|greedy, --rn N, --lambda L (a fixed
+   ridge parameter; 0 exactly zero). */
+static int parse_qm_value(const char *o, const char *v, args *a) {
+  char *end;
+  a->have_qm_opt = 1;
+  if (!strcmp(o, "--manifold")) {
+    if (!strcmp(v, "pod")) a->manifold = PHGMG_MANIFOLD_POD;
+    else if (!strcmp(v, "greedy")) a->manifold = PHGMG_MANIFOLD_GREEDY;
+    else if (!strcmp(v, "altmin"))
+      return usage("--manifold altmin: not distributed (phgmg-mpi fits the pod and greedy manifolds); use the "
+                   "serial `phgmg reduce`");
+    else return usage("--manifold '%s': expected pod or greedy", v);
+  } else if (!strcmp(o, "--rn")) {
+    long k;
+    if (!strcmp(v, "wide"))
+      return usage("--rn wide: not distributed (phgmg-mpi takes a fixed width 1 <= rn <= 4096); use the serial "
+                   "`phgmg reduce`");
+    errno = 0;
+    k = strtol(v, &end, 10);
+    if (errno || end == v || *end || k < 1 || k > 4096) return usage("--rn: expected an integer in [1, 4096], got '%s'", v);
+    a->rn = (int)k;
+  } else if (!strcmp(o, "--lambda")) {
+    if (!strcmp(v, "auto") || !strcmp(v, "cv"))
+      return usage("--lambda %s: phgmg-mpi takes a fixed ridge parameter (--lambda L, e.g. 1e-3; 0 means exactly "
+                   "zero): choosing it by %s needs the serial `phgmg reduce`", v,
+                   !strcmp(v, "auto") ? "simulating the runs" : "cross-validation");
+    errno = 0;
+    a->lambda = strtod(v, &end);
+    if (errno || end == v || *end || !(a->lambda >= 0.0) || !isfinite(a->lambda))
+      return usage("--lambda: expected a number >= 0, got '%s'", v);
+    a->have_lambda = 1;
+  }
   return 0;
 }
 
@@ -332,11 +390,14 @@ static int parse_value(const char *o, const char *v, args *a) {
     return named_potential(v, c, &deg, &ne);
   } else if (!strcmp(o, "--method")) {
     if (!strcmp(v, "gmg-pod")) a->method = PHGMG_METHOD_GMG_POD;
+    else if (!strcmp(v, "gmg-qm")) a->method = PHGMG_METHOD_GMG_QM;
     else if (!strcmp(v, "sp1")) a->method = PHGMG_METHOD_SP1;
     else if (!strcmp(v, "sp2")) a->method = PHGMG_METHOD_SP2;
     else
-      return usage("--method %s: phgmg-mpi reduces with gmg-pod, sp1 or sp2 only%s", v,
+      return usage("--method %s: phgmg-mpi reduces with gmg-pod, gmg-qm, sp1 or sp2 only%s", v,
                    strchr(v, ',') ? " (no lists of methods)" : "; use the serial `phgmg reduce` for the others");
+  } else {
+    return parse_qm_value(o, v, a);
   }
   return 0;
 }
@@ -352,13 +413,13 @@ static int name_ok(const char *s) {
 }
 
 /* argv[2..]: the options of reduce. 0 ok, 2 a usage error (the same on every rank: the same argv). */
-#define NVOPT 21   /* options with a value; the first NSOPT are file or name strings */
+#define NVOPT 24   /* options with a value; the first NSOPT are file or name strings */
 #define NSOPT 12
 static int parse_args(int argc, char **argv, args *a) {
   static const char *const with_value[NVOPT] = {"--J-coo", "--R-coo", "--Q-coo", "--B", "--X", "--out", "--name",
                                                 "--poly", "--exp", "--poly-idx", "--poly-w", "--E-coo", "--method", "--r",
                                                 "--dt", "--potential", "--hyper", "--hyper-tol", "--deim-tol",
-                                                "--deim-max", ""};
+                                                "--deim-max", "--manifold", "--rn", "--lambda", ""};
   const char **slot[NSOPT];
   int seen[NVOPT], i, k, rc;
   memset(a, 0, sizeof *a);
@@ -402,7 +463,12 @@ static int parse_args(int argc, char **argv, args *a) {
   if (!a->J || !a->R || !a->Q) return usage("--J-coo, --R-coo and --Q-coo are required");
   if (!a->B) return usage("--B is required");
   if (!a->X) return usage("--X is required (the snapshots; phgmg-mpi does not simulate)");
-  if (a->method < 0) return usage("--method is required (gmg-pod, sp1 or sp2)");
+  if (a->method < 0) return usage("--method is required (gmg-pod, gmg-qm, sp1 or sp2)");
+  if (a->have_qm_opt && a->method != PHGMG_METHOD_GMG_QM)
+    return usage("--lambda, --rn and --manifold apply to --method gmg-qm only (not %s)", method_name(a->method));
+  if (a->method == PHGMG_METHOD_GMG_QM && !a->have_lambda)
+    return usage("gmg-qm needs a fixed --lambda here (e.g. --lambda 1e-3; 0 means exactly zero): the serial "
+                 "default, --lambda auto, validates lambda by simulating the runs, which phgmg-mpi does not do");
   if (a->E && a->method != PHGMG_METHOD_GMG_POD)
     return usage("--E-coo: phgmg-mpi reduces models with a mass matrix by gmg-pod (for %s use the serial `phgmg "
                  "reduce`)", method_name(a->method));
@@ -851,7 +917,8 @@ typedef struct result {
    QB an orthonormal basis of B's columns), p = r - m; SP1 the snapshots,
    p = r. 0 if there is no further mode. Collective. */
 static phgmg_result sigma_ratio(const phgmg_mpi_ctx *ctx, const dist *d, const args *a, solver *se, double *ratio) {
-  const int ld = d->nloc > 0 ? d->nloc : 1, gmg = a->method == PHGMG_METHOD_GMG_POD, m = d->m, ns = d->ns;
+  const int ld = d->nloc > 0 ? d->nloc : 1, m = d->m, ns = d->ns;
+  const int gmg = a->method == PHGMG_METHOD_GMG_POD || a->method == PHGMG_METHOD_GMG_QM;
   const int p = gmg ? a->r - m : a->r;
   int kmax = p + 1, k = 0, i, j;
   double *Xa = (double *)malloc(sizeof(double) * ((size_t)ld * ns + (size_t)ld * (m + kmax) + (size_t)(m + kmax) * ns + 1));
@@ -890,7 +957,7 @@ static void explain(const args *a, const dist *d, phgmg_result rc) {
   if (rc == PHGMG_ERR_SIZE)
     say("%s: --r %d does not fit: %s (N = %d, m = %d, %d snapshots; the order must not exceed the snapshots' "
         "numerical rank%s)", meth, a->r, phgmg_result_string(rc), d->N, d->m, d->ns,
-        a->method != PHGMG_METHOD_GMG_POD ? "" : " plus m, and must exceed m");
+        a->method == PHGMG_METHOD_SP1 || a->method == PHGMG_METHOD_SP2 ? "" : " plus m, and must exceed m");
   else if (rc == PHGMG_ERR_SINGULAR)
     say("%s: J - R (--J-coo %s, --R-coo %s) is singular or its LU needs pivoting the sparse LU does not do: %s",
         meth, a->J, a->R, phgmg_result_string(rc));
@@ -920,6 +987,17 @@ static void explain(const args *a, const dist *d, phgmg_result rc) {
     say("%s: %s", meth, phgmg_result_string(rc));
 }
 
+/* gmg-qm's lifting dimension when --rn is not given: the serial command's
+   min(8, N - r, 4096 / (r - m)), at least 1. */
+static int default_rn(int N, int r, int m) {
+  phgmg_reduce_opts def;
+  int rn;
+  phgmg_reduce_opts_default(&def);
+  rn = def.qm.rn < N - r ? def.qm.rn : N - r;
+  if (r > m && rn > 4096 / (r - m)) rn = 4096 / (r - m);
+  return rn > 1 ? rn : 1;
+}
+
 /* The reduction on every rank: the context, Q (and for sp1 J - R) as
    distributed operators, the replicated solver, phgmg_mpi_reduce. */
 static int reduce(const args *a, dist *d, result *res) {
@@ -938,7 +1016,7 @@ static int reduce(const args *a, dist *d, result *res) {
   if (rc == PHGMG_OK) rc = make_op(ctx, d, d->TQ, d->nQ, 1.0, NULL, 0, 0.0, &Qop);
   phgmg_npy_free(d->TQ, NULL);   /* Q lives in its operator now */
   d->TQ = NULL;
-  if (rc == PHGMG_OK && a->method != PHGMG_METHOD_GMG_POD)   /* sp1, sp2: J - R as an operator */
+  if (rc == PHGMG_OK && (a->method == PHGMG_METHOD_SP1 || a->method == PHGMG_METHOD_SP2))   /* J - R as an operator */
     rc = make_op(ctx, d, d->TJ, d->nJ, 1.0, d->TR, d->nR, -1.0, &JRop);
   if (rc == PHGMG_OK) rc = phgmg_mpi_agree(MPI_COMM_WORLD, solver_create(d, &sv));
   if (rc == PHGMG_OK && a->E) {   /* the mass matrix: its rows as an operator, its replicated solver */
@@ -970,6 +1048,11 @@ static int reduce(const args *a, dist *d, result *res) {
     o.hyper.kind = (phgmg_hyper)a->hyper_kind;
     o.hyper.tol = a->have_hyper_tol ? a->hyper_tol : 0.0;
     o.hyper.deim_tol = a->deim_tol; o.hyper.deim_max = a->deim_max; o.hyper.allow_negative = a->deim_neg;
+    if (a->method == PHGMG_METHOD_GMG_QM) {   /* the serial command's gmg-qm options (a fixed lambda) */
+      o.qm.manifold = (phgmg_manifold)a->manifold;
+      o.qm.rn = a->rn ? a->rn : default_rn(d->N, a->r, d->m);
+      o.qm.lambda = a->lambda > 0.0 ? a->lambda : -1.0;   /* 0 on the command line: exactly zero */
+    }
     rc = phgmg_mpi_reduce(ctx, &md, d->ns, d->Xl, ld, &o, &res->mr, res->V0, ld);
   }
   res->seconds = MPI_Wtime() - t0;
@@ -987,29 +1070,44 @@ static int reduce(const args *a, dist *d, result *res) {
 
 /* ---- outputs (rank 0) ---------------------------------------------------------- */
 
-/* The outputs: the first 7 always, then those of kept nonlinear terms
-   (P0, w, poly; expo with exponentials): g_nout of them. */
-#define NOUT 11
-static const char *const out_suffix[NOUT] = {".phgmgrom", ".c", ".json", "_Bh.npy", "_Qh.npy", "_K.npy", "_V0.npy",
-                                             "_P0.npy", "_w.npy", "_poly.npy", "_expo.npy"};
-static int g_nout = 7;
+/* The outputs: DIR/NAME.phgmgrom, .c, .json, then arrays DIR/NAME_<array>.npy,
+   each array one the serial command writes, in its order: the blocks of the
+   reduced model (those it has), then the basis V0 and, for gmg-qm, V2 and M
+   of the lift. Output k < 3 is a file, k >= 3 the array arr_name[k - 3]. */
+#define NARR 18
+static const char *const arr_name[NARR] = {"Bh", "Qh", "K", "G00", "G01", "G10", "G11", "Q01", "Q11", "Ms",
+                                           "P0", "P1", "w", "poly", "expo", "V0", "V2", "M"};
+enum { ARR_V0 = 15, ARR_V2 = 16, ARR_M = 17 };
 
-/* The output paths DIR/NAME<suffix> (4096 + 96 chars each). */
+/* An array to write: its name (arr_name index), its values (phgmg_real of
+   the model, or double), its shape (rows x cols, column-major, ld rows). */
+typedef struct outarr {
+  int k, rows, cols;
+  const phgmg_real *re;
+  const double *d;
+} outarr;
+static outarr g_arr[NARR];
+static int g_narr = 0;
+
+/* The output path of output k (4096 + 96 chars). */
 static void out_path(const args *a, int k, char *buf, size_t cap) {
-  snprintf(buf, cap, "%.4000s/%s%s", a->out, a->name, out_suffix[k]);
+  static const char *const file_suffix[3] = {".phgmgrom", ".c", ".json"};
+  if (k < 3) snprintf(buf, cap, "%.4000s/%s%s", a->out, a->name, file_suffix[k]);
+  else snprintf(buf, cap, "%.4000s/%s_%s.npy", a->out, a->name, arr_name[k - 3]);
 }
 
 /* 1 if an output is one of the input files: a run never overwrites its inputs. */
 static int outputs_clash(const args *a) {
-  const char *in[9];
-  const char *opt[9] = {"--J-coo", "--R-coo", "--Q-coo", "--B", "--X", "--poly-idx", "--poly-w", "--poly", "--exp"};
+  const char *in[10];
+  const char *opt[10] = {"--J-coo", "--R-coo", "--Q-coo", "--B", "--X", "--poly-idx", "--poly-w", "--poly", "--exp",
+                         "--E-coo"};
   char p[4200];
   int k, i;
   in[0] = a->J; in[1] = a->R; in[2] = a->Q; in[3] = a->B; in[4] = a->X;
-  in[5] = a->poly_idx; in[6] = a->poly_w; in[7] = a->poly; in[8] = a->expf;
-  for (k = 0; k < (a->poly_idx ? NOUT : 7); ++k) {
+  in[5] = a->poly_idx; in[6] = a->poly_w; in[7] = a->poly; in[8] = a->expf; in[9] = a->E;
+  for (k = 0; k < 3 + NARR; ++k) {
     out_path(a, k, p, sizeof p);
-    for (i = 0; i < 9; ++i)
+    for (i = 0; i < 10; ++i)
       if (in[i] && (same_file(p, in[i]) || !strcmp(p, in[i]))) {
         say("--out %s: the output %s is the input file of %s; choose another --out or --name", a->out, p, opt[i]);
         return 1;
@@ -1045,7 +1143,10 @@ static int make_dir(const char *dir) {
 }
 
 /* Every output is written to PATH.part and renamed at the end (a failed run
-   leaves the previous outputs as they were). */
+   leaves the previous outputs as they were). Output j < 3 is file j, j >= 3
+   the array g_arr[j - 3]. */
+static int out_index(int j) { return j < 3 ? j : 3 + g_arr[j - 3].k; }
+
 static void part_path(const args *a, int k, char *buf, size_t cap) {
   char p[4200];
   out_path(a, k, p, sizeof p);
@@ -1054,16 +1155,16 @@ static void part_path(const args *a, int k, char *buf, size_t cap) {
 
 static void parts_remove(const args *a) {
   char p[4300];
-  int k;
-  for (k = 0; k < g_nout; ++k) { part_path(a, k, p, sizeof p); remove(p); }
+  int j;
+  for (j = 0; j < 3 + g_narr; ++j) { part_path(a, out_index(j), p, sizeof p); remove(p); }
 }
 
 static int parts_commit(const args *a) {
   char p[4300], q[4200];
-  int k;
-  for (k = 0; k < g_nout; ++k) {
-    part_path(a, k, p, sizeof p);
-    out_path(a, k, q, sizeof q);
+  int j;
+  for (j = 0; j < 3 + g_narr; ++j) {
+    part_path(a, out_index(j), p, sizeof p);
+    out_path(a, out_index(j), q, sizeof q);
     if (rename(p, q) != 0) { say("%s: cannot move into place: %s", q, strerror(errno)); return 1; }
   }
   return 0;
@@ -1082,19 +1183,20 @@ static int npy_header(FILE *f, long rows, long cols) {
   return fputc('\n', f) == EOF;
 }
 
-/* NAME_V0.npy (N x r): rank 0 writes the header, then each column gathered
-   from the ranks' rows. Collective; the verdict is agreed. */
-static int write_V0(const args *a, const dist *d, const double *V0) {
+/* A distributed array (N x cols, this rank's rows in A, ld): rank 0 writes
+   the header, then each column gathered from the ranks' rows. Collective;
+   the verdict is agreed. */
+static int write_rows(const args *a, const dist *d, int k, const double *A, int cols) {
   const int ld = d->nloc > 0 ? d->nloc : 1;
   char p[4300];
   FILE *f = NULL;
   double *col = NULL;
   int j, bad = 0;
   if (d->rank == 0) {
-    part_path(a, 6, p, sizeof p);
+    part_path(a, 3 + k, p, sizeof p);
     f = fopen(p, "wb");
     col = (double *)malloc(sizeof(double) * (size_t)d->N);
-    bad = !f || !col || npy_header(f, d->N, a->r);
+    bad = !f || !col || npy_header(f, d->N, cols);
   }
   if (any_rank(bad)) {
     if (f) fclose(f);
@@ -1102,8 +1204,8 @@ static int write_V0(const args *a, const dist *d, const double *V0) {
     say("%s: cannot write: %s", p, strerror(errno));
     return 1;
   }
-  for (j = 0; j < a->r; ++j) {
-    MPI_Gatherv(V0 + (size_t)j * ld, d->nloc, MPI_DOUBLE, col, d->cnt, d->dsp, MPI_DOUBLE, 0, MPI_COMM_WORLD);
+  for (j = 0; j < cols; ++j) {
+    MPI_Gatherv(A + (size_t)j * ld, d->nloc, MPI_DOUBLE, col, d->cnt, d->dsp, MPI_DOUBLE, 0, MPI_COMM_WORLD);
     if (d->rank == 0 && !bad) bad = fwrite(col, sizeof(double), (size_t)d->N, f) != (size_t)d->N;
   }
   if (d->rank == 0) {
@@ -1112,6 +1214,33 @@ static int write_V0(const args *a, const dist *d, const double *V0) {
   }
   free(col);
   return any_rank(bad);
+}
+
+/* The arrays of the model in the serial command's order (g_arr). */
+static void list_arrays(const args *a, const dist *d, const result *res) {
+  const phgmg_rom *rom = &res->mr.rom;
+  const int r = rom->r, m = rom->m, rn = rom->rn, nd = rom->nd, p = r - m, nf = rom->nphi > 1 ? rom->nphi : 1;
+  const int qm = rom->kind == PHGMG_ROM_QUADRATIC;
+  const phgmg_real *re[15];
+  const int shape[15][2] = {{r, m}, {r, r}, {r, r}, {r, r}, {r, rn}, {rn, r}, {rn, rn}, {r, rn}, {rn, rn},
+                            {rn, p * p}, {nd, r}, {nd, rn}, {nd, 1}, {nf, rom->poly_deg + 1}, {nf, 2 * rom->nexp}};
+  int k;
+  re[0] = rom->Bh; re[1] = rom->Qh; re[2] = rom->K; re[3] = rom->G00; re[4] = rom->G01; re[5] = rom->G10;
+  re[6] = rom->G11; re[7] = rom->Q01; re[8] = rom->Q11; re[9] = rom->Ms; re[10] = rom->P0; re[11] = rom->P1;
+  re[12] = rom->w; re[13] = rom->poly; re[14] = rom->expo;
+  g_narr = 0;
+  for (k = 0; k < 15; ++k) {
+    if (!re[k] || shape[k][0] < 1 || shape[k][1] < 1 || (k >= 3 && k <= 9 && !qm) || (k >= 10 && nd < 1)) continue;
+    g_arr[g_narr].k = k; g_arr[g_narr].re = re[k]; g_arr[g_narr].d = NULL;
+    g_arr[g_narr].rows = shape[k][0]; g_arr[g_narr].cols = shape[k][1];
+    ++g_narr;
+  }
+  g_arr[g_narr].k = ARR_V0; g_arr[g_narr].rows = d->N; g_arr[g_narr].cols = a->r; ++g_narr;
+  if (qm) {
+    g_arr[g_narr].k = ARR_V2; g_arr[g_narr].rows = d->N; g_arr[g_narr].cols = rn; ++g_narr;
+    g_arr[g_narr].k = ARR_M; g_arr[g_narr].d = res->mr.M; g_arr[g_narr].re = NULL;
+    g_arr[g_narr].rows = rn; g_arr[g_narr].cols = p * p; ++g_narr;
+  }
 }
 
 static void json_str(FILE *f, const char *s) {
@@ -1137,31 +1266,8 @@ static void json_num(FILE *f, double v) {
   fputs(buf, f);
 }
 
-/* NAME.json: the record of the serial command (what was reduced, how, and
-   where the outputs are), with the ranks and the solver of J - R. */
-static int write_json(const args *a, const dist *d, const result *res) {
-  const phgmg_rom *rom = &res->mr.rom;
-  const int gmg = a->method == PHGMG_METHOD_GMG_POD, r = a->r, m = d->m, nd = res->mr.nd;
-  const int nf = rom->nphi > 1 ? rom->nphi : 1, hyper = a->poly_idx && !a->no_hyper;
-  const int deim = hyper && a->hyper_kind != PHGMG_HYPER_ECSW;
-  /* the arrays in the serial command's order: Bh, Qh, K, (P0, w, poly, expo), V0 */
-  const int shape[NOUT][2] = {{0, 0}, {0, 0}, {0, 0}, {r, m}, {r, r}, {r, r}, {d->N, r}, {nd, r}, {nd, 1},
-                              {nf, rom->poly_deg + 1}, {nf, 2 * rom->nexp}};
-  char p[4300];
-  FILE *f;
-  int k, j, nneg = 0;
-  double wmin = HUGE_VAL;
-  for (j = 0; j < nd; ++j) { wmin = fmin(wmin, res->mr.w[j]); nneg += res->mr.w[j] < 0.0; }
-  part_path(a, 2, p, sizeof p);
-  if (!(f = fopen(p, "w"))) { say("%s: cannot write: %s", p, strerror(errno)); return 1; }
-  fprintf(f, "{\n  \"phgmg_version\": \"%s\",\n  \"name\": ", PHGMG_VERSION_STRING);
-  json_str(f, a->name);
-  fprintf(f, ",\n  \"method\": \"%s\",\n  \"kind\": \"%s\",\n  \"map\": \"linear\",\n", method_name(a->method),
-          a->poly_idx ? "nonlinear" : "linear");
-  fprintf(f, "  \"N\": %d, \"m\": %d, \"r\": %d, \"rn\": 0, \"nd\": %d, \"poly_deg\": %d,\n", d->N, m, r, nd,
-          nd ? rom->poly_deg : 0);
-  fprintf(f, "  \"E\": %s, \"N_full\": %d, \"algebraic\": 0, \"feedthrough\": false,\n  \"dt_map\": 0,\n",
-          a->E ? "true" : "false", d->N);
+/* The json record's "system" object: the input files. */
+static void json_system(FILE *f, const args *a) {
   fprintf(f, "  \"system\": {\"J\": "); json_str(f, a->J);
   fprintf(f, ", \"R\": "); json_str(f, a->R);
   fprintf(f, ", \"B\": "); json_str(f, a->B);
@@ -1176,10 +1282,19 @@ static int write_json(const args *a, const dist *d, const result *res) {
     if (a->poly_w) { fprintf(f, ", \"poly_w\": "); json_str(f, a->poly_w); }
   }
   fprintf(f, "},\n");
-  fprintf(f, "  \"snapshots\": {\"count\": %d, \"file\": ", d->ns); json_str(f, a->X);
-  if (a->have_dt) { fprintf(f, ", \"dt\": "); json_num(f, a->dt); }
-  fprintf(f, "},\n  \"options\": {\"training_runs\": 0, \"ref\": \"none\", \"hyper\": \"%s\"",
-          hyper ? hyper_name(a->hyper_kind) : "none");
+}
+
+/* The "options" object, as the serial command writes it (gmg-qm: its
+   lifting dimension, the fixed lambda and the manifold first). */
+static void json_options(FILE *f, const args *a, const result *res) {
+  const int hyper = a->poly_idx && !a->no_hyper, deim = hyper && a->hyper_kind != PHGMG_HYPER_ECSW;
+  fprintf(f, "  \"options\": {");
+  if (a->method == PHGMG_METHOD_GMG_QM) {
+    fprintf(f, "\"rn\": %d, \"lambda\": ", res->mr.rn); json_num(f, a->lambda);
+    fprintf(f, ", \"lambda_used\": "); json_num(f, a->lambda);
+    fprintf(f, ", \"manifold\": \"%s\", ", a->manifold == PHGMG_MANIFOLD_GREEDY ? "greedy" : "pod");
+  }
+  fprintf(f, "\"training_runs\": 0, \"ref\": \"none\", \"hyper\": \"%s\"", hyper ? hyper_name(a->hyper_kind) : "none");
   if (hyper && !deim) { fprintf(f, ", \"hyper_tol\": "); json_num(f, a->have_hyper_tol ? a->hyper_tol : 1e-6); }
   fprintf(f, ", \"deim\": %s", deim ? "true" : "false");
   if (deim) {
@@ -1187,9 +1302,17 @@ static int write_json(const args *a, const dist *d, const result *res) {
     fprintf(f, ", \"deim_max\": %d, \"deim_allow_negative\": %s", a->deim_max, a->deim_neg ? "true" : "false");
   }
   fprintf(f, "},\n");
+}
+
+/* The "info" object: the serial command's diagnostics, the ranks and the solver. */
+static void json_info(FILE *f, const args *a, const dist *d, const result *res) {
+  const int nd = res->mr.nd, hyper = a->poly_idx && !a->no_hyper, deim = hyper && a->hyper_kind != PHGMG_HYPER_ECSW;
+  int j, nneg = 0;
+  double wmin = HUGE_VAL;
+  for (j = 0; j < nd; ++j) { wmin = fmin(wmin, res->mr.w[j]); nneg += res->mr.w[j] < 0.0; }
   fprintf(f, "  \"info\": {\"pod_sigma_ratio\": "); json_num(f, res->sigma_ratio);
   fprintf(f, ", \"rcond_jr\": "); json_num(f, res->rcond_jr);
-  if (gmg) fprintf(f, ", \"degeneracy_tol\": 1e-12");
+  if (a->method == PHGMG_METHOD_GMG_POD || a->method == PHGMG_METHOD_GMG_QM) fprintf(f, ", \"degeneracy_tol\": 1e-12");
   if (hyper) {
     fprintf(f, ", \"hyper\": {\"method\": \"%s\", \"points\": %d, \"negative_weights\": %d, \"min_weight\": ",
             hyper_name(a->hyper_kind), nd, nneg);
@@ -1205,50 +1328,75 @@ static int write_json(const args *a, const dist *d, const result *res) {
   }
   fprintf(f, ", \"reduce_seconds\": "); json_num(f, res->seconds);
   fprintf(f, ", \"mpi_ranks\": %d, \"jr_solver\": \"sparse LU of J - R replicated on every rank\"},\n", d->size);
+}
+
+/* NAME.json: the record of the serial command (what was reduced, how, and
+   where the outputs are), with the ranks and the solver of J - R. */
+static int write_json(const args *a, const dist *d, const result *res) {
+  const phgmg_rom *rom = &res->mr.rom;
+  const int qm = rom->kind == PHGMG_ROM_QUADRATIC, nd = res->mr.nd;
+  char p[4300];
+  FILE *f;
+  int j;
+  part_path(a, 2, p, sizeof p);
+  if (!(f = fopen(p, "w"))) { say("%s: cannot write: %s", p, strerror(errno)); return 1; }
+  fprintf(f, "{\n  \"phgmg_version\": \"%s\",\n  \"name\": ", PHGMG_VERSION_STRING);
+  json_str(f, a->name);
+  fprintf(f, ",\n  \"method\": \"%s\",\n  \"kind\": \"%s\",\n  \"map\": \"%s\",\n", method_name(a->method),
+          a->poly_idx ? "nonlinear" : "linear", qm ? "quadratic" : "linear");
+  fprintf(f, "  \"N\": %d, \"m\": %d, \"r\": %d, \"rn\": %d, \"nd\": %d, \"poly_deg\": %d,\n", d->N, d->m, a->r,
+          res->mr.rn, nd, nd ? rom->poly_deg : 0);
+  fprintf(f, "  \"E\": %s, \"N_full\": %d, \"algebraic\": 0, \"feedthrough\": false,\n  \"dt_map\": 0,\n",
+          a->E ? "true" : "false", d->N);
+  json_system(f, a);
+  fprintf(f, "  \"snapshots\": {\"count\": %d, \"file\": ", d->ns); json_str(f, a->X);
+  if (a->have_dt) { fprintf(f, ", \"dt\": "); json_num(f, a->dt); }
+  fprintf(f, "},\n");
+  json_options(f, a, res);
+  json_info(f, a, d, res);
   fprintf(f, "  \"stepper_memsize_bytes\": %lu,\n", (unsigned long)phgmg_rom_stepper_memsize(rom));
-  fprintf(f, "  \"reconstruction\": \"x = V0 @ xr\",\n");
+  fprintf(f, "  \"reconstruction\": \"%s\",\n", qm ? "x = V0 @ xr + V2 @ (M @ kron(xr[m:], xr[m:]))" : "x = V0 @ xr");
   fprintf(f, "  \"files\": {\n    \"model\": \"%s.phgmgrom\",\n    \"c_source\": \"%s.c\",\n    \"arrays\": {", a->name,
           a->name);
-  for (j = 3; j < g_nout; ++j) {
-    k = j < 6 ? j : j == g_nout - 1 ? 6 : j + 1;   /* V0 last */
-    fprintf(f, "%s\n      \"%s%s\": [%d, %d]", j > 3 ? "," : "", a->name, out_suffix[k], shape[k][0], shape[k][1]);
-  }
+  for (j = 0; j < g_narr; ++j)
+    fprintf(f, "%s\n      \"%s_%s.npy\": [%d, %d]", j ? "," : "", a->name, arr_name[g_arr[j].k], g_arr[j].rows,
+            g_arr[j].cols);
   fprintf(f, "\n    }\n  }\n}\n");
   if (fclose(f) != 0) { say("%s: write error", p); return 1; }
   return 0;
 }
 
-/* Rank 0: the kept terms' arrays as the serial command writes them: P0
-   (nd x r), w (nd x 1), and the functions as the model holds them, one row
-   of coefficients per function (poly: nf x (poly_deg + 1); expo: nf x 2
-   nexp, nf = nd per term, else 1), written as those shapes. */
-static int write_terms(const args *a, const result *res) {
-  const phgmg_rom *rom = &res->mr.rom;
-  const int nd = res->mr.nd, nf = rom->nphi > 1 ? rom->nphi : 1, nc = rom->poly_deg + 1, ne = 2 * rom->nexp;
-  double *buf = (double *)malloc(sizeof(double) * ((size_t)nf * (size_t)(nc + ne) + 1));
+/* Rank 0: the replicated arrays (the model's, as double, and M). */
+static int write_small(const args *a) {
+  double *buf = NULL;
+  size_t cap = 0;
   char p[4300];
-  phgmg_result rc = buf ? PHGMG_OK : PHGMG_ERR_NOMEM;
-  size_t i;
-  for (i = 0; buf && i < (size_t)nf * nc; ++i) buf[i] = (double)rom->poly[i];
-  for (i = 0; buf && i < (size_t)nf * ne; ++i) buf[(size_t)nf * nc + i] = (double)rom->expo[i];
-  part_path(a, 7, p, sizeof p);
-  if (rc == PHGMG_OK) rc = phgmg_npy_write(p, res->mr.P0, nd, a->r, nd, 2, 0u);
-  if (rc == PHGMG_OK) { part_path(a, 8, p, sizeof p); rc = phgmg_npy_write(p, res->mr.w, nd, 1, nd, 2, 0u); }
-  if (rc == PHGMG_OK) { part_path(a, 9, p, sizeof p); rc = phgmg_npy_write(p, buf, nf, nc, nf, 2, 0u); }
-  if (rc == PHGMG_OK && ne) { part_path(a, 10, p, sizeof p); rc = phgmg_npy_write(p, buf + (size_t)nf * nc, nf, ne, nf, 2, 0u); }
+  phgmg_result rc = PHGMG_OK;
+  int j;
+  for (j = 0; j < g_narr && rc == PHGMG_OK; ++j) {
+    const outarr *o = &g_arr[j];
+    const size_t n = (size_t)o->rows * (size_t)o->cols;
+    size_t q;
+    if (o->k == ARR_V0 || o->k == ARR_V2) continue;   /* distributed: write_rows */
+    if (n > cap) {
+      double *nb = (double *)realloc(buf, n * sizeof(double));
+      if (!nb) { rc = PHGMG_ERR_NOMEM; break; }
+      buf = nb; cap = n;
+    }
+    for (q = 0; q < n; ++q) buf[q] = o->re ? (double)o->re[q] : o->d[q];
+    part_path(a, 3 + o->k, p, sizeof p);
+    rc = phgmg_npy_write(p, buf, o->rows, o->cols, o->rows, 2, 0u);
+  }
   free(buf);
   if (rc != PHGMG_OK) { say("%s: cannot write: %s", p, phgmg_result_string(rc)); return 1; }
   return 0;
 }
 
-/* Rank 0: the model file, its C source and the blocks K, Qh, Bh. */
-static int write_model(const args *a, const dist *d, result *res) {
+/* Rank 0: the model file, its C source and the replicated arrays. */
+static int write_model(const args *a, result *res) {
   phgmg_rom rom = res->mr.rom;
-  const double *blk[3];
-  const int cols[3] = {d->m, a->r, a->r};
   char p[4300];
   phgmg_result rc;
-  int k;
   rom.dt = a->have_dt ? a->dt : 0.0;   /* the snapshots' step, if known (simulate-rom's default) */
   part_path(a, 0, p, sizeof p);
   rc = phgmg_rom_save(&rom, p);
@@ -1256,28 +1404,23 @@ static int write_model(const args *a, const dist *d, result *res) {
   part_path(a, 1, p, sizeof p);
   rc = phgmg_rom_export_c(&rom, a->name, p);
   if (rc != PHGMG_OK) { say("%s: cannot write the C source: %s", p, phgmg_result_string(rc)); return 1; }
-  blk[0] = res->mr.Bh; blk[1] = res->mr.Qh; blk[2] = res->mr.K;
-  for (k = 0; k < 3; ++k) {
-    part_path(a, 3 + k, p, sizeof p);
-    rc = phgmg_npy_write(p, blk[k], a->r, cols[k], a->r, 2, 0u);
-    if (rc != PHGMG_OK) { say("%s: cannot write: %s", p, phgmg_result_string(rc)); return 1; }
-  }
-  return g_nout > 7 && write_terms(a, res);
+  return write_small(a);
 }
 
-/* Every output: the basis gathered (collective), then rank 0 writes the rest
-   and moves everything into place. */
+/* Every output: the distributed arrays gathered (collective), then rank 0
+   writes the rest and moves everything into place. */
 static int write_outputs(const args *a, const dist *d, result *res) {
   int bad = 0;
-  g_nout = res->mr.nd > 0 ? (res->mr.rom.nexp > 0 ? 11 : 10) : 7;   /* the kept terms' arrays, as the serial command */
+  list_arrays(a, d, res);
   if (any_rank(d->rank == 0 && make_dir(a->out))) return 1;
-  bad = write_V0(a, d, res->V0);
-  if (!bad && d->rank == 0) bad = write_model(a, d, res) || write_json(a, d, res) || parts_commit(a);
+  bad = write_rows(a, d, ARR_V0, res->V0, a->r);
+  if (!bad && res->mr.rom.kind == PHGMG_ROM_QUADRATIC) bad = write_rows(a, d, ARR_V2, res->mr.V2, res->mr.rn);
+  if (!bad && d->rank == 0) bad = write_model(a, res) || write_json(a, d, res) || parts_commit(a);
   if (bad && d->rank == 0) parts_remove(a);
   if (any_rank(bad)) return 1;
   if (d->rank == 0 && !a->quiet)
     printf("wrote %s/%s.phgmgrom, %s/%s.c, %s/%s.json and %d arrays %s/%s_*.npy (%s, r = %d, m = %d, N = %d, "
-           "%d rank%s)\n", a->out, a->name, a->out, a->name, a->out, a->name, g_nout - 3, a->out, a->name,
+           "%d rank%s)\n", a->out, a->name, a->out, a->name, a->out, a->name, g_narr, a->out, a->name,
            method_name(a->method), a->r, d->m, d->N, d->size, d->size > 1 ? "s" : "");
   return 0;
 }

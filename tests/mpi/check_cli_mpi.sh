@@ -32,7 +32,12 @@
 # same checks. A mass matrix (--E-coo: 1.25 on the positions, a
 # consistent-mass pattern on the momenta; its own 201 snapshots from the
 # serial simulate) with the cosh terms, gmg-pod at P = 2: the same
-# checks, and the json's "E".
+# checks, and the json's "E". GMG-QM with a fixed --lambda 1e-3: the
+# linear chain with the POD manifold and --rn 4 at P = 1, 3, the cosh chain
+# with the greedy manifold (default rn, ECSW) at P = 2, 4: besides the
+# above, every block of the quadratic model (G00, G01, G10, G11, Q01, Q11,
+# Ms), P1, V2 and M within 1e-10 after the signs of V0's and V2's columns
+# (Ms and M: row a by V2's sign, column (j, k) by those of V1's j and k).
 # Bad input at P = 3: a missing --X file must end every rank with a nonzero
 # status (each rank's status recorded by a wrapper), one message, within the
 # timeout (no rank left waiting in a collective); snapshots of the wrong
@@ -92,18 +97,20 @@ PYEOF
 "$PHGMG" simulate $M --E-coo "$D/E.npy" $NL --dt 0.1 --steps 200 --out "$D/y_full_e.npy" --states "$D/X_e.npy" --quiet > /dev/null
 # case: linear (gmg-pod, sp1), cosh (cosh-gmg-pod, cosh-sp1), per-term functions without hyper-reduction
 # (terms-sp1), cosh with DEIM (qdeim-gmg-pod, greedy-sp2), cosh with a mass matrix (mass-gmg-pod)
-for case in gmg-pod sp1 cosh-gmg-pod cosh-sp1 terms-sp1 qdeim-gmg-pod greedy-sp2 mass-gmg-pod; do
+for case in gmg-pod sp1 cosh-gmg-pod cosh-sp1 terms-sp1 qdeim-gmg-pod greedy-sp2 mass-gmg-pod qmpod-gmg-qm qmgreedy-gmg-qm; do
   ps="1 2 3 4"
   case $case in
     cosh-*) meth=${case#cosh-}; X="$D/X_nl.npy"; opt=$NL ;;
     qdeim-*|greedy-*) meth=${case#*-}; X="$D/X_nl.npy"; opt="$NL --hyper ${case%%-*} --deim-tol 1e-4 --deim-allow-negative" ;;
     mass-*) meth=${case#mass-}; X="$D/X_e.npy"; opt="$NL --E-coo $D/E.npy" ;;
     terms-*) meth=${case#terms-}; X="$D/X_pt.npy"; opt="$PT --no-hyper"; ps=3 ;;
+    qmpod-*) meth=gmg-qm; X="$D/X.npy"; opt="--manifold pod --rn 4 --lambda 1e-3" ;;
+    qmgreedy-*) meth=gmg-qm; X="$D/X_nl.npy"; opt="$NL --manifold greedy --lambda 1e-3" ;;
     *) meth=$case; X="$D/X.npy"; opt="" ;;
   esac
   case $case in   # every P over the two cases of a method (the library's layer is checked at each P by test_mpi_nl)
     gmg-pod) ps="1 3" ;; sp1) ps="2 4" ;; cosh-gmg-pod) ps="2 4" ;; cosh-sp1) ps="1 3" ;;
-    qdeim-*) ps="3" ;; greedy-*) ps="4" ;; mass-*) ps="2" ;;
+    qdeim-*) ps="3" ;; greedy-*) ps="4" ;; mass-*) ps="2" ;; qmpod-*) ps="1 3" ;; qmgreedy-*) ps="2 4" ;;
   esac
   "$PHGMG" reduce $M $opt --X "$X" --method $meth --r 10 --out "$D/serial_$case" --quiet > /dev/null
   "$PHGMG" simulate-rom --model "$D/serial_$case/rom.phgmgrom" --dt 0.1 --steps 300 --out "$D/y_serial_$case.npy" --quiet > /dev/null
@@ -130,7 +137,8 @@ echo "check_cli_mpi: a missing --X file: status $(sort -u "$D/bad_status.txt" | 
 # Refused: snapshots of the wrong shape (B has one column), --simulate, --ref.
 refused() {   # expected words, then the options
   want=$1; shift
-  if timeout 60 $MPIRUN -np 3 "$PMPI" reduce $M "$@" --method gmg-pod --r 10 --out "$D/bad" > /dev/null 2> "$D/err.txt"; then
+  case " $* " in *" --method "*) meth= ;; *) meth="--method gmg-pod" ;; esac   # gmg-pod unless given
+  if timeout 60 $MPIRUN -np 3 "$PMPI" reduce $M "$@" $meth --r 10 --out "$D/bad" > /dev/null 2> "$D/err.txt"; then
     echo "check_cli_mpi: FAILED: $* was accepted"; exit 1
   fi
   if ! grep -q -- "$want" "$D/err.txt" || [ -e "$D/bad" ]; then
@@ -145,7 +153,19 @@ refused "--deim-tol, --deim-max and --deim-allow-negative apply to --hyper qdeim
 refused "use --deim-allow-negative" --X "$D/X_nl.npy" $NL --hyper greedy --deim-tol 1e-4
 refused "algebraic constraints -- zero rows of E" --X "$D/X_e.npy" $NL --E-coo "$D/E0.npy"
 refused "--E: dense matrices are not read" --X "$D/X_e.npy" --E "$D/E.npy"
-echo "check_cli_mpi: wrong snapshot shape, --simulate, --ref, --poly-jdx, DEIM options without DEIM, negative DEIM weights, a mass matrix with a zero row, dense --E refused with messages naming them"
+refused "gmg-qm needs a fixed --lambda" --X "$D/X.npy" --method gmg-qm
+refused "--lambda auto: phgmg-mpi takes a fixed ridge parameter" --X "$D/X.npy" --method gmg-qm --lambda auto
+refused "--rn wide: not distributed" --X "$D/X.npy" --method gmg-qm --lambda 1e-3 --rn wide
+refused "--manifold altmin: not distributed" --X "$D/X.npy" --method gmg-qm --lambda 1e-3 --manifold altmin
+refused "apply to --method gmg-qm only" --X "$D/X.npy" --lambda 1e-3
+# An output that is an input file (here --E-coo as the basis' path) is refused and the file left as it was.
+mkdir -p "$D/clash" && cp "$D/E.npy" "$D/clash/rom_V0.npy"
+if timeout 60 $MPIRUN -np 2 "$PMPI" reduce $M --E-coo "$D/clash/rom_V0.npy" --X "$D/X_e.npy" --method gmg-pod --r 10 \
+     --out "$D/clash" > /dev/null 2> "$D/err.txt" || ! grep -q "is the input file of --E-coo" "$D/err.txt" || \
+   ! cmp -s "$D/E.npy" "$D/clash/rom_V0.npy" || [ -e "$D/clash/rom.json" ]; then
+  echo "check_cli_mpi: FAILED: an output that is the --E-coo file was not refused, or the file changed"; cat "$D/err.txt"; exit 1
+fi
+echo "check_cli_mpi: wrong snapshot shape, --simulate, --ref, --poly-jdx, DEIM options without DEIM, negative DEIM weights, a mass matrix with a zero row, dense --E, gmg-qm without a fixed --lambda, --lambda auto, --rn wide, --manifold altmin, --lambda with gmg-pod refused with messages naming them; an output on the --E-coo file refused, the file unchanged"
 
 $PY - "$D" <<'PYEOF'
 import json
@@ -166,9 +186,12 @@ def coords(P0, V0):
     return out
 
 bad = 0
-for case in ('gmg-pod', 'sp1', 'cosh-gmg-pod', 'cosh-sp1', 'terms-sp1', 'qdeim-gmg-pod', 'greedy-sp2', 'mass-gmg-pod'):
-    nl = case.startswith(('cosh-', 'terms-', 'qdeim-', 'greedy-', 'mass-'))
-    names = ('K', 'Qh', 'Bh', 'V0') + (('P0', 'w', 'poly', 'expo') if nl else ())
+for case in ('gmg-pod', 'sp1', 'cosh-gmg-pod', 'cosh-sp1', 'terms-sp1', 'qdeim-gmg-pod', 'greedy-sp2', 'mass-gmg-pod',
+             'qmpod-gmg-qm', 'qmgreedy-gmg-qm'):
+    nl = case.startswith(('cosh-', 'terms-', 'qdeim-', 'greedy-', 'mass-', 'qmgreedy-'))
+    qm = case.endswith('gmg-qm')
+    names = (('Qh', 'Bh', 'V0', 'G00', 'G01', 'G10', 'G11', 'Q01', 'Q11', 'Ms', 'V2', 'M') if qm else
+             ('K', 'Qh', 'Bh', 'V0')) + (('P0', 'w', 'poly', 'expo') if nl else ()) + (('P1',) if nl and qm else ())
     sd = '%s/serial_%s' % (d, case)
     ser = {n: np.load('%s/rom_%s.npy' % (sd, n)) for n in names}
     sj = json.load(open(sd + '/rom.json'))
@@ -184,11 +207,12 @@ for case in ('gmg-pod', 'sp1', 'cosh-gmg-pod', 'cosh-sp1', 'terms-sp1', 'qdeim-g
         print('check_cli_mpi: %s: the serial points were not found in V0' % case)
         bad = 1
     for p in {'gmg-pod': (1, 3), 'sp1': (2, 4), 'cosh-gmg-pod': (2, 4), 'cosh-sp1': (1, 3), 'terms-sp1': (3,),
-              'qdeim-gmg-pod': (3,), 'greedy-sp2': (4,), 'mass-gmg-pod': (2,)}[case]:
+              'qdeim-gmg-pod': (3,), 'greedy-sp2': (4,), 'mass-gmg-pod': (2,), 'qmpod-gmg-qm': (1, 3),
+              'qmgreedy-gmg-qm': (2, 4)}[case]:
         pd = '%s/p%d_%s' % (d, p, case)
         files_ok = sorted(os.listdir(pd)) == sorted(os.listdir(sd))
         pj = json.load(open(pd + '/rom.json'))
-        keys_ok = all(pj[k] == sj[k] for k in ('method', 'N', 'm', 'r', 'kind', 'map', 'nd', 'poly_deg', 'E')) and \
+        keys_ok = all(pj[k] == sj[k] for k in ('method', 'N', 'm', 'r', 'rn', 'kind', 'map', 'nd', 'poly_deg', 'E')) and \
             pj['snapshots']['count'] == sj['snapshots']['count'] and pj['files'] == sj['files'] and \
             pj['options'] == sj['options'] and \
             all(pj['system'].get(k) == sj['system'].get(k) for k in ('potential', 'poly', 'exp', 'poly_idx', 'poly_w', 'E'))
@@ -202,8 +226,21 @@ for case in ('gmg-pod', 'sp1', 'cosh-gmg-pod', 'cosh-sp1', 'terms-sp1', 'qdeim-g
         sg = np.sign(np.sum(dis['V0'] * ser['V0'], axis=0))
         sg[sg == 0] = 1.0
         S = np.diag(sg)
-        e = {'K': rel(S @ dis['K'] @ S, ser['K']), 'Qh': rel(S @ dis['Qh'] @ S, ser['Qh']),
-             'Bh': rel(S @ dis['Bh'], ser['Bh']), 'V0': rel(dis['V0'] @ S, ser['V0'])}
+        e = {'Qh': rel(S @ dis['Qh'] @ S, ser['Qh']), 'Bh': rel(S @ dis['Bh'], ser['Bh']),
+             'V0': rel(dis['V0'] @ S, ser['V0'])}
+        if not qm:
+            e['K'] = rel(S @ dis['K'] @ S, ser['K'])
+        else:   # V2's signs from its columns; Ms and M: row a by V2's, column (j, k) by V1's j and k
+            s2 = np.sign(np.sum(dis['V2'] * ser['V2'], axis=0))
+            s2[s2 == 0] = 1.0
+            S2, s1 = np.diag(s2), sg[pj['m']:]
+            SK = np.diag(np.kron(s1, s1))
+            for n, a in (('G00', S @ dis['G00'] @ S), ('G01', S @ dis['G01'] @ S2), ('G10', S2 @ dis['G10'] @ S),
+                         ('G11', S2 @ dis['G11'] @ S2), ('Q01', S @ dis['Q01'] @ S2), ('Q11', S2 @ dis['Q11'] @ S2),
+                         ('Ms', S2 @ dis['Ms'] @ SK), ('M', S2 @ dis['M'] @ SK), ('V2', dis['V2'] @ S2)):
+                e[n] = rel(a, ser[n]) if a.shape == ser[n].shape else np.inf
+            if nl:
+                e['P1'] = rel(dis['P1'] @ S2, ser['P1']) if dis['P1'].shape == ser['P1'].shape else np.inf
         pts = ''
         if nl:
             cd = kept(dis['P0'], dis['V0'])
@@ -220,10 +257,12 @@ for case in ('gmg-pod', 'sp1', 'cosh-gmg-pod', 'cosh-sp1', 'terms-sp1', 'qdeim-g
                 e.get('expo', np.inf))
         ey = np.abs(np.load('%s/y_p%d_%s.npy' % (d, p, case)) - ys).max() / np.abs(ys).max()
         ok = files_ok and keys_ok and e_sig <= TOL and e_rc <= TOL and max(e.values()) <= TOL and ey <= TOL
-        print('check_cli_mpi: %-12s P = %d: K %.1e, Qh %.1e, Bh %.1e, V0 %.1e, simulate-rom %.1e; '
+        qms = ', G00..Ms, V2, M, P1 %.1e' % max(e[n] for n in e if n not in ('K', 'Qh', 'Bh', 'V0', 'P0', 'w', 'poly',
+                                                                             'expo')) if qm else ''
+        print('check_cli_mpi: %-15s P = %d: K %.1e, Qh %.1e, Bh %.1e, V0 %.1e%s, simulate-rom %.1e; '
               'sigma ratio %.1e, rcond %.1e%s; files %s, json %s%s'
-              % (case, p, e['K'], e['Qh'], e['Bh'], e['V0'], ey, e_sig, e_rc, pts, 'same' if files_ok else 'DIFFER',
-                 'agrees' if keys_ok else 'DIFFERS', '' if ok else '  <-- FAILED'))
+              % (case, p, e.get('K', 0.0), e['Qh'], e['Bh'], e['V0'], qms, ey, e_sig, e_rc, pts,
+                 'same' if files_ok else 'DIFFER', 'agrees' if keys_ok else 'DIFFERS', '' if ok else '  <-- FAILED'))
         bad |= not ok
 if bad:
     print('check_cli_mpi: FAILED (tolerance 1e-10 relative)')

@@ -788,6 +788,41 @@ static void compare_qm(const chain *ch, const double *x0, const phgmg_reduced *r
   free(col);
 }
 
+/* Rank 0: the lift x = V0 xr + V2 M kron(x2, x2) of the distributed model
+   (V0f, V2f gathered, mr->M) against the serial phgmg_reduced_lift at a
+   few reduced states (the distributed one at the sign-adjusted xr: V2 M
+   does not depend on V2's signs), relative to the lift's size. */
+static void compare_lift(const phgmg_reduced *red, const phgmg_mpi_rom *mr, const double *V0f, const double *V2f,
+                         int N, double tol, const char *tag) {
+  const int r = mr->r, m = mr->m, p = r - m, rn = mr->rn;
+  double sg[64], xr[64], xd[64], *col = (double *)malloc(sizeof(double) * 2 * (size_t)N), *x = col + N;
+  double *q = (double *)malloc(sizeof(double) * (size_t)(rn > 0 ? rn : 1)), e = 0.0;
+  int i, j, k, a, t;
+  CHECK(rn > 0 && mr->M && (N == 0 || V2f), "%s: the lift's V2 and M not returned", tag);
+  mode_signs(red, N, r, V0f, sg);
+  for (t = 0; rn > 0 && t < 3; ++t) {
+    double em = 0.0, cm = 0.0;
+    for (j = 0; j < r; ++j) { xr[j] = 0.3 * sin(1.7 * (j + 1) * (t + 1)); xd[j] = sg[j] * xr[j]; }
+    phgmg_reduced_lift(red, xr, col);
+    for (a = 0; a < rn; ++a) {   /* q = M kron(x2, x2) at the distributed coordinates */
+      q[a] = 0.0;
+      for (j = 0; j < p; ++j)
+        for (k = 0; k < p; ++k) q[a] += mr->M[a + (size_t)(j * p + k) * rn] * xd[m + j] * xd[m + k];
+    }
+    for (i = 0; i < N; ++i) {
+      x[i] = 0.0;
+      for (j = 0; j < r; ++j) x[i] += V0f[i + (size_t)j * N] * xd[j];
+      for (a = 0; a < rn; ++a) x[i] += V2f[i + (size_t)a * N] * q[a];
+      em = fmax(em, fabs(x[i] - col[i]));
+      cm = fmax(cm, fabs(col[i]));
+    }
+    e = fmax(e, em / cm);
+  }
+  CHECK(e <= tol, "%s: the lift V0 xr + V2 M kron(x2, x2) against the serial one: %.2e", tag, e);
+  printf("  %s: lift with V2 and M %.1e\n", tag, e);
+  free(col); free(q);
+}
+
 /* Scale mode: how far the serial GMG-QM model itself moves when every
    snapshot entry changes by one unit in the last place (as
    serial_sensitivity): the blocks and outputs of compare_qm between the two
@@ -854,7 +889,7 @@ static void test_gmg_qm(int n, int r) {
   chain ch;
   dist d;
   double *X = (double *)malloc(sizeof(double) * (size_t)N * ns), *x0 = (double *)calloc((size_t)N, sizeof(double));
-  double *V0 = NULL, *V0f, *Vpod = NULL;
+  double *V0 = NULL, *V0f, *V2f, *Vpod = NULL;
   phgmg_reduce_opts o;
   phgmg_reduced *red = NULL;
   phgmg_mpi_rom mr;
@@ -884,11 +919,13 @@ static void test_gmg_qm(int n, int r) {
       rc = phgmg_mpi_reduce(d.c, &d.md, ns, d.Xl, d.ld, &o, &mr, V0, d.ld);
       CHECK(rc == PHGMG_OK && same_everywhere(mr.nd), "distributed %s: %d", tag, (int)rc);
       V0f = gather_v0(d.c, r, V0, d.ld);
+      V2f = rc == PHGMG_OK ? gather_v0(d.c, mr.rn, mr.V2, d.ld) : NULL;
       if (rank_ == 0 && rc == PHGMG_OK) {
         CHECK(phgmg_reduce(&red, &ch.sys, X, N, ns, &o, NULL, NULL) == PHGMG_OK, "serial %s", tag);
         double btol = 1e-12, ytol = 1e-10;
         if (red && scale_) qm_sensitivity(&ch, ns, X, x0, &o, red, &btol, &ytol);
         if (red) compare_qm(&ch, x0, red, &mr, V0f, 100, btol, ytol, NULL, tag);
+        if (red && V2f) compare_lift(red, &mr, V0f, V2f, N, 100.0 * btol, tag);
         phgmg_reduced_destroy(red);
         red = NULL;
       }
@@ -908,6 +945,7 @@ static void test_gmg_qm(int n, int r) {
       }
       quiet_barrier();
       phgmg_mpi_rom_free(&mr);
+      free(V2f);
       if (mf == 0) { free(Vpod); Vpod = V0f; } else free(V0f);
     }
     free(Vpod);
