@@ -927,10 +927,9 @@
    Not yet distributed: GMG-QM with a wide V2, ALTMIN or a chosen lambda;
    GMG_MANIFOLD; cached DEIM points
    (opts.cache), separable terms by callbacks and GENERAL nonlinear
-   Hamiltonians, a reference state (opts.ref), dampers, feedthrough,
-   algebraic constraints (singular E), and a mass matrix with SP1, SP2 or
-   GMG-QM; in the command line (below) also simulating the training runs
-   and mass matrices.
+   Hamiltonians, a reference state (opts.ref), dampers, feedthrough (and
+   so a port on an algebraic equation), and a mass matrix with SP1, SP2 or
+   GMG-QM; in the command line (below) also simulating the training runs.
    Mass matrices. A descriptor model E x' = (J - R) z + B u (manual 1.6, E
    of full rank) reduces by GMG-POD: phgmg_mpi_linear_model.E (the rows of
    E as a distributed operator) and solve_E (the user's collective solve
@@ -947,6 +946,35 @@
    1e-15, the same 56 ECSW points, weights within 3e-14, K within 8.3e-12
    and the outputs within 6.5e-12 -- the serial model itself moves K by
    3.7e-12 when the snapshots change by one ulp (cond G00).
+   Algebraic constraints. An index-one E (manual 1.8: k zero rows, the
+   algebraic equations a, and k zero columns, the algebraic variables c,
+   anywhere among the ranks, a and c need not coincide) reduces by GMG-POD
+   as the serial reduction of the condensed model (phgmg_reduce of
+   phgmg_dae_system with the snapshots restricted to x_d). Nothing is
+   condensed: with L = J - R, the condensed model's inverse (L_dd - L_da
+   L_aa^{-1} L_ad)^{-1} is the dd block of L^{-1}, so its G-blocks are
+   F^T L^{-1} F with F = E V0, whose rows in a are zero, solved by the
+   user's solve with the whole J - R; Qh = F^T Q V0 needs
+   only V0's rows d because Q_dc = 0 (1.8); the snapshots' rows c are left
+   out of the POD, so V0's rows c are zero (the serial command's embedding
+   of V0); the ports are E_dd^{-1} B, through solve_E, which then solves
+   with E_dd (its result's rows c are set to zero). The zero rows are read
+   from each rank's rows of E, the zero columns found by one exchange with
+   the neighbouring ranks (the operator's plan reversed). Not taken: a
+   port on an algebraic equation (its condensation is feedthrough:
+   PHGMG_ERR_UNSUPPORTED), different counts of zero rows and columns
+   (PHGMG_ERR_E_SINGULAR); separable terms on algebraic lines fail E's row
+   check (PHGMG_ERR_E_COUPLED). Index one (L_aa nonsingular) is the
+   caller's to ensure: the library sees J - R only through the solve. On
+   the chain of 600 masses with every fifth velocity massless (a zero row
+   and column of E, damped: index one) and a consistent-mass pattern
+   between the others that crosses the ranks' row blocks
+   (tests/mpi/test_mpi_nl.c) at 1-4 ranks, against the serial reduction
+   of the condensed model: the basis's rows at the algebraic variables
+   exactly zero, singular values within 6e-16 sigma_1, Qh within 1.5e-15,
+   the same 67 ECSW points, weights within 5e-14, K within 6.5e-13 and the
+   outputs within 2e-12 (the serial condensed model moves K by 5.2e-13 and
+   its outputs by 1.5e-12 under one-ulp changes of the snapshots).
    A PETSc + MUMPS example. examples/petsc_mumps.c puts a real distributed
    direct solver behind the solve callback: it reads the command line's
    files (J, R, Q as (nnz, 3) triplets, B, the snapshots X), each rank
@@ -999,8 +1027,8 @@
    rank's memory; beyond, put a distributed solver behind the same
    callback, as examples/petsc_mumps.c does with MUMPS. Everything else of
    `phgmg reduce` -- --simulate (make the snapshots with the serial
-   `phgmg simulate --states`), dense matrices, a mass matrix with zero rows
-   (algebraic constraints) or with sp1/sp2, springs (--poly-jdx),
+   `phgmg simulate --states`), dense matrices, a mass matrix with sp1,
+   sp2 or gmg-qm, a port on an algebraic equation, springs (--poly-jdx),
    dampers, feedthrough, --ref, gmg-qm's --lambda auto or cv, --rn wide
    and --manifold altmin, balancing, several --X files,
    method or order lists -- is refused with a message naming the option;
@@ -1021,8 +1049,17 @@
    8e-15; with a mass matrix (--E-coo: consistent-mass pattern on the
    momenta, gmg-pod with the cosh terms, P = 2; E factored by the
    library's sparse LU, replicated as J - R): the same 22 points, K within
-   2.7e-15, the weights within 1.4e-12, the outputs within 4.5e-15;
-   gmg-qm with --lambda 1e-3 (the POD manifold with --rn 4 on the linear
+   2.7e-15, the weights within 1.4e-12, the outputs within 4.5e-15; an
+   index-one RLC grid (bench/rlc_grid.py, 8 x 8 mains, N = 288 with 144
+   algebraic lines, rows and states scrambled by different permutations,
+   so that E's zero rows and zero columns are different index sets;
+   --E-coo with zero rows: the model checked as the serial command checks
+   it, E's replicated LU completed by a 1 pairing each zero row with a
+   zero column) with gmg-pod at P = 2, 3: K and Qh within 5e-14, V0
+   within 8e-13 (zero at the algebraic variables, as the serial command
+   writes it), the outputs within 4e-14, the json's N (the differential
+   count), N_full, algebraic and rcond_jr (the condensed model's) the
+   serial's; gmg-qm with --lambda 1e-3 (the POD manifold with --rn 4 on the linear
    chain at P = 1, 3; the greedy manifold, default rn and ECSW on the cosh
    chain at P = 2, 4): every block of the quadratic model, P1, V2 and M
    within 2.5e-12, the same 16 points, the outputs within 3.6e-15.
@@ -5408,6 +5445,13 @@ typedef phgmg_result (*phgmg_mpi_solve_fn)(char trans, int nrhs, double *X, int 
    is always 'N'); zero E: E = I. GMG-POD only (phgmg_mpi_gmg_pod_linear,
    phgmg_mpi_reduce; the other methods: PHGMG_ERR_UNSUPPORTED): the serial
    reduction's formulas, basis [E^{-1} B, V1], the G-blocks of E V0.
+   E may also be singular of index one (manual 1.8 and 2.7: zero rows and
+   as many zero columns, anywhere; no port on a zero row): the reduction
+   is then the serial one of the condensed model, solve_E must solve with
+   E_dd (the rows and columns that are not zero; its input is zero in the
+   zero rows, and what it returns in the zero columns' rows is ignored),
+   V0's rows at the zero columns are zero, and the pencil's index one
+   (J_aa - R_aa nonsingular) is the caller's to ensure.
    Zero the struct (memset) before setting its fields: a field left zero
    keeps its default. */
 typedef struct phgmg_mpi_linear_model {
@@ -27712,6 +27756,99 @@ PHGMG_DEF phgmg_result phgmg_mpi_op_project(const phgmg_mpi_op *op, int k, const
   return rc;
 }
 
+/* ---- index-one descriptor models: E's zero rows and columns (1.8) ------------- */
+/* used[i] = 1 when column row0 + i of the operator has a nonzero entry on
+   some rank: this rank's own columns directly, the halo columns sent back
+   to their owners along the product's plan reversed (one neighbour
+   exchange). Collective. */
+PHGMG__PRIV phgmg_result phgmg__mpi_op_cols_used(const phgmg_mpi_op *op, unsigned char *used) {
+  const phgmg_mpi_ctx *ctx = op->ctx;
+  const int n = ctx->nloc, nh = op->nhalo, nb = op->soff[op->nsend];
+  double *hm = phgmg__dalloc(&ctx->al, (size_t)nh + (size_t)nb + 1), *rb;
+  MPI_Request *req = PHGMG__CAST(MPI_Request *, phgmg__alloc(&ctx->al, (size_t)(op->nrecv + op->nsend + 1) *
+                                                                          sizeof(MPI_Request)));
+  int i, q;
+  size_t e;
+  phgmg_result rc = phgmg__mpi_agree(ctx, hm && req ? PHGMG_OK : PHGMG_ERR_NOMEM);
+  if (rc == PHGMG_OK) {
+    rb = hm + nh;
+    memset(hm, 0, ((size_t)nh + (size_t)nb) * sizeof(double));
+    if (n > 0) memset(used, 0, (size_t)n);
+    for (i = 0; i < n; ++i)
+      for (e = op->rp[i]; e < op->rp[i + 1]; ++e)
+        if (op->va[e] != 0.0) {
+          if (op->cl[e] < n) used[op->cl[e]] = 1;
+          else hm[op->cl[e] - n] = 1.0;
+        }
+    for (q = 0; q < op->nsend; ++q)   /* the marks of the rows this rank sends in a product */
+      MPI_Irecv(rb + op->soff[q], op->soff[q + 1] - op->soff[q], MPI_DOUBLE, op->srank[q], PHGMG__MPI_TAG, ctx->comm,
+                req + q);
+    for (q = 0; q < op->nrecv; ++q)
+      MPI_Isend(hm + op->roff[q], op->roff[q + 1] - op->roff[q], MPI_DOUBLE, op->rrank[q], PHGMG__MPI_TAG, ctx->comm,
+                req + op->nsend + q);
+    MPI_Waitall(op->nrecv + op->nsend, req, MPI_STATUSES_IGNORE);
+    if (ctx->counts) { ctx->counts->exchanges++; ctx->counts->exchange_bytes += 8LL * nh; }
+    for (i = 0; i < nb; ++i)
+      if (rb[i] != 0.0) used[op->sidx[i]] = 1;
+  }
+  phgmg__free(&ctx->al, hm);
+  phgmg__free(&ctx->al, req);
+  return rc;
+}
+
+/* The algebraic lines of an index-one descriptor model (manual 1.8): E's
+   zero rows (the algebraic equations, set a) and its zero columns (the
+   algebraic variables, set c), as many of each, anywhere among the ranks.
+   *xalg (this rank's rows, allocated here; NULL when no rank has a zero
+   row) marks the algebraic variables. A port on an algebraic equation (a
+   nonzero entry of B in a row of a: feedthrough after condensation) is
+   PHGMG_ERR_UNSUPPORTED; different counts of zero rows and zero columns
+   PHGMG_ERR_E_SINGULAR. Collective. */
+PHGMG__PRIV phgmg_result phgmg__mpi_alg_lines(const phgmg_mpi_ctx *ctx, const phgmg_mpi_linear_model *md,
+                                              unsigned char **xalg) {
+  const phgmg_mpi_op *E = md->E;
+  const int n = ctx->nloc;
+  long long loc[3] = {0, 0, 0}, tot[3] = {0, 0, 0};   /* zero rows, ports on them, zero columns */
+  unsigned char *used;
+  int i, j;
+  size_t e;
+  phgmg_result rc;
+  *xalg = NULL;
+  if (!E) return PHGMG_OK;
+  for (i = 0; i < n; ++i) {
+    int zero = 1;
+    for (e = E->rp[i]; e < E->rp[i + 1] && zero; ++e) zero = E->va[e] == 0.0;
+    loc[0] += zero;
+    for (j = 0; zero && j < md->m; ++j) loc[1] += md->B[i + (size_t)j * md->ldb] != 0.0;
+  }
+  MPI_Allreduce(loc, tot, 2, MPI_LONG_LONG, MPI_SUM, ctx->comm);
+  phgmg__mpi_count(ctx, 16.0);
+  if (tot[0] == 0) return PHGMG_OK;
+  used = PHGMG__CAST(unsigned char *, phgmg__alloc(&ctx->al, (size_t)n + 1));
+  rc = phgmg__mpi_agree(ctx, used ? PHGMG_OK : PHGMG_ERR_NOMEM);
+  if (rc == PHGMG_OK) rc = phgmg__mpi_op_cols_used(E, used);
+  for (i = 0; rc == PHGMG_OK && i < n; ++i) {
+    used[i] = !used[i];   /* now: an algebraic variable */
+    loc[2] += used[i];
+  }
+  if (rc == PHGMG_OK) {
+    MPI_Allreduce(loc + 2, tot + 2, 1, MPI_LONG_LONG, MPI_SUM, ctx->comm);
+    phgmg__mpi_count(ctx, 8.0);
+    rc = tot[1] ? PHGMG_ERR_UNSUPPORTED : tot[2] != tot[0] ? PHGMG_ERR_E_SINGULAR : PHGMG_OK;
+  }
+  if (rc != PHGMG_OK) { phgmg__free(&ctx->al, used); used = NULL; }
+  *xalg = used;
+  return rc;
+}
+
+/* Rows marked in xalg (this rank's, may be NULL) of k columns set to zero. */
+PHGMG__PRIV void phgmg__mpi_zero_rows(const phgmg_mpi_ctx *ctx, const unsigned char *xalg, int k, double *A, int ld) {
+  int i, j;
+  for (i = 0; xalg && i < ctx->nloc; ++i)
+    if (xalg[i])
+      for (j = 0; j < k; ++j) A[i + (size_t)j * ld] = 0.0;
+}
+
 /* ---- distributed GMG-POD of a linear model -------------------------------------- */
 /* The adjusted snapshots Xa (ld max(1, nloc) x ns) = X - QB QB^T X, QB =
    TSQR(B) (B's rank checked as the serial reduction does). Collective. */
@@ -27737,9 +27874,13 @@ PHGMG__PRIV phgmg_result phgmg__mpi_adjust(const phgmg_mpi_ctx *ctx, const phgmg
 }
 
 /* V0 (ld max(1, nloc)) = [B, V1]: V1 = the p leading POD modes of the
-   adjusted snapshots (phgmg__mpi_adjust); S (p). */
+   adjusted snapshots (phgmg__mpi_adjust); S (p). xalg (may be NULL): the
+   algebraic variables, whose rows of the snapshots are left out (zero) --
+   the POD of the differential part, as the serial reduction of the
+   condensed model. */
 PHGMG__PRIV phgmg_result phgmg__mpi_gmg_basis(const phgmg_mpi_ctx *ctx, const phgmg_mpi_linear_model *md, int ns,
-                                              const double *X, int ldx, int p, double *V0, double *S) {
+                                              const double *X, int ldx, int p, const unsigned char *xalg, double *V0,
+                                              double *S) {
   const int n = ctx->nloc, ld = PHGMG__MAX(1, n), m = md->m;
   const int kk = (int)PHGMG__MIN((phgmg_gidx)PHGMG__MIN(p + 1, ns), ctx->N);
   double *Xa = phgmg__dalloc(&ctx->al, (size_t)ld * ns + (size_t)ld * kk + (size_t)kk + phgmg__mpi_pod_ws(ctx, ns, kk));
@@ -27749,8 +27890,10 @@ PHGMG__PRIV phgmg_result phgmg__mpi_gmg_basis(const phgmg_mpi_ctx *ctx, const ph
   if (rc != PHGMG_OK) { phgmg__free(&ctx->al, Xa); return rc; }
   V1 = Xa + (size_t)ld * ns; s = V1 + (size_t)ld * kk; ws = s + kk;
   rc = phgmg__mpi_adjust(ctx, md, ns, X, ldx, Xa);
+  if (rc == PHGMG_OK) phgmg__mpi_zero_rows(ctx, xalg, ns, Xa, ld);
   if (rc == PHGMG_OK) rc = phgmg__mpi_pod_core(ctx, ns, Xa, ld, kk, 0.0, V1, ld, s, &k, Xa, ws);   /* Xa factored in place */
   if (rc == PHGMG_OK && k < p) rc = PHGMG_ERR_SIZE;   /* r - m beyond the numerical rank */
+  if (rc == PHGMG_OK) phgmg__mpi_zero_rows(ctx, xalg, p, V1, ld);   /* zero there but for rounding */
   if (rc == PHGMG_OK) {
     for (j = 0; j < m && n > 0; ++j) memcpy(V0 + (size_t)j * ld, md->B + (size_t)j * md->ldb, (size_t)n * sizeof(double));
     if (n > 0) memcpy(V0 + (size_t)m * ld, V1, (size_t)ld * p * sizeof(double));
@@ -27780,15 +27923,20 @@ PHGMG__PRIV phgmg_result phgmg__mpi_gmg_invert(int r, int m, const double *G00, 
 /* ---- descriptor models: the ports E^{-1} B and the left factor E V (1.6) ---- */
 /* *out = *md; with a mass matrix its B replaced by Bp = E^{-1} B (m solves
    with E; *Bp allocated here, the caller frees it), the GMG basis's port
-   columns; *Bp NULL without E. Collective. */
+   columns; *Bp NULL without E. With algebraic lines (*xalg, allocated
+   here, the caller frees it; phgmg__mpi_alg_lines) the solve is with E_dd
+   and Bp's rows at the algebraic variables are zero. Collective. */
 PHGMG__PRIV phgmg_result phgmg__mpi_ports(const phgmg_mpi_ctx *ctx, const phgmg_mpi_linear_model *md,
-                                          phgmg_mpi_linear_model *out, double **Bp) {
+                                          phgmg_mpi_linear_model *out, double **Bp, unsigned char **xalg) {
   const int n = ctx->nloc, ld = PHGMG__MAX(1, n), m = md->m;
   int j;
   phgmg_result rc;
   *out = *md;
   *Bp = NULL;
+  *xalg = NULL;
   if (!md->E) return PHGMG_OK;
+  rc = phgmg__mpi_alg_lines(ctx, md, xalg);
+  if (rc != PHGMG_OK) return rc;
   *Bp = phgmg__dalloc(&ctx->al, (size_t)ld * m);
   rc = phgmg__mpi_agree(ctx, *Bp ? PHGMG_OK : PHGMG_ERR_NOMEM);
   if (rc != PHGMG_OK) return rc;
@@ -27796,6 +27944,7 @@ PHGMG__PRIV phgmg_result phgmg__mpi_ports(const phgmg_mpi_ctx *ctx, const phgmg_
     if (n > 0) memcpy(*Bp + (size_t)j * ld, md->B + (size_t)j * md->ldb, (size_t)n * sizeof(double));
   rc = phgmg__mpi_agree(ctx, md->solve_E('N', m, *Bp, ld, md->solve_E_user));
   if (rc == PHGMG_OK) rc = phgmg__mpi_agree(ctx, phgmg__mat_finite(n, m, *Bp, ld) ? PHGMG_OK : PHGMG_ERR_NANINF);
+  phgmg__mpi_zero_rows(ctx, *xalg, m, *Bp, ld);
   out->B = *Bp; out->ldb = ld;
   return rc;
 }
@@ -27813,8 +27962,8 @@ PHGMG__PRIV phgmg_result phgmg__mpi_e_left(const phgmg_mpi_ctx *ctx, const phgmg
    K = G00^{-1} after the check, Qh = L^T Q V0, Bh = [I; 0] (L's first m
    columns are B). Vb: this rank's rows of V0 (ld x r). Collective. */
 PHGMG__PRIV phgmg_result phgmg__mpi_gmg_pod(const phgmg_mpi_ctx *ctx, const phgmg_mpi_linear_model *md, int ns,
-                                            const double *X, int ldx, int r, double *K, double *Qh, double *Bh,
-                                            double *S, double *Vb) {
+                                            const double *X, int ldx, int r, const unsigned char *xalg, double *K,
+                                            double *Qh, double *Bh, double *S, double *Vb) {
   const phgmg_allocator *al = &ctx->al;
   const int n = ctx->nloc, ld = PHGMG__MAX(1, n), m = md->m, p = r - m;
   double *L = phgmg__dalloc(al, 2 * (size_t)ld * r + 4 * (size_t)r * r + 3 * (size_t)r + (size_t)m * m);
@@ -27824,7 +27973,7 @@ PHGMG__PRIV phgmg_result phgmg__mpi_gmg_pod(const phgmg_mpi_ctx *ctx, const phgm
   if (rc != PHGMG_OK) { phgmg__free(al, L); phgmg__free(al, iwork); return rc; }
   GV = L + (size_t)ld * r; G00 = GV + (size_t)ld * r; s = G00 + (size_t)r * r; bn = s + r;
   work = bn + (size_t)m * m;
-  rc = phgmg__mpi_gmg_basis(ctx, md, ns, X, ldx, p, Vb, s);
+  rc = phgmg__mpi_gmg_basis(ctx, md, ns, X, ldx, p, xalg, Vb, s);
   if (rc == PHGMG_OK) rc = phgmg__mpi_e_left(ctx, md, r, Vb, ld, L);
   if (rc == PHGMG_OK) {   /* GV = (J - R)^{-1} L by the user's solve */
     memcpy(GV, L, (size_t)ld * r * sizeof(double));
@@ -27877,6 +28026,7 @@ PHGMG_DEF phgmg_result phgmg_mpi_gmg_pod_linear(const phgmg_mpi_ctx *ctx, const 
   const phgmg_allocator *al;
   phgmg_mpi_linear_model md;
   double *Vb = NULL, *Bp = NULL;
+  unsigned char *xalg = NULL;
   int n, ld, j;
   phgmg_result rc = PHGMG_OK;
   if (!ctx) return PHGMG_ERR_INVALID_ARG;
@@ -27887,12 +28037,13 @@ PHGMG_DEF phgmg_result phgmg_mpi_gmg_pod_linear(const phgmg_mpi_ctx *ctx, const 
   else if (rc == PHGMG_OK && !(Vb = phgmg__dalloc(al, (size_t)ld * r)))
     rc = PHGMG_ERR_NOMEM;
   rc = phgmg__mpi_agree(ctx, rc);
-  if (rc == PHGMG_OK) rc = phgmg__mpi_ports(ctx, model, &md, &Bp);
-  if (rc == PHGMG_OK) rc = phgmg__mpi_gmg_pod(ctx, &md, ns, X, ldx, r, K, Qh, Bh, S, Vb);
+  if (rc == PHGMG_OK) rc = phgmg__mpi_ports(ctx, model, &md, &Bp, &xalg);
+  if (rc == PHGMG_OK) rc = phgmg__mpi_gmg_pod(ctx, &md, ns, X, ldx, r, xalg, K, Qh, Bh, S, Vb);
   for (j = 0; rc == PHGMG_OK && j < r && V0 && n > 0; ++j)
     memcpy(V0 + (size_t)j * ldv0, Vb + (size_t)j * ld, (size_t)n * sizeof(double));
   phgmg__free(al, Vb);
   phgmg__free(al, Bp);
+  phgmg__free(al, xalg);
   return rc;
 }
 /* ---- distributed reduction of a separable nonlinear model ----------------------- */
@@ -29013,6 +29164,7 @@ PHGMG_DEF phgmg_result phgmg_mpi_reduce(const phgmg_mpi_ctx *ctx, const phgmg_mp
   phgmg__mpi_romdata d;
   phgmg_mpi_linear_model lin;   /* model->lin with the GMG basis's port columns (E^{-1} B with a mass matrix) */
   double *b = NULL, *Vb, *Wb, *Bp = NULL, resid = 0.0;
+  unsigned char *xalg = NULL;   /* the algebraic variables of an index-one E (this rank's rows) */
   int r = 0, m = 0, ld, wd = 0, sp1;
   phgmg_result rc = PHGMG_OK;
   if (!ctx) return PHGMG_ERR_INVALID_ARG;
@@ -29039,8 +29191,8 @@ PHGMG_DEF phgmg_result phgmg_mpi_reduce(const phgmg_mpi_ctx *ctx, const phgmg_mp
                                     (sp1 ? 2 : 1) * (size_t)ld * r);   /* SP1: V and W */
     rc = phgmg__mpi_agree(ctx, b ? PHGMG_OK : PHGMG_ERR_NOMEM);
   }
-  if (rc == PHGMG_OK) rc = phgmg__mpi_ports(ctx, &model->lin, &lin, &Bp);
-  if (rc != PHGMG_OK) { phgmg__free(&ctx->al, b); phgmg__free(&ctx->al, Bp); return rc; }
+  if (rc == PHGMG_OK) rc = phgmg__mpi_ports(ctx, &model->lin, &lin, &Bp, &xalg);
+  if (rc != PHGMG_OK) { phgmg__free(&ctx->al, b); phgmg__free(&ctx->al, Bp); phgmg__free(&ctx->al, xalg); return rc; }
   d.r = r; d.m = m; d.K = b; d.Qh = b + (size_t)r * r; d.Bh = d.Qh + (size_t)r * r; d.S = d.Bh + (size_t)r * m;
   d.env = d.S + r; Vb = b + 2 * (size_t)r * r + (size_t)r * m + 3 * (size_t)r;
   Wb = sp1 ? Vb + (size_t)ld * r : NULL;   /* SP1/SP2: W = Vg A^{-1} */
@@ -29052,7 +29204,7 @@ PHGMG_DEF phgmg_result phgmg_mpi_reduce(const phgmg_mpi_ctx *ctx, const phgmg_mp
     rc = phgmg__mpi_sp_blocks(ctx, model, ns, X, ldx, r, o.method == PHGMG_METHOD_SP2, b, b + (size_t)r * r,
                               b + 2 * (size_t)r * r, b + 2 * (size_t)r * r + (size_t)r * m, Vb, Wb);
   else
-    rc = phgmg__mpi_gmg_pod(ctx, &lin, ns, X, ldx, r, b, b + (size_t)r * r, b + 2 * (size_t)r * r,
+    rc = phgmg__mpi_gmg_pod(ctx, &lin, ns, X, ldx, r, xalg, b, b + (size_t)r * r, b + 2 * (size_t)r * r,
                             b + 2 * (size_t)r * r + (size_t)r * m, Vb);
   /* the separable terms (4b), then the training envelope */
   if (rc == PHGMG_OK) rc = phgmg__mpi_sep_terms(ctx, model, &o, ns, X, ldx, Vb, r, wd, NULL, &d, &resid);
@@ -29076,6 +29228,7 @@ PHGMG_DEF phgmg_result phgmg_mpi_reduce(const phgmg_mpi_ctx *ctx, const phgmg_mp
   phgmg__free(&ctx->al, (void *)d.w);
   phgmg__free(&ctx->al, b);
   phgmg__free(&ctx->al, Bp);
+  phgmg__free(&ctx->al, xalg);
   return rc;
 }
 
@@ -30653,6 +30806,13 @@ PHGMG_DEF phgmg_result phgmg_sym_eig(int n, double *A, int lda, double *w, doubl
    0.12.0 (2026-11-29)
           - phgmg_mpi_rom.rn, .M, .V2: GMG-QM's lift (M replicated, V2 this
             rank's rows).
+          - phgmg_mpi_reduce and phgmg_mpi_gmg_pod_linear: index-one mass
+            matrices (algebraic constraints: zero rows and as many zero
+            columns, anywhere among the ranks) reduce by GMG-POD as the
+            serial reduction of the condensed model, nothing condensed
+            (the dd block of (J - R)^{-1}); the zero columns found by one
+            neighbour exchange. phgmg-mpi --E-coo takes them (index checked
+            as the serial command checks it).
           - phgmg-mpi: --method gmg-qm with --manifold pod|greedy, --rn and
             a fixed --lambda; it writes the serial command's files (the
             quadratic blocks, V2, M). An output path equal to the --E-coo

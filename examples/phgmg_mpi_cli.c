@@ -60,11 +60,17 @@ static const char *const help_text[] = {
   "OPTIONS (those of `phgmg reduce`, with the same meaning)\n"
   "  --J-coo FILE, --R-coo FILE, --Q-coo FILE   J, R, Q as (nnz, 3) .npy arrays of\n"
   "                      (row, col, value) triplets, 0-based, duplicates summed.\n"
-  "  --E-coo FILE        a mass matrix E of full rank, (nnz, 3) triplets: the\n"
-  "                      descriptor model E x' = (J - R) z + B u, E^T z = grad H\n"
-  "                      (E^T Q symmetric; E's rows at the terms' coordinates positive\n"
-  "                      multiples of unit rows); gmg-pod only. Its solves use the\n"
-  "                      library's sparse LU of E, replicated as that of J - R.\n"
+  "  --E-coo FILE        a mass matrix E, (nnz, 3) triplets: the descriptor model\n"
+  "                      E x' = (J - R) z + B u, E^T z = grad H (E^T Q symmetric; E's\n"
+  "                      rows at the terms' coordinates positive multiples of unit\n"
+  "                      rows); gmg-pod only. E of full rank, or of index one: zero\n"
+  "                      rows (algebraic equations) and as many zero columns\n"
+  "                      (algebraic variables), no port on a zero row; the model is\n"
+  "                      then checked as the serial command checks it (index one)\n"
+  "                      and reduced as the serial command reduces it (the condensed\n"
+  "                      model; V0's rows at the algebraic variables are zero). Its\n"
+  "                      solves use the library's sparse LU of E, replicated as that\n"
+  "                      of J - R.\n"
   "  --B FILE            N x m port matrix, or a vector of length N for m = 1 (N is\n"
   "                      taken from B).\n"
   "  --X FILE            the snapshots, N x ns (one state per column). Every rank reads\n"
@@ -155,7 +161,7 @@ static const char *const help_text[] = {
   "NOT SUPPORTED HERE (each is refused with a message naming it)\n"
   "  --simulate (give the snapshots with --X; make them with the serial\n"
   "  `phgmg simulate ... --states X.npy`), dense --J/--R/--Q/--E, a mass matrix\n"
-  "  with zero rows (algebraic constraints) or with sp1/sp2, springs\n"
+  "  with sp1, sp2 or gmg-qm, a port on an algebraic equation, springs\n"
   "  (--poly-jdx), dampers, feedthrough, --ref, gmg-qm's --lambda auto or cv,\n"
   "  --rn wide and --manifold altmin, balancing, several --X files, method or\n"
   "  order lists, and every\n"
@@ -198,6 +204,9 @@ typedef struct solver {
   double rcond;
   double *full, *work;           /* N each */
   const dist *d;
+  unsigned char *calg;           /* the solver of E: its zero columns (N; nalg of them), else NULL */
+  int nalg;
+  double rcond_c;                /* with algebraic lines: rcond of the condensed model's J - R */
 } solver;
 
 static int g_rank = 0;
@@ -840,39 +849,104 @@ static phgmg_result solver_create(const dist *d, solver *s) {
   return rc;
 }
 
+/* E's algebraic lines from its triplets: *k zero rows (the algebraic
+   equations) and as many zero columns (the algebraic variables, marked in
+   calg, N entries); PHGMG_ERR_E_SINGULAR if the counts differ,
+   PHGMG_ERR_UNSUPPORTED for a port on a zero row (its condensation is a
+   feedthrough). */
+static phgmg_result e_lines(const dist *d, unsigned char *calg, int *k) {
+  unsigned char *rnz = (unsigned char *)calloc((size_t)d->N + 1, 1);
+  int i, kc = 0, port = 0;
+  long q;
+  if (!rnz) return PHGMG_ERR_NOMEM;
+  memset(calg, 1, (size_t)d->N);
+  for (q = 0; q < d->nE; ++q)
+    if (d->TE[2 * d->nE + q] != 0.0) { rnz[(int)d->TE[q]] = 1; calg[(int)d->TE[d->nE + q]] = 0; }
+  *k = 0;
+  for (i = 0; i < d->N; ++i) {
+    int j;
+    *k += !rnz[i]; kc += calg[i];
+    for (j = 0; !rnz[i] && j < d->m; ++j) port += d->Bfull[i + (size_t)j * d->N] != 0.0;
+  }
+  free(rnz);
+  return *k != kc ? PHGMG_ERR_E_SINGULAR : port ? PHGMG_ERR_UNSUPPORTED : PHGMG_OK;   /* a port on a constraint */
+}
+
+/* An index-one E: the serial checks of the whole model (J, R, Q, E, B:
+   phgmg_ph_validate on the sparse model, which checks the index and E^T Q's
+   symmetry), replicated like the solver; *rcond that of the condensed
+   model's J - R (the serial record's rcond_jr). */
+static phgmg_result e_index_check(const dist *d, double *rcond) {
+  phgmg_csc J, R, Q, E;
+  phgmg_ph_sparse *sp = NULL;
+  phgmg_dae *dae = NULL;
+  phgmg_result rc;
+  memset(&J, 0, sizeof J); memset(&R, 0, sizeof R); memset(&Q, 0, sizeof Q); memset(&E, 0, sizeof E);
+  rc = triplets_csc(d->N, d->TJ, d->nJ, &J);
+  if (rc == PHGMG_OK) rc = triplets_csc(d->N, d->TR, d->nR, &R);
+  if (rc == PHGMG_OK) rc = triplets_csc(d->N, d->TQ, d->nQ, &Q);
+  if (rc == PHGMG_OK) rc = triplets_csc(d->N, d->TE, d->nE, &E);
+  if (rc == PHGMG_OK) rc = phgmg_ph_sparse_create_e(&sp, d->N, d->m, &J, &R, &Q, &E, d->Bfull, NULL, NULL, NULL);
+  if (rc == PHGMG_OK) rc = phgmg_ph_validate(phgmg_ph_sparse_system(sp), 1e-12, NULL, NULL);
+  if (rc == PHGMG_OK) rc = phgmg_dae_create(&dae, phgmg_ph_sparse_system(sp), 0.0, NULL);
+  if (rc == PHGMG_OK) rc = phgmg_ph_validate(phgmg_dae_system(dae), 0.0, rcond, NULL);
+  phgmg_dae_destroy(dae);
+  phgmg_ph_sparse_destroy(sp);
+  phgmg_csc_free(&J, NULL); phgmg_csc_free(&R, NULL); phgmg_csc_free(&Q, NULL); phgmg_csc_free(&E, NULL);
+  return rc;
+}
+
 /* The replicated solver of the mass matrix (--E-coo): E joins J, R and
    (here) Q = I in a sparse model, whose factor of E (phgmg_e_factor_create)
-   solve_replicated then applies. A row of E without a non-zero (an
-   algebraic constraint) is refused first: PHGMG_ERR_E_SINGULAR. */
+   solve_replicated then applies. With algebraic lines (s->nalg zero rows
+   and columns, s->calg marking the columns) the model is first checked as
+   the serial command checks it (index one), and E is completed by a 1
+   pairing the i-th zero row with the i-th zero column: a nonsingular
+   matrix whose solve, on a right-hand side zero in the zero rows, gives
+   E_dd's solution and zero algebraic variables (the library's solve_E). */
 static phgmg_result solver_e_create(const dist *d, solver *s) {
   phgmg_csc J, R, I, E;
   phgmg_result rc;
-  int *idx = (int *)malloc(sizeof(int) * (size_t)d->N), i;
-  double *ones = (double *)malloc(sizeof(double) * (size_t)d->N);
-  char *nz = (char *)calloc((size_t)d->N + 1, 1);
-  long k;
+  int *idx = (int *)malloc(sizeof(int) * (size_t)d->N), i, ia = 0, ic = 0;
+  double *ones = (double *)malloc(sizeof(double) * (size_t)d->N), *T = NULL;
+  long k, n;
   memset(s, 0, sizeof *s);
   memset(&J, 0, sizeof J); memset(&R, 0, sizeof R); memset(&I, 0, sizeof I); memset(&E, 0, sizeof E);
   s->d = d;
   s->full = (double *)malloc(sizeof(double) * 2 * (size_t)d->N);
-  rc = idx && ones && nz && s->full ? PHGMG_OK : PHGMG_ERR_NOMEM;
-  for (k = 0; rc == PHGMG_OK && k < d->nE; ++k)
-    if (d->TE[2 * d->nE + k] != 0.0) nz[(int)d->TE[k]] = 1;
-  for (i = 0; rc == PHGMG_OK && i < d->N; ++i)
-    if (!nz[i]) rc = PHGMG_ERR_E_SINGULAR;
+  s->calg = (unsigned char *)malloc((size_t)d->N + 1);
+  rc = idx && ones && s->full && s->calg ? PHGMG_OK : PHGMG_ERR_NOMEM;
+  if (rc == PHGMG_OK) rc = e_lines(d, s->calg, &s->nalg);
+  if (rc == PHGMG_OK && s->nalg) rc = e_index_check(d, &s->rcond_c);
+  n = d->nE + s->nalg;
+  if (rc == PHGMG_OK && !(T = (double *)malloc(sizeof(double) * 3 * (size_t)n))) rc = PHGMG_ERR_NOMEM;
+  if (rc == PHGMG_OK) {   /* E's triplets, then the pairs (a_i, c_i, 1) */
+    unsigned char *rz = (unsigned char *)calloc((size_t)d->N + 1, 1);
+    for (k = 0; rz && k < d->nE; ++k) {
+      T[k] = d->TE[k]; T[n + k] = d->TE[d->nE + k]; T[2 * n + k] = d->TE[2 * d->nE + k];
+      if (d->TE[2 * d->nE + k] != 0.0) rz[(int)d->TE[k]] = 1;
+    }
+    for (k = d->nE; rz && k < n; ++k, ++ia, ++ic) {
+      while (rz[ia]) ++ia;
+      while (!s->calg[ic]) ++ic;
+      T[k] = ia; T[n + k] = ic; T[2 * n + k] = 1.0;
+    }
+    if (!rz) rc = PHGMG_ERR_NOMEM;
+    free(rz);
+  }
   if (rc == PHGMG_OK) {
     s->work = s->full + d->N;
     for (i = 0; i < d->N; ++i) { idx[i] = i; ones[i] = 1.0; }
     rc = triplets_csc(d->N, d->TJ, d->nJ, &J);
   }
   if (rc == PHGMG_OK) rc = triplets_csc(d->N, d->TR, d->nR, &R);
-  if (rc == PHGMG_OK) rc = triplets_csc(d->N, d->TE, d->nE, &E);
+  if (rc == PHGMG_OK) rc = triplets_csc(d->N, T, n, &E);
   if (rc == PHGMG_OK) rc = phgmg_csc_from_coo(&I, d->N, d->N, d->N, idx, idx, ones, NULL);
   if (rc == PHGMG_OK) rc = phgmg_ph_sparse_create_e(&s->sp, d->N, d->m, &J, &R, &I, &E, d->Bfull, NULL, NULL, NULL);
   if (rc == PHGMG_OK) rc = phgmg_e_factor_create(&s->f, phgmg_ph_sparse_system(s->sp), &s->rcond, NULL);
   if (rc == PHGMG_ERR_SINGULAR) rc = PHGMG_ERR_E_SINGULAR;   /* the message names E, not J - R */
   phgmg_csc_free(&J, NULL); phgmg_csc_free(&R, NULL); phgmg_csc_free(&I, NULL); phgmg_csc_free(&E, NULL);
-  free(idx); free(ones); free(nz);
+  free(idx); free(ones); free(T);
   return rc;
 }
 
@@ -880,6 +954,7 @@ static void solver_free(solver *s) {
   phgmg_jr_factor_destroy(s->f);
   phgmg_ph_sparse_destroy(s->sp);
   free(s->full);
+  free(s->calg);
 }
 
 /* The solve callback: each column of X (this rank's rows) gathered to every
@@ -910,6 +985,7 @@ typedef struct result {
   phgmg_mpi_rom mr;
   double *V0;                    /* this rank's rows (nloc x r) */
   double sigma_ratio, rcond_jr, seconds;
+  int nalg;                      /* E's algebraic lines (zero rows and columns) */
 } result;
 
 /* sigma_{p+1} / sigma_1 of what the method PODs (the serial info's
@@ -934,6 +1010,8 @@ static phgmg_result sigma_ratio(const phgmg_mpi_ctx *ctx, const dist *d, const a
     for (j = 0; rc == PHGMG_OK && j < m && d->nloc > 0; ++j)
       memcpy(Bp + (size_t)j * ld, d->Bl + (size_t)j * ld, sizeof(double) * (size_t)d->nloc);
     if (rc == PHGMG_OK && se) rc = phgmg_mpi_agree(MPI_COMM_WORLD, solve_replicated('N', m, Bp, ld, se));
+    for (i = 0; rc == PHGMG_OK && se && se->calg && i < d->nloc; ++i)   /* E_dd^{-1} B: 0 at the algebraic variables */
+      for (j = 0; se->calg[d->row0 + i] && j < m; ++j) Bp[i + (size_t)j * ld] = 0.0;
     if (rc == PHGMG_OK) rc = phgmg_mpi_tsqr(ctx, m, Bp, ld, QB, ld, C, m);
     free(Bp);
     if (rc == PHGMG_OK) rc = phgmg_mpi_atb(ctx, m, ns, QB, ld, Xa, ld, C, m);
@@ -945,11 +1023,15 @@ static phgmg_result sigma_ratio(const phgmg_mpi_ctx *ctx, const dist *d, const a
         Xa[i + (size_t)j * ld] -= s;
       }
   }
+  for (i = 0; rc == PHGMG_OK && gmg && se && se->calg && i < d->nloc; ++i)   /* the differential part only */
+    for (j = 0; se->calg[d->row0 + i] && j < ns; ++j) Xa[i + (size_t)j * ld] = 0.0;
   if (rc == PHGMG_OK && kmax > p) rc = phgmg_mpi_pod(ctx, ns, Xa, ld, kmax, 0.0, V, ld, S, &k);
   if (rc == PHGMG_OK && k > p && S[0] > 0.0) *ratio = S[p] / S[0];
   free(Xa);
   return rc;
 }
+
+static int res_nalg_ = 0;   /* explain: the model's algebraic lines */
 
 /* The message of a failed reduction. */
 static void explain(const args *a, const dist *d, phgmg_result rc) {
@@ -972,8 +1054,13 @@ static void explain(const args *a, const dist *d, phgmg_result rc) {
     say("--E-coo %s: %s (E's row at a nonlinear term's coordinate must be a positive multiple of the unit row)",
         a->E, phgmg_result_string(rc));
   else if (rc == PHGMG_ERR_E_SINGULAR)
-    say("--E-coo %s: %s (phgmg-mpi takes a mass matrix of full rank; algebraic constraints -- zero rows of E -- "
-        "reduce with the serial `phgmg reduce`)", a->E, phgmg_result_string(rc));
+    say("--E-coo %s: %s (phgmg-mpi takes a mass matrix of full rank, or one of index one: as many zero rows as "
+        "zero columns, the rest nonsingular)", a->E, phgmg_result_string(rc));
+  else if ((rc == PHGMG_ERR_INDEX || rc == PHGMG_ERR_PENCIL || rc == PHGMG_ERR_EQ_NOT_SYMMETRIC) && a->E)
+    say("--E-coo %s: %s", a->E, phgmg_result_string(rc));
+  else if (rc == PHGMG_ERR_UNSUPPORTED && res_nalg_ > 0)
+    say("--B %s: a port on an algebraic equation (a zero row of --E-coo %s) becomes a feedthrough when the "
+        "constraints are condensed, which phgmg-mpi does not take: use the serial `phgmg reduce`", a->B, a->E);
   else if (rc == PHGMG_ERR_NEGATIVE_WEIGHT)
     say("%s: %s (use --deim-allow-negative, a smaller --deim-tol, or --hyper ecsw)", meth, phgmg_result_string(rc));
   else if (rc == PHGMG_ERR_NOT_CONVERGED && a->poly_idx)
@@ -1014,15 +1101,16 @@ static int reduce(const args *a, dist *d, result *res) {
   memset(&md, 0, sizeof md);
   t0 = MPI_Wtime();
   if (rc == PHGMG_OK) rc = make_op(ctx, d, d->TQ, d->nQ, 1.0, NULL, 0, 0.0, &Qop);
-  phgmg_npy_free(d->TQ, NULL);   /* Q lives in its operator now */
-  d->TQ = NULL;
   if (rc == PHGMG_OK && (a->method == PHGMG_METHOD_SP1 || a->method == PHGMG_METHOD_SP2))   /* J - R as an operator */
     rc = make_op(ctx, d, d->TJ, d->nJ, 1.0, d->TR, d->nR, -1.0, &JRop);
   if (rc == PHGMG_OK) rc = phgmg_mpi_agree(MPI_COMM_WORLD, solver_create(d, &sv));
   if (rc == PHGMG_OK && a->E) {   /* the mass matrix: its rows as an operator, its replicated solver */
     rc = make_op(ctx, d, d->TE, d->nE, 1.0, NULL, 0, 0.0, &Eop);
     if (rc == PHGMG_OK) rc = phgmg_mpi_agree(MPI_COMM_WORLD, solver_e_create(d, &svE));
+    res->nalg = svE.nalg;
   }
+  phgmg_npy_free(d->TQ, NULL);   /* Q lives in its operator now */
+  d->TQ = NULL;
   phgmg_npy_free(d->TE, NULL);
   d->TE = NULL;
   phgmg_npy_free(d->TJ, NULL); phgmg_npy_free(d->TR, NULL); phgmg_npy_free(d->Bfull, NULL);
@@ -1056,7 +1144,8 @@ static int reduce(const args *a, dist *d, result *res) {
     rc = phgmg_mpi_reduce(ctx, &md, d->ns, d->Xl, ld, &o, &res->mr, res->V0, ld);
   }
   res->seconds = MPI_Wtime() - t0;
-  res->rcond_jr = sv.rcond;
+  res_nalg_ = res->nalg;
+  res->rcond_jr = svE.nalg ? svE.rcond_c : sv.rcond;   /* the serial record's: the condensed model's */
   if (rc == PHGMG_OK) rc = sigma_ratio(ctx, d, a, Eop ? &svE : NULL, &res->sigma_ratio);
   if (rc != PHGMG_OK) explain(a, d, rc);
   solver_free(&sv);
@@ -1344,10 +1433,10 @@ static int write_json(const args *a, const dist *d, const result *res) {
   json_str(f, a->name);
   fprintf(f, ",\n  \"method\": \"%s\",\n  \"kind\": \"%s\",\n  \"map\": \"%s\",\n", method_name(a->method),
           a->poly_idx ? "nonlinear" : "linear", qm ? "quadratic" : "linear");
-  fprintf(f, "  \"N\": %d, \"m\": %d, \"r\": %d, \"rn\": %d, \"nd\": %d, \"poly_deg\": %d,\n", d->N, d->m, a->r,
-          res->mr.rn, nd, nd ? rom->poly_deg : 0);
-  fprintf(f, "  \"E\": %s, \"N_full\": %d, \"algebraic\": 0, \"feedthrough\": false,\n  \"dt_map\": 0,\n",
-          a->E ? "true" : "false", d->N);
+  fprintf(f, "  \"N\": %d, \"m\": %d, \"r\": %d, \"rn\": %d, \"nd\": %d, \"poly_deg\": %d,\n", d->N - res->nalg,
+          d->m, a->r, res->mr.rn, nd, nd ? rom->poly_deg : 0);
+  fprintf(f, "  \"E\": %s, \"N_full\": %d, \"algebraic\": %d, \"feedthrough\": false,\n  \"dt_map\": 0,\n",
+          a->E ? "true" : "false", d->N, res->nalg);
   json_system(f, a);
   fprintf(f, "  \"snapshots\": {\"count\": %d, \"file\": ", d->ns); json_str(f, a->X);
   if (a->have_dt) { fprintf(f, ", \"dt\": "); json_num(f, a->dt); }
@@ -1418,10 +1507,13 @@ static int write_outputs(const args *a, const dist *d, result *res) {
   if (!bad && d->rank == 0) bad = write_model(a, res) || write_json(a, d, res) || parts_commit(a);
   if (bad && d->rank == 0) parts_remove(a);
   if (any_rank(bad)) return 1;
-  if (d->rank == 0 && !a->quiet)
-    printf("wrote %s/%s.phgmgrom, %s/%s.c, %s/%s.json and %d arrays %s/%s_*.npy (%s, r = %d, m = %d, N = %d, "
+  if (d->rank == 0 && !a->quiet) {
+    char dif[64] = "";
+    if (res->nalg) snprintf(dif, sizeof dif, ", of which %d differential", d->N - res->nalg);
+    printf("wrote %s/%s.phgmgrom, %s/%s.c, %s/%s.json and %d arrays %s/%s_*.npy (%s, r = %d, m = %d, N = %d%s, "
            "%d rank%s)\n", a->out, a->name, a->out, a->name, a->out, a->name, g_narr, a->out, a->name,
-           method_name(a->method), a->r, d->m, d->N, d->size, d->size > 1 ? "s" : "");
+           method_name(a->method), a->r, d->m, d->N, dif, d->size, d->size > 1 ? "s" : "");
+  }
   return 0;
 }
 

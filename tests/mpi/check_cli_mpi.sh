@@ -32,7 +32,10 @@
 # same checks. A mass matrix (--E-coo: 1.25 on the positions, a
 # consistent-mass pattern on the momenta; its own 201 snapshots from the
 # serial simulate) with the cosh terms, gmg-pod at P = 2: the same
-# checks, and the json's "E". GMG-QM with a fixed --lambda 1e-3: the
+# checks, and the json's "E". An index-one RLC grid (bench/rlc_grid.py,
+# 8 x 8 mains: N = 288, 144 algebraic lines; rows and states scrambled by
+# different permutations) with gmg-pod at P = 2, 3: the same checks and
+# the json's N (the differential count), N_full and algebraic. GMG-QM with a fixed --lambda 1e-3: the
 # linear chain with the POD manifold and --rn 4 at P = 1, 3, the cosh chain
 # with the greedy manifold (default rn, ECSW) at P = 2, 4: besides the
 # above, every block of the quadratic model (G00, G01, G10, G11, Q01, Q11,
@@ -42,8 +45,11 @@
 # status (each rank's status recorded by a wrapper), one message, within the
 # timeout (no rank left waiting in a collective); snapshots of the wrong
 # shape, --simulate and options of the serial reduce that the distributed
-# build does not take (--ref, springs --poly-jdx, dense --E, a mass matrix with a zero row), DEIM options without --hyper qdeim/greedy and negative DEIM weights without --deim-allow-negative are refused
-# with a message naming them.
+# build does not take (--ref, springs --poly-jdx, dense --E), a mass matrix
+# whose zero row and column make an index-two pencil, a port on an
+# algebraic equation, DEIM options without --hyper qdeim/greedy and negative
+# DEIM weights without --deim-allow-negative are refused with a message
+# naming them.
 #   sh tests/mpi/check_cli_mpi.sh SERIAL_PHGMG PHGMG_MPI     (make test-mpi)
 # MPIRUN overrides the launcher (default: mpirun --oversubscribe --mca
 # mpi_yield_when_idle 1, plus
@@ -95,9 +101,17 @@ PYEOF
 "$PHGMG" simulate $M $NL --dt 0.1 --steps 200 --out "$D/y_full_nl.npy" --states "$D/X_nl.npy" --quiet > /dev/null
 "$PHGMG" simulate $M $PT --dt 0.1 --steps 200 --out "$D/y_full_pt.npy" --states "$D/X_pt.npy" --quiet > /dev/null
 "$PHGMG" simulate $M --E-coo "$D/E.npy" $NL --dt 0.1 --steps 200 --out "$D/y_full_e.npy" --states "$D/X_e.npy" --quiet > /dev/null
+# an index-one RLC grid (bench/rlc_grid.py: 8 x 8 mains, N = 288, 144 algebraic lines, rows and states
+# scrambled by different permutations: the zero rows and zero columns of E are different index sets)
+$PY bench/rlc_grid.py "$D/rlc" --n 8 --steps 200 > /dev/null
+$PY bench/rlc_grid.py "$D/rlcp" --n 8 --steps 200 --port-on-constraint > /dev/null
+MR="--J-coo $D/rlc/J.npy --R-coo $D/rlc/R.npy --Q-coo $D/rlc/Q.npy --E-coo $D/rlc/E.npy --B $D/rlc/B.npy"
+"$PHGMG" simulate $MR --dt 0.02 --steps 200 --input "$D/rlc/chirp.npy" --out "$D/y_full_rlc.npy" --states "$D/X_rlc.npy" --quiet > /dev/null
 # case: linear (gmg-pod, sp1), cosh (cosh-gmg-pod, cosh-sp1), per-term functions without hyper-reduction
 # (terms-sp1), cosh with DEIM (qdeim-gmg-pod, greedy-sp2), cosh with a mass matrix (mass-gmg-pod)
-for case in gmg-pod sp1 cosh-gmg-pod cosh-sp1 terms-sp1 qdeim-gmg-pod greedy-sp2 mass-gmg-pod qmpod-gmg-qm qmgreedy-gmg-qm; do
+for case in gmg-pod sp1 cosh-gmg-pod cosh-sp1 terms-sp1 qdeim-gmg-pod greedy-sp2 mass-gmg-pod qmpod-gmg-qm qmgreedy-gmg-qm \
+            rlc-gmg-pod; do
+  model=$M
   ps="1 2 3 4"
   case $case in
     cosh-*) meth=${case#cosh-}; X="$D/X_nl.npy"; opt=$NL ;;
@@ -106,16 +120,18 @@ for case in gmg-pod sp1 cosh-gmg-pod cosh-sp1 terms-sp1 qdeim-gmg-pod greedy-sp2
     terms-*) meth=${case#terms-}; X="$D/X_pt.npy"; opt="$PT --no-hyper"; ps=3 ;;
     qmpod-*) meth=gmg-qm; X="$D/X.npy"; opt="--manifold pod --rn 4 --lambda 1e-3" ;;
     qmgreedy-*) meth=gmg-qm; X="$D/X_nl.npy"; opt="$NL --manifold greedy --lambda 1e-3" ;;
+    rlc-*) meth=gmg-pod; X="$D/X_rlc.npy"; opt=""; model=$MR ;;
     *) meth=$case; X="$D/X.npy"; opt="" ;;
   esac
   case $case in   # every P over the two cases of a method (the library's layer is checked at each P by test_mpi_nl)
     gmg-pod) ps="1 3" ;; sp1) ps="2 4" ;; cosh-gmg-pod) ps="2 4" ;; cosh-sp1) ps="1 3" ;;
     qdeim-*) ps="3" ;; greedy-*) ps="4" ;; mass-*) ps="2" ;; qmpod-*) ps="1 3" ;; qmgreedy-*) ps="2 4" ;;
+    rlc-*) ps="2 3" ;;
   esac
-  "$PHGMG" reduce $M $opt --X "$X" --method $meth --r 10 --out "$D/serial_$case" --quiet > /dev/null
+  "$PHGMG" reduce $model $opt --X "$X" --method $meth --r 10 --out "$D/serial_$case" --quiet > /dev/null
   "$PHGMG" simulate-rom --model "$D/serial_$case/rom.phgmgrom" --dt 0.1 --steps 300 --out "$D/y_serial_$case.npy" --quiet > /dev/null
   for p in $ps; do
-    timeout 120 $MPIRUN -np $p "$PMPI" reduce $M $opt --X "$X" --method $meth --r 10 --out "$D/p${p}_$case" --quiet
+    timeout 120 $MPIRUN -np $p "$PMPI" reduce $model $opt --X "$X" --method $meth --r 10 --out "$D/p${p}_$case" --quiet
     "$PHGMG" simulate-rom --model "$D/p${p}_$case/rom.phgmgrom" --dt 0.1 --steps 300 --out "$D/y_p${p}_$case.npy" --quiet > /dev/null
   done
 done
@@ -151,7 +167,12 @@ refused "--ref: not supported by the distributed build" --X "$D/X.npy" --ref mea
 refused "--poly-jdx: springs" --X "$D/X_nl.npy" $NL --poly-jdx "$D/idx.npy"
 refused "--deim-tol, --deim-max and --deim-allow-negative apply to --hyper qdeim or greedy" --X "$D/X_nl.npy" $NL --deim-tol 1e-4
 refused "use --deim-allow-negative" --X "$D/X_nl.npy" $NL --hyper greedy --deim-tol 1e-4
-refused "algebraic constraints -- zero rows of E" --X "$D/X_e.npy" $NL --E-coo "$D/E0.npy"
+refused "--E-coo $D/E0.npy: the descriptor model has index two" --X "$D/X_e.npy" $NL --E-coo "$D/E0.npy"
+if timeout 60 $MPIRUN -np 3 "$PMPI" reduce --J-coo "$D/rlcp/J.npy" --R-coo "$D/rlcp/R.npy" --Q-coo "$D/rlcp/Q.npy" \
+     --E-coo "$D/rlcp/E.npy" --B "$D/rlcp/B.npy" --X "$D/X_rlc.npy" --method gmg-pod --r 10 --out "$D/bad" \
+     > /dev/null 2> "$D/err.txt" || ! grep -q "a port on an algebraic equation" "$D/err.txt" || [ -e "$D/bad" ]; then
+  echo "check_cli_mpi: FAILED: a port on a constraint was not refused by name"; cat "$D/err.txt"; exit 1
+fi
 refused "--E: dense matrices are not read" --X "$D/X_e.npy" --E "$D/E.npy"
 refused "gmg-qm needs a fixed --lambda" --X "$D/X.npy" --method gmg-qm
 refused "--lambda auto: phgmg-mpi takes a fixed ridge parameter" --X "$D/X.npy" --method gmg-qm --lambda auto
@@ -165,7 +186,7 @@ if timeout 60 $MPIRUN -np 2 "$PMPI" reduce $M --E-coo "$D/clash/rom_V0.npy" --X 
    ! cmp -s "$D/E.npy" "$D/clash/rom_V0.npy" || [ -e "$D/clash/rom.json" ]; then
   echo "check_cli_mpi: FAILED: an output that is the --E-coo file was not refused, or the file changed"; cat "$D/err.txt"; exit 1
 fi
-echo "check_cli_mpi: wrong snapshot shape, --simulate, --ref, --poly-jdx, DEIM options without DEIM, negative DEIM weights, a mass matrix with a zero row, dense --E, gmg-qm without a fixed --lambda, --lambda auto, --rn wide, --manifold altmin, --lambda with gmg-pod refused with messages naming them; an output on the --E-coo file refused, the file unchanged"
+echo "check_cli_mpi: wrong snapshot shape, --simulate, --ref, --poly-jdx, DEIM options without DEIM, negative DEIM weights, an index-two mass matrix, a port on a constraint, dense --E, gmg-qm without a fixed --lambda, --lambda auto, --rn wide, --manifold altmin, --lambda with gmg-pod refused with messages naming them; an output on the --E-coo file refused, the file unchanged"
 
 $PY - "$D" <<'PYEOF'
 import json
@@ -187,7 +208,7 @@ def coords(P0, V0):
 
 bad = 0
 for case in ('gmg-pod', 'sp1', 'cosh-gmg-pod', 'cosh-sp1', 'terms-sp1', 'qdeim-gmg-pod', 'greedy-sp2', 'mass-gmg-pod',
-             'qmpod-gmg-qm', 'qmgreedy-gmg-qm'):
+             'qmpod-gmg-qm', 'qmgreedy-gmg-qm', 'rlc-gmg-pod'):
     nl = case.startswith(('cosh-', 'terms-', 'qdeim-', 'greedy-', 'mass-', 'qmgreedy-'))
     qm = case.endswith('gmg-qm')
     names = (('Qh', 'Bh', 'V0', 'G00', 'G01', 'G10', 'G11', 'Q01', 'Q11', 'Ms', 'V2', 'M') if qm else
@@ -208,11 +229,12 @@ for case in ('gmg-pod', 'sp1', 'cosh-gmg-pod', 'cosh-sp1', 'terms-sp1', 'qdeim-g
         bad = 1
     for p in {'gmg-pod': (1, 3), 'sp1': (2, 4), 'cosh-gmg-pod': (2, 4), 'cosh-sp1': (1, 3), 'terms-sp1': (3,),
               'qdeim-gmg-pod': (3,), 'greedy-sp2': (4,), 'mass-gmg-pod': (2,), 'qmpod-gmg-qm': (1, 3),
-              'qmgreedy-gmg-qm': (2, 4)}[case]:
+              'qmgreedy-gmg-qm': (2, 4), 'rlc-gmg-pod': (2, 3)}[case]:
         pd = '%s/p%d_%s' % (d, p, case)
         files_ok = sorted(os.listdir(pd)) == sorted(os.listdir(sd))
         pj = json.load(open(pd + '/rom.json'))
-        keys_ok = all(pj[k] == sj[k] for k in ('method', 'N', 'm', 'r', 'rn', 'kind', 'map', 'nd', 'poly_deg', 'E')) and \
+        keys_ok = all(pj[k] == sj[k] for k in ('method', 'N', 'N_full', 'algebraic', 'm', 'r', 'rn', 'kind', 'map', 'nd',
+                                               'poly_deg', 'E')) and \
             pj['snapshots']['count'] == sj['snapshots']['count'] and pj['files'] == sj['files'] and \
             pj['options'] == sj['options'] and \
             all(pj['system'].get(k) == sj['system'].get(k) for k in ('potential', 'poly', 'exp', 'poly_idx', 'poly_w', 'E'))

@@ -1134,6 +1134,111 @@ static void test_descriptor(void) {
   free(E); free(X); free(x0); free(V0); free(V0f);
 }
 
+/* An index-one descriptor model (manual 1.8): the chain with a diagonal
+   mass E(l_i, l_i) = 1 + 0.3 sin(i) on the positions and a consistent-mass
+   pattern on the velocities (2/3 + 0.1 sin(2i) on the diagonal, 1/6
+   between neighbours), except that every fifth velocity v_i (i = 3 mod 5)
+   is massless: a zero row and column of E, an algebraic line (its damping
+   0.3 makes L_aa = -0.3 I: index one). The lines' equations couple
+   neighbouring positions, and E's neighbour entries cross the ranks' row
+   blocks. The distributed GMG-POD with ECSW (E and E_dd^{-1} through the
+   user's solve) against the serial reduction of the condensed model
+   (phgmg_dae_create, snapshots restricted, phgmg_reduce): the basis's rows
+   at the algebraic variables exactly zero, K, Qh, Bh, the points, weights
+   and outputs as compare_serial. A port on an algebraic equation:
+   PHGMG_ERR_UNSUPPORTED; a zero row of E whose column is not zero:
+   PHGMG_ERR_E_SINGULAR; on every rank. */
+static void test_algebraic(void) {
+  const int n = 600, N = 2 * n, ns = 101, r = 12, kb = 3, ld = 2 * kb + 1;
+  chain ch, chd;
+  dist d;
+  double *X = (double *)malloc(sizeof(double) * (size_t)N * ns), *x0 = (double *)calloc((size_t)N, sizeof(double));
+  double *E = (double *)calloc((size_t)ld * N, sizeof(double)), *Ef = (double *)calloc((size_t)ld * N, sizeof(double));
+  double *V0, *V0f;
+  phgmg_mpi_op *Eop;
+  phgmg_ph_system sf;
+  phgmg_reduce_opts o;
+  phgmg_mpi_rom mr;
+  phgmg_result rc;
+  int i, nalg = 0;
+  chain_build(&ch, n, 0);
+#define AT(A, r, s) (A)[(size_t)(kb + (r) - (s)) + (size_t)(s) * ld]
+#define ALG(i) ((i) % 5 == 3)
+  for (i = 0; i < n; ++i) {
+    const int l = 2 * i, v = 2 * i + 1;
+    AT(E, l, l) = 1.0 + 0.3 * sin((double)i);
+    if (ALG(i)) { ++nalg; continue; }
+    AT(E, v, v) = 2.0 / 3.0 + 0.1 * sin(2.0 * i);
+    if (i + 1 < n && !ALG(i + 1)) { AT(E, v, v + 2) = 1.0 / 6.0; AT(E, v + 2, v) = 1.0 / 6.0; }
+  }
+  memcpy(Ef, E, sizeof(double) * (size_t)ld * N);   /* E_dd's solve: 1 on the algebraic lines' diagonal */
+  for (i = 0; i < n; ++i)
+    if (ALG(i)) AT(Ef, 2 * i + 1, 2 * i + 1) = 1.0;
+  ch.sys.E = E;
+  for (i = 0; i < n; ++i) x0[2 * i] = 0.8 * sin(3.0 * 3.14159265358979 * i / n) + 0.3 * sin(7.0 * 3.14159265358979 * i / n);
+  simulate_root(&ch, x0, 0.2, ns, X);
+  memset(&o, 0, sizeof o);
+  o.method = PHGMG_METHOD_GMG_POD; o.r = r; o.hyper.on = 1; o.hyper.kind = PHGMG_HYPER_ECSW; o.hyper.tol = 1e-3;
+  dist_build(&d, &ch, ns, X);
+  Eop = band_op(d.c, &ch, E, NULL, 0.0);
+  sf = ch.sys; sf.E = Ef;
+  esv_.c = d.c; esv_.fail_rank = -1;
+  CHECK(phgmg__e_factor(&sf, &esv_.f, NULL, NULL) == PHGMG_OK, "E_dd factor");
+  d.md.lin.E = Eop; d.md.lin.solve_E = solve_e_cb;
+  V0 = (double *)malloc(sizeof(double) * (size_t)d.ld * r);
+  rc = phgmg_mpi_reduce(d.c, &d.md, ns, d.Xl, d.ld, &o, &mr, V0, d.ld);
+  CHECK(rc == PHGMG_OK && same_everywhere(mr.nd) && mr.nd > 0, "distributed GMG-POD, index-one E: %d", (int)rc);
+  V0f = gather_v0(d.c, r, V0, d.ld);
+  if (rank_ == 0 && rc == PHGMG_OK) {
+    phgmg_dae *dae = NULL;
+    phgmg_reduced *red = NULL;
+    int nd, j, zero = 1;
+    double ktol = 1e-12, ytol = 1e-10, *Xd, *V0d, *x0d;
+    CHECK(phgmg_dae_create(&dae, &ch.sys, 0.0, NULL) == PHGMG_OK && phgmg_dae_nalg(dae) == nalg, "serial condensation");
+    nd = N - nalg;
+    Xd = (double *)malloc(sizeof(double) * (size_t)nd * ns);
+    V0d = (double *)malloc(sizeof(double) * (size_t)nd * r);
+    x0d = (double *)malloc(sizeof(double) * (size_t)nd);
+    for (j = 0; dae && j < ns; ++j) phgmg_dae_restrict(dae, X + (size_t)j * N, Xd + (size_t)j * nd);
+    for (j = 0; dae && j < r; ++j) phgmg_dae_restrict(dae, V0f + (size_t)j * N, V0d + (size_t)j * nd);
+    for (j = 0; j < r; ++j)
+      for (i = 0; i < n; ++i) zero &= !ALG(i) || V0f[2 * i + 1 + (size_t)j * N] == 0.0;
+    CHECK(zero, "index-one E: the basis's rows at the algebraic variables are not zero");
+    if (dae) phgmg_dae_restrict(dae, x0, x0d);
+    chd = ch; chd.N = nd;   /* the condensed model (idx: the terms' full coordinates, as mr.coord) */
+    if (dae) chd.sys = *phgmg_dae_system(dae);
+    CHECK(dae && phgmg_reduce(&red, &chd.sys, Xd, nd, ns, &o, NULL, NULL) == PHGMG_OK, "serial reduce, condensed");
+    if (red) serial_sensitivity(&chd, ns, Xd, x0d, &o, red, &ktol, &ytol);
+    if (red) compare_serial(&chd, ns, Xd, x0d, red, &mr, V0d, 200, ktol, ytol, "gmg-pod ecsw, index-one E");
+    phgmg_reduced_destroy(red);
+    phgmg_dae_destroy(dae);
+    free(Xd); free(V0d); free(x0d);
+  }
+  quiet_barrier();
+  phgmg_mpi_rom_free(&mr);
+  {   /* a port on an algebraic equation (v_3's row, owned by one rank) */
+    const long long at = 2 * 3 + 1;
+    double keep = 0.0;
+    if (at >= d.c->row0 && at < d.c->row0 + d.c->nloc) { keep = d.Bl[at - d.c->row0]; d.Bl[at - d.c->row0] = 0.5; }
+    rc = phgmg_mpi_reduce(d.c, &d.md, ns, d.Xl, d.ld, &o, &mr, NULL, 0);
+    CHECK(rc == PHGMG_ERR_UNSUPPORTED && same_everywhere(rc) && mr.mem_ == NULL, "port on a constraint: %d", (int)rc);
+    if (at >= d.c->row0 && at < d.c->row0 + d.c->nloc) d.Bl[at - d.c->row0] = keep;
+  }
+  phgmg_mpi_op_destroy(Eop);   /* E(v_4, v_3) != 0: v_3's row zero, its column not */
+  AT(E, 2 * 4 + 1, 2 * 3 + 1) = 0.05;
+  Eop = band_op(d.c, &ch, E, NULL, 0.0);
+  d.md.lin.E = Eop;
+  rc = phgmg_mpi_reduce(d.c, &d.md, ns, d.Xl, d.ld, &o, &mr, NULL, 0);
+  CHECK(rc == PHGMG_ERR_E_SINGULAR && same_everywhere(rc) && mr.mem_ == NULL, "zero row, nonzero column: %d", (int)rc);
+#undef ALG
+#undef AT
+  phgmg_mpi_op_destroy(Eop);
+  phgmg_jr_factor_destroy(esv_.f);
+  dist_free(&d);
+  chain_free(&ch);
+  free(E); free(Ef); free(X); free(x0); free(V0); free(V0f);
+}
+
 static void test_memory(void) {
   const long long N = 100000, NB = 10000;
   double one[2] = {0.0, 0.0}, gp, g1, t0 = MPI_Wtime();
@@ -1174,6 +1279,7 @@ int main(int argc, char **argv) {
     test_screened();
     test_gmg_qm(300, 8);
     test_descriptor();
+    test_algebraic();
     test_errors();
     test_memory();
   }
