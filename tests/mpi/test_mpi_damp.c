@@ -11,7 +11,8 @@
    the reduced models' outputs against the serial ones; the test catches a
    Cd that misses the cross-rank half of the dampers; the error codes of an
    energy-generating law, of dampers with GMG-QM and of duplicate damper
-   numbers, alike on every rank. Rank 0 runs the serial reductions and
+   numbers, alike on every rank; the number of collectives the dampers add,
+   the same at two sizes N. Rank 0 runs the serial reductions and
    compares (the distributed results are replicated). Exit status 0 iff
    every check passed on every rank. */
 #define _POSIX_C_SOURCE 199309L   /* nanosleep */
@@ -491,6 +492,52 @@ static void test_errors(int n) {
   chain_free(&ch);
 }
 
+/* The dampers' communication: the collectives phgmg_mpi_reduce makes with
+   the dampers less those it makes without them (GMG-POD and SP1, no
+   hyper-reduction), for chains of n and 2 n masses: the same count (the
+   rows of other ranks come in a fixed number of all-to-all exchanges,
+   whatever N). */
+static long long damper_collectives(int n, phgmg_method method) {
+  const int N = 2 * n, ns = 31;
+  chain ch;
+  dist d;
+  double *X = (double *)malloc(sizeof(double) * (size_t)N * ns), *x0 = (double *)calloc((size_t)N, sizeof(double));
+  phgmg_reduce_opts o;
+  phgmg_mpi_rom mr;
+  phgmg_mpi_counts c[2];
+  int i, pass;
+  chain_build(&ch, n);
+  for (i = 0; i < n; ++i) x0[2 * i] = 0.5 * sin(2.0 * 3.14159265358979 * i / n);
+  simulate_root(&ch, x0, 0.2, ns, X);
+  dist_build(&d, &ch, ns, X);
+  memset(&o, 0, sizeof o);
+  o.method = method; o.r = 8;
+  for (pass = 0; pass < 2; ++pass) {
+    phgmg_mpi_sep_model md = d.md;
+    if (pass) md.ndamp = 0;
+    phgmg_mpi_counts_reset(d.c);
+    CHECK(phgmg_mpi_reduce(d.c, &md, ns, d.Xl, d.ld, &o, &mr, NULL, 0) == PHGMG_OK, "counts: reduce, pass %d", pass);
+    phgmg_mpi_counts_get(d.c, &c[pass]);
+    phgmg_mpi_rom_free(&mr);
+  }
+  free(X); free(x0);
+  dist_free(&d);
+  chain_free(&ch);
+  return c[0].collectives - c[1].collectives;
+}
+
+static void test_counts(void) {
+  int mi;
+  for (mi = 0; mi < 2; ++mi) {
+    const phgmg_method me = mi ? PHGMG_METHOD_SP1 : PHGMG_METHOD_GMG_POD;
+    const long long a = damper_collectives(100, me), b = damper_collectives(200, me);
+    CHECK(a > 0 && a == b, "%s: the dampers' collectives %lld at N = 200, %lld at N = 400", mi ? "sp1" : "gmg-pod", a, b);
+    if (rank_ == 0)
+      printf("  counts: the dampers add %lld collectives to %s at N = 200 and %lld at N = 400\n", a,
+             mi ? "sp1" : "gmg-pod", b);
+  }
+}
+
 int main(int argc, char **argv) {
   int total = 0;
   double t0;
@@ -501,6 +548,7 @@ int main(int argc, char **argv) {
   if (rank_ == 0) printf("test_mpi_damp: P = %d\n", size_);
   test_methods(500, 10);
   test_errors(60);
+  test_counts();
   MPI_Allreduce(&fails_, &total, 1, MPI_INT, MPI_SUM, MPI_COMM_WORLD);
   if (rank_ == 0)
     printf("test_mpi_damp: P = %d: %s (%d failed checks, %.2f s)\n", size_, total ? "FAILED" : "passed", total,
