@@ -243,8 +243,8 @@
    quadrature h sum_i b_i s_ik rho_k(s_ik) with that of R (phgmg_energy.D,
    energy_inc[1]). For a non-quadratic H it holds up to the error of the
    Gauss rule on H(p(t))'.
-   Reduction (GMG-POD, SP1, SP2; GMG-QM and your manifold are
-   PHGMG_ERR_UNSUPPORTED). With the co-state test basis W_z of 1.6 (E = I:
+   Reduction (GMG-POD, SP1, SP2, also distributed by phgmg_mpi_reduce,
+   2.7; GMG-QM and your manifold are PHGMG_ERR_UNSUPPORTED). With the co-state test basis W_z of 1.6 (E = I:
    W_z = W) the reduced model replaces the co-state by z^ = W_z grad Hr(xr):
        xr' = W_z^T (J - R) z^ - W_z^T r(z^) + Bh u
            = K grad Hr - sum_k Cd_k rho_k(Cd_k^T grad Hr) + Bh u,
@@ -752,7 +752,8 @@
                             terms held by the ranks that own their
                             coordinates) with ECSW or DEIM (Q-DEIM, greedy)
                             hyper-reduction (GMG-QM:
-                            the POD and greedy manifolds with a narrow V2):
+                            the POD and greedy manifolds with a narrow V2),
+                            and nonlinear dampers (GMG-POD, SP1, SP2):
                             the serial phgmg_reduce's
                             phgmg_rom, replicated, the kept terms as global
                             indices (phgmg_mpi_rom_free)
@@ -927,10 +928,11 @@
    Not yet distributed: GMG-QM with a wide V2, ALTMIN or a chosen lambda;
    GMG_MANIFOLD; cached DEIM points
    (opts.cache), separable terms by callbacks and GENERAL nonlinear
-   Hamiltonians, a reference state (opts.ref), dampers, feedthrough,
-   algebraic constraints (singular E), and a mass matrix with SP1, SP2 or
-   GMG-QM; in the command line (below) also simulating the training runs
-   and mass matrices.
+   Hamiltonians, a reference state (opts.ref), feedthrough, algebraic
+   constraints (singular E), a mass matrix with SP1, SP2 or GMG-QM,
+   dampers with a mass matrix or with GMG-QM, dampers with callback laws
+   or a law per damper; in the command line (below) also simulating the
+   training runs, mass matrices and dampers.
    Mass matrices. A descriptor model E x' = (J - R) z + B u (manual 1.6, E
    of full rank) reduces by GMG-POD: phgmg_mpi_linear_model.E (the rows of
    E as a distributed operator) and solve_E (the user's collective solve
@@ -947,6 +949,42 @@
    1e-15, the same 56 ECSW points, weights within 3e-14, K within 8.3e-12
    and the outputs within 6.5e-12 -- the serial model itself moves K by
    3.7e-12 when the snapshots change by one ulp (cond G00).
+   Nonlinear dampers (1.7). phgmg_mpi_sep_model.ndamp, damp_i, damp_j,
+   damp_id, damp_deg, damp_poly: each rank passes the dampers whose first
+   index i is one of its rows, the second j anywhere (a row of another
+   rank too) or none, with global damper numbers and the serial model's
+   polynomial law, the same on every rank (PHGMG_ERR_DAMPER for one that
+   generates energy, on every rank). GMG-POD, SP1 and SP2 without a mass
+   matrix; with E or GMG-QM: PHGMG_ERR_UNSUPPORTED on every rank. With
+   dampers the solve callback solves with J - R - L, L = sum_k rho'(0) c_k
+   c_k^T, as the serial GMG's G = (J - R - L)^{-1} (JR, for SP1 and SP2,
+   stays J - R). The serial stage on distributed data: the co-state test
+   basis W_z (GMG: G^T V0 K^T by r solves with trans 'T'; SP1, SP2: W) on
+   each rank's rows; Cd_k = W_z(i_k, :) - W_z(j_k, :) by the rank that owns
+   i_k, the rows j_k of other ranks fetched in one exchange (one
+   MPI_Alltoall of counts, two MPI_Alltoallv: the indices, the rows), the
+   columns gathered to every rank (one MPI_Allgatherv) and put in the
+   order of the damper numbers; GMG's K += sum_k rho'(0) Cd_k Cd_k^T in
+   that order (the sum rounds alike for every partition). With hyper.on
+   ECSW over the dampers as the serial (the training forces rho(s_k) at the
+   snapshots, s_k = c_k^T z(x_j), the co-states at rows of other ranks
+   fetched in the same exchange; the fit of the separable terms, ties to
+   the lower damper number, so the kept set does not depend on the
+   partition); without it every damper is kept with weight 1. The result
+   is the serial phgmg_rom's dampers: rom.ndamp, Cd, dw, dpoly and dterm
+   (the kept dampers' numbers). The dampers add a fixed number of
+   collectives, whatever N (17 for GMG-POD, 16 for SP1, without ECSW). On a chain of 500 masses (N = 1000, 81 snapshots, r = 10) with
+   1007 cubic dampers between neighbouring and next-neighbouring velocities
+   (some across every rank boundary, either way round) and 20 cosh terms
+   (tests/mpi/test_mpi_damp.c) at 1-4 ranks, against the serial
+   phgmg_reduce: K, Qh and Bh within 9e-14 relative (after the modes'
+   signs), Cd within 2e-13, with ECSW at hyper.tol 1e-3 the same 90
+   (GMG-POD), 99 (SP1) and 94 (SP2) dampers with weights within 1.5e-13,
+   the reduced outputs over 200 steps within 1e-13; a Cd that leaves out
+   the other rank's half of the cross-boundary dampers is off by 0.09 to
+   0.9. Dampers that duplicate each other (the same pair twice, c and
+   -c) give ECSW equal columns: which of them it keeps is then decided by
+   rounding, in the serial reduction too.
    A PETSc + MUMPS example. examples/petsc_mumps.c puts a real distributed
    direct solver behind the solve callback: it reads the command line's
    files (J, R, Q as (nnz, 3) triplets, B, the snapshots X), each rank
@@ -5529,6 +5567,13 @@ typedef struct phgmg_mpi_rom {
    hyper.allow_negative; out->deim_negative, out->deim_sigma_ratio as the
    serial info's; the kept terms in the points' order. hyper.on = 0:
    every term kept with its weight (nd = all terms: O(terms) online).
+   Dampers (model->ndamp on some rank; GMG-POD, SP1, SP2 without E, else
+   PHGMG_ERR_UNSUPPORTED; the solve with J - R - L): the serial stage,
+   Cd_k = W_z^T c_k with the rows of other ranks fetched by one exchange,
+   GMG's K += sum_k rho'(0) Cd_k Cd_k^T in damper-number order, with
+   hyper.on ECSW over the dampers at hyper.tol (whatever hyper.kind says,
+   as the serial); out->rom.ndamp, Cd (columns in damper-number order), dw,
+   dpoly and dterm (the kept dampers' numbers).
    GMG_QM: the serial GMG-QM's stages with every N-dimensional product
    distributed: V1 the p = r - m leading POD modes (TSQR) of the adjusted
    snapshots X - QB QB^T X (POD manifold) or the serial greedy choice among
@@ -5547,8 +5592,10 @@ typedef struct phgmg_mpi_rom {
    rank's rows of the basis (the lift x = V0 xr; SP1: V; GMG_QM: [B, V1],
    the lift x = V0 xr + V2 q(xr) with V2 not returned). Errors: those of
    phgmg_mpi_gmg_pod_linear (a failing solve's code on every rank),
-   PHGMG_ERR_INVALID_ARG / _SIZE / _NANINF for bad terms,
-   PHGMG_ERR_NOT_CONVERGED (the ECSW fit misses tol), PHGMG_ERR_UNSUPPORTED.
+   PHGMG_ERR_INVALID_ARG / _SIZE / _NANINF for bad terms or dampers (a
+   damper number twice: _INVALID_ARG), PHGMG_ERR_DAMPER (an
+   energy-generating law), PHGMG_ERR_NOT_CONVERGED (the ECSW fit misses
+   tol), PHGMG_ERR_UNSUPPORTED.
    Collective. */
 PHGMG_DEF phgmg_result phgmg_mpi_reduce(const phgmg_mpi_ctx *ctx, const phgmg_mpi_sep_model *model, int ns,
                                         const double *X, int ldx, const phgmg_reduce_opts *opts,
