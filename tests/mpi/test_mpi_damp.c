@@ -8,7 +8,8 @@
    one-sided dampers and a few cosh terms; snapshots from the serial
    simulation of the full model. GMG-POD, SP1 and SP2, with and without ECSW
    of the dampers: K, Qh, Bh, Cd, the kept dampers and their weights, and
-   the reduced models' outputs against the serial ones; the test catches a
+   the reduced models' outputs against the serial ones; the one-sided
+   dampers alone, given without damp_j and damp_id; the test catches a
    Cd that misses the cross-rank half of the dampers; the error codes of an
    energy-generating law, of dampers with GMG-QM and of duplicate damper
    numbers, alike on every rank; the number of collectives the dampers add,
@@ -362,9 +363,11 @@ static void wrong_cd_control(const chain *ch, const dist *d, const phgmg_reduced
 }
 
 /* Rank 0: the distributed model against the serial one (tolerances 1e-12 on
-   the blocks, the weights and Cd, 1e-10 on the outputs). */
+   the blocks, the weights and Cd, 1e-10 on the outputs). idmap: the
+   distributed number of each serial damper (NULL: the same). */
 static void compare_serial(const chain *ch, const dist *d, const double *x0, const phgmg_reduced *red,
-                           const phgmg_mpi_rom *mr, const double *V0f, const char *tag, int control) {
+                           const phgmg_mpi_rom *mr, const double *V0f, const char *tag, int control,
+                           const int *idmap) {
   const phgmg_rom *ro = phgmg_reduced_rom(red);
   const int r = mr->r, m = mr->m, nd = ro->ndamp;
   double sg[64], e[5] = {0.0, 0.0, 0.0, 0.0, 0.0}, xr[64], xd[64], sw = 0.0;
@@ -375,7 +378,10 @@ static void compare_serial(const chain *ch, const dist *d, const double *x0, con
   e[2] = rel_diff(r, m, mr->Bh, ro->Bh, sg, NULL);
   CHECK(e[0] <= 1e-12 && e[1] <= 1e-12 && e[2] <= 1e-12, "%s: K %.2e, Qh %.2e, Bh %.2e", tag, e[0], e[1], e[2]);
   CHECK(same, "%s: %d dampers kept, serial %d", tag, mr->rom.ndamp, ro->ndamp);
-  for (j = 0; same && j < nd; ++j) same = mr->rom.dterm[j] == (ro->dterm ? ro->dterm[j] : j);
+  for (j = 0; same && j < nd; ++j) {
+    const int t = ro->dterm ? ro->dterm[j] : j;
+    same = mr->rom.dterm[j] == (idmap ? idmap[t] : t);
+  }
   CHECK(same, "%s: the kept dampers differ", tag);
   if (same) {
     for (j = 0; j < nd; ++j) {
@@ -427,13 +433,59 @@ static void test_methods(int n, int r) {
       V0f = gather_v0(d.c, r, V0, d.ld);
       if (rank_ == 0 && rc == PHGMG_OK) {
         CHECK(phgmg_reduce(&red, &ch.sys, X, N, ns, &o, NULL, NULL) == PHGMG_OK, "serial %s", tag);
-        if (red) compare_serial(&ch, &d, x0, red, &mr, V0f, tag, !hy && mi < 2);
+        if (red) compare_serial(&ch, &d, x0, red, &mr, V0f, tag, !hy && mi < 2, NULL);
         phgmg_reduced_destroy(red);
       }
       quiet_barrier();
       free(V0f);
       phgmg_mpi_rom_free(&mr);
     }
+  free(V0); free(X); free(x0);
+  dist_free(&d);
+  chain_free(&ch);
+}
+
+/* One-sided dampers only, given with damp_j and damp_id NULL (the damper
+   numbers are then the state indices): GMG-POD and SP1 with ECSW, against
+   the serial model of the same dampers. */
+static void test_one_sided(int n, int r) {
+  const int N = 2 * n, ns = 61;
+  chain ch;
+  dist d;
+  double *X = (double *)malloc(sizeof(double) * (size_t)N * ns), *x0 = (double *)calloc((size_t)N, sizeof(double));
+  double *V0 = NULL, *V0f;
+  int i, mi, off, nos;
+  chain_build(&ch, n);
+  off = 2 * n - 3; nos = ch.nd - off;
+  memmove(ch.di, ch.di + off, sizeof(int) * (size_t)nos);
+  memmove(ch.dj, ch.dj + off, sizeof(int) * (size_t)nos);
+  ch.nd = ch.sys.ndamp = nos;
+  for (i = 0; i < n; ++i) x0[2 * i] = 0.6 * sin(3.0 * 3.14159265358979 * i / n);
+  simulate_root(&ch, x0, 0.2, ns, X);
+  dist_build(&d, &ch, ns, X);
+  d.md.damp_j = NULL; d.md.damp_id = NULL;
+  V0 = (double *)malloc(sizeof(double) * (size_t)d.ld * r);
+  for (mi = 0; mi < 2; ++mi) {
+    phgmg_reduce_opts o;
+    phgmg_reduced *red = NULL;
+    phgmg_mpi_rom mr;
+    phgmg_result rc;
+    const char *tag = mi ? "sp1 ecsw, e_i" : "gmg-pod ecsw, e_i";
+    memset(&o, 0, sizeof o);
+    o.method = mi ? PHGMG_METHOD_SP1 : PHGMG_METHOD_GMG_POD; o.r = r;
+    o.hyper.on = 1; o.hyper.kind = PHGMG_HYPER_ECSW; o.hyper.tol = 1e-3;
+    rc = phgmg_mpi_reduce(d.c, &d.md, ns, d.Xl, d.ld, &o, &mr, V0, d.ld);
+    CHECK(rc == PHGMG_OK && same_everywhere(mr.rom.ndamp), "distributed %s: %d", tag, (int)rc);
+    V0f = gather_v0(d.c, r, V0, d.ld);
+    if (rank_ == 0 && rc == PHGMG_OK) {
+      CHECK(phgmg_reduce(&red, &ch.sys, X, N, ns, &o, NULL, NULL) == PHGMG_OK, "serial %s", tag);
+      if (red) compare_serial(&ch, &d, x0, red, &mr, V0f, tag, 0, ch.di);
+      phgmg_reduced_destroy(red);
+    }
+    quiet_barrier();
+    free(V0f);
+    phgmg_mpi_rom_free(&mr);
+  }
   free(V0); free(X); free(x0);
   dist_free(&d);
   chain_free(&ch);
@@ -547,6 +599,7 @@ int main(int argc, char **argv) {
   t0 = MPI_Wtime();
   if (rank_ == 0) printf("test_mpi_damp: P = %d\n", size_);
   test_methods(500, 10);
+  test_one_sided(500, 10);
   test_errors(60);
   test_counts();
   MPI_Allreduce(&fails_, &total, 1, MPI_INT, MPI_SUM, MPI_COMM_WORLD);
