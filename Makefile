@@ -87,7 +87,7 @@ test-build: tests/suites.inc
 # ($(BUILD)/mpi/lib.o; they are built with PHGMG_IMPLEMENTATION_ELSEWHERE),
 # except test_mpi_nl and test_mpi_damp, which read the reduced object's
 # internals.
-# About 70 s.
+# About 95 s.
 MPICC  ?= mpicc
 MPICXX ?= mpicxx
 MPIRUN  = mpirun --oversubscribe --mca mpi_yield_when_idle 1 $$(if [ "$$(id -u)" = 0 ]; then echo --allow-run-as-root; fi)
