@@ -73,11 +73,11 @@ test-build: tests/suites.inc
 	  $(BUILD)/export_model_d $(BUILD)/export_model_f
 
 # The distributed layer (PHGMG_MPI; tests/mpi/test_mpi.c, tests/mpi/test_mpi_nl.c,
-# examples/mpi_pod.c; the distributed command line against the serial one,
+# tests/mpi/test_mpi_damp.c, examples/mpi_pod.c; the distributed command line against the serial one,
 # tests/mpi/check_cli_mpi.sh)
 # at 1, 2, 3 and 4 ranks (4: one rank owns no rows; more ranks than cores;
-# test_mpi_nl, the longest, at 1, 3 and 4: the even split of 2 ranks is
-# covered by the others), each run's results compared with the one-rank
+# test_mpi_nl, the longest, and test_mpi_damp at 1, 3 and 4: the even split
+# of 2 ranks is covered by the others), each run's results compared with the one-rank
 # run's; the section's compile
 # checks (C99, float online scalar, C++). Skipped, with a message, without
 # mpicc and mpirun (Debian: openmpi-bin libopenmpi-dev). A deadlock fails
@@ -85,8 +85,9 @@ test-build: tests/suites.inc
 # they wait (mpi_yield_when_idle), so that the jobs beside them keep it. The
 # programs share one compile of the implementation
 # ($(BUILD)/mpi/lib.o; they are built with PHGMG_IMPLEMENTATION_ELSEWHERE),
-# except test_mpi_nl, which reads the reduced object's internals.
-# About 70 s.
+# except test_mpi_nl and test_mpi_damp, which read the reduced object's
+# internals.
+# About 95 s.
 MPICC  ?= mpicc
 MPICXX ?= mpicxx
 MPIRUN  = mpirun --oversubscribe --mca mpi_yield_when_idle 1 $$(if [ "$$(id -u)" = 0 ]; then echo --allow-run-as-root; fi)
@@ -108,6 +109,8 @@ test-mpi:
 	for p in 1 2 3 4; do timeout 120 $(MPIRUN) -np $$p ./$(BUILD)/test_mpi_stream || exit 1; done && \
 	$(MPICC) $(CFLAGS_T) -o $(BUILD)/test_mpi_nl tests/mpi/test_mpi_nl.c $(LDLIBS) && \
 	for p in 1 3 4; do timeout 120 $(MPIRUN) -np $$p ./$(BUILD)/test_mpi_nl $(BUILD)/mpi || exit 1; done && \
+	$(MPICC) $(CFLAGS_T) -o $(BUILD)/test_mpi_damp tests/mpi/test_mpi_damp.c $(LDLIBS) && \
+	for p in 1 3 4; do timeout 120 $(MPIRUN) -np $$p ./$(BUILD)/test_mpi_damp || exit 1; done && \
 	$(MPIRUN) -np 3 ./$(BUILD)/mpi_pod --N 3000 > $(BUILD)/mpi/example.txt && echo "test-mpi: examples/mpi_pod.c runs at 3 ranks" && \
 	$(MPICC) $(CFLAGS_T) -DPHGMG_IMPLEMENTATION_ELSEWHERE -o $(BUILD)/mpi/phgmg-mpi examples/phgmg_mpi_cli.c $(BUILD)/mpi/lib.o $(LDLIBS) && \
 	$(MAKE) --no-print-directory $(BUILD)/phgmg && sh tests/mpi/check_cli_mpi.sh $(BUILD)/phgmg $(BUILD)/mpi/phgmg-mpi

@@ -243,8 +243,8 @@
    quadrature h sum_i b_i s_ik rho_k(s_ik) with that of R (phgmg_energy.D,
    energy_inc[1]). For a non-quadratic H it holds up to the error of the
    Gauss rule on H(p(t))'.
-   Reduction (GMG-POD, SP1, SP2; GMG-QM and your manifold are
-   PHGMG_ERR_UNSUPPORTED). With the co-state test basis W_z of 1.6 (E = I:
+   Reduction (GMG-POD, SP1, SP2, also distributed by phgmg_mpi_reduce,
+   2.7; GMG-QM and your manifold are PHGMG_ERR_UNSUPPORTED). With the co-state test basis W_z of 1.6 (E = I:
    W_z = W) the reduced model replaces the co-state by z^ = W_z grad Hr(xr):
        xr' = W_z^T (J - R) z^ - W_z^T r(z^) + Bh u
            = K grad Hr - sum_k Cd_k rho_k(Cd_k^T grad Hr) + Bh u,
@@ -752,7 +752,8 @@
                             terms held by the ranks that own their
                             coordinates) with ECSW or DEIM (Q-DEIM, greedy)
                             hyper-reduction (GMG-QM:
-                            the POD and greedy manifolds with a narrow V2):
+                            the POD and greedy manifolds with a narrow V2),
+                            and nonlinear dampers (GMG-POD, SP1, SP2):
                             the serial phgmg_reduce's
                             phgmg_rom, replicated, the kept terms as global
                             indices (phgmg_mpi_rom_free)
@@ -927,9 +928,11 @@
    Not yet distributed: GMG-QM with a wide V2, ALTMIN or a chosen lambda;
    GMG_MANIFOLD; cached DEIM points
    (opts.cache), separable terms by callbacks and GENERAL nonlinear
-   Hamiltonians, a reference state (opts.ref), dampers, feedthrough (and
-   so a port on an algebraic equation), and a mass matrix with SP1, SP2 or
-   GMG-QM; in the command line (below) also simulating the training runs.
+   Hamiltonians, a reference state (opts.ref), feedthrough (and so a port
+   on an algebraic equation), a mass matrix with SP1, SP2 or GMG-QM,
+   dampers with a mass matrix or with GMG-QM, dampers with callback laws
+   or a law per damper; in the command line (below) also simulating the
+   training runs and dampers.
    Mass matrices. A descriptor model E x' = (J - R) z + B u (manual 1.6, E
    of full rank) reduces by GMG-POD: phgmg_mpi_linear_model.E (the rows of
    E as a distributed operator) and solve_E (the user's collective solve
@@ -975,6 +978,42 @@
    the same 67 ECSW points, weights within 5e-14, K within 6.5e-13 and the
    outputs within 2e-12 (the serial condensed model moves K by 5.2e-13 and
    its outputs by 1.5e-12 under one-ulp changes of the snapshots).
+   Nonlinear dampers (1.7). phgmg_mpi_sep_model.ndamp, damp_i, damp_j,
+   damp_id, damp_deg, damp_poly: each rank passes the dampers whose first
+   index i is one of its rows, the second j anywhere (a row of another
+   rank too) or none, with global damper numbers and the serial model's
+   polynomial law, the same on every rank (PHGMG_ERR_DAMPER for one that
+   generates energy, on every rank). GMG-POD, SP1 and SP2 without a mass
+   matrix; with E or GMG-QM: PHGMG_ERR_UNSUPPORTED on every rank. With
+   dampers the solve callback solves with J - R - L, L = sum_k rho'(0) c_k
+   c_k^T, as the serial GMG's G = (J - R - L)^{-1} (JR, for SP1 and SP2,
+   stays J - R). The serial stage on distributed data: the co-state test
+   basis W_z (GMG: G^T V0 K^T by r solves with trans 'T'; SP1, SP2: W) on
+   each rank's rows; Cd_k = W_z(i_k, :) - W_z(j_k, :) by the rank that owns
+   i_k, the rows j_k of other ranks fetched in one exchange (one
+   MPI_Alltoall of counts, two MPI_Alltoallv: the indices, the rows), the
+   columns gathered to every rank (one MPI_Allgatherv) and put in the
+   order of the damper numbers; GMG's K += sum_k rho'(0) Cd_k Cd_k^T in
+   that order (the sum rounds alike for every partition). With hyper.on
+   ECSW over the dampers as the serial (the training forces rho(s_k) at the
+   snapshots, s_k = c_k^T z(x_j), the co-states at rows of other ranks
+   fetched in the same exchange; the fit of the separable terms, ties to
+   the lower damper number, so the kept set does not depend on the
+   partition); without it every damper is kept with weight 1. The result
+   is the serial phgmg_rom's dampers: rom.ndamp, Cd, dw, dpoly and dterm
+   (the kept dampers' numbers). The dampers add a fixed number of
+   collectives, whatever N (17 for GMG-POD, 16 for SP1, without ECSW). On a chain of 500 masses (N = 1000, 81 snapshots, r = 10) with
+   1007 cubic dampers between neighbouring and next-neighbouring velocities
+   (some across every rank boundary, either way round) and 20 cosh terms
+   (tests/mpi/test_mpi_damp.c) at 1-4 ranks, against the serial
+   phgmg_reduce: K, Qh and Bh within 9e-14 relative (after the modes'
+   signs), Cd within 2e-13, with ECSW at hyper.tol 1e-3 the same 90
+   (GMG-POD), 99 (SP1) and 94 (SP2) dampers with weights within 1e-13,
+   the reduced outputs over 200 steps within 1e-13; a Cd that leaves out
+   the other rank's half of the cross-boundary dampers is off by 0.09 to
+   0.9. Dampers that duplicate each other (the same pair twice, c and
+   -c) give ECSW equal columns: which of them it keeps is then decided by
+   rounding, in the serial reduction too.
    A PETSc + MUMPS example. examples/petsc_mumps.c puts a real distributed
    direct solver behind the solve callback: it reads the command line's
    files (J, R, Q as (nnz, 3) triplets, B, the snapshots X), each rank
@@ -5503,7 +5542,22 @@ PHGMG_DEF phgmg_result phgmg_mpi_gmg_pod_linear(const phgmg_mpi_ctx *ctx, const 
    expo (2 nexp) the same on every rank; per_term = 1: one per term, row k
    of poly (nsep x (poly_deg + 1), ld poly_deg + 1) and expo (2 nexp per
    term) for this rank's term k. JR: J - R as a distributed operator, for
-   SP1 only (NULL otherwise). */
+   SP1 and SP2 only (NULL otherwise).
+   Nonlinear dampers (manual 1.7; ndamp = 0 on every rank: none):
+   x' = (J - R) z - sum_k c_k rho(c_k^T z) + B u, z = grad H(x),
+   c_k = e_i - e_j (i = damp_i[k], j = damp_j[k]) or e_i (j < 0, or damp_j
+   NULL: every damper of the rank one-sided). Each rank passes the ndamp
+   dampers whose i (a global state index) is one of its rows; j is any
+   global index, a row of another rank too. damp_id: their global damper
+   numbers (distinct over the ranks, ascending on each rank, below 2^31;
+   NULL: damp_i, so that two dampers of a rank with the same i are
+   refused). The law is the serial model's polynomial, one for every
+   damper: rho(s) = sum_{d=1}^{damp_deg} a_d s^d, a = damp_poly (damp_deg +
+   1 entries, constant term first), damp_deg and damp_poly the same on
+   every rank, odd with every a_d >= 0 (PHGMG_ERR_DAMPER otherwise). With
+   dampers lin.solve must solve with J - R - L instead of J - R, L = sum_k
+   rho'(0) c_k c_k^T the dampers' linearisation at rest (the serial GMG's
+   G = (J - R - L)^{-1}); JR stays J - R. */
 typedef struct phgmg_mpi_sep_model {
   phgmg_mpi_linear_model lin;
   const phgmg_mpi_op *JR;
@@ -5512,6 +5566,10 @@ typedef struct phgmg_mpi_sep_model {
   const double *sep_w;
   int poly_deg, nexp, per_term;
   const double *poly, *expo;
+  int ndamp;                                     /* this rank's dampers (0: none)           */
+  const phgmg_gidx *damp_i, *damp_j, *damp_id;   /* ndamp each; damp_j, damp_id may be NULL */
+  int damp_deg;                                  /* the law's degree, 1 .. 15               */
+  const double *damp_poly;                       /* its damp_deg + 1 coefficients           */
 } phgmg_mpi_sep_model;
 
 /* The result of phgmg_mpi_reduce, identical on every rank: rom the online
@@ -5573,6 +5631,13 @@ typedef struct phgmg_mpi_rom {
    hyper.allow_negative; out->deim_negative, out->deim_sigma_ratio as the
    serial info's; the kept terms in the points' order. hyper.on = 0:
    every term kept with its weight (nd = all terms: O(terms) online).
+   Dampers (model->ndamp on some rank; GMG-POD, SP1, SP2 without E, else
+   PHGMG_ERR_UNSUPPORTED; the solve with J - R - L): the serial stage,
+   Cd_k = W_z^T c_k with the rows of other ranks fetched by one exchange,
+   GMG's K += sum_k rho'(0) Cd_k Cd_k^T in damper-number order, with
+   hyper.on ECSW over the dampers at hyper.tol (whatever hyper.kind says,
+   as the serial); out->rom.ndamp, Cd (columns in damper-number order), dw,
+   dpoly and dterm (the kept dampers' numbers).
    GMG_QM: the serial GMG-QM's stages with every N-dimensional product
    distributed: V1 the p = r - m leading POD modes (TSQR) of the adjusted
    snapshots X - QB QB^T X (POD manifold) or the serial greedy choice among
@@ -5592,8 +5657,10 @@ typedef struct phgmg_mpi_rom {
    the lift x = V0 xr + V2 M kron(x2, x2) with this rank's rows of V2 and
    M in out->V2, out->M). Errors: those of
    phgmg_mpi_gmg_pod_linear (a failing solve's code on every rank),
-   PHGMG_ERR_INVALID_ARG / _SIZE / _NANINF for bad terms,
-   PHGMG_ERR_NOT_CONVERGED (the ECSW fit misses tol), PHGMG_ERR_UNSUPPORTED.
+   PHGMG_ERR_INVALID_ARG / _SIZE / _NANINF for bad terms or dampers (a
+   damper number twice: _INVALID_ARG), PHGMG_ERR_DAMPER (an
+   energy-generating law), PHGMG_ERR_NOT_CONVERGED (the ECSW fit misses
+   tol), PHGMG_ERR_UNSUPPORTED.
    Collective. */
 PHGMG_DEF phgmg_result phgmg_mpi_reduce(const phgmg_mpi_ctx *ctx, const phgmg_mpi_sep_model *model, int ns,
                                         const double *X, int ldx, const phgmg_reduce_opts *opts,
@@ -28132,17 +28199,19 @@ PHGMG__PRIV phgmg_result phgmg__mpi_sep_check_local(const phgmg_mpi_ctx *ctx, co
 }
 
 /* The same function family on every rank: poly_deg, nexp, per_term equal
-   and, for a shared function, rank 0's coefficients. Collective. */
+   and, for a shared function, rank 0's coefficients; *damped: whether some
+   rank has dampers. Collective. */
 PHGMG__PRIV phgmg_result phgmg__mpi_sep_check_global(const phgmg_mpi_ctx *ctx, const phgmg_mpi_sep_model *md,
-                                                     phgmg_result rc) {
-  int v[4] = {0, 0, 0, 0}, lo[4], hi[4], i;
+                                                     phgmg_result rc, int *damped) {
+  int v[5] = {0, 0, 0, 0, 0}, lo[5], hi[5], i;
   double c[32 + 1 + 16];
   const int nc = md ? md->poly_deg + 1 : 0, ne = md ? 2 * md->nexp : 0;
-  if (md) { v[0] = md->poly_deg; v[1] = md->nexp; v[2] = md->per_term; }
+  if (md) { v[0] = md->poly_deg; v[1] = md->nexp; v[2] = md->per_term; v[4] = md->ndamp > 0; }
   v[3] = rc;
-  MPI_Allreduce(v, lo, 4, MPI_INT, MPI_MIN, ctx->comm);
-  MPI_Allreduce(v, hi, 4, MPI_INT, MPI_MAX, ctx->comm);
-  phgmg__mpi_count(ctx, 16.0); phgmg__mpi_count(ctx, 16.0);
+  MPI_Allreduce(v, lo, 5, MPI_INT, MPI_MIN, ctx->comm);
+  MPI_Allreduce(v, hi, 5, MPI_INT, MPI_MAX, ctx->comm);
+  phgmg__mpi_count(ctx, 20.0); phgmg__mpi_count(ctx, 20.0);
+  *damped = hi[4];
   if (lo[3] != PHGMG_OK) return (phgmg_result)lo[3];
   for (i = 0; i < 3; ++i) if (lo[i] != hi[i]) rc = PHGMG_ERR_INVALID_ARG;
   if (rc != PHGMG_OK || md->per_term) return phgmg__mpi_agree(ctx, rc);
@@ -28544,6 +28613,11 @@ typedef struct phgmg__mpi_romdata {
   const phgmg_mpi_sep_model *md;
   int deim_neg;                            /* DEIM: negative weights, sigma_{nd+1}/sigma_1 */
   double deim_sratio;
+  int ndamp, damp_deg;                     /* dampers (ndamp = 0: none): Cd (r x ndamp), dw, */
+  const double *Cd, *dw, *dpoly;           /* the law (damp_deg + 1), the kept ones' ids     */
+  const phgmg_gidx *dterm;
+  double *dmem;                            /* (the dampers' stage storage: Cd, dw, dterm)    */
+  phgmg_gidx *dmem_i;
 } phgmg__mpi_romdata;
 
 PHGMG__PRIV void phgmg__mpi_rom_real(phgmg_real *dst, const double *src, size_t n) {
@@ -28556,18 +28630,29 @@ PHGMG__PRIV phgmg_result phgmg__mpi_rom_store(const phgmg_mpi_ctx *ctx, const ph
   const size_t r = (size_t)d->r, m = (size_t)d->m, nd = (size_t)d->nd, nf = (size_t)d->nf;
   const size_t npc = nf * (size_t)d->nc, nex = nf * 2 * (size_t)d->ne, rv = (size_t)d->rv;
   const size_t rn = (size_t)d->rn, p = r - m, nq = rn ? r * r + 2 * r * rn + 2 * rn * rn + r * rn + rn * p * p : 0;
+  const size_t ndm = (size_t)d->ndamp, ndc = ndm ? (size_t)d->damp_deg + 1 : 0;
   const size_t nv = 2 * r * r + r * m + nd * (1 + r) + npc + nex + 2 * r +
-                    (rn ? nq + nd * rn + 1 : 0);   /* what the rom views */
-  double *b = phgmg__dalloc(&ctx->al, nv + (size_t)d->nsv + 2 * nd + (nv * sizeof(phgmg_real)) / sizeof(double) + 1);
-  double *K, *Qh, *Bh, *w, *P0, *po, *ex, *env, *qd, *P1, *qm, *S;
+                    (rn ? nq + nd * rn + 1 : 0) + ndm * (r + 1) + ndc;   /* what the rom views */
+  double *b = phgmg__dalloc(&ctx->al, nv + (size_t)d->nsv + 2 * nd + (nv * sizeof(phgmg_real)) / sizeof(double) + 1 +
+                                          (ndm * sizeof(int)) / sizeof(double) + 1);
+  double *K, *Qh, *Bh, *w, *P0, *po, *ex, *env, *qd, *P1, *qm, *S, *Cd;
   phgmg_gidx *pts, *coord;
   phgmg_real *v;
+  int *dterm;
   size_t j;
   if (!b) return PHGMG_ERR_NOMEM;
   K = b; Qh = K + r * r; Bh = Qh + r * r; w = Bh + r * m; P0 = w + nd; po = P0 + nd * r; ex = po + npc;
-  env = ex + nex; qd = env + 2 * r; P1 = qd + nq; qm = P1 + (rn ? nd * rn : 0); S = qm + (rn ? 1 : 0);
+  env = ex + nex; qd = env + 2 * r; P1 = qd + nq; qm = P1 + (rn ? nd * rn : 0); Cd = qm + (rn ? 1 : 0);
+  S = Cd + ndm * (r + 1) + ndc;   /* Cd, then dw and the law */
   pts = PHGMG__CAST(phgmg_gidx *, PHGMG__CAST(void *, S + d->nsv)); coord = pts + nd;
   v = PHGMG__CAST(phgmg_real *, PHGMG__CAST(void *, coord + nd));
+  dterm = PHGMG__CAST(int *, PHGMG__CAST(void *, v + nv));
+  if (ndm) {
+    memcpy(Cd, d->Cd, ndm * r * sizeof(double));
+    memcpy(Cd + ndm * r, d->dw, ndm * sizeof(double));
+    memcpy(Cd + ndm * (r + 1), d->dpoly, ndc * sizeof(double));
+    for (j = 0; j < ndm; ++j) dterm[j] = (int)d->dterm[j];
+  }
   if (d->K) memcpy(K, d->K, r * r * sizeof(double));
   memcpy(Qh, d->Qh, r * r * sizeof(double));
   if (rn) {
@@ -28610,6 +28695,29 @@ PHGMG__PRIV phgmg_result phgmg__mpi_rom_store(const phgmg_mpi_ctx *ctx, const ph
     out->rom.poly = v + (po - b); out->rom.expo = d->ne ? v + (ex - b) : NULL;
   }
   out->rom.env_lo = v + (env - b); out->rom.env_hi = v + (env - b) + r;
+  if (ndm) {   /* the dampers (phgmg__publish_dampers's) */
+    out->rom.ndamp = d->ndamp; out->rom.damp_deg = d->damp_deg; out->rom.damp_nphi = 1;
+    out->rom.Cd = v + (Cd - b); out->rom.dw = out->rom.Cd + ndm * r; out->rom.dpoly = out->rom.dw + ndm;
+    out->rom.dterm = dterm;
+  }
+  return PHGMG_OK;
+}
+
+/* The co-states at the snapshots on this rank's rows, G (ld x ns): grad
+   H(x_j) = Q x_j + sum_k w_k phi_k'(x_j[i_k]) e_{i_k} (this rank's terms).
+   Collective. */
+PHGMG__PRIV phgmg_result phgmg__mpi_costates(const phgmg_mpi_ctx *ctx, const phgmg_mpi_sep_model *md, int ns,
+                                             const double *X, int ldx, double *G, int ld) {
+  phgmg_ph_system sy;
+  int k, j;
+  const phgmg_result rc = phgmg_mpi_op_apply(md->lin.Q, ns, X, ldx, G, ld);
+  if (rc != PHGMG_OK) return rc;
+  phgmg__mpi_sep_sys(md, &sy);
+  for (k = 0; k < md->nsep; ++k) {
+    const int row = (int)(md->sep_idx[k] - ctx->row0);
+    const double w = md->sep_w ? md->sep_w[k] : 1.0;
+    for (j = 0; j < ns; ++j) G[row + (size_t)j * ld] += w * phgmg__ph_phi(&sy, k, X[row + (size_t)j * ldx], 1);
+  }
   return PHGMG_OK;
 }
 
@@ -28623,19 +28731,12 @@ PHGMG__PRIV phgmg_result phgmg__mpi_sp2_test(const phgmg_mpi_ctx *ctx, const phg
   const int n = ctx->nloc, ld = PHGMG__MAX(1, n);
   const int kk = (int)PHGMG__MIN((phgmg_gidx)PHGMG__MIN(r + 1, ns), ctx->N);
   double *G = phgmg__dalloc(&ctx->al, (size_t)ld * ns + (size_t)ld * kk + (size_t)kk), *U, *sg, f2[2] = {0.0, 0.0};
-  phgmg_ph_system sy;
-  int k = 0, j;
+  int k = 0;
   phgmg_result rc = phgmg__mpi_agree(ctx, G ? PHGMG_OK : PHGMG_ERR_NOMEM);
   if (rc != PHGMG_OK) { phgmg__free(&ctx->al, G); return rc; }
   U = G + (size_t)ld * ns; sg = U + (size_t)ld * kk;
-  rc = phgmg_mpi_op_apply(md->lin.Q, ns, X, ldx, G, ld);
+  rc = phgmg__mpi_costates(ctx, md, ns, X, ldx, G, ld);
   if (rc == PHGMG_OK) {
-    phgmg__mpi_sep_sys(md, &sy);
-    for (k = 0; k < md->nsep; ++k) {
-      const int row = (int)(md->sep_idx[k] - ctx->row0);
-      const double w = md->sep_w ? md->sep_w[k] : 1.0;
-      for (j = 0; j < ns; ++j) G[row + (size_t)j * ld] += w * phgmg__ph_phi(&sy, k, X[row + (size_t)j * ldx], 1);
-    }
     f2[0] = n > 0 ? phgmg_normf(n, ns, G, ld) : 0.0;
     f2[0] *= f2[0];
     phgmg__mpi_sum(ctx, 1, f2, f2 + 1);
@@ -28905,6 +29006,311 @@ PHGMG__PRIV phgmg_result phgmg__mpi_sep_terms(const phgmg_mpi_ctx *ctx, const ph
   return rc;
 }
 
+/* ---- nonlinear dampers (manual 1.7, 2.7) ------------------------------------------ */
+/* Rows q[0 .. nq) of the row-distributed A (this rank's rows, lda, nc
+   columns) into out (nq x nc, ld max(1, nq)): q global rows ascending and
+   distinct, of any rank. One MPI_Alltoall of counts and two MPI_Alltoallv
+   (the indices, then the values), whatever N and nq. Collective. */
+PHGMG__PRIV phgmg_result phgmg__mpi_rows_fetch(const phgmg_mpi_ctx *ctx, int nq, const phgmg_gidx *q, int nc,
+                                               const double *A, int lda, double *out) {
+  const phgmg_allocator *al = &ctx->al;
+  const int P = ctx->size, ldo = PHGMG__MAX(1, nq);
+  int *cr = phgmg__ialloc(al, 8 * (size_t)P), *cs, *dr, *ds, *vr, *vs, *er, *es, i, a;
+  double *rv = phgmg__dalloc(al, (size_t)nq * nc + 1), *sv = NULL, tot = 0.0;
+  phgmg_gidx *sg = NULL;
+  phgmg_result rc = phgmg__mpi_agree(ctx, cr && rv ? PHGMG_OK : PHGMG_ERR_NOMEM);
+  if (rc != PHGMG_OK) { phgmg__free(al, cr); phgmg__free(al, rv); return rc; }
+  cs = cr + P; dr = cs + P; ds = dr + P; vr = ds + P; vs = vr + P; er = vs + P; es = er + P;
+  for (i = 0; i < P; ++i) cr[i] = 0;
+  for (i = 0; i < nq; ++i) cr[phgmg__mpi_owner(ctx, q[i])]++;
+  MPI_Alltoall(cr, 1, MPI_INT, cs, 1, MPI_INT, ctx->comm);
+  phgmg__mpi_count(ctx, (double)sizeof(int) * P);
+  for (i = 0; i < P; ++i) tot += (double)cs[i];
+  if (tot * (double)nc > 2147483647.0) rc = PHGMG_ERR_SIZE;
+  for (i = 0; i < P && rc == PHGMG_OK; ++i) {
+    dr[i] = i ? dr[i - 1] + cr[i - 1] : 0; ds[i] = i ? ds[i - 1] + cs[i - 1] : 0;
+    vr[i] = cr[i] * nc; er[i] = dr[i] * nc; vs[i] = cs[i] * nc; es[i] = ds[i] * nc;
+  }
+  if (rc == PHGMG_OK) {
+    sg = PHGMG__CAST(phgmg_gidx *, phgmg__alloc(al, sizeof(phgmg_gidx) * ((size_t)tot + 1)));
+    sv = phgmg__dalloc(al, (size_t)tot * nc + 1);
+    if (!sg || !sv) rc = PHGMG_ERR_NOMEM;
+  }
+  rc = phgmg__mpi_agree(ctx, rc);
+  if (rc == PHGMG_OK) {
+    MPI_Alltoallv(q, cr, dr, MPI_LONG_LONG, sg, cs, ds, MPI_LONG_LONG, ctx->comm);
+    phgmg__mpi_count(ctx, 8.0 * nq);
+    for (i = 0; i < (int)tot; ++i)
+      for (a = 0; a < nc; ++a) sv[(size_t)i * nc + a] = A[(size_t)(sg[i] - ctx->row0) + (size_t)a * lda];
+    MPI_Alltoallv(sv, vs, es, MPI_DOUBLE, rv, vr, er, MPI_DOUBLE, ctx->comm);
+    phgmg__mpi_count(ctx, 8.0 * nq * nc);
+    for (i = 0; i < nq; ++i)
+      for (a = 0; a < nc; ++a) out[i + (size_t)a * ldo] = rv[(size_t)i * nc + a];
+  }
+  phgmg__free(al, cr); phgmg__free(al, rv); phgmg__free(al, sg); phgmg__free(al, sv);
+  return rc;
+}
+
+/* The dampers of all ranks: ndg, each rank's count and offset in the
+   rank-order list of their global ids (ids), sid the ids ascending and pos[k]
+   the rank-order entry of sid[k]; the law as a phgmg_ph_system of one
+   damper (phgmg__damp_law). */
+typedef struct phgmg__mpi_damp {
+  int ndg, zero;
+  int *cnt, *dsp, *pos;
+  phgmg_gidx *ids, *sid;
+  phgmg_ph_system law;
+} phgmg__mpi_damp;
+
+PHGMG__PRIV void phgmg__mpi_damp_free(const phgmg_mpi_ctx *ctx, phgmg__mpi_damp *dm) {
+  phgmg__free(&ctx->al, dm->cnt);
+  phgmg__free(&ctx->al, dm->ids);
+  phgmg__free(&ctx->al, dm->pos);
+  memset(dm, 0, sizeof *dm);
+}
+
+PHGMG__PRIV phgmg_gidx phgmg__mpi_damp_id(const phgmg_mpi_sep_model *md, int k) {
+  return md->damp_id ? md->damp_id[k] : md->damp_i[k];
+}
+PHGMG__PRIV phgmg_gidx phgmg__mpi_damp_j(const phgmg_mpi_sep_model *md, int k) {
+  return md->damp_j && md->damp_j[k] >= 0 ? md->damp_j[k] : -1;
+}
+
+/* This rank's dampers: i one of its rows, j below N and not i, ids in
+   [0, 2^31) ascending (duplicates: PHGMG_ERR_INVALID_ARG). */
+PHGMG__PRIV phgmg_result phgmg__mpi_damp_local(const phgmg_mpi_ctx *ctx, const phgmg_mpi_sep_model *md) {
+  int k;
+  if (md->ndamp < 0) return PHGMG_ERR_SIZE;
+  if (md->ndamp > 0 && !md->damp_i) return PHGMG_ERR_INVALID_ARG;
+  for (k = 0; k < md->ndamp; ++k) {
+    const phgmg_gidx i = md->damp_i[k], j = phgmg__mpi_damp_j(md, k), id = phgmg__mpi_damp_id(md, k);
+    if (i < ctx->row0 || i >= ctx->row0 + ctx->nloc || j >= ctx->N || j == i || id < 0 || id > 2147483647LL)
+      return PHGMG_ERR_SIZE;
+    if (k > 0 && id <= phgmg__mpi_damp_id(md, k - 1)) return PHGMG_ERR_INVALID_ARG;
+  }
+  return PHGMG_OK;
+}
+
+/* The law: given on every rank, checked as the serial model's (sizes,
+   finite, PHGMG_ERR_DAMPER for one that generates energy), and equal to
+   rank 0's (PHGMG_ERR_INVALID_ARG otherwise). Collective. */
+PHGMG__PRIV phgmg_result phgmg__mpi_damp_law(const phgmg_mpi_ctx *ctx, const phgmg_mpi_sep_model *md,
+                                             phgmg__mpi_damp *dm) {
+  double c[PHGMG__DAMP_DEG_MAX + 2];
+  int e;
+  phgmg_result rc;
+  memset(&dm->law, 0, sizeof dm->law);
+  dm->law.N = 1; dm->law.ndamp = 1; dm->law.damp_i = &dm->zero;
+  dm->law.damp_deg = md->damp_deg; dm->law.damp_poly = md->damp_poly;
+  rc = phgmg__mpi_agree(ctx, md->damp_poly ? phgmg__ph_check_dampers(&dm->law) : PHGMG_ERR_INVALID_ARG);
+  if (rc != PHGMG_OK) return rc;
+  memset(c, 0, sizeof c);
+  c[0] = (double)md->damp_deg;
+  for (e = 0; e <= md->damp_deg; ++e) c[1 + e] = md->damp_poly[e];
+  MPI_Bcast(c, PHGMG__DAMP_DEG_MAX + 2, MPI_DOUBLE, 0, ctx->comm);
+  phgmg__mpi_count(ctx, 8.0 * (PHGMG__DAMP_DEG_MAX + 2));
+  if (c[0] != (double)md->damp_deg) rc = PHGMG_ERR_INVALID_ARG;
+  for (e = 0; rc == PHGMG_OK && e <= md->damp_deg; ++e)
+    if (c[1 + e] != md->damp_poly[e]) rc = PHGMG_ERR_INVALID_ARG;
+  return phgmg__mpi_agree(ctx, rc);
+}
+
+/* The dampers' setup when some rank has dampers: the law, the method (GMG-POD,
+   SP1 or SP2 without a mass matrix; else PHGMG_ERR_UNSUPPORTED), every
+   rank's ids (one MPI_Allgather of counts, one MPI_Allgatherv of ids),
+   duplicates refused (PHGMG_ERR_INVALID_ARG). Collective. */
+PHGMG__PRIV phgmg_result phgmg__mpi_damp_setup(const phgmg_mpi_ctx *ctx, const phgmg_mpi_sep_model *md,
+                                               const phgmg_reduce_opts *o, phgmg__mpi_damp *dm) {
+  const int P = ctx->size, nd = md->ndamp;
+  phgmg_gidx *pr = NULL, *mine = NULL;
+  double tot = 0.0;
+  int q, k;
+  phgmg_result rc = phgmg__mpi_damp_law(ctx, md, dm);
+  if (rc == PHGMG_OK && (md->lin.E || o->method == PHGMG_METHOD_GMG_QM)) rc = PHGMG_ERR_UNSUPPORTED;
+  if (rc == PHGMG_OK) rc = (dm->cnt = phgmg__ialloc(&ctx->al, 2 * (size_t)P)) ? PHGMG_OK : PHGMG_ERR_NOMEM;
+  rc = phgmg__mpi_agree(ctx, rc);
+  if (rc != PHGMG_OK) { phgmg__mpi_damp_free(ctx, dm); return rc; }
+  dm->dsp = dm->cnt + P;
+  MPI_Allgather(&nd, 1, MPI_INT, dm->cnt, 1, MPI_INT, ctx->comm);
+  phgmg__mpi_count(ctx, (double)sizeof(int) * P);
+  for (q = 0; q < P; ++q) { dm->dsp[q] = (int)tot; tot += (double)dm->cnt[q]; }
+  if (tot > 1e8) rc = PHGMG_ERR_SIZE;   /* replicated: the verdict is the same everywhere */
+  if (rc == PHGMG_OK) {
+    dm->ndg = (int)tot;
+    dm->ids = PHGMG__CAST(phgmg_gidx *, phgmg__alloc(&ctx->al, sizeof(phgmg_gidx) * (2 * (size_t)dm->ndg + 1)));
+    dm->pos = phgmg__ialloc(&ctx->al, (size_t)dm->ndg + 1);
+    pr = PHGMG__CAST(phgmg_gidx *, phgmg__alloc(&ctx->al, sizeof(phgmg_gidx) * (2 * (size_t)dm->ndg + 1)));
+    mine = PHGMG__CAST(phgmg_gidx *, phgmg__alloc(&ctx->al, sizeof(phgmg_gidx) * ((size_t)nd + 1)));
+    if (!dm->ids || !dm->pos || !pr || !mine) rc = PHGMG_ERR_NOMEM;
+  }
+  rc = phgmg__mpi_agree(ctx, rc);
+  if (rc == PHGMG_OK) {
+    dm->sid = dm->ids + dm->ndg;
+    for (k = 0; k < nd; ++k) mine[k] = phgmg__mpi_damp_id(md, k);
+    MPI_Allgatherv(mine, nd, MPI_LONG_LONG, dm->ids, dm->cnt, dm->dsp, MPI_LONG_LONG, ctx->comm);
+    phgmg__mpi_count(ctx, 8.0 * dm->ndg);
+    for (k = 0; k < dm->ndg; ++k) { pr[2 * k] = dm->ids[k]; pr[2 * k + 1] = k; }
+    qsort(pr, (size_t)dm->ndg, 2 * sizeof(phgmg_gidx), phgmg__mpi_gidx_cmp);   /* by id */
+    for (k = 0; k < dm->ndg; ++k) {
+      dm->sid[k] = pr[2 * k]; dm->pos[k] = (int)pr[2 * k + 1];
+      if (k > 0 && dm->sid[k] == dm->sid[k - 1]) rc = PHGMG_ERR_INVALID_ARG;   /* the same id on two ranks */
+    }
+  }
+  phgmg__free(&ctx->al, pr); phgmg__free(&ctx->al, mine);
+  if (rc != PHGMG_OK) phgmg__mpi_damp_free(ctx, dm);
+  return rc;
+}
+
+/* Aj (nd x nc, ld max(1, nd)): row j_k of A (this rank's rows, ld x nc) for
+   each of this rank's dampers, 0 for a one-sided one; the rows of other
+   ranks by phgmg__mpi_rows_fetch. Collective. */
+PHGMG__PRIV phgmg_result phgmg__mpi_damp_rows(const phgmg_mpi_ctx *ctx, const phgmg_mpi_sep_model *md,
+                                              const double *A, int ld, int nc, double *Aj) {
+  const int nd = md->ndamp, l1 = PHGMG__MAX(1, nd);
+  phgmg_gidx *q = PHGMG__CAST(phgmg_gidx *, phgmg__alloc(&ctx->al, sizeof(phgmg_gidx) * (size_t)l1));
+  double *R = phgmg__dalloc(&ctx->al, (size_t)l1 * nc);
+  int nq = 0, k, a;
+  phgmg_result rc = q && R ? PHGMG_OK : PHGMG_ERR_NOMEM;
+  if (rc == PHGMG_OK && (double)l1 * nc > 2147483647.0) rc = PHGMG_ERR_SIZE;
+  rc = phgmg__mpi_agree(ctx, rc);
+  for (k = 0; rc == PHGMG_OK && k < nd; ++k) {   /* the rows of other ranks, ascending and distinct */
+    const phgmg_gidx j = phgmg__mpi_damp_j(md, k);
+    if (j >= 0 && (j < ctx->row0 || j >= ctx->row0 + ctx->nloc)) q[nq++] = j;
+  }
+  if (rc == PHGMG_OK && nq > 1) {
+    qsort(q, (size_t)nq, sizeof *q, phgmg__mpi_gidx_cmp);
+    for (k = 1, a = 1; k < nq; ++k)
+      if (q[k] != q[a - 1]) q[a++] = q[k];
+    nq = a;
+  }
+  if (rc == PHGMG_OK) rc = phgmg__mpi_rows_fetch(ctx, nq, q, nc, A, ld, R);
+  for (k = 0; rc == PHGMG_OK && k < nd; ++k) {
+    const phgmg_gidx j = phgmg__mpi_damp_j(md, k);
+    const int loc = j >= ctx->row0 && j < ctx->row0 + ctx->nloc;
+    const phgmg_gidx *f = j < 0 || loc ? NULL
+                        : PHGMG__CAST(const phgmg_gidx *, bsearch(&j, q, (size_t)nq, sizeof *q, phgmg__mpi_gidx_cmp));
+    for (a = 0; a < nc; ++a)
+      Aj[k + (size_t)a * l1] = j < 0 ? 0.0 : loc ? A[(size_t)(j - ctx->row0) + (size_t)a * ld]
+                                                 : R[(size_t)(f - q) + (size_t)a * PHGMG__MAX(1, nq)];
+  }
+  phgmg__free(&ctx->al, q); phgmg__free(&ctx->al, R);
+  return rc;
+}
+
+/* Cd (r x ndg, replicated, columns in id order): this rank's columns
+   Wz(i_k, :) - Wz(j_k, :) (A's first r columns, Aj) gathered by one
+   MPI_Allgatherv. Collective. */
+PHGMG__PRIV phgmg_result phgmg__mpi_damp_cd(const phgmg_mpi_ctx *ctx, const phgmg_mpi_sep_model *md,
+                                            const phgmg__mpi_damp *dm, const double *A, int ld, const double *Aj,
+                                            int r, double *Cd) {
+  const int nd = md->ndamp, l1 = PHGMG__MAX(1, nd), P = ctx->size;
+  double *Cl = phgmg__dalloc(&ctx->al, (size_t)r * l1), *Ca = phgmg__dalloc(&ctx->al, (size_t)r * dm->ndg + 1);
+  int *cr = phgmg__ialloc(&ctx->al, 2 * (size_t)P), k, a;
+  phgmg_result rc = Cl && Ca && cr ? PHGMG_OK : PHGMG_ERR_NOMEM;
+  if (rc == PHGMG_OK && (double)r * dm->ndg > 2147483647.0) rc = PHGMG_ERR_SIZE;
+  rc = phgmg__mpi_agree(ctx, rc);
+  if (rc == PHGMG_OK) {
+    for (k = 0; k < nd; ++k) {
+      const int row = (int)(md->damp_i[k] - ctx->row0);
+      for (a = 0; a < r; ++a) Cl[a + (size_t)k * r] = A[row + (size_t)a * ld] - Aj[k + (size_t)a * l1];
+    }
+    for (k = 0; k < P; ++k) { cr[k] = dm->cnt[k] * r; cr[P + k] = dm->dsp[k] * r; }
+    MPI_Allgatherv(Cl, nd * r, MPI_DOUBLE, Ca, cr, cr + P, MPI_DOUBLE, ctx->comm);
+    phgmg__mpi_count(ctx, 8.0 * r * dm->ndg);
+    for (k = 0; k < dm->ndg; ++k) memcpy(Cd + (size_t)k * r, Ca + (size_t)dm->pos[k] * r, (size_t)r * sizeof(double));
+    if (!phgmg__all_finite(Cd, (size_t)r * dm->ndg)) rc = PHGMG_ERR_NANINF;   /* replicated */
+  }
+  phgmg__free(&ctx->al, Cl); phgmg__free(&ctx->al, Ca); phgmg__free(&ctx->al, cr);
+  return rc;
+}
+
+/* ECSW over the dampers (the serial phgmg__dampers_hyper): this rank's
+   training rows F(k, j) = rho(s_k(x_j)), s_k = z_i - z_j (the co-states: A's
+   and Aj's columns r .. r + ns), rows Cd_k^T, weights 1, the global ids;
+   fitted as the separable terms (phgmg__mpi_sep_ecsw). pts (room ndg): the
+   kept ids ascending, w their weights. Collective. */
+PHGMG__PRIV phgmg_result phgmg__mpi_damp_ecsw(const phgmg_mpi_ctx *ctx, const phgmg_mpi_sep_model *md,
+                                              const phgmg__mpi_damp *dm, double tol, int ns, const double *A,
+                                              int ld, const double *Aj, int r, phgmg_gidx *pts, double *w,
+                                              int *nk, double *resid) {
+  const int nd = md->ndamp, l1 = PHGMG__MAX(1, nd);
+  phgmg__mpi_terms t;
+  double d[2];
+  int k, j, a;
+  phgmg_result rc;
+  memset(&t, 0, sizeof t);
+  t.F = phgmg__dalloc(&ctx->al, (size_t)l1 * (ns + r + 1));
+  t.gid = PHGMG__CAST(phgmg_gidx *, phgmg__alloc(&ctx->al, sizeof(phgmg_gidx) * (size_t)l1));
+  rc = t.F && t.gid ? PHGMG_OK : PHGMG_ERR_NOMEM;
+  t.nl = nd;
+  if (t.F) { t.Vt = t.F + (size_t)l1 * ns; t.sw = t.Vt + (size_t)l1 * r; }
+  for (k = 0; rc == PHGMG_OK && k < nd; ++k) {
+    const int row = (int)(md->damp_i[k] - ctx->row0);
+    for (j = 0; j < ns && rc == PHGMG_OK; ++j) {
+      const double v = A[row + (size_t)(r + j) * ld] - Aj[k + (size_t)(r + j) * l1];
+      phgmg__damp_law(&dm->law, 0, v, d);
+      if (!(v * d[0] >= 0.0)) rc = d[0] != d[0] ? PHGMG_ERR_NANINF : PHGMG_ERR_DAMPER;
+      t.F[k + (size_t)j * nd] = d[0];
+    }
+    for (a = 0; a < r; ++a) t.Vt[k + (size_t)a * nd] = A[row + (size_t)a * ld] - Aj[k + (size_t)a * l1];
+    t.sw[k] = 1.0;
+    t.gid[k] = phgmg__mpi_damp_id(md, k);
+  }
+  rc = phgmg__mpi_agree(ctx, rc);
+  if (rc == PHGMG_OK) rc = phgmg__mpi_sep_ecsw(ctx, &t, ns, r, tol, dm->ndg, pts, w, nk, resid);
+  phgmg__mpi_terms_free(ctx, &t);
+  return rc;
+}
+
+/* The reduced dampers into d (the serial phgmg__stage_dampers): the co-state
+   test basis Wz = W (SP1, SP2: Wb), or for GMG (Wb NULL) Wz = G^T V0 K^T
+   (r solves with trans 'T', G = (J - R - L)^{-1}: the user's solve; Vb the
+   rows of V0) with K += sum_k rho'(0) Cd_k Cd_k^T after, in id order; Cd
+   (phgmg__mpi_damp_cd); with hyper.on the kept dampers and weights of
+   phgmg__mpi_damp_ecsw (the co-states at the snapshots fetched with Wz's
+   rows), else every damper with weight 1. Collective. */
+PHGMG__PRIV phgmg_result phgmg__mpi_dampers(const phgmg_mpi_ctx *ctx, const phgmg_mpi_sep_model *md,
+                                            const phgmg_reduce_opts *o, const phgmg__mpi_damp *dm, int ns,
+                                            const double *X, int ldx, const double *Vb, const double *Wb, int r,
+                                            double *K, phgmg__mpi_romdata *d) {
+  const int n = ctx->nloc, ld = PHGMG__MAX(1, n), hy = o->hyper.on, nc = r + (hy ? ns : 0), ndg = dm->ndg;
+  double *A = phgmg__dalloc(&ctx->al, (size_t)ld * nc + (size_t)PHGMG__MAX(1, md->ndamp) * nc + (size_t)ld * r);
+  double *Aj, *Y, *Cd = phgmg__dalloc(&ctx->al, (size_t)r * ndg + 1), *dw, dd[2], resid = 0.0;
+  phgmg_gidx *pts = PHGMG__CAST(phgmg_gidx *, phgmg__alloc(&ctx->al, sizeof(phgmg_gidx) * ((size_t)ndg + 1)));
+  int k, a, b, nk = ndg;
+  phgmg_result rc;
+  d->dmem = phgmg__dalloc(&ctx->al, (size_t)(r + 1) * ndg + 1);
+  d->dmem_i = pts;
+  rc = phgmg__mpi_agree(ctx, A && Cd && pts && d->dmem ? PHGMG_OK : PHGMG_ERR_NOMEM);
+  if (rc != PHGMG_OK) { phgmg__free(&ctx->al, A); phgmg__free(&ctx->al, Cd); return rc; }
+  Aj = A + (size_t)ld * nc; Y = Aj + (size_t)PHGMG__MAX(1, md->ndamp) * nc; dw = d->dmem + (size_t)r * ndg;
+  if (Wb) memcpy(A, Wb, (size_t)ld * r * sizeof(double));
+  else {   /* GMG: Y = G^T V0, Wz = Y K^T */
+    memcpy(Y, Vb, (size_t)ld * r * sizeof(double));
+    rc = phgmg__mpi_agree(ctx, md->lin.solve('T', r, Y, ld, md->lin.solve_user));
+    if (rc == PHGMG_OK && n > 0) phgmg_gemm('N', 'T', n, r, r, 1.0, Y, ld, K, r, 0.0, A, ld);
+  }
+  if (rc == PHGMG_OK && hy) rc = phgmg__mpi_costates(ctx, md, ns, X, ldx, A + (size_t)ld * r, ld);
+  if (rc == PHGMG_OK) rc = phgmg__mpi_damp_rows(ctx, md, A, ld, nc, Aj);
+  if (rc == PHGMG_OK) rc = phgmg__mpi_damp_cd(ctx, md, dm, A, ld, Aj, r, Cd);
+  phgmg__damp_law(&dm->law, 0, 0.0, dd);
+  for (k = 0; rc == PHGMG_OK && !Wb && k < ndg; ++k)   /* the serial order: dampers by id */
+    for (b = 0; b < r; ++b)
+      for (a = 0; a < r; ++a) K[a + (size_t)b * r] += dd[1] * Cd[a + (size_t)k * r] * Cd[b + (size_t)k * r];
+  if (rc == PHGMG_OK && hy) rc = phgmg__mpi_damp_ecsw(ctx, md, dm, o->hyper.tol, ns, A, ld, Aj, r, pts, dw, &nk, &resid);
+  for (k = 0; rc == PHGMG_OK && k < nk; ++k) {   /* the kept dampers' columns, in id order */
+    const phgmg_gidx *f = hy ? PHGMG__CAST(const phgmg_gidx *, bsearch(pts + k, dm->sid, (size_t)ndg, sizeof *pts,
+                                                                       phgmg__mpi_gidx_cmp))
+                             : dm->sid + k;
+    if (!hy) { pts[k] = dm->sid[k]; dw[k] = 1.0; }
+    memcpy(d->dmem + (size_t)k * r, Cd + (size_t)(f - dm->sid) * r, (size_t)r * sizeof(double));
+  }
+  d->ndamp = rc == PHGMG_OK ? nk : 0; d->damp_deg = md->damp_deg; d->dpoly = md->damp_poly;
+  d->Cd = d->dmem; d->dw = dw; d->dterm = pts;
+  phgmg__free(&ctx->al, A); phgmg__free(&ctx->al, Cd);
+  return rc;
+}
+
 /* ---- distributed GMG-QM (manifold POD or GREEDY, narrow V2) -------------------- */
 /* The distributed GMG-QM's state: the serial pipeline's context and a
    reduced object that hold only small data (the blocks, M, the checks'
@@ -29163,14 +29569,16 @@ PHGMG_DEF phgmg_result phgmg_mpi_reduce(const phgmg_mpi_ctx *ctx, const phgmg_mp
   phgmg_reduce_opts o;
   phgmg__mpi_romdata d;
   phgmg_mpi_linear_model lin;   /* model->lin with the GMG basis's port columns (E^{-1} B with a mass matrix) */
+  phgmg__mpi_damp dm;           /* the dampers of every rank (ndg = 0: none) */
   double *b = NULL, *Vb, *Wb, *Bp = NULL, resid = 0.0;
   unsigned char *xalg = NULL;   /* the algebraic variables of an index-one E (this rank's rows) */
-  int r = 0, m = 0, ld, wd = 0, sp1;
+  int r = 0, m = 0, ld, wd = 0, sp1, damped = 0;
   phgmg_result rc = PHGMG_OK;
   if (!ctx) return PHGMG_ERR_INVALID_ARG;
   if (out) memset(out, 0, sizeof *out);
   ld = PHGMG__MAX(1, ctx->nloc);
   memset(&d, 0, sizeof d);
+  memset(&dm, 0, sizeof dm);
   if (!model || !opts || !out) rc = PHGMG_ERR_INVALID_ARG;
   else if (V0 && !phgmg__mpi_ld_ok(ctx, ldv0)) rc = PHGMG_ERR_SIZE;
   else {
@@ -29179,9 +29587,11 @@ PHGMG_DEF phgmg_result phgmg_mpi_reduce(const phgmg_mpi_ctx *ctx, const phgmg_mp
     if (rc == PHGMG_OK) rc = phgmg__mpi_lin_args(ctx, &model->lin, X, ldx);
     if (rc == PHGMG_OK && model->lin.E && o.method != PHGMG_METHOD_GMG_POD) rc = PHGMG_ERR_UNSUPPORTED;
     if (rc == PHGMG_OK) rc = phgmg__mpi_e_rows(ctx, model);
+    if (rc == PHGMG_OK) rc = phgmg__mpi_damp_local(ctx, model);
     r = o.r; m = model->lin.m;
   }
-  rc = phgmg__mpi_sep_check_global(ctx, model ? model : NULL, rc);
+  rc = phgmg__mpi_sep_check_global(ctx, model ? model : NULL, rc, &damped);
+  if (rc == PHGMG_OK && damped) rc = phgmg__mpi_damp_setup(ctx, model, &o, &dm);   /* collective verdicts */
   sp1 = rc == PHGMG_OK && (o.method == PHGMG_METHOD_SP1 || o.method == PHGMG_METHOD_SP2);   /* SP1 or SP2 */
   if (rc == PHGMG_OK && (m < 1 || (phgmg_gidx)r > ctx->N || (sp1 ? r < 1 || r > ns : r <= m))) rc = PHGMG_ERR_SIZE;
   if (rc == PHGMG_OK && o.method == PHGMG_METHOD_GMG_QM)   /* the quadratic manifold: its own stages */
@@ -29192,7 +29602,10 @@ PHGMG_DEF phgmg_result phgmg_mpi_reduce(const phgmg_mpi_ctx *ctx, const phgmg_mp
     rc = phgmg__mpi_agree(ctx, b ? PHGMG_OK : PHGMG_ERR_NOMEM);
   }
   if (rc == PHGMG_OK) rc = phgmg__mpi_ports(ctx, &model->lin, &lin, &Bp, &xalg);
-  if (rc != PHGMG_OK) { phgmg__free(&ctx->al, b); phgmg__free(&ctx->al, Bp); phgmg__free(&ctx->al, xalg); return rc; }
+  if (rc != PHGMG_OK) {
+    phgmg__free(&ctx->al, b); phgmg__free(&ctx->al, Bp); phgmg__free(&ctx->al, xalg); phgmg__mpi_damp_free(ctx, &dm);
+    return rc;
+  }
   d.r = r; d.m = m; d.K = b; d.Qh = b + (size_t)r * r; d.Bh = d.Qh + (size_t)r * r; d.S = d.Bh + (size_t)r * m;
   d.env = d.S + r; Vb = b + 2 * (size_t)r * r + (size_t)r * m + 3 * (size_t)r;
   Wb = sp1 ? Vb + (size_t)ld * r : NULL;   /* SP1/SP2: W = Vg A^{-1} */
@@ -29206,6 +29619,8 @@ PHGMG_DEF phgmg_result phgmg_mpi_reduce(const phgmg_mpi_ctx *ctx, const phgmg_mp
   else
     rc = phgmg__mpi_gmg_pod(ctx, &lin, ns, X, ldx, r, xalg, b, b + (size_t)r * r, b + 2 * (size_t)r * r,
                             b + 2 * (size_t)r * r + (size_t)r * m, Vb);
+  /* the dampers (manual 1.7): Cd, GMG's K with their linearisation, ECSW */
+  if (rc == PHGMG_OK && dm.ndg > 0) rc = phgmg__mpi_dampers(ctx, model, &o, &dm, ns, X, ldx, Vb, Wb, r, b, &d);
   /* the separable terms (4b), then the training envelope */
   if (rc == PHGMG_OK) rc = phgmg__mpi_sep_terms(ctx, model, &o, ns, X, ldx, Vb, r, wd, NULL, &d, &resid);
   if (rc == PHGMG_OK)
@@ -29226,9 +29641,12 @@ PHGMG_DEF phgmg_result phgmg_mpi_reduce(const phgmg_mpi_ctx *ctx, const phgmg_mp
   phgmg__free(&ctx->al, (void *)d.D);
   phgmg__free(&ctx->al, (void *)d.pts);
   phgmg__free(&ctx->al, (void *)d.w);
+  phgmg__free(&ctx->al, d.dmem);
+  phgmg__free(&ctx->al, d.dmem_i);
   phgmg__free(&ctx->al, b);
   phgmg__free(&ctx->al, Bp);
   phgmg__free(&ctx->al, xalg);
+  phgmg__mpi_damp_free(ctx, &dm);
   return rc;
 }
 
@@ -30804,6 +31222,12 @@ PHGMG_DEF phgmg_result phgmg_sym_eig(int n, double *A, int lda, double *w, doubl
 /*
    REVISION HISTORY
    0.12.0 (2026-11-29)
+          - phgmg_mpi_reduce: nonlinear dampers (phgmg_mpi_sep_model.ndamp,
+            damp_i, damp_j, damp_id, damp_deg, damp_poly) with GMG-POD, SP1
+            and SP2 without a mass matrix: the co-state test basis's rows
+            of the other ranks fetched in one exchange, Cd in the damper
+            numbers' order, GMG's K with the dampers' linearisation, ECSW
+            over the dampers; the solve callback solves with J - R - L.
           - phgmg_mpi_rom.rn, .M, .V2: GMG-QM's lift (M replicated, V2 this
             rank's rows).
           - phgmg_mpi_reduce and phgmg_mpi_gmg_pod_linear: index-one mass
