@@ -1094,13 +1094,13 @@
    so that E's zero rows and zero columns are different index sets;
    --E-coo with zero rows: the model checked as the serial command checks
    it, E's replicated LU completed by a 1 pairing each zero row with a
-   zero column) with gmg-pod at P = 2, 3: K and Qh within 5e-14, V0
+   zero column) with gmg-pod at P = 3: K and Qh within 5e-14, V0
    within 8e-13 (zero at the algebraic variables, as the serial command
    writes it), the outputs within 4e-14, the json's N (the differential
    count), N_full, algebraic and rcond_jr (the condensed model's) the
    serial's; gmg-qm with --lambda 1e-3 (the POD manifold with --rn 4 on the linear
-   chain at P = 1, 3; the greedy manifold, default rn and ECSW on the cosh
-   chain at P = 2, 4): every block of the quadratic model, P1, V2 and M
+   chain at P = 3; the greedy manifold, default rn and ECSW on the cosh
+   chain at P = 4): every block of the quadratic model, P1, V2 and M
    within 2.5e-12, the same 16 points, the outputs within 3.6e-15.
    Measured at N = 2e5 (1001 snapshots, r = 20): bench/README.md.
    2.8 Large sparse linear models (>>lowrank). For a phgmg_ph_sparse model
