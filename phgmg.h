@@ -272,9 +272,10 @@
    such that sum_k dw_k Cd_k rho_k(s_k) matches sum_k Cd_k rho_k(s_k) on the
    training forces, s_k = c_k^T z(x_j) at the snapshots. Non-negative weights
    keep every kept term dissipative, so the hyper-reduced model is
-   port-Hamiltonian too. (The command line does not set it for dampers: its
-   reduced models keep every damper; its hyper-reduction options apply to
-   the separable terms.)
+   port-Hamiltonian too. opts.hyper.keep_dampers = 1 keeps every damper
+   while on = 1 hyper-reduces the separable part: the command line sets it,
+   so its reduced models keep every damper and its hyper-reduction options
+   apply to the separable terms.
    Not for damper models: model files and C export of a model
    with callback laws (PHGMG_ERR_UNSUPPORTED; polynomial laws are saved,
    format version 3, and exported), the step map, the studies' fast path
@@ -1321,6 +1322,9 @@
      hyper.deim_tol       1e-8                 DEIM modes: sigma_k/sigma_1 > tol
      hyper.deim_max       no cap               cap on DEIM modes
      hyper.allow_negative 0                    1: accept negative DEIM weights
+     hyper.keep_dampers   0                    1: keep every damper (on = 1
+                                               then hyper-reduces the
+                                               separable part only)
    cache (phgmg_reduce_cache; 2.3)
      cache.pod_basis/_cols NULL (computed)     cached POD basis
      cache.grad_basis/_cols NULL (computed)    SP2: cached gradient POD basis
@@ -4175,6 +4179,9 @@ typedef struct phgmg_hyper_opts {
   int deim_max;        /* cap on DEIM modes, >= 0 (0: no cap)                            */
   int allow_negative;  /* DEIM: 1 = accept negative weights (info.deim_negative); 0:
                           a negative weight gives PHGMG_ERR_NEGATIVE_WEIGHT              */
+  int keep_dampers;    /* with on = 1: 1 = keep every damper (the separable part alone
+                          is hyper-reduced); 0: the dampers are hyper-reduced too (ECSW,
+                          manual 1.7); else _INVALID_ARG                                  */
 } phgmg_hyper_opts;
 
 /* Results of earlier work reused by a reduction (manual 2.3), each from the
@@ -17991,6 +17998,7 @@ PHGMG__PRIV phgmg_result phgmg__reduce_check(const phgmg_ph_system *sys, const d
   if (o->method == PHGMG_METHOD_GMG_MANIFOLD && (!o->qm.eta || o->qm.rn < 1)) return PHGMG_ERR_INVALID_ARG;
   if (o->qm.rn < PHGMG_RN_WIDE) return PHGMG_ERR_INVALID_ARG;
   if (o->hyper.on != 0 && o->hyper.on != 1) return PHGMG_ERR_INVALID_ARG;
+  if (o->hyper.keep_dampers != 0 && o->hyper.keep_dampers != 1) return PHGMG_ERR_INVALID_ARG;
   if ((int)o->hyper.kind < 0 || (int)o->hyper.kind >= (int)PHGMG_HYPER_COUNT) return PHGMG_ERR_INVALID_ARG;
   if (!(o->hyper.tol >= 0.0 && o->hyper.tol < 1.0)) return PHGMG_ERR_INVALID_ARG;
   if (o->hyper.on && sys->nl == PHGMG_NL_GENERAL) return PHGMG_ERR_UNSUPPORTED;
@@ -19829,7 +19837,7 @@ PHGMG__PRIV phgmg_result phgmg__stage_dampers(phgmg__rctx *c, const double *Wz, 
       for (a = 0; a < r; ++a) red->K[a + (size_t)b * r] += d[1] * ck[a] * ck[b];
   }
   if (!phgmg__all_finite(red->Cd, (size_t)r * nd)) return PHGMG_ERR_NANINF;
-  return c->o->hyper.on ? phgmg__dampers_hyper(c) : PHGMG_OK;
+  return c->o->hyper.on && !c->o->hyper.keep_dampers ? phgmg__dampers_hyper(c) : PHGMG_OK;
 }
 
 PHGMG__PRIV int phgmg__has_feed(const phgmg_ph_system *sys) { return sys->P || sys->S || sys->Nskew; }
@@ -28169,7 +28177,8 @@ PHGMG__PRIV phgmg_result phgmg__mpi_sep_check_local(const phgmg_mpi_ctx *ctx, co
   if ((o->hyper.on != 0 && o->hyper.on != 1) || !(o->hyper.tol > 0.0 && o->hyper.tol < 1.0) ||
       (int)o->hyper.kind < 0 || (int)o->hyper.kind >= (int)PHGMG_HYPER_COUNT ||
       !(o->hyper.deim_tol >= 0.0 && o->hyper.deim_tol < 1.0) || o->hyper.deim_max < 0 ||
-      (o->hyper.allow_negative != 0 && o->hyper.allow_negative != 1) || (md->per_term != 0 && md->per_term != 1))
+      (o->hyper.allow_negative != 0 && o->hyper.allow_negative != 1) || (md->per_term != 0 && md->per_term != 1) ||
+      (o->hyper.keep_dampers != 0 && o->hyper.keep_dampers != 1))
     return PHGMG_ERR_INVALID_ARG;
   if (qm && ((int)o->qm.manifold < 0 || (int)o->qm.manifold >= (int)PHGMG_MANIFOLD_COUNT || o->qm.rn < PHGMG_RN_WIDE ||
              o->qm.lambda != o->qm.lambda))
@@ -29273,7 +29282,8 @@ PHGMG__PRIV phgmg_result phgmg__mpi_dampers(const phgmg_mpi_ctx *ctx, const phgm
                                             const phgmg_reduce_opts *o, const phgmg__mpi_damp *dm, int ns,
                                             const double *X, int ldx, const double *Vb, const double *Wb, int r,
                                             double *K, phgmg__mpi_romdata *d) {
-  const int n = ctx->nloc, ld = PHGMG__MAX(1, n), hy = o->hyper.on, nc = r + (hy ? ns : 0), ndg = dm->ndg;
+  const int n = ctx->nloc, ld = PHGMG__MAX(1, n), hy = o->hyper.on && !o->hyper.keep_dampers;
+  const int nc = r + (hy ? ns : 0), ndg = dm->ndg;
   double *A = phgmg__dalloc(&ctx->al, (size_t)ld * nc + (size_t)PHGMG__MAX(1, md->ndamp) * nc + (size_t)ld * r);
   double *Aj, *Y, *Cd = phgmg__dalloc(&ctx->al, (size_t)r * ndg + 1), *dw, dd[2], resid = 0.0;
   phgmg_gidx *pts = PHGMG__CAST(phgmg_gidx *, phgmg__alloc(&ctx->al, sizeof(phgmg_gidx) * ((size_t)ndg + 1)));
@@ -31237,6 +31247,11 @@ PHGMG_DEF phgmg_result phgmg_sym_eig(int n, double *A, int lda, double *w, doubl
             (the dd block of (J - R)^{-1}); the zero columns found by one
             neighbour exchange. phgmg-mpi --E-coo takes them (index checked
             as the serial command checks it).
+          - phgmg_hyper_opts.keep_dampers: 1 keeps every damper while
+            hyper.on hyper-reduces the separable part. The command line sets
+            it: with a nonlinear part and --dampers its reduced models
+            hyper-reduced the dampers too, against its documentation (every
+            damper kept); now they keep every damper.
           - phgmg-mpi: --method gmg-qm with --manifold pod|greedy, --rn and
             a fixed --lambda; it writes the serial command's files (the
             quadratic blocks, V2, M). An output path equal to the --E-coo

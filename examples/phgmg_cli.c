@@ -3899,6 +3899,7 @@ static int run_reduction(const reduce_args *A, reduce_state *S, int method, cons
   o.hyper.deim_tol = A->deim_tol > 0.0 ? A->deim_tol : 1e-300;
   o.hyper.deim_max = A->deim_max;
   o.hyper.allow_negative = A->deim_neg;
+  o.hyper.keep_dampers = 1;   /* --dampers: every damper kept (the options above apply to the terms) */
   o.dt = A->dt_map;
   o.select.lambda_mode = method == PHGMG_METHOD_GMG_QM ? A->lambda_auto : 0;
   o.qm.manifold = A->manifold;

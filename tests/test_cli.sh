@@ -689,6 +689,15 @@ np.save('d_bad.npy', np.array([[N, -1, 0.1, 0.0]]))
   [ ! -e oDn ] && pass || bad "energy-generating damper: output written"
   run_err "damper index out of range" 1 "d_bad.npy (--dampers)" "$P" simulate $SYS --dampers d_bad.npy $DSIM --out ydb.npy
   [ ! -e ydb.npy ] && pass || bad "bad damper index: output written"
+  # with a nonlinear part the hyper-reduction (ECSW, the default) applies to its terms only: every damper kept
+  nd=$("$PY" -c "
+import numpy as np
+N = np.load('toda/J.npy').shape[0]
+np.save('d_all.npy', np.array([[i, -1, 0.01, 0.1] for i in range(N)]))
+print(N)")
+  run_ok "reduce --potential toda --dampers (every state)" "$P" reduce $TSYS --potential toda --dampers d_all.npy $TRUN --out oDh --name m
+  run_ok "info of the toda model with dampers" "$P" info oDh/m.phgmgrom
+  grep -F -q "dampers: the model keeps all $nd " "$T/out.txt" || bad "the hyper-reduction of the terms dropped dampers (expected all $nd kept)"
 fi
 
 # ---- 9. a run never removes or overwrites its inputs; outputs checked up front ----

@@ -429,7 +429,9 @@ TEST(test_dissip_reduce_linear_damper) {
 
 /* Hyper-reduced dampers (opts.hyper.on = 1, ECSW): a damper on every mass, a
    few kept with weights >= 0, the reduced model still dissipative, its
-   energy balance exact, its output close to the full one. */
+   energy balance exact, its output close to the full one; with
+   hyper.keep_dampers = 1 every damper kept (the blocks those of the model
+   without hyper-reduction), 2 refused. */
 TEST(test_dissip_reduce_hyper) {
   dpm c;
   const int n = 30, ns = 600, r = 22;
@@ -462,6 +464,19 @@ TEST(test_dissip_reduce_hyper) {
     eyh = dp_rel(ns + 1, YR, Y);
     CHECK_LE(eyh, 2.0 * ey + 1e-3);
   }
+  phgmg_reduced_destroy(rh);
+  rh = NULL;
+  o.hyper.keep_dampers = 1;   /* every damper kept: the model without hyper-reduction, bit for bit */
+  CHECK_RC(phgmg_reduce(&rh, &s, X, c.N, ns + 1, &o, NULL, NULL), PHGMG_OK);
+  if (red && rh) {
+    const phgmg_rom *a = phgmg_reduced_rom(red), *b = phgmg_reduced_rom(rh);
+    CHECK(b->ndamp == c.nd && a->ndamp == c.nd);
+    CHECK(!memcmp(a->Cd, b->Cd, sizeof(phgmg_real) * (size_t)r * c.nd) && !memcmp(a->K, b->K, sizeof(phgmg_real) * r * r));
+  }
+  phgmg_reduced_destroy(rh);
+  rh = NULL;
+  o.hyper.keep_dampers = 2;
+  CHECK_RC(phgmg_reduce(&rh, &s, X, c.N, ns + 1, &o, NULL, NULL), PHGMG_ERR_INVALID_ARG);
   phgmg_reduced_destroy(red);
   phgmg_reduced_destroy(rh);
   free(X); free(Y); free(YR);
