@@ -862,8 +862,17 @@
    under one-ulp changes of the snapshots (stepped at 0.001: a stiff
    reduced model). Not yet: the
    wide V2 (qm.rn = PHGMG_RN_WIDE, the greedy manifold's default: set qm.rn
-   > 0), the ALTMIN manifold, a chosen lambda, your own eta
-   (GMG_MANIFOLD) (all PHGMG_ERR_UNSUPPORTED). With 4200 terms (a cosh
+   > 0), the ALTMIN manifold, a lambda validated by simulation
+   (PHGMG_LAMBDA_VALIDATED), your own eta (GMG_MANIFOLD) (all
+   PHGMG_ERR_UNSUPPORTED). A lambda chosen by held-out regression
+   (select.lambda_mode = PHGMG_LAMBDA_REGRESSION, manual 4.2) is the
+   serial choice made on the same replicated regression problem, with its
+   guard of D^T G D: on the linear chain (POD manifold, rn = 3) and the
+   cosh chain (greedy manifold, ECSW) of 300 masses at 1-4 ranks the
+   serial lambda (1e-12, 3.2e-4), the blocks within ten times the serial
+   model's own one-ulp movement (at lambda = 1e-12 the fit amplifies
+   rounding: blocks 2.8e-10 against the serial 2.1e-10) and the outputs
+   within 6.1e-12; phgmg_mpi_rom.qm_lambda reports the lambda used. With 4200 terms (a cosh
    term on every coordinate of 2100 masses, 31 snapshots, r = 8, rn = 4,
    the POD manifold, ECSW at 1e-3: the screened fit) at 1-4 ranks: the
    same 37 points, blocks within 1.2e-13, outputs within 5.3e-11, each
@@ -926,7 +935,8 @@
    solves and about 1.5 GB per rank; the efficiency falls below 90 % near
    16 000 ranks (size ns about 0.6 times the rows per rank), where TSQR's
    replicated stack dominates.
-   Not yet distributed: GMG-QM with a wide V2, ALTMIN or a chosen lambda;
+   Not yet distributed: GMG-QM with a wide V2, ALTMIN or a lambda
+   validated by simulation;
    GMG_MANIFOLD; cached DEIM points
    (opts.cache), separable terms by callbacks and GENERAL nonlinear
    Hamiltonians, a reference state (opts.ref), feedthrough (and so a port
@@ -1047,9 +1057,10 @@
    the quadratic model's blocks NAME_G00, _G01, _G10, _G11, _Q01, _Q11,
    _Ms (and _P1 with kept terms) instead of NAME_K, and the lift's
    NAME_V2.npy and NAME_M.npy (phgmg_mpi_rom.V2, .M) (rank 0 writes; V0
-   and V2 are gathered a column at a time). gmg-qm needs a fixed --lambda
-   (0: exactly zero): the serial default, --lambda auto, chooses lambda by
-   simulating the runs, which the distributed build does not do; --rn
+   and V2 are gathered a column at a time). gmg-qm needs --lambda: a
+   fixed value (0: exactly zero) or cv (held-out regression, the library's
+   PHGMG_LAMBDA_REGRESSION); the serial default, --lambda auto, chooses
+   lambda by simulating the runs, which the distributed build does not do; --rn
    defaults to the serial command's min(8, N - R, 4096 / (R - m)). Rank p keeps a contiguous block of
    about N / P rows of the state: its rows of Q (phgmg_mpi_op_create), of
    B, of the snapshots (read a batch of columns at a time,
@@ -1069,7 +1080,7 @@
    `phgmg reduce` -- --simulate (make the snapshots with the serial
    `phgmg simulate --states`), dense matrices, a mass matrix with sp1,
    sp2 or gmg-qm, a port on an algebraic equation, springs (--poly-jdx),
-   dampers, feedthrough, --ref, gmg-qm's --lambda auto or cv, --rn wide
+   dampers, feedthrough, --ref, gmg-qm's --lambda auto, --rn wide
    and --manifold altmin, balancing, several --X files,
    method or order lists -- is refused with a message naming the option;
    bad input (a missing file, wrong shapes, bad indices; J, R, B and J - R
@@ -1099,10 +1110,11 @@
    within 8e-13 (zero at the algebraic variables, as the serial command
    writes it), the outputs within 4e-14, the json's N (the differential
    count), N_full, algebraic and rcond_jr (the condensed model's) the
-   serial's; gmg-qm with --lambda 1e-3 (the POD manifold with --rn 4 on the linear
-   chain at P = 3; the greedy manifold, default rn and ECSW on the cosh
-   chain at P = 4): every block of the quadratic model, P1, V2 and M
-   within 2.5e-12, the same 16 points, the outputs within 3.6e-15.
+   serial's; gmg-qm on the cosh chain (the POD manifold with --rn 4 and
+   --lambda cv at P = 3: the serial lambda, 1e-14; the greedy manifold,
+   default rn and --lambda 1e-3 at P = 4; ECSW): every block of the
+   quadratic model, P1, V2 and M within 1.6e-11 (2.5e-12 at the fixed
+   lambda), the same 16 points, the outputs within 1e-13.
    Measured at N = 2e5 (1001 snapshots, r = 20): bench/README.md.
    2.8 Large sparse linear models (>>lowrank). For a phgmg_ph_sparse model
    with quadratic H (E x' = (J - R) Q x + B u, y = B^T Q x; E = I or a mass
@@ -1690,7 +1702,7 @@
    On MPI ranks, `mpirun -np P build/phgmg-mpi reduce ...` (make
    build/phgmg-mpi) reduces a linear model, or one with separable
    nonlinear terms (--potential or --poly/--exp, --poly-idx, ECSW or
-   DEIM), from the same files with gmg-pod, gmg-qm (a fixed --lambda), sp1
+   DEIM), from the same files with gmg-pod, gmg-qm (--lambda fixed or cv), sp1
    or sp2 and writes the same outputs (2.7,
    "The command line with MPI").
    Model options shared by reduce, validate and simulate include the mass
@@ -5604,6 +5616,8 @@ typedef struct phgmg_mpi_rom {
      (nloc x rn, leading dimension max(1, nloc)) */
   int rn;
   const double *M, *V2;
+  double qm_lambda;           /* the ridge parameter of M: qm.lambda, or the one chosen by
+                                 select.lambda_mode PHGMG_LAMBDA_REGRESSION (HUGE_VAL: M = 0) */
   void *qm_mem_;              /* their storage (private) */
 } phgmg_mpi_rom;
 
@@ -5611,7 +5625,10 @@ typedef struct phgmg_mpi_rom {
    hyper-reduction (opts: method PHGMG_METHOD_GMG_POD, SP1, SP2 or GMG_QM,
    r, hyper.on, hyper.kind ECSW, QDEIM or GREEDY, hyper.tol (ECSW),
    hyper.deim_tol, hyper.deim_max, hyper.allow_negative (DEIM); GMG_QM: qm.manifold POD or
-   GREEDY, qm.rn > 0, qm.lambda; the other fields zero, else
+   GREEDY, qm.rn > 0, qm.lambda, or select.lambda_mode PHGMG_LAMBDA_REGRESSION with
+   its select fields (lambda chosen by held-out regression, manual 4.2: the
+   serial choice, made on the same replicated regression problem; the
+   guard of D^T G D included); the other fields zero, else
    PHGMG_ERR_UNSUPPORTED). The serial phgmg_reduce's stages in its order and
    with its formulas: GMG-POD: the basis and the GMG blocks K, Qh, Bh as
    phgmg_mpi_gmg_pod_linear; SP1 (model->JR needed): V the r leading POD
@@ -17985,9 +18002,25 @@ PHGMG_DEF void phgmg_reduce_opts_default(phgmg_reduce_opts *o) {
 
 /* Options (resolved by phgmg__reduce_opts_resolve) and sizes; nothing
    allocated. X_checked: X is known finite (a study checked it). */
+/* The options of a chosen lambda (o->select, lambda_mode not FIXED; manual
+   4.2), ns snapshots: the serial and the distributed GMG-QM's check. */
+PHGMG__PRIV phgmg_result phgmg__select_check(const phgmg_reduce_opts *o, int ns) {
+  const int nf = o->select.folds, nb = o->select.blocks;
+  if (o->select.lambda_mode == PHGMG_LAMBDA_FIXED) return PHGMG_OK;
+  if ((int)o->select.lambda_mode < 0 || (int)o->select.lambda_mode >= (int)PHGMG_LAMBDA_MODE_COUNT ||
+      o->select.per_decade < 0 || nf < 2 || nb < 0)
+    return PHGMG_ERR_INVALID_ARG;
+  if (!(o->select.rcond >= 0.0 && o->select.rcond <= 1.0)) return PHGMG_ERR_INVALID_ARG;
+  if (phgmg__lambda_grid(o->select.lambda_min, o->select.lambda_max, o->select.per_decade, NULL) < 1)
+    return PHGMG_ERR_INVALID_ARG;
+  if (nb < nf || nb > ns) return PHGMG_ERR_SIZE;
+  return PHGMG_OK;
+}
+
 PHGMG__PRIV phgmg_result phgmg__reduce_check(const phgmg_ph_system *sys, const double *X, int ldx, int ns,
                                              const phgmg_reduce_opts *o, int X_checked) {
   const int N = sys->N, m = sys->m, r = o->r;
+  phgmg_result rc;
   if (N < 1 || m < 1 || ns < 1 || ldx < N) return PHGMG_ERR_SIZE;
   if (!phgmg__method(o->method)->by_reduce) return PHGMG_ERR_INVALID_ARG;
   if (phgmg__is_gmg(o->method)) {
@@ -18011,17 +18044,8 @@ PHGMG__PRIV phgmg_result phgmg__reduce_check(const phgmg_ph_system *sys, const d
   if (o->qm.lambda != o->qm.lambda || !(o->degeneracy_tol >= 0.0 && o->degeneracy_tol < 1.0)) return PHGMG_ERR_INVALID_ARG;
   if (sys->nl == PHGMG_NL_SEPARABLE && sys->poly_deg > 32) return PHGMG_ERR_SIZE;
   if (!X_checked && !phgmg__mat_finite(N, ns, X, ldx)) return PHGMG_ERR_NANINF; /* padding rows are not data */
-  if (o->select.lambda_mode != PHGMG_LAMBDA_FIXED) {
-    const int nf = o->select.folds, nb = o->select.blocks;
-    if ((int)o->select.lambda_mode < 0 || (int)o->select.lambda_mode >= (int)PHGMG_LAMBDA_MODE_COUNT ||
-        o->select.per_decade < 0 || nf < 2 || nb < 0)
-      return PHGMG_ERR_INVALID_ARG;
-    if (!(o->select.rcond >= 0.0 && o->select.rcond <= 1.0)) return PHGMG_ERR_INVALID_ARG;
-    if (phgmg__lambda_grid(o->select.lambda_min, o->select.lambda_max, o->select.per_decade, NULL) < 1)
-      return PHGMG_ERR_INVALID_ARG;
-    if (nb < nf || nb > ns) return PHGMG_ERR_SIZE;
-  }
-  return phgmg__deploy_check(o, ns);
+  rc = phgmg__select_check(o, ns);
+  return rc == PHGMG_OK ? phgmg__deploy_check(o, ns) : rc;
 }
 
 /* Column offsets of opts.runs (checked by phgmg__deploy_check). */
@@ -28165,15 +28189,18 @@ PHGMG__PRIV phgmg_result phgmg__mpi_e_rows(const phgmg_mpi_ctx *ctx, const phgmg
 
 /* The options this function takes (resolved copy in *o) and this rank's terms. */
 PHGMG__PRIV phgmg_result phgmg__mpi_sep_check_local(const phgmg_mpi_ctx *ctx, const phgmg_mpi_sep_model *md,
-                                                    phgmg_reduce_opts *o) {
+                                                    int ns, phgmg_reduce_opts *o) {
   const int nf = md->per_term ? md->nsep : 1, nc = md->poly_deg + 1;
   int k, qm;
-  phgmg__reduce_opts_resolve(o, 0);
+  phgmg_result rc;
+  phgmg__reduce_opts_resolve(o, ns);
   qm = o->method == PHGMG_METHOD_GMG_QM;
+  if (qm && (rc = phgmg__select_check(o, ns)) != PHGMG_OK) return rc;
   if ((o->method != PHGMG_METHOD_GMG_POD && o->method != PHGMG_METHOD_SP1 && o->method != PHGMG_METHOD_SP2 && !qm) ||
       o->ref != PHGMG_REF_NONE || o->dt != 0.0 || o->nrun || o->runs || o->cache.pod_basis || o->cache.deim_pts ||
-      o->select.lambda_mode != PHGMG_LAMBDA_FIXED || o->degeneracy_tol != 1e-12)
-    return PHGMG_ERR_UNSUPPORTED;
+      (o->select.lambda_mode != PHGMG_LAMBDA_FIXED && (!qm || o->select.lambda_mode != PHGMG_LAMBDA_REGRESSION)) ||
+      o->degeneracy_tol != 1e-12)
+    return PHGMG_ERR_UNSUPPORTED;   /* GMG-QM's lambda: fixed, or chosen by regression (no simulation here) */
   if ((o->hyper.on != 0 && o->hyper.on != 1) || !(o->hyper.tol > 0.0 && o->hyper.tol < 1.0) ||
       (int)o->hyper.kind < 0 || (int)o->hyper.kind >= (int)PHGMG_HYPER_COUNT ||
       !(o->hyper.deim_tol >= 0.0 && o->hyper.deim_tol < 1.0) || o->hyper.deim_max < 0 ||
@@ -29339,6 +29366,7 @@ PHGMG__PRIV void phgmg__mpi_qm_free(const phgmg_mpi_ctx *ctx, phgmg__mpi_qm *q) 
   phgmg__free(&ctx->al, q->L);
   phgmg__free(&ctx->al, q->c.dga);
   phgmg__free(&ctx->al, q->c.Tq);
+  phgmg__free(&ctx->al, q->c.lg);
   phgmg_reduced_destroy(q->c.red);
   memset(q, 0, sizeof *q);
 }
@@ -29357,6 +29385,8 @@ PHGMG__PRIV phgmg_result phgmg__mpi_qm_init(const phgmg_mpi_ctx *ctx, const phgm
   red->alloc = ctx->al; red->use_alloc = 1;
   q->c.red = red; q->c.sys = &q->sys; q->c.ro = *o; q->c.o = &q->c.ro; q->c.ns = ns; q->c.alloc = &ctx->al;
   q->c.gsel = -1; q->c.degtol = o->degeneracy_tol; q->c.lambda = o->qm.lambda < 0.0 ? 0.0 : o->qm.lambda;
+  if (o->select.lambda_mode == PHGMG_LAMBDA_REGRESSION)   /* lambda chosen on the replicated regression problem */
+    q->c.ng = phgmg__lambda_grid(o->select.lambda_min, o->select.lambda_max, o->select.per_decade, NULL);
   q->sys.N = (int)ctx->N; q->sys.m = m;
   red->N = (int)ctx->N; red->m = m; red->r = r; red->p = p; red->rn = rn; red->method = o->method;
   red->kind = PHGMG_ROM_QUADRATIC; red->sys = &q->sys;
@@ -29425,8 +29455,9 @@ PHGMG__PRIV phgmg_result phgmg__mpi_qm_v1(const phgmg_mpi_ctx *ctx, int ns, phgm
 /* Stage 2b (phgmg__stage_manifold): Xa minus its part in span V1, V2 the
    rn leading POD modes of that residual (unless the basis stage's SVD gave
    them), the coordinates Z1 = V1^T X and Z2 = V2^T Xa (replicated), then
-   the serial ridge problem and fit of M (phgmg__qm_problem, phgmg__qm_fit)
-   at the fixed lambda. Collective. */
+   the serial ridge problem (phgmg__qm_problem), lambda (fixed, or
+   chosen by phgmg__qm_lambda_auto) and fit of M (phgmg__qm_fit).
+   Collective. */
 PHGMG__PRIV phgmg_result phgmg__mpi_qm_manifold(const phgmg_mpi_ctx *ctx, int ns, const double *X, int ldx,
                                                 phgmg__mpi_qm *q) {
   phgmg_reduced *red = q->c.red;
@@ -29445,6 +29476,7 @@ PHGMG__PRIV phgmg_result phgmg__mpi_qm_manifold(const phgmg_mpi_ctx *ctx, int ns
   if (rc == PHGMG_OK) rc = phgmg_mpi_atb(ctx, rn, ns, V2, ld, q->Xa, ld, Z2, rn);
   phgmg__free(&ctx->al, T);
   if (rc == PHGMG_OK) rc = phgmg__qm_problem(&q->c);   /* replicated data from here on */
+  if (rc == PHGMG_OK && q->c.ng > 0) rc = phgmg__qm_lambda_auto(&q->c);   /* lambda by held-out regression */
   if (rc == PHGMG_OK)
     rc = phgmg__qm_fit(red, ns, q->c.Tq, q->c.Tq + (size_t)ns * nc, q->c.lambda, q->c.Tq + (size_t)ns * (nc + rn),
                        &ctx->al);
@@ -29510,6 +29542,7 @@ PHGMG__PRIV phgmg_result phgmg__mpi_qm_lift(const phgmg_mpi_ctx *ctx, const phgm
   if (ctx->nloc > 0) memcpy(b, q->L + (size_t)ld * red->r, nv * sizeof(double));
   memcpy(b + nv, red->M, nm * sizeof(double));
   out->rn = rn; out->V2 = b; out->M = b + nv; out->qm_mem_ = b;
+  out->qm_lambda = q->c.lambda;   /* fixed, or chosen (HUGE_VAL: M = 0) */
   return PHGMG_OK;
 }
 
@@ -29593,7 +29626,7 @@ PHGMG_DEF phgmg_result phgmg_mpi_reduce(const phgmg_mpi_ctx *ctx, const phgmg_mp
   else if (V0 && !phgmg__mpi_ld_ok(ctx, ldv0)) rc = PHGMG_ERR_SIZE;
   else {
     o = *opts;
-    rc = phgmg__mpi_sep_check_local(ctx, model, &o);
+    rc = phgmg__mpi_sep_check_local(ctx, model, ns, &o);
     if (rc == PHGMG_OK) rc = phgmg__mpi_lin_args(ctx, &model->lin, X, ldx);
     if (rc == PHGMG_OK && model->lin.E && o.method != PHGMG_METHOD_GMG_POD) rc = PHGMG_ERR_UNSUPPORTED;
     if (rc == PHGMG_OK) rc = phgmg__mpi_e_rows(ctx, model);
@@ -31239,7 +31272,9 @@ PHGMG_DEF phgmg_result phgmg_sym_eig(int n, double *A, int lda, double *w, doubl
             numbers' order, GMG's K with the dampers' linearisation, ECSW
             over the dampers; the solve callback solves with J - R - L.
           - phgmg_mpi_rom.rn, .M, .V2: GMG-QM's lift (M replicated, V2 this
-            rank's rows).
+            rank's rows); .qm_lambda. phgmg_mpi_reduce's GMG-QM takes
+            select.lambda_mode PHGMG_LAMBDA_REGRESSION (the serial choice on
+            the replicated regression problem, with its guard).
           - phgmg_mpi_reduce and phgmg_mpi_gmg_pod_linear: index-one mass
             matrices (algebraic constraints: zero rows and as many zero
             columns, anywhere among the ranks) reduce by GMG-POD as the
@@ -31253,7 +31288,7 @@ PHGMG_DEF phgmg_result phgmg_sym_eig(int n, double *A, int lda, double *w, doubl
             hyper-reduced the dampers too, against its documentation (every
             damper kept); now they keep every damper.
           - phgmg-mpi: --method gmg-qm with --manifold pod|greedy, --rn and
-            a fixed --lambda; it writes the serial command's files (the
+            --lambda fixed or cv; it writes the serial command's files (the
             quadratic blocks, V2, M). An output path equal to the --E-coo
             file is now refused (it was overwritten).
    0.11.0 (2026-11-29)

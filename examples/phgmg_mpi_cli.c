@@ -80,7 +80,7 @@ static const char *const help_text[] = {
   "                      Galerkin on the POD of the snapshots) or sp2 (sp1's trial\n"
   "                      basis, the test basis from the POD of the gradient snapshots)\n"
   "                      or gmg-qm (the quadratic manifold phi(x) = [B, V1] x +\n"
-  "                      V2 M (x2 kron x2), with a fixed --lambda).\n"
+  "                      V2 M (x2 kron x2), with --lambda a fixed value or cv).\n"
   "  --r R               the reduced order (gmg-pod, gmg-qm: R > m; sp1, sp2: R <= ns).\n"
   "  --out DIR           output directory (created if missing).\n"
   "  --name NAME         base name of the outputs (default rom; a C identifier).\n"
@@ -91,7 +91,10 @@ static const char *const help_text[] = {
   "GMG-QM (--method gmg-qm)\n"
   "  --lambda L          required here: the ridge parameter of the quadratic fit M, on the\n"
   "                      un-normalised sum over the snapshots (e.g. 1e-3, the paper's;\n"
-  "                      0 means exactly zero). The serial default, --lambda auto,\n"
+  "                      0 means exactly zero), or cv: chosen on a grid by held-out\n"
+  "                      regression error (time blocks; the serial --lambda cv, which\n"
+  "                      measures the regression, not the reduced model, and can pick\n"
+  "                      very small lambdas). The serial default, --lambda auto,\n"
   "                      chooses it by simulating the runs, which phgmg-mpi does not do.\n"
   "  --manifold KIND     pod (default: V1 the leading POD modes of the snapshots adjusted\n"
   "                      by B) or greedy (V1 chosen greedily among the leading modes for\n"
@@ -162,7 +165,7 @@ static const char *const help_text[] = {
   "  --simulate (give the snapshots with --X; make them with the serial\n"
   "  `phgmg simulate ... --states X.npy`), dense --J/--R/--Q/--E, a mass matrix\n"
   "  with sp1, sp2 or gmg-qm, a port on an algebraic equation, springs\n"
-  "  (--poly-jdx), dampers, feedthrough, --ref, gmg-qm's --lambda auto or cv,\n"
+  "  (--poly-jdx), dampers, feedthrough, --ref, gmg-qm's --lambda auto,\n"
   "  --rn wide and --manifold altmin, balancing, several --X files, method or\n"
   "  order lists, and every\n"
   "  other option of `phgmg reduce`: use the serial `phgmg` for them.\n"
@@ -177,7 +180,7 @@ typedef struct args {
   const char *E;                                             /* --E-coo: a mass matrix */
   int method, r, quiet, have_dt, no_hyper, have_hyper, have_hyper_tol;
   int hyper_kind, deim_max, deim_neg, have_deim_opt;   /* --hyper (PHGMG_HYPER_*), the DEIM options */
-  int manifold, rn, have_lambda, have_qm_opt;            /* gmg-qm: --manifold, --rn, --lambda */
+  int manifold, rn, have_lambda, have_qm_opt, lambda_cv; /* gmg-qm: --manifold, --rn, --lambda (cv: 1) */
   double dt, hyper_tol, deim_tol, lambda;
 } args;
 
@@ -334,10 +337,12 @@ static int parse_qm_value(const char *o, const char *v, args *a) {
     if (errno || end == v || *end || k < 1 || k > 4096) return usage("--rn: expected an integer in [1, 4096], got '%s'", v);
     a->rn = (int)k;
   } else if (!strcmp(o, "--lambda")) {
-    if (!strcmp(v, "auto") || !strcmp(v, "cv"))
-      return usage("--lambda %s: phgmg-mpi takes a fixed ridge parameter (--lambda L, e.g. 1e-3; 0 means exactly "
-                   "zero): choosing it by %s needs the serial `phgmg reduce`", v,
-                   !strcmp(v, "auto") ? "simulating the runs" : "cross-validation");
+    a->have_lambda = 1;
+    if (!strcmp(v, "cv")) { a->lambda_cv = 1; return 0; }
+    if (!strcmp(v, "auto"))
+      return usage("--lambda auto: phgmg-mpi does not simulate, so it cannot validate lambda by simulating the "
+                   "runs: give --lambda cv (chosen by held-out regression) or a fixed --lambda L (e.g. 1e-3; 0 "
+                   "means exactly zero), or use the serial `phgmg reduce`");
     errno = 0;
     a->lambda = strtod(v, &end);
     if (errno || end == v || *end || !(a->lambda >= 0.0) || !isfinite(a->lambda))
@@ -476,8 +481,9 @@ static int parse_args(int argc, char **argv, args *a) {
   if (a->have_qm_opt && a->method != PHGMG_METHOD_GMG_QM)
     return usage("--lambda, --rn and --manifold apply to --method gmg-qm only (not %s)", method_name(a->method));
   if (a->method == PHGMG_METHOD_GMG_QM && !a->have_lambda)
-    return usage("gmg-qm needs a fixed --lambda here (e.g. --lambda 1e-3; 0 means exactly zero): the serial "
-                 "default, --lambda auto, validates lambda by simulating the runs, which phgmg-mpi does not do");
+    return usage("gmg-qm needs --lambda here: cv (chosen by held-out regression) or a fixed value (e.g. 1e-3; 0 "
+                 "means exactly zero); the serial default, --lambda auto, validates lambda by simulating the runs, "
+                 "which phgmg-mpi does not do");
   if (a->E && a->method != PHGMG_METHOD_GMG_POD)
     return usage("--E-coo: phgmg-mpi reduces models with a mass matrix by gmg-pod (for %s use the serial `phgmg "
                  "reduce`)", method_name(a->method));
@@ -1140,6 +1146,7 @@ static int reduce(const args *a, dist *d, result *res) {
       o.qm.manifold = (phgmg_manifold)a->manifold;
       o.qm.rn = a->rn ? a->rn : default_rn(d->N, a->r, d->m);
       o.qm.lambda = a->lambda > 0.0 ? a->lambda : -1.0;   /* 0 on the command line: exactly zero */
+      if (a->lambda_cv) o.select.lambda_mode = PHGMG_LAMBDA_REGRESSION;   /* the serial --lambda cv */
     }
     rc = phgmg_mpi_reduce(ctx, &md, d->ns, d->Xl, ld, &o, &res->mr, res->V0, ld);
   }
@@ -1379,8 +1386,10 @@ static void json_options(FILE *f, const args *a, const result *res) {
   const int hyper = a->poly_idx && !a->no_hyper, deim = hyper && a->hyper_kind != PHGMG_HYPER_ECSW;
   fprintf(f, "  \"options\": {");
   if (a->method == PHGMG_METHOD_GMG_QM) {
-    fprintf(f, "\"rn\": %d, \"lambda\": ", res->mr.rn); json_num(f, a->lambda);
-    fprintf(f, ", \"lambda_used\": "); json_num(f, a->lambda);
+    fprintf(f, "\"rn\": %d, \"lambda\": ", res->mr.rn);
+    if (a->lambda_cv) json_str(f, "cv");
+    else json_num(f, a->lambda);
+    fprintf(f, ", \"lambda_used\": "); json_num(f, res->mr.qm_lambda == HUGE_VAL ? -1.0 : res->mr.qm_lambda);
     fprintf(f, ", \"manifold\": \"%s\", ", a->manifold == PHGMG_MANIFOLD_GREEDY ? "greedy" : "pod");
   }
   fprintf(f, "\"training_runs\": 0, \"ref\": \"none\", \"hyper\": \"%s\"", hyper ? hyper_name(a->hyper_kind) : "none");

@@ -35,9 +35,11 @@
 # checks, and the json's "E". An index-one RLC grid (bench/rlc_grid.py,
 # 8 x 8 mains: N = 288, 144 algebraic lines; rows and states scrambled by
 # different permutations) with gmg-pod at P = 3: the same checks and
-# the json's N (the differential count), N_full and algebraic. GMG-QM with a fixed --lambda 1e-3: the
-# linear chain with the POD manifold and --rn 4 at P = 3, the cosh chain
-# with the greedy manifold (default rn, ECSW) at P = 4: besides the
+# the json's N (the differential count), N_full and algebraic. GMG-QM on
+# the cosh chain: the POD manifold, --rn 4 and --lambda cv (chosen by
+# held-out regression: the json's lambda_used the serial's; it picks 1e-14
+# here, a model that needs simulate-rom --dt 0.01) at P = 3, the greedy
+# manifold (default rn, ECSW, --lambda 1e-3) at P = 4: besides the
 # above, every block of the quadratic model (G00, G01, G10, G11, Q01, Q11,
 # Ms), P1, V2 and M within 1e-10 after the signs of V0's and V2's columns
 # (Ms and M: row a by V2's sign, column (j, k) by those of V1's j and k).
@@ -112,13 +114,14 @@ MR="--J-coo $D/rlc/J.npy --R-coo $D/rlc/R.npy --Q-coo $D/rlc/Q.npy --E-coo $D/rl
 for case in gmg-pod sp1 cosh-gmg-pod cosh-sp1 terms-sp1 qdeim-gmg-pod greedy-sp2 mass-gmg-pod qmpod-gmg-qm qmgreedy-gmg-qm \
             rlc-gmg-pod; do
   model=$M
+  rdt=0.1
   ps="1 2 3 4"
   case $case in
     cosh-*) meth=${case#cosh-}; X="$D/X_nl.npy"; opt=$NL ;;
     qdeim-*|greedy-*) meth=${case#*-}; X="$D/X_nl.npy"; opt="$NL --hyper ${case%%-*} --deim-tol 1e-4 --deim-allow-negative" ;;
     mass-*) meth=${case#mass-}; X="$D/X_e.npy"; opt="$NL --E-coo $D/E.npy" ;;
     terms-*) meth=${case#terms-}; X="$D/X_pt.npy"; opt="$PT --no-hyper"; ps=3 ;;
-    qmpod-*) meth=gmg-qm; X="$D/X.npy"; opt="--manifold pod --rn 4 --lambda 1e-3" ;;
+    qmpod-*) meth=gmg-qm; X="$D/X_nl.npy"; opt="$NL --manifold pod --rn 4 --lambda cv"; rdt=0.01 ;;
     qmgreedy-*) meth=gmg-qm; X="$D/X_nl.npy"; opt="$NL --manifold greedy --lambda 1e-3" ;;
     rlc-*) meth=gmg-pod; X="$D/X_rlc.npy"; opt=""; model=$MR ;;
     *) meth=$case; X="$D/X.npy"; opt="" ;;
@@ -129,10 +132,10 @@ for case in gmg-pod sp1 cosh-gmg-pod cosh-sp1 terms-sp1 qdeim-gmg-pod greedy-sp2
     rlc-*) ps="3" ;;
   esac
   "$PHGMG" reduce $model $opt --X "$X" --method $meth --r 10 --out "$D/serial_$case" --quiet > /dev/null
-  "$PHGMG" simulate-rom --model "$D/serial_$case/rom.phgmgrom" --dt 0.1 --steps 300 --out "$D/y_serial_$case.npy" --quiet > /dev/null
+  "$PHGMG" simulate-rom --model "$D/serial_$case/rom.phgmgrom" --dt $rdt --steps 300 --out "$D/y_serial_$case.npy" --quiet > /dev/null
   for p in $ps; do
     timeout 120 $MPIRUN -np $p "$PMPI" reduce $model $opt --X "$X" --method $meth --r 10 --out "$D/p${p}_$case" --quiet
-    "$PHGMG" simulate-rom --model "$D/p${p}_$case/rom.phgmgrom" --dt 0.1 --steps 300 --out "$D/y_p${p}_$case.npy" --quiet > /dev/null
+    "$PHGMG" simulate-rom --model "$D/p${p}_$case/rom.phgmgrom" --dt $rdt --steps 300 --out "$D/y_p${p}_$case.npy" --quiet > /dev/null
   done
 done
 
@@ -174,8 +177,8 @@ if timeout 60 $MPIRUN -np 3 "$PMPI" reduce --J-coo "$D/rlcp/J.npy" --R-coo "$D/r
   echo "check_cli_mpi: FAILED: a port on a constraint was not refused by name"; cat "$D/err.txt"; exit 1
 fi
 refused "--E: dense matrices are not read" --X "$D/X_e.npy" --E "$D/E.npy"
-refused "gmg-qm needs a fixed --lambda" --X "$D/X.npy" --method gmg-qm
-refused "--lambda auto: phgmg-mpi takes a fixed ridge parameter" --X "$D/X.npy" --method gmg-qm --lambda auto
+refused "gmg-qm needs --lambda here" --X "$D/X.npy" --method gmg-qm
+refused "--lambda auto: phgmg-mpi does not simulate" --X "$D/X.npy" --method gmg-qm --lambda auto
 refused "--rn wide: not distributed" --X "$D/X.npy" --method gmg-qm --lambda 1e-3 --rn wide
 refused "--manifold altmin: not distributed" --X "$D/X.npy" --method gmg-qm --lambda 1e-3 --manifold altmin
 refused "apply to --method gmg-qm only" --X "$D/X.npy" --lambda 1e-3
@@ -186,7 +189,7 @@ if timeout 60 $MPIRUN -np 2 "$PMPI" reduce $M --E-coo "$D/clash/rom_V0.npy" --X 
    ! cmp -s "$D/E.npy" "$D/clash/rom_V0.npy" || [ -e "$D/clash/rom.json" ]; then
   echo "check_cli_mpi: FAILED: an output that is the --E-coo file was not refused, or the file changed"; cat "$D/err.txt"; exit 1
 fi
-echo "check_cli_mpi: wrong snapshot shape, --simulate, --ref, --poly-jdx, DEIM options without DEIM, negative DEIM weights, an index-two mass matrix, a port on a constraint, dense --E, gmg-qm without a fixed --lambda, --lambda auto, --rn wide, --manifold altmin, --lambda with gmg-pod refused with messages naming them; an output on the --E-coo file refused, the file unchanged"
+echo "check_cli_mpi: wrong snapshot shape, --simulate, --ref, --poly-jdx, DEIM options without DEIM, negative DEIM weights, an index-two mass matrix, a port on a constraint, dense --E, gmg-qm without --lambda, --lambda auto, --rn wide, --manifold altmin, --lambda with gmg-pod refused with messages naming them; an output on the --E-coo file refused, the file unchanged"
 
 $PY - "$D" <<'PYEOF'
 import json
@@ -209,7 +212,7 @@ def coords(P0, V0):
 bad = 0
 for case in ('gmg-pod', 'sp1', 'cosh-gmg-pod', 'cosh-sp1', 'terms-sp1', 'qdeim-gmg-pod', 'greedy-sp2', 'mass-gmg-pod',
              'qmpod-gmg-qm', 'qmgreedy-gmg-qm', 'rlc-gmg-pod'):
-    nl = case.startswith(('cosh-', 'terms-', 'qdeim-', 'greedy-', 'mass-', 'qmgreedy-'))
+    nl = case.startswith(('cosh-', 'terms-', 'qdeim-', 'greedy-', 'mass-', 'qmgreedy-', 'qmpod-'))
     qm = case.endswith('gmg-qm')
     names = (('Qh', 'Bh', 'V0', 'G00', 'G01', 'G10', 'G11', 'Q01', 'Q11', 'Ms', 'V2', 'M') if qm else
              ('K', 'Qh', 'Bh', 'V0')) + (('P0', 'w', 'poly', 'expo') if nl else ()) + (('P1',) if nl and qm else ())
