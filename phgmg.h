@@ -941,9 +941,8 @@
    (opts.cache), separable terms by callbacks and GENERAL nonlinear
    Hamiltonians, a reference state (opts.ref), feedthrough (and so a port
    on an algebraic equation), a mass matrix with SP1, SP2 or GMG-QM,
-   dampers with a mass matrix or with GMG-QM, dampers with callback laws
-   or a law per damper; in the command line (below) also simulating the
-   training runs and dampers.
+   dampers with a mass matrix or with GMG-QM, dampers with callback laws;
+   in the command line (below) also simulating the training runs.
    Mass matrices. A descriptor model E x' = (J - R) z + B u (manual 1.6, E
    of full rank) reduces by GMG-POD: phgmg_mpi_linear_model.E (the rows of
    E as a distributed operator) and solve_E (the user's collective solve
@@ -993,8 +992,11 @@
    damp_id, damp_deg, damp_poly: each rank passes the dampers whose first
    index i is one of its rows, the second j anywhere (a row of another
    rank too) or none, with global damper numbers and the serial model's
-   polynomial law, the same on every rank (PHGMG_ERR_DAMPER for one that
-   generates energy, on every rank). GMG-POD, SP1 and SP2 without a mass
+   polynomial law, the same on every rank, or with damp_per = 1 one law
+   per damper (row k of damp_poly for the rank's damper k; the serial
+   damp_nfun = ndamp: the laws travel with the reduced directions, and the
+   kept dampers' laws are the serial model's rows) (PHGMG_ERR_DAMPER for one
+   that generates energy, on every rank). GMG-POD, SP1 and SP2 without a mass
    matrix; with E or GMG-QM: PHGMG_ERR_UNSUPPORTED on every rank. With
    dampers the solve callback solves with J - R - L, L = sum_k rho'(0) c_k
    c_k^T, as the serial GMG's G = (J - R - L)^{-1} (JR, for SP1 and SP2,
@@ -5588,7 +5590,9 @@ typedef struct phgmg_mpi_sep_model {
   int ndamp;                                     /* this rank's dampers (0: none)           */
   const phgmg_gidx *damp_i, *damp_j, *damp_id;   /* ndamp each; damp_j, damp_id may be NULL */
   int damp_deg;                                  /* the law's degree, 1 .. 15               */
-  const double *damp_poly;                       /* its damp_deg + 1 coefficients           */
+  const double *damp_poly;                       /* its damp_deg + 1 coefficients, or with  */
+  int damp_per;                                  /* damp_per = 1 one law per damper: row k  */
+                                                 /* (damp_deg + 1) for this rank's damper k */
 } phgmg_mpi_sep_model;
 
 /* The result of phgmg_mpi_reduce, identical on every rank: rom the online
@@ -28649,7 +28653,7 @@ typedef struct phgmg__mpi_romdata {
   const phgmg_mpi_sep_model *md;
   int deim_neg;                            /* DEIM: negative weights, sigma_{nd+1}/sigma_1 */
   double deim_sratio;
-  int ndamp, damp_deg;                     /* dampers (ndamp = 0: none): Cd (r x ndamp), dw, */
+  int ndamp, damp_deg, damp_nphi;          /* dampers (ndamp = 0: none): Cd (r x ndamp), dw, */
   const double *Cd, *dw, *dpoly;           /* the law (damp_deg + 1), the kept ones' ids     */
   const phgmg_gidx *dterm;
   double *dmem;                            /* (the dampers' stage storage: Cd, dw, dterm)    */
@@ -28666,7 +28670,7 @@ PHGMG__PRIV phgmg_result phgmg__mpi_rom_store(const phgmg_mpi_ctx *ctx, const ph
   const size_t r = (size_t)d->r, m = (size_t)d->m, nd = (size_t)d->nd, nf = (size_t)d->nf;
   const size_t npc = nf * (size_t)d->nc, nex = nf * 2 * (size_t)d->ne, rv = (size_t)d->rv;
   const size_t rn = (size_t)d->rn, p = r - m, nq = rn ? r * r + 2 * r * rn + 2 * rn * rn + r * rn + rn * p * p : 0;
-  const size_t ndm = (size_t)d->ndamp, ndc = ndm ? (size_t)d->damp_deg + 1 : 0;
+  const size_t ndm = (size_t)d->ndamp, ndc = ndm ? (size_t)d->damp_nphi * ((size_t)d->damp_deg + 1) : 0;
   const size_t nv = 2 * r * r + r * m + nd * (1 + r) + npc + nex + 2 * r +
                     (rn ? nq + nd * rn + 1 : 0) + ndm * (r + 1) + ndc;   /* what the rom views */
   double *b = phgmg__dalloc(&ctx->al, nv + (size_t)d->nsv + 2 * nd + (nv * sizeof(phgmg_real)) / sizeof(double) + 1 +
@@ -28732,7 +28736,7 @@ PHGMG__PRIV phgmg_result phgmg__mpi_rom_store(const phgmg_mpi_ctx *ctx, const ph
   }
   out->rom.env_lo = v + (env - b); out->rom.env_hi = v + (env - b) + r;
   if (ndm) {   /* the dampers (phgmg__publish_dampers's) */
-    out->rom.ndamp = d->ndamp; out->rom.damp_deg = d->damp_deg; out->rom.damp_nphi = 1;
+    out->rom.ndamp = d->ndamp; out->rom.damp_deg = d->damp_deg; out->rom.damp_nphi = d->damp_nphi;
     out->rom.Cd = v + (Cd - b); out->rom.dw = out->rom.Cd + ndm * r; out->rom.dpoly = out->rom.dw + ndm;
     out->rom.dterm = dterm;
   }
@@ -29092,13 +29096,14 @@ PHGMG__PRIV phgmg_result phgmg__mpi_rows_fetch(const phgmg_mpi_ctx *ctx, int nq,
    the rank-order entry of sid[k]; the law as a phgmg_ph_system of one
    damper (phgmg__damp_law). */
 typedef struct phgmg__mpi_damp {
-  int ndg, zero;
-  int *cnt, *dsp, *pos;
+  int ndg, zero, nlaw;   /* nlaw: coefficients gathered per damper (damp_per: damp_deg + 1, else 0) */
+  int *cnt, *dsp, *pos, *zeros;
   phgmg_gidx *ids, *sid;
-  phgmg_ph_system law;
+  phgmg_ph_system law;   /* this rank's dampers' laws (N = 1; law k of damper k, or the one law) */
 } phgmg__mpi_damp;
 
 PHGMG__PRIV void phgmg__mpi_damp_free(const phgmg_mpi_ctx *ctx, phgmg__mpi_damp *dm) {
+  phgmg__free(&ctx->al, dm->zeros);
   phgmg__free(&ctx->al, dm->cnt);
   phgmg__free(&ctx->al, dm->ids);
   phgmg__free(&ctx->al, dm->pos);
@@ -29127,27 +29132,34 @@ PHGMG__PRIV phgmg_result phgmg__mpi_damp_local(const phgmg_mpi_ctx *ctx, const p
   return PHGMG_OK;
 }
 
-/* The law: given on every rank, checked as the serial model's (sizes,
-   finite, PHGMG_ERR_DAMPER for one that generates energy), and equal to
-   rank 0's (PHGMG_ERR_INVALID_ARG otherwise). Collective. */
+/* The laws: given on every rank (one shared law, or with damp_per one per
+   damper), checked as the serial model's (sizes, finite, PHGMG_ERR_DAMPER
+   for one that generates energy); the degree, damp_per and a shared law
+   equal to rank 0's (PHGMG_ERR_INVALID_ARG otherwise). Collective. */
 PHGMG__PRIV phgmg_result phgmg__mpi_damp_law(const phgmg_mpi_ctx *ctx, const phgmg_mpi_sep_model *md,
                                              phgmg__mpi_damp *dm) {
-  double c[PHGMG__DAMP_DEG_MAX + 2];
+  const int per = md->damp_per == 1, nl = per ? md->ndamp : 1;
+  double c[PHGMG__DAMP_DEG_MAX + 3];
   int e;
-  phgmg_result rc;
+  phgmg_result rc = (md->damp_per != 0 && !per) ? PHGMG_ERR_INVALID_ARG : PHGMG_OK;
   memset(&dm->law, 0, sizeof dm->law);
-  dm->law.N = 1; dm->law.ndamp = 1; dm->law.damp_i = &dm->zero;
+  dm->zeros = phgmg__ialloc(&ctx->al, (size_t)nl + 1);
+  if (rc == PHGMG_OK && !dm->zeros) rc = PHGMG_ERR_NOMEM;
+  for (e = 0; dm->zeros && e < nl; ++e) dm->zeros[e] = 0;
+  dm->law.N = 1; dm->law.ndamp = nl; dm->law.damp_i = dm->zeros; dm->law.damp_nfun = nl;
   dm->law.damp_deg = md->damp_deg; dm->law.damp_poly = md->damp_poly;
-  rc = phgmg__mpi_agree(ctx, md->damp_poly ? phgmg__ph_check_dampers(&dm->law) : PHGMG_ERR_INVALID_ARG);
+  dm->nlaw = per ? md->damp_deg + 1 : 0;
+  if (rc == PHGMG_OK && nl > 0) rc = md->damp_poly ? phgmg__ph_check_dampers(&dm->law) : PHGMG_ERR_INVALID_ARG;
+  rc = phgmg__mpi_agree(ctx, rc);
   if (rc != PHGMG_OK) return rc;
   memset(c, 0, sizeof c);
-  c[0] = (double)md->damp_deg;
-  for (e = 0; e <= md->damp_deg; ++e) c[1 + e] = md->damp_poly[e];
-  MPI_Bcast(c, PHGMG__DAMP_DEG_MAX + 2, MPI_DOUBLE, 0, ctx->comm);
-  phgmg__mpi_count(ctx, 8.0 * (PHGMG__DAMP_DEG_MAX + 2));
-  if (c[0] != (double)md->damp_deg) rc = PHGMG_ERR_INVALID_ARG;
-  for (e = 0; rc == PHGMG_OK && e <= md->damp_deg; ++e)
-    if (c[1 + e] != md->damp_poly[e]) rc = PHGMG_ERR_INVALID_ARG;
+  c[0] = (double)md->damp_deg; c[1] = (double)per;
+  for (e = 0; !per && e <= md->damp_deg; ++e) c[2 + e] = md->damp_poly[e];
+  MPI_Bcast(c, PHGMG__DAMP_DEG_MAX + 3, MPI_DOUBLE, 0, ctx->comm);
+  phgmg__mpi_count(ctx, 8.0 * (PHGMG__DAMP_DEG_MAX + 3));
+  if (c[0] != (double)md->damp_deg || c[1] != (double)per) rc = PHGMG_ERR_INVALID_ARG;
+  for (e = 0; rc == PHGMG_OK && !per && e <= md->damp_deg; ++e)
+    if (c[2 + e] != md->damp_poly[e]) rc = PHGMG_ERR_INVALID_ARG;
   return phgmg__mpi_agree(ctx, rc);
 }
 
@@ -29235,25 +29247,30 @@ PHGMG__PRIV phgmg_result phgmg__mpi_damp_rows(const phgmg_mpi_ctx *ctx, const ph
 
 /* Cd (r x ndg, replicated, columns in id order): this rank's columns
    Wz(i_k, :) - Wz(j_k, :) (A's first r columns, Aj) gathered by one
-   MPI_Allgatherv. Collective. */
+   MPI_Allgatherv; with one law per damper (dm->nlaw coefficients) the laws
+   ride along into Lw (nlaw x ndg, id order). Collective. */
 PHGMG__PRIV phgmg_result phgmg__mpi_damp_cd(const phgmg_mpi_ctx *ctx, const phgmg_mpi_sep_model *md,
                                             const phgmg__mpi_damp *dm, const double *A, int ld, const double *Aj,
-                                            int r, double *Cd) {
-  const int nd = md->ndamp, l1 = PHGMG__MAX(1, nd), P = ctx->size;
-  double *Cl = phgmg__dalloc(&ctx->al, (size_t)r * l1), *Ca = phgmg__dalloc(&ctx->al, (size_t)r * dm->ndg + 1);
+                                            int r, double *Cd, double *Lw) {
+  const int nd = md->ndamp, l1 = PHGMG__MAX(1, nd), P = ctx->size, w = r + dm->nlaw;
+  double *Cl = phgmg__dalloc(&ctx->al, (size_t)w * l1), *Ca = phgmg__dalloc(&ctx->al, (size_t)w * dm->ndg + 1);
   int *cr = phgmg__ialloc(&ctx->al, 2 * (size_t)P), k, a;
   phgmg_result rc = Cl && Ca && cr ? PHGMG_OK : PHGMG_ERR_NOMEM;
-  if (rc == PHGMG_OK && (double)r * dm->ndg > 2147483647.0) rc = PHGMG_ERR_SIZE;
+  if (rc == PHGMG_OK && (double)w * dm->ndg > 2147483647.0) rc = PHGMG_ERR_SIZE;
   rc = phgmg__mpi_agree(ctx, rc);
   if (rc == PHGMG_OK) {
     for (k = 0; k < nd; ++k) {
       const int row = (int)(md->damp_i[k] - ctx->row0);
-      for (a = 0; a < r; ++a) Cl[a + (size_t)k * r] = A[row + (size_t)a * ld] - Aj[k + (size_t)a * l1];
+      for (a = 0; a < r; ++a) Cl[a + (size_t)k * w] = A[row + (size_t)a * ld] - Aj[k + (size_t)a * l1];
+      for (a = 0; a < dm->nlaw; ++a) Cl[r + a + (size_t)k * w] = md->damp_poly[(size_t)k * dm->nlaw + a];
     }
-    for (k = 0; k < P; ++k) { cr[k] = dm->cnt[k] * r; cr[P + k] = dm->dsp[k] * r; }
-    MPI_Allgatherv(Cl, nd * r, MPI_DOUBLE, Ca, cr, cr + P, MPI_DOUBLE, ctx->comm);
-    phgmg__mpi_count(ctx, 8.0 * r * dm->ndg);
-    for (k = 0; k < dm->ndg; ++k) memcpy(Cd + (size_t)k * r, Ca + (size_t)dm->pos[k] * r, (size_t)r * sizeof(double));
+    for (k = 0; k < P; ++k) { cr[k] = dm->cnt[k] * w; cr[P + k] = dm->dsp[k] * w; }
+    MPI_Allgatherv(Cl, nd * w, MPI_DOUBLE, Ca, cr, cr + P, MPI_DOUBLE, ctx->comm);
+    phgmg__mpi_count(ctx, 8.0 * w * dm->ndg);
+    for (k = 0; k < dm->ndg; ++k) {
+      memcpy(Cd + (size_t)k * r, Ca + (size_t)dm->pos[k] * w, (size_t)r * sizeof(double));
+      for (a = 0; a < dm->nlaw; ++a) Lw[a + (size_t)k * dm->nlaw] = Ca[(size_t)dm->pos[k] * w + r + a];
+    }
     if (!phgmg__all_finite(Cd, (size_t)r * dm->ndg)) rc = PHGMG_ERR_NANINF;   /* replicated */
   }
   phgmg__free(&ctx->al, Cl); phgmg__free(&ctx->al, Ca); phgmg__free(&ctx->al, cr);
@@ -29284,7 +29301,7 @@ PHGMG__PRIV phgmg_result phgmg__mpi_damp_ecsw(const phgmg_mpi_ctx *ctx, const ph
     const int row = (int)(md->damp_i[k] - ctx->row0);
     for (j = 0; j < ns && rc == PHGMG_OK; ++j) {
       const double v = A[row + (size_t)(r + j) * ld] - Aj[k + (size_t)(r + j) * l1];
-      phgmg__damp_law(&dm->law, 0, v, d);
+      phgmg__damp_law(&dm->law, k, v, d);   /* damper k's law (the shared one: nfun 1) */
       if (!(v * d[0] >= 0.0)) rc = d[0] != d[0] ? PHGMG_ERR_NANINF : PHGMG_ERR_DAMPER;
       t.F[k + (size_t)j * nd] = d[0];
     }
@@ -29310,17 +29327,18 @@ PHGMG__PRIV phgmg_result phgmg__mpi_dampers(const phgmg_mpi_ctx *ctx, const phgm
                                             const double *X, int ldx, const double *Vb, const double *Wb, int r,
                                             double *K, phgmg__mpi_romdata *d) {
   const int n = ctx->nloc, ld = PHGMG__MAX(1, n), hy = o->hyper.on && !o->hyper.keep_dampers;
-  const int nc = r + (hy ? ns : 0), ndg = dm->ndg;
+  const int nc = r + (hy ? ns : 0), ndg = dm->ndg, nw = dm->nlaw;
   double *A = phgmg__dalloc(&ctx->al, (size_t)ld * nc + (size_t)PHGMG__MAX(1, md->ndamp) * nc + (size_t)ld * r);
-  double *Aj, *Y, *Cd = phgmg__dalloc(&ctx->al, (size_t)r * ndg + 1), *dw, dd[2], resid = 0.0;
+  double *Aj, *Y, *Cd = phgmg__dalloc(&ctx->al, (size_t)(r + nw) * ndg + 1), *Lw, *dw, dd[2] = {0.0, 0.0}, resid = 0.0;
   phgmg_gidx *pts = PHGMG__CAST(phgmg_gidx *, phgmg__alloc(&ctx->al, sizeof(phgmg_gidx) * ((size_t)ndg + 1)));
   int k, a, b, nk = ndg;
   phgmg_result rc;
-  d->dmem = phgmg__dalloc(&ctx->al, (size_t)(r + 1) * ndg + 1);
+  d->dmem = phgmg__dalloc(&ctx->al, (size_t)(r + 1 + nw) * ndg + 1);   /* Cd, dw, the kept laws */
   d->dmem_i = pts;
   rc = phgmg__mpi_agree(ctx, A && Cd && pts && d->dmem ? PHGMG_OK : PHGMG_ERR_NOMEM);
   if (rc != PHGMG_OK) { phgmg__free(&ctx->al, A); phgmg__free(&ctx->al, Cd); return rc; }
   Aj = A + (size_t)ld * nc; Y = Aj + (size_t)PHGMG__MAX(1, md->ndamp) * nc; dw = d->dmem + (size_t)r * ndg;
+  Lw = Cd + (size_t)r * ndg;
   if (Wb) memcpy(A, Wb, (size_t)ld * r * sizeof(double));
   else {   /* GMG: Y = G^T V0, Wz = Y K^T */
     memcpy(Y, Vb, (size_t)ld * r * sizeof(double));
@@ -29329,11 +29347,13 @@ PHGMG__PRIV phgmg_result phgmg__mpi_dampers(const phgmg_mpi_ctx *ctx, const phgm
   }
   if (rc == PHGMG_OK && hy) rc = phgmg__mpi_costates(ctx, md, ns, X, ldx, A + (size_t)ld * r, ld);
   if (rc == PHGMG_OK) rc = phgmg__mpi_damp_rows(ctx, md, A, ld, nc, Aj);
-  if (rc == PHGMG_OK) rc = phgmg__mpi_damp_cd(ctx, md, dm, A, ld, Aj, r, Cd);
-  phgmg__damp_law(&dm->law, 0, 0.0, dd);
-  for (k = 0; rc == PHGMG_OK && !Wb && k < ndg; ++k)   /* the serial order: dampers by id */
+  if (rc == PHGMG_OK) rc = phgmg__mpi_damp_cd(ctx, md, dm, A, ld, Aj, r, Cd, Lw);
+  if (!nw) phgmg__damp_law(&dm->law, 0, 0.0, dd);   /* the one law's rho'(0) */
+  for (k = 0; rc == PHGMG_OK && !Wb && k < ndg; ++k) {   /* the serial order: dampers by id */
+    const double s1 = nw ? Lw[1 + (size_t)k * nw] : dd[1];   /* rho_k'(0): the linear coefficient */
     for (b = 0; b < r; ++b)
-      for (a = 0; a < r; ++a) K[a + (size_t)b * r] += dd[1] * Cd[a + (size_t)k * r] * Cd[b + (size_t)k * r];
+      for (a = 0; a < r; ++a) K[a + (size_t)b * r] += s1 * Cd[a + (size_t)k * r] * Cd[b + (size_t)k * r];
+  }
   if (rc == PHGMG_OK && hy) rc = phgmg__mpi_damp_ecsw(ctx, md, dm, o->hyper.tol, ns, A, ld, Aj, r, pts, dw, &nk, &resid);
   for (k = 0; rc == PHGMG_OK && k < nk; ++k) {   /* the kept dampers' columns, in id order */
     const phgmg_gidx *f = hy ? PHGMG__CAST(const phgmg_gidx *, bsearch(pts + k, dm->sid, (size_t)ndg, sizeof *pts,
@@ -29341,8 +29361,12 @@ PHGMG__PRIV phgmg_result phgmg__mpi_dampers(const phgmg_mpi_ctx *ctx, const phgm
                              : dm->sid + k;
     if (!hy) { pts[k] = dm->sid[k]; dw[k] = 1.0; }
     memcpy(d->dmem + (size_t)k * r, Cd + (size_t)(f - dm->sid) * r, (size_t)r * sizeof(double));
+    if (nw) memcpy(d->dmem + (size_t)(r + 1) * ndg + (size_t)k * nw, Lw + (size_t)(f - dm->sid) * nw,
+                   (size_t)nw * sizeof(double));
   }
-  d->ndamp = rc == PHGMG_OK ? nk : 0; d->damp_deg = md->damp_deg; d->dpoly = md->damp_poly;
+  d->ndamp = rc == PHGMG_OK ? nk : 0; d->damp_deg = md->damp_deg;
+  d->dpoly = nw ? d->dmem + (size_t)(r + 1) * ndg : md->damp_poly;   /* the kept dampers' laws, or the one */
+  d->damp_nphi = nw ? nk : 1;
   d->Cd = d->dmem; d->dw = dw; d->dterm = pts;
   phgmg__free(&ctx->al, A); phgmg__free(&ctx->al, Cd);
   return rc;
@@ -31270,7 +31294,8 @@ PHGMG_DEF phgmg_result phgmg_sym_eig(int n, double *A, int lda, double *w, doubl
             and SP2 without a mass matrix: the co-state test basis's rows
             of the other ranks fetched in one exchange, Cd in the damper
             numbers' order, GMG's K with the dampers' linearisation, ECSW
-            over the dampers; the solve callback solves with J - R - L.
+            over the dampers; the solve callback solves with J - R - L. One
+            law for all, or one per damper (damp_per).
           - phgmg_mpi_rom.rn, .M, .V2: GMG-QM's lift (M replicated, V2 this
             rank's rows); .qm_lambda. phgmg_mpi_reduce's GMG-QM takes
             select.lambda_mode PHGMG_LAMBDA_REGRESSION (the serial choice on

@@ -65,11 +65,14 @@ static int same_everywhere(int v) {
    next neighbours the other way round, c = e_{v_{p+2}} - e_{v_p}, p = 37 t
    mod (n - 2) (so that at every rank boundary some dampers have their j on
    the next rank and some on the previous one); then one-sided dampers on
-   v_7, v_57, ...; law rho(s) = 0.2 s + 3 s^3. */
+   v_7, v_57, ...; law rho(s) = 0.2 s + 3 s^3, or with per_law_ one law
+   per damper, rho_k(s) = 0.2 (1 + 0.5 sin k) s + 3 (1 + 0.3 cos k) s^3
+   (damp_nfun = nd; distributed: damp_per = 1). */
+static int per_law_;
 typedef struct chain {
   phgmg_ph_system sys;
   int n, N, kb, nd;
-  double *J, *R, *Q, *B, *poly, *expo, *w, dpoly[4];
+  double *J, *R, *Q, *B, *poly, *expo, *w, dpoly[4], *dlaw;
   int *idx, *di, *dj;
 } chain;
 
@@ -121,6 +124,12 @@ static void chain_build(chain *c, int n) {
   c->sys.poly_deg = 0; c->sys.poly = c->poly; c->sys.nexp = 2; c->sys.expo = c->expo; c->sys.phi_nfun = nt;
   c->sys.ndamp = c->nd; c->sys.damp_i = c->di; c->sys.damp_j = c->dj;
   c->sys.damp_deg = 3; c->sys.damp_poly = c->dpoly;
+  c->dlaw = (double *)malloc(sizeof(double) * 4 * (size_t)c->nd);
+  for (t = 0; t < c->nd; ++t) {   /* one law per damper (used with per_law_) */
+    c->dlaw[4 * t] = 0.0; c->dlaw[4 * t + 1] = 0.2 * (1.0 + 0.5 * sin((double)t));
+    c->dlaw[4 * t + 2] = 0.0; c->dlaw[4 * t + 3] = 3.0 * (1.0 + 0.3 * cos((double)t));
+  }
+  if (per_law_) { c->sys.damp_poly = c->dlaw; c->sys.damp_nfun = c->nd; }
 }
 
 /* R + L (banded), L = rho'(0) sum_k c_k c_k^T: the user's solve is with J - (R + L). */
@@ -131,8 +140,9 @@ static double *chain_rl(const chain *c) {
   memcpy(Rl, c->R, sizeof(double) * (size_t)ld * c->N);
   for (k = 0; k < c->nd; ++k) {
     const int i = c->di[k], j = c->dj[k];
-    AT(Rl, i, i) += c->dpoly[1];
-    if (j >= 0) { AT(Rl, j, j) += c->dpoly[1]; AT(Rl, i, j) -= c->dpoly[1]; AT(Rl, j, i) -= c->dpoly[1]; }
+    const double c1 = per_law_ ? c->dlaw[4 * k + 1] : c->dpoly[1];
+    AT(Rl, i, i) += c1;
+    if (j >= 0) { AT(Rl, j, j) += c1; AT(Rl, i, j) -= c1; AT(Rl, j, i) -= c1; }
   }
   return Rl;
 }
@@ -140,7 +150,7 @@ static double *chain_rl(const chain *c) {
 
 static void chain_free(chain *c) {
   free(c->J); free(c->R); free(c->Q); free(c->B); free(c->poly); free(c->expo); free(c->w); free(c->idx);
-  free(c->di); free(c->dj);
+  free(c->di); free(c->dj); free(c->dlaw);
 }
 
 static void u_in(double t, double *u, void *user) { (void)user; u[0] = 0.5 * sin(0.7 * t); }
@@ -185,7 +195,7 @@ typedef struct dist {
   phgmg_mpi_op *Q, *JR;
   phgmg_mpi_sep_model md;
   solver sv;
-  double *Bl, *Xl, *pl, *el, *wl, *Rl;
+  double *Bl, *Xl, *pl, *el, *wl, *Rl, *dl;   /* dl: this rank's dampers' laws (per_law_) */
   long long *sidx, *sid, *di, *dj, *did;
   int ld;
 } dist;
@@ -244,8 +254,12 @@ static void dist_build(dist *d, const chain *ch, int ns, const double *X) {
   d->di = (long long *)malloc(sizeof(long long) * ((size_t)ch->nd + 1));
   d->dj = (long long *)malloc(sizeof(long long) * ((size_t)ch->nd + 1));
   d->did = (long long *)malloc(sizeof(long long) * ((size_t)ch->nd + 1));
+  d->dl = (double *)malloc(sizeof(double) * 4 * ((size_t)ch->nd + 1));
   for (k = 0; k < ch->nd; ++k)
-    if (ch->di[k] >= row0 && ch->di[k] < row0 + nloc) { d->di[nd] = ch->di[k]; d->dj[nd] = ch->dj[k]; d->did[nd++] = k; }
+    if (ch->di[k] >= row0 && ch->di[k] < row0 + nloc) {
+      memcpy(d->dl + 4 * (size_t)nd, ch->dlaw + 4 * (size_t)k, 4 * sizeof(double));
+      d->di[nd] = ch->di[k]; d->dj[nd] = ch->dj[k]; d->did[nd++] = k;
+    }
   sl = ch->sys;   /* J - (R + L) for the user's solve */
   d->Rl = chain_rl(ch);
   sl.R = d->Rl; sl.ndamp = 0; sl.damp_i = NULL; sl.damp_j = NULL; sl.damp_poly = NULL;
@@ -256,7 +270,7 @@ static void dist_build(dist *d, const chain *ch, int ns, const double *X) {
   d->md.nsep = nt; d->md.sep_idx = d->sidx; d->md.sep_id = d->sid; d->md.sep_w = d->wl;
   d->md.poly_deg = 0; d->md.nexp = 2; d->md.per_term = 1; d->md.poly = d->pl; d->md.expo = d->el;
   d->md.ndamp = nd; d->md.damp_i = d->di; d->md.damp_j = d->dj; d->md.damp_id = d->did;
-  d->md.damp_deg = 3; d->md.damp_poly = ch->dpoly;
+  d->md.damp_deg = 3; d->md.damp_poly = per_law_ ? d->dl : ch->dpoly; d->md.damp_per = per_law_;
 }
 
 static void dist_free(dist *d) {
@@ -264,7 +278,7 @@ static void dist_free(dist *d) {
   phgmg_mpi_op_destroy(d->Q);
   phgmg_mpi_op_destroy(d->JR);
   free(d->Bl); free(d->Xl); free(d->pl); free(d->el); free(d->wl); free(d->sidx); free(d->sid);
-  free(d->di); free(d->dj); free(d->did); free(d->Rl);
+  free(d->di); free(d->dj); free(d->did); free(d->Rl); free(d->dl);
   phgmg_mpi_ctx_destroy(d->c);
 }
 
@@ -398,7 +412,13 @@ static void compare_serial(const chain *ch, const dist *d, const double *x0, con
     e[4] = rel_diff(r, nd, mr->rom.Cd, ro->Cd, sg, NULL);
     CHECK(e[3] <= 1e-12 && e[4] <= 1e-12, "%s: damper weights %.2e, Cd %.2e", tag, e[3], e[4]);
   }
-  CHECK(mr->rom.damp_deg == 3 && mr->rom.dpoly && mr->rom.dpoly[1] == 0.2 && mr->rom.dpoly[3] == 3.0, "%s: law", tag);
+  {   /* the laws: the serial model's (one row, or one per kept damper), exactly */
+    const int nphi = ro->damp_nphi > 1 ? ro->damp_nphi : 1;
+    int same_law = mr->rom.damp_deg == ro->damp_deg && (mr->rom.damp_nphi > 1 ? mr->rom.damp_nphi : 1) == nphi &&
+                   mr->rom.dpoly != NULL;
+    for (j = 0; same_law && j < nphi * (ro->damp_deg + 1); ++j) same_law = mr->rom.dpoly[j] == ro->dpoly[j];
+    CHECK(same_law, "%s: the damper laws differ from the serial model's", tag);
+  }
   phgmg_reduced_restrict(red, x0, xr);
   for (j = 0; j < r; ++j) xd[j] = sg[j] * xr[j];
   e[0] = fmax(e[0], fmax(e[1], e[2]));
@@ -431,7 +451,7 @@ static void test_methods(int n, int r) {
       phgmg_mpi_rom mr;
       phgmg_result rc;
       char tag[64];
-      snprintf(tag, sizeof tag, "%s%s", name[mi], hy ? " ecsw" : "");
+      snprintf(tag, sizeof tag, "%s%s%s", name[mi], hy ? " ecsw" : "", per_law_ ? ", a law per damper" : "");
       memset(&o, 0, sizeof o);
       o.method = meth[mi]; o.r = r; o.hyper.on = hy; o.hyper.kind = PHGMG_HYPER_ECSW; o.hyper.tol = 1e-3;
       rc = phgmg_mpi_reduce(d.c, &d.md, ns, d.Xl, d.ld, &o, &mr, V0, d.ld);
@@ -605,6 +625,9 @@ int main(int argc, char **argv) {
   t0 = MPI_Wtime();
   if (rank_ == 0) printf("test_mpi_damp: P = %d\n", size_);
   test_methods(500, 10);
+  per_law_ = 1;   /* the same with one law per damper */
+  test_methods(500, 10);
+  per_law_ = 0;
   test_one_sided(500, 10);
   test_errors(60);
   test_counts();
