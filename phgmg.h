@@ -1044,7 +1044,7 @@
      mpirun -np P build/phgmg-mpi reduce --J-coo J.npy --R-coo R.npy
          --Q-coo Q.npy --B B.npy --X X.npy --method gmg-pod|gmg-qm|sp1|sp2
          --r R --out DIR [--name rom] [--dt DT] [--quiet]
-         [--manifold pod|greedy] [--rn RN] [--lambda L]
+         [--manifold pod|greedy] [--rn RN] [--lambda L] [--dampers D.npy]
          [--potential NAME | --poly c.npy [--exp e.npy]] --poly-idx idx.npy
          [--poly-w w.npy] [--hyper ecsw|qdeim|greedy] [--hyper-tol T]
          [--deim-tol T] [--deim-max K] [--deim-allow-negative] [--no-hyper]
@@ -1082,7 +1082,7 @@
    `phgmg reduce` -- --simulate (make the snapshots with the serial
    `phgmg simulate --states`), dense matrices, a mass matrix with sp1,
    sp2 or gmg-qm, a port on an algebraic equation, springs (--poly-jdx),
-   dampers, feedthrough, --ref, gmg-qm's --lambda auto, --rn wide
+   dampers with a mass matrix or gmg-qm, feedthrough, --ref, gmg-qm's --lambda auto, --rn wide
    and --manifold altmin, balancing, several --X files,
    method or order lists -- is refused with a message naming the option;
    bad input (a missing file, wrong shapes, bad indices; J, R, B and J - R
@@ -1112,7 +1112,12 @@
    within 8e-13 (zero at the algebraic variables, as the serial command
    writes it), the outputs within 4e-14, the json's N (the differential
    count), N_full, algebraic and rcond_jr (the condensed model's) the
-   serial's; gmg-qm on the cosh chain (the POD manifold with --rn 4 and
+   serial's; --dampers (the serial command's (k, 4) file of rows i, j, c1,
+   c3: each rank keeps the dampers on its rows, with their row numbers as
+   ids and a law each, damp_per; every damper kept, hyper.keep_dampers; the
+   replicated LU of J - R - L) on the cosh chain with 81 dampers, sp1 at
+   P = 3: K, Qh within 2e-15, the same 16 points, the outputs within
+   5e-15, the json's "dampers"; gmg-qm on the cosh chain (the POD manifold with --rn 4 and
    --lambda cv at P = 3: the serial lambda, 1e-14; the greedy manifold,
    default rn and --lambda 1e-3 at P = 4; ECSW): every block of the
    quadratic model, P1, V2 and M within 1.6e-11 (2.5e-12 at the fixed

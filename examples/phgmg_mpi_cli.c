@@ -3,7 +3,7 @@
      make build/phgmg-mpi        (mpicc; the library with PHGMG_MPI)
      mpirun -np P build/phgmg-mpi reduce --J-coo J.npy --R-coo R.npy --Q-coo Q.npy \
          --B B.npy --X X.npy --method gmg-pod|gmg-qm|sp1|sp2 --r R --out DIR [--name rom] [--dt DT] [--quiet]
-         [--manifold pod|greedy] [--rn RN] [--lambda L]
+         [--manifold pod|greedy] [--rn RN] [--lambda L] [--dampers D.npy]
          [--potential NAME | --poly c.npy [--exp e.npy]] --poly-idx idx.npy [--poly-w w.npy]
          [--hyper ecsw] [--hyper-tol T] [--no-hyper]
 
@@ -54,9 +54,9 @@ static const char *const help_text[] = {
   "               [--potential NAME | --poly FILE [--exp FILE]] --poly-idx FILE\n"
   "               [--poly-w FILE] [--hyper ecsw|qdeim|greedy] [--hyper-tol T]\n"
   "               [--deim-tol T] [--deim-max K] [--deim-allow-negative] [--no-hyper]\n"
-  "               [--E-coo E.npy]\n"
+  "               [--E-coo E.npy] [--dampers D.npy]\n"
   "  phgmg-mpi --help | --version\n"
-  "\n"
+  "\n",
   "OPTIONS (those of `phgmg reduce`, with the same meaning)\n"
   "  --J-coo FILE, --R-coo FILE, --Q-coo FILE   J, R, Q as (nnz, 3) .npy arrays of\n"
   "                      (row, col, value) triplets, 0-based, duplicates summed.\n"
@@ -71,6 +71,12 @@ static const char *const help_text[] = {
   "                      model; V0's rows at the algebraic variables are zero). Its\n"
   "                      solves use the library's sparse LU of E, replicated as that\n"
   "                      of J - R.\n"
+  "  --dampers FILE      nonlinear dampers, a (k, 4) array with rows (i, j, c1, c3): a\n"
+  "                      damper on s = z_i - z_j (j = -1: s = z_i) with the force\n"
+  "                      c1 s + c3 s^3, c1, c3 >= 0; gmg-pod, sp1, sp2 without --E-coo.\n"
+  "                      The reduced model keeps every damper (the hyper-reduction\n"
+  "                      options apply to the nonlinear terms only); the replicated\n"
+  "                      LU is then of J - R - L, L the dampers' c1 terms.\n"
   "  --B FILE            N x m port matrix, or a vector of length N for m = 1 (N is\n"
   "                      taken from B).\n"
   "  --X FILE            the snapshots, N x ns (one state per column). Every rank reads\n"
@@ -87,7 +93,7 @@ static const char *const help_text[] = {
   "  --dt DT             the snapshots' step, recorded in the model file\n"
   "                      (simulate-rom's default step).\n"
   "  --quiet             no summary line.\n"
-  "\n"
+  "\n",
   "GMG-QM (--method gmg-qm)\n"
   "  --lambda L          required here: the ridge parameter of the quadratic fit M, on the\n"
   "                      un-normalised sum over the snapshots (e.g. 1e-3, the paper's;\n"
@@ -165,9 +171,9 @@ static const char *const help_text[] = {
   "  --simulate (give the snapshots with --X; make them with the serial\n"
   "  `phgmg simulate ... --states X.npy`), dense --J/--R/--Q/--E, a mass matrix\n"
   "  with sp1, sp2 or gmg-qm, a port on an algebraic equation, springs\n"
-  "  (--poly-jdx), dampers, feedthrough, --ref, gmg-qm's --lambda auto,\n"
-  "  --rn wide and --manifold altmin, balancing, several --X files, method or\n"
-  "  order lists, and every\n"
+  "  (--poly-jdx), dampers with --E-coo or gmg-qm, feedthrough, --ref, gmg-qm's\n"
+  "  --lambda auto, --rn wide and --manifold altmin, balancing, several --X\n"
+  "  files, method or order lists, and every\n"
   "  other option of `phgmg reduce`: use the serial `phgmg` for them.\n"
   "\n"
   "EXIT STATUS\n"
@@ -178,6 +184,7 @@ typedef struct args {
   const char *J, *R, *Q, *B, *X, *out, *name;
   const char *potential, *poly, *expf, *poly_idx, *poly_w;   /* the separable nonlinear part */
   const char *E;                                             /* --E-coo: a mass matrix */
+  const char *dampf;                                         /* --dampers: (k, 4) rows (i, j, c1, c3) */
   int method, r, quiet, have_dt, no_hyper, have_hyper, have_hyper_tol;
   int hyper_kind, deim_max, deim_neg, have_deim_opt;   /* --hyper (PHGMG_HYPER_*), the DEIM options */
   int manifold, rn, have_lambda, have_qm_opt, lambda_cv; /* gmg-qm: --manifold, --rn, --lambda (cv: 1) */
@@ -198,6 +205,11 @@ typedef struct dist {
   phgmg_gidx *sidx, *sid;
   double *sw, *spoly, *sexpo;    /* sw NULL: weights 1 */
   double named[8];               /* --potential's coefficients (shared) */
+  /* the dampers: all of them (whole file, for the solver's J - R - L) and this rank's */
+  int nd_all, ndl;
+  double *D;                     /* nd_all x 4 (column-major: i, j, c1, c3) */
+  phgmg_gidx *dli, *dlj, *dlid;
+  double *dlaw;                  /* ndl x 4: {0, c1, 0, c3} */
 } dist;
 
 /* The replicated solver of J - R. */
@@ -427,11 +439,12 @@ static int name_ok(const char *s) {
 }
 
 /* argv[2..]: the options of reduce. 0 ok, 2 a usage error (the same on every rank: the same argv). */
-#define NVOPT 24   /* options with a value; the first NSOPT are file or name strings */
-#define NSOPT 12
+#define NVOPT 25   /* options with a value; the first NSOPT are file or name strings */
+#define NSOPT 13
 static int parse_args(int argc, char **argv, args *a) {
   static const char *const with_value[NVOPT] = {"--J-coo", "--R-coo", "--Q-coo", "--B", "--X", "--out", "--name",
-                                                "--poly", "--exp", "--poly-idx", "--poly-w", "--E-coo", "--method", "--r",
+                                                "--poly", "--exp", "--poly-idx", "--poly-w", "--E-coo", "--dampers",
+                                                "--method", "--r",
                                                 "--dt", "--potential", "--hyper", "--hyper-tol", "--deim-tol",
                                                 "--deim-max", "--manifold", "--rn", "--lambda", ""};
   const char **slot[NSOPT];
@@ -441,7 +454,7 @@ static int parse_args(int argc, char **argv, args *a) {
   a->name = "rom"; a->method = -1;
   slot[0] = &a->J; slot[1] = &a->R; slot[2] = &a->Q; slot[3] = &a->B; slot[4] = &a->X; slot[5] = &a->out;
   slot[6] = &a->name; slot[7] = &a->poly; slot[8] = &a->expf; slot[9] = &a->poly_idx; slot[10] = &a->poly_w;
-  slot[11] = &a->E;
+  slot[11] = &a->E; slot[12] = &a->dampf;
   for (i = 2; i < argc; ++i) {
     const char *o = argv[i];
     if (!strcmp(o, "--quiet")) { a->quiet = 1; continue; }
@@ -484,6 +497,9 @@ static int parse_args(int argc, char **argv, args *a) {
     return usage("gmg-qm needs --lambda here: cv (chosen by held-out regression) or a fixed value (e.g. 1e-3; 0 "
                  "means exactly zero); the serial default, --lambda auto, validates lambda by simulating the runs, "
                  "which phgmg-mpi does not do");
+  if (a->dampf && (a->E || a->method == PHGMG_METHOD_GMG_QM))
+    return usage("--dampers: phgmg-mpi reduces models with dampers by gmg-pod, sp1 or sp2 without a mass matrix "
+                 "(for %s use the serial `phgmg reduce`)", a->E ? "--E-coo" : "gmg-qm");
   if (a->E && a->method != PHGMG_METHOD_GMG_POD)
     return usage("--E-coo: phgmg-mpi reduces models with a mass matrix by gmg-pod (for %s use the serial `phgmg "
                  "reduce`)", method_name(a->method));
@@ -747,6 +763,51 @@ done:
   return bad;
 }
 
+/* --dampers FILE, as the serial command reads it: a (k, 4) array (or 4
+   values for one damper) of rows (i, j, c1, c3), a damper on s = z_i - z_j
+   (j = -1: z_i) with the force c1 s + c3 s^3, c1, c3 >= 0. Every rank reads
+   the whole (small) file and checks every row, keeps all of it (the solver
+   of J - R - L needs every damper's c1) and its own dampers (i on its rows)
+   with their row numbers as global ids. 0, or 1 after a message. */
+static int read_dampers(const args *a, dist *d) {
+  int rows, cols, vec, k, n;
+  if (!a->dampf) return 0;
+  if (read_array("--dampers", a->dampf, &d->D, &rows, &cols, &vec)) return 1;
+  n = rows * cols == 4 ? 1 : rows;
+  if (rows * cols != 4 * n || (n > 1 && cols != 4) || n < 1) {
+    say("--dampers %s: expected shape (k, 4), rows (i, j, c1, c3), got (%d, %d)", a->dampf, rows, cols);
+    return 1;
+  }
+  d->nd_all = n;
+  for (k = 0; k < n; ++k) {
+    const double vi = d->D[k], vj = d->D[k + n], c1 = d->D[k + 2 * n], c3 = d->D[k + 3 * n];
+    if (!(vi >= 0.0 && vi < d->N && vi == floor(vi)) || !(vj >= -1.0 && vj < d->N && vj == floor(vj)) || vi == vj) {
+      say("--dampers %s: row %d: i = %g, j = %g; expected integer states in [0, %d), j = -1 for one state, i != j",
+          a->dampf, k, vi, vj, d->N);
+      return 1;
+    }
+    if (!(c1 >= 0.0 && c3 >= 0.0)) {
+      say("--dampers %s: row %d: c1 = %g, c3 = %g: the damper generates energy (c1, c3 >= 0 needed)", a->dampf, k, c1,
+          c3);
+      return 1;
+    }
+    d->ndl += vi >= (double)d->row0 && vi < (double)(d->row0 + d->nloc);
+  }
+  d->dli = (phgmg_gidx *)malloc(sizeof(phgmg_gidx) * 3 * ((size_t)d->ndl + 1));
+  d->dlaw = (double *)malloc(sizeof(double) * 4 * ((size_t)d->ndl + 1));
+  if (!d->dli || !d->dlaw) { say("out of memory"); return 1; }
+  d->dlj = d->dli + d->ndl + 1; d->dlid = d->dlj + d->ndl + 1;
+  for (k = 0, d->ndl = 0; k < n; ++k) {   /* this rank's, ascending row numbers */
+    const double vi = d->D[k];
+    if (!(vi >= (double)d->row0 && vi < (double)(d->row0 + d->nloc))) continue;
+    d->dli[d->ndl] = (phgmg_gidx)vi; d->dlj[d->ndl] = (phgmg_gidx)d->D[k + n]; d->dlid[d->ndl] = k;
+    d->dlaw[4 * d->ndl] = 0.0; d->dlaw[4 * d->ndl + 1] = d->D[k + 2 * n];
+    d->dlaw[4 * d->ndl + 2] = 0.0; d->dlaw[4 * d->ndl + 3] = d->D[k + 3 * n];
+    ++d->ndl;
+  }
+  return 0;
+}
+
 /* The inputs, each step agreed over the ranks (a fault on one rank stops all). */
 static int read_inputs(const args *a, dist *d) {
   if (any_rank(read_B_layout(a, d))) return 1;
@@ -756,6 +817,7 @@ static int read_inputs(const args *a, dist *d) {
   if (any_rank(read_triplets("--Q-coo", a->Q, d->N, &d->TQ, &d->nQ))) return 1;
   if (a->E && any_rank(read_triplets("--E-coo", a->E, d->N, &d->TE, &d->nE))) return 1;
   if (any_rank(read_terms(a, d))) return 1;
+  if (any_rank(read_dampers(a, d))) return 1;
   return any_rank(read_X_rows(a, d));
 }
 
@@ -765,6 +827,7 @@ static void dist_free(dist *d) {
   phgmg_npy_free(d->Bfull, NULL);
   free(d->Bl); free(d->Xl); free(d->cnt);
   free(d->sidx); free(d->sw); free(d->spoly); free(d->sexpo);
+  phgmg_npy_free(d->D, NULL); free(d->dli); free(d->dlaw);
 }
 
 /* ---- the operators ------------------------------------------------------------ */
@@ -826,14 +889,37 @@ static phgmg_result triplets_csc(int N, const double *T, long nnz, phgmg_csc *ou
   return rc;
 }
 
+/* R + L as triplets (*T, *n; allocated), L = sum_k c1_k c_k c_k^T the
+   dampers' linearisation at rest (c_k = e_i - e_j, or e_i). */
+static phgmg_result r_plus_l(const dist *d, double **T, long *n) {
+  const long nd = d->nd_all, nn = d->nR + 4 * nd;
+  long k, q = d->nR;
+  *n = nn;
+  *T = (double *)malloc(sizeof(double) * 3 * (size_t)(nn + 1));
+  if (!*T) return PHGMG_ERR_NOMEM;
+  for (k = 0; k < d->nR; ++k) {
+    (*T)[k] = d->TR[k]; (*T)[nn + k] = d->TR[d->nR + k]; (*T)[2 * nn + k] = d->TR[2 * d->nR + k];
+  }
+  for (k = 0; k < nd; ++k) {
+    const double i = d->D[k], j = d->D[k + nd], c1 = d->D[k + 2 * nd];
+    const double ti[4] = {i, j, i, j}, tj[4] = {i, j, j, i}, tv[4] = {c1, c1, -c1, -c1};
+    int e;
+    for (e = 0; e < (j >= 0.0 ? 4 : 1); ++e, ++q) { (*T)[q] = ti[e]; (*T)[nn + q] = tj[e]; (*T)[2 * nn + q] = tv[e]; }
+  }
+  for (; q < nn; ++q) { (*T)[q] = 0.0; (*T)[nn + q] = 0.0; (*T)[2 * nn + q] = 0.0; }   /* one-sided: unused slots */
+  return PHGMG_OK;
+}
+
 /* The replicated solver: J - R (with Q = I, which the solve with J - R does
    not see) as a sparse model, checked as the serial command checks J, R
    and B, factored once by the library's sparse LU (band LU fall-back;
-   manual 8.12). Every rank does the same. */
+   manual 8.12); with dampers the factor is of J - R - L (the library's
+   solve for a model with dampers). Every rank does the same. */
 static phgmg_result solver_create(const dist *d, solver *s) {
   phgmg_csc J, R, I;
   phgmg_result rc;
-  double one = 1.0;
+  double one = 1.0, *TL = NULL;
+  long nL = 0;
   int *idx = (int *)malloc(sizeof(int) * (size_t)d->N), i;
   double *ones = (double *)malloc(sizeof(double) * (size_t)d->N);
   memset(s, 0, sizeof *s);
@@ -849,9 +935,19 @@ static phgmg_result solver_create(const dist *d, solver *s) {
   if (rc == PHGMG_OK) rc = phgmg_ph_sparse_create(&s->sp, d->N, d->m, &J, &R, &I, d->Bfull, NULL, NULL, NULL);
   /* the serial checks of J, R, B and J - R (relative tolerance 1e-12); Q here is I, so Q's are not made */
   if (rc == PHGMG_OK) rc = phgmg_ph_validate(phgmg_ph_sparse_system(s->sp), 1e-12, NULL, NULL);
+  if (rc == PHGMG_OK && d->nd_all) {   /* dampers: the model again with R + L, for the factor */
+    phgmg_ph_sparse_destroy(s->sp);
+    s->sp = NULL;
+    phgmg_csc_free(&R, NULL);
+    memset(&R, 0, sizeof R);
+    rc = r_plus_l(d, &TL, &nL);
+    if (rc == PHGMG_OK) rc = triplets_csc(d->N, TL, nL, &R);
+    if (rc == PHGMG_OK) rc = phgmg_ph_sparse_create(&s->sp, d->N, d->m, &J, &R, &I, d->Bfull, NULL, NULL, NULL);
+    if (rc == PHGMG_ERR_NOT_PSD || rc == PHGMG_ERR_NOT_SYMMETRIC) rc = PHGMG_ERR_DAMPER;
+  }
   if (rc == PHGMG_OK) rc = phgmg_jr_factor_create(&s->f, phgmg_ph_sparse_system(s->sp), &s->rcond, NULL);
   phgmg_csc_free(&J, NULL); phgmg_csc_free(&R, NULL); phgmg_csc_free(&I, NULL);
-  free(idx); free(ones);
+  free(idx); free(ones); free(TL);
   return rc;
 }
 
@@ -1046,9 +1142,14 @@ static void explain(const args *a, const dist *d, phgmg_result rc) {
     say("%s: --r %d does not fit: %s (N = %d, m = %d, %d snapshots; the order must not exceed the snapshots' "
         "numerical rank%s)", meth, a->r, phgmg_result_string(rc), d->N, d->m, d->ns,
         a->method == PHGMG_METHOD_SP1 || a->method == PHGMG_METHOD_SP2 ? "" : " plus m, and must exceed m");
+  else if (rc == PHGMG_ERR_SINGULAR && a->dampf)
+    say("--dampers %s: J - R minus the dampers' linear part at 0 (their c1 terms) is singular or its LU needs "
+        "pivoting the sparse LU does not do: %s", a->dampf, phgmg_result_string(rc));
   else if (rc == PHGMG_ERR_SINGULAR)
     say("%s: J - R (--J-coo %s, --R-coo %s) is singular or its LU needs pivoting the sparse LU does not do: %s",
         meth, a->J, a->R, phgmg_result_string(rc));
+  else if (rc == PHGMG_ERR_DAMPER)
+    say("--dampers %s: %s", a->dampf ? a->dampf : "", phgmg_result_string(rc));
   else if (rc == PHGMG_ERR_RANK)
     say("%s: --B %s is rank deficient: %s", meth, a->B, phgmg_result_string(rc));
   else if (rc == PHGMG_ERR_NOT_SKEW)
@@ -1135,6 +1236,10 @@ static int reduce(const args *a, dist *d, result *res) {
     } else {
       md.poly_deg = 1;   /* no separable terms (nsep = 0): a linear model */
     }
+    if (a->dampf) {   /* this rank's dampers, one law each (the serial command's c1 s + c3 s^3 per row) */
+      md.ndamp = d->ndl; md.damp_i = d->dli; md.damp_j = d->dlj; md.damp_id = d->dlid;
+      md.damp_deg = 3; md.damp_poly = d->dlaw; md.damp_per = 1;
+    }
     memset(&o, 0, sizeof o);
     o.method = (phgmg_method)a->method; o.r = a->r;
     /* the serial default: ECSW (tolerance 1e-6 unless --hyper-tol) on a nonlinear part, --no-hyper keeps every term */
@@ -1142,6 +1247,7 @@ static int reduce(const args *a, dist *d, result *res) {
     o.hyper.kind = (phgmg_hyper)a->hyper_kind;
     o.hyper.tol = a->have_hyper_tol ? a->hyper_tol : 0.0;
     o.hyper.deim_tol = a->deim_tol; o.hyper.deim_max = a->deim_max; o.hyper.allow_negative = a->deim_neg;
+    o.hyper.keep_dampers = 1;   /* as the serial command: every damper kept, the options apply to the terms */
     if (a->method == PHGMG_METHOD_GMG_QM) {   /* the serial command's gmg-qm options (a fixed lambda) */
       o.qm.manifold = (phgmg_manifold)a->manifold;
       o.qm.rn = a->rn ? a->rn : default_rn(d->N, a->r, d->m);
@@ -1194,16 +1300,16 @@ static void out_path(const args *a, int k, char *buf, size_t cap) {
 
 /* 1 if an output is one of the input files: a run never overwrites its inputs. */
 static int outputs_clash(const args *a) {
-  const char *in[10];
-  const char *opt[10] = {"--J-coo", "--R-coo", "--Q-coo", "--B", "--X", "--poly-idx", "--poly-w", "--poly", "--exp",
-                         "--E-coo"};
+  const char *in[11];
+  const char *opt[11] = {"--J-coo", "--R-coo", "--Q-coo", "--B", "--X", "--poly-idx", "--poly-w", "--poly", "--exp",
+                         "--E-coo", "--dampers"};
   char p[4200];
   int k, i;
   in[0] = a->J; in[1] = a->R; in[2] = a->Q; in[3] = a->B; in[4] = a->X;
-  in[5] = a->poly_idx; in[6] = a->poly_w; in[7] = a->poly; in[8] = a->expf; in[9] = a->E;
+  in[5] = a->poly_idx; in[6] = a->poly_w; in[7] = a->poly; in[8] = a->expf; in[9] = a->E; in[10] = a->dampf;
   for (k = 0; k < 3 + NARR; ++k) {
     out_path(a, k, p, sizeof p);
-    for (i = 0; i < 10; ++i)
+    for (i = 0; i < 11; ++i)
       if (in[i] && (same_file(p, in[i]) || !strcmp(p, in[i]))) {
         say("--out %s: the output %s is the input file of %s; choose another --out or --name", a->out, p, opt[i]);
         return 1;
@@ -1370,6 +1476,7 @@ static void json_system(FILE *f, const args *a) {
   fprintf(f, ", \"Q\": "); json_str(f, a->Q);
   fprintf(f, ", \"sparse\": true");
   if (a->E) { fprintf(f, ", \"E\": "); json_str(f, a->E); }
+  if (a->dampf) { fprintf(f, ", \"dampers\": "); json_str(f, a->dampf); }
   if (a->poly_idx) {
     if (a->poly) { fprintf(f, ", \"poly\": "); json_str(f, a->poly); }
     if (a->expf) { fprintf(f, ", \"exp\": "); json_str(f, a->expf); }
@@ -1441,7 +1548,7 @@ static int write_json(const args *a, const dist *d, const result *res) {
   fprintf(f, "{\n  \"phgmg_version\": \"%s\",\n  \"name\": ", PHGMG_VERSION_STRING);
   json_str(f, a->name);
   fprintf(f, ",\n  \"method\": \"%s\",\n  \"kind\": \"%s\",\n  \"map\": \"%s\",\n", method_name(a->method),
-          a->poly_idx ? "nonlinear" : "linear", qm ? "quadratic" : "linear");
+          a->poly_idx || a->dampf ? "nonlinear" : "linear", qm ? "quadratic" : "linear");
   fprintf(f, "  \"N\": %d, \"m\": %d, \"r\": %d, \"rn\": %d, \"nd\": %d, \"poly_deg\": %d,\n", d->N - res->nalg,
           d->m, a->r, res->mr.rn, nd, nd ? rom->poly_deg : 0);
   fprintf(f, "  \"E\": %s, \"N_full\": %d, \"algebraic\": %d, \"feedthrough\": false,\n  \"dt_map\": 0,\n",

@@ -35,7 +35,11 @@
 # checks, and the json's "E". An index-one RLC grid (bench/rlc_grid.py,
 # 8 x 8 mains: N = 288, 144 algebraic lines; rows and states scrambled by
 # different permutations) with gmg-pod at P = 3: the same checks and
-# the json's N (the differential count), N_full and algebraic. GMG-QM on
+# the json's N (the differential count), N_full and algebraic. The cosh
+# chain with 81 cubic dampers of their own laws (--dampers: between
+# momentum and position of every other mass, some one-sided; snapshots
+# from the serial simulate), sp1 at P = 3: the same checks, every damper
+# kept (the serial command's rule), and the json's "dampers". GMG-QM on
 # the cosh chain: the POD manifold, --rn 4 and --lambda cv (chosen by
 # held-out regression: the json's lambda_used the serial's; it picks 1e-14
 # here, a model that needs simulate-rom --dt 0.01) at P = 3, the greedy
@@ -96,6 +100,11 @@ rows = np.concatenate([q, p, p[:-1], p[1:]])
 cols = np.concatenate([q, p, p[1:], p[:-1]])
 vals = np.concatenate([1.25 * np.ones(n), mp, np.full(n - 1, 1.0 / 6.0), np.full(n - 1, 1.0 / 6.0)])
 np.save(d + '/E.npy', np.column_stack([rows, cols, vals]))
+# dampers (i, j, c1, c3), a law each: between momentum and position of every other mass (within the model's
+# band), and one-sided on every 40th momentum
+dr = [(p[k], q[k], 0.05 + 0.01 * (k % 4), 0.5 + 0.1 * (k % 3)) for k in range(0, n, 2)]
+dr += [(p[k], -1, 0.02, 0.3) for k in range(5, n, 40)]
+np.save(d + '/damp.npy', np.array(dr, dtype=float))
 keep = rows != q[5]   # one position's row empty: an algebraic constraint (refused by phgmg-mpi)
 np.save(d + '/E0.npy', np.column_stack([rows[keep], cols[keep], vals[keep]]))
 PYEOF
@@ -103,6 +112,7 @@ PYEOF
 "$PHGMG" simulate $M $NL --dt 0.1 --steps 200 --out "$D/y_full_nl.npy" --states "$D/X_nl.npy" --quiet > /dev/null
 "$PHGMG" simulate $M $PT --dt 0.1 --steps 200 --out "$D/y_full_pt.npy" --states "$D/X_pt.npy" --quiet > /dev/null
 "$PHGMG" simulate $M --E-coo "$D/E.npy" $NL --dt 0.1 --steps 200 --out "$D/y_full_e.npy" --states "$D/X_e.npy" --quiet > /dev/null
+"$PHGMG" simulate $M $NL --dampers "$D/damp.npy" --dt 0.1 --steps 200 --out "$D/y_full_d.npy" --states "$D/X_d.npy" --quiet > /dev/null
 # an index-one RLC grid (bench/rlc_grid.py: 8 x 8 mains, N = 288, 144 algebraic lines, rows and states
 # scrambled by different permutations: the zero rows and zero columns of E are different index sets)
 $PY bench/rlc_grid.py "$D/rlc" --n 8 --steps 200 > /dev/null
@@ -112,7 +122,7 @@ MR="--J-coo $D/rlc/J.npy --R-coo $D/rlc/R.npy --Q-coo $D/rlc/Q.npy --E-coo $D/rl
 # case: linear (gmg-pod, sp1), cosh (cosh-gmg-pod, cosh-sp1), per-term functions without hyper-reduction
 # (terms-sp1), cosh with DEIM (qdeim-gmg-pod, greedy-sp2), cosh with a mass matrix (mass-gmg-pod)
 for case in gmg-pod sp1 cosh-gmg-pod cosh-sp1 terms-sp1 qdeim-gmg-pod greedy-sp2 mass-gmg-pod qmpod-gmg-qm qmgreedy-gmg-qm \
-            rlc-gmg-pod; do
+            rlc-gmg-pod damp-sp1; do
   model=$M
   rdt=0.1
   ps="1 2 3 4"
@@ -124,12 +134,13 @@ for case in gmg-pod sp1 cosh-gmg-pod cosh-sp1 terms-sp1 qdeim-gmg-pod greedy-sp2
     qmpod-*) meth=gmg-qm; X="$D/X_nl.npy"; opt="$NL --manifold pod --rn 4 --lambda cv"; rdt=0.01 ;;
     qmgreedy-*) meth=gmg-qm; X="$D/X_nl.npy"; opt="$NL --manifold greedy --lambda 1e-3" ;;
     rlc-*) meth=gmg-pod; X="$D/X_rlc.npy"; opt=""; model=$MR ;;
+    damp-*) meth=${case#damp-}; X="$D/X_d.npy"; opt="$NL --dampers $D/damp.npy" ;;
     *) meth=$case; X="$D/X.npy"; opt="" ;;
   esac
   case $case in   # every P over the two cases of a method (the library's layer is checked at each P by test_mpi_nl)
     gmg-pod) ps="1 3" ;; sp1) ps="2 4" ;; cosh-gmg-pod) ps="2 4" ;; cosh-sp1) ps="1 3" ;;
     qdeim-*) ps="3" ;; greedy-*) ps="4" ;; mass-*) ps="2" ;; qmpod-*) ps="3" ;; qmgreedy-*) ps="4" ;;
-    rlc-*) ps="3" ;;
+    rlc-*) ps="3" ;; damp-*) ps="3" ;;
   esac
   "$PHGMG" reduce $model $opt --X "$X" --method $meth --r 10 --out "$D/serial_$case" --quiet > /dev/null
   "$PHGMG" simulate-rom --model "$D/serial_$case/rom.phgmgrom" --dt $rdt --steps 300 --out "$D/y_serial_$case.npy" --quiet > /dev/null
@@ -182,6 +193,8 @@ refused "--lambda auto: phgmg-mpi does not simulate" --X "$D/X.npy" --method gmg
 refused "--rn wide: not distributed" --X "$D/X.npy" --method gmg-qm --lambda 1e-3 --rn wide
 refused "--manifold altmin: not distributed" --X "$D/X.npy" --method gmg-qm --lambda 1e-3 --manifold altmin
 refused "apply to --method gmg-qm only" --X "$D/X.npy" --lambda 1e-3
+refused "--dampers: phgmg-mpi reduces models with dampers by gmg-pod, sp1 or sp2 without a mass matrix" \
+  --X "$D/X_d.npy" $NL --dampers "$D/damp.npy" --method gmg-qm --lambda 1e-3
 # An output that is an input file (here --E-coo as the basis' path) is refused and the file left as it was.
 mkdir -p "$D/clash" && cp "$D/E.npy" "$D/clash/rom_V0.npy"
 if timeout 60 $MPIRUN -np 2 "$PMPI" reduce $M --E-coo "$D/clash/rom_V0.npy" --X "$D/X_e.npy" --method gmg-pod --r 10 \
@@ -189,7 +202,7 @@ if timeout 60 $MPIRUN -np 2 "$PMPI" reduce $M --E-coo "$D/clash/rom_V0.npy" --X 
    ! cmp -s "$D/E.npy" "$D/clash/rom_V0.npy" || [ -e "$D/clash/rom.json" ]; then
   echo "check_cli_mpi: FAILED: an output that is the --E-coo file was not refused, or the file changed"; cat "$D/err.txt"; exit 1
 fi
-echo "check_cli_mpi: wrong snapshot shape, --simulate, --ref, --poly-jdx, DEIM options without DEIM, negative DEIM weights, an index-two mass matrix, a port on a constraint, dense --E, gmg-qm without --lambda, --lambda auto, --rn wide, --manifold altmin, --lambda with gmg-pod refused with messages naming them; an output on the --E-coo file refused, the file unchanged"
+echo "check_cli_mpi: wrong snapshot shape, --simulate, --ref, --poly-jdx, DEIM options without DEIM, negative DEIM weights, an index-two mass matrix, a port on a constraint, dense --E, gmg-qm without --lambda, --lambda auto, --rn wide, --manifold altmin, --lambda with gmg-pod, --dampers with gmg-qm refused with messages naming them; an output on the --E-coo file refused, the file unchanged"
 
 $PY - "$D" <<'PYEOF'
 import json
@@ -211,8 +224,8 @@ def coords(P0, V0):
 
 bad = 0
 for case in ('gmg-pod', 'sp1', 'cosh-gmg-pod', 'cosh-sp1', 'terms-sp1', 'qdeim-gmg-pod', 'greedy-sp2', 'mass-gmg-pod',
-             'qmpod-gmg-qm', 'qmgreedy-gmg-qm', 'rlc-gmg-pod'):
-    nl = case.startswith(('cosh-', 'terms-', 'qdeim-', 'greedy-', 'mass-', 'qmgreedy-', 'qmpod-'))
+             'qmpod-gmg-qm', 'qmgreedy-gmg-qm', 'rlc-gmg-pod', 'damp-sp1'):
+    nl = case.startswith(('cosh-', 'terms-', 'qdeim-', 'greedy-', 'mass-', 'qmgreedy-', 'qmpod-', 'damp-'))
     qm = case.endswith('gmg-qm')
     names = (('Qh', 'Bh', 'V0', 'G00', 'G01', 'G10', 'G11', 'Q01', 'Q11', 'Ms', 'V2', 'M') if qm else
              ('K', 'Qh', 'Bh', 'V0')) + (('P0', 'w', 'poly', 'expo') if nl else ()) + (('P1',) if nl and qm else ())
@@ -232,7 +245,7 @@ for case in ('gmg-pod', 'sp1', 'cosh-gmg-pod', 'cosh-sp1', 'terms-sp1', 'qdeim-g
         bad = 1
     for p in {'gmg-pod': (1, 3), 'sp1': (2, 4), 'cosh-gmg-pod': (2, 4), 'cosh-sp1': (1, 3), 'terms-sp1': (3,),
               'qdeim-gmg-pod': (3,), 'greedy-sp2': (4,), 'mass-gmg-pod': (2,), 'qmpod-gmg-qm': (3,),
-              'qmgreedy-gmg-qm': (4,), 'rlc-gmg-pod': (3,)}[case]:
+              'qmgreedy-gmg-qm': (4,), 'rlc-gmg-pod': (3,), 'damp-sp1': (3,)}[case]:
         pd = '%s/p%d_%s' % (d, p, case)
         files_ok = sorted(os.listdir(pd)) == sorted(os.listdir(sd))
         pj = json.load(open(pd + '/rom.json'))
@@ -240,7 +253,8 @@ for case in ('gmg-pod', 'sp1', 'cosh-gmg-pod', 'cosh-sp1', 'terms-sp1', 'qdeim-g
                                                'poly_deg', 'E')) and \
             pj['snapshots']['count'] == sj['snapshots']['count'] and pj['files'] == sj['files'] and \
             pj['options'] == sj['options'] and \
-            all(pj['system'].get(k) == sj['system'].get(k) for k in ('potential', 'poly', 'exp', 'poly_idx', 'poly_w', 'E'))
+            all(pj['system'].get(k) == sj['system'].get(k) for k in ('potential', 'poly', 'exp', 'poly_idx', 'poly_w', 'E',
+                                                                     'dampers'))
         if 'hyper' in sj['info'] or 'hyper' in pj['info']:
             hs, hp = sj['info']['hyper'], pj['info']['hyper']
             keys_ok = keys_ok and all(hp[k] == hs[k] for k in ('method', 'points', 'negative_weights', 'tol')) and \
