@@ -47,7 +47,7 @@
 # above, every block of the quadratic model (G00, G01, G10, G11, Q01, Q11,
 # Ms), P1, V2 and M within 1e-10 after the signs of V0's and V2's columns
 # (Ms and M: row a by V2's sign, column (j, k) by those of V1's j and k).
-# Bad input at P = 3: a missing --X file must end every rank with a nonzero
+# Bad input: a missing --X file at P = 3 must end every rank with a nonzero
 # status (each rank's status recorded by a wrapper), one message, within the
 # timeout (no rank left waiting in a collective); snapshots of the wrong
 # shape, --simulate and options of the serial reduce that the distributed
@@ -55,7 +55,7 @@
 # whose zero row and column make an index-two pencil, a port on an
 # algebraic equation, DEIM options without --hyper qdeim/greedy and negative
 # DEIM weights without --deim-allow-negative are refused with a message
-# naming them.
+# naming them (at P = 2).
 #   sh tests/mpi/check_cli_mpi.sh SERIAL_PHGMG PHGMG_MPI     (make test-mpi)
 # MPIRUN overrides the launcher (default: mpirun --oversubscribe --mca
 # mpi_yield_when_idle 1, plus
@@ -168,7 +168,7 @@ echo "check_cli_mpi: a missing --X file: status $(sort -u "$D/bad_status.txt" | 
 refused() {   # expected words, then the options
   want=$1; shift
   case " $* " in *" --method "*) meth= ;; *) meth="--method gmg-pod" ;; esac   # gmg-pod unless given
-  if timeout 60 $MPIRUN -np 3 "$PMPI" reduce $M "$@" $meth --r 10 --out "$D/bad" > /dev/null 2> "$D/err.txt"; then
+  if timeout 60 $MPIRUN -np 2 "$PMPI" reduce $M "$@" $meth --r 10 --out "$D/bad" > /dev/null 2> "$D/err.txt"; then
     echo "check_cli_mpi: FAILED: $* was accepted"; exit 1
   fi
   if ! grep -q -- "$want" "$D/err.txt" || [ -e "$D/bad" ]; then
