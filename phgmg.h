@@ -31319,8 +31319,9 @@ PHGMG_DEF phgmg_result phgmg_sym_eig(int n, double *A, int lda, double *w, doubl
             damper kept); now they keep every damper.
           - phgmg-mpi: --method gmg-qm with --manifold pod|greedy, --rn and
             --lambda fixed or cv; it writes the serial command's files (the
-            quadratic blocks, V2, M). An output path equal to the --E-coo
-            file is now refused (it was overwritten).
+            quadratic blocks, V2, M); --dampers (the serial command's file,
+            a law per damper, every damper kept). An output path equal to
+            the --E-coo file is now refused (it was overwritten).
    0.11.0 (2026-11-29)
           - phgmg_mpi_reduce: DEIM hyper-reduction (hyper.kind QDEIM or
             GREEDY) with every method it takes: the gradients' POD by TSQR
