@@ -56,7 +56,7 @@
 # whose zero row and column make an index-two pencil, a port on an
 # algebraic equation, DEIM options without --hyper qdeim/greedy and negative
 # DEIM weights without --deim-allow-negative are refused with a message
-# naming them (at P = 2).
+# naming them (at P = 2; usage errors, refused before any work, at P = 1).
 #   sh tests/mpi/check_cli_mpi.sh SERIAL_PHGMG PHGMG_MPI     (make test-mpi)
 # MPIRUN overrides the launcher (default: mpirun --oversubscribe --mca
 # mpi_yield_when_idle 1, plus
@@ -166,10 +166,12 @@ if [ "$(grep -c 'missing.npy' "$D/bad_err.txt")" != 1 ] || [ -e "$D/bad" ]; then
 fi
 echo "check_cli_mpi: a missing --X file: status $(sort -u "$D/bad_status.txt" | tr '\n' ' ')on all 3 ranks, one message: $(cat "$D/bad_err.txt")"
 # Refused: snapshots of the wrong shape (B has one column), --simulate, --ref.
-refused() {   # expected words, then the options
+NP=2
+refused1() { NP=1; refused "$@"; NP=2; }   # a usage error, refused before any work: one rank
+refused() {   # expected words, then the options, at NP ranks
   want=$1; shift
   case " $* " in *" --method "*) meth= ;; *) meth="--method gmg-pod" ;; esac   # gmg-pod unless given
-  if timeout 60 $MPIRUN -np 2 "$PMPI" reduce $M "$@" $meth --r 10 --out "$D/bad" > /dev/null 2> "$D/err.txt"; then
+  if timeout 60 $MPIRUN -np $NP "$PMPI" reduce $M "$@" $meth --r 10 --out "$D/bad" > /dev/null 2> "$D/err.txt"; then
     echo "check_cli_mpi: FAILED: $* was accepted"; exit 1
   fi
   if ! grep -q -- "$want" "$D/err.txt" || [ -e "$D/bad" ]; then
@@ -177,10 +179,10 @@ refused() {   # expected words, then the options
   fi
 }
 refused "expected (2400, ns)" --X "$D/B.npy"
-refused "--simulate: the distributed build does not simulate" --simulate
-refused "--ref: not supported by the distributed build" --X "$D/X.npy" --ref mean
-refused "--poly-jdx: springs" --X "$D/X_nl.npy" $NL --poly-jdx "$D/idx.npy"
-refused "--deim-tol, --deim-max and --deim-allow-negative apply to --hyper qdeim or greedy" --X "$D/X_nl.npy" $NL --deim-tol 1e-4
+refused1 "--simulate: the distributed build does not simulate" --simulate
+refused1 "--ref: not supported by the distributed build" --X "$D/X.npy" --ref mean
+refused1 "--poly-jdx: springs" --X "$D/X_nl.npy" $NL --poly-jdx "$D/idx.npy"
+refused1 "--deim-tol, --deim-max and --deim-allow-negative apply to --hyper qdeim or greedy" --X "$D/X_nl.npy" $NL --deim-tol 1e-4
 refused "use --deim-allow-negative" --X "$D/X_nl.npy" $NL --hyper greedy --deim-tol 1e-4
 refused "--E-coo $D/E0.npy: the descriptor model has index two" --X "$D/X_e.npy" $NL --E-coo "$D/E0.npy"
 if timeout 60 $MPIRUN -np 3 "$PMPI" reduce --J-coo "$D/rlcp/J.npy" --R-coo "$D/rlcp/R.npy" --Q-coo "$D/rlcp/Q.npy" \
@@ -188,13 +190,13 @@ if timeout 60 $MPIRUN -np 3 "$PMPI" reduce --J-coo "$D/rlcp/J.npy" --R-coo "$D/r
      > /dev/null 2> "$D/err.txt" || ! grep -q "a port on an algebraic equation" "$D/err.txt" || [ -e "$D/bad" ]; then
   echo "check_cli_mpi: FAILED: a port on a constraint was not refused by name"; cat "$D/err.txt"; exit 1
 fi
-refused "--E: dense matrices are not read" --X "$D/X_e.npy" --E "$D/E.npy"
-refused "gmg-qm needs --lambda here" --X "$D/X.npy" --method gmg-qm
-refused "--lambda auto: phgmg-mpi does not simulate" --X "$D/X.npy" --method gmg-qm --lambda auto
-refused "--rn wide: not distributed" --X "$D/X.npy" --method gmg-qm --lambda 1e-3 --rn wide
-refused "--manifold altmin: not distributed" --X "$D/X.npy" --method gmg-qm --lambda 1e-3 --manifold altmin
-refused "apply to --method gmg-qm only" --X "$D/X.npy" --lambda 1e-3
-refused "--dampers: phgmg-mpi reduces models with dampers by gmg-pod, sp1 or sp2 without a mass matrix" \
+refused1 "--E: dense matrices are not read" --X "$D/X_e.npy" --E "$D/E.npy"
+refused1 "gmg-qm needs --lambda here" --X "$D/X.npy" --method gmg-qm
+refused1 "--lambda auto: phgmg-mpi does not simulate" --X "$D/X.npy" --method gmg-qm --lambda auto
+refused1 "--rn wide: not distributed" --X "$D/X.npy" --method gmg-qm --lambda 1e-3 --rn wide
+refused1 "--manifold altmin: not distributed" --X "$D/X.npy" --method gmg-qm --lambda 1e-3 --manifold altmin
+refused1 "apply to --method gmg-qm only" --X "$D/X.npy" --lambda 1e-3
+refused1 "--dampers: phgmg-mpi reduces models with dampers by gmg-pod, sp1 or sp2 without a mass matrix" \
   --X "$D/X_d.npy" $NL --dampers "$D/damp.npy" --method gmg-qm --lambda 1e-3
 # An output that is an input file (here --E-coo as the basis' path) is refused and the file left as it was.
 mkdir -p "$D/clash" && cp "$D/E.npy" "$D/clash/rom_V0.npy"
