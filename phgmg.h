@@ -2824,7 +2824,8 @@
    reduce: phgmg_pod, phgmg_pod_randomized, phgmg_adjust_snapshots,
            phgmg_runs_columns, phgmg_simulate_inputs, phgmg_simulate_run,
            phgmg_reduce_opts_default, phgmg_reduce, phgmg_reduced_destroy,
-           phgmg_reduced_rom, phgmg_reduced_N, phgmg_reduced_qm, phgmg_reduced_lift,
+           phgmg_reduced_rom, phgmg_reduced_N, phgmg_reduced_qm, phgmg_reduced_terms,
+           phgmg_reduced_lift,
            phgmg_reduced_restrict, phgmg_reduced_dphi, phgmg_reduced_W,
            phgmg_reduced_simulate, phgmg_reduced_simulate_run,
            phgmg_reduced_validate, phgmg_reduced_validate_many, phgmg_rel_error,
@@ -2863,7 +2864,7 @@
            phgmg_lu_rcond, phgmg_norm1, phgmg_normf, phgmg_zlu_factor,
            phgmg_zlu_solve, phgmg_qr, phgmg_qrcp, phgmg_qr_form_q,
            phgmg_qr_apply, phgmg_lstsq, phgmg_svd, phgmg_sym_eig
-   (179 functions; 23 of them only with PHGMG_MPI; also the macros
+   (180 functions; 23 of them only with PHGMG_MPI; also the macros
    PHGMG_ROM_STEPPER_MEMSIZE_MAX and _MAX_CB.)
 */
 #ifndef PHGMG_H_INCLUDED
@@ -4363,6 +4364,12 @@ PHGMG_DEF int phgmg_reduced_N(const phgmg_reduced *red);
    valid until destroy. Returns rn; 0 (both views NULL) for any other model
    or a NULL red. Either pointer may be NULL. */
 PHGMG_DEF int phgmg_reduced_qm(const phgmg_reduced *red, const double **V2, const double **M);
+/* The separable terms the reduced model keeps (phgmg_reduced_rom(red)->nd
+   of them, in its order): each one's index in the full model's term list
+   (the hyper-reduction's points). Without hyper-reduction every term is
+   kept in the model's order: NULL or 0, 1, ...; NULL for a model without
+   separable terms and for NULL red. Valid until destroy. */
+PHGMG_DEF const int *phgmg_reduced_terms(const phgmg_reduced *red);
 /* Reconstruction x = phi(xr) (N). */
 PHGMG_DEF void phgmg_reduced_lift(const phgmg_reduced *red, const double *xr, double *x);
 /* Point reduction xr = rho(x) (r); rho(phi(xr)) = xr. */
@@ -15762,6 +15769,7 @@ PHGMG_DEF int phgmg_reduced_qm(const phgmg_reduced *red, const double **V2, cons
   if (M) *M = q && !red->eta ? red->M : NULL;
   return q ? red->rn : 0;
 }
+PHGMG_DEF const int *phgmg_reduced_terms(const phgmg_reduced *red) { return red && red->rom.nd ? red->term : NULL; }
 
 /* >>pod (implementation) ================================================== */
 /* C (m x n) = A^T B with A: k x m, B: k x n (column-major, tight). */
@@ -31312,6 +31320,7 @@ PHGMG_DEF phgmg_result phgmg_sym_eig(int n, double *A, int lda, double *w, doubl
             (the dd block of (J - R)^{-1}); the zero columns found by one
             neighbour exchange. phgmg-mpi --E-coo takes them (index checked
             as the serial command checks it).
+          - New: phgmg_reduced_terms (the kept separable terms' indices).
           - phgmg_hyper_opts.keep_dampers: 1 keeps every damper while
             hyper.on hyper-reduces the separable part. The command line sets
             it: with a nonlinear part and --dampers its reduced models

@@ -28,7 +28,7 @@ if [ -z "$MPIRUN" ]; then
   [ "$(id -u)" = 0 ] && MPIRUN="$MPIRUN --allow-run-as-root"
 fi
 mkdir -p build
-$MPICC -O2 -std=c99 -o build/test_mpi_nl_scale tests/mpi/test_mpi_nl.c -lm
+$MPICC -O2 -std=c99 -DPHGMG_IMPLEMENTATION -o build/test_mpi_nl_scale tests/mpi/test_mpi_nl.c -lm
 : > build/mpi_equivalence.txt
 for p in $PS; do
   /usr/bin/time -f "P = $p: %e s wall, %M KB peak (largest rank)" $MPIRUN -np "$p" ./build/test_mpi_nl_scale \

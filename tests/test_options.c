@@ -154,6 +154,37 @@ TEST(test_reduce_opts_hyper_on_and_enums) {
     mc = opt_model(&M.sys, X, &b, &lc, &kc);
     CHECK(mc && lc != la);
     free(ma); free(mb); free(mc);
+    {   /* phgmg_reduced_terms: the kept terms' indices, each kept row of P0 the basis's row at its coordinate */
+      const int *t;
+      CHECK_RC(phgmg_reduce(&red, &M.sys, X, M.sys.N, OPT_STEPS + 1, &a, NULL, NULL), PHGMG_OK);
+      t = phgmg_reduced_terms(red);
+      if (red && t) {
+        const phgmg_rom *rom = phgmg_reduced_rom(red);
+        double xr[16], *col = (double *)malloc(sizeof(double) * (size_t)M.sys.N);
+        int k, j, ok = rom->nd > 0 && rom->nd < M.sys.nsep && col;
+        for (j = 0; ok && j < rom->r; ++j) {
+          memset(xr, 0, sizeof xr); xr[j] = 1.0;
+          phgmg_reduced_lift(red, xr, col);   /* column j of the linear basis */
+          for (k = 0; k < rom->nd; ++k)
+            ok &= t[k] >= 0 && t[k] < M.sys.nsep && fabs((double)rom->P0[k + (size_t)j * rom->nd] - col[M.sys.sep_idx[t[k]]]) <= 1e-14;
+        }
+        CHECK(ok);
+        free(col);
+      } else {
+        CHECK(red && t);
+      }
+      phgmg_reduced_destroy(red);
+      red = NULL;
+      CHECK_RC(phgmg_reduce(&red, &M.sys, X, M.sys.N, OPT_STEPS + 1, &b, NULL, NULL), PHGMG_OK);
+      if (red) {   /* every term, in order: NULL or 0, 1, ... */
+        const int *all = phgmg_reduced_terms(red);
+        int k, ok = phgmg_reduced_rom(red)->nd == M.sys.nsep;
+        for (k = 0; all && ok && k < M.sys.nsep; ++k) ok = all[k] == k;
+        CHECK(ok && phgmg_reduced_terms(NULL) == NULL);
+      }
+      phgmg_reduced_destroy(red);
+      red = NULL;
+    }
     a.hyper.on = 2;
     CHECK_RC(phgmg_reduce(&red, &M.sys, X, M.sys.N, OPT_STEPS + 1, &a, NULL, NULL), PHGMG_ERR_INVALID_ARG);
     a.hyper.on = 1; a.hyper.kind = PHGMG_HYPER_COUNT;

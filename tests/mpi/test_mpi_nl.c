@@ -10,11 +10,11 @@
    runs, on a chain of n masses at r = 20, with a negative control (a
    Gram-matrix POD must miss V^T (J - R) V), then GMG-QM (POD and greedy
    manifolds, r = 8) on the linear chain of n masses; --scale-qm n: only
-   the latter (bench/mpi_equivalence.sh). */
+   the latter (bench/mpi_equivalence.sh). Built against the library's one
+   compile (make test-mpi: PHGMG_IMPLEMENTATION_ELSEWHERE and build/mpi/lib.o),
+   or alone with -DPHGMG_IMPLEMENTATION. */
 #define _POSIX_C_SOURCE 199309L   /* nanosleep */
 #define PHGMG_MPI
-#define PHGMG_STATIC
-#define PHGMG_IMPLEMENTATION
 #include "../../phgmg.h"
 #include "mem_chain.h"
 #include <math.h>
@@ -246,7 +246,7 @@ static void serial_sigma(const chain *ch, int ns, const double *X, int k, int ad
     phgmg_jr_factor *f = NULL;
     int i;
     b[1] = 1.0;
-    CHECK(phgmg__e_factor(&ch->sys, &f, NULL, NULL) == PHGMG_OK, "E factor (reference)");
+    CHECK(phgmg_e_factor_create(&f, &ch->sys, NULL, NULL) == PHGMG_OK, "E factor (reference)");
     if (f) phgmg_jr_solve(f, 'N', 1, b, N);
     for (i = 0; i < N; ++i) bb += b[i] * b[i];
     for (j = 0; j < ns; ++j) {
@@ -341,7 +341,8 @@ static void serial_sensitivity(const chain *ch, int ns, const double *X, const d
   phgmg_reduced_restrict(red, x0, xr);
   for (j = 0; j < r; ++j) x2[j] = sg[j] * xr[j];
   ey = online_diff(b, a, x2, xr, 200, "perturbed");
-  if (a->nd == b->nd && a->nd > 0 && red->term && red2->term && !memcmp(red->term, red2->term, sizeof(int) * (size_t)a->nd)) {
+  if (a->nd == b->nd && a->nd > 0 && phgmg_reduced_terms(red) && phgmg_reduced_terms(red2) &&
+      !memcmp(phgmg_reduced_terms(red), phgmg_reduced_terms(red2), sizeof(int) * (size_t)a->nd)) {
     double ew = 0.0, sw = 0.0;   /* the same points: how far the weights move */
     for (j = 0; j < a->nd; ++j) { ew = fmax(ew, fabs(b->w[j] - a->w[j])); sw = fmax(sw, fabs(a->w[j])); }
     wtol_ = fmax(1e-12, 10.0 * ew / sw);
@@ -380,7 +381,7 @@ static void compare_serial(const chain *ch, int ns, const double *X, const doubl
   CHECK(e <= 1e-12, "%s: Bh %.2e", tag, e);
   CHECK(same, "%s: %d points, serial %d", tag, mr->nd, ro->nd);
   for (j = 0; same && j < mr->nd; ++j)   /* serial: the kept terms' numbers (every term: none stored, j) */
-    same = mr->pts[j] == (red->term ? red->term[j] : j) && mr->coord[j] == ch->idx[mr->pts[j]];
+    same = mr->pts[j] == (phgmg_reduced_terms(red) ? phgmg_reduced_terms(red)[j] : j) && mr->coord[j] == ch->idx[mr->pts[j]];
   CHECK(same, "%s: point sets differ", tag);
   if (same) {
     double ew = 0.0, sw = 0.0;
@@ -762,10 +763,10 @@ static void compare_qm(const chain *ch, const double *x0, const phgmg_reduced *r
   CHECK(same, "%s: %d terms, serial %d", tag, rd->nd, ro->nd);
   for (j = 0, wmax = 0.0; same && j < rd->nd; ++j) wmax = fmax(wmax, fabs(ro->w[j]));
   for (j = 0; same && j < rd->nd; ++j) {   /* serial: the kept terms' numbers (every term: none stored, j) */
-    const int tj = red->term ? red->term[j] : j;
+    const int tj = phgmg_reduced_terms(red) ? phgmg_reduced_terms(red)[j] : j;
     /* ECSW's weights (> 0) each to 1e-12; DEIM's, the solution of a linear
        system with weights of both signs, to 1e-12 of the largest */
-    const double wref = red->nd > 0 && qm_deim_ ? wmax : fabs(ro->w[j]);
+    const double wref = ro->nd > 0 && qm_deim_ ? wmax : fabs(ro->w[j]);
     same = mr->pts[j] == tj && mr->coord[j] == ch->idx[tj] && (diffs || fabs(rd->w[j] - ro->w[j]) <= wtol_ * wref);
     ew = fmax(ew, fabs(rd->w[j] - ro->w[j]) / wref);
   }
@@ -858,7 +859,7 @@ static void qm_sensitivity(const chain *ch, int ns, const double *X, const doubl
   if (fake.nd > 0) {   /* the kept terms as the distributed result holds them */
     pc = (phgmg_gidx *)malloc(sizeof(phgmg_gidx) * 2 * (size_t)fake.nd);
     for (j = 0; j < fake.nd; ++j) {
-      pc[j] = red2->term ? red2->term[j] : j;
+      pc[j] = phgmg_reduced_terms(red2) ? phgmg_reduced_terms(red2)[j] : j;
       pc[fake.nd + j] = ch->idx[pc[j]];
     }
     fake.pts = pc; fake.coord = pc + fake.nd;
@@ -1128,7 +1129,7 @@ static void test_descriptor(void) {
   dist_build(&d, &ch, ns, X);
   Eop = band_op(d.c, &ch, E, NULL, 0.0);
   esv_.c = d.c; esv_.fail_rank = -1;
-  CHECK(phgmg__e_factor(&ch.sys, &esv_.f, NULL, NULL) == PHGMG_OK, "E factor");
+  CHECK(phgmg_e_factor_create(&esv_.f, &ch.sys, NULL, NULL) == PHGMG_OK, "E factor");
   d.md.lin.E = Eop; d.md.lin.solve_E = solve_e_cb;
   V0 = (double *)malloc(sizeof(double) * (size_t)d.ld * r);
   rc = phgmg_mpi_reduce(d.c, &d.md, ns, d.Xl, d.ld, &o, &mr, V0, d.ld);
@@ -1212,7 +1213,7 @@ static void test_algebraic(void) {
   Eop = band_op(d.c, &ch, E, NULL, 0.0);
   sf = ch.sys; sf.E = Ef;
   esv_.c = d.c; esv_.fail_rank = -1;
-  CHECK(phgmg__e_factor(&sf, &esv_.f, NULL, NULL) == PHGMG_OK, "E_dd factor");
+  CHECK(phgmg_e_factor_create(&esv_.f, &sf, NULL, NULL) == PHGMG_OK, "E_dd factor");
   d.md.lin.E = Eop; d.md.lin.solve_E = solve_e_cb;
   V0 = (double *)malloc(sizeof(double) * (size_t)d.ld * r);
   rc = phgmg_mpi_reduce(d.c, &d.md, ns, d.Xl, d.ld, &o, &mr, V0, d.ld);
