@@ -1,11 +1,15 @@
 /* What the MPI tests share (include after phgmg.h with PHGMG_MPI): this
    process's rank and the communicator's size, the failure count, CHECK
    (prints the failed condition's place with P and the rank, and goes on),
-   and the row layouts every test uses, uneven on purpose. */
+   the row layouts every test uses, uneven on purpose, and helpers of the
+   comparisons (a value the same on every rank, a basis gathered, a banded
+   matrix's rows as an operator). */
 #ifndef PHGMG_TEST_MPI_HARNESS_H
 #define PHGMG_TEST_MPI_HARNESS_H
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
 
 static int rank_, size_, fails_;
 #define CHECK(cond, ...)                                                            \
@@ -40,5 +44,50 @@ static inline phgmg_mpi_ctx *make_ctx(long long N) {
   layout(N, &row0, &nloc);
   CHECK(phgmg_mpi_ctx_create(&c, MPI_COMM_WORLD, N, row0, nloc, NULL) == PHGMG_OK, "ctx N=%lld", N);
   return c;
+}
+/* 1 if v is the same on every rank. Collective. */
+static inline int same_everywhere(int v) {
+  int lo, hi;
+  MPI_Allreduce(&v, &lo, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
+  MPI_Allreduce(&v, &hi, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
+  return lo == hi;
+}
+
+/* The distributed V0 (N x r) on every rank from the ranks' rows (ld). Collective. */
+static inline double *gather_v0(const phgmg_mpi_ctx *c, int r, const double *V0, int ld) {
+  const int N = (int)c->N;
+  double *full = (double *)calloc((size_t)N * r + 1, sizeof(double)), *col = (double *)malloc(sizeof(double) * ((size_t)c->nloc + 1));
+  int *cnt = (int *)malloc(sizeof(int) * (size_t)size_), *dsp = (int *)malloc(sizeof(int) * (size_t)size_), q, j;
+  for (q = 0; q < size_; ++q) { cnt[q] = (int)(c->starts[q + 1] - c->starts[q]); dsp[q] = (int)c->starts[q]; }
+  for (j = 0; j < r; ++j) {
+    memcpy(col, V0 + (size_t)j * ld, sizeof(double) * (size_t)c->nloc);
+    MPI_Allgatherv(col, c->nloc, MPI_DOUBLE, full + (size_t)j * N, cnt, dsp, MPI_DOUBLE, MPI_COMM_WORLD);
+  }
+  free(col); free(cnt); free(dsp);
+  return full;
+}
+
+/* This rank's rows of A - s C (N x N banded, half-bandwidth kb, LAPACK-style
+   storage with ld 2 kb + 1; C may be NULL) as a distributed operator. */
+static inline phgmg_mpi_op *band_op_kb(const phgmg_mpi_ctx *c, int N, int kb, const double *A, const double *C, double s) {
+  const int nloc = c->nloc;
+  long long *rp = (long long *)malloc(sizeof(long long) * ((size_t)nloc + 1));
+  long long *cols = (long long *)malloc(sizeof(long long) * ((size_t)nloc * (2 * kb + 1) + 1));
+  double *vals = (double *)malloc(sizeof(double) * ((size_t)nloc * (2 * kb + 1) + 1));
+  phgmg_mpi_op *op = NULL;
+  int i, j, nz = 0;
+  rp[0] = 0;
+  for (i = 0; i < nloc; ++i) {
+    const int g = (int)c->row0 + i;
+    for (j = g - kb; j <= g + kb; ++j) {
+      const size_t at = (size_t)(kb + g - j) + (size_t)j * (2 * kb + 1);
+      const double v = (j >= 0 && j < N) ? A[at] - (C ? s * C[at] : 0.0) : 0.0;
+      if (v != 0.0) { cols[nz] = j; vals[nz++] = v; }
+    }
+    rp[i + 1] = nz;
+  }
+  CHECK(phgmg_mpi_op_create(&op, c, rp, cols, vals) == PHGMG_OK, "operator");
+  free(rp); free(cols); free(vals);
+  return op;
 }
 #endif

@@ -57,14 +57,6 @@ static void graded(int N, int ns, double *X, double *U, double *sig) {
   free(W); free(US);
 }
 
-/* Same on every rank? (min and max over the ranks agree) */
-static int same_everywhere(int v) {
-  int lo, hi;
-  MPI_Allreduce(&v, &lo, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
-  MPI_Allreduce(&v, &hi, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
-  return lo == hi;
-}
-
 /* The full matrix (N x k) from the row blocks (nloc x k, ld nloc) on every rank. */
 static double *gather_rows(const phgmg_mpi_ctx *c, int k, const double *A) {
   double *full = (double *)calloc((size_t)c->N * k + 1, sizeof(double)), *col = (double *)calloc((size_t)c->N + 1, sizeof(double));

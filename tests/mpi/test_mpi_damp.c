@@ -50,12 +50,6 @@ static void quiet_barrier(void) {
   }
 }
 
-static int same_everywhere(int v) {
-  int lo, hi;
-  MPI_Allreduce(&v, &lo, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
-  MPI_Allreduce(&v, &hi, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
-  return lo == hi;
-}
 
 /* ---- the model ------------------------------------------------------------------ */
 /* n masses, N = 2n, interleaved states (l_i, v_i) (banded, kb = 4): J = [0
@@ -202,28 +196,6 @@ typedef struct dist {
   int ld;
 } dist;
 
-/* This rank's rows of the banded A - s C (C may be NULL) as a distributed operator. */
-static phgmg_mpi_op *band_op(const phgmg_mpi_ctx *c, const chain *ch, const double *A, const double *C, double s) {
-  const int N = ch->N, kb = ch->kb, nloc = c->nloc;
-  long long *rp = (long long *)malloc(sizeof(long long) * ((size_t)nloc + 1));
-  long long *cols = (long long *)malloc(sizeof(long long) * ((size_t)nloc * (2 * kb + 1) + 1));
-  double *vals = (double *)malloc(sizeof(double) * ((size_t)nloc * (2 * kb + 1) + 1));
-  phgmg_mpi_op *op = NULL;
-  int i, j, nz = 0;
-  rp[0] = 0;
-  for (i = 0; i < nloc; ++i) {
-    const int g = (int)c->row0 + i;
-    for (j = g - kb; j <= g + kb; ++j) {
-      const size_t at = (size_t)(kb + g - j) + (size_t)j * (2 * kb + 1);
-      const double v = (j >= 0 && j < N) ? A[at] - (C ? s * C[at] : 0.0) : 0.0;
-      if (v != 0.0) { cols[nz] = j; vals[nz++] = v; }
-    }
-    rp[i + 1] = nz;
-  }
-  CHECK(phgmg_mpi_op_create(&op, c, rp, cols, vals) == PHGMG_OK, "operator");
-  free(rp); free(cols); free(vals);
-  return op;
-}
 
 static void dist_build(dist *d, const chain *ch, int ns, const double *X) {
   const int N = ch->N;
@@ -234,8 +206,8 @@ static void dist_build(dist *d, const chain *ch, int ns, const double *X) {
   memset(d, 0, sizeof *d);
   CHECK(phgmg_mpi_ctx_create(&d->c, MPI_COMM_WORLD, N, row0, nloc, NULL) == PHGMG_OK, "ctx");
   d->ld = nloc > 0 ? nloc : 1;
-  d->Q = band_op(d->c, ch, ch->Q, NULL, 0.0);
-  d->JR = band_op(d->c, ch, ch->J, ch->R, 1.0);   /* J - R, without the dampers */
+  d->Q = band_op_kb(d->c, ch->N, ch->kb, ch->Q, NULL, 0.0);
+  d->JR = band_op_kb(d->c, ch->N, ch->kb, ch->J, ch->R, 1.0);   /* J - R, without the dampers */
   d->Bl = (double *)malloc(sizeof(double) * (size_t)d->ld);
   d->Xl = (double *)malloc(sizeof(double) * (size_t)d->ld * ns);
   for (i = 0; i < nloc; ++i) d->Bl[i] = ch->B[row0 + i];
@@ -337,19 +309,6 @@ static void mode_signs(const phgmg_reduced *red, int N, int r, const double *V0f
   free(col);
 }
 
-/* The distributed V0 (N x r) on every rank from the ranks' rows. */
-static double *gather_v0(const phgmg_mpi_ctx *c, int r, const double *V0, int ld) {
-  const int N = (int)c->N;
-  double *full = (double *)calloc((size_t)N * r + 1, sizeof(double)), *col = (double *)malloc(sizeof(double) * ((size_t)c->nloc + 1));
-  int *cnt = (int *)malloc(sizeof(int) * (size_t)size_), *dsp = (int *)malloc(sizeof(int) * (size_t)size_), q, j;
-  for (q = 0; q < size_; ++q) { cnt[q] = (int)(c->starts[q + 1] - c->starts[q]); dsp[q] = (int)c->starts[q]; }
-  for (j = 0; j < r; ++j) {
-    memcpy(col, V0 + (size_t)j * ld, sizeof(double) * (size_t)c->nloc);
-    MPI_Allgatherv(col, c->nloc, MPI_DOUBLE, full + (size_t)j * N, cnt, dsp, MPI_DOUBLE, MPI_COMM_WORLD);
-  }
-  free(col); free(cnt); free(dsp);
-  return full;
-}
 
 /* The control: Cd from the serial co-state test basis W (phgmg_reduced_W,
    E = I: W_z = W) matches the serial Cd, and the same with the j-half of
