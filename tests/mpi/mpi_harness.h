@@ -10,6 +10,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 static int rank_, size_, fails_;
 #define CHECK(cond, ...)                                                            \
@@ -89,5 +90,59 @@ static inline phgmg_mpi_op *band_op_kb(const phgmg_mpi_ctx *c, int N, int kb, co
   CHECK(phgmg_mpi_op_create(&op, c, rp, cols, vals) == PHGMG_OK, "operator");
   free(rp); free(cols); free(vals);
   return op;
+}
+/* Wait for rank 0's serial comparisons without spinning (the other ranks
+   sleep between tests of a non-blocking barrier: the cores stay free).
+   Needs _POSIX_C_SOURCE >= 199309L (nanosleep) from the test file. */
+static inline void quiet_barrier(void) {
+  MPI_Request rq;
+  int done = 0;
+  MPI_Ibarrier(MPI_COMM_WORLD, &rq);
+  while (!done) {
+    struct timespec ts;
+    MPI_Test(&rq, &done, MPI_STATUS_IGNORE);
+    ts.tv_sec = 0; ts.tv_nsec = 2000000;
+    if (!done && rank_ != 0) nanosleep(&ts, NULL);
+  }
+}
+
+/* The tests' input, u(t) = 0.5 sin(0.7 t) on one port. */
+static inline void u_in(double t, double *u, void *user) { (void)user; u[0] = 0.5 * sin(0.7 * t); }
+
+/* The serial simulation (rank 0, input u_in) broadcast to every rank: X (N x ns). */
+static inline void simulate_root(const phgmg_ph_system *sys, const double *x0, double dt, int ns, double *X) {
+  int ok = 1;
+  if (rank_ == 0)
+    ok = phgmg_simulate(sys, x0, 0.0, dt, ns - 1, u_in, NULL, NULL, X, NULL, NULL, NULL, NULL, NULL) == PHGMG_OK;
+  MPI_Bcast(&ok, 1, MPI_INT, 0, MPI_COMM_WORLD);
+  MPI_Bcast(X, sys->N * ns, MPI_DOUBLE, 0, MPI_COMM_WORLD);
+  CHECK(ok, "simulate");
+}
+
+/* Largest |d_i d_j A - B| / max |B| over r x c (d: the modes' signs; dj NULL: 1). */
+static inline double rel_diff(int r, int c, const double *A, const double *B, const double *di, const double *dj) {
+  double e = 0.0, s = 0.0;
+  int i, j;
+  for (j = 0; j < c; ++j)
+    for (i = 0; i < r; ++i) {
+      e = fmax(e, fabs(di[i] * (dj ? dj[j] : 1.0) * A[i + (size_t)j * r] - B[i + (size_t)j * r]));
+      s = fmax(s, fabs(B[i + (size_t)j * r]));
+    }
+  return s > 0.0 ? e / s : e;
+}
+
+/* The signs of the modes of a basis V0f (N x r) against a serial model's
+   (lifts of unit vectors). */
+static inline void mode_signs(const phgmg_reduced *red, int N, int r, const double *V0f, double *sg) {
+  double *col = (double *)malloc(sizeof(double) * (size_t)N), xr[64];
+  int i, j;
+  for (j = 0; j < r; ++j) {
+    double dot = 0.0;
+    memset(xr, 0, sizeof xr); xr[j] = 1.0;
+    phgmg_reduced_lift(red, xr, col);
+    for (i = 0; i < N; ++i) dot += col[i] * V0f[i + (size_t)j * N];
+    sg[j] = dot < 0.0 ? -1.0 : 1.0;
+  }
+  free(col);
 }
 #endif

@@ -5,6 +5,7 @@
    results are checked to be the same for every partition. Layouts: P = 2
    and 3 uneven blocks, P = 4 with rank 2 owning no rows. Exit status 0 iff
    every check passed on every rank. Built with mpicc (make test-mpi). */
+#define _POSIX_C_SOURCE 199309L   /* nanosleep (mpi_harness.h) */
 #define PHGMG_MPI
 #define PHGMG_IMPLEMENTATION
 #include "../../phgmg.h"

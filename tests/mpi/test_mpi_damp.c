@@ -37,18 +37,6 @@ static int owner(const phgmg_mpi_ctx *c, long long i) {
   return q;
 }
 
-/* Wait for rank 0's serial comparisons without spinning. */
-static void quiet_barrier(void) {
-  MPI_Request rq;
-  int done = 0;
-  MPI_Ibarrier(MPI_COMM_WORLD, &rq);
-  while (!done) {
-    struct timespec ts;
-    MPI_Test(&rq, &done, MPI_STATUS_IGNORE);
-    ts.tv_sec = 0; ts.tv_nsec = 2000000;
-    if (!done && rank_ != 0) nanosleep(&ts, NULL);
-  }
-}
 
 
 /* ---- the model ------------------------------------------------------------------ */
@@ -149,17 +137,7 @@ static void chain_free(chain *c) {
   free(c->di); free(c->dj); free(c->dlaw);
 }
 
-static void u_in(double t, double *u, void *user) { (void)user; u[0] = 0.5 * sin(0.7 * t); }
 
-/* The serial simulation (rank 0) broadcast to every rank: X (N x ns). */
-static void simulate_root(const chain *ch, const double *x0, double dt, int ns, double *X) {
-  int ok = 1;
-  if (rank_ == 0)
-    ok = phgmg_simulate(&ch->sys, x0, 0.0, dt, ns - 1, u_in, NULL, NULL, X, NULL, NULL, NULL, NULL, NULL) == PHGMG_OK;
-  MPI_Bcast(&ok, 1, MPI_INT, 0, MPI_COMM_WORLD);
-  MPI_Bcast(X, ch->N * ns, MPI_DOUBLE, 0, MPI_COMM_WORLD);
-  CHECK(ok, "simulate");
-}
 
 /* ---- the distributed inputs ------------------------------------------------------ */
 typedef struct solver {
@@ -256,18 +234,6 @@ static void dist_free(dist *d) {
   phgmg_mpi_ctx_destroy(d->c);
 }
 
-/* ---- comparisons ------------------------------------------------------------------ */
-/* Largest |d_i d_j A - B| / max |B| over r x c (d: the modes' signs). */
-static double rel_diff(int r, int c, const double *A, const double *B, const double *di, const double *dj) {
-  double e = 0.0, s = 0.0;
-  int i, j;
-  for (j = 0; j < c; ++j)
-    for (i = 0; i < r; ++i) {
-      e = fmax(e, fabs(di[i] * (dj ? dj[j] : 1.0) * A[i + (size_t)j * r] - B[i + (size_t)j * r]));
-      s = fmax(s, fabs(B[i + (size_t)j * r]));
-    }
-  return s > 0.0 ? e / s : e;
-}
 
 /* Largest output difference of two reduced models stepped nsteps steps of
    0.1 from xa, xb under u_in, over the largest output (HUGE_VAL if a step fails). */
@@ -295,19 +261,6 @@ static double online_diff(const phgmg_rom *a, const phgmg_rom *b, const double *
   return ok ? ey / sy : HUGE_VAL;
 }
 
-/* The signs of the distributed basis's modes V0f (N x r) against the serial model's. */
-static void mode_signs(const phgmg_reduced *red, int N, int r, const double *V0f, double *sg) {
-  double *col = (double *)malloc(sizeof(double) * (size_t)N), xr[64];
-  int i, j;
-  for (j = 0; j < r; ++j) {
-    double dot = 0.0;
-    memset(xr, 0, sizeof xr); xr[j] = 1.0;
-    phgmg_reduced_lift(red, xr, col);
-    for (i = 0; i < N; ++i) dot += col[i] * V0f[i + (size_t)j * N];
-    sg[j] = dot < 0.0 ? -1.0 : 1.0;
-  }
-  free(col);
-}
 
 
 /* The control: Cd from the serial co-state test basis W (phgmg_reduced_W,
@@ -402,7 +355,7 @@ static void test_methods(int n, int r) {
   int i, mi, hy;
   chain_build(&ch, n);
   for (i = 0; i < n; ++i) x0[2 * i] = 0.6 * sin(3.0 * 3.14159265358979 * i / n) + 0.3 * sin(7.0 * 3.14159265358979 * i / n);
-  simulate_root(&ch, x0, 0.2, ns, X);
+  simulate_root(&ch.sys, x0, 0.2, ns, X);
   dist_build(&d, &ch, ns, X);
   V0 = (double *)malloc(sizeof(double) * (size_t)d.ld * r);
   for (mi = 0; mi < (per_law_ ? 1 : 3); ++mi)   /* one law per damper: GMG-POD with ECSW (rho_k'(0) in K, kept laws) */
@@ -448,7 +401,7 @@ static void test_one_sided(int n, int r) {
   memmove(ch.dj, ch.dj + off, sizeof(int) * (size_t)nos);
   ch.nd = ch.sys.ndamp = nos;
   for (i = 0; i < n; ++i) x0[2 * i] = 0.6 * sin(3.0 * 3.14159265358979 * i / n);
-  simulate_root(&ch, x0, 0.2, ns, X);
+  simulate_root(&ch.sys, x0, 0.2, ns, X);
   dist_build(&d, &ch, ns, X);
   d.md.damp_j = NULL; d.md.damp_id = NULL;
   V0 = (double *)malloc(sizeof(double) * (size_t)d.ld * r);
@@ -496,7 +449,7 @@ static void test_errors(int n) {
   int i;
   chain_build(&ch, n);
   for (i = 0; i < n; ++i) x0[2 * i] = 0.5 * sin(2.0 * 3.14159265358979 * i / n);
-  simulate_root(&ch, x0, 0.2, ns, X);
+  simulate_root(&ch.sys, x0, 0.2, ns, X);
   dist_build(&d, &ch, ns, X);
   memset(&o, 0, sizeof o);
   o.method = PHGMG_METHOD_GMG_POD; o.r = 8;
@@ -547,7 +500,7 @@ static long long damper_collectives(int n, phgmg_method method) {
   int i, pass;
   chain_build(&ch, n);
   for (i = 0; i < n; ++i) x0[2 * i] = 0.5 * sin(2.0 * 3.14159265358979 * i / n);
-  simulate_root(&ch, x0, 0.2, ns, X);
+  simulate_root(&ch.sys, x0, 0.2, ns, X);
   dist_build(&d, &ch, ns, X);
   memset(&o, 0, sizeof o);
   o.method = method; o.r = 8;

@@ -34,19 +34,6 @@ static double wtol_ = 1e-12;
 static int ystep_ = 1;      /* compare_serial: 0 when the serial model itself cannot be stepped (scale mode) */ /* compare_qm: the weights' tolerance (scale mode: from the serial model's movement) */
 
 
-/* Wait for rank 0's serial comparisons without spinning (the other ranks
-   sleep between tests of a non-blocking barrier: the cores stay free). */
-static void quiet_barrier(void) {
-  MPI_Request rq;
-  int done = 0;
-  MPI_Ibarrier(MPI_COMM_WORLD, &rq);
-  while (!done) {
-    struct timespec ts;
-    MPI_Test(&rq, &done, MPI_STATUS_IGNORE);
-    ts.tv_sec = 0; ts.tv_nsec = 2000000;
-    if (!done && rank_ != 0) nanosleep(&ts, NULL);
-  }
-}
 
 
 /* ---- the model: a damped chain with an on-site cosh potential ------------- */
@@ -102,17 +89,7 @@ static void chain_free(chain *c) {
   free(c->J); free(c->R); free(c->Q); free(c->B); free(c->poly); free(c->expo); free(c->w); free(c->idx);
 }
 
-static void u_in(double t, double *u, void *user) { (void)user; u[0] = 0.5 * sin(0.7 * t); }
 
-/* The serial simulation (rank 0) broadcast to every rank: X (N x ns). */
-static void simulate_root(const chain *ch, const double *x0, double dt, int ns, double *X) {
-  int ok = 1;
-  if (rank_ == 0)
-    ok = phgmg_simulate(&ch->sys, x0, 0.0, dt, ns - 1, u_in, NULL, NULL, X, NULL, NULL, NULL, NULL, NULL) == PHGMG_OK;
-  MPI_Bcast(&ok, 1, MPI_INT, 0, MPI_COMM_WORLD);
-  MPI_Bcast(X, ch->N * ns, MPI_DOUBLE, 0, MPI_COMM_WORLD);
-  CHECK(ok, "simulate");
-}
 
 /* ---- the distributed inputs ----------------------------------------------------- */
 typedef struct solver {
@@ -195,17 +172,6 @@ static void dist_free(dist *d) {
   phgmg_mpi_ctx_destroy(d->c);
 }
 
-/* Largest |A - d_i d_j B| / max |B| over r x c (d: the modes' signs). */
-static double rel_diff(int r, int c, const double *A, const double *B, const double *di, const double *dj) {
-  double e = 0.0, s = 0.0;
-  int i, j;
-  for (j = 0; j < c; ++j)
-    for (i = 0; i < r; ++i) {
-      e = fmax(e, fabs(di[i] * (dj ? dj[j] : 1.0) * A[i + (size_t)j * r] - B[i + (size_t)j * r]));
-      s = fmax(s, fabs(B[i + (size_t)j * r]));
-    }
-  return s > 0.0 ? e / s : e;
-}
 
 /* The serial singular values of the snapshots (adj: of the adjusted ones X - QB QB^T X). */
 static void serial_sigma(const chain *ch, int ns, const double *X, int k, int adj, double *S) {
@@ -265,20 +231,6 @@ static double online_diff(const phgmg_rom *a, const phgmg_rom *b, const double *
   return ok ? ey / sy : HUGE_VAL;
 }
 
-/* The signs of the modes of basis V0f (N x r) against the serial model's
-   (lifts of unit vectors). */
-static void mode_signs(const phgmg_reduced *red, int N, int r, const double *V0f, double *sg) {
-  double *col = (double *)malloc(sizeof(double) * (size_t)N), xr[64];
-  int i, j;
-  for (j = 0; j < r; ++j) {
-    double dot = 0.0;
-    memset(xr, 0, sizeof xr); xr[j] = 1.0;
-    phgmg_reduced_lift(red, xr, col);
-    for (i = 0; i < N; ++i) dot += col[i] * V0f[i + (size_t)j * N];
-    sg[j] = dot < 0.0 ? -1.0 : 1.0;
-  }
-  free(col);
-}
 
 /* Scale mode: how far the serial model itself moves when every snapshot
    entry is changed by one unit in the last place (random signs), far below
@@ -470,7 +422,7 @@ static void test_gmg_pod_ecsw(int n, int r) {
   int i;
   chain_build(&ch, n, 0);
   for (i = 0; i < n; ++i) x0[2 * i] = 0.8 * sin(3.0 * 3.14159265358979 * i / n) + 0.3 * sin(7.0 * 3.14159265358979 * i / n);
-  simulate_root(&ch, x0, 0.2, ns, X);
+  simulate_root(&ch.sys, x0, 0.2, ns, X);
   memset(&o, 0, sizeof o);
   o.method = PHGMG_METHOD_GMG_POD; o.r = r; o.hyper.on = 1; o.hyper.kind = PHGMG_HYPER_ECSW; o.hyper.tol = 1e-3;
   dist_build(&d, &ch, ns, X);
@@ -607,7 +559,7 @@ static void test_screened(void) {
   int i;
   chain_build(&ch, n, 1);
   for (i = 0; i < n; ++i) x0[2 * i] = 0.8 * sin(3.0 * 3.14159265358979 * i / n);
-  simulate_root(&ch, x0, 0.2, ns, X);
+  simulate_root(&ch.sys, x0, 0.2, ns, X);
   memset(&o, 0, sizeof o);
   o.method = PHGMG_METHOD_GMG_POD; o.r = r; o.hyper.on = 1; o.hyper.tol = 1e-3;
   dist_build(&d, &ch, ns, X);
@@ -860,7 +812,7 @@ static void test_gmg_qm(int n, int r) {
     chain_build(&ch, n, 0);
     if (lin) { ch.sys.nl = PHGMG_NL_NONE; ch.sys.nsep = 0; }
     for (i = 0; i < n; ++i) x0[2 * i] = 0.8 * sin(3.0 * 3.14159265358979 * i / n) + 0.3 * sin(7.0 * 3.14159265358979 * i / n);
-    simulate_root(&ch, x0, 0.2, ns, X);
+    simulate_root(&ch.sys, x0, 0.2, ns, X);
     dist_build(&d, &ch, ns, X);
     if (lin) d.md.nsep = 0;
     V0 = (double *)malloc(sizeof(double) * (size_t)d.ld * r);
@@ -983,7 +935,7 @@ static void test_errors(void) {
   int i, kase;
   chain_build(&ch, n, 0);
   for (i = 0; i < n; ++i) x0[2 * i] = 0.5 * sin(0.1 * i);
-  simulate_root(&ch, x0, 0.2, ns, X);
+  simulate_root(&ch.sys, x0, 0.2, ns, X);
   dist_build(&d, &ch, ns, X);
   memset(&o, 0, sizeof o);
   o.method = PHGMG_METHOD_GMG_POD; o.r = r; o.hyper.on = 1;
@@ -1082,7 +1034,7 @@ static void test_descriptor(void) {
   }
   ch.sys.E = E;
   for (i = 0; i < n; ++i) x0[2 * i] = 0.8 * sin(3.0 * 3.14159265358979 * i / n) + 0.3 * sin(7.0 * 3.14159265358979 * i / n);
-  simulate_root(&ch, x0, 0.2, ns, X);
+  simulate_root(&ch.sys, x0, 0.2, ns, X);
   memset(&o, 0, sizeof o);
   o.method = PHGMG_METHOD_GMG_POD; o.r = r; o.hyper.on = 1; o.hyper.kind = PHGMG_HYPER_ECSW; o.hyper.tol = 1e-3;
   dist_build(&d, &ch, ns, X);
@@ -1165,7 +1117,7 @@ static void test_algebraic(void) {
     if (ALG(i)) AT(Ef, 2 * i + 1, 2 * i + 1) = 1.0;
   ch.sys.E = E;
   for (i = 0; i < n; ++i) x0[2 * i] = 0.8 * sin(3.0 * 3.14159265358979 * i / n) + 0.3 * sin(7.0 * 3.14159265358979 * i / n);
-  simulate_root(&ch, x0, 0.2, ns, X);
+  simulate_root(&ch.sys, x0, 0.2, ns, X);
   memset(&o, 0, sizeof o);
   o.method = PHGMG_METHOD_GMG_POD; o.r = r; o.hyper.on = 1; o.hyper.kind = PHGMG_HYPER_ECSW; o.hyper.tol = 1e-3;
   dist_build(&d, &ch, ns, X);

@@ -4,6 +4,7 @@
    rank 2 owning no rows. Also: the communication counts of the streaming
    POD, Cholesky-QR and V^T A V do not depend on N. Exit status 0 iff every
    check passed on every rank. Built with mpicc (make test-mpi). */
+#define _POSIX_C_SOURCE 199309L   /* nanosleep (mpi_harness.h) */
 #define PHGMG_MPI
 #define PHGMG_IMPLEMENTATION
 #include "../../phgmg.h"
